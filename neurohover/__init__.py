@@ -1,0 +1,23 @@
+"""neurohover: generalized helicopter hovering (Koppejan & Whiteson 2011), fast and faithful.
+
+Data flows one way: task family -> MDP -> batched rollouts of policies -> returns and flight data
+-> evolution / model learning -> agents -> experiments.
+"""
+
+from __future__ import annotations
+
+from .errors import NeurohoverError
+from .evaluate import Evaluation, PolicyTable, Safeguard, evaluate, evaluate_jobs
+from .flightdata import FlightData
+from .policies import Policy, baseline_policy, load_policy, prototype, save_policy
+from .tasks import FGHH, GHH08, GHH09, MDP, get_task_family
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "FGHH", "GHH08", "GHH09", "MDP", "Evaluation", "FlightData", "NeurohoverError", "Policy",
+    "PolicyTable", "Safeguard", "baseline_policy", "evaluate", "evaluate_jobs", "get_task_family",
+    "load_policy", "prototype", "save_policy",
+]
+
+from . import envs as _envs  # noqa: E402,F401  (registers the Gymnasium environments)

@@ -1,0 +1,288 @@
+"""Batched evaluation: fly many (policy, MDP, episode) jobs in parallel through the kernel.
+
+Every episode draws its gust noise from its own stream derived from (seed, episode index), so a
+result never depends on batch size, order or thread count. Jobs with the same episode index see
+the same noise (common random numbers), which makes comparisons between policies fairer.
+
+Example
+-------
+>>> from neurohover import evaluate, baseline_policy, get_task_family
+>>> ev = evaluate([baseline_policy()], get_task_family("ghh08").training_mdps(), episodes=2, seed=1)
+>>> ev.returns.shape            # (policies, MDPs, episodes)
+(1, 10, 2)
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from .errors import NeurohoverError
+from .flightdata import FlightData
+from .policies import GENOME_LENGTH, TOPOLOGIES, Policy
+from .sim.constants import EPISODE_STEPS, MDP_ROW_LEN, SAFEGUARD_LIMITS
+from .sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
+from .tasks import MDP
+
+_KIND = {"slp": POLICY_SLP, "mlp": POLICY_MLP}
+_MAX_SEED = 2**63 - 1
+
+
+@dataclass(frozen=True)
+class PolicyTable:
+    """Policies as the kernel reads them: a kind per row and genomes padded to 42 columns."""
+
+    kinds: np.ndarray  # (P,) int64
+    genomes: np.ndarray  # (P, 42) float64
+
+    @classmethod
+    def from_policies(cls, policies: Sequence[Policy]) -> "PolicyTable":
+        if len(policies) == 0:
+            raise NeurohoverError("no policies given: need at least one")
+        kinds = np.array([_KIND[p.topology] for p in policies], dtype=np.int64)
+        genomes = np.zeros((len(policies), GENOME_WIDTH))
+        for i, p in enumerate(policies):
+            genomes[i, : p.genome.size] = p.genome
+        return cls(kinds, genomes)
+
+    @classmethod
+    def from_genomes(cls, genomes: np.ndarray, topology: str) -> "PolicyTable":
+        """A table of genomes (P, D) of one topology (the evolution fast path)."""
+        if topology not in TOPOLOGIES:
+            raise NeurohoverError(f"unknown policy topology {topology!r}: allowed {', '.join(TOPOLOGIES)}")
+        g = np.asarray(genomes, dtype=float)
+        n = GENOME_LENGTH[topology]
+        if g.ndim != 2 or g.shape[1] != n or g.shape[0] == 0:
+            raise NeurohoverError(f"{topology} genomes must be an array of shape (P >= 1, {n}), got {g.shape}")
+        table = np.zeros((g.shape[0], GENOME_WIDTH))
+        table[:, :n] = g
+        return cls(np.full(g.shape[0], _KIND[topology], dtype=np.int64), table)
+
+    def __len__(self) -> int:
+        return self.kinds.shape[0]
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """Outcome of a batch of episodes; arrays share the shape of the jobs.
+
+    Attributes
+    ----------
+    returns : numpy.ndarray
+        Undiscounted return of each episode (minus the paper's "error").
+    crashed : numpy.ndarray of bool
+    steps : numpy.ndarray of int
+        Control steps flown (6000 for a full episode; the crashing step counts).
+    safeguard_step : numpy.ndarray of int
+        Control step at which the safeguard handed over to the fallback, or -1.
+    flight_data : FlightData or None
+        Flight data of the recorded episodes, in job order.
+    seconds : float
+        Wall time of the kernel call.
+    """
+
+    returns: np.ndarray
+    crashed: np.ndarray
+    steps: np.ndarray
+    safeguard_step: np.ndarray
+    flight_data: FlightData | None
+    seconds: float
+
+    @property
+    def episodes(self) -> int:
+        return int(self.returns.size)
+
+    @property
+    def episodes_per_second(self) -> float:
+        return self.episodes / self.seconds if self.seconds > 0 else float("inf")
+
+    def reshape(self, shape: tuple[int, ...]) -> "Evaluation":
+        return Evaluation(self.returns.reshape(shape), self.crashed.reshape(shape), self.steps.reshape(shape),
+                          self.safeguard_step.reshape(shape), self.flight_data, self.seconds)
+
+
+@contextlib.contextmanager
+def num_threads(threads: int | None) -> Iterator[None]:
+    """Run the kernel on ``threads`` threads (None: all cores) inside the block."""
+    if threads is None:
+        yield
+        return
+    limit = numba.config.NUMBA_NUM_THREADS
+    if not isinstance(threads, int) or not 1 <= threads <= limit:
+        raise NeurohoverError(f"threads={threads!r} is out of range: allowed 1..{limit} on this machine")
+    previous = numba.get_num_threads()
+    numba.set_num_threads(threads)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(previous)
+
+
+def mdp_rows(mdps: MDP | Sequence[MDP] | np.ndarray) -> np.ndarray:
+    """MDPs as the (M, 28) float64 array the kernel reads."""
+    if isinstance(mdps, MDP):
+        return mdps.row()[None, :]
+    if isinstance(mdps, np.ndarray):
+        if mdps.ndim != 2 or mdps.shape[1] != MDP_ROW_LEN or not np.all(np.isfinite(mdps)):
+            raise NeurohoverError(f"MDP rows must be a finite array of shape (M, {MDP_ROW_LEN}), got {mdps.shape}")
+        return np.ascontiguousarray(mdps, dtype=float)
+    if len(mdps) == 0 or not all(isinstance(m, MDP) for m in mdps):
+        raise NeurohoverError("mdps must be an MDP or a non-empty sequence of MDPs")
+    return np.stack([m.row() for m in mdps])
+
+
+def _index_array(values, n_jobs: int | None, upper: int | None, what: str) -> np.ndarray:
+    arr = np.asarray(values)
+    if arr.size and not np.issubdtype(arr.dtype, np.integer):
+        raise NeurohoverError(f"{what} must hold integers, got dtype {arr.dtype}")
+    arr = arr.astype(np.int64).reshape(-1)
+    if n_jobs is not None and arr.shape[0] != n_jobs:
+        raise NeurohoverError(f"{what} has {arr.shape[0]} entries but there are {n_jobs} jobs")
+    if arr.size and arr.min() < (0 if upper is not None else 0):
+        raise NeurohoverError(f"{what} holds negative values (min {arr.min()}); allowed >= 0")
+    if upper is not None and arr.size and arr.max() >= upper:
+        raise NeurohoverError(f"{what} holds {arr.max()}, out of range: allowed 0..{upper - 1}")
+    return arr
+
+
+def evaluate_jobs(
+    policies: Sequence[Policy] | PolicyTable,
+    mdps: MDP | Sequence[MDP] | np.ndarray,
+    policy_index,
+    mdp_index,
+    episode_index,
+    *,
+    seed: int = 0,
+    fallback_index=None,
+    safeguard_limits: Sequence[float] | None = None,
+    record=None,
+    n_steps: int = EPISODE_STEPS,
+    threads: int | None = None,
+) -> Evaluation:
+    """Fly the jobs ``(policy_index[j], mdp_index[j], episode_index[j])`` in parallel.
+
+    Parameters
+    ----------
+    policies : sequence of Policy or PolicyTable
+    mdps : MDP, sequence of MDP, or (M, 28) array of MDP rows
+    policy_index, mdp_index, episode_index : array_like of int, shape (J,)
+        Which policy flies which MDP, and the episode index that (with ``seed``) fixes the noise.
+    seed : int
+        Root seed of every episode's noise stream.
+    fallback_index : array_like of int, optional
+        Per job, the policy the safeguard hands control to (-1: no safeguard for that job).
+    safeguard_limits : sequence of 9 floats, optional
+        Limits of the dangerous-state test on (u, v, w, x, y, z, p, q, r); default 0.5 each.
+    record : array_like of bool, optional
+        Per job, whether to record its flight data.
+    n_steps : int
+        Control steps per episode (6000 in the benchmark).
+    threads : int, optional
+        Kernel threads (default: all cores). Results do not depend on it.
+    """
+    table = policies if isinstance(policies, PolicyTable) else PolicyTable.from_policies(policies)
+    rows = mdp_rows(mdps)
+    if not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= _MAX_SEED:
+        raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer in 0..2**63-1")
+    if not isinstance(n_steps, (int, np.integer)) or not 1 <= n_steps <= 10**7:
+        raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..10000000")
+    p_idx = _index_array(policy_index, None, len(table), "policy_index")
+    n_jobs = p_idx.shape[0]
+    m_idx = _index_array(mdp_index, n_jobs, rows.shape[0], "mdp_index")
+    e_idx = _index_array(episode_index, n_jobs, None, "episode_index")
+    if fallback_index is None:
+        fb = np.full(n_jobs, -1, dtype=np.int64)
+    else:
+        fb = np.asarray(fallback_index, dtype=np.int64).reshape(-1)
+        if fb.shape[0] != n_jobs or (fb.size and (fb.min() < -1 or fb.max() >= len(table))):
+            raise NeurohoverError(f"fallback_index must have {n_jobs} entries in -1..{len(table) - 1}")
+    limits = SAFEGUARD_LIMITS if safeguard_limits is None else np.asarray(safeguard_limits, dtype=float)
+    if limits.shape != (9,) or not np.all(limits > 0):
+        raise NeurohoverError(f"safeguard_limits must be 9 positive numbers (u, v, w, x, y, z, p, q, r), got {limits.tolist()}")
+    rec = np.zeros(n_jobs, dtype=bool) if record is None else np.asarray(record, dtype=bool).reshape(-1)
+    if rec.shape[0] != n_jobs:
+        raise NeurohoverError(f"record must have one flag per job ({n_jobs}), got {rec.shape[0]}")
+    slots = np.full(n_jobs, -1, dtype=np.int64)
+    slots[rec] = np.arange(int(rec.sum()))
+    n_rec = int(rec.sum())
+    obs_out = np.zeros((n_rec, n_steps + 1, 12))
+    act_out = np.zeros((n_rec, n_steps, 4))
+    returns = np.empty(n_jobs)
+    crashed = np.empty(n_jobs, dtype=np.bool_)
+    steps = np.empty(n_jobs, dtype=np.int64)
+    sg_step = np.empty(n_jobs, dtype=np.int64)
+    start = time.perf_counter()
+    with num_threads(threads):
+        rollout_batch(
+            rows, table.kinds, table.genomes, p_idx, m_idx, e_idx, fb, np.uint64(seed), n_steps,
+            bool((fb >= 0).any()), limits, slots, obs_out, act_out, returns, crashed, steps, sg_step,
+        )
+    seconds = time.perf_counter() - start
+    flight = None
+    if n_rec:
+        rec_steps = steps[rec]
+        flight = FlightData(
+            tuple(obs_out[i, : rec_steps[i] + 1].copy() for i in range(n_rec)),
+            tuple(act_out[i, : rec_steps[i]].copy() for i in range(n_rec)),
+        )
+    return Evaluation(returns, crashed, steps, sg_step, flight, seconds)
+
+
+def evaluate(
+    policies: Policy | Sequence[Policy] | PolicyTable,
+    mdps: MDP | Sequence[MDP] | np.ndarray,
+    *,
+    episodes: int = 1,
+    seed: int = 0,
+    first_episode: int = 0,
+    record: bool = False,
+    safeguard: "Safeguard | None" = None,
+    n_steps: int = EPISODE_STEPS,
+    threads: int | None = None,
+) -> Evaluation:
+    """Fly every policy on every MDP for ``episodes`` episodes; arrays are shaped (P, M, E).
+
+    Episode e on MDP m has episode index ``first_episode + m * episodes + e`` for every policy,
+    so all policies meet the same gusts.
+    """
+    if isinstance(policies, Policy):
+        policies = [policies]
+    table = policies if isinstance(policies, PolicyTable) else PolicyTable.from_policies(list(policies))
+    rows = mdp_rows(mdps)
+    if not isinstance(episodes, (int, np.integer)) or episodes < 1:
+        raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
+    if not isinstance(first_episode, (int, np.integer)) or first_episode < 0:
+        raise NeurohoverError(f"first_episode={first_episode!r} is out of range: allowed an integer >= 0")
+    n_pol, n_mdp = len(table), rows.shape[0]
+    p_idx, m_idx, e = np.meshgrid(np.arange(n_pol), np.arange(n_mdp), np.arange(episodes), indexing="ij")
+    episode_index = first_episode + m_idx * episodes + e
+    fallback = None
+    limits = None
+    if safeguard is not None:
+        table = PolicyTable(np.append(table.kinds, _KIND[safeguard.fallback.topology]),
+                            np.vstack([table.genomes, PolicyTable.from_policies([safeguard.fallback]).genomes]))
+        fallback = np.full(p_idx.size, n_pol, dtype=np.int64)
+        limits = safeguard.limits
+    ev = evaluate_jobs(
+        table, rows, p_idx.ravel(), m_idx.ravel(), episode_index.ravel(), seed=seed,
+        fallback_index=fallback, safeguard_limits=limits,
+        record=np.full(p_idx.size, record), n_steps=n_steps, threads=threads,
+    )
+    return ev.reshape((n_pol, n_mdp, episodes))
+
+
+@dataclass(frozen=True)
+class Safeguard:
+    """The hybrid agent's safeguard: on a dangerous state, ``fallback`` flies the rest of the episode.
+
+    ``limits`` bound |u|, |v|, |w|, |x|, |y|, |z|, |p|, |q|, |r| of the observation (SPEC section 7:
+    0.5 each).
+    """
+
+    fallback: Policy
+    limits: tuple[float, ...] = tuple(SAFEGUARD_LIMITS)

@@ -1,0 +1,87 @@
+"""Flight data: observations and actions of flown episodes at 10 Hz (SPEC section 6).
+
+Saved as a NumPy ``.npz`` archive with a format tag, the episodes concatenated and their
+lengths kept, so a file of any number of episodes loads back exactly.
+"""
+
+from __future__ import annotations
+
+import json
+import zipfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .errors import NeurohoverError
+
+FORMAT = "neurohover-flight-data/1"
+
+
+@dataclass(frozen=True)
+class FlightData:
+    """Flown episodes: ``observations[i]`` is (steps_i + 1, 12), ``actions[i]`` is (steps_i, 4).
+
+    ``observations[i][k]`` is what the policy saw before choosing ``actions[i][k]`` (the clipped
+    action the simulator applied); the last observation follows the last action.
+    """
+
+    observations: tuple[np.ndarray, ...]
+    actions: tuple[np.ndarray, ...]
+    metadata: dict = field(default_factory=dict, compare=False)
+
+    def __post_init__(self) -> None:
+        if len(self.observations) != len(self.actions):
+            raise NeurohoverError(f"flight data needs one action array per observation array, got {len(self.observations)} and {len(self.actions)}")
+        for i, (obs, act) in enumerate(zip(self.observations, self.actions)):
+            if obs.ndim != 2 or obs.shape[1] != 12 or act.ndim != 2 or act.shape[1] != 4 or obs.shape[0] != act.shape[0] + 1:
+                raise NeurohoverError(f"flight-data episode {i}: observations must be (T+1, 12) and actions (T, 4), got {obs.shape} and {act.shape}")
+
+    @property
+    def n_episodes(self) -> int:
+        return len(self.actions)
+
+    @property
+    def n_transitions(self) -> int:
+        return int(sum(a.shape[0] for a in self.actions))
+
+    def __add__(self, other: "FlightData") -> "FlightData":
+        return FlightData(self.observations + other.observations, self.actions + other.actions, {**self.metadata, **other.metadata})
+
+    def save(self, path: str | Path) -> Path:
+        """Write the flight data to ``path`` (``.npz``)."""
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        lengths = np.array([a.shape[0] for a in self.actions], dtype=np.int64)
+        with open(path, "wb") as f:  # a file object keeps numpy from appending ".npz"
+            np.savez_compressed(
+                f, format=np.array(FORMAT), lengths=lengths,
+                observations=np.concatenate(self.observations) if self.observations else np.zeros((0, 12)),
+                actions=np.concatenate(self.actions) if self.actions else np.zeros((0, 4)),
+                metadata=np.array(json.dumps(self.metadata)),
+            )
+        return path
+
+    @classmethod
+    def load(cls, path: str | Path) -> "FlightData":
+        """Read flight data written by :meth:`save`; other files are refused with a clear message."""
+        path = Path(path)
+        if not path.is_file():
+            raise NeurohoverError(f"flight-data file {str(path)!r} does not exist")
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                if "format" not in z.files or str(z["format"]) != FORMAT:
+                    raise NeurohoverError(f"{str(path)!r} is not a neurohover flight-data file (expected format {FORMAT})")
+                lengths, obs, act = z["lengths"], z["observations"], z["actions"]
+                metadata = json.loads(str(z["metadata"]))
+        except (OSError, ValueError, zipfile.BadZipFile, EOFError, KeyError) as err:
+            if isinstance(err, NeurohoverError):
+                raise
+            raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file ({type(err).__name__}: {err})") from None
+        if lengths.size == 0 or lengths.sum() == 0:
+            raise NeurohoverError(f"flight-data file {str(path)!r} holds no transitions")
+        if obs.shape != (int(lengths.sum() + lengths.size), 12) or act.shape != (int(lengths.sum()), 4):
+            raise NeurohoverError(f"flight-data file {str(path)!r} is truncated or inconsistent: {lengths.size} episodes of {lengths.sum()} steps but arrays {obs.shape} and {act.shape}")
+        obs_split = np.split(obs, np.cumsum(lengths + 1)[:-1])
+        act_split = np.split(act, np.cumsum(lengths)[:-1])
+        return cls(tuple(obs_split), tuple(act_split), metadata)

@@ -1,0 +1,209 @@
+"""Generic policies: the baseline, SLP and MLP networks, genomes and policy files (SPEC section 3).
+
+Networks see 9 of the 12 observation entries (u, v, w, x, y, z, qx, qy, qz) and output the four
+actions (aileron, elevator, rudder, collective). A genome is the flat vector of a network's weights
+and biases in SPEC's fixed order, so policies can be exchanged between tools.
+
+Policy files are JSON: ``{"topology": "slp" | "mlp", "genome": [...]}`` plus optional metadata
+keys. The name ``baseline`` stands for the competition's baseline policy wherever a file is taken.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .errors import NeurohoverError
+
+TOPOLOGIES = ("slp", "mlp")
+GENOME_LENGTH = {"slp": 40, "mlp": 42}
+INPUT_NAMES = ("u", "v", "w", "x", "y", "z", "qx", "qy", "qz")
+MLP_STEEPNESS = 4.924273
+MLP_BIAS_NAMES = ("hy", "hx", "hz", "L1", "L2", "L3", "L4", "S1", "S2", "S3", "S4", "a1", "a2", "a3", "a4")
+MLP_WEIGHT_NAMES = (
+    "y->hy", "x->hx", "z->hz",
+    "v->L1", "y->L1", "qx->L1", "hy->L1",
+    "u->L2", "x->L2", "qy->L2", "hx->L2",
+    "qz->L3",
+    "w->L4", "z->L4", "hz->L4",
+    "L1->S1", "L2->S2", "L3->S3", "L4->S4",
+    "L1->a1", "S1->a1", "L2->a2", "S2->a2", "L3->a3", "S3->a3", "L4->a4", "S4->a4",
+)
+MLP_GENE_NAMES = tuple(f"b:{n}" for n in MLP_BIAS_NAMES) + tuple(f"w:{n}" for n in MLP_WEIGHT_NAMES)
+
+# The competition's baseline policy: gains per (action, input) and output biases.
+BASELINE_GAINS = {
+    ("a1", "y"): -0.0196, ("a1", "v"): -0.0367, ("a1", "qx"): -0.7475,
+    ("a2", "x"): -0.0185, ("a2", "u"): -0.0322, ("a2", "qy"): 0.7904,
+    ("a3", "qz"): -0.1969,
+    ("a4", "z"): 0.0513, ("a4", "w"): 0.1348,
+}
+BASELINE_BIASES = (0.02, 0.0, 0.0, 0.23)
+
+
+def _sigmoid(s: float) -> float:
+    # Clamp the exponent so extreme genomes saturate instead of overflowing.
+    return 1.0 / (1.0 + math.exp(min(700.0, -MLP_STEEPNESS * s)))
+
+
+@dataclass(frozen=True)
+class Policy:
+    """A generic policy: topology and genome, plus free-form metadata.
+
+    Attributes
+    ----------
+    topology : {"slp", "mlp"}
+    genome : numpy.ndarray
+        Float64 vector of ``GENOME_LENGTH[topology]`` genes in SPEC's order (read-only).
+    metadata : dict
+        Anything worth keeping with the policy (task, MDP, score, how it was made).
+    """
+
+    topology: str
+    genome: np.ndarray
+    metadata: dict = field(default_factory=dict, compare=False)
+
+    def __post_init__(self) -> None:
+        if self.topology not in TOPOLOGIES:
+            raise NeurohoverError(f"unknown policy topology {self.topology!r}: allowed {', '.join(TOPOLOGIES)}")
+        genome = check_genome(self.genome, self.topology)
+        genome.setflags(write=False)
+        object.__setattr__(self, "genome", genome)
+
+    def act(self, observation: Sequence[float]) -> tuple[float, float, float, float]:
+        """Actions for a 12-number observation, computed in plain Python (the readable definition)."""
+        u, v, w, x, y, z, _p, _q, _r, qx, qy, qz = (float(o) for o in observation)
+        g = self.genome.tolist()
+        if self.topology == "slp":
+            inputs = (u, v, w, x, y, z, qx, qy, qz)
+            return tuple(  # type: ignore[return-value]
+                sum(g[9 * i + j] * inputs[j] for j in range(9)) + g[36 + i] for i in range(4)
+            )
+        b, wt = g[:15], g[15:]
+        hy = _sigmoid(b[0] + wt[0] * y)
+        hx = _sigmoid(b[1] + wt[1] * x)
+        hz = _sigmoid(b[2] + wt[2] * z)
+        l1 = b[3] + wt[3] * v + wt[4] * y + wt[5] * qx + wt[6] * hy
+        l2 = b[4] + wt[7] * u + wt[8] * x + wt[9] * qy + wt[10] * hx
+        l3 = b[5] + wt[11] * qz
+        l4 = b[6] + wt[12] * w + wt[13] * z + wt[14] * hz
+        s1, s2, s3, s4 = (_sigmoid(b[7 + k] + wt[15 + k] * lk) for k, lk in enumerate((l1, l2, l3, l4)))
+        return (
+            b[11] + wt[19] * l1 + wt[20] * s1,
+            b[12] + wt[21] * l2 + wt[22] * s2,
+            b[13] + wt[23] * l3 + wt[24] * s3,
+            b[14] + wt[25] * l4 + wt[26] * s4,
+        )
+
+    def with_genome(self, genome: np.ndarray, **metadata) -> "Policy":
+        """A policy of the same topology with another genome."""
+        return Policy(self.topology, np.array(genome, dtype=float), {**self.metadata, **metadata})
+
+
+def check_genome(genome, topology: str) -> np.ndarray:
+    """Return ``genome`` as a float64 vector of the topology's length, or raise a clear error."""
+    try:
+        arr = np.array(genome, dtype=float).reshape(-1) if np.ndim(genome) <= 1 else np.array(genome, dtype=float)
+    except (TypeError, ValueError):
+        raise NeurohoverError(f"a {topology} genome must be a list of numbers, got {genome!r:.80}") from None
+    n = GENOME_LENGTH[topology]
+    if arr.ndim != 1 or arr.shape[0] != n:
+        raise NeurohoverError(f"a {topology} genome has {n} genes, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise NeurohoverError(f"a {topology} genome must hold finite numbers; genes {np.flatnonzero(~np.isfinite(arr)).tolist()} are not")
+    return arr
+
+
+def zero_genome(topology: str) -> np.ndarray:
+    """The all-zero prototype of a topology."""
+    if topology not in TOPOLOGIES:
+        raise NeurohoverError(f"unknown policy topology {topology!r}: allowed {', '.join(TOPOLOGIES)}")
+    return np.zeros(GENOME_LENGTH[topology])
+
+
+def slp_baseline_genome() -> np.ndarray:
+    """SLP genome that acts exactly like the baseline policy."""
+    g = np.zeros(40)
+    for (action, inp), gain in BASELINE_GAINS.items():
+        g[9 * (int(action[1]) - 1) + INPUT_NAMES.index(inp)] = gain
+    g[36:40] = BASELINE_BIASES
+    return g
+
+
+def mlp_baseline_genome() -> np.ndarray:
+    """MLP genome that acts exactly like the baseline policy (SPEC: gains on the input-to-sum
+    weights, every Lk -> ak weight 1, output biases (0.02, 0, 0, 0.23), everything else 0)."""
+    g = np.zeros(42)
+    index = {name: 15 + i for i, name in enumerate(MLP_WEIGHT_NAMES)}
+    for (action, inp), gain in BASELINE_GAINS.items():
+        g[index[f"{inp}->L{action[1]}"]] = gain
+    for k in range(1, 5):
+        g[index[f"L{k}->a{k}"]] = 1.0
+    g[11:15] = BASELINE_BIASES
+    return g
+
+
+def baseline_policy() -> Policy:
+    """The competition's baseline policy (an SLP with the baseline gains)."""
+    return Policy("slp", slp_baseline_genome(), {"name": "baseline"})
+
+
+def prototype(topology: str, seed: str = "baseline") -> Policy:
+    """A prototype network: ``seed`` is ``"zero"`` or ``"baseline"`` (baseline-equivalent)."""
+    if seed == "zero":
+        return Policy(topology, zero_genome(topology), {"prototype": "zero"})
+    if seed == "baseline":
+        genome = slp_baseline_genome() if topology == "slp" else mlp_baseline_genome()
+        return Policy(topology, genome, {"prototype": "baseline"})
+    raise NeurohoverError(f"unknown prototype {seed!r}: allowed zero, baseline")
+
+
+def policy_to_dict(policy: Policy) -> dict:
+    return {"topology": policy.topology, "genome": policy.genome.tolist(), **policy.metadata}
+
+
+def policy_from_dict(d: dict, source: str = "policy") -> Policy:
+    """Build a policy from a dict in the policy-file format."""
+    if not isinstance(d, dict):
+        raise NeurohoverError(f"{source}: a policy must be a JSON object with keys 'topology' and 'genome'")
+    missing = [k for k in ("topology", "genome") if k not in d]
+    if missing:
+        raise NeurohoverError(f"{source}: missing key(s) {', '.join(missing)}; a policy file needs 'topology' (slp|mlp) and 'genome'")
+    if d["topology"] not in TOPOLOGIES:
+        raise NeurohoverError(f"{source}: unknown topology {d['topology']!r}: allowed {', '.join(TOPOLOGIES)}")
+    if not isinstance(d["genome"], list) or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in d["genome"]):
+        raise NeurohoverError(f"{source}: 'genome' must be a list of numbers")
+    try:
+        metadata = {k: v for k, v in d.items() if k not in ("topology", "genome")}
+        return Policy(d["topology"], np.array(d["genome"], dtype=float), metadata)
+    except NeurohoverError as err:
+        raise NeurohoverError(f"{source}: {err}") from None
+
+
+def load_policy(source: str | Path) -> Policy:
+    """Load a policy file (JSON), or the baseline policy for the name ``baseline``."""
+    if str(source) == "baseline":
+        return baseline_policy()
+    path = Path(source)
+    if not path.is_file():
+        raise NeurohoverError(f"policy file {str(path)!r} does not exist (give a JSON policy file or 'baseline')")
+    try:
+        data = json.loads(path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as err:
+        raise NeurohoverError(f"policy file {str(path)!r} is not valid JSON: {err}") from None
+    return policy_from_dict(data, f"policy file {str(path)!r}")
+
+
+def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
+    """Write ``policy`` (and extra metadata) as a JSON policy file; returns the path."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    data = policy_to_dict(policy)
+    data.update(metadata)
+    path.write_text(json.dumps(data, indent=1) + "\n")
+    return path

@@ -1,0 +1,70 @@
+"""Constants of the XCell Tempest hover model (SPEC section 1) and the MDP row layout.
+
+An MDP reaches the compiled kernel as one float64 row of ``MDP_ROW_LEN`` numbers, so a batch of
+MDPs (task-family MDPs or learned models) is a plain 2-D array.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+# Dynamics parameters in row order (the paper's Table 5 calls them C and D; D_u is always 0).
+PARAM_NAMES: tuple[str, ...] = (
+    "C_u", "C_v", "D_v", "C_w", "D_w", "C_p", "D_p", "C_q", "D_q", "C_r", "D_r",
+)
+DEFAULT_PARAMS = np.array(
+    [-0.18, -0.43, -0.54, -0.49, -42.15, -12.78, 33.04, -10.12, -33.32, -8.16, 70.54]
+)
+NOISE_NAMES: tuple[str, ...] = ("u", "v", "w", "p", "q", "r")
+DEFAULT_NOISE_STD = np.array([0.1941, 0.2975, 0.6058, 0.1508, 0.2492, 0.0734])
+
+GRAVITY = 9.81
+CONTROL_DT = 0.1
+SUBSTEPS = 10
+SUBSTEP_DT = 0.01
+EPISODE_STEPS = 6000
+NOISE_DECAY = 0.8  # AR(1) gust noise: n <- 0.8 n + 0.2 * N(0,1) * std * 2
+NOISE_GAIN = 0.2 * 2.0
+
+# Crash test limits (checked after the substeps of a control step).
+MAX_VELOCITY = 5.0
+MAX_POSITION = 20.0
+MAX_RATE = 4.0 * math.pi
+MIN_QW = math.cos(math.radians(15.0))  # |qw| below this: more than 30 degrees from level
+
+# Reward of one remaining step at the worst possible state; a crash is charged it for every
+# step left in the episode, including the crashing one.
+CRASH_STEP_PENALTY = (
+    3 * MAX_POSITION**2 + 3 * MAX_RATE**2 + 3 * MAX_VELOCITY**2 + (1.0 - MIN_QW**2)
+)
+
+# Wind models.
+WIND_NONE = 0
+WIND_CONSTANT = 1  # GHH-08: (wind_u, wind_v) in m/s, world frame
+WIND_SINUSOID = 2  # GHH-09: (maxf, freq, phase, center) for x then y, each in [0, 1]
+
+# Layout of an MDP row.
+ROW_PARAMS = slice(0, 11)
+ROW_NOISE = slice(11, 17)
+ROW_SUBSTEPS = 17
+ROW_DT = 18
+ROW_WIND_KIND = 19
+ROW_WIND = slice(20, 28)
+MDP_ROW_LEN = 28
+
+OBS_NAMES: tuple[str, ...] = ("u", "v", "w", "x", "y", "z", "p", "q", "r", "qx", "qy", "qz")
+ACTION_NAMES: tuple[str, ...] = ("aileron", "elevator", "rudder", "collective")
+OBS_DIM = 12
+ACTION_DIM = 4
+STATE_DIM = 13  # world velocity (3), world position (3), body rates (3), quaternion (qx, qy, qz, qw)
+
+# Default dangerous-state test of the safeguard (SPEC section 7): any velocity, position or
+# angular-rate entry of the observation outside [-0.5, 0.5].
+SAFEGUARD_LIMITS = np.full(9, 0.5)
+
+
+def crash_penalty(steps_taken: int, episode_steps: int = EPISODE_STEPS) -> float:
+    """Reward of the crashing control step when ``steps_taken`` steps (including it) were flown."""
+    return -CRASH_STEP_PENALTY * (episode_steps - steps_taken)

@@ -1,0 +1,381 @@
+"""The compiled simulation kernel: one implementation of the hover dynamics for everything.
+
+Evolution, resampling, selection races, learned models, on-line agents and the Gymnasium
+environments all fly helicopters through the functions here. An MDP is a float64 row (layout in
+:mod:`neurohover.sim.constants`) holding dynamics parameters, noise standard deviations, substep
+count and length, and the wind model, so a learned model (one 0.1 s substep, no wind) runs in
+the same code as the true simulator.
+
+Hot-path choices (the physics is exactly SPEC section 1's):
+- state lives in scalars, not arrays, so LLVM keeps it in registers;
+- orientation uses a rotation matrix built once per substep for the three frame changes;
+- the rotation-vector quaternion uses Taylor series of sin(x)/x and cos(x) accurate to double
+  precision for the small angles of hovering flight, and libm beyond them;
+- gust noise comes from a per-episode xoshiro256** stream through a ziggurat.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from .constants import (
+    CRASH_STEP_PENALTY,
+    GRAVITY,
+    MAX_POSITION,
+    MAX_RATE,
+    MAX_VELOCITY,
+    MIN_QW,
+    NOISE_DECAY,
+    NOISE_GAIN,
+    WIND_CONSTANT,
+    WIND_SINUSOID,
+)
+from .rng import next_normal, seed_stream
+
+POLICY_SLP = 0
+POLICY_MLP = 1
+GENOME_WIDTH = 42  # genome rows are padded to the MLP's length
+MLP_STEEPNESS = 4.924273
+SERIES_MAX_ANGLE = 0.5  # Taylor series below this rotation angle, libm above
+
+
+@nb.njit(cache=True, inline="always", fastmath={"contract"})
+def _sigmoid(s: float) -> float:
+    return 1.0 / (1.0 + math.exp(-MLP_STEEPNESS * s))
+
+
+@nb.njit(cache=True, fastmath={"contract"})
+def policy_action(kind, g, u, v, w, x, y, z, qx, qy, qz):
+    """Actions (a1..a4) of a generic policy for the 9 inputs it sees (SPEC section 3)."""
+    if kind == POLICY_SLP:
+        a1 = g[0] * u + g[1] * v + g[2] * w + g[3] * x + g[4] * y + g[5] * z + g[6] * qx + g[7] * qy + g[8] * qz + g[36]
+        a2 = g[9] * u + g[10] * v + g[11] * w + g[12] * x + g[13] * y + g[14] * z + g[15] * qx + g[16] * qy + g[17] * qz + g[37]
+        a3 = g[18] * u + g[19] * v + g[20] * w + g[21] * x + g[22] * y + g[23] * z + g[24] * qx + g[25] * qy + g[26] * qz + g[38]
+        a4 = g[27] * u + g[28] * v + g[29] * w + g[30] * x + g[31] * y + g[32] * z + g[33] * qx + g[34] * qy + g[35] * qz + g[39]
+        return a1, a2, a3, a4
+    # MLP: biases g[0:15] (hy hx hz L1..L4 S1..S4 a1..a4), then the 27 weights of SPEC's order.
+    hy = _sigmoid(g[0] + g[15] * y)
+    hx = _sigmoid(g[1] + g[16] * x)
+    hz = _sigmoid(g[2] + g[17] * z)
+    l1 = g[3] + g[18] * v + g[19] * y + g[20] * qx + g[21] * hy
+    l2 = g[4] + g[22] * u + g[23] * x + g[24] * qy + g[25] * hx
+    l3 = g[5] + g[26] * qz
+    l4 = g[6] + g[27] * w + g[28] * z + g[29] * hz
+    s1 = _sigmoid(g[7] + g[30] * l1)
+    s2 = _sigmoid(g[8] + g[31] * l2)
+    s3 = _sigmoid(g[9] + g[32] * l3)
+    s4 = _sigmoid(g[10] + g[33] * l4)
+    a1 = g[11] + g[34] * l1 + g[35] * s1
+    a2 = g[12] + g[36] * l2 + g[37] * s2
+    a3 = g[13] + g[38] * l3 + g[39] * s3
+    a4 = g[14] + g[40] * l4 + g[41] * s4
+    return a1, a2, a3, a4
+
+
+@nb.njit(cache=True, inline="always", fastmath={"contract"})
+def _clip(a: float) -> float:
+    return min(1.0, max(-1.0, a))
+
+
+@nb.njit(cache=True, inline="always", fastmath={"contract"})
+def _rotation(qx, qy, qz, qw):
+    """Rotation matrix (body to world) of a unit quaternion, row by row."""
+    xx = qx * qx
+    yy = qy * qy
+    zz = qz * qz
+    xy = qx * qy
+    xz = qx * qz
+    yz = qy * qz
+    wx = qw * qx
+    wy = qw * qy
+    wz = qw * qz
+    return (
+        1.0 - 2.0 * (yy + zz), 2.0 * (xy - wz), 2.0 * (xz + wy),
+        2.0 * (xy + wz), 1.0 - 2.0 * (xx + zz), 2.0 * (yz - wx),
+        2.0 * (xz - wy), 2.0 * (yz + wx), 1.0 - 2.0 * (xx + yy),
+    )
+
+
+@nb.njit(cache=True, fastmath={"contract"})
+def observe(s):
+    """The 12-number observation of state tuple ``s`` (world velocity and position into body frame)."""
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = _rotation(s[9], s[10], s[11], s[12])
+    vu, vv, vw, px, py, pz = s[0], s[1], s[2], s[3], s[4], s[5]
+    return (
+        r00 * vu + r10 * vv + r20 * vw,
+        r01 * vu + r11 * vv + r21 * vw,
+        r02 * vu + r12 * vv + r22 * vw,
+        r00 * px + r10 * py + r20 * pz,
+        r01 * px + r11 * py + r21 * pz,
+        r02 * px + r12 * py + r22 * pz,
+        s[6], s[7], s[8], s[9], s[10], s[11],
+    )
+
+
+@nb.njit(cache=True, inline="always", fastmath={"contract"})
+def reward_of(o) -> float:
+    """Minus the sum of squares of the 12 observation entries."""
+    acc = 0.0
+    for i in range(12):
+        acc += o[i] * o[i]
+    return -acc
+
+
+@nb.njit(cache=True, inline="always", fastmath={"contract"})
+def crashed(s) -> bool:
+    """SPEC's crash test on the world-frame state tuple."""
+    return (
+        abs(s[0]) > MAX_VELOCITY or abs(s[1]) > MAX_VELOCITY or abs(s[2]) > MAX_VELOCITY
+        or abs(s[3]) > MAX_POSITION or abs(s[4]) > MAX_POSITION or abs(s[5]) > MAX_POSITION
+        or abs(s[6]) > MAX_RATE or abs(s[7]) > MAX_RATE or abs(s[8]) > MAX_RATE
+        or abs(s[12]) < MIN_QW
+    )
+
+
+@nb.njit(cache=True, inline="always", fastmath={"contract"})
+def dangerous(o, limits) -> bool:
+    """Safeguard test: any velocity, position or rate entry of observation ``o`` beyond its limit."""
+    for i in range(9):
+        if abs(o[i]) > limits[i]:
+            return True
+    return False
+
+
+@nb.njit(cache=True, inline="always", fastmath={"contract"})
+def _half_angle_quaternion(rx, ry, rz):
+    """Unit quaternion (x, y, z, w) of rotation vector (rx, ry, rz), SPEC's small-angle rule included."""
+    theta2 = rx * rx + ry * ry + rz * rz
+    if theta2 < 1e-8:  # angle below 1e-4
+        hx = 0.5 * rx
+        hy = 0.5 * ry
+        hz = 0.5 * rz
+        return hx, hy, hz, math.sqrt(1.0 - (hx * hx + hy * hy + hz * hz))
+    x2 = 0.25 * theta2  # (theta/2)^2
+    if theta2 < 1e-4:  # angle below 0.01 (steady hover): remainders below 1e-17
+        sinc = 1.0 + x2 * (-1.0 / 6 + x2 * (1.0 / 120))
+        cos = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24 + x2 * (-1.0 / 720)))
+        k = 0.5 * sinc
+        return k * rx, k * ry, k * rz, cos
+    if theta2 < SERIES_MAX_ANGLE * SERIES_MAX_ANGLE:  # remainders below 1e-17
+        sinc = 1.0 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880 + x2 * (-1.0 / 39916800)))))
+        cos = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24 + x2 * (-1.0 / 720 + x2 * (1.0 / 40320 + x2 * (-1.0 / 3628800 + x2 * (1.0 / 479001600))))))
+        k = 0.5 * sinc  # sin(theta/2) / theta
+        return k * rx, k * ry, k * rz, cos
+    theta = math.sqrt(theta2)
+    k = math.sin(0.5 * theta) / theta
+    return k * rx, k * ry, k * rz, math.cos(0.5 * theta)
+
+
+@nb.njit(cache=True, fastmath={"contract"})
+def unpack_mdp(row):
+    """Dynamics, noise, integration and wind settings of an MDP row as a tuple of scalars."""
+    # Wind as A*sin(omega*t + phi) + c per world axis; constant wind is A = 0.
+    kind = int(row[19])
+    if kind == WIND_SINUSOID:
+        ax = 5.0 * (row[20] - row[23])
+        ox = 20.0 * math.pi * row[21]
+        phx = 2.0 * math.pi * row[22]
+        cx = 5.0 * row[23]
+        ay = 5.0 * (row[24] - row[27])
+        oy = 20.0 * math.pi * row[25]
+        phy = 2.0 * math.pi * row[26]
+        cy = 5.0 * row[27]
+    elif kind == WIND_CONSTANT:
+        ax, ox, phx, cx = 0.0, 0.0, 0.0, row[20]
+        ay, oy, phy, cy = 0.0, 0.0, 0.0, row[21]
+    else:
+        ax, ox, phx, cx, ay, oy, phy, cy = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    wind = (kind, ax, ox, phx, cx, ay, oy, phy, cy)
+    dyn = (row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7], row[8], row[9], row[10])
+    noise_std = (row[11], row[12], row[13], row[14], row[15], row[16])
+    return dyn, noise_std, int(row[17]), row[18], wind
+
+
+@nb.njit(cache=True, inline="always", fastmath={"contract"})
+def update_noise(n, std, z0, z1, z2, z3, z4, z5):
+    """AR(1) gust noise update, once per control step, fed six standard normals."""
+    return (
+        NOISE_DECAY * n[0] + NOISE_GAIN * z0 * std[0],
+        NOISE_DECAY * n[1] + NOISE_GAIN * z1 * std[1],
+        NOISE_DECAY * n[2] + NOISE_GAIN * z2 * std[2],
+        NOISE_DECAY * n[3] + NOISE_GAIN * z3 * std[3],
+        NOISE_DECAY * n[4] + NOISE_GAIN * z4 * std[4],
+        NOISE_DECAY * n[5] + NOISE_GAIN * z5 * std[5],
+    )
+
+
+@nb.njit(cache=True, fastmath={"contract"})
+def integrate(s, n, a1, a2, a3, a4, step, dyn, n_sub, dt, wind):
+    """Advance state tuple ``s`` through the substeps of control step ``step`` (counting from 0)."""
+    c_u, c_v, d_v, c_w, d_w, c_p, d_p, c_q, d_q, c_r, d_r = dyn
+    kind, ax, ox, phx, cx, ay, oy, phy, cy = wind
+    vu, vv, vw, px, py, pz, p, q, r, qx, qy, qz, qw = s
+    # Action and noise terms are constant over the control step.
+    bias_v = d_v + n[1]
+    bias_w = d_w * a4 + n[2]
+    drive_p = d_p * a1 + n[3]
+    drive_q = d_q * a2 + n[4]
+    drive_r = d_r * a3 + n[5]
+    nu = n[0]
+    for i in range(n_sub):
+        px += dt * vu
+        py += dt * vv
+        pz += dt * vw
+        r00, r01, r02, r10, r11, r12, r20, r21, r22 = _rotation(qx, qy, qz, qw)
+        bu = r00 * vu + r10 * vv + r20 * vw
+        bv = r01 * vu + r11 * vv + r21 * vw
+        bw = r02 * vu + r12 * vv + r22 * vw
+        if kind != 0:
+            t = (step * n_sub + i) * dt
+            wu = cx
+            wv = cy
+            if ax != 0.0:
+                wu += ax * math.sin(ox * t + phx)
+            if ay != 0.0:
+                wv += ay * math.sin(oy * t + phy)
+            # The world wind has no vertical component.
+            fu = c_u * (bu + (r00 * wu + r10 * wv)) + nu
+            fv = c_v * (bv + (r01 * wu + r11 * wv)) + bias_v
+        else:
+            fu = c_u * bu + nu
+            fv = c_v * bv + bias_v
+        fw = c_w * bw + bias_w
+        vu += dt * (r00 * fu + r01 * fv + r02 * fw)
+        vv += dt * (r10 * fu + r11 * fv + r12 * fw)
+        vw += dt * (r20 * fu + r21 * fv + r22 * fw + GRAVITY)
+        hx, hy, hz, hw = _half_angle_quaternion(dt * p, dt * q, dt * r)
+        nqw = qw * hw - qx * hx - qy * hy - qz * hz
+        nqx = qw * hx + qx * hw + qy * hz - qz * hy
+        nqy = qw * hy - qx * hz + qy * hw + qz * hx
+        nqz = qw * hz + qx * hy - qy * hx + qz * hw
+        qx, qy, qz, qw = nqx, nqy, nqz, nqw
+        p += dt * (c_p * p + drive_p)
+        q += dt * (c_q * q + drive_q)
+        r += dt * (c_r * r + drive_r)
+    return (vu, vv, vw, px, py, pz, p, q, r, qx, qy, qz, qw)
+
+
+@nb.njit(cache=True, parallel=True, fastmath={"contract"})
+def rollout_batch(
+    mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, job_fallback, seed,
+    n_steps, safeguard, limits, record_slot, obs_out, act_out,
+    out_return, out_crashed, out_steps, out_safeguard_step,
+):
+    """Fly every job (policy, MDP, episode) and write its return, crash flag, steps and safeguard step.
+
+    Jobs run in parallel; each draws noise from its own (seed, episode) stream, so results do not
+    depend on the thread count. ``record_slot[j] >= 0`` records job j's flight data there;
+    ``job_fallback[j] >= 0`` with ``safeguard`` hands control to that policy once the state is
+    dangerous. A non-finite action counts as a crash at that step.
+    """
+    n_jobs = job_policy.shape[0]
+    for j in nb.prange(n_jobs):
+        rng = np.empty(4, dtype=np.uint64)
+        seed_stream(rng, np.uint64(seed), np.uint64(job_episode[j]))
+        dyn, std, n_sub, dt, wind = unpack_mdp(mdp_rows[job_mdp[j]])
+        pol = job_policy[j]
+        kind = policy_kinds[pol]
+        g = genomes[pol]
+        fb = job_fallback[j]
+        slot = record_slot[j]
+        s = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)
+        n = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        o = observe(s)
+        total = 0.0
+        crash = False
+        sg_step = -1
+        t = 0
+        for k in range(n_steps):
+            if safeguard and fb >= 0 and sg_step < 0 and dangerous(o, limits):
+                sg_step = k
+                kind = policy_kinds[fb]
+                g = genomes[fb]
+            a1, a2, a3, a4 = policy_action(kind, g, o[0], o[1], o[2], o[3], o[4], o[5], o[9], o[10], o[11])
+            t = k + 1
+            if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
+                if slot >= 0:
+                    for i in range(12):
+                        obs_out[slot, k, i] = o[i]
+                    act_out[slot, k, 0] = a1
+                    act_out[slot, k, 1] = a2
+                    act_out[slot, k, 2] = a3
+                    act_out[slot, k, 3] = a4
+                crash = True
+                total += -CRASH_STEP_PENALTY * (n_steps - t)
+                break
+            a1 = _clip(a1)
+            a2 = _clip(a2)
+            a3 = _clip(a3)
+            a4 = _clip(a4)
+            if slot >= 0:
+                for i in range(12):
+                    obs_out[slot, k, i] = o[i]
+                act_out[slot, k, 0] = a1
+                act_out[slot, k, 1] = a2
+                act_out[slot, k, 2] = a3
+                act_out[slot, k, 3] = a4
+            n = update_noise(n, std, next_normal(rng), next_normal(rng), next_normal(rng),
+                             next_normal(rng), next_normal(rng), next_normal(rng))
+            s = integrate(s, n, a1, a2, a3, a4, k, dyn, n_sub, dt, wind)
+            o = observe(s)
+            if crashed(s):
+                crash = True
+                total += -CRASH_STEP_PENALTY * (n_steps - t)
+                break
+            total += reward_of(o)
+        if slot >= 0:
+            for i in range(12):
+                obs_out[slot, t, i] = o[i]
+        out_return[j] = total
+        out_crashed[j] = crash
+        out_steps[j] = t
+        out_safeguard_step[j] = sg_step
+
+
+
+@nb.njit(cache=True, fastmath={"contract"})
+def step_batch(mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps, obs_out, rew_out, crash_out):
+    """Advance many helicopters by one control step each (the vector environment's kernel).
+
+    ``states`` (N, 13), ``noise`` (N, 6), ``rngs`` (N, 4) and ``steps`` (N,) are updated in place.
+    A non-finite action is a crash charged the full penalty.
+    """
+    for i in range(states.shape[0]):
+        k = steps[i]
+        t = k + 1
+        steps[i] = t
+        a1, a2, a3, a4 = actions[i, 0], actions[i, 1], actions[i, 2], actions[i, 3]
+        if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
+            o = observe((states[i, 0], states[i, 1], states[i, 2], states[i, 3], states[i, 4],
+                         states[i, 5], states[i, 6], states[i, 7], states[i, 8], states[i, 9],
+                         states[i, 10], states[i, 11], states[i, 12]))
+            for m in range(12):
+                obs_out[i, m] = o[m]
+            rew_out[i] = -CRASH_STEP_PENALTY * (n_steps - t)
+            crash_out[i] = True
+            continue
+        dyn, std, n_sub, dt, wind = unpack_mdp(mdp_rows[env_mdp[i]])
+        rng = rngs[i]
+        n = (noise[i, 0], noise[i, 1], noise[i, 2], noise[i, 3], noise[i, 4], noise[i, 5])
+        n = update_noise(n, std, next_normal(rng), next_normal(rng), next_normal(rng),
+                         next_normal(rng), next_normal(rng), next_normal(rng))
+        s = (states[i, 0], states[i, 1], states[i, 2], states[i, 3], states[i, 4], states[i, 5],
+             states[i, 6], states[i, 7], states[i, 8], states[i, 9], states[i, 10], states[i, 11],
+             states[i, 12])
+        s = integrate(s, n, _clip(a1), _clip(a2), _clip(a3), _clip(a4), k, dyn, n_sub, dt, wind)
+        for m in range(13):
+            states[i, m] = s[m]
+        for m in range(6):
+            noise[i, m] = n[m]
+        o = observe(s)
+        for m in range(12):
+            obs_out[i, m] = o[m]
+        if crashed(s):
+            rew_out[i] = -CRASH_STEP_PENALTY * (n_steps - t)
+            crash_out[i] = True
+        else:
+            rew_out[i] = reward_of(o)
+            crash_out[i] = False

@@ -1,0 +1,173 @@
+"""Plain-Python reference simulator, written to be read next to SPEC section 1.
+
+It follows the equations literally (quaternion sandwich products, ``math.sin``/``math.cos``) and
+takes its gust-noise normals as input, so tests can feed it the same normals as the compiled
+kernel (:func:`neurohover.sim.rng.episode_normals`) and compare the two step by step. It is also
+the baseline that ``neurohover bench`` measures the kernel against. Nothing else uses it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+from .constants import (
+    CRASH_STEP_PENALTY,
+    EPISODE_STEPS,
+    GRAVITY,
+    MAX_POSITION,
+    MAX_RATE,
+    MAX_VELOCITY,
+    MIN_QW,
+    WIND_CONSTANT,
+    WIND_SINUSOID,
+)
+
+Vec = tuple[float, float, float]
+Quat = tuple[float, float, float, float]  # (x, y, z, w)
+
+
+def quat_mul(a: Quat, b: Quat) -> Quat:
+    """Hamilton product a * b of quaternions stored as (x, y, z, w)."""
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return (
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+        aw * bw - ax * bx - ay * by - az * bz,
+    )
+
+
+def quat_conj(q: Quat) -> Quat:
+    return (-q[0], -q[1], -q[2], q[3])
+
+
+def rotate(q: Quat, v: Vec) -> Vec:
+    """Rotate v by q (body frame to world frame): q v q*."""
+    x, y, z, _ = quat_mul(quat_mul(q, (v[0], v[1], v[2], 0.0)), quat_conj(q))
+    return (x, y, z)
+
+
+def rotate_inverse(q: Quat, v: Vec) -> Vec:
+    """Rotate v by the inverse of q (world frame to body frame): q* v q."""
+    x, y, z, _ = quat_mul(quat_mul(quat_conj(q), (v[0], v[1], v[2], 0.0)), q)
+    return (x, y, z)
+
+
+def rotation_vector_quaternion(rv: Vec) -> Quat:
+    """Unit quaternion of a rotation vector; first-order form below an angle of 1e-4 (SPEC)."""
+    angle = math.sqrt(rv[0] ** 2 + rv[1] ** 2 + rv[2] ** 2)
+    if angle < 1e-4:
+        half = (rv[0] / 2, rv[1] / 2, rv[2] / 2)
+        return (*half, math.sqrt(1.0 - (half[0] ** 2 + half[1] ** 2 + half[2] ** 2)))
+    s = math.sin(angle / 2) / angle
+    return (rv[0] * s, rv[1] * s, rv[2] * s, math.cos(angle / 2))
+
+
+@dataclass
+class ReferenceMDP:
+    """Everything that fixes an MDP, as plain numbers (see :mod:`neurohover.tasks`)."""
+
+    params: Sequence[float]  # C_u, C_v, D_v, C_w, D_w, C_p, D_p, C_q, D_q, C_r, D_r
+    noise_std: Sequence[float]  # u, v, w, p, q, r
+    wind_kind: int = 0
+    wind: Sequence[float] = (0.0,) * 8
+    substeps: int = 10
+    dt: float = 0.01
+
+    def wind_at(self, t: float) -> Vec:
+        """World-frame wind (m/s) at time t."""
+        if self.wind_kind == WIND_CONSTANT:
+            return (self.wind[0], self.wind[1], 0.0)
+        if self.wind_kind == WIND_SINUSOID:
+            out = []
+            for maxf, freq, phase, center in (self.wind[0:4], self.wind[4:8]):
+                amplitude = 5.0 * (maxf - center)
+                out.append(amplitude * math.sin(20.0 * math.pi * freq * t + 2.0 * math.pi * phase) + 5.0 * center)
+            return (out[0], out[1], 0.0)
+        return (0.0, 0.0, 0.0)
+
+
+@dataclass
+class ReferenceHelicopter:
+    """State of one helicopter in the world frame (north-east-down)."""
+
+    mdp: ReferenceMDP
+    velocity: Vec = (0.0, 0.0, 0.0)
+    position: Vec = (0.0, 0.0, 0.0)
+    rates: Vec = (0.0, 0.0, 0.0)
+    orientation: Quat = (0.0, 0.0, 0.0, 1.0)
+    noise: list[float] = field(default_factory=lambda: [0.0] * 6)
+    steps: int = 0
+    episode_steps: int = EPISODE_STEPS
+
+    def observation(self) -> list[float]:
+        """Body-frame velocity, body-frame position, angular rates, quaternion vector part."""
+        q = self.orientation
+        return [*rotate_inverse(q, self.velocity), *rotate_inverse(q, self.position), *self.rates, *q[:3]]
+
+    def crashed(self) -> bool:
+        return (
+            any(abs(c) > MAX_VELOCITY for c in self.velocity)
+            or any(abs(c) > MAX_POSITION for c in self.position)
+            or any(abs(c) > MAX_RATE for c in self.rates)
+            or abs(self.orientation[3]) < MIN_QW
+        )
+
+    def step(self, action: Sequence[float], normals: Sequence[float]) -> tuple[float, bool]:
+        """One 0.1 s control step; returns (reward, crashed)."""
+        self.steps += 1
+        if not all(math.isfinite(a) for a in action):
+            return -CRASH_STEP_PENALTY * (self.episode_steps - self.steps), True
+        a1, a2, a3, a4 = (min(1.0, max(-1.0, a)) for a in action)
+        std = self.mdp.noise_std
+        for i in range(6):
+            self.noise[i] = 0.8 * self.noise[i] + 0.2 * normals[i] * std[i] * 2
+        c_u, c_v, d_v, c_w, d_w, c_p, d_p, c_q, d_q, c_r, d_r = self.mdp.params
+        n_u, n_v, n_w, n_p, n_q, n_r = self.noise
+        dt = self.mdp.dt
+        for i in range(self.mdp.substeps):
+            t = ((self.steps - 1) * self.mdp.substeps + i) * dt
+            self.position = tuple(p + dt * v for p, v in zip(self.position, self.velocity))
+            q = self.orientation
+            vb = rotate_inverse(q, self.velocity)
+            wb = rotate_inverse(q, self.mdp.wind_at(t))
+            force = (
+                c_u * (vb[0] + wb[0]) + n_u,
+                c_v * (vb[1] + wb[1]) + d_v + n_v,
+                c_w * vb[2] + d_w * a4 + n_w,
+            )
+            fw = rotate(q, force)
+            u, v, w = (vel + dt * f for vel, f in zip(self.velocity, fw))
+            self.velocity = (u, v, w + dt * GRAVITY)
+            p, q_rate, r = self.rates
+            self.orientation = quat_mul(q, rotation_vector_quaternion((dt * p, dt * q_rate, dt * r)))
+            self.rates = (
+                p + dt * (c_p * p + d_p * a1 + n_p),
+                q_rate + dt * (c_q * q_rate + d_q * a2 + n_q),
+                r + dt * (c_r * r + d_r * a3 + n_r),
+            )
+        if self.crashed():
+            return -CRASH_STEP_PENALTY * (self.episode_steps - self.steps), True
+        return -sum(o * o for o in self.observation()), False
+
+
+def fly_episode(
+    mdp: ReferenceMDP,
+    policy: Callable[[list[float]], Sequence[float]],
+    normals: Sequence[Sequence[float]],
+    n_steps: int = EPISODE_STEPS,
+) -> tuple[float, bool, list[list[float]]]:
+    """Fly one episode; returns (return, crashed, observations after reset and every step)."""
+    heli = ReferenceHelicopter(mdp, episode_steps=n_steps)
+    observations = [heli.observation()]
+    total = 0.0
+    for k in range(n_steps):
+        reward, crash = heli.step(policy(observations[-1]), normals[k])
+        total += reward
+        observations.append(heli.observation())
+        if crash:
+            return total, True, observations
+    return total, False, observations
