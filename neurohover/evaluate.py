@@ -150,6 +150,20 @@ def _index_array(values, n_jobs: int | None, upper: int | None, what: str) -> np
     return arr
 
 
+_kernel_loaded = False
+
+
+def _load_kernel() -> None:
+    """Load (or compile) the kernel with an empty batch, so ``seconds`` times only flying."""
+    global _kernel_loaded
+    if not _kernel_loaded:
+        empty = np.zeros(0, dtype=np.int64)
+        rollout_batch(np.zeros((1, MDP_ROW_LEN)), np.zeros(1, dtype=np.int64), np.zeros((1, GENOME_WIDTH)),
+                      empty, empty, empty, empty, np.uint64(0), 1, False, SAFEGUARD_LIMITS, empty,
+                      np.zeros((0, 2, 12)), np.zeros((0, 1, 4)), np.zeros(0), np.zeros(0, dtype=np.bool_), empty, empty)
+        _kernel_loaded = True
+
+
 def evaluate_jobs(
     policies: Sequence[Policy] | PolicyTable,
     mdps: MDP | Sequence[MDP] | np.ndarray,
@@ -216,6 +230,7 @@ def evaluate_jobs(
     crashed = np.empty(n_jobs, dtype=np.bool_)
     steps = np.empty(n_jobs, dtype=np.int64)
     sg_step = np.empty(n_jobs, dtype=np.int64)
+    _load_kernel()
     start = time.perf_counter()
     with num_threads(threads):
         rollout_batch(

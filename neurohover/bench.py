@@ -1,0 +1,116 @@
+"""Throughput benchmarks (``neurohover bench``): the kernel against the plain-Python reference.
+
+Every figure comes from this run on this machine: episodes per second, control steps and
+simulator substeps per second, and the ratio against the reference simulator measured here too.
+The workload is the issue's: full 6000-step episodes of the MLP policy in the zero setting.
+"""
+
+from __future__ import annotations
+
+import platform
+import random
+import time
+from collections.abc import Callable
+
+import numba
+import numpy as np
+
+from .evaluate import evaluate_jobs
+from .policies import prototype
+from .sim.constants import EPISODE_STEPS, SUBSTEPS
+from .sim.reference import fly_episode
+from .tasks import get_task_family
+
+
+def _best_rate(run: Callable[[], float], repeats: int) -> float:
+    """Best of ``repeats`` runs of ``run`` (which returns work units done) in units per second."""
+    best = 0.0
+    for _ in range(repeats):
+        start = time.perf_counter()
+        work = run()
+        best = max(best, work / (time.perf_counter() - start))
+    return best
+
+
+def reference_episodes_per_second(episodes: int = 1) -> float:
+    """Plain-Python reference: full MLP episodes, noise drawn with Python's ``random``."""
+    policy = prototype("mlp", "baseline")
+    mdp = get_task_family("fghh").zero().to_reference()
+
+    def run() -> float:
+        for e in range(episodes):
+            rng = random.Random(e)
+            normals = [[rng.gauss(0.0, 1.0) for _ in range(6)] for _ in range(EPISODE_STEPS)]
+            fly_episode(mdp, policy.act, normals)
+        return episodes
+
+    return _best_rate(run, 1)
+
+
+def kernel_episodes_per_second(episodes: int, threads: int, repeats: int = 3) -> float:
+    """Compiled kernel: full MLP episodes in the zero setting on ``threads`` threads."""
+    policy = prototype("mlp", "baseline")
+    mdp = get_task_family("fghh").zero()
+    p_idx = np.zeros(episodes, dtype=np.int64)
+
+    def run() -> float:
+        ev = evaluate_jobs([policy], mdp, p_idx, p_idx, np.arange(episodes), seed=1, threads=threads)
+        assert not ev.crashed.any()
+        return episodes
+
+    evaluate_jobs([policy], mdp, [0, 0], [0, 0], [0, 1], seed=1, n_steps=10, threads=threads)  # warm-up
+    return _best_rate(run, repeats)
+
+
+def _extra_benchmarks(quick: bool) -> dict:
+    """Benchmarks of later stages, present once those stages are installed."""
+    out: dict = {}
+    try:
+        from .envs.vector import benchmark_vector_env
+    except ImportError:
+        return out
+    out["vector_env_1024_control_steps_per_second_1_core"] = benchmark_vector_env(1024, 200 if quick else 1000)
+    return out
+
+
+def run_benchmarks(quick: bool = False) -> dict:
+    """Measure everything and return a JSON-able report."""
+    cores = numba.config.NUMBA_NUM_THREADS
+    episodes = 100 if quick else 1000
+    ref = reference_episodes_per_second(1)
+    one = kernel_episodes_per_second(episodes, 1)
+    many = kernel_episodes_per_second(episodes * cores, cores)
+    per_episode = EPISODE_STEPS
+    report = {
+        "machine": {"cores": cores, "cpu": platform.processor() or platform.machine(), "python": platform.python_version(),
+                    "numba": numba.__version__},
+        "workload": "MLP policy (baseline-equivalent), zero setting, full 6000-step episodes",
+        "reference_episodes_per_second": ref,
+        "kernel_1_core": {
+            "episodes_per_second": one, "control_steps_per_second": one * per_episode,
+            "substeps_per_second": one * per_episode * SUBSTEPS, "speedup_vs_reference": one / ref,
+        },
+        f"kernel_{cores}_cores": {
+            "episodes_per_second": many, "control_steps_per_second": many * per_episode,
+            "substeps_per_second": many * per_episode * SUBSTEPS, "speedup_vs_reference": many / ref,
+            "speedup_vs_1_core": many / one,
+        },
+    }
+    report.update(_extra_benchmarks(quick))
+    return report
+
+
+def format_report(report: dict) -> str:
+    """Human-readable table of a benchmark report."""
+    lines = [f"neurohover bench on {report['machine']['cores']} cores ({report['machine']['cpu']}); {report['workload']}"]
+    lines.append(f"  {'reference (plain Python)':<34} {report['reference_episodes_per_second']:>12.3f} episodes/s")
+    for key, value in report.items():
+        if key.startswith("kernel_"):
+            extra = f", x{value['speedup_vs_1_core']:.2f} vs 1 core" if "speedup_vs_1_core" in value else ""
+            lines.append(
+                f"  {key:<34} {value['episodes_per_second']:>12.1f} episodes/s  {value['substeps_per_second'] / 1e6:8.1f} M substeps/s"
+                f"  x{value['speedup_vs_reference']:.0f} vs reference{extra}"
+            )
+        elif key not in ("machine", "workload", "reference_episodes_per_second"):
+            lines.append(f"  {key:<34} {value:>12.4g}" if isinstance(value, float) else f"  {key:<34} {value}")
+    return "\n".join(lines)

@@ -1,0 +1,163 @@
+"""Command line: ``neurohover COMMAND --help`` for each command.
+
+Bad input prints one clear message and exits with status 2 (never a traceback from numba).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from .errors import NeurohoverError
+
+COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {}
+
+
+def _floats(text: str, what: str) -> list[float]:
+    try:
+        return [float(x) for x in text.split(",") if x.strip() != ""]
+    except ValueError:
+        raise NeurohoverError(f"{what} must be comma-separated numbers, got {text!r}") from None
+
+
+def _family_and_mdps(args: argparse.Namespace, n: int, rng: np.random.Generator):
+    """The task family and the MDP of each of ``n`` episodes, from --task/--mdp/--wind/--params/--sigma."""
+    from .tasks import get_task_family
+
+    family = get_task_family(args.task, args.sigma)
+    if args.wind is not None and args.params is not None:
+        raise NeurohoverError("give either --wind (GHH-08) or --params, not both")
+    if args.wind is not None:
+        if family.name != "ghh08":
+            raise NeurohoverError(f"--wind U,V sets a GHH-08 MDP; task {args.task!r} takes --params")
+        return family, [family.make(_floats(args.wind, "--wind"))] * n
+    if args.params is not None:
+        return family, [family.make(_floats(args.params, "--params"))] * n
+    if args.mdp == "sample":  # a fresh MDP from G for every episode
+        return family, [family.sample(rng, label=f"{family.name}/sample:{i}") for i in range(n)]
+    return family, [family.mdp(args.mdp)] * n
+
+
+def _add_task_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--task", required=True, help="task family: ghh08, ghh09 or fghh")
+    p.add_argument("--mdp", default="zero", help="zero (default), train:N, test:N, or sample (a fresh MDP from G per episode)")
+    p.add_argument("--wind", help="GHH-08 only: constant wind U,V in m/s, each in [-5, 5]")
+    p.add_argument("--params", help="explicit MDP parameters, comma-separated: GHH-08 wind_u,wind_v; GHH-09 its 8 parameters in [0,1]; FGHH the 11 dynamics parameters")
+    p.add_argument("--sigma", type=float, help="FGHH breadth sigma (default 0.3)")
+
+
+def cmd_fly(args: argparse.Namespace) -> int:
+    """Fly a policy and print return statistics."""
+    from .evaluate import evaluate_jobs
+    from .policies import load_policy
+
+    if args.episodes < 1:
+        raise NeurohoverError(f"--episodes {args.episodes} is out of range: allowed >= 1")
+    if args.seed < 0:
+        raise NeurohoverError(f"--seed {args.seed} is out of range: allowed >= 0")
+    policy = load_policy(args.policy)
+    rng = np.random.default_rng(args.seed)
+    family, mdps = _family_and_mdps(args, args.episodes, rng)
+    unique = list(dict.fromkeys(mdps))
+    ev = evaluate_jobs(
+        [policy], unique, np.zeros(args.episodes, dtype=np.int64),
+        np.array([unique.index(m) for m in mdps]), np.arange(args.episodes), seed=args.seed,
+        record=np.full(args.episodes, args.record is not None), threads=args.threads,
+    )
+    if args.record is not None:
+        fd = ev.flight_data
+        fd.metadata.update({"task": family.name, "mdps": [m.to_dict() for m in mdps], "policy": str(args.policy),
+                            "seed": args.seed, "returns": ev.returns.tolist()})
+        fd.save(args.record)
+    summary = {
+        "task": family.name, "mdp": mdps[0].label if len(unique) == 1 else f"{len(unique)} MDPs",
+        "policy": str(args.policy), "episodes": args.episodes,
+        "mean_return": float(ev.returns.mean()), "std_return": float(ev.returns.std()),
+        "min_return": float(ev.returns.min()), "max_return": float(ev.returns.max()),
+        "crashes": int(ev.crashed.sum()), "episodes_per_second": ev.episodes_per_second,
+    }
+    if args.json:
+        print(json.dumps(summary))
+    else:
+        for key, value in summary.items():
+            print(f"{key:>20}: {value:.6g}" if isinstance(value, float) else f"{key:>20}: {value}")
+        if args.record is not None:
+            print(f"{'flight data':>20}: {args.record}")
+    return 0
+
+
+def cmd_demo(args: argparse.Namespace) -> int:
+    """Fly the baseline and the baseline-equivalent MLP on a few MDPs of each family; print a table."""
+    from .evaluate import evaluate
+    from .policies import baseline_policy, prototype
+    from .tasks import get_task_family
+
+    policies = {"baseline": baseline_policy(), "mlp(baseline seed)": prototype("mlp", "baseline")}
+    print(f"{'task':<6} {'mdp':<16} {'policy':<20} {'mean return':>12} {'sd':>10} {'crashes':>8}")
+    for name in ("ghh08", "ghh09", "fghh"):
+        family = get_task_family(name)
+        mdps = [family.zero()] + family.training_mdps()[: args.mdps]
+        ev = evaluate(list(policies.values()), mdps, episodes=args.episodes, seed=args.seed)
+        for i, label in enumerate(policies):
+            for m, mdp in enumerate(mdps):
+                r = ev.returns[i, m]
+                print(f"{name:<6} {mdp.label.split('/')[-1]:<16} {label:<20} {r.mean():>12.1f} {r.std():>10.1f} {int(ev.crashed[i, m].sum()):>8}")
+    return 0
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    """Measure throughput against the plain-Python reference simulator."""
+    from .bench import format_report, run_benchmarks
+
+    report = run_benchmarks(quick=args.quick)
+    print(json.dumps(report, indent=1) if args.json else format_report(report))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="neurohover", description="Generalized helicopter hovering (Koppejan & Whiteson 2011): fly, evolve, learn models, compete, reproduce.")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    p = sub.add_parser("fly", help="fly a policy and print return statistics", description=cmd_fly.__doc__)
+    _add_task_options(p)
+    p.add_argument("--policy", default="baseline", help="'baseline' or a JSON policy file")
+    p.add_argument("--episodes", type=int, default=10, help="number of episodes (default 10)")
+    p.add_argument("--seed", type=int, default=0, help="root seed of the noise streams (default 0)")
+    p.add_argument("--threads", type=int, help="kernel threads (default: all cores)")
+    p.add_argument("--record", metavar="FILE", help="write the flight data of every episode to FILE (.npz)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=cmd_fly)
+
+    p = sub.add_parser("demo", help="fly the baseline and an MLP policy on a few MDPs and print a table", description=cmd_demo.__doc__)
+    p.add_argument("--mdps", type=int, default=3, help="training MDPs per family (default 3)")
+    p.add_argument("--episodes", type=int, default=5, help="episodes per MDP (default 5)")
+    p.add_argument("--seed", type=int, default=0)
+    p.set_defaults(func=cmd_demo)
+
+    p = sub.add_parser("bench", help="measure simulator throughput", description=cmd_bench.__doc__)
+    p.add_argument("--quick", action="store_true", help="fewer episodes (a rough figure in a few seconds)")
+    p.add_argument("--json", action="store_true", help="print the report as JSON")
+    p.set_defaults(func=cmd_bench)
+    return parser
+
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except NeurohoverError as err:
+        print(f"neurohover {args.command}: error: {err}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"neurohover {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

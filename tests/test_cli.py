@@ -1,0 +1,99 @@
+"""The command line: JSON output, clear errors with exit status 2, and flight-data recording."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from neurohover.cli import main
+from neurohover.flightdata import FlightData
+from neurohover.policies import prototype, save_policy
+
+
+def _run(capsys, *argv: str) -> tuple[int, str, str]:
+    rc = main(list(argv))
+    out = capsys.readouterr()
+    return rc, out.out, out.err
+
+
+def test_fly_json_reports_the_issue_keys(capsys) -> None:
+    rc, out, _ = _run(capsys, "fly", "--task", "ghh08", "--mdp", "zero", "--episodes", "3", "--seed", "4", "--json")
+    assert rc == 0
+    result = json.loads(out)
+    for key in ("mean_return", "std_return", "crashes", "episodes", "episodes_per_second"):
+        assert key in result
+    assert result["episodes"] == 3 and result["crashes"] == 0
+    assert -1300 < result["mean_return"] < -700
+    assert result["min_return"] <= result["mean_return"] <= result["max_return"]
+
+
+def test_fly_wind_and_params_set_the_mdp(capsys, tmp_path: Path) -> None:
+    _, calm, _ = _run(capsys, "fly", "--task", "ghh08", "--wind", "0,0", "--episodes", "2", "--json")
+    _, windy, _ = _run(capsys, "fly", "--task", "ghh08", "--wind", "4,-4", "--episodes", "2", "--json")
+    assert json.loads(windy)["mean_return"] < json.loads(calm)["mean_return"]
+    rc, out, _ = _run(capsys, "fly", "--task", "ghh09", "--params", "0.9,0.5,0.2,0.1,0.8,0.3,0.7,0.6", "--episodes", "2", "--json")
+    assert rc == 0 and json.loads(out)["mean_return"] < json.loads(calm)["mean_return"]
+    policy_file = save_policy(prototype("mlp", "baseline"), tmp_path / "mlp.json", note="test")
+    _, mlp, _ = _run(capsys, "fly", "--task", "ghh08", "--wind", "0,0", "--episodes", "2", "--json", "--policy", str(policy_file))
+    assert json.loads(mlp)["mean_return"] == json.loads(calm)["mean_return"]
+
+
+def test_fly_record_writes_flight_data(capsys, tmp_path: Path) -> None:
+    path = tmp_path / "flight.npz"
+    rc, _, _ = _run(capsys, "fly", "--task", "fghh", "--mdp", "train:1", "--episodes", "2", "--record", str(path))
+    assert rc == 0
+    fd = FlightData.load(path)
+    assert fd.n_episodes == 2 and fd.n_transitions == 12000
+    assert fd.metadata["task"] == "fghh" and len(fd.metadata["returns"]) == 2
+    assert np.all(np.abs(fd.actions[0]) <= 1)
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["fly", "--task", "ghh10"], "unknown task 'ghh10': allowed ghh08, ghh09, fghh"),
+        (["fly", "--task", "ghh08", "--wind", "6,0"], "must lie in [-5, 5]"),
+        (["fly", "--task", "ghh09", "--wind", "1,0"], "--wind U,V sets a GHH-08 MDP"),
+        (["fly", "--task", "ghh09", "--params", "0.5,0.5"], "must be 8 numbers"),
+        (["fly", "--task", "ghh09", "--params", "0.5,0.5,0.5,0.5,0.5,0.5,0.5,1.5"], "y_center=1.5"),
+        (["fly", "--task", "fghh", "--sigma", "-1"], "sigma=-1.0 is out of range"),
+        (["fly", "--task", "ghh08", "--mdp", "train:10"], "allowed 0..9"),
+        (["fly", "--task", "ghh08", "--mdp", "windy"], "unknown MDP 'windy'"),
+        (["fly", "--task", "ghh08", "--episodes", "0"], "--episodes 0 is out of range"),
+        (["fly", "--task", "ghh08", "--policy", "missing.json"], "does not exist"),
+    ],
+)
+def test_bad_input_exits_2_with_one_clear_message(capsys, argv, message: str) -> None:
+    rc, out, err = _run(capsys, *argv)
+    assert rc == 2
+    assert message in err
+    assert "Traceback" not in err and err.count("\n") == 1
+
+
+def test_malformed_policy_files_are_refused(capsys, tmp_path: Path) -> None:
+    cases = {
+        "notjson.json": "{not json",
+        "nogenome.json": json.dumps({"topology": "mlp"}),
+        "short.json": json.dumps({"topology": "mlp", "genome": [0.0] * 40}),
+        "strings.json": json.dumps({"topology": "slp", "genome": ["a"] * 40}),
+    }
+    expected = {"notjson.json": "not valid JSON", "nogenome.json": "missing key(s) genome",
+                "short.json": "mlp genome has 42 genes", "strings.json": "list of numbers"}
+    for name, text in cases.items():
+        (tmp_path / name).write_text(text)
+        rc, _, err = _run(capsys, "fly", "--task", "ghh08", "--policy", str(tmp_path / name))
+        assert rc == 2 and expected[name] in err, (name, err)
+
+
+def test_every_command_has_help() -> None:
+    from neurohover.cli import build_parser
+
+    commands = build_parser()._subparsers._group_actions[0].choices
+    for name in commands:
+        out = subprocess.run([sys.executable, "-m", "neurohover.cli", name, "--help"], capture_output=True, text=True)
+        assert out.returncode == 0 and "usage: neurohover" in out.stdout, name
