@@ -6,15 +6,17 @@ Bad input prints one clear message and exits with status 2 (never a traceback fr
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 
 import numpy as np
 
 from .errors import NeurohoverError
 
-COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {}
+# Modules of later pipeline stages; each has ``register(subparsers)`` adding its commands.
+COMMAND_MODULES: tuple[str, ...] = ()
 
 
 def _floats(text: str, what: str) -> list[float]:
@@ -142,6 +144,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quick", action="store_true", help="fewer episodes (a rough figure in a few seconds)")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.set_defaults(func=cmd_bench)
+
+    for module in COMMAND_MODULES:
+        importlib.import_module(module).register(sub)
     return parser
 
 

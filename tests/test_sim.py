@@ -179,3 +179,21 @@ def test_crash_limits_are_spec_values() -> None:
 def test_bad_input_gets_clear_messages(call, message: str) -> None:
     with pytest.raises(NeurohoverError, match=message.replace("(", r"\(").replace(")", r"\)")):
         call()
+
+
+def test_memory_is_proportional_to_the_batch_not_the_episode_length() -> None:
+    import tracemalloc
+
+    policy = baseline_policy()
+    mdp = get_task_family("ghh08").zero()
+    evaluate_jobs([policy], mdp, [0], [0], [0], seed=1, n_steps=2)  # load the kernel first
+    n = 100_000
+    zeros = np.zeros(n, dtype=np.int64)
+    tracemalloc.start()
+    ev = evaluate_jobs([policy], mdp, zeros, zeros, np.arange(n), seed=1, n_steps=3)
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    assert ev.returns.shape == (n,)
+    # A few job-sized arrays (8 bytes per job each), nothing per step: a per-step array of the
+    # 12-number observation alone would need 100,000 x 4 x 12 x 8 bytes = 38 MB.
+    assert peak < 120 * n
