@@ -1,0 +1,310 @@
+"""Generalized helicopter hovering as a Gymnasium environment (one helicopter).
+
+The physics is the compiled kernel's :func:`neurohover.sim.kernel.step_batch`, called with a
+batch of one, so this environment, the vector environment and the batched evaluation fly exactly
+the same simulator.
+
+Example
+-------
+>>> import gymnasium as gym
+>>> import neurohover
+>>> env = gym.make("neurohover/GHH08-v0", mdp="train:3")
+>>> obs, info = env.reset(seed=0)
+>>> obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any, Union
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from ..errors import NeurohoverError
+from ..sim.constants import (
+    ACTION_DIM,
+    EPISODE_STEPS,
+    MDP_ROW_LEN,
+    OBS_DIM,
+    STATE_DIM,
+)
+from ..sim.kernel import step_batch
+from ..sim.rng import seed_stream
+from ..tasks import MDP, TaskFamily, get_task_family
+
+RENDER_FPS = 10  # control rate (Hz)
+MAX_EPISODE_STEPS = 10**7
+MAX_NOISE_SEED = 2**63 - 1  # the largest seed ``neurohover.evaluate_jobs`` accepts
+SAMPLE = "sample"
+MDP_OPTIONS = ("zero", "sample", "train:N", "test:N")
+RESET_OPTION_KEYS = ("mdp", "noise")
+
+MdpSpec = Union[str, MDP]
+
+
+def resolve_mdp(family: TaskFamily, spec: Any, cache: dict[str, MDP] | None = None) -> MDP | str:
+    """The MDP that ``spec`` names, or ``SAMPLE`` for a fresh MDP from G at every reset.
+
+    Parameters
+    ----------
+    family : TaskFamily
+        The environment's task family (it resolves ``zero``, ``train:N`` and ``test:N``).
+    spec : str or MDP
+        ``"zero"``, ``"sample"``, ``"train:N"``, ``"test:N"`` or an explicit :class:`MDP`
+        (any MDP is accepted, a learned model's included).
+    cache : dict, optional
+        Already resolved names; building the fixed sets is not free, so a vector environment
+        with many sub-environments resolves each name once.
+    """
+    if isinstance(spec, MDP):
+        row = spec.row()
+        if row.shape != (MDP_ROW_LEN,) or not np.all(np.isfinite(row)) or spec.substeps < 1:
+            raise NeurohoverError(f"MDP {spec.label or spec!r} is not flyable: its parameters must be finite and substeps >= 1")
+        return spec
+    if not isinstance(spec, str):
+        raise NeurohoverError(f"mdp={spec!r} is not allowed: use one of {', '.join(MDP_OPTIONS)} or an MDP instance")
+    if spec == SAMPLE:
+        return SAMPLE
+    if cache is not None and spec in cache:
+        return cache[spec]
+    mdp = family.mdp(spec)  # raises NeurohoverError naming the allowed names
+    if cache is not None:
+        cache[spec] = mdp
+    return mdp
+
+
+def check_noise_stream(value: Any, what: str = "noise") -> tuple[int, int]:
+    """A ``(seed, episode)`` pair naming one gust-noise stream of the kernel, validated."""
+    try:
+        seed, episode = value
+    except (TypeError, ValueError):
+        raise NeurohoverError(f"{what}={value!r} is not allowed: give a (seed, episode) pair of integers") from None
+    for name, v, hi in (("seed", seed, MAX_NOISE_SEED), ("episode", episode, MAX_NOISE_SEED)):
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or not 0 <= int(v) <= hi:
+            raise NeurohoverError(f"{what} {name}={v!r} is out of range: allowed an integer in 0..2**63-1")
+    return int(seed), int(episode)
+
+
+def check_episode_steps(episode_steps: Any) -> int:
+    """``episode_steps`` as an int, or a clear error."""
+    if isinstance(episode_steps, (bool, np.bool_)) or not isinstance(episode_steps, (int, np.integer)) \
+            or not 1 <= episode_steps <= MAX_EPISODE_STEPS:
+        raise NeurohoverError(f"episode_steps={episode_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
+    return int(episode_steps)
+
+
+def check_reset_options(options: dict[str, Any] | None, extra: Sequence[str] = ()) -> dict[str, Any]:
+    """``options`` as a dict whose keys are all known (a typo would otherwise be silently ignored)."""
+    if options is None:
+        return {}
+    if not isinstance(options, dict):
+        raise NeurohoverError(f"options={options!r} is not allowed: give a dict or None")
+    allowed = RESET_OPTION_KEYS + tuple(extra)
+    unknown = sorted(str(k) for k in options if k not in allowed)
+    if unknown:
+        raise NeurohoverError(f"unknown reset option(s) {', '.join(unknown)}: allowed {', '.join(allowed)}")
+    return options
+
+
+def draw_stream_seed(rng: np.random.Generator) -> int:
+    """A noise-stream seed (0..2**63-1) drawn from an environment's generator."""
+    # 63 raw bits: a tenth of the cost of Generator.integers, which matters when a vector
+    # environment resets hundreds of crashed helicopters per step.
+    return int(rng.bit_generator.random_raw()) >> 1
+
+
+def initial_state() -> np.ndarray:
+    """SPEC's start state: at rest at the origin, level, facing north."""
+    state = np.zeros(STATE_DIM)
+    state[12] = 1.0
+    return state
+
+
+def observation_space() -> spaces.Box:
+    return spaces.Box(-np.inf, np.inf, (OBS_DIM,), np.float64)
+
+
+def action_space() -> spaces.Box:
+    return spaces.Box(-1.0, 1.0, (ACTION_DIM,), np.float64)
+
+
+class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
+    """Hover an XCell Tempest helicopter at the origin, in an MDP drawn from a task family.
+
+    ## Description
+
+    The generalized helicopter hovering tasks of the 2008 and 2009 Reinforcement Learning
+    Competitions and Koppejan & Whiteson (2011): keep a simulated helicopter at its start point
+    for 10 minutes of flight at 10 Hz, in an MDP that the agent does not know. The task family
+    fixes the distribution G of MDPs: ``ghh08`` (constant wind up to 5 m/s), ``ghh09``
+    (sinusoidal winds) or ``fghh`` (every dynamics parameter perturbed, relative std ``sigma``).
+
+    ## Action Space
+
+    ``Box(-1, 1, (4,), float64)``; values outside [-1, 1] are clipped by the simulator.
+
+    | Num | Action                        | Min | Max |
+    |-----|-------------------------------|-----|-----|
+    | 0   | aileron (roll, a1)            | -1  | 1   |
+    | 1   | elevator (pitch, a2)          | -1  | 1   |
+    | 2   | rudder (yaw, a3)              | -1  | 1   |
+    | 3   | collective (main thrust, a4)  | -1  | 1   |
+
+    A non-finite action (NaN or infinity) counts as a crash.
+
+    ## Observation Space
+
+    ``Box(-inf, inf, (12,), float64)``; velocities and position errors are in the body frame.
+
+    | Num | Observation                           | Unit  |
+    |-----|---------------------------------------|-------|
+    | 0   | u: forward velocity                   | m/s   |
+    | 1   | v: sideways velocity                  | m/s   |
+    | 2   | w: downward velocity                  | m/s   |
+    | 3   | x: forward position error             | m     |
+    | 4   | y: sideways position error            | m     |
+    | 5   | z: downward position error            | m     |
+    | 6   | p: roll rate                          | rad/s |
+    | 7   | q: pitch rate                         | rad/s |
+    | 8   | r: yaw rate                           | rad/s |
+    | 9   | qx: orientation quaternion, x part    | -     |
+    | 10  | qy: orientation quaternion, y part    | -     |
+    | 11  | qz: orientation quaternion, z part    | -     |
+
+    ## Rewards
+
+    Minus the sum of squares of the 12 observation entries. The crashing step instead gets
+    ``-(3*20^2 + 3*(4*pi)^2 + 3*5^2 + (1 - cos^2(15 deg))) * (episode_steps - t)``, with t the
+    control steps taken including the crashing one: the worst possible reward for every step
+    that is left (about -1.05e7 for a crash at the start of a 6000-step episode).
+
+    ## Starting State
+
+    At rest at the origin, level and facing north; the observation is all zeros.
+
+    ## Episode End
+
+    - Termination (crash): any of |u|, |v|, |w| > 5 m/s, |x|, |y|, |z| > 20 m, |p|, |q|, |r| >
+      4*pi rad/s, or more than 30 degrees from level (|qw| < cos 15 deg), or a non-finite action.
+    - Truncation: ``episode_steps`` control steps flown (6000, i.e. 10 minutes, by default).
+      Like Gymnasium's ``TimeLimit``, truncation is reported at the limit even when that last
+      step also crashed.
+
+    ## Arguments
+
+    ``gymnasium.make("neurohover/GHH08-v0")``, ``"neurohover/GHH09-v0"`` or
+    ``"neurohover/FGHH-v0"`` (which takes ``sigma``, default 0.3), with:
+
+    - ``mdp``: ``"sample"`` (default: a fresh MDP drawn from G at each reset), ``"zero"`` (the
+      family's mean MDP), ``"train:N"`` / ``"test:N"`` (the family's fixed training and test
+      MDPs), or an explicit :class:`neurohover.MDP`.
+    - ``episode_steps``: control steps per episode (6000). ``gymnasium.make`` also adds a
+      ``TimeLimit`` of 6000 steps; pass ``max_episode_steps`` to ``make`` for longer episodes.
+
+    ``reset(seed=..., options=...)`` takes the options ``{"mdp": spec}`` (same values as the
+    ``mdp`` argument; it also applies to later episodes) and ``{"noise": (seed, episode)}``
+    (fly that gust-noise stream in this episode).
+
+    ## Seeding
+
+    ``reset(seed=s)`` seeds ``np_random``; the episode's MDP (when sampled) and then the seed of
+    its gust-noise stream are drawn from it, so an episode is a pure function of ``s`` and the
+    actions. The gusts are the kernel's stream ``(noise_stream[0], noise_stream[1])``, the one
+    ``neurohover.evaluate_jobs(..., seed=noise_stream[0], episode_index=[noise_stream[1]])``
+    flies, so a policy flown here and in a batched evaluation meets the same gusts.
+
+    ## Info
+
+    ``{"mdp": label of the current MDP, "crashed": bool}``.
+    """
+
+    metadata = {"render_modes": [], "render_fps": RENDER_FPS}
+
+    def __init__(
+        self,
+        task: str = "ghh08",
+        sigma: float | None = None,
+        mdp: MdpSpec = SAMPLE,
+        episode_steps: int = EPISODE_STEPS,
+        render_mode: str | None = None,
+    ) -> None:
+        if render_mode is not None:
+            raise NeurohoverError(f"render_mode={render_mode!r} is not supported: this environment has no rendering (use None)")
+        self.family: TaskFamily = get_task_family(task, sigma)
+        self.episode_steps = check_episode_steps(episode_steps)
+        self._spec: MDP | str = resolve_mdp(self.family, mdp)
+        self.observation_space = observation_space()
+        self.action_space = action_space()
+        self.render_mode = None
+        # The kernel steps batches; this environment is a batch of one.
+        self._rows = np.zeros((1, MDP_ROW_LEN))
+        self._index = np.zeros(1, dtype=np.int64)
+        self._state = initial_state()[None, :]
+        self._noise = np.zeros((1, 6))
+        self._rng = np.zeros((1, 4), dtype=np.uint64)
+        self._steps = np.zeros(1, dtype=np.int64)
+        self._action = np.zeros((1, ACTION_DIM))
+        self._obs = np.zeros((1, OBS_DIM))
+        self._reward = np.zeros(1)
+        self._crash = np.zeros(1, dtype=np.bool_)
+        self._mdp: MDP | None = None
+        self._stream: tuple[int, int] | None = None
+        self._done = True
+
+    @property
+    def mdp(self) -> MDP | None:
+        """The MDP of the current episode (None before the first reset)."""
+        return self._mdp
+
+    @property
+    def noise_stream(self) -> tuple[int, int] | None:
+        """The (seed, episode) gust-noise stream of the current episode."""
+        return self._stream
+
+    @property
+    def steps(self) -> int:
+        """Control steps flown in the current episode."""
+        return int(self._steps[0])
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
+        super().reset(seed=seed)
+        options = check_reset_options(options)
+        # Validate every option before touching the episode, so a bad call leaves it as it was.
+        spec = resolve_mdp(self.family, options["mdp"]) if "mdp" in options else self._spec
+        stream = check_noise_stream(options["noise"]) if "noise" in options else None
+        self._spec = spec
+        mdp = self.family.sample(self.np_random) if spec == SAMPLE else spec
+        if stream is None:
+            stream = (draw_stream_seed(self.np_random), 0)
+        self._mdp = mdp
+        self._stream = stream
+        self._rows[0] = mdp.row()
+        self._state[0] = initial_state()
+        self._noise.fill(0.0)
+        seed_stream(self._rng[0], np.uint64(stream[0]), np.uint64(stream[1]))
+        self._steps[0] = 0
+        self._done = False
+        return np.zeros(OBS_DIM), {"mdp": mdp.label, "crashed": False}
+
+    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        if self._done:
+            raise NeurohoverError("step() called on a finished episode (or before reset()): call reset() first")
+        try:
+            a = np.asarray(action, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise NeurohoverError(f"action {action!r} is not allowed: give 4 numbers (aileron, elevator, rudder, collective)") from None
+        if a.shape != (ACTION_DIM,):
+            raise NeurohoverError(f"action has shape {a.shape}, expected (4,): aileron, elevator, rudder, collective in [-1, 1]")
+        self._action[0] = a
+        step_batch(self._rows, self._index, self._state, self._noise, self._rng, self._steps, self._action,
+                   self.episode_steps, self._obs, self._reward, self._crash)
+        terminated = bool(self._crash[0])
+        truncated = bool(self._steps[0] >= self.episode_steps)
+        self._done = terminated or truncated
+        info = {"mdp": self._mdp.label, "crashed": terminated}  # type: ignore[union-attr]
+        return self._obs[0].copy(), float(self._reward[0]), terminated, truncated, info
+
+
+__all__ = ["HoverEnv", "MdpSpec"]

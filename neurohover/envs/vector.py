@@ -1,0 +1,346 @@
+"""Many helicopters in one Gymnasium vector environment, stepped by one kernel call.
+
+``HoverVectorEnv`` is what ``gymnasium.make_vec("neurohover/GHH08-v0", num_envs=N,
+vectorization_mode="vector_entry_point")`` builds. Every ``step`` advances all N helicopters
+through a single call of :func:`neurohover.sim.kernel.step_batch`; Python only touches the
+sub-environments that reset.
+
+Example
+-------
+>>> import gymnasium as gym
+>>> import numpy as np
+>>> import neurohover
+>>> envs = gym.make_vec("neurohover/GHH09-v0", num_envs=1024, vectorization_mode="vector_entry_point")
+>>> obs, info = envs.reset(seed=0)
+>>> obs, rewards, terminated, truncated, info = envs.step(np.zeros((1024, 4)))
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numba as nb
+import numpy as np
+from gymnasium.utils import seeding
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+
+from ..errors import NeurohoverError
+from ..sim.constants import ACTION_DIM, EPISODE_STEPS, MDP_ROW_LEN, OBS_DIM, ROW_PARAMS, ROW_WIND
+from ..sim.kernel import step_batch
+from ..sim.rng import seed_stream
+from ..tasks import MDP, TaskFamily, get_task_family
+from .hover import (
+    RENDER_FPS,
+    SAMPLE,
+    MdpSpec,
+    action_space,
+    check_episode_steps,
+    check_noise_stream,
+    check_reset_options,
+    draw_stream_seed,
+    initial_state,
+    observation_space,
+    resolve_mdp,
+)
+
+MAX_NUM_ENVS = 10**7
+
+
+@nb.njit(cache=True)
+def _seed_streams(rngs: np.ndarray, idx: np.ndarray, streams: np.ndarray) -> None:
+    """Seed the noise streams of sub-environments ``idx`` from their (seed, episode) rows."""
+    for i in idx:
+        seed_stream(rngs[i], np.uint64(streams[i, 0]), np.uint64(streams[i, 1]))
+
+
+def sample_row_layout(family: TaskFamily) -> tuple[np.ndarray, slice]:
+    """The kernel row of the family's sampled MDPs, and where a raw draw ``family._draw`` goes in it.
+
+    A sampled MDP's row is this template with the draw written into the slice; checked here
+    against ``family.make`` so that the fast path cannot drift from the MDP class.
+    """
+    probe = family._draw(np.random.default_rng(0))
+    template = family.make(probe).row()
+    where = ROW_PARAMS if family.name == "fghh" else slice(ROW_WIND.start, ROW_WIND.start + probe.size)
+    check = template.copy()
+    check[where] = probe
+    if not np.array_equal(check, template):
+        raise RuntimeError(f"sampled {family.name} MDP rows do not have the expected layout")
+    return template, where
+
+
+class HoverVectorEnv(VectorEnv):
+    """``num_envs`` independent hovering helicopters (see :class:`neurohover.envs.hover.HoverEnv`).
+
+    Observations are float64 arrays of shape (num_envs, 12), actions (num_envs, 4); rewards,
+    terminations and truncations are (num_envs,) arrays. Sub-environments reset automatically
+    in Gymnasium's ``NEXT_STEP`` mode: the step after sub-environment i terminated or was
+    truncated ignores its action and returns its new episode's first observation (all zeros),
+    reward 0 and ``terminated = truncated = False``.
+
+    Parameters
+    ----------
+    num_envs : int
+        Number of helicopters.
+    task : {"ghh08", "ghh09", "fghh"}
+        Task family.
+    sigma : float, optional
+        FGHH only: relative standard deviation of the dynamics parameters (default 0.3).
+    mdp : str, MDP or sequence of them
+        ``"sample"`` (default: each sub-environment draws its own fresh MDP from G at every
+        reset), ``"zero"``, ``"train:N"``, ``"test:N"`` or an :class:`~neurohover.MDP`, for all
+        sub-environments, or a sequence of ``num_envs`` of these, one per sub-environment.
+    episode_steps : int
+        Control steps per episode (6000); the crash penalty counts the steps left to it.
+    max_episode_steps : int, optional
+        Truncate earlier than ``episode_steps`` (``make_vec`` passes the registered limit).
+
+    Notes
+    -----
+    Seeding follows ``SyncVectorEnv``: ``reset(seed=s)`` gives sub-environment i its own
+    generator seeded with ``s + i`` (a list of seeds gives one each). Each reset of a
+    sub-environment, automatic or not, draws from its generator the MDP (when sampled) and then
+    its gust-noise stream seed, exactly as ``HoverEnv`` does, so sub-environment i flies the same
+    episodes, bit for bit, as ``HoverEnv`` after ``reset(seed=s + i)`` and then plain
+    ``reset()`` calls, given the same actions.
+
+    ``reset`` options: ``"mdp"`` (as the ``mdp`` argument; kept for later episodes),
+    ``"noise"`` (this reset only: one ``(seed, episode)`` pair, which gives sub-environment i the
+    stream ``(seed, episode + i)`` like ``neurohover.evaluate_jobs`` with consecutive episode
+    indices, or a sequence of ``num_envs`` pairs) and ``"reset_mask"`` (a (num_envs,) bool array:
+    reset only those sub-environments; the others keep flying).
+
+    Info: ``"crashed"`` every step; ``"mdp"`` (MDP labels) for the sub-environments that reset,
+    each with Gymnasium's ``"_key"`` mask. The current MDPs are ``mdps``.
+    """
+
+    metadata = {"render_modes": [], "render_fps": RENDER_FPS, "autoreset_mode": AutoresetMode.NEXT_STEP}
+
+    def __init__(
+        self,
+        num_envs: int = 1,
+        task: str = "ghh08",
+        sigma: float | None = None,
+        mdp: MdpSpec | Sequence[MdpSpec] = SAMPLE,
+        episode_steps: int = EPISODE_STEPS,
+        max_episode_steps: int | None = None,
+        render_mode: str | None = None,
+    ) -> None:
+        if isinstance(num_envs, (bool, np.bool_)) or not isinstance(num_envs, (int, np.integer)) or not 1 <= num_envs <= MAX_NUM_ENVS:
+            raise NeurohoverError(f"num_envs={num_envs!r} is out of range: allowed an integer in 1..{MAX_NUM_ENVS}")
+        if render_mode is not None:
+            raise NeurohoverError(f"render_mode={render_mode!r} is not supported: this environment has no rendering (use None)")
+        n = int(num_envs)
+        self.num_envs = n
+        self.family: TaskFamily = get_task_family(task, sigma)
+        self.episode_steps = check_episode_steps(episode_steps)
+        self.max_episode_steps = self.episode_steps if max_episode_steps is None else check_episode_steps(max_episode_steps)
+        self._limit = min(self.episode_steps, self.max_episode_steps)
+        self._specs: list[MDP | str] = self._resolve_specs(mdp)
+        self.render_mode = None
+        self.single_observation_space = observation_space()
+        self.single_action_space = action_space()
+        self.observation_space = batch_space(self.single_observation_space, n)
+        self.action_space = batch_space(self.single_action_space, n)
+
+        self._rows = np.zeros((n, MDP_ROW_LEN))
+        self._index = np.arange(n, dtype=np.int64)  # sub-environment i flies MDP row i
+        self._state = np.tile(initial_state(), (n, 1))
+        self._noise = np.zeros((n, 6))
+        self._rng = np.zeros((n, 4), dtype=np.uint64)
+        self._steps = np.zeros(n, dtype=np.int64)
+        self._obs = np.zeros((n, OBS_DIM))  # the current observation of every sub-environment
+        self._reward = np.zeros(n)
+        self._crash = np.zeros(n, dtype=np.bool_)
+        self._actions = np.zeros((n, ACTION_DIM))
+        self._streams = np.zeros((n, 2), dtype=np.int64)
+        self._gens: list[np.random.Generator | None] = [None] * n
+        self._mdps: list[MDP | None] = [None] * n
+        self._draws: list[np.ndarray | None] = [None] * n  # raw draw of each sampled MDP
+        self._sample_template, self._sample_slice = sample_row_layout(self.family)
+        self._sample_label = f"{self.family.name}/sample"
+        self._autoreset = np.zeros(n, dtype=np.bool_)
+        self._any_autoreset = False
+        self._ready = False
+        self._all = np.ones(n, dtype=np.bool_)
+        self._all.setflags(write=False)
+
+    # -- read-only views -------------------------------------------------------------------
+
+    @property
+    def mdps(self) -> list[MDP | None]:
+        """The MDP each sub-environment flies in its current episode (None before reset)."""
+        for i, d in enumerate(self._draws):
+            if d is not None and self._mdps[i] is None:
+                self._mdps[i] = self.family.make(d, label=self._sample_label)
+        return list(self._mdps)
+
+    @property
+    def noise_streams(self) -> np.ndarray:
+        """(num_envs, 2) array: the (seed, episode) gust-noise stream of each current episode."""
+        return self._streams.copy()
+
+    @property
+    def steps(self) -> np.ndarray:
+        """Control steps flown by each sub-environment in its current episode."""
+        return self._steps.copy()
+
+    # -- argument checks -------------------------------------------------------------------
+
+    def _resolve_specs(self, value: Any) -> list[MDP | str]:
+        cache: dict[str, MDP] = {}
+        if isinstance(value, (str, MDP)):
+            return [resolve_mdp(self.family, value, cache)] * self.num_envs
+        if isinstance(value, (list, tuple)):
+            if len(value) != self.num_envs:
+                raise NeurohoverError(f"mdp has {len(value)} entries but there are num_envs={self.num_envs} sub-environments")
+            return [resolve_mdp(self.family, v, cache) for v in value]
+        return [resolve_mdp(self.family, value, cache)]  # raises with the allowed values
+
+    def _check_seeds(self, seed: Any) -> list[int | None]:
+        n = self.num_envs
+        if seed is None:
+            return [None] * n
+        if isinstance(seed, (int, np.integer)) and not isinstance(seed, (bool, np.bool_)):
+            if seed < 0:
+                raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer >= 0")
+            return [int(seed) + i for i in range(n)]
+        if isinstance(seed, (list, tuple, np.ndarray)) and len(seed) == n and all(
+            s is None or (isinstance(s, (int, np.integer)) and not isinstance(s, (bool, np.bool_)) and s >= 0) for s in seed
+        ):
+            return [None if s is None else int(s) for s in seed]
+        raise NeurohoverError(f"seed={seed!r} is not allowed: give None, an integer >= 0, or a list of {n} such integers (or None)")
+
+    def _check_streams(self, value: Any) -> list[tuple[int, int]]:
+        n = self.num_envs
+        try:
+            per_env = np.ndim(value) == 2
+        except ValueError:  # ragged nesting
+            per_env = False
+        if per_env:
+            if len(value) != n:
+                raise NeurohoverError(f"noise has {len(value)} (seed, episode) pairs but there are num_envs={n} sub-environments")
+            return [check_noise_stream(tuple(v), f"noise[{i}]") for i, v in enumerate(value)]
+        seed, episode = check_noise_stream(value)
+        if episode + n - 1 > 2**63 - 1:
+            raise NeurohoverError(f"noise episode {episode} + {n - 1} sub-environments exceeds 2**63-1")
+        return [(seed, episode + i) for i in range(n)]
+
+    def _check_mask(self, mask: Any) -> np.ndarray:
+        if not isinstance(mask, np.ndarray) or mask.dtype != np.bool_ or mask.shape != (self.num_envs,) or not mask.any():
+            raise NeurohoverError(
+                f"reset_mask must be a bool numpy array of shape ({self.num_envs},) with at least one True, got {mask!r:.80}"
+            )
+        return mask.copy()
+
+    def _coerce_actions(self, actions: Any) -> np.ndarray:
+        try:
+            a = np.asarray(actions, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise NeurohoverError(f"actions must be a ({self.num_envs}, 4) array of numbers, got {actions!r:.80}") from None
+        if a.shape != (self.num_envs, ACTION_DIM):
+            raise NeurohoverError(f"actions have shape {a.shape}, expected ({self.num_envs}, 4): aileron, elevator, rudder, collective per helicopter")
+        np.copyto(self._actions, a)
+        return self._actions
+
+    # -- episodes --------------------------------------------------------------------------
+
+    def _reset_envs(self, idx: np.ndarray, streams: list[tuple[int, int]] | None) -> None:
+        """Start new episodes in sub-environments ``idx`` (their generators already exist)."""
+        draw = self.family._draw
+        template, where = self._sample_template, self._sample_slice
+        seeds = []
+        for i in idx.tolist():
+            gen = self._gens[i]
+            spec = self._specs[i]
+            if spec is SAMPLE:
+                # The same draws as family.sample(gen), but building the MDP object is ~8x dearer
+                # than the draw itself, so it is built only when someone asks (``mdps``).
+                d = draw(gen)
+                row = self._rows[i]
+                row[:] = template
+                row[where] = d
+                self._draws[i] = d
+                self._mdps[i] = None
+            elif spec is not self._mdps[i]:
+                self._rows[i] = spec.row()
+                self._draws[i] = None
+                self._mdps[i] = spec
+            if streams is None:
+                seeds.append(draw_stream_seed(gen))
+        if streams is None:
+            self._streams[idx, 0] = seeds
+            self._streams[idx, 1] = 0
+        else:
+            self._streams[idx] = [streams[i] for i in idx.tolist()]
+        _seed_streams(self._rng, idx, self._streams)
+        self._state[idx] = initial_state()
+        self._noise[idx] = 0.0
+        self._steps[idx] = 0
+        self._obs[idx] = 0.0  # the start state observes as all zeros
+
+    def _labels(self, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        labels = np.full(self.num_envs, None, dtype=object)
+        mask = np.zeros(self.num_envs, dtype=np.bool_)
+        for i in idx.tolist():
+            labels[i] = self._sample_label if self._draws[i] is not None else self._mdps[i].label  # type: ignore[union-attr]
+        mask[idx] = True
+        return labels, mask
+
+    def reset(
+        self, *, seed: int | Sequence[int | None] | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        options = check_reset_options(options, extra=("reset_mask",))
+        # Validate everything before changing anything, so a bad call leaves the env as it was.
+        seeds = self._check_seeds(seed)
+        mask = self._check_mask(options["reset_mask"]) if "reset_mask" in options else self._all
+        specs = self._resolve_specs(options["mdp"]) if "mdp" in options else self._specs
+        streams = self._check_streams(options["noise"]) if "noise" in options else None
+        if not self._ready and not mask.all():
+            raise NeurohoverError("the first reset() must reset every sub-environment: leave out reset_mask")
+        if isinstance(seed, (int, np.integer)):
+            super().reset(seed=int(seed))
+        idx = np.flatnonzero(mask)
+        for i in idx.tolist():
+            if seeds[i] is not None or self._gens[i] is None:
+                self._gens[i], _ = seeding.np_random(seeds[i])
+            self._specs[i] = specs[i]
+        self._reset_envs(idx, streams)
+        self._autoreset[idx] = False
+        self._any_autoreset = bool(self._autoreset.any())
+        self._ready = True
+        labels, label_mask = self._labels(idx)
+        info = {"mdp": labels, "_mdp": label_mask, "crashed": np.zeros(self.num_envs, dtype=np.bool_), "_crashed": label_mask.copy()}
+        return self._obs.copy(), info
+
+    def step(self, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        if not self._ready:
+            raise NeurohoverError("step() called before reset(): call reset() first")
+        a = actions
+        if not (type(a) is np.ndarray and a.dtype == np.float64 and a.shape == self._actions.shape and a.flags.c_contiguous):
+            a = self._coerce_actions(actions)
+        step_batch(self._rows, self._index, self._state, self._noise, self._rng, self._steps, a,
+                   self.episode_steps, self._obs, self._reward, self._crash)
+        rewards = self._reward.copy()
+        terminated = self._crash.copy()
+        truncated = self._steps >= self._limit
+        info: dict[str, Any] = {}
+        if self._any_autoreset:
+            # NEXT_STEP autoreset: the kernel also stepped these sub-environments (one batched
+            # call is cheaper than masking), and that step is now discarded.
+            idx = np.flatnonzero(self._autoreset)
+            self._reset_envs(idx, None)
+            rewards[idx] = 0.0
+            terminated[idx] = False
+            truncated[idx] = False
+            info["mdp"], info["_mdp"] = self._labels(idx)
+        info["crashed"] = terminated.copy()
+        info["_crashed"] = np.ones(self.num_envs, dtype=np.bool_)
+        np.logical_or(terminated, truncated, out=self._autoreset)
+        self._any_autoreset = bool(self._autoreset.any())
+        return self._obs.copy(), rewards, terminated, truncated, info
+
+
+__all__ = ["HoverVectorEnv"]
