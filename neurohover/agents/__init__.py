@@ -1,0 +1,6 @@
+"""On-line agents and the test-run protocol (SPEC section 7)."""
+
+from .model_free import ModelFreeAgent
+from .protocol import Agent, Choice, EpisodeOutcome, RunResult, run_test
+
+__all__ = ["Agent", "Choice", "EpisodeOutcome", "ModelFreeAgent", "RunResult", "run_test"]

@@ -1,0 +1,43 @@
+"""The model-free agent that won the 2008 competition (SPEC section 7, paper Section 3.3)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..errors import NeurohoverError
+from ..policies import Policy
+from ..tasks import TaskFamily
+from .protocol import Agent, Choice, EpisodeOutcome
+
+
+class ModelFreeAgent(Agent):
+    """Fly each specialised policy once, then keep the one with the best return for the rest.
+
+    Parameters
+    ----------
+    specialised : sequence of Policy
+        One policy evolved off-line per training MDP.
+    """
+
+    name = "model-free"
+
+    def __init__(self, specialised: Sequence[Policy]) -> None:
+        if len(specialised) == 0:
+            raise NeurohoverError("the model-free agent needs at least one specialised policy")
+        self.specialised = list(specialised)
+        self.trial_returns = np.full(len(self.specialised), -np.inf)
+
+    def start(self, family: TaskFamily, rng: np.random.Generator) -> None:
+        self.trial_returns = np.full(len(self.specialised), -np.inf)
+
+    def choose(self, episode: int) -> Choice:
+        if episode < len(self.specialised):
+            return Choice(self.specialised[episode], f"specialised:{episode}")
+        best = int(np.argmax(self.trial_returns))
+        return Choice(self.specialised[best], f"specialised:{best}", final=True)
+
+    def update(self, outcome: EpisodeOutcome) -> None:
+        if outcome.episode < len(self.specialised):
+            self.trial_returns[outcome.episode] = outcome.ret

@@ -1,0 +1,173 @@
+"""The on-line test-run protocol (SPEC section 7) and the interface every agent implements.
+
+A test run flies N episodes on one MDP the agent does not know; its score is the cumulative
+return of the whole run, so every crash counts. Before each episode the agent chooses the policy
+(and optionally a safeguard fallback); after it, the agent sees the outcome (with flight data if it
+asked for it) and may compute off-line, which is timed and recorded.
+
+Writing an agent
+----------------
+Subclass :class:`Agent` and implement ``choose`` and ``update``::
+
+    class AlwaysBaseline(Agent):
+        name = "always-baseline"
+        def choose(self, episode):
+            return Choice(baseline_policy(), "baseline", final=True)
+        def update(self, outcome):
+            pass
+
+``final=True`` promises the agent will choose the same policy for every remaining episode, which
+lets the harness fly the rest of the run in one parallel batch (same results, far faster).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import NeurohoverError
+from ..evaluate import PolicyTable, evaluate_jobs
+from ..flightdata import FlightData
+from ..policies import Policy
+from ..sim.constants import EPISODE_STEPS
+from ..tasks import MDP, TaskFamily
+
+
+@dataclass(frozen=True)
+class Choice:
+    """What the agent flies next.
+
+    Attributes
+    ----------
+    policy : Policy
+    label : str
+        Name of the policy in the run's records (e.g. ``"specialised:3"``, ``"model:2"``).
+    fallback : Policy or None
+        Safeguard fallback: on a dangerous state it flies the rest of the episode.
+    record : bool
+        Whether the agent wants this episode's flight data.
+    final : bool
+        The agent keeps this choice (without fallback changes) for the rest of the run.
+    """
+
+    policy: Policy
+    label: str
+    fallback: Policy | None = None
+    record: bool = False
+    final: bool = False
+
+
+@dataclass(frozen=True)
+class EpisodeOutcome:
+    """What the agent learns after an episode."""
+
+    episode: int
+    ret: float
+    crashed: bool
+    steps: int
+    safeguard_step: int  # control step at which the fallback took over, or -1
+    flight_data: FlightData | None
+
+
+class Agent:
+    """Base class of on-line agents. ``start`` is called once per test run, before episode 0."""
+
+    name: str = "agent"
+
+    def start(self, family: TaskFamily, rng: np.random.Generator) -> None:
+        """Prepare for a new run on an unknown MDP of ``family`` (reset any per-run state)."""
+
+    def choose(self, episode: int) -> Choice:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def update(self, outcome: EpisodeOutcome) -> None:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+
+@dataclass
+class RunResult:
+    """Per-episode records of one test run; ``score`` is the cumulative return."""
+
+    agent: str
+    mdp: MDP
+    returns: np.ndarray
+    crashed: np.ndarray
+    steps: np.ndarray
+    policy: list[str]
+    safeguard_fired: np.ndarray
+    offline_seconds: np.ndarray
+    seconds: float = 0.0
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def score(self) -> float:
+        return float(self.returns.sum())
+
+    @property
+    def cumulative(self) -> np.ndarray:
+        return np.cumsum(self.returns)
+
+    def rows(self) -> list[dict]:
+        """One dict per episode (for CSV / JSON export)."""
+        return [
+            {"episode": e, "return": float(self.returns[e]), "crashed": bool(self.crashed[e]),
+             "steps": int(self.steps[e]), "policy": self.policy[e],
+             "safeguard_fired": bool(self.safeguard_fired[e]), "offline_seconds": float(self.offline_seconds[e])}
+            for e in range(self.returns.size)
+        ]
+
+
+def run_test(
+    agent: Agent,
+    family: TaskFamily,
+    mdp: MDP,
+    *,
+    episodes: int = 1000,
+    seed: int = 0,
+    n_steps: int = EPISODE_STEPS,
+    threads: int | None = None,
+) -> RunResult:
+    """Fly one test run of ``episodes`` episodes of ``agent`` on ``mdp``.
+
+    Episode e's gusts come from stream (seed, e), so two agents run with the same seed meet the
+    same noise. The agent's own randomness derives from ``seed`` as well.
+    """
+    if not isinstance(episodes, (int, np.integer)) or episodes < 1:
+        raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
+    start_time = time.perf_counter()
+    agent.start(family, np.random.default_rng(np.random.SeedSequence([seed, 0xA6E27])))
+    returns = np.zeros(episodes)
+    crashed = np.zeros(episodes, dtype=bool)
+    steps = np.zeros(episodes, dtype=np.int64)
+    fired = np.zeros(episodes, dtype=bool)
+    offline = np.zeros(episodes)
+    labels: list[str] = [""] * episodes
+    e = 0
+    while e < episodes:
+        choice = agent.choose(e)
+        if choice.final:
+            # The choice holds for the rest of the run: fly it in one parallel batch.
+            rest = np.arange(e, episodes)
+            zeros = np.zeros(rest.size, dtype=np.int64)
+            table = PolicyTable.from_policies([choice.policy] + ([choice.fallback] if choice.fallback else []))
+            ev = evaluate_jobs(table, mdp, zeros, zeros, rest, seed=seed, n_steps=n_steps, threads=threads,
+                               fallback_index=np.full(rest.size, 1 if choice.fallback else -1))
+            returns[e:], crashed[e:], steps[e:] = ev.returns, ev.crashed, ev.steps
+            fired[e:] = ev.safeguard_step >= 0
+            labels[e:] = [choice.label] * rest.size
+            break
+        table = PolicyTable.from_policies([choice.policy] + ([choice.fallback] if choice.fallback else []))
+        ev = evaluate_jobs(table, mdp, [0], [0], [e], seed=seed, n_steps=n_steps, threads=threads,
+                           fallback_index=[1 if choice.fallback else -1], record=[choice.record])
+        returns[e], crashed[e], steps[e] = ev.returns[0], ev.crashed[0], ev.steps[0]
+        fired[e] = ev.safeguard_step[0] >= 0
+        labels[e] = choice.label
+        t0 = time.perf_counter()
+        agent.update(EpisodeOutcome(e, float(ev.returns[0]), bool(ev.crashed[0]), int(ev.steps[0]),
+                                    int(ev.safeguard_step[0]), ev.flight_data))
+        offline[e] = time.perf_counter() - t0
+        e += 1
+    return RunResult(agent.name, mdp, returns, crashed, steps, labels, fired, offline,
+                     time.perf_counter() - start_time)
