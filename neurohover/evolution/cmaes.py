@@ -1,0 +1,154 @@
+"""CMA-ES baseline with the same ask/tell surface as the neuroevolution optimisers.
+
+Built on :class:`cma.CMAEvolutionStrategy` (pycma). pycma minimises, so the
+returns told here (MAXIMISED, negative in the helicopter domain) are negated
+before being passed on.
+"""
+
+from __future__ import annotations
+
+import math
+
+import cma
+import numpy as np
+
+from .neuroevolution import (
+    ChampionRecord,
+    _ChampionTracker,
+    _check_prototype,
+    _check_returns,
+    _Clock,
+)
+
+__all__ = ["CMAES"]
+
+
+class CMAES:
+    """CMA-ES over flat genomes, ask/tell, maximising returns.
+
+    Randomness: pycma's ``seed`` option reseeds NumPy's GLOBAL random state,
+    so instead the strategy samples through its ``randn`` option from a
+    private ``numpy.random.Generator`` seeded with ``seed`` (and ``seed`` is
+    set to NaN, which tells pycma not to touch the global state). Runs are
+    reproducible and independent of other code using ``np.random``. No
+    output is printed and no files are written.
+
+    Non-finite returns (NaN, ``-inf``) are passed to pycma as a loss worse
+    than every finite loss of the batch (pycma only ranks within a batch,
+    so its update treats them as the worst); they never become champion.
+
+    Parameters
+    ----------
+    prototype : np.ndarray
+        1-D initial mean (D >= 2, a pycma requirement).
+    sigma0 : float, default 0.5
+        Initial step size (> 0).
+    seed : int, default 0
+        Seed of the private generator.
+    popsize : int, optional
+        Offspring per generation; pycma's default ``4 + 3 ln D`` if None.
+    budget : int, optional
+        Stop once this many evaluations were told.
+    """
+
+    def __init__(
+        self,
+        prototype: np.ndarray,
+        sigma0: float = 0.5,
+        seed: int = 0,
+        popsize: int | None = None,
+        budget: int | None = None,
+    ) -> None:
+        x0 = _check_prototype(prototype)
+        if x0.size < 2:
+            raise ValueError(f"CMAES needs a genome of length >= 2, got {x0.size}")
+        if not (isinstance(sigma0, (int, float)) and math.isfinite(sigma0) and sigma0 > 0):
+            raise ValueError(f"sigma0={sigma0!r} must be a finite number > 0")
+        if popsize is not None and (not isinstance(popsize, (int, np.integer)) or popsize < 2):
+            raise ValueError(f"popsize={popsize!r} must be None or an integer >= 2")
+        if budget is not None and (not isinstance(budget, (int, np.integer)) or budget < 1):
+            raise ValueError(f"budget={budget!r} must be None or an integer >= 1")
+        self._rng = np.random.default_rng(seed)
+        rng = self._rng
+        opts: dict = {
+            "seed": float("nan"),
+            "randn": lambda *shape: rng.standard_normal(shape),
+            "verbose": -9,
+            "verb_disp": 0,
+            "verb_log": 0,
+        }
+        if popsize is not None:
+            opts["popsize"] = int(popsize)
+        self._es = cma.CMAEvolutionStrategy(x0, float(sigma0), opts)
+        self.budget = None if budget is None else int(budget)
+        self._pending: list[np.ndarray] | None = None
+        self._tracker = _ChampionTracker()
+        self._clock = _Clock()
+
+    def ask(self) -> np.ndarray:
+        """Return one generation of genomes, shape ``(popsize, D)``."""
+        if self._pending is not None:
+            raise RuntimeError("ask() called again before tell() of the previous batch")
+        self._pending = [np.asarray(x, dtype=np.float64) for x in self._es.ask()]
+        return np.vstack(self._pending)
+
+    def tell(self, fitness: np.ndarray) -> None:
+        """Report one return per asked genome (maximised)."""
+        if self._pending is None:
+            raise RuntimeError("tell() called without a pending ask()")
+        f = _check_returns(fitness, len(self._pending))
+        losses = -f
+        bad = ~np.isfinite(losses)
+        if bad.any():
+            finite = losses[~bad]
+            worst = float(finite.max()) if finite.size else 0.0
+            losses[bad] = worst + max(1.0, abs(worst))
+        self._es.tell(self._pending, losses.tolist())
+        self._tracker.update(np.vstack(self._pending), f, self._clock())
+        self._pending = None
+
+    def stop(self) -> bool:
+        """True once the budget is spent or a pycma termination criterion fired."""
+        if self.budget is not None and self._tracker.evaluations >= self.budget:
+            return True
+        return self._tracker.evaluations > 0 and bool(self._es.stop())
+
+    @property
+    def popsize(self) -> int:
+        """Genomes per :meth:`ask`."""
+        return int(self._es.popsize)
+
+    @property
+    def mean(self) -> np.ndarray:
+        """Current distribution mean."""
+        return np.array(self._es.mean, dtype=np.float64)
+
+    @property
+    def sigma(self) -> float:
+        """Current overall step size."""
+        return float(self._es.sigma)
+
+    @property
+    def evaluations(self) -> int:
+        """Number of returns told so far."""
+        return self._tracker.evaluations
+
+    @property
+    def champion_genome(self) -> np.ndarray | None:
+        """Genome with the best single return ever told."""
+        return None if self._tracker.genome is None else self._tracker.genome.copy()
+
+    @property
+    def champion_return(self) -> float:
+        """Best single return ever told (``-inf`` before any finite return)."""
+        return self._tracker.best
+
+    @property
+    def evaluations_since_champion(self) -> int:
+        """Evaluations told since the current champion appeared."""
+        return self._tracker.since
+
+    @property
+    def history(self) -> list[ChampionRecord]:
+        """One record per new champion, in order."""
+        return list(self._tracker.history)

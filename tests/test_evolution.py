@@ -1,0 +1,491 @@
+"""Tests of the optimiser layer (neurohover.evolution): operators, NE, CMA-ES, races."""
+
+from __future__ import annotations
+
+import json
+import math
+import warnings
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from neurohover.evolution import (
+    CMAES,
+    GenerationalNE,
+    GenerationalSettings,
+    SteadyStateNE,
+    SteadyStateSettings,
+    bayes_mean_bounds,
+    crossover,
+    fixed_resampling,
+    mutate,
+    roulette_weights,
+    selection_race,
+)
+
+D = 10
+TARGET = np.random.default_rng(1234).normal(size=D)
+
+
+def sphere_return(genomes: np.ndarray) -> np.ndarray:
+    """Synthetic return to maximise: -||g - target||^2 - 1 (optimum -1, prototype ~ -6.6)."""
+    return -np.sum((np.atleast_2d(genomes) - TARGET) ** 2, axis=1) - 1.0
+
+
+PROTO_RETURN = float(sphere_return(np.zeros(D))[0])
+
+
+def run_to_stop(opt, fitness=sphere_return) -> None:
+    while not opt.stop():
+        opt.tell(fitness(opt.ask()))
+
+
+# --------------------------------------------------------------------------- operators
+
+
+def test_mutation_statistics() -> None:
+    s = SteadyStateSettings()  # frac 0.1, std 0.8, repl 0.25
+    g = np.full(400_000, 100.0)
+    out = mutate(g, np.random.default_rng(0), s)
+    assert np.all(g == 100.0)  # input untouched
+    changed = out != 100.0
+    assert changed.mean() == pytest.approx(0.1, abs=0.003)
+    replaced = changed & (np.abs(out) < 50.0)  # replaced genes are N(0, .8), shifted ones ~100
+    assert replaced.sum() / changed.sum() == pytest.approx(0.25, abs=0.01)
+    shifted = changed & ~replaced
+    assert np.std(out[shifted] - 100.0) == pytest.approx(0.8, rel=0.02)
+    assert np.std(out[replaced]) == pytest.approx(0.8, rel=0.03)
+    assert abs(np.mean(out[shifted] - 100.0)) < 0.02
+
+
+def test_mutation_extremes() -> None:
+    g = np.arange(50, dtype=float)
+    none = SteadyStateSettings(mutate_frac=0.0)
+    assert np.array_equal(mutate(g, np.random.default_rng(0), none), g)
+    allrepl = SteadyStateSettings(mutate_frac=1.0, mutate_repl=1.0, mutate_std=0.01)
+    assert np.all(np.abs(mutate(g, np.random.default_rng(0), allrepl)) < 0.1)
+
+
+def test_crossover_statistics() -> None:
+    s = SteadyStateSettings(averaging_prob=0.3)
+    a, b = np.zeros(300_000), np.ones(300_000)
+    child = crossover(a, b, np.random.default_rng(0), s)
+    assert set(np.unique(child)) == {0.0, 0.5, 1.0}
+    assert np.mean(child == 0.5) == pytest.approx(0.3, abs=0.004)
+    copies = child != 0.5
+    assert np.mean(child[copies] == 0.0) == pytest.approx(0.5, abs=0.005)
+    with pytest.raises(ValueError, match="same shape"):
+        crossover(np.zeros(3), np.zeros(4), np.random.default_rng(0), s)
+
+
+def test_roulette_weights() -> None:
+    w = roulette_weights(np.array([-1e4, -100.0, -1.0, 5.0, np.nan, -np.inf]))
+    assert np.all(np.isfinite(w)) and np.all(w[:4] > 0)
+    assert w[0] < w[1] < w[2]  # smaller error, larger weight
+    assert w[2] == w[3]  # error <= 1 clamped to the same floor
+    assert w[1] == pytest.approx(1.0 / math.log(100.0))
+    assert w[4] == 0.0 and w[5] == 0.0
+    assert np.array_equal(roulette_weights(np.array([np.nan, np.nan])), [1.0, 1.0])
+
+
+# --------------------------------------------------------------------------- settings
+
+
+@pytest.mark.parametrize(
+    ("cls", "kwargs", "message"),
+    [
+        (SteadyStateSettings, {"elite_size": 60}, r"elite_size=60 must be smaller than pop_size=50"),
+        (SteadyStateSettings, {"pop_size": 10}, r"elite_size=49 must be smaller than pop_size=10"),
+        (SteadyStateSettings, {"pop_size": 1, "elite_size": 0}, r"pop_size=1 must be an integer >= 2"),
+        (SteadyStateSettings, {"crossover_prob": 1.5}, r"crossover_prob=1.5 must be a probability in \[0, 1\]"),
+        (SteadyStateSettings, {"mutate_frac": -0.1}, r"mutate_frac=-0.1 must be a probability"),
+        (SteadyStateSettings, {"mutate_repl": float("nan")}, r"mutate_repl=nan must be a probability"),
+        (SteadyStateSettings, {"mutate_std": -1.0}, r"mutate_std=-1.0 must be a finite number >= 0"),
+        (SteadyStateSettings, {"mutate_std": math.inf}, r"mutate_std=inf must be a finite number"),
+        (SteadyStateSettings, {"plateau_threshold": 0}, r"plateau_threshold=0 must be an integer >= 1"),
+        (SteadyStateSettings, {"budget": 0}, r"budget=0 must be an integer >= 1"),
+        (SteadyStateSettings, {"elite_size": 2.5}, r"elite_size=2.5 must be an integer"),
+        (GenerationalSettings, {"select_size": 0}, r"select_size=0 must be an integer >= 1"),
+        (GenerationalSettings, {"select_size": 51}, r"select_size=51 must be in \[1, pop_size=50\]"),
+        (GenerationalSettings, {"generations": 0}, r"generations=0 must be an integer >= 1"),
+        (GenerationalSettings, {"averaging_prob": 2}, r"averaging_prob=2 must be a probability"),
+    ],
+)
+def test_settings_validation(cls, kwargs, message) -> None:
+    with pytest.raises(ValueError, match=message):
+        cls(**kwargs)
+
+
+def test_settings_defaults_are_paper_tables() -> None:
+    s = SteadyStateSettings()
+    assert (s.pop_size, s.elite_size, s.crossover_prob, s.averaging_prob) == (50, 49, 0.5, 0.5)
+    assert (s.mutate_prob, s.mutate_frac, s.mutate_std, s.mutate_repl) == (0.75, 0.1, 0.8, 0.25)
+    assert (s.plateau_threshold, s.budget) == (1000, None)
+    g = GenerationalSettings()
+    assert (g.pop_size, g.select_size, g.generations, g.crossover_prob) == (50, 20, 4000, 1.0)
+    assert (g.averaging_prob, g.mutate_prob, g.mutate_frac, g.mutate_std, g.mutate_repl) == (
+        0.5, 0.75, 0.1, 0.8, 0.25,
+    )
+    assert isinstance(SteadyStateSettings(pop_size=np.int64(60)).pop_size, int)
+
+
+# --------------------------------------------------------------------------- steady state
+
+
+def test_steady_state_ask_tell_shapes_and_budget() -> None:
+    opt = SteadyStateNE(np.zeros(D), SteadyStateSettings(budget=120), seed=0)
+    first = opt.ask()
+    assert first.shape == (50, D)
+    assert np.array_equal(first[0], np.zeros(D))  # the prototype itself
+    assert np.any(first[1:] != 0.0)  # mutated copies
+    with pytest.raises(RuntimeError):
+        opt.ask()
+    with pytest.raises(ValueError, match="shape"):
+        opt.tell(np.zeros(49))
+    opt.tell(sphere_return(first))
+    assert opt.ask().shape == (1, D)
+    with pytest.raises(ValueError, match=r"\+inf"):
+        opt.tell(np.array([np.inf]))
+    opt.tell(np.array([-5.0]))
+    run_to_stop(opt)
+    assert opt.evaluations == 120
+    assert opt.population.shape == (50, D)
+
+
+def test_steady_state_improves() -> None:
+    opt = SteadyStateNE(np.zeros(D), SteadyStateSettings(budget=3000), seed=3)
+    run_to_stop(opt)
+    assert opt.evaluations == 3000
+    assert opt.champion_return > -1.2  # prototype is ~ -6.6, optimum -1
+    assert opt.champion_return == pytest.approx(float(sphere_return(opt.champion_genome)[0]))
+    returns = [h.champion_return for h in opt.history]
+    evals = [h.evaluations for h in opt.history]
+    assert np.all(np.diff(returns) > 0) and np.all(np.diff(evals) > 0)
+    assert returns[-1] == opt.champion_return
+    # Elitism: the population's best is the champion.
+    assert np.nanmax(opt.fitness) == opt.champion_return
+
+
+def test_steady_state_plateau_stop() -> None:
+    # budget only guards against a hang if the plateau rule were broken
+    opt = SteadyStateNE(np.zeros(D), SteadyStateSettings(plateau_threshold=70, budget=500), seed=0)
+    run_to_stop(opt, lambda g: np.full(len(g), -10.0))  # nothing ever beats the first genome
+    assert opt.evaluations == 71
+    assert opt.evaluations_since_champion == 70
+    assert len(opt.history) == 1 and opt.history[0].evaluations == 1
+
+
+def test_steady_state_nonfinite_returns_rank_worst() -> None:
+    opt = SteadyStateNE(np.zeros(D), SteadyStateSettings(budget=1500), seed=0)
+    crash = np.random.default_rng(5)
+
+    def fitness(g):
+        r = sphere_return(g)
+        u = crash.random(r.size)
+        r[u < 0.2] = np.nan
+        r[u > 0.9] = -np.inf
+        return r
+
+    n_finite = []
+    while not opt.stop():
+        opt.tell(fitness(opt.ask()))
+        n_finite.append(int(np.isfinite(opt.fitness).sum()))
+        finite_fit = np.where(np.isinf(opt.fitness), np.nan, opt.fitness)
+        assert np.nanmax(finite_fit) == opt.champion_return
+    # Elitism never drops a finite genome in favour of a NaN / -inf one.
+    assert n_finite[0] < 50
+    assert all(b >= min(a, 49) for a, b in zip(n_finite, n_finite[1:]))
+    assert math.isfinite(opt.champion_return)
+    assert opt.champion_return > PROTO_RETURN + 5.0
+
+
+def test_steady_state_determinism() -> None:
+    runs = []
+    for seed in (7, 7, 8):
+        opt = SteadyStateNE(np.zeros(D), SteadyStateSettings(budget=400), seed=seed)
+        run_to_stop(opt)
+        runs.append(opt)
+    assert np.array_equal(runs[0].population, runs[1].population)
+    assert runs[0].champion_return == runs[1].champion_return
+    assert not np.array_equal(runs[0].population, runs[2].population)
+
+
+@pytest.mark.parametrize("between_ask_and_tell", [False, True])
+def test_steady_state_checkpoint_resume(between_ask_and_tell: bool) -> None:
+    settings = SteadyStateSettings(budget=500)
+    ref = SteadyStateNE(np.zeros(D), settings, seed=11)
+    run_to_stop(ref)
+
+    opt = SteadyStateNE(np.zeros(D), settings, seed=11)
+    for _ in range(40):
+        opt.tell(sphere_return(opt.ask()))
+    pending = opt.ask() if between_ask_and_tell else None
+    text = json.dumps(opt.state_dict(), allow_nan=False)
+    resumed = SteadyStateNE.from_state_dict(json.loads(text))
+    if pending is not None:
+        resumed.tell(sphere_return(pending))
+    run_to_stop(resumed)
+
+    assert resumed.evaluations == ref.evaluations == 500
+    assert np.array_equal(resumed.population, ref.population)
+    assert np.array_equal(resumed.fitness, ref.fitness)
+    assert np.array_equal(resumed.champion_genome, ref.champion_genome)
+    assert [(h.evaluations, h.champion_return) for h in resumed.history] == [
+        (h.evaluations, h.champion_return) for h in ref.history
+    ]
+    assert resumed.history[-1].wall_seconds >= resumed.history[0].wall_seconds
+
+
+# --------------------------------------------------------------------------- generational
+
+
+def test_generational_improves_and_records() -> None:
+    opt = GenerationalNE(np.zeros(D), GenerationalSettings(generations=60), seed=5)
+    first = opt.ask()
+    assert first.shape == (50, D) and np.array_equal(first[0], np.zeros(D))
+    opt.tell(sphere_return(first))
+    run_to_stop(opt)
+    assert opt.generation == 60 and opt.evaluations == 3000
+    hist = opt.history
+    assert [h.generation for h in hist] == list(range(1, 61))
+    assert all(h.episodes == 50 for h in hist) and hist[-1].evaluations == 3000
+    assert hist[0].champion_return < -3.0 < -1.3 < hist[-1].champion_return
+    assert opt.champion_return == hist[-1].champion_return
+    assert opt.champion_return == pytest.approx(float(sphere_return(opt.champion_genome)[0]))
+
+
+def test_generational_breeds_only_from_selected() -> None:
+    # With no mutation, children are per-gene averages/copies of parents, so
+    # they stay inside the selected parents' per-gene range.
+    s = GenerationalSettings(pop_size=20, select_size=4, generations=2, mutate_prob=0.0)
+    opt = GenerationalNE(np.zeros(3), s, seed=0)
+    pop = opt.ask()
+    chosen = np.array([3, 7, 11, 19])
+    opt.tell(np.zeros(20), selected=chosen, episodes=123)
+    children = opt.ask()
+    lo, hi = pop[chosen].min(axis=0), pop[chosen].max(axis=0)
+    assert np.all(children >= lo - 1e-12) and np.all(children <= hi + 1e-12)
+    assert opt.history[0].episodes == 123 and opt.evaluations == 123
+    with pytest.raises(ValueError, match="distinct integer indices"):
+        opt.tell(np.zeros(20), selected=np.array([1, 1, 2, 3]))
+
+
+def test_generational_with_selection_race_on_noisy_fitness() -> None:
+    noise_rng = np.random.default_rng(99)
+    s = GenerationalSettings(pop_size=20, select_size=6, generations=25)
+    opt = GenerationalNE(np.zeros(D), s, seed=2)
+    while not opt.stop():
+        pop = opt.ask()
+        true = sphere_return(pop)
+        race = selection_race(
+            lambda idx: true[idx] + noise_rng.normal(0.0, 0.3, idx.size), 20, 6, 0.9, t_limit=5
+        )
+        opt.tell_race(race)
+        assert opt.history[-1].episodes == race.episodes_spent
+    assert opt.evaluations == sum(h.episodes for h in opt.history) < 25 * 20 * 5
+    assert float(sphere_return(opt.champion_genome)[0]) > PROTO_RETURN + 3.0
+
+
+@pytest.mark.parametrize("between_ask_and_tell", [False, True])
+def test_generational_checkpoint_resume(between_ask_and_tell: bool) -> None:
+    s = GenerationalSettings(pop_size=12, select_size=4, generations=30)
+    ref = GenerationalNE(np.zeros(D), s, seed=4)
+    run_to_stop(ref)
+    opt = GenerationalNE(np.zeros(D), s, seed=4)
+    for _ in range(13):
+        opt.tell(sphere_return(opt.ask()))
+    pending = opt.ask() if between_ask_and_tell else None
+    text = json.dumps(opt.state_dict(), allow_nan=False)
+    resumed = GenerationalNE.from_state_dict(json.loads(text))
+    if pending is not None:
+        resumed.tell(sphere_return(pending))
+    run_to_stop(resumed)
+    assert np.array_equal(resumed.population, ref.population)
+    assert np.array_equal(resumed.champion_genome, ref.champion_genome)
+    assert [h.champion_return for h in resumed.history] == [h.champion_return for h in ref.history]
+
+
+def test_generational_determinism() -> None:
+    settings = GenerationalSettings(generations=5)
+    a, b, c = (GenerationalNE(np.zeros(D), settings, seed=s) for s in (1, 1, 2))
+    for opt in (a, b, c):
+        run_to_stop(opt)
+    assert np.array_equal(a.population, b.population)
+    assert not np.array_equal(a.population, c.population)
+
+
+# --------------------------------------------------------------------------- CMA-ES
+
+
+def test_cmaes_improves_is_deterministic_and_leaves_global_rng_alone() -> None:
+    before = np.random.get_state()[1].copy()
+    opts = [CMAES(np.zeros(D), sigma0=0.5, seed=s, budget=1500) for s in (3, 3, 4)]
+    for opt in opts:
+        run_to_stop(opt)
+    assert np.array_equal(np.random.get_state()[1], before)
+    a, b, c = opts
+    assert a.champion_return > -1.01
+    assert a.champion_return == b.champion_return and np.array_equal(a.mean, b.mean)
+    assert a.champion_return != c.champion_return
+    assert np.all(np.diff([h.champion_return for h in a.history]) > 0)
+    assert a.evaluations <= 1500 + a.popsize
+
+
+def test_cmaes_nonfinite_and_popsize() -> None:
+    opt = CMAES(np.zeros(D), seed=0, popsize=8, budget=400)
+    while not opt.stop():
+        x = opt.ask()
+        assert x.shape == (8, D)
+        r = sphere_return(x)
+        r[0], r[1] = np.nan, -np.inf
+        opt.tell(r)
+    assert math.isfinite(opt.champion_return) and opt.champion_return > PROTO_RETURN
+    with pytest.raises(ValueError, match="sigma0"):
+        CMAES(np.zeros(D), sigma0=0.0)
+
+
+# --------------------------------------------------------------------------- races
+
+
+def noisy_sampler(means: np.ndarray, sd: float, seed: int):
+    rng = np.random.default_rng(seed)
+    calls = []
+
+    def sample(idx: np.ndarray) -> np.ndarray:
+        calls.append(idx.size)
+        return means[idx] + rng.normal(0.0, sd, idx.size)
+
+    return sample, calls
+
+
+def test_bayes_mean_bounds_edge_cases() -> None:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert bayes_mean_bounds(np.array([3.0]), 0.9) == (-math.inf, math.inf)
+        assert bayes_mean_bounds(np.array([2.0, 2.0, 2.0]), 0.9) == (2.0, 2.0)
+        assert bayes_mean_bounds(np.array([-np.inf, 1.0]), 0.9) == (-math.inf, -math.inf)
+        lo, hi = bayes_mean_bounds(np.array([1.0, 2.0]), 0.9)
+        assert math.isfinite(lo) and lo < 1.5 < hi
+        x = np.random.default_rng(0).normal(5.0, 2.0, 7)
+        expected = stats.t.interval(0.8, 6, loc=x.mean(), scale=stats.sem(x))
+        assert bayes_mean_bounds(x, 0.8) == pytest.approx(expected)
+        assert bayes_mean_bounds(x, 0.95)[0] < bayes_mean_bounds(x, 0.5)[0]
+
+
+@pytest.mark.parametrize("n", [2, 3, 5, 10, 37, 1000, 1001, 1500])
+@pytest.mark.parametrize("delta", [0.1, 0.5, 0.9, 0.99])
+def test_bayes_mean_bounds_match_scipy_bayes_mvs(n: int, delta: float) -> None:
+    x = np.random.default_rng(n).normal(-3e4, 5e3, n)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # n=2: infinite statistic
+        expected = stats.bayes_mvs(x, alpha=delta)[0].minmax
+    assert bayes_mean_bounds(x, delta) == pytest.approx(expected, rel=1e-12, abs=1e-9)
+
+
+def test_race_selects_top_mu_and_saves_episodes() -> None:
+    means = -10.0 * np.arange(20)[::-1]  # candidate 19 best
+    sample, calls = noisy_sampler(means, 1.0, seed=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        race = selection_race(sample, 20, 5, delta=0.9, t_limit=10)
+    assert sorted(race.selected.tolist()) == [15, 16, 17, 18, 19]
+    assert race.n_raced == 5
+    fixed = fixed_resampling(noisy_sampler(means, 1.0, seed=0)[0], 20, k=10)
+    assert fixed.episodes_spent == 200 and fixed.samples.shape == (20, 10)
+    assert race.episodes_spent < fixed.episodes_spent / 2
+    assert race.episodes_spent == race.n_samples.sum() == sum(calls)
+    assert race.rounds == len(calls) and race.n_samples.max() <= 10
+    assert np.all(race.lower <= race.means) and np.all(race.means <= race.upper)
+    assert np.all(np.abs(race.means - means) < 4.0)
+
+
+def test_race_decision_rule_thresholds() -> None:
+    # Scripted returns, delta=0.5 (t quantile 1.0 at 1 dof). After round 2:
+    # c0 = [10, 12] -> bounds [10, 12]; c1 = [11.5, 11.5] -> point 11.5, inside
+    # c0's bounds; c2, c3 = [0, 0] -> point 0. With lambda=4, mu=1 nobody beats
+    # lambda-mu=3 others yet, while c2 and c3 lie below >= mu=1 others: discarded.
+    # Round 3: c0 = [10, 12, 11] -> 11 +- 0.47, so c1 (11.5) now beats all 3
+    # and c0 lies below c1.
+    script = {0: [10.0, 12.0, 11.0], 1: [11.5, 11.5, 11.5], 2: [0.0, 0.0, 0.0], 3: [0.0, 0.0, 0.0]}
+    calls = {i: 0 for i in script}
+
+    def sample(idx):
+        out = []
+        for i in idx:
+            out.append(script[int(i)][calls[int(i)]])
+            calls[int(i)] += 1
+        return np.array(out)
+
+    race = selection_race(sample, 4, 1, delta=0.5, t_limit=10)
+    assert race.rounds == 3 and race.n_raced == 1
+    assert race.selected.tolist() == [1]
+    assert race.discarded.tolist() == [2, 3, 0]  # c0 (upper 11.47 < 11.5) goes in round 3
+    assert race.n_samples.tolist() == [3, 3, 2, 2]
+    assert race.lower[0] == pytest.approx(11.0 - stats.t.ppf(0.75, 2) * math.sqrt(1 / 3))
+
+
+def test_race_indistinguishable_candidates_run_to_limit() -> None:
+    sample, _ = noisy_sampler(np.zeros(12), 1.0, seed=1)
+    race = selection_race(sample, 12, 4, delta=0.99, t_limit=6)
+    assert len(set(race.selected.tolist())) == 4
+    assert race.rounds == 6 and race.episodes_spent <= 12 * 6
+    # The fill step takes the best means among the undecided ones.
+    undecided = race.n_samples == 6
+    filled = race.selected[race.n_raced:]
+    assert np.all(undecided[filled])
+    others = np.setdiff1d(np.flatnonzero(undecided), race.selected)
+    assert race.means[filled].min() >= race.means[others].max()
+
+
+def test_race_single_sample_and_zero_variance() -> None:
+    means = np.arange(8, dtype=float)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        one = selection_race(lambda i: means[i], 8, 3, delta=0.9, t_limit=1)
+        assert one.rounds == 1 and one.episodes_spent == 8 and one.n_raced == 0
+        assert sorted(one.selected.tolist()) == [5, 6, 7]
+        exact = selection_race(lambda i: means[i], 8, 3, delta=0.9, t_limit=10)
+        assert exact.rounds == 2 and exact.episodes_spent == 16 and exact.n_raced == 3
+        assert sorted(exact.selected.tolist()) == [5, 6, 7]
+        ties = selection_race(lambda i: np.full(i.size, -4.0), 8, 3, delta=0.9, t_limit=4)
+        assert ties.rounds == 4 and ties.n_raced == 0 and len(set(ties.selected.tolist())) == 3
+
+
+def test_race_nan_returns_are_worst() -> None:
+    means = np.arange(10, dtype=float)
+
+    def sample(idx):
+        out = means[idx] + np.random.default_rng(int(idx.sum())).normal(0, 0.1, idx.size)
+        out[idx == 9] = np.nan  # the nominally best candidate crashes the simulator
+        return out
+
+    race = selection_race(sample, 10, 3, delta=0.9)
+    assert 9 not in race.selected and sorted(race.selected.tolist()) == [6, 7, 8]
+    assert race.means[9] == -math.inf
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"delta": 0.0}, r"delta=0.0 must be a confidence level strictly between 0 and 1"),
+        ({"delta": 1.0}, r"delta=1.0 must be"),
+        ({"mu": 0}, r"mu=0 must be an integer >= 1"),
+        ({"mu": 6}, r"mu=6 must be smaller than n_candidates=6"),
+        ({"t_limit": 0}, r"t_limit=0 must be an integer >= 1"),
+        ({"n_candidates": 1, "mu": 1}, r"n_candidates=1 must be an integer >= 2"),
+    ],
+)
+def test_race_validation(kwargs, message) -> None:
+    args = {"n_candidates": 6, "mu": 2, "delta": 0.9, "t_limit": 3} | kwargs
+    with pytest.raises(ValueError, match=message):
+        selection_race(lambda i: np.zeros(i.size), **args)
+
+
+def test_resampling_validation_and_shape_check() -> None:
+    with pytest.raises(ValueError, match=r"k=0 must be an integer >= 1"):
+        fixed_resampling(lambda i: np.zeros(i.size), 5, 0)
+    with pytest.raises(ValueError, match="sample_fn returned shape"):
+        fixed_resampling(lambda i: np.zeros(3), 5, 2)
+    res = fixed_resampling(lambda i: i.astype(float), 4, 3)
+    assert np.array_equal(res.means, [0.0, 1.0, 2.0, 3.0]) and res.episodes_spent == 12
