@@ -43,6 +43,7 @@ GHH09_PARAM_NAMES = (
 )
 _SET_ENTROPY = 20110401  # fixed root of the training and test sets (the paper's year)
 _FAMILY_CODE = {"ghh08": 8, "ghh09": 9, "fghh": 12}
+_FIXED_SETS: dict[tuple[str, int, int], tuple["MDP", ...]] = {}
 
 
 @dataclass(frozen=True)
@@ -148,8 +149,11 @@ class _FamilyBase:
         return self.make(self._draw(rng), label=label or f"{self.name}/sample")
 
     def _fixed_set(self, which: int, n: int, kind: str) -> list[MDP]:
-        rng = np.random.default_rng(_seed_sequence(self.name, which, self._set_key()))
-        return [self.make(self._draw(rng), label=f"{self.name}/{kind}:{i}") for i in range(n)]
+        key = (self.name, self._set_key(), which)
+        if key not in _FIXED_SETS:  # MDPs are immutable, so each set is built once per process
+            rng = np.random.default_rng(_seed_sequence(self.name, which, self._set_key()))
+            _FIXED_SETS[key] = tuple(self.make(self._draw(rng), label=f"{self.name}/{kind}:{i}") for i in range(n))
+        return list(_FIXED_SETS[key])
 
     def training_mdps(self) -> list[MDP]:
         """The fixed, seeded set of 10 training MDPs."""
