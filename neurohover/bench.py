@@ -89,7 +89,12 @@ def vector_env_steps_per_second(num_envs: int = 1024, steps: int = 1000) -> floa
 
 def _extra_benchmarks(quick: bool) -> dict:
     """Benchmarks of later pipeline stages."""
-    return {"vector_env_1024_control_steps_per_second_1_core": vector_env_steps_per_second(1024, 200 if quick else 1000)}
+    from .evolution.evolve import benchmark_evolution
+
+    out = {"vector_env_1024_control_steps_per_second_1_core": vector_env_steps_per_second(1024, 200 if quick else 1000)}
+    # evolve() against the raw kernel flying the very same episodes (ratio_vs_raw_kernel).
+    out.update(benchmark_evolution(quick))
+    return out
 
 
 def run_benchmarks(quick: bool = False) -> dict:

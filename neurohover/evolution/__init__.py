@@ -5,6 +5,16 @@ ask/tell interface; fitness evaluation is left to the caller.
 """
 
 from .cmaes import CMAES
+from .evolve import (
+    EvolutionInterrupted,
+    EvolutionResult,
+    HistoryRecord,
+    ProgressInfo,
+    Resampling,
+    evolve,
+    parse_resampling,
+    validation_return,
+)
 from .neuroevolution import (
     ROULETTE_ERROR_FLOOR,
     ChampionRecord,
@@ -26,6 +36,11 @@ from .races import (
 
 __all__ = [
     "CMAES",
+    "EvolutionInterrupted",
+    "EvolutionResult",
+    "HistoryRecord",
+    "ProgressInfo",
+    "Resampling",
     "ROULETTE_ERROR_FLOOR",
     "ChampionRecord",
     "GenerationRecord",
@@ -37,8 +52,11 @@ __all__ = [
     "SteadyStateSettings",
     "bayes_mean_bounds",
     "crossover",
+    "evolve",
     "fixed_resampling",
     "mutate",
+    "parse_resampling",
     "roulette_weights",
     "selection_race",
+    "validation_return",
 ]

@@ -1,0 +1,278 @@
+"""Commands of the learning stage: ``evolve`` (policies) and ``learn-model`` (helicopter models).
+
+``neurohover evolve`` writes three files for ``--out FILE``:
+
+* ``FILE``: the champion as a policy file (SPEC section 3 JSON) with metadata: task, mdp, sigma,
+  optimizer, resampling, budget, seed, champion_return, validation_return (mean return of 10 fresh
+  episodes: on the MDP, or each on a fresh MDP from G, independent of the evolution's episodes),
+  validation_sd, episodes, seconds, stop_reason, ...;
+* ``FILE.history.csv``: the run's history, columns
+  ``generation,evaluations,episodes,generation_episodes,champion_return,wall_seconds``
+  (see :class:`neurohover.evolution.evolve.HistoryRecord`: steady state, one line per new champion
+  and one for the last generation; generational, one line per generation, ``generation_episodes``
+  being the episodes a race or fixed resampling spent on it);
+* ``FILE.checkpoint.json``: the run's checkpoint (every ``--checkpoint-every`` seconds, at the end
+  and on Ctrl-C), which ``--resume`` continues from; the budget may be raised when resuming.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .errors import NeurohoverError
+
+MDP_FAMILY = "G"
+
+
+def _floats(text: str, what: str) -> list[float]:
+    try:
+        return [float(x) for x in text.split(",") if x.strip() != ""]
+    except ValueError:
+        raise NeurohoverError(f"{what} must be comma-separated numbers, got {text!r}") from None
+
+
+def _target(args: argparse.Namespace):
+    """(target, family, mdp description for the metadata)."""
+    from .tasks import get_task_family
+
+    family = get_task_family(args.task, args.sigma)
+    if args.wind is not None and args.params is not None:
+        raise NeurohoverError("give either --wind (GHH-08) or --params, not both")
+    if (args.wind is not None or args.params is not None) and args.mdp not in (None,):
+        raise NeurohoverError("--wind/--params set the MDP explicitly; leave out --mdp")
+    if args.wind is not None:
+        if family.name != "ghh08":
+            raise NeurohoverError(f"--wind U,V sets a GHH-08 MDP; task {args.task!r} takes --params")
+        return family.make(_floats(args.wind, "--wind")), family, f"wind={args.wind}"
+    if args.params is not None:
+        return family.make(_floats(args.params, "--params")), family, f"params={args.params}"
+    spec = args.mdp if args.mdp is not None else (MDP_FAMILY if family.name == "fghh" else "zero")
+    if spec == MDP_FAMILY:
+        return family, family, MDP_FAMILY
+    if spec == "sample":  # one MDP drawn from G with the run's seed
+        rng = np.random.default_rng(np.random.SeedSequence(args.seed, spawn_key=(4,)))
+        return family.sample(rng, label=f"{family.name}/sample"), family, "sample"
+    return family.mdp(spec), family, spec
+
+
+def _seed_policy(args: argparse.Namespace):
+    from .policies import load_policy
+
+    if args.seed_policy in ("zero", "baseline"):
+        return args.topology or "mlp", args.seed_policy
+    path = Path(args.seed_policy)
+    if not path.is_file():
+        raise NeurohoverError(f"--seed-policy {args.seed_policy!r}: no such file (give zero, baseline or a policy file)")
+    policy = load_policy(path)
+    if args.topology is not None and args.topology != policy.topology:
+        raise NeurohoverError(f"--seed-policy {args.seed_policy!r} is an {policy.topology} policy but --topology is {args.topology}")
+    return policy.topology, policy
+
+
+class _Bar:
+    """tqdm progress bar on stderr (silent when stderr is not a terminal)."""
+
+    def __init__(self, total: int | None, desc: str) -> None:
+        from tqdm import tqdm
+
+        self.bar = tqdm(total=total, desc=desc, unit="ep", file=sys.stderr, disable=None, dynamic_ncols=True)
+
+    def __call__(self, info) -> None:
+        if info.episodes > self.bar.n:
+            self.bar.update(info.episodes - self.bar.n)
+        champion = f"{info.champion_return:.5g}" if math.isfinite(info.champion_return) else "-"
+        self.bar.set_postfix_str(f"evals={info.evaluations} champion={champion} {info.episodes_per_second:.0f} ep/s", refresh=False)
+
+    def close(self) -> None:
+        self.bar.close()
+
+
+def cmd_evolve(args: argparse.Namespace) -> int:
+    """Evolve a policy: steady state on one MDP, or generational over the task family's MDPs (--mdp G)."""
+    from .evolution.evolve import EvolutionInterrupted, evolve, parse_resampling, validation_return, write_history_csv
+    from .policies import save_policy
+
+    if args.budget is not None and args.budget < 1:
+        raise NeurohoverError(f"--budget {args.budget} is out of range: allowed an integer >= 1 (episodes)")
+    if args.seed < 0:
+        raise NeurohoverError(f"--seed {args.seed} is out of range: allowed >= 0")
+    if args.episode_steps < 1:
+        raise NeurohoverError(f"--episode-steps {args.episode_steps} is out of range: allowed >= 1")
+    if not args.checkpoint_every > 0:
+        raise NeurohoverError(f"--checkpoint-every {args.checkpoint_every} is out of range: allowed > 0 seconds")
+    if args.validation_episodes < 1:
+        raise NeurohoverError(f"--validation-episodes {args.validation_episodes} is out of range: allowed >= 1")
+    resampling = parse_resampling(args.resampling)
+    target, family, mdp_desc = _target(args)
+    topology, proto = _seed_policy(args)
+    out = Path(args.out)
+    history_path = Path(f"{out}.history.csv")
+    checkpoint = Path(f"{out}.checkpoint.json")
+    if args.resume and not checkpoint.is_file():
+        raise NeurohoverError(f"--resume: no checkpoint {str(checkpoint)!r} (it is written next to --out by an earlier run)")
+    if not args.resume and checkpoint.is_file():
+        print(f"neurohover evolve: starting afresh; {checkpoint} will be overwritten (use --resume to continue it)", file=sys.stderr)
+    bar = _Bar(args.budget, f"evolve {family.name}/{mdp_desc}")
+    try:
+        result = evolve(target, topology=topology, prototype=proto, optimizer=args.optimizer, resampling=resampling,
+                        budget=args.budget, seed=args.seed, n_steps=args.episode_steps, threads=args.threads,
+                        progress=bar, checkpoint=checkpoint, checkpoint_every_s=args.checkpoint_every,
+                        resume=args.resume)
+    except EvolutionInterrupted as err:
+        bar.close()
+        if err.checkpoint is not None:
+            print(f"neurohover evolve: interrupted after {err.episodes} episodes; checkpoint saved to {err.checkpoint} "
+                  "(run the same command with --resume to continue)", file=sys.stderr)
+        else:
+            print(f"neurohover evolve: interrupted mid-generation; the last periodic checkpoint (if any) is {checkpoint}",
+                  file=sys.stderr)
+        return 130
+    bar.close()
+    validation = validation_return(result.champion, target, episodes=args.validation_episodes, seed=args.seed,
+                                   n_steps=args.episode_steps, threads=args.threads)
+    meta = {
+        "task": family.name, "mdp": mdp_desc, "optimizer": args.optimizer, "resampling": str(resampling),
+        "budget": args.budget, "seed": args.seed, "seed_policy": str(args.seed_policy),
+        "champion_return": result.champion_return, "validation_return": float(validation.mean()),
+        "validation_sd": float(validation.std()), "validation_episodes": int(validation.size),
+        "episode_steps": args.episode_steps, "episodes": result.episodes, "evaluations": result.evaluations,
+        "generations": result.generations, "seconds": round(result.seconds, 3), "stop_reason": result.stop_reason,
+        "history": history_path.name,
+    }
+    if family.name == "fghh":
+        meta["sigma"] = float(family.sigma)
+    if mdp_desc != MDP_FAMILY:
+        meta["mdp_params"] = target.to_dict()
+    save_policy(result.champion, out, **meta)
+    write_history_csv(result.history, history_path)
+    summary = {
+        "policy": str(out), "history": str(history_path), "checkpoint": str(checkpoint),
+        "champion_return": result.champion_return, "validation_return": float(validation.mean()),
+        "validation_sd": float(validation.std()), "episodes": result.episodes, "generations": result.generations,
+        "seconds": result.seconds, "episodes_per_second": result.episodes_per_second, "stop_reason": result.stop_reason,
+    }
+    if args.json:
+        print(json.dumps(summary))
+    else:
+        for key, value in summary.items():
+            print(f"{key:>20}: {value:.6g}" if isinstance(value, float) else f"{key:>20}: {value}")
+    return 0
+
+
+class _Ticker:
+    """An elapsed-time tqdm bar for steps without progress reports (learning a model)."""
+
+    def __init__(self, desc: str) -> None:
+        from tqdm import tqdm
+
+        self.bar = tqdm(desc=desc, total=None, file=sys.stderr, disable=None, bar_format="{desc}: {elapsed}")
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+
+    def _run(self) -> None:
+        while not self._stop.wait(0.5):
+            self.bar.refresh()
+
+    def __enter__(self) -> "_Ticker":
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._stop.set()
+        self._thread.join()
+        self.bar.close()
+
+
+def _true_mdp(metadata: dict):
+    """The MDP the flight data was flown on, when its metadata names exactly one."""
+    from .tasks import MDP
+
+    mdps = metadata.get("mdps")
+    if not isinstance(mdps, list) or not mdps:
+        return None, "the flight data's metadata names no MDP"
+    try:
+        parsed = [MDP.from_dict(d) for d in mdps]
+    except (KeyError, TypeError, ValueError) as err:
+        return None, f"the flight data's MDP metadata is unreadable ({err})"
+    if any(m != parsed[0] for m in parsed[1:]):
+        return None, f"the flight data comes from {len(set(parsed))} different MDPs"
+    return parsed[0], None
+
+
+def cmd_learn_model(args: argparse.Namespace) -> int:
+    """Learn a helicopter model from flight data (LR, EC-MENO or EC-MER) and print its parameters."""
+    from .flightdata import FlightData
+    from .models import format_parameter_table, learn_ec_mer, learn_ec_meno, learn_lr, parameter_table
+    from .policies import load_policy
+
+    if args.budget is not None and args.budget < 1:
+        raise NeurohoverError(f"--budget {args.budget} is out of range: allowed an integer >= 1 (evaluations)")
+    if args.seed < 0:
+        raise NeurohoverError(f"--seed {args.seed} is out of range: allowed >= 0")
+    data = FlightData.load(args.flight_data)
+    start = time.perf_counter()
+    extra = {} if args.budget is None else {"budget": args.budget}
+    with _Ticker(f"learning a {args.method} model from {data.n_episodes} episodes ({data.n_transitions} steps)"):
+        if args.method == "lr":
+            if args.budget is not None:
+                print("neurohover learn-model: --budget does not apply to lr (least squares); ignored", file=sys.stderr)
+            model = learn_lr(data)
+        elif args.method == "ec-meno":
+            model = learn_ec_meno(data, seed=args.seed, **extra)
+        else:
+            source = args.policy or data.metadata.get("policy") or "baseline"
+            model = learn_ec_mer(data, load_policy(source), seed=args.seed, **extra)
+    model.save(args.out)
+    truth, why = _true_mdp(data.metadata)
+    print(f"{args.method} model written to {args.out} ({time.perf_counter() - start:.2f} s)")
+    if truth is not None:
+        print(f"learned parameters (converted to the simulator's 10 substeps) next to the true ones of {truth.label or 'the MDP'}:")
+        print(format_parameter_table(parameter_table(model, truth)))
+    else:
+        print(f"{why}; learned parameters (converted to the simulator's 10 substeps) next to the simulator's defaults:")
+        print(format_parameter_table(parameter_table(model, None)))
+    return 0
+
+
+def register(sub) -> None:
+    p = sub.add_parser("evolve", help="evolve a policy on an MDP (steady state) or over a task family (generational)",
+                       description=cmd_evolve.__doc__ + "\n\n" + __doc__.split("\n\n", 1)[1],
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--task", required=True, help="task family: ghh08, ghh09 or fghh")
+    p.add_argument("--mdp", help="zero, train:N, test:N, sample (one MDP drawn from G with --seed), or G: evolve over "
+                                 "the family's distribution, a fresh MDP per episode (generational). Default: G for fghh, zero otherwise")
+    p.add_argument("--wind", help="GHH-08 only: evolve on the constant wind U,V (m/s, each in [-5, 5])")
+    p.add_argument("--params", help="evolve on explicit MDP parameters, comma-separated (GHH-08 2, GHH-09 8, FGHH 11)")
+    p.add_argument("--sigma", type=float, help="FGHH breadth sigma (default 0.3)")
+    p.add_argument("--topology", choices=("slp", "mlp"), help="network (default mlp, or the seed policy file's)")
+    p.add_argument("--seed-policy", default="baseline", help="prototype: zero, baseline (baseline-equivalent network; default) or a policy FILE")
+    p.add_argument("--optimizer", choices=("ne", "cma"), default="ne", help="ne: the paper's neuroevolution (default); cma: CMA-ES, same budget and resampling")
+    p.add_argument("--resampling", default="fixed:1", help="fixed:K (mean of K episodes per candidate; default fixed:1) or race:DELTA "
+                                                           "(selection races at confidence 0<DELTA<1; generational only)")
+    p.add_argument("--budget", type=int, help="episodes to fly (default: the paper's stop: plateau for steady state, 4000 generations for generational)")
+    p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")
+    p.add_argument("--seed", type=int, default=0, help="root seed of the run (default 0)")
+    p.add_argument("--threads", type=int, help="kernel threads (default: all cores; results do not depend on it)")
+    p.add_argument("--out", required=True, metavar="FILE", help="champion policy file; FILE.history.csv and FILE.checkpoint.json go next to it")
+    p.add_argument("--resume", action="store_true", help="continue the run from FILE.checkpoint.json (same options; the budget may be raised)")
+    p.add_argument("--checkpoint-every", type=float, default=60.0, metavar="SECONDS", help="checkpoint interval (default 60 s)")
+    p.add_argument("--validation-episodes", type=int, default=10, help="fresh episodes to validate the champion (default 10)")
+    p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    p.set_defaults(func=cmd_evolve)
+
+    p = sub.add_parser("learn-model", help="learn a helicopter model from flight data", description=cmd_learn_model.__doc__)
+    p.add_argument("--flight-data", required=True, metavar="FILE", help="flight data (.npz, e.g. from neurohover fly --record)")
+    p.add_argument("--method", required=True, choices=("lr", "ec-meno", "ec-mer"), help="lr (least squares), ec-meno or ec-mer (evolution)")
+    p.add_argument("--out", required=True, metavar="FILE", help="model file to write (JSON)")
+    p.add_argument("--budget", type=int, help="evaluations for ec-meno / ec-mer (defaults: 2000 / 500)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the evolution (ec-meno, ec-mer)")
+    p.add_argument("--policy", help="ec-mer: the policy that flew the data (default: the flight data's metadata, else baseline)")
+    p.set_defaults(func=cmd_learn_model)

@@ -1,0 +1,375 @@
+"""Whole evolution runs (neurohover.evolution.evolve) and the learning commands (evolve, learn-model).
+
+Short episodes (300-600 control steps) and small budgets keep every run well under a second.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numba
+import numpy as np
+import pytest
+
+from neurohover.cli import main
+from neurohover.errors import NeurohoverError
+from neurohover.evolution import SteadyStateNE, SteadyStateSettings
+from neurohover.evolution.evolve import (
+    HISTORY_COLUMNS,
+    EvolutionInterrupted,
+    _LeanSteadyStateNE,
+    _MDPStream,
+    evolve,
+    parse_resampling,
+    read_history_csv,
+    validation_return,
+)
+from neurohover.policies import Policy, load_policy, prototype
+from neurohover.tasks import get_task_family
+
+GHH08 = get_task_family("ghh08")
+FGHH = get_task_family("fghh", 0.3)
+TWO_THREADS = numba.config.NUMBA_NUM_THREADS >= 2
+
+
+def _key(result) -> tuple:
+    """Everything of a result that must be reproducible (not the wall times)."""
+    return (
+        result.champion.genome.tobytes(), result.champion_return, result.episodes, result.steps,
+        result.evaluations, result.generations, result.stop_reason,
+        [(h.generation, h.evaluations, h.episodes, h.generation_episodes, h.champion_return) for h in result.history],
+    )
+
+
+# --------------------------------------------------------------------------------- input checks
+
+
+def test_resampling_specs() -> None:
+    assert str(parse_resampling("fixed:5")) == "fixed:5" and parse_resampling("fixed:5").k == 5
+    assert parse_resampling("race:0.2").delta == 0.2 and str(parse_resampling("race:0.2")) == "race:0.2"
+    assert parse_resampling(None).kind == "fixed" and parse_resampling(None).k == 1
+    for bad, words in [("race:1.5", "between 0 and 1"), ("race:0", "between 0 and 1"), ("race:x", "between 0 and 1"),
+                       ("fixed:0", ">= 1"), ("fixed:-2", ">= 1"), ("fixed:2.5", ">= 1"), ("resample:3", "unknown resampling"),
+                       ("fixed", "unknown resampling")]:
+        with pytest.raises(NeurohoverError, match=words):
+            parse_resampling(bad)
+
+
+def test_bad_arguments_are_clear_errors() -> None:
+    mdp = GHH08.zero()
+    cases = [
+        (dict(budget=0), "budget=0 is out of range"),
+        (dict(seed=-1), "seed=-1 is out of range"),
+        (dict(topology="rnn"), "unknown topology"),
+        (dict(prototype="random"), "prototype must be"),
+        (dict(prototype=prototype("slp"), topology="mlp"), "slp policy but topology"),
+        (dict(optimizer="sgd"), "unknown optimizer"),
+        (dict(resampling="race:0.5"), "needs the generational method"),
+        (dict(settings={"pop_sise": 10}), "unknown steady-state setting"),
+        (dict(settings={"elite_size": 60}), "bad steady-state settings"),
+        (dict(optimizer="cma", settings={"sigma0": -1}), "sigma0"),
+        (dict(n_steps=0), "n_steps=0"),
+        (dict(resume=True), "needs the checkpoint path"),
+    ]
+    for kwargs, words in cases:
+        with pytest.raises(NeurohoverError, match=words):
+            evolve(mdp, **{"budget": 60, "n_steps": 50, **kwargs})
+    with pytest.raises(NeurohoverError, match="needs an MDP, a learned model or a task family"):
+        evolve("ghh08", budget=10)
+    with pytest.raises(NeurohoverError, match="generational method"):
+        evolve(FGHH, method="steady-state", budget=10)
+
+
+# --------------------------------------------------------------------------------- building blocks
+
+
+@pytest.mark.parametrize("family", [GHH08, get_task_family("ghh09"), FGHH])
+def test_mdp_stream_is_the_family_sampler_in_batches(family) -> None:
+    stream = _MDPStream(family, np.random.default_rng(7))
+    rows = np.vstack([stream.rows(3), stream.rows(1), stream.rows(4)])
+    rng = np.random.default_rng(7)
+    expected = np.stack([family.sample(rng).row() for _ in range(8)])
+    np.testing.assert_array_equal(rows, expected)
+
+
+def test_lean_steady_state_is_bit_identical_to_the_optimiser() -> None:
+    """The fast subclass evolve uses consumes the same random numbers and keeps the same state."""
+    target = np.random.default_rng(3).normal(size=12)
+    settings = SteadyStateSettings(pop_size=20, elite_size=19, plateau_threshold=10**6)
+    ref, lean = SteadyStateNE(np.zeros(12), settings, seed=5), _LeanSteadyStateNE(np.zeros(12), settings, seed=5)
+    noise = np.random.default_rng(9)
+    for gen in range(1500):
+        a, b = ref.ask(), lean.ask()
+        np.testing.assert_array_equal(a, b)
+        f = -np.sum((a - target) ** 2, axis=1) * 1e3 - 2.0 + noise.normal(0, 50, len(a))
+        if gen % 97 == 5:
+            f[0] = -np.inf  # a non-finite return now and then exercises the slow roulette path
+        ref.tell(f)
+        lean.tell(f.copy())
+    assert ref.champion_return == lean.champion_return and ref.evaluations == lean.evaluations
+    s_ref, s_lean = ref.state_dict(), lean.state_dict()
+    s_ref.pop("wall_seconds"), s_lean.pop("wall_seconds")
+    for d in (s_ref["tracker"], s_lean["tracker"]):
+        d["history"] = [h[:2] for h in d["history"]]
+    assert json.dumps(s_ref) == json.dumps(s_lean)
+
+
+# --------------------------------------------------------------------------------- evolution
+
+
+def test_steady_state_improves_the_mean_return_from_the_baseline() -> None:
+    mdp = GHH08.mdp("train:1")
+    result = evolve(mdp, topology="mlp", prototype="baseline", budget=1000, seed=1, n_steps=600, threads=1)
+    assert result.episodes == 1000 and result.evaluations == 1000 and result.stop_reason == "budget"
+    assert result.generations == 1 + 950  # the initial population, then one offspring per generation
+    # Re-evaluate on fresh episodes (not the optimistic best-ever fitness).
+    base = validation_return(prototype("mlp", "baseline"), mdp, episodes=20, seed=11, n_steps=600)
+    champ = validation_return(result.champion, mdp, episodes=20, seed=11, n_steps=600)
+    se = math.hypot(base.std(), champ.std()) / math.sqrt(20)
+    assert champ.mean() - base.mean() > 20 * se, (base.mean(), champ.mean(), se)
+    assert champ.mean() > 0.2 * base.mean()  # at least 5 times less error (about 50x here)
+    # History: one record per new champion (improving), the last one at the end of the run.
+    h = result.history
+    assert [r.champion_return for r in h] == sorted(r.champion_return for r in h)
+    assert h[0].episodes == 50 and h[-1].episodes == 1000 and h[-1].champion_return == result.champion_return
+    meta = result.champion.metadata
+    assert meta["method"] == "steady-state" and meta["target"] == "ghh08/train:1" and meta["episodes"] == 1000
+    assert result.settings["settings"]["pop_size"] == 50 and result.settings["resampling"] == "fixed:1"
+
+
+def test_plateau_stops_a_run_without_budget() -> None:
+    result = evolve(GHH08.zero(), topology="slp", n_steps=30, seed=2,
+                    settings={"plateau_threshold": 40, "pop_size": 10, "elite_size": 9})
+    assert result.stop_reason == "plateau"
+    last_new = result.history[-2].evaluations if len(result.history) > 1 else 10
+    assert result.evaluations - last_new >= 40
+
+
+def test_fixed_k_on_an_mdp_counts_episodes() -> None:
+    result = evolve(GHH08.mdp("train:2"), topology="slp", budget=300, resampling="fixed:3", seed=4, n_steps=200,
+                    settings={"pop_size": 20, "elite_size": 19})
+    assert result.episodes == 300 and result.evaluations == 100  # 20 + 80 candidates, 3 episodes each
+
+
+def test_generational_fixed_resampling_on_fghh() -> None:
+    result = evolve(FGHH, topology="mlp", budget=600, resampling="fixed:3", seed=3, n_steps=300)
+    assert result.settings["method"] == "generational" and result.stop_reason == "budget"
+    assert result.generations == 4 and result.episodes == 600  # 150 episodes per generation
+    assert [h.generation_episodes for h in result.history] == [150] * 4
+    assert [h.generation for h in result.history] == [1, 2, 3, 4]
+    assert result.champion.metadata["target"] == "fghh/G(sigma=0.3)"
+
+
+def test_generational_races_record_episodes_per_generation() -> None:
+    result = evolve(FGHH, topology="mlp", budget=700, resampling="race:0.5", seed=3, n_steps=300)
+    eps = [h.generation_episodes for h in result.history]
+    assert len(eps) == result.generations >= 2
+    assert all(50 <= e <= 500 for e in eps)  # every candidate once, at most t_limit = 10 times
+    assert sum(eps) == result.episodes >= 700
+    assert len(set(eps)) > 1 or eps[0] > 50  # races fly extra episodes where candidates are undecided
+    assert np.diff([h.episodes for h in result.history]).tolist() == eps[1:]
+
+
+@pytest.mark.parametrize("target", [GHH08.mdp("train:1"), FGHH], ids=["mdp", "family"])
+def test_cma_es_on_the_same_budget(target) -> None:
+    result = evolve(target, topology="slp", optimizer="cma", budget=400, seed=2, n_steps=300,
+                    resampling="fixed:2" if target is FGHH else None)
+    popsize = 4 + int(3 * math.log(40))
+    k = 2 if target is FGHH else 1
+    assert result.stop_reason == "budget" and 400 <= result.episodes < 400 + popsize * k
+    assert result.settings["optimizer"] == "cma" and result.champion.metadata["optimizer"] == "cma"
+    assert math.isfinite(result.champion_return)
+
+
+def test_cma_es_improves_on_an_mdp() -> None:
+    mdp = GHH08.mdp("train:1")
+    result = evolve(mdp, topology="slp", optimizer="cma", budget=600, seed=2, n_steps=400)
+    base = validation_return(prototype("slp", "baseline"), mdp, episodes=10, seed=3, n_steps=400)
+    champ = validation_return(result.champion, mdp, episodes=10, seed=3, n_steps=400)
+    assert champ.mean() > 0.2 * base.mean()
+
+
+@pytest.mark.skipif(not TWO_THREADS, reason="needs 2 kernel threads")
+@pytest.mark.parametrize("target,kwargs", [
+    (GHH08.mdp("train:3"), dict()),
+    (FGHH, dict(resampling="race:0.6")),
+    (FGHH, dict(resampling="fixed:2", optimizer="cma")),
+], ids=["steady", "race", "cma-family"])
+def test_results_do_not_depend_on_threads(target, kwargs) -> None:
+    runs = [evolve(target, topology="mlp", budget=400, seed=8, n_steps=300, threads=t, **kwargs) for t in (1, 2)]
+    assert _key(runs[0]) == _key(runs[1])
+
+
+def test_seed_changes_the_run() -> None:
+    a, b = (evolve(GHH08.mdp("train:0"), topology="slp", budget=200, seed=s, n_steps=200) for s in (1, 2))
+    assert _key(a) != _key(b)
+
+
+@pytest.mark.parametrize("target,kwargs", [
+    (GHH08.mdp("train:1"), dict()),
+    (GHH08.mdp("train:1"), dict(optimizer="cma")),
+    (FGHH, dict(resampling="race:0.6")),
+    (FGHH, dict(resampling="fixed:2", optimizer="cma")),
+], ids=["steady", "cma-mdp", "race", "cma-family"])
+def test_interrupted_and_resumed_equals_uninterrupted(tmp_path: Path, target, kwargs) -> None:
+    common = dict(topology="slp", seed=3, n_steps=300, **kwargs)
+    full = evolve(target, budget=600, **common)
+    ckpt = tmp_path / "run.checkpoint.json"
+
+    def stop_midway(info) -> None:
+        if info.episodes >= 250 and not info.done:
+            raise KeyboardInterrupt
+
+    with pytest.raises(EvolutionInterrupted) as err:
+        evolve(target, budget=600, checkpoint=ckpt, progress=stop_midway, progress_every_s=0, **common)
+    assert err.value.checkpoint == ckpt and ckpt.is_file() and not ckpt.with_name(ckpt.name + ".tmp").exists()
+    state = json.loads(ckpt.read_text())
+    assert 250 <= state["counters"]["episodes"] < 600
+    resumed = evolve(target, budget=600, checkpoint=ckpt, resume=True, **common)
+    assert _key(resumed) == _key(full)
+    # A finished run with a smaller budget continues to the larger one, also bit for bit.
+    evolve(target, budget=300, checkpoint=ckpt, **common)
+    extended = evolve(target, budget=600, checkpoint=ckpt, resume=True, **common)
+    assert _key(extended) == _key(full)
+
+
+def test_resume_refuses_another_run(tmp_path: Path) -> None:
+    ckpt = tmp_path / "c.json"
+    evolve(GHH08.zero(), topology="slp", budget=60, seed=1, n_steps=50, checkpoint=ckpt)
+    with pytest.raises(NeurohoverError, match="seed differ"):
+        evolve(GHH08.zero(), topology="slp", budget=100, seed=2, n_steps=50, checkpoint=ckpt, resume=True)
+    with pytest.raises(NeurohoverError, match="does not exist"):
+        evolve(GHH08.zero(), topology="slp", budget=100, seed=1, n_steps=50, checkpoint=tmp_path / "none.json", resume=True)
+
+
+def test_learned_model_and_policy_prototype_are_accepted() -> None:
+    from neurohover.models import LearnedModel
+
+    model = LearnedModel(tuple(np.array([-0.2, -0.4, -0.5, -0.5, -40.0, -7.5, 20.0, -6.5, -21.0, -5.5, 45.0])),
+                         (0.2, 0.3, 0.6, 0.15, 0.25, 0.07), "lr")
+    seed_policy = Policy("slp", prototype("slp", "baseline").genome, {"name": "mine"})
+    result = evolve(model, topology="slp", prototype=seed_policy, budget=120, seed=1, n_steps=200)
+    assert result.champion.metadata["target"] == "model/lr" and result.champion.metadata["name"] == "mine"
+
+
+def test_validation_episodes_are_fresh_and_reproducible() -> None:
+    policy = prototype("mlp", "baseline")
+    a = validation_return(policy, FGHH, episodes=5, seed=1, n_steps=200)
+    np.testing.assert_array_equal(a, validation_return(policy, FGHH, episodes=5, seed=1, n_steps=200))
+    assert len(set(a.tolist())) == 5
+
+
+# --------------------------------------------------------------------------------- commands
+
+
+def _run(capsys, *argv: str) -> tuple[int, str, str]:
+    rc = main(list(argv))
+    out = capsys.readouterr()
+    return rc, out.out, out.err
+
+
+def test_evolve_command_writes_policy_history_and_resumes(capsys, tmp_path: Path) -> None:
+    out = tmp_path / "champ.json"
+    args = ["evolve", "--task", "ghh08", "--mdp", "train:1", "--topology", "slp", "--episode-steps", "300",
+            "--seed", "5", "--out", str(out), "--json"]
+    rc, stdout, _ = _run(capsys, *args, "--budget", "300")
+    assert rc == 0
+    summary = json.loads(stdout)
+    policy = load_policy(out)
+    assert policy.topology == "slp"
+    meta = json.loads(out.read_text())
+    for key in ("task", "mdp", "optimizer", "resampling", "budget", "seed", "champion_return", "validation_return"):
+        assert key in meta, key
+    assert meta["task"] == "ghh08" and meta["mdp"] == "train:1" and meta["budget"] == 300 and meta["seed"] == 5
+    assert meta["validation_episodes"] == 10 and math.isfinite(meta["validation_return"])
+    assert summary["champion_return"] == meta["champion_return"]
+    history = read_history_csv(Path(f"{out}.history.csv"))
+    assert Path(f"{out}.history.csv").read_text().splitlines()[0] == ",".join(HISTORY_COLUMNS)
+    assert history[-1].episodes == 300
+    assert Path(f"{out}.checkpoint.json").is_file()
+    # --resume with a larger budget continues to exactly what one run of that budget gives.
+    rc, _, _ = _run(capsys, *args, "--budget", "600", "--resume")
+    assert rc == 0
+    resumed = load_policy(out)
+    direct = tmp_path / "direct.json"
+    rc, _, _ = _run(capsys, *[a if a != str(out) else str(direct) for a in args], "--budget", "600")
+    assert rc == 0
+    np.testing.assert_array_equal(resumed.genome, load_policy(direct).genome)
+    assert read_history_csv(Path(f"{out}.history.csv"))[-1].episodes == 600
+
+
+def test_evolve_command_over_the_family_with_races(capsys, tmp_path: Path) -> None:
+    out = tmp_path / "generic.json"
+    rc, stdout, _ = _run(capsys, "evolve", "--task", "fghh", "--sigma", "0.2", "--resampling", "race:0.5",
+                         "--budget", "200", "--episode-steps", "200", "--seed", "1", "--out", str(out), "--json")
+    assert rc == 0
+    meta = json.loads(out.read_text())
+    assert meta["mdp"] == "G" and meta["sigma"] == 0.2 and meta["method"] == "generational" and meta["resampling"] == "race:0.5"
+    assert all(h.generation_episodes >= 50 for h in read_history_csv(Path(f"{out}.history.csv")))
+
+
+def test_evolve_command_ctrl_c_saves_the_checkpoint(capsys, tmp_path: Path, monkeypatch) -> None:
+    from neurohover import commands_learning
+
+    def interrupt(self, info) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(commands_learning._Bar, "__call__", interrupt)
+    out = tmp_path / "p.json"
+    rc, _, err = _run(capsys, "evolve", "--task", "ghh08", "--topology", "slp", "--budget", "100000",
+                      "--episode-steps", "3000", "--out", str(out))
+    assert rc == 130
+    assert f"checkpoint saved to {out}.checkpoint.json" in err and "--resume" in err
+    assert Path(f"{out}.checkpoint.json").is_file() and not out.exists()
+
+
+@pytest.mark.parametrize("argv,words", [
+    (["--resampling", "race:1.5"], "strictly between 0 and 1"),
+    (["--resampling", "fixed:0"], "K must be an integer >= 1"),
+    (["--budget", "0"], "--budget 0 is out of range"),
+    (["--seed-policy", "nope.json"], "no such file"),
+    (["--resume"], "no checkpoint"),
+    (["--mdp", "train:1", "--resampling", "race:0.5"], "needs the generational method"),
+    (["--mdp", "train:99"], "out of range"),
+    (["--wind", "9,0"], "out of range"),
+])
+def test_evolve_command_bad_input(capsys, tmp_path: Path, argv, words) -> None:
+    rc, _, err = _run(capsys, "evolve", "--task", "ghh08", "--budget", "60", "--episode-steps", "50",
+                      "--out", str(tmp_path / "x.json"), *argv)
+    assert rc == 2
+    assert err.startswith("neurohover evolve: error:") and words in err
+
+
+def test_learn_model_command_prints_learned_next_to_true(capsys, tmp_path: Path) -> None:
+    data = tmp_path / "flight.npz"
+    rc, _, _ = _run(capsys, "fly", "--task", "ghh08", "--mdp", "zero", "--episodes", "2", "--seed", "3", "--record", str(data))
+    assert rc == 0
+    model_file = tmp_path / "model.json"
+    rc, out, _ = _run(capsys, "learn-model", "--flight-data", str(data), "--method", "lr", "--out", str(model_file))
+    assert rc == 0
+    assert "true ones of ghh08/zero" in out and "C_p" in out and "D_r" in out
+    from neurohover.models import LearnedModel
+
+    assert LearnedModel.load(model_file).method == "lr"
+    rc, out, _ = _run(capsys, "learn-model", "--flight-data", str(data), "--method", "ec-meno", "--budget", "100",
+                      "--out", str(tmp_path / "meno.json"))
+    assert rc == 0 and "ec-meno model written" in out
+
+
+def test_learn_model_command_bad_input(capsys, tmp_path: Path) -> None:
+    rc, _, err = _run(capsys, "learn-model", "--flight-data", str(tmp_path / "missing.npz"), "--method", "lr",
+                      "--out", str(tmp_path / "m.json"))
+    assert rc == 2 and "does not exist" in err
+    rc, _, err = _run(capsys, "learn-model", "--flight-data", str(tmp_path / "missing.npz"), "--method", "ec-mer",
+                      "--budget", "0", "--out", str(tmp_path / "m.json"))
+    assert rc == 2 and "--budget 0 is out of range" in err
+
+
+def test_commands_have_help(capsys) -> None:
+    for command in ("evolve", "learn-model"):
+        with pytest.raises(SystemExit) as exit_info:
+            main([command, "--help"])
+        assert exit_info.value.code == 0
+        assert "usage: neurohover " + command in capsys.readouterr().out
