@@ -124,7 +124,7 @@ def num_threads(threads: int | None) -> Iterator[None]:
 
 
 def mdp_rows(mdps: MDP | Sequence[MDP] | np.ndarray) -> np.ndarray:
-    """MDPs as the (M, 28) float64 array the kernel reads."""
+    """MDPs as the (M, 29) float64 array the kernel reads."""
     if isinstance(mdps, MDP):
         return mdps.row()[None, :]
     if isinstance(mdps, np.ndarray):
@@ -183,7 +183,7 @@ def evaluate_jobs(
     Parameters
     ----------
     policies : sequence of Policy or PolicyTable
-    mdps : MDP, sequence of MDP, or (M, 28) array of MDP rows
+    mdps : MDP, sequence of MDP, or (M, 29) array of MDP rows
     policy_index, mdp_index, episode_index : array_like of int, shape (J,)
         Which policy flies which MDP, and the episode index that (with ``seed``) fixes the noise.
     seed : int

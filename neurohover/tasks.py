@@ -26,6 +26,7 @@ from .sim.constants import (
     DEFAULT_PARAMS,
     MDP_ROW_LEN,
     PARAM_NAMES,
+    ROW_D_U,
     SUBSTEP_DT,
     SUBSTEPS,
     WIND_CONSTANT,
@@ -64,6 +65,9 @@ class MDP:
         (wind_u, wind_v) in m/s for kind 1; the 8 GHH-09 parameters for kind 2.
     substeps, dt : int, float
         Integration substeps per 0.1 s control step and their length (a learned model: 1, 0.1).
+    d_u : float
+        Constant body-frame u acceleration, the paper's D_u: 0 in every true MDP; a learned model
+        may fit it (a constant wind acts near hover as a constant acceleration).
     label : str
         Human-readable name, e.g. ``"ghh08/train:3"``.
     """
@@ -76,6 +80,7 @@ class MDP:
     substeps: int = SUBSTEPS
     dt: float = SUBSTEP_DT
     label: str = field(default="", compare=False)
+    d_u: float = 0.0
 
     def row(self) -> np.ndarray:
         """The float64 row the compiled kernel reads (layout in ``sim.constants``)."""
@@ -86,18 +91,19 @@ class MDP:
         row[18] = self.dt
         row[19] = self.wind_kind
         row[20 : 20 + len(self.wind)] = self.wind
+        row[ROW_D_U] = self.d_u
         return row
 
     def to_reference(self) -> ReferenceMDP:
         """The same MDP for the plain-Python reference simulator."""
         wind = tuple(self.wind) + (0.0,) * (8 - len(self.wind))
-        return ReferenceMDP(self.params, self.noise_std, self.wind_kind, wind, self.substeps, self.dt)
+        return ReferenceMDP(self.params, self.noise_std, self.wind_kind, wind, self.substeps, self.dt, self.d_u)
 
     def to_dict(self) -> dict:
         return {
             "family": self.family, "params": list(self.params), "noise_std": list(self.noise_std),
             "wind_kind": self.wind_kind, "wind": list(self.wind), "substeps": self.substeps,
-            "dt": self.dt, "label": self.label,
+            "dt": self.dt, "label": self.label, "d_u": self.d_u,
         }
 
     @classmethod
@@ -105,7 +111,7 @@ class MDP:
         return cls(
             d["family"], tuple(map(float, d["params"])), tuple(map(float, d["noise_std"])),
             int(d["wind_kind"]), tuple(map(float, d["wind"])), int(d["substeps"]), float(d["dt"]),
-            d.get("label", ""),
+            d.get("label", ""), float(d.get("d_u", 0.0)),
         )
 
 

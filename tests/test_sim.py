@@ -26,7 +26,7 @@ def _mlp_policy(rng_seed: int = 0) -> Policy:
 def _learned_model_mdp() -> MDP:
     rng = np.random.default_rng(3)
     params = get_task_family("fghh").zero().params
-    return MDP("model", params=tuple(np.array(params) * rng.uniform(0.9, 1.1, 11)), substeps=1, dt=0.1, label="model")
+    return MDP("model", params=tuple(np.array(params) * rng.uniform(0.9, 1.1, 11)), substeps=1, dt=0.1, label="model", d_u=0.3)
 
 
 CASES = {
@@ -169,7 +169,7 @@ def test_crash_limits_are_spec_values() -> None:
         (lambda: evaluate_jobs([baseline_policy()], get_task_family("ghh08").zero(), [0], [0, 0], [0]), "mdp_index has 2 entries"),
         (lambda: evaluate(baseline_policy(), get_task_family("ghh08").zero(), episodes=0), "episodes=0"),
         (lambda: evaluate(baseline_policy(), get_task_family("ghh08").zero(), seed=-1), "seed=-1"),
-        (lambda: evaluate(baseline_policy(), np.zeros((1, 5))), "shape (M, 28)"),
+        (lambda: evaluate(baseline_policy(), np.zeros((1, 5))), "shape (M, 29)"),
         (lambda: evaluate(baseline_policy(), get_task_family("ghh08").zero(), threads=999), "threads=999"),
         (lambda: Policy("mlp", np.zeros(40)), "mlp genome has 42 genes"),
         (lambda: Policy("rnn", np.zeros(40)), "unknown policy topology 'rnn'"),

@@ -10,7 +10,8 @@ import math
 
 import numpy as np
 
-# Dynamics parameters in row order (the paper's Table 5 calls them C and D; D_u is always 0).
+# Dynamics parameters in row order (the paper's Table 5 calls them C and D; D_u is 0 in the
+# simulator and has its own row slot, ROW_D_U, for learned models).
 PARAM_NAMES: tuple[str, ...] = (
     "C_u", "C_v", "D_v", "C_w", "D_w", "C_p", "D_p", "C_q", "D_q", "C_r", "D_r",
 )
@@ -52,7 +53,8 @@ ROW_SUBSTEPS = 17
 ROW_DT = 18
 ROW_WIND_KIND = 19
 ROW_WIND = slice(20, 28)
-MDP_ROW_LEN = 28
+ROW_D_U = 28  # constant u acceleration: 0 in every true MDP; the paper's D_u of a learned model
+MDP_ROW_LEN = 29
 
 OBS_NAMES: tuple[str, ...] = ("u", "v", "w", "x", "y", "z", "p", "q", "r", "qx", "qy", "qz")
 ACTION_NAMES: tuple[str, ...] = ("aileron", "elevator", "rudder", "collective")

@@ -189,7 +189,7 @@ def unpack_mdp(row):
     else:
         ax, ox, phx, cx, ay, oy, phy, cy = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     wind = (kind, ax, ox, phx, cx, ay, oy, phy, cy)
-    dyn = (row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7], row[8], row[9], row[10])
+    dyn = (row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7], row[8], row[9], row[10], row[28])
     noise_std = (row[11], row[12], row[13], row[14], row[15], row[16])
     return dyn, noise_std, int(row[17]), row[18], wind
 
@@ -210,7 +210,7 @@ def update_noise(n, std, z0, z1, z2, z3, z4, z5):
 @nb.njit(cache=True, fastmath={"contract"})
 def integrate(s, n, a1, a2, a3, a4, step, dyn, n_sub, dt, wind):
     """Advance state tuple ``s`` through the substeps of control step ``step`` (counting from 0)."""
-    c_u, c_v, d_v, c_w, d_w, c_p, d_p, c_q, d_q, c_r, d_r = dyn
+    c_u, c_v, d_v, c_w, d_w, c_p, d_p, c_q, d_q, c_r, d_r, d_u = dyn
     kind, ax, ox, phx, cx, ay, oy, phy, cy = wind
     vu, vv, vw, px, py, pz, p, q, r, qx, qy, qz, qw = s
     # Action and noise terms are constant over the control step.
@@ -219,7 +219,7 @@ def integrate(s, n, a1, a2, a3, a4, step, dyn, n_sub, dt, wind):
     drive_p = d_p * a1 + n[3]
     drive_q = d_q * a2 + n[4]
     drive_r = d_r * a3 + n[5]
-    nu = n[0]
+    nu = d_u + n[0]
     for i in range(n_sub):
         px += dt * vu
         py += dt * vv

@@ -76,6 +76,7 @@ class ReferenceMDP:
     wind: Sequence[float] = (0.0,) * 8
     substeps: int = 10
     dt: float = 0.01
+    d_u: float = 0.0  # constant u acceleration of a learned model (0 in every true MDP)
 
     def wind_at(self, t: float) -> Vec:
         """World-frame wind (m/s) at time t."""
@@ -135,7 +136,7 @@ class ReferenceHelicopter:
             vb = rotate_inverse(q, self.velocity)
             wb = rotate_inverse(q, self.mdp.wind_at(t))
             force = (
-                c_u * (vb[0] + wb[0]) + n_u,
+                c_u * (vb[0] + wb[0]) + self.mdp.d_u + n_u,
                 c_v * (vb[1] + wb[1]) + d_v + n_v,
                 c_w * vb[2] + d_w * a4 + n_w,
             )
