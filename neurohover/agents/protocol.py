@@ -34,6 +34,8 @@ from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
 
+REPEAT_CHUNK = 64  # episodes per kernel call for a repeated choice
+
 
 @dataclass(frozen=True)
 class Choice:
@@ -49,7 +51,11 @@ class Choice:
     record : bool
         Whether the agent wants this episode's flight data.
     final : bool
-        The agent keeps this choice (without fallback changes) for the rest of the run.
+        The agent keeps this choice for the rest of the run.
+    repeat : bool
+        The agent keeps this choice until an episode in which the safeguard fires or the
+        helicopter crashes. The harness then flies several episodes per kernel call and reports
+        them to ``update`` in order, up to and including that episode (same results, faster).
     """
 
     policy: Policy
@@ -57,6 +63,7 @@ class Choice:
     fallback: Policy | None = None
     record: bool = False
     final: bool = False
+    repeat: bool = False
 
 
 @dataclass(frozen=True)
@@ -158,16 +165,21 @@ def run_test(
             fired[e:] = ev.safeguard_step >= 0
             labels[e:] = [choice.label] * rest.size
             break
+        n = min(REPEAT_CHUNK, episodes - e) if choice.repeat and not choice.record else 1
         table = PolicyTable.from_policies([choice.policy] + ([choice.fallback] if choice.fallback else []))
-        ev = evaluate_jobs(table, mdp, [0], [0], [e], seed=seed, n_steps=n_steps, threads=threads,
-                           fallback_index=[1 if choice.fallback else -1], record=[choice.record])
-        returns[e], crashed[e], steps[e] = ev.returns[0], ev.crashed[0], ev.steps[0]
-        fired[e] = ev.safeguard_step[0] >= 0
-        labels[e] = choice.label
-        t0 = time.perf_counter()
-        agent.update(EpisodeOutcome(e, float(ev.returns[0]), bool(ev.crashed[0]), int(ev.steps[0]),
-                                    int(ev.safeguard_step[0]), ev.flight_data))
-        offline[e] = time.perf_counter() - t0
-        e += 1
+        zeros = np.zeros(n, dtype=np.int64)
+        ev = evaluate_jobs(table, mdp, zeros, zeros, np.arange(e, e + n), seed=seed, n_steps=n_steps, threads=threads,
+                           fallback_index=np.full(n, 1 if choice.fallback else -1), record=np.full(n, choice.record))
+        events = np.flatnonzero((ev.safeguard_step >= 0) | ev.crashed)
+        n = int(events[0]) + 1 if events.size else n  # later episodes would have flown another choice
+        for i in range(n):
+            returns[e], crashed[e], steps[e] = ev.returns[i], ev.crashed[i], ev.steps[i]
+            fired[e] = ev.safeguard_step[i] >= 0
+            labels[e] = choice.label
+            t0 = time.perf_counter()
+            agent.update(EpisodeOutcome(e, float(ev.returns[i]), bool(ev.crashed[i]), int(ev.steps[i]),
+                                        int(ev.safeguard_step[i]), ev.flight_data))
+            offline[e] = time.perf_counter() - t0
+            e += 1
     return RunResult(agent.name, mdp, returns, crashed, steps, labels, fired, offline,
                      time.perf_counter() - start_time)

@@ -1,0 +1,70 @@
+"""Commands of the on-line stage: ``build-policies`` and ``compete``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from .errors import NeurohoverError
+
+
+def cmd_build_policies(args: argparse.Namespace) -> int:
+    """Evolve a task family's generic and specialised policies (the agents' policy set)."""
+    from .policysets import build_policy_set
+
+    if args.budget < 1:
+        raise NeurohoverError(f"--budget {args.budget} is out of range: allowed >= 1")
+    ps = build_policy_set(args.task, args.out, budget=args.budget, fghh_budget=args.fghh_budget, seed=args.seed,
+                          n_steps=args.episode_steps, progress=lambda msg: print(msg, file=sys.stderr, flush=True))
+    print(f"policy set written to {ps.directory}")
+    return 0
+
+
+def cmd_compete(args: argparse.Namespace) -> int:
+    """Run R independent test runs of an agent; print a summary and write results and a plot."""
+    from tqdm import tqdm
+
+    from .compete import compete
+
+    bar = tqdm(total=args.runs, desc=f"{args.task} {args.agent}", unit="run", file=sys.stderr, disable=None)
+    try:
+        summary, _ = compete(
+            args.task, args.agent, runs=args.runs, episodes=args.episodes, mdps=args.mdps, seed=args.seed,
+            jobs=args.jobs, out=args.out, sigma=args.sigma, n_steps=args.episode_steps, policy_dir=args.policy_dir,
+            on_result=lambda spec, result: (bar.update(1), bar.set_postfix(score=f"{result.score:.4g}")),
+        )
+    except KeyboardInterrupt:
+        bar.close()
+        print(f"neurohover compete: interrupted; the finished runs are in {args.out}/episodes.csv", file=sys.stderr)
+        return 130
+    bar.close()
+    print(f"{'agent':<18} {'runs':>5} {'mean cum. return':>17} {'sd':>12} {'crash rate':>11} {'return/ep after learning':>25}")
+    print(f"{summary['agent']:<18} {summary['runs']:>5} {summary['mean_cumulative_return']:>17.5g} {summary['sd_cumulative_return']:>12.4g} "
+          f"{summary['crash_rate_runs']:>11.1%} {summary['mean_return_after_learning']:>25.5g}")
+    print(f"results: {args.out}/episodes.csv, {args.out}/summary.json, {args.out}/cumulative.png")
+    return 0
+
+
+def register(sub) -> None:
+    p = sub.add_parser("build-policies", help="evolve the generic and specialised policies of a task", description=cmd_build_policies.__doc__)
+    p.add_argument("--task", required=True, help="ghh08, ghh09 or fghh")
+    p.add_argument("--out", help="directory to write <task>/ into (default: the package's shipped policies)")
+    p.add_argument("--budget", type=int, default=20000, help="episodes per steady-state evolution (default 20000)")
+    p.add_argument("--fghh-budget", type=int, default=200000, help="episodes per FGHH generic-policy evolution over G (default 200000)")
+    p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")
+    p.add_argument("--seed", type=int, default=0)
+    p.set_defaults(func=cmd_build_policies)
+
+    p = sub.add_parser("compete", help="run test runs of an on-line agent", description=cmd_compete.__doc__)
+    p.add_argument("--task", required=True, help="ghh08, ghh09 or fghh")
+    p.add_argument("--agent", required=True, help="model-free, model-based, incremental, hybrid, hybrid-baseline, generic, baseline; FGHH: incremental-zero|fixed|race")
+    p.add_argument("--runs", type=int, default=10, help="independent test runs (default 10)")
+    p.add_argument("--episodes", type=int, default=1000, help="episodes per run (default 1000)")
+    p.add_argument("--mdps", default="test", help="test (the fixed test MDPs in turn), sample (fresh from G) or train")
+    p.add_argument("--sigma", type=float, help="FGHH breadth (default 0.3)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--jobs", type=int, default=1, help="runs in parallel processes (default 1)")
+    p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")
+    p.add_argument("--policy-dir", help="policy sets directory (default: the shipped ones)")
+    p.add_argument("--out", required=True, help="output directory")
+    p.set_defaults(func=cmd_compete)
