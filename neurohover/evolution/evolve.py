@@ -72,6 +72,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numba
 import numpy as np
 
 from ..errors import NeurohoverError
@@ -90,7 +91,6 @@ from .neuroevolution import (
     _rank,
     roulette_weights,
 )
-from .operators import crossover, mutate
 from .races import fixed_resampling, selection_race
 
 __all__ = [
@@ -353,7 +353,12 @@ class _Flyer:
         self._act = np.zeros((0, 1, 4))
         self._views: dict[int, tuple] = {}
         self.trace: list | None = None  # (genomes, rows, p, m, e) per kernel call, for benchmarks
+        self.max_threads = self._threads = 1
         self._ensure(64, 512)
+
+    def start(self) -> None:
+        """Take the kernel thread count in force now as the most to use (call inside ``num_threads``)."""
+        self.max_threads = self._threads = numba.get_num_threads()
 
     def _ensure(self, n_pol: int, n_jobs: int) -> None:
         if n_pol > self._p_cap:
@@ -386,6 +391,12 @@ class _Flyer:
         p = zeros if p_idx is None else (arange if isinstance(p_idx, str) else p_idx)
         m = zeros if m_idx is None else (arange if isinstance(m_idx, str) else m_idx)
         np.add(arange, self.episodes, out=e)
+        # Never more threads than jobs: every thread of a parallel call must check in, and on a busy
+        # machine a one-episode call on all cores runs up to 10x slower than on one.
+        want = n_jobs if n_jobs < self.max_threads else self.max_threads
+        if want != self._threads:
+            numba.set_num_threads(want)
+            self._threads = want
         t0 = time.perf_counter()
         rollout_batch(rows, self.kinds, self.genomes, p, m, e, minus, self.seed, self.n_steps,
                       False, self._limits, minus, self._obs, self._act, returns, crashed, steps, sg)
@@ -400,6 +411,32 @@ class _Flyer:
 # --------------------------------------------------------------------------------- lean steady state
 
 
+@numba.njit(cache=True)
+def _crossover_apply(a, b, average_r, take_r, averaging_prob):
+    """``operators.crossover`` given its two uniform draws: the same floats, elementwise."""
+    out = np.empty_like(a)
+    for i in range(a.size):
+        if average_r[i] < averaging_prob:
+            out[i] = 0.5 * (a[i] + b[i])
+        elif take_r[i] < 0.5:
+            out[i] = a[i]
+        else:
+            out[i] = b[i]
+    return out
+
+
+@numba.njit(cache=True)
+def _mutate_apply(g, hit_r, delta, replace_r, mutate_frac, mutate_repl):
+    """``operators.mutate`` given its three draws: the same floats, elementwise."""
+    out = np.empty_like(g)
+    for i in range(g.size):
+        if hit_r[i] < mutate_frac:
+            out[i] = delta[i] if replace_r[i] < mutate_repl else g[i] + delta[i]
+        else:
+            out[i] = g[i]
+    return out
+
+
 class _LeanSteadyStateNE(SteadyStateNE):
     """:class:`SteadyStateNE` with less Python per generation; same algorithm, random stream and
     ``state_dict`` (the tests check bit-identity over thousands of generations).
@@ -407,8 +444,9 @@ class _LeanSteadyStateNE(SteadyStateNE):
     With the paper's settings a generation is one offspring and one episode (about 2 ms), so the
     optimiser's own ~100 us of small NumPy calls per ask/tell would cost over 10 % of the
     throughput. This subclass computes the roulette weights with the same array operations (so the
-    same floats), spins the wheel with ``bisect`` on the same cumulative sums, skips defensive
-    copies and stacks, and reuses the parent's operators, ranking and champion tracking.
+    same floats), spins the wheel with ``bisect`` on the same cumulative sums, applies crossover and
+    mutation in compiled loops to the very draws the operators make, skips defensive copies and
+    stacks, and reuses the parent's ranking and champion tracking.
     """
 
     def ask(self) -> np.ndarray:  # the returned array must not be modified (evolve does not)
@@ -425,15 +463,24 @@ class _LeanSteadyStateNE(SteadyStateNE):
         last = len(cdf_list) - 1
         n = s.pop_size - s.elite_size
         batch = np.empty((n, pop.shape[1]))
+        d = pop.shape[1]
+        random, normal = rng.random, rng.normal
         for c in range(n):
-            if rng.random() < s.crossover_prob:
-                a = pop[min(bisect_right(cdf_list, rng.random() * total), last)]
-                b = pop[min(bisect_right(cdf_list, rng.random() * total), last)]
-                child = crossover(a, b, rng, s)
-                if rng.random() < s.mutate_prob:
-                    child = mutate(child, rng, s)
+            # Same draws in the same order as operators.crossover / operators.mutate.
+            if random() < s.crossover_prob:
+                a = pop[min(bisect_right(cdf_list, random() * total), last)]
+                b = pop[min(bisect_right(cdf_list, random() * total), last)]
+                average_r = random(d)
+                child = _crossover_apply(a, b, average_r, random(d), s.averaging_prob)
+                if random() < s.mutate_prob:
+                    hit_r = random(d)
+                    delta = normal(0.0, s.mutate_std, d)
+                    child = _mutate_apply(child, hit_r, delta, random(d), s.mutate_frac, s.mutate_repl)
             else:
-                child = mutate(pop[min(bisect_right(cdf_list, rng.random() * total), last)], rng, s)
+                g = pop[min(bisect_right(cdf_list, random() * total), last)]
+                hit_r = random(d)
+                delta = normal(0.0, s.mutate_std, d)
+                child = _mutate_apply(g, hit_r, delta, random(d), s.mutate_frac, s.mutate_repl)
             batch[c] = child
         self._pending = batch
         return batch
@@ -442,21 +489,57 @@ class _LeanSteadyStateNE(SteadyStateNE):
         pending = self._pending
         if pending is None or self._population is None:
             super().tell(fitness)
-            self._finite = bool(np.isfinite(self._fitness).all())
+            self._after_full_tell()
             return
-        f = fitness  # evolve's own float64 returns: finite, one per asked genome
-        keep = _rank(self._fitness)[: self.settings.elite_size]
-        self._population = np.concatenate((self._population[keep], pending))
-        self._fitness = np.concatenate((self._fitness[keep], f))
-        self._finite = bool(np.isfinite(self._fitness).all())
+        f = fitness  # evolve's own float64 returns, one per asked genome
+        elite = self.settings.elite_size
+        pop, fit = self._population, self._fitness
+        if self._sorted and len(pending) == 1 and pop.shape[0] == elite + 1:
+            # The elite pop[:elite] is in rank order (best first, ties by index), so ranking all
+            # pop_size is inserting the last child by bisection; keep the first elite_size, append.
+            t = fit[elite]
+            key = -math.inf if t != t else t
+            pos = bisect_right(self._negkeys, -key)
+            if pos < elite:
+                dropped = fit[elite - 1]
+                row = pop[elite].copy()
+                pop[pos + 1 : elite] = pop[pos : elite - 1]
+                fit[pos + 1 : elite] = fit[pos : elite - 1]
+                pop[pos], fit[pos] = row, t
+                self._negkeys.insert(pos, -key)
+                self._negkeys.pop()
+            else:
+                dropped = t
+            self._nonfinite -= not math.isfinite(dropped)
+            new = float(f[0])
+            pop[elite] = pending[0]
+            fit[elite] = new
+            self._nonfinite += not math.isfinite(new)
+            self._finite = self._nonfinite == 0
+        else:
+            keep = _rank(fit)[:elite]
+            self._population = np.concatenate((pop[keep], pending))
+            self._fitness = np.concatenate((fit[keep], f))
+            self._after_full_tell(sorted_elite=True)
         self._tracker.update(pending, f, self._clock())
         self._pending = None
         self._generation += 1
 
+    def _after_full_tell(self, sorted_elite: bool = False) -> None:
+        fit = self._fitness
+        self._nonfinite = int((~np.isfinite(fit)).sum())
+        self._finite = self._nonfinite == 0
+        self._sorted = sorted_elite
+        if sorted_elite:
+            key = np.where(np.isnan(fit[: self.settings.elite_size]), -np.inf, fit[: self.settings.elite_size])
+            self._negkeys = (-key).tolist()
+
     @classmethod
     def from_state_dict(cls, state: dict) -> "_LeanSteadyStateNE":
         opt = super().from_state_dict(state)
-        opt._finite = opt._fitness is not None and bool(np.isfinite(opt._fitness).all())
+        opt._sorted = False
+        if opt._fitness is not None:
+            opt._after_full_tell()
         return opt
 
 
@@ -546,7 +629,7 @@ def _resolve_prototype(prototype, topology: str) -> Policy:
         if prototype.topology != topology:
             raise NeurohoverError(f"the prototype is an {prototype.topology} policy but topology={topology!r}")
         return prototype
-    if prototype in ("zero", "baseline"):
+    if isinstance(prototype, str) and prototype in ("zero", "baseline"):
         return make_prototype(topology, prototype)
     raise NeurohoverError(f"prototype must be a Policy, 'zero' or 'baseline', got {prototype!r}")
 
@@ -738,9 +821,11 @@ class _Run:
         column, i.e. as k consecutive calls of a sample function would number them.
         """
         n, k = genomes.shape[0], self.resampling.k
-        rows = self.stream.rows(n * k)
         p = np.tile(np.arange(n, dtype=np.int64), k)
-        returns = self.flyer.fly(genomes, rows, p, "range", n * k).copy()
+        if self.stream is None:  # generational on one MDP: only the episodes' noise differs
+            returns = self.flyer.fly(genomes, self.rows, p, None, n * k).copy()
+        else:
+            returns = self.flyer.fly(genomes, self.stream.rows(n * k), p, "range", n * k).copy()
         cols = returns.reshape(k, n)
         calls = iter(range(k))
         result = fixed_resampling(lambda idx: cols[next(calls)], n, k)
@@ -748,9 +833,10 @@ class _Run:
 
     def _race_sample_fn(self, genomes: np.ndarray):
         def sample(idx: np.ndarray) -> np.ndarray:
-            rows = self.stream.rows(idx.shape[0])
             n = idx.shape[0]
-            return self.flyer.fly(genomes, rows, idx.astype(np.int64), "range", n).copy()
+            if self.stream is None:
+                return self.flyer.fly(genomes, self.rows, idx.astype(np.int64), None, n).copy()
+            return self.flyer.fly(genomes, self.stream.rows(n), idx.astype(np.int64), "range", n).copy()
         return sample
 
     # ----------------------------------------------------------------- loop
@@ -1011,7 +1097,8 @@ def evolve(
     # Load (or compile) the kernel before the clock runs, and validate the thread count.
     evaluate_jobs([run.proto], run.rows if run.rows is not None else run.family.zero(), [0], [0], [0],
                   n_steps=1, threads=threads)
-    with num_threads(threads):
+    with num_threads(threads if threads is not None else numba.get_num_threads()):  # restores the count after
+        run.flyer.start()
         run.run(progress, path, float(checkpoint_every_s), float(progress_every_s))
     return run.result()
 
