@@ -1,0 +1,126 @@
+"""Commands of the reproduction stage: ``reproduce``, ``results`` and ``report``.
+
+- ``neurohover reproduce NAME|all|FILE.toml --scale quick|paper --store FILE [--executor local|ray]
+  [--address ADDR] [--jobs J] [--set KEY=VALUE ...] [--fresh]``: run an experiment's units
+  (skipping those already in the store), with a progress bar over its units.
+- ``neurohover results NAME --store FILE [--scale S] [--format csv|json] [--out FILE]``: export.
+- ``neurohover report --store FILE --out DIR [--scale S] [NAME ...]``: figures and report.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .errors import NeurohoverError
+
+
+def cmd_reproduce(args: argparse.Namespace) -> int:
+    """Run a paper experiment (or all of them); every finished unit goes to the results store at once."""
+    from .experiments import Store, load_configs, make_executor, parse_override, reproduce
+    from .experiments.config import experiment_names
+
+    if args.list:
+        for name in experiment_names():
+            print(name)
+        return 0
+    if args.name is None:
+        raise NeurohoverError("give an experiment NAME (" + ", ".join(experiment_names()) + "), 'all', or a .toml config file")
+    if args.store is None:
+        raise NeurohoverError("give the results store file with --store FILE (it is created if missing)")
+    if args.executor == "ray" and args.jobs != 1:
+        raise NeurohoverError("--jobs applies to --executor local; Ray runs one unit per CPU of the cluster")
+    overrides = dict(parse_override(text) for text in args.set or [])
+    configs = load_configs(args.name, args.scale, overrides)
+    executor = make_executor(args.executor, jobs=args.jobs, address=args.address)
+    failed = False
+    try:
+        with Store(args.store) as store:
+            for config in configs:
+                try:
+                    summary = reproduce(config, store, executor, fresh=args.fresh, progress=args.progress)
+                except KeyboardInterrupt:
+                    done = len(store.results(config.name, config.scale))
+                    print(f"neurohover reproduce: interrupted; {done} finished units of {config.name} are in {args.store}; "
+                          f"run the same command again to resume", file=sys.stderr)
+                    return 130
+                print(summary.line())
+                failed = failed or summary.status != "finished"
+    finally:
+        executor.close()
+    return 1 if failed else 0
+
+
+def cmd_results(args: argparse.Namespace) -> int:
+    """Export an experiment's finished units from the results store as CSV or JSON."""
+    from .experiments import Store, export_results
+
+    if not Path(args.store).is_file():
+        raise NeurohoverError(f"results store {args.store!r} does not exist")
+    with Store(args.store, create=False) as store:
+        text = export_results(store, args.name, args.format, args.scale)
+    if args.out:
+        Path(args.out).write_text(text)
+        print(f"wrote {args.out}", file=sys.stderr)
+    else:
+        sys.stdout.write(text)
+    return 0
+
+
+def cmd_report(args: argparse.Namespace) -> int:
+    """Draw the paper's figures from the results store and write a Markdown report beside the paper's numbers."""
+    from .experiments import Store, write_report
+
+    if not Path(args.store).is_file():
+        raise NeurohoverError(f"results store {args.store!r} does not exist")
+    with Store(args.store, create=False) as store:
+        path = write_report(store, args.out, scale=args.scale, names=args.names or None)
+    print(f"report written to {path}")
+    return 0
+
+
+def register(sub) -> None:
+    p = sub.add_parser("reproduce", help="run a paper experiment into a results store", description=cmd_reproduce.__doc__)
+    p.add_argument("name", nargs="?", help="experiment (fig2, table4, fig7, fig8, fig11, fig12, fig13, fig15, fig16), 'all', or a .toml config")
+    p.add_argument("--scale", choices=("quick", "paper"), default="quick", help="quick (minutes; the default) or paper (the paper's protocol)")
+    p.add_argument("--store", help="results store file (SQLite; created if missing; finished units are skipped)")
+    p.add_argument("--executor", choices=("local", "ray"), default="local", help="local processes (default) or a Ray cluster")
+    p.add_argument("--address", help="Ray cluster address (default: start a local Ray instance)")
+    p.add_argument("--jobs", type=int, default=1, help="local worker processes (default 1: this process, kernel on all cores)")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a setting of the config (TOML value), e.g. --set episodes=50")
+    p.add_argument("--fresh", action="store_true", help="discard the experiment's stored results at this scale first")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None, help="progress bar (default: when stderr is a terminal)")
+    p.add_argument("--list", action="store_true", help="list the experiments and exit")
+    p.set_defaults(func=cmd_reproduce)
+
+    p = sub.add_parser("results", help="export an experiment's results as CSV or JSON", description=cmd_results.__doc__)
+    p.add_argument("name", help="experiment name")
+    p.add_argument("--store", required=True, help="results store file")
+    p.add_argument("--scale", choices=("quick", "paper"), help="which scale (needed when the store holds both)")
+    p.add_argument("--format", choices=("csv", "json"), default="csv")
+    p.add_argument("--out", help="output file (default: standard output)")
+    p.set_defaults(func=cmd_results)
+
+    p = sub.add_parser("report", help="draw the figures and write report.md from a results store", description=cmd_report.__doc__)
+    p.add_argument("names", nargs="*", help="experiments to include (default: all in the store)")
+    p.add_argument("--store", required=True, help="results store file")
+    p.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--scale", choices=("quick", "paper"), help="only this scale (default: every scale in the store)")
+    p.set_defaults(func=cmd_report)
+
+
+def main(argv=None) -> int:
+    """Entry point of ``python -m neurohover.experiments`` (the three commands on their own)."""
+    parser = argparse.ArgumentParser(prog="python -m neurohover.experiments", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    register(sub)
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except NeurohoverError as err:
+        print(f"neurohover {args.command}: error: {err}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"neurohover {args.command}: interrupted", file=sys.stderr)
+        return 130

@@ -1,0 +1,380 @@
+"""Experiment configs: plain TOML files, one per experiment, with a ``quick`` and a ``paper`` scale.
+
+File layout (see ``neurohover/experiments/configs/*.toml``; copy one and edit it)::
+
+    name = "fig7"                     # what `neurohover reproduce NAME` and the store call it
+    title = "Figure 7: ..."           # heading in the report
+    kind = "test_runs"                # evolution | model_learning | test_runs (what the units are)
+    paper_ref = "Figure 7, Section 3.4"
+    aliases = []                      # other names that select this experiment (optional)
+
+    [settings]                        # shared by both scales
+    task = "ghh08"
+    ...
+
+    [scales.quick]                    # a few minutes on 2 cores at most (used by the tests)
+    episodes = 20                     # each key replaces the [settings] key of the same name
+    [scales.paper]                    # the paper's protocol
+    episodes = 1000
+
+    [paper]                           # what the paper reports; the report compares against it
+
+A resolved config is ``[settings]`` updated with ``[scales.<scale>]`` and validated against the
+kind's schema below (unknown keys, wrong types and out-of-range values are refused with a message
+naming the allowed ones). Its hash covers every setting that changes results, plus
+``UNITS_VERSION`` and, for policies read from a directory, a digest of their genomes; title and
+``[paper]`` are left out so that editing the reference numbers never invalidates stored results.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ..errors import NeurohoverError
+
+CONFIG_DIR = Path(__file__).parent / "configs"
+SCALES = ("quick", "paper")
+KINDS = ("evolution", "model_learning", "test_runs")
+#: Experiments in report order (the shipped configs).
+ORDER = ("fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16")
+#: Bump when a unit function changes what it computes: stores written before are then refused.
+UNITS_VERSION = 1
+
+_TASKS = ("ghh08", "ghh09", "fghh")
+_AGENTS = ("baseline", "generic", "model-free", "model-based", "incremental", "hybrid", "hybrid-baseline",
+           "incremental-zero", "incremental-fixed", "incremental-race")
+_REQUIRED = object()
+
+
+def _int(minimum: int):
+    def check(v):
+        return isinstance(v, int) and not isinstance(v, bool) and v >= minimum, f"an integer >= {minimum}"
+    return check
+
+
+def _float(lo: float, hi: float):
+    def check(v):
+        return isinstance(v, (int, float)) and not isinstance(v, bool) and lo <= v <= hi, f"a number in [{lo:g}, {hi:g}]"
+    return check
+
+
+def _choice(*allowed: str):
+    def check(v):
+        return v in allowed, "one of " + ", ".join(repr(a) for a in allowed)
+    return check
+
+
+def _str():
+    def check(v):
+        return isinstance(v, str) and v != "", "a non-empty string"
+    return check
+
+
+def _bool():
+    def check(v):
+        return isinstance(v, bool), "true or false"
+    return check
+
+
+def _table():
+    def check(v):
+        return isinstance(v, dict), "a table"
+    return check
+
+
+def _str_list(*allowed: str):
+    def check(v):
+        ok = isinstance(v, list) and len(v) > 0 and all(isinstance(x, str) for x in v)
+        if ok and allowed:
+            ok = all(x in allowed for x in v)
+        return ok, "a non-empty list of " + ("strings" if not allowed else "names from " + ", ".join(allowed))
+    return check
+
+
+def _resampling():
+    def check(v):
+        if not isinstance(v, str):
+            return False, "a string fixed:K or race:DELTA"
+        from ..evolution.evolve import parse_resampling
+
+        try:
+            parse_resampling(v)
+        except NeurohoverError:
+            return False, "fixed:K (K >= 1) or race:DELTA (0 < DELTA < 1)"
+        return True, ""
+    return check
+
+
+def _policy_source():
+    def check(v):
+        return isinstance(v, str) and v != "", "'evolve', 'shipped' or a directory holding <task>/ policy sets"
+    return check
+
+
+# key -> (default or _REQUIRED, check)
+_COMMON: dict[str, tuple[Any, Any]] = {
+    "task": (_REQUIRED, _choice(*_TASKS)),
+    "sigma": (None, _float(0.0, 1.0)),
+    "seed": (_REQUIRED, _int(0)),
+    "n_steps": (6000, _int(1)),
+}
+
+_VARIANT = {
+    "key": (_REQUIRED, _str()),
+    "label": (_REQUIRED, _str()),
+    "topology": ("mlp", _choice("slp", "mlp")),
+    "prototype": ("baseline", _choice("zero", "baseline")),
+    "resampling": ("fixed:1", _resampling()),
+    "sigma": (None, _float(0.0, 1.0)),
+}
+
+_GROUP = {
+    "agent": (_REQUIRED, _choice(*_AGENTS)),
+    "label": (None, _str()),
+    "mdps": ("test", _choice("train", "test", "sample")),
+    "n_mdps": (_REQUIRED, _int(1)),
+    "runs_per_mdp": (1, _int(1)),
+    "exclude_own": (False, _bool()),
+}
+
+SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
+    "evolution": {
+        **_COMMON,
+        "target": (_REQUIRED, _choice("train", "zero", "family")),
+        "n_mdps": (10, _int(1)),
+        "runs": (_REQUIRED, _int(1)),
+        "budget": (0, _int(0)),
+        "optimiser": ({}, _table()),
+        "validation_episodes": (0, _int(0)),
+        "history_points": (300, _int(2)),
+        "robustness_variants": ([], lambda v: (isinstance(v, list) and all(isinstance(x, str) for x in v), "a list of variant keys")),
+        "robustness_episodes": (10, _int(1)),
+        "variants": (_REQUIRED, ("list", _VARIANT)),
+    },
+    "model_learning": {
+        **_COMMON,
+        "mdps": ("test", _choice("train", "test", "sample")),
+        "n_mdps": (_REQUIRED, _int(1)),
+        "methods": (["ec-mer", "ec-meno", "lr"], _str_list("ec-mer", "ec-meno", "lr")),
+        "generic": ("evolve", _policy_source()),
+        "generic_budget": (0, _int(0)),
+        "model_budget": (2000, _int(1)),
+        "ec_mer_episodes": (1, _int(1)),
+        "policy_budget": (0, _int(0)),
+        "policy_prototype": ("generic", _choice("generic", "baseline")),
+        "test_episodes": (5, _int(1)),
+    },
+    "test_runs": {
+        **_COMMON,
+        "episodes": (_REQUIRED, _int(1)),
+        "policies": ("evolve", _policy_source()),
+        "policy_budget": (0, _int(0)),
+        "generic_budget": (0, _int(0)),
+        "generic_resampling": ({"fixed": "fixed:5", "race": "race:0.2"}, _table()),
+        "generics_per_agent": (1, _int(1)),
+        "safety_episodes": (3, _int(1)),
+        "model_budget": (2000, _int(1)),
+        "predict_episodes": (5, _int(1)),
+        "max_learning_episodes": (25, _int(1)),
+        "groups": (_REQUIRED, ("list", _GROUP)),
+    },
+}
+
+
+def _validate_table(values: dict, schema: dict, where: str) -> dict:
+    unknown = sorted(set(values) - set(schema))
+    if unknown:
+        raise NeurohoverError(f"{where}: unknown setting(s) {', '.join(unknown)}; allowed: {', '.join(sorted(schema))}")
+    out: dict[str, Any] = {}
+    for key, (default, check) in schema.items():
+        if key not in values:
+            if default is _REQUIRED:
+                raise NeurohoverError(f"{where}: missing required setting {key!r}")
+            out[key] = json.loads(json.dumps(default))
+            continue
+        value = values[key]
+        if isinstance(check, tuple):  # a list of sub-tables
+            if not isinstance(value, list) or not value or not all(isinstance(x, dict) for x in value):
+                raise NeurohoverError(f"{where}: {key!r} must be a non-empty list of tables ([[{key}]] in TOML)")
+            out[key] = [_validate_table(item, check[1], f"{where}, {key}[{i}]") for i, item in enumerate(value)]
+            continue
+        if value is None and default is None:
+            out[key] = None
+            continue
+        ok, allowed = check(value)
+        if not ok:
+            raise NeurohoverError(f"{where}: {key} = {value!r} is not allowed: expected {allowed}")
+        out[key] = value
+    return out
+
+
+def _check_kind(settings: dict, kind: str, where: str) -> None:
+    """Cross-field checks."""
+    task, sigma = settings["task"], settings.get("sigma")
+    if sigma is not None and task != "fghh":
+        raise NeurohoverError(f"{where}: sigma applies to task 'fghh' only, not {task!r}")
+    if kind == "evolution":
+        keys = [v["key"] for v in settings["variants"]]
+        if len(set(keys)) != len(keys):
+            raise NeurohoverError(f"{where}: variant keys must be unique, got {keys}")
+        for v in settings["variants"]:
+            if v["sigma"] is not None and task != "fghh":
+                raise NeurohoverError(f"{where}: variant {v['key']!r} sets sigma but the task is {task!r}")
+            if settings["target"] != "family" and v["resampling"].startswith("race"):
+                raise NeurohoverError(f"{where}: variant {v['key']!r}: selection races need target = 'family'")
+        bad = [k for k in settings["robustness_variants"] if k not in keys]
+        if bad:
+            raise NeurohoverError(f"{where}: robustness_variants {bad} are not variant keys ({', '.join(keys)})")
+        if settings["robustness_variants"] and settings["target"] != "train":
+            raise NeurohoverError(f"{where}: robustness_variants need target = 'train'")
+        if settings["target"] == "train" and settings["n_mdps"] > 10:
+            raise NeurohoverError(f"{where}: n_mdps = {settings['n_mdps']} is out of range: there are 10 training MDPs")
+    if kind in ("model_learning", "test_runs"):
+        groups = settings.get("groups", [{"mdps": settings.get("mdps"), "n_mdps": settings.get("n_mdps")}])
+        for g in groups:
+            limit = {"train": 10, "test": 100}.get(g["mdps"])
+            if limit is not None and g["n_mdps"] > limit:
+                raise NeurohoverError(f"{where}: n_mdps = {g['n_mdps']} is out of range for mdps = {g['mdps']!r} (at most {limit})")
+    if kind == "test_runs":
+        labels = [g["label"] or g["agent"] for g in settings["groups"]]
+        if len(set(labels)) != len(labels):
+            raise NeurohoverError(f"{where}: group labels must be unique (set label = ... on repeated agents), got {labels}")
+        for g in settings["groups"]:
+            from .units import AGENT_TASKS
+
+            if task not in AGENT_TASKS[g["agent"]]:
+                raise NeurohoverError(f"{where}: agent {g['agent']!r} does not apply to task {task!r}")
+            g["label"] = g["label"] or g["agent"]
+        gr = settings["generic_resampling"]
+        if set(gr) - {"fixed", "race"} or not all(_resampling()(v)[0] for v in gr.values()):
+            raise NeurohoverError(f"{where}: generic_resampling must be a table with keys fixed and/or race holding fixed:K / race:DELTA")
+
+
+@dataclass(frozen=True)
+class ExperimentConfig:
+    """A resolved, validated experiment config at one scale."""
+
+    name: str
+    title: str
+    kind: str
+    scale: str
+    settings: dict
+    paper: dict = field(default_factory=dict)
+    paper_ref: str = ""
+    source: str = ""
+    external_digest: str = ""
+
+    @property
+    def hash(self) -> str:
+        """Hash of everything that changes results (16 hex digits)."""
+        payload = {"kind": self.kind, "settings": self.settings, "units_version": UNITS_VERSION,
+                   "external": self.external_digest}
+        return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "title": self.title, "kind": self.kind, "scale": self.scale,
+                "settings": self.settings, "paper": self.paper, "paper_ref": self.paper_ref,
+                "source": self.source, "external_digest": self.external_digest, "hash": self.hash}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "ExperimentConfig":
+        return cls(d["name"], d["title"], d["kind"], d["scale"], d["settings"], d.get("paper", {}),
+                   d.get("paper_ref", ""), d.get("source", ""), d.get("external_digest", ""))
+
+
+def shipped_configs() -> dict[str, Path]:
+    """Name -> path of the shipped configs, in report order."""
+    found = {p.stem: p for p in CONFIG_DIR.glob("*.toml")}
+    order = [n for n in ORDER if n in found] + sorted(n for n in found if n not in ORDER)
+    return {n: found[n] for n in order}
+
+
+def _aliases() -> dict[str, str]:
+    out = {}
+    for name, path in shipped_configs().items():
+        try:
+            for alias in tomllib.loads(path.read_text()).get("aliases", []):
+                out[alias] = name
+        except tomllib.TOMLDecodeError:
+            pass
+    return out
+
+
+def experiment_names() -> list[str]:
+    return list(shipped_configs())
+
+
+def resolve_name(name: str) -> Path:
+    """The config file of a shipped experiment name (or alias), or of a path to a .toml file."""
+    path = Path(name)
+    if name.endswith(".toml"):
+        if not path.is_file():
+            raise NeurohoverError(f"config file {name!r} does not exist")
+        return path
+    shipped = shipped_configs()
+    name = _aliases().get(name, name)
+    if name not in shipped:
+        raise NeurohoverError(f"unknown experiment {name!r}: known experiments are {', '.join(shipped)} "
+                              f"(or 'all', or a path to a .toml config file)")
+    return shipped[name]
+
+
+def parse_override(text: str) -> tuple[str, Any]:
+    """``KEY=VALUE`` with VALUE in TOML syntax (a bare word is taken as a string)."""
+    key, sep, value = text.partition("=")
+    key = key.strip()
+    if not sep or not key:
+        raise NeurohoverError(f"bad --set {text!r}: expected KEY=VALUE (VALUE in TOML syntax, e.g. runs=3 or policies=\"evolve\")")
+    try:
+        parsed = tomllib.loads(f"v = {value.strip()}")["v"]
+    except tomllib.TOMLDecodeError:
+        parsed = value.strip()
+    return key, parsed
+
+
+def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None = None) -> ExperimentConfig:
+    """Load, resolve and validate an experiment config at ``scale`` (``quick`` or ``paper``)."""
+    if scale not in SCALES:
+        raise NeurohoverError(f"unknown scale {scale!r}: allowed {', '.join(SCALES)}")
+    path = resolve_name(name_or_path)
+    try:
+        raw = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as err:
+        raise NeurohoverError(f"config {str(path)!r} is not valid TOML: {err}") from None
+    where = f"config {str(path)!r}"
+    allowed_top = {"name", "title", "kind", "paper_ref", "aliases", "settings", "scales", "paper"}
+    unknown = sorted(set(raw) - allowed_top)
+    if unknown:
+        raise NeurohoverError(f"{where}: unknown top-level key(s) {', '.join(unknown)}; allowed: {', '.join(sorted(allowed_top))}")
+    for key in ("name", "kind", "settings"):
+        if key not in raw:
+            raise NeurohoverError(f"{where}: missing top-level key {key!r}")
+    kind = raw["kind"]
+    if kind not in KINDS:
+        raise NeurohoverError(f"{where}: kind = {kind!r} is not allowed: expected one of {', '.join(KINDS)}")
+    scales = raw.get("scales", {})
+    bad_scales = sorted(set(scales) - set(SCALES))
+    if bad_scales:
+        raise NeurohoverError(f"{where}: unknown scale table(s) {', '.join(bad_scales)}; allowed: {', '.join(SCALES)}")
+    if scale not in scales:
+        raise NeurohoverError(f"{where}: has no [scales.{scale}] table")
+    merged = {**raw["settings"], **scales[scale], **(overrides or {})}
+    settings = _validate_table(merged, SCHEMAS[kind], f"{where} at scale {scale!r}")
+    _check_kind(settings, kind, f"{where} at scale {scale!r}")
+    from .plans import external_digest
+
+    digest = external_digest(kind, settings)
+    return ExperimentConfig(raw["name"], raw.get("title", raw["name"]), kind, scale, settings, raw.get("paper", {}),
+                            raw.get("paper_ref", ""), str(path), digest)
+
+
+def load_configs(name: str, scale: str, overrides: dict[str, Any] | None = None) -> list[ExperimentConfig]:
+    """``all`` (every shipped experiment) or one name / path."""
+    if name == "all":
+        return [load_config(n, scale, overrides) for n in shipped_configs()]
+    return [load_config(name, scale, overrides)]

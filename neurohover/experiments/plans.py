@@ -1,0 +1,299 @@
+"""From a resolved config to units of work, stage by stage.
+
+``plan(config, results)`` returns every unit that can be defined given the results finished so
+far (a later stage's units need earlier results: e.g. Table 3 tests the best champion of each
+MDP's evolution runs; test runs fly policies evolved by the experiment's own policy units) and the
+total number of units the experiment will have. The runner calls it until every planned unit is
+done. Planning is deterministic: the same config and results give the same units, keys, params.
+
+Unit keys (unique within an experiment)::
+
+    evolve/<variant>/train<i>/run<r>     evolution run r of a variant on training MDP i
+    evolve/<variant>/run<r>              ... on the zero setting or on G
+    robust/<variant>/train<i>            Table 3: best champion of MDP i flown on every MDP
+    policy/generic, policy/specialised<i>, policy/safety, policy/generic-<zero|fixed|race><j>
+    model/<method>/<mdps><i>             Table 4: one model-learning trial
+    run/<group>/<mdps><i>/rep<r>         one test run of a group's agent
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import NeurohoverError
+from .config import ExperimentConfig
+from .units import Unit, policy_dict, unit_seed
+
+_SAMPLE_TAG = 0x5A3
+
+
+@dataclass(frozen=True)
+class Plan:
+    units: list[Unit]
+    total: int
+
+
+def _family(task: str, sigma: float | None):
+    from ..tasks import get_task_family
+
+    return get_task_family(task, sigma if task == "fghh" else None)
+
+
+def _mdps(family, which: str, n: int, seed: int):
+    if which == "train":
+        return family.training_mdps()[:n]
+    if which == "test":
+        return family.test_mdps()[:n]
+    return [family.sample(np.random.default_rng(np.random.SeedSequence([seed, _SAMPLE_TAG, i])),
+                          label=f"{family.name}/sample:{i}") for i in range(n)]
+
+
+def _unit(cfg: ExperimentConfig, key: str, kind: str, params: dict, seed_key: str | None = None) -> Unit:
+    params = {**params, "seed": unit_seed(cfg.settings["seed"], cfg.name, seed_key or key)}
+    return Unit(cfg.name, key, kind, params)
+
+
+# --------------------------------------------------------------------------------- external policies
+
+
+def _load_external(task: str, source: str):
+    from ..policysets import load_policy_set
+
+    return load_policy_set(task, None if source == "shipped" else source)
+
+
+def external_digest(kind: str, s: dict) -> str:
+    """Digest of policies a config reads from a directory (so results never mix policy sets)."""
+    source = s.get("policies") if kind == "test_runs" else s.get("generic") if kind == "model_learning" else None
+    if source in (None, "evolve", "baseline"):
+        return ""
+    ps = _load_external(s["task"], source)
+    payload = {"generic": policy_dict(ps.generic), "specialised": [policy_dict(p) for p in ps.specialised],
+               "safe": list(ps.safe), "generics": {k: policy_dict(v) for k, v in sorted(ps.generics.items())}}
+    return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
+
+
+# --------------------------------------------------------------------------------- evolution
+
+
+def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
+    s = cfg.settings
+    family = _family(s["task"], s["sigma"])
+    units: list[Unit] = []
+    base = {"budget": s["budget"], "optimiser": s["optimiser"], "n_steps": s["n_steps"],
+            "validation_episodes": s["validation_episodes"], "history_points": s["history_points"]}
+    train = family.training_mdps()[: s["n_mdps"]]
+    for v in s["variants"]:
+        common = {**base, "topology": v["topology"], "prototype": v["prototype"], "resampling": v["resampling"]}
+        if s["target"] == "train":
+            for i, mdp in enumerate(train):
+                for r in range(s["runs"]):
+                    units.append(_unit(cfg, f"evolve/{v['key']}/train{i}/run{r}", "evolve",
+                                       {**common, "target": {"kind": "mdp", "mdp": mdp.to_dict()}}))
+        else:
+            sigma = v["sigma"] if v["sigma"] is not None else s["sigma"]
+            if s["target"] == "zero":
+                target = {"kind": "mdp", "mdp": _family(s["task"], sigma).zero().to_dict()}
+            else:
+                target = {"kind": "family", "task": s["task"], "sigma": sigma}
+            for r in range(s["runs"]):
+                units.append(_unit(cfg, f"evolve/{v['key']}/run{r}", "evolve", {**common, "target": target}))
+    total = len(units) + len(s["robustness_variants"]) * len(train)
+    for vkey in s["robustness_variants"]:
+        for i in range(len(train)):
+            keys = [f"evolve/{vkey}/train{i}/run{r}" for r in range(s["runs"])]
+            if not all(k in results for k in keys):
+                continue
+            best = max(keys, key=lambda k: float(results[k]["champion_return"]))
+            units.append(_unit(cfg, f"robust/{vkey}/train{i}", "robustness", {
+                "policy": results[best]["champion"], "source": best, "own": i,
+                "mdps": [m.to_dict() for m in train], "episodes": s["robustness_episodes"], "n_steps": s["n_steps"]}))
+    return Plan(units, total)
+
+
+# --------------------------------------------------------------------------------- policies of a test
+
+
+def _policy_evolution_unit(cfg: ExperimentConfig, key: str, target: dict, budget: int, resampling: str = "fixed:1") -> Unit:
+    s = cfg.settings
+    return _unit(cfg, key, "evolve", {
+        "target": target, "topology": "mlp", "prototype": "baseline", "resampling": resampling,
+        "budget": budget, "optimiser": {}, "n_steps": s["n_steps"], "validation_episodes": 0, "history_points": 50})
+
+
+def _needs(agent: str) -> set[str]:
+    return {
+        "baseline": set(), "generic": {"generic"}, "model-free": {"specialised"},
+        "model-based": {"generic"}, "incremental": {"generic"},
+        "hybrid": {"generic", "specialised", "safety"}, "hybrid-baseline": {"generic", "specialised", "safety"},
+        "incremental-zero": {"zero"}, "incremental-fixed": {"fixed"}, "incremental-race": {"race"},
+    }[agent]
+
+
+def _fghh_generic_kind(agent: str) -> str | None:
+    if agent.startswith("incremental-"):
+        return agent.split("-", 1)[1]
+    return "race" if agent in ("generic", "model-based", "incremental") else None
+
+
+class _Policies:
+    """The policies a test-runs experiment's agents fly: evolved by its own units, or read from a
+    policy set directory. ``get`` returns None while the units they come from are unfinished."""
+
+    def __init__(self, cfg: ExperimentConfig, results: dict) -> None:
+        self.cfg, self.results = cfg, results
+        s = cfg.settings
+        self.task = s["task"]
+        self.family = _family(s["task"], s["sigma"])
+        needs: set[str] = set()
+        for g in s["groups"]:
+            needs |= _needs(g["agent"])
+            if self.task == "fghh" and _fghh_generic_kind(g["agent"]):
+                needs.add(_fghh_generic_kind(g["agent"]))
+        self.needs = needs
+        self.units: list[Unit] = []
+        self.total = 0
+        self.external = None if s["policies"] == "evolve" else _load_external(self.task, s["policies"])
+        if self.external is not None:
+            if self.task == "fghh" and s["generics_per_agent"] != 1:
+                raise NeurohoverError(f"config {cfg.name!r}: a policy set holds one generic policy per method; "
+                                      f"generics_per_agent = {s['generics_per_agent']} needs policies = \"evolve\"")
+            return
+        budget = s["policy_budget"]
+        if self.task != "fghh":
+            if needs & {"generic"}:
+                self._add("policy/generic", {"kind": "mdp", "mdp": self.family.zero().to_dict()}, budget)
+            if needs & {"specialised", "safety"}:
+                for i, mdp in enumerate(self.family.training_mdps()):
+                    self._add(f"policy/specialised{i}", {"kind": "mdp", "mdp": mdp.to_dict()}, budget)
+            if "safety" in needs:
+                self.total += 1
+                spec = [self.results.get(f"policy/specialised{i}") for i in range(10)]
+                if all(spec):
+                    self.units.append(_unit(cfg, "policy/safety", "safety", {
+                        "policies": [r["champion"] for r in spec],
+                        "mdps": [m.to_dict() for m in self.family.training_mdps()],
+                        "episodes": s["safety_episodes"], "n_steps": s["n_steps"]}))
+        else:
+            for kind in ("zero", "fixed", "race"):
+                if kind not in needs:
+                    continue
+                for j in range(s["generics_per_agent"]):
+                    if kind == "zero":
+                        self._add(f"policy/generic-zero{j}", {"kind": "mdp", "mdp": self.family.zero().to_dict()}, budget)
+                    else:
+                        self._add(f"policy/generic-{kind}{j}", {"kind": "family", "task": "fghh", "sigma": s["sigma"]},
+                                  s["generic_budget"], s["generic_resampling"].get(kind, "fixed:5" if kind == "fixed" else "race:0.2"))
+
+    def _add(self, key: str, target: dict, budget: int, resampling: str = "fixed:1") -> None:
+        self.units.append(_policy_evolution_unit(self.cfg, key, target, budget, resampling))
+        self.total += 1
+
+    def _evolved(self, key: str) -> dict | None:
+        r = self.results.get(key)
+        return None if r is None else r["champion"]
+
+    def for_agent(self, agent: str, mdp_index: int | None, run_counter: int, exclude_own: bool) -> dict | None:
+        """The policies of one run of ``agent`` (None: not ready yet)."""
+        need = _needs(agent)
+        out: dict = {}
+        ext = self.external
+        if self.task == "fghh":
+            kind = _fghh_generic_kind(agent)
+            if kind is not None:
+                if ext is not None:
+                    out["generic"] = policy_dict(ext.generics[kind])
+                else:
+                    j = run_counter % self.cfg.settings["generics_per_agent"]
+                    out["generic"] = self._evolved(f"policy/generic-{kind}{j}")
+                    out["generic_source"] = f"policy/generic-{kind}{j}"
+            return None if any(v is None for v in out.values()) else out
+        if "generic" in need:
+            out["generic"] = policy_dict(ext.generic) if ext is not None else self._evolved("policy/generic")
+        if need & {"specialised", "safety"}:
+            spec = [policy_dict(p) for p in ext.specialised] if ext is not None else [
+                self._evolved(f"policy/specialised{i}") for i in range(10)]
+            if any(p is None for p in spec):
+                return None
+            if "safety" in need:
+                if ext is not None:
+                    safe = list(ext.safe)
+                else:
+                    sr = self.results.get("policy/safety")
+                    if sr is None:
+                        return None
+                    safe = sr["safe"]
+                out["safe"] = [spec[i] for i in safe]
+                out["safe_indices"] = safe
+            if agent == "model-free":
+                keep = [i for i in range(len(spec)) if not (exclude_own and i == mdp_index)]
+                out["specialised"] = [spec[i] for i in keep]
+                out["specialised_indices"] = keep
+        return None if any(v is None for v in out.values()) else out
+
+
+def _plan_test_runs(cfg: ExperimentConfig, results: dict) -> Plan:
+    s = cfg.settings
+    pol = _Policies(cfg, results)
+    units = list(pol.units)
+    total = pol.total
+    settings = {k: s[k] for k in ("task", "sigma", "episodes", "n_steps", "model_budget", "predict_episodes", "max_learning_episodes")}
+    for g in s["groups"]:
+        mdps = _mdps(pol.family, g["mdps"], g["n_mdps"], s["seed"])
+        counter = 0
+        for i, mdp in enumerate(mdps):
+            for rep in range(g["runs_per_mdp"]):
+                total += 1
+                policies = pol.for_agent(g["agent"], i if g["mdps"] == "train" else None, counter,
+                                         g["exclude_own"] and g["mdps"] == "train")
+                counter += 1
+                if policies is None:
+                    continue
+                units.append(_unit(cfg, f"run/{g['label']}/{g['mdps']}{i}/rep{rep}", "test_run", {
+                    **settings, "agent": g["agent"], "group": g["label"], "mdp": mdp.to_dict(), "policies": policies}))
+    return Plan(units, total)
+
+
+# --------------------------------------------------------------------------------- model learning
+
+
+def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
+    s = cfg.settings
+    family = _family(s["task"], s["sigma"])
+    units: list[Unit] = []
+    total = len(s["methods"]) * s["n_mdps"]
+    if s["generic"] == "evolve":
+        total += 1
+        units.append(_policy_evolution_unit(cfg, "policy/generic", {"kind": "mdp", "mdp": family.zero().to_dict()},
+                                            s["generic_budget"]))
+        generic = results.get("policy/generic", {}).get("champion")
+    elif s["generic"] == "baseline":
+        from ..policies import baseline_policy
+
+        generic = policy_dict(baseline_policy())
+    else:
+        generic = policy_dict(_load_external(s["task"], s["generic"]).generic)
+    if generic is None:
+        return Plan(units, total)
+    for i, mdp in enumerate(_mdps(family, s["mdps"], s["n_mdps"], s["seed"])):
+        for method in s["methods"]:
+            # The seed depends on the MDP only: every method learns from the same flight data and
+            # its policy meets the same gusts (a paired comparison).
+            units.append(_unit(cfg, f"model/{method}/{s['mdps']}{i}", "model", {
+                "method": method, "mdp": mdp.to_dict(), "generic": generic, "n_steps": s["n_steps"],
+                "model_budget": s["model_budget"], "ec_mer_episodes": s["ec_mer_episodes"],
+                "policy_budget": s["policy_budget"], "prototype": s["policy_prototype"],
+                "test_episodes": s["test_episodes"]}, seed_key=f"model/{s['mdps']}{i}"))
+    return Plan(units, total)
+
+
+_PLANNERS = {"evolution": _plan_evolution, "test_runs": _plan_test_runs, "model_learning": _plan_model_learning}
+
+
+def plan(cfg: ExperimentConfig, results: dict[str, dict]) -> Plan:
+    """Every unit that can be defined given ``results`` (key -> result), and the final unit count."""
+    return _PLANNERS[cfg.kind](cfg, results)

@@ -1,0 +1,223 @@
+"""The results store: one embedded SQLite file (Python's sqlite3, no server).
+
+Tables (schema version :data:`SCHEMA_VERSION`, kept in ``PRAGMA user_version``; the file is marked
+as a neurohover store by ``PRAGMA application_id``)::
+
+    experiments(name, scale, config_hash, config, created)        one row per (name, scale)
+    units(name, scale, key, kind, config_hash, params, result,    one row per finished unit
+          seconds, worker, finished)
+    sessions(id, name, scale, config_hash, executor, cores,       one row per `reproduce` call
+             started, wall_seconds, units_run, units_before, status)
+
+One store holds any number of experiments, keyed by name and scale. An experiment's config hash
+is fixed when it is first written: running the same name and scale with a different config is
+refused (never silently mixed), as is a store of another schema version or a file that is not a
+neurohover store.
+
+Durability: each finished unit is written in its own transaction (with its session's counters)
+the moment it finishes, so an interrupted run (Ctrl-C or SIGKILL) loses no finished unit, and
+running again with the same store skips every finished unit.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import socket
+import sqlite3
+import time
+from pathlib import Path
+from typing import Any
+
+from ..errors import NeurohoverError
+
+SCHEMA_VERSION = 1
+APPLICATION_ID = 0x4E484F56  # "NHOV"
+
+_SCHEMA = """
+CREATE TABLE experiments (
+    name TEXT NOT NULL, scale TEXT NOT NULL, config_hash TEXT NOT NULL, config TEXT NOT NULL,
+    created REAL NOT NULL, PRIMARY KEY (name, scale));
+CREATE TABLE units (
+    name TEXT NOT NULL, scale TEXT NOT NULL, key TEXT NOT NULL, kind TEXT NOT NULL,
+    config_hash TEXT NOT NULL, params TEXT NOT NULL, result TEXT NOT NULL, seconds REAL NOT NULL,
+    worker TEXT NOT NULL, finished REAL NOT NULL, PRIMARY KEY (name, scale, key));
+CREATE TABLE sessions (
+    id INTEGER PRIMARY KEY AUTOINCREMENT, name TEXT NOT NULL, scale TEXT NOT NULL,
+    config_hash TEXT NOT NULL, executor TEXT NOT NULL, cores INTEGER NOT NULL, started REAL NOT NULL,
+    wall_seconds REAL NOT NULL, units_run INTEGER NOT NULL, units_before INTEGER NOT NULL,
+    status TEXT NOT NULL);
+"""
+
+
+def _dumps(obj: Any) -> str:
+    return json.dumps(obj, separators=(",", ":"), allow_nan=False)
+
+
+class Store:
+    """A results store file (created if missing).
+
+    >>> store = Store("results.sqlite")
+    >>> store.experiments()          # [(name, scale, config_hash, units), ...]
+    """
+
+    def __init__(self, path: str | Path, *, create: bool = True) -> None:
+        self.path = Path(path)
+        if not self.path.exists() and not create:
+            raise NeurohoverError(f"results store {str(self.path)!r} does not exist")
+        if self.path.exists() and self.path.is_dir():
+            raise NeurohoverError(f"results store {str(self.path)!r} is a directory; give a file name")
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            self.conn = sqlite3.connect(str(self.path), timeout=30.0, isolation_level=None)
+            self.conn.execute("PRAGMA synchronous = FULL")
+            self._check_schema()
+        except sqlite3.DatabaseError as err:
+            raise NeurohoverError(f"{str(self.path)!r} is not a neurohover results store (SQLite says: {err})") from None
+
+    def close(self) -> None:
+        self.conn.close()
+
+    def __enter__(self) -> "Store":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # ------------------------------------------------------------------ schema
+
+    def _check_schema(self) -> None:
+        c = self.conn
+        version = c.execute("PRAGMA user_version").fetchone()[0]
+        app = c.execute("PRAGMA application_id").fetchone()[0]
+        tables = c.execute("SELECT count(*) FROM sqlite_master").fetchone()[0]
+        if version == 0 and app == 0 and tables == 0:
+            c.execute("BEGIN IMMEDIATE")
+            try:
+                if c.execute("SELECT count(*) FROM sqlite_master").fetchone()[0] == 0:
+                    for statement in _SCHEMA.split(";"):
+                        if statement.strip():
+                            c.execute(statement)
+                    c.execute(f"PRAGMA user_version = {SCHEMA_VERSION}")
+                    c.execute(f"PRAGMA application_id = {APPLICATION_ID}")
+                c.execute("COMMIT")
+            except BaseException:
+                if c.in_transaction:
+                    c.execute("ROLLBACK")
+                raise
+            return self._check_schema()
+        if app != APPLICATION_ID:
+            raise NeurohoverError(f"{str(self.path)!r} is an SQLite file but not a neurohover results store; "
+                                  f"give another --store file")
+        if version != SCHEMA_VERSION:
+            newer = "a newer" if version > SCHEMA_VERSION else "an older"
+            raise NeurohoverError(
+                f"results store {str(self.path)!r} has schema version {version}, written by {newer} neurohover; "
+                f"this version reads schema version {SCHEMA_VERSION}. Use a new --store file "
+                f"(or the neurohover version that wrote it); results of different schemas are never mixed")
+
+    # ------------------------------------------------------------------ experiments
+
+    def begin(self, name: str, scale: str, config_hash: str, config: dict, *, fresh: bool = False) -> None:
+        """Register experiment (name, scale) with its config hash, or check that it matches.
+
+        ``fresh`` deletes the experiment's stored units and sessions first (a deliberate restart).
+        """
+        c = self.conn
+        c.execute("BEGIN IMMEDIATE")
+        try:
+            if fresh:
+                for table in ("experiments", "units", "sessions"):
+                    c.execute(f"DELETE FROM {table} WHERE name = ? AND scale = ?", (name, scale))
+            row = c.execute("SELECT config_hash FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
+            if row is None:
+                c.execute("INSERT INTO experiments VALUES (?, ?, ?, ?, ?)", (name, scale, config_hash, _dumps(config), time.time()))
+            elif row[0] != config_hash:
+                raise NeurohoverError(
+                    f"results store {str(self.path)!r} already holds experiment {name!r} at scale {scale!r} with config "
+                    f"hash {row[0]}, but this config hashes to {config_hash}: the settings differ, so the results would "
+                    f"not be comparable. Use another --store file, restore the old config, or rerun with --fresh to "
+                    f"discard the stored results of {name!r} ({scale})")
+            c.execute("COMMIT")
+        except BaseException:
+            c.execute("ROLLBACK")
+            raise
+
+    def experiments(self) -> list[tuple[str, str, str, int]]:
+        """(name, scale, config_hash, finished units) of every experiment in the store."""
+        return [tuple(r) for r in self.conn.execute(
+            "SELECT e.name, e.scale, e.config_hash, (SELECT count(*) FROM units u WHERE u.name = e.name AND u.scale = e.scale) "
+            "FROM experiments e ORDER BY e.created")]
+
+    def config(self, name: str, scale: str) -> dict:
+        row = self.conn.execute("SELECT config FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
+        if row is None:
+            raise NeurohoverError(self._missing(name, scale))
+        return json.loads(row[0])
+
+    def _missing(self, name: str, scale: str | None) -> str:
+        present = [f"{n} ({s})" for n, s, _, _ in self.experiments()]
+        what = f"{name!r}" + (f" at scale {scale!r}" if scale else "")
+        return (f"results store {str(self.path)!r} holds no experiment {what}; it holds: "
+                + (", ".join(present) if present else "nothing yet"))
+
+    def scales(self, name: str) -> list[str]:
+        return [r[0] for r in self.conn.execute("SELECT scale FROM experiments WHERE name = ? ORDER BY created", (name,))]
+
+    # ------------------------------------------------------------------ units
+
+    def results(self, name: str, scale: str) -> dict[str, dict]:
+        """key -> result of every finished unit."""
+        return {k: json.loads(r) for k, r in self.conn.execute(
+            "SELECT key, result FROM units WHERE name = ? AND scale = ?", (name, scale))}
+
+    def units(self, name: str, scale: str) -> list[dict]:
+        """Every finished unit: key, kind, params, result, seconds, worker, finished (time)."""
+        rows = self.conn.execute(
+            "SELECT key, kind, params, result, seconds, worker, finished FROM units WHERE name = ? AND scale = ? ORDER BY key",
+            (name, scale))
+        return [{"key": k, "kind": kind, "params": json.loads(p), "result": json.loads(r), "seconds": s,
+                 "worker": w, "finished": f} for k, kind, p, r, s, w, f in rows]
+
+    def put(self, name: str, scale: str, config_hash: str, unit, result: dict, seconds: float,
+            worker: str = "", session: int | None = None) -> bool:
+        """Record one finished unit in its own transaction; False if it was already there."""
+        c = self.conn
+        text = _dumps(result)
+        c.execute("BEGIN IMMEDIATE")
+        try:
+            row = c.execute("SELECT config_hash FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
+            if row is None or row[0] != config_hash:
+                raise NeurohoverError(f"refusing to record unit {unit.key!r}: experiment {name!r} ({scale}) in "
+                                      f"{str(self.path)!r} has config hash {row[0] if row else None}, not {config_hash}")
+            cur = c.execute("INSERT OR IGNORE INTO units VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                            (name, scale, unit.key, unit.kind, config_hash, _dumps(unit.params), text, float(seconds),
+                             worker, time.time()))
+            if session is not None and cur.rowcount:
+                c.execute("UPDATE sessions SET units_run = units_run + 1, wall_seconds = ? - started WHERE id = ?",
+                          (time.time(), session))
+            c.execute("COMMIT")
+        except BaseException:
+            c.execute("ROLLBACK")
+            raise
+        return bool(cur.rowcount)
+
+    # ------------------------------------------------------------------ sessions
+
+    def start_session(self, name: str, scale: str, config_hash: str, executor: str, cores: int, units_before: int) -> int:
+        cur = self.conn.execute(
+            "INSERT INTO sessions (name, scale, config_hash, executor, cores, started, wall_seconds, units_run, units_before, status) "
+            "VALUES (?, ?, ?, ?, ?, ?, 0, 0, ?, 'running')", (name, scale, config_hash, executor, int(cores), time.time(), units_before))
+        return int(cur.lastrowid)
+
+    def end_session(self, session: int, status: str) -> None:
+        self.conn.execute("UPDATE sessions SET status = ?, wall_seconds = ? - started WHERE id = ?", (status, time.time(), session))
+
+    def sessions(self, name: str, scale: str) -> list[dict]:
+        cols = ("id", "executor", "cores", "started", "wall_seconds", "units_run", "units_before", "status")
+        rows = self.conn.execute(f"SELECT {', '.join(cols)} FROM sessions WHERE name = ? AND scale = ? ORDER BY id", (name, scale))
+        return [dict(zip(cols, r)) for r in rows]
+
+
+def worker_name() -> str:
+    return f"{socket.gethostname()}:{os.getpid()}"

@@ -1,0 +1,315 @@
+"""Units of work and the one pure function that runs them: :func:`run_unit`.
+
+A unit is one evolution run, one robustness test, one model-learning trial, one test run of an
+agent, ... Everything it needs travels in its ``params`` (plain JSON: MDPs as dicts, policies as
+``{"topology", "genome"}``, its own seed), so a unit runs the same in this process, in a spawned
+worker or on a Ray node, and its result (a JSON-able dict) depends on nothing else: no global
+random state, no files, no thread count.
+
+Seeds come from the unit's key: :func:`unit_seed` feeds the root seed of the config and a SHA-256
+of ``"<experiment>/<key>"`` to ``numpy.random.SeedSequence``.
+
+Results keep wall-clock measurements under the key ``"timing"``; everything else is a
+deterministic function of the params.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import os
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import NeurohoverError
+
+#: Agent name -> tasks it applies to (as in ``neurohover.agents.registry.AGENTS``).
+AGENT_TASKS: dict[str, tuple[str, ...]] = {
+    "baseline": ("ghh08", "ghh09", "fghh"),
+    "generic": ("ghh08", "ghh09", "fghh"),
+    "model-free": ("ghh08", "ghh09"),
+    "model-based": ("ghh08", "ghh09", "fghh"),
+    "incremental": ("ghh08", "ghh09", "fghh"),
+    "hybrid": ("ghh08", "ghh09"),
+    "hybrid-baseline": ("ghh08", "ghh09"),
+    "incremental-zero": ("fghh",),
+    "incremental-fixed": ("fghh",),
+    "incremental-race": ("fghh",),
+}
+
+
+@dataclass(frozen=True)
+class Unit:
+    """One unit of work of ``experiment``: ``key`` is unique within the experiment."""
+
+    experiment: str
+    key: str
+    kind: str
+    params: dict = field(hash=False, compare=False)
+
+    def to_dict(self) -> dict:
+        return {"experiment": self.experiment, "key": self.key, "kind": self.kind, "params": self.params}
+
+
+def unit_seed(root: int, experiment: str, key: str) -> int:
+    """A 63-bit seed for unit ``key``: ``SeedSequence([root, *sha256(experiment/key) words])``."""
+    digest = hashlib.sha256(f"{experiment}/{key}".encode()).digest()
+    words = [int(w) for w in np.frombuffer(digest, dtype="<u4")]
+    state = np.random.SeedSequence([int(root), *words]).generate_state(1, np.uint64)[0]
+    return int(state >> np.uint64(1))
+
+
+# --------------------------------------------------------------------------------- helpers
+
+
+def policy_dict(policy) -> dict:
+    return {"topology": policy.topology, "genome": [float(x) for x in policy.genome]}
+
+
+def _policy(d: dict):
+    from ..policies import Policy
+
+    return Policy(d["topology"], np.array(d["genome"], dtype=float))
+
+
+def _mdp(d: dict):
+    from ..tasks import MDP
+
+    return MDP.from_dict(d)
+
+
+def _family(task: str, sigma: float | None):
+    from ..tasks import get_task_family
+
+    return get_task_family(task, sigma if task == "fghh" else None)
+
+
+def _num(x: float) -> float | str:
+    """JSON-safe float (non-finite values as strings)."""
+    x = float(x)
+    return x if math.isfinite(x) else ("nan" if math.isnan(x) else ("inf" if x > 0 else "-inf"))
+
+
+def subsample(points: list[list[float]], n: int) -> list[list[float]]:
+    """At most ``n`` of ``points`` (sorted by x), keeping the first and last, spread on a log-x grid."""
+    if len(points) <= n:
+        return points
+    xs = np.array([p[0] for p in points], dtype=float)
+    grid = np.unique(np.geomspace(max(xs[0], 1.0), xs[-1], n))
+    idx = np.unique(np.clip(np.searchsorted(xs, grid, side="right") - 1, 0, len(points) - 1))
+    idx = np.unique(np.concatenate([[0], idx, [len(points) - 1]]))
+    return [points[i] for i in idx]
+
+
+# --------------------------------------------------------------------------------- unit kinds
+
+
+def _evolve_target(p: dict):
+    t = p["target"]
+    if t["kind"] == "mdp":
+        return _mdp(t["mdp"])
+    return _family(t["task"], t.get("sigma"))
+
+
+def run_evolve(p: dict, threads: int | None) -> dict:
+    """One evolution run (paper Section 3.1 / 5): champion, history, optional validation."""
+    from ..evolution.evolve import evolve, validation_return
+    from ..policies import prototype as make_prototype
+
+    target = _evolve_target(p)
+    proto = _policy(p["prototype"]) if isinstance(p["prototype"], dict) else make_prototype(p["topology"], p["prototype"])
+    t0 = time.perf_counter()
+    result = evolve(target, topology=p["topology"], prototype=proto, resampling=p["resampling"],
+                    budget=p["budget"] or None, settings=p["optimiser"] or None, seed=p["seed"],
+                    n_steps=p["n_steps"], threads=threads)
+    history = [[int(h.episodes), _num(h.champion_return)] for h in result.history]
+    out = {
+        "champion": policy_dict(result.champion), "champion_return": _num(result.champion_return),
+        "episodes": int(result.episodes), "evaluations": int(result.evaluations),
+        "generations": int(result.generations), "stop_reason": result.stop_reason,
+        "history": subsample(history, p.get("history_points", 300)),
+    }
+    if p.get("validation_episodes"):
+        v = validation_return(result.champion, target, episodes=p["validation_episodes"], seed=p["seed"],
+                              n_steps=p["n_steps"], threads=threads)
+        out["validation"] = [_num(x) for x in v]
+    out["timing"] = {"seconds": time.perf_counter() - t0, "kernel_seconds": float(result.kernel_seconds)}
+    return out
+
+
+def run_robustness(p: dict, threads: int | None) -> dict:
+    """Table 3: fly one policy ``episodes`` times on each of the given MDPs."""
+    from ..evaluate import evaluate
+
+    mdps = [_mdp(m) for m in p["mdps"]]
+    ev = evaluate(_policy(p["policy"]), mdps, episodes=p["episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads)
+    return {"returns": [[_num(x) for x in row] for row in ev.returns[0]],
+            "crashes": [int(c) for c in ev.crashed[0].sum(axis=1)], "own": p["own"]}
+
+
+def run_safety(p: dict, threads: int | None) -> dict:
+    """Crash matrix of the specialised policies on the training MDPs, and the two safe ones."""
+    from ..evaluate import evaluate
+    from ..policysets import choose_safe
+
+    policies = [_policy(d) for d in p["policies"]]
+    ev = evaluate(policies, [_mdp(m) for m in p["mdps"]], episodes=p["episodes"], seed=p["seed"],
+                  n_steps=p["n_steps"], threads=threads)
+    crashes, returns = ev.crashed.sum(axis=2), ev.returns.mean(axis=2)
+    return {"crashes": crashes.tolist(), "mean_returns": [[_num(x) for x in r] for r in returns],
+            "safe": list(choose_safe(crashes, returns))}
+
+
+def run_model(p: dict, threads: int | None) -> dict:
+    """Table 4: fly the generic policy once (flight data), learn a model, evolve a policy on the
+    model, fly that policy ``test_episodes`` times in the true MDP."""
+    from ..evaluate import evaluate
+    from ..evolution.evolve import evolve
+    from ..models import learn_ec_mer, learn_ec_meno, learn_lr
+
+    mdp = _mdp(p["mdp"])
+    generic = _policy(p["generic"])
+    seeds = np.random.SeedSequence(p["seed"]).generate_state(4, np.uint64) >> np.uint64(1)
+    data = evaluate(generic, mdp, seed=int(seeds[0]), record=True, n_steps=p["n_steps"], threads=threads)
+    t0 = time.perf_counter()
+    if p["method"] == "lr":
+        model = learn_lr(data.flight_data)
+    elif p["method"] == "ec-meno":
+        model = learn_ec_meno(data.flight_data, budget=p["model_budget"], seed=int(seeds[1]))
+    else:
+        model = learn_ec_mer(data.flight_data, generic, float(data.returns.ravel()[0]), budget=p["model_budget"],
+                             seed=int(seeds[1]), episodes=p["ec_mer_episodes"])
+    learn_seconds = time.perf_counter() - t0
+    proto = generic if p["prototype"] == "generic" else "baseline"
+    t1 = time.perf_counter()
+    evolved = evolve(model.mdp(), topology=generic.topology, prototype=proto, budget=p["policy_budget"] or None,
+                     seed=int(seeds[2]), n_steps=p["n_steps"], threads=threads)
+    evolve_seconds = time.perf_counter() - t1
+    test = evaluate(evolved.champion, mdp, episodes=p["test_episodes"], seed=int(seeds[3]), n_steps=p["n_steps"], threads=threads)
+    returns = test.returns.ravel()
+    return {
+        "method": p["method"], "mdp": mdp.label,
+        "generic_return": _num(data.returns.ravel()[0]), "generic_crashed": bool(data.crashed.ravel()[0]),
+        "model_params": [_num(x) for x in model.params], "model_noise_std": [_num(x) for x in model.noise_std],
+        "predicted_return": _num(evolved.champion_return),
+        "test_returns": [_num(x) for x in returns], "test_mean": _num(returns.mean()),
+        "test_crashes": int(test.crashed.sum()), "policy_episodes": int(evolved.episodes),
+        "timing": {"learn_seconds": learn_seconds, "evolve_seconds": evolve_seconds},
+    }
+
+
+def make_agent(p: dict):
+    """The agent of a test-run unit, built from the policies in its params.
+
+    Mirrors ``neurohover.agents.registry.AGENTS`` but passes the model-evolution settings, so that
+    the policies evolved on learned models fly episodes of the run's length.
+    """
+    from ..agents.hybrid import HybridAgent
+    from ..agents.model_based import IncrementalModelBasedAgent, ModelBasedAgent, ModelEvolution
+    from ..agents.model_free import ModelFreeAgent
+    from ..agents.registry import BaselineAgent
+    from ..policies import baseline_policy
+
+    name = p["agent"]
+    pol = p["policies"]
+    settings = ModelEvolution(budget=p["model_budget"], predict_episodes=p["predict_episodes"], n_steps=p["n_steps"])
+    if name == "baseline":
+        return BaselineAgent()
+    if name == "model-free":
+        agent = ModelFreeAgent([_policy(d) for d in pol["specialised"]])
+        return agent
+    generic = _policy(pol["generic"])
+    if name == "generic":
+        from types import SimpleNamespace
+
+        from ..agents.registry import GenericAgent
+
+        return GenericAgent(SimpleNamespace(generic=generic))
+    if name == "model-based":
+        return ModelBasedAgent(generic, settings)
+    if name.startswith("incremental"):
+        agent = IncrementalModelBasedAgent(generic, settings, max_learning_episodes=p["max_learning_episodes"])
+        agent.name = name
+        return agent
+    if name in ("hybrid", "hybrid-baseline"):
+        safe = [_policy(d) for d in pol["safe"]]
+        fallback = generic if name == "hybrid" else baseline_policy()
+        return HybridAgent(safe, generic, fallback, settings, name=name)
+    raise NeurohoverError(f"unknown agent {name!r}: allowed {', '.join(AGENT_TASKS)}")
+
+
+def run_test_run(p: dict, threads: int | None) -> dict:
+    """One test run (SPEC 7): ``episodes`` episodes of an agent on one MDP it does not know."""
+    from ..agents.protocol import run_test
+    from ..compete import after_learning_start
+
+    family = _family(p["task"], p.get("sigma"))
+    mdp = _mdp(p["mdp"])
+    agent = make_agent(p)
+    r = run_test(agent, family, mdp, episodes=p["episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads)
+    start = after_learning_start(r.policy)
+    changes = [[e, r.policy[e]] for e in range(len(r.policy)) if e == 0 or r.policy[e] != r.policy[e - 1]]
+    return {
+        "agent": p["agent"], "mdp": mdp.label, "score": _num(r.score),
+        "returns": [_num(x) for x in r.returns], "crash_episodes": [int(e) for e in np.flatnonzero(r.crashed)],
+        "safeguard_episodes": [int(e) for e in np.flatnonzero(r.safeguard_fired)],
+        "policy_changes": changes, "learning_episodes": int(start),
+        "mean_return_after_learning": _num(r.returns[start:].mean()),
+        "timing": {"seconds": float(r.seconds), "offline_seconds": float(r.offline_seconds.sum())},
+    }
+
+
+def run_diagnostic(p: dict, threads: int | None) -> dict:
+    """Diagnostics for the executors (used by the tests): sleep, or kill the worker process.
+
+    ``exit_unless`` names a marker file: if it does not exist, the unit creates it and the worker
+    process exits at once (as if killed), so a retry succeeds; ``always_exit`` always exits.
+    """
+    if p.get("always_exit"):
+        os._exit(3)
+    marker = p.get("exit_unless")
+    if marker and not os.path.exists(marker):
+        with open(marker, "w") as f:
+            f.write(str(os.getpid()))
+        os._exit(3)
+    time.sleep(float(p.get("sleep", 0.0)))
+    return {"value": p.get("value"), "seed": p.get("seed")}
+
+
+_RUNNERS = {
+    "evolve": run_evolve,
+    "robustness": run_robustness,
+    "safety": run_safety,
+    "model": run_model,
+    "test_run": run_test_run,
+    "diagnostic": run_diagnostic,
+}
+
+
+def run_unit(unit: Unit | dict, threads: int | None = 1) -> dict:
+    """Run one unit and return its JSON-able result (a pure function of the unit's params).
+
+    ``threads`` are kernel threads (1 when many units run in parallel; None: all cores); results
+    do not depend on it.
+    """
+    if isinstance(unit, dict):
+        unit = Unit(unit["experiment"], unit["key"], unit["kind"], unit["params"])
+    from ..evaluate import num_threads
+
+    runner = _RUNNERS.get(unit.kind)
+    if runner is None:
+        raise NeurohoverError(f"unknown unit kind {unit.kind!r}: allowed {', '.join(_RUNNERS)}")
+    with num_threads(threads):  # also for library calls that take no thread count (e.g. EC-MER)
+        return runner(unit.params, threads)
+
+
+def strip_timing(result: Any) -> Any:
+    """A result without its wall-clock measurements (for comparing runs)."""
+    if isinstance(result, dict):
+        return {k: strip_timing(v) for k, v in result.items() if k != "timing"}
+    if isinstance(result, list):
+        return [strip_timing(v) for v in result]
+    return result

@@ -1,0 +1,428 @@
+"""Reproduction experiments: configs, unit seeds, the SQLite results store (incl. resume after
+SIGKILL and Ctrl-C), results export, and a quick end-to-end subset with the report."""
+
+from __future__ import annotations
+
+import json
+import os
+import random
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from neurohover.commands_reproduce import main
+from neurohover.errors import NeurohoverError
+from neurohover.experiments import (
+    LocalExecutor,
+    Store,
+    experiment_names,
+    export_results,
+    load_config,
+    plan,
+    reproduce,
+    run_unit,
+    strip_timing,
+    unit_seed,
+    write_report,
+)
+from neurohover.experiments.config import CONFIG_DIR, parse_override
+from neurohover.experiments.store import SCHEMA_VERSION
+
+ROOT = Path(__file__).resolve().parents[1]
+PAPER_EXPERIMENTS = ["fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16"]
+
+# A small evolution experiment whose units take ~0.3 s each (for the interruption tests).
+SLOW_CONFIG = """
+name = "slowtest"
+title = "interruption test"
+kind = "evolution"
+[settings]
+task = "fghh"
+sigma = 0.3
+seed = 5
+target = "family"
+runs = 12
+[[settings.variants]]
+key = "k1"
+label = "k = 1"
+[scales.quick]
+budget = 3000
+n_steps = 200
+[scales.paper]
+budget = 3000
+n_steps = 200
+"""
+
+
+def _run(capsys, *argv: str) -> tuple[int, str, str]:
+    rc = main(list(argv))
+    out = capsys.readouterr()
+    return rc, out.out, out.err
+
+
+def _write(tmp_path: Path, text: str, name: str = "exp.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+# --------------------------------------------------------------------------------- configs
+
+
+def test_every_experiment_of_the_paper_is_shipped_at_both_scales() -> None:
+    assert experiment_names() == PAPER_EXPERIMENTS
+    for name in PAPER_EXPERIMENTS:
+        for scale in ("quick", "paper"):
+            cfg = load_config(name, scale)
+            assert cfg.name == name and cfg.scale == scale and len(cfg.hash) == 16
+            assert plan(cfg, {}).units, f"{name} {scale} plans no units"
+    assert load_config("table3", "quick").name == "fig2"  # alias
+
+
+@pytest.mark.parametrize("name, total, check", [
+    # Figure 2: 4 approaches x 10 training MDPs x 10 runs, plus Table 3 (2 topologies x 10 MDPs).
+    ("fig2", 420, lambda s: s["runs"] == 10 and s["n_mdps"] == 10 and s["n_steps"] == 6000 and s["robustness_episodes"] == 10),
+    # Table 4: 3 methods x 100 test MDPs, 5 test episodes, ~2000 model evaluations; + the generic policy.
+    ("table4", 301, lambda s: s["n_mdps"] == 100 and s["test_episodes"] == 5 and s["model_budget"] == 2000),
+    # Figure 7: 3 agents x 100 test MDPs x 1000 episodes; + generic and 10 specialised policies.
+    ("fig7", 311, lambda s: s["episodes"] == 1000 and all(g["n_mdps"] == 100 for g in s["groups"])),
+    # Figure 8: 3 agents x 80 runs (8 per training MDP); + policies and the safety test.
+    ("fig8", 252, lambda s: all(g["n_mdps"] * g["runs_per_mdp"] == 80 and g["mdps"] == "train" for g in s["groups"])),
+    # Figure 11: 60 + 60 runs on 20 MDPs, 300 hybrid-baseline runs on the 100 test MDPs; + policies.
+    ("fig11", 432, lambda s: [g["n_mdps"] * g["runs_per_mdp"] for g in s["groups"]] == [60, 60, 300]),
+    ("fig12", 96, lambda s: s["runs"] == 24 and s["sigma"] == 0.2 and s["budget"] == 500000),
+    ("fig13", 96, lambda s: s["runs"] == 24 and s["sigma"] == 0.3),
+    ("fig15", 120, lambda s: s["runs"] == 24 and s["variants"][0]["resampling"] == "fixed:5"),
+    # Figure 16: 3 x 100 runs, each with the generic policy of its own evolution run (2 x 100 over G, 100 on zero).
+    ("fig16", 600, lambda s: s["generics_per_agent"] == 100 and s["generic_budget"] == 500000 and s["episodes"] == 1000),
+])
+def test_paper_scale_follows_the_papers_protocol(name, total, check) -> None:
+    cfg = load_config(name, "paper")
+    assert plan(cfg, {}).total == total
+    assert check(cfg.settings)
+
+
+def test_unknown_experiment_lists_the_known_ones(capsys, tmp_path: Path) -> None:
+    with pytest.raises(NeurohoverError) as err:
+        load_config("fig99", "quick")
+    for name in PAPER_EXPERIMENTS:
+        assert name in str(err.value)
+    rc, _, stderr = _run(capsys, "reproduce", "fig99", "--store", str(tmp_path / "s.sqlite"))
+    assert rc == 2 and "unknown experiment 'fig99'" in stderr and "fig16" in stderr
+    rc, out, _ = _run(capsys, "reproduce", "--list")
+    assert rc == 0 and out.split() == PAPER_EXPERIMENTS
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda t: t.replace('target = "family"', 'target = "family"\nbudgett = 3'), "unknown setting(s) budgett"),
+    (lambda t: t.replace("runs = 12", 'runs = "twelve"'), "runs = 'twelve' is not allowed: expected an integer >= 1"),
+    (lambda t: t.replace("runs = 12\n", ""), "missing required setting 'runs'"),
+    (lambda t: t.replace('task = "fghh"', 'task = "ghh08"'), "sigma applies to task 'fghh' only"),
+    (lambda t: t.replace('label = "k = 1"', 'label = "k = 1"\nresampling = "race:2"'), "race:DELTA (0 < DELTA < 1)"),
+    (lambda t: t.replace('kind = "evolution"', 'kind = "magic"'), "kind = 'magic' is not allowed"),
+    (lambda t: t.replace("[scales.paper]", "[scales.huge]"), "unknown scale table(s) huge"),
+    (lambda t: t + "\n[[settings.variants]]\nkey = \"k1\"\nlabel = \"again\"\n", "variant keys must be unique"),
+    (lambda t: t.replace("runs = 12", "runs = [1"), "is not valid TOML"),
+])
+def test_bad_configs_are_refused_with_a_clear_message(tmp_path: Path, edit, message) -> None:
+    path = _write(tmp_path, edit(SLOW_CONFIG))
+    with pytest.raises(NeurohoverError) as err:
+        load_config(str(path), "quick")
+    assert message in str(err.value)
+
+
+def test_overrides_and_config_hash() -> None:
+    assert parse_override("runs=3") == ("runs", 3)
+    assert parse_override("policies=evolve") == ("policies", "evolve")
+    assert parse_override('policies="shipped"') == ("policies", "shipped")
+    with pytest.raises(NeurohoverError, match="KEY=VALUE"):
+        parse_override("runs")
+    base = load_config("fig12", "quick")
+    assert load_config("fig12", "quick").hash == base.hash
+    changed = load_config("fig12", "quick", {"runs": 2})
+    assert changed.settings["runs"] == 2 and changed.hash != base.hash
+    assert load_config("fig12", "paper").hash != base.hash
+    with pytest.raises(NeurohoverError, match="unknown setting"):
+        load_config("fig12", "quick", {"episodes": 3})
+
+
+def test_shipped_configs_are_plain_toml_files() -> None:
+    import tomllib
+
+    for path in CONFIG_DIR.glob("*.toml"):
+        raw = tomllib.loads(path.read_text())
+        assert raw["name"] == path.stem and set(raw["scales"]) == {"quick", "paper"} and "paper" in raw
+
+
+# --------------------------------------------------------------------------------- units and seeds
+
+
+def test_unit_seeds_come_from_the_key_not_global_state() -> None:
+    random.seed(1)
+    np.random.seed(1)
+    a = unit_seed(7, "fig7", "run/model-free/test3/rep0")
+    random.seed(2)
+    np.random.seed(2)
+    assert unit_seed(7, "fig7", "run/model-free/test3/rep0") == a
+    assert unit_seed(7, "fig7", "run/model-free/test4/rep0") != a
+    assert unit_seed(8, "fig7", "run/model-free/test3/rep0") != a
+    assert unit_seed(7, "fig8", "run/model-free/test3/rep0") != a
+    cfg = load_config("fig15", "quick")
+    first, second = plan(cfg, {}).units, plan(cfg, {}).units
+    assert [u.params for u in first] == [u.params for u in second]
+    assert len({u.params["seed"] for u in first}) == len(first)
+
+
+def test_a_unit_gives_the_same_result_on_one_or_all_threads() -> None:
+    cfg = load_config("fig15", "quick", {"budget": 600})
+    unit = plan(cfg, {}).units[-1]  # a selection-race run
+    a, b = run_unit(unit, threads=1), run_unit(unit.to_dict(), threads=None)
+    assert strip_timing(a) == strip_timing(b)
+    json.dumps(a, allow_nan=False)
+
+
+# --------------------------------------------------------------------------------- store
+
+
+def test_store_semantics(tmp_path: Path) -> None:
+    path = tmp_path / "s.sqlite"
+    cfg = load_config(str(_write(tmp_path, SLOW_CONFIG)), "quick", {"runs": 2, "budget": 200})
+    with Store(path) as store:
+        summary = reproduce(cfg, store, LocalExecutor(1), progress=False)
+        assert summary.status == "finished" and summary.units_run == 2 and summary.units_total == 2
+        assert set(store.results("slowtest", "quick")) == {"evolve/k1/run0", "evolve/k1/run1"}
+        # The same config again: nothing to do.
+        again = reproduce(cfg, store, LocalExecutor(1), progress=False)
+        assert again.units_run == 0 and again.units_before == 2 and again.status == "finished"
+        # Another scale of the same experiment lives beside it.
+        paper = load_config(str(tmp_path / "exp.toml"), "paper", {"runs": 1, "budget": 200})
+        reproduce(paper, store, LocalExecutor(1), progress=False)
+        assert {(n, s) for n, s, _, _ in store.experiments()} == {("slowtest", "quick"), ("slowtest", "paper")}
+        # A different config under the same name and scale is refused, never mixed ...
+        other = load_config(str(tmp_path / "exp.toml"), "quick", {"runs": 3, "budget": 200})
+        with pytest.raises(NeurohoverError, match="config hash .* but this config hashes to .*--fresh"):
+            reproduce(other, store, LocalExecutor(1), progress=False)
+        assert len(store.results("slowtest", "quick")) == 2
+        # ... unless the old results are discarded on purpose.
+        fresh = reproduce(other, store, LocalExecutor(1), fresh=True, progress=False)
+        assert fresh.units_run == 3 and fresh.units_before == 0
+        sessions = store.sessions("slowtest", "quick")
+        assert sessions[-1]["status"] == "finished" and sessions[-1]["cores"] >= 1 and sessions[-1]["units_run"] == 3
+
+
+def test_store_refuses_other_schema_versions_and_foreign_files(tmp_path: Path, capsys) -> None:
+    path = tmp_path / "s.sqlite"
+    Store(path).close()
+    conn = sqlite3.connect(path)
+    conn.execute(f"PRAGMA user_version = {SCHEMA_VERSION + 1}")
+    conn.commit()
+    conn.close()
+    with pytest.raises(NeurohoverError, match=f"schema version {SCHEMA_VERSION + 1}, written by a newer neurohover"):
+        Store(path)
+    rc, _, stderr = _run(capsys, "reproduce", "fig15", "--store", str(path))
+    assert rc == 2 and "schema version" in stderr
+    foreign = tmp_path / "other.sqlite"
+    conn = sqlite3.connect(foreign)
+    conn.execute("CREATE TABLE t (x)")
+    conn.commit()
+    conn.close()
+    with pytest.raises(NeurohoverError, match="not a neurohover results store"):
+        Store(foreign)
+    text = tmp_path / "notes.txt"
+    text.write_text("hello " * 1000)
+    with pytest.raises(NeurohoverError, match="not a neurohover results store"):
+        Store(text)
+
+
+def _finished(path: Path) -> dict[str, float]:
+    """key -> finish time of the units in a store another process is writing (empty if not ready)."""
+    try:
+        conn = sqlite3.connect(f"file:{path}?mode=ro", uri=True, timeout=5)
+        try:
+            return dict(conn.execute("SELECT key, finished FROM units"))
+        finally:
+            conn.close()
+    except sqlite3.OperationalError:
+        return {}
+
+
+def _start(config: Path, store: Path) -> subprocess.Popen:
+    env = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    return subprocess.Popen([sys.executable, "-m", "neurohover.experiments", "reproduce", str(config), "--scale", "quick",
+                             "--store", str(store), "--no-progress"], cwd=ROOT, env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def _interrupt_after(proc: subprocess.Popen, store: Path, n: int, sig: int) -> dict[str, float]:
+    deadline = time.time() + 240
+    while time.time() < deadline and proc.poll() is None:
+        if len(_finished(store)) >= n:
+            break
+        time.sleep(0.02)
+    assert proc.poll() is None, f"the run ended before it could be interrupted: {proc.communicate()}"
+    proc.send_signal(sig)
+    proc.communicate(timeout=60)
+    return _finished(store)
+
+
+def test_an_interrupted_run_loses_no_finished_unit_and_resumes(tmp_path: Path) -> None:
+    """Ctrl-C, then SIGKILL, then a full run on the same store: nothing finished is lost or redone."""
+    config = _write(tmp_path, SLOW_CONFIG)
+    store = tmp_path / "s.sqlite"
+    proc = _start(config, store)
+    first = _interrupt_after(proc, store, 2, signal.SIGINT)
+    assert proc.returncode == 130 and 2 <= len(first) < 12
+    proc = _start(config, store)
+    second = _interrupt_after(proc, store, len(first) + 2, signal.SIGKILL)
+    assert proc.returncode == -signal.SIGKILL and len(first) + 2 <= len(second) < 12
+    assert all(second[k] == t for k, t in first.items())
+    # Run again with the same store: only the missing units run; finished ones are untouched.
+    proc = _start(config, store)
+    out, err = proc.communicate(timeout=240)
+    assert proc.returncode == 0, err
+    assert f"ran {12 - len(second)} units, {len(second)} already in the store, 12/12 done" in out
+    after = _finished(store)
+    assert len(after) == 12 and all(after[k] == t for k, t in second.items())
+    with Store(store) as s:
+        sessions = s.sessions("slowtest", "quick")
+        assert [x["units_run"] for x in sessions] == [len(first), len(second) - len(first), 12 - len(second)]
+        assert [x["status"] for x in sessions] == ["interrupted", "running", "finished"]  # SIGKILL: no goodbye
+        resumed = s.results("slowtest", "quick")
+    # The resumed results equal those of an uninterrupted run (each unit is seeded by its key).
+    cfg = load_config(str(config), "quick")
+    for unit in plan(cfg, {}).units[:2]:
+        assert strip_timing(run_unit(unit)) == strip_timing(resumed[unit.key])
+
+
+# --------------------------------------------------------------------------------- end to end
+
+
+@pytest.fixture(scope="module")
+def quick_store(tmp_path_factory) -> Path:
+    """A representative quick subset: every unit kind (evolution incl. races, robustness, model
+    learning, policy evolution, safety, test runs of every GHH agent) in two worker processes."""
+    path = tmp_path_factory.mktemp("quick") / "results.sqlite"
+    runs = [  # (one spawned pool of two workers; the rest in this process, which is faster at this size)
+        ("fig15", ["--jobs", "2", "--set", "runs=2", "--set", "budget=1500"]),
+        ("fig2", ["--set", "n_mdps=1", "--set", "runs=2", "--set", "budget=300"]),
+        ("table4", ["--set", "n_mdps=2"]),
+        ("fig8", []),
+    ]
+    for name, extra in runs:
+        rc = main(["reproduce", name, "--scale", "quick", "--store", str(path), "--no-progress", *extra])
+        assert rc == 0
+    return path
+
+
+def test_quick_experiments_end_to_end(quick_store: Path, capsys) -> None:
+    with Store(quick_store) as store:
+        assert {n for n, _, _, _ in store.experiments()} == {"fig2", "table4", "fig8", "fig15"}
+        fig8 = store.results("fig8", "quick")
+        assert len(fig8) == 18 and len(store.sessions("fig8", "quick")) == 1
+        runs = [r for k, r in fig8.items() if k.startswith("run/")]
+        assert {r["agent"] for r in runs} == {"model-free", "incremental", "hybrid"}
+        assert all(len(r["returns"]) == 15 and r["score"] == pytest.approx(sum(r["returns"])) for r in runs)
+        free = [r for k, r in fig8.items() if k.startswith("run/model-free/")]
+        assert all(r["policy_changes"][0][1] == "specialised:0" and r["learning_episodes"] <= 9 for r in free)  # own MDP skipped
+        assert len(fig8["policy/safety"]["safe"]) == 2
+        models = store.results("table4", "quick")
+        assert {r["method"] for k, r in models.items() if k.startswith("model/")} == {"lr", "ec-meno", "ec-mer"}
+        robust = [r for k, r in store.results("fig2", "quick").items() if k.startswith("robust/")]
+        assert len(robust) == 2 and all(len(r["returns"]) == 1 and len(r["returns"][0]) == 3 for r in robust)
+    rc, out, _ = _run(capsys, "reproduce", "fig8", "--scale", "quick", "--store", str(quick_store), "--no-progress")
+    assert rc == 0 and "ran 0 units, 18 already in the store" in out
+
+
+def test_results_export_csv_and_json(quick_store: Path, capsys, tmp_path: Path) -> None:
+    rc, out, _ = _run(capsys, "results", "fig8", "--store", str(quick_store), "--format", "json")
+    data = json.loads(out)
+    assert rc == 0 and data["experiment"] == "fig8" and data["scale"] == "quick" and len(data["units"]) == 18
+    assert data["config"]["settings"]["task"] == "ghh09" and data["sessions"][0]["executor"] == "local"
+    with Store(quick_store) as store:
+        assert store.sessions("fig15", "quick")[0]["cores"] == 2
+    rc, _, _ = _run(capsys, "results", "fig8", "--store", str(quick_store), "--out", str(tmp_path / "fig8.csv"))
+    import csv
+
+    rows = list(csv.DictReader(open(tmp_path / "fig8.csv")))
+    assert rc == 0 and len(rows) == 18
+    run = next(r for r in rows if r["key"] == "run/hybrid/train0/rep0")
+    assert float(run["result.score"]) == pytest.approx(sum(json.loads(run["result.returns"])))
+    with Store(quick_store) as store:
+        assert export_results(store, "fig15", "csv").count("\n") == 5
+    rc, _, err = _run(capsys, "results", "fig7", "--store", str(quick_store))
+    assert rc == 2 and "holds no experiment 'fig7'" in err and "fig8 (quick)" in err
+    rc, _, err = _run(capsys, "results", "fig8", "--store", str(tmp_path / "missing.sqlite"))
+    assert rc == 2 and "does not exist" in err
+
+
+def test_report_draws_the_figures_and_compares_with_the_paper(quick_store: Path, tmp_path: Path, capsys) -> None:
+    out = tmp_path / "report"
+    rc, printed, _ = _run(capsys, "report", "--store", str(quick_store), "--out", str(out))
+    assert rc == 0 and "report.md" in printed
+    for name in ("fig2", "table4", "fig8", "fig15"):
+        png = out / f"{name}-quick.png"
+        assert png.is_file() and png.read_bytes()[:4] == b"\x89PNG"
+    text = (out / "report.md").read_text()
+    for needle in ("## Figure 2 and Table 3", "### Table 3: robustness", "-496.2", "-2.508e+06",  # Table 3 beside the paper
+                   "## Table 4", "562.9", "-142.2",                                               # Table 4 beside the paper
+                   "## Figure 8", "5.8e-12", "Student's p", "Welch's p", "runs with a crash",     # t tests, crashes
+                   "## Figure 15", "Scale: **quick**", "core(s) (local)", "s wall over 1 session(s)",
+                   "our crash rate", "vs paper", "### Discussion"):
+        assert needle in text, needle
+    assert "INCOMPLETE" not in text
+    # One experiment only, and a clear error for an unknown one.
+    with Store(quick_store) as store:
+        write_report(store, tmp_path / "one", names=["fig15"])
+    assert "Figure 2" not in (tmp_path / "one" / "report.md").read_text()
+    rc, _, err = _run(capsys, "report", "fig7", "--store", str(quick_store), "--out", str(tmp_path / "x"))
+    assert rc == 2 and "holds no experiment 'fig7'" in err
+
+
+def test_failed_units_are_reported_and_not_recorded(tmp_path: Path, monkeypatch) -> None:
+    from neurohover.experiments import runner
+    from neurohover.experiments.plans import Plan
+    from neurohover.experiments.units import Unit
+
+    cfg = load_config(str(_write(tmp_path, SLOW_CONFIG)), "quick")
+    units = [Unit("slowtest", "good", "diagnostic", {"value": 1}), Unit("slowtest", "bad", "nonsense", {})]
+    monkeypatch.setattr(runner, "plan", lambda config, results: Plan(units, 2))
+    with Store(tmp_path / "s.sqlite") as store:
+        summary = reproduce(cfg, store, LocalExecutor(1), progress=False)
+        assert summary.status == "failed" and summary.failed[0][0] == "bad" and "unknown unit kind" in summary.failed[0][1]
+        assert set(store.results("slowtest", "quick")) == {"good"}
+        assert store.sessions("slowtest", "quick")[-1]["status"] == "failed"
+
+
+def test_policies_from_a_policy_set_directory(tmp_path: Path, capsys) -> None:
+    from neurohover.policysets import build_policy_set
+
+    sets = tmp_path / "sets"
+    build_policy_set("ghh08", out=sets, budget=100, n_steps=100, seed=1)
+    store = tmp_path / "s.sqlite"
+    argv = ["reproduce", "fig7", "--store", str(store), "--set", f"policies={sets}", "--set", "episodes=12", "--no-progress"]
+    assert main(argv) == 0
+    assert "ran 9 units, 0 already in the store, 9/9 done" in capsys.readouterr().out  # test runs only
+    with Store(store) as s:
+        run = next(u for u in s.units("fig7", "quick") if u["key"].startswith("run/model-free/"))
+        assert len(run["params"]["policies"]["specialised"]) == 10
+    # The policies are part of the config hash: a rebuilt set is never mixed with the old results.
+    build_policy_set("ghh08", out=sets, budget=100, n_steps=100, seed=2)
+    assert main(argv) == 2
+    assert "config hash" in capsys.readouterr().err
+    assert main(["reproduce", "fig7", "--store", str(store), "--set", f"policies={tmp_path / 'none'}"]) == 2
+    assert "build it with: neurohover build-policies" in capsys.readouterr().err
+
+
+@pytest.mark.paper
+def test_paper_scale_reproduction() -> None:
+    """Every experiment at the paper's scale (days of CPU; resumable: set NEUROHOVER_PAPER_STORE)."""
+    store = os.environ.get("NEUROHOVER_PAPER_STORE", str(ROOT / "paper-results.sqlite"))
+    jobs = str(os.cpu_count() or 1)
+    assert main(["reproduce", "all", "--scale", "paper", "--store", store, "--jobs", jobs]) == 0
+    assert main(["report", "--store", store, "--scale", "paper", "--out", str(Path(store).with_suffix("")) + "-report"]) == 0
