@@ -49,7 +49,7 @@ def register(sub) -> None:
     p = sub.add_parser("build-policies", help="evolve the generic and specialised policies of a task", description=cmd_build_policies.__doc__)
     p.add_argument("--task", required=True, help="ghh08, ghh09 or fghh")
     p.add_argument("--out", help="directory to write <task>/ into (default: the package's shipped policies)")
-    p.add_argument("--budget", type=int, default=20000, help="episodes per steady-state evolution (default 20000)")
+    p.add_argument("--budget", type=int, default=40000, help="episodes per steady-state evolution (default 40000)")
     p.add_argument("--fghh-budget", type=int, default=200000, help="episodes per FGHH generic-policy evolution over G (default 200000)")
     p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")
     p.add_argument("--seed", type=int, default=0)

@@ -94,7 +94,7 @@ def build_policy_set(
     task: str,
     out: str | Path | None = None,
     *,
-    budget: int = 20000,
+    budget: int = 40000,
     fghh_budget: int = 200000,
     seed: int = 0,
     safety_episodes: int = 3,
@@ -102,6 +102,7 @@ def build_policy_set(
     progress: Callable[[str], None] | None = None,
 ) -> PolicySet:
     """Evolve the policy set of ``task`` with the project's own evolution and write it."""
+    from .evolution import SteadyStateSettings
     from .evolution.evolve import evolve
     from .policies import prototype
 
@@ -115,6 +116,8 @@ def build_policy_set(
 
     def run(target, name: str, child_seed: int, **kwargs) -> Policy:
         t0 = time.perf_counter()
+        if "resampling" not in kwargs:  # steady state: spend the whole budget (no plateau stop)
+            kwargs["settings"] = SteadyStateSettings(plateau_threshold=kwargs["budget"])
         result = evolve(target, topology="mlp", prototype=prototype("mlp", "baseline"), seed=child_seed, n_steps=n_steps, **kwargs)
         policy = result.champion
         save_policy(policy, root / f"{name}.json", task=family.name, name=name, episodes=int(result.episodes),

@@ -64,3 +64,116 @@ def test_run_rejects_bad_episode_counts() -> None:
         run_test(ModelFreeAgent([baseline_policy()]), family, family.zero(), episodes=0)
     with pytest.raises(NeurohoverError, match="at least one specialised policy"):
         ModelFreeAgent([])
+
+
+# ----------------------------------------------------------------------------- learning agents
+
+import csv  # noqa: E402
+import json  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+from neurohover.agents.hybrid import HybridAgent  # noqa: E402
+from neurohover.agents.model_based import IncrementalModelBasedAgent, ModelBasedAgent, ModelEvolution  # noqa: E402
+from neurohover.compete import compete  # noqa: E402
+from neurohover.policysets import build_policy_set, choose_safe, load_policy_set  # noqa: E402
+
+SHORT = ModelEvolution(budget=300, n_steps=1000)
+
+
+@pytest.fixture(scope="module")
+def tiny_policy_dir(tmp_path_factory) -> Path:
+    """A policy set built with the real build command, at a tiny budget and short episodes."""
+    root = tmp_path_factory.mktemp("policies")
+    build_policy_set("ghh08", root, budget=60, n_steps=300, safety_episodes=1)
+    return root
+
+
+def test_build_policies_writes_a_loadable_set_with_computed_safe_policies(tiny_policy_dir: Path) -> None:
+    ps = load_policy_set("ghh08", tiny_policy_dir)
+    assert len(ps.specialised) == 10 and ps.generic.topology == "mlp"
+    manifest = json.loads((tiny_policy_dir / "ghh08" / "manifest.json").read_text())
+    crashes = np.array(manifest["crashes_on_training_mdps"])
+    returns = np.array(manifest["mean_return_on_training_mdps"])
+    assert tuple(manifest["safe"]) == choose_safe(crashes, returns) == ps.safe
+
+
+def test_choose_safe_follows_the_papers_rule() -> None:
+    crashes = np.zeros((4, 4), dtype=int)
+    crashes[0, 2] = 1  # policy 0 crashed on another MDP
+    crashes[3, 3] = 5  # crashes on its own MDP do not count
+    returns = -np.array([[1, 9, 9, 9], [9, 1, 5, 5], [9, 9, 1, 9], [3, 3, 3, 1.0]])
+    assert choose_safe(crashes, returns) == (3, 1)
+
+
+def test_model_based_agents_beat_the_baseline_on_ghh08_test_mdps() -> None:
+    family = get_task_family("ghh08")
+    generic = prototype("mlp", "baseline")
+    totals = {"baseline": 0.0, "model-based": 0.0, "incremental": 0.0}
+    for i, mdp in enumerate(family.test_mdps()[:3]):
+        totals["baseline"] += run_test(ModelFreeAgent([baseline_policy()]), family, mdp, episodes=15, seed=i, n_steps=1000).score
+        totals["model-based"] += run_test(ModelBasedAgent(generic, SHORT), family, mdp, episodes=15, seed=i, n_steps=1000).score
+        totals["incremental"] += run_test(IncrementalModelBasedAgent(generic, SHORT), family, mdp, episodes=15, seed=i, n_steps=1000).score
+    assert totals["model-based"] > totals["baseline"] and totals["incremental"] > totals["baseline"], totals
+
+
+def test_incremental_agent_stops_learning_by_its_rule() -> None:
+    family = get_task_family("ghh08")
+    agent = IncrementalModelBasedAgent(prototype("mlp", "baseline"), SHORT)
+    result = run_test(agent, family, family.test_mdps()[1], episodes=20, seed=2, n_steps=1000)
+    assert agent.stopped_at is not None and agent.stopped_at < agent.max_learning_episodes - 1
+    k = agent.stopped_at
+    # The kept policy did at least as well as its model predicted, and is flown from then on.
+    assert result.returns[k] >= agent.predicted and not result.crashed[k]
+    assert set(result.policy[k:]) == {result.policy[k]}
+    assert (result.offline_seconds[k + 1:] == 0).all() and (result.offline_seconds[:k] > 0).all()
+
+
+def test_hybrid_discards_a_policy_that_needs_the_safeguard() -> None:
+    family = get_task_family("ghh09")
+    g = np.zeros(40)
+    g[36] = 0.6  # constant aileron: heads for a crash
+    roller = Policy("slp", g)
+    agent = HybridAgent([roller, baseline_policy()], prototype("mlp", "baseline"), baseline_policy(), SHORT)
+    result = run_test(agent, family, family.zero(), episodes=12, seed=1, n_steps=1000)
+    assert result.policy[0] == "safe:0" and result.safeguard_fired[0] and not result.crashed[0]
+    assert agent.trial_returns[0] == -np.inf  # discarded: never kept for the run
+    assert "safe:0" not in result.policy[5:]
+    assert not result.crashed.any()
+
+
+def test_compete_writes_results_plot_and_keeps_finished_runs_on_interrupt(tiny_policy_dir: Path, tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    summary, results = compete("ghh08", "model-free", runs=3, episodes=12, seed=1, jobs=2, out=out,
+                               n_steps=300, policy_dir=str(tiny_policy_dir))
+    assert summary["runs"] == 3 and (out / "cumulative.png").stat().st_size > 1000
+    rows = list(csv.DictReader(open(out / "episodes.csv")))
+    assert len(rows) == 36 and {r["run"] for r in rows} == {"0", "1", "2"}
+    assert summary["mean_cumulative_return"] == pytest.approx(np.mean([r.score for r in results]))
+    serial, _ = compete("ghh08", "model-free", runs=3, episodes=12, seed=1, jobs=1, out=tmp_path / "serial",
+                        n_steps=300, policy_dir=str(tiny_policy_dir))
+    assert serial["mean_cumulative_return"] == summary["mean_cumulative_return"]  # process count does not matter
+
+    def interrupt_after_first(spec, result):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        compete("ghh08", "model-free", runs=3, episodes=12, seed=1, out=tmp_path / "cut", n_steps=300,
+                policy_dir=str(tiny_policy_dir), on_result=interrupt_after_first)
+    rows = list(csv.DictReader(open(tmp_path / "cut" / "episodes.csv")))
+    assert len(rows) == 12 and {r["run"] for r in rows} == {"0"}
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"agent": "genius"}, "unknown agent 'genius'"),
+        ({"agent": "hybrid", "task": "fghh"}, "does not apply to task 'fghh'"),
+        ({"agent": "model-free", "policy_dir": "/nonexistent"}, "no policy set for ghh08"),
+        ({"agent": "baseline", "runs": 0}, "runs=0"),
+        ({"agent": "baseline", "episodes": 0}, "episodes=0"),
+    ],
+)
+def test_compete_bad_input(kwargs, message, tmp_path: Path) -> None:
+    args = {"task": "ghh08", "out": tmp_path, **kwargs}
+    with pytest.raises(NeurohoverError, match=message):
+        compete(args.pop("task"), args.pop("agent"), **args)
