@@ -397,6 +397,17 @@ def test_failed_units_are_reported_and_not_recorded(tmp_path: Path, monkeypatch)
         assert summary.status == "failed" and summary.failed[0][0] == "bad" and "unknown unit kind" in summary.failed[0][1]
         assert set(store.results("slowtest", "quick")) == {"good"}
         assert store.sessions("slowtest", "quick")[-1]["status"] == "failed"
+    # A worker process that dies (as if killed) is reported; its unit is not recorded.
+    units[1] = Unit("slowtest", "dies", "diagnostic", {"always_exit": True, "sleep": 0})
+    executor = LocalExecutor(2)
+    try:
+        with Store(tmp_path / "s2.sqlite") as store:
+            summary = reproduce(cfg, store, executor, progress=False)
+            assert summary.status == "failed" and "dies" in {k for k, _ in summary.failed}
+            assert "worker process died" in dict(summary.failed)["dies"]
+            assert "dies" not in store.results("slowtest", "quick")
+    finally:
+        executor.close()
 
 
 def test_policies_from_a_policy_set_directory(tmp_path: Path, capsys) -> None:

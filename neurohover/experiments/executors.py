@@ -47,6 +47,7 @@ class LocalExecutor:
         if not isinstance(jobs, int) or isinstance(jobs, bool) or jobs < 1:
             raise NeurohoverError(f"--jobs {jobs!r} is out of range: allowed an integer >= 1")
         self.jobs = jobs
+        self._pool: ProcessPoolExecutor | None = None
 
     @property
     def cores(self) -> int:
@@ -68,8 +69,11 @@ class LocalExecutor:
                     continue
                 on_result(unit, result, seconds, worker)
             return
-        ctx = multiprocessing.get_context("spawn")
-        pool = ProcessPoolExecutor(max_workers=self.jobs, mp_context=ctx)
+        if self._pool is None:
+            # One pool for the executor's lifetime (all stages and experiments): spawning workers
+            # and loading the compiled kernel costs seconds per process.
+            self._pool = ProcessPoolExecutor(max_workers=self.jobs, mp_context=multiprocessing.get_context("spawn"))
+        pool = self._pool
         try:
             pending = {pool.submit(timed_run, unit.to_dict(), 1): unit for unit in units}
             while pending:
@@ -80,6 +84,7 @@ class LocalExecutor:
                         result, seconds, worker = future.result()
                     except BrokenProcessPool as err:
                         on_error(unit, RuntimeError(f"worker process died ({err})"))
+                        self._pool = None  # a broken pool cannot run more units: start a new one next time
                         continue
                     except Exception as err:  # noqa: BLE001
                         on_error(unit, err)
@@ -87,11 +92,13 @@ class LocalExecutor:
                     on_result(unit, result, seconds, worker)
         except BaseException:
             pool.shutdown(wait=False, cancel_futures=True)
+            self._pool = None
             raise
-        pool.shutdown(wait=True)
 
     def close(self) -> None:
-        pass
+        if self._pool is not None:
+            self._pool.shutdown(wait=True)
+            self._pool = None
 
 
 def import_ray():

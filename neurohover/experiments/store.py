@@ -138,6 +138,8 @@ class Store:
                     f"hash {row[0]}, but this config hashes to {config_hash}: the settings differ, so the results would "
                     f"not be comparable. Use another --store file, restore the old config, or rerun with --fresh to "
                     f"discard the stored results of {name!r} ({scale})")
+            else:  # same settings: keep the latest title and paper numbers (they do not change results)
+                c.execute("UPDATE experiments SET config = ? WHERE name = ? AND scale = ?", (_dumps(config), name, scale))
             c.execute("COMMIT")
         except BaseException:
             c.execute("ROLLBACK")
