@@ -430,6 +430,14 @@ def test_policies_from_a_policy_set_directory(tmp_path: Path, capsys) -> None:
     assert "build it with: neurohover build-policies" in capsys.readouterr().err
 
 
+def test_the_commands_are_registered_in_the_cli(capsys) -> None:
+    from neurohover import cli
+
+    assert "neurohover.commands_reproduce" in cli.COMMAND_MODULES
+    assert cli.main(["reproduce", "--list"]) == 0
+    assert capsys.readouterr().out.split() == PAPER_EXPERIMENTS
+
+
 @pytest.mark.paper
 def test_paper_scale_reproduction() -> None:
     """Every experiment at the paper's scale (days of CPU; resumable: set NEUROHOVER_PAPER_STORE)."""

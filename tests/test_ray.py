@@ -7,6 +7,8 @@ not skip) when it is missing.
 
 from __future__ import annotations
 
+import os
+import subprocess
 import sys
 from pathlib import Path
 
@@ -14,7 +16,9 @@ import pytest
 
 from neurohover.commands_reproduce import main
 from neurohover.errors import NeurohoverError
-from neurohover.experiments import LocalExecutor, RayExecutor, Store, load_config, make_executor, plan, reproduce, strip_timing
+from neurohover.experiments import (
+    LocalExecutor, RayExecutor, Store, load_config, make_executor, plan, reproduce, run_unit, strip_timing,
+)
 from neurohover.experiments.plans import Plan
 from neurohover.experiments.units import Unit
 
@@ -68,6 +72,22 @@ def test_reproduce_command_with_the_ray_executor(ray_cluster, tmp_path: Path, ca
     assert "ran 0 units, 2 already in the store" in capsys.readouterr().out
     assert main(["reproduce", "fig15", "--store", str(store), "--executor", "ray", "--jobs", "2"]) == 2
     assert "--jobs applies to --executor local" in capsys.readouterr().err
+
+
+def test_a_driver_in_another_process_joins_the_cluster_with_address(ray_cluster, tmp_path: Path) -> None:
+    address = ray_cluster.get_runtime_context().gcs_address
+    root = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "PYTHONPATH": str(root) + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    store = tmp_path / "s.sqlite"
+    proc = subprocess.run([sys.executable, "-m", "neurohover.experiments", "reproduce", "fig15", "--set", "runs=1",
+                           "--set", "budget=600", "--store", str(store), "--executor", "ray", "--address", address,
+                           "--no-progress"], cwd=root, env=env, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert "ran 2 units" in proc.stdout and "on 2 cores (ray)" in proc.stdout
+    assert ray_cluster.is_initialized()  # the cluster outlives the driver that joined it
+    with Store(store) as s:
+        local = {u.key: run_unit(u) for u in plan(load_config("fig15", "quick", {"runs": 1, "budget": 600}), {}).units}
+        assert {k: strip_timing(v) for k, v in s.results("fig15", "quick").items()} == {k: strip_timing(v) for k, v in local.items()}
 
 
 def test_a_dying_worker_is_retried_by_ray(ray_cluster, tmp_path: Path) -> None:
