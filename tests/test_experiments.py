@@ -242,8 +242,11 @@ def test_store_refuses_other_schema_versions_and_foreign_files(tmp_path: Path, c
 
 def _finished(path: Path) -> dict[str, float]:
     """key -> finish time of the units in a store another process is writing (empty if not ready)."""
+    if not path.exists():
+        return {}
     try:
-        conn = sqlite3.connect(f"file:{path}?mode=ro", uri=True, timeout=5)
+        # Read-write, so that a hot journal left by a killed writer can be rolled back.
+        conn = sqlite3.connect(path, timeout=5)
         try:
             return dict(conn.execute("SELECT key, finished FROM units"))
         finally:
