@@ -87,6 +87,32 @@ def vector_env_steps_per_second(num_envs: int = 1024, steps: int = 1000) -> floa
     return num_envs * steps / elapsed
 
 
+def lr_seconds_per_episode_of_flight_data() -> float:
+    """LR model learning on one episode (6000 samples) of baseline flight data: best of 5."""
+    from .evaluate import evaluate
+    from .models import learn_lr
+    from .policies import baseline_policy
+
+    flight = evaluate(baseline_policy(), get_task_family("ghh08").training_mdps()[0], record=True, seed=3).flight_data
+    best = float("inf")
+    for _ in range(5):
+        start = time.perf_counter()
+        learn_lr(flight)
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
+def test_run_seconds(agent: str, episodes: int = 1000) -> float:
+    """Wall time of one on-line test run of ``agent`` on GHH-08 test MDP 0, on one core."""
+    from .agents.protocol import run_test
+    from .agents.registry import make_agent
+
+    family = get_task_family("ghh08")
+    start = time.perf_counter()
+    run_test(make_agent(agent, family), family, family.test_mdps()[0], episodes=episodes, seed=0, threads=1)
+    return time.perf_counter() - start
+
+
 def _extra_benchmarks(quick: bool) -> dict:
     """Benchmarks of later pipeline stages."""
     from .evolution.evolve import benchmark_evolution
@@ -94,6 +120,10 @@ def _extra_benchmarks(quick: bool) -> dict:
     out = {"vector_env_1024_control_steps_per_second_1_core": vector_env_steps_per_second(1024, 200 if quick else 1000)}
     # evolve() against the raw kernel flying the very same episodes (ratio_vs_raw_kernel).
     out.update(benchmark_evolution(quick))
+    out["lr_seconds_6000_samples"] = lr_seconds_per_episode_of_flight_data()
+    episodes = 100 if quick else 1000
+    for agent in ("model-free", "incremental"):
+        out[f"test_run_{agent}_{episodes}_episodes_seconds_1_core"] = test_run_seconds(agent, episodes)
     return out
 
 
