@@ -489,3 +489,213 @@ def test_resampling_validation_and_shape_check() -> None:
         fixed_resampling(lambda i: np.zeros(3), 5, 2)
     res = fixed_resampling(lambda i: i.astype(float), 4, 3)
     assert np.array_equal(res.means, [0.0, 1.0, 2.0, 3.0]) and res.episodes_spent == 12
+
+
+# ------------------------------------------------- selection_race regression (reference copy)
+# A frozen copy of the original per-candidate implementation of ``selection_race``
+# (one ``bayes_mean_bounds`` and one mean per candidate per round). The vectorised
+# implementation in neurohover.evolution.races must reproduce it exactly: same
+# selection (and order), same calls to ``sample_fn``, same means / bounds / counts.
+
+
+def _ref_draw(sample_fn, indices: np.ndarray) -> np.ndarray:
+    out = np.asarray(sample_fn(indices.copy()), dtype=np.float64)
+    if out.shape != indices.shape:
+        raise ValueError(
+            f"sample_fn returned shape {out.shape} for {indices.size} candidates; "
+            f"expected {indices.shape}"
+        )
+    if np.any(out == np.inf):
+        raise ValueError("sample_fn returned +inf; returns must be finite, NaN or -inf")
+    return np.where(np.isnan(out), -np.inf, out)
+
+
+def _ref_mean(samples: np.ndarray) -> float:
+    return -math.inf if np.any(np.isneginf(samples)) else float(np.mean(samples))
+
+
+def _ref_bounds(samples: np.ndarray, delta: float) -> tuple[float, float]:
+    x = np.asarray(samples, dtype=np.float64).ravel()
+    n = x.size
+    if np.any(np.isneginf(x)):
+        return -math.inf, -math.inf
+    if n == 1:
+        return -math.inf, math.inf
+    if np.all(x == x[0]):
+        m = float(x[0])
+        return m, m
+    xbar = float(x.mean())
+    var = float(x.var())
+    scale = math.sqrt(var / n) if n > 1000 else math.sqrt(var / (n - 1))
+    q_lo, q_hi = (1.0 - delta) / 2.0, (1.0 + delta) / 2.0
+    if n > 1000:
+        q_lo, q_hi = float(stats.norm.ppf(q_lo)), float(stats.norm.ppf(q_hi))
+    else:
+        q_lo, q_hi = float(stats.t.ppf(q_lo, n - 1)), float(stats.t.ppf(q_hi, n - 1))
+    return q_lo * scale + xbar, q_hi * scale + xbar
+
+
+def _ref_best_first(means: np.ndarray, idx: np.ndarray) -> np.ndarray:
+    return np.argsort(-means[idx], kind="stable")
+
+
+def _reference_selection_race(sample_fn, n: int, mu: int, delta: float, t_limit: int = 10) -> dict:
+    samples: list[list[float]] = [[] for _ in range(n)]
+    lower = np.full(n, -np.inf)
+    upper = np.full(n, np.inf)
+    means = np.full(n, np.nan)
+    undecided = np.ones(n, dtype=bool)
+    discarded = np.zeros(n, dtype=bool)
+    selected: list[int] = []
+    discard_order: list[int] = []
+    rounds = 0
+    while True:
+        active = np.flatnonzero(undecided)
+        for i, r in zip(active, _ref_draw(sample_fn, active)):
+            samples[i].append(float(r))
+            arr = np.asarray(samples[i])
+            means[i] = _ref_mean(arr)
+            lower[i], upper[i] = _ref_bounds(arr, delta)
+        rounds += 1
+        n_beaten = (upper[None, :] < lower[active, None]).sum(axis=1)
+        n_beating = (lower[None, :] > upper[active, None]).sum(axis=1)
+        newly_sel = active[n_beaten >= n - mu]
+        newly_dis = active[n_beating >= mu]
+        room = mu - len(selected)
+        if newly_sel.size > room:
+            newly_sel = newly_sel[_ref_best_first(means, newly_sel)][:room]
+        selected.extend(int(i) for i in newly_sel[_ref_best_first(means, newly_sel)])
+        undecided[newly_sel] = False
+        undecided[newly_dis] = False
+        discarded[newly_dis] = True
+        discard_order.extend(int(i) for i in newly_dis)
+        if len(selected) >= mu or not undecided.any():
+            break
+        if len(selected) + int(undecided.sum()) <= mu:
+            break
+        if rounds >= t_limit:
+            break
+    n_raced = len(selected)
+    for pool in (np.flatnonzero(undecided), np.flatnonzero(discarded)):
+        need = mu - len(selected)
+        if need <= 0:
+            break
+        selected.extend(int(i) for i in pool[_ref_best_first(means, pool)][:need])
+    n_samples = np.array([len(s) for s in samples], dtype=np.int64)
+    return {
+        "selected": np.asarray(selected, dtype=np.int64),
+        "means": means,
+        "n_samples": n_samples,
+        "lower": lower,
+        "upper": upper,
+        "discarded": np.asarray([i for i in discard_order if i not in selected], dtype=np.int64),
+        "n_raced": n_raced,
+        "episodes_spent": int(n_samples.sum()),
+        "rounds": rounds,
+    }
+
+
+def _race_case(seed: int):
+    """A random race problem: (n, mu, delta, t_limit, table of returns per candidate and sample)."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(5, 61))
+    mu = int(rng.integers(1, n))
+    delta = float(rng.uniform(0.05, 0.95))
+    t_limit = int(rng.integers(2, 11)) if seed % 11 else int(rng.integers(1, 4))
+    kind = seed % 7
+    scale = float(10.0 ** rng.uniform(-2, 4))
+    true = rng.normal(0.0, scale, n) - (3e4 if seed % 2 else 0.0)
+    noise = float(10.0 ** rng.uniform(-3, 0.5)) * scale
+    table = true[:, None] + rng.normal(0.0, noise, (n, t_limit))
+    if kind == 1:  # heavy ties: few distinct values
+        table = rng.integers(0, 3, (n, t_limit)).astype(float) + rng.integers(0, 2, (n, 1))
+    elif kind == 2:  # some constant candidates
+        const = rng.random(n) < 0.5
+        table[const] = true[const, None]
+    elif kind == 3:  # NaN and -inf returns
+        table[rng.random((n, t_limit)) < 0.05] = np.nan
+        table[rng.random((n, t_limit)) < 0.03] = -np.inf
+    elif kind == 4:  # all identical
+        table[:] = -4.0
+    elif kind == 5:  # rounded returns (ties between candidates and samples), some crashes
+        table = np.round(table / noise)
+        table[rng.random((n, t_limit)) < 0.02] = np.nan
+    elif kind == 6:  # huge dynamic range, sums where order matters
+        table = rng.choice([1e16, 1.0, -1e16, 0.1, 3.0, -2.5e-3], (n, t_limit)) + true[:, None] * 1e-3
+    return n, mu, delta, t_limit, table
+
+
+def _table_sampler(table: np.ndarray):
+    count = np.zeros(table.shape[0], dtype=np.int64)
+    calls: list[np.ndarray] = []
+
+    def sample(idx: np.ndarray) -> np.ndarray:
+        calls.append(idx.copy())
+        out = table[idx, count[idx]]
+        count[idx] += 1
+        idx[:] = -1  # a sample_fn scribbling on its argument must not matter
+        return out
+
+    return sample, calls
+
+
+def _assert_race_equal(new, ref: dict) -> None:
+    for key in ("selected", "n_samples", "discarded"):
+        got = getattr(new, key)
+        assert got.dtype == ref[key].dtype and np.array_equal(got, ref[key]), key
+    for key in ("n_raced", "episodes_spent", "rounds"):
+        assert getattr(new, key) == ref[key], key
+    for key in ("means", "lower", "upper"):
+        np.testing.assert_allclose(getattr(new, key), ref[key], rtol=1e-12, atol=0, err_msg=key)
+
+
+@pytest.mark.parametrize("seed", range(400))
+def test_selection_race_matches_reference_implementation(seed: int) -> None:
+    n, mu, delta, t_limit, table = _race_case(seed)
+    ref_sample, ref_calls = _table_sampler(table)
+    with warnings.catch_warnings(record=True) as ref_warnings:
+        warnings.simplefilter("always")
+        ref = _reference_selection_race(ref_sample, n, mu, delta, t_limit)
+    new_sample, new_calls = _table_sampler(table)
+    with warnings.catch_warnings(record=True) as new_warnings:
+        warnings.simplefilter("always")
+        new = selection_race(new_sample, n, mu, delta, t_limit)
+    _assert_race_equal(new, ref)
+    assert len(new_calls) == len(ref_calls)
+    for a, b in zip(new_calls, ref_calls):
+        assert a.dtype == b.dtype and np.array_equal(a, b)
+    if not ref_warnings:
+        assert not new_warnings
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_selection_race_matches_reference_with_stream_sampler(seed: int) -> None:
+    """Returns drawn from one RNG stream in call order (as the evolve loop does)."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(5, 61))
+    mu, delta, t_limit = int(rng.integers(1, n)), float(rng.uniform(0.05, 0.95)), int(rng.integers(2, 11))
+    true = rng.normal(0.0, 1.0, n)
+
+    def make():
+        stream = np.random.default_rng(seed + 1000)
+        return lambda idx: true[idx] + stream.normal(0.0, 2.0, idx.size)
+
+    ref = _reference_selection_race(make(), n, mu, delta, t_limit)
+    _assert_race_equal(selection_race(make(), n, mu, delta, t_limit), ref)
+
+
+def test_selection_race_matches_reference_beyond_1000_samples() -> None:
+    """Indistinguishable candidates raced past n = 1000 (normal-approximation bounds)."""
+    rng = np.random.default_rng(5)
+    table = rng.normal(0.0, 1.0, (3, 1003))
+    ref = _reference_selection_race(_table_sampler(table)[0], 3, 1, 0.999999, 1003)
+    new = selection_race(_table_sampler(table)[0], 3, 1, 0.999999, 1003)
+    assert ref["rounds"] > 1000
+    _assert_race_equal(new, ref)
+
+
+def test_selection_race_bad_returns_raise_like_reference() -> None:
+    for bad in (lambda i: np.zeros(i.size + 1), lambda i: np.where(i == 3, np.inf, 0.0)):
+        for impl in (_reference_selection_race, selection_race):
+            with pytest.raises(ValueError, match="sample_fn returned"):
+                impl(bad, 6, 2, 0.9, 3)

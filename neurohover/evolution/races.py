@@ -231,7 +231,10 @@ def selection_race(
     flies every candidate once; each later round flies every undecided
     candidate one more episode and recomputes its bounds FROM SCRATCH from all
     its samples with :func:`bayes_mean_bounds` (so a bound may loosen again;
-    the mean always lies inside). Then, with ``lambda = n_candidates``:
+    the mean always lies inside; all undecided candidates have the same number
+    of samples, so this is done for all of them at once with row-wise NumPy
+    reductions giving exactly the values of the per-candidate call). Then, with
+    ``lambda = n_candidates``:
 
     - an undecided candidate whose lower bound exceeds the upper bounds of at
       least ``lambda - mu`` others is selected;
@@ -279,7 +282,14 @@ def selection_race(
     delta = _check_delta(delta)
     t_limit = _check_int("t_limit", t_limit, 1)
 
-    samples: list[list[float]] = [[] for _ in range(n)]
+    # Samples live in one (n, capacity) array: in round r every undecided
+    # candidate has exactly r samples (columns 0..r-1), so the statistics of all
+    # of them come from one (n_active, r) block. Row-wise NumPy reductions of a
+    # C-contiguous block use the same (pairwise) summation as the per-row 1-D
+    # calls of :func:`bayes_mean_bounds`, so means and bounds are bit-identical.
+    samples = np.empty((n, min(t_limit, 16)))
+    n_samples = np.zeros(n, dtype=np.int64)
+    crashed = np.zeros(n, dtype=bool)  # some sample is -inf (or was NaN)
     lower = np.full(n, -np.inf)
     upper = np.full(n, np.inf)
     means = np.full(n, np.nan)
@@ -288,33 +298,41 @@ def selection_race(
     selected: list[int] = []
     discard_order: list[int] = []
     rounds = 0
+    need_select, need_discard = n - mu, mu
 
     while True:
         active = np.flatnonzero(undecided)
-        for i, r in zip(active, _draw(sample_fn, active)):
-            samples[i].append(float(r))
-            arr = np.asarray(samples[i])
-            means[i] = _mean(arr)
-            lower[i], upper[i] = bayes_mean_bounds(arr, delta)
+        draws = _draw(sample_fn, active)
+        if rounds == samples.shape[1]:
+            grown = np.empty((n, min(t_limit, 2 * rounds)))
+            grown[:, :rounds] = samples
+            samples = grown
+        samples[active, rounds] = draws
+        crashed[active] |= np.isneginf(draws)
         rounds += 1
+        n_samples[active] = rounds
+        _round_bounds(samples[active, :rounds], active, crashed[active], delta, means, lower, upper)
 
         # Decide simultaneously on this round's bounds.
         n_beaten = (upper[None, :] < lower[active, None]).sum(axis=1)
         n_beating = (lower[None, :] > upper[active, None]).sum(axis=1)
-        newly_sel = active[n_beaten >= n - mu]
-        newly_dis = active[n_beating >= mu]
-        room = mu - len(selected)
-        if newly_sel.size > room:
-            newly_sel = newly_sel[_best_first(means, newly_sel)][:room]
-        selected.extend(int(i) for i in newly_sel[_best_first(means, newly_sel)])
-        undecided[newly_sel] = False
-        undecided[newly_dis] = False
-        discarded[newly_dis] = True
-        discard_order.extend(int(i) for i in newly_dis)
+        newly_sel = active[n_beaten >= need_select]
+        newly_dis = active[n_beating >= need_discard]
+        if newly_sel.size:
+            room = mu - len(selected)
+            if newly_sel.size > room:
+                newly_sel = newly_sel[_best_first(means, newly_sel)][:room]
+            selected.extend(newly_sel[_best_first(means, newly_sel)].tolist())
+            undecided[newly_sel] = False
+        if newly_dis.size:
+            undecided[newly_dis] = False
+            discarded[newly_dis] = True
+            discard_order.extend(newly_dis.tolist())
 
-        if len(selected) >= mu or not undecided.any():
+        if len(selected) >= mu:
             break
-        if len(selected) + int(undecided.sum()) <= mu:
+        n_undecided = int(np.count_nonzero(undecided))
+        if n_undecided == 0 or len(selected) + n_undecided <= mu:
             break
         if rounds >= t_limit:  # every undecided candidate was flown in every round
             break
@@ -324,20 +342,65 @@ def selection_race(
         need = mu - len(selected)
         if need <= 0:
             break
-        selected.extend(int(i) for i in pool[_best_first(means, pool)][:need])
+        selected.extend(pool[_best_first(means, pool)][:need].tolist())
 
-    n_samples = np.array([len(s) for s in samples], dtype=np.int64)
+    chosen = set(selected)
     return RaceResult(
         selected=np.asarray(selected, dtype=np.int64),
         means=means,
         n_samples=n_samples,
         lower=lower,
         upper=upper,
-        discarded=np.asarray([i for i in discard_order if i not in selected], dtype=np.int64),
+        discarded=np.asarray([i for i in discard_order if i not in chosen], dtype=np.int64),
         n_raced=n_raced,
         episodes_spent=int(n_samples.sum()),
         rounds=rounds,
     )
+
+
+def _round_bounds(
+    block: np.ndarray,
+    rows: np.ndarray,
+    crashed: np.ndarray,
+    delta: float,
+    means: np.ndarray,
+    lower: np.ndarray,
+    upper: np.ndarray,
+) -> None:
+    """Means and :func:`bayes_mean_bounds` of every row of ``block`` at once.
+
+    ``block`` is ``(len(rows), k)``: the ``k`` samples of each candidate in
+    ``rows``; ``crashed`` flags rows holding a ``-inf``. Writes
+    ``means[rows]``, ``lower[rows]`` and ``upper[rows]`` with exactly the
+    values of ``_mean(row)`` and ``bayes_mean_bounds(row, delta)``.
+    """
+    k = block.shape[1]
+    if crashed.any():
+        ok = ~crashed
+        dead = rows[crashed]
+        means[dead] = lower[dead] = upper[dead] = -np.inf
+        rows, block = rows[ok], block[ok]
+        if rows.size == 0:
+            return
+    mean = block.mean(axis=1)
+    means[rows] = mean
+    if k == 1:
+        lower[rows] = -np.inf
+        upper[rows] = np.inf
+        return
+    first = block[:, 0]
+    const = (block == first[:, None]).all(axis=1)
+    if const.any():
+        lower[rows[const]] = upper[rows[const]] = first[const]
+        spread = ~const
+        rows, block, mean = rows[spread], block[spread], mean[spread]
+        if rows.size == 0:
+            return
+    var = block.var(axis=1)
+    scale = np.sqrt(var / k) if k > 1000 else np.sqrt(var / (k - 1))
+    q_lo, q_hi = _standard_quantiles(k, delta)
+    lower[rows] = q_lo * scale + mean
+    upper[rows] = q_hi * scale + mean
 
 
 def _best_first(means: np.ndarray, idx: np.ndarray) -> np.ndarray:
