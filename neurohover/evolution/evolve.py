@@ -66,7 +66,6 @@ import pickle
 import signal
 import threading
 import time
-from bisect import bisect_right
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -82,15 +81,7 @@ from ..sim.constants import DEFAULT_PARAMS, EPISODE_STEPS, MDP_ROW_LEN, ROW_PARA
 from ..sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
 from ..tasks import FGHH, GHH08, GHH09, MDP
 from .cmaes import CMAES
-from .neuroevolution import (
-    ROULETTE_ERROR_FLOOR,
-    GenerationalNE,
-    GenerationalSettings,
-    SteadyStateNE,
-    SteadyStateSettings,
-    _rank,
-    roulette_weights,
-)
+from .neuroevolution import GenerationalNE, GenerationalSettings, SteadyStateNE, SteadyStateSettings
 from .races import fixed_resampling, selection_race
 
 __all__ = [
@@ -408,141 +399,6 @@ class _Flyer:
         return returns
 
 
-# --------------------------------------------------------------------------------- lean steady state
-
-
-@numba.njit(cache=True)
-def _crossover_apply(a, b, average_r, take_r, averaging_prob):
-    """``operators.crossover`` given its two uniform draws: the same floats, elementwise."""
-    out = np.empty_like(a)
-    for i in range(a.size):
-        if average_r[i] < averaging_prob:
-            out[i] = 0.5 * (a[i] + b[i])
-        elif take_r[i] < 0.5:
-            out[i] = a[i]
-        else:
-            out[i] = b[i]
-    return out
-
-
-@numba.njit(cache=True)
-def _mutate_apply(g, hit_r, delta, replace_r, mutate_frac, mutate_repl):
-    """``operators.mutate`` given its three draws: the same floats, elementwise."""
-    out = np.empty_like(g)
-    for i in range(g.size):
-        if hit_r[i] < mutate_frac:
-            out[i] = delta[i] if replace_r[i] < mutate_repl else g[i] + delta[i]
-        else:
-            out[i] = g[i]
-    return out
-
-
-class _LeanSteadyStateNE(SteadyStateNE):
-    """:class:`SteadyStateNE` with less Python per generation; same algorithm, random stream and
-    ``state_dict`` (the tests check bit-identity over thousands of generations).
-
-    With the paper's settings a generation is one offspring and one episode (about 2 ms), so the
-    optimiser's own ~100 us of small NumPy calls per ask/tell would cost over 10 % of the
-    throughput. This subclass computes the roulette weights with the same array operations (so the
-    same floats), spins the wheel with ``bisect`` on the same cumulative sums, applies crossover and
-    mutation in compiled loops to the very draws the operators make, skips defensive copies and
-    stacks, and reuses the parent's ranking and champion tracking.
-    """
-
-    def ask(self) -> np.ndarray:  # the returned array must not be modified (evolve does not)
-        if self._pending is not None or self._population is None:
-            return super().ask()
-        s, rng, pop = self.settings, self._rng, self._population
-        f = self._fitness
-        if self._finite:
-            w = 1.0 / np.log(np.maximum(-f, ROULETTE_ERROR_FLOOR))  # = roulette_weights(f), all finite
-        else:
-            w = roulette_weights(f)
-        cdf_list = np.cumsum(w).tolist()
-        total = cdf_list[-1]
-        last = len(cdf_list) - 1
-        n = s.pop_size - s.elite_size
-        batch = np.empty((n, pop.shape[1]))
-        d = pop.shape[1]
-        random, normal = rng.random, rng.normal
-        for c in range(n):
-            # Same draws in the same order as operators.crossover / operators.mutate.
-            if random() < s.crossover_prob:
-                a = pop[min(bisect_right(cdf_list, random() * total), last)]
-                b = pop[min(bisect_right(cdf_list, random() * total), last)]
-                average_r = random(d)
-                child = _crossover_apply(a, b, average_r, random(d), s.averaging_prob)
-                if random() < s.mutate_prob:
-                    hit_r = random(d)
-                    delta = normal(0.0, s.mutate_std, d)
-                    child = _mutate_apply(child, hit_r, delta, random(d), s.mutate_frac, s.mutate_repl)
-            else:
-                g = pop[min(bisect_right(cdf_list, random() * total), last)]
-                hit_r = random(d)
-                delta = normal(0.0, s.mutate_std, d)
-                child = _mutate_apply(g, hit_r, delta, random(d), s.mutate_frac, s.mutate_repl)
-            batch[c] = child
-        self._pending = batch
-        return batch
-
-    def tell(self, fitness: np.ndarray) -> None:
-        pending = self._pending
-        if pending is None or self._population is None:
-            super().tell(fitness)
-            self._after_full_tell()
-            return
-        f = fitness  # evolve's own float64 returns, one per asked genome
-        elite = self.settings.elite_size
-        pop, fit = self._population, self._fitness
-        if self._sorted and len(pending) == 1 and pop.shape[0] == elite + 1:
-            # The elite pop[:elite] is in rank order (best first, ties by index), so ranking all
-            # pop_size is inserting the last child by bisection; keep the first elite_size, append.
-            t = fit[elite]
-            key = -math.inf if t != t else t
-            pos = bisect_right(self._negkeys, -key)
-            if pos < elite:
-                dropped = fit[elite - 1]
-                row = pop[elite].copy()
-                pop[pos + 1 : elite] = pop[pos : elite - 1]
-                fit[pos + 1 : elite] = fit[pos : elite - 1]
-                pop[pos], fit[pos] = row, t
-                self._negkeys.insert(pos, -key)
-                self._negkeys.pop()
-            else:
-                dropped = t
-            self._nonfinite -= not math.isfinite(dropped)
-            new = float(f[0])
-            pop[elite] = pending[0]
-            fit[elite] = new
-            self._nonfinite += not math.isfinite(new)
-            self._finite = self._nonfinite == 0
-        else:
-            keep = _rank(fit)[:elite]
-            self._population = np.concatenate((pop[keep], pending))
-            self._fitness = np.concatenate((fit[keep], f))
-            self._after_full_tell(sorted_elite=True)
-        self._tracker.update(pending, f, self._clock())
-        self._pending = None
-        self._generation += 1
-
-    def _after_full_tell(self, sorted_elite: bool = False) -> None:
-        fit = self._fitness
-        self._nonfinite = int((~np.isfinite(fit)).sum())
-        self._finite = self._nonfinite == 0
-        self._sorted = sorted_elite
-        if sorted_elite:
-            key = np.where(np.isnan(fit[: self.settings.elite_size]), -np.inf, fit[: self.settings.elite_size])
-            self._negkeys = (-key).tolist()
-
-    @classmethod
-    def from_state_dict(cls, state: dict) -> "_LeanSteadyStateNE":
-        opt = super().from_state_dict(state)
-        opt._sorted = False
-        if opt._fitness is not None:
-            opt._after_full_tell()
-        return opt
-
-
 # --------------------------------------------------------------------------------- interrupts
 
 
@@ -740,7 +596,7 @@ class _Run:
         if self.optimizer == "cma":
             self.opt = CMAES(genome, sigma0=self.settings["sigma0"], seed=opt_seed, popsize=self.settings["popsize"])
         elif self.method == "steady-state":
-            self.opt = _LeanSteadyStateNE(genome, self.settings, seed=opt_seed)
+            self.opt = SteadyStateNE(genome, self.settings, seed=opt_seed)
         else:
             self.opt = GenerationalNE(genome, self.settings, seed=opt_seed)
         self.history: list[HistoryRecord] = []
@@ -784,7 +640,7 @@ class _Run:
             if self.optimizer == "cma":
                 self.opt = _cma_from_state(opt_state)
             elif self.method == "steady-state":
-                self.opt = _LeanSteadyStateNE.from_state_dict(opt_state)
+                self.opt = SteadyStateNE.from_state_dict(opt_state)
             else:
                 self.opt = GenerationalNE.from_state_dict(opt_state)
         except (ValueError, KeyError, TypeError, pickle.UnpicklingError) as err:
