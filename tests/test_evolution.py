@@ -271,6 +271,23 @@ def test_generational_breeds_only_from_selected() -> None:
         opt.tell(np.zeros(20), selected=np.array([1, 1, 2, 3]))
 
 
+@pytest.mark.parametrize("elitist", [True, False])
+def test_generational_survivors(elitist: bool) -> None:
+    # Every gene mutates, so no two genomes coincide by chance.
+    s = GenerationalSettings(pop_size=10, select_size=3, generations=3, elitist=elitist, mutate_frac=1.0, mutate_prob=1.0)
+    opt = GenerationalNE(np.zeros(4), s, seed=1)
+    pop = opt.ask()
+    chosen = np.array([8, 2, 5])
+    opt.tell(np.arange(10.0), selected=chosen)
+    nxt = opt.ask()
+    survived = [any(np.array_equal(p, q) for q in nxt) for p in pop[chosen]]
+    # Elitist: the selected parents are the first rows of the next population; otherwise all
+    # rows are new (mutated) offspring.
+    assert all(survived) if elitist else not any(survived)
+    if elitist:
+        np.testing.assert_array_equal(nxt[:3], pop[chosen])
+
+
 def test_generational_with_selection_race_on_noisy_fitness() -> None:
     noise_rng = np.random.default_rng(99)
     s = GenerationalSettings(pop_size=20, select_size=6, generations=25)
