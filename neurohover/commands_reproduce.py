@@ -109,18 +109,3 @@ def register(sub) -> None:
     p.add_argument("--scale", choices=("quick", "paper"), help="only this scale (default: every scale in the store)")
     p.set_defaults(func=cmd_report)
 
-
-def main(argv=None) -> int:
-    """Entry point of ``python -m neurohover.experiments`` (the three commands on their own)."""
-    parser = argparse.ArgumentParser(prog="python -m neurohover.experiments", description=__doc__.splitlines()[0])
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    register(sub)
-    args = parser.parse_args(argv)
-    try:
-        return args.func(args)
-    except NeurohoverError as err:
-        print(f"neurohover {args.command}: error: {err}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print(f"neurohover {args.command}: interrupted", file=sys.stderr)
-        return 130

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from neurohover.commands_reproduce import main
+from neurohover.cli import main
 from neurohover.errors import NeurohoverError
 from neurohover.experiments import (
     LocalExecutor,

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from neurohover.commands_reproduce import main
+from neurohover.cli import main
 from neurohover.errors import NeurohoverError
 from neurohover.experiments import (
     LocalExecutor, RayExecutor, Store, load_config, make_executor, plan, reproduce, run_unit, strip_timing,

@@ -77,7 +77,7 @@ import numpy as np
 from ..errors import NeurohoverError
 from ..evaluate import evaluate_jobs, num_threads
 from ..policies import GENOME_LENGTH, TOPOLOGIES, Policy, prototype as make_prototype
-from ..sim.constants import DEFAULT_PARAMS, EPISODE_STEPS, MDP_ROW_LEN, ROW_PARAMS, ROW_WIND, SAFEGUARD_LIMITS
+from ..sim.constants import DEFAULT_PARAMS, EPISODE_STEPS, ROW_PARAMS, ROW_WIND, SAFEGUARD_LIMITS
 from ..sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
 from ..tasks import FGHH, GHH08, GHH09, MDP
 from .cmaes import CMAES

@@ -2,6 +2,6 @@
 
 import sys
 
-from ..commands_reproduce import main
+from ..cli import main
 
 sys.exit(main())
