@@ -177,3 +177,18 @@ def test_compete_bad_input(kwargs, message, tmp_path: Path) -> None:
     args = {"task": "ghh08", "out": tmp_path, **kwargs}
     with pytest.raises(NeurohoverError, match=message):
         compete(args.pop("task"), args.pop("agent"), **args)
+
+
+def test_policy_directory_missing_a_policy_is_refused_clearly(tiny_policy_dir: Path, tmp_path: Path, capsys) -> None:
+    import shutil
+
+    from neurohover.cli import main
+
+    broken = tmp_path / "broken"
+    shutil.copytree(tiny_policy_dir, broken)
+    (broken / "ghh08" / "specialised_3.json").unlink()
+    rc = main(["compete", "--task", "ghh08", "--agent", "model-free", "--policy-dir", str(broken), "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "missing specialised policy 3 (specialised_3.json)" in err and "neurohover build-policies" in err
+    rc = main(["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "0", "--out", str(tmp_path / "o")])
+    assert rc == 2 and "runs=0" in capsys.readouterr().err
