@@ -83,19 +83,22 @@ def _clip(a: float) -> float:
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
 def _rotation(qx, qy, qz, qw):
     """Rotation matrix (body to world) of a unit quaternion, row by row."""
-    xx = qx * qx
-    yy = qy * qy
-    zz = qz * qz
-    xy = qx * qy
-    xz = qx * qz
-    yz = qy * qz
-    wx = qw * qx
-    wy = qw * qy
-    wz = qw * qz
+    x2 = qx + qx  # doubling is exact, so 2(xy - wz) == x(2y) - w(2z) with fewer operations
+    y2 = qy + qy
+    z2 = qz + qz
+    xx = qx * x2
+    yy = qy * y2
+    zz = qz * z2
+    xy = qx * y2
+    xz = qx * z2
+    yz = qy * z2
+    wx = qw * x2
+    wy = qw * y2
+    wz = qw * z2
     return (
-        1.0 - 2.0 * (yy + zz), 2.0 * (xy - wz), 2.0 * (xz + wy),
-        2.0 * (xy + wz), 1.0 - 2.0 * (xx + zz), 2.0 * (yz - wx),
-        2.0 * (xz - wy), 2.0 * (yz + wx), 1.0 - 2.0 * (xx + yy),
+        1.0 - (yy + zz), xy - wz, xz + wy,
+        xy + wz, 1.0 - (xx + zz), yz - wx,
+        xz - wy, yz + wx, 1.0 - (xx + yy),
     )
 
 
