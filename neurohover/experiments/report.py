@@ -108,6 +108,14 @@ class _Section:
     def stem(self) -> str:
         return f"{self.cfg.name}-{self.cfg.scale}"
 
+    def save(self, fig) -> str:
+        """Write the section's figure next to the report; returns its file name."""
+        fig.tight_layout()
+        path = self.out / f"{self.stem}.png"
+        fig.savefig(path, dpi=110)
+        _plt().close(fig)
+        return path.name
+
     def add_tests(self, samples: dict[str, list[float]], labels: dict[str, str], what: str) -> None:
         for t in self.paper.get("ttests", []):
             a, b = t["a"], t["b"]
@@ -188,11 +196,7 @@ class _Evolution(_Section):
             ax.grid(alpha=0.3, which="both")
             ax.legend(fontsize=8)
         fig.suptitle(f"{self.cfg.title} ({self.cfg.scale} scale)", fontsize=10)
-        fig.tight_layout()
-        path = self.out / f"{self.stem}.png"
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
-        return path.name
+        return self.save(fig)
 
     def body(self) -> str:
         parts = []
@@ -277,11 +281,7 @@ class _ModelLearning(_Section):
         ax.set_ylabel("error of the evolved policy in the true MDP (log scale)")
         ax.set_title(f"Table 4: policies evolved on learned models ({self.cfg.scale} scale)", fontsize=10)
         ax.grid(alpha=0.3, which="both")
-        fig.tight_layout()
-        path = self.out / f"{self.stem}.png"
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
-        return path.name
+        return self.save(fig)
 
     def body(self) -> str:
         ref = self.paper.get("table", {})
@@ -342,11 +342,7 @@ class _TestRuns(_Section):
             ax.grid(alpha=0.3, which="both")
             ax.legend(fontsize=8)
         fig.suptitle(f"{self.cfg.title} ({self.cfg.scale} scale)", fontsize=10)
-        fig.tight_layout()
-        path = self.out / f"{self.stem}.png"
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
-        return path.name
+        return self.save(fig)
 
     def body(self) -> str:
         ref = self.paper.get("groups", {})

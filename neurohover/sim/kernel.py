@@ -261,6 +261,17 @@ def integrate(s, n, a1, a2, a3, a4, step, dyn, n_sub, dt, wind):
     return (vu, vv, vw, px, py, pz, p, q, r, qx, qy, qz, qw)
 
 
+@nb.njit(cache=True, inline="always")
+def _record(obs_out, act_out, slot, k, o, a1, a2, a3, a4):
+    """Flight data of control step k: the observation the policy saw and the action applied."""
+    for i in range(12):
+        obs_out[slot, k, i] = o[i]
+    act_out[slot, k, 0] = a1
+    act_out[slot, k, 1] = a2
+    act_out[slot, k, 2] = a3
+    act_out[slot, k, 3] = a4
+
+
 @nb.njit(cache=True, parallel=True, fastmath={"contract"})
 def rollout_batch(
     mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, job_fallback, seed,
@@ -300,12 +311,7 @@ def rollout_batch(
             t = k + 1
             if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
                 if slot >= 0:
-                    for i in range(12):
-                        obs_out[slot, k, i] = o[i]
-                    act_out[slot, k, 0] = a1
-                    act_out[slot, k, 1] = a2
-                    act_out[slot, k, 2] = a3
-                    act_out[slot, k, 3] = a4
+                    _record(obs_out, act_out, slot, k, o, a1, a2, a3, a4)
                 crash = True
                 total += -CRASH_STEP_PENALTY * (n_steps - t)
                 break
@@ -314,12 +320,7 @@ def rollout_batch(
             a3 = _clip(a3)
             a4 = _clip(a4)
             if slot >= 0:
-                for i in range(12):
-                    obs_out[slot, k, i] = o[i]
-                act_out[slot, k, 0] = a1
-                act_out[slot, k, 1] = a2
-                act_out[slot, k, 2] = a3
-                act_out[slot, k, 3] = a4
+                _record(obs_out, act_out, slot, k, o, a1, a2, a3, a4)
             n = update_noise(n, std, next_normal(rng), next_normal(rng), next_normal(rng),
                              next_normal(rng), next_normal(rng), next_normal(rng))
             s = integrate(s, n, a1, a2, a3, a4, k, dyn, n_sub, dt, wind)
