@@ -367,3 +367,14 @@ def test_generational_evolution_over_fghh_beats_its_seed_on_fresh_mdps() -> None
     ev = evaluate([result.champion, prototype("mlp", "baseline")], family.test_mdps()[:30], seed=8, n_steps=600)
     assert not ev.crashed[0].any()
     assert np.median(ev.returns[0]) > 2 * np.median(ev.returns[1])  # returns are negative: less than half the error
+
+
+def test_a_ctrl_c_after_the_last_generation_check_still_reaches_the_caller() -> None:
+    import signal
+
+    from neurohover.evolution.evolve import _InterruptFlag
+
+    with pytest.raises(KeyboardInterrupt):
+        with _InterruptFlag() as flag:
+            flag._handler(signal.SIGINT, None)  # arrives after the last check; the block ends normally
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # handler restored

@@ -422,9 +422,13 @@ class _InterruptFlag:
             raise KeyboardInterrupt
         self.set = True
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, exc_type, exc, tb) -> None:
         if self._previous is not None:
             signal.signal(signal.SIGINT, self._previous)
+        if self.set and exc_type is None:
+            # Ctrl-C came after the last generation's check: the run is complete, but the
+            # interrupt must still reach the caller (e.g. a reproduce loop), never be swallowed.
+            raise KeyboardInterrupt
 
 
 # --------------------------------------------------------------------------------- CMA-ES state
