@@ -374,7 +374,9 @@ def test_a_ctrl_c_after_the_last_generation_check_still_reaches_the_caller() -> 
 
     from neurohover.evolution.evolve import _InterruptFlag
 
+    before = signal.getsignal(signal.SIGINT)
     with pytest.raises(KeyboardInterrupt):
         with _InterruptFlag() as flag:
+            assert signal.getsignal(signal.SIGINT) != before
             flag._handler(signal.SIGINT, None)  # arrives after the last check; the block ends normally
-    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # handler restored
+    assert signal.getsignal(signal.SIGINT) == before  # the previous handler is back
