@@ -143,7 +143,7 @@ def _index_array(values, n_jobs: int | None, upper: int | None, what: str) -> np
     arr = arr.astype(np.int64).reshape(-1)
     if n_jobs is not None and arr.shape[0] != n_jobs:
         raise NeurohoverError(f"{what} has {arr.shape[0]} entries but there are {n_jobs} jobs")
-    if arr.size and arr.min() < (0 if upper is not None else 0):
+    if arr.size and arr.min() < 0:
         raise NeurohoverError(f"{what} holds negative values (min {arr.min()}); allowed >= 0")
     if upper is not None and arr.size and arr.max() >= upper:
         raise NeurohoverError(f"{what} holds {arr.max()}, out of range: allowed 0..{upper - 1}")

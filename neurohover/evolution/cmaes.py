@@ -13,7 +13,7 @@ import cma
 import numpy as np
 
 from .neuroevolution import (
-    ChampionRecord,
+    ChampionViews,
     _ChampionTracker,
     _check_prototype,
     _check_returns,
@@ -23,7 +23,7 @@ from .neuroevolution import (
 __all__ = ["CMAES"]
 
 
-class CMAES:
+class CMAES(ChampionViews):
     """CMA-ES over flat genomes, ask/tell, maximising returns.
 
     Randomness: pycma's ``seed`` option reseeds NumPy's GLOBAL random state,
@@ -127,28 +127,3 @@ class CMAES:
     def sigma(self) -> float:
         """Current overall step size."""
         return float(self._es.sigma)
-
-    @property
-    def evaluations(self) -> int:
-        """Number of returns told so far."""
-        return self._tracker.evaluations
-
-    @property
-    def champion_genome(self) -> np.ndarray | None:
-        """Genome with the best single return ever told."""
-        return None if self._tracker.genome is None else self._tracker.genome.copy()
-
-    @property
-    def champion_return(self) -> float:
-        """Best single return ever told (``-inf`` before any finite return)."""
-        return self._tracker.best
-
-    @property
-    def evaluations_since_champion(self) -> int:
-        """Evaluations told since the current champion appeared."""
-        return self._tracker.since
-
-    @property
-    def history(self) -> list[ChampionRecord]:
-        """One record per new champion, in order."""
-        return list(self._tracker.history)

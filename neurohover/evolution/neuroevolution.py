@@ -396,7 +396,38 @@ class _ChampionTracker:
 # --------------------------------------------------------------------------- steady state
 
 
-class SteadyStateNE:
+class ChampionViews:
+    """Read-outs of an optimiser's champion tracking (shared by SteadyStateNE and CMAES)."""
+
+    _tracker: _ChampionTracker
+
+    @property
+    def evaluations(self) -> int:
+        """Number of returns told so far."""
+        return self._tracker.evaluations
+
+    @property
+    def champion_genome(self) -> np.ndarray | None:
+        """Genome with the best single return ever told (None before any finite return)."""
+        return None if self._tracker.genome is None else self._tracker.genome.copy()
+
+    @property
+    def champion_return(self) -> float:
+        """Best single return ever told (``-inf`` before any finite return)."""
+        return self._tracker.best
+
+    @property
+    def evaluations_since_champion(self) -> int:
+        """Evaluations told since the current champion appeared."""
+        return self._tracker.since
+
+    @property
+    def history(self) -> list[ChampionRecord]:
+        """One record per new champion, in order."""
+        return list(self._tracker.history)
+
+
+class SteadyStateNE(ChampionViews):
     """Steady-state neuroevolution of Appendix A (GHH-08/09), ask/tell, maximising.
 
     The first :meth:`ask` returns the initial population: the prototype itself
@@ -530,31 +561,6 @@ class SteadyStateNE:
     def generation(self) -> int:
         """Number of :meth:`tell` calls so far (the initial population is generation 1)."""
         return self._generation
-
-    @property
-    def evaluations(self) -> int:
-        """Number of returns told so far."""
-        return self._tracker.evaluations
-
-    @property
-    def champion_genome(self) -> np.ndarray | None:
-        """Genome with the best single return ever told (None before any finite return)."""
-        return None if self._tracker.genome is None else self._tracker.genome.copy()
-
-    @property
-    def champion_return(self) -> float:
-        """Best single return ever told (``-inf`` before any finite return)."""
-        return self._tracker.best
-
-    @property
-    def evaluations_since_champion(self) -> int:
-        """Evaluations told since the current champion appeared."""
-        return self._tracker.since
-
-    @property
-    def history(self) -> list[ChampionRecord]:
-        """One record per new champion, in order."""
-        return list(self._tracker.history)
 
     @property
     def population(self) -> np.ndarray | None:
