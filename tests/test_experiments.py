@@ -448,3 +448,22 @@ def test_paper_scale_reproduction() -> None:
     jobs = str(os.cpu_count() or 1)
     assert main(["reproduce", "all", "--scale", "paper", "--store", store, "--jobs", jobs]) == 0
     assert main(["report", "--store", store, "--scale", "paper", "--out", str(Path(store).with_suffix("")) + "-report"]) == 0
+
+
+def test_only_runs_the_selected_units_and_a_later_call_finishes_the_rest(tmp_path: Path, capsys) -> None:
+    config = _write(tmp_path, SLOW_CONFIG.replace("runs = 12", "runs = 4").replace("budget = 3000", "budget = 200"))
+    store = tmp_path / "s.sqlite"
+    base = ["reproduce", str(config), "--store", str(store), "--no-progress"]
+    assert main([*base, "--only", "evolve/k1/run1", "--only", "*/run3"]) == 0
+    assert "selection finished; ran 2 units, 0 already in the store, 2/4 done" in capsys.readouterr().out
+    with Store(store) as s:
+        first = s.results("slowtest", "quick")
+    assert sorted(first) == ["evolve/k1/run1", "evolve/k1/run3"]
+    assert main(base) == 0
+    assert "finished; ran 2 units, 2 already in the store, 4/4 done" in capsys.readouterr().out
+    with Store(store) as s:
+        after = s.results("slowtest", "quick")
+    assert all(after[k] == v for k, v in first.items())
+    # A pattern that matches nothing is a typo, not a silent no-op.
+    assert main([*base, "--only", "run/hybrid/*"]) == 2
+    assert "--only 'run/hybrid/*' matches no unit; unit keys look like evolve/k1/" in capsys.readouterr().err

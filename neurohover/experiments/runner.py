@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import fnmatch
 import sys
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from ..errors import NeurohoverError
@@ -45,9 +47,20 @@ def _short(err: BaseException) -> str:
     return f"{type(err).__name__}: {lines[-1] if lines else text}"[:500]
 
 
-def reproduce(config: ExperimentConfig, store: Store, executor, *, fresh: bool = False, progress: bool | None = None) -> RunSummary:
+def selected(key: str, only: Sequence[str]) -> bool:
+    """Whether unit ``key`` is in the selection ``only`` (glob patterns; empty: every unit).
+
+    Shared prerequisites (``policy/...`` units: the policies that test runs fly) are always selected.
+    """
+    return not only or key.startswith("policy/") or any(fnmatch.fnmatchcase(key, pat) for pat in only)
+
+
+def reproduce(config: ExperimentConfig, store: Store, executor, *, fresh: bool = False, progress: bool | None = None,
+              only: Sequence[str] = ()) -> RunSummary:
     """Run every unfinished unit of ``config``; each finished unit is written to ``store`` at once.
 
+    ``only`` restricts the run to the units whose keys match one of these glob patterns (for example
+    ``run/hybrid/*/rep0``); the others stay unfinished, and a later call can run them.
     Raises KeyboardInterrupt (after recording every finished unit) when interrupted.
     """
     from tqdm import tqdm
@@ -71,13 +84,15 @@ def reproduce(config: ExperimentConfig, store: Store, executor, *, fresh: bool =
         summary.failed.append((unit.key, _short(err)))
         bar.write(f"{config.name}: unit {unit.key} failed: {_short(err)}", file=sys.stderr)
 
+    matched: set[str] = set()
     try:
         while True:
             p = plan(config, results)
+            matched.update(pat for pat in only for u in p.units if fnmatch.fnmatchcase(u.key, pat))
             summary.units_total = p.total
             bar.total = p.total
             bar.refresh()
-            todo = [u for u in p.units if u.key not in results]
+            todo = [u for u in p.units if u.key not in results and selected(u.key, only)]
             if not todo:
                 break
             executor.run(todo, on_result, on_error)
@@ -85,6 +100,12 @@ def reproduce(config: ExperimentConfig, store: Store, executor, *, fresh: bool =
                 break
         if summary.failed:
             summary.status = "failed"
+        elif set(only) - matched:
+            keys = ", ".join(u.key for u in p.units[:3])
+            raise NeurohoverError(f"{config.name}: --only {sorted(set(only) - matched)[0]!r} matches no unit; "
+                                  f"unit keys look like {keys}")
+        elif only:
+            summary.status = "finished" if len(results) >= summary.units_total else "selection finished"
         elif len(results) < summary.units_total:
             raise NeurohoverError(f"{config.name}: {summary.units_total - len(results)} units could not be planned")
         else:
