@@ -379,6 +379,15 @@ def test_report_draws_the_figures_and_compares_with_the_paper(quick_store: Path,
                    "our crash rate", "vs paper", "### Discussion"):
         assert needle in text, needle
     assert "INCOMPLETE" not in text
+    # A hand-written discussion beside the report survives regenerating it.
+    (out / "discussion").mkdir()
+    (out / "discussion" / "fig8-quick.md").write_text("Our hybrid agent fell back in most episodes.\n")
+    assert _run(capsys, "report", "--store", str(quick_store), "--out", str(out))[0] == 0
+    sections = (out / "report.md").read_text().split("\n## ")
+    fig8 = next(sec for sec in sections if sec.startswith("Figure 8"))
+    assert "### Discussion\n\nOur hybrid agent fell back in most episodes." in fig8
+    fig2 = next(sec for sec in sections if sec.startswith("Figure 2"))
+    assert "Quick scale only" in fig2 and "fell back" not in fig2
     # One experiment only, and a clear error for an unknown one.
     with Store(quick_store) as store:
         write_report(store, tmp_path / "one", names=["fig15"])

@@ -440,8 +440,24 @@ def _section(cfg: ExperimentConfig, store: Store, out: Path) -> str:
         lines.append("- Protocol notes (where this reproduction differs from, or had to fill in, the paper):")
         lines += [f"  - {n}" for n in notes]
     text.append("\n".join(lines) + "\n")
-    text.append("### Discussion\n\n_To be written: how our results compare with the paper's, and why._\n")
+    text.append("### Discussion\n\n" + _discussion(cfg, out) + "\n")
     return "\n".join(text)
+
+
+QUICK_DISCUSSION = ("Quick scale only: a check of the whole pipeline with 200-step episodes, few runs and tiny evolution "
+                    "budgets. Its numbers are not comparable with the paper's; run `neurohover reproduce NAME --scale "
+                    "paper` for that.")
+
+
+def _discussion(cfg: ExperimentConfig, out: Path) -> str:
+    """The hand-written discussion ``discussion/<name>-<scale>.md`` beside the report, kept across regenerations."""
+    path = out / "discussion" / f"{cfg.name}-{cfg.scale}.md"
+    if path.is_file():
+        return path.read_text().strip()
+    if cfg.scale == "quick":
+        return QUICK_DISCUSSION
+    return (f"_Not written yet: how these results compare with the paper's, and why, goes in "
+            f"`discussion/{cfg.name}-{cfg.scale}.md` beside this report; `neurohover report` includes it._")
 
 
 def write_report(store: Store, out: str | Path, *, scale: str | None = None, names: list[str] | None = None) -> Path:
