@@ -33,6 +33,8 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         raise NeurohoverError("--jobs applies to --executor local; Ray runs one unit per CPU of the cluster")
     overrides = dict(parse_override(text) for text in args.set or [])
     configs = load_configs(args.name, args.scale, overrides)
+    if args.only and len(configs) > 1:
+        raise NeurohoverError(f"--only selects units of one experiment: give its NAME instead of {args.name!r}")
     executor = make_executor(args.executor, jobs=args.jobs, address=args.address)
     failed = False
     try:

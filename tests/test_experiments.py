@@ -476,3 +476,5 @@ def test_only_runs_the_selected_units_and_a_later_call_finishes_the_rest(tmp_pat
     # A pattern that matches nothing is a typo, not a silent no-op.
     assert main([*base, "--only", "run/hybrid/*"]) == 2
     assert "--only 'run/hybrid/*' matches no unit; unit keys look like evolve/k1/" in capsys.readouterr().err
+    assert main(["reproduce", "all", "--store", str(store), "--only", "run/*"]) == 2
+    assert "--only selects units of one experiment: give its NAME instead of 'all'" in capsys.readouterr().err
