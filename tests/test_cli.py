@@ -95,5 +95,5 @@ def test_every_command_has_help() -> None:
 
     commands = build_parser()._subparsers._group_actions[0].choices
     for name in commands:
-        out = subprocess.run([sys.executable, "-m", "neurohover.cli", name, "--help"], capture_output=True, text=True)
+        out = subprocess.run([sys.executable, "-m", "neurohover", name, "--help"], capture_output=True, text=True)
         assert out.returncode == 0 and "usage: neurohover" in out.stdout, name
