@@ -478,3 +478,21 @@ def test_only_runs_the_selected_units_and_a_later_call_finishes_the_rest(tmp_pat
     assert "--only 'run/hybrid/*' matches no unit; unit keys look like evolve/k1/" in capsys.readouterr().err
     assert main(["reproduce", "all", "--store", str(store), "--only", "run/*"]) == 2
     assert "--only selects units of one experiment: give its NAME instead of 'all'" in capsys.readouterr().err
+
+
+def test_a_significant_difference_in_the_opposite_direction_does_not_agree_with_the_paper() -> None:
+    from neurohover.experiments.report import _Section
+
+    cfg = load_config("fig8", "quick")
+    sec = _Section(cfg, {}, None, Path("."))
+    rng = np.random.default_rng(0)
+    better, worse = list(rng.normal(-100, 5, 20)), list(rng.normal(-200, 5, 20))
+    # The paper found hybrid better than model-free (p = 1.4e-14) and incremental better (p = 5.8e-12).
+    sec.add_tests({"hybrid": worse, "model-free": better, "incremental": list(rng.normal(-300, 5, 20))},
+                  {}, "final cumulative reward")
+    by_pair = {c.split(" (")[0]: c for c in sec.comparisons}
+    assert by_pair["hybrid vs model-free"].endswith("disagrees: the opposite direction (the paper found hybrid better).")
+    assert by_pair["incremental vs model-free"].endswith("disagrees: the opposite direction (the paper found incremental better).")
+    sec.comparisons.clear()
+    sec.add_tests({"hybrid": better, "model-free": worse}, {}, "final cumulative reward")
+    assert sec.comparisons[0].endswith(": agrees.")

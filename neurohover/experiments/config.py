@@ -18,6 +18,7 @@ File layout (see ``neurohover/experiments/configs/*.toml``; copy one and edit it
     episodes = 1000
 
     [paper]                           # what the paper reports; the report compares against it
+    ttests = [{ a = "incremental", b = "model-free", p = "< 0.0002" }]   # a: the one the paper found better
 
 A resolved config is ``[settings]`` updated with ``[scales.<scale>]`` and validated against the
 kind's schema below (unknown keys, wrong types and out-of-range values are refused with a message

@@ -127,8 +127,12 @@ class _Section:
                                fmt_p(p_welch), str(t["p"])])
             expected = _p_significant(str(t["p"]))
             if p_student is not None and expected is not None:
+                # Each paper test names the approach the paper found better as ``a``.
                 ours = p_student < 0.05
-                agree = "agrees" if ours == expected else "disagrees"
+                if ours and expected and ma < mb:
+                    agree = f"disagrees: the opposite direction (the paper found {labels.get(a, a)} better)"
+                else:
+                    agree = "agrees" if ours == expected else "disagrees"
                 self.comparisons.append(
                     f"{labels.get(a, a)} vs {labels.get(b, b)} ({what}): our Student's p = {fmt_p(p_student)} "
                     f"({'significant' if ours else 'not significant'} at 5%; mean {fmt(ma)} vs {fmt(mb)}) vs paper p {t['p']}: {agree}.")
