@@ -496,3 +496,24 @@ def test_a_significant_difference_in_the_opposite_direction_does_not_agree_with_
     sec.comparisons.clear()
     sec.add_tests({"hybrid": better, "model-free": worse}, {}, "final cumulative reward")
     assert sec.comparisons[0].endswith(": agrees.")
+
+
+def test_an_interrupt_ends_the_running_worker_processes_at_once() -> None:
+    import multiprocessing
+
+    from neurohover.experiments.units import Unit
+
+    executor = LocalExecutor(2)
+    units = [Unit("x", "quick", "diagnostic", {"sleep": 0}), Unit("x", "slow", "diagnostic", {"sleep": 120})]
+
+    def on_result(unit, result, seconds, worker) -> None:
+        raise KeyboardInterrupt  # as if Ctrl-C arrived once the quick unit is done
+
+    start = time.perf_counter()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            executor.run(units, on_result, lambda unit, err: None)
+    finally:
+        executor.close()
+    assert time.perf_counter() - start < 60  # the 120 s unit was stopped, not waited for
+    assert not [p for p in multiprocessing.active_children() if p.is_alive()]

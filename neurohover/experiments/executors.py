@@ -91,7 +91,7 @@ class LocalExecutor:
                         continue
                     on_result(unit, result, seconds, worker)
         except BaseException:
-            pool.shutdown(wait=False, cancel_futures=True)
+            _stop(pool)
             self._pool = None
             raise
 
@@ -99,6 +99,20 @@ class LocalExecutor:
         if self._pool is not None:
             self._pool.shutdown(wait=True)
             self._pool = None
+
+
+def _stop(pool: ProcessPoolExecutor) -> None:
+    """Cancel the queued units and end the running ones at once (on Ctrl-C or an error).
+
+    An interrupted unit is never recorded, so letting a worker finish it (which the pool's own
+    shutdown does, for up to a unit's whole run time) would only keep the command waiting.
+    """
+    workers = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in workers:
+        process.terminate()
+    for process in workers:
+        process.join(timeout=10)
 
 
 def import_ray():
