@@ -111,8 +111,13 @@ def _stop(pool: ProcessPoolExecutor) -> None:
     pool.shutdown(wait=False, cancel_futures=True)
     for process in workers:
         process.terminate()
+    # The pool's manager thread may reap a worker while join() waits on it; join() then returns
+    # before the process is marked dead, so wait for that too.
+    deadline = time.monotonic() + 10
     for process in workers:
-        process.join(timeout=10)
+        process.join(timeout=max(0.0, deadline - time.monotonic()))
+        while process.is_alive() and time.monotonic() < deadline:
+            time.sleep(0.01)
 
 
 def import_ray():
