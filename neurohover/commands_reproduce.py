@@ -49,7 +49,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
                           f"run the same command again to resume", file=sys.stderr)
                     return 130
                 print(summary.line())
-                failed = failed or summary.status not in ("finished", "selection finished")
+                failed = failed or not summary.succeeded
     finally:
         executor.close()
     return 1 if failed else 0

@@ -33,6 +33,11 @@ class RunSummary:
     def units_done(self) -> int:
         return self.units_before + self.units_run
 
+    @property
+    def succeeded(self) -> bool:
+        """Every unit asked for (all, or the ``only`` selection) finished."""
+        return self.status in ("finished", "selection finished")
+
     def line(self) -> str:
         text = (f"{self.name} ({self.scale}): {self.status}; ran {self.units_run} units, {self.units_before} already in "
                 f"the store, {self.units_done}/{self.units_total} done, {self.wall_seconds:.1f} s on {self.cores} cores ({self.executor})")
