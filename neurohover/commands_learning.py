@@ -2,7 +2,7 @@
 
 ``neurohover evolve`` writes three files for ``--out FILE``:
 
-* ``FILE``: the champion as a policy file (SPEC section 3 JSON) with metadata: task, mdp, sigma,
+* ``FILE``: the champion as a policy file (JSON, docs/model.md, Policies) with metadata: task, mdp, sigma,
   optimizer, resampling, budget, seed, champion_return, validation_return (mean return of 10 fresh
   episodes: on the MDP, or each on a fresh MDP from G, independent of the evolution's episodes),
   validation_sd, episodes, seconds, stop_reason, ...;

@@ -295,7 +295,7 @@ def evaluate(
 class Safeguard:
     """The hybrid agent's safeguard: on a dangerous state, ``fallback`` flies the rest of the episode.
 
-    ``limits`` bound |u|, |v|, |w|, |x|, |y|, |z|, |p|, |q|, |r| of the observation (SPEC section 7:
+    ``limits`` bound |u|, |v|, |w|, |x|, |y|, |z|, |p|, |q|, |r| of the observation (docs/model.md, Safeguard:
     0.5 each).
     """
 

@@ -1,4 +1,4 @@
-"""Flight data: observations and actions of flown episodes at 10 Hz (SPEC section 6).
+"""Flight data: observations and actions of flown episodes at 10 Hz (docs/model.md, Learned models).
 
 Saved as a NumPy ``.npz`` archive with a format tag, the episodes concatenated and their
 lengths kept, so a file of any number of episodes loads back exactly.

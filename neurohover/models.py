@@ -1,4 +1,4 @@
-"""Learning helicopter models from flight data: LR, EC-MENO and EC-MER (paper Section 3.2, SPEC 6).
+"""Learning helicopter models from flight data: LR, EC-MENO and EC-MER (paper Section 3.2; docs/model.md, Learned models).
 
 A learned model has the simulator's equations but integrates once per 0.1 s control step (one
 substep, no wind) with its own 11 dynamics parameters and 6 gust-noise standard deviations, so it
@@ -466,7 +466,7 @@ def _noise_from_residuals(tr: _Transitions, residuals: np.ndarray) -> tuple[np.n
 
 
 def learn_lr(flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS, *, estimator: str = "gls") -> LearnedModel:
-    """Learn a model by least squares (SPEC 6 "LR"; module docstring for every detail).
+    """Learn a model by least squares (docs/model.md, Learned models, "LR"; module docstring for every detail).
 
     Parameters
     ----------

@@ -1,8 +1,8 @@
-"""Generic policies: the baseline, SLP and MLP networks, genomes and policy files (SPEC section 3).
+"""Generic policies: the baseline, SLP and MLP networks, genomes and policy files (docs/model.md, Policies).
 
 Networks see 9 of the 12 observation entries (u, v, w, x, y, z, qx, qy, qz) and output the four
 actions (aileron, elevator, rudder, collective). A genome is the flat vector of a network's weights
-and biases in SPEC's fixed order, so policies can be exchanged between tools.
+and biases in the fixed order of docs/model.md, Policies, so policies can be exchanged between tools.
 
 Policy files are JSON: ``{"topology": "slp" | "mlp", "genome": [...]}`` plus optional metadata
 keys. The name ``baseline`` stands for the competition's baseline policy wherever a file is taken.
@@ -59,7 +59,7 @@ class Policy:
     ----------
     topology : {"slp", "mlp"}
     genome : numpy.ndarray
-        Float64 vector of ``GENOME_LENGTH[topology]`` genes in SPEC's order (read-only).
+        Float64 vector of ``GENOME_LENGTH[topology]`` genes in the order of docs/model.md, Policies (read-only).
     metadata : dict
         Anything worth keeping with the policy (task, MDP, score, how it was made).
     """
@@ -136,7 +136,7 @@ def slp_baseline_genome() -> np.ndarray:
 
 
 def mlp_baseline_genome() -> np.ndarray:
-    """MLP genome that acts exactly like the baseline policy (SPEC: gains on the input-to-sum
+    """MLP genome that acts exactly like the baseline policy (docs/model.md, Policies: gains on the input-to-sum
     weights, every Lk -> ak weight 1, output biases (0.02, 0, 0, 0.23), everything else 0)."""
     g = np.zeros(42)
     index = {name: 15 + i for i, name in enumerate(MLP_WEIGHT_NAMES)}

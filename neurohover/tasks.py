@@ -1,4 +1,4 @@
-"""Task families (generalized tasks) and their MDPs: SPEC section 2.
+"""Task families (generalized tasks) and their MDPs: docs/model.md, Task families.
 
 A task family is a distribution G over MDPs; an MDP is fully fixed by its parameters. Each family
 offers its zero setting (the mean MDP), explicit construction from parameters (validated), a

@@ -59,7 +59,7 @@ def test_gymnasium_env_checker_passes(env_id: str) -> None:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         check_env(gym.make(env_id).unwrapped, skip_render_check=True)
-    # The observation space is unbounded by design (SPEC); anything else the checker says is a bug.
+    # The observation space is unbounded by design (docs/model.md, Simulator); anything else the checker says is a bug.
     other = [str(w.message) for w in caught if "infinity" not in str(w.message)]
     assert other == []
 

@@ -1,4 +1,4 @@
-"""Model learning (SPEC 6): LR, one-step prediction, EC-MENO, EC-MER, model files.
+"""Model learning (docs/model.md, Learned models): LR, one-step prediction, EC-MENO, EC-MER, model files.
 
 Every flight is seeded, so each number below is deterministic; tolerances come from the spread of
 the same quantities over 30 seeds (documented next to each), so they hold for the seed used and

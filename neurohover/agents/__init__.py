@@ -1,4 +1,4 @@
-"""On-line agents and the test-run protocol (SPEC section 7)."""
+"""On-line agents and the test-run protocol (docs/model.md, On-line agents)."""
 
 from .model_free import ModelFreeAgent
 from .protocol import Agent, Choice, EpisodeOutcome, RunResult, run_test

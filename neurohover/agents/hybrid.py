@@ -1,4 +1,4 @@
-"""The hybrid agent of GHH-09 with its safeguard (paper Sections 4.1-4.3, SPEC section 7)."""
+"""The hybrid agent of GHH-09 with its safeguard (paper Sections 4.1-4.3; docs/model.md, On-line agents and Safeguard)."""
 
 from __future__ import annotations
 

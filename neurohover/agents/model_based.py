@@ -1,4 +1,4 @@
-"""Model-based agents: learn an LR model from flight data, evolve a policy on it (SPEC section 7).
+"""Model-based agents: learn an LR model from flight data, evolve a policy on it (docs/model.md, On-line agents).
 
 The evolution on a learned model starts from the generic policy (the prototype) and uses the
 steady-state method with an evaluation budget; every episode flown on the model is simulated, so
@@ -82,7 +82,7 @@ class IncrementalModelBasedAgent(Agent):
     policy; stop once a policy does at least as well in the MDP as the model predicted, and keep it.
 
     If no policy meets its prediction within ``max_learning_episodes`` episodes, the agent keeps the
-    policy with the best return flown so far (a choice SPEC leaves open; the paper's runs stopped
+    policy with the best return flown so far (a choice the paper leaves open; the paper's runs stopped
     within a few episodes).
     """
 

@@ -1,4 +1,4 @@
-"""The model-free agent that won the 2008 competition (SPEC section 7, paper Section 3.3)."""
+"""The model-free agent that won the 2008 competition (docs/model.md, On-line agents; paper Section 3.3)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The on-line test-run protocol (SPEC section 7) and the interface every agent implements.
+"""The on-line test-run protocol (docs/model.md, On-line agents) and the interface every agent implements.
 
 A test run flies N episodes on one MDP the agent does not know; its score is the cumulative
 return of the whole run, so every crash counts. Before each episode the agent chooses the policy

@@ -116,7 +116,7 @@ def draw_stream_seed(rng: np.random.Generator) -> int:
 
 
 def initial_state() -> np.ndarray:
-    """SPEC's start state: at rest at the origin, level, facing north."""
+    """The start state (docs/model.md, Simulator): at rest at the origin, level, facing north."""
     state = np.zeros(STATE_DIM)
     state[12] = 1.0
     return state

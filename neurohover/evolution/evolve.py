@@ -1,4 +1,4 @@
-"""Whole evolution runs on the batched kernel: :func:`evolve` (SPEC sections 4 and 5).
+"""Whole evolution runs on the batched kernel: :func:`evolve` (docs/model.md, Neuroevolution).
 
 Two kinds of target
 -------------------
@@ -10,7 +10,7 @@ Two kinds of target
 * a task family G (``get_task_family("fghh", 0.3)``; any family works): the **generational**
   method of Appendix B (Table 7 defaults), for generic policies. Fitness is estimated by fixed
   resampling (``"fixed:K"``: K episodes per candidate, each on a fresh MDP drawn from G) or by
-  selection races (``"race:DELTA"``, SPEC 5, confidence level DELTA in (0, 1)).
+  selection races (``"race:DELTA"``, docs/model.md, Fitness under noise; confidence level DELTA in (0, 1)).
 
 ``optimizer="cma"`` replaces the neuroevolution by CMA-ES (pycma) on either target with the same
 budget semantics and the same fixed resampling, so the two can be compared on equal episodes.
@@ -105,7 +105,7 @@ CHECKPOINT_FORMAT = "neurohover-evolution-checkpoint/1"
 #: train:1 (600-step episodes, 1000 episodes, SLP and MLP from the baseline) found sigma0 0.01-0.03
 #: best and 0.1 crashing nearly every SLP candidate; popsize None is pycma's 4 + 3 ln D.
 CMA_DEFAULTS: dict[str, Any] = {"sigma0": 0.02, "popsize": None}
-RACE_T_LIMIT = 10  # SPEC 5: t_limit = t_min = t_max = 10
+RACE_T_LIMIT = 10  # docs/model.md, Fitness under noise: t_limit = t_min = t_max = 10
 _KIND = {"slp": POLICY_SLP, "mlp": POLICY_MLP}
 _MAX_SEED = 2**63 - 1
 

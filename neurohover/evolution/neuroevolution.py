@@ -1,4 +1,4 @@
-"""Steady-state and generational neuroevolution (paper Appendices A and B, SPEC 4).
+"""Steady-state and generational neuroevolution (paper Appendices A and B; docs/model.md, Neuroevolution).
 
 Both optimisers work on flat genome vectors (network weights) through an
 ask/tell interface in the style of pycma / evosax; the caller evaluates the

@@ -1,4 +1,4 @@
-"""Genome variation operators of the paper's neuroevolution (SPEC 4, Appendix A).
+"""Genome variation operators of the paper's neuroevolution (docs/model.md, Neuroevolution; Appendix A).
 
 Genomes are flat float vectors (the network weights). Both operators are
 elementwise, so they also accept stacked genomes of any shape; they never

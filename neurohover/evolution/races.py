@@ -1,4 +1,4 @@
-"""Fitness estimation under noise: fixed resampling and selection races (SPEC 5).
+"""Fitness estimation under noise: fixed resampling and selection races (docs/model.md, Fitness under noise).
 
 Both functions are driven by a caller-supplied ``sample_fn(indices) -> returns``
 that flies every listed candidate for ONE more episode, each on a fresh MDP

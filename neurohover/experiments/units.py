@@ -242,7 +242,7 @@ def make_agent(p: dict):
 
 
 def run_test_run(p: dict, threads: int | None) -> dict:
-    """One test run (SPEC 7): ``episodes`` episodes of an agent on one MDP it does not know."""
+    """One test run (docs/model.md, On-line agents): ``episodes`` episodes of an agent on one MDP it does not know."""
     from ..agents.protocol import run_test
     from ..compete import after_learning_start
 

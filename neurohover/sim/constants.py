@@ -1,4 +1,4 @@
-"""Constants of the XCell Tempest hover model (SPEC section 1) and the MDP row layout.
+"""Constants of the XCell Tempest hover model (docs/model.md, Simulator) and the MDP row layout.
 
 An MDP reaches the compiled kernel as one float64 row of ``MDP_ROW_LEN`` numbers, so a batch of
 MDPs (task-family MDPs or learned models) is a plain 2-D array.
@@ -62,7 +62,7 @@ OBS_DIM = 12
 ACTION_DIM = 4
 STATE_DIM = 13  # world velocity (3), world position (3), body rates (3), quaternion (qx, qy, qz, qw)
 
-# Default dangerous-state test of the safeguard (SPEC section 7): any velocity, position or
+# Default dangerous-state test of the safeguard (docs/model.md, Safeguard): any velocity, position or
 # angular-rate entry of the observation outside [-0.5, 0.5].
 SAFEGUARD_LIMITS = np.full(9, 0.5)
 

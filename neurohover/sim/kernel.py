@@ -6,7 +6,7 @@ environments all fly helicopters through the functions here. An MDP is a float64
 count and length, and the wind model, so a learned model (one 0.1 s substep, no wind) runs in
 the same code as the true simulator.
 
-Hot-path choices (the physics is exactly SPEC section 1's):
+Hot-path choices (the physics is exactly that of docs/model.md, Simulator):
 - state lives in scalars, not arrays, so LLVM keeps it in registers;
 - orientation uses a rotation matrix built once per substep for the three frame changes;
 - the rotation-vector quaternion uses Taylor series of sin(x)/x and cos(x) accurate to double
@@ -49,14 +49,14 @@ def _sigmoid(s: float) -> float:
 
 @nb.njit(cache=True, fastmath={"contract"})
 def policy_action(kind, g, u, v, w, x, y, z, qx, qy, qz):
-    """Actions (a1..a4) of a generic policy for the 9 inputs it sees (SPEC section 3)."""
+    """Actions (a1..a4) of a generic policy for the 9 inputs it sees (docs/model.md, Policies)."""
     if kind == POLICY_SLP:
         a1 = g[0] * u + g[1] * v + g[2] * w + g[3] * x + g[4] * y + g[5] * z + g[6] * qx + g[7] * qy + g[8] * qz + g[36]
         a2 = g[9] * u + g[10] * v + g[11] * w + g[12] * x + g[13] * y + g[14] * z + g[15] * qx + g[16] * qy + g[17] * qz + g[37]
         a3 = g[18] * u + g[19] * v + g[20] * w + g[21] * x + g[22] * y + g[23] * z + g[24] * qx + g[25] * qy + g[26] * qz + g[38]
         a4 = g[27] * u + g[28] * v + g[29] * w + g[30] * x + g[31] * y + g[32] * z + g[33] * qx + g[34] * qy + g[35] * qz + g[39]
         return a1, a2, a3, a4
-    # MLP: biases g[0:15] (hy hx hz L1..L4 S1..S4 a1..a4), then the 27 weights of SPEC's order.
+    # MLP: biases g[0:15] (hy hx hz L1..L4 S1..S4 a1..a4), then the 27 weights in the order of docs/model.md, Policies.
     hy = _sigmoid(g[0] + g[15] * y)
     hx = _sigmoid(g[1] + g[16] * x)
     hz = _sigmoid(g[2] + g[17] * z)
@@ -129,7 +129,7 @@ def reward_of(o) -> float:
 
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
 def crashed(s) -> bool:
-    """SPEC's crash test on the world-frame state tuple."""
+    """The crash test (docs/model.md, Simulator) on the world-frame state tuple."""
     return (
         abs(s[0]) > MAX_VELOCITY or abs(s[1]) > MAX_VELOCITY or abs(s[2]) > MAX_VELOCITY
         or abs(s[3]) > MAX_POSITION or abs(s[4]) > MAX_POSITION or abs(s[5]) > MAX_POSITION
@@ -149,7 +149,7 @@ def dangerous(o, limits) -> bool:
 
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
 def _half_angle_quaternion(rx, ry, rz):
-    """Unit quaternion (x, y, z, w) of rotation vector (rx, ry, rz), SPEC's small-angle rule included."""
+    """Unit quaternion (x, y, z, w) of rotation vector (rx, ry, rz), the small-angle rule of docs/model.md, Simulator, included."""
     theta2 = rx * rx + ry * ry + rz * rz
     if theta2 < 1e-8:  # angle below 1e-4
         hx = 0.5 * rx

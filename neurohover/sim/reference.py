@@ -1,4 +1,4 @@
-"""Plain-Python reference simulator, written to be read next to SPEC section 1.
+"""Plain-Python reference simulator, written to be read next to docs/model.md, Simulator.
 
 It follows the equations literally (quaternion sandwich products, ``math.sin``/``math.cos``) and
 takes its gust-noise normals as input, so tests can feed it the same normals as the compiled
@@ -57,7 +57,7 @@ def rotate_inverse(q: Quat, v: Vec) -> Vec:
 
 
 def rotation_vector_quaternion(rv: Vec) -> Quat:
-    """Unit quaternion of a rotation vector; first-order form below an angle of 1e-4 (SPEC)."""
+    """Unit quaternion of a rotation vector; first-order form below an angle of 1e-4 (docs/model.md, Simulator)."""
     angle = math.sqrt(rv[0] ** 2 + rv[1] ** 2 + rv[2] ** 2)
     if angle < 1e-4:
         half = (rv[0] / 2, rv[1] / 2, rv[2] / 2)
