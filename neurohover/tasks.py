@@ -2,7 +2,13 @@
 
 A task family is a distribution G over MDPs; an MDP is fully fixed by its parameters. Each family
 offers its zero setting (the mean MDP), explicit construction from parameters (validated), a
-sampler of fresh MDPs, and fixed seeded sets of 10 training and 100 test MDPs.
+sampler of fresh MDPs, and fixed sets of 10 training and 100 test MDPs.
+
+The fixed sets are the competitions' own MDPs, as the paper's authors used them (their experiment
+code's lists, shipped as ``neurohover/data/competition-mdps.json``; 0-based, the paper numbers
+from 1): GHH-08, GHH-09 and FGHH at sigma = 0.3. Seeded draws from G form a second, harder pair of
+sets, named ``seeded-train:N`` / ``seeded-test:N`` (:meth:`seeded_training_mdps`); for FGHH at any
+other sigma they are the only fixed sets, and ``train:N`` / ``test:N`` name them.
 
 Example
 -------
@@ -14,8 +20,10 @@ Example
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Sequence
+from pathlib import Path
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -42,9 +50,12 @@ MAX_WIND = 5.0
 GHH09_PARAM_NAMES = (
     "x_maxf", "x_freq", "x_phase", "x_center", "y_maxf", "y_freq", "y_phase", "y_center",
 )
-_SET_ENTROPY = 20110401  # fixed root of the training and test sets (the paper's year)
+_SET_ENTROPY = 20110401  # fixed root of the seeded training and test sets (the paper's year)
 _FAMILY_CODE = {"ghh08": 8, "ghh09": 9, "fghh": 12}
 _FIXED_SETS: dict[tuple[str, int, int], tuple["MDP", ...]] = {}
+COMPETITION_MDPS_FILE = Path(__file__).parent / "data" / "competition-mdps.json"
+COMPETITION_FGHH_SIGMA = 0.3  # the only FGHH sigma the authors' code lists MDPs for
+_COMPETITION: dict[str, dict] = {}
 
 
 @dataclass(frozen=True)
@@ -154,37 +165,78 @@ class _FamilyBase:
         rng = np.random.default_rng(rng)
         return self.make(self._draw(rng), label=label or f"{self.name}/sample")
 
-    def _fixed_set(self, which: int, n: int, kind: str) -> list[MDP]:
+    def _seeded_set(self, which: int, n: int, kind: str) -> list[MDP]:
         key = (self.name, self._set_key(), which)
         if key not in _FIXED_SETS:  # MDPs are immutable, so each set is built once per process
             rng = np.random.default_rng(_seed_sequence(self.name, which, self._set_key()))
             _FIXED_SETS[key] = tuple(self.make(self._draw(rng), label=f"{self.name}/{kind}:{i}") for i in range(n))
         return list(_FIXED_SETS[key])
 
+    @property
+    def has_competition_sets(self) -> bool:
+        """True when ``train:N`` / ``test:N`` are the competition's MDPs (else the seeded draws)."""
+        return True
+
+    def _competition_row(self, value: Sequence[float]) -> Sequence[float]:
+        """The MDP parameters of one row of the competition file (GHH-08 scales it to m/s)."""
+        return value
+
+    def _competition_set(self, kind: str) -> list[MDP]:
+        key = (self.name, -1, 0 if kind == "train" else 1)
+        if key not in _FIXED_SETS:
+            rows = competition_rows(self.name)[kind]
+            _FIXED_SETS[key] = tuple(
+                self.make(self._competition_row(r), label=f"{self.name}/{kind}:{i}") for i, r in enumerate(rows)
+            )
+        return list(_FIXED_SETS[key])
+
     def training_mdps(self) -> list[MDP]:
-        """The fixed, seeded set of 10 training MDPs."""
-        return self._fixed_set(0, N_TRAINING, "train")
+        """The 10 training MDPs: the competition's (seeded draws where it has none)."""
+        if self.has_competition_sets:
+            return self._competition_set("train")
+        return self.seeded_training_mdps()
 
     def test_mdps(self) -> list[MDP]:
-        """The fixed, seeded set of 100 test MDPs."""
-        return self._fixed_set(1, N_TEST, "test")
+        """The 100 test MDPs: the competition's (seeded draws where it has none)."""
+        if self.has_competition_sets:
+            return self._competition_set("test")
+        return self.seeded_test_mdps()
+
+    def seeded_training_mdps(self) -> list[MDP]:
+        """10 training MDPs drawn from G with a fixed seed (``seeded-train:N``): harder than the competition's."""
+        return self._seeded_set(0, N_TRAINING, "seeded-train")
+
+    def seeded_test_mdps(self) -> list[MDP]:
+        """100 test MDPs drawn from G with a fixed seed (``seeded-test:N``)."""
+        return self._seeded_set(1, N_TEST, "seeded-test")
 
     def mdp(self, spec: str, rng: np.random.Generator | int | None = None) -> MDP:
-        """An MDP by name: ``zero``, ``train:N``, ``test:N`` or ``sample``."""
+        """An MDP by name: ``zero``, ``train:N``, ``test:N``, ``seeded-train:N``, ``seeded-test:N`` or ``sample``."""
         if spec == "zero":
             return self.zero()
         if spec == "sample":
             return self.sample(rng)
         kind, _, index = spec.partition(":")
-        sets = {"train": (self.training_mdps, N_TRAINING), "test": (self.test_mdps, N_TEST)}
+        sets = {
+            "train": (self.training_mdps, N_TRAINING), "test": (self.test_mdps, N_TEST),
+            "seeded-train": (self.seeded_training_mdps, N_TRAINING), "seeded-test": (self.seeded_test_mdps, N_TEST),
+        }
         if kind in sets and index.isdigit():
             getter, n = sets[kind]
             if int(index) < n:
                 return getter()[int(index)]
             raise NeurohoverError(f"MDP index {index} in {spec!r} is out of range: allowed 0..{n - 1}")
         raise NeurohoverError(
-            f"unknown MDP {spec!r}: allowed zero, sample, train:N (0..{N_TRAINING - 1}), test:N (0..{N_TEST - 1})"
+            f"unknown MDP {spec!r}: allowed zero, sample, train:N and seeded-train:N (0..{N_TRAINING - 1}), "
+            f"test:N and seeded-test:N (0..{N_TEST - 1})"
         )
+
+
+def competition_rows(family: str) -> dict:
+    """The competition's training and test rows of ``family`` as listed in the shipped data file."""
+    if not _COMPETITION:
+        _COMPETITION.update(json.loads(COMPETITION_MDPS_FILE.read_text()))
+    return _COMPETITION[family]
 
 
 @dataclass(frozen=True)
@@ -205,6 +257,9 @@ class GHH08(_FamilyBase):
 
     def _draw(self, rng: np.random.Generator) -> np.ndarray:
         return rng.uniform(-MAX_WIND, MAX_WIND, 2)
+
+    def _competition_row(self, value: Sequence[float]) -> Sequence[float]:
+        return [MAX_WIND * v for v in value]  # the file lists the wind as values in [-1, 1]
 
 
 @dataclass(frozen=True)
@@ -252,6 +307,10 @@ class FGHH(_FamilyBase):
 
     def _set_key(self) -> int:
         return int(round(self.sigma * 1_000_000))
+
+    @property
+    def has_competition_sets(self) -> bool:
+        return self.sigma == COMPETITION_FGHH_SIGMA
 
 
 TaskFamily = GHH08 | GHH09 | FGHH

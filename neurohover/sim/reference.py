@@ -66,6 +66,13 @@ def rotation_vector_quaternion(rv: Vec) -> Quat:
     return (rv[0] * s, rv[1] * s, rv[2] * s, math.cos(angle / 2))
 
 
+def competition_time(step: int, substep: int) -> float:
+    """Time (s) of a substep as the competition software computed it: ``t = 0.1*step + 0.01*substep``
+    in floating point, floored to 0.01 s by ``int(t*100)/100.0`` (so some land 0.01 s early)."""
+    t = 0.1 * step + 0.01 * substep
+    return int(t * 100) / 100.0
+
+
 @dataclass
 class ReferenceMDP:
     """Everything that fixes an MDP, as plain numbers (see :mod:`neurohover.tasks`)."""
@@ -79,14 +86,15 @@ class ReferenceMDP:
     d_u: float = 0.0  # constant u acceleration of a learned model (0 in every true MDP)
 
     def wind_at(self, t: float) -> Vec:
-        """World-frame wind (m/s) at time t."""
+        """World-frame wind (m/s) at time t (for GHH-09, t as :func:`competition_time` floors it)."""
         if self.wind_kind == WIND_CONSTANT:
             return (self.wind[0], self.wind[1], 0.0)
         if self.wind_kind == WIND_SINUSOID:
             out = []
             for maxf, freq, phase, center in (self.wind[0:4], self.wind[4:8]):
                 amplitude = 5.0 * (maxf - center)
-                out.append(amplitude * math.sin(20.0 * math.pi * freq * t + 2.0 * math.pi * phase) + 5.0 * center)
+                phi = 2.0 * math.pi * phase if freq != 0.0 else 0.0  # the competition's rule
+                out.append(amplitude * math.sin(20.0 * math.pi * freq * t + phi) + 5.0 * center)
             return (out[0], out[1], 0.0)
         return (0.0, 0.0, 0.0)
 
@@ -130,7 +138,7 @@ class ReferenceHelicopter:
         n_u, n_v, n_w, n_p, n_q, n_r = self.noise
         dt = self.mdp.dt
         for i in range(self.mdp.substeps):
-            t = ((self.steps - 1) * self.mdp.substeps + i) * dt
+            t = competition_time(self.steps - 1, i)
             self.position = tuple(p + dt * v for p, v in zip(self.position, self.velocity))
             q = self.orientation
             vb = rotate_inverse(q, self.velocity)
