@@ -7,7 +7,7 @@ Data flows one way: task family -> MDP -> batched rollouts of policies -> return
 from __future__ import annotations
 
 from .errors import NeurohoverError
-from .evaluate import Evaluation, PolicyTable, Safeguard, evaluate, evaluate_jobs
+from .evaluate import DangerousState, Evaluation, PolicyTable, Safeguard, evaluate, evaluate_jobs
 from .flightdata import FlightData
 from .policies import Policy, baseline_policy, load_policy, prototype, save_policy
 from .tasks import FGHH, GHH08, GHH09, MDP, get_task_family
@@ -16,7 +16,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "FGHH", "GHH08", "GHH09", "MDP", "Evaluation", "FlightData", "NeurohoverError", "Policy",
-    "PolicyTable", "Safeguard", "baseline_policy", "evaluate", "evaluate_jobs", "get_task_family",
+    "DangerousState", "PolicyTable", "Safeguard", "baseline_policy", "evaluate", "evaluate_jobs", "get_task_family",
     "load_policy", "prototype", "save_policy",
 ]
 

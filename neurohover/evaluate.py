@@ -25,7 +25,7 @@ import numpy as np
 from .errors import NeurohoverError
 from .flightdata import FlightData
 from .policies import GENOME_LENGTH, TOPOLOGIES, Policy
-from .sim.constants import EPISODE_STEPS, MDP_ROW_LEN, SAFEGUARD_LIMITS
+from .sim.constants import EPISODE_STEPS, MDP_ROW_LEN, SAFEGUARD_BOX, SAFEGUARD_LIMITS, SAFEGUARD_TILT
 from .sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
 from .tasks import MDP
 
@@ -190,8 +190,10 @@ def evaluate_jobs(
         Root seed of every episode's noise stream.
     fallback_index : array_like of int, optional
         Per job, the policy the safeguard hands control to (-1: no safeguard for that job).
-    safeguard_limits : sequence of 9 floats, optional
-        Limits of the dangerous-state test on (u, v, w, x, y, z, p, q, r); default 0.5 each.
+    safeguard_limits : sequence of 10 floats, optional
+        The dangerous-state test in the kernel's layout (:meth:`DangerousState.limits`): limits on
+        |u|, |v|, |w|, |x|, |y|, |z|, |p|, |q|, |r|, then the tilt threshold on qw (inf: no tilt
+        condition). Default: ``DangerousState()``, the authors' test.
     record : array_like of bool, optional
         Per job, whether to record its flight data.
     n_steps : int
@@ -216,8 +218,9 @@ def evaluate_jobs(
         if fb.shape[0] != n_jobs or (fb.size and (fb.min() < -1 or fb.max() >= len(table))):
             raise NeurohoverError(f"fallback_index must have {n_jobs} entries in -1..{len(table) - 1}")
     limits = SAFEGUARD_LIMITS if safeguard_limits is None else np.asarray(safeguard_limits, dtype=float)
-    if limits.shape != (9,) or not np.all(limits > 0):
-        raise NeurohoverError(f"safeguard_limits must be 9 positive numbers (u, v, w, x, y, z, p, q, r), got {limits.tolist()}")
+    if limits.shape != (10,) or not np.all(limits > 0) or np.isnan(limits).any():
+        raise NeurohoverError("safeguard_limits must be 10 positive numbers (u, v, w, x, y, z, p, q, r limits, "
+                              f"then the tilt threshold on qw), got {limits.tolist()}")
     rec = np.zeros(n_jobs, dtype=bool) if record is None else np.asarray(record, dtype=bool).reshape(-1)
     if rec.shape[0] != n_jobs:
         raise NeurohoverError(f"record must have one flag per job ({n_jobs}), got {rec.shape[0]}")
@@ -282,7 +285,7 @@ def evaluate(
         table = PolicyTable(np.append(table.kinds, _KIND[safeguard.fallback.topology]),
                             np.vstack([table.genomes, PolicyTable.from_policies([safeguard.fallback]).genomes]))
         fallback = np.full(p_idx.size, n_pol, dtype=np.int64)
-        limits = safeguard.limits
+        limits = safeguard.dangerous.limits()
     ev = evaluate_jobs(
         table, rows, p_idx.ravel(), m_idx.ravel(), episode_index.ravel(), seed=seed,
         fallback_index=fallback, safeguard_limits=limits,
@@ -291,13 +294,45 @@ def evaluate(
     return ev.reshape((n_pol, n_mdp, episodes))
 
 
-@dataclass(frozen=True)
-class Safeguard:
-    """The hybrid agent's safeguard: on a dangerous state, ``fallback`` flies the rest of the episode.
+SAFEGUARD_RULES = ("code", "paper")
 
-    ``limits`` bound |u|, |v|, |w|, |x|, |y|, |z|, |p|, |q|, |r| of the observation (docs/model.md, Safeguard:
-    0.5 each).
+
+@dataclass(frozen=True)
+class DangerousState:
+    """When the safeguard hands control to the fallback (docs/model.md, Safeguard).
+
+    Parameters
+    ----------
+    rule : {"code", "paper"}
+        ``"code"`` (default, as the authors' code ran it): the helicopter is tilted, qw < ``tilt``,
+        and some velocity, position or angular-rate entry of the observation lies outside
+        [-box, box]. ``"paper"``: the paper's text, the box test alone.
+    box : float
+        Bound on |u|, |v|, |w|, |x|, |y|, |z|, |p|, |q|, |r| (> 0; 0.5 in the paper).
+    tilt : float
+        qw below this counts as tilted, in (0, 1] (0.99 in the authors' code); unused by ``"paper"``.
     """
 
+    rule: str = "code"
+    box: float = SAFEGUARD_BOX
+    tilt: float = SAFEGUARD_TILT
+
+    def __post_init__(self) -> None:
+        if self.rule not in SAFEGUARD_RULES:
+            raise NeurohoverError(f"unknown safeguard rule {self.rule!r}: allowed {', '.join(SAFEGUARD_RULES)}")
+        if not (isinstance(self.box, (int, float)) and np.isfinite(self.box) and self.box > 0):
+            raise NeurohoverError(f"safeguard box={self.box!r} is out of range: allowed a finite number > 0")
+        if not (isinstance(self.tilt, (int, float)) and 0 < self.tilt <= 1):
+            raise NeurohoverError(f"safeguard tilt={self.tilt!r} is out of range: allowed 0 < tilt <= 1 (qw threshold)")
+
+    def limits(self) -> np.ndarray:
+        """The test in the kernel's layout: 9 box limits, then the tilt threshold (inf: no tilt condition)."""
+        return np.array([float(self.box)] * 9 + [float(self.tilt) if self.rule == "code" else np.inf])
+
+
+@dataclass(frozen=True)
+class Safeguard:
+    """The hybrid agent's safeguard: once the state is dangerous, ``fallback`` flies the rest of the episode."""
+
     fallback: Policy
-    limits: tuple[float, ...] = tuple(SAFEGUARD_LIMITS)
+    dangerous: DangerousState = DangerousState()

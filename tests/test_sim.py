@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from neurohover import MDP, NeurohoverError, Policy, Safeguard, baseline_policy, evaluate, evaluate_jobs, get_task_family, prototype
+from neurohover import MDP, DangerousState, NeurohoverError, Policy, Safeguard, baseline_policy, evaluate, evaluate_jobs, get_task_family, prototype
 from neurohover.sim.constants import CRASH_STEP_PENALTY, EPISODE_STEPS, MAX_RATE, MAX_VELOCITY, MIN_QW
 from neurohover.sim.reference import fly_episode
 from neurohover.sim.rng import episode_normals
@@ -146,7 +146,8 @@ def test_safeguard_hands_over_to_fallback() -> None:
     mdp = get_task_family("ghh08").zero()
     alone = evaluate(roller, mdp, episodes=3, seed=SEED)
     assert alone.crashed.all() and (alone.safeguard_step == -1).all()
-    guarded = evaluate(roller, mdp, episodes=3, seed=SEED, safeguard=Safeguard(baseline_policy()), record=True)
+    paper = Safeguard(baseline_policy(), DangerousState("paper"))  # the box test alone
+    guarded = evaluate(roller, mdp, episodes=3, seed=SEED, safeguard=paper, record=True)
     assert (guarded.safeguard_step > 0).all() and not guarded.crashed.any()
     assert (guarded.steps == EPISODE_STEPS).all()
     # From the hand-over on, the fallback's actions are applied.

@@ -62,9 +62,14 @@ OBS_DIM = 12
 ACTION_DIM = 4
 STATE_DIM = 13  # world velocity (3), world position (3), body rates (3), quaternion (qx, qy, qz, qw)
 
-# Default dangerous-state test of the safeguard (docs/model.md, Safeguard): any velocity, position or
-# angular-rate entry of the observation outside [-0.5, 0.5].
-SAFEGUARD_LIMITS = np.full(9, 0.5)
+# Dangerous-state test of the safeguard (docs/model.md, Safeguard). The authors' code fires when
+# the helicopter is tilted (qw < 0.99) and any velocity, position or angular-rate entry of the
+# observation lies outside [-0.5, 0.5]; the paper's text states the box test alone.
+SAFEGUARD_BOX = 0.5
+SAFEGUARD_TILT = 0.99
+# Kernel layout: the 9 box limits (u, v, w, x, y, z, p, q, r), then the tilt threshold on qw
+# (infinity: every attitude counts as tilted, i.e. the paper's box test alone).
+SAFEGUARD_LIMITS = np.array([SAFEGUARD_BOX] * 9 + [SAFEGUARD_TILT])
 
 
 def crash_penalty(steps_taken: int, episode_steps: int = EPISODE_STEPS) -> float:

@@ -140,11 +140,17 @@ def crashed(s) -> bool:
 
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
 def dangerous(o, limits) -> bool:
-    """Safeguard test: any velocity, position or rate entry of observation ``o`` beyond its limit."""
+    """Safeguard test on observation ``o``: some velocity, position or rate entry beyond its limit
+    ``limits[0:9]`` while the helicopter is tilted, qw < ``limits[9]`` (qw from the quaternion's
+    vector part, as the authors' code computed it; ``limits[9] = inf``: the box test alone)."""
+    outside = False
     for i in range(9):
         if abs(o[i]) > limits[i]:
-            return True
-    return False
+            outside = True
+    if not outside:
+        return False
+    qw = math.sqrt(max(0.0, 1.0 - (o[9] * o[9] + o[10] * o[10] + o[11] * o[11])))
+    return qw < limits[9]
 
 
 @nb.njit(cache=True, inline="always", fastmath={"contract"})

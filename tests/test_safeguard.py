@@ -1,0 +1,77 @@
+"""The safeguard's dangerous-state test: the authors' rule (tilted and outside the box) and the paper's."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from neurohover import DangerousState, NeurohoverError, Policy, Safeguard, baseline_policy, evaluate, get_task_family
+
+
+def _qw(obs: np.ndarray) -> np.ndarray:
+    return np.sqrt(np.maximum(0.0, 1.0 - (obs[:, 9:12] ** 2).sum(axis=1)))
+
+
+def _drifter() -> Policy:
+    # The baseline plus a steady collective offset: the helicopter climbs out of the box while level.
+    g = np.zeros(40)
+    g[:36] = np.array([[0, -0.0367, 0, 0, -0.0196, 0, -0.7475, 0, 0], [-0.0322, 0, 0, -0.0185, 0, 0, 0, 0.7904, 0],
+                       [0, 0, 0, 0, 0, 0, 0, 0, -0.1969], [0, 0, 0.1348, 0, 0, 0.0513, 0, 0, 0]]).ravel()
+    g[36:] = (0.02, 0.0, 0.0, 0.23 + 0.03)
+    return Policy("slp", g)
+
+
+def test_code_rule_needs_a_tilt_where_the_box_alone_fires() -> None:
+    mdp = get_task_family("ghh08").zero()
+    drifter = _drifter()
+    paper = evaluate(drifter, mdp, episodes=4, seed=3, n_steps=600, record=True,
+                     safeguard=Safeguard(baseline_policy(), DangerousState("paper")))
+    code = evaluate(drifter, mdp, episodes=4, seed=3, n_steps=600, record=True,
+                    safeguard=Safeguard(baseline_policy(), DangerousState("code")))
+    assert (paper.safeguard_step >= 0).all()  # a level drift leaves the 0.5 box...
+    obs = code.flight_data.observations
+    for e in range(4):
+        k = int(code.safeguard_step.ravel()[e])
+        seen = obs[e][: (k if k >= 0 else len(obs[e]) - 1)]
+        outside = (np.abs(seen[:, :9]) > 0.5).any(axis=1)
+        assert outside.any() and not (outside & (_qw(seen) < 0.99)).any()  # ...but never while tilted before k
+        if k >= 0:
+            assert np.abs(obs[e][k, :9]).max() > 0.5 and _qw(obs[e][k : k + 1])[0] < 0.99
+    assert (code.safeguard_step == -1).all()  # a level drift is not dangerous to the authors' code
+
+
+def test_a_rolling_policy_is_caught_by_both_rules() -> None:
+    g = np.zeros(40)
+    g[36] = 0.6  # constant aileron: rolls over
+    roller = Policy("slp", g)
+    mdp = get_task_family("ghh08").zero()
+    for rule in ("code", "paper"):
+        ev = evaluate(roller, mdp, episodes=2, seed=1, safeguard=Safeguard(baseline_policy(), DangerousState(rule)))
+        assert (ev.safeguard_step > 0).all() and not ev.crashed.any()
+
+
+def test_limits_are_settings() -> None:
+    np.testing.assert_array_equal(DangerousState().limits(), [0.5] * 9 + [0.99])
+    np.testing.assert_array_equal(DangerousState("paper", box=0.8).limits(), [0.8] * 9 + [math.inf])
+    np.testing.assert_array_equal(DangerousState(box=1.0, tilt=0.95).limits(), [1.0] * 9 + [0.95])
+    # a wider box fires later (or not at all) on the same flights
+    roller = Policy("slp", np.r_[np.zeros(36), 0.3, 0, 0, 0.23])
+    mdp = get_task_family("ghh08").zero()
+    steps = [evaluate(roller, mdp, episodes=2, seed=5, safeguard=Safeguard(baseline_policy(), DangerousState(box=b))).safeguard_step
+             for b in (0.5, 2.0)]
+    assert (steps[0] >= 0).all() and ((steps[1] > steps[0]) | (steps[1] == -1)).all()
+
+
+@pytest.mark.parametrize(("kwargs", "message"), [
+    ({"rule": "literal"}, "unknown safeguard rule 'literal': allowed code, paper"),
+    ({"box": -0.5}, "box=-0.5 is out of range"),
+    ({"box": 0}, "box=0 is out of range"),
+    ({"tilt": 1.2}, r"tilt=1.2 is out of range: allowed 0 < tilt <= 1"),
+    ({"tilt": 0}, "tilt=0 is out of range"),
+    ({"box": float("nan")}, "box=nan is out of range"),
+])
+def test_bad_settings_are_refused(kwargs: dict, message: str) -> None:
+    with pytest.raises(NeurohoverError, match=message):
+        DangerousState(**kwargs)
