@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import NeurohoverError
 from ..evaluate import evaluate
 from ..flightdata import FlightData
 from ..policies import Policy
@@ -24,19 +25,33 @@ class ModelEvolution:
     """How an agent evolves a policy on a learned model.
 
     ``budget`` episodes on the model per evolution (steady state, paper Table 6 otherwise);
-    ``predict_episodes`` model episodes to predict the evolved policy's return.
+    ``predict_episodes`` model episodes to predict the evolved policy's return; ``estimator`` the
+    least-squares estimator of the LR model (:func:`learn_model`): ``"ols"`` (default, the paper's)
+    or ``"gls"``.
     """
 
     budget: int = 2000
     predict_episodes: int = 5
     n_steps: int = EPISODE_STEPS
+    estimator: str = "ols"
+
+    def __post_init__(self) -> None:
+        from ..models import ESTIMATORS
+
+        if self.estimator not in ESTIMATORS:
+            raise NeurohoverError(f"estimator={self.estimator!r} is not allowed: choose one of {', '.join(ESTIMATORS)}")
 
 
-def learn_model(flight_data: FlightData) -> MDP:
-    """The LR model (the paper's best method) of the flight data, as an MDP."""
+def learn_model(flight_data: FlightData, estimator: str = "ols") -> MDP:
+    """The LR model (the paper's best method) of the flight data, as an MDP.
+
+    ``estimator="ols"`` (default): ordinary least squares, as the paper and the authors' code;
+    ``"gls"``: the AR(1) quasi-differencing option (:func:`neurohover.models.learn_lr`). Intercepts
+    are LR's default, ``"uv"`` (D_v and the model's D_u).
+    """
     from ..models import learn_lr
 
-    return learn_lr(flight_data).mdp()
+    return learn_lr(flight_data, estimator=estimator).mdp()
 
 
 def evolve_on_model(model: MDP, prototype: Policy, settings: ModelEvolution, seed: int) -> tuple[Policy, float]:
@@ -73,7 +88,7 @@ class ModelBasedAgent(Agent):
 
     def update(self, outcome: EpisodeOutcome) -> None:
         if self.policy is None and outcome.flight_data is not None:
-            model = learn_model(outcome.flight_data)
+            model = learn_model(outcome.flight_data, self.settings.estimator)
             self.policy, _ = evolve_on_model(model, self.generic, self.settings, int(self._rng.integers(2**62)))
 
 
@@ -129,7 +144,7 @@ class IncrementalModelBasedAgent(Agent):
             return
         if outcome.flight_data is not None:
             self.flight_data = outcome.flight_data if self.flight_data is None else self.flight_data + outcome.flight_data
-        model = learn_model(self.flight_data)
+        model = learn_model(self.flight_data, self.settings.estimator)
         self.models_learned += 1
         self.current, self.predicted = evolve_on_model(model, self.generic, self.settings, int(self._rng.integers(2**62)))
         self.current_label = f"model:{self.models_learned}"
