@@ -217,6 +217,8 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
         raise NeurohoverError(f"--budget {args.budget} is out of range: allowed an integer >= 1 (evaluations)")
     if args.seed < 0:
         raise NeurohoverError(f"--seed {args.seed} is out of range: allowed >= 0")
+    if args.estimator is not None and args.method != "lr":
+        print(f"neurohover learn-model: --estimator applies to lr only (least squares), not {args.method}; ignored", file=sys.stderr)
     data = FlightData.load(args.flight_data)
     start = time.perf_counter()
     extra = {} if args.budget is None else {"budget": args.budget}
@@ -224,7 +226,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
         if args.method == "lr":
             if args.budget is not None:
                 print("neurohover learn-model: --budget does not apply to lr (least squares); ignored", file=sys.stderr)
-            model = learn_lr(data)
+            model = learn_lr(data, estimator=args.estimator or "ols")
         elif args.method == "ec-meno":
             model = learn_ec_meno(data, seed=args.seed, **extra)
         else:
@@ -273,6 +275,8 @@ def register(sub) -> None:
     p.add_argument("--method", required=True, choices=("lr", "ec-meno", "ec-mer"), help="lr (least squares), ec-meno or ec-mer (evolution)")
     p.add_argument("--out", required=True, metavar="FILE", help="model file to write (JSON)")
     p.add_argument("--budget", type=int, help="evaluations for ec-meno / ec-mer (defaults: 2000 / 500)")
+    p.add_argument("--estimator", choices=("ols", "gls"), help="lr: ols, ordinary least squares (default, as the paper), or gls, "
+                                                             "quasi-differencing by the gusts' AR(1) coefficient")
     p.add_argument("--seed", type=int, default=0, help="seed of the evolution (ec-meno, ec-mer)")
     p.add_argument("--policy", help="ec-mer: the policy that flew the data (default: the flight data's metadata, else baseline)")
     p.set_defaults(func=cmd_learn_model)
