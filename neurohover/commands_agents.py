@@ -24,13 +24,24 @@ def cmd_compete(args: argparse.Namespace) -> int:
     """Run R independent test runs of an agent; print a summary and write results and a plot."""
     from tqdm import tqdm
 
+    from .agents.hybrid import HybridSettings
+    from .agents.registry import HYBRID_AGENTS
     from .compete import compete
+    from .evaluate import DangerousState
 
+    given = [f"--{k.replace('_', '-')}" for k in _HYBRID_OPTIONS if getattr(args, k) is not None]
+    if given and args.agent not in HYBRID_AGENTS:
+        raise NeurohoverError(f"{', '.join(given)} apply to the hybrid agents only ({', '.join(HYBRID_AGENTS)}), not to --agent {args.agent}")
+    d = DangerousState()
+    dangerous = DangerousState(args.safeguard_rule or d.rule, d.box if args.safeguard_box is None else args.safeguard_box,
+                               d.tilt if args.safeguard_tilt is None else args.safeguard_tilt)
+    h = HybridSettings()
+    hybrid = HybridSettings(args.hybrid_replacement or h.replacement, args.hybrid_model_from or h.model_from, dangerous)
     bar = tqdm(total=args.runs, desc=f"{args.task} {args.agent}", unit="run", file=sys.stderr, disable=None)
     try:
         summary, _ = compete(
             args.task, args.agent, runs=args.runs, episodes=args.episodes, mdps=args.mdps, seed=args.seed,
-            jobs=args.jobs, out=args.out, sigma=args.sigma, n_steps=args.episode_steps, policy_dir=args.policy_dir,
+            jobs=args.jobs, out=args.out, sigma=args.sigma, n_steps=args.episode_steps, policy_dir=args.policy_dir, hybrid=hybrid,
             on_result=lambda spec, result: (bar.update(1), bar.set_postfix(score=f"{result.score:.4g}")),
         )
     except KeyboardInterrupt:
@@ -43,6 +54,9 @@ def cmd_compete(args: argparse.Namespace) -> int:
           f"{summary['crash_rate_runs']:>11.1%} {summary['mean_return_after_learning']:>25.5g}")
     print(f"results: {args.out}/episodes.csv, {args.out}/summary.json, {args.out}/cumulative.png")
     return 0
+
+
+_HYBRID_OPTIONS = ("safeguard_rule", "safeguard_box", "safeguard_tilt", "hybrid_replacement", "hybrid_model_from")
 
 
 def register(sub) -> None:
@@ -67,4 +81,10 @@ def register(sub) -> None:
     p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")
     p.add_argument("--policy-dir", help="policy sets directory (default: the shipped ones)")
     p.add_argument("--out", required=True, help="output directory")
+    g = p.add_argument_group("hybrid agents (defaults: the authors' code; see docs/model.md, Safeguard)")
+    g.add_argument("--safeguard-rule", help="code (tilted and outside the box, default) or paper (outside the box)")
+    g.add_argument("--safeguard-box", type=float, help="bound on |u|..|r| of a safe state (default 0.5)")
+    g.add_argument("--safeguard-tilt", type=float, help="qw below this is tilted, in (0, 1] (default 0.99)")
+    g.add_argument("--hybrid-replacement", help="rerank (charge 1e6, fly the best remaining policy; default) or evolve (evolve a replacement)")
+    g.add_argument("--hybrid-model-from", help="first-safe (default) or both trial episodes")
     p.set_defaults(func=cmd_compete)

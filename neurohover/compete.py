@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .agents.hybrid import HybridSettings
 from .agents.protocol import RunResult, run_test
 from .errors import NeurohoverError
 from .sim.constants import EPISODE_STEPS
@@ -48,6 +49,7 @@ class RunSpec:
     seed: int
     n_steps: int
     policy_dir: str | None
+    hybrid: HybridSettings = HybridSettings()
 
 
 def run_mdps(task: str, runs: int, mdps: str, seed: int, sigma: float | None = None) -> list[MDP]:
@@ -70,7 +72,7 @@ def execute(spec: RunSpec, threads: int | None = 1) -> RunResult:
     from .agents.registry import make_agent
 
     family = get_task_family(spec.task, spec.sigma)
-    agent = make_agent(spec.agent, family, policy_dir=spec.policy_dir)
+    agent = make_agent(spec.agent, family, policy_dir=spec.policy_dir, hybrid=spec.hybrid)
     return run_test(agent, family, spec.mdp, episodes=spec.episodes, seed=spec.seed * 1_000_003 + spec.index,
                     n_steps=spec.n_steps, threads=threads)
 
@@ -155,9 +157,12 @@ def compete(
     sigma: float | None = None,
     n_steps: int = EPISODE_STEPS,
     policy_dir: str | None = None,
+    hybrid: HybridSettings = HybridSettings(),
     on_result: Callable[[RunSpec, RunResult], None] | None = None,
 ) -> tuple[dict, list[RunResult]]:
     """Run ``runs`` test runs in ``jobs`` processes; write results and plot to ``out``.
+
+    ``hybrid`` sets the safeguard and replacement rule of the hybrid agents (ignored by the others).
 
     Raises KeyboardInterrupt after saving every finished run when interrupted.
     """
@@ -172,7 +177,7 @@ def compete(
     csv_path = out / "episodes.csv"
     if csv_path.exists():
         csv_path.unlink()
-    specs = [RunSpec(i, task, sigma, agent, m, episodes, seed, n_steps, policy_dir)
+    specs = [RunSpec(i, task, sigma, agent, m, episodes, seed, n_steps, policy_dir, hybrid)
              for i, m in enumerate(run_mdps(task, runs, mdps, seed, sigma))]
     results: dict[int, RunResult] = {}
 

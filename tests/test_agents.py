@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from neurohover import NeurohoverError, Policy, baseline_policy, evaluate_jobs, get_task_family, prototype
+from neurohover import NeurohoverError, Policy, baseline_policy, evaluate, evaluate_jobs, get_task_family, prototype
 from neurohover.agents import Agent, Choice, EpisodeOutcome, ModelFreeAgent, run_test
 
 STEPS = 400
@@ -72,8 +72,8 @@ import csv  # noqa: E402
 import json  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from neurohover.agents.hybrid import HybridAgent  # noqa: E402
-from neurohover.agents.model_based import IncrementalModelBasedAgent, ModelBasedAgent, ModelEvolution  # noqa: E402
+from neurohover.agents.hybrid import DISCARD_RETURN, HybridAgent, HybridSettings  # noqa: E402
+from neurohover.agents.model_based import IncrementalModelBasedAgent, ModelBasedAgent, ModelEvolution, learn_model  # noqa: E402
 from neurohover.compete import compete  # noqa: E402
 from neurohover.policysets import build_policy_set, choose_safe, load_policy_set  # noqa: E402
 
@@ -128,17 +128,67 @@ def test_incremental_agent_stops_learning_by_its_rule() -> None:
     assert (result.offline_seconds[k + 1:] == 0).all() and (result.offline_seconds[:k] > 0).all()
 
 
-def test_hybrid_discards_a_policy_that_needs_the_safeguard() -> None:
-    family = get_task_family("ghh09")
+def _roller() -> Policy:
     g = np.zeros(40)
     g[36] = 0.6  # constant aileron: heads for a crash
-    roller = Policy("slp", g)
-    agent = HybridAgent([roller, baseline_policy()], prototype("mlp", "baseline"), baseline_policy(), SHORT)
+    return Policy("slp", g)
+
+
+@pytest.mark.parametrize("replacement", ["rerank", "evolve"])
+def test_hybrid_discards_a_policy_that_needs_the_safeguard(replacement: str) -> None:
+    family = get_task_family("ghh09")
+    agent = HybridAgent([_roller(), baseline_policy()], prototype("mlp", "baseline"), baseline_policy(), SHORT,
+                        hybrid=HybridSettings(replacement=replacement))
     result = run_test(agent, family, family.zero(), episodes=12, seed=1, n_steps=1000)
     assert result.policy[0] == "safe:0" and result.safeguard_fired[0] and not result.crashed[0]
-    assert agent.trial_returns[0] == -np.inf  # discarded: never kept for the run
-    assert "safe:0" not in result.policy[5:]
+    assert agent.trial_fired[0] and not any(agent.trial_fired[1:])
+    assert "safe:0" not in result.policy[5:]  # discarded: never kept for the run
     assert not result.crashed.any()
+    if replacement == "rerank":  # the authors' code: charged 1e6, its episode credited to the fallback
+        assert agent.scores[0] == DISCARD_RETURN and agent.discarded == 1 and agent.replacements == 0
+        assert agent.candidates[-1][1] == "fallback" and agent.scores[-1] == result.returns[0]
+        assert result.policy[5] == agent.candidates[int(np.argmax(agent.scores))][1]
+
+
+def test_hybrid_rerank_falls_back_to_the_best_remaining_policy_without_evolving() -> None:
+    family = get_task_family("ghh09")
+    agent = HybridAgent([baseline_policy(), baseline_policy()], prototype("mlp", "baseline"), baseline_policy(), SHORT)
+    agent.start(family, np.random.default_rng(0))
+    for e, ret in enumerate([-500.0, -400.0, -300.0, -600.0, -700.0]):
+        agent.update(EpisodeOutcome(e, ret, False, 1000, -1, None if e > 1 else _flight(e)))
+    assert agent.current[1] == "model:0"
+    agent.update(EpisodeOutcome(5, -900.0, False, 1000, 40, None))  # the kept policy needed the safeguard
+    assert agent.current[1] == "safe:1" and agent.discarded == 1 and agent.replacements == 0
+    assert dict(zip((lb for _, lb in agent.candidates), agent.scores))["fallback"] == -900.0
+    agent.update(EpisodeOutcome(6, -950.0, False, 1000, 12, None))
+    assert agent.current[1] == "safe:0"  # next best remaining; the fallback scores the mean of its episodes
+    assert dict(zip((lb for _, lb in agent.candidates), agent.scores))["fallback"] == -925.0
+
+
+def _flight(e: int):
+    family = get_task_family("ghh09")
+    return evaluate(baseline_policy(), family.training_mdps()[0], seed=e, record=True, n_steps=300).flight_data
+
+
+@pytest.mark.parametrize("model_from", ["first-safe", "both"])
+def test_hybrid_learns_its_model_from_the_chosen_trial_episodes(model_from: str) -> None:
+    family = get_task_family("ghh09")
+    agent = HybridAgent([_roller(), baseline_policy()], prototype("mlp", "baseline"), baseline_policy(), SHORT,
+                        hybrid=HybridSettings(model_from=model_from))
+    run_test(agent, family, family.zero(), episodes=5, seed=3, n_steps=600)
+    (first, fired0), (second, fired1) = agent.trial_data
+    assert fired0 and not fired1
+    expected = learn_model(second if model_from == "first-safe" else first + second)
+    assert agent.model == expected
+
+
+@pytest.mark.parametrize(("kwargs", "message"), [
+    ({"replacement": "re-evolve"}, "unknown hybrid replacement 're-evolve': allowed rerank, evolve"),
+    ({"model_from": "first"}, "unknown hybrid model_from 'first': allowed first-safe, both"),
+])
+def test_hybrid_settings_refuse_unknown_variants(kwargs: dict, message: str) -> None:
+    with pytest.raises(NeurohoverError, match=message):
+        HybridSettings(**kwargs)
 
 
 def test_compete_writes_results_plot_and_keeps_finished_runs_on_interrupt(tiny_policy_dir: Path, tmp_path: Path) -> None:

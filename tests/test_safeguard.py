@@ -75,3 +75,59 @@ def test_limits_are_settings() -> None:
 def test_bad_settings_are_refused(kwargs: dict, message: str) -> None:
     with pytest.raises(NeurohoverError, match=message):
         DangerousState(**kwargs)
+
+
+# ------------------------------------------------------------------ settings of experiments and compete
+
+from pathlib import Path  # noqa: E402
+
+from neurohover.cli import main  # noqa: E402
+from neurohover.experiments.config import CONFIG_DIR, load_config  # noqa: E402
+from neurohover.experiments.plans import group_hybrid_settings  # noqa: E402
+
+
+def _fig8_with(tmp_path: Path, group_extra: str, agent: str = "hybrid") -> Path:
+    text = (CONFIG_DIR / "fig8.toml").read_text()
+    marker = f'[[settings.groups]]\nagent = "{agent}"\n'
+    assert marker in text
+    path = tmp_path / "fig8x.toml"
+    path.write_text(text.replace(marker, marker + group_extra, 1))
+    return path
+
+
+def test_experiment_groups_carry_thegroup_hybrid_settings_into_their_units(tmp_path: Path) -> None:
+    cfg = load_config(str(_fig8_with(tmp_path, 'hybrid = { replacement = "evolve", rule = "paper", box = 0.7 }\n')), "paper")
+    group = next(g for g in cfg.settings["groups"] if g["agent"] == "hybrid")
+    want = {"replacement": "evolve", "model_from": "first-safe", "rule": "paper", "box": 0.7, "tilt": 0.99}
+    assert group["hybrid"] == want and group_hybrid_settings(group) == want
+    incremental = next(g for g in cfg.settings["groups"] if g["agent"] == "incremental")
+    assert group_hybrid_settings(incremental) is None  # other agents' units carry no hybrid settings
+    default = load_config("fig8", "paper")
+    assert default.hash != cfg.hash  # the settings are part of the experiment's identity
+
+
+@pytest.mark.parametrize(("extra", "agent", "message"), [
+    ('hybrid = { tilt = 1.5 }\n', "hybrid", "tilt=1.5 is out of range"),
+    ('hybrid = { box = -1 }\n', "hybrid", "box=-1 is out of range"),
+    ('hybrid = { replacement = "magic" }\n', "hybrid", "unknown hybrid replacement 'magic'"),
+    ('hybrid = { colour = "red" }\n', "hybrid", "unknown hybrid setting(s) colour"),
+    ('hybrid = { rule = "paper" }\n', "incremental", "hybrid settings apply to the agents hybrid, hybrid-baseline only"),
+])
+def test_badgroup_hybrid_settings_in_configs_are_refused(tmp_path: Path, extra: str, agent: str, message: str) -> None:
+    with pytest.raises(NeurohoverError) as err:
+        load_config(str(_fig8_with(tmp_path, extra, agent)), "paper")
+    assert message in str(err.value)
+
+
+@pytest.mark.parametrize(("argv", "message"), [
+    (["--agent", "hybrid", "--safeguard-tilt", "0"], "tilt=0.0 is out of range"),
+    (["--agent", "hybrid", "--safeguard-box", "-0.5"], "box=-0.5 is out of range"),
+    (["--agent", "hybrid", "--safeguard-rule", "text"], "unknown safeguard rule 'text'"),
+    (["--agent", "hybrid", "--hybrid-replacement", "x"], "unknown hybrid replacement 'x'"),
+    (["--agent", "model-free", "--safeguard-rule", "paper"], "--safeguard-rule apply to the hybrid agents only"),
+])
+def test_compete_refuses_bad_hybrid_options(tmp_path: Path, capsys, argv: list[str], message: str) -> None:
+    rc = main(["compete", "--task", "ghh09", "--runs", "1", "--episodes", "2", "--out", str(tmp_path / "o"), *argv])
+    err = capsys.readouterr().err
+    assert rc == 2 and message in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()

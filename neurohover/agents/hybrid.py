@@ -1,19 +1,80 @@
-"""The hybrid agent of GHH-09 with its safeguard (paper Sections 4.1-4.3; docs/model.md, On-line agents and Safeguard)."""
+"""The hybrid agent of GHH-09 with its safeguard (paper Sections 4.1-4.3; docs/model.md, On-line agents).
+
+Where the paper's text and the authors' code differ, the code is the default (it produced the
+paper's figures) and the text is an option:
+
+| setting | default (authors' code) | option (paper's text) |
+|---|---|---|
+| dangerous state | tilted (qw < 0.99) and outside the 0.5 box | outside the box |
+| a policy that needed the safeguard | charged an error of 1e6; the best remaining policy flies on (``"rerank"``) | replaced by a policy newly evolved on the model (``"evolve"``) |
+| flight data of the model | the first trial episode that needed no safeguard (``"first-safe"``) | both trial episodes (``"both"``) |
+"""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import NeurohoverError
+from ..evaluate import DangerousState
 from ..flightdata import FlightData
 from ..policies import Policy
 from ..tasks import MDP, TaskFamily
 from .model_based import ModelEvolution, evolve_on_model, learn_model
 from .protocol import Agent, Choice, EpisodeOutcome
 
+HYBRID_AGENTS = ("hybrid", "hybrid-baseline")  # the registry's names (generic or baseline fallback)
 N_EVOLVED = 3
+DISCARD_RETURN = -1e6  # the authors' code charges a policy that needed the safeguard an error of 1e6
+REPLACEMENTS = ("rerank", "evolve")
+MODEL_DATA = ("first-safe", "both")
+
+
+@dataclass(frozen=True)
+class HybridSettings:
+    """How the hybrid agent treats dangerous states.
+
+    Parameters
+    ----------
+    replacement : {"rerank", "evolve"}
+        What happens to a policy that needed the safeguard. ``"rerank"`` (the authors' code): it is
+        charged a return of -1e6, the episode's return is credited to the fallback (which becomes a
+        candidate), and the best-scoring candidate flies on; nothing is re-evolved. ``"evolve"`` (the
+        paper's text): it is discarded and a policy newly evolved on the model replaces it.
+    model_from : {"first-safe", "both"}
+        Which trial episodes the LR model learns from: the first of the two safe specialised
+        policies' episodes in which the safeguard did not fire (both when it fired in each), as the
+        authors' code did; or both episodes, as the paper's text says.
+    dangerous : DangerousState
+        The safeguard's dangerous-state test (default: the authors').
+    """
+
+    replacement: str = "rerank"
+    model_from: str = "first-safe"
+    dangerous: DangerousState = DangerousState()
+
+    def __post_init__(self) -> None:
+        if self.replacement not in REPLACEMENTS:
+            raise NeurohoverError(f"unknown hybrid replacement {self.replacement!r}: allowed {', '.join(REPLACEMENTS)}")
+        if self.model_from not in MODEL_DATA:
+            raise NeurohoverError(f"unknown hybrid model_from {self.model_from!r}: allowed {', '.join(MODEL_DATA)}")
+
+    def to_dict(self) -> dict:
+        """Plain settings: replacement, model_from, rule, box, tilt (as experiment configs write them)."""
+        d = self.dangerous
+        return {"replacement": self.replacement, "model_from": self.model_from, "rule": d.rule, "box": d.box, "tilt": d.tilt}
+
+    @classmethod
+    def from_dict(cls, values: dict) -> "HybridSettings":
+        """Settings from a (partial) dict of :meth:`to_dict`'s keys; unknown keys are refused."""
+        known = set(cls().to_dict())
+        unknown = sorted(set(values) - known)
+        if unknown:
+            raise NeurohoverError(f"unknown hybrid setting(s) {', '.join(unknown)}: allowed {', '.join(sorted(known))}")
+        v = {**cls().to_dict(), **values}
+        return cls(v["replacement"], v["model_from"], DangerousState(v["rule"], v["box"], v["tilt"]))
 
 
 class HybridAgent(Agent):
@@ -22,63 +83,115 @@ class HybridAgent(Agent):
 
     Every episode flies under the safeguard: on a dangerous state the ``fallback`` policy (the
     generic policy, or the baseline, which the paper found safer) takes over for the rest of the
-    episode. A policy that induced a dangerous state is discarded: during the five trials it can no
-    longer be chosen, and afterwards it is replaced by a policy newly evolved on the model.
+    episode. What then happens to the policy that needed it is ``hybrid.replacement``.
     """
 
     name = "hybrid"
 
     def __init__(self, safe: Sequence[Policy], generic: Policy, fallback: Policy,
-                 settings: ModelEvolution = ModelEvolution(), name: str = "hybrid") -> None:
+                 settings: ModelEvolution = ModelEvolution(), name: str = "hybrid",
+                 hybrid: HybridSettings = HybridSettings()) -> None:
         if len(safe) != 2:
             raise NeurohoverError(f"the hybrid agent needs exactly 2 safe specialised policies, got {len(safe)}")
         self.safe = list(safe)
         self.generic = generic
         self.fallback = fallback
         self.settings = settings
+        self.hybrid = hybrid
         self.name = name
         self._reset(np.random.default_rng(0))
 
     def _reset(self, rng: np.random.Generator) -> None:
         self._rng = rng
-        self.flight_data: FlightData | None = None
         self.model: MDP | None = None
         self.candidates: list[tuple[Policy, str]] = [(p, f"safe:{i}") for i, p in enumerate(self.safe)]
         self.trial_returns: list[float] = []
+        self.trial_fired: list[bool] = []  # the safeguard fired (or the helicopter crashed) in that trial
+        self.trial_data: list[tuple[FlightData, bool]] = []  # (flight data, safeguard fired)
+        self.scores: list[float] = []  # "rerank": the score of each candidate
+        self.fallback_returns: list[float] = []  # "rerank": episode returns credited to the fallback
         self.current: tuple[Policy, str] | None = None
-        self.replacements = 0
+        self.replacements = 0  # "evolve": policies evolved to replace one that needed the safeguard
+        self.discarded = 0  # "rerank": policies charged DISCARD_RETURN
 
     def start(self, family: TaskFamily, rng: np.random.Generator) -> None:
         self._reset(rng)
 
     def _evolve(self, label: str) -> tuple[Policy, str]:
+        assert self.model is not None
         policy, _ = evolve_on_model(self.model, self.generic, self.settings, int(self._rng.integers(2**62)))
         return policy, label
 
     def choose(self, episode: int) -> Choice:
+        d = self.hybrid.dangerous
         if self.current is None:
             policy, label = self.candidates[len(self.trial_returns)]
-            return Choice(policy, label, fallback=self.fallback, record=len(self.trial_returns) < 2)
-        return Choice(self.current[0], self.current[1], fallback=self.fallback, repeat=True)
+            return Choice(policy, label, fallback=self.fallback, dangerous=d, record=len(self.trial_returns) < 2)
+        return Choice(self.current[0], self.current[1], fallback=self.fallback, dangerous=d, repeat=True)
+
+    def _model_data(self) -> FlightData:
+        if self.hybrid.model_from == "first-safe":
+            for data, fired in self.trial_data:
+                if not fired:
+                    return data
+        data = self.trial_data[0][0]
+        for more, _ in self.trial_data[1:]:
+            data = data + more
+        return data
+
+    def _credit_fallback(self, ret: float) -> None:
+        self.fallback_returns.append(ret)
+        score = float(np.mean(self.fallback_returns))
+        labels = [label for _, label in self.candidates]
+        if "fallback" in labels:
+            self.scores[labels.index("fallback")] = score
+        else:
+            self.candidates.append((self.fallback, "fallback"))
+            self.scores.append(score)
+
+    def _pick_best(self) -> None:
+        self.current = self.candidates[int(np.argmax(self.scores))]
 
     def update(self, outcome: EpisodeOutcome) -> None:
         dangerous = outcome.safeguard_step >= 0 or outcome.crashed
+        rerank = self.hybrid.replacement == "rerank"
         if self.current is None:
-            # Trials: a policy that needed the safeguard is discarded.
-            self.trial_returns.append(-np.inf if dangerous else outcome.ret)
+            self.trial_returns.append(outcome.ret)
+            self.trial_fired.append(dangerous)
             if outcome.flight_data is not None:
-                self.flight_data = outcome.flight_data if self.flight_data is None else self.flight_data + outcome.flight_data
+                self.trial_data.append((outcome.flight_data, dangerous))
             if len(self.trial_returns) == 2:
-                self.model = learn_model(self.flight_data)
+                self.model = learn_model(self._model_data())
                 self.candidates += [self._evolve(f"model:{i}") for i in range(N_EVOLVED)]
-            if len(self.trial_returns) == len(self.candidates):
-                best = int(np.argmax(self.trial_returns))
-                if np.isfinite(self.trial_returns[best]):
-                    self.current = self.candidates[best]
-                else:  # every trial needed the safeguard: start with a fresh policy from the model
-                    self.replacements += 1
-                    self.current = self._evolve(f"replacement:{self.replacements}")
+            if len(self.trial_returns) < N_EVOLVED + 2:
+                return
+            fired = self.trial_fired
+            if rerank:
+                self.scores = [DISCARD_RETURN if f else r for f, r in zip(fired, self.trial_returns)]
+                self.discarded += sum(fired)
+                for f, r in zip(fired, self.trial_returns):
+                    if f:
+                        self._credit_fallback(r)
+                self._pick_best()
+                return
+            # "evolve": a policy that needed the safeguard is discarded
+            finite = [-np.inf if f else r for f, r in zip(fired, self.trial_returns)]
+            best = int(np.argmax(finite))
+            if np.isfinite(finite[best]):
+                self.current = self.candidates[best]
+            else:  # every trial needed the safeguard: start with a fresh policy from the model
+                self.replacements += 1
+                self.current = self._evolve(f"replacement:{self.replacements}")
             return
-        if dangerous:
+        if not dangerous:
+            return
+        if not rerank:
             self.replacements += 1
             self.current = self._evolve(f"replacement:{self.replacements}")
+            return
+        index = [label for _, label in self.candidates].index(self.current[1])
+        if self.current[1] != "fallback":
+            self.scores[index] = DISCARD_RETURN
+            self.discarded += 1
+        self._credit_fallback(outcome.ret)
+        self._pick_best()

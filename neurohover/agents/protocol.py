@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import NeurohoverError
-from ..evaluate import PolicyTable, evaluate_jobs
+from ..evaluate import DangerousState, PolicyTable, evaluate_jobs
 from ..flightdata import FlightData
 from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
@@ -48,6 +48,8 @@ class Choice:
         Name of the policy in the run's records (e.g. ``"specialised:3"``, ``"model:2"``).
     fallback : Policy or None
         Safeguard fallback: on a dangerous state it flies the rest of the episode.
+    dangerous : DangerousState
+        What counts as a dangerous state (default: the authors' test, docs/model.md, Safeguard).
     record : bool
         Whether the agent wants this episode's flight data.
     final : bool
@@ -61,6 +63,7 @@ class Choice:
     policy: Policy
     label: str
     fallback: Policy | None = None
+    dangerous: DangerousState = DangerousState()
     record: bool = False
     final: bool = False
     repeat: bool = False
@@ -160,7 +163,8 @@ def run_test(
             zeros = np.zeros(rest.size, dtype=np.int64)
             table = PolicyTable.from_policies([choice.policy] + ([choice.fallback] if choice.fallback else []))
             ev = evaluate_jobs(table, mdp, zeros, zeros, rest, seed=seed, n_steps=n_steps, threads=threads,
-                               fallback_index=np.full(rest.size, 1 if choice.fallback else -1))
+                               fallback_index=np.full(rest.size, 1 if choice.fallback else -1),
+                               safeguard_limits=choice.dangerous.limits())
             returns[e:], crashed[e:], steps[e:] = ev.returns, ev.crashed, ev.steps
             fired[e:] = ev.safeguard_step >= 0
             labels[e:] = [choice.label] * rest.size
@@ -169,7 +173,8 @@ def run_test(
         table = PolicyTable.from_policies([choice.policy] + ([choice.fallback] if choice.fallback else []))
         zeros = np.zeros(n, dtype=np.int64)
         ev = evaluate_jobs(table, mdp, zeros, zeros, np.arange(e, e + n), seed=seed, n_steps=n_steps, threads=threads,
-                           fallback_index=np.full(n, 1 if choice.fallback else -1), record=np.full(n, choice.record))
+                           fallback_index=np.full(n, 1 if choice.fallback else -1), record=np.full(n, choice.record),
+                           safeguard_limits=choice.dangerous.limits())
         events = np.flatnonzero((ev.safeguard_step >= 0) | ev.crashed)
         n = int(events[0]) + 1 if events.size else n  # later episodes would have flown another choice
         for i in range(n):

@@ -8,7 +8,7 @@ from ..errors import NeurohoverError
 from ..policies import baseline_policy
 from ..policysets import PolicySet, load_policy_set
 from ..tasks import TaskFamily
-from .hybrid import HybridAgent
+from .hybrid import HYBRID_AGENTS, HybridAgent, HybridSettings
 from .model_based import IncrementalModelBasedAgent, ModelBasedAgent
 from .model_free import ModelFreeAgent
 from .protocol import Agent, Choice, EpisodeOutcome
@@ -50,16 +50,17 @@ def _incremental(generic_name: str | None) -> Callable[[PolicySet], Agent]:
     return make
 
 
-def _hybrid(fallback: str) -> Callable[[PolicySet], Agent]:
-    def make(ps: PolicySet) -> Agent:
+def _hybrid(fallback: str) -> Callable[..., Agent]:
+    def make(ps: PolicySet, hybrid: HybridSettings = HybridSettings()) -> Agent:
         safe = [ps.specialised[i] for i in ps.safe]
         fb = ps.generic if fallback == "generic" else baseline_policy()
-        return HybridAgent(safe, ps.generic, fb, name="hybrid" if fallback == "generic" else "hybrid-baseline")
+        return HybridAgent(safe, ps.generic, fb, name="hybrid" if fallback == "generic" else "hybrid-baseline",
+                           hybrid=hybrid)
     return make
 
 
 # name -> (tasks it applies to, factory from the policy set; None: needs no policy set)
-AGENTS: dict[str, tuple[tuple[str, ...], Callable[[PolicySet], Agent] | None]] = {
+AGENTS: dict[str, tuple[tuple[str, ...], Callable[..., Agent] | None]] = {
     "baseline": (("ghh08", "ghh09", "fghh"), None),
     "generic": (("ghh08", "ghh09", "fghh"), GenericAgent),
     "model-free": (("ghh08", "ghh09"), lambda ps: ModelFreeAgent(ps.specialised)),
@@ -84,11 +85,14 @@ def check_agent(name: str, task: str, policy_dir: str | None = None) -> None:
         factory(load_policy_set(task, policy_dir))
 
 
-def make_agent(name: str, family: TaskFamily, *, policy_dir: str | None = None) -> Agent:
-    """A fresh agent called ``name`` for ``family``."""
+def make_agent(name: str, family: TaskFamily, *, policy_dir: str | None = None,
+               hybrid: HybridSettings = HybridSettings()) -> Agent:
+    """A fresh agent called ``name`` for ``family`` (``hybrid``: the hybrid agents' safeguard settings)."""
     if name not in AGENTS:
         raise NeurohoverError(f"unknown agent {name!r}: allowed {', '.join(AGENTS)}")
     _, factory = AGENTS[name]
     if factory is None:
         return BaselineAgent()
+    if name in HYBRID_AGENTS:
+        return factory(load_policy_set(family.name, policy_dir), hybrid)
     return factory(load_policy_set(family.name, policy_dir))

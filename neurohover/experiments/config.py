@@ -141,6 +141,7 @@ _GROUP = {
     "n_mdps": (_REQUIRED, _int(1)),
     "runs_per_mdp": (1, _int(1)),
     "exclude_own": (False, _bool()),
+    "hybrid": ({}, _table()),  # hybrid agents: replacement, model_from, rule, box, tilt (HybridSettings)
 }
 
 SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
@@ -251,6 +252,16 @@ def _check_kind(settings: dict, kind: str, where: str) -> None:
             if task not in AGENT_TASKS[g["agent"]]:
                 raise NeurohoverError(f"{where}: agent {g['agent']!r} does not apply to task {task!r}")
             g["label"] = g["label"] or g["agent"]
+            if g["hybrid"]:
+                from ..agents.hybrid import HYBRID_AGENTS, HybridSettings
+
+                if g["agent"] not in HYBRID_AGENTS:
+                    raise NeurohoverError(f"{where}: group {g['label']!r}: hybrid settings apply to the agents "
+                                          f"{', '.join(HYBRID_AGENTS)} only, not to {g['agent']!r}")
+                try:
+                    g["hybrid"] = HybridSettings.from_dict(g["hybrid"]).to_dict()
+                except NeurohoverError as e:
+                    raise NeurohoverError(f"{where}: group {g['label']!r}: {e}") from None
         gr = settings["generic_resampling"]
         if set(gr) - {"fixed", "race"} or not all(_resampling()(v)[0] for v in gr.values()):
             raise NeurohoverError(f"{where}: generic_resampling must be a table with keys fixed and/or race holding fixed:K / race:DELTA")

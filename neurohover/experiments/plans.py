@@ -236,6 +236,13 @@ class _Policies:
         return None if any(v is None for v in out.values()) else out
 
 
+def group_hybrid_settings(group: dict) -> dict | None:
+    """The full hybrid settings of a group's units (None: the group's agent is not a hybrid agent)."""
+    from ..agents.hybrid import HYBRID_AGENTS, HybridSettings
+
+    return HybridSettings.from_dict(group["hybrid"]).to_dict() if group["agent"] in HYBRID_AGENTS else None
+
+
 def _plan_test_runs(cfg: ExperimentConfig, results: dict) -> Plan:
     s = cfg.settings
     pol = _Policies(cfg, results)
@@ -253,8 +260,10 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict) -> Plan:
                 counter += 1
                 if policies is None:
                     continue
+                hybrid = group_hybrid_settings(g)
                 units.append(_unit(cfg, f"run/{g['label']}/{g['mdps']}{i}/rep{rep}", "test_run", {
-                    **settings, "agent": g["agent"], "group": g["label"], "mdp": mdp.to_dict(), "policies": policies}))
+                    **settings, "agent": g["agent"], "group": g["label"], "mdp": mdp.to_dict(), "policies": policies,
+                    **({"hybrid": hybrid} if hybrid else {})}))
     return Plan(units, total)
 
 

@@ -207,7 +207,7 @@ def make_agent(p: dict):
     Mirrors ``neurohover.agents.registry.AGENTS`` but passes the model-evolution settings, so that
     the policies evolved on learned models fly episodes of the run's length.
     """
-    from ..agents.hybrid import HybridAgent
+    from ..agents.hybrid import HybridAgent, HybridSettings
     from ..agents.model_based import IncrementalModelBasedAgent, ModelBasedAgent, ModelEvolution
     from ..agents.model_free import ModelFreeAgent
     from ..agents.registry import BaselineAgent
@@ -237,7 +237,7 @@ def make_agent(p: dict):
     if name in ("hybrid", "hybrid-baseline"):
         safe = [_policy(d) for d in pol["safe"]]
         fallback = generic if name == "hybrid" else baseline_policy()
-        return HybridAgent(safe, generic, fallback, settings, name=name)
+        return HybridAgent(safe, generic, fallback, settings, name=name, hybrid=HybridSettings.from_dict(p["hybrid"]))
     raise NeurohoverError(f"unknown agent {name!r}: allowed {', '.join(AGENT_TASKS)}")
 
 
