@@ -120,12 +120,18 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         raise NeurohoverError(f"--resume: no checkpoint {str(checkpoint)!r} (it is written next to --out by an earlier run)")
     if not args.resume and checkpoint.is_file():
         print(f"neurohover evolve: starting afresh; {checkpoint} will be overwritten (use --resume to continue it)", file=sys.stderr)
+    settings = None
+    if args.plateau_rule is not None:
+        if args.optimizer != "ne" or mdp_desc == MDP_FAMILY:
+            raise NeurohoverError(f"--plateau-rule {args.plateau_rule} applies to the steady-state method only "
+                                  "(optimizer ne on one MDP)")
+        settings = {"plateau_rule": args.plateau_rule}
     bar = _Bar(args.budget, f"evolve {family.name}/{mdp_desc}")
     try:
         result = evolve(target, topology=topology, prototype=proto, optimizer=args.optimizer, resampling=resampling,
                         budget=args.budget, seed=args.seed, n_steps=args.episode_steps, threads=args.threads,
                         progress=bar, checkpoint=checkpoint, checkpoint_every_s=args.checkpoint_every,
-                        resume=args.resume)
+                        resume=args.resume, settings=settings)
     except EvolutionInterrupted as err:
         bar.close()
         if err.checkpoint is not None:
@@ -260,6 +266,9 @@ def register(sub) -> None:
     p.add_argument("--resampling", default="fixed:1", help="fixed:K (mean of K episodes per candidate; default fixed:1) or race:DELTA "
                                                            "(selection races at confidence 0<DELTA<1; generational only)")
     p.add_argument("--budget", type=int, help="episodes to fly (default: the paper's stop: plateau for steady state, 4000 generations for generational)")
+    p.add_argument("--plateau-rule", choices=("no-crash", "literal"),
+                   help="steady state: no-crash (default) counts the plateau only once the champion completed an episode "
+                        "without crashing (a run whose champion still crashes ends at --budget only); literal: Appendix A as written")
     p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")
     p.add_argument("--seed", type=int, default=0, help="root seed of the run (default 0)")
     p.add_argument("--threads", type=int, help="kernel threads (default: all cores; results do not depend on it)")

@@ -6,7 +6,10 @@ Two kinds of target
   ``.mdp()``; a :class:`~neurohover.models.LearnedModel` itself is accepted too): the
   **steady-state** method of Appendix A (Table 6 defaults). A candidate's fitness is the return of
   one episode, or the mean of ``K`` episodes with ``resampling="fixed:K"``. The run stops when no
-  new champion appeared in ``plateau_threshold`` evaluations, or at the episode budget.
+  new champion appeared in ``plateau_threshold`` evaluations, or at the episode budget. By default
+  (``plateau_rule="no-crash"``) those evaluations count only while the champion's own evaluation
+  did not crash (with ``fixed:K``: none of its K episodes crashed), so a run whose champion still
+  crashes ends only at its budget; ``plateau_rule="literal"`` is Appendix A as written.
 * a task family G (``get_task_family("fghh", 0.3)``; any family works): the **generational**
   method of Appendix B (Table 7 defaults), for generic policies. Fitness is estimated by fixed
   resampling (``"fixed:K"``: K episodes per candidate, each on a fresh MDP drawn from G) or by
@@ -82,6 +85,7 @@ from ..sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
 from ..tasks import FGHH, GHH08, GHH09, MDP
 from .cmaes import CMAES
 from .neuroevolution import GenerationalNE, GenerationalSettings, SteadyStateNE, SteadyStateSettings
+from .neuroevolution import SteadyStateNE as _SteadyStateNE  # the class itself (tests may patch the name)
 from .races import fixed_resampling, selection_race
 
 __all__ = [
@@ -107,6 +111,9 @@ CHECKPOINT_FORMAT = "neurohover-evolution-checkpoint/1"
 CMA_DEFAULTS: dict[str, Any] = {"sigma0": 0.02, "popsize": None}
 RACE_T_LIMIT = 10  # docs/model.md, Fitness under noise: t_limit = t_min = t_max = 10
 _KIND = {"slp": POLICY_SLP, "mlp": POLICY_MLP}
+#: Steady-state settings that checkpoints written before they existed ran with.
+_OLD_STEADY_STATE = {"plateau_rule": "literal", "selection": "roulette", "tournament_size": 5,
+                     "init_mutate_frac": None, "init_mutate_std": None}
 _MAX_SEED = 2**63 - 1
 
 
@@ -344,6 +351,7 @@ class _Flyer:
         self._act = np.zeros((0, 1, 4))
         self._views: dict[int, tuple] = {}
         self.trace: list | None = None  # (genomes, rows, p, m, e) per kernel call, for benchmarks
+        self.crashed = np.zeros(0, dtype=np.bool_)  # crash flags of the last call (a view, like its returns)
         self.max_threads = self._threads = 1
         self._ensure(64, 512)
 
@@ -396,6 +404,7 @@ class _Flyer:
             self.trace.append((genomes.copy(), rows, p.copy(), m.copy(), e.copy()))
         self.episodes += n_jobs
         self.steps += int(steps[0]) if n_jobs == 1 else int(steps.sum())
+        self.crashed = crashed
         return returns
 
 
@@ -633,6 +642,9 @@ class _Run:
         if state.get("format") != CHECKPOINT_FORMAT:
             raise NeurohoverError(f"{source} is not an evolution checkpoint (expected format {CHECKPOINT_FORMAT!r})")
         saved = state["config"]
+        if saved.get("method") == "steady-state" and "plateau_rule" not in saved.get("settings", {}):
+            # Written before these settings existed: it ran Appendix A's literal plateau rule.
+            saved = {**saved, "settings": {**_OLD_STEADY_STATE, **saved["settings"]}}
         if saved != self.config:
             diff = sorted(k for k in set(saved) | set(self.config) if saved.get(k) != self.config.get(k))
             raise NeurohoverError(
@@ -673,6 +685,13 @@ class _Run:
             return self.flyer.fly(genomes, self.rows, "range", None, n).copy()
         p = np.repeat(np.arange(n, dtype=np.int64), k)
         return self.flyer.fly(genomes, self.rows, p, None, n * k).reshape(n, k).mean(axis=1)
+
+    def _fly_fixed_crashed(self, genomes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`_fly_fixed` and whether each genome crashed (in any of its K episodes)."""
+        returns = self._fly_fixed(genomes)
+        k = self.resampling.k
+        crashed = self.flyer.crashed.copy() if k == 1 else self.flyer.crashed.reshape(-1, k).any(axis=1)
+        return returns, crashed
 
     def _fly_family_fixed(self, genomes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Fixed resampling on G in ONE kernel call: (means, samples (n, k)).
@@ -764,7 +783,11 @@ class _Run:
         before = opt.champion_return
         before_eps = self.flyer.episodes
         genomes = opt.ask()
-        opt.tell(self._fly_fixed(genomes))
+        if isinstance(opt, _SteadyStateNE):
+            returns, crashed = self._fly_fixed_crashed(genomes)
+            opt.tell(returns, crashed=crashed)
+        else:  # an optimiser without crash flags (e.g. a test's frozen reference)
+            opt.tell(self._fly_fixed(genomes))
         self.generation += 1
         self.evaluations += genomes.shape[0]
         best = opt.champion_return

@@ -32,10 +32,13 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import NeurohoverError
 from .operators import crossover, mutate
 from .races import RaceResult, ResamplingResult
 
 __all__ = [
+    "PLATEAU_RULES",
+    "SELECTIONS",
     "SteadyStateSettings",
     "GenerationalSettings",
     "ChampionRecord",
@@ -53,6 +56,16 @@ __all__ = [
 ROULETTE_ERROR_FLOOR = 1.0 + 1e-6
 
 _STATE_VERSION = 1
+
+#: Plateau rules of :class:`SteadyStateSettings` (docs/model.md, Neuroevolution): ``no-crash`` (default) counts
+#: evaluations without a new champion only while the champion's own evaluation did not crash;
+#: ``literal`` is Appendix A as written (counts every evaluation without a new champion).
+PLATEAU_RULES = ("no-crash", "literal")
+
+#: Parent selection of :class:`SteadyStateSettings`: ``roulette`` (Appendix A, weights
+#: ``1/ln(error)``) or ``tournament`` (the best of ``tournament_size`` distinct genomes drawn
+#: uniformly, as in the authors' ``eonn`` code; SPEC 4).
+SELECTIONS = ("roulette", "tournament")
 
 
 # --------------------------------------------------------------------------- settings
@@ -123,9 +136,27 @@ class SteadyStateSettings:
     mutate_repl : float
         Probability that a mutated gene is replaced rather than shifted.
     plateau_threshold : int
-        Stop after this many evaluations without a new champion (>= 1).
+        Stop after this many counted evaluations without a new champion (>= 1); which
+        evaluations count is ``plateau_rule``'s choice.
     budget : int or None
         Optional cap on the number of evaluations (>= 1).
+    plateau_rule : {"no-crash", "literal"}
+        ``"no-crash"`` (default, a documented deviation, docs/model.md, Neuroevolution): the plateau counter runs only
+        while the champion's evaluation completed without crashing (crash flags come through
+        ``SteadyStateNE.tell(..., crashed=...)``); a population whose champion still crashes
+        never stops at the plateau, so such a run ends only at its budget (give one when the
+        prototype may crash, e.g. a zero seed). ``"literal"``: Appendix A as written, every
+        evaluation without a new champion counts (about 30% of zero-seeded runs then stop while
+        the whole population still crashes). When the champion never crashed, or no crash
+        flags are told, both rules give bit-identical runs.
+    selection : {"roulette", "tournament"}
+        Parent selection: ``"roulette"`` (default, Appendix A) or ``"tournament"`` (the best of
+        ``tournament_size`` distinct genomes drawn uniformly; the authors' ``eonn`` code).
+    tournament_size : int
+        Genomes per tournament (``1 <= tournament_size <= pop_size``; default 5, as in ``eonn``).
+    init_mutate_frac, init_mutate_std : float or None
+        Mutation of the prototype's copies in the initial population; None (default): as
+        ``mutate_frac`` / ``mutate_std`` (Appendix A). ``eonn`` used 0.5 and 0.5.
     """
 
     pop_size: int = 50
@@ -138,9 +169,30 @@ class SteadyStateSettings:
     mutate_repl: float = 0.25
     plateau_threshold: int = 1000
     budget: int | None = None
+    plateau_rule: str = "no-crash"
+    selection: str = "roulette"
+    tournament_size: int = 5
+    init_mutate_frac: float | None = None
+    init_mutate_std: float | None = None
 
     def __post_init__(self) -> None:
         _validate_common(self)
+        if not isinstance(self.plateau_rule, str) or self.plateau_rule not in PLATEAU_RULES:
+            raise NeurohoverError(
+                f"unknown plateau_rule {self.plateau_rule!r}: allowed {', '.join(PLATEAU_RULES)}"
+            )
+        if not isinstance(self.selection, str) or self.selection not in SELECTIONS:
+            raise NeurohoverError(
+                f"unknown selection {self.selection!r}: allowed {', '.join(SELECTIONS)}"
+            )
+        size = _require_int("tournament_size", self.tournament_size, 1)
+        if size > self.pop_size:
+            raise ValueError(f"tournament_size={size} must be in [1, pop_size={self.pop_size}]")
+        _normalise(self, "tournament_size", size)
+        if self.init_mutate_frac is not None:
+            _normalise(self, "init_mutate_frac", _require_prob("init_mutate_frac", self.init_mutate_frac))
+        if self.init_mutate_std is not None:
+            _normalise(self, "init_mutate_std", _require_std("init_mutate_std", self.init_mutate_std))
         elite = _require_int("elite_size", self.elite_size, 0)
         if elite >= self.pop_size:
             raise ValueError(f"elite_size={elite} must be smaller than pop_size={self.pop_size}")
@@ -206,11 +258,13 @@ class GenerationalSettings:
 
 @dataclass(frozen=True)
 class ChampionRecord:
-    """A new champion: evaluations done so far, its return, seconds since the start."""
+    """A new champion: evaluations done so far, its return, seconds since the start, and whether
+    its evaluation crashed (as told to ``SteadyStateNE.tell``; False without crash flags)."""
 
     evaluations: int
     champion_return: float
     wall_seconds: float
+    crashed: bool = False
 
 
 @dataclass(frozen=True)
@@ -351,7 +405,12 @@ class _Clock:
 
 
 class _ChampionTracker:
-    """Best single return ever told, evaluations since it, and its history."""
+    """Best single return ever told, evaluations since it, and its history.
+
+    The champion's crash flag is its history record's (the last one): it is fixed for the
+    champion's lifetime, so the ``no-crash`` plateau count is ``since`` or 0 (:meth:`plateau`)
+    and needs no state of its own.
+    """
 
     def __init__(self) -> None:
         self.evaluations = 0
@@ -360,16 +419,28 @@ class _ChampionTracker:
         self.since = 0
         self.history: list[ChampionRecord] = []
 
-    def update(self, genomes: np.ndarray, returns: np.ndarray, wall: float) -> None:
-        for g, r in zip(genomes, returns):
+    def update(
+        self, genomes: np.ndarray, returns: np.ndarray, wall: float, crashed: np.ndarray | None = None
+    ) -> None:
+        for k, (g, r) in enumerate(zip(genomes, returns)):
             self.evaluations += 1
             if r > self.best:  # strict; NaN compares False
                 self.best = float(r)
                 self.genome = np.array(g, dtype=np.float64)
                 self.since = 0
-                self.history.append(ChampionRecord(self.evaluations, self.best, wall))
+                hit = crashed is not None and bool(crashed[k])
+                self.history.append(ChampionRecord(self.evaluations, self.best, wall, hit))
             else:
                 self.since += 1
+
+    @property
+    def champion_crashed(self) -> bool:
+        return bool(self.history) and self.history[-1].crashed
+
+    def plateau(self, literal: bool) -> int:
+        """Evaluations counted towards the plateau: all since the champion (``literal``), or
+        only while the champion's evaluation did not crash (``no-crash``)."""
+        return self.since if literal or not self.champion_crashed else 0
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -377,8 +448,10 @@ class _ChampionTracker:
             "genome": _enc_array(self.genome),
             "best": _enc_float(self.best),
             "since": self.since,
-            "history": [
-                [h.evaluations, _enc_float(h.champion_return), h.wall_seconds] for h in self.history
+            "history": [  # a 4th element only for a crashed champion (the format stays as it was)
+                [h.evaluations, _enc_float(h.champion_return), h.wall_seconds]
+                + ([True] if h.crashed else [])
+                for h in self.history
             ],
         }
 
@@ -389,7 +462,10 @@ class _ChampionTracker:
         t.genome = _dec_array(d["genome"])
         t.best = float(d["best"])
         t.since = int(d["since"])
-        t.history = [ChampionRecord(int(e), float(r), float(w)) for e, r, w in d["history"]]
+        t.history = [
+            ChampionRecord(int(h[0]), float(h[1]), float(h[2]), bool(h[3]) if len(h) > 3 else False)
+            for h in d["history"]
+        ]
         return t
 
 
@@ -422,6 +498,11 @@ class ChampionViews:
         return self._tracker.since
 
     @property
+    def champion_crashed(self) -> bool:
+        """Whether the champion's evaluation was told as crashed (False without crash flags)."""
+        return self._tracker.champion_crashed
+
+    @property
     def history(self) -> list[ChampionRecord]:
         """One record per new champion, in order."""
         return list(self._tracker.history)
@@ -448,7 +529,10 @@ class SteadyStateNE(ChampionViews):
     run stops (:meth:`stop`) when ``plateau_threshold`` evaluations passed
     without a strictly better one, or when ``budget`` evaluations were done
     (checked between batches, so the initial population may overshoot a
-    budget smaller than ``pop_size``).
+    budget smaller than ``pop_size``). Under the default ``plateau_rule``
+    ``"no-crash"`` an evaluation counts towards the plateau only while the
+    champion's own evaluation did not crash (``tell(..., crashed=...)``); see
+    :class:`SteadyStateSettings`.
 
     Parameters
     ----------
@@ -498,59 +582,93 @@ class SteadyStateNE(ChampionViews):
         if self._pending is not None:
             raise RuntimeError("ask() called again before tell() of the previous batch")
         if self._population is None:
-            batch = _initial_population(
-                self._prototype, self.settings.pop_size, self._rng, self.settings
-            )
+            s = self.settings
+            init = s
+            if s.init_mutate_frac is not None or s.init_mutate_std is not None:
+                init = dataclasses.replace(
+                    s,
+                    mutate_frac=s.mutate_frac if s.init_mutate_frac is None else s.init_mutate_frac,
+                    mutate_std=s.mutate_std if s.init_mutate_std is None else s.init_mutate_std,
+                )
+            batch = _initial_population(self._prototype, s.pop_size, self._rng, init)
         else:
             batch = self._breed(self.settings.pop_size - self.settings.elite_size)
         self._pending = batch
         return batch.copy()
 
-    def tell(self, fitness: np.ndarray) -> None:
+    def tell(self, fitness: np.ndarray, crashed: np.ndarray | None = None) -> None:
         """Report the returns of exactly the genomes of the last :meth:`ask`.
 
         Parameters
         ----------
         fitness : np.ndarray
             One return per asked genome (maximised; NaN/-inf rank worst).
+        crashed : np.ndarray of bool, optional
+            Whether each genome's evaluation crashed (with a mean over several episodes: whether
+            any of them crashed). Only the ``no-crash`` plateau rule uses it; None: no crash.
         """
         if self._pending is None:
             raise RuntimeError("tell() called without a pending ask()")
         f = _check_returns(fitness, len(self._pending))
+        if crashed is not None:
+            c = np.asarray(crashed)
+            if c.shape != f.shape or not (c.dtype == np.bool_ or np.issubdtype(c.dtype, np.integer)):
+                raise ValueError(
+                    f"crashed must be {f.size} booleans, one per asked genome; got {crashed!r}"
+                )
+            crashed = c.astype(bool)
         if self._population is None:
             self._population, self._fitness = self._pending, f
         else:
             keep = _rank(self._fitness)[: self.settings.elite_size]
             self._population = np.concatenate((self._population.take(keep, axis=0), self._pending))
             self._fitness = np.concatenate((self._fitness.take(keep), f))
-        self._tracker.update(self._pending, f, self._clock())
+        self._tracker.update(self._pending, f, self._clock(), crashed)
         self._pending = None
         self._generation += 1
 
     def stop(self) -> bool:
-        """True once the plateau threshold or the evaluation budget is reached."""
+        """True once the plateau threshold (counted by ``plateau_rule``) or the budget is reached."""
         s = self.settings
         if self._tracker.evaluations == 0:
             return False
-        if self._tracker.since >= s.plateau_threshold:
+        if self._tracker.plateau(s.plateau_rule == "literal") >= s.plateau_threshold:
             return True
         return s.budget is not None and self._tracker.evaluations >= s.budget
 
     def _breed(self, n: int) -> np.ndarray:
         s, rng, pop = self.settings, self._rng, self._population
-        cdf = roulette_weights(self._fitness).cumsum().tolist()
+        if s.selection == "tournament":
+            key = np.fmax(self._fitness, -np.inf)  # NaN ranks worst
+            size = len(pop)
+
+            def pick() -> int:
+                entrants = rng.choice(size, s.tournament_size, replace=False)
+                return int(entrants[np.argmax(key[entrants])])  # ties: the first drawn
+        else:
+            cdf = roulette_weights(self._fitness).cumsum().tolist()
+
+            def pick() -> int:
+                return _spin(cdf, rng)
         children = np.empty((n, pop.shape[1]))
         for c in range(n):
             if rng.random() < s.crossover_prob:
-                child = crossover(pop[_spin(cdf, rng)], pop[_spin(cdf, rng)], rng, s)
+                child = crossover(pop[pick()], pop[pick()], rng, s)
                 if rng.random() < s.mutate_prob:
                     child = mutate(child, rng, s)
             else:
-                child = mutate(pop[_spin(cdf, rng)], rng, s)
+                child = mutate(pop[pick()], rng, s)
             children[c] = child
         return children
 
     # ----------------------------------------------------------------- read-outs
+
+    @property
+    def plateau_evaluations(self) -> int:
+        """Evaluations the plateau rule has counted since the current champion appeared (equal
+        to :attr:`evaluations_since_champion`, or 0 while the champion's evaluation crashed under
+        the ``no-crash`` rule)."""
+        return self._tracker.plateau(self.settings.plateau_rule == "literal")
 
     @property
     def dim(self) -> int:
@@ -594,7 +712,9 @@ class SteadyStateNE(ChampionViews):
     def from_state_dict(cls, state: dict[str, Any]) -> SteadyStateNE:
         """Rebuild an optimiser from :meth:`state_dict`; it continues identically."""
         _check_version(state, "SteadyStateNE")
-        opt = cls(_dec_array(state["prototype"]), SteadyStateSettings(**state["settings"]))
+        # States written before the plateau rule existed followed the literal rule.
+        settings = {"plateau_rule": "literal", **state["settings"]}
+        opt = cls(_dec_array(state["prototype"]), SteadyStateSettings(**settings))
         opt._population = _dec_array(state["population"])
         opt._fitness = _dec_array(state["fitness"])
         opt._pending = _dec_array(state["pending"])
