@@ -283,7 +283,8 @@ def register(sub) -> None:
     p.add_argument("--flight-data", required=True, metavar="FILE", help="flight data (.npz, e.g. from neurohover fly --record)")
     p.add_argument("--method", required=True, choices=("lr", "ec-meno", "ec-mer"), help="lr (least squares), ec-meno or ec-mer (evolution)")
     p.add_argument("--out", required=True, metavar="FILE", help="model file to write (JSON)")
-    p.add_argument("--budget", type=int, help="evaluations for ec-meno / ec-mer (defaults: 2000 / 500)")
+    p.add_argument("--budget", type=int, help="evaluations for ec-meno / ec-mer (defaults: ec-meno runs to the paper's "
+                                                   "plateau stop, 1000 evaluations without a new champion; ec-mer 500)")
     p.add_argument("--estimator", choices=("ols", "gls"), help="lr: ols, ordinary least squares (default, as the paper), or gls, "
                                                              "quasi-differencing by the gusts' AR(1) coefficient")
     p.add_argument("--seed", type=int, default=0, help="seed of the evolution (ec-meno, ec-mer)")
