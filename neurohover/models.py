@@ -9,7 +9,8 @@ Methods
 ``learn_lr``
     Least squares on consecutive observations (the paper's best method). Details below.
 ``learn_ec_meno``
-    Steady-state neuroevolution of the 11 parameters minimising the mean one-step prediction error.
+    Steady-state neuroevolution of the 11 parameters minimising the mean one-step prediction error,
+    a quadratic whose exact minimum (per-axis OLS) :meth:`OneStepProblem.least_squares` gives.
 ``learn_ec_mer``
     Steady-state neuroevolution minimising |model-predicted return of the generic policy over one
     episode - the return observed in the flight data|.
@@ -125,7 +126,7 @@ from .sim.constants import (
 from .tasks import MDP
 
 __all__ = [
-    "DEFAULT_ESTIMATOR", "DEFAULT_INTERCEPTS", "ESTIMATORS", "FORMAT", "INTERCEPTS", "LearnedModel", "OneStepProblem",
+    "DEFAULT_ESTIMATOR", "DEFAULT_INTERCEPTS", "EC_MENO_SCALINGS", "ESTIMATORS", "FORMAT", "INTERCEPTS", "LearnedModel", "OneStepProblem",
     "ParamRow", "equivalent_params", "format_parameter_table", "learn_ec_mer", "learn_ec_meno",
     "learn_lr", "ec_meno_gene_scale", "observed_return", "one_step_error", "one_substep_params", "parameter_table",
 ]
@@ -146,8 +147,9 @@ _AXIS_C = (0, 1, 3, 5, 7, 9)
 _AXIS_GAINS = ((), (2,), (4,), (6,), (8,), (10,))
 _AXIS_PARAMS = tuple([c, *g] for c, g in zip(_AXIS_C, _AXIS_GAINS))  # every parameter of each axis
 _PARAM_AXIS = np.array([0, 1, 1, 2, 2, 3, 3, 4, 4, 5, 5])  # the axis of each parameter
-# Genes of the EC methods are parameters divided by |default|, so the paper's absolute mutation
-# standard deviation (0.8) acts on one scale for drags of 0.18 and gains of 70.
+# Genes of EC-MER (and of EC-MENO with scaling="default") are parameters divided by |default|, so
+# the paper's absolute mutation standard deviation (0.8) acts on one scale for drags of 0.18 and
+# gains of 70. EC-MENO's default genes are scaled from the data instead (ec_meno_gene_scale).
 _GENE_SCALE = np.abs(DEFAULT_PARAMS)
 
 
