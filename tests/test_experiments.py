@@ -88,8 +88,9 @@ def test_every_experiment_of_the_paper_is_shipped_at_both_scales() -> None:
 @pytest.mark.parametrize("name, total, check", [
     # Figure 2: 4 approaches x 10 training MDPs x 10 runs, plus Table 3 (2 topologies x 10 MDPs).
     ("fig2", 420, lambda s: s["runs"] == 10 and s["n_mdps"] == 10 and s["n_steps"] == 6000 and s["robustness_episodes"] == 10),
-    # Table 4: 3 methods x 100 test MDPs, 5 test episodes, ~2000 model evaluations; + the generic policy.
-    ("table4", 301, lambda s: s["n_mdps"] == 100 and s["test_episodes"] == 5 and s["model_budget"] == 2000),
+    # Table 4: 3 methods + the GLS option x 100 test MDPs, 5 test episodes; + the generic policy.
+    ("table4", 401, lambda s: s["n_mdps"] == 100 and s["test_episodes"] == 5 and s["model_budget"] == 2000
+     and s["ec_meno_budget"] == 0 and s["methods"][2:] == ["lr", "lr-gls"]),
     # Figure 7: 3 agents x 100 test MDPs x 1000 episodes; + generic and 10 specialised policies.
     ("fig7", 311, lambda s: s["episodes"] == 1000 and all(g["n_mdps"] == 100 for g in s["groups"])),
     # Figure 8: 3 agents x 80 runs (8 per training MDP); + policies and the safety test.
@@ -335,7 +336,7 @@ def test_quick_experiments_end_to_end(quick_store: Path, capsys) -> None:
         assert all(r["policy_changes"][0][1] == "specialised:0" and r["learning_episodes"] <= 9 for r in free)  # own MDP skipped
         assert len(fig8["policy/safety"]["safe"]) == 2
         models = store.results("table4", "quick")
-        assert {r["method"] for k, r in models.items() if k.startswith("model/")} == {"lr", "ec-meno", "ec-mer"}
+        assert {r["method"] for k, r in models.items() if k.startswith("model/")} == {"lr", "lr-gls", "ec-meno", "ec-mer"}
         robust = [r for k, r in store.results("fig2", "quick").items() if k.startswith("robust/")]
         assert len(robust) == 2 and all(len(r["returns"]) == 1 and len(r["returns"][0]) == 3 for r in robust)
     rc, out, _ = _run(capsys, "reproduce", "fig8", "--scale", "quick", "--store", str(quick_store), "--no-progress")

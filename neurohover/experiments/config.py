@@ -162,10 +162,11 @@ SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
         **_COMMON,
         "mdps": ("test", _choice("train", "test", "sample")),
         "n_mdps": (_REQUIRED, _int(1)),
-        "methods": (["ec-mer", "ec-meno", "lr"], _str_list("ec-mer", "ec-meno", "lr")),
+        "methods": (["ec-mer", "ec-meno", "lr"], _str_list("ec-mer", "ec-meno", "lr", "lr-gls")),
         "generic": ("evolve", _policy_source()),
         "generic_budget": (0, _int(0)),
-        "model_budget": (2000, _int(1)),
+        "model_budget": (2000, _int(1)),  # EC-MER evaluations
+        "ec_meno_budget": (0, _int(0)),  # EC-MENO evaluations; 0: the plateau stop
         "ec_mer_episodes": (1, _int(1)),
         "policy_budget": (0, _int(0)),
         "policy_prototype": ("generic", _choice("generic", "baseline")),

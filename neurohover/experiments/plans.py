@@ -294,7 +294,7 @@ def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
             # its policy meets the same gusts (a paired comparison).
             units.append(_unit(cfg, f"model/{method}/{s['mdps']}{i}", "model", {
                 "method": method, "mdp": mdp.to_dict(), "generic": generic, "n_steps": s["n_steps"],
-                "model_budget": s["model_budget"], "ec_mer_episodes": s["ec_mer_episodes"],
+                "model_budget": s["model_budget"], "ec_meno_budget": s["ec_meno_budget"], "ec_mer_episodes": s["ec_mer_episodes"],
                 "policy_budget": s["policy_budget"], "prototype": s["policy_prototype"],
                 "test_episodes": s["test_episodes"]}, seed_key=f"model/{s['mdps']}{i}"))
     return Plan(units, total)

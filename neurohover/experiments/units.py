@@ -165,7 +165,9 @@ def run_safety(p: dict, threads: int | None) -> dict:
 
 def run_model(p: dict, threads: int | None) -> dict:
     """Table 4: fly the generic policy once (flight data), learn a model, evolve a policy on the
-    model, fly that policy ``test_episodes`` times in the true MDP."""
+    model, fly that policy ``test_episodes`` times in the true MDP. Methods: ``lr`` (OLS, the
+    paper's), ``lr-gls`` (the GLS option), ``ec-meno`` (``ec_meno_budget`` evaluations, 0: the
+    plateau stop) and ``ec-mer`` (``model_budget`` evaluations)."""
     from ..evaluate import evaluate
     from ..evolution.evolve import evolve
     from ..models import learn_ec_mer, learn_ec_meno, learn_lr
@@ -175,10 +177,10 @@ def run_model(p: dict, threads: int | None) -> dict:
     seeds = np.random.SeedSequence(p["seed"]).generate_state(4, np.uint64) >> np.uint64(1)
     data = evaluate(generic, mdp, seed=int(seeds[0]), record=True, n_steps=p["n_steps"], threads=threads)
     t0 = time.perf_counter()
-    if p["method"] == "lr":
-        model = learn_lr(data.flight_data)
+    if p["method"] in ("lr", "lr-gls"):  # ordinary least squares (the paper's), or the GLS option
+        model = learn_lr(data.flight_data, estimator="gls" if p["method"] == "lr-gls" else "ols")
     elif p["method"] == "ec-meno":
-        model = learn_ec_meno(data.flight_data, budget=p["model_budget"], seed=int(seeds[1]))
+        model = learn_ec_meno(data.flight_data, budget=p["ec_meno_budget"] or None, seed=int(seeds[1]))
     else:
         model = learn_ec_mer(data.flight_data, generic, float(data.returns.ravel()[0]), budget=p["model_budget"],
                              seed=int(seeds[1]), episodes=p["ec_mer_episodes"])
