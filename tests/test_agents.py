@@ -242,3 +242,35 @@ def test_policy_directory_missing_a_policy_is_refused_clearly(tiny_policy_dir: P
     assert rc == 2 and "missing specialised policy 3 (specialised_3.json)" in err and "neurohover build-policies" in err
     rc = main(["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "0", "--out", str(tmp_path / "o")])
     assert rc == 2 and "runs=0" in capsys.readouterr().err
+
+
+class _Repeater(Agent):
+    """Keeps one policy under the safeguard; counts the outcomes it is shown."""
+
+    name = "repeater"
+
+    def __init__(self, policy: Policy) -> None:
+        self.policy = policy
+        self.seen: list[int] = []
+
+    def choose(self, episode: int) -> Choice:
+        return Choice(self.policy, "p", fallback=baseline_policy(), repeat=True)
+
+    def update(self, outcome: EpisodeOutcome) -> None:
+        self.seen.append(outcome.episode)
+
+
+def test_repeated_choices_flown_ahead_equal_episode_by_episode_flights() -> None:
+    # Some episodes fire the safeguard, some do not: the speculative chunks must not change a result.
+    family = get_task_family("ghh09")
+    mdp = family.training_mdps()[1]
+    policy = Policy("slp", np.r_[prototype("slp", "baseline").genome[:36], 0.02, 0.0, 0.0, 0.245])
+    agent = _Repeater(policy)
+    result = run_test(agent, family, mdp, episodes=150, seed=4, n_steps=STEPS)
+    assert agent.seen == list(range(150))
+    assert 0 < result.safeguard_fired.sum() < 150
+    table = [policy, baseline_policy()]
+    each = evaluate_jobs(table, mdp, np.zeros(150, dtype=int), np.zeros(150, dtype=int), np.arange(150), seed=4,
+                         n_steps=STEPS, fallback_index=np.ones(150, dtype=int))
+    np.testing.assert_array_equal(result.returns, each.returns)
+    np.testing.assert_array_equal(result.safeguard_fired, each.safeguard_step >= 0)

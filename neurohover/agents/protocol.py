@@ -34,7 +34,7 @@ from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
 
-REPEAT_CHUNK = 64  # episodes per kernel call for a repeated choice
+REPEAT_CHUNK = 64  # most episodes per kernel call for a repeated choice
 
 
 @dataclass(frozen=True)
@@ -155,6 +155,7 @@ def run_test(
     offline = np.zeros(episodes)
     labels: list[str] = [""] * episodes
     e = 0
+    chunk = 1
     while e < episodes:
         choice = agent.choose(e)
         if choice.final:
@@ -169,7 +170,9 @@ def run_test(
             fired[e:] = ev.safeguard_step >= 0
             labels[e:] = [choice.label] * rest.size
             break
-        n = min(REPEAT_CHUNK, episodes - e) if choice.repeat and not choice.record else 1
+        # A repeated choice flies ahead speculatively; the chunk doubles while no event cuts it short
+        # and restarts at 1 after one, so frequent safeguard firings waste at most half the work.
+        n = min(chunk, episodes - e) if choice.repeat and not choice.record else 1
         table = PolicyTable.from_policies([choice.policy] + ([choice.fallback] if choice.fallback else []))
         zeros = np.zeros(n, dtype=np.int64)
         ev = evaluate_jobs(table, mdp, zeros, zeros, np.arange(e, e + n), seed=seed, n_steps=n_steps, threads=threads,
@@ -177,6 +180,7 @@ def run_test(
                            safeguard_limits=choice.dangerous.limits())
         events = np.flatnonzero((ev.safeguard_step >= 0) | ev.crashed)
         n = int(events[0]) + 1 if events.size else n  # later episodes would have flown another choice
+        chunk = 1 if events.size else min(2 * chunk, REPEAT_CHUNK)
         for i in range(n):
             returns[e], crashed[e], steps[e] = ev.returns[i], ev.crashed[i], ev.steps[i]
             fired[e] = ev.safeguard_step[i] >= 0
