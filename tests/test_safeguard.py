@@ -83,7 +83,8 @@ from pathlib import Path  # noqa: E402
 
 from neurohover.cli import main  # noqa: E402
 from neurohover.experiments.config import CONFIG_DIR, load_config  # noqa: E402
-from neurohover.experiments.plans import group_hybrid_settings  # noqa: E402
+from neurohover.agents.hybrid import HybridSettings  # noqa: E402
+from neurohover.experiments.plans import group_hybrid_settings, plan  # noqa: E402
 
 
 def _fig8_with(tmp_path: Path, group_extra: str, agent: str = "hybrid") -> Path:
@@ -131,3 +132,15 @@ def test_compete_refuses_bad_hybrid_options(tmp_path: Path, capsys, argv: list[s
     err = capsys.readouterr().err
     assert rc == 2 and message in err and "Traceback" not in err
     assert not (tmp_path / "o").exists()
+
+
+def test_ablation_groups_reach_their_agents() -> None:
+    from neurohover.experiments.units import make_agent
+
+    units = {u.key: u for u in plan(load_config("ablation-hybrid", "paper"), {}).units}
+    gls = make_agent(units["run/incremental-gls/train3/rep0"].params)
+    ols = make_agent(units["run/incremental/train3/rep0"].params)
+    assert gls.settings.estimator == "gls" and ols.settings.estimator == "ols"
+    text = make_agent(units["run/hybrid-paper-text/train0/rep0"].params)
+    assert text.hybrid == HybridSettings("evolve", "both", DangerousState("paper"))
+    assert make_agent(units["run/hybrid/train0/rep0"].params).hybrid == HybridSettings()

@@ -42,7 +42,8 @@ CONFIG_DIR = Path(__file__).parent / "configs"
 SCALES = ("quick", "paper")
 KINDS = ("evolution", "model_learning", "test_runs")
 #: Experiments in report order (the shipped configs).
-ORDER = ("fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16")
+ORDER = ("fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16",
+         "ablation-plateau", "ablation-hybrid")
 #: Bump when a unit function changes what it computes: stores written before are then refused.
 UNITS_VERSION = 2  # 2: competition MDP sets, the authors' safeguard, OLS, the no-crash plateau
 
@@ -142,6 +143,7 @@ _GROUP = {
     "runs_per_mdp": (1, _int(1)),
     "exclude_own": (False, _bool()),
     "hybrid": ({}, _table()),  # hybrid agents: replacement, model_from, rule, box, tilt (HybridSettings)
+    "estimator": ("ols", _choice("ols", "gls")),  # least squares of the LR models an agent learns
 }
 
 SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {

@@ -263,6 +263,7 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict) -> Plan:
                 hybrid = group_hybrid_settings(g)
                 units.append(_unit(cfg, f"run/{g['label']}/{g['mdps']}{i}/rep{rep}", "test_run", {
                     **settings, "agent": g["agent"], "group": g["label"], "mdp": mdp.to_dict(), "policies": policies,
+                    "estimator": g["estimator"],
                     **({"hybrid": hybrid} if hybrid else {})}))
     return Plan(units, total)
 

@@ -217,7 +217,8 @@ def make_agent(p: dict):
 
     name = p["agent"]
     pol = p["policies"]
-    settings = ModelEvolution(budget=p["model_budget"], predict_episodes=p["predict_episodes"], n_steps=p["n_steps"])
+    settings = ModelEvolution(budget=p["model_budget"], predict_episodes=p["predict_episodes"], n_steps=p["n_steps"],
+                              estimator=p["estimator"])
     if name == "baseline":
         return BaselineAgent()
     if name == "model-free":
