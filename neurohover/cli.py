@@ -46,7 +46,7 @@ def _family_and_mdps(args: argparse.Namespace, n: int, rng: np.random.Generator)
 
 def _add_task_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--task", required=True, help="task family: ghh08, ghh09 or fghh")
-    p.add_argument("--mdp", default="zero", help="zero (default), train:N, test:N, or sample (a fresh MDP from G per episode)")
+    p.add_argument("--mdp", default="zero", help="zero (default), train:N, test:N (the competition sets), seeded-train:N, seeded-test:N, or sample (a fresh MDP from G per episode)")
     p.add_argument("--wind", help="GHH-08 only: constant wind U,V in m/s, each in [-5, 5]")
     p.add_argument("--params", help="explicit MDP parameters, comma-separated: GHH-08 wind_u,wind_v; GHH-09 its 8 parameters in [0,1]; FGHH the 11 dynamics parameters")
     p.add_argument("--sigma", type=float, help="FGHH breadth sigma (default 0.3)")

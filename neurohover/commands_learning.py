@@ -255,7 +255,7 @@ def register(sub) -> None:
                        description=cmd_evolve.__doc__ + "\n\n" + __doc__.split("\n\n", 1)[1],
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--task", required=True, help="task family: ghh08, ghh09 or fghh")
-    p.add_argument("--mdp", help="zero, train:N, test:N, sample (one MDP drawn from G with --seed), or G: evolve over "
+    p.add_argument("--mdp", help="zero, train:N, test:N, seeded-train:N, seeded-test:N, sample (one MDP drawn from G with --seed), or G: evolve over "
                                  "the family's distribution, a fresh MDP per episode (generational). Default: G for fghh, zero otherwise")
     p.add_argument("--wind", help="GHH-08 only: evolve on the constant wind U,V (m/s, each in [-5, 5])")
     p.add_argument("--params", help="evolve on explicit MDP parameters, comma-separated (GHH-08 2, GHH-09 8, FGHH 11)")
