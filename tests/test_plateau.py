@@ -167,3 +167,11 @@ def test_checkpoint_from_before_the_plateau_rule_resumes_under_the_literal_rule(
     assert resumed.champion.genome.tobytes() == straight.champion.genome.tobytes() and resumed.episodes == 200
     with pytest.raises(NeurohoverError, match="settings differ"):
         evolve(mdp, budget=300, resume=True, **{**kw, "settings": dict(pop_size=10, elite_size=9)})
+
+
+def test_evolution_result_says_whether_the_champion_crashed() -> None:
+    mdp = get_task_family("ghh08").zero()
+    crashing = evolve(mdp, topology="slp", prototype="zero", budget=200, seed=1, n_steps=300, threads=1)
+    flying = evolve(mdp, topology="mlp", prototype="baseline", budget=200, seed=1, n_steps=300, threads=1)
+    assert crashing.champion_crashed and crashing.champion_return < -1e5
+    assert not flying.champion_crashed

@@ -229,6 +229,8 @@ class EvolutionResult:
     settings : dict
         Everything that defines the run (JSON-able): target, method, optimizer, resampling,
         optimiser settings, topology, seed, n_steps, budget.
+    champion_crashed : bool
+        Steady state: whether the champion's evaluation crashed (False for the other methods).
     """
 
     champion: Policy
@@ -242,6 +244,7 @@ class EvolutionResult:
     kernel_seconds: float
     stop_reason: str
     settings: dict
+    champion_crashed: bool = False
 
     @property
     def episodes_per_second(self) -> float:
@@ -873,7 +876,8 @@ class _Run:
         champion = Policy(self.topology, np.array(genome, dtype=float), {**self.proto.metadata, **meta})
         return EvolutionResult(champion, ret, self._history_with_last(), self.flyer.episodes, self.flyer.steps,
                                self.evaluations, self.generation, self.elapsed, self.flyer.kernel_seconds,
-                               self.stop_reason or "", settings)
+                               self.stop_reason or "", settings,
+                               isinstance(self.opt, _SteadyStateNE) and self.opt.champion_crashed)
 
 
 def _enc(x: float) -> float | str:

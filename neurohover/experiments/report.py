@@ -222,13 +222,18 @@ class _Evolution(_Section):
                          fmt(-np.mean(finals)) if validated else "n/a", fmt(_sd(finals)) if validated else "n/a",
                          fmt(np.mean([r["episodes"] for _, r in runs])),
                          fmt(np.mean([r["timing"]["seconds"] for _, r in runs])),
-                         ", ".join(f"{k} {n}" for k, n in sorted(stops.items()))])
+                         ", ".join(f"{k} {n}" for k, n in sorted(stops.items())),
+                         # stores written before the flag was recorded have no answer
+                         str(sum(bool(r["champion_crashed"]) for _, r in runs))
+                         if all("champion_crashed" in r for _, r in runs) else "n/a"])
         what = ("mean return of the final champion on fresh validation episodes" if validated
                 else "final champion return")
         parts.append("### Final champions\n\n" + _table(
             ["setting", "runs", "mean champion error", "median", "best", "validation error (mean)", "sd", "episodes/run",
-             "seconds/run", "stopped by"], rows) + "\n\nChampion error: minus the champion's fitness estimate at the end "
-            "of the run (what the figure shows). Validation: the final champion flown on fresh episodes"
+             "seconds/run", "stopped by", "champion crashing at the end"], rows)
+            + "\n\nChampion error: minus the champion's fitness estimate at the end "
+            "of the run (what the figure shows). Champion crashing at the end: runs whose final champion's own "
+            "evaluation crashed (steady state). Validation: the final champion flown on fresh episodes"
             + (" (each on a fresh MDP from G)" if self.s["target"] == "family" else " of its MDP") + ".\n")
         if samples:
             order = sorted(samples, key=lambda k: -np.mean(samples[k]))

@@ -130,6 +130,7 @@ def run_evolve(p: dict, threads: int | None) -> dict:
         "champion": policy_dict(result.champion), "champion_return": _num(result.champion_return),
         "episodes": int(result.episodes), "evaluations": int(result.evaluations),
         "generations": int(result.generations), "stop_reason": result.stop_reason,
+        "champion_crashed": bool(result.champion_crashed),
         "history": subsample(history, p.get("history_points", 300)),
     }
     if p.get("validation_episodes"):
