@@ -1,4 +1,4 @@
-"""The steady-state plateau rule (SPEC 4): ``no-crash`` (default) counts evaluations without a new
+"""The steady-state plateau rule (docs/model.md, Neuroevolution): ``no-crash`` (default) counts evaluations without a new
 champion only once the champion's evaluation completed without crashing; ``literal`` is Appendix A
 as written. Also the eonn-style options of :class:`SteadyStateSettings` (selection, initial
 population)."""

@@ -64,7 +64,7 @@ PLATEAU_RULES = ("no-crash", "literal")
 
 #: Parent selection of :class:`SteadyStateSettings`: ``roulette`` (Appendix A, weights
 #: ``1/ln(error)``) or ``tournament`` (the best of ``tournament_size`` distinct genomes drawn
-#: uniformly, as in the authors' ``eonn`` code; SPEC 4).
+#: uniformly, as in the authors' ``eonn`` code; docs/model.md, Neuroevolution).
 SELECTIONS = ("roulette", "tournament")
 
 
