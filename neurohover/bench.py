@@ -102,12 +102,12 @@ def lr_seconds_per_episode_of_flight_data() -> float:
     return best
 
 
-def test_run_seconds(agent: str, episodes: int = 1000) -> float:
-    """Wall time of one on-line test run of ``agent`` on GHH-08 test MDP 0, on one core."""
+def test_run_seconds(agent: str, episodes: int = 1000, task: str = "ghh08") -> float:
+    """Wall time of one on-line test run of ``agent`` on test MDP 0 of ``task``, on one core."""
     from .agents.protocol import run_test
     from .agents.registry import make_agent
 
-    family = get_task_family("ghh08")
+    family = get_task_family(task)
     start = time.perf_counter()
     run_test(make_agent(agent, family), family, family.test_mdps()[0], episodes=episodes, seed=0, threads=1)
     return time.perf_counter() - start
@@ -124,6 +124,8 @@ def _extra_benchmarks(quick: bool) -> dict:
     episodes = 100 if quick else 1000
     for agent in ("model-free", "incremental"):
         out[f"test_run_{agent}_{episodes}_episodes_seconds_1_core"] = test_run_seconds(agent, episodes)
+    # the hybrid agent with the authors' safeguard (the paper's box test fired in most episodes)
+    out["test_run_ghh09_hybrid_100_episodes_seconds_1_core"] = test_run_seconds("hybrid", 100, "ghh09")
     return out
 
 
