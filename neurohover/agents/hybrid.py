@@ -39,9 +39,11 @@ class HybridSettings:
     Parameters
     ----------
     replacement : {"rerank", "evolve"}
-        What happens to a policy that needed the safeguard. ``"rerank"`` (the authors' code): it is
-        charged a return of -1e6, the episode's return is credited to the fallback (which becomes a
-        candidate), and the best-scoring candidate flies on; nothing is re-evolved. ``"evolve"`` (the
+        What happens to a policy that needed the safeguard (or crashed under it). ``"rerank"`` (the
+        authors' code): it is charged a return of -1e6, the episode's return is credited to the
+        fallback (which becomes a candidate, scored by the mean of its credited episodes), and the
+        best-scoring candidate flies on, ties to the earliest; nothing is re-evolved, so where every
+        candidate and the fallback fail the run keeps failing. ``"evolve"`` (the
         paper's text): it is discarded and a policy newly evolved on the model replaces it.
     model_from : {"first-safe", "both"}
         Which trial episodes the LR model learns from: the first of the two safe specialised
