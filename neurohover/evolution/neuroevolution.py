@@ -157,6 +157,12 @@ class SteadyStateSettings:
     init_mutate_frac, init_mutate_std : float or None
         Mutation of the prototype's copies in the initial population; None (default): as
         ``mutate_frac`` / ``mutate_std`` (Appendix A). ``eonn`` used 0.5 and 0.5.
+    mutation_floor : float or None
+        None (default): Appendix A's mutation, the same absolute size for every gene. A number
+        > 0: gene i's perturbation (and replacement value) is scaled by
+        ``max(|prototype gene i|, mutation_floor)`` (an experimental deviation: from the baseline
+        seed, the paper's N(0, 0.8) cannot move gains of size 0.02 smoothly; see
+        docs/reproduction/discussion/fig2-paper.md).
     """
 
     pop_size: int = 50
@@ -174,9 +180,15 @@ class SteadyStateSettings:
     tournament_size: int = 5
     init_mutate_frac: float | None = None
     init_mutate_std: float | None = None
+    mutation_floor: float | None = None
 
     def __post_init__(self) -> None:
         _validate_common(self)
+        if self.mutation_floor is not None:
+            floor = self.mutation_floor
+            if isinstance(floor, bool) or not isinstance(floor, (int, float)) or not (math.isfinite(floor) and floor > 0):
+                raise NeurohoverError(f"mutation_floor={floor!r} is out of range: allowed None or a finite number > 0")
+            _normalise(self, "mutation_floor", float(floor))
         if not isinstance(self.plateau_rule, str) or self.plateau_rule not in PLATEAU_RULES:
             raise NeurohoverError(
                 f"unknown plateau_rule {self.plateau_rule!r}: allowed {', '.join(PLATEAU_RULES)}"
@@ -387,11 +399,16 @@ def _spin(cdf: list[float], rng: np.random.Generator) -> int:
 
 
 def _initial_population(
-    prototype: np.ndarray, n: int, rng: np.random.Generator, settings: Any
+    prototype: np.ndarray, n: int, rng: np.random.Generator, settings: Any, scale: np.ndarray | None = None
 ) -> np.ndarray:
     # Appendix A: the prototype plus copies of it, each put through the
     # mutation operator once (unconditionally, i.e. not gated by mutate_prob).
-    return np.vstack([prototype] + [mutate(prototype, rng, settings) for _ in range(n - 1)])
+    return np.vstack([prototype] + [_mutate(prototype, rng, settings, scale) for _ in range(n - 1)])
+
+
+def _mutate(genome: np.ndarray, rng: np.random.Generator, settings: Any, scale: np.ndarray | None) -> np.ndarray:
+    """``mutate`` with the optional per-gene scale (the plain call when there is none)."""
+    return mutate(genome, rng, settings) if scale is None else mutate(genome, rng, settings, scale)
 
 
 class _Clock:
@@ -561,6 +578,8 @@ class SteadyStateNE(ChampionViews):
     ) -> None:
         self.settings = settings if settings is not None else SteadyStateSettings()
         self._prototype = _check_prototype(prototype)
+        floor = self.settings.mutation_floor
+        self._scale = None if floor is None else np.maximum(np.abs(self._prototype), floor)
         self._rng = np.random.default_rng(seed)
         self._population: np.ndarray | None = None
         self._fitness: np.ndarray | None = None
@@ -590,7 +609,7 @@ class SteadyStateNE(ChampionViews):
                     mutate_frac=s.mutate_frac if s.init_mutate_frac is None else s.init_mutate_frac,
                     mutate_std=s.mutate_std if s.init_mutate_std is None else s.init_mutate_std,
                 )
-            batch = _initial_population(self._prototype, s.pop_size, self._rng, init)
+            batch = _initial_population(self._prototype, s.pop_size, self._rng, init, self._scale)
         else:
             batch = self._breed(self.settings.pop_size - self.settings.elite_size)
         self._pending = batch
@@ -655,9 +674,9 @@ class SteadyStateNE(ChampionViews):
             if rng.random() < s.crossover_prob:
                 child = crossover(pop[pick()], pop[pick()], rng, s)
                 if rng.random() < s.mutate_prob:
-                    child = mutate(child, rng, s)
+                    child = _mutate(child, rng, s, self._scale)
             else:
-                child = mutate(pop[pick()], rng, s)
+                child = _mutate(pop[pick()], rng, s, self._scale)
             children[c] = child
         return children
 

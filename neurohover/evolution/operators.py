@@ -40,13 +40,17 @@ class CrossoverParams(Protocol):
     def averaging_prob(self) -> float: ...
 
 
-def mutate(genome: np.ndarray, rng: np.random.Generator, settings: MutationParams) -> np.ndarray:
+def mutate(
+    genome: np.ndarray, rng: np.random.Generator, settings: MutationParams, scale: np.ndarray | None = None
+) -> np.ndarray:
     """Return a mutated copy of ``genome``.
 
     Each gene is, independently with probability ``settings.mutate_frac``,
     perturbed by ``delta ~ N(0, settings.mutate_std)``; a perturbed gene is,
     with probability ``settings.mutate_repl``, replaced by ``delta`` instead
-    of shifted by it.
+    of shifted by it. With ``scale``, gene i's ``delta`` is multiplied by
+    ``scale[i]`` (the same random draws, so ``scale=None`` and a scale of ones
+    give identical genomes).
 
     Parameters
     ----------
@@ -57,6 +61,8 @@ def mutate(genome: np.ndarray, rng: np.random.Generator, settings: MutationParam
         consumed per call, whatever the outcome, so runs stay reproducible.
     settings : MutationParams
         Provides ``mutate_frac``, ``mutate_std`` and ``mutate_repl``.
+    scale : np.ndarray, optional
+        Per-gene scale of ``delta`` (shape of ``genome``).
 
     Returns
     -------
@@ -66,6 +72,8 @@ def mutate(genome: np.ndarray, rng: np.random.Generator, settings: MutationParam
     g = np.asarray(genome, dtype=np.float64)
     hit_r = rng.random(g.size)
     delta = rng.normal(0.0, settings.mutate_std, g.size)
+    if scale is not None:
+        delta *= np.asarray(scale, dtype=np.float64).reshape(-1)
     replace_r = rng.random(g.size)
     return _mutate_genes(g, hit_r, delta, replace_r, settings.mutate_frac, settings.mutate_repl)
 
