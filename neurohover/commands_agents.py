@@ -27,16 +27,13 @@ def cmd_compete(args: argparse.Namespace) -> int:
     from .agents.hybrid import HybridSettings
     from .agents.registry import HYBRID_AGENTS
     from .compete import compete
-    from .evaluate import DangerousState
 
     given = [f"--{k.replace('_', '-')}" for k in _HYBRID_OPTIONS if getattr(args, k) is not None]
     if given and args.agent not in HYBRID_AGENTS:
         raise NeurohoverError(f"{', '.join(given)} apply to the hybrid agents only ({', '.join(HYBRID_AGENTS)}), not to --agent {args.agent}")
-    d = DangerousState()
-    dangerous = DangerousState(args.safeguard_rule or d.rule, d.box if args.safeguard_box is None else args.safeguard_box,
-                               d.tilt if args.safeguard_tilt is None else args.safeguard_tilt)
-    h = HybridSettings()
-    hybrid = HybridSettings(args.hybrid_replacement or h.replacement, args.hybrid_model_from or h.model_from, dangerous)
+    given_values = {"rule": args.safeguard_rule, "box": args.safeguard_box, "tilt": args.safeguard_tilt,
+                    "replacement": args.hybrid_replacement, "model_from": args.hybrid_model_from}
+    hybrid = HybridSettings.from_dict({k: v for k, v in given_values.items() if v is not None})
     bar = tqdm(total=args.runs, desc=f"{args.task} {args.agent}", unit="run", file=sys.stderr, disable=None)
     try:
         summary, _ = compete(
