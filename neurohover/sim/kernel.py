@@ -143,14 +143,11 @@ def dangerous(o, limits) -> bool:
     """Safeguard test on observation ``o``: some velocity, position or rate entry beyond its limit
     ``limits[0:9]`` while the helicopter is tilted, qw < ``limits[9]`` (qw from the quaternion's
     vector part, as the authors' code computed it; ``limits[9] = inf``: the box test alone)."""
-    outside = False
     for i in range(9):
         if abs(o[i]) > limits[i]:
-            outside = True
-    if not outside:
-        return False
-    qw = math.sqrt(max(0.0, 1.0 - (o[9] * o[9] + o[10] * o[10] + o[11] * o[11])))
-    return qw < limits[9]
+            qw = math.sqrt(max(0.0, 1.0 - (o[9] * o[9] + o[10] * o[10] + o[11] * o[11])))
+            return qw < limits[9]
+    return False
 
 
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
