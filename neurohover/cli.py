@@ -33,6 +33,9 @@ def _family_and_mdps(args: argparse.Namespace, n: int, rng: np.random.Generator)
     family = get_task_family(args.task, args.sigma)
     if args.wind is not None and args.params is not None:
         raise NeurohoverError("give either --wind (GHH-08) or --params, not both")
+    if (args.wind is not None or args.params is not None) and args.mdp is not None:
+        given = "--wind" if args.wind is not None else "--params"
+        raise NeurohoverError(f"{given} sets the MDP explicitly; it cannot be combined with --mdp {args.mdp}")
     if args.wind is not None:
         if family.name != "ghh08":
             raise NeurohoverError(f"--wind U,V sets a GHH-08 MDP; task {args.task!r} takes --params")
@@ -41,20 +44,50 @@ def _family_and_mdps(args: argparse.Namespace, n: int, rng: np.random.Generator)
         return family, [family.make(_floats(args.params, "--params"))] * n
     if args.mdp == "sample":  # a fresh MDP from G for every episode
         return family, [family.sample(rng, label=f"{family.name}/sample:{i}") for i in range(n)]
-    return family, [family.mdp(args.mdp)] * n
+    return family, [family.mdp(args.mdp or "zero")] * n
 
 
 def _add_task_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--task", required=True, help="task family: ghh08, ghh09 or fghh")
-    p.add_argument("--mdp", default="zero", help="zero (default), train:N, test:N (the competition sets), seeded-train:N, seeded-test:N, or sample (a fresh MDP from G per episode)")
-    p.add_argument("--wind", help="GHH-08 only: constant wind U,V in m/s, each in [-5, 5]")
-    p.add_argument("--params", help="explicit MDP parameters, comma-separated: GHH-08 wind_u,wind_v; GHH-09 its 8 parameters in [0,1]; FGHH the 11 dynamics parameters")
+    p.add_argument("--mdp", help="zero (default), train:N, test:N (the competition sets), seeded-train:N, seeded-test:N, or sample (a fresh MDP from G per episode)")
+    p.add_argument("--wind", help="GHH-08 only: constant wind U,V in m/s, each in [-5, 5] (instead of --mdp)")
+    p.add_argument("--params", help="explicit MDP parameters, comma-separated (instead of --mdp): GHH-08 wind_u,wind_v; GHH-09 its 8 parameters in [0,1]; FGHH the 11 dynamics parameters")
     p.add_argument("--sigma", type=float, help="FGHH breadth sigma (default 0.3)")
+
+
+# Episodes per kernel call of a progress-reporting fly: large enough to keep every core busy.
+FLY_CHUNK = 256
+
+
+def _fly(policy, mdps: list, args: argparse.Namespace, show_progress: bool):
+    """Fly ``policy`` once on each of ``mdps`` (episode i on mdps[i]); chunked under a progress bar."""
+    from tqdm import tqdm
+
+    from .evaluate import evaluate_jobs
+
+    unique = list(dict.fromkeys(mdps))
+    mdp_index = np.array([unique.index(m) for m in mdps])
+    n = len(mdps)
+    returns, crashed, seconds, flight = [], [], 0.0, None
+    # Every episode's gusts come from (seed, episode index), so chunking changes no result.
+    with tqdm(total=n, desc=f"fly {mdps[0].label if len(unique) == 1 else 'MDPs'}", unit="ep", file=sys.stderr,
+              disable=None if show_progress else True, dynamic_ncols=True) as bar:
+        for start in range(0, n, FLY_CHUNK if show_progress else n):
+            idx = np.arange(start, min(n, start + (FLY_CHUNK if show_progress else n)))
+            ev = evaluate_jobs([policy], unique, np.zeros(idx.size, dtype=np.int64), mdp_index[idx], idx, seed=args.seed,
+                               record=np.full(idx.size, args.record is not None), threads=args.threads)
+            returns.append(ev.returns)
+            crashed.append(ev.crashed)
+            seconds += ev.seconds
+            if ev.flight_data is not None:
+                flight = ev.flight_data if flight is None else flight + ev.flight_data
+            bar.update(idx.size)
+    return np.concatenate(returns), np.concatenate(crashed), seconds, flight, len(unique)
 
 
 def cmd_fly(args: argparse.Namespace) -> int:
     """Fly a policy and print return statistics."""
-    from .evaluate import evaluate_jobs
+    from .paths import output_file
     from .policies import load_policy
 
     if args.episodes < 1:
@@ -64,31 +97,28 @@ def cmd_fly(args: argparse.Namespace) -> int:
     policy = load_policy(args.policy)
     rng = np.random.default_rng(args.seed)
     family, mdps = _family_and_mdps(args, args.episodes, rng)
-    unique = list(dict.fromkeys(mdps))
-    ev = evaluate_jobs(
-        [policy], unique, np.zeros(args.episodes, dtype=np.int64),
-        np.array([unique.index(m) for m in mdps]), np.arange(args.episodes), seed=args.seed,
-        record=np.full(args.episodes, args.record is not None), threads=args.threads,
-    )
     if args.record is not None:
-        fd = ev.flight_data
+        output_file(args.record, "--record")
+    returns, crashed, seconds, fd, n_unique = _fly(policy, mdps, args, show_progress=not args.json)
+    if fd is not None:
         fd.metadata.update({"task": family.name, "mdps": [m.to_dict() for m in mdps], "policy": str(args.policy),
-                            "seed": args.seed, "returns": ev.returns.tolist()})
+                            "seed": args.seed, "returns": returns.tolist()})
         fd.save(args.record)
     summary = {
-        "task": family.name, "mdp": mdps[0].label if len(unique) == 1 else f"{len(unique)} MDPs",
+        "task": family.name, "mdp": mdps[0].label if n_unique == 1 else f"{n_unique} MDPs",
         "policy": str(args.policy), "episodes": args.episodes,
-        "mean_return": float(ev.returns.mean()), "std_return": float(ev.returns.std()),
-        "min_return": float(ev.returns.min()), "max_return": float(ev.returns.max()),
-        "crashes": int(ev.crashed.sum()), "episodes_per_second": ev.episodes_per_second,
+        "mean_return": float(returns.mean()), "std_return": float(returns.std()),
+        "min_return": float(returns.min()), "max_return": float(returns.max()),
+        "crashes": int(crashed.sum()), "episodes_per_second": args.episodes / seconds if seconds > 0 else float("inf"),
     }
+    if args.record is not None:
+        summary["flight_data"] = str(args.record)
     if args.json:
         print(json.dumps(summary))
     else:
         for key, value in summary.items():
-            print(f"{key:>20}: {value:.6g}" if isinstance(value, float) else f"{key:>20}: {value}")
-        if args.record is not None:
-            print(f"{'flight data':>20}: {args.record}")
+            label = "flight data" if key == "flight_data" else key
+            print(f"{label:>20}: {value:.6g}" if isinstance(value, float) else f"{label:>20}: {value}")
     return 0
 
 
@@ -120,8 +150,18 @@ def cmd_bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("neurohover")
+    except PackageNotFoundError:  # run from a source tree that was never installed
+        return "unknown (not installed)"
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="neurohover", description="Generalized helicopter hovering (Koppejan & Whiteson 2011): fly, evolve, learn models, compete, reproduce.")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     p = sub.add_parser("fly", help="fly a policy and print return statistics", description=cmd_fly.__doc__)

@@ -10,10 +10,13 @@ from .errors import NeurohoverError
 
 def cmd_build_policies(args: argparse.Namespace) -> int:
     """Evolve a task family's generic and specialised policies (the agents' policy set)."""
+    from .paths import output_dir
     from .policysets import build_policy_set
 
     if args.budget < 1:
         raise NeurohoverError(f"--budget {args.budget} is out of range: allowed >= 1")
+    if args.out is not None:
+        output_dir(args.out, "--out")
     ps = build_policy_set(args.task, args.out, budget=args.budget, fghh_budget=args.fghh_budget, seed=args.seed,
                           n_steps=args.episode_steps, progress=lambda msg: print(msg, file=sys.stderr, flush=True))
     print(f"policy set written to {ps.directory}")
@@ -27,6 +30,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
     from .agents.hybrid import HybridSettings
     from .agents.registry import HYBRID_AGENTS
     from .compete import compete
+    from .paths import input_dir, output_dir
 
     given = [f"--{k.replace('_', '-')}" for k in _HYBRID_OPTIONS if getattr(args, k) is not None]
     if given and args.agent not in HYBRID_AGENTS:
@@ -34,6 +38,9 @@ def cmd_compete(args: argparse.Namespace) -> int:
     given_values = {"rule": args.safeguard_rule, "box": args.safeguard_box, "tilt": args.safeguard_tilt,
                     "replacement": args.hybrid_replacement, "model_from": args.hybrid_model_from}
     hybrid = HybridSettings.from_dict({k: v for k, v in given_values.items() if v is not None})
+    if args.policy_dir is not None:
+        input_dir(args.policy_dir, "--policy-dir")
+    output_dir(args.out, "--out")
     bar = tqdm(total=args.runs, desc=f"{args.task} {args.agent}", unit="run", file=sys.stderr, disable=None)
     try:
         summary, _ = compete(

@@ -46,8 +46,9 @@ def _target(args: argparse.Namespace):
     family = get_task_family(args.task, args.sigma)
     if args.wind is not None and args.params is not None:
         raise NeurohoverError("give either --wind (GHH-08) or --params, not both")
-    if (args.wind is not None or args.params is not None) and args.mdp not in (None,):
-        raise NeurohoverError("--wind/--params set the MDP explicitly; leave out --mdp")
+    if (args.wind is not None or args.params is not None) and args.mdp is not None:
+        given = "--wind" if args.wind is not None else "--params"
+        raise NeurohoverError(f"{given} sets the MDP explicitly; it cannot be combined with --mdp {args.mdp}")
     if args.wind is not None:
         if family.name != "ghh08":
             raise NeurohoverError(f"--wind U,V sets a GHH-08 MDP; task {args.task!r} takes --params")
@@ -98,6 +99,7 @@ class _Bar:
 def cmd_evolve(args: argparse.Namespace) -> int:
     """Evolve a policy: steady state on one MDP, or generational over the task family's MDPs (--mdp G)."""
     from .evolution.evolve import EvolutionInterrupted, evolve, parse_resampling, validation_return, write_history_csv
+    from .paths import output_file
     from .policies import save_policy
 
     if args.budget is not None and args.budget < 1:
@@ -113,9 +115,9 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     resampling = parse_resampling(args.resampling)
     target, family, mdp_desc = _target(args)
     topology, proto = _seed_policy(args)
-    out = Path(args.out)
-    history_path = Path(f"{out}.history.csv")
-    checkpoint = Path(f"{out}.checkpoint.json")
+    out = output_file(args.out, "--out")
+    history_path = output_file(f"{out}.history.csv", "--out (its history file)")
+    checkpoint = output_file(f"{out}.checkpoint.json", "--out (its checkpoint file)")
     if args.resume and not checkpoint.is_file():
         raise NeurohoverError(f"--resume: no checkpoint {str(checkpoint)!r} (it is written next to --out by an earlier run)")
     if not args.resume and checkpoint.is_file():
@@ -217,6 +219,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     """Learn a helicopter model from flight data (LR, EC-MENO or EC-MER) and print its parameters."""
     from .flightdata import FlightData
     from .models import format_parameter_table, learn_ec_mer, learn_ec_meno, learn_lr, parameter_table
+    from .paths import input_file, output_file
     from .policies import load_policy
 
     if args.budget is not None and args.budget < 1:
@@ -224,30 +227,76 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     if args.seed < 0:
         raise NeurohoverError(f"--seed {args.seed} is out of range: allowed >= 0")
     if args.estimator is not None and args.method != "lr":
-        print(f"neurohover learn-model: --estimator applies to lr only (least squares), not {args.method}; ignored", file=sys.stderr)
-    data = FlightData.load(args.flight_data)
+        raise NeurohoverError(f"--estimator applies to --method lr only (least squares), not to --method {args.method}")
+    if args.budget is not None and args.method == "lr":
+        raise NeurohoverError("--budget applies to the evolutionary methods (ec-meno, ec-mer), not to --method lr (least squares)")
+    if args.policy is not None and args.method != "ec-mer":
+        raise NeurohoverError(f"--policy applies to --method ec-mer only (the policy that flew the data), not to --method {args.method}")
+    data = FlightData.load(input_file(args.flight_data, "--flight-data", "flight-data file"))
+    out = output_file(args.out, "--out")
     start = time.perf_counter()
     extra = {} if args.budget is None else {"budget": args.budget}
     with _Ticker(f"learning a {args.method} model from {data.n_episodes} episodes ({data.n_transitions} steps)"):
         if args.method == "lr":
-            if args.budget is not None:
-                print("neurohover learn-model: --budget does not apply to lr (least squares); ignored", file=sys.stderr)
             model = learn_lr(data, estimator=args.estimator or "ols")
         elif args.method == "ec-meno":
             model = learn_ec_meno(data, seed=args.seed, **extra)
         else:
             source = args.policy or data.metadata.get("policy") or "baseline"
             model = learn_ec_mer(data, load_policy(source), seed=args.seed, **extra)
-    model.save(args.out)
+    model.save(out)
     truth, why = _true_mdp(data.metadata)
-    print(f"{args.method} model written to {args.out} ({time.perf_counter() - start:.2f} s)")
+    print(f"{args.method} model written to {out} ({time.perf_counter() - start:.2f} s)")
+    rows = parameter_table(model, truth)
     if truth is not None:
         print(f"learned parameters (converted to the simulator's 10 substeps) next to the true ones of {truth.label or 'the MDP'}:")
-        print(format_parameter_table(parameter_table(model, truth)))
     else:
         print(f"{why}; learned parameters (converted to the simulator's 10 substeps) next to the simulator's defaults:")
-        print(format_parameter_table(parameter_table(model, None)))
+    print(format_parameter_table(rows))
+    for line in _model_notes(model, data, truth, rows):
+        print(f"neurohover learn-model: {line}", file=sys.stderr)
     return 0
+
+
+# Fewer transitions than this (one minute of flight) give unreliable estimates.
+MIN_TRANSITIONS = 600
+# Episodes the baseline policy flies on the learned model (and the true MDP) to check it is usable.
+CHECK_EPISODES = 3
+
+
+def _model_notes(model, data, truth, rows) -> list[str]:
+    """Warnings and explanations that keep the learned model's table from misleading."""
+    import numpy as np
+
+    from .evaluate import evaluate
+    from .models import PARAM_NAMES
+    from .policies import baseline_policy
+    from .sim.constants import WIND_NONE
+
+    notes = []
+    nan_axes = [r.name for r in rows if not np.isfinite(r.learned)]
+    if nan_axes:
+        notes.append(f"note: {', '.join(nan_axes)} show nan: on their axis the learned one-step multiplier 1 + 0.1*C is not "
+                     "positive, which no 10-substep integration can produce; the model itself is still a valid "
+                     "one-substep model (the model file holds its values)")
+    if data.n_transitions < MIN_TRANSITIONS:
+        notes.append(f"warning: only {data.n_transitions} transitions (fewer than {MIN_TRANSITIONS}, one minute of flight); "
+                     "estimates from so little data are unreliable")
+    if truth is not None and truth.wind_kind != WIND_NONE and any(w != 0 for w in truth.wind):
+        absorbed = f" (fitted D_u = {model.d_u:.4g})" if model.d_u else ""
+        notes.append(f"note: the data were flown in wind ({truth.label or truth.wind}); a learned model has no wind, so the "
+                     f"wind's force is absorbed into its constants{absorbed} and biases the drag terms "
+                     f"({', '.join(PARAM_NAMES[:3])}): their errors above are not only estimation error")
+    mdps = [model.mdp("learned")] + ([truth] if truth is not None else [])
+    ev = evaluate(baseline_policy(), mdps, episodes=CHECK_EPISODES, seed=0)
+    crashed = ev.crashed.sum(axis=(0, 2))
+    if crashed[0] and (truth is None or not crashed[1]):
+        steps = ev.steps[0, 0][ev.crashed[0, 0]]
+        where = "" if truth is None else ", while it never crashes in the true MDP"
+        notes.append(f"warning: the baseline policy crashes on this model in {crashed[0]} of {CHECK_EPISODES} episodes "
+                     f"(after {steps.min()}-{steps.max()} steps){where}: the model's closed-loop dynamics differ from the "
+                     "helicopter's, so do not read its parameters as the truth, and check any policy planned on it in the true MDP")
+    return notes
 
 
 def register(sub) -> None:

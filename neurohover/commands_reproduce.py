@@ -20,6 +20,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     """Run a paper experiment (or all of them); every finished unit goes to the results store at once."""
     from .experiments import Store, load_configs, make_executor, parse_override, reproduce
     from .experiments.config import experiment_names
+    from .paths import output_file
 
     if args.list:
         for name in experiment_names():
@@ -31,6 +32,9 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         raise NeurohoverError("give the results store file with --store FILE (it is created if missing)")
     if args.executor == "ray" and args.jobs != 1:
         raise NeurohoverError("--jobs applies to --executor local; Ray runs one unit per CPU of the cluster")
+    if args.address is not None and args.executor != "ray":
+        raise NeurohoverError(f"--address {args.address} names a Ray cluster; add --executor ray (or leave out --address)")
+    output_file(args.store, "--store")
     overrides = dict(parse_override(text) for text in args.set or [])
     configs = load_configs(args.name, args.scale, overrides)
     if args.only and len(configs) > 1:
@@ -58,13 +62,14 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
 def cmd_results(args: argparse.Namespace) -> int:
     """Export an experiment's finished units from the results store as CSV or JSON."""
     from .experiments import Store, export_results
+    from .paths import input_file, output_file
 
-    if not Path(args.store).is_file():
-        raise NeurohoverError(f"results store {args.store!r} does not exist")
+    input_file(args.store, "--store", "results store")
+    out = None if args.out is None else output_file(args.out, "--out")
     with Store(args.store, create=False) as store:
         text = export_results(store, args.name, args.format, args.scale)
-    if args.out:
-        Path(args.out).write_text(text)
+    if out is not None:
+        out.write_text(text)
         print(f"wrote {args.out}", file=sys.stderr)
     else:
         sys.stdout.write(text)
@@ -74,9 +79,10 @@ def cmd_results(args: argparse.Namespace) -> int:
 def cmd_report(args: argparse.Namespace) -> int:
     """Draw the paper's figures from the results store and write a Markdown report beside the paper's numbers."""
     from .experiments import Store, write_report
+    from .paths import input_file, output_dir
 
-    if not Path(args.store).is_file():
-        raise NeurohoverError(f"results store {args.store!r} does not exist")
+    input_file(args.store, "--store", "results store")
+    output_dir(args.out, "--out")
     with Store(args.store, create=False) as store:
         path = write_report(store, args.out, scale=args.scale, names=args.names or None)
     print(f"report written to {path}")

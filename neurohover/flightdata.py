@@ -68,6 +68,9 @@ class FlightData:
         path = Path(path)
         if not path.is_file():
             raise NeurohoverError(f"flight-data file {str(path)!r} does not exist")
+        if not zipfile.is_zipfile(path):  # np.load would try (and refuse) to unpickle anything else
+            raise NeurohoverError(f"{str(path)!r} is not a neurohover flight-data file: flight data are .npz archives "
+                                  "(written by neurohover fly --record or FlightData.save)")
         try:
             with np.load(path, allow_pickle=False) as z:
                 if "format" not in z.files or str(z["format"]) != FORMAT:

@@ -267,6 +267,8 @@ class LearnedModel:
             data = json.loads(path.read_text())
         except (json.JSONDecodeError, UnicodeDecodeError) as err:
             raise NeurohoverError(f"model file {str(path)!r} is not valid JSON (truncated or not a model file?): {err}") from None
+        except OSError as err:
+            raise NeurohoverError(f"model file {str(path)!r} cannot be read ({err.strerror or type(err).__name__})") from None
         return cls.from_dict(data, f"model file {str(path)!r}")
 
 

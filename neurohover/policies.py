@@ -191,11 +191,14 @@ def load_policy(source: str | Path) -> Policy:
         return baseline_policy()
     path = Path(source)
     if not path.is_file():
-        raise NeurohoverError(f"policy file {str(path)!r} does not exist (give a JSON policy file or 'baseline')")
+        what = "is not a file" if path.exists() else "does not exist"
+        raise NeurohoverError(f"policy file {str(path)!r} {what} (give a JSON policy file or 'baseline')")
     try:
         data = json.loads(path.read_text())
     except (json.JSONDecodeError, UnicodeDecodeError) as err:
         raise NeurohoverError(f"policy file {str(path)!r} is not valid JSON: {err}") from None
+    except OSError as err:
+        raise NeurohoverError(f"policy file {str(path)!r} cannot be read ({err.strerror or type(err).__name__})") from None
     return policy_from_dict(data, f"policy file {str(path)!r}")
 
 

@@ -361,6 +361,8 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
         raw = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as err:
         raise NeurohoverError(f"config {str(path)!r} is not valid TOML: {err}") from None
+    except (OSError, UnicodeDecodeError) as err:
+        raise NeurohoverError(f"config {str(path)!r} cannot be read ({getattr(err, 'strerror', None) or type(err).__name__})") from None
     where = f"config {str(path)!r}"
     allowed_top = {"name", "title", "kind", "paper_ref", "aliases", "settings", "scales", "paper"}
     unknown = sorted(set(raw) - allowed_top)

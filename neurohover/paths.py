@@ -1,0 +1,109 @@
+"""Checks of the command line's file and directory arguments, made before any long computation.
+
+Each check refuses a bad path with one :class:`~neurohover.errors.NeurohoverError` that names the
+option, the path and what is expected. Output checks really create (and remove again) a file, so
+an unwritable place is found even where permission bits do not tell (``/proc``, read-only mounts,
+running as root). Missing parent directories of an output are created, and a note on standard
+error says so: a typo in a path shows up at once instead of silently.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+from .errors import NeurohoverError
+
+__all__ = ["input_file", "input_dir", "output_dir", "output_file"]
+
+
+def _why(err: OSError) -> str:
+    return err.strerror or type(err).__name__
+
+
+def _make_dirs(directory: Path, option: str, given: str) -> None:
+    """Create ``directory`` and any missing parents, saying so; refuse a file in the way."""
+    missing = []
+    here = directory
+    while not here.exists():
+        missing.append(here)
+        if here.parent == here:
+            break
+        here = here.parent
+    if here.exists() and not here.is_dir():
+        raise NeurohoverError(f"{option} {given!r}: {str(here)!r} is a file, not a directory")
+    if not missing:
+        return
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise NeurohoverError(f"{option} {given!r}: cannot create the directory {str(directory)!r} ({_why(err)})") from None
+    print(f"neurohover: created directory {str(missing[-1])!r}" + (f" and {len(missing) - 1} below it" if len(missing) > 1 else ""),
+          file=sys.stderr)
+
+
+def output_file(path: str | os.PathLike, option: str) -> Path:
+    """Check that the file ``path`` can be written (an existing file is kept as it is).
+
+    Refuses a directory, a parent that is a file, and any place where a file cannot be created;
+    creates missing parent directories (saying so on standard error).
+    """
+    p = Path(path)
+    if str(path) == "" or p.is_dir():
+        raise NeurohoverError(f"{option} {str(path)!r} is a directory; give a file path")
+    _make_dirs(p.parent, option, str(path))
+    existed = p.exists()
+    try:
+        with open(p, "ab"):  # appending nothing leaves an existing file's content and time as they are
+            pass
+    except OSError as err:
+        what = "write this file" if existed else f"create a file in {str(p.parent)!r}"
+        raise NeurohoverError(f"{option} {str(path)!r}: cannot {what} ({_why(err)})") from None
+    if not existed:
+        p.unlink(missing_ok=True)
+    return p
+
+
+def output_dir(path: str | os.PathLike, option: str) -> Path:
+    """Check that files can be written in the directory ``path``, creating it (saying so) if missing."""
+    p = Path(path)
+    if str(path) == "":
+        raise NeurohoverError(f"{option} is empty; give a directory")
+    if p.exists() and not p.is_dir():
+        raise NeurohoverError(f"{option} {str(path)!r} is a file; give a directory")
+    _make_dirs(p, option, str(path))
+    try:
+        with tempfile.TemporaryFile(dir=p):
+            pass
+    except OSError as err:
+        raise NeurohoverError(f"{option} {str(path)!r}: cannot write files in this directory ({_why(err)})") from None
+    return p
+
+
+def input_file(path: str | os.PathLike, option: str, what: str = "file") -> Path:
+    """Check that ``path`` is an existing, readable regular file."""
+    p = Path(path)
+    if not p.exists():
+        raise NeurohoverError(f"{option} {str(path)!r}: no such {what}")
+    if p.is_dir():
+        raise NeurohoverError(f"{option} {str(path)!r} is a directory; give a {what}")
+    if not p.is_file():
+        raise NeurohoverError(f"{option} {str(path)!r} is not a regular file; give a {what}")
+    try:
+        with open(p, "rb") as f:
+            f.read(1)
+    except OSError as err:
+        raise NeurohoverError(f"{option} {str(path)!r}: cannot read this {what} ({_why(err)})") from None
+    return p
+
+
+def input_dir(path: str | os.PathLike, option: str) -> Path:
+    """Check that ``path`` is an existing directory."""
+    p = Path(path)
+    if not p.exists():
+        raise NeurohoverError(f"{option} {str(path)!r}: no such directory")
+    if not p.is_dir():
+        raise NeurohoverError(f"{option} {str(path)!r} is a file; give a directory")
+    return p

@@ -1,0 +1,92 @@
+"""Bad paths and conflicting options on the command line: each must end with one clear message.
+
+Run as a script (``python3 tests/bad_input.py``) it flies every case in a fresh process and prints
+one line per case: exit status, whether a traceback appeared, and the message. The test suite
+(tests/test_bad_input.py) runs the same cases.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+# (arguments, a piece of the expected message); paths are relative to the directory made by setup().
+CASES: list[tuple[list[str], str]] = [
+    (["fly", "--task", "ghh08", "--episodes", "1", "--record", "adir"], "is a directory"),
+    (["fly", "--task", "ghh08", "--episodes", "1", "--record", "afile/x.npz"], "is a file, not a directory"),
+    (["fly", "--task", "ghh08", "--episodes", "1", "--record", "/proc/x.npz"], "cannot create a file in '/proc'"),
+    (["fly", "--task", "ghh08", "--policy", "/proc/self/mem"], "cannot be read"),
+    (["fly", "--task", "ghh08", "--policy", "adir"], "is not a file"),
+    (["evolve", "--task", "ghh08", "--budget", "1000000000", "--out", "adir"], "is a directory"),
+    (["evolve", "--task", "ghh08", "--budget", "1000000000", "--out", "/proc/p.json"], "cannot create a file in '/proc'"),
+    (["evolve", "--task", "ghh08", "--budget", "1000000000", "--out", "afile/p.json"], "is a file, not a directory"),
+    (["learn-model", "--flight-data", "fd.npz", "--method", "lr", "--out", "adir"], "is a directory"),
+    (["learn-model", "--flight-data", "j.json", "--method", "lr", "--out", "m.json"], "not a neurohover flight-data file"),
+    (["learn-model", "--flight-data", "adir", "--method", "lr", "--out", "m.json"], "is a directory"),
+    (["learn-model", "--flight-data", "/proc/self/mem", "--method", "lr", "--out", "m.json"], "cannot read this flight-data file"),
+    (["learn-model", "--flight-data", "missing.npz", "--method", "lr", "--out", "m.json"], "no such flight-data file"),
+    (["results", "fig2", "--store", "store.sqlite", "--out", "adir"], "is a directory"),
+    (["results", "fig2", "--store", "adir"], "is a directory"),
+    (["report", "--store", "store.sqlite", "--out", "afile"], "is a file; give a directory"),
+    (["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--out", "afile"],
+     "is a file; give a directory"),
+    (["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--out", "q",
+      "--policy-dir", "afile"], "is a file; give a directory"),
+    (["build-policies", "--task", "ghh08", "--budget", "10", "--out", "afile"], "is a file; give a directory"),
+    (["reproduce", "fig2", "--store", "adir"], "is a directory"),
+    (["reproduce", "fig2", "--store", "/proc/s.sqlite"], "cannot create a file in '/proc'"),
+    (["reproduce", "adir/x.toml", "--store", "s.sqlite"], "does not exist"),
+    # option conflicts
+    (["fly", "--task", "ghh08", "--wind", "1,1", "--mdp", "train:0"], "cannot be combined with --mdp train:0"),
+    (["fly", "--task", "ghh08", "--params", "1,1", "--mdp", "test:3"], "cannot be combined with --mdp test:3"),
+    (["evolve", "--task", "ghh08", "--wind", "1,1", "--mdp", "train:0", "--out", "p.json"], "cannot be combined with --mdp train:0"),
+    (["learn-model", "--flight-data", "fd.npz", "--method", "lr", "--budget", "5", "--out", "m.json"], "not to --method lr"),
+    (["learn-model", "--flight-data", "fd.npz", "--method", "ec-meno", "--estimator", "ols", "--out", "m.json"],
+     "--estimator applies to --method lr only"),
+    (["learn-model", "--flight-data", "fd.npz", "--method", "lr", "--policy", "baseline", "--out", "m.json"],
+     "--policy applies to --method ec-mer only"),
+    (["reproduce", "fig2", "--store", "s.sqlite", "--address", "127.0.0.1:6379"], "add --executor ray"),
+    (["compete", "--task", "ghh08", "--agent", "baseline", "--safeguard-box", "0.3", "--out", "q"], "hybrid agents only"),
+]
+
+
+def setup(directory: Path) -> Path:
+    """Make the files the cases name: a directory, a plain file, a JSON file, flight data, a store."""
+    from neurohover.evaluate import evaluate_jobs
+    from neurohover.experiments import Store
+    from neurohover.policies import baseline_policy
+    from neurohover.tasks import get_task_family
+
+    (directory / "adir").mkdir()
+    (directory / "afile").write_text("not a directory\n")
+    (directory / "j.json").write_text("{}\n")
+    ev = evaluate_jobs([baseline_policy()], [get_task_family("ghh08").zero()], [0], [0], [0], record=[True], n_steps=50)
+    ev.flight_data.save(directory / "fd.npz")
+    Store(directory / "store.sqlite").close()
+    return directory
+
+
+def run_case(args: list[str], cwd: Path, timeout: float = 120.0) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "neurohover", *args], cwd=cwd, capture_output=True, text=True,
+                          timeout=timeout)
+
+
+def main() -> int:
+    bad = 0
+    with tempfile.TemporaryDirectory() as tmp:
+        cwd = setup(Path(tmp))
+        for args, expected in CASES:
+            proc = run_case(args, cwd)
+            lines = proc.stderr.strip().splitlines()
+            ok = proc.returncode == 2 and "Traceback" not in proc.stderr and len(lines) == 1 and expected in proc.stderr
+            bad += not ok
+            print(f"{'ok ' if ok else 'BAD'} exit={proc.returncode} traceback={'Traceback' in proc.stderr} "
+                  f"neurohover {' '.join(args)} -> {lines[-1] if lines else '(no message)'}")
+    print(f"{len(CASES) - bad} of {len(CASES)} cases refused cleanly")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,114 @@
+"""Bad paths and option conflicts: one clear message, exit status 2, before any long computation."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import time
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from bad_input import CASES, run_case, setup
+from neurohover.cli import main
+from neurohover.flightdata import FlightData
+
+
+@pytest.fixture(scope="module")
+def workdir(tmp_path_factory) -> Path:
+    return setup(tmp_path_factory.mktemp("bad-input"))
+
+
+@pytest.mark.parametrize("args, expected", CASES, ids=[" ".join(a[:1] + a[-2:]) for a, _ in CASES])
+def test_each_case_is_refused_with_one_clear_line(args, expected, workdir: Path, capsys, monkeypatch) -> None:
+    monkeypatch.chdir(workdir)
+    before = sorted(p.name for p in workdir.iterdir())
+    rc = main(list(args))  # an uncaught exception (a traceback) fails the test here
+    err = capsys.readouterr().err
+    assert rc == 2
+    assert len(err.strip().splitlines()) == 1 and expected in err, err
+    assert sorted(p.name for p in workdir.iterdir()) == before  # nothing written, no stray directories
+
+
+def test_the_script_runs_a_case_in_a_fresh_process(workdir: Path) -> None:
+    # evolve with an unwritable --out and a budget of 1e9 episodes: refused at once, not after evolving.
+    start = time.perf_counter()
+    proc = run_case(["evolve", "--task", "ghh08", "--budget", "1000000000", "--out", "adir"], workdir, timeout=120)
+    assert time.perf_counter() - start < 60
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    assert proc.stderr.strip() == "neurohover evolve: error: --out 'adir' is a directory; give a file path"
+
+
+def test_missing_parent_directories_are_created_and_announced(tmp_path: Path, capsys) -> None:
+    target = tmp_path / "new" / "deeper" / "flight.npz"
+    rc = main(["fly", "--task", "ghh08", "--episodes", "2", "--record", str(target), "--json"])
+    out, err = capsys.readouterr()
+    assert rc == 0 and target.is_file()
+    assert f"created directory {str(tmp_path / 'new')!r} and 1 below it" in err
+    assert json.loads(out)["flight_data"] == str(target)
+
+
+def test_an_existing_output_file_survives_the_check(tmp_path: Path) -> None:
+    from neurohover.paths import output_file
+
+    path = tmp_path / "keep.txt"
+    path.write_text("results\n")
+    mtime = os.stat(path).st_mtime_ns
+    assert output_file(path, "--out") == path
+    assert path.read_text() == "results\n" and os.stat(path).st_mtime_ns == mtime
+    output_file(tmp_path / "fresh.txt", "--out")
+    assert not (tmp_path / "fresh.txt").exists()  # the probe leaves nothing behind
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root may write anywhere; /proc covers unwritable places above")
+def test_an_unwritable_directory_is_refused(tmp_path: Path, capsys) -> None:
+    locked = tmp_path / "locked"
+    locked.mkdir(mode=0o500)
+    assert main(["fly", "--task", "ghh08", "--episodes", "1", "--record", str(locked / "x.npz")]) == 2
+    assert "cannot create a file in" in capsys.readouterr().err
+
+
+def test_recorded_flight_data_are_compressed(tmp_path: Path, capsys) -> None:
+    path = tmp_path / "f.npz"
+    assert main(["fly", "--task", "ghh08", "--episodes", "2", "--record", str(path), "--json"]) == 0
+    with zipfile.ZipFile(path) as z:
+        assert {i.compress_type for i in z.infolist()} == {zipfile.ZIP_DEFLATED}
+        raw = sum(i.file_size for i in z.infolist())
+    assert path.stat().st_size < raw  # float64 noise compresses little, but it does compress
+    assert FlightData.load(path).n_transitions == 12000
+
+
+def test_fly_progress_is_quiet_with_json_and_chunking_changes_no_result(tmp_path: Path, capsys, monkeypatch) -> None:
+    import neurohover.cli as cli
+
+    assert main(["fly", "--task", "ghh08", "--mdp", "train:1", "--episodes", "7", "--json"]) == 0
+    whole = capsys.readouterr()
+    assert whole.err == ""
+    monkeypatch.setattr(cli, "FLY_CHUNK", 3)  # three kernel calls of 3, 3 and 1 episodes
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True, raising=False)
+    assert main(["fly", "--task", "ghh08", "--mdp", "train:1", "--episodes", "7"]) == 0
+    chunked = capsys.readouterr()
+    assert "7/7" in chunked.err  # the progress bar ran to the end
+    mean = float(next(line for line in chunked.out.splitlines() if "mean_return" in line).split(":")[1])
+    np.testing.assert_allclose(mean, json.loads(whole.out)["mean_return"], rtol=1e-6)
+
+
+def test_version_names_the_installed_package(capsys) -> None:
+    from importlib.metadata import version
+
+    with pytest.raises(SystemExit) as stop:
+        main(["--version"])
+    assert stop.value.code == 0
+    assert capsys.readouterr().out.strip() == f"neurohover {version('neurohover')}"
+
+
+def test_the_script_prints_one_line_per_case() -> None:
+    proc = subprocess.run([sys.executable, str(Path(__file__).with_name("bad_input.py"))], capture_output=True, text=True,
+                          timeout=900)
+    lines = proc.stdout.strip().splitlines()
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert len(lines) == len(CASES) + 1 and all(line.startswith("ok ") for line in lines[:-1])
