@@ -253,7 +253,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     else:
         print(f"{why}; learned parameters (converted to the simulator's 10 substeps) next to the simulator's defaults:")
     print(format_parameter_table(rows))
-    for line in _model_notes(model, data, truth, rows):
+    for line in model_notes(model, data, truth, rows):
         print(f"neurohover learn-model: {line}", file=sys.stderr)
     return 0
 
@@ -264,8 +264,14 @@ MIN_TRANSITIONS = 600
 CHECK_EPISODES = 3
 
 
-def _model_notes(model, data, truth, rows) -> list[str]:
-    """Warnings and explanations that keep the learned model's table from misleading."""
+def model_notes(model, data, truth, rows) -> list[str]:
+    """Warnings and explanations that keep ``learn-model``'s parameter table from misleading.
+
+    Explains rows without a 10-substep equivalent (nan), and warns when the data are short, when
+    the true MDP's wind was absorbed into the model, and when the baseline policy crashes on the
+    model (flown ``CHECK_EPISODES`` times) but not in the true MDP. ``rows`` is the
+    :func:`~neurohover.models.parameter_table` of ``model`` against ``truth`` (None: unknown).
+    """
     import numpy as np
 
     from .evaluate import evaluate
