@@ -18,10 +18,9 @@ from __future__ import annotations
 
 import csv
 import json
-import multiprocessing
 import os
 from collections.abc import Callable, Sequence
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, wait
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -30,6 +29,7 @@ import numpy as np
 from .agents.hybrid import HybridSettings
 from .agents.protocol import RunResult, run_test
 from .errors import NeurohoverError
+from .procs import sigterm_as_interrupt, stop_pool, worker_pool
 from .sim.constants import EPISODE_STEPS
 from .tasks import MDP, get_task_family
 
@@ -164,7 +164,8 @@ def compete(
 
     ``hybrid`` sets the safeguard and replacement rule of the hybrid agents (ignored by the others).
 
-    Raises KeyboardInterrupt after saving every finished run when interrupted.
+    Raises KeyboardInterrupt after saving every finished run when interrupted (SIGTERM too, as
+    :class:`~neurohover.procs.Terminated`, while ``jobs > 1``).
     """
     from .agents.registry import check_agent
 
@@ -191,19 +192,19 @@ def compete(
         for spec in specs:
             finish(spec, execute(spec, threads=None))
     else:
-        # Spawned workers: numba's thread pools do not survive fork safely.
-        ctx = multiprocessing.get_context("spawn")
-        with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
-            pending = {pool.submit(execute, spec, 1): spec for spec in specs}
-            try:
+        # Spawned workers that exit when this process dies; SIGTERM ends them like Ctrl-C.
+        pool = worker_pool(jobs)
+        try:
+            with sigterm_as_interrupt():
+                pending = {pool.submit(execute, spec, 1): spec for spec in specs}
                 while pending:
                     done, _ = wait(pending, return_when=FIRST_COMPLETED)
                     for future in done:
                         finish(pending.pop(future), future.result())
-            except KeyboardInterrupt:
-                for future in pending:
-                    future.cancel()
-                raise
+        except BaseException:
+            stop_pool(pool)  # an unfinished run is never written: end the others at once
+            raise
+        pool.shutdown(wait=True)
     ordered = [results[i] for i in sorted(results)]
     summary = {"task": task, "agent": agent, "mdps": mdps, "seed": seed, **summarise(ordered)}
     (out / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")

@@ -2,7 +2,8 @@
 
 - :class:`LocalExecutor`: in this process (``jobs=1``, the kernel on all cores), or in ``jobs``
   spawned worker processes (one kernel thread each; spawn, because numba's thread pools are not
-  fork-safe).
+  fork-safe). The workers exit when this process dies (see :mod:`neurohover.procs`), and SIGTERM
+  ends them like Ctrl-C.
 - :class:`RayExecutor`: Ray tasks on a cluster (``address``), or on a local Ray instance it starts.
   The driver collects results with ``ray.wait`` (and drives the progress bar). A task whose worker
   dies is retried by Ray up to ``max_retries`` times; if it still fails, the unit is reported as
@@ -14,13 +15,13 @@ Results and seeds are the same on every executor: a unit carries its own seed (d
 
 from __future__ import annotations
 
-import multiprocessing
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 
 from ..errors import NeurohoverError
+from ..procs import sigterm_as_interrupt, stop_pool, worker_pool
 from .store import worker_name
 from .units import Unit, run_unit
 
@@ -72,26 +73,27 @@ class LocalExecutor:
         if self._pool is None:
             # One pool for the executor's lifetime (all stages and experiments): spawning workers
             # and loading the compiled kernel costs seconds per process.
-            self._pool = ProcessPoolExecutor(max_workers=self.jobs, mp_context=multiprocessing.get_context("spawn"))
+            self._pool = worker_pool(self.jobs)
         pool = self._pool
         try:
-            pending = {pool.submit(timed_run, unit.to_dict(), 1): unit for unit in units}
-            while pending:
-                done, _ = wait(pending, return_when=FIRST_COMPLETED)
-                for future in done:
-                    unit = pending.pop(future)
-                    try:
-                        result, seconds, worker = future.result()
-                    except BrokenProcessPool as err:
-                        on_error(unit, RuntimeError(f"worker process died ({err})"))
-                        self._pool = None  # a broken pool cannot run more units: start a new one next time
-                        continue
-                    except Exception as err:  # noqa: BLE001
-                        on_error(unit, err)
-                        continue
-                    on_result(unit, result, seconds, worker)
+            with sigterm_as_interrupt():  # SIGTERM ends the workers like Ctrl-C, not leaving them orphaned
+                pending = {pool.submit(timed_run, unit.to_dict(), 1): unit for unit in units}
+                while pending:
+                    done, _ = wait(pending, return_when=FIRST_COMPLETED)
+                    for future in done:
+                        unit = pending.pop(future)
+                        try:
+                            result, seconds, worker = future.result()
+                        except BrokenProcessPool as err:
+                            on_error(unit, RuntimeError(f"worker process died ({err})"))
+                            self._pool = None  # a broken pool cannot run more units: start a new one next time
+                            continue
+                        except Exception as err:  # noqa: BLE001
+                            on_error(unit, err)
+                            continue
+                        on_result(unit, result, seconds, worker)
         except BaseException:
-            _stop(pool)
+            stop_pool(pool)
             self._pool = None
             raise
 
@@ -99,25 +101,6 @@ class LocalExecutor:
         if self._pool is not None:
             self._pool.shutdown(wait=True)
             self._pool = None
-
-
-def _stop(pool: ProcessPoolExecutor) -> None:
-    """Cancel the queued units and end the running ones at once (on Ctrl-C or an error).
-
-    An interrupted unit is never recorded, so letting a worker finish it (which the pool's own
-    shutdown does, for up to a unit's whole run time) would only keep the command waiting.
-    """
-    workers = list((getattr(pool, "_processes", None) or {}).values())
-    pool.shutdown(wait=False, cancel_futures=True)
-    for process in workers:
-        process.terminate()
-    # The pool's manager thread may reap a worker while join() waits on it; join() then returns
-    # before the process is marked dead, so wait for that too.
-    deadline = time.monotonic() + 10
-    for process in workers:
-        process.join(timeout=max(0.0, deadline - time.monotonic()))
-        while process.is_alive() and time.monotonic() < deadline:
-            time.sleep(0.01)
 
 
 def import_ray():

@@ -1,0 +1,122 @@
+"""Worker process pools that never outlive their parent.
+
+A spawned worker of a plain :class:`~concurrent.futures.ProcessPoolExecutor` waits forever for its
+next task when its parent is killed (SIGKILL, or SIGTERM without a handler): it keeps its cores
+busy with a unit nobody will record, then idles as an orphan. The pools made here avoid that:
+
+- each worker watches its parent: on Linux the kernel sends it SIGKILL when the parent dies
+  (``PR_SET_PDEATHSIG``), and a daemon thread checks ``os.getppid()`` every
+  :data:`WATCH_SECONDS` everywhere (a worker reparented to init or a subreaper exits at once);
+- :func:`sigterm_as_interrupt` turns SIGTERM in the parent into :class:`Terminated` (a
+  KeyboardInterrupt), so the parent's Ctrl-C path runs: finished work is kept, the workers are
+  ended by :func:`stop_pool`, and the command exits as if interrupted.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import multiprocessing
+import os
+import signal
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from concurrent.futures import ProcessPoolExecutor
+
+WATCH_SECONDS = 0.5  # how often a worker checks that its parent is alive
+
+_PR_SET_PDEATHSIG = 1  # from <linux/prctl.h>
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM arrived while a worker pool was running (handled like Ctrl-C)."""
+
+
+def _die_with_parent() -> bool:
+    """Ask the kernel to SIGKILL this process when its parent thread exits (Linux); True if set."""
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        return libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0
+    except (OSError, AttributeError):
+        return False
+
+
+def _watch(parent: int) -> None:
+    while True:
+        if os.getppid() != parent:
+            os._exit(1)  # no cleanup: the work of an orphan is never recorded
+        time.sleep(WATCH_SECONDS)
+
+
+def watch_parent(parent: int, pdeathsig: bool = True) -> None:
+    """Pool initializer: end this worker process when process ``parent`` is gone.
+
+    Parameters
+    ----------
+    parent : int
+        Pid of the process that started this worker.
+    pdeathsig : bool
+        Also ask the Linux kernel for SIGKILL on the parent's death. Only right when the worker was
+        started from the parent's main thread: the kernel sends the signal when the *thread* that
+        started the worker exits, not the process.
+    """
+    if pdeathsig:
+        _die_with_parent()
+    if os.getppid() != parent:  # the parent died before the watch began
+        os._exit(1)
+    # The thread covers the other systems (a numba kernel holding the GIL may delay it a little).
+    threading.Thread(target=_watch, args=(parent,), name="neurohover-parent-watch", daemon=True).start()
+
+
+def worker_pool(jobs: int) -> ProcessPoolExecutor:
+    """A pool of ``jobs`` spawned worker processes that exit when this process dies.
+
+    Spawned, not forked: numba's thread pools are not fork-safe.
+    """
+    main = threading.current_thread() is threading.main_thread()
+    return ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("spawn"),
+                               initializer=watch_parent, initargs=(os.getpid(), main))
+
+
+def stop_pool(pool: ProcessPoolExecutor) -> None:
+    """Cancel the queued tasks and end the running ones at once (on Ctrl-C, SIGTERM or an error).
+
+    Interrupted work is never recorded, so letting a worker finish its task (which the pool's own
+    shutdown does, for up to a task's whole run time) would only keep the command waiting.
+    """
+    workers = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in workers:
+        process.terminate()
+    # The pool's manager thread may reap a worker while join() waits on it; join() then returns
+    # before the process is marked dead, so wait for that too.
+    deadline = time.monotonic() + 10
+    for process in workers:
+        process.join(timeout=max(0.0, deadline - time.monotonic()))
+        while process.is_alive() and time.monotonic() < deadline:
+            time.sleep(0.01)
+
+
+def _raise_terminated(signum, frame) -> None:
+    raise Terminated(f"signal {signum}")
+
+
+@contextlib.contextmanager
+def sigterm_as_interrupt() -> Iterator[None]:
+    """While inside, SIGTERM raises :class:`Terminated` in the main thread.
+
+    Does nothing outside the main thread or when SIGTERM already has a handler of its own.
+    """
+    if threading.current_thread() is not threading.main_thread() or signal.getsignal(signal.SIGTERM) != signal.SIG_DFL:
+        yield
+        return
+    signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)

@@ -1,0 +1,160 @@
+"""Robustness of long runs (issue 10), with real processes: worker processes never outlive a killed
+``reproduce`` or ``compete``, a bad or dead Ray address ends at once with a clear message, and one
+store has one writer at a time.
+
+Linux only: the tests find a process's children in /proc.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from neurohover.experiments import Store
+
+ROOT = Path(__file__).resolve().parents[1]
+ENV = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
+
+# An evolution experiment whose units each take tens of seconds (far longer than the tests wait).
+LONG_CONFIG = """
+name = "longtest"
+title = "orphan test"
+kind = "evolution"
+[settings]
+task = "fghh"
+sigma = 0.3
+seed = 5
+target = "family"
+runs = 4
+[[settings.variants]]
+key = "k1"
+label = "k = 1"
+[scales.quick]
+budget = 400000
+n_steps = 200
+[scales.paper]
+budget = 400000
+n_steps = 200
+"""
+
+
+def _start(tmp_path: Path, *argv: str) -> subprocess.Popen:
+    """``neurohover ARGV`` in its own session (so a failed test can end the whole group)."""
+    out = open(tmp_path / "stdout.txt", "w")
+    err = open(tmp_path / "stderr.txt", "w")
+    try:
+        return subprocess.Popen([sys.executable, "-m", "neurohover", *argv], cwd=ROOT, env=ENV, stdout=out, stderr=err,
+                                start_new_session=True)
+    finally:
+        out.close()
+        err.close()
+
+
+def _children(pid: int) -> set[int]:
+    found: set[int] = set()
+    for task in Path(f"/proc/{pid}/task").glob("*"):
+        try:
+            found.update(int(x) for x in (task / "children").read_text().split())
+        except OSError:
+            pass
+    return found
+
+
+def _alive(pid: int) -> bool:
+    """Whether ``pid`` runs (a zombie, dead but not yet reaped by its new parent, does not)."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return False
+    return stat.rsplit(")", 1)[1].split()[0] not in ("Z", "X")
+
+
+def _cpu_seconds(pid: int) -> float:
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return 0.0
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def _is_worker(pid: int) -> bool:
+    try:
+        return b"spawn_main" in Path(f"/proc/{pid}/cmdline").read_bytes()
+    except OSError:
+        return False
+
+
+def _busy_workers(proc: subprocess.Popen, n: int, cpu: float = 1.0, timeout: float = 180) -> set[int]:
+    """Every child of ``proc`` once ``n`` of them are pool workers that have each run ``cpu`` s."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        assert proc.poll() is None, f"the command ended early ({proc.returncode})"
+        children = _children(proc.pid)
+        workers = [p for p in children if _is_worker(p)]
+        if len(workers) >= n and all(_cpu_seconds(p) >= cpu for p in workers):
+            return children
+        time.sleep(0.1)
+    raise AssertionError(f"no {n} busy workers after {timeout} s: children {_children(proc.pid)}")
+
+
+def _gone_within(pids: set[int], seconds: float) -> set[int]:
+    """The pids of ``pids`` still alive after ``seconds``."""
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline and any(_alive(p) for p in pids):
+        time.sleep(0.05)
+    return {p for p in pids if _alive(p)}
+
+
+def _end_group(proc: subprocess.Popen) -> None:
+    """Clean up after a failed test: SIGKILL everything left in the command's process group."""
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except ProcessLookupError:
+        pass
+    if proc.poll() is None:
+        proc.wait(timeout=30)
+
+
+# --------------------------------------------------------------------------------- no orphans
+
+
+@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM], ids=["SIGKILL", "SIGTERM"])
+def test_the_workers_of_a_killed_reproduce_exit(tmp_path: Path, sig: int) -> None:
+    config = tmp_path / "long.toml"
+    config.write_text(LONG_CONFIG)
+    store = tmp_path / "s.sqlite"
+    proc = _start(tmp_path, "reproduce", str(config), "--store", str(store), "--jobs", "2", "--no-progress")
+    try:
+        children = _busy_workers(proc, 2)
+        os.kill(proc.pid, sig)
+        rc = proc.wait(timeout=30)
+        assert not _gone_within(children, 10), "worker processes outlived their parent"
+        if sig == signal.SIGTERM:  # handled like Ctrl-C: the run is marked interrupted
+            assert rc == 130, (tmp_path / "stderr.txt").read_text()[-2000:]
+            assert "interrupted" in (tmp_path / "stderr.txt").read_text()
+            with Store(store) as s:
+                assert [x["status"] for x in s.sessions("longtest", "quick")] == ["interrupted"]
+        else:
+            assert rc == -signal.SIGKILL
+    finally:
+        _end_group(proc)
+
+
+@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM], ids=["SIGKILL", "SIGTERM"])
+def test_the_workers_of_a_killed_compete_exit(tmp_path: Path, sig: int) -> None:
+    proc = _start(tmp_path, "compete", "--task", "ghh08", "--agent", "baseline", "--runs", "2", "--jobs", "2",
+                  "--episodes", "200000", "--out", str(tmp_path / "out"))
+    try:
+        children = _busy_workers(proc, 2)
+        os.kill(proc.pid, sig)
+        rc = proc.wait(timeout=30)
+        assert not _gone_within(children, 10), "worker processes outlived their parent"
+        assert rc == (130 if sig == signal.SIGTERM else -signal.SIGKILL), (tmp_path / "stderr.txt").read_text()[-2000:]
+    finally:
+        _end_group(proc)
