@@ -1050,7 +1050,7 @@ def benchmark_evolution(quick: bool = False, repeats: int | None = None) -> dict
 
     cores = numba.config.NUMBA_NUM_THREADS
     repeats = (1 if quick else 2) if repeats is None else repeats
-    budget_ss, budget_gen = (300, 1000) if quick else (2000, 5000)
+    budget_ss, budget_gen = (200, 300) if quick else (2000, 5000)  # quick: about a second (2 generations of fixed:5)
     cases = [
         ("evolve_steady_state_1_core", get_task_family("fghh").zero(), 1, budget_ss, None),
         (f"evolve_generational_fixed5_{cores}_cores", get_task_family("fghh", 0.3), cores, budget_gen, "fixed:5"),
