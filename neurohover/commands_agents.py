@@ -64,6 +64,8 @@ _HYBRID_OPTIONS = ("safeguard_rule", "safeguard_box", "safeguard_tilt", "hybrid_
 
 
 def register(sub) -> None:
+    from .agents.registry import AGENTS
+
     p = sub.add_parser("build-policies", help="evolve the generic and specialised policies of a task", description=cmd_build_policies.__doc__)
     p.add_argument("--task", required=True, help="ghh08, ghh09 or fghh")
     p.add_argument("--out", help="directory to write <task>/ into (default: the package's shipped policies)")
@@ -75,7 +77,7 @@ def register(sub) -> None:
 
     p = sub.add_parser("compete", help="run test runs of an on-line agent", description=cmd_compete.__doc__)
     p.add_argument("--task", required=True, help="ghh08, ghh09 or fghh")
-    p.add_argument("--agent", required=True, help="model-free, model-based, incremental, hybrid, hybrid-baseline, generic, baseline; FGHH: incremental-zero|fixed|race")
+    p.add_argument("--agent", required=True, help="; ".join(f"{name} ({', '.join(spec.tasks)}): {spec.summary}" for name, spec in AGENTS.items()))
     p.add_argument("--runs", type=int, default=10, help="independent test runs (default 10)")
     p.add_argument("--episodes", type=int, default=1000, help="episodes per run (default 1000)")
     p.add_argument("--mdps", default="test", help="test (the fixed test MDPs in turn), sample (fresh from G) or train")

@@ -69,10 +69,10 @@ def run_mdps(task: str, runs: int, mdps: str, seed: int, sigma: float | None = N
 
 def execute(spec: RunSpec, threads: int | None = 1) -> RunResult:
     """Fly one test run (in this process)."""
-    from .agents.registry import make_agent
+    from .agents.registry import AgentOptions, make_agent
 
     family = get_task_family(spec.task, spec.sigma)
-    agent = make_agent(spec.agent, family, policy_dir=spec.policy_dir, hybrid=spec.hybrid)
+    agent = make_agent(spec.agent, family, policy_dir=spec.policy_dir, options=AgentOptions(hybrid=spec.hybrid))
     return run_test(agent, family, spec.mdp, episodes=spec.episodes, seed=spec.seed * 1_000_003 + spec.index,
                     n_steps=spec.n_steps, threads=threads)
 

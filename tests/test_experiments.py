@@ -363,7 +363,7 @@ def test_results_export_csv_and_json(quick_store: Path, capsys, tmp_path: Path) 
     rc, _, err = _run(capsys, "results", "fig7", "--store", str(quick_store))
     assert rc == 2 and "holds no experiment 'fig7'" in err and "fig8 (quick)" in err
     rc, _, err = _run(capsys, "results", "fig8", "--store", str(tmp_path / "missing.sqlite"))
-    assert rc == 2 and "does not exist" in err
+    assert rc == 2 and "no such results store" in err
 
 
 def test_report_draws_the_figures_and_compares_with_the_paper(quick_store: Path, tmp_path: Path, capsys) -> None:

@@ -20,12 +20,12 @@ import numpy as np
 from ..errors import NeurohoverError
 from ..evaluate import DangerousState
 from ..flightdata import FlightData
-from ..policies import Policy
+from ..policies import Policy, baseline_policy
 from ..tasks import MDP, TaskFamily
 from .model_based import ModelEvolution, evolve_on_model, learn_model
 from .protocol import Agent, Choice, EpisodeOutcome
+from .spec import AgentOptions, AgentPolicies, AgentSpec
 
-HYBRID_AGENTS = ("hybrid", "hybrid-baseline")  # the registry's names (generic or baseline fallback)
 N_EVOLVED = 3
 DISCARD_RETURN = -1e6  # the authors' code charges a policy that needed the safeguard an error of 1e6
 REPLACEMENTS = ("rerank", "evolve")
@@ -197,3 +197,20 @@ class HybridAgent(Agent):
             self.discarded += 1
         self._credit_fallback(outcome.ret)
         self._pick_best()
+
+
+def _hybrid(name: str, fallback: str):
+    def build(policies: AgentPolicies, options: AgentOptions) -> Agent:
+        assert policies.generic is not None
+        backup = policies.generic if fallback == "generic" else baseline_policy()
+        return HybridAgent(policies.safe, policies.generic, backup, options.evolution or ModelEvolution(), name=name,
+                           hybrid=options.hybrid or HybridSettings())
+    return build
+
+
+AGENT_SPECS = (
+    AgentSpec("hybrid", ("ghh08", "ghh09"), frozenset({"generic", "safe"}), _hybrid("hybrid", "generic"), takes_hybrid=True,
+              summary="the safe specialised pair, then policies evolved on a model, under a safeguard (generic fallback)"),
+    AgentSpec("hybrid-baseline", ("ghh08", "ghh09"), frozenset({"generic", "safe"}), _hybrid("hybrid-baseline", "baseline"),
+              takes_hybrid=True, summary="the hybrid agent with the baseline policy as the safeguard's fallback"),
+)

@@ -18,6 +18,7 @@ from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
 from .protocol import Agent, Choice, EpisodeOutcome
+from .spec import AgentOptions, AgentPolicies, AgentSpec
 
 
 @dataclass(frozen=True)
@@ -148,3 +149,31 @@ class IncrementalModelBasedAgent(Agent):
         self.models_learned += 1
         self.current, self.predicted = evolve_on_model(model, self.generic, self.settings, int(self._rng.integers(2**62)))
         self.current_label = f"model:{self.models_learned}"
+
+
+def _model_based(policies: AgentPolicies, options: AgentOptions) -> Agent:
+    assert policies.generic is not None
+    return ModelBasedAgent(policies.generic, options.evolution or ModelEvolution())
+
+
+def _incremental(name: str):
+    def build(policies: AgentPolicies, options: AgentOptions) -> Agent:
+        assert policies.generic is not None
+        limit = {} if options.max_learning_episodes is None else {"max_learning_episodes": options.max_learning_episodes}
+        agent = IncrementalModelBasedAgent(policies.generic, options.evolution or ModelEvolution(), **limit)
+        agent.name = name
+        return agent
+    return build
+
+
+_ALL = ("ghh08", "ghh09", "fghh")
+AGENT_SPECS = (
+    AgentSpec("model-based", _ALL, frozenset({"generic"}), _model_based, generic_kind={"fghh": "race"},
+              summary="fly the generic policy once, learn a model, evolve a policy on it, keep it"),
+    AgentSpec("incremental", _ALL, frozenset({"generic"}), _incremental("incremental"), generic_kind={"fghh": "race"},
+              summary="re-learn the model and re-evolve after every episode until a policy meets its prediction"),
+    *(AgentSpec(f"incremental-{kind}", ("fghh",), frozenset({"generic"}), _incremental(f"incremental-{kind}"),
+                generic_kind={"fghh": kind}, summary=f"incremental, from the FGHH generic policy evolved {what}")
+      for kind, what in (("zero", "on the zero setting"), ("fixed", "over G with fixed resampling"),
+                         ("race", "over G with selection races"))),
+)

@@ -10,6 +10,7 @@ from ..errors import NeurohoverError
 from ..policies import Policy
 from ..tasks import TaskFamily
 from .protocol import Agent, Choice, EpisodeOutcome
+from .spec import AgentSpec
 
 
 class ModelFreeAgent(Agent):
@@ -41,3 +42,10 @@ class ModelFreeAgent(Agent):
     def update(self, outcome: EpisodeOutcome) -> None:
         if outcome.episode < len(self.specialised):
             self.trial_returns[outcome.episode] = outcome.ret
+
+
+AGENT_SPECS = (
+    AgentSpec("model-free", ("ghh08", "ghh09"), frozenset({"specialised"}),
+              lambda policies, options: ModelFreeAgent(policies.specialised),
+              summary="fly each specialised policy once, keep the best (the 2008 winner)"),
+)

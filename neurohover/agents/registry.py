@@ -1,98 +1,84 @@
-"""Agents by name, built from a task family's policy set (what ``neurohover compete --agent`` takes)."""
+"""Agents by name: the one registry that the CLI, the competitions and the experiments read.
+
+Every module of :mod:`neurohover.agents` that declares ``AGENT_SPECS`` (a sequence of
+:class:`~neurohover.agents.spec.AgentSpec`) is found here; adding an agent is one new module in
+this package (see the README's contributor section).
+"""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import importlib
+import pkgutil
 
 from ..errors import NeurohoverError
-from ..policies import baseline_policy
 from ..policysets import PolicySet, load_policy_set
 from ..tasks import TaskFamily
-from .hybrid import HYBRID_AGENTS, HybridAgent, HybridSettings
-from .model_based import IncrementalModelBasedAgent, ModelBasedAgent
-from .model_free import ModelFreeAgent
-from .protocol import Agent, Choice, EpisodeOutcome
+from .protocol import Agent
+from .spec import AgentOptions, AgentPolicies, AgentSpec
+
+# Modules listed first come first in help texts and messages; any other module follows by name.
+_FIRST = ("reference", "model_free", "model_based", "hybrid")
 
 
-class BaselineAgent(Agent):
-    """Flies the competition's baseline policy every episode (a reference, not a learner)."""
-
-    name = "baseline"
-
-    def choose(self, episode: int) -> Choice:
-        return Choice(baseline_policy(), "baseline", final=True)
-
-    def update(self, outcome: EpisodeOutcome) -> None:
-        pass
-
-
-class GenericAgent(Agent):
-    """Flies the task's generic policy every episode (no on-line learning)."""
-
-    name = "generic"
-
-    def __init__(self, policies: PolicySet) -> None:
-        self.generic = policies.generic
-
-    def choose(self, episode: int) -> Choice:
-        return Choice(self.generic, "generic", final=True)
-
-    def update(self, outcome: EpisodeOutcome) -> None:
-        pass
+def discover(package: str) -> dict[str, AgentSpec]:
+    """The ``AGENT_SPECS`` of every module of ``package``, by agent name, in a stable order."""
+    path = importlib.import_module(package).__path__
+    names = sorted((m.name for m in pkgutil.iter_modules(path)),
+                   key=lambda n: (_FIRST.index(n) if n in _FIRST else len(_FIRST), n))
+    specs: dict[str, AgentSpec] = {}
+    for name in names:
+        if name == "registry":
+            continue
+        for spec in getattr(importlib.import_module(f"{package}.{name}"), "AGENT_SPECS", ()):
+            if spec.name in specs:
+                raise RuntimeError(f"agent {spec.name!r} is declared twice (module {name!r} and another)")
+            specs[spec.name] = spec
+    return specs
 
 
-def _incremental(generic_name: str | None) -> Callable[[PolicySet], Agent]:
-    def make(ps: PolicySet) -> Agent:
-        generic = ps.generic if generic_name is None else ps.generics[generic_name]
-        agent = IncrementalModelBasedAgent(generic)
-        agent.name = "incremental" if generic_name is None else f"incremental-{generic_name}"
-        return agent
-    return make
+#: Every agent by name, in a stable order.
+AGENTS: dict[str, AgentSpec] = discover(__package__)
+#: The agents that take hybrid settings (safeguard and replacement rule).
+HYBRID_AGENTS: tuple[str, ...] = tuple(name for name, spec in AGENTS.items() if spec.takes_hybrid)
 
 
-def _hybrid(fallback: str) -> Callable[..., Agent]:
-    def make(ps: PolicySet, hybrid: HybridSettings = HybridSettings()) -> Agent:
-        safe = [ps.specialised[i] for i in ps.safe]
-        fb = ps.generic if fallback == "generic" else baseline_policy()
-        return HybridAgent(safe, ps.generic, fb, name="hybrid" if fallback == "generic" else "hybrid-baseline",
-                           hybrid=hybrid)
-    return make
+def agent_spec(name: str, task: str | None = None) -> AgentSpec:
+    """The spec of agent ``name``; refuses unknown names and, given ``task``, agents for other tasks."""
+    if name not in AGENTS:
+        raise NeurohoverError(f"unknown agent {name!r}: allowed {', '.join(AGENTS)}")
+    spec = AGENTS[name]
+    if task is not None and task not in spec.tasks:
+        raise NeurohoverError(f"agent {name!r} does not apply to task {task!r}: it runs on {', '.join(spec.tasks)}")
+    return spec
 
 
-# name -> (tasks it applies to, factory from the policy set; None: needs no policy set)
-AGENTS: dict[str, tuple[tuple[str, ...], Callable[..., Agent] | None]] = {
-    "baseline": (("ghh08", "ghh09", "fghh"), None),
-    "generic": (("ghh08", "ghh09", "fghh"), GenericAgent),
-    "model-free": (("ghh08", "ghh09"), lambda ps: ModelFreeAgent(ps.specialised)),
-    "model-based": (("ghh08", "ghh09", "fghh"), lambda ps: ModelBasedAgent(ps.generic)),
-    "incremental": (("ghh08", "ghh09", "fghh"), _incremental(None)),
-    "hybrid": (("ghh08", "ghh09"), _hybrid("generic")),
-    "hybrid-baseline": (("ghh08", "ghh09"), _hybrid("baseline")),
-    "incremental-zero": (("fghh",), _incremental("zero")),
-    "incremental-fixed": (("fghh",), _incremental("fixed")),
-    "incremental-race": (("fghh",), _incremental("race")),
-}
+def policies_from_set(spec: AgentSpec, ps: PolicySet) -> AgentPolicies:
+    """The policies of a policy set that agent ``spec`` flies."""
+    generic = None
+    if "generic" in spec.needs:
+        kind = spec.generic_kind.get(ps.task)
+        generic = ps.generics[kind] if kind is not None and ps.generics else ps.generic
+    return AgentPolicies(
+        generic=generic,
+        specialised=tuple(ps.specialised) if "specialised" in spec.needs else (),
+        safe=tuple(ps.specialised[i] for i in ps.safe) if "safe" in spec.needs else (),
+    )
 
 
 def check_agent(name: str, task: str, policy_dir: str | None = None) -> None:
     """Refuse unknown agents, agents for another task, and missing policy sets, with clear messages."""
-    if name not in AGENTS:
-        raise NeurohoverError(f"unknown agent {name!r}: allowed {', '.join(AGENTS)}")
-    tasks, factory = AGENTS[name]
-    if task not in tasks:
-        raise NeurohoverError(f"agent {name!r} does not apply to task {task!r}: it runs on {', '.join(tasks)}")
-    if factory is not None:
-        factory(load_policy_set(task, policy_dir))
+    spec = agent_spec(name, task)
+    if spec.needs:
+        spec.build(policies_from_set(spec, load_policy_set(task, policy_dir)), AgentOptions())
 
 
 def make_agent(name: str, family: TaskFamily, *, policy_dir: str | None = None,
-               hybrid: HybridSettings = HybridSettings()) -> Agent:
-    """A fresh agent called ``name`` for ``family`` (``hybrid``: the hybrid agents' safeguard settings)."""
-    if name not in AGENTS:
-        raise NeurohoverError(f"unknown agent {name!r}: allowed {', '.join(AGENTS)}")
-    _, factory = AGENTS[name]
-    if factory is None:
-        return BaselineAgent()
-    if name in HYBRID_AGENTS:
-        return factory(load_policy_set(family.name, policy_dir), hybrid)
-    return factory(load_policy_set(family.name, policy_dir))
+               options: AgentOptions = AgentOptions()) -> Agent:
+    """A fresh agent called ``name`` for ``family``, flying the policies of its policy set."""
+    spec = agent_spec(name, family.name)
+    policies = policies_from_set(spec, load_policy_set(family.name, policy_dir)) if spec.needs else AgentPolicies()
+    return spec.build(policies, options)
+
+
+__all__ = ["AGENTS", "HYBRID_AGENTS", "AgentOptions", "AgentPolicies", "AgentSpec", "agent_spec", "check_agent", "discover",
+           "make_agent", "policies_from_set"]

@@ -48,8 +48,6 @@ ORDER = ("fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "
 UNITS_VERSION = 2  # 2: competition MDP sets, the authors' safeguard, OLS, the no-crash plateau
 
 _TASKS = ("ghh08", "ghh09", "fghh")
-_AGENTS = ("baseline", "generic", "model-free", "model-based", "incremental", "hybrid", "hybrid-baseline",
-           "incremental-zero", "incremental-fixed", "incremental-race")
 _REQUIRED = object()
 
 
@@ -68,6 +66,14 @@ def _float(lo: float, hi: float):
 def _choice(*allowed: str):
     def check(v):
         return v in allowed, "one of " + ", ".join(repr(a) for a in allowed)
+    return check
+
+
+def _agent():
+    def check(v):
+        from ..agents.registry import AGENTS  # the one list of agents
+
+        return v in AGENTS, "one of " + ", ".join(repr(a) for a in AGENTS)
     return check
 
 
@@ -136,7 +142,7 @@ _VARIANT = {
 }
 
 _GROUP = {
-    "agent": (_REQUIRED, _choice(*_AGENTS)),
+    "agent": (_REQUIRED, _agent()),
     "label": (None, _str()),
     "mdps": ("test", _choice("train", "test", "sample")),
     "n_mdps": (_REQUIRED, _int(1)),
@@ -250,13 +256,13 @@ def _check_kind(settings: dict, kind: str, where: str) -> None:
         if len(set(labels)) != len(labels):
             raise NeurohoverError(f"{where}: group labels must be unique (set label = ... on repeated agents), got {labels}")
         for g in settings["groups"]:
-            from .units import AGENT_TASKS
+            from ..agents.registry import AGENTS, HYBRID_AGENTS
 
-            if task not in AGENT_TASKS[g["agent"]]:
+            if task not in AGENTS[g["agent"]].tasks:
                 raise NeurohoverError(f"{where}: agent {g['agent']!r} does not apply to task {task!r}")
             g["label"] = g["label"] or g["agent"]
             if g["hybrid"]:
-                from ..agents.hybrid import HYBRID_AGENTS, HybridSettings
+                from ..agents.hybrid import HybridSettings
 
                 if g["agent"] not in HYBRID_AGENTS:
                     raise NeurohoverError(f"{where}: group {g['label']!r}: hybrid settings apply to the agents "

@@ -125,19 +125,10 @@ def _policy_evolution_unit(cfg: ExperimentConfig, key: str, target: dict, budget
         "budget": budget, "optimiser": {}, "n_steps": s["n_steps"], "validation_episodes": 0, "history_points": 50})
 
 
-def _needs(agent: str) -> set[str]:
-    return {
-        "baseline": set(), "generic": {"generic"}, "model-free": {"specialised"},
-        "model-based": {"generic"}, "incremental": {"generic"},
-        "hybrid": {"generic", "specialised", "safety"}, "hybrid-baseline": {"generic", "specialised", "safety"},
-        "incremental-zero": {"zero"}, "incremental-fixed": {"fixed"}, "incremental-race": {"race"},
-    }[agent]
+def _spec(agent: str):
+    from ..agents.registry import agent_spec
 
-
-def _fghh_generic_kind(agent: str) -> str | None:
-    if agent.startswith("incremental-"):
-        return agent.split("-", 1)[1]
-    return "race" if agent in ("generic", "model-based", "incremental") else None
+    return agent_spec(agent)
 
 
 class _Policies:
@@ -151,9 +142,10 @@ class _Policies:
         self.family = _family(s["task"], s["sigma"])
         needs: set[str] = set()
         for g in s["groups"]:
-            needs |= _needs(g["agent"])
-            if self.task == "fghh" and _fghh_generic_kind(g["agent"]):
-                needs.add(_fghh_generic_kind(g["agent"]))
+            spec = _spec(g["agent"])
+            needs |= spec.needs
+            if self.task == "fghh" and self.task in spec.generic_kind:
+                needs.add(spec.generic_kind[self.task])
         self.needs = needs
         self.units: list[Unit] = []
         self.total = 0
@@ -167,10 +159,10 @@ class _Policies:
         if self.task != "fghh":
             if needs & {"generic"}:
                 self._add("policy/generic", {"kind": "mdp", "mdp": self.family.zero().to_dict()}, budget)
-            if needs & {"specialised", "safety"}:
+            if needs & {"specialised", "safe"}:
                 for i, mdp in enumerate(self.family.training_mdps()):
                     self._add(f"policy/specialised{i}", {"kind": "mdp", "mdp": mdp.to_dict()}, budget)
-            if "safety" in needs:
+            if "safe" in needs:
                 self.total += 1
                 spec = [self.results.get(f"policy/specialised{i}") for i in range(10)]
                 if all(spec):
@@ -199,11 +191,12 @@ class _Policies:
 
     def for_agent(self, agent: str, mdp_index: int | None, run_counter: int, exclude_own: bool) -> dict | None:
         """The policies of one run of ``agent`` (None: not ready yet)."""
-        need = _needs(agent)
+        spec = _spec(agent)
+        need = spec.needs
         out: dict = {}
         ext = self.external
         if self.task == "fghh":
-            kind = _fghh_generic_kind(agent)
+            kind = spec.generic_kind.get(self.task)
             if kind is not None:
                 if ext is not None:
                     out["generic"] = policy_dict(ext.generics[kind])
@@ -214,12 +207,12 @@ class _Policies:
             return None if any(v is None for v in out.values()) else out
         if "generic" in need:
             out["generic"] = policy_dict(ext.generic) if ext is not None else self._evolved("policy/generic")
-        if need & {"specialised", "safety"}:
-            spec = [policy_dict(p) for p in ext.specialised] if ext is not None else [
+        if need & {"specialised", "safe"}:
+            specialised = [policy_dict(p) for p in ext.specialised] if ext is not None else [
                 self._evolved(f"policy/specialised{i}") for i in range(10)]
-            if any(p is None for p in spec):
+            if any(p is None for p in specialised):
                 return None
-            if "safety" in need:
+            if "safe" in need:
                 if ext is not None:
                     safe = list(ext.safe)
                 else:
@@ -227,18 +220,19 @@ class _Policies:
                     if sr is None:
                         return None
                     safe = sr["safe"]
-                out["safe"] = [spec[i] for i in safe]
+                out["safe"] = [specialised[i] for i in safe]
                 out["safe_indices"] = safe
-            if agent == "model-free":
-                keep = [i for i in range(len(spec)) if not (exclude_own and i == mdp_index)]
-                out["specialised"] = [spec[i] for i in keep]
+            if "specialised" in need:
+                keep = [i for i in range(len(specialised)) if not (exclude_own and i == mdp_index)]
+                out["specialised"] = [specialised[i] for i in keep]
                 out["specialised_indices"] = keep
         return None if any(v is None for v in out.values()) else out
 
 
 def group_hybrid_settings(group: dict) -> dict | None:
     """The full hybrid settings of a group's units (None: the group's agent is not a hybrid agent)."""
-    from ..agents.hybrid import HYBRID_AGENTS, HybridSettings
+    from ..agents.hybrid import HybridSettings
+    from ..agents.registry import HYBRID_AGENTS
 
     return HybridSettings.from_dict(group["hybrid"]).to_dict() if group["agent"] in HYBRID_AGENTS else None
 

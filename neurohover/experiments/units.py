@@ -26,21 +26,6 @@ import numpy as np
 
 from ..errors import NeurohoverError
 
-#: Agent name -> tasks it applies to (as in ``neurohover.agents.registry.AGENTS``).
-AGENT_TASKS: dict[str, tuple[str, ...]] = {
-    "baseline": ("ghh08", "ghh09", "fghh"),
-    "generic": ("ghh08", "ghh09", "fghh"),
-    "model-free": ("ghh08", "ghh09"),
-    "model-based": ("ghh08", "ghh09", "fghh"),
-    "incremental": ("ghh08", "ghh09", "fghh"),
-    "hybrid": ("ghh08", "ghh09"),
-    "hybrid-baseline": ("ghh08", "ghh09"),
-    "incremental-zero": ("fghh",),
-    "incremental-fixed": ("fghh",),
-    "incremental-race": ("fghh",),
-}
-
-
 @dataclass(frozen=True)
 class Unit:
     """One unit of work of ``experiment``: ``key`` is unique within the experiment."""
@@ -205,44 +190,26 @@ def run_model(p: dict, threads: int | None) -> dict:
 
 
 def make_agent(p: dict):
-    """The agent of a test-run unit, built from the policies in its params.
+    """The agent of a test-run unit, built from the policies in its params and the run's settings
+    (policies evolved on learned models fly episodes of the run's length)."""
+    from ..agents.hybrid import HybridSettings
+    from ..agents.model_based import ModelEvolution
+    from ..agents.registry import AgentOptions, AgentPolicies, agent_spec
 
-    Mirrors ``neurohover.agents.registry.AGENTS`` but passes the model-evolution settings, so that
-    the policies evolved on learned models fly episodes of the run's length.
-    """
-    from ..agents.hybrid import HybridAgent, HybridSettings
-    from ..agents.model_based import IncrementalModelBasedAgent, ModelBasedAgent, ModelEvolution
-    from ..agents.model_free import ModelFreeAgent
-    from ..agents.registry import BaselineAgent
-    from ..policies import baseline_policy
-
-    name = p["agent"]
+    spec = agent_spec(p["agent"])
     pol = p["policies"]
-    settings = ModelEvolution(budget=p["model_budget"], predict_episodes=p["predict_episodes"], n_steps=p["n_steps"],
-                              estimator=p["estimator"])
-    if name == "baseline":
-        return BaselineAgent()
-    if name == "model-free":
-        agent = ModelFreeAgent([_policy(d) for d in pol["specialised"]])
-        return agent
-    generic = _policy(pol["generic"])
-    if name == "generic":
-        from types import SimpleNamespace
-
-        from ..agents.registry import GenericAgent
-
-        return GenericAgent(SimpleNamespace(generic=generic))
-    if name == "model-based":
-        return ModelBasedAgent(generic, settings)
-    if name.startswith("incremental"):
-        agent = IncrementalModelBasedAgent(generic, settings, max_learning_episodes=p["max_learning_episodes"])
-        agent.name = name
-        return agent
-    if name in ("hybrid", "hybrid-baseline"):
-        safe = [_policy(d) for d in pol["safe"]]
-        fallback = generic if name == "hybrid" else baseline_policy()
-        return HybridAgent(safe, generic, fallback, settings, name=name, hybrid=HybridSettings.from_dict(p["hybrid"]))
-    raise NeurohoverError(f"unknown agent {name!r}: allowed {', '.join(AGENT_TASKS)}")
+    policies = AgentPolicies(
+        generic=_policy(pol["generic"]) if "generic" in pol else None,
+        specialised=tuple(_policy(d) for d in pol.get("specialised", ())),
+        safe=tuple(_policy(d) for d in pol.get("safe", ())),
+    )
+    options = AgentOptions(
+        evolution=ModelEvolution(budget=p["model_budget"], predict_episodes=p["predict_episodes"], n_steps=p["n_steps"],
+                                 estimator=p["estimator"]),
+        hybrid=HybridSettings.from_dict(p["hybrid"]) if spec.takes_hybrid else None,
+        max_learning_episodes=p["max_learning_episodes"],
+    )
+    return spec.build(policies, options)
 
 
 def run_test_run(p: dict, threads: int | None) -> dict:

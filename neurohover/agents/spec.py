@@ -1,0 +1,83 @@
+"""What an agent is to the rest of neurohover: a name, the tasks it runs on, the policies it flies
+and how to build it. Every agent module declares its agents in ``AGENT_SPECS``; the registry
+(:mod:`neurohover.agents.registry`) collects them, and the CLI, the competitions and the
+experiments read them from there.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+from ..policies import Policy
+
+if TYPE_CHECKING:
+    from .hybrid import HybridSettings
+    from .model_based import ModelEvolution
+    from .protocol import Agent
+
+#: The policies an agent can need: the generic policy, the specialised policies (one per training
+#: MDP), and the safe pair of specialised policies (the paper's rule, :mod:`neurohover.policysets`).
+POLICY_NEEDS = ("generic", "specialised", "safe")
+
+
+@dataclass(frozen=True)
+class AgentPolicies:
+    """The policies one agent flies (those its spec ``needs``; the rest stay empty)."""
+
+    generic: Policy | None = None
+    specialised: tuple[Policy, ...] = ()
+    safe: tuple[Policy, ...] = ()
+
+
+@dataclass(frozen=True)
+class AgentOptions:
+    """Settings of the learning agents; None: the agent's own default.
+
+    ``evolution``: how policies are evolved on learned models (``ModelEvolution``); ``hybrid``:
+    the hybrid agents' safeguard and replacement rule (``HybridSettings``); ``max_learning_episodes``:
+    when the incremental agent stops learning at the latest.
+    """
+
+    evolution: ModelEvolution | None = None
+    hybrid: HybridSettings | None = None
+    max_learning_episodes: int | None = None
+
+
+@dataclass(frozen=True)
+class AgentSpec:
+    """One agent, as everything else sees it.
+
+    Attributes
+    ----------
+    name : str
+        What ``--agent`` and experiment configs call it.
+    tasks : tuple of str
+        The task families it runs on.
+    needs : frozenset of str
+        Which of :data:`POLICY_NEEDS` it flies.
+    build : callable
+        ``build(policies, options) -> Agent``: a fresh agent from an :class:`AgentPolicies` and
+        :class:`AgentOptions`.
+    generic_kind : dict
+        Per task family that has several generic policies (FGHH: ``"zero"``, ``"fixed"``,
+        ``"race"``), which one is this agent's generic policy.
+    takes_hybrid : bool
+        Whether it accepts hybrid settings (``AgentOptions.hybrid``).
+    summary : str
+        One line for help texts.
+    """
+
+    name: str
+    tasks: tuple[str, ...]
+    needs: frozenset[str]
+    build: Callable[[AgentPolicies, AgentOptions], Agent]
+    generic_kind: dict[str, str] = field(default_factory=dict)
+    takes_hybrid: bool = False
+    summary: str = ""
+
+    def __post_init__(self) -> None:
+        unknown = set(self.needs) - set(POLICY_NEEDS)
+        if unknown:
+            raise ValueError(f"agent {self.name!r}: unknown policy needs {sorted(unknown)}; allowed {POLICY_NEEDS}")

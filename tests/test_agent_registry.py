@@ -1,0 +1,77 @@
+"""The agent registry: one spec per agent, read by the CLI, the competitions and the experiments."""
+
+from __future__ import annotations
+
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from neurohover.agents.registry import AGENTS, HYBRID_AGENTS, agent_spec, discover, make_agent
+from neurohover.agents.spec import AgentPolicies, AgentSpec
+from neurohover.errors import NeurohoverError
+from neurohover.experiments.config import load_config
+from neurohover.tasks import get_task_family
+
+
+def test_the_paper_agents_are_registered_with_their_tasks() -> None:
+    assert list(AGENTS)[:2] == ["baseline", "generic"]
+    assert set(AGENTS) == {"baseline", "generic", "model-free", "model-based", "incremental", "incremental-zero",
+                           "incremental-fixed", "incremental-race", "hybrid", "hybrid-baseline"}
+    assert HYBRID_AGENTS == ("hybrid", "hybrid-baseline")
+    assert AGENTS["model-free"].tasks == ("ghh08", "ghh09") and AGENTS["incremental-race"].tasks == ("fghh",)
+
+
+@pytest.mark.parametrize("name", list(AGENTS))
+def test_every_agent_builds_from_the_shipped_policy_set_of_each_of_its_tasks(name: str) -> None:
+    spec = AGENTS[name]
+    for task in spec.tasks:
+        agent = make_agent(name, get_task_family(task))
+        assert agent.name == name
+    other = {"ghh08", "ghh09", "fghh"} - set(spec.tasks)
+    for task in other:
+        with pytest.raises(NeurohoverError, match=f"does not apply to task '{task}'"):
+            make_agent(name, get_task_family(task))
+
+
+def test_fghh_agents_fly_the_generic_policy_of_their_kind() -> None:
+    from neurohover.policysets import load_policy_set
+
+    ps = load_policy_set("fghh")
+    for kind in ("zero", "fixed", "race"):
+        flown = make_agent(f"incremental-{kind}", get_task_family("fghh")).generic.genome
+        assert np.array_equal(flown, ps.generics[kind].genome)
+    assert np.array_equal(make_agent("incremental", get_task_family("fghh")).generic.genome, ps.generics["race"].genome)
+    assert not np.array_equal(ps.generics["zero"].genome, ps.generics["race"].genome)
+
+
+def test_unknown_agents_are_refused_everywhere_with_the_same_list() -> None:
+    with pytest.raises(NeurohoverError, match="unknown agent 'sarsa': allowed baseline, generic, model-free"):
+        agent_spec("sarsa")
+    with pytest.raises(NeurohoverError, match="'sarsa'.*one of 'baseline', 'generic', 'model-free'"):
+        load_config("fig7", "quick", {"groups": [{"agent": "sarsa", "n_mdps": 1}]})
+
+
+def test_a_new_agent_module_is_discovered_without_editing_any_other_file(tmp_path: Path, monkeypatch) -> None:
+    package = tmp_path / "myagents"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "always_generic.py").write_text(textwrap.dedent('''
+        from neurohover.agents.reference import GenericAgent
+        from neurohover.agents.spec import AgentSpec
+
+        AGENT_SPECS = (AgentSpec("always-generic", ("ghh08",), frozenset({"generic"}),
+                                 lambda policies, options: GenericAgent(policies.generic)),)
+    '''))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    specs = discover("myagents")
+    assert list(specs) == ["always-generic"] and isinstance(specs["always-generic"], AgentSpec)
+    sys.modules.pop("myagents", None)
+
+
+def test_a_spec_refuses_unknown_policy_needs() -> None:
+    with pytest.raises(ValueError, match="unknown policy needs"):
+        AgentSpec("x", ("ghh08",), frozenset({"teacher"}), lambda p, o: None)
+    assert AgentPolicies().generic is None
