@@ -95,7 +95,7 @@ def test_edits_outside_kernel_py_recompile_and_unchanged_sources_load_from_cache
     assert heavier["state"] == pytest.approx(run("step", jit=False)["state"], rel=1e-12, abs=1e-15)
 
     # A constant of the random streams that a function outside sim/ links in.
-    _edit(copy / "neurohover/sim/rng.py", "_EPISODE_KEY = _U64(0xD1B54A32D192ED03)", "_EPISODE_KEY = _U64(0xD1B54A32D192ED05)")
+    _edit(copy / "neurohover/sim/rng.py", "_U64(0xD1B54A32D192ED03)", "_U64(0xD1B54A32D192ED05)")
     rekeyed = run()
     assert rekeyed["stats"]["seed_streams"] == [0, 1]
     assert rekeyed["stream"] != first["stream"]
