@@ -6,13 +6,18 @@ Data flows one way: task family -> MDP -> batched rollouts of policies -> return
 
 from __future__ import annotations
 
+import importlib.metadata
+
 from .errors import NeurohoverError
 from .evaluate import DangerousState, Evaluation, PolicyTable, Safeguard, evaluate, evaluate_jobs
 from .flightdata import FlightData
 from .policies import Policy, baseline_policy, load_policy, prototype, save_policy
 from .tasks import FGHH, GHH08, GHH09, MDP, get_task_family
 
-__version__ = "0.1.0"
+try:
+    __version__ = importlib.metadata.version("neurohover")  # one source of truth: pyproject.toml, as installed
+except importlib.metadata.PackageNotFoundError:  # a source tree on sys.path that was never installed
+    __version__ = "0+unknown"
 
 __all__ = [
     "FGHH", "GHH08", "GHH09", "MDP", "Evaluation", "FlightData", "NeurohoverError", "Policy",

@@ -8,11 +8,17 @@ where it stopped. :func:`write_report` draws the paper's figures and writes ``re
 
 Example
 -------
->>> from neurohover.experiments import load_config, reproduce, Store, LocalExecutor, write_report
->>> config = load_config("fig7", "quick")
->>> with Store("results.sqlite") as store:
-...     summary = reproduce(config, store, LocalExecutor(jobs=2))
-...     write_report(store, "report/")
+A script (the ``__main__`` guard is needed: ``LocalExecutor(jobs=2)`` spawns worker processes,
+which import the main module again)::
+
+    from neurohover.experiments import LocalExecutor, Store, load_config, reproduce, write_report
+
+    if __name__ == "__main__":
+        config = load_config("fig7", "quick")  # seconds on 2 cores; "paper" runs the paper's protocol
+        with Store("results.sqlite") as store:
+            summary = reproduce(config, store, LocalExecutor(jobs=2))
+            print(summary)
+            write_report(store, "report/")
 """
 
 from .config import ExperimentConfig, experiment_names, load_config, load_configs, parse_override
