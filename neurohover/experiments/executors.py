@@ -15,6 +15,8 @@ Results and seeds are the same on every executor: a unit carries its own seed (d
 
 from __future__ import annotations
 
+import os
+import socket
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -111,8 +113,75 @@ def import_ray():
     return ray
 
 
+RAY_ADDRESS_FORMS = ("host:port (port 1 to 65535, e.g. 10.0.0.5:6379, as printed by `ray start --head`), "
+                     "ray://host:port (Ray Client), or auto (the cluster started on this machine)")
+CONNECT_SECONDS = 3.0  # how long to wait for a cluster's port to accept a connection
+
+
+def ray_endpoint(address: str, source: str = "--address") -> tuple[str, int] | None:
+    """The (host, port) that a Ray cluster ``address`` names.
+
+    Parameters
+    ----------
+    address : str
+        ``host:port``, ``[ipv6]:port``, ``ray://host:port``, or ``auto`` / ``local`` (which Ray
+        resolves itself; None is returned for them).
+    source : str
+        Where the address came from, for the message (``--address`` or ``RAY_ADDRESS``).
+
+    Raises
+    ------
+    NeurohoverError
+        For any other form, naming the address and the forms allowed.
+    """
+    if address in ("auto", "local"):
+        return None
+    rest = address[len("ray://"):] if address.startswith("ray://") else address
+    host, sep, port = rest.rpartition(":")
+    if host.startswith("[") and host.endswith("]"):
+        host = host[1:-1]
+    elif ":" in host:
+        host = ""  # an IPv6 host needs brackets: [::1]:6379
+    valid_host = host and not any(c.isspace() or c in "/[]@" for c in host)
+    if not (sep and valid_host and port.isascii() and port.isdigit() and 1 <= int(port) <= 65535):
+        raise NeurohoverError(f"{source} {address!r} is not a Ray cluster address: allowed {RAY_ADDRESS_FORMS}")
+    return host, int(port)
+
+
+def check_ray_address(address: str, source: str = "--address") -> None:
+    """Refuse ``address`` at once, with one clear message, if it is malformed or nothing listens there.
+
+    Ray itself retries an unreachable cluster for many minutes; a short TCP connect settles it first.
+    """
+    endpoint = ray_endpoint(address, source)
+    if endpoint is None:
+        return
+    host, port = endpoint
+    try:
+        socket.create_connection((host, port), timeout=CONNECT_SECONDS).close()
+    except OSError as err:
+        if isinstance(err, TimeoutError):
+            reason = f"no answer within {CONNECT_SECONDS:g} s"
+        elif isinstance(err, socket.gaierror):
+            reason = f"unknown host {host!r}"
+        else:
+            reason = (err.strerror or str(err)).lower()
+        raise NeurohoverError(
+            f"{source} {address!r}: no Ray cluster is listening at {host}:{port} ({reason}); start one first "
+            f"(`ray start --head` prints its address) or leave out --address to start a local Ray instance") from None
+
+
+def _one_line(err: BaseException) -> str:
+    lines = [ln.strip() for ln in str(err).splitlines() if ln.strip()]
+    return lines[0] if lines else type(err).__name__
+
+
 class RayExecutor:
-    """Run units as Ray tasks (one CPU each) on the cluster at ``address`` or on a local one."""
+    """Run units as Ray tasks (one CPU each) on the cluster at ``address`` or on a local one.
+
+    Without ``address``, Ray's own ``RAY_ADDRESS`` environment variable, if set, names the cluster.
+    A malformed address, or one where nothing listens, is refused at once with a NeurohoverError.
+    """
 
     name = "ray"
 
@@ -121,13 +190,18 @@ class RayExecutor:
         self.ray = ray
         self.started = False
         if not ray.is_initialized():
+            # ray.init(address=None) joins the cluster named by RAY_ADDRESS, so check that one too.
+            source, given = ("--address", address) if address is not None else ("RAY_ADDRESS", os.environ.get("RAY_ADDRESS") or None)
+            if given is not None:
+                check_ray_address(given, source)
             kwargs = {"include_dashboard": False, "log_to_driver": True}
-            if address is None and num_cpus is not None:
+            if given is None and num_cpus is not None:
                 kwargs["num_cpus"] = num_cpus
             try:
                 ray.init(address=address, **kwargs)
-            except ConnectionError as err:
-                raise NeurohoverError(f"cannot connect to the Ray cluster at {address!r}: {err}") from None
+            except Exception as err:  # noqa: BLE001 - ConnectionError, ValueError, RuntimeError, ... from Ray
+                where = f"the Ray cluster at {source} {given!r}" if given is not None else "a local Ray instance"
+                raise NeurohoverError(f"cannot connect to {where}: {_one_line(err)}") from None
             self.started = True
         self.max_retries = max_retries
         self._remote = ray.remote(num_cpus=1, max_retries=max_retries)(timed_run)
