@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import signal
+import sqlite3
 import subprocess
 import sys
 import time
@@ -206,3 +207,73 @@ def test_a_bad_ray_address_environment_variable_is_named(tmp_path: Path) -> None
                           cwd=ROOT, env={**ENV, "RAY_ADDRESS": "127.0.0.1:1"}, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
     assert "RAY_ADDRESS '127.0.0.1:1': no Ray cluster is listening at 127.0.0.1:1" in proc.stderr
+
+
+# --------------------------------------------------------------------------------- one writer per store
+
+TINY_CONFIG = LONG_CONFIG.replace('"longtest"', '"tinytest"').replace("runs = 4", "runs = 1").replace("400000", "200")
+
+
+def _neurohover(*argv: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "neurohover", *argv], cwd=ROOT, env=ENV, capture_output=True, text=True,
+                          timeout=300)
+
+
+def _running_session(store: Path, name: str) -> bool:
+    """Whether a run of ``name`` is under way in ``store`` (which another process is writing)."""
+    try:
+        conn = sqlite3.connect(store, timeout=5)
+        try:
+            return conn.execute("SELECT count(*) FROM sessions WHERE name = ? AND status = 'running'", (name,)).fetchone()[0] > 0
+        finally:
+            conn.close()
+    except sqlite3.OperationalError:
+        return False
+
+
+def test_a_store_that_a_live_run_writes_is_refused_and_a_killed_run_blocks_nothing(tmp_path: Path) -> None:
+    store = tmp_path / "s.sqlite"
+    lock = tmp_path / "s.sqlite.lock"
+    (tmp_path / "long.toml").write_text(LONG_CONFIG)
+    (tmp_path / "tiny.toml").write_text(TINY_CONFIG)
+    tiny = ["reproduce", str(tmp_path / "tiny.toml"), "--store", str(store), "--no-progress"]
+    assert _neurohover(*tiny).returncode == 0
+    holder = _start(tmp_path, "reproduce", str(tmp_path / "long.toml"), "--store", str(store), "--no-progress")
+    try:
+        deadline = time.monotonic() + 120
+        while not _running_session(store, "longtest"):
+            assert holder.poll() is None and time.monotonic() < deadline, (tmp_path / "stderr.txt").read_text()[-2000:]
+            time.sleep(0.05)
+        # A second writer is refused at once, naming the store and the run that holds it ...
+        second = _neurohover(*tiny)
+        assert second.returncode == 2 and "Traceback" not in second.stderr
+        assert f"results store {str(store)!r} is in use: another run (pid {holder.pid} on host" in second.stderr
+        assert len(second.stderr.strip().splitlines()) == 1 and "ran 0 units" not in second.stdout
+        # ... while reading the store still works.
+        results = _neurohover("results", "tinytest", "--store", str(store), "--format", "json")
+        assert results.returncode == 0 and "evolve/k1/run0" in results.stdout, results.stderr[-2000:]
+        report = _neurohover("report", "tinytest", "--store", str(store), "--out", str(tmp_path / "report"))
+        assert report.returncode == 0 and (tmp_path / "report" / "report.md").exists(), report.stderr[-2000:]
+        assert holder.poll() is None
+        # A killed holder leaves its lock file (with its pid) but no lock: the next run proceeds.
+        holder.kill()
+        holder.wait(timeout=30)
+        assert lock.read_text().split()[0] == str(holder.pid)
+        third = _neurohover(*tiny, "--fresh")
+        assert third.returncode == 0, third.stderr[-2000:]
+        assert "ran 1 units, 0 already in the store" in third.stdout
+    finally:
+        _end_group(holder)
+
+
+def test_two_stores_on_one_file_in_one_process_take_turns(tmp_path: Path) -> None:
+    from neurohover.errors import NeurohoverError
+
+    path = tmp_path / "s.sqlite"
+    with Store(path) as first, Store(path) as second:
+        first.begin("x", "quick", "h", {})
+        with pytest.raises(NeurohoverError, match=rf"is in use: another run \(pid {os.getpid()} on host "):
+            second.begin("x", "quick", "h", {})
+        assert first.experiments() == second.experiments() == [("x", "quick", "h", 0)]  # reading needs no lock
+        first.close()
+        second.begin("x", "quick", "h", {})  # a closed Store's lock is released

@@ -66,10 +66,12 @@ def reproduce(config: ExperimentConfig, store: Store, executor, *, fresh: bool =
 
     ``only`` restricts the run to the units whose keys match one of these glob patterns (for example
     ``run/hybrid/*/rep0``); the others stay unfinished, and a later call can run them.
-    Raises KeyboardInterrupt (after recording every finished unit) when interrupted.
+    Raises KeyboardInterrupt (after recording every finished unit) when interrupted, and
+    NeurohoverError when another run is writing ``store`` (see :meth:`Store.lock`).
     """
     from tqdm import tqdm
 
+    store.lock()  # one writer per store: a second run would redo every unit the first has not finished
     store.begin(config.name, config.scale, config.hash, config.to_dict(), fresh=fresh)
     results = store.results(config.name, config.scale)
     summary = RunSummary(config.name, config.scale, executor.name, executor.cores, units_before=len(results))

@@ -17,19 +17,30 @@ neurohover store.
 Durability: each finished unit is written in its own transaction (with its session's counters)
 the moment it finishes, so an interrupted run (Ctrl-C or SIGKILL) loses no finished unit, and
 running again with the same store skips every finished unit.
+
+One writer: a run holds an OS lock (``flock``) on ``STORE.lock`` beside the store from its first
+write until it closes the store, and writes its pid there; a second run is refused, naming that
+pid. The kernel drops the lock when its process dies, so a killed run never blocks the next one.
+Readers (``results``, ``report``) take no lock.
 """
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import socket
 import sqlite3
 import time
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 from ..errors import NeurohoverError
+
+try:
+    import fcntl
+except ImportError:  # not POSIX: no writer lock; one run per store is then the user's care
+    fcntl = None
 
 SCHEMA_VERSION = 1
 APPLICATION_ID = 0x4E484F56  # "NHOV"
@@ -68,6 +79,7 @@ class Store:
         if self.path.exists() and self.path.is_dir():
             raise NeurohoverError(f"results store {str(self.path)!r} is a directory; give a file name")
         self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._lock: IO[str] | None = None
         try:
             self.conn = sqlite3.connect(str(self.path), timeout=30.0, isolation_level=None)
             self.conn.execute("PRAGMA synchronous = FULL")
@@ -77,6 +89,53 @@ class Store:
 
     def close(self) -> None:
         self.conn.close()
+        if self._lock is not None:
+            self._lock.close()  # closing the file releases the lock
+            self._lock = None
+
+    # ------------------------------------------------------------------ one writer
+
+    @property
+    def lock_path(self) -> Path:
+        """The lock file beside the store (``STORE.lock``); it stays, only its lock matters."""
+        return self.path.with_name(self.path.name + ".lock")
+
+    def lock(self) -> None:
+        """Make this Store the file's only writer until :meth:`close` (does nothing if it already is).
+
+        Two runs writing one store would each compute every unit the other has not finished yet.
+        The lock is an OS advisory lock on :attr:`lock_path`, which the kernel releases when the
+        holder's process ends in any way, so a lock can never be left behind.
+
+        Raises
+        ------
+        NeurohoverError
+            If another live process (or another Store in this one) holds the lock; the message names
+            the store and the holder's pid.
+        """
+        if self._lock is not None or fcntl is None:
+            return
+        try:
+            file = os.fdopen(os.open(self.lock_path, os.O_RDWR | os.O_CREAT, 0o644), "r+")
+        except OSError as err:
+            raise NeurohoverError(f"cannot open {str(self.lock_path)!r}, the writer lock of results store "
+                                  f"{str(self.path)!r}: {err.strerror}") from None
+        try:
+            fcntl.flock(file.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as err:
+            holder = file.read().split()
+            file.close()
+            if err.errno not in (errno.EAGAIN, errno.EWOULDBLOCK, errno.EACCES):
+                return  # the filesystem cannot lock (ENOLCK, ...): write unguarded, as without a lock
+            who = f"pid {holder[0]} on host {holder[1]}" if len(holder) == 2 else f"see {str(self.lock_path)!r}"
+            raise NeurohoverError(
+                f"results store {str(self.path)!r} is in use: another run ({who}) is writing it; wait for that run "
+                f"to end (or stop it), or give another --store file. Reading it (results, report) works meanwhile") from None
+        file.seek(0)
+        file.truncate()
+        file.write(f"{os.getpid()} {socket.gethostname()}\n")
+        file.flush()
+        self._lock = file
 
     def __enter__(self) -> "Store":
         return self
@@ -122,7 +181,9 @@ class Store:
         """Register experiment (name, scale) with its config hash, or check that it matches.
 
         ``fresh`` deletes the experiment's stored units and sessions first (a deliberate restart).
+        Takes the writer lock first (see :meth:`lock`).
         """
+        self.lock()
         c = self.conn
         c.execute("BEGIN IMMEDIATE")
         try:
