@@ -181,7 +181,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_demo)
 
     p = sub.add_parser("bench", help="measure simulator throughput", description=cmd_bench.__doc__)
-    p.add_argument("--quick", action="store_true", help="fewer episodes (a rough figure in a few seconds)")
+    p.add_argument("--quick", action="store_true", help="fewer episodes (rough figures in 5-10 seconds on 2 cores)")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.set_defaults(func=cmd_bench)
 

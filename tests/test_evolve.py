@@ -343,7 +343,7 @@ def test_learn_model_command_prints_learned_next_to_true(capsys, tmp_path: Path)
 def test_learn_model_command_bad_input(capsys, tmp_path: Path) -> None:
     rc, _, err = _run(capsys, "learn-model", "--flight-data", str(tmp_path / "missing.npz"), "--method", "lr",
                       "--out", str(tmp_path / "m.json"))
-    assert rc == 2 and "does not exist" in err
+    assert rc == 2 and "no such flight-data file" in err
     rc, _, err = _run(capsys, "learn-model", "--flight-data", str(tmp_path / "missing.npz"), "--method", "ec-mer",
                       "--budget", "0", "--out", str(tmp_path / "m.json"))
     assert rc == 2 and "--budget 0 is out of range" in err
