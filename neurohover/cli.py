@@ -126,11 +126,11 @@ def cmd_demo(args: argparse.Namespace) -> int:
     """Fly the baseline and the baseline-equivalent MLP on a few MDPs of each family; print a table."""
     from .evaluate import evaluate
     from .policies import baseline_policy, prototype
-    from .tasks import get_task_family
+    from .tasks import TASK_NAMES, get_task_family
 
     policies = {"baseline": baseline_policy(), "mlp(baseline seed)": prototype("mlp", "baseline")}
     print(f"{'task':<6} {'mdp':<16} {'policy':<20} {'mean return':>12} {'sd':>10} {'crashes':>8}")
-    for name in ("ghh08", "ghh09", "fghh"):
+    for name in TASK_NAMES:
         family = get_task_family(name)
         mdps = [family.zero()] + family.training_mdps()[: args.mdps]
         ev = evaluate(list(policies.values()), mdps, episodes=args.episodes, seed=args.seed)

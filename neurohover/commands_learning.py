@@ -55,7 +55,7 @@ def _target(args: argparse.Namespace):
         return family.make(_floats(args.wind, "--wind")), family, f"wind={args.wind}"
     if args.params is not None:
         return family.make(_floats(args.params, "--params")), family, f"params={args.params}"
-    spec = args.mdp if args.mdp is not None else (MDP_FAMILY if family.name == "fghh" else "zero")
+    spec = args.mdp if args.mdp is not None else (MDP_FAMILY if family.generic_over_distribution else "zero")
     if spec == MDP_FAMILY:
         return family, family, MDP_FAMILY
     if spec == "sample":  # one MDP drawn from G with the run's seed
@@ -155,7 +155,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         "generations": result.generations, "seconds": round(result.seconds, 3), "stop_reason": result.stop_reason,
         "history": history_path.name,
     }
-    if family.name == "fghh":
+    if family.sigma is not None:
         meta["sigma"] = float(family.sigma)
     if mdp_desc != MDP_FAMILY:
         meta["mdp_params"] = target.to_dict()

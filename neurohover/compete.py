@@ -172,7 +172,7 @@ def compete(
     for name, value in (("runs", runs), ("episodes", episodes), ("jobs", jobs)):
         if not isinstance(value, int) or value < 1:
             raise NeurohoverError(f"{name}={value!r} is out of range: allowed an integer >= 1")
-    check_agent(agent, task, policy_dir)
+    check_agent(agent, get_task_family(task, sigma), policy_dir)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     csv_path = out / "episodes.csv"

@@ -65,9 +65,9 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
         raise NeurohoverError(f"no policy set for {family.name} in {str(root)!r} (manifest.json missing); "
                               f"build it with: neurohover build-policies --task {family.name}")
     manifest = json.loads(manifest_path.read_text())
-    if family.name == "fghh":
+    if family.generic_over_distribution:
         generics = {name: _load(root / f"generic_{name}.json", f"the {name} generic policy") for name in FGHH_GENERICS}
-        return PolicySet("fghh", root, generics["race"], generics=generics, manifest=manifest)
+        return PolicySet(family.name, root, generics["race"], generics=generics, manifest=manifest)
     generic = _load(root / "generic.json", "the generic policy")
     specialised = tuple(_load(root / f"specialised_{i}.json", f"specialised policy {i}") for i in range(10))
     return PolicySet(family.name, root, generic, specialised, tuple(manifest.get("safe", ())), manifest=manifest)
@@ -125,17 +125,16 @@ def build_policy_set(
         say(f"{family.name}/{name}: champion {result.champion_return:.1f} after {result.episodes} episodes ({time.perf_counter() - t0:.0f} s)")
         return policy
 
-    if family.name == "fghh":
-        fam = get_task_family("fghh", 0.3)
-        manifest.update({"sigma": 0.3, "fghh_budget": fghh_budget})
+    if family.generic_over_distribution:
+        manifest.update({"sigma": family.sigma, "fghh_budget": fghh_budget})
         generics = {
-            "zero": run(fam.zero(), "generic_zero", int(seeds[0]), budget=budget),
-            "fixed": run(fam, "generic_fixed", int(seeds[1]), budget=fghh_budget, resampling="fixed:5"),
-            "race": run(fam, "generic_race", int(seeds[2]), budget=fghh_budget, resampling="race:0.2"),
+            "zero": run(family.zero(), "generic_zero", int(seeds[0]), budget=budget),
+            "fixed": run(family, "generic_fixed", int(seeds[1]), budget=fghh_budget, resampling="fixed:5"),
+            "race": run(family, "generic_race", int(seeds[2]), budget=fghh_budget, resampling="race:0.2"),
         }
         manifest["seconds"] = round(time.perf_counter() - start, 1)
         (root / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n")
-        return PolicySet("fghh", root, generics["race"], generics=generics, manifest=manifest)
+        return PolicySet(family.name, root, generics["race"], generics=generics, manifest=manifest)
 
     generic = run(family.zero(), "generic", int(seeds[0]), budget=budget)
     train = family.training_mdps()

@@ -75,3 +75,15 @@ def test_a_spec_refuses_unknown_policy_needs() -> None:
     with pytest.raises(ValueError, match="unknown policy needs"):
         AgentSpec("x", ("ghh08",), frozenset({"teacher"}), lambda p, o: None)
     assert AgentPolicies().generic is None
+
+
+def test_a_policy_set_evolved_for_another_sigma_is_refused(tmp_path: Path, capsys) -> None:
+    from neurohover.cli import main
+
+    with pytest.raises(NeurohoverError, match="evolved for sigma = 0.3, not 0.2"):
+        make_agent("generic", get_task_family("fghh", 0.2))
+    assert make_agent("generic", get_task_family("fghh", 0.3)).name == "generic"
+    assert make_agent("baseline", get_task_family("fghh", 0.2)).name == "baseline"  # flies no policy set
+    rc = main(["compete", "--task", "fghh", "--sigma", "0.2", "--agent", "incremental-race", "--runs", "1",
+               "--episodes", "2", "--out", str(tmp_path / "c")])
+    assert rc == 2 and "evolved for sigma = 0.3, not 0.2" in capsys.readouterr().err

@@ -65,18 +65,28 @@ def policies_from_set(spec: AgentSpec, ps: PolicySet) -> AgentPolicies:
     )
 
 
-def check_agent(name: str, task: str, policy_dir: str | None = None) -> None:
-    """Refuse unknown agents, agents for another task, and missing policy sets, with clear messages."""
-    spec = agent_spec(name, task)
+def _policy_set(family: TaskFamily, policy_dir: str | None) -> PolicySet:
+    """The family's policy set, refused when it was evolved for another breadth sigma."""
+    ps = load_policy_set(family.name, policy_dir)
+    built = ps.manifest.get("sigma")
+    if family.sigma is not None and family.generic_over_distribution and built is not None and float(built) != family.sigma:
+        raise NeurohoverError(f"the {family.name} policy set in {str(ps.directory)!r} was evolved for sigma = {built}, "
+                              f"not {family.sigma}: build one for this sigma and give its directory (--policy-dir)")
+    return ps
+
+
+def check_agent(name: str, family: TaskFamily, policy_dir: str | None = None) -> None:
+    """Refuse unknown agents, agents for another task, and missing or mismatched policy sets, with clear messages."""
+    spec = agent_spec(name, family.name)
     if spec.needs:
-        spec.build(policies_from_set(spec, load_policy_set(task, policy_dir)), AgentOptions())
+        spec.build(policies_from_set(spec, _policy_set(family, policy_dir)), AgentOptions())
 
 
 def make_agent(name: str, family: TaskFamily, *, policy_dir: str | None = None,
                options: AgentOptions = AgentOptions()) -> Agent:
     """A fresh agent called ``name`` for ``family``, flying the policies of its policy set."""
     spec = agent_spec(name, family.name)
-    policies = policies_from_set(spec, load_policy_set(family.name, policy_dir)) if spec.needs else AgentPolicies()
+    policies = policies_from_set(spec, _policy_set(family, policy_dir)) if spec.needs else AgentPolicies()
     return spec.build(policies, options)
 
 

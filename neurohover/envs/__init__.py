@@ -1,7 +1,7 @@
 """Gymnasium environments, registered on import of :mod:`neurohover`.
 
 Ids: ``neurohover/GHH08-v0``, ``neurohover/GHH09-v0`` and ``neurohover/FGHH-v0`` (which takes
-``sigma``, default 0.3). ``gymnasium.make`` builds :class:`HoverEnv`;
+``sigma``, default 0.3): one per task family. ``gymnasium.make`` builds :class:`HoverEnv`;
 ``gymnasium.make_vec(..., vectorization_mode="vector_entry_point")`` builds
 :class:`HoverVectorEnv`, which steps every helicopter in one kernel call.
 """
@@ -11,14 +11,12 @@ from __future__ import annotations
 import gymnasium
 
 from ..sim.constants import EPISODE_STEPS
+from ..tasks import TASK_NAMES
 from .hover import HoverEnv
 from .vector import HoverVectorEnv
 
-ENV_IDS: dict[str, str] = {
-    "neurohover/GHH08-v0": "ghh08",
-    "neurohover/GHH09-v0": "ghh09",
-    "neurohover/FGHH-v0": "fghh",
-}
+#: One id per task family, ``neurohover/<NAME>-v0``.
+ENV_IDS: dict[str, str] = {f"neurohover/{name.upper()}-v0": name for name in TASK_NAMES}
 
 
 def register_envs() -> None:

@@ -27,7 +27,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from ..errors import NeurohoverError
-from ..sim.constants import ACTION_DIM, EPISODE_STEPS, MDP_ROW_LEN, OBS_DIM, ROW_PARAMS, ROW_WIND
+from ..sim.constants import ACTION_DIM, EPISODE_STEPS, MDP_ROW_LEN, OBS_DIM
 from ..sim.kernel import step_batch
 from ..sim.rng import seed_stream
 from ..tasks import MDP, TaskFamily, get_task_family
@@ -53,22 +53,6 @@ def _seed_streams(rngs: np.ndarray, idx: np.ndarray, streams: np.ndarray) -> Non
     """Seed the noise streams of sub-environments ``idx`` from their (seed, episode) rows."""
     for i in idx:
         seed_stream(rngs[i], np.uint64(streams[i, 0]), np.uint64(streams[i, 1]))
-
-
-def sample_row_layout(family: TaskFamily) -> tuple[np.ndarray, slice]:
-    """The kernel row of the family's sampled MDPs, and where a raw draw ``family._draw`` goes in it.
-
-    A sampled MDP's row is this template with the draw written into the slice; checked here
-    against ``family.make`` so that the fast path cannot drift from the MDP class.
-    """
-    probe = family._draw(np.random.default_rng(0))
-    template = family.make(probe).row()
-    where = ROW_PARAMS if family.name == "fghh" else slice(ROW_WIND.start, ROW_WIND.start + probe.size)
-    check = template.copy()
-    check[where] = probe
-    if not np.array_equal(check, template):
-        raise RuntimeError(f"sampled {family.name} MDP rows do not have the expected layout")
-    return template, where
 
 
 class HoverVectorEnv(VectorEnv):
@@ -159,7 +143,7 @@ class HoverVectorEnv(VectorEnv):
         self._gens: list[np.random.Generator | None] = [None] * n
         self._mdps: list[MDP | None] = [None] * n
         self._draws: list[np.ndarray | None] = [None] * n  # raw draw of each sampled MDP
-        self._sample_template, self._sample_slice = sample_row_layout(self.family)
+        self._sample_template, self._sample_slice = self.family.row_template(), self.family.row_slice
         self._sample_label = f"{self.family.name}/sample"
         self._autoreset = np.zeros(n, dtype=np.bool_)
         self._any_autoreset = False
@@ -249,7 +233,7 @@ class HoverVectorEnv(VectorEnv):
 
     def _reset_envs(self, idx: np.ndarray, streams: list[tuple[int, int]] | None) -> None:
         """Start new episodes in sub-environments ``idx`` (their generators already exist)."""
-        draw = self.family._draw
+        sample_params = self.family.sample_params
         template, where = self._sample_template, self._sample_slice
         seeds = []
         for i in idx.tolist():
@@ -258,7 +242,7 @@ class HoverVectorEnv(VectorEnv):
             if spec is SAMPLE:
                 # The same draws as family.sample(gen), but building the MDP object is ~8x dearer
                 # than the draw itself, so it is built only when someone asks (``mdps``).
-                d = draw(gen)
+                d = sample_params(gen, 1)[0]
                 row = self._rows[i]
                 row[:] = template
                 row[where] = d

@@ -80,9 +80,9 @@ import numpy as np
 from ..errors import NeurohoverError
 from ..evaluate import evaluate_jobs, num_threads
 from ..policies import GENOME_LENGTH, TOPOLOGIES, Policy, prototype as make_prototype
-from ..sim.constants import DEFAULT_PARAMS, EPISODE_STEPS, ROW_PARAMS, ROW_WIND, SAFEGUARD_LIMITS
+from ..sim.constants import EPISODE_STEPS, SAFEGUARD_LIMITS
 from ..sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
-from ..tasks import FGHH, GHH08, GHH09, MDP
+from ..tasks import MDP, TaskFamily
 from .cmaes import CMAES
 from .neuroevolution import GenerationalNE, GenerationalSettings, SteadyStateNE, SteadyStateSettings
 from .neuroevolution import SteadyStateNE as _SteadyStateNE  # the class itself (tests may patch the name)
@@ -302,35 +302,15 @@ def _check_seed(seed) -> int:
 
 
 class _MDPStream:
-    """Fresh MDPs drawn from a task family, as kernel rows, in batches.
+    """Fresh MDPs drawn from a task family, as kernel rows, in batches (:meth:`TaskFamily.sample_rows`:
+    one fixed sequence of MDPs whatever the batch sizes)."""
 
-    Batched draws consume the generator exactly like consecutive ``family.sample(rng)`` calls (one
-    row of a ``size=(n, d)`` draw per MDP), so a stream is one fixed sequence of MDPs whatever the
-    batch sizes; the tests check the equality with ``family.sample``.
-    """
-
-    def __init__(self, family, rng: np.random.Generator) -> None:
+    def __init__(self, family: TaskFamily, rng: np.random.Generator) -> None:
         self.family = family
         self.rng = rng
-        if isinstance(family, GHH08):
-            self.template, self.cols = family.make([0.0, 0.0]).row(), ROW_WIND.start + np.arange(2)
-            self.draw = lambda n: rng.uniform(-5.0, 5.0, (n, 2))
-        elif isinstance(family, GHH09):
-            self.template, self.cols = family.make([0.0] * 8).row(), ROW_WIND.start + np.arange(8)
-            self.draw = lambda n: rng.uniform(0.0, 1.0, (n, 8))
-        elif isinstance(family, FGHH):
-            scale = np.abs(DEFAULT_PARAMS) * family.sigma
-            self.template, self.cols = family.zero().row(), ROW_PARAMS.start + np.arange(11)
-            self.draw = lambda n: rng.normal(DEFAULT_PARAMS, scale, (n, 11))
-        else:  # any other family: one sample() per MDP
-            self.template = None
 
     def rows(self, n: int) -> np.ndarray:
-        if self.template is None:
-            return np.stack([self.family.sample(self.rng).row() for _ in range(n)])
-        out = np.repeat(self.template[None, :], n, axis=0)
-        out[:, self.cols] = self.draw(n)
-        return out
+        return self.family.sample_rows(self.rng, n)
 
 
 # --------------------------------------------------------------------------------- kernel path
@@ -510,9 +490,9 @@ def _resolve_target(target):
     """(mdp or None, family or None, description dict)."""
     if isinstance(target, MDP):
         return target, None, {"kind": "mdp", "mdp": target.to_dict()}
-    if isinstance(target, (GHH08, GHH09, FGHH)):
+    if isinstance(target, TaskFamily):
         desc = {"kind": "family", "family": target.name}
-        if isinstance(target, FGHH):
+        if target.sigma is not None:
             desc["sigma"] = float(target.sigma)
         return None, target, desc
     if callable(getattr(target, "mdp", None)) and hasattr(target, "method"):  # a LearnedModel

@@ -37,6 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import NeurohoverError
+from ..tasks import TASK_NAMES
 
 CONFIG_DIR = Path(__file__).parent / "configs"
 SCALES = ("quick", "paper")
@@ -47,7 +48,6 @@ ORDER = ("fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "
 #: Bump when a unit function changes what it computes: stores written before are then refused.
 UNITS_VERSION = 2  # 2: competition MDP sets, the authors' safeguard, OLS, the no-crash plateau
 
-_TASKS = ("ghh08", "ghh09", "fghh")
 _REQUIRED = object()
 
 
@@ -126,7 +126,7 @@ def _policy_source():
 
 # key -> (default or _REQUIRED, check)
 _COMMON: dict[str, tuple[Any, Any]] = {
-    "task": (_REQUIRED, _choice(*_TASKS)),
+    "task": (_REQUIRED, _choice(*TASK_NAMES)),
     "sigma": (None, _float(0.0, 1.0)),
     "seed": (_REQUIRED, _int(0)),
     "n_steps": (6000, _int(1)),
@@ -227,14 +227,17 @@ def _validate_table(values: dict, schema: dict, where: str) -> dict:
 def _check_kind(settings: dict, kind: str, where: str) -> None:
     """Cross-field checks."""
     task, sigma = settings["task"], settings.get("sigma")
-    if sigma is not None and task != "fghh":
-        raise NeurohoverError(f"{where}: sigma applies to task 'fghh' only, not {task!r}")
+    from ..tasks import TASK_FAMILIES
+
+    if sigma is not None and not TASK_FAMILIES[task].has_sigma:
+        with_sigma = ", ".join(repr(n) for n, c in TASK_FAMILIES.items() if c.has_sigma)
+        raise NeurohoverError(f"{where}: sigma applies to task {with_sigma} only, not {task!r}")
     if kind == "evolution":
         keys = [v["key"] for v in settings["variants"]]
         if len(set(keys)) != len(keys):
             raise NeurohoverError(f"{where}: variant keys must be unique, got {keys}")
         for v in settings["variants"]:
-            if v["sigma"] is not None and task != "fghh":
+            if v["sigma"] is not None and not TASK_FAMILIES[task].has_sigma:
                 raise NeurohoverError(f"{where}: variant {v['key']!r} sets sigma but the task is {task!r}")
             if settings["target"] != "family" and v["resampling"].startswith("race"):
                 raise NeurohoverError(f"{where}: variant {v['key']!r}: selection races need target = 'family'")

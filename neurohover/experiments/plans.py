@@ -38,9 +38,9 @@ class Plan:
 
 
 def _family(task: str, sigma: float | None):
-    from ..tasks import get_task_family
+    from ..tasks import family_for
 
-    return get_task_family(task, sigma if task == "fghh" else None)
+    return family_for(task, sigma)
 
 
 def _mdps(family, which: str, n: int, seed: int):
@@ -144,19 +144,19 @@ class _Policies:
         for g in s["groups"]:
             spec = _spec(g["agent"])
             needs |= spec.needs
-            if self.task == "fghh" and self.task in spec.generic_kind:
+            if self.family.generic_over_distribution and self.task in spec.generic_kind:
                 needs.add(spec.generic_kind[self.task])
         self.needs = needs
         self.units: list[Unit] = []
         self.total = 0
         self.external = None if s["policies"] == "evolve" else _load_external(self.task, s["policies"])
         if self.external is not None:
-            if self.task == "fghh" and s["generics_per_agent"] != 1:
+            if self.family.generic_over_distribution and s["generics_per_agent"] != 1:
                 raise NeurohoverError(f"config {cfg.name!r}: a policy set holds one generic policy per method; "
                                       f"generics_per_agent = {s['generics_per_agent']} needs policies = \"evolve\"")
             return
         budget = s["policy_budget"]
-        if self.task != "fghh":
+        if not self.family.generic_over_distribution:
             if needs & {"generic"}:
                 self._add("policy/generic", {"kind": "mdp", "mdp": self.family.zero().to_dict()}, budget)
             if needs & {"specialised", "safe"}:
@@ -178,7 +178,7 @@ class _Policies:
                     if kind == "zero":
                         self._add(f"policy/generic-zero{j}", {"kind": "mdp", "mdp": self.family.zero().to_dict()}, budget)
                     else:
-                        self._add(f"policy/generic-{kind}{j}", {"kind": "family", "task": "fghh", "sigma": s["sigma"]},
+                        self._add(f"policy/generic-{kind}{j}", {"kind": "family", "task": self.task, "sigma": s["sigma"]},
                                   s["generic_budget"], s["generic_resampling"].get(kind, "fixed:5" if kind == "fixed" else "race:0.2"))
 
     def _add(self, key: str, target: dict, budget: int, resampling: str = "fixed:1") -> None:
@@ -195,7 +195,7 @@ class _Policies:
         need = spec.needs
         out: dict = {}
         ext = self.external
-        if self.task == "fghh":
+        if self.family.generic_over_distribution:
             kind = spec.generic_kind.get(self.task)
             if kind is not None:
                 if ext is not None:

@@ -67,9 +67,9 @@ def _mdp(d: dict):
 
 
 def _family(task: str, sigma: float | None):
-    from ..tasks import get_task_family
+    from ..tasks import family_for
 
-    return get_task_family(task, sigma if task == "fghh" else None)
+    return family_for(task, sigma)
 
 
 def _num(x: float) -> float | str:

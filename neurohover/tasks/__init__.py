@@ -1,0 +1,81 @@
+"""Task families (generalized tasks) and their MDPs: docs/model.md, Task families.
+
+A task family is a distribution G over MDPs; an MDP is fully fixed by its parameters. Each family
+offers its zero setting (the mean MDP), explicit construction from parameters (validated), a
+sampler of fresh MDPs (as objects or as kernel rows), and fixed sets of 10 training and 100 test
+MDPs. The protocol is :class:`~neurohover.tasks.base.TaskFamily`; each family is one module of
+this package that names its class ``TASK_FAMILY``, found here without a list to edit.
+
+The fixed sets are the competitions' own MDPs, as the paper's authors used them (their experiment
+code's lists, shipped as ``neurohover/data/competition-mdps.json``; 0-based, the paper numbers
+from 1): GHH-08, GHH-09 and FGHH at sigma = 0.3. Seeded draws from G form a second, harder pair of
+sets, named ``seeded-train:N`` / ``seeded-test:N`` (``seeded_training_mdps``); for FGHH at any
+other sigma they are the only fixed sets, and ``train:N`` / ``test:N`` name them.
+
+Example
+-------
+>>> from neurohover.tasks import get_task_family
+>>> family = get_task_family("ghh08")
+>>> mdp = family.make([2.5, -1.0])            # constant wind (m/s)
+>>> train = family.training_mdps()            # 10 fixed MDPs
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+
+from ..errors import NeurohoverError
+from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, competition_rows, finite_vector
+from .fghh import COMPETITION_FGHH_SIGMA, FGHH
+from .ghh08 import GHH08, MAX_WIND
+from .ghh09 import GHH09, GHH09_PARAM_NAMES
+
+_FIRST = ("ghh08", "ghh09", "fghh")  # the paper's order in help texts; other families follow by name
+
+
+def discover(package: str) -> dict[str, type[TaskFamily]]:
+    """The ``TASK_FAMILY`` class of every module of ``package``, by family name."""
+    names = sorted((m.name for m in pkgutil.iter_modules(importlib.import_module(package).__path__)),
+                   key=lambda n: (_FIRST.index(n) if n in _FIRST else len(_FIRST), n))
+    found: dict[str, type[TaskFamily]] = {}
+    for module in names:
+        cls = getattr(importlib.import_module(f"{package}.{module}"), "TASK_FAMILY", None)
+        if cls is not None:
+            if cls.name in found:
+                raise RuntimeError(f"task family {cls.name!r} is declared twice")
+            found[cls.name] = cls
+    return found
+
+
+#: Every task family class by name.
+TASK_FAMILIES: dict[str, type[TaskFamily]] = discover(__name__)
+TASK_NAMES: tuple[str, ...] = tuple(TASK_FAMILIES)
+
+
+def get_task_family(name: str, sigma: float | None = None) -> TaskFamily:
+    """The task family called ``name`` (``ghh08``, ``ghh09``, ``fghh``, ...; ``sigma``: its breadth, where it has one)."""
+    key = str(name).lower().replace("-", "")
+    if key not in TASK_FAMILIES:
+        raise NeurohoverError(f"unknown task {name!r}: allowed {', '.join(TASK_NAMES)}")
+    cls = TASK_FAMILIES[key]
+    if sigma is not None and not cls.has_sigma:
+        with_sigma = [n for n, c in TASK_FAMILIES.items() if c.has_sigma]
+        raise NeurohoverError(f"sigma applies to the {', '.join(with_sigma)} task only, not to {name!r}")
+    if cls.has_sigma and sigma is not None:
+        return cls(sigma=float(sigma))  # type: ignore[call-arg]
+    return cls()
+
+
+def family_for(name: str, sigma: float | None) -> TaskFamily:
+    """Like :func:`get_task_family`, but a ``sigma`` is ignored for families without one (configs carry one for all)."""
+    key = str(name).lower().replace("-", "")
+    has = key in TASK_FAMILIES and TASK_FAMILIES[key].has_sigma
+    return get_task_family(name, sigma if has else None)
+
+
+__all__ = [
+    "COMPETITION_FGHH_SIGMA", "COMPETITION_MDPS_FILE", "FGHH", "GHH08", "GHH09", "GHH09_PARAM_NAMES", "MAX_WIND", "MDP",
+    "N_TEST", "N_TRAINING", "TASK_FAMILIES", "TASK_NAMES", "TaskFamily", "competition_rows", "family_for",
+    "finite_vector", "get_task_family",
+]

@@ -1,0 +1,268 @@
+"""The MDP and the task-family protocol that every family implements (docs/model.md, Task families)."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import NeurohoverError
+from ..sim.constants import (
+    DEFAULT_NOISE_STD,
+    DEFAULT_PARAMS,
+    MDP_ROW_LEN,
+    ROW_D_U,
+    SUBSTEP_DT,
+    SUBSTEPS,
+    WIND_NONE,
+)
+from ..sim.reference import ReferenceMDP
+
+N_TRAINING = 10
+N_TEST = 100
+_SET_ENTROPY = 20110401  # fixed root of the seeded training and test sets (the paper's year)
+_FIXED_SETS: dict[tuple[str, int, int], tuple["MDP", ...]] = {}
+_ROW_LAYOUTS: dict[tuple[str, int], np.ndarray] = {}
+COMPETITION_MDPS_FILE = Path(__file__).parent.parent / "data" / "competition-mdps.json"
+_COMPETITION: dict[str, dict] = {}
+
+
+@dataclass(frozen=True)
+class MDP:
+    """One fully specified helicopter MDP (or learned model).
+
+    Attributes
+    ----------
+    family : str
+        ``"ghh08"``, ``"ghh09"``, ``"fghh"`` or ``"model"`` (a learned model).
+    params : tuple of float
+        The 11 dynamics parameters, in the order of ``neurohover.sim.constants.PARAM_NAMES``.
+    noise_std : tuple of float
+        Gust-noise standard deviations for u, v, w, p, q, r.
+    wind_kind : int
+        0 none, 1 constant (GHH-08), 2 sinusoidal (GHH-09).
+    wind : tuple of float
+        (wind_u, wind_v) in m/s for kind 1; the 8 GHH-09 parameters for kind 2.
+    substeps, dt : int, float
+        Integration substeps per 0.1 s control step and their length (a learned model: 1, 0.1).
+    d_u : float
+        Constant body-frame u acceleration, the paper's D_u: 0 in every true MDP; a learned model
+        may fit it (a constant wind acts near hover as a constant acceleration).
+    label : str
+        Human-readable name, e.g. ``"ghh08/train:3"``.
+    """
+
+    family: str
+    params: tuple[float, ...] = tuple(DEFAULT_PARAMS)
+    noise_std: tuple[float, ...] = tuple(DEFAULT_NOISE_STD)
+    wind_kind: int = WIND_NONE
+    wind: tuple[float, ...] = ()
+    substeps: int = SUBSTEPS
+    dt: float = SUBSTEP_DT
+    label: str = field(default="", compare=False)
+    d_u: float = 0.0
+
+    def row(self) -> np.ndarray:
+        """The float64 row the compiled kernel reads (layout in ``sim.constants``)."""
+        row = np.zeros(MDP_ROW_LEN)
+        row[0:11] = self.params
+        row[11:17] = self.noise_std
+        row[17] = self.substeps
+        row[18] = self.dt
+        row[19] = self.wind_kind
+        row[20 : 20 + len(self.wind)] = self.wind
+        row[ROW_D_U] = self.d_u
+        return row
+
+    def to_reference(self) -> ReferenceMDP:
+        """The same MDP for the plain-Python reference simulator."""
+        wind = tuple(self.wind) + (0.0,) * (8 - len(self.wind))
+        return ReferenceMDP(self.params, self.noise_std, self.wind_kind, wind, self.substeps, self.dt, self.d_u)
+
+    def to_dict(self) -> dict:
+        return {
+            "family": self.family, "params": list(self.params), "noise_std": list(self.noise_std),
+            "wind_kind": self.wind_kind, "wind": list(self.wind), "substeps": self.substeps,
+            "dt": self.dt, "label": self.label, "d_u": self.d_u,
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "MDP":
+        return cls(
+            d["family"], tuple(map(float, d["params"])), tuple(map(float, d["noise_std"])),
+            int(d["wind_kind"]), tuple(map(float, d["wind"])), int(d["substeps"]), float(d["dt"]),
+            d.get("label", ""), float(d.get("d_u", 0.0)),
+        )
+
+
+def finite_vector(values: Sequence[float] | np.ndarray, length: int, what: str) -> np.ndarray:
+    """``values`` as a float array of ``length`` finite numbers, or a clear error naming ``what``."""
+    try:
+        arr = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise NeurohoverError(f"{what} must be {length} numbers, got {values!r}") from None
+    if arr.shape != (length,):
+        raise NeurohoverError(f"{what} must be {length} numbers, got {arr.size}: {values!r}")
+    if not np.all(np.isfinite(arr)):
+        raise NeurohoverError(f"{what} must be finite numbers, got {arr.tolist()}")
+    return arr
+
+
+def competition_rows(family: str) -> dict:
+    """The competition's training and test rows of ``family`` as listed in the shipped data file."""
+    if not _COMPETITION:
+        _COMPETITION.update(json.loads(COMPETITION_MDPS_FILE.read_text()))
+    return _COMPETITION[family]
+
+
+class TaskFamily:
+    """A task family: a distribution G over MDPs, each MDP fixed by ``n_params`` numbers.
+
+    A family module subclasses this (as a frozen dataclass) and sets the class attributes and
+    the three methods marked below; sampling, kernel rows, fixed sets and names come from here.
+
+    Attributes
+    ----------
+    name : str
+        Its id (``--task``), e.g. ``"ghh08"``.
+    n_params, param_names
+        The MDP parameters :meth:`make` takes.
+    row_slice : slice
+        Where those parameters sit in an MDP's kernel row (the rest of a sampled row is fixed).
+    set_code : int
+        Distinguishes its seeded fixed sets from other families'.
+    has_sigma : bool
+        Whether it has a breadth ``sigma`` (FGHH).
+    generic_over_distribution : bool
+        Whether its generic policies are evolved over G (FGHH: fixed resampling and races) rather
+        than on the zero setting (GHH-08, GHH-09); decides the layout of its policy set.
+    """
+
+    name: str = ""
+    n_params: int = 0
+    param_names: tuple[str, ...] = ()
+    row_slice: slice = slice(0, 0)
+    set_code: int = 0
+    has_sigma: bool = False
+    sigma: float | None = None  # the breadth of G, for families with has_sigma
+    generic_over_distribution: bool = False
+
+    # -- what a family defines ------------------------------------------------------------
+
+    def make(self, params: Sequence[float], label: str = "") -> MDP:  # pragma: no cover - overridden
+        """The MDP of ``params`` (validated; a clear error names a bad value)."""
+        raise NotImplementedError
+
+    def zero(self) -> MDP:  # pragma: no cover - overridden
+        """The zero setting: no wind, default dynamics."""
+        raise NotImplementedError
+
+    def sample_params(self, rng: np.random.Generator, n: int) -> np.ndarray:  # pragma: no cover - overridden
+        """Parameters of ``n`` fresh MDPs from G, shape (n, n_params): the generator is consumed as
+        by ``n`` consecutive one-MDP draws, so a stream of MDPs does not depend on batch sizes."""
+        raise NotImplementedError
+
+    # -- what every family gets -----------------------------------------------------------
+
+    def set_variant(self) -> int:
+        """Distinguishes seeded fixed sets of one family (FGHH: by sigma)."""
+        return 0
+
+    def competition_params(self, row: Sequence[float]) -> Sequence[float]:
+        """The MDP parameters of one row of the competition file (GHH-08 scales it to m/s)."""
+        return row
+
+    @property
+    def has_competition_sets(self) -> bool:
+        """True when ``train:N`` / ``test:N`` are the competition's MDPs (else the seeded draws)."""
+        return True
+
+    def sample(self, rng: np.random.Generator | int | None = None, label: str = "") -> MDP:
+        """A fresh MDP drawn from G."""
+        rng = np.random.default_rng(rng)
+        return self.make(self.sample_params(rng, 1)[0], label=label or f"{self.name}/sample")
+
+    def row_template(self) -> np.ndarray:
+        """The kernel row every sampled MDP shares outside :attr:`row_slice` (checked once against :meth:`make`)."""
+        key = (self.name, self.set_variant())
+        if key not in _ROW_LAYOUTS:
+            probe = self.sample_params(np.random.default_rng(0), 1)[0]
+            template = self.make(probe).row()
+            check = template.copy()
+            check[self.row_slice] = probe
+            if not np.array_equal(check, template):
+                raise RuntimeError(f"{self.name}: make() does not put the parameters in row_slice {self.row_slice}")
+            _ROW_LAYOUTS[key] = template
+        return _ROW_LAYOUTS[key].copy()
+
+    def rows(self, params: np.ndarray) -> np.ndarray:
+        """Kernel rows of the MDPs of ``params`` (n, n_params), as ``make(p).row()`` gives, unvalidated."""
+        params = np.asarray(params, dtype=float)
+        out = np.repeat(self.row_template()[None, :], params.shape[0], axis=0)
+        out[:, self.row_slice] = params
+        return out
+
+    def sample_rows(self, rng: np.random.Generator, n: int) -> np.ndarray:
+        """Kernel rows of ``n`` fresh MDPs: the rows of ``n`` consecutive :meth:`sample` calls."""
+        return self.rows(self.sample_params(rng, n))
+
+    def _seeded_set(self, which: int, n: int, kind: str) -> list[MDP]:
+        key = (self.name, self.set_variant(), which)
+        if key not in _FIXED_SETS:  # MDPs are immutable, so each set is built once per process
+            rng = np.random.default_rng(np.random.SeedSequence([_SET_ENTROPY, self.set_code, which, self.set_variant()]))
+            _FIXED_SETS[key] = tuple(self.make(self.sample_params(rng, 1)[0], label=f"{self.name}/{kind}:{i}")
+                                     for i in range(n))
+        return list(_FIXED_SETS[key])
+
+    def _competition_set(self, kind: str) -> list[MDP]:
+        key = (self.name, -1, 0 if kind == "train" else 1)
+        if key not in _FIXED_SETS:
+            rows = competition_rows(self.name)[kind]
+            _FIXED_SETS[key] = tuple(
+                self.make(self.competition_params(r), label=f"{self.name}/{kind}:{i}") for i, r in enumerate(rows)
+            )
+        return list(_FIXED_SETS[key])
+
+    def training_mdps(self) -> list[MDP]:
+        """The 10 training MDPs: the competition's (seeded draws where it has none)."""
+        if self.has_competition_sets:
+            return self._competition_set("train")
+        return self.seeded_training_mdps()
+
+    def test_mdps(self) -> list[MDP]:
+        """The 100 test MDPs: the competition's (seeded draws where it has none)."""
+        if self.has_competition_sets:
+            return self._competition_set("test")
+        return self.seeded_test_mdps()
+
+    def seeded_training_mdps(self) -> list[MDP]:
+        """10 training MDPs drawn from G with a fixed seed (``seeded-train:N``): harder than the competition's."""
+        return self._seeded_set(0, N_TRAINING, "seeded-train")
+
+    def seeded_test_mdps(self) -> list[MDP]:
+        """100 test MDPs drawn from G with a fixed seed (``seeded-test:N``)."""
+        return self._seeded_set(1, N_TEST, "seeded-test")
+
+    def mdp(self, spec: str, rng: np.random.Generator | int | None = None) -> MDP:
+        """An MDP by name: ``zero``, ``train:N``, ``test:N``, ``seeded-train:N``, ``seeded-test:N`` or ``sample``."""
+        if spec == "zero":
+            return self.zero()
+        if spec == "sample":
+            return self.sample(rng)
+        kind, _, index = spec.partition(":")
+        sets = {
+            "train": (self.training_mdps, N_TRAINING), "test": (self.test_mdps, N_TEST),
+            "seeded-train": (self.seeded_training_mdps, N_TRAINING), "seeded-test": (self.seeded_test_mdps, N_TEST),
+        }
+        if kind in sets and index.isdigit():
+            getter, n = sets[kind]
+            if int(index) < n:
+                return getter()[int(index)]
+            raise NeurohoverError(f"MDP index {index} in {spec!r} is out of range: allowed 0..{n - 1}")
+        raise NeurohoverError(
+            f"unknown MDP {spec!r}: allowed zero, sample, train:N and seeded-train:N (0..{N_TRAINING - 1}), "
+            f"test:N and seeded-test:N (0..{N_TEST - 1})"
+        )
