@@ -199,9 +199,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except NeurohoverError as err:
         print(f"neurohover {args.command}: error: {err}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print(f"neurohover {args.command}: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as stop:
+        from .procs import Terminated
+
+        print(f"neurohover {args.command}: {'terminated' if isinstance(stop, Terminated) else 'interrupted'}", file=sys.stderr)
+        return 143 if isinstance(stop, Terminated) else 130  # 128 + the signal's number, as shells report
 
 
 if __name__ == "__main__":

@@ -38,6 +38,8 @@ CASES: list[tuple[list[str], str]] = [
     (["reproduce", "fig2", "--store", "adir"], "is a directory"),
     (["reproduce", "fig2", "--store", "/proc/s.sqlite"], "cannot create a file in '/proc'"),
     (["reproduce", "adir/x.toml", "--store", "s.sqlite"], "does not exist"),
+    (["reproduce", "fig2", "--store", "s.sqlite", "--executor", "ray", "--address", "notanaddress"], "'notanaddress'"),
+    (["reproduce", "fig2", "--store", "s.sqlite", "--executor", "ray", "--address", "127.0.0.1:1"], "127.0.0.1:1"),
     # option conflicts
     (["fly", "--task", "ghh08", "--wind", "1,1", "--mdp", "train:0"], "cannot be combined with --mdp train:0"),
     (["fly", "--task", "ghh08", "--params", "1,1", "--mdp", "test:3"], "cannot be combined with --mdp test:3"),

@@ -277,3 +277,22 @@ def test_two_stores_on_one_file_in_one_process_take_turns(tmp_path: Path) -> Non
         assert first.experiments() == second.experiments() == [("x", "quick", "h", 0)]  # reading needs no lock
         first.close()
         second.begin("x", "quick", "h", {})  # a closed Store's lock is released
+
+
+def test_a_terminated_command_exits_with_143_and_an_interrupt_with_130(monkeypatch, capsys) -> None:
+    import neurohover.cli as cli
+    from neurohover.procs import Terminated
+
+    def stop(exc):
+        def run(args):
+            raise exc
+        return run
+
+    for exc, status, word in ((Terminated(), 143, "terminated"), (KeyboardInterrupt(), 130, "interrupted")):
+        parser = cli.build_parser()
+        args = parser.parse_args(["demo"])
+        monkeypatch.setattr(cli, "build_parser", lambda p=parser: p)
+        monkeypatch.setattr(parser, "parse_args", lambda argv=None, a=args: a)
+        args.func = stop(exc)
+        assert cli.main(["demo"]) == status
+        assert capsys.readouterr().err.strip() == f"neurohover demo: {word}"
