@@ -1,5 +1,5 @@
 """Models as the paper fitted them: OLS by default, the intercepts as documented, and EC-MENO
-against the closed-form minimum of its own objective (neurohover/models.py docstrings).
+against the closed-form minimum of its own objective (neurohover/models/ docstrings).
 
 Flight data: one baseline episode of 1500 control steps on the windy GHH-08 test MDP 0 (the
 competition's own set), every number seeded. The tolerances on EC-MENO come from 4 seeds on these

@@ -1,0 +1,144 @@
+"""LR: a learned model by least squares on consecutive observations (the paper's best method).
+
+How LR works, and why (every choice is consistent with the one-substep kernel)
+-------------------------------------------------------------------------------
+For each transition k -> k+1 of an episode, with R_k the body-to-world rotation of the observed
+quaternion (qw = sqrt(1 - |q vector|^2)), world velocity V_k = R_k (u, v, w)_k:
+
+* velocity targets: ``f_k = R_k^T ((V_{k+1} - V_k) / 0.1 - g e_z)``: the world acceleration minus
+  gravity, expressed in the body frame *of step k*. The kernel's one substep computes
+  ``V_{k+1} = V_k + 0.1 (R_k f(vb_k, a_k) + g e_z)`` with the orientation before the rotation
+  update, so this target is exactly the body force the model would need; and because R_k is
+  orthogonal, least squares on f_k is least squares on the predicted world velocity.
+  Regressors: u on u_k; v on v_k and a constant (the constant is D_v); w on w_k and a4_k.
+* rate targets ``(p_{k+1} - p_k) / 0.1`` on p_k and a1_k (likewise q/a2, r/a3): the kernel's
+  Euler step of the rates.
+* estimator ``"ols"`` (default, ``DEFAULT_ESTIMATOR``): ordinary least squares, as the paper and
+  the authors' code fit LR, and what every agent uses (docs/model.md). The gusts are AR(1) with the
+  known coefficient 0.8 (``n_k = 0.8 n_{k-1} + 0.4 std z_k``) and the state at k already carries
+  n_{k-1}, which is correlated with n_k, so OLS does not estimate the simulator's parameters: it
+  estimates the best one-step predictor, which leans on the gusts' autocorrelation. Measured on one
+  baseline episode of the GHH-08 zero setting (seed 11, compared after :func:`equivalent_params`):
+  OLS is 77-86 % off on every rate parameter, 16 % on D_w, and makes all three velocity drags
+  positive (C_w about +3.9 instead of -0.49); GLS is within 4.5 % on all but C_u (-21 %) and
+  C_w (+9 %). With one baseline episode on each of the 10 GHH-08 training MDPs, the baseline policy
+  crashes in 68 of 80 episodes flown on the OLS ``"uv"`` models, in none on the GLS ones.
+  ``"gls"`` (the option): quasi-differences every target and regressor within an episode
+  (``y_k - 0.8 y_{k-1}``), which leaves white innovations ``0.4 std z_k`` that the regressors of
+  step k do not depend on, so the fit is consistent. Kept only as an option: docs/model.md reports
+  that it gave policies that crash in the first episode on some GHH-09 MDPs where OLS gave none.
+* intercepts (what the code does; ``stats["intercepts"]`` records the choice):
+
+  - ``"uv"`` (default, ``DEFAULT_INTERCEPTS``): a constant column on u and on v. The v constant is
+    the parameter D_v (``params[2]``); the u constant becomes the model's D_u
+    (:attr:`LearnedModel.d_u`), a constant body-frame u acceleration the model flies with (the
+    MDP's D_u slot). The residuals, hence the noise std, are those of the model with D_u.
+  - ``"v"``: a constant on v only (D_v); u is fitted on u alone and D_u = 0.
+  - ``"all"``: a constant on every axis while fitting; the v constant is D_v, the other five
+    (u, w, p, q, r, the u constant included) are discarded: reported in
+    ``stats["discarded_intercepts"]``, D_u = 0, and the residuals and noise std are computed without
+    them (so the noise absorbs what they explained).
+  - ``"none"``: no constant at all (D_v = 0, D_u = 0), an ablation.
+
+  A constant wind acts near hover as a constant body-frame acceleration, which D_u carries.
+  Measured with GLS, one baseline episode on each of the 10 GHH-08 training MDPs, predicting the
+  baseline's mean return on the true MDP (8 episodes each): ``"uv"`` is off by 1.0 % on average (at
+  most 2.2 %), ``"v"`` by 29 % (at most 80 %: without D_u the model cannot carry the wind's drag on
+  u), ``"all"`` by 28 %, ``"none"`` by 63 %. Hence ``"uv"``. (With OLS the baseline crashes on most
+  of these models whatever the intercepts, so returns do not rank them; tests/test_models.py checks
+  that ``"uv"`` also lowers the OLS one-step error, in sample and on a held-out episode.)
+* noise: the one-step residuals of the learned model (accelerations it does not explain) are the
+  model's gusts n_k. Their innovations ``e_k = r_k - 0.8 r_{k-1}`` are ``0.4 std z_k``, so
+  ``std = rms(e) / 0.4``. (The residuals' own rms would give ``std = rms(r) * 0.6 / 0.4`` if they
+  were pure AR(1) noise; any slowly varying misfit, e.g. a wind the model cannot represent, inflates
+  that estimate much more than the innovation estimate. Both are kept in ``stats``.)
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from ..errors import NeurohoverError
+from ..flightdata import FlightData
+from ..sim.constants import NOISE_DECAY, NOISE_NAMES, PARAM_NAMES
+from .model import LearnedModel
+from .transitions import Transitions, noise_from_residuals
+
+__all__ = ["DEFAULT_ESTIMATOR", "DEFAULT_INTERCEPTS", "ESTIMATORS", "INTERCEPTS", "learn_lr"]
+
+INTERCEPTS = ("v", "uv", "all", "none")
+DEFAULT_INTERCEPTS = "uv"
+ESTIMATORS = ("ols", "gls")
+DEFAULT_ESTIMATOR = "ols"
+
+
+def learn_lr(flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS, *, estimator: str = DEFAULT_ESTIMATOR) -> LearnedModel:
+    """Learn a model by least squares (docs/model.md, Learned models, "LR"; module docstring for every detail).
+
+    Parameters
+    ----------
+    flight_data : FlightData
+        One or more episodes (all transitions are pooled; pairs never straddle episodes).
+    intercepts : {"uv", "v", "all", "none"}
+        Which axes get a constant column (module docstring). ``"uv"`` (default): u and v; the v
+        constant is D_v and the u constant is kept as the model's D_u (``d_u``). ``"v"``: v only
+        (D_v; D_u = 0). ``"all"``: every axis; only the v constant is kept (D_v), the others,
+        the u constant included, are discarded (``stats["discarded_intercepts"]``; D_u = 0).
+        ``"none"``: no constant (D_v = 0, D_u = 0).
+    estimator : {"ols", "gls"}
+        ``"ols"`` (default): ordinary least squares, the paper's and the agents' estimator (biased
+        for the simulator's parameters by the AR(1) gusts; the best one-step predictor).
+        ``"gls"``: quasi-differencing with the gusts' known AR(1) coefficient 0.8 (consistent).
+
+    Returns
+    -------
+    LearnedModel
+        ``method="lr"``; ``stats`` holds the standard errors of the parameters (``param_se``),
+        the discarded intercepts, residual rms and both noise estimates.
+    """
+    start = time.perf_counter()
+    if intercepts not in INTERCEPTS:
+        raise NeurohoverError(f"intercepts={intercepts!r} is not allowed: choose one of {', '.join(INTERCEPTS)}")
+    if estimator not in ESTIMATORS:
+        raise NeurohoverError(f"estimator={estimator!r} is not allowed: choose one of {', '.join(ESTIMATORS)}")
+    tr = Transitions(flight_data)
+    y = tr.targets()
+    params = np.zeros(11)
+    se = np.zeros(11)
+    discarded: dict[str, float] = {}
+    for axis in range(6):
+        intercept = intercepts == "all" or (axis == 1 and intercepts in ("v", "uv")) or (axis == 0 and intercepts == "uv")
+        x, idx = tr.regressors(axis, intercept)
+        target = y[:, axis]
+        if estimator == "gls":
+            x = (x[1:] - NOISE_DECAY * x[:-1])[tr.pair]
+            target = (target[1:] - NOISE_DECAY * target[:-1])[tr.pair]
+        theta, _, rank, _ = np.linalg.lstsq(x, target, rcond=None)
+        if rank < x.shape[1]:
+            raise NeurohoverError(
+                f"flight data do not determine the {NOISE_NAMES[axis]} axis (regressors "
+                f"{[PARAM_NAMES[i] if i >= 0 else 'constant' for i in idx]} are collinear); fly with a policy that varies its actions")
+        dof = max(1, x.shape[0] - x.shape[1])
+        sigma2 = float(np.sum((target - x @ theta) ** 2)) / dof
+        cov = sigma2 * np.linalg.inv(x.T @ x)
+        for col, i in enumerate(idx):
+            if i >= 0:
+                params[i] = theta[col]
+                se[i] = math.sqrt(max(cov[col, col], 0.0))
+            else:
+                discarded[NOISE_NAMES[axis]] = float(theta[col])
+    d_u = discarded.pop("u", 0.0) if intercepts == "uv" else 0.0  # "uv" keeps the u constant as D_u
+    residuals = tr.model_residuals(params)[0]
+    residuals[:, 0] -= d_u
+    noise, stationary = noise_from_residuals(tr, residuals)
+    seconds = time.perf_counter() - start
+    stats = {
+        "estimator": estimator, "intercepts": intercepts, "n_transitions": tr.n, "n_episodes": tr.n_episodes,
+        "param_se": se.tolist(), "discarded_intercepts": discarded,
+        "residual_rms": np.sqrt(np.mean(residuals**2, axis=0)).tolist(),
+        "noise_std_stationary": stationary.tolist(),
+    }
+    return LearnedModel(tuple(params), tuple(noise), "lr", seconds, stats, d_u)
