@@ -17,7 +17,7 @@ from __future__ import annotations
 import contextlib
 import time
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numba
 import numpy as np
@@ -83,7 +83,7 @@ class Evaluation:
     flight_data : FlightData or None
         Flight data of the recorded episodes, in job order.
     seconds : float
-        Wall time of the kernel call.
+        Wall time of the kernel call (not part of ``==``).
     """
 
     returns: np.ndarray
@@ -91,7 +91,7 @@ class Evaluation:
     steps: np.ndarray
     safeguard_step: np.ndarray
     flight_data: FlightData | None
-    seconds: float
+    seconds: float = field(compare=False)  # wall-clock, not part of the outcome
 
     @property
     def episodes(self) -> int:

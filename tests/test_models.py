@@ -8,6 +8,7 @@ frame puts C_u 50 % off on kernel-consistent data).
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -270,3 +271,21 @@ def test_ec_mer_lowers_return_error(zero_flight) -> None:
     flown = evaluate(baseline_policy(), model.mdp(), episodes=1, seed=s["episode_seed"]).returns[0, 0, 0]
     assert flown == pytest.approx(s["predicted_return"], rel=1e-9)
     assert abs(flown - true_return) == pytest.approx(s["return_error"], rel=1e-6, abs=1e-9)
+
+
+def test_equality_ignores_wall_clock_fields(zero_flight) -> None:
+    """Two fits of the same data are equal: the seconds spent learning take no part in ==."""
+    fd = zero_flight.flight_data
+    a = learn_lr(fd)
+    assert learn_lr(fd) == learn_lr(fd)
+    assert dataclasses.replace(a, seconds=a.seconds + 1.0) == a
+    assert dataclasses.replace(a, params=(0.0,) * 11) != a
+    # Other results that carry wall-clock time keep it out of equality too.
+    from neurohover.agents.protocol import RunResult
+    from neurohover.evaluate import Evaluation
+
+    timed = {"Evaluation": (Evaluation, {"seconds"}), "RunResult": (RunResult, {"seconds", "offline_seconds"}),
+             "LearnedModel": (LearnedModel, {"seconds"})}
+    for name, (cls, wall) in timed.items():
+        compared = {f.name for f in dataclasses.fields(cls) if f.compare}
+        assert not compared & wall, f"{name} compares wall-clock fields {sorted(compared & wall)}"

@@ -107,8 +107,8 @@ class RunResult:
     steps: np.ndarray
     policy: list[str]
     safeguard_fired: np.ndarray
-    offline_seconds: np.ndarray
-    seconds: float = 0.0
+    offline_seconds: np.ndarray = field(compare=False)  # wall-clock, like seconds: not part of ==
+    seconds: float = field(default=0.0, compare=False)
     extra: dict = field(default_factory=dict)
 
     @property

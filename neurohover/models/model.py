@@ -102,7 +102,7 @@ class LearnedModel:
         ``"uv"`` (the default); 0 for every other intercepts choice and for EC-MENO and EC-MER,
         which do not evolve it.
     seconds : float
-        Wall time spent learning it.
+        Wall time spent learning it (not part of ``==``: two fits of the same data are equal).
     stats : dict
         Fit statistics (JSON-serialisable): transitions used, standard errors, residuals, errors.
     """
@@ -110,7 +110,7 @@ class LearnedModel:
     params: tuple[float, ...]
     noise_std: tuple[float, ...]
     method: str
-    seconds: float = 0.0
+    seconds: float = field(default=0.0, compare=False)  # wall-clock: equal fits stay equal
     stats: dict = field(default_factory=dict, compare=False)
     d_u: float = 0.0
 
