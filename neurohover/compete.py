@@ -118,12 +118,13 @@ def summarise(results: Sequence[RunResult]) -> dict:
 
 def plot_cumulative(curves: dict[str, np.ndarray], path: Path, title: str) -> Path:
     """Mean cumulative error per episode of each agent, linear and log scale (paper Figs 4 and 7)."""
-    import matplotlib
+    # Object-oriented matplotlib (no pyplot): the caller's backend and pyplot figures stay as they are.
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    fig = Figure(figsize=(11, 4))
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(1, 2)
     for name, cumulative in curves.items():
         error = -cumulative.mean(axis=0)
         episodes = np.arange(1, error.size + 1)
@@ -140,7 +141,6 @@ def plot_cumulative(curves: dict[str, np.ndarray], path: Path, title: str) -> Pa
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path
 
 

@@ -73,13 +73,16 @@ def _sd(x) -> float:
     return float(x.std(ddof=1)) if x.size > 1 else float("nan")
 
 
-def _plt():
-    import matplotlib
+def _figure(ncols: int = 1, *, figsize: tuple[float, float]):
+    """A new figure with a 1 x ``ncols`` grid of axes (an array, always 2-d), drawn by Agg.
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    Object-oriented matplotlib: no pyplot, so the caller's backend and pyplot's figures are untouched."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
-    return plt
+    fig = Figure(figsize=figsize)
+    FigureCanvasAgg(fig)
+    return fig, fig.subplots(1, ncols, squeeze=False)
 
 
 def _p_significant(p_paper: str) -> bool | None:
@@ -113,7 +116,6 @@ class _Section:
         fig.tight_layout()
         path = self.out / f"{self.stem}.png"
         fig.savefig(path, dpi=110)
-        _plt().close(fig)
         return path.name
 
     def add_tests(self, samples: dict[str, list[float]], labels: dict[str, str], what: str) -> None:
@@ -174,9 +176,8 @@ class _Evolution(_Section):
         xmax = max(r["history"][-1][0] for runs in data.values() for _, r in runs)
         xmin = min(r["history"][0][0] for runs in data.values() for _, r in runs)
         grid = np.linspace(max(xmin, 1), xmax, 400)
-        plt = _plt()
         two = self.cfg.name == "fig2" or self.s["target"] == "train"
-        fig, axes = plt.subplots(1, 2 if two else 1, figsize=(11 if two else 6.5, 4.2), squeeze=False)
+        fig, axes = _figure(2 if two else 1, figsize=(11 if two else 6.5, 4.2))
         axes = axes[0]
         for v in self.variants():
             runs = data[v["key"]]
@@ -281,8 +282,8 @@ class _ModelLearning(_Section):
         data = {m: v for m, v in data.items() if v}
         if not data:
             return None
-        plt = _plt()
-        fig, ax = plt.subplots(figsize=(6.5, 4))
+        fig, axes = _figure(figsize=(6.5, 4))
+        ax = axes[0, 0]
         errors = [np.maximum(-np.array([float(r["test_mean"]) for r in v]), 1e-3) for v in data.values()]
         ax.boxplot(errors)
         ax.set_xticks(range(1, len(data) + 1), [m.upper() for m in data])
@@ -336,8 +337,8 @@ class _TestRuns(_Section):
         data = {k: v for k, v in data.items() if v}
         if not data:
             return None
-        plt = _plt()
-        fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+        fig, axes = _figure(2, figsize=(11, 4.2))
+        axes = axes[0]
         for label, runs in data.items():
             cum = -np.cumsum(np.array([[float(x) for x in r["returns"]] for r in runs]), axis=1).mean(axis=0)
             episodes = np.arange(1, cum.size + 1)
