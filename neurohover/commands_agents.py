@@ -42,11 +42,16 @@ def cmd_compete(args: argparse.Namespace) -> int:
         input_dir(args.policy_dir, "--policy-dir")
     output_dir(args.out, "--out")
     bar = tqdm(total=args.runs, desc=f"{args.task} {args.agent}", unit="run", file=sys.stderr, disable=None)
+
+    def finished(spec, result) -> None:
+        bar.update(1)
+        bar.set_postfix(score=f"{result.score:.4g}")
+
     try:
         summary, _ = compete(
             args.task, args.agent, runs=args.runs, episodes=args.episodes, mdps=args.mdps, seed=args.seed,
             jobs=args.jobs, out=args.out, sigma=args.sigma, n_steps=args.episode_steps, policy_dir=args.policy_dir, hybrid=hybrid,
-            on_result=lambda spec, result: (bar.update(1), bar.set_postfix(score=f"{result.score:.4g}")),
+            on_result=finished,
         )
     except KeyboardInterrupt:
         bar.close()

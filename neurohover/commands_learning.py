@@ -307,7 +307,7 @@ def model_notes(model, data, truth, rows) -> list[str]:
 
 def register(sub) -> None:
     p = sub.add_parser("evolve", help="evolve a policy on an MDP (steady state) or over a task family (generational)",
-                       description=cmd_evolve.__doc__ + "\n\n" + __doc__.split("\n\n", 1)[1],
+                       description=(cmd_evolve.__doc__ or "") + "\n\n" + (__doc__ or "").split("\n\n", 1)[1],
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--task", required=True, help="task family: ghh08, ghh09 or fghh")
     p.add_argument("--mdp", help="zero, train:N, test:N, seeded-train:N, seeded-test:N, sample (one MDP drawn from G with --seed), or G: evolve over "

@@ -81,7 +81,7 @@ class Policy:
         g = self.genome.tolist()
         if self.topology == "slp":
             inputs = (u, v, w, x, y, z, qx, qy, qz)
-            return tuple(  # type: ignore[return-value]
+            return tuple(
                 sum(g[9 * i + j] * inputs[j] for j in range(9)) + g[36 + i] for i in range(4)
             )
         b, wt = g[:15], g[15:]

@@ -145,6 +145,7 @@ class IncrementalModelBasedAgent(Agent):
             return
         if outcome.flight_data is not None:
             self.flight_data = outcome.flight_data if self.flight_data is None else self.flight_data + outcome.flight_data
+        assert self.flight_data is not None  # the first episode is always recorded
         model = learn_model(self.flight_data, self.settings.estimator)
         self.models_learned += 1
         self.current, self.predicted = evolve_on_model(model, self.generic, self.settings, int(self._rng.integers(2**62)))

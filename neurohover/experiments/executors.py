@@ -18,6 +18,7 @@ from __future__ import annotations
 import os
 import socket
 import time
+from typing import Any
 from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
@@ -57,7 +58,7 @@ class LocalExecutor:
         if self.jobs == 1:
             import numba
 
-            return int(numba.config.NUMBA_NUM_THREADS)
+            return int(numba.config.NUMBA_NUM_THREADS)  # type: ignore[attr-defined]
         return self.jobs
 
     def run(self, units: Sequence[Unit], on_result: OnResult, on_error: OnError) -> None:
@@ -194,7 +195,7 @@ class RayExecutor:
             source, given = ("--address", address) if address is not None else ("RAY_ADDRESS", os.environ.get("RAY_ADDRESS") or None)
             if given is not None:
                 check_ray_address(given, source)
-            kwargs = {"include_dashboard": False, "log_to_driver": True}
+            kwargs: dict[str, Any] = {"include_dashboard": False, "log_to_driver": True}
             if given is None and num_cpus is not None:
                 kwargs["num_cpus"] = num_cpus
             try:

@@ -40,7 +40,7 @@ from ..errors import NeurohoverError
 try:
     import fcntl
 except ImportError:  # not POSIX: no writer lock; one run per store is then the user's care
-    fcntl = None
+    fcntl = None  # type: ignore[assignment]
 
 SCHEMA_VERSION = 1
 APPLICATION_ID = 0x4E484F56  # "NHOV"
@@ -271,7 +271,8 @@ class Store:
         cur = self.conn.execute(
             "INSERT INTO sessions (name, scale, config_hash, executor, cores, started, wall_seconds, units_run, units_before, status) "
             "VALUES (?, ?, ?, ?, ?, ?, 0, 0, ?, 'running')", (name, scale, config_hash, executor, int(cores), time.time(), units_before))
-        return int(cur.lastrowid)
+        assert cur.lastrowid is not None  # an INSERT always sets it
+        return cur.lastrowid
 
     def end_session(self, session: int, status: str) -> None:
         self.conn.execute("UPDATE sessions SET status = ?, wall_seconds = ? - started WHERE id = ?", (status, time.time(), session))

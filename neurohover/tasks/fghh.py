@@ -19,7 +19,7 @@ COMPETITION_FGHH_SIGMA = 0.3  # the only FGHH sigma the authors' code lists MDPs
 class FGHH(TaskFamily):
     """Fully generalized: no wind; each of the 11 dynamics parameters ~ N(d, (|d| sigma)^2)."""
 
-    sigma: float = 0.3  # type: ignore[assignment]  # a field here, None on families without a breadth
+    sigma: float = 0.3  # a field here; None on families without a breadth
     name = "fghh"
     n_params = 11
     param_names = PARAM_NAMES
