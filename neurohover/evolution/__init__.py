@@ -1,10 +1,16 @@
 """Optimisers over flat genome vectors: neuroevolution, selection races, CMA-ES.
 
-All optimisers MAXIMISE returns (negative in the helicopter domain) and use an
-ask/tell interface; fitness evaluation is left to the caller.
+All optimisers MAXIMISE returns (negative in the helicopter domain) and share one ask/tell
+protocol (:class:`Optimiser`); fitness evaluation is left to the caller.
+
+Modules: ``steady_state`` and ``generational`` (the paper's neuroevolution), ``cmaes``, ``common``
+(the protocol and what the optimisers share), ``operators`` (mutation, crossover), ``races``
+(fitness under noise); whole runs: ``evolve`` (the public entry point), ``config``, ``run``,
+``records``, ``seeding``.
 """
 
 from .cmaes import CMAES
+from .common import ChampionRecord, Optimiser
 from .evolve import (
     EvolutionInterrupted,
     EvolutionResult,
@@ -15,16 +21,7 @@ from .evolve import (
     parse_resampling,
     validation_return,
 )
-from .neuroevolution import (
-    ROULETTE_ERROR_FLOOR,
-    ChampionRecord,
-    GenerationalNE,
-    GenerationalSettings,
-    GenerationRecord,
-    SteadyStateNE,
-    SteadyStateSettings,
-    roulette_weights,
-)
+from .generational import GenerationalNE, GenerationalSettings, GenerationRecord
 from .operators import crossover, mutate
 from .races import (
     RaceResult,
@@ -33,6 +30,7 @@ from .races import (
     fixed_resampling,
     selection_race,
 )
+from .steady_state import ROULETTE_ERROR_FLOOR, SteadyStateNE, SteadyStateSettings, roulette_weights
 
 __all__ = [
     "CMAES",
@@ -46,6 +44,7 @@ __all__ = [
     "GenerationRecord",
     "GenerationalNE",
     "GenerationalSettings",
+    "Optimiser",
     "RaceResult",
     "ResamplingResult",
     "SteadyStateNE",

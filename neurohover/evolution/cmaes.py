@@ -7,20 +7,62 @@ before being passed on.
 
 from __future__ import annotations
 
+import base64
+import io
 import math
+import pickle
+from typing import Any
 
 import cma
 import numpy as np
 
-from .neuroevolution import (
-    ChampionViews,
-    _ChampionTracker,
-    _check_prototype,
-    _check_returns,
-    _Clock,
-)
+from . import common
+from .common import ChampionTracker, ChampionViews, Clock, check_prototype, check_returns
 
 __all__ = ["CMAES"]
+
+#: Where classes pickled in earlier checkpoints now live (module, name) -> (module, name).
+_MOVED = {
+    ("neurohover.evolution.neuroevolution", "_ChampionTracker"): (common, "ChampionTracker"),
+    ("neurohover.evolution.neuroevolution", "_Clock"): (common, "Clock"),
+    ("neurohover.evolution.neuroevolution", "ChampionRecord"): (common, "ChampionRecord"),
+}
+
+
+class _Randn:
+    """pycma's ``randn`` option drawing from the CMAES wrapper's private generator (rebuilt on load)."""
+
+    def __init__(self, holder: list) -> None:
+        self.holder = holder
+
+    def __call__(self, *shape):
+        return self.holder[0].standard_normal(shape)
+
+
+class _Pickler(pickle.Pickler):
+    """Pickles a :class:`CMAES`, replacing its ``randn`` closure(s) by a persistent id."""
+
+    def __init__(self, file, randn) -> None:
+        super().__init__(file, protocol=4)
+        self._randn = randn
+
+    def persistent_id(self, obj):
+        return "randn" if obj is self._randn or isinstance(obj, _Randn) else None
+
+
+class _Unpickler(pickle.Unpickler):
+    def __init__(self, file, holder: list) -> None:
+        super().__init__(file)
+        self._randn = _Randn(holder)
+
+    def persistent_load(self, pid):
+        if pid != "randn":
+            raise pickle.UnpicklingError(f"unknown persistent id {pid!r}")
+        return self._randn
+
+    def find_class(self, module: str, name: str):
+        moved = _MOVED.get((module, name))
+        return getattr(*moved) if moved is not None else super().find_class(module, name)
 
 
 class CMAES(ChampionViews):
@@ -59,7 +101,7 @@ class CMAES(ChampionViews):
         popsize: int | None = None,
         budget: int | None = None,
     ) -> None:
-        x0 = _check_prototype(prototype)
+        x0 = check_prototype(prototype)
         if x0.size < 2:
             raise ValueError(f"CMAES needs a genome of length >= 2, got {x0.size}")
         if not (isinstance(sigma0, (int, float)) and math.isfinite(sigma0) and sigma0 > 0):
@@ -82,8 +124,8 @@ class CMAES(ChampionViews):
         self._es = cma.CMAEvolutionStrategy(x0, float(sigma0), opts)
         self.budget = None if budget is None else int(budget)
         self._pending: list[np.ndarray] | None = None
-        self._tracker = _ChampionTracker()
-        self._clock = _Clock()
+        self._tracker = ChampionTracker()
+        self._clock = Clock()
 
     def ask(self) -> np.ndarray:
         """Return one generation of genomes, shape ``(popsize, D)``."""
@@ -96,7 +138,7 @@ class CMAES(ChampionViews):
         """Report one return per asked genome (maximised)."""
         if self._pending is None:
             raise RuntimeError("tell() called without a pending ask()")
-        f = _check_returns(fitness, len(self._pending))
+        f = check_returns(fitness, len(self._pending))
         losses = -f
         bad = ~np.isfinite(losses)
         if bad.any():
@@ -127,3 +169,27 @@ class CMAES(ChampionViews):
     def sigma(self) -> float:
         """Current overall step size."""
         return float(self._es.sigma)
+
+    # ----------------------------------------------------------------- checkpoint
+
+    def state_dict(self) -> dict[str, Any]:
+        """JSON-serialisable snapshot: the whole optimiser pickled (pycma's state has no plainer
+        form), base64-encoded, with the private generator's draws reconnected on load."""
+        buf = io.BytesIO()
+        _Pickler(buf, self._es.opts["randn"]).dump(self)
+        return {"type": "CMAES", "pickle": base64.b64encode(buf.getvalue()).decode("ascii")}
+
+    @classmethod
+    def from_state_dict(cls, state: dict[str, Any]) -> CMAES:
+        """Rebuild an optimiser from :meth:`state_dict`; it continues identically.
+
+        Raises
+        ------
+        pickle.UnpicklingError, ValueError, KeyError
+            A state that is not one of :meth:`state_dict` (only load states you trust: unpickling
+            runs code).
+        """
+        holder: list = [None]
+        opt = _Unpickler(io.BytesIO(base64.b64decode(state["pickle"])), holder).load()
+        holder[0] = opt._rng
+        return opt

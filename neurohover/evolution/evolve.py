@@ -59,9 +59,7 @@ Example
 
 from __future__ import annotations
 
-import base64
 import dataclasses
-import io
 import json
 import math
 import os
@@ -84,9 +82,10 @@ from ..sim.constants import EPISODE_STEPS, SAFEGUARD_LIMITS
 from ..sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
 from ..tasks import MDP, TaskFamily
 from .cmaes import CMAES
-from .neuroevolution import GenerationalNE, GenerationalSettings, SteadyStateNE, SteadyStateSettings
-from .neuroevolution import SteadyStateNE as _SteadyStateNE  # the class itself (tests may patch the name)
+from .generational import GenerationalNE, GenerationalSettings
 from .races import fixed_resampling, selection_race
+from .steady_state import SteadyStateNE, SteadyStateSettings
+from .steady_state import SteadyStateNE as _SteadyStateNE  # the class itself (tests may patch the name)
 
 __all__ = [
     "CHECKPOINT_FORMAT",
@@ -423,54 +422,6 @@ class _InterruptFlag:
             raise KeyboardInterrupt
 
 
-# --------------------------------------------------------------------------------- CMA-ES state
-
-
-class _Randn:
-    """pycma's ``randn`` option drawing from the CMAES wrapper's private generator (rebuilt on load)."""
-
-    def __init__(self, holder: list) -> None:
-        self.holder = holder
-
-    def __call__(self, *shape):
-        return self.holder[0].standard_normal(shape)
-
-
-class _CMAPickler(pickle.Pickler):
-    """Pickles a :class:`CMAES`, replacing its ``randn`` closure(s) by a persistent id."""
-
-    def __init__(self, file, randn) -> None:
-        super().__init__(file, protocol=4)
-        self._randn = randn
-
-    def persistent_id(self, obj):
-        return "randn" if obj is self._randn or isinstance(obj, _Randn) else None
-
-
-class _CMAUnpickler(pickle.Unpickler):
-    def __init__(self, file, holder: list) -> None:
-        super().__init__(file)
-        self._randn = _Randn(holder)
-
-    def persistent_load(self, pid):
-        if pid != "randn":
-            raise pickle.UnpicklingError(f"unknown persistent id {pid!r}")
-        return self._randn
-
-
-def _cma_state(opt: CMAES) -> dict:
-    buf = io.BytesIO()
-    _CMAPickler(buf, opt._es.opts["randn"]).dump(opt)
-    return {"type": "CMAES", "pickle": base64.b64encode(buf.getvalue()).decode("ascii")}
-
-
-def _cma_from_state(state: dict) -> CMAES:
-    holder: list = [None]
-    opt = _CMAUnpickler(io.BytesIO(base64.b64decode(state["pickle"])), holder).load()
-    holder[0] = opt._rng
-    return opt
-
-
 # --------------------------------------------------------------------------------- the run
 
 
@@ -606,7 +557,7 @@ class _Run:
     # ----------------------------------------------------------------- checkpoints
 
     def state(self, wall: float) -> dict:
-        opt_state = _cma_state(self.opt) if self.optimizer == "cma" else self.opt.state_dict()
+        opt_state = self.opt.state_dict()
         return {
             "format": CHECKPOINT_FORMAT, "config": self.config, "budget": self.budget,
             "optimizer_state": opt_state,
@@ -637,7 +588,7 @@ class _Run:
         opt_state = state["optimizer_state"]
         try:
             if self.optimizer == "cma":
-                self.opt = _cma_from_state(opt_state)
+                self.opt = CMAES.from_state_dict(opt_state)
             elif self.method == "steady-state":
                 self.opt = SteadyStateNE.from_state_dict(opt_state)
             else:

@@ -1,0 +1,334 @@
+"""What the optimisers share: the ask/tell protocol, champion tracking, checks and state encoding.
+
+Sign convention
+---------------
+The optimisers MAXIMISE returns. In the helicopter domain returns are negative (accumulated
+negative reward), so "best" means "closest to zero"; the paper's "error" of a genome is
+``-return``. Non-finite returns (NaN or ``-inf``, e.g. from a diverged simulation) rank as the
+worst possible; ``+inf`` is refused.
+
+Checkpointing
+-------------
+``state_dict()`` returns a plain, strictly JSON-serialisable dict (non-finite floats are stored as
+strings, see :func:`enc_float`) including the ``numpy.random.Generator`` state; ``from_state_dict``
+rebuilds an optimiser that continues bit-for-bit identically, also when saved between ``ask()``
+and ``tell()``.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+import time
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+
+__all__ = [
+    "STATE_VERSION",
+    "ChampionRecord",
+    "ChampionTracker",
+    "ChampionViews",
+    "Clock",
+    "Optimiser",
+    "check_prototype",
+    "check_returns",
+    "check_state",
+    "dec_array",
+    "enc_array",
+    "enc_float",
+    "rank",
+    "require_int",
+    "require_prob",
+    "require_std",
+    "rng_from_state",
+    "set_field",
+    "validate_variation_settings",
+]
+
+#: Version of the optimisers' ``state_dict`` format.
+STATE_VERSION = 1
+
+
+class Optimiser(Protocol):
+    """The ask/tell surface of every optimiser here (:class:`SteadyStateNE`, :class:`GenerationalNE`,
+    :class:`CMAES`), which is what an evolution run (:mod:`neurohover.evolution.run`) uses.
+
+    An optimiser whose ``tell`` also takes ``crashed=`` flags (one bool per genome) says so with
+    a class attribute ``tells_crashes = True``; the run tells the others returns only.
+    """
+
+    def ask(self) -> np.ndarray:
+        """The genomes to evaluate next, shape ``(n, D)``."""
+
+    def tell(self, fitness: np.ndarray, /) -> None:
+        """One return (or fitness estimate) per genome of the last :meth:`ask`, maximised."""
+
+    def stop(self) -> bool:
+        """Whether the optimiser's own termination criterion has fired."""
+
+    @property
+    def champion_genome(self) -> np.ndarray | None:
+        """The champion (None before any finite fitness was told)."""
+
+    @property
+    def champion_return(self) -> float:
+        """The champion's fitness (``-inf`` before any finite fitness was told)."""
+
+    def state_dict(self) -> dict[str, Any]:
+        """A plain JSON-serialisable snapshot of the whole state."""
+
+    @classmethod
+    def from_state_dict(cls, state: dict[str, Any]) -> Optimiser:
+        """The optimiser :meth:`state_dict` saved; it continues bit-for-bit identically."""
+
+
+# --------------------------------------------------------------------------- settings checks
+
+
+def require_int(name: str, value: Any, minimum: int) -> int:
+    """``value`` as an int, or ValueError unless it is an integer (not a bool) ``>= minimum``."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < minimum:
+        raise ValueError(f"{name}={value!r} must be an integer >= {minimum}")
+    return int(value)
+
+
+def require_prob(name: str, value: Any) -> float:
+    """``value`` as a float, or ValueError unless it is a probability in [0, 1]."""
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, numbers.Real)
+        or not 0.0 <= float(value) <= 1.0
+    ):
+        raise ValueError(f"{name}={value!r} must be a probability in [0, 1]")
+    return float(value)
+
+
+def require_std(name: str, value: Any) -> float:
+    """``value`` as a float, or ValueError unless it is a finite number >= 0."""
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, numbers.Real)
+        or not math.isfinite(float(value))
+        or float(value) < 0.0
+    ):
+        raise ValueError(f"{name}={value!r} must be a finite number >= 0")
+    return float(value)
+
+
+def set_field(obj: Any, name: str, value: Any) -> None:
+    """Set a field of a frozen settings dataclass (in ``__post_init__``)."""
+    # Frozen dataclass: store plain Python numbers so that asdict() is JSON-able.
+    object.__setattr__(obj, name, value)
+
+
+def validate_variation_settings(obj: Any) -> None:
+    """Check and normalise the fields both neuroevolution settings share (population, variation, budget)."""
+    set_field(obj, "pop_size", require_int("pop_size", obj.pop_size, 2))
+    for name in ("crossover_prob", "averaging_prob", "mutate_prob", "mutate_frac", "mutate_repl"):
+        set_field(obj, name, require_prob(name, getattr(obj, name)))
+    set_field(obj, "mutate_std", require_std("mutate_std", obj.mutate_std))
+    if obj.budget is not None:
+        set_field(obj, "budget", require_int("budget", obj.budget, 1))
+
+
+# --------------------------------------------------------------------------- genomes and returns
+
+
+def check_prototype(prototype: np.ndarray) -> np.ndarray:
+    """A float64 copy of a non-empty, finite 1-D genome (ValueError otherwise)."""
+    p = np.array(prototype, dtype=np.float64)
+    if p.ndim != 1 or p.size == 0:
+        raise ValueError(f"prototype must be a non-empty 1-D genome, got shape {p.shape}")
+    if not np.all(np.isfinite(p)):
+        raise ValueError("prototype must be finite")
+    return p
+
+
+def check_returns(values: Any, n: int, what: str = "fitness") -> np.ndarray:
+    """``n`` returns as float64, one per asked genome; ``+inf`` is refused (ValueError)."""
+    f = np.array(values, dtype=np.float64)
+    if f.shape != (n,):
+        raise ValueError(
+            f"{what} must have shape ({n},), one return per asked genome; got shape {f.shape}"
+        )
+    if np.count_nonzero(f == np.inf):
+        raise ValueError(f"{what} contains +inf; returns must be finite, NaN or -inf")
+    return f
+
+
+def rank(returns: np.ndarray) -> np.ndarray:
+    """Indices best first; NaN/-inf last; ties keep their order (deterministic)."""
+    key = np.fmax(returns, -np.inf)  # NaN -> -inf
+    return (-key).argsort(kind="stable")
+
+
+# --------------------------------------------------------------------------- state encoding
+
+
+def enc_float(x: float) -> float | str:
+    """A float for strict JSON: non-finite values become ``"nan"``, ``"inf"`` or ``"-inf"``
+    (``float()`` reads them back)."""
+    x = float(x)
+    if math.isfinite(x):
+        return x
+    return "nan" if math.isnan(x) else ("inf" if x > 0 else "-inf")
+
+
+def enc_array(a: np.ndarray | None) -> dict[str, Any] | None:
+    """An array for strict JSON: its shape and its values through :func:`enc_float`."""
+    if a is None:
+        return None
+    a = np.asarray(a, dtype=np.float64)
+    return {"shape": list(a.shape), "data": [enc_float(v) for v in a.ravel()]}
+
+
+def dec_array(d: dict[str, Any] | None) -> np.ndarray | None:
+    """The array :func:`enc_array` encoded."""
+    if d is None:
+        return None
+    return np.array([float(v) for v in d["data"]], dtype=np.float64).reshape(d["shape"])
+
+
+def rng_from_state(state: dict[str, Any]) -> np.random.Generator:
+    """A ``numpy.random.Generator`` in the saved ``bit_generator.state``."""
+    bit_generator = getattr(np.random, state["bit_generator"])()
+    bit_generator.state = state
+    return np.random.Generator(bit_generator)
+
+
+def check_state(state: dict[str, Any], kind: str) -> None:
+    """ValueError unless ``state`` is a ``state_dict`` of type ``kind`` in :data:`STATE_VERSION`."""
+    if state.get("type") != kind:
+        raise ValueError(f"state dict is for {state.get('type')!r}, not {kind!r}")
+    if state.get("version") != STATE_VERSION:
+        raise ValueError(f"unsupported state version {state.get('version')!r}")
+
+
+# --------------------------------------------------------------------------- champions
+
+
+class Clock:
+    """Wall-clock seconds since the start of a run, continued across checkpoints."""
+
+    def __init__(self, elapsed: float = 0.0) -> None:
+        self._start = time.perf_counter() - elapsed
+
+    def __call__(self) -> float:
+        return time.perf_counter() - self._start
+
+
+@dataclass(frozen=True)
+class ChampionRecord:
+    """A new champion: evaluations done so far, its return, seconds since the start, and whether
+    its evaluation crashed (as told to ``SteadyStateNE.tell``; False without crash flags)."""
+
+    evaluations: int
+    champion_return: float
+    wall_seconds: float
+    crashed: bool = False
+
+
+class ChampionTracker:
+    """Best single return ever told, evaluations since it, and its history.
+
+    The champion's crash flag is its history record's (the last one): it is fixed for the
+    champion's lifetime, so the ``no-crash`` plateau count is ``since`` or 0 (:meth:`plateau`)
+    and needs no state of its own.
+    """
+
+    def __init__(self) -> None:
+        self.evaluations = 0
+        self.genome: np.ndarray | None = None
+        self.best = -math.inf
+        self.since = 0
+        self.history: list[ChampionRecord] = []
+
+    def update(
+        self, genomes: np.ndarray, returns: np.ndarray, wall: float, crashed: np.ndarray | None = None
+    ) -> None:
+        """Count one evaluation per genome; a strictly better return makes a new champion."""
+        for k, (g, r) in enumerate(zip(genomes, returns, strict=True)):
+            self.evaluations += 1
+            if r > self.best:  # strict; NaN compares False
+                self.best = float(r)
+                self.genome = np.array(g, dtype=np.float64)
+                self.since = 0
+                hit = crashed is not None and bool(crashed[k])
+                self.history.append(ChampionRecord(self.evaluations, self.best, wall, hit))
+            else:
+                self.since += 1
+
+    @property
+    def champion_crashed(self) -> bool:
+        return bool(self.history) and self.history[-1].crashed
+
+    def plateau(self, literal: bool) -> int:
+        """Evaluations counted towards the plateau: all since the champion (``literal``), or
+        only while the champion's evaluation did not crash (``no-crash``)."""
+        return self.since if literal or not self.champion_crashed else 0
+
+    def to_dict(self) -> dict[str, Any]:
+        """Strict-JSON state (the ``tracker`` entry of ``SteadyStateNE.state_dict``)."""
+        return {
+            "evaluations": self.evaluations,
+            "genome": enc_array(self.genome),
+            "best": enc_float(self.best),
+            "since": self.since,
+            "history": [  # a 4th element only for a crashed champion (the format stays as it was)
+                [h.evaluations, enc_float(h.champion_return), h.wall_seconds]
+                + ([True] if h.crashed else [])
+                for h in self.history
+            ],
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> ChampionTracker:
+        """The tracker :meth:`to_dict` saved."""
+        t = cls()
+        t.evaluations = int(d["evaluations"])
+        t.genome = dec_array(d["genome"])
+        t.best = float(d["best"])
+        t.since = int(d["since"])
+        t.history = [
+            ChampionRecord(int(h[0]), float(h[1]), float(h[2]), bool(h[3]) if len(h) > 3 else False)
+            for h in d["history"]
+        ]
+        return t
+
+
+class ChampionViews:
+    """Read-outs of an optimiser's champion tracking (shared by SteadyStateNE and CMAES)."""
+
+    _tracker: ChampionTracker
+
+    @property
+    def evaluations(self) -> int:
+        """Number of returns told so far."""
+        return self._tracker.evaluations
+
+    @property
+    def champion_genome(self) -> np.ndarray | None:
+        """Genome with the best single return ever told (None before any finite return)."""
+        return None if self._tracker.genome is None else self._tracker.genome.copy()
+
+    @property
+    def champion_return(self) -> float:
+        """Best single return ever told (``-inf`` before any finite return)."""
+        return self._tracker.best
+
+    @property
+    def evaluations_since_champion(self) -> int:
+        """Evaluations told since the current champion appeared."""
+        return self._tracker.since
+
+    @property
+    def champion_crashed(self) -> bool:
+        """Whether the champion's evaluation was told as crashed (False without crash flags)."""
+        return self._tracker.champion_crashed
+
+    @property
+    def history(self) -> list[ChampionRecord]:
+        """One record per new champion, in order."""
+        return list(self._tracker.history)

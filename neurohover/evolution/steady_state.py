@@ -1,0 +1,432 @@
+"""Steady-state neuroevolution of the paper's Appendix A (GHH-08/09; docs/model.md, Neuroevolution).
+
+:class:`SteadyStateNE` works on flat genome vectors (network weights) through the ask/tell
+interface of :class:`~neurohover.evolution.common.Optimiser`; the caller evaluates the asked
+genomes and tells their returns (maximised; see :mod:`neurohover.evolution.common` for the sign
+convention and the checkpoint format).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from bisect import bisect_right
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import NeurohoverError
+from .common import (
+    STATE_VERSION,
+    ChampionTracker,
+    ChampionViews,
+    Clock,
+    check_prototype,
+    check_returns,
+    check_state,
+    dec_array,
+    enc_array,
+    rank,
+    require_int,
+    require_prob,
+    require_std,
+    rng_from_state,
+    set_field,
+    validate_variation_settings,
+)
+from .operators import crossover, mutate
+
+__all__ = [
+    "PLATEAU_RULES",
+    "ROULETTE_ERROR_FLOOR",
+    "SELECTIONS",
+    "SteadyStateNE",
+    "SteadyStateSettings",
+    "roulette_weights",
+]
+
+#: Errors (``-return``) are clamped to at least this before ``1/ln(error)``:
+#: ``ln`` is zero at 1 and negative below, which would give infinite or
+#: negative roulette weights. Any genome with return ``>= -ROULETTE_ERROR_FLOOR``
+#: therefore gets the maximal weight ``1/ln(1 + 1e-6) ~ 1e6``.
+ROULETTE_ERROR_FLOOR = 1.0 + 1e-6
+
+#: Plateau rules of :class:`SteadyStateSettings` (docs/model.md, Neuroevolution): ``no-crash`` (default) counts
+#: evaluations without a new champion only while the champion's own evaluation did not crash;
+#: ``literal`` is Appendix A as written (counts every evaluation without a new champion).
+PLATEAU_RULES = ("no-crash", "literal")
+
+#: Parent selection of :class:`SteadyStateSettings`: ``roulette`` (Appendix A, weights
+#: ``1/ln(error)``) or ``tournament`` (the best of ``tournament_size`` distinct genomes drawn
+#: uniformly, as in the authors' ``eonn`` code; docs/model.md, Neuroevolution).
+SELECTIONS = ("roulette", "tournament")
+
+
+@dataclass(frozen=True)
+class SteadyStateSettings:
+    """Settings of :class:`SteadyStateNE`; defaults are the paper's Table 6.
+
+    Attributes
+    ----------
+    pop_size : int
+        Population size (>= 2).
+    elite_size : int
+        Best individuals kept each generation (``0 <= elite_size < pop_size``);
+        the other ``pop_size - elite_size`` are replaced by offspring.
+    crossover_prob : float
+        Probability that an offspring is made by crossover (else a mutated copy).
+    averaging_prob : float
+        Per-gene probability that crossover averages the parents.
+    mutate_prob : float
+        Probability that a crossover child is then mutated.
+    mutate_frac : float
+        Per-gene mutation probability.
+    mutate_std : float
+        Standard deviation of the Gaussian mutation (finite, >= 0).
+    mutate_repl : float
+        Probability that a mutated gene is replaced rather than shifted.
+    plateau_threshold : int
+        Stop after this many counted evaluations without a new champion (>= 1); which
+        evaluations count is ``plateau_rule``'s choice.
+    budget : int or None
+        Optional cap on the number of evaluations (>= 1).
+    plateau_rule : {"no-crash", "literal"}
+        ``"no-crash"`` (default, a documented deviation, docs/model.md, Neuroevolution): the plateau counter runs only
+        while the champion's evaluation completed without crashing (crash flags come through
+        ``SteadyStateNE.tell(..., crashed=...)``); a population whose champion still crashes
+        never stops at the plateau, so such a run ends only at its budget (give one when the
+        prototype may crash, e.g. a zero seed). ``"literal"``: Appendix A as written, every
+        evaluation without a new champion counts (about 30% of zero-seeded runs then stop while
+        the whole population still crashes). When the champion never crashed, or no crash
+        flags are told, both rules give bit-identical runs.
+    selection : {"roulette", "tournament"}
+        Parent selection: ``"roulette"`` (default, Appendix A) or ``"tournament"`` (the best of
+        ``tournament_size`` distinct genomes drawn uniformly; the authors' ``eonn`` code).
+    tournament_size : int
+        Genomes per tournament (``1 <= tournament_size <= pop_size``; default 5, as in ``eonn``).
+    init_mutate_frac, init_mutate_std : float or None
+        Mutation of the prototype's copies in the initial population; None (default): as
+        ``mutate_frac`` / ``mutate_std`` (Appendix A). ``eonn`` used 0.5 and 0.5.
+    mutation_floor : float or None
+        None (default): Appendix A's mutation, the same absolute size for every gene. A number
+        > 0: gene i's perturbation (and replacement value) is scaled by
+        ``max(|prototype gene i|, mutation_floor)`` (an experimental deviation: from the baseline
+        seed, the paper's N(0, 0.8) cannot move gains of size 0.02 smoothly; see
+        docs/reproduction/discussion/fig2-paper.md).
+    """
+
+    pop_size: int = 50
+    elite_size: int = 49
+    crossover_prob: float = 0.5
+    averaging_prob: float = 0.5
+    mutate_prob: float = 0.75
+    mutate_frac: float = 0.1
+    mutate_std: float = 0.8
+    mutate_repl: float = 0.25
+    plateau_threshold: int = 1000
+    budget: int | None = None
+    plateau_rule: str = "no-crash"
+    selection: str = "roulette"
+    tournament_size: int = 5
+    init_mutate_frac: float | None = None
+    init_mutate_std: float | None = None
+    mutation_floor: float | None = None
+
+    def __post_init__(self) -> None:
+        validate_variation_settings(self)
+        if self.mutation_floor is not None:
+            floor = self.mutation_floor
+            if isinstance(floor, bool) or not isinstance(floor, (int, float)) or not (math.isfinite(floor) and floor > 0):
+                raise NeurohoverError(f"mutation_floor={floor!r} is out of range: allowed None or a finite number > 0")
+            set_field(self, "mutation_floor", float(floor))
+        if not isinstance(self.plateau_rule, str) or self.plateau_rule not in PLATEAU_RULES:
+            raise NeurohoverError(
+                f"unknown plateau_rule {self.plateau_rule!r}: allowed {', '.join(PLATEAU_RULES)}"
+            )
+        if not isinstance(self.selection, str) or self.selection not in SELECTIONS:
+            raise NeurohoverError(
+                f"unknown selection {self.selection!r}: allowed {', '.join(SELECTIONS)}"
+            )
+        size = require_int("tournament_size", self.tournament_size, 1)
+        if size > self.pop_size:
+            raise ValueError(f"tournament_size={size} must be in [1, pop_size={self.pop_size}]")
+        set_field(self, "tournament_size", size)
+        if self.init_mutate_frac is not None:
+            set_field(self, "init_mutate_frac", require_prob("init_mutate_frac", self.init_mutate_frac))
+        if self.init_mutate_std is not None:
+            set_field(self, "init_mutate_std", require_std("init_mutate_std", self.init_mutate_std))
+        elite = require_int("elite_size", self.elite_size, 0)
+        if elite >= self.pop_size:
+            raise ValueError(f"elite_size={elite} must be smaller than pop_size={self.pop_size}")
+        set_field(self, "elite_size", elite)
+        set_field(
+            self, "plateau_threshold", require_int("plateau_threshold", self.plateau_threshold, 1)
+        )
+
+
+def roulette_weights(returns: np.ndarray) -> np.ndarray:
+    """Positive roulette-wheel weights ``1 / ln(error)`` with ``error = -return``.
+
+    This is the transform of the original code. Errors are clamped to at least
+    :data:`ROULETTE_ERROR_FLOOR` (slightly above 1) so that every finite
+    return gets a finite positive weight; NaN / ``-inf`` returns get weight 0
+    (never picked unless every weight is 0, in which case all get weight 1).
+
+    Parameters
+    ----------
+    returns : np.ndarray
+        Returns of the population (maximised; normally negative).
+
+    Returns
+    -------
+    np.ndarray
+        Non-negative weights, same shape.
+    """
+    r = np.asarray(returns, dtype=np.float64)
+    error = np.maximum(-r, ROULETTE_ERROR_FLOOR)
+    w = np.divide(1.0, np.log(error), out=np.zeros(r.shape), where=np.isfinite(r))
+    if not np.count_nonzero(w):
+        w = np.ones_like(r)
+    return w
+
+
+def _spin(cdf: list[float], rng: np.random.Generator) -> int:
+    """Spin the roulette wheel given the cumulative weights (a list: bisecting a list is much
+    faster than ``np.searchsorted`` for a single value)."""
+    return min(bisect_right(cdf, rng.random() * cdf[-1]), len(cdf) - 1)
+
+
+def _initial_population(
+    prototype: np.ndarray, n: int, rng: np.random.Generator, settings: Any, scale: np.ndarray | None = None
+) -> np.ndarray:
+    # Appendix A: the prototype plus copies of it, each put through the
+    # mutation operator once (unconditionally, i.e. not gated by mutate_prob).
+    return np.vstack([prototype] + [_mutate(prototype, rng, settings, scale) for _ in range(n - 1)])
+
+
+def _mutate(genome: np.ndarray, rng: np.random.Generator, settings: Any, scale: np.ndarray | None) -> np.ndarray:
+    """``mutate`` with the optional per-gene scale (the plain call when there is none)."""
+    return mutate(genome, rng, settings) if scale is None else mutate(genome, rng, settings, scale)
+
+
+class SteadyStateNE(ChampionViews):
+    """Steady-state neuroevolution of Appendix A (GHH-08/09), ask/tell, maximising.
+
+    The first :meth:`ask` returns the initial population: the prototype itself
+    plus ``pop_size - 1`` copies each mutated once by :func:`mutate`. Every
+    later :meth:`ask` returns the ``pop_size - elite_size`` offspring of one
+    generation (one with the paper's settings). On :meth:`tell` the
+    ``elite_size`` best of the current population are kept and the told
+    offspring replace the rest.
+
+    Each offspring is, with probability ``crossover_prob``, the crossover of
+    two parents chosen by roulette wheel (two independent spins, so both may
+    be the same genome), then mutated with probability ``mutate_prob``;
+    otherwise it is a mutated copy of one roulette-selected parent. Parents
+    are drawn from the whole current (evaluated) population, with weights
+    :func:`roulette_weights` (``1/ln(-return)``).
+
+    The champion is the genome with the best single return ever told; the
+    run stops (:meth:`stop`) when ``plateau_threshold`` evaluations passed
+    without a strictly better one, or when ``budget`` evaluations were done
+    (checked between batches, so the initial population may overshoot a
+    budget smaller than ``pop_size``). Under the default ``plateau_rule``
+    ``"no-crash"`` an evaluation counts towards the plateau only while the
+    champion's own evaluation did not crash (``tell(..., crashed=...)``); see
+    :class:`SteadyStateSettings`.
+
+    Parameters
+    ----------
+    prototype : np.ndarray
+        1-D genome the initial population is built from.
+    settings : SteadyStateSettings, optional
+        Defaults to the paper's Table 6.
+    seed : int, default 0
+        Seed of the optimiser's own ``numpy.random.Generator``.
+
+    Examples
+    --------
+    >>> opt = SteadyStateNE(np.zeros(3), SteadyStateSettings(budget=200), seed=1)
+    >>> while not opt.stop():
+    ...     genomes = opt.ask()
+    ...     opt.tell(-np.sum((genomes - 1.0) ** 2, axis=1) - 1.0)
+    >>> opt.champion_return > -4.0
+    True
+    """
+
+    #: :meth:`tell` takes ``crashed=`` flags (the ``no-crash`` plateau rule needs them).
+    tells_crashes = True
+
+    def __init__(
+        self,
+        prototype: np.ndarray,
+        settings: SteadyStateSettings | None = None,
+        seed: int = 0,
+    ) -> None:
+        self.settings = settings if settings is not None else SteadyStateSettings()
+        self._prototype = check_prototype(prototype)
+        floor = self.settings.mutation_floor
+        self._scale = None if floor is None else np.maximum(np.abs(self._prototype), floor)
+        self._rng = np.random.default_rng(seed)
+        self._population: np.ndarray | None = None
+        self._fitness: np.ndarray | None = None
+        self._pending: np.ndarray | None = None
+        self._generation = 0
+        self._tracker = ChampionTracker()
+        self._clock = Clock()
+
+    # ----------------------------------------------------------------- ask/tell
+
+    def ask(self) -> np.ndarray:
+        """Return the genomes to evaluate next, shape ``(n, D)``.
+
+        Raises
+        ------
+        RuntimeError
+            If the previous batch has not been told yet.
+        """
+        if self._pending is not None:
+            raise RuntimeError("ask() called again before tell() of the previous batch")
+        if self._population is None:
+            s = self.settings
+            init = s
+            if s.init_mutate_frac is not None or s.init_mutate_std is not None:
+                init = dataclasses.replace(
+                    s,
+                    mutate_frac=s.mutate_frac if s.init_mutate_frac is None else s.init_mutate_frac,
+                    mutate_std=s.mutate_std if s.init_mutate_std is None else s.init_mutate_std,
+                )
+            batch = _initial_population(self._prototype, s.pop_size, self._rng, init, self._scale)
+        else:
+            batch = self._breed(self.settings.pop_size - self.settings.elite_size)
+        self._pending = batch
+        return batch.copy()
+
+    def tell(self, fitness: np.ndarray, crashed: np.ndarray | None = None) -> None:
+        """Report the returns of exactly the genomes of the last :meth:`ask`.
+
+        Parameters
+        ----------
+        fitness : np.ndarray
+            One return per asked genome (maximised; NaN/-inf rank worst).
+        crashed : np.ndarray of bool, optional
+            Whether each genome's evaluation crashed (with a mean over several episodes: whether
+            any of them crashed). Only the ``no-crash`` plateau rule uses it; None: no crash.
+        """
+        if self._pending is None:
+            raise RuntimeError("tell() called without a pending ask()")
+        f = check_returns(fitness, len(self._pending))
+        if crashed is not None:
+            c = np.asarray(crashed)
+            if c.shape != f.shape or not (c.dtype == np.bool_ or np.issubdtype(c.dtype, np.integer)):
+                raise ValueError(
+                    f"crashed must be {f.size} booleans, one per asked genome; got {crashed!r}"
+                )
+            crashed = c.astype(bool)
+        if self._population is None:
+            self._population, self._fitness = self._pending, f
+        else:
+            keep = rank(self._fitness)[: self.settings.elite_size]
+            self._population = np.concatenate((self._population.take(keep, axis=0), self._pending))
+            self._fitness = np.concatenate((self._fitness.take(keep), f))
+        self._tracker.update(self._pending, f, self._clock(), crashed)
+        self._pending = None
+        self._generation += 1
+
+    def stop(self) -> bool:
+        """True once the plateau threshold (counted by ``plateau_rule``) or the budget is reached."""
+        s = self.settings
+        if self._tracker.evaluations == 0:
+            return False
+        if self._tracker.plateau(s.plateau_rule == "literal") >= s.plateau_threshold:
+            return True
+        return s.budget is not None and self._tracker.evaluations >= s.budget
+
+    def _breed(self, n: int) -> np.ndarray:
+        s, rng, pop = self.settings, self._rng, self._population
+        if s.selection == "tournament":
+            key = np.fmax(self._fitness, -np.inf)  # NaN ranks worst
+            size = len(pop)
+
+            def pick() -> int:
+                entrants = rng.choice(size, s.tournament_size, replace=False)
+                return int(entrants[np.argmax(key[entrants])])  # ties: the first drawn
+        else:
+            cdf = roulette_weights(self._fitness).cumsum().tolist()
+
+            def pick() -> int:
+                return _spin(cdf, rng)
+        children = np.empty((n, pop.shape[1]))
+        for c in range(n):
+            if rng.random() < s.crossover_prob:
+                child = crossover(pop[pick()], pop[pick()], rng, s)
+                if rng.random() < s.mutate_prob:
+                    child = _mutate(child, rng, s, self._scale)
+            else:
+                child = _mutate(pop[pick()], rng, s, self._scale)
+            children[c] = child
+        return children
+
+    # ----------------------------------------------------------------- read-outs
+
+    @property
+    def plateau_evaluations(self) -> int:
+        """Evaluations the plateau rule has counted since the current champion appeared (equal
+        to :attr:`evaluations_since_champion`, or 0 while the champion's evaluation crashed under
+        the ``no-crash`` rule)."""
+        return self._tracker.plateau(self.settings.plateau_rule == "literal")
+
+    @property
+    def dim(self) -> int:
+        """Genome length D."""
+        return self._prototype.size
+
+    @property
+    def generation(self) -> int:
+        """Number of :meth:`tell` calls so far (the initial population is generation 1)."""
+        return self._generation
+
+    @property
+    def population(self) -> np.ndarray | None:
+        """Current evaluated population ``(pop_size, D)`` (None before the first tell)."""
+        return None if self._population is None else self._population.copy()
+
+    @property
+    def fitness(self) -> np.ndarray | None:
+        """Returns of :attr:`population`."""
+        return None if self._fitness is None else self._fitness.copy()
+
+    # ----------------------------------------------------------------- checkpoint
+
+    def state_dict(self) -> dict[str, Any]:
+        """Plain JSON-serialisable snapshot of the full optimiser state."""
+        return {
+            "type": "SteadyStateNE",
+            "version": STATE_VERSION,
+            "settings": dataclasses.asdict(self.settings),
+            "prototype": enc_array(self._prototype),
+            "population": enc_array(self._population),
+            "fitness": enc_array(self._fitness),
+            "pending": enc_array(self._pending),
+            "generation": self._generation,
+            "rng": self._rng.bit_generator.state,
+            "tracker": self._tracker.to_dict(),
+            "wall_seconds": self._clock(),
+        }
+
+    @classmethod
+    def from_state_dict(cls, state: dict[str, Any]) -> SteadyStateNE:
+        """Rebuild an optimiser from :meth:`state_dict`; it continues identically."""
+        check_state(state, "SteadyStateNE")
+        # States written before the plateau rule existed followed the literal rule.
+        settings = {"plateau_rule": "literal", **state["settings"]}
+        opt = cls(dec_array(state["prototype"]), SteadyStateSettings(**settings))
+        opt._population = dec_array(state["population"])
+        opt._fitness = dec_array(state["fitness"])
+        opt._pending = dec_array(state["pending"])
+        opt._generation = int(state["generation"])
+        opt._rng = rng_from_state(state["rng"])
+        opt._tracker = ChampionTracker.from_dict(state["tracker"])
+        opt._clock = Clock(float(state["wall_seconds"]))
+        return opt
