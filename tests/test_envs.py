@@ -47,7 +47,7 @@ def test_make_and_spaces(env_id: str) -> None:
     assert env.action_space == gym.spaces.Box(-1.0, 1.0, (4,), np.float64)
     obs, info = env.reset(seed=0)
     assert obs.dtype == np.float64 and obs.shape == (12,) and not obs.any()
-    assert info == {"mdp": f"{TASK_OF[env_id]}/sample", "crashed": False}
+    assert info["mdp"] == f"{TASK_OF[env_id]}/sample" and info["crashed"] is False  # "mdp_info": tests/test_env_info.py
     obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
     assert obs.dtype == np.float64 and isinstance(reward, float) and reward < 0
     assert env.unwrapped.mdp.family == TASK_OF[env_id]
@@ -316,7 +316,8 @@ def test_vector_mdp_and_noise_options() -> None:
         (lambda: HoverEnv("ghh08", mdp="medium"), "unknown MDP 'medium'.*allowed zero, sample"),
         (lambda: HoverEnv("ghh08", mdp=3), "mdp=3 is not allowed.*MDP instance"),
         (lambda: HoverEnv("ghh08", episode_steps=0), "episode_steps=0 is out of range"),
-        (lambda: HoverEnv("ghh08", render_mode="human"), "render_mode='human' is not supported"),
+        (lambda: HoverEnv("ghh08", render_mode="ansi"), "render_mode='ansi' is not supported.*'human', 'rgb_array'"),
+        (lambda: HoverVectorEnv(2, render_mode="rgb_array"), "render_mode='rgb_array' is not supported"),
         (lambda: HoverVectorEnv(0), "num_envs=0 is out of range"),
         (lambda: HoverVectorEnv(2, mdp=["zero"]), "mdp has 1 entries but there are num_envs=2"),
         (lambda: gym.make_vec("neurohover/GHH08-v0", num_envs=2, vectorization_mode="vector_entry_point", task="x"),

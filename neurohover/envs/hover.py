@@ -28,13 +28,18 @@ from ..sim.constants import (
     EPISODE_STEPS,
     MDP_ROW_LEN,
     OBS_DIM,
+    PARAM_NAMES,
     STATE_DIM,
 )
 from ..sim.kernel import step_batch
+from ..sim.reference import competition_time
 from ..sim.rng import seed_stream
-from ..tasks import MDP, TaskFamily, get_task_family
+from ..tasks import MDP, TASK_FAMILIES, TaskFamily, get_task_family
 
 RENDER_FPS = 10  # control rate (Hz)
+RENDER_MODES = ("human", "rgb_array")
+TRAIL_STEPS = 100  # positions kept for the rendered track: the last 10 s of flight
+OBS_DTYPES = ("float64", "float32")
 MAX_EPISODE_STEPS = 10**7
 MAX_NOISE_SEED = 2**63 - 1  # the largest seed ``neurohover.evaluate_jobs`` accepts
 SAMPLE = "sample"
@@ -122,8 +127,46 @@ def initial_state() -> np.ndarray:
     return state
 
 
-def observation_space() -> spaces.Box:
-    return spaces.Box(-np.inf, np.inf, (OBS_DIM,), np.float64)
+def check_obs_dtype(obs_dtype: Any) -> np.dtype:
+    """``obs_dtype`` (``"float64"``, ``"float32"`` or the NumPy type) as a dtype, or a clear error."""
+    try:
+        dtype = np.dtype(obs_dtype)
+    except TypeError:
+        dtype = None
+    if obs_dtype is None or dtype is None or dtype.name not in OBS_DTYPES:
+        raise NeurohoverError(f"obs_dtype={obs_dtype!r} is not allowed: use {' or '.join(map(repr, OBS_DTYPES))}")
+    return dtype
+
+
+def check_render_mode(render_mode: Any) -> str | None:
+    """``render_mode`` if it is None or one of :data:`RENDER_MODES`, else a clear error."""
+    if render_mode is not None and render_mode not in RENDER_MODES:
+        raise NeurohoverError(f"render_mode={render_mode!r} is not supported: use None, {', '.join(map(repr, RENDER_MODES))}")
+    return render_mode
+
+
+def mdp_info(mdp: MDP) -> dict[str, Any]:
+    """The MDP's family, label and parameters, as ``info["mdp_info"]`` carries them.
+
+    ``params`` are the numbers its task family draws (GHH-08: wind_u, wind_v; GHH-09: its 8 wind
+    parameters; FGHH: the 11 dynamics parameters), named by ``param_names``. An MDP of no task
+    family (a learned model) gives its 11 dynamics parameters and D_u.
+    """
+    cls = TASK_FAMILIES.get(mdp.family)
+    if cls is not None:
+        params, names = mdp.row()[cls.row_slice], tuple(cls.param_names)
+    else:
+        params, names = np.array([*mdp.params, mdp.d_u]), (*PARAM_NAMES, "D_u")
+    return {"family": mdp.family, "label": mdp.label, "params": tuple(float(v) for v in params), "param_names": names}
+
+
+def world_wind(mdp: MDP, steps: int) -> tuple[float, float, float]:
+    """World wind (m/s, north-east-down) of ``mdp`` after ``steps`` control steps, as the kernel flies it."""
+    return mdp.to_reference().wind_at(competition_time(steps, 0))
+
+
+def observation_space(dtype: Any = np.float64) -> spaces.Box:
+    return spaces.Box(-np.inf, np.inf, (OBS_DIM,), dtype)
 
 
 def action_space() -> spaces.Box:
@@ -156,7 +199,8 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
 
     ## Observation Space
 
-    ``Box(-inf, inf, (12,), float64)``; velocities and position errors are in the body frame.
+    ``Box(-inf, inf, (12,), float64)`` (``float32`` with ``obs_dtype="float32"``); velocities and
+    position errors are in the body frame.
 
     | Num | Observation                           | Unit  |
     |-----|---------------------------------------|-------|
@@ -178,7 +222,8 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
     Minus the sum of squares of the 12 observation entries. The crashing step instead gets
     ``-(3*20^2 + 3*(4*pi)^2 + 3*5^2 + (1 - cos^2(15 deg))) * (episode_steps - t)``, with t the
     control steps taken including the crashing one: the worst possible reward for every step
-    that is left (about -1.05e7 for a crash at the start of a 6000-step episode).
+    that is left (about -1.05e7 for a crash at the start of a 6000-step episode). Rewards are
+    Python floats (float64) whatever ``obs_dtype`` is.
 
     ## Starting State
 
@@ -202,6 +247,10 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
       MDPs), or an explicit :class:`neurohover.MDP`.
     - ``episode_steps``: control steps per episode (6000). ``gymnasium.make`` also adds a
       ``TimeLimit`` of 6000 steps; pass ``max_episode_steps`` to ``make`` for longer episodes.
+    - ``obs_dtype``: ``"float64"`` (default) or ``"float32"`` (for deep-RL libraries): the
+      observation space's dtype and the returned observations'. The simulation itself always
+      runs in float64, so the episodes are the same, observations rounded to float32.
+    - ``render_mode``: ``None`` (default), ``"rgb_array"`` or ``"human"`` (see Rendering).
 
     ``reset(seed=..., options=...)`` takes the options ``{"mdp": spec}`` (same values as the
     ``mdp`` argument; it also applies to later episodes) and ``{"noise": (seed, episode)}``
@@ -215,12 +264,37 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
     ``neurohover.evaluate_jobs(..., seed=noise_stream[0], episode_index=[noise_stream[1]])``
     flies, so a policy flown here and in a batched evaluation meets the same gusts.
 
+    ## Rendering
+
+    | Mode        | ``render()`` returns                     | Shown                               |
+    |-------------|------------------------------------------|-------------------------------------|
+    | None        | None (Gymnasium warns)                   | nothing                             |
+    | "rgb_array" | (340, 720, 3) uint8 frame                | nothing                             |
+    | "human"     | None                                     | a matplotlib window, at 10 fps      |
+
+    A frame shows a top view (east right, north up) and a side view seen from the east (north
+    right, altitude up) of the hover target (green cross, the origin), the helicopter rotated by
+    its attitude (blue rotor disk, orange nose) and its track over the last 10 s; a compass with
+    the MDP's current world wind (full radius 5 m/s); and a text line with the MDP label, step and
+    return so far. The views span 5 m either way, widening to 10 m and then to the crash box.
+    In ``"human"`` mode ``reset`` and ``step`` show each frame themselves; the window opens at the
+    first frame, and without a display the frames are drawn and dropped (with one warning). Both
+    modes work with Gymnasium's ``RecordVideo`` (``"rgb_array"``; it needs moviepy). Rendering
+    never changes the episode: observations and rewards are the same with or without it.
+
     ## Info
 
-    ``{"mdp": label of the current MDP, "crashed": bool}``.
+    | Key         | Value                                                                     |
+    |-------------|---------------------------------------------------------------------------|
+    | "mdp"       | label of the current MDP (str), e.g. ``"ghh08/test:4"``                   |
+    | "crashed"   | whether this step crashed (bool; False after ``reset``)                   |
+    | "mdp_info"  | ``{"family": str, "label": str, "params": tuple, "param_names": tuple}``: |
+    |             | the numbers that fix the MDP within its family (:func:`mdp_info`)         |
+
+    All three come from ``reset`` and from every ``step``.
     """
 
-    metadata = {"render_modes": [], "render_fps": RENDER_FPS}
+    metadata = {"render_modes": list(RENDER_MODES), "render_fps": RENDER_FPS}
 
     def __init__(
         self,
@@ -229,15 +303,15 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         mdp: MdpSpec = SAMPLE,
         episode_steps: int = EPISODE_STEPS,
         render_mode: str | None = None,
+        obs_dtype: Any = "float64",
     ) -> None:
-        if render_mode is not None:
-            raise NeurohoverError(f"render_mode={render_mode!r} is not supported: this environment has no rendering (use None)")
+        self.render_mode = check_render_mode(render_mode)
+        self.obs_dtype = check_obs_dtype(obs_dtype)
         self.family: TaskFamily = get_task_family(task, sigma)
         self.episode_steps = check_episode_steps(episode_steps)
         self._spec: MDP | str = resolve_mdp(self.family, mdp)
-        self.observation_space = observation_space()
+        self.observation_space = observation_space(self.obs_dtype)
         self.action_space = action_space()
-        self.render_mode = None
         # The kernel steps batches; this environment is a batch of one.
         self._rows = np.zeros((1, MDP_ROW_LEN))
         self._index = np.zeros(1, dtype=np.int64)
@@ -250,8 +324,14 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         self._reward = np.zeros(1)
         self._crash = np.zeros(1, dtype=np.bool_)
         self._mdp: MDP | None = None
+        self._mdp_info: dict[str, Any] = {}
         self._stream: tuple[int, int] | None = None
         self._done = True
+        # Rendering state: read by render() only, so it cannot change the episode.
+        self._return = 0.0
+        self._trail: list[np.ndarray] = []
+        self._renderer: Any = None
+        self._window: Any = None
 
     @property
     def mdp(self) -> MDP | None:
@@ -268,6 +348,14 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         """Control steps flown in the current episode."""
         return int(self._steps[0])
 
+    @property
+    def episode_return(self) -> float:
+        """Sum of the rewards of the current episode so far."""
+        return self._return
+
+    def _info(self, crashed: bool) -> dict[str, Any]:
+        return {"mdp": self._mdp_info["label"], "crashed": crashed, "mdp_info": dict(self._mdp_info)}
+
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
         super().reset(seed=seed)
         options = check_reset_options(options)
@@ -275,7 +363,7 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         spec = resolve_mdp(self.family, options["mdp"]) if "mdp" in options else self._spec
         stream = check_noise_stream(options["noise"]) if "noise" in options else None
         self._spec = spec
-        mdp = self.family.sample(self.np_random) if spec == SAMPLE else spec
+        mdp = self.family.sample(self.np_random) if isinstance(spec, str) else spec  # a str spec is SAMPLE
         if stream is None:
             stream = (draw_stream_seed(self.np_random), 0)
         self._mdp = mdp
@@ -286,7 +374,12 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         seed_stream(self._rng[0], np.uint64(stream[0]), np.uint64(stream[1]))
         self._steps[0] = 0
         self._done = False
-        return np.zeros(OBS_DIM), {"mdp": mdp.label, "crashed": False}
+        self._mdp_info = mdp_info(mdp)
+        self._return = 0.0
+        self._trail = [self._state[0, 3:6].copy()]
+        if self.render_mode == "human":
+            self.render()
+        return np.zeros(OBS_DIM, dtype=self.obs_dtype), self._info(False)
 
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         if self._done:
@@ -303,8 +396,63 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         terminated = bool(self._crash[0])
         truncated = bool(self._steps[0] >= self.episode_steps)
         self._done = terminated or truncated
-        info = {"mdp": self._mdp.label, "crashed": terminated}  # type: ignore[union-attr]
-        return self._obs[0].copy(), float(self._reward[0]), terminated, truncated, info
+        reward = float(self._reward[0])
+        self._return += reward
+        if self.render_mode is not None:
+            self._trail.append(self._state[0, 3:6].copy())
+            del self._trail[:-TRAIL_STEPS]
+            if self.render_mode == "human":
+                self.render()
+        obs = self._obs[0].astype(self.obs_dtype)  # astype copies: the returned array is the caller's
+        return obs, reward, terminated, truncated, self._info(terminated)
+
+    def render(self) -> np.ndarray | None:
+        """The current frame (``"rgb_array"``), or show it (``"human"``); see Rendering above.
+
+        Returns
+        -------
+        numpy.ndarray or None
+            An (340, 720, 3) uint8 RGB image in ``"rgb_array"`` mode, else None.
+        """
+        if self.render_mode is None:
+            gym.logger.warn("You are calling render method without specifying any render mode. "
+                            "You can specify the render_mode at initialization, "
+                            f'e.g. gym.make("{self.spec.id if self.spec else "neurohover/GHH08-v0"}", render_mode="rgb_array")')
+            return None
+        frame = self._draw()
+        if self.render_mode == "rgb_array":
+            return frame
+        if self._window is None:
+            from .render import HumanWindow
+
+            self._window = HumanWindow(self.metadata["render_fps"])
+        self._window.show(frame)
+        return None
+
+    def _draw(self) -> np.ndarray:
+        if self._renderer is None:
+            from .render import HoverRenderer  # matplotlib is loaded only by environments that render
+
+            self._renderer = HoverRenderer()
+        steps = self.steps
+        if self._mdp is None:  # before the first reset: the start state, no MDP yet
+            wind, text = (0.0, 0.0, 0.0), f"{self.family.name}: call reset()"
+        else:
+            wind = world_wind(self._mdp, steps)
+            end = "  CRASHED" if self._crash[0] and self._done else ""
+            text = f"{self._mdp.label}   step {steps}/{self.episode_steps}   return {self._return:.6g}{end}"
+        trail = np.array(self._trail) if self._trail else None
+        return self._renderer.draw(self._state[0], wind, text, trail)
+
+    def close(self) -> None:
+        """Close the window of ``"human"`` mode and release the renderer (safe to call twice)."""
+        if self._window is not None:
+            self._window.close()
+            self._window = None
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+        super().close()
 
 
-__all__ = ["HoverEnv", "MdpSpec"]
+__all__ = ["HoverEnv", "MdpSpec", "mdp_info", "world_wind"]

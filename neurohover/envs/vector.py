@@ -38,9 +38,11 @@ from .hover import (
     action_space,
     check_episode_steps,
     check_noise_stream,
+    check_obs_dtype,
     check_reset_options,
     draw_stream_seed,
     initial_state,
+    mdp_info,
     observation_space,
     resolve_mdp,
 )
@@ -58,7 +60,8 @@ def _seed_streams(rngs: np.ndarray, idx: np.ndarray, streams: np.ndarray) -> Non
 class HoverVectorEnv(VectorEnv):
     """``num_envs`` independent hovering helicopters (see :class:`neurohover.envs.hover.HoverEnv`).
 
-    Observations are float64 arrays of shape (num_envs, 12), actions (num_envs, 4); rewards,
+    Observations are float64 arrays of shape (num_envs, 12) (float32 with
+    ``obs_dtype="float32"``), actions (num_envs, 4); rewards (float64),
     terminations and truncations are (num_envs,) arrays. Sub-environments reset automatically
     in Gymnasium's ``NEXT_STEP`` mode: the step after sub-environment i terminated or was
     truncated ignores its action and returns its new episode's first observation (all zeros),
@@ -80,6 +83,11 @@ class HoverVectorEnv(VectorEnv):
         Control steps per episode (6000); the crash penalty counts the steps left to it.
     max_episode_steps : int, optional
         Truncate earlier than ``episode_steps`` (``make_vec`` passes the registered limit).
+    obs_dtype : {"float64", "float32"}
+        dtype of the observation space and the returned observations (the simulation runs in
+        float64 either way).
+    render_mode : None
+        No rendering (render a single :class:`~neurohover.envs.hover.HoverEnv` instead).
 
     Notes
     -----
@@ -96,8 +104,12 @@ class HoverVectorEnv(VectorEnv):
     indices, or a sequence of ``num_envs`` pairs) and ``"reset_mask"`` (a (num_envs,) bool array:
     reset only those sub-environments; the others keep flying).
 
-    Info: ``"crashed"`` every step; ``"mdp"`` (MDP labels) for the sub-environments that reset,
-    each with Gymnasium's ``"_key"`` mask. The current MDPs are ``mdps``.
+    Info: ``"crashed"`` every step; ``"mdp"`` (MDP labels) and ``"mdp_info"`` (family, label and
+    parameters, as :func:`neurohover.envs.hover.mdp_info` gives them) for the sub-environments
+    that reset, each with Gymnasium's ``"_key"`` mask. ``"mdp_info"`` is laid out as
+    ``SyncVectorEnv`` lays out the single environment's: a dict of (num_envs,) object arrays
+    ``"family"``, ``"label"``, ``"params"`` (tuples), ``"param_names"`` (tuples), each with its
+    mask. The current MDPs are ``mdps``.
     """
 
     metadata = {"render_modes": [], "render_fps": RENDER_FPS, "autoreset_mode": AutoresetMode.NEXT_STEP}
@@ -111,6 +123,7 @@ class HoverVectorEnv(VectorEnv):
         episode_steps: int = EPISODE_STEPS,
         max_episode_steps: int | None = None,
         render_mode: str | None = None,
+        obs_dtype: Any = "float64",
     ) -> None:
         if isinstance(num_envs, (bool, np.bool_)) or not isinstance(num_envs, (int, np.integer)) or not 1 <= num_envs <= MAX_NUM_ENVS:
             raise NeurohoverError(f"num_envs={num_envs!r} is out of range: allowed an integer in 1..{MAX_NUM_ENVS}")
@@ -118,13 +131,14 @@ class HoverVectorEnv(VectorEnv):
             raise NeurohoverError(f"render_mode={render_mode!r} is not supported: this environment has no rendering (use None)")
         n = int(num_envs)
         self.num_envs = n
+        self.obs_dtype = check_obs_dtype(obs_dtype)
         self.family: TaskFamily = get_task_family(task, sigma)
         self.episode_steps = check_episode_steps(episode_steps)
         self.max_episode_steps = self.episode_steps if max_episode_steps is None else check_episode_steps(max_episode_steps)
         self._limit = min(self.episode_steps, self.max_episode_steps)
         self._specs: list[MDP | str] = self._resolve_specs(mdp)
         self.render_mode = None
-        self.single_observation_space = observation_space()
+        self.single_observation_space = observation_space(self.obs_dtype)
         self.single_action_space = action_space()
         self.observation_space = batch_space(self.single_observation_space, n)
         self.action_space = batch_space(self.single_action_space, n)
@@ -145,6 +159,7 @@ class HoverVectorEnv(VectorEnv):
         self._draws: list[np.ndarray | None] = [None] * n  # raw draw of each sampled MDP
         self._sample_template, self._sample_slice = self.family.row_template(), self.family.row_slice
         self._sample_label = f"{self.family.name}/sample"
+        self._sample_names = tuple(self.family.param_names)
         self._autoreset = np.zeros(n, dtype=np.bool_)
         self._any_autoreset = False
         self._ready = False
@@ -273,6 +288,23 @@ class HoverVectorEnv(VectorEnv):
         mask[idx] = True
         return labels, mask
 
+    def _mdp_infos(self, idx: np.ndarray, mask: np.ndarray) -> dict[str, np.ndarray]:
+        """``info["mdp_info"]`` of sub-environments ``idx`` (``mask``: their bool mask)."""
+        n = self.num_envs
+        family, label, params, names = (np.full(n, None, dtype=object) for _ in range(4))
+        # Sampled MDPs (the common case, hundreds per step under a crashing policy) column by column.
+        sampled = [i for i in idx.tolist() if self._draws[i] is not None]
+        if sampled:
+            family[sampled], label[sampled] = self.family.name, self._sample_label
+            for i in sampled:  # one at a time: a list of equal-length tuples would be read as a 2-D array
+                params[i], names[i] = tuple(self._draws[i].tolist()), self._sample_names
+        for i in idx.tolist():
+            if self._draws[i] is None:
+                item = mdp_info(self._mdps[i])
+                family[i], label[i], params[i], names[i] = item["family"], item["label"], item["params"], item["param_names"]
+        return {"family": family, "_family": mask.copy(), "label": label, "_label": mask.copy(),
+                "params": params, "_params": mask.copy(), "param_names": names, "_param_names": mask.copy()}
+
     def reset(
         self, *, seed: int | Sequence[int | None] | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
@@ -296,8 +328,9 @@ class HoverVectorEnv(VectorEnv):
         self._any_autoreset = bool(self._autoreset.any())
         self._ready = True
         labels, label_mask = self._labels(idx)
-        info = {"mdp": labels, "_mdp": label_mask, "crashed": np.zeros(self.num_envs, dtype=np.bool_), "_crashed": label_mask.copy()}
-        return self._obs.copy(), info
+        info = {"mdp": labels, "_mdp": label_mask, "crashed": np.zeros(self.num_envs, dtype=np.bool_), "_crashed": label_mask.copy(),
+                "mdp_info": self._mdp_infos(idx, label_mask), "_mdp_info": label_mask.copy()}
+        return self._obs.astype(self.obs_dtype), info
 
     def step(self, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         if not self._ready:
@@ -320,11 +353,12 @@ class HoverVectorEnv(VectorEnv):
             terminated[idx] = False
             truncated[idx] = False
             info["mdp"], info["_mdp"] = self._labels(idx)
+            info["mdp_info"], info["_mdp_info"] = self._mdp_infos(idx, info["_mdp"]), info["_mdp"].copy()
         info["crashed"] = terminated.copy()
         info["_crashed"] = np.ones(self.num_envs, dtype=np.bool_)
         np.logical_or(terminated, truncated, out=self._autoreset)
         self._any_autoreset = bool(self._autoreset.any())
-        return self._obs.copy(), rewards, terminated, truncated, info
+        return self._obs.astype(self.obs_dtype), rewards, terminated, truncated, info
 
 
 __all__ = ["HoverVectorEnv"]
