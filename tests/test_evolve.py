@@ -18,7 +18,6 @@ from neurohover.errors import NeurohoverError
 from neurohover.evolution.evolve import (
     HISTORY_COLUMNS,
     EvolutionInterrupted,
-    _MDPStream,
     evolve,
     parse_resampling,
     read_history_csv,
@@ -85,8 +84,8 @@ def test_bad_arguments_are_clear_errors() -> None:
 
 @pytest.mark.parametrize("family", [GHH08, get_task_family("ghh09"), FGHH])
 def test_mdp_stream_is_the_family_sampler_in_batches(family) -> None:
-    stream = _MDPStream(family, np.random.default_rng(7))
-    rows = np.vstack([stream.rows(3), stream.rows(1), stream.rows(4)])
+    stream = np.random.default_rng(7)  # a run draws its MDPs in batches of sample_rows from one generator
+    rows = np.vstack([family.sample_rows(stream, 3), family.sample_rows(stream, 1), family.sample_rows(stream, 4)])
     rng = np.random.default_rng(7)
     expected = np.stack([family.sample(rng).row() for _ in range(8)])
     np.testing.assert_array_equal(rows, expected)
@@ -372,11 +371,11 @@ def test_generational_evolution_over_fghh_beats_its_seed_on_fresh_mdps() -> None
 def test_a_ctrl_c_after_the_last_generation_check_still_reaches_the_caller() -> None:
     import signal
 
-    from neurohover.evolution.evolve import _InterruptFlag
+    from neurohover.evolution.run import InterruptFlag
 
     before = signal.getsignal(signal.SIGINT)
     with pytest.raises(KeyboardInterrupt):
-        with _InterruptFlag() as flag:
+        with InterruptFlag() as flag:
             assert signal.getsignal(signal.SIGINT) != before
             flag._handler(signal.SIGINT, None)  # arrives after the last check; the block ends normally
     assert signal.getsignal(signal.SIGINT) == before  # the previous handler is back

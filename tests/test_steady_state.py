@@ -29,7 +29,7 @@ from neurohover.evolution import (
 from neurohover.evolution.common import rank
 from neurohover.tasks import get_task_family
 
-evolve_module = importlib.import_module("neurohover.evolution.evolve")
+run_module = importlib.import_module("neurohover.evolution.run")
 generational_module = importlib.import_module("neurohover.evolution.generational")
 
 GHH08 = get_task_family("ghh08")
@@ -323,7 +323,7 @@ def test_evolve_matches_the_reference(monkeypatch, topology, seed, kwargs) -> No
     runs = []
     for cls in (SteadyStateNE, FrozenSteadyStateNE):
         made: list = []
-        monkeypatch.setattr(evolve_module, "SteadyStateNE", _recording(cls, made))
+        monkeypatch.setattr(run_module, "SteadyStateNE", _recording(cls, made))
         result = evolve(mdp, topology=topology, seed=seed, n_steps=200, threads=1, **kwargs)
         (opt,) = made
         runs.append((result, opt))

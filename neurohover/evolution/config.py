@@ -1,0 +1,241 @@
+"""What defines an evolution run: target, prototype, method, optimiser settings, resampling, budget.
+
+:meth:`RunConfig.build` checks every argument of :func:`~neurohover.evolution.evolve.evolve` that
+fixes the run and :meth:`RunConfig.to_dict` gives the JSON a checkpoint must match to be resumed.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import NeurohoverError
+from ..policies import TOPOLOGIES, Policy
+from ..policies import prototype as make_prototype
+from ..tasks import MDP, TaskFamily
+from .generational import GenerationalSettings
+from .seeding import check_seed
+from .steady_state import SteadyStateSettings
+
+__all__ = [
+    "CMA_DEFAULTS",
+    "METHODS",
+    "RACE_T_LIMIT",
+    "Resampling",
+    "RunConfig",
+    "make_settings",
+    "parse_resampling",
+    "resolve_prototype",
+    "resolve_target",
+    "upgrade_saved_config",
+]
+
+#: CMA-ES settings (override with ``settings={"sigma0": ..., "popsize": ...}``). A sweep on GHH-08
+#: train:1 (600-step episodes, 1000 episodes, SLP and MLP from the baseline) found sigma0 0.01-0.03
+#: best and 0.1 crashing nearly every SLP candidate; popsize None is pycma's 4 + 3 ln D.
+CMA_DEFAULTS: dict[str, Any] = {"sigma0": 0.02, "popsize": None}
+RACE_T_LIMIT = 10  # docs/model.md, Fitness under noise: t_limit = t_min = t_max = 10
+#: What a run's ``method`` may be (``cma`` whenever the optimizer is CMA-ES).
+METHODS = ("steady-state", "generational", "cma")
+#: Steady-state settings that checkpoints written before they existed ran with.
+_OLD_STEADY_STATE = {"plateau_rule": "literal", "selection": "roulette", "tournament_size": 5,
+                     "init_mutate_frac": None, "init_mutate_std": None}
+
+
+@dataclass(frozen=True)
+class Resampling:
+    """How a candidate's fitness is estimated: ``fixed`` (mean of ``k`` episodes) or ``race``
+    (selection race at confidence level ``delta``). ``str()`` gives the spec back."""
+
+    kind: str
+    k: int = 1
+    delta: float | None = None
+
+    def __str__(self) -> str:
+        return f"fixed:{self.k}" if self.kind == "fixed" else f"race:{self.delta:g}"
+
+
+def parse_resampling(spec: str | Resampling | None) -> Resampling:
+    """``"fixed:K"`` (K >= 1 episodes per candidate) or ``"race:DELTA"`` (0 < DELTA < 1); None is ``fixed:1``."""
+    if spec is None:
+        return Resampling("fixed", 1)
+    if isinstance(spec, Resampling):
+        return spec
+    text = str(spec).strip().lower()
+    kind, sep, value = text.partition(":")
+    allowed = "allowed fixed:K (K >= 1 episodes per candidate) or race:DELTA (confidence level 0 < DELTA < 1)"
+    if kind == "fixed" and sep:
+        if value.isdigit() and int(value) >= 1:
+            return Resampling("fixed", int(value))
+        raise NeurohoverError(f"bad resampling {spec!r}: K must be an integer >= 1; {allowed}")
+    if kind == "race" and sep:
+        try:
+            delta = float(value)
+        except ValueError:
+            delta = math.nan
+        if 0.0 < delta < 1.0:
+            return Resampling("race", 1, delta)
+        raise NeurohoverError(f"bad resampling {spec!r}: DELTA must be a number strictly between 0 and 1; {allowed}")
+    raise NeurohoverError(f"unknown resampling {spec!r}: {allowed}")
+
+
+def resolve_prototype(prototype, topology: str) -> Policy:
+    """The prototype policy: a :class:`Policy` of ``topology``, or ``"zero"`` / ``"baseline"``."""
+    if topology not in TOPOLOGIES:
+        raise NeurohoverError(f"unknown topology {topology!r}: allowed {', '.join(TOPOLOGIES)}")
+    if isinstance(prototype, Policy):
+        if prototype.topology != topology:
+            raise NeurohoverError(f"the prototype is an {prototype.topology} policy but topology={topology!r}")
+        return prototype
+    if isinstance(prototype, str) and prototype in ("zero", "baseline"):
+        return make_prototype(topology, prototype)
+    raise NeurohoverError(f"prototype must be a Policy, 'zero' or 'baseline', got {prototype!r}")
+
+
+def resolve_target(target) -> tuple[MDP | None, TaskFamily | None, dict]:
+    """``(mdp or None, family or None, description dict)`` of an MDP, a learned model or a task family."""
+    if isinstance(target, MDP):
+        return target, None, {"kind": "mdp", "mdp": target.to_dict()}
+    if isinstance(target, TaskFamily):
+        desc = {"kind": "family", "family": target.name}
+        if target.sigma is not None:
+            desc["sigma"] = float(target.sigma)
+        return None, target, desc
+    if callable(getattr(target, "mdp", None)) and hasattr(target, "method"):  # a LearnedModel
+        mdp = target.mdp()
+        return mdp, None, {"kind": "mdp", "mdp": mdp.to_dict()}
+    raise NeurohoverError(
+        f"evolve needs an MDP, a learned model or a task family as target, got {type(target).__name__}"
+    )
+
+
+def make_settings(method: str, optimizer: str, settings) -> dict | SteadyStateSettings | GenerationalSettings:
+    """The optimiser settings of a run: ``settings`` (None, a settings object or a dict of
+    overrides) checked for ``method`` / ``optimizer``; a dict for CMA-ES, the budget left None
+    for neuroevolution (the run counts the budget in episodes itself)."""
+    if optimizer == "cma":
+        cfg = dict(CMA_DEFAULTS)
+        if settings is not None:
+            if not isinstance(settings, Mapping):
+                raise NeurohoverError("settings for optimizer='cma' must be a dict with keys sigma0, popsize")
+            unknown = sorted(set(settings) - set(cfg))
+            if unknown:
+                raise NeurohoverError(f"unknown CMA-ES setting(s) {', '.join(unknown)}: allowed {', '.join(cfg)}")
+            cfg.update(settings)
+        s0, pop = cfg["sigma0"], cfg["popsize"]
+        if isinstance(s0, bool) or not isinstance(s0, (int, float)) or not (math.isfinite(s0) and s0 > 0):
+            raise NeurohoverError(f"CMA-ES sigma0={s0!r} must be a finite number > 0")
+        if pop is not None and (isinstance(pop, bool) or not isinstance(pop, (int, np.integer)) or pop < 2):
+            raise NeurohoverError(f"CMA-ES popsize={pop!r} must be None or an integer >= 2")
+        return {"sigma0": float(s0), "popsize": None if pop is None else int(pop)}
+    cls = SteadyStateSettings if method == "steady-state" else GenerationalSettings
+    if settings is None:
+        return cls()
+    if isinstance(settings, cls):
+        return dataclasses.replace(settings, budget=None)
+    if isinstance(settings, (SteadyStateSettings, GenerationalSettings)):
+        raise NeurohoverError(f"the {method} method takes {cls.__name__}, got {type(settings).__name__}")
+    if not isinstance(settings, Mapping):
+        raise NeurohoverError(f"settings must be a {cls.__name__} or a dict of its fields, got {type(settings).__name__}")
+    fields = {f.name for f in dataclasses.fields(cls)} - {"budget"}
+    unknown = sorted(set(settings) - fields)
+    if unknown:
+        raise NeurohoverError(f"unknown {method} setting(s) {', '.join(unknown)}: allowed {', '.join(sorted(fields))}")
+    try:
+        return cls(**dict(settings))
+    except ValueError as err:
+        raise NeurohoverError(f"bad {method} settings: {err}") from None
+
+
+def upgrade_saved_config(saved: dict) -> dict:
+    """A checkpoint's ``config`` as this version writes it (steady-state settings added since
+    filled in with the values the old run used)."""
+    if saved.get("method") == "steady-state" and "plateau_rule" not in saved.get("settings", {}):
+        # Written before these settings existed: it ran Appendix A's literal plateau rule.
+        return {**saved, "settings": {**_OLD_STEADY_STATE, **saved["settings"]}}
+    return saved
+
+
+@dataclass(frozen=True)
+class RunConfig:
+    """A checked run definition (build it with :meth:`build`).
+
+    Attributes
+    ----------
+    mdp, family : MDP or None, TaskFamily or None
+        The target: exactly one is set.
+    target : dict
+        JSON description of the target.
+    prototype : Policy
+    topology, optimizer : str
+    method : {"steady-state", "generational", "cma"}
+    resampling : Resampling
+    budget : int or None
+        Episodes (not part of :meth:`to_dict`: a resumed run may raise it).
+    seed, n_steps : int
+    settings : SteadyStateSettings, GenerationalSettings or dict
+        The optimiser's settings (a dict for CMA-ES).
+    """
+
+    mdp: MDP | None
+    family: TaskFamily | None
+    target: dict
+    prototype: Policy
+    topology: str
+    optimizer: str
+    method: str
+    resampling: Resampling
+    budget: int | None
+    seed: int
+    n_steps: int
+    settings: Any
+
+    @classmethod
+    def build(cls, target, *, topology, prototype, optimizer, resampling, budget, settings, seed, n_steps,
+              method) -> RunConfig:
+        """Check the arguments of ``evolve`` that define the run (NeurohoverError on bad input)."""
+        mdp, family, target_desc = resolve_target(target)
+        proto = resolve_prototype(prototype, topology)
+        if optimizer not in ("ne", "cma"):
+            raise NeurohoverError(f"unknown optimizer {optimizer!r}: allowed ne, cma")
+        resampling = parse_resampling(resampling)
+        if budget is None and isinstance(settings, (SteadyStateSettings, GenerationalSettings)):
+            budget = settings.budget
+        if budget is not None and (isinstance(budget, bool) or not isinstance(budget, (int, np.integer)) or budget < 1):
+            raise NeurohoverError(f"budget={budget!r} is out of range: allowed an integer >= 1 (episodes)")
+        seed = check_seed(seed)
+        if isinstance(n_steps, bool) or not isinstance(n_steps, (int, np.integer)) or not 1 <= n_steps <= 10**7:
+            raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..10000000")
+        chosen = ("steady-state" if mdp is not None else "generational") if method is None else method
+        if chosen not in ("steady-state", "generational"):
+            raise NeurohoverError(f"unknown method {method!r}: allowed steady-state, generational")
+        if chosen == "steady-state" and family is not None:
+            raise NeurohoverError("the steady-state method evolves on one MDP; a task family needs the generational method")
+        if optimizer == "cma":
+            chosen = "cma"
+        if resampling.kind == "race" and chosen != "generational":
+            raise NeurohoverError(
+                f"resampling {resampling} (a selection race) needs the generational method "
+                "(a task family as target, optimizer 'ne'); use fixed:K here"
+            )
+        checked = make_settings("steady-state" if chosen == "steady-state" else "generational", optimizer, settings)
+        if optimizer == "cma" and proto.genome.size < 2:
+            raise NeurohoverError("CMA-ES needs a genome of at least 2 genes")
+        return cls(mdp, family, target_desc, proto, topology, optimizer, chosen, resampling,
+                   None if budget is None else int(budget), seed, int(n_steps), checked)
+
+    def to_dict(self) -> dict:
+        """What a checkpoint records of the run (JSON types, as read back from a file)."""
+        config = {
+            "target": self.target, "method": self.method, "optimizer": self.optimizer,
+            "resampling": str(self.resampling), "topology": self.topology,
+            "prototype": self.prototype.genome.tolist(), "seed": self.seed, "n_steps": self.n_steps,
+            "settings": dict(self.settings) if isinstance(self.settings, dict) else dataclasses.asdict(self.settings),
+        }
+        return json.loads(json.dumps(config))  # as a checkpoint would hold it

@@ -1,0 +1,216 @@
+"""What an evolution run reports and saves: results, history, progress, history CSV, checkpoint files."""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import json
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import NeurohoverError
+from ..policies import Policy
+from .common import enc_float
+
+__all__ = [
+    "CHECKPOINT_FORMAT",
+    "HISTORY_COLUMNS",
+    "EvolutionInterrupted",
+    "EvolutionResult",
+    "HistoryRecord",
+    "ProgressInfo",
+    "decode_history",
+    "encode_history",
+    "read_checkpoint",
+    "read_history_csv",
+    "write_checkpoint",
+    "write_history_csv",
+]
+
+#: The ``format`` entry of a checkpoint file.
+CHECKPOINT_FORMAT = "neurohover-evolution-checkpoint/1"
+
+
+@dataclass(frozen=True)
+class HistoryRecord:
+    """One line of a run's history.
+
+    Steady state (and CMA-ES on an MDP): one record per new champion, plus the last generation.
+    Generational (and CMA-ES on a family): one record per generation.
+
+    Attributes
+    ----------
+    generation : int
+        Generations completed (steady state: one per offspring batch; the initial population is 1).
+    evaluations : int
+        Candidate fitness estimates made so far.
+    episodes : int
+        Episodes flown so far (the budget's unit).
+    generation_episodes : int
+        Episodes flown in this generation (a race's ``episodes_spent``; ``pop_size * K`` for fixed
+        resampling).
+    champion_return : float
+        The champion's fitness (steady state: best ever; generational: best estimate of this generation).
+    wall_seconds : float
+        Seconds since the start of the run (continued across resumes).
+    """
+
+    generation: int
+    evaluations: int
+    episodes: int
+    generation_episodes: int
+    champion_return: float
+    wall_seconds: float
+
+
+#: Columns of a history CSV file, in order (the fields of :class:`HistoryRecord`).
+HISTORY_COLUMNS = tuple(f.name for f in dataclasses.fields(HistoryRecord))
+
+
+@dataclass(frozen=True)
+class ProgressInfo:
+    """What the ``progress`` callback sees (at most every ``progress_every_s``, and once at the end)."""
+
+    generation: int
+    evaluations: int
+    episodes: int
+    budget: int | None
+    champion_return: float
+    wall_seconds: float
+    episodes_per_second: float
+    done: bool
+
+
+@dataclass(frozen=True)
+class EvolutionResult:
+    """Outcome of :func:`~neurohover.evolution.evolve.evolve`.
+
+    Attributes
+    ----------
+    champion : Policy
+        The champion, with metadata (method, optimizer, resampling, target, seed, budget, ...).
+    champion_return : float
+        Its fitness (see :mod:`neurohover.evolution.evolve` for which candidate is the champion).
+    history : tuple of HistoryRecord
+    episodes, steps : int
+        Episodes and control steps flown.
+    evaluations, generations : int
+    seconds : float
+        Wall time of the run (continued across resumes).
+    kernel_seconds : float
+        Of which inside the simulation kernel.
+    stop_reason : str
+        ``budget``, ``plateau`` (steady state), ``generations`` (generational), ``cma-stop``.
+    settings : dict
+        Everything that defines the run (JSON-able): target, method, optimizer, resampling,
+        optimiser settings, topology, seed, n_steps, budget.
+    champion_crashed : bool
+        Steady state: whether the champion's evaluation crashed (False for the other methods).
+    """
+
+    champion: Policy
+    champion_return: float
+    history: tuple[HistoryRecord, ...]
+    episodes: int
+    steps: int
+    evaluations: int
+    generations: int
+    seconds: float
+    kernel_seconds: float
+    stop_reason: str
+    settings: dict
+    champion_crashed: bool = False
+
+    @property
+    def episodes_per_second(self) -> float:
+        return self.episodes / self.seconds if self.seconds > 0 else math.inf
+
+
+class EvolutionInterrupted(KeyboardInterrupt):
+    """The run was interrupted; ``checkpoint`` is where its state was saved (None: not saved)."""
+
+    def __init__(self, checkpoint: Path | None, episodes: int) -> None:
+        super().__init__(f"evolution interrupted after {episodes} episodes" +
+                         (f"; checkpoint saved to {checkpoint}" if checkpoint else ""))
+        self.checkpoint = checkpoint
+        self.episodes = episodes
+
+
+# --------------------------------------------------------------------------------- history CSV
+
+
+def write_history_csv(history, path: str | Path) -> Path:
+    """Write history records as CSV with the header :data:`HISTORY_COLUMNS`.
+
+    ``champion_return`` is written exactly (``repr``), ``wall_seconds`` to 0.1 ms.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w", newline="") as f:
+        writer = csv.writer(f, lineterminator="\n")
+        writer.writerow(HISTORY_COLUMNS)
+        for h in history:
+            writer.writerow([h.generation, h.evaluations, h.episodes, h.generation_episodes, repr(h.champion_return),
+                             f"{h.wall_seconds:.4f}"])
+    return path
+
+
+def read_history_csv(path: str | Path) -> list[HistoryRecord]:
+    """Read a file written by :func:`write_history_csv`.
+
+    Raises
+    ------
+    NeurohoverError
+        If the file does not start with the header :data:`HISTORY_COLUMNS`, or a row is not one
+        record.
+    """
+    with open(path, newline="") as f:
+        rows = [row for row in csv.reader(f) if row]
+    if not rows or tuple(rows[0]) != HISTORY_COLUMNS:
+        raise NeurohoverError(f"{str(path)!r} is not an evolution history (expected the header {','.join(HISTORY_COLUMNS)})")
+    out = []
+    for n, row in enumerate(rows[1:], start=2):
+        try:
+            g, ev, ep, gep, r, w = row
+            out.append(HistoryRecord(int(g), int(ev), int(ep), int(gep), float(r), float(w)))
+        except ValueError:
+            raise NeurohoverError(f"{str(path)!r}, row {n}: {','.join(row)!r} is not a history record "
+                                  f"({','.join(HISTORY_COLUMNS)})") from None
+    return out
+
+
+# --------------------------------------------------------------------------------- checkpoints
+
+
+def encode_history(history) -> list[list]:
+    """History records as a checkpoint holds them: strict-JSON lists in :data:`HISTORY_COLUMNS` order."""
+    return [[h.generation, h.evaluations, h.episodes, h.generation_episodes, enc_float(h.champion_return), h.wall_seconds]
+            for h in history]
+
+
+def decode_history(rows) -> list[HistoryRecord]:
+    """The records :func:`encode_history` encoded."""
+    return [HistoryRecord(int(g), int(e), int(ep), int(gep), float(r), float(w)) for g, e, ep, gep, r, w in rows]
+
+
+def write_checkpoint(path: Path, state: dict) -> None:
+    """Write a checkpoint atomically: strict JSON to ``PATH.tmp``, synced, then renamed over ``path``."""
+    tmp = path.with_name(path.name + ".tmp")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(tmp, "w") as f:
+        json.dump(state, f, allow_nan=False)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+
+
+def read_checkpoint(path: Path) -> dict:
+    """The JSON a checkpoint file holds (NeurohoverError if it is missing or not JSON)."""
+    if not path.is_file():
+        raise NeurohoverError(f"no checkpoint to resume from: {str(path)!r} does not exist")
+    try:
+        return json.loads(path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as err:
+        raise NeurohoverError(f"checkpoint {str(path)!r} is not valid JSON: {err}") from None

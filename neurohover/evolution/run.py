@@ -1,0 +1,354 @@
+"""The evolution run loop: ask, fly, tell, record, checkpoint (what :func:`~neurohover.evolution.evolve.evolve` drives).
+
+A :class:`Run` holds one run's whole state: its optimiser (any :class:`~.common.Optimiser`), the
+:class:`~neurohover.evaluate.KernelFlyer` that flies the candidates and counts the episodes, the
+generator of the task family's MDPs, counters and history. :meth:`Run.state` is the checkpoint
+and :meth:`Run.restore` continues from one bit-for-bit.
+"""
+
+from __future__ import annotations
+
+import math
+import pickle
+import signal
+import threading
+import time
+from pathlib import Path
+from typing import cast
+
+import numpy as np
+
+from ..errors import NeurohoverError
+from ..evaluate import KernelFlyer
+from ..policies import Policy
+from .cmaes import CMAES
+from .common import Optimiser, enc_float
+from .config import RACE_T_LIMIT, RunConfig, upgrade_saved_config
+from .generational import GenerationalNE
+from .races import fixed_resampling, selection_race
+from .records import (
+    CHECKPOINT_FORMAT,
+    EvolutionInterrupted,
+    EvolutionResult,
+    HistoryRecord,
+    ProgressInfo,
+    decode_history,
+    encode_history,
+    write_checkpoint,
+)
+from .seeding import mdp_rng, noise_seed, optimiser_seed
+from .steady_state import SteadyStateNE
+
+__all__ = ["InterruptFlag", "Run"]
+
+
+class InterruptFlag:
+    """Context manager: a first Ctrl-C (SIGINT) sets :attr:`set`, so that the run stops at the next
+    generation boundary; a second one raises ``KeyboardInterrupt`` at once. Outside the main
+    thread it installs no handler."""
+
+    def __init__(self) -> None:
+        self.set = False
+        self._previous = None
+
+    def __enter__(self) -> InterruptFlag:
+        if threading.current_thread() is threading.main_thread():
+            try:
+                self._previous = signal.signal(signal.SIGINT, self._handler)
+            except ValueError:  # not allowed here (e.g. embedded interpreter)
+                self._previous = None
+        return self
+
+    def _handler(self, signum, frame) -> None:
+        if self.set:
+            raise KeyboardInterrupt
+        self.set = True
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if self._previous is not None:
+            signal.signal(signal.SIGINT, self._previous)
+        if self.set and exc_type is None:
+            # Ctrl-C came after the last generation's check: the run is complete, but the
+            # interrupt must still reach the caller (e.g. a reproduce loop), never be swallowed.
+            raise KeyboardInterrupt
+
+
+class Run:
+    """State of one evolution run (everything a checkpoint holds).
+
+    Parameters
+    ----------
+    config : RunConfig
+        The checked run definition; seeds follow :mod:`neurohover.evolution.seeding`.
+    """
+
+    def __init__(self, config: RunConfig) -> None:
+        self.cfg = config
+        self.mdp, self.family, self.method = config.mdp, config.family, config.method
+        self.resampling, self.budget = config.resampling, config.budget
+        self.config = config.to_dict()
+        self.flyer = KernelFlyer(config.topology, noise_seed(config.seed), config.n_steps)
+        self.mdp_rng = None if self.family is None else mdp_rng(config.seed)
+        self.rows = None if self.mdp is None else self.mdp.row()[None, :]
+        genome, settings, seed = config.prototype.genome, config.settings, optimiser_seed(config.seed)
+        # Classes looked up here at run time (a test may replace SteadyStateNE by a reference).
+        self.opt: Optimiser
+        if self.method == "cma":
+            self.opt = CMAES(genome, sigma0=settings["sigma0"], seed=seed, popsize=settings["popsize"])
+        elif self.method == "steady-state":
+            self.opt = SteadyStateNE(genome, settings, seed=seed)
+        else:
+            self.opt = GenerationalNE(genome, settings, seed=seed)
+        self.history: list[HistoryRecord] = []
+        self.generation = 0
+        self.evaluations = 0
+        self.elapsed = 0.0  # wall seconds of earlier sessions (resume)
+        self.champion_genome: np.ndarray | None = None  # CMA-ES on a family: best of the last generation
+        self.champion_return = -math.inf
+        self.stop_reason: str | None = None
+
+    # ----------------------------------------------------------------- checkpoints
+
+    def state(self, wall: float) -> dict:
+        """The checkpoint (strict JSON) after ``wall`` seconds of the run."""
+        return {
+            "format": CHECKPOINT_FORMAT, "config": self.config, "budget": self.budget,
+            "optimizer_state": self.opt.state_dict(),
+            "counters": {"episodes": self.flyer.episodes, "steps": self.flyer.steps, "generation": self.generation,
+                         "evaluations": self.evaluations, "wall_seconds": wall,
+                         "kernel_seconds": self.flyer.kernel_seconds},
+            "mdp_stream": None if self.mdp_rng is None else self.mdp_rng.bit_generator.state,
+            "champion": {"genome": None if self.champion_genome is None else self.champion_genome.tolist(),
+                         "return": enc_float(self.champion_return)},
+            "history": encode_history(self.history),
+            "stop_reason": self.stop_reason,
+        }
+
+    def restore(self, state: dict, source: str) -> None:
+        """Continue from checkpoint ``state`` (read from ``source``, named in errors); its run must
+        be this one, except the budget."""
+        if state.get("format") != CHECKPOINT_FORMAT:
+            raise NeurohoverError(f"{source} is not an evolution checkpoint (expected format {CHECKPOINT_FORMAT!r})")
+        saved = upgrade_saved_config(state["config"])
+        if saved != self.config:
+            diff = sorted(k for k in set(saved) | set(self.config) if saved.get(k) != self.config.get(k))
+            raise NeurohoverError(
+                f"{source} was written by a different run: {', '.join(diff)} differ; resume with the same "
+                "target, method, optimizer, resampling, topology, prototype, seed, episode steps and settings (only the budget may change)"
+            )
+        try:
+            self.opt = type(self.opt).from_state_dict(state["optimizer_state"])
+        except (ValueError, KeyError, TypeError, pickle.UnpicklingError) as err:
+            raise NeurohoverError(f"{source}: cannot restore the optimiser ({err})") from None
+        c = state["counters"]
+        self.flyer.episodes, self.flyer.steps = int(c["episodes"]), int(c["steps"])
+        self.flyer.kernel_seconds = float(c["kernel_seconds"])
+        self.generation, self.evaluations = int(c["generation"]), int(c["evaluations"])
+        self.elapsed = float(c["wall_seconds"])
+        if self.mdp_rng is not None:
+            self.mdp_rng.bit_generator.state = state["mdp_stream"]
+        ch = state["champion"]
+        self.champion_genome = None if ch["genome"] is None else np.array(ch["genome"], dtype=float)
+        self.champion_return = float(ch["return"])
+        self.history = decode_history(state["history"])
+
+    # ----------------------------------------------------------------- fitness
+
+    def _fly_fixed(self, genomes: np.ndarray) -> np.ndarray:
+        """Fitness of each genome on the fixed MDP: mean of K episodes (fresh episode indices)."""
+        n, k = genomes.shape[0], self.resampling.k
+        if k == 1:
+            if n == 1:
+                return self.flyer.fly(genomes, self.rows, None, None, 1).copy()
+            return self.flyer.fly(genomes, self.rows, "range", None, n).copy()
+        p = np.repeat(np.arange(n, dtype=np.int64), k)
+        return self.flyer.fly(genomes, self.rows, p, None, n * k).reshape(n, k).mean(axis=1)
+
+    def _crashed(self) -> np.ndarray:
+        """Whether each genome of the last :meth:`_fly_fixed` crashed (in any of its K episodes)."""
+        k = self.resampling.k
+        return self.flyer.crashed.copy() if k == 1 else self.flyer.crashed.reshape(-1, k).any(axis=1)
+
+    def _fly_family_fixed(self, genomes: np.ndarray):
+        """Fixed resampling on G in ONE kernel call: (means, ResamplingResult).
+
+        Column j holds every candidate's j-th episode; episodes and MDPs are numbered column by
+        column, i.e. as k consecutive calls of a sample function would number them.
+        """
+        n, k = genomes.shape[0], self.resampling.k
+        p = np.tile(np.arange(n, dtype=np.int64), k)
+        if self.mdp_rng is None:  # generational on one MDP: only the episodes' noise differs
+            returns = self.flyer.fly(genomes, self.rows, p, None, n * k).copy()
+        else:
+            returns = self.flyer.fly(genomes, self.family.sample_rows(self.mdp_rng, n * k), p, "range", n * k).copy()
+        cols = returns.reshape(k, n)
+        calls = iter(range(k))
+        result = fixed_resampling(lambda idx: cols[next(calls)], n, k)
+        return result.means, result
+
+    def _race_sample_fn(self, genomes: np.ndarray):
+        def sample(idx: np.ndarray) -> np.ndarray:
+            n = idx.shape[0]
+            if self.mdp_rng is None:
+                return self.flyer.fly(genomes, self.rows, idx.astype(np.int64), None, n).copy()
+            return self.flyer.fly(genomes, self.family.sample_rows(self.mdp_rng, n), idx.astype(np.int64), "range", n).copy()
+        return sample
+
+    # ----------------------------------------------------------------- loop
+
+    def run(self, progress, checkpoint: Path | None, checkpoint_every_s: float, progress_every_s: float) -> None:
+        """Fly generations until a stop reason (:meth:`_should_stop`), reporting ``progress`` and
+        writing ``checkpoint``; on an interrupt, save it and raise :class:`EvolutionInterrupted`."""
+        start = time.perf_counter() - self.elapsed
+        flag_every = checkpoint_every_s if checkpoint is not None else math.inf
+        next_ckpt = time.perf_counter() + flag_every
+        next_progress = time.perf_counter() + progress_every_s
+        budget = self.budget
+        step = {"steady-state": self._best_ever_generation, "generational": self._generational_generation,
+                "cma": self._best_ever_generation if self.family is None else self._cma_family_generation}[self.method]
+        boundary = True  # False while a generation is half done (its state is not checkpointable)
+        with InterruptFlag() as flag:
+            try:
+                while True:
+                    reason = self._should_stop()
+                    if reason is not None:
+                        self.stop_reason = reason
+                        break
+                    boundary = False
+                    step(start)
+                    boundary = True
+                    now = time.perf_counter()
+                    if flag.set:
+                        raise KeyboardInterrupt
+                    if now >= next_progress and progress is not None:
+                        next_progress = now + progress_every_s
+                        progress(self._info(now - start, False, budget))
+                    if now >= next_ckpt:
+                        write_checkpoint(checkpoint, self.state(now - start))
+                        next_ckpt = time.perf_counter() + flag_every
+            except KeyboardInterrupt:
+                # At a generation boundary (first Ctrl-C, or the progress callback) the state is whole
+                # and is saved; a second Ctrl-C mid-generation leaves the last periodic checkpoint.
+                if not boundary or checkpoint is None:
+                    raise EvolutionInterrupted(None, self.flyer.episodes) from None
+                write_checkpoint(checkpoint, self.state(time.perf_counter() - start))
+                raise EvolutionInterrupted(checkpoint, self.flyer.episodes) from None
+        wall = time.perf_counter() - start
+        self.elapsed = wall
+        if checkpoint is not None:
+            write_checkpoint(checkpoint, self.state(wall))
+        if progress is not None:
+            progress(self._info(wall, True, budget))
+
+    def _info(self, wall: float, done: bool, budget) -> ProgressInfo:
+        eps = self.flyer.episodes
+        return ProgressInfo(self.generation, self.evaluations, eps, budget, self._champion_return(), wall,
+                            eps / wall if wall > 0 else 0.0, done)
+
+    def _should_stop(self) -> str | None:
+        if self.budget is not None and self.flyer.episodes >= self.budget:
+            return "budget"
+        if self.generation == 0:
+            return None
+        if self.method == "cma":
+            return "cma-stop" if self.opt.stop() else None
+        if self.opt.stop():
+            return "plateau" if self.method == "steady-state" else "generations"
+        return None
+
+    def _record(self, before_eps: int, champion: float, start: float) -> None:
+        self.history.append(HistoryRecord(self.generation, self.evaluations, self.flyer.episodes,
+                                          self.flyer.episodes - before_eps, champion, time.perf_counter() - start))
+
+    def _best_ever_generation(self, start: float) -> None:
+        """Steady state, or CMA-ES on an MDP: the champion is the best single fitness ever told;
+        a record per new champion."""
+        opt = self.opt
+        before = opt.champion_return
+        before_eps = self.flyer.episodes
+        genomes = opt.ask()
+        returns = self._fly_fixed(genomes)
+        if getattr(opt, "tells_crashes", False):
+            cast(SteadyStateNE, opt).tell(returns, crashed=self._crashed())
+        else:
+            opt.tell(returns)
+        self.generation += 1
+        self.evaluations += genomes.shape[0]
+        if opt.champion_return != before:
+            self._record(before_eps, opt.champion_return, start)
+
+    def _generational_generation(self, start: float) -> None:
+        """Generational NE: fixed resampling or a selection race; a record per generation."""
+        opt = cast(GenerationalNE, self.opt)
+        before_eps = self.flyer.episodes
+        genomes = opt.ask()
+        if self.resampling.kind == "race":
+            race = selection_race(self._race_sample_fn(genomes), genomes.shape[0], opt.settings.select_size,
+                                  self.resampling.delta, t_limit=RACE_T_LIMIT)
+            opt.tell_race(race)
+        else:
+            _, result = self._fly_family_fixed(genomes)
+            opt.tell_resampled(result)
+        self.generation += 1
+        self.evaluations += genomes.shape[0]
+        self._record(before_eps, opt.champion_return, start)
+
+    def _cma_family_generation(self, start: float) -> None:
+        """CMA-ES on a family: the champion is the best estimate of the last generation (a
+        best-ever maximum over noisy estimates would be biased); a record per generation."""
+        opt = self.opt
+        before_eps = self.flyer.episodes
+        genomes = opt.ask()
+        means, _ = self._fly_family_fixed(genomes)
+        opt.tell(means)
+        key = np.where(np.isnan(means), -np.inf, means)
+        best = int(np.argmax(key))
+        self.champion_genome, self.champion_return = genomes[best].copy(), float(key[best])
+        self.generation += 1
+        self.evaluations += genomes.shape[0]
+        self._record(before_eps, self.champion_return, start)
+
+    # ----------------------------------------------------------------- result
+
+    def _history_with_last(self) -> tuple[HistoryRecord, ...]:
+        """The history plus, if the last generation made no record, one for it (not checkpointed)."""
+        history = list(self.history)
+        if self.generation and (not history or history[-1].generation != self.generation):
+            last = history[-1] if history else None
+            history.append(HistoryRecord(self.generation, self.evaluations, self.flyer.episodes,
+                                         0 if last is None else self.flyer.episodes - last.episodes,
+                                         self._champion_return(), self.elapsed))
+        return tuple(history)
+
+    def _champion_return(self) -> float:
+        if self.method == "cma" and self.family is not None:
+            return self.champion_return
+        return float(self.opt.champion_return)
+
+    def _champion_genome(self) -> np.ndarray | None:
+        if self.method == "cma" and self.family is not None:
+            return self.champion_genome
+        return self.opt.champion_genome
+
+    def result(self) -> EvolutionResult:
+        """The run's :class:`EvolutionResult` (NeurohoverError if no candidate had a finite fitness)."""
+        genome = self._champion_genome()
+        if genome is None:
+            raise NeurohoverError("the evolution found no candidate with a finite fitness")
+        ret = self._champion_return()
+        settings = {**self.config, "budget": self.budget}
+        settings.pop("prototype")
+        target = self.config["target"]
+        label = target["mdp"]["label"] if target["kind"] == "mdp" else f"{target['family']}/G" + (
+            f"(sigma={target['sigma']:g})" if "sigma" in target else "")
+        cfg = self.cfg
+        meta = {
+            "method": self.method if cfg.optimizer == "ne" else "cma-es", "optimizer": cfg.optimizer,
+            "resampling": str(self.resampling), "target": label, "seed": cfg.seed, "budget": self.budget,
+            "episodes": self.flyer.episodes, "evaluations": self.evaluations, "generations": self.generation,
+            "champion_return": ret, "n_steps": cfg.n_steps, "stop_reason": self.stop_reason,
+        }
+        champion = Policy(cfg.topology, np.array(genome, dtype=float), {**cfg.prototype.metadata, **meta})
+        return EvolutionResult(champion, ret, self._history_with_last(), self.flyer.episodes, self.flyer.steps,
+                               self.evaluations, self.generation, self.elapsed, self.flyer.kernel_seconds,
+                               self.stop_reason or "", settings, bool(getattr(self.opt, "champion_crashed", False)))

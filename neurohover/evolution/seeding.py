@@ -1,0 +1,62 @@
+"""The one seed derivation of an evolution run: everything random comes from ``SeedSequence(seed)``.
+
+Child ``(key,)`` of ``numpy.random.SeedSequence(seed)`` seeds one job of a run:
+
+* ``(0,)``, :func:`optimiser_seed`: the optimiser's own generator (NE or CMA-ES);
+* ``(1,)``, :func:`mdp_rng`: the stream of MDPs drawn from a task family;
+* ``(2,)``, :func:`noise_seed`: the root of the episodes' gust noise. Every episode a run flies
+  gets the next index of its episode counter and flies noise stream ``(noise root, index)``, so no
+  two episodes of a run share noise and results do not depend on the number of kernel threads;
+* ``(3,)``, :func:`validation_seeds`: the noise and MDPs of ``validation_return``, which a run
+  never uses, so validation episodes are independent of the run's.
+
+An integer seed taken from a child is its first 64-bit state word shifted right by one (63 bits,
+the range the kernel's seeds allow).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import NeurohoverError
+
+__all__ = ["MAX_SEED", "check_seed", "child_int", "mdp_rng", "noise_seed", "optimiser_seed", "validation_seeds"]
+
+#: The largest seed (seeds are integers in ``0..MAX_SEED``).
+MAX_SEED = 2**63 - 1
+_OPTIMISER, _MDPS, _NOISE, _VALIDATION = 0, 1, 2, 3
+
+
+def check_seed(seed) -> int:
+    """``seed`` as an int; NeurohoverError unless it is an integer in ``0..2**63-1`` (not a bool)."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= MAX_SEED:
+        raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer in 0..2**63-1")
+    return int(seed)
+
+
+def child_int(seed: int, key: int) -> int:
+    """A 63-bit integer from child ``key`` of ``SeedSequence(seed)``."""
+    return int(np.random.SeedSequence(seed, spawn_key=(key,)).generate_state(1, np.uint64)[0] >> np.uint64(1))
+
+
+def optimiser_seed(seed: int) -> int:
+    """Seed of the optimiser of the run with root ``seed``."""
+    return child_int(seed, _OPTIMISER)
+
+
+def noise_seed(seed: int) -> int:
+    """Root of the gust noise of the episodes of the run with root ``seed``."""
+    return child_int(seed, _NOISE)
+
+
+def mdp_rng(seed: int) -> np.random.Generator:
+    """The generator the run with root ``seed`` draws its task family's MDPs with."""
+    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(_MDPS,)))
+
+
+def validation_seeds(seed: int) -> tuple[int, int]:
+    """``(noise seed, MDP seed)`` of the validation episodes for root ``seed``: the first two
+    63-bit words of child ``(3,)``."""
+    state = np.random.SeedSequence(seed, spawn_key=(_VALIDATION,)).generate_state(2, np.uint64)
+    noise, mdps = (int(x >> np.uint64(1)) for x in state)
+    return noise, mdps
