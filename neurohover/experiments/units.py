@@ -3,28 +3,45 @@
 A unit is one evolution run, one robustness test, one model-learning trial, one test run of an
 agent, ... Everything it needs travels in its ``params`` (plain JSON: MDPs as dicts, policies as
 ``{"topology", "genome"}``, its own seed), so a unit runs the same in this process, in a spawned
-worker or on a Ray node, and its result (a JSON-able dict) depends on nothing else: no global
-random state, no files, no thread count.
+worker or on a Ray node, and its result depends on nothing else: no global random state, no
+files, no thread count. Each unit kind builds its typed result
+(:mod:`~neurohover.experiments.results`) and returns its JSON dict, which the store keeps.
 
 Seeds come from the unit's key: :func:`unit_seed` feeds the root seed of the config and a SHA-256
 of ``"<experiment>/<key>"`` to ``numpy.random.SeedSequence``.
 
-Results keep wall-clock measurements under the key ``"timing"``; everything else is a
-deterministic function of the params.
+Results keep wall-clock measurements under the key ``"timing"`` (outside the results' ``==``);
+everything else is a deterministic function of the params.
 """
 
 from __future__ import annotations
 
 import hashlib
-import math
 import os
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
 from ..errors import NeurohoverError
+from .results import (
+    DiagnosticResult,
+    EvolveResult,
+    EvolveTiming,
+    ModelResult,
+    ModelTiming,
+    RobustnessResult,
+    SafetyResult,
+    StoredPolicy,
+    TestRunResult,
+    TestRunTiming,
+    num,
+)
+
+_P = TypeVar("_P", bound=Sequence)  # a point (x, y, ...) of subsample
+
 
 @dataclass(frozen=True)
 class Unit:
@@ -51,7 +68,8 @@ def unit_seed(root: int, experiment: str, key: str) -> int:
 
 
 def policy_dict(policy) -> dict:
-    return {"topology": policy.topology, "genome": [float(x) for x in policy.genome]}
+    """A policy as params and results hold it: ``{"topology", "genome"}``."""
+    return StoredPolicy.of(policy).to_dict()
 
 
 def _policy(d: dict):
@@ -72,13 +90,7 @@ def _family(task: str, sigma: float | None):
     return family_for(task, sigma)
 
 
-def _num(x: float) -> float | str:
-    """JSON-safe float (non-finite values as strings)."""
-    x = float(x)
-    return x if math.isfinite(x) else ("nan" if math.isnan(x) else ("inf" if x > 0 else "-inf"))
-
-
-def subsample(points: list[list[float]], n: int) -> list[list[float]]:
+def subsample(points: list[_P], n: int) -> list[_P]:
     """At most ``n`` of ``points`` (sorted by x), keeping the first and last, spread on a log-x grid."""
     if len(points) <= n:
         return points
@@ -110,20 +122,20 @@ def run_evolve(p: dict, threads: int | None) -> dict:
     result = evolve(target, topology=p["topology"], prototype=proto, resampling=p["resampling"],
                     budget=p["budget"] or None, settings=p["optimiser"] or None, seed=p["seed"],
                     n_steps=p["n_steps"], threads=threads)
-    history = [[int(h.episodes), _num(h.champion_return)] for h in result.history]
-    out = {
-        "champion": policy_dict(result.champion), "champion_return": _num(result.champion_return),
-        "episodes": int(result.episodes), "evaluations": int(result.evaluations),
-        "generations": int(result.generations), "stop_reason": result.stop_reason,
-        "champion_crashed": bool(result.champion_crashed),
-        "history": subsample(history, p.get("history_points", 300)),
-    }
+    history = [(int(h.episodes), num(h.champion_return)) for h in result.history]
+    validation = None
     if p.get("validation_episodes"):
         v = validation_return(result.champion, target, episodes=p["validation_episodes"], seed=p["seed"],
                               n_steps=p["n_steps"], threads=threads)
-        out["validation"] = [_num(x) for x in v]
-    out["timing"] = {"seconds": time.perf_counter() - t0, "kernel_seconds": float(result.kernel_seconds)}
-    return out
+        validation = tuple(num(x) for x in v)
+    return EvolveResult(
+        champion=StoredPolicy.of(result.champion), champion_return=num(result.champion_return),
+        episodes=int(result.episodes), evaluations=int(result.evaluations),
+        generations=int(result.generations), stop_reason=result.stop_reason,
+        champion_crashed=bool(result.champion_crashed),
+        history=tuple(subsample(history, p.get("history_points", 300))), validation=validation,
+        timing=EvolveTiming(seconds=time.perf_counter() - t0, kernel_seconds=float(result.kernel_seconds)),
+    ).to_dict()
 
 
 def run_robustness(p: dict, threads: int | None) -> dict:
@@ -132,8 +144,8 @@ def run_robustness(p: dict, threads: int | None) -> dict:
 
     mdps = [_mdp(m) for m in p["mdps"]]
     ev = evaluate(_policy(p["policy"]), mdps, episodes=p["episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads)
-    return {"returns": [[_num(x) for x in row] for row in ev.returns[0]],
-            "crashes": [int(c) for c in ev.crashed[0].sum(axis=1)], "own": p["own"]}
+    return RobustnessResult(returns=tuple(tuple(num(x) for x in row) for row in ev.returns[0]),
+                            crashes=tuple(int(c) for c in ev.crashed[0].sum(axis=1)), own=p["own"]).to_dict()
 
 
 def run_safety(p: dict, threads: int | None) -> dict:
@@ -145,8 +157,8 @@ def run_safety(p: dict, threads: int | None) -> dict:
     ev = evaluate(policies, [_mdp(m) for m in p["mdps"]], episodes=p["episodes"], seed=p["seed"],
                   n_steps=p["n_steps"], threads=threads)
     crashes, returns = ev.crashed.sum(axis=2), ev.returns.mean(axis=2)
-    return {"crashes": crashes.tolist(), "mean_returns": [[_num(x) for x in r] for r in returns],
-            "safe": list(choose_safe(crashes, returns))}
+    return SafetyResult(crashes=tuple(tuple(int(c) for c in row) for row in crashes),
+                        mean_returns=tuple(tuple(num(x) for x in r) for r in returns), safe=choose_safe(crashes, returns)).to_dict()
 
 
 def run_model(p: dict, threads: int | None) -> dict:
@@ -156,7 +168,7 @@ def run_model(p: dict, threads: int | None) -> dict:
     plateau stop) and ``ec-mer`` (``model_budget`` evaluations)."""
     from ..evaluate import evaluate
     from ..evolution.evolve import evolve
-    from ..models import learn_ec_mer, learn_ec_meno, learn_lr
+    from ..models import learn_ec_meno, learn_ec_mer, learn_lr
 
     mdp = _mdp(p["mdp"])
     generic = _policy(p["generic"])
@@ -178,15 +190,15 @@ def run_model(p: dict, threads: int | None) -> dict:
     evolve_seconds = time.perf_counter() - t1
     test = evaluate(evolved.champion, mdp, episodes=p["test_episodes"], seed=int(seeds[3]), n_steps=p["n_steps"], threads=threads)
     returns = test.returns.ravel()
-    return {
-        "method": p["method"], "mdp": mdp.label,
-        "generic_return": _num(data.returns.ravel()[0]), "generic_crashed": bool(data.crashed.ravel()[0]),
-        "model_params": [_num(x) for x in model.params], "model_noise_std": [_num(x) for x in model.noise_std],
-        "predicted_return": _num(evolved.champion_return),
-        "test_returns": [_num(x) for x in returns], "test_mean": _num(returns.mean()),
-        "test_crashes": int(test.crashed.sum()), "policy_episodes": int(evolved.episodes),
-        "timing": {"learn_seconds": learn_seconds, "evolve_seconds": evolve_seconds},
-    }
+    return ModelResult(
+        method=p["method"], mdp=mdp.label,
+        generic_return=num(data.returns.ravel()[0]), generic_crashed=bool(data.crashed.ravel()[0]),
+        model_params=tuple(num(x) for x in model.params), model_noise_std=tuple(num(x) for x in model.noise_std),
+        predicted_return=num(evolved.champion_return),
+        test_returns=tuple(num(x) for x in returns), test_mean=num(returns.mean()),
+        test_crashes=int(test.crashed.sum()), policy_episodes=int(evolved.episodes),
+        timing=ModelTiming(learn_seconds=learn_seconds, evolve_seconds=evolve_seconds),
+    ).to_dict()
 
 
 def make_agent(p: dict):
@@ -222,15 +234,15 @@ def run_test_run(p: dict, threads: int | None) -> dict:
     agent = make_agent(p)
     r = run_test(agent, family, mdp, episodes=p["episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads)
     start = after_learning_start(r.policy)
-    changes = [[e, r.policy[e]] for e in range(len(r.policy)) if e == 0 or r.policy[e] != r.policy[e - 1]]
-    return {
-        "agent": p["agent"], "mdp": mdp.label, "score": _num(r.score),
-        "returns": [_num(x) for x in r.returns], "crash_episodes": [int(e) for e in np.flatnonzero(r.crashed)],
-        "safeguard_episodes": [int(e) for e in np.flatnonzero(r.safeguard_fired)],
-        "policy_changes": changes, "learning_episodes": int(start),
-        "mean_return_after_learning": _num(r.returns[start:].mean()),
-        "timing": {"seconds": float(r.seconds), "offline_seconds": float(r.offline_seconds.sum())},
-    }
+    changes = tuple((e, r.policy[e]) for e in range(len(r.policy)) if e == 0 or r.policy[e] != r.policy[e - 1])
+    return TestRunResult(
+        agent=p["agent"], mdp=mdp.label, score=num(r.score),
+        returns=tuple(num(x) for x in r.returns), crash_episodes=tuple(int(e) for e in np.flatnonzero(r.crashed)),
+        safeguard_episodes=tuple(int(e) for e in np.flatnonzero(r.safeguard_fired)),
+        policy_changes=changes, learning_episodes=int(start),
+        mean_return_after_learning=num(r.returns[start:].mean()),
+        timing=TestRunTiming(seconds=float(r.seconds), offline_seconds=float(r.offline_seconds.sum())),
+    ).to_dict()
 
 
 def run_diagnostic(p: dict, threads: int | None) -> dict:
@@ -247,7 +259,7 @@ def run_diagnostic(p: dict, threads: int | None) -> dict:
             f.write(str(os.getpid()))
         os._exit(3)
     time.sleep(float(p.get("sleep", 0.0)))
-    return {"value": p.get("value"), "seed": p.get("seed")}
+    return DiagnosticResult(value=p.get("value"), seed=p.get("seed")).to_dict()
 
 
 _RUNNERS = {
@@ -261,7 +273,8 @@ _RUNNERS = {
 
 
 def run_unit(unit: Unit | dict, threads: int | None = 1) -> dict:
-    """Run one unit and return its JSON-able result (a pure function of the unit's params).
+    """Run one unit and return its JSON-able result (a pure function of the unit's params): the
+    ``to_dict()`` of its typed result (:data:`~neurohover.experiments.results.RESULT_TYPES`).
 
     ``threads`` are kernel threads (1 when many units run in parallel; None: all cores); results
     do not depend on it.

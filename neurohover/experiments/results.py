@@ -1,0 +1,477 @@
+"""Typed results of the experiment units, one frozen dataclass per unit kind, and the parser of unit keys.
+
+A unit (:mod:`~neurohover.experiments.units`) builds its result as one of these types and the
+store keeps its :meth:`~UnitResult.to_dict`; the report and the export read stored results back
+with :func:`result_from_dict`. ``to_dict`` writes exactly the JSON the store has always held
+(same keys in the same order, same values), so ``result_from_dict(kind, d).to_dict() == d`` for
+every stored result, and new results are stored as before.
+
+Conventions of the stored JSON, kept by the types:
+
+* numbers that may be non-finite (returns) are :data:`Num`: a float, or one of the strings
+  ``"nan"``, ``"inf"``, ``"-inf"`` (:func:`num`); ``float()`` reads both;
+* lists become tuples in the types (so results are immutable) and lists again in ``to_dict``;
+* wall-clock measurements are in a ``timing`` part, which takes no part in ``==``: two runs of
+  the same unit give equal results;
+* keys that older stores lack are optional fields, None when absent, and stay absent.
+
+:class:`UnitKey` parses the unit keys of :mod:`~neurohover.experiments.plans` (stage, group, MDP,
+repetition), in this one place.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import re
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+
+from ..errors import NeurohoverError
+
+__all__ = [
+    "DiagnosticResult", "EvolveResult", "EvolveTiming", "ModelResult", "ModelTiming", "Num", "RESULT_TYPES", "RobustnessResult",
+    "SafetyResult", "StoredPolicy", "TestRunResult", "TestRunTiming", "UnitKey", "UnitResult", "num", "result_from_dict",
+]
+
+#: A JSON-safe float: finite values as floats, non-finite ones as ``"nan"``, ``"inf"`` or ``"-inf"``.
+Num = float | str
+
+
+def num(x: float) -> Num:
+    """``x`` as a JSON-safe :data:`Num` (non-finite values as strings)."""
+    x = float(x)
+    return x if math.isfinite(x) else ("nan" if math.isnan(x) else ("inf" if x > 0 else "-inf"))
+
+
+def _tuples(value: Any) -> Any:
+    """Lists (nested) as tuples; anything else as it is."""
+    return tuple(_tuples(v) for v in value) if isinstance(value, (list, tuple)) else value
+
+
+def _lists(value: Any) -> Any:
+    """Tuples (nested) as lists; anything else as it is."""
+    return [_lists(v) for v in value] if isinstance(value, (list, tuple)) else value
+
+
+class _Record:
+    """``to_dict`` / ``from_dict`` for a frozen dataclass whose fields, in order, are its JSON keys.
+
+    ``_NESTED`` names the fields that are records themselves; ``_OPTIONAL`` the keys older stores
+    lack (None: absent); ``_RAW`` the fields kept exactly as JSON gives them (no tuple conversion)."""
+
+    _NESTED: ClassVar[dict[str, type[_Record]]] = {}
+    _OPTIONAL: ClassVar[tuple[str, ...]] = ()
+    _RAW: ClassVar[tuple[str, ...]] = ()
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):  # type: ignore[arg-type]
+            value = getattr(self, f.name)
+            if f.name in self._NESTED:
+                if not isinstance(value, self._NESTED[f.name]):
+                    raise NeurohoverError(f"{type(self).__name__}.{f.name} must be a {self._NESTED[f.name].__name__}, "
+                                          f"got {type(value).__name__}")
+            elif f.name not in self._RAW:
+                object.__setattr__(self, f.name, _tuples(value))
+
+    def to_dict(self) -> dict:
+        """The JSON dict of this record, as the results store holds it.
+
+        Returns
+        -------
+        dict
+            Keys in field order (optional ones left out when None), tuples as lists, parts as dicts.
+        """
+        out = {}
+        for f in dataclasses.fields(self):  # type: ignore[arg-type]
+            value = getattr(self, f.name)
+            if value is None and f.name in self._OPTIONAL:
+                continue
+            out[f.name] = value.to_dict() if f.name in self._NESTED else value if f.name in self._RAW else _lists(value)
+        return out
+
+    @classmethod
+    def from_dict(cls, d: dict, what: str | None = None):
+        """Read a dict written by :meth:`to_dict` (``from_dict(d).to_dict() == d``).
+
+        Parameters
+        ----------
+        d : dict
+            The stored JSON object.
+        what : str, optional
+            What it is, for error messages (default: the class name).
+
+        Raises
+        ------
+        NeurohoverError
+            ``d`` is not a dict, lacks a key, or has a key this type does not know.
+        """
+        what = what or cls.__name__
+        if not isinstance(d, dict):
+            raise NeurohoverError(f"{what}: expected a JSON object, got {type(d).__name__}")
+        names = [f.name for f in dataclasses.fields(cls)]  # type: ignore[arg-type]
+        missing = [n for n in names if n not in d and n not in cls._OPTIONAL]
+        unknown = [k for k in d if k not in names]
+        if missing or unknown:
+            raise NeurohoverError(f"{what}: " + "; ".join(
+                ([f"missing key(s) {', '.join(missing)}"] if missing else [])
+                + ([f"unknown key(s) {', '.join(unknown)} (written by another neurohover version?)"] if unknown else [])))
+        values = {n: cls._NESTED[n].from_dict(d[n], f"{what}.{n}") if n in cls._NESTED else d.get(n) for n in names}
+        return cls(**values)
+
+    def columns(self) -> dict[str, Any]:
+        """Flat columns (for CSV): a part's keys as ``part.key``, a policy and every list as
+        compact JSON, scalars as they are."""
+        out: dict[str, Any] = {}
+
+        def add(name: str, value: Any) -> None:
+            if isinstance(value, dict):
+                for k, v in value.items():
+                    add(f"{name}.{k}", v)
+            elif isinstance(value, (int, float, str, bool)) or value is None:
+                out[name] = value
+            else:
+                out[name] = json.dumps(value, separators=(",", ":"))
+
+        for name, value in self.to_dict().items():
+            if self._NESTED.get(name) is StoredPolicy:
+                out[name] = json.dumps(value, separators=(",", ":"))  # a policy stays one cell
+            else:
+                add(name, value)
+        return out
+
+
+# --------------------------------------------------------------------------------- parts
+
+
+@dataclass(frozen=True)
+class StoredPolicy(_Record):
+    """A policy as results and params hold it: ``{"topology", "genome"}``.
+
+    Attributes
+    ----------
+    topology : str
+    genome : tuple of float
+    """
+
+    topology: str
+    genome: tuple[float, ...]
+
+    @classmethod
+    def of(cls, policy) -> StoredPolicy:
+        """The stored form of a :class:`~neurohover.policies.Policy`."""
+        return cls(policy.topology, tuple(float(x) for x in policy.genome))
+
+    def policy(self):
+        """The :class:`~neurohover.policies.Policy` (no metadata)."""
+        from ..policies import Policy
+
+        return Policy(self.topology, np.array(self.genome, dtype=float))
+
+
+@dataclass(frozen=True)
+class EvolveTiming(_Record):
+    """Wall-clock seconds of an evolution run, and of its kernel calls."""
+
+    seconds: float
+    kernel_seconds: float
+
+
+@dataclass(frozen=True)
+class ModelTiming(_Record):
+    """Wall-clock seconds to learn the model and to evolve the policy on it."""
+
+    learn_seconds: float
+    evolve_seconds: float
+
+
+@dataclass(frozen=True)
+class TestRunTiming(_Record):
+    """Wall-clock seconds of a test run, and of the agent's work between episodes."""
+
+    __test__ = False  # not a pytest test class
+
+    seconds: float
+    offline_seconds: float
+
+
+# --------------------------------------------------------------------------------- unit results
+
+
+@dataclass(frozen=True, kw_only=True)
+class EvolveResult(_Record):
+    """Result of an ``evolve`` unit: one evolution run (paper Section 3.1 / 5).
+
+    Attributes
+    ----------
+    champion : StoredPolicy
+    champion_return : Num
+        The champion's fitness estimate at the end of the run.
+    episodes, evaluations, generations : int
+    stop_reason : str
+    champion_crashed : bool or None
+        Whether the final champion's own evaluation crashed (None: a store written before it was recorded).
+    history : tuple of (int, Num)
+        (episodes, champion return) records, subsampled.
+    validation : tuple of Num or None
+        Returns of the champion on fresh validation episodes (None: no validation asked for).
+    timing : EvolveTiming
+        Wall-clock; not part of ``==``.
+    """
+
+    _NESTED: ClassVar[dict[str, type[_Record]]] = {"champion": StoredPolicy, "timing": EvolveTiming}
+    _OPTIONAL: ClassVar[tuple[str, ...]] = ("champion_crashed", "validation")
+
+    champion: StoredPolicy
+    champion_return: Num
+    episodes: int
+    evaluations: int
+    generations: int
+    stop_reason: str
+    champion_crashed: bool | None = None
+    history: tuple[tuple[int, Num], ...]
+    validation: tuple[Num, ...] | None = None
+    timing: EvolveTiming = field(compare=False)
+
+    @property
+    def final_score(self) -> float:
+        """The run's score: mean validation return if validated, else the champion's return."""
+        if self.validation is not None:
+            return float(np.mean([float(x) for x in self.validation]))
+        return float(self.champion_return)
+
+
+@dataclass(frozen=True, kw_only=True)
+class RobustnessResult(_Record):
+    """Result of a ``robustness`` unit (Table 3): one policy flown on each of several MDPs.
+
+    Attributes
+    ----------
+    returns : tuple of tuple of Num
+        Per MDP, the return of each episode.
+    crashes : tuple of int
+        Per MDP, the crashed episodes.
+    own : int
+        Index of the MDP the policy was evolved on.
+    """
+
+    returns: tuple[tuple[Num, ...], ...]
+    crashes: tuple[int, ...]
+    own: int
+
+
+@dataclass(frozen=True, kw_only=True)
+class SafetyResult(_Record):
+    """Result of a ``safety`` unit: the specialised policies' crash matrix and the safe ones.
+
+    Attributes
+    ----------
+    crashes : tuple of tuple of int
+        Crashed episodes of policy i on training MDP j.
+    mean_returns : tuple of tuple of Num
+        Mean return of policy i on training MDP j.
+    safe : tuple of int
+        Indices of the safe policies.
+    """
+
+    crashes: tuple[tuple[int, ...], ...]
+    mean_returns: tuple[tuple[Num, ...], ...]
+    safe: tuple[int, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class ModelResult(_Record):
+    """Result of a ``model`` unit (Table 4): learn a model, evolve a policy on it, test it.
+
+    Attributes
+    ----------
+    method : str
+        ``"lr"``, ``"lr-gls"``, ``"ec-meno"`` or ``"ec-mer"``.
+    mdp : str
+        Label of the true MDP.
+    generic_return : Num
+        Return of the generic policy's episode that gave the flight data.
+    generic_crashed : bool
+    model_params, model_noise_std : tuple of Num
+        The learned model's 11 parameters and 6 noise standard deviations.
+    predicted_return : Num
+        The evolved champion's return on the model.
+    test_returns : tuple of Num
+        Returns of the evolved policy in the true MDP.
+    test_mean : Num
+    test_crashes : int
+    policy_episodes : int
+        Episodes the policy's evolution flew.
+    timing : ModelTiming
+        Wall-clock; not part of ``==``.
+    """
+
+    _NESTED: ClassVar[dict[str, type[_Record]]] = {"timing": ModelTiming}
+
+    method: str
+    mdp: str
+    generic_return: Num
+    generic_crashed: bool
+    model_params: tuple[Num, ...]
+    model_noise_std: tuple[Num, ...]
+    predicted_return: Num
+    test_returns: tuple[Num, ...]
+    test_mean: Num
+    test_crashes: int
+    policy_episodes: int
+    timing: ModelTiming = field(compare=False)
+
+
+@dataclass(frozen=True, kw_only=True)
+class TestRunResult(_Record):
+    """Result of a ``test_run`` unit: one agent's episodes on one MDP it does not know.
+
+    Attributes
+    ----------
+    agent : str
+    mdp : str
+        Label of the MDP.
+    score : Num
+        Cumulative return of the run.
+    returns : tuple of Num
+        Return of each episode.
+    crash_episodes, safeguard_episodes : tuple of int
+        Episodes that crashed, and episodes in which the safeguard fired.
+    policy_changes : tuple of (int, str)
+        (episode, policy) wherever the flown policy changed (episode 0 first).
+    learning_episodes : int
+        Episodes before the agent settled (see :func:`neurohover.compete.after_learning_start`).
+    mean_return_after_learning : Num
+    timing : TestRunTiming
+        Wall-clock; not part of ``==``.
+    """
+
+    __test__ = False  # not a pytest test class
+    _NESTED: ClassVar[dict[str, type[_Record]]] = {"timing": TestRunTiming}
+
+    agent: str
+    mdp: str
+    score: Num
+    returns: tuple[Num, ...]
+    crash_episodes: tuple[int, ...]
+    safeguard_episodes: tuple[int, ...]
+    policy_changes: tuple[tuple[int, str], ...]
+    learning_episodes: int
+    mean_return_after_learning: Num
+    timing: TestRunTiming = field(compare=False)
+
+
+@dataclass(frozen=True, kw_only=True)
+class DiagnosticResult(_Record):
+    """Result of a ``diagnostic`` unit (executor tests): the value and seed it was given, as given."""
+
+    _RAW: ClassVar[tuple[str, ...]] = ("value", "seed")
+
+    value: Any
+    seed: Any
+
+
+UnitResult = EvolveResult | RobustnessResult | SafetyResult | ModelResult | TestRunResult | DiagnosticResult
+
+#: The result type of each unit kind.
+RESULT_TYPES: dict[str, type[_Record]] = {
+    "evolve": EvolveResult, "robustness": RobustnessResult, "safety": SafetyResult, "model": ModelResult,
+    "test_run": TestRunResult, "diagnostic": DiagnosticResult,
+}
+
+
+def result_from_dict(kind: str, d: dict, key: str | None = None) -> UnitResult:
+    """The typed result of a unit from its stored dict.
+
+    Parameters
+    ----------
+    kind : str
+        The unit's kind (a key of :data:`RESULT_TYPES`).
+    d : dict
+        The result as the store holds it.
+    key : str, optional
+        The unit's key, for error messages.
+
+    Returns
+    -------
+    EvolveResult, RobustnessResult, SafetyResult, ModelResult, TestRunResult or DiagnosticResult
+
+    Raises
+    ------
+    NeurohoverError
+        An unknown kind, or a dict that is not a result of that kind.
+    """
+    cls = RESULT_TYPES.get(kind)
+    if cls is None:
+        raise NeurohoverError(f"unknown unit kind {kind!r}: allowed {', '.join(RESULT_TYPES)}")
+    return cls.from_dict(d, f"result of {kind} unit {key!r}" if key else None)
+
+
+# --------------------------------------------------------------------------------- unit keys
+
+
+_KEY_PATTERNS = (
+    ("evolve", re.compile(r"evolve/(?P<group>.+?)(?:/(?P<mdp>train\d+))?/run(?P<rep>\d+)")),
+    ("robust", re.compile(r"robust/(?P<group>.+)/(?P<mdp>train\d+)")),
+    ("policy", re.compile(r"policy/(?P<group>.+)")),
+    ("model", re.compile(r"model/(?P<group>.+)/(?P<mdp>[a-z]+\d+)")),
+    ("run", re.compile(r"run/(?P<group>.+)/(?P<mdp>[a-z]+\d+)/rep(?P<rep>\d+)")),
+)
+
+
+@dataclass(frozen=True)
+class UnitKey:
+    """The parts of a unit key (the scheme of :mod:`~neurohover.experiments.plans`).
+
+    ========================================  ========  =============  =========  =====
+    key                                       stage     group          mdp        rep
+    ========================================  ========  =============  =========  =====
+    ``evolve/<variant>/train<i>/run<r>``      evolve    variant        train<i>   r
+    ``evolve/<variant>/run<r>``               evolve    variant        None       r
+    ``robust/<variant>/train<i>``             robust    variant        train<i>   None
+    ``policy/<name>``                         policy    name           None       None
+    ``model/<method>/<mdps><i>``              model     method         <mdps><i>  None
+    ``run/<group>/<mdps><i>/rep<r>``          run       group label    <mdps><i>  r
+    anything else (e.g. diagnostic units)     ""        ""             None       None
+    ========================================  ========  =============  =========  =====
+
+    Attributes
+    ----------
+    key : str
+    stage : str
+    group : str
+    mdp : str or None
+        Which MDP set and index (``"train3"``, ``"test0"``, ``"sample2"``).
+    rep : int or None
+        The run or repetition number.
+    """
+
+    key: str
+    stage: str
+    group: str
+    mdp: str | None = None
+    rep: int | None = None
+
+    @classmethod
+    def parse(cls, key: str) -> UnitKey:
+        """Split a unit key into its parts.
+
+        Parameters
+        ----------
+        key : str
+            A unit key; one outside the scheme (e.g. a diagnostic unit's) gives stage and group ``""``.
+
+        Returns
+        -------
+        UnitKey
+        """
+        for stage, pattern in _KEY_PATTERNS:
+            m = pattern.fullmatch(key)
+            if m:
+                parts = m.groupdict()
+                rep = parts.get("rep")
+                return cls(key, stage, parts["group"], parts.get("mdp"), None if rep is None else int(rep))
+        return cls(key, "", "")

@@ -1,0 +1,120 @@
+"""Typed unit results (neurohover/experiments/results.py): every result of the committed results
+store reads back and writes out exactly as stored, timing takes no part in ==, bad dicts are
+refused, and the one parser of unit keys."""
+
+from __future__ import annotations
+
+import gzip
+import json
+import shutil
+import sqlite3
+from pathlib import Path
+
+import pytest
+
+from neurohover.errors import NeurohoverError
+from neurohover.experiments import load_config, plan, run_unit
+from neurohover.experiments.results import (
+    RESULT_TYPES,
+    EvolveResult,
+    RobustnessResult,
+    StoredPolicy,
+    TestRunResult,
+    UnitKey,
+    result_from_dict,
+)
+from neurohover.experiments.store import _dumps
+
+ROOT = Path(__file__).resolve().parents[1]
+STORE_GZ = ROOT / "docs" / "reproduction" / "results.sqlite.gz"
+
+
+@pytest.fixture(scope="module")
+def committed_store(tmp_path_factory) -> Path:
+    if not STORE_GZ.is_file():
+        pytest.skip("the committed results store is not in this checkout")
+    path = tmp_path_factory.mktemp("store") / "results.sqlite"
+    with gzip.open(STORE_GZ) as src, open(path, "wb") as dst:
+        shutil.copyfileobj(src, dst)
+    return path
+
+
+def _stored(path: Path, *where: str):
+    with sqlite3.connect(path) as conn:
+        return conn.execute("SELECT name, scale, key, kind, result FROM units" + (" WHERE " + where[0] if where else ""),
+                            where[1:]).fetchall()
+
+
+def test_every_stored_result_round_trips_exactly(committed_store: Path) -> None:
+    rows = _stored(committed_store)
+    kinds = set()
+    for name, scale, key, kind, text in rows:
+        d = json.loads(text)
+        result = result_from_dict(kind, d, key)
+        assert isinstance(result, RESULT_TYPES[kind])
+        assert result.to_dict() == d, (name, scale, key)
+        assert _dumps(result.to_dict()) == text, (name, scale, key)  # same keys in the same order: stored identically
+        kinds.add(kind)
+    assert kinds == set(RESULT_TYPES) - {"diagnostic"} and len(rows) > 1000
+
+
+def test_units_store_their_typed_result(committed_store: Path) -> None:
+    """A unit returns its typed result's to_dict(): it reads back into the same result."""
+    stored = {k: json.loads(t) for _, _, k, _, t in _stored(committed_store, "name = ? AND scale = ?", "fig2", "quick")}
+    unit = next(u for u in plan(load_config("fig2", "quick"), stored).units if u.kind == "robustness")
+    result = run_unit(unit)
+    assert list(result) == ["returns", "crashes", "own"]
+    assert RobustnessResult.from_dict(result).to_dict() == result
+    d = run_unit({"experiment": "x", "key": "k", "kind": "diagnostic", "params": {"value": [1, {"a": 2}], "seed": 3}})
+    assert d == {"value": [1, {"a": 2}], "seed": 3} and result_from_dict("diagnostic", d).to_dict() == d
+
+
+def _evolve_dict(**changes) -> dict:
+    d = {"champion": {"topology": "slp", "genome": [0.5, -1.0]}, "champion_return": -12.5, "episodes": 40,
+         "evaluations": 40, "generations": 4, "stop_reason": "budget", "champion_crashed": False,
+         "history": [[1, "-inf"], [40, -12.5]], "validation": [-13.0, "nan"],
+         "timing": {"seconds": 1.25, "kernel_seconds": 0.5}}
+    d.update(changes)
+    return {k: v for k, v in d.items() if v is not None}
+
+
+def test_timing_takes_no_part_in_equality() -> None:
+    a = EvolveResult.from_dict(_evolve_dict())
+    assert a == EvolveResult.from_dict(_evolve_dict(timing={"seconds": 9.0, "kernel_seconds": 8.0}))
+    assert a != EvolveResult.from_dict(_evolve_dict(champion_return=-12.0))
+    assert a.champion == StoredPolicy("slp", (0.5, -1.0)) and a.history == ((1, "-inf"), (40, -12.5))
+    assert a.final_score != a.final_score  # nan in the validation returns stays nan
+    # keys that older stores lack stay absent
+    old = _evolve_dict(champion_crashed=None, validation=None)
+    r = EvolveResult.from_dict(old)
+    assert r.champion_crashed is None and r.validation is None and r.to_dict() == old and r.final_score == -12.5
+
+
+def test_bad_result_dicts_are_refused() -> None:
+    with pytest.raises(NeurohoverError, match="missing key.*stop_reason"):
+        EvolveResult.from_dict({k: v for k, v in _evolve_dict().items() if k != "stop_reason"})
+    with pytest.raises(NeurohoverError, match="unknown key.*surprise"):
+        EvolveResult.from_dict(_evolve_dict(surprise=1))
+    with pytest.raises(NeurohoverError, match="timing: expected a JSON object"):
+        EvolveResult.from_dict(_evolve_dict(timing=[1.0, 2.0]))
+    with pytest.raises(NeurohoverError, match="unknown unit kind 'nope'"):
+        result_from_dict("nope", {})
+    with pytest.raises(NeurohoverError, match="must be a TestRunTiming"):
+        TestRunResult(agent="a", mdp="m", score=0.0, returns=[], crash_episodes=[], safeguard_episodes=[], policy_changes=[],
+                      learning_episodes=0, mean_return_after_learning=0.0, timing={"seconds": 1.0, "offline_seconds": 0.0})
+
+
+@pytest.mark.parametrize("key, parts", [
+    ("evolve/mlp-baseline/train3/run7", ("evolve", "mlp-baseline", "train3", 7)),
+    ("evolve/race0.2/run0", ("evolve", "race0.2", None, 0)),
+    ("robust/slp-zero/train9", ("robust", "slp-zero", "train9", None)),
+    ("policy/generic", ("policy", "generic", None, None)),
+    ("policy/generic-race1", ("policy", "generic-race1", None, None)),
+    ("model/lr-gls/test12", ("model", "lr-gls", "test12", None)),
+    ("run/hybrid-baseline/sample4/rep2", ("run", "hybrid-baseline", "sample4", 2)),
+    ("run/a/b/train0/rep1", ("run", "a/b", "train0", 1)),  # a group label with a slash
+    ("good", ("", "", None, None)),
+])
+def test_unit_keys_parse(key: str, parts: tuple) -> None:
+    k = UnitKey.parse(key)
+    assert (k.stage, k.group, k.mdp, k.rep) == parts and k.key == key
