@@ -118,3 +118,24 @@ def test_bad_result_dicts_are_refused() -> None:
 def test_unit_keys_parse(key: str, parts: tuple) -> None:
     k = UnitKey.parse(key)
     assert (k.stage, k.group, k.mdp, k.rep) == parts and k.key == key
+
+
+def test_export_and_report_read_typed_results(committed_store: Path, tmp_path: Path) -> None:
+    """The CSV gains the key's parts from UnitKey; a result the types refuse stops the report with its unit named."""
+    import csv
+    import io
+
+    from neurohover.experiments import Store, export_results, write_report
+
+    with Store(committed_store, create=False) as store:
+        rows = list(csv.DictReader(io.StringIO(export_results(store, "fig8", "csv", "quick"))))
+    run = next(r for r in rows if r["key"] == "run/hybrid/train0/rep0")
+    assert (run["group"], run["mdp"], run["rep"]) == ("hybrid", "train0", "0")
+    assert json.loads(run["result.returns"]) and float(run["result.timing.seconds"]) > 0
+    assert json.loads(next(r for r in rows if r["key"] == "policy/generic")["result.champion"])["topology"] == "mlp"
+    broken = shutil.copy(committed_store, tmp_path / "broken.sqlite")  # the module's store stays intact
+    with sqlite3.connect(broken) as conn:
+        conn.execute("UPDATE units SET result = ? WHERE name = 'fig15' AND scale = 'quick' AND key = 'evolve/k5/run0'",
+                     (json.dumps({"champion_return": 1.0}),))
+    with Store(broken, create=False) as store, pytest.raises(NeurohoverError, match="evolve/k5/run0.*missing key"):
+        write_report(store, tmp_path / "report", scale="quick", names=["fig15"])

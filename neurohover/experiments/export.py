@@ -1,4 +1,10 @@
-"""``neurohover results``: export an experiment's finished units as CSV or JSON."""
+"""``neurohover results``: export an experiment's finished units as CSV or JSON.
+
+CSV: one row per unit: experiment, scale, key, kind, the key's parts (group, mdp, rep:
+:class:`~neurohover.experiments.results.UnitKey`), seconds, worker, then the params (``param.*``)
+and the typed result's columns (``result.*``: :meth:`~neurohover.experiments.results.EvolveResult.columns`).
+JSON: the units exactly as the store holds them.
+"""
 
 from __future__ import annotations
 
@@ -7,6 +13,7 @@ import io
 import json
 
 from ..errors import NeurohoverError
+from .results import UnitKey, result_from_dict
 from .store import Store
 
 FORMATS = ("csv", "json")
@@ -26,7 +33,8 @@ def _scale(store: Store, name: str, scale: str | None) -> str:
 
 
 def _flat(prefix: str, value, out: dict) -> None:
-    if isinstance(value, dict) and not prefix.endswith(("policies", "champion", "mdp", "policy", "generic")):
+    """Params as flat columns: nested dicts as ``a.b``, except MDPs and policies (one JSON cell)."""
+    if isinstance(value, dict) and not prefix.endswith(("policies", "mdp", "policy", "generic")):
         for k, v in value.items():
             _flat(f"{prefix}.{k}" if prefix else k, v, out)
     else:
@@ -45,9 +53,11 @@ def export_results(store: Store, name: str, fmt: str = "csv", scale: str | None 
                            "sessions": store.sessions(name, scale), "units": units}, indent=1) + "\n"
     rows = []
     for u in units:
-        row = {"experiment": name, "scale": scale, "key": u["key"], "kind": u["kind"], "seconds": u["seconds"], "worker": u["worker"]}
+        key = UnitKey.parse(u["key"])
+        row = {"experiment": name, "scale": scale, "key": u["key"], "kind": u["kind"], "group": key.group, "mdp": key.mdp,
+               "rep": key.rep, "seconds": u["seconds"], "worker": u["worker"]}
         _flat("param", {k: v for k, v in u["params"].items()}, row)
-        _flat("result", u["result"], row)
+        row.update({f"result.{k}": v for k, v in result_from_dict(u["kind"], u["result"], u["key"]).columns().items()})
         rows.append(row)
     columns: list[str] = []
     for row in rows:

@@ -17,12 +17,14 @@ from __future__ import annotations
 import math
 import time
 import warnings
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import NeurohoverError
 from .config import ORDER, ExperimentConfig
+from .results import EvolveResult, ModelResult, RobustnessResult, TestRunResult, UnitKey, UnitResult, result_from_dict
 from .store import Store
 
 
@@ -100,12 +102,17 @@ def _p_significant(p_paper: str) -> bool | None:
 
 
 class _Section:
-    def __init__(self, config: ExperimentConfig, results: dict[str, dict], store: Store, out: Path) -> None:
+    def __init__(self, config: ExperimentConfig, results: dict[str, UnitResult], store: Store, out: Path) -> None:
         self.cfg, self.results, self.store, self.out = config, results, store, out
+        self.keys = {k: UnitKey.parse(k) for k in results}
         self.s = config.settings
         self.paper = config.paper
         self.comparisons: list[str] = []
         self.tests: list[list] = []
+
+    def group(self, stage: str, group: str) -> list:
+        """The results of the units of ``stage`` and ``group`` (:class:`UnitKey`), in key order."""
+        return [self.results[k] for k in sorted(self.results) if (self.keys[k].stage, self.keys[k].group) == (stage, group)]
 
     @property
     def stem(self) -> str:
@@ -146,7 +153,7 @@ class _Section:
             ["comparison", "mean A", "mean B", "t", "Student's p", "Welch's p", "paper p"], self.tests) + "\n")
 
 
-def _curve(points: list[list[float]], grid: np.ndarray) -> np.ndarray:
+def _curve(points: Sequence[Sequence[float | str]], grid: np.ndarray) -> np.ndarray:
     """Champion error of one run on ``grid`` (a step function; NaN before its first record,
     held after its last)."""
     xs = np.array([p[0] for p in points], dtype=float)
@@ -160,21 +167,18 @@ class _Evolution(_Section):
     def variants(self) -> list[dict]:
         return self.s["variants"]
 
-    def runs(self, vkey: str) -> list[tuple[str, dict]]:
-        prefix = f"evolve/{vkey}/"
-        return [(k, r) for k, r in sorted(self.results.items()) if k.startswith(prefix)]
+    def runs(self, vkey: str) -> list[EvolveResult]:
+        return self.group("evolve", vkey)
 
-    def final_scores(self, runs) -> list[float]:
-        if runs and "validation" in runs[0][1]:
-            return [float(np.mean([float(x) for x in r["validation"]])) for _, r in runs]
-        return [float(r["champion_return"]) for _, r in runs]
+    def final_scores(self, runs: list[EvolveResult]) -> list[float]:
+        return [r.final_score for r in runs]
 
     def figure(self) -> str | None:
         data = {v["key"]: self.runs(v["key"]) for v in self.variants()}
         if not any(data.values()):
             return None
-        xmax = max(r["history"][-1][0] for runs in data.values() for _, r in runs)
-        xmin = min(r["history"][0][0] for runs in data.values() for _, r in runs)
+        xmax = max(r.history[-1][0] for runs in data.values() for r in runs)
+        xmin = min(r.history[0][0] for runs in data.values() for r in runs)
         grid = np.linspace(max(xmin, 1), xmax, 400)
         two = self.cfg.name == "fig2" or self.s["target"] == "train"
         fig, axes = _figure(2 if two else 1, figsize=(11 if two else 6.5, 4.2))
@@ -183,13 +187,13 @@ class _Evolution(_Section):
             runs = data[v["key"]]
             if not runs:
                 continue
-            curves = np.array([_curve(r["history"], grid) for _, r in runs])
+            curves = np.array([_curve(r.history, grid) for r in runs])
             with np.errstate(all="ignore"), warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)  # grid points before any run's first champion
                 mean = np.nanmean(np.where(np.isfinite(curves), curves, np.nan), axis=0)
             axes[0].plot(grid, mean, label=v["label"])
             if two:
-                best = int(np.argmin([-float(r["champion_return"]) for _, r in runs]))
+                best = int(np.argmin([-float(r.champion_return) for r in runs]))
                 axes[1].plot(grid, curves[best], label=v["label"])
         axes[0].set_title("average of the runs" if two else f"average of {len(next(iter(data.values())))} runs per setting")
         if two:
@@ -212,21 +216,21 @@ class _Evolution(_Section):
             runs = self.runs(v["key"])
             if not runs:
                 continue
-            champ = [-float(r["champion_return"]) for _, r in runs]
+            champ = [-float(r.champion_return) for r in runs]
             finals = self.final_scores(runs)
-            validated = "validation" in runs[0][1]
+            validated = runs[0].validation is not None
             samples[v["key"]], labels[v["key"]] = finals, v["label"]
             stops = {}
-            for _, r in runs:
-                stops[r["stop_reason"]] = stops.get(r["stop_reason"], 0) + 1
+            for r in runs:
+                stops[r.stop_reason] = stops.get(r.stop_reason, 0) + 1
             rows.append([v["label"], str(len(runs)), fmt(np.mean(champ)), fmt(np.median(champ)), fmt(np.min(champ)),
                          fmt(-np.mean(finals)) if validated else "n/a", fmt(_sd(finals)) if validated else "n/a",
-                         fmt(np.mean([r["episodes"] for _, r in runs])),
-                         fmt(np.mean([r["timing"]["seconds"] for _, r in runs])),
+                         fmt(np.mean([r.episodes for r in runs])),
+                         fmt(np.mean([r.timing.seconds for r in runs])),
                          ", ".join(f"{k} {n}" for k, n in sorted(stops.items())),
                          # stores written before the flag was recorded have no answer
-                         str(sum(bool(r["champion_crashed"]) for _, r in runs))
-                         if all("champion_crashed" in r for _, r in runs) else "n/a"])
+                         str(sum(bool(r.champion_crashed) for r in runs))
+                         if all(r.champion_crashed is not None for r in runs) else "n/a"])
         what = ("mean return of the final champion on fresh validation episodes" if validated
                 else "final champion return")
         parts.append("### Final champions\n\n" + _table(
@@ -249,14 +253,14 @@ class _Evolution(_Section):
         ref = self.paper.get("table3", {})
         for vkey in self.s["robustness_variants"]:
             label = next(v["label"] for v in self.variants() if v["key"] == vkey)
-            units = [r for k, r in sorted(self.results.items()) if k.startswith(f"robust/{vkey}/")]
+            units: list[RobustnessResult] = self.group("robust", vkey)
             if not units:
                 continue
-            own = [float(np.mean([float(x) for x in u["returns"][u["own"]]])) for u in units]
-            across = [float(np.mean([float(x) for row in u["returns"] for x in row])) for u in units]
-            crashes_own = sum(u["crashes"][u["own"]] for u in units)
-            crashes_all = sum(sum(u["crashes"]) for u in units)
-            episodes = sum(len(row) for u in units for row in u["returns"])
+            own = [float(np.mean([float(x) for x in u.returns[u.own]])) for u in units]
+            across = [float(np.mean([float(x) for row in u.returns for x in row])) for u in units]
+            crashes_own = sum(u.crashes[u.own] for u in units)
+            crashes_all = sum(sum(u.crashes) for u in units)
+            episodes = sum(len(row) for u in units for row in u.returns)
             p = ref.get(vkey, {})
             rows.append([label, str(len(units)), fmt(np.mean(own)), fmt(_sd(own)), fmt(p.get("r")), fmt(p.get("sd")),
                          fmt(np.mean(across)), fmt(_sd(across)), fmt(p.get("r_G")), fmt(p.get("sd_G")),
@@ -278,13 +282,13 @@ class _Evolution(_Section):
 
 class _ModelLearning(_Section):
     def figure(self) -> str | None:
-        data = {m: [r for k, r in self.results.items() if k.startswith(f"model/{m}/")] for m in self.s["methods"]}
+        data: dict[str, list[ModelResult]] = {m: self.group("model", m) for m in self.s["methods"]}
         data = {m: v for m, v in data.items() if v}
         if not data:
             return None
         fig, axes = _figure(figsize=(6.5, 4))
         ax = axes[0, 0]
-        errors = [np.maximum(-np.array([float(r["test_mean"]) for r in v]), 1e-3) for v in data.values()]
+        errors = [np.maximum(-np.array([float(r.test_mean) for r in v]), 1e-3) for v in data.values()]
         ax.boxplot(errors)
         ax.set_xticks(range(1, len(data) + 1), [m.upper() for m in data])
         ax.set_yscale("log")
@@ -298,13 +302,13 @@ class _ModelLearning(_Section):
         rows = []
         means = {}
         for m in self.s["methods"]:
-            units = [r for k, r in sorted(self.results.items()) if k.startswith(f"model/{m}/")]
+            units: list[ModelResult] = self.group("model", m)
             if not units:
                 continue
-            r = np.array([float(u["test_mean"]) for u in units])
-            t = np.array([u["timing"]["learn_seconds"] for u in units])
-            crashes = sum(u["test_crashes"] for u in units)
-            episodes = sum(len(u["test_returns"]) for u in units)
+            r = np.array([float(u.test_mean) for u in units])
+            t = np.array([u.timing.learn_seconds for u in units])
+            crashes = sum(u.test_crashes for u in units)
+            episodes = sum(len(u.test_returns) for u in units)
             p = ref.get(m, {})
             means[m] = r.mean()
             rows.append([m.upper(), str(len(units)), fmt(t.mean()), fmt(p.get("t")), fmt(np.median(r)), fmt(p.get("r_m")),
@@ -329,8 +333,8 @@ class _TestRuns(_Section):
     def groups(self) -> list[dict]:
         return self.s["groups"]
 
-    def runs(self, label: str) -> list[dict]:
-        return [r for k, r in sorted(self.results.items()) if k.startswith(f"run/{label}/")]
+    def runs(self, label: str) -> list[TestRunResult]:
+        return self.group("run", label)
 
     def figure(self) -> str | None:
         data = {g["label"]: self.runs(g["label"]) for g in self.groups()}
@@ -340,7 +344,7 @@ class _TestRuns(_Section):
         fig, axes = _figure(2, figsize=(11, 4.2))
         axes = axes[0]
         for label, runs in data.items():
-            cum = -np.cumsum(np.array([[float(x) for x in r["returns"]] for r in runs]), axis=1).mean(axis=0)
+            cum = -np.cumsum(np.array([[float(x) for x in r.returns] for r in runs]), axis=1).mean(axis=0)
             episodes = np.arange(1, cum.size + 1)
             for ax in axes:
                 ax.plot(episodes, cum, label=f"{label} ({len(runs)} runs)")
@@ -362,21 +366,21 @@ class _TestRuns(_Section):
             runs = self.runs(label)
             if not runs:
                 continue
-            scores = np.array([float(r["score"]) for r in runs])
-            crashed = [r for r in runs if r["crash_episodes"]]
-            clean = [r for r in runs if not r["crash_episodes"]]
-            per_episode_clean = float(np.mean([float(x) for r in clean for x in r["returns"]])) if clean else float("nan")
+            scores = np.array([float(r.score) for r in runs])
+            crashed = [r for r in runs if r.crash_episodes]
+            clean = [r for r in runs if not r.crash_episodes]
+            per_episode_clean = float(np.mean([float(x) for r in clean for x in r.returns])) if clean else float("nan")
             crash_rate = len(crashed) / len(runs)
             samples[label], labels[label] = scores.tolist(), label
             p = ref.get(label, {})
             rows.append([label, str(len(runs)), fmt(scores.mean()), fmt(_sd(scores)), f"{len(crashed)} ({crash_rate:.1%})",
-                         str(sum(len(r["crash_episodes"]) for r in runs)),
+                         str(sum(len(r.crash_episodes) for r in runs)),
                          f"{p['crash_rate']:.2%}" if "crash_rate" in p else "n/a", fmt(per_episode_clean),
                          fmt(p.get("return_per_episode_no_crash")),
-                         fmt(np.mean([float(r["mean_return_after_learning"]) for r in runs])),
-                         fmt(np.mean([r["learning_episodes"] for r in runs])),
-                         str(sum(len(r["safeguard_episodes"]) for r in runs)),
-                         fmt(np.mean([r["timing"]["seconds"] for r in runs]))])
+                         fmt(np.mean([float(r.mean_return_after_learning) for r in runs])),
+                         fmt(np.mean([r.learning_episodes for r in runs])),
+                         str(sum(len(r.safeguard_episodes) for r in runs)),
+                         fmt(np.mean([r.timing.seconds for r in runs]))])
             if p:
                 line = f"{label}: our crash rate {crash_rate:.1%} of {len(runs)} runs"
                 if "crash_rate" in p:
@@ -403,12 +407,12 @@ _SETTING_KEYS = ("task", "sigma", "target", "n_mdps", "runs", "episodes", "n_ste
                  "generic_budget", "generics_per_agent", "model_budget", "validation_episodes", "test_episodes", "policies", "generic")
 
 
-def _header(cfg: ExperimentConfig, store: Store, done: int, total: int | None) -> str:
+def _header(cfg: ExperimentConfig, store: Store, units: list[dict], total: int | None) -> str:
+    done = len(units)
     sessions = store.sessions(cfg.name, cfg.scale)
     wall = sum(s["wall_seconds"] for s in sessions)
     cores = sorted({s["cores"] for s in sessions})
     executors = sorted({s["executor"] for s in sessions})
-    units = store.units(cfg.name, cfg.scale)
     unit_seconds = sum(u["seconds"] for u in units)
     settings = ", ".join(f"{k} = {cfg.settings[k]}" for k in _SETTING_KEYS if cfg.settings.get(k) not in (None, ""))
     if cfg.kind == "test_runs":
@@ -425,13 +429,14 @@ def _header(cfg: ExperimentConfig, store: Store, done: int, total: int | None) -
 def _section(cfg: ExperimentConfig, store: Store, out: Path) -> str:
     from .plans import plan
 
-    results = store.results(cfg.name, cfg.scale)
+    units = store.units(cfg.name, cfg.scale)
     try:
-        total = plan(cfg, results).total
+        total = plan(cfg, {u["key"]: u["result"] for u in units}).total
     except NeurohoverError:
         total = None
+    results = {u["key"]: result_from_dict(u["kind"], u["result"], u["key"]) for u in units}
     sec = _SECTIONS[cfg.kind](cfg, results, store, out)
-    text = [f"## {cfg.title} [{cfg.scale}]\n", _header(cfg, store, len(results), total)]
+    text = [f"## {cfg.title} [{cfg.scale}]\n", _header(cfg, store, units, total)]
     figure = sec.figure()
     if figure:
         text.append(f"![{cfg.title}]({figure})\n")
