@@ -16,7 +16,7 @@ import numpy as np
 from .errors import NeurohoverError
 
 # Modules of later pipeline stages; each has ``register(subparsers)`` adding its commands.
-COMMAND_MODULES: tuple[str, ...] = ("neurohover.commands_learning", "neurohover.commands_agents", "neurohover.commands_reproduce")
+COMMAND_MODULES: tuple[str, ...] = ("neurohover.commands_learning", "neurohover.commands_agents", "neurohover.commands_reproduce", "neurohover.commands_plots")
 
 
 def _floats(text: str, what: str) -> list[float]:

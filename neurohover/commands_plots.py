@@ -1,0 +1,64 @@
+"""``neurohover plot``: PNG plots of recorded flights and of competition results.
+
+``neurohover plot FLIGHT.npz [--out DIR]`` draws each episode of a flight-data file (written by
+``neurohover fly --record``) to ``DIR/<name>-episode<i>.png``: position error, velocity, attitude
+(roll, pitch, yaw), angular rates and actions over time, a crash (an episode shorter than 6000
+steps) marked in red. ``DIR`` defaults to the file's directory.
+
+``neurohover plot --compete DIR [DIR ...] [--out OUTDIR]`` overlays the mean cumulative error of
+several ``neurohover compete --out DIR`` results (their ``episodes.csv``; agent and task from
+``summary.json``) on one figure, linear and log scale, written to ``OUTDIR/compete.png``;
+``OUTDIR`` defaults to the directory holding the first DIR.
+
+The files written are printed, one per line.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from .errors import NeurohoverError
+
+COMPETE_PNG = "compete.png"
+
+
+def cmd_plot(args: argparse.Namespace) -> int:
+    """Plot a recorded flight (one PNG per episode) or overlay competition results (one PNG)."""
+    from .paths import input_dir, input_file, output_dir
+
+    if args.flight is not None and args.compete:
+        raise NeurohoverError("give either a flight-data file or --compete DIR ..., not both")
+    if args.flight is None and not args.compete:
+        raise NeurohoverError("nothing to plot: give a flight-data file (neurohover fly --record) or --compete DIR ...")
+    if args.flight is not None:
+        from .flightdata import FlightData
+
+        path = input_file(args.flight, "FLIGHT", "flight-data file")
+        data = FlightData.load(path)  # refuses anything but flight data, with the reason
+        out = output_dir(args.out if args.out is not None else path.parent, "--out")
+        from .plots import plot_flight_data
+
+        written = plot_flight_data(data, out, stem=path.stem)
+    else:
+        dirs = [input_dir(d, "--compete") for d in args.compete]
+        from .plots import compete_figure, read_compete_dir, save_figure
+
+        results = [read_compete_dir(d) for d in dirs]  # every directory read before anything is written
+        out = output_dir(args.out if args.out is not None else dirs[0].resolve().parent, "--out")
+        written = [save_figure(compete_figure(results), out / COMPETE_PNG)]
+    for p in written:
+        print(p)
+    return 0
+
+
+def register(sub) -> None:
+    p = sub.add_parser("plot", help="plot recorded flights (fly --record) or overlay competition results (compete --out)",
+                       description=(cmd_plot.__doc__ or "") + "\n\n" + __doc__.split("\n\n", 1)[1],
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("flight", nargs="?", metavar="FLIGHT.npz", help="flight data written by neurohover fly --record")
+    p.add_argument("--compete", nargs="+", metavar="DIR", help="directories written by neurohover compete --out, overlaid on one figure")
+    p.add_argument("--out", metavar="DIR", help="directory for the PNG files (default: beside the input)")
+    p.set_defaults(func=cmd_plot)
+
+
+__all__ = ["cmd_plot", "register"]

@@ -1,0 +1,299 @@
+"""Plots of flights and competitions, drawn with matplotlib's object-oriented API.
+
+- :func:`flight_figure`: one episode of flight data (``neurohover fly --record``) over time:
+  position error, velocity, attitude (roll, pitch, yaw), angular rates and actions, a crash marked.
+- :func:`compete_figure`: several ``neurohover compete --out DIR`` results overlaid, mean
+  cumulative error per episode on a linear and a log scale (the paper's Figures 4 and 7).
+
+Every figure is a :class:`matplotlib.figure.Figure` on its own
+:class:`~matplotlib.backends.backend_agg.FigureCanvasAgg`: nothing here touches pyplot or the
+process's matplotlib backend, so plotting is safe in any program (and thread) that uses matplotlib
+otherwise. ``neurohover plot`` (:mod:`neurohover.commands_plots`) calls :func:`plot_flight_data`
+and :func:`plot_compete`.
+
+Example
+-------
+>>> from neurohover.flightdata import FlightData
+>>> from neurohover.plots import plot_flight_data
+>>> paths = plot_flight_data(FlightData.load("flight.npz"), "plots/")  # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
+
+from .errors import NeurohoverError
+from .flightdata import FlightData
+from .sim.constants import ACTION_NAMES, CONTROL_DT, EPISODE_STEPS
+
+__all__ = [
+    "CompeteResult", "attitude_angles", "compete_figure", "crashed_episode", "flight_figure",
+    "plot_compete", "plot_flight_data", "read_compete_dir", "save_figure",
+]
+
+CRASH_COLOR = "tab:red"
+COMPETE_FILE = "episodes.csv"
+COMPETE_SUMMARY = "summary.json"
+COMPETE_COLUMNS = ("run", "episode", "return")  # the columns of compete's episodes.csv read here
+
+
+def new_figure(width: float, height: float, dpi: int = 100) -> Figure:
+    """A figure with its own Agg canvas (no pyplot)."""
+    fig = Figure(figsize=(width, height), dpi=dpi)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def save_figure(fig: Figure, path: str | Path) -> Path:
+    """Write ``fig`` as a PNG to ``path`` (parent directories must exist)."""
+    path = Path(path)
+    fig.savefig(path, format="png")
+    return path
+
+
+# -- flight data ------------------------------------------------------------------------------
+
+
+def attitude_angles(observations: np.ndarray) -> np.ndarray:
+    """Roll, pitch and yaw (degrees, Z-Y-X Euler angles) of each observation's quaternion.
+
+    Parameters
+    ----------
+    observations : (T, 12) array
+        Observations; entries 9-11 are the quaternion's vector part, its scalar part qw is
+        ``sqrt(1 - |q|^2)`` (positive: a helicopter more than 30 degrees from level has crashed).
+
+    Returns
+    -------
+    (T, 3) array
+        Roll, pitch, yaw in degrees.
+    """
+    q = np.asarray(observations, dtype=np.float64)[:, 9:12]
+    qx, qy, qz = q[:, 0], q[:, 1], q[:, 2]
+    qw = np.sqrt(np.clip(1.0 - (qx * qx + qy * qy + qz * qz), 0.0, 1.0))
+    roll = np.arctan2(2.0 * (qw * qx + qy * qz), 1.0 - 2.0 * (qx * qx + qy * qy))
+    pitch = np.arcsin(np.clip(2.0 * (qw * qy - qz * qx), -1.0, 1.0))
+    yaw = np.arctan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
+    return np.degrees(np.stack([roll, pitch, yaw], axis=1))
+
+
+def crashed_episode(actions: np.ndarray, episode_steps: int = EPISODE_STEPS) -> bool:
+    """Whether an episode of ``actions`` crashed: it ended before ``episode_steps`` control steps."""
+    return len(actions) < episode_steps
+
+
+def flight_figure(
+    observations: np.ndarray,
+    actions: np.ndarray,
+    *,
+    title: str = "",
+    crashed: bool | None = None,
+    episode_steps: int = EPISODE_STEPS,
+) -> Figure:
+    """One episode over time: position error, velocity, attitude, rates and actions.
+
+    Parameters
+    ----------
+    observations : (T + 1, 12) array
+        The episode's observations (the first one before the first action).
+    actions : (T, 4) array
+        The actions applied (aileron, elevator, rudder, collective).
+    title : str
+        Figure title.
+    crashed : bool, optional
+        Whether the episode crashed; by default, whether it is shorter than ``episode_steps``.
+        A crash is marked by a red line at its time on every panel.
+    episode_steps : int
+        Control steps of a full episode (6000).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Five panels sharing the time axis (seconds at 10 Hz).
+    """
+    obs = np.asarray(observations, dtype=np.float64)
+    act = np.asarray(actions, dtype=np.float64)
+    if crashed is None:
+        crashed = crashed_episode(act, episode_steps)
+    t_obs = np.arange(obs.shape[0]) * CONTROL_DT
+    t_act = np.arange(act.shape[0]) * CONTROL_DT
+    fig = new_figure(10.0, 11.0)
+    axes = fig.subplots(5, 1, sharex=True)
+    panels = [
+        ("position error (m, body)", t_obs, obs[:, 3:6], ("x", "y", "z")),
+        ("velocity (m/s, body)", t_obs, obs[:, 0:3], ("u", "v", "w")),
+        ("attitude (deg)", t_obs, attitude_angles(obs), ("roll", "pitch", "yaw")),
+        ("angular rate (rad/s)", t_obs, obs[:, 6:9], ("p", "q", "r")),
+        ("action", t_act, act, ACTION_NAMES),
+    ]
+    for ax, (label, t, values, names) in zip(axes, panels, strict=True):
+        for j, name in enumerate(names):
+            ax.plot(t, values[:, j], lw=0.8, label=name)
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+        ax.legend(loc="upper right", fontsize=8, ncol=len(names))
+        if crashed:
+            ax.axvline(t_obs[-1], color=CRASH_COLOR, ls="--", lw=1.2)
+    axes[-1].set_ylim(-1.05, 1.05)
+    axes[-1].set_xlabel("time (s)")
+    end = f"crashed at {t_obs[-1]:.1f} s (step {act.shape[0]})" if crashed else f"{act.shape[0]} steps, no crash"
+    fig.suptitle(f"{title}\n{end}" if title else end, color=CRASH_COLOR if crashed else "black")
+    fig.tight_layout()
+    return fig
+
+
+def _episode_title(data: FlightData, i: int, stem: str) -> str:
+    """'stem: episode i, MDP label, return R, policy P', from what the metadata holds."""
+    meta = data.metadata if isinstance(data.metadata, dict) else {}
+    parts = [f"{stem}: episode {i}"]
+    mdps = meta.get("mdps")
+    if isinstance(mdps, list) and i < len(mdps) and isinstance(mdps[i], dict) and mdps[i].get("label"):
+        parts.append(str(mdps[i]["label"]))
+    returns = meta.get("returns")
+    if isinstance(returns, list) and i < len(returns) and isinstance(returns[i], (int, float)):
+        parts.append(f"return {returns[i]:.6g}")
+    if meta.get("policy"):
+        parts.append(f"policy {meta['policy']}")
+    return ", ".join(parts)
+
+
+def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight") -> list[Path]:
+    """One PNG per episode of ``data`` (:func:`flight_figure`), ``<stem>-episode<i>.png`` in ``out_dir``.
+
+    Titles take the MDP label, return and policy from the metadata that ``neurohover fly
+    --record`` writes (``mdps``, ``returns``, ``policy``); ``episode_steps`` in the metadata, if
+    present, sets the length of a full episode (default 6000).
+
+    Returns
+    -------
+    list of Path
+        The files written, in episode order.
+    """
+    out_dir = Path(out_dir)
+    steps = data.metadata.get("episode_steps", EPISODE_STEPS) if isinstance(data.metadata, dict) else EPISODE_STEPS
+    width = len(str(max(data.n_episodes - 1, 0)))
+    paths = []
+    for i, (obs, act) in enumerate(zip(data.observations, data.actions, strict=True)):
+        fig = flight_figure(obs, act, title=_episode_title(data, i, stem), episode_steps=int(steps))
+        paths.append(save_figure(fig, out_dir / f"{stem}-episode{i:0{width}d}.png"))
+    return paths
+
+
+# -- competitions -----------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class CompeteResult:
+    """The returns of one ``neurohover compete --out DIR``.
+
+    Attributes
+    ----------
+    label : str
+        Legend label: agent and task from ``summary.json`` (else the directory's name).
+    returns : (runs, episodes) array
+        Return of each episode of each run (runs cut to the shortest, should they differ).
+    crashes : int
+        Crashed episodes over all runs (the ``crashed`` column, where present).
+    path : Path
+        The directory.
+    """
+
+    label: str
+    returns: np.ndarray
+    crashes: int
+    path: Path
+
+    @property
+    def cumulative_error(self) -> np.ndarray:
+        """Mean over runs of the cumulative error (minus the cumulative return) after each episode."""
+        return -np.cumsum(self.returns, axis=1).mean(axis=0)
+
+
+def read_compete_dir(path: str | Path) -> CompeteResult:
+    """Read ``episodes.csv`` (and ``summary.json``, for the label) of a compete output directory.
+
+    Raises
+    ------
+    NeurohoverError
+        If the directory has no ``episodes.csv`` or it is not one compete wrote.
+    """
+    path = Path(path)
+    csv_path = path / COMPETE_FILE
+    if not csv_path.is_file():
+        raise NeurohoverError(f"--compete {str(path)!r} holds no {COMPETE_FILE}: give directories written by neurohover compete --out")
+    runs: dict[int, list[tuple[int, float]]] = {}
+    crashes = 0
+    try:
+        with open(csv_path, newline="") as f:
+            reader = csv.DictReader(f)
+            missing = [c for c in COMPETE_COLUMNS if c not in (reader.fieldnames or [])]
+            if missing:
+                raise NeurohoverError(f"--compete {str(csv_path)!r} is not a compete episodes file: no column {', '.join(missing)}")
+            for line, row in enumerate(reader, start=2):
+                try:
+                    run, episode, ret = int(row["run"]), int(row["episode"]), float(row["return"])
+                    crashes += int(row.get("crashed") or 0)
+                except (TypeError, ValueError):
+                    raise NeurohoverError(f"--compete {str(csv_path)!r}, line {line}: run, episode and return must be numbers") from None
+                if not math.isfinite(ret):
+                    raise NeurohoverError(f"--compete {str(csv_path)!r}, line {line}: return {row['return']!r} is not finite")
+                runs.setdefault(run, []).append((episode, ret))
+    except (OSError, UnicodeDecodeError, csv.Error) as err:
+        raise NeurohoverError(f"--compete {str(csv_path)!r}: cannot read it ({err})") from None
+    if not runs:
+        raise NeurohoverError(f"--compete {str(csv_path)!r} holds no episodes")
+    n = min(len(rows) for rows in runs.values())
+    returns = np.array([[r for _, r in sorted(rows)[:n]] for _, rows in sorted(runs.items())])
+    label = path.resolve().name
+    try:
+        summary = json.loads((path / COMPETE_SUMMARY).read_text())
+        if isinstance(summary, dict) and summary.get("agent"):
+            label = f"{summary['agent']} ({summary.get('task', '?')})"
+    except (OSError, ValueError):
+        pass  # no summary (an interrupted competition): the directory's name labels it
+    return CompeteResult(label, returns, crashes, path)
+
+
+def compete_figure(results: Sequence[CompeteResult], title: str = "") -> Figure:
+    """Mean cumulative error per episode of each result, linear (left) and log scale (right).
+
+    Each axes holds exactly one line per result, in order; a legend names each with its runs
+    and crashes.
+    """
+    fig = new_figure(11.0, 4.5)
+    axes = fig.subplots(1, 2)
+    labels = [r.label for r in results]
+    for r in results:
+        name = r.label if labels.count(r.label) == 1 else f"{r.label} [{r.path.name}]"  # same agent twice
+        error = r.cumulative_error
+        episodes = np.arange(1, error.size + 1)
+        for ax in axes:
+            ax.plot(episodes, error, label=f"{name}: {r.returns.shape[0]} runs, {r.crashes} crashes")
+    axes[0].set_ylabel("cumulative error (-cumulative reward)")
+    axes[1].set_yscale("log")
+    axes[1].set_ylabel("cumulative error (log scale)")
+    for ax in axes:
+        ax.set_xlabel("episode")
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.suptitle(title or "mean cumulative error over runs")
+    fig.tight_layout()
+    return fig
+
+
+def plot_compete(dirs: Sequence[str | Path], out: str | Path) -> tuple[Path, Figure]:
+    """Overlay the compete results in ``dirs`` (:func:`compete_figure`) and write the PNG ``out``."""
+    results = [read_compete_dir(d) for d in dirs]
+    fig = compete_figure(results)
+    return save_figure(fig, out), fig
