@@ -275,8 +275,9 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
     A frame shows a top view (east right, north up) and a side view seen from the east (north
     right, altitude up) of the hover target (green cross, the origin), the helicopter rotated by
     its attitude (blue rotor disk, orange nose) and its track over the last 10 s; a compass with
-    the MDP's current world wind (full radius 5 m/s); and a text line with the MDP label, step and
-    return so far. The views span 5 m either way, widening to 10 m and then to the crash box.
+    the MDP's current world wind (full radius 5 m/s), drawn as the way the air moves: the drag acts
+    on velocity + W, so a wind parameter W pushes the helicopter along -W, and the arrow is -W;
+    and a text line with the MDP label, step and return so far. The views span 5 m either way, widening to 10 m and then to the crash box.
     In ``"human"`` mode ``reset`` and ``step`` show each frame themselves; the window opens at the
     first frame, and without a display the frames are drawn and dropped (with one warning). Both
     modes work with Gymnasium's ``RecordVideo`` (``"rgb_array"``; it needs moviepy). Rendering

@@ -13,7 +13,9 @@ Frames (world frame north-east-down, metres):
 
 - top view: east (y) to the right, north (x) up;
 - side view, seen from the east: north (x) to the right, altitude (-z) up;
-- wind compass: the world wind (m/s) as an arrow, north up, a full radius being 5 m/s.
+- wind compass: where the air moves, north up, a full radius being 5 m/s. The simulator's drag
+  acts on ``body velocity + W`` for the MDP's world wind ``W`` (docs/model.md, Simulator), so
+  ``W`` pushes the helicopter along ``-W``: the arrow is ``-W``, the way the helicopter drifts.
 
 Both views show the same square window around the target: 5 m either way, zooming out to 10 m
 and then to the crash box (20 m) when the helicopter leaves it.
@@ -119,7 +121,7 @@ class HoverRenderer:
         w.set_aspect("equal")
         w.set_xticks([])
         w.set_yticks([])
-        w.set_title("wind", fontsize=9)
+        w.set_title("wind (air moves)", fontsize=9)
         w.add_patch(Circle((0.0, 0.0), 1.0, fill=False, lw=0.8, color="0.5"))
         w.text(0.0, 1.02, "N", ha="center", va="bottom", fontsize=7)
         w.text(1.02, 0.0, "E", ha="left", va="center", fontsize=7)
@@ -164,7 +166,8 @@ class HoverRenderer:
         state : sequence of 13 floats
             World state: velocity (3), position (3), body rates (3), quaternion (qx, qy, qz, qw).
         wind : sequence of 2 or 3 floats
-            World wind (m/s): north, east (and down, ignored).
+            The MDP's world wind ``W`` (m/s): north, east (and down, ignored); the compass shows
+            the air's motion ``-W`` (see the module docstring).
         text : str
             The line drawn above the views.
         trail : (n, 3) array, optional
@@ -187,13 +190,13 @@ class HoverRenderer:
             for artist, points in zip(parts, shapes, strict=True):
                 artist.set_data(*project(points))
 
-        north, east = float(wind[0]), float(wind[1])
+        north, east = -float(wind[0]), -float(wind[1])  # the air moves along -W
         speed = math.hypot(north, east)
         if self._arrow is not None:
             self._arrow.remove()
             self._arrow = None
         if speed > 1e-9:
-            # Arrow along the wind vector, its length proportional to the speed (capped at the rim).
+            # Arrow along the air's motion, its length proportional to the speed (capped at the rim).
             scale = min(speed / WIND_FULL_SCALE, 1.0) / speed
             dx, dy = east * scale, north * scale
             self._arrow = self._arrow_kind(0.0, 0.0, dx, dy, width=0.06, head_width=0.22,
