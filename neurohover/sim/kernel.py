@@ -175,11 +175,17 @@ def _half_angle_quaternion(rx, ry, rz):
     return k * rx, k * ry, k * rz, math.cos(0.5 * theta)
 
 
+@nb.njit(cache=True, inline="always", fastmath=False)
+def _product(a, b):
+    """``a * b`` rounded on its own, never fused into an FMA (the CUDA build maps it to ``dmul_rn``)."""
+    return a * b
+
+
 @nb.njit(cache=True, fastmath=False)  # explicit: callees inherit fastmath, and an FMA rounds differently
 def competition_time(step, substep):
     """Time (s) of a substep as the competition software computed it: ``int(t*100)/100.0`` with
     ``t = 0.1*step + 0.01*substep`` in floating point (about 4% of substeps land 0.01 s early)."""
-    t = 0.1 * step + 0.01 * substep
+    t = _product(0.1, step) + _product(0.01, substep)
     return int(t * 100.0) / 100.0
 
 
@@ -284,6 +290,68 @@ def _record(obs_out, act_out, slot, k, o, a1, a2, a3, a4):
     act_out[slot, k, 3] = a4
 
 
+@nb.njit(cache=True, inline="always", fastmath={"contract"})
+def fly_job(
+    j, rng, mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, job_fallback, seed,
+    n_steps, safeguard, limits, record_slot, obs_out, act_out,
+    out_return, out_crashed, out_steps, out_safeguard_step,
+):
+    """Fly job ``j`` of :func:`rollout_batch` with ``rng`` (4 uint64) as its stream's state.
+
+    The whole episode of one job, shared by the CPU kernel (one prange iteration) and the CUDA
+    kernel (one thread, :mod:`neurohover.sim.cuda`), so both targets compile this source.
+    """
+    seed_stream(rng, np.uint64(seed), np.uint64(job_episode[j]))
+    dyn, std, n_sub, dt, wind = unpack_mdp(mdp_rows[job_mdp[j]])
+    pol = job_policy[j]
+    kind = policy_kinds[pol]
+    g = genomes[pol]
+    fb = job_fallback[j]
+    slot = record_slot[j]
+    s = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)
+    n = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    o = observe(s)
+    total = 0.0
+    crash = False
+    sg_step = -1
+    t = 0
+    for k in range(n_steps):
+        if safeguard and fb >= 0 and sg_step < 0 and dangerous(o, limits):
+            sg_step = k
+            kind = policy_kinds[fb]
+            g = genomes[fb]
+        a1, a2, a3, a4 = policy_action(kind, g, o[0], o[1], o[2], o[3], o[4], o[5], o[9], o[10], o[11])
+        t = k + 1
+        if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
+            if slot >= 0:
+                _record(obs_out, act_out, slot, k, o, a1, a2, a3, a4)
+            crash = True
+            total += -CRASH_STEP_PENALTY * (n_steps - t)
+            break
+        a1 = _clip(a1)
+        a2 = _clip(a2)
+        a3 = _clip(a3)
+        a4 = _clip(a4)
+        if slot >= 0:
+            _record(obs_out, act_out, slot, k, o, a1, a2, a3, a4)
+        n = update_noise(n, std, next_normal(rng), next_normal(rng), next_normal(rng),
+                         next_normal(rng), next_normal(rng), next_normal(rng))
+        s = integrate(s, n, a1, a2, a3, a4, k, dyn, n_sub, dt, wind)
+        o = observe(s)
+        if crashed(s):
+            crash = True
+            total += -CRASH_STEP_PENALTY * (n_steps - t)
+            break
+        total += reward_of(o)
+    if slot >= 0:
+        for i in range(12):
+            obs_out[slot, t, i] = o[i]
+    out_return[j] = total
+    out_crashed[j] = crash
+    out_steps[j] = t
+    out_safeguard_step[j] = sg_step
+
+
 @nb.njit(cache=True, parallel=True, fastmath={"contract"})
 def rollout_batch(
     mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, job_fallback, seed,
@@ -300,56 +368,9 @@ def rollout_batch(
     n_jobs = job_policy.shape[0]
     for j in nb.prange(n_jobs):
         rng = np.empty(4, dtype=np.uint64)
-        seed_stream(rng, np.uint64(seed), np.uint64(job_episode[j]))
-        dyn, std, n_sub, dt, wind = unpack_mdp(mdp_rows[job_mdp[j]])
-        pol = job_policy[j]
-        kind = policy_kinds[pol]
-        g = genomes[pol]
-        fb = job_fallback[j]
-        slot = record_slot[j]
-        s = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)
-        n = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-        o = observe(s)
-        total = 0.0
-        crash = False
-        sg_step = -1
-        t = 0
-        for k in range(n_steps):
-            if safeguard and fb >= 0 and sg_step < 0 and dangerous(o, limits):
-                sg_step = k
-                kind = policy_kinds[fb]
-                g = genomes[fb]
-            a1, a2, a3, a4 = policy_action(kind, g, o[0], o[1], o[2], o[3], o[4], o[5], o[9], o[10], o[11])
-            t = k + 1
-            if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
-                if slot >= 0:
-                    _record(obs_out, act_out, slot, k, o, a1, a2, a3, a4)
-                crash = True
-                total += -CRASH_STEP_PENALTY * (n_steps - t)
-                break
-            a1 = _clip(a1)
-            a2 = _clip(a2)
-            a3 = _clip(a3)
-            a4 = _clip(a4)
-            if slot >= 0:
-                _record(obs_out, act_out, slot, k, o, a1, a2, a3, a4)
-            n = update_noise(n, std, next_normal(rng), next_normal(rng), next_normal(rng),
-                             next_normal(rng), next_normal(rng), next_normal(rng))
-            s = integrate(s, n, a1, a2, a3, a4, k, dyn, n_sub, dt, wind)
-            o = observe(s)
-            if crashed(s):
-                crash = True
-                total += -CRASH_STEP_PENALTY * (n_steps - t)
-                break
-            total += reward_of(o)
-        if slot >= 0:
-            for i in range(12):
-                obs_out[slot, t, i] = o[i]
-        out_return[j] = total
-        out_crashed[j] = crash
-        out_steps[j] = t
-        out_safeguard_step[j] = sg_step
-
+        fly_job(j, rng, mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, job_fallback, seed,
+                n_steps, safeguard, limits, record_slot, obs_out, act_out,
+                out_return, out_crashed, out_steps, out_safeguard_step)
 
 
 @nb.njit(cache=True, fastmath={"contract"})
