@@ -177,6 +177,7 @@ def evaluate_jobs(
     record=None,
     n_steps: int = EPISODE_STEPS,
     threads: int | None = None,
+    device: str = "cpu",
 ) -> Evaluation:
     """Fly the jobs ``(policy_index[j], mdp_index[j], episode_index[j])`` in parallel.
 
@@ -199,8 +200,21 @@ def evaluate_jobs(
     n_steps : int
         Control steps per episode (6000 in the benchmark).
     threads : int, optional
-        Kernel threads (default: all cores). Results do not depend on it.
+        Kernel threads (default: all cores). Results do not depend on it. Unused on ``"cuda"``.
+    device : {"cpu", "cuda"}
+        Where the kernel runs: the CPU kernel, or the CUDA build of the same source on a GPU
+        (one thread per job, the same gust streams; returns agree with the CPU's to about 1e-12
+        relative, see docs/gpu.md). ``seconds`` then includes the copies to and from the GPU.
     """
+    if device not in ("cpu", "cuda"):
+        raise NeurohoverError(f"device={device!r} is unknown: allowed 'cpu' or 'cuda'")
+    if device == "cuda":
+        from .sim import cuda as sim_cuda  # numba.cuda is imported only when asked for
+
+        problem = sim_cuda.cuda_problem()
+        if problem is not None:
+            raise NeurohoverError(f"device='cuda' cannot run here: {problem}. It needs an NVIDIA GPU with its driver and "
+                                  "pip install 'neurohover[cuda]' (numba-cuda); NUMBA_ENABLE_CUDASIM=1 runs numba's CUDA simulator instead")
     table = policies if isinstance(policies, PolicyTable) else PolicyTable.from_policies(policies)
     rows = mdp_rows(mdps)
     if not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= _MAX_SEED:
@@ -233,10 +247,15 @@ def evaluate_jobs(
     crashed = np.empty(n_jobs, dtype=np.bool_)
     steps = np.empty(n_jobs, dtype=np.int64)
     sg_step = np.empty(n_jobs, dtype=np.int64)
-    _load_kernel()
+    if device == "cuda":
+        sim_cuda.load_kernel()
+        rollout = sim_cuda.rollout_batch_cuda
+    else:
+        _load_kernel()
+        rollout = rollout_batch
     start = time.perf_counter()
     with num_threads(threads):
-        rollout_batch(
+        rollout(
             rows, table.kinds, table.genomes, p_idx, m_idx, e_idx, fb, np.uint64(seed), n_steps,
             bool((fb >= 0).any()), limits, slots, obs_out, act_out, returns, crashed, steps, sg_step,
         )
@@ -262,11 +281,12 @@ def evaluate(
     safeguard: "Safeguard | None" = None,
     n_steps: int = EPISODE_STEPS,
     threads: int | None = None,
+    device: str = "cpu",
 ) -> Evaluation:
     """Fly every policy on every MDP for ``episodes`` episodes; arrays are shaped (P, M, E).
 
     Episode e on MDP m has episode index ``first_episode + m * episodes + e`` for every policy,
-    so all policies meet the same gusts.
+    so all policies meet the same gusts. ``device="cuda"`` flies them on a GPU (:func:`evaluate_jobs`).
     """
     if isinstance(policies, Policy):
         policies = [policies]
@@ -289,7 +309,7 @@ def evaluate(
     ev = evaluate_jobs(
         table, rows, p_idx.ravel(), m_idx.ravel(), episode_index.ravel(), seed=seed,
         fallback_index=fallback, safeguard_limits=limits,
-        record=np.full(p_idx.size, record), n_steps=n_steps, threads=threads,
+        record=np.full(p_idx.size, record), n_steps=n_steps, threads=threads, device=device,
     )
     return ev.reshape((n_pol, n_mdp, episodes))
 

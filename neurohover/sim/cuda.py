@@ -1,0 +1,219 @@
+"""The CUDA build of the simulation kernel: the CPU kernel's own Python source, compiled for the GPU.
+
+Nothing here is physics. :func:`device_function` takes a compiled CPU function of the simulator
+(its ``.py_func``: the very function object numba compiled for the CPU) and builds a CUDA device
+function from the same code object, with every compiled simulator function it calls replaced by
+that callee's device version, recursively. The CPU kernel is untouched (same machine code, same
+on-disk cache); the GPU runs :func:`neurohover.sim.kernel.fly_job`, the body of the CPU kernel's
+parallel loop, one thread per job, with the same ``(seed, episode)`` gust streams. Global NumPy
+arrays the source reads (the ziggurat tables ``ZIG_X``, ``ZIG_F``) become device constant arrays:
+numba's CUDA target places global arrays in constant memory.
+
+The one target-specific piece is a primitive, not physics: ``_product`` (a product that must not
+be fused into an FMA, for the competition's clock) maps to libdevice's ``dmul_rn`` on a real GPU,
+whose compiler contracts ``a * b + c`` into an FMA by default.
+
+Tolerance against the CPU kernel: under numba's CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``, plain
+Python, no FMA) returns agree to 1e-9 relative (in practice about 1e-13: the CPU kernel contracts
+some products into FMAs); on a GPU, FMA placement and libdevice's ``exp``/``sin``/``log`` (within
+2 ulp of glibc's) give about 1e-12 relative over a 6000-step episode. Crash flags and steps agree
+except for a trajectory that meets a crash bound within that rounding.
+
+The module imports without CUDA; :func:`cuda_problem` says why the GPU cannot be used.
+"""
+
+from __future__ import annotations
+
+import types
+
+import numpy as np
+from numba.core.registry import CPUDispatcher
+
+from . import kernel, rng
+from .constants import MDP_ROW_LEN, ROW_DT, ROW_SUBSTEPS, SAFEGUARD_LIMITS
+
+try:  # numba-cuda (``pip install 'neurohover[cuda]'``) or numba's built-in target; may be broken or absent
+    from numba import cuda
+except Exception as exc:  # pragma: no cover - depends on the installation
+    cuda = None
+    _IMPORT_ERROR: Exception | None = exc
+else:
+    _IMPORT_ERROR = None
+
+THREADS_PER_BLOCK = 128
+SIM_MODULES = (kernel.__name__, rng.__name__)  # compiled functions from these modules are retargeted
+
+
+def simulating() -> bool:
+    """Whether numba's CUDA simulator stands in for a GPU (``NUMBA_ENABLE_CUDASIM=1`` at numba's import)."""
+    from numba.core import config
+
+    return bool(config.ENABLE_CUDASIM)
+
+
+def cuda_problem() -> str | None:
+    """Why ``device="cuda"`` cannot run here, or None when a GPU (or the simulator) is usable."""
+    if cuda is None:
+        return f"numba.cuda cannot be imported ({type(_IMPORT_ERROR).__name__}: {_IMPORT_ERROR})"
+    if simulating():
+        return None
+    try:
+        if cuda.is_available():
+            return None
+    except Exception as exc:  # pragma: no cover - driver errors vary
+        return f"the CUDA driver failed ({type(exc).__name__}: {exc})"
+    return "numba finds no usable CUDA GPU (numba.cuda.is_available() is False)"
+
+
+def _product_rn(a, b):
+    # Round-to-nearest product that the GPU compiler may not contract into an FMA.
+    return libdevice.dmul_rn(float(a), float(b))
+
+
+libdevice = None  # numba.cuda.libdevice, loaded with the first device function on a real GPU
+_PRIMITIVES: dict = {}  # per-target replacements of primitives, by the callee's name in the source
+_DEVICE: dict = {}
+
+
+def _global_names(code: types.CodeType) -> set[str]:
+    names = set(code.co_names)
+    for const in code.co_consts:
+        if isinstance(const, types.CodeType):
+            names |= _global_names(const)
+    return names
+
+
+def _rebind(py_func: types.FunctionType) -> types.FunctionType:
+    """``py_func`` (same code object) with globals of its own: each simulator function it calls is its device version."""
+    source = py_func.__globals__
+    g = {"__builtins__": source["__builtins__"], "__name__": source["__name__"]}
+    for name in _global_names(py_func.__code__):
+        if name in _PRIMITIVES:
+            g[name] = _PRIMITIVES[name]
+        elif name in source:
+            value = source[name]
+            if isinstance(value, CPUDispatcher) and value.py_func.__module__ in SIM_MODULES:
+                value = device_function(value)
+            g[name] = value
+    f = types.FunctionType(py_func.__code__, g, py_func.__name__, py_func.__defaults__, py_func.__closure__)
+    f.__qualname__ = py_func.__qualname__
+    f.__doc__ = py_func.__doc__
+    return f
+
+
+def device_function(func):
+    """The CUDA device function compiled from simulator function ``func`` (a CPU dispatcher or plain function).
+
+    Parameters
+    ----------
+    func : numba CPUDispatcher or function
+        A function of :mod:`neurohover.sim.kernel` or :mod:`neurohover.sim.rng`.
+
+    Returns
+    -------
+    numba CUDA dispatcher
+        Built once per function and cached in this process.
+    """
+    py_func = getattr(func, "py_func", func)
+    built = _DEVICE.get(py_func)
+    if built is None:
+        _require()
+        built = _DEVICE[py_func] = cuda.jit(device=True)(_rebind(py_func))
+    return built
+
+
+def _rollout_thread(
+    mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, job_fallback, seed,
+    n_steps, safeguard, limits, record_slot, obs_out, act_out,
+    out_return, out_crashed, out_steps, out_safeguard_step,
+):
+    """One CUDA thread per job: the CPU kernel's loop body with a thread-local stream state."""
+    j = cuda.grid(1)
+    if j < job_policy.shape[0]:
+        state = cuda.local.array(4, np.uint64)
+        fly_job(j, state, mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, job_fallback, seed,
+                n_steps, safeguard, limits, record_slot, obs_out, act_out,
+                out_return, out_crashed, out_steps, out_safeguard_step)
+
+
+fly_job = kernel.fly_job  # the CPU dispatcher; _rebind hands the kernel its device version
+_KERNEL = None
+
+
+def _require() -> None:
+    """Raise RuntimeError unless a GPU (or the simulator) is usable; set up the target's primitives."""
+    global libdevice
+    problem = cuda_problem()
+    if problem is not None:
+        raise RuntimeError(problem)
+    if libdevice is None and not simulating():  # plain Python (the simulator) never fuses a product
+        from numba.cuda import libdevice as lib
+
+        libdevice = lib
+        _PRIMITIVES["_product"] = cuda.jit(device=True)(_product_rn)
+
+
+def rollout_kernel():
+    """The CUDA kernel (built on first use): same arguments as :func:`neurohover.sim.kernel.rollout_batch`."""
+    global _KERNEL
+    if _KERNEL is None:
+        _require()
+        _KERNEL = cuda.jit(_rebind(_rollout_thread))
+    return _KERNEL
+
+
+_loaded = False
+
+
+def load_kernel() -> None:
+    """Compile the CUDA kernel now (one job of one step), so that later calls time only flying."""
+    global _loaded
+    if not _loaded:
+        one = np.zeros(1, dtype=np.int64)
+        row = np.zeros((1, MDP_ROW_LEN))
+        row[0, ROW_SUBSTEPS], row[0, ROW_DT] = 1.0, 0.01
+        rollout_batch_cuda(row, one, np.zeros((1, kernel.GENOME_WIDTH)), one, one, one, one - 1, np.uint64(0), 1,
+                           False, SAFEGUARD_LIMITS, one - 1, np.zeros((0, 2, 12)), np.zeros((0, 1, 4)),
+                           np.zeros(1), np.zeros(1, dtype=np.bool_), np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64))
+        _loaded = True
+
+
+def rollout_batch_cuda(
+    mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, job_fallback, seed,
+    n_steps, safeguard, limits, record_slot, obs_out, act_out,
+    out_return, out_crashed, out_steps, out_safeguard_step,
+    threads_per_block: int | None = None,
+) -> None:
+    """:func:`~neurohover.sim.kernel.rollout_batch` on the GPU: copy in, one thread per job, copy back.
+
+    Arguments and outputs are host NumPy arrays, exactly as the CPU kernel takes them; outputs
+    (and ``obs_out``/``act_out`` where jobs record) are filled in place. Raises RuntimeError when
+    no GPU (and no simulator) is usable. ``threads_per_block`` defaults to :data:`THREADS_PER_BLOCK`.
+    """
+    n_jobs = job_policy.shape[0]
+    k = rollout_kernel()
+    if n_jobs == 0:
+        return
+    to = cuda.to_device
+    recording = obs_out.shape[0] > 0
+    # A zero-size device array is avoided: no job writes flight data when none records.
+    d_obs = to(obs_out) if recording else cuda.device_array((1, 1, 12))
+    d_act = to(act_out) if recording else cuda.device_array((1, 1, 4))
+    d_ret = cuda.device_array(n_jobs, dtype=np.float64)
+    d_crash = cuda.device_array(n_jobs, dtype=np.bool_)
+    d_steps = cuda.device_array(n_jobs, dtype=np.int64)
+    d_sg = cuda.device_array(n_jobs, dtype=np.int64)
+    tpb = threads_per_block or THREADS_PER_BLOCK
+    k[(n_jobs + tpb - 1) // tpb, tpb](
+        to(mdp_rows), to(policy_kinds), to(genomes), to(job_policy), to(job_mdp), to(job_episode), to(job_fallback),
+        np.uint64(seed), np.int64(n_steps), bool(safeguard), to(limits), to(record_slot), d_obs, d_act,
+        d_ret, d_crash, d_steps, d_sg,
+    )
+    d_ret.copy_to_host(out_return)
+    d_crash.copy_to_host(out_crashed)
+    d_steps.copy_to_host(out_steps)
+    d_sg.copy_to_host(out_safeguard_step)
+    if recording:
+        d_obs.copy_to_host(obs_out)
+        d_act.copy_to_host(act_out)
+    cuda.synchronize()
