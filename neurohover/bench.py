@@ -210,6 +210,10 @@ def run_benchmarks(quick: bool = False) -> dict:
         },
     }
     report.update(_extra_benchmarks(quick))
+    # The CUDA build of the kernel when a GPU is present ({"status": "no CUDA device"} otherwise).
+    from .bench_gpu import gpu_benchmarks
+
+    report["gpu"] = gpu_benchmarks(quick, cpu_episodes_per_second=many)
     return report
 
 
@@ -224,6 +228,10 @@ def format_report(report: dict) -> str:
                 f"  {key:<34} {value['episodes_per_second']:>12.1f} episodes/s  {value['substeps_per_second'] / 1e6:8.1f} M substeps/s"
                 f"  x{value['speedup_vs_reference']:.0f} vs reference{extra}"
             )
+        elif key == "gpu":
+            from .bench_gpu import format_gpu
+
+            lines += format_gpu(value)
         elif key not in ("machine", "workload", "reference_episodes_per_second"):
             lines.append(f"  {key:<34} {value:>12.4g}" if isinstance(value, float) else f"  {key:<34} {value}")
     return "\n".join(lines)
