@@ -194,7 +194,10 @@ def rollout_batch_cuda(
     k = rollout_kernel()
     if n_jobs == 0:
         return
-    to = cuda.to_device
+
+    def to(a):  # to_device copies one contiguous buffer; a strided view of the caller's would not do
+        return cuda.to_device(np.ascontiguousarray(a))
+
     recording = obs_out.shape[0] > 0
     # A zero-size device array is avoided: no job writes flight data when none records.
     d_obs = to(obs_out) if recording else cuda.device_array((1, 1, 12))
