@@ -25,12 +25,10 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
 
 def cmd_compete(args: argparse.Namespace) -> int:
     """Run R independent test runs of an agent; print a summary and write results and a plot."""
-    from tqdm import tqdm
-
     from .agents.hybrid import HybridSettings
     from .agents.registry import HYBRID_AGENTS
     from .compete import compete
-    from .paths import input_dir, output_dir
+    from .paths import input_dir, output_dir, output_file
 
     given = [f"--{k.replace('_', '-')}" for k in _HYBRID_OPTIONS if getattr(args, k) is not None]
     if given and args.agent not in HYBRID_AGENTS:
@@ -41,27 +39,22 @@ def cmd_compete(args: argparse.Namespace) -> int:
     if args.policy_dir is not None:
         input_dir(args.policy_dir, "--policy-dir")
     output_dir(args.out, "--out")
-    bar = tqdm(total=args.runs, desc=f"{args.task} {args.agent}", unit="run", file=sys.stderr, disable=None)
-
-    def finished(spec, result) -> None:
-        bar.update(1)
-        bar.set_postfix(score=f"{result.score:.4g}")
-
+    if args.store is not None:
+        output_file(args.store, "--store")
     try:
         summary, _ = compete(
             args.task, args.agent, runs=args.runs, episodes=args.episodes, mdps=args.mdps, seed=args.seed,
             jobs=args.jobs, out=args.out, sigma=args.sigma, n_steps=args.episode_steps, policy_dir=args.policy_dir, hybrid=hybrid,
-            on_result=finished,
+            store=args.store, progress=None,
         )
     except KeyboardInterrupt:
-        bar.close()
-        print(f"neurohover compete: interrupted; the finished runs are in {args.out}/episodes.csv", file=sys.stderr)
+        print(f"neurohover compete: interrupted; the finished runs are in {args.out}/episodes.csv and the results store; "
+              "run the same command again to resume", file=sys.stderr)
         return 130
-    bar.close()
     print(f"{'agent':<18} {'runs':>5} {'mean cum. return':>17} {'sd':>12} {'crash rate':>11} {'return/ep after learning':>25}")
     print(f"{summary['agent']:<18} {summary['runs']:>5} {summary['mean_cumulative_return']:>17.5g} {summary['sd_cumulative_return']:>12.4g} "
           f"{summary['crash_rate_runs']:>11.1%} {summary['mean_return_after_learning']:>25.5g}")
-    print(f"results: {args.out}/episodes.csv, {args.out}/summary.json, {args.out}/cumulative.png")
+    print(f"results: {args.out}/episodes.csv, {args.out}/summary.json, {args.out}/cumulative.png; store: {summary['store']}")
     return 0
 
 
@@ -91,7 +84,8 @@ def register(sub) -> None:
     p.add_argument("--jobs", type=int, default=1, help="runs in parallel processes (default 1)")
     p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")
     p.add_argument("--policy-dir", help="policy sets directory (default: the shipped ones)")
-    p.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--out", required=True, help="output directory (episodes.csv, summary.json, cumulative.png, results.sqlite)")
+    p.add_argument("--store", help="results store to keep the runs in (default: OUT/results.sqlite); finished runs are not flown again")
     g = p.add_argument_group("hybrid agents (defaults: the authors' code; see docs/model.md, Safeguard)")
     g.add_argument("--safeguard-rule", help="code (tilted and outside the box, default) or paper (outside the box)")
     g.add_argument("--safeguard-box", type=float, help="bound on |u|..|r| of a safe state (default 0.5)")

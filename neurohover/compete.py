@@ -1,93 +1,45 @@
 """The competition harness: R independent test runs of an agent, summary, files and plots.
 
-``neurohover compete`` writes to its output directory:
+A competition is a small inline experiment (kind ``test_runs``, one group): it runs through the
+same planner, units, executor, unit seeds and results store as ``neurohover reproduce``, so a
+run of ``compete`` and the same group in an experiment config fly the same MDPs, and an
+interrupted competition resumes where it stopped. ``neurohover compete`` writes to its output
+directory:
 
+- ``results.sqlite``: the results store (or the one given with ``--store``); running the same
+  command again skips the finished runs;
 - ``episodes.csv``: one row per (run, episode): run, mdp, episode, return, crashed, steps, policy,
-  safeguard_fired, offline_seconds. Each run's rows are appended the moment the run finishes, so
-  an interrupted competition keeps every finished run.
-- ``summary.json``: the summary table below plus the settings.
+  safeguard_fired (steps is the crash step, or the episode length);
+- ``summary.json``: the summary table below plus the settings;
 - ``cumulative.png``: mean cumulative error (minus cumulative return) per episode, on a linear
   and a log scale, like the paper's Figures 4 and 7.
 
 Summary per agent: mean and sd of the cumulative return over runs, crash rate (share of runs
 with at least one crash, and crashes per episode), and the mean return per episode after
 learning (from the first episode after which the agent's policy no longer changes).
+
+Seeds: every unit's seed is ``unit_seed(seed, experiment name, unit key)``
+(:func:`neurohover.experiments.units.unit_seed`); a competition's experiment is named
+``compete-<task>-<agent>``, and MDPs sampled from G come from ``SeedSequence([seed, tag, i])``
+exactly as in the experiments.
 """
 
 from __future__ import annotations
 
 import csv
 import json
-import os
 from collections.abc import Callable, Sequence
-from concurrent.futures import FIRST_COMPLETED, wait
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from .agents.hybrid import HybridSettings
-from .agents.protocol import RunResult, run_test
 from .errors import NeurohoverError
-from .procs import sigterm_as_interrupt, stop_pool, worker_pool
 from .sim.constants import EPISODE_STEPS
-from .tasks import MDP, get_task_family
+from .tasks import N_TEST, N_TRAINING, get_task_family
 
-CSV_COLUMNS = ("run", "mdp", "episode", "return", "crashed", "steps", "policy", "safeguard_fired", "offline_seconds")
-
-
-@dataclass(frozen=True)
-class RunSpec:
-    """One unit of work: test run ``index`` of ``agent`` on ``mdp``."""
-
-    index: int
-    task: str
-    sigma: float | None
-    agent: str
-    mdp: MDP
-    episodes: int
-    seed: int
-    n_steps: int
-    policy_dir: str | None
-    hybrid: HybridSettings = HybridSettings()
-
-
-def run_mdps(task: str, runs: int, mdps: str, seed: int, sigma: float | None = None) -> list[MDP]:
-    """The MDP of each run: the test set in turn (``test``) or fresh draws from G (``sample``)."""
-    family = get_task_family(task, sigma)
-    if mdps == "test":
-        test = family.test_mdps()
-        return [test[i % len(test)] for i in range(runs)]
-    if mdps == "sample":
-        rng = np.random.default_rng(np.random.SeedSequence([seed, 0x5A3]))
-        return [family.sample(rng, label=f"{family.name}/sample:{i}") for i in range(runs)]
-    if mdps == "train":
-        train = family.training_mdps()
-        return [train[i % len(train)] for i in range(runs)]
-    raise NeurohoverError(f"unknown --mdps {mdps!r}: allowed test, sample, train")
-
-
-def execute(spec: RunSpec, threads: int | None = 1) -> RunResult:
-    """Fly one test run (in this process)."""
-    from .agents.registry import AgentOptions, make_agent
-
-    family = get_task_family(spec.task, spec.sigma)
-    agent = make_agent(spec.agent, family, policy_dir=spec.policy_dir, options=AgentOptions(hybrid=spec.hybrid))
-    return run_test(agent, family, spec.mdp, episodes=spec.episodes, seed=spec.seed * 1_000_003 + spec.index,
-                    n_steps=spec.n_steps, threads=threads)
-
-
-def _append_rows(path: Path, spec: RunSpec, result: RunResult) -> None:
-    new = not path.exists()
-    with open(path, "a", newline="") as f:
-        writer = csv.writer(f)
-        if new:
-            writer.writerow(CSV_COLUMNS)
-        for row in result.rows():
-            writer.writerow([spec.index, spec.mdp.label, row["episode"], repr(row["return"]), int(row["crashed"]),
-                             row["steps"], row["policy"], int(row["safeguard_fired"]), f"{row['offline_seconds']:.6f}"])
-        f.flush()
-        os.fsync(f.fileno())
+CSV_COLUMNS = ("run", "mdp", "episode", "return", "crashed", "steps", "policy", "safeguard_fired")
+STORE_FILE = "results.sqlite"
 
 
 def after_learning_start(policy_labels: Sequence[str]) -> int:
@@ -98,22 +50,36 @@ def after_learning_start(policy_labels: Sequence[str]) -> int:
     return start
 
 
-def summarise(results: Sequence[RunResult]) -> dict:
-    """Summary figures over test runs (see the module docstring)."""
-    scores = np.array([r.score for r in results])
-    after = [r.returns[after_learning_start(r.policy):] for r in results]
-    crashes = np.array([int(r.crashed.sum()) for r in results])
+def summarise(results: Sequence) -> dict:
+    """Summary figures over test runs (:class:`~neurohover.experiments.results.TestRunResult`; see the module docstring)."""
+    scores = np.array([float(r.score) for r in results])
+    returns = [np.array(r.returns, dtype=float) for r in results]
+    after = [ret[r.learning_episodes:] for r, ret in zip(results, returns, strict=True)]
+    crashes = np.array([len(r.crash_episodes) for r in results])
     return {
         "runs": len(results),
-        "episodes": int(results[0].returns.size) if results else 0,
+        "episodes": int(returns[0].size) if results else 0,
         "mean_cumulative_return": float(scores.mean()),
         "sd_cumulative_return": float(scores.std(ddof=1)) if len(results) > 1 else 0.0,
         "crash_rate_runs": float(np.mean(crashes > 0)),
-        "crashes_per_episode": float(crashes.sum() / sum(r.returns.size for r in results)),
+        "crashes_per_episode": float(crashes.sum() / sum(ret.size for ret in returns)),
         "mean_return_after_learning": float(np.mean(np.concatenate(after))),
-        "mean_seconds_per_run": float(np.mean([r.seconds for r in results])),
-        "mean_offline_seconds_per_run": float(np.mean([r.offline_seconds.sum() for r in results])),
+        "mean_seconds_per_run": float(np.mean([r.timing.seconds for r in results])),
+        "mean_offline_seconds_per_run": float(np.mean([r.timing.offline_seconds for r in results])),
     }
+
+
+def episode_rows(run: int, result, n_steps: int) -> list[list]:
+    """The ``episodes.csv`` rows of one test run (a ``TestRunResult``)."""
+    policy = [""] * len(result.returns)
+    for e, label in result.policy_changes:
+        policy[e:] = [label] * (len(policy) - e)
+    steps = [n_steps] * len(policy)
+    for e, s in zip(result.crash_episodes, result.crash_steps or (), strict=False):
+        steps[e] = s
+    crashed, fired = set(result.crash_episodes), set(result.safeguard_episodes)
+    return [[run, result.mdp, e, repr(float(ret)), int(e in crashed), steps[e], policy[e], int(e in fired)]
+            for e, ret in enumerate(result.returns)]
 
 
 def plot_cumulative(curves: dict[str, np.ndarray], path: Path, title: str) -> Path:
@@ -144,6 +110,45 @@ def plot_cumulative(curves: dict[str, np.ndarray], path: Path, title: str) -> Pa
     return path
 
 
+def _group(task: str, runs: int, mdps: str) -> dict:
+    """The experiment group of ``runs`` runs on the MDP set ``mdps``, the set's MDPs in turn."""
+    size = {"test": N_TEST, "train": N_TRAINING}.get(mdps)
+    if mdps not in ("test", "train", "sample"):
+        raise NeurohoverError(f"unknown --mdps {mdps!r}: allowed test, sample, train")
+    if size is None or runs <= size:
+        return {"mdps": mdps, "n_mdps": runs, "runs_per_mdp": 1}
+    if runs % size:
+        raise NeurohoverError(f"runs={runs} on the {size} {mdps} MDPs of {task}: give at most {size} runs, or a "
+                              f"multiple of {size} (each MDP then gets the same number of runs)")
+    return {"mdps": mdps, "n_mdps": size, "runs_per_mdp": runs // size}
+
+
+def competition_config(task: str, agent: str, *, runs: int, episodes: int, mdps: str = "test", seed: int = 0,
+                       sigma: float | None = None, n_steps: int = EPISODE_STEPS, policy_dir: str | None = None,
+                       hybrid: HybridSettings = HybridSettings()):
+    """The inline experiment of a competition (an ``ExperimentConfig`` of kind ``test_runs``).
+
+    Its scale is a digest of the settings, so competitions with other settings in the same store
+    are kept apart and the same settings resume.
+    """
+    import hashlib
+
+    from .agents.registry import HYBRID_AGENTS
+    from .experiments.config import make_config
+
+    for name, value in (("runs", runs), ("episodes", episodes), ("seed", seed)):
+        if isinstance(value, bool) or not isinstance(value, int) or value < (0 if name == "seed" else 1):
+            raise NeurohoverError(f"{name}={value!r} is out of range: allowed an integer >= {0 if name == 'seed' else 1}")
+    group = {"agent": agent, **_group(task, runs, mdps)}
+    if agent in HYBRID_AGENTS:
+        group["hybrid"] = hybrid.to_dict()
+    settings = {"task": task, "sigma": sigma, "seed": seed, "n_steps": n_steps, "episodes": episodes,
+                "policies": policy_dir if policy_dir is not None else "shipped", "groups": [group]}
+    digest = hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()[:10]
+    return make_config(f"compete-{task}-{agent}", "test_runs", f"settings-{digest}", settings,
+                       title=f"compete: {agent} on {task}")
+
+
 def compete(
     task: str,
     agent: str,
@@ -158,56 +163,87 @@ def compete(
     n_steps: int = EPISODE_STEPS,
     policy_dir: str | None = None,
     hybrid: HybridSettings = HybridSettings(),
-    on_result: Callable[[RunSpec, RunResult], None] | None = None,
-) -> tuple[dict, list[RunResult]]:
-    """Run ``runs`` test runs in ``jobs`` processes; write results and plot to ``out``.
+    store: str | Path | None = None,
+    progress: bool | None = False,
+    on_result: Callable[[str, object], None] | None = None,
+) -> tuple[dict, list]:
+    """Run ``runs`` test runs of ``agent`` as an inline experiment; write results and plot to ``out``.
 
-    ``hybrid`` sets the safeguard and replacement rule of the hybrid agents (ignored by the others).
+    Parameters
+    ----------
+    task, agent : str
+        The task family and the agent (:data:`neurohover.agents.registry.AGENTS`).
+    runs, episodes : int
+        Test runs, and episodes per run.
+    mdps : {"test", "train", "sample"}
+        The fixed test or training MDPs in turn, or fresh MDPs from G.
+    jobs : int
+        Local worker processes.
+    store : path, optional
+        Results store (default ``out/results.sqlite``); finished runs in it are not flown again.
+    hybrid : HybridSettings
+        Safeguard and replacement rule of the hybrid agents (refused for the others by the CLI).
+    on_result : callable, optional
+        ``on_result(unit key, TestRunResult)`` after each run finished in this call.
 
-    Raises KeyboardInterrupt after saving every finished run when interrupted (SIGTERM too, as
-    :class:`~neurohover.procs.Terminated`, while ``jobs > 1``).
+    Returns
+    -------
+    (dict, list of TestRunResult)
+        The summary and the runs in order.
+
+    Raises
+    ------
+    KeyboardInterrupt
+        When interrupted (SIGTERM too while ``jobs > 1``), after writing ``episodes.csv`` of every
+        finished run; the store keeps them, and the same call resumes.
     """
     from .agents.registry import check_agent
+    from .experiments import Store, make_executor, reproduce
+    from .experiments.results import TestRunResult
 
-    for name, value in (("runs", runs), ("episodes", episodes), ("jobs", jobs)):
-        if not isinstance(value, int) or value < 1:
-            raise NeurohoverError(f"{name}={value!r} is out of range: allowed an integer >= 1")
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        raise NeurohoverError(f"jobs={jobs!r} is out of range: allowed an integer >= 1")
     check_agent(agent, get_task_family(task, sigma), policy_dir)
+    config = competition_config(task, agent, runs=runs, episodes=episodes, mdps=mdps, seed=seed, sigma=sigma,
+                                n_steps=n_steps, policy_dir=policy_dir, hybrid=hybrid)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    csv_path = out / "episodes.csv"
-    if csv_path.exists():
-        csv_path.unlink()
-    specs = [RunSpec(i, task, sigma, agent, m, episodes, seed, n_steps, policy_dir, hybrid)
-             for i, m in enumerate(run_mdps(task, runs, mdps, seed, sigma))]
-    results: dict[int, RunResult] = {}
+    store_path = Path(store) if store is not None else out / STORE_FILE
 
-    def finish(spec: RunSpec, result: RunResult) -> None:
-        results[spec.index] = result
-        _append_rows(csv_path, spec, result)
-        if on_result is not None:
-            on_result(spec, result)
+    def finished(key: str, result: dict) -> None:
+        if on_result is not None and key.startswith("run/"):
+            on_result(key, TestRunResult.from_dict(result, key))
 
-    if jobs == 1:
-        for spec in specs:
-            finish(spec, execute(spec, threads=None))
-    else:
-        # Spawned workers that exit when this process dies; SIGTERM ends them like Ctrl-C.
-        pool = worker_pool(jobs)
+    executor = make_executor("local", jobs=jobs)
+    with Store(store_path) as db:
         try:
-            with sigterm_as_interrupt():
-                pending = {pool.submit(execute, spec, 1): spec for spec in specs}
-                while pending:
-                    done, _ = wait(pending, return_when=FIRST_COMPLETED)
-                    for future in done:
-                        finish(pending.pop(future), future.result())
-        except BaseException:
-            stop_pool(pool)  # an unfinished run is never written: end the others at once
-            raise
-        pool.shutdown(wait=True)
-    ordered = [results[i] for i in sorted(results)]
-    summary = {"task": task, "agent": agent, "mdps": mdps, "seed": seed, **summarise(ordered)}
+            reproduce(config, db, executor, progress=progress, on_unit=finished)
+        finally:
+            executor.close()
+            stored = db.results(config.name, config.scale)
+            keys = sorted((k for k in stored if k.startswith("run/")), key=_run_order)
+            ordered = [TestRunResult.from_dict(stored[k], k) for k in keys]
+            _write_episodes(out / "episodes.csv", ordered, n_steps)
+    summary = {"task": task, "agent": agent, "mdps": mdps, "seed": seed, "store": str(store_path),
+               "experiment": config.name, "scale": config.scale, **summarise(ordered)}
     (out / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
-    plot_cumulative({agent: np.array([r.cumulative for r in ordered])}, out / "cumulative.png",
-                    f"{task}: {agent}, {len(ordered)} runs")
+    plot_cumulative({agent: np.array([np.cumsum(np.array(r.returns, dtype=float)) for r in ordered])},
+                    out / "cumulative.png", f"{task}: {agent}, {len(ordered)} runs")
     return summary, ordered
+
+
+def _run_order(key: str) -> tuple[int, int]:
+    """Runs in the order of their MDP, then repetition (keys ``run/<agent>/<set><i>/rep<r>``)."""
+    from .experiments.results import UnitKey
+
+    parsed = UnitKey.parse(key)
+    digits = (parsed.mdp or "").lstrip("abcdefghijklmnopqrstuvwxyz")
+    return (int(digits) if digits.isdigit() else -1, parsed.rep if parsed.rep is not None else 0)
+
+
+def _write_episodes(path: Path, results: Sequence, n_steps: int) -> None:
+    with open(path, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(CSV_COLUMNS)
+        for run, result in enumerate(results):
+            writer.writerows(episode_rows(run, result, n_steps))

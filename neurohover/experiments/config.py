@@ -390,13 +390,26 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
     if scale not in scales:
         raise NeurohoverError(f"{where}: has no [scales.{scale}] table")
     merged = {**raw["settings"], **scales[scale], **(overrides or {})}
-    settings = _validate_table(merged, SCHEMAS[kind], f"{where} at scale {scale!r}")
-    _check_kind(settings, kind, f"{where} at scale {scale!r}")
+    return make_config(raw["name"], kind, scale, merged, title=raw.get("title", raw["name"]), paper=raw.get("paper", {}),
+                       paper_ref=raw.get("paper_ref", ""), source=str(path), where=f"{where} at scale {scale!r}")
+
+
+def make_config(name: str, kind: str, scale: str, settings: dict[str, Any], *, title: str = "", paper: dict | None = None,
+                paper_ref: str = "", source: str = "", where: str | None = None) -> ExperimentConfig:
+    """Validate ``settings`` of an experiment of ``kind`` and resolve them into a config.
+
+    The one path from settings to a config: shipped TOML files (:func:`load_config`) and inline
+    experiments (``neurohover compete``) both come through here.
+    """
+    where = where or f"experiment {name!r}"
+    if kind not in KINDS:
+        raise NeurohoverError(f"{where}: kind = {kind!r} is not allowed: expected one of {', '.join(KINDS)}")
+    resolved = _validate_table(dict(settings), SCHEMAS[kind], where)
+    _check_kind(resolved, kind, where)
     from .plans import external_digest
 
-    digest = external_digest(kind, settings)
-    return ExperimentConfig(raw["name"], raw.get("title", raw["name"]), kind, scale, settings, raw.get("paper", {}),
-                            raw.get("paper_ref", ""), str(path), digest)
+    digest = external_digest(kind, resolved)
+    return ExperimentConfig(name, title or name, kind, scale, resolved, paper or {}, paper_ref, source, digest)
 
 
 def load_configs(name: str, scale: str, overrides: dict[str, Any] | None = None) -> list[ExperimentConfig]:

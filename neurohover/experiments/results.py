@@ -345,12 +345,16 @@ class TestRunResult(_Record):
     learning_episodes : int
         Episodes before the agent settled (see :func:`neurohover.compete.after_learning_start`).
     mean_return_after_learning : Num
+    crash_steps : tuple of int or None
+        The control step at which each crash episode ended, in the order of ``crash_episodes``
+        (None: a store written before it was recorded).
     timing : TestRunTiming
         Wall-clock; not part of ``==``.
     """
 
     __test__ = False  # not a pytest test class
     _NESTED: ClassVar[dict[str, type[_Record]]] = {"timing": TestRunTiming}
+    _OPTIONAL: ClassVar[tuple[str, ...]] = ("crash_steps",)
 
     agent: str
     mdp: str
@@ -361,6 +365,7 @@ class TestRunResult(_Record):
     policy_changes: tuple[tuple[int, str], ...]
     learning_episodes: int
     mean_return_after_learning: Num
+    crash_steps: tuple[int, ...] | None = None
     timing: TestRunTiming = field(compare=False)
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import fnmatch
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 from ..errors import NeurohoverError
@@ -61,11 +61,12 @@ def selected(key: str, only: Sequence[str]) -> bool:
 
 
 def reproduce(config: ExperimentConfig, store: Store, executor, *, fresh: bool = False, progress: bool | None = None,
-              only: Sequence[str] = ()) -> RunSummary:
+              only: Sequence[str] = (), on_unit: Callable[[str, dict], None] | None = None) -> RunSummary:
     """Run every unfinished unit of ``config``; each finished unit is written to ``store`` at once.
 
     ``only`` restricts the run to the units whose keys match one of these glob patterns (for example
     ``run/hybrid/*/rep0``); the others stay unfinished, and a later call can run them.
+    ``on_unit(key, result)`` is called for every unit finished in this call, once it is stored.
     Raises KeyboardInterrupt (after recording every finished unit) when interrupted, and
     NeurohoverError when another run is writing ``store`` (see :meth:`Store.lock`).
     """
@@ -86,6 +87,8 @@ def reproduce(config: ExperimentConfig, store: Store, executor, *, fresh: bool =
             summary.units_run += 1
         results[unit.key] = result
         bar.update(1)
+        if on_unit is not None:
+            on_unit(unit.key, result)
 
     def on_error(unit, err) -> None:
         summary.failed.append((unit.key, _short(err)))

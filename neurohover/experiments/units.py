@@ -241,6 +241,7 @@ def run_test_run(p: dict, threads: int | None) -> dict:
         safeguard_episodes=tuple(int(e) for e in np.flatnonzero(r.safeguard_fired)),
         policy_changes=changes, learning_episodes=int(start),
         mean_return_after_learning=num(r.returns[start:].mean()),
+        crash_steps=tuple(int(s) for s in r.steps[r.crashed]),
         timing=TestRunTiming(seconds=float(r.seconds), offline_seconds=float(r.offline_seconds.sum())),
     ).to_dict()
 

@@ -1,0 +1,68 @@
+"""compete is an inline experiment: same planner, units, seeds and store as reproduce."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import pytest
+
+from neurohover.compete import compete, competition_config
+from neurohover.errors import NeurohoverError
+from neurohover.experiments import Store, plan, unit_seed
+from neurohover.experiments.config import make_config
+from neurohover.tasks import MDP
+
+
+def test_sampled_mdps_are_those_of_the_same_group_in_any_experiment_with_that_seed() -> None:
+    cfg = competition_config("ghh09", "baseline", runs=3, episodes=2, mdps="sample", seed=17, n_steps=50)
+    twin = make_config("my-experiment", "test_runs", "quick", {**cfg.settings})
+    ours, theirs = plan(cfg, {}).units, plan(twin, {}).units
+    assert [u.params["mdp"] for u in ours] == [u.params["mdp"] for u in theirs]
+    assert [MDP.from_dict(u.params["mdp"]).label for u in ours] == [f"ghh09/sample:{i}" for i in range(3)]
+    # Unit seeds derive from (seed, experiment name, unit key): documented, and different per experiment.
+    assert [u.params["seed"] for u in ours] == [unit_seed(17, cfg.name, u.key) for u in ours]
+    assert [u.params["seed"] for u in ours] != [u.params["seed"] for u in theirs]
+
+
+def test_a_competition_resumes_from_its_store_and_flies_nothing_twice(tmp_path: Path) -> None:
+    flown: list[str] = []
+    first, runs = compete("ghh08", "baseline", runs=3, episodes=4, n_steps=80, out=tmp_path / "a",
+                          on_result=lambda key, result: flown.append(key))
+    assert len(flown) == 3 and (tmp_path / "a" / "results.sqlite").is_file()
+    again, runs_again = compete("ghh08", "baseline", runs=3, episodes=4, n_steps=80, out=tmp_path / "a",
+                                on_result=lambda key, result: flown.append(key))
+    assert len(flown) == 3 and again["mean_cumulative_return"] == first["mean_cumulative_return"]
+    assert runs_again == runs
+    # Other settings in the same store are another experiment scale: kept apart, nothing refused.
+    longer, _ = compete("ghh08", "baseline", runs=3, episodes=5, n_steps=80, out=tmp_path / "a")
+    assert longer["episodes"] == 5 and len(flown) == 3
+    with Store(tmp_path / "a" / "results.sqlite", create=False) as store:
+        assert sorted(n for n, *_ in store.experiments()) == ["compete-ghh08-baseline"] * 2
+
+
+def test_episode_rows_carry_steps_and_policies(tmp_path: Path) -> None:
+    summary, runs = compete("ghh08", "baseline", runs=2, episodes=3, n_steps=60, out=tmp_path / "b")
+    rows = list(csv.DictReader(open(tmp_path / "b" / "episodes.csv")))
+    assert len(rows) == 6 and {r["policy"] for r in rows} == {"baseline"} and {r["steps"] for r in rows} == {"60"}
+    assert [float(r["return"]) for r in rows[:3]] == [float(x) for x in runs[0].returns]
+    assert summary["crash_rate_runs"] == 0.0
+
+
+def test_runs_beyond_the_set_must_fill_it_evenly() -> None:
+    assert competition_config("ghh08", "baseline", runs=200, episodes=1).settings["groups"][0]["runs_per_mdp"] == 2
+    with pytest.raises(NeurohoverError, match="runs=150 on the 100 test MDPs of ghh08"):
+        competition_config("ghh08", "baseline", runs=150, episodes=1)
+    with pytest.raises(NeurohoverError, match="unknown --mdps 'all'"):
+        competition_config("ghh08", "baseline", runs=1, episodes=1, mdps="all")
+
+
+def test_a_crashing_run_records_its_crash_step() -> None:
+    from neurohover.compete import episode_rows
+    from neurohover.experiments.results import TestRunResult, TestRunTiming
+
+    result = TestRunResult(agent="x", mdp="m", score=-3.0, returns=(-1.0, -2.0), crash_episodes=(1,),
+                           safeguard_episodes=(0,), policy_changes=((0, "a"), (1, "b")), learning_episodes=1,
+                           mean_return_after_learning=-2.0, crash_steps=(17,),
+                           timing=TestRunTiming(seconds=0.0, offline_seconds=0.0))
+    assert episode_rows(4, result, 100) == [[4, "m", 0, "-1.0", 0, 100, "a", 1], [4, "m", 1, "-2.0", 1, 17, "b", 0]]
