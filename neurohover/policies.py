@@ -51,9 +51,11 @@ def _sigmoid(s: float) -> float:
     return 1.0 / (1.0 + math.exp(min(700.0, -MLP_STEEPNESS * s)))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Policy:
     """A generic policy: topology and genome, plus free-form metadata.
+
+    Two policies are equal when their topologies and genomes are (metadata does not count).
 
     Attributes
     ----------
@@ -74,6 +76,14 @@ class Policy:
         genome = check_genome(self.genome, self.topology)
         genome.setflags(write=False)
         object.__setattr__(self, "genome", genome)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Policy):
+            return NotImplemented
+        return self.topology == other.topology and np.array_equal(self.genome, other.genome)
+
+    def __hash__(self) -> int:
+        return hash((self.topology, self.genome.tobytes()))
 
     def act(self, observation: Sequence[float]) -> tuple[float, float, float, float]:
         """Actions for a 12-number observation, computed in plain Python (the readable definition)."""

@@ -379,3 +379,17 @@ def test_a_ctrl_c_after_the_last_generation_check_still_reaches_the_caller() -> 
             assert signal.getsignal(signal.SIGINT) != before
             flag._handler(signal.SIGINT, None)  # arrives after the last check; the block ends normally
     assert signal.getsignal(signal.SIGINT) == before  # the previous handler is back
+
+
+def test_two_equal_runs_give_equal_results_whatever_their_wall_clock() -> None:
+    from neurohover.policies import Policy, prototype
+
+    mdp = get_task_family("ghh08").mdp("train:1")
+    a = evolve(mdp, budget=100, n_steps=50, seed=3, threads=1)
+    b = evolve(mdp, budget=100, n_steps=50, seed=3, threads=1)
+    assert a.seconds != b.seconds or a.kernel_seconds != b.kernel_seconds or a.history[-1].wall_seconds != b.history[-1].wall_seconds
+    assert a == b and a.history == b.history
+    assert a != evolve(mdp, budget=100, n_steps=50, seed=4, threads=1)
+    p = prototype("mlp", "baseline")
+    assert p == Policy("mlp", p.genome.copy(), {"note": "metadata does not count"}) and len({p, prototype("mlp", "baseline")}) == 1
+    assert p != prototype("mlp", "zero") and p != prototype("slp", "baseline")

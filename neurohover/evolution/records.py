@@ -7,7 +7,7 @@ import dataclasses
 import json
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import NeurohoverError
@@ -62,7 +62,7 @@ class HistoryRecord:
     episodes: int
     generation_episodes: int
     champion_return: float
-    wall_seconds: float
+    wall_seconds: float = field(compare=False)  # wall-clock: two equal runs compare equal
 
 
 #: Columns of a history CSV file, in order (the fields of :class:`HistoryRecord`).
@@ -117,8 +117,8 @@ class EvolutionResult:
     steps: int
     evaluations: int
     generations: int
-    seconds: float
-    kernel_seconds: float
+    seconds: float = field(compare=False)  # wall-clock, not part of ==
+    kernel_seconds: float = field(compare=False)
     stop_reason: str
     settings: dict
     champion_crashed: bool = False
