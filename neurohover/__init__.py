@@ -20,9 +20,24 @@ except importlib.metadata.PackageNotFoundError:  # a source tree on sys.path tha
     __version__ = "0+unknown"
 
 __all__ = [
-    "FGHH", "GHH08", "GHH09", "MDP", "Evaluation", "FlightData", "NeurohoverError", "Policy",
-    "DangerousState", "PolicyTable", "Safeguard", "baseline_policy", "evaluate", "evaluate_jobs", "get_task_family",
-    "load_policy", "prototype", "save_policy",
+    "FGHH",
+    "GHH08",
+    "GHH09",
+    "MDP",
+    "Evaluation",
+    "FlightData",
+    "NeurohoverError",
+    "Policy",
+    "DangerousState",
+    "PolicyTable",
+    "Safeguard",
+    "baseline_policy",
+    "evaluate",
+    "evaluate_jobs",
+    "get_task_family",
+    "load_policy",
+    "prototype",
+    "save_policy",
 ]
 
 from . import envs as _envs  # noqa: E402,F401  (registers the Gymnasium environments)

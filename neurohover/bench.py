@@ -124,8 +124,7 @@ def _replay_seconds(trace: list, topology: str, noise_seed: int, n_steps: int, t
     p = np.concatenate([t[2] + o for t, o in zip(trace, g_off, strict=True)])
     m = np.concatenate([t[3] + o for t, o in zip(trace, r_off, strict=True)])
     e = np.concatenate([t[4] for t in trace])
-    ev = evaluate_jobs(PolicyTable.from_genomes(genomes, topology), rows, p, m, e, seed=noise_seed,
-                       n_steps=n_steps, threads=threads)
+    ev = evaluate_jobs(PolicyTable.from_genomes(genomes, topology), rows, p, m, e, seed=noise_seed, n_steps=n_steps, threads=threads)
     return ev.seconds
 
 
@@ -159,8 +158,7 @@ def benchmark_evolution(quick: bool = False, repeats: int | None = None) -> dict
         best_evolve, best_raw = math.inf, math.inf
         for _ in range(repeats):
             trace: list = []
-            result = evolve(target, topology="mlp", prototype="baseline", budget=budget, resampling=resampling,
-                            seed=1, threads=threads, _trace=trace)
+            result = evolve(target, topology="mlp", prototype="baseline", budget=budget, resampling=resampling, seed=1, threads=threads, _trace=trace)
             best_evolve = min(best_evolve, result.seconds)
             best_raw = min(best_raw, _replay_seconds(trace, "mlp", noise_seed(1), EPISODE_STEPS, threads))
         out[f"{name}_episodes_per_second"] = result.episodes / best_evolve
@@ -195,17 +193,20 @@ def run_benchmarks(quick: bool = False) -> dict:
     many = kernel_episodes_per_second(episodes * cores, cores, repeats)
     per_episode = EPISODE_STEPS
     report = {
-        "machine": {"cores": cores, "cpu": platform.processor() or platform.machine(), "python": platform.python_version(),
-                    "numba": numba.__version__},
+        "machine": {"cores": cores, "cpu": platform.processor() or platform.machine(), "python": platform.python_version(), "numba": numba.__version__},
         "workload": "MLP policy (baseline-equivalent), zero setting, full 6000-step episodes",
         "reference_episodes_per_second": ref,
         "kernel_1_core": {
-            "episodes_per_second": one, "control_steps_per_second": one * per_episode,
-            "substeps_per_second": one * per_episode * SUBSTEPS, "speedup_vs_reference": one / ref,
+            "episodes_per_second": one,
+            "control_steps_per_second": one * per_episode,
+            "substeps_per_second": one * per_episode * SUBSTEPS,
+            "speedup_vs_reference": one / ref,
         },
         f"kernel_{cores}_cores": {
-            "episodes_per_second": many, "control_steps_per_second": many * per_episode,
-            "substeps_per_second": many * per_episode * SUBSTEPS, "speedup_vs_reference": many / ref,
+            "episodes_per_second": many,
+            "control_steps_per_second": many * per_episode,
+            "substeps_per_second": many * per_episode * SUBSTEPS,
+            "speedup_vs_reference": many / ref,
             "speedup_vs_1_core": many / one,
         },
     }

@@ -40,9 +40,11 @@ def gpu_device() -> dict | None:
         return None
     dev = sim_cuda.cuda.get_current_device()
     name = getattr(dev, "name", "?")
-    return {"name": name.decode() if isinstance(name, bytes) else str(name),
-            "compute_capability": ".".join(map(str, getattr(dev, "compute_capability", ()))),
-            "numba_cuda": getattr(sim_cuda.cuda, "implementation", "?")}
+    return {
+        "name": name.decode() if isinstance(name, bytes) else str(name),
+        "compute_capability": ".".join(map(str, getattr(dev, "compute_capability", ()))),
+        "numba_cuda": getattr(sim_cuda.cuda, "implementation", "?"),
+    }
 
 
 def _agreement_jobs() -> tuple[PolicyTable, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -51,8 +53,7 @@ def _agreement_jobs() -> tuple[PolicyTable, np.ndarray, np.ndarray, np.ndarray, 
     mlp = prototype("mlp", "baseline").genome + np.random.default_rng(0).normal(0, 0.01, 42)
     policies = [baseline_policy(), prototype("mlp", "baseline"), Policy("mlp", mlp), Policy("slp", rolling)]
     fghh = get_task_family("fghh", 0.3)
-    rows = np.vstack([get_task_family("ghh09").mdp("train:0").row(), fghh.sample_rows(np.random.default_rng(5), 2),
-                      fghh.zero().row()])
+    rows = np.vstack([get_task_family("ghh09").mdp("train:0").row(), fghh.sample_rows(np.random.default_rng(5), 2), fghh.zero().row()])
     p, m, e = (a.ravel() for a in np.meshgrid(np.arange(len(policies)), np.arange(len(rows)), np.arange(8), indexing="ij"))
     return PolicyTable.from_policies(policies), rows, p, m, m * 8 + e
 
@@ -64,13 +65,17 @@ def agreement(n_steps: int = EPISODE_STEPS) -> dict:
     gpu = evaluate_jobs(table, rows, p, m, e, seed=3, n_steps=n_steps, device="cuda")
     same = (gpu.crashed == cpu.crashed) & (gpu.steps == cpu.steps)
     rel = (np.abs(gpu.returns - cpu.returns) / np.maximum(np.abs(cpu.returns), 1e-300))[same].max(initial=0.0)
-    return {"episodes": int(p.size), "crashed": int(cpu.crashed.sum()), "max_relative_return_difference": float(rel),
-            "bit_equal_returns": int((gpu.returns == cpu.returns).sum()), "crash_or_step_mismatches": int((~same).sum()),
-            "within_tolerance": bool(same.all() and rel <= GPU_RTOL)}
+    return {
+        "episodes": int(p.size),
+        "crashed": int(cpu.crashed.sum()),
+        "max_relative_return_difference": float(rel),
+        "bit_equal_returns": int((gpu.returns == cpu.returns).sum()),
+        "crash_or_step_mismatches": int((~same).sum()),
+        "within_tolerance": bool(same.all() and rel <= GPU_RTOL),
+    }
 
 
-def gpu_episodes_per_second(episodes: int, repeats: int = 2, n_steps: int = EPISODE_STEPS,
-                            threads_per_block: int | None = None) -> float:
+def gpu_episodes_per_second(episodes: int, repeats: int = 2, n_steps: int = EPISODE_STEPS, threads_per_block: int | None = None) -> float:
     """MLP baseline on the zero setting, one batch of ``episodes`` on the GPU (best of ``repeats``), in
     full (6000-step) episodes per second."""
     from .sim import cuda as sim_cuda
@@ -82,8 +87,7 @@ def gpu_episodes_per_second(episodes: int, repeats: int = 2, n_steps: int = EPIS
     sim_cuda.THREADS_PER_BLOCK = threads_per_block or default
     try:
         for _ in range(repeats):
-            ev = evaluate_jobs([prototype("mlp", "baseline")], mdp, idx, idx, np.arange(episodes), seed=1,
-                               n_steps=n_steps, device="cuda")
+            ev = evaluate_jobs([prototype("mlp", "baseline")], mdp, idx, idx, np.arange(episodes), seed=1, n_steps=n_steps, device="cuda")
             assert not ev.crashed.any()
             best = min(best, ev.seconds)
     finally:
@@ -132,8 +136,7 @@ def gpu_benchmarks(quick: bool = False, cpu_episodes_per_second: float | None = 
     for n in QUICK_BATCHES if quick else BATCHES:
         report[f"episodes_per_second_batch_{n}"] = gpu_episodes_per_second(n, 1 if quick else 2)
     if not quick:  # the launch shape: THREADS_PER_BLOCK is a guess until measured
-        report["episodes_per_second_batch_50000_by_block_size"] = {
-            tpb: gpu_episodes_per_second(50_000, 1, threads_per_block=tpb) for tpb in (64, 128, 256)}
+        report["episodes_per_second_batch_50000_by_block_size"] = {tpb: gpu_episodes_per_second(50_000, 1, threads_per_block=tpb) for tpb in (64, 128, 256)}
     report["fghh_generation_50x5"] = fghh_generation(repeats=1 if quick else 3)
     cores = numba.config.NUMBA_NUM_THREADS
     if cpu_episodes_per_second is None:
@@ -147,11 +150,13 @@ def format_gpu(report: dict) -> list[str]:
     if "device" not in report:
         return [f"  {'gpu':<34} {report.get('status', 'no CUDA device')}"]
     d, a, g = report["device"], report["agreement"], report["fghh_generation_50x5"]
-    lines = [f"  gpu: {d['name']} (compute capability {d['compute_capability']}, numba.cuda {d['numba_cuda']}), "
-             f"kernel compiled in {report['compile_seconds']:.1f} s",
-             f"    agreement with the CPU kernel on {a['episodes']} full episodes: max relative return difference "
-             f"{a['max_relative_return_difference']:.2g}, {a['crash_or_step_mismatches']} crash/step mismatches "
-             f"({'within' if a['within_tolerance'] else 'OUTSIDE'} {GPU_RTOL:g})"]
+    lines = [
+        f"  gpu: {d['name']} (compute capability {d['compute_capability']}, numba.cuda {d['numba_cuda']}), "
+        f"kernel compiled in {report['compile_seconds']:.1f} s",
+        f"    agreement with the CPU kernel on {a['episodes']} full episodes: max relative return difference "
+        f"{a['max_relative_return_difference']:.2g}, {a['crash_or_step_mismatches']} crash/step mismatches "
+        f"({'within' if a['within_tolerance'] else 'OUTSIDE'} {GPU_RTOL:g})",
+    ]
     cpu = report.get("cpu_kernel_all_cores_episodes_per_second")
     for key, value in report.items():
         if key.startswith("episodes_per_second_batch_") and isinstance(value, float):
@@ -160,8 +165,10 @@ def format_gpu(report: dict) -> list[str]:
     sweep = report.get("episodes_per_second_batch_50000_by_block_size")
     if sweep:
         lines.append("    batch of 50000 by threads per block  " + ", ".join(f"{k}: {v:.0f}/s" for k, v in sweep.items()))
-    lines.append(f"    FGHH generation (50 x 5 fresh MDPs)   GPU {g['cuda_seconds']:.3f} s, CPU ({g['cpu_cores']} cores) "
-                 f"{g['cpu_seconds']:.3f} s; {g['crashed']} crashed, {g['mean_steps']:.0f} steps on average")
+    lines.append(
+        f"    FGHH generation (50 x 5 fresh MDPs)   GPU {g['cuda_seconds']:.3f} s, CPU ({g['cpu_cores']} cores) "
+        f"{g['cpu_seconds']:.3f} s; {g['crashed']} crashed, {g['mean_steps']:.0f} steps on average"
+    )
     return lines
 
 

@@ -49,9 +49,15 @@ def _family_and_mdps(args: argparse.Namespace, n: int, rng: np.random.Generator)
 
 def _add_task_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--task", required=True, help="task family: ghh08, ghh09 or fghh")
-    p.add_argument("--mdp", help="zero (default), train:N, test:N (the competition sets), seeded-train:N, seeded-test:N, or sample (a fresh MDP from G per episode)")
+    p.add_argument(
+        "--mdp", help="zero (default), train:N, test:N (the competition sets), seeded-train:N, seeded-test:N, or sample (a fresh MDP from G per episode)"
+    )
     p.add_argument("--wind", help="GHH-08 only: constant wind U,V in m/s, each in [-5, 5] (instead of --mdp)")
-    p.add_argument("--params", help="explicit MDP parameters, comma-separated (instead of --mdp): GHH-08 wind_u,wind_v; GHH-09 its 8 parameters in [0,1]; FGHH the 11 dynamics parameters")
+    p.add_argument(
+        "--params",
+        help="explicit MDP parameters, comma-separated (instead of --mdp): GHH-08 wind_u,wind_v; "
+        "GHH-09 its 8 parameters in [0,1]; FGHH the 11 dynamics parameters",
+    )
     p.add_argument("--sigma", type=float, help="FGHH breadth sigma (default 0.3)")
 
 
@@ -70,12 +76,26 @@ def _fly(policy, mdps: list, args: argparse.Namespace, show_progress: bool):
     n = len(mdps)
     returns, crashed, seconds, flight = [], [], 0.0, None
     # Every episode's gusts come from (seed, episode index), so chunking changes no result.
-    with tqdm(total=n, desc=f"fly {mdps[0].label if len(unique) == 1 else 'MDPs'}", unit="ep", file=sys.stderr,
-              disable=None if show_progress else True, dynamic_ncols=True) as bar:
+    with tqdm(
+        total=n,
+        desc=f"fly {mdps[0].label if len(unique) == 1 else 'MDPs'}",
+        unit="ep",
+        file=sys.stderr,
+        disable=None if show_progress else True,
+        dynamic_ncols=True,
+    ) as bar:
         for start in range(0, n, FLY_CHUNK if show_progress else n):
             idx = np.arange(start, min(n, start + (FLY_CHUNK if show_progress else n)))
-            ev = evaluate_jobs([policy], unique, np.zeros(idx.size, dtype=np.int64), mdp_index[idx], idx, seed=args.seed,
-                               record=np.full(idx.size, args.record is not None), threads=args.threads)
+            ev = evaluate_jobs(
+                [policy],
+                unique,
+                np.zeros(idx.size, dtype=np.int64),
+                mdp_index[idx],
+                idx,
+                seed=args.seed,
+                record=np.full(idx.size, args.record is not None),
+                threads=args.threads,
+            )
             returns.append(ev.returns)
             crashed.append(ev.crashed)
             seconds += ev.seconds
@@ -101,15 +121,21 @@ def cmd_fly(args: argparse.Namespace) -> int:
         output_file(args.record, "--record")
     returns, crashed, seconds, fd, n_unique = _fly(policy, mdps, args, show_progress=not args.json)
     if fd is not None:
-        fd.metadata.update({"task": family.name, "mdps": [m.to_dict() for m in mdps], "policy": str(args.policy),
-                            "seed": args.seed, "returns": returns.tolist()})
+        fd.metadata.update(
+            {"task": family.name, "mdps": [m.to_dict() for m in mdps], "policy": str(args.policy), "seed": args.seed, "returns": returns.tolist()}
+        )
         fd.save(args.record)
     summary = {
-        "task": family.name, "mdp": mdps[0].label if n_unique == 1 else f"{n_unique} MDPs",
-        "policy": str(args.policy), "episodes": args.episodes,
-        "mean_return": float(returns.mean()), "std_return": float(returns.std()),
-        "min_return": float(returns.min()), "max_return": float(returns.max()),
-        "crashes": int(crashed.sum()), "episodes_per_second": args.episodes / seconds if seconds > 0 else float("inf"),
+        "task": family.name,
+        "mdp": mdps[0].label if n_unique == 1 else f"{n_unique} MDPs",
+        "policy": str(args.policy),
+        "episodes": args.episodes,
+        "mean_return": float(returns.mean()),
+        "std_return": float(returns.std()),
+        "min_return": float(returns.min()),
+        "max_return": float(returns.max()),
+        "crashes": int(crashed.sum()),
+        "episodes_per_second": args.episodes / seconds if seconds > 0 else float("inf"),
     }
     if args.record is not None:
         summary["flight_data"] = str(args.record)
@@ -160,7 +186,9 @@ def _version() -> str:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="neurohover", description="Generalized helicopter hovering (Koppejan & Whiteson 2011): fly, evolve, learn models, compete, reproduce.")
+    parser = argparse.ArgumentParser(
+        prog="neurohover", description="Generalized helicopter hovering (Koppejan & Whiteson 2011): fly, evolve, learn models, compete, reproduce."
+    )
     parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
@@ -188,7 +216,6 @@ def build_parser() -> argparse.ArgumentParser:
     for module in COMMAND_MODULES:
         importlib.import_module(module).register(sub)
     return parser
-
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -17,8 +17,15 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
         raise NeurohoverError(f"--budget {args.budget} is out of range: allowed >= 1")
     if args.out is not None:
         output_dir(args.out, "--out")
-    ps = build_policy_set(args.task, args.out, budget=args.budget, fghh_budget=args.fghh_budget, seed=args.seed,
-                          n_steps=args.episode_steps, progress=lambda msg: print(msg, file=sys.stderr, flush=True))
+    ps = build_policy_set(
+        args.task,
+        args.out,
+        budget=args.budget,
+        fghh_budget=args.fghh_budget,
+        seed=args.seed,
+        n_steps=args.episode_steps,
+        progress=lambda msg: print(msg, file=sys.stderr, flush=True),
+    )
     print(f"policy set written to {ps.directory}")
     return 0
 
@@ -33,8 +40,13 @@ def cmd_compete(args: argparse.Namespace) -> int:
     given = [f"--{k.replace('_', '-')}" for k in _HYBRID_OPTIONS if getattr(args, k) is not None]
     if given and args.agent not in HYBRID_AGENTS:
         raise NeurohoverError(f"{', '.join(given)} apply to the hybrid agents only ({', '.join(HYBRID_AGENTS)}), not to --agent {args.agent}")
-    given_values = {"rule": args.safeguard_rule, "box": args.safeguard_box, "tilt": args.safeguard_tilt,
-                    "replacement": args.hybrid_replacement, "model_from": args.hybrid_model_from}
+    given_values = {
+        "rule": args.safeguard_rule,
+        "box": args.safeguard_box,
+        "tilt": args.safeguard_tilt,
+        "replacement": args.hybrid_replacement,
+        "model_from": args.hybrid_model_from,
+    }
     hybrid = HybridSettings.from_dict({k: v for k, v in given_values.items() if v is not None})
     if args.policy_dir is not None:
         input_dir(args.policy_dir, "--policy-dir")
@@ -43,17 +55,32 @@ def cmd_compete(args: argparse.Namespace) -> int:
         output_file(args.store, "--store")
     try:
         summary, _ = compete(
-            args.task, args.agent, runs=args.runs, episodes=args.episodes, mdps=args.mdps, seed=args.seed,
-            jobs=args.jobs, out=args.out, sigma=args.sigma, n_steps=args.episode_steps, policy_dir=args.policy_dir, hybrid=hybrid,
-            store=args.store, progress=None,
+            args.task,
+            args.agent,
+            runs=args.runs,
+            episodes=args.episodes,
+            mdps=args.mdps,
+            seed=args.seed,
+            jobs=args.jobs,
+            out=args.out,
+            sigma=args.sigma,
+            n_steps=args.episode_steps,
+            policy_dir=args.policy_dir,
+            hybrid=hybrid,
+            store=args.store,
+            progress=None,
         )
     except KeyboardInterrupt:
-        print(f"neurohover compete: interrupted; the finished runs are in {args.out}/episodes.csv and the results store; "
-              "run the same command again to resume", file=sys.stderr)
+        print(
+            f"neurohover compete: interrupted; the finished runs are in {args.out}/episodes.csv and the results store; run the same command again to resume",
+            file=sys.stderr,
+        )
         return 130
     print(f"{'agent':<18} {'runs':>5} {'mean cum. return':>17} {'sd':>12} {'crash rate':>11} {'return/ep after learning':>25}")
-    print(f"{summary['agent']:<18} {summary['runs']:>5} {summary['mean_cumulative_return']:>17.5g} {summary['sd_cumulative_return']:>12.4g} "
-          f"{summary['crash_rate_runs']:>11.1%} {summary['mean_return_after_learning']:>25.5g}")
+    print(
+        f"{summary['agent']:<18} {summary['runs']:>5} {summary['mean_cumulative_return']:>17.5g} {summary['sd_cumulative_return']:>12.4g} "
+        f"{summary['crash_rate_runs']:>11.1%} {summary['mean_return_after_learning']:>25.5g}"
+    )
     print(f"results: {args.out}/episodes.csv, {args.out}/summary.json, {args.out}/cumulative.png; store: {summary['store']}")
     return 0
 

@@ -125,34 +125,57 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     settings = None
     if args.plateau_rule is not None:
         if args.optimizer != "ne" or mdp_desc == MDP_FAMILY:
-            raise NeurohoverError(f"--plateau-rule {args.plateau_rule} applies to the steady-state method only "
-                                  "(optimizer ne on one MDP)")
+            raise NeurohoverError(f"--plateau-rule {args.plateau_rule} applies to the steady-state method only (optimizer ne on one MDP)")
         settings = {"plateau_rule": args.plateau_rule}
     bar = _Bar(args.budget, f"evolve {family.name}/{mdp_desc}")
     try:
-        result = evolve(target, topology=topology, prototype=proto, optimizer=args.optimizer, resampling=resampling,
-                        budget=args.budget, seed=args.seed, n_steps=args.episode_steps, threads=args.threads,
-                        progress=bar, checkpoint=checkpoint, checkpoint_every_s=args.checkpoint_every,
-                        resume=args.resume, settings=settings)
+        result = evolve(
+            target,
+            topology=topology,
+            prototype=proto,
+            optimizer=args.optimizer,
+            resampling=resampling,
+            budget=args.budget,
+            seed=args.seed,
+            n_steps=args.episode_steps,
+            threads=args.threads,
+            progress=bar,
+            checkpoint=checkpoint,
+            checkpoint_every_s=args.checkpoint_every,
+            resume=args.resume,
+            settings=settings,
+        )
     except EvolutionInterrupted as err:
         bar.close()
         if err.checkpoint is not None:
-            print(f"neurohover evolve: interrupted after {err.episodes} episodes; checkpoint saved to {err.checkpoint} "
-                  "(run the same command with --resume to continue)", file=sys.stderr)
+            print(
+                f"neurohover evolve: interrupted after {err.episodes} episodes; checkpoint saved to {err.checkpoint} "
+                "(run the same command with --resume to continue)",
+                file=sys.stderr,
+            )
         else:
-            print(f"neurohover evolve: interrupted mid-generation; the last periodic checkpoint (if any) is {checkpoint}",
-                  file=sys.stderr)
+            print(f"neurohover evolve: interrupted mid-generation; the last periodic checkpoint (if any) is {checkpoint}", file=sys.stderr)
         return 130
     bar.close()
-    validation = validation_return(result.champion, target, episodes=args.validation_episodes, seed=args.seed,
-                                   n_steps=args.episode_steps, threads=args.threads)
+    validation = validation_return(result.champion, target, episodes=args.validation_episodes, seed=args.seed, n_steps=args.episode_steps, threads=args.threads)
     meta = {
-        "task": family.name, "mdp": mdp_desc, "optimizer": args.optimizer, "resampling": str(resampling),
-        "budget": args.budget, "seed": args.seed, "seed_policy": str(args.seed_policy),
-        "champion_return": result.champion_return, "validation_return": float(validation.mean()),
-        "validation_sd": float(validation.std()), "validation_episodes": int(validation.size),
-        "episode_steps": args.episode_steps, "episodes": result.episodes, "evaluations": result.evaluations,
-        "generations": result.generations, "seconds": round(result.seconds, 3), "stop_reason": result.stop_reason,
+        "task": family.name,
+        "mdp": mdp_desc,
+        "optimizer": args.optimizer,
+        "resampling": str(resampling),
+        "budget": args.budget,
+        "seed": args.seed,
+        "seed_policy": str(args.seed_policy),
+        "champion_return": result.champion_return,
+        "validation_return": float(validation.mean()),
+        "validation_sd": float(validation.std()),
+        "validation_episodes": int(validation.size),
+        "episode_steps": args.episode_steps,
+        "episodes": result.episodes,
+        "evaluations": result.evaluations,
+        "generations": result.generations,
+        "seconds": round(result.seconds, 3),
+        "stop_reason": result.stop_reason,
         "history": history_path.name,
     }
     if family.sigma is not None:
@@ -162,10 +185,17 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     save_policy(result.champion, out, **meta)
     write_history_csv(result.history, history_path)
     summary = {
-        "policy": str(out), "history": str(history_path), "checkpoint": str(checkpoint),
-        "champion_return": result.champion_return, "validation_return": float(validation.mean()),
-        "validation_sd": float(validation.std()), "episodes": result.episodes, "generations": result.generations,
-        "seconds": result.seconds, "episodes_per_second": result.episodes_per_second, "stop_reason": result.stop_reason,
+        "policy": str(out),
+        "history": str(history_path),
+        "checkpoint": str(checkpoint),
+        "champion_return": result.champion_return,
+        "validation_return": float(validation.mean()),
+        "validation_sd": float(validation.std()),
+        "episodes": result.episodes,
+        "generations": result.generations,
+        "seconds": result.seconds,
+        "episodes_per_second": result.episodes_per_second,
+        "stop_reason": result.stop_reason,
     }
     if args.json:
         print(json.dumps(summary))
@@ -189,7 +219,7 @@ class _Ticker:
         while not self._stop.wait(0.5):
             self.bar.refresh()
 
-    def __enter__(self) -> "_Ticker":
+    def __enter__(self) -> _Ticker:
         self._thread.start()
         return self
 
@@ -218,7 +248,7 @@ def _true_mdp(metadata: dict):
 def cmd_learn_model(args: argparse.Namespace) -> int:
     """Learn a helicopter model from flight data (LR, EC-MENO or EC-MER) and print its parameters."""
     from .flightdata import FlightData
-    from .models import format_parameter_table, learn_ec_mer, learn_ec_meno, learn_lr, parameter_table
+    from .models import format_parameter_table, learn_ec_meno, learn_ec_mer, learn_lr, parameter_table
     from .paths import input_file, output_file
     from .policies import load_policy
 
@@ -282,48 +312,67 @@ def model_notes(model, data, truth, rows) -> list[str]:
     notes = []
     nan_axes = [r.name for r in rows if not np.isfinite(r.learned)]
     if nan_axes:
-        notes.append(f"note: {', '.join(nan_axes)} show nan: on their axis the learned one-step multiplier 1 + 0.1*C is not "
-                     "positive, which no 10-substep integration can produce; the model itself is still a valid "
-                     "one-substep model (the model file holds its values)")
+        notes.append(
+            f"note: {', '.join(nan_axes)} show nan: on their axis the learned one-step multiplier 1 + 0.1*C is not "
+            "positive, which no 10-substep integration can produce; the model itself is still a valid "
+            "one-substep model (the model file holds its values)"
+        )
     if data.n_transitions < MIN_TRANSITIONS:
-        notes.append(f"warning: only {data.n_transitions} transitions (fewer than {MIN_TRANSITIONS}, one minute of flight); "
-                     "estimates from so little data are unreliable")
+        notes.append(
+            f"warning: only {data.n_transitions} transitions (fewer than {MIN_TRANSITIONS}, one minute of flight); estimates from so little data are unreliable"
+        )
     if truth is not None and truth.wind_kind != WIND_NONE and any(w != 0 for w in truth.wind):
         absorbed = f" (fitted D_u = {model.d_u:.4g})" if model.d_u else ""
-        notes.append(f"note: the data were flown in wind ({truth.label or truth.wind}); a learned model has no wind, so the "
-                     f"wind's force is absorbed into its constants{absorbed} and biases the drag terms "
-                     f"({', '.join(PARAM_NAMES[:3])}): their errors above are not only estimation error")
+        notes.append(
+            f"note: the data were flown in wind ({truth.label or truth.wind}); a learned model has no wind, so the "
+            f"wind's force is absorbed into its constants{absorbed} and biases the drag terms "
+            f"({', '.join(PARAM_NAMES[:3])}): their errors above are not only estimation error"
+        )
     mdps = [model.mdp("learned")] + ([truth] if truth is not None else [])
     ev = evaluate(baseline_policy(), mdps, episodes=CHECK_EPISODES, seed=0)
     crashed = ev.crashed.sum(axis=(0, 2))
     if crashed[0] and (truth is None or not crashed[1]):
         steps = ev.steps[0, 0][ev.crashed[0, 0]]
         where = "" if truth is None else ", while it never crashes in the true MDP"
-        notes.append(f"warning: the baseline policy crashes on this model in {crashed[0]} of {CHECK_EPISODES} episodes "
-                     f"(after {steps.min()}-{steps.max()} steps){where}: the model's closed-loop dynamics differ from the "
-                     "helicopter's, so do not read its parameters as the truth, and check any policy planned on it in the true MDP")
+        notes.append(
+            f"warning: the baseline policy crashes on this model in {crashed[0]} of {CHECK_EPISODES} episodes "
+            f"(after {steps.min()}-{steps.max()} steps){where}: the model's closed-loop dynamics differ from the "
+            "helicopter's, so do not read its parameters as the truth, and check any policy planned on it in the true MDP"
+        )
     return notes
 
 
 def register(sub) -> None:
-    p = sub.add_parser("evolve", help="evolve a policy on an MDP (steady state) or over a task family (generational)",
-                       description=(cmd_evolve.__doc__ or "") + "\n\n" + (__doc__ or "").split("\n\n", 1)[1],
-                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = sub.add_parser(
+        "evolve",
+        help="evolve a policy on an MDP (steady state) or over a task family (generational)",
+        description=(cmd_evolve.__doc__ or "") + "\n\n" + (__doc__ or "").split("\n\n", 1)[1],
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("--task", required=True, help="task family: ghh08, ghh09 or fghh")
-    p.add_argument("--mdp", help="zero, train:N, test:N, seeded-train:N, seeded-test:N, sample (one MDP drawn from G with --seed), or G: evolve over "
-                                 "the family's distribution, a fresh MDP per episode (generational). Default: G for fghh, zero otherwise")
+    p.add_argument(
+        "--mdp",
+        help="zero, train:N, test:N, seeded-train:N, seeded-test:N, sample (one MDP drawn from G with --seed), or G: evolve over "
+        "the family's distribution, a fresh MDP per episode (generational). Default: G for fghh, zero otherwise",
+    )
     p.add_argument("--wind", help="GHH-08 only: evolve on the constant wind U,V (m/s, each in [-5, 5])")
     p.add_argument("--params", help="evolve on explicit MDP parameters, comma-separated (GHH-08 2, GHH-09 8, FGHH 11)")
     p.add_argument("--sigma", type=float, help="FGHH breadth sigma (default 0.3)")
     p.add_argument("--topology", choices=("slp", "mlp"), help="network (default mlp, or the seed policy file's)")
     p.add_argument("--seed-policy", default="baseline", help="prototype: zero, baseline (baseline-equivalent network; default) or a policy FILE")
     p.add_argument("--optimizer", choices=("ne", "cma"), default="ne", help="ne: the paper's neuroevolution (default); cma: CMA-ES, same budget and resampling")
-    p.add_argument("--resampling", default="fixed:1", help="fixed:K (mean of K episodes per candidate; default fixed:1) or race:DELTA "
-                                                           "(selection races at confidence 0<DELTA<1; generational only)")
+    p.add_argument(
+        "--resampling",
+        default="fixed:1",
+        help="fixed:K (mean of K episodes per candidate; default fixed:1) or race:DELTA (selection races at confidence 0<DELTA<1; generational only)",
+    )
     p.add_argument("--budget", type=int, help="episodes to fly (default: the paper's stop: plateau for steady state, 4000 generations for generational)")
-    p.add_argument("--plateau-rule", choices=("no-crash", "literal"),
-                   help="steady state: no-crash (default) counts the plateau only once the champion completed an episode "
-                        "without crashing (a run whose champion still crashes ends at --budget only); literal: Appendix A as written")
+    p.add_argument(
+        "--plateau-rule",
+        choices=("no-crash", "literal"),
+        help="steady state: no-crash (default) counts the plateau only once the champion completed an episode "
+        "without crashing (a run whose champion still crashes ends at --budget only); literal: Appendix A as written",
+    )
     p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")
     p.add_argument("--seed", type=int, default=0, help="root seed of the run (default 0)")
     p.add_argument("--threads", type=int, help="kernel threads (default: all cores; results do not depend on it)")
@@ -338,10 +387,16 @@ def register(sub) -> None:
     p.add_argument("--flight-data", required=True, metavar="FILE", help="flight data (.npz, e.g. from neurohover fly --record)")
     p.add_argument("--method", required=True, choices=("lr", "ec-meno", "ec-mer"), help="lr (least squares), ec-meno or ec-mer (evolution)")
     p.add_argument("--out", required=True, metavar="FILE", help="model file to write (JSON)")
-    p.add_argument("--budget", type=int, help="evaluations for ec-meno / ec-mer (defaults: ec-meno runs to the paper's "
-                                                   "plateau stop, 1000 evaluations without a new champion; ec-mer 500)")
-    p.add_argument("--estimator", choices=("ols", "gls"), help="lr: ols, ordinary least squares (default, as the paper), or gls, "
-                                                             "quasi-differencing by the gusts' AR(1) coefficient")
+    p.add_argument(
+        "--budget",
+        type=int,
+        help="evaluations for ec-meno / ec-mer (defaults: ec-meno runs to the paper's plateau stop, 1000 evaluations without a new champion; ec-mer 500)",
+    )
+    p.add_argument(
+        "--estimator",
+        choices=("ols", "gls"),
+        help="lr: ols, ordinary least squares (default, as the paper), or gls, quasi-differencing by the gusts' AR(1) coefficient",
+    )
     p.add_argument("--seed", type=int, default=0, help="seed of the evolution (ec-meno, ec-mer)")
     p.add_argument("--policy", help="ec-mer: the policy that flew the data (default: the flight data's metadata, else baseline)")
     p.set_defaults(func=cmd_learn_model)

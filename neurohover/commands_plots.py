@@ -52,9 +52,12 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
 
 def register(sub) -> None:
-    p = sub.add_parser("plot", help="plot recorded flights (fly --record) or overlay competition results (compete --out)",
-                       description=(cmd_plot.__doc__ or "") + "\n\n" + __doc__.split("\n\n", 1)[1],
-                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = sub.add_parser(
+        "plot",
+        help="plot recorded flights (fly --record) or overlay competition results (compete --out)",
+        description=(cmd_plot.__doc__ or "") + "\n\n" + __doc__.split("\n\n", 1)[1],
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("flight", nargs="?", metavar="FLIGHT.npz", help="flight data written by neurohover fly --record")
     p.add_argument("--compete", nargs="+", metavar="DIR", help="directories written by neurohover compete --out, overlaid on one figure")
     p.add_argument("--out", metavar="DIR", help="directory for the PNG files (default: beside the input)")

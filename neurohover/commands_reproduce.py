@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 from .errors import NeurohoverError
 
@@ -45,12 +44,13 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         with Store(args.store) as store:
             for config in configs:
                 try:
-                    summary = reproduce(config, store, executor, fresh=args.fresh, progress=args.progress,
-                                        only=tuple(args.only or ()))
+                    summary = reproduce(config, store, executor, fresh=args.fresh, progress=args.progress, only=tuple(args.only or ()))
                 except KeyboardInterrupt:
                     done = len(store.results(config.name, config.scale))
-                    print(f"neurohover reproduce: interrupted; {done} finished units of {config.name} are in {args.store}; "
-                          f"run the same command again to resume", file=sys.stderr)
+                    print(
+                        f"neurohover reproduce: interrupted; {done} finished units of {config.name} are in {args.store}; run the same command again to resume",
+                        file=sys.stderr,
+                    )
                     return 130
                 print(summary.line())
                 failed = failed or not summary.succeeded
@@ -98,9 +98,12 @@ def register(sub) -> None:
     p.add_argument("--address", help="Ray cluster address (default: start a local Ray instance)")
     p.add_argument("--jobs", type=int, default=1, help="local worker processes (default 1: this process, kernel on all cores)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a setting of the config (TOML value), e.g. --set episodes=50")
-    p.add_argument("--only", action="append", metavar="PATTERN",
-                   help="run only the units whose keys match this glob (repeatable), e.g. 'run/hybrid/*/rep0'; "
-                        "the policies they fly are always made")
+    p.add_argument(
+        "--only",
+        action="append",
+        metavar="PATTERN",
+        help="run only the units whose keys match this glob (repeatable), e.g. 'run/hybrid/*/rep0'; the policies they fly are always made",
+    )
     p.add_argument("--fresh", action="store_true", help="discard the experiment's stored results at this scale first")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None, help="progress bar (default: when stderr is a terminal)")
     p.add_argument("--list", action="store_true", help="list the experiments and exit")
@@ -120,4 +123,3 @@ def register(sub) -> None:
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--scale", choices=("quick", "paper"), help="only this scale (default: every scale in the store)")
     p.set_defaults(func=cmd_report)
-

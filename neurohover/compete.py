@@ -54,7 +54,7 @@ def summarise(results: Sequence) -> dict:
     """Summary figures over test runs (:class:`~neurohover.experiments.results.TestRunResult`; see the module docstring)."""
     scores = np.array([float(r.score) for r in results])
     returns = [np.array(r.returns, dtype=float) for r in results]
-    after = [ret[r.learning_episodes:] for r, ret in zip(results, returns, strict=True)]
+    after = [ret[r.learning_episodes :] for r, ret in zip(results, returns, strict=True)]
     crashes = np.array([len(r.crash_episodes) for r in results])
     return {
         "runs": len(results),
@@ -78,8 +78,7 @@ def episode_rows(run: int, result, n_steps: int) -> list[list]:
     for e, s in zip(result.crash_episodes, result.crash_steps or (), strict=False):
         steps[e] = s
     crashed, fired = set(result.crash_episodes), set(result.safeguard_episodes)
-    return [[run, result.mdp, e, repr(float(ret)), int(e in crashed), steps[e], policy[e], int(e in fired)]
-            for e, ret in enumerate(result.returns)]
+    return [[run, result.mdp, e, repr(float(ret)), int(e in crashed), steps[e], policy[e], int(e in fired)] for e, ret in enumerate(result.returns)]
 
 
 def plot_cumulative(curves: dict[str, np.ndarray], path: Path, title: str) -> Path:
@@ -118,14 +117,25 @@ def _group(task: str, runs: int, mdps: str) -> dict:
     if size is None or runs <= size:
         return {"mdps": mdps, "n_mdps": runs, "runs_per_mdp": 1}
     if runs % size:
-        raise NeurohoverError(f"runs={runs} on the {size} {mdps} MDPs of {task}: give at most {size} runs, or a "
-                              f"multiple of {size} (each MDP then gets the same number of runs)")
+        raise NeurohoverError(
+            f"runs={runs} on the {size} {mdps} MDPs of {task}: give at most {size} runs, or a multiple of {size} (each MDP then gets the same number of runs)"
+        )
     return {"mdps": mdps, "n_mdps": size, "runs_per_mdp": runs // size}
 
 
-def competition_config(task: str, agent: str, *, runs: int, episodes: int, mdps: str = "test", seed: int = 0,
-                       sigma: float | None = None, n_steps: int = EPISODE_STEPS, policy_dir: str | None = None,
-                       hybrid: HybridSettings = HybridSettings()):
+def competition_config(
+    task: str,
+    agent: str,
+    *,
+    runs: int,
+    episodes: int,
+    mdps: str = "test",
+    seed: int = 0,
+    sigma: float | None = None,
+    n_steps: int = EPISODE_STEPS,
+    policy_dir: str | None = None,
+    hybrid: HybridSettings = HybridSettings(),
+):
     """The inline experiment of a competition (an ``ExperimentConfig`` of kind ``test_runs``).
 
     Its scale is a digest of the settings, so competitions with other settings in the same store
@@ -142,11 +152,17 @@ def competition_config(task: str, agent: str, *, runs: int, episodes: int, mdps:
     group = {"agent": agent, **_group(task, runs, mdps)}
     if agent in HYBRID_AGENTS:
         group["hybrid"] = hybrid.to_dict()
-    settings = {"task": task, "sigma": sigma, "seed": seed, "n_steps": n_steps, "episodes": episodes,
-                "policies": policy_dir if policy_dir is not None else "shipped", "groups": [group]}
+    settings = {
+        "task": task,
+        "sigma": sigma,
+        "seed": seed,
+        "n_steps": n_steps,
+        "episodes": episodes,
+        "policies": policy_dir if policy_dir is not None else "shipped",
+        "groups": [group],
+    }
     digest = hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()[:10]
-    return make_config(f"compete-{task}-{agent}", "test_runs", f"settings-{digest}", settings,
-                       title=f"compete: {agent} on {task}")
+    return make_config(f"compete-{task}-{agent}", "test_runs", f"settings-{digest}", settings, title=f"compete: {agent} on {task}")
 
 
 def compete(
@@ -204,8 +220,9 @@ def compete(
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise NeurohoverError(f"jobs={jobs!r} is out of range: allowed an integer >= 1")
     check_agent(agent, get_task_family(task, sigma), policy_dir)
-    config = competition_config(task, agent, runs=runs, episodes=episodes, mdps=mdps, seed=seed, sigma=sigma,
-                                n_steps=n_steps, policy_dir=policy_dir, hybrid=hybrid)
+    config = competition_config(
+        task, agent, runs=runs, episodes=episodes, mdps=mdps, seed=seed, sigma=sigma, n_steps=n_steps, policy_dir=policy_dir, hybrid=hybrid
+    )
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     store_path = Path(store) if store is not None else out / STORE_FILE
@@ -224,11 +241,20 @@ def compete(
             keys = sorted((k for k in stored if k.startswith("run/")), key=_run_order)
             ordered = [TestRunResult.from_dict(stored[k], k) for k in keys]
             _write_episodes(out / "episodes.csv", ordered, n_steps)
-    summary = {"task": task, "agent": agent, "mdps": mdps, "seed": seed, "store": str(store_path),
-               "experiment": config.name, "scale": config.scale, **summarise(ordered)}
+    summary = {
+        "task": task,
+        "agent": agent,
+        "mdps": mdps,
+        "seed": seed,
+        "store": str(store_path),
+        "experiment": config.name,
+        "scale": config.scale,
+        **summarise(ordered),
+    }
     (out / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
-    plot_cumulative({agent: np.array([np.cumsum(np.array(r.returns, dtype=float)) for r in ordered])},
-                    out / "cumulative.png", f"{task}: {agent}, {len(ordered)} runs")
+    plot_cumulative(
+        {agent: np.array([np.cumsum(np.array(r.returns, dtype=float)) for r in ordered])}, out / "cumulative.png", f"{task}: {agent}, {len(ordered)} runs"
+    )
     return summary, ordered
 
 

@@ -41,7 +41,7 @@ class PolicyTable:
     genomes: np.ndarray  # (P, 42) float64
 
     @classmethod
-    def from_policies(cls, policies: Sequence[Policy]) -> "PolicyTable":
+    def from_policies(cls, policies: Sequence[Policy]) -> PolicyTable:
         if len(policies) == 0:
             raise NeurohoverError("no policies given: need at least one")
         kinds = np.array([_KIND[p.topology] for p in policies], dtype=np.int64)
@@ -51,7 +51,7 @@ class PolicyTable:
         return cls(kinds, genomes)
 
     @classmethod
-    def from_genomes(cls, genomes: np.ndarray, topology: str) -> "PolicyTable":
+    def from_genomes(cls, genomes: np.ndarray, topology: str) -> PolicyTable:
         """A table of genomes (P, D) of one topology (the evolution fast path)."""
         if topology not in TOPOLOGIES:
             raise NeurohoverError(f"unknown policy topology {topology!r}: allowed {', '.join(TOPOLOGIES)}")
@@ -101,9 +101,15 @@ class Evaluation:
     def episodes_per_second(self) -> float:
         return self.episodes / self.seconds if self.seconds > 0 else float("inf")
 
-    def reshape(self, shape: tuple[int, ...]) -> "Evaluation":
-        return Evaluation(self.returns.reshape(shape), self.crashed.reshape(shape), self.steps.reshape(shape),
-                          self.safeguard_step.reshape(shape), self.flight_data, self.seconds)
+    def reshape(self, shape: tuple[int, ...]) -> Evaluation:
+        return Evaluation(
+            self.returns.reshape(shape),
+            self.crashed.reshape(shape),
+            self.steps.reshape(shape),
+            self.safeguard_step.reshape(shape),
+            self.flight_data,
+            self.seconds,
+        )
 
 
 @contextlib.contextmanager
@@ -158,9 +164,26 @@ def _load_kernel() -> None:
     global _kernel_loaded
     if not _kernel_loaded:
         empty = np.zeros(0, dtype=np.int64)
-        rollout_batch(np.zeros((1, MDP_ROW_LEN)), np.zeros(1, dtype=np.int64), np.zeros((1, GENOME_WIDTH)),
-                      empty, empty, empty, empty, np.uint64(0), 1, False, SAFEGUARD_LIMITS, empty,
-                      np.zeros((0, 2, 12)), np.zeros((0, 1, 4)), np.zeros(0), np.zeros(0, dtype=np.bool_), empty, empty)
+        rollout_batch(
+            np.zeros((1, MDP_ROW_LEN)),
+            np.zeros(1, dtype=np.int64),
+            np.zeros((1, GENOME_WIDTH)),
+            empty,
+            empty,
+            empty,
+            empty,
+            np.uint64(0),
+            1,
+            False,
+            SAFEGUARD_LIMITS,
+            empty,
+            np.zeros((0, 2, 12)),
+            np.zeros((0, 1, 4)),
+            np.zeros(0),
+            np.zeros(0, dtype=np.bool_),
+            empty,
+            empty,
+        )
         _kernel_loaded = True
 
 
@@ -213,8 +236,10 @@ def evaluate_jobs(
 
         problem = sim_cuda.cuda_problem()
         if problem is not None:
-            raise NeurohoverError(f"device='cuda' cannot run here: {problem}. It needs an NVIDIA GPU with its driver and "
-                                  "pip install 'neurohover[cuda]' (numba-cuda); NUMBA_ENABLE_CUDASIM=1 runs numba's CUDA simulator instead")
+            raise NeurohoverError(
+                f"device='cuda' cannot run here: {problem}. It needs an NVIDIA GPU with its driver and "
+                "pip install 'neurohover[cuda]' (numba-cuda); NUMBA_ENABLE_CUDASIM=1 runs numba's CUDA simulator instead"
+            )
     table = policies if isinstance(policies, PolicyTable) else PolicyTable.from_policies(policies)
     rows = mdp_rows(mdps)
     if not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= _MAX_SEED:
@@ -233,8 +258,9 @@ def evaluate_jobs(
             raise NeurohoverError(f"fallback_index must have {n_jobs} entries in -1..{len(table) - 1}")
     limits = SAFEGUARD_LIMITS if safeguard_limits is None else np.asarray(safeguard_limits, dtype=float)
     if limits.shape != (10,) or not np.all(limits > 0) or np.isnan(limits).any():
-        raise NeurohoverError("safeguard_limits must be 10 positive numbers (u, v, w, x, y, z, p, q, r limits, "
-                              f"then the tilt threshold on qw), got {limits.tolist()}")
+        raise NeurohoverError(
+            f"safeguard_limits must be 10 positive numbers (u, v, w, x, y, z, p, q, r limits, then the tilt threshold on qw), got {limits.tolist()}"
+        )
     rec = np.zeros(n_jobs, dtype=bool) if record is None else np.asarray(record, dtype=bool).reshape(-1)
     if rec.shape[0] != n_jobs:
         raise NeurohoverError(f"record must have one flag per job ({n_jobs}), got {rec.shape[0]}")
@@ -256,8 +282,24 @@ def evaluate_jobs(
     start = time.perf_counter()
     with num_threads(threads):
         rollout(
-            rows, table.kinds, table.genomes, p_idx, m_idx, e_idx, fb, np.uint64(seed), n_steps,
-            bool((fb >= 0).any()), limits, slots, obs_out, act_out, returns, crashed, steps, sg_step,
+            rows,
+            table.kinds,
+            table.genomes,
+            p_idx,
+            m_idx,
+            e_idx,
+            fb,
+            np.uint64(seed),
+            n_steps,
+            bool((fb >= 0).any()),
+            limits,
+            slots,
+            obs_out,
+            act_out,
+            returns,
+            crashed,
+            steps,
+            sg_step,
         )
     seconds = time.perf_counter() - start
     flight = None
@@ -278,7 +320,7 @@ def evaluate(
     seed: int = 0,
     first_episode: int = 0,
     record: bool = False,
-    safeguard: "Safeguard | None" = None,
+    safeguard: Safeguard | None = None,
     n_steps: int = EPISODE_STEPS,
     threads: int | None = None,
     device: str = "cpu",
@@ -302,14 +344,24 @@ def evaluate(
     fallback = None
     limits = None
     if safeguard is not None:
-        table = PolicyTable(np.append(table.kinds, _KIND[safeguard.fallback.topology]),
-                            np.vstack([table.genomes, PolicyTable.from_policies([safeguard.fallback]).genomes]))
+        table = PolicyTable(
+            np.append(table.kinds, _KIND[safeguard.fallback.topology]), np.vstack([table.genomes, PolicyTable.from_policies([safeguard.fallback]).genomes])
+        )
         fallback = np.full(p_idx.size, n_pol, dtype=np.int64)
         limits = safeguard.dangerous.limits()
     ev = evaluate_jobs(
-        table, rows, p_idx.ravel(), m_idx.ravel(), episode_index.ravel(), seed=seed,
-        fallback_index=fallback, safeguard_limits=limits,
-        record=np.full(p_idx.size, record), n_steps=n_steps, threads=threads, device=device,
+        table,
+        rows,
+        p_idx.ravel(),
+        m_idx.ravel(),
+        episode_index.ravel(),
+        seed=seed,
+        fallback_index=fallback,
+        safeguard_limits=limits,
+        record=np.full(p_idx.size, record),
+        n_steps=n_steps,
+        threads=threads,
+        device=device,
     )
     return ev.reshape((n_pol, n_mdp, episodes))
 
@@ -388,9 +440,16 @@ class KernelFlyer:
             self._kinds = np.full(self._p_cap, self.kind, dtype=np.int64)
         if n_jobs > self._j_cap:
             self._j_cap = j = max(n_jobs, 2 * self._j_cap)
-            self._buffers = (np.zeros(j, dtype=np.int64), np.arange(j, dtype=np.int64), np.zeros(j, dtype=np.int64),
-                             np.full(j, -1, dtype=np.int64), np.zeros(j), np.zeros(j, dtype=np.bool_),
-                             np.zeros(j, dtype=np.int64), np.zeros(j, dtype=np.int64))
+            self._buffers = (
+                np.zeros(j, dtype=np.int64),
+                np.arange(j, dtype=np.int64),
+                np.zeros(j, dtype=np.int64),
+                np.full(j, -1, dtype=np.int64),
+                np.zeros(j),
+                np.zeros(j, dtype=np.bool_),
+                np.zeros(j, dtype=np.int64),
+                np.zeros(j, dtype=np.int64),
+            )
             self._views = {}
 
     def _views_for(self, n_jobs: int) -> tuple:
@@ -434,8 +493,26 @@ class KernelFlyer:
             numba.set_num_threads(want)
             self._threads = want
         t0 = time.perf_counter()
-        rollout_batch(rows, self._kinds, self._genomes, p, m, e, minus, self.seed, self.n_steps,
-                      False, self._limits, minus, self._obs, self._act, returns, crashed, steps, sg)
+        rollout_batch(
+            rows,
+            self._kinds,
+            self._genomes,
+            p,
+            m,
+            e,
+            minus,
+            self.seed,
+            self.n_steps,
+            False,
+            self._limits,
+            minus,
+            self._obs,
+            self._act,
+            returns,
+            crashed,
+            steps,
+            sg,
+        )
         self.kernel_seconds += time.perf_counter() - t0
         if self.trace is not None:
             self.trace.append((genomes.copy(), rows, p.copy(), m.copy(), e.copy()))

@@ -45,7 +45,7 @@ class FlightData:
     def n_transitions(self) -> int:
         return int(sum(a.shape[0] for a in self.actions))
 
-    def __add__(self, other: "FlightData") -> "FlightData":
+    def __add__(self, other: FlightData) -> FlightData:
         return FlightData(self.observations + other.observations, self.actions + other.actions, {**self.metadata, **other.metadata})
 
     def save(self, path: str | Path) -> Path:
@@ -55,7 +55,9 @@ class FlightData:
         lengths = np.array([a.shape[0] for a in self.actions], dtype=np.int64)
         with open(path, "wb") as f:  # a file object keeps numpy from appending ".npz"
             np.savez_compressed(
-                f, format=np.array(FORMAT), lengths=lengths,
+                f,
+                format=np.array(FORMAT),
+                lengths=lengths,
                 observations=np.concatenate(self.observations) if self.observations else np.zeros((0, 12)),
                 actions=np.concatenate(self.actions) if self.actions else np.zeros((0, 4)),
                 metadata=np.array(json.dumps(self.metadata)),
@@ -63,14 +65,15 @@ class FlightData:
         return path
 
     @classmethod
-    def load(cls, path: str | Path) -> "FlightData":
+    def load(cls, path: str | Path) -> FlightData:
         """Read flight data written by :meth:`save`; other files are refused with a clear message."""
         path = Path(path)
         if not path.is_file():
             raise NeurohoverError(f"flight-data file {str(path)!r} does not exist")
         if not zipfile.is_zipfile(path):  # np.load would try (and refuse) to unpickle anything else
-            raise NeurohoverError(f"{str(path)!r} is not a neurohover flight-data file: flight data are .npz archives "
-                                  "(written by neurohover fly --record or FlightData.save)")
+            raise NeurohoverError(
+                f"{str(path)!r} is not a neurohover flight-data file: flight data are .npz archives (written by neurohover fly --record or FlightData.save)"
+            )
         try:
             with np.load(path, allow_pickle=False) as z:
                 if "format" not in z.files or str(z["format"]) != FORMAT:
@@ -84,7 +87,10 @@ class FlightData:
         if lengths.size == 0 or lengths.sum() == 0:
             raise NeurohoverError(f"flight-data file {str(path)!r} holds no transitions")
         if obs.shape != (int(lengths.sum() + lengths.size), 12) or act.shape != (int(lengths.sum()), 4):
-            raise NeurohoverError(f"flight-data file {str(path)!r} is truncated or inconsistent: {lengths.size} episodes of {lengths.sum()} steps but arrays {obs.shape} and {act.shape}")
+            raise NeurohoverError(
+                f"flight-data file {str(path)!r} is truncated or inconsistent: {lengths.size} episodes of {lengths.sum()} steps "
+                f"but arrays {obs.shape} and {act.shape}"
+            )
         obs_split = np.split(obs, np.cumsum(lengths + 1)[:-1])
         act_split = np.split(act, np.cumsum(lengths)[:-1])
         return cls(tuple(obs_split), tuple(act_split), metadata)

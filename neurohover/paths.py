@@ -40,8 +40,7 @@ def _make_dirs(directory: Path, option: str, given: str) -> None:
         directory.mkdir(parents=True, exist_ok=True)
     except OSError as err:
         raise NeurohoverError(f"{option} {given!r}: cannot create the directory {str(directory)!r} ({_why(err)})") from None
-    print(f"neurohover: created directory {str(missing[-1])!r}" + (f" and {len(missing) - 1} below it" if len(missing) > 1 else ""),
-          file=sys.stderr)
+    print(f"neurohover: created directory {str(missing[-1])!r}" + (f" and {len(missing) - 1} below it" if len(missing) > 1 else ""), file=sys.stderr)
 
 
 def output_file(path: str | os.PathLike, option: str) -> Path:

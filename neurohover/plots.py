@@ -37,8 +37,15 @@ from .flightdata import FlightData
 from .sim.constants import ACTION_NAMES, CONTROL_DT, EPISODE_STEPS
 
 __all__ = [
-    "CompeteResult", "attitude_angles", "compete_figure", "crashed_episode", "flight_figure",
-    "plot_compete", "plot_flight_data", "read_compete_dir", "save_figure",
+    "CompeteResult",
+    "attitude_angles",
+    "compete_figure",
+    "crashed_episode",
+    "flight_figure",
+    "plot_compete",
+    "plot_flight_data",
+    "read_compete_dir",
+    "save_figure",
 ]
 
 CRASH_COLOR = "tab:red"

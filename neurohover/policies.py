@@ -26,22 +26,47 @@ INPUT_NAMES = ("u", "v", "w", "x", "y", "z", "qx", "qy", "qz")
 MLP_STEEPNESS = 4.924273
 MLP_BIAS_NAMES = ("hy", "hx", "hz", "L1", "L2", "L3", "L4", "S1", "S2", "S3", "S4", "a1", "a2", "a3", "a4")
 MLP_WEIGHT_NAMES = (
-    "y->hy", "x->hx", "z->hz",
-    "v->L1", "y->L1", "qx->L1", "hy->L1",
-    "u->L2", "x->L2", "qy->L2", "hx->L2",
+    "y->hy",
+    "x->hx",
+    "z->hz",
+    "v->L1",
+    "y->L1",
+    "qx->L1",
+    "hy->L1",
+    "u->L2",
+    "x->L2",
+    "qy->L2",
+    "hx->L2",
     "qz->L3",
-    "w->L4", "z->L4", "hz->L4",
-    "L1->S1", "L2->S2", "L3->S3", "L4->S4",
-    "L1->a1", "S1->a1", "L2->a2", "S2->a2", "L3->a3", "S3->a3", "L4->a4", "S4->a4",
+    "w->L4",
+    "z->L4",
+    "hz->L4",
+    "L1->S1",
+    "L2->S2",
+    "L3->S3",
+    "L4->S4",
+    "L1->a1",
+    "S1->a1",
+    "L2->a2",
+    "S2->a2",
+    "L3->a3",
+    "S3->a3",
+    "L4->a4",
+    "S4->a4",
 )
 MLP_GENE_NAMES = tuple(f"b:{n}" for n in MLP_BIAS_NAMES) + tuple(f"w:{n}" for n in MLP_WEIGHT_NAMES)
 
 # The competition's baseline policy: gains per (action, input) and output biases.
 BASELINE_GAINS = {
-    ("a1", "y"): -0.0196, ("a1", "v"): -0.0367, ("a1", "qx"): -0.7475,
-    ("a2", "x"): -0.0185, ("a2", "u"): -0.0322, ("a2", "qy"): 0.7904,
+    ("a1", "y"): -0.0196,
+    ("a1", "v"): -0.0367,
+    ("a1", "qx"): -0.7475,
+    ("a2", "x"): -0.0185,
+    ("a2", "u"): -0.0322,
+    ("a2", "qy"): 0.7904,
     ("a3", "qz"): -0.1969,
-    ("a4", "z"): 0.0513, ("a4", "w"): 0.1348,
+    ("a4", "z"): 0.0513,
+    ("a4", "w"): 0.1348,
 }
 BASELINE_BIASES = (0.02, 0.0, 0.0, 0.23)
 
@@ -91,9 +116,7 @@ class Policy:
         g = self.genome.tolist()
         if self.topology == "slp":
             inputs = (u, v, w, x, y, z, qx, qy, qz)
-            return tuple(
-                sum(g[9 * i + j] * inputs[j] for j in range(9)) + g[36 + i] for i in range(4)
-            )
+            return tuple(sum(g[9 * i + j] * inputs[j] for j in range(9)) + g[36 + i] for i in range(4))
         b, wt = g[:15], g[15:]
         hy = _sigmoid(b[0] + wt[0] * y)
         hx = _sigmoid(b[1] + wt[1] * x)
@@ -110,7 +133,7 @@ class Policy:
             b[14] + wt[25] * l4 + wt[26] * s4,
         )
 
-    def with_genome(self, genome: np.ndarray, **metadata) -> "Policy":
+    def with_genome(self, genome: np.ndarray, **metadata) -> Policy:
         """A policy of the same topology with another genome."""
         return Policy(self.topology, np.array(genome, dtype=float), {**self.metadata, **metadata})
 

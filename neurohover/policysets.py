@@ -51,8 +51,10 @@ def policy_dir(task: str, directory: str | Path | None = None) -> Path:
 
 def _load(path: Path, what: str) -> Policy:
     if not path.is_file():
-        raise NeurohoverError(f"policy set {str(path.parent)!r} is missing {what} ({path.name}); "
-                              f"build it with: neurohover build-policies --task {path.parent.name} --out {path.parent.parent}")
+        raise NeurohoverError(
+            f"policy set {str(path.parent)!r} is missing {what} ({path.name}); "
+            f"build it with: neurohover build-policies --task {path.parent.name} --out {path.parent.parent}"
+        )
     return load_policy(path)
 
 
@@ -62,8 +64,9 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
     root = policy_dir(family.name, directory)
     manifest_path = root / "manifest.json"
     if not manifest_path.is_file():
-        raise NeurohoverError(f"no policy set for {family.name} in {str(root)!r} (manifest.json missing); "
-                              f"build it with: neurohover build-policies --task {family.name}")
+        raise NeurohoverError(
+            f"no policy set for {family.name} in {str(root)!r} (manifest.json missing); build it with: neurohover build-policies --task {family.name}"
+        )
     manifest = json.loads(manifest_path.read_text())
     if family.generic_over_distribution:
         generics = {name: _load(root / f"generic_{name}.json", f"the {name} generic policy") for name in FGHH_GENERICS}
@@ -120,8 +123,7 @@ def build_policy_set(
             kwargs["settings"] = SteadyStateSettings(plateau_threshold=kwargs["budget"])
         result = evolve(target, topology="mlp", prototype=prototype("mlp", "baseline"), seed=child_seed, n_steps=n_steps, **kwargs)
         policy = result.champion
-        save_policy(policy, root / f"{name}.json", task=family.name, name=name, episodes=int(result.episodes),
-                    seconds=round(time.perf_counter() - t0, 2))
+        save_policy(policy, root / f"{name}.json", task=family.name, name=name, episodes=int(result.episodes), seconds=round(time.perf_counter() - t0, 2))
         say(f"{family.name}/{name}: champion {result.champion_return:.1f} after {result.episodes} episodes ({time.perf_counter() - t0:.0f} s)")
         return policy
 
@@ -141,9 +143,15 @@ def build_policy_set(
     specialised = [run(mdp, f"specialised_{i}", int(seeds[1 + i]), budget=budget) for i, mdp in enumerate(train)]
     crashes, returns = crash_matrix(specialised, train, safety_episodes, seed=int(seeds[11]), n_steps=n_steps)
     safe = choose_safe(crashes, returns)
-    manifest.update({"safe": list(safe), "safety_episodes": safety_episodes,
-                     "crashes_on_training_mdps": crashes.tolist(), "mean_return_on_training_mdps": returns.round(2).tolist(),
-                     "seconds": round(time.perf_counter() - start, 1)})
+    manifest.update(
+        {
+            "safe": list(safe),
+            "safety_episodes": safety_episodes,
+            "crashes_on_training_mdps": crashes.tolist(),
+            "mean_return_on_training_mdps": returns.round(2).tolist(),
+            "seconds": round(time.perf_counter() - start, 1),
+        }
+    )
     (root / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n")
     say(f"{family.name}: safe specialised policies {safe}")
     return PolicySet(family.name, root, generic, tuple(specialised), safe, manifest=manifest)

@@ -79,8 +79,7 @@ def worker_pool(jobs: int) -> ProcessPoolExecutor:
     Spawned, not forked: numba's thread pools are not fork-safe.
     """
     main = threading.current_thread() is threading.main_thread()
-    return ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("spawn"),
-                               initializer=watch_parent, initargs=(os.getpid(), main))
+    return ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("spawn"), initializer=watch_parent, initargs=(os.getpid(), main))
 
 
 def stop_pool(pool: ProcessPoolExecutor) -> None:

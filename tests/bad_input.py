@@ -30,10 +30,11 @@ CASES: list[tuple[list[str], str]] = [
     (["results", "fig2", "--store", "store.sqlite", "--out", "adir"], "is a directory"),
     (["results", "fig2", "--store", "adir"], "is a directory"),
     (["report", "--store", "store.sqlite", "--out", "afile"], "is a file; give a directory"),
-    (["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--out", "afile"],
-     "is a file; give a directory"),
-    (["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--out", "q",
-      "--policy-dir", "afile"], "is a file; give a directory"),
+    (["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--out", "afile"], "is a file; give a directory"),
+    (
+        ["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--out", "q", "--policy-dir", "afile"],
+        "is a file; give a directory",
+    ),
     (["build-policies", "--task", "ghh08", "--budget", "10", "--out", "afile"], "is a file; give a directory"),
     (["reproduce", "fig2", "--store", "adir"], "is a directory"),
     (["reproduce", "fig2", "--store", "/proc/s.sqlite"], "cannot create a file in '/proc'"),
@@ -45,10 +46,8 @@ CASES: list[tuple[list[str], str]] = [
     (["fly", "--task", "ghh08", "--params", "1,1", "--mdp", "test:3"], "cannot be combined with --mdp test:3"),
     (["evolve", "--task", "ghh08", "--wind", "1,1", "--mdp", "train:0", "--out", "p.json"], "cannot be combined with --mdp train:0"),
     (["learn-model", "--flight-data", "fd.npz", "--method", "lr", "--budget", "5", "--out", "m.json"], "not to --method lr"),
-    (["learn-model", "--flight-data", "fd.npz", "--method", "ec-meno", "--estimator", "ols", "--out", "m.json"],
-     "--estimator applies to --method lr only"),
-    (["learn-model", "--flight-data", "fd.npz", "--method", "lr", "--policy", "baseline", "--out", "m.json"],
-     "--policy applies to --method ec-mer only"),
+    (["learn-model", "--flight-data", "fd.npz", "--method", "ec-meno", "--estimator", "ols", "--out", "m.json"], "--estimator applies to --method lr only"),
+    (["learn-model", "--flight-data", "fd.npz", "--method", "lr", "--policy", "baseline", "--out", "m.json"], "--policy applies to --method ec-mer only"),
     (["reproduce", "fig2", "--store", "s.sqlite", "--address", "127.0.0.1:6379"], "add --executor ray"),
     (["compete", "--task", "ghh08", "--agent", "baseline", "--safeguard-box", "0.3", "--out", "q"], "hybrid agents only"),
 ]
@@ -71,8 +70,7 @@ def setup(directory: Path) -> Path:
 
 
 def run_case(args: list[str], cwd: Path, timeout: float = 120.0) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "neurohover", *args], cwd=cwd, capture_output=True, text=True,
-                          timeout=timeout)
+    return subprocess.run([sys.executable, "-m", "neurohover", *args], cwd=cwd, capture_output=True, text=True, timeout=timeout)
 
 
 def main() -> int:
@@ -84,8 +82,10 @@ def main() -> int:
             lines = proc.stderr.strip().splitlines()
             ok = proc.returncode == 2 and "Traceback" not in proc.stderr and len(lines) == 1 and expected in proc.stderr
             bad += not ok
-            print(f"{'ok ' if ok else 'BAD'} exit={proc.returncode} traceback={'Traceback' in proc.stderr} "
-                  f"neurohover {' '.join(args)} -> {lines[-1] if lines else '(no message)'}")
+            print(
+                f"{'ok ' if ok else 'BAD'} exit={proc.returncode} traceback={'Traceback' in proc.stderr} "
+                f"neurohover {' '.join(args)} -> {lines[-1] if lines else '(no message)'}"
+            )
     print(f"{len(CASES) - bad} of {len(CASES)} cases refused cleanly")
     return 1 if bad else 0
 

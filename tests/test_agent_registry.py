@@ -18,8 +18,18 @@ from neurohover.tasks import get_task_family
 
 def test_the_paper_agents_are_registered_with_their_tasks() -> None:
     assert list(AGENTS)[:2] == ["baseline", "generic"]
-    assert set(AGENTS) == {"baseline", "generic", "model-free", "model-based", "incremental", "incremental-zero",
-                           "incremental-fixed", "incremental-race", "hybrid", "hybrid-baseline"}
+    assert set(AGENTS) == {
+        "baseline",
+        "generic",
+        "model-free",
+        "model-based",
+        "incremental",
+        "incremental-zero",
+        "incremental-fixed",
+        "incremental-race",
+        "hybrid",
+        "hybrid-baseline",
+    }
     assert HYBRID_AGENTS == ("hybrid", "hybrid-baseline")
     assert AGENTS["model-free"].tasks == ("ghh08", "ghh09") and AGENTS["incremental-race"].tasks == ("fghh",)
 
@@ -58,13 +68,15 @@ def test_a_new_agent_module_is_discovered_without_editing_any_other_file(tmp_pat
     package = tmp_path / "myagents"
     package.mkdir()
     (package / "__init__.py").write_text("")
-    (package / "always_generic.py").write_text(textwrap.dedent('''
+    (package / "always_generic.py").write_text(
+        textwrap.dedent("""
         from neurohover.agents.reference import GenericAgent
         from neurohover.agents.spec import AgentSpec
 
         AGENT_SPECS = (AgentSpec("always-generic", ("ghh08",), frozenset({"generic"}),
                                  lambda policies, options: GenericAgent(policies.generic)),)
-    '''))
+    """)
+    )
     monkeypatch.syspath_prepend(str(tmp_path))
     specs = discover("myagents")
     assert list(specs) == ["always-generic"] and isinstance(specs["always-generic"], AgentSpec)
@@ -84,6 +96,5 @@ def test_a_policy_set_evolved_for_another_sigma_is_refused(tmp_path: Path, capsy
         make_agent("generic", get_task_family("fghh", 0.2))
     assert make_agent("generic", get_task_family("fghh", 0.3)).name == "generic"
     assert make_agent("baseline", get_task_family("fghh", 0.2)).name == "baseline"  # flies no policy set
-    rc = main(["compete", "--task", "fghh", "--sigma", "0.2", "--agent", "incremental-race", "--runs", "1",
-               "--episodes", "2", "--out", str(tmp_path / "c")])
+    rc = main(["compete", "--task", "fghh", "--sigma", "0.2", "--agent", "incremental-race", "--runs", "1", "--episodes", "2", "--out", str(tmp_path / "c")])
     assert rc == 2 and "evolved for sigma = 0.3, not 0.2" in capsys.readouterr().err

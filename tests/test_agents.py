@@ -125,7 +125,7 @@ def test_incremental_agent_stops_learning_by_its_rule() -> None:
     # The kept policy did at least as well as its model predicted, and is flown from then on.
     assert result.returns[k] >= agent.predicted and not result.crashed[k]
     assert set(result.policy[k:]) == {result.policy[k]}
-    assert (result.offline_seconds[k + 1:] == 0).all() and (result.offline_seconds[:k] > 0).all()
+    assert (result.offline_seconds[k + 1 :] == 0).all() and (result.offline_seconds[:k] > 0).all()
 
 
 def _roller() -> Policy:
@@ -137,8 +137,7 @@ def _roller() -> Policy:
 @pytest.mark.parametrize("replacement", ["rerank", "evolve"])
 def test_hybrid_discards_a_policy_that_needs_the_safeguard(replacement: str) -> None:
     family = get_task_family("ghh09")
-    agent = HybridAgent([_roller(), baseline_policy()], prototype("mlp", "baseline"), baseline_policy(), SHORT,
-                        hybrid=HybridSettings(replacement=replacement))
+    agent = HybridAgent([_roller(), baseline_policy()], prototype("mlp", "baseline"), baseline_policy(), SHORT, hybrid=HybridSettings(replacement=replacement))
     result = run_test(agent, family, family.zero(), episodes=12, seed=1, n_steps=1000)
     assert result.policy[0] == "safe:0" and result.safeguard_fired[0] and not result.crashed[0]
     assert agent.trial_fired[0] and not any(agent.trial_fired[1:])
@@ -173,8 +172,7 @@ def _flight(e: int):
 @pytest.mark.parametrize("model_from", ["first-safe", "both"])
 def test_hybrid_learns_its_model_from_the_chosen_trial_episodes(model_from: str) -> None:
     family = get_task_family("ghh09")
-    agent = HybridAgent([_roller(), baseline_policy()], prototype("mlp", "baseline"), baseline_policy(), SHORT,
-                        hybrid=HybridSettings(model_from=model_from))
+    agent = HybridAgent([_roller(), baseline_policy()], prototype("mlp", "baseline"), baseline_policy(), SHORT, hybrid=HybridSettings(model_from=model_from))
     run_test(agent, family, family.zero(), episodes=5, seed=3, n_steps=600)
     (first, fired0), (second, fired1) = agent.trial_data
     assert fired0 and not fired1
@@ -182,10 +180,13 @@ def test_hybrid_learns_its_model_from_the_chosen_trial_episodes(model_from: str)
     assert agent.model == expected
 
 
-@pytest.mark.parametrize(("kwargs", "message"), [
-    ({"replacement": "re-evolve"}, "unknown hybrid replacement 're-evolve': allowed rerank, evolve"),
-    ({"model_from": "first"}, "unknown hybrid model_from 'first': allowed first-safe, both"),
-])
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"replacement": "re-evolve"}, "unknown hybrid replacement 're-evolve': allowed rerank, evolve"),
+        ({"model_from": "first"}, "unknown hybrid model_from 'first': allowed first-safe, both"),
+    ],
+)
 def test_hybrid_settings_refuse_unknown_variants(kwargs: dict, message: str) -> None:
     with pytest.raises(NeurohoverError, match=message):
         HybridSettings(**kwargs)
@@ -193,22 +194,29 @@ def test_hybrid_settings_refuse_unknown_variants(kwargs: dict, message: str) -> 
 
 def test_compete_writes_results_plot_and_keeps_finished_runs_on_interrupt(tiny_policy_dir: Path, tmp_path: Path) -> None:
     out = tmp_path / "run"
-    summary, results = compete("ghh08", "model-free", runs=3, episodes=12, seed=1, jobs=2, out=out,
-                               n_steps=300, policy_dir=str(tiny_policy_dir))
+    summary, results = compete("ghh08", "model-free", runs=3, episodes=12, seed=1, jobs=2, out=out, n_steps=300, policy_dir=str(tiny_policy_dir))
     assert summary["runs"] == 3 and (out / "cumulative.png").stat().st_size > 1000
     rows = list(csv.DictReader(open(out / "episodes.csv")))
     assert len(rows) == 36 and {r["run"] for r in rows} == {"0", "1", "2"}
     assert summary["mean_cumulative_return"] == pytest.approx(np.mean([r.score for r in results]))
-    serial, _ = compete("ghh08", "model-free", runs=3, episodes=12, seed=1, jobs=1, out=tmp_path / "serial",
-                        n_steps=300, policy_dir=str(tiny_policy_dir))
+    serial, _ = compete("ghh08", "model-free", runs=3, episodes=12, seed=1, jobs=1, out=tmp_path / "serial", n_steps=300, policy_dir=str(tiny_policy_dir))
     assert serial["mean_cumulative_return"] == summary["mean_cumulative_return"]  # process count does not matter
 
     def interrupt_after_first(spec, result):
         raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        compete("ghh08", "model-free", runs=3, episodes=12, seed=1, out=tmp_path / "cut", n_steps=300,
-                policy_dir=str(tiny_policy_dir), on_result=interrupt_after_first)
+        compete(
+            "ghh08",
+            "model-free",
+            runs=3,
+            episodes=12,
+            seed=1,
+            out=tmp_path / "cut",
+            n_steps=300,
+            policy_dir=str(tiny_policy_dir),
+            on_result=interrupt_after_first,
+        )
     rows = list(csv.DictReader(open(tmp_path / "cut" / "episodes.csv")))
     assert len(rows) == 12 and {r["run"] for r in rows} == {"0"}
 
@@ -270,7 +278,8 @@ def test_repeated_choices_flown_ahead_equal_episode_by_episode_flights() -> None
     assert agent.seen == list(range(150))
     assert 0 < result.safeguard_fired.sum() < 150
     table = [policy, baseline_policy()]
-    each = evaluate_jobs(table, mdp, np.zeros(150, dtype=int), np.zeros(150, dtype=int), np.arange(150), seed=4,
-                         n_steps=STEPS, fallback_index=np.ones(150, dtype=int))
+    each = evaluate_jobs(
+        table, mdp, np.zeros(150, dtype=int), np.zeros(150, dtype=int), np.arange(150), seed=4, n_steps=STEPS, fallback_index=np.ones(150, dtype=int)
+    )
     np.testing.assert_array_equal(result.returns, each.returns)
     np.testing.assert_array_equal(result.safeguard_fired, each.safeguard_step >= 0)

@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from bad_input import CASES, run_case, setup
+
 from neurohover.cli import main
 from neurohover.flightdata import FlightData
 
@@ -107,8 +107,7 @@ def test_version_names_the_installed_package(capsys) -> None:
 
 
 def test_the_script_prints_one_line_per_case() -> None:
-    proc = subprocess.run([sys.executable, str(Path(__file__).with_name("bad_input.py"))], capture_output=True, text=True,
-                          timeout=900)
+    proc = subprocess.run([sys.executable, str(Path(__file__).with_name("bad_input.py"))], capture_output=True, text=True, timeout=900)
     lines = proc.stdout.strip().splitlines()
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert len(lines) == len(CASES) + 1 and all(line.startswith("ok ") for line in lines[:-1])

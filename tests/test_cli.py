@@ -82,8 +82,12 @@ def test_malformed_policy_files_are_refused(capsys, tmp_path: Path) -> None:
         "short.json": json.dumps({"topology": "mlp", "genome": [0.0] * 40}),
         "strings.json": json.dumps({"topology": "slp", "genome": ["a"] * 40}),
     }
-    expected = {"notjson.json": "not valid JSON", "nogenome.json": "missing key(s) genome",
-                "short.json": "mlp genome has 42 genes", "strings.json": "list of numbers"}
+    expected = {
+        "notjson.json": "not valid JSON",
+        "nogenome.json": "missing key(s) genome",
+        "short.json": "mlp genome has 42 genes",
+        "strings.json": "list of numbers",
+    }
     for name, text in cases.items():
         (tmp_path / name).write_text(text)
         rc, _, err = _run(capsys, "fly", "--task", "ghh08", "--policy", str(tmp_path / name))

@@ -27,11 +27,9 @@ def test_sampled_mdps_are_those_of_the_same_group_in_any_experiment_with_that_se
 
 def test_a_competition_resumes_from_its_store_and_flies_nothing_twice(tmp_path: Path) -> None:
     flown: list[str] = []
-    first, runs = compete("ghh08", "baseline", runs=3, episodes=4, n_steps=80, out=tmp_path / "a",
-                          on_result=lambda key, result: flown.append(key))
+    first, runs = compete("ghh08", "baseline", runs=3, episodes=4, n_steps=80, out=tmp_path / "a", on_result=lambda key, result: flown.append(key))
     assert len(flown) == 3 and (tmp_path / "a" / "results.sqlite").is_file()
-    again, runs_again = compete("ghh08", "baseline", runs=3, episodes=4, n_steps=80, out=tmp_path / "a",
-                                on_result=lambda key, result: flown.append(key))
+    again, runs_again = compete("ghh08", "baseline", runs=3, episodes=4, n_steps=80, out=tmp_path / "a", on_result=lambda key, result: flown.append(key))
     assert len(flown) == 3 and again["mean_cumulative_return"] == first["mean_cumulative_return"]
     assert runs_again == runs
     # Other settings in the same store are another experiment scale: kept apart, nothing refused.
@@ -61,8 +59,17 @@ def test_a_crashing_run_records_its_crash_step() -> None:
     from neurohover.compete import episode_rows
     from neurohover.experiments.results import TestRunResult, TestRunTiming
 
-    result = TestRunResult(agent="x", mdp="m", score=-3.0, returns=(-1.0, -2.0), crash_episodes=(1,),
-                           safeguard_episodes=(0,), policy_changes=((0, "a"), (1, "b")), learning_episodes=1,
-                           mean_return_after_learning=-2.0, crash_steps=(17,),
-                           timing=TestRunTiming(seconds=0.0, offline_seconds=0.0))
+    result = TestRunResult(
+        agent="x",
+        mdp="m",
+        score=-3.0,
+        returns=(-1.0, -2.0),
+        crash_episodes=(1,),
+        safeguard_episodes=(0,),
+        policy_changes=((0, "a"), (1, "b")),
+        learning_episodes=1,
+        mean_return_after_learning=-2.0,
+        crash_steps=(17,),
+        timing=TestRunTiming(seconds=0.0, offline_seconds=0.0),
+    )
     assert episode_rows(4, result, 100) == [[4, "m", 0, "-1.0", 0, 100, "a", 1], [4, "m", 1, "-2.0", 1, 17, "b", 0]]

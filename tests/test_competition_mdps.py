@@ -61,10 +61,15 @@ def test_fghh_at_another_sigma_uses_its_seeded_sets() -> None:
     assert np.median(spread(family.test_mdps())) < np.median(spread(get_task_family("fghh").test_mdps()))
 
 
-@pytest.mark.parametrize(("spec", "message"), [
-    ("seeded-train:10", r"out of range: allowed 0\.\.9"), ("seeded-test:100", r"out of range: allowed 0\.\.99"),
-    ("seeded:1", "seeded-train:N"), ("competition:0", "seeded-train:N"),
-])
+@pytest.mark.parametrize(
+    ("spec", "message"),
+    [
+        ("seeded-train:10", r"out of range: allowed 0\.\.9"),
+        ("seeded-test:100", r"out of range: allowed 0\.\.99"),
+        ("seeded:1", "seeded-train:N"),
+        ("competition:0", "seeded-train:N"),
+    ],
+)
 def test_bad_mdp_names_are_refused(spec: str, message: str) -> None:
     with pytest.raises(NeurohoverError, match=message):
         get_task_family("ghh08").mdp(spec)

@@ -91,9 +91,23 @@ def test_cuda_safeguard_and_flight_data_match_the_cpu_kernel(simulated: dict) ->
 
 def test_cuda_build_compiles_the_cpu_sources_with_every_callee_retargeted(simulated: dict) -> None:
     # The physics and the streams come from the CPU kernel's own functions, none hand-copied ...
-    for name in ("fly_job", "policy_action", "integrate", "observe", "crashed", "dangerous", "update_noise",
-                 "unpack_mdp", "competition_time", "_half_angle_quaternion", "seed_stream", "splitmix64",
-                 "next_normal", "_normal_slow", "next_u64"):
+    for name in (
+        "fly_job",
+        "policy_action",
+        "integrate",
+        "observe",
+        "crashed",
+        "dangerous",
+        "update_noise",
+        "unpack_mdp",
+        "competition_time",
+        "_half_angle_quaternion",
+        "seed_stream",
+        "splitmix64",
+        "next_normal",
+        "_normal_slow",
+        "next_u64",
+    ):
         assert name in simulated["device_functions"]
     # ... and no device function calls back into a CPU-compiled one.
     assert simulated["cpu_callees_left"] == []

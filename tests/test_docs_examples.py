@@ -42,8 +42,7 @@ def test_readme_has_python_examples() -> None:
     assert len(_readme_python_blocks()) >= 3
 
 
-@pytest.mark.parametrize("index", range(len(_readme_python_blocks())),
-                         ids=[f"{i}-{h}" for i, (h, _) in enumerate(_readme_python_blocks())])
+@pytest.mark.parametrize("index", range(len(_readme_python_blocks())), ids=[f"{i}-{h}" for i, (h, _) in enumerate(_readme_python_blocks())])
 def test_readme_python_block_runs_as_written(index: int, tmp_path: Path) -> None:
     heading, code = _readme_python_blocks()[index]
     proc = _run_script(code, tmp_path)
@@ -52,12 +51,12 @@ def test_readme_python_block_runs_as_written(index: int, tmp_path: Path) -> None
 
 def test_experiments_docstring_example_runs_as_a_script(tmp_path: Path) -> None:
     doc = neurohover.experiments.__doc__
-    example = doc[doc.index("Example\n-------"):]
+    example = doc[doc.index("Example\n-------") :]
     if ">>> " in example:  # doctest form: the prompted lines, prompts removed
         code = "\n".join(line[4:] for line in example.splitlines() if line.startswith((">>> ", "... ")))
     else:  # the literal block after "::"
         lines = []
-        for line in example[example.index("::\n\n") + 4:].splitlines():
+        for line in example[example.index("::\n\n") + 4 :].splitlines():
             if line and not line.startswith("    "):
                 break
             lines.append(line)
@@ -77,8 +76,14 @@ def test_version_is_the_installed_distributions(tmp_path: Path) -> None:
     dist = tmp_path / "neurohover-9.8.7.dist-info"
     dist.mkdir()
     (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: neurohover\nVersion: 9.8.7\n")
-    proc = subprocess.run([sys.executable, "-c", "import neurohover; print(neurohover.__version__)"], cwd=tmp_path,
-                          env={**os.environ, "PYTHONPATH": str(tmp_path)}, capture_output=True, text=True, timeout=120)
+    proc = subprocess.run(
+        [sys.executable, "-c", "import neurohover; print(neurohover.__version__)"],
+        cwd=tmp_path,
+        env={**os.environ, "PYTHONPATH": str(tmp_path)},
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == "9.8.7"
 

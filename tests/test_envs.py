@@ -251,7 +251,7 @@ def test_vector_next_step_autoreset_semantics() -> None:
     envs.reset(seed=0)
     actions = np.tile([0.02, 0.0, 0.0, 0.23], (4, 1))
     actions[1] = FALL
-    for t in range(1, 20):
+    for t in range(1, 20):  # noqa: B007 - t is read after the loop
         obs, rewards, terminated, truncated, info = envs.step(actions)
         if terminated[1]:
             break
@@ -269,8 +269,7 @@ def test_vector_next_step_autoreset_semantics() -> None:
 
 
 def test_vector_truncation_and_max_episode_steps() -> None:
-    envs = gym.make_vec("neurohover/GHH08-v0", num_envs=3, vectorization_mode="vector_entry_point",
-                        mdp="zero", max_episode_steps=5)
+    envs = gym.make_vec("neurohover/GHH08-v0", num_envs=3, vectorization_mode="vector_entry_point", mdp="zero", max_episode_steps=5)
     envs.reset(seed=0)
     actions = np.tile([0.02, 0.0, 0.0, 0.23], (3, 1))
     for _ in range(4):
@@ -288,8 +287,7 @@ def test_vector_mdp_and_noise_options() -> None:
     obs = [envs.reset(options={"noise": (7, 20)})[0]]
     for _ in range(40):
         obs.append(envs.step(np.array([BASELINE.act(o) for o in obs[-1]]))[0])
-    ev = evaluate_jobs([BASELINE], [train[0], family.zero(), train[5]], [0, 0, 0], [0, 1, 2], [20, 21, 22],
-                       seed=7, record=[True] * 3, n_steps=40)
+    ev = evaluate_jobs([BASELINE], [train[0], family.zero(), train[5]], [0, 0, 0], [0, 1, 2], [20, 21, 22], seed=7, record=[True] * 3, n_steps=40)
     for i in range(3):
         np.testing.assert_allclose(np.array(obs)[:, i], ev.flight_data.observations[i], rtol=1e-7, atol=1e-9)
     # Per-env noise pairs, a new MDP for all, and a partial reset.
@@ -320,8 +318,7 @@ def test_vector_mdp_and_noise_options() -> None:
         (lambda: HoverVectorEnv(2, render_mode="rgb_array"), "render_mode='rgb_array' is not supported"),
         (lambda: HoverVectorEnv(0), "num_envs=0 is out of range"),
         (lambda: HoverVectorEnv(2, mdp=["zero"]), "mdp has 1 entries but there are num_envs=2"),
-        (lambda: gym.make_vec("neurohover/GHH08-v0", num_envs=2, vectorization_mode="vector_entry_point", task="x"),
-         "unknown task 'x'"),
+        (lambda: gym.make_vec("neurohover/GHH08-v0", num_envs=2, vectorization_mode="vector_entry_point", task="x"), "unknown task 'x'"),
     ],
 )
 def test_bad_construction_raises(make, match: str) -> None:

@@ -125,7 +125,11 @@ def test_settings_defaults_are_paper_tables() -> None:
     g = GenerationalSettings()
     assert (g.pop_size, g.select_size, g.generations, g.crossover_prob) == (50, 20, 4000, 1.0)
     assert (g.averaging_prob, g.mutate_prob, g.mutate_frac, g.mutate_std, g.mutate_repl) == (
-        0.5, 0.75, 0.1, 0.8, 0.25,
+        0.5,
+        0.75,
+        0.1,
+        0.8,
+        0.25,
     )
     assert isinstance(SteadyStateSettings(pop_size=np.int64(60)).pop_size, int)
 
@@ -231,9 +235,7 @@ def test_steady_state_checkpoint_resume(between_ask_and_tell: bool) -> None:
     assert np.array_equal(resumed.population, ref.population)
     assert np.array_equal(resumed.fitness, ref.fitness)
     assert np.array_equal(resumed.champion_genome, ref.champion_genome)
-    assert [(h.evaluations, h.champion_return) for h in resumed.history] == [
-        (h.evaluations, h.champion_return) for h in ref.history
-    ]
+    assert [(h.evaluations, h.champion_return) for h in resumed.history] == [(h.evaluations, h.champion_return) for h in ref.history]
     assert resumed.history[-1].wall_seconds >= resumed.history[0].wall_seconds
 
 
@@ -295,9 +297,7 @@ def test_generational_with_selection_race_on_noisy_fitness() -> None:
     while not opt.stop():
         pop = opt.ask()
         true = sphere_return(pop)
-        race = selection_race(
-            lambda idx: true[idx] + noise_rng.normal(0.0, 0.3, idx.size), 20, 6, 0.9, t_limit=5
-        )
+        race = selection_race(lambda idx, true=true: true[idx] + noise_rng.normal(0.0, 0.3, idx.size), 20, 6, 0.9, t_limit=5)
         opt.tell_race(race)
         assert opt.history[-1].episodes == race.episodes_spent
     assert opt.evaluations == sum(h.episodes for h in opt.history) < 25 * 20 * 5
@@ -449,7 +449,7 @@ def test_race_indistinguishable_candidates_run_to_limit() -> None:
     assert race.rounds == 6 and race.episodes_spent <= 12 * 6
     # The fill step takes the best means among the undecided ones.
     undecided = race.n_samples == 6
-    filled = race.selected[race.n_raced:]
+    filled = race.selected[race.n_raced :]
     assert np.all(undecided[filled])
     others = np.setdiff1d(np.flatnonzero(undecided), race.selected)
     assert race.means[filled].min() >= race.means[others].max()
@@ -518,10 +518,7 @@ def test_resampling_validation_and_shape_check() -> None:
 def _ref_draw(sample_fn, indices: np.ndarray) -> np.ndarray:
     out = np.asarray(sample_fn(indices.copy()), dtype=np.float64)
     if out.shape != indices.shape:
-        raise ValueError(
-            f"sample_fn returned shape {out.shape} for {indices.size} candidates; "
-            f"expected {indices.shape}"
-        )
+        raise ValueError(f"sample_fn returned shape {out.shape} for {indices.size} candidates; expected {indices.shape}")
     if np.any(out == np.inf):
         raise ValueError("sample_fn returned +inf; returns must be finite, NaN or -inf")
     return np.where(np.isnan(out), -np.inf, out)

@@ -34,8 +34,13 @@ TWO_THREADS = numba.config.NUMBA_NUM_THREADS >= 2
 def _key(result) -> tuple:
     """Everything of a result that must be reproducible (not the wall times)."""
     return (
-        result.champion.genome.tobytes(), result.champion_return, result.episodes, result.steps,
-        result.evaluations, result.generations, result.stop_reason,
+        result.champion.genome.tobytes(),
+        result.champion_return,
+        result.episodes,
+        result.steps,
+        result.evaluations,
+        result.generations,
+        result.stop_reason,
         [(h.generation, h.evaluations, h.episodes, h.generation_episodes, h.champion_return) for h in result.history],
     )
 
@@ -47,9 +52,16 @@ def test_resampling_specs() -> None:
     assert str(parse_resampling("fixed:5")) == "fixed:5" and parse_resampling("fixed:5").k == 5
     assert parse_resampling("race:0.2").delta == 0.2 and str(parse_resampling("race:0.2")) == "race:0.2"
     assert parse_resampling(None).kind == "fixed" and parse_resampling(None).k == 1
-    for bad, words in [("race:1.5", "between 0 and 1"), ("race:0", "between 0 and 1"), ("race:x", "between 0 and 1"),
-                       ("fixed:0", ">= 1"), ("fixed:-2", ">= 1"), ("fixed:2.5", ">= 1"), ("resample:3", "unknown resampling"),
-                       ("fixed", "unknown resampling")]:
+    for bad, words in [
+        ("race:1.5", "between 0 and 1"),
+        ("race:0", "between 0 and 1"),
+        ("race:x", "between 0 and 1"),
+        ("fixed:0", ">= 1"),
+        ("fixed:-2", ">= 1"),
+        ("fixed:2.5", ">= 1"),
+        ("resample:3", "unknown resampling"),
+        ("fixed", "unknown resampling"),
+    ]:
         with pytest.raises(NeurohoverError, match=words):
             parse_resampling(bad)
 
@@ -115,16 +127,14 @@ def test_steady_state_improves_the_mean_return_from_the_baseline() -> None:
 
 
 def test_plateau_stops_a_run_without_budget() -> None:
-    result = evolve(GHH08.zero(), topology="slp", n_steps=30, seed=2,
-                    settings={"plateau_threshold": 40, "pop_size": 10, "elite_size": 9})
+    result = evolve(GHH08.zero(), topology="slp", n_steps=30, seed=2, settings={"plateau_threshold": 40, "pop_size": 10, "elite_size": 9})
     assert result.stop_reason == "plateau"
     last_new = result.history[-2].evaluations if len(result.history) > 1 else 10
     assert result.evaluations - last_new >= 40
 
 
 def test_fixed_k_on_an_mdp_counts_episodes() -> None:
-    result = evolve(GHH08.mdp("train:2"), topology="slp", budget=300, resampling="fixed:3", seed=4, n_steps=200,
-                    settings={"pop_size": 20, "elite_size": 19})
+    result = evolve(GHH08.mdp("train:2"), topology="slp", budget=300, resampling="fixed:3", seed=4, n_steps=200, settings={"pop_size": 20, "elite_size": 19})
     assert result.episodes == 300 and result.evaluations == 100  # 20 + 80 candidates, 3 episodes each
 
 
@@ -155,8 +165,7 @@ def test_generational_method_on_one_mdp() -> None:
 
 @pytest.mark.parametrize("target", [GHH08.mdp("train:1"), FGHH], ids=["mdp", "family"])
 def test_cma_es_on_the_same_budget(target) -> None:
-    result = evolve(target, topology="slp", optimizer="cma", budget=400, seed=2, n_steps=300,
-                    resampling="fixed:2" if target is FGHH else None)
+    result = evolve(target, topology="slp", optimizer="cma", budget=400, seed=2, n_steps=300, resampling="fixed:2" if target is FGHH else None)
     popsize = 4 + int(3 * math.log(40))
     k = 2 if target is FGHH else 1
     assert result.stop_reason == "budget" and 400 <= result.episodes < 400 + popsize * k
@@ -173,11 +182,15 @@ def test_cma_es_improves_on_an_mdp() -> None:
 
 
 @pytest.mark.skipif(not TWO_THREADS, reason="needs 2 kernel threads")
-@pytest.mark.parametrize("target,kwargs", [
-    (GHH08.mdp("train:3"), dict()),
-    (FGHH, dict(resampling="race:0.6")),
-    (FGHH, dict(resampling="fixed:2", optimizer="cma")),
-], ids=["steady", "race", "cma-family"])
+@pytest.mark.parametrize(
+    "target,kwargs",
+    [
+        (GHH08.mdp("train:3"), dict()),
+        (FGHH, dict(resampling="race:0.6")),
+        (FGHH, dict(resampling="fixed:2", optimizer="cma")),
+    ],
+    ids=["steady", "race", "cma-family"],
+)
 def test_results_do_not_depend_on_threads(target, kwargs) -> None:
     runs = [evolve(target, topology="mlp", budget=400, seed=8, n_steps=300, threads=t, **kwargs) for t in (1, 2)]
     assert _key(runs[0]) == _key(runs[1])
@@ -188,12 +201,16 @@ def test_seed_changes_the_run() -> None:
     assert _key(a) != _key(b)
 
 
-@pytest.mark.parametrize("target,kwargs", [
-    (GHH08.mdp("train:1"), dict()),
-    (GHH08.mdp("train:1"), dict(optimizer="cma")),
-    (FGHH, dict(resampling="race:0.6")),
-    (FGHH, dict(resampling="fixed:2", optimizer="cma")),
-], ids=["steady", "cma-mdp", "race", "cma-family"])
+@pytest.mark.parametrize(
+    "target,kwargs",
+    [
+        (GHH08.mdp("train:1"), dict()),
+        (GHH08.mdp("train:1"), dict(optimizer="cma")),
+        (FGHH, dict(resampling="race:0.6")),
+        (FGHH, dict(resampling="fixed:2", optimizer="cma")),
+    ],
+    ids=["steady", "cma-mdp", "race", "cma-family"],
+)
 def test_interrupted_and_resumed_equals_uninterrupted(tmp_path: Path, target, kwargs) -> None:
     common = dict(topology="slp", seed=3, n_steps=300, **kwargs)
     full = evolve(target, budget=600, **common)
@@ -228,8 +245,7 @@ def test_resume_refuses_another_run(tmp_path: Path) -> None:
 def test_learned_model_and_policy_prototype_are_accepted() -> None:
     from neurohover.models import LearnedModel
 
-    model = LearnedModel(tuple(np.array([-0.2, -0.4, -0.5, -0.5, -40.0, -7.5, 20.0, -6.5, -21.0, -5.5, 45.0])),
-                         (0.2, 0.3, 0.6, 0.15, 0.25, 0.07), "lr")
+    model = LearnedModel(tuple(np.array([-0.2, -0.4, -0.5, -0.5, -40.0, -7.5, 20.0, -6.5, -21.0, -5.5, 45.0])), (0.2, 0.3, 0.6, 0.15, 0.25, 0.07), "lr")
     seed_policy = Policy("slp", prototype("slp", "baseline").genome, {"name": "mine"})
     result = evolve(model, topology="slp", prototype=seed_policy, budget=120, seed=1, n_steps=200)
     assert result.champion.metadata["target"] == "model/lr" and result.champion.metadata["name"] == "mine"
@@ -253,8 +269,7 @@ def _run(capsys, *argv: str) -> tuple[int, str, str]:
 
 def test_evolve_command_writes_policy_history_and_resumes(capsys, tmp_path: Path) -> None:
     out = tmp_path / "champ.json"
-    args = ["evolve", "--task", "ghh08", "--mdp", "train:1", "--topology", "slp", "--episode-steps", "300",
-            "--seed", "5", "--out", str(out), "--json"]
+    args = ["evolve", "--task", "ghh08", "--mdp", "train:1", "--topology", "slp", "--episode-steps", "300", "--seed", "5", "--out", str(out), "--json"]
     rc, stdout, _ = _run(capsys, *args, "--budget", "300")
     assert rc == 0
     summary = json.loads(stdout)
@@ -283,8 +298,25 @@ def test_evolve_command_writes_policy_history_and_resumes(capsys, tmp_path: Path
 
 def test_evolve_command_over_the_family_with_races(capsys, tmp_path: Path) -> None:
     out = tmp_path / "generic.json"
-    rc, stdout, _ = _run(capsys, "evolve", "--task", "fghh", "--sigma", "0.2", "--resampling", "race:0.5",
-                         "--budget", "200", "--episode-steps", "200", "--seed", "1", "--out", str(out), "--json")
+    rc, stdout, _ = _run(
+        capsys,
+        "evolve",
+        "--task",
+        "fghh",
+        "--sigma",
+        "0.2",
+        "--resampling",
+        "race:0.5",
+        "--budget",
+        "200",
+        "--episode-steps",
+        "200",
+        "--seed",
+        "1",
+        "--out",
+        str(out),
+        "--json",
+    )
     assert rc == 0
     meta = json.loads(out.read_text())
     assert meta["mdp"] == "G" and meta["sigma"] == 0.2 and meta["method"] == "generational" and meta["resampling"] == "race:0.5"
@@ -299,26 +331,27 @@ def test_evolve_command_ctrl_c_saves_the_checkpoint(capsys, tmp_path: Path, monk
 
     monkeypatch.setattr(commands_learning._Bar, "__call__", interrupt)
     out = tmp_path / "p.json"
-    rc, _, err = _run(capsys, "evolve", "--task", "ghh08", "--topology", "slp", "--budget", "100000",
-                      "--episode-steps", "3000", "--out", str(out))
+    rc, _, err = _run(capsys, "evolve", "--task", "ghh08", "--topology", "slp", "--budget", "100000", "--episode-steps", "3000", "--out", str(out))
     assert rc == 130
     assert f"checkpoint saved to {out}.checkpoint.json" in err and "--resume" in err
     assert Path(f"{out}.checkpoint.json").is_file() and not out.exists()
 
 
-@pytest.mark.parametrize("argv,words", [
-    (["--resampling", "race:1.5"], "strictly between 0 and 1"),
-    (["--resampling", "fixed:0"], "K must be an integer >= 1"),
-    (["--budget", "0"], "--budget 0 is out of range"),
-    (["--seed-policy", "nope.json"], "no such file"),
-    (["--resume"], "no checkpoint"),
-    (["--mdp", "train:1", "--resampling", "race:0.5"], "needs the generational method"),
-    (["--mdp", "train:99"], "out of range"),
-    (["--wind", "9,0"], "out of range"),
-])
+@pytest.mark.parametrize(
+    "argv,words",
+    [
+        (["--resampling", "race:1.5"], "strictly between 0 and 1"),
+        (["--resampling", "fixed:0"], "K must be an integer >= 1"),
+        (["--budget", "0"], "--budget 0 is out of range"),
+        (["--seed-policy", "nope.json"], "no such file"),
+        (["--resume"], "no checkpoint"),
+        (["--mdp", "train:1", "--resampling", "race:0.5"], "needs the generational method"),
+        (["--mdp", "train:99"], "out of range"),
+        (["--wind", "9,0"], "out of range"),
+    ],
+)
 def test_evolve_command_bad_input(capsys, tmp_path: Path, argv, words) -> None:
-    rc, _, err = _run(capsys, "evolve", "--task", "ghh08", "--budget", "60", "--episode-steps", "50",
-                      "--out", str(tmp_path / "x.json"), *argv)
+    rc, _, err = _run(capsys, "evolve", "--task", "ghh08", "--budget", "60", "--episode-steps", "50", "--out", str(tmp_path / "x.json"), *argv)
     assert rc == 2
     assert err.startswith("neurohover evolve: error:") and words in err
 
@@ -334,17 +367,16 @@ def test_learn_model_command_prints_learned_next_to_true(capsys, tmp_path: Path)
     from neurohover.models import LearnedModel
 
     assert LearnedModel.load(model_file).method == "lr"
-    rc, out, _ = _run(capsys, "learn-model", "--flight-data", str(data), "--method", "ec-meno", "--budget", "100",
-                      "--out", str(tmp_path / "meno.json"))
+    rc, out, _ = _run(capsys, "learn-model", "--flight-data", str(data), "--method", "ec-meno", "--budget", "100", "--out", str(tmp_path / "meno.json"))
     assert rc == 0 and "ec-meno model written" in out
 
 
 def test_learn_model_command_bad_input(capsys, tmp_path: Path) -> None:
-    rc, _, err = _run(capsys, "learn-model", "--flight-data", str(tmp_path / "missing.npz"), "--method", "lr",
-                      "--out", str(tmp_path / "m.json"))
+    rc, _, err = _run(capsys, "learn-model", "--flight-data", str(tmp_path / "missing.npz"), "--method", "lr", "--out", str(tmp_path / "m.json"))
     assert rc == 2 and "no such flight-data file" in err
-    rc, _, err = _run(capsys, "learn-model", "--flight-data", str(tmp_path / "missing.npz"), "--method", "ec-mer",
-                      "--budget", "0", "--out", str(tmp_path / "m.json"))
+    rc, _, err = _run(
+        capsys, "learn-model", "--flight-data", str(tmp_path / "missing.npz"), "--method", "ec-mer", "--budget", "0", "--out", str(tmp_path / "m.json")
+    )
     assert rc == 2 and "--budget 0 is out of range" in err
 
 

@@ -86,24 +86,36 @@ def test_every_experiment_of_the_paper_is_shipped_at_both_scales() -> None:
     assert load_config("table3", "quick").name == "fig2"  # alias
 
 
-@pytest.mark.parametrize("name, total, check", [
-    # Figure 2: 4 approaches x 10 training MDPs x 10 runs, plus Table 3 (2 topologies x 10 MDPs).
-    ("fig2", 420, lambda s: s["runs"] == 10 and s["n_mdps"] == 10 and s["n_steps"] == 6000 and s["robustness_episodes"] == 10),
-    # Table 4: 3 methods + the GLS option x 100 test MDPs, 5 test episodes; + the generic policy.
-    ("table4", 401, lambda s: s["n_mdps"] == 100 and s["test_episodes"] == 5 and s["model_budget"] == 2000
-     and s["ec_meno_budget"] == 0 and s["methods"][2:] == ["lr", "lr-gls"]),
-    # Figure 7: 3 agents x 100 test MDPs x 1000 episodes; + generic and 10 specialised policies.
-    ("fig7", 311, lambda s: s["episodes"] == 1000 and all(g["n_mdps"] == 100 for g in s["groups"])),
-    # Figure 8: 3 agents x 80 runs (8 per training MDP); + policies and the safety test.
-    ("fig8", 252, lambda s: all(g["n_mdps"] * g["runs_per_mdp"] == 80 and g["mdps"] == "train" for g in s["groups"])),
-    # Figure 11: 60 + 60 runs on 20 MDPs, 300 hybrid-baseline runs on the 100 test MDPs; + policies.
-    ("fig11", 432, lambda s: [g["n_mdps"] * g["runs_per_mdp"] for g in s["groups"]] == [60, 60, 300]),
-    ("fig12", 96, lambda s: s["runs"] == 24 and s["sigma"] == 0.2 and s["budget"] == 500000),
-    ("fig13", 96, lambda s: s["runs"] == 24 and s["sigma"] == 0.3),
-    ("fig15", 120, lambda s: s["runs"] == 24 and s["variants"][0]["resampling"] == "fixed:5"),
-    # Figure 16: 3 x 100 runs, each with the generic policy of its own evolution run (2 x 100 over G, 100 on zero).
-    ("fig16", 600, lambda s: s["generics_per_agent"] == 100 and s["generic_budget"] == 500000 and s["episodes"] == 1000),
-])
+@pytest.mark.parametrize(
+    "name, total, check",
+    [
+        # Figure 2: 4 approaches x 10 training MDPs x 10 runs, plus Table 3 (2 topologies x 10 MDPs).
+        ("fig2", 420, lambda s: s["runs"] == 10 and s["n_mdps"] == 10 and s["n_steps"] == 6000 and s["robustness_episodes"] == 10),
+        # Table 4: 3 methods + the GLS option x 100 test MDPs, 5 test episodes; + the generic policy.
+        (
+            "table4",
+            401,
+            lambda s: (
+                s["n_mdps"] == 100
+                and s["test_episodes"] == 5
+                and s["model_budget"] == 2000
+                and s["ec_meno_budget"] == 0
+                and s["methods"][2:] == ["lr", "lr-gls"]
+            ),
+        ),
+        # Figure 7: 3 agents x 100 test MDPs x 1000 episodes; + generic and 10 specialised policies.
+        ("fig7", 311, lambda s: s["episodes"] == 1000 and all(g["n_mdps"] == 100 for g in s["groups"])),
+        # Figure 8: 3 agents x 80 runs (8 per training MDP); + policies and the safety test.
+        ("fig8", 252, lambda s: all(g["n_mdps"] * g["runs_per_mdp"] == 80 and g["mdps"] == "train" for g in s["groups"])),
+        # Figure 11: 60 + 60 runs on 20 MDPs, 300 hybrid-baseline runs on the 100 test MDPs; + policies.
+        ("fig11", 432, lambda s: [g["n_mdps"] * g["runs_per_mdp"] for g in s["groups"]] == [60, 60, 300]),
+        ("fig12", 96, lambda s: s["runs"] == 24 and s["sigma"] == 0.2 and s["budget"] == 500000),
+        ("fig13", 96, lambda s: s["runs"] == 24 and s["sigma"] == 0.3),
+        ("fig15", 120, lambda s: s["runs"] == 24 and s["variants"][0]["resampling"] == "fixed:5"),
+        # Figure 16: 3 x 100 runs, each with the generic policy of its own evolution run (2 x 100 over G, 100 on zero).
+        ("fig16", 600, lambda s: s["generics_per_agent"] == 100 and s["generic_budget"] == 500000 and s["episodes"] == 1000),
+    ],
+)
 def test_paper_scale_follows_the_papers_protocol(name, total, check) -> None:
     cfg = load_config(name, "paper")
     assert plan(cfg, {}).total == total
@@ -121,17 +133,20 @@ def test_unknown_experiment_lists_the_known_ones(capsys, tmp_path: Path) -> None
     assert rc == 0 and out.split() == PAPER_EXPERIMENTS + ABLATIONS
 
 
-@pytest.mark.parametrize("edit, message", [
-    (lambda t: t.replace('target = "family"', 'target = "family"\nbudgett = 3'), "unknown setting(s) budgett"),
-    (lambda t: t.replace("runs = 12", 'runs = "twelve"'), "runs = 'twelve' is not allowed: expected an integer >= 1"),
-    (lambda t: t.replace("runs = 12\n", ""), "missing required setting 'runs'"),
-    (lambda t: t.replace('task = "fghh"', 'task = "ghh08"'), "sigma applies to task 'fghh' only"),
-    (lambda t: t.replace('label = "k = 1"', 'label = "k = 1"\nresampling = "race:2"'), "race:DELTA (0 < DELTA < 1)"),
-    (lambda t: t.replace('kind = "evolution"', 'kind = "magic"'), "kind = 'magic' is not allowed"),
-    (lambda t: t.replace("[scales.paper]", "[scales.huge]"), "unknown scale table(s) huge"),
-    (lambda t: t + "\n[[settings.variants]]\nkey = \"k1\"\nlabel = \"again\"\n", "variant keys must be unique"),
-    (lambda t: t.replace("runs = 12", "runs = [1"), "is not valid TOML"),
-])
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (lambda t: t.replace('target = "family"', 'target = "family"\nbudgett = 3'), "unknown setting(s) budgett"),
+        (lambda t: t.replace("runs = 12", 'runs = "twelve"'), "runs = 'twelve' is not allowed: expected an integer >= 1"),
+        (lambda t: t.replace("runs = 12\n", ""), "missing required setting 'runs'"),
+        (lambda t: t.replace('task = "fghh"', 'task = "ghh08"'), "sigma applies to task 'fghh' only"),
+        (lambda t: t.replace('label = "k = 1"', 'label = "k = 1"\nresampling = "race:2"'), "race:DELTA (0 < DELTA < 1)"),
+        (lambda t: t.replace('kind = "evolution"', 'kind = "magic"'), "kind = 'magic' is not allowed"),
+        (lambda t: t.replace("[scales.paper]", "[scales.huge]"), "unknown scale table(s) huge"),
+        (lambda t: t + '\n[[settings.variants]]\nkey = "k1"\nlabel = "again"\n', "variant keys must be unique"),
+        (lambda t: t.replace("runs = 12", "runs = [1"), "is not valid TOML"),
+    ],
+)
 def test_bad_configs_are_refused_with_a_clear_message(tmp_path: Path, edit, message) -> None:
     path = _write(tmp_path, edit(SLOW_CONFIG))
     with pytest.raises(NeurohoverError) as err:
@@ -259,9 +274,14 @@ def _finished(path: Path) -> dict[str, float]:
 
 def _start(config: Path, store: Path) -> subprocess.Popen:
     env = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
-    return subprocess.Popen([sys.executable, "-m", "neurohover.experiments", "reproduce", str(config), "--scale", "quick",
-                             "--store", str(store), "--no-progress"], cwd=ROOT, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return subprocess.Popen(
+        [sys.executable, "-m", "neurohover.experiments", "reproduce", str(config), "--scale", "quick", "--store", str(store), "--no-progress"],
+        cwd=ROOT,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
 
 
 def _interrupt_after(proc: subprocess.Popen, store: Path, n: int, sig: int) -> dict[str, float]:
@@ -374,11 +394,27 @@ def test_report_draws_the_figures_and_compares_with_the_paper(quick_store: Path,
         png = out / f"{name}-quick.png"
         assert png.is_file() and png.read_bytes()[:4] == b"\x89PNG"
     text = (out / "report.md").read_text()
-    for needle in ("## Figure 2 and Table 3", "### Table 3: robustness", "-496.2", "-2.508e+06",  # Table 3 beside the paper
-                   "## Table 4", "562.9", "-142.2",                                               # Table 4 beside the paper
-                   "## Figure 8", "5.8e-12", "Student's p", "Welch's p", "runs with a crash",     # t tests, crashes
-                   "## Figure 15", "Scale: **quick**", "core(s) (local)", "s wall over 1 session(s)",
-                   "our crash rate", "vs paper", "### Discussion"):
+    for needle in (
+        "## Figure 2 and Table 3",
+        "### Table 3: robustness",
+        "-496.2",
+        "-2.508e+06",  # Table 3 beside the paper
+        "## Table 4",
+        "562.9",
+        "-142.2",  # Table 4 beside the paper
+        "## Figure 8",
+        "5.8e-12",
+        "Student's p",
+        "Welch's p",
+        "runs with a crash",  # t tests, crashes
+        "## Figure 15",
+        "Scale: **quick**",
+        "core(s) (local)",
+        "s wall over 1 session(s)",
+        "our crash rate",
+        "vs paper",
+        "### Discussion",
+    ):
         assert needle in text, needle
     assert "INCOMPLETE" not in text
     # A hand-written discussion beside the report survives regenerating it.
@@ -490,8 +526,7 @@ def test_a_significant_difference_in_the_opposite_direction_does_not_agree_with_
     rng = np.random.default_rng(0)
     better, worse = list(rng.normal(-100, 5, 20)), list(rng.normal(-200, 5, 20))
     # The paper found hybrid better than model-free (p = 1.4e-14) and incremental better (p = 5.8e-12).
-    sec.add_tests({"hybrid": worse, "model-free": better, "incremental": list(rng.normal(-300, 5, 20))},
-                  {}, "final cumulative reward")
+    sec.add_tests({"hybrid": worse, "model-free": better, "incremental": list(rng.normal(-300, 5, 20))}, {}, "final cumulative reward")
     by_pair = {c.split(" (")[0]: c for c in sec.comparisons}
     assert by_pair["hybrid vs model-free"].endswith("disagrees: the opposite direction (the paper found hybrid better).")
     assert by_pair["incremental vs model-free"].endswith("disagrees: the opposite direction (the paper found incremental better).")

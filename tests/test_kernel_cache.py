@@ -73,8 +73,9 @@ def test_edits_outside_kernel_py_recompile_and_unchanged_sources_load_from_cache
 
     def run(*args: str, jit: bool = True) -> dict:
         e = env if jit else {**env, "NUMBA_DISABLE_JIT": "1"}
-        proc = subprocess.run([sys.executable, "-W", "ignore", str(tmp_path / "probe.py"), *args], env=e,
-                              cwd=tmp_path, capture_output=True, text=True, timeout=600)
+        proc = subprocess.run(
+            [sys.executable, "-W", "ignore", str(tmp_path / "probe.py"), *args], env=e, cwd=tmp_path, capture_output=True, text=True, timeout=600
+        )
         assert proc.returncode == 0, proc.stderr
         out = json.loads(proc.stdout)
         assert Path(out["file"]).resolve().is_relative_to(copy)
@@ -108,8 +109,7 @@ def test_every_cached_function_of_the_package_is_keyed_on_the_simulator_sources(
         if info.name.endswith("__main__"):
             continue
         module = importlib.import_module(info.name)
-        dispatchers += [f for f in vars(module).values()
-                        if isinstance(f, CPUDispatcher) and f.__module__ == module.__name__]
+        dispatchers += [f for f in vars(module).values() if isinstance(f, CPUDispatcher) and f.__module__ == module.__name__]
     assert len(dispatchers) > 20
     for f in dispatchers:
         assert isinstance(f._cache._impl.locator, SimSourceLocator), f.__qualname__

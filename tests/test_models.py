@@ -21,8 +21,8 @@ from neurohover.models import (
     OneStepProblem,
     equivalent_params,
     format_parameter_table,
-    learn_ec_mer,
     learn_ec_meno,
+    learn_ec_mer,
     learn_lr,
     observed_return,
     one_step_error,
@@ -51,8 +51,9 @@ def windy_flights():
     mdps = [get_task_family("ghh08").training_mdps()[i] for i in (0, 3)]
     ev = evaluate(baseline_policy(), mdps, episodes=2, seed=SEED, record=True)
     fd = ev.flight_data
-    return [(FlightData((fd.observations[2 * i],), (fd.actions[2 * i],)),
-             FlightData((fd.observations[2 * i + 1],), (fd.actions[2 * i + 1],))) for i in range(2)]
+    return [
+        (FlightData((fd.observations[2 * i],), (fd.actions[2 * i],)), FlightData((fd.observations[2 * i + 1],), (fd.actions[2 * i + 1],))) for i in range(2)
+    ]
 
 
 def _rel(rows):
@@ -70,8 +71,7 @@ def test_lr_recovers_default_parameters_from_one_simulator_episode(zero_flight) 
     # Well-determined parameters: over 30 seeds |rel. error| stays below
     # D_v 5.9 %, D_w 2.6 %, C_p 7.4 %, D_p 6.9 %, C_q 8.8 %, D_q 10.8 %, C_r 6.7 %, D_r 8.3 %;
     # plain OLS misses D_w by 16 % and every rate parameter by about 80 %.
-    tolerance = {"D_v": 0.06, "D_w": 0.03, "C_p": 0.08, "D_p": 0.08, "C_q": 0.09,
-                 "D_q": 0.11, "C_r": 0.08, "D_r": 0.09}
+    tolerance = {"D_v": 0.06, "D_w": 0.03, "C_p": 0.08, "D_p": 0.08, "C_q": 0.09, "D_q": 0.11, "C_r": 0.08, "D_r": 0.09}
     for name, tol in tolerance.items():
         assert abs(rel[name]) < tol, (name, rel[name])
     # Drag of the velocities is weakly identified by one baseline episode (sd 7-21 % over seeds)
@@ -124,11 +124,13 @@ def test_one_step_prediction_matches_the_kernel(zero_flight) -> None:
 
 
 def _rotation(qx, qy, qz, qw) -> np.ndarray:
-    return np.array([
-        [1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qw * qz), 2 * (qx * qz + qw * qy)],
-        [2 * (qx * qy + qw * qz), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qw * qx)],
-        [2 * (qx * qz - qw * qy), 2 * (qy * qz + qw * qx), 1 - 2 * (qx * qx + qy * qy)],
-    ])
+    return np.array(
+        [
+            [1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qw * qz), 2 * (qx * qz + qw * qy)],
+            [2 * (qx * qy + qw * qz), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qw * qx)],
+            [2 * (qx * qz - qw * qy), 2 * (qy * qz + qw * qx), 1 - 2 * (qx * qx + qy * qy)],
+        ]
+    )
 
 
 def test_lr_beats_the_default_parameters_and_plain_ols_flies_worse(zero_flight) -> None:
@@ -284,8 +286,7 @@ def test_equality_ignores_wall_clock_fields(zero_flight) -> None:
     from neurohover.agents.protocol import RunResult
     from neurohover.evaluate import Evaluation
 
-    timed = {"Evaluation": (Evaluation, {"seconds"}), "RunResult": (RunResult, {"seconds", "offline_seconds"}),
-             "LearnedModel": (LearnedModel, {"seconds"})}
+    timed = {"Evaluation": (Evaluation, {"seconds"}), "RunResult": (RunResult, {"seconds", "offline_seconds"}), "LearnedModel": (LearnedModel, {"seconds"})}
     for name, (cls, wall) in timed.items():
         compared = {f.name for f in dataclasses.fields(cls) if f.compare}
         assert not compared & wall, f"{name} compares wall-clock fields {sorted(compared & wall)}"

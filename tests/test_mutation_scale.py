@@ -50,8 +50,7 @@ def test_the_floor_survives_a_checkpoint() -> None:
 
 def test_evolve_takes_the_floor_as_a_setting() -> None:
     mdp = get_task_family("ghh08").training_mdps()[3]
-    a = evolve(mdp, topology="mlp", prototype="baseline", budget=120, seed=1, n_steps=200, threads=1,
-               settings={"mutation_floor": 0.02})
+    a = evolve(mdp, topology="mlp", prototype="baseline", budget=120, seed=1, n_steps=200, threads=1, settings={"mutation_floor": 0.02})
     b = evolve(mdp, topology="mlp", prototype="baseline", budget=120, seed=1, n_steps=200, threads=1)
     assert a.settings["settings"]["mutation_floor"] == 0.02
     assert not np.array_equal(a.champion.genome, b.champion.genome)

@@ -25,8 +25,8 @@ from neurohover.models import (
     ESTIMATORS,
     LearnedModel,
     OneStepProblem,
-    learn_ec_mer,
     learn_ec_meno,
+    learn_ec_mer,
     learn_lr,
     one_substep_params,
 )
@@ -118,7 +118,7 @@ def test_intercepts_do_what_the_docstring_says(windy) -> None:
     assert p["all"][0] == pytest.approx(p["uv"][0], rel=1e-9)
     # Residuals (hence noise) of "all" are those of the model without the u constant: with an
     # intercept the OLS residual has mean zero, so rms_all^2 = rms_uv^2 + D_u^2 on u.
-    assert m["all"].stats["residual_rms"][0] ** 2 == pytest.approx(m["uv"].stats["residual_rms"][0] ** 2 + m["uv"].d_u**2, rel=1e-9)
+    assert m["all"].stats["residual_rms"][0] ** 2 == pytest.approx(m["uv"].stats["residual_rms"][0] ** 2 + m["uv"].d_u ** 2, rel=1e-9)
     assert m["all"].noise_std[0] > m["uv"].noise_std[0]
     # "v": no u constant at all (a different C_u), D_u = 0.
     assert m["v"].d_u == 0.0 and m["v"].stats["discarded_intercepts"] == {}

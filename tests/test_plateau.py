@@ -115,8 +115,7 @@ def _always_crashing() -> Policy:
 @pytest.mark.parametrize("rule,reason", [("literal", "plateau"), ("no-crash", "budget")])
 def test_evolve_passes_crash_flags(rule, reason) -> None:
     settings = dict(plateau_threshold=30, pop_size=10, elite_size=9, mutate_frac=0.0, plateau_rule=rule)
-    result = evolve(get_task_family("ghh08").zero(), prototype=_always_crashing(), budget=2000, settings=settings,
-                    seed=0, n_steps=100, threads=1)
+    result = evolve(get_task_family("ghh08").zero(), prototype=_always_crashing(), budget=2000, settings=settings, seed=0, n_steps=100, threads=1)
     assert result.stop_reason == reason
     assert (result.episodes < 300) if rule == "literal" else (result.episodes == 2000)
 
@@ -124,10 +123,16 @@ def test_evolve_passes_crash_flags(rule, reason) -> None:
 def test_evolve_is_bit_identical_when_the_champion_never_crashes() -> None:
     keys = []
     for rule in ("literal", "no-crash"):
-        r = evolve(get_task_family("ghh08").zero(), topology="slp", budget=3000, seed=2, n_steps=100, threads=1,
-                   settings=dict(plateau_threshold=60, pop_size=10, elite_size=9, plateau_rule=rule))
-        keys.append((r.champion.genome.tobytes(), r.champion_return, r.episodes, r.stop_reason,
-                     [(h.evaluations, h.champion_return) for h in r.history]))
+        r = evolve(
+            get_task_family("ghh08").zero(),
+            topology="slp",
+            budget=3000,
+            seed=2,
+            n_steps=100,
+            threads=1,
+            settings=dict(plateau_threshold=60, pop_size=10, elite_size=9, plateau_rule=rule),
+        )
+        keys.append((r.champion.genome.tobytes(), r.champion_return, r.episodes, r.stop_reason, [(h.evaluations, h.champion_return) for h in r.history]))
     assert keys[0] == keys[1] and keys[0][3] == "plateau"
 
 
@@ -135,8 +140,9 @@ def test_evolve_is_bit_identical_when_the_champion_never_crashes() -> None:
 
 
 def test_tournament_selection_and_initial_mutation_options() -> None:
-    s = SteadyStateSettings(pop_size=10, elite_size=9, selection="tournament", tournament_size=5,
-                            crossover_prob=1.0, init_mutate_frac=0.5, init_mutate_std=0.5, budget=400)
+    s = SteadyStateSettings(
+        pop_size=10, elite_size=9, selection="tournament", tournament_size=5, crossover_prob=1.0, init_mutate_frac=0.5, init_mutate_std=0.5, budget=400
+    )
     opt = SteadyStateNE(np.zeros(20), s, seed=1)
     first = opt.ask()
     assert np.array_equal(first[0], np.zeros(20))
@@ -153,8 +159,7 @@ def test_tournament_selection_and_initial_mutation_options() -> None:
 
 def test_checkpoint_from_before_the_plateau_rule_resumes_under_the_literal_rule(tmp_path) -> None:
     ckpt = tmp_path / "run.json"
-    kw = dict(topology="slp", seed=1, n_steps=50, threads=1, checkpoint=ckpt,
-              settings=dict(pop_size=10, elite_size=9, plateau_rule="literal"))
+    kw = dict(topology="slp", seed=1, n_steps=50, threads=1, checkpoint=ckpt, settings=dict(pop_size=10, elite_size=9, plateau_rule="literal"))
     mdp = get_task_family("ghh08").zero()
     evolve(mdp, budget=100, **kw)
     state = json.loads(ckpt.read_text())

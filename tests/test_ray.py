@@ -17,7 +17,15 @@ import pytest
 from neurohover.cli import main
 from neurohover.errors import NeurohoverError
 from neurohover.experiments import (
-    LocalExecutor, RayExecutor, Store, load_config, make_executor, plan, reproduce, run_unit, strip_timing,
+    LocalExecutor,
+    RayExecutor,
+    Store,
+    load_config,
+    make_executor,
+    plan,
+    reproduce,
+    run_unit,
+    strip_timing,
 )
 from neurohover.experiments.plans import Plan
 from neurohover.experiments.units import Unit
@@ -63,8 +71,7 @@ def test_ray_and_local_runs_give_identical_results(ray_cluster, tmp_path: Path) 
 
 def test_reproduce_command_with_the_ray_executor(ray_cluster, tmp_path: Path, capsys) -> None:
     store = tmp_path / "s.sqlite"
-    argv = ["reproduce", "fig15", "--scale", "quick", "--set", "runs=1", "--set", "budget=600", "--store", str(store),
-            "--executor", "ray", "--no-progress"]
+    argv = ["reproduce", "fig15", "--scale", "quick", "--set", "runs=1", "--set", "budget=600", "--store", str(store), "--executor", "ray", "--no-progress"]
     assert main(argv) == 0
     out = capsys.readouterr().out
     assert "ran 2 units, 0 already in the store" in out and "(ray)" in out
@@ -79,9 +86,31 @@ def test_a_driver_in_another_process_joins_the_cluster_with_address(ray_cluster,
     root = Path(__file__).resolve().parents[1]
     env = {**os.environ, "PYTHONPATH": str(root) + os.pathsep + os.environ.get("PYTHONPATH", "")}
     store = tmp_path / "s.sqlite"
-    proc = subprocess.run([sys.executable, "-m", "neurohover.experiments", "reproduce", "fig15", "--set", "runs=1",
-                           "--set", "budget=600", "--store", str(store), "--executor", "ray", "--address", address,
-                           "--no-progress"], cwd=root, env=env, capture_output=True, text=True, timeout=300)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "neurohover.experiments",
+            "reproduce",
+            "fig15",
+            "--set",
+            "runs=1",
+            "--set",
+            "budget=600",
+            "--store",
+            str(store),
+            "--executor",
+            "ray",
+            "--address",
+            address,
+            "--no-progress",
+        ],
+        cwd=root,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert "ran 2 units" in proc.stdout and "on 2 cores (ray)" in proc.stdout
     assert ray_cluster.is_initialized()  # the cluster outlives the driver that joined it
@@ -103,8 +132,7 @@ def test_a_unit_whose_worker_keeps_dying_is_reported_not_recorded(ray_cluster, t
     from neurohover.experiments import runner
 
     cfg = load_config("fig15", "quick")
-    units = [Unit(cfg.name, "good", "diagnostic", {"value": 1}),
-             Unit(cfg.name, "dies", "diagnostic", {"always_exit": True})]
+    units = [Unit(cfg.name, "good", "diagnostic", {"value": 1}), Unit(cfg.name, "dies", "diagnostic", {"always_exit": True})]
     monkeypatch.setattr(runner, "plan", lambda config, results: Plan(units, 2))
     with Store(tmp_path / "s.sqlite") as store:
         summary = reproduce(cfg, store, RayExecutor(max_retries=1), progress=False)

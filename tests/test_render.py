@@ -62,11 +62,13 @@ def test_frames_change_as_the_helicopter_moves() -> None:
     for a, b in zip(frames, frames[1:], strict=False):
         assert _changed(_crop(a, "side"), _crop(b, "side")) > 20
         assert _changed(_crop(a, "text"), _crop(b, "text")) > 0  # step and return
+
     # The drawn helicopter itself moved down: the lowest dark (body) pixel row in the side view.
     def lowest_ink(frame: np.ndarray) -> int:
         side = _crop(frame, "side")[5:-5, 5:-5]  # inside the axes frame
-        rows = np.flatnonzero(((side.max(axis=-1) < 80)).any(axis=1))
+        rows = np.flatnonzero((side.max(axis=-1) < 80).any(axis=1))
         return int(rows.max())
+
     assert lowest_ink(frames[-1]) > lowest_ink(frames[0]) + 10
 
 
@@ -98,10 +100,12 @@ def test_windy_frame_differs_from_calm_only_in_wind_and_text() -> None:
         r0, r1, c0, c1 = BOXES.pixel_box(part)
         outside[r0:r1, c0:c1] = False
     assert np.array_equal(a[outside], b[outside])
+
     # A windier MDP draws a longer arrow: more purple-ish pixels in the compass.
     def arrow_pixels(frame: np.ndarray) -> int:
         w = _crop(frame, "wind").astype(int)
         return int(((w[..., 0] - w[..., 1] > 40) & (w[..., 2] - w[..., 1] > 40)).sum())
+
     stronger = HoverEnv("ghh08", mdp=family.make([5.0, -4.0]), render_mode="rgb_array")
     stronger.reset(seed=0)
     assert arrow_pixels(a) == 0 and arrow_pixels(stronger.render()) > arrow_pixels(b) > 20

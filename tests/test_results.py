@@ -41,8 +41,7 @@ def committed_store(tmp_path_factory) -> Path:
 
 def _stored(path: Path, *where: str):
     with sqlite3.connect(path) as conn:
-        return conn.execute("SELECT name, scale, key, kind, result FROM units" + (" WHERE " + where[0] if where else ""),
-                            where[1:]).fetchall()
+        return conn.execute("SELECT name, scale, key, kind, result FROM units" + (" WHERE " + where[0] if where else ""), where[1:]).fetchall()
 
 
 def test_every_stored_result_round_trips_exactly(committed_store: Path) -> None:
@@ -70,10 +69,18 @@ def test_units_store_their_typed_result(committed_store: Path) -> None:
 
 
 def _evolve_dict(**changes) -> dict:
-    d = {"champion": {"topology": "slp", "genome": [0.5, -1.0]}, "champion_return": -12.5, "episodes": 40,
-         "evaluations": 40, "generations": 4, "stop_reason": "budget", "champion_crashed": False,
-         "history": [[1, "-inf"], [40, -12.5]], "validation": [-13.0, "nan"],
-         "timing": {"seconds": 1.25, "kernel_seconds": 0.5}}
+    d = {
+        "champion": {"topology": "slp", "genome": [0.5, -1.0]},
+        "champion_return": -12.5,
+        "episodes": 40,
+        "evaluations": 40,
+        "generations": 4,
+        "stop_reason": "budget",
+        "champion_crashed": False,
+        "history": [[1, "-inf"], [40, -12.5]],
+        "validation": [-13.0, "nan"],
+        "timing": {"seconds": 1.25, "kernel_seconds": 0.5},
+    }
     d.update(changes)
     return {k: v for k, v in d.items() if v is not None}
 
@@ -100,21 +107,34 @@ def test_bad_result_dicts_are_refused() -> None:
     with pytest.raises(NeurohoverError, match="unknown unit kind 'nope'"):
         result_from_dict("nope", {})
     with pytest.raises(NeurohoverError, match="must be a TestRunTiming"):
-        TestRunResult(agent="a", mdp="m", score=0.0, returns=[], crash_episodes=[], safeguard_episodes=[], policy_changes=[],
-                      learning_episodes=0, mean_return_after_learning=0.0, timing={"seconds": 1.0, "offline_seconds": 0.0})
+        TestRunResult(
+            agent="a",
+            mdp="m",
+            score=0.0,
+            returns=[],
+            crash_episodes=[],
+            safeguard_episodes=[],
+            policy_changes=[],
+            learning_episodes=0,
+            mean_return_after_learning=0.0,
+            timing={"seconds": 1.0, "offline_seconds": 0.0},
+        )
 
 
-@pytest.mark.parametrize("key, parts", [
-    ("evolve/mlp-baseline/train3/run7", ("evolve", "mlp-baseline", "train3", 7)),
-    ("evolve/race0.2/run0", ("evolve", "race0.2", None, 0)),
-    ("robust/slp-zero/train9", ("robust", "slp-zero", "train9", None)),
-    ("policy/generic", ("policy", "generic", None, None)),
-    ("policy/generic-race1", ("policy", "generic-race1", None, None)),
-    ("model/lr-gls/test12", ("model", "lr-gls", "test12", None)),
-    ("run/hybrid-baseline/sample4/rep2", ("run", "hybrid-baseline", "sample4", 2)),
-    ("run/a/b/train0/rep1", ("run", "a/b", "train0", 1)),  # a group label with a slash
-    ("good", ("", "", None, None)),
-])
+@pytest.mark.parametrize(
+    "key, parts",
+    [
+        ("evolve/mlp-baseline/train3/run7", ("evolve", "mlp-baseline", "train3", 7)),
+        ("evolve/race0.2/run0", ("evolve", "race0.2", None, 0)),
+        ("robust/slp-zero/train9", ("robust", "slp-zero", "train9", None)),
+        ("policy/generic", ("policy", "generic", None, None)),
+        ("policy/generic-race1", ("policy", "generic-race1", None, None)),
+        ("model/lr-gls/test12", ("model", "lr-gls", "test12", None)),
+        ("run/hybrid-baseline/sample4/rep2", ("run", "hybrid-baseline", "sample4", 2)),
+        ("run/a/b/train0/rep1", ("run", "a/b", "train0", 1)),  # a group label with a slash
+        ("good", ("", "", None, None)),
+    ],
+)
 def test_unit_keys_parse(key: str, parts: tuple) -> None:
     k = UnitKey.parse(key)
     assert (k.stage, k.group, k.mdp, k.rep) == parts and k.key == key
@@ -135,7 +155,6 @@ def test_export_and_report_read_typed_results(committed_store: Path, tmp_path: P
     assert json.loads(next(r for r in rows if r["key"] == "policy/generic")["result.champion"])["topology"] == "mlp"
     broken = shutil.copy(committed_store, tmp_path / "broken.sqlite")  # the module's store stays intact
     with sqlite3.connect(broken) as conn:
-        conn.execute("UPDATE units SET result = ? WHERE name = 'fig15' AND scale = 'quick' AND key = 'evolve/k5/run0'",
-                     (json.dumps({"champion_return": 1.0}),))
+        conn.execute("UPDATE units SET result = ? WHERE name = 'fig15' AND scale = 'quick' AND key = 'evolve/k5/run0'", (json.dumps({"champion_return": 1.0}),))
     with Store(broken, create=False) as store, pytest.raises(NeurohoverError, match="evolve/k5/run0.*missing key"):
         write_report(store, tmp_path / "report", scale="quick", names=["fig15"])

@@ -50,8 +50,7 @@ def _start(tmp_path: Path, *argv: str) -> subprocess.Popen:
     out = open(tmp_path / "stdout.txt", "w")
     err = open(tmp_path / "stderr.txt", "w")
     try:
-        return subprocess.Popen([sys.executable, "-m", "neurohover", *argv], cwd=ROOT, env=ENV, stdout=out, stderr=err,
-                                start_new_session=True)
+        return subprocess.Popen([sys.executable, "-m", "neurohover", *argv], cwd=ROOT, env=ENV, stdout=out, stderr=err, start_new_session=True)
     finally:
         out.close()
         err.close()
@@ -149,8 +148,9 @@ def test_the_workers_of_a_killed_reproduce_exit(tmp_path: Path, sig: int) -> Non
 
 @pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM], ids=["SIGKILL", "SIGTERM"])
 def test_the_workers_of_a_killed_compete_exit(tmp_path: Path, sig: int) -> None:
-    proc = _start(tmp_path, "compete", "--task", "ghh08", "--agent", "baseline", "--runs", "2", "--jobs", "2",
-                  "--episodes", "200000", "--out", str(tmp_path / "out"))
+    proc = _start(
+        tmp_path, "compete", "--task", "ghh08", "--agent", "baseline", "--runs", "2", "--jobs", "2", "--episodes", "200000", "--out", str(tmp_path / "out")
+    )
     try:
         children = _busy_workers(proc, 2)
         os.kill(proc.pid, sig)
@@ -164,16 +164,37 @@ def test_the_workers_of_a_killed_compete_exit(tmp_path: Path, sig: int) -> None:
 # --------------------------------------------------------------------------------- Ray addresses
 
 
-@pytest.mark.parametrize("address, message", [
-    ("notanaddress", "--address 'notanaddress' is not a Ray cluster address: allowed host:port (port 1 to 65535"),
-    ("127.0.0.1:1", "--address '127.0.0.1:1': no Ray cluster is listening at 127.0.0.1:1 (connection refused)"),
-])
+@pytest.mark.parametrize(
+    "address, message",
+    [
+        ("notanaddress", "--address 'notanaddress' is not a Ray cluster address: allowed host:port (port 1 to 65535"),
+        ("127.0.0.1:1", "--address '127.0.0.1:1': no Ray cluster is listening at 127.0.0.1:1 (connection refused)"),
+    ],
+)
 def test_a_bad_or_dead_ray_address_ends_at_once_with_one_clear_line(tmp_path: Path, address: str, message: str) -> None:
     env = {k: v for k, v in ENV.items() if k != "RAY_ADDRESS"}
     start = time.monotonic()
-    proc = subprocess.run([sys.executable, "-m", "neurohover", "reproduce", "fig2", "--executor", "ray", "--address", address,
-                           "--store", str(tmp_path / "s.sqlite"), "--no-progress"],
-                          cwd=ROOT, env=env, capture_output=True, text=True, timeout=120)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "neurohover",
+            "reproduce",
+            "fig2",
+            "--executor",
+            "ray",
+            "--address",
+            address,
+            "--store",
+            str(tmp_path / "s.sqlite"),
+            "--no-progress",
+        ],
+        cwd=ROOT,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert time.monotonic() - start < 30, "Ray retried instead of refusing the address"
     assert proc.returncode == 2, proc.stderr[-2000:]
     assert "Traceback" not in proc.stderr
@@ -181,18 +202,24 @@ def test_a_bad_or_dead_ray_address_ends_at_once_with_one_clear_line(tmp_path: Pa
     assert proc.stderr.startswith(f"neurohover reproduce: error: {message}")
 
 
-@pytest.mark.parametrize("address, endpoint", [
-    ("10.0.0.5:6379", ("10.0.0.5", 6379)), ("head-node:1", ("head-node", 1)), ("ray://head:10001", ("head", 10001)),
-    ("[::1]:65535", ("::1", 65535)), ("auto", None), ("local", None),
-])
+@pytest.mark.parametrize(
+    "address, endpoint",
+    [
+        ("10.0.0.5:6379", ("10.0.0.5", 6379)),
+        ("head-node:1", ("head-node", 1)),
+        ("ray://head:10001", ("head", 10001)),
+        ("[::1]:65535", ("::1", 65535)),
+        ("auto", None),
+        ("local", None),
+    ],
+)
 def test_ray_address_forms_that_ray_accepts(address: str, endpoint) -> None:
     from neurohover.experiments.executors import ray_endpoint
 
     assert ray_endpoint(address) == endpoint
 
 
-@pytest.mark.parametrize("address", ["notanaddress", "h:0", "h:65536", "h:abc", ":6379", "::1:6379", "ray://head", "h: 1",
-                                     "http://h:1", "h:1:2", ""])
+@pytest.mark.parametrize("address", ["notanaddress", "h:0", "h:65536", "h:abc", ":6379", "::1:6379", "ray://head", "h: 1", "http://h:1", "h:1:2", ""])
 def test_malformed_ray_addresses_are_refused(address: str) -> None:
     from neurohover.errors import NeurohoverError
     from neurohover.experiments.executors import ray_endpoint
@@ -202,9 +229,14 @@ def test_malformed_ray_addresses_are_refused(address: str) -> None:
 
 
 def test_a_bad_ray_address_environment_variable_is_named(tmp_path: Path) -> None:
-    proc = subprocess.run([sys.executable, "-m", "neurohover", "reproduce", "fig2", "--executor", "ray",
-                           "--store", str(tmp_path / "s.sqlite"), "--no-progress"],
-                          cwd=ROOT, env={**ENV, "RAY_ADDRESS": "127.0.0.1:1"}, capture_output=True, text=True, timeout=120)
+    proc = subprocess.run(
+        [sys.executable, "-m", "neurohover", "reproduce", "fig2", "--executor", "ray", "--store", str(tmp_path / "s.sqlite"), "--no-progress"],
+        cwd=ROOT,
+        env={**ENV, "RAY_ADDRESS": "127.0.0.1:1"},
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
     assert "RAY_ADDRESS '127.0.0.1:1': no Ray cluster is listening at 127.0.0.1:1" in proc.stderr
 
@@ -215,8 +247,7 @@ TINY_CONFIG = LONG_CONFIG.replace('"longtest"', '"tinytest"').replace("runs = 4"
 
 
 def _neurohover(*argv: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "neurohover", *argv], cwd=ROOT, env=ENV, capture_output=True, text=True,
-                          timeout=300)
+    return subprocess.run([sys.executable, "-m", "neurohover", *argv], cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=300)
 
 
 def _running_session(store: Path, name: str) -> bool:
@@ -286,6 +317,7 @@ def test_a_terminated_command_exits_with_143_and_an_interrupt_with_130(monkeypat
     def stop(exc):
         def run(args):
             raise exc
+
         return run
 
     for exc, status, word in ((Terminated(), 143, "terminated"), (KeyboardInterrupt(), 130, "interrupted")):

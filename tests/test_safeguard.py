@@ -17,8 +17,14 @@ def _qw(obs: np.ndarray) -> np.ndarray:
 def _drifter() -> Policy:
     # The baseline plus a steady collective offset: the helicopter climbs out of the box while level.
     g = np.zeros(40)
-    g[:36] = np.array([[0, -0.0367, 0, 0, -0.0196, 0, -0.7475, 0, 0], [-0.0322, 0, 0, -0.0185, 0, 0, 0, 0.7904, 0],
-                       [0, 0, 0, 0, 0, 0, 0, 0, -0.1969], [0, 0, 0.1348, 0, 0, 0.0513, 0, 0, 0]]).ravel()
+    g[:36] = np.array(
+        [
+            [0, -0.0367, 0, 0, -0.0196, 0, -0.7475, 0, 0],
+            [-0.0322, 0, 0, -0.0185, 0, 0, 0, 0.7904, 0],
+            [0, 0, 0, 0, 0, 0, 0, 0, -0.1969],
+            [0, 0, 0.1348, 0, 0, 0.0513, 0, 0, 0],
+        ]
+    ).ravel()
     g[36:] = (0.02, 0.0, 0.0, 0.23 + 0.03)
     return Policy("slp", g)
 
@@ -26,10 +32,8 @@ def _drifter() -> Policy:
 def test_code_rule_needs_a_tilt_where_the_box_alone_fires() -> None:
     mdp = get_task_family("ghh08").zero()
     drifter = _drifter()
-    paper = evaluate(drifter, mdp, episodes=4, seed=3, n_steps=600, record=True,
-                     safeguard=Safeguard(baseline_policy(), DangerousState("paper")))
-    code = evaluate(drifter, mdp, episodes=4, seed=3, n_steps=600, record=True,
-                    safeguard=Safeguard(baseline_policy(), DangerousState("code")))
+    paper = evaluate(drifter, mdp, episodes=4, seed=3, n_steps=600, record=True, safeguard=Safeguard(baseline_policy(), DangerousState("paper")))
+    code = evaluate(drifter, mdp, episodes=4, seed=3, n_steps=600, record=True, safeguard=Safeguard(baseline_policy(), DangerousState("code")))
     assert (paper.safeguard_step >= 0).all()  # a level drift leaves the 0.5 box...
     obs = code.flight_data.observations
     for e in range(4):
@@ -59,19 +63,21 @@ def test_limits_are_settings() -> None:
     # a wider box fires later (or not at all) on the same flights
     roller = Policy("slp", np.r_[np.zeros(36), 0.3, 0, 0, 0.23])
     mdp = get_task_family("ghh08").zero()
-    steps = [evaluate(roller, mdp, episodes=2, seed=5, safeguard=Safeguard(baseline_policy(), DangerousState(box=b))).safeguard_step
-             for b in (0.5, 2.0)]
+    steps = [evaluate(roller, mdp, episodes=2, seed=5, safeguard=Safeguard(baseline_policy(), DangerousState(box=b))).safeguard_step for b in (0.5, 2.0)]
     assert (steps[0] >= 0).all() and ((steps[1] > steps[0]) | (steps[1] == -1)).all()
 
 
-@pytest.mark.parametrize(("kwargs", "message"), [
-    ({"rule": "literal"}, "unknown safeguard rule 'literal': allowed code, paper"),
-    ({"box": -0.5}, "box=-0.5 is out of range"),
-    ({"box": 0}, "box=0 is out of range"),
-    ({"tilt": 1.2}, r"tilt=1.2 is out of range: allowed 0 < tilt <= 1"),
-    ({"tilt": 0}, "tilt=0 is out of range"),
-    ({"box": float("nan")}, "box=nan is out of range"),
-])
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"rule": "literal"}, "unknown safeguard rule 'literal': allowed code, paper"),
+        ({"box": -0.5}, "box=-0.5 is out of range"),
+        ({"box": 0}, "box=0 is out of range"),
+        ({"tilt": 1.2}, r"tilt=1.2 is out of range: allowed 0 < tilt <= 1"),
+        ({"tilt": 0}, "tilt=0 is out of range"),
+        ({"box": float("nan")}, "box=nan is out of range"),
+    ],
+)
 def test_bad_settings_are_refused(kwargs: dict, message: str) -> None:
     with pytest.raises(NeurohoverError, match=message):
         DangerousState(**kwargs)
@@ -81,9 +87,9 @@ def test_bad_settings_are_refused(kwargs: dict, message: str) -> None:
 
 from pathlib import Path  # noqa: E402
 
+from neurohover.agents.hybrid import HybridSettings  # noqa: E402
 from neurohover.cli import main  # noqa: E402
 from neurohover.experiments.config import CONFIG_DIR, load_config  # noqa: E402
-from neurohover.agents.hybrid import HybridSettings  # noqa: E402
 from neurohover.experiments.plans import group_hybrid_settings, plan  # noqa: E402
 
 
@@ -107,26 +113,32 @@ def test_experiment_groups_carry_thegroup_hybrid_settings_into_their_units(tmp_p
     assert default.hash != cfg.hash  # the settings are part of the experiment's identity
 
 
-@pytest.mark.parametrize(("extra", "agent", "message"), [
-    ('hybrid = { tilt = 1.5 }\n', "hybrid", "tilt=1.5 is out of range"),
-    ('hybrid = { box = -1 }\n', "hybrid", "box=-1 is out of range"),
-    ('hybrid = { replacement = "magic" }\n', "hybrid", "unknown hybrid replacement 'magic'"),
-    ('hybrid = { colour = "red" }\n', "hybrid", "unknown hybrid setting(s) colour"),
-    ('hybrid = { rule = "paper" }\n', "incremental", "hybrid settings apply to the agents hybrid, hybrid-baseline only"),
-])
+@pytest.mark.parametrize(
+    ("extra", "agent", "message"),
+    [
+        ("hybrid = { tilt = 1.5 }\n", "hybrid", "tilt=1.5 is out of range"),
+        ("hybrid = { box = -1 }\n", "hybrid", "box=-1 is out of range"),
+        ('hybrid = { replacement = "magic" }\n', "hybrid", "unknown hybrid replacement 'magic'"),
+        ('hybrid = { colour = "red" }\n', "hybrid", "unknown hybrid setting(s) colour"),
+        ('hybrid = { rule = "paper" }\n', "incremental", "hybrid settings apply to the agents hybrid, hybrid-baseline only"),
+    ],
+)
 def test_badgroup_hybrid_settings_in_configs_are_refused(tmp_path: Path, extra: str, agent: str, message: str) -> None:
     with pytest.raises(NeurohoverError) as err:
         load_config(str(_fig8_with(tmp_path, extra, agent)), "paper")
     assert message in str(err.value)
 
 
-@pytest.mark.parametrize(("argv", "message"), [
-    (["--agent", "hybrid", "--safeguard-tilt", "0"], "tilt=0.0 is out of range"),
-    (["--agent", "hybrid", "--safeguard-box", "-0.5"], "box=-0.5 is out of range"),
-    (["--agent", "hybrid", "--safeguard-rule", "text"], "unknown safeguard rule 'text'"),
-    (["--agent", "hybrid", "--hybrid-replacement", "x"], "unknown hybrid replacement 'x'"),
-    (["--agent", "model-free", "--safeguard-rule", "paper"], "--safeguard-rule apply to the hybrid agents only"),
-])
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--agent", "hybrid", "--safeguard-tilt", "0"], "tilt=0.0 is out of range"),
+        (["--agent", "hybrid", "--safeguard-box", "-0.5"], "box=-0.5 is out of range"),
+        (["--agent", "hybrid", "--safeguard-rule", "text"], "unknown safeguard rule 'text'"),
+        (["--agent", "hybrid", "--hybrid-replacement", "x"], "unknown hybrid replacement 'x'"),
+        (["--agent", "model-free", "--safeguard-rule", "paper"], "--safeguard-rule apply to the hybrid agents only"),
+    ],
+)
 def test_compete_refuses_bad_hybrid_options(tmp_path: Path, capsys, argv: list[str], message: str) -> None:
     rc = main(["compete", "--task", "ghh09", "--runs", "1", "--episodes", "2", "--out", str(tmp_path / "o"), *argv])
     err = capsys.readouterr().err

@@ -155,7 +155,7 @@ def test_safeguard_hands_over_to_fallback() -> None:
     k = int(guarded.safeguard_step[0, 0, 0])
     obs, acts = fd.observations[0], fd.actions[0]
     assert np.max(np.abs(obs[k, :9])) > 0.5 and np.max(np.abs(obs[k - 1, :9])) <= 0.5
-    np.testing.assert_allclose(acts[k:k + 50], np.clip([baseline_policy().act(o) for o in obs[k:k + 50]], -1, 1), rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(acts[k : k + 50], np.clip([baseline_policy().act(o) for o in obs[k : k + 50]], -1, 1), rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(acts[:k, 0], 0.6)
 
 

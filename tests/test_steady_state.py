@@ -158,8 +158,7 @@ def assert_same_state(opt: SteadyStateNE, ref: FrozenSteadyStateNE) -> None:
     assert opt.champion_return == ref.champion_return
     assert same_bits(opt.champion_genome, ref.champion_genome)
     assert [(h.evaluations, h.champion_return) for h in opt.history] == ref.history
-    assert (opt.evaluations, opt.generation, opt.evaluations_since_champion, opt.stop()) == (
-        ref.evaluations, ref.generation, ref.since, ref.stop())
+    assert (opt.evaluations, opt.generation, opt.evaluations_since_champion, opt.stop()) == (ref.evaluations, ref.generation, ref.since, ref.stop())
     assert opt.state_dict()["rng"] == ref.rng.bit_generator.state  # the same draws were made
 
 
@@ -190,8 +189,11 @@ def roundtrip(opt: SteadyStateNE) -> SteadyStateNE:
 @pytest.mark.parametrize("shape,order", [((42,), "C"), ((1,), "C"), ((), "C"), ((3, 5), "C"), ((4, 6), "F")])
 def test_operators_match_the_reference(shape, order) -> None:
     rng = np.random.default_rng(0)
-    settings = [SteadyStateSettings(), SteadyStateSettings(mutate_frac=1.0, mutate_repl=0.5, averaging_prob=0.0),
-                SteadyStateSettings(mutate_frac=0.0, mutate_std=0.0, averaging_prob=1.0)]
+    settings = [
+        SteadyStateSettings(),
+        SteadyStateSettings(mutate_frac=1.0, mutate_repl=0.5, averaging_prob=0.0),
+        SteadyStateSettings(mutate_frac=0.0, mutate_std=0.0, averaging_prob=1.0),
+    ]
     for trial in range(60):
         s = settings[trial % len(settings)]
         a = np.asarray(rng.normal(size=shape), order=order)
@@ -210,8 +212,14 @@ def test_operators_match_the_reference(shape, order) -> None:
 
 
 def test_roulette_weights_match_the_reference() -> None:
-    cases = [np.array([-1e4, -100.0, -1.0, 5.0, np.nan, -np.inf, np.inf, 0.0, -0.0, -1.000001]),
-             np.array([np.nan, -np.inf]), np.array([-3.0]), np.array(-7.0), np.zeros(0), -np.abs(np.random.default_rng(2).normal(0, 1e3, 50))]
+    cases = [
+        np.array([-1e4, -100.0, -1.0, 5.0, np.nan, -np.inf, np.inf, 0.0, -0.0, -1.000001]),
+        np.array([np.nan, -np.inf]),
+        np.array([-3.0]),
+        np.array(-7.0),
+        np.zeros(0),
+        -np.abs(np.random.default_rng(2).normal(0, 1e3, 50)),
+    ]
     for r in cases:
         assert same_bits(roulette_weights(r), ref_roulette_weights(r))
 
@@ -250,16 +258,18 @@ def test_generational_breeding_is_unchanged(monkeypatch) -> None:
 # --------------------------------------------------------------------------------- steady state ask/tell
 
 
-@pytest.mark.parametrize("pop_size,elite_size,crossover_prob,dim", [
-    (50, 49, 0.5, 42),  # the paper's settings
-    (20, 19, 0.5, 12),
-    (10, 7, 0.5, 12),   # several offspring per generation
-    (6, 0, 1.0, 5),     # no elite; always crossover
-    (8, 5, 0.0, 5),     # never crossover
-])
+@pytest.mark.parametrize(
+    "pop_size,elite_size,crossover_prob,dim",
+    [
+        (50, 49, 0.5, 42),  # the paper's settings
+        (20, 19, 0.5, 12),
+        (10, 7, 0.5, 12),  # several offspring per generation
+        (6, 0, 1.0, 5),  # no elite; always crossover
+        (8, 5, 0.0, 5),  # never crossover
+    ],
+)
 def test_ask_tell_matches_the_reference(pop_size, elite_size, crossover_prob, dim) -> None:
-    settings = SteadyStateSettings(pop_size=pop_size, elite_size=elite_size, crossover_prob=crossover_prob,
-                                   plateau_threshold=400)
+    settings = SteadyStateSettings(pop_size=pop_size, elite_size=elite_size, crossover_prob=crossover_prob, plateau_threshold=400)
     target = np.random.default_rng(3).normal(size=dim)
     opt, ref = SteadyStateNE(np.zeros(dim), settings, seed=5), FrozenSteadyStateNE(np.zeros(dim), settings, seed=5)
     noise = np.random.default_rng(9)
@@ -285,8 +295,9 @@ def test_state_dict_format_is_unchanged() -> None:
     opt.tell(-np.arange(1.0, 6.0) * 10 + 0 * opt.ask()[:, 0])
     opt.ask()
     state = opt.state_dict()
-    assert sorted(state) == sorted(["type", "version", "settings", "prototype", "population", "fitness", "pending",
-                                    "generation", "rng", "tracker", "wall_seconds"])
+    assert sorted(state) == sorted(
+        ["type", "version", "settings", "prototype", "population", "fitness", "pending", "generation", "rng", "tracker", "wall_seconds"]
+    )
     assert (state["type"], state["version"], state["generation"]) == ("SteadyStateNE", 1, 1)
     assert state["population"]["shape"] == [5, 4] and state["pending"]["shape"] == [1, 4]
     assert sorted(state["tracker"]) == ["best", "evaluations", "genome", "history", "since"]
@@ -300,24 +311,33 @@ def _recording(cls, made: list):
     def make(*args, **kwargs):
         made.append(cls(*args, **kwargs))
         return made[-1]
+
     return make
 
 
 def _result_key(result) -> tuple:
     return (
-        result.champion.genome.tobytes(), result.champion_return, result.episodes, result.steps,
-        result.evaluations, result.generations, result.stop_reason,
+        result.champion.genome.tobytes(),
+        result.champion_return,
+        result.episodes,
+        result.steps,
+        result.evaluations,
+        result.generations,
+        result.stop_reason,
         [(h.generation, h.evaluations, h.episodes, h.generation_episodes, h.champion_return) for h in result.history],
     )
 
 
-@pytest.mark.parametrize("topology,seed,kwargs", [
-    ("slp", 0, dict(budget=600)),
-    ("mlp", 1, dict(budget=600)),
-    ("mlp", 2, dict(budget=600, mdp="train:1")),
-    ("slp", 3, dict(budget=1000, resampling="fixed:2", settings={"pop_size": 10, "elite_size": 7})),
-    ("mlp", 4, dict(settings={"plateau_threshold": 150, "pop_size": 20, "elite_size": 19})),
-])
+@pytest.mark.parametrize(
+    "topology,seed,kwargs",
+    [
+        ("slp", 0, dict(budget=600)),
+        ("mlp", 1, dict(budget=600)),
+        ("mlp", 2, dict(budget=600, mdp="train:1")),
+        ("slp", 3, dict(budget=1000, resampling="fixed:2", settings={"pop_size": 10, "elite_size": 7})),
+        ("mlp", 4, dict(settings={"plateau_threshold": 150, "pop_size": 20, "elite_size": 19})),
+    ],
+)
 def test_evolve_matches_the_reference(monkeypatch, topology, seed, kwargs) -> None:
     mdp = GHH08.mdp(kwargs.pop("mdp", "train:0"))
     runs = []

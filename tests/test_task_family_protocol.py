@@ -45,7 +45,8 @@ def test_a_new_family_module_is_discovered_and_gets_samples_rows_and_sets(tmp_pa
     package = tmp_path / "myfamilies"
     package.mkdir()
     (package / "__init__.py").write_text("")
-    (package / "heavy.py").write_text(textwrap.dedent('''
+    (package / "heavy.py").write_text(
+        textwrap.dedent('''
         from dataclasses import dataclass
 
         from neurohover.sim.constants import DEFAULT_PARAMS, ROW_PARAMS
@@ -80,7 +81,8 @@ def test_a_new_family_module_is_discovered_and_gets_samples_rows_and_sets(tmp_pa
 
         import numpy as np
         TASK_FAMILY = Heavy
-    '''))
+    ''')
+    )
     monkeypatch.syspath_prepend(str(tmp_path))
     found = discover("myfamilies")
     assert list(found) == ["heavy"]

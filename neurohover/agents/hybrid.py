@@ -69,7 +69,7 @@ class HybridSettings:
         return {"replacement": self.replacement, "model_from": self.model_from, "rule": d.rule, "box": d.box, "tilt": d.tilt}
 
     @classmethod
-    def from_dict(cls, values: dict) -> "HybridSettings":
+    def from_dict(cls, values: dict) -> HybridSettings:
         """Settings from a (partial) dict of :meth:`to_dict`'s keys; unknown keys are refused."""
         known = set(cls().to_dict())
         unknown = sorted(set(values) - known)
@@ -90,9 +90,15 @@ class HybridAgent(Agent):
 
     name = "hybrid"
 
-    def __init__(self, safe: Sequence[Policy], generic: Policy, fallback: Policy,
-                 settings: ModelEvolution = ModelEvolution(), name: str = "hybrid",
-                 hybrid: HybridSettings = HybridSettings()) -> None:
+    def __init__(
+        self,
+        safe: Sequence[Policy],
+        generic: Policy,
+        fallback: Policy,
+        settings: ModelEvolution = ModelEvolution(),
+        name: str = "hybrid",
+        hybrid: HybridSettings = HybridSettings(),
+    ) -> None:
         if len(safe) != 2:
             raise NeurohoverError(f"the hybrid agent needs exactly 2 safe specialised policies, got {len(safe)}")
         self.safe = list(safe)
@@ -203,14 +209,26 @@ def _hybrid(name: str, fallback: str):
     def build(policies: AgentPolicies, options: AgentOptions) -> Agent:
         assert policies.generic is not None
         backup = policies.generic if fallback == "generic" else baseline_policy()
-        return HybridAgent(policies.safe, policies.generic, backup, options.evolution or ModelEvolution(), name=name,
-                           hybrid=options.hybrid or HybridSettings())
+        return HybridAgent(policies.safe, policies.generic, backup, options.evolution or ModelEvolution(), name=name, hybrid=options.hybrid or HybridSettings())
+
     return build
 
 
 AGENT_SPECS = (
-    AgentSpec("hybrid", ("ghh08", "ghh09"), frozenset({"generic", "safe"}), _hybrid("hybrid", "generic"), takes_hybrid=True,
-              summary="the safe specialised pair, then policies evolved on a model, under a safeguard (generic fallback)"),
-    AgentSpec("hybrid-baseline", ("ghh08", "ghh09"), frozenset({"generic", "safe"}), _hybrid("hybrid-baseline", "baseline"),
-              takes_hybrid=True, summary="the hybrid agent with the baseline policy as the safeguard's fallback"),
+    AgentSpec(
+        "hybrid",
+        ("ghh08", "ghh09"),
+        frozenset({"generic", "safe"}),
+        _hybrid("hybrid", "generic"),
+        takes_hybrid=True,
+        summary="the safe specialised pair, then policies evolved on a model, under a safeguard (generic fallback)",
+    ),
+    AgentSpec(
+        "hybrid-baseline",
+        ("ghh08", "ghh09"),
+        frozenset({"generic", "safe"}),
+        _hybrid("hybrid-baseline", "baseline"),
+        takes_hybrid=True,
+        summary="the hybrid agent with the baseline policy as the safeguard's fallback",
+    ),
 )

@@ -59,11 +59,9 @@ def evolve_on_model(model: MDP, prototype: Policy, settings: ModelEvolution, see
     """Evolve a policy on ``model``; return it and its predicted return (mean over model episodes)."""
     from ..evolution.evolve import evolve
 
-    result = evolve(model, topology=prototype.topology, prototype=prototype, budget=settings.budget,
-                    seed=seed, n_steps=settings.n_steps, threads=1)
+    result = evolve(model, topology=prototype.topology, prototype=prototype, budget=settings.budget, seed=seed, n_steps=settings.n_steps, threads=1)
     policy = result.champion
-    predicted = evaluate(policy, model, episodes=settings.predict_episodes, seed=seed,
-                         first_episode=10**9, n_steps=settings.n_steps, threads=1).returns.mean()
+    predicted = evaluate(policy, model, episodes=settings.predict_episodes, seed=seed, first_episode=10**9, n_steps=settings.n_steps, threads=1).returns.mean()
     return policy, float(predicted)
 
 
@@ -164,17 +162,37 @@ def _incremental(name: str):
         agent = IncrementalModelBasedAgent(policies.generic, options.evolution or ModelEvolution(), **limit)
         agent.name = name
         return agent
+
     return build
 
 
 _ALL = ("ghh08", "ghh09", "fghh")
 AGENT_SPECS = (
-    AgentSpec("model-based", _ALL, frozenset({"generic"}), _model_based, generic_kind={"fghh": "race"},
-              summary="fly the generic policy once, learn a model, evolve a policy on it, keep it"),
-    AgentSpec("incremental", _ALL, frozenset({"generic"}), _incremental("incremental"), generic_kind={"fghh": "race"},
-              summary="re-learn the model and re-evolve after every episode until a policy meets its prediction"),
-    *(AgentSpec(f"incremental-{kind}", ("fghh",), frozenset({"generic"}), _incremental(f"incremental-{kind}"),
-                generic_kind={"fghh": kind}, summary=f"incremental, from the FGHH generic policy evolved {what}")
-      for kind, what in (("zero", "on the zero setting"), ("fixed", "over G with fixed resampling"),
-                         ("race", "over G with selection races"))),
+    AgentSpec(
+        "model-based",
+        _ALL,
+        frozenset({"generic"}),
+        _model_based,
+        generic_kind={"fghh": "race"},
+        summary="fly the generic policy once, learn a model, evolve a policy on it, keep it",
+    ),
+    AgentSpec(
+        "incremental",
+        _ALL,
+        frozenset({"generic"}),
+        _incremental("incremental"),
+        generic_kind={"fghh": "race"},
+        summary="re-learn the model and re-evolve after every episode until a policy meets its prediction",
+    ),
+    *(
+        AgentSpec(
+            f"incremental-{kind}",
+            ("fghh",),
+            frozenset({"generic"}),
+            _incremental(f"incremental-{kind}"),
+            generic_kind={"fghh": kind},
+            summary=f"incremental, from the FGHH generic policy evolved {what}",
+        )
+        for kind, what in (("zero", "on the zero setting"), ("fixed", "over G with fixed resampling"), ("race", "over G with selection races"))
+    ),
 )

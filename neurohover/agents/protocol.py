@@ -122,9 +122,15 @@ class RunResult:
     def rows(self) -> list[dict]:
         """One dict per episode (for CSV / JSON export)."""
         return [
-            {"episode": e, "return": float(self.returns[e]), "crashed": bool(self.crashed[e]),
-             "steps": int(self.steps[e]), "policy": self.policy[e],
-             "safeguard_fired": bool(self.safeguard_fired[e]), "offline_seconds": float(self.offline_seconds[e])}
+            {
+                "episode": e,
+                "return": float(self.returns[e]),
+                "crashed": bool(self.crashed[e]),
+                "steps": int(self.steps[e]),
+                "policy": self.policy[e],
+                "safeguard_fired": bool(self.safeguard_fired[e]),
+                "offline_seconds": float(self.offline_seconds[e]),
+            }
             for e in range(self.returns.size)
         ]
 
@@ -163,9 +169,18 @@ def run_test(
             rest = np.arange(e, episodes)
             zeros = np.zeros(rest.size, dtype=np.int64)
             table = PolicyTable.from_policies([choice.policy] + ([choice.fallback] if choice.fallback else []))
-            ev = evaluate_jobs(table, mdp, zeros, zeros, rest, seed=seed, n_steps=n_steps, threads=threads,
-                               fallback_index=np.full(rest.size, 1 if choice.fallback else -1),
-                               safeguard_limits=choice.dangerous.limits())
+            ev = evaluate_jobs(
+                table,
+                mdp,
+                zeros,
+                zeros,
+                rest,
+                seed=seed,
+                n_steps=n_steps,
+                threads=threads,
+                fallback_index=np.full(rest.size, 1 if choice.fallback else -1),
+                safeguard_limits=choice.dangerous.limits(),
+            )
             returns[e:], crashed[e:], steps[e:] = ev.returns, ev.crashed, ev.steps
             fired[e:] = ev.safeguard_step >= 0
             labels[e:] = [choice.label] * rest.size
@@ -175,9 +190,19 @@ def run_test(
         n = min(chunk, episodes - e) if choice.repeat and not choice.record else 1
         table = PolicyTable.from_policies([choice.policy] + ([choice.fallback] if choice.fallback else []))
         zeros = np.zeros(n, dtype=np.int64)
-        ev = evaluate_jobs(table, mdp, zeros, zeros, np.arange(e, e + n), seed=seed, n_steps=n_steps, threads=threads,
-                           fallback_index=np.full(n, 1 if choice.fallback else -1), record=np.full(n, choice.record),
-                           safeguard_limits=choice.dangerous.limits())
+        ev = evaluate_jobs(
+            table,
+            mdp,
+            zeros,
+            zeros,
+            np.arange(e, e + n),
+            seed=seed,
+            n_steps=n_steps,
+            threads=threads,
+            fallback_index=np.full(n, 1 if choice.fallback else -1),
+            record=np.full(n, choice.record),
+            safeguard_limits=choice.dangerous.limits(),
+        )
         events = np.flatnonzero((ev.safeguard_step >= 0) | ev.crashed)
         n = int(events[0]) + 1 if events.size else n  # later episodes would have flown another choice
         chunk = 1 if events.size else min(2 * chunk, REPEAT_CHUNK)
@@ -186,9 +211,7 @@ def run_test(
             fired[e] = ev.safeguard_step[i] >= 0
             labels[e] = choice.label
             t0 = time.perf_counter()
-            agent.update(EpisodeOutcome(e, float(ev.returns[i]), bool(ev.crashed[i]), int(ev.steps[i]),
-                                        int(ev.safeguard_step[i]), ev.flight_data))
+            agent.update(EpisodeOutcome(e, float(ev.returns[i]), bool(ev.crashed[i]), int(ev.steps[i]), int(ev.safeguard_step[i]), ev.flight_data))
             offline[e] = time.perf_counter() - t0
             e += 1
-    return RunResult(agent.name, mdp, returns, crashed, steps, labels, fired, offline,
-                     time.perf_counter() - start_time)
+    return RunResult(agent.name, mdp, returns, crashed, steps, labels, fired, offline, time.perf_counter() - start_time)

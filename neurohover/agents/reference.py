@@ -40,8 +40,19 @@ def _generic(policies: AgentPolicies, options: AgentOptions) -> Agent:
 
 
 AGENT_SPECS = (
-    AgentSpec("baseline", ("ghh08", "ghh09", "fghh"), frozenset(), lambda policies, options: BaselineAgent(),
-              summary="the competition's baseline policy, every episode"),
-    AgentSpec("generic", ("ghh08", "ghh09", "fghh"), frozenset({"generic"}), _generic, generic_kind={"fghh": "race"},
-              summary="the task's generic policy, every episode"),
+    AgentSpec(
+        "baseline",
+        ("ghh08", "ghh09", "fghh"),
+        frozenset(),
+        lambda policies, options: BaselineAgent(),
+        summary="the competition's baseline policy, every episode",
+    ),
+    AgentSpec(
+        "generic",
+        ("ghh08", "ghh09", "fghh"),
+        frozenset({"generic"}),
+        _generic,
+        generic_kind={"fghh": "race"},
+        summary="the task's generic policy, every episode",
+    ),
 )

@@ -23,8 +23,7 @@ _FIRST = ("reference", "model_free", "model_based", "hybrid")
 def discover(package: str) -> dict[str, AgentSpec]:
     """The ``AGENT_SPECS`` of every module of ``package``, by agent name, in a stable order."""
     path = importlib.import_module(package).__path__
-    names = sorted((m.name for m in pkgutil.iter_modules(path)),
-                   key=lambda n: (_FIRST.index(n) if n in _FIRST else len(_FIRST), n))
+    names = sorted((m.name for m in pkgutil.iter_modules(path)), key=lambda n: (_FIRST.index(n) if n in _FIRST else len(_FIRST), n))
     specs: dict[str, AgentSpec] = {}
     for name in names:
         if name == "registry":
@@ -70,8 +69,10 @@ def _policy_set(family: TaskFamily, policy_dir: str | None) -> PolicySet:
     ps = load_policy_set(family.name, policy_dir)
     built = ps.manifest.get("sigma")
     if family.sigma is not None and family.generic_over_distribution and built is not None and float(built) != family.sigma:
-        raise NeurohoverError(f"the {family.name} policy set in {str(ps.directory)!r} was evolved for sigma = {built}, "
-                              f"not {family.sigma}: build one for this sigma and give its directory (--policy-dir)")
+        raise NeurohoverError(
+            f"the {family.name} policy set in {str(ps.directory)!r} was evolved for sigma = {built}, "
+            f"not {family.sigma}: build one for this sigma and give its directory (--policy-dir)"
+        )
     return ps
 
 
@@ -82,13 +83,11 @@ def check_agent(name: str, family: TaskFamily, policy_dir: str | None = None) ->
         spec.build(policies_from_set(spec, _policy_set(family, policy_dir)), AgentOptions())
 
 
-def make_agent(name: str, family: TaskFamily, *, policy_dir: str | None = None,
-               options: AgentOptions = AgentOptions()) -> Agent:
+def make_agent(name: str, family: TaskFamily, *, policy_dir: str | None = None, options: AgentOptions = AgentOptions()) -> Agent:
     """A fresh agent called ``name`` for ``family``, flying the policies of its policy set."""
     spec = agent_spec(name, family.name)
     policies = policies_from_set(spec, _policy_set(family, policy_dir)) if spec.needs else AgentPolicies()
     return spec.build(policies, options)
 
 
-__all__ = ["AGENTS", "HYBRID_AGENTS", "AgentOptions", "AgentPolicies", "AgentSpec", "agent_spec", "check_agent", "discover",
-           "make_agent", "policies_from_set"]
+__all__ = ["AGENTS", "HYBRID_AGENTS", "AgentOptions", "AgentPolicies", "AgentSpec", "agent_spec", "check_agent", "discover", "make_agent", "policies_from_set"]

@@ -16,7 +16,7 @@ Example
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any, Union
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -46,7 +46,7 @@ SAMPLE = "sample"
 MDP_OPTIONS = ("zero", "sample", "train:N", "test:N")
 RESET_OPTION_KEYS = ("mdp", "noise")
 
-MdpSpec = Union[str, MDP]
+MdpSpec = str | MDP
 
 
 def resolve_mdp(family: TaskFamily, spec: Any, cache: dict[str, MDP] | None = None) -> MDP | str:
@@ -94,8 +94,7 @@ def check_noise_stream(value: Any, what: str = "noise") -> tuple[int, int]:
 
 def check_episode_steps(episode_steps: Any) -> int:
     """``episode_steps`` as an int, or a clear error."""
-    if isinstance(episode_steps, (bool, np.bool_)) or not isinstance(episode_steps, (int, np.integer)) \
-            or not 1 <= episode_steps <= MAX_EPISODE_STEPS:
+    if isinstance(episode_steps, (bool, np.bool_)) or not isinstance(episode_steps, (int, np.integer)) or not 1 <= episode_steps <= MAX_EPISODE_STEPS:
         raise NeurohoverError(f"episode_steps={episode_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
     return int(episode_steps)
 
@@ -392,8 +391,9 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         if a.shape != (ACTION_DIM,):
             raise NeurohoverError(f"action has shape {a.shape}, expected (4,): aileron, elevator, rudder, collective in [-1, 1]")
         self._action[0] = a
-        step_batch(self._rows, self._index, self._state, self._noise, self._rng, self._steps, self._action,
-                   self.episode_steps, self._obs, self._reward, self._crash)
+        step_batch(
+            self._rows, self._index, self._state, self._noise, self._rng, self._steps, self._action, self.episode_steps, self._obs, self._reward, self._crash
+        )
         terminated = bool(self._crash[0])
         truncated = bool(self._steps[0] >= self.episode_steps)
         self._done = terminated or truncated
@@ -416,9 +416,11 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
             An (340, 720, 3) uint8 RGB image in ``"rgb_array"`` mode, else None.
         """
         if self.render_mode is None:
-            gym.logger.warn("You are calling render method without specifying any render mode. "
-                            "You can specify the render_mode at initialization, "
-                            f'e.g. gym.make("{self.spec.id if self.spec else "neurohover/GHH08-v0"}", render_mode="rgb_array")')
+            gym.logger.warn(
+                "You are calling render method without specifying any render mode. "
+                "You can specify the render_mode at initialization, "
+                f'e.g. gym.make("{self.spec.id if self.spec else "neurohover/GHH08-v0"}", render_mode="rgb_array")'
+            )
             return None
         frame = self._draw()
         if self.render_mode == "rgb_array":

@@ -55,11 +55,13 @@ _NOSE = np.array([[0.55, 0.0, 0.05]])
 
 def rotation_matrix(qx: float, qy: float, qz: float, qw: float) -> np.ndarray:
     """Body-to-world rotation matrix of a unit quaternion (the kernel's convention)."""
-    return np.array([
-        [1.0 - 2.0 * (qy * qy + qz * qz), 2.0 * (qx * qy - qw * qz), 2.0 * (qx * qz + qw * qy)],
-        [2.0 * (qx * qy + qw * qz), 1.0 - 2.0 * (qx * qx + qz * qz), 2.0 * (qy * qz - qw * qx)],
-        [2.0 * (qx * qz - qw * qy), 2.0 * (qy * qz + qw * qx), 1.0 - 2.0 * (qx * qx + qy * qy)],
-    ])
+    return np.array(
+        [
+            [1.0 - 2.0 * (qy * qy + qz * qz), 2.0 * (qx * qy - qw * qz), 2.0 * (qx * qz + qw * qy)],
+            [2.0 * (qx * qy + qw * qz), 1.0 - 2.0 * (qx * qx + qz * qz), 2.0 * (qy * qz - qw * qx)],
+            [2.0 * (qx * qz - qw * qy), 2.0 * (qy * qz + qw * qx), 1.0 - 2.0 * (qx * qx + qy * qy)],
+        ]
+    )
 
 
 def view_range(position: Sequence[float] | np.ndarray) -> float:
@@ -106,14 +108,14 @@ class HoverRenderer:
             ax.tick_params(labelsize=7)
             ax.grid(alpha=0.3)
             ax.plot([0.0], [0.0], marker="+", color="tab:green", markersize=14, mew=2)  # the hover target
-            box, = ax.plot([], [], ls="--", lw=0.8, color="tab:red")  # the crash box, once in view
+            (box,) = ax.plot([], [], ls="--", lw=0.8, color="tab:red")  # the crash box, once in view
             # Moving parts are "animated": left out of the background, drawn on it per frame.
-            trail, = ax.plot([], [], lw=1.0, color="0.55", animated=True)
-            rotor, = ax.plot([], [], lw=1.2, color="tab:blue", animated=True)
-            body, = ax.plot([], [], lw=2.5, color="0.15", solid_capstyle="round", animated=True)
-            mast, = ax.plot([], [], lw=1.5, color="0.15", animated=True)
-            tail, = ax.plot([], [], lw=1.0, color="0.15", animated=True)
-            nose, = ax.plot([], [], marker="o", markersize=5, color="tab:orange", ls="", animated=True)
+            (trail,) = ax.plot([], [], lw=1.0, color="0.55", animated=True)
+            (rotor,) = ax.plot([], [], lw=1.2, color="tab:blue", animated=True)
+            (body,) = ax.plot([], [], lw=2.5, color="0.15", solid_capstyle="round", animated=True)
+            (mast,) = ax.plot([], [], lw=1.5, color="0.15", animated=True)
+            (tail,) = ax.plot([], [], lw=1.0, color="0.15", animated=True)
+            (nose,) = ax.plot([], [], marker="o", markersize=5, color="tab:orange", ls="", animated=True)
             self._views[ax] = (box, trail, rotor, body, mast, tail, nose)
         w = self.wind
         w.set_xlim(-1.15, 1.15)
@@ -140,8 +142,12 @@ class HoverRenderer:
         x0, y0, x1, y1 = ax.get_position().extents
         if part == "wind":
             y0 -= 0.08  # the speed written below the compass
-        return (int(math.floor((1.0 - y1) * self.height)), int(math.ceil((1.0 - y0) * self.height)),
-                int(math.floor(x0 * self.width)), int(math.ceil(x1 * self.width)))
+        return (
+            int(math.floor((1.0 - y1) * self.height)),
+            int(math.ceil((1.0 - y0) * self.height)),
+            int(math.floor(x0 * self.width)),
+            int(math.ceil(x1 * self.width)),
+        )
 
     def _set_range(self, r: float) -> None:
         if r == self._range:
@@ -157,8 +163,7 @@ class HoverRenderer:
             else:
                 box.set_data([], [])
 
-    def draw(self, state: Sequence[float], wind: Sequence[float], text: str,
-             trail: np.ndarray | None = None) -> np.ndarray:
+    def draw(self, state: Sequence[float], wind: Sequence[float], text: str, trail: np.ndarray | None = None) -> np.ndarray:
         """One frame, an (height, width, 3) uint8 array.
 
         Parameters
@@ -199,9 +204,18 @@ class HoverRenderer:
             # Arrow along the air's motion, its length proportional to the speed (capped at the rim).
             scale = min(speed / WIND_FULL_SCALE, 1.0) / speed
             dx, dy = east * scale, north * scale
-            self._arrow = self._arrow_kind(0.0, 0.0, dx, dy, width=0.06, head_width=0.22,
-                                           head_length=min(0.25, 0.6 * math.hypot(dx, dy)),
-                                           length_includes_head=True, color="tab:purple", animated=True)
+            self._arrow = self._arrow_kind(
+                0.0,
+                0.0,
+                dx,
+                dy,
+                width=0.06,
+                head_width=0.22,
+                head_length=min(0.25, 0.6 * math.hypot(dx, dy)),
+                length_includes_head=True,
+                color="tab:purple",
+                animated=True,
+            )
             self.wind.add_patch(self._arrow)
             self._wind_text.set_text(f"{speed:.2f} m/s")
         else:
@@ -267,8 +281,10 @@ class HumanWindow:
             plt.pause(1.0 / self.fps)  # draws the window and paces the frames at the control rate
         elif not self._warned:
             self._warned = True
-            warnings.warn(f"render_mode='human': matplotlib's backend {matplotlib.get_backend()!r} has no window "
-                          "(no display?); frames are drawn but not shown", stacklevel=3)
+            warnings.warn(
+                f"render_mode='human': matplotlib's backend {matplotlib.get_backend()!r} has no window (no display?); frames are drawn but not shown",
+                stacklevel=3,
+            )
 
     def close(self) -> None:
         if self._figure is not None:

@@ -206,8 +206,10 @@ class HoverVectorEnv(VectorEnv):
             if seed < 0:
                 raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer >= 0")
             return [int(seed) + i for i in range(n)]
-        if isinstance(seed, (list, tuple, np.ndarray)) and len(seed) == n and all(
-            s is None or (isinstance(s, (int, np.integer)) and not isinstance(s, (bool, np.bool_)) and s >= 0) for s in seed
+        if (
+            isinstance(seed, (list, tuple, np.ndarray))
+            and len(seed) == n
+            and all(s is None or (isinstance(s, (int, np.integer)) and not isinstance(s, (bool, np.bool_)) and s >= 0) for s in seed)
         ):
             return [None if s is None else int(s) for s in seed]
         raise NeurohoverError(f"seed={seed!r} is not allowed: give None, an integer >= 0, or a list of {n} such integers (or None)")
@@ -229,9 +231,7 @@ class HoverVectorEnv(VectorEnv):
 
     def _check_mask(self, mask: Any) -> np.ndarray:
         if not isinstance(mask, np.ndarray) or mask.dtype != np.bool_ or mask.shape != (self.num_envs,) or not mask.any():
-            raise NeurohoverError(
-                f"reset_mask must be a bool numpy array of shape ({self.num_envs},) with at least one True, got {mask!r:.80}"
-            )
+            raise NeurohoverError(f"reset_mask must be a bool numpy array of shape ({self.num_envs},) with at least one True, got {mask!r:.80}")
         return mask.copy()
 
     def _coerce_actions(self, actions: Any) -> np.ndarray:
@@ -302,12 +302,18 @@ class HoverVectorEnv(VectorEnv):
             if self._draws[i] is None:
                 item = mdp_info(self._mdps[i])
                 family[i], label[i], params[i], names[i] = item["family"], item["label"], item["params"], item["param_names"]
-        return {"family": family, "_family": mask.copy(), "label": label, "_label": mask.copy(),
-                "params": params, "_params": mask.copy(), "param_names": names, "_param_names": mask.copy()}
+        return {
+            "family": family,
+            "_family": mask.copy(),
+            "label": label,
+            "_label": mask.copy(),
+            "params": params,
+            "_params": mask.copy(),
+            "param_names": names,
+            "_param_names": mask.copy(),
+        }
 
-    def reset(
-        self, *, seed: int | Sequence[int | None] | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[np.ndarray, dict[str, Any]]:
+    def reset(self, *, seed: int | Sequence[int | None] | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
         options = check_reset_options(options, extra=("reset_mask",))
         # Validate everything before changing anything, so a bad call leaves the env as it was.
         seeds = self._check_seeds(seed)
@@ -328,8 +334,14 @@ class HoverVectorEnv(VectorEnv):
         self._any_autoreset = bool(self._autoreset.any())
         self._ready = True
         labels, label_mask = self._labels(idx)
-        info = {"mdp": labels, "_mdp": label_mask, "crashed": np.zeros(self.num_envs, dtype=np.bool_), "_crashed": label_mask.copy(),
-                "mdp_info": self._mdp_infos(idx, label_mask), "_mdp_info": label_mask.copy()}
+        info = {
+            "mdp": labels,
+            "_mdp": label_mask,
+            "crashed": np.zeros(self.num_envs, dtype=np.bool_),
+            "_crashed": label_mask.copy(),
+            "mdp_info": self._mdp_infos(idx, label_mask),
+            "_mdp_info": label_mask.copy(),
+        }
         return self._obs.astype(self.obs_dtype), info
 
     def step(self, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
@@ -338,8 +350,7 @@ class HoverVectorEnv(VectorEnv):
         a = actions
         if not (type(a) is np.ndarray and a.dtype == np.float64 and a.shape == self._actions.shape and a.flags.c_contiguous):
             a = self._coerce_actions(actions)
-        step_batch(self._rows, self._index, self._state, self._noise, self._rng, self._steps, a,
-                   self.episode_steps, self._obs, self._reward, self._crash)
+        step_batch(self._rows, self._index, self._state, self._noise, self._rng, self._steps, a, self.episode_steps, self._obs, self._reward, self._crash)
         rewards = self._reward.copy()
         terminated = self._crash.copy()
         truncated = self._steps >= self._limit

@@ -96,23 +96,14 @@ def require_int(name: str, value: Any, minimum: int) -> int:
 
 def require_prob(name: str, value: Any) -> float:
     """``value`` as a float, or ValueError unless it is a probability in [0, 1]."""
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, numbers.Real)
-        or not 0.0 <= float(value) <= 1.0
-    ):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not 0.0 <= float(value) <= 1.0:
         raise ValueError(f"{name}={value!r} must be a probability in [0, 1]")
     return float(value)
 
 
 def require_std(name: str, value: Any) -> float:
     """``value`` as a float, or ValueError unless it is a finite number >= 0."""
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, numbers.Real)
-        or not math.isfinite(float(value))
-        or float(value) < 0.0
-    ):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(float(value)) or float(value) < 0.0:
         raise ValueError(f"{name}={value!r} must be a finite number >= 0")
     return float(value)
 
@@ -150,9 +141,7 @@ def check_returns(values: Any, n: int, what: str = "fitness") -> np.ndarray:
     """``n`` returns as float64, one per asked genome; ``+inf`` is refused (ValueError)."""
     f = np.array(values, dtype=np.float64)
     if f.shape != (n,):
-        raise ValueError(
-            f"{what} must have shape ({n},), one return per asked genome; got shape {f.shape}"
-        )
+        raise ValueError(f"{what} must have shape ({n},), one return per asked genome; got shape {f.shape}")
     if np.count_nonzero(f == np.inf):
         raise ValueError(f"{what} contains +inf; returns must be finite, NaN or -inf")
     return f
@@ -245,9 +234,7 @@ class ChampionTracker:
         self.since = 0
         self.history: list[ChampionRecord] = []
 
-    def update(
-        self, genomes: np.ndarray, returns: np.ndarray, wall: float, crashed: np.ndarray | None = None
-    ) -> None:
+    def update(self, genomes: np.ndarray, returns: np.ndarray, wall: float, crashed: np.ndarray | None = None) -> None:
         """Count one evaluation per genome; a strictly better return makes a new champion."""
         for k, (g, r) in enumerate(zip(genomes, returns, strict=True)):
             self.evaluations += 1
@@ -277,9 +264,7 @@ class ChampionTracker:
             "best": enc_float(self.best),
             "since": self.since,
             "history": [  # a 4th element only for a crashed champion (the format stays as it was)
-                [h.evaluations, enc_float(h.champion_return), h.wall_seconds]
-                + ([True] if h.crashed else [])
-                for h in self.history
+                [h.evaluations, enc_float(h.champion_return), h.wall_seconds] + ([True] if h.crashed else []) for h in self.history
             ],
         }
 
@@ -291,10 +276,7 @@ class ChampionTracker:
         t.genome = dec_array(d["genome"])
         t.best = float(d["best"])
         t.since = int(d["since"])
-        t.history = [
-            ChampionRecord(int(h[0]), float(h[1]), float(h[2]), bool(h[3]) if len(h) > 3 else False)
-            for h in d["history"]
-        ]
+        t.history = [ChampionRecord(int(h[0]), float(h[1]), float(h[2]), bool(h[3]) if len(h) > 3 else False) for h in d["history"]]
         return t
 
 

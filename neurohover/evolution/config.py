@@ -44,8 +44,7 @@ RACE_T_LIMIT = 10  # docs/model.md, Fitness under noise: t_limit = t_min = t_max
 #: What a run's ``method`` may be (``cma`` whenever the optimizer is CMA-ES).
 METHODS = ("steady-state", "generational", "cma")
 #: Steady-state settings that checkpoints written before they existed ran with.
-_OLD_STEADY_STATE = {"plateau_rule": "literal", "selection": "roulette", "tournament_size": 5,
-                     "init_mutate_frac": None, "init_mutate_std": None}
+_OLD_STEADY_STATE = {"plateau_rule": "literal", "selection": "roulette", "tournament_size": 5, "init_mutate_frac": None, "init_mutate_std": None}
 
 
 @dataclass(frozen=True)
@@ -110,9 +109,7 @@ def resolve_target(target) -> tuple[MDP | None, TaskFamily | None, dict]:
     if callable(getattr(target, "mdp", None)) and hasattr(target, "method"):  # a LearnedModel
         mdp = target.mdp()
         return mdp, None, {"kind": "mdp", "mdp": mdp.to_dict()}
-    raise NeurohoverError(
-        f"evolve needs an MDP, a learned model or a task family as target, got {type(target).__name__}"
-    )
+    raise NeurohoverError(f"evolve needs an MDP, a learned model or a task family as target, got {type(target).__name__}")
 
 
 def make_settings(method: str, optimizer: str, settings) -> dict | SteadyStateSettings | GenerationalSettings:
@@ -197,8 +194,7 @@ class RunConfig:
     settings: Any
 
     @classmethod
-    def build(cls, target, *, topology, prototype, optimizer, resampling, budget, settings, seed, n_steps,
-              method) -> RunConfig:
+    def build(cls, target, *, topology, prototype, optimizer, resampling, budget, settings, seed, n_steps, method) -> RunConfig:
         """Check the arguments of ``evolve`` that define the run (NeurohoverError on bad input)."""
         mdp, family, target_desc = resolve_target(target)
         proto = resolve_prototype(prototype, topology)
@@ -221,21 +217,26 @@ class RunConfig:
             chosen = "cma"
         if resampling.kind == "race" and chosen != "generational":
             raise NeurohoverError(
-                f"resampling {resampling} (a selection race) needs the generational method "
-                "(a task family as target, optimizer 'ne'); use fixed:K here"
+                f"resampling {resampling} (a selection race) needs the generational method (a task family as target, optimizer 'ne'); use fixed:K here"
             )
         checked = make_settings("steady-state" if chosen == "steady-state" else "generational", optimizer, settings)
         if optimizer == "cma" and proto.genome.size < 2:
             raise NeurohoverError("CMA-ES needs a genome of at least 2 genes")
-        return cls(mdp, family, target_desc, proto, topology, optimizer, chosen, resampling,
-                   None if budget is None else int(budget), seed, int(n_steps), checked)
+        return cls(
+            mdp, family, target_desc, proto, topology, optimizer, chosen, resampling, None if budget is None else int(budget), seed, int(n_steps), checked
+        )
 
     def to_dict(self) -> dict:
         """What a checkpoint records of the run (JSON types, as read back from a file)."""
         config = {
-            "target": self.target, "method": self.method, "optimizer": self.optimizer,
-            "resampling": str(self.resampling), "topology": self.topology,
-            "prototype": self.prototype.genome.tolist(), "seed": self.seed, "n_steps": self.n_steps,
+            "target": self.target,
+            "method": self.method,
+            "optimizer": self.optimizer,
+            "resampling": str(self.resampling),
+            "topology": self.topology,
+            "prototype": self.prototype.genome.tolist(),
+            "seed": self.seed,
+            "n_steps": self.n_steps,
             "settings": dict(self.settings) if isinstance(self.settings, dict) else dataclasses.asdict(self.settings),
         }
         return json.loads(json.dumps(config))  # as a checkpoint would hold it

@@ -174,9 +174,20 @@ def evolve(
     EvolutionInterrupted
         On Ctrl-C or a ``KeyboardInterrupt`` from ``progress``.
     """
-    run = Run(RunConfig.build(target, topology=topology, prototype=prototype, optimizer=optimizer,
-                              resampling=resampling, budget=budget, settings=settings, seed=seed, n_steps=n_steps,
-                              method=method))
+    run = Run(
+        RunConfig.build(
+            target,
+            topology=topology,
+            prototype=prototype,
+            optimizer=optimizer,
+            resampling=resampling,
+            budget=budget,
+            settings=settings,
+            seed=seed,
+            n_steps=n_steps,
+            method=method,
+        )
+    )
     if not isinstance(checkpoint_every_s, (int, float)) or not checkpoint_every_s > 0:
         raise NeurohoverError(f"checkpoint_every_s={checkpoint_every_s!r} must be a number > 0")
     path = None if checkpoint is None else Path(checkpoint)
@@ -187,16 +198,14 @@ def evolve(
         run.stop_reason = None
     run.flyer.trace = _trace
     # Load (or compile) the kernel before the clock runs, and validate the thread count.
-    evaluate_jobs([run.cfg.prototype], run.rows if run.rows is not None else run.family.zero(), [0], [0], [0],
-                  n_steps=1, threads=threads)
+    evaluate_jobs([run.cfg.prototype], run.rows if run.rows is not None else run.family.zero(), [0], [0], [0], n_steps=1, threads=threads)
     with num_threads(threads if threads is not None else numba.get_num_threads()):  # restores the count after
         run.flyer.start()
         run.run(progress, path, float(checkpoint_every_s), float(progress_every_s))
     return run.result()
 
 
-def validation_return(policy: Policy, target, *, episodes: int = 10, seed: int = 0,
-                      n_steps: int = EPISODE_STEPS, threads: int | None = None) -> np.ndarray:
+def validation_return(policy: Policy, target, *, episodes: int = 10, seed: int = 0, n_steps: int = EPISODE_STEPS, threads: int | None = None) -> np.ndarray:
     """Returns of ``episodes`` fresh episodes of ``policy``: on the MDP, or each on a fresh MDP from G.
 
     The noise and MDPs come from ``SeedSequence(seed)`` child ``(3,)``, which :func:`evolve` never
@@ -212,6 +221,5 @@ def validation_return(policy: Policy, target, *, episodes: int = 10, seed: int =
     else:
         rows = family.sample_rows(np.random.default_rng(mdp_seed), episodes)
         m_idx = np.arange(episodes)
-    ev = evaluate_jobs([policy], rows, np.zeros(episodes, dtype=np.int64), m_idx, np.arange(episodes),
-                       seed=noise_seed, n_steps=n_steps, threads=threads)
+    ev = evaluate_jobs([policy], rows, np.zeros(episodes, dtype=np.int64), m_idx, np.arange(episodes), seed=noise_seed, n_steps=n_steps, threads=threads)
     return ev.returns

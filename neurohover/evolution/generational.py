@@ -81,9 +81,7 @@ class GenerationalSettings:
             raise ValueError(f"elitist={self.elitist!r} must be True or False")
         sel = require_int("select_size", self.select_size, 1)
         if sel > self.pop_size:
-            raise ValueError(
-                f"select_size={sel} must be in [1, pop_size={self.pop_size}]"
-            )
+            raise ValueError(f"select_size={sel} must be in [1, pop_size={self.pop_size}]")
         set_field(self, "select_size", sel)
         set_field(self, "generations", require_int("generations", self.generations, 1))
 
@@ -162,10 +160,7 @@ class GenerationalNE:
         self._rng = np.random.default_rng(seed)
         # As Appendix A's: the prototype plus copies of it, each put through the mutation
         # operator once (unconditionally, i.e. not gated by mutate_prob).
-        self._population = np.vstack(
-            [self._prototype]
-            + [mutate(self._prototype, self._rng, self.settings) for _ in range(self.settings.pop_size - 1)]
-        )
+        self._population = np.vstack([self._prototype] + [mutate(self._prototype, self._rng, self.settings) for _ in range(self.settings.pop_size - 1)])
         self._asked = False
         self._generation = 0
         self._evaluations = 0
@@ -218,11 +213,7 @@ class GenerationalNE:
         self._champion_return = float(f[best]) if not math.isnan(f[best]) else -math.inf
         self._evaluations += ep
         self._generation += 1
-        self._history.append(
-            GenerationRecord(
-                self._generation, self._evaluations, ep, self._champion_return, self._clock()
-            )
-        )
+        self._history.append(GenerationRecord(self._generation, self._evaluations, ep, self._champion_return, self._clock()))
         self._population = self._breed(self._population[sel])
         self._asked = False
 
@@ -252,10 +243,7 @@ class GenerationalNE:
             or sel.min() < 0
             or sel.max() >= s.pop_size
         ):
-            raise ValueError(
-                f"selected must be {s.select_size} distinct integer indices in "
-                f"[0, {s.pop_size}), got {selected!r}"
-            )
+            raise ValueError(f"selected must be {s.select_size} distinct integer indices in [0, {s.pop_size}), got {selected!r}")
         return sel
 
     def _breed(self, parents: np.ndarray) -> np.ndarray:
@@ -350,10 +338,7 @@ class GenerationalNE:
         opt._evaluations = int(state["evaluations"])
         opt._champion_genome = dec_array(state["champion_genome"])
         opt._champion_return = float(state["champion_return"])
-        opt._history = [
-            GenerationRecord(int(g), int(e), int(ep), float(r), float(w))
-            for g, e, ep, r, w in state["history"]
-        ]
+        opt._history = [GenerationRecord(int(g), int(e), int(ep), float(r), float(w)) for g, e, ep, r, w in state["history"]]
         opt._rng = rng_from_state(state["rng"])
         opt._clock = Clock(float(state["wall_seconds"]))
         return opt

@@ -40,9 +40,7 @@ class CrossoverParams(Protocol):
     def averaging_prob(self) -> float: ...
 
 
-def mutate(
-    genome: np.ndarray, rng: np.random.Generator, settings: MutationParams, scale: np.ndarray | None = None
-) -> np.ndarray:
+def mutate(genome: np.ndarray, rng: np.random.Generator, settings: MutationParams, scale: np.ndarray | None = None) -> np.ndarray:
     """Return a mutated copy of ``genome``.
 
     Each gene is, independently with probability ``settings.mutate_frac``,
@@ -78,9 +76,7 @@ def mutate(
     return _mutate_genes(g, hit_r, delta, replace_r, settings.mutate_frac, settings.mutate_repl)
 
 
-def crossover(
-    a: np.ndarray, b: np.ndarray, rng: np.random.Generator, settings: CrossoverParams
-) -> np.ndarray:
+def crossover(a: np.ndarray, b: np.ndarray, rng: np.random.Generator, settings: CrossoverParams) -> np.ndarray:
     """Return a child of two aligned genomes.
 
     Each child gene is, with probability ``settings.averaging_prob``, the mean

@@ -102,15 +102,8 @@ def _check_int(name: str, value: object, minimum: int) -> int:
 
 
 def _check_delta(delta: object) -> float:
-    if (
-        isinstance(delta, bool)
-        or not isinstance(delta, numbers.Real)
-        or not 0.0 < float(delta) < 1.0
-    ):
-        raise ValueError(
-            f"delta={delta!r} must be a confidence level strictly between 0 and 1 "
-            "(e.g. 0.9 for 90% confidence bounds)"
-        )
+    if isinstance(delta, bool) or not isinstance(delta, numbers.Real) or not 0.0 < float(delta) < 1.0:
+        raise ValueError(f"delta={delta!r} must be a confidence level strictly between 0 and 1 (e.g. 0.9 for 90% confidence bounds)")
     return float(delta)
 
 
@@ -118,10 +111,7 @@ def _draw(sample_fn: SampleFn, indices: np.ndarray) -> np.ndarray:
     """Call ``sample_fn`` and check its answer; NaN returns become ``-inf`` (worst)."""
     out = np.asarray(sample_fn(indices.copy()), dtype=np.float64)
     if out.shape != indices.shape:
-        raise ValueError(
-            f"sample_fn returned shape {out.shape} for {indices.size} candidates; "
-            f"expected {indices.shape}"
-        )
+        raise ValueError(f"sample_fn returned shape {out.shape} for {indices.size} candidates; expected {indices.shape}")
     if np.any(out == np.inf):
         raise ValueError("sample_fn returned +inf; returns must be finite, NaN or -inf")
     return np.where(np.isnan(out), -np.inf, out)

@@ -132,8 +132,7 @@ class EvolutionInterrupted(KeyboardInterrupt):
     """The run was interrupted; ``checkpoint`` is where its state was saved (None: not saved)."""
 
     def __init__(self, checkpoint: Path | None, episodes: int) -> None:
-        super().__init__(f"evolution interrupted after {episodes} episodes" +
-                         (f"; checkpoint saved to {checkpoint}" if checkpoint else ""))
+        super().__init__(f"evolution interrupted after {episodes} episodes" + (f"; checkpoint saved to {checkpoint}" if checkpoint else ""))
         self.checkpoint = checkpoint
         self.episodes = episodes
 
@@ -152,8 +151,7 @@ def write_history_csv(history, path: str | Path) -> Path:
         writer = csv.writer(f, lineterminator="\n")
         writer.writerow(HISTORY_COLUMNS)
         for h in history:
-            writer.writerow([h.generation, h.evaluations, h.episodes, h.generation_episodes, repr(h.champion_return),
-                             f"{h.wall_seconds:.4f}"])
+            writer.writerow([h.generation, h.evaluations, h.episodes, h.generation_episodes, repr(h.champion_return), f"{h.wall_seconds:.4f}"])
     return path
 
 
@@ -176,8 +174,7 @@ def read_history_csv(path: str | Path) -> list[HistoryRecord]:
             g, ev, ep, gep, r, w = row
             out.append(HistoryRecord(int(g), int(ev), int(ep), int(gep), float(r), float(w)))
         except ValueError:
-            raise NeurohoverError(f"{str(path)!r}, row {n}: {','.join(row)!r} is not a history record "
-                                  f"({','.join(HISTORY_COLUMNS)})") from None
+            raise NeurohoverError(f"{str(path)!r}, row {n}: {','.join(row)!r} is not a history record ({','.join(HISTORY_COLUMNS)})") from None
     return out
 
 
@@ -186,8 +183,7 @@ def read_history_csv(path: str | Path) -> list[HistoryRecord]:
 
 def encode_history(history) -> list[list]:
     """History records as a checkpoint holds them: strict-JSON lists in :data:`HISTORY_COLUMNS` order."""
-    return [[h.generation, h.evaluations, h.episodes, h.generation_episodes, enc_float(h.champion_return), h.wall_seconds]
-            for h in history]
+    return [[h.generation, h.evaluations, h.episodes, h.generation_episodes, enc_float(h.champion_return), h.wall_seconds] for h in history]
 
 
 def decode_history(rows) -> list[HistoryRecord]:

@@ -112,14 +112,20 @@ class Run:
     def state(self, wall: float) -> dict:
         """The checkpoint (strict JSON) after ``wall`` seconds of the run."""
         return {
-            "format": CHECKPOINT_FORMAT, "config": self.config, "budget": self.budget,
+            "format": CHECKPOINT_FORMAT,
+            "config": self.config,
+            "budget": self.budget,
             "optimizer_state": self.opt.state_dict(),
-            "counters": {"episodes": self.flyer.episodes, "steps": self.flyer.steps, "generation": self.generation,
-                         "evaluations": self.evaluations, "wall_seconds": wall,
-                         "kernel_seconds": self.flyer.kernel_seconds},
+            "counters": {
+                "episodes": self.flyer.episodes,
+                "steps": self.flyer.steps,
+                "generation": self.generation,
+                "evaluations": self.evaluations,
+                "wall_seconds": wall,
+                "kernel_seconds": self.flyer.kernel_seconds,
+            },
             "mdp_stream": None if self.mdp_rng is None else self.mdp_rng.bit_generator.state,
-            "champion": {"genome": None if self.champion_genome is None else self.champion_genome.tolist(),
-                         "return": enc_float(self.champion_return)},
+            "champion": {"genome": None if self.champion_genome is None else self.champion_genome.tolist(), "return": enc_float(self.champion_return)},
             "history": encode_history(self.history),
             "stop_reason": self.stop_reason,
         }
@@ -192,6 +198,7 @@ class Run:
             if self.mdp_rng is None:
                 return self.flyer.fly(genomes, self.rows, idx.astype(np.int64), None, n).copy()
             return self.flyer.fly(genomes, self.family.sample_rows(self.mdp_rng, n), idx.astype(np.int64), "range", n).copy()
+
         return sample
 
     # ----------------------------------------------------------------- loop
@@ -204,8 +211,11 @@ class Run:
         next_ckpt = time.perf_counter() + flag_every
         next_progress = time.perf_counter() + progress_every_s
         budget = self.budget
-        step = {"steady-state": self._best_ever_generation, "generational": self._generational_generation,
-                "cma": self._best_ever_generation if self.family is None else self._cma_family_generation}[self.method]
+        step = {
+            "steady-state": self._best_ever_generation,
+            "generational": self._generational_generation,
+            "cma": self._best_ever_generation if self.family is None else self._cma_family_generation,
+        }[self.method]
         boundary = True  # False while a generation is half done (its state is not checkpointable)
         with InterruptFlag() as flag:
             try:
@@ -242,8 +252,7 @@ class Run:
 
     def _info(self, wall: float, done: bool, budget) -> ProgressInfo:
         eps = self.flyer.episodes
-        return ProgressInfo(self.generation, self.evaluations, eps, budget, self._champion_return(), wall,
-                            eps / wall if wall > 0 else 0.0, done)
+        return ProgressInfo(self.generation, self.evaluations, eps, budget, self._champion_return(), wall, eps / wall if wall > 0 else 0.0, done)
 
     def _should_stop(self) -> str | None:
         if self.budget is not None and self.flyer.episodes >= self.budget:
@@ -257,8 +266,9 @@ class Run:
         return None
 
     def _record(self, before_eps: int, champion: float, start: float) -> None:
-        self.history.append(HistoryRecord(self.generation, self.evaluations, self.flyer.episodes,
-                                          self.flyer.episodes - before_eps, champion, time.perf_counter() - start))
+        self.history.append(
+            HistoryRecord(self.generation, self.evaluations, self.flyer.episodes, self.flyer.episodes - before_eps, champion, time.perf_counter() - start)
+        )
 
     def _best_ever_generation(self, start: float) -> None:
         """Steady state, or CMA-ES on an MDP: the champion is the best single fitness ever told;
@@ -283,8 +293,7 @@ class Run:
         before_eps = self.flyer.episodes
         genomes = opt.ask()
         if self.resampling.kind == "race":
-            race = selection_race(self._race_sample_fn(genomes), genomes.shape[0], opt.settings.select_size,
-                                  self.resampling.delta, t_limit=RACE_T_LIMIT)
+            race = selection_race(self._race_sample_fn(genomes), genomes.shape[0], opt.settings.select_size, self.resampling.delta, t_limit=RACE_T_LIMIT)
             opt.tell_race(race)
         else:
             _, result = self._fly_family_fixed(genomes)
@@ -315,9 +324,16 @@ class Run:
         history = list(self.history)
         if self.generation and (not history or history[-1].generation != self.generation):
             last = history[-1] if history else None
-            history.append(HistoryRecord(self.generation, self.evaluations, self.flyer.episodes,
-                                         0 if last is None else self.flyer.episodes - last.episodes,
-                                         self._champion_return(), self.elapsed))
+            history.append(
+                HistoryRecord(
+                    self.generation,
+                    self.evaluations,
+                    self.flyer.episodes,
+                    0 if last is None else self.flyer.episodes - last.episodes,
+                    self._champion_return(),
+                    self.elapsed,
+                )
+            )
         return tuple(history)
 
     def _champion_return(self) -> float:
@@ -339,16 +355,34 @@ class Run:
         settings = {**self.config, "budget": self.budget}
         settings.pop("prototype")
         target = self.config["target"]
-        label = target["mdp"]["label"] if target["kind"] == "mdp" else f"{target['family']}/G" + (
-            f"(sigma={target['sigma']:g})" if "sigma" in target else "")
+        label = target["mdp"]["label"] if target["kind"] == "mdp" else f"{target['family']}/G" + (f"(sigma={target['sigma']:g})" if "sigma" in target else "")
         cfg = self.cfg
         meta = {
-            "method": self.method if cfg.optimizer == "ne" else "cma-es", "optimizer": cfg.optimizer,
-            "resampling": str(self.resampling), "target": label, "seed": cfg.seed, "budget": self.budget,
-            "episodes": self.flyer.episodes, "evaluations": self.evaluations, "generations": self.generation,
-            "champion_return": ret, "n_steps": cfg.n_steps, "stop_reason": self.stop_reason,
+            "method": self.method if cfg.optimizer == "ne" else "cma-es",
+            "optimizer": cfg.optimizer,
+            "resampling": str(self.resampling),
+            "target": label,
+            "seed": cfg.seed,
+            "budget": self.budget,
+            "episodes": self.flyer.episodes,
+            "evaluations": self.evaluations,
+            "generations": self.generation,
+            "champion_return": ret,
+            "n_steps": cfg.n_steps,
+            "stop_reason": self.stop_reason,
         }
         champion = Policy(cfg.topology, np.array(genome, dtype=float), {**cfg.prototype.metadata, **meta})
-        return EvolutionResult(champion, ret, self._history_with_last(), self.flyer.episodes, self.flyer.steps,
-                               self.evaluations, self.generation, self.elapsed, self.flyer.kernel_seconds,
-                               self.stop_reason or "", settings, bool(getattr(self.opt, "champion_crashed", False)))
+        return EvolutionResult(
+            champion,
+            ret,
+            self._history_with_last(),
+            self.flyer.episodes,
+            self.flyer.steps,
+            self.evaluations,
+            self.generation,
+            self.elapsed,
+            self.flyer.kernel_seconds,
+            self.stop_reason or "",
+            settings,
+            bool(getattr(self.opt, "champion_crashed", False)),
+        )

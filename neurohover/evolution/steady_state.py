@@ -141,13 +141,9 @@ class SteadyStateSettings:
                 raise NeurohoverError(f"mutation_floor={floor!r} is out of range: allowed None or a finite number > 0")
             set_field(self, "mutation_floor", float(floor))
         if not isinstance(self.plateau_rule, str) or self.plateau_rule not in PLATEAU_RULES:
-            raise NeurohoverError(
-                f"unknown plateau_rule {self.plateau_rule!r}: allowed {', '.join(PLATEAU_RULES)}"
-            )
+            raise NeurohoverError(f"unknown plateau_rule {self.plateau_rule!r}: allowed {', '.join(PLATEAU_RULES)}")
         if not isinstance(self.selection, str) or self.selection not in SELECTIONS:
-            raise NeurohoverError(
-                f"unknown selection {self.selection!r}: allowed {', '.join(SELECTIONS)}"
-            )
+            raise NeurohoverError(f"unknown selection {self.selection!r}: allowed {', '.join(SELECTIONS)}")
         size = require_int("tournament_size", self.tournament_size, 1)
         if size > self.pop_size:
             raise ValueError(f"tournament_size={size} must be in [1, pop_size={self.pop_size}]")
@@ -160,9 +156,7 @@ class SteadyStateSettings:
         if elite >= self.pop_size:
             raise ValueError(f"elite_size={elite} must be smaller than pop_size={self.pop_size}")
         set_field(self, "elite_size", elite)
-        set_field(
-            self, "plateau_threshold", require_int("plateau_threshold", self.plateau_threshold, 1)
-        )
+        set_field(self, "plateau_threshold", require_int("plateau_threshold", self.plateau_threshold, 1))
 
 
 def roulette_weights(returns: np.ndarray) -> np.ndarray:
@@ -197,9 +191,7 @@ def _spin(cdf: list[float], rng: np.random.Generator) -> int:
     return min(bisect_right(cdf, rng.random() * cdf[-1]), len(cdf) - 1)
 
 
-def _initial_population(
-    prototype: np.ndarray, n: int, rng: np.random.Generator, settings: Any, scale: np.ndarray | None = None
-) -> np.ndarray:
+def _initial_population(prototype: np.ndarray, n: int, rng: np.random.Generator, settings: Any, scale: np.ndarray | None = None) -> np.ndarray:
     # Appendix A: the prototype plus copies of it, each put through the
     # mutation operator once (unconditionally, i.e. not gated by mutate_prob).
     return np.vstack([prototype] + [_mutate(prototype, rng, settings, scale) for _ in range(n - 1)])
@@ -320,9 +312,7 @@ class SteadyStateNE(ChampionViews):
         if crashed is not None:
             c = np.asarray(crashed)
             if c.shape != f.shape or not (c.dtype == np.bool_ or np.issubdtype(c.dtype, np.integer)):
-                raise ValueError(
-                    f"crashed must be {f.size} booleans, one per asked genome; got {crashed!r}"
-                )
+                raise ValueError(f"crashed must be {f.size} booleans, one per asked genome; got {crashed!r}")
             crashed = c.astype(bool)
         if self._population is None:
             self._population, self._fitness = self._pending, f
@@ -357,6 +347,7 @@ class SteadyStateNE(ChampionViews):
 
             def pick() -> int:
                 return _spin(cdf, rng)
+
         children = np.empty((n, pop.shape[1]))
         for c in range(n):
             if rng.random() < s.crossover_prob:

@@ -31,7 +31,24 @@ from .store import SCHEMA_VERSION, Store
 from .units import Unit, run_unit, strip_timing, unit_seed
 
 __all__ = [
-    "SCHEMA_VERSION", "ExperimentConfig", "LocalExecutor", "Plan", "RayExecutor", "RunSummary", "Store", "Unit",
-    "experiment_names", "export_results", "load_config", "load_configs", "make_executor", "parse_override", "plan",
-    "reproduce", "run_unit", "strip_timing", "unit_seed", "write_report",
+    "SCHEMA_VERSION",
+    "ExperimentConfig",
+    "LocalExecutor",
+    "Plan",
+    "RayExecutor",
+    "RunSummary",
+    "Store",
+    "Unit",
+    "experiment_names",
+    "export_results",
+    "load_config",
+    "load_configs",
+    "make_executor",
+    "parse_override",
+    "plan",
+    "reproduce",
+    "run_unit",
+    "strip_timing",
+    "unit_seed",
+    "write_report",
 ]

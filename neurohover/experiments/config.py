@@ -43,8 +43,7 @@ CONFIG_DIR = Path(__file__).parent / "configs"
 SCALES = ("quick", "paper")
 KINDS = ("evolution", "model_learning", "test_runs")
 #: Experiments in report order (the shipped configs).
-ORDER = ("fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16",
-         "ablation-plateau", "ablation-hybrid")
+ORDER = ("fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16", "ablation-plateau", "ablation-hybrid")
 #: Bump when a unit function changes what it computes: stores written before are then refused.
 UNITS_VERSION = 2  # 2: competition MDP sets, the authors' safeguard, OLS, the no-crash plateau
 
@@ -54,18 +53,21 @@ _REQUIRED = object()
 def _int(minimum: int):
     def check(v):
         return isinstance(v, int) and not isinstance(v, bool) and v >= minimum, f"an integer >= {minimum}"
+
     return check
 
 
 def _float(lo: float, hi: float):
     def check(v):
         return isinstance(v, (int, float)) and not isinstance(v, bool) and lo <= v <= hi, f"a number in [{lo:g}, {hi:g}]"
+
     return check
 
 
 def _choice(*allowed: str):
     def check(v):
         return v in allowed, "one of " + ", ".join(repr(a) for a in allowed)
+
     return check
 
 
@@ -74,24 +76,28 @@ def _agent():
         from ..agents.registry import AGENTS  # the one list of agents
 
         return v in AGENTS, "one of " + ", ".join(repr(a) for a in AGENTS)
+
     return check
 
 
 def _str():
     def check(v):
         return isinstance(v, str) and v != "", "a non-empty string"
+
     return check
 
 
 def _bool():
     def check(v):
         return isinstance(v, bool), "true or false"
+
     return check
 
 
 def _table():
     def check(v):
         return isinstance(v, dict), "a table"
+
     return check
 
 
@@ -101,6 +107,7 @@ def _str_list(*allowed: str):
         if ok and allowed:
             ok = all(x in allowed for x in v)
         return ok, "a non-empty list of " + ("strings" if not allowed else "names from " + ", ".join(allowed))
+
     return check
 
 
@@ -115,12 +122,14 @@ def _resampling():
         except NeurohoverError:
             return False, "fixed:K (K >= 1) or race:DELTA (0 < DELTA < 1)"
         return True, ""
+
     return check
 
 
 def _policy_source():
     def check(v):
         return isinstance(v, str) and v != "", "'evolve', 'shipped' or a directory holding <task>/ policy sets"
+
     return check
 
 
@@ -268,8 +277,9 @@ def _check_kind(settings: dict, kind: str, where: str) -> None:
                 from ..agents.hybrid import HybridSettings
 
                 if g["agent"] not in HYBRID_AGENTS:
-                    raise NeurohoverError(f"{where}: group {g['label']!r}: hybrid settings apply to the agents "
-                                          f"{', '.join(HYBRID_AGENTS)} only, not to {g['agent']!r}")
+                    raise NeurohoverError(
+                        f"{where}: group {g['label']!r}: hybrid settings apply to the agents {', '.join(HYBRID_AGENTS)} only, not to {g['agent']!r}"
+                    )
                 try:
                     g["hybrid"] = HybridSettings.from_dict(g["hybrid"]).to_dict()
                 except NeurohoverError as e:
@@ -296,19 +306,36 @@ class ExperimentConfig:
     @property
     def hash(self) -> str:
         """Hash of everything that changes results (16 hex digits)."""
-        payload = {"kind": self.kind, "settings": self.settings, "units_version": UNITS_VERSION,
-                   "external": self.external_digest}
+        payload = {"kind": self.kind, "settings": self.settings, "units_version": UNITS_VERSION, "external": self.external_digest}
         return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
 
     def to_dict(self) -> dict:
-        return {"name": self.name, "title": self.title, "kind": self.kind, "scale": self.scale,
-                "settings": self.settings, "paper": self.paper, "paper_ref": self.paper_ref,
-                "source": self.source, "external_digest": self.external_digest, "hash": self.hash}
+        return {
+            "name": self.name,
+            "title": self.title,
+            "kind": self.kind,
+            "scale": self.scale,
+            "settings": self.settings,
+            "paper": self.paper,
+            "paper_ref": self.paper_ref,
+            "source": self.source,
+            "external_digest": self.external_digest,
+            "hash": self.hash,
+        }
 
     @classmethod
-    def from_dict(cls, d: dict) -> "ExperimentConfig":
-        return cls(d["name"], d["title"], d["kind"], d["scale"], d["settings"], d.get("paper", {}),
-                   d.get("paper_ref", ""), d.get("source", ""), d.get("external_digest", ""))
+    def from_dict(cls, d: dict) -> ExperimentConfig:
+        return cls(
+            d["name"],
+            d["title"],
+            d["kind"],
+            d["scale"],
+            d["settings"],
+            d.get("paper", {}),
+            d.get("paper_ref", ""),
+            d.get("source", ""),
+            d.get("external_digest", ""),
+        )
 
 
 def shipped_configs() -> dict[str, Path]:
@@ -343,8 +370,7 @@ def resolve_name(name: str) -> Path:
     shipped = shipped_configs()
     name = _aliases().get(name, name)
     if name not in shipped:
-        raise NeurohoverError(f"unknown experiment {name!r}: known experiments are {', '.join(shipped)} "
-                              f"(or 'all', or a path to a .toml config file)")
+        raise NeurohoverError(f"unknown experiment {name!r}: known experiments are {', '.join(shipped)} (or 'all', or a path to a .toml config file)")
     return shipped[name]
 
 
@@ -353,7 +379,7 @@ def parse_override(text: str) -> tuple[str, Any]:
     key, sep, value = text.partition("=")
     key = key.strip()
     if not sep or not key:
-        raise NeurohoverError(f"bad --set {text!r}: expected KEY=VALUE (VALUE in TOML syntax, e.g. runs=3 or policies=\"evolve\")")
+        raise NeurohoverError(f'bad --set {text!r}: expected KEY=VALUE (VALUE in TOML syntax, e.g. runs=3 or policies="evolve")')
     try:
         parsed = tomllib.loads(f"v = {value.strip()}")["v"]
     except tomllib.TOMLDecodeError:
@@ -390,12 +416,31 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
     if scale not in scales:
         raise NeurohoverError(f"{where}: has no [scales.{scale}] table")
     merged = {**raw["settings"], **scales[scale], **(overrides or {})}
-    return make_config(raw["name"], kind, scale, merged, title=raw.get("title", raw["name"]), paper=raw.get("paper", {}),
-                       paper_ref=raw.get("paper_ref", ""), source=str(path), where=f"{where} at scale {scale!r}")
+    return make_config(
+        raw["name"],
+        kind,
+        scale,
+        merged,
+        title=raw.get("title", raw["name"]),
+        paper=raw.get("paper", {}),
+        paper_ref=raw.get("paper_ref", ""),
+        source=str(path),
+        where=f"{where} at scale {scale!r}",
+    )
 
 
-def make_config(name: str, kind: str, scale: str, settings: dict[str, Any], *, title: str = "", paper: dict | None = None,
-                paper_ref: str = "", source: str = "", where: str | None = None) -> ExperimentConfig:
+def make_config(
+    name: str,
+    kind: str,
+    scale: str,
+    settings: dict[str, Any],
+    *,
+    title: str = "",
+    paper: dict | None = None,
+    paper_ref: str = "",
+    source: str = "",
+    where: str | None = None,
+) -> ExperimentConfig:
     """Validate ``settings`` of an experiment of ``kind`` and resolve them into a config.
 
     The one path from settings to a config: shipped TOML files (:func:`load_config`) and inline

@@ -18,10 +18,10 @@ from __future__ import annotations
 import os
 import socket
 import time
-from typing import Any
 from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+from typing import Any
 
 from ..errors import NeurohoverError
 from ..procs import sigterm_as_interrupt, stop_pool, worker_pool
@@ -31,8 +31,7 @@ from .units import Unit, run_unit
 OnResult = Callable[[Unit, dict, float, str], None]
 OnError = Callable[[Unit, BaseException], None]
 
-RAY_INSTALL_HINT = ("--executor ray needs Ray, an optional extra: pip install 'neurohover[ray]' "
-                    "(or pip install 'ray>=2.9'); --executor local runs without it")
+RAY_INSTALL_HINT = "--executor ray needs Ray, an optional extra: pip install 'neurohover[ray]' (or pip install 'ray>=2.9'); --executor local runs without it"
 
 
 def timed_run(unit: dict, threads: int | None = 1) -> tuple[dict, float, str]:
@@ -114,8 +113,10 @@ def import_ray():
     return ray
 
 
-RAY_ADDRESS_FORMS = ("host:port (port 1 to 65535, e.g. 10.0.0.5:6379, as printed by `ray start --head`), "
-                     "ray://host:port (Ray Client), or auto (the cluster started on this machine)")
+RAY_ADDRESS_FORMS = (
+    "host:port (port 1 to 65535, e.g. 10.0.0.5:6379, as printed by `ray start --head`), "
+    "ray://host:port (Ray Client), or auto (the cluster started on this machine)"
+)
 CONNECT_SECONDS = 3.0  # how long to wait for a cluster's port to accept a connection
 
 
@@ -137,7 +138,7 @@ def ray_endpoint(address: str, source: str = "--address") -> tuple[str, int] | N
     """
     if address in ("auto", "local"):
         return None
-    rest = address[len("ray://"):] if address.startswith("ray://") else address
+    rest = address[len("ray://") :] if address.startswith("ray://") else address
     host, sep, port = rest.rpartition(":")
     if host.startswith("[") and host.endswith("]"):
         host = host[1:-1]
@@ -169,7 +170,8 @@ def check_ray_address(address: str, source: str = "--address") -> None:
             reason = (err.strerror or str(err)).lower()
         raise NeurohoverError(
             f"{source} {address!r}: no Ray cluster is listening at {host}:{port} ({reason}); start one first "
-            f"(`ray start --head` prints its address) or leave out --address to start a local Ray instance") from None
+            f"(`ray start --head` prints its address) or leave out --address to start a local Ray instance"
+        ) from None
 
 
 def _one_line(err: BaseException) -> str:

@@ -49,13 +49,27 @@ def export_results(store: Store, name: str, fmt: str = "csv", scale: str | None 
     units = store.units(name, scale)
     config = store.config(name, scale)
     if fmt == "json":
-        return json.dumps({"experiment": name, "scale": scale, "config_hash": config["hash"], "config": config,
-                           "sessions": store.sessions(name, scale), "units": units}, indent=1) + "\n"
+        return (
+            json.dumps(
+                {"experiment": name, "scale": scale, "config_hash": config["hash"], "config": config, "sessions": store.sessions(name, scale), "units": units},
+                indent=1,
+            )
+            + "\n"
+        )
     rows = []
     for u in units:
         key = UnitKey.parse(u["key"])
-        row = {"experiment": name, "scale": scale, "key": u["key"], "kind": u["kind"], "group": key.group, "mdp": key.mdp,
-               "rep": key.rep, "seconds": u["seconds"], "worker": u["worker"]}
+        row = {
+            "experiment": name,
+            "scale": scale,
+            "key": u["key"],
+            "kind": u["kind"],
+            "group": key.group,
+            "mdp": key.mdp,
+            "rep": key.rep,
+            "seconds": u["seconds"],
+            "worker": u["worker"],
+        }
         _flat("param", {k: v for k, v in u["params"].items()}, row)
         row.update({f"result.{k}": v for k, v in result_from_dict(u["kind"], u["result"], u["key"]).columns().items()})
         rows.append(row)

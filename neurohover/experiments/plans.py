@@ -48,8 +48,7 @@ def _mdps(family, which: str, n: int, seed: int):
         return family.training_mdps()[:n]
     if which == "test":
         return family.test_mdps()[:n]
-    return [family.sample(np.random.default_rng(np.random.SeedSequence([seed, _SAMPLE_TAG, i])),
-                          label=f"{family.name}/sample:{i}") for i in range(n)]
+    return [family.sample(np.random.default_rng(np.random.SeedSequence([seed, _SAMPLE_TAG, i])), label=f"{family.name}/sample:{i}") for i in range(n)]
 
 
 def _unit(cfg: ExperimentConfig, key: str, kind: str, params: dict, seed_key: str | None = None) -> Unit:
@@ -72,8 +71,12 @@ def external_digest(kind: str, s: dict) -> str:
     if source in (None, "evolve", "baseline"):
         return ""
     ps = _load_external(s["task"], source)
-    payload = {"generic": policy_dict(ps.generic), "specialised": [policy_dict(p) for p in ps.specialised],
-               "safe": list(ps.safe), "generics": {k: policy_dict(v) for k, v in sorted(ps.generics.items())}}
+    payload = {
+        "generic": policy_dict(ps.generic),
+        "specialised": [policy_dict(p) for p in ps.specialised],
+        "safe": list(ps.safe),
+        "generics": {k: policy_dict(v) for k, v in sorted(ps.generics.items())},
+    }
     return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
 
 
@@ -84,16 +87,20 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
     s = cfg.settings
     family = _family(s["task"], s["sigma"])
     units: list[Unit] = []
-    base = {"budget": s["budget"], "optimiser": s["optimiser"], "n_steps": s["n_steps"],
-            "validation_episodes": s["validation_episodes"], "history_points": s["history_points"]}
+    base = {
+        "budget": s["budget"],
+        "optimiser": s["optimiser"],
+        "n_steps": s["n_steps"],
+        "validation_episodes": s["validation_episodes"],
+        "history_points": s["history_points"],
+    }
     train = family.training_mdps()[: s["n_mdps"]]
     for v in s["variants"]:
         common = {**base, "topology": v["topology"], "prototype": v["prototype"], "resampling": v["resampling"]}
         if s["target"] == "train":
             for i, mdp in enumerate(train):
                 for r in range(s["runs"]):
-                    units.append(_unit(cfg, f"evolve/{v['key']}/train{i}/run{r}", "evolve",
-                                       {**common, "target": {"kind": "mdp", "mdp": mdp.to_dict()}}))
+                    units.append(_unit(cfg, f"evolve/{v['key']}/train{i}/run{r}", "evolve", {**common, "target": {"kind": "mdp", "mdp": mdp.to_dict()}}))
         else:
             sigma = v["sigma"] if v["sigma"] is not None else s["sigma"]
             if s["target"] == "zero":
@@ -109,9 +116,21 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
             if not all(k in results for k in keys):
                 continue
             best = max(keys, key=lambda k: float(results[k]["champion_return"]))
-            units.append(_unit(cfg, f"robust/{vkey}/train{i}", "robustness", {
-                "policy": results[best]["champion"], "source": best, "own": i,
-                "mdps": [m.to_dict() for m in train], "episodes": s["robustness_episodes"], "n_steps": s["n_steps"]}))
+            units.append(
+                _unit(
+                    cfg,
+                    f"robust/{vkey}/train{i}",
+                    "robustness",
+                    {
+                        "policy": results[best]["champion"],
+                        "source": best,
+                        "own": i,
+                        "mdps": [m.to_dict() for m in train],
+                        "episodes": s["robustness_episodes"],
+                        "n_steps": s["n_steps"],
+                    },
+                )
+            )
     return Plan(units, total)
 
 
@@ -120,9 +139,22 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
 
 def _policy_evolution_unit(cfg: ExperimentConfig, key: str, target: dict, budget: int, resampling: str = "fixed:1") -> Unit:
     s = cfg.settings
-    return _unit(cfg, key, "evolve", {
-        "target": target, "topology": "mlp", "prototype": "baseline", "resampling": resampling,
-        "budget": budget, "optimiser": {}, "n_steps": s["n_steps"], "validation_episodes": 0, "history_points": 50})
+    return _unit(
+        cfg,
+        key,
+        "evolve",
+        {
+            "target": target,
+            "topology": "mlp",
+            "prototype": "baseline",
+            "resampling": resampling,
+            "budget": budget,
+            "optimiser": {},
+            "n_steps": s["n_steps"],
+            "validation_episodes": 0,
+            "history_points": 50,
+        },
+    )
 
 
 def _spec(agent: str):
@@ -152,8 +184,10 @@ class _Policies:
         self.external = None if s["policies"] == "evolve" else _load_external(self.task, s["policies"])
         if self.external is not None:
             if self.family.generic_over_distribution and s["generics_per_agent"] != 1:
-                raise NeurohoverError(f"config {cfg.name!r}: a policy set holds one generic policy per method; "
-                                      f"generics_per_agent = {s['generics_per_agent']} needs policies = \"evolve\"")
+                raise NeurohoverError(
+                    f"config {cfg.name!r}: a policy set holds one generic policy per method; "
+                    f'generics_per_agent = {s["generics_per_agent"]} needs policies = "evolve"'
+                )
             return
         budget = s["policy_budget"]
         if not self.family.generic_over_distribution:
@@ -166,10 +200,19 @@ class _Policies:
                 self.total += 1
                 spec = [self.results.get(f"policy/specialised{i}") for i in range(10)]
                 if all(spec):
-                    self.units.append(_unit(cfg, "policy/safety", "safety", {
-                        "policies": [r["champion"] for r in spec],
-                        "mdps": [m.to_dict() for m in self.family.training_mdps()],
-                        "episodes": s["safety_episodes"], "n_steps": s["n_steps"]}))
+                    self.units.append(
+                        _unit(
+                            cfg,
+                            "policy/safety",
+                            "safety",
+                            {
+                                "policies": [r["champion"] for r in spec],
+                                "mdps": [m.to_dict() for m in self.family.training_mdps()],
+                                "episodes": s["safety_episodes"],
+                                "n_steps": s["n_steps"],
+                            },
+                        )
+                    )
         else:
             for kind in ("zero", "fixed", "race"):
                 if kind not in needs:
@@ -178,8 +221,12 @@ class _Policies:
                     if kind == "zero":
                         self._add(f"policy/generic-zero{j}", {"kind": "mdp", "mdp": self.family.zero().to_dict()}, budget)
                     else:
-                        self._add(f"policy/generic-{kind}{j}", {"kind": "family", "task": self.task, "sigma": s["sigma"]},
-                                  s["generic_budget"], s["generic_resampling"].get(kind, "fixed:5" if kind == "fixed" else "race:0.2"))
+                        self._add(
+                            f"policy/generic-{kind}{j}",
+                            {"kind": "family", "task": self.task, "sigma": s["sigma"]},
+                            s["generic_budget"],
+                            s["generic_resampling"].get(kind, "fixed:5" if kind == "fixed" else "race:0.2"),
+                        )
 
     def _add(self, key: str, target: dict, budget: int, resampling: str = "fixed:1") -> None:
         self.units.append(_policy_evolution_unit(self.cfg, key, target, budget, resampling))
@@ -208,8 +255,7 @@ class _Policies:
         if "generic" in need:
             out["generic"] = policy_dict(ext.generic) if ext is not None else self._evolved("policy/generic")
         if need & {"specialised", "safe"}:
-            specialised = [policy_dict(p) for p in ext.specialised] if ext is not None else [
-                self._evolved(f"policy/specialised{i}") for i in range(10)]
+            specialised = [policy_dict(p) for p in ext.specialised] if ext is not None else [self._evolved(f"policy/specialised{i}") for i in range(10)]
             if any(p is None for p in specialised):
                 return None
             if "safe" in need:
@@ -249,16 +295,27 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict) -> Plan:
         for i, mdp in enumerate(mdps):
             for rep in range(g["runs_per_mdp"]):
                 total += 1
-                policies = pol.for_agent(g["agent"], i if g["mdps"] == "train" else None, counter,
-                                         g["exclude_own"] and g["mdps"] == "train")
+                policies = pol.for_agent(g["agent"], i if g["mdps"] == "train" else None, counter, g["exclude_own"] and g["mdps"] == "train")
                 counter += 1
                 if policies is None:
                     continue
                 hybrid = group_hybrid_settings(g)
-                units.append(_unit(cfg, f"run/{g['label']}/{g['mdps']}{i}/rep{rep}", "test_run", {
-                    **settings, "agent": g["agent"], "group": g["label"], "mdp": mdp.to_dict(), "policies": policies,
-                    "estimator": g["estimator"],
-                    **({"hybrid": hybrid} if hybrid else {})}))
+                units.append(
+                    _unit(
+                        cfg,
+                        f"run/{g['label']}/{g['mdps']}{i}/rep{rep}",
+                        "test_run",
+                        {
+                            **settings,
+                            "agent": g["agent"],
+                            "group": g["label"],
+                            "mdp": mdp.to_dict(),
+                            "policies": policies,
+                            "estimator": g["estimator"],
+                            **({"hybrid": hybrid} if hybrid else {}),
+                        },
+                    )
+                )
     return Plan(units, total)
 
 
@@ -272,8 +329,7 @@ def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
     total = len(s["methods"]) * s["n_mdps"]
     if s["generic"] == "evolve":
         total += 1
-        units.append(_policy_evolution_unit(cfg, "policy/generic", {"kind": "mdp", "mdp": family.zero().to_dict()},
-                                            s["generic_budget"]))
+        units.append(_policy_evolution_unit(cfg, "policy/generic", {"kind": "mdp", "mdp": family.zero().to_dict()}, s["generic_budget"]))
         generic = results.get("policy/generic", {}).get("champion")
     elif s["generic"] == "baseline":
         from ..policies import baseline_policy
@@ -287,11 +343,26 @@ def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
         for method in s["methods"]:
             # The seed depends on the MDP only: every method learns from the same flight data and
             # its policy meets the same gusts (a paired comparison).
-            units.append(_unit(cfg, f"model/{method}/{s['mdps']}{i}", "model", {
-                "method": method, "mdp": mdp.to_dict(), "generic": generic, "n_steps": s["n_steps"],
-                "model_budget": s["model_budget"], "ec_meno_budget": s["ec_meno_budget"], "ec_mer_episodes": s["ec_mer_episodes"],
-                "policy_budget": s["policy_budget"], "prototype": s["policy_prototype"],
-                "test_episodes": s["test_episodes"]}, seed_key=f"model/{s['mdps']}{i}"))
+            units.append(
+                _unit(
+                    cfg,
+                    f"model/{method}/{s['mdps']}{i}",
+                    "model",
+                    {
+                        "method": method,
+                        "mdp": mdp.to_dict(),
+                        "generic": generic,
+                        "n_steps": s["n_steps"],
+                        "model_budget": s["model_budget"],
+                        "ec_meno_budget": s["ec_meno_budget"],
+                        "ec_mer_episodes": s["ec_mer_episodes"],
+                        "policy_budget": s["policy_budget"],
+                        "prototype": s["policy_prototype"],
+                        "test_episodes": s["test_episodes"],
+                    },
+                    seed_key=f"model/{s['mdps']}{i}",
+                )
+            )
     return Plan(units, total)
 
 

@@ -27,7 +27,6 @@ from .config import ORDER, ExperimentConfig
 from .results import EvolveResult, ModelResult, RobustnessResult, TestRunResult, UnitKey, UnitResult, result_from_dict
 from .store import Store
 
-
 # --------------------------------------------------------------------------------- formatting
 
 
@@ -41,7 +40,7 @@ def fmt(x, digits: int = 4) -> str:
         return "n/a" if math.isnan(x) else ("inf" if x > 0 else "-inf")
     if x != 0 and (abs(x) >= 1e5 or abs(x) < 1e-3):
         return f"{x:.{digits - 1}e}"
-    return f"{x:.{digits}g}" if abs(x) < 10 ** digits else f"{x:.0f}"
+    return f"{x:.{digits}g}" if abs(x) < 10**digits else f"{x:.0f}"
 
 
 def fmt_p(p) -> str:
@@ -132,8 +131,7 @@ class _Section:
                 continue
             stat, p_student, p_welch = ttest(samples[a], samples[b])
             ma, mb = np.mean(samples[a]), np.mean(samples[b])
-            self.tests.append([f"{labels.get(a, a)} vs {labels.get(b, b)}", fmt(ma), fmt(mb), fmt(stat), fmt_p(p_student),
-                               fmt_p(p_welch), str(t["p"])])
+            self.tests.append([f"{labels.get(a, a)} vs {labels.get(b, b)}", fmt(ma), fmt(mb), fmt(stat), fmt_p(p_student), fmt_p(p_welch), str(t["p"])])
             expected = _p_significant(str(t["p"]))
             if p_student is not None and expected is not None:
                 # Each paper test names the approach the paper found better as ``a``.
@@ -144,13 +142,13 @@ class _Section:
                     agree = "agrees" if ours == expected else "disagrees"
                 self.comparisons.append(
                     f"{labels.get(a, a)} vs {labels.get(b, b)} ({what}): our Student's p = {fmt_p(p_student)} "
-                    f"({'significant' if ours else 'not significant'} at 5%; mean {fmt(ma)} vs {fmt(mb)}) vs paper p {t['p']}: {agree}.")
+                    f"({'significant' if ours else 'not significant'} at 5%; mean {fmt(ma)} vs {fmt(mb)}) vs paper p {t['p']}: {agree}."
+                )
 
     def tests_markdown(self) -> str:
         if not self.tests:
             return ""
-        return ("### Statistical tests\n\n" + _table(
-            ["comparison", "mean A", "mean B", "t", "Student's p", "Welch's p", "paper p"], self.tests) + "\n")
+        return "### Statistical tests\n\n" + _table(["comparison", "mean A", "mean B", "t", "Student's p", "Welch's p", "paper p"], self.tests) + "\n"
 
 
 def _curve(points: Sequence[Sequence[float | str]], grid: np.ndarray) -> np.ndarray:
@@ -223,23 +221,47 @@ class _Evolution(_Section):
             stops = {}
             for r in runs:
                 stops[r.stop_reason] = stops.get(r.stop_reason, 0) + 1
-            rows.append([v["label"], str(len(runs)), fmt(np.mean(champ)), fmt(np.median(champ)), fmt(np.min(champ)),
-                         fmt(-np.mean(finals)) if validated else "n/a", fmt(_sd(finals)) if validated else "n/a",
-                         fmt(np.mean([r.episodes for r in runs])),
-                         fmt(np.mean([r.timing.seconds for r in runs])),
-                         ", ".join(f"{k} {n}" for k, n in sorted(stops.items())),
-                         # stores written before the flag was recorded have no answer
-                         str(sum(bool(r.champion_crashed) for r in runs))
-                         if all(r.champion_crashed is not None for r in runs) else "n/a"])
-        what = ("mean return of the final champion on fresh validation episodes" if validated
-                else "final champion return")
-        parts.append("### Final champions\n\n" + _table(
-            ["setting", "runs", "mean champion error", "median", "best", "validation error (mean)", "sd", "episodes/run",
-             "seconds/run", "stopped by", "champion crashing at the end"], rows)
+            rows.append(
+                [
+                    v["label"],
+                    str(len(runs)),
+                    fmt(np.mean(champ)),
+                    fmt(np.median(champ)),
+                    fmt(np.min(champ)),
+                    fmt(-np.mean(finals)) if validated else "n/a",
+                    fmt(_sd(finals)) if validated else "n/a",
+                    fmt(np.mean([r.episodes for r in runs])),
+                    fmt(np.mean([r.timing.seconds for r in runs])),
+                    ", ".join(f"{k} {n}" for k, n in sorted(stops.items())),
+                    # stores written before the flag was recorded have no answer
+                    str(sum(bool(r.champion_crashed) for r in runs)) if all(r.champion_crashed is not None for r in runs) else "n/a",
+                ]
+            )
+        what = "mean return of the final champion on fresh validation episodes" if validated else "final champion return"
+        parts.append(
+            "### Final champions\n\n"
+            + _table(
+                [
+                    "setting",
+                    "runs",
+                    "mean champion error",
+                    "median",
+                    "best",
+                    "validation error (mean)",
+                    "sd",
+                    "episodes/run",
+                    "seconds/run",
+                    "stopped by",
+                    "champion crashing at the end",
+                ],
+                rows,
+            )
             + "\n\nChampion error: minus the champion's fitness estimate at the end "
             "of the run (what the figure shows). Champion crashing at the end: runs whose final champion's own "
             "evaluation crashed (steady state). Validation: the final champion flown on fresh episodes"
-            + (" (each on a fresh MDP from G)" if self.s["target"] == "family" else " of its MDP") + ".\n")
+            + (" (each on a fresh MDP from G)" if self.s["target"] == "family" else " of its MDP")
+            + ".\n"
+        )
         if samples:
             order = sorted(samples, key=lambda k: -np.mean(samples[k]))
             self.comparisons.append("Ranking by " + what + " (best first): ours " + " > ".join(labels[k] for k in order) + ".")
@@ -262,22 +284,53 @@ class _Evolution(_Section):
             crashes_all = sum(sum(u.crashes) for u in units)
             episodes = sum(len(row) for u in units for row in u.returns)
             p = ref.get(vkey, {})
-            rows.append([label, str(len(units)), fmt(np.mean(own)), fmt(_sd(own)), fmt(p.get("r")), fmt(p.get("sd")),
-                         fmt(np.mean(across)), fmt(_sd(across)), fmt(p.get("r_G")), fmt(p.get("sd_G")),
-                         f"{crashes_own} / {crashes_all} of {episodes}", str(p.get("crashes_G", "n/a"))])
+            rows.append(
+                [
+                    label,
+                    str(len(units)),
+                    fmt(np.mean(own)),
+                    fmt(_sd(own)),
+                    fmt(p.get("r")),
+                    fmt(p.get("sd")),
+                    fmt(np.mean(across)),
+                    fmt(_sd(across)),
+                    fmt(p.get("r_G")),
+                    fmt(p.get("sd_G")),
+                    f"{crashes_own} / {crashes_all} of {episodes}",
+                    str(p.get("crashes_G", "n/a")),
+                ]
+            )
             if p:
-                self.comparisons.append(f"Table 3, {label}: our r = {fmt(np.mean(own))} vs paper {fmt(p.get('r'))}; "
-                                        f"our r_G = {fmt(np.mean(across))} vs paper {fmt(p.get('r_G'))}; "
-                                        f"crashes across the training MDPs: ours {crashes_all}"
-                                        + (f" vs paper {p['crashes_G']}" if "crashes_G" in p else "") + ".")
+                self.comparisons.append(
+                    f"Table 3, {label}: our r = {fmt(np.mean(own))} vs paper {fmt(p.get('r'))}; "
+                    f"our r_G = {fmt(np.mean(across))} vs paper {fmt(p.get('r_G'))}; "
+                    f"crashes across the training MDPs: ours {crashes_all}" + (f" vs paper {p['crashes_G']}" if "crashes_G" in p else "") + "."
+                )
         if not rows:
             return ""
         n = self.s["robustness_episodes"]
-        return ("### Table 3: robustness of the best champions\n\n" + _table(
-            ["policy", "MDPs", "r (own MDP)", "sd", "paper r", "paper sd", "r_G (all MDPs)", "sd_G", "paper r_G", "paper sd_G",
-             "crashes own / all", "paper crashes"], rows)
+        return (
+            "### Table 3: robustness of the best champions\n\n"
+            + _table(
+                [
+                    "policy",
+                    "MDPs",
+                    "r (own MDP)",
+                    "sd",
+                    "paper r",
+                    "paper sd",
+                    "r_G (all MDPs)",
+                    "sd_G",
+                    "paper r_G",
+                    "paper sd_G",
+                    "crashes own / all",
+                    "paper crashes",
+                ],
+                rows,
+            )
             + f"\n\nThe best champion of each training MDP's runs flown {n} episodes on its own MDP (r) and on every "
-            f"training MDP used (r_G); sd over the policies' mean returns.\n")
+            f"training MDP used (r_G); sd over the policies' mean returns.\n"
+        )
 
 
 class _ModelLearning(_Section):
@@ -311,22 +364,43 @@ class _ModelLearning(_Section):
             episodes = sum(len(u.test_returns) for u in units)
             p = ref.get(m, {})
             means[m] = r.mean()
-            rows.append([m.upper(), str(len(units)), fmt(t.mean()), fmt(p.get("t")), fmt(np.median(r)), fmt(p.get("r_m")),
-                         fmt(r.mean()), fmt(p.get("r_a")), fmt(_sd(r)), fmt(p.get("sd")), f"{crashes} of {episodes}"])
+            rows.append(
+                [
+                    m.upper(),
+                    str(len(units)),
+                    fmt(t.mean()),
+                    fmt(p.get("t")),
+                    fmt(np.median(r)),
+                    fmt(p.get("r_m")),
+                    fmt(r.mean()),
+                    fmt(p.get("r_a")),
+                    fmt(_sd(r)),
+                    fmt(p.get("sd")),
+                    f"{crashes} of {episodes}",
+                ]
+            )
             if p:
-                self.comparisons.append(f"{m.upper()}: our median {fmt(np.median(r))} vs paper {fmt(p.get('r_m'))}; our mean "
-                                        f"{fmt(r.mean())} vs paper {fmt(p.get('r_a'))}; our time to learn {fmt(t.mean())} s vs paper "
-                                        f"{fmt(p.get('t'))} s.")
+                self.comparisons.append(
+                    f"{m.upper()}: our median {fmt(np.median(r))} vs paper {fmt(p.get('r_m'))}; our mean "
+                    f"{fmt(r.mean())} vs paper {fmt(p.get('r_a'))}; our time to learn {fmt(t.mean())} s vs paper "
+                    f"{fmt(p.get('t'))} s."
+                )
         if ref and means:
             ours = sorted(means, key=lambda k: -means[k])
             paper = sorted((k for k in ref if k in means), key=lambda k: -ref[k]["r_a"])
-            self.comparisons.append("Ranking by mean return (best first): ours " + " > ".join(x.upper() for x in ours)
-                                    + "; paper " + " > ".join(x.upper() for x in paper)
-                                    + (" (same order)." if ours == paper else " (different order)."))
-        return ("### Table 4\n\n" + _table(
-            ["method", "MDPs", "t (s)", "paper t", "r_m", "paper r_m", "r_a", "paper r_a", "sd", "paper sd", "crashed episodes"], rows)
+            self.comparisons.append(
+                "Ranking by mean return (best first): ours "
+                + " > ".join(x.upper() for x in ours)
+                + "; paper "
+                + " > ".join(x.upper() for x in paper)
+                + (" (same order)." if ours == paper else " (different order).")
+            )
+        return (
+            "### Table 4\n\n"
+            + _table(["method", "MDPs", "t (s)", "paper t", "r_m", "paper r_m", "r_a", "paper r_a", "sd", "paper sd", "crashed episodes"], rows)
             + f"\n\nt: seconds to learn the model from one episode of flight data of the generic policy; r_m, r_a, sd: median, "
-            f"mean and sd over MDPs of the evolved policy's mean return over {self.s['test_episodes']} episodes in the true MDP.\n")
+            f"mean and sd over MDPs of the evolved policy's mean return over {self.s['test_episodes']} episodes in the true MDP.\n"
+        )
 
 
 class _TestRuns(_Section):
@@ -373,38 +447,80 @@ class _TestRuns(_Section):
             crash_rate = len(crashed) / len(runs)
             samples[label], labels[label] = scores.tolist(), label
             p = ref.get(label, {})
-            rows.append([label, str(len(runs)), fmt(scores.mean()), fmt(_sd(scores)), f"{len(crashed)} ({crash_rate:.1%})",
-                         str(sum(len(r.crash_episodes) for r in runs)),
-                         f"{p['crash_rate']:.2%}" if "crash_rate" in p else "n/a", fmt(per_episode_clean),
-                         fmt(p.get("return_per_episode_no_crash")),
-                         fmt(np.mean([float(r.mean_return_after_learning) for r in runs])),
-                         fmt(np.mean([r.learning_episodes for r in runs])),
-                         str(sum(len(r.safeguard_episodes) for r in runs)),
-                         fmt(np.mean([r.timing.seconds for r in runs]))])
+            rows.append(
+                [
+                    label,
+                    str(len(runs)),
+                    fmt(scores.mean()),
+                    fmt(_sd(scores)),
+                    f"{len(crashed)} ({crash_rate:.1%})",
+                    str(sum(len(r.crash_episodes) for r in runs)),
+                    f"{p['crash_rate']:.2%}" if "crash_rate" in p else "n/a",
+                    fmt(per_episode_clean),
+                    fmt(p.get("return_per_episode_no_crash")),
+                    fmt(np.mean([float(r.mean_return_after_learning) for r in runs])),
+                    fmt(np.mean([r.learning_episodes for r in runs])),
+                    str(sum(len(r.safeguard_episodes) for r in runs)),
+                    fmt(np.mean([r.timing.seconds for r in runs])),
+                ]
+            )
             if p:
                 line = f"{label}: our crash rate {crash_rate:.1%} of {len(runs)} runs"
                 if "crash_rate" in p:
                     line += f" vs paper {p['crash_rate']:.2%}"
                 if "return_per_episode_no_crash" in p:
-                    line += (f"; our mean return per episode without a crash {fmt(per_episode_clean)} vs paper "
-                             f"{fmt(p['return_per_episode_no_crash'])}")
+                    line += f"; our mean return per episode without a crash {fmt(per_episode_clean)} vs paper {fmt(p['return_per_episode_no_crash'])}"
                 self.comparisons.append(line + ".")
         if samples:
             order = sorted(samples, key=lambda k: -np.mean(samples[k]))
             self.comparisons.append("Ranking by mean cumulative reward (best first): ours " + " > ".join(order) + ".")
         self.add_tests(samples, labels, "final cumulative reward")
-        return ("### Test runs\n\n" + _table(
-            ["agent", "runs", "mean cumulative reward", "sd", "runs with a crash", "crashes", "paper crash rate",
-             "return/episode (runs without crash)", "paper", "return/episode after learning", "learning episodes",
-             "safeguard fired", "seconds/run"], rows)
+        return (
+            "### Test runs\n\n"
+            + _table(
+                [
+                    "agent",
+                    "runs",
+                    "mean cumulative reward",
+                    "sd",
+                    "runs with a crash",
+                    "crashes",
+                    "paper crash rate",
+                    "return/episode (runs without crash)",
+                    "paper",
+                    "return/episode after learning",
+                    "learning episodes",
+                    "safeguard fired",
+                    "seconds/run",
+                ],
+                rows,
+            )
             + f"\n\nEach run: {self.s['episodes']} episodes of {self.s['n_steps']} control steps on one MDP; the score is the "
-            "cumulative reward of the whole run.\n")
+            "cumulative reward of the whole run.\n"
+        )
 
 
+QUICK_NOTE = "a fast smoke-scale run: short episodes and few runs; magnitudes are not comparable with the paper"
 _SECTIONS = {"evolution": _Evolution, "model_learning": _ModelLearning, "test_runs": _TestRuns}
 
-_SETTING_KEYS = ("task", "sigma", "target", "n_mdps", "runs", "episodes", "n_steps", "budget", "policy_budget",
-                 "generic_budget", "generics_per_agent", "model_budget", "validation_episodes", "test_episodes", "policies", "generic")
+_SETTING_KEYS = (
+    "task",
+    "sigma",
+    "target",
+    "n_mdps",
+    "runs",
+    "episodes",
+    "n_steps",
+    "budget",
+    "policy_budget",
+    "generic_budget",
+    "generics_per_agent",
+    "model_budget",
+    "validation_episodes",
+    "test_episodes",
+    "policies",
+    "generic",
+)
 
 
 def _header(cfg: ExperimentConfig, store: Store, units: list[dict], total: int | None) -> str:
@@ -418,12 +534,14 @@ def _header(cfg: ExperimentConfig, store: Store, units: list[dict], total: int |
     if cfg.kind == "test_runs":
         settings += "; " + ", ".join(f"{g['label']}: {g['n_mdps']} {g['mdps']} MDPs x {g['runs_per_mdp']}" for g in cfg.settings["groups"])
     status = "complete" if total is not None and done >= total else f"INCOMPLETE ({done} of {total} units)"
-    return (f"- Paper: {cfg.paper_ref or 'n/a'}\n"
-            f"- Scale: **{cfg.scale}** ({'the paper protocol' if cfg.scale == 'paper' else 'a fast smoke-scale run: short episodes and few runs; magnitudes are not comparable with the paper'}); config hash `{cfg.hash}`\n"
-            f"- Settings: {settings}\n"
-            f"- Units: {done} finished, {status}\n"
-            f"- Time: {wall:.1f} s wall over {len(sessions)} session(s) on {', '.join(map(str, cores)) or '?'} core(s) "
-            f"({', '.join(executors) or '?'}); {unit_seconds:.1f} s summed over units\n")
+    return (
+        f"- Paper: {cfg.paper_ref or 'n/a'}\n"
+        f"- Scale: **{cfg.scale}** ({'the paper protocol' if cfg.scale == 'paper' else QUICK_NOTE}); config hash `{cfg.hash}`\n"
+        f"- Settings: {settings}\n"
+        f"- Units: {done} finished, {status}\n"
+        f"- Time: {wall:.1f} s wall over {len(sessions)} session(s) on {', '.join(map(str, cores)) or '?'} core(s) "
+        f"({', '.join(executors) or '?'}); {unit_seconds:.1f} s summed over units\n"
+    )
 
 
 def _section(cfg: ExperimentConfig, store: Store, out: Path) -> str:
@@ -459,9 +577,11 @@ def _section(cfg: ExperimentConfig, store: Store, out: Path) -> str:
     return "\n".join(text)
 
 
-QUICK_DISCUSSION = ("Quick scale only: a check of the whole pipeline with 200-step episodes, few runs and tiny evolution "
-                    "budgets. Its numbers are not comparable with the paper's; run `neurohover reproduce NAME --scale "
-                    "paper` for that.")
+QUICK_DISCUSSION = (
+    "Quick scale only: a check of the whole pipeline with 200-step episodes, few runs and tiny evolution "
+    "budgets. Its numbers are not comparable with the paper's; run `neurohover reproduce NAME --scale "
+    "paper` for that."
+)
 
 
 def _discussion(cfg: ExperimentConfig, out: Path) -> str:
@@ -471,8 +591,10 @@ def _discussion(cfg: ExperimentConfig, out: Path) -> str:
         return path.read_text().strip()
     if cfg.scale == "quick":
         return QUICK_DISCUSSION
-    return (f"_Not written yet: how these results compare with the paper's, and why, goes in "
-            f"`discussion/{cfg.name}-{cfg.scale}.md` beside this report; `neurohover report` includes it._")
+    return (
+        f"_Not written yet: how these results compare with the paper's, and why, goes in "
+        f"`discussion/{cfg.name}-{cfg.scale}.md` beside this report; `neurohover report` includes it._"
+    )
 
 
 def write_report(store: Store, out: str | Path, *, scale: str | None = None, names: list[str] | None = None) -> Path:
@@ -493,10 +615,12 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
         cfg = ExperimentConfig.from_dict(store.config(name, sc))
         sections.append(_section(cfg, store, out))
         toc.append(f"- [{cfg.title} [{sc}]](#{_anchor(cfg.title + ' [' + sc + ']')})")
-    head = (f"# Reproduction report: Koppejan & Whiteson (2011)\n\n"
-            f"Generated {time.strftime('%Y-%m-%d %H:%M:%S')} from the results store `{store.path}`. Error is minus the "
-            f"return (lower is better). Quick-scale runs use short episodes and few runs: they check the pipeline, and "
-            f"their numbers are not comparable in magnitude with the paper's.\n\n" + "\n".join(toc) + "\n")
+    head = (
+        f"# Reproduction report: Koppejan & Whiteson (2011)\n\n"
+        f"Generated {time.strftime('%Y-%m-%d %H:%M:%S')} from the results store `{store.path}`. Error is minus the "
+        f"return (lower is better). Quick-scale runs use short episodes and few runs: they check the pipeline, and "
+        f"their numbers are not comparable in magnitude with the paper's.\n\n" + "\n".join(toc) + "\n"
+    )
     path = out / "report.md"
     path.write_text(head + "\n" + "\n".join(sections))
     return path

@@ -33,8 +33,22 @@ import numpy as np
 from ..errors import NeurohoverError
 
 __all__ = [
-    "DiagnosticResult", "EvolveResult", "EvolveTiming", "ModelResult", "ModelTiming", "Num", "RESULT_TYPES", "RobustnessResult",
-    "SafetyResult", "StoredPolicy", "TestRunResult", "TestRunTiming", "UnitKey", "UnitResult", "num", "result_from_dict",
+    "DiagnosticResult",
+    "EvolveResult",
+    "EvolveTiming",
+    "ModelResult",
+    "ModelTiming",
+    "Num",
+    "RESULT_TYPES",
+    "RobustnessResult",
+    "SafetyResult",
+    "StoredPolicy",
+    "TestRunResult",
+    "TestRunTiming",
+    "UnitKey",
+    "UnitResult",
+    "num",
+    "result_from_dict",
 ]
 
 #: A JSON-safe float: finite values as floats, non-finite ones as ``"nan"``, ``"inf"`` or ``"-inf"``.
@@ -72,8 +86,7 @@ class _Record:
             value = getattr(self, f.name)
             if f.name in self._NESTED:
                 if not isinstance(value, self._NESTED[f.name]):
-                    raise NeurohoverError(f"{type(self).__name__}.{f.name} must be a {self._NESTED[f.name].__name__}, "
-                                          f"got {type(value).__name__}")
+                    raise NeurohoverError(f"{type(self).__name__}.{f.name} must be a {self._NESTED[f.name].__name__}, got {type(value).__name__}")
             elif f.name not in self._RAW:
                 object.__setattr__(self, f.name, _tuples(value))
 
@@ -116,9 +129,13 @@ class _Record:
         missing = [n for n in names if n not in d and n not in cls._OPTIONAL]
         unknown = [k for k in d if k not in names]
         if missing or unknown:
-            raise NeurohoverError(f"{what}: " + "; ".join(
-                ([f"missing key(s) {', '.join(missing)}"] if missing else [])
-                + ([f"unknown key(s) {', '.join(unknown)} (written by another neurohover version?)"] if unknown else [])))
+            raise NeurohoverError(
+                f"{what}: "
+                + "; ".join(
+                    ([f"missing key(s) {', '.join(missing)}"] if missing else [])
+                    + ([f"unknown key(s) {', '.join(unknown)} (written by another neurohover version?)"] if unknown else [])
+                )
+            )
         values = {n: cls._NESTED[n].from_dict(d[n], f"{what}.{n}") if n in cls._NESTED else d.get(n) for n in names}
         return cls(**values)
 
@@ -383,8 +400,12 @@ UnitResult = EvolveResult | RobustnessResult | SafetyResult | ModelResult | Test
 
 #: The result type of each unit kind.
 RESULT_TYPES: dict[str, type[_Record]] = {
-    "evolve": EvolveResult, "robustness": RobustnessResult, "safety": SafetyResult, "model": ModelResult,
-    "test_run": TestRunResult, "diagnostic": DiagnosticResult,
+    "evolve": EvolveResult,
+    "robustness": RobustnessResult,
+    "safety": SafetyResult,
+    "model": ModelResult,
+    "test_run": TestRunResult,
+    "diagnostic": DiagnosticResult,
 }
 
 

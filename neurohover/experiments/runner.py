@@ -39,8 +39,10 @@ class RunSummary:
         return self.status in ("finished", "selection finished")
 
     def line(self) -> str:
-        text = (f"{self.name} ({self.scale}): {self.status}; ran {self.units_run} units, {self.units_before} already in "
-                f"the store, {self.units_done}/{self.units_total} done, {self.wall_seconds:.1f} s on {self.cores} cores ({self.executor})")
+        text = (
+            f"{self.name} ({self.scale}): {self.status}; ran {self.units_run} units, {self.units_before} already in "
+            f"the store, {self.units_done}/{self.units_total} done, {self.wall_seconds:.1f} s on {self.cores} cores ({self.executor})"
+        )
         if self.failed:
             text += f"; {len(self.failed)} failed, first: {self.failed[0][0]}: {self.failed[0][1]}"
         return text
@@ -60,8 +62,16 @@ def selected(key: str, only: Sequence[str]) -> bool:
     return not only or key.startswith("policy/") or any(fnmatch.fnmatchcase(key, pat) for pat in only)
 
 
-def reproduce(config: ExperimentConfig, store: Store, executor, *, fresh: bool = False, progress: bool | None = None,
-              only: Sequence[str] = (), on_unit: Callable[[str, dict], None] | None = None) -> RunSummary:
+def reproduce(
+    config: ExperimentConfig,
+    store: Store,
+    executor,
+    *,
+    fresh: bool = False,
+    progress: bool | None = None,
+    only: Sequence[str] = (),
+    on_unit: Callable[[str, dict], None] | None = None,
+) -> RunSummary:
     """Run every unfinished unit of ``config``; each finished unit is written to ``store`` at once.
 
     ``only`` restricts the run to the units whose keys match one of these glob patterns (for example
@@ -79,8 +89,7 @@ def reproduce(config: ExperimentConfig, store: Store, executor, *, fresh: bool =
     session = store.start_session(config.name, config.scale, config.hash, executor.name, summary.cores, len(results))
     start = time.perf_counter()
     disable = None if progress is None else not progress
-    bar = tqdm(total=0, initial=len(results), desc=f"{config.name} ({config.scale})", unit="unit", file=sys.stderr,
-               disable=disable, dynamic_ncols=True)
+    bar = tqdm(total=0, initial=len(results), desc=f"{config.name} ({config.scale})", unit="unit", file=sys.stderr, disable=disable, dynamic_ncols=True)
 
     def on_result(unit, result, seconds, worker) -> None:
         if store.put(config.name, config.scale, config.hash, unit, result, seconds, worker, session):
@@ -112,8 +121,7 @@ def reproduce(config: ExperimentConfig, store: Store, executor, *, fresh: bool =
             summary.status = "failed"
         elif set(only) - matched:
             keys = ", ".join(u.key for u in p.units[:3])
-            raise NeurohoverError(f"{config.name}: --only {sorted(set(only) - matched)[0]!r} matches no unit; "
-                                  f"unit keys look like {keys}")
+            raise NeurohoverError(f"{config.name}: --only {sorted(set(only) - matched)[0]!r} matches no unit; unit keys look like {keys}")
         elif only:
             summary.status = "finished" if len(results) >= summary.units_total else "selection finished"
         elif len(results) < summary.units_total:

@@ -118,8 +118,7 @@ class Store:
         try:
             file = os.fdopen(os.open(self.lock_path, os.O_RDWR | os.O_CREAT, 0o644), "r+")
         except OSError as err:
-            raise NeurohoverError(f"cannot open {str(self.lock_path)!r}, the writer lock of results store "
-                                  f"{str(self.path)!r}: {err.strerror}") from None
+            raise NeurohoverError(f"cannot open {str(self.lock_path)!r}, the writer lock of results store {str(self.path)!r}: {err.strerror}") from None
         try:
             fcntl.flock(file.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as err:
@@ -130,14 +129,15 @@ class Store:
             who = f"pid {holder[0]} on host {holder[1]}" if len(holder) == 2 else f"see {str(self.lock_path)!r}"
             raise NeurohoverError(
                 f"results store {str(self.path)!r} is in use: another run ({who}) is writing it; wait for that run "
-                f"to end (or stop it), or give another --store file. Reading it (results, report) works meanwhile") from None
+                f"to end (or stop it), or give another --store file. Reading it (results, report) works meanwhile"
+            ) from None
         file.seek(0)
         file.truncate()
         file.write(f"{os.getpid()} {socket.gethostname()}\n")
         file.flush()
         self._lock = file
 
-    def __enter__(self) -> "Store":
+    def __enter__(self) -> Store:
         return self
 
     def __exit__(self, *exc) -> None:
@@ -166,14 +166,14 @@ class Store:
                 raise
             return self._check_schema()
         if app != APPLICATION_ID:
-            raise NeurohoverError(f"{str(self.path)!r} is an SQLite file but not a neurohover results store; "
-                                  f"give another --store file")
+            raise NeurohoverError(f"{str(self.path)!r} is an SQLite file but not a neurohover results store; give another --store file")
         if version != SCHEMA_VERSION:
             newer = "a newer" if version > SCHEMA_VERSION else "an older"
             raise NeurohoverError(
                 f"results store {str(self.path)!r} has schema version {version}, written by {newer} neurohover; "
                 f"this version reads schema version {SCHEMA_VERSION}. Use a new --store file "
-                f"(or the neurohover version that wrote it); results of different schemas are never mixed")
+                f"(or the neurohover version that wrote it); results of different schemas are never mixed"
+            )
 
     # ------------------------------------------------------------------ experiments
 
@@ -198,7 +198,8 @@ class Store:
                     f"results store {str(self.path)!r} already holds experiment {name!r} at scale {scale!r} with config "
                     f"hash {row[0]}, but this config hashes to {config_hash}: the settings differ, so the results would "
                     f"not be comparable. Use another --store file, restore the old config, or rerun with --fresh to "
-                    f"discard the stored results of {name!r} ({scale})")
+                    f"discard the stored results of {name!r} ({scale})"
+                )
             else:  # same settings: keep the latest title and paper numbers (they do not change results)
                 c.execute("UPDATE experiments SET config = ? WHERE name = ? AND scale = ?", (_dumps(config), name, scale))
             c.execute("COMMIT")
@@ -208,9 +209,13 @@ class Store:
 
     def experiments(self) -> list[tuple[str, str, str, int]]:
         """(name, scale, config_hash, finished units) of every experiment in the store."""
-        return [tuple(r) for r in self.conn.execute(
-            "SELECT e.name, e.scale, e.config_hash, (SELECT count(*) FROM units u WHERE u.name = e.name AND u.scale = e.scale) "
-            "FROM experiments e ORDER BY e.created")]
+        return [
+            tuple(r)
+            for r in self.conn.execute(
+                "SELECT e.name, e.scale, e.config_hash, (SELECT count(*) FROM units u WHERE u.name = e.name AND u.scale = e.scale) "
+                "FROM experiments e ORDER BY e.created"
+            )
+        ]
 
     def config(self, name: str, scale: str) -> dict:
         row = self.conn.execute("SELECT config FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
@@ -221,8 +226,7 @@ class Store:
     def _missing(self, name: str, scale: str | None) -> str:
         present = [f"{n} ({s})" for n, s, _, _ in self.experiments()]
         what = f"{name!r}" + (f" at scale {scale!r}" if scale else "")
-        return (f"results store {str(self.path)!r} holds no experiment {what}; it holds: "
-                + (", ".join(present) if present else "nothing yet"))
+        return f"results store {str(self.path)!r} holds no experiment {what}; it holds: " + (", ".join(present) if present else "nothing yet")
 
     def scales(self, name: str) -> list[str]:
         return [r[0] for r in self.conn.execute("SELECT scale FROM experiments WHERE name = ? ORDER BY created", (name,))]
@@ -231,19 +235,19 @@ class Store:
 
     def results(self, name: str, scale: str) -> dict[str, dict]:
         """key -> result of every finished unit."""
-        return {k: json.loads(r) for k, r in self.conn.execute(
-            "SELECT key, result FROM units WHERE name = ? AND scale = ?", (name, scale))}
+        return {k: json.loads(r) for k, r in self.conn.execute("SELECT key, result FROM units WHERE name = ? AND scale = ?", (name, scale))}
 
     def units(self, name: str, scale: str) -> list[dict]:
         """Every finished unit: key, kind, params, result, seconds, worker, finished (time)."""
         rows = self.conn.execute(
-            "SELECT key, kind, params, result, seconds, worker, finished FROM units WHERE name = ? AND scale = ? ORDER BY key",
-            (name, scale))
-        return [{"key": k, "kind": kind, "params": json.loads(p), "result": json.loads(r), "seconds": s,
-                 "worker": w, "finished": f} for k, kind, p, r, s, w, f in rows]
+            "SELECT key, kind, params, result, seconds, worker, finished FROM units WHERE name = ? AND scale = ? ORDER BY key", (name, scale)
+        )
+        return [
+            {"key": k, "kind": kind, "params": json.loads(p), "result": json.loads(r), "seconds": s, "worker": w, "finished": f}
+            for k, kind, p, r, s, w, f in rows
+        ]
 
-    def put(self, name: str, scale: str, config_hash: str, unit, result: dict, seconds: float,
-            worker: str = "", session: int | None = None) -> bool:
+    def put(self, name: str, scale: str, config_hash: str, unit, result: dict, seconds: float, worker: str = "", session: int | None = None) -> bool:
         """Record one finished unit in its own transaction; False if it was already there."""
         c = self.conn
         text = _dumps(result)
@@ -251,14 +255,16 @@ class Store:
         try:
             row = c.execute("SELECT config_hash FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
             if row is None or row[0] != config_hash:
-                raise NeurohoverError(f"refusing to record unit {unit.key!r}: experiment {name!r} ({scale}) in "
-                                      f"{str(self.path)!r} has config hash {row[0] if row else None}, not {config_hash}")
-            cur = c.execute("INSERT OR IGNORE INTO units VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                            (name, scale, unit.key, unit.kind, config_hash, _dumps(unit.params), text, float(seconds),
-                             worker, time.time()))
+                raise NeurohoverError(
+                    f"refusing to record unit {unit.key!r}: experiment {name!r} ({scale}) in "
+                    f"{str(self.path)!r} has config hash {row[0] if row else None}, not {config_hash}"
+                )
+            cur = c.execute(
+                "INSERT OR IGNORE INTO units VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                (name, scale, unit.key, unit.kind, config_hash, _dumps(unit.params), text, float(seconds), worker, time.time()),
+            )
             if session is not None and cur.rowcount:
-                c.execute("UPDATE sessions SET units_run = units_run + 1, wall_seconds = ? - started WHERE id = ?",
-                          (time.time(), session))
+                c.execute("UPDATE sessions SET units_run = units_run + 1, wall_seconds = ? - started WHERE id = ?", (time.time(), session))
             c.execute("COMMIT")
         except BaseException:
             c.execute("ROLLBACK")
@@ -270,7 +276,9 @@ class Store:
     def start_session(self, name: str, scale: str, config_hash: str, executor: str, cores: int, units_before: int) -> int:
         cur = self.conn.execute(
             "INSERT INTO sessions (name, scale, config_hash, executor, cores, started, wall_seconds, units_run, units_before, status) "
-            "VALUES (?, ?, ?, ?, ?, ?, 0, 0, ?, 'running')", (name, scale, config_hash, executor, int(cores), time.time(), units_before))
+            "VALUES (?, ?, ?, ?, ?, ?, 0, 0, ?, 'running')",
+            (name, scale, config_hash, executor, int(cores), time.time(), units_before),
+        )
         assert cur.lastrowid is not None  # an INSERT always sets it
         return cur.lastrowid
 

@@ -119,21 +119,32 @@ def run_evolve(p: dict, threads: int | None) -> dict:
     target = _evolve_target(p)
     proto = _policy(p["prototype"]) if isinstance(p["prototype"], dict) else make_prototype(p["topology"], p["prototype"])
     t0 = time.perf_counter()
-    result = evolve(target, topology=p["topology"], prototype=proto, resampling=p["resampling"],
-                    budget=p["budget"] or None, settings=p["optimiser"] or None, seed=p["seed"],
-                    n_steps=p["n_steps"], threads=threads)
+    result = evolve(
+        target,
+        topology=p["topology"],
+        prototype=proto,
+        resampling=p["resampling"],
+        budget=p["budget"] or None,
+        settings=p["optimiser"] or None,
+        seed=p["seed"],
+        n_steps=p["n_steps"],
+        threads=threads,
+    )
     history = [(int(h.episodes), num(h.champion_return)) for h in result.history]
     validation = None
     if p.get("validation_episodes"):
-        v = validation_return(result.champion, target, episodes=p["validation_episodes"], seed=p["seed"],
-                              n_steps=p["n_steps"], threads=threads)
+        v = validation_return(result.champion, target, episodes=p["validation_episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads)
         validation = tuple(num(x) for x in v)
     return EvolveResult(
-        champion=StoredPolicy.of(result.champion), champion_return=num(result.champion_return),
-        episodes=int(result.episodes), evaluations=int(result.evaluations),
-        generations=int(result.generations), stop_reason=result.stop_reason,
+        champion=StoredPolicy.of(result.champion),
+        champion_return=num(result.champion_return),
+        episodes=int(result.episodes),
+        evaluations=int(result.evaluations),
+        generations=int(result.generations),
+        stop_reason=result.stop_reason,
         champion_crashed=bool(result.champion_crashed),
-        history=tuple(subsample(history, p.get("history_points", 300))), validation=validation,
+        history=tuple(subsample(history, p.get("history_points", 300))),
+        validation=validation,
         timing=EvolveTiming(seconds=time.perf_counter() - t0, kernel_seconds=float(result.kernel_seconds)),
     ).to_dict()
 
@@ -144,8 +155,9 @@ def run_robustness(p: dict, threads: int | None) -> dict:
 
     mdps = [_mdp(m) for m in p["mdps"]]
     ev = evaluate(_policy(p["policy"]), mdps, episodes=p["episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads)
-    return RobustnessResult(returns=tuple(tuple(num(x) for x in row) for row in ev.returns[0]),
-                            crashes=tuple(int(c) for c in ev.crashed[0].sum(axis=1)), own=p["own"]).to_dict()
+    return RobustnessResult(
+        returns=tuple(tuple(num(x) for x in row) for row in ev.returns[0]), crashes=tuple(int(c) for c in ev.crashed[0].sum(axis=1)), own=p["own"]
+    ).to_dict()
 
 
 def run_safety(p: dict, threads: int | None) -> dict:
@@ -154,11 +166,13 @@ def run_safety(p: dict, threads: int | None) -> dict:
     from ..policysets import choose_safe
 
     policies = [_policy(d) for d in p["policies"]]
-    ev = evaluate(policies, [_mdp(m) for m in p["mdps"]], episodes=p["episodes"], seed=p["seed"],
-                  n_steps=p["n_steps"], threads=threads)
+    ev = evaluate(policies, [_mdp(m) for m in p["mdps"]], episodes=p["episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads)
     crashes, returns = ev.crashed.sum(axis=2), ev.returns.mean(axis=2)
-    return SafetyResult(crashes=tuple(tuple(int(c) for c in row) for row in crashes),
-                        mean_returns=tuple(tuple(num(x) for x in r) for r in returns), safe=choose_safe(crashes, returns)).to_dict()
+    return SafetyResult(
+        crashes=tuple(tuple(int(c) for c in row) for row in crashes),
+        mean_returns=tuple(tuple(num(x) for x in r) for r in returns),
+        safe=choose_safe(crashes, returns),
+    ).to_dict()
 
 
 def run_model(p: dict, threads: int | None) -> dict:
@@ -180,23 +194,30 @@ def run_model(p: dict, threads: int | None) -> dict:
     elif p["method"] == "ec-meno":
         model = learn_ec_meno(data.flight_data, budget=p["ec_meno_budget"] or None, seed=int(seeds[1]))
     else:
-        model = learn_ec_mer(data.flight_data, generic, float(data.returns.ravel()[0]), budget=p["model_budget"],
-                             seed=int(seeds[1]), episodes=p["ec_mer_episodes"])
+        model = learn_ec_mer(
+            data.flight_data, generic, float(data.returns.ravel()[0]), budget=p["model_budget"], seed=int(seeds[1]), episodes=p["ec_mer_episodes"]
+        )
     learn_seconds = time.perf_counter() - t0
     proto = generic if p["prototype"] == "generic" else "baseline"
     t1 = time.perf_counter()
-    evolved = evolve(model.mdp(), topology=generic.topology, prototype=proto, budget=p["policy_budget"] or None,
-                     seed=int(seeds[2]), n_steps=p["n_steps"], threads=threads)
+    evolved = evolve(
+        model.mdp(), topology=generic.topology, prototype=proto, budget=p["policy_budget"] or None, seed=int(seeds[2]), n_steps=p["n_steps"], threads=threads
+    )
     evolve_seconds = time.perf_counter() - t1
     test = evaluate(evolved.champion, mdp, episodes=p["test_episodes"], seed=int(seeds[3]), n_steps=p["n_steps"], threads=threads)
     returns = test.returns.ravel()
     return ModelResult(
-        method=p["method"], mdp=mdp.label,
-        generic_return=num(data.returns.ravel()[0]), generic_crashed=bool(data.crashed.ravel()[0]),
-        model_params=tuple(num(x) for x in model.params), model_noise_std=tuple(num(x) for x in model.noise_std),
+        method=p["method"],
+        mdp=mdp.label,
+        generic_return=num(data.returns.ravel()[0]),
+        generic_crashed=bool(data.crashed.ravel()[0]),
+        model_params=tuple(num(x) for x in model.params),
+        model_noise_std=tuple(num(x) for x in model.noise_std),
         predicted_return=num(evolved.champion_return),
-        test_returns=tuple(num(x) for x in returns), test_mean=num(returns.mean()),
-        test_crashes=int(test.crashed.sum()), policy_episodes=int(evolved.episodes),
+        test_returns=tuple(num(x) for x in returns),
+        test_mean=num(returns.mean()),
+        test_crashes=int(test.crashed.sum()),
+        policy_episodes=int(evolved.episodes),
         timing=ModelTiming(learn_seconds=learn_seconds, evolve_seconds=evolve_seconds),
     ).to_dict()
 
@@ -216,8 +237,7 @@ def make_agent(p: dict):
         safe=tuple(_policy(d) for d in pol.get("safe", ())),
     )
     options = AgentOptions(
-        evolution=ModelEvolution(budget=p["model_budget"], predict_episodes=p["predict_episodes"], n_steps=p["n_steps"],
-                                 estimator=p["estimator"]),
+        evolution=ModelEvolution(budget=p["model_budget"], predict_episodes=p["predict_episodes"], n_steps=p["n_steps"], estimator=p["estimator"]),
         hybrid=HybridSettings.from_dict(p["hybrid"]) if spec.takes_hybrid else None,
         max_learning_episodes=p["max_learning_episodes"],
     )
@@ -236,10 +256,14 @@ def run_test_run(p: dict, threads: int | None) -> dict:
     start = after_learning_start(r.policy)
     changes = tuple((e, r.policy[e]) for e in range(len(r.policy)) if e == 0 or r.policy[e] != r.policy[e - 1])
     return TestRunResult(
-        agent=p["agent"], mdp=mdp.label, score=num(r.score),
-        returns=tuple(num(x) for x in r.returns), crash_episodes=tuple(int(e) for e in np.flatnonzero(r.crashed)),
+        agent=p["agent"],
+        mdp=mdp.label,
+        score=num(r.score),
+        returns=tuple(num(x) for x in r.returns),
+        crash_episodes=tuple(int(e) for e in np.flatnonzero(r.crashed)),
         safeguard_episodes=tuple(int(e) for e in np.flatnonzero(r.safeguard_fired)),
-        policy_changes=changes, learning_episodes=int(start),
+        policy_changes=changes,
+        learning_episodes=int(start),
         mean_return_after_learning=num(r.returns[start:].mean()),
         crash_steps=tuple(int(s) for s in r.steps[r.crashed]),
         timing=TestRunTiming(seconds=float(r.seconds), offline_seconds=float(r.offline_seconds.sum())),

@@ -48,8 +48,9 @@ def _prototype_params(prototype) -> np.ndarray:
     return np.array(DEFAULT_PARAMS if prototype is None else check_vector(prototype, 11, "prototype parameters"))
 
 
-def _evolve(fitness, proto_params: np.ndarray, scale: np.ndarray, budget: int | None, seed: int, settings,
-            max_evaluations: int | None = None) -> tuple[np.ndarray, float, int, list]:
+def _evolve(
+    fitness, proto_params: np.ndarray, scale: np.ndarray, budget: int | None, seed: int, settings, max_evaluations: int | None = None
+) -> tuple[np.ndarray, float, int, list]:
     """Run steady-state NE on genes ``params / scale`` from ``proto_params``; returns champion
     params, its fitness, evaluations, history. ``max_evaluations`` caps a run without a budget."""
     from ..evolution import SteadyStateNE
@@ -90,8 +91,7 @@ def ec_meno_gene_scale(problem: OneStepProblem, prototype=None) -> np.ndarray:
     return scale
 
 
-def learn_ec_meno(flight_data: FlightData, *, budget: int | None = None, seed: int = 0, prototype=None,
-                  settings=None, scaling: str = "data") -> LearnedModel:
+def learn_ec_meno(flight_data: FlightData, *, budget: int | None = None, seed: int = 0, prototype=None, settings=None, scaling: str = "data") -> LearnedModel:
     """EC-MENO: evolve the 11 parameters to minimise the mean one-step prediction error.
 
     Steady-state neuroevolution (paper Appendix A, Table 6 settings unless ``settings`` is given)
@@ -158,8 +158,7 @@ def learn_ec_meno(flight_data: FlightData, *, budget: int | None = None, seed: i
     def fitness(params: np.ndarray) -> np.ndarray:
         return -problem.n * problem.errors(params)
 
-    best, _, evaluations, history = _evolve(fitness, proto_params, scale, budget, seed, settings,
-                                            max_evaluations=EC_MENO_MAX_EVALUATIONS)
+    best, _, evaluations, history = _evolve(fitness, proto_params, scale, budget, seed, settings, max_evaluations=EC_MENO_MAX_EVALUATIONS)
     residuals = problem.transitions.model_residuals(best)[0]
     noise, stationary = noise_from_residuals(problem.transitions, residuals)
     try:
@@ -168,12 +167,19 @@ def learn_ec_meno(flight_data: FlightData, *, budget: int | None = None, seed: i
         ls_error = None
     error = problem.errors(best)
     stats = {
-        "budget": None if budget is None else int(budget), "scaling": scaling, "evaluations": evaluations, "seed": int(seed),
-        "n_transitions": problem.n, "n_episodes": problem.transitions.n_episodes,
-        "one_step_error": error, "prototype_one_step_error": problem.errors(proto_params),
+        "budget": None if budget is None else int(budget),
+        "scaling": scaling,
+        "evaluations": evaluations,
+        "seed": int(seed),
+        "n_transitions": problem.n,
+        "n_episodes": problem.transitions.n_episodes,
+        "one_step_error": error,
+        "prototype_one_step_error": problem.errors(proto_params),
         "least_squares_one_step_error": ls_error,
         "excess": None if ls_error is None or ls_error <= 0 else (error - ls_error) / ls_error,
-        "gene_scale": scale.tolist(), "noise_std_stationary": stationary.tolist(), "history": _thin(history),
+        "gene_scale": scale.tolist(),
+        "noise_std_stationary": stationary.tolist(),
+        "history": _thin(history),
     }
     return LearnedModel(tuple(best), tuple(noise), "ec-meno", time.perf_counter() - start, stats)
 
@@ -202,9 +208,18 @@ def _model_rows(params: np.ndarray, noise: np.ndarray) -> np.ndarray:
     return rows
 
 
-def learn_ec_mer(flight_data: FlightData, generic_policy, true_return: float | None = None, *,
-                 budget: int = 500, seed: int = 0, episode_seed: int = 0, episodes: int = 1,
-                 prototype=None, settings=None) -> LearnedModel:
+def learn_ec_mer(
+    flight_data: FlightData,
+    generic_policy,
+    true_return: float | None = None,
+    *,
+    budget: int = 500,
+    seed: int = 0,
+    episode_seed: int = 0,
+    episodes: int = 1,
+    prototype=None,
+    settings=None,
+) -> LearnedModel:
     """EC-MER: evolve the 11 parameters to minimise the error in predicted return.
 
     Fitness of a candidate is ``-|R_model - true_return|``, where R_model is the mean return of
@@ -242,8 +257,7 @@ def learn_ec_mer(flight_data: FlightData, generic_policy, true_return: float | N
         n = params.shape[0]
         m_idx = np.repeat(np.arange(n), episodes)
         e_idx = np.tile(np.arange(episodes), n)
-        ev = evaluate_jobs(table, rows, np.zeros(n * episodes, dtype=np.int64), m_idx, e_idx,
-                           seed=episode_seed, n_steps=n_steps)
+        ev = evaluate_jobs(table, rows, np.zeros(n * episodes, dtype=np.int64), m_idx, e_idx, seed=episode_seed, n_steps=n_steps)
         return ev.returns.reshape(n, episodes).mean(axis=1)
 
     def fitness(params: np.ndarray) -> np.ndarray:
@@ -255,11 +269,18 @@ def learn_ec_mer(flight_data: FlightData, generic_policy, true_return: float | N
     noise, stationary = noise_from_residuals(tr, tr.model_residuals(best))
     proto_pred = float(predicted(proto_params[None, :])[0])
     stats = {
-        "budget": int(budget), "evaluations": evaluations, "seed": int(seed), "episode_seed": int(episode_seed),
-        "episodes": int(episodes), "n_steps": n_steps, "true_return": float(true_return),
+        "budget": int(budget),
+        "evaluations": evaluations,
+        "seed": int(seed),
+        "episode_seed": int(episode_seed),
+        "episodes": int(episodes),
+        "n_steps": n_steps,
+        "true_return": float(true_return),
         "predicted_return": float(predicted(best[None, :])[0]),
-        "return_error": -float(best_fit), "prototype_predicted_return": proto_pred,
+        "return_error": -float(best_fit),
+        "prototype_predicted_return": proto_pred,
         "prototype_return_error": abs(proto_pred - float(true_return)),
-        "noise_std_stationary": stationary.tolist(), "history": history,
+        "noise_std_stationary": stationary.tolist(),
+        "history": history,
     }
     return LearnedModel(tuple(best), tuple(noise), "ec-mer", time.perf_counter() - start, stats)

@@ -120,7 +120,8 @@ def learn_lr(flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS, *, e
         if rank < x.shape[1]:
             raise NeurohoverError(
                 f"flight data do not determine the {NOISE_NAMES[axis]} axis (regressors "
-                f"{[PARAM_NAMES[i] if i >= 0 else 'constant' for i in idx]} are collinear); fly with a policy that varies its actions")
+                f"{[PARAM_NAMES[i] if i >= 0 else 'constant' for i in idx]} are collinear); fly with a policy that varies its actions"
+            )
         dof = max(1, x.shape[0] - x.shape[1])
         sigma2 = float(np.sum((target - x @ theta) ** 2)) / dof
         cov = sigma2 * np.linalg.inv(x.T @ x)
@@ -136,8 +137,12 @@ def learn_lr(flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS, *, e
     noise, stationary = noise_from_residuals(tr, residuals)
     seconds = time.perf_counter() - start
     stats = {
-        "estimator": estimator, "intercepts": intercepts, "n_transitions": tr.n, "n_episodes": tr.n_episodes,
-        "param_se": se.tolist(), "discarded_intercepts": discarded,
+        "estimator": estimator,
+        "intercepts": intercepts,
+        "n_transitions": tr.n,
+        "n_episodes": tr.n_episodes,
+        "param_se": se.tolist(),
+        "discarded_intercepts": discarded,
         "residual_rms": np.sqrt(np.mean(residuals**2, axis=0)).tolist(),
         "noise_std_stationary": stationary.tolist(),
     }

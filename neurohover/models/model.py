@@ -40,8 +40,18 @@ from ..sim.constants import CONTROL_DT, DEFAULT_NOISE_STD, DEFAULT_PARAMS, NOISE
 from ..tasks import MDP
 
 __all__ = [
-    "AXIS_C", "AXIS_GAINS", "FORMAT", "METHODS", "MODEL_DT", "LearnedModel", "ParamRow", "check_vector", "equivalent_params",
-    "format_parameter_table", "one_substep_params", "parameter_table",
+    "AXIS_C",
+    "AXIS_GAINS",
+    "FORMAT",
+    "METHODS",
+    "MODEL_DT",
+    "LearnedModel",
+    "ParamRow",
+    "check_vector",
+    "equivalent_params",
+    "format_parameter_table",
+    "one_substep_params",
+    "parameter_table",
 ]
 
 FORMAT = "neurohover-model/1"
@@ -128,8 +138,15 @@ class LearnedModel:
 
     def mdp(self, label: str | None = None) -> MDP:
         """The model as an MDP for the kernel: family ``"model"``, one 0.1 s substep, no wind."""
-        return MDP("model", params=self.params, noise_std=self.noise_std, substeps=1, dt=MODEL_DT,
-                   label=label if label is not None else f"model/{self.method}", d_u=float(self.d_u))
+        return MDP(
+            "model",
+            params=self.params,
+            noise_std=self.noise_std,
+            substeps=1,
+            dt=MODEL_DT,
+            label=label if label is not None else f"model/{self.method}",
+            d_u=float(self.d_u),
+        )
 
     def equivalent(self, substeps: int = SUBSTEPS, dt: float = SUBSTEP_DT) -> tuple[np.ndarray, np.ndarray]:
         """Parameters and noise std of the same model for ``substeps`` substeps of ``dt``
@@ -142,9 +159,15 @@ class LearnedModel:
 
     def to_dict(self) -> dict:
         return {
-            "format": FORMAT, "method": self.method, "param_names": list(PARAM_NAMES),
-            "params": list(self.params), "noise_names": list(NOISE_NAMES),
-            "noise_std": list(self.noise_std), "d_u": float(self.d_u), "seconds": float(self.seconds), "stats": self.stats,
+            "format": FORMAT,
+            "method": self.method,
+            "param_names": list(PARAM_NAMES),
+            "params": list(self.params),
+            "noise_names": list(NOISE_NAMES),
+            "noise_std": list(self.noise_std),
+            "d_u": float(self.d_u),
+            "seconds": float(self.seconds),
+            "stats": self.stats,
         }
 
     @classmethod
@@ -158,8 +181,7 @@ class LearnedModel:
         if "param_names" in d and list(d["param_names"]) != list(PARAM_NAMES):
             raise NeurohoverError(f"{source}: parameters are named {d['param_names']}, expected {list(PARAM_NAMES)}")
         try:
-            return cls(d["params"], d["noise_std"], d["method"], float(d.get("seconds", 0.0)), dict(d.get("stats", {})),
-                       float(d.get("d_u", 0.0)))
+            return cls(d["params"], d["noise_std"], d["method"], float(d.get("seconds", 0.0)), dict(d.get("stats", {})), float(d.get("d_u", 0.0)))
         except NeurohoverError as err:
             raise NeurohoverError(f"{source}: {err}") from None
         except (TypeError, ValueError) as err:
@@ -250,9 +272,14 @@ class ParamRow(NamedTuple):
     rel_error: float
 
 
-def parameter_table(model: LearnedModel, true_params: MDP | Sequence[float] | None = None,
-                    true_noise_std: Sequence[float] | None = None, *, substeps: int | None = None,
-                    dt: float | None = None) -> list[ParamRow]:
+def parameter_table(
+    model: LearnedModel,
+    true_params: MDP | Sequence[float] | None = None,
+    true_noise_std: Sequence[float] | None = None,
+    *,
+    substeps: int | None = None,
+    dt: float | None = None,
+) -> list[ParamRow]:
     """Learned parameters (and noise std) next to the true ones, with signed relative errors.
 
     ``true_params`` is an MDP (its parameters, noise and integration are used) or 11 numbers
@@ -288,4 +315,3 @@ def format_parameter_table(rows: Sequence[ParamRow]) -> str:
     lines = [f"{'name':>6} {'learned':>11} {'true':>11} {'rel.err':>8}"]
     lines += [f"{r.name:>6} {r.learned:>11.4f} {r.true:>11.4f} {100 * r.rel_error:>7.1f}%" for r in rows]
     return "\n".join(lines)
-

@@ -90,11 +90,13 @@ class Transitions:
         for arr in (obs, nxt):
             norm2 = np.einsum("ij,ij->i", arr[:, 9:12], arr[:, 9:12])
             if np.any(norm2 > _MAX_QUAT_NORM2):
-                raise NeurohoverError(f"{what}: quaternion vector parts (qx, qy, qz) longer than 1 "
-                                      f"(max {math.sqrt(norm2.max()):.6g}); not helicopter observations")
+                raise NeurohoverError(
+                    f"{what}: quaternion vector parts (qx, qy, qz) longer than 1 (max {math.sqrt(norm2.max()):.6g}); not helicopter observations"
+                )
         if np.any(np.abs(act) > 1.0 + 1e-12):
-            raise NeurohoverError(f"{what}: actions outside [-1, 1] (max |a| {np.abs(act).max():.6g}); "
-                                  "flight data hold the clipped actions the simulator applied")
+            raise NeurohoverError(
+                f"{what}: actions outside [-1, 1] (max |a| {np.abs(act).max():.6g}); flight data hold the clipped actions the simulator applied"
+            )
         first = np.zeros(n, dtype=bool)
         first[np.cumsum([0] + [a.shape[0] for _, a in episodes[:-1]])] = True
         self.obs, self.nxt, self.act, self.first = obs, nxt, act, first
@@ -146,7 +148,7 @@ class Transitions:
         res[:, :, 2] = y[:, 2] - p[:, 3:4] * o[:, 2] - p[:, 4:5] * a[:, 3]
         for j in range(3):
             ci, gi = AXIS_C[3 + j], AXIS_GAINS[3 + j][0]
-            res[:, :, 3 + j] = y[:, 3 + j] - p[:, ci:ci + 1] * o[:, 6 + j] - p[:, gi:gi + 1] * a[:, j]
+            res[:, :, 3 + j] = y[:, 3 + j] - p[:, ci : ci + 1] * o[:, 6 + j] - p[:, gi : gi + 1] * a[:, j]
         return res
 
     def innovations(self, series: np.ndarray) -> np.ndarray:
@@ -219,12 +221,14 @@ class OneStepProblem:
         h = _half_angle_quaternions(MODEL_DT * tr.obs[:, 6:9])
         qx, qy, qz, qw = q.T
         hx, hy, hz, hw = h.T
-        nq = np.column_stack([
-            qw * hx + qx * hw + qy * hz - qz * hy,
-            qw * hy - qx * hz + qy * hw + qz * hx,
-            qw * hz + qx * hy - qy * hx + qz * hw,
-            qw * hw - qx * hx - qy * hy - qz * hz,
-        ])
+        nq = np.column_stack(
+            [
+                qw * hx + qx * hw + qy * hz - qz * hy,
+                qw * hy - qx * hz + qy * hw + qz * hx,
+                qw * hz + qx * hy - qy * hx + qz * hw,
+                qw * hw - qx * hx - qy * hy - qz * hz,
+            ]
+        )
         r_next = _rotation_matrices(nq[:, 0], nq[:, 1], nq[:, 2], nq[:, 3])
         pos = np.einsum("nij,nj->ni", tr.R, tr.obs[:, 3:6]) + MODEL_DT * tr.V
         vel = tr.V.copy()
@@ -283,8 +287,10 @@ class OneStepProblem:
         for axis, idx in enumerate(_AXIS_PARAMS):
             h = self._h[np.ix_(idx, idx)]
             if np.linalg.matrix_rank(h) < len(idx):
-                raise NeurohoverError(f"flight data do not determine the {NOISE_NAMES[axis]} axis (regressors "
-                                      f"{[PARAM_NAMES[i] for i in idx]} are collinear); fly with a policy that varies its actions")
+                raise NeurohoverError(
+                    f"flight data do not determine the {NOISE_NAMES[axis]} axis (regressors "
+                    f"{[PARAM_NAMES[i] for i in idx]} are collinear); fly with a policy that varies its actions"
+                )
             theta[idx] = np.linalg.solve(h, -self._b[idx])
         return theta
 

@@ -13,11 +13,19 @@ import numpy as np
 # Dynamics parameters in row order (the paper's Table 5 calls them C and D; D_u is 0 in the
 # simulator and has its own row slot, ROW_D_U, for learned models).
 PARAM_NAMES: tuple[str, ...] = (
-    "C_u", "C_v", "D_v", "C_w", "D_w", "C_p", "D_p", "C_q", "D_q", "C_r", "D_r",
+    "C_u",
+    "C_v",
+    "D_v",
+    "C_w",
+    "D_w",
+    "C_p",
+    "D_p",
+    "C_q",
+    "D_q",
+    "C_r",
+    "D_r",
 )
-DEFAULT_PARAMS = np.array(
-    [-0.18, -0.43, -0.54, -0.49, -42.15, -12.78, 33.04, -10.12, -33.32, -8.16, 70.54]
-)
+DEFAULT_PARAMS = np.array([-0.18, -0.43, -0.54, -0.49, -42.15, -12.78, 33.04, -10.12, -33.32, -8.16, 70.54])
 NOISE_NAMES: tuple[str, ...] = ("u", "v", "w", "p", "q", "r")
 DEFAULT_NOISE_STD = np.array([0.1941, 0.2975, 0.6058, 0.1508, 0.2492, 0.0734])
 
@@ -37,9 +45,7 @@ MIN_QW = math.cos(math.radians(15.0))  # |qw| below this: more than 30 degrees f
 
 # Reward of one remaining step at the worst possible state; a crash is charged it for every
 # step left in the episode, including the crashing one.
-CRASH_STEP_PENALTY = (
-    3 * MAX_POSITION**2 + 3 * MAX_RATE**2 + 3 * MAX_VELOCITY**2 + (1.0 - MIN_QW**2)
-)
+CRASH_STEP_PENALTY = 3 * MAX_POSITION**2 + 3 * MAX_RATE**2 + 3 * MAX_VELOCITY**2 + (1.0 - MIN_QW**2)
 
 # Wind models.
 WIND_NONE = 0

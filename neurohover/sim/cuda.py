@@ -123,17 +123,51 @@ def device_function(func):
 
 
 def _rollout_thread(
-    mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, job_fallback, seed,
-    n_steps, safeguard, limits, record_slot, obs_out, act_out,
-    out_return, out_crashed, out_steps, out_safeguard_step,
+    mdp_rows,
+    policy_kinds,
+    genomes,
+    job_policy,
+    job_mdp,
+    job_episode,
+    job_fallback,
+    seed,
+    n_steps,
+    safeguard,
+    limits,
+    record_slot,
+    obs_out,
+    act_out,
+    out_return,
+    out_crashed,
+    out_steps,
+    out_safeguard_step,
 ):
     """One CUDA thread per job: the CPU kernel's loop body with a thread-local stream state."""
     j = cuda.grid(1)
     if j < job_policy.shape[0]:
         state = cuda.local.array(4, np.uint64)
-        fly_job(j, state, mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, job_fallback, seed,
-                n_steps, safeguard, limits, record_slot, obs_out, act_out,
-                out_return, out_crashed, out_steps, out_safeguard_step)
+        fly_job(
+            j,
+            state,
+            mdp_rows,
+            policy_kinds,
+            genomes,
+            job_policy,
+            job_mdp,
+            job_episode,
+            job_fallback,
+            seed,
+            n_steps,
+            safeguard,
+            limits,
+            record_slot,
+            obs_out,
+            act_out,
+            out_return,
+            out_crashed,
+            out_steps,
+            out_safeguard_step,
+        )
 
 
 fly_job = kernel.fly_job  # the CPU dispatcher; _rebind hands the kernel its device version
@@ -172,16 +206,48 @@ def load_kernel() -> None:
         one = np.zeros(1, dtype=np.int64)
         row = np.zeros((1, MDP_ROW_LEN))
         row[0, ROW_SUBSTEPS], row[0, ROW_DT] = 1.0, 0.01
-        rollout_batch_cuda(row, one, np.zeros((1, kernel.GENOME_WIDTH)), one, one, one, one - 1, np.uint64(0), 1,
-                           False, SAFEGUARD_LIMITS, one - 1, np.zeros((0, 2, 12)), np.zeros((0, 1, 4)),
-                           np.zeros(1), np.zeros(1, dtype=np.bool_), np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64))
+        rollout_batch_cuda(
+            row,
+            one,
+            np.zeros((1, kernel.GENOME_WIDTH)),
+            one,
+            one,
+            one,
+            one - 1,
+            np.uint64(0),
+            1,
+            False,
+            SAFEGUARD_LIMITS,
+            one - 1,
+            np.zeros((0, 2, 12)),
+            np.zeros((0, 1, 4)),
+            np.zeros(1),
+            np.zeros(1, dtype=np.bool_),
+            np.zeros(1, dtype=np.int64),
+            np.zeros(1, dtype=np.int64),
+        )
         _loaded = True
 
 
 def rollout_batch_cuda(
-    mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, job_fallback, seed,
-    n_steps, safeguard, limits, record_slot, obs_out, act_out,
-    out_return, out_crashed, out_steps, out_safeguard_step,
+    mdp_rows,
+    policy_kinds,
+    genomes,
+    job_policy,
+    job_mdp,
+    job_episode,
+    job_fallback,
+    seed,
+    n_steps,
+    safeguard,
+    limits,
+    record_slot,
+    obs_out,
+    act_out,
+    out_return,
+    out_crashed,
+    out_steps,
+    out_safeguard_step,
     threads_per_block: int | None = None,
 ) -> None:
     """:func:`~neurohover.sim.kernel.rollout_batch` on the GPU: copy in, one thread per job, copy back.
@@ -208,9 +274,24 @@ def rollout_batch_cuda(
     d_sg = cuda.device_array(n_jobs, dtype=np.int64)
     tpb = threads_per_block or THREADS_PER_BLOCK
     k[(n_jobs + tpb - 1) // tpb, tpb](
-        to(mdp_rows), to(policy_kinds), to(genomes), to(job_policy), to(job_mdp), to(job_episode), to(job_fallback),
-        np.uint64(seed), np.int64(n_steps), bool(safeguard), to(limits), to(record_slot), d_obs, d_act,
-        d_ret, d_crash, d_steps, d_sg,
+        to(mdp_rows),
+        to(policy_kinds),
+        to(genomes),
+        to(job_policy),
+        to(job_mdp),
+        to(job_episode),
+        to(job_fallback),
+        np.uint64(seed),
+        np.int64(n_steps),
+        bool(safeguard),
+        to(limits),
+        to(record_slot),
+        d_obs,
+        d_act,
+        d_ret,
+        d_crash,
+        d_steps,
+        d_sg,
     )
     d_ret.copy_to_host(out_return)
     d_crash.copy_to_host(out_crashed)

@@ -96,9 +96,15 @@ def _rotation(qx, qy, qz, qw):
     wy = qw * y2
     wz = qw * z2
     return (
-        1.0 - (yy + zz), xy - wz, xz + wy,
-        xy + wz, 1.0 - (xx + zz), yz - wx,
-        xz - wy, yz + wx, 1.0 - (xx + yy),
+        1.0 - (yy + zz),
+        xy - wz,
+        xz + wy,
+        xy + wz,
+        1.0 - (xx + zz),
+        yz - wx,
+        xz - wy,
+        yz + wx,
+        1.0 - (xx + yy),
     )
 
 
@@ -114,7 +120,12 @@ def observe(s):
         r00 * px + r10 * py + r20 * pz,
         r01 * px + r11 * py + r21 * pz,
         r02 * px + r12 * py + r22 * pz,
-        s[6], s[7], s[8], s[9], s[10], s[11],
+        s[6],
+        s[7],
+        s[8],
+        s[9],
+        s[10],
+        s[11],
     )
 
 
@@ -131,9 +142,15 @@ def reward_of(o) -> float:
 def crashed(s) -> bool:
     """The crash test (docs/model.md, Simulator) on the world-frame state tuple."""
     return (
-        abs(s[0]) > MAX_VELOCITY or abs(s[1]) > MAX_VELOCITY or abs(s[2]) > MAX_VELOCITY
-        or abs(s[3]) > MAX_POSITION or abs(s[4]) > MAX_POSITION or abs(s[5]) > MAX_POSITION
-        or abs(s[6]) > MAX_RATE or abs(s[7]) > MAX_RATE or abs(s[8]) > MAX_RATE
+        abs(s[0]) > MAX_VELOCITY
+        or abs(s[1]) > MAX_VELOCITY
+        or abs(s[2]) > MAX_VELOCITY
+        or abs(s[3]) > MAX_POSITION
+        or abs(s[4]) > MAX_POSITION
+        or abs(s[5]) > MAX_POSITION
+        or abs(s[6]) > MAX_RATE
+        or abs(s[7]) > MAX_RATE
+        or abs(s[8]) > MAX_RATE
         or abs(s[12]) < MIN_QW
     )
 
@@ -292,9 +309,26 @@ def _record(obs_out, act_out, slot, k, o, a1, a2, a3, a4):
 
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
 def fly_job(
-    j, rng, mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, job_fallback, seed,
-    n_steps, safeguard, limits, record_slot, obs_out, act_out,
-    out_return, out_crashed, out_steps, out_safeguard_step,
+    j,
+    rng,
+    mdp_rows,
+    policy_kinds,
+    genomes,
+    job_policy,
+    job_mdp,
+    job_episode,
+    job_fallback,
+    seed,
+    n_steps,
+    safeguard,
+    limits,
+    record_slot,
+    obs_out,
+    act_out,
+    out_return,
+    out_crashed,
+    out_steps,
+    out_safeguard_step,
 ):
     """Fly job ``j`` of :func:`rollout_batch` with ``rng`` (4 uint64) as its stream's state.
 
@@ -334,8 +368,7 @@ def fly_job(
         a4 = _clip(a4)
         if slot >= 0:
             _record(obs_out, act_out, slot, k, o, a1, a2, a3, a4)
-        n = update_noise(n, std, next_normal(rng), next_normal(rng), next_normal(rng),
-                         next_normal(rng), next_normal(rng), next_normal(rng))
+        n = update_noise(n, std, next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng))
         s = integrate(s, n, a1, a2, a3, a4, k, dyn, n_sub, dt, wind)
         o = observe(s)
         if crashed(s):
@@ -354,9 +387,24 @@ def fly_job(
 
 @nb.njit(cache=True, parallel=True, fastmath={"contract"})
 def rollout_batch(
-    mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, job_fallback, seed,
-    n_steps, safeguard, limits, record_slot, obs_out, act_out,
-    out_return, out_crashed, out_steps, out_safeguard_step,
+    mdp_rows,
+    policy_kinds,
+    genomes,
+    job_policy,
+    job_mdp,
+    job_episode,
+    job_fallback,
+    seed,
+    n_steps,
+    safeguard,
+    limits,
+    record_slot,
+    obs_out,
+    act_out,
+    out_return,
+    out_crashed,
+    out_steps,
+    out_safeguard_step,
 ):
     """Fly every job (policy, MDP, episode) and write its return, crash flag, steps and safeguard step.
 
@@ -368,9 +416,28 @@ def rollout_batch(
     n_jobs = job_policy.shape[0]
     for j in nb.prange(n_jobs):
         rng = np.empty(4, dtype=np.uint64)
-        fly_job(j, rng, mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, job_fallback, seed,
-                n_steps, safeguard, limits, record_slot, obs_out, act_out,
-                out_return, out_crashed, out_steps, out_safeguard_step)
+        fly_job(
+            j,
+            rng,
+            mdp_rows,
+            policy_kinds,
+            genomes,
+            job_policy,
+            job_mdp,
+            job_episode,
+            job_fallback,
+            seed,
+            n_steps,
+            safeguard,
+            limits,
+            record_slot,
+            obs_out,
+            act_out,
+            out_return,
+            out_crashed,
+            out_steps,
+            out_safeguard_step,
+        )
 
 
 @nb.njit(cache=True, fastmath={"contract"})
@@ -386,9 +453,23 @@ def step_batch(mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps, 
         steps[i] = t
         a1, a2, a3, a4 = actions[i, 0], actions[i, 1], actions[i, 2], actions[i, 3]
         if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
-            o = observe((states[i, 0], states[i, 1], states[i, 2], states[i, 3], states[i, 4],
-                         states[i, 5], states[i, 6], states[i, 7], states[i, 8], states[i, 9],
-                         states[i, 10], states[i, 11], states[i, 12]))
+            o = observe(
+                (
+                    states[i, 0],
+                    states[i, 1],
+                    states[i, 2],
+                    states[i, 3],
+                    states[i, 4],
+                    states[i, 5],
+                    states[i, 6],
+                    states[i, 7],
+                    states[i, 8],
+                    states[i, 9],
+                    states[i, 10],
+                    states[i, 11],
+                    states[i, 12],
+                )
+            )
             for m in range(12):
                 obs_out[i, m] = o[m]
             rew_out[i] = -CRASH_STEP_PENALTY * (n_steps - t)
@@ -397,11 +478,22 @@ def step_batch(mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps, 
         dyn, std, n_sub, dt, wind = unpack_mdp(mdp_rows[env_mdp[i]])
         rng = rngs[i]
         n = (noise[i, 0], noise[i, 1], noise[i, 2], noise[i, 3], noise[i, 4], noise[i, 5])
-        n = update_noise(n, std, next_normal(rng), next_normal(rng), next_normal(rng),
-                         next_normal(rng), next_normal(rng), next_normal(rng))
-        s = (states[i, 0], states[i, 1], states[i, 2], states[i, 3], states[i, 4], states[i, 5],
-             states[i, 6], states[i, 7], states[i, 8], states[i, 9], states[i, 10], states[i, 11],
-             states[i, 12])
+        n = update_noise(n, std, next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng))
+        s = (
+            states[i, 0],
+            states[i, 1],
+            states[i, 2],
+            states[i, 3],
+            states[i, 4],
+            states[i, 5],
+            states[i, 6],
+            states[i, 7],
+            states[i, 8],
+            states[i, 9],
+            states[i, 10],
+            states[i, 11],
+            states[i, 12],
+        )
         s = integrate(s, n, _clip(a1), _clip(a2), _clip(a3), _clip(a4), k, dyn, n_sub, dt, wind)
         for m in range(13):
             states[i, m] = s[m]

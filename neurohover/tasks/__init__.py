@@ -36,8 +36,9 @@ _FIRST = ("ghh08", "ghh09", "fghh")  # the paper's order in help texts; other fa
 
 def discover(package: str) -> dict[str, type[TaskFamily]]:
     """The ``TASK_FAMILY`` class of every module of ``package``, by family name."""
-    names = sorted((m.name for m in pkgutil.iter_modules(importlib.import_module(package).__path__)),
-                   key=lambda n: (_FIRST.index(n) if n in _FIRST else len(_FIRST), n))
+    names = sorted(
+        (m.name for m in pkgutil.iter_modules(importlib.import_module(package).__path__)), key=lambda n: (_FIRST.index(n) if n in _FIRST else len(_FIRST), n)
+    )
     found: dict[str, type[TaskFamily]] = {}
     for module in names:
         cls = getattr(importlib.import_module(f"{package}.{module}"), "TASK_FAMILY", None)
@@ -75,7 +76,21 @@ def family_for(name: str, sigma: float | None) -> TaskFamily:
 
 
 __all__ = [
-    "COMPETITION_FGHH_SIGMA", "COMPETITION_MDPS_FILE", "FGHH", "GHH08", "GHH09", "GHH09_PARAM_NAMES", "MAX_WIND", "MDP",
-    "N_TEST", "N_TRAINING", "TASK_FAMILIES", "TASK_NAMES", "TaskFamily", "competition_rows", "family_for",
-    "finite_vector", "get_task_family",
+    "COMPETITION_FGHH_SIGMA",
+    "COMPETITION_MDPS_FILE",
+    "FGHH",
+    "GHH08",
+    "GHH09",
+    "GHH09_PARAM_NAMES",
+    "MAX_WIND",
+    "MDP",
+    "N_TEST",
+    "N_TRAINING",
+    "TASK_FAMILIES",
+    "TASK_NAMES",
+    "TaskFamily",
+    "competition_rows",
+    "family_for",
+    "finite_vector",
+    "get_task_family",
 ]

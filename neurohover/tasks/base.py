@@ -24,7 +24,7 @@ from ..sim.reference import ReferenceMDP
 N_TRAINING = 10
 N_TEST = 100
 _SET_ENTROPY = 20110401  # fixed root of the seeded training and test sets (the paper's year)
-_FIXED_SETS: dict[tuple[str, int, int], tuple["MDP", ...]] = {}
+_FIXED_SETS: dict[tuple[str, int, int], tuple[MDP, ...]] = {}
 _ROW_LAYOUTS: dict[tuple[str, int], np.ndarray] = {}
 COMPETITION_MDPS_FILE = Path(__file__).parent.parent / "data" / "competition-mdps.json"
 _COMPETITION: dict[str, dict] = {}
@@ -84,17 +84,29 @@ class MDP:
 
     def to_dict(self) -> dict:
         return {
-            "family": self.family, "params": list(self.params), "noise_std": list(self.noise_std),
-            "wind_kind": self.wind_kind, "wind": list(self.wind), "substeps": self.substeps,
-            "dt": self.dt, "label": self.label, "d_u": self.d_u,
+            "family": self.family,
+            "params": list(self.params),
+            "noise_std": list(self.noise_std),
+            "wind_kind": self.wind_kind,
+            "wind": list(self.wind),
+            "substeps": self.substeps,
+            "dt": self.dt,
+            "label": self.label,
+            "d_u": self.d_u,
         }
 
     @classmethod
-    def from_dict(cls, d: dict) -> "MDP":
+    def from_dict(cls, d: dict) -> MDP:
         return cls(
-            d["family"], tuple(map(float, d["params"])), tuple(map(float, d["noise_std"])),
-            int(d["wind_kind"]), tuple(map(float, d["wind"])), int(d["substeps"]), float(d["dt"]),
-            d.get("label", ""), float(d.get("d_u", 0.0)),
+            d["family"],
+            tuple(map(float, d["params"])),
+            tuple(map(float, d["noise_std"])),
+            int(d["wind_kind"]),
+            tuple(map(float, d["wind"])),
+            int(d["substeps"]),
+            float(d["dt"]),
+            d.get("label", ""),
+            float(d.get("d_u", 0.0)),
         )
 
 
@@ -213,17 +225,14 @@ class TaskFamily:
         key = (self.name, self.set_variant(), which)
         if key not in _FIXED_SETS:  # MDPs are immutable, so each set is built once per process
             rng = np.random.default_rng(np.random.SeedSequence([_SET_ENTROPY, self.set_code, which, self.set_variant()]))
-            _FIXED_SETS[key] = tuple(self.make(self.sample_params(rng, 1)[0], label=f"{self.name}/{kind}:{i}")
-                                     for i in range(n))
+            _FIXED_SETS[key] = tuple(self.make(self.sample_params(rng, 1)[0], label=f"{self.name}/{kind}:{i}") for i in range(n))
         return list(_FIXED_SETS[key])
 
     def _competition_set(self, kind: str) -> list[MDP]:
         key = (self.name, -1, 0 if kind == "train" else 1)
         if key not in _FIXED_SETS:
             rows = competition_rows(self.name)[kind]
-            _FIXED_SETS[key] = tuple(
-                self.make(self.competition_params(r), label=f"{self.name}/{kind}:{i}") for i, r in enumerate(rows)
-            )
+            _FIXED_SETS[key] = tuple(self.make(self.competition_params(r), label=f"{self.name}/{kind}:{i}") for i, r in enumerate(rows))
         return list(_FIXED_SETS[key])
 
     def training_mdps(self) -> list[MDP]:
@@ -254,8 +263,10 @@ class TaskFamily:
             return self.sample(rng)
         kind, _, index = spec.partition(":")
         sets = {
-            "train": (self.training_mdps, N_TRAINING), "test": (self.test_mdps, N_TEST),
-            "seeded-train": (self.seeded_training_mdps, N_TRAINING), "seeded-test": (self.seeded_test_mdps, N_TEST),
+            "train": (self.training_mdps, N_TRAINING),
+            "test": (self.test_mdps, N_TEST),
+            "seeded-train": (self.seeded_training_mdps, N_TRAINING),
+            "seeded-test": (self.seeded_test_mdps, N_TEST),
         }
         if kind in sets and index.isdigit():
             getter, n = sets[kind]
@@ -263,6 +274,5 @@ class TaskFamily:
                 return getter()[int(index)]
             raise NeurohoverError(f"MDP index {index} in {spec!r} is out of range: allowed 0..{n - 1}")
         raise NeurohoverError(
-            f"unknown MDP {spec!r}: allowed zero, sample, train:N and seeded-train:N (0..{N_TRAINING - 1}), "
-            f"test:N and seeded-test:N (0..{N_TEST - 1})"
+            f"unknown MDP {spec!r}: allowed zero, sample, train:N and seeded-train:N (0..{N_TRAINING - 1}), test:N and seeded-test:N (0..{N_TEST - 1})"
         )

@@ -12,7 +12,14 @@ from ..sim.constants import ROW_WIND, WIND_SINUSOID
 from .base import MDP, TaskFamily, finite_vector
 
 GHH09_PARAM_NAMES = (
-    "x_maxf", "x_freq", "x_phase", "x_center", "y_maxf", "y_freq", "y_phase", "y_center",
+    "x_maxf",
+    "x_freq",
+    "x_phase",
+    "x_center",
+    "y_maxf",
+    "y_freq",
+    "y_phase",
+    "y_center",
 )
 
 
