@@ -98,3 +98,25 @@ def test_a_policy_set_evolved_for_another_sigma_is_refused(tmp_path: Path, capsy
     assert make_agent("baseline", get_task_family("fghh", 0.2)).name == "baseline"  # flies no policy set
     rc = main(["compete", "--task", "fghh", "--sigma", "0.2", "--agent", "incremental-race", "--runs", "1", "--episodes", "2", "--out", str(tmp_path / "c")])
     assert rc == 2 and "evolved for sigma = 0.3, not 0.2" in capsys.readouterr().err
+
+
+def test_the_readmes_example_agent_works_as_one_new_module(tmp_path: Path, monkeypatch) -> None:
+    from neurohover.agents.protocol import run_test
+    from neurohover.agents.registry import policies_from_set
+    from neurohover.agents.spec import AgentOptions
+    from neurohover.policysets import load_policy_set
+
+    readme = (Path(__file__).parent.parent / "README.md").read_text()
+    block = readme.split("# neurohover/agents/best_of_two.py\n", 1)[1].split("```", 1)[0]
+    package = tmp_path / "readme_agents"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "best_of_two.py").write_text(block)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    spec = discover("readme_agents")["best-of-two"]
+    family = get_task_family("ghh08")
+    agent = spec.build(policies_from_set(spec, load_policy_set("ghh08")), AgentOptions())
+    run = run_test(agent, family, family.test_mdps()[0], episodes=4, n_steps=100)
+    assert run.policy[:2] == ["candidate:0", "candidate:1"] and run.policy[2] == run.policy[3]
+    sys.modules.pop("readme_agents", None)
+    sys.modules.pop("readme_agents.best_of_two", None)
