@@ -164,7 +164,7 @@ class TaskFamily:
 
     # -- what a family defines ------------------------------------------------------------
 
-    def make(self, params: Sequence[float], label: str = "") -> MDP:  # pragma: no cover - overridden
+    def make(self, params: Sequence[float] | np.ndarray, label: str = "") -> MDP:  # pragma: no cover - overridden
         """The MDP of ``params`` (validated; a clear error names a bad value)."""
         raise NotImplementedError
 

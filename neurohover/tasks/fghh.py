@@ -33,7 +33,7 @@ class FGHH(TaskFamily):
         if not (isinstance(s, (int, float)) and math.isfinite(s) and 0.0 <= s <= 1.0):
             raise NeurohoverError(f"FGHH sigma={s!r} is out of range: allowed 0 <= sigma <= 1 (the paper uses 0.2 and 0.3)")
 
-    def make(self, params: Sequence[float], label: str = "") -> MDP:
+    def make(self, params: Sequence[float] | np.ndarray, label: str = "") -> MDP:
         p = finite_vector(params, 11, "FGHH dynamics parameters " + "/".join(PARAM_NAMES))
         return MDP("fghh", params=tuple(p.tolist()), label=label or "fghh/custom")
 

@@ -24,7 +24,7 @@ class GHH08(TaskFamily):
     row_slice = slice(ROW_WIND.start, ROW_WIND.start + 2)
     set_code = 8
 
-    def make(self, params: Sequence[float], label: str = "") -> MDP:
+    def make(self, params: Sequence[float] | np.ndarray, label: str = "") -> MDP:
         wind = finite_vector(params, 2, "GHH-08 wind (wind_u, wind_v)")
         if np.any(np.abs(wind) > MAX_WIND):
             raise NeurohoverError(f"GHH-08 wind {wind.tolist()} m/s is out of range: each component must lie in [-5, 5]")

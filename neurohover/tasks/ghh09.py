@@ -33,7 +33,7 @@ class GHH09(TaskFamily):
     row_slice = slice(ROW_WIND.start, ROW_WIND.start + 8)
     set_code = 9
 
-    def make(self, params: Sequence[float], label: str = "") -> MDP:
+    def make(self, params: Sequence[float] | np.ndarray, label: str = "") -> MDP:
         p = finite_vector(params, 8, "GHH-09 parameters " + "/".join(GHH09_PARAM_NAMES))
         bad = [f"{n}={v}" for n, v in zip(GHH09_PARAM_NAMES, p) if not 0.0 <= v <= 1.0]
         if bad:
