@@ -284,7 +284,7 @@ class HoverVectorEnv(VectorEnv):
         labels = np.full(self.num_envs, None, dtype=object)
         mask = np.zeros(self.num_envs, dtype=np.bool_)
         for i in idx.tolist():
-            labels[i] = self._sample_label if self._draws[i] is not None else self._mdps[i].label  # type: ignore[union-attr]
+            labels[i] = self._sample_label if self._draws[i] is not None else self._mdps[i].label
         mask[idx] = True
         return labels, mask
 
