@@ -102,7 +102,7 @@ def resolve_target(target) -> tuple[MDP | None, TaskFamily | None, dict]:
     if isinstance(target, MDP):
         return target, None, {"kind": "mdp", "mdp": target.to_dict()}
     if isinstance(target, TaskFamily):
-        desc = {"kind": "family", "family": target.name}
+        desc: dict[str, Any] = {"kind": "family", "family": target.name}
         if target.sigma is not None:
             desc["sigma"] = float(target.sigma)
         return None, target, desc

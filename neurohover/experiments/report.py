@@ -218,7 +218,7 @@ class _Evolution(_Section):
             finals = self.final_scores(runs)
             validated = runs[0].validation is not None
             samples[v["key"]], labels[v["key"]] = finals, v["label"]
-            stops = {}
+            stops: dict[str, int] = {}
             for r in runs:
                 stops[r.stop_reason] = stops.get(r.stop_reason, 0) + 1
             rows.append(

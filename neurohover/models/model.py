@@ -61,7 +61,7 @@ MODEL_DT = CONTROL_DT
 #: Per axis (u, v, w, p, q, r): index of its C parameter; the axis index is also the noise index.
 AXIS_C = (0, 1, 3, 5, 7, 9)
 #: Per axis: indices of its gain parameters (D_v, D_w, D_p, D_q, D_r; u has none).
-AXIS_GAINS = ((), (2,), (4,), (6,), (8,), (10,))
+AXIS_GAINS: tuple[tuple[int, ...], ...] = ((), (2,), (4,), (6,), (8,), (10,))
 
 
 def check_vector(values, length: int, what: str, nonnegative: bool = False) -> tuple[float, ...]:

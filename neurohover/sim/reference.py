@@ -139,7 +139,8 @@ class ReferenceHelicopter:
         dt = self.mdp.dt
         for i in range(self.mdp.substeps):
             t = competition_time(self.steps - 1, i)
-            self.position = tuple(p + dt * v for p, v in zip(self.position, self.velocity))
+            x, y, z = (p + dt * v for p, v in zip(self.position, self.velocity))
+            self.position = (x, y, z)
             q = self.orientation
             vb = rotate_inverse(q, self.velocity)
             wb = rotate_inverse(q, self.mdp.wind_at(t))
