@@ -21,7 +21,7 @@ import math
 import numbers
 import time
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any, Protocol, overload
 
 import numpy as np
 
@@ -173,6 +173,12 @@ def enc_array(a: np.ndarray | None) -> dict[str, Any] | None:
     return {"shape": list(a.shape), "data": [enc_float(v) for v in a.ravel()]}
 
 
+@overload
+def dec_array(d: dict[str, Any]) -> np.ndarray: ...
+@overload
+def dec_array(d: None) -> None: ...
+@overload
+def dec_array(d: dict[str, Any] | None) -> np.ndarray | None: ...
 def dec_array(d: dict[str, Any] | None) -> np.ndarray | None:
     """The array :func:`enc_array` encoded."""
     if d is None:

@@ -317,6 +317,7 @@ class SteadyStateNE(ChampionViews):
         if self._population is None:
             self._population, self._fitness = self._pending, f
         else:
+            assert self._fitness is not None  # set with the population
             keep = rank(self._fitness)[: self.settings.elite_size]
             self._population = np.concatenate((self._population.take(keep, axis=0), self._pending))
             self._fitness = np.concatenate((self._fitness.take(keep), f))
@@ -334,16 +335,17 @@ class SteadyStateNE(ChampionViews):
         return s.budget is not None and self._tracker.evaluations >= s.budget
 
     def _breed(self, n: int) -> np.ndarray:
-        s, rng, pop = self.settings, self._rng, self._population
+        s, rng, pop, fitness = self.settings, self._rng, self._population, self._fitness
+        assert pop is not None and fitness is not None  # ask() breeds only after the first tell()
         if s.selection == "tournament":
-            key = np.fmax(self._fitness, -np.inf)  # NaN ranks worst
+            key = np.fmax(fitness, -np.inf)  # NaN ranks worst
             size = len(pop)
 
             def pick() -> int:
                 entrants = rng.choice(size, s.tournament_size, replace=False)
                 return int(entrants[np.argmax(key[entrants])])  # ties: the first drawn
         else:
-            cdf = roulette_weights(self._fitness).cumsum().tolist()
+            cdf = roulette_weights(fitness).cumsum().tolist()
 
             def pick() -> int:
                 return _spin(cdf, rng)
