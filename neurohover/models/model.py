@@ -290,6 +290,7 @@ def parameter_table(
     """
     if not isinstance(model, LearnedModel):
         raise NeurohoverError(f"parameter_table needs a LearnedModel, got {type(model).__name__}")
+    noise: np.ndarray | None  # None: the true noise is unknown
     if isinstance(true_params, MDP):
         mdp = true_params
         truth = np.array(mdp.params, dtype=float)
