@@ -145,6 +145,14 @@ class _Section:
                     f"({'significant' if ours else 'not significant'} at 5%; mean {fmt(ma)} vs {fmt(mb)}) vs paper p {t['p']}: {agree}."
                 )
 
+    def figure(self) -> str | None:
+        """Write the section's figure (each kind of section defines it); returns its file name, or None."""
+        raise NotImplementedError
+
+    def body(self) -> str:
+        """The section's Markdown (each kind of section defines it)."""
+        raise NotImplementedError
+
     def tests_markdown(self) -> str:
         if not self.tests:
             return ""
