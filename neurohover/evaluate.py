@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 
 import numba
@@ -118,7 +118,7 @@ def num_threads(threads: int | None) -> Iterator[None]:
     if threads is None:
         yield
         return
-    limit = numba.config.NUMBA_NUM_THREADS
+    limit = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # numba.config sets it at import, from the environment
     if not isinstance(threads, int) or not 1 <= threads <= limit:
         raise NeurohoverError(f"threads={threads!r} is out of range: allowed 1..{limit} on this machine")
     previous = numba.get_num_threads()
@@ -196,7 +196,7 @@ def evaluate_jobs(
     *,
     seed: int = 0,
     fallback_index=None,
-    safeguard_limits: Sequence[float] | None = None,
+    safeguard_limits: Sequence[float] | np.ndarray | None = None,
     record=None,
     n_steps: int = EPISODE_STEPS,
     threads: int | None = None,
@@ -214,7 +214,7 @@ def evaluate_jobs(
         Root seed of every episode's noise stream.
     fallback_index : array_like of int, optional
         Per job, the policy the safeguard hands control to (-1: no safeguard for that job).
-    safeguard_limits : sequence of 10 floats, optional
+    safeguard_limits : sequence or array of 10 floats, optional
         The dangerous-state test in the kernel's layout (:meth:`DangerousState.limits`): limits on
         |u|, |v|, |w|, |x|, |y|, |z|, |p|, |q|, |r|, then the tilt threshold on qw (inf: no tilt
         condition). Default: ``DangerousState()``, the authors' test.
@@ -273,6 +273,7 @@ def evaluate_jobs(
     crashed = np.empty(n_jobs, dtype=np.bool_)
     steps = np.empty(n_jobs, dtype=np.int64)
     sg_step = np.empty(n_jobs, dtype=np.int64)
+    rollout: Callable[..., None]  # the CPU kernel (a numba dispatcher) or the CUDA launcher, same arguments
     if device == "cuda":
         sim_cuda.load_kernel()
         rollout = sim_cuda.rollout_batch_cuda
