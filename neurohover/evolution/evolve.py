@@ -76,6 +76,7 @@ from ..errors import NeurohoverError
 from ..evaluate import evaluate_jobs, num_threads
 from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
+from ..tasks import MDP
 from .config import CMA_DEFAULTS, Resampling, RunConfig, parse_resampling, resolve_target
 from .records import (
     CHECKPOINT_FORMAT,
@@ -198,7 +199,12 @@ def evolve(
         run.stop_reason = None
     run.flyer.trace = _trace
     # Load (or compile) the kernel before the clock runs, and validate the thread count.
-    evaluate_jobs([run.cfg.prototype], run.rows if run.rows is not None else run.family.zero(), [0], [0], [0], n_steps=1, threads=threads)
+    if run.rows is not None:
+        warm_up: np.ndarray | MDP = run.rows
+    else:
+        assert run.family is not None  # a run has one MDP (its rows) or a family
+        warm_up = run.family.zero()
+    evaluate_jobs([run.cfg.prototype], warm_up, [0], [0], [0], n_steps=1, threads=threads)
     with num_threads(threads if threads is not None else numba.get_num_threads()):  # restores the count after
         run.flyer.start()
         run.run(progress, path, float(checkpoint_every_s), float(progress_every_s))
@@ -219,6 +225,7 @@ def validation_return(policy: Policy, target, *, episodes: int = 10, seed: int =
         rows = mdp.row()[None, :]
         m_idx = np.zeros(episodes, dtype=np.int64)
     else:
+        assert family is not None  # resolve_target gives an MDP or a family
         rows = family.sample_rows(np.random.default_rng(mdp_seed), episodes)
         m_idx = np.arange(episodes)
     ev = evaluate_jobs([policy], rows, np.zeros(episodes, dtype=np.int64), m_idx, np.arange(episodes), seed=noise_seed, n_steps=n_steps, threads=threads)

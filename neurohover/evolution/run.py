@@ -13,8 +13,10 @@ import pickle
 import signal
 import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import cast
+from types import FrameType
+from typing import Any, cast
 
 import numpy as np
 
@@ -49,7 +51,7 @@ class InterruptFlag:
 
     def __init__(self) -> None:
         self.set = False
-        self._previous = None
+        self._previous: Callable[[int, FrameType | None], Any] | int | None = None  # the handler signal.signal replaced
 
     def __enter__(self) -> InterruptFlag:
         if threading.current_thread() is threading.main_thread():
@@ -162,18 +164,20 @@ class Run:
 
     def _fly_fixed(self, genomes: np.ndarray) -> np.ndarray:
         """Fitness of each genome on the fixed MDP: mean of K episodes (fresh episode indices)."""
-        n, k = genomes.shape[0], self.resampling.k
+        n, k, rows = genomes.shape[0], self.resampling.k, self.rows
+        assert rows is not None  # only runs on one MDP fly fixed (steady state, CMA-ES on an MDP)
         if k == 1:
             if n == 1:
-                return self.flyer.fly(genomes, self.rows, None, None, 1).copy()
-            return self.flyer.fly(genomes, self.rows, "range", None, n).copy()
+                return self.flyer.fly(genomes, rows, None, None, 1).copy()
+            return self.flyer.fly(genomes, rows, "range", None, n).copy()
         p = np.repeat(np.arange(n, dtype=np.int64), k)
-        return self.flyer.fly(genomes, self.rows, p, None, n * k).reshape(n, k).mean(axis=1)
+        return self.flyer.fly(genomes, rows, p, None, n * k).reshape(n, k).mean(axis=1)
 
     def _crashed(self) -> np.ndarray:
         """Whether each genome of the last :meth:`_fly_fixed` crashed (in any of its K episodes)."""
         k = self.resampling.k
-        return self.flyer.crashed.copy() if k == 1 else self.flyer.crashed.reshape(-1, k).any(axis=1)
+        # cast: numpy's stubs allow a scalar from any(axis=1), which a 2-d array never gives
+        return self.flyer.crashed.copy() if k == 1 else cast(np.ndarray, self.flyer.crashed.reshape(-1, k).any(axis=1))
 
     def _fly_family_fixed(self, genomes: np.ndarray):
         """Fixed resampling on G in ONE kernel call: (means, ResamplingResult).
@@ -183,10 +187,13 @@ class Run:
         """
         n, k = genomes.shape[0], self.resampling.k
         p = np.tile(np.arange(n, dtype=np.int64), k)
+        rows, family = self.rows, self.family
         if self.mdp_rng is None:  # generational on one MDP: only the episodes' noise differs
-            returns = self.flyer.fly(genomes, self.rows, p, None, n * k).copy()
+            assert rows is not None  # mdp_rng is None exactly when the run has one MDP
+            returns = self.flyer.fly(genomes, rows, p, None, n * k).copy()
         else:
-            returns = self.flyer.fly(genomes, self.family.sample_rows(self.mdp_rng, n * k), p, "range", n * k).copy()
+            assert family is not None  # mdp_rng is set exactly when the run has a family
+            returns = self.flyer.fly(genomes, family.sample_rows(self.mdp_rng, n * k), p, "range", n * k).copy()
         cols = returns.reshape(k, n)
         calls = iter(range(k))
         result = fixed_resampling(lambda idx: cols[next(calls)], n, k)
@@ -194,10 +201,12 @@ class Run:
 
     def _race_sample_fn(self, genomes: np.ndarray):
         def sample(idx: np.ndarray) -> np.ndarray:
-            n = idx.shape[0]
+            n, rows, family = idx.shape[0], self.rows, self.family
             if self.mdp_rng is None:
-                return self.flyer.fly(genomes, self.rows, idx.astype(np.int64), None, n).copy()
-            return self.flyer.fly(genomes, self.family.sample_rows(self.mdp_rng, n), idx.astype(np.int64), "range", n).copy()
+                assert rows is not None  # mdp_rng is None exactly when the run has one MDP
+                return self.flyer.fly(genomes, rows, idx.astype(np.int64), None, n).copy()
+            assert family is not None  # mdp_rng is set exactly when the run has a family
+            return self.flyer.fly(genomes, family.sample_rows(self.mdp_rng, n), idx.astype(np.int64), "range", n).copy()
 
         return sample
 
@@ -233,7 +242,7 @@ class Run:
                     if now >= next_progress and progress is not None:
                         next_progress = now + progress_every_s
                         progress(self._info(now - start, False, budget))
-                    if now >= next_ckpt:
+                    if checkpoint is not None and now >= next_ckpt:  # (next_ckpt is inf without a checkpoint)
                         write_checkpoint(checkpoint, self.state(now - start))
                         next_ckpt = time.perf_counter() + flag_every
             except KeyboardInterrupt:
@@ -293,7 +302,9 @@ class Run:
         before_eps = self.flyer.episodes
         genomes = opt.ask()
         if self.resampling.kind == "race":
-            race = selection_race(self._race_sample_fn(genomes), genomes.shape[0], opt.settings.select_size, self.resampling.delta, t_limit=RACE_T_LIMIT)
+            delta = self.resampling.delta
+            assert delta is not None  # every race has its delta (Run() formats it in config.to_dict() first)
+            race = selection_race(self._race_sample_fn(genomes), genomes.shape[0], opt.settings.select_size, delta, t_limit=RACE_T_LIMIT)
             opt.tell_race(race)
         else:
             _, result = self._fly_family_fixed(genomes)
