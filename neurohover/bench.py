@@ -96,6 +96,7 @@ def lr_seconds_per_episode_of_flight_data() -> float:
     from .policies import baseline_policy
 
     flight = evaluate(baseline_policy(), get_task_family("ghh08").training_mdps()[0], record=True, seed=3).flight_data
+    assert flight is not None  # recorded
     best = float("inf")
     for _ in range(5):
         start = time.perf_counter()
@@ -143,7 +144,7 @@ def benchmark_evolution(quick: bool = False, repeats: int | None = None) -> dict
     from .evolution.evolve import evolve
     from .evolution.seeding import noise_seed
 
-    cores = numba.config.NUMBA_NUM_THREADS
+    cores = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # numba.config sets it at import, from the environment
     repeats = (1 if quick else 2) if repeats is None else repeats
     budget_ss, budget_gen = (200, 300) if quick else (2000, 5000)  # quick: about a second (2 generations of fixed:5)
     cases = [
@@ -184,7 +185,7 @@ def _extra_benchmarks(quick: bool) -> dict:
 
 def run_benchmarks(quick: bool = False) -> dict:
     """Measure everything and return a JSON-able report."""
-    cores = numba.config.NUMBA_NUM_THREADS
+    cores = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # numba.config sets it at import, from the environment
     episodes = 100 if quick else 1000
     repeats = 1 if quick else 3
     # The hovering baseline costs the same every step, so a sixth of an episode gives the rate.

@@ -110,9 +110,10 @@ def fghh_generation(candidates: int = 50, episodes: int = 5, repeats: int = 3, n
             start = time.perf_counter()
             ev = evaluate_jobs(table, rows, p, m, m, seed=2, n_steps=n_steps, device=device)
             best = min(best, time.perf_counter() - start)
+        assert ev is not None  # repeats >= 1
         out[f"{device}_seconds"] = best
         out["crashed"], out["mean_steps"] = int(ev.crashed.sum()), float(ev.steps.mean())
-    out["cpu_cores"] = numba.config.NUMBA_NUM_THREADS
+    out["cpu_cores"] = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # numba.config sets it at import, from the environment
     return out
 
 
@@ -138,7 +139,7 @@ def gpu_benchmarks(quick: bool = False, cpu_episodes_per_second: float | None = 
     if not quick:  # the launch shape: THREADS_PER_BLOCK is a guess until measured
         report["episodes_per_second_batch_50000_by_block_size"] = {tpb: gpu_episodes_per_second(50_000, 1, threads_per_block=tpb) for tpb in (64, 128, 256)}
     report["fghh_generation_50x5"] = fghh_generation(repeats=1 if quick else 3)
-    cores = numba.config.NUMBA_NUM_THREADS
+    cores = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # numba.config sets it at import, from the environment
     if cpu_episodes_per_second is None:
         cpu_episodes_per_second = kernel_episodes_per_second(200 * cores, cores, 1)
     report["cpu_kernel_all_cores_episodes_per_second"] = cpu_episodes_per_second

@@ -188,15 +188,15 @@ def run_model(p: dict, threads: int | None) -> dict:
     generic = _policy(p["generic"])
     seeds = np.random.SeedSequence(p["seed"]).generate_state(4, np.uint64) >> np.uint64(1)
     data = evaluate(generic, mdp, seed=int(seeds[0]), record=True, n_steps=p["n_steps"], threads=threads)
+    flight = data.flight_data
+    assert flight is not None  # recorded
     t0 = time.perf_counter()
     if p["method"] in ("lr", "lr-gls"):  # ordinary least squares (the paper's), or the GLS option
-        model = learn_lr(data.flight_data, estimator="gls" if p["method"] == "lr-gls" else "ols")
+        model = learn_lr(flight, estimator="gls" if p["method"] == "lr-gls" else "ols")
     elif p["method"] == "ec-meno":
-        model = learn_ec_meno(data.flight_data, budget=p["ec_meno_budget"] or None, seed=int(seeds[1]))
+        model = learn_ec_meno(flight, budget=p["ec_meno_budget"] or None, seed=int(seeds[1]))
     else:
-        model = learn_ec_mer(
-            data.flight_data, generic, float(data.returns.ravel()[0]), budget=p["model_budget"], seed=int(seeds[1]), episodes=p["ec_mer_episodes"]
-        )
+        model = learn_ec_mer(flight, generic, float(data.returns.ravel()[0]), budget=p["model_budget"], seed=int(seeds[1]), episodes=p["ec_mer_episodes"])
     learn_seconds = time.perf_counter() - t0
     proto = generic if p["prototype"] == "generic" else "baseline"
     t1 = time.perf_counter()
