@@ -19,8 +19,9 @@ from numba.core import caching
 SIM_DIR = Path(__file__).resolve().parent
 PACKAGE_DIR = SIM_DIR.parent
 
-# numba 0.68 made the implementation class public; older releases keep it private.
-_CacheImpl = getattr(caching, "CacheImpl", None) or caching._CacheImpl
+# numba 0.68 made the implementation class public; older releases keep it private. Both by getattr:
+# mypy checks against the installed numba, which lacks one of the two names.
+_CacheImpl = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl")  # noqa: B009
 
 
 def sim_source_hash(sim_dir: Path = SIM_DIR) -> str:

@@ -35,7 +35,7 @@ from .constants import MDP_ROW_LEN, ROW_DT, ROW_SUBSTEPS, SAFEGUARD_LIMITS
 try:  # numba-cuda (``pip install 'neurohover[cuda]'``) or numba's built-in target; may be broken or absent
     from numba import cuda
 except Exception as exc:  # pragma: no cover - depends on the installation
-    cuda = None
+    cuda = None  # type: ignore[assignment]  # no numba.cuda: every use follows cuda_problem(), which reports it
     _IMPORT_ERROR: Exception | None = exc
 else:
     _IMPORT_ERROR = None
@@ -48,7 +48,7 @@ def simulating() -> bool:
     """Whether numba's CUDA simulator stands in for a GPU (``NUMBA_ENABLE_CUDASIM=1`` at numba's import)."""
     from numba.core import config
 
-    return bool(config.ENABLE_CUDASIM)
+    return bool(config.ENABLE_CUDASIM)  # type: ignore[attr-defined]  # numba.config sets it at import, from the environment
 
 
 def cuda_problem() -> str | None:
