@@ -183,6 +183,11 @@ def _extra_benchmarks(quick: bool) -> dict:
     return out
 
 
+#: Estimated limit of one core on the benchmark workload (episodes/s): a full episode is 60,000
+#: substeps of a few hundred flops plus 36,000 normal draws (issue 12's estimate, 3,000-5,000).
+ESTIMATED_LIMIT_PER_CORE = (3000.0, 5000.0)
+
+
 def run_benchmarks(quick: bool = False) -> dict:
     """Measure everything and return a JSON-able report."""
     cores = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # numba.config sets it at import, from the environment
@@ -202,6 +207,7 @@ def run_benchmarks(quick: bool = False) -> dict:
             "control_steps_per_second": one * per_episode,
             "substeps_per_second": one * per_episode * SUBSTEPS,
             "speedup_vs_reference": one / ref,
+            "fraction_of_estimated_limit": [one / limit for limit in reversed(ESTIMATED_LIMIT_PER_CORE)],
         },
         f"kernel_{cores}_cores": {
             "episodes_per_second": many,
@@ -226,6 +232,9 @@ def format_report(report: dict) -> str:
     for key, value in report.items():
         if key.startswith("kernel_"):
             extra = f", x{value['speedup_vs_1_core']:.2f} vs 1 core" if "speedup_vs_1_core" in value else ""
+            if "fraction_of_estimated_limit" in value:
+                low, high = value["fraction_of_estimated_limit"]
+                extra += f", {low:.0%}-{high:.0%} of one core's estimated limit"
             lines.append(
                 f"  {key:<34} {value['episodes_per_second']:>12.1f} episodes/s  {value['substeps_per_second'] / 1e6:8.1f} M substeps/s"
                 f"  x{value['speedup_vs_reference']:.0f} vs reference{extra}"
