@@ -22,13 +22,13 @@ FORMATS = ("csv", "json")
 def _scale(store: Store, name: str, scale: str | None) -> str:
     scales = store.scales(name)
     if not scales:
-        raise NeurohoverError(store._missing(name, None))
+        raise NeurohoverError(store.missing_message(name, None))
     if scale is None:
         if len(scales) > 1:
             raise NeurohoverError(f"experiment {name!r} is in the store at scales {', '.join(scales)}: choose one with --scale")
         return scales[0]
     if scale not in scales:
-        raise NeurohoverError(store._missing(name, scale))
+        raise NeurohoverError(store.missing_message(name, scale))
     return scale
 
 

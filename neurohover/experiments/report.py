@@ -613,9 +613,9 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
     if names:
         missing = [n for n in names if n not in {e[0] for e in entries}]
         if missing:
-            raise NeurohoverError(store._missing(missing[0], scale))
+            raise NeurohoverError(store.missing_message(missing[0], scale))
     if not entries:
-        raise NeurohoverError(store._missing("(any)", scale))
+        raise NeurohoverError(store.missing_message("(any)", scale))
     rank = {n: i for i, n in enumerate(ORDER)}
     entries.sort(key=lambda e: (rank.get(e[0], len(ORDER)), e[0], e[1]))
     sections, toc = [], []

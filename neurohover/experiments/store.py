@@ -220,10 +220,11 @@ class Store:
     def config(self, name: str, scale: str) -> dict:
         row = self.conn.execute("SELECT config FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
         if row is None:
-            raise NeurohoverError(self._missing(name, scale))
+            raise NeurohoverError(self.missing_message(name, scale))
         return json.loads(row[0])
 
-    def _missing(self, name: str, scale: str | None) -> str:
+    def missing_message(self, name: str, scale: str | None) -> str:
+        """The message for an experiment (at ``scale``, if given) this store does not hold, listing what it holds."""
         present = [f"{n} ({s})" for n, s, _, _ in self.experiments()]
         what = f"{name!r}" + (f" at scale {scale!r}" if scale else "")
         return f"results store {str(self.path)!r} holds no experiment {what}; it holds: " + (", ".join(present) if present else "nothing yet")
