@@ -30,8 +30,8 @@ How it works
   flown again for every lane, from the saved start, with ``K.integrate`` itself (libm sin/cos).
 - Bit-identity: the kernel is compiled with fastmath={"contract"}, so which ``a*b + c`` become FMAs is
   decided by LLVM's x86 instruction selection from the order of the operands in its optimized IR, and the
-  SLP vectorizer reorders operands, so the same source contracted differently when packed (2.8e-16 relative
-  differences in returns). Here the lane code is compiled without contraction and every FMA that the
+  SLP vectorizer reorders operands, so the same source contracted differently when packed (returns near -1000
+  differed by up to 8e-13 after 6000 steps). Here the lane code is compiled without contraction and every FMA that the
   kernel's compiled code forms is written out as ``llvm.fma`` (``fma`` below), read from the kernel's
   optimized IR (``integrate.inspect_llvm()``; fly_job for the observation and the reward): an add whose
   first operand is a single-use product is fused with that product, otherwise with the second one; products
