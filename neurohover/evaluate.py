@@ -27,6 +27,7 @@ from .flightdata import FlightData
 from .policies import GENOME_LENGTH, TOPOLOGIES, Policy
 from .sim.constants import EPISODE_STEPS, MDP_ROW_LEN, SAFEGUARD_BOX, SAFEGUARD_LIMITS, SAFEGUARD_TILT
 from .sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
+from .sim.lanes import LANES, rollout_lanes
 from .tasks import MDP
 
 _KIND = {"slp": POLICY_SLP, "mlp": POLICY_MLP}
@@ -187,6 +188,40 @@ def _load_kernel() -> None:
         _kernel_loaded = True
 
 
+_lanes_loaded = False
+
+
+def _load_lanes() -> None:
+    """Load (or compile) the lanes path with an empty batch, so ``seconds`` times only flying."""
+    global _lanes_loaded
+    if not _lanes_loaded:
+        empty = np.zeros(0, dtype=np.int64)
+        rollout_lanes(
+            np.zeros(MDP_ROW_LEN),
+            np.int64(POLICY_MLP),
+            np.zeros(GENOME_WIDTH),
+            np.uint64(0),
+            empty,
+            1,
+            1,
+            np.zeros(0),
+            np.zeros(0, dtype=np.bool_),
+            empty,
+            empty,
+        )
+        _lanes_loaded = True
+
+
+def _use_lanes(device: str, p_idx: np.ndarray, m_idx: np.ndarray, fb: np.ndarray, rec: np.ndarray) -> bool:
+    """Whether the jobs fly in SIMD lanes (:func:`neurohover.sim.lanes.rollout_lanes`) rather than the scalar kernel.
+
+    The lanes share one policy and one MDP row and implement neither recording nor the safeguard;
+    below LANES jobs a thread's lanes would mostly idle. Results are the same bits either way.
+    """
+    n_jobs = p_idx.shape[0]
+    return device == "cpu" and n_jobs >= LANES and bool((p_idx == p_idx[0]).all()) and bool((m_idx == m_idx[0]).all()) and not (fb >= 0).any() and not rec.any()
+
+
 def evaluate_jobs(
     policies: Sequence[Policy] | PolicyTable,
     mdps: MDP | Sequence[MDP] | np.ndarray,
@@ -273,6 +308,25 @@ def evaluate_jobs(
     crashed = np.empty(n_jobs, dtype=np.bool_)
     steps = np.empty(n_jobs, dtype=np.int64)
     sg_step = np.empty(n_jobs, dtype=np.int64)
+    if _use_lanes(device, p_idx, m_idx, fb, rec):
+        _load_lanes()
+        pol, row = int(p_idx[0]), int(m_idx[0])
+        start = time.perf_counter()
+        with num_threads(threads):
+            rollout_lanes(
+                rows[row].copy(),
+                table.kinds[pol],
+                table.genomes[pol].copy(),
+                np.uint64(seed),
+                e_idx,
+                n_steps,
+                numba.get_num_threads(),
+                returns,
+                crashed,
+                steps,
+                sg_step,
+            )
+        return Evaluation(returns, crashed, steps, sg_step, None, time.perf_counter() - start)
     rollout: Callable[..., None]  # the CPU kernel (a numba dispatcher) or the CUDA launcher, same arguments
     if device == "cuda":
         sim_cuda.load_kernel()

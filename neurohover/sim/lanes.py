@@ -1,0 +1,439 @@
+"""Several episodes per thread in SIMD lanes: the kernel's rollout for a batch of one policy on one MDP.
+
+:func:`rollout_lanes` flies the jobs of :func:`neurohover.sim.kernel.rollout_batch` when they all
+share one policy and one MDP row and none records flight data or has a safeguard, LANES episodes
+per thread in lockstep, and writes bit-identical returns, crash flags and steps (about 2.2x the
+scalar kernel's episodes/s per core, docs/performance.md). :func:`neurohover.evaluate.evaluate_jobs`
+chooses it for such batches.
+
+How it works
+- Lanes in lockstep over control steps, one episode per lane, and a queue: a lane whose episode ends
+  takes the next one, so lanes run at different steps. An idle lane flies at rest.
+- All lane data live in one flat float64 buffer ``B[row * LANES + lane]`` (state, drive terms, wind,
+  observation, reward, crash flag), so LLVM sees constant, non-overlapping offsets and its SLP
+  vectorizer packs the fully unrolled ``for lane in range(LANES)`` loops (the substeps, then the
+  observation, reward and crash test) into packed instructions on ymm/zmm registers.
+- The three Taylor regimes of ``kernel._half_angle_quaternion`` are all computed and chosen by
+  selects; a lane at or above SERIES_MAX_ANGLE (or NaN) is counted, and then that control step is
+  flown again for every lane, from the saved start, with ``kernel.integrate`` itself (libm sin/cos).
+- Bit-identity: the kernel is compiled with fastmath={"contract"}, so which ``a*b + c`` become FMAs
+  is decided by LLVM from the operand order of its optimised IR, and the SLP vectorizer reorders
+  operands (the same source contracted differently when packed: returns near -1000 differed by up
+  to 8e-13). The lane code is therefore compiled without contraction and every FMA that the
+  kernel's compiled code forms is written out as ``llvm.fma`` (:func:`fma`), read from the kernel's
+  optimised IR. This is the fragile part: a numba/LLVM upgrade or an edit of ``integrate`` or
+  ``observe`` can change the kernel's FMA pattern; tests/test_lanes.py pins both paths bit-identical.
+- Still scalar per lane: the policy (``exp`` has no bit-identical packed form), the xoshiro256** /
+  ziggurat gust noise, the wind's sin, and the bookkeeping.
+
+The prototype and its measurements: docs/performance/simd_lanes_prototype.py.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+from llvmlite import ir
+from numba.core import types
+from numba.extending import intrinsic
+
+from .constants import CRASH_STEP_PENALTY, GRAVITY, MAX_POSITION, MAX_RATE, MAX_VELOCITY, MIN_QW, WIND_SINUSOID
+from .kernel import SERIES_MAX_ANGLE, _clip, _rotation, competition_time, integrate, observe, policy_action, unpack_mdp, update_noise
+from .rng import next_normal, seed_stream
+
+LANES = 8  # episodes per thread: 8 doubles fill an AVX-512 register (prototype: 4 lanes 1.94x, 8 2.20x, 16 2.27x)
+BIG2 = SERIES_MAX_ANGLE * SERIES_MAX_ANGLE
+ROW_OBS = 21  # buffer rows: 0-12 state, 13-18 drive terms, 19-20 wind, 21-32 observation
+ROW_REWARD = 33
+ROW_CRASH = 34
+ROW_BIG = 35  # counts the step's substeps where the lane turned SERIES_MAX_ANGLE or more
+ROWS = 36
+
+
+@intrinsic
+def fma(typingctx, a, b, c):
+    """``a * b + c`` rounded once: llvm.fma.f64, which SLP packs into vfmadd...pd."""
+    sig = types.float64(types.float64, types.float64, types.float64)
+
+    def codegen(context, builder, signature, args):
+        d = ir.DoubleType()
+        fn = builder.module.declare_intrinsic("llvm.fma", [d], ir.FunctionType(d, [d, d, d]))
+        return builder.call(fn, args)
+
+    return sig, codegen
+
+
+@nb.njit(cache=True, inline="always", fastmath=False)
+def _hq_select(rx, ry, rz):
+    """kernel._half_angle_quaternion below SERIES_MAX_ANGLE: the three regimes all computed, one chosen
+    by selects; each with the operations the kernel's compiled code performs (FMAs explicit)."""
+    theta2 = fma(rz, rz, fma(ry, ry, rx * rx))
+    h1x = rx * 0.5
+    h1y = ry * 0.5
+    h1z = rz * 0.5
+    w1 = math.sqrt(1.0 - fma(h1z, h1z, fma(h1y, h1y, h1x * h1x)))
+    x2 = theta2 * 0.25
+    sinc2 = fma(x2, fma(x2, 1.0 / 120, -1.0 / 6), 1.0)
+    cos2 = fma(x2, fma(x2, fma(x2, -1.0 / 720, 1.0 / 24), -0.5), 1.0)
+    sinc3 = fma(x2, fma(x2, fma(x2, fma(x2, fma(x2, -1.0 / 39916800, 1.0 / 362880), -1.0 / 5040), 1.0 / 120), -1.0 / 6), 1.0)
+    cos3 = fma(x2, fma(x2, fma(x2, fma(x2, fma(x2, fma(x2, 1.0 / 479001600, -1.0 / 3628800), 1.0 / 40320), -1.0 / 720), 1.0 / 24), -0.5), 1.0)
+    mid = theta2 < 1e-4
+    sinc = sinc2 if mid else sinc3
+    cs = cos2 if mid else cos3
+    k = sinc * 0.5
+    small = theta2 < 1e-8
+    hx = h1x if small else rx * k
+    hy = h1y if small else ry * k
+    hz = h1z if small else rz * k
+    hw = w1 if small else cs
+    return hx, hy, hz, hw, theta2
+
+
+@nb.njit(cache=True, inline="always", fastmath=False)
+def _lane_substep(B, lane, dyn, dt, has_wind):
+    """One substep of one lane: kernel.integrate's loop body, every FMA the kernel's compiled code
+    forms written out (from its optimised LLVM IR and x86's contraction rule), so that a packed
+    and a scalar build give the same bits. Lane state B[m * LANES + lane]: rows 0-12 the state,
+    13-18 the drive terms (nu, bias_v, bias_w, drive_p, drive_q, drive_r), 19-20 the wind."""
+    c_u, c_v, d_v, c_w, d_w, c_p, d_p, c_q, d_q, c_r, d_r, d_u = dyn
+    vu = B[0 * LANES + lane]
+    vv = B[1 * LANES + lane]
+    vw = B[2 * LANES + lane]
+    p = B[6 * LANES + lane]
+    q = B[7 * LANES + lane]
+    r = B[8 * LANES + lane]
+    qx = B[9 * LANES + lane]
+    qy = B[10 * LANES + lane]
+    qz = B[11 * LANES + lane]
+    qw = B[12 * LANES + lane]
+    B[3 * LANES + lane] = fma(dt, vu, B[3 * LANES + lane])
+    B[4 * LANES + lane] = fma(dt, vv, B[4 * LANES + lane])
+    B[5 * LANES + lane] = fma(dt, vw, B[5 * LANES + lane])
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = _rotation(qx, qy, qz, qw)  # no FMA there
+    bu = fma(r20, vw, fma(r10, vv, r00 * vu))
+    bv = fma(r21, vw, fma(r11, vv, r01 * vu))
+    bw = fma(r22, vw, fma(r12, vv, r02 * vu))
+    if has_wind:
+        wu = B[19 * LANES + lane]
+        wv = B[20 * LANES + lane]
+        bu = bu + fma(r00, wu, r10 * wv)
+        bv = bv + fma(r01, wu, r11 * wv)
+    fu = fma(c_u, bu, B[13 * LANES + lane])
+    fv = fma(c_v, bv, B[14 * LANES + lane])
+    fw = fma(c_w, bw, B[15 * LANES + lane])
+    B[0 * LANES + lane] = fma(dt, fma(r02, fw, fma(r00, fu, r01 * fv)), vu)
+    B[1 * LANES + lane] = fma(dt, fma(r12, fw, fma(r10, fu, r11 * fv)), vv)
+    B[2 * LANES + lane] = fma(dt, fma(r22, fw, fma(r20, fu, r21 * fv)) + GRAVITY, vw)
+    hx, hy, hz, hw, theta2 = _hq_select(dt * p, dt * q, dt * r)
+    B[ROW_BIG * LANES + lane] += 0.0 if theta2 < BIG2 else 1.0  # NaN counts: the scalar code then decides
+    B[12 * LANES + lane] = fma(-qz, hz, fma(-qy, hy, fma(qw, hw, -(qx * hx))))
+    B[9 * LANES + lane] = fma(-qz, hy, fma(qy, hz, fma(qx, hw, qw * hx)))
+    B[10 * LANES + lane] = fma(qz, hx, fma(qy, hw, fma(qw, hy, -(qx * hz))))
+    B[11 * LANES + lane] = fma(qz, hw, fma(-qy, hx, fma(qw, hz, qx * hy)))
+    B[6 * LANES + lane] = fma(dt, fma(c_p, p, B[16 * LANES + lane]), p)
+    B[7 * LANES + lane] = fma(dt, fma(c_q, q, B[17 * LANES + lane]), q)
+    B[8 * LANES + lane] = fma(dt, fma(c_r, r, B[18 * LANES + lane]), r)
+
+
+@nb.njit(cache=True, fastmath=False)
+def _substeps(B, W, n_sub, dyn, dt, has_wind):
+    """All substeps of one control step for all lanes of B, in place; the lane loops are the SIMD
+    part. Returns False at the first substep where some lane would turn more than
+    SERIES_MAX_ANGLE (libm's sin/cos): the caller then restores the step's start and flies it
+    with kernel.integrate."""
+    for lane in range(LANES):
+        B[ROW_BIG * LANES + lane] = 0.0
+    for i in range(n_sub):
+        if has_wind:
+            for lane in range(LANES):
+                B[19 * LANES + lane] = W[0, i, lane]
+                B[20 * LANES + lane] = W[1, i, lane]
+            for lane in range(LANES):
+                _lane_substep(B, lane, dyn, dt, True)
+        else:
+            for lane in range(LANES):
+                _lane_substep(B, lane, dyn, dt, False)
+    n_big = 0
+    for lane in range(LANES):
+        n_big += B[ROW_BIG * LANES + lane] != 0.0
+    return n_big == 0
+
+
+@nb.njit(cache=True, fastmath=False)
+def _observe_lanes(B):
+    """kernel.observe, kernel.reward_of and kernel.crashed of every lane, packed, with the FMAs of the kernel's
+    compiled fly_job written out: rows 21-32 the observation, 33 the reward, 34 the crash flag."""
+    for lane in range(LANES):
+        vu = B[0 * LANES + lane]
+        vv = B[1 * LANES + lane]
+        vw = B[2 * LANES + lane]
+        px = B[3 * LANES + lane]
+        py = B[4 * LANES + lane]
+        pz = B[5 * LANES + lane]
+        p = B[6 * LANES + lane]
+        q = B[7 * LANES + lane]
+        r = B[8 * LANES + lane]
+        qx = B[9 * LANES + lane]
+        qy = B[10 * LANES + lane]
+        qz = B[11 * LANES + lane]
+        qw = B[12 * LANES + lane]
+        r00, r01, r02, r10, r11, r12, r20, r21, r22 = _rotation(qx, qy, qz, qw)
+        o0 = fma(vw, r20, fma(vv, r10, vu * r00))
+        o1 = fma(vw, r21, fma(vu, r01, vv * r11))
+        o2 = fma(vw, r22, fma(vu, r02, vv * r12))
+        o3 = fma(pz, r20, fma(py, r10, px * r00))
+        o4 = fma(pz, r21, fma(px, r01, py * r11))
+        o5 = fma(pz, r22, fma(px, r02, py * r12))
+        acc = o0 * o0
+        acc = fma(o1, o1, acc)
+        acc = fma(o2, o2, acc)
+        acc = fma(o3, o3, acc)
+        acc = fma(o4, o4, acc)
+        acc = fma(o5, o5, acc)
+        acc = fma(p, p, acc)
+        acc = fma(q, q, acc)
+        acc = fma(r, r, acc)
+        acc = fma(qx, qx, acc)
+        acc = fma(qy, qy, acc)
+        acc = fma(qz, qz, acc)
+        B[(ROW_OBS + 0) * LANES + lane] = o0
+        B[(ROW_OBS + 1) * LANES + lane] = o1
+        B[(ROW_OBS + 2) * LANES + lane] = o2
+        B[(ROW_OBS + 3) * LANES + lane] = o3
+        B[(ROW_OBS + 4) * LANES + lane] = o4
+        B[(ROW_OBS + 5) * LANES + lane] = o5
+        B[(ROW_OBS + 6) * LANES + lane] = p
+        B[(ROW_OBS + 7) * LANES + lane] = q
+        B[(ROW_OBS + 8) * LANES + lane] = r
+        B[(ROW_OBS + 9) * LANES + lane] = qx
+        B[(ROW_OBS + 10) * LANES + lane] = qy
+        B[(ROW_OBS + 11) * LANES + lane] = qz
+        B[ROW_REWARD * LANES + lane] = -acc
+        crash = (
+            (abs(vu) > MAX_VELOCITY)
+            | (abs(vv) > MAX_VELOCITY)
+            | (abs(vw) > MAX_VELOCITY)
+            | (abs(px) > MAX_POSITION)
+            | (abs(py) > MAX_POSITION)
+            | (abs(pz) > MAX_POSITION)
+            | (abs(p) > MAX_RATE)
+            | (abs(q) > MAX_RATE)
+            | (abs(r) > MAX_RATE)
+            | (abs(qw) < MIN_QW)
+        )
+        B[ROW_CRASH * LANES + lane] = 1.0 if crash else 0.0
+
+
+@nb.njit(cache=True, inline="always")
+def _state(B, lane):
+    """The 13 state values of one lane, as the tuple the kernel's functions take."""
+    return (
+        B[0 * LANES + lane],
+        B[1 * LANES + lane],
+        B[2 * LANES + lane],
+        B[3 * LANES + lane],
+        B[4 * LANES + lane],
+        B[5 * LANES + lane],
+        B[6 * LANES + lane],
+        B[7 * LANES + lane],
+        B[8 * LANES + lane],
+        B[9 * LANES + lane],
+        B[10 * LANES + lane],
+        B[11 * LANES + lane],
+        B[12 * LANES + lane],
+    )
+
+
+@nb.njit(cache=True, fastmath={"contract"})
+def _reset_lane(B, N, A, lane):
+    """A lane at rest at the start of an episode (also what an idle lane flies)."""
+    for m in range(ROWS):
+        B[m * LANES + lane] = 0.0
+    B[12 * LANES + lane] = 1.0
+    for m in range(6):
+        N[m, lane] = 0.0
+    for m in range(4):
+        A[m, lane] = 0.0
+    o = observe(_state(B, lane))
+    for m in range(12):
+        B[(ROW_OBS + m) * LANES + lane] = o[m]
+
+
+@nb.njit(cache=True, fastmath={"contract"})
+def fly_lanes(row, kind, g, seed, episodes, n_steps, out_return, out_crashed, out_steps, stats):
+    """Fly episode indices ``episodes`` of policy (kind, g) on MDP ``row``, LANES at a time;
+    write each episode's return, crash flag and steps (as kernel.fly_job: no recording, no safeguard).
+
+    A lane whose episode ends takes the next one (a queue), so lanes run at different steps.
+    stats[0] counts control steps, stats[1] those flown by the scalar fallback.
+    """
+    dyn, std, n_sub, dt, wind = unpack_mdp(row)
+    c_u, c_v, d_v, c_w, d_w, c_p, d_p, c_q, d_q, c_r, d_r, d_u = dyn
+    wkind, ax, ox, phx, cx, ay, oy, phy, cy = wind
+    has_wind = wkind != 0
+    n_jobs = episodes.shape[0]
+    B = np.zeros(ROWS * LANES)
+    B0 = np.zeros(13 * LANES)
+    N = np.zeros((6, LANES))
+    A = np.zeros((4, LANES))
+    W = np.zeros((2, n_sub, LANES))
+    rngs = np.empty((LANES, 4), dtype=np.uint64)
+    job = np.full(LANES, -1, dtype=np.int64)
+    step = np.zeros(LANES, dtype=np.int64)
+    total = np.zeros(LANES)
+    nxt = 0
+    live = 0
+    for lane in range(LANES):
+        _reset_lane(B, N, A, lane)
+        if nxt < n_jobs:
+            job[lane] = nxt
+            seed_stream(rngs[lane], np.uint64(seed), np.uint64(episodes[nxt]))
+            nxt += 1
+            live += 1
+    while live > 0:
+        # Control-step part, scalar per lane: policy, clipping, gust noise, drive terms, wind.
+        for lane in range(LANES):
+            if job[lane] < 0:
+                continue
+            k = step[lane]
+            o0 = B[(ROW_OBS + 0) * LANES + lane]
+            o1 = B[(ROW_OBS + 1) * LANES + lane]
+            o2 = B[(ROW_OBS + 2) * LANES + lane]
+            o3 = B[(ROW_OBS + 3) * LANES + lane]
+            o4 = B[(ROW_OBS + 4) * LANES + lane]
+            o5 = B[(ROW_OBS + 5) * LANES + lane]
+            o9 = B[(ROW_OBS + 9) * LANES + lane]
+            o10 = B[(ROW_OBS + 10) * LANES + lane]
+            o11 = B[(ROW_OBS + 11) * LANES + lane]
+            a1, a2, a3, a4 = policy_action(kind, g, o0, o1, o2, o3, o4, o5, o9, o10, o11)
+            if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
+                j = job[lane]
+                out_return[j] = total[lane] + -CRASH_STEP_PENALTY * (n_steps - (k + 1))
+                out_crashed[j] = True
+                out_steps[j] = k + 1
+                job[lane] = -2  # over; the lane idles through this step and is refilled after it
+                _reset_lane(B, N, A, lane)
+                continue
+            a1 = _clip(a1)
+            a2 = _clip(a2)
+            a3 = _clip(a3)
+            a4 = _clip(a4)
+            rng = rngs[lane]
+            n = (N[0, lane], N[1, lane], N[2, lane], N[3, lane], N[4, lane], N[5, lane])
+            n = update_noise(n, std, next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng))
+            for m in range(6):
+                N[m, lane] = n[m]
+            A[0, lane] = a1
+            A[1, lane] = a2
+            A[2, lane] = a3
+            A[3, lane] = a4
+            B[13 * LANES + lane] = d_u + n[0]
+            B[14 * LANES + lane] = d_v + n[1]
+            B[15 * LANES + lane] = d_w * a4 + n[2]
+            B[16 * LANES + lane] = d_p * a1 + n[3]
+            B[17 * LANES + lane] = d_q * a2 + n[4]
+            B[18 * LANES + lane] = d_r * a3 + n[5]
+            if has_wind:
+                for i in range(n_sub):
+                    wu = cx
+                    wv = cy
+                    if wkind == WIND_SINUSOID:
+                        t = competition_time(k, i)
+                        if ax != 0.0:
+                            wu += ax * math.sin(ox * t + phx)
+                        if ay != 0.0:
+                            wv += ay * math.sin(oy * t + phy)
+                    W[0, i, lane] = wu
+                    W[1, i, lane] = wv
+        stats[0] += 1
+        B0[:] = B[: 13 * LANES]
+        if not _substeps(B, W, n_sub, dyn, dt, has_wind):
+            stats[1] += 1
+            B[: 13 * LANES] = B0
+            for lane in range(LANES):
+                s = integrate(
+                    _state(B, lane),
+                    (N[0, lane], N[1, lane], N[2, lane], N[3, lane], N[4, lane], N[5, lane]),
+                    A[0, lane],
+                    A[1, lane],
+                    A[2, lane],
+                    A[3, lane],
+                    step[lane],
+                    dyn,
+                    n_sub,
+                    dt,
+                    wind,
+                )
+                for m in range(13):
+                    B[m * LANES + lane] = s[m]
+        _observe_lanes(B)
+        # Bookkeeping, scalar per lane: return, end of episode, refill.
+        for lane in range(LANES):
+            j = job[lane]
+            if j == -1:
+                continue
+            if j >= 0:
+                t = step[lane] + 1
+                step[lane] = t
+                if B[ROW_CRASH * LANES + lane] != 0.0:
+                    out_return[j] = total[lane] + -CRASH_STEP_PENALTY * (n_steps - t)
+                    out_crashed[j] = True
+                elif t == n_steps:
+                    out_return[j] = total[lane] + B[ROW_REWARD * LANES + lane]
+                    out_crashed[j] = False
+                else:
+                    total[lane] += B[ROW_REWARD * LANES + lane]
+                    continue
+                out_steps[j] = t
+            _reset_lane(B, N, A, lane)
+            total[lane] = 0.0
+            step[lane] = 0
+            if nxt < n_jobs:
+                job[lane] = nxt
+                seed_stream(rngs[lane], np.uint64(seed), np.uint64(episodes[nxt]))
+                nxt += 1
+            else:
+                job[lane] = -1
+                live -= 1
+
+
+@nb.njit(cache=True, parallel=True, fastmath={"contract"})
+def rollout_lanes(row, kind, g, seed, job_episode, n_steps, n_threads, out_return, out_crashed, out_steps, out_safeguard_step):
+    """Fly episodes ``job_episode`` of one policy on one MDP, LANES per thread, in parallel.
+
+    The outputs are those of :func:`neurohover.sim.kernel.rollout_batch` for jobs that all have
+    this policy and MDP, no recording and no safeguard, bit for bit.
+
+    Parameters
+    ----------
+    row : numpy.ndarray
+        ``(29,)`` MDP row.
+    kind : int
+        Policy kind (``kernel.POLICY_SLP`` or ``kernel.POLICY_MLP``).
+    g : numpy.ndarray
+        ``(42,)`` genome, padded as in :class:`neurohover.evaluate.PolicyTable`.
+    seed : numpy.uint64
+        Root seed of the noise streams.
+    job_episode : numpy.ndarray of int64
+        Per job, the episode index that with ``seed`` fixes its noise.
+    n_steps : int
+        Control steps per episode.
+    n_threads : int
+        Threads to split the jobs over (``numba.get_num_threads()``; a parameter because reading
+        it in compiled code would keep this function out of the on-disk cache).
+    out_return, out_crashed, out_steps, out_safeguard_step : numpy.ndarray
+        Per job: return, crash flag, steps flown, and -1 (no safeguard), written here.
+    """
+    n_jobs = job_episode.shape[0]
+    # One contiguous chunk per thread, each with its own lane queue; no chunk smaller than LANES
+    # jobs unless the batch is, so lanes stay full.
+    n_chunks = max(1, min(n_threads, n_jobs // LANES))
+    for c in nb.prange(n_chunks):
+        a = c * n_jobs // n_chunks
+        b = (c + 1) * n_jobs // n_chunks
+        stats = np.zeros(2, dtype=np.int64)
+        fly_lanes(row, kind, g, seed, job_episode[a:b], n_steps, out_return[a:b], out_crashed[a:b], out_steps[a:b], stats)
+        for j in range(a, b):
+            out_safeguard_step[j] = -1
