@@ -185,6 +185,7 @@ def _load_kernel() -> None:
             empty,
             empty,
         )
+        _load_lanes()  # with the scalar kernel, so that a warm-up call of either path loads both (about 0.03 s from the cache)
         _kernel_loaded = True
 
 
