@@ -39,7 +39,9 @@ How it works
 - Still scalar per lane: the policy (``exp`` has no bit-identical packed form), the xoshiro256** /
   ziggurat gust noise, the wind's sin, and the bookkeeping.
 
-Integration would take: this in kernel.py as a second path of rollout_batch (jobs grouped by MDP and policy,
+Integrated since as neurohover/sim/lanes.py (rollout_lanes; evaluate_jobs takes it for batches of one policy on
+one MDP row without recording or safeguard; tests/test_lanes.py). What integration was planned to take: this in
+kernel.py as a second path of rollout_batch (jobs grouped by MDP and policy,
 LANES jobs per prange iteration), recording and the safeguard per lane, a test that pins the two paths
 bit-identical (as here) on every MDP kind, and a guard for the fragile part: the FMA pattern of the
 scalar kernel is LLVM's choice, so a numba/LLVM upgrade or an edit of integrate/observe can change it.
