@@ -16,21 +16,22 @@ A single-file, CleanRL-style script: read it top to bottom. It
 Install and run (``docs/deep-rl.md`` has the comparison with neuroevolution)::
 
     pip install -e '.[examples]'          # stable-baselines3 (and torch)
-    python examples/ppo_ghh08.py --mdp zero --total-steps 300000 --seed 0 --out runs/ppo-zero
-    python examples/ppo_ghh08.py --mdp train:3 --total-steps 300000 --seed 0 --out runs/ppo-train3
-    python examples/ppo_ghh08.py --mdp sample --total-steps 300000 --out runs/ppo-G   # a fresh MDP from G per episode
+    python examples/ppo_ghh08.py --mdp zero --total-steps 500000 --seed 0 --out runs/ppo-zero
+    python examples/ppo_ghh08.py --mdp train:3 --total-steps 500000 --seed 0 --out runs/ppo-train3
+    python examples/ppo_ghh08.py --mdp sample --total-steps 500000 --out runs/ppo-G   # a fresh MDP from G per episode
 
 Why the reward transform. A step earns minus the sum of squares of the observation (about -0.2
 in calm air, -5 to -20 in wind); a crash earns once the worst possible step (``P =
 CRASH_STEP_PENALTY``, 1748.8) times the steps left, up to about -1.75e6 in a 1000-step training
-episode. Value targets mixing -1 and -1e6 wreck the critic, and since PPO clips the gradient
-norm of the joint loss, the policy too. Squashing every reward with ``-log(1 + |r|)`` (the
+episode. Value targets mixing -1 and -1e6 would make the critic's loss all about crashes, and
+since PPO clips the gradient norm of the joint loss, the policy's step too (not tried here). Squashing every reward with ``-log(1 + |r|)`` (the
 README's example) bounds them, but then a crash (about -14) is *cheaper* than flying on at -1 per
 step for the discount horizon, and the agent learns to crash. So :class:`SquashedReward` squashes
 the ordinary steps, ``-log(1 + |r|)``, and keeps the meaning of the crash penalty, "the worst step
 for every step left", in the squashed and discounted currency: ``-log(1 + P) * (1 + g + ... +
 g**(k-1))`` for the k steps left (the crashing one included). A crash is then always worse than
-any way of flying on.
+any way of flying on. ``--reward log`` trains on the README's plain squashing instead, for
+comparison: with it PPO learned to crash at the first step of every episode (docs/deep-rl.md).
 """
 
 from __future__ import annotations
@@ -60,12 +61,13 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0], formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     p.add_argument("--algo", choices=("ppo", "sac"), default="ppo", help="Stable-Baselines3 algorithm")
     p.add_argument("--mdp", default="zero", help="training MDP: zero, train:N, test:N, or sample (a fresh MDP from G per episode)")
-    p.add_argument("--total-steps", type=int, default=300_000, help="environment steps of training")
+    p.add_argument("--total-steps", type=int, default=500_000, help="environment steps of training")
     p.add_argument("--episode-steps", type=int, default=1000, help="steps per training episode (evaluation always flies 6000)")
     p.add_argument("--seed", type=int, default=0, help="seed of the training run (networks, environments)")
     p.add_argument("--n-envs", type=int, default=8, help="parallel training environments (PPO)")
     p.add_argument("--n-steps", type=int, default=512, help="PPO: steps per environment per rollout")
     p.add_argument("--gamma", type=float, default=0.99, help="discount factor (also used by the reward transform)")
+    p.add_argument("--reward", choices=("crash-aware", "log"), default="crash-aware", help="reward transform for learning (see the module docstring)")
     p.add_argument("--reward-scale", type=float, default=0.1, help="factor on the transformed rewards")
     p.add_argument("--learning-rate", type=float, default=3e-4)
     p.add_argument("--eval-episodes", type=int, default=20, help="full 6000-step episodes per evaluation MDP")
@@ -116,6 +118,8 @@ def make_train_env(args: argparse.Namespace):
     def thunk() -> gym.Env:
         env = gym.make(ENV_ID, mdp=args.mdp, obs_dtype="float32", episode_steps=args.episode_steps, max_episode_steps=args.episode_steps)
         env = gym.wrappers.RecordEpisodeStatistics(env)  # info["episode"]: raw return "r", length "l"
+        if args.reward == "log":  # the README's example: sign(r) log(1 + |r|), a crash about -14
+            return gym.wrappers.TransformReward(env, lambda r: args.reward_scale * float(np.sign(r) * np.log1p(abs(r))))
         return SquashedReward(env, args.episode_steps, args.gamma, args.reward_scale)
 
     return thunk
@@ -127,11 +131,11 @@ def make_train_env(args: argparse.Namespace):
 
 
 class TrainingCurve(BaseCallback):
-    """Collects every finished training episode (raw return, length, crash) and prints progress per rollout."""
+    """Collects every finished training episode (raw return, length, crash) and prints progress every ``every`` steps."""
 
-    def __init__(self, quiet: bool) -> None:
+    def __init__(self, quiet: bool, every: int = 10_000) -> None:
         super().__init__()
-        self.quiet = quiet
+        self.quiet, self.every, self.next_print = quiet, every, every
         self.episodes: list[dict] = []  # {"step", "return", "length", "crashed"}
         self.start = time.perf_counter()
 
@@ -142,9 +146,10 @@ class TrainingCurve(BaseCallback):
                 self.episodes.append({"step": self.num_timesteps, "return": float(ep["r"]), "length": int(ep["l"]), "crashed": bool(info["crashed"])})
         return True
 
-    def _on_rollout_end(self) -> None:
-        if self.quiet or not self.episodes:
+    def _on_rollout_end(self) -> None:  # PPO: after each rollout; SAC: after every step
+        if self.quiet or not self.episodes or self.num_timesteps < self.next_print:
             return
+        self.next_print += self.every * ((self.num_timesteps - self.next_print) // self.every + 1)
         last = self.episodes[-20:]
         sps = self.num_timesteps / (time.perf_counter() - self.start)
         print(
