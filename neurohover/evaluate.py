@@ -223,6 +223,30 @@ def _use_lanes(device: str, p_idx: np.ndarray, m_idx: np.ndarray, fb: np.ndarray
     return device == "cpu" and n_jobs >= LANES and bool((p_idx == p_idx[0]).all()) and bool((m_idx == m_idx[0]).all()) and not (fb >= 0).any() and not rec.any()
 
 
+DEVICES = ("cpu", "cuda")
+
+
+def check_device(device: str) -> None:
+    """Refuse an unknown device, or ``"cuda"`` where no GPU (nor numba's CUDA simulator) is usable.
+
+    Raises
+    ------
+    NeurohoverError
+        With one message that names the problem; ``"cpu"`` never imports numba.cuda.
+    """
+    if device not in DEVICES:
+        raise NeurohoverError(f"device={device!r} is unknown: allowed 'cpu' or 'cuda'")
+    if device == "cuda":
+        from .sim import cuda as sim_cuda  # numba.cuda is imported only when asked for
+
+        problem = sim_cuda.cuda_problem()
+        if problem is not None:
+            raise NeurohoverError(
+                f"device='cuda' cannot run here: {problem}. It needs an NVIDIA GPU with its driver and "
+                "pip install 'neurohover[cuda]' (numba-cuda); NUMBA_ENABLE_CUDASIM=1 runs numba's CUDA simulator instead"
+            )
+
+
 def evaluate_jobs(
     policies: Sequence[Policy] | PolicyTable,
     mdps: MDP | Sequence[MDP] | np.ndarray,
@@ -265,17 +289,7 @@ def evaluate_jobs(
         (one thread per job, the same gust streams; returns agree with the CPU's to about 1e-12
         relative, see docs/gpu.md). ``seconds`` then includes the copies to and from the GPU.
     """
-    if device not in ("cpu", "cuda"):
-        raise NeurohoverError(f"device={device!r} is unknown: allowed 'cpu' or 'cuda'")
-    if device == "cuda":
-        from .sim import cuda as sim_cuda  # numba.cuda is imported only when asked for
-
-        problem = sim_cuda.cuda_problem()
-        if problem is not None:
-            raise NeurohoverError(
-                f"device='cuda' cannot run here: {problem}. It needs an NVIDIA GPU with its driver and "
-                "pip install 'neurohover[cuda]' (numba-cuda); NUMBA_ENABLE_CUDASIM=1 runs numba's CUDA simulator instead"
-            )
+    check_device(device)
     table = policies if isinstance(policies, PolicyTable) else PolicyTable.from_policies(policies)
     rows = mdp_rows(mdps)
     if not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= _MAX_SEED:
@@ -330,6 +344,8 @@ def evaluate_jobs(
         return Evaluation(returns, crashed, steps, sg_step, None, time.perf_counter() - start)
     rollout: Callable[..., None]  # the CPU kernel (a numba dispatcher) or the CUDA launcher, same arguments
     if device == "cuda":
+        from .sim import cuda as sim_cuda  # numba.cuda is imported only when asked for
+
         sim_cuda.load_kernel()
         rollout = sim_cuda.rollout_batch_cuda
     else:
@@ -439,6 +455,9 @@ class KernelFlyer:
         Root seed of the episodes' noise streams (0..2**63-1).
     n_steps : int
         Control steps per episode.
+    device : {"cpu", "cuda"}
+        Where the jobs fly: the CPU kernel (default), or its CUDA build on a GPU (the same gust
+        streams; returns agree to within docs/gpu.md's tolerance). Checked here, once.
 
     Attributes
     ----------
@@ -456,7 +475,8 @@ class KernelFlyer:
         (copies, except the rows), e.g. to replay the same jobs in one batch in a benchmark.
     """
 
-    def __init__(self, topology: str, seed: int, n_steps: int) -> None:
+    def __init__(self, topology: str, seed: int, n_steps: int, device: str = "cpu") -> None:
+        check_device(device)
         if topology not in TOPOLOGIES:
             raise NeurohoverError(f"unknown policy topology {topology!r}: allowed {', '.join(TOPOLOGIES)}")
         if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= _MAX_SEED:
@@ -467,6 +487,7 @@ class KernelFlyer:
         self.dim = GENOME_LENGTH[topology]
         self.seed = np.uint64(seed)
         self.n_steps = int(n_steps)
+        self.device = device
         self.episodes = 0
         self.steps = 0
         self.kernel_seconds = 0.0
@@ -542,14 +563,24 @@ class KernelFlyer:
         p = zeros if policy_index is None else (arange if isinstance(policy_index, str) else policy_index)
         m = zeros if mdp_index is None else (arange if isinstance(mdp_index, str) else mdp_index)
         np.add(arange, self.episodes, out=e)
-        # Never more threads than jobs: every thread of a parallel call must check in, and on a busy
-        # machine a one-episode call on all cores runs up to 10x slower than on one.
-        want = n_jobs if n_jobs < self.max_threads else self.max_threads
-        if want != self._threads:
-            numba.set_num_threads(want)
-            self._threads = want
+        rollout: Callable[..., None] = rollout_batch
+        if self.device == "cuda":
+            # The CUDA launcher copies the inputs to the GPU and the results back on every call
+            # (acceptable for now: a generation's jobs are few); buffers kept on the GPU between
+            # calls would save those copies. The thread count does not apply.
+            from .sim import cuda as sim_cuda
+
+            sim_cuda.load_kernel()
+            rollout = sim_cuda.rollout_batch_cuda
+        else:
+            # Never more threads than jobs: every thread of a parallel call must check in, and on a busy
+            # machine a one-episode call on all cores runs up to 10x slower than on one.
+            want = n_jobs if n_jobs < self.max_threads else self.max_threads
+            if want != self._threads:
+                numba.set_num_threads(want)
+                self._threads = want
         t0 = time.perf_counter()
-        rollout_batch(
+        rollout(
             rows,
             self._kinds,
             self._genomes,

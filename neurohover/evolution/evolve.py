@@ -121,6 +121,7 @@ def evolve(
     seed: int = 0,
     n_steps: int = EPISODE_STEPS,
     threads: int | None = None,
+    device: str = "cpu",
     progress: Callable[[ProgressInfo], None] | None = None,
     checkpoint: str | Path | None = None,
     checkpoint_every_s: float = 60.0,
@@ -153,7 +154,11 @@ def evolve(
     n_steps : int
         Control steps per episode (6000 in the paper).
     threads : int, optional
-        Kernel threads (default: all cores); results do not depend on it.
+        Kernel threads (default: all cores); results do not depend on it. Unused on ``"cuda"``.
+    device : {"cpu", "cuda"}
+        Where the candidates fly: the CPU kernel (default) or its CUDA build on a GPU
+        (:class:`~neurohover.evaluate.KernelFlyer`); results agree to within docs/gpu.md's
+        tolerance. Not part of the run's config: a checkpoint resumes on either device.
     progress : callable, optional
         Called with a :class:`ProgressInfo` after a generation at most every ``progress_every_s``
         seconds (default 0.2; 0: every generation) and at the end; may raise ``KeyboardInterrupt``
@@ -187,7 +192,8 @@ def evolve(
             seed=seed,
             n_steps=n_steps,
             method=method,
-        )
+        ),
+        device=device,
     )
     if not isinstance(checkpoint_every_s, (int, float)) or not checkpoint_every_s > 0:
         raise NeurohoverError(f"checkpoint_every_s={checkpoint_every_s!r} must be a number > 0")
@@ -204,18 +210,20 @@ def evolve(
     else:
         assert run.family is not None  # a run has one MDP (its rows) or a family
         warm_up = run.family.zero()
-    evaluate_jobs([run.cfg.prototype], warm_up, [0], [0], [0], n_steps=1, threads=threads)
+    evaluate_jobs([run.cfg.prototype], warm_up, [0], [0], [0], n_steps=1, threads=threads, device=device)
     with num_threads(threads if threads is not None else numba.get_num_threads()):  # restores the count after
         run.flyer.start()
         run.run(progress, path, float(checkpoint_every_s), float(progress_every_s))
     return run.result()
 
 
-def validation_return(policy: Policy, target, *, episodes: int = 10, seed: int = 0, n_steps: int = EPISODE_STEPS, threads: int | None = None) -> np.ndarray:
+def validation_return(
+    policy: Policy, target, *, episodes: int = 10, seed: int = 0, n_steps: int = EPISODE_STEPS, threads: int | None = None, device: str = "cpu"
+) -> np.ndarray:
     """Returns of ``episodes`` fresh episodes of ``policy``: on the MDP, or each on a fresh MDP from G.
 
     The noise and MDPs come from ``SeedSequence(seed)`` child ``(3,)``, which :func:`evolve` never
-    uses, so these episodes are independent of the ones the run flew.
+    uses, so these episodes are independent of the ones the run flew. ``device`` as in :func:`evolve`.
     """
     mdp, family, _ = resolve_target(target)
     if isinstance(episodes, bool) or not isinstance(episodes, (int, np.integer)) or episodes < 1:
@@ -228,5 +236,7 @@ def validation_return(policy: Policy, target, *, episodes: int = 10, seed: int =
         assert family is not None  # resolve_target gives an MDP or a family
         rows = family.sample_rows(np.random.default_rng(mdp_seed), episodes)
         m_idx = np.arange(episodes)
-    ev = evaluate_jobs([policy], rows, np.zeros(episodes, dtype=np.int64), m_idx, np.arange(episodes), seed=noise_seed, n_steps=n_steps, threads=threads)
+    ev = evaluate_jobs(
+        [policy], rows, np.zeros(episodes, dtype=np.int64), m_idx, np.arange(episodes), seed=noise_seed, n_steps=n_steps, threads=threads, device=device
+    )
     return ev.returns

@@ -84,12 +84,13 @@ class Run:
         The checked run definition; seeds follow :mod:`neurohover.evolution.seeding`.
     """
 
-    def __init__(self, config: RunConfig) -> None:
+    def __init__(self, config: RunConfig, device: str = "cpu") -> None:
         self.cfg = config
         self.mdp, self.family, self.method = config.mdp, config.family, config.method
         self.resampling, self.budget = config.resampling, config.budget
         self.config = config.to_dict()
-        self.flyer = KernelFlyer(config.topology, noise_seed(config.seed), config.n_steps)
+        # The device is not part of the config (nor of a checkpoint): results agree across devices.
+        self.flyer = KernelFlyer(config.topology, noise_seed(config.seed), config.n_steps, device=device)
         self.mdp_rng = None if self.family is None else mdp_rng(config.seed)
         self.rows = None if self.mdp is None else self.mdp.row()[None, :]
         genome, settings, seed = config.prototype.genome, config.settings, optimiser_seed(config.seed)
