@@ -24,6 +24,7 @@ from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
 from ..errors import NeurohoverError
+from ..evaluate import DEVICES, check_device
 from ..procs import sigterm_as_interrupt, stop_pool, worker_pool
 from .store import worker_name
 from .units import Unit, run_unit
@@ -34,22 +35,25 @@ OnError = Callable[[Unit, BaseException], None]
 RAY_INSTALL_HINT = "--executor ray needs Ray, an optional extra: pip install 'neurohover[ray]' (or pip install 'ray>=2.9'); --executor local runs without it"
 
 
-def timed_run(unit: dict, threads: int | None = 1) -> tuple[dict, float, str]:
-    """Run a unit (given as a dict); return (result, seconds, worker)."""
+def timed_run(unit: dict, threads: int | None = 1, device: str = "cpu") -> tuple[dict, float, str]:
+    """Run a unit (given as a dict) on ``device``; return (result, seconds, worker)."""
     t0 = time.perf_counter()
-    result = run_unit(unit, threads)
+    result = run_unit(unit, threads, device)
     return result, time.perf_counter() - t0, worker_name()
 
 
 class LocalExecutor:
-    """Run units here (``jobs=1``) or in ``jobs`` spawned processes."""
+    """Run units here (``jobs=1``) or in ``jobs`` spawned processes, flying on ``device``
+    (``"cpu"`` or ``"cuda"``; with ``jobs > 1`` every worker process uses the same GPU)."""
 
     name = "local"
 
-    def __init__(self, jobs: int = 1) -> None:
+    def __init__(self, jobs: int = 1, device: str = "cpu") -> None:
         if not isinstance(jobs, int) or isinstance(jobs, bool) or jobs < 1:
             raise NeurohoverError(f"--jobs {jobs!r} is out of range: allowed an integer >= 1")
+        check_device(device)
         self.jobs = jobs
+        self.device = device
         self._pool: ProcessPoolExecutor | None = None
 
     @property
@@ -64,7 +68,7 @@ class LocalExecutor:
         if self.jobs == 1:
             for unit in units:
                 try:
-                    result, seconds, worker = timed_run(unit.to_dict(), None)
+                    result, seconds, worker = timed_run(unit.to_dict(), None, self.device)
                 except KeyboardInterrupt:
                     raise
                 except Exception as err:  # noqa: BLE001 - reported, the unit stays unfinished
@@ -79,7 +83,7 @@ class LocalExecutor:
         pool = self._pool
         try:
             with sigterm_as_interrupt():  # SIGTERM ends the workers like Ctrl-C, not leaving them orphaned
-                pending = {pool.submit(timed_run, unit.to_dict(), 1): unit for unit in units}
+                pending = {pool.submit(timed_run, unit.to_dict(), 1, self.device): unit for unit in units}
                 while pending:
                     done, _ = wait(pending, return_when=FIRST_COMPLETED)
                     for future in done:
@@ -184,11 +188,15 @@ class RayExecutor:
 
     Without ``address``, Ray's own ``RAY_ADDRESS`` environment variable, if set, names the cluster.
     A malformed address, or one where nothing listens, is refused at once with a NeurohoverError.
+    ``device`` is where the tasks fly (``"cuda"``: each node needs a GPU; it is checked there).
     """
 
     name = "ray"
 
-    def __init__(self, address: str | None = None, *, max_retries: int = 3, num_cpus: int | None = None) -> None:
+    def __init__(self, address: str | None = None, *, max_retries: int = 3, num_cpus: int | None = None, device: str = "cpu") -> None:
+        if device not in DEVICES:
+            raise NeurohoverError(f"device={device!r} is unknown: allowed 'cpu' or 'cuda'")
+        self.device = device
         ray = import_ray()
         self.ray = ray
         self.started = False
@@ -215,7 +223,7 @@ class RayExecutor:
 
     def run(self, units: Sequence[Unit], on_result: OnResult, on_error: OnError) -> None:
         ray = self.ray
-        pending = {self._remote.remote(unit.to_dict(), 1): unit for unit in units}
+        pending = {self._remote.remote(unit.to_dict(), 1, self.device): unit for unit in units}
         try:
             while pending:
                 ready, _ = ray.wait(list(pending), num_returns=1, timeout=5.0)
@@ -241,11 +249,11 @@ class RayExecutor:
             self.started = False
 
 
-def make_executor(kind: str, *, jobs: int = 1, address: str | None = None):
+def make_executor(kind: str, *, jobs: int = 1, address: str | None = None, device: str = "cpu"):
     if kind == "local":
         if address is not None:
             raise NeurohoverError("--address applies to --executor ray only")
-        return LocalExecutor(jobs)
+        return LocalExecutor(jobs, device)
     if kind == "ray":
-        return RayExecutor(address)
+        return RayExecutor(address, device=device)
     raise NeurohoverError(f"unknown executor {kind!r}: allowed local, ray")

@@ -111,7 +111,7 @@ def _evolve_target(p: dict):
     return _family(t["task"], t.get("sigma"))
 
 
-def run_evolve(p: dict, threads: int | None) -> dict:
+def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:
     """One evolution run (paper Section 3.1 / 5): champion, history, optional validation."""
     from ..evolution.evolve import evolve, validation_return
     from ..policies import prototype as make_prototype
@@ -129,11 +129,12 @@ def run_evolve(p: dict, threads: int | None) -> dict:
         seed=p["seed"],
         n_steps=p["n_steps"],
         threads=threads,
+        device=device,
     )
     history = [(int(h.episodes), num(h.champion_return)) for h in result.history]
     validation = None
     if p.get("validation_episodes"):
-        v = validation_return(result.champion, target, episodes=p["validation_episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads)
+        v = validation_return(result.champion, target, episodes=p["validation_episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads, device=device)
         validation = tuple(num(x) for x in v)
     return EvolveResult(
         champion=StoredPolicy.of(result.champion),
@@ -149,24 +150,24 @@ def run_evolve(p: dict, threads: int | None) -> dict:
     ).to_dict()
 
 
-def run_robustness(p: dict, threads: int | None) -> dict:
+def run_robustness(p: dict, threads: int | None, device: str = "cpu") -> dict:
     """Table 3: fly one policy ``episodes`` times on each of the given MDPs."""
     from ..evaluate import evaluate
 
     mdps = [_mdp(m) for m in p["mdps"]]
-    ev = evaluate(_policy(p["policy"]), mdps, episodes=p["episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads)
+    ev = evaluate(_policy(p["policy"]), mdps, episodes=p["episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads, device=device)
     return RobustnessResult(
         returns=tuple(tuple(num(x) for x in row) for row in ev.returns[0]), crashes=tuple(int(c) for c in ev.crashed[0].sum(axis=1)), own=p["own"]
     ).to_dict()
 
 
-def run_safety(p: dict, threads: int | None) -> dict:
+def run_safety(p: dict, threads: int | None, device: str = "cpu") -> dict:
     """Crash matrix of the specialised policies on the training MDPs, and the two safe ones."""
     from ..evaluate import evaluate
     from ..policysets import choose_safe
 
     policies = [_policy(d) for d in p["policies"]]
-    ev = evaluate(policies, [_mdp(m) for m in p["mdps"]], episodes=p["episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads)
+    ev = evaluate(policies, [_mdp(m) for m in p["mdps"]], episodes=p["episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads, device=device)
     crashes, returns = ev.crashed.sum(axis=2), ev.returns.mean(axis=2)
     return SafetyResult(
         crashes=tuple(tuple(int(c) for c in row) for row in crashes),
@@ -175,7 +176,7 @@ def run_safety(p: dict, threads: int | None) -> dict:
     ).to_dict()
 
 
-def run_model(p: dict, threads: int | None) -> dict:
+def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
     """Table 4: fly the generic policy once (flight data), learn a model, evolve a policy on the
     model, fly that policy ``test_episodes`` times in the true MDP. Methods: ``lr`` (OLS, the
     paper's), ``lr-gls`` (the GLS option), ``ec-meno`` (``ec_meno_budget`` evaluations, 0: the
@@ -187,7 +188,7 @@ def run_model(p: dict, threads: int | None) -> dict:
     mdp = _mdp(p["mdp"])
     generic = _policy(p["generic"])
     seeds = np.random.SeedSequence(p["seed"]).generate_state(4, np.uint64) >> np.uint64(1)
-    data = evaluate(generic, mdp, seed=int(seeds[0]), record=True, n_steps=p["n_steps"], threads=threads)
+    data = evaluate(generic, mdp, seed=int(seeds[0]), record=True, n_steps=p["n_steps"], threads=threads, device=device)
     flight = data.flight_data
     assert flight is not None  # recorded
     t0 = time.perf_counter()
@@ -201,10 +202,17 @@ def run_model(p: dict, threads: int | None) -> dict:
     proto = generic if p["prototype"] == "generic" else "baseline"
     t1 = time.perf_counter()
     evolved = evolve(
-        model.mdp(), topology=generic.topology, prototype=proto, budget=p["policy_budget"] or None, seed=int(seeds[2]), n_steps=p["n_steps"], threads=threads
+        model.mdp(),
+        topology=generic.topology,
+        prototype=proto,
+        budget=p["policy_budget"] or None,
+        seed=int(seeds[2]),
+        n_steps=p["n_steps"],
+        threads=threads,
+        device=device,
     )
     evolve_seconds = time.perf_counter() - t1
-    test = evaluate(evolved.champion, mdp, episodes=p["test_episodes"], seed=int(seeds[3]), n_steps=p["n_steps"], threads=threads)
+    test = evaluate(evolved.champion, mdp, episodes=p["test_episodes"], seed=int(seeds[3]), n_steps=p["n_steps"], threads=threads, device=device)
     returns = test.returns.ravel()
     return ModelResult(
         method=p["method"],
@@ -244,7 +252,7 @@ def make_agent(p: dict):
     return spec.build(policies, options)
 
 
-def run_test_run(p: dict, threads: int | None) -> dict:
+def run_test_run(p: dict, threads: int | None, device: str = "cpu") -> dict:
     """One test run (docs/model.md, On-line agents): ``episodes`` episodes of an agent on one MDP it does not know."""
     from ..agents.protocol import run_test
     from ..compete import after_learning_start
@@ -252,6 +260,8 @@ def run_test_run(p: dict, threads: int | None) -> dict:
     family = _family(p["task"], p.get("sigma"))
     mdp = _mdp(p["mdp"])
     agent = make_agent(p)
+    # The agents fly their episodes one by one through neurohover.agents (no device option there):
+    # a test run stays on the CPU whatever ``device`` says.
     r = run_test(agent, family, mdp, episodes=p["episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads)
     start = after_learning_start(r.policy)
     changes = tuple((e, r.policy[e]) for e in range(len(r.policy)) if e == 0 or r.policy[e] != r.policy[e - 1])
@@ -270,7 +280,7 @@ def run_test_run(p: dict, threads: int | None) -> dict:
     ).to_dict()
 
 
-def run_diagnostic(p: dict, threads: int | None) -> dict:
+def run_diagnostic(p: dict, threads: int | None, device: str = "cpu") -> dict:
     """Diagnostics for the executors (used by the tests): sleep, or kill the worker process.
 
     ``exit_unless`` names a marker file: if it does not exist, the unit creates it and the worker
@@ -297,12 +307,15 @@ _RUNNERS = {
 }
 
 
-def run_unit(unit: Unit | dict, threads: int | None = 1) -> dict:
+def run_unit(unit: Unit | dict, threads: int | None = 1, device: str = "cpu") -> dict:
     """Run one unit and return its JSON-able result (a pure function of the unit's params): the
     ``to_dict()`` of its typed result (:data:`~neurohover.experiments.results.RESULT_TYPES`).
 
     ``threads`` are kernel threads (1 when many units run in parallel; None: all cores); results
-    do not depend on it.
+    do not depend on it. ``device`` (``"cpu"`` or ``"cuda"``) is where evolve, robustness, safety
+    and model units fly their episodes (test-run units stay on the CPU); like ``threads`` it is no
+    part of the unit's params or the config hash: results agree across devices to within
+    docs/gpu.md's tolerance.
     """
     if isinstance(unit, dict):
         unit = Unit(unit["experiment"], unit["key"], unit["kind"], unit["params"])
@@ -312,7 +325,7 @@ def run_unit(unit: Unit | dict, threads: int | None = 1) -> dict:
     if runner is None:
         raise NeurohoverError(f"unknown unit kind {unit.kind!r}: allowed {', '.join(_RUNNERS)}")
     with num_threads(threads):  # also for library calls that take no thread count (e.g. EC-MER)
-        return runner(unit.params, threads)
+        return runner(unit.params, threads, device)
 
 
 def strip_timing(result: Any) -> Any:
