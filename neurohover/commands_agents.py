@@ -6,6 +6,7 @@ import argparse
 import sys
 
 from .errors import NeurohoverError
+from .evaluate import DEVICES, check_device
 
 
 def cmd_build_policies(args: argparse.Namespace) -> int:
@@ -48,6 +49,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
         "model_from": args.hybrid_model_from,
     }
     hybrid = HybridSettings.from_dict({k: v for k, v in given_values.items() if v is not None})
+    check_device(args.device)  # before the output directory is made
     if args.policy_dir is not None:
         input_dir(args.policy_dir, "--policy-dir")
     output_dir(args.out, "--out")
@@ -69,6 +71,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
             hybrid=hybrid,
             store=args.store,
             progress=None,
+            device=args.device,
         )
     except KeyboardInterrupt:
         print(
@@ -109,6 +112,12 @@ def register(sub) -> None:
     p.add_argument("--sigma", type=float, help="FGHH breadth (default 0.3)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--jobs", type=int, default=1, help="runs in parallel processes (default 1)")
+    p.add_argument(
+        "--device",
+        choices=DEVICES,
+        default="cpu",
+        help="where the units' episodes fly: cpu (default) or cuda (docs/gpu.md; the agents' test runs themselves still fly on the CPU)",
+    )
     p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")
     p.add_argument("--policy-dir", help="policy sets directory (default: the shipped ones)")
     p.add_argument("--out", required=True, help="output directory (episodes.csv, summary.json, cumulative.png, results.sqlite)")

@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import NeurohoverError
+from .evaluate import DEVICES, check_device
 
 MDP_FAMILY = "G"
 
@@ -112,6 +113,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         raise NeurohoverError(f"--checkpoint-every {args.checkpoint_every} is out of range: allowed > 0 seconds")
     if args.validation_episodes < 1:
         raise NeurohoverError(f"--validation-episodes {args.validation_episodes} is out of range: allowed >= 1")
+    check_device(args.device)  # before any file is touched: a GPU missing is one clear error
     resampling = parse_resampling(args.resampling)
     target, family, mdp_desc = _target(args)
     topology, proto = _seed_policy(args)
@@ -139,6 +141,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
             seed=args.seed,
             n_steps=args.episode_steps,
             threads=args.threads,
+            device=args.device,
             progress=bar,
             checkpoint=checkpoint,
             checkpoint_every_s=args.checkpoint_every,
@@ -157,7 +160,9 @@ def cmd_evolve(args: argparse.Namespace) -> int:
             print(f"neurohover evolve: interrupted mid-generation; the last periodic checkpoint (if any) is {checkpoint}", file=sys.stderr)
         return 130
     bar.close()
-    validation = validation_return(result.champion, target, episodes=args.validation_episodes, seed=args.seed, n_steps=args.episode_steps, threads=args.threads)
+    validation = validation_return(
+        result.champion, target, episodes=args.validation_episodes, seed=args.seed, n_steps=args.episode_steps, threads=args.threads, device=args.device
+    )
     meta = {
         "task": family.name,
         "mdp": mdp_desc,
@@ -376,6 +381,12 @@ def register(sub) -> None:
     p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")
     p.add_argument("--seed", type=int, default=0, help="root seed of the run (default 0)")
     p.add_argument("--threads", type=int, help="kernel threads (default: all cores; results do not depend on it)")
+    p.add_argument(
+        "--device",
+        choices=DEVICES,
+        default="cpu",
+        help="where episodes fly: cpu (default) or cuda, an NVIDIA GPU (docs/gpu.md; results agree to about 1e-12 relative)",
+    )
     p.add_argument("--out", required=True, metavar="FILE", help="champion policy file; FILE.history.csv and FILE.checkpoint.json go next to it")
     p.add_argument("--resume", action="store_true", help="continue the run from FILE.checkpoint.json (same options; the budget may be raised)")
     p.add_argument("--checkpoint-every", type=float, default=60.0, metavar="SECONDS", help="checkpoint interval (default 60 s)")

@@ -13,6 +13,7 @@ import argparse
 import sys
 
 from .errors import NeurohoverError
+from .evaluate import DEVICES, check_device
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
@@ -33,12 +34,13 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         raise NeurohoverError("--jobs applies to --executor local; Ray runs one unit per CPU of the cluster")
     if args.address is not None and args.executor != "ray":
         raise NeurohoverError(f"--address {args.address} names a Ray cluster; add --executor ray (or leave out --address)")
+    check_device(args.device)
     output_file(args.store, "--store")
     overrides = dict(parse_override(text) for text in args.set or [])
     configs = load_configs(args.name, args.scale, overrides)
     if args.only and len(configs) > 1:
         raise NeurohoverError(f"--only selects units of one experiment: give its NAME instead of {args.name!r}")
-    executor = make_executor(args.executor, jobs=args.jobs, address=args.address)
+    executor = make_executor(args.executor, jobs=args.jobs, address=args.address, device=args.device)
     failed = False
     try:
         with Store(args.store) as store:
@@ -97,6 +99,13 @@ def register(sub) -> None:
     p.add_argument("--executor", choices=("local", "ray"), default="local", help="local processes (default) or a Ray cluster")
     p.add_argument("--address", help="Ray cluster address (default: start a local Ray instance)")
     p.add_argument("--jobs", type=int, default=1, help="local worker processes (default 1: this process, kernel on all cores)")
+    p.add_argument(
+        "--device",
+        choices=DEVICES,
+        default="cpu",
+        help="where the units fly: cpu (default) or cuda, an NVIDIA GPU (evolve, robustness, safety and model units; "
+        "test runs stay on the CPU); not part of the config: results agree to about 1e-12 relative (docs/gpu.md)",
+    )
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a setting of the config (TOML value), e.g. --set episodes=50")
     p.add_argument(
         "--only",

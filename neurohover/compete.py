@@ -182,6 +182,7 @@ def compete(
     store: str | Path | None = None,
     progress: bool | None = False,
     on_result: Callable[[str, object], None] | None = None,
+    device: str = "cpu",
 ) -> tuple[dict, list]:
     """Run ``runs`` test runs of ``agent`` as an inline experiment; write results and plot to ``out``.
 
@@ -201,6 +202,9 @@ def compete(
         Safeguard and replacement rule of the hybrid agents (refused for the others by the CLI).
     on_result : callable, optional
         ``on_result(unit key, TestRunResult)`` after each run finished in this call.
+    device : {"cpu", "cuda"}
+        Passed to the executor (:func:`neurohover.experiments.units.run_unit`); not part of the
+        config. The test-run units fly on the CPU whatever it says (docs/gpu.md).
 
     Returns
     -------
@@ -231,7 +235,7 @@ def compete(
         if on_result is not None and key.startswith("run/"):
             on_result(key, TestRunResult.from_dict(result, key))
 
-    executor = make_executor("local", jobs=jobs)
+    executor = make_executor("local", jobs=jobs, device=device)
     with Store(store_path) as db:
         try:
             reproduce(config, db, executor, progress=progress, on_unit=finished)
