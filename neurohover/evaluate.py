@@ -198,11 +198,13 @@ def _load_lanes() -> None:
     if not _lanes_loaded:
         empty = np.zeros(0, dtype=np.int64)
         rollout_lanes(
-            np.zeros(MDP_ROW_LEN),
-            np.int64(POLICY_MLP),
-            np.zeros(GENOME_WIDTH),
-            np.uint64(0),
+            np.zeros((1, MDP_ROW_LEN)),
+            np.zeros(1, dtype=np.int64),
+            np.zeros((1, GENOME_WIDTH)),
             empty,
+            empty,
+            empty,
+            np.uint64(0),
             1,
             1,
             np.zeros(0),
@@ -213,14 +215,24 @@ def _load_lanes() -> None:
         _lanes_loaded = True
 
 
-def _use_lanes(device: str, p_idx: np.ndarray, m_idx: np.ndarray, fb: np.ndarray, rec: np.ndarray) -> bool:
+def _use_lanes(device: str, rows: np.ndarray, m_idx: np.ndarray, fb: np.ndarray | None = None, rec: np.ndarray | None = None) -> bool:
     """Whether the jobs fly in SIMD lanes (:func:`neurohover.sim.lanes.rollout_lanes`) rather than the scalar kernel.
 
-    The lanes share one policy and one MDP row and implement neither recording nor the safeguard;
-    below LANES jobs a thread's lanes would mostly idle. Results are the same bits either way.
+    Any CPU batch of at least LANES jobs (below that a thread's lanes would mostly idle) without
+    recording or safeguard (the lanes implement neither); policies and MDP rows may differ per job.
+    Restriction: the jobs' rows must share the substep count (learned models 1, true MDPs 10) and
+    whether there is wind, because the packed substep loop takes both as constants; per-lane
+    values would turn it into per-lane branches that no longer vectorize. Results are the same
+    bits either way.
     """
-    n_jobs = p_idx.shape[0]
-    return device == "cpu" and n_jobs >= LANES and bool((p_idx == p_idx[0]).all()) and bool((m_idx == m_idx[0]).all()) and not (fb >= 0).any() and not rec.any()
+    n_jobs = m_idx.shape[0]
+    if device != "cpu" or n_jobs < LANES or (fb is not None and (fb >= 0).any()) or (rec is not None and rec.any()):
+        return False
+    sub, windy = rows[:, 17], rows[:, 19] != 0.0
+    if (sub == sub[0]).all() and (windy == windy[0]).all():
+        return True  # every row alike: no need to look at the jobs
+    used = np.unique(m_idx)
+    return bool((sub[used] == sub[used[0]]).all()) and bool((windy[used] == windy[used[0]]).all())
 
 
 DEVICES = ("cpu", "cuda")
@@ -323,17 +335,18 @@ def evaluate_jobs(
     crashed = np.empty(n_jobs, dtype=np.bool_)
     steps = np.empty(n_jobs, dtype=np.int64)
     sg_step = np.empty(n_jobs, dtype=np.int64)
-    if _use_lanes(device, p_idx, m_idx, fb, rec):
+    if _use_lanes(device, rows, m_idx, fb, rec):
         _load_lanes()
-        pol, row = int(p_idx[0]), int(m_idx[0])
         start = time.perf_counter()
         with num_threads(threads):
             rollout_lanes(
-                rows[row].copy(),
-                table.kinds[pol],
-                table.genomes[pol].copy(),
-                np.uint64(seed),
+                rows,
+                table.kinds,
+                table.genomes,
+                p_idx,
+                m_idx,
                 e_idx,
+                np.uint64(seed),
                 n_steps,
                 numba.get_num_threads(),
                 returns,
@@ -564,6 +577,7 @@ class KernelFlyer:
         m = zeros if mdp_index is None else (arange if isinstance(mdp_index, str) else mdp_index)
         np.add(arange, self.episodes, out=e)
         rollout: Callable[..., None] = rollout_batch
+        lanes = self.device == "cpu" and _use_lanes("cpu", rows, m)
         if self.device == "cuda":
             # The CUDA launcher copies the inputs to the GPU and the results back on every call
             # (acceptable for now: a generation's jobs are few); buffers kept on the GPU between
@@ -579,27 +593,33 @@ class KernelFlyer:
             if want != self._threads:
                 numba.set_num_threads(want)
                 self._threads = want
+        if lanes:
+            _load_lanes()
         t0 = time.perf_counter()
-        rollout(
-            rows,
-            self._kinds,
-            self._genomes,
-            p,
-            m,
-            e,
-            minus,
-            self.seed,
-            self.n_steps,
-            False,
-            self._limits,
-            minus,
-            self._obs,
-            self._act,
-            returns,
-            crashed,
-            steps,
-            sg,
-        )
+        if lanes:
+            # The same bits as the scalar kernel (neurohover/sim/lanes.py), LANES episodes per thread.
+            rollout_lanes(rows, self._kinds, self._genomes, p, m, e, self.seed, self.n_steps, numba.get_num_threads(), returns, crashed, steps, sg)
+        else:
+            rollout(
+                rows,
+                self._kinds,
+                self._genomes,
+                p,
+                m,
+                e,
+                minus,
+                self.seed,
+                self.n_steps,
+                False,
+                self._limits,
+                minus,
+                self._obs,
+                self._act,
+                returns,
+                crashed,
+                steps,
+                sg,
+            )
         self.kernel_seconds += time.perf_counter() - t0
         if self.trace is not None:
             self.trace.append((genomes.copy(), rows, p.copy(), m.copy(), e.copy()))

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from neurohover import baseline_policy, evaluate, evaluate_jobs, get_task_family, prototype
-from neurohover.evaluate import PolicyTable, _use_lanes, num_threads
+from neurohover.evaluate import KernelFlyer, PolicyTable, _use_lanes, num_threads
+from neurohover.policies import GENOME_LENGTH
 from neurohover.sim.constants import SAFEGUARD_LIMITS
 from neurohover.sim.kernel import POLICY_SLP, rollout_batch
 from neurohover.sim.lanes import LANES, fly_lanes, rollout_lanes
@@ -38,24 +39,32 @@ def _spinning() -> PolicyTable:
     return PolicyTable(np.array([POLICY_SLP], dtype=np.int64), g)
 
 
-def _scalar(table: PolicyTable, row: np.ndarray, seed: int, episodes: np.ndarray, n_steps: int):
-    """The scalar kernel's rollout_batch, called directly."""
+def _scalar(table: PolicyTable, row: np.ndarray, seed: int, episodes: np.ndarray, n_steps: int, p=None, m=None):
+    """The scalar kernel's rollout_batch, called directly; ``row`` one row or (M, 29) rows, p and m
+    the jobs' policy and row indices (default 0)."""
     n = episodes.shape[0]
     zeros = np.zeros(n, dtype=np.int64)
     minus = np.full(n, -1, dtype=np.int64)
+    rows = np.atleast_2d(row)
+    p = zeros if p is None else p
+    m = zeros if m is None else m
     r, c, s, sg = np.empty(n), np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
     rollout_batch(
-        row[None, :], table.kinds, table.genomes, zeros, zeros, episodes, minus, np.uint64(seed), n_steps, False, SAFEGUARD_LIMITS, minus,
+        rows, table.kinds, table.genomes, p, m, episodes, minus, np.uint64(seed), n_steps, False, SAFEGUARD_LIMITS, minus,
         np.zeros((0, 1, 12)), np.zeros((0, 1, 4)), r, c, s, sg,
     )  # fmt: skip
     return r, c, s, sg
 
 
-def _lanes(table: PolicyTable, row: np.ndarray, seed: int, episodes: np.ndarray, n_steps: int, threads: int):
+def _lanes(table: PolicyTable, row: np.ndarray, seed: int, episodes: np.ndarray, n_steps: int, threads: int, p=None, m=None):
     n = episodes.shape[0]
+    zeros = np.zeros(n, dtype=np.int64)
+    rows = np.atleast_2d(row).copy()
+    p = zeros if p is None else p
+    m = zeros if m is None else m
     r, c, s, sg = np.empty(n), np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.int64), np.full(n, 7, dtype=np.int64)
     with num_threads(threads):
-        rollout_lanes(row.copy(), table.kinds[0], table.genomes[0].copy(), np.uint64(seed), episodes, n_steps, threads, r, c, s, sg)
+        rollout_lanes(rows, table.kinds, table.genomes.copy(), p, m, episodes, np.uint64(seed), n_steps, threads, r, c, s, sg)
     return r, c, s, sg
 
 
@@ -110,22 +119,32 @@ def test_cases_cover_crashes_non_finite_actions_and_the_fallback() -> None:
         table, row = CASES[name]
         n = 2
         stats = np.zeros(2, dtype=np.int64)
-        fly_lanes(
-            row, table.kinds[0], table.genomes[0], np.uint64(0), ep[:n], 200, np.empty(n), np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.int64), stats
-        )
+        z = np.zeros(n, dtype=np.int64)
+        out = np.empty(n), np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.int64)
+        fly_lanes(row[None, :], table.kinds, table.genomes, z, z, ep[:n], np.uint64(0), 200, *out, stats)
         assert stats[1] > 0, name  # the large-angle scalar fallback ran
 
 
 def test_evaluate_jobs_dispatch() -> None:
     n = 2 * LANES + 1
-    p, m, fb, rec = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64), np.full(n, -1, dtype=np.int64), np.zeros(n, dtype=bool)
-    assert _use_lanes("cpu", p, m, fb, rec)
-    assert not _use_lanes("cuda", p, m, fb, rec)
-    assert not _use_lanes("cpu", p[: LANES - 1], m[: LANES - 1], fb[: LANES - 1], rec[: LANES - 1])
-    for arr, value in ((p, 1), (m, 1), (fb, 0), (rec, True)):
+    rows = np.stack([ZERO, ZERO])
+    m, fb, rec = np.zeros(n, dtype=np.int64), np.full(n, -1, dtype=np.int64), np.zeros(n, dtype=bool)
+    assert _use_lanes("cpu", rows, m, fb, rec)
+    assert _use_lanes("cpu", rows, m)
+    assert not _use_lanes("cuda", rows, m, fb, rec)
+    assert not _use_lanes("cpu", rows, m[: LANES - 1], fb[: LANES - 1], rec[: LANES - 1])
+    for arr, value in ((fb, 0), (rec, True)):
         arr[-1] = value
-        assert not _use_lanes("cpu", p, m, fb, rec)
+        assert not _use_lanes("cpu", rows, m, fb, rec)
         arr[-1] = np.zeros(1, dtype=arr.dtype)[0] if arr is not fb else -1
+    m[-1] = 1
+    assert _use_lanes("cpu", rows, m, fb, rec)  # different rows (and policies) are fine
+    wind = get_task_family("ghh09").test_mdps()[0].row()
+    for other in (COARSE, wind):  # a row with another substep count or with wind: the scalar kernel
+        mixed = np.stack([ZERO, other])
+        assert not _use_lanes("cpu", mixed, m, fb, rec)
+        assert _use_lanes("cpu", mixed, np.zeros(n, dtype=np.int64), fb, rec)  # row 1 unused
+        assert _use_lanes("cpu", mixed, np.ones(n, dtype=np.int64), fb, rec)
     # Through evaluate_jobs and evaluate: the same bits as the scalar kernel, safeguard step -1.
     table, row = CASES["crashing MLP"]
     ep = np.arange(n, dtype=np.int64)
@@ -133,3 +152,66 @@ def test_evaluate_jobs_dispatch() -> None:
     _assert_same((ev.returns, ev.crashed, ev.steps, ev.safeguard_step), _scalar(table, row, 9, ep, 3000))
     ev = evaluate(table, row[None, :], episodes=n, seed=9, n_steps=3000)
     _assert_same((ev.returns.reshape(-1), ev.crashed.reshape(-1), ev.steps.reshape(-1), ev.safeguard_step.reshape(-1)), _scalar(table, row, 9, ep, 3000))
+
+
+FGHH = [get_task_family("fghh", 0.3).sample(np.random.default_rng(i)).row() for i in range(4)]
+GHH08 = [mdp.row() for mdp in get_task_family("ghh08").test_mdps()[:3]]
+GHH09 = [mdp.row() for mdp in get_task_family("ghh09").test_mdps()[:3]]
+_MIXED = [MLP, _perturbed(0.08), _perturbed(0.5, 3), PolicyTable.from_policies([baseline_policy()]), _spinning(), _non_finite()]
+MIXED_POLICIES = PolicyTable(np.concatenate([t.kinds for t in _MIXED]), np.concatenate([t.genomes for t in _MIXED]))  # MLP and SLP genomes
+MIXED_ROWS = {"fghh samples": FGHH, "ghh08 winds": GHH08, "ghh09 winds": GHH09, "fghh 1 substep": [np.r_[r[:17], 1, 0.1, r[19:]] for r in FGHH]}
+
+
+@pytest.mark.parametrize("rows_name", list(MIXED_ROWS))
+@pytest.mark.parametrize("n_jobs", [LANES + 3, 4 * LANES + 5])
+@pytest.mark.parametrize("threads", [1, 2])
+def test_mixed_policies_and_mdps(rows_name: str, n_jobs: int, threads: int) -> None:
+    """Each lane its own genome (MLP and SLP, crashing, non-finite, spinning) and its own MDP row."""
+    rows = np.stack(MIXED_ROWS[rows_name])
+    rng = np.random.default_rng(n_jobs)
+    p = rng.integers(0, len(MIXED_POLICIES), n_jobs)
+    m = rng.integers(0, rows.shape[0], n_jobs)
+    ep = rng.permutation(10_000)[:n_jobs].astype(np.int64)
+    ref = _scalar(MIXED_POLICIES, rows, 7, ep, 3000, p, m)
+    assert ref[1].any() and not ref[1].all()
+    assert n_jobs < 2 * LANES or len(set(ref[2][ref[1]].tolist())) > 1  # episodes end at different steps
+    _assert_same(_lanes(MIXED_POLICIES, rows, 7, ep, 3000, threads, p, m), ref)
+
+
+def test_mixed_rows_really_differ() -> None:
+    for name, rows in MIXED_ROWS.items():
+        a = np.stack(rows)
+        assert (a[:, [0, 1, 3, 5, 7, 9]].std(axis=0) > 0).any() or (a[:, 19:28].std(axis=0) > 0).any(), name
+    assert all(r[19] != 0 for r in GHH08 + GHH09)
+
+
+def test_rollout_lanes_refuses_rows_it_cannot_pack() -> None:
+    ep = np.arange(LANES, dtype=np.int64)
+    m = np.arange(LANES, dtype=np.int64) % 2
+    for other in (COARSE, GHH09[0]):
+        with pytest.raises(ValueError):
+            _lanes(MLP, np.stack([ZERO, other]), 0, ep, 10, 1, m=m)
+
+
+def test_evaluate_jobs_and_kernel_flyer_mixed() -> None:
+    """evaluate_jobs and KernelFlyer.fly take the lanes for mixed batches and give the scalar kernel's bits."""
+    rows = np.stack(FGHH)
+    n = 3 * LANES + 2
+    rng = np.random.default_rng(2)
+    p = rng.integers(0, len(MIXED_POLICIES), n)
+    m = rng.integers(0, rows.shape[0], n)
+    ep = np.arange(n, dtype=np.int64)
+    ref = _scalar(MIXED_POLICIES, rows, 9, ep, 2000, p, m)
+    ev = evaluate_jobs(MIXED_POLICIES, rows, p, m, ep, seed=9, n_steps=2000, threads=2)
+    _assert_same((ev.returns, ev.crashed, ev.steps, ev.safeguard_step), ref)
+    mlp = np.flatnonzero(MIXED_POLICIES.kinds == MLP.kinds[0])
+    sel = np.isin(p, mlp)
+    pm = np.searchsorted(mlp, p[sel])
+    genomes = MIXED_POLICIES.genomes[mlp][:, : GENOME_LENGTH["mlp"]]
+    flyer = KernelFlyer("mlp", 9, 2000)
+    with num_threads(2):
+        flyer.start()
+        ret = flyer.fly(genomes, rows, pm, m[sel], int(sel.sum())).copy()
+    ref = _scalar(MIXED_POLICIES, rows, 9, np.arange(int(sel.sum()), dtype=np.int64), 2000, p[sel], m[sel])
+    assert np.array_equal(ret.view(np.int64), ref[0].view(np.int64))
+    assert np.array_equal(flyer.crashed, ref[1])

@@ -1,16 +1,17 @@
-"""Several episodes per thread in SIMD lanes: the kernel's rollout for a batch of one policy on one MDP.
+"""Several episodes per thread in SIMD lanes: the kernel's rollout without recording or safeguard.
 
-:func:`rollout_lanes` flies the jobs of :func:`neurohover.sim.kernel.rollout_batch` when they all
-share one policy and one MDP row and none records flight data or has a safeguard, LANES episodes
-per thread in lockstep, and writes bit-identical returns, crash flags and steps (about 2.2x the
-scalar kernel's episodes/s per core, docs/performance.md). :func:`neurohover.evaluate.evaluate_jobs`
-chooses it for such batches.
+:func:`rollout_lanes` flies the jobs of :func:`neurohover.sim.kernel.rollout_batch` when none
+records flight data or has a safeguard and their MDP rows share the substep count and whether
+there is wind, LANES episodes per thread in lockstep, each lane with its own job's genome and MDP
+row, and writes bit-identical returns, crash flags and steps (about 2.2x the scalar kernel's
+episodes/s per core, docs/performance.md). :func:`neurohover.evaluate.evaluate_jobs` and
+:meth:`neurohover.evaluate.KernelFlyer.fly` choose it for such batches of at least LANES jobs.
 
 How it works
 - Lanes in lockstep over control steps, one episode per lane, and a queue: a lane whose episode ends
   takes the next one, so lanes run at different steps. An idle lane flies at rest.
 - All lane data live in one flat float64 buffer ``B[row * LANES + lane]`` (state, drive terms, wind,
-  observation, reward, crash flag), so LLVM sees constant, non-overlapping offsets and its SLP
+  observation, reward, crash flag, and the lane's MDP's dynamics coefficients and dt), so LLVM sees constant, non-overlapping offsets and its SLP
   vectorizer packs the fully unrolled ``for lane in range(LANES)`` loops (the substeps, then the
   observation, reward and crash test) into packed instructions on ymm/zmm registers.
 - The three Taylor regimes of ``kernel._half_angle_quaternion`` are all computed and chosen by
@@ -49,7 +50,9 @@ ROW_OBS = 21  # buffer rows: 0-12 state, 13-18 drive terms, 19-20 wind, 21-32 ob
 ROW_REWARD = 33
 ROW_CRASH = 34
 ROW_BIG = 35  # counts the step's substeps where the lane turned SERIES_MAX_ANGLE or more
-ROWS = 36
+ROW_DYN = 36  # rows 36-41 the lane's MDP's c_u, c_v, c_w, c_p, c_q, c_r, row 42 its substep length dt
+ROWS = 43
+N_PAR = 21  # per-lane scalar parameters (P[lane]): 0-5 noise std, 6-11 d_u d_v d_w d_p d_q d_r, 12-20 wind
 
 
 @intrinsic
@@ -92,12 +95,19 @@ def _hq_select(rx, ry, rz):
 
 
 @nb.njit(cache=True, inline="always", fastmath=False)
-def _lane_substep(B, lane, dyn, dt, has_wind):
+def _lane_substep(B, lane, has_wind):
     """One substep of one lane: kernel.integrate's loop body, every FMA the kernel's compiled code
     forms written out (from its optimised LLVM IR and x86's contraction rule), so that a packed
     and a scalar build give the same bits. Lane state B[m * LANES + lane]: rows 0-12 the state,
-    13-18 the drive terms (nu, bias_v, bias_w, drive_p, drive_q, drive_r), 19-20 the wind."""
-    c_u, c_v, d_v, c_w, d_w, c_p, d_p, c_q, d_q, c_r, d_r, d_u = dyn
+    13-18 the drive terms (nu, bias_v, bias_w, drive_p, drive_q, drive_r), 19-20 the wind, 36-42
+    the lane's own dynamics (c_u, c_v, c_w, c_p, c_q, c_r, dt), so lanes may fly different MDPs."""
+    c_u = B[(ROW_DYN + 0) * LANES + lane]
+    c_v = B[(ROW_DYN + 1) * LANES + lane]
+    c_w = B[(ROW_DYN + 2) * LANES + lane]
+    c_p = B[(ROW_DYN + 3) * LANES + lane]
+    c_q = B[(ROW_DYN + 4) * LANES + lane]
+    c_r = B[(ROW_DYN + 5) * LANES + lane]
+    dt = B[(ROW_DYN + 6) * LANES + lane]
     vu = B[0 * LANES + lane]
     vv = B[1 * LANES + lane]
     vw = B[2 * LANES + lane]
@@ -138,7 +148,7 @@ def _lane_substep(B, lane, dyn, dt, has_wind):
 
 
 @nb.njit(cache=True, fastmath=False)
-def _substeps(B, W, n_sub, dyn, dt, has_wind):
+def _substeps(B, W, n_sub, has_wind):
     """All substeps of one control step for all lanes of B, in place; the lane loops are the SIMD
     part. Returns False at the first substep where some lane would turn more than
     SERIES_MAX_ANGLE (libm's sin/cos): the caller then restores the step's start and flies it
@@ -151,10 +161,10 @@ def _substeps(B, W, n_sub, dyn, dt, has_wind):
                 B[19 * LANES + lane] = W[0, i, lane]
                 B[20 * LANES + lane] = W[1, i, lane]
             for lane in range(LANES):
-                _lane_substep(B, lane, dyn, dt, True)
+                _lane_substep(B, lane, True)
         else:
             for lane in range(LANES):
-                _lane_substep(B, lane, dyn, dt, False)
+                _lane_substep(B, lane, False)
     n_big = 0
     for lane in range(LANES):
         n_big += B[ROW_BIG * LANES + lane] != 0.0
@@ -262,20 +272,57 @@ def _reset_lane(B, N, A, lane):
 
 
 @nb.njit(cache=True, fastmath={"contract"})
-def fly_lanes(row, kind, g, seed, episodes, n_steps, out_return, out_crashed, out_steps, stats):
-    """Fly episode indices ``episodes`` of policy (kind, g) on MDP ``row``, LANES at a time;
-    write each episode's return, crash flag and steps (as kernel.fly_job: no recording, no safeguard).
-
-    A lane whose episode ends takes the next one (a queue), so lanes run at different steps.
-    stats[0] counts control steps, stats[1] those flown by the scalar fallback.
-    """
+def _start_lane(B, P, lane, row):
+    """Load the MDP row's parameters into a lane that starts an episode: the dynamics the
+    substeps read into B's rows 36-42, the noise, drive and wind parameters into P[lane]."""
     dyn, std, n_sub, dt, wind = unpack_mdp(row)
     c_u, c_v, d_v, c_w, d_w, c_p, d_p, c_q, d_q, c_r, d_r, d_u = dyn
+    B[(ROW_DYN + 0) * LANES + lane] = c_u
+    B[(ROW_DYN + 1) * LANES + lane] = c_v
+    B[(ROW_DYN + 2) * LANES + lane] = c_w
+    B[(ROW_DYN + 3) * LANES + lane] = c_p
+    B[(ROW_DYN + 4) * LANES + lane] = c_q
+    B[(ROW_DYN + 5) * LANES + lane] = c_r
+    B[(ROW_DYN + 6) * LANES + lane] = dt
+    for m in range(6):
+        P[lane, m] = std[m]
+    P[lane, 6] = d_u
+    P[lane, 7] = d_v
+    P[lane, 8] = d_w
+    P[lane, 9] = d_p
+    P[lane, 10] = d_q
+    P[lane, 11] = d_r
     wkind, ax, ox, phx, cx, ay, oy, phy, cy = wind
-    has_wind = wkind != 0
+    P[lane, 12] = wkind
+    P[lane, 13] = ax
+    P[lane, 14] = ox
+    P[lane, 15] = phx
+    P[lane, 16] = cx
+    P[lane, 17] = ay
+    P[lane, 18] = oy
+    P[lane, 19] = phy
+    P[lane, 20] = cy
+
+
+@nb.njit(cache=True, fastmath={"contract"})
+def fly_lanes(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, seed, n_steps, out_return, out_crashed, out_steps, stats):
+    """Fly jobs j (policy ``job_policy[j]``, MDP row ``job_mdp[j]``, episode index ``episodes[j]``),
+    LANES at a time; write each job's return, crash flag and steps (as kernel.fly_job: no
+    recording, no safeguard). Every job's MDP row must have the substep count and the wind
+    presence (kind 0 or not) of the first job's row.
+
+    A lane whose episode ends takes the next job (a queue), so lanes run at different steps, each
+    with its own genome and its own MDP's parameters.
+    stats[0] counts control steps, stats[1] those flown by the scalar fallback.
+    """
     n_jobs = episodes.shape[0]
+    if n_jobs == 0:
+        return
+    n_sub = int(mdp_rows[job_mdp[0], 17])
+    has_wind = int(mdp_rows[job_mdp[0], 19]) != 0
     B = np.zeros(ROWS * LANES)
     B0 = np.zeros(13 * LANES)
+    P = np.zeros((LANES, N_PAR))
     N = np.zeros((6, LANES))
     A = np.zeros((4, LANES))
     W = np.zeros((2, n_sub, LANES))
@@ -290,6 +337,7 @@ def fly_lanes(row, kind, g, seed, episodes, n_steps, out_return, out_crashed, ou
         if nxt < n_jobs:
             job[lane] = nxt
             seed_stream(rngs[lane], np.uint64(seed), np.uint64(episodes[nxt]))
+            _start_lane(B, P, lane, mdp_rows[job_mdp[nxt]])
             nxt += 1
             live += 1
     while live > 0:
@@ -307,13 +355,14 @@ def fly_lanes(row, kind, g, seed, episodes, n_steps, out_return, out_crashed, ou
             o9 = B[(ROW_OBS + 9) * LANES + lane]
             o10 = B[(ROW_OBS + 10) * LANES + lane]
             o11 = B[(ROW_OBS + 11) * LANES + lane]
-            a1, a2, a3, a4 = policy_action(kind, g, o0, o1, o2, o3, o4, o5, o9, o10, o11)
+            pol = job_policy[job[lane]]
+            a1, a2, a3, a4 = policy_action(policy_kinds[pol], genomes[pol], o0, o1, o2, o3, o4, o5, o9, o10, o11)
             if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
                 j = job[lane]
                 out_return[j] = total[lane] + -CRASH_STEP_PENALTY * (n_steps - (k + 1))
                 out_crashed[j] = True
                 out_steps[j] = k + 1
-                job[lane] = -2  # over; the lane idles through this step and is refilled after it
+                job[lane] = -2  # over; the lane idles through this step (at rest, dt 0) and is refilled after it
                 _reset_lane(B, N, A, lane)
                 continue
             a1 = _clip(a1)
@@ -321,6 +370,7 @@ def fly_lanes(row, kind, g, seed, episodes, n_steps, out_return, out_crashed, ou
             a3 = _clip(a3)
             a4 = _clip(a4)
             rng = rngs[lane]
+            std = (P[lane, 0], P[lane, 1], P[lane, 2], P[lane, 3], P[lane, 4], P[lane, 5])
             n = (N[0, lane], N[1, lane], N[2, lane], N[3, lane], N[4, lane], N[5, lane])
             n = update_noise(n, std, next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng))
             for m in range(6):
@@ -329,13 +379,16 @@ def fly_lanes(row, kind, g, seed, episodes, n_steps, out_return, out_crashed, ou
             A[1, lane] = a2
             A[2, lane] = a3
             A[3, lane] = a4
-            B[13 * LANES + lane] = d_u + n[0]
-            B[14 * LANES + lane] = d_v + n[1]
-            B[15 * LANES + lane] = d_w * a4 + n[2]
-            B[16 * LANES + lane] = d_p * a1 + n[3]
-            B[17 * LANES + lane] = d_q * a2 + n[4]
-            B[18 * LANES + lane] = d_r * a3 + n[5]
+            B[13 * LANES + lane] = P[lane, 6] + n[0]
+            B[14 * LANES + lane] = P[lane, 7] + n[1]
+            B[15 * LANES + lane] = P[lane, 8] * a4 + n[2]
+            B[16 * LANES + lane] = P[lane, 9] * a1 + n[3]
+            B[17 * LANES + lane] = P[lane, 10] * a2 + n[4]
+            B[18 * LANES + lane] = P[lane, 11] * a3 + n[5]
             if has_wind:
+                wkind = int(P[lane, 12])
+                ax, ox, phx, cx = P[lane, 13], P[lane, 14], P[lane, 15], P[lane, 16]
+                ay, oy, phy, cy = P[lane, 17], P[lane, 18], P[lane, 19], P[lane, 20]
                 for i in range(n_sub):
                     wu = cx
                     wv = cy
@@ -349,10 +402,13 @@ def fly_lanes(row, kind, g, seed, episodes, n_steps, out_return, out_crashed, ou
                     W[1, i, lane] = wv
         stats[0] += 1
         B0[:] = B[: 13 * LANES]
-        if not _substeps(B, W, n_sub, dyn, dt, has_wind):
+        if not _substeps(B, W, n_sub, has_wind):
             stats[1] += 1
             B[: 13 * LANES] = B0
             for lane in range(LANES):
+                if job[lane] < 0:
+                    continue  # idle: stays at rest
+                dyn, std, n_sub_l, dt, wind = unpack_mdp(mdp_rows[job_mdp[job[lane]]])
                 s = integrate(
                     _state(B, lane),
                     (N[0, lane], N[1, lane], N[2, lane], N[3, lane], N[4, lane], N[5, lane]),
@@ -362,7 +418,7 @@ def fly_lanes(row, kind, g, seed, episodes, n_steps, out_return, out_crashed, ou
                     A[3, lane],
                     step[lane],
                     dyn,
-                    n_sub,
+                    n_sub_l,
                     dt,
                     wind,
                 )
@@ -393,6 +449,7 @@ def fly_lanes(row, kind, g, seed, episodes, n_steps, out_return, out_crashed, ou
             if nxt < n_jobs:
                 job[lane] = nxt
                 seed_stream(rngs[lane], np.uint64(seed), np.uint64(episodes[nxt]))
+                _start_lane(B, P, lane, mdp_rows[job_mdp[nxt]])
                 nxt += 1
             else:
                 job[lane] = -1
@@ -400,24 +457,28 @@ def fly_lanes(row, kind, g, seed, episodes, n_steps, out_return, out_crashed, ou
 
 
 @nb.njit(cache=True, parallel=True, fastmath={"contract"})
-def rollout_lanes(row, kind, g, seed, job_episode, n_steps, n_threads, out_return, out_crashed, out_steps, out_safeguard_step):
-    """Fly episodes ``job_episode`` of one policy on one MDP, LANES per thread, in parallel.
+def rollout_lanes(
+    mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, seed, n_steps, n_threads, out_return, out_crashed, out_steps, out_safeguard_step
+):
+    """Fly the jobs ``(job_policy[j], job_mdp[j], job_episode[j])``, LANES per thread, in parallel.
 
-    The outputs are those of :func:`neurohover.sim.kernel.rollout_batch` for jobs that all have
-    this policy and MDP, no recording and no safeguard, bit for bit.
+    The outputs are those of :func:`neurohover.sim.kernel.rollout_batch` for the same jobs with no
+    recording and no safeguard, bit for bit. Each lane flies its own job's genome and MDP row;
+    all rows used must share the substep count (row[17]) and whether there is wind (row[19] != 0),
+    which the packed substep loop takes as constants (ValueError otherwise).
 
     Parameters
     ----------
-    row : numpy.ndarray
-        ``(29,)`` MDP row.
-    kind : int
-        Policy kind (``kernel.POLICY_SLP`` or ``kernel.POLICY_MLP``).
-    g : numpy.ndarray
-        ``(42,)`` genome, padded as in :class:`neurohover.evaluate.PolicyTable`.
+    mdp_rows : numpy.ndarray
+        ``(M, 29)`` MDP rows.
+    policy_kinds : numpy.ndarray of int64
+        ``(P,)`` policy kinds (``kernel.POLICY_SLP`` or ``kernel.POLICY_MLP``).
+    genomes : numpy.ndarray
+        ``(P, 42)`` genomes, padded as in :class:`neurohover.evaluate.PolicyTable`.
+    job_policy, job_mdp, job_episode : numpy.ndarray of int64
+        Per job, its policy, its MDP row, and the episode index that with ``seed`` fixes its noise.
     seed : numpy.uint64
         Root seed of the noise streams.
-    job_episode : numpy.ndarray of int64
-        Per job, the episode index that with ``seed`` fixes its noise.
     n_steps : int
         Control steps per episode.
     n_threads : int
@@ -427,6 +488,12 @@ def rollout_lanes(row, kind, g, seed, job_episode, n_steps, n_threads, out_retur
         Per job: return, crash flag, steps flown, and -1 (no safeguard), written here.
     """
     n_jobs = job_episode.shape[0]
+    if n_jobs > 0:
+        n_sub = mdp_rows[job_mdp[0], 17]
+        windy = mdp_rows[job_mdp[0], 19] != 0.0
+        for j in range(n_jobs):
+            if mdp_rows[job_mdp[j], 17] != n_sub or (mdp_rows[job_mdp[j], 19] != 0.0) != windy:
+                raise ValueError("rollout_lanes: the jobs' MDP rows differ in substep count or wind presence")
     # One contiguous chunk per thread, each with its own lane queue; no chunk smaller than LANES
     # jobs unless the batch is, so lanes stay full.
     n_chunks = max(1, min(n_threads, n_jobs // LANES))
@@ -434,6 +501,9 @@ def rollout_lanes(row, kind, g, seed, job_episode, n_steps, n_threads, out_retur
         a = c * n_jobs // n_chunks
         b = (c + 1) * n_jobs // n_chunks
         stats = np.zeros(2, dtype=np.int64)
-        fly_lanes(row, kind, g, seed, job_episode[a:b], n_steps, out_return[a:b], out_crashed[a:b], out_steps[a:b], stats)
+        fly_lanes(
+            mdp_rows, policy_kinds, genomes, job_policy[a:b], job_mdp[a:b], job_episode[a:b], seed, n_steps,
+            out_return[a:b], out_crashed[a:b], out_steps[a:b], stats,
+        )  # fmt: skip
         for j in range(a, b):
             out_safeguard_step[j] = -1
