@@ -28,19 +28,22 @@ class ModelEvolution:
     ``budget`` episodes on the model per evolution (steady state, paper Table 6 otherwise);
     ``predict_episodes`` model episodes to predict the evolved policy's return; ``estimator`` the
     least-squares estimator of the LR model (:func:`learn_model`): ``"ols"`` (default, the paper's)
-    or ``"gls"``.
+    or ``"gls"``; ``device`` where those episodes fly (``"cpu"`` or ``"cuda"``, docs/gpu.md).
     """
 
     budget: int = 2000
     predict_episodes: int = 5
     n_steps: int = EPISODE_STEPS
     estimator: str = "ols"
+    device: str = "cpu"
 
     def __post_init__(self) -> None:
+        from ..evaluate import check_device
         from ..models import ESTIMATORS
 
         if self.estimator not in ESTIMATORS:
             raise NeurohoverError(f"estimator={self.estimator!r} is not allowed: choose one of {', '.join(ESTIMATORS)}")
+        check_device(self.device)
 
 
 def learn_model(flight_data: FlightData, estimator: str = "ols") -> MDP:
@@ -59,9 +62,13 @@ def evolve_on_model(model: MDP, prototype: Policy, settings: ModelEvolution, see
     """Evolve a policy on ``model``; return it and its predicted return (mean over model episodes)."""
     from ..evolution.evolve import evolve
 
-    result = evolve(model, topology=prototype.topology, prototype=prototype, budget=settings.budget, seed=seed, n_steps=settings.n_steps, threads=1)
+    result = evolve(
+        model, topology=prototype.topology, prototype=prototype, budget=settings.budget, seed=seed, n_steps=settings.n_steps, threads=1, device=settings.device
+    )
     policy = result.champion
-    predicted = evaluate(policy, model, episodes=settings.predict_episodes, seed=seed, first_episode=10**9, n_steps=settings.n_steps, threads=1).returns.mean()
+    predicted = evaluate(
+        policy, model, episodes=settings.predict_episodes, seed=seed, first_episode=10**9, n_steps=settings.n_steps, threads=1, device=settings.device
+    ).returns.mean()
     return policy, float(predicted)
 
 

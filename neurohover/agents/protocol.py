@@ -144,11 +144,13 @@ def run_test(
     seed: int = 0,
     n_steps: int = EPISODE_STEPS,
     threads: int | None = None,
+    device: str = "cpu",
 ) -> RunResult:
     """Fly one test run of ``episodes`` episodes of ``agent`` on ``mdp``.
 
     Episode e's gusts come from stream (seed, e), so two agents run with the same seed meet the
-    same noise. The agent's own randomness derives from ``seed`` as well.
+    same noise. The agent's own randomness derives from ``seed`` as well. ``device``: where the
+    episodes in the MDP fly (the agent's own evolutions on models follow its ``ModelEvolution``).
     """
     if not isinstance(episodes, (int, np.integer)) or episodes < 1:
         raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
@@ -178,6 +180,7 @@ def run_test(
                 seed=seed,
                 n_steps=n_steps,
                 threads=threads,
+                device=device,
                 fallback_index=np.full(rest.size, 1 if choice.fallback else -1),
                 safeguard_limits=choice.dangerous.limits(),
             )
@@ -199,6 +202,7 @@ def run_test(
             seed=seed,
             n_steps=n_steps,
             threads=threads,
+            device=device,
             fallback_index=np.full(n, 1 if choice.fallback else -1),
             record=np.full(n, choice.record),
             safeguard_limits=choice.dangerous.limits(),

@@ -230,9 +230,9 @@ def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
     ).to_dict()
 
 
-def make_agent(p: dict):
+def make_agent(p: dict, device: str = "cpu"):
     """The agent of a test-run unit, built from the policies in its params and the run's settings
-    (policies evolved on learned models fly episodes of the run's length)."""
+    (policies evolved on learned models fly episodes of the run's length, on ``device``)."""
     from ..agents.hybrid import HybridSettings
     from ..agents.model_based import ModelEvolution
     from ..agents.registry import AgentOptions, AgentPolicies, agent_spec
@@ -245,7 +245,9 @@ def make_agent(p: dict):
         safe=tuple(_policy(d) for d in pol.get("safe", ())),
     )
     options = AgentOptions(
-        evolution=ModelEvolution(budget=p["model_budget"], predict_episodes=p["predict_episodes"], n_steps=p["n_steps"], estimator=p["estimator"]),
+        evolution=ModelEvolution(
+            budget=p["model_budget"], predict_episodes=p["predict_episodes"], n_steps=p["n_steps"], estimator=p["estimator"], device=device
+        ),
         hybrid=HybridSettings.from_dict(p["hybrid"]) if spec.takes_hybrid else None,
         max_learning_episodes=p["max_learning_episodes"],
     )
@@ -259,10 +261,8 @@ def run_test_run(p: dict, threads: int | None, device: str = "cpu") -> dict:
 
     family = _family(p["task"], p.get("sigma"))
     mdp = _mdp(p["mdp"])
-    agent = make_agent(p)
-    # The agents fly their episodes one by one through neurohover.agents (no device option there):
-    # a test run stays on the CPU whatever ``device`` says.
-    r = run_test(agent, family, mdp, episodes=p["episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads)
+    agent = make_agent(p, device)
+    r = run_test(agent, family, mdp, episodes=p["episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads, device=device)
     start = after_learning_start(r.policy)
     changes = tuple((e, r.policy[e]) for e in range(len(r.policy)) if e == 0 or r.policy[e] != r.policy[e - 1])
     return TestRunResult(
@@ -312,8 +312,7 @@ def run_unit(unit: Unit | dict, threads: int | None = 1, device: str = "cpu") ->
     ``to_dict()`` of its typed result (:data:`~neurohover.experiments.results.RESULT_TYPES`).
 
     ``threads`` are kernel threads (1 when many units run in parallel; None: all cores); results
-    do not depend on it. ``device`` (``"cpu"`` or ``"cuda"``) is where evolve, robustness, safety
-    and model units fly their episodes (test-run units stay on the CPU); like ``threads`` it is no
+    do not depend on it. ``device`` (``"cpu"`` or ``"cuda"``) is where every unit flies its episodes; like ``threads`` it is no
     part of the unit's params or the config hash: results agree across devices to within
     docs/gpu.md's tolerance.
     """
