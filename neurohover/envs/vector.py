@@ -27,6 +27,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from ..errors import NeurohoverError
+from ..evaluate import check_device
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS, MDP_ROW_LEN, OBS_DIM
 from ..sim.kernel import step_batch
 from ..sim.rng import seed_stream
@@ -88,6 +89,12 @@ class HoverVectorEnv(VectorEnv):
         float64 either way).
     render_mode : None
         No rendering (render a single :class:`~neurohover.envs.hover.HoverEnv` instead).
+    device : {"cpu", "cuda"}
+        Where the helicopters fly (docs/gpu.md). ``"cuda"``: one CUDA thread per helicopter; the
+        states, gust noise, noise-stream states and step counters stay on the GPU between steps,
+        and each step copies the actions in and the observations, rewards and crash flags out
+        (resets copy the reset sub-environments' rows in). ``"cuda"`` where no GPU is usable
+        raises :class:`~neurohover.NeurohoverError`.
 
     Notes
     -----
@@ -124,7 +131,9 @@ class HoverVectorEnv(VectorEnv):
         max_episode_steps: int | None = None,
         render_mode: str | None = None,
         obs_dtype: Any = "float64",
+        device: str = "cpu",
     ) -> None:
+        check_device(device)
         if isinstance(num_envs, (bool, np.bool_)) or not isinstance(num_envs, (int, np.integer)) or not 1 <= num_envs <= MAX_NUM_ENVS:
             raise NeurohoverError(f"num_envs={num_envs!r} is out of range: allowed an integer in 1..{MAX_NUM_ENVS}")
         if render_mode is not None:
@@ -165,6 +174,14 @@ class HoverVectorEnv(VectorEnv):
         self._ready = False
         self._all = np.ones(n, dtype=np.bool_)
         self._all.setflags(write=False)
+        self.device = device
+        self._gpu = None
+        if device == "cuda":
+            from ..sim import cuda as sim_cuda  # numba.cuda is imported only when asked for
+
+            # On the GPU the host's _state, _noise and _rng rows are written only by resets (and
+            # then copied in); the device holds the flying values. _steps is mirrored on the host.
+            self._gpu = sim_cuda.StepBatch(self._rows, self._index, self._state, self._noise, self._rng, self._steps)
 
     # -- read-only views -------------------------------------------------------------------
 
@@ -279,6 +296,8 @@ class HoverVectorEnv(VectorEnv):
         self._noise[idx] = 0.0
         self._steps[idx] = 0
         self._obs[idx] = 0.0  # the start state observes as all zeros
+        if self._gpu is not None:
+            self._gpu.set_rows(idx, self._rows[idx], self._state[idx], self._noise[idx], self._rng[idx], self._steps[idx])
 
     def _labels(self, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         labels = np.full(self.num_envs, None, dtype=object)
@@ -350,7 +369,11 @@ class HoverVectorEnv(VectorEnv):
         a = actions
         if not (type(a) is np.ndarray and a.dtype == np.float64 and a.shape == self._actions.shape and a.flags.c_contiguous):
             a = self._coerce_actions(actions)
-        step_batch(self._rows, self._index, self._state, self._noise, self._rng, self._steps, a, self.episode_steps, self._obs, self._reward, self._crash)
+        if self._gpu is None:
+            step_batch(self._rows, self._index, self._state, self._noise, self._rng, self._steps, a, self.episode_steps, self._obs, self._reward, self._crash)
+        else:
+            self._gpu.step(a, self.episode_steps, self._obs, self._reward, self._crash)
+            self._steps += 1  # as the kernel counts every helicopter's step
         rewards = self._reward.copy()
         terminated = self._crash.copy()
         truncated = self._steps >= self._limit

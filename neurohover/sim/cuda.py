@@ -174,6 +174,34 @@ fly_job = kernel.fly_job  # the CPU dispatcher; _rebind hands the kernel its dev
 _KERNEL = None
 
 
+def _step_thread(mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps, obs_out, rew_out, crash_out):
+    """One CUDA thread per helicopter: the CPU ``step_batch`` loop body."""
+    i = cuda.grid(1)
+    if i < states.shape[0]:
+        step_one(i, mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps, obs_out, rew_out, crash_out)
+
+
+def _reset_thread(idx, rows, states, noise, rngs, steps, mdp_rows, d_states, d_noise, d_rngs, d_steps):
+    """Plumbing, not physics: copy the host's rows of the reset sub-environments ``idx`` into the device arrays."""
+    t = cuda.grid(1)
+    if t < idx.shape[0]:
+        i = idx[t]
+        for m in range(rows.shape[1]):
+            mdp_rows[i, m] = rows[t, m]
+        for m in range(states.shape[1]):
+            d_states[i, m] = states[t, m]
+        for m in range(noise.shape[1]):
+            d_noise[i, m] = noise[t, m]
+        for m in range(rngs.shape[1]):
+            d_rngs[i, m] = rngs[t, m]
+        d_steps[i] = steps[t]
+
+
+step_one = kernel.step_one  # the CPU dispatcher; _rebind hands the kernel its device version
+_STEP_KERNEL = None
+_RESET_KERNEL = None
+
+
 def _require() -> None:
     """Raise RuntimeError unless a GPU (or the simulator) is usable; set up the target's primitives."""
     global libdevice
@@ -301,3 +329,89 @@ def rollout_batch_cuda(
         d_obs.copy_to_host(obs_out)
         d_act.copy_to_host(act_out)
     cuda.synchronize()
+
+
+def step_kernel():
+    """The CUDA kernel (built on first use): same arguments as :func:`neurohover.sim.kernel.step_batch`."""
+    global _STEP_KERNEL
+    if _STEP_KERNEL is None:
+        _require()
+        _STEP_KERNEL = cuda.jit(_rebind(_step_thread))
+    return _STEP_KERNEL
+
+
+def _reset_kernel():
+    global _RESET_KERNEL
+    if _RESET_KERNEL is None:
+        _require()
+        _RESET_KERNEL = cuda.jit(_reset_thread)
+    return _RESET_KERNEL
+
+
+class StepBatch:
+    """:func:`~neurohover.sim.kernel.step_batch` on the GPU with its per-helicopter arrays kept there.
+
+    The MDP rows, states, noise, stream states and step counters of ``n`` helicopters live in
+    device memory between steps; :meth:`step` copies the actions in and the observations, rewards
+    and crash flags out; :meth:`set_rows` overwrites the rows of some helicopters (their resets)
+    from host arrays. Raises RuntimeError when no GPU (and no simulator) is usable.
+    """
+
+    def __init__(self, mdp_rows, env_mdp, states, noise, rngs, steps, threads_per_block: int | None = None) -> None:
+        self._kernel = step_kernel()
+        self._n = states.shape[0]
+        self._tpb = threads_per_block or THREADS_PER_BLOCK
+
+        def to(a):
+            return cuda.to_device(np.ascontiguousarray(a))
+
+        self.rows, self.env_mdp, self.states, self.noise, self.rngs, self.steps = (to(a) for a in (mdp_rows, env_mdp, states, noise, rngs, steps))
+        self._actions = cuda.device_array((self._n, 4), dtype=np.float64)
+        self._obs = cuda.device_array((self._n, 12), dtype=np.float64)
+        self._rew = cuda.device_array(self._n, dtype=np.float64)
+        self._crash = cuda.device_array(self._n, dtype=np.bool_)
+
+    def set_rows(self, idx, mdp_rows, states, noise, rngs, steps) -> None:
+        """Helicopters ``idx`` take row ``t`` of each host array (``mdp_rows[t]`` etc., one row per entry of ``idx``)."""
+        n = len(idx)
+        if n == 0:
+            return
+
+        def to(a):
+            return cuda.to_device(np.ascontiguousarray(a))
+
+        blocks = (n + self._tpb - 1) // self._tpb
+        _reset_kernel()[blocks, self._tpb](
+            to(np.asarray(idx, dtype=np.int64)),
+            to(mdp_rows),
+            to(states),
+            to(noise),
+            to(rngs),
+            to(steps),
+            self.rows,
+            self.states,
+            self.noise,
+            self.rngs,
+            self.steps,
+        )
+
+    def step(self, actions, n_steps, obs_out, rew_out, crash_out) -> None:
+        """One control step of every helicopter: ``actions`` (n, 4) in, the host outputs filled in place."""
+        self._actions.copy_to_device(np.ascontiguousarray(actions))
+        self._kernel[(self._n + self._tpb - 1) // self._tpb, self._tpb](
+            self.rows,
+            self.env_mdp,
+            self.states,
+            self.noise,
+            self.rngs,
+            self.steps,
+            self._actions,
+            np.int64(n_steps),
+            self._obs,
+            self._rew,
+            self._crash,
+        )
+        self._obs.copy_to_host(obs_out)
+        self._rew.copy_to_host(rew_out)
+        self._crash.copy_to_host(crash_out)
+        cuda.synchronize()

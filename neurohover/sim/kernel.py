@@ -440,71 +440,81 @@ def rollout_batch(
         )
 
 
+@nb.njit(cache=True, inline="always", fastmath={"contract"})
+def step_one(i, mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps, obs_out, rew_out, crash_out):
+    """Advance helicopter ``i`` of :func:`step_batch` by one control step (its arguments, plus ``i``).
+
+    Shared by the CPU kernel (one loop iteration) and the CUDA kernel (one thread,
+    :mod:`neurohover.sim.cuda`), so both targets compile this source.
+    """
+    k = steps[i]
+    t = k + 1
+    steps[i] = t
+    a1, a2, a3, a4 = actions[i, 0], actions[i, 1], actions[i, 2], actions[i, 3]
+    if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
+        o = observe(
+            (
+                states[i, 0],
+                states[i, 1],
+                states[i, 2],
+                states[i, 3],
+                states[i, 4],
+                states[i, 5],
+                states[i, 6],
+                states[i, 7],
+                states[i, 8],
+                states[i, 9],
+                states[i, 10],
+                states[i, 11],
+                states[i, 12],
+            )
+        )
+        for m in range(12):
+            obs_out[i, m] = o[m]
+        rew_out[i] = -CRASH_STEP_PENALTY * (n_steps - t)
+        crash_out[i] = True
+        return
+    dyn, std, n_sub, dt, wind = unpack_mdp(mdp_rows[env_mdp[i]])
+    rng = rngs[i]
+    n = (noise[i, 0], noise[i, 1], noise[i, 2], noise[i, 3], noise[i, 4], noise[i, 5])
+    n = update_noise(n, std, next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng))
+    s = (
+        states[i, 0],
+        states[i, 1],
+        states[i, 2],
+        states[i, 3],
+        states[i, 4],
+        states[i, 5],
+        states[i, 6],
+        states[i, 7],
+        states[i, 8],
+        states[i, 9],
+        states[i, 10],
+        states[i, 11],
+        states[i, 12],
+    )
+    s = integrate(s, n, _clip(a1), _clip(a2), _clip(a3), _clip(a4), k, dyn, n_sub, dt, wind)
+    for m in range(13):
+        states[i, m] = s[m]
+    for m in range(6):
+        noise[i, m] = n[m]
+    o = observe(s)
+    for m in range(12):
+        obs_out[i, m] = o[m]
+    if crashed(s):
+        rew_out[i] = -CRASH_STEP_PENALTY * (n_steps - t)
+        crash_out[i] = True
+    else:
+        rew_out[i] = reward_of(o)
+        crash_out[i] = False
+
+
 @nb.njit(cache=True, fastmath={"contract"})
 def step_batch(mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps, obs_out, rew_out, crash_out):
     """Advance many helicopters by one control step each (the vector environment's kernel).
 
     ``states`` (N, 13), ``noise`` (N, 6), ``rngs`` (N, 4) and ``steps`` (N,) are updated in place.
-    A non-finite action is a crash charged the full penalty.
+    A non-finite action is a crash charged the full penalty. The body is :func:`step_one`.
     """
     for i in range(states.shape[0]):
-        k = steps[i]
-        t = k + 1
-        steps[i] = t
-        a1, a2, a3, a4 = actions[i, 0], actions[i, 1], actions[i, 2], actions[i, 3]
-        if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
-            o = observe(
-                (
-                    states[i, 0],
-                    states[i, 1],
-                    states[i, 2],
-                    states[i, 3],
-                    states[i, 4],
-                    states[i, 5],
-                    states[i, 6],
-                    states[i, 7],
-                    states[i, 8],
-                    states[i, 9],
-                    states[i, 10],
-                    states[i, 11],
-                    states[i, 12],
-                )
-            )
-            for m in range(12):
-                obs_out[i, m] = o[m]
-            rew_out[i] = -CRASH_STEP_PENALTY * (n_steps - t)
-            crash_out[i] = True
-            continue
-        dyn, std, n_sub, dt, wind = unpack_mdp(mdp_rows[env_mdp[i]])
-        rng = rngs[i]
-        n = (noise[i, 0], noise[i, 1], noise[i, 2], noise[i, 3], noise[i, 4], noise[i, 5])
-        n = update_noise(n, std, next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng))
-        s = (
-            states[i, 0],
-            states[i, 1],
-            states[i, 2],
-            states[i, 3],
-            states[i, 4],
-            states[i, 5],
-            states[i, 6],
-            states[i, 7],
-            states[i, 8],
-            states[i, 9],
-            states[i, 10],
-            states[i, 11],
-            states[i, 12],
-        )
-        s = integrate(s, n, _clip(a1), _clip(a2), _clip(a3), _clip(a4), k, dyn, n_sub, dt, wind)
-        for m in range(13):
-            states[i, m] = s[m]
-        for m in range(6):
-            noise[i, m] = n[m]
-        o = observe(s)
-        for m in range(12):
-            obs_out[i, m] = o[m]
-        if crashed(s):
-            rew_out[i] = -CRASH_STEP_PENALTY * (n_steps - t)
-            crash_out[i] = True
-        else:
-            rew_out[i] = reward_of(o)
-            crash_out[i] = False
+        step_one(i, mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps, obs_out, rew_out, crash_out)
