@@ -267,8 +267,8 @@ def _run_order(key: str) -> tuple[int, int]:
     from .experiments.results import UnitKey
 
     parsed = UnitKey.parse(key)
-    digits = (parsed.mdp or "").lstrip("abcdefghijklmnopqrstuvwxyz")
-    return (int(digits) if digits.isdigit() else -1, parsed.rep if parsed.rep is not None else 0)
+    index = parsed.mdp_index
+    return (index if index is not None else -1, parsed.rep if parsed.rep is not None else 0)
 
 
 def _write_episodes(path: Path, results: Sequence, n_steps: int) -> None:

@@ -138,6 +138,13 @@ def test_bad_result_dicts_are_refused() -> None:
 def test_unit_keys_parse(key: str, parts: tuple) -> None:
     k = UnitKey.parse(key)
     assert (k.stage, k.group, k.mdp, k.rep) == parts and k.key == key
+    assert k.mdp_index == (None if k.mdp is None else int(k.mdp.lstrip("abcdefghijklmnopqrstuvwxyz")))
+
+
+def test_the_mdp_index_is_the_number_in_the_mdp_part() -> None:
+    assert UnitKey.parse("model/lr-gls/test12").mdp_index == 12
+    assert UnitKey.parse("run/a/b/train0/rep1").mdp_index == 0
+    assert UnitKey.parse("policy/generic-race1").mdp_index is None
 
 
 def test_export_and_report_read_typed_results(committed_store: Path, tmp_path: Path) -> None:

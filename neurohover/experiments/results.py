@@ -481,6 +481,12 @@ class UnitKey:
     mdp: str | None = None
     rep: int | None = None
 
+    @property
+    def mdp_index(self) -> int | None:
+        """The index in :attr:`mdp` (``3`` of ``"train3"``), or None without one."""
+        digits = (self.mdp or "").lstrip("abcdefghijklmnopqrstuvwxyz")
+        return int(digits) if digits.isdigit() else None
+
     @classmethod
     def parse(cls, key: str) -> UnitKey:
         """Split a unit key into its parts.
