@@ -13,6 +13,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from . import __version__
 from .errors import NeurohoverError
 
 # Modules of later pipeline stages; each has ``register(subparsers)`` adding its commands.
@@ -176,20 +177,11 @@ def cmd_bench(args: argparse.Namespace) -> int:
     return 0
 
 
-def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("neurohover")
-    except PackageNotFoundError:  # run from a source tree that was never installed
-        return "unknown (not installed)"
-
-
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="neurohover", description="Generalized helicopter hovering (Koppejan & Whiteson 2011): fly, evolve, learn models, compete, reproduce."
     )
-    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     p = sub.add_parser("fly", help="fly a policy and print return statistics", description=cmd_fly.__doc__)
