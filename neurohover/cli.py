@@ -20,18 +20,20 @@ from .errors import NeurohoverError
 COMMAND_MODULES: tuple[str, ...] = ("neurohover.commands_learning", "neurohover.commands_agents", "neurohover.commands_reproduce", "neurohover.commands_plots")
 
 
-def _floats(text: str, what: str) -> list[float]:
+def parse_floats(text: str, what: str) -> list[float]:
+    """Comma-separated numbers of option ``what``, or one clear error."""
     try:
         return [float(x) for x in text.split(",") if x.strip() != ""]
     except ValueError:
         raise NeurohoverError(f"{what} must be comma-separated numbers, got {text!r}") from None
 
 
-def _family_and_mdps(args: argparse.Namespace, n: int, rng: np.random.Generator):
-    """The task family and the MDP of each of ``n`` episodes, from --task/--mdp/--wind/--params/--sigma."""
-    from .tasks import get_task_family
+def explicit_mdp(args: argparse.Namespace, family):
+    """The MDP set by --wind or --params, with its description (``"wind=..."``), or None without them.
 
-    family = get_task_family(args.task, args.sigma)
+    Refuses both together, either with --mdp, and --wind for a family other than GHH-08
+    (shared by ``fly`` and ``evolve``).
+    """
     if args.wind is not None and args.params is not None:
         raise NeurohoverError("give either --wind (GHH-08) or --params, not both")
     if (args.wind is not None or args.params is not None) and args.mdp is not None:
@@ -40,9 +42,20 @@ def _family_and_mdps(args: argparse.Namespace, n: int, rng: np.random.Generator)
     if args.wind is not None:
         if family.name != "ghh08":
             raise NeurohoverError(f"--wind U,V sets a GHH-08 MDP; task {args.task!r} takes --params")
-        return family, [family.make(_floats(args.wind, "--wind"))] * n
+        return family.make(parse_floats(args.wind, "--wind")), f"wind={args.wind}"
     if args.params is not None:
-        return family, [family.make(_floats(args.params, "--params"))] * n
+        return family.make(parse_floats(args.params, "--params")), f"params={args.params}"
+    return None
+
+
+def _family_and_mdps(args: argparse.Namespace, n: int, rng: np.random.Generator):
+    """The task family and the MDP of each of ``n`` episodes, from --task/--mdp/--wind/--params/--sigma."""
+    from .tasks import get_task_family
+
+    family = get_task_family(args.task, args.sigma)
+    explicit = explicit_mdp(args, family)
+    if explicit is not None:
+        return family, [explicit[0]] * n
     if args.mdp == "sample":  # a fresh MDP from G for every episode
         return family, [family.sample(rng, label=f"{family.name}/sample:{i}") for i in range(n)]
     return family, [family.mdp(args.mdp or "zero")] * n

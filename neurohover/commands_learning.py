@@ -33,29 +33,15 @@ from .evaluate import DEVICES, check_device
 MDP_FAMILY = "G"
 
 
-def _floats(text: str, what: str) -> list[float]:
-    try:
-        return [float(x) for x in text.split(",") if x.strip() != ""]
-    except ValueError:
-        raise NeurohoverError(f"{what} must be comma-separated numbers, got {text!r}") from None
-
-
 def _target(args: argparse.Namespace):
     """(target, family, mdp description for the metadata)."""
+    from .cli import explicit_mdp
     from .tasks import get_task_family
 
     family = get_task_family(args.task, args.sigma)
-    if args.wind is not None and args.params is not None:
-        raise NeurohoverError("give either --wind (GHH-08) or --params, not both")
-    if (args.wind is not None or args.params is not None) and args.mdp is not None:
-        given = "--wind" if args.wind is not None else "--params"
-        raise NeurohoverError(f"{given} sets the MDP explicitly; it cannot be combined with --mdp {args.mdp}")
-    if args.wind is not None:
-        if family.name != "ghh08":
-            raise NeurohoverError(f"--wind U,V sets a GHH-08 MDP; task {args.task!r} takes --params")
-        return family.make(_floats(args.wind, "--wind")), family, f"wind={args.wind}"
-    if args.params is not None:
-        return family.make(_floats(args.params, "--params")), family, f"params={args.params}"
+    explicit = explicit_mdp(args, family)
+    if explicit is not None:
+        return explicit[0], family, explicit[1]
     spec = args.mdp if args.mdp is not None else (MDP_FAMILY if family.generic_over_distribution else "zero")
     if spec == MDP_FAMILY:
         return family, family, MDP_FAMILY
