@@ -7,13 +7,13 @@ cases are small (20 jobs of 40 steps: a few seconds).
 
 from __future__ import annotations
 
-import json
 import os
 import subprocess
 import sys
 
 import numpy as np
 import pytest
+from cuda_sim import run_simulated
 
 from neurohover import NeurohoverError, baseline_policy, evaluate, evaluate_jobs, get_task_family
 
@@ -61,10 +61,7 @@ print(json.dumps(out))
 
 @pytest.fixture(scope="module")
 def simulated() -> dict:
-    env = {**os.environ, "NUMBA_ENABLE_CUDASIM": "1"}
-    proc = subprocess.run([sys.executable, "-c", SCRIPT], env=env, capture_output=True, text=True, timeout=600)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return json.loads(proc.stdout.splitlines()[-1])
+    return run_simulated(SCRIPT)
 
 
 def test_cuda_kernel_matches_cpu_kernel_under_the_simulator(simulated: dict) -> None:

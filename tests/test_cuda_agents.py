@@ -6,13 +6,9 @@ As in tests/test_cuda_plumbing.py the GPU side runs in a subprocess with NUMBA_E
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
-import sys
-
 import numpy as np
 import pytest
+from cuda_sim import run_simulated
 
 from neurohover.agents.model_based import ModelEvolution
 from neurohover.errors import NeurohoverError
@@ -40,10 +36,7 @@ print(json.dumps(out))
 
 
 def test_agents_fly_the_same_test_runs_on_the_simulated_gpu() -> None:
-    env = {**os.environ, "NUMBA_ENABLE_CUDASIM": "1"}
-    proc = subprocess.run([sys.executable, "-c", SCRIPT], capture_output=True, text=True, env=env, timeout=600)
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    out = run_simulated(SCRIPT)
     cpu, gpu = out["cpu"], out["cuda"]
     assert gpu["free_policy"] == cpu["free_policy"] and gpu["inc_policy"] == cpu["inc_policy"]
     np.testing.assert_allclose(gpu["free"], cpu["free"], rtol=1e-9)

@@ -9,14 +9,11 @@ the same comparisons, are the same genomes.
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from cuda_sim import run_simulated
 
 from neurohover.cli import main
 
@@ -102,10 +99,7 @@ print(json.dumps(out))
 @pytest.fixture(scope="module")
 def simulated(tmp_path_factory) -> dict:
     tmp = tmp_path_factory.mktemp("cudasim")
-    env = {**os.environ, "NUMBA_ENABLE_CUDASIM": "1"}
-    proc = subprocess.run([sys.executable, "-c", SCRIPT, str(tmp)], env=env, capture_output=True, text=True, timeout=600)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return json.loads(proc.stdout.splitlines()[-1])
+    return run_simulated(SCRIPT, str(tmp))
 
 
 def _close(a, b, path: str = "") -> None:

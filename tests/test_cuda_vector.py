@@ -9,13 +9,9 @@ MDPs, one fed a non-finite action (a crash, then an autoreset) and a short ``max
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
-import sys
-
 import numpy as np
 import pytest
+from cuda_sim import run_simulated
 
 from neurohover import NeurohoverError
 from neurohover.envs import HoverVectorEnv
@@ -64,10 +60,7 @@ print(json.dumps(out))
 
 @pytest.fixture(scope="module")
 def simulated() -> dict:
-    env = {**os.environ, "NUMBA_ENABLE_CUDASIM": "1"}
-    proc = subprocess.run([sys.executable, "-c", SCRIPT], env=env, capture_output=True, text=True, timeout=600)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return json.loads(proc.stdout.splitlines()[-1])
+    return run_simulated(SCRIPT)
 
 
 def test_vector_env_on_cuda_matches_the_cpu(simulated: dict) -> None:
