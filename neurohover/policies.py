@@ -219,13 +219,21 @@ def policy_from_dict(d: dict, source: str = "policy") -> Policy:
 
 
 def load_policy(source: str | Path) -> Policy:
-    """Load a policy file (JSON), or the baseline policy for the name ``baseline``."""
+    """Load a policy file (JSON, or the authors' ``.net`` format: :mod:`neurohover.netfile`), or
+    the baseline policy for the name ``baseline``."""
     if str(source) == "baseline":
         return baseline_policy()
     path = Path(source)
     if not path.is_file():
         what = "is not a file" if path.exists() else "does not exist"
-        raise NeurohoverError(f"policy file {str(path)!r} {what} (give a JSON policy file or 'baseline')")
+        raise NeurohoverError(f"policy file {str(path)!r} {what} (give a JSON policy file, an authors' .net file or 'baseline')")
+    if path.suffix == ".net":
+        from .netfile import policy_from_net
+
+        try:
+            return policy_from_net(path.read_text(), f"network file {str(path)!r}")
+        except (OSError, UnicodeDecodeError) as err:
+            raise NeurohoverError(f"network file {str(path)!r} cannot be read ({getattr(err, 'strerror', None) or type(err).__name__})") from None
     try:
         data = json.loads(path.read_text())
     except (json.JSONDecodeError, UnicodeDecodeError) as err:

@@ -1,0 +1,113 @@
+"""The authors' .net network files: parsing, writing, and flying them like any policy file."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from neurohover import NeurohoverError, evaluate, get_task_family
+from neurohover.netfile import policy_from_net, policy_to_net
+from neurohover.policies import Policy, baseline_policy, load_policy, mlp_baseline_genome
+
+# The authors' baseline.net as their eonn package wrote it (node and link lines, 4 decimals).
+BASELINE_NET = """n 1 0 0 +0.0000
+n 2 0 0 +0.0000
+n 3 0 0 +0.0000
+n 4 0 0 +0.0000
+n 5 0 0 +0.0000
+n 6 0 0 +0.0000
+n 7 0 0 +0.0000
+n 8 0 0 +0.0000
+n 9 0 0 +0.0000
+n 10 0 0 +0.0000
+n 11 0 0 +0.0000
+n 12 0 0 +0.0000
+n 13 2 1 +0.0000
+n 14 2 1 +0.0000
+n 15 2 1 +0.0000
+n 16 2 0 +0.0000
+n 17 2 0 +0.0000
+n 18 2 0 +0.0000
+n 19 2 0 +0.0000
+n 20 2 1 +0.0000
+n 21 2 1 +0.0000
+n 22 2 1 +0.0000
+n 23 2 1 +0.0000
+n 24 1 0 +0.0200
+n 25 1 0 +0.0000
+n 26 1 0 +0.0000
+n 27 1 0 +0.2300
+s 1 17 -0.0322
+s 2 16 -0.0367
+s 3 19 +0.1348
+s 4 14 +0.0000
+s 4 17 -0.0185
+s 5 13 +0.0000
+s 5 16 -0.0196
+s 6 15 +0.0000
+s 6 19 +0.0513
+s 10 16 -0.7475
+s 11 17 +0.7904
+s 12 18 -0.1969
+s 13 16 +0.0000
+s 14 17 +0.0000
+s 15 19 +0.0000
+s 16 20 +0.0000
+s 16 24 +1.0000
+s 17 21 +0.0000
+s 17 25 +1.0000
+s 18 22 +0.0000
+s 18 26 +1.0000
+s 19 23 +0.0000
+s 19 27 +1.0000
+s 20 24 +0.0000
+s 21 25 +0.0000
+s 22 26 +0.0000
+s 23 27 +0.0000
+"""
+
+
+def test_the_authors_baseline_file_is_our_baseline_seed_and_flies_like_the_baseline(tmp_path: Path) -> None:
+    path = tmp_path / "baseline.net"
+    path.write_text("# wind: [+0.000, +0.000]\n" + BASELINE_NET)
+    policy = load_policy(path)
+    assert policy.topology == "mlp"
+    np.testing.assert_array_equal(policy.genome, mlp_baseline_genome())
+    assert policy.metadata["comments"] == ["wind: [+0.000, +0.000]"]
+    mdps = get_task_family("ghh08").training_mdps()[:2]
+    a = evaluate(policy, mdps, episodes=1, seed=3, n_steps=300).returns
+    b = evaluate(baseline_policy(), mdps, episodes=1, seed=3, n_steps=300).returns
+    np.testing.assert_allclose(a, b, rtol=1e-12)
+
+
+def test_writing_and_reading_a_net_file_keeps_every_gene_and_its_place() -> None:
+    genome = np.random.default_rng(0).normal(size=42)
+    policy = Policy("mlp", genome)
+    back = policy_from_net(policy_to_net(policy))
+    np.testing.assert_array_equal(back.genome, genome)
+    # Shuffled lines are read by node and link ids, not by position.
+    lines = policy_to_net(policy).splitlines()
+    np.testing.assert_array_equal(policy_from_net("\n".join(reversed(lines))).genome, genome)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (BASELINE_NET.replace("s 23 27 +0.0000\n", ""), "missing link S4->a4"),
+        (BASELINE_NET + "s 1 24 +0.5\n", "link 1 -> 24 (u->a1) is not a link of the paper's MLP"),
+        (BASELINE_NET + "n 28 2 0 +0.0\n", "node 28 is not a node of the paper's MLP"),
+        (BASELINE_NET.replace("s 2 16 -0.0367", "s 2 16 heavy"), "line 29"),
+    ],
+    ids=["missing-link", "extra-link", "extra-node", "bad-number"],
+)
+def test_a_file_that_is_not_the_papers_mlp_is_refused_with_the_line(text: str, message: str) -> None:
+    with pytest.raises(NeurohoverError, match=re.escape(message)):
+        policy_from_net(text, "x.net")
+
+
+def test_only_an_mlp_has_a_net_form() -> None:
+    with pytest.raises(NeurohoverError, match="only MLP policies"):
+        policy_to_net(Policy("slp", np.zeros(40)))
