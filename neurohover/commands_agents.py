@@ -12,10 +12,12 @@ from .evaluate import DEVICES, check_device
 def cmd_build_policies(args: argparse.Namespace) -> int:
     """Evolve a task family's generic and specialised policies (the agents' policy set)."""
     from .paths import output_dir
-    from .policysets import build_policy_set
+    from .policysets import LINEAGES, build_policy_set
 
     if args.budget < 1:
         raise NeurohoverError(f"--budget {args.budget} is out of range: allowed >= 1")
+    if args.lineage not in LINEAGES:
+        raise NeurohoverError(f"--lineage {args.lineage!r} is not known: allowed {', '.join(LINEAGES)}")
     if args.out is not None:
         output_dir(args.out, "--out")
     ps = build_policy_set(
@@ -25,6 +27,7 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
         fghh_budget=args.fghh_budget,
         seed=args.seed,
         n_steps=args.episode_steps,
+        lineage=args.lineage,
         progress=lambda msg: print(msg, file=sys.stderr, flush=True),
     )
     print(f"policy set written to {ps.directory}")
@@ -101,6 +104,12 @@ def register(sub) -> None:
     p.add_argument("--fghh-budget", type=int, default=200000, help="episodes per FGHH generic-policy evolution over G (default 200000)")
     p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument(
+        "--lineage",
+        default="chain",
+        help="GHH-08/09: chain (default: every run seeded from an ancestor evolved over the training MDPs in turn, as the authors' policies were) "
+        "or independent (every run from the baseline policy)",
+    )
     p.set_defaults(func=cmd_build_policies)
 
     p = sub.add_parser("compete", help="run test runs of an on-line agent", description=cmd_compete.__doc__)

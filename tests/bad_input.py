@@ -36,6 +36,7 @@ CASES: list[tuple[list[str], str]] = [
         "is a file; give a directory",
     ),
     (["build-policies", "--task", "ghh08", "--budget", "10", "--out", "afile"], "is a file; give a directory"),
+    (["build-policies", "--task", "ghh08", "--budget", "10", "--out", "q", "--lineage", "tree"], "--lineage 'tree' is not known: allowed chain, independent"),
     (["reproduce", "fig2", "--store", "adir"], "is a directory"),
     (["reproduce", "fig2", "--store", "/proc/s.sqlite"], "cannot create a file in '/proc'"),
     (["reproduce", "adir/x.toml", "--store", "s.sqlite"], "does not exist"),

@@ -75,7 +75,8 @@ from pathlib import Path  # noqa: E402
 from neurohover.agents.hybrid import DISCARD_RETURN, HybridAgent, HybridSettings  # noqa: E402
 from neurohover.agents.model_based import IncrementalModelBasedAgent, ModelBasedAgent, ModelEvolution, learn_model  # noqa: E402
 from neurohover.compete import compete  # noqa: E402
-from neurohover.policysets import build_policy_set, choose_safe, load_policy_set  # noqa: E402
+from neurohover.policies import load_policy  # noqa: E402
+from neurohover.policysets import build_policy_set, choose_safe, load_policy_set, table3_summary  # noqa: E402
 
 SHORT = ModelEvolution(budget=300, n_steps=1000)
 
@@ -95,6 +96,47 @@ def test_build_policies_writes_a_loadable_set_with_computed_safe_policies(tiny_p
     crashes = np.array(manifest["crashes_on_training_mdps"])
     returns = np.array(manifest["mean_return_on_training_mdps"])
     assert tuple(manifest["safe"]) == choose_safe(crashes, returns) == ps.safe
+    assert manifest["table3"] == table3_summary(crashes, returns)
+
+
+def test_table3_summary_averages_own_mdp_and_all_mdps() -> None:
+    returns = -np.array([[100.0, 300.0], [500.0, 200.0]])
+    crashes = np.array([[0, 1], [0, 0]])
+    assert table3_summary(crashes, returns) == {"r": -150.0, "r_G": -275.0, "crashed_episodes": 1}
+
+
+def test_chain_lineage_seeds_every_run_from_the_ancestor_and_independent_from_the_baseline(tiny_policy_dir: Path, tmp_path: Path) -> None:
+    base = prototype("mlp", "baseline").genome
+    manifest = json.loads((tiny_policy_dir / "ghh08" / "manifest.json").read_text())
+    assert manifest["lineage"] == "chain"
+    ancestor = load_policy(tiny_policy_dir / "ghh08" / "ancestor.json").genome
+    ps = load_policy_set("ghh08", tiny_policy_dir)
+    # Genes the ancestor evolved away from the baseline, and that a short run left alone, are the
+    # ancestor's exact values in every policy of a chained set (as in the authors' policy files).
+    evolved = ancestor != base
+    assert evolved.sum() > 5
+    for policy in (ps.generic, *ps.specialised):
+        assert np.sum((policy.genome == ancestor) & evolved) > 0
+    build_policy_set("ghh08", tmp_path, budget=30, n_steps=100, safety_episodes=1, lineage="independent")
+    independent = load_policy_set("ghh08", tmp_path)
+    assert not (tmp_path / "ghh08" / "ancestor.json").exists()
+    assert json.loads((tmp_path / "ghh08" / "manifest.json").read_text())["lineage"] == "independent"
+    for policy in independent.specialised:
+        assert np.sum(policy.genome == base) > 30  # a 30-episode run from the baseline keeps most of its genes
+    with pytest.raises(NeurohoverError, match="lineage 'tree' is not known: allowed chain, independent"):
+        build_policy_set("ghh08", tmp_path, budget=30, lineage="tree")
+
+
+def test_shipped_ghh08_specialised_policies_match_table_3s_mlp_row() -> None:
+    """Table 3 (MLP, evolved from the baseline): r = -132.60 on the policy's own training MDP,
+    r_G = -2001.89 across all ten, no crash on any. The shipped set must stay near that."""
+    family = get_task_family("ghh08")
+    ps = load_policy_set("ghh08")
+    ev = evaluate(list(ps.specialised), family.training_mdps(), episodes=2, seed=7)
+    returns = ev.returns.mean(axis=2)  # (policy, MDP)
+    assert int(ev.crashed.sum()) == 0
+    r, r_g = float(np.diag(returns).mean()), float(returns.mean())
+    assert -175 < r and -2700 < r_g, (r, r_g)
 
 
 def test_choose_safe_follows_the_papers_rule() -> None:
