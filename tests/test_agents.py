@@ -75,7 +75,8 @@ from pathlib import Path  # noqa: E402
 from neurohover.agents.hybrid import DISCARD_RETURN, HybridAgent, HybridSettings  # noqa: E402
 from neurohover.agents.model_based import IncrementalModelBasedAgent, ModelBasedAgent, ModelEvolution, learn_model  # noqa: E402
 from neurohover.compete import compete  # noqa: E402
-from neurohover.policies import load_policy  # noqa: E402
+from neurohover.models import MIN_TRANSITIONS  # noqa: E402
+from neurohover.policies import load_policy, slp_baseline_genome  # noqa: E402
 from neurohover.policysets import build_policy_set, choose_safe, load_policy_set, table3_summary  # noqa: E402
 
 SHORT = ModelEvolution(budget=300, n_steps=1000)
@@ -156,6 +157,18 @@ def test_model_based_agents_beat_the_baseline_on_ghh08_test_mdps() -> None:
         totals["model-based"] += run_test(ModelBasedAgent(generic, SHORT), family, mdp, episodes=15, seed=i, n_steps=1000).score
         totals["incremental"] += run_test(IncrementalModelBasedAgent(generic, SHORT), family, mdp, episodes=15, seed=i, n_steps=1000).score
     assert totals["model-based"] > totals["baseline"] and totals["incremental"] > totals["baseline"], totals
+
+
+@pytest.mark.parametrize("agent_class", [ModelBasedAgent, IncrementalModelBasedAgent])
+def test_a_generic_policy_that_crashes_at_once_flies_again_until_a_model_can_be_learned(agent_class) -> None:
+    family = get_task_family("ghh08")
+    genome = slp_baseline_genome()
+    genome[36] = 1.0  # the baseline with full aileron trim: rolls over and crashes within a few steps
+    generic = Policy("slp", genome)
+    agent = agent_class(generic, ModelEvolution(budget=60, n_steps=200))
+    result = run_test(agent, family, family.training_mdps()[0], episodes=12, seed=0, n_steps=200)
+    assert result.crashed[:6].all() and result.steps[:6].sum() < MIN_TRANSITIONS  # six short flights: too little data
+    assert result.policy[0] == "generic" and any(label.startswith("model:") for label in result.policy)  # then it learned
 
 
 def test_incremental_agent_stops_learning_by_its_rule() -> None:

@@ -14,6 +14,7 @@ import numpy as np
 from ..errors import NeurohoverError
 from ..evaluate import evaluate
 from ..flightdata import FlightData
+from ..models.transitions import MIN_TRANSITIONS
 from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
@@ -58,6 +59,12 @@ def learn_model(flight_data: FlightData, estimator: str = "ols") -> MDP:
     return learn_lr(flight_data, estimator=estimator).mdp()
 
 
+def enough_to_learn(flight_data: FlightData) -> bool:
+    """Whether ``flight_data`` hold the transitions a model needs (``MIN_TRANSITIONS``): an agent
+    whose flights crash within a few steps flies again to gather more before it learns."""
+    return sum(a.shape[0] for a in flight_data.actions) >= MIN_TRANSITIONS
+
+
 def evolve_on_model(model: MDP, prototype: Policy, settings: ModelEvolution, seed: int) -> tuple[Policy, float]:
     """Evolve a policy on ``model``; return it and its predicted return (mean over model episodes)."""
     from ..evolution.evolve import evolve
@@ -81,10 +88,12 @@ class ModelBasedAgent(Agent):
         self.generic = generic
         self.settings = settings
         self.policy: Policy | None = None
+        self.flight_data: FlightData | None = None
         self._rng = np.random.default_rng(0)
 
     def start(self, family: TaskFamily, rng: np.random.Generator) -> None:
         self.policy = None
+        self.flight_data = None
         self._rng = rng
 
     def choose(self, episode: int) -> Choice:
@@ -94,8 +103,10 @@ class ModelBasedAgent(Agent):
 
     def update(self, outcome: EpisodeOutcome) -> None:
         if self.policy is None and outcome.flight_data is not None:
-            model = learn_model(outcome.flight_data, self.settings.estimator)
-            self.policy, _ = evolve_on_model(model, self.generic, self.settings, int(self._rng.integers(2**62)))
+            self.flight_data = outcome.flight_data if self.flight_data is None else self.flight_data + outcome.flight_data
+            if enough_to_learn(self.flight_data):  # a generic that crashed at once flies again first
+                model = learn_model(self.flight_data, self.settings.estimator)
+                self.policy, _ = evolve_on_model(model, self.generic, self.settings, int(self._rng.integers(2**62)))
 
 
 class IncrementalModelBasedAgent(Agent):
@@ -151,6 +162,8 @@ class IncrementalModelBasedAgent(Agent):
         if outcome.flight_data is not None:
             self.flight_data = outcome.flight_data if self.flight_data is None else self.flight_data + outcome.flight_data
         assert self.flight_data is not None  # the first episode is always recorded
+        if not enough_to_learn(self.flight_data):  # the policy crashed at once: fly it again first
+            return
         model = learn_model(self.flight_data, self.settings.estimator)
         self.models_learned += 1
         self.current, self.predicted = evolve_on_model(model, self.generic, self.settings, int(self._rng.integers(2**62)))
