@@ -140,6 +140,17 @@ def test_shipped_ghh08_specialised_policies_match_table_3s_mlp_row() -> None:
     assert -175 < r and -2700 < r_g, (r, r_g)
 
 
+def test_shipped_ghh09_set_is_crash_free_on_the_training_mdps_and_its_safe_pair_is_the_papers() -> None:
+    """The paper's hybrid flies the specialised policies of training MDPs #4 and #7 (0-based 3, 6)."""
+    family = get_task_family("ghh09")
+    ps = load_policy_set("ghh09")
+    ev = evaluate(list(ps.specialised), family.training_mdps(), episodes=1, seed=11)
+    assert int(ev.crashed.sum()) == 0
+    manifest = ps.manifest
+    assert choose_safe(np.array(manifest["crashes_on_training_mdps"]), np.array(manifest["mean_return_on_training_mdps"])) == ps.safe
+    assert set(ps.safe) == {3, 6}
+
+
 def test_choose_safe_follows_the_papers_rule() -> None:
     crashes = np.zeros((4, 4), dtype=int)
     crashes[0, 2] = 1  # policy 0 crashed on another MDP
