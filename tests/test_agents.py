@@ -209,25 +209,32 @@ def test_hybrid_discards_a_policy_that_needs_the_safeguard(replacement: str) -> 
     assert agent.trial_fired[0] and not any(agent.trial_fired[1:])
     assert "safe:0" not in result.policy[5:]  # discarded: never kept for the run
     assert not result.crashed.any()
-    if replacement == "rerank":  # the authors' code: charged 1e6, its episode credited to the fallback
-        assert agent.scores[0] == DISCARD_RETURN and agent.discarded == 1 and agent.replacements == 0
-        assert agent.candidates[-1][1] == "fallback" and agent.scores[-1] == result.returns[0]
-        assert result.policy[5] == agent.candidates[int(np.argmax(agent.scores))][1]
+    if replacement == "rerank":  # the authors' code: charged 1e6, its episode's return to the fallback
+        assert agent.values[0] == [DISCARD_RETURN] and agent.discarded == 1 and agent.replacements == 0
+        assert agent.fallback_returns == [result.returns[0]] and "fallback" not in {label for _, label in agent.candidates}
+        assert result.policy[5] == agent.candidates[int(np.argmax([np.mean(v[:1]) for v in agent.values]))][1]
 
 
-def test_hybrid_rerank_falls_back_to_the_best_remaining_policy_without_evolving() -> None:
+def test_hybrid_rerank_scores_each_candidate_by_the_mean_of_its_episodes_as_the_authors_code() -> None:
     family = get_task_family("ghh09")
     agent = HybridAgent([baseline_policy(), baseline_policy()], prototype("mlp", "baseline"), baseline_policy(), SHORT)
     agent.start(family, np.random.default_rng(0))
     for e, ret in enumerate([-500.0, -400.0, -300.0, -600.0, -700.0]):
         agent.update(EpisodeOutcome(e, ret, False, 1000, -1, None if e > 1 else _flight(e)))
     assert agent.current[1] == "model:0"
-    agent.update(EpisodeOutcome(5, -900.0, False, 1000, 40, None))  # the kept policy needed the safeguard
-    assert agent.current[1] == "safe:1" and agent.discarded == 1 and agent.replacements == 0
-    assert dict(zip((lb for _, lb in agent.candidates), agent.scores))["fallback"] == -900.0
-    agent.update(EpisodeOutcome(6, -950.0, False, 1000, 12, None))
-    assert agent.current[1] == "safe:0"  # next best remaining; the fallback scores the mean of its episodes
-    assert dict(zip((lb for _, lb in agent.candidates), agent.scores))["fallback"] == -925.0
+    for e in range(5, 8):  # three good episodes: its mean becomes (-300 - 3 * 200) / 4
+        agent.update(EpisodeOutcome(e, -200.0, False, 1000, -1, None))
+    assert agent.current[1] == "model:0" and agent.scores[2] == -225.0
+    agent.update(EpisodeOutcome(8, -900.0, False, 1000, 40, None))  # the safeguard fired: -1e6 joins its mean
+    assert agent.discarded == 1 and agent.replacements == 0 and agent.fallback_returns == [-900.0]
+    assert agent.values[2][-1] == DISCARD_RETURN and agent.current[1] == "safe:1"  # the best mean now
+    agent.update(EpisodeOutcome(9, -700.0, False, 1000, -1, None))  # safe:1 mean -550, below safe:0's -500
+    assert agent.current[1] == "safe:0"  # re-ranked after an ordinary episode too
+    assert all(label != "fallback" for _, label in agent.candidates)  # the fallback is never a candidate
+    for e in range(10, 14):  # every candidate fires once: the best mean wins, ties to the earliest
+        agent.update(EpisodeOutcome(e, -900.0, False, 1000, 5, None))
+    means = [np.mean(v) for v in agent.values]
+    assert agent.current == agent.candidates[int(np.argmax(means))]
 
 
 def _flight(e: int):

@@ -40,11 +40,13 @@ class HybridSettings:
     ----------
     replacement : {"rerank", "evolve"}
         What happens to a policy that needed the safeguard (or crashed under it). ``"rerank"`` (the
-        authors' code): it is charged a return of -1e6, the episode's return is credited to the
-        fallback (which becomes a candidate, scored by the mean of its credited episodes), and the
-        best-scoring candidate flies on, ties to the earliest; nothing is re-evolved, so where every
-        candidate and the fallback fail the run keeps failing. ``"evolve"`` (the
-        paper's text): it is discarded and a policy newly evolved on the model replaces it.
+        authors' code): every candidate is scored by the mean over the episodes it started, each
+        counting its return, or -1e6 when the safeguard fired (that episode's return goes to the
+        fallback, which is never a candidate); after every episode the best-scoring candidate flies
+        the next, ties to the earliest. So one firing after many good episodes barely moves a
+        policy, a policy that fired in its only episode is ranked below every policy that has not,
+        and nothing is re-evolved. ``"evolve"`` (the paper's text): the policy is discarded and a
+        policy newly evolved on the model replaces it.
     model_from : {"first-safe", "both"}
         Which trial episodes the LR model learns from: the first of the two safe specialised
         policies' episodes in which the safeguard did not fire (both when it fired in each), as the
@@ -116,8 +118,10 @@ class HybridAgent(Agent):
         self.trial_returns: list[float] = []
         self.trial_fired: list[bool] = []  # the safeguard fired (or the helicopter crashed) in that trial
         self.trial_data: list[tuple[FlightData, bool]] = []  # (flight data, safeguard fired)
-        self.scores: list[float] = []  # "rerank": the score of each candidate
-        self.fallback_returns: list[float] = []  # "rerank": episode returns credited to the fallback
+        self.trial_values: list[float] = []  # each trial's return, or DISCARD_RETURN if the safeguard fired
+        self.values: list[list[float]] = []  # "rerank": per candidate, the values of the episodes it started
+        self.scores: list[float] = []  # "rerank": each candidate's mean value
+        self.fallback_returns: list[float] = []  # "rerank": returns of the episodes the fallback finished
         self.current: tuple[Policy, str] | None = None
         self.replacements = 0  # "evolve": policies evolved to replace one that needed the safeguard
         self.discarded = 0  # "rerank": policies charged DISCARD_RETURN
@@ -135,7 +139,9 @@ class HybridAgent(Agent):
         if self.current is None:
             policy, label = self.candidates[len(self.trial_returns)]
             return Choice(policy, label, fallback=self.fallback, dangerous=d, record=len(self.trial_returns) < 2)
-        return Choice(self.current[0], self.current[1], fallback=self.fallback, dangerous=d, repeat=True)
+        # Re-ranking after every episode may change the choice after any episode: fly one at a time.
+        repeat = self.hybrid.replacement != "rerank"
+        return Choice(self.current[0], self.current[1], fallback=self.fallback, dangerous=d, repeat=repeat)
 
     def _model_data(self) -> FlightData:
         if self.hybrid.model_from == "first-safe":
@@ -147,25 +153,22 @@ class HybridAgent(Agent):
             data = data + more
         return data
 
-    def _credit_fallback(self, ret: float) -> None:
-        self.fallback_returns.append(ret)
-        score = float(np.mean(self.fallback_returns))
-        labels = [label for _, label in self.candidates]
-        if "fallback" in labels:
-            self.scores[labels.index("fallback")] = score
-        else:
-            self.candidates.append((self.fallback, "fallback"))
-            self.scores.append(score)
-
-    def _pick_best(self) -> None:
-        self.current = self.candidates[int(np.argmax(self.scores))]
+    def _rank(self) -> None:
+        self.scores = [float(np.mean(v)) for v in self.values]
+        self.current = self.candidates[int(np.argmax(self.scores))]  # ties: the earliest, as Python's min
 
     def update(self, outcome: EpisodeOutcome) -> None:
-        dangerous = outcome.safeguard_step >= 0 or outcome.crashed
+        fired = outcome.safeguard_step >= 0
+        dangerous = fired or outcome.crashed
+        value = DISCARD_RETURN if fired else outcome.ret  # the authors' error of 1e6 for a firing
         rerank = self.hybrid.replacement == "rerank"
+        if rerank and fired:
+            self.fallback_returns.append(outcome.ret)
+            self.discarded += 1
         if self.current is None:
             self.trial_returns.append(outcome.ret)
             self.trial_fired.append(dangerous)
+            self.trial_values.append(value)
             if outcome.flight_data is not None:
                 self.trial_data.append((outcome.flight_data, dangerous))
             if len(self.trial_returns) == 2:
@@ -173,17 +176,12 @@ class HybridAgent(Agent):
                 self.candidates += [self._evolve(f"model:{i}") for i in range(N_EVOLVED)]
             if len(self.trial_returns) < N_EVOLVED + 2:
                 return
-            fired = self.trial_fired
             if rerank:
-                self.scores = [DISCARD_RETURN if f else r for f, r in zip(fired, self.trial_returns)]
-                self.discarded += sum(fired)
-                for f, r in zip(fired, self.trial_returns):
-                    if f:
-                        self._credit_fallback(r)
-                self._pick_best()
+                self.values = [[v] for v in self.trial_values]
+                self._rank()
                 return
             # "evolve": a policy that needed the safeguard is discarded
-            finite = [-np.inf if f else r for f, r in zip(fired, self.trial_returns)]
+            finite = [-np.inf if f else r for f, r in zip(self.trial_fired, self.trial_returns)]
             best = int(np.argmax(finite))
             if np.isfinite(finite[best]):
                 self.current = self.candidates[best]
@@ -191,18 +189,13 @@ class HybridAgent(Agent):
                 self.replacements += 1
                 self.current = self._evolve(f"replacement:{self.replacements}")
             return
-        if not dangerous:
+        if rerank:
+            self.values[[label for _, label in self.candidates].index(self.current[1])].append(value)
+            self._rank()
             return
-        if not rerank:
+        if dangerous:
             self.replacements += 1
             self.current = self._evolve(f"replacement:{self.replacements}")
-            return
-        index = [label for _, label in self.candidates].index(self.current[1])
-        if self.current[1] != "fallback":
-            self.scores[index] = DISCARD_RETURN
-            self.discarded += 1
-        self._credit_fallback(outcome.ret)
-        self._pick_best()
 
 
 def _hybrid(name: str, fallback: str):
