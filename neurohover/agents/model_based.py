@@ -62,7 +62,7 @@ def learn_model(flight_data: FlightData, estimator: str = "ols") -> MDP:
 def enough_to_learn(flight_data: FlightData) -> bool:
     """Whether ``flight_data`` hold the transitions a model needs (``MIN_TRANSITIONS``): an agent
     whose flights crash within a few steps flies again to gather more before it learns."""
-    return sum(a.shape[0] for a in flight_data.actions) >= MIN_TRANSITIONS
+    return flight_data.n_transitions >= MIN_TRANSITIONS
 
 
 def evolve_on_model(model: MDP, prototype: Policy, settings: ModelEvolution, seed: int) -> tuple[Policy, float]:
