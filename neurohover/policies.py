@@ -227,20 +227,23 @@ def load_policy(source: str | Path) -> Policy:
     if not path.is_file():
         what = "is not a file" if path.exists() else "does not exist"
         raise NeurohoverError(f"policy file {str(path)!r} {what} (give a JSON policy file, an authors' .net file or 'baseline')")
-    if path.suffix == ".net":
+    net = path.suffix == ".net"
+    name = f"{'network' if net else 'policy'} file {str(path)!r}"
+    try:
+        text = path.read_text()
+    except UnicodeDecodeError as err:
+        raise NeurohoverError(f"{name} cannot be read (UnicodeDecodeError)" if net else f"{name} is not valid JSON: {err}") from None
+    except OSError as err:
+        raise NeurohoverError(f"{name} cannot be read ({err.strerror or type(err).__name__})") from None
+    if net:
         from .netfile import policy_from_net
 
-        try:
-            return policy_from_net(path.read_text(), f"network file {str(path)!r}")
-        except (OSError, UnicodeDecodeError) as err:
-            raise NeurohoverError(f"network file {str(path)!r} cannot be read ({getattr(err, 'strerror', None) or type(err).__name__})") from None
+        return policy_from_net(text, name)
     try:
-        data = json.loads(path.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as err:
-        raise NeurohoverError(f"policy file {str(path)!r} is not valid JSON: {err}") from None
-    except OSError as err:
-        raise NeurohoverError(f"policy file {str(path)!r} cannot be read ({err.strerror or type(err).__name__})") from None
-    return policy_from_dict(data, f"policy file {str(path)!r}")
+        data = json.loads(text)
+    except json.JSONDecodeError as err:
+        raise NeurohoverError(f"{name} is not valid JSON: {err}") from None
+    return policy_from_dict(data, name)
 
 
 def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
