@@ -120,7 +120,6 @@ class HybridAgent(Agent):
         self.trial_data: list[tuple[FlightData, bool]] = []  # (flight data, safeguard fired)
         self.trial_values: list[float] = []  # each trial's return, or DISCARD_RETURN if the safeguard fired
         self.values: list[list[float]] = []  # "rerank": per candidate, the values of the episodes it started
-        self.scores: list[float] = []  # "rerank": each candidate's mean value
         self.fallback_returns: list[float] = []  # "rerank": returns of the episodes the fallback finished
         self.current: tuple[Policy, str] | None = None
         self.replacements = 0  # "evolve": policies evolved to replace one that needed the safeguard
@@ -153,8 +152,12 @@ class HybridAgent(Agent):
             data = data + more
         return data
 
+    @property
+    def scores(self) -> list[float]:
+        """``"rerank"``: each candidate's score, the mean value of the episodes it started."""
+        return [float(np.mean(v)) for v in self.values]
+
     def _rank(self) -> None:
-        self.scores = [float(np.mean(v)) for v in self.values]
         self.current = self.candidates[int(np.argmax(self.scores))]  # ties: the earliest, as Python's min
 
     def update(self, outcome: EpisodeOutcome) -> None:
