@@ -22,21 +22,21 @@ from collections import Counter
 import numpy as np
 
 from neurohover import evaluate, get_task_family
-from neurohover.policies import MLP_GENE_NAMES, Policy, baseline_policy, load_policy, mlp_baseline_genome, slp_baseline_genome
+from neurohover.policies import (
+    BASELINE_GAINS,
+    INPUT_NAMES,
+    MLP_GENE_NAMES,
+    Policy,
+    baseline_policy,
+    load_policy,
+    mlp_baseline_genome,
+    slp_baseline_genome,
+)
+from neurohover.sim.constants import OBS_NAMES
 
-# (action row, observation index, label) of the baseline's nine gains; observations u v w x y z p q r qx qy qz
-GAINS = [
-    (0, 4, "y->a1"),
-    (0, 1, "v->a1"),
-    (0, 9, "qx->a1"),
-    (1, 3, "x->a2"),
-    (1, 0, "u->a2"),
-    (1, 10, "qy->a2"),
-    (2, 11, "qz->a3"),
-    (3, 5, "z->a4"),
-    (3, 2, "w->a4"),
-]
-SLP_COLUMNS = [0, 1, 2, 3, 4, 5, 9, 10, 11]  # the observation entries an SLP sees
+# (action row, observation index, label) of the baseline policy's nine gains
+GAINS = [(int(action[1]) - 1, OBS_NAMES.index(obs), f"{obs}->{action}") for action, obs in BASELINE_GAINS]
+SLP_COLUMNS = [OBS_NAMES.index(name) for name in INPUT_NAMES]  # the observation entries an SLP sees
 
 
 def jacobian(policy: Policy, h: float = 1e-5) -> np.ndarray:
