@@ -8,7 +8,8 @@ true MDP. ``ours``: the agents' default (steady state from the generic policy, 2
 episodes; ``gls`` the same with the GLS estimator). ``eonn-*``: an emulation of the authors' code
 (their ``functions.evolve``): 50 genomes, each generation every genome flies one more model episode
 and is scored by the mean of all its episodes, the 49 best are kept and one child is bred
-(tournament of 5, averaging crossover, then mutation with probability 0.75), 500 generations, from
+(tournament of 5, the paper's crossover and mutation operators from ``neurohover.evolution.operators``,
+mutation with probability 0.75), 500 generations, from
 the baseline policy (as their code) or from the generic policy. Prints one JSON line per run and a
 summary (the numbers of the Table 4 and Figure 8 discussions).
 """
@@ -17,22 +18,19 @@ from __future__ import annotations
 
 import json
 import sys
+from dataclasses import replace
 
 import numpy as np
 
 from neurohover import evaluate, get_task_family
 from neurohover.agents.model_based import ModelEvolution, evolve_on_model, learn_model
+from neurohover.evolution import SteadyStateSettings
+from neurohover.evolution.operators import crossover, mutate
 from neurohover.policies import Policy, prototype
 from neurohover.policysets import load_policy_set
 
-
-def mutate(genome: np.ndarray, rng: np.random.Generator, frac: float, std: float, repl: float = 0.25) -> np.ndarray:
-    g = genome.copy()
-    hit = rng.random(g.size) < frac
-    delta = rng.normal(0.0, std, g.size)
-    shift = rng.random(g.size) > repl
-    g[hit] = np.where(shift[hit], g[hit] + delta[hit], delta[hit])
-    return g
+PAPER = SteadyStateSettings()  # mutation (0.1, 0.8, 0.25) and averaging crossover (0.5): eonn's values too
+SPAWN = replace(PAPER, mutate_frac=0.5, mutate_std=0.5)  # eonn's initial population
 
 
 def tournament(pool: list[np.ndarray], fitness: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -43,19 +41,16 @@ def tournament(pool: list[np.ndarray], fitness: np.ndarray, rng: np.random.Gener
 def eonn_on_model(model, start: Policy, seed: int, generations: int) -> Policy:
     """The authors' generational EA with 49 elites, every genome re-flown each generation."""
     rng = np.random.default_rng(seed)
-    pool = [start.genome.copy()] + [mutate(start.genome, rng, 0.5, 0.5) for _ in range(49)]
+    pool = [start.genome.copy()] + [mutate(start.genome, rng, SPAWN) for _ in range(49)]
     scores: list[list[float]] = [[] for _ in pool]
     for gen in range(generations + 1):
         if gen:
             fitness = np.array([np.mean(s) for s in scores])
             order = np.argsort(-fitness)[:49]
-
             mom, dad = (tournament(pool, fitness, rng) for _ in range(2))
-            average = rng.integers(0, 2, mom.size).astype(bool)
-            take_mom = rng.integers(0, 2, mom.size).astype(bool)
-            child = np.where(average, (mom + dad) / 2, np.where(take_mom, mom, dad))
+            child = crossover(mom, dad, rng, PAPER)
             if rng.random() < 0.75:
-                child = mutate(child, rng, 0.1, 0.8)
+                child = mutate(child, rng, PAPER)
             pool = [pool[i] for i in order] + [child]
             scores = [scores[i] for i in order] + [[]]
         returns = evaluate([Policy("mlp", g) for g in pool], model, episodes=1, seed=seed, first_episode=gen, threads=1).returns[:, 0, 0]
