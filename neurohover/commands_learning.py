@@ -29,6 +29,7 @@ import numpy as np
 
 from .errors import NeurohoverError
 from .evaluate import DEVICES, check_device
+from .evolution.generational import GENERATIONAL_PRESETS
 
 MDP_FAMILY = "G"
 
@@ -55,7 +56,7 @@ def _seed_policy(args: argparse.Namespace):
     from .policies import load_policy
 
     if args.seed_policy in ("zero", "baseline"):
-        return args.topology or "mlp", args.seed_policy
+        return args.topology, args.seed_policy  # None: evolve's default (SLP over a family, MLP on one MDP)
     path = Path(args.seed_policy)
     if not path.is_file():
         raise NeurohoverError(f"--seed-policy {args.seed_policy!r}: no such file (give zero, baseline or a policy file)")
@@ -63,6 +64,25 @@ def _seed_policy(args: argparse.Namespace):
     if args.topology is not None and args.topology != policy.topology:
         raise NeurohoverError(f"--seed-policy {args.seed_policy!r} is an {policy.topology} policy but --topology is {args.topology}")
     return policy.topology, policy
+
+
+def _optimiser_settings(args: argparse.Namespace, over_family: bool) -> dict | None:
+    """The optimiser settings of ``evolve`` from --plateau-rule, --preset and --setting (None: the defaults)."""
+    from .experiments.config import parse_override
+
+    settings: dict = {}
+    if args.plateau_rule is not None:
+        if args.optimizer != "ne" or over_family:
+            raise NeurohoverError(f"--plateau-rule {args.plateau_rule} applies to the steady-state method only (optimizer ne on one MDP)")
+        settings["plateau_rule"] = args.plateau_rule
+    if args.preset is not None:
+        if args.optimizer != "ne" or not over_family:
+            raise NeurohoverError(f"--preset {args.preset} names generational settings: it applies to evolution over a family (--mdp G, optimizer ne)")
+        settings["preset"] = args.preset
+    for text in args.setting or []:
+        key, value = parse_override(text)
+        settings[key] = value
+    return settings or None
 
 
 class _Bar:
@@ -110,11 +130,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         raise NeurohoverError(f"--resume: no checkpoint {str(checkpoint)!r} (it is written next to --out by an earlier run)")
     if not args.resume and checkpoint.is_file():
         print(f"neurohover evolve: starting afresh; {checkpoint} will be overwritten (use --resume to continue it)", file=sys.stderr)
-    settings = None
-    if args.plateau_rule is not None:
-        if args.optimizer != "ne" or mdp_desc == MDP_FAMILY:
-            raise NeurohoverError(f"--plateau-rule {args.plateau_rule} applies to the steady-state method only (optimizer ne on one MDP)")
-        settings = {"plateau_rule": args.plateau_rule}
+    settings = _optimiser_settings(args, mdp_desc == MDP_FAMILY)
     bar = _Bar(args.budget, f"evolve {family.name}/{mdp_desc}")
     try:
         result = evolve(
@@ -154,6 +170,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         "mdp": mdp_desc,
         "optimizer": args.optimizer,
         "resampling": str(resampling),
+        "settings": result.settings["settings"],
         "budget": args.budget,
         "seed": args.seed,
         "seed_policy": str(args.seed_policy),
@@ -349,7 +366,7 @@ def register(sub) -> None:
     p.add_argument("--wind", help="GHH-08 only: evolve on the constant wind U,V (m/s, each in [-5, 5])")
     p.add_argument("--params", help="evolve on explicit MDP parameters, comma-separated (GHH-08 2, GHH-09 8, FGHH 11)")
     p.add_argument("--sigma", type=float, help="FGHH breadth sigma (default 0.3)")
-    p.add_argument("--topology", choices=("slp", "mlp"), help="network (default mlp, or the seed policy file's)")
+    p.add_argument("--topology", choices=("slp", "mlp"), help="network (default: the seed policy file's, else slp over a family (--mdp G) and mlp on one MDP)")
     p.add_argument("--seed-policy", default="baseline", help="prototype: zero, baseline (baseline-equivalent network; default) or a policy FILE")
     p.add_argument("--optimizer", choices=("ne", "cma"), default="ne", help="ne: the paper's neuroevolution (default); cma: CMA-ES, same budget and resampling")
     p.add_argument(
@@ -363,6 +380,19 @@ def register(sub) -> None:
         choices=("no-crash", "literal"),
         help="steady state: no-crash (default) counts the plateau only once the champion completed an episode "
         "without crashing (a run whose champion still crashes ends at --budget only); literal: Appendix A as written",
+    )
+    p.add_argument(
+        "--preset",
+        choices=tuple(GENERATIONAL_PRESETS),
+        help="generational settings over a family: table7 (default: Table 7 with the authors' 1/ln(error) fitness, no survivors), "
+        "authors-script (their FGHH script's lambda 30, mu 10, mutation 0.2/1.0) or raw-elitist (mean raw returns, surviving parents)",
+    )
+    p.add_argument(
+        "--setting",
+        action="append",
+        metavar="KEY=VALUE",
+        help="one optimiser setting (repeatable), e.g. --setting fitness=return --setting elitist=true --setting pop_size=30; "
+        "the fields of SteadyStateSettings / GenerationalSettings, or sigma0, popsize for cma",
     )
     p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")
     p.add_argument("--seed", type=int, default=0, help="root seed of the run (default 0)")

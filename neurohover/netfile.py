@@ -1,21 +1,24 @@
-"""The authors' network files (``.net``, their ``eonn`` package's format) as neurohover MLP policies.
+"""The authors' network files (``.net``, their ``eonn`` package's format) as neurohover policies.
 
 The paper's authors published their policies as text files with one gene per line:
-``n ID POSITION FUNCTION BIAS`` for a node and ``s SOURCE DEST WEIGHT`` for a link, optionally
-after ``#`` comment lines. Their MLP (the paper's Figure 1) numbers its nodes as below; the
-mapping to our genome order (docs/model.md, Policies) is fixed by the node and link names, so
-``load_policy("mdp0.net")`` flies one of their policies exactly as their simulator did (the
-returns in a file's ``# reward`` comment are met within the noise).
+``n ID POSITION FUNCTION BIAS`` for a node (position 0 input, 1 output, 2 hidden; function 0 sum,
+1 sigmoid) and ``s SOURCE DEST WEIGHT`` for a link, optionally after ``#`` comment lines. Two
+topologies occur: the paper's MLP (Figure 1; their GHH-08/09 policies) and the SLP of their FGHH
+generics. The nodes are numbered as below; the mapping to our genome orders (docs/model.md,
+Policies) is fixed by the node and link names, so ``load_policy("mdp0.net")`` flies one of their
+policies exactly as their simulator did (the returns in a file's ``# reward`` comment are met
+within the noise).
 
-==========  ====================================================================
-node ids    meaning
-==========  ====================================================================
-1..12       inputs: u, v, w, x, y, z, p, q, r, qx, qy, qz (p, q, r are unused)
-13, 14, 15  position sigmoids hy, hx, hz
-16..19      linear sums L1..L4
-20..23      sigmoids S1..S4
-24..27      outputs a1..a4
-==========  ====================================================================
+==========  =====================================================  ===========================
+node ids    MLP                                                    SLP
+==========  =====================================================  ===========================
+1..12       inputs u, v, w, x, y, z, p, q, r, qx, qy, qz           the same inputs
+            (p, q, r are unused)
+13..16      position sigmoids hy, hx, hz; linear sum L1            outputs a1..a4 (sums),
+                                                                   each linked from the 9 used
+                                                                   inputs
+17..27      sums L2..L4, sigmoids S1..S4, outputs a1..a4           (none)
+==========  =====================================================  ===========================
 """
 
 from __future__ import annotations
@@ -23,18 +26,33 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import NeurohoverError
-from .policies import MLP_BIAS_NAMES, MLP_WEIGHT_NAMES, Policy
+from .policies import INPUT_NAMES, MLP_BIAS_NAMES, MLP_WEIGHT_NAMES, Policy
 
-NODE_NAMES = {1: "u", 2: "v", 3: "w", 4: "x", 5: "y", 6: "z", 7: "p", 8: "q", 9: "r", 10: "qx", 11: "qy", 12: "qz"}
-NODE_NAMES.update({13 + i: name for i, name in enumerate(MLP_BIAS_NAMES)})
-NODE_IDS = {name: i for i, name in NODE_NAMES.items()}
-_INPUT_IDS = range(1, 13)
+_INPUTS = {1: "u", 2: "v", 3: "w", 4: "x", 5: "y", 6: "z", 7: "p", 8: "q", 9: "r", 10: "qx", 11: "qy", 12: "qz"}
+_ACTIONS = ("a1", "a2", "a3", "a4")
+#: Node id -> name, per topology.
+NODE_NAMES = {
+    "mlp": {**_INPUTS, **{13 + i: name for i, name in enumerate(MLP_BIAS_NAMES)}},
+    "slp": {**_INPUTS, **{13 + i: name for i, name in enumerate(_ACTIONS)}},
+}
+NODE_IDS = {topology: {name: i for i, name in names.items()} for topology, names in NODE_NAMES.items()}
+SLP_LINK_NAMES = tuple(f"{i}->{a}" for a in _ACTIONS for i in INPUT_NAMES)  # row by row, as the SLP genome
+_LINKS = {"mlp": MLP_WEIGHT_NAMES, "slp": SLP_LINK_NAMES}
+_BIASES = {"mlp": MLP_BIAS_NAMES, "slp": _ACTIONS}
+_DESCRIPTION = {"mlp": "the paper's MLP (ids 1-27)", "slp": "an SLP (ids 1-16)"}
 
 
-def policy_from_net(text: str, source: str = "network file") -> Policy:
-    """Parse an authors' ``.net`` MLP into a :class:`Policy` (comment lines become metadata)."""
-    biases: dict[str, float] = {}
-    weights: dict[str, float] = {}
+def _role(topology: str, name: str) -> tuple[int, int]:
+    """(eonn position, eonn function) of a non-input node: outputs 1, hidden 2; sigmoids 1, sums 0."""
+    position = 1 if name.startswith("a") else 2
+    function = 1 if topology == "mlp" and name[0] in "hS" else 0
+    return position, function
+
+
+def _parse_lines(text: str, source: str):
+    """Node and link lines with their line numbers, and the comment lines."""
+    nodes: dict[int, tuple[int, int, float, int, str]] = {}
+    links: dict[tuple[int, int], tuple[float, int, str]] = {}
     comments = []
     for number, line in enumerate(text.splitlines(), 1):
         fields = line.split()
@@ -45,44 +63,79 @@ def policy_from_net(text: str, source: str = "network file") -> Policy:
             continue
         try:
             if fields[0] == "n" and len(fields) == 5:
-                node, value = int(fields[1]), float(fields[4])
-                if node not in NODE_NAMES:
-                    raise ValueError(f"node {node} is not a node of the paper's MLP (ids 1-27)")
-                if node not in _INPUT_IDS:
-                    biases[NODE_NAMES[node]] = value
+                nodes[int(fields[1])] = (int(fields[2]), int(fields[3]), float(fields[4]), number, line.strip())
             elif fields[0] == "s" and len(fields) == 4:
-                src, dst = int(fields[1]), int(fields[2])
-                name = f"{NODE_NAMES.get(src, src)}->{NODE_NAMES.get(dst, dst)}"
-                if name not in MLP_WEIGHT_NAMES:
-                    raise ValueError(f"link {src} -> {dst} ({name}) is not a link of the paper's MLP")
-                weights[name] = float(fields[3])
+                links[(int(fields[1]), int(fields[2]))] = (float(fields[3]), number, line.strip())
             else:
                 raise ValueError("expected 'n ID POSITION FUNCTION BIAS' or 's SOURCE DEST WEIGHT'")
         except ValueError as err:
             raise NeurohoverError(f"{source}, line {number}: {err}: {line.strip()!r}") from None
-    missing = [f"bias of {n}" for n in MLP_BIAS_NAMES if n not in biases] + [f"link {n}" for n in MLP_WEIGHT_NAMES if n not in weights]
+    return nodes, links, comments
+
+
+def _topology(nodes: dict, source: str) -> str:
+    """``slp`` when node 13 is an output (an SLP's a1), else ``mlp`` (node 13 is the MLP's hidden hy)."""
+    topology = "slp" if 13 in nodes and nodes[13][0] == 1 else "mlp"
+    for node, (_, _, _, number, line) in sorted(nodes.items()):
+        if node not in NODE_NAMES[topology]:
+            raise NeurohoverError(
+                f"{source}, line {number}: node {node} is not a node of {_DESCRIPTION[topology]}; "
+                f"known topologies: {_DESCRIPTION['mlp']}, {_DESCRIPTION['slp']}: {line!r}"
+            )
+    return topology
+
+
+def policy_from_net(text: str, source: str = "network file") -> Policy:
+    """Parse an authors' ``.net`` network (MLP or SLP) into a :class:`Policy` (comments become metadata)."""
+    nodes, links, comments = _parse_lines(text, source)
+    topology = _topology(nodes, source)
+    names = NODE_NAMES[topology]
+    biases: dict[str, float] = {}
+    for node, (pos, func, bias, number, line) in nodes.items():
+        if node in _INPUTS:
+            continue
+        if (pos, func) != _role(topology, names[node]):
+            want = _role(topology, names[node])
+            raise NeurohoverError(
+                f"{source}, line {number}: node {node} ({names[node]}) of {_DESCRIPTION[topology]} must have position {want[0]} "
+                f"and function {want[1]}, not {pos} and {func}: {line!r}"
+            )
+        biases[names[node]] = bias
+    weights: dict[str, float] = {}
+    for (src, dst), (weight, number, line) in links.items():
+        name = f"{names.get(src, src)}->{names.get(dst, dst)}"
+        if name not in _LINKS[topology]:
+            raise NeurohoverError(f"{source}, line {number}: link {src} -> {dst} ({name}) is not a link of {_DESCRIPTION[topology]}: {line!r}")
+        weights[name] = weight
+    missing = [f"bias of {n}" for n in _BIASES[topology] if n not in biases] + [f"link {n}" for n in _LINKS[topology] if n not in weights]
     if missing:
-        raise NeurohoverError(f"{source}: not the paper's MLP: missing {', '.join(missing[:4])}{' ...' if len(missing) > 4 else ''}")
-    genome = np.array([biases[n] for n in MLP_BIAS_NAMES] + [weights[n] for n in MLP_WEIGHT_NAMES])
+        raise NeurohoverError(f"{source}: not {_DESCRIPTION[topology]}: missing {', '.join(missing[:4])}{' ...' if len(missing) > 4 else ''}")
+    if topology == "mlp":
+        genome = [biases[n] for n in MLP_BIAS_NAMES] + [weights[n] for n in MLP_WEIGHT_NAMES]
+    else:
+        genome = [weights[n] for n in SLP_LINK_NAMES] + [biases[a] for a in _ACTIONS]
     metadata: dict[str, object] = {"source": "authors' network file"}
     if comments:
         metadata["comments"] = comments
-    return Policy("mlp", genome, metadata)
+    return Policy(topology, np.array(genome), metadata)
 
 
 def policy_to_net(policy: Policy) -> str:
-    """Write an MLP policy in the authors' ``.net`` format (the inverse of :func:`policy_from_net`)."""
-    if policy.topology != "mlp":
-        raise NeurohoverError(f"only MLP policies have a .net form, not {policy.topology!r}")
-    lines = [f"n {i} 0 0 +0.0000" for i in _INPUT_IDS]
-    for k, name in enumerate(MLP_BIAS_NAMES):
-        node = NODE_IDS[name]
-        position = 1 if name.startswith("a") else 2  # eonn: 1 output, 2 hidden
-        function = 1 if name[0] in "hS" else 0  # eonn: 1 sigmoid, 0 sum
-        lines.append(f"n {node} {position} {function} {policy.genome[k]:+.17g}")
+    """Write an MLP or SLP policy in the authors' ``.net`` format (the inverse of :func:`policy_from_net`)."""
+    topology = policy.topology
+    if topology not in NODE_NAMES:
+        raise NeurohoverError(f"no .net form for topology {topology!r}: allowed {', '.join(NODE_NAMES)}")
+    ids = NODE_IDS[topology]
+    n_weights = len(_LINKS[topology])
+    bias_values = policy.genome[n_weights:] if topology == "slp" else policy.genome[: len(MLP_BIAS_NAMES)]
+    weight_values = policy.genome[:n_weights] if topology == "slp" else policy.genome[len(MLP_BIAS_NAMES) :]
+    lines = [f"n {i} 0 0 +0.0000" for i in _INPUTS]
+    for name, bias in sorted(zip(_BIASES[topology], bias_values), key=lambda nb: ids[nb[0]]):
+        position, function = _role(topology, name)
+        lines.append(f"n {ids[name]} {position} {function} {bias:+.17g}")
     links = []
-    for k, name in enumerate(MLP_WEIGHT_NAMES):
+    for name, weight in zip(_LINKS[topology], weight_values):
         src, dst = name.split("->")
-        links.append((NODE_IDS[src], NODE_IDS[dst], policy.genome[len(MLP_BIAS_NAMES) + k]))
+        links.append((ids[src], ids[dst], weight))
     lines += [f"s {s} {d} {w:+.17g}" for s, d, w in sorted(links)]
     return "\n".join(lines) + "\n"

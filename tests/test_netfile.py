@@ -10,7 +10,7 @@ import pytest
 
 from neurohover import NeurohoverError, evaluate, get_task_family
 from neurohover.netfile import policy_from_net, policy_to_net
-from neurohover.policies import Policy, baseline_policy, load_policy, mlp_baseline_genome
+from neurohover.policies import Policy, baseline_policy, load_policy, mlp_baseline_genome, prototype
 
 # The authors' baseline.net as their eonn package wrote it (node and link lines, 4 decimals).
 BASELINE_NET = """n 1 0 0 +0.0000
@@ -108,6 +108,48 @@ def test_a_file_that_is_not_the_papers_mlp_is_refused_with_the_line(text: str, m
         policy_from_net(text, "x.net")
 
 
-def test_only_an_mlp_has_a_net_form() -> None:
-    with pytest.raises(NeurohoverError, match="only MLP policies"):
-        policy_to_net(Policy("slp", np.zeros(40)))
+# The baseline as an SLP in the authors' format (their FGHH generics' layout: outputs 13-16, every
+# used input linked to every output, zero weights written too), 4 decimals as eonn writes them.
+_SLP_GAINS = {(5, 13): -0.0196, (2, 13): -0.0367, (10, 13): -0.7475, (4, 14): -0.0185, (1, 14): -0.0322, (11, 14): 0.7904, (12, 15): -0.1969}
+_SLP_GAINS.update({(6, 16): 0.0513, (3, 16): 0.1348})
+BASELINE_SLP_NET = (
+    "".join(f"n {i} 0 0 +0.0000\n" for i in range(1, 13))
+    + "n 13 1 0 +0.0200\nn 14 1 0 +0.0000\nn 15 1 0 +0.0000\nn 16 1 0 +0.2300\n"
+    + "".join(f"s {src} {dst} {_SLP_GAINS.get((src, dst), 0.0):+.4f}\n" for src in (1, 2, 3, 4, 5, 6, 10, 11, 12) for dst in (13, 14, 15, 16))
+)
+
+
+def test_an_slp_file_in_the_authors_layout_is_the_baseline_slp_and_flies_like_the_baseline(tmp_path: Path) -> None:
+    path = tmp_path / "policy_01.net"
+    path.write_text("# score: 0.2\n" + BASELINE_SLP_NET)
+    policy = load_policy(path)
+    assert policy.topology == "slp"
+    np.testing.assert_array_equal(policy.genome, prototype("slp", "baseline").genome)
+    mdps = get_task_family("fghh", 0.3).test_mdps()[:2]
+    a = evaluate(policy, mdps, episodes=1, seed=3, n_steps=300).returns
+    b = evaluate(baseline_policy(), mdps, episodes=1, seed=3, n_steps=300).returns
+    np.testing.assert_allclose(a, b, rtol=1e-12)
+
+
+def test_writing_and_reading_an_slp_net_file_keeps_every_gene_and_its_place() -> None:
+    genome = np.random.default_rng(1).normal(size=40)
+    text = policy_to_net(Policy("slp", genome))
+    np.testing.assert_array_equal(policy_from_net(text).genome, genome)
+    np.testing.assert_array_equal(policy_from_net("\n".join(reversed(text.splitlines()))).genome, genome)
+    assert "n 13 1 0" in text and "s 12 16" in text  # output nodes 13-16, links from the inputs' ids
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (BASELINE_SLP_NET.replace("s 12 16 +0.0000\n", ""), "not an SLP (ids 1-16): missing link qz->a4"),
+        (BASELINE_SLP_NET + "s 7 13 +0.5\n", "line 53: link 7 -> 13 (p->a1) is not a link of an SLP"),
+        (BASELINE_SLP_NET + "n 17 1 0 +0.0\n", "line 53: node 17 is not a node of an SLP (ids 1-16); known topologies"),
+        (BASELINE_SLP_NET.replace("n 14 1 0", "n 14 1 1"), "line 14: node 14 (a2) of an SLP (ids 1-16) must have position 1 and function 0, not 1 and 1"),
+        (BASELINE_SLP_NET.replace("n 16 1 0 +0.2300", "n 16 1 0 lots"), "line 16"),
+    ],
+    ids=["missing-link", "rate-input", "unknown-node", "sigmoid-output", "bad-number"],
+)
+def test_a_malformed_or_unknown_slp_file_is_refused_with_the_line(text: str, message: str) -> None:
+    with pytest.raises(NeurohoverError, match=re.escape(message)):
+        policy_from_net(text, "x.net")

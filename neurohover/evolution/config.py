@@ -19,7 +19,7 @@ from ..errors import NeurohoverError
 from ..policies import TOPOLOGIES, Policy
 from ..policies import prototype as make_prototype
 from ..tasks import MDP, TaskFamily
-from .generational import GenerationalSettings
+from .generational import GENERATIONAL_PRESETS, OLD_GENERATIONAL, GenerationalSettings
 from .seeding import check_seed
 from .steady_state import SteadyStateSettings
 
@@ -113,9 +113,11 @@ def resolve_target(target) -> tuple[MDP | None, TaskFamily | None, dict]:
 
 
 def make_settings(method: str, optimizer: str, settings) -> dict | SteadyStateSettings | GenerationalSettings:
-    """The optimiser settings of a run: ``settings`` (None, a settings object or a dict of
-    overrides) checked for ``method`` / ``optimizer``; a dict for CMA-ES, the budget left None
-    for neuroevolution (the run counts the budget in episodes itself)."""
+    """The optimiser settings of a run: ``settings`` (None, a settings object, a dict of
+    overrides, or for the generational method a preset's name; a dict may name its base with
+    ``"preset"``, :data:`~.generational.GENERATIONAL_PRESETS`) checked for ``method`` /
+    ``optimizer``; a dict for CMA-ES, the budget left None for neuroevolution (the run counts the
+    budget in episodes itself)."""
     if optimizer == "cma":
         cfg = dict(CMA_DEFAULTS)
         if settings is not None:
@@ -134,6 +136,8 @@ def make_settings(method: str, optimizer: str, settings) -> dict | SteadyStateSe
     cls = SteadyStateSettings if method == "steady-state" else GenerationalSettings
     if settings is None:
         return cls()
+    if isinstance(settings, str):  # a preset's name
+        settings = {"preset": settings}
     if isinstance(settings, cls):
         return dataclasses.replace(settings, budget=None)
     if isinstance(settings, (SteadyStateSettings, GenerationalSettings)):
@@ -141,11 +145,19 @@ def make_settings(method: str, optimizer: str, settings) -> dict | SteadyStateSe
     if not isinstance(settings, Mapping):
         raise NeurohoverError(f"settings must be a {cls.__name__} or a dict of its fields, got {type(settings).__name__}")
     fields = {f.name for f in dataclasses.fields(cls)} - {"budget"}
-    unknown = sorted(set(settings) - fields)
+    presets = GENERATIONAL_PRESETS if cls is GenerationalSettings else {}
+    unknown = sorted(set(settings) - fields - ({"preset"} if presets else set()))
     if unknown:
-        raise NeurohoverError(f"unknown {method} setting(s) {', '.join(unknown)}: allowed {', '.join(sorted(fields))}")
+        raise NeurohoverError(f"unknown {method} setting(s) {', '.join(unknown)}: allowed {', '.join(sorted(fields | ({'preset'} if presets else set())))}")
+    values = dict(settings)
+    if "preset" in values:
+        name = values.pop("preset")
+        if name not in presets:
+            raise NeurohoverError(f"unknown {method} preset {name!r}: allowed {', '.join(presets)}")
+        values = {**dataclasses.asdict(presets[name]), **values}
+        values.pop("budget")
     try:
-        return cls(**dict(settings))
+        return cls(**values)
     except ValueError as err:
         raise NeurohoverError(f"bad {method} settings: {err}") from None
 
@@ -156,6 +168,9 @@ def upgrade_saved_config(saved: dict) -> dict:
     if saved.get("method") == "steady-state" and "plateau_rule" not in saved.get("settings", {}):
         # Written before these settings existed: it ran Appendix A's literal plateau rule.
         return {**saved, "settings": {**_OLD_STEADY_STATE, **saved["settings"]}}
+    if saved.get("method") == "generational" and "fitness" not in saved.get("settings", {}):
+        # Written before the fitness scale existed: mean raw returns, elitist, plain initial mutation.
+        return {**saved, "settings": {**OLD_GENERATIONAL, **saved["settings"]}}
     return saved
 
 
@@ -197,6 +212,8 @@ class RunConfig:
     def build(cls, target, *, topology, prototype, optimizer, resampling, budget, settings, seed, n_steps, method) -> RunConfig:
         """Check the arguments of ``evolve`` that define the run (NeurohoverError on bad input)."""
         mdp, family, target_desc = resolve_target(target)
+        if topology is None:  # the prototype's, else the authors' choice: SLP generics over a family, MLPs on one MDP
+            topology = prototype.topology if isinstance(prototype, Policy) else ("slp" if family is not None else "mlp")
         proto = resolve_prototype(prototype, topology)
         if optimizer not in ("ne", "cma"):
             raise NeurohoverError(f"unknown optimizer {optimizer!r}: allowed ne, cma")

@@ -11,9 +11,12 @@ Two kinds of target
   did not crash (with ``fixed:K``: none of its K episodes crashed), so a run whose champion still
   crashes ends only at its budget; ``plateau_rule="literal"`` is Appendix A as written.
 * a task family G (``get_task_family("fghh", 0.3)``; any family works): the **generational**
-  method of Appendix B (Table 7 defaults), for generic policies. Fitness is estimated by fixed
-  resampling (``"fixed:K"``: K episodes per candidate, each on a fresh MDP drawn from G) or by
-  selection races (``"race:DELTA"``, docs/model.md, Fitness under noise; confidence level DELTA in (0, 1)).
+  method of Appendix B (Table 7 defaults) for generic policies, as the authors' FGHH code ran it:
+  SLP networks from the baseline, each episode scored ``1/ln(error)`` and a candidate's estimate
+  the mean over its episodes (``fitness="return"``: mean raw returns), no surviving parents.
+  Fitness is estimated by fixed resampling (``"fixed:K"``: K episodes per candidate, each on a
+  fresh MDP drawn from G) or by selection races (``"race:DELTA"``, docs/model.md, Fitness under
+  noise; confidence level DELTA in (0, 1)), whose bounds are then on the fitness scale too.
 
 ``optimizer="cma"`` replaces the neuroevolution by CMA-ES (pycma) on either target with the same
 budget semantics and the same fixed resampling, so the two can be compared on equal episodes.
@@ -25,7 +28,7 @@ checked between generations, so a run may overshoot it by at most one generation
 method's first generation is the whole initial population of ``pop_size`` candidates). The
 champion is, as in the optimisers, the candidate with the best single fitness ever told for a fixed
 MDP (steady state; CMA-ES on an MDP), and the candidate with the best estimate of the last
-generation for a task family (generational; CMA-ES on a family), because a best-ever maximum over
+generation for a task family (generational: the best selected parent; CMA-ES on a family), because a best-ever maximum over
 noisy estimates of different MDPs is optimistically biased.
 
 Seeding and reproducibility
@@ -112,7 +115,7 @@ __all__ = [
 def evolve(
     target,
     *,
-    topology: str = "mlp",
+    topology: str | None = None,
     prototype: Policy | str = "baseline",
     optimizer: str = "ne",
     resampling: str | Resampling | None = None,
@@ -136,7 +139,9 @@ def evolve(
     ----------
     target : MDP, LearnedModel or task family
         A fixed MDP (steady state) or a task family G (generational); see the module doc.
-    topology : {"slp", "mlp"}
+    topology : {"slp", "mlp"}, optional
+        Default: the prototype policy's; else ``"slp"`` on a task family (the authors' FGHH
+        generics are SLPs) and ``"mlp"`` on one MDP.
     prototype : Policy or {"zero", "baseline"}
         The genome the initial population is built from.
     optimizer : {"ne", "cma"}
@@ -146,9 +151,12 @@ def evolve(
     budget : int, optional
         Episodes to fly (checked between generations). Default: the paper's termination
         (steady state: plateau; generational: ``generations``; CMA-ES: pycma's criteria).
-    settings : SteadyStateSettings, GenerationalSettings or dict, optional
-        Overrides of the optimiser settings (paper Tables 6/7); for CMA-ES a dict with
-        ``sigma0`` and ``popsize`` (:data:`CMA_DEFAULTS`).
+    settings : SteadyStateSettings, GenerationalSettings, dict or str, optional
+        Overrides of the optimiser settings (paper Tables 6/7): a settings object, a dict of
+        fields, or for the generational method a preset's name (``"table7"``, the default;
+        ``"authors-script"``; ``"raw-elitist"``; a dict may start from one with ``"preset"``),
+        including the fitness scale (``fitness="inv-log-error"`` or ``"return"``); for CMA-ES a
+        dict with ``sigma0`` and ``popsize`` (:data:`CMA_DEFAULTS`).
     seed : int
         Root of all randomness (``numpy.random.SeedSequence(seed)``).
     n_steps : int

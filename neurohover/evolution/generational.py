@@ -27,19 +27,22 @@ from .common import (
     enc_float,
     rank,
     require_int,
+    require_prob,
+    require_std,
     rng_from_state,
     set_field,
     validate_variation_settings,
 )
+from .fitness import FITNESS_SCALES
 from .operators import crossover, mutate
 from .races import RaceResult, ResamplingResult
 
-__all__ = ["GenerationRecord", "GenerationalNE", "GenerationalSettings"]
+__all__ = ["GENERATIONAL_PRESETS", "OLD_GENERATIONAL", "GenerationRecord", "GenerationalNE", "GenerationalSettings"]
 
 
 @dataclass(frozen=True)
 class GenerationalSettings:
-    """Settings of :class:`GenerationalNE`; defaults are the paper's Table 7.
+    """Settings of :class:`GenerationalNE`; defaults are the paper's Table 7 with the authors' FGHH code.
 
     Attributes
     ----------
@@ -54,13 +57,21 @@ class GenerationalSettings:
     budget : int or None
         Optional cap on the total number of episodes (>= 1); not in the paper.
     elitist : bool
-        True (default): the ``select_size`` selected parents survive into the next generation,
-        where they are evaluated again on fresh episodes, beside ``pop_size - select_size``
-        offspring. False: every generation is ``pop_size`` new offspring (no survivors), the
-        literal reading of Appendix B. With the paper's mutation strength the non-elitist
-        variant loses its progress: on FGHH (sigma 0.3, fixed resampling k=5, MLP from the
-        baseline seed) its generation champion fell from about -1,800 to -66,000 in 20
-        generations, while the elitist variant rose to about -780 (and -330 with races).
+        False (default, the authors' code and Appendix B): every generation is ``pop_size`` new
+        offspring of the selected parents, no survivors. True: the ``select_size`` selected
+        parents survive into the next generation, where they are evaluated again on fresh
+        episodes, beside ``pop_size - select_size`` offspring.
+    fitness : {"inv-log-error", "return"}
+        The scale of one episode's fitness (:mod:`neurohover.evolution.fitness`), whose mean over
+        a candidate's episodes is its estimate, for fixed resampling and for the races' bounds:
+        ``inv-log-error`` (default) is the authors' ``1/ln(error)``, ``return`` the raw return.
+        Read by the run that flies the candidates; the optimiser ranks whatever it is told.
+    init_mutate_frac, init_mutate_std : float or None
+        Mutation of the initial population's copies of the prototype (default 0.5 and 0.5, the
+        authors' ``eonn``; None: ``mutate_frac`` / ``mutate_std``).
+
+    :data:`GENERATIONAL_PRESETS` names whole settings: ``table7`` (the defaults), ``authors-script``
+    (the sizes of the authors' FGHH script) and ``raw-elitist`` (this library's earlier reading).
     """
 
     pop_size: int = 50
@@ -73,17 +84,48 @@ class GenerationalSettings:
     mutate_std: float = 0.8
     mutate_repl: float = 0.25
     budget: int | None = None
-    elitist: bool = True
+    elitist: bool = False
+    fitness: str = "inv-log-error"
+    init_mutate_frac: float | None = 0.5
+    init_mutate_std: float | None = 0.5
 
     def __post_init__(self) -> None:
         validate_variation_settings(self)
         if not isinstance(self.elitist, bool):
             raise ValueError(f"elitist={self.elitist!r} must be True or False")
+        if self.fitness not in FITNESS_SCALES:
+            raise ValueError(f"fitness={self.fitness!r} is not a fitness scale: allowed {', '.join(FITNESS_SCALES)}")
+        if self.init_mutate_frac is not None:
+            set_field(self, "init_mutate_frac", require_prob("init_mutate_frac", self.init_mutate_frac))
+        if self.init_mutate_std is not None:
+            set_field(self, "init_mutate_std", require_std("init_mutate_std", self.init_mutate_std))
         sel = require_int("select_size", self.select_size, 1)
         if sel > self.pop_size:
             raise ValueError(f"select_size={sel} must be in [1, pop_size={self.pop_size}]")
         set_field(self, "select_size", sel)
         set_field(self, "generations", require_int("generations", self.generations, 1))
+
+    def initial_mutation(self) -> GenerationalSettings:
+        """These settings with the initial population's mutation as the mutation."""
+        return dataclasses.replace(
+            self,
+            mutate_frac=self.mutate_frac if self.init_mutate_frac is None else self.init_mutate_frac,
+            mutate_std=self.mutate_std if self.init_mutate_std is None else self.init_mutate_std,
+        )
+
+
+#: Named generational settings (``evolve(settings={"preset": NAME, ...})``, configs' ``optimiser``):
+#: ``table7``: the paper's Table 7 sizes and mutation, the authors' fitness scale, breeding and
+#: initial population (the default); ``authors-script``: the authors' FGHH script (lambda 30, mu 10,
+#: their package's mutation defaults frac 0.2 and std 1.0); ``raw-elitist``: mean raw returns,
+#: selected parents surviving, the initial copies mutated like offspring (neurohover 0.1's reading).
+GENERATIONAL_PRESETS: dict[str, GenerationalSettings] = {
+    "table7": GenerationalSettings(),
+    "authors-script": GenerationalSettings(pop_size=30, select_size=10, mutate_frac=0.2, mutate_std=1.0),
+    "raw-elitist": GenerationalSettings(elitist=True, fitness="return", init_mutate_frac=None, init_mutate_std=None),
+}
+#: Settings a checkpoint written before a field existed ran with.
+OLD_GENERATIONAL = {"elitist": True, "fitness": "return", "init_mutate_frac": None, "init_mutate_std": None}
 
 
 @dataclass(frozen=True)
@@ -115,26 +157,26 @@ class GenerationalNE:
     """Generational neuroevolution of Appendix B (FGHH), ask/tell, maximising.
 
     :meth:`ask` returns the whole population ``(pop_size, D)``; the first one
-    is the prototype plus ``pop_size - 1`` mutated copies. :meth:`tell` takes
-    one fitness ESTIMATE per genome (a single return, a mean over ``k``
-    episodes, or a race's means), selects ``select_size`` parents (the best
-    estimates, or the indices a selection race picked) and breeds the next
-    population: the selected parents (re-evaluated next generation) plus
-    ``pop_size - select_size`` offspring, or, with ``elitist=False``, a complete
-    new population (see :class:`GenerationalSettings` for why elitism is the
-    default).
+    is the prototype plus ``pop_size - 1`` copies mutated with the initial
+    mutation (``init_mutate_frac`` / ``init_mutate_std``). :meth:`tell` takes
+    one fitness ESTIMATE per genome (a mean over ``k`` episodes, or a race's
+    means, on the run's fitness scale), selects ``select_size`` parents (the
+    best estimates, or the indices a selection race picked) and breeds the next
+    population: ``pop_size`` new offspring (the default, as the authors' code),
+    or with ``elitist=True`` the selected parents (re-evaluated next
+    generation) plus ``pop_size - select_size`` offspring.
 
     Each child's two parents are drawn uniformly at random, without
     replacement (the same parent twice only if ``select_size`` is 1), from
-    the selected parents. The paper does not say how parents are drawn;
-    uniform draws use the selection (e.g. a race's) as a set, without
-    trusting the noisy estimates a second time.
+    the selected parents, as the authors' FGHH code does (``random.sample``
+    of two parents); uniform draws use the selection (e.g. a race's) as a
+    set, without trusting the noisy estimates a second time.
     With probability ``crossover_prob`` (1 in the paper) the child is their
     crossover, then mutated with probability ``mutate_prob``; otherwise it is
     a mutated copy of the first parent.
 
-    The generation champion is the genome with the best estimate of that
-    generation; :attr:`champion_genome` / :attr:`champion_return` refer to the
+    The generation champion is the selected parent with the best estimate of
+    that generation (the authors' ``max(parents)``); :attr:`champion_genome` / :attr:`champion_return` refer to the
     latest generation (a best-ever maximum over noisy estimates would be
     optimistically biased). :attr:`history` holds one
     :class:`GenerationRecord` per generation.
@@ -158,9 +200,9 @@ class GenerationalNE:
         self.settings = settings if settings is not None else GenerationalSettings()
         self._prototype = check_prototype(prototype)
         self._rng = np.random.default_rng(seed)
-        # As Appendix A's: the prototype plus copies of it, each put through the mutation
-        # operator once (unconditionally, i.e. not gated by mutate_prob).
-        self._population = np.vstack([self._prototype] + [mutate(self._prototype, self._rng, self.settings) for _ in range(self.settings.pop_size - 1)])
+        # The prototype plus copies of it, each put through the (initial) mutation once, not gated by mutate_prob.
+        init = self.settings.initial_mutation()
+        self._population = np.vstack([self._prototype] + [mutate(self._prototype, self._rng, init) for _ in range(self.settings.pop_size - 1)])
         self._asked = False
         self._generation = 0
         self._evaluations = 0
@@ -208,7 +250,7 @@ class GenerationalNE:
             sel = self._check_selected(selected)
         ep = s.pop_size if episodes is None else require_int("episodes", episodes, 0)
 
-        best = int(order[0])
+        best = int(sel[rank(f[sel])[0]])  # the best selected parent (a race may select below a discarded mean)
         self._champion_genome = self._population[best].copy()
         self._champion_return = float(f[best]) if not math.isnan(f[best]) else -math.inf
         self._evaluations += ep
@@ -331,7 +373,7 @@ class GenerationalNE:
     def from_state_dict(cls, state: dict[str, Any]) -> GenerationalNE:
         """Rebuild an optimiser from :meth:`state_dict`; it continues identically."""
         check_state(state, "GenerationalNE")
-        opt = cls(dec_array(state["prototype"]), GenerationalSettings(**state["settings"]))
+        opt = cls(dec_array(state["prototype"]), GenerationalSettings(**{**OLD_GENERATIONAL, **state["settings"]}))
         opt._population = dec_array(state["population"])
         opt._asked = bool(state["asked"])
         opt._generation = int(state["generation"])

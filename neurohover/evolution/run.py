@@ -26,6 +26,7 @@ from ..policies import Policy
 from .cmaes import CMAES
 from .common import Optimiser, enc_float
 from .config import RACE_T_LIMIT, RunConfig, upgrade_saved_config
+from .fitness import episode_fitness
 from .generational import GenerationalNE
 from .races import fixed_resampling, selection_race
 from .records import (
@@ -93,6 +94,8 @@ class Run:
         self.flyer = KernelFlyer(config.topology, noise_seed(config.seed), config.n_steps, device=device)
         self.mdp_rng = None if self.family is None else mdp_rng(config.seed)
         self.rows = None if self.mdp is None else self.mdp.row()[None, :]
+        # The scale of one episode's fitness (fitness.py): generational runs choose it, the others fly raw returns.
+        self.fitness = config.settings.fitness if self.method == "generational" else "return"
         genome, settings, seed = config.prototype.genome, config.settings, optimiser_seed(config.seed)
         # Classes looked up here at run time (a test may replace SteadyStateNE by a reference).
         self.opt: Optimiser
@@ -195,7 +198,7 @@ class Run:
         else:
             assert family is not None  # mdp_rng is set exactly when the run has a family
             returns = self.flyer.fly(genomes, family.sample_rows(self.mdp_rng, n * k), p, "range", n * k).copy()
-        cols = returns.reshape(k, n)
+        cols = episode_fitness(returns, self.fitness).reshape(k, n)
         calls = iter(range(k))
         result = fixed_resampling(lambda idx: cols[next(calls)], n, k)
         return result.means, result
@@ -205,9 +208,11 @@ class Run:
             n, rows, family = idx.shape[0], self.rows, self.family
             if self.mdp_rng is None:
                 assert rows is not None  # mdp_rng is None exactly when the run has one MDP
-                return self.flyer.fly(genomes, rows, idx.astype(np.int64), None, n).copy()
-            assert family is not None  # mdp_rng is set exactly when the run has a family
-            return self.flyer.fly(genomes, family.sample_rows(self.mdp_rng, n), idx.astype(np.int64), "range", n).copy()
+                returns = self.flyer.fly(genomes, rows, idx.astype(np.int64), None, n)
+            else:
+                assert family is not None  # mdp_rng is set exactly when the run has a family
+                returns = self.flyer.fly(genomes, family.sample_rows(self.mdp_rng, n), idx.astype(np.int64), "range", n)
+            return episode_fitness(returns, self.fitness)
 
         return sample
 

@@ -35,6 +35,7 @@ from .common import (
     set_field,
     validate_variation_settings,
 )
+from .fitness import ERROR_FLOOR, episode_fitness
 from .operators import crossover, mutate
 
 __all__ = [
@@ -46,11 +47,8 @@ __all__ = [
     "roulette_weights",
 ]
 
-#: Errors (``-return``) are clamped to at least this before ``1/ln(error)``:
-#: ``ln`` is zero at 1 and negative below, which would give infinite or
-#: negative roulette weights. Any genome with return ``>= -ROULETTE_ERROR_FLOOR``
-#: therefore gets the maximal weight ``1/ln(1 + 1e-6) ~ 1e6``.
-ROULETTE_ERROR_FLOOR = 1.0 + 1e-6
+#: Errors (``-return``) are clamped to at least this before ``1/ln(error)`` (:mod:`.fitness`).
+ROULETTE_ERROR_FLOOR = ERROR_FLOOR
 
 #: Plateau rules of :class:`SteadyStateSettings` (docs/model.md, Neuroevolution): ``no-crash`` (default) counts
 #: evaluations without a new champion only while the champion's own evaluation did not crash;
@@ -178,8 +176,7 @@ def roulette_weights(returns: np.ndarray) -> np.ndarray:
         Non-negative weights, same shape.
     """
     r = np.asarray(returns, dtype=np.float64)
-    error = np.maximum(-r, ROULETTE_ERROR_FLOOR)
-    w = np.divide(1.0, np.log(error), out=np.zeros(r.shape), where=np.isfinite(r))
+    w = np.where(np.isfinite(r), episode_fitness(r, "inv-log-error"), 0.0)
     if not np.count_nonzero(w):
         w = np.ones_like(r)
     return w

@@ -48,6 +48,7 @@ ORDER = ("fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "
 UNITS_VERSION = 2  # 2: competition MDP sets, the authors' safeguard, OLS, the no-crash plateau
 
 _REQUIRED = object()
+_OMIT = object()  # default of a setting added later: absent from the resolved config unless given (older configs keep their hash)
 
 
 def _int(minimum: int):
@@ -170,6 +171,9 @@ SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
         "budget": (0, _int(0)),
         "optimiser": ({}, _table()),
         "validation_episodes": (0, _int(0)),
+        # "fresh": each champion on fresh draws (of its MDP, or from G) of its own seed; "test": every
+        # champion on the family's test MDPs with the same noise (paired comparisons)
+        "validation_mdps": (_OMIT, _choice("fresh", "test")),
         "history_points": (300, _int(2)),
         "robustness_variants": ([], lambda v: (isinstance(v, list) and all(isinstance(x, str) for x in v), "a list of variant keys")),
         "robustness_episodes": (10, _int(1)),
@@ -215,6 +219,8 @@ def _validate_table(values: dict, schema: dict, where: str) -> dict:
         if key not in values:
             if default is _REQUIRED:
                 raise NeurohoverError(f"{where}: missing required setting {key!r}")
+            if default is _OMIT:
+                continue
             out[key] = json.loads(json.dumps(default))
             continue
         value = values[key]
@@ -255,6 +261,8 @@ def _check_kind(settings: dict, kind: str, where: str) -> None:
             raise NeurohoverError(f"{where}: robustness_variants {bad} are not variant keys ({', '.join(keys)})")
         if settings["robustness_variants"] and settings["target"] != "train":
             raise NeurohoverError(f"{where}: robustness_variants need target = 'train'")
+        if settings.get("validation_mdps") == "test" and settings["target"] != "family":
+            raise NeurohoverError(f"{where}: validation_mdps = 'test' flies champions evolved over G on the family's test MDPs: it needs target = 'family'")
         if settings["target"] == "train" and settings["n_mdps"] > 10:
             raise NeurohoverError(f"{where}: n_mdps = {settings['n_mdps']} is out of range: there are 10 training MDPs")
     if kind in ("model_learning", "test_runs"):

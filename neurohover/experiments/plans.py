@@ -94,6 +94,8 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
         "validation_episodes": s["validation_episodes"],
         "history_points": s["history_points"],
     }
+    if s.get("validation_mdps") == "test":  # one seed for every run's validation: the same MDPs and gusts
+        base.update(validation_mdps="test", validation_seed=unit_seed(s["seed"], cfg.name, "validation"))
     train = family.training_mdps()[: s["n_mdps"]]
     for v in s["variants"]:
         common = {**base, "topology": v["topology"], "prototype": v["prototype"], "resampling": v["resampling"]}

@@ -235,12 +235,17 @@ class EvolveResult(_Record):
         (episodes, champion return) records, subsampled.
     validation : tuple of Num or None
         Returns of the champion on fresh validation episodes (None: no validation asked for).
+    validation_crashed : tuple of bool or None
+        Whether each validation episode crashed (None: not recorded, stores before FGHH's paper scale).
+    fitness : str or None
+        The scale of ``champion_return`` and ``history`` (:mod:`neurohover.evolution.fitness`):
+        ``inv-log-error`` or ``return`` (None: raw returns, as every run before the scale existed).
     timing : EvolveTiming
         Wall-clock; not part of ``==``.
     """
 
     _NESTED: ClassVar[dict[str, type[_Record]]] = {"champion": StoredPolicy, "timing": EvolveTiming}
-    _OPTIONAL: ClassVar[tuple[str, ...]] = ("champion_crashed", "validation")
+    _OPTIONAL: ClassVar[tuple[str, ...]] = ("champion_crashed", "validation", "validation_crashed", "fitness")
 
     champion: StoredPolicy
     champion_return: Num
@@ -251,6 +256,8 @@ class EvolveResult(_Record):
     champion_crashed: bool | None = None
     history: tuple[tuple[int, Num], ...]
     validation: tuple[Num, ...] | None = None
+    validation_crashed: tuple[bool, ...] | None = None
+    fitness: str | None = None
     timing: EvolveTiming = field(compare=False)
 
     @property

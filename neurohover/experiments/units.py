@@ -132,10 +132,14 @@ def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:
         device=device,
     )
     history = [(int(h.episodes), num(h.champion_return)) for h in result.history]
-    validation = None
-    if p.get("validation_episodes"):
+    validation = crashed = None
+    if p.get("validation_mdps") == "test":  # every run's champion on the family's test MDPs, with shared noise (paired)
+        ev = _fly_on_test_mdps(result.champion, target, p["validation_episodes"], p["validation_seed"], p["n_steps"], threads, device)
+        validation, crashed = tuple(num(x) for x in ev.returns), tuple(bool(c) for c in ev.crashed)
+    elif p.get("validation_episodes"):
         v = validation_return(result.champion, target, episodes=p["validation_episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads, device=device)
         validation = tuple(num(x) for x in v)
+    scale = result.settings["settings"].get("fitness") if result.settings.get("method") == "generational" else None
     return EvolveResult(
         champion=StoredPolicy.of(result.champion),
         champion_return=num(result.champion_return),
@@ -146,8 +150,20 @@ def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:
         champion_crashed=bool(result.champion_crashed),
         history=tuple(subsample(history, p.get("history_points", 300))),
         validation=validation,
+        validation_crashed=crashed,
+        fitness=scale,
         timing=EvolveTiming(seconds=time.perf_counter() - t0, kernel_seconds=float(result.kernel_seconds)),
     ).to_dict()
+
+
+def _fly_on_test_mdps(policy, family, episodes: int, seed: int, n_steps: int, threads, device):
+    """``policy`` flown once on each of the first ``episodes`` test MDPs of ``family`` (cycling), episode
+    ``i`` with noise stream ``(seed, i)``: the same MDPs and gusts for every policy flown so."""
+    from ..evaluate import evaluate_jobs
+
+    rows = np.array([m.row() for m in family.test_mdps()])
+    idx = np.arange(episodes, dtype=np.int64)
+    return evaluate_jobs([policy], rows, np.zeros(episodes, dtype=np.int64), idx % len(rows), idx, seed=seed, n_steps=n_steps, threads=threads, device=device)
 
 
 def run_robustness(p: dict, threads: int | None, device: str = "cpu") -> dict:

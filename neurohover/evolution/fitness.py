@@ -1,0 +1,44 @@
+"""Fitness scales of an episode (docs/model.md, Fitness under noise; the authors' FGHH code).
+
+A candidate's fitness estimate is the mean over its episodes of one episode's fitness:
+
+- ``inv-log-error`` (the authors' FGHH scripts, and the steady state's roulette weights):
+  ``1 / ln(error)`` with ``error = -return`` (crash penalty included). A crash (error about 1e7)
+  scores about 0.062, hovering at an error of 1,000 about 0.145, at 150 about 0.200: one crash in
+  k episodes costs a bounded amount instead of outweighing everything else.
+- ``return``: the raw return (the paper's text read literally).
+
+Errors are clamped to at least :data:`ERROR_FLOOR` (slightly above 1, where ``ln`` is zero), which
+only very short episodes reach; a NaN return (a numerical blow-up) gets fitness ``-inf``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["ERROR_FLOOR", "FITNESS_SCALES", "episode_fitness", "error_of_fitness"]
+
+#: What a generational run's ``fitness`` setting may be.
+FITNESS_SCALES = ("inv-log-error", "return")
+#: Errors are clamped to at least this before ``1/ln(error)`` (its fitness is about 1e6).
+ERROR_FLOOR = 1.0 + 1e-6
+
+
+def episode_fitness(returns: np.ndarray, scale: str) -> np.ndarray:
+    """The fitness of each episode's return on ``scale`` (one of :data:`FITNESS_SCALES`); NaN -> ``-inf``."""
+    r = np.asarray(returns, dtype=np.float64)
+    if scale == "return":
+        return np.where(np.isnan(r), -np.inf, r)
+    if scale != "inv-log-error":
+        raise ValueError(f"unknown fitness scale {scale!r}: allowed {', '.join(FITNESS_SCALES)}")
+    error = np.maximum(np.where(np.isnan(r), np.inf, -r), ERROR_FLOOR)
+    return np.where(np.isnan(r), -np.inf, 1.0 / np.log(error))
+
+
+def error_of_fitness(fitness: np.ndarray | float, scale: str) -> np.ndarray:
+    """The error (``-return``) whose fitness on ``scale`` is ``fitness``: ``exp(1/f)`` or ``-f``."""
+    f = np.asarray(fitness, dtype=np.float64)
+    if scale == "return":
+        return -f
+    with np.errstate(divide="ignore", over="ignore"):
+        return np.where(f > 0, np.exp(1.0 / np.where(f > 0, f, 1.0)), np.inf)
