@@ -2,7 +2,8 @@
 
 Both functions are driven by a caller-supplied ``sample_fn(indices) -> returns``
 that flies every listed candidate for ONE more episode, each on a fresh MDP
-drawn from the task family, and returns one return per index (same order).
+drawn from the task family, and returns one return per index (same order; a
+candidate listed twice flies two episodes, numbered in list order).
 Returns are maximised (in the helicopter domain they are negative).
 
 Recording the cost per generation
@@ -79,7 +80,8 @@ class RaceResult:
     episodes_spent : int
         Total episodes flown (``n_samples.sum()``).
     rounds : int
-        Number of calls made to ``sample_fn``.
+        Rounds raced (the most samples of a candidate): ``rounds - 1`` calls of ``sample_fn`` when
+        ``t_limit >= 2``, whose first flies rounds 1 and 2.
     """
 
     selected: np.ndarray
@@ -218,7 +220,8 @@ def selection_race(
     Implements the prose of Sect. 5.2 (Algorithm 1 with the paper's two
     changes; ``t_limit = t_min = t_max`` so no adaptation of ``t_limit``).
     Candidates are kept in selected / discarded / undecided pools. Round 1
-    flies every candidate once; each later round flies every undecided
+    flies every candidate once (in the same call of ``sample_fn`` as round 2,
+    since one sample decides nothing); each later round flies every undecided
     candidate one more episode and recomputes its bounds FROM SCRATCH from all
     its samples with :func:`bayes_mean_bounds` (so a bound may loosen again;
     the mean always lies inside; all undecided candidates have the same number
@@ -292,14 +295,19 @@ def selection_race(
 
     while True:
         active = np.flatnonzero(undecided)
-        draws = _draw(sample_fn, active)
+        # Round 1 can decide nothing (one sample: bounds (-inf, inf), or (-inf, -inf) for a crash,
+        # which no lower bound of -inf exceeds), so rounds 1 and 2 fly in one call: every candidate
+        # listed twice, in round order, numbered as two calls would number them.
+        both = rounds == 0 and t_limit >= 2
+        draws = _draw(sample_fn, np.concatenate([active, active]) if both else active)
         if rounds == samples.shape[1]:
             grown = np.empty((n, min(t_limit, 2 * rounds)))
             grown[:, :rounds] = samples
             samples = grown
-        samples[active, rounds] = draws
-        crashed[active] |= np.isneginf(draws)
-        rounds += 1
+        for column in np.split(draws, 2) if both else [draws]:
+            samples[active, rounds] = column
+            crashed[active] |= np.isneginf(column)
+            rounds += 1
         n_samples[active] = rounds
         _round_bounds(samples[active, :rounds], active, crashed[active], delta, means, lower, upper)
 
