@@ -456,8 +456,8 @@ class KernelFlyer:
 
     The fast path of an evolution run, which flies thousands of small batches: no per-call
     validation, no :class:`Evaluation` objects, no recording and no safeguard. Each call flies its
-    jobs with the next unused indices of the flyer's episode counter, so no two episodes of one
-    flyer share gust noise; episode ``i`` flies noise stream ``(seed, i)``, so a job's return is
+    jobs with the next unused episode indices (or with indices the caller reserved), so no two
+    episodes of one flyer share gust noise; episode ``i`` flies noise stream ``(seed, i)``, so a job's return is
     the one :func:`evaluate_jobs` gives for the same genome, MDP row and episode index.
 
     Parameters
@@ -475,17 +475,26 @@ class KernelFlyer:
     Attributes
     ----------
     episodes : int
-        The episode counter: episodes flown so far, i.e. the next unused episode index (a resumed
-        run sets it, with ``steps`` and ``kernel_seconds``).
+        Episodes counted so far: every call's jobs, except those of calls with explicit episode
+        indices, whose caller counts what it used (:meth:`reserve`). A resumed run sets it, with
+        ``next_index``, ``steps`` and ``kernel_seconds``.
+    next_index : int
+        The next unused episode index (``episodes`` unless indices were reserved).
+    flown : int
+        Episodes flown so far, counted or not (a race's look-ahead flies some it does not use).
     steps : int
-        Control steps flown so far.
+        Control steps of the counted episodes.
     kernel_seconds : float
         Wall time spent inside the kernel.
     crashed : numpy.ndarray of bool
         Crash flags of the last call's jobs (a view like the returns :meth:`fly` gives).
+    job_steps : numpy.ndarray of int64
+        Control steps of each of the last call's jobs (a view, likewise).
     trace : list or None
         If a list, every call appends ``(genomes, rows, policy_index, mdp_index, episode_index)``
         (copies, except the rows), e.g. to replay the same jobs in one batch in a benchmark.
+    trace_unused : list
+        While tracing, the episode indices a caller flew but did not use (a race's look-ahead).
     """
 
     def __init__(self, topology: str, seed: int, n_steps: int, device: str = "cpu") -> None:
@@ -502,10 +511,14 @@ class KernelFlyer:
         self.n_steps = int(n_steps)
         self.device = device
         self.episodes = 0
+        self.next_index = 0
+        self.flown = 0
         self.steps = 0
         self.kernel_seconds = 0.0
         self.trace: list | None = None
+        self.trace_unused: list[int] = []
         self.crashed = np.zeros(0, dtype=np.bool_)
+        self.job_steps = np.zeros(0, dtype=np.int64)
         self.max_threads = self._threads = 1
         self._p_cap = 0
         self._j_cap = 0
@@ -549,8 +562,14 @@ class KernelFlyer:
             views = self._views[n_jobs] = tuple(b[:n_jobs] for b in self._buffers)
         return views
 
-    def fly(self, genomes: np.ndarray, rows: np.ndarray, policy_index, mdp_index, n_jobs: int) -> np.ndarray:
-        """Fly ``n_jobs`` jobs with the next ``n_jobs`` episode indices.
+    def reserve(self, n: int) -> int:
+        """Reserve the next ``n`` episode indices for calls with explicit ``episode_index``; returns the first."""
+        first = self.next_index
+        self.next_index += n
+        return first
+
+    def fly(self, genomes: np.ndarray, rows: np.ndarray, policy_index, mdp_index, n_jobs: int, episode_index: np.ndarray | None = None) -> np.ndarray:
+        """Fly ``n_jobs`` jobs with the next ``n_jobs`` episode indices (or the given ones).
 
         Parameters
         ----------
@@ -562,6 +581,9 @@ class KernelFlyer:
             Per job, the genome and the MDP row it flies; None: 0 for every job; ``"range"``:
             job j flies number j.
         n_jobs : int
+        episode_index : numpy.ndarray of int64, optional
+            Per job, its episode index, from indices :meth:`reserve` gave: the jobs are then not
+            counted in :attr:`episodes` and :attr:`steps` (the caller counts what it uses).
 
         Returns
         -------
@@ -575,7 +597,10 @@ class KernelFlyer:
         zeros, arange, e, minus, returns, crashed, steps, sg = self._views_for(n_jobs)
         p = zeros if policy_index is None else (arange if isinstance(policy_index, str) else policy_index)
         m = zeros if mdp_index is None else (arange if isinstance(mdp_index, str) else mdp_index)
-        np.add(arange, self.episodes, out=e)
+        if episode_index is None:
+            np.add(arange, self.next_index, out=e)
+        else:
+            e[:] = episode_index
         rollout: Callable[..., None] = rollout_batch
         lanes = self.device == "cpu" and _use_lanes("cpu", rows, m)
         if self.device == "cuda":
@@ -623,9 +648,13 @@ class KernelFlyer:
         self.kernel_seconds += time.perf_counter() - t0
         if self.trace is not None:
             self.trace.append((genomes.copy(), rows, p.copy(), m.copy(), e.copy()))
-        self.episodes += n_jobs
-        self.steps += int(steps[0]) if n_jobs == 1 else int(steps.sum())
+        if episode_index is None:
+            self.episodes += n_jobs
+            self.next_index += n_jobs
+            self.steps += int(steps[0]) if n_jobs == 1 else int(steps.sum())
+        self.flown += n_jobs
         self.crashed = crashed
+        self.job_steps = steps
         return returns
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import warnings
@@ -718,3 +719,21 @@ def test_selection_race_bad_returns_raise_like_reference() -> None:
         for impl in (_reference_selection_race, selection_race):
             with pytest.raises(ValueError, match="sample_fn returned"):
                 impl(bad, 6, 2, 0.9, 3)
+
+
+@pytest.mark.parametrize("seed", range(0, 400, 7))
+def test_a_races_look_ahead_changes_no_result(seed: int) -> None:
+    """With every candidate's t-th sample fixed (the table), look-ahead batches fly more samples
+    per call but the race uses exactly the samples it used without them."""
+    n, mu, delta, t_limit, table = _race_case(seed)
+    plain_sample, plain_calls = _table_sampler(table)
+    plain = selection_race(plain_sample, n, mu, delta, t_limit)
+    for batch in (7, 64, 10_000):
+        sample, calls = _table_sampler(table)
+        ahead = selection_race(sample, n, mu, delta, t_limit, batch=batch)
+        _assert_race_equal(ahead, dataclasses.asdict(plain))
+        assert len(calls) <= len(plain_calls)
+        if batch == 10_000:  # every sample up to t_limit in the first call
+            assert len(calls) == 1
+        assert ahead.episodes_flown == sum(c.size for c in calls) >= ahead.episodes_spent
+    assert plain.episodes_flown == plain.episodes_spent

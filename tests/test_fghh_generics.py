@@ -144,3 +144,16 @@ def test_evolve_on_the_command_line_takes_a_preset_and_settings(tmp_path, capsys
     assert "fitness='log' is not a fitness scale: allowed inv-log-error, return" in capsys.readouterr().err
     assert main([*args, "--mdp", "zero", "--preset", "table7"]) == 2
     assert "applies to evolution over a family" in capsys.readouterr().err
+
+
+def test_a_races_look_ahead_is_a_speed_setting_only(monkeypatch) -> None:
+    import neurohover.evolution.run as run_module
+
+    runs = []
+    for per_thread in (1, 400):
+        monkeypatch.setattr(run_module, "RACE_BATCH_PER_THREAD", per_thread)
+        runs.append(evolve(FGHH, resampling="race:0.5", seed=6, n_steps=200, budget=400, threads=1))
+    a, b = runs
+    np.testing.assert_array_equal(a.champion.genome, b.champion.genome)
+    assert (a.champion_return, a.episodes, a.steps, a.generations) == (b.champion_return, b.episodes, b.steps, b.generations)
+    assert [h.champion_return for h in a.history] == [h.champion_return for h in b.history]

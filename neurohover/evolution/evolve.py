@@ -132,6 +132,7 @@ def evolve(
     method: str | None = None,
     progress_every_s: float = 0.2,
     _trace: list | None = None,
+    _unused: list | None = None,
 ) -> EvolutionResult:
     """Run a whole evolution on the batched kernel and return its champion and history.
 
@@ -180,6 +181,9 @@ def evolve(
     _trace : list, optional
         For benchmarks: receives every kernel call's jobs (:attr:`KernelFlyer.trace
         <neurohover.evaluate.KernelFlyer>`).
+    _unused : list, optional
+        For benchmarks, with ``_trace``: receives the episode indices flown but not used (a
+        race's look-ahead).
 
     Raises
     ------
@@ -212,6 +216,8 @@ def evolve(
         run.restore(read_checkpoint(path), f"checkpoint {str(path)!r}")
         run.stop_reason = None
     run.flyer.trace = _trace
+    if _unused is not None:
+        run.flyer.trace_unused = _unused
     # Load (or compile) the kernel before the clock runs, and validate the thread count.
     if run.rows is not None:
         warm_up: np.ndarray | MDP = run.rows

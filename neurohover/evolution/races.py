@@ -80,8 +80,10 @@ class RaceResult:
     episodes_spent : int
         Total episodes flown (``n_samples.sum()``).
     rounds : int
-        Rounds raced (the most samples of a candidate): ``rounds - 1`` calls of ``sample_fn`` when
-        ``t_limit >= 2``, whose first flies rounds 1 and 2.
+        Rounds raced (the most samples of a candidate); the first call of ``sample_fn`` flies
+        rounds 1 and 2 when ``t_limit >= 2``.
+    episodes_flown : int
+        Samples drawn in all: ``episodes_spent`` plus look-ahead samples the race never used.
     """
 
     selected: np.ndarray
@@ -93,6 +95,7 @@ class RaceResult:
     n_raced: int
     episodes_spent: int
     rounds: int
+    episodes_flown: int = 0
 
 
 def _check_int(name: str, value: object, minimum: int) -> int:
@@ -214,6 +217,7 @@ def selection_race(
     mu: int,
     delta: float,
     t_limit: int = 10,
+    batch: int = 0,
 ) -> RaceResult:
     """Pick ``mu`` of ``n_candidates`` noisy candidates with a selection race.
 
@@ -263,6 +267,13 @@ def selection_race(
         cautious (wider bounds, more episodes).
     t_limit : int, default 10
         Maximum episodes per candidate (>= 1).
+    batch : int, default 0
+        Look-ahead for speed: when a call of ``sample_fn`` is due, each undecided candidate is
+        listed for its next ``ceil(batch / undecided)`` samples at once (at most up to
+        ``t_limit``; at least the one the round needs), and later rounds use them before calling
+        again. Samples of a candidate decided before it reaches them are never used. With a
+        ``sample_fn`` whose t-th sample of a candidate is fixed (as an evolution run's is) the
+        result does not depend on ``batch``; ``episodes_flown`` counts what it flew in all.
 
     Returns
     -------
@@ -274,6 +285,7 @@ def selection_race(
         raise ValueError(f"mu={mu} must be smaller than n_candidates={n}")
     delta = _check_delta(delta)
     t_limit = _check_int("t_limit", t_limit, 1)
+    batch = _check_int("batch", batch, 0)
 
     # Samples live in one (n, capacity) array: in round r every undecided
     # candidate has exactly r samples (columns 0..r-1), so the statistics of all
@@ -291,23 +303,28 @@ def selection_race(
     selected: list[int] = []
     discard_order: list[int] = []
     rounds = 0
+    episodes_flown = 0
     need_select, need_discard = n - mu, mu
 
+    flown = 0  # samples drawn so far by every undecided candidate (they stay in lockstep)
     while True:
         active = np.flatnonzero(undecided)
-        # Round 1 can decide nothing (one sample: bounds (-inf, inf), or (-inf, -inf) for a crash,
-        # which no lower bound of -inf exceeds), so rounds 1 and 2 fly in one call: every candidate
-        # listed twice, in round order, numbered as two calls would number them.
-        both = rounds == 0 and t_limit >= 2
-        draws = _draw(sample_fn, np.concatenate([active, active]) if both else active)
-        if rounds == samples.shape[1]:
-            grown = np.empty((n, min(t_limit, 2 * rounds)))
-            grown[:, :rounds] = samples
-            samples = grown
-        for column in np.split(draws, 2) if both else [draws]:
-            samples[active, rounds] = column
-            crashed[active] |= np.isneginf(column)
-            rounds += 1
+        if flown == rounds:  # a call is due: this round's samples, and any look-ahead
+            # Round 1 can decide nothing (one sample: bounds (-inf, inf), or (-inf, -inf) for a crash,
+            # which no lower bound of -inf exceeds), so its call flies round 2 too.
+            ahead = max(2 if rounds == 0 else 1, -(-batch // active.size))
+            ahead = min(ahead, t_limit - rounds)
+            draws = _draw(sample_fn, np.tile(active, ahead))  # listed in round order
+            if rounds + ahead > samples.shape[1]:
+                grown = np.empty((n, min(t_limit, max(2 * samples.shape[1], rounds + ahead))))
+                grown[:, : samples.shape[1]] = samples
+                samples = grown
+            samples[active, rounds : rounds + ahead] = draws.reshape(ahead, active.size).T
+            flown += ahead
+            episodes_flown += draws.size
+        samples_now = samples[active, rounds : rounds + (2 if rounds == 0 and t_limit >= 2 else 1)]
+        crashed[active] |= np.isneginf(samples_now).any(axis=1)
+        rounds += samples_now.shape[1]
         n_samples[active] = rounds
         _round_bounds(samples[active, :rounds], active, crashed[active], delta, means, lower, upper)
 
@@ -353,6 +370,7 @@ def selection_race(
         n_raced=n_raced,
         episodes_spent=int(n_samples.sum()),
         rounds=rounds,
+        episodes_flown=episodes_flown,
     )
 
 

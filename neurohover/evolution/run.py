@@ -23,6 +23,7 @@ import numpy as np
 from ..errors import NeurohoverError
 from ..evaluate import KernelFlyer
 from ..policies import Policy
+from ..sim.lanes import LANES
 from .cmaes import CMAES
 from .common import Optimiser, enc_float
 from .config import RACE_T_LIMIT, RunConfig, upgrade_saved_config
@@ -43,6 +44,10 @@ from .seeding import mdp_rng, noise_seed, optimiser_seed
 from .steady_state import SteadyStateNE
 
 __all__ = ["InterruptFlag", "Run"]
+
+#: A race's look-ahead per kernel thread (:meth:`Run._race_batch`): 4 lane loads of LANES episodes, the best
+#: of 0-32 lane loads measured on FGHH (docs/performance.md): more fills the lanes but flies samples never used.
+RACE_BATCH_PER_THREAD = 4 * LANES
 
 
 class InterruptFlag:
@@ -112,6 +117,8 @@ class Run:
         self.champion_genome: np.ndarray | None = None  # CMA-ES on a family: best of the last generation
         self.champion_return = -math.inf
         self.stop_reason: str | None = None
+        self._race_steps = np.zeros((0, RACE_T_LIMIT), dtype=np.int64)  # the current race's steps per sample flown
+        self._race_base, self._race_base_drawn = 0, np.zeros(0, dtype=np.int64)  # its first episode index, samples flown
 
     # ----------------------------------------------------------------- checkpoints
 
@@ -124,6 +131,8 @@ class Run:
             "optimizer_state": self.opt.state_dict(),
             "counters": {
                 "episodes": self.flyer.episodes,
+                "next_index": self.flyer.next_index,
+                "flown": self.flyer.flown,
                 "steps": self.flyer.steps,
                 "generation": self.generation,
                 "evaluations": self.evaluations,
@@ -154,6 +163,8 @@ class Run:
             raise NeurohoverError(f"{source}: cannot restore the optimiser ({err})") from None
         c = state["counters"]
         self.flyer.episodes, self.flyer.steps = int(c["episodes"]), int(c["steps"])
+        # Checkpoints before races reserved indices: every index flown was counted.
+        self.flyer.next_index, self.flyer.flown = int(c.get("next_index", c["episodes"])), int(c.get("flown", c["episodes"]))
         self.flyer.kernel_seconds = float(c["kernel_seconds"])
         self.generation, self.evaluations = int(c["generation"]), int(c["evaluations"])
         self.elapsed = float(c["wall_seconds"])
@@ -203,15 +214,35 @@ class Run:
         result = fixed_resampling(lambda idx: cols[next(calls)], n, k)
         return result.means, result
 
+    def _race_batch(self) -> int:
+        """Episodes per call a race's look-ahead aims at: enough to keep every thread's SIMD lanes
+        busy to the end of a call (a speed setting only: it changes no result)."""
+        return RACE_BATCH_PER_THREAD * self.flyer.max_threads
+
     def _race_sample_fn(self, genomes: np.ndarray):
+        """A race's ``sample_fn`` in which candidate i's t-th episode is fixed: episode index
+        ``base + t * n + i`` and MDP row ``t * n + i``, reserved and drawn when the race starts,
+        so the race's look-ahead (which flies samples it may not use) changes no result."""
+        n = genomes.shape[0]
+        base = self._race_base = self.flyer.reserve(n * RACE_T_LIMIT)
+        if self.family is None:
+            assert self.rows is not None  # a run has one MDP (its rows) or a family
+            rows = self.rows
+        else:
+            assert self.mdp_rng is not None  # set exactly when the run has a family
+            rows = self.family.sample_rows(self.mdp_rng, n * RACE_T_LIMIT)
+        drawn = self._race_base_drawn = np.zeros(n, dtype=np.int64)  # samples flown per candidate
+        self._race_steps = np.zeros((n, RACE_T_LIMIT), dtype=np.int64)  # steps of each sample flown
+
         def sample(idx: np.ndarray) -> np.ndarray:
-            n, rows, family = idx.shape[0], self.rows, self.family
-            if self.mdp_rng is None:
-                assert rows is not None  # mdp_rng is None exactly when the run has one MDP
-                returns = self.flyer.fly(genomes, rows, idx.astype(np.int64), None, n)
-            else:
-                assert family is not None  # mdp_rng is set exactly when the run has a family
-                returns = self.flyer.fly(genomes, family.sample_rows(self.mdp_rng, n), idx.astype(np.int64), "range", n)
+            idx = idx.astype(np.int64)
+            t = np.empty_like(idx)
+            for q, i in enumerate(idx.tolist()):  # a candidate listed again flies its next sample
+                t[q] = drawn[i]
+                drawn[i] += 1
+            slot = t * n + idx
+            returns = self.flyer.fly(genomes, rows, idx, None if self.family is None else slot, idx.shape[0], episode_index=base + slot)
+            self._race_steps[idx, t] = self.flyer.job_steps
             return episode_fitness(returns, self.fitness)
 
         return sample
@@ -310,7 +341,17 @@ class Run:
         if self.resampling.kind == "race":
             delta = self.resampling.delta
             assert delta is not None  # every race has its delta (Run() formats it in config.to_dict() first)
-            race = selection_race(self._race_sample_fn(genomes), genomes.shape[0], opt.settings.select_size, delta, t_limit=RACE_T_LIMIT)
+            race = selection_race(
+                self._race_sample_fn(genomes), genomes.shape[0], opt.settings.select_size, delta, t_limit=RACE_T_LIMIT, batch=self._race_batch()
+            )
+            # Count the episodes the race used (its look-ahead flew more): what depends on no speed setting.
+            used = np.arange(RACE_T_LIMIT)[None, :] < race.n_samples[:, None]
+            self.flyer.episodes += race.episodes_spent
+            self.flyer.steps += int(self._race_steps[used].sum())
+            if self.flyer.trace is not None:  # for benchmarks: the look-ahead's samples the race never used
+                n = genomes.shape[0]
+                t, i = np.nonzero(((self._race_base_drawn[:, None] > np.arange(RACE_T_LIMIT)) & ~used).T)
+                self.flyer.trace_unused.extend((self._race_base + t * n + i).tolist())
             opt.tell_race(race)
         else:
             _, result = self._fly_family_fixed(genomes)
