@@ -20,6 +20,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     """Run a paper experiment (or all of them); every finished unit goes to the results store at once."""
     from .experiments import Store, load_configs, make_executor, parse_override, reproduce
     from .experiments.config import experiment_names
+    from .experiments.plans import source_experiments
     from .paths import output_file
 
     if args.list:
@@ -38,6 +39,17 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     output_file(args.store, "--store")
     overrides = dict(parse_override(text) for text in args.set or [])
     configs = load_configs(args.name, args.scale, overrides)
+    named = [c.name for c in configs]
+    for config in list(configs):  # experiments that draw from others run after them (e.g. fig16 after fig13 and fig15)
+        for source in source_experiments(config):
+            if source not in named:
+                print(f"neurohover reproduce: {config.name} draws its generic policies from {source}: running {source} first", file=sys.stderr)
+                configs.insert(configs.index(config), load_configs(source, args.scale)[0])
+                named.append(source)
+    if args.only and len(configs) > 1 and args.name != "all":
+        raise NeurohoverError(
+            f"--only selects units of one experiment; {args.name} also runs {', '.join(c.name for c in configs if c.name != args.name)} first"
+        )
     if args.only and len(configs) > 1:
         raise NeurohoverError(f"--only selects units of one experiment: give its NAME instead of {args.name!r}")
     executor = make_executor(args.executor, jobs=args.jobs, address=args.address, device=args.device)

@@ -25,7 +25,18 @@ import numpy as np
 from .errors import NeurohoverError
 from .flightdata import FlightData
 from .policies import GENOME_LENGTH, TOPOLOGIES, Policy
-from .sim.constants import EPISODE_STEPS, MDP_ROW_LEN, SAFEGUARD_BOX, SAFEGUARD_LIMITS, SAFEGUARD_TILT
+from .sim.constants import (
+    EPISODE_STEPS,
+    MDP_ROW_LEN,
+    SAFEGUARD_BOX,
+    SAFEGUARD_KIND_BOX,
+    SAFEGUARD_KIND_RATIO,
+    SAFEGUARD_LAYOUT_LEN,
+    SAFEGUARD_LIMITS,
+    SAFEGUARD_RATIO_LIMITS,
+    SAFEGUARD_RATIO_THRESHOLD,
+    SAFEGUARD_TILT,
+)
 from .sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
 from .sim.lanes import LANES, rollout_lanes
 from .tasks import MDP
@@ -286,10 +297,11 @@ def evaluate_jobs(
         Root seed of every episode's noise stream.
     fallback_index : array_like of int, optional
         Per job, the policy the safeguard hands control to (-1: no safeguard for that job).
-    safeguard_limits : sequence or array of 10 floats, optional
+    safeguard_limits : sequence or array of 24 floats, optional
         The dangerous-state test in the kernel's layout (:meth:`DangerousState.limits`): limits on
-        |u|, |v|, |w|, |x|, |y|, |z|, |p|, |q|, |r|, then the tilt threshold on qw (inf: no tilt
-        condition). Default: ``DangerousState()``, the authors' test.
+        |u|, |v|, |w|, |x|, |y|, |z|, |p|, |q|, |r|, the tilt threshold on qw (inf: no tilt
+        condition), the test's kind, the ratio-sum threshold and limits. Default:
+        ``DangerousState()``, the authors' GHH-09 test.
     record : array_like of bool, optional
         Per job, whether to record its flight data.
     n_steps : int
@@ -319,9 +331,10 @@ def evaluate_jobs(
         if fb.shape[0] != n_jobs or (fb.size and (fb.min() < -1 or fb.max() >= len(table))):
             raise NeurohoverError(f"fallback_index must have {n_jobs} entries in -1..{len(table) - 1}")
     limits = SAFEGUARD_LIMITS if safeguard_limits is None else np.asarray(safeguard_limits, dtype=float)
-    if limits.shape != (10,) or not np.all(limits > 0) or np.isnan(limits).any():
+    if limits.shape != (SAFEGUARD_LAYOUT_LEN,) or not np.all(np.delete(limits, 10) > 0) or np.isnan(limits).any() or limits[10] not in (0.0, 1.0):
         raise NeurohoverError(
-            f"safeguard_limits must be 10 positive numbers (u, v, w, x, y, z, p, q, r limits, then the tilt threshold on qw), got {limits.tolist()}"
+            f"safeguard_limits must be {SAFEGUARD_LAYOUT_LEN} numbers in the layout of DangerousState.limits() (9 box limits, the tilt "
+            f"threshold, the kind 0 or 1, the ratio threshold, 12 ratio limits; all but the kind > 0), got {limits.tolist()}"
         )
     rec = np.zeros(n_jobs, dtype=bool) if record is None else np.asarray(record, dtype=bool).reshape(-1)
     if rec.shape[0] != n_jobs:
@@ -658,7 +671,7 @@ class KernelFlyer:
         return returns
 
 
-SAFEGUARD_RULES = ("code", "paper")
+SAFEGUARD_RULES = ("code", "paper", "ratio-sum")
 
 
 @dataclass(frozen=True)
@@ -667,19 +680,24 @@ class DangerousState:
 
     Parameters
     ----------
-    rule : {"code", "paper"}
-        ``"code"`` (default, as the authors' code ran it): the helicopter is tilted, qw < ``tilt``,
-        and some velocity, position or angular-rate entry of the observation lies outside
-        [-box, box]. ``"paper"``: the paper's text, the box test alone.
+    rule : {"code", "paper", "ratio-sum"}
+        ``"code"`` (default, as the authors' GHH-09 code ran it): the helicopter is tilted, qw <
+        ``tilt``, and some velocity, position or angular-rate entry of the observation lies outside
+        [-box, box]. ``"paper"``: the paper's text, the box test alone. ``"ratio-sum"`` (the
+        authors' FGHH agent): the signed sum over the 12 observation entries of entry / limit
+        (limits 5 m/s, 20 m, 4 pi rad/s, 1) exceeds ``threshold``.
     box : float
         Bound on |u|, |v|, |w|, |x|, |y|, |z|, |p|, |q|, |r| (> 0; 0.5 in the paper).
     tilt : float
-        qw below this counts as tilted, in (0, 1] (0.99 in the authors' code); unused by ``"paper"``.
+        qw below this counts as tilted, in (0, 1] (0.99 in the authors' code); used by ``"code"`` only.
+    threshold : float
+        The ``"ratio-sum"`` test's threshold (> 0; 0.15 in the authors' FGHH agent).
     """
 
     rule: str = "code"
     box: float = SAFEGUARD_BOX
     tilt: float = SAFEGUARD_TILT
+    threshold: float = SAFEGUARD_RATIO_THRESHOLD
 
     def __post_init__(self) -> None:
         if self.rule not in SAFEGUARD_RULES:
@@ -688,10 +706,15 @@ class DangerousState:
             raise NeurohoverError(f"safeguard box={self.box!r} is out of range: allowed a finite number > 0")
         if not (isinstance(self.tilt, (int, float)) and 0 < self.tilt <= 1):
             raise NeurohoverError(f"safeguard tilt={self.tilt!r} is out of range: allowed 0 < tilt <= 1 (qw threshold)")
+        if not (isinstance(self.threshold, (int, float)) and np.isfinite(self.threshold) and self.threshold > 0):
+            raise NeurohoverError(f"safeguard threshold={self.threshold!r} is out of range: allowed a finite number > 0")
 
     def limits(self) -> np.ndarray:
-        """The test in the kernel's layout: 9 box limits, then the tilt threshold (inf: no tilt condition)."""
-        return np.array([float(self.box)] * 9 + [float(self.tilt) if self.rule == "code" else np.inf])
+        """The test in the kernel's layout (sim/constants.SAFEGUARD_LIMITS): 9 box limits, the tilt
+        threshold (inf: no tilt condition), the kind (0 box, 1 ratio sum), the ratio threshold and limits."""
+        kind = SAFEGUARD_KIND_RATIO if self.rule == "ratio-sum" else SAFEGUARD_KIND_BOX
+        tilt = float(self.tilt) if self.rule == "code" else np.inf
+        return np.array([float(self.box)] * 9 + [tilt, kind, float(self.threshold), *SAFEGUARD_RATIO_LIMITS])
 
 
 @dataclass(frozen=True)

@@ -56,10 +56,36 @@ def test_a_rolling_policy_is_caught_by_both_rules() -> None:
         assert (ev.safeguard_step > 0).all() and not ev.crashed.any()
 
 
+_RATIOS = [5.0] * 3 + [20.0] * 3 + [4 * math.pi] * 3 + [1.0] * 3
+
+
 def test_limits_are_settings() -> None:
-    np.testing.assert_array_equal(DangerousState().limits(), [0.5] * 9 + [0.99])
-    np.testing.assert_array_equal(DangerousState("paper", box=0.8).limits(), [0.8] * 9 + [math.inf])
-    np.testing.assert_array_equal(DangerousState(box=1.0, tilt=0.95).limits(), [1.0] * 9 + [0.95])
+    np.testing.assert_array_equal(DangerousState().limits(), [0.5] * 9 + [0.99, 0, 0.15, *_RATIOS])
+    np.testing.assert_array_equal(DangerousState("paper", box=0.8).limits(), [0.8] * 9 + [math.inf, 0, 0.15, *_RATIOS])
+    np.testing.assert_array_equal(DangerousState(box=1.0, tilt=0.95).limits(), [1.0] * 9 + [0.95, 0, 0.15, *_RATIOS])
+    np.testing.assert_array_equal(DangerousState("ratio-sum", threshold=0.2).limits()[10:12], [1, 0.2])
+    with pytest.raises(NeurohoverError, match="safeguard threshold=0 is out of range"):
+        DangerousState("ratio-sum", threshold=0)
+
+
+def test_the_ratio_sum_rule_fires_at_the_first_step_whose_signed_ratio_sum_exceeds_the_threshold() -> None:
+    """The authors' FGHH agent's test: sum over the 12 observation entries of entry / limit > 0.15."""
+    family = get_task_family("fghh", 0.3)
+    mdps = family.test_mdps()[:6]
+    wobbly = Policy("slp", np.r_[np.zeros(36), 0.05, -0.05, 0.1, 0.3])  # no feedback: drifts off within seconds
+    guard = Safeguard(baseline_policy(), DangerousState("ratio-sum"))
+    ev = evaluate(wobbly, mdps, episodes=1, seed=5, n_steps=400, record=True, safeguard=guard)
+    steps = ev.safeguard_step.ravel()
+    assert (steps > 0).sum() >= 2
+    for e, k in enumerate(steps):
+        obs = ev.flight_data.observations[e]
+        ratio = (obs / np.array(_RATIOS)).sum(axis=1)  # signed: a drift the other way never fires
+        if k >= 0:
+            assert ratio[k] > 0.15 and (ratio[:k] <= 0.15).all()  # the observation the policy would have acted on next
+        else:
+            assert (ratio[:-1] <= 0.15).all()
+    box = evaluate(wobbly, mdps, episodes=1, seed=5, n_steps=400, safeguard=Safeguard(baseline_policy(), DangerousState("code")))
+    assert not np.array_equal(box.safeguard_step, ev.safeguard_step)  # another test, other steps
     # a wider box fires later (or not at all) on the same flights
     roller = Policy("slp", np.r_[np.zeros(36), 0.3, 0, 0, 0.23])
     mdp = get_task_family("ghh08").zero()

@@ -201,6 +201,9 @@ SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
         "generic_budget": (0, _int(0)),
         "generic_resampling": ({"fixed": "fixed:5", "race": "race:0.2"}, _table()),
         "generics_per_agent": (1, _int(1)),
+        # kind -> "EXPERIMENT/VARIANT" (or "EXPERIMENT/best-race"): each run's generic drawn from the
+        # final champions of another experiment's evolution runs, in the same store and scale
+        "generics_from": (_OMIT, _table()),
         "safety_episodes": (3, _int(1)),
         "model_budget": (2000, _int(1)),
         "predict_episodes": (5, _int(1)),
@@ -292,6 +295,13 @@ def _check_kind(settings: dict, kind: str, where: str) -> None:
                     g["hybrid"] = HybridSettings.from_dict(g["hybrid"]).to_dict()
                 except NeurohoverError as e:
                     raise NeurohoverError(f"{where}: group {g['label']!r}: {e}") from None
+        for kind, source in settings.get("generics_from", {}).items():
+            name, _, variant = str(source).partition("/")
+            if kind not in ("fixed", "race") or not isinstance(source, str) or not name or not variant:
+                raise NeurohoverError(
+                    f"{where}: generics_from = {{ {kind} = {source!r} }} is not allowed: expected keys fixed and/or race holding "
+                    "'EXPERIMENT/VARIANT' or 'EXPERIMENT/best-race' (e.g. fixed = 'fig13/k5')"
+                )
         gr = settings["generic_resampling"]
         if set(gr) - {"fixed", "race"} or not all(_resampling()(v)[0] for v in gr.values()):
             raise NeurohoverError(f"{where}: generic_resampling must be a table with keys fixed and/or race holding fixed:K / race:DELTA")

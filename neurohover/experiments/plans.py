@@ -35,6 +35,7 @@ _SAMPLE_TAG = 0x5A3
 class Plan:
     units: list[Unit]
     total: int
+    waiting: tuple[str, ...] = ()  # why some units cannot be planned yet (unfinished sources)
 
 
 def _family(task: str, sigma: float | None):
@@ -165,11 +166,40 @@ def _spec(agent: str):
     return agent_spec(agent)
 
 
-class _Policies:
-    """The policies a test-runs experiment's agents fly: evolved by its own units, or read from a
-    policy set directory. ``get`` returns None while the units they come from are unfinished."""
+def source_experiments(cfg: ExperimentConfig) -> list[str]:
+    """The experiments whose results a config's units need (``generics_from``), in the order named."""
+    names = [str(src).partition("/")[0] for src in cfg.settings.get("generics_from", {}).values()]
+    return list(dict.fromkeys(names))
 
-    def __init__(self, cfg: ExperimentConfig, results: dict) -> None:
+
+def _source_champions(source: str, scale: str, results: dict) -> tuple[list[tuple[str, dict]] | None, str]:
+    """The final champions ``[(key, policy)]`` of ``source`` (``EXPERIMENT/VARIANT`` or
+    ``EXPERIMENT/best-race``: the race variant whose final champions' fitness estimates have the
+    highest mean, so that no test MDP chooses it), or None and why while its runs are unfinished."""
+    from .config import load_config
+
+    name, _, want = source.partition("/")
+    src = load_config(name, scale)
+    variants = [v for v in src.settings["variants"] if v["resampling"].startswith("race")] if want == "best-race" else [
+        v for v in src.settings["variants"] if v["key"] == want
+    ]  # fmt: skip
+    if not variants:
+        keys = ", ".join(v["key"] for v in src.settings["variants"])
+        raise NeurohoverError(f"generics_from {source!r}: {name} has no variant {want!r} (its variants: {keys}; or best-race)")
+    runs = {v["key"]: [f"evolve/{v['key']}/run{r}" for r in range(src.settings["runs"])] for v in variants}
+    missing = sum(k not in results for keys in runs.values() for k in keys)
+    if missing:
+        return None, f"{missing} of {sum(map(len, runs.values()))} evolution runs of {name} ({', '.join(runs)}) are not in the store yet"
+    best = max(runs, key=lambda v: float(np.mean([float(results[k]["champion_return"]) for k in runs[v]])))
+    return [(f"{name}/{k}", results[k]["champion"]) for k in runs[best]], ""
+
+
+class _Policies:
+    """The policies a test-runs experiment's agents fly: evolved by its own units, read from a
+    policy set directory, or drawn from another experiment's champions (``generics_from``).
+    ``get`` returns None while the units they come from are unfinished."""
+
+    def __init__(self, cfg: ExperimentConfig, results: dict, sources: dict[str, dict] | None = None) -> None:
         self.cfg, self.results = cfg, results
         s = cfg.settings
         self.task = s["task"]
@@ -216,8 +246,15 @@ class _Policies:
                         )
                     )
         else:
+            self.drawn: dict[str, list[tuple[str, dict]] | None] = {}
+            self.waiting: list[str] = []
+            for kind, source in s.get("generics_from", {}).items():
+                if kind in needs:
+                    self.drawn[kind], why = _source_champions(source, cfg.scale, (sources or {}).get(source.partition("/")[0], {}))
+                    if why:
+                        self.waiting.append(f"the {kind} generics come from {source}: {why}")
             for kind in ("zero", "fixed", "race"):
-                if kind not in needs:
+                if kind not in needs or kind in self.drawn:
                     continue
                 for j in range(s["generics_per_agent"]):
                     if kind == "zero":
@@ -238,8 +275,8 @@ class _Policies:
         r = self.results.get(key)
         return None if r is None else r["champion"]
 
-    def for_agent(self, agent: str, mdp_index: int | None, run_counter: int, exclude_own: bool) -> dict | None:
-        """The policies of one run of ``agent`` (None: not ready yet)."""
+    def for_agent(self, agent: str, mdp_index: int | None, run_counter: int, exclude_own: bool, key: str = "") -> dict | None:
+        """The policies of one run of ``agent``, unit ``key`` (None: not ready yet)."""
         spec = _spec(agent)
         need = spec.needs
         out: dict = {}
@@ -247,7 +284,15 @@ class _Policies:
         if self.family.generic_over_distribution:
             kind = spec.generic_kind.get(self.task)
             if kind is not None:
-                if ext is not None:
+                if kind in getattr(self, "drawn", {}):
+                    champions = self.drawn[kind]
+                    if champions is None:
+                        return None
+                    # Each run draws one of the source's champions, as the authors' agent picks one of its files.
+                    rng = np.random.default_rng(unit_seed(self.cfg.settings["seed"], self.cfg.name, f"{key}/generic"))
+                    source, out["generic"] = champions[int(rng.integers(len(champions)))]
+                    out["generic_source"] = source
+                elif ext is not None:
                     out["generic"] = policy_dict(ext.generics[kind])
                 else:
                     j = run_counter % self.cfg.settings["generics_per_agent"]
@@ -285,9 +330,9 @@ def group_hybrid_settings(group: dict) -> dict | None:
     return HybridSettings.from_dict(group["hybrid"]).to_dict() if group["agent"] in HYBRID_AGENTS else None
 
 
-def _plan_test_runs(cfg: ExperimentConfig, results: dict) -> Plan:
+def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dict] | None = None) -> Plan:
     s = cfg.settings
-    pol = _Policies(cfg, results)
+    pol = _Policies(cfg, results, sources)
     units = list(pol.units)
     total = pol.total
     settings = {k: s[k] for k in ("task", "sigma", "episodes", "n_steps", "model_budget", "predict_episodes", "max_learning_episodes")}
@@ -297,7 +342,8 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict) -> Plan:
         for i, mdp in enumerate(mdps):
             for rep in range(g["runs_per_mdp"]):
                 total += 1
-                policies = pol.for_agent(g["agent"], i if g["mdps"] == "train" else None, counter, g["exclude_own"] and g["mdps"] == "train")
+                key = f"run/{g['label']}/{g['mdps']}{i}/rep{rep}"
+                policies = pol.for_agent(g["agent"], i if g["mdps"] == "train" else None, counter, g["exclude_own"] and g["mdps"] == "train", key)
                 counter += 1
                 if policies is None:
                     continue
@@ -305,7 +351,7 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict) -> Plan:
                 units.append(
                     _unit(
                         cfg,
-                        f"run/{g['label']}/{g['mdps']}{i}/rep{rep}",
+                        key,
                         "test_run",
                         {
                             **settings,
@@ -318,7 +364,7 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict) -> Plan:
                         },
                     )
                 )
-    return Plan(units, total)
+    return Plan(units, total, tuple(getattr(pol, "waiting", ())))
 
 
 # --------------------------------------------------------------------------------- model learning
@@ -371,6 +417,10 @@ def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
 _PLANNERS = {"evolution": _plan_evolution, "test_runs": _plan_test_runs, "model_learning": _plan_model_learning}
 
 
-def plan(cfg: ExperimentConfig, results: dict[str, dict]) -> Plan:
-    """Every unit that can be defined given ``results`` (key -> result), and the final unit count."""
+def plan(cfg: ExperimentConfig, results: dict[str, dict], sources: dict[str, dict[str, dict]] | None = None) -> Plan:
+    """Every unit that can be defined given ``results`` (key -> result) and the results of the
+    experiments it draws from (``sources``: name -> results, :func:`source_experiments`), and the
+    final unit count."""
+    if cfg.kind == "test_runs":
+        return _plan_test_runs(cfg, results, sources)
     return _PLANNERS[cfg.kind](cfg, results)

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 from ..errors import NeurohoverError
 from .config import ExperimentConfig
-from .plans import plan
+from .plans import plan, source_experiments
 from .store import Store
 
 
@@ -85,6 +85,7 @@ def reproduce(
     store.lock()  # one writer per store: a second run would redo every unit the first has not finished
     store.begin(config.name, config.scale, config.hash, config.to_dict(), fresh=fresh)
     results = store.results(config.name, config.scale)
+    sources = {name: store.results(name, config.scale) for name in source_experiments(config)}
     summary = RunSummary(config.name, config.scale, executor.name, executor.cores, units_before=len(results))
     session = store.start_session(config.name, config.scale, config.hash, executor.name, summary.cores, len(results))
     start = time.perf_counter()
@@ -106,7 +107,7 @@ def reproduce(
     matched: set[str] = set()
     try:
         while True:
-            p = plan(config, results)
+            p = plan(config, results, sources)
             matched.update(pat for pat in only for u in p.units if fnmatch.fnmatchcase(u.key, pat))
             summary.units_total = p.total
             bar.total = p.total
@@ -125,7 +126,8 @@ def reproduce(
         elif only:
             summary.status = "finished" if len(results) >= summary.units_total else "selection finished"
         elif len(results) < summary.units_total:
-            raise NeurohoverError(f"{config.name}: {summary.units_total - len(results)} units could not be planned")
+            why = f": {p.waiting[0]} (run them first, into the same store)" if p.waiting else ""
+            raise NeurohoverError(f"{config.name}: {summary.units_total - len(results)} units could not be planned{why}")
         else:
             summary.status = "finished"
     except KeyboardInterrupt:

@@ -157,9 +157,17 @@ def crashed(s) -> bool:
 
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
 def dangerous(o, limits) -> bool:
-    """Safeguard test on observation ``o``: some velocity, position or rate entry beyond its limit
-    ``limits[0:9]`` while the helicopter is tilted, qw < ``limits[9]`` (qw from the quaternion's
-    vector part, as the authors' code computed it; ``limits[9] = inf``: the box test alone)."""
+    """Safeguard test on observation ``o`` (``limits`` in the layout of constants.SAFEGUARD_LIMITS).
+
+    Kind 0 (``limits[10]``): some velocity, position or rate entry beyond its limit ``limits[0:9]``
+    while the helicopter is tilted, qw < ``limits[9]`` (qw from the quaternion's vector part, as
+    the authors' code computed it; ``limits[9] = inf``: the box test alone). Kind 1 (the authors'
+    FGHH agent): the signed sum of ``o[i] / limits[12 + i]`` over the 12 entries above ``limits[11]``."""
+    if limits[10] != 0.0:
+        total = 0.0
+        for i in range(12):
+            total += o[i] / limits[12 + i]
+        return total > limits[11]
     for i in range(9):
         if abs(o[i]) > limits[i]:
             qw = math.sqrt(max(0.0, 1.0 - (o[9] * o[9] + o[10] * o[10] + o[11] * o[11])))

@@ -1,0 +1,198 @@
+"""The FGHH agent of the authors' code (docs/model.md, On-line agents; their FGHH ``mb_agent``).
+
+It is not the paper's incremental loop. In the run's first episode it flies its generic policy
+(no safeguard) and records it; an LR model is learned from that episode alone. After episodes
+1, 2 and 3 it evolves a policy on the model and flies it in the next episode under the
+``ratio-sum`` safeguard (:class:`~neurohover.evaluate.DangerousState`: the signed sum of the
+observation's ratios to their limits above 0.15 hands the rest of the episode to the baseline
+policy and charges the offending policy an error of 100,000). From episode 5 on it flies, every
+episode and under the same safeguard, the policy with the lowest mean error so far among the
+generic and the three evolved ones.
+
+==========================  ===============================================================
+the authors' code            here
+==========================  ===============================================================
+evolution on the model       ``eonn`` with 49 of 50 kept, 2,500 generations of one offspring,
+                             tournaments of 5, from their ``model.net`` MLP: steady state with
+                             the same settings (:data:`MODEL_EVOLUTION`), 2,550 model
+                             episodes, from the baseline-equivalent MLP (their ``model.net``
+                             is not ours to ship)
+a candidate's error          their ``end()`` appends the episode's last reward only (an
+                             oversight); here the episode's error, ``-return``
+a safeguard firing           the offending policy's entry for that episode is 100,000 (the
+                             episode's own error goes to the fallback, which is never a
+                             candidate)
+a generic that crashes       their LR then fits on a few steps; here the generic flies again
+within 20 steps              (recorded) until the flight data hold 20 transitions
+==========================  ===============================================================
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import NeurohoverError
+from ..evaluate import DangerousState
+from ..evolution.steady_state import SteadyStateSettings
+from ..flightdata import FlightData
+from ..policies import Policy, baseline_policy, prototype
+from ..sim.constants import EPISODE_STEPS
+from ..tasks import TaskFamily
+from .model_based import enough_to_learn, learn_model
+from .protocol import Agent, Choice, EpisodeOutcome
+from .spec import AgentOptions, AgentPolicies, AgentSpec
+
+#: The authors' ``eonn`` settings on the model (their FGHH agent): 49 of 50 kept, one offspring a
+#: generation by crossover of two tournament winners (then mutation with probability 0.75), the
+#: initial copies mutated with frac 0.5 and std 0.5; no plateau stop (a fixed number of generations).
+MODEL_EVOLUTION = SteadyStateSettings(
+    pop_size=50,
+    elite_size=49,
+    crossover_prob=1.0,
+    selection="tournament",
+    tournament_size=5,
+    init_mutate_frac=0.5,
+    init_mutate_std=0.5,
+    plateau_threshold=10**9,
+)
+
+
+@dataclass(frozen=True)
+class CodeAgentSettings:
+    """Settings of :class:`CodeFGHHAgent` (defaults: the authors' code).
+
+    Attributes
+    ----------
+    evolutions : int
+        Policies evolved on the model, one after each of the first ``evolutions`` episodes (3).
+    model_budget : int
+        Model episodes per evolution (2,550: 50 initial candidates and 2,500 generations).
+    fired_error : float
+        The error charged to a policy for an episode in which the safeguard fired (100,000).
+    dangerous : DangerousState
+        The safeguard's test (the ``ratio-sum`` rule at 0.15).
+    n_steps : int
+        Control steps of a model episode.
+    estimator : {"ols", "gls"}
+        The LR model's least squares (OLS, as the authors).
+    """
+
+    evolutions: int = 3
+    model_budget: int = 2550
+    fired_error: float = 1e5
+    dangerous: DangerousState = DangerousState("ratio-sum")
+    n_steps: int = EPISODE_STEPS
+    estimator: str = "ols"
+
+    def __post_init__(self) -> None:
+        for name, low in (("evolutions", 1), ("model_budget", 50), ("n_steps", 1)):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < low:
+                raise NeurohoverError(f"{name}={value!r} is out of range: allowed an integer >= {low}")
+        if not (isinstance(self.fired_error, (int, float)) and np.isfinite(self.fired_error) and self.fired_error >= 0):
+            raise NeurohoverError(f"fired_error={self.fired_error!r} is out of range: allowed a finite number >= 0")
+
+
+class CodeFGHHAgent(Agent):
+    """The authors' FGHH agent (module docstring): the generic, three model policies, then the best."""
+
+    name = "authors"
+
+    def __init__(self, generic: Policy, settings: CodeAgentSettings = CodeAgentSettings()) -> None:
+        self.generic = generic
+        self.settings = settings
+        self.fallback = baseline_policy()
+        self._reset(np.random.default_rng(0))
+
+    def _reset(self, rng: np.random.Generator) -> None:
+        self._rng = rng
+        self.flight_data: FlightData | None = None
+        self.model = None
+        self.candidates: list[tuple[Policy, str]] = [(self.generic, "generic")]
+        self.errors: dict[str, list[float]] = {"generic": []}
+        self.next_trial = 1  # the evolved candidate flown next (1-based), until all are flown
+        self.flying = "generic"
+
+    def start(self, family: TaskFamily, rng: np.random.Generator) -> None:
+        self._reset(rng)
+
+    def _mean_error(self, label: str) -> float:
+        e = self.errors[label]
+        return float(np.mean(e)) if e else np.inf
+
+    def best(self) -> tuple[Policy, str]:
+        """The candidate with the lowest mean error so far (the first of equals)."""
+        return min(self.candidates, key=lambda c: self._mean_error(c[1]))
+
+    def choose(self, episode: int) -> Choice:
+        s = self.settings
+        if self.model is None:  # the generic gathers the flight data, without a safeguard
+            self.flying = "generic"
+            return Choice(self.generic, "generic", record=True)
+        if self.next_trial <= len(self.candidates) - 1:
+            policy, label = self.candidates[self.next_trial]
+        else:
+            policy, label = self.best()
+        self.flying = label
+        return Choice(policy, label, fallback=self.fallback, dangerous=s.dangerous)
+
+    def update(self, outcome: EpisodeOutcome) -> None:
+        s = self.settings
+        fired = outcome.safeguard_step >= 0
+        self.errors[self.flying].append(s.fired_error if fired else -outcome.ret)
+        if self.model is None:
+            assert outcome.flight_data is not None  # the generic's episodes are recorded
+            self.flight_data = outcome.flight_data if self.flight_data is None else self.flight_data + outcome.flight_data
+            if not enough_to_learn(self.flight_data):
+                return
+            self.model = learn_model(self.flight_data, s.estimator)
+        elif self.flying != "generic" and self.next_trial <= len(self.candidates) - 1:
+            self.next_trial += 1
+        if len(self.candidates) - 1 < s.evolutions and self.next_trial == len(self.candidates):
+            self._evolve()
+
+    def _evolve(self) -> None:
+        from ..evolution.evolve import evolve
+
+        s = self.settings
+        result = evolve(
+            self.model,
+            topology="mlp",
+            prototype=prototype("mlp", "baseline"),
+            budget=s.model_budget,
+            settings=MODEL_EVOLUTION,
+            seed=int(self._rng.integers(2**62)),
+            n_steps=s.n_steps,
+            threads=1,
+        )
+        label = f"model:{len(self.candidates)}"
+        self.candidates.append((result.champion, label))
+        self.errors[label] = []
+
+
+def _build(name: str):
+    def build(policies: AgentPolicies, options: AgentOptions) -> Agent:
+        assert policies.generic is not None
+        evo = options.evolution
+        # A run's model budget (the configs' model_budget) applies here too: 2,550 is the authors'.
+        settings = CodeAgentSettings() if evo is None else CodeAgentSettings(model_budget=max(50, evo.budget), n_steps=evo.n_steps, estimator=evo.estimator)
+        agent = CodeFGHHAgent(policies.generic, settings)
+        agent.name = name
+        return agent
+
+    return build
+
+
+AGENT_SPECS = tuple(
+    AgentSpec(
+        f"authors-{kind}",
+        ("fghh",),
+        frozenset({"generic"}),
+        _build(f"authors-{kind}"),
+        generic_kind={"fghh": kind},
+        summary=f"the authors' FGHH agent (generic, one-episode model, three model policies, the best) from the generic evolved {what}",
+    )
+    for kind, what in (("zero", "on the zero setting"), ("fixed", "over G with fixed resampling"), ("race", "over G with selection races"))
+)

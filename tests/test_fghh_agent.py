@@ -1,0 +1,95 @@
+"""Figure 16 as the authors' code ran it: their FGHH agent, and generics drawn from Figures 13 and 15's champions."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from neurohover import NeurohoverError, get_task_family
+from neurohover.agents.fghh_code import CodeAgentSettings, CodeFGHHAgent
+from neurohover.agents.protocol import run_test
+from neurohover.cli import main
+from neurohover.experiments import Store, load_config
+from neurohover.experiments.plans import plan
+from neurohover.policies import load_policy
+
+FGHH = get_task_family("fghh", 0.3)
+GENERIC = Path(__file__).parent.parent / "neurohover" / "data" / "policies" / "fghh" / "generic_race.json"
+
+
+@pytest.mark.parametrize("mdp", [0, 3, 7])
+def test_the_authors_agent_flies_the_generic_three_model_policies_then_the_lowest_mean_error(mdp: int) -> None:
+    settings = CodeAgentSettings(model_budget=60, n_steps=300)
+    agent = CodeFGHHAgent(load_policy(GENERIC), settings)
+    r = run_test(agent, FGHH, FGHH.test_mdps()[mdp], episodes=14, seed=mdp, n_steps=300)
+    assert r.policy[:4] == ["generic", "model:1", "model:2", "model:3"]
+    assert not r.safeguard_fired[0]  # the generic's flight-data episode flies without a safeguard
+    errors: dict[str, list[float]] = {}
+    for e, label in enumerate(r.policy):
+        if e >= 4:  # every later episode: the candidate of lowest mean error so far (the first of equals)
+            means = {k: np.mean(v) for k, v in errors.items()}
+            assert label == min(means, key=means.get)
+        errors.setdefault(label, []).append(settings.fired_error if r.safeguard_fired[e] else -r.returns[e])
+    assert agent.errors == errors
+
+
+def test_the_authors_agent_settings_are_checked() -> None:
+    with pytest.raises(NeurohoverError, match="model_budget=10 is out of range"):
+        CodeAgentSettings(model_budget=10)
+    with pytest.raises(NeurohoverError, match="fired_error=-1 is out of range"):
+        CodeAgentSettings(fired_error=-1)
+
+
+@pytest.fixture(scope="module")
+def sources(tmp_path_factory) -> tuple[Path, dict]:
+    """A store holding quick Figures 13 and 15 (their champions are Figure 16's generics)."""
+    path = tmp_path_factory.mktemp("fig16") / "store.sqlite"
+    for name in ("fig13", "fig15"):
+        assert main(["reproduce", name, "--store", str(path), "--no-progress"]) == 0
+    with Store(path) as store:
+        return path, {name: store.results(name, "quick") for name in ("fig13", "fig15")}
+
+
+def test_each_run_draws_its_generic_from_the_sources_champions(sources) -> None:
+    _, results = sources
+    cfg = load_config("fig16", "quick")
+    units = [u for u in plan(cfg, {}, results).units if u.kind == "test_run"]
+    fig15 = load_config("fig15", "quick").settings
+    races = [v["key"] for v in fig15["variants"] if v["resampling"].startswith("race")]
+    best = max(races, key=lambda v: np.mean([results["fig15"][f"evolve/{v}/run{r}"]["champion_return"] for r in range(fig15["runs"])]))
+    for u in units:
+        p = u.params["policies"]
+        source = p["generic_source"]
+        if u.params["agent"].endswith("-race"):
+            assert source.startswith(f"fig15/evolve/{best}/")
+        elif u.params["agent"].endswith("-fixed"):
+            assert source.startswith("fig13/evolve/k5/")
+        else:
+            assert source.startswith("policy/generic-zero")
+            continue
+        name, key = source.split("/", 1)
+        assert p["generic"] == results[name][key]["champion"]
+    drawn = [u.params["policies"]["generic_source"] for u in units if u.params["agent"].endswith("-race")]
+    assert len(set(drawn)) > 1  # drawn per run, not one for all
+    assert [u.params for u in plan(cfg, {}, results).units] == [u.params for u in plan(cfg, {}, results).units]
+
+
+def test_without_its_sources_figure_16_waits_and_says_for_what(sources, tmp_path: Path, capsys) -> None:
+    cfg = load_config("fig16", "quick")
+    p = plan(cfg, {}, {})
+    assert not any(u.params.get("agent", "").endswith(("-race", "-fixed")) for u in p.units)
+    assert any("fig15" in w and "not in the store yet" for w in p.waiting)
+    # On the command line the sources run first, into the same store.
+    store = tmp_path / "s.sqlite"
+    assert main(["reproduce", "fig16", "--store", str(store), "--no-progress"]) == 0
+    err = capsys.readouterr().err
+    assert "running fig13 first" in err and "running fig15 first" in err
+
+
+def test_a_bad_generics_source_is_refused() -> None:
+    with pytest.raises(NeurohoverError, match="generics_from = { fixed = 'fig13' } is not allowed"):
+        load_config("fig16", "quick", {"generics_from": {"fixed": "fig13"}})
+    with pytest.raises(NeurohoverError, match="fig13 has no variant 'k7'"):
+        plan(load_config("fig16", "quick", {"generics_from": {"fixed": "fig13/k7"}}), {}, {})
