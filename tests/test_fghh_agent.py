@@ -93,3 +93,24 @@ def test_a_bad_generics_source_is_refused() -> None:
         load_config("fig16", "quick", {"generics_from": {"fixed": "fig13"}})
     with pytest.raises(NeurohoverError, match="fig13 has no variant 'k7'"):
         plan(load_config("fig16", "quick", {"generics_from": {"fixed": "fig13/k7"}}), {}, {})
+
+
+def test_the_report_shows_fghh_runs_on_their_fitness_scale_beside_the_authors_generics(sources, tmp_path: Path) -> None:
+    import json
+
+    from neurohover.experiments import write_report
+
+    path, results = sources
+    out = tmp_path / "report"
+    out.mkdir()
+    flights = {"returns": [[-150.0, -1e7], [-1000.0, -200.0]], "crashed": [[False, True], [False, False]]}
+    (out / "authors-fghh-generics.json").write_text(json.dumps({"fig13-quick": {"resampling_05": flights}}))
+    with Store(path) as store:
+        text = write_report(store, out, scale="quick", names=["fig13"]).read_text()
+    assert "| setting | runs | final fitness estimate (mean) | as error | validation crash rate | median error | mean 1/ln(error) |" in text
+    k5 = [results["fig13"][f"evolve/k5/run{r}"]["champion_return"] for r in range(3)]
+    assert f"| k = 5 | 3 | {np.mean(k5):.4g} |" in text
+    # The authors' row: 1 crash in 4 episodes, median error 600, mean over policies of their mean 1/ln(error).
+    fits = np.mean([np.mean([1 / np.log(150), 1 / np.log(1e7)]), np.mean([1 / np.log(1000), 1 / np.log(200)])])
+    assert f"| the authors' resampling_05 (2 files) | 2 |  |  | 25.0% | 600 | {fits:.4g} |" in text
+    assert (out / "fig13-quick.png").is_file()

@@ -39,7 +39,7 @@ from ..evolution.steady_state import SteadyStateSettings
 from ..flightdata import FlightData
 from ..policies import Policy, baseline_policy, prototype
 from ..sim.constants import EPISODE_STEPS
-from ..tasks import TaskFamily
+from ..tasks import MDP, TaskFamily
 from .model_based import enough_to_learn, learn_model
 from .protocol import Agent, Choice, EpisodeOutcome
 from .spec import AgentOptions, AgentPolicies, AgentSpec
@@ -109,7 +109,7 @@ class CodeFGHHAgent(Agent):
     def _reset(self, rng: np.random.Generator) -> None:
         self._rng = rng
         self.flight_data: FlightData | None = None
-        self.model = None
+        self.model: MDP | None = None
         self.candidates: list[tuple[Policy, str]] = [(self.generic, "generic")]
         self.errors: dict[str, list[float]] = {"generic": []}
         self.next_trial = 1  # the evolved candidate flown next (1-based), until all are flown

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import NeurohoverError
+from ..evolution.fitness import episode_fitness, error_of_fitness
 from .config import ORDER, ExperimentConfig
 from .results import EvolveResult, ModelResult, RobustnessResult, TestRunResult, UnitKey, UnitResult, result_from_dict
 from .store import Store
@@ -159,11 +160,11 @@ class _Section:
         return "### Statistical tests\n\n" + _table(["comparison", "mean A", "mean B", "t", "Student's p", "Welch's p", "paper p"], self.tests) + "\n"
 
 
-def _curve(points: Sequence[Sequence[float | str]], grid: np.ndarray) -> np.ndarray:
-    """Champion error of one run on ``grid`` (a step function; NaN before its first record,
-    held after its last)."""
+def _curve(points: Sequence[Sequence[float | str]], grid: np.ndarray, sign: float = -1.0) -> np.ndarray:
+    """Champion error (``sign`` -1; +1: the champion's fitness as recorded) of one run on ``grid``
+    (a step function; NaN before its first record, held after its last)."""
     xs = np.array([p[0] for p in points], dtype=float)
-    ys = -np.array([float(p[1]) for p in points], dtype=float)
+    ys = sign * np.array([float(p[1]) for p in points], dtype=float)
     idx = np.searchsorted(xs, grid, side="right") - 1
     out = np.where(idx >= 0, ys[np.clip(idx, 0, None)], np.nan)
     return out
@@ -177,12 +178,17 @@ class _Evolution(_Section):
         return self.group("evolve", vkey)
 
     def final_scores(self, runs: list[EvolveResult]) -> list[float]:
+        """Per run: the mean validation return, or on the 1/ln(error) scale the mean validation fitness."""
+        if _on_fitness_scale(runs) and all(r.validation is not None for r in runs):
+            return [float(np.mean(episode_fitness(np.array([float(x) for x in r.validation or ()]), FITNESS_SCALE))) for r in runs]
         return [r.final_score for r in runs]
 
     def figure(self) -> str | None:
         data = {v["key"]: self.runs(v["key"]) for v in self.variants()}
         if not any(data.values()):
             return None
+        if all(_on_fitness_scale(runs) for runs in data.values() if runs):
+            return self._fitness_figure(data)
         xmax = max(r.history[-1][0] for runs in data.values() for r in runs)
         xmin = min(r.history[0][0] for runs in data.values() for r in runs)
         grid = np.linspace(max(xmin, 1), xmax, 400)
@@ -213,7 +219,96 @@ class _Evolution(_Section):
         fig.suptitle(f"{self.cfg.title} ({self.cfg.scale} scale)", fontsize=10)
         return self.save(fig)
 
+    def _fitness_figure(self, data: dict[str, list[EvolveResult]]) -> str:
+        """Figures 12, 13, 15 in the paper's form on the scale the runs used: the champion's fitness
+        estimate, 1/ln(error), averaged over the runs, and the same curve as error, exp(1/fitness)."""
+        xmax = max(r.history[-1][0] for runs in data.values() for r in runs)
+        grid = np.linspace(1, xmax, 400)
+        fig, axes = _figure(2, figsize=(11, 4.2))
+        axes = axes[0]
+        for v in self.variants():
+            runs = data[v["key"]]
+            if not runs:
+                continue
+            curves = np.array([_curve(r.history, grid, sign=1.0) for r in runs])
+            with np.errstate(all="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # grid points before any run's first champion
+                mean = np.nanmean(np.where(np.isfinite(curves), curves, np.nan), axis=0)
+            axes[0].plot(grid, mean, label=f"{v['label']} ({len(runs)} runs)")
+            axes[1].plot(grid, error_of_fitness(mean, FITNESS_SCALE), label=v["label"])
+        axes[0].set_ylabel("champion fitness, 1/ln(error) (mean over runs)")
+        axes[1].set_ylabel("as error, exp(1/fitness) (log scale)")
+        axes[1].set_yscale("log")
+        for ax in axes:
+            ax.set_xlabel("episodes")
+            ax.grid(alpha=0.3, which="both")
+            ax.legend(fontsize=8)
+        fig.suptitle(f"{self.cfg.title} ({self.cfg.scale} scale)", fontsize=10)
+        return self.save(fig)
+
+    def _fitness_body(self) -> str:
+        """Final champions of runs on the 1/ln(error) scale, flown on the test MDPs, beside the authors' generics."""
+        rows, samples, labels = [], {}, {}
+        for v in self.variants():
+            runs = self.runs(v["key"])
+            if not runs:
+                continue
+            row, finals = _validation_row(v["label"], [[float(x) for x in r.validation or ()] for r in runs], [r.validation_crashed for r in runs])
+            champ = [float(r.champion_return) for r in runs]
+            rows.append([row[0], str(len(runs)), fmt(np.mean(champ)), fmt(float(error_of_fitness(float(np.mean(champ)), FITNESS_SCALE))), *row[1:]])
+            rows[-1] += [fmt(np.mean([r.episodes for r in runs])), fmt(np.mean([r.timing.seconds for r in runs]))]
+            samples[v["key"]], labels[v["key"]] = finals, v["label"]
+        authors = _authors_generics(self.out, self.cfg)
+        for folder, entry in authors.items():
+            row, _ = _validation_row(f"the authors' {folder} ({len(entry['returns'])} files)", entry["returns"], entry["crashed"])
+            rows.append([row[0], str(len(entry["returns"])), "", "", *row[1:], "", ""])
+        where = "once on each of the family's test MDPs, the same gusts for every run" if self.s.get("validation_mdps") == "test" else "on fresh MDPs"
+        text = (
+            "### Final champions\n\n"
+            + _table(
+                [
+                    "setting",
+                    "runs",
+                    "final fitness estimate (mean)",
+                    "as error",
+                    "validation crash rate",
+                    "median error",
+                    "mean 1/ln(error)",
+                    "sd over runs",
+                    "episodes/run",
+                    "seconds/run",
+                ],
+                rows,
+            )
+            + "\n\nFinal fitness estimate: the best selected parent's mean 1/ln(error) over its episodes in the last generation "
+            f"(what the figure's left panel ends on); as error: exp(1/fitness). Validation: each final champion flown {where}; "
+            "crash rate over all validation episodes, median error over them, mean 1/ln(error) per run then over runs (the "
+            "t tests' sample)."
+            + (
+                " The authors' rows: their published FGHH generics (their `policies/` folders beside `mdp.py`) flown on the same "
+                "MDPs with the same gusts (`docs/reproduction/authors_fghh_generics.py`)."
+                if authors
+                else ""
+            )
+            + "\n"
+        )
+        if samples:
+            order = sorted(samples, key=lambda k: -np.mean(samples[k]))
+            self.comparisons.append("Ranking by mean validation 1/ln(error) (best first): ours " + " > ".join(labels[k] for k in order) + ".")
+            for folder, entry in authors.items():
+                fits = [float(np.mean(episode_fitness(np.array(r), FITNESS_SCALE))) for r in entry["returns"]]
+                self.comparisons.append(
+                    f"The authors' {folder} generics on the same MDPs: mean 1/ln(error) {fmt(np.mean(fits))}, crash rate "
+                    f"{np.mean([c for cs in entry['crashed'] for c in cs]):.1%} (ours: "
+                    + ", ".join(f"{labels[k]} {fmt(np.mean(samples[k]))}" for k in order)
+                    + ")."
+                )
+        self.add_tests(samples, labels, "mean validation 1/ln(error) of the final champions")
+        return text
+
     def body(self) -> str:
+        if all(_on_fitness_scale(self.runs(v["key"])) for v in self.variants() if self.runs(v["key"])) and any(self.runs(v["key"]) for v in self.variants()):
+            return self._fitness_body()
         parts = []
         rows = []
         samples, labels = {}, {}
@@ -339,6 +434,36 @@ class _Evolution(_Section):
             + f"\n\nThe best champion of each training MDP's runs flown {n} episodes on its own MDP (r) and on every "
             f"training MDP used (r_G); sd over the policies' mean returns.\n"
         )
+
+
+FITNESS_SCALE = "inv-log-error"
+
+
+def _on_fitness_scale(runs: list[EvolveResult]) -> bool:
+    """Whether the runs recorded their champions on the 1/ln(error) scale (FGHH as the authors ran it)."""
+    return bool(runs) and all(r.fitness == FITNESS_SCALE for r in runs)
+
+
+def _validation_row(label: str, returns: list[list[float]], crashed: list) -> tuple[list[str], list[float]]:
+    """[label, crash rate, median error, mean 1/ln(error), sd over runs] of validation flights, and the per-run means."""
+    flat = np.array([x for r in returns for x in r], dtype=float)
+    if flat.size == 0:
+        return [label, "n/a", "n/a", "n/a", "n/a"], []
+    per_run = [float(np.mean(episode_fitness(np.array(r, dtype=float), FITNESS_SCALE))) for r in returns if r]
+    known = [c for cs in crashed if cs is not None for c in cs]
+    rate = f"{np.mean(known):.1%}" if known else "n/a"
+    return [label, rate, fmt(float(np.median(-flat))), fmt(float(np.mean(per_run))), fmt(_sd(per_run))], per_run
+
+
+def _authors_generics(out: Path, cfg: ExperimentConfig) -> dict:
+    """The authors' published FGHH generics flown on this experiment's validation MDPs, if measured
+    (``authors-fghh-generics.json`` beside the report, written by docs/reproduction/authors_fghh_generics.py)."""
+    import json
+
+    path = out / "authors-fghh-generics.json"
+    if not path.is_file():
+        return {}
+    return json.loads(path.read_text()).get(f"{cfg.name}-{cfg.scale}", {})
 
 
 class _ModelLearning(_Section):

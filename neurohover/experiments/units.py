@@ -134,7 +134,7 @@ def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:
     history = [(int(h.episodes), num(h.champion_return)) for h in result.history]
     validation = crashed = None
     if p.get("validation_mdps") == "test":  # every run's champion on the family's test MDPs, with shared noise (paired)
-        ev = _fly_on_test_mdps(result.champion, target, p["validation_episodes"], p["validation_seed"], p["n_steps"], threads, device)
+        ev = fly_on_test_mdps(result.champion, target, p["validation_episodes"], p["validation_seed"], p["n_steps"], threads, device)
         validation, crashed = tuple(num(x) for x in ev.returns), tuple(bool(c) for c in ev.crashed)
     elif p.get("validation_episodes"):
         v = validation_return(result.champion, target, episodes=p["validation_episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads, device=device)
@@ -156,7 +156,7 @@ def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:
     ).to_dict()
 
 
-def _fly_on_test_mdps(policy, family, episodes: int, seed: int, n_steps: int, threads, device):
+def fly_on_test_mdps(policy, family, episodes: int, seed: int, n_steps: int, threads, device):
     """``policy`` flown once on each of the first ``episodes`` test MDPs of ``family`` (cycling), episode
     ``i`` with noise stream ``(seed, i)``: the same MDPs and gusts for every policy flown so."""
     from ..evaluate import evaluate_jobs
