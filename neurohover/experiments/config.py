@@ -43,7 +43,7 @@ CONFIG_DIR = Path(__file__).parent / "configs"
 SCALES = ("quick", "paper")
 KINDS = ("evolution", "model_learning", "test_runs")
 #: Experiments in report order (the shipped configs).
-ORDER = ("fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16", "ablation-plateau", "ablation-hybrid")
+ORDER = ("fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16", "ablation-plateau", "ablation-hybrid", "ablation-fghh")
 #: Bump when a unit function changes what it computes: stores written before are then refused.
 UNITS_VERSION = 2  # 2: competition MDP sets, the authors' safeguard, OLS, the no-crash plateau
 
@@ -149,6 +149,7 @@ _VARIANT = {
     "prototype": ("baseline", _choice("zero", "baseline")),
     "resampling": ("fixed:1", _resampling()),
     "sigma": (None, _float(0.0, 1.0)),
+    "optimiser": (_OMIT, _table()),  # this variant's optimiser settings, over the experiment's `optimiser`
 }
 
 _GROUP = {

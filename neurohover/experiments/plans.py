@@ -100,6 +100,8 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
     train = family.training_mdps()[: s["n_mdps"]]
     for v in s["variants"]:
         common = {**base, "topology": v["topology"], "prototype": v["prototype"], "resampling": v["resampling"]}
+        if "optimiser" in v:
+            common["optimiser"] = {**s["optimiser"], **v["optimiser"]}
         if s["target"] == "train":
             for i, mdp in enumerate(train):
                 for r in range(s["runs"]):
