@@ -105,7 +105,9 @@ def cmd_report(args: argparse.Namespace) -> int:
 
 def register(sub) -> None:
     p = sub.add_parser("reproduce", help="run a paper experiment into a results store", description=cmd_reproduce.__doc__)
-    p.add_argument("name", nargs="?", help="experiment (fig2, table4, fig7, fig8, fig11, fig12, fig13, fig15, fig16), 'all', or a .toml config")
+    from .experiments.config import experiment_names
+
+    p.add_argument("name", nargs="?", help=f"experiment ({', '.join(experiment_names())}), 'all', or a .toml config")
     p.add_argument("--scale", choices=("quick", "paper"), default="quick", help="quick (minutes; the default) or paper (the paper's protocol)")
     p.add_argument("--store", help="results store file (SQLite; created if missing; finished units are skipped)")
     p.add_argument("--executor", choices=("local", "ray"), default="local", help="local processes (default) or a Ray cluster")

@@ -36,7 +36,7 @@ from neurohover.experiments.store import SCHEMA_VERSION
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER_EXPERIMENTS = ["fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16"]
-ABLATIONS = ["ablation-plateau", "ablation-hybrid"]
+ABLATIONS = ["ablation-plateau", "ablation-hybrid", "ablation-fghh"]
 
 # A small evolution experiment whose units take ~0.3 s each (for the interruption tests).
 SLOW_CONFIG = """
