@@ -157,3 +157,17 @@ def test_a_races_look_ahead_is_a_speed_setting_only(monkeypatch) -> None:
     np.testing.assert_array_equal(a.champion.genome, b.champion.genome)
     assert (a.champion_return, a.episodes, a.steps, a.generations) == (b.champion_return, b.episodes, b.steps, b.generations)
     assert [h.champion_return for h in a.history] == [h.champion_return for h in b.history]
+
+
+def test_configs_take_the_settings_and_refuse_bad_ones_when_loaded() -> None:
+    from neurohover.experiments import load_config
+    from neurohover.experiments.plans import plan
+
+    cfg = load_config("ablation-fghh", "quick")
+    by_variant = {u.key.split("/")[1]: u.params["optimiser"] for u in plan(cfg, {}).units}
+    assert by_variant["raw-returns"] == {"fitness": "return"} and by_variant["script-sizes"] == {"preset": "authors-script"}
+    assert {u.params["topology"] for u in plan(load_config("fig13", "paper"), {}).units} == {"slp"}
+    with pytest.raises(NeurohoverError, match="optimiser: bad generational settings: fitness='bogus' is not a fitness scale"):
+        load_config("fig13", "quick", {"optimiser": {"fitness": "bogus"}})
+    with pytest.raises(NeurohoverError, match="unknown steady-state setting"):
+        load_config("ablation-plateau", "quick", {"optimiser": {"preset": "table7"}})

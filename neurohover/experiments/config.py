@@ -260,6 +260,16 @@ def _check_kind(settings: dict, kind: str, where: str) -> None:
                 raise NeurohoverError(f"{where}: variant {v['key']!r} sets sigma but the task is {task!r}")
             if settings["target"] != "family" and v["resampling"].startswith("race"):
                 raise NeurohoverError(f"{where}: variant {v['key']!r}: selection races need target = 'family'")
+        from ..evolution.config import make_settings
+
+        method = "generational" if settings["target"] == "family" else "steady-state"
+        for v in [None, *settings["variants"]]:
+            table = settings["optimiser"] if v is None else {**settings["optimiser"], **v.get("optimiser", {})}
+            try:  # the optimiser settings are checked here, not when a unit first runs
+                make_settings(method, "ne", table)
+            except NeurohoverError as err:
+                whose = "" if v is None else f" of variant {v['key']!r}"
+                raise NeurohoverError(f"{where}: optimiser{whose}: {err}") from None
         bad = [k for k in settings["robustness_variants"] if k not in keys]
         if bad:
             raise NeurohoverError(f"{where}: robustness_variants {bad} are not variant keys ({', '.join(keys)})")
