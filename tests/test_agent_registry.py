@@ -29,9 +29,13 @@ def test_the_paper_agents_are_registered_with_their_tasks() -> None:
         "incremental-race",
         "hybrid",
         "hybrid-baseline",
+        "authors-zero",
+        "authors-fixed",
+        "authors-race",
     }
     assert HYBRID_AGENTS == ("hybrid", "hybrid-baseline")
     assert AGENTS["model-free"].tasks == ("ghh08", "ghh09") and AGENTS["incremental-race"].tasks == ("fghh",)
+    assert AGENTS["authors-fixed"].tasks == ("fghh",) and AGENTS["authors-fixed"].generic_kind == {"fghh": "fixed"}
 
 
 @pytest.mark.parametrize("name", list(AGENTS))
