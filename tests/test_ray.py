@@ -45,8 +45,9 @@ def ray_cluster():
 
 def _subset_config():
     """A representative subset in few units: policy evolution (steady state and over G with fixed
-    resampling and races), and test runs of the incremental model-based agent."""
-    return load_config("fig16", "quick", {"generics_per_agent": 1})
+    resampling and races: no generics drawn from other experiments), and test runs of the authors'
+    and the incremental model-based agents."""
+    return load_config("fig16", "quick", {"generics_per_agent": 1, "generics_from": {}})
 
 
 def test_ray_and_local_runs_give_identical_results(ray_cluster, tmp_path: Path) -> None:
@@ -56,7 +57,7 @@ def test_ray_and_local_runs_give_identical_results(ray_cluster, tmp_path: Path) 
         executor = RayExecutor()
         assert not executor.started  # the session's cluster is reused, not restarted
         b = reproduce(cfg, remote, executor, progress=False)
-        assert a.status == b.status == "finished" and a.units_run == b.units_run == a.units_total == 12
+        assert a.status == b.status == "finished" and a.units_run == b.units_run == a.units_total == 15
         assert b.executor == "ray" and b.cores == 2
         ra, rb = local.results(cfg.name, cfg.scale), remote.results(cfg.name, cfg.scale)
         assert ra.keys() == rb.keys()
@@ -133,7 +134,7 @@ def test_a_unit_whose_worker_keeps_dying_is_reported_not_recorded(ray_cluster, t
 
     cfg = load_config("fig15", "quick")
     units = [Unit(cfg.name, "good", "diagnostic", {"value": 1}), Unit(cfg.name, "dies", "diagnostic", {"always_exit": True})]
-    monkeypatch.setattr(runner, "plan", lambda config, results: Plan(units, 2))
+    monkeypatch.setattr(runner, "plan", lambda config, results, sources=None: Plan(units, 2))
     with Store(tmp_path / "s.sqlite") as store:
         summary = reproduce(cfg, store, RayExecutor(max_retries=1), progress=False)
         assert summary.status == "failed" and [k for k, _ in summary.failed] == ["dies"]
