@@ -26,7 +26,7 @@ CRASH_STEP_PENALTY``, 1748.8) times the steps left, up to about -1.75e6 in a 100
 episode. Value targets mixing -1 and -1e6 would make the critic's loss all about crashes, and
 since PPO clips the gradient norm of the joint loss, the policy's step too (not tried here). Squashing every reward with ``-log(1 + |r|)`` (the
 README's example) bounds them, but then a crash (about -14) is *cheaper* than flying on at -1 per
-step for the discount horizon, and the agent learns to crash. So :class:`SquashedReward` squashes
+step for the discount horizon, and the agent learns to crash. So :class:`neurohover.wrappers.CrashAwareReward` squashes
 the ordinary steps, ``-log(1 + |r|)``, and keeps the meaning of the crash penalty, "the worst step
 for every step left", in the squashed and discounted currency: ``-log(1 + P) * (1 + g + ... +
 g**(k-1))`` for the k steps left (the crashing one included). A crash is then always worse than
@@ -38,7 +38,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import time
 from pathlib import Path
 
@@ -51,7 +50,7 @@ from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 
 import neurohover  # noqa: F401  (registers the neurohover/* environments)
 from neurohover import baseline_policy
-from neurohover.sim.constants import CRASH_STEP_PENALTY
+from neurohover.wrappers import CrashAwareReward
 
 ENV_ID = "neurohover/GHH08-v0"
 FULL_EPISODE = 6000  # steps of the paper's episodes (10 minutes at 10 Hz)
@@ -84,34 +83,6 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
 # ---------------------------------------------------------------------------------------------
 
 
-class SquashedReward(gym.Wrapper):
-    """Rewards for learning: ``-log(1 + |r|)`` per step, a crash the squashed worst step for every step left, discounted.
-
-    Put it outside :class:`gymnasium.wrappers.RecordEpisodeStatistics`, so the recorded
-    episode returns stay the environment's own.
-    """
-
-    def __init__(self, env: gym.Env, episode_steps: int, gamma: float, scale: float) -> None:
-        super().__init__(env)
-        self.episode_steps, self.gamma, self.scale = episode_steps, gamma, scale
-        self.worst_step = math.log1p(CRASH_STEP_PENALTY)  # about 7.47
-        self.t = 0
-
-    def reset(self, **kwargs):
-        self.t = 0
-        return self.env.reset(**kwargs)
-
-    def step(self, action):
-        obs, reward, terminated, truncated, info = self.env.step(action)
-        self.t += 1
-        if terminated:  # a crash: the environment charged P * (steps left)
-            left = self.episode_steps - self.t + 1
-            reward = -self.worst_step * (1.0 - self.gamma**left) / (1.0 - self.gamma)
-        else:
-            reward = -math.log1p(-reward)
-        return obs, self.scale * reward, terminated, truncated, info
-
-
 def make_train_env(args: argparse.Namespace):
     """A function building one training environment (what Stable-Baselines3's vector envs want)."""
 
@@ -120,7 +91,7 @@ def make_train_env(args: argparse.Namespace):
         env = gym.wrappers.RecordEpisodeStatistics(env)  # info["episode"]: raw return "r", length "l"
         if args.reward == "log":  # the README's example: sign(r) log(1 + |r|), a crash about -14
             return gym.wrappers.TransformReward(env, lambda r: args.reward_scale * float(np.sign(r) * np.log1p(abs(r))))
-        return SquashedReward(env, args.episode_steps, args.gamma, args.reward_scale)
+        return CrashAwareReward(env, args.gamma, args.reward_scale)
 
     return thunk
 

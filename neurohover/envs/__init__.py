@@ -1,7 +1,10 @@
 """Gymnasium environments, registered on import of :mod:`neurohover`.
 
 Ids: ``neurohover/GHH08-v0``, ``neurohover/GHH09-v0`` and ``neurohover/FGHH-v0`` (which takes
-``sigma``, default 0.3): one per task family. ``gymnasium.make`` builds :class:`HoverEnv`;
+``sigma``, default 0.3): one per task family, the paper's 6000-step episodes in float64; and
+``neurohover/<NAME>-Short-v0`` for deep RL: 1000-step episodes whose crash charge counts the
+steps left of the short episode, float32 observations and actions (:class:`HoverEnv`'s docstring
+has the table). ``gymnasium.make`` builds :class:`HoverEnv`;
 ``gymnasium.make_vec(..., vectorization_mode="vector_entry_point")`` builds
 :class:`HoverVectorEnv`, which steps every helicopter in one kernel call.
 """
@@ -17,22 +20,28 @@ from .vector import HoverVectorEnv
 
 #: One id per task family, ``neurohover/<NAME>-v0``.
 ENV_IDS: dict[str, str] = {f"neurohover/{name.upper()}-v0": name for name in TASK_NAMES}
+SHORT_EPISODE_STEPS = 1000
+#: The deep-RL variant of each family, ``neurohover/<NAME>-Short-v0``: its settings over the family's.
+SHORT_ENV_IDS: dict[str, str] = {f"neurohover/{name.upper()}-Short-v0": name for name in TASK_NAMES}
+SHORT_SETTINGS = {"episode_steps": SHORT_EPISODE_STEPS, "obs_dtype": "float32", "action_dtype": "float32"}
 
 
 def register_envs() -> None:
     """Register the environments with Gymnasium; ids already registered are left alone."""
-    for env_id, task in ENV_IDS.items():
+    ids: list[tuple[str, str, dict, int]] = [(env_id, task, {}, EPISODE_STEPS) for env_id, task in ENV_IDS.items()]
+    ids += [(env_id, task, SHORT_SETTINGS, SHORT_EPISODE_STEPS) for env_id, task in SHORT_ENV_IDS.items()]
+    for env_id, task, settings, limit in ids:
         if env_id in gymnasium.registry:  # re-import or reload: Gymnasium would warn about overriding
             continue
         gymnasium.register(
             id=env_id,
             entry_point="neurohover.envs.hover:HoverEnv",
             vector_entry_point="neurohover.envs.vector:HoverVectorEnv",
-            max_episode_steps=EPISODE_STEPS,
-            kwargs={"task": task},
+            max_episode_steps=limit,
+            kwargs={"task": task, **settings},
         )
 
 
 register_envs()
 
-__all__ = ["ENV_IDS", "HoverEnv", "HoverVectorEnv", "register_envs"]
+__all__ = ["ENV_IDS", "SHORT_ENV_IDS", "HoverEnv", "HoverVectorEnv", "register_envs"]

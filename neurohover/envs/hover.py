@@ -168,8 +168,19 @@ def observation_space(dtype: Any = np.float64) -> spaces.Box:
     return spaces.Box(-np.inf, np.inf, (OBS_DIM,), dtype)
 
 
-def action_space() -> spaces.Box:
-    return spaces.Box(-1.0, 1.0, (ACTION_DIM,), np.float64)
+def action_space(dtype: Any = np.float64) -> spaces.Box:
+    return spaces.Box(-1.0, 1.0, (ACTION_DIM,), dtype)
+
+
+def check_action_dtype(action_dtype: Any) -> np.dtype:
+    """``action_dtype`` (``"float64"``, ``"float32"`` or the NumPy type) as a dtype, or a clear error."""
+    try:
+        dtype = np.dtype(action_dtype)
+    except TypeError:
+        dtype = None
+    if action_dtype is None or dtype is None or dtype.name not in OBS_DTYPES:
+        raise NeurohoverError(f"action_dtype={action_dtype!r} is not allowed: use {' or '.join(map(repr, OBS_DTYPES))}")
+    return dtype
 
 
 class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
@@ -185,7 +196,8 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
 
     ## Action Space
 
-    ``Box(-1, 1, (4,), float64)``; values outside [-1, 1] are clipped by the simulator.
+    ``Box(-1, 1, (4,), float64)`` (``float32`` with ``action_dtype="float32"``); values outside
+    [-1, 1] are clipped by the simulator, which flies float64 either way.
 
     | Num | Action                        | Min | Max |
     |-----|-------------------------------|-----|-----|
@@ -239,7 +251,18 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
     ## Arguments
 
     ``gymnasium.make("neurohover/GHH08-v0")``, ``"neurohover/GHH09-v0"`` or
-    ``"neurohover/FGHH-v0"`` (which takes ``sigma``, default 0.3), with:
+    ``"neurohover/FGHH-v0"`` (which takes ``sigma``, default 0.3), with the arguments below. Each
+    family also has a variant for deep RL, whose id alone sets it up:
+
+    | Id                               | episode_steps, time limit | obs_dtype, action_dtype |
+    |----------------------------------|---------------------------|-------------------------|
+    | ``neurohover/GHH08-v0`` (...)    | 6000 (the paper's)        | float64                 |
+    | ``neurohover/GHH08-Short-v0``    | 1000: a crash is charged  | float32                 |
+    | ``neurohover/GHH09-Short-v0``    | the steps left of the     |                         |
+    | ``neurohover/FGHH-Short-v0``     | 1000-step episode         |                         |
+
+    Rewards stay the environment's own; :class:`neurohover.wrappers.CrashAwareReward` is the
+    reward transform that learns (docs/deep-rl.md).
 
     - ``mdp``: ``"sample"`` (default: a fresh MDP drawn from G at each reset), ``"zero"`` (the
       family's mean MDP), ``"train:N"`` / ``"test:N"`` (the family's fixed training and test
@@ -249,6 +272,7 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
     - ``obs_dtype``: ``"float64"`` (default) or ``"float32"`` (for deep-RL libraries): the
       observation space's dtype and the returned observations'. The simulation itself always
       runs in float64, so the episodes are the same, observations rounded to float32.
+    - ``action_dtype``: ``"float64"`` (default) or ``"float32"``: the action space's dtype.
     - ``render_mode``: ``None`` (default), ``"rgb_array"`` or ``"human"`` (see Rendering).
 
     ``reset(seed=..., options=...)`` takes the options ``{"mdp": spec}`` (same values as the
@@ -304,14 +328,16 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         episode_steps: int = EPISODE_STEPS,
         render_mode: str | None = None,
         obs_dtype: Any = "float64",
+        action_dtype: Any = "float64",
     ) -> None:
         self.render_mode = check_render_mode(render_mode)
         self.obs_dtype = check_obs_dtype(obs_dtype)
+        self.action_dtype = check_action_dtype(action_dtype)
         self.family: TaskFamily = get_task_family(task, sigma)
         self.episode_steps = check_episode_steps(episode_steps)
         self._spec: MDP | str = resolve_mdp(self.family, mdp)
         self.observation_space = observation_space(self.obs_dtype)
-        self.action_space = action_space()
+        self.action_space = action_space(self.action_dtype)
         # The kernel steps batches; this environment is a batch of one.
         self._rows = np.zeros((1, MDP_ROW_LEN))
         self._index = np.zeros(1, dtype=np.int64)

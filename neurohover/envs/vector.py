@@ -37,6 +37,7 @@ from .hover import (
     SAMPLE,
     MdpSpec,
     action_space,
+    check_action_dtype,
     check_episode_steps,
     check_noise_stream,
     check_obs_dtype,
@@ -95,6 +96,8 @@ class HoverVectorEnv(VectorEnv):
         and each step copies the actions in and the observations, rewards and crash flags out
         (resets copy the reset sub-environments' rows in). ``"cuda"`` where no GPU is usable
         raises :class:`~neurohover.NeurohoverError`.
+    action_dtype : {"float64", "float32"}
+        dtype of the action space (the simulation runs in float64 either way).
 
     Notes
     -----
@@ -132,6 +135,7 @@ class HoverVectorEnv(VectorEnv):
         render_mode: str | None = None,
         obs_dtype: Any = "float64",
         device: str = "cpu",
+        action_dtype: Any = "float64",
     ) -> None:
         check_device(device)
         if isinstance(num_envs, (bool, np.bool_)) or not isinstance(num_envs, (int, np.integer)) or not 1 <= num_envs <= MAX_NUM_ENVS:
@@ -148,7 +152,7 @@ class HoverVectorEnv(VectorEnv):
         self._specs: list[MDP | str] = self._resolve_specs(mdp)
         self.render_mode = None
         self.single_observation_space = observation_space(self.obs_dtype)
-        self.single_action_space = action_space()
+        self.single_action_space = action_space(check_action_dtype(action_dtype))
         self.observation_space = batch_space(self.single_observation_space, n)
         self.action_space = batch_space(self.single_action_space, n)
 

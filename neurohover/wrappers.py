@@ -1,0 +1,61 @@
+"""Reward transforms for learning on the hovering environments (docs/deep-rl.md).
+
+A crash ends an episode with one reward of ``-CRASH_STEP_PENALTY`` (1748.8, the worst possible
+step) times the steps left: about -1.05e7 at the start of a 6000-step episode, where an ordinary
+step is about -0.2. Value functions then see losses of 1e13, and ``NormalizeReward`` scales every
+ordinary step to nothing. A plain ``sign(r) log(1 + |r|)`` squash makes a crash cost about as much
+as two bad steps, and agents learn to crash at once. :func:`crash_aware` squashes an ordinary step
+to ``-log(1 + |r|)`` and charges a crash that squashed worst step for every step left, discounted,
+so a crash stays worse than any way of flying on::
+
+    import gymnasium as gym, neurohover
+    from neurohover.wrappers import CrashAwareReward
+
+    env = CrashAwareReward(gym.make("neurohover/GHH08-Short-v0"))   # a crash at step 1: about -750
+
+On a vector environment use ``gymnasium.wrappers.vector.TransformReward(envs, crash_aware)``.
+Report the unwrapped environment's returns (``RecordEpisodeStatistics`` inside this wrapper).
+"""
+
+from __future__ import annotations
+
+import math
+
+import gymnasium as gym
+import numpy as np
+
+from .errors import NeurohoverError
+from .sim.constants import CRASH_STEP_PENALTY
+
+__all__ = ["CrashAwareReward", "crash_aware"]
+
+WORST_STEP = math.log1p(CRASH_STEP_PENALTY)  # the squashed worst step, about 7.47
+
+
+def crash_aware(reward, gamma: float = 0.99, scale: float = 1.0):
+    """The crash-aware squash of a reward (a float, or an array of them).
+
+    ``-log(1 + |r|)`` for an ordinary step; for a crash step (``|r| >= CRASH_STEP_PENALTY``,
+    ``left = |r| / CRASH_STEP_PENALTY`` steps charged) ``-log(1 + CRASH_STEP_PENALTY) * (1 -
+    gamma**left) / (1 - gamma)``; times ``scale``.
+    """
+    r = np.abs(np.asarray(reward, dtype=np.float64))
+    left = r / CRASH_STEP_PENALTY
+    crash = -WORST_STEP * (left if gamma == 1.0 else (1.0 - gamma**left) / (1.0 - gamma))
+    out = scale * np.where(r >= CRASH_STEP_PENALTY, crash, -np.log1p(r))
+    return float(out) if np.ndim(reward) == 0 else out
+
+
+class CrashAwareReward(gym.RewardWrapper):
+    """Rewards of :func:`crash_aware` (``gamma``: the learner's discount, in (0, 1]; ``scale`` > 0)."""
+
+    def __init__(self, env: gym.Env, gamma: float = 0.99, scale: float = 1.0) -> None:
+        if isinstance(gamma, bool) or not isinstance(gamma, (int, float)) or not 0.0 < gamma <= 1.0:
+            raise NeurohoverError(f"gamma={gamma!r} is out of range: allowed a discount in (0, 1]")
+        if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not (math.isfinite(scale) and scale > 0):
+            raise NeurohoverError(f"scale={scale!r} is out of range: allowed a finite number > 0")
+        super().__init__(env)
+        self.gamma, self.scale = float(gamma), float(scale)
+
+    def reward(self, reward):
+        return crash_aware(reward, self.gamma, self.scale)
