@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import os
 import sys
 from collections.abc import Sequence
 
@@ -15,6 +16,7 @@ import numpy as np
 
 from . import __version__
 from .errors import NeurohoverError
+from .sim.constants import EPISODE_STEPS
 
 # Modules of later pipeline stages; each has ``register(subparsers)`` adding its commands.
 COMMAND_MODULES: tuple[str, ...] = ("neurohover.commands_learning", "neurohover.commands_agents", "neurohover.commands_reproduce", "neurohover.commands_plots")
@@ -77,6 +79,20 @@ def _add_task_options(p: argparse.ArgumentParser) -> None:
 
 # Episodes per kernel call of a progress-reporting fly: large enough to keep every core busy.
 FLY_CHUNK = 256
+# What one episode of ``fly`` holds in memory (its MDP's slot, index, return, crash flag and list
+# entries; a sampled MDP's object; a recorded episode's 12 + 4 float64 a step), for the cap below.
+_FLY_BYTES_PER_EPISODE = 64
+_SAMPLED_MDP_BYTES = 2000
+_RECORD_BYTES_PER_STEP = 16 * 8
+
+
+def max_in_memory(bytes_each: int) -> int:
+    """How many items of ``bytes_each`` bytes fit in half the memory free now (checked before any work)."""
+    try:
+        free = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):  # not POSIX: no cap
+        return 2**62
+    return max(1, free // 2 // bytes_each)
 
 
 def _fly(policy, mdps: list, args: argparse.Namespace, show_progress: bool):
@@ -128,6 +144,12 @@ def cmd_fly(args: argparse.Namespace) -> int:
         raise NeurohoverError(f"--episodes {args.episodes} is out of range: allowed >= 1")
     if args.seed < 0:
         raise NeurohoverError(f"--seed {args.seed} is out of range: allowed >= 0")
+    per_episode = _FLY_BYTES_PER_EPISODE + (_SAMPLED_MDP_BYTES if args.mdp == "sample" else 0) + (_RECORD_BYTES_PER_STEP * EPISODE_STEPS if args.record else 0)
+    most = max_in_memory(per_episode)
+    if args.episodes > most:
+        raise NeurohoverError(
+            f"--episodes {args.episodes} is out of range: about {per_episode} bytes each, at most {most} fit in half this machine's free memory"
+        )
     policy = load_policy(args.policy)
     rng = np.random.default_rng(args.seed)
     family, mdps = _family_and_mdps(args, args.episodes, rng)

@@ -39,6 +39,8 @@ def cmd_compete(args: argparse.Namespace) -> int:
     from .agents.hybrid import HybridSettings
     from .agents.registry import HYBRID_AGENTS
     from .compete import compete
+    from .evolution.seeding import check_seed
+    from .experiments.executors import check_jobs
     from .paths import input_dir, output_dir, output_file
 
     given = [f"--{k.replace('_', '-')}" for k in _HYBRID_OPTIONS if getattr(args, k) is not None]
@@ -53,6 +55,8 @@ def cmd_compete(args: argparse.Namespace) -> int:
     }
     hybrid = HybridSettings.from_dict({k: v for k, v in given_values.items() if v is not None})
     check_device(args.device)  # before the output directory is made
+    check_jobs(args.jobs)
+    check_seed(args.seed)
     if args.policy_dir is not None:
         input_dir(args.policy_dir, "--policy-dir")
     output_dir(args.out, "--out")

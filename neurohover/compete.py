@@ -35,6 +35,7 @@ import numpy as np
 
 from .agents.hybrid import HybridSettings
 from .errors import NeurohoverError
+from .evolution.seeding import check_seed
 from .sim.constants import EPISODE_STEPS
 from .tasks import N_TEST, N_TRAINING, get_task_family
 
@@ -146,9 +147,10 @@ def competition_config(
     from .agents.registry import HYBRID_AGENTS
     from .experiments.config import make_config
 
-    for name, value in (("runs", runs), ("episodes", episodes), ("seed", seed)):
-        if isinstance(value, bool) or not isinstance(value, int) or value < (0 if name == "seed" else 1):
-            raise NeurohoverError(f"{name}={value!r} is out of range: allowed an integer >= {0 if name == 'seed' else 1}")
+    for name, value in (("runs", runs), ("episodes", episodes)):
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise NeurohoverError(f"{name}={value!r} is out of range: allowed an integer >= 1")
+    check_seed(seed)  # the range every command takes
     group = {"agent": agent, **_group(task, runs, mdps)}
     if agent in HYBRID_AGENTS:
         group["hybrid"] = hybrid.to_dict()

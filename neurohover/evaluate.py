@@ -18,13 +18,14 @@ import contextlib
 import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numba
 import numpy as np
 
 from .errors import NeurohoverError
 from .flightdata import FlightData
-from .policies import GENOME_LENGTH, TOPOLOGIES, Policy
+from .policies import GENOME_LENGTH, TOPOLOGIES, Policy, load_policy
 from .sim.constants import (
     EPISODE_STEPS,
     MDP_ROW_LEN,
@@ -43,6 +44,24 @@ from .tasks import MDP
 
 _KIND = {"slp": POLICY_SLP, "mlp": POLICY_MLP}
 _MAX_SEED = 2**63 - 1
+
+
+def as_policies(policies) -> list[Policy]:
+    """``policies`` as a list of :class:`Policy`: a Policy, a policy file's path or ``"baseline"``
+    (as wherever a policy file is accepted), or a sequence of these; anything else is refused."""
+
+    def one(p) -> Policy:
+        if isinstance(p, Policy):
+            return p
+        if isinstance(p, (str, Path)):
+            return load_policy(p)
+        raise NeurohoverError(f"policy {p!r} is not allowed: give a Policy, a policy file's path or 'baseline' (or a sequence of these, or a PolicyTable)")
+
+    if isinstance(policies, (Policy, str, Path)):
+        return [one(policies)]
+    if isinstance(policies, Sequence):
+        return [one(p) for p in policies]
+    raise NeurohoverError(f"policies={policies!r} is not allowed: give a Policy, a policy file's path or 'baseline' (or a sequence of these, or a PolicyTable)")
 
 
 @dataclass(frozen=True)
@@ -428,9 +447,7 @@ def evaluate(
     Episode e on MDP m has episode index ``first_episode + m * episodes + e`` for every policy,
     so all policies meet the same gusts. ``device="cuda"`` flies them on a GPU (:func:`evaluate_jobs`).
     """
-    if isinstance(policies, Policy):
-        policies = [policies]
-    table = policies if isinstance(policies, PolicyTable) else PolicyTable.from_policies(list(policies))
+    table = policies if isinstance(policies, PolicyTable) else PolicyTable.from_policies(as_policies(policies))
     rows = mdp_rows(mdps)
     if not isinstance(episodes, (int, np.integer)) or episodes < 1:
         raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")

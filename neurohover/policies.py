@@ -111,8 +111,16 @@ class Policy:
         return hash((self.topology, self.genome.tobytes()))
 
     def act(self, observation: Sequence[float]) -> tuple[float, float, float, float]:
-        """Actions for a 12-number observation, computed in plain Python (the readable definition)."""
-        u, v, w, x, y, z, _p, _q, _r, qx, qy, qz = (float(o) for o in observation)
+        """Actions for a 12-number observation, computed in plain Python (the readable definition).
+
+        Raises NeurohoverError for an observation that is not 12 finite numbers (a NaN would give NaN actions silently)."""
+        try:
+            obs = np.asarray(observation, dtype=np.float64).ravel()
+        except (TypeError, ValueError):
+            obs = np.zeros(0)
+        if obs.size != 12 or not np.all(np.isfinite(obs)):
+            raise NeurohoverError(f"observation {observation!r} is not allowed: give 12 finite numbers (u, v, w, x, y, z, p, q, r, qx, qy, qz)")
+        u, v, w, x, y, z, _p, _q, _r, qx, qy, qz = obs.tolist()
         g = self.genome.tolist()
         if self.topology == "slp":
             inputs = (u, v, w, x, y, z, qx, qy, qz)

@@ -51,6 +51,14 @@ CASES: list[tuple[list[str], str]] = [
     (["learn-model", "--flight-data", "fd.npz", "--method", "lr", "--policy", "baseline", "--out", "m.json"], "--policy applies to --method ec-mer only"),
     (["reproduce", "fig2", "--store", "s.sqlite", "--address", "127.0.0.1:6379"], "add --executor ray"),
     (["compete", "--task", "ghh08", "--agent", "baseline", "--safeguard-box", "0.3", "--out", "q"], "hybrid agents only"),
+    # Sizes that would exhaust memory, more processes than cores, seeds out of the one range, unknown policy sources.
+    (["fly", "--task", "ghh08", "--episodes", "10000000000000"], "--episodes 10000000000000 is out of range"),
+    (["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--out", "q", "--jobs", "64"], "--jobs 64 is out of range"),
+    (
+        ["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--out", "q", "--seed", str(2**70)],
+        "is out of range: allowed an integer in 0..2**63-1",
+    ),
+    (["reproduce", "fig7", "--store", "s.sqlite", "--set", 'policies="bought"'], "policies = 'bought' is not allowed: give 'evolve', 'shipped' or a directory"),
 ]
 
 

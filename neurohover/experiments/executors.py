@@ -42,6 +42,14 @@ def timed_run(unit: dict, threads: int | None = 1, device: str = "cpu") -> tuple
     return result, time.perf_counter() - t0, worker_name()
 
 
+def check_jobs(jobs) -> int:
+    """``jobs`` local worker processes: an integer from 1 to this machine's cores (NeurohoverError otherwise)."""
+    cores = os.cpu_count() or 1
+    if not isinstance(jobs, int) or isinstance(jobs, bool) or not 1 <= jobs <= cores:
+        raise NeurohoverError(f"--jobs {jobs!r} is out of range: allowed an integer in 1..{cores} (the cores of this machine)")
+    return jobs
+
+
 class LocalExecutor:
     """Run units here (``jobs=1``) or in ``jobs`` spawned processes, flying on ``device``
     (``"cpu"`` or ``"cuda"``; with ``jobs > 1`` every worker process uses the same GPU)."""
@@ -49,8 +57,7 @@ class LocalExecutor:
     name = "local"
 
     def __init__(self, jobs: int = 1, device: str = "cpu") -> None:
-        if not isinstance(jobs, int) or isinstance(jobs, bool) or jobs < 1:
-            raise NeurohoverError(f"--jobs {jobs!r} is out of range: allowed an integer >= 1")
+        check_jobs(jobs)
         check_device(device)
         self.jobs = jobs
         self.device = device

@@ -61,8 +61,12 @@ def _unit(cfg: ExperimentConfig, key: str, kind: str, params: dict, seed_key: st
 
 
 def _load_external(task: str, source: str):
+    from pathlib import Path
+
     from ..policysets import load_policy_set
 
+    if source != "shipped" and not Path(source).is_dir():
+        raise NeurohoverError(f"policies = {source!r} is not allowed: give 'evolve', 'shipped' or a directory holding <task>/ policy sets (no such directory)")
     return load_policy_set(task, None if source == "shipped" else source)
 
 

@@ -1,0 +1,30 @@
+"""Bad input in Python: one NeurohoverError naming the value and what is allowed."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import neurohover as nh
+from neurohover import NeurohoverError
+
+
+def test_evaluate_takes_baseline_by_name_as_a_policy_file_would() -> None:
+    mdp = nh.get_task_family("ghh08").zero()
+    by_name = nh.evaluate("baseline", mdp, episodes=2, seed=1, n_steps=50).returns
+    by_object = nh.evaluate(nh.baseline_policy(), mdp, episodes=2, seed=1, n_steps=50).returns
+    np.testing.assert_array_equal(by_name, by_object)
+    assert nh.evaluate(["baseline", nh.baseline_policy()], mdp, episodes=1, n_steps=20).returns.shape[0] == 2
+
+
+@pytest.mark.parametrize("bad", [3, None, [nh.baseline_policy(), 2.5]])
+def test_evaluate_refuses_what_is_not_a_policy(bad) -> None:
+    with pytest.raises(NeurohoverError, match="is not allowed: give a Policy, a policy file's path or 'baseline'"):
+        nh.evaluate(bad, nh.get_task_family("ghh08").zero(), episodes=1, n_steps=10)
+
+
+@pytest.mark.parametrize("obs", [np.zeros(3), np.full(12, np.nan), [0.0] * 11 + [np.inf], "twelve"])
+def test_act_refuses_an_observation_that_is_not_12_finite_numbers(obs) -> None:
+    with pytest.raises(NeurohoverError, match="give 12 finite numbers"):
+        nh.baseline_policy().act(obs)
+    assert nh.baseline_policy().act(np.zeros(12)) == pytest.approx((0.02, 0.0, 0.0, 0.23))
