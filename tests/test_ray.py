@@ -47,7 +47,7 @@ def _subset_config():
     """A representative subset in few units: policy evolution (steady state and over G with fixed
     resampling and races: no generics drawn from other experiments), and test runs of the authors'
     and the incremental model-based agents."""
-    return load_config("fig16", "quick", {"generics_per_agent": 1, "generics_from": {}})
+    return load_config("fig16", "quick", {"generics_per_agent": 1, "generics_from": {}, "generic_budget": 2000})
 
 
 def test_ray_and_local_runs_give_identical_results(ray_cluster, tmp_path: Path) -> None:

@@ -66,7 +66,10 @@ def _load_external(task: str, source: str):
     from ..policysets import load_policy_set
 
     if source != "shipped" and not Path(source).is_dir():
-        raise NeurohoverError(f"policies = {source!r} is not allowed: give 'evolve', 'shipped' or a directory holding <task>/ policy sets (no such directory)")
+        raise NeurohoverError(
+            f"policies = {source!r} is not allowed: give 'evolve', 'shipped' or a directory holding <task>/ policy sets "
+            f"(no such directory; build it with: neurohover build-policies --task {task} --out {source})"
+        )
     return load_policy_set(task, None if source == "shipped" else source)
 
 
