@@ -38,15 +38,24 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
-import torch
-from stable_baselines3 import PPO, SAC
-from stable_baselines3.common.callbacks import BaseCallback
-from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+
+try:
+    import torch
+    from stable_baselines3 import PPO, SAC
+    from stable_baselines3.common.callbacks import BaseCallback
+    from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+except ModuleNotFoundError as missing:  # the examples extra is not installed: one clear line, exit 2
+    print(
+        f"examples/ppo_ghh08.py needs {missing.name}: pip install 'neurohover[examples]' (for a CPU build of torch first: pip install torch==2.13.0)",
+        file=sys.stderr,
+    )
+    raise SystemExit(2) from None
 
 import neurohover  # noqa: F401  (registers the neurohover/* environments)
 from neurohover import baseline_policy

@@ -45,5 +45,8 @@ def flight_plot(path: Path) -> Path:
 
 
 if __name__ == "__main__":
+    import argparse
+
+    argparse.ArgumentParser(description=str(__doc__).splitlines()[0]).parse_args()  # --help describes, it draws nothing
     for made in (render_frame(HERE / "render.png"), flight_plot(HERE / "flight.png")):
         print(made)

@@ -65,6 +65,13 @@ class MDP:
     label: str = field(default="", compare=False)
     d_u: float = 0.0
 
+    def __post_init__(self) -> None:
+        # Plain Python numbers (the same values): reprs read MDP(params=(-0.18, ...)), not np.float64(-0.18).
+        for name in ("params", "noise_std", "wind"):
+            object.__setattr__(self, name, tuple(float(x) for x in getattr(self, name)))
+        object.__setattr__(self, "dt", float(self.dt))
+        object.__setattr__(self, "d_u", float(self.d_u))
+
     def row(self) -> np.ndarray:
         """The float64 row the compiled kernel reads (layout in ``sim.constants``)."""
         row = np.zeros(MDP_ROW_LEN)

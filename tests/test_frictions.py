@@ -1,0 +1,40 @@
+"""Small rough edges a newcomer met (issue 19): each mended, each checked."""
+
+from __future__ import annotations
+
+import importlib.util
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import neurohover as nh
+
+ROOT = Path(__file__).parent.parent
+
+
+def test_an_mdp_reads_as_plain_numbers() -> None:
+    mdp = nh.get_task_family("ghh08").mdp("train:3")
+    assert "np.float64" not in repr(mdp) and "params=(-0.18, -0.43" in repr(mdp)
+    built = nh.get_task_family("fghh", 0.3).make(np.array(mdp.params))
+    assert all(type(x) is float for x in built.params) and built.params == mdp.params
+
+
+def test_make_images_help_describes_and_draws_nothing(tmp_path: Path) -> None:
+    images = ROOT / "docs" / "images"
+    before = {p.name: p.stat().st_mtime_ns for p in images.glob("*.png")}
+    proc = subprocess.run([sys.executable, str(images / "make_images.py"), "--help"], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0 and "usage: make_images.py" in proc.stdout
+    assert {p.name: p.stat().st_mtime_ns for p in images.glob("*.png")} == before
+
+
+@pytest.mark.skipif(importlib.util.find_spec("stable_baselines3") is not None, reason="the examples extra is installed")
+def test_the_ppo_example_without_its_extra_says_what_to_install() -> None:
+    proc = subprocess.run([sys.executable, str(ROOT / "examples" / "ppo_ghh08.py"), "--help"], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    assert proc.stderr.strip().splitlines() == [
+        f"examples/ppo_ghh08.py needs {'torch' if importlib.util.find_spec('torch') is None else 'stable_baselines3'}: "
+        "pip install 'neurohover[examples]' (for a CPU build of torch first: pip install torch==2.13.0)"
+    ]
