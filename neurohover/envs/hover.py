@@ -126,15 +126,19 @@ def initial_state() -> np.ndarray:
     return state
 
 
-def check_obs_dtype(obs_dtype: Any) -> np.dtype:
-    """``obs_dtype`` (``"float64"``, ``"float32"`` or the NumPy type) as a dtype, or a clear error."""
+def _check_dtype(value: Any, name: str) -> np.dtype:
     try:
-        dtype = np.dtype(obs_dtype)
+        dtype = np.dtype(value)
     except TypeError:
         dtype = None
-    if obs_dtype is None or dtype is None or dtype.name not in OBS_DTYPES:
-        raise NeurohoverError(f"obs_dtype={obs_dtype!r} is not allowed: use {' or '.join(map(repr, OBS_DTYPES))}")
+    if value is None or dtype is None or dtype.name not in OBS_DTYPES:
+        raise NeurohoverError(f"{name}={value!r} is not allowed: use {' or '.join(map(repr, OBS_DTYPES))}")
     return dtype
+
+
+def check_obs_dtype(obs_dtype: Any) -> np.dtype:
+    """``obs_dtype`` (``"float64"``, ``"float32"`` or the NumPy type) as a dtype, or a clear error."""
+    return _check_dtype(obs_dtype, "obs_dtype")
 
 
 def check_render_mode(render_mode: Any) -> str | None:
@@ -174,13 +178,7 @@ def action_space(dtype: Any = np.float64) -> spaces.Box:
 
 def check_action_dtype(action_dtype: Any) -> np.dtype:
     """``action_dtype`` (``"float64"``, ``"float32"`` or the NumPy type) as a dtype, or a clear error."""
-    try:
-        dtype = np.dtype(action_dtype)
-    except TypeError:
-        dtype = None
-    if action_dtype is None or dtype is None or dtype.name not in OBS_DTYPES:
-        raise NeurohoverError(f"action_dtype={action_dtype!r} is not allowed: use {' or '.join(map(repr, OBS_DTYPES))}")
-    return dtype
+    return _check_dtype(action_dtype, "action_dtype")
 
 
 class HoverEnv(gym.Env[np.ndarray, np.ndarray]):

@@ -125,6 +125,18 @@ class _Section:
         fig.savefig(path, dpi=110)
         return path.name
 
+    def save_panels(self, fig, axes, xlabel: str, ylabels: tuple[str, str]) -> str:
+        """Label two panels (the second on a log scale), title the figure and save it."""
+        axes[0].set_ylabel(ylabels[0])
+        axes[1].set_ylabel(ylabels[1])
+        axes[1].set_yscale("log")
+        for ax in axes:
+            ax.set_xlabel(xlabel)
+            ax.grid(alpha=0.3, which="both")
+            ax.legend(fontsize=8)
+        fig.suptitle(f"{self.cfg.title} ({self.cfg.scale} scale)", fontsize=10)
+        return self.save(fig)
+
     def add_tests(self, samples: dict[str, list[float]], labels: dict[str, str], what: str) -> None:
         for t in self.paper.get("ttests", []):
             a, b = t["a"], t["b"]
@@ -236,15 +248,7 @@ class _Evolution(_Section):
                 mean = np.nanmean(np.where(np.isfinite(curves), curves, np.nan), axis=0)
             axes[0].plot(grid, mean, label=f"{v['label']} ({len(runs)} runs)")
             axes[1].plot(grid, error_of_fitness(mean, FITNESS_SCALE), label=v["label"])
-        axes[0].set_ylabel("champion fitness, 1/ln(error) (mean over runs)")
-        axes[1].set_ylabel("as error, exp(1/fitness) (log scale)")
-        axes[1].set_yscale("log")
-        for ax in axes:
-            ax.set_xlabel("episodes")
-            ax.grid(alpha=0.3, which="both")
-            ax.legend(fontsize=8)
-        fig.suptitle(f"{self.cfg.title} ({self.cfg.scale} scale)", fontsize=10)
-        return self.save(fig)
+        return self.save_panels(fig, axes, "episodes", ("champion fitness, 1/ln(error) (mean over runs)", "as error, exp(1/fitness) (log scale)"))
 
     def _fitness_body(self) -> str:
         """Final champions of runs on the 1/ln(error) scale, flown on the test MDPs, beside the authors' generics."""
@@ -555,15 +559,7 @@ class _TestRuns(_Section):
             episodes = np.arange(1, cum.size + 1)
             for ax in axes:
                 ax.plot(episodes, cum, label=f"{label} ({len(runs)} runs)")
-        axes[0].set_ylabel("mean cumulative error (-cumulative reward)")
-        axes[1].set_ylabel("mean cumulative error (log scale)")
-        axes[1].set_yscale("log")
-        for ax in axes:
-            ax.set_xlabel("episode")
-            ax.grid(alpha=0.3, which="both")
-            ax.legend(fontsize=8)
-        fig.suptitle(f"{self.cfg.title} ({self.cfg.scale} scale)", fontsize=10)
-        return self.save(fig)
+        return self.save_panels(fig, axes, "episode", ("mean cumulative error (-cumulative reward)", "mean cumulative error (log scale)"))
 
     def body(self) -> str:
         ref = self.paper.get("groups", {})
