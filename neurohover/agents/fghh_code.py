@@ -42,7 +42,7 @@ from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
 from .model_based import enough_to_learn, learn_model
 from .protocol import Agent, Choice, EpisodeOutcome
-from .spec import AgentOptions, AgentPolicies, AgentSpec
+from .spec import FGHH_GENERIC_KINDS, AgentOptions, AgentPolicies, AgentSpec
 
 #: The authors' ``eonn`` settings on the model (their FGHH agent): 49 of 50 kept, one offspring a
 #: generation by crossover of two tournament winners (then mutation with probability 0.75), the
@@ -194,5 +194,5 @@ AGENT_SPECS = tuple(
         generic_kind={"fghh": kind},
         summary=f"the authors' FGHH agent (generic, one-episode model, three model policies, the best) from the generic evolved {what}",
     )
-    for kind, what in (("zero", "on the zero setting"), ("fixed", "over G with fixed resampling"), ("race", "over G with selection races"))
+    for kind, what in FGHH_GENERIC_KINDS
 )

@@ -19,7 +19,7 @@ from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
 from .protocol import Agent, Choice, EpisodeOutcome
-from .spec import AgentOptions, AgentPolicies, AgentSpec
+from .spec import FGHH_GENERIC_KINDS, AgentOptions, AgentPolicies, AgentSpec
 
 
 @dataclass(frozen=True)
@@ -213,6 +213,6 @@ AGENT_SPECS = (
             generic_kind={"fghh": kind},
             summary=f"incremental, from the FGHH generic policy evolved {what}",
         )
-        for kind, what in (("zero", "on the zero setting"), ("fixed", "over G with fixed resampling"), ("race", "over G with selection races"))
+        for kind, what in FGHH_GENERIC_KINDS
     ),
 )

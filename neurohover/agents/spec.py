@@ -20,6 +20,8 @@ if TYPE_CHECKING:
 #: The policies an agent can need: the generic policy, the specialised policies (one per training
 #: MDP), and the safe pair of specialised policies (the paper's rule, :mod:`neurohover.policysets`).
 POLICY_NEEDS = ("generic", "specialised", "safe")
+#: FGHH's generic policies, by kind: how each was evolved (agents named ``<agent>-<kind>`` fly one).
+FGHH_GENERIC_KINDS = (("zero", "on the zero setting"), ("fixed", "over G with fixed resampling"), ("race", "over G with selection races"))
 
 
 @dataclass(frozen=True)
