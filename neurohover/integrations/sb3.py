@@ -1,0 +1,95 @@
+"""Stable-Baselines3 over the native vector environment: every helicopter in one kernel call.
+
+SB3 (and RL Zoo) step a ``VecEnv``; their own ``DummyVecEnv`` steps one Python environment after
+another. :class:`SB3VecEnv` is an SB3 ``VecEnv`` over :class:`neurohover.envs.HoverVectorEnv`, so
+a step of 1024 helicopters is one kernel call. SB3's conventions are kept: a finished episode
+resets at once, its last observation in ``infos[i]["terminal_observation"]`` and
+``infos[i]["TimeLimit.truncated"]`` set when the time limit (not a crash) ended it::
+
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.vec_env import VecMonitor
+    from neurohover.integrations.sb3 import SB3VecEnv
+
+    env = VecMonitor(SB3VecEnv("neurohover/GHH08-Short-v0", num_envs=64))
+    PPO("MlpPolicy", env).learn(10_000)
+
+Needs ``stable-baselines3`` (``pip install 'neurohover[examples]'``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from ..errors import NeurohoverError
+
+try:
+    from stable_baselines3.common.vec_env.base_vec_env import VecEnv
+except ModuleNotFoundError as missing:  # the optional extra
+    raise NeurohoverError(f"neurohover.integrations.sb3 needs {missing.name}: pip install 'neurohover[examples]'") from None
+
+__all__ = ["SB3VecEnv"]
+
+
+class SB3VecEnv(VecEnv):
+    """An SB3 ``VecEnv`` of ``num_envs`` helicopters of a registered id (``gym.make_vec`` keyword
+    arguments, e.g. ``mdp="train:3"``, pass through to :class:`~neurohover.envs.HoverVectorEnv`)."""
+
+    def __init__(self, env_id: str, num_envs: int, **kwargs: Any) -> None:
+        if env_id not in gym.registry or not str(gym.registry[env_id].entry_point).startswith("neurohover."):
+            raise NeurohoverError(f"env_id={env_id!r} is not a neurohover environment: use one of the neurohover/* ids")
+        self.venv = gym.make_vec(env_id, num_envs=num_envs, vectorization_mode="vector_entry_point", **kwargs)
+        self.native = self.venv.unwrapped
+        super().__init__(num_envs, self.native.single_observation_space, self.native.single_action_space)
+        self._actions: np.ndarray | None = None
+        self._seed: int | None = None
+
+    def reset(self) -> np.ndarray:
+        obs, info = self.venv.reset(seed=self._seed)
+        self._seed = None
+        self.reset_infos = [{"mdp": info["mdp"][i]} for i in range(self.num_envs)]
+        return obs
+
+    def step_async(self, actions: np.ndarray) -> None:
+        self._actions = np.asarray(actions, dtype=np.float64).reshape(self.num_envs, -1)
+
+    def step_wait(self):
+        assert self._actions is not None  # step_async first, as SB3's VecEnv.step does
+        obs, rewards, terminated, truncated, info = self.venv.step(self._actions)
+        done = terminated | truncated
+        infos: list[dict[str, Any]] = [{"crashed": bool(terminated[i])} for i in range(self.num_envs)]
+        if done.any():
+            for i in np.flatnonzero(done).tolist():
+                infos[i]["terminal_observation"] = obs[i].copy()
+                infos[i]["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
+            fresh, _ = self.venv.reset(options={"reset_mask": done})  # SB3 resets at once (Gymnasium: at the next step)
+            obs = np.where(done[:, None], fresh, obs)
+        return obs, rewards.astype(np.float32), done, infos
+
+    def close(self) -> None:
+        self.venv.close()
+
+    def seed(self, seed: int | None = None) -> Sequence[None | int]:
+        """The seed of the next :meth:`reset` (sub-environment i: ``seed + i``, as Gymnasium's vector envs)."""
+        self._seed = seed
+        return [None if seed is None else seed + i for i in range(self.num_envs)]
+
+    def get_attr(self, attr_name: str, indices=None) -> list[Any]:
+        return [getattr(self.native, attr_name)] * len(self._indices(indices))
+
+    def set_attr(self, attr_name: str, value: Any, indices=None) -> None:
+        raise NeurohoverError(f"set_attr({attr_name!r}) is not supported: the helicopters share one native vector environment")
+
+    def env_method(self, method_name: str, *method_args, indices=None, **method_kwargs) -> list[Any]:
+        raise NeurohoverError(f"env_method({method_name!r}) is not supported: the helicopters share one native vector environment")
+
+    def env_is_wrapped(self, wrapper_class, indices=None) -> list[bool]:
+        return [False] * len(self._indices(indices))
+
+    def _indices(self, indices) -> list[int]:
+        if indices is None:
+            return list(range(self.num_envs))
+        return [indices] if isinstance(indices, int) else list(indices)
