@@ -28,3 +28,27 @@ def test_act_refuses_an_observation_that_is_not_12_finite_numbers(obs) -> None:
     with pytest.raises(NeurohoverError, match="give 12 finite numbers"):
         nh.baseline_policy().act(obs)
     assert nh.baseline_policy().act(np.zeros(12)) == pytest.approx((0.02, 0.0, 0.0, 0.23))
+
+
+def test_an_env_refuses_an_unknown_argument_naming_the_allowed_ones() -> None:
+    import gymnasium as gym
+
+    with pytest.raises(NeurohoverError, match="unknown argument.s. windd: allowed task, sigma, mdp, episode_steps"):
+        gym.make("neurohover/GHH08-v0", windd=3)
+    with pytest.raises(NeurohoverError, match="unknown argument.s. windd: allowed num_envs"):
+        gym.make_vec("neurohover/GHH08-v0", num_envs=2, vectorization_mode="vector_entry_point", windd=3)
+
+
+def test_an_env_refuses_an_mdp_of_another_family_but_takes_a_learned_model() -> None:
+    import gymnasium as gym
+
+    env = gym.make("neurohover/GHH08-v0")
+    with pytest.raises(NeurohoverError, match="is an MDP of ghh09, not of this environment's family ghh08"):
+        env.reset(options={"mdp": nh.get_task_family("ghh09").mdp("train:1")})
+    from neurohover.models import learn_lr
+
+    flights = nh.evaluate(nh.baseline_policy(), nh.get_task_family("ghh08").zero(), episodes=1, record=True, n_steps=300).flight_data
+    model = learn_lr(flights).mdp()
+    assert model.family == "model"
+    obs, info = env.reset(seed=0, options={"mdp": model})
+    assert obs.shape == (12,)

@@ -64,6 +64,11 @@ def resolve_mdp(family: TaskFamily, spec: Any, cache: dict[str, MDP] | None = No
         with many sub-environments resolves each name once.
     """
     if isinstance(spec, MDP):
+        if spec.family not in (family.name, "model"):
+            raise NeurohoverError(
+                f"mdp {spec.label or spec.family!r} is an MDP of {spec.family}, not of this environment's family {family.name}: "
+                f"give one of {family.name}'s MDPs (or a learned model)"
+            )
         row = spec.row()
         if row.shape != (MDP_ROW_LEN,) or not np.all(np.isfinite(row)) or spec.substeps < 1:
             raise NeurohoverError(f"MDP {spec.label or spec!r} is not flyable: its parameters must be finite and substeps >= 1")
@@ -90,6 +95,16 @@ def check_noise_stream(value: Any, what: str = "noise") -> tuple[int, int]:
         if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or not 0 <= int(v) <= hi:
             raise NeurohoverError(f"{what} {name}={v!r} is out of range: allowed an integer in 0..2**63-1")
     return int(seed), int(episode)
+
+
+#: What ``gymnasium.make`` may pass to :class:`HoverEnv` (its ``max_episode_steps`` is Gymnasium's own).
+ENV_KWARGS = ("task", "sigma", "mdp", "episode_steps", "render_mode", "obs_dtype", "action_dtype")
+
+
+def check_no_unknown_kwargs(unknown: dict[str, Any], allowed: Sequence[str]) -> None:
+    """A clear error for keyword arguments an environment does not take (a typo would be a TypeError)."""
+    if unknown:
+        raise NeurohoverError(f"unknown argument(s) {', '.join(sorted(unknown))}: allowed {', '.join(allowed)}")
 
 
 def check_episode_steps(episode_steps: Any) -> int:
@@ -327,7 +342,9 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         render_mode: str | None = None,
         obs_dtype: Any = "float64",
         action_dtype: Any = "float64",
+        **unknown: Any,
     ) -> None:
+        check_no_unknown_kwargs(unknown, ENV_KWARGS)
         self.render_mode = check_render_mode(render_mode)
         self.obs_dtype = check_obs_dtype(obs_dtype)
         self.action_dtype = check_action_dtype(action_dtype)

@@ -39,6 +39,7 @@ from .hover import (
     action_space,
     check_action_dtype,
     check_episode_steps,
+    check_no_unknown_kwargs,
     check_noise_stream,
     check_obs_dtype,
     check_reset_options,
@@ -50,6 +51,8 @@ from .hover import (
 )
 
 MAX_NUM_ENVS = 10**7
+#: What ``gymnasium.make_vec`` may pass to :class:`HoverVectorEnv`.
+VECTOR_ENV_KWARGS = ("num_envs", "task", "sigma", "mdp", "episode_steps", "max_episode_steps", "render_mode", "obs_dtype", "device", "action_dtype")
 
 
 @nb.njit(cache=True)
@@ -136,7 +139,9 @@ class HoverVectorEnv(VectorEnv):
         obs_dtype: Any = "float64",
         device: str = "cpu",
         action_dtype: Any = "float64",
+        **unknown: Any,
     ) -> None:
+        check_no_unknown_kwargs(unknown, VECTOR_ENV_KWARGS)
         check_device(device)
         if isinstance(num_envs, (bool, np.bool_)) or not isinstance(num_envs, (int, np.integer)) or not 1 <= num_envs <= MAX_NUM_ENVS:
             raise NeurohoverError(f"num_envs={num_envs!r} is out of range: allowed an integer in 1..{MAX_NUM_ENVS}")

@@ -28,7 +28,7 @@ try:
     import torch
     from evotorch import Problem, SolutionBatch
 except ModuleNotFoundError as missing:  # the optional extra
-    raise NeurohoverError(f"neurohover.integrations.evotorch needs {missing.name}: pip install evotorch") from None
+    raise NeurohoverError(f"neurohover.integrations.evotorch needs {missing.name}: pip install 'neurohover[evotorch]'") from None
 
 from ..evaluate import PolicyTable, evaluate_jobs
 from ..evolution.seeding import check_seed
