@@ -52,3 +52,16 @@ def test_an_env_refuses_an_mdp_of_another_family_but_takes_a_learned_model() -> 
     assert model.family == "model"
     obs, info = env.reset(seed=0, options={"mdp": model})
     assert obs.shape == (12,)
+
+
+def test_a_typo_in_the_scale_not_run_is_refused_at_once(tmp_path) -> None:
+    from neurohover.experiments import load_config
+    from neurohover.experiments.config import CONFIG_DIR
+
+    text = (CONFIG_DIR / "fig7.toml").read_text()
+    assert "[[scales.paper.groups]]" not in text  # the paper scale's groups come from [settings]
+    bad = tmp_path / "fig7-typo.toml"
+    bad.write_text(text.replace("[scales.paper]", '[scales.paper]\nagnet = "x"'))
+    with pytest.raises(NeurohoverError, match="at scale 'paper': unknown setting.s. agnet"):
+        load_config(str(bad), "quick")
+    load_config("fig7", "quick")  # the shipped one loads

@@ -57,8 +57,8 @@ def resolve_mdp(family: TaskFamily, spec: Any, cache: dict[str, MDP] | None = No
     family : TaskFamily
         The environment's task family (it resolves ``zero``, ``train:N`` and ``test:N``).
     spec : str or MDP
-        ``"zero"``, ``"sample"``, ``"train:N"``, ``"test:N"`` or an explicit :class:`MDP`
-        (any MDP is accepted, a learned model's included).
+        ``"zero"``, ``"sample"``, ``"train:N"``, ``"test:N"`` or an explicit :class:`MDP` of the
+        family, or a learned model's (an MDP of another family is refused).
     cache : dict, optional
         Already resolved names; building the fixed sets is not free, so a vector environment
         with many sub-environments resolves each name once.

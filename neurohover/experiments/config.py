@@ -444,6 +444,10 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
         raise NeurohoverError(f"{where}: unknown scale table(s) {', '.join(bad_scales)}; allowed: {', '.join(SCALES)}")
     if scale not in scales:
         raise NeurohoverError(f"{where}: has no [scales.{scale}] table")
+    for other in scales:  # a typo in the scale not run now must not wait for the day it runs
+        if other != scale:
+            resolved = _validate_table({**raw["settings"], **scales[other]}, SCHEMAS[kind], f"{where} at scale {other!r}")
+            _check_kind(resolved, kind, f"{where} at scale {other!r}")
     merged = {**raw["settings"], **scales[scale], **(overrides or {})}
     return make_config(
         raw["name"],
