@@ -22,6 +22,23 @@ from .errors import NeurohoverError
 COMPETE_PNG = "compete.png"
 
 
+def _episodes(text: str | None, n: int) -> list[int] | None:
+    """``--episodes 0,3,10-12`` as episode indices (None: every episode), each checked against ``n``."""
+    if text is None:
+        return None
+    out: list[int] = []
+    for part in text.split(","):
+        lo, sep, hi = part.strip().partition("-")
+        try:
+            first, last = int(lo), int(hi) if sep else int(lo)
+        except ValueError:
+            raise NeurohoverError(f"--episodes {text!r} is not allowed: give episode numbers and ranges, e.g. 0,3,10-12") from None
+        if not (0 <= first <= last < n):
+            raise NeurohoverError(f"--episodes {part.strip()!r} is out of range: the flight data hold episodes 0..{n - 1}")
+        out.extend(range(first, last + 1))
+    return out
+
+
 def cmd_plot(args: argparse.Namespace) -> int:
     """Plot a recorded flight (one PNG per episode) or overlay competition results (one PNG)."""
     from .paths import input_dir, input_file, output_dir
@@ -38,7 +55,7 @@ def cmd_plot(args: argparse.Namespace) -> int:
         out = output_dir(args.out if args.out is not None else path.parent, "--out")
         from .plots import plot_flight_data
 
-        written = plot_flight_data(data, out, stem=path.stem)
+        written = plot_flight_data(data, out, stem=path.stem, episodes=_episodes(args.episodes, data.n_episodes))
     else:
         dirs = [input_dir(d, "--compete") for d in args.compete]
         from .plots import compete_figure, read_compete_dir, save_figure
@@ -61,6 +78,7 @@ def register(sub) -> None:
     p.add_argument("flight", nargs="?", metavar="FLIGHT.npz", help="flight data written by neurohover fly --record")
     p.add_argument("--compete", nargs="+", metavar="DIR", help="directories written by neurohover compete --out, overlaid on one figure")
     p.add_argument("--out", metavar="DIR", help="directory for the PNG files (default: beside the input)")
+    p.add_argument("--episodes", metavar="LIST", help="flight data: only these episodes (0-based), e.g. 0,3,10-12 (default: every episode, about 1 s each)")
     p.set_defaults(func=cmd_plot)
 
 

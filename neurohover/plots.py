@@ -174,8 +174,9 @@ def _episode_title(data: FlightData, i: int, stem: str) -> str:
     return ", ".join(parts)
 
 
-def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight") -> list[Path]:
-    """One PNG per episode of ``data`` (:func:`flight_figure`), ``<stem>-episode<i>.png`` in ``out_dir``.
+def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight", episodes: Sequence[int] | None = None) -> list[Path]:
+    """One PNG per episode of ``data`` (:func:`flight_figure`), ``<stem>-episode<i>.png`` in ``out_dir``;
+    ``episodes``: only these (0-based; default all).
 
     Titles take the MDP label, return and policy from the metadata that ``neurohover fly
     --record`` writes (``mdps``, ``returns``, ``policy``); ``episode_steps`` in the metadata, if
@@ -189,8 +190,13 @@ def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight"
     out_dir = Path(out_dir)
     steps = data.metadata.get("episode_steps", EPISODE_STEPS) if isinstance(data.metadata, dict) else EPISODE_STEPS
     width = len(str(max(data.n_episodes - 1, 0)))
+    chosen = range(data.n_episodes) if episodes is None else list(episodes)
+    bad = [i for i in chosen if not (isinstance(i, int) and 0 <= i < data.n_episodes)]
+    if bad:
+        raise NeurohoverError(f"episode {bad[0]!r} is out of range: the flight data hold episodes 0..{data.n_episodes - 1}")
     paths = []
-    for i, (obs, act) in enumerate(zip(data.observations, data.actions, strict=True)):
+    for i in chosen:
+        obs, act = data.observations[i], data.actions[i]
         fig = flight_figure(obs, act, title=_episode_title(data, i, stem), episode_steps=int(steps))
         paths.append(save_figure(fig, out_dir / f"{stem}-episode{i:0{width}d}.png"))
     return paths

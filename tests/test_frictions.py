@@ -38,3 +38,15 @@ def test_the_ppo_example_without_its_extra_says_what_to_install() -> None:
         f"examples/ppo_ghh08.py needs {'torch' if importlib.util.find_spec('torch') is None else 'stable_baselines3'}: "
         "pip install 'neurohover[examples]' (for a CPU build of torch first: pip install torch==2.13.0)"
     ]
+
+
+def test_plot_draws_only_the_episodes_asked_for(tmp_path: Path, capsys) -> None:
+    from neurohover.cli import main
+
+    flights = tmp_path / "f.npz"
+    nh.evaluate(nh.baseline_policy(), nh.get_task_family("ghh08").zero(), episodes=4, record=True, n_steps=40).flight_data.save(flights)
+    assert main(["plot", str(flights), "--episodes", "0,2-3"]) == 0
+    assert sorted(p.name for p in tmp_path.glob("*.png")) == ["f-episode0.png", "f-episode2.png", "f-episode3.png"]
+    capsys.readouterr()
+    assert main(["plot", str(flights), "--episodes", "4"]) == 2
+    assert "--episodes '4' is out of range: the flight data hold episodes 0..3" in capsys.readouterr().err

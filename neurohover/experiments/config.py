@@ -138,7 +138,7 @@ def _policy_source():
 _COMMON: dict[str, tuple[Any, Any]] = {
     "task": (_REQUIRED, _choice(*TASK_NAMES)),
     "sigma": (None, _float(0.0, 1.0)),
-    "seed": (_REQUIRED, _int(0)),
+    "seed": (_REQUIRED, lambda v: (isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= 2**63 - 1, "an integer in 0..2**63-1")),
     "n_steps": (6000, _int(1)),
 }
 
