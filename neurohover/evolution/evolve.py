@@ -36,8 +36,10 @@ Seeding and reproducibility
 Everything random derives from ``numpy.random.SeedSequence(seed)``: child ``(0,)`` seeds the
 optimiser, ``(1,)`` the stream of MDPs drawn from G, ``(2,)`` the root of the episodes' gust noise
 (:mod:`neurohover.evolution.seeding`). Every episode flown gets the next index of an episode
-counter (its noise stream is ``(noise root, index)``), so no two episodes of a run share noise and
-the result does not depend on the number of kernel threads.
+counter (its noise stream is ``(noise root, index)``; a selection race reserves λ·t_limit indices
+and MDPs at its start, candidate i's t-th sample being index ``base + t·λ + i``), so no two
+episodes of a run share noise and the result depends neither on the number of kernel threads nor
+on how a race batches its episodes.
 
 Checkpoints
 -----------
