@@ -40,12 +40,14 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     overrides = dict(parse_override(text) for text in args.set or [])
     configs = load_configs(args.name, args.scale, overrides)
     named = [c.name for c in configs]
+    sources_added: set[str] = set()
     for config in list(configs):  # experiments that draw from others run after them (e.g. fig16 after fig13 and fig15)
         for source in source_experiments(config):
             if source not in named:
                 print(f"neurohover reproduce: {config.name} draws its generic policies from {source}: running {source} first", file=sys.stderr)
                 configs.insert(configs.index(config), load_configs(source, args.scale)[0])
                 named.append(source)
+                sources_added.add(source)
     if args.only and len(configs) > 1 and args.name != "all":
         raise NeurohoverError(
             f"--only selects units of one experiment; {args.name} also runs {', '.join(c.name for c in configs if c.name != args.name)} first"
@@ -58,7 +60,9 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         with Store(args.store) as store:
             for config in configs:
                 try:
-                    summary = reproduce(config, store, executor, fresh=args.fresh, progress=args.progress, only=tuple(args.only or ()))
+                    # --fresh applies to the experiments named, never to the sources run first (their results stay).
+                    fresh = args.fresh and config.name not in sources_added
+                    summary = reproduce(config, store, executor, fresh=fresh, progress=args.progress, only=tuple(args.only or ()))
                 except KeyboardInterrupt:
                     done = len(store.results(config.name, config.scale))
                     print(

@@ -114,3 +114,14 @@ def test_the_report_shows_fghh_runs_on_their_fitness_scale_beside_the_authors_ge
     fits = np.mean([np.mean([1 / np.log(150), 1 / np.log(1e7)]), np.mean([1 / np.log(1000), 1 / np.log(200)])])
     assert f"| the authors' resampling_05 (2 files) | 2 |  |  | 25.0% | 600 | {fits:.4g} |" in text
     assert (out / "fig13-quick.png").is_file()
+
+
+def test_fresh_never_discards_the_sources_run_first(tmp_path: Path, capsys) -> None:
+    store = tmp_path / "s.sqlite"
+    assert main(["reproduce", "fig13", "--store", str(store), "--no-progress"]) == 0
+    with Store(store) as s:
+        before = {u["key"]: u["finished"] for u in s.units("fig13", "quick")}
+    assert main(["reproduce", "fig16", "--store", str(store), "--fresh", "--no-progress"]) == 0
+    with Store(store) as s:
+        assert {u["key"]: u["finished"] for u in s.units("fig13", "quick")} == before  # kept, not recomputed
+    assert "fig13 (quick): finished; ran 0 units" in capsys.readouterr().out
