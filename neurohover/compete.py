@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import csv
 import json
+import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -240,7 +241,9 @@ def compete(
     executor = make_executor("local", jobs=jobs, device=device)
     with Store(store_path) as db:
         try:
-            reproduce(config, db, executor, progress=progress, on_unit=finished)
+            run = reproduce(config, db, executor, progress=progress, on_unit=finished)
+            if run.units_before:  # say so, as reproduce does: these runs were not flown again
+                print(f"neurohover compete: {run.units_before} of {run.units_total} units (runs and the policies they fly) were already in {store_path}: reused", file=sys.stderr)
         finally:
             executor.close()
             stored = db.results(config.name, config.scale)

@@ -50,3 +50,13 @@ def test_plot_draws_only_the_episodes_asked_for(tmp_path: Path, capsys) -> None:
     capsys.readouterr()
     assert main(["plot", str(flights), "--episodes", "4"]) == 2
     assert "--episodes '4' is out of range: the flight data hold episodes 0..3" in capsys.readouterr().err
+
+
+def test_compete_says_when_it_reuses_stored_runs(tmp_path: Path, capsys) -> None:
+    from neurohover.cli import main
+
+    args = ["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "2", "--episodes", "3", "--out", str(tmp_path / "c")]
+    assert main(args) == 0
+    assert "reused" not in capsys.readouterr().err
+    assert main(args) == 0
+    assert "2 of 2 units (runs and the policies they fly) were already in" in capsys.readouterr().err
