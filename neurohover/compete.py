@@ -243,7 +243,8 @@ def compete(
         try:
             run = reproduce(config, db, executor, progress=progress, on_unit=finished)
             if run.units_before:  # say so, as reproduce does: these runs were not flown again
-                print(f"neurohover compete: {run.units_before} of {run.units_total} units (runs and the policies they fly) were already in {store_path}: reused", file=sys.stderr)
+                reused = f"{run.units_before} of {run.units_total} units (runs and the policies they fly)"
+                print(f"neurohover compete: {reused} were already in {store_path}: reused", file=sys.stderr)
         finally:
             executor.close()
             stored = db.results(config.name, config.scale)
