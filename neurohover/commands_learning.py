@@ -3,7 +3,8 @@
 ``neurohover evolve`` writes three files for ``--out FILE``:
 
 * ``FILE``: the champion as a policy file (JSON, docs/model.md, Policies) with metadata: task, mdp, sigma,
-  optimizer, resampling, budget, seed, champion_return, validation_return (mean return of 10 fresh
+  optimizer, resampling, budget, seed, champion_return (on the scale champion_fitness_scale names:
+  ``return``, or ``inv-log-error`` for generational runs, 1/ln(error)), validation_return (mean return of 10 fresh
   episodes: on the MDP, or each on a fresh MDP from G, independent of the evolution's episodes),
   validation_sd, episodes, seconds, stop_reason, ...;
 * ``FILE.history.csv``: the run's history, columns
@@ -162,6 +163,8 @@ def cmd_evolve(args: argparse.Namespace) -> int:
             print(f"neurohover evolve: interrupted mid-generation; the last periodic checkpoint (if any) is {checkpoint}", file=sys.stderr)
         return 130
     bar.close()
+    # The champion's estimate is on the run's fitness scale (1/ln(error) over a family by default).
+    scale = result.settings["settings"].get("fitness", "return") if result.settings.get("method") == "generational" else "return"
     validation = validation_return(
         result.champion, target, episodes=args.validation_episodes, seed=args.seed, n_steps=args.episode_steps, threads=args.threads, device=args.device
     )
@@ -175,6 +178,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         "seed": args.seed,
         "seed_policy": str(args.seed_policy),
         "champion_return": result.champion_return,
+        "champion_fitness_scale": scale,
         "validation_return": float(validation.mean()),
         "validation_sd": float(validation.std()),
         "validation_episodes": int(validation.size),
@@ -197,6 +201,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         "history": str(history_path),
         "checkpoint": str(checkpoint),
         "champion_return": result.champion_return,
+        "champion_fitness_scale": scale,
         "validation_return": float(validation.mean()),
         "validation_sd": float(validation.std()),
         "episodes": result.episodes,

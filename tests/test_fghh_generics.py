@@ -139,6 +139,10 @@ def test_evolve_on_the_command_line_takes_a_preset_and_settings(tmp_path, capsys
     assert saved["topology"] == "slp"
     settings = saved["settings"]
     assert (settings["pop_size"], settings["fitness"], settings["elitist"]) == (30, "return", True)
+    assert saved["champion_fitness_scale"] == "return" and saved["champion_return"] < 0
+    assert main([*args]) == 0  # the default over a family: 1/ln(error)
+    saved = json.loads(out.read_text())
+    assert saved["champion_fitness_scale"] == "inv-log-error" and 0 < saved["champion_return"] < 1
     capsys.readouterr()
     assert main([*args, "--setting", "fitness=log"]) == 2
     assert "fitness='log' is not a fitness scale: allowed inv-log-error, return" in capsys.readouterr().err
