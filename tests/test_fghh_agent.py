@@ -125,3 +125,14 @@ def test_fresh_never_discards_the_sources_run_first(tmp_path: Path, capsys) -> N
     with Store(store) as s:
         assert {u["key"]: u["finished"] for u in s.units("fig13", "quick")} == before  # kept, not recomputed
     assert "fig13 (quick): finished; ran 0 units" in capsys.readouterr().out
+
+
+def test_the_report_compares_variants_of_either_scale_on_the_test_mdps(tmp_path: Path) -> None:
+    from neurohover.experiments import write_report
+
+    store = tmp_path / "s.sqlite"
+    assert main(["reproduce", "ablation-fghh", "--store", str(store), "--no-progress"]) == 0
+    with Store(store) as s:
+        text = write_report(s, tmp_path / "out", scale="quick", names=["ablation-fghh"]).read_text()
+    assert "| raw-return means | 2 | " in text and "(a return) |" in text  # its estimate is a mean return
+    assert "Ranking by mean validation 1/ln(error)" in text  # every variant compared on the test MDPs' 1/ln(error)

@@ -191,7 +191,7 @@ class _Evolution(_Section):
 
     def final_scores(self, runs: list[EvolveResult]) -> list[float]:
         """Per run: the mean validation return, or on the 1/ln(error) scale the mean validation fitness."""
-        if _on_fitness_scale(runs) and all(r.validation is not None for r in runs):
+        if self._fghh_style() and all(r.validation is not None for r in runs):
             return [float(np.mean(episode_fitness(np.array([float(x) for x in r.validation or ()]), FITNESS_SCALE))) for r in runs]
         return [r.final_score for r in runs]
 
@@ -199,7 +199,7 @@ class _Evolution(_Section):
         data = {v["key"]: self.runs(v["key"]) for v in self.variants()}
         if not any(data.values()):
             return None
-        if all(_on_fitness_scale(runs) for runs in data.values() if runs):
+        if self._fghh_style():
             return self._fitness_figure(data)
         xmax = max(r.history[-1][0] for runs in data.values() for r in runs)
         xmin = min(r.history[0][0] for runs in data.values() for r in runs)
@@ -242,13 +242,23 @@ class _Evolution(_Section):
             runs = data[v["key"]]
             if not runs:
                 continue
-            curves = np.array([_curve(r.history, grid, sign=1.0) for r in runs])
+            raw = not _on_fitness_scale(runs)  # a variant run on mean raw returns: its curve converted
+            curves = np.array([_curve(r.history, grid, sign=-1.0 if raw else 1.0) for r in runs])
             with np.errstate(all="ignore"), warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)  # grid points before any run's first champion
                 mean = np.nanmean(np.where(np.isfinite(curves), curves, np.nan), axis=0)
-            axes[0].plot(grid, mean, label=f"{v['label']} ({len(runs)} runs)")
-            axes[1].plot(grid, error_of_fitness(mean, FITNESS_SCALE), label=v["label"])
+            fitness = episode_fitness(-mean, FITNESS_SCALE) if raw else mean
+            error = mean if raw else error_of_fitness(mean, FITNESS_SCALE)
+            note = ", raw returns: 1/ln of the mean error" if raw else ""
+            axes[0].plot(grid, fitness, label=f"{v['label']} ({len(runs)} runs{note})")
+            axes[1].plot(grid, error, label=v["label"])
         return self.save_panels(fig, axes, "episodes", ("champion fitness, 1/ln(error) (mean over runs)", "as error, exp(1/fitness) (log scale)"))
+
+    def _fghh_style(self) -> bool:
+        """Whether the section reads as FGHH's as the authors ran it: runs on the 1/ln(error) scale,
+        or champions validated on the test MDPs (every variant then compared on 1/ln(error))."""
+        runs = [r for v in self.variants() for r in self.runs(v["key"])]
+        return bool(runs) and (any(r.fitness == FITNESS_SCALE for r in runs) or self.s.get("validation_mdps") == "test")
 
     def _fitness_body(self) -> str:
         """Final champions of runs on the 1/ln(error) scale, flown on the test MDPs, beside the authors' generics."""
@@ -258,8 +268,12 @@ class _Evolution(_Section):
             if not runs:
                 continue
             row, finals = _validation_row(v["label"], [[float(x) for x in r.validation or ()] for r in runs], [r.validation_crashed for r in runs])
-            champ = [float(r.champion_return) for r in runs]
-            rows.append([row[0], str(len(runs)), fmt(np.mean(champ)), fmt(float(error_of_fitness(float(np.mean(champ)), FITNESS_SCALE))), *row[1:]])
+            champ = float(np.mean([float(r.champion_return) for r in runs]))
+            if _on_fitness_scale(runs):
+                estimate, as_error = fmt(champ), fmt(float(error_of_fitness(champ, FITNESS_SCALE)))
+            else:  # a variant run on mean raw returns
+                estimate, as_error = f"{fmt(champ)} (a return)", fmt(-champ)
+            rows.append([row[0], str(len(runs)), estimate, as_error, *row[1:]])
             rows[-1] += [fmt(np.mean([r.episodes for r in runs])), fmt(np.mean([r.timing.seconds for r in runs]))]
             samples[v["key"]], labels[v["key"]] = finals, v["label"]
         authors = _authors_generics(self.out, self.cfg)
@@ -285,7 +299,8 @@ class _Evolution(_Section):
                 rows,
             )
             + "\n\nFinal fitness estimate: the best selected parent's mean 1/ln(error) over its episodes in the last generation "
-            f"(what the figure's left panel ends on); as error: exp(1/fitness). Validation: each final champion flown {where}; "
+            "(what the figure's left panel ends on; a variant run on raw returns: its mean return); as error: exp(1/fitness). "
+            f"Validation: each final champion flown {where}; "
             "crash rate over all validation episodes, median error over them, mean 1/ln(error) per run then over runs (the "
             "t tests' sample)."
             + (
@@ -311,7 +326,7 @@ class _Evolution(_Section):
         return text
 
     def body(self) -> str:
-        if all(_on_fitness_scale(self.runs(v["key"])) for v in self.variants() if self.runs(v["key"])) and any(self.runs(v["key"]) for v in self.variants()):
+        if self._fghh_style():
             return self._fitness_body()
         parts = []
         rows = []
