@@ -106,8 +106,8 @@ def test_edits_outside_kernel_py_recompile_and_unchanged_sources_load_from_cache
 def test_every_cached_function_of_the_package_is_keyed_on_the_simulator_sources() -> None:
     dispatchers = []
     for info in pkgutil.walk_packages(neurohover.__path__, "neurohover."):
-        if info.name.endswith("__main__"):
-            continue
+        if info.name.endswith("__main__") or info.name.startswith("neurohover.integrations."):
+            continue  # the integrations import optional libraries and compile nothing
         module = importlib.import_module(info.name)
         dispatchers += [f for f in vars(module).values() if isinstance(f, CPUDispatcher) and f.__module__ == module.__name__]
     assert len(dispatchers) > 20
