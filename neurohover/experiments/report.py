@@ -192,7 +192,7 @@ class _Evolution(_Section):
     def final_scores(self, runs: list[EvolveResult]) -> list[float]:
         """Per run: the mean validation return, or on the 1/ln(error) scale the mean validation fitness."""
         if self._fghh_style() and all(r.validation is not None for r in runs):
-            return [float(np.mean(episode_fitness(np.array([float(x) for x in r.validation or ()]), FITNESS_SCALE))) for r in runs]
+            return [_mean_fitness([float(x) for x in r.validation or ()]) for r in runs]
         return [r.final_score for r in runs]
 
     def figure(self) -> str | None:
@@ -315,7 +315,7 @@ class _Evolution(_Section):
             order = sorted(samples, key=lambda k: -np.mean(samples[k]))
             self.comparisons.append("Ranking by mean validation 1/ln(error) (best first): ours " + " > ".join(labels[k] for k in order) + ".")
             for folder, entry in authors.items():
-                fits = [float(np.mean(episode_fitness(np.array(r), FITNESS_SCALE))) for r in entry["returns"]]
+                fits = [_mean_fitness(r) for r in entry["returns"]]
                 self.comparisons.append(
                     f"The authors' {folder} generics on the same MDPs: mean 1/ln(error) {fmt(np.mean(fits))}, crash rate "
                     f"{np.mean([c for cs in entry['crashed'] for c in cs]):.1%} (ours: "
@@ -458,6 +458,11 @@ class _Evolution(_Section):
 FITNESS_SCALE = "inv-log-error"
 
 
+def _mean_fitness(returns) -> float:
+    """Mean 1/ln(error) of one policy's episode returns (a run's validation, or one authors' file's)."""
+    return float(np.mean(episode_fitness(np.asarray(returns, dtype=float), FITNESS_SCALE)))
+
+
 def _on_fitness_scale(runs: list[EvolveResult]) -> bool:
     """Whether the runs recorded their champions on the 1/ln(error) scale (FGHH as the authors ran it)."""
     return bool(runs) and all(r.fitness == FITNESS_SCALE for r in runs)
@@ -468,7 +473,7 @@ def _validation_row(label: str, returns: list[list[float]], crashed: list) -> tu
     flat = np.array([x for r in returns for x in r], dtype=float)
     if flat.size == 0:
         return [label, "n/a", "n/a", "n/a", "n/a"], []
-    per_run = [float(np.mean(episode_fitness(np.array(r, dtype=float), FITNESS_SCALE))) for r in returns if r]
+    per_run = [_mean_fitness(r) for r in returns if r]
     known = [c for cs in crashed if cs is not None for c in cs]
     rate = f"{np.mean(known):.1%}" if known else "n/a"
     return [label, rate, fmt(float(np.median(-flat))), fmt(float(np.mean(per_run))), fmt(_sd(per_run))], per_run
