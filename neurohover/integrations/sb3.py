@@ -18,7 +18,9 @@ Needs ``stable-baselines3`` (``pip install 'neurohover[examples]'``).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import pickle
+from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
@@ -31,7 +33,7 @@ try:
 except ModuleNotFoundError as missing:  # the optional extra
     raise NeurohoverError(f"neurohover.integrations.sb3 needs {missing.name}: pip install 'neurohover[examples]'") from None
 
-__all__ = ["SB3VecEnv"]
+__all__ = ["SB3VecEnv", "rl_zoo_policy"]
 
 
 class SB3VecEnv(VecEnv):
@@ -93,3 +95,38 @@ class SB3VecEnv(VecEnv):
         if indices is None:
             return list(range(self.num_envs))
         return [indices] if isinstance(indices, int) else list(indices)
+
+
+def rl_zoo_policy(run: str | Path, *, algo: str = "ppo", deterministic: bool = True) -> Callable[[np.ndarray], np.ndarray]:
+    """The trained policy of an RL Zoo run folder (``logs/ppo/neurohover-GHH08-Short-v0_1``), as a batch function.
+
+    It loads the folder's final model (``ENV.zip``, or ``best_model.zip`` when there is no final
+    one) and its observation statistics (``ENV/vecnormalize.pkl``, frozen), and maps a batch of
+    observations to the model's actions (the Gaussian's mean when ``deterministic``), ready for
+    :func:`neurohover.integrations.flying.evaluate_callable`.
+    """
+    from stable_baselines3 import A2C, PPO, SAC, TD3
+
+    algos = {"ppo": PPO, "sac": SAC, "td3": TD3, "a2c": A2C}
+    if algo not in algos:
+        raise NeurohoverError(f"algo={algo!r} is not supported: allowed {', '.join(algos)}")
+    run = Path(run)
+    zips = sorted(z for z in run.glob("*.zip") if not z.name.startswith("rl_model_"))
+    finals = [z for z in zips if z.name != "best_model.zip"]
+    model_zip = finals[0] if len(finals) == 1 else run / "best_model.zip"
+    if len(finals) > 1 or not model_zip.is_file():
+        raise NeurohoverError(f"{str(run)!r} is not an RL Zoo run folder: expected one ENV.zip (or best_model.zip) in it, found {[z.name for z in zips]}")
+    model = algos[algo].load(model_zip, device="cpu")
+    stats_file = run / model_zip.stem / "vecnormalize.pkl"
+    if model_zip.name == "best_model.zip":
+        stats_file = next(run.glob("*/vecnormalize.pkl"), stats_file)
+    stats = None
+    if stats_file.is_file():
+        with stats_file.open("rb") as f:
+            stats = pickle.load(f)  # a VecNormalize without its environment: normalize_obs needs only its statistics
+        stats.training = False
+
+    def act(obs: np.ndarray) -> np.ndarray:
+        return model.predict(stats.normalize_obs(obs) if stats is not None else obs, deterministic=deterministic)[0]
+
+    return act

@@ -1,0 +1,95 @@
+"""Fly a Python policy (a batch of observations -> a batch of actions) as ``neurohover.evaluate`` flies a policy file.
+
+A learned network (SB3, CleanRL, torch, JAX) is no :class:`~neurohover.policies.Policy`, so the
+compiled kernel cannot run it inside its loop. :func:`evaluate_callable` steps all its episodes
+in lockstep in one native vector environment, one network call per control step for the whole
+batch, and gives episode ``e`` on MDP ``m`` the gust stream ``(seed, first_episode + m * episodes
++ e)``: the very gusts :func:`neurohover.evaluate` gives any policy file, so a learned policy and
+the paper's policies are compared on the same episodes::
+
+    import neurohover as nh
+    from neurohover.integrations.flying import evaluate_callable
+
+    ghh08 = nh.get_task_family("ghh08")
+    mdps = [ghh08.mdp(f"train:{i}") for i in range(10)]
+    learned = evaluate_callable(lambda obs: model.predict(obs, deterministic=True)[0], mdps, episodes=20)
+    baseline = nh.evaluate(nh.baseline_policy(), mdps, episodes=20)   # the same gusts
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from ..envs.vector import HoverVectorEnv
+from ..errors import NeurohoverError
+from ..evaluate import Evaluation
+from ..sim.constants import ACTION_DIM, EPISODE_STEPS
+from ..tasks import MDP
+
+__all__ = ["evaluate_callable"]
+
+MAX_EPISODES = 1 << 16  # helicopters in one lockstep batch: the vector environment's arrays stay small
+
+
+def evaluate_callable(
+    act: Callable[[np.ndarray], Any],
+    mdps: MDP | Sequence[MDP],
+    *,
+    episodes: int = 1,
+    seed: int = 0,
+    first_episode: int = 0,
+    n_steps: int = EPISODE_STEPS,
+    obs_dtype: str = "float32",
+) -> Evaluation:
+    """Fly ``act`` for ``episodes`` episodes on every MDP; arrays are shaped (M, E).
+
+    Parameters
+    ----------
+    act : callable
+        Maps observations, shape (B, 12) of ``obs_dtype``, to actions, shape (B, 4) (clipped to
+        [-1, 1] by the environment, as for every policy). B is the number of episodes still flying.
+    mdps : MDP or sequence of MDP
+        MDPs of one task family.
+    episodes, seed, first_episode, n_steps
+        As :func:`neurohover.evaluate`: episode e on MDP m meets gust stream
+        ``(seed, first_episode + m * episodes + e)``.
+    obs_dtype : {"float32", "float64"}
+        What ``act`` receives (float32 for networks trained on the ``-Short-v0`` ids).
+    """
+    mdps = [mdps] if isinstance(mdps, MDP) else list(mdps)
+    if not mdps or not all(isinstance(m, MDP) for m in mdps):
+        raise NeurohoverError("mdps must be one MDP or a non-empty sequence of MDPs (e.g. get_task_family('ghh08').mdp('train:3'))")
+    families = sorted({m.family for m in mdps})
+    if len(families) != 1 or families[0] == "model":
+        raise NeurohoverError(f"mdps must all be MDPs of one task family (got {', '.join(families)})")
+    if isinstance(episodes, (bool, np.bool_)) or not isinstance(episodes, (int, np.integer)) or not 1 <= episodes * len(mdps) <= MAX_EPISODES:
+        raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1 with episodes x MDPs <= {MAX_EPISODES}")
+    n = len(mdps) * int(episodes)
+    sigma = getattr(mdps[0], "sigma", None)
+    env = HoverVectorEnv(n, task=families[0], sigma=sigma, mdp=[m for m in mdps for _ in range(episodes)], episode_steps=n_steps, obs_dtype=obs_dtype)
+    streams = [(seed, first_episode + k) for k in range(n)]  # k = m * episodes + e, as evaluate numbers them
+    start = time.perf_counter()
+    obs, _ = env.reset(seed=seed, options={"noise": streams})
+    returns, steps = np.zeros(n), np.zeros(n, dtype=np.int64)
+    crashed, alive = np.zeros(n, dtype=np.bool_), np.ones(n, dtype=np.bool_)
+    actions = np.zeros((n, ACTION_DIM))
+    while alive.any():
+        live = np.flatnonzero(alive)
+        out = np.asarray(act(obs[live]), dtype=np.float64)
+        if out.shape != (live.size, ACTION_DIM):
+            raise NeurohoverError(f"act returned actions of shape {out.shape} for {live.size} observations: expected ({live.size}, {ACTION_DIM})")
+        actions[live] = out
+        obs, reward, terminated, truncated, _ = env.step(actions)  # finished episodes autoreset; they no longer count
+        returns[live] += reward[live]
+        steps[live] += 1
+        crashed[live] |= terminated[live]
+        alive[live] = ~(terminated[live] | truncated[live])
+    env.close()
+    shape = (len(mdps), int(episodes))
+    return Evaluation(
+        returns.reshape(shape), crashed.reshape(shape), steps.reshape(shape), np.full(shape, -1, dtype=np.int64), None, time.perf_counter() - start
+    )
