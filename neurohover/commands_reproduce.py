@@ -140,7 +140,12 @@ def register(sub) -> None:
     p.add_argument("name", help="experiment name")
     p.add_argument("--store", required=True, help="results store file")
     p.add_argument("--scale", choices=("quick", "paper"), help="which scale (needed when the store holds both)")
-    p.add_argument("--format", choices=("csv", "json"), default="csv")
+    p.add_argument(
+        "--format",
+        choices=("csv", "json"),
+        default="csv",
+        help="csv: one row per unit, one plain value per cell (a long list as its count and mean); json: every unit in full",
+    )
     p.add_argument("--out", help="output file (default: standard output)")
     p.set_defaults(func=cmd_results)
 

@@ -1,9 +1,14 @@
 """``neurohover results``: export an experiment's finished units as CSV or JSON.
 
-CSV: one row per unit: experiment, scale, key, kind, the key's parts (group, mdp, rep:
+CSV: one row per unit, one plain value per cell, for a spreadsheet or ``pandas.read_csv``:
+experiment, scale, key, kind, the key's parts (group, mdp, rep:
 :class:`~neurohover.experiments.results.UnitKey`), seconds, worker, then the params (``param.*``)
 and the typed result's columns (``result.*``: :meth:`~neurohover.experiments.results.EvolveResult.columns`).
-JSON: the units exactly as the store holds them.
+Nested values are spread out: a dict as dotted columns (``param.target.mdp.label``), a list of at
+most ``SHORT_LIST`` (8) plain values one column per entry (``.0``, ``.1``), a longer list of numbers
+its count and mean (``.n``, ``.mean``; flags: ``.n``, ``.sum``), any other list (a history, a
+genome, episodes of several MDPs) its count alone. JSON: the units exactly as the store holds
+them, every list in full.
 """
 
 from __future__ import annotations
@@ -13,7 +18,7 @@ import io
 import json
 
 from ..errors import NeurohoverError
-from .results import UnitKey, result_from_dict
+from .results import UnitKey, flat_cells, result_from_dict
 from .store import Store
 
 FORMATS = ("csv", "json")
@@ -32,17 +37,8 @@ def _scale(store: Store, name: str, scale: str | None) -> str:
     return scale
 
 
-def _flat(prefix: str, value, out: dict) -> None:
-    """Params as flat columns: nested dicts as ``a.b``, except MDPs and policies (one JSON cell)."""
-    if isinstance(value, dict) and not prefix.endswith(("policies", "mdp", "policy", "generic")):
-        for k, v in value.items():
-            _flat(f"{prefix}.{k}" if prefix else k, v, out)
-    else:
-        out[prefix] = value if isinstance(value, (int, float, str, bool)) or value is None else json.dumps(value, separators=(",", ":"))
-
-
 def export_results(store: Store, name: str, fmt: str = "csv", scale: str | None = None) -> str:
-    """The finished units of ``name`` as CSV (one row per unit; nested values JSON-encoded) or JSON."""
+    """The finished units of ``name`` as CSV (one row per unit, one plain value per cell) or JSON (everything)."""
     if fmt not in FORMATS:
         raise NeurohoverError(f"unknown format {fmt!r}: allowed {', '.join(FORMATS)}")
     scale = _scale(store, name, scale)
@@ -70,7 +66,7 @@ def export_results(store: Store, name: str, fmt: str = "csv", scale: str | None 
             "seconds": u["seconds"],
             "worker": u["worker"],
         }
-        _flat("param", {k: v for k, v in u["params"].items()}, row)
+        flat_cells("param", u["params"], row)
         row.update({f"result.{k}": v for k, v in result_from_dict(u["kind"], u["result"], u["key"]).columns().items()})
         rows.append(row)
     columns: list[str] = []

@@ -22,7 +22,6 @@ repetition), in this one place.
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 import re
 from dataclasses import dataclass, field
@@ -140,28 +139,48 @@ class _Record:
         return cls(**values)
 
     def columns(self) -> dict[str, Any]:
-        """Flat columns (for CSV): a part's keys as ``part.key``, a policy and every list as
-        compact JSON, scalars as they are."""
+        """Flat columns (for CSV), one plain value each: :func:`flat_cells`'s rules."""
         out: dict[str, Any] = {}
-
-        def add(name: str, value: Any) -> None:
-            if isinstance(value, dict):
-                for k, v in value.items():
-                    add(f"{name}.{k}", v)
-            elif isinstance(value, (int, float, str, bool)) or value is None:
-                out[name] = value
-            else:
-                out[name] = json.dumps(value, separators=(",", ":"))
-
         for name, value in self.to_dict().items():
-            if self._NESTED.get(name) is StoredPolicy:
-                out[name] = json.dumps(value, separators=(",", ":"))  # a policy stays one cell
-            else:
-                add(name, value)
+            flat_cells(name, value, out)
         return out
 
 
 # --------------------------------------------------------------------------------- parts
+
+
+SHORT_LIST = 8  # lists up to this long (an MDP's parameters, the safe policies) get a column per entry
+
+
+def _plain(value) -> bool:
+    return isinstance(value, (int, float, str, bool)) or value is None
+
+
+def flat_cells(prefix: str, value, out: dict) -> None:
+    """``value`` as plain cells named from ``prefix``, for a CSV row (``neurohover results``).
+
+    A dict becomes dotted columns (``target.mdp.label``); a list of at most ``SHORT_LIST`` plain
+    values one column per entry (``.0``, ``.1``); a longer list of numbers its count and mean
+    (``.n``, ``.mean``; flags: ``.n``, ``.sum``); any other list (a history, a genome, episodes
+    of several MDPs) its count alone. The store's JSON keeps every list in full.
+    """
+    if isinstance(value, dict):
+        for k, v in value.items():
+            flat_cells(f"{prefix}.{k}" if prefix else str(k), v, out)
+    elif isinstance(value, (list, tuple)):
+        if all(_plain(v) for v in value) and len(value) <= SHORT_LIST:
+            for i, v in enumerate(value):
+                out[f"{prefix}.{i}"] = v
+            return
+        out[f"{prefix}.n"] = len(value)
+        if prefix.endswith("genome") or not all(isinstance(v, (int, float)) for v in value):
+            return  # a genome's weights, or nested lists: no summary means anything
+        if all(isinstance(v, bool) for v in value):
+            out[f"{prefix}.sum"] = sum(value)
+        else:
+            out[f"{prefix}.mean"] = sum(value) / len(value)
+    else:
+        out[prefix] = value
 
 
 @dataclass(frozen=True)
