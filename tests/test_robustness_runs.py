@@ -307,7 +307,34 @@ def test_two_stores_on_one_file_in_one_process_take_turns(tmp_path: Path) -> Non
             second.begin("x", "quick", "h", {})
         assert first.experiments() == second.experiments() == [("x", "quick", "h", 0)]  # reading needs no lock
         first.close()
-        second.begin("x", "quick", "h", {})  # a closed Store's lock is released
+        assert not first.lock_path.exists()  # a closed Store removes its lock file ...
+        second.begin("x", "quick", "h", {})  # ... and releases its lock
+        assert second.lock_path.read_text().split()[0] == str(os.getpid())
+    assert not path.with_name("s.sqlite.lock").exists()
+
+
+def test_a_run_that_opened_the_lock_file_as_its_writer_removed_it_locks_the_new_one(tmp_path: Path, monkeypatch) -> None:
+    path = tmp_path / "s.sqlite"
+    first = Store(path)
+    first.lock()
+    stale = open(first.lock_path)  # the next run opened the file while the first still held it
+    first.close()  # removes the file, then releases the lock: flock on `stale` would now succeed
+    second = Store(path)
+    opened = []
+    real_open = Store._open_lock_file
+
+    def open_lock_file(self):
+        opened.append(1)
+        return stale if len(opened) == 1 else real_open(self)
+
+    monkeypatch.setattr(Store, "_open_lock_file", open_lock_file)
+    second.lock()
+    assert len(opened) == 2  # it saw that its first file was gone and locked the path's new one
+    third = Store(path)
+    with pytest.raises(ValueError, match="is in use"):  # so the lock still excludes a third writer
+        third.lock()
+    second.close()
+    third.close()
 
 
 def test_a_terminated_command_exits_with_143_and_an_interrupt_with_130(monkeypatch, capsys) -> None:

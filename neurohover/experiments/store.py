@@ -20,7 +20,8 @@ running again with the same store skips every finished unit.
 
 One writer: a run holds an OS lock (``flock``) on ``STORE.lock`` beside the store from its first
 write until it closes the store, and writes its pid there; a second run is refused, naming that
-pid. The kernel drops the lock when its process dies, so a killed run never blocks the next one.
+pid. Closing the store removes the file; the kernel drops the lock when its process dies, so a
+killed run (which leaves the file) never blocks the next one.
 Readers (``results``, ``report``) take no lock.
 """
 
@@ -36,6 +37,8 @@ from pathlib import Path
 from typing import IO, Any
 
 from ..errors import NeurohoverError
+
+LOCK_ATTEMPTS = 100  # tries to lock STORE.lock while earlier writers remove it as they close
 
 try:
     import fcntl
@@ -90,6 +93,12 @@ class Store:
     def close(self) -> None:
         self.conn.close()
         if self._lock is not None:
+            # Unlink while still holding the lock: a run that opened the file meanwhile finds, once
+            # it gets the lock, that the path no longer names its file, and starts over (lock()).
+            try:
+                self.lock_path.unlink()
+            except OSError:
+                pass
             self._lock.close()  # closing the file releases the lock
             self._lock = None
 
@@ -97,7 +106,7 @@ class Store:
 
     @property
     def lock_path(self) -> Path:
-        """The lock file beside the store (``STORE.lock``); it stays, only its lock matters."""
+        """The lock file beside the store (``STORE.lock``), there while a run writes the store."""
         return self.path.with_name(self.path.name + ".lock")
 
     def lock(self) -> None:
@@ -115,27 +124,45 @@ class Store:
         """
         if self._lock is not None or fcntl is None:
             return
-        try:
-            file = os.fdopen(os.open(self.lock_path, os.O_RDWR | os.O_CREAT, 0o644), "r+")
-        except OSError as err:
-            raise NeurohoverError(f"cannot open {str(self.lock_path)!r}, the writer lock of results store {str(self.path)!r}: {err.strerror}") from None
-        try:
-            fcntl.flock(file.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError as err:
-            holder = file.read().split()
-            file.close()
-            if err.errno not in (errno.EAGAIN, errno.EWOULDBLOCK, errno.EACCES):
-                return  # the filesystem cannot lock (ENOLCK, ...): write unguarded, as without a lock
-            who = f"pid {holder[0]} on host {holder[1]}" if len(holder) == 2 else f"see {str(self.lock_path)!r}"
-            raise NeurohoverError(
-                f"results store {str(self.path)!r} is in use: another run ({who}) is writing it; wait for that run "
-                f"to end (or stop it), or give another --store file. Reading it (results, report) works meanwhile"
-            ) from None
+        for _ in range(LOCK_ATTEMPTS):
+            file = self._open_lock_file()
+            try:
+                fcntl.flock(file.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError as err:
+                holder = file.read().split()
+                file.close()
+                if err.errno not in (errno.EAGAIN, errno.EWOULDBLOCK, errno.EACCES):
+                    return  # the filesystem cannot lock (ENOLCK, ...): write unguarded, as without a lock
+                who = f"pid {holder[0]} on host {holder[1]}" if len(holder) == 2 else f"see {str(self.lock_path)!r}"
+                raise NeurohoverError(
+                    f"results store {str(self.path)!r} is in use: another run ({who}) is writing it; wait for that run "
+                    f"to end (or stop it), or give another --store file. Reading it (results, report) works meanwhile"
+                ) from None
+            if self._names_the_lock_file(file):
+                break
+            file.close()  # the previous writer removed it as it closed: lock the path's new file
+        else:
+            raise NeurohoverError(f"could not lock {str(self.lock_path)!r}, the writer lock of results store {str(self.path)!r}: it kept being replaced")
         file.seek(0)
         file.truncate()
         file.write(f"{os.getpid()} {socket.gethostname()}\n")
         file.flush()
         self._lock = file
+
+    def _open_lock_file(self) -> IO[str]:
+        try:
+            return os.fdopen(os.open(self.lock_path, os.O_RDWR | os.O_CREAT, 0o644), "r+")
+        except OSError as err:
+            raise NeurohoverError(f"cannot open {str(self.lock_path)!r}, the writer lock of results store {str(self.path)!r}: {err.strerror}") from None
+
+    def _names_the_lock_file(self, file: IO[str]) -> bool:
+        """Whether :attr:`lock_path` still is the file ``file`` holds (not removed or replaced since it was opened)."""
+        try:
+            now = os.stat(self.lock_path)
+        except FileNotFoundError:
+            return False
+        held = os.fstat(file.fileno())
+        return (now.st_dev, now.st_ino) == (held.st_dev, held.st_ino)
 
     def __enter__(self) -> Store:
         return self
