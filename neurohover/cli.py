@@ -248,10 +248,14 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    from .paths import forget_created_dirs, remove_created_dirs
+
+    forget_created_dirs()
     try:
         return args.func(args)
     except NeurohoverError as err:
         print(f"neurohover {args.command}: error: {err}", file=sys.stderr)
+        remove_created_dirs()  # a failed command leaves no empty output directory behind
         return 2
     except KeyboardInterrupt as stop:
         from .procs import Terminated

@@ -4,7 +4,9 @@ Each check refuses a bad path with one :class:`~neurohover.errors.NeurohoverErro
 option, the path and what is expected. Output checks really create (and remove again) a file, so
 an unwritable place is found even where permission bits do not tell (``/proc``, read-only mounts,
 running as root). Missing parent directories of an output are created, and a note on standard
-error says so: a typo in a path shows up at once instead of silently.
+error says so: a typo in a path shows up at once instead of silently. When the command then
+fails, :func:`remove_created_dirs` takes away those it created that are still empty, so a refused
+or failed run leaves nothing behind (a directory holding any result stays).
 """
 
 from __future__ import annotations
@@ -16,7 +18,9 @@ from pathlib import Path
 
 from .errors import NeurohoverError
 
-__all__ = ["input_file", "input_dir", "output_dir", "output_file"]
+__all__ = ["input_file", "input_dir", "output_dir", "output_file", "remove_created_dirs"]
+
+_created: list[Path] = []  # directories this process's checks created, deepest first
 
 
 def _why(err: OSError) -> str:
@@ -40,6 +44,7 @@ def _make_dirs(directory: Path, option: str, given: str) -> None:
         directory.mkdir(parents=True, exist_ok=True)
     except OSError as err:
         raise NeurohoverError(f"{option} {given!r}: cannot create the directory {str(directory)!r} ({_why(err)})") from None
+    _created[:0] = missing
     print(f"neurohover: created directory {str(missing[-1])!r}" + (f" and {len(missing) - 1} below it" if len(missing) > 1 else ""), file=sys.stderr)
 
 
@@ -106,3 +111,23 @@ def input_dir(path: str | os.PathLike, option: str) -> Path:
     if not p.is_dir():
         raise NeurohoverError(f"{option} {str(path)!r} is a file; give a directory")
     return p
+
+
+def remove_created_dirs() -> list[Path]:
+    """Remove the directories the checks above created that are still empty (a failed command's); returns them."""
+    removed = []
+    for directory in list(_created):
+        try:
+            directory.rmdir()  # only an empty directory goes
+        except OSError:
+            continue
+        removed.append(directory)
+    _created.clear()
+    if removed:
+        print(f"neurohover: removed the empty directory {str(removed[-1])!r} it had created", file=sys.stderr)
+    return removed
+
+
+def forget_created_dirs() -> None:
+    """Start a command afresh: what earlier commands in this process created is theirs."""
+    _created.clear()

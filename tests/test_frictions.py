@@ -67,3 +67,22 @@ def test_compete_says_when_it_reuses_stored_runs(tmp_path: Path, capsys) -> None
     assert "reused" not in capsys.readouterr().err
     assert main(args) == 0
     assert "2 of 2 units (runs and the policies they fly) were already in" in capsys.readouterr().err
+
+
+def test_a_failed_command_leaves_no_empty_output_directory(tmp_path: Path, capsys) -> None:
+    from neurohover.cli import main
+    from neurohover.experiments import Store
+
+    Store(tmp_path / "empty.sqlite").close()
+    out = tmp_path / "new" / "report"
+    assert main(["report", "--store", str(tmp_path / "empty.sqlite"), "--out", str(out), "fig7"]) == 2
+    err = capsys.readouterr().err
+    assert "created directory" in err and f"removed the empty directory {str(tmp_path / 'new')!r}" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["empty.sqlite"]
+    # compete: refused after its --out check (an unknown MDP), so nothing was written there either
+    assert main(["compete", "--task", "ghh08", "--agent", "model-free", "--runs", "1", "--episodes", "2", "--mdps", "nope", "--out", str(out)]) == 2
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["empty.sqlite"]
+    # a directory that was there already stays, empty or not
+    (tmp_path / "mine").mkdir()
+    assert main(["report", "--store", str(tmp_path / "empty.sqlite"), "--out", str(tmp_path / "mine"), "fig7"]) == 2
+    assert (tmp_path / "mine").is_dir()
