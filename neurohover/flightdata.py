@@ -1,7 +1,8 @@
 """Flight data: observations and actions of flown episodes at 10 Hz (docs/model.md, Learned models).
 
 Saved as a NumPy ``.npz`` archive with a format tag, the episodes concatenated and their
-lengths kept, so a file of any number of episodes loads back exactly.
+lengths kept, so a file of any number of episodes loads back exactly; or, with
+``dtype="float32"``, in about half the space, rounded to float32 (and loaded back as float64).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import numpy as np
 from .errors import NeurohoverError
 
 FORMAT = "neurohover-flight-data/1"
+SAVE_DTYPES = ("float64", "float32")
 
 
 @dataclass(frozen=True)
@@ -48,8 +50,10 @@ class FlightData:
     def __add__(self, other: FlightData) -> FlightData:
         return FlightData(self.observations + other.observations, self.actions + other.actions, {**self.metadata, **other.metadata})
 
-    def save(self, path: str | Path) -> Path:
-        """Write the flight data to ``path`` (``.npz``)."""
+    def save(self, path: str | Path, dtype: str = "float64") -> Path:
+        """Write the flight data to ``path`` (``.npz``), as float64 (exact) or float32 (half the space)."""
+        if dtype not in SAVE_DTYPES:
+            raise NeurohoverError(f"flight-data dtype {dtype!r} is not allowed: use {' or '.join(SAVE_DTYPES)}")
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         lengths = np.array([a.shape[0] for a in self.actions], dtype=np.int64)
@@ -58,8 +62,8 @@ class FlightData:
                 f,
                 format=np.array(FORMAT),
                 lengths=lengths,
-                observations=np.concatenate(self.observations) if self.observations else np.zeros((0, 12)),
-                actions=np.concatenate(self.actions) if self.actions else np.zeros((0, 4)),
+                observations=(np.concatenate(self.observations) if self.observations else np.zeros((0, 12))).astype(dtype),
+                actions=(np.concatenate(self.actions) if self.actions else np.zeros((0, 4))).astype(dtype),
                 metadata=np.array(json.dumps(self.metadata)),
             )
         return path
@@ -91,6 +95,7 @@ class FlightData:
                 f"flight-data file {str(path)!r} is truncated or inconsistent: {lengths.size} episodes of {lengths.sum()} steps "
                 f"but arrays {obs.shape} and {act.shape}"
             )
+        obs, act = obs.astype(np.float64), act.astype(np.float64)  # a float32 file loads as float64, like every array here
         obs_split = np.split(obs, np.cumsum(lengths + 1)[:-1])
         act_split = np.split(act, np.cumsum(lengths)[:-1])
         return cls(tuple(obs_split), tuple(act_split), metadata)

@@ -86,3 +86,22 @@ def test_a_failed_command_leaves_no_empty_output_directory(tmp_path: Path, capsy
     (tmp_path / "mine").mkdir()
     assert main(["report", "--store", str(tmp_path / "empty.sqlite"), "--out", str(tmp_path / "mine"), "fig7"]) == 2
     assert (tmp_path / "mine").is_dir()
+
+
+def test_flight_data_can_be_recorded_in_float32_in_half_the_space(tmp_path: Path, capsys) -> None:
+    from neurohover.cli import main
+    from neurohover.flightdata import FlightData
+
+    sizes = {}
+    for dtype in ("float64", "float32"):
+        path = tmp_path / f"{dtype}.npz"
+        assert main(["fly", "--task", "ghh08", "--mdp", "train:3", "--episodes", "2", "--record", str(path), "--record-dtype", dtype, "--json"]) == 0
+        sizes[dtype] = path.stat().st_size
+    capsys.readouterr()
+    exact, rounded = FlightData.load(tmp_path / "float64.npz"), FlightData.load(tmp_path / "float32.npz")
+    assert sizes["float32"] < 0.6 * sizes["float64"]
+    for a, b in zip(exact.observations + exact.actions, rounded.observations + rounded.actions):
+        assert b.dtype == np.float64 and np.array_equal(b, a.astype(np.float32).astype(np.float64))
+    assert rounded.metadata["returns"] == exact.metadata["returns"]
+    with pytest.raises(nh.NeurohoverError, match="flight-data dtype 'float16' is not allowed: use float64 or float32"):
+        exact.save(tmp_path / "x.npz", dtype="float16")
