@@ -31,6 +31,7 @@ import numpy as np
 from .errors import NeurohoverError
 from .evaluate import DEVICES, check_device
 from .evolution.generational import GENERATIONAL_PRESETS
+from .evolution.optimisers import OPTIMISERS, optimiser_names
 
 MDP_FAMILY = "G"
 
@@ -373,7 +374,13 @@ def register(sub) -> None:
     p.add_argument("--sigma", type=float, help="FGHH breadth sigma (default 0.3)")
     p.add_argument("--topology", choices=("slp", "mlp"), help="network (default: the seed policy file's, else slp over a family (--mdp G) and mlp on one MDP)")
     p.add_argument("--seed-policy", default="baseline", help="prototype: zero, baseline (baseline-equivalent network; default) or a policy FILE")
-    p.add_argument("--optimizer", choices=("ne", "cma"), default="ne", help="ne: the paper's neuroevolution (default); cma: CMA-ES, same budget and resampling")
+    p.add_argument(
+        "--optimizer",
+        "--optimiser",
+        choices=optimiser_names(),
+        default="ne",
+        help="ne: the paper's neuroevolution (default); " + "; ".join(f"{n}: {s.summary}" for n, s in OPTIMISERS.items()) + " (same budget and resampling)",
+    )
     p.add_argument(
         "--resampling",
         default="fixed:1",

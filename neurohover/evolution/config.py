@@ -20,6 +20,8 @@ from ..policies import TOPOLOGIES, Policy
 from ..policies import prototype as make_prototype
 from ..tasks import MDP, TaskFamily
 from .generational import GENERATIONAL_PRESETS, OLD_GENERATIONAL, GenerationalSettings
+from .optimisers import NE, OPTIMISERS, optimiser_names, population_settings
+from .optimisers.cma import CMASettings
 from .seeding import check_seed
 from .steady_state import SteadyStateSettings
 
@@ -30,19 +32,18 @@ __all__ = [
     "Resampling",
     "RunConfig",
     "make_settings",
+    "optimiser_of",
     "parse_resampling",
     "resolve_prototype",
     "resolve_target",
     "upgrade_saved_config",
 ]
 
-#: CMA-ES settings (override with ``settings={"sigma0": ..., "popsize": ...}``). A sweep on GHH-08
-#: train:1 (600-step episodes, 1000 episodes, SLP and MLP from the baseline) found sigma0 0.01-0.03
-#: best and 0.1 crashing nearly every SLP candidate; popsize None is pycma's 4 + 3 ln D.
-CMA_DEFAULTS: dict[str, Any] = {"sigma0": 0.02, "popsize": None}
+#: CMA-ES's default settings (:class:`~.optimisers.cma.CMASettings`; override with ``settings={"sigma0": ..., "popsize": ...}``).
+CMA_DEFAULTS: dict[str, Any] = dataclasses.asdict(CMASettings())
 RACE_T_LIMIT = 10  # docs/model.md, Fitness under noise: t_limit = t_min = t_max = 10
-#: What a run's ``method`` may be (``cma`` whenever the optimizer is CMA-ES).
-METHODS = ("steady-state", "generational", "cma")
+#: What a run's ``method`` may be: the neuroevolution's two, or a population optimiser's name (:mod:`.optimisers`).
+METHODS = ("steady-state", "generational", *OPTIMISERS)
 #: Steady-state settings that checkpoints written before they existed ran with.
 _OLD_STEADY_STATE = {"plateau_rule": "literal", "selection": "roulette", "tournament_size": 5, "init_mutate_frac": None, "init_mutate_std": None}
 
@@ -112,27 +113,24 @@ def resolve_target(target) -> tuple[MDP | None, TaskFamily | None, dict]:
     raise NeurohoverError(f"evolve needs an MDP, a learned model or a task family as target, got {type(target).__name__}")
 
 
-def make_settings(method: str, optimizer: str, settings) -> dict | SteadyStateSettings | GenerationalSettings:
+def optimiser_of(table: Mapping[str, Any]) -> tuple[str, dict[str, Any]]:
+    """An experiment config's ``optimiser`` table split into the optimiser's name (its ``name``
+    key, default ``ne``) and its settings; an unknown name is refused."""
+    rest = dict(table)
+    name = rest.pop("name", NE)
+    if name not in optimiser_names():
+        raise NeurohoverError(f"unknown optimizer name = {name!r}: allowed {', '.join(optimiser_names())}")
+    return name, rest
+
+
+def make_settings(method: str, optimizer: str, settings) -> Any:
     """The optimiser settings of a run: ``settings`` (None, a settings object, a dict of
     overrides, or for the generational method a preset's name; a dict may name its base with
     ``"preset"``, :data:`~.generational.GENERATIONAL_PRESETS`) checked for ``method`` /
-    ``optimizer``; a dict for CMA-ES, the budget left None for neuroevolution (the run counts the
-    budget in episodes itself)."""
-    if optimizer == "cma":
-        cfg = dict(CMA_DEFAULTS)
-        if settings is not None:
-            if not isinstance(settings, Mapping):
-                raise NeurohoverError("settings for optimizer='cma' must be a dict with keys sigma0, popsize")
-            unknown = sorted(set(settings) - set(cfg))
-            if unknown:
-                raise NeurohoverError(f"unknown CMA-ES setting(s) {', '.join(unknown)}: allowed {', '.join(cfg)}")
-            cfg.update(settings)
-        s0, pop = cfg["sigma0"], cfg["popsize"]
-        if isinstance(s0, bool) or not isinstance(s0, (int, float)) or not (math.isfinite(s0) and s0 > 0):
-            raise NeurohoverError(f"CMA-ES sigma0={s0!r} must be a finite number > 0")
-        if pop is not None and (isinstance(pop, bool) or not isinstance(pop, (int, np.integer)) or pop < 2):
-            raise NeurohoverError(f"CMA-ES popsize={pop!r} must be None or an integer >= 2")
-        return {"sigma0": float(s0), "popsize": None if pop is None else int(pop)}
+    ``optimizer``: a population optimiser's settings dataclass (:mod:`.optimisers`), or the
+    neuroevolution's with the budget left None (the run counts the budget in episodes itself)."""
+    if optimizer != NE:
+        return population_settings(optimizer, settings)
     cls = SteadyStateSettings if method == "steady-state" else GenerationalSettings
     if settings is None:
         return cls()
@@ -186,13 +184,13 @@ class RunConfig:
         JSON description of the target.
     prototype : Policy
     topology, optimizer : str
-    method : {"steady-state", "generational", "cma"}
+    method : str
+        ``steady-state`` or ``generational`` (optimizer ``ne``), else the population optimiser's name.
     resampling : Resampling
     budget : int or None
         Episodes (not part of :meth:`to_dict`: a resumed run may raise it).
     seed, n_steps : int
-    settings : SteadyStateSettings, GenerationalSettings or dict
-        The optimiser's settings (a dict for CMA-ES).
+    settings : SteadyStateSettings, GenerationalSettings, or a population optimiser's settings
     """
 
     mdp: MDP | None
@@ -215,8 +213,8 @@ class RunConfig:
         if topology is None:  # the prototype's, else the authors' choice: SLP generics over a family, MLPs on one MDP
             topology = prototype.topology if isinstance(prototype, Policy) else ("slp" if family is not None else "mlp")
         proto = resolve_prototype(prototype, topology)
-        if optimizer not in ("ne", "cma"):
-            raise NeurohoverError(f"unknown optimizer {optimizer!r}: allowed ne, cma")
+        if optimizer not in optimiser_names():
+            raise NeurohoverError(f"unknown optimizer {optimizer!r}: allowed {', '.join(optimiser_names())}")
         resampling = parse_resampling(resampling)
         if budget is None and isinstance(settings, (SteadyStateSettings, GenerationalSettings)):
             budget = settings.budget
@@ -230,15 +228,17 @@ class RunConfig:
             raise NeurohoverError(f"unknown method {method!r}: allowed steady-state, generational")
         if chosen == "steady-state" and family is not None:
             raise NeurohoverError("the steady-state method evolves on one MDP; a task family needs the generational method")
-        if optimizer == "cma":
-            chosen = "cma"
+        if optimizer != NE:
+            chosen = optimizer  # a population optimiser is its own method
         if resampling.kind == "race" and chosen != "generational":
             raise NeurohoverError(
                 f"resampling {resampling} (a selection race) needs the generational method (a task family as target, optimizer 'ne'); use fixed:K here"
             )
         checked = make_settings("steady-state" if chosen == "steady-state" else "generational", optimizer, settings)
-        if optimizer == "cma" and proto.genome.size < 2:
-            raise NeurohoverError("CMA-ES needs a genome of at least 2 genes")
+        if optimizer != NE and budget is None and not OPTIMISERS[optimizer].stops_itself:
+            raise NeurohoverError(f"optimizer {optimizer!r} has no stopping rule of its own: give a budget (episodes)")
+        if optimizer != NE and proto.genome.size < OPTIMISERS[optimizer].min_genes:
+            raise NeurohoverError(f"{optimizer} needs a genome of at least {OPTIMISERS[optimizer].min_genes} genes")
         return cls(
             mdp, family, target_desc, proto, topology, optimizer, chosen, resampling, None if budget is None else int(budget), seed, int(n_steps), checked
         )

@@ -18,8 +18,10 @@ Two kinds of target
   fresh MDP drawn from G) or by selection races (``"race:DELTA"``, docs/model.md, Fitness under
   noise; confidence level DELTA in (0, 1)), whose bounds are then on the fitness scale too.
 
-``optimizer="cma"`` replaces the neuroevolution by CMA-ES (pycma) on either target with the same
-budget semantics and the same fixed resampling, so the two can be compared on equal episodes.
+``optimizer="cma"`` (CMA-ES, pycma) or ``"openai-es"`` (OpenAI-ES), or any population optimiser
+of the registry (:mod:`neurohover.evolution.optimisers`), replaces the neuroevolution on either
+target with the same budget semantics and the same fixed resampling, so they can be compared on
+equal episodes.
 
 Budget, evaluations, champion
 -----------------------------
@@ -27,8 +29,8 @@ The budget counts **episodes flown** (one evaluation with ``fixed:K`` costs K ep
 checked between generations, so a run may overshoot it by at most one generation (the steady-state
 method's first generation is the whole initial population of ``pop_size`` candidates). The
 champion is, as in the optimisers, the candidate with the best single fitness ever told for a fixed
-MDP (steady state; CMA-ES on an MDP), and the candidate with the best estimate of the last
-generation for a task family (generational: the best selected parent; CMA-ES on a family), because a best-ever maximum over
+MDP (steady state; a population optimiser on an MDP), and the candidate with the best estimate of the last
+generation for a task family (generational: the best selected parent; a population optimiser on a family), because a best-ever maximum over
 noisy estimates of different MDPs is optimistically biased.
 
 Seeding and reproducibility
@@ -147,19 +149,22 @@ def evolve(
         generics are SLPs) and ``"mlp"`` on one MDP.
     prototype : Policy or {"zero", "baseline"}
         The genome the initial population is built from.
-    optimizer : {"ne", "cma"}
-        The paper's neuroevolution, or CMA-ES (pycma) with the same budget and resampling.
+    optimizer : {"ne", "cma", "openai-es"} or another registered name
+        The paper's neuroevolution, or a population optimiser (:mod:`neurohover.evolution.optimisers`)
+        with the same budget and resampling.
     resampling : str, optional
         ``"fixed:K"`` (default ``fixed:1``) or ``"race:DELTA"`` (generational NE on a family only).
     budget : int, optional
         Episodes to fly (checked between generations). Default: the paper's termination
-        (steady state: plateau; generational: ``generations``; CMA-ES: pycma's criteria).
+        (steady state: plateau; generational: ``generations``; CMA-ES: pycma's criteria; OpenAI-ES
+        has none, so it needs a budget).
     settings : SteadyStateSettings, GenerationalSettings, dict or str, optional
         Overrides of the optimiser settings (paper Tables 6/7): a settings object, a dict of
         fields, or for the generational method a preset's name (``"table7"``, the default;
         ``"authors-script"``; ``"raw-elitist"``; a dict may start from one with ``"preset"``),
-        including the fitness scale (``fitness="inv-log-error"`` or ``"return"``); for CMA-ES a
-        dict with ``sigma0`` and ``popsize`` (:data:`CMA_DEFAULTS`).
+        including the fitness scale (``fitness="inv-log-error"`` or ``"return"``); for a population
+        optimiser its settings object or a dict of its fields (CMA-ES: ``sigma0``, ``popsize``,
+        :data:`CMA_DEFAULTS`; OpenAI-ES: :class:`~neurohover.evolution.optimisers.openai_es.OpenAIESSettings`).
     seed : int
         Root of all randomness (``numpy.random.SeedSequence(seed)``).
     n_steps : int

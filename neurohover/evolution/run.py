@@ -24,11 +24,11 @@ from ..errors import NeurohoverError
 from ..evaluate import KernelFlyer
 from ..policies import Policy
 from ..sim.lanes import LANES
-from .cmaes import CMAES
 from .common import Optimiser, enc_float
 from .config import RACE_T_LIMIT, RunConfig, upgrade_saved_config
 from .fitness import episode_fitness
 from .generational import GenerationalNE
+from .optimisers import OPTIMISERS
 from .races import fixed_resampling, selection_race
 from .records import (
     CHECKPOINT_FORMAT,
@@ -104,8 +104,8 @@ class Run:
         genome, settings, seed = config.prototype.genome, config.settings, optimiser_seed(config.seed)
         # Classes looked up here at run time (a test may replace SteadyStateNE by a reference).
         self.opt: Optimiser
-        if self.method == "cma":
-            self.opt = CMAES(genome, sigma0=settings["sigma0"], seed=seed, popsize=settings["popsize"])
+        if self.method in OPTIMISERS:
+            self.opt = OPTIMISERS[self.method].make(genome, settings, seed)
         elif self.method == "steady-state":
             self.opt = SteadyStateNE(genome, settings, seed=seed)
         else:
@@ -114,7 +114,7 @@ class Run:
         self.generation = 0
         self.evaluations = 0
         self.elapsed = 0.0  # wall seconds of earlier sessions (resume)
-        self.champion_genome: np.ndarray | None = None  # CMA-ES on a family: best of the last generation
+        self.champion_genome: np.ndarray | None = None  # a population optimiser on a family: best of the last generation
         self.champion_return = -math.inf
         self.stop_reason: str | None = None
         self._race_steps = np.zeros((0, RACE_T_LIMIT), dtype=np.int64)  # the current race's steps per sample flown
@@ -257,11 +257,12 @@ class Run:
         next_ckpt = time.perf_counter() + flag_every
         next_progress = time.perf_counter() + progress_every_s
         budget = self.budget
-        step = {
-            "steady-state": self._best_ever_generation,
-            "generational": self._generational_generation,
-            "cma": self._best_ever_generation if self.family is None else self._cma_family_generation,
-        }[self.method]
+        if self.method == "generational":
+            step = self._generational_generation
+        elif self.method == "steady-state" or self.family is None:
+            step = self._best_ever_generation
+        else:
+            step = self._population_family_generation
         boundary = True  # False while a generation is half done (its state is not checkpointable)
         with InterruptFlag() as flag:
             try:
@@ -305,8 +306,8 @@ class Run:
             return "budget"
         if self.generation == 0:
             return None
-        if self.method == "cma":
-            return "cma-stop" if self.opt.stop() else None
+        if self.method in OPTIMISERS:
+            return OPTIMISERS[self.method].stop_reason if self.opt.stop() else None
         if self.opt.stop():
             return "plateau" if self.method == "steady-state" else "generations"
         return None
@@ -317,7 +318,7 @@ class Run:
         )
 
     def _best_ever_generation(self, start: float) -> None:
-        """Steady state, or CMA-ES on an MDP: the champion is the best single fitness ever told;
+        """Steady state, or a population optimiser on an MDP: the champion is the best single fitness ever told;
         a record per new champion."""
         opt = self.opt
         before = opt.champion_return
@@ -360,8 +361,8 @@ class Run:
         self.evaluations += genomes.shape[0]
         self._record(before_eps, opt.champion_return, start)
 
-    def _cma_family_generation(self, start: float) -> None:
-        """CMA-ES on a family: the champion is the best estimate of the last generation (a
+    def _population_family_generation(self, start: float) -> None:
+        """A population optimiser on a family: the champion is the best estimate of the last generation (a
         best-ever maximum over noisy estimates would be biased); a record per generation."""
         opt = self.opt
         before_eps = self.flyer.episodes
@@ -395,12 +396,12 @@ class Run:
         return tuple(history)
 
     def _champion_return(self) -> float:
-        if self.method == "cma" and self.family is not None:
+        if self.method in OPTIMISERS and self.family is not None:
             return self.champion_return
         return float(self.opt.champion_return)
 
     def _champion_genome(self) -> np.ndarray | None:
-        if self.method == "cma" and self.family is not None:
+        if self.method in OPTIMISERS and self.family is not None:
             return self.champion_genome
         return self.opt.champion_genome
 
@@ -416,7 +417,7 @@ class Run:
         label = target["mdp"]["label"] if target["kind"] == "mdp" else f"{target['family']}/G" + (f"(sigma={target['sigma']:g})" if "sigma" in target else "")
         cfg = self.cfg
         meta = {
-            "method": self.method if cfg.optimizer == "ne" else "cma-es",
+            "method": OPTIMISERS[cfg.optimizer].label if cfg.optimizer in OPTIMISERS else self.method,
             "optimizer": cfg.optimizer,
             "resampling": str(self.resampling),
             "target": label,

@@ -260,13 +260,17 @@ def _check_kind(settings: dict, kind: str, where: str) -> None:
                 raise NeurohoverError(f"{where}: variant {v['key']!r} sets sigma but the task is {task!r}")
             if settings["target"] != "family" and v["resampling"].startswith("race"):
                 raise NeurohoverError(f"{where}: variant {v['key']!r}: selection races need target = 'family'")
-        from ..evolution.config import make_settings
+        from ..evolution.config import make_settings, optimiser_of
+        from ..evolution.optimisers import OPTIMISERS
 
         method = "generational" if settings["target"] == "family" else "steady-state"
         for v in [None, *settings["variants"]]:
-            table = settings["optimiser"] if v is None else {**settings["optimiser"], **v.get("optimiser", {})}
+            table = settings["optimiser"] if v is None else variant_optimiser(settings["optimiser"], v)
             try:  # the optimiser settings are checked here, not when a unit first runs
-                make_settings(method, "ne", table)
+                name, rest = optimiser_of(table)
+                if name != "ne" and settings["budget"] == 0 and not OPTIMISERS[name].stops_itself:
+                    raise NeurohoverError(f"optimizer {name!r} has no stopping rule of its own: give the experiment a budget")
+                make_settings(method, name, rest)
             except NeurohoverError as err:
                 whose = "" if v is None else f" of variant {v['key']!r}"
                 raise NeurohoverError(f"{where}: optimiser{whose}: {err}") from None
@@ -389,8 +393,9 @@ def experiment_names() -> list[str]:
     return list(shipped_configs())
 
 
-def resolve_name(name: str) -> Path:
+def resolve_name(name: str | Path) -> Path:
     """The config file of a shipped experiment name (or alias), or of a path to a .toml file."""
+    name = str(name)  # a pathlib.Path of a .toml file too
     path = Path(name)
     if name.endswith(".toml"):
         if not path.is_file():
@@ -495,3 +500,12 @@ def load_configs(name: str, scale: str, overrides: dict[str, Any] | None = None)
     if name == "all":
         return [load_config(n, scale, overrides) for n in shipped_configs()]
     return [load_config(name, scale, overrides)]
+
+
+def variant_optimiser(experiment: dict, variant: dict) -> dict:
+    """The ``optimiser`` table a variant runs: its own keys over the experiment's, or its own alone
+    when it names another optimiser (``name``), whose settings are not the experiment's."""
+    own = variant.get("optimiser", {})
+    if own.get("name", "ne") != experiment.get("name", "ne"):
+        return dict(own)
+    return {**experiment, **own}

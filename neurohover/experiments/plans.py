@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import NeurohoverError
-from .config import ExperimentConfig
+from .config import ExperimentConfig, variant_optimiser
 from .units import Unit, policy_dict, unit_seed
 
 _SAMPLE_TAG = 0x5A3
@@ -108,7 +108,7 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
     for v in s["variants"]:
         common = {**base, "topology": v["topology"], "prototype": v["prototype"], "resampling": v["resampling"]}
         if "optimiser" in v:
-            common["optimiser"] = {**s["optimiser"], **v["optimiser"]}
+            common["optimiser"] = variant_optimiser(s["optimiser"], v)
         if s["target"] == "train":
             for i, mdp in enumerate(train):
                 for r in range(s["runs"]):

@@ -113,19 +113,22 @@ def _evolve_target(p: dict):
 
 def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:
     """One evolution run (paper Section 3.1 / 5): champion, history, optional validation."""
+    from ..evolution.config import optimiser_of
     from ..evolution.evolve import evolve, validation_return
     from ..policies import prototype as make_prototype
 
     target = _evolve_target(p)
     proto = _policy(p["prototype"]) if isinstance(p["prototype"], dict) else make_prototype(p["topology"], p["prototype"])
+    optimizer, settings = optimiser_of(p["optimiser"])
     t0 = time.perf_counter()
     result = evolve(
         target,
         topology=p["topology"],
         prototype=proto,
+        optimizer=optimizer,
         resampling=p["resampling"],
         budget=p["budget"] or None,
-        settings=p["optimiser"] or None,
+        settings=settings or None,
         seed=p["seed"],
         n_steps=p["n_steps"],
         threads=threads,

@@ -1,0 +1,109 @@
+"""Population optimisers by name: the registry that ``evolve``, ``build-policies``, experiment configs and the CLI read.
+
+The paper's neuroevolution (``"ne"``: steady state on one MDP, generational with resampling or
+selection races over a family) is the evolution run's own. Any other optimiser that asks a
+generation of genomes and is told their returns is a **population optimiser**: every module of
+this package that declares ``OPTIMISER_SPECS`` (a sequence of :class:`OptimiserSpec`) is found
+here, so adding one is one new module plus its tests (``openai_es.py`` shows how). The run flies
+each generation with fixed resampling, keeps on one MDP the best single return ever told as
+champion, and over a task family the best estimate of the last generation.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+import pkgutil
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ...errors import NeurohoverError
+
+__all__ = ["NE", "OPTIMISERS", "OptimiserSpec", "optimiser_names", "population_settings"]
+
+NE = "ne"  # the paper's neuroevolution: not a population optimiser of this registry
+
+
+@dataclass(frozen=True)
+class OptimiserSpec:
+    """One population optimiser.
+
+    Attributes
+    ----------
+    name : str
+        What ``evolve(optimizer=...)``, ``--optimizer`` and a config's ``optimiser.name`` say.
+    summary : str
+        One line for help texts.
+    settings : type
+        A frozen dataclass of its settings, with defaults; its ``__post_init__`` raises
+        ValueError on a bad value.
+    make : callable
+        ``make(prototype genome, settings, seed)`` -> an optimiser with ``ask``, ``tell(returns)``,
+        ``stop``, ``champion_genome``, ``champion_return``, ``state_dict`` and a
+        ``from_state_dict`` classmethod (:class:`~neurohover.evolution.common.Optimiser`).
+    min_genes : int
+        The shortest genome it can search.
+    stop_reason : str
+        What a run records when the optimiser's own ``stop()`` ends it.
+    label : str
+        The ``method`` written in a champion's metadata (default: the name).
+    stops_itself : bool
+        Whether ``stop()`` can ever fire; an optimiser without a criterion of its own needs a budget.
+    """
+
+    name: str
+    summary: str
+    settings: type
+    make: Callable[[np.ndarray, Any, int], Any]
+    min_genes: int = 1
+    stop_reason: str = "optimiser-stop"
+    label: str = ""
+    stops_itself: bool = True
+
+    def __post_init__(self) -> None:
+        if not self.label:
+            object.__setattr__(self, "label", self.name)
+
+
+def _discover() -> dict[str, OptimiserSpec]:
+    specs: dict[str, OptimiserSpec] = {}
+    for module in sorted(m.name for m in pkgutil.iter_modules(__path__)):
+        for spec in getattr(importlib.import_module(f"{__name__}.{module}"), "OPTIMISER_SPECS", ()):
+            if spec.name in specs or spec.name == NE:
+                raise RuntimeError(f"optimiser {spec.name!r} is declared twice (module {module!r} and another)")
+            specs[spec.name] = spec
+    return specs
+
+
+#: Every population optimiser by name (modules in name order: cma, openai_es, ...).
+OPTIMISERS: dict[str, OptimiserSpec] = _discover()
+
+
+def optimiser_names() -> tuple[str, ...]:
+    """Every optimiser an evolution run takes: the paper's ``ne`` first, then the registry's."""
+    return (NE, *OPTIMISERS)
+
+
+def population_settings(name: str, settings: Any) -> Any:
+    """The checked settings object of population optimiser ``name`` from None (the defaults), an
+    object of its settings class, or a dict of overrides (NeurohoverError on a bad key or value)."""
+    if name not in OPTIMISERS:
+        raise NeurohoverError(f"unknown optimizer {name!r}: allowed {', '.join(optimiser_names())}")
+    cls = OPTIMISERS[name].settings
+    if settings is None:
+        return cls()
+    if isinstance(settings, cls):
+        return settings
+    fields = [f.name for f in dataclasses.fields(cls)]
+    if not isinstance(settings, Mapping):
+        raise NeurohoverError(f"settings for optimizer {name!r} must be a {cls.__name__} or a dict with keys {', '.join(fields)}")
+    unknown = sorted(set(settings) - set(fields))
+    if unknown:
+        raise NeurohoverError(f"unknown {name} setting(s) {', '.join(unknown)}: allowed {', '.join(fields)}")
+    try:
+        return cls(**settings)
+    except (TypeError, ValueError) as err:
+        raise NeurohoverError(f"bad {name} settings: {err}") from None
