@@ -303,7 +303,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
 
 
 # Fewer transitions than this (one minute of flight) give unreliable estimates.
-MIN_TRANSITIONS = 600
+RELIABLE_TRANSITIONS = 600
 # Episodes the baseline policy flies on the learned model (and the true MDP) to check it is usable.
 CHECK_EPISODES = 3
 
@@ -331,9 +331,10 @@ def model_notes(model, data, truth, rows) -> list[str]:
             "positive, which no 10-substep integration can produce; the model itself is still a valid "
             "one-substep model (the model file holds its values)"
         )
-    if data.n_transitions < MIN_TRANSITIONS:
+    if data.n_transitions < RELIABLE_TRANSITIONS:
         notes.append(
-            f"warning: only {data.n_transitions} transitions (fewer than {MIN_TRANSITIONS}, one minute of flight); estimates from so little data are unreliable"
+            f"warning: only {data.n_transitions} transitions (fewer than {RELIABLE_TRANSITIONS}, one minute of flight); "
+            "estimates from so little data are unreliable"
         )
     if truth is not None and truth.wind_kind != WIND_NONE and any(w != 0 for w in truth.wind):
         absorbed = f" (fitted D_u = {model.d_u:.4g})" if model.d_u else ""

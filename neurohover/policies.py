@@ -19,11 +19,11 @@ from pathlib import Path
 import numpy as np
 
 from .errors import NeurohoverError
+from .sim.constants import MLP_STEEPNESS
 
 TOPOLOGIES = ("slp", "mlp")
 GENOME_LENGTH = {"slp": 40, "mlp": 42}
 INPUT_NAMES = ("u", "v", "w", "x", "y", "z", "qx", "qy", "qz")
-MLP_STEEPNESS = 4.924273
 MLP_BIAS_NAMES = ("hy", "hx", "hz", "L1", "L2", "L3", "L4", "S1", "S2", "S3", "S4", "a1", "a2", "a3", "a4")
 MLP_WEIGHT_NAMES = (
     "y->hy",

@@ -173,12 +173,12 @@ def test_compete_refuses_bad_hybrid_options(tmp_path: Path, capsys, argv: list[s
 
 
 def test_ablation_groups_reach_their_agents() -> None:
-    from neurohover.experiments.units import make_agent
+    from neurohover.experiments.units import unit_agent
 
     units = {u.key: u for u in plan(load_config("ablation-hybrid", "paper"), {}).units}
-    gls = make_agent(units["run/incremental-gls/train3/rep0"].params)
-    ols = make_agent(units["run/incremental/train3/rep0"].params)
+    gls = unit_agent(units["run/incremental-gls/train3/rep0"].params)
+    ols = unit_agent(units["run/incremental/train3/rep0"].params)
     assert gls.settings.estimator == "gls" and ols.settings.estimator == "ols"
-    text = make_agent(units["run/hybrid-paper-text/train0/rep0"].params)
+    text = unit_agent(units["run/hybrid-paper-text/train0/rep0"].params)
     assert text.hybrid == HybridSettings("evolve", "both", DangerousState("paper"))
-    assert make_agent(units["run/hybrid/train0/rep0"].params).hybrid == HybridSettings()
+    assert unit_agent(units["run/hybrid/train0/rep0"].params).hybrid == HybridSettings()

@@ -74,10 +74,6 @@ def test_a_new_family_module_is_discovered_and_gets_samples_rows_and_sets(tmp_pa
                 out[:, 4] *= rng.uniform(0.5, 1.0, n)
                 return out
 
-            @property
-            def has_competition_sets(self):
-                return False
-
 
         import numpy as np
         TASK_FAMILY = Heavy

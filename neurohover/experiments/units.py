@@ -249,7 +249,7 @@ def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
     ).to_dict()
 
 
-def make_agent(p: dict, device: str = "cpu"):
+def unit_agent(p: dict, device: str = "cpu"):
     """The agent of a test-run unit, built from the policies in its params and the run's settings
     (policies evolved on learned models fly episodes of the run's length, on ``device``)."""
     from ..agents.hybrid import HybridSettings
@@ -280,7 +280,7 @@ def run_test_run(p: dict, threads: int | None, device: str = "cpu") -> dict:
 
     family = _family(p["task"], p.get("sigma"))
     mdp = _mdp(p["mdp"])
-    agent = make_agent(p, device)
+    agent = unit_agent(p, device)
     r = run_test(agent, family, mdp, episodes=p["episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads, device=device)
     start = after_learning_start(r.policy)
     changes = tuple((e, r.policy[e]) for e in range(len(r.policy)) if e == 0 or r.policy[e] != r.policy[e - 1])

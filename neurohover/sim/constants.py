@@ -88,3 +88,7 @@ SAFEGUARD_LIMITS = np.array([SAFEGUARD_BOX] * 9 + [SAFEGUARD_TILT, SAFEGUARD_KIN
 def crash_penalty(steps_taken: int, episode_steps: int = EPISODE_STEPS) -> float:
     """Reward of the crashing control step when ``steps_taken`` steps (including it) were flown."""
     return -CRASH_STEP_PENALTY * (episode_steps - steps_taken)
+
+
+#: The MLP's steepened logistic sigma(s) = 1 / (1 + exp(-MLP_STEEPNESS s)) (docs/model.md, Policies).
+MLP_STEEPNESS = 4.924273

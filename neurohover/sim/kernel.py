@@ -1,7 +1,9 @@
-"""The compiled simulation kernel: one implementation of the hover dynamics for everything.
+"""The compiled simulation kernel: the hover dynamics that everything flies.
 
 Evolution, resampling, selection races, learned models, on-line agents and the Gymnasium
-environments all fly helicopters through the functions here. An MDP is a float64 row (layout in
+environments all fly helicopters through the functions here: the scalar episode loop, and the
+step functions that the SIMD lanes (:mod:`.lanes`) and the CUDA kernel (:mod:`.cuda`) build on,
+tested bit-identical to it. An MDP is a float64 row (layout in
 :mod:`neurohover.sim.constants`) holding dynamics parameters, noise standard deviations, substep
 count and length, and the wind model, so a learned model (one 0.1 s substep, no wind) runs in
 the same code as the true simulator.
@@ -28,6 +30,7 @@ from .constants import (
     MAX_RATE,
     MAX_VELOCITY,
     MIN_QW,
+    MLP_STEEPNESS,
     NOISE_DECAY,
     NOISE_GAIN,
     WIND_CONSTANT,
@@ -38,7 +41,6 @@ from .rng import next_normal, seed_stream
 POLICY_SLP = 0
 POLICY_MLP = 1
 GENOME_WIDTH = 42  # genome rows are padded to the MLP's length
-MLP_STEEPNESS = 4.924273
 SERIES_MAX_ANGLE = 0.5  # Taylor series below this rotation angle, libm above
 
 

@@ -3,7 +3,9 @@
 It follows the equations literally (quaternion sandwich products, ``math.sin``/``math.cos``) and
 takes its gust-noise normals as input, so tests can feed it the same normals as the compiled
 kernel (:func:`neurohover.sim.rng.episode_normals`) and compare the two step by step. It is also
-the baseline that ``neurohover bench`` measures the kernel against. Nothing else uses it.
+the baseline that ``neurohover bench`` measures the kernel against. No episode is flown with it
+outside tests and the benchmark; the task families take its :class:`ReferenceMDP` (an MDP's
+readable form) and the environments its wind formula for their ``info`` (:func:`competition_time`).
 """
 
 from __future__ import annotations

@@ -132,9 +132,16 @@ def finite_vector(values: Sequence[float] | np.ndarray, length: int, what: str) 
 
 def competition_rows(family: str) -> dict:
     """The competition's training and test rows of ``family`` as listed in the shipped data file."""
+    if family not in competition_families():
+        raise NeurohoverError(f"the competition data file lists no MDPs of {family!r}: it has {', '.join(competition_families())}")
+    return _COMPETITION[family]
+
+
+def competition_families() -> tuple[str, ...]:
+    """The families the competition's data file lists MDPs of."""
     if not _COMPETITION:
         _COMPETITION.update(json.loads(COMPETITION_MDPS_FILE.read_text()))
-    return _COMPETITION[family]
+    return tuple(k for k, v in _COMPETITION.items() if isinstance(v, dict) and "train" in v)  # not its "about" note
 
 
 class TaskFamily:
@@ -196,8 +203,9 @@ class TaskFamily:
 
     @property
     def has_competition_sets(self) -> bool:
-        """True when ``train:N`` / ``test:N`` are the competition's MDPs (else the seeded draws)."""
-        return True
+        """True when ``train:N`` / ``test:N`` are the competition's MDPs: the data file lists the
+        family (else they are the seeded draws, as for a new family)."""
+        return self.name in competition_families()
 
     def sample(self, rng: np.random.Generator | int | None = None, label: str = "") -> MDP:
         """A fresh MDP drawn from G."""
