@@ -42,6 +42,28 @@ def test_readme_has_python_examples() -> None:
     assert len(_readme_python_blocks()) >= 3
 
 
+def test_the_readmes_new_agent_is_found_and_flies_as_it_says(tmp_path: Path, monkeypatch) -> None:
+    """The contributor section's agent module, dropped into a package, is discovered and keeps the better candidate."""
+    from neurohover.agents.protocol import run_test
+    from neurohover.agents.registry import discover, policies_from_set
+    from neurohover.agents.spec import AgentOptions
+    from neurohover.policysets import load_policy_set
+
+    (code,) = [c for _, c in _readme_python_blocks() if c.startswith("# neurohover/agents/best_of_two.py")]
+    (tmp_path / "myagents").mkdir()
+    (tmp_path / "myagents" / "__init__.py").write_text("")
+    (tmp_path / "myagents" / "best_of_two.py").write_text(code)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    spec = discover("myagents")["best-of-two"]
+    ghh08 = neurohover.get_task_family("ghh08")
+    agent = spec.build(policies_from_set(spec, load_policy_set("ghh08")), AgentOptions())
+    run = run_test(agent, ghh08, ghh08.mdp("train:0"), episodes=4, seed=1, n_steps=300)
+    better = int(run.returns[1] > run.returns[0])
+    assert run.policy[:2] == ["candidate:0", "candidate:1"] and run.policy[2:] == [f"candidate:{better}"] * 2
+    sys.modules.pop("myagents", None)
+    sys.modules.pop("myagents.best_of_two", None)
+
+
 @pytest.mark.parametrize("index", range(len(_readme_python_blocks())), ids=[f"{i}-{h}" for i, (h, _) in enumerate(_readme_python_blocks())])
 def test_readme_python_block_runs_as_written(index: int, tmp_path: Path) -> None:
     heading, code = _readme_python_blocks()[index]
