@@ -166,3 +166,19 @@ def test_export_and_report_read_typed_results(committed_store: Path, tmp_path: P
         conn.execute("UPDATE units SET result = ? WHERE name = 'fig15' AND scale = 'quick' AND key = 'evolve/k5/run0'", (json.dumps({"champion_return": 1.0}),))
     with Store(broken, create=False) as store, pytest.raises(NeurohoverError, match="evolve/k5/run0.*missing key"):
         write_report(store, tmp_path / "report", scale="quick", names=["fig15"])
+
+
+def test_unit_keys_are_made_and_parsed_by_one_scheme() -> None:
+    from neurohover.experiments.config import load_config, shipped_configs
+    from neurohover.experiments.plans import plan
+    from neurohover.experiments.results import UnitKey
+
+    for name in shipped_configs():
+        for unit in plan(load_config(name, "paper"), {}).units:
+            k = UnitKey.parse(unit.key)
+            assert k.stage and UnitKey.make(k.stage, k.group, k.mdp, k.rep) == unit.key
+    assert UnitKey.make("run", "hybrid", "train3", 2) == "run/hybrid/train3/rep2"
+    with pytest.raises(ValueError, match="do not fit the key scheme"):
+        UnitKey.make("robust", "k5", "test3")  # robustness units fly training MDPs only
+    with pytest.raises(ValueError, match="unknown unit stage 'evolved'"):
+        UnitKey.make("evolved", "k5")

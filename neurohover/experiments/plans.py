@@ -26,6 +26,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from .config import ExperimentConfig, variant_optimiser
+from .results import UnitKey
 from .units import Unit, policy_dict, unit_seed
 
 _SAMPLE_TAG = 0x5A3
@@ -112,7 +113,8 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
         if s["target"] == "train":
             for i, mdp in enumerate(train):
                 for r in range(s["runs"]):
-                    units.append(_unit(cfg, f"evolve/{v['key']}/train{i}/run{r}", "evolve", {**common, "target": {"kind": "mdp", "mdp": mdp.to_dict()}}))
+                    key = UnitKey.make("evolve", v["key"], f"train{i}", r)
+                    units.append(_unit(cfg, key, "evolve", {**common, "target": {"kind": "mdp", "mdp": mdp.to_dict()}}))
         else:
             sigma = v["sigma"] if v["sigma"] is not None else s["sigma"]
             if s["target"] == "zero":
@@ -120,18 +122,18 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
             else:
                 target = {"kind": "family", "task": s["task"], "sigma": sigma}
             for r in range(s["runs"]):
-                units.append(_unit(cfg, f"evolve/{v['key']}/run{r}", "evolve", {**common, "target": target}))
+                units.append(_unit(cfg, UnitKey.make("evolve", v["key"], rep=r), "evolve", {**common, "target": target}))
     total = len(units) + len(s["robustness_variants"]) * len(train)
     for vkey in s["robustness_variants"]:
         for i in range(len(train)):
-            keys = [f"evolve/{vkey}/train{i}/run{r}" for r in range(s["runs"])]
+            keys = [UnitKey.make("evolve", vkey, f"train{i}", r) for r in range(s["runs"])]
             if not all(k in results for k in keys):
                 continue
             best = max(keys, key=lambda k: float(results[k]["champion_return"]))
             units.append(
                 _unit(
                     cfg,
-                    f"robust/{vkey}/train{i}",
+                    UnitKey.make("robust", vkey, f"train{i}"),
                     "robustness",
                     {
                         "policy": results[best]["champion"],
@@ -195,7 +197,7 @@ def _source_champions(source: str, scale: str, results: dict) -> tuple[list[tupl
     if not variants:
         keys = ", ".join(v["key"] for v in src.settings["variants"])
         raise NeurohoverError(f"generics_from {source!r}: {name} has no variant {want!r} (its variants: {keys}; or best-race)")
-    runs = {v["key"]: [f"evolve/{v['key']}/run{r}" for r in range(src.settings["runs"])] for v in variants}
+    runs = {v["key"]: [UnitKey.make("evolve", v["key"], rep=r) for r in range(src.settings["runs"])] for v in variants}
     missing = sum(k not in results for keys in runs.values() for k in keys)
     if missing:
         return None, f"{missing} of {sum(map(len, runs.values()))} evolution runs of {name} ({', '.join(runs)}) are not in the store yet"
@@ -233,18 +235,18 @@ class _Policies:
         budget = s["policy_budget"]
         if not self.family.generic_over_distribution:
             if needs & {"generic"}:
-                self._add("policy/generic", {"kind": "mdp", "mdp": self.family.zero().to_dict()}, budget)
+                self._add(UnitKey.make("policy", "generic"), {"kind": "mdp", "mdp": self.family.zero().to_dict()}, budget)
             if needs & {"specialised", "safe"}:
                 for i, mdp in enumerate(self.family.training_mdps()):
-                    self._add(f"policy/specialised{i}", {"kind": "mdp", "mdp": mdp.to_dict()}, budget)
+                    self._add(UnitKey.make("policy", f"specialised{i}"), {"kind": "mdp", "mdp": mdp.to_dict()}, budget)
             if "safe" in needs:
                 self.total += 1
-                spec = [self.results.get(f"policy/specialised{i}") for i in range(10)]
+                spec = [self.results.get(UnitKey.make("policy", f"specialised{i}")) for i in range(10)]
                 if all(spec):
                     self.units.append(
                         _unit(
                             cfg,
-                            "policy/safety",
+                            UnitKey.make("policy", "safety"),
                             "safety",
                             {
                                 "policies": [r["champion"] for r in spec],
@@ -267,10 +269,10 @@ class _Policies:
                     continue
                 for j in range(s["generics_per_agent"]):
                     if kind == "zero":
-                        self._add(f"policy/generic-zero{j}", {"kind": "mdp", "mdp": self.family.zero().to_dict()}, budget)
+                        self._add(UnitKey.make("policy", f"generic-zero{j}"), {"kind": "mdp", "mdp": self.family.zero().to_dict()}, budget)
                     else:
                         self._add(
-                            f"policy/generic-{kind}{j}",
+                            UnitKey.make("policy", f"generic-{kind}{j}"),
                             {"kind": "family", "task": self.task, "sigma": s["sigma"]},
                             s["generic_budget"],
                             s["generic_resampling"].get(kind, "fixed:5" if kind == "fixed" else "race:0.2"),
@@ -305,20 +307,24 @@ class _Policies:
                     out["generic"] = policy_dict(ext.generics[kind])
                 else:
                     j = run_counter % self.cfg.settings["generics_per_agent"]
-                    out["generic"] = self._evolved(f"policy/generic-{kind}{j}")
-                    out["generic_source"] = f"policy/generic-{kind}{j}"
+                    out["generic"] = self._evolved(UnitKey.make("policy", f"generic-{kind}{j}"))
+                    out["generic_source"] = UnitKey.make("policy", f"generic-{kind}{j}")
             return None if any(v is None for v in out.values()) else out
         if "generic" in need:
-            out["generic"] = policy_dict(ext.generic) if ext is not None else self._evolved("policy/generic")
+            out["generic"] = policy_dict(ext.generic) if ext is not None else self._evolved(UnitKey.make("policy", "generic"))
         if need & {"specialised", "safe"}:
-            specialised = [policy_dict(p) for p in ext.specialised] if ext is not None else [self._evolved(f"policy/specialised{i}") for i in range(10)]
+            specialised: list[dict | None]
+            if ext is not None:
+                specialised = [policy_dict(p) for p in ext.specialised]
+            else:
+                specialised = [self._evolved(UnitKey.make("policy", f"specialised{i}")) for i in range(10)]
             if any(p is None for p in specialised):
                 return None
             if "safe" in need:
                 if ext is not None:
                     safe = list(ext.safe)
                 else:
-                    sr = self.results.get("policy/safety")
+                    sr = self.results.get(UnitKey.make("policy", "safety"))
                     if sr is None:
                         return None
                     safe = sr["safe"]
@@ -351,7 +357,7 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dic
         for i, mdp in enumerate(mdps):
             for rep in range(g["runs_per_mdp"]):
                 total += 1
-                key = f"run/{g['label']}/{g['mdps']}{i}/rep{rep}"
+                key = UnitKey.make("run", g["label"], f"{g['mdps']}{i}", rep)
                 policies = pol.for_agent(g["agent"], i if g["mdps"] == "train" else None, counter, g["exclude_own"] and g["mdps"] == "train", key)
                 counter += 1
                 if policies is None:
@@ -386,8 +392,8 @@ def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
     total = len(s["methods"]) * s["n_mdps"]
     if s["generic"] == "evolve":
         total += 1
-        units.append(_policy_evolution_unit(cfg, "policy/generic", {"kind": "mdp", "mdp": family.zero().to_dict()}, s["generic_budget"]))
-        generic = results.get("policy/generic", {}).get("champion")
+        units.append(_policy_evolution_unit(cfg, UnitKey.make("policy", "generic"), {"kind": "mdp", "mdp": family.zero().to_dict()}, s["generic_budget"]))
+        generic = results.get(UnitKey.make("policy", "generic"), {}).get("champion")
     elif s["generic"] == "baseline":
         from ..policies import baseline_policy
 
@@ -403,7 +409,7 @@ def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
             units.append(
                 _unit(
                     cfg,
-                    f"model/{method}/{s['mdps']}{i}",
+                    UnitKey.make("model", method, f"{s['mdps']}{i}"),
                     "model",
                     {
                         "method": method,

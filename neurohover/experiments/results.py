@@ -514,6 +514,26 @@ class UnitKey:
         return int(digits) if digits.isdigit() else None
 
     @classmethod
+    def make(cls, stage: str, group: str, mdp: str | None = None, rep: int | None = None) -> str:
+        """The key of a unit with these parts (the planner's only way to name units): the inverse of :meth:`parse`.
+
+        Raises ValueError for parts outside the scheme (a part that would not parse back).
+        """
+        forms = {
+            "evolve": f"evolve/{group}/{mdp}/run{rep}" if mdp is not None else f"evolve/{group}/run{rep}",
+            "robust": f"robust/{group}/{mdp}",
+            "policy": f"policy/{group}",
+            "model": f"model/{group}/{mdp}",
+            "run": f"run/{group}/{mdp}/rep{rep}",
+        }
+        if stage not in forms:
+            raise ValueError(f"unknown unit stage {stage!r}: allowed {', '.join(forms)}")
+        key = forms[stage]
+        if cls.parse(key) != cls(key, stage, group, mdp, rep if stage in ("evolve", "run") else None):
+            raise ValueError(f"unit key parts {(stage, group, mdp, rep)!r} do not fit the key scheme")
+        return key
+
+    @classmethod
     def parse(cls, key: str) -> UnitKey:
         """Split a unit key into its parts.
 
