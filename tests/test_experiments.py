@@ -534,10 +534,10 @@ def test_only_runs_the_selected_units_and_a_later_call_finishes_the_rest(tmp_pat
 
 
 def test_a_significant_difference_in_the_opposite_direction_does_not_agree_with_the_paper() -> None:
-    from neurohover.experiments.report import _Section
+    from neurohover.experiments.report_base import Section
 
     cfg = load_config("fig8", "quick")
-    sec = _Section(cfg, {}, None, Path("."))
+    sec = Section(cfg, {}, None, Path("."))
     rng = np.random.default_rng(0)
     better, worse = list(rng.normal(-100, 5, 20)), list(rng.normal(-200, 5, 20))
     # The paper found hybrid better than model-free (p = 1.4e-14) and incremental better (p = 5.8e-12).

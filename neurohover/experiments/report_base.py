@@ -1,0 +1,155 @@
+"""What every section of ``neurohover report`` shares: number formatting, tables, t tests, figures, and the :class:`Section` base."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .config import ExperimentConfig
+from .results import UnitKey, UnitResult
+from .store import Store
+
+# --------------------------------------------------------------------------------- formatting
+
+
+def fmt(x, digits: int = 4) -> str:
+    if x is None:
+        return "n/a"
+    if isinstance(x, str):
+        return x
+    x = float(x)
+    if not math.isfinite(x):
+        return "n/a" if math.isnan(x) else ("inf" if x > 0 else "-inf")
+    if x != 0 and (abs(x) >= 1e5 or abs(x) < 1e-3):
+        return f"{x:.{digits - 1}e}"
+    return f"{x:.{digits}g}" if abs(x) < 10**digits else f"{x:.0f}"
+
+
+def fmt_p(p) -> str:
+    if p is None or (isinstance(p, float) and math.isnan(p)):
+        return "n/a"
+    return f"{p:.3g}"
+
+
+def table(headers: list[str], rows: list[list]) -> str:
+    lines = ["| " + " | ".join(headers) + " |", "|" + "|".join("---" for _ in headers) + "|"]
+    lines += ["| " + " | ".join(fmt(c) if not isinstance(c, str) else c for c in row) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def ttest(a, b) -> tuple[float | None, float | None, float | None]:
+    """(t, Student's p, Welch's p) of two samples, or Nones when a test is undefined."""
+    from scipy import stats
+
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    if a.size < 2 or b.size < 2 or not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
+        return None, None, None
+    if np.var(a) == 0 and np.var(b) == 0:
+        return None, None, None
+    student = stats.ttest_ind(a, b, equal_var=True)
+    welch = stats.ttest_ind(a, b, equal_var=False)
+    return float(student.statistic), float(student.pvalue), float(welch.pvalue)
+
+
+def sd(x) -> float:
+    x = np.asarray(x, dtype=float)
+    return float(x.std(ddof=1)) if x.size > 1 else float("nan")
+
+
+def new_figure(ncols: int = 1, *, figsize: tuple[float, float]):
+    """A new figure with a 1 x ``ncols`` grid of axes (an array, always 2-d), drawn by Agg.
+
+    Object-oriented matplotlib: no pyplot, so the caller's backend and pyplot's figures are untouched."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=figsize)
+    FigureCanvasAgg(fig)
+    return fig, fig.subplots(1, ncols, squeeze=False)
+
+
+def p_significant(p_paper: str) -> bool | None:
+    text = p_paper.strip().lower()
+    if text.startswith("not"):
+        return False
+    try:
+        value = float(text.lstrip("<= ").strip())
+    except ValueError:
+        return None
+    return value < 0.05
+
+
+# --------------------------------------------------------------------------------- sections
+
+
+class Section:
+    def __init__(self, config: ExperimentConfig, results: dict[str, UnitResult], store: Store, out: Path) -> None:
+        self.cfg, self.results, self.store, self.out = config, results, store, out
+        self.keys = {k: UnitKey.parse(k) for k in results}
+        self.s = config.settings
+        self.paper = config.paper
+        self.comparisons: list[str] = []
+        self.tests: list[list] = []
+
+    def group(self, stage: str, group: str) -> list:
+        """The results of the units of ``stage`` and ``group`` (:class:`UnitKey`), in key order."""
+        return [self.results[k] for k in sorted(self.results) if (self.keys[k].stage, self.keys[k].group) == (stage, group)]
+
+    @property
+    def stem(self) -> str:
+        return f"{self.cfg.name}-{self.cfg.scale}"
+
+    def save(self, fig) -> str:
+        """Write the section's figure next to the report; returns its file name."""
+        fig.tight_layout()
+        path = self.out / f"{self.stem}.png"
+        fig.savefig(path, dpi=110)
+        return path.name
+
+    def save_panels(self, fig, axes, xlabel: str, ylabels: tuple[str, str]) -> str:
+        """Label two panels (the second on a log scale), title the figure and save it."""
+        axes[0].set_ylabel(ylabels[0])
+        axes[1].set_ylabel(ylabels[1])
+        axes[1].set_yscale("log")
+        for ax in axes:
+            ax.set_xlabel(xlabel)
+            ax.grid(alpha=0.3, which="both")
+            ax.legend(fontsize=8)
+        fig.suptitle(f"{self.cfg.title} ({self.cfg.scale} scale)", fontsize=10)
+        return self.save(fig)
+
+    def add_tests(self, samples: dict[str, list[float]], labels: dict[str, str], what: str) -> None:
+        for t in self.paper.get("ttests", []):
+            a, b = t["a"], t["b"]
+            if a not in samples or b not in samples:
+                continue
+            stat, p_student, p_welch = ttest(samples[a], samples[b])
+            ma, mb = np.mean(samples[a]), np.mean(samples[b])
+            self.tests.append([f"{labels.get(a, a)} vs {labels.get(b, b)}", fmt(ma), fmt(mb), fmt(stat), fmt_p(p_student), fmt_p(p_welch), str(t["p"])])
+            expected = p_significant(str(t["p"]))
+            if p_student is not None and expected is not None:
+                # Each paper test names the approach the paper found better as ``a``.
+                ours = p_student < 0.05
+                if ours and expected and ma < mb:
+                    agree = f"disagrees: the opposite direction (the paper found {labels.get(a, a)} better)"
+                else:
+                    agree = "agrees" if ours == expected else "disagrees"
+                self.comparisons.append(
+                    f"{labels.get(a, a)} vs {labels.get(b, b)} ({what}): our Student's p = {fmt_p(p_student)} "
+                    f"({'significant' if ours else 'not significant'} at 5%; mean {fmt(ma)} vs {fmt(mb)}) vs paper p {t['p']}: {agree}."
+                )
+
+    def figure(self) -> str | None:
+        """Write the section's figure (each kind of section defines it); returns its file name, or None."""
+        raise NotImplementedError
+
+    def body(self) -> str:
+        """The section's Markdown (each kind of section defines it)."""
+        raise NotImplementedError
+
+    def tests_markdown(self) -> str:
+        if not self.tests:
+            return ""
+        return "### Statistical tests\n\n" + table(["comparison", "mean A", "mean B", "t", "Student's p", "Welch's p", "paper p"], self.tests) + "\n"
