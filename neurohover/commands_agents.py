@@ -28,6 +28,7 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
         seed=args.seed,
         n_steps=args.episode_steps,
         lineage=args.lineage,
+        optimizer=args.optimizer,
         progress=lambda msg: print(msg, file=sys.stderr, flush=True),
     )
     print(f"policy set written to {ps.directory}")
@@ -100,6 +101,7 @@ _HYBRID_OPTIONS = ("safeguard_rule", "safeguard_box", "safeguard_tilt", "hybrid_
 
 def register(sub) -> None:
     from .agents.registry import AGENTS
+    from .evolution.optimisers import optimiser_names
 
     p = sub.add_parser("build-policies", help="evolve the generic and specialised policies of a task", description=cmd_build_policies.__doc__)
     p.add_argument("--task", required=True, help="ghh08, ghh09 or fghh")
@@ -113,6 +115,13 @@ def register(sub) -> None:
         default="chain",
         help="GHH-08/09: chain (default: every run seeded from an ancestor evolved over the training MDPs in turn, as the authors' policies were) "
         "or independent (every run from the baseline policy)",
+    )
+    p.add_argument(
+        "--optimizer",
+        "--optimiser",
+        choices=optimiser_names(),
+        default="ne",
+        help="ne (default: the paper's neuroevolution) or a population optimiser for the runs on one MDP and FGHH's fixed generic",
     )
     p.set_defaults(func=cmd_build_policies)
 

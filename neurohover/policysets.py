@@ -124,6 +124,7 @@ def build_policy_set(
     safety_episodes: int = 3,
     n_steps: int = 6000,
     lineage: str = "chain",
+    optimizer: str = "ne",
     progress: Callable[[str], None] | None = None,
 ) -> PolicySet:
     """Evolve the policy set of ``task`` with the project's own evolution and write it.
@@ -147,26 +148,37 @@ def build_policy_set(
     lineage : {"chain", "independent"}
         GHH-08/09: seed every run from an ancestor evolved over the training MDPs in turn
         (default; see the module doc), or from the baseline policy.
+    optimizer : str
+        ``ne`` (the paper's neuroevolution) or a population optimiser of
+        :mod:`neurohover.evolution.optimisers` for every run on one MDP and FGHH's fixed-resampling
+        generic; FGHH's race generic is always NE's (a selection race is the generational method's).
     progress : callable, optional
         Called with one line of text per finished run.
     """
     from .evolution import SteadyStateSettings
     from .evolution.evolve import evolve
+    from .evolution.optimisers import NE, optimiser_names
     from .policies import prototype
 
     if lineage not in LINEAGES:
         raise NeurohoverError(f"lineage {lineage!r} is not known: allowed {', '.join(LINEAGES)}")
+    if optimizer not in optimiser_names():
+        raise NeurohoverError(f"unknown optimizer {optimizer!r}: allowed {', '.join(optimiser_names())}")
     family = get_task_family(task)
     root = policy_dir(family.name, out)
     root.mkdir(parents=True, exist_ok=True)
     say = progress or (lambda _msg: None)
     manifest: dict = {"task": family.name, "budget": budget, "seed": seed, "n_steps": n_steps, "built": time.strftime("%Y-%m-%d %H:%M:%S")}
+    if optimizer != NE:
+        manifest["optimizer"] = optimizer
     seeds = np.random.SeedSequence(seed).generate_state(32, dtype=np.uint32)
     start = time.perf_counter()
 
     def run(target, name: str, child_seed: int, seed_policy: Policy | None = None, save: bool = True, **kwargs) -> Policy:
         t0 = time.perf_counter()
-        if "resampling" not in kwargs:  # steady state: spend the whole budget (no plateau stop)
+        race = str(kwargs.get("resampling", "")).startswith("race")
+        kwargs["optimizer"] = NE if race else optimizer
+        if "resampling" not in kwargs and kwargs["optimizer"] == NE:  # steady state: spend the whole budget (no plateau stop)
             kwargs["settings"] = SteadyStateSettings(plateau_threshold=kwargs["budget"])
         start_from = seed_policy if seed_policy is not None else prototype("mlp", "baseline")
         result = evolve(target, topology="mlp", prototype=start_from, seed=child_seed, n_steps=n_steps, **kwargs)

@@ -147,3 +147,13 @@ variants = [
     config.write_text(bad)
     with pytest.raises(nh.NeurohoverError, match="variant 'es'.*popsize=11 must be even"):
         load_config(config, "quick")
+
+
+def test_build_policies_takes_it_for_every_run_but_fghhs_race(tmp_path: Path) -> None:
+    from neurohover.policysets import build_policy_set
+
+    ps = build_policy_set("fghh", tmp_path, budget=40, fghh_budget=40, n_steps=50, optimizer="openai-es")
+    assert ps.manifest["optimizer"] == "openai-es"
+    assert {k: p.metadata["method"] for k, p in ps.generics.items()} == {"zero": "openai-es", "fixed": "openai-es", "race": "generational"}
+    with pytest.raises(nh.NeurohoverError, match="unknown optimizer 'adam'"):
+        build_policy_set("ghh08", tmp_path, budget=10, optimizer="adam")
