@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from neurohover import baseline_policy, evaluate, evaluate_jobs, get_task_family, prototype
-from neurohover.evaluate import KernelFlyer, PolicyTable, _use_lanes, num_threads
+from neurohover.evaluate import KernelFlyer, PolicyTable, num_threads
+from neurohover.launch import use_lanes as _use_lanes
 from neurohover.policies import GENOME_LENGTH
 from neurohover.sim.constants import SAFEGUARD_LIMITS
 from neurohover.sim.kernel import POLICY_SLP, rollout_batch

@@ -21,7 +21,7 @@ from typing import Any, cast
 import numpy as np
 
 from ..errors import NeurohoverError
-from ..evaluate import KernelFlyer
+from ..flyer import KernelFlyer
 from ..policies import Policy
 from ..sim.lanes import LANES
 from .common import Optimiser, enc_float

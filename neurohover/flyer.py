@@ -1,0 +1,189 @@
+"""The evolution's fast path through the kernel: batches of one topology's genomes, buffers reused across calls."""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from .errors import NeurohoverError
+from .launch import KIND, MAX_SEED, check_device, launch
+from .policies import GENOME_LENGTH, TOPOLOGIES
+from .sim.constants import SAFEGUARD_LIMITS
+from .sim.kernel import GENOME_WIDTH
+
+__all__ = ["KernelFlyer"]
+
+
+class KernelFlyer:
+    """Fly batches of one topology's genomes through the kernel with buffers reused across calls.
+
+    The fast path of an evolution run, which flies thousands of small batches: no per-call
+    validation, no :class:`Evaluation` objects, no recording and no safeguard. Each call flies its
+    jobs with the next unused episode indices (or with indices the caller reserved), so no two
+    episodes of one flyer share gust noise; episode ``i`` flies noise stream ``(seed, i)``, so a job's return is
+    the one :func:`evaluate_jobs` gives for the same genome, MDP row and episode index.
+
+    Parameters
+    ----------
+    topology : {"slp", "mlp"}
+        Topology of every genome flown.
+    seed : int
+        Root seed of the episodes' noise streams (0..2**63-1).
+    n_steps : int
+        Control steps per episode.
+    device : {"cpu", "cuda"}
+        Where the jobs fly: the CPU kernel (default), or its CUDA build on a GPU (the same gust
+        streams; returns agree to within docs/gpu.md's tolerance). Checked here, once.
+
+    Attributes
+    ----------
+    episodes : int
+        Episodes counted so far: every call's jobs, except those of calls with explicit episode
+        indices, whose caller counts what it used (:meth:`reserve`). A resumed run sets it, with
+        ``next_index``, ``steps`` and ``kernel_seconds``.
+    next_index : int
+        The next unused episode index (``episodes`` unless indices were reserved).
+    flown : int
+        Episodes flown so far, counted or not (a race's look-ahead flies some it does not use).
+    steps : int
+        Control steps of the counted episodes.
+    kernel_seconds : float
+        Wall time spent inside the kernel.
+    crashed : numpy.ndarray of bool
+        Crash flags of the last call's jobs (a view like the returns :meth:`fly` gives).
+    job_steps : numpy.ndarray of int64
+        Control steps of each of the last call's jobs (a view, likewise).
+    trace : list or None
+        If a list, every call appends ``(genomes, rows, policy_index, mdp_index, episode_index)``
+        (copies, except the rows), e.g. to replay the same jobs in one batch in a benchmark.
+    trace_unused : list
+        While tracing, the episode indices a caller flew but did not use (a race's look-ahead).
+    """
+
+    def __init__(self, topology: str, seed: int, n_steps: int, device: str = "cpu") -> None:
+        check_device(device)
+        if topology not in TOPOLOGIES:
+            raise NeurohoverError(f"unknown policy topology {topology!r}: allowed {', '.join(TOPOLOGIES)}")
+        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= MAX_SEED:
+            raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer in 0..2**63-1")
+        if isinstance(n_steps, bool) or not isinstance(n_steps, (int, np.integer)) or not 1 <= n_steps <= 10**7:
+            raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..10000000")
+        self.kind = KIND[topology]
+        self.dim = GENOME_LENGTH[topology]
+        self.seed = np.uint64(seed)
+        self.n_steps = int(n_steps)
+        self.device = device
+        self.episodes = 0
+        self.next_index = 0
+        self.flown = 0
+        self.steps = 0
+        self.kernel_seconds = 0.0
+        self.trace: list | None = None
+        self.trace_unused: list[int] = []
+        self.crashed = np.zeros(0, dtype=np.bool_)
+        self.job_steps = np.zeros(0, dtype=np.int64)
+        self.max_threads = self._threads = 1
+        self._p_cap = 0
+        self._j_cap = 0
+        self._limits = np.asarray(SAFEGUARD_LIMITS, dtype=float)
+        self._obs = np.zeros((0, 1, 12))
+        self._act = np.zeros((0, 1, 4))
+        self._views: dict[int, tuple] = {}
+        self._ensure(64, 512)
+
+    def start(self) -> None:
+        """Take the kernel thread count in force now as the most threads to use.
+
+        Call it inside :func:`num_threads`, which restores the count afterwards: :meth:`fly`
+        lowers the count to the number of jobs of a smaller call.
+        """
+        self.max_threads = self._threads = numba.get_num_threads()
+
+    def _ensure(self, n_pol: int, n_jobs: int) -> None:
+        if n_pol > self._p_cap:
+            self._p_cap = max(n_pol, 2 * self._p_cap)
+            self._genomes = np.zeros((self._p_cap, GENOME_WIDTH))
+            self._kinds = np.full(self._p_cap, self.kind, dtype=np.int64)
+        if n_jobs > self._j_cap:
+            self._j_cap = j = max(n_jobs, 2 * self._j_cap)
+            self._buffers = (
+                np.zeros(j, dtype=np.int64),
+                np.arange(j, dtype=np.int64),
+                np.zeros(j, dtype=np.int64),
+                np.full(j, -1, dtype=np.int64),
+                np.zeros(j),
+                np.zeros(j, dtype=np.bool_),
+                np.zeros(j, dtype=np.int64),
+                np.zeros(j, dtype=np.int64),
+            )
+            self._views = {}
+
+    def _views_for(self, n_jobs: int) -> tuple:
+        views = self._views.get(n_jobs)
+        if views is None:
+            self._ensure(0, n_jobs)
+            views = self._views[n_jobs] = tuple(b[:n_jobs] for b in self._buffers)
+        return views
+
+    def reserve(self, n: int) -> int:
+        """Reserve the next ``n`` episode indices for calls with explicit ``episode_index``; returns the first."""
+        first = self.next_index
+        self.next_index += n
+        return first
+
+    def fly(self, genomes: np.ndarray, rows: np.ndarray, policy_index, mdp_index, n_jobs: int, episode_index: np.ndarray | None = None) -> np.ndarray:
+        """Fly ``n_jobs`` jobs with the next ``n_jobs`` episode indices (or the given ones).
+
+        Parameters
+        ----------
+        genomes : numpy.ndarray
+            ``(P, D)`` genomes of the flyer's topology.
+        rows : numpy.ndarray
+            ``(M, 29)`` MDP rows (:func:`mdp_rows`).
+        policy_index, mdp_index : numpy.ndarray of int64, None or "range"
+            Per job, the genome and the MDP row it flies; None: 0 for every job; ``"range"``:
+            job j flies number j.
+        n_jobs : int
+        episode_index : numpy.ndarray of int64, optional
+            Per job, its episode index, from indices :meth:`reserve` gave: the jobs are then not
+            counted in :attr:`episodes` and :attr:`steps` (the caller counts what it uses).
+
+        Returns
+        -------
+        numpy.ndarray
+            The jobs' returns: a view of the flyer's buffer, valid until the next call.
+        """
+        n_pol = genomes.shape[0]
+        if n_pol > self._p_cap:
+            self._ensure(n_pol, 0)
+        self._genomes[:n_pol, : self.dim] = genomes
+        zeros, arange, e, minus, returns, crashed, steps, sg = self._views_for(n_jobs)
+        p = zeros if policy_index is None else (arange if isinstance(policy_index, str) else policy_index)
+        m = zeros if mdp_index is None else (arange if isinstance(mdp_index, str) else mdp_index)
+        if episode_index is None:
+            np.add(arange, self.next_index, out=e)
+        else:
+            e[:] = episode_index
+        if self.device == "cpu":
+            # Never more threads than jobs: every thread of a parallel call must check in, and on a busy
+            # machine a one-episode call on all cores runs up to 10x slower than on one.
+            want = n_jobs if n_jobs < self.max_threads else self.max_threads
+            if want != self._threads:
+                numba.set_num_threads(want)
+                self._threads = want
+        # (CUDA: the launcher copies the inputs to the GPU and the results back on every call,
+        # acceptable while a generation's jobs are few; the thread count does not apply.)
+        self.kernel_seconds += launch(
+            rows, self._kinds, self._genomes, p, m, e, self.seed, self.n_steps, returns, crashed, steps, sg,
+            device=self.device, fallback=minus, limits=self._limits, slots=minus, obs_out=self._obs, act_out=self._act,
+        )  # fmt: skip
+        if self.trace is not None:
+            self.trace.append((genomes.copy(), rows, p.copy(), m.copy(), e.copy()))
+        if episode_index is None:
+            self.episodes += n_jobs
+            self.next_index += n_jobs
+            self.steps += int(steps[0]) if n_jobs == 1 else int(steps.sum())
+        self.flown += n_jobs
+        self.crashed = crashed
+        self.job_steps = steps
+        return returns
