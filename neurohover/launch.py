@@ -18,7 +18,7 @@ import numba
 import numpy as np
 
 from .errors import NeurohoverError
-from .sim.constants import MDP_ROW_LEN, SAFEGUARD_LIMITS
+from .sim.constants import MDP_ROW_LEN, ROW_SUBSTEPS, ROW_WIND_KIND, SAFEGUARD_LIMITS
 from .sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
 from .sim.lanes import LANES, rollout_lanes
 
@@ -117,7 +117,7 @@ def use_lanes(device: str, rows: np.ndarray, m_idx: np.ndarray, fb: np.ndarray |
     n_jobs = m_idx.shape[0]
     if device != "cpu" or n_jobs < LANES or (fb is not None and (fb >= 0).any()) or (rec is not None and rec.any()):
         return False
-    sub, windy = rows[:, 17], rows[:, 19] != 0.0
+    sub, windy = rows[:, ROW_SUBSTEPS], rows[:, ROW_WIND_KIND] != 0.0
     if (sub == sub[0]).all() and (windy == windy[0]).all():
         return True  # every row alike: no need to look at the jobs
     used = np.unique(m_idx)

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from ..flightdata import FlightData
-from ..sim.constants import DEFAULT_PARAMS
+from ..sim.constants import DEFAULT_PARAMS, ROW_NOISE, ROW_PARAMS
 from ..tasks import MDP
 from .model import MODEL_DT, LearnedModel, check_vector
 from .transitions import OneStepProblem, Transitions, noise_from_residuals
@@ -203,8 +203,8 @@ def observed_return(flight_data: FlightData, episode: int = 0) -> float:
 
 def _model_rows(params: np.ndarray, noise: np.ndarray) -> np.ndarray:
     rows = np.stack([MDP("model", substeps=1, dt=MODEL_DT).row()] * params.shape[0])
-    rows[:, 0:11] = params
-    rows[:, 11:17] = noise
+    rows[:, ROW_PARAMS] = params
+    rows[:, ROW_NOISE] = noise
     return rows
 
 

@@ -54,11 +54,13 @@ WIND_SINUSOID = 2  # GHH-09: (maxf, freq, phase, center) for x then y, each in [
 
 # Layout of an MDP row.
 ROW_PARAMS = slice(0, 11)
-ROW_NOISE = slice(11, 17)
+ROW_NOISE_START = 11
+ROW_NOISE = slice(ROW_NOISE_START, ROW_NOISE_START + 6)
 ROW_SUBSTEPS = 17
 ROW_DT = 18
 ROW_WIND_KIND = 19
-ROW_WIND = slice(20, 28)
+ROW_WIND_START = 20  # (the kernel indexes from it: numba folds module-level ints, not slices)
+ROW_WIND = slice(ROW_WIND_START, ROW_WIND_START + 8)
 ROW_D_U = 28  # constant u acceleration: 0 in every true MDP; the paper's D_u of a learned model
 MDP_ROW_LEN = 29
 

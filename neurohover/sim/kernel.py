@@ -33,6 +33,12 @@ from .constants import (
     MLP_STEEPNESS,
     NOISE_DECAY,
     NOISE_GAIN,
+    ROW_D_U,
+    ROW_DT,
+    ROW_NOISE_START,
+    ROW_SUBSTEPS,
+    ROW_WIND_KIND,
+    ROW_WIND_START,
     WIND_CONSTANT,
     WIND_SINUSOID,
 )
@@ -220,25 +226,26 @@ def competition_time(step, substep):
 def unpack_mdp(row):
     """Dynamics, noise, integration and wind settings of an MDP row as a tuple of scalars."""
     # Wind as A*sin(omega*t + phi) + c per world axis; constant wind is A = 0.
-    kind = int(row[19])
+    # The row's layout: sim.constants (ROW_*); w: the wind parameters (maxf, freq, phase, center per axis).
+    kind, w, s = int(row[ROW_WIND_KIND]), ROW_WIND_START, ROW_NOISE_START
     if kind == WIND_SINUSOID:
-        ax = 5.0 * (row[20] - row[23])
-        ox = 20.0 * math.pi * row[21]
-        phx = 2.0 * math.pi * row[22] if row[21] != 0.0 else 0.0  # the competition: no phase without frequency
-        cx = 5.0 * row[23]
-        ay = 5.0 * (row[24] - row[27])
-        oy = 20.0 * math.pi * row[25]
-        phy = 2.0 * math.pi * row[26] if row[25] != 0.0 else 0.0
-        cy = 5.0 * row[27]
+        ax = 5.0 * (row[w] - row[w + 3])
+        ox = 20.0 * math.pi * row[w + 1]
+        phx = 2.0 * math.pi * row[w + 2] if row[w + 1] != 0.0 else 0.0  # the competition: no phase without frequency
+        cx = 5.0 * row[w + 3]
+        ay = 5.0 * (row[w + 4] - row[w + 7])
+        oy = 20.0 * math.pi * row[w + 5]
+        phy = 2.0 * math.pi * row[w + 6] if row[w + 5] != 0.0 else 0.0
+        cy = 5.0 * row[w + 7]
     elif kind == WIND_CONSTANT:
-        ax, ox, phx, cx = 0.0, 0.0, 0.0, row[20]
-        ay, oy, phy, cy = 0.0, 0.0, 0.0, row[21]
+        ax, ox, phx, cx = 0.0, 0.0, 0.0, row[w]
+        ay, oy, phy, cy = 0.0, 0.0, 0.0, row[w + 1]
     else:
         ax, ox, phx, cx, ay, oy, phy, cy = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     wind = (kind, ax, ox, phx, cx, ay, oy, phy, cy)
-    dyn = (row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7], row[8], row[9], row[10], row[28])
-    noise_std = (row[11], row[12], row[13], row[14], row[15], row[16])
-    return dyn, noise_std, int(row[17]), row[18], wind
+    dyn = (row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7], row[8], row[9], row[10], row[ROW_D_U])  # ROW_PARAMS, then D_u
+    noise_std = (row[s], row[s + 1], row[s + 2], row[s + 3], row[s + 4], row[s + 5])
+    return dyn, noise_std, int(row[ROW_SUBSTEPS]), row[ROW_DT], wind
 
 
 @nb.njit(cache=True, inline="always", fastmath={"contract"})

@@ -464,7 +464,7 @@ def rollout_lanes(
 
     The outputs are those of :func:`neurohover.sim.kernel.rollout_batch` for the same jobs with no
     recording and no safeguard, bit for bit. Each lane flies its own job's genome and MDP row;
-    all rows used must share the substep count (row[17]) and whether there is wind (row[19] != 0),
+    all rows used must share the substep count (row[ROW_SUBSTEPS]) and whether there is wind (row[ROW_WIND_KIND] != 0),
     which the packed substep loop takes as constants (ValueError otherwise).
 
     Parameters

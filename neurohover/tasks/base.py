@@ -15,6 +15,12 @@ from ..sim.constants import (
     DEFAULT_PARAMS,
     MDP_ROW_LEN,
     ROW_D_U,
+    ROW_DT,
+    ROW_NOISE,
+    ROW_PARAMS,
+    ROW_SUBSTEPS,
+    ROW_WIND_KIND,
+    ROW_WIND_START,
     SUBSTEP_DT,
     SUBSTEPS,
     WIND_NONE,
@@ -75,12 +81,12 @@ class MDP:
     def row(self) -> np.ndarray:
         """The float64 row the compiled kernel reads (layout in ``sim.constants``)."""
         row = np.zeros(MDP_ROW_LEN)
-        row[0:11] = self.params
-        row[11:17] = self.noise_std
-        row[17] = self.substeps
-        row[18] = self.dt
-        row[19] = self.wind_kind
-        row[20 : 20 + len(self.wind)] = self.wind
+        row[ROW_PARAMS] = self.params
+        row[ROW_NOISE] = self.noise_std
+        row[ROW_SUBSTEPS] = self.substeps
+        row[ROW_DT] = self.dt
+        row[ROW_WIND_KIND] = self.wind_kind
+        row[ROW_WIND_START : ROW_WIND_START + len(self.wind)] = self.wind
         row[ROW_D_U] = self.d_u
         return row
 
