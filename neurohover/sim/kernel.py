@@ -138,6 +138,12 @@ def observe(s):
 
 
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
+def crash_charge(n_steps, t) -> float:
+    """The reward of a crash at control step ``t`` (1-based) of an ``n_steps`` episode: the worst step for every step left."""
+    return -CRASH_STEP_PENALTY * (n_steps - t)
+
+
+@nb.njit(cache=True, inline="always", fastmath={"contract"})
 def reward_of(o) -> float:
     """Minus the sum of squares of the 12 observation entries."""
     acc = 0.0
@@ -377,7 +383,7 @@ def fly_job(
             if slot >= 0:
                 _record(obs_out, act_out, slot, k, o, a1, a2, a3, a4)
             crash = True
-            total += -CRASH_STEP_PENALTY * (n_steps - t)
+            total += crash_charge(n_steps, t)
             break
         a1 = _clip(a1)
         a2 = _clip(a2)
@@ -390,7 +396,7 @@ def fly_job(
         o = observe(s)
         if crashed(s):
             crash = True
-            total += -CRASH_STEP_PENALTY * (n_steps - t)
+            total += crash_charge(n_steps, t)
             break
         total += reward_of(o)
     if slot >= 0:
@@ -488,7 +494,7 @@ def step_one(i, mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps,
         )
         for m in range(12):
             obs_out[i, m] = o[m]
-        rew_out[i] = -CRASH_STEP_PENALTY * (n_steps - t)
+        rew_out[i] = crash_charge(n_steps, t)
         crash_out[i] = True
         return
     dyn, std, n_sub, dt, wind = unpack_mdp(mdp_rows[env_mdp[i]])
@@ -519,7 +525,7 @@ def step_one(i, mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps,
     for m in range(12):
         obs_out[i, m] = o[m]
     if crashed(s):
-        rew_out[i] = -CRASH_STEP_PENALTY * (n_steps - t)
+        rew_out[i] = crash_charge(n_steps, t)
         crash_out[i] = True
     else:
         rew_out[i] = reward_of(o)

@@ -40,8 +40,8 @@ from llvmlite import ir
 from numba.core import types
 from numba.extending import intrinsic
 
-from .constants import CRASH_STEP_PENALTY, GRAVITY, MAX_POSITION, MAX_RATE, MAX_VELOCITY, MIN_QW, WIND_SINUSOID
-from .kernel import SERIES_MAX_ANGLE, _clip, _rotation, competition_time, integrate, observe, policy_action, unpack_mdp, update_noise
+from .constants import GRAVITY, MAX_POSITION, MAX_RATE, MAX_VELOCITY, MIN_QW, WIND_SINUSOID
+from .kernel import SERIES_MAX_ANGLE, _clip, _rotation, competition_time, crash_charge, integrate, observe, policy_action, unpack_mdp, update_noise
 from .rng import next_normal, seed_stream
 
 LANES = 8  # episodes per thread: 8 doubles fill an AVX-512 register (prototype: 4 lanes 1.94x, 8 2.20x, 16 2.27x)
@@ -359,7 +359,7 @@ def fly_lanes(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, se
             a1, a2, a3, a4 = policy_action(policy_kinds[pol], genomes[pol], o0, o1, o2, o3, o4, o5, o9, o10, o11)
             if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
                 j = job[lane]
-                out_return[j] = total[lane] + -CRASH_STEP_PENALTY * (n_steps - (k + 1))
+                out_return[j] = total[lane] + crash_charge(n_steps, k + 1)
                 out_crashed[j] = True
                 out_steps[j] = k + 1
                 job[lane] = -2  # over; the lane idles through this step (at rest, dt 0) and is refilled after it
@@ -434,7 +434,7 @@ def fly_lanes(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, se
                 t = step[lane] + 1
                 step[lane] = t
                 if B[ROW_CRASH * LANES + lane] != 0.0:
-                    out_return[j] = total[lane] + -CRASH_STEP_PENALTY * (n_steps - t)
+                    out_return[j] = total[lane] + crash_charge(n_steps, t)
                     out_crashed[j] = True
                 elif t == n_steps:
                     out_return[j] = total[lane] + B[ROW_REWARD * LANES + lane]
