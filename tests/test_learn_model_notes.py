@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from neurohover.cli import main
-from neurohover.commands_learning import MIN_TRANSITIONS, model_notes
+from neurohover.commands_learning import RELIABLE_TRANSITIONS, model_notes
 from neurohover.evaluate import evaluate
 from neurohover.models import LearnedModel, one_substep_params, parameter_table
 from neurohover.policies import baseline_policy
@@ -40,9 +40,9 @@ def test_nan_rows_are_explained() -> None:
 def test_short_data_are_warned_of() -> None:
     zero = get_task_family("ghh08").zero()
     model = _true_model()
-    data = _flown(zero, n_steps=MIN_TRANSITIONS - 1)
+    data = _flown(zero, n_steps=RELIABLE_TRANSITIONS - 1)
     notes = model_notes(model, data, zero, parameter_table(model, zero))
-    assert any(f"only {MIN_TRANSITIONS - 1} transitions" in n for n in notes)
+    assert any(f"only {RELIABLE_TRANSITIONS - 1} transitions" in n for n in notes)
 
 
 def test_wind_absorbed_into_the_model_is_noted() -> None:
