@@ -42,6 +42,9 @@ from .tasks import get_task_family
 
 SHIPPED = Path(__file__).parent / "data" / "policies"
 FGHH_GENERICS = ("zero", "fixed", "race")
+#: How FGHH's generics over G estimate fitness (the zero-setting one flies one MDP, fixed:1): the
+#: paper's k = 5 and delta = 0.2; build-policies and the experiments' planner both read it.
+FGHH_GENERIC_RESAMPLING = {"fixed": "fixed:5", "race": "race:0.2"}
 #: How GHH-08/09 policy sets seed their runs (see the module doc).
 LINEAGES = ("chain", "independent")
 
@@ -192,8 +195,8 @@ def build_policy_set(
         manifest.update({"sigma": family.sigma, "fghh_budget": fghh_budget})
         generics = {
             "zero": run(family.zero(), "generic_zero", int(seeds[0]), budget=budget),
-            "fixed": run(family, "generic_fixed", int(seeds[1]), budget=fghh_budget, resampling="fixed:5"),
-            "race": run(family, "generic_race", int(seeds[2]), budget=fghh_budget, resampling="race:0.2"),
+            "fixed": run(family, "generic_fixed", int(seeds[1]), budget=fghh_budget, resampling=FGHH_GENERIC_RESAMPLING["fixed"]),
+            "race": run(family, "generic_race", int(seeds[2]), budget=fghh_budget, resampling=FGHH_GENERIC_RESAMPLING["race"]),
         }
         manifest["seconds"] = round(time.perf_counter() - start, 1)
         (root / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n")

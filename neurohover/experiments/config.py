@@ -37,6 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import NeurohoverError
+from ..policysets import FGHH_GENERIC_RESAMPLING
 from ..tasks import TASK_NAMES
 
 CONFIG_DIR = Path(__file__).parent / "configs"
@@ -200,7 +201,7 @@ SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
         "policies": ("evolve", _policy_source()),
         "policy_budget": (0, _int(0)),
         "generic_budget": (0, _int(0)),
-        "generic_resampling": ({"fixed": "fixed:5", "race": "race:0.2"}, _table()),
+        "generic_resampling": (dict(FGHH_GENERIC_RESAMPLING), _table()),
         "generics_per_agent": (1, _int(1)),
         # kind -> "EXPERIMENT/VARIANT" (or "EXPERIMENT/best-race"): each run's generic drawn from the
         # final champions of another experiment's evolution runs, in the same store and scale

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import NeurohoverError
+from ..policysets import FGHH_GENERIC_RESAMPLING
 from .config import ExperimentConfig, variant_optimiser
 from .results import UnitKey
 from .units import Unit, policy_dict, unit_seed
@@ -275,7 +276,7 @@ class _Policies:
                             UnitKey.make("policy", f"generic-{kind}{j}"),
                             {"kind": "family", "task": self.task, "sigma": s["sigma"]},
                             s["generic_budget"],
-                            s["generic_resampling"].get(kind, "fixed:5" if kind == "fixed" else "race:0.2"),
+                            s["generic_resampling"].get(kind, FGHH_GENERIC_RESAMPLING[kind]),
                         )
 
     def _add(self, key: str, target: dict, budget: int, resampling: str = "fixed:1") -> None:
