@@ -35,7 +35,7 @@ def test_the_paper_agents_are_registered_with_their_tasks() -> None:
     }
     assert HYBRID_AGENTS == ("hybrid", "hybrid-baseline")
     assert AGENTS["model-free"].tasks == ("ghh08", "ghh09") and AGENTS["incremental-race"].tasks == ("fghh",)
-    assert AGENTS["authors-fixed"].tasks == ("fghh",) and AGENTS["authors-fixed"].generic_kind == {"fghh": "fixed"}
+    assert AGENTS["authors-fixed"].tasks == ("fghh",) and AGENTS["authors-fixed"].generic_kind == "fixed"
 
 
 @pytest.mark.parametrize("name", list(AGENTS))
@@ -77,7 +77,7 @@ def test_a_new_agent_module_is_discovered_without_editing_any_other_file(tmp_pat
         from neurohover.agents.reference import GenericAgent
         from neurohover.agents.spec import AgentSpec
 
-        AGENT_SPECS = (AgentSpec("always-generic", ("ghh08",), frozenset({"generic"}),
+        AGENT_SPECS = (AgentSpec("always-generic", "specialised", frozenset({"generic"}),
                                  lambda policies, options: GenericAgent(policies.generic)),)
     """)
     )
@@ -89,7 +89,11 @@ def test_a_new_agent_module_is_discovered_without_editing_any_other_file(tmp_pat
 
 def test_a_spec_refuses_unknown_policy_needs() -> None:
     with pytest.raises(ValueError, match="unknown policy needs"):
-        AgentSpec("x", ("ghh08",), frozenset({"teacher"}), lambda p, o: None)
+        AgentSpec("x", "specialised", frozenset({"teacher"}), lambda p, o: None)
+    with pytest.raises(ValueError, match=r"runs_on=\('ghh08',\); allowed \('any', 'specialised', 'generics-by-kind'\)"):
+        AgentSpec("x", ("ghh08",), frozenset({"generic"}), lambda p, o: None)
+    with pytest.raises(ValueError, match="name its generic_kind"):
+        AgentSpec("x", "any", frozenset({"generic"}), lambda p, o: None)
     assert AgentPolicies().generic is None
 
 
@@ -124,3 +128,17 @@ def test_the_readmes_example_agent_works_as_one_new_module(tmp_path: Path, monke
     assert run.policy[:2] == ["candidate:0", "candidate:1"] and run.policy[2] == run.policy[3]
     sys.modules.pop("readme_agents", None)
     sys.modules.pop("readme_agents.best_of_two", None)
+
+
+def test_a_new_family_gets_every_agent_its_policy_set_can_serve() -> None:
+    """Agents name a condition on the family, not a list of names: a new family needs no agent edited."""
+    from types import SimpleNamespace
+
+    specialised_like = SimpleNamespace(name="heavy", generic_over_distribution=False)  # its sets: generic + specialised
+    over_g_like = SimpleNamespace(name="fghh-wide", generic_over_distribution=True)  # its sets: generics by kind
+    on_first = {n for n, s in AGENTS.items() if s.applies_to(specialised_like)}
+    on_second = {n for n, s in AGENTS.items() if s.applies_to(over_g_like)}
+    assert {"baseline", "generic", "model-free", "incremental", "hybrid"} <= on_first and not any(n.startswith("authors-") for n in on_first)
+    assert {"baseline", "incremental", "authors-race", "incremental-zero"} <= on_second and "model-free" not in on_second and "hybrid" not in on_second
+    with pytest.raises(NeurohoverError, match="agent 'hybrid' does not apply to task 'fghh-wide': it runs on ghh08, ghh09"):
+        agent_spec("hybrid", over_g_like)

@@ -188,10 +188,10 @@ def _build(name: str):
 AGENT_SPECS = tuple(
     AgentSpec(
         f"authors-{kind}",
-        ("fghh",),
+        "generics-by-kind",
         frozenset({"generic"}),
         _build(f"authors-{kind}"),
-        generic_kind={"fghh": kind},
+        generic_kind=kind,
         summary=f"the authors' FGHH agent (generic, one-episode model, three model policies, the best) from the generic evolved {what}",
     )
     for kind, what in FGHH_GENERIC_KINDS

@@ -213,7 +213,7 @@ def _hybrid(name: str, fallback: str):
 AGENT_SPECS = (
     AgentSpec(
         "hybrid",
-        ("ghh08", "ghh09"),
+        "specialised",
         frozenset({"generic", "safe"}),
         _hybrid("hybrid", "generic"),
         takes_hybrid=True,
@@ -221,7 +221,7 @@ AGENT_SPECS = (
     ),
     AgentSpec(
         "hybrid-baseline",
-        ("ghh08", "ghh09"),
+        "specialised",
         frozenset({"generic", "safe"}),
         _hybrid("hybrid-baseline", "baseline"),
         takes_hybrid=True,

@@ -186,31 +186,30 @@ def _incremental(name: str):
     return build
 
 
-_ALL = ("ghh08", "ghh09", "fghh")
 AGENT_SPECS = (
     AgentSpec(
         "model-based",
-        _ALL,
+        "any",
         frozenset({"generic"}),
         _model_based,
-        generic_kind={"fghh": "race"},
+        generic_kind="race",
         summary="fly the generic policy once, learn a model, evolve a policy on it, keep it",
     ),
     AgentSpec(
         "incremental",
-        _ALL,
+        "any",
         frozenset({"generic"}),
         _incremental("incremental"),
-        generic_kind={"fghh": "race"},
+        generic_kind="race",
         summary="re-learn the model and re-evolve after every episode until a policy meets its prediction",
     ),
     *(
         AgentSpec(
             f"incremental-{kind}",
-            ("fghh",),
+            "generics-by-kind",
             frozenset({"generic"}),
             _incremental(f"incremental-{kind}"),
-            generic_kind={"fghh": kind},
+            generic_kind=kind,
             summary=f"incremental, from the FGHH generic policy evolved {what}",
         )
         for kind, what in FGHH_GENERIC_KINDS

@@ -47,7 +47,7 @@ class ModelFreeAgent(Agent):
 AGENT_SPECS = (
     AgentSpec(
         "model-free",
-        ("ghh08", "ghh09"),
+        "specialised",
         frozenset({"specialised"}),
         lambda policies, options: ModelFreeAgent(policies.specialised),
         summary="fly each specialised policy once, keep the best (the 2008 winner)",

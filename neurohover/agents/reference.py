@@ -42,17 +42,17 @@ def _generic(policies: AgentPolicies, options: AgentOptions) -> Agent:
 AGENT_SPECS = (
     AgentSpec(
         "baseline",
-        ("ghh08", "ghh09", "fghh"),
+        "any",
         frozenset(),
         lambda policies, options: BaselineAgent(),
         summary="the competition's baseline policy, every episode",
     ),
     AgentSpec(
         "generic",
-        ("ghh08", "ghh09", "fghh"),
+        "any",
         frozenset({"generic"}),
         _generic,
-        generic_kind={"fghh": "race"},
+        generic_kind="race",
         summary="the task's generic policy, every episode",
     ),
 )

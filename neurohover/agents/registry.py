@@ -12,7 +12,7 @@ import pkgutil
 
 from ..errors import NeurohoverError
 from ..policysets import PolicySet, load_policy_set
-from ..tasks import TaskFamily
+from ..tasks import TaskFamily, get_task_family
 from .protocol import Agent
 from .spec import AgentOptions, AgentPolicies, AgentSpec
 
@@ -41,13 +41,15 @@ AGENTS: dict[str, AgentSpec] = discover(__package__)
 HYBRID_AGENTS: tuple[str, ...] = tuple(name for name, spec in AGENTS.items() if spec.takes_hybrid)
 
 
-def agent_spec(name: str, task: str | None = None) -> AgentSpec:
-    """The spec of agent ``name``; refuses unknown names and, given ``task``, agents for other tasks."""
+def agent_spec(name: str, task: str | TaskFamily | None = None) -> AgentSpec:
+    """The spec of agent ``name``; refuses unknown names and, given ``task`` (a name or a family), agents for other tasks."""
     if name not in AGENTS:
         raise NeurohoverError(f"unknown agent {name!r}: allowed {', '.join(AGENTS)}")
     spec = AGENTS[name]
-    if task is not None and task not in spec.tasks:
-        raise NeurohoverError(f"agent {name!r} does not apply to task {task!r}: it runs on {', '.join(spec.tasks)}")
+    if task is not None:
+        family = get_task_family(task) if isinstance(task, str) else task
+        if not spec.applies_to(family):
+            raise NeurohoverError(f"agent {name!r} does not apply to task {family.name!r}: it runs on {', '.join(spec.tasks)}")
     return spec
 
 
@@ -55,7 +57,7 @@ def policies_from_set(spec: AgentSpec, ps: PolicySet) -> AgentPolicies:
     """The policies of a policy set that agent ``spec`` flies."""
     generic = None
     if "generic" in spec.needs:
-        kind = spec.generic_kind.get(ps.task)
+        kind = spec.generic_kind if ps.generics else None
         generic = ps.generics[kind] if kind is not None and ps.generics else ps.generic
     return AgentPolicies(
         generic=generic,
@@ -78,14 +80,14 @@ def _policy_set(family: TaskFamily, policy_dir: str | None) -> PolicySet:
 
 def check_agent(name: str, family: TaskFamily, policy_dir: str | None = None) -> None:
     """Refuse unknown agents, agents for another task, and missing or mismatched policy sets, with clear messages."""
-    spec = agent_spec(name, family.name)
+    spec = agent_spec(name, family)
     if spec.needs:
         spec.build(policies_from_set(spec, _policy_set(family, policy_dir)), AgentOptions())
 
 
 def make_agent(name: str, family: TaskFamily, *, policy_dir: str | None = None, options: AgentOptions = AgentOptions()) -> Agent:
     """A fresh agent called ``name`` for ``family``, flying the policies of its policy set."""
-    spec = agent_spec(name, family.name)
+    spec = agent_spec(name, family)
     policies = policies_from_set(spec, _policy_set(family, policy_dir)) if spec.needs else AgentPolicies()
     return spec.build(policies, options)
 

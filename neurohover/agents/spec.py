@@ -7,12 +7,13 @@ experiments read them from there.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ..policies import Policy
 
 if TYPE_CHECKING:
+    from ..tasks import TaskFamily
     from .hybrid import HybridSettings
     from .model_based import ModelEvolution
     from .protocol import Agent
@@ -22,6 +23,10 @@ if TYPE_CHECKING:
 POLICY_NEEDS = ("generic", "specialised", "safe")
 #: FGHH's generic policies, by kind: how each was evolved (agents named ``<agent>-<kind>`` fly one).
 FGHH_GENERIC_KINDS = (("zero", "on the zero setting"), ("fixed", "over G with fixed resampling"), ("race", "over G with selection races"))
+#: Which task families an agent runs on, by what the families' policy sets hold: every family;
+#: the families with specialised policies (one per training MDP: GHH-08, GHH-09, and any family
+#: whose generic is not evolved over G); or the families whose generics are evolved over G, by kind (FGHH).
+FAMILY_CONDITIONS = ("any", "specialised", "generics-by-kind")
 
 
 @dataclass(frozen=True)
@@ -55,16 +60,17 @@ class AgentSpec:
     ----------
     name : str
         What ``--agent`` and experiment configs call it.
-    tasks : tuple of str
-        The task families it runs on.
+    runs_on : {"any", "specialised", "generics-by-kind"}
+        The task families it runs on (:data:`FAMILY_CONDITIONS`), a condition on the family rather
+        than a list of names, so a new family gets every agent its policy set can serve.
     needs : frozenset of str
         Which of :data:`POLICY_NEEDS` it flies.
     build : callable
         ``build(policies, options) -> Agent``: a fresh agent from an :class:`AgentPolicies` and
         :class:`AgentOptions`.
-    generic_kind : dict
-        Per task family that has several generic policies (FGHH: ``"zero"``, ``"fixed"``,
-        ``"race"``), which one is this agent's generic policy.
+    generic_kind : str or None
+        On a family with generic policies by kind (FGHH: ``"zero"``, ``"fixed"``, ``"race"``),
+        which one is this agent's generic policy.
     takes_hybrid : bool
         Whether it accepts hybrid settings (``AgentOptions.hybrid``).
     summary : str
@@ -72,10 +78,10 @@ class AgentSpec:
     """
 
     name: str
-    tasks: tuple[str, ...]
+    runs_on: str
     needs: frozenset[str]
     build: Callable[[AgentPolicies, AgentOptions], Agent]
-    generic_kind: dict[str, str] = field(default_factory=dict)
+    generic_kind: str | None = None
     takes_hybrid: bool = False
     summary: str = ""
 
@@ -83,3 +89,19 @@ class AgentSpec:
         unknown = set(self.needs) - set(POLICY_NEEDS)
         if unknown:
             raise ValueError(f"agent {self.name!r}: unknown policy needs {sorted(unknown)}; allowed {POLICY_NEEDS}")
+        if self.runs_on not in FAMILY_CONDITIONS:
+            raise ValueError(f"agent {self.name!r}: runs_on={self.runs_on!r}; allowed {FAMILY_CONDITIONS}")
+        if self.runs_on != "specialised" and "generic" in self.needs and self.generic_kind is None:
+            raise ValueError(f"agent {self.name!r} flies a generic policy on families with generics by kind: name its generic_kind")
+
+    def applies_to(self, family: TaskFamily) -> bool:
+        """Whether the agent runs on ``family`` (its :attr:`runs_on` condition)."""
+        by_kind = family.generic_over_distribution
+        return self.runs_on == "any" or (self.runs_on == "generics-by-kind") == by_kind
+
+    @property
+    def tasks(self) -> tuple[str, ...]:
+        """The registered task families it runs on, by name (for help texts)."""
+        from ..tasks import TASK_NAMES, get_task_family
+
+        return tuple(name for name in TASK_NAMES if self.applies_to(get_task_family(name)))

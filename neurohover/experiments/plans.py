@@ -220,8 +220,8 @@ class _Policies:
         for g in s["groups"]:
             spec = _spec(g["agent"])
             needs |= spec.needs
-            if self.family.generic_over_distribution and self.task in spec.generic_kind:
-                needs.add(spec.generic_kind[self.task])
+            if self.family.generic_over_distribution and spec.generic_kind is not None:
+                needs.add(spec.generic_kind)
         self.needs = needs
         self.units: list[Unit] = []
         self.total = 0
@@ -294,7 +294,7 @@ class _Policies:
         out: dict = {}
         ext = self.external
         if self.family.generic_over_distribution:
-            kind = spec.generic_kind.get(self.task)
+            kind = spec.generic_kind
             if kind is not None:
                 if kind in getattr(self, "drawn", {}):
                     champions = self.drawn[kind]
