@@ -96,7 +96,7 @@ class FrozenSteadyStateNE:
         self.pending = batch
         return batch.copy()
 
-    def tell(self, fitness):
+    def tell(self, fitness, info=None):  # the protocol: tell(fitness, info); the literal plateau rule needs no crash flags
         f = np.array(fitness, dtype=np.float64)
         if self.population is None:
             self.population, self.fitness = self.pending, f

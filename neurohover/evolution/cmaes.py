@@ -17,7 +17,7 @@ import cma
 import numpy as np
 
 from . import common
-from .common import ChampionTracker, ChampionViews, Clock, check_prototype, check_returns
+from .common import ChampionTracker, ChampionViews, Clock, TellInfo, check_prototype, check_returns
 
 __all__ = ["CMAES"]
 
@@ -134,8 +134,8 @@ class CMAES(ChampionViews):
         self._pending = [np.asarray(x, dtype=np.float64) for x in self._es.ask()]
         return np.vstack(self._pending)
 
-    def tell(self, fitness: np.ndarray) -> None:
-        """Report one return per asked genome (maximised)."""
+    def tell(self, fitness: np.ndarray, info: TellInfo | None = None) -> None:
+        """Report one return per asked genome (maximised); ``info`` is not used."""
         if self._pending is None:
             raise RuntimeError("tell() called without a pending ask()")
         f = check_returns(fitness, len(self._pending))

@@ -32,6 +32,7 @@ __all__ = [
     "ChampionViews",
     "Clock",
     "Optimiser",
+    "TellInfo",
     "check_prototype",
     "check_returns",
     "check_state",
@@ -51,19 +52,37 @@ __all__ = [
 STATE_VERSION = 1
 
 
+@dataclass(frozen=True)
+class TellInfo:
+    """What an evolution run knows of a generation besides its fitness values; each optimiser
+    reads what it uses and ignores the rest.
+
+    Attributes
+    ----------
+    crashed : np.ndarray of bool, optional
+        Per genome, whether its evaluation crashed (steady state's ``no-crash`` plateau rule).
+    selected : np.ndarray of int, optional
+        The parents a selection race chose (generational NE).
+    episodes : int, optional
+        Episodes the generation cost (generational NE's history).
+    """
+
+    crashed: np.ndarray | None = None
+    selected: np.ndarray | None = None
+    episodes: int | None = None
+
+
 class Optimiser(Protocol):
     """The ask/tell surface of every optimiser here (:class:`SteadyStateNE`, :class:`GenerationalNE`,
-    :class:`CMAES`), which is what an evolution run (:mod:`neurohover.evolution.run`) uses.
-
-    An optimiser whose ``tell`` also takes ``crashed=`` flags (one bool per genome) says so with
-    a class attribute ``tells_crashes = True``; the run tells the others returns only.
+    :class:`CMAES`, the population optimisers of :mod:`neurohover.evolution.optimisers`), which
+    is what an evolution run (:mod:`neurohover.evolution.run`) uses: one ``tell(fitness, info)``.
     """
 
     def ask(self) -> np.ndarray:
         """The genomes to evaluate next, shape ``(n, D)``."""
 
-    def tell(self, fitness: np.ndarray, /) -> None:
-        """One return (or fitness estimate) per genome of the last :meth:`ask`, maximised."""
+    def tell(self, fitness: np.ndarray, info: TellInfo | None = None, /) -> None:
+        """One return (or fitness estimate) per genome of the last :meth:`ask`, maximised, and what else the run knows."""
 
     def stop(self) -> bool:
         """Whether the optimiser's own termination criterion has fired."""

@@ -19,6 +19,7 @@ import numpy as np
 from .common import (
     STATE_VERSION,
     Clock,
+    TellInfo,
     check_prototype,
     check_returns,
     check_state,
@@ -223,6 +224,7 @@ class GenerationalNE:
     def tell(
         self,
         fitness_estimates: np.ndarray,
+        info: TellInfo | None = None,
         selected: np.ndarray | None = None,
         episodes: int | None = None,
     ) -> None:
@@ -232,6 +234,8 @@ class GenerationalNE:
         ----------
         fitness_estimates : np.ndarray
             ``(pop_size,)`` estimated returns (maximised; NaN/-inf rank worst).
+        info : TellInfo, optional
+            Its ``selected`` and ``episodes``, as the run tells them (the two below, given directly, win).
         selected : np.ndarray, optional
             ``select_size`` distinct indices chosen as parents (e.g.
             ``RaceResult.selected``); default: the best estimates.
@@ -241,6 +245,9 @@ class GenerationalNE:
         """
         if not self._asked:
             raise RuntimeError("tell() called without a pending ask()")
+        if info is not None:
+            selected = info.selected if selected is None else selected
+            episodes = info.episodes if episodes is None else episodes
         s = self.settings
         f = check_returns(fitness_estimates, s.pop_size, "fitness_estimates")
         order = rank(f)
@@ -261,11 +268,11 @@ class GenerationalNE:
 
     def tell_race(self, result: RaceResult) -> None:
         """``tell`` with a selection race's means, selection and episode count."""
-        self.tell(result.means, selected=result.selected, episodes=result.episodes_spent)
+        self.tell(result.means, TellInfo(selected=result.selected, episodes=result.episodes_spent))
 
     def tell_resampled(self, result: ResamplingResult) -> None:
         """``tell`` with fixed-resampling means and episode count."""
-        self.tell(result.means, episodes=result.episodes_spent)
+        self.tell(result.means, TellInfo(episodes=result.episodes_spent))
 
     def stop(self) -> bool:
         """True after ``generations`` generations or once ``budget`` episodes are spent."""

@@ -24,7 +24,7 @@ from ..errors import NeurohoverError
 from ..flyer import KernelFlyer
 from ..policies import Policy
 from ..sim.lanes import LANES
-from .common import Optimiser, enc_float
+from .common import Optimiser, TellInfo, enc_float
 from .config import RACE_T_LIMIT, RunConfig, upgrade_saved_config
 from .fitness import episode_fitness
 from .generational import GenerationalNE
@@ -325,10 +325,7 @@ class Run:
         before_eps = self.flyer.episodes
         genomes = opt.ask()
         returns = self._fly_fixed(genomes)
-        if getattr(opt, "tells_crashes", False):
-            cast(SteadyStateNE, opt).tell(returns, crashed=self._crashed())
-        else:
-            opt.tell(returns)
+        opt.tell(returns, TellInfo(crashed=self._crashed()))
         self.generation += 1
         self.evaluations += genomes.shape[0]
         if opt.champion_return != before:
@@ -353,10 +350,10 @@ class Run:
                 n = genomes.shape[0]
                 t, i = np.nonzero(((self._race_base_drawn[:, None] > np.arange(RACE_T_LIMIT)) & ~used).T)
                 self.flyer.trace_unused.extend((self._race_base + t * n + i).tolist())
-            opt.tell_race(race)
+            opt.tell(race.means, TellInfo(selected=race.selected, episodes=race.episodes_spent))
         else:
             _, result = self._fly_family_fixed(genomes)
-            opt.tell_resampled(result)
+            opt.tell(result.means, TellInfo(episodes=result.episodes_spent))
         self.generation += 1
         self.evaluations += genomes.shape[0]
         self._record(before_eps, opt.champion_return, start)

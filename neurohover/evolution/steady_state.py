@@ -22,6 +22,7 @@ from .common import (
     ChampionTracker,
     ChampionViews,
     Clock,
+    TellInfo,
     check_prototype,
     check_returns,
     check_state,
@@ -245,7 +246,6 @@ class SteadyStateNE(ChampionViews):
     """
 
     #: :meth:`tell` takes ``crashed=`` flags (the ``no-crash`` plateau rule needs them).
-    tells_crashes = True
 
     def __init__(
         self,
@@ -292,17 +292,22 @@ class SteadyStateNE(ChampionViews):
         self._pending = batch
         return batch.copy()
 
-    def tell(self, fitness: np.ndarray, crashed: np.ndarray | None = None) -> None:
+    def tell(self, fitness: np.ndarray, info: TellInfo | None = None, crashed: np.ndarray | None = None) -> None:
         """Report the returns of exactly the genomes of the last :meth:`ask`.
 
         Parameters
         ----------
         fitness : np.ndarray
             One return per asked genome (maximised; NaN/-inf rank worst).
+        info : TellInfo, optional
+            Its ``crashed`` flags, as the run tells them.
         crashed : np.ndarray of bool, optional
-            Whether each genome's evaluation crashed (with a mean over several episodes: whether
-            any of them crashed). Only the ``no-crash`` plateau rule uses it; None: no crash.
+            The same flags given directly: whether each genome's evaluation crashed (with a mean
+            over several episodes: whether any of them crashed). Only the ``no-crash`` plateau
+            rule uses them; None: no crash.
         """
+        if crashed is None and info is not None:
+            crashed = info.crashed
         if self._pending is None:
             raise RuntimeError("tell() called without a pending ask()")
         f = check_returns(fitness, len(self._pending))

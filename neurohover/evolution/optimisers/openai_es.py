@@ -28,6 +28,7 @@ from ..common import (
     ChampionTracker,
     ChampionViews,
     Clock,
+    TellInfo,
     check_prototype,
     check_returns,
     check_state,
@@ -123,8 +124,8 @@ class OpenAIES(ChampionViews):
         sigma = self.settings.sigma
         return np.vstack([self.mean + sigma * self._eps, self.mean - sigma * self._eps])
 
-    def tell(self, fitness: np.ndarray) -> None:
-        """One return per asked genome (maximised): an Adam step of the mean up the estimated gradient."""
+    def tell(self, fitness: np.ndarray, info: TellInfo | None = None) -> None:
+        """One return per asked genome (maximised): an Adam step of the mean up the estimated gradient (``info`` unused)."""
         if self._eps is None:
             raise RuntimeError("tell() called without a pending ask()")
         s = self.settings
