@@ -19,7 +19,12 @@ import numpy as np
 from . import common
 from .common import ChampionTracker, ChampionViews, Clock, TellInfo, check_prototype, check_returns
 
-__all__ = ["CMAES"]
+__all__ = ["CMAES", "SIGMA0"]
+
+#: The initial step size for the baseline-seeded policies: a sweep on GHH-08 train:1 (600-step
+#: episodes, 1000 episodes, SLP and MLP from the baseline) found 0.01-0.03 best and 0.1 crashing
+#: nearly every SLP candidate (pycma's usual 0.5 belongs to problems scaled to unit boxes).
+SIGMA0 = 0.02
 
 #: Where classes pickled in earlier checkpoints now live (module, name) -> (module, name).
 _MOVED = {
@@ -83,7 +88,7 @@ class CMAES(ChampionViews):
     ----------
     prototype : np.ndarray
         1-D initial mean (D >= 2, a pycma requirement).
-    sigma0 : float, default 0.5
+    sigma0 : float, default :data:`SIGMA0` (0.02)
         Initial step size (> 0).
     seed : int, default 0
         Seed of the private generator.
@@ -96,7 +101,7 @@ class CMAES(ChampionViews):
     def __init__(
         self,
         prototype: np.ndarray,
-        sigma0: float = 0.5,
+        sigma0: float = SIGMA0,
         seed: int = 0,
         popsize: int | None = None,
         budget: int | None = None,

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..cmaes import CMAES
+from ..cmaes import CMAES, SIGMA0
 from . import OptimiserSpec
 
 __all__ = ["CMASettings"]
@@ -15,11 +15,10 @@ __all__ = ["CMASettings"]
 
 @dataclass(frozen=True)
 class CMASettings:
-    """CMA-ES settings. A sweep on GHH-08 train:1 (600-step episodes, 1000 episodes, SLP and MLP
-    from the baseline) found sigma0 0.01-0.03 best and 0.1 crashing nearly every SLP candidate;
-    popsize None is pycma's 4 + 3 ln D."""
+    """CMA-ES settings: the initial step size (:data:`~neurohover.evolution.cmaes.SIGMA0`, why 0.02)
+    and the population (None: pycma's 4 + 3 ln D)."""
 
-    sigma0: float = 0.02
+    sigma0: float = SIGMA0
     popsize: int | None = None
 
     def __post_init__(self) -> None:
