@@ -41,3 +41,19 @@ def test_bad_settings_are_refused() -> None:
         HoverProblem(topology="rnn")
     with pytest.raises(nh.NeurohoverError, match="MDP index 99 in .train:99. is out of range"):
         HoverProblem(mdps="train:99")
+
+
+def test_the_snes_example_runs_and_is_reproducible() -> None:
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parents[1] / "examples" / "evotorch_snes.py"
+    runs = []
+    for _ in range(2):
+        cmd = [sys.executable, str(script), "--generations", "3", "--popsize", "8", "--n-steps", "200"]
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+        assert proc.returncode == 0, proc.stderr[-2000:]
+        runs.append({line.split()[0]: float(line.split("mean return")[1].split()[0]) for line in proc.stdout.splitlines() if "mean return" in line})
+    assert set(runs[0]) == {"baseline", "SNES"} and all(np.isfinite(list(runs[0].values())))
+    assert runs[0] == runs[1]  # the seed fixes SNES's samples and the gusts

@@ -47,6 +47,12 @@ def test_the_rl_zoo_evaluation_example_without_its_extra_says_what_to_install() 
     assert "needs stable_baselines3: pip install 'neurohover[examples]'" in proc.stderr
 
 
+@pytest.mark.skipif(importlib.util.find_spec("evotorch") is not None, reason="evotorch is installed")
+def test_the_evotorch_example_without_its_extra_says_what_to_install() -> None:
+    proc = subprocess.run([sys.executable, str(ROOT / "examples" / "evotorch_snes.py"), "--help"], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr and "needs torch: pip install 'neurohover[evotorch]'" in proc.stderr
+
+
 def test_plot_draws_only_the_episodes_asked_for(tmp_path: Path, capsys) -> None:
     from neurohover.cli import main
 
