@@ -37,7 +37,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from ..sim.constants import CONTROL_DT, DEFAULT_NOISE_STD, DEFAULT_PARAMS, NOISE_NAMES, PARAM_NAMES, SUBSTEP_DT, SUBSTEPS
-from ..tasks import MDP
+from ..tasks import MDP, finite_vector
 
 __all__ = [
     "AXIS_C",
@@ -83,13 +83,10 @@ def check_vector(values, length: int, what: str, nonnegative: bool = False) -> t
     tuple of float
     """
     try:
-        arr = np.asarray(values, dtype=float).reshape(-1)
+        flat = np.asarray(values, dtype=float).reshape(-1)
     except (TypeError, ValueError):
         raise NeurohoverError(f"{what} must be {length} numbers, got {values!r:.80}") from None
-    if arr.shape != (length,):
-        raise NeurohoverError(f"{what} must be {length} numbers, got {arr.size}")
-    if not np.all(np.isfinite(arr)):
-        raise NeurohoverError(f"{what} must be finite numbers, got {arr.tolist()}")
+    arr = finite_vector(flat, length, what)  # the one finite-vector check (neurohover.tasks)
     if nonnegative and np.any(arr < 0):
         raise NeurohoverError(f"{what} must be >= 0, got {arr.tolist()}")
     return tuple(float(x) for x in arr)
