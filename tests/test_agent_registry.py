@@ -142,3 +142,60 @@ def test_a_new_family_gets_every_agent_its_policy_set_can_serve() -> None:
     assert {"baseline", "incremental", "authors-race", "incremental-zero"} <= on_second and "model-free" not in on_second and "hybrid" not in on_second
     with pytest.raises(NeurohoverError, match="agent 'hybrid' does not apply to task 'fghh-wide': it runs on ghh08, ghh09"):
         agent_spec("hybrid", over_g_like)
+
+
+def test_an_agent_with_settings_of_its_own_takes_them_from_a_config_group(tmp_path, monkeypatch) -> None:
+    """An agent's typed settings class is all it takes: configs validate them, units carry them, the agent gets them."""
+    from dataclasses import dataclass
+
+    from neurohover.agents import registry
+    from neurohover.agents.reference import GenericAgent
+    from neurohover.agents.spec import AgentSettings
+    from neurohover.experiments.plans import plan
+    from neurohover.experiments.units import unit_agent
+
+    @dataclass(frozen=True)
+    class PatientSettings(AgentSettings):
+        patience: int = 3
+
+        def __post_init__(self) -> None:
+            if self.patience < 1:
+                raise ValueError(f"patience={self.patience} must be >= 1")
+
+    built = []
+
+    def build(policies, options):
+        built.append(options.settings)
+        return GenericAgent(policies.generic)
+
+    spec = AgentSpec("patient", "any", frozenset({"generic"}), build, generic_kind="race", settings=PatientSettings)
+    monkeypatch.setitem(registry.AGENTS, "patient", spec)
+    config = tmp_path / "patient.toml"
+    text = """
+name = "patienttest"
+kind = "test_runs"
+[settings]
+task = "ghh08"
+seed = 3
+policies = "shipped"
+groups = [{ agent = "patient", n_mdps = 1, settings = { patience = 7 } }, { agent = "generic", n_mdps = 1 }]
+[scales.quick]
+episodes = 2
+n_steps = 50
+"""
+    config.write_text(text)
+    cfg = load_config(config, "quick")
+    units = {u.key: u for u in plan(cfg, {}).units}
+    assert units["run/patient/test0/rep0"].params["agent_settings"] == {"patience": 7}
+    assert "agent_settings" not in units["run/generic/test0/rep0"].params  # others' params (and hashes) as before
+    unit_agent(units["run/patient/test0/rep0"].params)
+    assert built == [PatientSettings(patience=7)]
+    config.write_text(text.replace("patience = 7", "patience = 0"))
+    with pytest.raises(NeurohoverError, match="group 'patient': bad PatientSettings: patience=0 must be >= 1"):
+        load_config(config, "quick")
+    config.write_text(text.replace("patience = 7", "patiense = 7"))
+    with pytest.raises(NeurohoverError, match="unknown PatientSettings setting.*patiense.*allowed patience"):
+        load_config(config, "quick")
+    config.write_text(text.replace('{ agent = "generic", n_mdps = 1 }', '{ agent = "generic", n_mdps = 1, settings = { patience = 2 } }'))
+    with pytest.raises(NeurohoverError, match="agent 'generic' takes no settings table"):
+        load_config(config, "quick")

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -24,7 +25,7 @@ from ..policies import Policy, baseline_policy
 from ..tasks import MDP, TaskFamily
 from .model_based import ModelEvolution, evolve_on_model, learn_model
 from .protocol import Agent, Choice, EpisodeOutcome
-from .spec import AgentOptions, AgentPolicies, AgentSpec
+from .spec import AgentOptions, AgentPolicies, AgentSettings, AgentSpec
 
 N_EVOLVED = 3
 DISCARD_RETURN = -1e6  # the authors' code charges a policy that needed the safeguard an error of 1e6
@@ -33,8 +34,9 @@ MODEL_DATA = ("first-safe", "both")
 
 
 @dataclass(frozen=True)
-class HybridSettings:
-    """How the hybrid agent treats dangerous states.
+class HybridSettings(AgentSettings):
+    """How the hybrid agent treats dangerous states (the hybrid agents' own settings; a test-run
+    unit holds them as its ``hybrid`` table, from the config group's ``hybrid``).
 
     Parameters
     ----------
@@ -54,6 +56,8 @@ class HybridSettings:
     dangerous : DangerousState
         The safeguard's dangerous-state test (default: the authors').
     """
+
+    UNIT_KEY: ClassVar[str] = "hybrid"
 
     replacement: str = "rerank"
     model_from: str = "first-safe"
@@ -205,7 +209,9 @@ def _hybrid(name: str, fallback: str):
     def build(policies: AgentPolicies, options: AgentOptions) -> Agent:
         assert policies.generic is not None
         backup = policies.generic if fallback == "generic" else baseline_policy()
-        return HybridAgent(policies.safe, policies.generic, backup, options.evolution or ModelEvolution(), name=name, hybrid=options.hybrid or HybridSettings())
+        return HybridAgent(
+            policies.safe, policies.generic, backup, options.evolution or ModelEvolution(), name=name, hybrid=options.settings or HybridSettings()
+        )
 
     return build
 
@@ -216,7 +222,7 @@ AGENT_SPECS = (
         "specialised",
         frozenset({"generic", "safe"}),
         _hybrid("hybrid", "generic"),
-        takes_hybrid=True,
+        settings=HybridSettings,
         summary="the safe specialised pair, then policies evolved on a model, under a safeguard (generic fallback)",
     ),
     AgentSpec(
@@ -224,7 +230,7 @@ AGENT_SPECS = (
         "specialised",
         frozenset({"generic", "safe"}),
         _hybrid("hybrid-baseline", "baseline"),
-        takes_hybrid=True,
+        settings=HybridSettings,
         summary="the hybrid agent with the baseline policy as the safeguard's fallback",
     ),
 )

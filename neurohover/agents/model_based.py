@@ -8,6 +8,7 @@ this costs computation but no samples of the real MDP.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -19,7 +20,7 @@ from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
 from .protocol import Agent, Choice, EpisodeOutcome
-from .spec import FGHH_GENERIC_KINDS, AgentOptions, AgentPolicies, AgentSpec
+from .spec import FGHH_GENERIC_KINDS, AgentOptions, AgentPolicies, AgentSettings, AgentSpec
 
 
 @dataclass(frozen=True)
@@ -170,6 +171,26 @@ class IncrementalModelBasedAgent(Agent):
         self.current_label = f"model:{self.models_learned}"
 
 
+@dataclass(frozen=True)
+class IncrementalSettings(AgentSettings):
+    """The incremental agents' own settings: ``max_learning_episodes``, the episode by which it
+    stops learning at the latest (a test-run unit's ``max_learning_episodes``, a setting of the
+    whole experiment)."""
+
+    UNIT_KEY: ClassVar[str] = "max_learning_episodes"
+
+    max_learning_episodes: int = 25
+
+    def __post_init__(self) -> None:
+        m = self.max_learning_episodes
+        if isinstance(m, bool) or not isinstance(m, int) or m < 1:
+            raise ValueError(f"max_learning_episodes={m!r} is out of range: allowed an integer >= 1")
+
+    @classmethod
+    def from_unit(cls, params: dict) -> IncrementalSettings:
+        return cls(max_learning_episodes=params["max_learning_episodes"])
+
+
 def _model_based(policies: AgentPolicies, options: AgentOptions) -> Agent:
     assert policies.generic is not None
     return ModelBasedAgent(policies.generic, options.evolution or ModelEvolution())
@@ -178,8 +199,8 @@ def _model_based(policies: AgentPolicies, options: AgentOptions) -> Agent:
 def _incremental(name: str):
     def build(policies: AgentPolicies, options: AgentOptions) -> Agent:
         assert policies.generic is not None
-        limit = {} if options.max_learning_episodes is None else {"max_learning_episodes": options.max_learning_episodes}
-        agent = IncrementalModelBasedAgent(policies.generic, options.evolution or ModelEvolution(), **limit)
+        settings = options.settings or IncrementalSettings()
+        agent = IncrementalModelBasedAgent(policies.generic, options.evolution or ModelEvolution(), max_learning_episodes=settings.max_learning_episodes)
         agent.name = name
         return agent
 
@@ -201,6 +222,7 @@ AGENT_SPECS = (
         frozenset({"generic"}),
         _incremental("incremental"),
         generic_kind="race",
+        settings=IncrementalSettings,
         summary="re-learn the model and re-evolve after every episode until a policy meets its prediction",
     ),
     *(
@@ -210,6 +232,7 @@ AGENT_SPECS = (
             frozenset({"generic"}),
             _incremental(f"incremental-{kind}"),
             generic_kind=kind,
+            settings=IncrementalSettings,
             summary=f"incremental, from the FGHH generic policy evolved {what}",
         )
         for kind, what in FGHH_GENERIC_KINDS

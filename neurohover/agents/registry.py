@@ -37,8 +37,8 @@ def discover(package: str) -> dict[str, AgentSpec]:
 
 #: Every agent by name, in a stable order.
 AGENTS: dict[str, AgentSpec] = discover(__package__)
-#: The agents that take hybrid settings (safeguard and replacement rule).
-HYBRID_AGENTS: tuple[str, ...] = tuple(name for name, spec in AGENTS.items() if spec.takes_hybrid)
+#: The agents that take hybrid settings (safeguard and replacement rule): those whose own settings are HybridSettings.
+HYBRID_AGENTS: tuple[str, ...] = tuple(name for name, spec in AGENTS.items() if spec.settings is not None and spec.settings.UNIT_KEY == "hybrid")
 
 
 def agent_spec(name: str, task: str | TaskFamily | None = None) -> AgentSpec:

@@ -6,15 +6,15 @@ experiments read them from there.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from ..policies import Policy
 
 if TYPE_CHECKING:
     from ..tasks import TaskFamily
-    from .hybrid import HybridSettings
     from .model_based import ModelEvolution
     from .protocol import Agent
 
@@ -40,16 +40,42 @@ class AgentPolicies:
 
 @dataclass(frozen=True)
 class AgentOptions:
-    """Settings of the learning agents; None: the agent's own default.
-
-    ``evolution``: how policies are evolved on learned models (``ModelEvolution``); ``hybrid``:
-    the hybrid agents' safeguard and replacement rule (``HybridSettings``); ``max_learning_episodes``:
-    when the incremental agent stops learning at the latest.
-    """
+    """What a run hands an agent's ``build``: ``evolution``, how the learning agents evolve policies
+    on learned models (a ``ModelEvolution``, shared by all of them; None: its defaults), and
+    ``settings``, the agent's own typed settings (an instance of its spec's ``settings`` class;
+    None: that class's defaults)."""
 
     evolution: ModelEvolution | None = None
-    hybrid: HybridSettings | None = None
-    max_learning_episodes: int | None = None
+    settings: Any = None
+
+
+class AgentSettings:
+    """What an agent's own settings class provides (a frozen dataclass that also subclasses this):
+    ``from_dict`` (unknown keys refused, a NeurohoverError for a bad value), ``to_dict``, and
+    ``from_unit``, the settings of an experiment's test-run unit: by default its params'
+    ``agent_settings`` table, which the planner copies from the config group's ``settings``."""
+
+    UNIT_KEY: ClassVar[str] = "agent_settings"
+
+    @classmethod
+    def from_dict(cls, values: dict) -> Any:
+        from ..errors import NeurohoverError
+
+        known = {f.name for f in dataclasses.fields(cls)}  # type: ignore[arg-type]  # subclasses are dataclasses
+        unknown = sorted(set(values) - known)
+        if unknown:
+            raise NeurohoverError(f"unknown {cls.__name__} setting(s) {', '.join(unknown)}: allowed {', '.join(sorted(known))}")
+        try:
+            return cls(**values)
+        except (TypeError, ValueError) as err:
+            raise NeurohoverError(f"bad {cls.__name__}: {err}") from None
+
+    def to_dict(self) -> dict:
+        return dataclasses.asdict(self)  # type: ignore[call-overload]  # subclasses are dataclasses
+
+    @classmethod
+    def from_unit(cls, params: dict) -> Any:
+        return cls.from_dict(params.get(cls.UNIT_KEY) or {})
 
 
 @dataclass(frozen=True)
@@ -71,8 +97,9 @@ class AgentSpec:
     generic_kind : str or None
         On a family with generic policies by kind (FGHH: ``"zero"``, ``"fixed"``, ``"race"``),
         which one is this agent's generic policy.
-    takes_hybrid : bool
-        Whether it accepts hybrid settings (``AgentOptions.hybrid``).
+    settings : type, optional
+        Its own typed settings (an :class:`AgentSettings` dataclass), handed to ``build`` as
+        ``AgentOptions.settings``; None: it has none.
     summary : str
         One line for help texts.
     """
@@ -82,7 +109,7 @@ class AgentSpec:
     needs: frozenset[str]
     build: Callable[[AgentPolicies, AgentOptions], Agent]
     generic_kind: str | None = None
-    takes_hybrid: bool = False
+    settings: type[AgentSettings] | None = None
     summary: str = ""
 
     def __post_init__(self) -> None:

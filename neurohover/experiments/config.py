@@ -161,6 +161,7 @@ _GROUP = {
     "runs_per_mdp": (1, _int(1)),
     "exclude_own": (False, _bool()),
     "hybrid": ({}, _table()),  # hybrid agents: replacement, model_from, rule, box, tilt (HybridSettings)
+    "settings": (_OMIT, _table()),  # an agent's own typed settings (its spec's settings class), for agents that read them from it
     "estimator": ("ols", _choice("ols", "gls")),  # least squares of the LR models an agent learns
 }
 
@@ -309,6 +310,14 @@ def _check_kind(settings: dict, kind: str, where: str) -> None:
                     )
                 try:
                     g["hybrid"] = HybridSettings.from_dict(g["hybrid"]).to_dict()
+                except NeurohoverError as e:
+                    raise NeurohoverError(f"{where}: group {g['label']!r}: {e}") from None
+            if "settings" in g:  # checked here, not when a unit first runs
+                own = AGENTS[g["agent"]].settings
+                if own is None or own.UNIT_KEY != "agent_settings":
+                    raise NeurohoverError(f"{where}: group {g['label']!r}: agent {g['agent']!r} takes no settings table")
+                try:
+                    g["settings"] = own.from_dict(g["settings"]).to_dict()
                 except NeurohoverError as e:
                     raise NeurohoverError(f"{where}: group {g['label']!r}: {e}") from None
         for kind, source in settings.get("generics_from", {}).items():

@@ -377,6 +377,7 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dic
                             "policies": policies,
                             "estimator": g["estimator"],
                             **({"hybrid": hybrid} if hybrid else {}),
+                            **({"agent_settings": g["settings"]} if "settings" in g else {}),
                         },
                     )
                 )

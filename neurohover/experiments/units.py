@@ -252,7 +252,6 @@ def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
 def unit_agent(p: dict, device: str = "cpu"):
     """The agent of a test-run unit, built from the policies in its params and the run's settings
     (policies evolved on learned models fly episodes of the run's length, on ``device``)."""
-    from ..agents.hybrid import HybridSettings
     from ..agents.model_based import ModelEvolution
     from ..agents.registry import AgentOptions, AgentPolicies, agent_spec
 
@@ -267,8 +266,7 @@ def unit_agent(p: dict, device: str = "cpu"):
         evolution=ModelEvolution(
             budget=p["model_budget"], predict_episodes=p["predict_episodes"], n_steps=p["n_steps"], estimator=p["estimator"], device=device
         ),
-        hybrid=HybridSettings.from_dict(p["hybrid"]) if spec.takes_hybrid else None,
-        max_learning_episodes=p["max_learning_episodes"],
+        settings=None if spec.settings is None else spec.settings.from_unit(p),  # the agent's own, typed
     )
     return spec.build(policies, options)
 
