@@ -17,6 +17,7 @@ pytest.importorskip("stable_baselines3")
 import gymnasium as gym  # noqa: E402
 
 from neurohover.sim.constants import CRASH_STEP_PENALTY  # noqa: E402
+from neurohover.wrappers import CrashAwareReward  # noqa: E402
 
 SCRIPT = Path(__file__).resolve().parents[1] / "examples" / "ppo_ghh08.py"
 
@@ -50,9 +51,10 @@ def test_ppo_script_trains_evaluates_and_writes_results(tmp_path):
 
 def test_squashed_reward_keeps_a_crash_worse_than_flying_on():
     script = _load_script()
+    assert script.CrashAwareReward is CrashAwareReward  # the script trains with the package's wrapper
     gamma, scale, steps = 0.99, 0.1, 1000
     env = gym.make(script.ENV_ID, mdp="zero", obs_dtype="float32", episode_steps=steps, max_episode_steps=steps)
-    wrapped = script.SquashedReward(gym.wrappers.RecordEpisodeStatistics(env), steps, gamma, scale)
+    wrapped = CrashAwareReward(gym.wrappers.RecordEpisodeStatistics(env), gamma, scale)
     obs, _ = wrapped.reset(seed=0)
     assert obs.dtype == np.float32
     rewards, info = [], {}
@@ -64,7 +66,7 @@ def test_squashed_reward_keeps_a_crash_worse_than_flying_on():
     assert terminated and info["crashed"]
     t = len(rewards)
     worst = math.log1p(CRASH_STEP_PENALTY)
-    assert rewards[-1] == pytest.approx(-scale * worst * (1 - gamma ** (steps - t + 1)) / (1 - gamma))
+    assert rewards[-1] == pytest.approx(-scale * worst * (1 - gamma ** (steps - t)) / (1 - gamma))  # the steps left after the crash
     # Ordinary steps are squashed into (-worst, 0]; the crash is worse than the worst step forever after.
     assert all(-scale * worst <= r <= 0 for r in rewards[:-1])
     assert rewards[-1] < -scale * worst / (1 - gamma) * 0.99
