@@ -2,6 +2,22 @@
 
 from __future__ import annotations
 
+import dataclasses
+from typing import Any
+
 
 class NeurohoverError(ValueError):
     """Bad input: the message names the bad value and what is allowed."""
+
+
+def settings_from_dict(cls: type, values: Any, *, unknown_what: str, bad_what: str) -> Any:
+    """An instance of the settings dataclass ``cls`` from a dict of some of its fields: unknown keys and
+    values ``cls`` refuses (TypeError, ValueError) become one NeurohoverError each, naming them."""
+    fields = [f.name for f in dataclasses.fields(cls)]
+    unknown = sorted(set(values) - set(fields))
+    if unknown:
+        raise NeurohoverError(f"unknown {unknown_what} setting(s) {', '.join(unknown)}: allowed {', '.join(fields)}")
+    try:
+        return cls(**values)
+    except (TypeError, ValueError) as err:
+        raise NeurohoverError(f"bad {bad_what}: {err}") from None

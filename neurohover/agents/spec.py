@@ -11,6 +11,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
+from ..errors import settings_from_dict
 from ..policies import Policy
 
 if TYPE_CHECKING:
@@ -59,16 +60,7 @@ class AgentSettings:
 
     @classmethod
     def from_dict(cls, values: dict) -> Any:
-        from ..errors import NeurohoverError
-
-        known = {f.name for f in dataclasses.fields(cls)}  # type: ignore[arg-type]  # subclasses are dataclasses
-        unknown = sorted(set(values) - known)
-        if unknown:
-            raise NeurohoverError(f"unknown {cls.__name__} setting(s) {', '.join(unknown)}: allowed {', '.join(sorted(known))}")
-        try:
-            return cls(**values)
-        except (TypeError, ValueError) as err:
-            raise NeurohoverError(f"bad {cls.__name__}: {err}") from None
+        return settings_from_dict(cls, values, unknown_what=cls.__name__, bad_what=cls.__name__)
 
     def to_dict(self) -> dict:
         return dataclasses.asdict(self)  # type: ignore[call-overload]  # subclasses are dataclasses

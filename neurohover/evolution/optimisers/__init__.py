@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import NeurohoverError
+from ...errors import NeurohoverError, settings_from_dict
 
 __all__ = ["NE", "OPTIMISERS", "OptimiserSpec", "optimiser_names", "population_settings"]
 
@@ -97,13 +97,7 @@ def population_settings(name: str, settings: Any) -> Any:
         return cls()
     if isinstance(settings, cls):
         return settings
-    fields = [f.name for f in dataclasses.fields(cls)]
     if not isinstance(settings, Mapping):
+        fields = [f.name for f in dataclasses.fields(cls)]
         raise NeurohoverError(f"settings for optimizer {name!r} must be a {cls.__name__} or a dict with keys {', '.join(fields)}")
-    unknown = sorted(set(settings) - set(fields))
-    if unknown:
-        raise NeurohoverError(f"unknown {name} setting(s) {', '.join(unknown)}: allowed {', '.join(fields)}")
-    try:
-        return cls(**settings)
-    except (TypeError, ValueError) as err:
-        raise NeurohoverError(f"bad {name} settings: {err}") from None
+    return settings_from_dict(cls, settings, unknown_what=name, bad_what=f"{name} settings")
