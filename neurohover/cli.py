@@ -50,11 +50,28 @@ def explicit_mdp(args: argparse.Namespace, family):
     return None
 
 
-def _family_and_mdps(args: argparse.Namespace, n: int, rng: np.random.Generator):
-    """The task family and the MDP of each of ``n`` episodes, from --task/--mdp/--wind/--params/--sigma."""
-    from .tasks import get_task_family
+def add_sensor_options(p: argparse.ArgumentParser) -> None:
+    """--obs-noise and --obs-delay: the task seen through noisy or late sensors (:mod:`neurohover.tasks.sensor`)."""
+    g = p.add_argument_group("noisy sensors (docs/benchmarks.md; default: exact sensors)")
+    g.add_argument(
+        "--obs-noise",
+        help="sensor noise on what the policy sees: a level (e.g. 0.5: std 0.05 m/s, 0.05 m, 0.05 rad/s, 0.005) or key=value pairs "
+        "of velocity, position, rates, attitude (stds), correlation (AR(1), 0 <= c < 1), level",
+    )
+    g.add_argument("--obs-delay", type=int, help="control steps (0..10, 0.1 s each) the readings arrive late (default 0)")
 
-    family = get_task_family(args.task, args.sigma)
+
+def task_family_of(args: argparse.Namespace):
+    """The task family of --task/--sigma, seen through the sensor of --obs-noise/--obs-delay."""
+    from .tasks import Sensor, get_task_family
+
+    noise, delay = getattr(args, "obs_noise", None), getattr(args, "obs_delay", None)
+    return get_task_family(args.task, args.sigma, None if noise is None and delay is None else Sensor.of(noise, delay))
+
+
+def _family_and_mdps(args: argparse.Namespace, n: int, rng: np.random.Generator):
+    """The task family and the MDP of each of ``n`` episodes, from --task/--mdp/--wind/--params/--sigma/--obs-noise/--obs-delay."""
+    family = task_family_of(args)
     explicit = explicit_mdp(args, family)
     if explicit is not None:
         return family, [explicit[0]] * n
@@ -75,6 +92,7 @@ def _add_task_options(p: argparse.ArgumentParser) -> None:
         "GHH-09 its 8 parameters in [0,1]; FGHH the 11 dynamics parameters",
     )
     p.add_argument("--sigma", type=float, help="FGHH breadth sigma (default 0.3)")
+    add_sensor_options(p)
 
 
 # Episodes per kernel call of a progress-reporting fly: large enough to keep every core busy.
@@ -163,6 +181,7 @@ def cmd_fly(args: argparse.Namespace) -> int:
         fd.save(args.record, dtype=args.record_dtype)
     summary = {
         "task": family.name,
+        **({} if family.sensor.exact else {"sensor": family.sensor.to_dict()}),
         "mdp": mdps[0].label if n_unique == 1 else f"{n_unique} MDPs",
         "policy": str(args.policy),
         "episodes": args.episodes,

@@ -38,10 +38,9 @@ MDP_FAMILY = "G"
 
 def _target(args: argparse.Namespace):
     """(target, family, mdp description for the metadata)."""
-    from .cli import explicit_mdp
-    from .tasks import get_task_family
+    from .cli import explicit_mdp, task_family_of
 
-    family = get_task_family(args.task, args.sigma)
+    family = task_family_of(args)
     explicit = explicit_mdp(args, family)
     if explicit is not None:
         return explicit[0], family, explicit[1]
@@ -171,6 +170,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     )
     meta = {
         "task": family.name,
+        **({} if family.sensor.exact else {"sensor": family.sensor.to_dict()}),
         "mdp": mdp_desc,
         "optimizer": args.optimizer,
         "resampling": str(resampling),
@@ -358,6 +358,8 @@ def model_notes(model, data, truth, rows) -> list[str]:
 
 
 def register(sub) -> None:
+    from .cli import add_sensor_options
+
     p = sub.add_parser(
         "evolve",
         help="evolve a policy on an MDP (steady state) or over a task family (generational)",
@@ -373,6 +375,7 @@ def register(sub) -> None:
     p.add_argument("--wind", help="GHH-08 only: evolve on the constant wind U,V (m/s, each in [-5, 5])")
     p.add_argument("--params", help="evolve on explicit MDP parameters, comma-separated (GHH-08 2, GHH-09 8, FGHH 11)")
     p.add_argument("--sigma", type=float, help="FGHH breadth sigma (default 0.3)")
+    add_sensor_options(p)
     p.add_argument("--topology", choices=("slp", "mlp"), help="network (default: the seed policy file's, else slp over a family (--mdp G) and mlp on one MDP)")
     p.add_argument("--seed-policy", default="baseline", help="prototype: zero, baseline (baseline-equivalent network; default) or a policy FILE")
     p.add_argument(

@@ -27,7 +27,9 @@ from .launch import DEVICES, KIND, MAX_SEED, check_device, launch, num_threads, 
 from .policies import GENOME_LENGTH, TOPOLOGIES, Policy, load_policy
 from .sim.constants import (
     EPISODE_STEPS,
+    MAX_SENSOR_DELAY,
     MDP_ROW_LEN,
+    ROW_SENSOR,
     SAFEGUARD_BOX,
     SAFEGUARD_KIND_BOX,
     SAFEGUARD_KIND_RATIO,
@@ -156,12 +158,20 @@ class Evaluation:
 
 
 def mdp_rows(mdps: MDP | Sequence[MDP] | np.ndarray) -> np.ndarray:
-    """MDPs as the (M, 29) float64 array the kernel reads."""
+    """MDPs as the (M, MDP_ROW_LEN) float64 array the kernel reads (an array's sensor slots checked)."""
     if isinstance(mdps, MDP):
         return mdps.row()[None, :]
     if isinstance(mdps, np.ndarray):
         if mdps.ndim != 2 or mdps.shape[1] != MDP_ROW_LEN or not np.all(np.isfinite(mdps)):
             raise NeurohoverError(f"MDP rows must be a finite array of shape (M, {MDP_ROW_LEN}), got {mdps.shape}")
+        sensors = mdps[:, ROW_SENSOR]
+        bad = (sensors[:, :5] < 0).any(axis=1) | (sensors[:, 4] >= 1) | (sensors[:, 5] > MAX_SENSOR_DELAY) | (sensors[:, 5] != np.round(sensors[:, 5]))
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise NeurohoverError(
+                f"MDP row {i} has an invalid sensor model {sensors[i].tolist()}: allowed 4 stds >= 0, a correlation in [0, 1) "
+                f"and a whole delay in 0..{MAX_SENSOR_DELAY} (neurohover.tasks.sensor)"
+            )
         return np.ascontiguousarray(mdps, dtype=float)
     if len(mdps) == 0 or not all(isinstance(m, MDP) for m in mdps):
         raise NeurohoverError("mdps must be an MDP or a non-empty sequence of MDPs")
@@ -202,7 +212,7 @@ def evaluate_jobs(
     Parameters
     ----------
     policies : sequence of Policy or PolicyTable
-    mdps : MDP, sequence of MDP, or (M, 29) array of MDP rows
+    mdps : MDP, sequence of MDP, or (M, MDP_ROW_LEN) array of MDP rows
     policy_index, mdp_index, episode_index : array_like of int, shape (J,)
         Which policy flies which MDP, and the episode index that (with ``seed``) fixes the noise.
     seed : int

@@ -139,7 +139,7 @@ class KernelFlyer:
         genomes : numpy.ndarray
             ``(P, D)`` genomes of the flyer's topology.
         rows : numpy.ndarray
-            ``(M, 29)`` MDP rows (:func:`mdp_rows`).
+            ``(M, MDP_ROW_LEN)`` MDP rows (:func:`mdp_rows`).
         policy_index, mdp_index : numpy.ndarray of int64, None or "range"
             Per job, the genome and the MDP row it flies; None: 0 for every job; ``"range"``:
             job j flies number j.

@@ -41,7 +41,7 @@ def _spinning() -> PolicyTable:
 
 
 def _scalar(table: PolicyTable, row: np.ndarray, seed: int, episodes: np.ndarray, n_steps: int, p=None, m=None):
-    """The scalar kernel's rollout_batch, called directly; ``row`` one row or (M, 29) rows, p and m
+    """The scalar kernel's rollout_batch, called directly; ``row`` one row or (M, MDP_ROW_LEN) rows, p and m
     the jobs' policy and row indices (default 0)."""
     n = episodes.shape[0]
     zeros = np.zeros(n, dtype=np.int64)

@@ -4,7 +4,9 @@ Ids: ``neurohover/GHH08-v0``, ``neurohover/GHH09-v0`` and ``neurohover/FGHH-v0``
 ``sigma``, default 0.3): one per task family, the paper's 6000-step episodes in float64; and
 ``neurohover/<NAME>-Short-v0`` for deep RL: 1000-step episodes whose crash charge counts the
 steps left of the short episode, float32 observations and actions (:class:`HoverEnv`'s docstring
-has the table). ``gymnasium.make`` builds :class:`HoverEnv`;
+has the table); and ``neurohover/<NAME>-NoisySensors-v0``, ``-CorrelatedSensors-v0`` and
+``-DelayedSensors-v0``: the paper's episodes seen through the harder sensors of its Section 7
+(:data:`SENSOR_ENV_SETTINGS`, :mod:`neurohover.tasks.sensor`). ``gymnasium.make`` builds :class:`HoverEnv`;
 ``gymnasium.make_vec(..., vectorization_mode="vector_entry_point")`` builds
 :class:`HoverVectorEnv`, which steps every helicopter in one kernel call.
 """
@@ -26,10 +28,21 @@ SHORT_ENV_IDS: dict[str, str] = {f"neurohover/{name.upper()}-Short-v0": name for
 SHORT_SETTINGS = {"episode_steps": SHORT_EPISODE_STEPS, "obs_dtype": "float32", "action_dtype": "float32"}
 
 
+#: The sensor variants' settings, by the suffix of their ids (``neurohover/<NAME>-<suffix>-v0``).
+SENSOR_ENV_SETTINGS: dict[str, dict] = {
+    "NoisySensors": {"obs_noise": 1.0},  # level 1, white
+    "CorrelatedSensors": {"obs_noise": {"level": 1.0, "correlation": 0.95}},  # level 1, AR(1) as motion capture drifts
+    "DelayedSensors": {"obs_delay": 2},  # exact readings 0.2 s late
+}
+#: Every sensor variant id and its task family.
+SENSOR_ENV_IDS: dict[str, str] = {f"neurohover/{name.upper()}-{suffix}-v0": name for name in TASK_NAMES for suffix in SENSOR_ENV_SETTINGS}
+
+
 def register_envs() -> None:
     """Register the environments with Gymnasium; ids already registered are left alone."""
     ids: list[tuple[str, str, dict, int]] = [(env_id, task, {}, EPISODE_STEPS) for env_id, task in ENV_IDS.items()]
     ids += [(env_id, task, SHORT_SETTINGS, SHORT_EPISODE_STEPS) for env_id, task in SHORT_ENV_IDS.items()]
+    ids += [(env_id, task, SENSOR_ENV_SETTINGS[env_id.split("-")[1]], EPISODE_STEPS) for env_id, task in SENSOR_ENV_IDS.items()]
     for env_id, task, settings, limit in ids:
         if env_id in gymnasium.registry:  # re-import or reload: Gymnasium would warn about overriding
             continue
@@ -44,4 +57,4 @@ def register_envs() -> None:
 
 register_envs()
 
-__all__ = ["ENV_IDS", "SHORT_ENV_IDS", "HoverEnv", "HoverVectorEnv", "register_envs"]
+__all__ = ["ENV_IDS", "SENSOR_ENV_IDS", "SENSOR_ENV_SETTINGS", "SHORT_ENV_IDS", "HoverEnv", "HoverVectorEnv", "register_envs"]

@@ -31,10 +31,11 @@ from ..sim.constants import (
     PARAM_NAMES,
     STATE_DIM,
 )
-from ..sim.kernel import step_batch
+from ..sim.kernel import ENV_NOISE_WIDTH, ENV_RNG_WIDTH, start_readings, step_batch
 from ..sim.reference import competition_time
 from ..sim.rng import seed_stream
 from ..tasks import MDP, TASK_FAMILIES, TaskFamily, get_task_family
+from ..tasks.sensor import Sensor
 
 RENDER_FPS = 10  # control rate (Hz)
 RENDER_MODES = ("human", "rgb_array")
@@ -98,7 +99,12 @@ def check_noise_stream(value: Any, what: str = "noise") -> tuple[int, int]:
 
 
 #: What ``gymnasium.make`` may pass to :class:`HoverEnv` (its ``max_episode_steps`` is Gymnasium's own).
-ENV_KWARGS = ("task", "sigma", "mdp", "episode_steps", "render_mode", "obs_dtype", "action_dtype")
+ENV_KWARGS = ("task", "sigma", "mdp", "episode_steps", "render_mode", "obs_dtype", "action_dtype", "obs_noise", "obs_delay")
+
+
+def sensed_family(task: str, sigma: float | None, obs_noise: Any, obs_delay: Any) -> TaskFamily:
+    """The environment's task family, seen through the sensor of ``obs_noise`` / ``obs_delay`` (:meth:`Sensor.of`)."""
+    return get_task_family(task, sigma, sensor=Sensor.of(obs_noise, obs_delay))
 
 
 def check_no_unknown_kwargs(unknown: dict[str, Any], allowed: Sequence[str]) -> None:
@@ -251,7 +257,8 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
 
     ## Starting State
 
-    At rest at the origin, level and facing north; the observation is all zeros.
+    At rest at the origin, level and facing north; the observation is all zeros (with noisy
+    sensors, their first reading of zeros).
 
     ## Episode End
 
@@ -274,6 +281,16 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
     | ``neurohover/GHH09-Short-v0``    | the steps left of the     |                         |
     | ``neurohover/FGHH-Short-v0``     | 1000-step episode         |                         |
 
+    and variants with the harder sensors of the paper's Section 7 (:mod:`neurohover.tasks.sensor`;
+    docs/benchmarks.md), each family's:
+
+    | Id                                        | obs_noise                       | obs_delay |
+    |-------------------------------------------|---------------------------------|-----------|
+    | ``neurohover/GHH08-NoisySensors-v0``      | level 1, white                  | 0         |
+    | ``neurohover/GHH08-CorrelatedSensors-v0`` | level 1, AR(1) correlation 0.95 | 0         |
+    | ``neurohover/GHH08-DelayedSensors-v0``    | exact                           | 2 (0.2 s) |
+    | (likewise GHH09-, FGHH-)                  |                                 |           |
+
     Rewards stay the environment's own; :class:`neurohover.wrappers.CrashAwareReward` is the
     reward transform that learns (docs/deep-rl.md).
 
@@ -287,6 +304,11 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
       runs in float64, so the episodes are the same, observations rounded to float32.
     - ``action_dtype``: ``"float64"`` (default) or ``"float32"``: the action space's dtype.
     - ``render_mode``: ``None`` (default), ``"rgb_array"`` or ``"human"`` (see Rendering).
+    - ``obs_noise``: the sensors' noise: ``None`` (exact, default), a level (a number: the profile
+      0.1 m/s, 0.1 m, 0.1 rad/s, 0.01 scaled by it), a dict of :class:`neurohover.tasks.sensor.Sensor`
+      settings (``velocity``, ``position``, ``rates``, ``attitude``, ``correlation``, ``level``) or
+      a ``Sensor``. Observations are then the noisy readings; reward and crash stay on the true
+      state. ``obs_delay``: control steps (0..10) the readings arrive late.
 
     ``reset(seed=..., options=...)`` takes the options ``{"mdp": spec}`` (same values as the
     ``mdp`` argument; it also applies to later episodes) and ``{"noise": (seed, episode)}``
@@ -342,13 +364,15 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         render_mode: str | None = None,
         obs_dtype: Any = "float64",
         action_dtype: Any = "float64",
+        obs_noise: Any = None,
+        obs_delay: Any = None,
         **unknown: Any,
     ) -> None:
         check_no_unknown_kwargs(unknown, ENV_KWARGS)
         self.render_mode = check_render_mode(render_mode)
         self.obs_dtype = check_obs_dtype(obs_dtype)
         self.action_dtype = check_action_dtype(action_dtype)
-        self.family: TaskFamily = get_task_family(task, sigma)
+        self.family: TaskFamily = sensed_family(task, sigma, obs_noise, obs_delay)
         self.episode_steps = check_episode_steps(episode_steps)
         self._spec: MDP | str = resolve_mdp(self.family, mdp)
         self.observation_space = observation_space(self.obs_dtype)
@@ -357,8 +381,8 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         self._rows = np.zeros((1, MDP_ROW_LEN))
         self._index = np.zeros(1, dtype=np.int64)
         self._state = initial_state()[None, :]
-        self._noise = np.zeros((1, 6))
-        self._rng = np.zeros((1, 4), dtype=np.uint64)
+        self._noise = np.zeros((1, ENV_NOISE_WIDTH))  # gust noise, then the sensor's state (one helicopter: always room for it)
+        self._rng = np.zeros((1, ENV_RNG_WIDTH), dtype=np.uint64)
         self._steps = np.zeros(1, dtype=np.int64)
         self._action = np.zeros((1, ACTION_DIM))
         self._obs = np.zeros((1, OBS_DIM))
@@ -413,6 +437,7 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         self._state[0] = initial_state()
         self._noise.fill(0.0)
         seed_stream(self._rng[0], np.uint64(stream[0]), np.uint64(stream[1]))
+        start_readings(self._rows, self._index, self._index, np.array([stream], dtype=np.int64), self._rng, self._noise, self._obs)
         self._steps[0] = 0
         self._done = False
         self._mdp_info = mdp_info(mdp)
@@ -420,7 +445,7 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         self._trail = [self._state[0, 3:6].copy()]
         if self.render_mode == "human":
             self.render()
-        return np.zeros(OBS_DIM, dtype=self.obs_dtype), self._info(False)
+        return self._obs[0].astype(self.obs_dtype), self._info(False)
 
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         if self._done:

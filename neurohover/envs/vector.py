@@ -29,9 +29,9 @@ from gymnasium.vector.utils import batch_space
 from ..errors import NeurohoverError
 from ..evaluate import check_device
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS, MDP_ROW_LEN, OBS_DIM
-from ..sim.kernel import step_batch
+from ..sim.kernel import ENV_NOISE_WIDTH, ENV_RNG_WIDTH, start_readings, step_batch
 from ..sim.rng import seed_stream
-from ..tasks import MDP, TaskFamily, get_task_family
+from ..tasks import MDP, TaskFamily
 from .hover import (
     RENDER_FPS,
     SAMPLE,
@@ -48,11 +48,14 @@ from .hover import (
     mdp_info,
     observation_space,
     resolve_mdp,
+    sensed_family,
 )
 
 MAX_NUM_ENVS = 10**7
 #: What ``gymnasium.make_vec`` may pass to :class:`HoverVectorEnv`.
-VECTOR_ENV_KWARGS = ("num_envs", "task", "sigma", "mdp", "episode_steps", "max_episode_steps", "render_mode", "obs_dtype", "device", "action_dtype")
+VECTOR_ENV_KWARGS = (
+    "num_envs", "task", "sigma", "mdp", "episode_steps", "max_episode_steps", "render_mode", "obs_dtype", "device", "action_dtype", "obs_noise", "obs_delay",
+)  # fmt: skip
 
 
 @nb.njit(cache=True)
@@ -69,7 +72,7 @@ class HoverVectorEnv(VectorEnv):
     ``obs_dtype="float32"``), actions (num_envs, 4); rewards (float64),
     terminations and truncations are (num_envs,) arrays. Sub-environments reset automatically
     in Gymnasium's ``NEXT_STEP`` mode: the step after sub-environment i terminated or was
-    truncated ignores its action and returns its new episode's first observation (all zeros),
+    truncated ignores its action and returns its new episode's first observation (all zeros; with noisy sensors their reading),
     reward 0 and ``terminated = truncated = False``.
 
     Parameters
@@ -139,6 +142,8 @@ class HoverVectorEnv(VectorEnv):
         obs_dtype: Any = "float64",
         device: str = "cpu",
         action_dtype: Any = "float64",
+        obs_noise: Any = None,
+        obs_delay: Any = None,
         **unknown: Any,
     ) -> None:
         check_no_unknown_kwargs(unknown, VECTOR_ENV_KWARGS)
@@ -150,7 +155,7 @@ class HoverVectorEnv(VectorEnv):
         n = int(num_envs)
         self.num_envs = n
         self.obs_dtype = check_obs_dtype(obs_dtype)
-        self.family: TaskFamily = get_task_family(task, sigma)
+        self.family: TaskFamily = sensed_family(task, sigma, obs_noise, obs_delay)
         self.episode_steps = check_episode_steps(episode_steps)
         self.max_episode_steps = self.episode_steps if max_episode_steps is None else check_episode_steps(max_episode_steps)
         self._limit = min(self.episode_steps, self.max_episode_steps)
@@ -164,7 +169,7 @@ class HoverVectorEnv(VectorEnv):
         self._rows = np.zeros((n, MDP_ROW_LEN))
         self._index = np.arange(n, dtype=np.int64)  # sub-environment i flies MDP row i
         self._state = np.tile(initial_state(), (n, 1))
-        self._noise = np.zeros((n, 6))
+        self._noise = np.zeros((n, 6))  # widened (_make_room_for_sensors) once an MDP with a sensor model is flown
         self._rng = np.zeros((n, 4), dtype=np.uint64)
         self._steps = np.zeros(n, dtype=np.int64)
         self._obs = np.zeros((n, OBS_DIM))  # the current observation of every sub-environment
@@ -185,6 +190,7 @@ class HoverVectorEnv(VectorEnv):
         self._all.setflags(write=False)
         self.device = device
         self._gpu = None
+        self._make_room_for_sensors(self._specs)
         if device == "cuda":
             from ..sim import cuda as sim_cuda  # numba.cuda is imported only when asked for
 
@@ -211,6 +217,23 @@ class HoverVectorEnv(VectorEnv):
     def steps(self) -> np.ndarray:
         """Control steps flown by each sub-environment in its current episode."""
         return self._steps.copy()
+
+    def _senses(self, specs: Sequence[MDP | str]) -> bool:
+        return any(not (self.family.sensor if isinstance(spec, str) else spec.sensor).exact for spec in specs)  # a str spec is SAMPLE
+
+    def _make_room_for_sensors(self, specs: Sequence[MDP | str]) -> None:
+        """Widen the per-helicopter noise and stream state for sensor models (kept narrow, and fast, without them)."""
+        if self._noise.shape[1] >= ENV_NOISE_WIDTH or not self._senses(specs):
+            return
+        if self._gpu is not None:
+            raise NeurohoverError(
+                "this vector environment on device='cuda' was made without a sensor model and cannot fly one now: "
+                "make it with obs_noise/obs_delay, or with the sensing MDPs as its mdp argument"
+            )
+        n = self.num_envs
+        noise, rng = np.zeros((n, ENV_NOISE_WIDTH)), np.zeros((n, ENV_RNG_WIDTH), dtype=np.uint64)
+        noise[:, :6], rng[:, :4] = self._noise, self._rng
+        self._noise, self._rng = noise, rng
 
     # -- argument checks -------------------------------------------------------------------
 
@@ -304,7 +327,10 @@ class HoverVectorEnv(VectorEnv):
         self._state[idx] = initial_state()
         self._noise[idx] = 0.0
         self._steps[idx] = 0
-        self._obs[idx] = 0.0  # the start state observes as all zeros
+        if self._noise.shape[1] >= ENV_NOISE_WIDTH:
+            start_readings(self._rows, self._index, idx, self._streams, self._rng, self._noise, self._obs)
+        else:
+            self._obs[idx] = 0.0  # the start state observes as all zeros
         if self._gpu is not None:
             self._gpu.set_rows(idx, self._rows[idx], self._state[idx], self._noise[idx], self._rng[idx], self._steps[idx])
 
@@ -350,6 +376,7 @@ class HoverVectorEnv(VectorEnv):
         streams = self._check_streams(options["noise"]) if "noise" in options else None
         if not self._ready and not mask.all():
             raise NeurohoverError("the first reset() must reset every sub-environment: leave out reset_mask")
+        self._make_room_for_sensors(specs)
         if isinstance(seed, (int, np.integer)):
             super().reset(seed=int(seed))
         idx = np.flatnonzero(mask)

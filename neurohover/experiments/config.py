@@ -128,6 +128,21 @@ def _resampling():
     return check
 
 
+def _sensor_table():
+    def check(v):
+        from ..tasks import Sensor
+
+        if not isinstance(v, dict):
+            return False, "a table of sensor settings (level, velocity, position, rates, attitude, correlation, delay)"
+        try:
+            Sensor.from_dict(v)
+        except NeurohoverError as exc:
+            return False, f"a valid sensor ({exc})"
+        return True, ""
+
+    return check
+
+
 def _policy_source():
     def check(v):
         return isinstance(v, str) and v != "", "'evolve', 'shipped' or a directory holding <task>/ policy sets"
@@ -141,6 +156,7 @@ _COMMON: dict[str, tuple[Any, Any]] = {
     "sigma": (None, _float(0.0, 1.0)),
     "seed": (_REQUIRED, lambda v: (isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= 2**63 - 1, "an integer in 0..2**63-1")),
     "n_steps": (6000, _int(1)),
+    "sensor": (_OMIT, _sensor_table()),  # every MDP of the experiment seen through these sensors (docs/benchmarks.md)
 }
 
 _VARIANT = {
@@ -163,6 +179,7 @@ _GROUP = {
     "hybrid": ({}, _table()),  # hybrid agents: replacement, model_from, rule, box, tilt (HybridSettings)
     "settings": (_OMIT, _table()),  # an agent's own typed settings (its spec's settings class), for agents that read them from it
     "estimator": ("ols", _choice("ols", "gls")),  # least squares of the LR models an agent learns
+    "sensor": (_OMIT, _sensor_table()),  # this group's agents fly the group's MDPs through these sensors
 }
 
 SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {

@@ -40,10 +40,22 @@ class Plan:
     waiting: tuple[str, ...] = ()  # why some units cannot be planned yet (unfinished sources)
 
 
-def _family(task: str, sigma: float | None):
+def _sensor(table: dict | None):
+    from ..tasks import Sensor
+
+    return None if table is None else Sensor.from_dict(table)
+
+
+def _family(task: str, sigma: float | None, sensor: dict | None = None):
+    """The experiment's task family (``sensor``: its ``sensor`` table, None: exact sensors)."""
     from ..tasks import family_for
 
-    return family_for(task, sigma)
+    return family_for(task, sigma, _sensor(sensor))
+
+
+def _family_target(s: dict, sigma: float | None) -> dict:
+    """An evolution unit's target "over the family": its task, breadth and (when set) sensor."""
+    return {"kind": "family", "task": s["task"], "sigma": sigma, **({"sensor": s["sensor"]} if "sensor" in s else {})}
 
 
 def _mdps(family, which: str, n: int, seed: int):
@@ -95,7 +107,7 @@ def external_digest(kind: str, s: dict) -> str:
 
 def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
     s = cfg.settings
-    family = _family(s["task"], s["sigma"])
+    family = _family(s["task"], s["sigma"], s.get("sensor"))
     units: list[Unit] = []
     base = {
         "budget": s["budget"],
@@ -119,9 +131,9 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
         else:
             sigma = v["sigma"] if v["sigma"] is not None else s["sigma"]
             if s["target"] == "zero":
-                target = {"kind": "mdp", "mdp": _family(s["task"], sigma).zero().to_dict()}
+                target = {"kind": "mdp", "mdp": _family(s["task"], sigma, s.get("sensor")).zero().to_dict()}
             else:
-                target = {"kind": "family", "task": s["task"], "sigma": sigma}
+                target = _family_target(s, sigma)
             for r in range(s["runs"]):
                 units.append(_unit(cfg, UnitKey.make("evolve", v["key"], rep=r), "evolve", {**common, "target": target}))
     total = len(units) + len(s["robustness_variants"]) * len(train)
@@ -215,7 +227,7 @@ class _Policies:
         self.cfg, self.results = cfg, results
         s = cfg.settings
         self.task = s["task"]
-        self.family = _family(s["task"], s["sigma"])
+        self.family = _family(s["task"], s["sigma"], s.get("sensor"))
         needs: set[str] = set()
         for g in s["groups"]:
             spec = _spec(g["agent"])
@@ -274,7 +286,7 @@ class _Policies:
                     else:
                         self._add(
                             UnitKey.make("policy", f"generic-{kind}{j}"),
-                            {"kind": "family", "task": self.task, "sigma": s["sigma"]},
+                            _family_target(s, s["sigma"]),
                             s["generic_budget"],
                             s["generic_resampling"].get(kind, FGHH_GENERIC_RESAMPLING[kind]),
                         )
@@ -354,6 +366,8 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dic
     settings = {k: s[k] for k in ("task", "sigma", "episodes", "n_steps", "model_budget", "predict_episodes", "max_learning_episodes")}
     for g in s["groups"]:
         mdps = _mdps(pol.family, g["mdps"], g["n_mdps"], s["seed"])
+        if "sensor" in g:  # this group's agents fly the same MDPs through sensors of its own
+            mdps = [m.with_sensor(_sensor(g["sensor"])) for m in mdps]
         counter = 0
         for i, mdp in enumerate(mdps):
             for rep in range(g["runs_per_mdp"]):
@@ -376,6 +390,7 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dic
                             "mdp": mdp.to_dict(),
                             "policies": policies,
                             "estimator": g["estimator"],
+                            **({"sensor": g.get("sensor", s.get("sensor"))} if "sensor" in g or "sensor" in s else {}),
                             **({"hybrid": hybrid} if hybrid else {}),
                             **({"agent_settings": g["settings"]} if "settings" in g else {}),
                         },
@@ -389,7 +404,7 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dic
 
 def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
     s = cfg.settings
-    family = _family(s["task"], s["sigma"])
+    family = _family(s["task"], s["sigma"], s.get("sensor"))
     units: list[Unit] = []
     total = len(s["methods"]) * s["n_mdps"]
     if s["generic"] == "evolve":

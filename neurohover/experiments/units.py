@@ -84,10 +84,10 @@ def _mdp(d: dict):
     return MDP.from_dict(d)
 
 
-def _family(task: str, sigma: float | None):
-    from ..tasks import family_for
+def _family(task: str, sigma: float | None, sensor: dict | None = None):
+    from ..tasks import Sensor, family_for
 
-    return family_for(task, sigma)
+    return family_for(task, sigma, None if sensor is None else Sensor.from_dict(sensor))
 
 
 def subsample(points: list[_P], n: int) -> list[_P]:
@@ -108,7 +108,7 @@ def _evolve_target(p: dict):
     t = p["target"]
     if t["kind"] == "mdp":
         return _mdp(t["mdp"])
-    return _family(t["task"], t.get("sigma"))
+    return _family(t["task"], t.get("sigma"), t.get("sensor"))
 
 
 def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:
@@ -276,7 +276,7 @@ def run_test_run(p: dict, threads: int | None, device: str = "cpu") -> dict:
     from ..agents.protocol import run_test
     from ..compete import after_learning_start
 
-    family = _family(p["task"], p.get("sigma"))
+    family = _family(p["task"], p.get("sigma"), p.get("sensor"))
     mdp = _mdp(p["mdp"])
     agent = unit_agent(p, device)
     r = run_test(agent, family, mdp, episodes=p["episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads, device=device)

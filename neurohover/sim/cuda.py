@@ -30,7 +30,7 @@ import numpy as np
 from numba.core.registry import CPUDispatcher
 
 from . import kernel, rng
-from .constants import MDP_ROW_LEN, ROW_DT, ROW_SUBSTEPS, SAFEGUARD_LIMITS
+from .constants import MDP_ROW_LEN, ROW_DT, ROW_SUBSTEPS, SAFEGUARD_LIMITS, SENSOR_SCRATCH
 
 try:  # numba-cuda (``pip install 'neurohover[cuda]'``) or numba's built-in target; may be broken or absent
     from numba import cuda
@@ -146,9 +146,13 @@ def _rollout_thread(
     j = cuda.grid(1)
     if j < job_policy.shape[0]:
         state = cuda.local.array(4, np.uint64)
+        sensor_state = cuda.local.array(4, np.uint64)
+        scratch = cuda.local.array(SENSOR_SCRATCH, np.float64)
         fly_job(
             j,
             state,
+            sensor_state,
+            scratch,
             mdp_rows,
             policy_kinds,
             genomes,

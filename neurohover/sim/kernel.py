@@ -28,6 +28,7 @@ from .constants import (
     GRAVITY,
     MAX_POSITION,
     MAX_RATE,
+    MAX_SENSOR_DELAY,
     MAX_VELOCITY,
     MIN_QW,
     MLP_STEEPNESS,
@@ -36,16 +37,20 @@ from .constants import (
     ROW_D_U,
     ROW_DT,
     ROW_NOISE_START,
+    ROW_SENSOR_START,
     ROW_SUBSTEPS,
     ROW_WIND_KIND,
     ROW_WIND_START,
+    SENSOR_SCRATCH,
     WIND_CONSTANT,
     WIND_SINUSOID,
 )
-from .rng import next_normal, seed_stream
+from .rng import SENSOR_STREAM_KEY, next_normal, seed_stream
 
 POLICY_SLP = 0
 POLICY_MLP = 1
+ENV_NOISE_WIDTH = 6 + SENSOR_SCRATCH  # step_batch's per-helicopter floats when it senses: gust noise, then the sensor's
+ENV_RNG_WIDTH = 8  # and uint64 words: the gust stream, then the sensor stream
 GENOME_WIDTH = 42  # genome rows are padded to the MLP's length
 SERIES_MAX_ANGLE = 0.5  # Taylor series below this rotation angle, libm above
 
@@ -254,6 +259,41 @@ def unpack_mdp(row):
     return dyn, noise_std, int(row[ROW_SUBSTEPS]), row[ROW_DT], wind
 
 
+@nb.njit(cache=True)
+def unpack_sensor(row):
+    """The sensor model of an MDP row: (velocity, position, rate, attitude std, AR(1) coefficient, delay), and whether it senses at all."""
+    s = ROW_SENSOR_START
+    sensor = (row[s], row[s + 1], row[s + 2], row[s + 3], row[s + 4], min(max(row[s + 5], 0.0), float(MAX_SENSOR_DELAY)))  # clamped: the buffer's size
+    on = row[s] != 0.0 or row[s + 1] != 0.0 or row[s + 2] != 0.0 or row[s + 3] != 0.0 or row[s + 5] != 0.0
+    return sensor, on
+
+
+@nb.njit(cache=True, inline="always", fastmath={"contract"})
+def sense(o, k, sensor, srng, scratch):
+    """What the sensors report at reading ``k`` (0: the reset) of true observation ``o``.
+
+    The reading is ``o`` plus noise e, e_0 = std z and e_k = rho e_(k-1) + sqrt(1 - rho^2) std z
+    (stationary std per entry group, 12 normals from the sensor stream ``srng`` per reading),
+    delivered ``delay`` readings late (the first reading until then). ``scratch``
+    (SENSOR_SCRATCH floats) holds e and the ring buffer of the last delay + 1 readings.
+    """
+    s_v, s_p, s_r, s_a, rho, d = sensor
+    delay = int(d)
+    gain = math.sqrt(1.0 - rho * rho)
+    put = 12 + (k % (delay + 1)) * 12
+    for i in range(12):
+        std = s_v if i < 3 else (s_p if i < 6 else (s_r if i < 9 else s_a))
+        z = next_normal(srng)
+        e = std * z if k == 0 else rho * scratch[i] + gain * (std * z)
+        scratch[i] = e
+        scratch[put + i] = o[i] + e
+    b = 12 + (max(k - delay, 0) % (delay + 1)) * 12
+    return (
+        scratch[b], scratch[b + 1], scratch[b + 2], scratch[b + 3], scratch[b + 4], scratch[b + 5],
+        scratch[b + 6], scratch[b + 7], scratch[b + 8], scratch[b + 9], scratch[b + 10], scratch[b + 11],
+    )  # fmt: skip
+
+
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
 def update_noise(n, std, z0, z1, z2, z3, z4, z5):
     """AR(1) gust noise update, once per control step, fed six standard normals."""
@@ -334,6 +374,8 @@ def _record(obs_out, act_out, slot, k, o, a1, a2, a3, a4):
 def fly_job(
     j,
     rng,
+    srng,
+    scratch,
     mdp_rows,
     policy_kinds,
     genomes,
@@ -353,13 +395,18 @@ def fly_job(
     out_steps,
     out_safeguard_step,
 ):
-    """Fly job ``j`` of :func:`rollout_batch` with ``rng`` (4 uint64) as its stream's state.
+    """Fly job ``j`` of :func:`rollout_batch` with ``rng`` (4 uint64) as its gust stream's state.
 
     The whole episode of one job, shared by the CPU kernel (one prange iteration) and the CUDA
-    kernel (one thread, :mod:`neurohover.sim.cuda`), so both targets compile this source.
+    kernel (one thread, :mod:`neurohover.sim.cuda`), so both targets compile this source. ``srng``
+    (4 uint64) and ``scratch`` (SENSOR_SCRATCH floats) serve the sensor model when the row has one:
+    the policy, the safeguard and the recording see ``seen``; reward and crash test the true state.
     """
     seed_stream(rng, np.uint64(seed), np.uint64(job_episode[j]))
     dyn, std, n_sub, dt, wind = unpack_mdp(mdp_rows[job_mdp[j]])
+    sensor, sensing = unpack_sensor(mdp_rows[job_mdp[j]])
+    if sensing:
+        seed_stream(srng, np.uint64(seed) ^ SENSOR_STREAM_KEY, np.uint64(job_episode[j]))
     pol = job_policy[j]
     kind = policy_kinds[pol]
     g = genomes[pol]
@@ -368,20 +415,21 @@ def fly_job(
     s = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)
     n = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     o = observe(s)
+    seen = sense(o, 0, sensor, srng, scratch) if sensing else o
     total = 0.0
     crash = False
     sg_step = -1
     t = 0
     for k in range(n_steps):
-        if safeguard and fb >= 0 and sg_step < 0 and dangerous(o, limits):
+        if safeguard and fb >= 0 and sg_step < 0 and dangerous(seen, limits):
             sg_step = k
             kind = policy_kinds[fb]
             g = genomes[fb]
-        a1, a2, a3, a4 = policy_action(kind, g, o[0], o[1], o[2], o[3], o[4], o[5], o[9], o[10], o[11])
+        a1, a2, a3, a4 = policy_action(kind, g, seen[0], seen[1], seen[2], seen[3], seen[4], seen[5], seen[9], seen[10], seen[11])
         t = k + 1
         if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
             if slot >= 0:
-                _record(obs_out, act_out, slot, k, o, a1, a2, a3, a4)
+                _record(obs_out, act_out, slot, k, seen, a1, a2, a3, a4)
             crash = True
             total += crash_charge(n_steps, t)
             break
@@ -390,10 +438,14 @@ def fly_job(
         a3 = _clip(a3)
         a4 = _clip(a4)
         if slot >= 0:
-            _record(obs_out, act_out, slot, k, o, a1, a2, a3, a4)
+            _record(obs_out, act_out, slot, k, seen, a1, a2, a3, a4)
         n = update_noise(n, std, next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng))
         s = integrate(s, n, a1, a2, a3, a4, k, dyn, n_sub, dt, wind)
         o = observe(s)
+        if sensing:
+            seen = sense(o, t, sensor, srng, scratch)
+        else:
+            seen = o
         if crashed(s):
             crash = True
             total += crash_charge(n_steps, t)
@@ -401,7 +453,7 @@ def fly_job(
         total += reward_of(o)
     if slot >= 0:
         for i in range(12):
-            obs_out[slot, t, i] = o[i]
+            obs_out[slot, t, i] = seen[i]
     out_return[j] = total
     out_crashed[j] = crash
     out_steps[j] = t
@@ -439,9 +491,13 @@ def rollout_batch(
     n_jobs = job_policy.shape[0]
     for j in nb.prange(n_jobs):
         rng = np.empty(4, dtype=np.uint64)
+        srng = np.empty(4, dtype=np.uint64)
+        scratch = np.empty(SENSOR_SCRATCH)
         fly_job(
             j,
             rng,
+            srng,
+            scratch,
             mdp_rows,
             policy_kinds,
             genomes,
@@ -473,6 +529,8 @@ def step_one(i, mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps,
     k = steps[i]
     t = k + 1
     steps[i] = t
+    sensor, sensing = unpack_sensor(mdp_rows[env_mdp[i]])
+    sensing = sensing and noise.shape[1] >= ENV_NOISE_WIDTH and rngs.shape[1] >= ENV_RNG_WIDTH  # (an env sizes them for its sensors)
     a1, a2, a3, a4 = actions[i, 0], actions[i, 1], actions[i, 2], actions[i, 3]
     if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
         o = observe(
@@ -492,6 +550,8 @@ def step_one(i, mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps,
                 states[i, 12],
             )
         )
+        if sensing:
+            o = sense(o, t, sensor, rngs[i, 4:], noise[i, 6:])
         for m in range(12):
             obs_out[i, m] = o[m]
         rew_out[i] = crash_charge(n_steps, t)
@@ -522,8 +582,9 @@ def step_one(i, mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps,
     for m in range(6):
         noise[i, m] = n[m]
     o = observe(s)
+    seen = sense(o, t, sensor, rngs[i, 4:], noise[i, 6:]) if sensing else o
     for m in range(12):
-        obs_out[i, m] = o[m]
+        obs_out[i, m] = seen[m]
     if crashed(s):
         rew_out[i] = crash_charge(n_steps, t)
         crash_out[i] = True
@@ -537,7 +598,28 @@ def step_batch(mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps, 
     """Advance many helicopters by one control step each (the vector environment's kernel).
 
     ``states`` (N, 13), ``noise`` (N, 6), ``rngs`` (N, 4) and ``steps`` (N,) are updated in place.
-    A non-finite action is a crash charged the full penalty. The body is :func:`step_one`.
+    A non-finite action is a crash charged the full penalty. The body is :func:`step_one`. Rows
+    with a sensor model need ``noise`` (N, ENV_NOISE_WIDTH) and ``rngs`` (N, ENV_RNG_WIDTH): the
+    gust state, then the sensor's (:func:`start_readings` starts it); ``obs_out`` gets the readings.
     """
     for i in range(states.shape[0]):
         step_one(i, mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps, obs_out, rew_out, crash_out)
+
+
+@nb.njit(cache=True)
+def start_readings(mdp_rows, env_mdp, idx, streams, rngs, noise, obs_out):
+    """The first reading of each new episode ``idx`` of :func:`step_batch`: zeros, or the sensors' reading of them.
+
+    ``streams`` (N, 2) holds each episode's (seed, episode); a sensing row's sensor stream is
+    seeded from it (as :func:`fly_job` seeds it) into ``rngs[i, 4:]`` and its noise kept in ``noise[i, 6:]``.
+    """
+    zero = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    for i in idx:
+        sensor, sensing = unpack_sensor(mdp_rows[env_mdp[i]])
+        seen = zero
+        if sensing and noise.shape[1] >= ENV_NOISE_WIDTH and rngs.shape[1] >= ENV_RNG_WIDTH:
+            srng = rngs[i, 4:]
+            seed_stream(srng, np.uint64(streams[i, 0]) ^ SENSOR_STREAM_KEY, np.uint64(streams[i, 1]))
+            seen = sense(zero, 0, sensor, srng, noise[i, 6:])
+        for m in range(12):
+            obs_out[i, m] = seen[m]

@@ -470,7 +470,7 @@ def rollout_lanes(
     Parameters
     ----------
     mdp_rows : numpy.ndarray
-        ``(M, 29)`` MDP rows.
+        ``(M, MDP_ROW_LEN)`` MDP rows.
     policy_kinds : numpy.ndarray of int64
         ``(P,)`` policy kinds (``kernel.POLICY_SLP`` or ``kernel.POLICY_MLP``).
     genomes : numpy.ndarray

@@ -86,6 +86,7 @@ class ReferenceMDP:
     substeps: int = 10
     dt: float = 0.01
     d_u: float = 0.0  # constant u acceleration of a learned model (0 in every true MDP)
+    sensor: Sequence[float] = (0.0,) * 6  # noise std of velocity, position, rates, attitude; AR(1) coefficient; delay
 
     def wind_at(self, t: float) -> Vec:
         """World-frame wind (m/s) at time t (for GHH-09, t as :func:`competition_time` floors it)."""
@@ -166,20 +167,52 @@ class ReferenceHelicopter:
         return -sum(o * o for o in self.observation()), False
 
 
+@dataclass
+class ReferenceSensors:
+    """The sensor model of docs/benchmarks.md, literally: noise e_k on each reading, delivered ``delay`` readings late."""
+
+    sensor: Sequence[float]
+    normals: Sequence[Sequence[float]]  # 12 standard normals per reading (rng.sensor_normals)
+    noise: list[float] = field(default_factory=lambda: [0.0] * 12)
+    readings: list[list[float]] = field(default_factory=list)
+
+    def read(self, observation: Sequence[float]) -> list[float]:
+        """The reading the policy gets now, of the true ``observation`` just made."""
+        k = len(self.readings)
+        rho, delay = self.sensor[4], int(self.sensor[5])
+        for i in range(12):
+            std = self.sensor[i // 3]  # groups of three entries: velocity, position, rates, attitude
+            z = self.normals[k][i]
+            self.noise[i] = std * z if k == 0 else rho * self.noise[i] + math.sqrt(1.0 - rho * rho) * std * z
+        self.readings.append([o + e for o, e in zip(observation, self.noise)])
+        return self.readings[max(k - delay, 0)]
+
+
 def fly_episode(
     mdp: ReferenceMDP,
     policy: Callable[[list[float]], Sequence[float]],
     normals: Sequence[Sequence[float]],
     n_steps: int = EPISODE_STEPS,
+    sensor_normals: Sequence[Sequence[float]] | None = None,
 ) -> tuple[float, bool, list[list[float]]]:
-    """Fly one episode; returns (return, crashed, observations after reset and every step)."""
+    """Fly one episode; returns (return, crashed, observations after reset and every step).
+
+    With ``sensor_normals`` (n_steps + 1 rows of 12, :func:`neurohover.sim.rng.sensor_normals`)
+    the policy flies on the readings of ``mdp.sensor``, and those readings are returned (as the
+    kernel records them); the reward stays on the true observation.
+    """
     heli = ReferenceHelicopter(mdp, episode_steps=n_steps)
-    observations = [heli.observation()]
+    sensors = None if sensor_normals is None else ReferenceSensors(mdp.sensor, sensor_normals)
+
+    def seen(observation: list[float]) -> list[float]:
+        return observation if sensors is None else sensors.read(observation)
+
+    observations = [seen(heli.observation())]
     total = 0.0
     for k in range(n_steps):
         reward, crash = heli.step(policy(observations[-1]), normals[k])
         total += reward
-        observations.append(heli.observation())
+        observations.append(seen(heli.observation()))
         if crash:
             return total, True, observations
     return total, False, observations

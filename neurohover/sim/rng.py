@@ -19,6 +19,7 @@ _GOLDEN = _U64(0x9E3779B97F4A7C15)
 _MIX1 = _U64(0xBF58476D1CE4E5B9)
 _MIX2 = _U64(0x94D049BB133111EB)
 _EPISODE_KEY = _U64(0xD1B54A32D192ED03)  # odd constant that separates episode indices from seeds
+SENSOR_STREAM_KEY = _U64(0x2545F4914F6CDD1D)  # xored into the seed: an episode's sensor noise has a stream of its own
 _TWO_POW_M53 = 1.0 / 9007199254740992.0
 
 
@@ -133,5 +134,21 @@ def episode_normals(seed: np.uint64, episode: np.uint64, n_steps: int) -> np.nda
     out = np.empty((n_steps, 6))
     for k in range(n_steps):
         for j in range(6):
+            out[k, j] = next_normal(state)
+    return out
+
+
+@nb.njit(cache=True)
+def sensor_normals(seed: np.uint64, episode: np.uint64, n_readings: int) -> np.ndarray:
+    """The (n_readings, 12) standard normals that episode ``episode`` of ``seed`` feeds the sensor noise.
+
+    One row per reading: the reset's, then one after every control step; the stream is the gusts'
+    stream of seed ``seed ^ SENSOR_STREAM_KEY``, so sensor noise never shifts the gusts.
+    """
+    state = np.empty(4, dtype=np.uint64)
+    seed_stream(state, seed ^ SENSOR_STREAM_KEY, episode)
+    out = np.empty((n_readings, 12))
+    for k in range(n_readings):
+        for j in range(12):
             out[k, j] = next_normal(state)
     return out

@@ -30,6 +30,7 @@ from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, co
 from .fghh import COMPETITION_FGHH_SIGMA, FGHH
 from .ghh08 import GHH08, MAX_WIND
 from .ghh09 import GHH09, GHH09_PARAM_NAMES
+from .sensor import EXACT, Sensor
 
 _FIRST = ("ghh08", "ghh09", "fghh")  # the paper's order in help texts; other families follow by name
 
@@ -54,8 +55,14 @@ TASK_FAMILIES: dict[str, type[TaskFamily]] = discover(__name__)
 TASK_NAMES: tuple[str, ...] = tuple(TASK_FAMILIES)
 
 
-def get_task_family(name: str, sigma: float | None = None) -> TaskFamily:
-    """The task family called ``name`` (``ghh08``, ``ghh09``, ``fghh``, ...; ``sigma``: its breadth, where it has one)."""
+def get_task_family(name: str, sigma: float | None = None, sensor: Sensor | None = None) -> TaskFamily:
+    """The task family called ``name`` (``ghh08``, ``ghh09``, ``fghh``, ...; ``sigma``: its breadth, where it has one),
+    seen through ``sensor`` (:mod:`neurohover.tasks.sensor`; None: exact sensors)."""
+    family = _family(name, sigma)
+    return family if sensor is None or sensor.exact else family.with_sensor(sensor)
+
+
+def _family(name: str, sigma: float | None) -> TaskFamily:
     key = str(name).lower().replace("-", "")
     if key not in TASK_FAMILIES:
         raise NeurohoverError(f"unknown task {name!r}: allowed {', '.join(TASK_NAMES)}")
@@ -68,11 +75,11 @@ def get_task_family(name: str, sigma: float | None = None) -> TaskFamily:
     return cls()
 
 
-def family_for(name: str, sigma: float | None) -> TaskFamily:
+def family_for(name: str, sigma: float | None, sensor: Sensor | None = None) -> TaskFamily:
     """Like :func:`get_task_family`, but a ``sigma`` is ignored for families without one (configs carry one for all)."""
     key = str(name).lower().replace("-", "")
     has = key in TASK_FAMILIES and TASK_FAMILIES[key].has_sigma
-    return get_task_family(name, sigma if has else None)
+    return get_task_family(name, sigma if has else None, sensor)
 
 
 __all__ = [
@@ -86,6 +93,8 @@ __all__ = [
     "MDP",
     "N_TEST",
     "N_TRAINING",
+    "EXACT",
+    "Sensor",
     "TASK_FAMILIES",
     "TASK_NAMES",
     "TaskFamily",

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import copy
+import functools
 import json
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +20,7 @@ from ..sim.constants import (
     ROW_DT,
     ROW_NOISE,
     ROW_PARAMS,
+    ROW_SENSOR,
     ROW_SUBSTEPS,
     ROW_WIND_KIND,
     ROW_WIND_START,
@@ -26,12 +29,13 @@ from ..sim.constants import (
     WIND_NONE,
 )
 from ..sim.reference import ReferenceMDP
+from .sensor import EXACT, Sensor
 
 N_TRAINING = 10
 N_TEST = 100
 _SET_ENTROPY = 20110401  # fixed root of the seeded training and test sets (the paper's year)
-_FIXED_SETS: dict[tuple[str, int, int], tuple[MDP, ...]] = {}
-_ROW_LAYOUTS: dict[tuple[str, int], np.ndarray] = {}
+_FIXED_SETS: dict[tuple[str, int, int, Sensor], tuple[MDP, ...]] = {}
+_ROW_LAYOUTS: dict[tuple[str, int, Sensor], np.ndarray] = {}
 COMPETITION_MDPS_FILE = Path(__file__).parent.parent / "data" / "competition-mdps.json"
 _COMPETITION: dict[str, dict] = {}
 
@@ -59,6 +63,8 @@ class MDP:
         may fit it (a constant wind acts near hover as a constant acceleration).
     label : str
         Human-readable name, e.g. ``"ghh08/train:3"``.
+    sensor : Sensor
+        What the policy sees (:mod:`neurohover.tasks.sensor`); exact sensors by default.
     """
 
     family: str
@@ -70,8 +76,11 @@ class MDP:
     dt: float = SUBSTEP_DT
     label: str = field(default="", compare=False)
     d_u: float = 0.0
+    sensor: Sensor = EXACT
 
     def __post_init__(self) -> None:
+        if not isinstance(self.sensor, Sensor):
+            raise NeurohoverError(f"sensor must be a neurohover Sensor, got {self.sensor!r}")
         # Plain Python numbers (the same values): reprs read MDP(params=(-0.18, ...)), not np.float64(-0.18).
         for name in ("params", "noise_std", "wind"):
             object.__setattr__(self, name, tuple(float(x) for x in getattr(self, name)))
@@ -88,15 +97,21 @@ class MDP:
         row[ROW_WIND_KIND] = self.wind_kind
         row[ROW_WIND_START : ROW_WIND_START + len(self.wind)] = self.wind
         row[ROW_D_U] = self.d_u
+        row[ROW_SENSOR] = self.sensor.row_values()
         return row
+
+    def with_sensor(self, sensor: Sensor) -> MDP:
+        """The same MDP seen through ``sensor``."""
+        return replace(self, sensor=sensor)
 
     def to_reference(self) -> ReferenceMDP:
         """The same MDP for the plain-Python reference simulator."""
         wind = tuple(self.wind) + (0.0,) * (8 - len(self.wind))
-        return ReferenceMDP(self.params, self.noise_std, self.wind_kind, wind, self.substeps, self.dt, self.d_u)
+        return ReferenceMDP(self.params, self.noise_std, self.wind_kind, wind, self.substeps, self.dt, self.d_u, self.sensor.row_values())
 
     def to_dict(self) -> dict:
-        return {
+        """The MDP as plain data (``sensor`` only when not exact, so older dicts read the same)."""
+        d = {
             "family": self.family,
             "params": list(self.params),
             "noise_std": list(self.noise_std),
@@ -107,6 +122,9 @@ class MDP:
             "label": self.label,
             "d_u": self.d_u,
         }
+        if not self.sensor.exact:
+            d["sensor"] = self.sensor.to_dict()
+        return d
 
     @classmethod
     def from_dict(cls, d: dict) -> MDP:
@@ -120,6 +138,7 @@ class MDP:
             float(d["dt"]),
             d.get("label", ""),
             float(d.get("d_u", 0.0)),
+            Sensor.from_dict(d["sensor"]) if "sensor" in d else EXACT,
         )
 
 
@@ -150,6 +169,34 @@ def competition_families() -> tuple[str, ...]:
     return tuple(k for k, v in _COMPETITION.items() if isinstance(v, dict) and "train" in v)  # not its "about" note
 
 
+def _through_sensor(method):
+    """``method`` (a family's make or zero) with the family's sensor put on the MDP it returns."""
+
+    @functools.wraps(method)
+    def made(self, *args, **kwargs):
+        mdp = method(self, *args, **kwargs)
+        return mdp if self.sensor.exact else mdp.with_sensor(self.sensor)
+
+    return made
+
+
+def _family_eq(self, other) -> bool:
+    if type(other) is not type(self):
+        return NotImplemented
+    return all(getattr(self, f.name) == getattr(other, f.name) for f in fields(self)) and self.sensor == other.sensor
+
+
+def _family_hash(self) -> int:
+    return hash((type(self).__name__, *(getattr(self, f.name) for f in fields(self)), self.sensor))
+
+
+def _family_repr(self) -> str:
+    args = [f"{f.name}={getattr(self, f.name)!r}" for f in fields(self)]
+    if not self.sensor.exact:
+        args.append(f"sensor={self.sensor!r}")
+    return f"{type(self).__name__}({', '.join(args)})"
+
+
 class TaskFamily:
     """A task family: a distribution G over MDPs, each MDP fixed by ``n_params`` numbers.
 
@@ -171,6 +218,8 @@ class TaskFamily:
     generic_over_distribution : bool
         Whether its generic policies are evolved over G (FGHH: fixed resampling and races) rather
         than on the zero setting (GHH-08, GHH-09); decides the layout of its policy set.
+    sensor : Sensor
+        What the policy sees in every MDP of the family (:meth:`with_sensor`; exact by default).
     """
 
     name: str = ""
@@ -181,6 +230,25 @@ class TaskFamily:
     has_sigma: bool = False
     sigma: float | None = None  # the breadth of G, for families with has_sigma
     generic_over_distribution: bool = False
+    sensor: Sensor = EXACT  # set on a copy by with_sensor(); part of the family's identity
+
+    def __init_subclass__(cls, **kwargs) -> None:
+        super().__init_subclass__(**kwargs)
+        for name in ("make", "zero"):  # the one place a family's MDPs get its sensor
+            if name in cls.__dict__:
+                setattr(cls, name, _through_sensor(cls.__dict__[name]))
+        # Defined before the dataclass decorator runs, so it keeps them: equality includes the sensor.
+        cls.__eq__ = _family_eq  # type: ignore[method-assign]
+        cls.__hash__ = _family_hash  # type: ignore[method-assign]
+        cls.__repr__ = _family_repr  # type: ignore[method-assign]
+
+    def with_sensor(self, sensor: Sensor) -> TaskFamily:
+        """This family seen through ``sensor``: every MDP it makes, samples or lists carries it."""
+        if not isinstance(sensor, Sensor):
+            raise NeurohoverError(f"sensor must be a neurohover Sensor, got {sensor!r}")
+        out = copy.copy(self)
+        object.__setattr__(out, "sensor", sensor)
+        return out
 
     # -- what a family defines ------------------------------------------------------------
 
@@ -220,7 +288,7 @@ class TaskFamily:
 
     def row_template(self) -> np.ndarray:
         """The kernel row every sampled MDP shares outside :attr:`row_slice` (checked once against :meth:`make`)."""
-        key = (self.name, self.set_variant())
+        key = (self.name, self.set_variant(), self.sensor)
         if key not in _ROW_LAYOUTS:
             probe = self.sample_params(np.random.default_rng(0), 1)[0]
             template = self.make(probe).row()
@@ -243,14 +311,14 @@ class TaskFamily:
         return self.rows(self.sample_params(rng, n))
 
     def _seeded_set(self, which: int, n: int, kind: str) -> list[MDP]:
-        key = (self.name, self.set_variant(), which)
+        key = (self.name, self.set_variant(), which, self.sensor)
         if key not in _FIXED_SETS:  # MDPs are immutable, so each set is built once per process
             rng = np.random.default_rng(np.random.SeedSequence([_SET_ENTROPY, self.set_code, which, self.set_variant()]))
             _FIXED_SETS[key] = tuple(self.make(self.sample_params(rng, 1)[0], label=f"{self.name}/{kind}:{i}") for i in range(n))
         return list(_FIXED_SETS[key])
 
     def _competition_set(self, kind: str) -> list[MDP]:
-        key = (self.name, -1, 0 if kind == "train" else 1)
+        key = (self.name, -1, 0 if kind == "train" else 1, self.sensor)
         if key not in _FIXED_SETS:
             rows = competition_rows(self.name)[kind]
             _FIXED_SETS[key] = tuple(self.make(self.competition_params(r), label=f"{self.name}/{kind}:{i}") for i, r in enumerate(rows))

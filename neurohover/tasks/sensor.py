@@ -1,0 +1,176 @@
+"""The sensor model of an MDP: what the policy sees when the sensors are noisy or late (docs/benchmarks.md).
+
+The simulator's transition dynamics are noisy but its observations are exact; the paper (Section
+7) names noisy sensors as the harder benchmark it leaves out. A :class:`Sensor` makes the 12
+observation entries that the policy, the safeguard and the recorded flight data see
+
+    reading_k = o_k + e_k,   e_0 = std z_0,   e_k = rho e_(k-1) + sqrt(1 - rho^2) std z_k
+
+(z_k: 12 standard normals from the episode's own sensor stream, so noise never shifts the gusts;
+std: one per group of three entries), delivered ``delay`` control steps late (the reset's reading
+until the first one arrives). Reward and crash test stay on the true state, as in the simulator.
+``rho = 0`` is white noise; ``rho`` near 1 drifts as motion-capture errors do. The exact sensor
+(all zero) leaves every result bit-identical to a simulator without one.
+
+=============  =======  ==========================================================
+setting        unit     meaning
+=============  =======  ==========================================================
+velocity       m/s      std of the noise on u, v, w (body frame)
+position       m        std of the noise on x, y, z (body frame)
+rates          rad/s    std of the noise on p, q, r
+attitude       1        std of the noise on the quaternion's qx, qy, qz
+correlation    1        AR(1) coefficient rho of the noise, 0 <= rho < 1
+delay          steps    control steps (0.1 s each) the readings arrive late, 0..10
+=============  =======  ==========================================================
+
+A noise *level* L is the profile ``L * (0.1 m/s, 0.1 m, 0.1 rad/s, 0.01)``: at level 1 each
+entry's noise is about the size of the baseline policy's typical hovering error on it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, fields, replace
+
+from ..errors import NeurohoverError
+from ..sim.constants import MAX_SENSOR_DELAY, SENSOR_GROUPS
+
+#: The std of each group at noise level 1 (velocity m/s, position m, rates rad/s, attitude).
+LEVEL_PROFILE = (0.1, 0.1, 0.1, 0.01)
+
+
+@dataclass(frozen=True)
+class Sensor:
+    """Noisy, correlated, late sensors; ``Sensor()`` is exact (see the module docstring's table)."""
+
+    velocity: float = 0.0
+    position: float = 0.0
+    rates: float = 0.0
+    attitude: float = 0.0
+    correlation: float = 0.0
+    delay: int = 0
+
+    def __post_init__(self) -> None:
+        for name in (*SENSOR_GROUPS, "correlation"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+                raise NeurohoverError(f"sensor {name}={value!r} is out of range: allowed a finite number >= 0")
+            object.__setattr__(self, name, float(value))
+        if self.correlation >= 1.0:
+            raise NeurohoverError(f"sensor correlation={self.correlation!r} is out of range: allowed 0 <= correlation < 1")
+        d = self.delay
+        if isinstance(d, bool) or not isinstance(d, int) or not 0 <= d <= MAX_SENSOR_DELAY:
+            raise NeurohoverError(f"sensor delay={d!r} is out of range: allowed an integer number of control steps in 0..{MAX_SENSOR_DELAY}")
+
+    @property
+    def exact(self) -> bool:
+        """Whether the sensors report the true observation at once (no noise, no delay)."""
+        return self == EXACT
+
+    @property
+    def stds(self) -> tuple[float, float, float, float]:
+        """The noise std of each group of three observation entries (velocity, position, rates, attitude)."""
+        return (self.velocity, self.position, self.rates, self.attitude)
+
+    def row_values(self) -> tuple[float, ...]:
+        """The six numbers of an MDP row's sensor slots (``sim.constants.ROW_SENSOR``)."""
+        return (*self.stds, self.correlation, float(self.delay))
+
+    @classmethod
+    def from_row_values(cls, values) -> Sensor:
+        """The sensor of an MDP row's six sensor slots (refused clearly when they are not a valid sensor)."""
+        v = [float(x) for x in values]
+        if not float(v[5]).is_integer():
+            raise NeurohoverError(f"sensor delay={v[5]!r} in an MDP row is not a whole number of control steps")
+        return cls(v[0], v[1], v[2], v[3], correlation=v[4], delay=int(v[5]))
+
+    @classmethod
+    def at_level(cls, level: float, correlation: float = 0.0, delay: int = 0) -> Sensor:
+        """The sensor of noise level ``level``: :data:`LEVEL_PROFILE` scaled by it."""
+        if isinstance(level, bool) or not isinstance(level, (int, float)) or not math.isfinite(level) or level < 0:
+            raise NeurohoverError(f"sensor noise level={level!r} is out of range: allowed a finite number >= 0")
+        v, p, r, a = (level * s for s in LEVEL_PROFILE)
+        return cls(v, p, r, a, correlation=correlation, delay=delay)
+
+    @classmethod
+    def parse(cls, text: str, delay: int = 0) -> Sensor:
+        """A sensor from the command line: a level (``"0.5"``) or ``key=value`` pairs (``"position=0.2,correlation=0.9"``).
+
+        Keys are the settings of the module's table plus ``level`` (the profile scaled, before
+        any group std given beside it); ``delay`` applies unless the text sets one.
+        """
+        text = str(text).strip()
+        allowed = ("level", *(f.name for f in fields(cls)))
+        try:
+            return cls.at_level(float(text), delay=delay)
+        except ValueError as exc:
+            if isinstance(exc, NeurohoverError):
+                raise
+        settings: dict[str, float] = {}
+        expected = f"allowed a noise level (e.g. 0.5) or key=value pairs with keys {', '.join(allowed)}"
+        for part in filter(None, (p.strip() for p in text.split(","))):
+            key, eq, value = part.partition("=")
+            key = key.strip()
+            if not eq or key not in allowed:
+                raise NeurohoverError(f"sensor setting {part!r} is not understood: {expected}")
+            try:
+                settings[key] = float(value)
+            except ValueError:
+                raise NeurohoverError(f"sensor setting {part!r} needs a number after '='") from None
+        if not settings:
+            raise NeurohoverError(f"sensor {text!r} is empty: {expected}")
+        base = cls.at_level(settings.pop("level", 0.0))
+        values = asdict(base) | {"delay": delay} | settings
+        if not float(values["delay"]).is_integer():
+            raise NeurohoverError(f"sensor delay={values['delay']!r} is not a whole number of control steps")
+        values["delay"] = int(values["delay"])
+        return cls(**values)
+
+    @classmethod
+    def of(cls, obs_noise=None, obs_delay=None) -> Sensor:
+        """The sensor of the ``obs_noise`` / ``obs_delay`` options (of the CLI, the configs and the environments).
+
+        ``obs_noise``: None (no noise), a level (a number), a :class:`Sensor`, a dict of its
+        settings, or the command line's text (:meth:`parse`); ``obs_delay``: None or the control
+        steps the readings arrive late (given once: a Sensor or dict that sets another refuses it).
+        """
+        if obs_delay is None:
+            delay = None
+        elif isinstance(obs_delay, bool) or not isinstance(obs_delay, int) and not (isinstance(obs_delay, float) and obs_delay.is_integer()):
+            raise NeurohoverError(f"obs_delay={obs_delay!r} is not allowed: give a whole number of control steps in 0..{MAX_SENSOR_DELAY}")
+        else:
+            delay = int(obs_delay)
+        if obs_noise is None:
+            return cls(delay=delay or 0)
+        if isinstance(obs_noise, Sensor):
+            sensor = obs_noise
+        elif isinstance(obs_noise, dict):
+            sensor = cls.from_dict(obs_noise)
+        elif isinstance(obs_noise, str):
+            sensor = cls.parse(obs_noise)
+        else:
+            sensor = cls.at_level(obs_noise)
+        if delay is None:
+            return sensor
+        if sensor.delay not in (0, delay):
+            raise NeurohoverError(f"obs_delay={delay} conflicts with the delay={sensor.delay} that obs_noise sets: give the delay once")
+        return replace(sensor, delay=delay)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> Sensor:
+        """A sensor from a dict of the settings (unknown keys refused by name)."""
+        if not isinstance(d, dict):
+            raise NeurohoverError(f"a sensor must be a table of settings, got {d!r}")
+        allowed = {f.name for f in fields(cls)}
+        unknown = sorted(set(d) - allowed - {"level"})
+        if unknown:
+            raise NeurohoverError(f"unknown sensor setting(s) {', '.join(map(repr, unknown))}: allowed level, {', '.join(sorted(allowed))}")
+        d = dict(d)
+        base = cls.at_level(d.pop("level", 0.0))
+        return cls(**(asdict(base) | d))
+
+
+EXACT = Sensor()
