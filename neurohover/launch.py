@@ -18,7 +18,7 @@ import numba
 import numpy as np
 
 from .errors import NeurohoverError
-from .sim.constants import MDP_ROW_LEN, ROW_SENSOR, ROW_SUBSTEPS, ROW_WIND_KIND, SAFEGUARD_LIMITS
+from .sim.constants import MDP_ROW_LEN, ROW_SUBSTEPS, ROW_WIND_KIND, SAFEGUARD_LIMITS
 from .sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
 from .sim.lanes import LANES, rollout_lanes
 
@@ -108,7 +108,7 @@ def use_lanes(device: str, rows: np.ndarray, m_idx: np.ndarray, fb: np.ndarray |
     """Whether the jobs fly in SIMD lanes (:func:`neurohover.sim.lanes.rollout_lanes`) rather than the scalar kernel.
 
     Any CPU batch of at least LANES jobs (below that a thread's lanes would mostly idle) without
-    recording, safeguard or sensor model (the lanes implement none of them); policies and MDP rows may differ per job.
+    recording or safeguard (the lanes implement neither); policies, MDP rows and their sensor models may differ per job.
     Restriction: the jobs' rows must share the substep count (learned models 1, true MDPs 10) and
     whether there is wind, because the packed substep loop takes both as constants; per-lane
     values would turn it into per-lane branches that no longer vectorize. Results are the same
@@ -118,11 +118,10 @@ def use_lanes(device: str, rows: np.ndarray, m_idx: np.ndarray, fb: np.ndarray |
     if device != "cpu" or n_jobs < LANES or (fb is not None and (fb >= 0).any()) or (rec is not None and rec.any()):
         return False
     sub, windy = rows[:, ROW_SUBSTEPS], rows[:, ROW_WIND_KIND] != 0.0
-    sensing: np.ndarray = (rows[:, ROW_SENSOR] != 0.0).any(axis=1)
-    if (sub == sub[0]).all() and (windy == windy[0]).all() and not sensing.any():
+    if (sub == sub[0]).all() and (windy == windy[0]).all():
         return True  # every row alike: no need to look at the jobs
     used = np.unique(m_idx)
-    return bool((sub[used] == sub[used[0]]).all()) and bool((windy[used] == windy[used[0]]).all()) and not sensing[used].any()
+    return bool((sub[used] == sub[used[0]]).all()) and bool((windy[used] == windy[used[0]]).all())
 
 
 DEVICES = ("cpu", "cuda")

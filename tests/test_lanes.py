@@ -17,8 +17,10 @@ from neurohover.policies import GENOME_LENGTH
 from neurohover.sim.constants import SAFEGUARD_LIMITS
 from neurohover.sim.kernel import POLICY_SLP, rollout_batch
 from neurohover.sim.lanes import LANES, fly_lanes, rollout_lanes
+from neurohover.tasks import Sensor
 
-ZERO = get_task_family("fghh").zero().row()
+ZERO_MDP = get_task_family("fghh").zero()
+ZERO = ZERO_MDP.row()
 COARSE = ZERO.copy()
 COARSE[17], COARSE[18] = 1, 0.1  # one substep of 0.1 s, as a learned model flies
 MLP = PolicyTable.from_policies([prototype("mlp", "baseline")])
@@ -89,6 +91,11 @@ CASES = {
 for _fam in ("ghh08", "ghh09"):
     for _m in get_task_family(_fam).test_mdps()[:2]:
         CASES[f"{_m.label} MLP"] = (MLP, _m.row())
+# Sensor models: readings from kernel.sense, scalar per lane (white, correlated, late, and a crashing policy on them).
+_SENSED = get_task_family("ghh09").test_mdps()[0]
+CASES["white sensors MLP"] = (MLP, _SENSED.with_sensor(Sensor.at_level(1.0)).row())
+CASES["correlated late sensors baseline"] = (PolicyTable.from_policies([baseline_policy()]), _SENSED.with_sensor(Sensor.at_level(1.5, 0.9, 2)).row())
+CASES["late sensors, crashing MLP"] = (_perturbed(0.06), ZERO_MDP.with_sensor(Sensor(delay=4)).row())
 
 
 @pytest.mark.parametrize("name", list(CASES))
@@ -98,6 +105,16 @@ def test_lanes_bit_identical_to_scalar_kernel(name: str, threads: int) -> None:
     episodes = np.arange(3, 3 + 2 * LANES + 3, dtype=np.int64)  # not a multiple of LANES
     ref = _scalar(table, row, 11, episodes, 6000)
     _assert_same(_lanes(table, row, 11, episodes, 6000, threads), ref)
+
+
+def test_lanes_bit_identical_with_rows_that_sense_and_rows_that_do_not() -> None:
+    other = get_task_family("fghh").test_mdps()[3]  # rows alike in substeps and wind, as the lanes need
+    rows = np.stack([ZERO, other.with_sensor(Sensor.at_level(1.0, 0.5, 1)).row(), other.row()])
+    table = _perturbed(0.06)
+    n = 3 * LANES + 2
+    episodes = np.arange(n, dtype=np.int64)
+    m = np.arange(n, dtype=np.int64) % 3
+    _assert_same(_lanes(table, rows, 5, episodes, 1500, 2, m=m), _scalar(table, rows, 5, episodes, 1500, m=m))
 
 
 @pytest.mark.parametrize("n_jobs", [1, LANES - 1, LANES, LANES + 1, 3 * LANES, 5 * LANES + 3])

@@ -151,12 +151,15 @@ def test_the_noise_has_the_stated_std_and_correlation() -> None:
     np.testing.assert_allclose(rho, 0.7, atol=0.04)
 
 
-def test_sensing_batches_fly_in_the_scalar_kernel_not_the_lanes() -> None:
-    family = get_task_family("fghh")
-    rows = family.sample_rows(np.random.default_rng(0), LANES)
-    idx = np.arange(LANES)
+def test_sensing_batches_fly_in_the_lanes_with_the_scalar_kernels_results() -> None:
+    family = get_task_family("fghh").with_sensor(Sensor.at_level(1.0, correlation=0.8, delay=2))
+    rows = family.sample_rows(np.random.default_rng(0), 3)
+    n = 2 * LANES + 1
+    idx = np.arange(n) % 3
     assert use_lanes("cpu", rows, idx)
-    assert not use_lanes("cpu", family.with_sensor(Sensor(delay=1)).sample_rows(np.random.default_rng(0), LANES), idx)
+    lanes = evaluate_jobs([baseline_policy()], rows, [0] * n, idx, range(n), seed=2, n_steps=400)
+    scalar = evaluate_jobs([baseline_policy()], rows, [0] * n, idx, range(n), seed=2, n_steps=400, record=[True] + [False] * (n - 1))
+    assert np.array_equal(lanes.returns, scalar.returns) and np.array_equal(lanes.steps, scalar.steps)
 
 
 def test_safeguard_sees_the_readings() -> None:
