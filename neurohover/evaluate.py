@@ -23,7 +23,7 @@ import numpy as np
 from .errors import NeurohoverError
 from .flightdata import FlightData
 from .flyer import KernelFlyer
-from .launch import DEVICES, KIND, MAX_SEED, check_device, launch, num_threads, use_lanes
+from .launch import DEVICES, KIND, MAX_SEED, Batch, Flown, check_device, launch, num_threads, use_lanes
 from .policies import GENOME_LENGTH, TOPOLOGIES, Policy, load_policy
 from .sim.constants import (
     EPISODE_STEPS,
@@ -266,24 +266,18 @@ def evaluate_jobs(
     n_rec = int(rec.sum())
     obs_out = np.zeros((n_rec, n_steps + 1, 12))
     act_out = np.zeros((n_rec, n_steps, 4))
-    returns = np.empty(n_jobs)
-    crashed = np.empty(n_jobs, dtype=np.bool_)
-    steps = np.empty(n_jobs, dtype=np.int64)
-    sg_step = np.empty(n_jobs, dtype=np.int64)
+    batch = Batch(rows, table.kinds, table.genomes, p_idx, m_idx, e_idx, seed, n_steps, fb, limits, slots, obs_out, act_out)
+    out = Flown.empty(n_jobs)
     with num_threads(threads):
-        seconds = launch(
-            rows, table.kinds, table.genomes, p_idx, m_idx, e_idx, np.uint64(seed), n_steps, returns, crashed, steps, sg_step,
-            device=device, fallback=fb, safeguard=bool((fb >= 0).any()), limits=limits,
-            slots=slots, recording=bool(n_rec), obs_out=obs_out, act_out=act_out,
-        )  # fmt: skip
+        seconds = launch(batch, out, device)
     flight = None
     if n_rec:
-        rec_steps = steps[rec]
+        rec_steps = out.steps[rec]
         flight = FlightData(
             tuple(obs_out[i, : rec_steps[i] + 1].copy() for i in range(n_rec)),
             tuple(act_out[i, : rec_steps[i]].copy() for i in range(n_rec)),
         )
-    return Evaluation(returns, crashed, steps, sg_step, flight, seconds)
+    return Evaluation(out.returns, out.crashed, out.steps, out.safeguard_step, flight, seconds)
 
 
 def evaluate(

@@ -6,7 +6,7 @@ import numba
 import numpy as np
 
 from .errors import NeurohoverError
-from .launch import KIND, MAX_SEED, check_device, launch
+from .launch import KIND, MAX_SEED, Batch, Flown, check_device, launch
 from .policies import GENOME_LENGTH, TOPOLOGIES
 from .sim.constants import SAFEGUARD_LIMITS
 from .sim.kernel import GENOME_WIDTH
@@ -86,8 +86,6 @@ class KernelFlyer:
         self._p_cap = 0
         self._j_cap = 0
         self._limits = np.asarray(SAFEGUARD_LIMITS, dtype=float)
-        self._obs = np.zeros((0, 1, 12))
-        self._act = np.zeros((0, 1, 4))
         self._views: dict[int, tuple] = {}
         self._ensure(64, 512)
 
@@ -173,10 +171,8 @@ class KernelFlyer:
                 self._threads = want
         # (CUDA: the launcher copies the inputs to the GPU and the results back on every call,
         # acceptable while a generation's jobs are few; the thread count does not apply.)
-        self.kernel_seconds += launch(
-            rows, self._kinds, self._genomes, p, m, e, self.seed, self.n_steps, returns, crashed, steps, sg,
-            device=self.device, fallback=minus, limits=self._limits, slots=minus, obs_out=self._obs, act_out=self._act,
-        )  # fmt: skip
+        batch = Batch(rows, self._kinds, self._genomes, p, m, e, self.seed, self.n_steps, minus, self._limits, minus, safeguard=False, recording=False)
+        self.kernel_seconds += launch(batch, Flown(returns, crashed, steps, sg), self.device)
         if self.trace is not None:
             self.trace.append((genomes.copy(), rows, p.copy(), m.copy(), e.copy()))
         if episode_index is None:

@@ -4,8 +4,11 @@ A batch flies in the SIMD lanes (:func:`neurohover.sim.lanes.rollout_lanes`: CPU
 ``LANES`` jobs, no recording or safeguard, rows alike in substeps and wind), in the CUDA build of
 the kernel (``device="cuda"``), or in the scalar kernel (:func:`neurohover.sim.kernel.rollout_batch`);
 all three give the same returns (the lanes and the scalar kernel bit for bit). :func:`launch` makes
-that choice and the call; :func:`neurohover.evaluate_jobs` (validated, any jobs) and
-:class:`neurohover.flyer.KernelFlyer` (an evolution's fast path) both fly through it.
+that choice and the call on a :class:`Batch` (the jobs, checked once) into a :class:`Flown` (the
+outputs); :func:`neurohover.evaluate_jobs` (validated, any jobs),
+:class:`neurohover.flyer.KernelFlyer` (an evolution's fast path) and the warm-ups all fly through
+it. A per-job input of the task (such as the sensor model) lives in the MDP row, so it reaches
+every path without a new argument.
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ from __future__ import annotations
 import contextlib
 import time
 from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
 
 import numba
 import numpy as np
@@ -22,7 +26,7 @@ from .sim.constants import MDP_ROW_LEN, ROW_SUBSTEPS, ROW_WIND_KIND, SAFEGUARD_L
 from .sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
 from .sim.lanes import LANES, rollout_lanes
 
-__all__ = ["DEVICES", "KIND", "MAX_SEED", "check_device", "launch", "load_kernel", "num_threads", "use_lanes"]
+__all__ = ["DEVICES", "KIND", "MAX_SEED", "Batch", "Flown", "check_device", "launch", "load_kernel", "num_threads", "use_lanes"]
 
 #: The kernel's code of each policy topology.
 KIND = {"slp": POLICY_SLP, "mlp": POLICY_MLP}
@@ -46,62 +50,119 @@ def num_threads(threads: int | None) -> Iterator[None]:
         numba.set_num_threads(previous)
 
 
-_kernel_loaded = False
+@dataclass(frozen=True)
+class Batch:
+    """The jobs of one kernel launch, as the kernel reads them; checked once, here, by shape and dtype.
+
+    Job j flies policy ``policy_index[j]`` (a row of ``kinds`` / ``genomes``) on MDP row
+    ``mdp_index[j]`` (the row holds the MDP's dynamics, wind and sensor model) with the gusts of
+    episode ``episode_index[j]`` of ``seed``. ``fallback`` (per job, -1: none) with ``limits`` is the
+    safeguard; ``slots`` (per job, -1: not recorded) with ``obs_out`` / ``act_out`` the recording.
+    Callers that fly many small batches pass their own all -1 arrays; ``safeguard`` and
+    ``recording`` (None: look at those arrays) say whether any job has either.
+    """
+
+    rows: np.ndarray
+    kinds: np.ndarray
+    genomes: np.ndarray
+    policy_index: np.ndarray
+    mdp_index: np.ndarray
+    episode_index: np.ndarray
+    seed: int | np.uint64
+    n_steps: int
+    fallback: np.ndarray | None = None
+    limits: np.ndarray = field(default_factory=lambda: SAFEGUARD_LIMITS)
+    slots: np.ndarray | None = None
+    obs_out: np.ndarray | None = None
+    act_out: np.ndarray | None = None
+    safeguard: bool | None = None
+    recording: bool | None = None
+
+    def __post_init__(self) -> None:
+        n = self.policy_index.shape[0]
+        checks = (
+            ("rows", self.rows, 2, np.float64, MDP_ROW_LEN),
+            ("kinds", self.kinds, 1, np.int64, None),
+            ("genomes", self.genomes, 2, np.float64, GENOME_WIDTH),
+            ("policy_index", self.policy_index, 1, np.int64, None),
+            ("mdp_index", self.mdp_index, 1, np.int64, None),
+            ("episode_index", self.episode_index, 1, np.int64, None),
+            ("limits", self.limits, 1, np.float64, None),
+        )
+        for name, a, ndim, dtype, width in checks:
+            if a.ndim != ndim or a.dtype != dtype or (width is not None and a.shape[1] != width):
+                columns = f" with {width} columns" if width else ""
+                raise ValueError(f"Batch.{name}: {a.ndim}-d {a.dtype} of shape {a.shape}, expected {ndim}-d {np.dtype(dtype)}{columns}")
+        for name, per_job in (("mdp_index", self.mdp_index), ("episode_index", self.episode_index), ("fallback", self.fallback), ("slots", self.slots)):
+            if per_job is not None and per_job.shape != (n,):
+                raise ValueError(f"Batch.{name} has shape {per_job.shape}, expected ({n},): one entry per job")
+        if self.safeguard is None:
+            object.__setattr__(self, "safeguard", self.fallback is not None and bool((self.fallback >= 0).any()))
+        if self.recording is None:
+            object.__setattr__(self, "recording", self.slots is not None and bool((self.slots >= 0).any()))
+        if self.recording and (self.obs_out is None or self.act_out is None):
+            raise ValueError("Batch: jobs record flight data but obs_out / act_out are missing")
+
+    @property
+    def n_jobs(self) -> int:
+        return int(self.policy_index.shape[0])
+
+    @classmethod
+    def empty(cls) -> Batch:
+        """No jobs (one zero MDP row and policy): what the warm-ups launch to load the compiled code."""
+        none = np.zeros(0, dtype=np.int64)
+        return cls(np.zeros((1, MDP_ROW_LEN)), np.zeros(1, dtype=np.int64), np.zeros((1, GENOME_WIDTH)), none, none, none, 0, 1)
+
+
+@dataclass(frozen=True)
+class Flown:
+    """What a launch writes per job: return, crash flag, control steps flown, the step the safeguard fired (-1: never)."""
+
+    returns: np.ndarray
+    crashed: np.ndarray
+    steps: np.ndarray
+    safeguard_step: np.ndarray
+
+    @classmethod
+    def empty(cls, n_jobs: int) -> Flown:
+        return cls(np.empty(n_jobs), np.empty(n_jobs, dtype=np.bool_), np.empty(n_jobs, dtype=np.int64), np.empty(n_jobs, dtype=np.int64))
+
+
+def _fly_lanes(b: Batch, out: Flown) -> None:
+    rollout_lanes(
+        b.rows, b.kinds, b.genomes, b.policy_index, b.mdp_index, b.episode_index, np.uint64(b.seed), b.n_steps, numba.get_num_threads(),
+        out.returns, out.crashed, out.steps, out.safeguard_step,
+    )  # fmt: skip
+
+
+def _fly_kernel(rollout: Callable[..., None], b: Batch, out: Flown) -> None:
+    """The one call in the kernel's positional layout (``rollout``: the CPU kernel or the CUDA launcher, same arguments)."""
+    none = None if b.fallback is not None and b.slots is not None else np.full(b.n_jobs, -1, dtype=np.int64)
+    rollout(
+        b.rows, b.kinds, b.genomes, b.policy_index, b.mdp_index, b.episode_index,
+        none if b.fallback is None else b.fallback, np.uint64(b.seed), b.n_steps, bool(b.safeguard), b.limits,
+        none if b.slots is None else b.slots,
+        np.zeros((0, 1, 12)) if b.obs_out is None else b.obs_out, np.zeros((0, 1, 4)) if b.act_out is None else b.act_out,
+        out.returns, out.crashed, out.steps, out.safeguard_step,
+    )  # fmt: skip
+
+
+_loaded: set[str] = set()
 
 
 def load_kernel() -> None:
-    """Load (or compile) the kernel with an empty batch, so ``seconds`` times only flying."""
-    global _kernel_loaded
-    if not _kernel_loaded:
-        empty = np.zeros(0, dtype=np.int64)
-        rollout_batch(
-            np.zeros((1, MDP_ROW_LEN)),
-            np.zeros(1, dtype=np.int64),
-            np.zeros((1, GENOME_WIDTH)),
-            empty,
-            empty,
-            empty,
-            empty,
-            np.uint64(0),
-            1,
-            False,
-            SAFEGUARD_LIMITS,
-            empty,
-            np.zeros((0, 2, 12)),
-            np.zeros((0, 1, 4)),
-            np.zeros(0),
-            np.zeros(0, dtype=np.bool_),
-            empty,
-            empty,
-        )
+    """Load (or compile) the scalar kernel and the lanes with an empty batch, so ``seconds`` times only flying."""
+    if "cpu" not in _loaded:
+        _fly_kernel(rollout_batch, Batch.empty(), Flown.empty(0))
         load_lanes()  # with the scalar kernel, so that a warm-up call of either path loads both (about 0.03 s from the cache)
-        _kernel_loaded = True
-
-
-_lanes_loaded = False
+        _loaded.add("cpu")
 
 
 def load_lanes() -> None:
     """Load (or compile) the lanes path with an empty batch, so ``seconds`` times only flying."""
-    global _lanes_loaded
-    if not _lanes_loaded:
-        empty = np.zeros(0, dtype=np.int64)
-        rollout_lanes(
-            np.zeros((1, MDP_ROW_LEN)),
-            np.zeros(1, dtype=np.int64),
-            np.zeros((1, GENOME_WIDTH)),
-            empty,
-            empty,
-            empty,
-            np.uint64(0),
-            1,
-            1,
-            np.zeros(0),
-            np.zeros(0, dtype=np.bool_),
-            empty,
-            empty,
-        )
-        _lanes_loaded = True
+    if "lanes" not in _loaded:
+        _fly_lanes(Batch.empty(), Flown.empty(0))
+        _loaded.add("lanes")
 
 
 def use_lanes(device: str, rows: np.ndarray, m_idx: np.ndarray, fb: np.ndarray | None = None, rec: np.ndarray | None = None) -> bool:
@@ -148,44 +209,19 @@ def check_device(device: str) -> None:
             )
 
 
-def launch(
-    rows: np.ndarray,
-    kinds: np.ndarray,
-    genomes: np.ndarray,
-    policy_index: np.ndarray,
-    mdp_index: np.ndarray,
-    episode_index: np.ndarray,
-    seed: np.uint64,
-    n_steps: int,
-    returns: np.ndarray,
-    crashed: np.ndarray,
-    steps: np.ndarray,
-    safeguard_step: np.ndarray,
-    *,
-    device: str = "cpu",
-    fallback: np.ndarray | None = None,
-    safeguard: bool = False,
-    limits: np.ndarray = SAFEGUARD_LIMITS,
-    slots: np.ndarray | None = None,
-    recording: bool = False,
-    obs_out: np.ndarray | None = None,
-    act_out: np.ndarray | None = None,
-) -> float:
-    """Fly the jobs (arrays already checked, int64 indices, outputs preallocated); returns the kernel's wall seconds.
+def launch(batch: Batch, out: Flown, device: str = "cpu") -> float:
+    """Fly the batch's jobs, writing ``out``; returns the kernel's wall seconds.
 
-    ``fallback`` (per job, -1: none) with ``safeguard`` (whether any job has one) and ``limits``
-    are the safeguard; ``slots`` (per job, -1: not recorded) with ``recording`` and ``obs_out`` /
-    ``act_out`` the recording. A CPU batch with neither may fly in the lanes (:func:`use_lanes`).
-    Arrays left None are all -1 (a caller flying many small batches passes its own). The kernel is
-    loaded (compiled or read from the cache) before the clock starts.
+    The one place that chooses the path: a CPU batch without safeguard or recording may fly in the
+    lanes (:func:`use_lanes`), the rest in the scalar kernel, or on the GPU with ``device="cuda"``.
+    The compiled code is loaded (compiled or read from the cache) before the clock starts.
     """
-    if not safeguard and not recording and use_lanes(device, rows, mdp_index):
+    if not batch.safeguard and not batch.recording and use_lanes(device, batch.rows, batch.mdp_index):
         load_lanes()
         t0 = time.perf_counter()
-        threads = numba.get_num_threads()
-        rollout_lanes(rows, kinds, genomes, policy_index, mdp_index, episode_index, seed, n_steps, threads, returns, crashed, steps, safeguard_step)
+        _fly_lanes(batch, out)
         return time.perf_counter() - t0
-    rollout: Callable[..., None]  # the CPU kernel (a numba dispatcher) or the CUDA launcher, same arguments
+    rollout: Callable[..., None]
     if device == "cuda":
         from .sim import cuda as sim_cuda  # numba.cuda is imported only when asked for
 
@@ -194,14 +230,6 @@ def launch(
     else:
         load_kernel()
         rollout = rollout_batch
-    none = None if fallback is not None and slots is not None else np.full(policy_index.shape[0], -1, dtype=np.int64)
-    fb = none if fallback is None else fallback
-    rec = none if slots is None else slots
-    obs = np.zeros((0, 1, 12)) if obs_out is None else obs_out
-    act = np.zeros((0, 1, 4)) if act_out is None else act_out
     t0 = time.perf_counter()
-    rollout(
-        rows, kinds, genomes, policy_index, mdp_index, episode_index, fb, seed, n_steps, safeguard,
-        limits, rec, obs, act, returns, crashed, steps, safeguard_step,
-    )  # fmt: skip
+    _fly_kernel(rollout, batch, out)
     return time.perf_counter() - t0
