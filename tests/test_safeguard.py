@@ -130,10 +130,10 @@ def _fig8_with(tmp_path: Path, group_extra: str, agent: str = "hybrid") -> Path:
 
 def test_experiment_groups_carry_thegroup_hybrid_settings_into_their_units(tmp_path: Path) -> None:
     cfg = load_config(str(_fig8_with(tmp_path, 'hybrid = { replacement = "evolve", rule = "paper", box = 0.7 }\n')), "paper")
-    group = next(g for g in cfg.settings["groups"] if g["agent"] == "hybrid")
+    group = next(g for g in cfg.typed.groups if g.agent == "hybrid")
     want = {"replacement": "evolve", "model_from": "first-safe", "rule": "paper", "box": 0.7, "tilt": 0.99}
-    assert group["hybrid"] == want and group_hybrid_settings(group) == want
-    incremental = next(g for g in cfg.settings["groups"] if g["agent"] == "incremental")
+    assert group.hybrid == want and group_hybrid_settings(group) == want
+    incremental = next(g for g in cfg.typed.groups if g.agent == "incremental")
     assert group_hybrid_settings(incremental) is None  # other agents' units carry no hybrid settings
     default = load_config("fig8", "paper")
     assert default.hash != cfg.hash  # the settings are part of the experiment's identity

@@ -29,6 +29,7 @@ naming the allowed ones). Its hash covers every setting that changes results, pl
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import tomllib
@@ -39,6 +40,7 @@ from typing import Any
 from ..errors import NeurohoverError
 from ..policysets import FGHH_GENERIC_RESAMPLING
 from ..tasks import TASK_NAMES
+from .settings import ExperimentSettings, typed_settings
 
 CONFIG_DIR = Path(__file__).parent / "configs"
 SCALES = ("quick", "paper")
@@ -284,7 +286,7 @@ def _check_kind(settings: dict, kind: str, where: str) -> None:
 
         method = "generational" if settings["target"] == "family" else "steady-state"
         for v in [None, *settings["variants"]]:
-            table = settings["optimiser"] if v is None else variant_optimiser(settings["optimiser"], v)
+            table = settings["optimiser"] if v is None else variant_optimiser(settings["optimiser"], v.get("optimiser"))
             try:  # the optimiser settings are checked here, not when a unit first runs
                 name, rest = optimiser_of(table)
                 if name != "ne" and settings["budget"] == 0 and not OPTIMISERS[name].stops_itself:
@@ -362,6 +364,11 @@ class ExperimentConfig:
     paper_ref: str = ""
     source: str = ""
     external_digest: str = ""
+
+    @functools.cached_property
+    def typed(self) -> ExperimentSettings:
+        """The settings as their kind's frozen dataclass (:mod:`neurohover.experiments.settings`)."""
+        return typed_settings(self.kind, self.settings)
 
     @property
     def hash(self) -> str:
@@ -529,10 +536,10 @@ def load_configs(name: str, scale: str, overrides: dict[str, Any] | None = None)
     return [load_config(name, scale, overrides)]
 
 
-def variant_optimiser(experiment: dict, variant: dict) -> dict:
-    """The ``optimiser`` table a variant runs: its own keys over the experiment's, or its own alone
-    when it names another optimiser (``name``), whose settings are not the experiment's."""
-    own = variant.get("optimiser", {})
+def variant_optimiser(experiment: dict, own: dict | None) -> dict:
+    """The ``optimiser`` table a variant runs: its own keys (``own``, None: none) over the experiment's,
+    or its own alone when it names another optimiser (``name``), whose settings are not the experiment's."""
+    own = own or {}
     if own.get("name", "ne") != experiment.get("name", "ne"):
         return dict(own)
     return {**experiment, **own}

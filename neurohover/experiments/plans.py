@@ -28,6 +28,7 @@ from ..errors import NeurohoverError
 from ..policysets import FGHH_GENERIC_RESAMPLING
 from .config import ExperimentConfig, variant_optimiser
 from .results import UnitKey
+from .settings import EvolutionSettings, ExperimentSettings, Group, ModelLearningSettings, TestRunsSettings
 from .units import Unit, policy_dict, unit_seed
 
 _SAMPLE_TAG = 0x5A3
@@ -53,9 +54,9 @@ def _family(task: str, sigma: float | None, sensor: dict | None = None):
     return family_for(task, sigma, _sensor(sensor))
 
 
-def _family_target(s: dict, sigma: float | None) -> dict:
+def _family_target(s: ExperimentSettings, sigma: float | None) -> dict:
     """An evolution unit's target "over the family": its task, breadth and (when set) sensor."""
-    return {"kind": "family", "task": s["task"], "sigma": sigma, **({"sensor": s["sensor"]} if "sensor" in s else {})}
+    return {"kind": "family", "task": s.task, "sigma": sigma, **({"sensor": s.sensor} if s.sensor is not None else {})}
 
 
 def _mdps(family, which: str, n: int, seed: int):
@@ -67,7 +68,7 @@ def _mdps(family, which: str, n: int, seed: int):
 
 
 def _unit(cfg: ExperimentConfig, key: str, kind: str, params: dict, seed_key: str | None = None) -> Unit:
-    params = {**params, "seed": unit_seed(cfg.settings["seed"], cfg.name, seed_key or key)}
+    params = {**params, "seed": unit_seed(cfg.typed.seed, cfg.name, seed_key or key)}
     return Unit(cfg.name, key, kind, params)
 
 
@@ -106,40 +107,41 @@ def external_digest(kind: str, s: dict) -> str:
 
 
 def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
-    s = cfg.settings
-    family = _family(s["task"], s["sigma"], s.get("sensor"))
+    s = cfg.typed
+    assert isinstance(s, EvolutionSettings)
+    family = _family(s.task, s.sigma, s.sensor)
     units: list[Unit] = []
     base = {
-        "budget": s["budget"],
-        "optimiser": s["optimiser"],
-        "n_steps": s["n_steps"],
-        "validation_episodes": s["validation_episodes"],
-        "history_points": s["history_points"],
+        "budget": s.budget,
+        "optimiser": s.optimiser,
+        "n_steps": s.n_steps,
+        "validation_episodes": s.validation_episodes,
+        "history_points": s.history_points,
     }
-    if s.get("validation_mdps") == "test":  # one seed for every run's validation: the same MDPs and gusts
-        base.update(validation_mdps="test", validation_seed=unit_seed(s["seed"], cfg.name, "validation"))
-    train = family.training_mdps()[: s["n_mdps"]]
-    for v in s["variants"]:
-        common = {**base, "topology": v["topology"], "prototype": v["prototype"], "resampling": v["resampling"]}
-        if "optimiser" in v:
-            common["optimiser"] = variant_optimiser(s["optimiser"], v)
-        if s["target"] == "train":
+    if s.validation_mdps == "test":  # one seed for every run's validation: the same MDPs and gusts
+        base.update(validation_mdps="test", validation_seed=unit_seed(s.seed, cfg.name, "validation"))
+    train = family.training_mdps()[: s.n_mdps]
+    for v in s.variants:
+        common = {**base, "topology": v.topology, "prototype": v.prototype, "resampling": v.resampling}
+        if v.optimiser is not None:
+            common["optimiser"] = variant_optimiser(s.optimiser, v.optimiser)
+        if s.target == "train":
             for i, mdp in enumerate(train):
-                for r in range(s["runs"]):
-                    key = UnitKey.make("evolve", v["key"], f"train{i}", r)
+                for r in range(s.runs):
+                    key = UnitKey.make("evolve", v.key, f"train{i}", r)
                     units.append(_unit(cfg, key, "evolve", {**common, "target": {"kind": "mdp", "mdp": mdp.to_dict()}}))
         else:
-            sigma = v["sigma"] if v["sigma"] is not None else s["sigma"]
-            if s["target"] == "zero":
-                target = {"kind": "mdp", "mdp": _family(s["task"], sigma, s.get("sensor")).zero().to_dict()}
+            sigma = v.sigma if v.sigma is not None else s.sigma
+            if s.target == "zero":
+                target = {"kind": "mdp", "mdp": _family(s.task, sigma, s.sensor).zero().to_dict()}
             else:
                 target = _family_target(s, sigma)
-            for r in range(s["runs"]):
-                units.append(_unit(cfg, UnitKey.make("evolve", v["key"], rep=r), "evolve", {**common, "target": target}))
-    total = len(units) + len(s["robustness_variants"]) * len(train)
-    for vkey in s["robustness_variants"]:
+            for r in range(s.runs):
+                units.append(_unit(cfg, UnitKey.make("evolve", v.key, rep=r), "evolve", {**common, "target": target}))
+    total = len(units) + len(s.robustness_variants) * len(train)
+    for vkey in s.robustness_variants:
         for i in range(len(train)):
-            keys = [UnitKey.make("evolve", vkey, f"train{i}", r) for r in range(s["runs"])]
+            keys = [UnitKey.make("evolve", vkey, f"train{i}", r) for r in range(s.runs)]
             if not all(k in results for k in keys):
                 continue
             best = max(keys, key=lambda k: float(results[k]["champion_return"]))
@@ -153,8 +155,8 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
                         "source": best,
                         "own": i,
                         "mdps": [m.to_dict() for m in train],
-                        "episodes": s["robustness_episodes"],
-                        "n_steps": s["n_steps"],
+                        "episodes": s.robustness_episodes,
+                        "n_steps": s.n_steps,
                     },
                 )
             )
@@ -165,7 +167,6 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
 
 
 def _policy_evolution_unit(cfg: ExperimentConfig, key: str, target: dict, budget: int, resampling: str = "fixed:1") -> Unit:
-    s = cfg.settings
     return _unit(
         cfg,
         key,
@@ -177,7 +178,7 @@ def _policy_evolution_unit(cfg: ExperimentConfig, key: str, target: dict, budget
             "resampling": resampling,
             "budget": budget,
             "optimiser": {},
-            "n_steps": s["n_steps"],
+            "n_steps": cfg.typed.n_steps,
             "validation_episodes": 0,
             "history_points": 50,
         },
@@ -192,7 +193,8 @@ def _spec(agent: str):
 
 def source_experiments(cfg: ExperimentConfig) -> list[str]:
     """The experiments whose results a config's units need (``generics_from``), in the order named."""
-    names = [str(src).partition("/")[0] for src in cfg.settings.get("generics_from", {}).values()]
+    s = cfg.typed
+    names = [str(src).partition("/")[0] for src in (s.generics_from or {}).values()] if isinstance(s, TestRunsSettings) else []
     return list(dict.fromkeys(names))
 
 
@@ -203,14 +205,14 @@ def _source_champions(source: str, scale: str, results: dict) -> tuple[list[tupl
     from .config import load_config
 
     name, _, want = source.partition("/")
-    src = load_config(name, scale)
-    variants = [v for v in src.settings["variants"] if v["resampling"].startswith("race")] if want == "best-race" else [
-        v for v in src.settings["variants"] if v["key"] == want
-    ]  # fmt: skip
+    src = load_config(name, scale).typed
+    if not isinstance(src, EvolutionSettings):
+        raise NeurohoverError(f"generics_from {source!r}: {name} is not an evolution experiment")
+    variants = [v for v in src.variants if v.resampling.startswith("race")] if want == "best-race" else [v for v in src.variants if v.key == want]
     if not variants:
-        keys = ", ".join(v["key"] for v in src.settings["variants"])
+        keys = ", ".join(v.key for v in src.variants)
         raise NeurohoverError(f"generics_from {source!r}: {name} has no variant {want!r} (its variants: {keys}; or best-race)")
-    runs = {v["key"]: [UnitKey.make("evolve", v["key"], rep=r) for r in range(src.settings["runs"])] for v in variants}
+    runs = {v.key: [UnitKey.make("evolve", v.key, rep=r) for r in range(src.runs)] for v in variants}
     missing = sum(k not in results for keys in runs.values() for k in keys)
     if missing:
         return None, f"{missing} of {sum(map(len, runs.values()))} evolution runs of {name} ({', '.join(runs)}) are not in the store yet"
@@ -225,27 +227,29 @@ class _Policies:
 
     def __init__(self, cfg: ExperimentConfig, results: dict, sources: dict[str, dict] | None = None) -> None:
         self.cfg, self.results = cfg, results
-        s = cfg.settings
-        self.task = s["task"]
-        self.family = _family(s["task"], s["sigma"], s.get("sensor"))
+        s = cfg.typed
+        assert isinstance(s, TestRunsSettings)
+        self.settings = s
+        self.task = s.task
+        self.family = _family(s.task, s.sigma, s.sensor)
         needs: set[str] = set()
-        for g in s["groups"]:
-            spec = _spec(g["agent"])
+        for g in s.groups:
+            spec = _spec(g.agent)
             needs |= spec.needs
             if self.family.generic_over_distribution and spec.generic_kind is not None:
                 needs.add(spec.generic_kind)
         self.needs = needs
         self.units: list[Unit] = []
         self.total = 0
-        self.external = None if s["policies"] == "evolve" else _load_external(self.task, s["policies"])
+        self.external = None if s.policies == "evolve" else _load_external(self.task, s.policies)
         if self.external is not None:
-            if self.family.generic_over_distribution and s["generics_per_agent"] != 1:
+            if self.family.generic_over_distribution and s.generics_per_agent != 1:
                 raise NeurohoverError(
                     f"config {cfg.name!r}: a policy set holds one generic policy per method; "
-                    f'generics_per_agent = {s["generics_per_agent"]} needs policies = "evolve"'
+                    f'generics_per_agent = {s.generics_per_agent} needs policies = "evolve"'
                 )
             return
-        budget = s["policy_budget"]
+        budget = s.policy_budget
         if not self.family.generic_over_distribution:
             if needs & {"generic"}:
                 self._add(UnitKey.make("policy", "generic"), {"kind": "mdp", "mdp": self.family.zero().to_dict()}, budget)
@@ -264,15 +268,15 @@ class _Policies:
                             {
                                 "policies": [r["champion"] for r in spec],
                                 "mdps": [m.to_dict() for m in self.family.training_mdps()],
-                                "episodes": s["safety_episodes"],
-                                "n_steps": s["n_steps"],
+                                "episodes": s.safety_episodes,
+                                "n_steps": s.n_steps,
                             },
                         )
                     )
         else:
             self.drawn: dict[str, list[tuple[str, dict]] | None] = {}
             self.waiting: list[str] = []
-            for kind, source in s.get("generics_from", {}).items():
+            for kind, source in (s.generics_from or {}).items():
                 if kind in needs:
                     self.drawn[kind], why = _source_champions(source, cfg.scale, (sources or {}).get(source.partition("/")[0], {}))
                     if why:
@@ -280,15 +284,15 @@ class _Policies:
             for kind in ("zero", "fixed", "race"):
                 if kind not in needs or kind in self.drawn:
                     continue
-                for j in range(s["generics_per_agent"]):
+                for j in range(s.generics_per_agent):
                     if kind == "zero":
                         self._add(UnitKey.make("policy", f"generic-zero{j}"), {"kind": "mdp", "mdp": self.family.zero().to_dict()}, budget)
                     else:
                         self._add(
                             UnitKey.make("policy", f"generic-{kind}{j}"),
-                            _family_target(s, s["sigma"]),
-                            s["generic_budget"],
-                            s["generic_resampling"].get(kind, FGHH_GENERIC_RESAMPLING[kind]),
+                            _family_target(s, s.sigma),
+                            s.generic_budget,
+                            s.generic_resampling.get(kind, FGHH_GENERIC_RESAMPLING[kind]),
                         )
 
     def _add(self, key: str, target: dict, budget: int, resampling: str = "fixed:1") -> None:
@@ -313,13 +317,13 @@ class _Policies:
                     if champions is None:
                         return None
                     # Each run draws one of the source's champions, as the authors' agent picks one of its files.
-                    rng = np.random.default_rng(unit_seed(self.cfg.settings["seed"], self.cfg.name, f"{key}/generic"))
+                    rng = np.random.default_rng(unit_seed(self.settings.seed, self.cfg.name, f"{key}/generic"))
                     source, out["generic"] = champions[int(rng.integers(len(champions)))]
                     out["generic_source"] = source
                 elif ext is not None:
                     out["generic"] = policy_dict(ext.generics[kind])
                 else:
-                    j = run_counter % self.cfg.settings["generics_per_agent"]
+                    j = run_counter % self.settings.generics_per_agent
                     out["generic"] = self._evolved(UnitKey.make("policy", f"generic-{kind}{j}"))
                     out["generic_source"] = UnitKey.make("policy", f"generic-{kind}{j}")
             return None if any(v is None for v in out.values()) else out
@@ -350,34 +354,38 @@ class _Policies:
         return None if any(v is None for v in out.values()) else out
 
 
-def group_hybrid_settings(group: dict) -> dict | None:
+def group_hybrid_settings(group: Group) -> dict | None:
     """The full hybrid settings of a group's units (None: the group's agent is not a hybrid agent)."""
     from ..agents.hybrid import HybridSettings
     from ..agents.registry import HYBRID_AGENTS
 
-    return HybridSettings.from_dict(group["hybrid"]).to_dict() if group["agent"] in HYBRID_AGENTS else None
+    return HybridSettings.from_dict(group.hybrid).to_dict() if group.agent in HYBRID_AGENTS else None
 
 
 def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dict] | None = None) -> Plan:
-    s = cfg.settings
     pol = _Policies(cfg, results, sources)
+    s = pol.settings
     units = list(pol.units)
     total = pol.total
-    settings = {k: s[k] for k in ("task", "sigma", "episodes", "n_steps", "model_budget", "predict_episodes", "max_learning_episodes")}
-    for g in s["groups"]:
-        mdps = _mdps(pol.family, g["mdps"], g["n_mdps"], s["seed"])
-        if "sensor" in g:  # this group's agents fly the same MDPs through sensors of its own
-            mdps = [m.with_sensor(_sensor(g["sensor"])) for m in mdps]
+    settings = {
+        "task": s.task, "sigma": s.sigma, "episodes": s.episodes, "n_steps": s.n_steps, "model_budget": s.model_budget,
+        "predict_episodes": s.predict_episodes, "max_learning_episodes": s.max_learning_episodes,
+    }  # fmt: skip
+    for g in s.groups:
+        mdps = _mdps(pol.family, g.mdps, g.n_mdps, s.seed)
+        if g.sensor is not None:  # this group's agents fly the same MDPs through sensors of its own
+            mdps = [m.with_sensor(_sensor(g.sensor)) for m in mdps]
+        sensor = g.sensor if g.sensor is not None else s.sensor
+        hybrid = group_hybrid_settings(g)
         counter = 0
         for i, mdp in enumerate(mdps):
-            for rep in range(g["runs_per_mdp"]):
+            for rep in range(g.runs_per_mdp):
                 total += 1
-                key = UnitKey.make("run", g["label"], f"{g['mdps']}{i}", rep)
-                policies = pol.for_agent(g["agent"], i if g["mdps"] == "train" else None, counter, g["exclude_own"] and g["mdps"] == "train", key)
+                key = UnitKey.make("run", g.label, f"{g.mdps}{i}", rep)
+                policies = pol.for_agent(g.agent, i if g.mdps == "train" else None, counter, g.exclude_own and g.mdps == "train", key)
                 counter += 1
                 if policies is None:
                     continue
-                hybrid = group_hybrid_settings(g)
                 units.append(
                     _unit(
                         cfg,
@@ -385,14 +393,14 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dic
                         "test_run",
                         {
                             **settings,
-                            "agent": g["agent"],
-                            "group": g["label"],
+                            "agent": g.agent,
+                            "group": g.label,
                             "mdp": mdp.to_dict(),
                             "policies": policies,
-                            "estimator": g["estimator"],
-                            **({"sensor": g.get("sensor", s.get("sensor"))} if "sensor" in g or "sensor" in s else {}),
+                            "estimator": g.estimator,
+                            **({"sensor": sensor} if sensor is not None else {}),
                             **({"hybrid": hybrid} if hybrid else {}),
-                            **({"agent_settings": g["settings"]} if "settings" in g else {}),
+                            **({"agent_settings": g.settings} if g.settings is not None else {}),
                         },
                     )
                 )
@@ -403,44 +411,45 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dic
 
 
 def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
-    s = cfg.settings
-    family = _family(s["task"], s["sigma"], s.get("sensor"))
+    s = cfg.typed
+    assert isinstance(s, ModelLearningSettings)
+    family = _family(s.task, s.sigma, s.sensor)
     units: list[Unit] = []
-    total = len(s["methods"]) * s["n_mdps"]
-    if s["generic"] == "evolve":
+    total = len(s.methods) * s.n_mdps
+    if s.generic == "evolve":
         total += 1
-        units.append(_policy_evolution_unit(cfg, UnitKey.make("policy", "generic"), {"kind": "mdp", "mdp": family.zero().to_dict()}, s["generic_budget"]))
+        units.append(_policy_evolution_unit(cfg, UnitKey.make("policy", "generic"), {"kind": "mdp", "mdp": family.zero().to_dict()}, s.generic_budget))
         generic = results.get(UnitKey.make("policy", "generic"), {}).get("champion")
-    elif s["generic"] == "baseline":
+    elif s.generic == "baseline":
         from ..policies import baseline_policy
 
         generic = policy_dict(baseline_policy())
     else:
-        generic = policy_dict(_load_external(s["task"], s["generic"]).generic)
+        generic = policy_dict(_load_external(s.task, s.generic).generic)
     if generic is None:
         return Plan(units, total)
-    for i, mdp in enumerate(_mdps(family, s["mdps"], s["n_mdps"], s["seed"])):
-        for method in s["methods"]:
+    for i, mdp in enumerate(_mdps(family, s.mdps, s.n_mdps, s.seed)):
+        for method in s.methods:
             # The seed depends on the MDP only: every method learns from the same flight data and
             # its policy meets the same gusts (a paired comparison).
             units.append(
                 _unit(
                     cfg,
-                    UnitKey.make("model", method, f"{s['mdps']}{i}"),
+                    UnitKey.make("model", method, f"{s.mdps}{i}"),
                     "model",
                     {
                         "method": method,
                         "mdp": mdp.to_dict(),
                         "generic": generic,
-                        "n_steps": s["n_steps"],
-                        "model_budget": s["model_budget"],
-                        "ec_meno_budget": s["ec_meno_budget"],
-                        "ec_mer_episodes": s["ec_mer_episodes"],
-                        "policy_budget": s["policy_budget"],
-                        "prototype": s["policy_prototype"],
-                        "test_episodes": s["test_episodes"],
+                        "n_steps": s.n_steps,
+                        "model_budget": s.model_budget,
+                        "ec_meno_budget": s.ec_meno_budget,
+                        "ec_mer_episodes": s.ec_mer_episodes,
+                        "policy_budget": s.policy_budget,
+                        "prototype": s.policy_prototype,
+                        "test_episodes": s.test_episodes,
                     },
-                    seed_key=f"model/{s['mdps']}{i}",
+                    seed_key=f"model/{s.mdps}{i}",
                 )
             )
     return Plan(units, total)

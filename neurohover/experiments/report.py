@@ -24,12 +24,13 @@ from .config import ORDER, ExperimentConfig
 from .report_base import Section, fmt, new_figure, sd, table
 from .report_evolution import EvolutionSection
 from .results import ModelResult, TestRunResult, result_from_dict
+from .settings import Group
 from .store import Store
 
 
 class _ModelLearning(Section):
     def figure(self) -> str | None:
-        data: dict[str, list[ModelResult]] = {m: self.group("model", m) for m in self.s["methods"]}
+        data: dict[str, list[ModelResult]] = {m: self.group("model", m) for m in self.s.methods}
         data = {m: v for m, v in data.items() if v}
         if not data:
             return None
@@ -48,7 +49,7 @@ class _ModelLearning(Section):
         ref = self.paper.get("table", {})
         rows = []
         means = {}
-        for m in self.s["methods"]:
+        for m in self.s.methods:
             units: list[ModelResult] = self.group("model", m)
             if not units:
                 continue
@@ -93,19 +94,19 @@ class _ModelLearning(Section):
             "### Table 4\n\n"
             + table(["method", "MDPs", "t (s)", "paper t", "r_m", "paper r_m", "r_a", "paper r_a", "sd", "paper sd", "crashed episodes"], rows)
             + f"\n\nt: seconds to learn the model from one episode of flight data of the generic policy; r_m, r_a, sd: median, "
-            f"mean and sd over MDPs of the evolved policy's mean return over {self.s['test_episodes']} episodes in the true MDP.\n"
+            f"mean and sd over MDPs of the evolved policy's mean return over {self.s.test_episodes} episodes in the true MDP.\n"
         )
 
 
 class _TestRuns(Section):
-    def groups(self) -> list[dict]:
-        return self.s["groups"]
+    def groups(self) -> tuple[Group, ...]:
+        return self.s.groups
 
     def runs(self, label: str) -> list[TestRunResult]:
         return self.group("run", label)
 
     def figure(self) -> str | None:
-        data = {g["label"]: self.runs(g["label"]) for g in self.groups()}
+        data = {g.label: self.runs(g.label) for g in self.groups()}
         data = {k: v for k, v in data.items() if v}
         if not data:
             return None
@@ -122,7 +123,7 @@ class _TestRuns(Section):
         ref = self.paper.get("groups", {})
         rows, samples, labels = [], {}, {}
         for g in self.groups():
-            label = g["label"]
+            label = g.label
             runs = self.runs(label)
             if not runs:
                 continue
@@ -181,7 +182,7 @@ class _TestRuns(Section):
                 ],
                 rows,
             )
-            + f"\n\nEach run: {self.s['episodes']} episodes of {self.s['n_steps']} control steps on one MDP; the score is the "
+            + f"\n\nEach run: {self.s.episodes} episodes of {self.s.n_steps} control steps on one MDP; the score is the "
             "cumulative reward of the whole run.\n"
         )
 
@@ -218,7 +219,7 @@ def _header(cfg: ExperimentConfig, store: Store, units: list[dict], total: int |
     unit_seconds = sum(u["seconds"] for u in units)
     settings = ", ".join(f"{k} = {cfg.settings[k]}" for k in _SETTING_KEYS if cfg.settings.get(k) not in (None, ""))
     if cfg.kind == "test_runs":
-        settings += "; " + ", ".join(f"{g['label']}: {g['n_mdps']} {g['mdps']} MDPs x {g['runs_per_mdp']}" for g in cfg.settings["groups"])
+        settings += "; " + ", ".join(f"{g.label}: {g.n_mdps} {g.mdps} MDPs x {g.runs_per_mdp}" for g in getattr(cfg.typed, "groups", ()))
     status = "complete" if total is not None and done >= total else f"INCOMPLETE ({done} of {total} units)"
     return (
         f"- Paper: {cfg.paper_ref or 'n/a'}\n"

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -88,7 +89,7 @@ class Section:
     def __init__(self, config: ExperimentConfig, results: dict[str, UnitResult], store: Store, out: Path) -> None:
         self.cfg, self.results, self.store, self.out = config, results, store, out
         self.keys = {k: UnitKey.parse(k) for k in results}
-        self.s = config.settings
+        self.s: Any = config.typed  # the kind's settings dataclass (neurohover.experiments.settings)
         self.paper = config.paper
         self.comparisons: list[str] = []
         self.tests: list[list] = []

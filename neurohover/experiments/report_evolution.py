@@ -12,6 +12,7 @@ from ..evolution.fitness import episode_fitness, error_of_fitness
 from .config import ExperimentConfig
 from .report_base import Section, fmt, new_figure, sd, table
 from .results import EvolveResult, RobustnessResult
+from .settings import Variant
 
 
 def _curve(points: Sequence[Sequence[float | str]], grid: np.ndarray, sign: float = -1.0) -> np.ndarray:
@@ -25,8 +26,8 @@ def _curve(points: Sequence[Sequence[float | str]], grid: np.ndarray, sign: floa
 
 
 class EvolutionSection(Section):
-    def variants(self) -> list[dict]:
-        return self.s["variants"]
+    def variants(self) -> tuple[Variant, ...]:
+        return self.s.variants
 
     def runs(self, vkey: str) -> list[EvolveResult]:
         return self.group("evolve", vkey)
@@ -38,7 +39,7 @@ class EvolutionSection(Section):
         return [r.final_score for r in runs]
 
     def figure(self) -> str | None:
-        data = {v["key"]: self.runs(v["key"]) for v in self.variants()}
+        data = {v.key: self.runs(v.key) for v in self.variants()}
         if not any(data.values()):
             return None
         if self._fghh_style():
@@ -46,21 +47,21 @@ class EvolutionSection(Section):
         xmax = max(r.history[-1][0] for runs in data.values() for r in runs)
         xmin = min(r.history[0][0] for runs in data.values() for r in runs)
         grid = np.linspace(max(xmin, 1), xmax, 400)
-        two = self.cfg.name == "fig2" or self.s["target"] == "train"
+        two = self.cfg.name == "fig2" or self.s.target == "train"
         fig, axes = new_figure(2 if two else 1, figsize=(11 if two else 6.5, 4.2))
         axes = axes[0]
         for v in self.variants():
-            runs = data[v["key"]]
+            runs = data[v.key]
             if not runs:
                 continue
             curves = np.array([_curve(r.history, grid) for r in runs])
             with np.errstate(all="ignore"), warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)  # grid points before any run's first champion
                 mean = np.nanmean(np.where(np.isfinite(curves), curves, np.nan), axis=0)
-            axes[0].plot(grid, mean, label=v["label"])
+            axes[0].plot(grid, mean, label=v.label)
             if two:
                 best = int(np.argmin([-float(r.champion_return) for r in runs]))
-                axes[1].plot(grid, curves[best], label=v["label"])
+                axes[1].plot(grid, curves[best], label=v.label)
         axes[0].set_title("average of the runs" if two else f"average of {len(next(iter(data.values())))} runs per setting")
         if two:
             axes[1].set_title("best run")
@@ -81,7 +82,7 @@ class EvolutionSection(Section):
         fig, axes = new_figure(2, figsize=(11, 4.2))
         axes = axes[0]
         for v in self.variants():
-            runs = data[v["key"]]
+            runs = data[v.key]
             if not runs:
                 continue
             raw = not _on_fitness_scale(runs)  # a variant run on mean raw returns: its curve converted
@@ -92,24 +93,24 @@ class EvolutionSection(Section):
             fitness = episode_fitness(-mean, FITNESS_SCALE) if raw else mean
             error = mean if raw else error_of_fitness(mean, FITNESS_SCALE)
             note = ", raw returns: 1/ln of the mean error" if raw else ""
-            axes[0].plot(grid, fitness, label=f"{v['label']} ({len(runs)} runs{note})")
-            axes[1].plot(grid, error, label=v["label"])
+            axes[0].plot(grid, fitness, label=f"{v.label} ({len(runs)} runs{note})")
+            axes[1].plot(grid, error, label=v.label)
         return self.save_panels(fig, axes, "episodes", ("champion fitness, 1/ln(error) (mean over runs)", "as error, exp(1/fitness) (log scale)"))
 
     def _fghh_style(self) -> bool:
         """Whether the section reads as FGHH's as the authors ran it: runs on the 1/ln(error) scale,
         or champions validated on the test MDPs (every variant then compared on 1/ln(error))."""
-        runs = [r for v in self.variants() for r in self.runs(v["key"])]
-        return bool(runs) and (any(r.fitness == FITNESS_SCALE for r in runs) or self.s.get("validation_mdps") == "test")
+        runs = [r for v in self.variants() for r in self.runs(v.key)]
+        return bool(runs) and (any(r.fitness == FITNESS_SCALE for r in runs) or self.s.validation_mdps == "test")
 
     def _fitness_body(self) -> str:
         """Final champions of runs on the 1/ln(error) scale, flown on the test MDPs, beside the authors' generics."""
         rows, samples, labels = [], {}, {}
         for v in self.variants():
-            runs = self.runs(v["key"])
+            runs = self.runs(v.key)
             if not runs:
                 continue
-            row, finals = _validation_row(v["label"], [[float(x) for x in r.validation or ()] for r in runs], [r.validation_crashed for r in runs])
+            row, finals = _validation_row(v.label, [[float(x) for x in r.validation or ()] for r in runs], [r.validation_crashed for r in runs])
             champ = float(np.mean([float(r.champion_return) for r in runs]))
             if _on_fitness_scale(runs):
                 estimate, as_error = fmt(champ), fmt(float(error_of_fitness(champ, FITNESS_SCALE)))
@@ -117,12 +118,12 @@ class EvolutionSection(Section):
                 estimate, as_error = f"{fmt(champ)} (a return)", fmt(-champ)
             rows.append([row[0], str(len(runs)), estimate, as_error, *row[1:]])
             rows[-1] += [fmt(np.mean([r.episodes for r in runs])), fmt(np.mean([r.timing.seconds for r in runs]))]
-            samples[v["key"]], labels[v["key"]] = finals, v["label"]
+            samples[v.key], labels[v.key] = finals, v.label
         authors = _authors_generics(self.out, self.cfg)
         for folder, entry in authors.items():
             row, _ = _validation_row(f"the authors' {folder} ({len(entry['returns'])} files)", entry["returns"], entry["crashed"])
             rows.append([row[0], str(len(entry["returns"])), "", "", *row[1:], "", ""])
-        where = "once on each of the family's test MDPs, the same gusts for every run" if self.s.get("validation_mdps") == "test" else "on fresh MDPs"
+        where = "once on each of the family's test MDPs, the same gusts for every run" if self.s.validation_mdps == "test" else "on fresh MDPs"
         text = (
             "### Final champions\n\n"
             + table(
@@ -175,19 +176,19 @@ class EvolutionSection(Section):
         samples, labels = {}, {}
         validated = False
         for v in self.variants():
-            runs = self.runs(v["key"])
+            runs = self.runs(v.key)
             if not runs:
                 continue
             champ = [-float(r.champion_return) for r in runs]
             finals = self.final_scores(runs)
             validated = runs[0].validation is not None
-            samples[v["key"]], labels[v["key"]] = finals, v["label"]
+            samples[v.key], labels[v.key] = finals, v.label
             stops: dict[str, int] = {}
             for r in runs:
                 stops[r.stop_reason] = stops.get(r.stop_reason, 0) + 1
             rows.append(
                 [
-                    v["label"],
+                    v.label,
                     str(len(runs)),
                     fmt(np.mean(champ)),
                     fmt(np.median(champ)),
@@ -223,22 +224,22 @@ class EvolutionSection(Section):
             + "\n\nChampion error: minus the champion's fitness estimate at the end "
             "of the run (what the figure shows). Champion crashing at the end: runs whose final champion's own "
             "evaluation crashed (steady state). Validation: the final champion flown on fresh episodes"
-            + (" (each on a fresh MDP from G)" if self.s["target"] == "family" else " of its MDP")
+            + (" (each on a fresh MDP from G)" if self.s.target == "family" else " of its MDP")
             + ".\n"
         )
         if samples:
             order = sorted(samples, key=lambda k: -np.mean(samples[k]))
             self.comparisons.append("Ranking by " + what + " (best first): ours " + " > ".join(labels[k] for k in order) + ".")
         self.add_tests(samples, labels, what)
-        if self.s["robustness_variants"]:
+        if self.s.robustness_variants:
             parts.append(self.table3())
         return "\n".join(parts)
 
     def table3(self) -> str:
         rows = []
         ref = self.paper.get("table3", {})
-        for vkey in self.s["robustness_variants"]:
-            label = next(v["label"] for v in self.variants() if v["key"] == vkey)
+        for vkey in self.s.robustness_variants:
+            label = next(v.label for v in self.variants() if v.key == vkey)
             units: list[RobustnessResult] = self.group("robust", vkey)
             if not units:
                 continue
@@ -272,7 +273,7 @@ class EvolutionSection(Section):
                 )
         if not rows:
             return ""
-        n = self.s["robustness_episodes"]
+        n = self.s.robustness_episodes
         return (
             "### Table 3: robustness of the best champions\n\n"
             + table(

@@ -26,6 +26,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 from ..errors import NeurohoverError
+from .params import unit_params
 from .results import (
     DiagnosticResult,
     EvolveResult,
@@ -104,8 +105,8 @@ def subsample(points: list[_P], n: int) -> list[_P]:
 # --------------------------------------------------------------------------------- unit kinds
 
 
-def _evolve_target(p: dict):
-    t = p["target"]
+def _evolve_target(t: dict):
+    """An evolution unit's target: the MDP, or the family (its task, breadth and sensors)."""
     if t["kind"] == "mdp":
         return _mdp(t["mdp"])
     return _family(t["task"], t.get("sigma"), t.get("sensor"))
@@ -113,34 +114,35 @@ def _evolve_target(p: dict):
 
 def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:
     """One evolution run (paper Section 3.1 / 5): champion, history, optional validation."""
+    q = unit_params("evolve", p)
     from ..evolution.config import optimiser_of
     from ..evolution.evolve import evolve, validation_return
     from ..policies import prototype as make_prototype
 
-    target = _evolve_target(p)
-    proto = _policy(p["prototype"]) if isinstance(p["prototype"], dict) else make_prototype(p["topology"], p["prototype"])
-    optimizer, settings = optimiser_of(p["optimiser"])
+    target = _evolve_target(q.target)
+    proto = _policy(q.prototype) if isinstance(q.prototype, dict) else make_prototype(q.topology, q.prototype)
+    optimizer, settings = optimiser_of(q.optimiser)
     t0 = time.perf_counter()
     result = evolve(
         target,
-        topology=p["topology"],
+        topology=q.topology,
         prototype=proto,
         optimizer=optimizer,
-        resampling=p["resampling"],
-        budget=p["budget"] or None,
+        resampling=q.resampling,
+        budget=q.budget or None,
         settings=settings or None,
-        seed=p["seed"],
-        n_steps=p["n_steps"],
+        seed=q.seed,
+        n_steps=q.n_steps,
         threads=threads,
         device=device,
     )
     history = [(int(h.episodes), num(h.champion_return)) for h in result.history]
     validation = crashed = None
-    if p.get("validation_mdps") == "test":  # every run's champion on the family's test MDPs, with shared noise (paired)
-        ev = fly_on_test_mdps(result.champion, target, p["validation_episodes"], p["validation_seed"], p["n_steps"], threads, device)
+    if q.validation_mdps == "test":  # every run's champion on the family's test MDPs, with shared noise (paired)
+        ev = fly_on_test_mdps(result.champion, target, q.validation_episodes, q.validation_seed, q.n_steps, threads, device)
         validation, crashed = tuple(num(x) for x in ev.returns), tuple(bool(c) for c in ev.crashed)
-    elif p.get("validation_episodes"):
-        v = validation_return(result.champion, target, episodes=p["validation_episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads, device=device)
+    elif q.validation_episodes:
+        v = validation_return(result.champion, target, episodes=q.validation_episodes, seed=q.seed, n_steps=q.n_steps, threads=threads, device=device)
         validation = tuple(num(x) for x in v)
     scale = result.settings["settings"].get("fitness") if result.settings.get("method") == "generational" else None
     return EvolveResult(
@@ -151,7 +153,7 @@ def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:
         generations=int(result.generations),
         stop_reason=result.stop_reason,
         champion_crashed=bool(result.champion_crashed),
-        history=tuple(subsample(history, p.get("history_points", 300))),
+        history=tuple(subsample(history, q.history_points)),
         validation=validation,
         validation_crashed=crashed,
         fitness=scale,
@@ -171,22 +173,24 @@ def fly_on_test_mdps(policy, family, episodes: int, seed: int, n_steps: int, thr
 
 def run_robustness(p: dict, threads: int | None, device: str = "cpu") -> dict:
     """Table 3: fly one policy ``episodes`` times on each of the given MDPs."""
+    q = unit_params("robustness", p)
     from ..evaluate import evaluate
 
-    mdps = [_mdp(m) for m in p["mdps"]]
-    ev = evaluate(_policy(p["policy"]), mdps, episodes=p["episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads, device=device)
+    mdps = [_mdp(m) for m in q.mdps]
+    ev = evaluate(_policy(q.policy), mdps, episodes=q.episodes, seed=q.seed, n_steps=q.n_steps, threads=threads, device=device)
     return RobustnessResult(
-        returns=tuple(tuple(num(x) for x in row) for row in ev.returns[0]), crashes=tuple(int(c) for c in ev.crashed[0].sum(axis=1)), own=p["own"]
+        returns=tuple(tuple(num(x) for x in row) for row in ev.returns[0]), crashes=tuple(int(c) for c in ev.crashed[0].sum(axis=1)), own=q.own
     ).to_dict()
 
 
 def run_safety(p: dict, threads: int | None, device: str = "cpu") -> dict:
     """Crash matrix of the specialised policies on the training MDPs, and the two safe ones."""
+    q = unit_params("safety", p)
     from ..evaluate import evaluate
     from ..policysets import choose_safe
 
-    policies = [_policy(d) for d in p["policies"]]
-    ev = evaluate(policies, [_mdp(m) for m in p["mdps"]], episodes=p["episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads, device=device)
+    policies = [_policy(d) for d in q.policies]
+    ev = evaluate(policies, [_mdp(m) for m in q.mdps], episodes=q.episodes, seed=q.seed, n_steps=q.n_steps, threads=threads, device=device)
     crashes, returns = ev.crashed.sum(axis=2), ev.returns.mean(axis=2)
     return SafetyResult(
         crashes=tuple(tuple(int(c) for c in row) for row in crashes),
@@ -200,41 +204,42 @@ def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
     model, fly that policy ``test_episodes`` times in the true MDP. Methods: ``lr`` (OLS, the
     paper's), ``lr-gls`` (the GLS option), ``ec-meno`` (``ec_meno_budget`` evaluations, 0: the
     plateau stop) and ``ec-mer`` (``model_budget`` evaluations)."""
+    q = unit_params("model", p)
     from ..evaluate import evaluate
     from ..evolution.evolve import evolve
     from ..models import learn_ec_meno, learn_ec_mer, learn_lr
 
-    mdp = _mdp(p["mdp"])
-    generic = _policy(p["generic"])
-    seeds = np.random.SeedSequence(p["seed"]).generate_state(4, np.uint64) >> np.uint64(1)
-    data = evaluate(generic, mdp, seed=int(seeds[0]), record=True, n_steps=p["n_steps"], threads=threads, device=device)
+    mdp = _mdp(q.mdp)
+    generic = _policy(q.generic)
+    seeds = np.random.SeedSequence(q.seed).generate_state(4, np.uint64) >> np.uint64(1)
+    data = evaluate(generic, mdp, seed=int(seeds[0]), record=True, n_steps=q.n_steps, threads=threads, device=device)
     flight = data.flight_data
     assert flight is not None  # recorded
     t0 = time.perf_counter()
-    if p["method"] in ("lr", "lr-gls"):  # ordinary least squares (the paper's), or the GLS option
-        model = learn_lr(flight, estimator="gls" if p["method"] == "lr-gls" else "ols")
-    elif p["method"] == "ec-meno":
-        model = learn_ec_meno(flight, budget=p["ec_meno_budget"] or None, seed=int(seeds[1]))
+    if q.method in ("lr", "lr-gls"):  # ordinary least squares (the paper's), or the GLS option
+        model = learn_lr(flight, estimator="gls" if q.method == "lr-gls" else "ols")
+    elif q.method == "ec-meno":
+        model = learn_ec_meno(flight, budget=q.ec_meno_budget or None, seed=int(seeds[1]))
     else:
-        model = learn_ec_mer(flight, generic, float(data.returns.ravel()[0]), budget=p["model_budget"], seed=int(seeds[1]), episodes=p["ec_mer_episodes"])
+        model = learn_ec_mer(flight, generic, float(data.returns.ravel()[0]), budget=q.model_budget, seed=int(seeds[1]), episodes=q.ec_mer_episodes)
     learn_seconds = time.perf_counter() - t0
-    proto = generic if p["prototype"] == "generic" else "baseline"
+    proto = generic if q.prototype == "generic" else "baseline"
     t1 = time.perf_counter()
     evolved = evolve(
         model.mdp(),
         topology=generic.topology,
         prototype=proto,
-        budget=p["policy_budget"] or None,
+        budget=q.policy_budget or None,
         seed=int(seeds[2]),
-        n_steps=p["n_steps"],
+        n_steps=q.n_steps,
         threads=threads,
         device=device,
     )
     evolve_seconds = time.perf_counter() - t1
-    test = evaluate(evolved.champion, mdp, episodes=p["test_episodes"], seed=int(seeds[3]), n_steps=p["n_steps"], threads=threads, device=device)
+    test = evaluate(evolved.champion, mdp, episodes=q.test_episodes, seed=int(seeds[3]), n_steps=q.n_steps, threads=threads, device=device)
     returns = test.returns.ravel()
     return ModelResult(
-        method=p["method"],
+        method=q.method,
         mdp=mdp.label,
         generic_return=num(data.returns.ravel()[0]),
         generic_crashed=bool(data.crashed.ravel()[0]),
@@ -255,8 +260,9 @@ def unit_agent(p: dict, device: str = "cpu"):
     from ..agents.model_based import ModelEvolution
     from ..agents.registry import AgentOptions, AgentPolicies, agent_spec
 
-    spec = agent_spec(p["agent"])
-    pol = p["policies"]
+    q = unit_params("test_run", p)
+    spec = agent_spec(q.agent)
+    pol = q.policies
     policies = AgentPolicies(
         generic=_policy(pol["generic"]) if "generic" in pol else None,
         specialised=tuple(_policy(d) for d in pol.get("specialised", ())),
@@ -264,26 +270,27 @@ def unit_agent(p: dict, device: str = "cpu"):
     )
     options = AgentOptions(
         evolution=ModelEvolution(
-            budget=p["model_budget"], predict_episodes=p["predict_episodes"], n_steps=p["n_steps"], estimator=p["estimator"], device=device
+            budget=q.model_budget, predict_episodes=q.predict_episodes, n_steps=q.n_steps, estimator=q.estimator, device=device
         ),
-        settings=None if spec.settings is None else spec.settings.from_unit(p),  # the agent's own, typed
+        settings=None if spec.settings is None else spec.settings.from_unit(p),  # the agent's own, typed (from its UNIT_KEY)
     )
     return spec.build(policies, options)
 
 
 def run_test_run(p: dict, threads: int | None, device: str = "cpu") -> dict:
     """One test run (docs/model.md, On-line agents): ``episodes`` episodes of an agent on one MDP it does not know."""
+    q = unit_params("test_run", p)
     from ..agents.protocol import run_test
     from ..compete import after_learning_start
 
-    family = _family(p["task"], p.get("sigma"), p.get("sensor"))
-    mdp = _mdp(p["mdp"])
+    family = _family(q.task, q.sigma, q.sensor)
+    mdp = _mdp(q.mdp)
     agent = unit_agent(p, device)
-    r = run_test(agent, family, mdp, episodes=p["episodes"], seed=p["seed"], n_steps=p["n_steps"], threads=threads, device=device)
+    r = run_test(agent, family, mdp, episodes=q.episodes, seed=q.seed, n_steps=q.n_steps, threads=threads, device=device)
     start = after_learning_start(r.policy)
     changes = tuple((e, r.policy[e]) for e in range(len(r.policy)) if e == 0 or r.policy[e] != r.policy[e - 1])
     return TestRunResult(
-        agent=p["agent"],
+        agent=q.agent,
         mdp=mdp.label,
         score=num(r.score),
         returns=tuple(num(x) for x in r.returns),

@@ -1,0 +1,111 @@
+"""Typed unit params, one frozen dataclass per unit kind (what a unit's runner reads).
+
+The planner writes a unit's params as plain data (the store keeps them beside its result); its
+runner reads them through :func:`unit_params` into these classes, which refuse a key they do not
+declare (tests/test_experiments.py parses every planned unit of every shipped config, so the
+planner and these declarations cannot drift apart). Optional keys the planner leaves out are None.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import Any
+
+
+@dataclass(frozen=True, kw_only=True)
+class EvolveParams:
+    """One evolution run: ``target`` is ``{"kind": "mdp", "mdp": ...}`` or ``{"kind": "family", "task", "sigma"[, "sensor"]}``."""
+
+    target: dict
+    topology: str
+    prototype: str | dict
+    resampling: str
+    budget: int
+    optimiser: dict
+    n_steps: int
+    validation_episodes: int
+    history_points: int = 300
+    validation_mdps: str | None = None
+    validation_seed: int | None = None
+    seed: int
+
+
+@dataclass(frozen=True, kw_only=True)
+class RobustnessParams:
+    """One champion flown on every training MDP (Table 4)."""
+
+    policy: dict
+    source: str
+    own: int
+    mdps: list
+    episodes: int
+    n_steps: int
+    seed: int
+
+
+@dataclass(frozen=True, kw_only=True)
+class SafetyParams:
+    """The specialised policies flown on every training MDP, to find the safe ones."""
+
+    policies: list
+    mdps: list
+    episodes: int
+    n_steps: int
+    seed: int
+
+
+@dataclass(frozen=True, kw_only=True)
+class ModelParams:
+    """One learned model of one MDP, and the policy evolved on it."""
+
+    method: str
+    mdp: dict
+    generic: dict
+    n_steps: int
+    model_budget: int
+    ec_meno_budget: int
+    ec_mer_episodes: int
+    policy_budget: int
+    prototype: str
+    test_episodes: int
+    seed: int
+
+
+@dataclass(frozen=True, kw_only=True)
+class TestRunParams:
+    """One test run of an agent on one MDP; ``hybrid`` / ``agent_settings`` are the agent's own settings (read by its spec)."""
+
+    task: str
+    sigma: float | None
+    episodes: int
+    n_steps: int
+    model_budget: int
+    predict_episodes: int
+    max_learning_episodes: int
+    agent: str
+    group: str
+    mdp: dict
+    policies: dict
+    estimator: str = "ols"
+    sensor: dict | None = None
+    hybrid: dict | None = None
+    agent_settings: dict | None = None
+    seed: int
+
+
+PARAMS: dict[str, type] = {
+    "evolve": EvolveParams,
+    "robustness": RobustnessParams,
+    "safety": SafetyParams,
+    "model": ModelParams,
+    "test_run": TestRunParams,
+}
+
+
+def unit_params(kind: str, params: dict) -> Any:
+    """The params of a unit of ``kind`` as its typed params (a key the class does not declare is refused)."""
+    cls = PARAMS[kind]
+    unknown = sorted(set(params) - {f.name for f in fields(cls)})
+    if unknown:
+        raise ValueError(f"a {kind!r} unit's params hold {', '.join(unknown)}, which {cls.__name__} does not declare")
+    return cls(**params)

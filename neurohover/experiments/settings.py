@@ -1,0 +1,127 @@
+"""Typed experiment settings, one frozen dataclass per experiment kind (what the planner reads).
+
+A config's settings are checked against :data:`neurohover.experiments.config.SCHEMAS` and kept as
+that plain table (``ExperimentConfig.settings``: it is what the config hash and the store hold);
+:func:`typed_settings` reads the checked table into these classes (``ExperimentConfig.typed``),
+so the planner and the report name their fields instead of string keys. A setting that a config
+may leave out is None here when it did.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import Any
+
+
+@dataclass(frozen=True, kw_only=True)
+class Variant:
+    """One evolution variant (a ``[[settings.variants]]`` table)."""
+
+    key: str
+    label: str
+    topology: str = "mlp"
+    prototype: str = "baseline"
+    resampling: str = "fixed:1"
+    sigma: float | None = None
+    optimiser: dict | None = None  # over the experiment's optimiser table (None: left out)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Group:
+    """One group of test runs (a ``[[settings.groups]]`` table): an agent on some MDPs."""
+
+    agent: str
+    label: str
+    n_mdps: int
+    mdps: str = "test"
+    runs_per_mdp: int = 1
+    exclude_own: bool = False
+    hybrid: dict
+    settings: dict | None = None  # the agent's own typed settings, as a table
+    estimator: str = "ols"
+    sensor: dict | None = None  # this group's sensors (None: the experiment's)
+
+
+@dataclass(frozen=True, kw_only=True)
+class ExperimentSettings:
+    """What every experiment kind has."""
+
+    task: str
+    seed: int
+    sigma: float | None = None
+    n_steps: int = 6000
+    sensor: dict | None = None  # every MDP of the experiment seen through these sensors (None: exact)
+
+
+@dataclass(frozen=True, kw_only=True)
+class EvolutionSettings(ExperimentSettings):
+    target: str
+    runs: int
+    n_mdps: int = 10
+    budget: int = 0
+    optimiser: dict
+    validation_episodes: int = 0
+    validation_mdps: str | None = None
+    history_points: int = 300
+    robustness_variants: tuple[str, ...] = ()
+    robustness_episodes: int = 10
+    variants: tuple[Variant, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class ModelLearningSettings(ExperimentSettings):
+    mdps: str = "test"
+    n_mdps: int
+    methods: tuple[str, ...]
+    generic: str = "evolve"
+    generic_budget: int = 0
+    model_budget: int = 2000
+    ec_meno_budget: int = 0
+    ec_mer_episodes: int = 1
+    policy_budget: int = 0
+    policy_prototype: str = "generic"
+    test_episodes: int = 5
+
+
+@dataclass(frozen=True, kw_only=True)
+class TestRunsSettings(ExperimentSettings):
+    episodes: int
+    policies: str = "evolve"
+    policy_budget: int = 0
+    generic_budget: int = 0
+    generic_resampling: dict
+    generics_per_agent: int = 1
+    generics_from: dict | None = None
+    safety_episodes: int = 3
+    model_budget: int = 2000
+    predict_episodes: int = 5
+    max_learning_episodes: int = 25
+    groups: tuple[Group, ...]
+
+
+KIND_SETTINGS: dict[str, type[ExperimentSettings]] = {
+    "evolution": EvolutionSettings,
+    "model_learning": ModelLearningSettings,
+    "test_runs": TestRunsSettings,
+}
+_NESTED: dict[str, type] = {"variants": Variant, "groups": Group}
+
+
+def _build(cls: type, table: dict) -> Any:
+    names = {f.name for f in fields(cls)}
+    unknown = sorted(set(table) - names)
+    if unknown:  # the schemas and these classes must agree: a programming error, not a user's
+        raise RuntimeError(f"{cls.__name__} has no field(s) {', '.join(unknown)}: add them beside the schema's")
+    values: dict[str, Any] = {}
+    for name, value in table.items():
+        if name in _NESTED:
+            value = tuple(_build(_NESTED[name], item) for item in value)
+        elif isinstance(value, list):
+            value = tuple(value)
+        values[name] = value
+    return cls(**values)
+
+
+def typed_settings(kind: str, table: dict) -> ExperimentSettings:
+    """The checked settings ``table`` of an experiment of ``kind`` as its typed settings."""
+    return _build(KIND_SETTINGS[kind], table)

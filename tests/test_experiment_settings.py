@@ -1,0 +1,62 @@
+"""Typed experiment settings (neurohover.experiments.settings) and unit params (neurohover.experiments.params)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from neurohover import NeurohoverError
+from neurohover.experiments.config import SCHEMAS, experiment_names, load_config
+from neurohover.experiments.params import PARAMS, TestRunParams, unit_params
+from neurohover.experiments.plans import plan
+from neurohover.experiments.settings import KIND_SETTINGS, EvolutionSettings, Group, TestRunsSettings, Variant
+
+
+def test_every_schema_key_is_a_field_of_its_kinds_settings_class() -> None:
+    nested = {"variants": Variant, "groups": Group}
+    for kind, schema in SCHEMAS.items():
+        names = {f.name for f in dataclasses.fields(KIND_SETTINGS[kind])}
+        assert set(schema) == names, kind
+        for key, (_, check) in schema.items():
+            if isinstance(check, tuple):  # a list of sub-tables
+                assert set(check[1]) == {f.name for f in dataclasses.fields(nested[key])}, key
+
+
+@pytest.mark.parametrize("scale", ["quick", "paper"])
+def test_every_shipped_config_reads_as_its_typed_settings(scale: str) -> None:
+    for name in experiment_names():
+        cfg = load_config(name, scale)
+        typed = cfg.typed
+        assert isinstance(typed, KIND_SETTINGS[cfg.kind])
+        assert typed.task == cfg.settings["task"] and typed.seed == cfg.settings["seed"]
+        if isinstance(typed, EvolutionSettings):
+            assert [v.key for v in typed.variants] == [v["key"] for v in cfg.settings["variants"]]
+        if isinstance(typed, TestRunsSettings):
+            assert [g.label for g in typed.groups] == [g["label"] for g in cfg.settings["groups"]]
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            typed.seed = 1  # type: ignore[misc]
+
+
+@pytest.mark.parametrize("scale", ["quick", "paper"])
+def test_every_planned_unit_reads_as_its_typed_params(scale: str) -> None:
+    kinds = set()
+    for name in experiment_names():
+        cfg = load_config(name, scale)
+        try:  # test runs need policies: the shipped sets plan every run at once
+            units = plan(load_config(name, scale, {"policies": "shipped"}), {}, {}).units if cfg.kind == "test_runs" else plan(cfg, {}, {}).units
+        except NeurohoverError:  # FGHH runs drawing several generics per agent take no policy set
+            units = plan(cfg, {}, {}).units
+        for unit in units:
+            if unit.kind in PARAMS:
+                params = unit_params(unit.kind, unit.params)
+                assert params.seed == unit.params["seed"]
+                kinds.add(unit.kind)
+    assert kinds >= {"evolve", "test_run"}
+
+
+def test_unit_params_refuse_a_key_they_do_not_declare() -> None:
+    fields = {f.name: None for f in dataclasses.fields(TestRunParams) if f.default is dataclasses.MISSING}
+    with pytest.raises(ValueError, match="does not declare"):
+        unit_params("test_run", {**fields, "sensr": {}})
+    assert unit_params("test_run", fields).sensor is None
