@@ -10,19 +10,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import neurohover as nh
 from neurohover.cli import main
 from neurohover.flightdata import FlightData
 from neurohover.policies import prototype, save_policy
 
 
-def _run(capsys, *argv: str) -> tuple[int, str, str]:
-    rc = main(list(argv))
-    out = capsys.readouterr()
-    return rc, out.out, out.err
-
-
-def test_fly_json_reports_the_issue_keys(capsys) -> None:
-    rc, out, _ = _run(capsys, "fly", "--task", "ghh08", "--mdp", "zero", "--episodes", "3", "--seed", "4", "--json")
+def test_fly_json_reports_the_issue_keys(cli) -> None:
+    rc, out, _ = cli("fly", "--task", "ghh08", "--mdp", "zero", "--episodes", "3", "--seed", "4", "--json")
     assert rc == 0
     result = json.loads(out)
     for key in ("mean_return", "std_return", "crashes", "episodes", "episodes_per_second"):
@@ -32,20 +27,20 @@ def test_fly_json_reports_the_issue_keys(capsys) -> None:
     assert result["min_return"] <= result["mean_return"] <= result["max_return"]
 
 
-def test_fly_wind_and_params_set_the_mdp(capsys, tmp_path: Path) -> None:
-    _, calm, _ = _run(capsys, "fly", "--task", "ghh08", "--wind", "0,0", "--episodes", "2", "--json")
-    _, windy, _ = _run(capsys, "fly", "--task", "ghh08", "--wind", "4,-4", "--episodes", "2", "--json")
+def test_fly_wind_and_params_set_the_mdp(cli, tmp_path: Path) -> None:
+    _, calm, _ = cli("fly", "--task", "ghh08", "--wind", "0,0", "--episodes", "2", "--json")
+    _, windy, _ = cli("fly", "--task", "ghh08", "--wind", "4,-4", "--episodes", "2", "--json")
     assert json.loads(windy)["mean_return"] < json.loads(calm)["mean_return"]
-    rc, out, _ = _run(capsys, "fly", "--task", "ghh09", "--params", "0.9,0.5,0.2,0.1,0.8,0.3,0.7,0.6", "--episodes", "2", "--json")
+    rc, out, _ = cli("fly", "--task", "ghh09", "--params", "0.9,0.5,0.2,0.1,0.8,0.3,0.7,0.6", "--episodes", "2", "--json")
     assert rc == 0 and json.loads(out)["mean_return"] < json.loads(calm)["mean_return"]
     policy_file = save_policy(prototype("mlp", "baseline"), tmp_path / "mlp.json", note="test")
-    _, mlp, _ = _run(capsys, "fly", "--task", "ghh08", "--wind", "0,0", "--episodes", "2", "--json", "--policy", str(policy_file))
+    _, mlp, _ = cli("fly", "--task", "ghh08", "--wind", "0,0", "--episodes", "2", "--json", "--policy", str(policy_file))
     assert json.loads(mlp)["mean_return"] == json.loads(calm)["mean_return"]
 
 
-def test_fly_record_writes_flight_data(capsys, tmp_path: Path) -> None:
+def test_fly_record_writes_flight_data(cli, tmp_path: Path) -> None:
     path = tmp_path / "flight.npz"
-    rc, _, _ = _run(capsys, "fly", "--task", "fghh", "--mdp", "train:1", "--episodes", "2", "--record", str(path))
+    rc, _, _ = cli("fly", "--task", "fghh", "--mdp", "train:1", "--episodes", "2", "--record", str(path))
     assert rc == 0
     fd = FlightData.load(path)
     assert fd.n_episodes == 2 and fd.n_transitions == 12000
@@ -68,14 +63,14 @@ def test_fly_record_writes_flight_data(capsys, tmp_path: Path) -> None:
         (["fly", "--task", "ghh08", "--policy", "missing.json"], "does not exist"),
     ],
 )
-def test_bad_input_exits_2_with_one_clear_message(capsys, argv, message: str) -> None:
-    rc, out, err = _run(capsys, *argv)
+def test_bad_input_exits_2_with_one_clear_message(cli, argv, message: str) -> None:
+    rc, out, err = cli(*argv)
     assert rc == 2
     assert message in err
     assert "Traceback" not in err and err.count("\n") == 1
 
 
-def test_malformed_policy_files_are_refused(capsys, tmp_path: Path) -> None:
+def test_malformed_policy_files_are_refused(cli, tmp_path: Path) -> None:
     cases = {
         "notjson.json": "{not json",
         "nogenome.json": json.dumps({"topology": "mlp"}),
@@ -90,12 +85,12 @@ def test_malformed_policy_files_are_refused(capsys, tmp_path: Path) -> None:
     }
     for name, text in cases.items():
         (tmp_path / name).write_text(text)
-        rc, _, err = _run(capsys, "fly", "--task", "ghh08", "--policy", str(tmp_path / name))
+        rc, _, err = cli("fly", "--task", "ghh08", "--policy", str(tmp_path / name))
         assert rc == 2 and expected[name] in err, (name, err)
 
 
 def test_every_command_has_help(capsys) -> None:
-    from neurohover.cli import build_parser, main
+    from neurohover.cli import build_parser
 
     commands = build_parser()._subparsers._group_actions[0].choices
     for name in commands:  # in this process: a fresh interpreter per command cost 1 s each
@@ -106,3 +101,41 @@ def test_every_command_has_help(capsys) -> None:
     # and the entry point itself, once, as a user runs it
     out = subprocess.run([sys.executable, "-m", "neurohover", "evolve", "--help"], capture_output=True, text=True)
     assert out.returncode == 0 and "usage: neurohover evolve" in out.stdout
+
+
+def test_a_failed_command_leaves_no_empty_output_directory(tmp_path: Path, capsys) -> None:
+    from neurohover.cli import main
+    from neurohover.experiments import Store
+
+    Store(tmp_path / "empty.sqlite").close()
+    out = tmp_path / "new" / "report"
+    assert main(["report", "--store", str(tmp_path / "empty.sqlite"), "--out", str(out), "fig7"]) == 2
+    err = capsys.readouterr().err
+    assert "created directory" in err and f"removed the empty directory {str(tmp_path / 'new')!r}" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["empty.sqlite"]
+    # compete: refused after its --out check (an unknown MDP), so nothing was written there either
+    assert main(["compete", "--task", "ghh08", "--agent", "model-free", "--runs", "1", "--episodes", "2", "--mdps", "nope", "--out", str(out)]) == 2
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["empty.sqlite"]
+    # a directory that was there already stays, empty or not
+    (tmp_path / "mine").mkdir()
+    assert main(["report", "--store", str(tmp_path / "empty.sqlite"), "--out", str(tmp_path / "mine"), "fig7"]) == 2
+    assert (tmp_path / "mine").is_dir()
+
+
+def test_flight_data_can_be_recorded_in_float32_in_half_the_space(tmp_path: Path, capsys) -> None:
+    from neurohover.cli import main
+    from neurohover.flightdata import FlightData
+
+    sizes = {}
+    for dtype in ("float64", "float32"):
+        path = tmp_path / f"{dtype}.npz"
+        assert main(["fly", "--task", "ghh08", "--mdp", "train:3", "--episodes", "2", "--record", str(path), "--record-dtype", dtype, "--json"]) == 0
+        sizes[dtype] = path.stat().st_size
+    capsys.readouterr()
+    exact, rounded = FlightData.load(tmp_path / "float64.npz"), FlightData.load(tmp_path / "float32.npz")
+    assert sizes["float32"] < 0.6 * sizes["float64"]
+    for a, b in zip(exact.observations + exact.actions, rounded.observations + rounded.actions):
+        assert b.dtype == np.float64 and np.array_equal(b, a.astype(np.float32).astype(np.float64))
+    assert rounded.metadata["returns"] == exact.metadata["returns"]
+    with pytest.raises(nh.NeurohoverError, match="flight-data dtype 'float16' is not allowed: use float64 or float32"):
+        exact.save(tmp_path / "x.npz", dtype="float16")

@@ -13,11 +13,11 @@ import tomllib
 from pathlib import Path
 
 import pytest
+from conftest import ROOT
 
 import neurohover
 import neurohover.experiments
 
-ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
 
 

@@ -262,16 +262,10 @@ def test_validation_episodes_are_fresh_and_reproducible() -> None:
 # --------------------------------------------------------------------------------- commands
 
 
-def _run(capsys, *argv: str) -> tuple[int, str, str]:
-    rc = main(list(argv))
-    out = capsys.readouterr()
-    return rc, out.out, out.err
-
-
-def test_evolve_command_writes_policy_history_and_resumes(capsys, tmp_path: Path) -> None:
+def test_evolve_command_writes_policy_history_and_resumes(cli, tmp_path: Path) -> None:
     out = tmp_path / "champ.json"
     args = ["evolve", "--task", "ghh08", "--mdp", "train:1", "--topology", "slp", "--episode-steps", "300", "--seed", "5", "--out", str(out), "--json"]
-    rc, stdout, _ = _run(capsys, *args, "--budget", "300")
+    rc, stdout, _ = cli(*args, "--budget", "300")
     assert rc == 0
     summary = json.loads(stdout)
     policy = load_policy(out)
@@ -287,20 +281,19 @@ def test_evolve_command_writes_policy_history_and_resumes(capsys, tmp_path: Path
     assert history[-1].episodes == 300
     assert Path(f"{out}.checkpoint.json").is_file()
     # --resume with a larger budget continues to exactly what one run of that budget gives.
-    rc, _, _ = _run(capsys, *args, "--budget", "600", "--resume")
+    rc, _, _ = cli(*args, "--budget", "600", "--resume")
     assert rc == 0
     resumed = load_policy(out)
     direct = tmp_path / "direct.json"
-    rc, _, _ = _run(capsys, *[a if a != str(out) else str(direct) for a in args], "--budget", "600")
+    rc, _, _ = cli(*[a if a != str(out) else str(direct) for a in args], "--budget", "600")
     assert rc == 0
     np.testing.assert_array_equal(resumed.genome, load_policy(direct).genome)
     assert read_history_csv(Path(f"{out}.history.csv"))[-1].episodes == 600
 
 
-def test_evolve_command_over_the_family_with_races(capsys, tmp_path: Path) -> None:
+def test_evolve_command_over_the_family_with_races(cli, tmp_path: Path) -> None:
     out = tmp_path / "generic.json"
-    rc, stdout, _ = _run(
-        capsys,
+    rc, stdout, _ = cli(
         "evolve",
         "--task",
         "fghh",
@@ -324,7 +317,7 @@ def test_evolve_command_over_the_family_with_races(capsys, tmp_path: Path) -> No
     assert all(h.generation_episodes >= 50 for h in read_history_csv(Path(f"{out}.history.csv")))
 
 
-def test_evolve_command_ctrl_c_saves_the_checkpoint(capsys, tmp_path: Path, monkeypatch) -> None:
+def test_evolve_command_ctrl_c_saves_the_checkpoint(cli, tmp_path: Path, monkeypatch) -> None:
     from neurohover import commands_learning
 
     def interrupt(self, info) -> None:
@@ -332,7 +325,7 @@ def test_evolve_command_ctrl_c_saves_the_checkpoint(capsys, tmp_path: Path, monk
 
     monkeypatch.setattr(commands_learning._Bar, "__call__", interrupt)
     out = tmp_path / "p.json"
-    rc, _, err = _run(capsys, "evolve", "--task", "ghh08", "--topology", "slp", "--budget", "100000", "--episode-steps", "3000", "--out", str(out))
+    rc, _, err = cli("evolve", "--task", "ghh08", "--topology", "slp", "--budget", "100000", "--episode-steps", "3000", "--out", str(out))
     assert rc == 130
     assert f"checkpoint saved to {out}.checkpoint.json" in err and "--resume" in err
     assert Path(f"{out}.checkpoint.json").is_file() and not out.exists()
@@ -351,33 +344,31 @@ def test_evolve_command_ctrl_c_saves_the_checkpoint(capsys, tmp_path: Path, monk
         (["--wind", "9,0"], "out of range"),
     ],
 )
-def test_evolve_command_bad_input(capsys, tmp_path: Path, argv, words) -> None:
-    rc, _, err = _run(capsys, "evolve", "--task", "ghh08", "--budget", "60", "--episode-steps", "50", "--out", str(tmp_path / "x.json"), *argv)
+def test_evolve_command_bad_input(cli, tmp_path: Path, argv, words) -> None:
+    rc, _, err = cli("evolve", "--task", "ghh08", "--budget", "60", "--episode-steps", "50", "--out", str(tmp_path / "x.json"), *argv)
     assert rc == 2
     assert err.startswith("neurohover evolve: error:") and words in err
 
 
-def test_learn_model_command_prints_learned_next_to_true(capsys, tmp_path: Path) -> None:
+def test_learn_model_command_prints_learned_next_to_true(cli, tmp_path: Path) -> None:
     data = tmp_path / "flight.npz"
-    rc, _, _ = _run(capsys, "fly", "--task", "ghh08", "--mdp", "zero", "--episodes", "2", "--seed", "3", "--record", str(data))
+    rc, _, _ = cli("fly", "--task", "ghh08", "--mdp", "zero", "--episodes", "2", "--seed", "3", "--record", str(data))
     assert rc == 0
     model_file = tmp_path / "model.json"
-    rc, out, _ = _run(capsys, "learn-model", "--flight-data", str(data), "--method", "lr", "--out", str(model_file))
+    rc, out, _ = cli("learn-model", "--flight-data", str(data), "--method", "lr", "--out", str(model_file))
     assert rc == 0
     assert "true ones of ghh08/zero" in out and "C_p" in out and "D_r" in out
     from neurohover.models import LearnedModel
 
     assert LearnedModel.load(model_file).method == "lr"
-    rc, out, _ = _run(capsys, "learn-model", "--flight-data", str(data), "--method", "ec-meno", "--budget", "100", "--out", str(tmp_path / "meno.json"))
+    rc, out, _ = cli("learn-model", "--flight-data", str(data), "--method", "ec-meno", "--budget", "100", "--out", str(tmp_path / "meno.json"))
     assert rc == 0 and "ec-meno model written" in out
 
 
-def test_learn_model_command_bad_input(capsys, tmp_path: Path) -> None:
-    rc, _, err = _run(capsys, "learn-model", "--flight-data", str(tmp_path / "missing.npz"), "--method", "lr", "--out", str(tmp_path / "m.json"))
+def test_learn_model_command_bad_input(cli, tmp_path: Path) -> None:
+    rc, _, err = cli("learn-model", "--flight-data", str(tmp_path / "missing.npz"), "--method", "lr", "--out", str(tmp_path / "m.json"))
     assert rc == 2 and "no such flight-data file" in err
-    rc, _, err = _run(
-        capsys, "learn-model", "--flight-data", str(tmp_path / "missing.npz"), "--method", "ec-mer", "--budget", "0", "--out", str(tmp_path / "m.json")
-    )
+    rc, _, err = cli("learn-model", "--flight-data", str(tmp_path / "missing.npz"), "--method", "ec-mer", "--budget", "0", "--out", str(tmp_path / "m.json"))
     assert rc == 2 and "--budget 0 is out of range" in err
 
 

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import ROOT
 
 pytest.importorskip("stable_baselines3")
 
@@ -72,3 +73,34 @@ def test_squashed_reward_keeps_a_crash_worse_than_flying_on():
     assert rewards[-1] < -scale * worst / (1 - gamma) * 0.99
     # The statistics inside the transform keep the environment's raw return.
     assert info["episode"]["r"] < -1e6
+
+
+def test_make_images_help_describes_and_draws_nothing(tmp_path: Path) -> None:
+    images = ROOT / "docs" / "images"
+    before = {p.name: p.stat().st_mtime_ns for p in images.glob("*.png")}
+    proc = subprocess.run([sys.executable, str(images / "make_images.py"), "--help"], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0 and "usage: make_images.py" in proc.stdout
+    assert {p.name: p.stat().st_mtime_ns for p in images.glob("*.png")} == before
+
+
+@pytest.mark.skipif(importlib.util.find_spec("stable_baselines3") is not None, reason="the examples extra is installed")
+def test_the_ppo_example_without_its_extra_says_what_to_install() -> None:
+    proc = subprocess.run([sys.executable, str(ROOT / "examples" / "ppo_ghh08.py"), "--help"], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    assert proc.stderr.strip().splitlines() == [
+        f"examples/ppo_ghh08.py needs {'torch' if importlib.util.find_spec('torch') is None else 'stable_baselines3'}: "
+        "pip install 'neurohover[examples]' (for a CPU build of torch first: pip install torch==2.13.0)"
+    ]
+
+
+@pytest.mark.skipif(importlib.util.find_spec("stable_baselines3") is not None, reason="the examples extra is installed")
+def test_the_rl_zoo_evaluation_example_without_its_extra_says_what_to_install() -> None:
+    proc = subprocess.run([sys.executable, str(ROOT / "examples" / "evaluate_rl_zoo.py"), "--help"], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    assert "needs stable_baselines3: pip install 'neurohover[examples]'" in proc.stderr
+
+
+@pytest.mark.skipif(importlib.util.find_spec("evotorch") is not None, reason="evotorch is installed")
+def test_the_evotorch_example_without_its_extra_says_what_to_install() -> None:
+    proc = subprocess.run([sys.executable, str(ROOT / "examples" / "evotorch_snes.py"), "--help"], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr and "needs torch: pip install 'neurohover[evotorch]'" in proc.stderr

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import ROOT
 
 from neurohover.cli import main
 from neurohover.errors import NeurohoverError
@@ -34,7 +35,6 @@ from neurohover.experiments import (
 from neurohover.experiments.config import CONFIG_DIR, parse_override
 from neurohover.experiments.store import SCHEMA_VERSION
 
-ROOT = Path(__file__).resolve().parents[1]
 PAPER_EXPERIMENTS = ["fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16"]
 ABLATIONS = ["ablation-plateau", "ablation-hybrid", "ablation-fghh"]
 
@@ -59,12 +59,6 @@ n_steps = 200
 budget = 3000
 n_steps = 200
 """
-
-
-def _run(capsys, *argv: str) -> tuple[int, str, str]:
-    rc = main(list(argv))
-    out = capsys.readouterr()
-    return rc, out.out, out.err
 
 
 def _write(tmp_path: Path, text: str, name: str = "exp.toml") -> Path:
@@ -132,14 +126,14 @@ def test_paper_scale_follows_the_papers_protocol(name, total, check) -> None:
     assert check(cfg.settings)
 
 
-def test_unknown_experiment_lists_the_known_ones(capsys, tmp_path: Path) -> None:
+def test_unknown_experiment_lists_the_known_ones(cli, tmp_path: Path) -> None:
     with pytest.raises(NeurohoverError) as err:
         load_config("fig99", "quick")
     for name in PAPER_EXPERIMENTS:
         assert name in str(err.value)
-    rc, _, stderr = _run(capsys, "reproduce", "fig99", "--store", str(tmp_path / "s.sqlite"))
+    rc, _, stderr = cli("reproduce", "fig99", "--store", str(tmp_path / "s.sqlite"))
     assert rc == 2 and "unknown experiment 'fig99'" in stderr and "fig16" in stderr
-    rc, out, _ = _run(capsys, "reproduce", "--list")
+    rc, out, _ = cli("reproduce", "--list")
     assert rc == 0 and out.split() == PAPER_EXPERIMENTS + ABLATIONS
 
 
@@ -243,7 +237,7 @@ def test_store_semantics(tmp_path: Path) -> None:
         assert sessions[-1]["status"] == "finished" and sessions[-1]["cores"] >= 1 and sessions[-1]["units_run"] == 3
 
 
-def test_store_refuses_other_schema_versions_and_foreign_files(tmp_path: Path, capsys) -> None:
+def test_store_refuses_other_schema_versions_and_foreign_files(tmp_path: Path, cli) -> None:
     path = tmp_path / "s.sqlite"
     Store(path).close()
     conn = sqlite3.connect(path)
@@ -252,7 +246,7 @@ def test_store_refuses_other_schema_versions_and_foreign_files(tmp_path: Path, c
     conn.close()
     with pytest.raises(NeurohoverError, match=f"schema version {SCHEMA_VERSION + 1}, written by a newer neurohover"):
         Store(path)
-    rc, _, stderr = _run(capsys, "reproduce", "fig15", "--store", str(path))
+    rc, _, stderr = cli("reproduce", "fig15", "--store", str(path))
     assert rc == 2 and "schema version" in stderr
     foreign = tmp_path / "other.sqlite"
     conn = sqlite3.connect(foreign)
@@ -282,10 +276,26 @@ def _finished(path: Path) -> dict[str, float]:
         return {}
 
 
-def _start(config: Path, store: Path) -> subprocess.Popen:
+GATED_RUN = """
+import sys
+from neurohover.cli import main
+from neurohover.experiments import runner
+from neurohover.experiments.plans import Plan
+from neurohover.experiments.units import Unit
+
+# Twelve units, unit i held until the test creates gates/i: the test, not the machine's speed, decides
+# how far a run gets before it is interrupted.
+gates = sys.argv[1]
+units = [Unit("slowtest", f"u{i:02d}", "diagnostic", {"value": i, "wait_for": f"{gates}/{i}"}) for i in range(12)]
+runner.plan = lambda config, results, sources=None: Plan(units, 12)
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+def _start(config: Path, store: Path, gates: Path) -> subprocess.Popen:
     env = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
     return subprocess.Popen(
-        [sys.executable, "-m", "neurohover.experiments", "reproduce", str(config), "--scale", "quick", "--store", str(store), "--no-progress"],
+        [sys.executable, "-c", GATED_RUN, str(gates), "reproduce", str(config), "--scale", "quick", "--store", str(store), "--no-progress"],
         cwd=ROOT,
         env=env,
         stdout=subprocess.PIPE,
@@ -294,11 +304,15 @@ def _start(config: Path, store: Path) -> subprocess.Popen:
     )
 
 
+def _open_gates(gates: Path, upto: int) -> None:
+    for i in range(upto):
+        (gates / str(i)).touch()
+
+
 def _interrupt_after(proc: subprocess.Popen, store: Path, n: int, sig: int) -> dict[str, float]:
-    deadline = time.time() + 240
-    while time.time() < deadline and proc.poll() is None:
-        if len(_finished(store)) >= n:
-            break
+    """Signal ``proc`` once ``n`` units are stored; unit ``n`` waits at its closed gate, so the run is still going."""
+    deadline = time.monotonic() + 240  # a safety net against a hung run, not a speed assumption
+    while time.monotonic() < deadline and proc.poll() is None and len(_finished(store)) < n:
         time.sleep(0.02)
     assert proc.poll() is None, f"the run ended before it could be interrupted: {proc.communicate()}"
     proc.send_signal(sig)
@@ -309,30 +323,37 @@ def _interrupt_after(proc: subprocess.Popen, store: Path, n: int, sig: int) -> d
 def test_an_interrupted_run_loses_no_finished_unit_and_resumes(tmp_path: Path) -> None:
     """Ctrl-C, then SIGKILL, then a full run on the same store: nothing finished is lost or redone."""
     config = _write(tmp_path, SLOW_CONFIG)
-    store = tmp_path / "s.sqlite"
-    proc = _start(config, store)
+    store, gates = tmp_path / "s.sqlite", tmp_path / "gates"
+    gates.mkdir()
+    _open_gates(gates, 2)
+    proc = _start(config, store, gates)
     first = _interrupt_after(proc, store, 2, signal.SIGINT)
-    assert proc.returncode == 130 and 2 <= len(first) < 12
-    proc = _start(config, store)
-    second = _interrupt_after(proc, store, len(first) + 2, signal.SIGKILL)
-    assert proc.returncode == -signal.SIGKILL and len(first) + 2 <= len(second) < 12
+    assert proc.returncode == 130 and len(first) == 2
+    _open_gates(gates, 5)
+    proc = _start(config, store, gates)
+    second = _interrupt_after(proc, store, 5, signal.SIGKILL)
+    assert proc.returncode == -signal.SIGKILL and len(second) == 5
     assert all(second[k] == t for k, t in first.items())
     # Run again with the same store: only the missing units run; finished ones are untouched.
-    proc = _start(config, store)
+    _open_gates(gates, 12)
+    proc = _start(config, store, gates)
     out, err = proc.communicate(timeout=240)
     assert proc.returncode == 0, err
-    assert f"ran {12 - len(second)} units, {len(second)} already in the store, 12/12 done" in out
+    assert "ran 7 units, 5 already in the store, 12/12 done" in out
     after = _finished(store)
     assert len(after) == 12 and all(after[k] == t for k, t in second.items())
     with Store(store) as s:
         sessions = s.sessions("slowtest", "quick")
-        assert [x["units_run"] for x in sessions] == [len(first), len(second) - len(first), 12 - len(second)]
+        assert [x["units_run"] for x in sessions] == [2, 3, 7]
         assert [x["status"] for x in sessions] == ["interrupted", "running", "finished"]  # SIGKILL: no goodbye
-        resumed = s.results("slowtest", "quick")
-    # The resumed results equal those of an uninterrupted run (each unit is seeded by its key).
-    cfg = load_config(str(config), "quick")
-    for unit in plan(cfg, {}).units[:2]:
-        assert strip_timing(run_unit(unit)) == strip_timing(resumed[unit.key])
+        assert [s.results("slowtest", "quick")[f"u{i:02d}"]["value"] for i in range(12)] == list(range(12))
+
+
+def test_a_resumed_unit_equals_an_uninterrupted_one(tmp_path: Path) -> None:
+    # Each unit is seeded by its key, so a unit run after an interruption gives what it would have.
+    cfg = load_config(str(_write(tmp_path, SLOW_CONFIG)), "quick")
+    unit = plan(cfg, {}).units[3]
+    assert strip_timing(run_unit(unit)) == strip_timing(run_unit(unit))
 
 
 # --------------------------------------------------------------------------------- end to end
@@ -355,7 +376,7 @@ def quick_store(tmp_path_factory) -> Path:
     return path
 
 
-def test_quick_experiments_end_to_end(quick_store: Path, capsys) -> None:
+def test_quick_experiments_end_to_end(quick_store: Path, cli) -> None:
     with Store(quick_store) as store:
         assert {n for n, _, _, _ in store.experiments()} == {"fig2", "table4", "fig8", "fig15"}
         fig8 = store.results("fig8", "quick")
@@ -370,18 +391,18 @@ def test_quick_experiments_end_to_end(quick_store: Path, capsys) -> None:
         assert {r["method"] for k, r in models.items() if k.startswith("model/")} == {"lr", "lr-gls", "ec-meno", "ec-mer"}
         robust = [r for k, r in store.results("fig2", "quick").items() if k.startswith("robust/")]
         assert len(robust) == 2 and all(len(r["returns"]) == 1 and len(r["returns"][0]) == 3 for r in robust)
-    rc, out, _ = _run(capsys, "reproduce", "fig8", "--scale", "quick", "--store", str(quick_store), "--no-progress")
+    rc, out, _ = cli("reproduce", "fig8", "--scale", "quick", "--store", str(quick_store), "--no-progress")
     assert rc == 0 and "ran 0 units, 18 already in the store" in out
 
 
-def test_results_export_csv_and_json(quick_store: Path, capsys, tmp_path: Path) -> None:
-    rc, out, _ = _run(capsys, "results", "fig8", "--store", str(quick_store), "--format", "json")
+def test_results_export_csv_and_json(quick_store: Path, cli, tmp_path: Path) -> None:
+    rc, out, _ = cli("results", "fig8", "--store", str(quick_store), "--format", "json")
     data = json.loads(out)
     assert rc == 0 and data["experiment"] == "fig8" and data["scale"] == "quick" and len(data["units"]) == 18
     assert data["config"]["settings"]["task"] == "ghh09" and data["sessions"][0]["executor"] == "local"
     with Store(quick_store) as store:
         assert store.sessions("fig15", "quick")[0]["cores"] == 2
-    rc, _, _ = _run(capsys, "results", "fig8", "--store", str(quick_store), "--out", str(tmp_path / "fig8.csv"))
+    rc, _, _ = cli("results", "fig8", "--store", str(quick_store), "--out", str(tmp_path / "fig8.csv"))
     import csv
 
     rows = list(csv.DictReader(open(tmp_path / "fig8.csv")))
@@ -395,15 +416,15 @@ def test_results_export_csv_and_json(quick_store: Path, capsys, tmp_path: Path) 
     assert run["param.mdp.label"] == "ghh09/train:0" and run["param.policies.safe_indices.0"] != ""
     with Store(quick_store) as store:
         assert export_results(store, "fig15", "csv").count("\n") == 5
-    rc, _, err = _run(capsys, "results", "fig7", "--store", str(quick_store))
+    rc, _, err = cli("results", "fig7", "--store", str(quick_store))
     assert rc == 2 and "holds no experiment 'fig7'" in err and "fig8 (quick)" in err
-    rc, _, err = _run(capsys, "results", "fig8", "--store", str(tmp_path / "missing.sqlite"))
+    rc, _, err = cli("results", "fig8", "--store", str(tmp_path / "missing.sqlite"))
     assert rc == 2 and "no such results store" in err
 
 
-def test_report_draws_the_figures_and_compares_with_the_paper(quick_store: Path, tmp_path: Path, capsys) -> None:
+def test_report_draws_the_figures_and_compares_with_the_paper(quick_store: Path, tmp_path: Path, cli) -> None:
     out = tmp_path / "report"
-    rc, printed, _ = _run(capsys, "report", "--store", str(quick_store), "--out", str(out))
+    rc, printed, _ = cli("report", "--store", str(quick_store), "--out", str(out))
     assert rc == 0 and "report.md" in printed
     for name in ("fig2", "table4", "fig8", "fig15"):
         png = out / f"{name}-quick.png"
@@ -435,7 +456,7 @@ def test_report_draws_the_figures_and_compares_with_the_paper(quick_store: Path,
     # A hand-written discussion beside the report survives regenerating it.
     (out / "discussion").mkdir()
     (out / "discussion" / "fig8-quick.md").write_text("Our hybrid agent fell back in most episodes.\n")
-    assert _run(capsys, "report", "--store", str(quick_store), "--out", str(out))[0] == 0
+    assert cli("report", "--store", str(quick_store), "--out", str(out))[0] == 0
     sections = (out / "report.md").read_text().split("\n## ")
     fig8 = next(sec for sec in sections if sec.startswith("Figure 8"))
     assert "### Discussion\n\nOur hybrid agent fell back in most episodes." in fig8
@@ -445,7 +466,7 @@ def test_report_draws_the_figures_and_compares_with_the_paper(quick_store: Path,
     with Store(quick_store) as store:
         write_report(store, tmp_path / "one", names=["fig15"])
     assert "Figure 2" not in (tmp_path / "one" / "report.md").read_text()
-    rc, _, err = _run(capsys, "report", "fig7", "--store", str(quick_store), "--out", str(tmp_path / "x"))
+    rc, _, err = cli("report", "fig7", "--store", str(quick_store), "--out", str(tmp_path / "x"))
     assert rc == 2 and "holds no experiment 'fig7'" in err
 
 

@@ -14,6 +14,7 @@ import matplotlib.image as mpimg
 import numpy as np
 import pytest
 
+import neurohover as nh
 from neurohover.cli import main
 from neurohover.flightdata import FlightData
 from neurohover.plots import (
@@ -210,3 +211,15 @@ def test_bad_input_in_a_real_process(tmp_path: Path) -> None:
     run = subprocess.run([sys.executable, "-m", "neurohover", "plot", str(tmp_path / "none.npz")], capture_output=True, text=True)
     assert run.returncode == 2 and "Traceback" not in run.stderr
     assert run.stderr.strip() == f"neurohover plot: error: FLIGHT '{tmp_path / 'none.npz'}': no such flight-data file"
+
+
+def test_plot_draws_only_the_episodes_asked_for(tmp_path: Path, capsys) -> None:
+    from neurohover.cli import main
+
+    flights = tmp_path / "f.npz"
+    nh.evaluate(nh.baseline_policy(), nh.get_task_family("ghh08").zero(), episodes=4, record=True, n_steps=40).flight_data.save(flights)
+    assert main(["plot", str(flights), "--episodes", "0,2-3"]) == 0
+    assert sorted(p.name for p in tmp_path.glob("*.png")) == ["f-episode0.png", "f-episode2.png", "f-episode3.png"]
+    capsys.readouterr()
+    assert main(["plot", str(flights), "--episodes", "4"]) == 2
+    assert "--episodes '4' is out of range: the flight data hold episodes 0..3" in capsys.readouterr().err

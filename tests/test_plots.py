@@ -3,7 +3,6 @@ object-oriented API (a Figure with an Agg canvas), so a notebook user's backend 
 
 from __future__ import annotations
 
-import gzip
 import shutil
 import struct
 from pathlib import Path
@@ -14,8 +13,6 @@ import pytest
 from neurohover.compete import plot_cumulative
 from neurohover.experiments import Store, write_report
 
-ROOT = Path(__file__).resolve().parents[1]
-STORE_GZ = ROOT / "docs" / "reproduction" / "results.sqlite.gz"
 DPI = 110  # what both plotters save with
 
 
@@ -55,11 +52,9 @@ def test_compete_plot_keeps_the_backend(svg_backend, tmp_path: Path) -> None:
     _assert_png(path, {(11, 4)})
 
 
-@pytest.mark.skipif(not STORE_GZ.is_file(), reason="the committed results store is not in this checkout")
-def test_report_figures_keep_the_backend(svg_backend, tmp_path: Path) -> None:
+def test_report_figures_keep_the_backend(svg_backend, committed_store: Path, tmp_path: Path) -> None:
     store_path = tmp_path / "results.sqlite"
-    with gzip.open(STORE_GZ) as src, open(store_path, "wb") as dst:
-        shutil.copyfileobj(src, dst)
+    shutil.copyfile(committed_store, store_path)
     out = tmp_path / "report"
     names = ["fig15", "table4", "fig8"]  # one experiment of each kind: evolution, model learning, test runs
     with Store(store_path, create=False) as store:

@@ -8,6 +8,7 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 import pytest
+from conftest import ROOT
 from gymnasium.utils.env_checker import check_env
 
 import neurohover
@@ -18,7 +19,6 @@ from neurohover.envs.render import FRAME_HEIGHT, FRAME_WIDTH, HoverRenderer, vie
 
 BASELINE = neurohover.baseline_policy()
 BOXES = HoverRenderer()  # the layout is the same in every renderer of the default size
-ROOT = Path(__file__).resolve().parent.parent
 
 
 def _crop(frame: np.ndarray, part: str) -> np.ndarray:

@@ -4,7 +4,6 @@ refused, and the one parser of unit keys."""
 
 from __future__ import annotations
 
-import gzip
 import json
 import shutil
 import sqlite3
@@ -24,19 +23,6 @@ from neurohover.experiments.results import (
     result_from_dict,
 )
 from neurohover.experiments.store import _dumps
-
-ROOT = Path(__file__).resolve().parents[1]
-STORE_GZ = ROOT / "docs" / "reproduction" / "results.sqlite.gz"
-
-
-@pytest.fixture(scope="module")
-def committed_store(tmp_path_factory) -> Path:
-    if not STORE_GZ.is_file():
-        pytest.skip("the committed results store is not in this checkout")
-    path = tmp_path_factory.mktemp("store") / "results.sqlite"
-    with gzip.open(STORE_GZ) as src, open(path, "wb") as dst:
-        shutil.copyfileobj(src, dst)
-    return path
 
 
 def _stored(path: Path, *where: str):

@@ -12,6 +12,7 @@ import pytest
 
 pytest.importorskip("rl_zoo3", reason="rl_zoo3 is not installed (pip install 'neurohover[examples]' rl_zoo3)")
 
+from conftest import ROOT
 from rl_zoo3.utils import get_wrapper_class  # noqa: E402
 
 import neurohover as nh  # noqa: E402
@@ -20,8 +21,6 @@ from neurohover.integrations.flying import evaluate_callable  # noqa: E402
 from neurohover.integrations.rlzoo_ppo import hyperparams  # noqa: E402
 from neurohover.integrations.sb3 import rl_zoo_policy  # noqa: E402
 from neurohover.wrappers import CrashAwareReward  # noqa: E402
-
-ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_every_short_id_has_the_recipe_and_rl_zoo_builds_its_wrapper() -> None:

@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 
 import gymnasium as gym
 import numpy as np
@@ -231,18 +229,14 @@ def test_env_sensor_arguments_are_checked() -> None:
 # -- the command line and the configs ---------------------------------------------------------
 
 
-def run_cli(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "neurohover", *args], capture_output=True, text=True, timeout=300)
-
-
-def test_fly_with_noisy_sensors_from_the_command_line() -> None:
+def test_fly_with_noisy_sensors_from_the_command_line(cli) -> None:
     base = ("fly", "--policy", "baseline", "--task", "ghh08", "--mdp", "train:1", "--episodes", "4", "--json")
-    exact = json.loads(run_cli(*base).stdout)
-    noisy = json.loads(run_cli(*base, "--obs-noise", "position=0.3,correlation=0.9", "--obs-delay", "1").stdout)
+    exact = json.loads(cli(*base)[1])
+    noisy = json.loads(cli(*base, "--obs-noise", "position=0.3,correlation=0.9", "--obs-delay", "1")[1])
     assert "sensor" not in exact and noisy["sensor"] == Sensor(position=0.3, correlation=0.9, delay=1).to_dict()
     assert noisy["mean_return"] != exact["mean_return"]
-    bad = run_cli(*base, "--obs-noise", "foo=1")
-    assert bad.returncode == 2 and "'foo=1' is not understood" in bad.stderr and "Traceback" not in bad.stderr
+    rc, _, err = cli(*base, "--obs-noise", "foo=1")
+    assert rc == 2 and "'foo=1' is not understood" in err and "Traceback" not in err
 
 
 def test_a_test_runs_group_flies_its_mdps_through_its_sensor(tmp_path) -> None:

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import neurohover as nh
 from neurohover.envs import ENV_IDS
 from neurohover.errors import NeurohoverError
 from neurohover.tasks import TASK_FAMILIES, TASK_NAMES, TaskFamily, discover, family_for, get_task_family
@@ -91,3 +92,10 @@ def test_a_new_family_module_is_discovered_and_gets_samples_rows_and_sets(tmp_pa
     assert rows.shape[0] == 2 and np.all((rows[:, 4] >= -42.15) & (rows[:, 4] <= -42.15 * 0.5))  # D_w < 0
     sys.modules.pop("myfamilies", None)
     sys.modules.pop("myfamilies.heavy", None)
+
+
+def test_an_mdp_reads_as_plain_numbers() -> None:
+    mdp = nh.get_task_family("ghh08").mdp("train:3")
+    assert "np.float64" not in repr(mdp) and "params=(-0.18, -0.43" in repr(mdp)
+    built = nh.get_task_family("fghh", 0.3).make(np.array(mdp.params))
+    assert all(type(x) is float for x in built.params) and built.params == mdp.params

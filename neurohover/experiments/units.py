@@ -307,9 +307,16 @@ def run_diagnostic(p: dict, threads: int | None, device: str = "cpu") -> dict:
 
     ``exit_unless`` names a marker file: if it does not exist, the unit creates it and the worker
     process exits at once (as if killed), so a retry succeeds; ``always_exit`` always exits.
+    ``wait_for`` names a gate file: the unit waits until it exists (at most 600 s), so a test holds
+    a run at a unit of its choosing, whatever the machine's speed.
     """
     if p.get("always_exit"):
         os._exit(3)
+    gate = p.get("wait_for")
+    if gate:
+        deadline = time.monotonic() + 600.0
+        while not os.path.exists(gate) and time.monotonic() < deadline:
+            time.sleep(0.01)
     marker = p.get("exit_unless")
     if marker and not os.path.exists(marker):
         with open(marker, "w") as f:

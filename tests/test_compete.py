@@ -73,3 +73,13 @@ def test_a_crashing_run_records_its_crash_step() -> None:
         timing=TestRunTiming(seconds=0.0, offline_seconds=0.0),
     )
     assert episode_rows(4, result, 100) == [[4, "m", 0, "-1.0", 0, 100, "a", 1], [4, "m", 1, "-2.0", 1, 17, "b", 0]]
+
+
+def test_compete_says_when_it_reuses_stored_runs(tmp_path: Path, capsys) -> None:
+    from neurohover.cli import main
+
+    args = ["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "2", "--episodes", "3", "--out", str(tmp_path / "c")]
+    assert main(args) == 0
+    assert "reused" not in capsys.readouterr().err
+    assert main(args) == 0
+    assert "2 of 2 units (runs and the policies they fly) were already in" in capsys.readouterr().err

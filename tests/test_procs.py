@@ -1,4 +1,4 @@
-"""Robustness of long runs (issue 10), with real processes: worker processes never outlive a killed
+"""neurohover.procs and the long runs it guards, with real processes: worker processes never outlive a killed
 ``reproduce`` or ``compete``, a bad or dead Ray address ends at once with a clear message, and one
 store has one writer at a time.
 
@@ -16,10 +16,10 @@ import time
 from pathlib import Path
 
 import pytest
+from conftest import ROOT
 
 from neurohover.experiments import Store
 
-ROOT = Path(__file__).resolve().parents[1]
 ENV = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
 
 # An evolution experiment whose units each take tens of seconds (far longer than the tests wait).
