@@ -25,13 +25,13 @@ from neurohover.sim._cache import SimSourceLocator, sim_source_hash
 PACKAGE = Path(neurohover.__file__).resolve().parent
 
 # Seeds one noise stream (envs/vector.py, compiled code linking sim/rng.py) and, with "step", flies
-# one control step without noise or wind (sim/kernel.py, compiled code inlining sim/constants.py).
+# one control step without noise or wind (sim/step.py on sim/kernel.py, compiled code inlining sim/constants.py).
 PROBE = """
 import json, sys
 import numpy as np
 import neurohover
 from neurohover.envs.vector import _seed_streams
-from neurohover.sim import kernel
+from neurohover.sim import step
 from neurohover.sim.constants import DEFAULT_PARAMS, MDP_ROW_LEN, ROW_DT, ROW_PARAMS, ROW_SUBSTEPS
 
 out = {"file": neurohover.__file__}
@@ -45,13 +45,13 @@ if "step" in sys.argv:
     row[0, ROW_DT] = 0.01
     states = np.zeros((1, 13))
     states[0, 12] = 1.0
-    kernel.step_batch(row, np.zeros(1, dtype=np.int64), states, np.zeros((1, 6)), rngs,
+    step.step_batch(row, np.zeros(1, dtype=np.int64), states, np.zeros((1, 6)), rngs,
                       np.zeros(1, dtype=np.int64), np.zeros((1, 4)), 6000, np.zeros((1, 12)),
                       np.zeros(1), np.zeros(1, dtype=np.bool_))
     out["state"] = states[0].tolist()
 out["stats"] = {
     name: [sum(f.stats.cache_hits.values()), sum(f.stats.cache_misses.values())]
-    for name, f in (("seed_streams", _seed_streams), ("step_batch", kernel.step_batch))
+    for name, f in (("seed_streams", _seed_streams), ("step_batch", step.step_batch))
     if hasattr(f, "stats")  # plain Python functions under NUMBA_DISABLE_JIT
 }
 print(json.dumps(out))

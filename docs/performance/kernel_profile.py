@@ -35,10 +35,10 @@ def run(row, kind, g, n_eps, n_steps, use_noise, use_policy, n_sub_override):
                 a1, a2, a3, a4 = K.policy_action(kind, g, o[0], o[1], o[2], o[3], o[4], o[5], o[9], o[10], o[11])
             else:
                 a1, a2, a3, a4 = 0.02 - 0.0196 * o[4], -0.0185 * o[3], 0.0, 0.23 + 0.0513 * o[5]
-            a1 = K._clip(a1)
-            a2 = K._clip(a2)
-            a3 = K._clip(a3)
-            a4 = K._clip(a4)
+            a1 = K.clip_action(a1)
+            a2 = K.clip_action(a2)
+            a3 = K.clip_action(a3)
+            a4 = K.clip_action(a4)
             if use_noise:
                 n = K.update_noise(n, std, next_normal(ra), next_normal(ra), next_normal(ra), next_normal(ra), next_normal(ra), next_normal(ra))
             s = K.integrate(s, n, a1, a2, a3, a4, k, dyn, n_sub, dt, wind)

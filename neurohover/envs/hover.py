@@ -1,6 +1,6 @@
 """Generalized helicopter hovering as a Gymnasium environment (one helicopter).
 
-The physics is the compiled kernel's :func:`neurohover.sim.kernel.step_batch`, called with a
+The physics is the compiled kernel's :func:`neurohover.sim.step.step_batch`, called with a
 batch of one, so this environment, the vector environment and the batched evaluation fly exactly
 the same simulator.
 
@@ -31,9 +31,9 @@ from ..sim.constants import (
     PARAM_NAMES,
     STATE_DIM,
 )
-from ..sim.kernel import ENV_NOISE_WIDTH, ENV_RNG_WIDTH, start_readings, step_batch
 from ..sim.reference import competition_time
 from ..sim.rng import seed_stream
+from ..sim.step import ENV_NOISE_WIDTH, ENV_RNG_WIDTH, start_readings, step_batch
 from ..tasks import MDP, TASK_FAMILIES, TaskFamily, get_task_family
 from ..tasks.sensor import Sensor
 

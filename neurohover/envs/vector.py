@@ -2,7 +2,7 @@
 
 ``HoverVectorEnv`` is what ``gymnasium.make_vec("neurohover/GHH08-v0", num_envs=N,
 vectorization_mode="vector_entry_point")`` builds. Every ``step`` advances all N helicopters
-through a single call of :func:`neurohover.sim.kernel.step_batch`; Python only touches the
+through a single call of :func:`neurohover.sim.step.step_batch`; Python only touches the
 sub-environments that reset.
 
 Example
@@ -29,8 +29,8 @@ from gymnasium.vector.utils import batch_space
 from ..errors import NeurohoverError
 from ..evaluate import check_device
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS, MDP_ROW_LEN, OBS_DIM
-from ..sim.kernel import ENV_NOISE_WIDTH, ENV_RNG_WIDTH, start_readings, step_batch
 from ..sim.rng import seed_stream
+from ..sim.step import ENV_NOISE_WIDTH, ENV_RNG_WIDTH, start_readings, step_batch
 from ..tasks import MDP, TaskFamily
 from .hover import (
     RENDER_FPS,

@@ -29,7 +29,7 @@ import types
 import numpy as np
 from numba.core.registry import CPUDispatcher
 
-from . import kernel, rng
+from . import kernel, rng, step
 from .constants import MDP_ROW_LEN, ROW_DT, ROW_SUBSTEPS, SAFEGUARD_LIMITS, SENSOR_SCRATCH
 
 try:  # numba-cuda (``pip install 'neurohover[cuda]'``) or numba's built-in target; may be broken or absent
@@ -41,7 +41,7 @@ else:
     _IMPORT_ERROR = None
 
 THREADS_PER_BLOCK = 128
-SIM_MODULES = (kernel.__name__, rng.__name__)  # compiled functions from these modules are retargeted
+SIM_MODULES = (kernel.__name__, step.__name__, rng.__name__)  # compiled functions from these modules are retargeted
 
 
 def simulating() -> bool:
@@ -201,7 +201,7 @@ def _reset_thread(idx, rows, states, noise, rngs, steps, mdp_rows, d_states, d_n
         d_steps[i] = steps[t]
 
 
-step_one = kernel.step_one  # the CPU dispatcher; _rebind hands the kernel its device version
+step_one = step.step_one  # the CPU dispatcher; _rebind hands the kernel its device version
 _STEP_KERNEL = None
 _RESET_KERNEL = None
 
@@ -336,7 +336,7 @@ def rollout_batch_cuda(
 
 
 def step_kernel():
-    """The CUDA kernel (built on first use): same arguments as :func:`neurohover.sim.kernel.step_batch`."""
+    """The CUDA kernel (built on first use): same arguments as :func:`neurohover.sim.step.step_batch`."""
     global _STEP_KERNEL
     if _STEP_KERNEL is None:
         _require()
@@ -353,7 +353,7 @@ def _reset_kernel():
 
 
 class StepBatch:
-    """:func:`~neurohover.sim.kernel.step_batch` on the GPU with its per-helicopter arrays kept there.
+    """:func:`~neurohover.sim.step.step_batch` on the GPU with its per-helicopter arrays kept there.
 
     The MDP rows, states, noise, stream states and step counters of ``n`` helicopters live in
     device memory between steps; :meth:`step` copies the actions in and the observations, rewards

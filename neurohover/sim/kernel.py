@@ -2,8 +2,8 @@
 
 Evolution, resampling, selection races, learned models, on-line agents and the Gymnasium
 environments all fly helicopters through the functions here: the scalar episode loop, and the
-step functions that the SIMD lanes (:mod:`.lanes`) and the CUDA kernel (:mod:`.cuda`) build on,
-tested bit-identical to it. An MDP is a float64 row (layout in
+physics that the SIMD lanes (:mod:`.lanes`), the environments' step (:mod:`.step`) and the CUDA
+kernel (:mod:`.cuda`) build on, tested bit-identical to it. An MDP is a float64 row (layout in
 :mod:`neurohover.sim.constants`) holding dynamics parameters, noise standard deviations, substep
 count and length, and the wind model, so a learned model (one 0.1 s substep, no wind) runs in
 the same code as the true simulator.
@@ -49,8 +49,6 @@ from .rng import SENSOR_STREAM_KEY, next_normal, seed_stream
 
 POLICY_SLP = 0
 POLICY_MLP = 1
-ENV_NOISE_WIDTH = 6 + SENSOR_SCRATCH  # step_batch's per-helicopter floats when it senses: gust noise, then the sensor's
-ENV_RNG_WIDTH = 8  # and uint64 words: the gust stream, then the sensor stream
 GENOME_WIDTH = 42  # genome rows are padded to the MLP's length
 SERIES_MAX_ANGLE = 0.5  # Taylor series below this rotation angle, libm above
 
@@ -89,12 +87,12 @@ def policy_action(kind, g, u, v, w, x, y, z, qx, qy, qz):
 
 
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
-def _clip(a: float) -> float:
+def clip_action(a: float) -> float:
     return min(1.0, max(-1.0, a))
 
 
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
-def _rotation(qx, qy, qz, qw):
+def rotation_matrix(qx, qy, qz, qw):
     """Rotation matrix (body to world) of a unit quaternion, row by row."""
     x2 = qx + qx  # doubling is exact, so 2(xy - wz) == x(2y) - w(2z) with fewer operations
     y2 = qy + qy
@@ -124,7 +122,7 @@ def _rotation(qx, qy, qz, qw):
 @nb.njit(cache=True, fastmath={"contract"})
 def observe(s):
     """The 12-number observation of state tuple ``s`` (world velocity and position into body frame)."""
-    r00, r01, r02, r10, r11, r12, r20, r21, r22 = _rotation(s[9], s[10], s[11], s[12])
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_matrix(s[9], s[10], s[11], s[12])
     vu, vv, vw, px, py, pz = s[0], s[1], s[2], s[3], s[4], s[5]
     return (
         r00 * vu + r10 * vv + r20 * vw,
@@ -324,7 +322,7 @@ def integrate(s, n, a1, a2, a3, a4, step, dyn, n_sub, dt, wind):
         px += dt * vu
         py += dt * vv
         pz += dt * vw
-        r00, r01, r02, r10, r11, r12, r20, r21, r22 = _rotation(qx, qy, qz, qw)
+        r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_matrix(qx, qy, qz, qw)
         bu = r00 * vu + r10 * vv + r20 * vw
         bv = r01 * vu + r11 * vv + r21 * vw
         bw = r02 * vu + r12 * vv + r22 * vw
@@ -433,10 +431,10 @@ def fly_job(
             crash = True
             total += crash_charge(n_steps, t)
             break
-        a1 = _clip(a1)
-        a2 = _clip(a2)
-        a3 = _clip(a3)
-        a4 = _clip(a4)
+        a1 = clip_action(a1)
+        a2 = clip_action(a2)
+        a3 = clip_action(a3)
+        a4 = clip_action(a4)
         if slot >= 0:
             _record(obs_out, act_out, slot, k, seen, a1, a2, a3, a4)
         n = update_noise(n, std, next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng))
@@ -517,109 +515,3 @@ def rollout_batch(
             out_steps,
             out_safeguard_step,
         )
-
-
-@nb.njit(cache=True, inline="always", fastmath={"contract"})
-def step_one(i, mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps, obs_out, rew_out, crash_out):
-    """Advance helicopter ``i`` of :func:`step_batch` by one control step (its arguments, plus ``i``).
-
-    Shared by the CPU kernel (one loop iteration) and the CUDA kernel (one thread,
-    :mod:`neurohover.sim.cuda`), so both targets compile this source.
-    """
-    k = steps[i]
-    t = k + 1
-    steps[i] = t
-    sensor, sensing = unpack_sensor(mdp_rows[env_mdp[i]])
-    sensing = sensing and noise.shape[1] >= ENV_NOISE_WIDTH and rngs.shape[1] >= ENV_RNG_WIDTH  # (an env sizes them for its sensors)
-    a1, a2, a3, a4 = actions[i, 0], actions[i, 1], actions[i, 2], actions[i, 3]
-    if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
-        o = observe(
-            (
-                states[i, 0],
-                states[i, 1],
-                states[i, 2],
-                states[i, 3],
-                states[i, 4],
-                states[i, 5],
-                states[i, 6],
-                states[i, 7],
-                states[i, 8],
-                states[i, 9],
-                states[i, 10],
-                states[i, 11],
-                states[i, 12],
-            )
-        )
-        if sensing:
-            o = sense(o, t, sensor, rngs[i, 4:], noise[i, 6:])
-        for m in range(12):
-            obs_out[i, m] = o[m]
-        rew_out[i] = crash_charge(n_steps, t)
-        crash_out[i] = True
-        return
-    dyn, std, n_sub, dt, wind = unpack_mdp(mdp_rows[env_mdp[i]])
-    rng = rngs[i]
-    n = (noise[i, 0], noise[i, 1], noise[i, 2], noise[i, 3], noise[i, 4], noise[i, 5])
-    n = update_noise(n, std, next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng))
-    s = (
-        states[i, 0],
-        states[i, 1],
-        states[i, 2],
-        states[i, 3],
-        states[i, 4],
-        states[i, 5],
-        states[i, 6],
-        states[i, 7],
-        states[i, 8],
-        states[i, 9],
-        states[i, 10],
-        states[i, 11],
-        states[i, 12],
-    )
-    s = integrate(s, n, _clip(a1), _clip(a2), _clip(a3), _clip(a4), k, dyn, n_sub, dt, wind)
-    for m in range(13):
-        states[i, m] = s[m]
-    for m in range(6):
-        noise[i, m] = n[m]
-    o = observe(s)
-    seen = sense(o, t, sensor, rngs[i, 4:], noise[i, 6:]) if sensing else o
-    for m in range(12):
-        obs_out[i, m] = seen[m]
-    if crashed(s):
-        rew_out[i] = crash_charge(n_steps, t)
-        crash_out[i] = True
-    else:
-        rew_out[i] = reward_of(o)
-        crash_out[i] = False
-
-
-@nb.njit(cache=True, fastmath={"contract"})
-def step_batch(mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps, obs_out, rew_out, crash_out):
-    """Advance many helicopters by one control step each (the vector environment's kernel).
-
-    ``states`` (N, 13), ``noise`` (N, 6), ``rngs`` (N, 4) and ``steps`` (N,) are updated in place.
-    A non-finite action is a crash charged the full penalty. The body is :func:`step_one`. Rows
-    with a sensor model need ``noise`` (N, ENV_NOISE_WIDTH) and ``rngs`` (N, ENV_RNG_WIDTH): the
-    gust state, then the sensor's (:func:`start_readings` starts it); ``obs_out`` gets the readings.
-    """
-    for i in range(states.shape[0]):
-        step_one(i, mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps, obs_out, rew_out, crash_out)
-
-
-@nb.njit(cache=True)
-def start_readings(mdp_rows, env_mdp, idx, streams, rngs, noise, obs_out):
-    """The first reading of each new episode ``idx`` of :func:`step_batch`: zeros, or the sensors' reading of them.
-
-    ``streams`` (N, 2) holds each episode's (seed, episode); a sensing row's sensor stream is
-    seeded from it (as :func:`fly_job` seeds it) into ``rngs[i, 4:]`` and its noise kept in ``noise[i, 6:]``.
-    """
-    zero = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-    for i in idx:
-        sensor, sensing = unpack_sensor(mdp_rows[env_mdp[i]])
-        seen = zero
-        if sensing and noise.shape[1] >= ENV_NOISE_WIDTH and rngs.shape[1] >= ENV_RNG_WIDTH:
-            srng = rngs[i, 4:]
-            seed_stream(srng, np.uint64(streams[i, 0]) ^ SENSOR_STREAM_KEY, np.uint64(streams[i, 1]))
-            seen = sense(zero, 0, sensor, srng, noise[i, 6:])
-        for m in range(12):
-            obs_out[i, m] = seen[m]

@@ -46,13 +46,13 @@ from numba.extending import intrinsic
 from .constants import GRAVITY, MAX_POSITION, MAX_RATE, MAX_VELOCITY, MIN_QW, SENSOR_SCRATCH, WIND_SINUSOID
 from .kernel import (
     SERIES_MAX_ANGLE,
-    _clip,
-    _rotation,
+    clip_action,
     competition_time,
     crash_charge,
     integrate,
     observe,
     policy_action,
+    rotation_matrix,
     sense,
     unpack_mdp,
     unpack_sensor,
@@ -137,7 +137,7 @@ def _lane_substep(B, lane, has_wind):
     B[3 * LANES + lane] = fma(dt, vu, B[3 * LANES + lane])
     B[4 * LANES + lane] = fma(dt, vv, B[4 * LANES + lane])
     B[5 * LANES + lane] = fma(dt, vw, B[5 * LANES + lane])
-    r00, r01, r02, r10, r11, r12, r20, r21, r22 = _rotation(qx, qy, qz, qw)  # no FMA there
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_matrix(qx, qy, qz, qw)  # no FMA there
     bu = fma(r20, vw, fma(r10, vv, r00 * vu))
     bv = fma(r21, vw, fma(r11, vv, r01 * vu))
     bw = fma(r22, vw, fma(r12, vv, r02 * vu))
@@ -205,7 +205,7 @@ def _observe_lanes(B):
         qy = B[10 * LANES + lane]
         qz = B[11 * LANES + lane]
         qw = B[12 * LANES + lane]
-        r00, r01, r02, r10, r11, r12, r20, r21, r22 = _rotation(qx, qy, qz, qw)
+        r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_matrix(qx, qy, qz, qw)
         o0 = fma(vw, r20, fma(vv, r10, vu * r00))
         o1 = fma(vw, r21, fma(vu, r01, vv * r11))
         o2 = fma(vw, r22, fma(vu, r02, vv * r12))
@@ -418,10 +418,10 @@ def fly_lanes(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, se
                 job[lane] = -2  # over; the lane idles through this step (at rest, dt 0) and is refilled after it
                 _reset_lane(B, N, A, lane)
                 continue
-            a1 = _clip(a1)
-            a2 = _clip(a2)
-            a3 = _clip(a3)
-            a4 = _clip(a4)
+            a1 = clip_action(a1)
+            a2 = clip_action(a2)
+            a3 = clip_action(a3)
+            a4 = clip_action(a4)
             rng = rngs[lane]
             std = (P[lane, 0], P[lane, 1], P[lane, 2], P[lane, 3], P[lane, 4], P[lane, 5])
             n = (N[0, lane], N[1, lane], N[2, lane], N[3, lane], N[4, lane], N[5, lane])
