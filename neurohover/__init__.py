@@ -12,7 +12,7 @@ from .errors import NeurohoverError
 from .evaluate import DangerousState, Evaluation, PolicyTable, Safeguard, evaluate, evaluate_jobs
 from .flightdata import FlightData
 from .policies import Policy, baseline_policy, load_policy, prototype, save_policy
-from .tasks import FGHH, GHH08, GHH09, MDP, Sensor, get_task_family
+from .tasks import FGHH, GHH08, GHH09, MDP, Drift, Sensor, get_task_family
 
 try:
     __version__ = importlib.metadata.version("neurohover")  # one source of truth: pyproject.toml, as installed
@@ -25,6 +25,7 @@ __all__ = [
     "GHH09",
     "MDP",
     "Sensor",
+    "Drift",
     "Evaluation",
     "FlightData",
     "NeurohoverError",

@@ -43,6 +43,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
     from .evolution.seeding import check_seed
     from .experiments.executors import check_jobs
     from .paths import input_dir, output_dir, output_file
+    from .tasks import Drift, Sensor
 
     given = [f"--{k.replace('_', '-')}" for k in _HYBRID_OPTIONS if getattr(args, k) is not None]
     if given and args.agent not in HYBRID_AGENTS:
@@ -63,6 +64,8 @@ def cmd_compete(args: argparse.Namespace) -> int:
     output_dir(args.out, "--out")
     if args.store is not None:
         output_file(args.store, "--store")
+    noise, delay = args.obs_noise, args.obs_delay
+    sensor = None if noise is None and delay is None else Sensor.of(noise, delay)
     try:
         summary, _ = compete(
             args.task,
@@ -80,6 +83,8 @@ def cmd_compete(args: argparse.Namespace) -> int:
             store=args.store,
             progress=None,
             device=args.device,
+            sensor=sensor,
+            drift=None if args.drift is None else Drift.parse(args.drift),
         )
     except KeyboardInterrupt:
         print(
@@ -101,6 +106,7 @@ _HYBRID_OPTIONS = ("safeguard_rule", "safeguard_box", "safeguard_tilt", "hybrid_
 
 def register(sub) -> None:
     from .agents.registry import AGENTS
+    from .cli import add_sensor_options
     from .evolution.optimisers import optimiser_names
 
     p = sub.add_parser("build-policies", help="evolve the generic and specialised policies of a task", description=cmd_build_policies.__doc__)
@@ -132,6 +138,12 @@ def register(sub) -> None:
     p.add_argument("--episodes", type=int, default=1000, help="episodes per run (default 1000)")
     p.add_argument("--mdps", default="test", help="test (the fixed test MDPs in turn), sample (fresh from G) or train")
     p.add_argument("--sigma", type=float, help="FGHH breadth (default 0.3)")
+    add_sensor_options(p)
+    p.add_argument(
+        "--drift",
+        help="drifting dynamics over each run (docs/benchmarks.md): walk=STD (a log random walk of the 11 dynamics parameters per episode) "
+        "and/or PARAM=FACTOR@LO-HI (an abrupt change at an episode drawn from LO..HI), e.g. D_w=0.8@200-800",
+    )
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--jobs", type=int, default=1, help="runs in parallel processes (default 1)")
     p.add_argument(

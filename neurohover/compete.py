@@ -38,7 +38,7 @@ from .agents.hybrid import HybridSettings
 from .errors import NeurohoverError
 from .evolution.seeding import check_seed
 from .sim.constants import EPISODE_STEPS
-from .tasks import N_TEST, N_TRAINING, get_task_family
+from .tasks import N_TEST, N_TRAINING, Drift, Sensor, get_task_family
 
 CSV_COLUMNS = ("run", "mdp", "episode", "return", "crashed", "steps", "policy", "safeguard_fired")
 STORE_FILE = "results.sqlite"
@@ -137,6 +137,8 @@ def competition_config(
     n_steps: int = EPISODE_STEPS,
     policy_dir: str | None = None,
     hybrid: HybridSettings = HybridSettings(),
+    sensor: Sensor | None = None,
+    drift: Drift | None = None,
 ):
     """The inline experiment of a competition (an ``ExperimentConfig`` of kind ``test_runs``).
 
@@ -155,7 +157,7 @@ def competition_config(
     group = {"agent": agent, **_group(task, runs, mdps)}
     if agent in HYBRID_AGENTS:
         group["hybrid"] = hybrid.to_dict()
-    settings = {
+    settings: dict[str, object] = {
         "task": task,
         "sigma": sigma,
         "seed": seed,
@@ -164,6 +166,10 @@ def competition_config(
         "policies": policy_dir if policy_dir is not None else "shipped",
         "groups": [group],
     }
+    if sensor is not None and not sensor.exact:
+        settings["sensor"] = sensor.to_dict()
+    if drift is not None and not drift.none:
+        settings["drift"] = drift.to_dict()
     digest = hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()[:10]
     return make_config(f"compete-{task}-{agent}", "test_runs", f"settings-{digest}", settings, title=f"compete: {agent} on {task}")
 
@@ -186,6 +192,8 @@ def compete(
     progress: bool | None = False,
     on_result: Callable[[str, object], None] | None = None,
     device: str = "cpu",
+    sensor: Sensor | None = None,
+    drift: Drift | None = None,
 ) -> tuple[dict, list]:
     """Run ``runs`` test runs of ``agent`` as an inline experiment; write results and plot to ``out``.
 
@@ -208,6 +216,8 @@ def compete(
     device : {"cpu", "cuda"}
         Passed to the executor (:func:`neurohover.experiments.units.run_unit`); not part of the
         config. The test-run units fly on the CPU whatever it says (docs/gpu.md).
+    sensor, drift : Sensor, Drift, optional
+        The harder task (docs/benchmarks.md): every MDP seen through ``sensor``, its dynamics drifting by ``drift``.
 
     Returns
     -------
@@ -228,8 +238,9 @@ def compete(
         raise NeurohoverError(f"jobs={jobs!r} is out of range: allowed an integer >= 1")
     check_agent(agent, get_task_family(task, sigma), policy_dir)
     config = competition_config(
-        task, agent, runs=runs, episodes=episodes, mdps=mdps, seed=seed, sigma=sigma, n_steps=n_steps, policy_dir=policy_dir, hybrid=hybrid
-    )
+        task, agent, runs=runs, episodes=episodes, mdps=mdps, seed=seed, sigma=sigma, n_steps=n_steps, policy_dir=policy_dir, hybrid=hybrid,
+        sensor=sensor, drift=drift,
+    )  # fmt: skip
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     store_path = Path(store) if store is not None else out / STORE_FILE

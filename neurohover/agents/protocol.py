@@ -149,7 +149,8 @@ def run_test(
     """Fly one test run of ``episodes`` episodes of ``agent`` on ``mdp``.
 
     Episode e's gusts come from stream (seed, e), so two agents run with the same seed meet the
-    same noise. The agent's own randomness derives from ``seed`` as well. ``device``: where the
+    same noise. The agent's own randomness derives from ``seed`` as well, and so does the drift of
+    an MDP with drifting dynamics (``mdp.drift``: episode e flies its row e, the agent unaware). ``device``: where the
     episodes in the MDP fly (the agent's own evolutions on models follow its ``ModelEvolution``).
     """
     if not isinstance(episodes, (int, np.integer)) or episodes < 1:
@@ -162,6 +163,15 @@ def run_test(
     fired = np.zeros(episodes, dtype=bool)
     offline = np.zeros(episodes)
     labels: list[str] = [""] * episodes
+    # Drifting dynamics (neurohover.tasks.drift): episode e flies drifted row e; else every episode flies the MDP.
+    drifted = None if mdp.drift.none else mdp.drift.rows(mdp.row(), episodes, seed)
+
+    def mdps_of(first: int, n: int):
+        """The MDP rows and per-job row indices of episodes first..first+n-1."""
+        if drifted is None:
+            return mdp, np.zeros(n, dtype=np.int64)
+        return drifted[first : first + n], np.arange(n, dtype=np.int64)
+
     e = 0
     chunk = 1
     while e < episodes:
@@ -171,11 +181,12 @@ def run_test(
             rest = np.arange(e, episodes)
             zeros = np.zeros(rest.size, dtype=np.int64)
             table = PolicyTable.from_policies([choice.policy] + ([choice.fallback] if choice.fallback else []))
+            rows, index = mdps_of(e, rest.size)
             ev = evaluate_jobs(
                 table,
-                mdp,
+                rows,
                 zeros,
-                zeros,
+                index,
                 rest,
                 seed=seed,
                 n_steps=n_steps,
@@ -193,11 +204,12 @@ def run_test(
         n = min(chunk, episodes - e) if choice.repeat and not choice.record else 1
         table = PolicyTable.from_policies([choice.policy] + ([choice.fallback] if choice.fallback else []))
         zeros = np.zeros(n, dtype=np.int64)
+        rows, index = mdps_of(e, n)
         ev = evaluate_jobs(
             table,
-            mdp,
+            rows,
             zeros,
-            zeros,
+            index,
             np.arange(e, e + n),
             seed=seed,
             n_steps=n_steps,

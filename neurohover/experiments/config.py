@@ -145,6 +145,21 @@ def _sensor_table():
     return check
 
 
+def _drift_table():
+    def check(v):
+        from ..tasks import Drift
+
+        if not isinstance(v, dict):
+            return False, "a table of drift settings (walk, change, change_at)"
+        try:
+            Drift.from_dict(v)
+        except NeurohoverError as exc:
+            return False, f"a valid drift ({exc})"
+        return True, ""
+
+    return check
+
+
 def _policy_source():
     def check(v):
         return isinstance(v, str) and v != "", "'evolve', 'shipped' or a directory holding <task>/ policy sets"
@@ -182,6 +197,7 @@ _GROUP = {
     "settings": (_OMIT, _table()),  # an agent's own typed settings (its spec's settings class), for agents that read them from it
     "estimator": ("ols", _choice("ols", "gls")),  # least squares of the LR models an agent learns
     "sensor": (_OMIT, _sensor_table()),  # this group's agents fly the group's MDPs through these sensors
+    "drift": (_OMIT, _drift_table()),  # and with these drifting dynamics (neurohover.tasks.drift)
 }
 
 SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
@@ -230,6 +246,7 @@ SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
         "model_budget": (2000, _int(1)),
         "predict_episodes": (5, _int(1)),
         "max_learning_episodes": (25, _int(1)),
+        "drift": (_OMIT, _drift_table()),  # every test run's MDP drifts so (neurohover.tasks.drift)
         "groups": (_REQUIRED, ("list", _GROUP)),
     },
 }

@@ -26,6 +26,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from ..policysets import FGHH_GENERIC_RESAMPLING
+from ..tasks.drift import Drift
 from .config import ExperimentConfig, variant_optimiser
 from .results import UnitKey
 from .settings import EvolutionSettings, ExperimentSettings, Group, ModelLearningSettings, TestRunsSettings
@@ -375,6 +376,9 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dic
         mdps = _mdps(pol.family, g.mdps, g.n_mdps, s.seed)
         if g.sensor is not None:  # this group's agents fly the same MDPs through sensors of its own
             mdps = [m.with_sensor(_sensor(g.sensor)) for m in mdps]
+        drift = g.drift if g.drift is not None else s.drift
+        if drift is not None:  # the test runs' MDPs drift (the harness flies the drift, neurohover.tasks.drift)
+            mdps = [m.with_drift(Drift.from_dict(drift)) for m in mdps]
         sensor = g.sensor if g.sensor is not None else s.sensor
         hybrid = group_hybrid_settings(g)
         counter = 0

@@ -40,6 +40,7 @@ class Group:
     settings: dict | None = None  # the agent's own typed settings, as a table
     estimator: str = "ols"
     sensor: dict | None = None  # this group's sensors (None: the experiment's)
+    drift: dict | None = None  # this group's drifting dynamics (None: the experiment's)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -96,6 +97,7 @@ class TestRunsSettings(ExperimentSettings):
     model_budget: int = 2000
     predict_episodes: int = 5
     max_learning_episodes: int = 25
+    drift: dict | None = None  # every test run's MDP drifts so (None: fixed dynamics)
     groups: tuple[Group, ...]
 
 

@@ -27,6 +27,7 @@ import pkgutil
 
 from ..errors import NeurohoverError
 from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, competition_rows, finite_vector
+from .drift import NO_DRIFT, Drift
 from .fghh import COMPETITION_FGHH_SIGMA, FGHH
 from .ghh08 import GHH08, MAX_WIND
 from .ghh09 import GHH09, GHH09_PARAM_NAMES
@@ -55,11 +56,14 @@ TASK_FAMILIES: dict[str, type[TaskFamily]] = discover(__name__)
 TASK_NAMES: tuple[str, ...] = tuple(TASK_FAMILIES)
 
 
-def get_task_family(name: str, sigma: float | None = None, sensor: Sensor | None = None) -> TaskFamily:
+def get_task_family(name: str, sigma: float | None = None, sensor: Sensor | None = None, drift: Drift | None = None) -> TaskFamily:
     """The task family called ``name`` (``ghh08``, ``ghh09``, ``fghh``, ...; ``sigma``: its breadth, where it has one),
-    seen through ``sensor`` (:mod:`neurohover.tasks.sensor`; None: exact sensors)."""
+    seen through ``sensor`` (:mod:`neurohover.tasks.sensor`; None: exact sensors), its dynamics drifting
+    over a test run by ``drift`` (:mod:`neurohover.tasks.drift`; None: fixed)."""
     family = _family(name, sigma)
-    return family if sensor is None or sensor.exact else family.with_sensor(sensor)
+    if sensor is not None and not sensor.exact:
+        family = family.with_sensor(sensor)
+    return family if drift is None or drift.none else family.with_drift(drift)
 
 
 def _family(name: str, sigma: float | None) -> TaskFamily:
@@ -75,11 +79,11 @@ def _family(name: str, sigma: float | None) -> TaskFamily:
     return cls()
 
 
-def family_for(name: str, sigma: float | None, sensor: Sensor | None = None) -> TaskFamily:
+def family_for(name: str, sigma: float | None, sensor: Sensor | None = None, drift: Drift | None = None) -> TaskFamily:
     """Like :func:`get_task_family`, but a ``sigma`` is ignored for families without one (configs carry one for all)."""
     key = str(name).lower().replace("-", "")
     has = key in TASK_FAMILIES and TASK_FAMILIES[key].has_sigma
-    return get_task_family(name, sigma if has else None, sensor)
+    return get_task_family(name, sigma if has else None, sensor, drift)
 
 
 __all__ = [
@@ -94,6 +98,8 @@ __all__ = [
     "N_TEST",
     "N_TRAINING",
     "EXACT",
+    "NO_DRIFT",
+    "Drift",
     "Sensor",
     "TASK_FAMILIES",
     "TASK_NAMES",

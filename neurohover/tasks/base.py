@@ -29,12 +29,13 @@ from ..sim.constants import (
     WIND_NONE,
 )
 from ..sim.reference import ReferenceMDP
+from .drift import NO_DRIFT, Drift
 from .sensor import EXACT, Sensor
 
 N_TRAINING = 10
 N_TEST = 100
 _SET_ENTROPY = 20110401  # fixed root of the seeded training and test sets (the paper's year)
-_FIXED_SETS: dict[tuple[str, int, int, Sensor], tuple[MDP, ...]] = {}
+_FIXED_SETS: dict[tuple[str, int, int, Sensor, Drift], tuple[MDP, ...]] = {}
 _ROW_LAYOUTS: dict[tuple[str, int, Sensor], np.ndarray] = {}
 COMPETITION_MDPS_FILE = Path(__file__).parent.parent / "data" / "competition-mdps.json"
 _COMPETITION: dict[str, dict] = {}
@@ -65,6 +66,8 @@ class MDP:
         Human-readable name, e.g. ``"ghh08/train:3"``.
     sensor : Sensor
         What the policy sees (:mod:`neurohover.tasks.sensor`); exact sensors by default.
+    drift : Drift
+        How its dynamics change between the episodes of a test run (:mod:`neurohover.tasks.drift`); none by default.
     """
 
     family: str
@@ -77,10 +80,13 @@ class MDP:
     label: str = field(default="", compare=False)
     d_u: float = 0.0
     sensor: Sensor = EXACT
+    drift: Drift = NO_DRIFT
 
     def __post_init__(self) -> None:
         if not isinstance(self.sensor, Sensor):
             raise NeurohoverError(f"sensor must be a neurohover Sensor, got {self.sensor!r}")
+        if not isinstance(self.drift, Drift):
+            raise NeurohoverError(f"drift must be a neurohover Drift, got {self.drift!r}")
         # Plain Python numbers (the same values): reprs read MDP(params=(-0.18, ...)), not np.float64(-0.18).
         for name in ("params", "noise_std", "wind"):
             object.__setattr__(self, name, tuple(float(x) for x in getattr(self, name)))
@@ -104,6 +110,10 @@ class MDP:
         """The same MDP seen through ``sensor``."""
         return replace(self, sensor=sensor)
 
+    def with_drift(self, drift: Drift) -> MDP:
+        """The same MDP, its dynamics drifting by ``drift`` over a test run."""
+        return replace(self, drift=drift)
+
     def to_reference(self) -> ReferenceMDP:
         """The same MDP for the plain-Python reference simulator."""
         wind = tuple(self.wind) + (0.0,) * (8 - len(self.wind))
@@ -124,6 +134,8 @@ class MDP:
         }
         if not self.sensor.exact:
             d["sensor"] = self.sensor.to_dict()
+        if not self.drift.none:
+            d["drift"] = self.drift.to_dict()
         return d
 
     @classmethod
@@ -139,6 +151,7 @@ class MDP:
             d.get("label", ""),
             float(d.get("d_u", 0.0)),
             Sensor.from_dict(d["sensor"]) if "sensor" in d else EXACT,
+            Drift.from_dict(d["drift"]) if "drift" in d else NO_DRIFT,
         )
 
 
@@ -170,12 +183,14 @@ def competition_families() -> tuple[str, ...]:
 
 
 def _through_sensor(method):
-    """``method`` (a family's make or zero) with the family's sensor put on the MDP it returns."""
+    """``method`` (a family's make or zero) with the family's sensor and drift put on the MDP it returns."""
 
     @functools.wraps(method)
     def made(self, *args, **kwargs):
         mdp = method(self, *args, **kwargs)
-        return mdp if self.sensor.exact else mdp.with_sensor(self.sensor)
+        if not self.sensor.exact:
+            mdp = mdp.with_sensor(self.sensor)
+        return mdp if self.drift.none else mdp.with_drift(self.drift)
 
     return made
 
@@ -183,17 +198,20 @@ def _through_sensor(method):
 def _family_eq(self, other) -> bool:
     if type(other) is not type(self):
         return NotImplemented
-    return all(getattr(self, f.name) == getattr(other, f.name) for f in fields(self)) and self.sensor == other.sensor
+    same = all(getattr(self, f.name) == getattr(other, f.name) for f in fields(self))
+    return same and self.sensor == other.sensor and self.drift == other.drift
 
 
 def _family_hash(self) -> int:
-    return hash((type(self).__name__, *(getattr(self, f.name) for f in fields(self)), self.sensor))
+    return hash((type(self).__name__, *(getattr(self, f.name) for f in fields(self)), self.sensor, self.drift))
 
 
 def _family_repr(self) -> str:
     args = [f"{f.name}={getattr(self, f.name)!r}" for f in fields(self)]
     if not self.sensor.exact:
         args.append(f"sensor={self.sensor!r}")
+    if not self.drift.none:
+        args.append(f"drift={self.drift!r}")
     return f"{type(self).__name__}({', '.join(args)})"
 
 
@@ -220,6 +238,8 @@ class TaskFamily:
         than on the zero setting (GHH-08, GHH-09); decides the layout of its policy set.
     sensor : Sensor
         What the policy sees in every MDP of the family (:meth:`with_sensor`; exact by default).
+    drift : Drift
+        How the dynamics of every MDP of the family drift over a test run (:meth:`with_drift`; none by default).
     """
 
     name: str = ""
@@ -231,6 +251,7 @@ class TaskFamily:
     sigma: float | None = None  # the breadth of G, for families with has_sigma
     generic_over_distribution: bool = False
     sensor: Sensor = EXACT  # set on a copy by with_sensor(); part of the family's identity
+    drift: Drift = NO_DRIFT  # likewise, by with_drift()
 
     def __init_subclass__(cls, **kwargs) -> None:
         super().__init_subclass__(**kwargs)
@@ -248,6 +269,14 @@ class TaskFamily:
             raise NeurohoverError(f"sensor must be a neurohover Sensor, got {sensor!r}")
         out = copy.copy(self)
         object.__setattr__(out, "sensor", sensor)
+        return out
+
+    def with_drift(self, drift: Drift) -> TaskFamily:
+        """This family with drifting dynamics: every MDP it makes, samples or lists carries ``drift``."""
+        if not isinstance(drift, Drift):
+            raise NeurohoverError(f"drift must be a neurohover Drift, got {drift!r}")
+        out = copy.copy(self)
+        object.__setattr__(out, "drift", drift)
         return out
 
     # -- what a family defines ------------------------------------------------------------
@@ -311,14 +340,14 @@ class TaskFamily:
         return self.rows(self.sample_params(rng, n))
 
     def _seeded_set(self, which: int, n: int, kind: str) -> list[MDP]:
-        key = (self.name, self.set_variant(), which, self.sensor)
+        key = (self.name, self.set_variant(), which, self.sensor, self.drift)
         if key not in _FIXED_SETS:  # MDPs are immutable, so each set is built once per process
             rng = np.random.default_rng(np.random.SeedSequence([_SET_ENTROPY, self.set_code, which, self.set_variant()]))
             _FIXED_SETS[key] = tuple(self.make(self.sample_params(rng, 1)[0], label=f"{self.name}/{kind}:{i}") for i in range(n))
         return list(_FIXED_SETS[key])
 
     def _competition_set(self, kind: str) -> list[MDP]:
-        key = (self.name, -1, 0 if kind == "train" else 1, self.sensor)
+        key = (self.name, -1, 0 if kind == "train" else 1, self.sensor, self.drift)
         if key not in _FIXED_SETS:
             rows = competition_rows(self.name)[kind]
             _FIXED_SETS[key] = tuple(self.make(self.competition_params(r), label=f"{self.name}/{kind}:{i}") for i, r in enumerate(rows))

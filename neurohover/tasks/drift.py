@@ -1,0 +1,138 @@
+"""Drifting dynamics: an MDP whose dynamics change between the episodes of a test run (docs/benchmarks.md).
+
+The paper (Section 7) names the harder problem its benchmark leaves out: "a more challenging
+problem would require the agent to constantly refine its model as new flight data arrives". A
+:class:`Drift` on an MDP makes episode ``e`` of a test run fly the MDP with its 11 dynamics
+parameters (C and D, ``sim.constants.PARAM_NAMES``)
+
+    p_e = p_0 * exp(walk * W_e) * (factor where e >= E),   W_e = z_1 + ... + z_e
+
+``z`` standard normals, one per parameter and episode; ``E`` the episode of the abrupt change,
+drawn uniformly from ``change_at`` (the agent is not told it). Both come from the run's own drift
+stream (its seed), so two agents run with one seed meet the same drift, and the gusts and sensors
+are unchanged. Within an episode the MDP stays fixed.
+
+=============  ==========  =========================================================================
+setting        default     meaning
+=============  ==========  =========================================================================
+walk           0           per-episode std of each parameter's log random walk (0.01: about the
+                           breadth of FGHH's G, sigma 0.3, after 1000 episodes)
+change         {}          factors of named parameters at the change, e.g. ``{"D_w": 0.8}``: the
+                           collective's gain loses 20 %, as under a heavier load
+change_at      (200, 800)  the change happens at an episode drawn uniformly from lo..hi
+=============  ==========  =========================================================================
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import NeurohoverError
+from ..sim.constants import PARAM_NAMES, ROW_PARAMS
+
+_DRIFT_TAG = 0xD81F7  # separates a run's drift stream from its agent's and its gusts'
+
+
+@dataclass(frozen=True)
+class Drift:
+    """How an MDP's dynamics change between episodes; ``Drift()`` is none (see the module docstring's table)."""
+
+    walk: float = 0.0
+    change: tuple[tuple[str, float], ...] = ()
+    change_at: tuple[int, int] = (200, 800)
+    _factors: np.ndarray | None = field(default=None, init=False, repr=False, compare=False, hash=False)
+
+    def __post_init__(self) -> None:
+        w = self.walk
+        if isinstance(w, bool) or not isinstance(w, (int, float)) or not math.isfinite(w) or not 0 <= w <= 1:
+            raise NeurohoverError(f"drift walk={w!r} is out of range: allowed a number in 0..1 (a per-episode log std)")
+        object.__setattr__(self, "walk", float(w))
+        change = dict(self.change) if not isinstance(self.change, dict) else self.change
+        factors = np.ones(len(PARAM_NAMES))
+        for name, factor in change.items():
+            if name not in PARAM_NAMES:
+                raise NeurohoverError(f"drift change of {name!r}: not a dynamics parameter; allowed {', '.join(PARAM_NAMES)}")
+            if isinstance(factor, bool) or not isinstance(factor, (int, float)) or not math.isfinite(factor) or factor <= 0:
+                raise NeurohoverError(f"drift change {name}={factor!r} is out of range: allowed a factor > 0")
+            factors[PARAM_NAMES.index(name)] = float(factor)
+        object.__setattr__(self, "change", tuple(sorted((n, float(f)) for n, f in change.items())))
+        object.__setattr__(self, "_factors", factors)
+        try:
+            lo, hi = (int(x) for x in self.change_at)
+        except (TypeError, ValueError):
+            raise NeurohoverError(f"drift change_at={self.change_at!r} is not allowed: give two episode numbers lo, hi with 0 <= lo <= hi") from None
+        if not 0 <= lo <= hi or list(self.change_at) != [lo, hi]:
+            raise NeurohoverError(f"drift change_at={self.change_at!r} is out of range: allowed whole episode numbers 0 <= lo <= hi")
+        object.__setattr__(self, "change_at", (lo, hi))
+
+    @property
+    def none(self) -> bool:
+        """Whether the dynamics stay fixed."""
+        return self.walk == 0.0 and not self.change
+
+    def change_episode(self, seed: int) -> int | None:
+        """The episode at which run ``seed`` changes abruptly (None: no abrupt change)."""
+        if not self.change:
+            return None
+        return int(self._rng(seed).integers(self.change_at[0], self.change_at[1] + 1))
+
+    def rows(self, row: np.ndarray, episodes: int, seed: int) -> np.ndarray:
+        """The (episodes, MDP_ROW_LEN) rows that episodes 0..episodes-1 of run ``seed`` fly, from the MDP's ``row``."""
+        rng = self._rng(seed)
+        change = int(rng.integers(self.change_at[0], self.change_at[1] + 1)) if self.change else episodes
+        out = np.repeat(np.asarray(row, dtype=float)[None, :], episodes, axis=0)
+        if self.walk:
+            walk = np.cumsum(rng.standard_normal((episodes, len(PARAM_NAMES))), axis=0)
+            walk[0] = 0.0  # episode 0 flies the MDP as given
+            out[:, ROW_PARAMS] *= np.exp(self.walk * walk)
+        if self._factors is not None:
+            out[change:, ROW_PARAMS] *= self._factors
+        return out
+
+    def _rng(self, seed: int) -> np.random.Generator:
+        return np.random.default_rng(np.random.SeedSequence([int(seed), _DRIFT_TAG]))
+
+    def to_dict(self) -> dict:
+        return {"walk": self.walk, "change": dict(self.change), "change_at": list(self.change_at)}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> Drift:
+        """A drift from a table of its settings (unknown keys refused by name)."""
+        if not isinstance(d, dict):
+            raise NeurohoverError(f"a drift must be a table of settings (walk, change, change_at), got {d!r}")
+        unknown = sorted(set(d) - {"walk", "change", "change_at"})
+        if unknown:
+            raise NeurohoverError(f"unknown drift setting(s) {', '.join(map(repr, unknown))}: allowed walk, change, change_at")
+        change = d.get("change", {})
+        if not isinstance(change, dict):
+            raise NeurohoverError(f"drift change={change!r} is not allowed: give a table of parameter factors, e.g. {{D_w = 0.8}}")
+        at = tuple(d.get("change_at", (200, 800)))
+        return cls(float(d.get("walk", 0.0)), tuple(change.items()), at)  # checked in __post_init__
+
+    @classmethod
+    def parse(cls, text: str) -> Drift:
+        """A drift from the command line: ``walk=0.01``, ``D_w=0.8@200-800`` (a change, at an episode in 200..800), or both, comma-separated."""
+        walk, change, at = 0.0, {}, (200, 800)
+        for part in filter(None, (p.strip() for p in str(text).split(","))):
+            key, eq, value = part.partition("=")
+            value, _, when = value.partition("@")
+            try:
+                number = float(value)
+                if when:
+                    lo, _, hi = when.partition("-")
+                    at = (int(lo), int(hi or lo))
+            except ValueError:
+                raise NeurohoverError(f"drift {part!r} is not understood: give walk=STD or PARAM=FACTOR[@LO-HI], e.g. walk=0.01,D_w=0.8@200-800") from None
+            if not eq:
+                raise NeurohoverError(f"drift {part!r} is not understood: give walk=STD or PARAM=FACTOR[@LO-HI], e.g. walk=0.01,D_w=0.8@200-800")
+            if key.strip() == "walk":
+                walk = number
+            else:
+                change[key.strip()] = number
+        return cls(walk, tuple(change.items()), at)
+
+
+NO_DRIFT = Drift()

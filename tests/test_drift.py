@@ -1,0 +1,122 @@
+"""Drifting dynamics (neurohover.tasks.drift): the drifted rows, the test-run harness, configs and the CLI."""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+
+import numpy as np
+import pytest
+
+from neurohover import NeurohoverError, baseline_policy, evaluate_jobs, get_task_family
+from neurohover.agents.protocol import run_test
+from neurohover.agents.registry import agent_spec, policies_from_set
+from neurohover.agents.spec import AgentOptions
+from neurohover.policysets import load_policy_set
+from neurohover.sim.constants import PARAM_NAMES, ROW_PARAMS
+from neurohover.tasks import MDP, Drift
+
+D_W = PARAM_NAMES.index("D_w")
+
+
+def test_no_drift_is_the_default_and_leaves_dicts_as_they_were() -> None:
+    mdp = get_task_family("fghh").mdp("test:2")
+    assert mdp.drift.none and "drift" not in mdp.to_dict()
+    drifting = mdp.with_drift(Drift(0.01, (("D_w", 0.8),)))
+    assert MDP.from_dict(drifting.to_dict()) == drifting and drifting.row().tolist() == mdp.row().tolist()
+
+
+def test_drifted_rows_start_at_the_mdp_change_once_and_walk_by_the_stated_std() -> None:
+    row = get_task_family("fghh").mdp("test:2").row()
+    step = Drift(0.0, (("D_w", 0.8),), (10, 40))
+    rows = step.rows(row, 60, seed=5)
+    at = step.change_episode(5)
+    assert 10 <= at <= 40
+    assert (rows[:at] == row).all()
+    np.testing.assert_allclose(rows[at:, D_W], row[D_W] * 0.8)
+    others = [i for i in range(len(PARAM_NAMES)) if i != D_W]
+    assert (rows[:, ROW_PARAMS][:, others] == row[ROW_PARAMS][others]).all()
+    walk = Drift(0.02).rows(row, 2001, seed=1)
+    steps = np.diff(np.log(walk[:, ROW_PARAMS] / row[ROW_PARAMS]), axis=0)
+    assert (walk[0] == row).all() and steps.std() == pytest.approx(0.02, rel=0.05)
+    assert np.array_equal(Drift(0.02).rows(row, 50, seed=1), walk[:50]) and not np.array_equal(Drift(0.02).rows(row, 50, seed=2), walk[:50])
+    assert {Drift(0.0, (("D_w", 0.8),), (0, 999)).change_episode(s) for s in range(20)} != {0}  # drawn, not fixed
+
+
+@pytest.mark.parametrize(
+    ("make", "message"),
+    [
+        (lambda: Drift(-0.1), "walk=-0.1 is out of range"),
+        (lambda: Drift(0.0, (("D_x", 0.8),)), "'D_x': not a dynamics parameter"),
+        (lambda: Drift(0.0, (("D_w", 0.0),)), "D_w=0.0 is out of range"),
+        (lambda: Drift(0.0, (), (9, 3)), "change_at=(9, 3) is out of range"),
+        (lambda: Drift.parse("D_w=abc"), "'D_w=abc' is not understood"),
+        (lambda: Drift.from_dict({"wlak": 0.1}), "unknown drift setting"),
+        (lambda: get_task_family("ghh08").with_drift("slow"), "must be a neurohover Drift"),  # type: ignore[arg-type]
+    ],
+)
+def test_bad_drift_settings_get_one_clear_message(make, message: str) -> None:
+    with pytest.raises(NeurohoverError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        make()
+
+
+def test_parse_reads_the_command_lines_form() -> None:
+    assert Drift.parse("walk=0.01,D_w=0.8@200-800") == Drift(0.01, (("D_w", 0.8),), (200, 800))
+    assert Drift.parse("C_u=1.5@300") == Drift(0.0, (("C_u", 1.5),), (300, 300))
+
+
+def _generic_run(mdp: MDP, episodes: int = 12):
+    spec = agent_spec("generic")
+    agent = spec.build(policies_from_set(spec, load_policy_set("ghh08")), AgentOptions())
+    return run_test(agent, get_task_family("ghh08"), mdp, episodes=episodes, seed=4, n_steps=400)
+
+
+def test_the_harness_flies_episode_e_on_drifted_row_e() -> None:
+    mdp = get_task_family("ghh08").mdp("test:3")
+    drift = Drift(0.03, (("D_w", 0.5),), (4, 8))
+    run = _generic_run(mdp.with_drift(drift))
+    rows = drift.rows(mdp.row(), 12, seed=4)
+    generic = load_policy_set("ghh08").generic
+    direct = evaluate_jobs([generic], rows, [0] * 12, range(12), range(12), seed=4, n_steps=400)
+    assert np.array_equal(run.returns, direct.returns)
+    assert np.array_equal(_generic_run(mdp.with_drift(Drift())).returns, _generic_run(mdp).returns)
+    assert not np.array_equal(run.returns, _generic_run(mdp).returns)
+
+
+def test_test_runs_config_and_groups_carry_the_drift_into_their_units(tmp_path) -> None:
+    from neurohover.experiments.config import load_config
+    from neurohover.experiments.plans import plan
+
+    config = tmp_path / "drift.toml"
+    config.write_text(
+        'name = "drift"\ntitle = "t"\nkind = "test_runs"\n[settings]\ntask = "ghh08"\nseed = 3\nepisodes = 2\npolicies = "shipped"\n'
+        "drift = { walk = 0.01 }\n"
+        '[[settings.groups]]\nagent = "generic"\nn_mdps = 1\n'
+        '[[settings.groups]]\nagent = "generic"\nlabel = "stepped"\nn_mdps = 1\ndrift = { change = { D_w = 0.8 }, change_at = [5, 9] }\n[scales.quick]\n'
+    )
+    units = {u.key: u for u in plan(load_config(str(config), "quick"), {}, {}).units}
+    assert MDP.from_dict(units["run/generic/test0/rep0"].params["mdp"]).drift == Drift(0.01)
+    assert MDP.from_dict(units["run/stepped/test0/rep0"].params["mdp"]).drift == Drift(0.0, (("D_w", 0.8),), (5, 9))
+    config.write_text(config.read_text().replace("walk = 0.01", "walk = -1"))
+    with pytest.raises(NeurohoverError, match="drift"):
+        load_config(str(config), "quick")
+
+
+def test_compete_flies_a_drifting_task_from_the_command_line(cli, tmp_path) -> None:
+    out = tmp_path / "c"
+    rc, _, err = cli("compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "3", "--episode-steps", "100",
+                     "--drift", "walk=0.05", "--obs-noise", "0.5", "--out", str(out))  # fmt: skip
+    assert rc == 0, err
+    with sqlite3.connect(out / "results.sqlite") as conn:
+        (params,) = [json.loads(p) for (p,) in conn.execute("SELECT params FROM units WHERE key LIKE 'run/%'")]
+    assert params["mdp"]["drift"]["walk"] == 0.05 and params["mdp"]["sensor"]["velocity"] == pytest.approx(0.05)
+    rc, _, err = cli("compete", "--task", "ghh08", "--agent", "baseline", "--drift", "D_q=2@x", "--out", str(tmp_path / "d"))
+    assert rc == 2 and "is not understood" in err
+
+
+def test_baseline_flies_the_same_with_or_without_a_zero_drift() -> None:
+    mdp = get_task_family("fghh").mdp("test:1")
+    rows = Drift().rows(mdp.row(), 3, seed=0)
+    a = evaluate_jobs([baseline_policy()], rows, [0] * 3, range(3), range(3), seed=1, n_steps=200)
+    b = evaluate_jobs([baseline_policy()], [mdp], [0] * 3, [0] * 3, range(3), seed=1, n_steps=200)
+    assert np.array_equal(a.returns, b.returns)
