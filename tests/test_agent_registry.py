@@ -32,6 +32,7 @@ def test_the_paper_agents_are_registered_with_their_tasks() -> None:
         "authors-zero",
         "authors-fixed",
         "authors-race",
+        "continual",
     }
     assert HYBRID_AGENTS == ("hybrid", "hybrid-baseline")
     assert AGENTS["model-free"].tasks == ("ghh08", "ghh09") and AGENTS["incremental-race"].tasks == ("fghh",)

@@ -1,0 +1,163 @@
+"""An agent that keeps learning: refits its model as flight data arrive, and re-evolves when the model stops predicting.
+
+The paper's incremental agent learns until one policy meets its model's prediction and then keeps
+it for the rest of the run, which is right when the MDP stays fixed. Under drifting dynamics
+(:mod:`neurohover.tasks.drift`) the kept policy's model goes stale. This agent records every
+episode and keeps a sliding window of the most recent episodes' flight data, which its LR model
+is refitted on whenever it learns (lazily: the model a refit after every episode would give at that
+moment). It watches the one-step prediction error of the model its policy was evolved on, on
+each new episode. When that error exceeds ``threshold`` times the error the model had on its own
+data, for ``patience`` episodes in a row, or the helicopter crashes, it learns again as the
+incremental agent does: it evolves on the newest model and flies the result, until a policy meets
+its prediction or ``max_learning_episodes`` episodes pass. It flies with the generic policy as
+the safeguard's fallback (``safeguard``).
+
+==========================  =======  ==================================================================
+setting                     default  meaning
+==========================  =======  ==================================================================
+window                      5        the most recent episodes a model is fitted on
+threshold                   2.0      re-learn once an episode's one-step error exceeds this x the model's own
+patience                    2        ... in this many consecutive episodes (a crash re-learns at once)
+max_learning_episodes       10       episodes of one learning phase, then the phase's best policy is kept
+safeguard                   True     fly with the generic policy as the safeguard's fallback
+==========================  =======  ==================================================================
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import NeurohoverError
+from ..flightdata import FlightData
+from ..models import LearnedModel, learn_lr
+from ..models.transitions import one_step_error
+from ..policies import Policy
+from ..tasks import TaskFamily
+from .model_based import ModelEvolution, enough_to_learn, evolve_on_model
+from .protocol import Agent, Choice, EpisodeOutcome
+from .spec import AgentOptions, AgentPolicies, AgentSettings, AgentSpec
+
+
+@dataclass(frozen=True)
+class ContinualSettings(AgentSettings):
+    """The continual agent's settings (the module docstring's table; a test-runs group's ``settings`` table)."""
+
+    window: int = 5
+    threshold: float = 2.0
+    patience: int = 2
+    max_learning_episodes: int = 10
+    safeguard: bool = True
+
+    def __post_init__(self) -> None:
+        for name in ("window", "patience", "max_learning_episodes"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+                raise NeurohoverError(f"continual {name}={v!r} is out of range: allowed an integer >= 1")
+        t = self.threshold
+        if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t <= 1:
+            raise NeurohoverError(f"continual threshold={t!r} is out of range: allowed a number > 1 (a ratio of one-step errors)")
+        if not isinstance(self.safeguard, bool):
+            raise NeurohoverError(f"continual safeguard={self.safeguard!r} is not allowed: true or false")
+
+
+class ContinualAgent(Agent):
+    """Learn as the incremental agent, then keep refitting and watching the model; re-learn when it stops predicting."""
+
+    name = "continual"
+
+    def __init__(self, generic: Policy, evolution: ModelEvolution = ModelEvolution(), settings: ContinualSettings = ContinualSettings()) -> None:
+        self.generic, self.evolution, self.settings = generic, evolution, settings
+        self._reset(np.random.default_rng(0))
+
+    def _reset(self, rng: np.random.Generator) -> None:
+        self._rng = rng
+        self.window: list[tuple[np.ndarray, np.ndarray]] = []  # (observations, actions) of the recent episodes
+        self.policy, self.label = self.generic, "generic"
+        self.learning = True  # in a learning phase (else flying a kept policy and watching its model)
+        self.phase_start = 0
+        self.phase_best: tuple[float, Policy, str] = (-np.inf, self.generic, "generic")
+        self.predicted: float | None = None
+        self.reference_error: float | None = None  # the kept policy's model's error on its own data
+        self.policy_model: LearnedModel | None = None
+        self.strikes = 0
+        self.models = 0
+        self.relearned_at: list[int] = []  # episodes after which a change was detected
+
+    def start(self, family: TaskFamily, rng: np.random.Generator) -> None:
+        self._reset(rng)
+
+    def choose(self, episode: int) -> Choice:
+        fallback = self.generic if self.settings.safeguard and self.policy is not self.generic else None
+        return Choice(self.policy, self.label, fallback=fallback, record=True)
+
+    def _data(self) -> FlightData:
+        return FlightData(tuple(o for o, _ in self.window), tuple(a for _, a in self.window))
+
+    def _evolve(self) -> None:
+        """Refit on the window and evolve a policy on the model (the next episode flies it)."""
+        data = self._data()
+        if not enough_to_learn(data):
+            return
+        model = learn_lr(data, estimator=self.evolution.estimator)
+        self.models += 1
+        self.policy_model = model
+        self.reference_error = float(one_step_error(model, data))
+        self.policy, self.predicted = evolve_on_model(model.mdp(), self.generic, self.evolution, int(self._rng.integers(2**62)))
+        self.label = f"model:{self.models}"
+
+    def update(self, outcome: EpisodeOutcome) -> None:
+        fd = outcome.flight_data
+        if fd is not None:
+            self.window.append((fd.observations[-1], fd.actions[-1]))
+            del self.window[: -self.settings.window]
+        if self.learning:
+            self._learn(outcome)
+        else:
+            self._watch(outcome)
+
+    def _learn(self, outcome: EpisodeOutcome) -> None:
+        if outcome.ret > self.phase_best[0]:
+            self.phase_best = (outcome.ret, self.policy, self.label)
+        met = self.predicted is not None and not outcome.crashed and outcome.ret >= self.predicted
+        if met or outcome.episode + 1 - self.phase_start >= self.settings.max_learning_episodes:
+            if not met:  # the phase's best policy (its model stays the one it was evolved on)
+                self.policy, self.label = self.phase_best[1], self.phase_best[2]
+            self.learning, self.strikes = False, 0
+            return
+        self._evolve()
+
+    def _watch(self, outcome: EpisodeOutcome) -> None:
+        stale = outcome.crashed
+        if not stale and self.policy_model is not None and self.reference_error and outcome.flight_data is not None:
+            latest = FlightData((outcome.flight_data.observations[-1],), (outcome.flight_data.actions[-1],))
+            if enough_to_learn(latest):
+                error = float(one_step_error(self.policy_model, latest))
+                self.strikes = self.strikes + 1 if error > self.settings.threshold * self.reference_error else 0
+                stale = self.strikes >= self.settings.patience
+        if stale:  # the dynamics moved away from the model: learn again from the recent episodes
+            self.relearned_at.append(outcome.episode)
+            self.learning, self.phase_start, self.strikes = True, outcome.episode + 1, 0
+            self.phase_best, self.predicted = (-np.inf, self.policy, self.label), None
+            self.window = self.window[-self.settings.patience :]  # keep the episodes that showed the change
+            self._evolve()
+
+
+def _continual(policies: AgentPolicies, options: AgentOptions) -> Agent:
+    assert policies.generic is not None
+    return ContinualAgent(policies.generic, options.evolution or ModelEvolution(), options.settings or ContinualSettings())
+
+
+AGENT_SPECS = (
+    AgentSpec(
+        "continual",
+        "any",
+        frozenset({"generic"}),
+        _continual,
+        generic_kind="race",
+        settings=ContinualSettings,
+        summary="learn as incremental, then refit the model on every episode and re-learn when its one-step error grows",
+    ),
+)

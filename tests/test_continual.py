@@ -1,0 +1,68 @@
+"""The continual agent (neurohover.agents.continual): it keeps watching its model and re-learns after a change."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from neurohover import NeurohoverError, get_task_family
+from neurohover.agents.continual import ContinualSettings
+from neurohover.agents.model_based import ModelEvolution
+from neurohover.agents.protocol import run_test
+from neurohover.agents.registry import agent_spec, policies_from_set
+from neurohover.agents.spec import AgentOptions
+from neurohover.policysets import load_policy_set
+from neurohover.tasks import Drift
+
+EVOLUTION = ModelEvolution(budget=600, n_steps=1000)
+STRONGER_ROTORS = Drift(0.0, (("D_p", 2.5), ("D_q", 2.5)), (25, 25))  # roll and pitch gains x2.5 at episode 25
+
+
+def _run(name: str, drift: Drift, episodes: int = 60):
+    spec = agent_spec(name)
+    agent = spec.build(policies_from_set(spec, load_policy_set("ghh08")), AgentOptions(evolution=EVOLUTION))
+    family = get_task_family("ghh08")
+    return agent, run_test(agent, family, family.mdp("test:3").with_drift(drift), episodes=episodes, seed=4, n_steps=1000)
+
+
+def test_on_a_fixed_mdp_it_learns_once_and_keeps_its_policy() -> None:
+    agent, run = _run("continual", Drift(), episodes=40)
+    _, incremental = _run("incremental", Drift(), episodes=40)
+    assert agent.relearned_at == [] and not run.crashed.any()
+    assert run.returns.sum() == pytest.approx(incremental.returns.sum(), rel=0.05)
+
+
+def test_after_an_abrupt_change_it_re_learns_where_the_incremental_agent_keeps_crashing() -> None:
+    agent, run = _run("continual", STRONGER_ROTORS)
+    _, incremental = _run("incremental", STRONGER_ROTORS)
+    assert not run.crashed[:25].any() and not incremental.crashed[:25].any()
+    assert agent.relearned_at and 25 <= agent.relearned_at[0] <= 27  # detected within the patience
+    assert incremental.crashed[25:].mean() > 0.5  # the kept policy cannot fly the changed helicopter
+    assert run.crashed[35:].sum() == 0 and run.returns.sum() > 10 * incremental.returns.sum()  # returns are negative
+
+
+@pytest.mark.parametrize(
+    ("values", "message"),
+    [({"window": 0}, "window=0 is out of range"), ({"threshold": 1.0}, "threshold=1.0 is out of range"), ({"safeguard": "yes"}, "safeguard='yes'")],
+)
+def test_bad_settings_are_refused(values: dict, message: str) -> None:
+    with pytest.raises(NeurohoverError, match=message):
+        ContinualSettings.from_dict(values)
+
+
+def test_it_runs_on_every_family_and_takes_a_config_groups_settings(tmp_path) -> None:
+    from neurohover.experiments.config import load_config
+    from neurohover.experiments.plans import plan
+    from neurohover.experiments.units import unit_agent
+
+    assert set(agent_spec("continual").tasks) == {"ghh08", "ghh09", "fghh"}
+    config = tmp_path / "c.toml"
+    config.write_text(
+        'name = "c"\ntitle = "t"\nkind = "test_runs"\n[settings]\ntask = "ghh09"\nseed = 1\nepisodes = 2\npolicies = "shipped"\n'
+        'drift = { change = { D_w = 0.8 } }\n[[settings.groups]]\nagent = "continual"\nn_mdps = 1\nsettings = { window = 3, threshold = 1.5 }\n'
+        "[scales.quick]\n"
+    )
+    (unit,) = plan(load_config(str(config), "quick"), {}, {}).units
+    agent = unit_agent(unit.params)
+    assert agent.settings == ContinualSettings(window=3, threshold=1.5)
+    assert np.isfinite(agent.settings.threshold)
