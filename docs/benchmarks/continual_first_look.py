@@ -9,12 +9,12 @@ import time
 
 import numpy as np
 
-from neurohover.tasks import get_task_family, Drift
-from neurohover.agents.registry import agent_spec, policies_from_set
-from neurohover.agents.spec import AgentOptions
 from neurohover.agents.model_based import ModelEvolution
 from neurohover.agents.protocol import run_test
+from neurohover.agents.registry import agent_spec, policies_from_set
+from neurohover.agents.spec import AgentOptions
 from neurohover.policysets import load_policy_set
+from neurohover.tasks import Drift, get_task_family
 
 fam = get_task_family("ghh08")
 ev = ModelEvolution(budget=600, n_steps=1000)
