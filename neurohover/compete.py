@@ -44,14 +44,6 @@ CSV_COLUMNS = ("run", "mdp", "episode", "return", "crashed", "steps", "policy", 
 STORE_FILE = "results.sqlite"
 
 
-def after_learning_start(policy_labels: Sequence[str]) -> int:
-    """First episode from which the policy no longer changes."""
-    start = len(policy_labels) - 1
-    while start > 0 and policy_labels[start - 1] == policy_labels[-1]:
-        start -= 1
-    return start
-
-
 def summarise(results: Sequence) -> dict:
     """Summary figures over test runs (:class:`~neurohover.experiments.results.TestRunResult`; see the module docstring)."""
     scores = np.array([float(r.score) for r in results])

@@ -23,6 +23,7 @@ lets the harness fly the rest of the run in one parallel batch (same results, fa
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -133,6 +134,14 @@ class RunResult:
             }
             for e in range(self.returns.size)
         ]
+
+
+def after_learning_start(policy_labels: Sequence[str]) -> int:
+    """First episode from which the policy no longer changes (a run's ``policy`` labels)."""
+    start = len(policy_labels) - 1
+    while start > 0 and policy_labels[start - 1] == policy_labels[-1]:
+        start -= 1
+    return start
 
 
 def run_test(

@@ -37,9 +37,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..agents.hybrid import HybridSettings
+from ..agents.registry import AGENTS, HYBRID_AGENTS
 from ..errors import NeurohoverError
+from ..evolution.config import make_settings, optimiser_of
+from ..evolution.evolve import parse_resampling
+from ..evolution.optimisers import OPTIMISERS
 from ..policysets import FGHH_GENERIC_RESAMPLING
-from ..tasks import TASK_NAMES
+from ..tasks import TASK_FAMILIES, TASK_NAMES, Drift, Sensor
 from .settings import ExperimentSettings, typed_settings
 
 CONFIG_DIR = Path(__file__).parent / "configs"
@@ -77,7 +82,6 @@ def _choice(*allowed: str):
 
 def _agent():
     def check(v):
-        from ..agents.registry import AGENTS  # the one list of agents
 
         return v in AGENTS, "one of " + ", ".join(repr(a) for a in AGENTS)
 
@@ -119,7 +123,6 @@ def _resampling():
     def check(v):
         if not isinstance(v, str):
             return False, "a string fixed:K or race:DELTA"
-        from ..evolution.evolve import parse_resampling
 
         try:
             parse_resampling(v)
@@ -132,7 +135,6 @@ def _resampling():
 
 def _sensor_table():
     def check(v):
-        from ..tasks import Sensor
 
         if not isinstance(v, dict):
             return False, "a table of sensor settings (level, velocity, position, rates, attitude, correlation, delay)"
@@ -147,7 +149,6 @@ def _sensor_table():
 
 def _drift_table():
     def check(v):
-        from ..tasks import Drift
 
         if not isinstance(v, dict):
             return False, "a table of drift settings (walk, change, change_at)"
@@ -284,7 +285,6 @@ def _validate_table(values: dict, schema: dict, where: str) -> dict:
 def _check_kind(settings: dict, kind: str, where: str) -> None:
     """Cross-field checks."""
     task, sigma = settings["task"], settings.get("sigma")
-    from ..tasks import TASK_FAMILIES
 
     if sigma is not None and not TASK_FAMILIES[task].has_sigma:
         with_sigma = ", ".join(repr(n) for n, c in TASK_FAMILIES.items() if c.has_sigma)
@@ -298,8 +298,6 @@ def _check_kind(settings: dict, kind: str, where: str) -> None:
                 raise NeurohoverError(f"{where}: variant {v['key']!r} sets sigma but the task is {task!r}")
             if settings["target"] != "family" and v["resampling"].startswith("race"):
                 raise NeurohoverError(f"{where}: variant {v['key']!r}: selection races need target = 'family'")
-        from ..evolution.config import make_settings, optimiser_of
-        from ..evolution.optimisers import OPTIMISERS
 
         method = "generational" if settings["target"] == "family" else "steady-state"
         for v in [None, *settings["variants"]]:
@@ -332,14 +330,10 @@ def _check_kind(settings: dict, kind: str, where: str) -> None:
         if len(set(labels)) != len(labels):
             raise NeurohoverError(f"{where}: group labels must be unique (set label = ... on repeated agents), got {labels}")
         for g in settings["groups"]:
-            from ..agents.registry import AGENTS, HYBRID_AGENTS
-
             if task not in AGENTS[g["agent"]].tasks:
                 raise NeurohoverError(f"{where}: agent {g['agent']!r} does not apply to task {task!r}")
             g["label"] = g["label"] or g["agent"]
             if g["hybrid"]:
-                from ..agents.hybrid import HybridSettings
-
                 if g["agent"] not in HYBRID_AGENTS:
                     raise NeurohoverError(
                         f"{where}: group {g['label']!r}: hybrid settings apply to the agents {', '.join(HYBRID_AGENTS)} only, not to {g['agent']!r}"

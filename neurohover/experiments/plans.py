@@ -24,10 +24,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..agents.hybrid import HybridSettings
+from ..agents.registry import HYBRID_AGENTS, agent_spec
 from ..errors import NeurohoverError
-from ..policysets import FGHH_GENERIC_RESAMPLING
+from ..policies import baseline_policy
+from ..policysets import FGHH_GENERIC_RESAMPLING, load_policy_set
+from ..tasks import Sensor, family_for
 from ..tasks.drift import Drift
-from .config import ExperimentConfig, variant_optimiser
+from .config import ExperimentConfig, load_config, variant_optimiser
 from .results import UnitKey
 from .settings import EvolutionSettings, ExperimentSettings, Group, ModelLearningSettings, TestRunsSettings
 from .units import Unit, policy_dict, unit_seed
@@ -43,14 +47,12 @@ class Plan:
 
 
 def _sensor(table: dict | None):
-    from ..tasks import Sensor
 
     return None if table is None else Sensor.from_dict(table)
 
 
 def _family(task: str, sigma: float | None, sensor: dict | None = None):
     """The experiment's task family (``sensor``: its ``sensor`` table, None: exact sensors)."""
-    from ..tasks import family_for
 
     return family_for(task, sigma, _sensor(sensor))
 
@@ -78,8 +80,6 @@ def _unit(cfg: ExperimentConfig, key: str, kind: str, params: dict, seed_key: st
 
 def _load_external(task: str, source: str):
     from pathlib import Path
-
-    from ..policysets import load_policy_set
 
     if source != "shipped" and not Path(source).is_dir():
         raise NeurohoverError(
@@ -187,7 +187,6 @@ def _policy_evolution_unit(cfg: ExperimentConfig, key: str, target: dict, budget
 
 
 def _spec(agent: str):
-    from ..agents.registry import agent_spec
 
     return agent_spec(agent)
 
@@ -203,7 +202,6 @@ def _source_champions(source: str, scale: str, results: dict) -> tuple[list[tupl
     """The final champions ``[(key, policy)]`` of ``source`` (``EXPERIMENT/VARIANT`` or
     ``EXPERIMENT/best-race``: the race variant whose final champions' fitness estimates have the
     highest mean, so that no test MDP chooses it), or None and why while its runs are unfinished."""
-    from .config import load_config
 
     name, _, want = source.partition("/")
     src = load_config(name, scale).typed
@@ -357,8 +355,6 @@ class _Policies:
 
 def group_hybrid_settings(group: Group) -> dict | None:
     """The full hybrid settings of a group's units (None: the group's agent is not a hybrid agent)."""
-    from ..agents.hybrid import HybridSettings
-    from ..agents.registry import HYBRID_AGENTS
 
     return HybridSettings.from_dict(group.hybrid).to_dict() if group.agent in HYBRID_AGENTS else None
 
@@ -425,8 +421,6 @@ def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
         units.append(_policy_evolution_unit(cfg, UnitKey.make("policy", "generic"), {"kind": "mdp", "mdp": family.zero().to_dict()}, s.generic_budget))
         generic = results.get(UnitKey.make("policy", "generic"), {}).get("champion")
     elif s.generic == "baseline":
-        from ..policies import baseline_policy
-
         generic = policy_dict(baseline_policy())
     else:
         generic = policy_dict(_load_external(s.task, s.generic).generic)

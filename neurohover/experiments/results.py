@@ -386,7 +386,7 @@ class TestRunResult(_Record):
     policy_changes : tuple of (int, str)
         (episode, policy) wherever the flown policy changed (episode 0 first).
     learning_episodes : int
-        Episodes before the agent settled (see :func:`neurohover.compete.after_learning_start`).
+        Episodes before the agent settled (see :func:`neurohover.agents.protocol.after_learning_start`).
     mean_return_after_learning : Num
     crash_steps : tuple of int or None
         The control step at which each crash episode ended, in the order of ``crash_episodes``

@@ -25,7 +25,18 @@ from typing import Any, TypeVar
 
 import numpy as np
 
+from ..agents.model_based import ModelEvolution
+from ..agents.protocol import after_learning_start, run_test
+from ..agents.registry import AgentOptions, AgentPolicies, agent_spec
 from ..errors import NeurohoverError
+from ..evaluate import evaluate, evaluate_jobs, num_threads
+from ..evolution.config import optimiser_of
+from ..evolution.evolve import evolve, validation_return
+from ..models import learn_ec_meno, learn_ec_mer, learn_lr
+from ..policies import Policy
+from ..policies import prototype as make_prototype
+from ..policysets import choose_safe
+from ..tasks import MDP, Sensor, family_for
 from .params import unit_params
 from .results import (
     DiagnosticResult,
@@ -74,19 +85,16 @@ def policy_dict(policy) -> dict:
 
 
 def _policy(d: dict):
-    from ..policies import Policy
 
     return Policy(d["topology"], np.array(d["genome"], dtype=float))
 
 
 def _mdp(d: dict):
-    from ..tasks import MDP
 
     return MDP.from_dict(d)
 
 
 def _family(task: str, sigma: float | None, sensor: dict | None = None):
-    from ..tasks import Sensor, family_for
 
     return family_for(task, sigma, None if sensor is None else Sensor.from_dict(sensor))
 
@@ -115,9 +123,6 @@ def _evolve_target(t: dict):
 def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:
     """One evolution run (paper Section 3.1 / 5): champion, history, optional validation."""
     q = unit_params("evolve", p)
-    from ..evolution.config import optimiser_of
-    from ..evolution.evolve import evolve, validation_return
-    from ..policies import prototype as make_prototype
 
     target = _evolve_target(q.target)
     proto = _policy(q.prototype) if isinstance(q.prototype, dict) else make_prototype(q.topology, q.prototype)
@@ -164,7 +169,6 @@ def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:
 def fly_on_test_mdps(policy, family, episodes: int, seed: int, n_steps: int, threads, device):
     """``policy`` flown once on each of the first ``episodes`` test MDPs of ``family`` (cycling), episode
     ``i`` with noise stream ``(seed, i)``: the same MDPs and gusts for every policy flown so."""
-    from ..evaluate import evaluate_jobs
 
     rows = np.array([m.row() for m in family.test_mdps()])
     idx = np.arange(episodes, dtype=np.int64)
@@ -174,7 +178,6 @@ def fly_on_test_mdps(policy, family, episodes: int, seed: int, n_steps: int, thr
 def run_robustness(p: dict, threads: int | None, device: str = "cpu") -> dict:
     """Table 3: fly one policy ``episodes`` times on each of the given MDPs."""
     q = unit_params("robustness", p)
-    from ..evaluate import evaluate
 
     mdps = [_mdp(m) for m in q.mdps]
     ev = evaluate(_policy(q.policy), mdps, episodes=q.episodes, seed=q.seed, n_steps=q.n_steps, threads=threads, device=device)
@@ -186,8 +189,6 @@ def run_robustness(p: dict, threads: int | None, device: str = "cpu") -> dict:
 def run_safety(p: dict, threads: int | None, device: str = "cpu") -> dict:
     """Crash matrix of the specialised policies on the training MDPs, and the two safe ones."""
     q = unit_params("safety", p)
-    from ..evaluate import evaluate
-    from ..policysets import choose_safe
 
     policies = [_policy(d) for d in q.policies]
     ev = evaluate(policies, [_mdp(m) for m in q.mdps], episodes=q.episodes, seed=q.seed, n_steps=q.n_steps, threads=threads, device=device)
@@ -205,9 +206,6 @@ def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
     paper's), ``lr-gls`` (the GLS option), ``ec-meno`` (``ec_meno_budget`` evaluations, 0: the
     plateau stop) and ``ec-mer`` (``model_budget`` evaluations)."""
     q = unit_params("model", p)
-    from ..evaluate import evaluate
-    from ..evolution.evolve import evolve
-    from ..models import learn_ec_meno, learn_ec_mer, learn_lr
 
     mdp = _mdp(q.mdp)
     generic = _policy(q.generic)
@@ -257,8 +255,6 @@ def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
 def unit_agent(p: dict, device: str = "cpu"):
     """The agent of a test-run unit, built from the policies in its params and the run's settings
     (policies evolved on learned models fly episodes of the run's length, on ``device``)."""
-    from ..agents.model_based import ModelEvolution
-    from ..agents.registry import AgentOptions, AgentPolicies, agent_spec
 
     q = unit_params("test_run", p)
     spec = agent_spec(q.agent)
@@ -278,8 +274,6 @@ def unit_agent(p: dict, device: str = "cpu"):
 def run_test_run(p: dict, threads: int | None, device: str = "cpu") -> dict:
     """One test run (docs/model.md, On-line agents): ``episodes`` episodes of an agent on one MDP it does not know."""
     q = unit_params("test_run", p)
-    from ..agents.protocol import run_test
-    from ..compete import after_learning_start
 
     family = _family(q.task, q.sigma, q.sensor)
     mdp = _mdp(q.mdp)
@@ -347,7 +341,6 @@ def run_unit(unit: Unit | dict, threads: int | None = 1, device: str = "cpu") ->
     """
     if isinstance(unit, dict):
         unit = Unit(unit["experiment"], unit["key"], unit["kind"], unit["params"])
-    from ..evaluate import num_threads
 
     runner = _RUNNERS.get(unit.kind)
     if runner is None:
