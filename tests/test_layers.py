@@ -1,0 +1,63 @@
+"""Data flows one way: no module imports one of a layer above it (anywhere in the file, in functions too)."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import neurohover
+
+PACKAGE = Path(neurohover.__file__).resolve().parent
+
+# task family -> MDP rows -> batched rollouts -> returns and flight data -> evolution / models -> agents
+# -> experiments -> store, report, plots; the command line and the package's front door on top.
+LAYERS = [
+    {"errors", "paths", "procs"},
+    {"sim"},
+    {"tasks", "flightdata", "policies", "netfile", "wrappers"},
+    {"launch", "flyer", "plots"},
+    {"evaluate"},
+    {"evolution", "envs"},
+    {"models", "policysets", "integrations"},
+    {"agents"},
+    {"experiments"},
+    {"compete"},
+    {"cli", "commands_agents", "commands_learning", "commands_plots", "commands_reproduce", "bench", "bench_gpu", "__main__", "__init__"},
+]
+RANK = {name: i for i, layer in enumerate(LAYERS) for name in layer}
+ENTRY_POINTS = {"neurohover/experiments/__main__.py"}  # `python -m neurohover.experiments` is the command line
+
+
+def _imports(path: Path) -> list[tuple[str, int]]:
+    """(top-level package part imported, line) of every relative import of ``path``."""
+    rel = path.relative_to(PACKAGE.parent)
+    package = list(rel.parts[:-1])
+    out = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom) and node.level:
+            base = package[: len(package) - (node.level - 1)]
+            target = [*base, *(node.module.split(".") if node.module else [])]
+            out.append((target[1] if len(target) > 1 else "__init__", node.lineno))
+    return out
+
+
+def _layer_of(path: Path) -> str:
+    rel = path.relative_to(PACKAGE)
+    return rel.parts[0] if len(rel.parts) > 1 else rel.stem
+
+
+def test_every_module_has_a_layer() -> None:
+    names = {_layer_of(p) for p in PACKAGE.rglob("*.py")}
+    assert names <= set(RANK), sorted(names - set(RANK))
+
+
+def test_no_import_runs_back_up() -> None:
+    upward = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        if str(path.relative_to(PACKAGE.parent)) in ENTRY_POINTS:
+            continue
+        own = _layer_of(path)
+        for target, line in _imports(path):
+            if RANK[target] > RANK[own]:
+                upward.append(f"{path.relative_to(PACKAGE.parent)}:{line} ({own}) imports {target}")
+    assert not upward, "\n".join(upward)
