@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import gzip
+import os
 import shutil
+import subprocess
+import sys
 from collections.abc import Callable
 from pathlib import Path
 
@@ -14,6 +17,32 @@ STORE_GZ = ROOT / "docs" / "reproduction" / "results.sqlite.gz"
 
 #: What the ``cli`` fixture returns for one command: exit status, standard output, standard error.
 CliRun = Callable[..., tuple[int, str, str]]
+
+
+#: A ``reproduce`` whose plan is twelve diagnostic units (argv: GATES EXPERIMENT reproduce ...): unit i waits
+#: until the file GATES/i exists, so a test, not the machine's speed, decides how far the run gets.
+GATED_RUN = """
+import sys
+from neurohover.cli import main
+from neurohover.experiments import runner
+from neurohover.experiments.plans import Plan
+from neurohover.experiments.units import Unit
+
+# Twelve units, unit i held until the test creates gates/i: the test, not the machine's speed, decides
+# how far a run gets before it is interrupted.
+gates = sys.argv[1]
+units = [Unit(sys.argv[2], f"u{i:02d}", "diagnostic", {"value": i, "wait_for": f"{gates}/{i}"}) for i in range(12)]
+runner.plan = lambda config, results, sources=None: Plan(units, 12)
+sys.exit(main(sys.argv[3:]))
+"""
+
+
+def start_gated_run(config: Path, store: Path, gates: Path, name: str = "slowtest") -> subprocess.Popen:
+    """``neurohover reproduce CONFIG --store STORE`` in a process of its own, its units held at ``gates`` (:data:`GATED_RUN`)."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    argv = [sys.executable, "-c", GATED_RUN, str(gates), name, "reproduce", str(config), "--scale", "quick", "--store", str(store), "--no-progress"]
+    # Its own session, so a failed test can end the whole process group.
+    return subprocess.Popen(argv, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
 
 
 @pytest.fixture(scope="session")

@@ -9,13 +9,12 @@ import random
 import signal
 import sqlite3
 import subprocess
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import ROOT
+from conftest import ROOT, start_gated_run
 
 from neurohover.cli import main
 from neurohover.errors import NeurohoverError
@@ -276,32 +275,8 @@ def _finished(path: Path) -> dict[str, float]:
         return {}
 
 
-GATED_RUN = """
-import sys
-from neurohover.cli import main
-from neurohover.experiments import runner
-from neurohover.experiments.plans import Plan
-from neurohover.experiments.units import Unit
-
-# Twelve units, unit i held until the test creates gates/i: the test, not the machine's speed, decides
-# how far a run gets before it is interrupted.
-gates = sys.argv[1]
-units = [Unit("slowtest", f"u{i:02d}", "diagnostic", {"value": i, "wait_for": f"{gates}/{i}"}) for i in range(12)]
-runner.plan = lambda config, results, sources=None: Plan(units, 12)
-sys.exit(main(sys.argv[2:]))
-"""
-
-
 def _start(config: Path, store: Path, gates: Path) -> subprocess.Popen:
-    env = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
-    return subprocess.Popen(
-        [sys.executable, "-c", GATED_RUN, str(gates), "reproduce", str(config), "--scale", "quick", "--store", str(store), "--no-progress"],
-        cwd=ROOT,
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    return start_gated_run(config, store, gates)
 
 
 def _open_gates(gates: Path, upto: int) -> None:

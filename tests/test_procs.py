@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import ROOT
+from conftest import ROOT, start_gated_run
 
 from neurohover.experiments import Store
 
@@ -269,11 +269,12 @@ def test_a_store_that_a_live_run_writes_is_refused_and_a_killed_run_blocks_nothi
     (tmp_path / "tiny.toml").write_text(TINY_CONFIG)
     tiny = ["reproduce", str(tmp_path / "tiny.toml"), "--store", str(store), "--no-progress"]
     assert _neurohover(*tiny).returncode == 0
-    holder = _start(tmp_path, "reproduce", str(tmp_path / "long.toml"), "--store", str(store), "--no-progress")
+    (tmp_path / "gates").mkdir()  # never opened: the holder waits at its first unit until it is killed
+    holder = start_gated_run(tmp_path / "long.toml", store, tmp_path / "gates", name="longtest")
     try:
         deadline = time.monotonic() + 120
         while not _running_session(store, "longtest"):
-            assert holder.poll() is None and time.monotonic() < deadline, (tmp_path / "stderr.txt").read_text()[-2000:]
+            assert holder.poll() is None and time.monotonic() < deadline, "the holding run ended or never began its session"
             time.sleep(0.05)
         # A second writer is refused at once, naming the store and the run that holds it ...
         second = _neurohover(*tiny)
