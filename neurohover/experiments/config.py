@@ -51,7 +51,10 @@ CONFIG_DIR = Path(__file__).parent / "configs"
 SCALES = ("quick", "paper")
 KINDS = ("evolution", "model_learning", "test_runs")
 #: Experiments in report order (the shipped configs).
-ORDER = ("fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16", "ablation-plateau", "ablation-hybrid", "ablation-fghh")
+ORDER = (
+    "fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16", "ablation-plateau", "ablation-hybrid", "ablation-fghh",
+    "bench-sensors", "bench-drift",
+)  # fmt: skip
 #: Bump when a unit function changes what it computes: stores written before are then refused.
 UNITS_VERSION = 2  # 2: competition MDP sets, the authors' safeguard, OLS, the no-crash plateau
 
