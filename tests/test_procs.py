@@ -262,13 +262,14 @@ def _running_session(store: Path, name: str) -> bool:
         return False
 
 
-def test_a_store_that_a_live_run_writes_is_refused_and_a_killed_run_blocks_nothing(tmp_path: Path) -> None:
+def test_a_store_that_a_live_run_writes_is_refused_and_a_killed_run_blocks_nothing(tmp_path: Path, cli) -> None:
+    # The holder is a process of its own; this process plays the second writer and the readers.
     store = tmp_path / "s.sqlite"
     lock = tmp_path / "s.sqlite.lock"
     (tmp_path / "long.toml").write_text(LONG_CONFIG)
     (tmp_path / "tiny.toml").write_text(TINY_CONFIG)
     tiny = ["reproduce", str(tmp_path / "tiny.toml"), "--store", str(store), "--no-progress"]
-    assert _neurohover(*tiny).returncode == 0
+    assert cli(*tiny)[0] == 0
     (tmp_path / "gates").mkdir()  # never opened: the holder waits at its first unit until it is killed
     holder = start_gated_run(tmp_path / "long.toml", store, tmp_path / "gates", name="longtest")
     try:
@@ -277,23 +278,23 @@ def test_a_store_that_a_live_run_writes_is_refused_and_a_killed_run_blocks_nothi
             assert holder.poll() is None and time.monotonic() < deadline, "the holding run ended or never began its session"
             time.sleep(0.05)
         # A second writer is refused at once, naming the store and the run that holds it ...
-        second = _neurohover(*tiny)
-        assert second.returncode == 2 and "Traceback" not in second.stderr
-        assert f"results store {str(store)!r} is in use: another run (pid {holder.pid} on host" in second.stderr
-        assert len(second.stderr.strip().splitlines()) == 1 and "ran 0 units" not in second.stdout
+        rc, out, err = cli(*tiny)
+        assert rc == 2 and "Traceback" not in err
+        assert f"results store {str(store)!r} is in use: another run (pid {holder.pid} on host" in err
+        assert len(err.strip().splitlines()) == 1 and "ran 0 units" not in out
         # ... while reading the store still works.
-        results = _neurohover("results", "tinytest", "--store", str(store), "--format", "json")
-        assert results.returncode == 0 and "evolve/k1/run0" in results.stdout, results.stderr[-2000:]
-        report = _neurohover("report", "tinytest", "--store", str(store), "--out", str(tmp_path / "report"))
-        assert report.returncode == 0 and (tmp_path / "report" / "report.md").exists(), report.stderr[-2000:]
+        rc, out, err = cli("results", "tinytest", "--store", str(store), "--format", "json")
+        assert rc == 0 and "evolve/k1/run0" in out, err[-2000:]
+        rc, _, err = cli("report", "tinytest", "--store", str(store), "--out", str(tmp_path / "report"))
+        assert rc == 0 and (tmp_path / "report" / "report.md").exists(), err[-2000:]
         assert holder.poll() is None
         # A killed holder leaves its lock file (with its pid) but no lock: the next run proceeds.
         holder.kill()
         holder.wait(timeout=30)
         assert lock.read_text().split()[0] == str(holder.pid)
-        third = _neurohover(*tiny, "--fresh")
-        assert third.returncode == 0, third.stderr[-2000:]
-        assert "ran 1 units, 0 already in the store" in third.stdout
+        rc, out, err = cli(*tiny, "--fresh")
+        assert rc == 0, err[-2000:]
+        assert "ran 1 units, 0 already in the store" in out
     finally:
         _end_group(holder)
 
