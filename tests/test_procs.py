@@ -246,10 +246,6 @@ def test_a_bad_ray_address_environment_variable_is_named(tmp_path: Path) -> None
 TINY_CONFIG = LONG_CONFIG.replace('"longtest"', '"tinytest"').replace("runs = 4", "runs = 1").replace("400000", "200")
 
 
-def _neurohover(*argv: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "neurohover", *argv], cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=300)
-
-
 def _running_session(store: Path, name: str) -> bool:
     """Whether a run of ``name`` is under way in ``store`` (which another process is writing)."""
     try:
