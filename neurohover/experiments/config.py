@@ -136,32 +136,27 @@ def _resampling():
     return check
 
 
-def _sensor_table():
-    def check(v):
+def _settings_table(cls, keys: str):
+    """A table that ``cls.from_dict`` reads (a Sensor's or a Drift's), checked by it."""
 
+    def check(v):
         if not isinstance(v, dict):
-            return False, "a table of sensor settings (level, velocity, position, rates, attitude, correlation, delay)"
+            return False, f"a table of {cls.__name__.lower()} settings ({keys})"
         try:
-            Sensor.from_dict(v)
+            cls.from_dict(v)
         except NeurohoverError as exc:
-            return False, f"a valid sensor ({exc})"
+            return False, f"a valid {cls.__name__.lower()} ({exc})"
         return True, ""
 
     return check
+
+
+def _sensor_table():
+    return _settings_table(Sensor, "level, velocity, position, rates, attitude, correlation, delay")
 
 
 def _drift_table():
-    def check(v):
-
-        if not isinstance(v, dict):
-            return False, "a table of drift settings (walk, change, change_at)"
-        try:
-            Drift.from_dict(v)
-        except NeurohoverError as exc:
-            return False, f"a valid drift ({exc})"
-        return True, ""
-
-    return check
+    return _settings_table(Drift, "walk, change, change_at")
 
 
 def _policy_source():

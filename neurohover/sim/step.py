@@ -22,6 +22,13 @@ ENV_NOISE_WIDTH = 6 + SENSOR_SCRATCH  # per-helicopter floats when it senses: gu
 ENV_RNG_WIDTH = 8  # and uint64 words: the gust stream, then the sensor stream
 
 
+@nb.njit(cache=True, inline="always")
+def _state(states, i):
+    """Helicopter ``i``'s state row as the kernel's state tuple."""
+    r = states[i]
+    return (r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8], r[9], r[10], r[11], r[12])
+
+
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
 def step_one(i, mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps, obs_out, rew_out, crash_out):
     """Advance helicopter ``i`` of :func:`step_batch` by one control step (its arguments, plus ``i``).
@@ -36,23 +43,7 @@ def step_one(i, mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps,
     sensing = sensing and noise.shape[1] >= ENV_NOISE_WIDTH and rngs.shape[1] >= ENV_RNG_WIDTH  # (an env sizes them for its sensors)
     a1, a2, a3, a4 = actions[i, 0], actions[i, 1], actions[i, 2], actions[i, 3]
     if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
-        o = observe(
-            (
-                states[i, 0],
-                states[i, 1],
-                states[i, 2],
-                states[i, 3],
-                states[i, 4],
-                states[i, 5],
-                states[i, 6],
-                states[i, 7],
-                states[i, 8],
-                states[i, 9],
-                states[i, 10],
-                states[i, 11],
-                states[i, 12],
-            )
-        )
+        o = observe(_state(states, i))
         if sensing:
             o = sense(o, t, sensor, rngs[i, 4:], noise[i, 6:])
         for m in range(12):
@@ -64,21 +55,7 @@ def step_one(i, mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps,
     rng = rngs[i]
     n = (noise[i, 0], noise[i, 1], noise[i, 2], noise[i, 3], noise[i, 4], noise[i, 5])
     n = update_noise(n, std, next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng))
-    s = (
-        states[i, 0],
-        states[i, 1],
-        states[i, 2],
-        states[i, 3],
-        states[i, 4],
-        states[i, 5],
-        states[i, 6],
-        states[i, 7],
-        states[i, 8],
-        states[i, 9],
-        states[i, 10],
-        states[i, 11],
-        states[i, 12],
-    )
+    s = _state(states, i)
     s = integrate(s, n, clip_action(a1), clip_action(a2), clip_action(a3), clip_action(a4), k, dyn, n_sub, dt, wind)
     for m in range(13):
         states[i, m] = s[m]
