@@ -1,7 +1,7 @@
 """numba's on-disk cache never runs a kernel compiled from older simulator sources.
 
-The end-to-end test compiles a copy of the package in subprocesses (two compiles of the small
-vector-environment kernel, a few seconds each), edits the copy and checks what runs.
+The end-to-end test compiles a copy of the package in subprocesses (two compiles of the kernel's
+integrate, a few seconds each), edits the copy and checks what runs.
 """
 
 from __future__ import annotations
@@ -25,33 +25,28 @@ from neurohover.sim._cache import SimSourceLocator, sim_source_hash
 PACKAGE = Path(neurohover.__file__).resolve().parent
 
 # Seeds one noise stream (envs/vector.py, compiled code linking sim/rng.py) and, with "step", flies
-# one control step without noise or wind (sim/step.py on sim/kernel.py, compiled code inlining sim/constants.py).
+# one control step without noise or wind (sim/kernel.py's integrate, compiled code inlining sim/constants.py).
 PROBE = """
 import json, sys
 import numpy as np
 import neurohover
 from neurohover.envs.vector import _seed_streams
-from neurohover.sim import step
-from neurohover.sim.constants import DEFAULT_PARAMS, MDP_ROW_LEN, ROW_DT, ROW_PARAMS, ROW_SUBSTEPS
+from neurohover.sim import kernel
+from neurohover.sim.constants import DEFAULT_PARAMS
 
 out = {"file": neurohover.__file__}
 rngs = np.zeros((1, 4), dtype=np.uint64)
 _seed_streams(rngs, np.zeros(1, dtype=np.int64), np.array([[7, 3]], dtype=np.int64))
 out["stream"] = [int(x) for x in rngs[0]]
 if "step" in sys.argv:
-    row = np.zeros((1, MDP_ROW_LEN))
-    row[0, ROW_PARAMS] = DEFAULT_PARAMS
-    row[0, ROW_SUBSTEPS] = 10
-    row[0, ROW_DT] = 0.01
-    states = np.zeros((1, 13))
-    states[0, 12] = 1.0
-    step.step_batch(row, np.zeros(1, dtype=np.int64), states, np.zeros((1, 6)), rngs,
-                      np.zeros(1, dtype=np.int64), np.zeros((1, 4)), 6000, np.zeros((1, 12)),
-                      np.zeros(1), np.zeros(1, dtype=np.bool_))
-    out["state"] = states[0].tolist()
+    # One control step at rest, no noise or wind: integrate alone (a light compile) inlines GRAVITY.
+    dyn = (*(float(x) for x in DEFAULT_PARAMS), 0.0)
+    state = (0.0,) * 12 + (1.0,)
+    wind = (0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    out["state"] = list(kernel.integrate(state, (0.0,) * 6, 0.0, 0.0, 0.0, 0.0, 0, dyn, 10, 0.01, wind))
 out["stats"] = {
     name: [sum(f.stats.cache_hits.values()), sum(f.stats.cache_misses.values())]
-    for name, f in (("seed_streams", _seed_streams), ("step_batch", step.step_batch))
+    for name, f in (("seed_streams", _seed_streams), ("step", kernel.integrate))
     if hasattr(f, "stats")  # plain Python functions under NUMBA_DISABLE_JIT
 }
 print(json.dumps(out))
@@ -82,16 +77,16 @@ def test_edits_outside_kernel_py_recompile_and_unchanged_sources_load_from_cache
         return out
 
     first = run("step")
-    assert first["stats"] == {"seed_streams": [0, 1], "step_batch": [0, 1]}  # compiled, cache empty
+    assert first["stats"] == {"seed_streams": [0, 1], "step": [0, 1]}  # compiled, cache empty
 
     again = run("step")
-    assert again["stats"] == {"seed_streams": [1, 0], "step_batch": [1, 0]}  # loaded, no compile
+    assert again["stats"] == {"seed_streams": [1, 0], "step": [1, 0]}  # loaded, no compile
     assert again["state"] == first["state"] and again["stream"] == first["stream"]
 
     # A constant the kernel inlines: gravity doubles the climb of the first step.
     _edit(copy / "neurohover/sim/constants.py", "GRAVITY = 9.81\n", "GRAVITY = 19.62\n")
     heavier = run("step")
-    assert heavier["stats"]["step_batch"] == [0, 1]
+    assert heavier["stats"]["step"] == [0, 1]
     assert heavier["state"][2] == pytest.approx(2 * first["state"][2], rel=0.05)
     assert heavier["state"] == pytest.approx(run("step", jit=False)["state"], rel=1e-12, abs=1e-15)
 
