@@ -120,3 +120,15 @@ def test_baseline_flies_the_same_with_or_without_a_zero_drift() -> None:
     a = evaluate_jobs([baseline_policy()], rows, [0] * 3, range(3), range(3), seed=1, n_steps=200)
     b = evaluate_jobs([baseline_policy()], [mdp], [0] * 3, [0] * 3, range(3), seed=1, n_steps=200)
     assert np.array_equal(a.returns, b.returns)
+
+
+def test_the_benchmark_report_tabulates_agents_by_condition(cli, tmp_path) -> None:
+    store = tmp_path / "r.sqlite"
+    assert cli("reproduce", "bench-drift", "--store", str(store), "--no-progress")[0] == 0
+    assert cli("report", "bench-drift", "--store", str(store), "--out", str(tmp_path / "report"))[0] == 0
+    text = (tmp_path / "report" / "report.md").read_text()
+    section = text[text.index("### Agents by condition") :]
+    header, rule, *rows = section.split("\n\n")[1].splitlines()
+    assert header == "| agent | fixed | walk | change |"
+    assert [r.split(" | ")[0] for r in rows] == ["| baseline", "| generic", "| model-free", "| incremental", "| hybrid", "| continual"]
+    assert all(r.count("%") == 3 for r in rows)

@@ -119,6 +119,31 @@ class _TestRuns(Section):
                 ax.plot(episodes, cum, label=f"{label} ({len(runs)} runs)")
         return self.save_panels(fig, axes, "episode", ("mean cumulative error (-cumulative reward)", "mean cumulative error (log scale)"))
 
+    def _matrix(self) -> str:
+        """Where every group is labelled AGENT/CONDITION (the benchmarks): agents by conditions, crash rate and median score."""
+        split = [g.label.split("/") for g in self.groups()]
+        if not split or any(len(parts) != 2 for parts in split):
+            return ""
+        agents = list(dict.fromkeys(a for a, _ in split))
+        conditions = list(dict.fromkeys(c for _, c in split))
+        rows = []
+        for agent in agents:
+            row = [agent]
+            for condition in conditions:
+                runs = self.runs(f"{agent}/{condition}")
+                if not runs:
+                    row.append("n/a")
+                    continue
+                episodes = sum(len(r.returns) for r in runs)
+                crashes = sum(len(r.crash_episodes) for r in runs)
+                row.append(f"{crashes / episodes:.0%} ({fmt(np.median([float(r.score) for r in runs]))})")
+            rows.append(row)
+        return (
+            "### Agents by condition\n\n"
+            + table(["agent", *conditions], rows)
+            + "\n\nEach cell: the fraction of all the group's episodes that crashed (the median over runs of the cumulative reward).\n\n"
+        )
+
     def body(self) -> str:
         ref = self.paper.get("groups", {})
         rows, samples, labels = [], {}, {}
@@ -163,7 +188,8 @@ class _TestRuns(Section):
             self.comparisons.append("Ranking by mean cumulative reward (best first): ours " + " > ".join(order) + ".")
         self.add_tests(samples, labels, "final cumulative reward")
         return (
-            "### Test runs\n\n"
+            self._matrix()
+            + "### Test runs\n\n"
             + table(
                 [
                     "agent",
