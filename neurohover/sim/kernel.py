@@ -266,7 +266,7 @@ def unpack_sensor(row):
     return sensor, on
 
 
-@nb.njit(cache=True, inline="always", fastmath={"contract"})
+@nb.njit(cache=True, fastmath={"contract"})  # not inlined: it runs only for rows with a sensor model, and compiles once
 def sense(o, k, sensor, srng, scratch):
     """What the sensors report at reading ``k`` (0: the reset) of true observation ``o``.
 
