@@ -45,32 +45,6 @@ def start_gated_run(config: Path, store: Path, gates: Path, name: str = "slowtes
     return subprocess.Popen(argv, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
 
 
-# The compiled code every test process needs, each piece compiled in a process of its own.
-_WARM_UPS = (
-    "from neurohover.launch import Batch, Flown, _fly_kernel; from neurohover.sim.kernel import rollout_batch; "
-    "_fly_kernel(rollout_batch, Batch.empty(), Flown.empty(0))",
-    "from neurohover.launch import Batch, Flown, _fly_lanes; _fly_lanes(Batch.empty(), Flown.empty(0))",
-    "import numpy as np; from neurohover.envs.vector import HoverVectorEnv; v = HoverVectorEnv(1, task='ghh08'); v.reset(seed=0); v.step(np.zeros((1, 4)))",
-)
-
-
-def pytest_configure(config) -> None:
-    """Before pytest-xdist starts its workers, fill numba's on-disk cache, the pieces side by side on every core.
-
-    From a fresh clone every worker would otherwise compile the same kernels itself (about a minute
-    each on this project's 2-core machine); once they are cached this costs a few seconds.
-    """
-    workers = getattr(config.option, "numprocesses", None)
-    if hasattr(config, "workerinput") or not workers or os.environ.get("NUMBA_DISABLE_JIT") == "1":
-        return
-    procs = [subprocess.Popen([sys.executable, "-c", code], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) for code in _WARM_UPS]
-    for proc in procs:
-        try:
-            proc.wait(timeout=900)
-        except subprocess.TimeoutExpired:  # the tests compile what is missing themselves
-            proc.kill()
-
-
 @pytest.fixture(scope="session")
 def repo_root() -> Path:
     """The checkout the tests run from (README, docs, examples, configs)."""
