@@ -45,7 +45,7 @@ from .constants import (
     WIND_CONSTANT,
     WIND_SINUSOID,
 )
-from .rng import SENSOR_STREAM_KEY, next_normal, seed_stream
+from .rng import next_normal, seed_sensor_stream, seed_stream
 
 POLICY_SLP = 0
 POLICY_MLP = 1
@@ -404,7 +404,7 @@ def fly_job(
     dyn, std, n_sub, dt, wind = unpack_mdp(mdp_rows[job_mdp[j]])
     sensor, sensing = unpack_sensor(mdp_rows[job_mdp[j]])
     if sensing:
-        seed_stream(srng, np.uint64(seed) ^ SENSOR_STREAM_KEY, np.uint64(job_episode[j]))
+        seed_sensor_stream(srng, np.uint64(seed), np.uint64(job_episode[j]))
     pol = job_policy[j]
     kind = policy_kinds[pol]
     g = genomes[pol]

@@ -58,7 +58,7 @@ from .kernel import (
     unpack_sensor,
     update_noise,
 )
-from .rng import SENSOR_STREAM_KEY, next_normal, seed_stream
+from .rng import next_normal, seed_sensor_stream, seed_stream
 
 LANES = 8  # episodes per thread: 8 doubles fill an AVX-512 register (prototype: 4 lanes 1.94x, 8 2.20x, 16 2.27x)
 BIG2 = SERIES_MAX_ANGLE * SERIES_MAX_ANGLE
@@ -325,7 +325,7 @@ def _start_sensing(seen, srngs, scratch, lane, row, seed, episode) -> bool:
     """Start the sensor model of a lane's new episode (as kernel.fly_job does); whether its row has one."""
     sensor, on = unpack_sensor(row)
     if on:
-        seed_stream(srngs[lane], np.uint64(seed) ^ SENSOR_STREAM_KEY, np.uint64(episode))
+        seed_sensor_stream(srngs[lane], np.uint64(seed), np.uint64(episode))
         o = sense((0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), 0, sensor, srngs[lane], scratch[lane])
         for m in range(12):
             seen[lane, m] = o[m]

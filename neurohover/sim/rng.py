@@ -139,14 +139,20 @@ def episode_normals(seed: np.uint64, episode: np.uint64, n_steps: int) -> np.nda
 
 
 @nb.njit(cache=True)
+def seed_sensor_stream(state: np.ndarray, seed: np.uint64, episode: np.uint64) -> None:
+    """Fill ``state`` with episode ``episode``'s sensor-noise stream: the gust stream of seed ``seed ^ SENSOR_STREAM_KEY``."""
+    seed_stream(state, np.uint64(seed) ^ SENSOR_STREAM_KEY, np.uint64(episode))
+
+
+@nb.njit(cache=True)
 def sensor_normals(seed: np.uint64, episode: np.uint64, n_readings: int) -> np.ndarray:
     """The (n_readings, 12) standard normals that episode ``episode`` of ``seed`` feeds the sensor noise.
 
-    One row per reading: the reset's, then one after every control step; the stream is the gusts'
-    stream of seed ``seed ^ SENSOR_STREAM_KEY``, so sensor noise never shifts the gusts.
+    One row per reading: the reset's, then one after every control step, from
+    :func:`seed_sensor_stream`'s stream, so sensor noise never shifts the gusts.
     """
     state = np.empty(4, dtype=np.uint64)
-    seed_stream(state, seed ^ SENSOR_STREAM_KEY, episode)
+    seed_sensor_stream(state, seed, episode)
     out = np.empty((n_readings, 12))
     for k in range(n_readings):
         for j in range(12):
