@@ -327,10 +327,8 @@ class HoverVectorEnv(VectorEnv):
         self._state[idx] = initial_state()
         self._noise[idx] = 0.0
         self._steps[idx] = 0
-        if self._noise.shape[1] >= ENV_NOISE_WIDTH:
-            start_readings(self._rows, self._index, idx, self._streams, self._rng, self._noise, self._obs)
-        else:
-            self._obs[idx] = 0.0  # the start state observes as all zeros
+        # The first readings: all zeros (the start state observes so), or what the sensors make of them.
+        start_readings(self._rows, self._index, idx, self._streams, self._rng, self._noise, self._obs)
         if self._gpu is not None:
             self._gpu.set_rows(idx, self._rows[idx], self._state[idx], self._noise[idx], self._rng[idx], self._steps[idx])
 

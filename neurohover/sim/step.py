@@ -16,7 +16,7 @@ import numpy as np
 
 from .constants import SENSOR_SCRATCH
 from .kernel import clip_action, crash_charge, crashed, integrate, observe, reward_of, sense, unpack_mdp, unpack_sensor, update_noise
-from .rng import SENSOR_STREAM_KEY, next_normal, seed_stream
+from .rng import next_normal, seed_sensor_stream
 
 ENV_NOISE_WIDTH = 6 + SENSOR_SCRATCH  # per-helicopter floats when it senses: gust noise, then the sensor's
 ENV_RNG_WIDTH = 8  # and uint64 words: the gust stream, then the sensor stream
@@ -29,6 +29,13 @@ def _state(states, i):
     return (r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8], r[9], r[10], r[11], r[12])
 
 
+@nb.njit(cache=True, inline="always")
+def _sensor_of(row, noise, rngs):
+    """The row's sensor model, and whether it senses here: the caller's arrays must have room for it (an env sizes them so)."""
+    sensor, on = unpack_sensor(row)
+    return sensor, on and noise.shape[1] >= ENV_NOISE_WIDTH and rngs.shape[1] >= ENV_RNG_WIDTH
+
+
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
 def step_one(i, mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps, obs_out, rew_out, crash_out):
     """Advance helicopter ``i`` of :func:`step_batch` by one control step (its arguments, plus ``i``).
@@ -39,8 +46,7 @@ def step_one(i, mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps,
     k = steps[i]
     t = k + 1
     steps[i] = t
-    sensor, sensing = unpack_sensor(mdp_rows[env_mdp[i]])
-    sensing = sensing and noise.shape[1] >= ENV_NOISE_WIDTH and rngs.shape[1] >= ENV_RNG_WIDTH  # (an env sizes them for its sensors)
+    sensor, sensing = _sensor_of(mdp_rows[env_mdp[i]], noise, rngs)
     a1, a2, a3, a4 = actions[i, 0], actions[i, 1], actions[i, 2], actions[i, 3]
     if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
         o = observe(_state(states, i))
@@ -95,11 +101,11 @@ def start_readings(mdp_rows, env_mdp, idx, streams, rngs, noise, obs_out):
     """
     zero = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     for i in idx:
-        sensor, sensing = unpack_sensor(mdp_rows[env_mdp[i]])
+        sensor, sensing = _sensor_of(mdp_rows[env_mdp[i]], noise, rngs)
         seen = zero
-        if sensing and noise.shape[1] >= ENV_NOISE_WIDTH and rngs.shape[1] >= ENV_RNG_WIDTH:
+        if sensing:
             srng = rngs[i, 4:]
-            seed_stream(srng, np.uint64(streams[i, 0]) ^ SENSOR_STREAM_KEY, np.uint64(streams[i, 1]))
+            seed_sensor_stream(srng, np.uint64(streams[i, 0]), np.uint64(streams[i, 1]))
             seen = sense(zero, 0, sensor, srng, noise[i, 6:])
         for m in range(12):
             obs_out[i, m] = seen[m]
