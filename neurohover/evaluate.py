@@ -27,7 +27,6 @@ from .launch import DEVICES, KIND, MAX_SEED, Batch, Flown, check_device, launch,
 from .policies import GENOME_LENGTH, TOPOLOGIES, Policy, load_policy
 from .sim.constants import (
     EPISODE_STEPS,
-    MAX_SENSOR_DELAY,
     MDP_ROW_LEN,
     ROW_SENSOR,
     SAFEGUARD_BOX,
@@ -40,7 +39,7 @@ from .sim.constants import (
     SAFEGUARD_TILT,
 )
 from .sim.kernel import GENOME_WIDTH
-from .tasks import MDP
+from .tasks import MDP, Sensor
 
 # Re-exported where they were first defined: KernelFlyer, DEVICES, check_device, num_threads, use_lanes.
 __all__ = [
@@ -165,13 +164,13 @@ def mdp_rows(mdps: MDP | Sequence[MDP] | np.ndarray) -> np.ndarray:
         if mdps.ndim != 2 or mdps.shape[1] != MDP_ROW_LEN or not np.all(np.isfinite(mdps)):
             raise NeurohoverError(f"MDP rows must be a finite array of shape (M, {MDP_ROW_LEN}), got {mdps.shape}")
         sensors = mdps[:, ROW_SENSOR]
-        bad = (sensors[:, :5] < 0).any(axis=1) | (sensors[:, 4] >= 1) | (sensors[:, 5] > MAX_SENSOR_DELAY) | (sensors[:, 5] != np.round(sensors[:, 5]))
-        if bad.any():
-            i = int(np.flatnonzero(bad)[0])
-            raise NeurohoverError(
-                f"MDP row {i} has an invalid sensor model {sensors[i].tolist()}: allowed 4 stds >= 0, a correlation in [0, 1) "
-                f"and a whole delay in 0..{MAX_SENSOR_DELAY} (neurohover.tasks.sensor)"
-            )
+        if sensors.any():  # the rows' sensor models, each distinct one checked by Sensor's own rules
+            for values in np.unique(sensors, axis=0):
+                try:
+                    Sensor.from_row_values(values)
+                except NeurohoverError as err:
+                    i = int(np.flatnonzero((sensors == values).all(axis=1))[0])
+                    raise NeurohoverError(f"MDP row {i} has an invalid sensor model {values.tolist()}: {err}") from None
         return np.ascontiguousarray(mdps, dtype=float)
     if len(mdps) == 0 or not all(isinstance(m, MDP) for m in mdps):
         raise NeurohoverError("mdps must be an MDP or a non-empty sequence of MDPs")

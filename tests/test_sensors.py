@@ -88,10 +88,11 @@ def test_a_family_seen_through_a_sensor_puts_it_on_every_mdp_it_makes() -> None:
     assert "sensor=Sensor(" in repr(family) and "sensor" not in repr(plain)
 
 
-def test_kernel_refuses_raw_rows_with_an_invalid_sensor_model() -> None:
-    rows = get_task_family("ghh08").mdp("train:0").row()[None, :].copy()
-    rows[0, ROW_SENSOR.start + 5] = 12  # a delay beyond the ring buffer
-    with pytest.raises(NeurohoverError, match="invalid sensor model"):
+@pytest.mark.parametrize(("slot", "value", "message"), [(5, 12, "delay=12 is out of range"), (5, -1, "delay=-1 is out of range"), (4, 1.0, "correlation=1.0")])
+def test_kernel_refuses_raw_rows_with_an_invalid_sensor_model(slot: int, value: float, message: str) -> None:
+    rows = np.repeat(get_task_family("ghh08").mdp("train:0").row()[None, :], 2, axis=0)
+    rows[1, ROW_SENSOR.start + slot] = value  # beyond the ring buffer, before the reset, or noise that never settles
+    with pytest.raises(NeurohoverError, match=f"MDP row 1 has an invalid sensor model .*{message}"):
         evaluate_jobs([baseline_policy()], rows, [0], [0], [0], n_steps=10)
 
 
