@@ -61,12 +61,19 @@ def add_sensor_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--obs-delay", type=int, help="control steps (0..10, 0.1 s each) the readings arrive late (default 0)")
 
 
-def task_family_of(args: argparse.Namespace):
-    """The task family of --task/--sigma, seen through the sensor of --obs-noise/--obs-delay."""
-    from .tasks import Sensor, get_task_family
+def sensor_of(args: argparse.Namespace):
+    """The sensor of --obs-noise/--obs-delay (None where neither is given: exact sensors)."""
+    from .tasks import Sensor
 
     noise, delay = getattr(args, "obs_noise", None), getattr(args, "obs_delay", None)
-    return get_task_family(args.task, args.sigma, None if noise is None and delay is None else Sensor.of(noise, delay))
+    return None if noise is None and delay is None else Sensor.of(noise, delay)
+
+
+def task_family_of(args: argparse.Namespace):
+    """The task family of --task/--sigma, seen through the sensor of --obs-noise/--obs-delay."""
+    from .tasks import get_task_family
+
+    return get_task_family(args.task, args.sigma, sensor_of(args))
 
 
 def _family_and_mdps(args: argparse.Namespace, n: int, rng: np.random.Generator):

@@ -39,11 +39,12 @@ def cmd_compete(args: argparse.Namespace) -> int:
     """Run R independent test runs of an agent; print a summary and write results and a plot."""
     from .agents.hybrid import HybridSettings
     from .agents.registry import HYBRID_AGENTS
+    from .cli import sensor_of
     from .compete import compete
     from .evolution.seeding import check_seed
     from .experiments.executors import check_jobs
     from .paths import input_dir, output_dir, output_file
-    from .tasks import Drift, Sensor
+    from .tasks import Drift
 
     given = [f"--{k.replace('_', '-')}" for k in _HYBRID_OPTIONS if getattr(args, k) is not None]
     if given and args.agent not in HYBRID_AGENTS:
@@ -64,8 +65,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
     output_dir(args.out, "--out")
     if args.store is not None:
         output_file(args.store, "--store")
-    noise, delay = args.obs_noise, args.obs_delay
-    sensor = None if noise is None and delay is None else Sensor.of(noise, delay)
+    sensor = sensor_of(args)
     try:
         summary, _ = compete(
             args.task,
