@@ -85,7 +85,6 @@ def _choice(*allowed: str):
 
 def _agent():
     def check(v):
-
         return v in AGENTS, "one of " + ", ".join(repr(a) for a in AGENTS)
 
     return check

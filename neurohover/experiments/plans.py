@@ -29,12 +29,12 @@ from ..agents.registry import HYBRID_AGENTS, agent_spec
 from ..errors import NeurohoverError
 from ..policies import baseline_policy
 from ..policysets import FGHH_GENERIC_RESAMPLING, load_policy_set
-from ..tasks import Sensor, family_for
+from ..tasks import Sensor
 from ..tasks.drift import Drift
 from .config import ExperimentConfig, load_config, variant_optimiser
 from .results import UnitKey
 from .settings import EvolutionSettings, ExperimentSettings, Group, ModelLearningSettings, TestRunsSettings
-from .units import Unit, policy_dict, unit_seed
+from .units import Unit, family_of, policy_dict, unit_seed
 
 _SAMPLE_TAG = 0x5A3
 
@@ -44,17 +44,6 @@ class Plan:
     units: list[Unit]
     total: int
     waiting: tuple[str, ...] = ()  # why some units cannot be planned yet (unfinished sources)
-
-
-def _sensor(table: dict | None):
-
-    return None if table is None else Sensor.from_dict(table)
-
-
-def _family(task: str, sigma: float | None, sensor: dict | None = None):
-    """The experiment's task family (``sensor``: its ``sensor`` table, None: exact sensors)."""
-
-    return family_for(task, sigma, _sensor(sensor))
 
 
 def _family_target(s: ExperimentSettings, sigma: float | None) -> dict:
@@ -110,7 +99,7 @@ def external_digest(kind: str, s: dict) -> str:
 def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
     s = cfg.typed
     assert isinstance(s, EvolutionSettings)
-    family = _family(s.task, s.sigma, s.sensor)
+    family = family_of(s.task, s.sigma, s.sensor)
     units: list[Unit] = []
     base = {
         "budget": s.budget,
@@ -134,7 +123,7 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
         else:
             sigma = v.sigma if v.sigma is not None else s.sigma
             if s.target == "zero":
-                target = {"kind": "mdp", "mdp": _family(s.task, sigma, s.sensor).zero().to_dict()}
+                target = {"kind": "mdp", "mdp": family_of(s.task, sigma, s.sensor).zero().to_dict()}
             else:
                 target = _family_target(s, sigma)
             for r in range(s.runs):
@@ -187,7 +176,6 @@ def _policy_evolution_unit(cfg: ExperimentConfig, key: str, target: dict, budget
 
 
 def _spec(agent: str):
-
     return agent_spec(agent)
 
 
@@ -230,7 +218,7 @@ class _Policies:
         assert isinstance(s, TestRunsSettings)
         self.settings = s
         self.task = s.task
-        self.family = _family(s.task, s.sigma, s.sensor)
+        self.family = family_of(s.task, s.sigma, s.sensor)
         needs: set[str] = set()
         for g in s.groups:
             spec = _spec(g.agent)
@@ -371,10 +359,12 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dic
     for g in s.groups:
         mdps = _mdps(pol.family, g.mdps, g.n_mdps, s.seed)
         if g.sensor is not None:  # this group's agents fly the same MDPs through sensors of its own
-            mdps = [m.with_sensor(_sensor(g.sensor)) for m in mdps]
+            group_sensor = Sensor.from_dict(g.sensor)
+            mdps = [m.with_sensor(group_sensor) for m in mdps]
         drift = g.drift if g.drift is not None else s.drift
         if drift is not None:  # the test runs' MDPs drift (the harness flies the drift, neurohover.tasks.drift)
-            mdps = [m.with_drift(Drift.from_dict(drift)) for m in mdps]
+            run_drift = Drift.from_dict(drift)
+            mdps = [m.with_drift(run_drift) for m in mdps]
         sensor = g.sensor if g.sensor is not None else s.sensor
         hybrid = group_hybrid_settings(g)
         counter = 0
@@ -413,7 +403,7 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dic
 def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
     s = cfg.typed
     assert isinstance(s, ModelLearningSettings)
-    family = _family(s.task, s.sigma, s.sensor)
+    family = family_of(s.task, s.sigma, s.sensor)
     units: list[Unit] = []
     total = len(s.methods) * s.n_mdps
     if s.generic == "evolve":

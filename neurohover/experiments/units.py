@@ -85,17 +85,15 @@ def policy_dict(policy) -> dict:
 
 
 def _policy(d: dict):
-
     return Policy(d["topology"], np.array(d["genome"], dtype=float))
 
 
 def _mdp(d: dict):
-
     return MDP.from_dict(d)
 
 
-def _family(task: str, sigma: float | None, sensor: dict | None = None):
-
+def family_of(task: str, sigma: float | None, sensor: dict | None = None):
+    """A config's or a unit's task family: its task, breadth and sensor table (None: exact sensors)."""
     return family_for(task, sigma, None if sensor is None else Sensor.from_dict(sensor))
 
 
@@ -117,7 +115,7 @@ def _evolve_target(t: dict):
     """An evolution unit's target: the MDP, or the family (its task, breadth and sensors)."""
     if t["kind"] == "mdp":
         return _mdp(t["mdp"])
-    return _family(t["task"], t.get("sigma"), t.get("sensor"))
+    return family_of(t["task"], t.get("sigma"), t.get("sensor"))
 
 
 def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:
@@ -275,7 +273,7 @@ def run_test_run(p: dict, threads: int | None, device: str = "cpu") -> dict:
     """One test run (docs/model.md, On-line agents): ``episodes`` episodes of an agent on one MDP it does not know."""
     q = unit_params("test_run", p)
 
-    family = _family(q.task, q.sigma, q.sensor)
+    family = family_of(q.task, q.sigma, q.sensor)
     mdp = _mdp(q.mdp)
     agent = unit_agent(p, device)
     r = run_test(agent, family, mdp, episodes=q.episodes, seed=q.seed, n_steps=q.n_steps, threads=threads, device=device)
