@@ -119,12 +119,11 @@ class Sensor:
                 raise NeurohoverError(f"sensor setting {part!r} needs a number after '='") from None
         if not settings:
             raise NeurohoverError(f"sensor {text!r} is empty: {expected}")
-        base = cls.at_level(settings.pop("level", 0.0))
-        values = asdict(base) | {"delay": delay} | settings
+        values: dict[str, float | int] = {"delay": delay} | settings
         if not float(values["delay"]).is_integer():
             raise NeurohoverError(f"sensor delay={values['delay']!r} is not a whole number of control steps")
         values["delay"] = int(values["delay"])
-        return cls(**values)
+        return cls.from_dict(values)  # the level, then the stds given beside it
 
     @classmethod
     def of(cls, obs_noise=None, obs_delay=None) -> Sensor:
