@@ -52,6 +52,9 @@ def test_drifted_rows_start_at_the_mdp_change_once_and_walk_by_the_stated_std() 
         (lambda: Drift(0.0, (), (9, 3)), "change_at=(9, 3) is out of range"),
         (lambda: Drift.parse("D_w=abc"), "'D_w=abc' is not understood"),
         (lambda: Drift.from_dict({"wlak": 0.1}), "unknown drift setting"),
+        (lambda: Drift.from_dict({"walk": "abc"}), "walk='abc' is out of range"),
+        (lambda: Drift.from_dict({"walk": True}), "walk=True is out of range"),
+        (lambda: Drift.from_dict({"change_at": 5}), "change_at=5 is not allowed"),
         (lambda: get_task_family("ghh08").with_drift("slow"), "must be a neurohover Drift"),  # type: ignore[arg-type]
     ],
 )

@@ -34,6 +34,8 @@ from ..errors import NeurohoverError
 from ..sim.constants import PARAM_NAMES, ROW_PARAMS
 
 _DRIFT_TAG = 0xD81F7  # separates a run's drift stream from its agent's and its gusts'
+CHANGE_AT = (200, 800)  # the default range of the abrupt change's episode
+_PARSE_FORM = "give walk=STD or PARAM=FACTOR[@LO-HI], e.g. walk=0.01,D_w=0.8@200-800"
 
 
 @dataclass(frozen=True)
@@ -42,7 +44,7 @@ class Drift:
 
     walk: float = 0.0
     change: tuple[tuple[str, float], ...] = ()
-    change_at: tuple[int, int] = (200, 800)
+    change_at: tuple[int, int] = CHANGE_AT
     _factors: np.ndarray | None = field(default=None, init=False, repr=False, compare=False, hash=False)
 
     def __post_init__(self) -> None:
@@ -109,13 +111,12 @@ class Drift:
         change = d.get("change", {})
         if not isinstance(change, dict):
             raise NeurohoverError(f"drift change={change!r} is not allowed: give a table of parameter factors, e.g. {{D_w = 0.8}}")
-        at = tuple(d.get("change_at", (200, 800)))
-        return cls(float(d.get("walk", 0.0)), tuple(change.items()), at)  # checked in __post_init__
+        return cls(d.get("walk", 0.0), tuple(change.items()), d.get("change_at", CHANGE_AT))  # checked in __post_init__
 
     @classmethod
     def parse(cls, text: str) -> Drift:
         """A drift from the command line: ``walk=0.01``, ``D_w=0.8@200-800`` (a change, at an episode in 200..800), or both, comma-separated."""
-        walk, change, at = 0.0, {}, (200, 800)
+        walk, change, at = 0.0, {}, CHANGE_AT
         for part in filter(None, (p.strip() for p in str(text).split(","))):
             key, eq, value = part.partition("=")
             value, _, when = value.partition("@")
@@ -125,9 +126,9 @@ class Drift:
                     lo, _, hi = when.partition("-")
                     at = (int(lo), int(hi or lo))
             except ValueError:
-                raise NeurohoverError(f"drift {part!r} is not understood: give walk=STD or PARAM=FACTOR[@LO-HI], e.g. walk=0.01,D_w=0.8@200-800") from None
+                raise NeurohoverError(f"drift {part!r} is not understood: {_PARSE_FORM}") from None
             if not eq:
-                raise NeurohoverError(f"drift {part!r} is not understood: give walk=STD or PARAM=FACTOR[@LO-HI], e.g. walk=0.01,D_w=0.8@200-800")
+                raise NeurohoverError(f"drift {part!r} is not understood: {_PARSE_FORM}")
             if key.strip() == "walk":
                 walk = number
             else:
