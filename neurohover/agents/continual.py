@@ -32,11 +32,10 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from ..flightdata import FlightData
-from ..models import LearnedModel, learn_lr
 from ..models.transitions import one_step_error
 from ..policies import Policy
-from ..tasks import TaskFamily
-from .model_based import ModelEvolution, enough_to_learn, evolve_on_model
+from ..tasks import MDP, TaskFamily
+from .model_based import ModelEvolution, enough_to_learn, evolve_on_model, learn_model
 from .protocol import Agent, Choice, EpisodeOutcome
 from .spec import AgentOptions, AgentPolicies, AgentSettings, AgentSpec
 
@@ -78,10 +77,10 @@ class ContinualAgent(Agent):
         self.policy, self.label = self.generic, "generic"
         self.learning = True  # in a learning phase (else flying a kept policy and watching its model)
         self.phase_start = 0
-        self.phase_best: tuple[float, Policy, str] = (-np.inf, self.generic, "generic")
         self.predicted: float | None = None
-        self.reference_error: float | None = None  # the kept policy's model's error on its own data
-        self.policy_model: LearnedModel | None = None
+        self.policy_model: MDP | None = None  # the model the flying policy was evolved on (None: the generic)
+        self.reference_error: float | None = None  # that model's one-step error on its own data
+        self.phase_best = self._candidate(-np.inf)
         self.strikes = 0
         self.models = 0
         self.relearned_at: list[int] = []  # episodes after which a change was detected
@@ -93,6 +92,10 @@ class ContinualAgent(Agent):
         fallback = self.generic if self.settings.safeguard and self.policy is not self.generic else None
         return Choice(self.policy, self.label, fallback=fallback, record=True)
 
+    def _candidate(self, ret: float) -> tuple:
+        """The flying policy with its return, label, model and the model's own error (a phase's best so far)."""
+        return (ret, self.policy, self.label, self.policy_model, self.reference_error)
+
     def _data(self) -> FlightData:
         return FlightData(tuple(o for o, _ in self.window), tuple(a for _, a in self.window))
 
@@ -101,11 +104,11 @@ class ContinualAgent(Agent):
         data = self._data()
         if not enough_to_learn(data):
             return
-        model = learn_lr(data, estimator=self.evolution.estimator)
+        model = learn_model(data, self.evolution.estimator)
         self.models += 1
         self.policy_model = model
         self.reference_error = float(one_step_error(model, data))
-        self.policy, self.predicted = evolve_on_model(model.mdp(), self.generic, self.evolution, int(self._rng.integers(2**62)))
+        self.policy, self.predicted = evolve_on_model(model, self.generic, self.evolution, int(self._rng.integers(2**62)))
         self.label = f"model:{self.models}"
 
     def update(self, outcome: EpisodeOutcome) -> None:
@@ -120,11 +123,11 @@ class ContinualAgent(Agent):
 
     def _learn(self, outcome: EpisodeOutcome) -> None:
         if outcome.ret > self.phase_best[0]:
-            self.phase_best = (outcome.ret, self.policy, self.label)
+            self.phase_best = self._candidate(outcome.ret)
         met = self.predicted is not None and not outcome.crashed and outcome.ret >= self.predicted
         if met or outcome.episode + 1 - self.phase_start >= self.settings.max_learning_episodes:
-            if not met:  # the phase's best policy (its model stays the one it was evolved on)
-                self.policy, self.label = self.phase_best[1], self.phase_best[2]
+            if not met:  # the phase's best policy, watched against the model it was evolved on
+                _, self.policy, self.label, self.policy_model, self.reference_error = self.phase_best
             self.learning, self.strikes = False, 0
             return
         self._evolve()
@@ -140,7 +143,7 @@ class ContinualAgent(Agent):
         if stale:  # the dynamics moved away from the model: learn again from the recent episodes
             self.relearned_at.append(outcome.episode)
             self.learning, self.phase_start, self.strikes = True, outcome.episode + 1, 0
-            self.phase_best, self.predicted = (-np.inf, self.policy, self.label), None
+            self.phase_best, self.predicted = self._candidate(-np.inf), None
             self.window = self.window[-self.settings.patience :]  # keep the episodes that showed the change
             self._evolve()
 
