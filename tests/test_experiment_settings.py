@@ -7,10 +7,11 @@ import dataclasses
 import pytest
 
 from neurohover import NeurohoverError
+from neurohover.experiments import params, settings
 from neurohover.experiments.config import SCHEMAS, experiment_names, load_config
-from neurohover.experiments.params import PARAMS, TestRunParams, unit_params
+from neurohover.experiments.params import PARAMS, unit_params
 from neurohover.experiments.plans import plan
-from neurohover.experiments.settings import KIND_SETTINGS, EvolutionSettings, Group, TestRunsSettings, Variant
+from neurohover.experiments.settings import KIND_SETTINGS, EvolutionSettings, Group, Variant
 
 
 def test_every_schema_key_is_a_field_of_its_kinds_settings_class() -> None:
@@ -32,7 +33,7 @@ def test_every_shipped_config_reads_as_its_typed_settings(scale: str) -> None:
         assert typed.task == cfg.settings["task"] and typed.seed == cfg.settings["seed"]
         if isinstance(typed, EvolutionSettings):
             assert [v.key for v in typed.variants] == [v["key"] for v in cfg.settings["variants"]]
-        if isinstance(typed, TestRunsSettings):
+        if isinstance(typed, settings.TestRunsSettings):
             assert [g.label for g in typed.groups] == [g["label"] for g in cfg.settings["groups"]]
         with pytest.raises(dataclasses.FrozenInstanceError):
             typed.seed = 1  # type: ignore[misc]
@@ -56,7 +57,7 @@ def test_every_planned_unit_reads_as_its_typed_params(scale: str) -> None:
 
 
 def test_unit_params_refuse_a_key_they_do_not_declare() -> None:
-    fields = {f.name: None for f in dataclasses.fields(TestRunParams) if f.default is dataclasses.MISSING}
+    fields = {f.name: None for f in dataclasses.fields(params.TestRunParams) if f.default is dataclasses.MISSING}
     with pytest.raises(ValueError, match="does not declare"):
         unit_params("test_run", {**fields, "sensr": {}})
     assert unit_params("test_run", fields).sensor is None

@@ -10,6 +10,7 @@ import signal
 import sqlite3
 import subprocess
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -444,6 +445,25 @@ def test_report_draws_the_figures_and_compares_with_the_paper(quick_store: Path,
     assert "Figure 2" not in (tmp_path / "one" / "report.md").read_text()
     rc, _, err = cli("report", "fig7", "--store", str(quick_store), "--out", str(tmp_path / "x"))
     assert rc == 2 and "holds no experiment 'fig7'" in err
+
+
+def test_a_report_of_fghh_runs_without_validation_ranks_nothing_and_warns_nothing(tmp_path: Path, cli) -> None:
+    # Bug: the ranking took the mean of an empty list of validation scores (numpy's "Mean of empty slice").
+    config = tmp_path / "tiny.toml"
+    config.write_text(
+        'name = "tinyfghh"\ntitle = "t"\nkind = "evolution"\n[settings]\ntask = "fghh"\nsigma = 0.3\nseed = 5\n'
+        'target = "family"\nruns = 1\n[[settings.variants]]\nkey = "k1"\nlabel = "k = 1"\n'
+        "[scales.quick]\nbudget = 200\nn_steps = 200\n"
+    )
+    store = tmp_path / "s.sqlite"
+    assert cli("reproduce", str(config), "--store", str(store), "--no-progress")[0] == 0
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rc, _, err = cli("report", "tinyfghh", "--store", str(store), "--out", str(tmp_path / "report"))
+    assert rc == 0, err
+    assert [str(w.message) for w in caught if issubclass(w.category, RuntimeWarning)] == []
+    text = (tmp_path / "report" / "report.md").read_text()
+    assert "| k = 1 |" in text and "Ranking by mean validation" not in text
 
 
 def test_failed_units_are_reported_and_not_recorded(tmp_path: Path, monkeypatch) -> None:

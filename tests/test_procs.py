@@ -117,8 +117,7 @@ def _end_group(proc: subprocess.Popen) -> None:
         os.killpg(proc.pid, signal.SIGKILL)
     except ProcessLookupError:
         pass
-    if proc.poll() is None:
-        proc.wait(timeout=30)
+    proc.communicate(timeout=30)  # reaps it and closes its pipes (unclosed, they warn in a later test)
 
 
 # --------------------------------------------------------------------------------- no orphans

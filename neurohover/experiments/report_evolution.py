@@ -118,7 +118,8 @@ class EvolutionSection(Section):
                 estimate, as_error = f"{fmt(champ)} (a return)", fmt(-champ)
             rows.append([row[0], str(len(runs)), estimate, as_error, *row[1:]])
             rows[-1] += [fmt(np.mean([r.episodes for r in runs])), fmt(np.mean([r.timing.seconds for r in runs]))]
-            samples[v.key], labels[v.key] = finals, v.label
+            if finals:  # runs without validation have no final scores to rank or test
+                samples[v.key], labels[v.key] = finals, v.label
         authors = _authors_generics(self.out, self.cfg)
         for folder, entry in authors.items():
             row, _ = _validation_row(f"the authors' {folder} ({len(entry['returns'])} files)", entry["returns"], entry["crashed"])
