@@ -15,6 +15,10 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 STORE_GZ = ROOT / "docs" / "reproduction" / "results.sqlite.gz"
 
+# Every process a test starts (scripts, commands, Ray workers) imports this checkout, as the tests do, and so
+# shares its compiled-kernel cache: from another directory it found the installed copy and compiled it afresh.
+os.environ["PYTHONPATH"] = os.pathsep.join([str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])])
+
 #: What the ``cli`` fixture returns for one command: exit status, standard output, standard error.
 CliRun = Callable[..., tuple[int, str, str]]
 
@@ -39,10 +43,9 @@ sys.exit(main(sys.argv[3:]))
 
 def start_gated_run(config: Path, store: Path, gates: Path, name: str = "slowtest") -> subprocess.Popen:
     """``neurohover reproduce CONFIG --store STORE`` in a process of its own, its units held at ``gates`` (:data:`GATED_RUN`)."""
-    env = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
     argv = [sys.executable, "-c", GATED_RUN, str(gates), name, "reproduce", str(config), "--scale", "quick", "--store", str(store), "--no-progress"]
     # Its own session, so a failed test can end the whole process group.
-    return subprocess.Popen(argv, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    return subprocess.Popen(argv, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
 
 
 @pytest.fixture(scope="session")

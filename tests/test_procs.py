@@ -20,7 +20,7 @@ from conftest import ROOT, start_gated_run
 
 from neurohover.experiments import Store
 
-ENV = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
+ENV = dict(os.environ)  # with this checkout on PYTHONPATH (conftest)
 
 # An evolution experiment whose units each take tens of seconds (far longer than the tests wait).
 LONG_CONFIG = """

@@ -7,12 +7,12 @@ not skip) when it is missing.
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from conftest import ROOT
 
 from neurohover.cli import main
 from neurohover.errors import NeurohoverError
@@ -84,8 +84,6 @@ def test_reproduce_command_with_the_ray_executor(ray_cluster, tmp_path: Path, ca
 
 def test_a_driver_in_another_process_joins_the_cluster_with_address(ray_cluster, tmp_path: Path) -> None:
     address = ray_cluster.get_runtime_context().gcs_address
-    root = Path(__file__).resolve().parents[1]
-    env = {**os.environ, "PYTHONPATH": str(root) + os.pathsep + os.environ.get("PYTHONPATH", "")}
     store = tmp_path / "s.sqlite"
     proc = subprocess.run(
         [
@@ -106,8 +104,7 @@ def test_a_driver_in_another_process_joins_the_cluster_with_address(ray_cluster,
             address,
             "--no-progress",
         ],
-        cwd=root,
-        env=env,
+        cwd=ROOT,
         capture_output=True,
         text=True,
         timeout=300,
