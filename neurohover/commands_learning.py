@@ -274,6 +274,8 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
         raise NeurohoverError(f"--estimator applies to --method lr only (least squares), not to --method {args.method}")
     if args.budget is not None and args.method == "lr":
         raise NeurohoverError("--budget applies to the evolutionary methods (ec-meno, ec-mer), not to --method lr (least squares)")
+    if args.wind_model is not None and args.method != "lr":
+        raise NeurohoverError(f"--wind-model applies to --method lr only (least squares), not to --method {args.method}")
     if args.policy is not None and args.method != "ec-mer":
         raise NeurohoverError(f"--policy applies to --method ec-mer only (the policy that flew the data), not to --method {args.method}")
     data = FlightData.load(input_file(args.flight_data, "--flight-data", "flight-data file"))
@@ -282,7 +284,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     extra = {} if args.budget is None else {"budget": args.budget}
     with _Ticker(f"learning a {args.method} model from {data.n_episodes} episodes ({data.n_transitions} steps)"):
         if args.method == "lr":
-            model = learn_lr(data, estimator=args.estimator or "ols")
+            model = learn_lr(data, estimator=args.estimator or "ols", wind_model=args.wind_model or "none")
         elif args.method == "ec-meno":
             model = learn_ec_meno(data, seed=args.seed, **extra)
         else:
@@ -300,6 +302,10 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     for line in model_notes(model, data, truth, rows):
         print(f"neurohover learn-model: {line}", file=sys.stderr)
     return 0
+
+
+def _wind_text(x, y) -> str:
+    return "; ".join(f"{n}: {a.amplitude:.4g} sin({a.omega:.5g} t + {a.phase:.4g}) + {a.offset:.4g}" for n, a in (("x", x), ("y", y)))
 
 
 # Fewer transitions than this (one minute of flight) give unreliable estimates.
@@ -320,8 +326,9 @@ def model_notes(model, data, truth, rows) -> list[str]:
 
     from .evaluate import evaluate
     from .models import PARAM_NAMES
+    from .models.wind import effective_wind, sinusoid_axes
     from .policies import baseline_policy
-    from .sim.constants import WIND_NONE
+    from .sim.constants import WIND_NONE, WIND_SINUSOID
 
     notes = []
     nan_axes = [r.name for r in rows if not np.isfinite(r.learned)]
@@ -336,7 +343,15 @@ def model_notes(model, data, truth, rows) -> list[str]:
             f"warning: only {data.n_transitions} transitions (fewer than {RELIABLE_TRANSITIONS}, one minute of flight); "
             "estimates from so little data are unreliable"
         )
-    if truth is not None and truth.wind_kind != WIND_NONE and any(w != 0 for w in truth.wind):
+    if model.wind.kind != "none":
+        notes.append(f"note: identified wind (world frame; omega rad/s, phase rad, m/s): {_wind_text(model.wind.x, model.wind.y)}")
+        if truth is not None and truth.wind_kind == WIND_SINUSOID:
+            true_axes = [effective_wind(a) for a in sinusoid_axes(truth.wind)]
+            notes.append(
+                f"note: the true wind as a one-substep model sampled at 10 Hz sees it (step-averaged, frequency folded into "
+                f"[0, 10 pi]): {_wind_text(*true_axes)}"
+            )
+    elif truth is not None and truth.wind_kind != WIND_NONE and any(w != 0 for w in truth.wind):
         absorbed = f" (fitted D_u = {model.d_u:.4g})" if model.d_u else ""
         notes.append(
             f"note: the data were flown in wind ({truth.label or truth.wind}); a learned model has no wind, so the "
@@ -439,6 +454,12 @@ def register(sub) -> None:
         "--estimator",
         choices=("ols", "gls"),
         help="lr: ols, ordinary least squares (default, as the paper), or gls, quasi-differencing by the gusts' AR(1) coefficient",
+    )
+    p.add_argument(
+        "--wind-model",
+        choices=("none", "constant", "sinusoid"),
+        help="lr: none (default, the paper's wind-blind model), or a world-frame wind per horizontal axis, constant or sinusoidal, "
+        "identified from the data (docs/model.md, Wind-aware models)",
     )
     p.add_argument("--seed", type=int, default=0, help="seed of the evolution (ec-meno, ec-mer)")
     p.add_argument("--policy", help="ec-mer: the policy that flew the data (default: the flight data's metadata, else baseline)")

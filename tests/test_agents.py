@@ -356,3 +356,29 @@ def test_repeated_choices_flown_ahead_equal_episode_by_episode_flights() -> None
     )
     np.testing.assert_array_equal(result.returns, each.returns)
     np.testing.assert_array_equal(result.safeguard_fired, each.safeguard_step >= 0)
+
+
+def _one_step_crashes(n: int):
+    """``n`` episodes that each crash on their first step: every transition starts from rest."""
+    from neurohover.flightdata import FlightData
+
+    rng = np.random.default_rng(0)
+    obs = [np.vstack([np.zeros(12), np.concatenate([rng.normal(0, 1, 9), np.zeros(3)])]) for _ in range(n)]
+    return FlightData(tuple(obs), tuple(rng.uniform(-1, 1, (1, 4)) for _ in range(n)))
+
+
+def test_agents_keep_flying_while_their_flight_data_do_not_determine_a_model() -> None:
+    # Bug (fig16, paper scale): 20 one-step crashes passed the transition count, then LR refused the data.
+    from neurohover.agents.fghh_code import CodeFGHHAgent
+    from neurohover.agents.model_based import enough_to_learn
+
+    data = _one_step_crashes(MIN_TRANSITIONS)
+    assert data.n_transitions >= MIN_TRANSITIONS and not enough_to_learn(data)
+    with pytest.raises(NeurohoverError, match="do not determine the u axis"):
+        learn_model(data)
+    family = get_task_family("fghh", 0.3)
+    for agent in (IncrementalModelBasedAgent(baseline_policy()), ModelBasedAgent(baseline_policy()), CodeFGHHAgent(baseline_policy())):
+        agent.start(family, np.random.default_rng(0))
+        for e in range(MIN_TRANSITIONS + 5):
+            assert agent.choose(e).label == "generic"
+            agent.update(EpisodeOutcome(e, -1e7, True, 1, -1, _one_step_crashes(1)))

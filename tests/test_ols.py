@@ -76,18 +76,23 @@ def test_ols_is_the_default_of_every_agents_model_learning(windy, monkeypatch) -
     class Learned(Exception):
         pass
 
-    def spy(flight_data, estimator="ols"):
-        raise Learned(estimator)
+    def spy(flight_data, estimator="ols", wind_model="none"):
+        raise Learned(estimator, wind_model)
 
     monkeypatch.setattr(mb, "learn_model", spy)
     outcome = EpisodeOutcome(0, -1e4, False, STEPS, -1, windy)
+    cases = (
+        (ModelEvolution(), ("ols", "none")),
+        (ModelEvolution(estimator="gls"), ("gls", "none")),
+        (ModelEvolution(wind_model="sinusoid"), ("ols", "sinusoid")),
+    )
     for cls in (ModelBasedAgent, IncrementalModelBasedAgent):
-        for settings, expected in ((ModelEvolution(), "ols"), (ModelEvolution(estimator="gls"), "gls")):
+        for settings, expected in cases:
             agent = cls(baseline_policy(), settings)
             agent.start(get_task_family("ghh08"), np.random.default_rng(0))
             with pytest.raises(Learned) as caught:
                 agent.update(outcome)
-            assert caught.value.args == (expected,), (cls, expected)
+            assert caught.value.args == expected, (cls, expected)
 
 
 def test_learn_model_command_uses_ols_unless_told(windy, tmp_path, capsys) -> None:

@@ -104,7 +104,7 @@ class ContinualAgent(Agent):
         data = self._data()
         if not enough_to_learn(data):
             return
-        model = learn_model(data, self.evolution.estimator)
+        model = learn_model(data, self.evolution.estimator, self.evolution.wind_model)
         self.models += 1
         self.policy_model = model
         self.reference_error = float(one_step_error(model, data))

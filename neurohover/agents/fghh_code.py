@@ -77,6 +77,8 @@ class CodeAgentSettings:
         Control steps of a model episode.
     estimator : {"ols", "gls"}
         The LR model's least squares (OLS, as the authors).
+    wind_model : {"none", "constant", "sinusoid"}
+        The LR model's wind (none, as the authors; FGHH has no wind).
     """
 
     evolutions: int = 3
@@ -85,6 +87,7 @@ class CodeAgentSettings:
     dangerous: DangerousState = DangerousState("ratio-sum")
     n_steps: int = EPISODE_STEPS
     estimator: str = "ols"
+    wind_model: str = "none"
 
     def __post_init__(self) -> None:
         for name, low in (("evolutions", 1), ("model_budget", 50), ("n_steps", 1)):
@@ -147,7 +150,7 @@ class CodeFGHHAgent(Agent):
             self.flight_data = outcome.flight_data if self.flight_data is None else self.flight_data + outcome.flight_data
             if not enough_to_learn(self.flight_data):
                 return
-            self.model = learn_model(self.flight_data, s.estimator)
+            self.model = learn_model(self.flight_data, s.estimator, s.wind_model)
         elif self.flying != "generic" and self.next_trial <= len(self.candidates) - 1:
             self.next_trial += 1
         if len(self.candidates) - 1 < s.evolutions and self.next_trial == len(self.candidates):
@@ -177,7 +180,11 @@ def _build(name: str):
         assert policies.generic is not None
         evo = options.evolution
         # A run's model budget (the configs' model_budget) applies here too: 2,550 is the authors'.
-        settings = CodeAgentSettings() if evo is None else CodeAgentSettings(model_budget=max(50, evo.budget), n_steps=evo.n_steps, estimator=evo.estimator)
+        settings = (
+            CodeAgentSettings()
+            if evo is None
+            else CodeAgentSettings(model_budget=max(50, evo.budget), n_steps=evo.n_steps, estimator=evo.estimator, wind_model=evo.wind_model)
+        )
         agent = CodeFGHHAgent(policies.generic, settings)
         agent.name = name
         return agent

@@ -179,7 +179,7 @@ class HybridAgent(Agent):
             if outcome.flight_data is not None:
                 self.trial_data.append((outcome.flight_data, dangerous))
             if len(self.trial_returns) == 2:
-                self.model = learn_model(self._model_data(), self.settings.estimator)
+                self.model = learn_model(self._model_data(), self.settings.estimator, self.settings.wind_model)
                 self.candidates += [self._evolve(f"model:{i}") for i in range(N_EVOLVED)]
             if len(self.trial_returns) < N_EVOLVED + 2:
                 return

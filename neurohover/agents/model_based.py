@@ -15,6 +15,7 @@ import numpy as np
 from ..errors import NeurohoverError
 from ..evaluate import evaluate
 from ..flightdata import FlightData
+from ..models.lr import lr_determined
 from ..models.transitions import MIN_TRANSITIONS
 from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
@@ -30,7 +31,8 @@ class ModelEvolution:
     ``budget`` episodes on the model per evolution (steady state, paper Table 6 otherwise);
     ``predict_episodes`` model episodes to predict the evolved policy's return; ``estimator`` the
     least-squares estimator of the LR model (:func:`learn_model`): ``"ols"`` (default, the paper's)
-    or ``"gls"``; ``device`` where those episodes fly (``"cpu"`` or ``"cuda"``, docs/gpu.md).
+    or ``"gls"``; ``wind_model`` its wind: ``"none"`` (default, the paper's wind-blind model),
+    ``"constant"`` or ``"sinusoid"`` (:mod:`neurohover.models.wind`); ``device`` where those episodes fly (``"cpu"`` or ``"cuda"``, docs/gpu.md).
     """
 
     budget: int = 2000
@@ -38,32 +40,39 @@ class ModelEvolution:
     n_steps: int = EPISODE_STEPS
     estimator: str = "ols"
     device: str = "cpu"
+    wind_model: str = "none"
 
     def __post_init__(self) -> None:
         from ..evaluate import check_device
         from ..models import ESTIMATORS
+        from ..models.wind import WIND_MODELS
 
         if self.estimator not in ESTIMATORS:
             raise NeurohoverError(f"estimator={self.estimator!r} is not allowed: choose one of {', '.join(ESTIMATORS)}")
+        if self.wind_model not in WIND_MODELS:
+            raise NeurohoverError(f"wind_model={self.wind_model!r} is not allowed: choose one of {', '.join(WIND_MODELS)}")
         check_device(self.device)
 
 
-def learn_model(flight_data: FlightData, estimator: str = "ols") -> MDP:
+def learn_model(flight_data: FlightData, estimator: str = "ols", wind_model: str = "none") -> MDP:
     """The LR model (the paper's best method) of the flight data, as an MDP.
 
     ``estimator="ols"`` (default): ordinary least squares, as the paper and the authors' code;
     ``"gls"``: the AR(1) quasi-differencing option (:func:`neurohover.models.learn_lr`). Intercepts
-    are LR's default, ``"uv"`` (D_v and the model's D_u).
+    are LR's default, ``"uv"`` (D_v and the model's D_u). ``wind_model``: ``"none"`` (default, the
+    paper's), ``"constant"`` or ``"sinusoid"``, a world-frame wind identified from the data.
     """
     from ..models import learn_lr
 
-    return learn_lr(flight_data, estimator=estimator).mdp()
+    return learn_lr(flight_data, estimator=estimator, wind_model=wind_model).mdp()
 
 
 def enough_to_learn(flight_data: FlightData) -> bool:
-    """Whether ``flight_data`` hold the transitions a model needs (``MIN_TRANSITIONS``): an agent
-    whose flights crash within a few steps flies again to gather more before it learns."""
-    return flight_data.n_transitions >= MIN_TRANSITIONS
+    """Whether ``flight_data`` determine an LR model (``MIN_TRANSITIONS`` transitions, regressors of
+    full rank; :func:`neurohover.models.lr.lr_determined`): an agent whose flights crash within a
+    few steps flies again to gather more before it learns. (Twenty one-step crashes give twenty
+    transitions that all start from rest: u never varies.)"""
+    return flight_data.n_transitions >= MIN_TRANSITIONS and lr_determined(flight_data)
 
 
 def evolve_on_model(model: MDP, prototype: Policy, settings: ModelEvolution, seed: int) -> tuple[Policy, float]:
@@ -106,7 +115,7 @@ class ModelBasedAgent(Agent):
         if self.policy is None and outcome.flight_data is not None:
             self.flight_data = outcome.flight_data if self.flight_data is None else self.flight_data + outcome.flight_data
             if enough_to_learn(self.flight_data):  # a generic that crashed at once flies again first
-                model = learn_model(self.flight_data, self.settings.estimator)
+                model = learn_model(self.flight_data, self.settings.estimator, self.settings.wind_model)
                 self.policy, _ = evolve_on_model(model, self.generic, self.settings, int(self._rng.integers(2**62)))
 
 
@@ -165,7 +174,7 @@ class IncrementalModelBasedAgent(Agent):
         assert self.flight_data is not None  # the first episode is always recorded
         if not enough_to_learn(self.flight_data):  # the policy crashed at once: fly it again first
             return
-        model = learn_model(self.flight_data, self.settings.estimator)
+        model = learn_model(self.flight_data, self.settings.estimator, self.settings.wind_model)
         self.models_learned += 1
         self.current, self.predicted = evolve_on_model(model, self.generic, self.settings, int(self._rng.integers(2**62)))
         self.current_label = f"model:{self.models_learned}"

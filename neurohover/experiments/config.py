@@ -194,6 +194,7 @@ _GROUP = {
     "hybrid": ({}, _table()),  # hybrid agents: replacement, model_from, rule, box, tilt (HybridSettings)
     "settings": (_OMIT, _table()),  # an agent's own typed settings (its spec's settings class), for agents that read them from it
     "estimator": ("ols", _choice("ols", "gls")),  # least squares of the LR models an agent learns
+    "wind_model": (_OMIT, _choice("none", "constant", "sinusoid")),  # and their wind (neurohover.models.wind; absent: none)
     "sensor": (_OMIT, _sensor_table()),  # this group's agents fly the group's MDPs through these sensors
     "drift": (_OMIT, _drift_table()),  # and with these drifting dynamics (neurohover.tasks.drift)
 }

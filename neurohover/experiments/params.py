@@ -87,6 +87,7 @@ class TestRunParams:
     mdp: dict
     policies: dict
     estimator: str = "ols"
+    wind_model: str = "none"
     sensor: dict | None = None
     hybrid: dict | None = None
     agent_settings: dict | None = None

@@ -388,6 +388,7 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dic
                             "mdp": mdp.to_dict(),
                             "policies": policies,
                             "estimator": g.estimator,
+                            **({"wind_model": g.wind_model} if g.wind_model != "none" else {}),  # absent: unit keys as before winds
                             **({"sensor": sensor} if sensor is not None else {}),
                             **({"hybrid": hybrid} if hybrid else {}),
                             **({"agent_settings": g.settings} if g.settings is not None else {}),

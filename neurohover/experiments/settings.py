@@ -39,6 +39,7 @@ class Group:
     hybrid: dict
     settings: dict | None = None  # the agent's own typed settings, as a table
     estimator: str = "ols"
+    wind_model: str = "none"  # the wind of the LR models its agents learn
     sensor: dict | None = None  # this group's sensors (None: the experiment's)
     drift: dict | None = None  # this group's drifting dynamics (None: the experiment's)
 

@@ -263,7 +263,9 @@ def unit_agent(p: dict, device: str = "cpu"):
         safe=tuple(_policy(d) for d in pol.get("safe", ())),
     )
     options = AgentOptions(
-        evolution=ModelEvolution(budget=q.model_budget, predict_episodes=q.predict_episodes, n_steps=q.n_steps, estimator=q.estimator, device=device),
+        evolution=ModelEvolution(
+            budget=q.model_budget, predict_episodes=q.predict_episodes, n_steps=q.n_steps, estimator=q.estimator, device=device, wind_model=q.wind_model
+        ),
         settings=None if spec.settings is None else spec.settings.from_unit(p),  # the agent's own, typed (from its UNIT_KEY)
     )
     return spec.build(policies, options)

@@ -1,8 +1,9 @@
 """Learning helicopter models from flight data: LR, EC-MENO and EC-MER (paper Section 3.2; docs/model.md, Learned models).
 
 A learned model has the simulator's equations but integrates once per 0.1 s control step (one
-substep, no wind) with its own 11 dynamics parameters and 6 gust-noise standard deviations, so it
-flies in the same compiled kernel as the true MDPs (:meth:`LearnedModel.mdp`).
+substep; no wind, as in the paper, unless LR is asked for one) with its own 11 dynamics parameters
+and 6 gust-noise standard deviations, so it flies in the same compiled kernel as the true MDPs
+(:meth:`LearnedModel.mdp`).
 
 Methods
 -------
@@ -27,6 +28,10 @@ Modules
     :func:`learn_lr`.
 ``ec``
     :func:`learn_ec_meno`, :func:`learn_ec_mer` and :func:`observed_return`.
+``wind``
+    :class:`WindModel`: a learned model's world-frame wind (constant or sinusoidal), identified by
+    ``learn_lr(..., wind_model=...)``, and :func:`effective_wind`, what of a true wind a model
+    sampled at 10 Hz can see.
 
 Every public name is importable from ``neurohover.models`` itself.
 
@@ -41,7 +46,7 @@ Example
 
 from ..sim.constants import NOISE_NAMES, PARAM_NAMES
 from .ec import EC_MENO_MAX_EVALUATIONS, EC_MENO_SCALINGS, ec_meno_gene_scale, learn_ec_meno, learn_ec_mer, observed_return
-from .lr import DEFAULT_ESTIMATOR, DEFAULT_INTERCEPTS, ESTIMATORS, INTERCEPTS, learn_lr
+from .lr import DEFAULT_ESTIMATOR, DEFAULT_INTERCEPTS, ESTIMATORS, INTERCEPTS, learn_lr, lr_determined
 from .model import (
     AXIS_C,
     AXIS_GAINS,
@@ -57,22 +62,31 @@ from .model import (
     parameter_table,
 )
 from .transitions import MIN_TRANSITIONS, OneStepProblem, Transitions, noise_from_residuals, one_step_error
+from .wind import DEFAULT_WIND_MODEL, NO_WIND, WIND_MODELS, WindAxis, WindModel, effective_wind, fit_wind
 
 __all__ = [
     "DEFAULT_ESTIMATOR",
     "DEFAULT_INTERCEPTS",
+    "DEFAULT_WIND_MODEL",
     "EC_MENO_SCALINGS",
     "ESTIMATORS",
     "FORMAT",
     "INTERCEPTS",
     "LearnedModel",
+    "NO_WIND",
     "OneStepProblem",
     "ParamRow",
+    "WIND_MODELS",
+    "WindAxis",
+    "WindModel",
+    "effective_wind",
+    "fit_wind",
     "equivalent_params",
     "format_parameter_table",
     "learn_ec_mer",
     "learn_ec_meno",
     "learn_lr",
+    "lr_determined",
     "ec_meno_gene_scale",
     "observed_return",
     "one_step_error",

@@ -64,10 +64,11 @@ import numpy as np
 from ..errors import NeurohoverError
 from ..flightdata import FlightData
 from ..sim.constants import NOISE_DECAY, NOISE_NAMES, PARAM_NAMES
-from .model import LearnedModel
-from .transitions import Transitions, noise_from_residuals
+from .model import LearnedModel, one_substep_params
+from .transitions import MIN_TRANSITIONS, Transitions, noise_from_residuals
+from .wind import DEFAULT_WIND_MODEL, NO_WIND, WIND_MODELS, body_wind, fit_wind
 
-__all__ = ["DEFAULT_ESTIMATOR", "DEFAULT_INTERCEPTS", "ESTIMATORS", "INTERCEPTS", "learn_lr"]
+__all__ = ["DEFAULT_ESTIMATOR", "DEFAULT_INTERCEPTS", "ESTIMATORS", "INTERCEPTS", "learn_lr", "lr_determined"]
 
 INTERCEPTS = ("v", "uv", "all", "none")
 DEFAULT_INTERCEPTS = "uv"
@@ -75,7 +76,25 @@ ESTIMATORS = ("ols", "gls")
 DEFAULT_ESTIMATOR = "ols"
 
 
-def learn_lr(flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS, *, estimator: str = DEFAULT_ESTIMATOR) -> LearnedModel:
+def _intercept(axis: int, intercepts: str) -> bool:
+    """Whether LR fits a constant on ``axis`` (0-5: u, v, w, p, q, r) under ``intercepts``."""
+    return intercepts == "all" or (axis == 1 and intercepts in ("v", "uv")) or (axis == 0 and intercepts == "uv")
+
+
+def lr_determined(flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS) -> bool:
+    """Whether the flight data determine every axis of an LR model (enough transitions, regressors of
+    full rank): one-step episodes all start from the same state, so their u column is constant.
+
+    GLS (quasi-differenced regressors) may still find an axis undetermined where this says yes."""
+    if flight_data.n_transitions < MIN_TRANSITIONS:
+        return False
+    tr = Transitions(flight_data)
+    return all(np.linalg.matrix_rank(x) == x.shape[1] for x in (tr.regressors(axis, _intercept(axis, intercepts))[0] for axis in range(6)))
+
+
+def learn_lr(
+    flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS, *, estimator: str = DEFAULT_ESTIMATOR, wind_model: str = DEFAULT_WIND_MODEL
+) -> LearnedModel:
     """Learn a model by least squares (docs/model.md, Learned models, "LR"; module docstring for every detail).
 
     Parameters
@@ -92,6 +111,11 @@ def learn_lr(flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS, *, e
         ``"ols"`` (default): ordinary least squares, the paper's and the agents' estimator (biased
         for the simulator's parameters by the AR(1) gusts; the best one-step predictor).
         ``"gls"``: quasi-differencing with the gusts' known AR(1) coefficient 0.8 (consistent).
+    wind_model : {"none", "constant", "sinusoid"}
+        ``"none"`` (default): the paper's wind-blind model. Otherwise a world-frame wind per
+        horizontal axis, constant or sinusoidal (:func:`neurohover.models.wind.fit_wind`); the u
+        and v axes then keep the default helicopter's C_u, C_v and D_v and have no D_u, whatever
+        ``intercepts`` says for them (the other axes are fitted as without a wind).
 
     Returns
     -------
@@ -104,14 +128,15 @@ def learn_lr(flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS, *, e
         raise NeurohoverError(f"intercepts={intercepts!r} is not allowed: choose one of {', '.join(INTERCEPTS)}")
     if estimator not in ESTIMATORS:
         raise NeurohoverError(f"estimator={estimator!r} is not allowed: choose one of {', '.join(ESTIMATORS)}")
+    if wind_model not in WIND_MODELS:
+        raise NeurohoverError(f"wind_model={wind_model!r} is not allowed: choose one of {', '.join(WIND_MODELS)}")
     tr = Transitions(flight_data)
     y = tr.targets()
     params = np.zeros(11)
     se = np.zeros(11)
     discarded: dict[str, float] = {}
     for axis in range(6):
-        intercept = intercepts == "all" or (axis == 1 and intercepts in ("v", "uv")) or (axis == 0 and intercepts == "uv")
-        x, idx = tr.regressors(axis, intercept)
+        x, idx = tr.regressors(axis, _intercept(axis, intercepts))
         target = y[:, axis]
         if estimator == "gls":
             x = (x[1:] - NOISE_DECAY * x[:-1])[tr.pair]
@@ -132,8 +157,19 @@ def learn_lr(flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS, *, e
             else:
                 discarded[NOISE_NAMES[axis]] = float(theta[col])
     d_u = discarded.pop("u", 0.0) if intercepts == "uv" else 0.0  # "uv" keeps the u constant as D_u
+    wind, wind_stats = NO_WIND, dict[str, float]()
+    if wind_model != "none":
+        blind = tr.model_residuals(params)[0]
+        blind[:, 0] -= d_u
+        held = one_substep_params()[0]  # the default helicopter's C_u, C_v, D_v in the model's integration
+        wind, params[0], params[1], wind_stats = fit_wind(tr, wind_model, float(held[0]), float(held[1]), float(held[2]))
+        params[2], d_u = held[2], 0.0
+        discarded.pop("u", None)
+        wind_stats["uv_residual_rms_wind_blind"] = float(np.sqrt(np.mean(blind[:, :2] ** 2)))
     residuals = tr.model_residuals(params)[0]
     residuals[:, 0] -= d_u
+    if wind_model != "none":
+        residuals[:, 0:2] -= np.array([params[0], params[1]]) * body_wind(tr, wind)
     noise, stationary = noise_from_residuals(tr, residuals)
     seconds = time.perf_counter() - start
     stats = {
@@ -145,5 +181,7 @@ def learn_lr(flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS, *, e
         "discarded_intercepts": discarded,
         "residual_rms": np.sqrt(np.mean(residuals**2, axis=0)).tolist(),
         "noise_std_stationary": stationary.tolist(),
+        "wind_model": wind_model,
+        **wind_stats,
     }
-    return LearnedModel(tuple(params), tuple(noise), "lr", seconds, stats, d_u)
+    return LearnedModel(tuple(params), tuple(noise), "lr", seconds, stats, d_u, wind)

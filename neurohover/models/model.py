@@ -38,6 +38,7 @@ import numpy as np
 from ..errors import NeurohoverError
 from ..sim.constants import CONTROL_DT, DEFAULT_NOISE_STD, DEFAULT_PARAMS, NOISE_NAMES, PARAM_NAMES, SUBSTEP_DT, SUBSTEPS
 from ..tasks import MDP, finite_vector
+from .wind import NO_WIND, WindModel
 
 __all__ = [
     "AXIS_C",
@@ -94,7 +95,7 @@ def check_vector(values, length: int, what: str, nonnegative: bool = False) -> t
 
 @dataclass(frozen=True)
 class LearnedModel:
-    """A helicopter model learned from flight data (one 0.1 s substep per control step, no wind).
+    """A helicopter model learned from flight data (one 0.1 s substep per control step).
 
     Attributes
     ----------
@@ -106,8 +107,11 @@ class LearnedModel:
         ``"lr"``, ``"ec-meno"`` or ``"ec-mer"``.
     d_u : float
         Constant body-frame u acceleration (D_u): the u constant fitted by LR with intercepts
-        ``"uv"`` (the default); 0 for every other intercepts choice and for EC-MENO and EC-MER,
-        which do not evolve it.
+        ``"uv"`` (the default); 0 for every other intercepts choice, for EC-MENO and EC-MER,
+        which do not evolve it, and for a model with a wind.
+    wind : WindModel
+        Its world-frame wind (:mod:`neurohover.models.wind`): none (the paper's wind-blind model,
+        the default), constant or sinusoidal, as LR's ``wind_model`` identified it.
     seconds : float
         Wall time spent learning it (not part of ``==``: two fits of the same data are equal).
     stats : dict
@@ -120,6 +124,7 @@ class LearnedModel:
     seconds: float = field(default=0.0, compare=False)  # wall-clock: equal fits stay equal
     stats: dict = field(default_factory=dict, compare=False)
     d_u: float = 0.0
+    wind: WindModel = NO_WIND
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "params", check_vector(self.params, 11, "model parameters " + "/".join(PARAM_NAMES)))
@@ -132,13 +137,18 @@ class LearnedModel:
             raise NeurohoverError("stats must be a dict")
         if not isinstance(self.d_u, (int, float)) or not math.isfinite(self.d_u):
             raise NeurohoverError(f"d_u={self.d_u!r} must be a finite number")
+        if not isinstance(self.wind, WindModel):
+            raise NeurohoverError(f"wind must be a WindModel, got {self.wind!r:.80}")
 
     def mdp(self, label: str | None = None) -> MDP:
-        """The model as an MDP for the kernel: family ``"model"``, one 0.1 s substep, no wind."""
+        """The model as an MDP for the kernel: family ``"model"``, one 0.1 s substep, its wind (if any)."""
+        wind_kind, wind = self.wind.mdp_wind()
         return MDP(
             "model",
             params=self.params,
             noise_std=self.noise_std,
+            wind_kind=wind_kind,
+            wind=wind,
             substeps=1,
             dt=MODEL_DT,
             label=label if label is not None else f"model/{self.method}",
@@ -163,6 +173,7 @@ class LearnedModel:
             "noise_names": list(NOISE_NAMES),
             "noise_std": list(self.noise_std),
             "d_u": float(self.d_u),
+            "wind": self.wind.to_dict(),
             "seconds": float(self.seconds),
             "stats": self.stats,
         }
@@ -178,7 +189,8 @@ class LearnedModel:
         if "param_names" in d and list(d["param_names"]) != list(PARAM_NAMES):
             raise NeurohoverError(f"{source}: parameters are named {d['param_names']}, expected {list(PARAM_NAMES)}")
         try:
-            return cls(d["params"], d["noise_std"], d["method"], float(d.get("seconds", 0.0)), dict(d.get("stats", {})), float(d.get("d_u", 0.0)))
+            wind = WindModel.from_dict(d["wind"], "wind") if "wind" in d else NO_WIND  # files before winds: none
+            return cls(d["params"], d["noise_std"], d["method"], float(d.get("seconds", 0.0)), dict(d.get("stats", {})), float(d.get("d_u", 0.0)), wind)
         except NeurohoverError as err:
             raise NeurohoverError(f"{source}: {err}") from None
         except (TypeError, ValueError) as err:

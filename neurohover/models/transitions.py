@@ -18,6 +18,7 @@ from ..flightdata import FlightData
 from ..sim.constants import GRAVITY, NOISE_DECAY, NOISE_GAIN, NOISE_NAMES, PARAM_NAMES
 from ..tasks import MDP
 from .model import AXIS_C, AXIS_GAINS, MODEL_DT, LearnedModel, check_vector
+from .wind import NO_WIND, WindModel, body_wind
 
 __all__ = ["MIN_TRANSITIONS", "OneStepProblem", "Transitions", "noise_from_residuals", "one_step_error"]
 
@@ -67,6 +68,8 @@ class Transitions:
         Observations at k (N, 12), at k+1 (N, 12) and actions at k (N, 4).
     first : numpy.ndarray of bool
         Whether transition k is the first of its episode.
+    step : numpy.ndarray of int64
+        The control step of each transition within its episode (0 first): a wind's time.
     R, Rn : numpy.ndarray
         Body-to-world rotations (N, 3, 3) at k and k+1; ``qw`` the scalar part at k.
     V, Vn : numpy.ndarray
@@ -100,6 +103,7 @@ class Transitions:
         first = np.zeros(n, dtype=bool)
         first[np.cumsum([0] + [a.shape[0] for _, a in episodes[:-1]])] = True
         self.obs, self.nxt, self.act, self.first = obs, nxt, act, first
+        self.step = np.concatenate([np.arange(a.shape[0], dtype=np.int64) for _, a in episodes])
         self.n = n
         self.n_episodes = len(episodes)
         self.R, self.qw = _rotations(obs[:, 9:12])
@@ -251,6 +255,7 @@ class OneStepProblem:
             jac[:, 6 + j, AXIS_GAINS[3 + j][0]] = MODEL_DT * a[:, j]
         r0 = base - tr.nxt
         self.du_jac = MODEL_DT * m[:, :, 0]  # effect of D_u on the next body velocity (N, 3)
+        self.dv_jac = MODEL_DT * m[:, :, 1]  # and of a body v acceleration (a wind's)
         self.base, self.jac = base, jac
         self.n = n
         self._h = np.einsum("nij,nik->jk", jac, jac)
@@ -299,11 +304,14 @@ class OneStepProblem:
         ``regressor_ms()[i] * d**2`` when parameter i alone moves by d (the diagonal curvature)."""
         return np.diag(self._h) / self.n
 
-    def predict(self, params, d_u: float = 0.0) -> np.ndarray:
-        """Predicted next observations (N, 12) of one model's 11 parameters (and its D_u)."""
+    def predict(self, params, d_u: float = 0.0, wind: WindModel = NO_WIND) -> np.ndarray:
+        """Predicted next observations (N, 12) of one model's 11 parameters (and its D_u and wind)."""
         theta = np.array(check_vector(params, 11, "model parameters"))
         pred = self.base + self.jac @ theta
         pred[:, 0:3] += d_u * self.du_jac
+        if wind.kind != "none":  # the wind's body accelerations C_u wb_u and C_v wb_v
+            wb = body_wind(self.transitions, wind)
+            pred[:, 0:3] += (theta[0] * wb[:, 0])[:, None] * self.du_jac + (theta[1] * wb[:, 1])[:, None] * self.dv_jac
         return pred
 
     def errors(self, params) -> np.ndarray | float:
@@ -330,13 +338,14 @@ def _params_of(model) -> np.ndarray:
 def one_step_error(model, flight_data: FlightData | OneStepProblem):
     """Mean squared noise-free one-step prediction error of the 12-number observation.
 
-    ``model`` is a LearnedModel, a one-substep model MDP, 11 parameters, or an (n, 11) array of
-    parameter sets (then an array of n errors comes back). The error of a transition is the sum of
+    ``model`` is a LearnedModel (with its D_u and wind), a one-substep model MDP without wind, 11
+    parameters, or an (n, 11) array of parameter sets (then an array of n errors comes back). The error of a transition is the sum of
     squares over the 12 observation entries; the mean is over all transitions.
     """
     problem = flight_data if isinstance(flight_data, OneStepProblem) else OneStepProblem(flight_data)
     d_u = model.d_u if isinstance(model, (LearnedModel, MDP)) else 0.0
-    if d_u != 0.0:
-        residual = problem.predict(_params_of(model), d_u) - problem.transitions.nxt
+    wind = model.wind if isinstance(model, LearnedModel) else NO_WIND
+    if d_u != 0.0 or wind.kind != "none":
+        residual = problem.predict(_params_of(model), d_u, wind) - problem.transitions.nxt
         return float(np.einsum("ij,ij->", residual, residual)) / problem.n
     return problem.errors(_params_of(model))
