@@ -38,6 +38,7 @@ from neurohover.experiments.store import SCHEMA_VERSION
 PAPER_EXPERIMENTS = ["fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16"]
 ABLATIONS = ["ablation-plateau", "ablation-hybrid", "ablation-fghh"]
 BENCHMARKS = ["bench-sensors", "bench-drift"]  # the harder benchmarks of the paper's Section 7 (docs/benchmarks.md)
+BEYOND = ["wind-fig8", "wind-fig11"]  # what the paper's conclusions predict and it could not run (docs/model.md)
 
 # A small evolution experiment whose units take ~0.3 s each (for the interruption tests).
 SLOW_CONFIG = """
@@ -72,8 +73,8 @@ def _write(tmp_path: Path, text: str, name: str = "exp.toml") -> Path:
 
 
 def test_every_experiment_of_the_paper_is_shipped_at_both_scales() -> None:
-    assert experiment_names() == PAPER_EXPERIMENTS + ABLATIONS + BENCHMARKS
-    for name in PAPER_EXPERIMENTS + ABLATIONS + BENCHMARKS:
+    assert experiment_names() == PAPER_EXPERIMENTS + ABLATIONS + BENCHMARKS + BEYOND
+    for name in PAPER_EXPERIMENTS + ABLATIONS + BENCHMARKS + BEYOND:
         for scale in ("quick", "paper"):
             cfg = load_config(name, scale)
             assert cfg.name == name and cfg.scale == scale and len(cfg.hash) == 16
@@ -135,7 +136,7 @@ def test_unknown_experiment_lists_the_known_ones(cli, tmp_path: Path) -> None:
     rc, _, stderr = cli("reproduce", "fig99", "--store", str(tmp_path / "s.sqlite"))
     assert rc == 2 and "unknown experiment 'fig99'" in stderr and "fig16" in stderr
     rc, out, _ = cli("reproduce", "--list")
-    assert rc == 0 and out.split() == PAPER_EXPERIMENTS + ABLATIONS + BENCHMARKS
+    assert rc == 0 and out.split() == PAPER_EXPERIMENTS + ABLATIONS + BENCHMARKS + BEYOND
 
 
 @pytest.mark.parametrize(
@@ -517,7 +518,7 @@ def test_the_commands_are_registered_in_the_cli(capsys) -> None:
 
     assert "neurohover.commands_reproduce" in cli.COMMAND_MODULES
     assert cli.main(["reproduce", "--list"]) == 0
-    assert capsys.readouterr().out.split() == PAPER_EXPERIMENTS + ABLATIONS + BENCHMARKS
+    assert capsys.readouterr().out.split() == PAPER_EXPERIMENTS + ABLATIONS + BENCHMARKS + BEYOND
 
 
 @pytest.mark.paper
