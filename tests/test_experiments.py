@@ -421,6 +421,8 @@ def test_report_draws_the_figures_and_compares_with_the_paper(quick_store: Path,
         "Student's p",
         "Welch's p",
         "runs with a crash",  # t tests, crashes
+        "### Winning a competition",
+        "P(win), 20 runs",
         "## Figure 15",
         "Scale: **quick**",
         "core(s) (local)",

@@ -14,6 +14,7 @@ Error is minus the return (lower is better), as in the paper's plots.
 
 from __future__ import annotations
 
+import json
 import time
 from pathlib import Path
 
@@ -26,6 +27,10 @@ from .report_evolution import EvolutionSection
 from .results import ModelResult, TestRunResult, result_from_dict
 from .settings import Group
 from .store import Store
+from .wins import DEFAULT_DRAWS, win_probabilities
+
+#: Competition lengths the report gives win odds for (the paper's analysis of GHH-09: 20 runs).
+WIN_RUNS = (1, 5, 20)
 
 
 class _ModelLearning(Section):
@@ -144,6 +149,36 @@ class _TestRuns(Section):
             + "\n\nEach cell: the fraction of all the group's episodes that crashed (the median over runs of the cumulative reward).\n\n"
         )
 
+    def _wins(self) -> str:
+        """Each agent's bootstrap probability of winning competitions of 1, 5 and 20 runs against the
+        section's other groups that flew the same MDPs (the same sensors and drift)."""
+        by_condition: dict[str, list[str]] = {}
+        for g in self.groups():
+            if self.runs(g.label):
+                by_condition.setdefault(json.dumps([g.sensor, g.drift], sort_keys=True), []).append(g.label)
+        rows = []
+        for group in by_condition.values():
+            runs: dict[str, dict[str, list[float]]] = {}
+            for label in group:
+                for r in self.runs(label):
+                    runs.setdefault(label, {}).setdefault(r.mdp, []).append(float(r.score))
+            common = set.intersection(*(set(m) for m in runs.values())) if len(runs) > 1 else set()
+            if not common:
+                continue
+            odds = {n: win_probabilities(runs, n, seed=self.s.seed) for n in WIN_RUNS}
+            for label in group:
+                rows.append([label, str(len(common)), *(f"{odds[n][label]:.1%}" for n in WIN_RUNS)])
+        if not rows:
+            return ""
+        return (
+            "### Winning a competition\n\n"
+            + table(["agent", "MDPs shared", *(f"P(win), {n} run{'s' if n > 1 else ''}" for n in WIN_RUNS)], rows)
+            + f"\n\nEach agent's probability of the highest total cumulative reward in a competition of N runs against the other "
+            f"{'groups that flew the same MDPs (sensors, drift)' if len(by_condition) > 1 else 'groups'}: {DEFAULT_DRAWS:,} simulated competitions, each "
+            "N of the MDPs every agent flew (with replacement) and, on each, one of the agent's stored runs there; ties share "
+            "the win (neurohover.experiments.wins; binomial standard error at most 0.5 %).\n\n"
+        )
+
     def body(self) -> str:
         ref = self.paper.get("groups", {})
         rows, samples, labels = [], {}, {}
@@ -189,6 +224,7 @@ class _TestRuns(Section):
         self.add_tests(samples, labels, "final cumulative reward")
         return (
             self._matrix()
+            + self._wins()
             + "### Test runs\n\n"
             + table(
                 [

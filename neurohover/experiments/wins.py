@@ -1,0 +1,89 @@
+"""The competition simulator (issue 22): from stored test runs, each agent's probability of winning a
+competition of N runs against the others.
+
+A competition, as the RL Competitions ran GHH: every agent flies one test run on each of N MDPs
+drawn from the task family, and the agent with the highest total cumulative reward wins. One crash
+costs about 1e7, so the agent best in expectation need not win most often (the paper: "the optimal
+amount of risk aversion is a function of known factors such as the number of test runs"). We
+estimate the odds by the bootstrap: each simulated competition draws N of the MDPs that every agent
+flew (with replacement) and, for each agent and MDP, one of its stored runs there; ties share the
+win. Drawing MDPs first keeps the agents paired on the same MDPs, as in a competition.
+"""
+
+from __future__ import annotations
+
+import numbers
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from ..errors import NeurohoverError
+
+__all__ = ["DEFAULT_DRAWS", "WinOdds", "win_probabilities"]
+
+DEFAULT_DRAWS = 10_000
+_MAX_CELLS = 50_000_000  # draws x runs per agent held at once: about 400 MB of float64
+
+
+class WinOdds(dict):
+    """Agent -> probability of winning (a dict), with ``n_runs``, ``draws``, ``mdps`` (MDPs shared by every agent)."""
+
+    n_runs: int
+    draws: int
+    mdps: int
+
+    def standard_error(self, agent: str) -> float:
+        """The bootstrap estimate's binomial standard error."""
+        p = self[agent]
+        return float(np.sqrt(p * (1.0 - p) / self.draws))
+
+
+def win_probabilities(runs: Mapping[str, Mapping[str, Sequence[float]]], n_runs: int, draws: int = DEFAULT_DRAWS, seed: int = 0) -> WinOdds:
+    """Each agent's probability of the highest total over a competition of ``n_runs`` runs.
+
+    Parameters
+    ----------
+    runs : mapping
+        Agent label -> {MDP label -> the cumulative rewards of its runs on that MDP}. Only MDPs that
+        every agent flew take part.
+    n_runs : int
+        Runs in a competition (the RL Competitions: one per MDP; 20 for GHH-09's paper analysis).
+    draws : int
+        Simulated competitions.
+    seed : int
+        Seed of the bootstrap (results depend on nothing else).
+
+    Returns
+    -------
+    WinOdds
+        Agent -> probability; the probabilities sum to 1.
+    """
+    for name, value, low in (("n_runs", n_runs, 1), ("draws", draws, 1), ("seed", seed, 0)):
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < low:
+            raise NeurohoverError(f"{name}={value!r} is out of range: allowed an integer >= {low}")
+    if draws * n_runs > _MAX_CELLS:
+        raise NeurohoverError(f"draws x n_runs = {draws * n_runs:,} is too large: at most {_MAX_CELLS:,} simulated runs per agent at once")
+    agents = list(runs)
+    if len(agents) < 2:
+        raise NeurohoverError(f"a competition needs at least two agents, got {agents}")
+    common = sorted(set.intersection(*(set(m for m, s in runs[a].items() if len(s)) for a in agents)))
+    if not common:
+        raise NeurohoverError(f"the agents {', '.join(agents)} flew no MDP in common: their runs cannot be paired into competitions")
+    rng = np.random.default_rng(seed)
+    picks = rng.integers(len(common), size=(draws, n_runs))
+    totals = np.empty((len(agents), draws))
+    for i, agent in enumerate(agents):
+        pools = [np.asarray(runs[agent][m], dtype=float) for m in common]
+        if not all(np.all(np.isfinite(p)) for p in pools):
+            raise NeurohoverError(f"agent {agent!r} has a run whose score is not a finite number")
+        counts = np.array([p.size for p in pools])
+        flat = np.concatenate(pools)
+        start = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        which = (rng.random((draws, n_runs)) * counts[picks]).astype(np.int64)
+        totals[i] = flat[start[picks] + which].sum(axis=1)
+    best = totals.max(axis=0)
+    winners = totals == best
+    share = winners / winners.sum(axis=0)  # ties share the win
+    odds = WinOdds({a: float(share[i].mean()) for i, a in enumerate(agents)})
+    odds.n_runs, odds.draws, odds.mdps = n_runs, draws, len(common)
+    return odds
