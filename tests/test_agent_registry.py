@@ -33,6 +33,9 @@ def test_the_paper_agents_are_registered_with_their_tasks() -> None:
         "authors-fixed",
         "authors-race",
         "continual",
+        "model-free-risk",
+        "hybrid-risk",
+        "hybrid-baseline-risk",
     }
     assert HYBRID_AGENTS == ("hybrid", "hybrid-baseline")
     assert AGENTS["model-free"].tasks == ("ghh08", "ghh09") and AGENTS["incremental-race"].tasks == ("fghh",)

@@ -382,3 +382,54 @@ def test_agents_keep_flying_while_their_flight_data_do_not_determine_a_model() -
         for e in range(MIN_TRANSITIONS + 5):
             assert agent.choose(e).label == "generic"
             agent.update(EpisodeOutcome(e, -1e7, True, 1, -1, _one_step_crashes(1)))
+
+
+def test_risk_scores_and_settings() -> None:
+    from neurohover.agents.risk import RiskSettings
+
+    values = [-100.0, -120.0, -1e6]
+    assert RiskSettings("mean").score(values) == pytest.approx(np.mean(values))
+    assert RiskSettings("worst").score(values) == -1e6
+    lcb = RiskSettings("lcb", level=2.0).score(values)
+    assert lcb == pytest.approx(np.mean(values) - 2.0 * np.std(values, ddof=1) / np.sqrt(3))
+    assert RiskSettings("lcb").score([-5.0]) == -5.0  # one episode: no spread known
+    for bad, message in (({"criterion": "cvar"}, "criterion 'cvar' is not allowed"), ({"level": -1}, "level=-1 is out of range"), ({"trials": 0}, "trials=0")):
+        with pytest.raises(NeurohoverError, match=message):
+            RiskSettings.from_dict(bad)
+
+
+def test_the_risk_sensitive_model_free_agent_keeps_the_policy_that_never_crashed() -> None:
+    from neurohover.agents.risk import RiskModelFreeAgent, RiskSettings
+
+    policies = [baseline_policy(), baseline_policy()]
+    # Policy 0: better on average, but one of its two trials went badly; policy 1 steady and a little worse.
+    outcomes = {0: -50.0, 1: -1100.0, 2: -2000.0, 3: -1100.0}
+    chosen = {}
+    for criterion in ("mean", "lcb", "worst"):
+        agent = RiskModelFreeAgent(policies, RiskSettings(criterion, trials=2))
+        agent.start(get_task_family("ghh08"), np.random.default_rng(0))
+        labels = []
+        for e in range(4):
+            labels.append(agent.choose(e).label)
+            agent.update(EpisodeOutcome(e, outcomes[e], False, 10, -1, None))
+        assert labels == ["specialised:0", "specialised:1", "specialised:0", "specialised:1"]  # round robin
+        chosen[criterion] = agent.choose(4).label
+    assert chosen == {"mean": "specialised:0", "lcb": "specialised:1", "worst": "specialised:1"}
+    # Over one trial each, the mean and the risk scores agree with the paper's agent.
+    agent = RiskModelFreeAgent(policies, RiskSettings("worst", trials=1))
+    agent.start(get_task_family("ghh08"), np.random.default_rng(0))
+    for e, ret in enumerate((-50.0, -300.0)):
+        agent.update(EpisodeOutcome(e, ret, False, 10, -1, None))
+    assert agent.choose(2).label == "specialised:0" and agent.choose(2).final
+
+
+def test_the_risk_sensitive_hybrid_ranks_its_candidates_by_the_risk_score() -> None:
+    from neurohover.agents.risk import RiskHybridAgent, RiskSettings
+
+    safe = [baseline_policy(), baseline_policy()]
+    for criterion, expected in (("mean", "safe:0"), ("worst", "safe:1")):
+        agent = RiskHybridAgent(safe, baseline_policy(), baseline_policy(), risk=RiskSettings(criterion))
+        # Candidate 0: nine good episodes and one the safeguard ended (the authors' -1e6); candidate 1 steady.
+        agent.values = [[-100.0] * 9 + [DISCARD_RETURN], [-150_000.0]]
+        agent._rank()
+        assert agent.current is not None and agent.current[1] == expected, criterion

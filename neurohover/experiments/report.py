@@ -166,6 +166,12 @@ class _TestRuns(Section):
             if not common:
                 continue
             odds = {n: win_probabilities(runs, n, seed=self.s.seed) for n in WIN_RUNS}
+            if len(group) > 2:  # which agent (which risk level) to enter for each length
+                self.comparisons.append(
+                    "Best odds of winning a competition of "
+                    + "; ".join(f"{n} run{'s' if n > 1 else ''}: {max(odds[n], key=odds[n].__getitem__)} ({max(odds[n].values()):.1%})" for n in WIN_RUNS)
+                    + "."
+                )
             for label in group:
                 rows.append([label, str(len(common)), *(f"{odds[n][label]:.1%}" for n in WIN_RUNS)])
         if not rows:

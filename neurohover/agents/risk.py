@@ -1,0 +1,147 @@
+"""Risk-sensitive variants of the model-free and hybrid agents (issue 22; paper Section 4.3: "competition
+agents should also be risk sensitive").
+
+A single crash (about -1e7) decides a competition, so the candidate best in expectation need not be
+the one to fly for a whole run. These agents choose among their candidate policies by a
+risk-sensitive score of each candidate's episodes instead of its mean:
+
+=========  =====================================================================================
+criterion  score of a candidate's episode values v_1..v_n
+=========  =====================================================================================
+mean       their mean (the paper's agents)
+lcb        a lower confidence bound, ``mean - level * sd / sqrt(n)`` (sample sd; 0 for one episode)
+worst      the worst of them
+=========  =====================================================================================
+
+``model-free-risk`` flies each specialised policy ``trials`` times (round robin) and keeps the best
+by the score. ``hybrid-risk`` and ``hybrid-baseline-risk`` are the hybrid agents (authors'
+re-ranking, generic or baseline fallback, their other settings at the defaults) ranking candidates
+by the score; an episode in which the safeguard fired counts as the authors' -1e6, a near-crash.
+Settings: a test-runs group's ``settings`` table (``criterion``, ``level``, ``trials``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import NeurohoverError
+from ..policies import Policy, baseline_policy
+from .hybrid import HybridAgent
+from .model_based import ModelEvolution
+from .model_free import ModelFreeAgent
+from .protocol import Agent, Choice, EpisodeOutcome
+from .spec import AgentOptions, AgentPolicies, AgentSettings, AgentSpec
+
+CRITERIA = ("mean", "lcb", "worst")
+
+
+@dataclass(frozen=True)
+class RiskSettings(AgentSettings):
+    """How a risk-sensitive agent scores its candidates (module docstring)."""
+
+    criterion: str = "lcb"
+    level: float = 1.0
+    trials: int = 2  # model-free-risk only: episodes per specialised policy before it settles (the hybrids ignore it)
+
+    def __post_init__(self) -> None:
+        if self.criterion not in CRITERIA:
+            raise NeurohoverError(f"risk criterion {self.criterion!r} is not allowed: choose one of {', '.join(CRITERIA)}")
+        if isinstance(self.level, bool) or not isinstance(self.level, (int, float)) or not math.isfinite(self.level) or self.level < 0:
+            raise NeurohoverError(f"risk level={self.level!r} is out of range: allowed a finite number >= 0 (standard errors below the mean)")
+        if isinstance(self.trials, bool) or not isinstance(self.trials, int) or self.trials < 1:
+            raise NeurohoverError(f"risk trials={self.trials!r} is out of range: allowed an integer >= 1")
+
+    def score(self, values: Sequence[float]) -> float:
+        """The candidate's score from its episode values (higher is better)."""
+        v = np.asarray(values, dtype=float)
+        if v.size == 0:
+            raise NeurohoverError("a candidate with no episode has no score")
+        if self.criterion == "worst":
+            return float(v.min())
+        mean = float(v.mean())
+        if self.criterion == "mean" or v.size == 1:
+            return mean
+        return mean - self.level * float(v.std(ddof=1)) / math.sqrt(v.size)
+
+
+class RiskModelFreeAgent(ModelFreeAgent):
+    """The model-free agent flying each specialised policy ``trials`` times, keeping the best by a risk score."""
+
+    name = "model-free-risk"
+
+    def __init__(self, specialised: Sequence[Policy], risk: RiskSettings = RiskSettings()) -> None:
+        super().__init__(specialised)
+        self.risk = risk
+        self.trials: list[list[float]] = [[] for _ in self.specialised]
+
+    def start(self, family, rng: np.random.Generator) -> None:
+        super().start(family, rng)
+        self.trials = [[] for _ in self.specialised]
+
+    def _trying(self, episode: int) -> bool:
+        return episode < len(self.specialised) * self.risk.trials
+
+    def choose(self, episode: int) -> Choice:
+        n = len(self.specialised)
+        if self._trying(episode):
+            return Choice(self.specialised[episode % n], f"specialised:{episode % n}")
+        best = int(np.argmax([self.risk.score(t) for t in self.trials]))  # ties: the earliest
+        return Choice(self.specialised[best], f"specialised:{best}", final=True)
+
+    def update(self, outcome: EpisodeOutcome) -> None:
+        if self._trying(outcome.episode):
+            self.trials[outcome.episode % len(self.specialised)].append(outcome.ret)
+
+
+class RiskHybridAgent(HybridAgent):
+    """The hybrid agent (authors' re-ranking) ranking its candidates by a risk score instead of the mean."""
+
+    def __init__(self, safe, generic, fallback, settings: ModelEvolution = ModelEvolution(), name: str = "hybrid-risk", risk: RiskSettings = RiskSettings()):
+        super().__init__(safe, generic, fallback, settings, name=name)
+        self.risk = risk
+
+    @property
+    def scores(self) -> list[float]:
+        return [self.risk.score(v) for v in self.values]
+
+
+def _hybrid_risk(name: str, fallback: str):
+    def build(policies: AgentPolicies, options: AgentOptions) -> Agent:
+        assert policies.generic is not None
+        backup = policies.generic if fallback == "generic" else baseline_policy()
+        risk = options.settings or RiskSettings()
+        return RiskHybridAgent(policies.safe, policies.generic, backup, options.evolution or ModelEvolution(), name=name, risk=risk)
+
+    return build
+
+
+AGENT_SPECS = (
+    AgentSpec(
+        "model-free-risk",
+        "specialised",
+        frozenset({"specialised"}),
+        lambda policies, options: RiskModelFreeAgent(policies.specialised, options.settings or RiskSettings()),
+        settings=RiskSettings,
+        summary="model-free, each specialised policy flown `trials` times, the best kept by a risk score (lcb or worst)",
+    ),
+    AgentSpec(
+        "hybrid-risk",
+        "specialised",
+        frozenset({"generic", "safe"}),
+        _hybrid_risk("hybrid-risk", "generic"),
+        settings=RiskSettings,
+        summary="the hybrid agent ranking its candidates by a risk score (generic fallback)",
+    ),
+    AgentSpec(
+        "hybrid-baseline-risk",
+        "specialised",
+        frozenset({"generic", "safe"}),
+        _hybrid_risk("hybrid-baseline-risk", "baseline"),
+        settings=RiskSettings,
+        summary="the hybrid agent ranking its candidates by a risk score (baseline fallback)",
+    ),
+)
