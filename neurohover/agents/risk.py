@@ -128,20 +128,15 @@ AGENT_SPECS = (
         settings=RiskSettings,
         summary="model-free, each specialised policy flown `trials` times, the best kept by a risk score (lcb or worst)",
     ),
-    AgentSpec(
-        "hybrid-risk",
-        "specialised",
-        frozenset({"generic", "safe"}),
-        _hybrid_risk("hybrid-risk", "generic"),
-        settings=RiskSettings,
-        summary="the hybrid agent ranking its candidates by a risk score (generic fallback)",
-    ),
-    AgentSpec(
-        "hybrid-baseline-risk",
-        "specialised",
-        frozenset({"generic", "safe"}),
-        _hybrid_risk("hybrid-baseline-risk", "baseline"),
-        settings=RiskSettings,
-        summary="the hybrid agent ranking its candidates by a risk score (baseline fallback)",
+    *(
+        AgentSpec(
+            name,
+            "specialised",
+            frozenset({"generic", "safe"}),
+            _hybrid_risk(name, fallback),
+            settings=RiskSettings,
+            summary=f"the hybrid agent ranking its candidates by a risk score ({fallback} fallback)",
+        )
+        for name, fallback in (("hybrid-risk", "generic"), ("hybrid-baseline-risk", "baseline"))
     ),
 )
