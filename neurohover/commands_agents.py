@@ -38,7 +38,7 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
 def cmd_compete(args: argparse.Namespace) -> int:
     """Run R independent test runs of an agent; print a summary and write results and a plot."""
     from .agents.hybrid import HybridSettings
-    from .agents.registry import HYBRID_AGENTS
+    from .agents.registry import AGENTS, HYBRID_AGENTS
     from .cli import sensor_of
     from .compete import compete
     from .evolution.seeding import check_seed
@@ -57,6 +57,9 @@ def cmd_compete(args: argparse.Namespace) -> int:
         "model_from": args.hybrid_model_from,
     }
     hybrid = HybridSettings.from_dict({k: v for k, v in given_values.items() if v is not None})
+    if args.wind_model is not None and not AGENTS[args.agent].learns_models:
+        learners = ", ".join(name for name, spec in AGENTS.items() if spec.learns_models)
+        raise NeurohoverError(f"--wind-model applies to the agents that learn models ({learners}), not to --agent {args.agent}")
     check_device(args.device)  # before the output directory is made
     check_jobs(args.jobs)
     check_seed(args.seed)
@@ -85,6 +88,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
             device=args.device,
             sensor=sensor,
             drift=None if args.drift is None else Drift.parse(args.drift),
+            wind_model=args.wind_model or "none",
         )
     except KeyboardInterrupt:
         print(
@@ -156,6 +160,11 @@ def register(sub) -> None:
     p.add_argument("--policy-dir", help="policy sets directory (default: the shipped ones)")
     p.add_argument("--out", required=True, help="output directory (episodes.csv, summary.json, cumulative.png, results.sqlite)")
     p.add_argument("--store", help="results store to keep the runs in (default: OUT/results.sqlite); finished runs are not flown again")
+    p.add_argument(
+        "--wind-model",
+        choices=("none", "constant", "sinusoid"),
+        help="model-based agents: the wind of the LR models they learn (default none, the paper's; docs/model.md, Wind-aware models)",
+    )
     g = p.add_argument_group("hybrid agents (defaults: the authors' code; see docs/model.md, Safeguard)")
     g.add_argument("--safeguard-rule", help="code (tilted and outside the box, default) or paper (outside the box)")
     g.add_argument("--safeguard-box", type=float, help="bound on |u|..|r| of a safe state (default 0.5)")

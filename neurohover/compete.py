@@ -131,6 +131,7 @@ def competition_config(
     hybrid: HybridSettings = HybridSettings(),
     sensor: Sensor | None = None,
     drift: Drift | None = None,
+    wind_model: str = "none",
 ):
     """The inline experiment of a competition (an ``ExperimentConfig`` of kind ``test_runs``).
 
@@ -149,6 +150,8 @@ def competition_config(
     group = {"agent": agent, **_group(task, runs, mdps)}
     if agent in HYBRID_AGENTS:
         group["hybrid"] = hybrid.to_dict()
+    if wind_model != "none":  # the wind of the LR models the agent learns (absent: the digest of older competitions)
+        group["wind_model"] = wind_model
     settings: dict[str, object] = {
         "task": task,
         "sigma": sigma,
@@ -186,6 +189,7 @@ def compete(
     device: str = "cpu",
     sensor: Sensor | None = None,
     drift: Drift | None = None,
+    wind_model: str = "none",
 ) -> tuple[dict, list]:
     """Run ``runs`` test runs of ``agent`` as an inline experiment; write results and plot to ``out``.
 
@@ -210,6 +214,8 @@ def compete(
         config. The test-run units fly on the CPU whatever it says (docs/gpu.md).
     sensor, drift : Sensor, Drift, optional
         The harder task (docs/benchmarks.md): every MDP seen through ``sensor``, its dynamics drifting by ``drift``.
+    wind_model : {"none", "constant", "sinusoid"}
+        The wind of the LR models a model-based agent learns (docs/model.md, Wind-aware models).
 
     Returns
     -------
@@ -231,7 +237,7 @@ def compete(
     check_agent(agent, get_task_family(task, sigma), policy_dir)
     config = competition_config(
         task, agent, runs=runs, episodes=episodes, mdps=mdps, seed=seed, sigma=sigma, n_steps=n_steps, policy_dir=policy_dir, hybrid=hybrid,
-        sensor=sensor, drift=drift,
+        sensor=sensor, drift=drift, wind_model=wind_model,
     )  # fmt: skip
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

@@ -29,6 +29,7 @@ CASES: list[tuple[list[str], str]] = [
     (["learn-model", "--flight-data", "/proc/self/mem", "--method", "lr", "--out", "m.json"], "cannot read this flight-data file"),
     (["learn-model", "--flight-data", "missing.npz", "--method", "lr", "--out", "m.json"], "no such flight-data file"),
     (["learn-model", "--flight-data", "fd.npz", "--method", "ec-mer", "--wind-model", "sinusoid", "--out", "m.json"], "applies to --method lr only"),
+    (["compete", "--task", "ghh09", "--agent", "model-free", "--wind-model", "sinusoid", "--out", "q"], "--wind-model applies to the agents that learn models"),
     (["results", "fig2", "--store", "store.sqlite", "--out", "adir"], "is a directory"),
     (["results", "fig2", "--store", "adir"], "is a directory"),
     (["report", "--store", "store.sqlite", "--out", "afile"], "is a file; give a directory"),

@@ -160,3 +160,13 @@ def test_learn_model_command_writes_the_wind_and_refuses_it_for_evolved_models(g
     assert "identified wind (world frame" in capsys.readouterr().err
     assert main(["learn-model", "--flight-data", str(path), "--method", "ec-meno", "--wind-model", "constant", "--out", str(out)]) == 2
     assert "--wind-model applies to --method lr only" in capsys.readouterr().err
+
+
+def test_a_competition_hands_the_wind_model_to_its_agent_and_keeps_older_digests() -> None:
+    from neurohover.compete import competition_config
+
+    plain = competition_config("ghh09", "hybrid", runs=2, episodes=3)
+    windy = competition_config("ghh09", "hybrid", runs=2, episodes=3, wind_model="sinusoid")
+    assert "wind_model" not in plain.settings["groups"][0] and plain.scale != windy.scale
+    units = plan(windy, {}).units
+    assert units and all(unit_agent(u.params).settings.wind_model == "sinusoid" for u in units)

@@ -161,6 +161,7 @@ AGENT_SPECS = (
         _continual,
         generic_kind="race",
         settings=ContinualSettings,
+        learns_models=True,
         summary="learn as incremental, then refit the model on every episode and re-learn when its one-step error grows",
     ),
 )

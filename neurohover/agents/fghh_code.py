@@ -199,6 +199,7 @@ AGENT_SPECS = tuple(
         frozenset({"generic"}),
         _build(f"authors-{kind}"),
         generic_kind=kind,
+        learns_models=True,
         summary=f"the authors' FGHH agent (generic, one-episode model, three model policies, the best) from the generic evolved {what}",
     )
     for kind, what in FGHH_GENERIC_KINDS

@@ -223,6 +223,7 @@ AGENT_SPECS = (
         frozenset({"generic", "safe"}),
         _hybrid("hybrid", "generic"),
         settings=HybridSettings,
+        learns_models=True,
         summary="the safe specialised pair, then policies evolved on a model, under a safeguard (generic fallback)",
     ),
     AgentSpec(
@@ -231,6 +232,7 @@ AGENT_SPECS = (
         frozenset({"generic", "safe"}),
         _hybrid("hybrid-baseline", "baseline"),
         settings=HybridSettings,
+        learns_models=True,
         summary="the hybrid agent with the baseline policy as the safeguard's fallback",
     ),
 )

@@ -223,6 +223,7 @@ AGENT_SPECS = (
         frozenset({"generic"}),
         _model_based,
         generic_kind="race",
+        learns_models=True,
         summary="fly the generic policy once, learn a model, evolve a policy on it, keep it",
     ),
     AgentSpec(
@@ -232,6 +233,7 @@ AGENT_SPECS = (
         _incremental("incremental"),
         generic_kind="race",
         settings=IncrementalSettings,
+        learns_models=True,
         summary="re-learn the model and re-evolve after every episode until a policy meets its prediction",
     ),
     *(
@@ -242,6 +244,7 @@ AGENT_SPECS = (
             _incremental(f"incremental-{kind}"),
             generic_kind=kind,
             settings=IncrementalSettings,
+            learns_models=True,
             summary=f"incremental, from the FGHH generic policy evolved {what}",
         )
         for kind, what in FGHH_GENERIC_KINDS

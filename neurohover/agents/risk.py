@@ -135,6 +135,7 @@ AGENT_SPECS = (
             frozenset({"generic", "safe"}),
             _hybrid_risk(name, fallback),
             settings=RiskSettings,
+            learns_models=True,
             summary=f"the hybrid agent ranking its candidates by a risk score ({fallback} fallback)",
         )
         for name, fallback in (("hybrid-risk", "generic"), ("hybrid-baseline-risk", "baseline"))

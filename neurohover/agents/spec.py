@@ -92,6 +92,9 @@ class AgentSpec:
     settings : type, optional
         Its own typed settings (an :class:`AgentSettings` dataclass), handed to ``build`` as
         ``AgentOptions.settings``; None: it has none.
+    learns_models : bool
+        Whether it learns LR models from its flight data (so the model options, such as the
+        wind model, apply to it).
     summary : str
         One line for help texts.
     """
@@ -102,6 +105,7 @@ class AgentSpec:
     build: Callable[[AgentPolicies, AgentOptions], Agent]
     generic_kind: str | None = None
     settings: type[AgentSettings] | None = None
+    learns_models: bool = False
     summary: str = ""
 
     def __post_init__(self) -> None:
