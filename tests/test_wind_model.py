@@ -170,3 +170,13 @@ def test_a_competition_hands_the_wind_model_to_its_agent_and_keeps_older_digests
     assert "wind_model" not in plain.settings["groups"][0] and plain.scale != windy.scale
     units = plan(windy, {}).units
     assert units and all(unit_agent(u.params).settings.wind_model == "sinusoid" for u in units)
+
+
+def test_agents_wait_for_flight_data_that_span_a_winds_frequency() -> None:
+    from neurohover.agents.model_based import enough_to_learn
+
+    data = evaluate(baseline_policy(), get_task_family("ghh09").training_mdps()[1], episodes=3, seed=3, record=True, n_steps=7).flight_data
+    assert data.n_transitions == 21 and enough_to_learn(data) and enough_to_learn(data, "constant")
+    assert not enough_to_learn(data, "sinusoid")
+    with pytest.raises(NeurohoverError, match="at least 8 control steps, got 7"):
+        learn_lr(data, wind_model="sinusoid")

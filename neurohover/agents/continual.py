@@ -102,7 +102,7 @@ class ContinualAgent(Agent):
     def _evolve(self) -> None:
         """Refit on the window and evolve a policy on the model (the next episode flies it)."""
         data = self._data()
-        if not enough_to_learn(data):
+        if not enough_to_learn(data, self.evolution.wind_model):
             return
         model = learn_model(data, self.evolution.estimator, self.evolution.wind_model)
         self.models += 1
@@ -136,7 +136,7 @@ class ContinualAgent(Agent):
         stale = outcome.crashed
         if not stale and self.policy_model is not None and self.reference_error and outcome.flight_data is not None:
             latest = FlightData((outcome.flight_data.observations[-1],), (outcome.flight_data.actions[-1],))
-            if enough_to_learn(latest):
+            if enough_to_learn(latest, self.evolution.wind_model):
                 error = float(one_step_error(self.policy_model, latest))
                 self.strikes = self.strikes + 1 if error > self.settings.threshold * self.reference_error else 0
                 stale = self.strikes >= self.settings.patience

@@ -148,7 +148,7 @@ class CodeFGHHAgent(Agent):
         if self.model is None:
             assert outcome.flight_data is not None  # the generic's episodes are recorded
             self.flight_data = outcome.flight_data if self.flight_data is None else self.flight_data + outcome.flight_data
-            if not enough_to_learn(self.flight_data):
+            if not enough_to_learn(self.flight_data, s.wind_model):
                 return
             self.model = learn_model(self.flight_data, s.estimator, s.wind_model)
         elif self.flying != "generic" and self.next_trial <= len(self.candidates) - 1:

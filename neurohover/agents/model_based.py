@@ -67,12 +67,13 @@ def learn_model(flight_data: FlightData, estimator: str = "ols", wind_model: str
     return learn_lr(flight_data, estimator=estimator, wind_model=wind_model).mdp()
 
 
-def enough_to_learn(flight_data: FlightData) -> bool:
+def enough_to_learn(flight_data: FlightData, wind_model: str = "none") -> bool:
     """Whether ``flight_data`` determine an LR model (``MIN_TRANSITIONS`` transitions, regressors of
     full rank; :func:`neurohover.models.lr.lr_determined`): an agent whose flights crash within a
     few steps flies again to gather more before it learns. (Twenty one-step crashes give twenty
-    transitions that all start from rest: u never varies.)"""
-    return flight_data.n_transitions >= MIN_TRANSITIONS and lr_determined(flight_data)
+    transitions that all start from rest: u never varies.) With ``wind_model="sinusoid"`` an
+    episode must also span the control steps a wind frequency needs."""
+    return flight_data.n_transitions >= MIN_TRANSITIONS and lr_determined(flight_data, wind_model=wind_model)
 
 
 def evolve_on_model(model: MDP, prototype: Policy, settings: ModelEvolution, seed: int) -> tuple[Policy, float]:
@@ -114,7 +115,7 @@ class ModelBasedAgent(Agent):
     def update(self, outcome: EpisodeOutcome) -> None:
         if self.policy is None and outcome.flight_data is not None:
             self.flight_data = outcome.flight_data if self.flight_data is None else self.flight_data + outcome.flight_data
-            if enough_to_learn(self.flight_data):  # a generic that crashed at once flies again first
+            if enough_to_learn(self.flight_data, self.settings.wind_model):  # a generic that crashed at once flies again first
                 model = learn_model(self.flight_data, self.settings.estimator, self.settings.wind_model)
                 self.policy, _ = evolve_on_model(model, self.generic, self.settings, int(self._rng.integers(2**62)))
 
@@ -172,7 +173,7 @@ class IncrementalModelBasedAgent(Agent):
         if outcome.flight_data is not None:
             self.flight_data = outcome.flight_data if self.flight_data is None else self.flight_data + outcome.flight_data
         assert self.flight_data is not None  # the first episode is always recorded
-        if not enough_to_learn(self.flight_data):  # the policy crashed at once: fly it again first
+        if not enough_to_learn(self.flight_data, self.settings.wind_model):  # the policy crashed at once: fly it again first
             return
         model = learn_model(self.flight_data, self.settings.estimator, self.settings.wind_model)
         self.models_learned += 1

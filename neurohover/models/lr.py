@@ -66,7 +66,7 @@ from ..flightdata import FlightData
 from ..sim.constants import NOISE_DECAY, NOISE_NAMES, PARAM_NAMES
 from .model import LearnedModel, one_substep_params
 from .transitions import MIN_TRANSITIONS, Transitions, noise_from_residuals
-from .wind import DEFAULT_WIND_MODEL, NO_WIND, WIND_MODELS, body_wind, fit_wind
+from .wind import DEFAULT_WIND_MODEL, MIN_WIND_STEPS, NO_WIND, WIND_MODELS, body_wind, fit_wind
 
 __all__ = ["DEFAULT_ESTIMATOR", "DEFAULT_INTERCEPTS", "ESTIMATORS", "INTERCEPTS", "learn_lr", "lr_determined"]
 
@@ -81,12 +81,15 @@ def _intercept(axis: int, intercepts: str) -> bool:
     return intercepts == "all" or (axis == 1 and intercepts in ("v", "uv")) or (axis == 0 and intercepts == "uv")
 
 
-def lr_determined(flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS) -> bool:
+def lr_determined(flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS, wind_model: str = DEFAULT_WIND_MODEL) -> bool:
     """Whether the flight data determine every axis of an LR model (enough transitions, regressors of
-    full rank): one-step episodes all start from the same state, so their u column is constant.
+    full rank: one-step episodes all start from the same state, so their u column is constant) and,
+    for a sinusoidal wind, span the control steps its frequency needs (``MIN_WIND_STEPS``).
 
     GLS (quasi-differenced regressors) may still find an axis undetermined where this says yes."""
     if flight_data.n_transitions < MIN_TRANSITIONS:
+        return False
+    if wind_model == "sinusoid" and max(a.shape[0] for a in flight_data.actions) < MIN_WIND_STEPS:
         return False
     tr = Transitions(flight_data)
     return all(np.linalg.matrix_rank(x) == x.shape[1] for x in (tr.regressors(axis, _intercept(axis, intercepts))[0] for axis in range(6)))

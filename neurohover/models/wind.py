@@ -48,6 +48,7 @@ __all__ = ["DEFAULT_WIND_MODEL", "NO_WIND", "WIND_MODELS", "WindAxis", "WindMode
 WIND_MODELS = ("none", "constant", "sinusoid")
 DEFAULT_WIND_MODEL = "none"  # the paper's wind-blind model
 _NYQUIST = math.pi / CONTROL_DT  # rad/s: 10 pi, half the 10 Hz sampling rate
+MIN_WIND_STEPS = 8  # control steps an episode must span for a sinusoid's frequency
 
 
 @dataclass(frozen=True)
@@ -197,8 +198,8 @@ def _frequency(series: np.ndarray, t: np.ndarray, step: np.ndarray) -> float:
     mean = np.bincount(step, weights=series)[seen] / counts[seen]
     k = np.flatnonzero(seen)
     n = int(k[-1]) + 1
-    if k.size < 8:
-        raise NeurohoverError(f"a sinusoidal wind needs flight data over at least 8 control steps, got {k.size}")
+    if k.size < MIN_WIND_STEPS:
+        raise NeurohoverError(f"a sinusoidal wind needs flight data over at least {MIN_WIND_STEPS} control steps, got {k.size}")
     grid = np.zeros(n)
     grid[k] = mean - mean.mean()
     pad = 8 * n
