@@ -16,7 +16,6 @@ from ..errors import NeurohoverError
 from ..evaluate import evaluate
 from ..flightdata import FlightData
 from ..models.lr import lr_determined
-from ..models.transitions import MIN_TRANSITIONS
 from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
@@ -73,7 +72,7 @@ def enough_to_learn(flight_data: FlightData, wind_model: str = "none") -> bool:
     few steps flies again to gather more before it learns. (Twenty one-step crashes give twenty
     transitions that all start from rest: u never varies.) With ``wind_model="sinusoid"`` an
     episode must also span the control steps a wind frequency needs."""
-    return flight_data.n_transitions >= MIN_TRANSITIONS and lr_determined(flight_data, wind_model=wind_model)
+    return lr_determined(flight_data, wind_model=wind_model)  # it counts the transitions first
 
 
 def evolve_on_model(model: MDP, prototype: Policy, settings: ModelEvolution, seed: int) -> tuple[Policy, float]:

@@ -33,6 +33,10 @@ from .wins import DEFAULT_DRAWS, win_probabilities
 WIN_RUNS = (1, 5, 20)
 
 
+def _runs(n: int) -> str:
+    return f"{n} run{'s' if n > 1 else ''}"
+
+
 class _ModelLearning(Section):
     def figure(self) -> str | None:
         data: dict[str, list[ModelResult]] = {m: self.group("model", m) for m in self.s.methods}
@@ -169,7 +173,7 @@ class _TestRuns(Section):
             if len(group) > 2:  # which agent (which risk level) to enter for each length
                 self.comparisons.append(
                     "Best odds of winning a competition of "
-                    + "; ".join(f"{n} run{'s' if n > 1 else ''}: {max(odds[n], key=odds[n].__getitem__)} ({max(odds[n].values()):.1%})" for n in WIN_RUNS)
+                    + "; ".join(f"{_runs(n)}: {max(odds[n], key=odds[n].__getitem__)} ({max(odds[n].values()):.1%})" for n in WIN_RUNS)
                     + "."
                 )
             for label in group:
@@ -178,7 +182,7 @@ class _TestRuns(Section):
             return ""
         return (
             "### Winning a competition\n\n"
-            + table(["agent", "MDPs shared", *(f"P(win), {n} run{'s' if n > 1 else ''}" for n in WIN_RUNS)], rows)
+            + table(["agent", "MDPs shared", *(f"P(win), {_runs(n)}" for n in WIN_RUNS)], rows)
             + f"\n\nEach agent's probability of the highest total cumulative reward in a competition of N runs against the other "
             f"{'groups that flew the same MDPs (sensors, drift)' if len(by_condition) > 1 else 'groups'}: {DEFAULT_DRAWS:,} simulated competitions, each "
             "N of the MDPs every agent flew (with replacement) and, on each, one of the agent's stored runs there; ties share "
