@@ -6,7 +6,7 @@ import numba
 import numpy as np
 
 from .errors import NeurohoverError
-from .launch import KIND, MAX_SEED, Batch, Flown, check_device, launch
+from .launch import KIND, MAX_SEED, Batch, Flown, Parking, check_device, launch, launch_parked, rows_alike
 from .policies import GENOME_LENGTH, TOPOLOGIES
 from .sim.constants import SAFEGUARD_LIMITS
 from .sim.kernel import GENOME_WIDTH
@@ -44,7 +44,9 @@ class KernelFlyer:
     next_index : int
         The next unused episode index (``episodes`` unless indices were reserved).
     flown : int
-        Episodes flown so far, counted or not (a race's look-ahead flies some it does not use).
+        Episodes flown to their end so far, counted or not (a race's look-ahead flies some it does not use).
+    flown_steps : int
+        Control steps flown so far, counted or not, parked episodes' included.
     steps : int
         Control steps of the counted episodes.
     kernel_seconds : float
@@ -54,10 +56,9 @@ class KernelFlyer:
     job_steps : numpy.ndarray of int64
         Control steps of each of the last call's jobs (a view, likewise).
     trace : list or None
-        If a list, every call appends ``(genomes, rows, policy_index, mdp_index, episode_index)``
-        (copies, except the rows), e.g. to replay the same jobs in one batch in a benchmark.
-    trace_unused : list
-        While tracing, the episode indices a caller flew but did not use (a race's look-ahead).
+        If a list, every :meth:`fly` call appends ``(genomes, rows, policy_index, mdp_index, episode_index)``
+        (copies, except the rows), e.g. to replay the same jobs in one batch in a benchmark; a
+        caller that flies more than it uses (a race) may replace its calls' entries by what it used.
     """
 
     def __init__(self, topology: str, seed: int, n_steps: int, device: str = "cpu") -> None:
@@ -76,10 +77,10 @@ class KernelFlyer:
         self.episodes = 0
         self.next_index = 0
         self.flown = 0
+        self.flown_steps = 0
         self.steps = 0
         self.kernel_seconds = 0.0
         self.trace: list | None = None
-        self.trace_unused: list[int] = []
         self.crashed = np.zeros(0, dtype=np.bool_)
         self.job_steps = np.zeros(0, dtype=np.int64)
         self.max_threads = self._threads = 1
@@ -129,6 +130,18 @@ class KernelFlyer:
         self.next_index += n
         return first
 
+    def _set_threads(self, n_jobs: int) -> None:
+        # Never more threads than jobs: every thread of a parallel call must check in, and on a busy
+        # machine a one-episode call on all cores runs up to 10x slower than on one.
+        want = n_jobs if n_jobs < self.max_threads else self.max_threads
+        if want != self._threads:
+            numba.set_num_threads(want)
+            self._threads = want
+
+    def can_park(self, rows: np.ndarray) -> bool:
+        """Whether :meth:`fly_parked` can fly jobs on these MDP rows (the CPU lanes: rows alike in substeps and wind)."""
+        return self.device == "cpu" and rows_alike(rows)
+
     def fly(self, genomes: np.ndarray, rows: np.ndarray, policy_index, mdp_index, n_jobs: int, episode_index: np.ndarray | None = None) -> np.ndarray:
         """Fly ``n_jobs`` jobs with the next ``n_jobs`` episode indices (or the given ones).
 
@@ -163,12 +176,7 @@ class KernelFlyer:
         else:
             e[:] = episode_index
         if self.device == "cpu":
-            # Never more threads than jobs: every thread of a parallel call must check in, and on a busy
-            # machine a one-episode call on all cores runs up to 10x slower than on one.
-            want = n_jobs if n_jobs < self.max_threads else self.max_threads
-            if want != self._threads:
-                numba.set_num_threads(want)
-                self._threads = want
+            self._set_threads(n_jobs)
         # (CUDA: the launcher copies the inputs to the GPU and the results back on every call,
         # acceptable while a generation's jobs are few; the thread count does not apply.)
         batch = Batch(rows, self._kinds, self._genomes, p, m, e, self.seed, self.n_steps, minus, self._limits, minus, safeguard=False, recording=False)
@@ -180,6 +188,43 @@ class KernelFlyer:
             self.next_index += n_jobs
             self.steps += int(steps[0]) if n_jobs == 1 else int(steps.sum())
         self.flown += n_jobs
+        self.flown_steps += int(steps.sum())
+        self.crashed = crashed
+        self.job_steps = steps
+        return returns
+
+    def fly_parked(
+        self, genomes: np.ndarray, rows: np.ndarray, policy_index: np.ndarray, mdp_index: np.ndarray | None, episode_index: np.ndarray,
+        slots: np.ndarray, n_required: int, parking: Parking,
+    ) -> np.ndarray:  # fmt: skip
+        """Fly the first ``n_required`` jobs to their end and the later ones in the lanes they leave idle,
+        parking what is in flight when the required ones are over (:func:`neurohover.launch.launch_parked`).
+
+        Jobs fly reserved episode indices (:meth:`reserve`; not counted in :attr:`episodes`); job j's
+        episode is parked in, and resumed from, slot ``slots[j]`` of ``parking``. Only where
+        :meth:`can_park` says so.
+
+        Returns
+        -------
+        numpy.ndarray
+            The jobs' returns (a view, valid until the next call); :attr:`job_steps` is 0 for each
+            job not over, :attr:`crashed` its crash flags.
+        """
+        n_jobs = slots.shape[0]
+        n_pol = genomes.shape[0]
+        if n_pol > self._p_cap:
+            self._ensure(n_pol, 0)
+        self._genomes[:n_pol, : self.dim] = genomes
+        zeros, _, e, minus, returns, crashed, steps, _ = self._views_for(n_jobs)
+        e[:] = episode_index
+        before = parking.steps[slots]
+        self._set_threads(n_jobs)
+        m = zeros if mdp_index is None else mdp_index
+        batch = Batch(rows, self._kinds, self._genomes, policy_index, m, e, self.seed, self.n_steps, safeguard=False, recording=False)
+        self.kernel_seconds += launch_parked(batch, Flown(returns, crashed, steps, minus), slots, n_required, parking)
+        over = steps > 0
+        self.flown += int(over.sum())
+        self.flown_steps += int(np.where(over, steps, parking.steps[slots]).sum() - before.sum())
         self.crashed = crashed
         self.job_steps = steps
         return returns

@@ -24,9 +24,12 @@ import numpy as np
 from .errors import NeurohoverError
 from .sim.constants import MDP_ROW_LEN, ROW_SUBSTEPS, ROW_WIND_KIND, SAFEGUARD_LIMITS
 from .sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
-from .sim.lanes import LANES, rollout_lanes
+from .sim.lanes import LANES, PARK_F, PARK_U, rollout_lanes, rollout_lanes_parked
 
-__all__ = ["DEVICES", "KIND", "MAX_SEED", "Batch", "Flown", "check_device", "launch", "load_kernel", "num_threads", "use_lanes"]
+__all__ = [
+    "DEVICES", "KIND", "MAX_SEED", "Batch", "Flown", "Parking", "check_device", "launch", "launch_parked", "load_kernel", "num_threads",
+    "rows_alike", "use_lanes",
+]  # fmt: skip
 
 #: The kernel's code of each policy topology.
 KIND = {"slp": POLICY_SLP, "mlp": POLICY_MLP}
@@ -128,6 +131,28 @@ class Flown:
         return cls(np.empty(n_jobs), np.empty(n_jobs, dtype=np.bool_), np.empty(n_jobs, dtype=np.int64), np.empty(n_jobs, dtype=np.int64))
 
 
+@dataclass(frozen=True)
+class Parking:
+    """Episodes left in flight by :func:`launch_parked`, one slot each: what the lanes need to resume them.
+
+    ``steps[s]`` is slot ``s``'s control steps flown (0: not begun); ``floats`` and ``streams`` hold
+    its state, gust noise, return so far, sensor state and random streams
+    (:func:`neurohover.sim.lanes.park_lane`).
+    """
+
+    floats: np.ndarray
+    streams: np.ndarray
+    steps: np.ndarray
+
+    @classmethod
+    def empty(cls, n_slots: int) -> Parking:
+        return cls(np.zeros((n_slots, PARK_F)), np.zeros((n_slots, PARK_U), dtype=np.uint64), np.zeros(n_slots, dtype=np.int64))
+
+    def clear(self) -> None:
+        """Forget every parked episode (a slot then starts from its first step)."""
+        self.steps[:] = 0
+
+
 def _fly_lanes(b: Batch, out: Flown) -> None:
     rollout_lanes(
         b.rows, b.kinds, b.genomes, b.policy_index, b.mdp_index, b.episode_index, np.uint64(b.seed), b.n_steps, numba.get_num_threads(),
@@ -178,9 +203,17 @@ def use_lanes(device: str, rows: np.ndarray, m_idx: np.ndarray, fb: np.ndarray |
     n_jobs = m_idx.shape[0]
     if device != "cpu" or n_jobs < LANES or (fb is not None and (fb >= 0).any()) or (rec is not None and rec.any()):
         return False
+    return rows_alike(rows, m_idx)
+
+
+def rows_alike(rows: np.ndarray, m_idx: np.ndarray | None = None) -> bool:
+    """Whether the MDP rows (those ``m_idx`` lists, if given) share the substep count and whether there is
+    wind: what one call of the lanes needs."""
     sub, windy = rows[:, ROW_SUBSTEPS], rows[:, ROW_WIND_KIND] != 0.0
     if (sub == sub[0]).all() and (windy == windy[0]).all():
         return True  # every row alike: no need to look at the jobs
+    if m_idx is None:
+        return False
     used = np.unique(m_idx)
     return bool((sub[used] == sub[used[0]]).all()) and bool((windy[used] == windy[used[0]]).all())
 
@@ -207,6 +240,36 @@ def check_device(device: str) -> None:
                 f"device='cuda' cannot run here: {problem}. It needs an NVIDIA GPU with its driver and "
                 "pip install 'neurohover[cuda]' (numba-cuda); NUMBA_ENABLE_CUDASIM=1 runs numba's CUDA simulator instead"
             )
+
+
+def launch_parked(batch: Batch, out: Flown, slots: np.ndarray, n_required: int, parking: Parking) -> float:
+    """Fly the batch's first ``n_required`` jobs to their end and its later jobs in the lanes they leave idle
+    (:func:`neurohover.sim.lanes.rollout_lanes_parked`); returns the kernel's wall seconds.
+
+    Job j's episode is kept in slot ``slots[j]`` of ``parking`` if the call ends while it flies, and
+    resumes there when a later call lists that slot: its return is the same bits as in one call.
+    ``out.steps[j]`` is 0 for an optional job not over. CPU only, with rows alike in substeps and
+    wind and no safeguard or recording (:func:`use_lanes`; the caller checks).
+    """
+    load_parked()
+    t0 = time.perf_counter()
+    rollout_lanes_parked(
+        batch.rows, batch.kinds, batch.genomes, batch.policy_index, batch.mdp_index, batch.episode_index, slots, n_required,
+        np.uint64(batch.seed), batch.n_steps, numba.get_num_threads(), parking.floats, parking.streams, parking.steps,
+        out.returns, out.crashed, out.steps,
+    )  # fmt: skip
+    return time.perf_counter() - t0
+
+
+def load_parked() -> None:
+    """Load (or compile) :func:`neurohover.sim.lanes.rollout_lanes_parked` with an empty batch."""
+    if "parked" not in _loaded:
+        none = np.zeros(0, dtype=np.int64)
+        b, out, p = Batch.empty(), Flown.empty(0), Parking.empty(0)
+        rollout_lanes_parked(
+            b.rows, b.kinds, b.genomes, none, none, none, none, 0, np.uint64(0), 1, 1, p.floats, p.streams, p.steps, out.returns, out.crashed, out.steps
+        )  # fmt: skip
+        _loaded.add("parked")
 
 
 def launch(batch: Batch, out: Flown, device: str = "cpu") -> float:

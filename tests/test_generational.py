@@ -150,17 +150,25 @@ def test_evolve_on_the_command_line_takes_a_preset_and_settings(tmp_path, capsys
     assert "applies to evolution over a family" in capsys.readouterr().err
 
 
-def test_a_races_look_ahead_is_a_speed_setting_only(monkeypatch) -> None:
+@pytest.mark.parametrize("threads", [1, 2])
+def test_how_a_race_keeps_the_lanes_busy_changes_no_result(monkeypatch, threads: int) -> None:
+    """Parking (the CPU's way) and the look-ahead (elsewhere, any size) fly different episodes, and more
+    than the race uses, but the race uses the same ones."""
     import neurohover.evolution.run as run_module
+    from neurohover.flyer import KernelFlyer
 
-    runs = []
+    flown: dict = {}
+    runs = [evolve(FGHH, resampling="race:0.5", seed=6, n_steps=200, budget=400, threads=threads, _flown=flown)]
+    assert flown["steps"] > runs[0].steps  # the idle lanes flew later samples, some never used
+    monkeypatch.setattr(KernelFlyer, "can_park", lambda self, rows: False)
     for per_thread in (1, 400):
         monkeypatch.setattr(run_module, "RACE_BATCH_PER_THREAD", per_thread)
-        runs.append(evolve(FGHH, resampling="race:0.5", seed=6, n_steps=200, budget=400, threads=1))
-    a, b = runs
-    np.testing.assert_array_equal(a.champion.genome, b.champion.genome)
-    assert (a.champion_return, a.episodes, a.steps, a.generations) == (b.champion_return, b.episodes, b.steps, b.generations)
-    assert [h.champion_return for h in a.history] == [h.champion_return for h in b.history]
+        runs.append(evolve(FGHH, resampling="race:0.5", seed=6, n_steps=200, budget=400, threads=threads))
+    a = runs[0]
+    for b in runs[1:]:
+        np.testing.assert_array_equal(a.champion.genome, b.champion.genome)
+        assert (a.champion_return, a.episodes, a.steps, a.generations) == (b.champion_return, b.episodes, b.steps, b.generations)
+        assert [h.champion_return for h in a.history] == [h.champion_return for h in b.history]
 
 
 def test_configs_take_the_settings_and_refuse_bad_ones_when_loaded() -> None:

@@ -12,11 +12,12 @@ import pytest
 
 from neurohover import baseline_policy, evaluate, evaluate_jobs, get_task_family, prototype
 from neurohover.evaluate import KernelFlyer, PolicyTable, num_threads
+from neurohover.launch import Flown, Parking
 from neurohover.launch import use_lanes as _use_lanes
 from neurohover.policies import GENOME_LENGTH
 from neurohover.sim.constants import SAFEGUARD_LIMITS
 from neurohover.sim.kernel import POLICY_SLP, rollout_batch
-from neurohover.sim.lanes import LANES, fly_lanes, rollout_lanes
+from neurohover.sim.lanes import LANES, fly_lanes, rollout_lanes, rollout_lanes_parked
 from neurohover.tasks import Sensor
 
 ZERO_MDP = get_task_family("fghh").zero()
@@ -233,3 +234,71 @@ def test_evaluate_jobs_and_kernel_flyer_mixed() -> None:
     ref = _scalar(MIXED_POLICIES, rows, 9, np.arange(int(sel.sum()), dtype=np.int64), 2000, p[sel], m[sel])
     assert np.array_equal(ret.view(np.int64), ref[0].view(np.int64))
     assert np.array_equal(flyer.crashed, ref[1])
+
+
+def _parked_calls(table, rows, m, episodes, n_steps, threads, plan) -> tuple:
+    """Fly the jobs in several calls of rollout_lanes_parked: ``plan`` gives each call's number of required
+    jobs, taken from the jobs not over yet (parked first), every other job not over being optional."""
+    n = episodes.shape[0]
+    r, c, s = np.zeros(n), np.zeros(n, dtype=np.bool_), np.zeros(n, dtype=np.int64)
+    parking = Parking.empty(n + 3)
+    slot = np.arange(n, dtype=np.int64) + 3  # slots need not be job numbers
+    over = np.zeros(n, dtype=bool)
+    resumed = 0
+    with num_threads(threads):
+        for n_req in [*plan, n]:
+            waiting = np.flatnonzero(~over)
+            if waiting.size == 0:
+                break
+            waiting = waiting[np.argsort(-parking.steps[slot[waiting]], kind="stable")]  # parked ones required first
+            resumed += int((parking.steps[slot[waiting[:n_req]]] > 0).sum())
+            jobs = waiting
+            out = Flown.empty(jobs.size)
+            rollout_lanes_parked(
+                rows, table.kinds, table.genomes, np.zeros(jobs.size, dtype=np.int64), m[jobs], episodes[jobs], slot[jobs],
+                min(n_req, jobs.size), np.uint64(5), n_steps, threads, parking.floats, parking.streams, parking.steps,
+                out.returns, out.crashed, out.steps,
+            )  # fmt: skip
+            done = out.steps > 0
+            assert done[: min(n_req, jobs.size)].all()  # every required job is over
+            r[jobs[done]], c[jobs[done]], s[jobs[done]] = out.returns[done], out.crashed[done], out.steps[done]
+            over[jobs[done]] = True
+    return (r, c, s, np.full(n, -1, dtype=np.int64)), resumed
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+@pytest.mark.parametrize(
+    "rows",
+    [
+        np.stack([m.row() for m in get_task_family("fghh").test_mdps()[:3]]),
+        np.stack([m.row() for m in get_task_family("ghh09").test_mdps()[:3]]),
+        np.stack([_SENSED.with_sensor(Sensor.at_level(1.5, 0.9, 2)).row(), _SENSED.row()]),
+    ],
+    ids=["fghh", "ghh09 winds", "sensors"],
+)
+def test_parked_episodes_resume_to_the_same_bits(rows: np.ndarray, threads: int) -> None:
+    """An optional episode in flight when a call's required ones are over is parked and resumed by a
+    later call; every job's return, crash flag and steps are the scalar kernel's, bit for bit."""
+    table = _perturbed(0.05)  # crashes at various steps
+    n = 5 * LANES + 3
+    episodes = np.random.default_rng(2).permutation(500)[:n].astype(np.int64)
+    m = np.arange(n, dtype=np.int64) % rows.shape[0]
+    ref = _scalar(table, rows, 5, episodes, 700, m=m)
+    got, resumed = _parked_calls(table, rows, m, episodes, 700, threads, [3, 2 * LANES, 5])
+    _assert_same(got, ref)
+    assert resumed > 0  # some episode was parked mid-flight and finished by a later call
+
+
+def test_a_parked_call_flies_optional_jobs_only_in_idle_lanes_and_counts_them_not_over() -> None:
+    table = _perturbed(0.0)  # the hovering baseline: every episode runs its full length
+    n = 3 * LANES
+    episodes = np.arange(n, dtype=np.int64)
+    parking = Parking.empty(n)
+    out = Flown.empty(n)
+    with num_threads(1):
+        rollout_lanes_parked(
+            np.atleast_2d(ZERO), table.kinds, table.genomes, np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64), episodes,
+            episodes, LANES, np.uint64(1), 300, 1, parking.floats, parking.streams, parking.steps, out.returns, out.crashed, out.steps,
+        )  # fmt: skip
+    # The LANES required episodes fill the lanes to their common end: no optional job began.
+    assert (out.steps[:LANES] == 300).all() and (out.steps[LANES:] == 0).all() and (parking.steps == 0).all()

@@ -136,7 +136,7 @@ def evolve(
     method: str | None = None,
     progress_every_s: float = 0.2,
     _trace: list | None = None,
-    _unused: list | None = None,
+    _flown: dict | None = None,
 ) -> EvolutionResult:
     """Run a whole evolution on the batched kernel and return its champion and history.
 
@@ -188,9 +188,9 @@ def evolve(
     _trace : list, optional
         For benchmarks: receives every kernel call's jobs (:attr:`KernelFlyer.trace
         <neurohover.evaluate.KernelFlyer>`).
-    _unused : list, optional
-        For benchmarks, with ``_trace``: receives the episode indices flown but not used (a
-        race's look-ahead).
+    _flown : dict, optional
+        For benchmarks: receives ``steps``, the control steps the kernel flew (a race flies some it
+        does not use: parked or look-ahead samples).
 
     Raises
     ------
@@ -223,8 +223,6 @@ def evolve(
         run.restore(read_checkpoint(path), f"checkpoint {str(path)!r}")
         run.stop_reason = None
     run.flyer.trace = _trace
-    if _unused is not None:
-        run.flyer.trace_unused = _unused
     # Load (or compile) the kernel before the clock runs, and validate the thread count.
     if run.rows is not None:
         warm_up: np.ndarray | MDP = run.rows
@@ -235,6 +233,8 @@ def evolve(
     with num_threads(threads if threads is not None else numba.get_num_threads()):  # restores the count after
         run.flyer.start()
         run.run(progress, path, float(checkpoint_every_s), float(progress_every_s))
+    if _flown is not None:
+        _flown["steps"] = run.flyer.flown_steps
     return run.result()
 
 

@@ -22,6 +22,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from ..flyer import KernelFlyer
+from ..launch import Parking
 from ..policies import Policy
 from ..sim.lanes import LANES
 from .common import Optimiser, TellInfo, enc_float
@@ -29,6 +30,7 @@ from .config import RACE_T_LIMIT, RunConfig, upgrade_saved_config
 from .fitness import episode_fitness
 from .generational import GenerationalNE
 from .optimisers import OPTIMISERS
+from .race_sampler import RaceSampler
 from .races import fixed_resampling, selection_race
 from .records import (
     CHECKPOINT_FORMAT,
@@ -45,8 +47,8 @@ from .steady_state import SteadyStateNE
 
 __all__ = ["InterruptFlag", "Run"]
 
-#: A race's look-ahead per kernel thread (:meth:`Run._race_batch`): 4 lane loads of LANES episodes, the best
-#: of 0-32 lane loads measured on FGHH (docs/performance.md): more fills the lanes but flies samples never used.
+#: A race's look-ahead per kernel thread where it cannot park (:class:`RaceSampler`): 4 lane loads of LANES episodes, the
+#: best of 0-32 lane loads measured on FGHH (docs/performance.md): more fills the lanes but flies samples never used.
 RACE_BATCH_PER_THREAD = 4 * LANES
 
 
@@ -117,8 +119,7 @@ class Run:
         self.champion_genome: np.ndarray | None = None  # a population optimiser on a family: best of the last generation
         self.champion_return = -math.inf
         self.stop_reason: str | None = None
-        self._race_steps = np.zeros((0, RACE_T_LIMIT), dtype=np.int64)  # the current race's steps per sample flown
-        self._race_base, self._race_base_drawn = 0, np.zeros(0, dtype=np.int64)  # its first episode index, samples flown
+        self._parking: Parking | None = None  # slots of a race's parked episodes, reused from race to race
 
     # ----------------------------------------------------------------- checkpoints
 
@@ -214,38 +215,25 @@ class Run:
         result = fixed_resampling(lambda idx: cols[next(calls)], n, k)
         return result.means, result
 
-    def _race_batch(self) -> int:
-        """Episodes per call a race's look-ahead aims at: enough to keep every thread's SIMD lanes
-        busy to the end of a call (a speed setting only: it changes no result)."""
-        return RACE_BATCH_PER_THREAD * self.flyer.max_threads
-
-    def _race_sample_fn(self, genomes: np.ndarray):
+    def _race_sampler(self, genomes: np.ndarray, mu: int) -> RaceSampler:
         """A race's ``sample_fn`` in which candidate i's t-th episode is fixed: episode index
-        ``base + t * n + i`` and MDP row ``t * n + i``, reserved and drawn when the race starts,
-        so the race's look-ahead (which flies samples it may not use) changes no result."""
+        ``base + t * n + i`` and MDP row ``t * n + i``, reserved and drawn when the race starts, so
+        parking or look-ahead (which fly samples the race may not use) change no result."""
         n = genomes.shape[0]
-        base = self._race_base = self.flyer.reserve(n * RACE_T_LIMIT)
+        base = self.flyer.reserve(n * RACE_T_LIMIT)
         if self.family is None:
             assert self.rows is not None  # a run has one MDP (its rows) or a family
             rows = self.rows
         else:
             assert self.mdp_rng is not None  # set exactly when the run has a family
             rows = self.family.sample_rows(self.mdp_rng, n * RACE_T_LIMIT)
-        drawn = self._race_base_drawn = np.zeros(n, dtype=np.int64)  # samples flown per candidate
-        self._race_steps = np.zeros((n, RACE_T_LIMIT), dtype=np.int64)  # steps of each sample flown
-
-        def sample(idx: np.ndarray) -> np.ndarray:
-            idx = idx.astype(np.int64)
-            t = np.empty_like(idx)
-            for q, i in enumerate(idx.tolist()):  # a candidate listed again flies its next sample
-                t[q] = drawn[i]
-                drawn[i] += 1
-            slot = t * n + idx
-            returns = self.flyer.fly(genomes, rows, idx, None if self.family is None else slot, idx.shape[0], episode_index=base + slot)
-            self._race_steps[idx, t] = self.flyer.job_steps
-            return episode_fitness(returns, self.fitness)
-
-        return sample
+        parking = None
+        if self.flyer.can_park(rows):
+            if self._parking is None or self._parking.steps.shape[0] < n * RACE_T_LIMIT:
+                self._parking = Parking.empty(n * RACE_T_LIMIT)
+            parking = self._parking
+        look_ahead = RACE_BATCH_PER_THREAD * self.flyer.max_threads
+        return RaceSampler(self.flyer, genomes, rows, base, self.family is not None, self.fitness, RACE_T_LIMIT, mu, look_ahead, parking)
 
     # ----------------------------------------------------------------- loop
 
@@ -339,17 +327,17 @@ class Run:
         if self.resampling.kind == "race":
             delta = self.resampling.delta
             assert delta is not None  # every race has its delta (Run() formats it in config.to_dict() first)
-            race = selection_race(
-                self._race_sample_fn(genomes), genomes.shape[0], opt.settings.select_size, delta, t_limit=RACE_T_LIMIT, batch=self._race_batch()
-            )
-            # Count the episodes the race used (its look-ahead flew more): what depends on no speed setting.
-            used = np.arange(RACE_T_LIMIT)[None, :] < race.n_samples[:, None]
+            sampler = self._race_sampler(genomes, opt.settings.select_size)
+            traced = None if self.flyer.trace is None else len(self.flyer.trace)
+            race = selection_race(sampler, genomes.shape[0], opt.settings.select_size, delta, t_limit=RACE_T_LIMIT, batch=sampler.batch)
+            # Count the episodes the race used (parking or look-ahead flew more): what depends on no speed setting.
             self.flyer.episodes += race.episodes_spent
-            self.flyer.steps += int(self._race_steps[used].sum())
-            if self.flyer.trace is not None:  # for benchmarks: the look-ahead's samples the race never used
-                n = genomes.shape[0]
-                t, i = np.nonzero(((self._race_base_drawn[:, None] > np.arange(RACE_T_LIMIT)) & ~used).T)
-                self.flyer.trace_unused.extend((self._race_base + t * n + i).tolist())
+            used = sampler.used(race.n_samples)
+            self.flyer.steps += int(sampler.slot_steps[used].sum())
+            if self.flyer.trace is not None:  # for benchmarks: the race's calls replaced by the episodes it used
+                del self.flyer.trace[traced:]
+                m = used if self.family is not None else np.zeros_like(used)
+                self.flyer.trace.append((genomes.copy(), sampler.rows, used % genomes.shape[0], m, sampler.base + used))
             opt.tell(race.means, TellInfo(selected=race.selected, episodes=race.episodes_spent))
         else:
             _, result = self._fly_family_fixed(genomes)

@@ -9,24 +9,17 @@ there is wind, LANES episodes per thread in lockstep, each lane with its own job
 row, and writes bit-identical returns, crash flags and steps (about 2.2x the scalar kernel's
 episodes/s per core, docs/performance.md). :func:`neurohover.evaluate.evaluate_jobs` and
 :meth:`neurohover.evaluate.KernelFlyer.fly` choose it for such batches of at least LANES jobs.
+:func:`rollout_lanes_parked` is the same with optional jobs and parking: a selection race's later
+samples fill the lanes its round leaves idle, and an episode in flight when the round's samples are
+over is kept and resumed by a later call (docs/performance.md, Selection races).
 
 How it works
 - Lanes in lockstep over control steps, one episode per lane, and a queue: a lane whose episode ends
   takes the next one, so lanes run at different steps. An idle lane flies at rest.
-- All lane data live in one flat float64 buffer ``B[row * LANES + lane]`` (state, drive terms, wind,
-  observation, reward, crash flag, and the lane's MDP's dynamics coefficients and dt), so LLVM sees constant, non-overlapping offsets and its SLP
-  vectorizer packs the fully unrolled ``for lane in range(LANES)`` loops (the substeps, then the
-  observation, reward and crash test) into packed instructions on ymm/zmm registers.
-- The three Taylor regimes of ``kernel._half_angle_quaternion`` are all computed and chosen by
-  selects; a lane at or above SERIES_MAX_ANGLE (or NaN) is counted, and then that control step is
-  flown again for every lane, from the saved start, with ``kernel.integrate`` itself (libm sin/cos).
-- Bit-identity: the kernel is compiled with fastmath={"contract"}, so which ``a*b + c`` become FMAs
-  is decided by LLVM from the operand order of its optimised IR, and the SLP vectorizer reorders
-  operands (the same source contracted differently when packed: returns near -1000 differed by up
-  to 8e-13). The lane code is therefore compiled without contraction and every FMA that the
-  kernel's compiled code forms is written out as ``llvm.fma`` (:func:`fma`), read from the kernel's
-  optimised IR. This is the fragile part: a numba/LLVM upgrade or an edit of ``integrate`` or
-  ``observe`` can change the kernel's FMA pattern; tests/test_lanes.py pins both paths bit-identical.
+- The substeps, then the observation, reward and crash test, run packed for all lanes at once
+  (:mod:`neurohover.sim.packed`, which says how they stay bit-identical to the scalar kernel); a
+  control step in which some lane turns more than SERIES_MAX_ANGLE is flown again for every lane,
+  from the saved start, with ``kernel.integrate`` itself (libm sin/cos).
 - Still scalar per lane: the policy (``exp`` has no bit-identical packed form), the xoshiro256** /
   ziggurat gust noise, the wind's sin, and the bookkeeping.
 
@@ -39,217 +32,26 @@ import math
 
 import numba as nb
 import numpy as np
-from llvmlite import ir
 from numba.core import types
 from numba.extending import intrinsic
 
-from .constants import GRAVITY, MAX_POSITION, MAX_RATE, MAX_VELOCITY, MIN_QW, SENSOR_SCRATCH, WIND_SINUSOID
+from .constants import SENSOR_SCRATCH, WIND_SINUSOID
 from .kernel import (
-    SERIES_MAX_ANGLE,
     clip_action,
     competition_time,
     crash_charge,
     integrate,
     observe,
     policy_action,
-    rotation_matrix,
     sense,
     unpack_mdp,
     unpack_sensor,
     update_noise,
 )
+from .packed import LANES, N_PAR, ROW_CRASH, ROW_DYN, ROW_OBS, ROW_REWARD, ROWS, observe_lanes, substeps
 from .rng import next_normal, seed_sensor_stream, seed_stream
 
-LANES = 8  # episodes per thread: 8 doubles fill an AVX-512 register (prototype: 4 lanes 1.94x, 8 2.20x, 16 2.27x)
-BIG2 = SERIES_MAX_ANGLE * SERIES_MAX_ANGLE
-ROW_OBS = 21  # buffer rows: 0-12 state, 13-18 drive terms, 19-20 wind, 21-32 observation
-ROW_REWARD = 33
-ROW_CRASH = 34
-ROW_BIG = 35  # counts the step's substeps where the lane turned SERIES_MAX_ANGLE or more
-ROW_DYN = 36  # rows 36-41 the lane's MDP's c_u, c_v, c_w, c_p, c_q, c_r, row 42 its substep length dt
-ROWS = 43
-N_PAR = 21  # per-lane scalar parameters (P[lane]): 0-5 noise std, 6-11 d_u d_v d_w d_p d_q d_r, 12-20 wind
-
-
-@intrinsic
-def fma(typingctx, a, b, c):
-    """``a * b + c`` rounded once: llvm.fma.f64, which SLP packs into vfmadd...pd."""
-    sig = types.float64(types.float64, types.float64, types.float64)
-
-    def codegen(context, builder, signature, args):
-        d = ir.DoubleType()
-        fn = builder.module.declare_intrinsic("llvm.fma", [d], ir.FunctionType(d, [d, d, d]))
-        return builder.call(fn, args)
-
-    return sig, codegen
-
-
-@nb.njit(cache=True, inline="always", fastmath=False)
-def _hq_select(rx, ry, rz):
-    """kernel._half_angle_quaternion below SERIES_MAX_ANGLE: the three regimes all computed, one chosen
-    by selects; each with the operations the kernel's compiled code performs (FMAs explicit)."""
-    theta2 = fma(rz, rz, fma(ry, ry, rx * rx))
-    h1x = rx * 0.5
-    h1y = ry * 0.5
-    h1z = rz * 0.5
-    w1 = math.sqrt(1.0 - fma(h1z, h1z, fma(h1y, h1y, h1x * h1x)))
-    x2 = theta2 * 0.25
-    sinc2 = fma(x2, fma(x2, 1.0 / 120, -1.0 / 6), 1.0)
-    cos2 = fma(x2, fma(x2, fma(x2, -1.0 / 720, 1.0 / 24), -0.5), 1.0)
-    sinc3 = fma(x2, fma(x2, fma(x2, fma(x2, fma(x2, -1.0 / 39916800, 1.0 / 362880), -1.0 / 5040), 1.0 / 120), -1.0 / 6), 1.0)
-    cos3 = fma(x2, fma(x2, fma(x2, fma(x2, fma(x2, fma(x2, 1.0 / 479001600, -1.0 / 3628800), 1.0 / 40320), -1.0 / 720), 1.0 / 24), -0.5), 1.0)
-    mid = theta2 < 1e-4
-    sinc = sinc2 if mid else sinc3
-    cs = cos2 if mid else cos3
-    k = sinc * 0.5
-    small = theta2 < 1e-8
-    hx = h1x if small else rx * k
-    hy = h1y if small else ry * k
-    hz = h1z if small else rz * k
-    hw = w1 if small else cs
-    return hx, hy, hz, hw, theta2
-
-
-@nb.njit(cache=True, inline="always", fastmath=False)
-def _lane_substep(B, lane, has_wind):
-    """One substep of one lane: kernel.integrate's loop body, every FMA the kernel's compiled code
-    forms written out (from its optimised LLVM IR and x86's contraction rule), so that a packed
-    and a scalar build give the same bits. Lane state B[m * LANES + lane]: rows 0-12 the state,
-    13-18 the drive terms (nu, bias_v, bias_w, drive_p, drive_q, drive_r), 19-20 the wind, 36-42
-    the lane's own dynamics (c_u, c_v, c_w, c_p, c_q, c_r, dt), so lanes may fly different MDPs."""
-    c_u = B[(ROW_DYN + 0) * LANES + lane]
-    c_v = B[(ROW_DYN + 1) * LANES + lane]
-    c_w = B[(ROW_DYN + 2) * LANES + lane]
-    c_p = B[(ROW_DYN + 3) * LANES + lane]
-    c_q = B[(ROW_DYN + 4) * LANES + lane]
-    c_r = B[(ROW_DYN + 5) * LANES + lane]
-    dt = B[(ROW_DYN + 6) * LANES + lane]
-    vu = B[0 * LANES + lane]
-    vv = B[1 * LANES + lane]
-    vw = B[2 * LANES + lane]
-    p = B[6 * LANES + lane]
-    q = B[7 * LANES + lane]
-    r = B[8 * LANES + lane]
-    qx = B[9 * LANES + lane]
-    qy = B[10 * LANES + lane]
-    qz = B[11 * LANES + lane]
-    qw = B[12 * LANES + lane]
-    B[3 * LANES + lane] = fma(dt, vu, B[3 * LANES + lane])
-    B[4 * LANES + lane] = fma(dt, vv, B[4 * LANES + lane])
-    B[5 * LANES + lane] = fma(dt, vw, B[5 * LANES + lane])
-    r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_matrix(qx, qy, qz, qw)  # no FMA there
-    bu = fma(r20, vw, fma(r10, vv, r00 * vu))
-    bv = fma(r21, vw, fma(r11, vv, r01 * vu))
-    bw = fma(r22, vw, fma(r12, vv, r02 * vu))
-    if has_wind:
-        wu = B[19 * LANES + lane]
-        wv = B[20 * LANES + lane]
-        bu = bu + fma(r00, wu, r10 * wv)
-        bv = bv + fma(r01, wu, r11 * wv)
-    fu = fma(c_u, bu, B[13 * LANES + lane])
-    fv = fma(c_v, bv, B[14 * LANES + lane])
-    fw = fma(c_w, bw, B[15 * LANES + lane])
-    B[0 * LANES + lane] = fma(dt, fma(r02, fw, fma(r00, fu, r01 * fv)), vu)
-    B[1 * LANES + lane] = fma(dt, fma(r12, fw, fma(r10, fu, r11 * fv)), vv)
-    B[2 * LANES + lane] = fma(dt, fma(r22, fw, fma(r20, fu, r21 * fv)) + GRAVITY, vw)
-    hx, hy, hz, hw, theta2 = _hq_select(dt * p, dt * q, dt * r)
-    B[ROW_BIG * LANES + lane] += 0.0 if theta2 < BIG2 else 1.0  # NaN counts: the scalar code then decides
-    B[12 * LANES + lane] = fma(-qz, hz, fma(-qy, hy, fma(qw, hw, -(qx * hx))))
-    B[9 * LANES + lane] = fma(-qz, hy, fma(qy, hz, fma(qx, hw, qw * hx)))
-    B[10 * LANES + lane] = fma(qz, hx, fma(qy, hw, fma(qw, hy, -(qx * hz))))
-    B[11 * LANES + lane] = fma(qz, hw, fma(-qy, hx, fma(qw, hz, qx * hy)))
-    B[6 * LANES + lane] = fma(dt, fma(c_p, p, B[16 * LANES + lane]), p)
-    B[7 * LANES + lane] = fma(dt, fma(c_q, q, B[17 * LANES + lane]), q)
-    B[8 * LANES + lane] = fma(dt, fma(c_r, r, B[18 * LANES + lane]), r)
-
-
-@nb.njit(cache=True, fastmath=False)
-def _substeps(B, W, n_sub, has_wind):
-    """All substeps of one control step for all lanes of B, in place; the lane loops are the SIMD
-    part. Returns False at the first substep where some lane would turn more than
-    SERIES_MAX_ANGLE (libm's sin/cos): the caller then restores the step's start and flies it
-    with kernel.integrate."""
-    for lane in range(LANES):
-        B[ROW_BIG * LANES + lane] = 0.0
-    for i in range(n_sub):
-        if has_wind:
-            for lane in range(LANES):
-                B[19 * LANES + lane] = W[0, i, lane]
-                B[20 * LANES + lane] = W[1, i, lane]
-            for lane in range(LANES):
-                _lane_substep(B, lane, True)
-        else:
-            for lane in range(LANES):
-                _lane_substep(B, lane, False)
-    n_big = 0
-    for lane in range(LANES):
-        n_big += B[ROW_BIG * LANES + lane] != 0.0
-    return n_big == 0
-
-
-@nb.njit(cache=True, fastmath=False)
-def _observe_lanes(B):
-    """kernel.observe, kernel.reward_of and kernel.crashed of every lane, packed, with the FMAs of the kernel's
-    compiled fly_job written out: rows 21-32 the observation, 33 the reward, 34 the crash flag."""
-    for lane in range(LANES):
-        vu = B[0 * LANES + lane]
-        vv = B[1 * LANES + lane]
-        vw = B[2 * LANES + lane]
-        px = B[3 * LANES + lane]
-        py = B[4 * LANES + lane]
-        pz = B[5 * LANES + lane]
-        p = B[6 * LANES + lane]
-        q = B[7 * LANES + lane]
-        r = B[8 * LANES + lane]
-        qx = B[9 * LANES + lane]
-        qy = B[10 * LANES + lane]
-        qz = B[11 * LANES + lane]
-        qw = B[12 * LANES + lane]
-        r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_matrix(qx, qy, qz, qw)
-        o0 = fma(vw, r20, fma(vv, r10, vu * r00))
-        o1 = fma(vw, r21, fma(vu, r01, vv * r11))
-        o2 = fma(vw, r22, fma(vu, r02, vv * r12))
-        o3 = fma(pz, r20, fma(py, r10, px * r00))
-        o4 = fma(pz, r21, fma(px, r01, py * r11))
-        o5 = fma(pz, r22, fma(px, r02, py * r12))
-        acc = o0 * o0
-        acc = fma(o1, o1, acc)
-        acc = fma(o2, o2, acc)
-        acc = fma(o3, o3, acc)
-        acc = fma(o4, o4, acc)
-        acc = fma(o5, o5, acc)
-        acc = fma(p, p, acc)
-        acc = fma(q, q, acc)
-        acc = fma(r, r, acc)
-        acc = fma(qx, qx, acc)
-        acc = fma(qy, qy, acc)
-        acc = fma(qz, qz, acc)
-        B[(ROW_OBS + 0) * LANES + lane] = o0
-        B[(ROW_OBS + 1) * LANES + lane] = o1
-        B[(ROW_OBS + 2) * LANES + lane] = o2
-        B[(ROW_OBS + 3) * LANES + lane] = o3
-        B[(ROW_OBS + 4) * LANES + lane] = o4
-        B[(ROW_OBS + 5) * LANES + lane] = o5
-        B[(ROW_OBS + 6) * LANES + lane] = p
-        B[(ROW_OBS + 7) * LANES + lane] = q
-        B[(ROW_OBS + 8) * LANES + lane] = r
-        B[(ROW_OBS + 9) * LANES + lane] = qx
-        B[(ROW_OBS + 10) * LANES + lane] = qy
-        B[(ROW_OBS + 11) * LANES + lane] = qz
-        B[ROW_REWARD * LANES + lane] = -acc
-        crash = (
-            (abs(vu) > MAX_VELOCITY)
-            | (abs(vv) > MAX_VELOCITY)
-            | (abs(vw) > MAX_VELOCITY)
-            | (abs(px) > MAX_POSITION)
-            | (abs(py) > MAX_POSITION)
-            | (abs(pz) > MAX_POSITION)
-            | (abs(p) > MAX_RATE)
-            | (abs(q) > MAX_RATE)
-            | (abs(r) > MAX_RATE)
-            | (abs(qw) < MIN_QW)
-        )
-        B[ROW_CRASH * LANES + lane] = 1.0 if crash else 0.0
+__all__ = ["LANES", "PARK_F", "PARK_U", "fly_lanes", "fly_queue", "park_lane", "rollout_lanes", "rollout_lanes_parked"]
 
 
 @nb.njit(cache=True, inline="always")
@@ -347,8 +149,90 @@ def _read(B, seen, srngs, scratch, lane, t, row):
         seen[lane, m] = r[m]
 
 
+PARK_F = 13 + 12 + 6 + 1 + 12 + SENSOR_SCRATCH  # a parked episode: state, observation, gust noise, return so far, sensor reading and scratch
+PARK_U = 8  # its gust stream and its sensor stream
+
+
+@intrinsic
+def _fence(typingctx):
+    """A sequentially consistent fence: the loads after it are not hoisted above it (another thread's counts)."""
+    sig = types.void()
+
+    def codegen(context, builder, signature, args):
+        builder.fence("seq_cst")
+
+    return sig, codegen
+
+
+@nb.njit(cache=True)
+def _all_over(left) -> bool:
+    """Whether every queue of a call has no required job left (``left``: one count per queue)."""
+    _fence()  # type: ignore[call-arg]  # an intrinsic: numba supplies typingctx
+    for c in range(left.shape[0]):
+        if left[c] != 0:
+            return False
+    return True
+
+
 @nb.njit(cache=True, fastmath={"contract"})
-def fly_lanes(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, seed, n_steps, out_return, out_crashed, out_steps, stats):
+def park_lane(B, N, rngs, seen, srngs, scratch, step, total, sensing, lane, slot, park_f, park_u, park_step) -> None:
+    """Keep a lane's episode, between two control steps, in ``slot`` of the park arrays: everything its
+    next step reads (the drive terms, wind and packed rows are rewritten each step; P from the row)."""
+    for m in range(13):
+        park_f[slot, m] = B[m * LANES + lane]
+    for m in range(12):
+        park_f[slot, 13 + m] = B[(ROW_OBS + m) * LANES + lane]
+    for m in range(6):
+        park_f[slot, 25 + m] = N[m, lane]
+    park_f[slot, 31] = total[lane]
+    for m in range(4):
+        park_u[slot, m] = rngs[lane, m]
+    if sensing[lane]:
+        for m in range(12):
+            park_f[slot, 32 + m] = seen[lane, m]
+        for m in range(SENSOR_SCRATCH):
+            park_f[slot, 44 + m] = scratch[lane, m]
+        for m in range(4):
+            park_u[slot, 4 + m] = srngs[lane, m]
+    park_step[slot] = step[lane]
+
+
+@nb.njit(cache=True, fastmath={"contract"})
+def _begin(B, P, N, rngs, seen, srngs, scratch, step, total, lane, row, seed, episode, job_slot, q, park_f, park_u, park_step) -> bool:
+    """Start job ``q``'s episode in a lane at rest: from its first step, or where it was parked. Returns whether it senses."""
+    _start_lane(B, P, lane, row)
+    s = job_slot[q] if park_step.shape[0] > 0 else -1
+    if s < 0 or park_step[s] == 0:
+        seed_stream(rngs[lane], np.uint64(seed), np.uint64(episode))
+        step[lane] = 0
+        total[lane] = 0.0
+        return _start_sensing(seen, srngs, scratch, lane, row, seed, episode)
+    for m in range(13):
+        B[m * LANES + lane] = park_f[s, m]
+    for m in range(12):
+        B[(ROW_OBS + m) * LANES + lane] = park_f[s, 13 + m]
+    for m in range(6):
+        N[m, lane] = park_f[s, 25 + m]
+    total[lane] = park_f[s, 31]
+    step[lane] = park_step[s]
+    for m in range(4):
+        rngs[lane, m] = park_u[s, m]
+    _, on = unpack_sensor(row)
+    if on:
+        for m in range(12):
+            seen[lane, m] = park_f[s, 32 + m]
+        for m in range(SENSOR_SCRATCH):
+            scratch[lane, m] = park_f[s, 44 + m]
+        for m in range(4):
+            srngs[lane, m] = park_u[s, 4 + m]
+    return on
+
+
+@nb.njit(cache=True, fastmath={"contract"})
+def fly_queue(
+    mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, seed, n_steps, out_return, out_crashed, out_steps, stats,
+    n_required, job_slot, park_f, park_u, park_step, left, chunk,
+):  # fmt: skip
     """Fly jobs j (policy ``job_policy[j]``, MDP row ``job_mdp[j]``, episode index ``episodes[j]``),
     LANES at a time; write each job's return, crash flag and steps (as kernel.fly_job: no
     recording, no safeguard). Every job's MDP row must have the substep count and the wind
@@ -357,6 +241,12 @@ def fly_lanes(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, se
     A lane whose episode ends takes the next job (a queue), so lanes run at different steps, each
     with its own genome and its own MDP's parameters.
     stats[0] counts control steps, stats[1] those flown by the scalar fallback.
+
+    Parking (``park_step`` not empty): jobs ``n_required`` and later are optional. Job j's episode
+    is kept in slot ``job_slot[j]`` of ``park_f`` / ``park_u`` / ``park_step`` (:func:`park_lane`): one
+    whose ``park_step`` is above 0 resumes there. ``left[chunk]`` counts this queue's required
+    jobs not yet over; once every queue's count is 0, the episodes still in flight are parked and
+    the call returns (an optional job not over keeps ``out_steps`` 0).
     """
     n_jobs = episodes.shape[0]
     if n_jobs == 0:
@@ -384,12 +274,18 @@ def fly_lanes(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, se
         _reset_lane(B, N, A, lane)
         if nxt < n_jobs:
             job[lane] = nxt
-            seed_stream(rngs[lane], np.uint64(seed), np.uint64(episodes[nxt]))
-            _start_lane(B, P, lane, mdp_rows[job_mdp[nxt]])
-            sensing[lane] = _start_sensing(seen, srngs, scratch, lane, mdp_rows[job_mdp[nxt]], seed, episodes[nxt])
+            sensing[lane] = _begin(
+                B, P, N, rngs, seen, srngs, scratch, step, total, lane, mdp_rows[job_mdp[nxt]], seed, episodes[nxt], job_slot, nxt, park_f, park_u, park_step
+            )  # fmt: skip
             nxt += 1
             live += 1
+    parking = park_step.shape[0] > 0
     while live > 0:
+        if parking and left[chunk] == 0 and _all_over(left):  # every queue's required jobs are over
+            for lane in range(LANES):
+                if job[lane] >= 0:
+                    park_lane(B, N, rngs, seen, srngs, scratch, step, total, sensing, lane, job_slot[job[lane]], park_f, park_u, park_step)
+            break
         # Control-step part, scalar per lane: policy, clipping, gust noise, drive terms, wind.
         for lane in range(LANES):
             if job[lane] < 0:
@@ -415,6 +311,10 @@ def fly_lanes(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, se
                 out_return[j] = total[lane] + crash_charge(n_steps, k + 1)
                 out_crashed[j] = True
                 out_steps[j] = k + 1
+                if j < n_required:
+                    left[chunk] -= 1
+                if parking:
+                    park_step[job_slot[j]] = 0
                 job[lane] = -2  # over; the lane idles through this step (at rest, dt 0) and is refilled after it
                 _reset_lane(B, N, A, lane)
                 continue
@@ -455,7 +355,7 @@ def fly_lanes(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, se
                     W[1, i, lane] = wv
         stats[0] += 1
         B0[:] = B[: 13 * LANES]
-        if not _substeps(B, W, n_sub, has_wind):
+        if not substeps(B, W, n_sub, has_wind):
             stats[1] += 1
             B[: 13 * LANES] = B0
             for lane in range(LANES):
@@ -477,7 +377,7 @@ def fly_lanes(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, se
                 )
                 for m in range(13):
                     B[m * LANES + lane] = s[m]
-        _observe_lanes(B)
+        observe_lanes(B)
         # Bookkeeping, scalar per lane: return, end of episode, refill.
         for lane in range(LANES):
             j = job[lane]
@@ -498,18 +398,33 @@ def fly_lanes(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, se
                         _read(B, seen, srngs, scratch, lane, t, mdp_rows[job_mdp[j]])
                     continue
                 out_steps[j] = t
+                if j < n_required:
+                    left[chunk] -= 1
+                if parking:
+                    park_step[job_slot[j]] = 0  # over: a later listing of its slot begins afresh
             _reset_lane(B, N, A, lane)
             total[lane] = 0.0
             step[lane] = 0
             if nxt < n_jobs:
                 job[lane] = nxt
-                seed_stream(rngs[lane], np.uint64(seed), np.uint64(episodes[nxt]))
-                _start_lane(B, P, lane, mdp_rows[job_mdp[nxt]])
-                sensing[lane] = _start_sensing(seen, srngs, scratch, lane, mdp_rows[job_mdp[nxt]], seed, episodes[nxt])
+                sensing[lane] = _begin(
+                B, P, N, rngs, seen, srngs, scratch, step, total, lane, mdp_rows[job_mdp[nxt]], seed, episodes[nxt], job_slot, nxt, park_f, park_u, park_step
+            )  # fmt: skip
                 nxt += 1
             else:
                 job[lane] = -1
                 live -= 1
+
+
+@nb.njit(cache=True, fastmath={"contract"})
+def fly_lanes(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, seed, n_steps, out_return, out_crashed, out_steps, stats):
+    """:func:`fly_queue` without parking: every job is flown to its end."""
+    none = np.zeros(0, dtype=np.int64)
+    left = np.full(1, episodes.shape[0], dtype=np.int64)
+    fly_queue(
+        mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, seed, n_steps, out_return, out_crashed, out_steps, stats,
+        episodes.shape[0], none, np.zeros((0, PARK_F)), np.zeros((0, PARK_U), dtype=np.uint64), none, left, 0,
+    )  # fmt: skip
 
 
 @nb.njit(cache=True, parallel=True, fastmath={"contract"})
@@ -563,3 +478,52 @@ def rollout_lanes(
         )  # fmt: skip
         for j in range(a, b):
             out_safeguard_step[j] = -1
+
+
+@nb.njit(cache=True, parallel=True, fastmath={"contract"})
+def rollout_lanes_parked(
+    mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, job_slot, n_required, seed, n_steps, n_threads,
+    park_f, park_u, park_step, out_return, out_crashed, out_steps,
+):  # fmt: skip
+    """:func:`rollout_lanes` with optional jobs and parking: fly jobs ``0 .. n_required - 1`` to their end,
+    and jobs ``n_required ..`` only in lanes the required ones leave idle.
+
+    The call returns once every required job is over; an optional episode then in flight is parked in
+    its slot ``job_slot[j]`` of ``park_f`` (``(S, PARK_F)``), ``park_u`` (``(S, PARK_U)`` uint64) and
+    ``park_step`` (``(S,)``: its steps flown; 0 for an episode not begun), and a later call that lists
+    the same slot resumes it there, so an episode's return is the same bits however many calls it
+    took. Jobs are dealt to the threads' queues in turn, required ones first; a queue whose required
+    jobs are over flies its optional ones until every queue's are. ``out_steps[j]`` is 0 for an
+    optional job not over (parked, or not begun); otherwise the outputs are :func:`rollout_lanes`'s.
+    The rows must be alike in substeps and wind, as there (not checked here: one race's rows are).
+    """
+    n_jobs = job_episode.shape[0]
+    for j in range(n_jobs):
+        out_steps[j] = 0
+    n_chunks = max(1, min(n_threads, n_jobs // LANES))
+    left = np.zeros(n_chunks, dtype=np.int64)
+    for j in range(n_required):
+        left[j % n_chunks] += 1  # every count set before any queue starts
+    for c in nb.prange(n_chunks):
+        # This queue's jobs: required j = c, c + n_chunks, ..., then optional ones likewise.
+        n_req = (n_required - c + n_chunks - 1) // n_chunks
+        n_mine = n_req + (n_jobs - n_required - c + n_chunks - 1) // n_chunks
+        ids = np.empty(n_mine, dtype=np.int64)
+        for q in range(n_req):
+            ids[q] = c + q * n_chunks
+        for q in range(n_mine - n_req):
+            ids[n_req + q] = n_required + c + q * n_chunks
+        ret = np.empty(n_mine)
+        crashed = np.zeros(n_mine, dtype=np.bool_)
+        steps = np.zeros(n_mine, dtype=np.int64)
+        stats = np.zeros(2, dtype=np.int64)
+        fly_queue(
+            mdp_rows, policy_kinds, genomes, job_policy[ids], job_mdp[ids], job_episode[ids], seed, n_steps, ret, crashed, steps, stats,
+            n_req, job_slot[ids], park_f, park_u, park_step, left, c,
+        )  # fmt: skip
+        for q in range(n_mine):
+            j = ids[q]
+            if steps[q] > 0:
+                out_return[j] = ret[q]
+                out_crashed[j] = crashed[q]
+                out_steps[j] = steps[q]

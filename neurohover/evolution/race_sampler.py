@@ -1,0 +1,133 @@
+"""A selection race's samples flown through the kernel, each a fixed episode, with the lanes kept busy.
+
+Candidate i's t-th sample of a race of n candidates is slot ``t * n + i``: episode index ``base + slot``
+and, on a task family, MDP row ``slot`` (all reserved and drawn when the race starts), so no
+result depends on how the samples are grouped into kernel calls. Two ways to keep the SIMD lanes
+busy at the end of a call, where a round's few episodes would leave most lanes idle
+(docs/performance.md, Selection races):
+
+- **parking** (the CPU lanes): a call flies the samples the round asks for and, in the lanes they
+  leave idle, the same candidates' later samples; when the asked-for ones are over, the later ones
+  still in flight are parked and resumed by whichever call asks for them
+  (:meth:`~neurohover.flyer.KernelFlyer.fly_parked`). A round whose samples are all over already
+  needs no call.
+- **look-ahead** (elsewhere, e.g. CUDA): the race lists each undecided candidate's next samples at
+  once (``selection_race(batch=...)``), and later rounds use them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..flyer import KernelFlyer
+from ..launch import Parking
+from .fitness import episode_fitness
+
+__all__ = ["RaceSampler"]
+
+
+class RaceSampler:
+    """The ``sample_fn`` of one race (:func:`~neurohover.evolution.races.selection_race`).
+
+    Parameters
+    ----------
+    flyer : KernelFlyer
+        Flies the episodes; ``base`` .. ``base + n * t_limit - 1`` are reserved with it.
+    genomes : numpy.ndarray
+        ``(n, D)`` the candidates.
+    rows : numpy.ndarray
+        The MDP rows: ``n * t_limit`` (one per slot) with ``per_slot``, else one row for every sample.
+    base : int
+        The race's first episode index.
+    per_slot : bool
+        Whether each slot has its own MDP row.
+    fitness : str
+        The fitness scale of one episode (:func:`~neurohover.evolution.fitness.episode_fitness`).
+    t_limit : int
+        The most samples a candidate gets.
+    mu : int
+        How many candidates the race selects (the parked samples' order: :meth:`_contested_first`).
+    look_ahead : int
+        The race's look-ahead in episodes per call, where there is no parking.
+    parking : Parking or None
+        Slots for parked episodes (at least ``n * t_limit``; cleared here), or None for the look-ahead.
+
+    Attributes
+    ----------
+    batch : int
+        The look-ahead to give the race: 0 with parking.
+    slot_steps : numpy.ndarray
+        Control steps of each slot's sample over (0: not over).
+    """
+
+    def __init__(
+        self, flyer: KernelFlyer, genomes: np.ndarray, rows: np.ndarray, base: int, per_slot: bool, fitness: str, t_limit: int,
+        mu: int, look_ahead: int, parking: Parking | None,
+    ) -> None:  # fmt: skip
+        n = genomes.shape[0]
+        self.flyer, self.genomes, self.rows, self.base, self.per_slot, self.fitness = flyer, genomes, rows, base, per_slot, fitness
+        self.n, self.t_limit, self.mu, self.parking = n, t_limit, mu, parking
+        self.batch = 0 if parking is not None else look_ahead
+        self.asked = np.zeros(n, dtype=np.int64)  # samples asked for per candidate
+        self._over = np.zeros(n * t_limit, dtype=bool)
+        self._fitness = np.zeros(n * t_limit)
+        self.slot_steps = np.zeros(n * t_limit, dtype=np.int64)
+        if parking is not None:
+            parking.clear()
+
+    def __call__(self, idx: np.ndarray) -> np.ndarray:
+        """Each listed candidate's next sample (a candidate listed again: the one after), as fitness."""
+        idx = np.asarray(idx, dtype=np.int64)
+        t = np.empty_like(idx)
+        for q, i in enumerate(idx.tolist()):
+            t[q] = self.asked[i]
+            self.asked[i] += 1
+        slots = t * self.n + idx
+        if self.parking is None:
+            returns = self.flyer.fly(self.genomes, self.rows, idx, slots if self.per_slot else None, slots.shape[0], episode_index=self.base + slots)
+            self._keep(slots, returns, self.flyer.job_steps)
+        else:
+            need = slots[~self._over[slots]]
+            if need.size:
+                self._fly_parked(need, np.unique(idx))
+        return self._fitness[slots]
+
+    def used(self, n_samples: np.ndarray) -> np.ndarray:
+        """The slots a race used, given its ``n_samples`` per candidate (ascending)."""
+        t = np.arange(self.t_limit)
+        return np.flatnonzero((t[:, None] < n_samples[None, :]).ravel())
+
+    def _fly_parked(self, need: np.ndarray, candidates: np.ndarray) -> None:
+        # The optional jobs: the asked candidates' later samples (the race keeps its undecided candidates in
+        # lockstep), round by round, most contested first within a round: a candidate the race decides
+        # leaves its later samples unused, and one whose mean lies near the selection boundary is decided last.
+        t_next = int(self.asked[candidates].max())
+        later = (np.arange(t_next, self.t_limit)[:, None] * self.n + self._contested_first(candidates)[None, :]).ravel()
+        jobs = np.concatenate([need, later[~self._over[later]]])
+        assert self.parking is not None  # _fly_parked is called only with parking
+        returns = self.flyer.fly_parked(
+            self.genomes, self.rows, jobs % self.n, jobs if self.per_slot else None, self.base + jobs, jobs, need.shape[0], self.parking
+        )
+        over = self.flyer.job_steps > 0
+        self._keep(jobs[over], returns[over], self.flyer.job_steps[over])
+
+    def _contested_first(self, candidates: np.ndarray) -> np.ndarray:
+        """The candidates by the distance of their mean from the selection boundary (between the mu-th and
+        (mu+1)-th best means of all candidates), in standard errors, nearest first (a speed heuristic)."""
+        k = self.asked[candidates].min()
+        if k < 2 or self.n <= self.mu:
+            return candidates
+        asked = np.arange(self.t_limit)[:, None] < self.asked[None, :]
+        fit = np.where(asked, self._fitness.reshape(self.t_limit, self.n), 0.0)
+        count = np.maximum(self.asked, 1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            means = fit.sum(axis=0) / count
+            boundary = np.sort(means)[::-1][self.mu - 1 : self.mu + 1].mean()
+            var = (np.where(asked, fit - means, 0.0) ** 2).sum(axis=0) / np.maximum(count - 1, 1)
+            z = np.abs(means[candidates] - boundary) / np.sqrt(var[candidates] / count[candidates])
+        return candidates[np.argsort(np.nan_to_num(z, nan=np.inf), kind="stable")]
+
+    def _keep(self, slots: np.ndarray, returns: np.ndarray, steps: np.ndarray) -> None:
+        self._over[slots] = True
+        self._fitness[slots] = episode_fitness(returns, self.fitness)
+        self.slot_steps[slots] = steps
