@@ -61,3 +61,21 @@ def test_unit_params_refuse_a_key_they_do_not_declare() -> None:
     with pytest.raises(ValueError, match="does not declare"):
         unit_params("test_run", {**fields, "sensr": {}})
     assert unit_params("test_run", fields).sensor is None
+
+
+def test_a_group_with_seeds_of_flies_the_seeds_of_the_other_experiments_group() -> None:
+    # wind-fig8's groups take Figure 8's seeds: its wind-blind runs are Figure 8's runs, and the wind-aware
+    # runs fly the same gusts (the paired comparison issue 22 asks for).
+    figure = {u.key: u.params["seed"] for u in plan(load_config("fig8", "paper", {"policies": "shipped"}), {}).units}
+    wind = {u.key: u.params["seed"] for u in plan(load_config("wind-fig8", "paper"), {}).units}
+    assert wind["run/incremental/wind-aware/train3/rep5"] == wind["run/incremental/wind-blind/train3/rep5"] == figure["run/incremental/train3/rep5"]
+    assert wind["run/hybrid/wind-aware/train0/rep0"] == figure["run/hybrid/train0/rep0"] != figure["run/hybrid/train0/rep1"]
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [{"experiment": "fig8", "seed": 2010}, {"experiment": "", "seed": 1, "group": "hybrid"}, {"experiment": "fig8", "seed": -1, "group": "hybrid"}, "fig8"],
+)
+def test_a_bad_seeds_of_is_refused_when_the_config_loads(bad) -> None:
+    with pytest.raises(NeurohoverError, match="seeds_of"):
+        load_config("wind-fig8", "paper", {"groups": [{"agent": "hybrid", "n_mdps": 1, "seeds_of": bad}]})

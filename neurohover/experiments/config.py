@@ -158,6 +158,21 @@ def _drift_table():
     return _settings_table(Drift, "walk, change, change_at")
 
 
+def _seeds_of():
+    def check(v):
+        ok = (
+            isinstance(v, dict)
+            and set(v) == {"experiment", "seed", "group"}
+            and all(isinstance(v[k], str) and v[k] != "" for k in ("experiment", "group"))
+            and isinstance(v["seed"], int)
+            and not isinstance(v["seed"], bool)
+            and 0 <= v["seed"] <= 2**63 - 1
+        )
+        return ok, "a table {experiment = NAME, seed = ITS ROOT SEED, group = ITS GROUP'S LABEL}"
+
+    return check
+
+
 def _policy_source():
     def check(v):
         return isinstance(v, str) and v != "", "'evolve', 'shipped' or a directory holding <task>/ policy sets"
@@ -197,6 +212,8 @@ _GROUP = {
     "wind_model": (_OMIT, _choice("none", "constant", "sinusoid")),  # and their wind (neurohover.models.wind; absent: none)
     "sensor": (_OMIT, _sensor_table()),  # this group's agents fly the group's MDPs through these sensors
     "drift": (_OMIT, _drift_table()),  # and with these drifting dynamics (neurohover.tasks.drift)
+    # run i of MDP m takes the seed of that run of another experiment's group: the same gusts and draws (paired)
+    "seeds_of": (_OMIT, _seeds_of()),
 }
 
 SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {

@@ -59,8 +59,8 @@ def _mdps(family, which: str, n: int, seed: int):
     return [family.sample(np.random.default_rng(np.random.SeedSequence([seed, _SAMPLE_TAG, i])), label=f"{family.name}/sample:{i}") for i in range(n)]
 
 
-def _unit(cfg: ExperimentConfig, key: str, kind: str, params: dict, seed_key: str | None = None) -> Unit:
-    params = {**params, "seed": unit_seed(cfg.typed.seed, cfg.name, seed_key or key)}
+def _unit(cfg: ExperimentConfig, key: str, kind: str, params: dict, seed_key: str | None = None, seed: int | None = None) -> Unit:
+    params = {**params, "seed": unit_seed(cfg.typed.seed, cfg.name, seed_key or key) if seed is None else seed}
     return Unit(cfg.name, key, kind, params)
 
 
@@ -372,6 +372,10 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dic
             for rep in range(g.runs_per_mdp):
                 total += 1
                 key = UnitKey.make("run", g.label, f"{g.mdps}{i}", rep)
+                seed = None
+                if g.seeds_of is not None:  # the seed of the same run of another experiment's group
+                    of = g.seeds_of
+                    seed = unit_seed(of["seed"], of["experiment"], UnitKey.make("run", of["group"], f"{g.mdps}{i}", rep))
                 policies = pol.for_agent(g.agent, i if g.mdps == "train" else None, counter, g.exclude_own and g.mdps == "train", key)
                 counter += 1
                 if policies is None:
@@ -393,6 +397,7 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dic
                             **({"hybrid": hybrid} if hybrid else {}),
                             **({"agent_settings": g.settings} if g.settings is not None else {}),
                         },
+                        seed=seed,
                     )
                 )
     return Plan(units, total, tuple(getattr(pol, "waiting", ())))

@@ -42,6 +42,7 @@ class Group:
     wind_model: str = "none"  # the wind of the LR models its agents learn
     sensor: dict | None = None  # this group's sensors (None: the experiment's)
     drift: dict | None = None  # this group's drifting dynamics (None: the experiment's)
+    seeds_of: dict | None = None  # {experiment, seed, group}: its runs take that group's seeds (None: its own)
 
 
 @dataclass(frozen=True, kw_only=True)
