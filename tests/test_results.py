@@ -12,8 +12,7 @@ from pathlib import Path
 import pytest
 
 from neurohover.errors import NeurohoverError
-from neurohover.experiments import load_config, plan, run_unit
-from neurohover.experiments.units import strip_timing
+from neurohover.experiments import load_config, plan, run_unit, strip_timing
 from neurohover.experiments.results import (
     RESULT_TYPES,
     EvolveResult,
