@@ -39,7 +39,7 @@ from .sim.constants import (
     SAFEGUARD_TILT,
 )
 from .sim.kernel import GENOME_WIDTH
-from .tasks import MDP, Sensor
+from .tasks import MDP, Sensor, refuse_drift
 
 # Re-exported where they were first defined: KernelFlyer, DEVICES, check_device, num_threads, use_lanes.
 __all__ = [
@@ -159,6 +159,7 @@ class Evaluation:
 def mdp_rows(mdps: MDP | Sequence[MDP] | np.ndarray) -> np.ndarray:
     """MDPs as the (M, MDP_ROW_LEN) float64 array the kernel reads (an array's sensor slots checked)."""
     if isinstance(mdps, MDP):
+        refuse_drift(mdps, "this batch")
         return mdps.row()[None, :]
     if isinstance(mdps, np.ndarray):
         if mdps.ndim != 2 or mdps.shape[1] != MDP_ROW_LEN or not np.all(np.isfinite(mdps)):
@@ -174,6 +175,8 @@ def mdp_rows(mdps: MDP | Sequence[MDP] | np.ndarray) -> np.ndarray:
         return np.ascontiguousarray(mdps, dtype=float)
     if len(mdps) == 0 or not all(isinstance(m, MDP) for m in mdps):
         raise NeurohoverError("mdps must be an MDP or a non-empty sequence of MDPs")
+    for m in mdps:
+        refuse_drift(m, "this batch")
     return np.stack([m.row() for m in mdps])
 
 

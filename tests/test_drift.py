@@ -135,3 +135,78 @@ def test_the_benchmark_report_tabulates_agents_by_condition(cli, tmp_path) -> No
     assert header == "| agent | fixed | walk | change |"
     assert [r.split(" | ")[0] for r in rows] == ["| baseline", "| generic", "| model-free", "| incremental", "| hybrid", "| continual"]
     assert all(r.count("%") == 3 for r in rows)
+
+
+# -- Gymnasium: a drifting environment's episodes are test runs ---------------------------------------
+
+
+def _fly_baseline(env, **reset) -> tuple[float, tuple[int, int]]:
+    obs, info = env.reset(**reset)
+    policy, total, done = baseline_policy(), 0.0, False
+    while not done:
+        obs, reward, terminated, truncated, info = env.step(np.array(policy.act(obs)))
+        total += reward
+        done = terminated or truncated
+    return total, env.noise_stream
+
+
+def test_a_drifting_environment_flies_episode_e_of_its_run_on_drifted_row_e() -> None:
+    from neurohover.envs import HoverEnv
+
+    mdp = get_task_family("fghh").test_mdps()[2]
+    env = HoverEnv(task="fghh", mdp=mdp, episode_steps=150, drift={"walk": 0.05, "change": {"D_w": 0.5}, "change_at": [2, 2]})
+    flown = [_fly_baseline(env, seed=4)] + [_fly_baseline(env) for _ in range(3)]
+    run = env.drift_run
+    assert run is not None and env._info(False)["run_episode"] == 3
+    rows = env.drift.rows(mdp.row(), 4, run.seed)
+    for e, (total, (seed, index)) in enumerate(flown):
+        ev = evaluate_jobs([baseline_policy()], rows[e : e + 1], [0], [0], [index], seed=seed, n_steps=150)
+        assert not ev.crashed[0] and np.isclose(total, ev.returns[0], rtol=1e-12, atol=1e-9), e
+    assert len({round(t, 6) for t, _ in flown}) == 4  # the dynamics (and gusts) differ from episode to episode
+    _fly_baseline(env, seed=4)  # a seeded reset begins the run again: the same drift
+    assert env.drift_run.seed == run.seed and env._info(False)["run_episode"] == 0
+
+
+def test_an_explicit_mdps_own_drift_drifts_the_environment_and_no_drift_leaves_it_as_it_was() -> None:
+    from neurohover.envs import HoverEnv
+
+    mdp = get_task_family("ghh08").mdp("train:1")
+    plain = [_fly_baseline(HoverEnv(task="ghh08", mdp=mdp, episode_steps=100), seed=s)[0] for s in (1, 2)]
+    still = HoverEnv(task="ghh08", mdp=mdp.with_drift(Drift()), episode_steps=100)
+    assert [_fly_baseline(still, seed=s)[0] for s in (1, 2)] == plain and still.drift_run is None
+    own = HoverEnv(task="ghh08", mdp=mdp.with_drift(Drift(0.2)), episode_steps=100)
+    _fly_baseline(own, seed=1)
+    _fly_baseline(own)
+    assert own.drift_run is not None and own.drift_run.drift == Drift(0.2)
+
+
+@pytest.mark.parametrize("suffix", ["DriftingDynamics", "AbruptChange"])
+@pytest.mark.parametrize("task", ["GHH08", "GHH09", "FGHH"])
+def test_registered_drift_variants_pass_gymnasiums_checker(task: str, suffix: str) -> None:
+    import gymnasium as gym
+    from gymnasium.utils.env_checker import check_env
+
+    env = gym.make(f"neurohover/{task}-{suffix}-v0")
+    check_env(env.unwrapped, skip_render_check=True)
+    assert not env.unwrapped.drift.none
+    vec = gym.make_vec(f"neurohover/{task}-{suffix}-v0", num_envs=2, vectorization_mode="sync")
+    assert vec.reset(seed=0)[0].shape == (2, 12)
+
+
+def test_what_flies_a_drifting_mdp_as_fixed_refuses_it_by_name() -> None:
+    from neurohover.envs import HoverEnv, HoverVectorEnv
+    from neurohover.evolution.evolve import evolve
+
+    drifting = get_task_family("ghh08").mdp("train:1").with_drift(Drift(0.01))
+    with pytest.raises(NeurohoverError, match="ghh08/train:1 has drifting dynamics .* which this batch would fly as if fixed"):
+        evaluate_jobs([baseline_policy()], drifting, [0], [0], [0], n_steps=10)
+    with pytest.raises(NeurohoverError, match="which evolution would fly as if fixed"):
+        evolve(drifting, budget=10, n_steps=10)
+    with pytest.raises(NeurohoverError, match="which evolution would fly as if fixed"):
+        evolve(get_task_family("fghh", drift=Drift(0.01)), budget=10, n_steps=10)
+    with pytest.raises(NeurohoverError, match="which the vector environment"):
+        HoverVectorEnv(2, task="ghh08", mdp=drifting)
+    with pytest.raises(NeurohoverError, match="drift=3 is not allowed"):
+        HoverEnv(task="ghh08", drift=3)
+    with pytest.raises(NeurohoverError, match="not a dynamics parameter"):
+        HoverEnv(task="ghh08", drift="D_x=0.8")

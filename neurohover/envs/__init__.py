@@ -6,7 +6,9 @@ Ids: ``neurohover/GHH08-v0``, ``neurohover/GHH09-v0`` and ``neurohover/FGHH-v0``
 steps left of the short episode, float32 observations and actions (:class:`HoverEnv`'s docstring
 has the table); and ``neurohover/<NAME>-NoisySensors-v0``, ``-CorrelatedSensors-v0`` and
 ``-DelayedSensors-v0``: the paper's episodes seen through the harder sensors of its Section 7
-(:data:`SENSOR_ENV_SETTINGS`, :mod:`neurohover.tasks.sensor`). ``gymnasium.make`` builds :class:`HoverEnv`;
+(:data:`SENSOR_ENV_SETTINGS`, :mod:`neurohover.tasks.sensor`); and ``-DriftingDynamics-v0`` and
+``-AbruptChange-v0``: test runs of one MDP whose dynamics drift between episodes
+(:data:`DRIFT_ENV_SETTINGS`, :mod:`neurohover.tasks.drift`). ``gymnasium.make`` builds :class:`HoverEnv`;
 ``gymnasium.make_vec(..., vectorization_mode="vector_entry_point")`` builds
 :class:`HoverVectorEnv`, which steps every helicopter in one kernel call.
 """
@@ -37,19 +39,29 @@ SENSOR_ENV_SETTINGS: dict[str, dict] = {
 #: Every sensor variant id and its task family.
 SENSOR_ENV_IDS: dict[str, str] = {f"neurohover/{name.upper()}-{suffix}-v0": name for name in TASK_NAMES for suffix in SENSOR_ENV_SETTINGS}
 
+#: The drifting-dynamics variants' settings (:mod:`neurohover.tasks.drift`), by the suffix of their ids: their
+#: episodes are test runs of one MDP (HoverEnv's docstring), so they have no vector entry point.
+DRIFT_ENV_SETTINGS: dict[str, dict] = {
+    "DriftingDynamics": {"drift": {"walk": 0.01}},  # a slow log random walk of the 11 dynamics parameters
+    "AbruptChange": {"drift": {"change": {"D_w": 0.8}}},  # the collective's gain loses 20 % at an episode in 200..800
+}
+DRIFT_ENV_IDS: dict[str, str] = {f"neurohover/{name.upper()}-{suffix}-v0": name for name in TASK_NAMES for suffix in DRIFT_ENV_SETTINGS}
+
 
 def register_envs() -> None:
     """Register the environments with Gymnasium; ids already registered are left alone."""
     ids: list[tuple[str, str, dict, int]] = [(env_id, task, {}, EPISODE_STEPS) for env_id, task in ENV_IDS.items()]
     ids += [(env_id, task, SHORT_SETTINGS, SHORT_EPISODE_STEPS) for env_id, task in SHORT_ENV_IDS.items()]
     ids += [(env_id, task, SENSOR_ENV_SETTINGS[env_id.split("-")[1]], EPISODE_STEPS) for env_id, task in SENSOR_ENV_IDS.items()]
+    ids += [(env_id, task, DRIFT_ENV_SETTINGS[env_id.split("-")[1]], EPISODE_STEPS) for env_id, task in DRIFT_ENV_IDS.items()]
     for env_id, task, settings, limit in ids:
         if env_id in gymnasium.registry:  # re-import or reload: Gymnasium would warn about overriding
             continue
+        vector = None if "drift" in settings else "neurohover.envs.vector:HoverVectorEnv"
         gymnasium.register(
             id=env_id,
             entry_point="neurohover.envs.hover:HoverEnv",
-            vector_entry_point="neurohover.envs.vector:HoverVectorEnv",
+            vector_entry_point=vector,
             max_episode_steps=limit,
             kwargs={"task": task, **settings},
         )
@@ -57,4 +69,14 @@ def register_envs() -> None:
 
 register_envs()
 
-__all__ = ["ENV_IDS", "SENSOR_ENV_IDS", "SENSOR_ENV_SETTINGS", "SHORT_ENV_IDS", "HoverEnv", "HoverVectorEnv", "register_envs"]
+__all__ = [
+    "DRIFT_ENV_IDS",
+    "DRIFT_ENV_SETTINGS",
+    "ENV_IDS",
+    "SENSOR_ENV_IDS",
+    "SENSOR_ENV_SETTINGS",
+    "SHORT_ENV_IDS",
+    "HoverEnv",
+    "HoverVectorEnv",
+    "register_envs",
+]

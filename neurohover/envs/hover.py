@@ -35,6 +35,7 @@ from ..sim.reference import competition_time
 from ..sim.rng import seed_stream
 from ..sim.step import ENV_NOISE_WIDTH, ENV_RNG_WIDTH, start_readings, step_batch
 from ..tasks import MDP, TASK_FAMILIES, TaskFamily, get_task_family
+from ..tasks.drift import Drift, DriftRun
 from ..tasks.sensor import Sensor
 
 RENDER_FPS = 10  # control rate (Hz)
@@ -99,7 +100,7 @@ def check_noise_stream(value: Any, what: str = "noise") -> tuple[int, int]:
 
 
 #: What ``gymnasium.make`` may pass to :class:`HoverEnv` (its ``max_episode_steps`` is Gymnasium's own).
-ENV_KWARGS = ("task", "sigma", "mdp", "episode_steps", "render_mode", "obs_dtype", "action_dtype", "obs_noise", "obs_delay")
+ENV_KWARGS = ("task", "sigma", "mdp", "episode_steps", "render_mode", "obs_dtype", "action_dtype", "obs_noise", "obs_delay", "drift")
 
 
 def sensed_family(task: str, sigma: float | None, obs_noise: Any, obs_delay: Any) -> TaskFamily:
@@ -309,6 +310,20 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
       settings (``velocity``, ``position``, ``rates``, ``attitude``, ``correlation``, ``level``) or
       a ``Sensor``. Observations are then the noisy readings; reward and crash stay on the true
       state. ``obs_delay``: control steps (0..10) the readings arrive late.
+    - ``drift``: drifting dynamics (:mod:`neurohover.tasks.drift`): ``None`` (fixed, default), a
+      :class:`neurohover.tasks.Drift`, a dict of its settings (``walk``, ``change``, ``change_at``)
+      or the command line's text (``"walk=0.01,D_w=0.8@200-800"``); an explicit MDP with a drift of
+      its own drifts so too. The episodes then make up test runs: ``reset(seed=s)`` (or an ``mdp``
+      option, or the first reset) begins a run, drawing its MDP (``"sample"``) and then its drift's
+      seed from ``np_random``; each later ``reset()`` is the run's next episode, on the same MDP
+      with its dynamics drifted to that episode. ``info["run_episode"]`` counts the run's episodes
+      from 0; ``info["mdp_info"]`` describes the run's MDP as drawn.
+
+    | Id                                        | drift                                          |
+    |-------------------------------------------|------------------------------------------------|
+    | ``neurohover/GHH08-DriftingDynamics-v0``  | walk 0.01 (about G's breadth after 1000 runs)  |
+    | ``neurohover/GHH08-AbruptChange-v0``      | D_w x 0.8 at an episode drawn from 200..800    |
+    | (likewise GHH09-, FGHH-)                  |                                                |
 
     ``reset(seed=..., options=...)`` takes the options ``{"mdp": spec}`` (same values as the
     ``mdp`` argument; it also applies to later episodes) and ``{"noise": (seed, episode)}``
@@ -366,9 +381,11 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         action_dtype: Any = "float64",
         obs_noise: Any = None,
         obs_delay: Any = None,
+        drift: Any = None,
         **unknown: Any,
     ) -> None:
         check_no_unknown_kwargs(unknown, ENV_KWARGS)
+        self.drift = Drift.of(drift)
         self.render_mode = check_render_mode(render_mode)
         self.obs_dtype = check_obs_dtype(obs_dtype)
         self.action_dtype = check_action_dtype(action_dtype)
@@ -391,6 +408,9 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         self._mdp: MDP | None = None
         self._mdp_info: dict[str, Any] = {}
         self._stream: tuple[int, int] | None = None
+        self._run: DriftRun | None = None  # the test run that a drifting environment's episodes make up
+        self._run_mdp: MDP | None = None
+        self._run_episode = 0
         self._done = True
         # Rendering state: read by render() only, so it cannot change the episode.
         self._return = 0.0
@@ -402,6 +422,11 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
     def mdp(self) -> MDP | None:
         """The MDP of the current episode (None before the first reset)."""
         return self._mdp
+
+    @property
+    def drift_run(self) -> DriftRun | None:
+        """The current test run of drifting dynamics (its ``seed`` and rows; None without drift)."""
+        return self._run
 
     @property
     def noise_stream(self) -> tuple[int, int] | None:
@@ -419,7 +444,22 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         return self._return
 
     def _info(self, crashed: bool) -> dict[str, Any]:
-        return {"mdp": self._mdp_info["label"], "crashed": crashed, "mdp_info": dict(self._mdp_info)}
+        info = {"mdp": self._mdp_info["label"], "crashed": crashed, "mdp_info": dict(self._mdp_info)}
+        if self._run is not None:
+            info["run_episode"] = self._run_episode
+        return info
+
+    def _drifted(self, spec: MDP | str, new_run: bool) -> tuple[MDP, np.ndarray]:
+        """The MDP of this episode of the test run and the (drifted) row it flies: a seeded reset, a new
+        ``mdp`` option or the first reset begins a run (its MDP, then its drift seed, drawn here)."""
+        if new_run or self._run is None or self._run_mdp is None:
+            mdp = self.family.sample(self.np_random) if isinstance(spec, str) else spec
+            drift = self.drift if not self.drift.none else mdp.drift
+            self._run = DriftRun(drift, mdp.row(), int(self.np_random.integers(2**63 - 1)))
+            self._run_mdp, self._run_episode = mdp, 0
+        else:
+            self._run_episode += 1
+        return self._run_mdp, self._run.row(self._run_episode)
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
         super().reset(seed=seed)
@@ -428,12 +468,16 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         spec = resolve_mdp(self.family, options["mdp"]) if "mdp" in options else self._spec
         stream = check_noise_stream(options["noise"]) if "noise" in options else None
         self._spec = spec
-        mdp = self.family.sample(self.np_random) if isinstance(spec, str) else spec  # a str spec is SAMPLE
+        if self.drift.none and (isinstance(spec, str) or spec.drift.none):
+            mdp = self.family.sample(self.np_random) if isinstance(spec, str) else spec  # a str spec is SAMPLE
+            row = mdp.row()
+        else:  # drifting dynamics: the episodes are a test run of one MDP (neurohover.tasks.drift)
+            mdp, row = self._drifted(spec, seed is not None or "mdp" in options)
         if stream is None:
             stream = (draw_stream_seed(self.np_random), 0)
         self._mdp = mdp
         self._stream = stream
-        self._rows[0] = mdp.row()
+        self._rows[0] = row
         self._state[0] = initial_state()
         self._noise.fill(0.0)
         seed_stream(self._rng[0], np.uint64(stream[0]), np.uint64(stream[1]))

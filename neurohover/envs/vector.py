@@ -31,7 +31,7 @@ from ..evaluate import check_device
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS, MDP_ROW_LEN, OBS_DIM
 from ..sim.rng import seed_stream
 from ..sim.step import ENV_NOISE_WIDTH, ENV_RNG_WIDTH, start_readings, step_batch
-from ..tasks import MDP, TaskFamily
+from ..tasks import MDP, TaskFamily, refuse_drift
 from .hover import (
     RENDER_FPS,
     SAMPLE,
@@ -240,12 +240,17 @@ class HoverVectorEnv(VectorEnv):
     def _resolve_specs(self, value: Any) -> list[MDP | str]:
         cache: dict[str, MDP] = {}
         if isinstance(value, (str, MDP)):
-            return [resolve_mdp(self.family, value, cache)] * self.num_envs
-        if isinstance(value, (list, tuple)):
+            specs = [resolve_mdp(self.family, value, cache)] * self.num_envs
+        elif isinstance(value, (list, tuple)):
             if len(value) != self.num_envs:
                 raise NeurohoverError(f"mdp has {len(value)} entries but there are num_envs={self.num_envs} sub-environments")
-            return [resolve_mdp(self.family, v, cache) for v in value]
-        return [resolve_mdp(self.family, value, cache)]  # raises with the allowed values
+            specs = [resolve_mdp(self.family, v, cache) for v in value]
+        else:
+            return [resolve_mdp(self.family, value, cache)]  # raises with the allowed values
+        for spec in specs:
+            if isinstance(spec, MDP):
+                refuse_drift(spec, "the vector environment (one episode per sub-environment, no runs)")
+        return specs
 
     def _check_seeds(self, seed: Any) -> list[int | None]:
         n = self.num_envs

@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import NeurohoverError
 from ..policies import TOPOLOGIES, Policy
 from ..policies import prototype as make_prototype
-from ..tasks import MDP, TaskFamily
+from ..tasks import MDP, TaskFamily, refuse_drift
 from .generational import GENERATIONAL_PRESETS, OLD_GENERATIONAL, GenerationalSettings
 from .optimisers import NE, OPTIMISERS, optimiser_names, population_settings
 from .optimisers.cma import CMASettings
@@ -100,6 +100,8 @@ def resolve_prototype(prototype, topology: str) -> Policy:
 
 def resolve_target(target) -> tuple[MDP | None, TaskFamily | None, dict]:
     """``(mdp or None, family or None, description dict)`` of an MDP, a learned model or a task family."""
+    if isinstance(target, (MDP, TaskFamily)):
+        refuse_drift(target, "evolution")
     if isinstance(target, MDP):
         return target, None, {"kind": "mdp", "mdp": target.to_dict()}
     if isinstance(target, TaskFamily):

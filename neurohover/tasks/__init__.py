@@ -27,7 +27,7 @@ import pkgutil
 
 from ..errors import NeurohoverError
 from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, competition_rows, finite_vector
-from .drift import NO_DRIFT, Drift
+from .drift import NO_DRIFT, Drift, refuse_drift
 from .fghh import COMPETITION_FGHH_SIGMA, FGHH
 from .ghh08 import GHH08, MAX_WIND
 from .ghh09 import GHH09, GHH09_PARAM_NAMES
@@ -108,4 +108,5 @@ __all__ = [
     "family_for",
     "finite_vector",
     "get_task_family",
+    "refuse_drift",
 ]

@@ -114,6 +114,20 @@ class Drift:
         return cls(d.get("walk", 0.0), tuple(change.items()), d.get("change_at", CHANGE_AT))  # checked in __post_init__
 
     @classmethod
+    def of(cls, value) -> Drift:
+        """The drift of a ``drift`` option (of the environments): None (none), a :class:`Drift`, a dict of
+        its settings (:meth:`from_dict`) or the command line's text (:meth:`parse`)."""
+        if value is None:
+            return NO_DRIFT
+        if isinstance(value, Drift):
+            return value
+        if isinstance(value, dict):
+            return cls.from_dict(value)
+        if isinstance(value, str):
+            return cls.parse(value)
+        raise NeurohoverError(f"drift={value!r} is not allowed: give None, a Drift, a dict of walk/change/change_at or text ({_PARSE_FORM})")
+
+    @classmethod
     def parse(cls, text: str) -> Drift:
         """A drift from the command line: ``walk=0.01``, ``D_w=0.8@200-800`` (a change, at an episode in 200..800), or both, comma-separated."""
         walk, change, at = 0.0, {}, CHANGE_AT
@@ -137,3 +151,28 @@ class Drift:
 
 
 NO_DRIFT = Drift()
+
+
+class DriftRun:
+    """The rows that the episodes of one test run of a drifting MDP fly, one at a time (an environment
+    resets through them): ``row(e)`` is ``drift.rows(row, e + 1, seed)[e]``, computed in growing blocks."""
+
+    def __init__(self, drift: Drift, row: np.ndarray, seed: int) -> None:
+        self.drift, self._row, self.seed = drift, np.asarray(row, dtype=float), int(seed)
+        self._rows = np.zeros((0, self._row.shape[0]))
+
+    def row(self, episode: int) -> np.ndarray:
+        if episode >= self._rows.shape[0]:  # a longer prefix of the same draws: the earlier rows do not change
+            self._rows = self.drift.rows(self._row, max(2 * self._rows.shape[0], episode + 1, 1024), self.seed)
+        return self._rows[episode]
+
+
+def refuse_drift(mdp, where: str) -> None:
+    """A clear error where an MDP (or task family) that drifts would be flown as if its dynamics were fixed:
+    only test runs and :class:`neurohover.envs.HoverEnv` fly the drift."""
+    if not mdp.drift.none:
+        raise NeurohoverError(
+            f"{getattr(mdp, 'label', None) or mdp.name} has drifting dynamics ({mdp.drift.to_dict()}), which {where} would fly as if fixed: "
+            "drift is flown by test runs (compete, run_test, test-runs configs) and HoverEnv(drift=...); "
+            "for the fixed dynamics use .with_drift(Drift())"
+        )
