@@ -12,7 +12,7 @@ from neurohover.agents.protocol import run_test
 from neurohover.agents.registry import agent_spec, policies_from_set
 from neurohover.agents.spec import AgentOptions
 from neurohover.policysets import load_policy_set
-from neurohover.tasks import Drift
+from neurohover.tasks import Drift, Sensor
 
 EVOLUTION = ModelEvolution(budget=600, n_steps=1000)
 STRONGER_ROTORS = Drift(0.0, (("D_p", 2.5), ("D_q", 2.5)), (25, 25))  # roll and pitch gains x2.5 at episode 25
@@ -66,3 +66,31 @@ def test_it_runs_on_every_family_and_takes_a_config_groups_settings(tmp_path) ->
     agent = unit_agent(unit.params)
     assert agent.settings == ContinualSettings(window=3, threshold=1.5)
     assert np.isfinite(agent.settings.threshold)
+
+
+def test_a_cooldown_bounds_the_re_learning_where_every_policy_crashes() -> None:
+    # Readings 0.4 s late: every policy crashes in every episode, so each crash would start a new phase.
+    spec = agent_spec("continual")
+    family = get_task_family("ghh08")
+    mdp = family.mdp("test:3").with_sensor(Sensor(delay=4))
+    runs = {}
+    for cooldown in (0, 3):
+        options = AgentOptions(evolution=ModelEvolution(budget=100, n_steps=300), settings=ContinualSettings(max_learning_episodes=2, cooldown=cooldown))
+        agent = spec.build(policies_from_set(spec, load_policy_set("ghh08")), options)
+        run = run_test(agent, family, mdp, episodes=40, seed=2, n_steps=300)
+        assert run.crashed.all()
+        runs[cooldown] = agent.relearned_at
+    eager, patient = runs[0], runs[3]
+    assert len(eager) >= 12 and set(np.diff(eager)) == {3}  # a phase of 2 episodes, a crash, a new phase: all run long
+    # The first phase (episodes 0-1) fails: quiet for 3 x 2 episodes, a new phase at the crash of episode 7
+    # (8-9) fails too: quiet for 3 x 4, a phase after episode 21 (22-23), then 3 x 8 reaches past the run.
+    assert patient == [7, 21]
+
+
+@pytest.mark.parametrize("task", ["ghh09", "fghh"])
+def test_it_flies_on_every_family(task: str) -> None:
+    spec = agent_spec("continual")
+    family = get_task_family(task)
+    agent = spec.build(policies_from_set(spec, load_policy_set(task)), AgentOptions(evolution=ModelEvolution(budget=60, n_steps=200)))
+    run = run_test(agent, family, family.test_mdps()[0].with_drift(Drift(0.05)), episodes=6, seed=1, n_steps=200)
+    assert agent.models >= 1 and np.isfinite(run.returns).all() and run.returns.shape == (6,)

@@ -132,9 +132,9 @@ def test_the_benchmark_report_tabulates_agents_by_condition(cli, tmp_path) -> No
     text = (tmp_path / "report" / "report.md").read_text()
     section = text[text.index("### Agents by condition") :]
     header, rule, *rows = section.split("\n\n")[1].splitlines()
-    assert header == "| agent | fixed | walk | change |"
+    assert header == "| agent | fixed | walk | change | load |"
     assert [r.split(" | ")[0] for r in rows] == ["| baseline", "| generic", "| model-free", "| incremental", "| hybrid", "| continual"]
-    assert all(r.count("%") == 3 for r in rows)
+    assert all(r.count("%") == 4 for r in rows)
 
 
 # -- Gymnasium: a drifting environment's episodes are test runs ---------------------------------------

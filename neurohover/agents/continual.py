@@ -20,6 +20,10 @@ threshold                   2.0      re-learn once an episode's one-step error e
 patience                    2        ... in this many consecutive episodes (a crash re-learns at once)
 max_learning_episodes       10       episodes of one learning phase, then the phase's best policy is kept
 safeguard                   True     fly with the generic policy as the safeguard's fallback
+cooldown                    0        after a phase, changes (and crashes) do not start another for this
+                                     many episodes, doubled after each phase in a row that ended without
+                                     meeting its prediction (0: re-learn at once; it bounds the model
+                                     evolutions of a run where every policy crashes)
 ==========================  =======  ==================================================================
 """
 
@@ -49,12 +53,16 @@ class ContinualSettings(AgentSettings):
     patience: int = 2
     max_learning_episodes: int = 10
     safeguard: bool = True
+    cooldown: int = 0
 
     def __post_init__(self) -> None:
         for name in ("window", "patience", "max_learning_episodes"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, int) or v < 1:
                 raise NeurohoverError(f"continual {name}={v!r} is out of range: allowed an integer >= 1")
+        c = self.cooldown
+        if isinstance(c, bool) or not isinstance(c, int) or not 0 <= c <= 10**6:
+            raise NeurohoverError(f"continual cooldown={c!r} is out of range: allowed an integer in 0..1000000 (episodes)")
         t = self.threshold
         if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t <= 1:
             raise NeurohoverError(f"continual threshold={t!r} is out of range: allowed a number > 1 (a ratio of one-step errors)")
@@ -84,6 +92,8 @@ class ContinualAgent(Agent):
         self.strikes = 0
         self.models = 0
         self.relearned_at: list[int] = []  # episodes after which a change was detected
+        self.quiet_until = -1  # no new phase before this episode (the cooldown)
+        self.failed_phases = 0  # phases in a row that ended without meeting their prediction
 
     def start(self, family: TaskFamily, rng: np.random.Generator) -> None:
         self._reset(rng)
@@ -129,6 +139,8 @@ class ContinualAgent(Agent):
             if not met:  # the phase's best policy, watched against the model it was evolved on
                 _, self.policy, self.label, self.policy_model, self.reference_error = self.phase_best
             self.learning, self.strikes = False, 0
+            self.failed_phases = 0 if met else self.failed_phases + 1
+            self.quiet_until = outcome.episode + self.settings.cooldown * 2**self.failed_phases
             return
         self._evolve()
 
@@ -140,6 +152,8 @@ class ContinualAgent(Agent):
                 error = float(one_step_error(self.policy_model, latest))
                 self.strikes = self.strikes + 1 if error > self.settings.threshold * self.reference_error else 0
                 stale = self.strikes >= self.settings.patience
+        if stale and outcome.episode < self.quiet_until:  # cooling down: fly on (the safeguard still acts)
+            stale, self.strikes = False, 0
         if stale:  # the dynamics moved away from the model: learn again from the recent episodes
             self.relearned_at.append(outcome.episode)
             self.learning, self.phase_start, self.strikes = True, outcome.episode + 1, 0
