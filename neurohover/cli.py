@@ -11,12 +11,14 @@ import json
 import os
 import sys
 from collections.abc import Sequence
+from dataclasses import fields
 
 import numpy as np
 
 from . import __version__
 from .errors import NeurohoverError
 from .sim.constants import EPISODE_STEPS
+from .tasks.sensor import Sensor
 
 # Modules of later pipeline stages; each has ``register(subparsers)`` adding its commands.
 COMMAND_MODULES: tuple[str, ...] = ("neurohover.commands_learning", "neurohover.commands_agents", "neurohover.commands_reproduce", "neurohover.commands_plots")
@@ -56,15 +58,13 @@ def add_sensor_options(p: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--obs-noise",
         help="sensor noise on what the policy sees: a level (e.g. 0.5: std 0.05 m/s, 0.05 m, 0.05 rad/s, 0.005) or key=value pairs "
-        "of velocity, position, rates, attitude (stds), correlation (AR(1), 0 <= c < 1), level",
+        f"of {', '.join(f.name for f in fields(Sensor) if f.name != 'delay')} or level (docs/benchmarks.md)",
     )
     g.add_argument("--obs-delay", type=int, help="control steps (0..10, 0.1 s each) the readings arrive late (default 0)")
 
 
 def sensor_of(args: argparse.Namespace):
     """The sensor of --obs-noise/--obs-delay (None where neither is given: exact sensors)."""
-    from .tasks import Sensor
-
     noise, delay = getattr(args, "obs_noise", None), getattr(args, "obs_delay", None)
     return None if noise is None and delay is None else Sensor.of(noise, delay)
 

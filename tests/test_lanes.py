@@ -15,7 +15,7 @@ from neurohover.evaluate import KernelFlyer, PolicyTable, num_threads
 from neurohover.launch import Flown, Parking
 from neurohover.launch import use_lanes as _use_lanes
 from neurohover.policies import GENOME_LENGTH
-from neurohover.sim.constants import SAFEGUARD_LIMITS
+from neurohover.sim.constants import ROW_DT, ROW_SUBSTEPS, ROW_WIND_KIND, SAFEGUARD_LIMITS
 from neurohover.sim.kernel import POLICY_SLP, rollout_batch
 from neurohover.sim.lanes import LANES, fly_lanes, rollout_lanes, rollout_lanes_parked
 from neurohover.tasks import Sensor
@@ -23,7 +23,7 @@ from neurohover.tasks import Sensor
 ZERO_MDP = get_task_family("fghh").zero()
 ZERO = ZERO_MDP.row()
 COARSE = ZERO.copy()
-COARSE[17], COARSE[18] = 1, 0.1  # one substep of 0.1 s, as a learned model flies
+COARSE[ROW_SUBSTEPS], COARSE[ROW_DT] = 1, 0.1  # one substep of 0.1 s, as a learned model flies
 MLP = PolicyTable.from_policies([prototype("mlp", "baseline")])
 
 
@@ -201,7 +201,7 @@ def test_mixed_rows_really_differ() -> None:
     for name, rows in MIXED_ROWS.items():
         a = np.stack(rows)
         assert (a[:, [0, 1, 3, 5, 7, 9]].std(axis=0) > 0).any() or (a[:, 19:28].std(axis=0) > 0).any(), name
-    assert all(r[19] != 0 for r in GHH08 + GHH09)
+    assert all(r[ROW_WIND_KIND] != 0 for r in GHH08 + GHH09)
 
 
 def test_rollout_lanes_refuses_rows_it_cannot_pack() -> None:

@@ -60,7 +60,7 @@ Modules
 This module is the public entry point; the run itself lives in :mod:`~neurohover.evolution.config`
 (what defines a run), :mod:`~neurohover.evolution.run` (the loop), :mod:`~neurohover.evolution.records`
 (results, history, checkpoint files) and :mod:`~neurohover.evolution.seeding`; the candidates fly
-through :class:`neurohover.evaluate.KernelFlyer`.
+through :class:`neurohover.flyer.KernelFlyer`.
 
 Example
 -------
@@ -173,7 +173,7 @@ def evolve(
         Kernel threads (default: all cores); results do not depend on it. Unused on ``"cuda"``.
     device : {"cpu", "cuda"}
         Where the candidates fly: the CPU kernel (default) or its CUDA build on a GPU
-        (:class:`~neurohover.evaluate.KernelFlyer`); results agree to within docs/gpu.md's
+        (:class:`~neurohover.flyer.KernelFlyer`); results agree to within docs/gpu.md's
         tolerance. Not part of the run's config: a checkpoint resumes on either device.
     progress : callable, optional
         Called with a :class:`ProgressInfo` after a generation at most every ``progress_every_s``
@@ -187,7 +187,7 @@ def evolve(
         Default: steady state for an MDP, generational for a family.
     _trace : list, optional
         For benchmarks: receives every kernel call's jobs (:attr:`KernelFlyer.trace
-        <neurohover.evaluate.KernelFlyer>`).
+        <neurohover.flyer.KernelFlyer>`).
     _flown : dict, optional
         For benchmarks: receives ``steps``, the control steps the kernel flew (a race flies some it
         does not use: parked or look-ahead samples).

@@ -1,7 +1,7 @@
 """The evolution run loop: ask, fly, tell, record, checkpoint (what :func:`~neurohover.evolution.evolve.evolve` drives).
 
 A :class:`Run` holds one run's whole state: its optimiser (any :class:`~.common.Optimiser`), the
-:class:`~neurohover.evaluate.KernelFlyer` that flies the candidates and counts the episodes, the
+:class:`~neurohover.flyer.KernelFlyer` that flies the candidates and counts the episodes, the
 generator of the task family's MDPs, counters and history. :meth:`Run.state` is the checkpoint
 and :meth:`Run.restore` continues from one bit-for-bit.
 """

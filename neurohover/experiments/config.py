@@ -33,7 +33,7 @@ import functools
 import hashlib
 import json
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
@@ -136,7 +136,7 @@ def _resampling():
 
 
 def _settings_table(cls, keys: str):
-    """A table that ``cls.from_dict`` reads (a Sensor's or a Drift's), checked by it."""
+    """A table that ``cls.from_dict`` reads (a Sensor's or a Drift's), checked by it; ``keys`` names its settings."""
 
     def check(v):
         if not isinstance(v, dict):
@@ -151,11 +151,11 @@ def _settings_table(cls, keys: str):
 
 
 def _sensor_table():
-    return _settings_table(Sensor, "level, velocity, position, rates, attitude, correlation, delay")
+    return _settings_table(Sensor, ", ".join(["level", *(f.name for f in fields(Sensor))]))
 
 
 def _drift_table():
-    return _settings_table(Drift, "walk, change, change_at")
+    return _settings_table(Drift, ", ".join(f.name for f in fields(Drift) if f.init))
 
 
 def _seeds_of():

@@ -2,7 +2,7 @@
 
 The planner writes a unit's params as plain data (the store keeps them beside its result); its
 runner reads them through :func:`unit_params` into these classes, which refuse a key they do not
-declare (tests/test_experiments.py parses every planned unit of every shipped config, so the
+declare (tests/test_experiment_settings.py parses every planned unit of every shipped config, so the
 planner and these declarations cannot drift apart). Optional keys the planner leaves out are None.
 """
 

@@ -53,7 +53,8 @@ WIND_CONSTANT = 1  # GHH-08: (wind_u, wind_v) in m/s, world frame
 WIND_SINUSOID = 2  # GHH-09: (maxf, freq, phase, center) for x then y, each in [0, 1]
 
 # Layout of an MDP row.
-ROW_PARAMS = slice(0, 11)
+ROW_PARAMS_START = 0  # the 11 dynamics parameters (PARAM_NAMES order)
+ROW_PARAMS = slice(ROW_PARAMS_START, ROW_PARAMS_START + 11)
 ROW_NOISE_START = 11
 ROW_NOISE = slice(ROW_NOISE_START, ROW_NOISE_START + 6)
 ROW_SUBSTEPS = 17

@@ -37,6 +37,7 @@ from .constants import (
     ROW_D_U,
     ROW_DT,
     ROW_NOISE_START,
+    ROW_PARAMS_START,
     ROW_SENSOR_START,
     ROW_SUBSTEPS,
     ROW_WIND_KIND,
@@ -252,7 +253,8 @@ def unpack_mdp(row):
     else:
         ax, ox, phx, cx, ay, oy, phy, cy = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     wind = (kind, ax, ox, phx, cx, ay, oy, phy, cy)
-    dyn = (row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7], row[8], row[9], row[10], row[ROW_D_U])  # ROW_PARAMS, then D_u
+    p = ROW_PARAMS_START
+    dyn = (row[p], row[p + 1], row[p + 2], row[p + 3], row[p + 4], row[p + 5], row[p + 6], row[p + 7], row[p + 8], row[p + 9], row[p + 10], row[ROW_D_U])
     noise_std = (row[s], row[s + 1], row[s + 2], row[s + 3], row[s + 4], row[s + 5])
     return dyn, noise_std, int(row[ROW_SUBSTEPS]), row[ROW_DT], wind
 

@@ -7,8 +7,9 @@ lane, and its policy reads them instead of the packed observation.
 records flight data or has a safeguard and their MDP rows share the substep count and whether
 there is wind, LANES episodes per thread in lockstep, each lane with its own job's genome and MDP
 row, and writes bit-identical returns, crash flags and steps (about 2.2x the scalar kernel's
-episodes/s per core, docs/performance.md). :func:`neurohover.evaluate.evaluate_jobs` and
-:meth:`neurohover.evaluate.KernelFlyer.fly` choose it for such batches of at least LANES jobs.
+episodes/s per core, docs/performance.md). :func:`neurohover.launch.launch` chooses it for such batches of at least LANES jobs
+(:func:`neurohover.evaluate.evaluate_jobs` and the evolution's :class:`neurohover.flyer.KernelFlyer`
+fly through it).
 :func:`rollout_lanes_parked` is the same with optional jobs and parking: a selection race's later
 samples fill the lanes its round leaves idle, and an episode in flight when the round's samples are
 over is kept and resumed by a later call (docs/performance.md, Selection races).
@@ -35,7 +36,7 @@ import numpy as np
 from numba.core import types
 from numba.extending import intrinsic
 
-from .constants import SENSOR_SCRATCH, WIND_SINUSOID
+from .constants import ROW_SUBSTEPS, ROW_WIND_KIND, SENSOR_SCRATCH, WIND_SINUSOID
 from .kernel import (
     clip_action,
     competition_time,
@@ -251,8 +252,8 @@ def fly_queue(
     n_jobs = episodes.shape[0]
     if n_jobs == 0:
         return
-    n_sub = int(mdp_rows[job_mdp[0], 17])
-    has_wind = int(mdp_rows[job_mdp[0], 19]) != 0
+    n_sub = int(mdp_rows[job_mdp[0], ROW_SUBSTEPS])
+    has_wind = int(mdp_rows[job_mdp[0], ROW_WIND_KIND]) != 0
     B = np.zeros(ROWS * LANES)
     B0 = np.zeros(13 * LANES)
     P = np.zeros((LANES, N_PAR))
@@ -460,10 +461,10 @@ def rollout_lanes(
     """
     n_jobs = job_episode.shape[0]
     if n_jobs > 0:
-        n_sub = mdp_rows[job_mdp[0], 17]
-        windy = mdp_rows[job_mdp[0], 19] != 0.0
+        n_sub = mdp_rows[job_mdp[0], ROW_SUBSTEPS]
+        windy = mdp_rows[job_mdp[0], ROW_WIND_KIND] != 0.0
         for j in range(n_jobs):
-            if mdp_rows[job_mdp[j], 17] != n_sub or (mdp_rows[job_mdp[j], 19] != 0.0) != windy:
+            if mdp_rows[job_mdp[j], ROW_SUBSTEPS] != n_sub or (mdp_rows[job_mdp[j], ROW_WIND_KIND] != 0.0) != windy:
                 raise ValueError("rollout_lanes: the jobs' MDP rows differ in substep count or wind presence")
     # One contiguous chunk per thread, each with its own lane queue; no chunk smaller than LANES
     # jobs unless the batch is, so lanes stay full.

@@ -41,7 +41,7 @@ class OptimiserSpec:
         A frozen dataclass of its settings, with defaults; its ``__post_init__`` raises
         ValueError on a bad value.
     make : callable
-        ``make(prototype genome, settings, seed)`` -> an optimiser with ``ask``, ``tell(returns)``,
+        ``make(prototype genome, settings, seed)`` -> an optimiser with ``ask``, ``tell(fitness, info)``,
         ``stop``, ``champion_genome``, ``champion_return``, ``state_dict`` and a
         ``from_state_dict`` classmethod (:class:`~neurohover.evolution.common.Optimiser`).
     min_genes : int
