@@ -25,6 +25,7 @@ from .errors import NeurohoverError
 from .sim.constants import MDP_ROW_LEN, ROW_SUBSTEPS, ROW_WIND_KIND, SAFEGUARD_LIMITS
 from .sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
 from .sim.lanes import LANES, PARK_F, PARK_U, rollout_lanes, rollout_lanes_parked
+from .sim.rng import MAX_SEED
 
 __all__ = [
     "DEVICES", "KIND", "MAX_SEED", "Batch", "Flown", "Parking", "check_device", "launch", "launch_parked", "load_kernel", "num_threads",
@@ -33,7 +34,6 @@ __all__ = [
 
 #: The kernel's code of each policy topology.
 KIND = {"slp": POLICY_SLP, "mlp": POLICY_MLP}
-MAX_SEED = 2**63 - 1
 
 
 @contextlib.contextmanager

@@ -27,7 +27,7 @@ from .steady_state import SteadyStateSettings
 
 __all__ = [
     "CMA_DEFAULTS",
-    "METHODS",
+    "EVOLUTION_METHODS",
     "RACE_T_LIMIT",
     "Resampling",
     "RunConfig",
@@ -43,7 +43,7 @@ __all__ = [
 CMA_DEFAULTS: dict[str, Any] = dataclasses.asdict(CMASettings())
 RACE_T_LIMIT = 10  # docs/model.md, Fitness under noise: t_limit = t_min = t_max = 10
 #: What a run's ``method`` may be: the neuroevolution's two, or a population optimiser's name (:mod:`.optimisers`).
-METHODS = ("steady-state", "generational", *OPTIMISERS)
+EVOLUTION_METHODS = ("steady-state", "generational", *OPTIMISERS)
 #: Steady-state settings that checkpoints written before they existed ran with.
 _OLD_STEADY_STATE = {"plateau_rule": "literal", "selection": "roulette", "tournament_size": 5, "init_mutate_frac": None, "init_mutate_std": None}
 

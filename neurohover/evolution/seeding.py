@@ -19,11 +19,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import NeurohoverError
+from ..sim.rng import MAX_SEED
 
 __all__ = ["MAX_SEED", "check_seed", "child_int", "mdp_rng", "noise_seed", "optimiser_seed", "validation_seeds"]
 
-#: The largest seed (seeds are integers in ``0..MAX_SEED``).
-MAX_SEED = 2**63 - 1
 _OPTIMISER, _MDPS, _NOISE, _VALIDATION = 0, 1, 2, 3
 
 

@@ -44,7 +44,7 @@ __all__ = [
     "AXIS_C",
     "AXIS_GAINS",
     "FORMAT",
-    "METHODS",
+    "MODEL_METHODS",
     "MODEL_DT",
     "LearnedModel",
     "ParamRow",
@@ -56,7 +56,7 @@ __all__ = [
 ]
 
 FORMAT = "neurohover-model/1"
-METHODS = ("lr", "ec-meno", "ec-mer")
+MODEL_METHODS = ("lr", "ec-meno", "ec-mer")
 MODEL_DT = CONTROL_DT
 
 #: Per axis (u, v, w, p, q, r): index of its C parameter; the axis index is also the noise index.
@@ -129,8 +129,8 @@ class LearnedModel:
     def __post_init__(self) -> None:
         object.__setattr__(self, "params", check_vector(self.params, 11, "model parameters " + "/".join(PARAM_NAMES)))
         object.__setattr__(self, "noise_std", check_vector(self.noise_std, 6, "model noise std (u, v, w, p, q, r)", nonnegative=True))
-        if self.method not in METHODS:
-            raise NeurohoverError(f"unknown model-learning method {self.method!r}: allowed {', '.join(METHODS)}")
+        if self.method not in MODEL_METHODS:
+            raise NeurohoverError(f"unknown model-learning method {self.method!r}: allowed {', '.join(MODEL_METHODS)}")
         if not isinstance(self.seconds, (int, float)) or not math.isfinite(self.seconds) or self.seconds < 0:
             raise NeurohoverError(f"seconds={self.seconds!r} must be a finite number >= 0")
         if not isinstance(self.stats, dict):

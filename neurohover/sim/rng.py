@@ -21,6 +21,8 @@ _MIX2 = _U64(0x94D049BB133111EB)
 _EPISODE_KEY = _U64(0xD1B54A32D192ED03)  # odd constant that separates episode indices from seeds
 SENSOR_STREAM_KEY = _U64(0x2545F4914F6CDD1D)  # xored into the seed: an episode's sensor noise has a stream of its own
 _TWO_POW_M53 = 1.0 / 9007199254740992.0
+#: The largest root seed of the streams (seeds are integers in ``0..MAX_SEED``).
+MAX_SEED = 2**63 - 1
 
 
 @nb.njit(cache=True, inline="always")
