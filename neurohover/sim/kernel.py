@@ -232,6 +232,23 @@ def competition_time(step, substep):
     return int(t * 100.0) / 100.0
 
 
+@nb.njit(cache=True, inline="always", fastmath={"contract"})
+def wind_at(wind, step, substep):
+    """The world wind ``(u, v)`` (m/s) of substep ``substep`` of control step ``step``: per axis
+    ``c + A sin(omega t + phi)`` at the competition's time t (:func:`competition_time`), ``c`` alone for
+    a constant wind. ``wind`` is :func:`unpack_mdp`'s tuple; its kind is not 0 (no wind)."""
+    kind, ax, ox, phx, cx, ay, oy, phy, cy = wind
+    wu = cx
+    wv = cy
+    if kind == WIND_SINUSOID:
+        t = competition_time(step, substep)
+        if ax != 0.0:
+            wu += ax * math.sin(ox * t + phx)
+        if ay != 0.0:
+            wv += ay * math.sin(oy * t + phy)
+    return wu, wv
+
+
 @nb.njit(cache=True, fastmath={"contract"})
 def unpack_mdp(row):
     """Dynamics, noise, integration and wind settings of an MDP row as a tuple of scalars."""
@@ -311,7 +328,7 @@ def update_noise(n, std, z0, z1, z2, z3, z4, z5):
 def integrate(s, n, a1, a2, a3, a4, step, dyn, n_sub, dt, wind):
     """Advance state tuple ``s`` through the substeps of control step ``step`` (counting from 0)."""
     c_u, c_v, d_v, c_w, d_w, c_p, d_p, c_q, d_q, c_r, d_r, d_u = dyn
-    kind, ax, ox, phx, cx, ay, oy, phy, cy = wind
+    kind = wind[0]
     vu, vv, vw, px, py, pz, p, q, r, qx, qy, qz, qw = s
     # Action and noise terms are constant over the control step.
     bias_v = d_v + n[1]
@@ -329,14 +346,7 @@ def integrate(s, n, a1, a2, a3, a4, step, dyn, n_sub, dt, wind):
         bv = r01 * vu + r11 * vv + r21 * vw
         bw = r02 * vu + r12 * vv + r22 * vw
         if kind != 0:
-            wu = cx
-            wv = cy
-            if kind == WIND_SINUSOID:
-                t = competition_time(step, i)
-                if ax != 0.0:
-                    wu += ax * math.sin(ox * t + phx)
-                if ay != 0.0:
-                    wv += ay * math.sin(oy * t + phy)
+            wu, wv = wind_at(wind, step, i)
             # The world wind has no vertical component.
             fu = c_u * (bu + (r00 * wu + r10 * wv)) + nu
             fv = c_v * (bv + (r01 * wu + r11 * wv)) + bias_v

@@ -36,10 +36,9 @@ import numpy as np
 from numba.core import types
 from numba.extending import intrinsic
 
-from .constants import ROW_SUBSTEPS, ROW_WIND_KIND, SENSOR_SCRATCH, WIND_SINUSOID
+from .constants import ROW_SUBSTEPS, ROW_WIND_KIND, SENSOR_SCRATCH
 from .kernel import (
     clip_action,
-    competition_time,
     crash_charge,
     integrate,
     observe,
@@ -48,6 +47,7 @@ from .kernel import (
     unpack_mdp,
     unpack_sensor,
     update_noise,
+    wind_at,
 )
 from .packed import LANES, N_PAR, ROW_CRASH, ROW_DYN, ROW_OBS, ROW_REWARD, ROWS, observe_lanes, substeps
 from .rng import next_normal, seed_sensor_stream, seed_stream
@@ -340,20 +340,9 @@ def fly_queue(
             B[17 * LANES + lane] = P[lane, 10] * a2 + n[4]
             B[18 * LANES + lane] = P[lane, 11] * a3 + n[5]
             if has_wind:
-                wkind = int(P[lane, 12])
-                ax, ox, phx, cx = P[lane, 13], P[lane, 14], P[lane, 15], P[lane, 16]
-                ay, oy, phy, cy = P[lane, 17], P[lane, 18], P[lane, 19], P[lane, 20]
+                wind = (int(P[lane, 12]), P[lane, 13], P[lane, 14], P[lane, 15], P[lane, 16], P[lane, 17], P[lane, 18], P[lane, 19], P[lane, 20])
                 for i in range(n_sub):
-                    wu = cx
-                    wv = cy
-                    if wkind == WIND_SINUSOID:
-                        t = competition_time(k, i)
-                        if ax != 0.0:
-                            wu += ax * math.sin(ox * t + phx)
-                        if ay != 0.0:
-                            wv += ay * math.sin(oy * t + phy)
-                    W[0, i, lane] = wu
-                    W[1, i, lane] = wv
+                    W[0, i, lane], W[1, i, lane] = wind_at(wind, k, i)
         stats[0] += 1
         B0[:] = B[: 13 * LANES]
         if not substeps(B, W, n_sub, has_wind):
