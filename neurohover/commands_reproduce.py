@@ -10,6 +10,7 @@
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 
 from .errors import NeurohoverError
@@ -94,6 +95,60 @@ def cmd_results(args: argparse.Namespace) -> int:
     return 0
 
 
+def _positive_ints(text: str, option: str) -> list[int]:
+    try:
+        values = [int(v) for v in text.split(",")]
+    except ValueError:
+        values = []
+    if not values or min(values) < 1:
+        raise NeurohoverError(f"{option} {text!r} is not allowed: give whole numbers >= 1, comma-separated (e.g. 1,5,20)")
+    return values
+
+
+def cmd_wins(args: argparse.Namespace) -> int:
+    """Each agent's probability of winning a competition of N runs against the others, simulated from an
+    experiment's stored test runs (neurohover.experiments.wins: the bootstrap over the MDPs every agent
+    flew, one stored run per agent and MDP, ties sharing the win), so the agent or risk level to enter
+    can be chosen for N. With --against LABEL, each agent against that one alone."""
+    from .experiments import Store
+    from .experiments.export import resolve_scale
+    from .experiments.wins import stored_runs, win_probabilities
+    from .paths import input_file
+
+    input_file(args.store, "--store", "results store")
+    lengths = _positive_ints(args.runs, "--runs")
+    with Store(args.store, create=False) as store:
+        scale = resolve_scale(store, args.name, args.scale)
+        runs = stored_runs(store.results(args.name, scale))
+    if not runs:
+        raise NeurohoverError(f"experiment {args.name!r} ({scale}) has no stored test runs: wins compares the agents of a test-runs experiment")
+    chosen = args.agents.split(",") if args.agents else list(runs)
+    for label in [*chosen, *([args.against] if args.against else [])]:
+        if label not in runs:
+            raise NeurohoverError(f"agent {label!r} has no test runs in {args.name!r} ({scale}): allowed {', '.join(runs)}")
+    if args.against:
+        fields = {a: {args.against: runs[args.against], a: runs[a]} for a in chosen if a != args.against}
+    else:
+        fields = {"all": {a: runs[a] for a in chosen}}
+    rows = []
+    for field in fields.values():
+        odds = {n: win_probabilities(field, n, draws=args.draws, seed=args.seed) for n in lengths}
+        for agent in field:
+            if args.against and agent == args.against:
+                continue
+            rows.append({"agent": agent, "mdps": odds[lengths[0]].mdps, **{str(n): odds[n][agent] for n in lengths}})
+    if args.json:
+        print(json.dumps({"experiment": args.name, "scale": scale, "against": args.against, "draws": args.draws, "seed": args.seed, "rows": rows}, indent=1))
+        return 0
+    what = f"against {args.against} alone" if args.against else "against the others"
+    print(f"{args.name} ({scale}): probability of winning a competition of N runs {what} ({args.draws:,} simulated competitions)")
+    width = max(len(r["agent"]) for r in rows)
+    print(f"{'agent':<{width}}  MDPs  " + "  ".join(f"{'N = ' + str(n):>8}" for n in lengths))
+    for r in rows:
+        print(f"{r['agent']:<{width}}  {r['mdps']:>4}  " + "  ".join(f"{r[str(n)]:>8.1%}" for n in lengths))
+    return 0
+
+
 def cmd_report(args: argparse.Namespace) -> int:
     """Draw the paper's figures from the results store and write a Markdown report beside the paper's numbers."""
     from .experiments import Store, write_report
@@ -148,6 +203,18 @@ def register(sub) -> None:
     )
     p.add_argument("--out", help="output file (default: standard output)")
     p.set_defaults(func=cmd_results)
+
+    p = sub.add_parser("wins", help="each agent's odds of winning an N-run competition, from stored test runs", description=cmd_wins.__doc__)
+    p.add_argument("name", help="experiment name (a test-runs experiment)")
+    p.add_argument("--store", required=True, help="results store file")
+    p.add_argument("--scale", choices=("quick", "paper"), help="which scale (needed when the store holds both)")
+    p.add_argument("--runs", default="1,5,20", help="competition lengths N, comma-separated (default 1,5,20)")
+    p.add_argument("--agents", help="group labels to enter, comma-separated (default: every group of the experiment)")
+    p.add_argument("--against", metavar="LABEL", help="each agent against this group alone (head to head)")
+    p.add_argument("--draws", type=int, default=10_000, help="simulated competitions (default 10,000)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the bootstrap (default 0)")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(func=cmd_wins)
 
     p = sub.add_parser("report", help="draw the figures and write report.md from a results store", description=cmd_report.__doc__)
     p.add_argument("names", nargs="*", help="experiments to include (default: all in the store)")

@@ -52,3 +52,31 @@ def test_only_the_mdps_every_agent_flew_take_part_and_the_seed_decides() -> None
 def test_bad_input_is_refused_with_one_clear_message(runs, n, draws, message) -> None:
     with pytest.raises(NeurohoverError, match=message):
         win_probabilities(runs, n, draws=draws)
+
+
+def test_the_wins_command_gives_each_agents_odds_from_a_stores_test_runs(cli, tmp_path) -> None:
+    import json
+
+    store = str(tmp_path / "s.sqlite")
+    assert cli("reproduce", "fig11", "--store", store, "--no-progress")[0] == 0
+    rc, out, err = cli("wins", "fig11", "--store", store, "--runs", "1,4", "--json")
+    assert rc == 0, err
+    rows = json.loads(out)["rows"]
+    assert sorted(r["agent"] for r in rows) == ["hybrid", "hybrid-baseline", "model-free"]
+    assert all(r["mdps"] == 2 for r in rows)  # the quick scale's test MDPs 0-1, flown by every group
+    for n in ("1", "4"):
+        assert sum(r[n] for r in rows) == pytest.approx(1.0)
+    rc, out, _ = cli("wins", "fig11", "--store", store, "--against", "model-free", "--runs", "3", "--json")
+    head = json.loads(out)["rows"]
+    assert rc == 0 and sorted(r["agent"] for r in head) == ["hybrid", "hybrid-baseline"] and all(0 <= r["3"] <= 1 for r in head)
+    rc, out, _ = cli("wins", "fig11", "--store", store)
+    assert rc == 0 and "N = 20" in out.splitlines()[1]
+    for args, message in (
+        (("--runs", "0,5"), "--runs '0,5' is not allowed: give whole numbers >= 1"),
+        (("--agents", "hybrid,nobody"), "agent 'nobody' has no test runs in 'fig11' (quick): allowed"),
+        (("--against", "nobody"), "agent 'nobody' has no test runs"),
+    ):
+        rc, _, err = cli("wins", "fig11", "--store", store, *args)
+        assert rc == 2 and message in err, err
+    rc, _, err = cli("wins", "fig2", "--store", store)
+    assert rc == 2 and "fig2" in err

@@ -24,7 +24,8 @@ from .store import Store
 FORMATS = ("csv", "json")
 
 
-def _scale(store: Store, name: str, scale: str | None) -> str:
+def resolve_scale(store: Store, name: str, scale: str | None) -> str:
+    """The scale of experiment ``name`` in the store: ``scale``, or its only one (a clear error otherwise)."""
     scales = store.scales(name)
     if not scales:
         raise NeurohoverError(store.missing_message(name, None))
@@ -41,7 +42,7 @@ def export_results(store: Store, name: str, fmt: str = "csv", scale: str | None 
     """The finished units of ``name`` as CSV (one row per unit, one plain value per cell) or JSON (everything)."""
     if fmt not in FORMATS:
         raise NeurohoverError(f"unknown format {fmt!r}: allowed {', '.join(FORMATS)}")
-    scale = _scale(store, name, scale)
+    scale = resolve_scale(store, name, scale)
     units = store.units(name, scale)
     config = store.config(name, scale)
     if fmt == "json":

@@ -18,8 +18,9 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from ..errors import NeurohoverError
+from .results import UnitKey
 
-__all__ = ["DEFAULT_DRAWS", "WinOdds", "win_probabilities"]
+__all__ = ["DEFAULT_DRAWS", "WinOdds", "stored_runs", "win_probabilities"]
 
 DEFAULT_DRAWS = 10_000
 _MAX_CELLS = 50_000_000  # draws x runs per agent held at once: about 400 MB of float64
@@ -87,3 +88,14 @@ def win_probabilities(runs: Mapping[str, Mapping[str, Sequence[float]]], n_runs:
     odds = WinOdds({a: float(share[i].mean()) for i, a in enumerate(agents)})
     odds.n_runs, odds.draws, odds.mdps = n_runs, draws, len(common)
     return odds
+
+
+def stored_runs(results: Mapping[str, dict]) -> dict[str, dict[str, list[float]]]:
+    """Group label -> {MDP label -> cumulative rewards} of an experiment's stored test runs (its ``run/``
+    units; ``results``: unit key -> result, as :meth:`neurohover.experiments.Store.results` gives them)."""
+    runs: dict[str, dict[str, list[float]]] = {}
+    for key, result in results.items():
+        unit = UnitKey.parse(key)
+        if unit.stage == "run":
+            runs.setdefault(unit.group, {}).setdefault(str(result["mdp"]), []).append(float(result["score"]))
+    return runs
