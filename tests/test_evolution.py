@@ -24,6 +24,7 @@ from neurohover.evolution import (
     roulette_weights,
     selection_race,
 )
+from neurohover.evolution.common import TellInfo
 
 D = 10
 TARGET = np.random.default_rng(1234).normal(size=D)
@@ -299,7 +300,7 @@ def test_generational_with_selection_race_on_noisy_fitness() -> None:
         pop = opt.ask()
         true = sphere_return(pop)
         race = selection_race(lambda idx, true=true: true[idx] + noise_rng.normal(0.0, 0.3, idx.size), 20, 6, 0.9, t_limit=5)
-        opt.tell_race(race)
+        opt.tell(race.means, TellInfo(selected=race.selected, episodes=race.episodes_spent))
         assert opt.history[-1].episodes == race.episodes_spent
     assert opt.evaluations == sum(h.episodes for h in opt.history) < 25 * 20 * 5
     assert float(sphere_return(opt.champion_genome)[0]) > PROTO_RETURN + 3.0

@@ -12,6 +12,7 @@ import pytest
 
 from neurohover.errors import NeurohoverError
 from neurohover.evolution import SteadyStateNE, SteadyStateSettings, evolve
+from neurohover.evolution.common import TellInfo
 from neurohover.policies import Policy, prototype
 from neurohover.tasks import get_task_family
 
@@ -25,7 +26,7 @@ def _run(opt: SteadyStateNE, returns, crashed, max_tells: int = 500) -> int:
         if opt.stop():
             return tells
         n = len(opt.ask())
-        opt.tell([returns(k + i) for i in range(n)], crashed=[crashed(k + i) for i in range(n)])
+        opt.tell([returns(k + i) for i in range(n)], TellInfo(crashed=np.array([crashed(k + i) for i in range(n)])))
         k += n
     return max_tells
 
@@ -58,7 +59,7 @@ def test_crashing_new_champion_stops_the_counter_again() -> None:
     opt = SteadyStateNE(np.zeros(3), SteadyStateSettings(**SMALL), seed=0)
     for k in range(10):
         opt.ask()
-        opt.tell(np.full(5 if k == 0 else 1, -500.0 + k), crashed=np.array([k >= 5] * (5 if k == 0 else 1)))
+        opt.tell(np.full(5 if k == 0 else 1, -500.0 + k), TellInfo(crashed=np.array([k >= 5] * (5 if k == 0 else 1))))
     assert opt.champion_crashed and opt.plateau_evaluations == 0 and not opt.stop()
 
 
@@ -86,7 +87,7 @@ def test_bad_crash_flags_are_refused() -> None:
     opt = SteadyStateNE(np.zeros(3), SteadyStateSettings(**SMALL), seed=0)
     opt.ask()
     with pytest.raises(ValueError, match="crashed must be 5 booleans"):
-        opt.tell(np.zeros(5), crashed=[True, False])
+        opt.tell(np.zeros(5), TellInfo(crashed=np.array([True, False])))
 
 
 def test_state_dict_keeps_the_champion_crash_flag() -> None:

@@ -36,7 +36,6 @@ from .common import (
 )
 from .fitness import FITNESS_SCALES
 from .operators import crossover, mutate
-from .races import RaceResult, ResamplingResult
 
 __all__ = ["GENERATIONAL_PRESETS", "OLD_GENERATIONAL", "GenerationRecord", "GenerationalNE", "GenerationalSettings"]
 
@@ -265,14 +264,6 @@ class GenerationalNE:
         self._history.append(GenerationRecord(self._generation, self._evaluations, ep, self._champion_return, self._clock()))
         self._population = self._breed(self._population[sel])
         self._asked = False
-
-    def tell_race(self, result: RaceResult) -> None:
-        """``tell`` with a selection race's means, selection and episode count."""
-        self.tell(result.means, TellInfo(selected=result.selected, episodes=result.episodes_spent))
-
-    def tell_resampled(self, result: ResamplingResult) -> None:
-        """``tell`` with fixed-resampling means and episode count."""
-        self.tell(result.means, TellInfo(episodes=result.episodes_spent))
 
     def stop(self) -> bool:
         """True after ``generations`` generations or once ``budget`` episodes are spent."""

@@ -8,10 +8,9 @@ Returns are maximised (in the helicopter domain they are negative).
 
 Recording the cost per generation
 ---------------------------------
-Both results carry ``episodes_spent``; pass it to
-``GenerationalNE.tell(..., episodes=result.episodes_spent)`` (or use
-``GenerationalNE.tell_race`` / ``GenerationalNE.tell_resampled``) so that the
-optimiser's per-generation history records how many episodes were flown.
+Both results carry ``episodes_spent``; pass it to ``GenerationalNE.tell(means,
+TellInfo(episodes=result.episodes_spent))`` (a race: also ``selected=result.selected``) so that
+the optimiser's per-generation history records how many episodes were flown.
 """
 
 from __future__ import annotations

@@ -93,7 +93,7 @@ class SteadyStateSettings:
     plateau_rule : {"no-crash", "literal"}
         ``"no-crash"`` (default, a documented deviation, docs/model.md, Neuroevolution): the plateau counter runs only
         while the champion's evaluation completed without crashing (crash flags come through
-        ``SteadyStateNE.tell(..., crashed=...)``); a population whose champion still crashes
+        ``SteadyStateNE.tell(..., TellInfo(crashed=...))``); a population whose champion still crashes
         never stops at the plateau, so such a run ends only at its budget (give one when the
         prototype may crash, e.g. a zero seed). ``"literal"``: Appendix A as written, every
         evaluation without a new champion counts (about 30% of zero-seeded runs then stop while
@@ -292,7 +292,7 @@ class SteadyStateNE(ChampionViews):
         self._pending = batch
         return batch.copy()
 
-    def tell(self, fitness: np.ndarray, info: TellInfo | None = None, crashed: np.ndarray | None = None) -> None:
+    def tell(self, fitness: np.ndarray, info: TellInfo | None = None) -> None:
         """Report the returns of exactly the genomes of the last :meth:`ask`.
 
         Parameters
@@ -300,14 +300,11 @@ class SteadyStateNE(ChampionViews):
         fitness : np.ndarray
             One return per asked genome (maximised; NaN/-inf rank worst).
         info : TellInfo, optional
-            Its ``crashed`` flags, as the run tells them.
-        crashed : np.ndarray of bool, optional
-            The same flags given directly: whether each genome's evaluation crashed (with a mean
-            over several episodes: whether any of them crashed). Only the ``no-crash`` plateau
-            rule uses them; None: no crash.
+            Its ``crashed`` flags: whether each genome's evaluation crashed (with a mean over
+            several episodes: whether any of them crashed). Only the ``no-crash`` plateau rule uses
+            them; none: no crash.
         """
-        if crashed is None and info is not None:
-            crashed = info.crashed
+        crashed = None if info is None else info.crashed
         if self._pending is None:
             raise RuntimeError("tell() called without a pending ask()")
         f = check_returns(fitness, len(self._pending))
