@@ -69,6 +69,12 @@ def cmd_compete(args: argparse.Namespace) -> int:
     if args.store is not None:
         output_file(args.store, "--store")
     sensor = sensor_of(args)
+    agent_settings = None
+    if args.agent_setting:
+        from .compete import check_agent_settings
+        from .experiments.config import parse_override
+
+        agent_settings = check_agent_settings(args.agent, dict(parse_override(text) for text in args.agent_setting))
     try:
         summary, _ = compete(
             args.task,
@@ -89,6 +95,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
             sensor=sensor,
             drift=None if args.drift is None else Drift.parse(args.drift),
             wind_model=args.wind_model or "none",
+            agent_settings=agent_settings,
         )
     except KeyboardInterrupt:
         print(
@@ -164,6 +171,13 @@ def register(sub) -> None:
         "--wind-model",
         choices=("none", "constant", "sinusoid"),
         help="model-based agents: the wind of the LR models they learn (default none, the paper's; docs/model.md, Wind-aware models)",
+    )
+    p.add_argument(
+        "--agent-setting",
+        action="append",
+        metavar="KEY=VALUE",
+        help='one of the agent\'s own settings (repeatable; VALUE in TOML syntax), e.g. --agent hybrid-risk --agent-setting criterion="lcb" '
+        "--agent-setting level=3, or --agent continual --agent-setting cooldown=10 (docs/model.md, docs/benchmarks.md)",
     )
     g = p.add_argument_group("hybrid agents (defaults: the authors' code; see docs/model.md, Safeguard)")
     g.add_argument("--safeguard-rule", help="code (tilted and outside the box, default) or paper (outside the box)")

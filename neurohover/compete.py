@@ -29,7 +29,7 @@ from __future__ import annotations
 import csv
 import json
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -117,6 +117,24 @@ def _group(task: str, runs: int, mdps: str) -> dict:
     return {"mdps": mdps, "n_mdps": size, "runs_per_mdp": runs // size}
 
 
+def check_agent_settings(agent: str, values: Mapping[str, object]) -> dict:
+    """``values`` as the agent's own settings table, checked by its spec's settings class (one clear message)."""
+    from .agents.registry import agent_spec
+
+    spec = agent_spec(agent)
+    if spec.settings is None or spec.settings.UNIT_KEY != "agent_settings":
+        hybrid = " (the hybrid agents' settings are the --safeguard-*/--hybrid-* options)" if spec.settings is not None else ""
+        raise NeurohoverError(f"agent {agent!r} takes no settings table of its own{hybrid}; agents that do: {', '.join(agents_with_settings())}")
+    return spec.settings.from_dict(dict(values)).to_dict()
+
+
+def agents_with_settings() -> list[str]:
+    """The registered agents that take settings of their own (their spec's settings class)."""
+    from .agents.registry import AGENTS
+
+    return sorted(name for name, spec in AGENTS.items() if spec.settings is not None and spec.settings.UNIT_KEY == "agent_settings")
+
+
 def competition_config(
     task: str,
     agent: str,
@@ -132,6 +150,7 @@ def competition_config(
     sensor: Sensor | None = None,
     drift: Drift | None = None,
     wind_model: str = "none",
+    agent_settings: Mapping[str, object] | None = None,
 ):
     """The inline experiment of a competition (an ``ExperimentConfig`` of kind ``test_runs``).
 
@@ -152,6 +171,8 @@ def competition_config(
         group["hybrid"] = hybrid.to_dict()
     if wind_model != "none":  # the wind of the LR models the agent learns (absent: the digest of older competitions)
         group["wind_model"] = wind_model
+    if agent_settings:  # the agent's own typed settings, checked by its spec's class (absent: as before)
+        group["settings"] = check_agent_settings(agent, agent_settings)
     settings: dict[str, object] = {
         "task": task,
         "sigma": sigma,
@@ -190,6 +211,7 @@ def compete(
     sensor: Sensor | None = None,
     drift: Drift | None = None,
     wind_model: str = "none",
+    agent_settings: Mapping[str, object] | None = None,
 ) -> tuple[dict, list]:
     """Run ``runs`` test runs of ``agent`` as an inline experiment; write results and plot to ``out``.
 
@@ -216,6 +238,9 @@ def compete(
         The harder task (docs/benchmarks.md): every MDP seen through ``sensor``, its dynamics drifting by ``drift``.
     wind_model : {"none", "constant", "sinusoid"}
         The wind of the LR models a model-based agent learns (docs/model.md, Wind-aware models).
+    agent_settings : mapping, optional
+        The agent's own settings (its spec's settings class, e.g. ``{"criterion": "lcb", "level": 3}``
+        for ``hybrid-risk``, ``{"cooldown": 10}`` for ``continual``); refused for an agent without one.
 
     Returns
     -------
@@ -237,7 +262,7 @@ def compete(
     check_agent(agent, get_task_family(task, sigma), policy_dir)
     config = competition_config(
         task, agent, runs=runs, episodes=episodes, mdps=mdps, seed=seed, sigma=sigma, n_steps=n_steps, policy_dir=policy_dir, hybrid=hybrid,
-        sensor=sensor, drift=drift, wind_model=wind_model,
+        sensor=sensor, drift=drift, wind_model=wind_model, agent_settings=agent_settings,
     )  # fmt: skip
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import json
 from pathlib import Path
 
 import pytest
@@ -83,3 +84,25 @@ def test_compete_says_when_it_reuses_stored_runs(tmp_path: Path, capsys) -> None
     assert "reused" not in capsys.readouterr().err
     assert main(args) == 0
     assert "2 of 2 units (runs and the policies they fly) were already in" in capsys.readouterr().err
+
+
+def test_an_agents_own_settings_reach_its_runs_and_are_checked(cli, tmp_path) -> None:
+    from neurohover.compete import competition_config
+
+    plain = competition_config("ghh08", "hybrid-risk", runs=1, episodes=3)
+    config = competition_config("ghh08", "hybrid-risk", runs=1, episodes=3, agent_settings={"criterion": "worst"})
+    assert config.scale != plain.scale and config.settings["groups"][0]["settings"]["criterion"] == "worst"
+    assert "settings" not in plain.settings["groups"][0]  # without them, older competitions' digests stay as they were
+    rc, out, err = cli(
+        "compete", "--task", "ghh08", "--agent", "hybrid-risk", "--agent-setting", 'criterion="lcb"', "--agent-setting", "level=3",
+        "--runs", "1", "--episodes", "4", "--episode-steps", "100", "--out", str(tmp_path / "a"),
+    )  # fmt: skip
+    assert rc == 0, err
+    summary = json.loads((tmp_path / "a" / "summary.json").read_text())
+    with Store(tmp_path / "a" / "results.sqlite", create=False) as store:
+        (unit,) = [u for u in store.units(summary["experiment"], summary["scale"]) if u["key"].startswith("run/")]
+    assert {k: unit["params"]["agent_settings"][k] for k in ("criterion", "level")} == {"criterion": "lcb", "level": 3}
+    rc, _, err = cli("compete", "--task", "ghh08", "--agent", "baseline", "--agent-setting", "level=3", "--runs", "1", "--out", str(tmp_path / "b"))
+    assert rc == 2 and "agent 'baseline' takes no settings table of its own; agents that do:" in err and "continual" in err
+    rc, _, err = cli("compete", "--task", "ghh08", "--agent", "continual", "--agent-setting", "cooldwn=3", "--runs", "1", "--out", str(tmp_path / "c"))
+    assert rc == 2 and "unknown ContinualSettings setting(s) cooldwn" in err
