@@ -433,3 +433,20 @@ def test_the_risk_sensitive_hybrid_ranks_its_candidates_by_the_risk_score() -> N
         agent.values = [[-100.0] * 9 + [DISCARD_RETURN], [-150_000.0]]
         agent._rank()
         assert agent.current is not None and agent.current[1] == expected, criterion
+
+
+def test_the_hybrid_keeps_flying_when_its_trials_crash_too_soon_to_learn_a_model() -> None:
+    # Readings 0.4 s late: both trial policies crash within a few steps, too few transitions for LR; the
+    # hybrid then ranks its two safe policies alone (it used to stop the run with an error).
+    from neurohover.agents.protocol import run_test
+    from neurohover.agents.registry import agent_spec, policies_from_set
+    from neurohover.agents.spec import AgentOptions
+    from neurohover.policysets import load_policy_set
+    from neurohover.tasks import Sensor
+
+    family = get_task_family("ghh09")
+    spec = agent_spec("hybrid")
+    agent = spec.build(policies_from_set(spec, load_policy_set("ghh09")), AgentOptions(evolution=ModelEvolution(budget=50, n_steps=200)))
+    run = run_test(agent, family, family.test_mdps()[9].with_sensor(Sensor(delay=4)), episodes=6, seed=3, n_steps=300)
+    assert agent.model is None and [label for _, label in agent.candidates] == ["safe:0", "safe:1"]
+    assert run.returns.shape == (6,) and np.isfinite(run.returns).all()

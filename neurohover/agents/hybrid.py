@@ -23,7 +23,7 @@ from ..evaluate import DangerousState
 from ..flightdata import FlightData
 from ..policies import Policy, baseline_policy
 from ..tasks import MDP, TaskFamily
-from .model_based import ModelEvolution, evolve_on_model, learn_model
+from .model_based import ModelEvolution, enough_to_learn, evolve_on_model, learn_model
 from .protocol import Agent, Choice, EpisodeOutcome
 from .spec import AgentOptions, AgentPolicies, AgentSettings, AgentSpec
 
@@ -179,9 +179,12 @@ class HybridAgent(Agent):
             if outcome.flight_data is not None:
                 self.trial_data.append((outcome.flight_data, dangerous))
             if len(self.trial_returns) == 2:
-                self.model = learn_model(self._model_data(), self.settings.estimator, self.settings.wind_model)
-                self.candidates += [self._evolve(f"model:{i}") for i in range(N_EVOLVED)]
-            if len(self.trial_returns) < N_EVOLVED + 2:
+                data = self._model_data()
+                # Trials that crash within a few steps may not determine a model: then the two safe policies are all there is.
+                if enough_to_learn(data, self.settings.wind_model):
+                    self.model = learn_model(data, self.settings.estimator, self.settings.wind_model)
+                    self.candidates += [self._evolve(f"model:{i}") for i in range(N_EVOLVED)]
+            if len(self.trial_returns) < len(self.candidates):
                 return
             if rerank:
                 self.values = [[v] for v in self.trial_values]
@@ -190,7 +193,7 @@ class HybridAgent(Agent):
             # "evolve": a policy that needed the safeguard is discarded
             finite = [-np.inf if f else r for f, r in zip(self.trial_fired, self.trial_returns)]
             best = int(np.argmax(finite))
-            if np.isfinite(finite[best]):
+            if np.isfinite(finite[best]) or self.model is None:
                 self.current = self.candidates[best]
             else:  # every trial needed the safeguard: start with a fresh policy from the model
                 self.replacements += 1
@@ -200,7 +203,7 @@ class HybridAgent(Agent):
             self.values[[label for _, label in self.candidates].index(self.current[1])].append(value)
             self._rank()
             return
-        if dangerous:
+        if dangerous and self.model is not None:
             self.replacements += 1
             self.current = self._evolve(f"replacement:{self.replacements}")
 
