@@ -130,6 +130,12 @@ class KernelFlyer:
         self.next_index += n
         return first
 
+    def _load_genomes(self, genomes: np.ndarray) -> None:
+        n_pol = genomes.shape[0]
+        if n_pol > self._p_cap:
+            self._ensure(n_pol, 0)
+        self._genomes[:n_pol, : self.dim] = genomes
+
     def _set_threads(self, n_jobs: int) -> None:
         # Never more threads than jobs: every thread of a parallel call must check in, and on a busy
         # machine a one-episode call on all cores runs up to 10x slower than on one.
@@ -164,10 +170,7 @@ class KernelFlyer:
         numpy.ndarray
             The jobs' returns: a view of the flyer's buffer, valid until the next call.
         """
-        n_pol = genomes.shape[0]
-        if n_pol > self._p_cap:
-            self._ensure(n_pol, 0)
-        self._genomes[:n_pol, : self.dim] = genomes
+        self._load_genomes(genomes)
         zeros, arange, e, minus, returns, crashed, steps, sg = self._views_for(n_jobs)
         p = zeros if policy_index is None else (arange if isinstance(policy_index, str) else policy_index)
         m = zeros if mdp_index is None else (arange if isinstance(mdp_index, str) else mdp_index)
@@ -211,10 +214,7 @@ class KernelFlyer:
             job not over, :attr:`crashed` its crash flags.
         """
         n_jobs = slots.shape[0]
-        n_pol = genomes.shape[0]
-        if n_pol > self._p_cap:
-            self._ensure(n_pol, 0)
-        self._genomes[:n_pol, : self.dim] = genomes
+        self._load_genomes(genomes)
         zeros, _, e, minus, returns, crashed, steps, _ = self._views_for(n_jobs)
         e[:] = episode_index
         before = parking.steps[slots]

@@ -253,22 +253,21 @@ def launch_parked(batch: Batch, out: Flown, slots: np.ndarray, n_required: int, 
     """
     load_parked()
     t0 = time.perf_counter()
-    rollout_lanes_parked(
-        batch.rows, batch.kinds, batch.genomes, batch.policy_index, batch.mdp_index, batch.episode_index, slots, n_required,
-        np.uint64(batch.seed), batch.n_steps, numba.get_num_threads(), parking.floats, parking.streams, parking.steps,
-        out.returns, out.crashed, out.steps,
-    )  # fmt: skip
+    _fly_parked(batch, out, slots, n_required, parking)
     return time.perf_counter() - t0
+
+
+def _fly_parked(b: Batch, out: Flown, slots: np.ndarray, n_required: int, parking: Parking) -> None:
+    rollout_lanes_parked(
+        b.rows, b.kinds, b.genomes, b.policy_index, b.mdp_index, b.episode_index, slots, n_required, np.uint64(b.seed), b.n_steps,
+        numba.get_num_threads(), parking.floats, parking.streams, parking.steps, out.returns, out.crashed, out.steps,
+    )  # fmt: skip
 
 
 def load_parked() -> None:
     """Load (or compile) :func:`neurohover.sim.lanes.rollout_lanes_parked` with an empty batch."""
     if "parked" not in _loaded:
-        none = np.zeros(0, dtype=np.int64)
-        b, out, p = Batch.empty(), Flown.empty(0), Parking.empty(0)
-        rollout_lanes_parked(
-            b.rows, b.kinds, b.genomes, none, none, none, none, 0, np.uint64(0), 1, 1, p.floats, p.streams, p.steps, out.returns, out.crashed, out.steps
-        )  # fmt: skip
+        _fly_parked(Batch.empty(), Flown.empty(0), np.zeros(0, dtype=np.int64), 0, Parking.empty(0))
         _loaded.add("parked")
 
 
