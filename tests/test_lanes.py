@@ -17,7 +17,7 @@ from neurohover.launch import use_lanes as _use_lanes
 from neurohover.policies import GENOME_LENGTH
 from neurohover.sim.constants import ROW_DT, ROW_SUBSTEPS, ROW_WIND_KIND, SAFEGUARD_LIMITS
 from neurohover.sim.kernel import POLICY_SLP, rollout_batch
-from neurohover.sim.lanes import LANES, fly_lanes, rollout_lanes, rollout_lanes_parked
+from neurohover.sim.lanes import LANES, SCALAR_TAIL, fly_lanes, rollout_lanes, rollout_lanes_parked
 from neurohover.tasks import Sensor
 
 ZERO_MDP = get_task_family("fghh").zero()
@@ -136,7 +136,7 @@ def test_cases_cover_crashes_non_finite_actions_and_the_fallback() -> None:
     assert len(set(s[c].tolist())) > 1  # lanes end at different steps
     for name in ("spinning SLP, 1 substep",):  # with 10 substeps it crashes on its rate before turning that far
         table, row = CASES[name]
-        n = 2
+        n = SCALAR_TAIL + 1  # more lanes in flight than the per-lane tail, so the steps are packed
         stats = np.zeros(2, dtype=np.int64)
         z = np.zeros(n, dtype=np.int64)
         out = np.empty(n), np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.int64)

@@ -20,7 +20,8 @@ How it works
 - The substeps, then the observation, reward and crash test, run packed for all lanes at once
   (:mod:`neurohover.sim.packed`, which says how they stay bit-identical to the scalar kernel); a
   control step in which some lane turns more than SERIES_MAX_ANGLE is flown again for every lane,
-  from the saved start, with ``kernel.integrate`` itself (libm sin/cos).
+  from the saved start, with ``kernel.integrate`` itself (libm sin/cos). The tail of a queue, where
+  at most ``SCALAR_TAIL`` lanes are left in flight, runs that way too (cheaper than a packed step).
 - Still scalar per lane: the policy (``exp`` has no bit-identical packed form), the xoshiro256** /
   ziggurat gust noise, the wind's sin, and the bookkeeping.
 
@@ -52,7 +53,11 @@ from .kernel import (
 from .packed import LANES, N_PAR, ROW_CRASH, ROW_DYN, ROW_OBS, ROW_REWARD, ROWS, observe_lanes, substeps
 from .rng import next_normal, seed_sensor_stream, seed_stream
 
-__all__ = ["LANES", "PARK_F", "PARK_U", "fly_lanes", "fly_queue", "park_lane", "rollout_lanes", "rollout_lanes_parked"]
+#: At most this many lanes in flight (the queue empty), a control step's substeps run per lane with ``kernel.integrate``
+#: (the same bits): one packed step costs about as much as 2-3 scalar ones (docs/performance.md, Selection races).
+SCALAR_TAIL = 2
+
+__all__ = ["LANES", "SCALAR_TAIL", "PARK_F", "PARK_U", "fly_lanes", "fly_queue", "park_lane", "rollout_lanes", "rollout_lanes_parked"]
 
 
 @nb.njit(cache=True, inline="always")
@@ -241,7 +246,8 @@ def fly_queue(
 
     A lane whose episode ends takes the next job (a queue), so lanes run at different steps, each
     with its own genome and its own MDP's parameters.
-    stats[0] counts control steps, stats[1] those flown by the scalar fallback.
+    stats[0] counts control steps, stats[1] those flown again by the large-angle fallback. Once the queue is
+    empty and at most SCALAR_TAIL lanes fly, their substeps run per lane with ``kernel.integrate``.
 
     Parking (``park_step`` not empty): jobs ``n_required`` and later are optional. Job j's episode
     is kept in slot ``job_slot[j]`` of ``park_f`` / ``park_u`` / ``park_step`` (:func:`park_lane`): one
@@ -344,10 +350,13 @@ def fly_queue(
                 for i in range(n_sub):
                     W[0, i, lane], W[1, i, lane] = wind_at(wind, k, i)
         stats[0] += 1
-        B0[:] = B[: 13 * LANES]
-        if not substeps(B, W, n_sub, has_wind):
-            stats[1] += 1
-            B[: 13 * LANES] = B0
+        packed = live > SCALAR_TAIL
+        if packed:
+            B0[:] = B[: 13 * LANES]
+        if not (packed and substeps(B, W, n_sub, has_wind)):
+            if packed:
+                stats[1] += 1
+                B[: 13 * LANES] = B0
             for lane in range(LANES):
                 if job[lane] < 0:
                     continue  # idle: stays at rest
