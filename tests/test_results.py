@@ -195,3 +195,9 @@ def test_stored_units_run_again_to_their_stored_results(committed_store: Path) -
             kind, params, stored = row
             again = run_unit({"experiment": name, "key": key, "kind": kind, "params": json.loads(params)}, threads=2)
             assert strip_timing(again) == strip_timing(json.loads(stored)), (name, scale, key)
+
+
+def test_a_crash_rate_is_never_shown_as_zero_when_an_episode_crashed() -> None:
+    from neurohover.experiments.report import crash_rate
+
+    assert [crash_rate(c, 20_000) for c in (0, 1, 30, 200, 10_687, 20_000)] == ["0%", "0.005%", "0.15%", "1%", "53%", "100%"]

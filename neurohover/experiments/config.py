@@ -32,6 +32,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
+import re
 import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
@@ -53,7 +54,7 @@ KINDS = ("evolution", "model_learning", "test_runs")
 #: Experiments in report order (the shipped configs).
 ORDER = (
     "fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16", "ablation-plateau", "ablation-hybrid", "ablation-fghh",
-    "bench-sensors", "bench-drift", "wind-fig7", "wind-fig8", "wind-fig11", "risk-ghh09",
+    "bench-sensors", "bench-sensors-fallback", "bench-sensor-models", "bench-drift", "wind-fig7", "wind-fig8", "wind-fig11", "risk-ghh09",
 )  # fmt: skip
 #: Bump when a unit function changes what it computes: stores written before are then refused.
 UNITS_VERSION = 2  # 2: competition MDP sets, the authors' safeguard, OLS, the no-crash plateau
@@ -216,6 +217,15 @@ _GROUP = {
     "seeds_of": (_OMIT, _seeds_of()),
 }
 
+# One sensor condition of a model-learning experiment: its models learn from flight data seen through
+# these sensors, and are checked against exact ones (docs/benchmarks.md, learned models under sensor noise).
+_CONDITION = {
+    "key": (_REQUIRED, _str()),
+    "label": (None, _str()),
+    "sensor": (_OMIT, _sensor_table()),  # absent: exact sensors
+    "data_episodes": (1, _int(1)),  # episodes of the generic policy's flight data each model learns from
+}
+
 SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
     "evolution": {
         **_COMMON,
@@ -246,6 +256,7 @@ SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
         "policy_budget": (0, _int(0)),
         "policy_prototype": ("generic", _choice("generic", "baseline")),
         "test_episodes": (5, _int(1)),
+        "conditions": (_OMIT, ("list", _CONDITION)),  # sensor conditions, each its own models of every MDP
     },
     "test_runs": {
         **_COMMON,
@@ -334,6 +345,15 @@ def _check_kind(settings: dict, kind: str, where: str) -> None:
             raise NeurohoverError(f"{where}: validation_mdps = 'test' flies champions evolved over G on the family's test MDPs: it needs target = 'family'")
         if settings["target"] == "train" and settings["n_mdps"] > 10:
             raise NeurohoverError(f"{where}: n_mdps = {settings['n_mdps']} is out of range: there are 10 training MDPs")
+    if kind == "model_learning" and "conditions" in settings:
+        keys = [c["key"] for c in settings["conditions"]]
+        bad = [k for k in keys if not re.fullmatch(r"[a-z0-9][a-z0-9.-]*", k)]
+        if bad or len(set(keys)) != len(keys):
+            raise NeurohoverError(f"{where}: condition keys must be unique and of lower-case letters, digits, '.' and '-', got {keys}")
+        if "sensor" in settings:
+            raise NeurohoverError(f"{where}: sensor is set by each of the conditions here: leave [settings] sensor out")
+        for c in settings["conditions"]:
+            c["label"] = c["label"] or c["key"]
     if kind in ("model_learning", "test_runs"):
         groups = settings.get("groups", [{"mdps": settings.get("mdps"), "n_mdps": settings.get("n_mdps")}])
         for g in groups:

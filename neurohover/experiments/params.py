@@ -68,6 +68,8 @@ class ModelParams:
     policy_budget: int
     prototype: str
     test_episodes: int
+    data_episodes: int = 1  # episodes of the generic's flight data the model learns from
+    exact_checks: bool = False  # also check the model and its policy against exact sensors (the MDP has a sensor model)
     seed: int
 
 

@@ -29,7 +29,7 @@ from ..agents.registry import HYBRID_AGENTS, agent_spec
 from ..errors import NeurohoverError
 from ..policies import baseline_policy
 from ..policysets import FGHH_GENERIC_RESAMPLING, load_policy_set
-from ..tasks import Sensor
+from ..tasks import EXACT, Sensor
 from ..tasks.drift import Drift
 from .config import ExperimentConfig, load_config, variant_optimiser
 from .results import UnitKey
@@ -411,7 +411,7 @@ def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
     assert isinstance(s, ModelLearningSettings)
     family = family_of(s.task, s.sigma, s.sensor)
     units: list[Unit] = []
-    total = len(s.methods) * s.n_mdps
+    total = len(s.methods) * s.n_mdps * max(1, len(s.conditions))
     if s.generic == "evolve":
         total += 1
         units.append(_policy_evolution_unit(cfg, UnitKey.make("policy", "generic"), {"kind": "mdp", "mdp": family.zero().to_dict()}, s.generic_budget))
@@ -424,28 +424,26 @@ def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
         return Plan(units, total)
     for i, mdp in enumerate(_mdps(family, s.mdps, s.n_mdps, s.seed)):
         for method in s.methods:
-            # The seed depends on the MDP only: every method learns from the same flight data and
-            # its policy meets the same gusts (a paired comparison).
-            units.append(
-                _unit(
-                    cfg,
-                    UnitKey.make("model", method, f"{s.mdps}{i}"),
-                    "model",
-                    {
-                        "method": method,
-                        "mdp": mdp.to_dict(),
-                        "generic": generic,
-                        "n_steps": s.n_steps,
-                        "model_budget": s.model_budget,
-                        "ec_meno_budget": s.ec_meno_budget,
-                        "ec_mer_episodes": s.ec_mer_episodes,
-                        "policy_budget": s.policy_budget,
-                        "prototype": s.policy_prototype,
-                        "test_episodes": s.test_episodes,
-                    },
-                    seed_key=f"model/{s.mdps}{i}",
-                )
-            )
+            # The seed depends on the MDP only: every method (and sensor condition) learns from the same
+            # gusts' flight data and its policy meets the same gusts (a paired comparison).
+            common = {
+                "method": method,
+                "generic": generic,
+                "n_steps": s.n_steps,
+                "model_budget": s.model_budget,
+                "ec_meno_budget": s.ec_meno_budget,
+                "ec_mer_episodes": s.ec_mer_episodes,
+                "policy_budget": s.policy_budget,
+                "prototype": s.policy_prototype,
+                "test_episodes": s.test_episodes,
+            }
+            seed_key = f"model/{s.mdps}{i}"
+            if not s.conditions:
+                units.append(_unit(cfg, UnitKey.make("model", method, f"{s.mdps}{i}"), "model", {**common, "mdp": mdp.to_dict()}, seed_key=seed_key))
+            for c in s.conditions:
+                seen = mdp.with_sensor(EXACT if c.sensor is None else Sensor.from_dict(c.sensor))
+                params = {**common, "mdp": seen.to_dict(), "data_episodes": c.data_episodes, "exact_checks": True}
+                units.append(_unit(cfg, UnitKey.make("model", f"{method}@{c.key}", f"{s.mdps}{i}"), "model", params, seed_key=seed_key))
     return Plan(units, total)
 
 

@@ -24,6 +24,7 @@ from ..errors import NeurohoverError
 from .config import ORDER, ExperimentConfig
 from .report_base import Section, fmt, new_figure, sd, table
 from .report_evolution import EvolutionSection
+from .report_models import SensorModels
 from .results import ModelResult, TestRunResult, result_from_dict
 from .settings import Group
 from .store import Store
@@ -31,6 +32,12 @@ from .wins import DEFAULT_DRAWS, win_probabilities
 
 #: Competition lengths the report gives win odds for (the paper's analysis of GHH-09: 20 runs).
 WIN_RUNS = (1, 5, 20)
+
+
+def crash_rate(crashes: int, episodes: int) -> str:
+    """A crash fraction as a percentage that is never 0 % when some episode crashed (1 of 20,000: 0.005%)."""
+    rate = crashes / episodes
+    return f"{rate:.0%}" if rate == 0 or rate >= 0.01 else f"{100 * rate:.2g}%"
 
 
 def _runs(n: int) -> str:
@@ -145,7 +152,7 @@ class _TestRuns(Section):
                     continue
                 episodes = sum(len(r.returns) for r in runs)
                 crashes = sum(len(r.crash_episodes) for r in runs)
-                row.append(f"{crashes / episodes:.0%} ({fmt(np.median([float(r.score) for r in runs]))})")
+                row.append(f"{crash_rate(crashes, episodes)} ({fmt(np.median([float(r.score) for r in runs]))})")
             rows.append(row)
         return (
             "### Agents by condition\n\n"
@@ -312,7 +319,8 @@ def _section(cfg: ExperimentConfig, store: Store, out: Path) -> str:
     except NeurohoverError:
         total = None
     results = {u["key"]: result_from_dict(u["kind"], u["result"], u["key"]) for u in units}
-    sec = _SECTIONS[cfg.kind](cfg, results, store, out)
+    kind = SensorModels if cfg.kind == "model_learning" and cfg.typed.conditions else _SECTIONS[cfg.kind]  # type: ignore[attr-defined]
+    sec = kind(cfg, results, store, out)
     text = [f"## {cfg.title} [{cfg.scale}]\n", _header(cfg, store, units, total)]
     figure = sec.figure()
     if figure:

@@ -350,9 +350,19 @@ class ModelResult(_Record):
         Episodes the policy's evolution flew.
     timing : ModelTiming
         Wall-clock; not part of ``==``.
+    own_one_step_error, exact_one_step_error : Num or None
+        With exact checks (a sensor condition): the model's one-step error on the flight data it learned
+        from, and on an episode of exact flight data of the generic policy in the true MDP.
+    param_relative_errors : tuple of Num or None
+        With exact checks: ``|learned - true| / |true|`` of the 11 dynamics parameters.
+    exact_test_returns : tuple of Num or None
+        With exact checks: the evolved policy in the true MDP with exact sensors (the same gusts as
+        ``test_returns``, which it flew through the condition's sensors).
+    exact_test_crashes : int or None
     """
 
     _NESTED: ClassVar[dict[str, type[_Record]]] = {"timing": ModelTiming}
+    _OPTIONAL: ClassVar[tuple[str, ...]] = ("own_one_step_error", "exact_one_step_error", "param_relative_errors", "exact_test_returns", "exact_test_crashes")
 
     method: str
     mdp: str
@@ -366,6 +376,11 @@ class ModelResult(_Record):
     test_crashes: int
     policy_episodes: int
     timing: ModelTiming = field(compare=False)
+    own_one_step_error: Num | None = None
+    exact_one_step_error: Num | None = None
+    param_relative_errors: tuple[Num, ...] | None = None
+    exact_test_returns: tuple[Num, ...] | None = None
+    exact_test_crashes: int | None = None
 
 
 @dataclass(frozen=True, kw_only=True)

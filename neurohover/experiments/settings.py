@@ -46,6 +46,16 @@ class Group:
 
 
 @dataclass(frozen=True, kw_only=True)
+class Condition:
+    """One sensor condition of a model-learning experiment (a ``[[settings.conditions]]`` table)."""
+
+    key: str
+    label: str
+    sensor: dict | None = None  # None: exact sensors
+    data_episodes: int = 1
+
+
+@dataclass(frozen=True, kw_only=True)
 class ExperimentSettings:
     """What every experiment kind has."""
 
@@ -84,6 +94,7 @@ class ModelLearningSettings(ExperimentSettings):
     policy_budget: int = 0
     policy_prototype: str = "generic"
     test_episodes: int = 5
+    conditions: tuple[Condition, ...] = ()  # empty: one condition, the experiment's sensor and one episode of data
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -108,7 +119,7 @@ KIND_SETTINGS: dict[str, type[ExperimentSettings]] = {
     "model_learning": ModelLearningSettings,
     "test_runs": TestRunsSettings,
 }
-_NESTED: dict[str, type] = {"variants": Variant, "groups": Group}
+_NESTED: dict[str, type] = {"variants": Variant, "groups": Group, "conditions": Condition}
 
 
 def _build(cls: type, table: dict) -> Any:

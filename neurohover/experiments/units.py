@@ -32,11 +32,11 @@ from ..errors import NeurohoverError
 from ..evaluate import evaluate, evaluate_jobs, num_threads
 from ..evolution.config import optimiser_of
 from ..evolution.evolve import evolve, validation_return
-from ..models import learn_ec_meno, learn_ec_mer, learn_lr
+from ..models import learn_ec_meno, learn_ec_mer, learn_lr, one_step_error
 from ..policies import Policy
 from ..policies import prototype as make_prototype
 from ..policysets import choose_safe
-from ..tasks import MDP, Sensor, family_for
+from ..tasks import EXACT, MDP, Sensor, family_for
 from .params import unit_params
 from .results import (
     DiagnosticResult,
@@ -202,13 +202,15 @@ def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
     """Table 4: fly the generic policy once (flight data), learn a model, evolve a policy on the
     model, fly that policy ``test_episodes`` times in the true MDP. Methods: ``lr`` (OLS, the
     paper's), ``lr-gls`` (the GLS option), ``ec-meno`` (``ec_meno_budget`` evaluations, 0: the
-    plateau stop) and ``ec-mer`` (``model_budget`` evaluations)."""
+    plateau stop) and ``ec-mer`` (``model_budget`` evaluations). The model learns from ``data_episodes``
+    episodes (flown through the MDP's sensors, when it has a sensor model); with ``exact_checks`` the
+    model and its policy are also checked against exact sensors (:class:`ModelResult`)."""
     q = unit_params("model", p)
 
     mdp = _mdp(q.mdp)
     generic = _policy(q.generic)
     seeds = np.random.SeedSequence(q.seed).generate_state(4, np.uint64) >> np.uint64(1)
-    data = evaluate(generic, mdp, seed=int(seeds[0]), record=True, n_steps=q.n_steps, threads=threads, device=device)
+    data = evaluate(generic, mdp, episodes=q.data_episodes, seed=int(seeds[0]), record=True, n_steps=q.n_steps, threads=threads, device=device)
     flight = data.flight_data
     assert flight is not None  # recorded
     t0 = time.perf_counter()
@@ -234,11 +236,14 @@ def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
     evolve_seconds = time.perf_counter() - t1
     test = evaluate(evolved.champion, mdp, episodes=q.test_episodes, seed=int(seeds[3]), n_steps=q.n_steps, threads=threads, device=device)
     returns = test.returns.ravel()
+    checks = {}
+    if q.exact_checks:
+        checks = _exact_checks(q, mdp, generic, model, flight, evolved.champion, int(seeds[3]), threads, device)
     return ModelResult(
         method=q.method,
         mdp=mdp.label,
-        generic_return=num(data.returns.ravel()[0]),
-        generic_crashed=bool(data.crashed.ravel()[0]),
+        generic_return=num(data.returns.ravel().mean()),
+        generic_crashed=bool(data.crashed.any()),
         model_params=tuple(num(x) for x in model.params),
         model_noise_std=tuple(num(x) for x in model.noise_std),
         predicted_return=num(evolved.champion_return),
@@ -247,7 +252,27 @@ def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
         test_crashes=int(test.crashed.sum()),
         policy_episodes=int(evolved.episodes),
         timing=ModelTiming(learn_seconds=learn_seconds, evolve_seconds=evolve_seconds),
+        **checks,
     ).to_dict()
+
+
+def _exact_checks(q, mdp, generic, model, flight, champion, test_seed: int, threads: int | None, device: str) -> dict:
+    """What a model learned through the MDP's sensors does against exact ones: its one-step error on its own
+    data and on an exact episode of the generic policy (gusts of its own seed), its parameters' relative
+    errors, and its policy flown with exact sensors on the test's gusts."""
+    exact = mdp.with_sensor(EXACT)
+    exact_seed = int(np.random.SeedSequence([q.seed, 1]).generate_state(1, np.uint64)[0] >> np.uint64(1))
+    exact_flight = evaluate(generic, exact, seed=exact_seed, record=True, n_steps=q.n_steps, threads=threads, device=device).flight_data
+    assert exact_flight is not None  # recorded
+    truth = np.asarray(mdp.params, dtype=float)
+    flown = evaluate(champion, exact, episodes=q.test_episodes, seed=test_seed, n_steps=q.n_steps, threads=threads, device=device)
+    return {
+        "own_one_step_error": num(one_step_error(model, flight)),
+        "exact_one_step_error": num(one_step_error(model, exact_flight)),
+        "param_relative_errors": tuple(num(x) for x in np.abs(np.asarray(model.params) - truth) / np.abs(truth)),
+        "exact_test_returns": tuple(num(x) for x in flown.returns.ravel()),
+        "exact_test_crashes": int(flown.crashed.sum()),
+    }
 
 
 def unit_agent(p: dict, device: str = "cpu"):
