@@ -174,6 +174,16 @@ def crashed(s) -> bool:
 
 
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
+def step_outcome(s, o, n_steps, t):
+    """The end-of-step rule, once for the compiled code (the lanes keep its packed form): control step ``t``
+    (1-based) of an ``n_steps`` episode that left state ``s`` and observation ``o`` earns ``(reward, crashed)``,
+    the crash charge if the helicopter crashed, else the observation's reward."""
+    if crashed(s):
+        return crash_charge(n_steps, t), True
+    return reward_of(o), False
+
+
+@nb.njit(cache=True, inline="always", fastmath={"contract"})
 def dangerous(o, limits) -> bool:
     """Safeguard test on observation ``o`` (``limits`` in the layout of constants.SAFEGUARD_LIMITS).
 
@@ -456,11 +466,10 @@ def fly_job(
             seen = sense(o, t, sensor, srng, scratch)
         else:
             seen = o
-        if crashed(s):
-            crash = True
-            total += crash_charge(n_steps, t)
+        reward, crash = step_outcome(s, o, n_steps, t)
+        total += reward
+        if crash:
             break
-        total += reward_of(o)
     if slot >= 0:
         for i in range(12):
             obs_out[slot, t, i] = seen[i]

@@ -15,7 +15,7 @@ import numba as nb
 import numpy as np
 
 from .constants import SENSOR_SCRATCH
-from .kernel import clip_action, crash_charge, crashed, integrate, observe, reward_of, sense, unpack_mdp, unpack_sensor, update_noise
+from .kernel import clip_action, crash_charge, integrate, observe, sense, step_outcome, unpack_mdp, unpack_sensor, update_noise
 from .rng import next_normal, seed_sensor_stream
 
 ENV_NOISE_WIDTH = 6 + SENSOR_SCRATCH  # per-helicopter floats when it senses: gust noise, then the sensor's
@@ -71,12 +71,7 @@ def step_one(i, mdp_rows, env_mdp, states, noise, rngs, steps, actions, n_steps,
     seen = sense(o, t, sensor, rngs[i, 4:], noise[i, 6:]) if sensing else o
     for m in range(12):
         obs_out[i, m] = seen[m]
-    if crashed(s):
-        rew_out[i] = crash_charge(n_steps, t)
-        crash_out[i] = True
-    else:
-        rew_out[i] = reward_of(o)
-        crash_out[i] = False
+    rew_out[i], crash_out[i] = step_outcome(s, o, n_steps, t)
 
 
 @nb.njit(cache=True, fastmath={"contract"})
