@@ -395,7 +395,6 @@ def register(sub) -> None:
     p.add_argument("--seed-policy", default="baseline", help="prototype: zero, baseline (baseline-equivalent network; default) or a policy FILE")
     p.add_argument(
         "--optimizer",
-        "--optimiser",
         choices=optimiser_names(),
         default="ne",
         help="ne: the paper's neuroevolution (default); " + "; ".join(f"{n}: {s.summary}" for n, s in OPTIMISERS.items()) + " (same budget and resampling)",

@@ -179,7 +179,18 @@ def test_configs_take_the_settings_and_refuse_bad_ones_when_loaded() -> None:
     by_variant = {u.key.split("/")[1]: u.params["optimiser"] for u in plan(cfg, {}).units}
     assert by_variant["raw-returns"] == {"fitness": "return"} and by_variant["script-sizes"] == {"preset": "authors-script"}
     assert {u.params["topology"] for u in plan(load_config("fig13", "paper"), {}).units} == {"slp"}
-    with pytest.raises(NeurohoverError, match="optimiser: bad generational settings: fitness='bogus' is not a fitness scale"):
-        load_config("fig13", "quick", {"optimiser": {"fitness": "bogus"}})
+    with pytest.raises(NeurohoverError, match="optimizer: bad generational settings: fitness='bogus' is not a fitness scale"):
+        load_config("fig13", "quick", {"optimizer": {"fitness": "bogus"}})
     with pytest.raises(NeurohoverError, match="unknown steady-state setting"):
-        load_config("ablation-plateau", "quick", {"optimiser": {"preset": "table7"}})
+        load_config("ablation-plateau", "quick", {"optimizer": {"preset": "table7"}})
+
+
+def test_the_optimizer_table_has_one_spelling() -> None:
+    from neurohover.experiments.config import load_config
+
+    with pytest.raises(NeurohoverError, match="unknown setting.*optimiser.*spelled `optimizer`, as on the command line"):
+        load_config("ablation-fghh", "quick", {"optimiser": {"fitness": "return"}})
+    # Its settings hold the one spelling; their hash reads the table under its former name, so the
+    # stores written before resume (tests/test_stored_plans.py checks every stored experiment's hash).
+    cfg = load_config("ablation-fghh", "paper")
+    assert "optimizer" in cfg.settings and all("optimiser" not in v for v in cfg.settings["variants"])

@@ -106,7 +106,7 @@ def test_the_cli_takes_it_under_either_spelling(tmp_path: Path, capsys) -> None:
 
     out = tmp_path / "p.json"
     args = ["evolve", "--task", "ghh08", "--mdp", "train:0", "--budget", "100", "--seed", "1", "--out", str(out), "--json"]
-    assert main([*args, "--optimiser", "openai-es", "--setting", "popsize=10"]) == 0
+    assert main([*args, "--optimizer", "openai-es", "--setting", "popsize=10"]) == 0
     summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     assert summary["stop_reason"] == "budget" and nh.load_policy(out).metadata["method"] == "openai-es"
     assert main([*args, "--optimizer", "openai-es", "--setting", "popsize=7"]) == 2
@@ -129,10 +129,10 @@ runs = 1
 budget = 60
 n_steps = 100
 seed = 4
-optimiser = { mutate_std = 0.5 }
+optimizer = { mutate_std = 0.5 }
 variants = [
   { key = "ne", label = "steady-state NE", topology = "slp" },
-  { key = "es", label = "OpenAI-ES", topology = "slp", optimiser = { name = "openai-es", popsize = 10 } },
+  { key = "es", label = "OpenAI-ES", topology = "slp", optimizer = { name = "openai-es", popsize = 10 } },
 ]
 [scales.quick]
 """

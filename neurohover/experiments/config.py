@@ -197,7 +197,7 @@ _VARIANT = {
     "prototype": ("baseline", _choice("zero", "baseline")),
     "resampling": ("fixed:1", _resampling()),
     "sigma": (None, _float(0.0, 1.0)),
-    "optimiser": (_OMIT, _table()),  # this variant's optimiser settings, over the experiment's `optimiser`
+    "optimizer": (_OMIT, _table()),  # this variant's optimizer settings, over the experiment's `optimizer`
 }
 
 _GROUP = {
@@ -233,7 +233,7 @@ SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
         "n_mdps": (10, _int(1)),
         "runs": (_REQUIRED, _int(1)),
         "budget": (0, _int(0)),
-        "optimiser": ({}, _table()),
+        "optimizer": ({}, _table()),
         "validation_episodes": (0, _int(0)),
         # "fresh": each champion on fresh draws (of its MDP, or from G) of its own seed; "test": every
         # champion on the family's test MDPs with the same noise (paired comparisons)
@@ -282,7 +282,8 @@ SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
 def _validate_table(values: dict, schema: dict, where: str) -> dict:
     unknown = sorted(set(values) - set(schema))
     if unknown:
-        raise NeurohoverError(f"{where}: unknown setting(s) {', '.join(unknown)}; allowed: {', '.join(sorted(schema))}")
+        hint = " (the optimizer table is spelled `optimizer`, as on the command line)" if "optimiser" in unknown else ""
+        raise NeurohoverError(f"{where}: unknown setting(s) {', '.join(unknown)}; allowed: {', '.join(sorted(schema))}{hint}")
     out: dict[str, Any] = {}
     for key, (default, check) in schema.items():
         if key not in values:
@@ -327,15 +328,15 @@ def _check_kind(settings: dict, kind: str, where: str) -> None:
 
         method = "generational" if settings["target"] == "family" else "steady-state"
         for v in [None, *settings["variants"]]:
-            table = settings["optimiser"] if v is None else variant_optimiser(settings["optimiser"], v.get("optimiser"))
-            try:  # the optimiser settings are checked here, not when a unit first runs
+            table = settings["optimizer"] if v is None else variant_optimizer(settings["optimizer"], v.get("optimizer"))
+            try:  # the optimizer settings are checked here, not when a unit first runs
                 name, rest = optimiser_of(table)
                 if name != "ne" and settings["budget"] == 0 and not OPTIMISERS[name].stops_itself:
                     raise NeurohoverError(f"optimizer {name!r} has no stopping rule of its own: give the experiment a budget")
                 make_settings(method, name, rest)
             except NeurohoverError as err:
                 whose = "" if v is None else f" of variant {v['key']!r}"
-                raise NeurohoverError(f"{where}: optimiser{whose}: {err}") from None
+                raise NeurohoverError(f"{where}: optimizer{whose}: {err}") from None
         bad = [k for k in settings["robustness_variants"] if k not in keys]
         if bad:
             raise NeurohoverError(f"{where}: robustness_variants {bad} are not variant keys ({', '.join(keys)})")
@@ -397,6 +398,16 @@ def _check_kind(settings: dict, kind: str, where: str) -> None:
             raise NeurohoverError(f"{where}: generic_resampling must be a table with keys fixed and/or race holding fixed:K / race:DELTA")
 
 
+def _hashed(settings: dict) -> dict:
+    """The settings as the config hash reads them: the optimizer tables under their spelling before
+    2026-12-02 (``optimiser``), so that stores written before keep their hash and resume."""
+    if "optimizer" not in settings:
+        return settings
+    out = {("optimiser" if k == "optimizer" else k): v for k, v in settings.items()}
+    out["variants"] = [{("optimiser" if k == "optimizer" else k): v for k, v in var.items()} for var in settings["variants"]]
+    return out
+
+
 @dataclass(frozen=True)
 class ExperimentConfig:
     """A resolved, validated experiment config at one scale."""
@@ -419,7 +430,7 @@ class ExperimentConfig:
     @property
     def hash(self) -> str:
         """Hash of everything that changes results (16 hex digits)."""
-        payload = {"kind": self.kind, "settings": self.settings, "units_version": UNITS_VERSION, "external": self.external_digest}
+        payload = {"kind": self.kind, "settings": _hashed(self.settings), "units_version": UNITS_VERSION, "external": self.external_digest}
         return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
 
     def to_dict(self) -> dict:
@@ -582,8 +593,8 @@ def load_configs(name: str, scale: str, overrides: dict[str, Any] | None = None)
     return [load_config(name, scale, overrides)]
 
 
-def variant_optimiser(experiment: dict, own: dict | None) -> dict:
-    """The ``optimiser`` table a variant runs: its own keys (``own``, None: none) over the experiment's,
+def variant_optimizer(experiment: dict, own: dict | None) -> dict:
+    """The ``optimizer`` table a variant runs: its own keys (``own``, None: none) over the experiment's,
     or its own alone when it names another optimiser (``name``), whose settings are not the experiment's."""
     own = own or {}
     if own.get("name", "ne") != experiment.get("name", "ne"):

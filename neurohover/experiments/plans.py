@@ -31,7 +31,7 @@ from ..policies import baseline_policy
 from ..policysets import FGHH_GENERIC_RESAMPLING, load_policy_set
 from ..tasks import EXACT, Sensor
 from ..tasks.drift import Drift
-from .config import ExperimentConfig, load_config, variant_optimiser
+from .config import ExperimentConfig, load_config, variant_optimizer
 from .results import UnitKey
 from .settings import EvolutionSettings, ExperimentSettings, Group, ModelLearningSettings, TestRunsSettings
 from .units import Unit, family_of, policy_dict, unit_seed
@@ -103,7 +103,7 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
     units: list[Unit] = []
     base = {
         "budget": s.budget,
-        "optimiser": s.optimiser,
+        "optimiser": s.optimizer,  # the unit's param keeps its first spelling: the stored plans' params
         "n_steps": s.n_steps,
         "validation_episodes": s.validation_episodes,
         "history_points": s.history_points,
@@ -113,8 +113,8 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
     train = family.training_mdps()[: s.n_mdps]
     for v in s.variants:
         common = {**base, "topology": v.topology, "prototype": v.prototype, "resampling": v.resampling}
-        if v.optimiser is not None:
-            common["optimiser"] = variant_optimiser(s.optimiser, v.optimiser)
+        if v.optimizer is not None:
+            common["optimiser"] = variant_optimizer(s.optimizer, v.optimizer)
         if s.target == "train":
             for i, mdp in enumerate(train):
                 for r in range(s.runs):

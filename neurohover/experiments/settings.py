@@ -23,7 +23,7 @@ class Variant:
     prototype: str = "baseline"
     resampling: str = "fixed:1"
     sigma: float | None = None
-    optimiser: dict | None = None  # over the experiment's optimiser table (None: left out)
+    optimizer: dict | None = None  # over the experiment's optimizer table (None: left out)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -72,7 +72,7 @@ class EvolutionSettings(ExperimentSettings):
     runs: int
     n_mdps: int = 10
     budget: int = 0
-    optimiser: dict
+    optimizer: dict
     validation_episodes: int = 0
     validation_mdps: str | None = None
     history_points: int = 300

@@ -34,7 +34,7 @@ class OptimiserSpec:
     Attributes
     ----------
     name : str
-        What ``evolve(optimizer=...)``, ``--optimizer`` and a config's ``optimiser.name`` say.
+        What ``evolve(optimizer=...)``, ``--optimizer`` and a config's ``optimizer.name`` say.
     summary : str
         One line for help texts.
     settings : type
