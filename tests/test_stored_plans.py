@@ -7,7 +7,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from neurohover.experiments.config import load_config, shipped_configs
+from neurohover.experiments.config import ExperimentConfig, load_config, shipped_configs
 from neurohover.experiments.plans import plan, source_experiments
 from neurohover.experiments.store import Store
 
@@ -22,6 +22,8 @@ def test_every_stored_experiment_is_planned_again_with_its_stored_params(committ
         for name, scale, stored_hash, _ in store.experiments():
             if name not in shipped:
                 continue
+            as_stored = ExperimentConfig.from_dict(store.config(name, scale))  # what the report reads
+            assert as_stored.hash == stored_hash and as_stored.typed.seed == as_stored.settings["seed"], f"{name} ({scale})"
             stored = store.config(name, scale)["settings"]
             # the documented override (`reproduce ... --set policies=shipped`): where the policies come from
             overrides = {k: stored[k] for k in POLICY_SOURCES if k in stored}

@@ -408,6 +408,15 @@ def _hashed(settings: dict) -> dict:
     return out
 
 
+def _spelled_now(settings: dict) -> dict:
+    """Stored settings in today's spelling: a store written before 2026-12-02 holds ``optimiser`` tables."""
+    if "optimiser" not in settings:
+        return settings
+    out = {("optimizer" if k == "optimiser" else k): v for k, v in settings.items()}
+    out["variants"] = [{("optimizer" if k == "optimiser" else k): v for k, v in var.items()} for var in settings["variants"]]
+    return out
+
+
 @dataclass(frozen=True)
 class ExperimentConfig:
     """A resolved, validated experiment config at one scale."""
@@ -449,12 +458,13 @@ class ExperimentConfig:
 
     @classmethod
     def from_dict(cls, d: dict) -> ExperimentConfig:
+        """A config as :meth:`to_dict` wrote it (a store's), in today's spelling (:func:`_spelled_now`)."""
         return cls(
             d["name"],
             d["title"],
             d["kind"],
             d["scale"],
-            d["settings"],
+            _spelled_now(d["settings"]),
             d.get("paper", {}),
             d.get("paper_ref", ""),
             d.get("source", ""),
