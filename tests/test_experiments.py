@@ -37,7 +37,8 @@ from neurohover.experiments.store import SCHEMA_VERSION
 
 PAPER_EXPERIMENTS = ["fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16"]
 ABLATIONS = ["ablation-plateau", "ablation-hybrid", "ablation-fghh"]
-BENCHMARKS = ["bench-sensors", "bench-sensors-fallback", "bench-sensor-models", "bench-drift"]  # the harder benchmarks of the paper's Section 7 (docs/benchmarks.md)
+# the harder benchmarks of the paper's Section 7 (docs/benchmarks.md)
+BENCHMARKS = ["bench-sensors", "bench-sensors-fallback", "bench-sensor-models", "bench-drift"]
 BEYOND = ["wind-fig7", "wind-fig8", "wind-fig11", "risk-ghh09"]  # what the paper's conclusions predict and it could not run (docs/model.md)
 
 # A small evolution experiment whose units take ~0.3 s each (for the interruption tests).
