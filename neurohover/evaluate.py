@@ -29,6 +29,7 @@ from .sim.constants import (
     EPISODE_STEPS,
     MDP_ROW_LEN,
     ROW_SENSOR,
+    SAFEGUARD_ARM,
     SAFEGUARD_BOX,
     SAFEGUARD_KIND_BOX,
     SAFEGUARD_KIND_RATIO,
@@ -255,10 +256,17 @@ def evaluate_jobs(
         if fb.shape[0] != n_jobs or (fb.size and (fb.min() < -1 or fb.max() >= len(table))):
             raise NeurohoverError(f"fallback_index must have {n_jobs} entries in -1..{len(table) - 1}")
     limits = SAFEGUARD_LIMITS if safeguard_limits is None else np.asarray(safeguard_limits, dtype=float)
-    if limits.shape != (SAFEGUARD_LAYOUT_LEN,) or not np.all(np.delete(limits, 10) > 0) or np.isnan(limits).any() or limits[10] not in (0.0, 1.0):
+    if (
+        limits.shape != (SAFEGUARD_LAYOUT_LEN,)
+        or np.isnan(limits).any()
+        or not np.all(np.delete(limits, [10, SAFEGUARD_ARM]) > 0)
+        or limits[10] not in (0.0, 1.0)
+        or not (limits[SAFEGUARD_ARM] >= 0 and float(limits[SAFEGUARD_ARM]).is_integer())
+    ):
         raise NeurohoverError(
             f"safeguard_limits must be {SAFEGUARD_LAYOUT_LEN} numbers in the layout of DangerousState.limits() (9 box limits, the tilt "
-            f"threshold, the kind 0 or 1, the ratio threshold, 12 ratio limits; all but the kind > 0), got {limits.tolist()}"
+            f"threshold, the kind 0 or 1, the ratio threshold, 12 ratio limits, all > 0 but the kind; then the arming step, a whole "
+            f"number >= 0), got {limits.tolist()}"
         )
     rec = np.zeros(n_jobs, dtype=bool) if record is None else np.asarray(record, dtype=bool).reshape(-1)
     if rec.shape[0] != n_jobs:
@@ -355,12 +363,17 @@ class DangerousState:
         qw below this counts as tilted, in (0, 1] (0.99 in the authors' code); used by ``"code"`` only.
     threshold : float
         The ``"ratio-sum"`` test's threshold (> 0; 0.15 in the authors' FGHH agent).
+    arm_after : int
+        Control steps at the start of an episode in which the test does not apply (>= 0; 0, the
+        authors': from the first step). A learned policy's start-up correction can trip the test
+        in the first steps of an episode it then flies well (docs/benchmarks.md).
     """
 
     rule: str = "code"
     box: float = SAFEGUARD_BOX
     tilt: float = SAFEGUARD_TILT
     threshold: float = SAFEGUARD_RATIO_THRESHOLD
+    arm_after: int = 0
 
     def __post_init__(self) -> None:
         if self.rule not in SAFEGUARD_RULES:
@@ -371,13 +384,16 @@ class DangerousState:
             raise NeurohoverError(f"safeguard tilt={self.tilt!r} is out of range: allowed 0 < tilt <= 1 (qw threshold)")
         if not (isinstance(self.threshold, (int, float)) and np.isfinite(self.threshold) and self.threshold > 0):
             raise NeurohoverError(f"safeguard threshold={self.threshold!r} is out of range: allowed a finite number > 0")
+        if isinstance(self.arm_after, bool) or not isinstance(self.arm_after, int) or not 0 <= self.arm_after <= 10**6:
+            raise NeurohoverError(f"safeguard arm_after={self.arm_after!r} is out of range: allowed an integer in 0..1000000 (control steps)")
 
     def limits(self) -> np.ndarray:
         """The test in the kernel's layout (sim/constants.SAFEGUARD_LIMITS): 9 box limits, the tilt
-        threshold (inf: no tilt condition), the kind (0 box, 1 ratio sum), the ratio threshold and limits."""
+        threshold (inf: no tilt condition), the kind (0 box, 1 ratio sum), the ratio threshold and
+        limits, the arming step."""
         kind = SAFEGUARD_KIND_RATIO if self.rule == "ratio-sum" else SAFEGUARD_KIND_BOX
         tilt = float(self.tilt) if self.rule == "code" else np.inf
-        return np.array([float(self.box)] * 9 + [tilt, kind, float(self.threshold), *SAFEGUARD_RATIO_LIMITS])
+        return np.array([float(self.box)] * 9 + [tilt, kind, float(self.threshold), *SAFEGUARD_RATIO_LIMITS, float(self.arm_after)])
 
 
 @dataclass(frozen=True)

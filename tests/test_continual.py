@@ -43,7 +43,12 @@ def test_after_an_abrupt_change_it_re_learns_where_the_incremental_agent_keeps_c
 
 @pytest.mark.parametrize(
     ("values", "message"),
-    [({"window": 0}, "window=0 is out of range"), ({"threshold": 1.0}, "threshold=1.0 is out of range"), ({"safeguard": "yes"}, "safeguard='yes'")],
+    [
+        ({"window": 0}, "window=0 is out of range"),
+        ({"threshold": 1.0}, "threshold=1.0 is out of range"),
+        ({"safeguard": "yes"}, "safeguard='yes'"),
+        ({"safeguard_after": -1}, "safeguard_after=-1 is out of range"),
+    ],
 )
 def test_bad_settings_are_refused(values: dict, message: str) -> None:
     with pytest.raises(NeurohoverError, match=message):
@@ -94,3 +99,15 @@ def test_it_flies_on_every_family(task: str) -> None:
     agent = spec.build(policies_from_set(spec, load_policy_set(task)), AgentOptions(evolution=ModelEvolution(budget=60, n_steps=200)))
     run = run_test(agent, family, family.test_mdps()[0].with_drift(Drift(0.05)), episodes=6, seed=1, n_steps=200)
     assert agent.models >= 1 and np.isfinite(run.returns).all() and run.returns.shape == (6,)
+
+
+def test_its_safeguard_can_be_armed_after_the_first_steps() -> None:
+    spec = agent_spec("continual")
+    policies = policies_from_set(spec, load_policy_set("ghh08"))
+    armed = spec.build(policies, AgentOptions(evolution=EVOLUTION, settings=ContinualSettings(safeguard_after=10)))
+    armed.start(get_task_family("ghh08"), np.random.default_rng(0))
+    armed.policy = load_policy_set("ghh08").specialised[0]  # any policy but the generic flies under the safeguard
+    choice = armed.choose(1)
+    assert choice.fallback is armed.generic and choice.dangerous.arm_after == 10
+    # left out of its table at the default, so the configs written before keep their hash
+    assert "safeguard_after" not in ContinualSettings().to_dict() and ContinualSettings(safeguard_after=10).to_dict()["safeguard_after"] == 10

@@ -56,13 +56,32 @@ def test_a_rolling_policy_is_caught_by_both_rules() -> None:
         assert (ev.safeguard_step > 0).all() and not ev.crashed.any()
 
 
+def test_an_armed_test_fires_at_the_first_dangerous_step_from_its_arming_step() -> None:
+    g = np.zeros(40)
+    g[36] = 0.6  # constant aileron: rolls over, dangerous from some step k0 on
+    roller = Policy("slp", g)
+    mdp = get_task_family("ghh08").zero()
+
+    def fly(d: DangerousState):
+        return evaluate(roller, mdp, episodes=2, seed=1, n_steps=300, safeguard=Safeguard(baseline_policy(), d))
+
+    k0 = fly(DangerousState()).safeguard_step.ravel()
+    assert (k0 > 0).all()
+    assert (fly(DangerousState(arm_after=int(k0.min()))).safeguard_step.ravel() == k0).all()  # armed in time: the same step
+    late = fly(DangerousState(arm_after=int(k0.max()) + 1))
+    steps = late.safeguard_step.ravel()
+    # armed later: it fires no earlier than its arming step, or the roller crashed before the fallback could take over
+    assert ((steps >= k0.max() + 1) | ((steps == -1) & late.crashed.ravel())).all()
+    assert (fly(DangerousState(arm_after=10**6)).safeguard_step.ravel() == -1).all()  # never armed
+
+
 _RATIOS = [5.0] * 3 + [20.0] * 3 + [4 * math.pi] * 3 + [1.0] * 3
 
 
 def test_limits_are_settings() -> None:
-    np.testing.assert_array_equal(DangerousState().limits(), [0.5] * 9 + [0.99, 0, 0.15, *_RATIOS])
-    np.testing.assert_array_equal(DangerousState("paper", box=0.8).limits(), [0.8] * 9 + [math.inf, 0, 0.15, *_RATIOS])
-    np.testing.assert_array_equal(DangerousState(box=1.0, tilt=0.95).limits(), [1.0] * 9 + [0.95, 0, 0.15, *_RATIOS])
+    np.testing.assert_array_equal(DangerousState().limits(), [0.5] * 9 + [0.99, 0, 0.15, *_RATIOS, 0])
+    np.testing.assert_array_equal(DangerousState("paper", box=0.8).limits(), [0.8] * 9 + [math.inf, 0, 0.15, *_RATIOS, 0])
+    np.testing.assert_array_equal(DangerousState(box=1.0, tilt=0.95, arm_after=7).limits(), [1.0] * 9 + [0.95, 0, 0.15, *_RATIOS, 7])
     np.testing.assert_array_equal(DangerousState("ratio-sum", threshold=0.2).limits()[10:12], [1, 0.2])
     with pytest.raises(NeurohoverError, match="safeguard threshold=0 is out of range"):
         DangerousState("ratio-sum", threshold=0)
@@ -102,6 +121,8 @@ def test_the_ratio_sum_rule_fires_at_the_first_step_whose_signed_ratio_sum_excee
         ({"tilt": 1.2}, r"tilt=1.2 is out of range: allowed 0 < tilt <= 1"),
         ({"tilt": 0}, "tilt=0 is out of range"),
         ({"box": float("nan")}, "box=nan is out of range"),
+        ({"arm_after": -1}, r"arm_after=-1 is out of range: allowed an integer in 0..1000000"),
+        ({"arm_after": 2.5}, "arm_after=2.5 is out of range"),
     ],
 )
 def test_bad_settings_are_refused(kwargs: dict, message: str) -> None:

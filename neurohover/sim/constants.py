@@ -88,12 +88,14 @@ SAFEGUARD_TILT = 0.99
 # (limits 5 m/s, 20 m, 4 pi rad/s and 1 for the quaternion's vector part) above 0.15.
 SAFEGUARD_RATIO_LIMITS = (5.0,) * 3 + (20.0,) * 3 + (4 * math.pi,) * 3 + (1.0,) * 3
 SAFEGUARD_RATIO_THRESHOLD = 0.15
-# Kernel layout (24 floats): the 9 box limits (u, v, w, x, y, z, p, q, r), the tilt threshold on qw
+# Kernel layout (25 floats): the 9 box limits (u, v, w, x, y, z, p, q, r), the tilt threshold on qw
 # (infinity: every attitude counts as tilted, i.e. the paper's box test alone), the test's kind (0:
-# box and tilt, 1: sum of ratios), the ratio threshold, the 12 ratio limits.
-SAFEGUARD_LAYOUT_LEN = 24
+# box and tilt, 1: sum of ratios), the ratio threshold, the 12 ratio limits, and the control step
+# from which the test applies (SAFEGUARD_ARM; 0: from the first, as the authors' agents ran it).
+SAFEGUARD_LAYOUT_LEN = 25
+SAFEGUARD_ARM = 24
 SAFEGUARD_KIND_BOX, SAFEGUARD_KIND_RATIO = 0.0, 1.0
-SAFEGUARD_LIMITS = np.array([SAFEGUARD_BOX] * 9 + [SAFEGUARD_TILT, SAFEGUARD_KIND_BOX, SAFEGUARD_RATIO_THRESHOLD, *SAFEGUARD_RATIO_LIMITS])
+SAFEGUARD_LIMITS = np.array([SAFEGUARD_BOX] * 9 + [SAFEGUARD_TILT, SAFEGUARD_KIND_BOX, SAFEGUARD_RATIO_THRESHOLD, *SAFEGUARD_RATIO_LIMITS, 0.0])
 
 
 def crash_penalty(steps_taken: int, episode_steps: int = EPISODE_STEPS) -> float:

@@ -42,6 +42,7 @@ from .constants import (
     ROW_SUBSTEPS,
     ROW_WIND_KIND,
     ROW_WIND_START,
+    SAFEGUARD_ARM,
     SENSOR_SCRATCH,
     WIND_CONSTANT,
     WIND_SINUSOID,
@@ -441,7 +442,7 @@ def fly_job(
     sg_step = -1
     t = 0
     for k in range(n_steps):
-        if safeguard and fb >= 0 and sg_step < 0 and dangerous(seen, limits):
+        if safeguard and fb >= 0 and sg_step < 0 and k >= limits[SAFEGUARD_ARM] and dangerous(seen, limits):
             sg_step = k
             kind = policy_kinds[fb]
             g = genomes[fb]
