@@ -38,7 +38,7 @@ from neurohover.experiments.store import SCHEMA_VERSION
 PAPER_EXPERIMENTS = ["fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16"]
 ABLATIONS = ["ablation-plateau", "ablation-hybrid", "ablation-fghh"]
 # the harder benchmarks of the paper's Section 7 (docs/benchmarks.md)
-BENCHMARKS = ["bench-sensors", "bench-sensors-fallback", "bench-sensor-models", "bench-drift"]
+BENCHMARKS = ["bench-sensors", "bench-sensors-fallback", "bench-sensor-models", "bench-drift", "bench-drift-armed"]
 BEYOND = ["wind-fig7", "wind-fig8", "wind-fig11", "risk-ghh09"]  # what the paper's conclusions predict and it could not run (docs/model.md)
 
 # A small evolution experiment whose units take ~0.3 s each (for the interruption tests).
