@@ -65,12 +65,10 @@ class ContinualSettings(AgentSettings):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, int) or v < 1:
                 raise NeurohoverError(f"continual {name}={v!r} is out of range: allowed an integer >= 1")
-        c = self.cooldown
-        if isinstance(c, bool) or not isinstance(c, int) or not 0 <= c <= 10**6:
-            raise NeurohoverError(f"continual cooldown={c!r} is out of range: allowed an integer in 0..1000000 (episodes)")
-        a = self.safeguard_after
-        if isinstance(a, bool) or not isinstance(a, int) or not 0 <= a <= 10**6:
-            raise NeurohoverError(f"continual safeguard_after={a!r} is out of range: allowed an integer in 0..1000000 (control steps)")
+        for name, unit in (("cooldown", "episodes"), ("safeguard_after", "control steps")):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v <= 10**6:
+                raise NeurohoverError(f"continual {name}={v!r} is out of range: allowed an integer in 0..1000000 ({unit})")
         t = self.threshold
         if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t <= 1:
             raise NeurohoverError(f"continual threshold={t!r} is out of range: allowed a number > 1 (a ratio of one-step errors)")

@@ -398,22 +398,16 @@ def _check_kind(settings: dict, kind: str, where: str) -> None:
             raise NeurohoverError(f"{where}: generic_resampling must be a table with keys fixed and/or race holding fixed:K / race:DELTA")
 
 
-def _hashed(settings: dict) -> dict:
-    """The settings as the config hash reads them: the optimizer tables under their spelling before
-    2026-12-02 (``optimiser``), so that stores written before keep their hash and resume."""
-    if "optimizer" not in settings:
-        return settings
-    out = {("optimiser" if k == "optimizer" else k): v for k, v in settings.items()}
-    out["variants"] = [{("optimiser" if k == "optimizer" else k): v for k, v in var.items()} for var in settings["variants"]]
-    return out
+def _respelled(settings: dict, old: str, new: str) -> dict:
+    """``settings`` with the optimizer tables (the experiment's and its variants') under key ``new`` instead of ``old``.
 
-
-def _spelled_now(settings: dict) -> dict:
-    """Stored settings in today's spelling: a store written before 2026-12-02 holds ``optimiser`` tables."""
-    if "optimiser" not in settings:
+    The table was spelled ``optimiser`` until 2026-12-02: the config hash reads it under that name (so
+    stores written before keep their hash and resume), and stored configs are read in today's spelling.
+    """
+    if old not in settings:
         return settings
-    out = {("optimizer" if k == "optimiser" else k): v for k, v in settings.items()}
-    out["variants"] = [{("optimizer" if k == "optimiser" else k): v for k, v in var.items()} for var in settings["variants"]]
+    out = {(new if k == old else k): v for k, v in settings.items()}
+    out["variants"] = [{(new if k == old else k): v for k, v in var.items()} for var in settings["variants"]]
     return out
 
 
@@ -439,7 +433,8 @@ class ExperimentConfig:
     @property
     def hash(self) -> str:
         """Hash of everything that changes results (16 hex digits)."""
-        payload = {"kind": self.kind, "settings": _hashed(self.settings), "units_version": UNITS_VERSION, "external": self.external_digest}
+        settings = _respelled(self.settings, "optimizer", "optimiser")
+        payload = {"kind": self.kind, "settings": settings, "units_version": UNITS_VERSION, "external": self.external_digest}
         return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
 
     def to_dict(self) -> dict:
@@ -458,13 +453,13 @@ class ExperimentConfig:
 
     @classmethod
     def from_dict(cls, d: dict) -> ExperimentConfig:
-        """A config as :meth:`to_dict` wrote it (a store's), in today's spelling (:func:`_spelled_now`)."""
+        """A config as :meth:`to_dict` wrote it (a store's), in today's spelling (:func:`_respelled`)."""
         return cls(
             d["name"],
             d["title"],
             d["kind"],
             d["scale"],
-            _spelled_now(d["settings"]),
+            _respelled(d["settings"], "optimiser", "optimizer"),
             d.get("paper", {}),
             d.get("paper_ref", ""),
             d.get("source", ""),

@@ -22,11 +22,11 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from .config import ORDER, ExperimentConfig
-from .report_base import Section, fmt, new_figure, sd, table
+from .report_base import Section, fmt, log_errors, new_figure, sd, table
 from .report_evolution import EvolutionSection
 from .report_models import SensorModels
 from .results import ModelResult, TestRunResult, result_from_dict
-from .settings import Group
+from .settings import Group, ModelLearningSettings
 from .store import Store
 from .wins import DEFAULT_DRAWS, win_probabilities
 
@@ -52,7 +52,7 @@ class _ModelLearning(Section):
             return None
         fig, axes = new_figure(figsize=(6.5, 4))
         ax = axes[0, 0]
-        errors = [np.maximum(-np.array([float(r.test_mean) for r in v]), 1e-3) for v in data.values()]
+        errors = [log_errors([float(r.test_mean) for r in v]) for v in data.values()]
         ax.boxplot(errors)
         ax.set_xticks(range(1, len(data) + 1), [m.upper() for m in data])
         ax.set_yscale("log")
@@ -319,7 +319,7 @@ def _section(cfg: ExperimentConfig, store: Store, out: Path) -> str:
     except NeurohoverError:
         total = None
     results = {u["key"]: result_from_dict(u["kind"], u["result"], u["key"]) for u in units}
-    kind = SensorModels if cfg.kind == "model_learning" and cfg.typed.conditions else _SECTIONS[cfg.kind]  # type: ignore[attr-defined]
+    kind = SensorModels if isinstance(cfg.typed, ModelLearningSettings) and cfg.typed.conditions else _SECTIONS[cfg.kind]
     sec = kind(cfg, results, store, out)
     text = [f"## {cfg.title} [{cfg.scale}]\n", _header(cfg, store, units, total)]
     figure = sec.figure()

@@ -34,6 +34,11 @@ def fmt_p(p) -> str:
     return f"{p:.3g}"
 
 
+def log_errors(returns) -> np.ndarray:
+    """Errors (minus the returns) floored at 1e-3, for log scales."""
+    return np.maximum(-np.asarray(returns, dtype=float), 1e-3)
+
+
 def table(headers: list[str], rows: list[list]) -> str:
     lines = ["| " + " | ".join(headers) + " |", "|" + "|".join("---" for _ in headers) + "|"]
     lines += ["| " + " | ".join(fmt(c) if not isinstance(c, str) else c for c in row) + " |" for row in rows]

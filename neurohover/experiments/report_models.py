@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-from .report_base import Section, fmt, fmt_p, new_figure, table
+from .report_base import Section, fmt, fmt_p, log_errors, new_figure, table
 from .results import ModelResult
 
 
@@ -50,11 +50,6 @@ class _Checked:
         )
 
 
-def _errors(values) -> np.ndarray:
-    """Error (minus the return) floored at 1e-3, for log scales."""
-    return np.maximum(-np.asarray(values, dtype=float), 1e-3)
-
-
 class SensorModels(Section):
     """A model-learning experiment's sections when it has ``conditions``."""
 
@@ -75,7 +70,7 @@ class SensorModels(Section):
         labels = list(data)
         panels = (
             ("one-step error on exact flight data", [[u.exact for u in v] for v in data.values()]),
-            ("policy error, exact sensors", [list(_errors([u.true for u in v])) for v in data.values()]),
+            ("policy error, exact sensors", [list(log_errors([u.true for u in v])) for v in data.values()]),
         )
         for ax, (what, values) in zip(axes[0], panels, strict=True):
             ax.boxplot(values)
