@@ -34,7 +34,7 @@ import math
 
 import numba as nb
 import numpy as np
-from numba.core import types
+from numba.core import cgutils, types
 from numba.extending import intrinsic
 
 from .constants import ROW_SUBSTEPS, ROW_WIND_KIND, SENSOR_SCRATCH
@@ -57,7 +57,7 @@ from .rng import next_normal, seed_sensor_stream, seed_stream
 #: (the same bits): one packed step costs about as much as 2-3 scalar ones (docs/performance.md, Selection races).
 SCALAR_TAIL = 2
 
-__all__ = ["LANES", "SCALAR_TAIL", "PARK_F", "PARK_U", "fly_lanes", "fly_queue", "park_lane", "rollout_lanes", "rollout_lanes_parked"]
+__all__ = ["LANES", "SCALAR_TAIL", "PARK_F", "PARK_U", "fly_lanes", "fly_queue", "fly_shared", "park_lane", "rollout_lanes", "rollout_lanes_parked"]
 
 
 @nb.njit(cache=True, inline="always")
@@ -160,6 +160,20 @@ PARK_U = 8  # its gust stream and its sensor stream
 
 
 @intrinsic
+def _fetch_add(typingctx, counter, delta):
+    """Atomically add ``delta`` to ``counter[0]`` (an int64 array) and return its value before: a queue
+    that several threads take jobs from, one index each."""
+    sig = types.int64(counter, types.int64)
+
+    def codegen(context, builder, signature, args):
+        ary = context.make_array(signature.args[0])(context, builder, args[0])
+        ptr = cgutils.get_item_pointer(context, builder, signature.args[0], ary, [context.get_constant(types.intp, 0)])
+        return builder.atomic_rmw("add", ptr, args[1], "seq_cst")
+
+    return sig, codegen
+
+
+@intrinsic
 def _fence(typingctx):
     """A sequentially consistent fence: the loads after it are not hoisted above it (another thread's counts)."""
     sig = types.void()
@@ -171,13 +185,16 @@ def _fence(typingctx):
 
 
 @nb.njit(cache=True)
-def _all_over(left) -> bool:
-    """Whether every queue of a call has no required job left (``left``: one count per queue)."""
+def _take(counter) -> int:
+    """The next job index of a shared queue (one per call, every thread taking from it)."""
+    return _fetch_add(counter, 1)  # type: ignore[call-arg]  # an intrinsic: numba supplies typingctx
+
+
+@nb.njit(cache=True)
+def _required_over(left) -> bool:
+    """Whether a call's required jobs are all over (``left[0]``: those not over, counted down by every thread)."""
     _fence()  # type: ignore[call-arg]  # an intrinsic: numba supplies typingctx
-    for c in range(left.shape[0]):
-        if left[c] != 0:
-            return False
-    return True
+    return left[0] == 0
 
 
 @nb.njit(cache=True, fastmath={"contract"})
@@ -237,22 +254,24 @@ def _begin(B, P, N, rngs, seen, srngs, scratch, step, total, lane, row, seed, ep
 @nb.njit(cache=True, fastmath={"contract"})
 def fly_queue(
     mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, seed, n_steps, out_return, out_crashed, out_steps, stats,
-    n_required, job_slot, park_f, park_u, park_step, left, chunk,
+    n_required, job_slot, park_f, park_u, park_step, left, queue,
 ):  # fmt: skip
     """Fly jobs j (policy ``job_policy[j]``, MDP row ``job_mdp[j]``, episode index ``episodes[j]``),
     LANES at a time; write each job's return, crash flag and steps (as kernel.fly_job: no
     recording, no safeguard). Every job's MDP row must have the substep count and the wind
     presence (kind 0 or not) of the first job's row.
 
-    A lane whose episode ends takes the next job (a queue), so lanes run at different steps, each
-    with its own genome and its own MDP's parameters.
+    A lane whose episode ends takes the next job, so lanes run at different steps, each with its own
+    genome and its own MDP's parameters. The jobs are taken in order from ``queue[0]`` (the next
+    index), which every thread of a call shares: a thread whose jobs end early takes more, and none
+    idles while a job is left (results do not depend on which thread flies a job).
     stats[0] counts control steps, stats[1] those flown again by the large-angle fallback. Once the queue is
     empty and at most SCALAR_TAIL lanes fly, their substeps run per lane with ``kernel.integrate``.
 
     Parking (``park_step`` not empty): jobs ``n_required`` and later are optional. Job j's episode
     is kept in slot ``job_slot[j]`` of ``park_f`` / ``park_u`` / ``park_step`` (:func:`park_lane`): one
-    whose ``park_step`` is above 0 resumes there. ``left[chunk]`` counts this queue's required
-    jobs not yet over; once every queue's count is 0, the episodes still in flight are parked and
+    whose ``park_step`` is above 0 resumes there. ``left[0]`` counts the call's required jobs not
+    yet over (every thread counts it down); once it is 0, the episodes still in flight are parked and
     the call returns (an optional job not over keeps ``out_steps`` 0).
     """
     n_jobs = episodes.shape[0]
@@ -275,20 +294,22 @@ def fly_queue(
     job = np.full(LANES, -1, dtype=np.int64)
     step = np.zeros(LANES, dtype=np.int64)
     total = np.zeros(LANES)
-    nxt = 0
+    nxt = -1  # the last job index this thread took
     live = 0
     for lane in range(LANES):
         _reset_lane(B, N, A, lane)
+        if nxt < n_jobs:
+            nxt = _take(queue)
         if nxt < n_jobs:
             job[lane] = nxt
             sensing[lane] = _begin(
                 B, P, N, rngs, seen, srngs, scratch, step, total, lane, mdp_rows[job_mdp[nxt]], seed, episodes[nxt], job_slot, nxt, park_f, park_u, park_step
             )  # fmt: skip
-            nxt += 1
             live += 1
     parking = park_step.shape[0] > 0
     while live > 0:
-        if parking and left[chunk] == 0 and _all_over(left):  # every queue's required jobs are over
+        # (a thread whose last job was required below the last one holds required jobs only: it flies on)
+        if parking and nxt >= n_required - 1 and _required_over(left):
             for lane in range(LANES):
                 if job[lane] >= 0:
                     park_lane(B, N, rngs, seen, srngs, scratch, step, total, sensing, lane, job_slot[job[lane]], park_f, park_u, park_step)
@@ -318,8 +339,8 @@ def fly_queue(
                 out_return[j] = total[lane] + crash_charge(n_steps, k + 1)
                 out_crashed[j] = True
                 out_steps[j] = k + 1
-                if j < n_required:
-                    left[chunk] -= 1
+                if parking and j < n_required:
+                    _fetch_add(left, -1)
                 if parking:
                     park_step[job_slot[j]] = 0
                 job[lane] = -2  # over; the lane idles through this step (at rest, dt 0) and is refilled after it
@@ -397,19 +418,20 @@ def fly_queue(
                         _read(B, seen, srngs, scratch, lane, t, mdp_rows[job_mdp[j]])
                     continue
                 out_steps[j] = t
-                if j < n_required:
-                    left[chunk] -= 1
+                if parking and j < n_required:
+                    _fetch_add(left, -1)
                 if parking:
                     park_step[job_slot[j]] = 0  # over: a later listing of its slot begins afresh
             _reset_lane(B, N, A, lane)
             total[lane] = 0.0
             step[lane] = 0
             if nxt < n_jobs:
+                nxt = _take(queue)
+            if nxt < n_jobs:
                 job[lane] = nxt
                 sensing[lane] = _begin(
                 B, P, N, rngs, seen, srngs, scratch, step, total, lane, mdp_rows[job_mdp[nxt]], seed, episodes[nxt], job_slot, nxt, park_f, park_u, park_step
             )  # fmt: skip
-                nxt += 1
             else:
                 job[lane] = -1
                 live -= 1
@@ -418,11 +440,17 @@ def fly_queue(
 @nb.njit(cache=True, fastmath={"contract"})
 def fly_lanes(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, seed, n_steps, out_return, out_crashed, out_steps, stats):
     """:func:`fly_queue` without parking: every job is flown to its end."""
+    queue = np.zeros(1, dtype=np.int64)
+    fly_shared(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, seed, n_steps, out_return, out_crashed, out_steps, stats, queue)
+
+
+@nb.njit(cache=True, fastmath={"contract"})
+def fly_shared(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, seed, n_steps, out_return, out_crashed, out_steps, stats, queue):
+    """:func:`fly_lanes` taking its jobs from ``queue`` (shared with the call's other threads)."""
     none = np.zeros(0, dtype=np.int64)
-    left = np.full(1, episodes.shape[0], dtype=np.int64)
     fly_queue(
         mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, seed, n_steps, out_return, out_crashed, out_steps, stats,
-        episodes.shape[0], none, np.zeros((0, PARK_F)), np.zeros((0, PARK_U), dtype=np.uint64), none, left, 0,
+        episodes.shape[0], none, np.zeros((0, PARK_F)), np.zeros((0, PARK_U), dtype=np.uint64), none, np.zeros(1, dtype=np.int64), queue,
     )  # fmt: skip
 
 
@@ -464,19 +492,15 @@ def rollout_lanes(
         for j in range(n_jobs):
             if mdp_rows[job_mdp[j], ROW_SUBSTEPS] != n_sub or (mdp_rows[job_mdp[j], ROW_WIND_KIND] != 0.0) != windy:
                 raise ValueError("rollout_lanes: the jobs' MDP rows differ in substep count or wind presence")
-    # One contiguous chunk per thread, each with its own lane queue; no chunk smaller than LANES
-    # jobs unless the batch is, so lanes stay full.
+    # One lane set per thread, all taking jobs from one shared queue (a thread whose episodes end early
+    # takes more); no thread with fewer than LANES jobs on average unless the batch is, so lanes stay full.
     n_chunks = max(1, min(n_threads, n_jobs // LANES))
-    for c in nb.prange(n_chunks):
-        a = c * n_jobs // n_chunks
-        b = (c + 1) * n_jobs // n_chunks
+    queue = np.zeros(1, dtype=np.int64)
+    for _ in nb.prange(n_chunks):  # one lane set per thread
         stats = np.zeros(2, dtype=np.int64)
-        fly_lanes(
-            mdp_rows, policy_kinds, genomes, job_policy[a:b], job_mdp[a:b], job_episode[a:b], seed, n_steps,
-            out_return[a:b], out_crashed[a:b], out_steps[a:b], stats,
-        )  # fmt: skip
-        for j in range(a, b):
-            out_safeguard_step[j] = -1
+        fly_shared(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, seed, n_steps, out_return, out_crashed, out_steps, stats, queue)
+    for j in range(n_jobs):
+        out_safeguard_step[j] = -1
 
 
 @nb.njit(cache=True, parallel=True, fastmath={"contract"})
@@ -491,8 +515,8 @@ def rollout_lanes_parked(
     its slot ``job_slot[j]`` of ``park_f`` (``(S, PARK_F)``), ``park_u`` (``(S, PARK_U)`` uint64) and
     ``park_step`` (``(S,)``: its steps flown; 0 for an episode not begun), and a later call that lists
     the same slot resumes it there, so an episode's return is the same bits however many calls it
-    took. Jobs are dealt to the threads' queues in turn, required ones first; a queue whose required
-    jobs are over flies its optional ones until every queue's are. ``out_steps[j]`` is 0 for an
+    took. Every thread takes jobs in order from one shared queue, required ones first: a thread with
+    no required job left flies optional ones until every required one is over. ``out_steps[j]`` is 0 for an
     optional job not over (parked, or not begun); otherwise the outputs are :func:`rollout_lanes`'s.
     The rows must be alike in substeps and wind, as there (not checked here: one race's rows are).
     """
@@ -500,29 +524,11 @@ def rollout_lanes_parked(
     for j in range(n_jobs):
         out_steps[j] = 0
     n_chunks = max(1, min(n_threads, n_jobs // LANES))
-    left = np.zeros(n_chunks, dtype=np.int64)
-    for j in range(n_required):
-        left[j % n_chunks] += 1  # every count set before any queue starts
-    for c in nb.prange(n_chunks):
-        # This queue's jobs: required j = c, c + n_chunks, ..., then optional ones likewise.
-        n_req = (n_required - c + n_chunks - 1) // n_chunks
-        n_mine = n_req + (n_jobs - n_required - c + n_chunks - 1) // n_chunks
-        ids = np.empty(n_mine, dtype=np.int64)
-        for q in range(n_req):
-            ids[q] = c + q * n_chunks
-        for q in range(n_mine - n_req):
-            ids[n_req + q] = n_required + c + q * n_chunks
-        ret = np.empty(n_mine)
-        crashed = np.zeros(n_mine, dtype=np.bool_)
-        steps = np.zeros(n_mine, dtype=np.int64)
+    left = np.full(1, n_required, dtype=np.int64)  # set before any thread starts
+    queue = np.zeros(1, dtype=np.int64)
+    for _ in nb.prange(n_chunks):  # one lane set per thread
         stats = np.zeros(2, dtype=np.int64)
         fly_queue(
-            mdp_rows, policy_kinds, genomes, job_policy[ids], job_mdp[ids], job_episode[ids], seed, n_steps, ret, crashed, steps, stats,
-            n_req, job_slot[ids], park_f, park_u, park_step, left, c,
+            mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, seed, n_steps, out_return, out_crashed, out_steps, stats,
+            n_required, job_slot, park_f, park_u, park_step, left, queue,
         )  # fmt: skip
-        for q in range(n_mine):
-            j = ids[q]
-            if steps[q] > 0:
-                out_return[j] = ret[q]
-                out_crashed[j] = crashed[q]
-                out_steps[j] = steps[q]
