@@ -8,9 +8,10 @@ import pytest
 
 from neurohover import NeurohoverError
 from neurohover.experiments import params, settings
-from neurohover.experiments.config import SCHEMAS, experiment_names, load_config
+from neurohover.experiments.config import experiment_names, load_config
 from neurohover.experiments.params import PARAMS, unit_params
 from neurohover.experiments.plans import plan
+from neurohover.experiments.schema import SCHEMAS
 from neurohover.experiments.settings import KIND_SETTINGS, EvolutionSettings, Group, Variant
 
 

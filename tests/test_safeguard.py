@@ -160,6 +160,20 @@ def test_experiment_groups_carry_thegroup_hybrid_settings_into_their_units(tmp_p
     assert default.hash != cfg.hash  # the settings are part of the experiment's identity
 
 
+def test_a_hybrid_group_takes_its_settings_under_the_name_every_agent_uses(tmp_path: Path) -> None:
+    table = '{ replacement = "evolve", rule = "paper", box = 0.7 }'
+    as_settings = load_config(str(_fig8_with(tmp_path, f"settings = {table}\n")), "paper")
+    as_hybrid = load_config(str(_fig8_with(tmp_path, f"hybrid = {table}\n")), "paper")
+    group = next(g for g in as_settings.typed.groups if g.agent == "hybrid")
+    assert group.hybrid["rule"] == "paper" and group.hybrid["box"] == 0.7
+    assert as_settings.hash == as_hybrid.hash  # resolved under `hybrid`: stored experiments keep their hash
+    assert as_settings.hash != load_config("fig8", "paper").hash
+    with pytest.raises(NeurohoverError, match="give the hybrid settings once"):
+        load_config(str(_fig8_with(tmp_path, f"settings = {table}\nhybrid = {{ box = 0.5 }}\n")), "paper")
+    with pytest.raises(NeurohoverError, match="box=-1 is out of range"):
+        load_config(str(_fig8_with(tmp_path, "settings = { box = -1 }\n")), "paper")
+
+
 @pytest.mark.parametrize(
     ("extra", "agent", "message"),
     [

@@ -31,8 +31,9 @@ from ..policies import baseline_policy
 from ..policysets import FGHH_GENERIC_RESAMPLING, load_policy_set
 from ..tasks import EXACT, Sensor
 from ..tasks.drift import Drift
-from .config import ExperimentConfig, load_config, variant_optimizer
+from .config import ExperimentConfig, load_config
 from .results import UnitKey
+from .schema import variant_optimizer
 from .settings import EvolutionSettings, ExperimentSettings, Group, ModelLearningSettings, TestRunsSettings
 from .units import Unit, family_of, policy_dict, unit_seed
 

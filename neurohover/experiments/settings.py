@@ -1,6 +1,6 @@
 """Typed experiment settings, one frozen dataclass per experiment kind (what the planner reads).
 
-A config's settings are checked against :data:`neurohover.experiments.config.SCHEMAS` and kept as
+A config's settings are checked against :data:`neurohover.experiments.schema.SCHEMAS` and kept as
 that plain table (``ExperimentConfig.settings``: it is what the config hash and the store hold);
 :func:`typed_settings` reads the checked table into these classes (``ExperimentConfig.typed``),
 so the planner and the report name their fields instead of string keys. A setting that a config

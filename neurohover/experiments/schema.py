@@ -1,0 +1,377 @@
+"""The schema of experiment configs: each kind's settings, their defaults and checks (:mod:`.config`).
+
+``SCHEMAS[kind]`` maps each setting to ``(default, check)``: the default is ``REQUIRED`` (the config
+must give it), ``OMIT`` (a setting added later, absent from the resolved config unless given, so that
+older configs keep their hash) or a value; the check returns ``(ok, what is allowed)``; a
+``("list", SUB_SCHEMA)`` pair is a list of sub-tables (``[[variants]]``, ``[[groups]]``).
+:func:`validate_table` applies a schema, :func:`check_kind` the checks across settings.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from dataclasses import fields
+from typing import Any
+
+from ..agents.hybrid import HybridSettings
+from ..agents.registry import AGENTS, HYBRID_AGENTS
+from ..errors import NeurohoverError
+from ..evolution.config import make_settings, optimiser_of
+from ..evolution.evolve import parse_resampling
+from ..evolution.optimisers import OPTIMISERS
+from ..policysets import FGHH_GENERIC_RESAMPLING
+from ..tasks import TASK_FAMILIES, TASK_NAMES, Drift, Sensor
+
+REQUIRED = object()
+OMIT = object()  # default of a setting added later: absent from the resolved config unless given (older configs keep their hash)
+
+
+def _int(minimum: int):
+    def check(v):
+        return isinstance(v, int) and not isinstance(v, bool) and v >= minimum, f"an integer >= {minimum}"
+
+    return check
+
+
+def _float(lo: float, hi: float):
+    def check(v):
+        return isinstance(v, (int, float)) and not isinstance(v, bool) and lo <= v <= hi, f"a number in [{lo:g}, {hi:g}]"
+
+    return check
+
+
+def _choice(*allowed: str):
+    def check(v):
+        return v in allowed, "one of " + ", ".join(repr(a) for a in allowed)
+
+    return check
+
+
+def _agent():
+    def check(v):
+        return v in AGENTS, "one of " + ", ".join(repr(a) for a in AGENTS)
+
+    return check
+
+
+def _str():
+    def check(v):
+        return isinstance(v, str) and v != "", "a non-empty string"
+
+    return check
+
+
+def _bool():
+    def check(v):
+        return isinstance(v, bool), "true or false"
+
+    return check
+
+
+def _table():
+    def check(v):
+        return isinstance(v, dict), "a table"
+
+    return check
+
+
+def _str_list(*allowed: str):
+    def check(v):
+        ok = isinstance(v, list) and len(v) > 0 and all(isinstance(x, str) for x in v)
+        if ok and allowed:
+            ok = all(x in allowed for x in v)
+        return ok, "a non-empty list of " + ("strings" if not allowed else "names from " + ", ".join(allowed))
+
+    return check
+
+
+def _resampling():
+    def check(v):
+        if not isinstance(v, str):
+            return False, "a string fixed:K or race:DELTA"
+
+        try:
+            parse_resampling(v)
+        except NeurohoverError:
+            return False, "fixed:K (K >= 1) or race:DELTA (0 < DELTA < 1)"
+        return True, ""
+
+    return check
+
+
+def _settings_table(cls, keys: str):
+    """A table that ``cls.from_dict`` reads (a Sensor's or a Drift's), checked by it; ``keys`` names its settings."""
+
+    def check(v):
+        if not isinstance(v, dict):
+            return False, f"a table of {cls.__name__.lower()} settings ({keys})"
+        try:
+            cls.from_dict(v)
+        except NeurohoverError as exc:
+            return False, f"a valid {cls.__name__.lower()} ({exc})"
+        return True, ""
+
+    return check
+
+
+def _sensor_table():
+    return _settings_table(Sensor, ", ".join(["level", *(f.name for f in fields(Sensor))]))
+
+
+def _drift_table():
+    return _settings_table(Drift, ", ".join(f.name for f in fields(Drift) if f.init))
+
+
+def _seeds_of():
+    def check(v):
+        ok = (
+            isinstance(v, dict)
+            and set(v) == {"experiment", "seed", "group"}
+            and all(isinstance(v[k], str) and v[k] != "" for k in ("experiment", "group"))
+            and isinstance(v["seed"], int)
+            and not isinstance(v["seed"], bool)
+            and 0 <= v["seed"] <= 2**63 - 1
+        )
+        return ok, "a table {experiment = NAME, seed = ITS ROOT SEED, group = ITS GROUP'S LABEL}"
+
+    return check
+
+
+def _policy_source():
+    def check(v):
+        return isinstance(v, str) and v != "", "'evolve', 'shipped' or a directory holding <task>/ policy sets"
+
+    return check
+
+
+# key -> (default or REQUIRED, check)
+_COMMON: dict[str, tuple[Any, Any]] = {
+    "task": (REQUIRED, _choice(*TASK_NAMES)),
+    "sigma": (None, _float(0.0, 1.0)),
+    "seed": (REQUIRED, lambda v: (isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= 2**63 - 1, "an integer in 0..2**63-1")),
+    "n_steps": (6000, _int(1)),
+    "sensor": (OMIT, _sensor_table()),  # every MDP of the experiment seen through these sensors (docs/benchmarks.md)
+}
+
+_VARIANT = {
+    "key": (REQUIRED, _str()),
+    "label": (REQUIRED, _str()),
+    "topology": ("mlp", _choice("slp", "mlp")),
+    "prototype": ("baseline", _choice("zero", "baseline")),
+    "resampling": ("fixed:1", _resampling()),
+    "sigma": (None, _float(0.0, 1.0)),
+    "optimizer": (OMIT, _table()),  # this variant's optimizer settings, over the experiment's `optimizer`
+}
+
+_GROUP = {
+    "agent": (REQUIRED, _agent()),
+    "label": (None, _str()),
+    "mdps": ("test", _choice("train", "test", "sample")),
+    "n_mdps": (REQUIRED, _int(1)),
+    "runs_per_mdp": (1, _int(1)),
+    "exclude_own": (False, _bool()),
+    # an agent's own typed settings (its spec's settings class); a hybrid agent's (replacement, model_from, rule,
+    # box, tilt: HybridSettings) are resolved under `hybrid`, their older name (either spelling is read)
+    "settings": (OMIT, _table()),
+    "hybrid": ({}, _table()),
+    "estimator": ("ols", _choice("ols", "gls")),  # least squares of the LR models an agent learns
+    "wind_model": (OMIT, _choice("none", "constant", "sinusoid")),  # and their wind (neurohover.models.wind; absent: none)
+    "sensor": (OMIT, _sensor_table()),  # this group's agents fly the group's MDPs through these sensors
+    "drift": (OMIT, _drift_table()),  # and with these drifting dynamics (neurohover.tasks.drift)
+    # run i of MDP m takes the seed of that run of another experiment's group: the same gusts and draws (paired)
+    "seeds_of": (OMIT, _seeds_of()),
+}
+
+# One sensor condition of a model-learning experiment: its models learn from flight data seen through
+# these sensors, and are checked against exact ones (docs/benchmarks.md, learned models under sensor noise).
+_CONDITION = {
+    "key": (REQUIRED, _str()),
+    "label": (None, _str()),
+    "sensor": (OMIT, _sensor_table()),  # absent: exact sensors
+    "data_episodes": (1, _int(1)),  # episodes of the generic policy's flight data each model learns from
+}
+
+SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
+    "evolution": {
+        **_COMMON,
+        "target": (REQUIRED, _choice("train", "zero", "family")),
+        "n_mdps": (10, _int(1)),
+        "runs": (REQUIRED, _int(1)),
+        "budget": (0, _int(0)),
+        "optimizer": ({}, _table()),
+        "validation_episodes": (0, _int(0)),
+        # "fresh": each champion on fresh draws (of its MDP, or from G) of its own seed; "test": every
+        # champion on the family's test MDPs with the same noise (paired comparisons)
+        "validation_mdps": (OMIT, _choice("fresh", "test")),
+        "history_points": (300, _int(2)),
+        "robustness_variants": ([], lambda v: (isinstance(v, list) and all(isinstance(x, str) for x in v), "a list of variant keys")),
+        "robustness_episodes": (10, _int(1)),
+        "variants": (REQUIRED, ("list", _VARIANT)),
+    },
+    "model_learning": {
+        **_COMMON,
+        "mdps": ("test", _choice("train", "test", "sample")),
+        "n_mdps": (REQUIRED, _int(1)),
+        "methods": (["ec-mer", "ec-meno", "lr"], _str_list("ec-mer", "ec-meno", "lr", "lr-gls")),
+        "generic": ("evolve", _policy_source()),
+        "generic_budget": (0, _int(0)),
+        "model_budget": (2000, _int(1)),  # EC-MER evaluations
+        "ec_meno_budget": (0, _int(0)),  # EC-MENO evaluations; 0: the plateau stop
+        "ec_mer_episodes": (1, _int(1)),
+        "policy_budget": (0, _int(0)),
+        "policy_prototype": ("generic", _choice("generic", "baseline")),
+        "test_episodes": (5, _int(1)),
+        "conditions": (OMIT, ("list", _CONDITION)),  # sensor conditions, each its own models of every MDP
+    },
+    "test_runs": {
+        **_COMMON,
+        "episodes": (REQUIRED, _int(1)),
+        "policies": ("evolve", _policy_source()),
+        "policy_budget": (0, _int(0)),
+        "generic_budget": (0, _int(0)),
+        "generic_resampling": (dict(FGHH_GENERIC_RESAMPLING), _table()),
+        "generics_per_agent": (1, _int(1)),
+        # kind -> "EXPERIMENT/VARIANT" (or "EXPERIMENT/best-race"): each run's generic drawn from the
+        # final champions of another experiment's evolution runs, in the same store and scale
+        "generics_from": (OMIT, _table()),
+        "safety_episodes": (3, _int(1)),
+        "model_budget": (2000, _int(1)),
+        "predict_episodes": (5, _int(1)),
+        "max_learning_episodes": (25, _int(1)),
+        "drift": (OMIT, _drift_table()),  # every test run's MDP drifts so (neurohover.tasks.drift)
+        "groups": (REQUIRED, ("list", _GROUP)),
+    },
+}
+
+
+def validate_table(values: dict, schema: dict, where: str) -> dict:
+    unknown = sorted(set(values) - set(schema))
+    if unknown:
+        hint = " (the optimizer table is spelled `optimizer`, as on the command line)" if "optimiser" in unknown else ""
+        raise NeurohoverError(f"{where}: unknown setting(s) {', '.join(unknown)}; allowed: {', '.join(sorted(schema))}{hint}")
+    out: dict[str, Any] = {}
+    for key, (default, check) in schema.items():
+        if key not in values:
+            if default is REQUIRED:
+                raise NeurohoverError(f"{where}: missing required setting {key!r}")
+            if default is OMIT:
+                continue
+            out[key] = json.loads(json.dumps(default))
+            continue
+        value = values[key]
+        if isinstance(check, tuple):  # a list of sub-tables
+            if not isinstance(value, list) or not value or not all(isinstance(x, dict) for x in value):
+                raise NeurohoverError(f"{where}: {key!r} must be a non-empty list of tables ([[{key}]] in TOML)")
+            out[key] = [validate_table(item, check[1], f"{where}, {key}[{i}]") for i, item in enumerate(value)]
+            continue
+        if value is None and default is None:
+            out[key] = None
+            continue
+        ok, allowed = check(value)
+        if not ok:
+            raise NeurohoverError(f"{where}: {key} = {value!r} is not allowed: expected {allowed}")
+        out[key] = value
+    return out
+
+
+def check_kind(settings: dict, kind: str, where: str) -> None:
+    """Cross-field checks."""
+    task, sigma = settings["task"], settings.get("sigma")
+
+    if sigma is not None and not TASK_FAMILIES[task].has_sigma:
+        with_sigma = ", ".join(repr(n) for n, c in TASK_FAMILIES.items() if c.has_sigma)
+        raise NeurohoverError(f"{where}: sigma applies to task {with_sigma} only, not {task!r}")
+    if kind == "evolution":
+        keys = [v["key"] for v in settings["variants"]]
+        if len(set(keys)) != len(keys):
+            raise NeurohoverError(f"{where}: variant keys must be unique, got {keys}")
+        for v in settings["variants"]:
+            if v["sigma"] is not None and not TASK_FAMILIES[task].has_sigma:
+                raise NeurohoverError(f"{where}: variant {v['key']!r} sets sigma but the task is {task!r}")
+            if settings["target"] != "family" and v["resampling"].startswith("race"):
+                raise NeurohoverError(f"{where}: variant {v['key']!r}: selection races need target = 'family'")
+
+        method = "generational" if settings["target"] == "family" else "steady-state"
+        for v in [None, *settings["variants"]]:
+            table = settings["optimizer"] if v is None else variant_optimizer(settings["optimizer"], v.get("optimizer"))
+            try:  # the optimizer settings are checked here, not when a unit first runs
+                name, rest = optimiser_of(table)
+                if name != "ne" and settings["budget"] == 0 and not OPTIMISERS[name].stops_itself:
+                    raise NeurohoverError(f"optimizer {name!r} has no stopping rule of its own: give the experiment a budget")
+                make_settings(method, name, rest)
+            except NeurohoverError as err:
+                whose = "" if v is None else f" of variant {v['key']!r}"
+                raise NeurohoverError(f"{where}: optimizer{whose}: {err}") from None
+        bad = [k for k in settings["robustness_variants"] if k not in keys]
+        if bad:
+            raise NeurohoverError(f"{where}: robustness_variants {bad} are not variant keys ({', '.join(keys)})")
+        if settings["robustness_variants"] and settings["target"] != "train":
+            raise NeurohoverError(f"{where}: robustness_variants need target = 'train'")
+        if settings.get("validation_mdps") == "test" and settings["target"] != "family":
+            raise NeurohoverError(f"{where}: validation_mdps = 'test' flies champions evolved over G on the family's test MDPs: it needs target = 'family'")
+        if settings["target"] == "train" and settings["n_mdps"] > 10:
+            raise NeurohoverError(f"{where}: n_mdps = {settings['n_mdps']} is out of range: there are 10 training MDPs")
+    if kind == "model_learning" and "conditions" in settings:
+        keys = [c["key"] for c in settings["conditions"]]
+        bad = [k for k in keys if not re.fullmatch(r"[a-z0-9][a-z0-9.-]*", k)]
+        if bad or len(set(keys)) != len(keys):
+            raise NeurohoverError(f"{where}: condition keys must be unique and of lower-case letters, digits, '.' and '-', got {keys}")
+        if "sensor" in settings:
+            raise NeurohoverError(f"{where}: sensor is set by each of the conditions here: leave [settings] sensor out")
+        for c in settings["conditions"]:
+            c["label"] = c["label"] or c["key"]
+    if kind in ("model_learning", "test_runs"):
+        groups = settings.get("groups", [{"mdps": settings.get("mdps"), "n_mdps": settings.get("n_mdps")}])
+        for g in groups:
+            limit = {"train": 10, "test": 100}.get(g["mdps"])
+            if limit is not None and g["n_mdps"] > limit:
+                raise NeurohoverError(f"{where}: n_mdps = {g['n_mdps']} is out of range for mdps = {g['mdps']!r} (at most {limit})")
+    if kind == "test_runs":
+        labels = [g["label"] or g["agent"] for g in settings["groups"]]
+        if len(set(labels)) != len(labels):
+            raise NeurohoverError(f"{where}: group labels must be unique (set label = ... on repeated agents), got {labels}")
+        for g in settings["groups"]:
+            if task not in AGENTS[g["agent"]].tasks:
+                raise NeurohoverError(f"{where}: agent {g['agent']!r} does not apply to task {task!r}")
+            g["label"] = g["label"] or g["agent"]
+            if "settings" in g and g["agent"] in HYBRID_AGENTS:  # one spelling for every agent's own settings
+                if g["hybrid"]:
+                    raise NeurohoverError(f"{where}: group {g['label']!r}: give the hybrid settings once, as settings (hybrid is its older name), not both")
+                g["hybrid"] = g.pop("settings")  # kept under `hybrid`: configs written before keep their hash
+            if g["hybrid"]:
+                if g["agent"] not in HYBRID_AGENTS:
+                    raise NeurohoverError(
+                        f"{where}: group {g['label']!r}: hybrid settings apply to the agents {', '.join(HYBRID_AGENTS)} only, not to {g['agent']!r}"
+                    )
+                try:
+                    g["hybrid"] = HybridSettings.from_dict(g["hybrid"]).to_dict()
+                except NeurohoverError as e:
+                    raise NeurohoverError(f"{where}: group {g['label']!r}: {e}") from None
+            if "settings" in g:  # checked here, not when a unit first runs
+                own = AGENTS[g["agent"]].settings
+                if own is None or own.UNIT_KEY != "agent_settings":
+                    raise NeurohoverError(f"{where}: group {g['label']!r}: agent {g['agent']!r} takes no settings table")
+                try:
+                    g["settings"] = own.from_dict(g["settings"]).to_dict()
+                except NeurohoverError as e:
+                    raise NeurohoverError(f"{where}: group {g['label']!r}: {e}") from None
+        for kind, source in settings.get("generics_from", {}).items():
+            name, _, variant = str(source).partition("/")
+            if kind not in ("fixed", "race") or not isinstance(source, str) or not name or not variant:
+                raise NeurohoverError(
+                    f"{where}: generics_from = {{ {kind} = {source!r} }} is not allowed: expected keys fixed and/or race holding "
+                    "'EXPERIMENT/VARIANT' or 'EXPERIMENT/best-race' (e.g. fixed = 'fig13/k5')"
+                )
+        gr = settings["generic_resampling"]
+        if set(gr) - {"fixed", "race"} or not all(_resampling()(v)[0] for v in gr.values()):
+            raise NeurohoverError(f"{where}: generic_resampling must be a table with keys fixed and/or race holding fixed:K / race:DELTA")
+
+
+def variant_optimizer(experiment: dict, own: dict | None) -> dict:
+    """The ``optimizer`` table a variant runs: its own keys (``own``, None: none) over the experiment's,
+    or its own alone when it names another optimiser (``name``), whose settings are not the experiment's."""
+    own = own or {}
+    if own.get("name", "ne") != experiment.get("name", "ne"):
+        return dict(own)
+    return {**experiment, **own}
