@@ -7,7 +7,9 @@ all three give the same returns (the lanes and the scalar kernel bit for bit). :
 that choice and the call on a :class:`Batch` (the jobs, checked once) into a :class:`Flown` (the
 outputs); :func:`neurohover.evaluate_jobs` (validated, any jobs),
 :class:`neurohover.flyer.KernelFlyer` (an evolution's fast path) and the warm-ups all fly through
-it. A per-job input of the task (such as the sensor model) lives in the MDP row, so it reaches
+it. The vector environment steps its helicopters one control step at a time instead; :func:`stepper`
+chooses its path (the CPU's :func:`neurohover.sim.step.step_batch` or the CUDA build) here too.
+A per-job input of the task (such as the sensor model) lives in the MDP row, so it reaches
 every path without a new argument.
 """
 
@@ -26,10 +28,11 @@ from .sim.constants import MDP_ROW_LEN, ROW_SUBSTEPS, ROW_WIND_KIND, SAFEGUARD_L
 from .sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
 from .sim.lanes import LANES, PARK_F, PARK_U, rollout_lanes, rollout_lanes_parked
 from .sim.rng import MAX_SEED
+from .sim.step import step_batch
 
 __all__ = [
     "DEVICES", "KIND", "MAX_SEED", "Batch", "Flown", "Parking", "check_device", "launch", "launch_parked", "load_kernel", "num_threads",
-    "rows_alike", "use_lanes",
+    "rows_alike", "Stepper", "stepper", "use_lanes",
 ]  # fmt: skip
 
 #: The kernel's code of each policy topology.
@@ -295,3 +298,50 @@ def launch(batch: Batch, out: Flown, device: str = "cpu") -> float:
     t0 = time.perf_counter()
     _fly_kernel(rollout, batch, out)
     return time.perf_counter() - t0
+
+
+class _CpuSteps:
+    """One control step of every helicopter of a vector environment on the CPU; the arrays are the env's own."""
+
+    def __init__(self, rows: np.ndarray, index: np.ndarray, state: np.ndarray, noise: np.ndarray, rng: np.ndarray, steps: np.ndarray) -> None:
+        self.rows, self.index, self.state, self.noise, self.rng, self.steps = rows, index, state, noise, rng, steps
+
+    def set_rows(self, idx: np.ndarray, rows: np.ndarray, state: np.ndarray, noise: np.ndarray, rng: np.ndarray, steps: np.ndarray) -> None:
+        """Nothing to copy: the env wrote the reset rows into the arrays this steps."""
+
+    def step(self, actions: np.ndarray, n_steps: int, obs: np.ndarray, reward: np.ndarray, crash: np.ndarray) -> None:
+        step_batch(self.rows, self.index, self.state, self.noise, self.rng, self.steps, actions, n_steps, obs, reward, crash)
+
+
+class _CudaSteps:
+    """The same on the GPU (:class:`neurohover.sim.cuda.StepBatch`): the device holds the flying state;
+    the host's step counts are kept in step here."""
+
+    def __init__(self, rows: np.ndarray, index: np.ndarray, state: np.ndarray, noise: np.ndarray, rng: np.ndarray, steps: np.ndarray) -> None:
+        from .sim import cuda as sim_cuda  # numba.cuda is imported only when asked for
+
+        self.gpu = sim_cuda.StepBatch(rows, index, state, noise, rng, steps)
+        self.steps = steps
+
+    def set_rows(self, idx: np.ndarray, rows: np.ndarray, state: np.ndarray, noise: np.ndarray, rng: np.ndarray, steps: np.ndarray) -> None:
+        """Copy the reset helicopters' rows (``idx``) to the device."""
+        self.gpu.set_rows(idx, rows, state, noise, rng, steps)
+
+    def step(self, actions: np.ndarray, n_steps: int, obs: np.ndarray, reward: np.ndarray, crash: np.ndarray) -> None:
+        self.gpu.step(actions, n_steps, obs, reward, crash)
+        self.steps += 1  # as the kernel counts every helicopter's step
+
+
+Stepper = _CpuSteps | _CudaSteps
+
+
+def stepper(
+    device: str, rows: np.ndarray, index: np.ndarray, state: np.ndarray, noise: np.ndarray, rng: np.ndarray, steps: np.ndarray
+) -> _CpuSteps | _CudaSteps:
+    """The one choice of path for a vector environment's control steps: ``step(actions, n_steps, obs,
+    reward, crash)`` advances every helicopter (helicopter i on MDP row ``rows[index[i]]``, its state,
+    gust noise, streams and step count in row i of the others, updated in place on the CPU) and
+    ``set_rows(idx, ...)`` takes the rows of reset helicopters. ``device="cuda"`` keeps the flying
+    state on the GPU (docs/gpu.md)."""
+    check_device(device)
+    return (_CudaSteps if device == "cuda" else _CpuSteps)(rows, index, state, noise, rng, steps)

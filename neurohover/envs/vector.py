@@ -2,7 +2,8 @@
 
 ``HoverVectorEnv`` is what ``gymnasium.make_vec("neurohover/GHH08-v0", num_envs=N,
 vectorization_mode="vector_entry_point")`` builds. Every ``step`` advances all N helicopters
-through a single call of :func:`neurohover.sim.step.step_batch`; Python only touches the
+through a single call of the kernel's step (:func:`neurohover.launch.stepper` chooses the CPU's
+:func:`neurohover.sim.step.step_batch` or the CUDA build); Python only touches the
 sub-environments that reset.
 
 Example
@@ -27,10 +28,10 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from ..errors import NeurohoverError
-from ..evaluate import check_device
+from ..launch import check_device, stepper
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS, MDP_ROW_LEN, OBS_DIM
 from ..sim.rng import seed_stream
-from ..sim.step import ENV_NOISE_WIDTH, ENV_RNG_WIDTH, start_readings, step_batch
+from ..sim.step import ENV_NOISE_WIDTH, ENV_RNG_WIDTH, start_readings
 from ..tasks import MDP, TaskFamily, refuse_drift
 from .hover import (
     RENDER_FPS,
@@ -189,14 +190,10 @@ class HoverVectorEnv(VectorEnv):
         self._all = np.ones(n, dtype=np.bool_)
         self._all.setflags(write=False)
         self.device = device
-        self._gpu = None
-        self._make_room_for_sensors(self._specs)
-        if device == "cuda":
-            from ..sim import cuda as sim_cuda  # numba.cuda is imported only when asked for
-
-            # On the GPU the host's _state, _noise and _rng rows are written only by resets (and
-            # then copied in); the device holds the flying values. _steps is mirrored on the host.
-            self._gpu = sim_cuda.StepBatch(self._rows, self._index, self._state, self._noise, self._rng, self._steps)
+        self._make_room_for_sensors(self._specs, made=False)
+        # On the GPU the host's _state, _noise and _rng rows are written only by resets (and then
+        # copied in); the device holds the flying values. _steps is mirrored on the host.
+        self._stepper = stepper(device, self._rows, self._index, self._state, self._noise, self._rng, self._steps)
 
     # -- read-only views -------------------------------------------------------------------
 
@@ -221,11 +218,12 @@ class HoverVectorEnv(VectorEnv):
     def _senses(self, specs: Sequence[MDP | str]) -> bool:
         return any(not (self.family.sensor if isinstance(spec, str) else spec.sensor).exact for spec in specs)  # a str spec is SAMPLE
 
-    def _make_room_for_sensors(self, specs: Sequence[MDP | str]) -> None:
-        """Widen the per-helicopter noise and stream state for sensor models (kept narrow, and fast, without them)."""
+    def _make_room_for_sensors(self, specs: Sequence[MDP | str], made: bool = True) -> None:
+        """Widen the per-helicopter noise and stream state for sensor models (kept narrow, and fast, without them);
+        ``made``: the stepper exists (and then steps the widened arrays)."""
         if self._noise.shape[1] >= ENV_NOISE_WIDTH or not self._senses(specs):
             return
-        if self._gpu is not None:
+        if made and self.device == "cuda":
             raise NeurohoverError(
                 "this vector environment on device='cuda' was made without a sensor model and cannot fly one now: "
                 "make it with obs_noise/obs_delay, or with the sensing MDPs as its mdp argument"
@@ -234,6 +232,8 @@ class HoverVectorEnv(VectorEnv):
         noise, rng = np.zeros((n, ENV_NOISE_WIDTH)), np.zeros((n, ENV_RNG_WIDTH), dtype=np.uint64)
         noise[:, :6], rng[:, :4] = self._noise, self._rng
         self._noise, self._rng = noise, rng
+        if made:
+            self._stepper = stepper(self.device, self._rows, self._index, self._state, self._noise, self._rng, self._steps)
 
     # -- argument checks -------------------------------------------------------------------
 
@@ -334,8 +334,7 @@ class HoverVectorEnv(VectorEnv):
         self._steps[idx] = 0
         # The first readings: all zeros (the start state observes so), or what the sensors make of them.
         start_readings(self._rows, self._index, idx, self._streams, self._rng, self._noise, self._obs)
-        if self._gpu is not None:
-            self._gpu.set_rows(idx, self._rows[idx], self._state[idx], self._noise[idx], self._rng[idx], self._steps[idx])
+        self._stepper.set_rows(idx, self._rows[idx], self._state[idx], self._noise[idx], self._rng[idx], self._steps[idx])
 
     def _labels(self, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         labels = np.full(self.num_envs, None, dtype=object)
@@ -408,11 +407,7 @@ class HoverVectorEnv(VectorEnv):
         a = actions
         if not (type(a) is np.ndarray and a.dtype == np.float64 and a.shape == self._actions.shape and a.flags.c_contiguous):
             a = self._coerce_actions(actions)
-        if self._gpu is None:
-            step_batch(self._rows, self._index, self._state, self._noise, self._rng, self._steps, a, self.episode_steps, self._obs, self._reward, self._crash)
-        else:
-            self._gpu.step(a, self.episode_steps, self._obs, self._reward, self._crash)
-            self._steps += 1  # as the kernel counts every helicopter's step
+        self._stepper.step(a, self.episode_steps, self._obs, self._reward, self._crash)
         rewards = self._reward.copy()
         terminated = self._crash.copy()
         truncated = self._steps >= self._limit
