@@ -50,6 +50,31 @@ LINEAGES = ("chain", "independent")
 
 
 @dataclass(frozen=True)
+class Role:
+    """One policy of a task family's policy set: the recipe that ``build-policies`` and the experiments'
+    planner both follow (:func:`policy_set_roles`).
+
+    ``kind``: ``"generic"`` or ``"specialised"`` (GHH-08/09), or an FGHH generic's kind (``"zero"``,
+    ``"fixed"``, ``"race"``); ``index``: a specialised policy's training MDP; ``target``: ``"zero"``
+    (evolved on the zero setting), ``"train"`` (on training MDP ``index``) or ``"family"`` (over G);
+    ``resampling``: how a run over G estimates fitness (``"fixed:1"`` on one MDP).
+    """
+
+    kind: str
+    index: int
+    target: str
+    resampling: str = "fixed:1"
+
+
+def policy_set_roles(family) -> tuple[Role, ...]:
+    """The policies of ``family``'s set, in the order they are evolved (``build-policies`` seeds the
+    k-th from the k-th child of its root seed)."""
+    if family.generic_over_distribution:
+        return (Role("zero", 0, "zero"), *(Role(kind, 0, "family", FGHH_GENERIC_RESAMPLING[kind]) for kind in ("fixed", "race")))
+    return (Role("generic", 0, "zero"), *(Role("specialised", i, "train") for i in range(len(family.training_mdps()))))
+
+
+@dataclass(frozen=True)
 class PolicySet:
     """The policies of one task family that the agents use."""
 
@@ -175,6 +200,7 @@ def build_policy_set(
     if optimizer != NE:
         manifest["optimizer"] = optimizer
     seeds = np.random.SeedSequence(seed).generate_state(32, dtype=np.uint32)
+    roles = policy_set_roles(family)
     start = time.perf_counter()
 
     def run(target, name: str, child_seed: int, seed_policy: Policy | None = None, save: bool = True, **kwargs) -> Policy:
@@ -193,11 +219,10 @@ def build_policy_set(
 
     if family.generic_over_distribution:
         manifest.update({"sigma": family.sigma, "fghh_budget": fghh_budget})
-        generics = {
-            "zero": run(family.zero(), "generic_zero", int(seeds[0]), budget=budget),
-            "fixed": run(family, "generic_fixed", int(seeds[1]), budget=fghh_budget, resampling=FGHH_GENERIC_RESAMPLING["fixed"]),
-            "race": run(family, "generic_race", int(seeds[2]), budget=fghh_budget, resampling=FGHH_GENERIC_RESAMPLING["race"]),
-        }
+        generics = {}
+        for k, role in enumerate(roles):
+            over_g = {"budget": fghh_budget, "resampling": role.resampling} if role.target == "family" else {"budget": budget}
+            generics[role.kind] = run(family if role.target == "family" else family.zero(), f"generic_{role.kind}", int(seeds[k]), **over_g)
         manifest["seconds"] = round(time.perf_counter() - start, 1)
         (root / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n")
         return PolicySet(family.name, root, generics["race"], generics=generics, manifest=manifest)
@@ -211,8 +236,13 @@ def build_policy_set(
             ancestor = run(mdp, f"ancestor (stage {i + 1} of {len(train)}, training MDP {i})", int(seeds[12 + i]), ancestor, save=False, budget=budget)
         assert ancestor is not None
         save_policy(ancestor, root / "ancestor.json", task=family.name, name="ancestor", episodes=budget * len(train))
-    generic = run(family.zero(), "generic", int(seeds[0]), ancestor, budget=budget)
-    specialised = [run(mdp, f"specialised_{i}", int(seeds[1 + i]), ancestor, budget=budget) for i, mdp in enumerate(train)]
+    evolved = [
+        run(family.zero(), "generic", int(seeds[k]), ancestor, budget=budget)
+        if role.target == "zero"
+        else run(train[role.index], f"specialised_{role.index}", int(seeds[k]), ancestor, budget=budget)
+        for k, role in enumerate(roles)
+    ]
+    generic, specialised = evolved[0], evolved[1:]
     crashes, returns = crash_matrix(specialised, train, safety_episodes, seed=int(seeds[11]), n_steps=n_steps)
     safe = choose_safe(crashes, returns)
     manifest.update(

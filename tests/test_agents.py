@@ -128,6 +128,28 @@ def test_chain_lineage_seeds_every_run_from_the_ancestor_and_independent_from_th
         build_policy_set("ghh08", tmp_path, budget=30, lineage="tree")
 
 
+def test_build_policies_and_the_planner_evolve_the_policies_of_one_recipe() -> None:
+    from neurohover.experiments.config import load_config
+    from neurohover.experiments.plans import plan
+    from neurohover.policysets import FGHH_GENERIC_RESAMPLING, policy_set_roles
+
+    ghh = policy_set_roles(get_task_family("ghh08"))
+    assert [(r.kind, r.index, r.target) for r in ghh] == [("generic", 0, "zero")] + [("specialised", i, "train") for i in range(10)]
+    fghh = policy_set_roles(get_task_family("fghh"))
+    assert [(r.kind, r.target, r.resampling) for r in fghh] == [("zero", "zero", "fixed:1")] + [
+        (k, "family", FGHH_GENERIC_RESAMPLING[k]) for k in ("fixed", "race")
+    ]
+    # The planner evolves the roles an experiment's agents need, in the recipe's order, on the recipe's MDPs.
+    fig8 = load_config("fig8", "quick")
+    units = [u for u in plan(fig8, {}).units if u.key.startswith("policy/")]
+    assert [u.key for u in units] == ["policy/generic"] + [f"policy/specialised{i}" for i in range(10)]
+    train = get_task_family(fig8.settings["task"]).training_mdps()
+    assert all(u.params["target"]["mdp"] == train[i].to_dict() for i, u in enumerate(units[1:]))
+    cfg = load_config("fig16", "quick", {"generics_from": {}, "generic_resampling": {}})
+    over_g = {u.key: u.params["resampling"] for u in plan(cfg, {}).units if u.key.startswith("policy/generic-") and "zero" not in u.key}
+    assert over_g and all(r == FGHH_GENERIC_RESAMPLING[k.split("-")[1].rstrip("0123456789")] for k, r in over_g.items())
+
+
 def test_shipped_ghh08_specialised_policies_match_table_3s_mlp_row() -> None:
     """Table 3 (MLP, evolved from the baseline): r = -132.60 on the policy's own training MDP,
     r_G = -2001.89 across all ten, no crash on any. The shipped set must stay near that."""

@@ -28,7 +28,7 @@ from ..agents.hybrid import HybridSettings
 from ..agents.registry import HYBRID_AGENTS, agent_spec
 from ..errors import NeurohoverError
 from ..policies import baseline_policy
-from ..policysets import FGHH_GENERIC_RESAMPLING, load_policy_set
+from ..policysets import load_policy_set, policy_set_roles
 from ..tasks import EXACT, Sensor
 from ..tasks.drift import Drift
 from .config import ExperimentConfig, load_config
@@ -238,12 +238,14 @@ class _Policies:
                 )
             return
         budget = s.policy_budget
+        roles = policy_set_roles(self.family)  # the policies of the task's set, as build-policies evolves them
         if not self.family.generic_over_distribution:
-            if needs & {"generic"}:
-                self._add(UnitKey.make("policy", "generic"), {"kind": "mdp", "mdp": self.family.zero().to_dict()}, budget)
-            if needs & {"specialised", "safe"}:
-                for i, mdp in enumerate(self.family.training_mdps()):
-                    self._add(UnitKey.make("policy", f"specialised{i}"), {"kind": "mdp", "mdp": mdp.to_dict()}, budget)
+            train = self.family.training_mdps()
+            for role in roles:
+                if role.kind == "generic" and "generic" in needs:
+                    self._add(UnitKey.make("policy", "generic"), {"kind": "mdp", "mdp": self.family.zero().to_dict()}, budget)
+                if role.kind == "specialised" and needs & {"specialised", "safe"}:
+                    self._add(UnitKey.make("policy", f"specialised{role.index}"), {"kind": "mdp", "mdp": train[role.index].to_dict()}, budget)
             if "safe" in needs:
                 self.total += 1
                 spec = [self.results.get(UnitKey.make("policy", f"specialised{i}")) for i in range(10)]
@@ -269,19 +271,16 @@ class _Policies:
                     self.drawn[kind], why = _source_champions(source, cfg.scale, (sources or {}).get(source.partition("/")[0], {}))
                     if why:
                         self.waiting.append(f"the {kind} generics come from {source}: {why}")
-            for kind in ("zero", "fixed", "race"):
+            for role in roles:
+                kind = role.kind
                 if kind not in needs or kind in self.drawn:
                     continue
                 for j in range(s.generics_per_agent):
-                    if kind == "zero":
+                    if role.target == "zero":
                         self._add(UnitKey.make("policy", f"generic-zero{j}"), {"kind": "mdp", "mdp": self.family.zero().to_dict()}, budget)
                     else:
-                        self._add(
-                            UnitKey.make("policy", f"generic-{kind}{j}"),
-                            _family_target(s, s.sigma),
-                            s.generic_budget,
-                            s.generic_resampling.get(kind, FGHH_GENERIC_RESAMPLING[kind]),
-                        )
+                        resampling = s.generic_resampling.get(kind, role.resampling)
+                        self._add(UnitKey.make("policy", f"generic-{kind}{j}"), _family_target(s, s.sigma), s.generic_budget, resampling)
 
     def _add(self, key: str, target: dict, budget: int, resampling: str = "fixed:1") -> None:
         self.units.append(_policy_evolution_unit(self.cfg, key, target, budget, resampling))
