@@ -5,6 +5,7 @@ from __future__ import annotations
 import gzip
 import os
 import shutil
+import signal
 import subprocess
 import sys
 from collections.abc import Callable
@@ -26,7 +27,11 @@ CliRun = Callable[..., tuple[int, str, str]]
 #: A ``reproduce`` whose plan is twelve diagnostic units (argv: GATES EXPERIMENT reproduce ...): unit i waits
 #: until the file GATES/i exists, so a test, not the machine's speed, decides how far the run gets.
 GATED_RUN = """
+import faulthandler
+import signal
 import sys
+
+faulthandler.register(signal.SIGUSR1, all_threads=True)  # finish_run asks a run that does not end where it is
 from neurohover.cli import main
 from neurohover.experiments import runner
 from neurohover.experiments.plans import Plan
@@ -76,3 +81,18 @@ def cli(capsys) -> CliRun:
         return rc, out.out, out.err
 
     return run
+
+
+def finish_run(proc: subprocess.Popen, timeout: float) -> tuple[str, str]:
+    """``proc.communicate()``; a run still going after ``timeout`` seconds (a safety net, not a speed
+    assumption) prints its threads' stacks, is killed with its process group, and fails the test with its output."""
+    try:
+        return proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        proc.send_signal(signal.SIGUSR1)
+        try:
+            out, err = proc.communicate(timeout=5)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            out, err = proc.communicate()
+        pytest.fail(f"the run did not end within {timeout:g} s; its stacks and output:\n{out}\n{err}")

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import ROOT, start_gated_run
+from conftest import ROOT, finish_run, start_gated_run
 
 from neurohover.cli import main
 from neurohover.errors import NeurohoverError
@@ -295,7 +295,7 @@ def _interrupt_after(proc: subprocess.Popen, store: Path, n: int, sig: int) -> d
         time.sleep(0.02)
     assert proc.poll() is None, f"the run ended before it could be interrupted: {proc.communicate()}"
     proc.send_signal(sig)
-    proc.communicate(timeout=60)
+    finish_run(proc, 120)
     return _finished(store)
 
 
@@ -316,7 +316,7 @@ def test_an_interrupted_run_loses_no_finished_unit_and_resumes(tmp_path: Path) -
     # Run again with the same store: only the missing units run; finished ones are untouched.
     _open_gates(gates, 12)
     proc = _start(config, store, gates)
-    out, err = proc.communicate(timeout=240)
+    out, err = finish_run(proc, 240)
     assert proc.returncode == 0, err
     assert "ran 7 units, 5 already in the store, 12/12 done" in out
     after = _finished(store)

@@ -351,3 +351,32 @@ def test_a_terminated_command_exits_with_143_and_an_interrupt_with_130(monkeypat
         args.func = stop(exc)
         assert cli.main(["demo"]) == status
         assert capsys.readouterr().err.strip() == f"neurohover demo: {word}"
+
+
+class _CommitThenInterrupt:
+    """A store connection on which Ctrl-C lands just after a transaction commits."""
+
+    def __init__(self, conn: sqlite3.Connection) -> None:
+        self.conn = conn
+
+    def execute(self, sql: str, *args):
+        out = self.conn.execute(sql, *args)
+        if sql == "COMMIT":
+            raise KeyboardInterrupt
+        return out
+
+    def __getattr__(self, name: str):
+        return getattr(self.conn, name)
+
+
+def test_a_ctrl_c_just_after_a_unit_commits_stays_a_ctrl_c_and_keeps_the_unit(tmp_path: Path) -> None:
+    from neurohover.experiments.units import Unit
+
+    with Store(tmp_path / "s.sqlite") as store:
+        store.begin("exp", "quick", "h" * 16, {})
+        conn = store.conn
+        store.conn = _CommitThenInterrupt(conn)  # type: ignore[assignment]
+        with pytest.raises(KeyboardInterrupt):  # not sqlite's "cannot rollback - no transaction is active"
+            store.put("exp", "quick", "h" * 16, Unit("exp", "u0", "diagnostic", {"value": 1}), {"value": 1}, 0.1)
+        store.conn = conn
+        assert list(store.results("exp", "quick")) == ["u0"]  # committed: kept

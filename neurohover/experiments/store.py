@@ -231,7 +231,8 @@ class Store:
                 c.execute("UPDATE experiments SET config = ? WHERE name = ? AND scale = ?", (_dumps(config), name, scale))
             c.execute("COMMIT")
         except BaseException:
-            c.execute("ROLLBACK")
+            if c.in_transaction:  # a Ctrl-C just after COMMIT must stay a Ctrl-C, not "no transaction is active"
+                c.execute("ROLLBACK")
             raise
 
     def experiments(self) -> list[tuple[str, str, str, int]]:
@@ -295,7 +296,8 @@ class Store:
                 c.execute("UPDATE sessions SET units_run = units_run + 1, wall_seconds = ? - started WHERE id = ?", (time.time(), session))
             c.execute("COMMIT")
         except BaseException:
-            c.execute("ROLLBACK")
+            if c.in_transaction:  # a Ctrl-C just after COMMIT must stay a Ctrl-C, not "no transaction is active"
+                c.execute("ROLLBACK")
             raise
         return bool(cur.rowcount)
 
