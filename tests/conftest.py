@@ -32,6 +32,9 @@ import signal
 import sys
 
 faulthandler.register(signal.SIGUSR1, all_threads=True)  # finish_run asks a run that does not end where it is
+# Ctrl-C as in a terminal, however the tests were started: a shell without job control starts a background
+# command (`pytest ... &`) with SIGINT ignored, every process below inherits that, and the run would never stop.
+signal.signal(signal.SIGINT, signal.default_int_handler)
 from neurohover.cli import main
 from neurohover.experiments import runner
 from neurohover.experiments.plans import Plan
