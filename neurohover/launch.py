@@ -335,9 +335,7 @@ class _CudaSteps:
 Stepper = _CpuSteps | _CudaSteps
 
 
-def stepper(
-    device: str, rows: np.ndarray, index: np.ndarray, state: np.ndarray, noise: np.ndarray, rng: np.ndarray, steps: np.ndarray
-) -> _CpuSteps | _CudaSteps:
+def stepper(device: str, rows: np.ndarray, index: np.ndarray, state: np.ndarray, noise: np.ndarray, rng: np.ndarray, steps: np.ndarray) -> Stepper:
     """The one choice of path for a vector environment's control steps: ``step(actions, n_steps, obs,
     reward, crash)`` advances every helicopter (helicopter i on MDP row ``rows[index[i]]``, its state,
     gust noise, streams and step count in row i of the others, updated in place on the CPU) and

@@ -221,8 +221,8 @@ def build_policy_set(
         manifest.update({"sigma": family.sigma, "fghh_budget": fghh_budget})
         generics = {}
         for k, role in enumerate(roles):
-            over_g = {"budget": fghh_budget, "resampling": role.resampling} if role.target == "family" else {"budget": budget}
-            generics[role.kind] = run(family if role.target == "family" else family.zero(), f"generic_{role.kind}", int(seeds[k]), **over_g)
+            how = {"budget": fghh_budget, "resampling": role.resampling} if role.target == "family" else {"budget": budget}
+            generics[role.kind] = run(family if role.target == "family" else family.zero(), f"generic_{role.kind}", int(seeds[k]), **how)
         manifest["seconds"] = round(time.perf_counter() - start, 1)
         (root / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n")
         return PolicySet(family.name, root, generics["race"], generics=generics, manifest=manifest)

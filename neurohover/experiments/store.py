@@ -27,12 +27,14 @@ Readers (``results``, ``report``) take no lock.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import json
 import os
 import socket
 import sqlite3
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
 
@@ -66,6 +68,20 @@ CREATE TABLE sessions (
 
 def _dumps(obj: Any) -> str:
     return json.dumps(obj, separators=(",", ":"), allow_nan=False)
+
+
+@contextlib.contextmanager
+def _transaction(c: sqlite3.Connection) -> Iterator[None]:
+    """One write transaction (taking the write lock at once): committed when the block ends, rolled back
+    when it raises. A Ctrl-C landing just after the COMMIT stays a Ctrl-C: there is nothing left to roll back."""
+    c.execute("BEGIN IMMEDIATE")
+    try:
+        yield
+        c.execute("COMMIT")
+    except BaseException:
+        if c.in_transaction:
+            c.execute("ROLLBACK")
+        raise
 
 
 class Store:
@@ -178,19 +194,13 @@ class Store:
         app = c.execute("PRAGMA application_id").fetchone()[0]
         tables = c.execute("SELECT count(*) FROM sqlite_master").fetchone()[0]
         if version == 0 and app == 0 and tables == 0:
-            c.execute("BEGIN IMMEDIATE")
-            try:
+            with _transaction(c):
                 if c.execute("SELECT count(*) FROM sqlite_master").fetchone()[0] == 0:
                     for statement in _SCHEMA.split(";"):
                         if statement.strip():
                             c.execute(statement)
                     c.execute(f"PRAGMA user_version = {SCHEMA_VERSION}")
                     c.execute(f"PRAGMA application_id = {APPLICATION_ID}")
-                c.execute("COMMIT")
-            except BaseException:
-                if c.in_transaction:
-                    c.execute("ROLLBACK")
-                raise
             return self._check_schema()
         if app != APPLICATION_ID:
             raise NeurohoverError(f"{str(self.path)!r} is an SQLite file but not a neurohover results store; give another --store file")
@@ -212,8 +222,7 @@ class Store:
         """
         self.lock()
         c = self.conn
-        c.execute("BEGIN IMMEDIATE")
-        try:
+        with _transaction(c):
             if fresh:
                 for table in ("experiments", "units", "sessions"):
                     c.execute(f"DELETE FROM {table} WHERE name = ? AND scale = ?", (name, scale))
@@ -229,11 +238,6 @@ class Store:
                 )
             else:  # same settings: keep the latest title and paper numbers (they do not change results)
                 c.execute("UPDATE experiments SET config = ? WHERE name = ? AND scale = ?", (_dumps(config), name, scale))
-            c.execute("COMMIT")
-        except BaseException:
-            if c.in_transaction:  # a Ctrl-C just after COMMIT must stay a Ctrl-C, not "no transaction is active"
-                c.execute("ROLLBACK")
-            raise
 
     def experiments(self) -> list[tuple[str, str, str, int]]:
         """(name, scale, config_hash, finished units) of every experiment in the store."""
@@ -280,8 +284,7 @@ class Store:
         """Record one finished unit in its own transaction; False if it was already there."""
         c = self.conn
         text = _dumps(result)
-        c.execute("BEGIN IMMEDIATE")
-        try:
+        with _transaction(c):
             row = c.execute("SELECT config_hash FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
             if row is None or row[0] != config_hash:
                 raise NeurohoverError(
@@ -294,11 +297,6 @@ class Store:
             )
             if session is not None and cur.rowcount:
                 c.execute("UPDATE sessions SET units_run = units_run + 1, wall_seconds = ? - started WHERE id = ?", (time.time(), session))
-            c.execute("COMMIT")
-        except BaseException:
-            if c.in_transaction:  # a Ctrl-C just after COMMIT must stay a Ctrl-C, not "no transaction is active"
-                c.execute("ROLLBACK")
-            raise
         return bool(cur.rowcount)
 
     # ------------------------------------------------------------------ sessions

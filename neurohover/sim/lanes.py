@@ -339,9 +339,9 @@ def fly_queue(
                 out_return[j] = total[lane] + crash_charge(n_steps, k + 1)
                 out_crashed[j] = True
                 out_steps[j] = k + 1
-                if parking and j < n_required:
-                    _fetch_add(left, -1)
                 if parking:
+                    if j < n_required:
+                        _fetch_add(left, -1)
                     park_step[job_slot[j]] = 0
                 job[lane] = -2  # over; the lane idles through this step (at rest, dt 0) and is refilled after it
                 _reset_lane(B, N, A, lane)
@@ -418,9 +418,9 @@ def fly_queue(
                         _read(B, seen, srngs, scratch, lane, t, mdp_rows[job_mdp[j]])
                     continue
                 out_steps[j] = t
-                if parking and j < n_required:
-                    _fetch_add(left, -1)
                 if parking:
+                    if j < n_required:
+                        _fetch_add(left, -1)
                     park_step[job_slot[j]] = 0  # over: a later listing of its slot begins afresh
             _reset_lane(B, N, A, lane)
             total[lane] = 0.0
