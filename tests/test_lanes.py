@@ -291,6 +291,18 @@ def test_parked_episodes_resume_to_the_same_bits(rows: np.ndarray, threads: int)
     assert resumed > 0 or threads > 1
 
 
+@pytest.mark.parametrize("n_jobs", [2, 5, LANES + 3])
+def test_a_few_parked_jobs_on_two_threads_keep_their_bits(n_jobs: int) -> None:
+    """Under 2 * LANES jobs a parked call still takes a lane set on every thread (a race's last rounds):
+    each thread then flies part of the few jobs, and every result is the scalar kernel's."""
+    table = _perturbed(0.05)
+    rows = np.stack([m.row() for m in get_task_family("fghh").test_mdps()[:3]])
+    episodes = np.arange(n_jobs, dtype=np.int64) * 7 + 1
+    m = np.arange(n_jobs, dtype=np.int64) % rows.shape[0]
+    got, _ = _parked_calls(table, rows, m, episodes, 700, 2, [1, 2])
+    _assert_same(got, _scalar(table, rows, 5, episodes, 700, m=m))
+
+
 def test_a_parked_call_flies_optional_jobs_only_in_idle_lanes_and_counts_them_not_over() -> None:
     table = _perturbed(0.0)  # the hovering baseline: every episode runs its full length
     n = 3 * LANES

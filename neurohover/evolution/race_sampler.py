@@ -78,10 +78,12 @@ class RaceSampler:
     def __call__(self, idx: np.ndarray) -> np.ndarray:
         """Each listed candidate's next sample (a candidate listed again: the one after), as fitness."""
         idx = np.asarray(idx, dtype=np.int64)
+        # The q-th listing of candidate i asks for its sample asked[i] + q: rank each listing among its candidate's.
+        order = np.argsort(idx, kind="stable")
+        ranked = idx[order]
         t = np.empty_like(idx)
-        for q, i in enumerate(idx.tolist()):
-            t[q] = self.asked[i]
-            self.asked[i] += 1
+        t[order] = self.asked[ranked] + np.arange(idx.size) - np.searchsorted(ranked, ranked)
+        np.add.at(self.asked, idx, 1)
         slots = t * self.n + idx
         if self.parking is None:
             returns = self.flyer.fly(self.genomes, self.rows, idx, slots if self.per_slot else None, slots.shape[0], episode_index=self.base + slots)

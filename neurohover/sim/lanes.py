@@ -523,7 +523,9 @@ def rollout_lanes_parked(
     n_jobs = job_episode.shape[0]
     for j in range(n_jobs):
         out_steps[j] = 0
-    n_chunks = max(1, min(n_threads, n_jobs // LANES))
+    # Every thread takes a lane set even for fewer than 2 * LANES jobs (unlike rollout_lanes): a race's last
+    # rounds list a few required jobs, and two threads with half-full lanes end them sooner than one thread.
+    n_chunks = max(1, min(n_threads, n_jobs))
     left = np.full(1, n_required, dtype=np.int64)  # set before any thread starts
     queue = np.zeros(1, dtype=np.int64)
     for _ in nb.prange(n_chunks):  # one lane set per thread
