@@ -194,3 +194,33 @@ def test_the_optimizer_table_has_one_spelling() -> None:
     # stores written before resume (tests/test_stored_plans.py checks every stored experiment's hash).
     cfg = load_config("ablation-fghh", "paper")
     assert "optimizer" in cfg.settings and all("optimiser" not in v for v in cfg.settings["variants"])
+
+
+def _contested_numpy(fitness: np.ndarray, asked: np.ndarray, candidates: np.ndarray, n: int, t_limit: int, mu: int) -> np.ndarray:
+    """The race sampler's candidate order as NumPy computed it before it was compiled."""
+    mask = np.arange(t_limit)[:, None] < asked[None, :]
+    fit = np.where(mask, fitness.reshape(t_limit, n), 0.0)
+    count = np.maximum(asked, 1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        means = fit.sum(axis=0) / count
+        boundary = np.sort(means)[::-1][mu - 1 : mu + 1].mean()
+        var = (np.where(mask, fit - means, 0.0) ** 2).sum(axis=0) / np.maximum(count - 1, 1)
+        z = np.abs(means[candidates] - boundary) / np.sqrt(var[candidates] / count[candidates])
+    return candidates[np.argsort(np.nan_to_num(z, nan=np.inf), kind="stable")]
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_race_samplers_compiled_order_is_the_numpy_one(seed: int) -> None:
+    """Which later samples fill idle lanes first (nearest the selection boundary first): the compiled
+    order equals the NumPy form, with crashes (-inf), zero spreads and equal distances among the data."""
+    from neurohover.evolution.race_sampler import _contested_order
+
+    rng = np.random.default_rng(seed)
+    n, t_limit, mu = 50, 10, 20
+    fitness = np.round(rng.normal(0.12, 0.03, n * t_limit), 2)  # rounded: ties and zero spreads
+    fitness[rng.random(n * t_limit) < 0.03] = -np.inf
+    fitness[: 3 * n : n] = fitness[n]  # candidate 0's first samples all equal
+    asked = rng.integers(2, t_limit + 1, n)
+    candidates = np.flatnonzero(rng.random(n) < 0.6).astype(np.int64)
+    got = _contested_order(fitness, asked, candidates, n, mu)
+    np.testing.assert_array_equal(got, _contested_numpy(fitness, asked, candidates, n, t_limit, mu))
