@@ -390,3 +390,44 @@ def test_a_races_look_ahead_changes_no_result(seed: int) -> None:
             assert len(calls) == 1
         assert ahead.episodes_flown == sum(c.size for c in calls) >= ahead.episodes_spent
     assert plain.episodes_flown == plain.episodes_spent
+
+
+# ------------------------------------------------- the compiled round, to the bits
+
+
+def test_the_compiled_sum_is_numpys_to_the_bits() -> None:
+    from neurohover.evolution.races import _pairwise_sum
+
+    rng = np.random.default_rng(0)
+    for n in [*range(1, 40), 127, 128, 129, 255, 300, 1003]:
+        x = rng.normal(0, 1, n) * 10.0 ** rng.integers(-8, 9, n)  # sums where the order matters
+        assert _pairwise_sum(x, n) == x.sum(), n
+
+
+@pytest.mark.parametrize("k", [1, 2, 3, 7, 8, 9, 10, 17, 1001])
+def test_a_compiled_round_gives_bayes_mean_bounds_and_the_decisions_to_the_bits(k: int) -> None:
+    """Each undecided candidate's mean and bounds are ``_mean`` and :func:`bayes_mean_bounds` of its row, bit for
+    bit (crashes, constant rows, wide ranges among them), and the selections and discards are those counted on
+    everyone's bounds as the race defines them."""
+    from neurohover.evolution.races import _race_round, _standard_quantiles
+
+    rng = np.random.default_rng(k)
+    n, mu, delta = 40, 15, 0.7
+    samples = rng.normal(-1000.0, 50.0, (n, k + 2)) * 10.0 ** rng.integers(-3, 4, (n, 1))
+    samples[rng.random(n) < 0.2, rng.integers(0, k)] = -np.inf
+    samples[:3, :] = samples[:3, :1]  # constant rows
+    active = np.flatnonzero(rng.random(n) < 0.7).astype(np.int64)
+    crashed = np.zeros(n, dtype=bool)
+    means, lower, upper = np.full(n, np.nan), rng.normal(-1000, 50, n), rng.normal(-900, 50, n)  # the others' bounds
+    sel, dis = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+    q_lo, q_hi = _standard_quantiles(k, delta) if k > 1 else (math.nan, math.nan)
+    _race_round(samples, active, 0, k, q_lo, q_hi, n - mu, mu, crashed, means, lower, upper, sel, dis)
+    for i in active:
+        row = samples[i, :k]
+        assert crashed[i] == bool(np.isneginf(row).any())
+        want_mean = -math.inf if crashed[i] else float(np.mean(row))
+        assert np.float64(means[i]).tobytes() == np.float64(want_mean).tobytes()
+        lo, hi = bayes_mean_bounds(row, delta)
+        assert (np.float64(lower[i]).tobytes(), np.float64(upper[i]).tobytes()) == (np.float64(lo).tobytes(), np.float64(hi).tobytes())
+    np.testing.assert_array_equal(sel[: active.size], (upper[None, :] < lower[active, None]).sum(axis=1) >= n - mu)
+    np.testing.assert_array_equal(dis[: active.size], (lower[None, :] > upper[active, None]).sum(axis=1) >= mu)

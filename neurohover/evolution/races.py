@@ -21,6 +21,7 @@ import numbers
 from collections.abc import Callable
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 from scipy import stats
 
@@ -228,8 +229,8 @@ def selection_race(
     candidate one more episode and recomputes its bounds FROM SCRATCH from all
     its samples with :func:`bayes_mean_bounds` (so a bound may loosen again;
     the mean always lies inside; all undecided candidates have the same number
-    of samples, so this is done for all of them at once with row-wise NumPy
-    reductions giving exactly the values of the per-candidate call). Then, with
+    of samples, so this is done for all of them in one compiled call giving
+    exactly the values of the per-candidate call). Then, with
     ``lambda = n_candidates``:
 
     - an undecided candidate whose lower bound exceeds the upper bounds of at
@@ -287,10 +288,8 @@ def selection_race(
     batch = _check_int("batch", batch, 0)
 
     # Samples live in one (n, capacity) array: in round r every undecided
-    # candidate has exactly r samples (columns 0..r-1), so the statistics of all
-    # of them come from one (n_active, r) block. Row-wise NumPy reductions of a
-    # C-contiguous block use the same (pairwise) summation as the per-row 1-D
-    # calls of :func:`bayes_mean_bounds`, so means and bounds are bit-identical.
+    # candidate has exactly r samples (columns 0..r-1 of its row). _race_round sums
+    # them in NumPy's order, so means and bounds are those of bayes_mean_bounds.
     samples = np.empty((n, min(t_limit, 16)))
     n_samples = np.zeros(n, dtype=np.int64)
     crashed = np.zeros(n, dtype=bool)  # some sample is -inf (or was NaN)
@@ -304,6 +303,8 @@ def selection_race(
     rounds = 0
     episodes_flown = 0
     need_select, need_discard = n - mu, mu
+    sel = np.zeros(n, dtype=np.bool_)  # per undecided candidate of a round: selected, discarded
+    dis = np.zeros(n, dtype=np.bool_)
 
     flown = 0  # samples drawn so far by every undecided candidate (they stay in lockstep)
     while True:
@@ -321,17 +322,14 @@ def selection_race(
             samples[active, rounds : rounds + ahead] = draws.reshape(ahead, active.size).T
             flown += ahead
             episodes_flown += draws.size
-        samples_now = samples[active, rounds : rounds + (2 if rounds == 0 and t_limit >= 2 else 1)]
-        crashed[active] |= np.isneginf(samples_now).any(axis=1)
-        rounds += samples_now.shape[1]
+        first_new = rounds
+        rounds += 2 if rounds == 0 and t_limit >= 2 else 1
         n_samples[active] = rounds
-        _round_bounds(samples[active, :rounds], active, crashed[active], delta, means, lower, upper)
-
-        # Decide simultaneously on this round's bounds.
-        n_beaten = (upper[None, :] < lower[active, None]).sum(axis=1)
-        n_beating = (lower[None, :] > upper[active, None]).sum(axis=1)
-        newly_sel = active[n_beaten >= need_select]
-        newly_dis = active[n_beating >= need_discard]
+        q_lo, q_hi = _standard_quantiles(rounds, delta) if rounds > 1 else (math.nan, math.nan)
+        # This round's bounds, then the decisions on them, all undecided candidates at once.
+        _race_round(samples, active, first_new, rounds, q_lo, q_hi, need_select, need_discard, crashed, means, lower, upper, sel, dis)
+        newly_sel = active[sel[: active.size]]
+        newly_dis = active[dis[: active.size]]
         if newly_sel.size:
             room = mu - len(selected)
             if newly_sel.size > room:
@@ -373,49 +371,77 @@ def selection_race(
     )
 
 
-def _round_bounds(
-    block: np.ndarray,
-    rows: np.ndarray,
-    crashed: np.ndarray,
-    delta: float,
-    means: np.ndarray,
-    lower: np.ndarray,
-    upper: np.ndarray,
-) -> None:
-    """Means and :func:`bayes_mean_bounds` of every row of ``block`` at once.
+@numba.njit(cache=True, error_model="numpy")
+def _pairwise_sum(x, n):
+    """NumPy's sum of ``x[:n]`` (its pairwise summation: blocks of 8 in 8 partial sums), to the same bits."""
+    if n < 8:
+        total = -0.0
+        for i in range(n):
+            total += x[i]
+        return total
+    if n <= 128:
+        r = x[:8].copy()
+        i = 8
+        while i < n - n % 8:
+            for j in range(8):
+                r[j] += x[i + j]
+            i += 8
+        total = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
+        while i < n:
+            total += x[i]
+            i += 1
+        return total
+    half = n // 2
+    half -= half % 8
+    return _pairwise_sum(x, half) + _pairwise_sum(x[half:], n - half)
 
-    ``block`` is ``(len(rows), k)``: the ``k`` samples of each candidate in
-    ``rows``; ``crashed`` flags rows holding a ``-inf``. Writes
-    ``means[rows]``, ``lower[rows]`` and ``upper[rows]`` with exactly the
-    values of ``_mean(row)`` and ``bayes_mean_bounds(row, delta)``.
-    """
-    k = block.shape[1]
-    if crashed.any():
-        ok = ~crashed
-        dead = rows[crashed]
-        means[dead] = lower[dead] = upper[dead] = -np.inf
-        rows, block = rows[ok], block[ok]
-        if rows.size == 0:
-            return
-    mean = block.mean(axis=1)
-    means[rows] = mean
-    if k == 1:
-        lower[rows] = -np.inf
-        upper[rows] = np.inf
-        return
-    first = block[:, 0]
-    const = (block == first[:, None]).all(axis=1)
-    if const.any():
-        lower[rows[const]] = upper[rows[const]] = first[const]
-        spread = ~const
-        rows, block, mean = rows[spread], block[spread], mean[spread]
-        if rows.size == 0:
-            return
-    var = block.var(axis=1)
-    scale = np.sqrt(var / k) if k > 1000 else np.sqrt(var / (k - 1))
-    q_lo, q_hi = _standard_quantiles(k, delta)
-    lower[rows] = q_lo * scale + mean
-    upper[rows] = q_hi * scale + mean
+
+@numba.njit(cache=True, error_model="numpy")
+def _race_round(samples, active, first_new, k, q_lo, q_hi, need_select, need_discard, crashed, means, lower, upper, sel, dis):
+    """One round of :func:`selection_race` for its undecided candidates ``active`` (each with ``k`` samples in
+    its row of ``samples``, ``first_new ..`` new this round): update ``crashed``, write ``means`` and the
+    bounds, :func:`bayes_mean_bounds` to the bits (NumPy's summation order: ``_pairwise_sum``), then flag in
+    ``sel`` / ``dis`` (per position in ``active``) those this round selects and discards, on everyone's
+    current bounds. ``q_lo`` / ``q_hi``: the standardised quantiles for ``k`` samples."""
+    for i in active:
+        for t in range(first_new, k):
+            if samples[i, t] == -np.inf:
+                crashed[i] = True
+    squares = np.empty(k)
+    for i in active:
+        row = samples[i]
+        if crashed[i]:
+            means[i] = lower[i] = upper[i] = -np.inf
+            continue
+        mean = _pairwise_sum(row, k) / k
+        means[i] = mean
+        if k == 1:
+            lower[i], upper[i] = -np.inf, np.inf
+            continue
+        constant = True
+        for t in range(1, k):
+            if row[t] != row[0]:
+                constant = False
+                break
+        if constant:
+            lower[i] = upper[i] = row[0]
+            continue
+        for t in range(k):
+            d = row[t] - mean
+            squares[t] = d * d
+        var = _pairwise_sum(squares, k) / k
+        scale = np.sqrt(var / k) if k > 1000 else np.sqrt(var / (k - 1))
+        lower[i] = q_lo * scale + mean
+        upper[i] = q_hi * scale + mean
+    for q in range(active.shape[0]):
+        i = active[q]
+        beaten = 0
+        beating = 0
+        for j in range(means.shape[0]):
+            beaten += upper[j] < lower[i]
+            beating += lower[j] > upper[i]
+        sel[q] = beaten >= need_select
+        dis[q] = beating >= need_discard
 
 
 def _best_first(means: np.ndarray, idx: np.ndarray) -> np.ndarray:
