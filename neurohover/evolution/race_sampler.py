@@ -79,12 +79,15 @@ class RaceSampler:
     def __call__(self, idx: np.ndarray) -> np.ndarray:
         """Each listed candidate's next sample (a candidate listed again: the one after), as fitness."""
         idx = np.asarray(idx, dtype=np.int64)
-        # The q-th listing of candidate i asks for its sample asked[i] + q: rank each listing among its candidate's.
-        order = np.argsort(idx, kind="stable")
-        ranked = idx[order]
-        t = np.empty_like(idx)
-        t[order] = self.asked[ranked] + np.arange(idx.size) - np.searchsorted(ranked, ranked)
-        np.add.at(self.asked, idx, 1)
+        listed = np.bincount(idx, minlength=self.n)
+        if listed.max() == 1:
+            t = self.asked[idx]
+        else:  # the q-th listing of candidate i asks for its sample asked[i] + q: rank each listing among its candidate's
+            order = np.argsort(idx, kind="stable")
+            ranked = idx[order]
+            t = np.empty_like(idx)
+            t[order] = self.asked[ranked] + np.arange(idx.size) - np.searchsorted(ranked, ranked)
+        self.asked += listed
         slots = t * self.n + idx
         if self.parking is None:
             returns = self.flyer.fly(self.genomes, self.rows, idx, slots if self.per_slot else None, slots.shape[0], episode_index=self.base + slots)
@@ -92,7 +95,7 @@ class RaceSampler:
         else:
             need = slots[~self._over[slots]]
             if need.size:
-                self._fly_parked(need, np.unique(idx))
+                self._fly_parked(need, np.flatnonzero(listed))
         return self._fitness[slots]
 
     def used(self, n_samples: np.ndarray) -> np.ndarray:
