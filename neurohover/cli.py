@@ -52,6 +52,18 @@ def explicit_mdp(args: argparse.Namespace, family):
     return None
 
 
+def add_lr_fit_options(p: argparse.ArgumentParser, who: str) -> None:
+    """--d-u and --noise-estimate: LR fitted as ours or as the authors' code did (``who`` applies them)."""
+    from .models.lr import D_U_CHOICES, NOISE_ESTIMATES
+
+    p.add_argument("--d-u", choices=D_U_CHOICES, help=f"{who}: keep the fitted u constant as the model's D_u (default) or discard it, as the authors' code did")
+    p.add_argument(
+        "--noise-estimate",
+        choices=NOISE_ESTIMATES,
+        help=f"{who}: the model's gust noise from the residuals' innovations / 0.4 (default) or the authors' rms one-step error / 0.05",
+    )
+
+
 def add_sensor_options(p: argparse.ArgumentParser) -> None:
     """--obs-noise and --obs-delay: the task seen through noisy or late sensors (:mod:`neurohover.tasks.sensor`)."""
     g = p.add_argument_group("noisy sensors (docs/benchmarks.md; default: exact sensors)")

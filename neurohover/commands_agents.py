@@ -57,9 +57,15 @@ def cmd_compete(args: argparse.Namespace) -> int:
         "model_from": args.hybrid_model_from,
     }
     hybrid = HybridSettings.from_dict({k: v for k, v in given_values.items() if v is not None})
-    if args.wind_model is not None and not AGENTS[args.agent].learns_models:
-        learners = ", ".join(name for name, spec in AGENTS.items() if spec.learns_models)
-        raise NeurohoverError(f"--wind-model applies to the agents that learn models ({learners}), not to --agent {args.agent}")
+    for option, value in (
+        ("--wind-model", args.wind_model),
+        ("--d-u", args.d_u),
+        ("--noise-estimate", args.noise_estimate),
+        ("--model-policy", args.model_policy),
+    ):
+        if value is not None and not AGENTS[args.agent].learns_models:
+            learners = ", ".join(name for name, spec in AGENTS.items() if spec.learns_models)
+            raise NeurohoverError(f"{option} applies to the agents that learn models ({learners}), not to --agent {args.agent}")
     check_device(args.device)  # before the output directory is made
     check_jobs(args.jobs)
     check_seed(args.seed)
@@ -95,6 +101,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
             sensor=sensor,
             drift=None if args.drift is None else Drift.parse(args.drift),
             wind_model=args.wind_model or "none",
+            lr_fit={k: v for k, v in (("d_u", args.d_u), ("noise", args.noise_estimate), ("model_policy", args.model_policy)) if v is not None},
             agent_settings=agent_settings,
         )
     except KeyboardInterrupt:
@@ -116,8 +123,9 @@ _HYBRID_OPTIONS = ("safeguard_rule", "safeguard_box", "safeguard_tilt", "hybrid_
 
 
 def register(sub) -> None:
+    from .agents.model_based import MODEL_POLICIES
     from .agents.registry import AGENTS
-    from .cli import add_sensor_options
+    from .cli import add_lr_fit_options, add_sensor_options
     from .evolution.optimisers import optimiser_names
 
     p = sub.add_parser("build-policies", help="evolve the generic and specialised policies of a task", description=cmd_build_policies.__doc__)
@@ -170,6 +178,12 @@ def register(sub) -> None:
         "--wind-model",
         choices=("none", "constant", "sinusoid"),
         help="model-based agents: the wind of the LR models they learn (default none, the paper's; docs/model.md, Wind-aware models)",
+    )
+    add_lr_fit_options(p, "model-based agents")
+    p.add_argument(
+        "--model-policy",
+        choices=MODEL_POLICIES,
+        help="model-based agents: evolve on the model from the generic policy (ours, default) or an SLP from the baseline by the authors' eonn (authors)",
     )
     p.add_argument(
         "--agent-setting",

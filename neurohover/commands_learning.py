@@ -274,8 +274,16 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
         raise NeurohoverError(f"--estimator applies to --method lr only (least squares), not to --method {args.method}")
     if args.budget is not None and args.method == "lr":
         raise NeurohoverError("--budget applies to the evolutionary methods (ec-meno, ec-mer), not to --method lr (least squares)")
-    if args.wind_model is not None and args.method != "lr":
-        raise NeurohoverError(f"--wind-model applies to --method lr only (least squares), not to --method {args.method}")
+    for option, value in (
+        ("--wind-model", args.wind_model),
+        ("--d-u", args.d_u),
+        ("--noise-estimate", args.noise_estimate),
+        ("--as-authors", args.as_authors or None),
+    ):
+        if value is not None and args.method != "lr":
+            raise NeurohoverError(f"{option} applies to --method lr only (least squares), not to --method {args.method}")
+    if args.as_authors and (args.d_u, args.noise_estimate) != (None, None):
+        raise NeurohoverError("--as-authors sets --d-u discard and --noise-estimate rms: give either it or those options, not both")
     if args.policy is not None and args.method != "ec-mer":
         raise NeurohoverError(f"--policy applies to --method ec-mer only (the policy that flew the data), not to --method {args.method}")
     data = FlightData.load(input_file(args.flight_data, "--flight-data", "flight-data file"))
@@ -284,7 +292,8 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     extra = {} if args.budget is None else {"budget": args.budget}
     with _Ticker(f"learning a {args.method} model from {data.n_episodes} episodes ({data.n_transitions} steps)"):
         if args.method == "lr":
-            model = learn_lr(data, estimator=args.estimator or "ols", wind_model=args.wind_model or "none")
+            d_u, noise = ("discard", "rms") if args.as_authors else (args.d_u or "keep", args.noise_estimate or "innovations")
+            model = learn_lr(data, estimator=args.estimator or "ols", wind_model=args.wind_model or "none", d_u=d_u, noise=noise)
         elif args.method == "ec-meno":
             model = learn_ec_meno(data, seed=args.seed, **extra)
         else:
@@ -373,7 +382,7 @@ def model_notes(model, data, truth, rows) -> list[str]:
 
 
 def register(sub) -> None:
-    from .cli import add_sensor_options
+    from .cli import add_lr_fit_options, add_sensor_options
 
     p = sub.add_parser(
         "evolve",
@@ -459,6 +468,12 @@ def register(sub) -> None:
         choices=("none", "constant", "sinusoid"),
         help="lr: none (default, the paper's wind-blind model), or a world-frame wind per horizontal axis, constant or sinusoidal, "
         "identified from the data (docs/model.md, Wind-aware models)",
+    )
+    add_lr_fit_options(p, "lr")
+    p.add_argument(
+        "--as-authors",
+        action="store_true",
+        help="lr: fit as the authors' code did (--d-u discard --noise-estimate rms; docs/model.md, LR as the authors fitted it)",
     )
     p.add_argument("--seed", type=int, default=0, help="seed of the evolution (ec-meno, ec-mer)")
     p.add_argument("--policy", help="ec-mer: the policy that flew the data (default: the flight data's metadata, else baseline)")

@@ -44,6 +44,10 @@ CSV_COLUMNS = ("run", "mdp", "episode", "return", "crashed", "steps", "policy", 
 STORE_FILE = "results.sqlite"
 
 
+#: The LR-fit settings a competition takes (``lr_fit``): the experiment groups' keys of the same names.
+LR_FIT_KEYS = ("d_u", "noise", "model_policy")
+
+
 def summarise(results: Sequence) -> dict:
     """Summary figures over test runs (:class:`~neurohover.experiments.results.TestRunResult`; see the module docstring)."""
     scores = np.array([float(r.score) for r in results])
@@ -150,6 +154,7 @@ def competition_config(
     sensor: Sensor | None = None,
     drift: Drift | None = None,
     wind_model: str = "none",
+    lr_fit: Mapping[str, str] | None = None,
     agent_settings: Mapping[str, object] | None = None,
 ):
     """The inline experiment of a competition (an ``ExperimentConfig`` of kind ``test_runs``).
@@ -166,11 +171,15 @@ def competition_config(
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise NeurohoverError(f"{name}={value!r} is out of range: allowed an integer >= 1")
     check_seed(seed)  # the range every command takes
-    group = {"agent": agent, **_group(task, runs, mdps)}
+    group: dict[str, object] = {"agent": agent, **_group(task, runs, mdps)}
     if agent in HYBRID_AGENTS:
         group["hybrid"] = hybrid.to_dict()
     if wind_model != "none":  # the wind of the LR models the agent learns (absent: the digest of older competitions)
         group["wind_model"] = wind_model
+    for key, choice in (lr_fit or {}).items():  # LR as the authors fitted it (absent: ours, the digest of older competitions)
+        if key not in LR_FIT_KEYS:
+            raise NeurohoverError(f"lr_fit key {key!r} is not allowed: choose from {', '.join(LR_FIT_KEYS)}")
+        group[key] = choice
     if agent_settings:  # the agent's own typed settings, checked by its spec's class (absent: as before)
         group["settings"] = check_agent_settings(agent, agent_settings)
     settings: dict[str, object] = {
@@ -211,6 +220,7 @@ def compete(
     sensor: Sensor | None = None,
     drift: Drift | None = None,
     wind_model: str = "none",
+    lr_fit: Mapping[str, str] | None = None,
     agent_settings: Mapping[str, object] | None = None,
 ) -> tuple[dict, list]:
     """Run ``runs`` test runs of ``agent`` as an inline experiment; write results and plot to ``out``.
@@ -238,6 +248,11 @@ def compete(
         The harder task (docs/benchmarks.md): every MDP seen through ``sensor``, its dynamics drifting by ``drift``.
     wind_model : {"none", "constant", "sinusoid"}
         The wind of the LR models a model-based agent learns (docs/model.md, Wind-aware models).
+    lr_fit : mapping, optional
+        How a model-based agent fits LR and evolves on it, where it differs from ours: ``d_u``
+        (``"keep"``/``"discard"``), ``noise`` (``"innovations"``/``"rms"``), ``model_policy``
+        (``"ours"``/``"authors"``) (:class:`~neurohover.agents.model_based.ModelEvolution`); checked
+        with the config (a bad value is refused with the allowed ones).
     agent_settings : mapping, optional
         The agent's own settings (its spec's settings class, e.g. ``{"criterion": "lcb", "level": 3}``
         for ``hybrid-risk``, ``{"cooldown": 10}`` for ``continual``); refused for an agent without one.
@@ -262,7 +277,7 @@ def compete(
     check_agent(agent, get_task_family(task, sigma), policy_dir)
     config = competition_config(
         task, agent, runs=runs, episodes=episodes, mdps=mdps, seed=seed, sigma=sigma, n_steps=n_steps, policy_dir=policy_dir, hybrid=hybrid,
-        sensor=sensor, drift=drift, wind_model=wind_model, agent_settings=agent_settings,
+        sensor=sensor, drift=drift, wind_model=wind_model, lr_fit=lr_fit, agent_settings=agent_settings,
     )  # fmt: skip
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

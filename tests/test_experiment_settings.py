@@ -16,7 +16,7 @@ from neurohover.experiments.settings import KIND_SETTINGS, EvolutionSettings, Gr
 
 
 def test_every_schema_key_is_a_field_of_its_kinds_settings_class() -> None:
-    nested = {"variants": Variant, "groups": Group, "conditions": settings.Condition}
+    nested = {"variants": Variant, "groups": Group, "conditions": settings.Condition, "fits": settings.Fit}
     for kind, schema in SCHEMAS.items():
         names = {f.name for f in dataclasses.fields(KIND_SETTINGS[kind])}
         assert set(schema) == names, kind

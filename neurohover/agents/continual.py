@@ -43,7 +43,7 @@ from ..flightdata import FlightData
 from ..models.transitions import one_step_error
 from ..policies import Policy
 from ..tasks import MDP, TaskFamily
-from .model_based import ModelEvolution, enough_to_learn, evolve_on_model, learn_model
+from .model_based import ModelEvolution, enough_to_learn, evolve_on_model
 from .protocol import Agent, Choice, EpisodeOutcome
 from .spec import AgentOptions, AgentPolicies, AgentSettings, AgentSpec
 
@@ -127,7 +127,7 @@ class ContinualAgent(Agent):
         data = self._data()
         if not enough_to_learn(data, self.evolution.wind_model):
             return
-        model = learn_model(data, self.evolution.estimator, self.evolution.wind_model)
+        model = self.evolution.learn(data)
         self.models += 1
         self.policy_model = model
         self.reference_error = float(one_step_error(model, data))

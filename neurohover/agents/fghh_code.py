@@ -79,6 +79,10 @@ class CodeAgentSettings:
         The LR model's least squares (OLS, as the authors).
     wind_model : {"none", "constant", "sinusoid"}
         The LR model's wind (none, as the authors; FGHH has no wind).
+    d_u, noise : str
+        The LR model's u constant and noise estimate (:func:`neurohover.models.learn_lr`; ours by
+        default, ``"discard"`` and ``"rms"`` as the authors' code). Its evolution on the model is
+        always the authors' (:data:`MODEL_EVOLUTION`), whatever a run's ``model_policy`` says.
     """
 
     evolutions: int = 3
@@ -88,6 +92,8 @@ class CodeAgentSettings:
     n_steps: int = EPISODE_STEPS
     estimator: str = "ols"
     wind_model: str = "none"
+    d_u: str = "keep"
+    noise: str = "innovations"
 
     def __post_init__(self) -> None:
         for name, low in (("evolutions", 1), ("model_budget", 50), ("n_steps", 1)):
@@ -150,7 +156,7 @@ class CodeFGHHAgent(Agent):
             self.flight_data = outcome.flight_data if self.flight_data is None else self.flight_data + outcome.flight_data
             if not enough_to_learn(self.flight_data, s.wind_model):
                 return
-            self.model = learn_model(self.flight_data, s.estimator, s.wind_model)
+            self.model = learn_model(self.flight_data, s.estimator, s.wind_model, d_u=s.d_u, noise=s.noise)
         elif self.flying != "generic" and self.next_trial <= len(self.candidates) - 1:
             self.next_trial += 1
         if len(self.candidates) - 1 < s.evolutions and self.next_trial == len(self.candidates):
@@ -183,7 +189,9 @@ def _build(name: str):
         settings = (
             CodeAgentSettings()
             if evo is None
-            else CodeAgentSettings(model_budget=max(50, evo.budget), n_steps=evo.n_steps, estimator=evo.estimator, wind_model=evo.wind_model)
+            else CodeAgentSettings(
+                model_budget=max(50, evo.budget), n_steps=evo.n_steps, estimator=evo.estimator, wind_model=evo.wind_model, d_u=evo.d_u, noise=evo.noise
+            )
         )
         agent = CodeFGHHAgent(policies.generic, settings)
         agent.name = name

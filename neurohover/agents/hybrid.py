@@ -23,7 +23,7 @@ from ..evaluate import DangerousState
 from ..flightdata import FlightData
 from ..policies import Policy, baseline_policy
 from ..tasks import MDP, TaskFamily
-from .model_based import ModelEvolution, enough_to_learn, evolve_on_model, learn_model
+from .model_based import ModelEvolution, enough_to_learn, evolve_on_model
 from .protocol import Agent, Choice, EpisodeOutcome
 from .spec import AgentOptions, AgentPolicies, AgentSettings, AgentSpec
 
@@ -182,7 +182,7 @@ class HybridAgent(Agent):
                 data = self._model_data()
                 # Trials that crash within a few steps may not determine a model: then the two safe policies are all there is.
                 if enough_to_learn(data, self.settings.wind_model):
-                    self.model = learn_model(data, self.settings.estimator, self.settings.wind_model)
+                    self.model = self.settings.learn(data)
                     self.candidates += [self._evolve(f"model:{i}") for i in range(N_EVOLVED)]
             if len(self.trial_returns) < len(self.candidates):
                 return

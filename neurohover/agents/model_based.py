@@ -16,22 +16,34 @@ from ..errors import NeurohoverError
 from ..evaluate import evaluate
 from ..flightdata import FlightData
 from ..models.lr import lr_determined
-from ..policies import Policy
+from ..policies import Policy, baseline_policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
 from .protocol import Agent, Choice, EpisodeOutcome
 from .spec import FGHH_GENERIC_KINDS, AgentOptions, AgentPolicies, AgentSettings, AgentSpec
 
+#: How a policy is evolved on a learned model: ``"ours"``, steady state from the generic policy with
+#: the model budget; ``"authors"``, the authors' GHH-09 agents: an SLP from the baseline by their
+#: ``eonn`` (:mod:`neurohover.evolution.eonn`, 50 genomes, 49 kept, ``authors_generations`` generations).
+MODEL_POLICIES = ("ours", "authors")
+
 
 @dataclass(frozen=True)
 class ModelEvolution:
-    """How an agent evolves a policy on a learned model.
+    """How an agent learns a model and evolves a policy on it.
 
     ``budget`` episodes on the model per evolution (steady state, paper Table 6 otherwise);
     ``predict_episodes`` model episodes to predict the evolved policy's return; ``estimator`` the
     least-squares estimator of the LR model (:func:`learn_model`): ``"ols"`` (default, the paper's)
     or ``"gls"``; ``wind_model`` its wind: ``"none"`` (default, the paper's wind-blind model),
     ``"constant"`` or ``"sinusoid"`` (:mod:`neurohover.models.wind`); ``device`` where those episodes fly (``"cpu"`` or ``"cuda"``, docs/gpu.md).
+
+    How LR was fitted and used by the authors' code, each selectable: ``d_u`` ``"keep"`` (default) or
+    ``"discard"`` (the authors': the fitted u constant thrown away); ``noise`` ``"innovations"``
+    (default) or ``"rms"`` (the authors' ``rms / 0.05``) (:func:`neurohover.models.learn_lr`);
+    ``model_policy`` ``"ours"`` (default: steady state from the generic policy, ``budget`` episodes)
+    or ``"authors"`` (an SLP from the baseline by the authors' ``eonn``, ``authors_generations``
+    generations of 50 episodes; :data:`MODEL_POLICIES`).
     """
 
     budget: int = 2000
@@ -40,30 +52,49 @@ class ModelEvolution:
     estimator: str = "ols"
     device: str = "cpu"
     wind_model: str = "none"
+    d_u: str = "keep"
+    noise: str = "innovations"
+    model_policy: str = "ours"
+    authors_generations: int = 500
 
     def __post_init__(self) -> None:
         from ..evaluate import check_device
-        from ..models import ESTIMATORS
+        from ..models import D_U_CHOICES, ESTIMATORS, NOISE_ESTIMATES
         from ..models.wind import WIND_MODELS
 
-        if self.estimator not in ESTIMATORS:
-            raise NeurohoverError(f"estimator={self.estimator!r} is not allowed: choose one of {', '.join(ESTIMATORS)}")
-        if self.wind_model not in WIND_MODELS:
-            raise NeurohoverError(f"wind_model={self.wind_model!r} is not allowed: choose one of {', '.join(WIND_MODELS)}")
+        for name, allowed in (
+            ("estimator", ESTIMATORS),
+            ("wind_model", WIND_MODELS),
+            ("d_u", D_U_CHOICES),
+            ("noise", NOISE_ESTIMATES),
+            ("model_policy", MODEL_POLICIES),
+        ):
+            value = getattr(self, name)
+            if value not in allowed:
+                raise NeurohoverError(f"{name}={value!r} is not allowed: choose one of {', '.join(allowed)}")
+        g = self.authors_generations
+        if isinstance(g, bool) or not isinstance(g, int) or g < 1:
+            raise NeurohoverError(f"authors_generations={g!r} is out of range: allowed an integer >= 1")
         check_device(self.device)
 
+    def learn(self, flight_data: FlightData) -> MDP:
+        """The LR model of ``flight_data`` under these settings, as an MDP."""
+        return learn_model(flight_data, self.estimator, self.wind_model, d_u=self.d_u, noise=self.noise)
 
-def learn_model(flight_data: FlightData, estimator: str = "ols", wind_model: str = "none") -> MDP:
+
+def learn_model(flight_data: FlightData, estimator: str = "ols", wind_model: str = "none", *, d_u: str = "keep", noise: str = "innovations") -> MDP:
     """The LR model (the paper's best method) of the flight data, as an MDP.
 
     ``estimator="ols"`` (default): ordinary least squares, as the paper and the authors' code;
     ``"gls"``: the AR(1) quasi-differencing option (:func:`neurohover.models.learn_lr`). Intercepts
-    are LR's default, ``"uv"`` (D_v and the model's D_u). ``wind_model``: ``"none"`` (default, the
-    paper's), ``"constant"`` or ``"sinusoid"``, a world-frame wind identified from the data.
+    are LR's default, ``"uv"`` (D_v, and the model's D_u unless ``d_u="discard"``, as the authors).
+    ``wind_model``: ``"none"`` (default, the paper's), ``"constant"`` or ``"sinusoid"``, a
+    world-frame wind identified from the data. ``noise``: ``"innovations"`` (default) or the
+    authors' ``"rms"``.
     """
     from ..models import learn_lr
 
-    return learn_lr(flight_data, estimator=estimator, wind_model=wind_model).mdp()
+    return learn_lr(flight_data, estimator=estimator, wind_model=wind_model, d_u=d_u, noise=noise).mdp()
 
 
 def enough_to_learn(flight_data: FlightData, wind_model: str = "none") -> bool:
@@ -76,13 +107,33 @@ def enough_to_learn(flight_data: FlightData, wind_model: str = "none") -> bool:
 
 
 def evolve_on_model(model: MDP, prototype: Policy, settings: ModelEvolution, seed: int) -> tuple[Policy, float]:
-    """Evolve a policy on ``model``; return it and its predicted return (mean over model episodes)."""
+    """Evolve a policy on ``model`` (from ``prototype``, or as ``settings.model_policy`` says); return it
+    and its predicted return (mean over model episodes)."""
+    from ..evolution.eonn import EonnSettings, eonn_evolve
     from ..evolution.evolve import evolve
 
-    result = evolve(
-        model, topology=prototype.topology, prototype=prototype, budget=settings.budget, seed=seed, n_steps=settings.n_steps, threads=1, device=settings.device
-    )
-    policy = result.champion
+    if settings.model_policy == "authors":  # their GHH-09 agents: an SLP from the baseline, whatever the generic
+        policy = eonn_evolve(
+            model,
+            baseline_policy(),
+            settings=EonnSettings(generations=settings.authors_generations),
+            seed=seed,
+            n_steps=settings.n_steps,
+            threads=1,
+            device=settings.device,
+        ).champion
+    else:
+        result = evolve(
+            model,
+            topology=prototype.topology,
+            prototype=prototype,
+            budget=settings.budget,
+            seed=seed,
+            n_steps=settings.n_steps,
+            threads=1,
+            device=settings.device,
+        )
+        policy = result.champion
     predicted = evaluate(
         policy, model, episodes=settings.predict_episodes, seed=seed, first_episode=10**9, n_steps=settings.n_steps, threads=1, device=settings.device
     ).returns.mean()
@@ -115,7 +166,7 @@ class ModelBasedAgent(Agent):
         if self.policy is None and outcome.flight_data is not None:
             self.flight_data = outcome.flight_data if self.flight_data is None else self.flight_data + outcome.flight_data
             if enough_to_learn(self.flight_data, self.settings.wind_model):  # a generic that crashed at once flies again first
-                model = learn_model(self.flight_data, self.settings.estimator, self.settings.wind_model)
+                model = self.settings.learn(self.flight_data)
                 self.policy, _ = evolve_on_model(model, self.generic, self.settings, int(self._rng.integers(2**62)))
 
 
@@ -174,7 +225,7 @@ class IncrementalModelBasedAgent(Agent):
         assert self.flight_data is not None  # the first episode is always recorded
         if not enough_to_learn(self.flight_data, self.settings.wind_model):  # the policy crashed at once: fly it again first
             return
-        model = learn_model(self.flight_data, self.settings.estimator, self.settings.wind_model)
+        model = self.settings.learn(self.flight_data)
         self.models_learned += 1
         self.current, self.predicted = evolve_on_model(model, self.generic, self.settings, int(self._rng.integers(2**62)))
         self.current_label = f"model:{self.models_learned}"

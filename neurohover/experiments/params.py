@@ -69,6 +69,10 @@ class ModelParams:
     prototype: str
     test_episodes: int
     data_episodes: int = 1  # episodes of the generic's flight data the model learns from
+    d_u: str = "keep"  # LR as the authors fitted it, each choice apart (neurohover.agents.model_based.ModelEvolution)
+    noise: str = "innovations"
+    model_policy: str = "ours"
+    authors_generations: int = 500
     exact_checks: bool = False  # also check the model and its policy against exact sensors (the MDP has a sensor model)
     seed: int
 
@@ -90,6 +94,10 @@ class TestRunParams:
     policies: dict
     estimator: str = "ols"
     wind_model: str = "none"
+    d_u: str = "keep"  # LR as the authors fitted it, each choice apart (neurohover.agents.model_based.ModelEvolution)
+    noise: str = "innovations"
+    model_policy: str = "ours"
+    authors_generations: int = 500
     sensor: dict | None = None
     hybrid: dict | None = None
     agent_settings: dict | None = None

@@ -341,6 +341,19 @@ class _Policies:
         return None if any(v is None for v in out.values()) else out
 
 
+def _lr_fit(d_u: str, noise: str, model_policy: str, authors_generations: int) -> dict:
+    """A unit's LR-fit params where they differ from ours (absent when ours: stored units keep their params)."""
+    out: dict = {}
+    if d_u != "keep":
+        out["d_u"] = d_u
+    if noise != "innovations":
+        out["noise"] = noise
+    if model_policy != "ours":
+        out["model_policy"] = model_policy
+        out["authors_generations"] = authors_generations
+    return out
+
+
 def group_hybrid_settings(group: Group) -> dict | None:
     """The full hybrid settings of a group's units (None: the group's agent is not a hybrid agent)."""
 
@@ -393,6 +406,7 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dic
                             "policies": policies,
                             "estimator": g.estimator,
                             **({"wind_model": g.wind_model} if g.wind_model != "none" else {}),  # absent: unit keys as before winds
+                            **_lr_fit(g.d_u, g.noise, g.model_policy, s.authors_generations),  # absent: ours, as before these settings
                             **({"sensor": sensor} if sensor is not None else {}),
                             **({"hybrid": hybrid} if hybrid else {}),
                             **({"agent_settings": g.settings} if g.settings is not None else {}),
@@ -411,7 +425,7 @@ def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
     assert isinstance(s, ModelLearningSettings)
     family = family_of(s.task, s.sigma, s.sensor)
     units: list[Unit] = []
-    total = len(s.methods) * s.n_mdps * max(1, len(s.conditions))
+    total = len(s.methods) * s.n_mdps * max(1, len(s.conditions), len(s.fits))
     if s.generic == "evolve":
         total += 1
         units.append(_policy_evolution_unit(cfg, UnitKey.make("policy", "generic"), {"kind": "mdp", "mdp": family.zero().to_dict()}, s.generic_budget))
@@ -438,8 +452,11 @@ def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
                 "test_episodes": s.test_episodes,
             }
             seed_key = f"model/{s.mdps}{i}"
-            if not s.conditions:
+            if not s.conditions and not s.fits:
                 units.append(_unit(cfg, UnitKey.make("model", method, f"{s.mdps}{i}"), "model", {**common, "mdp": mdp.to_dict()}, seed_key=seed_key))
+            for f in s.fits:  # every fit learns from the same flight data and its policy meets the same gusts
+                params = {**common, "mdp": mdp.to_dict(), **_lr_fit(f.d_u, f.noise, f.model_policy, s.authors_generations)}
+                units.append(_unit(cfg, UnitKey.make("model", f"{method}@{f.key}", f"{s.mdps}{i}"), "model", params, seed_key=seed_key))
             for c in s.conditions:
                 seen = mdp.with_sensor(EXACT if c.sensor is None else Sensor.from_dict(c.sensor))
                 params = {**common, "mdp": seen.to_dict(), "data_episodes": c.data_episodes, "exact_checks": True}

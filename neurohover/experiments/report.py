@@ -24,6 +24,7 @@ from ..errors import NeurohoverError
 from .config import ORDER, ExperimentConfig
 from .report_base import Section, fmt, log_errors, new_figure, sd, table
 from .report_evolution import EvolutionSection
+from .report_factorial import FitFactorial, test_run_effects, varies
 from .report_models import SensorModels
 from .results import ModelResult, TestRunResult, result_from_dict
 from .settings import Group, ModelLearningSettings
@@ -120,6 +121,11 @@ class _TestRuns(Section):
 
     def runs(self, label: str) -> list[TestRunResult]:
         return self.group("run", label)
+
+    def paired_runs(self, label: str) -> dict[str, TestRunResult]:
+        """A group's runs by MDP and repetition (groups flying the same seeds pair on these keys)."""
+        keys = sorted(k for k in self.results if (self.keys[k].stage, self.keys[k].group) == ("run", label))
+        return dict(zip((f"{self.keys[k].mdp}/rep{self.keys[k].rep}" for k in keys), self.runs(label)))  # runs(): the same keys, in order
 
     def figure(self) -> str | None:
         data = {g.label: self.runs(g.label) for g in self.groups()}
@@ -239,6 +245,8 @@ class _TestRuns(Section):
             order = sorted(samples, key=lambda k: -np.mean(samples[k]))
             self.comparisons.append("Ranking by mean cumulative reward (best first): ours " + " > ".join(order) + ".")
         self.add_tests(samples, labels, "final cumulative reward")
+        effects, lines = test_run_effects(self.groups(), self.paired_runs) if varies(self.groups()) else ("", [])
+        self.comparisons += lines
         return (
             self._matrix()
             + self._wins()
@@ -262,7 +270,7 @@ class _TestRuns(Section):
                 rows,
             )
             + f"\n\nEach run: {self.s.episodes} episodes of {self.s.n_steps} control steps on one MDP; the score is the "
-            "cumulative reward of the whole run.\n"
+            "cumulative reward of the whole run.\n" + (f"\n{effects}" if effects else "")
         )
 
 
@@ -319,7 +327,9 @@ def _section(cfg: ExperimentConfig, store: Store, out: Path) -> str:
     except NeurohoverError:
         total = None
     results = {u["key"]: result_from_dict(u["kind"], u["result"], u["key"]) for u in units}
-    kind = SensorModels if isinstance(cfg.typed, ModelLearningSettings) and cfg.typed.conditions else _SECTIONS[cfg.kind]
+    kind = _SECTIONS[cfg.kind]
+    if isinstance(cfg.typed, ModelLearningSettings):
+        kind = SensorModels if cfg.typed.conditions else FitFactorial if cfg.typed.fits else kind
     sec = kind(cfg, results, store, out)
     text = [f"## {cfg.title} [{cfg.scale}]\n", _header(cfg, store, units, total)]
     figure = sec.figure()

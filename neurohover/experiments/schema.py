@@ -15,11 +15,13 @@ from dataclasses import fields
 from typing import Any
 
 from ..agents.hybrid import HybridSettings
+from ..agents.model_based import MODEL_POLICIES
 from ..agents.registry import AGENTS, HYBRID_AGENTS
 from ..errors import NeurohoverError
 from ..evolution.config import make_settings, optimiser_of
 from ..evolution.evolve import parse_resampling
 from ..evolution.optimisers import OPTIMISERS
+from ..models.lr import D_U_CHOICES, NOISE_ESTIMATES
 from ..policysets import FGHH_GENERIC_RESAMPLING
 from ..tasks import TASK_FAMILIES, TASK_NAMES, Drift, Sensor
 
@@ -177,6 +179,10 @@ _GROUP = {
     "hybrid": ({}, _table()),
     "estimator": ("ols", _choice("ols", "gls")),  # least squares of the LR models an agent learns
     "wind_model": (OMIT, _choice("none", "constant", "sinusoid")),  # and their wind (neurohover.models.wind; absent: none)
+    # LR as the authors fitted it, each choice apart (absent: ours; neurohover.agents.model_based.ModelEvolution)
+    "d_u": (OMIT, _choice(*D_U_CHOICES)),
+    "noise": (OMIT, _choice(*NOISE_ESTIMATES)),
+    "model_policy": (OMIT, _choice(*MODEL_POLICIES)),
     "sensor": (OMIT, _sensor_table()),  # this group's agents fly the group's MDPs through these sensors
     "drift": (OMIT, _drift_table()),  # and with these drifting dynamics (neurohover.tasks.drift)
     # run i of MDP m takes the seed of that run of another experiment's group: the same gusts and draws (paired)
@@ -190,6 +196,15 @@ _CONDITION = {
     "label": (None, _str()),
     "sensor": (OMIT, _sensor_table()),  # absent: exact sensors
     "data_episodes": (1, _int(1)),  # episodes of the generic policy's flight data each model learns from
+}
+
+# One way of fitting LR and evolving a policy on the model (the LR methods' units of each fit; docs/model.md)
+_FIT = {
+    "key": (REQUIRED, _str()),
+    "label": (None, _str()),
+    "d_u": ("keep", _choice(*D_U_CHOICES)),
+    "noise": ("innovations", _choice(*NOISE_ESTIMATES)),
+    "model_policy": ("ours", _choice(*MODEL_POLICIES)),
 }
 
 SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
@@ -223,6 +238,8 @@ SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
         "policy_prototype": ("generic", _choice("generic", "baseline")),
         "test_episodes": (5, _int(1)),
         "conditions": (OMIT, ("list", _CONDITION)),  # sensor conditions, each its own models of every MDP
+        "fits": (OMIT, ("list", _FIT)),  # LR fits, each its own LR models of every MDP (paired with the others)
+        "authors_generations": (OMIT, _int(1)),  # the authors' eonn generations (absent: 500, theirs)
     },
     "test_runs": {
         **_COMMON,
@@ -239,6 +256,7 @@ SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
         "model_budget": (2000, _int(1)),
         "predict_episodes": (5, _int(1)),
         "max_learning_episodes": (25, _int(1)),
+        "authors_generations": (OMIT, _int(1)),  # the authors' eonn generations on a model (absent: 500, theirs)
         "drift": (OMIT, _drift_table()),  # every test run's MDP drifts so (neurohover.tasks.drift)
         "groups": (REQUIRED, ("list", _GROUP)),
     },
@@ -321,6 +339,17 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
             raise NeurohoverError(f"{where}: sensor is set by each of the conditions here: leave [settings] sensor out")
         for c in settings["conditions"]:
             c["label"] = c["label"] or c["key"]
+    if kind == "model_learning" and "fits" in settings:
+        keys = [f["key"] for f in settings["fits"]]
+        bad = [k for k in keys if not re.fullmatch(r"[a-z0-9][a-z0-9.-]*", k)]
+        if bad or len(set(keys)) != len(keys):
+            raise NeurohoverError(f"{where}: fit keys must be unique and of lower-case letters, digits, '.' and '-', got {keys}")
+        if "conditions" in settings:
+            raise NeurohoverError(f"{where}: fits and conditions cannot be combined: give one of them")
+        if not set(settings["methods"]) <= {"lr", "lr-gls"}:
+            raise NeurohoverError(f"{where}: fits apply to the LR methods only (lr, lr-gls), not to {sorted(set(settings['methods']) - {'lr', 'lr-gls'})}")
+        for f in settings["fits"]:
+            f["label"] = f["label"] or f["key"]
     if kind in ("model_learning", "test_runs"):
         groups = settings.get("groups", [{"mdps": settings.get("mdps"), "n_mdps": settings.get("n_mdps")}])
         for g in groups:
@@ -335,6 +364,12 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
             if task not in AGENTS[g["agent"]].tasks:
                 raise NeurohoverError(f"{where}: agent {g['agent']!r} does not apply to task {task!r}")
             g["label"] = g["label"] or g["agent"]
+            lr_keys = [k for k in ("d_u", "noise", "model_policy") if k in g]
+            if lr_keys and not AGENTS[g["agent"]].learns_models:
+                learners = ", ".join(name for name, spec in AGENTS.items() if spec.learns_models)
+                raise NeurohoverError(
+                    f"{where}: group {g['label']!r}: {', '.join(lr_keys)} apply to the agents that learn models ({learners}), not to {g['agent']!r}"
+                )
             if "settings" in g and g["agent"] in HYBRID_AGENTS:  # one spelling for every agent's own settings
                 if g["hybrid"]:
                     raise NeurohoverError(f"{where}: group {g['label']!r}: give the hybrid settings once, as settings (hybrid is its older name), not both")

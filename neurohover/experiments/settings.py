@@ -40,6 +40,9 @@ class Group:
     settings: dict | None = None  # the agent's own typed settings, as a table
     estimator: str = "ols"
     wind_model: str = "none"  # the wind of the LR models its agents learn
+    d_u: str = "keep"  # how its LR models treat the fitted u constant (the authors': discard)
+    noise: str = "innovations"  # their gust-noise estimate (the authors': rms)
+    model_policy: str = "ours"  # how policies are evolved on them (the authors': an SLP from the baseline by eonn)
     sensor: dict | None = None  # this group's sensors (None: the experiment's)
     drift: dict | None = None  # this group's drifting dynamics (None: the experiment's)
     seeds_of: dict | None = None  # {experiment, seed, group}: its runs take that group's seeds (None: its own)
@@ -53,6 +56,17 @@ class Condition:
     label: str
     sensor: dict | None = None  # None: exact sensors
     data_episodes: int = 1
+
+
+@dataclass(frozen=True, kw_only=True)
+class Fit:
+    """One way of fitting LR and evolving on it in a model-learning experiment (a ``[[settings.fits]]`` table)."""
+
+    key: str
+    label: str
+    d_u: str = "keep"
+    noise: str = "innovations"
+    model_policy: str = "ours"
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -95,6 +109,8 @@ class ModelLearningSettings(ExperimentSettings):
     policy_prototype: str = "generic"
     test_episodes: int = 5
     conditions: tuple[Condition, ...] = ()  # empty: one condition, the experiment's sensor and one episode of data
+    fits: tuple[Fit, ...] = ()  # empty: LR as the methods say (D_u kept, innovation noise, our evolution)
+    authors_generations: int = 500  # generations of the authors' eonn, where a fit evolves so
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -110,6 +126,7 @@ class TestRunsSettings(ExperimentSettings):
     model_budget: int = 2000
     predict_episodes: int = 5
     max_learning_episodes: int = 25
+    authors_generations: int = 500  # generations of the authors' eonn, where a group's agents evolve so
     drift: dict | None = None  # every test run's MDP drifts so (None: fixed dynamics)
     groups: tuple[Group, ...]
 
@@ -119,7 +136,7 @@ KIND_SETTINGS: dict[str, type[ExperimentSettings]] = {
     "model_learning": ModelLearningSettings,
     "test_runs": TestRunsSettings,
 }
-_NESTED: dict[str, type] = {"variants": Variant, "groups": Group, "conditions": Condition}
+_NESTED: dict[str, type] = {"variants": Variant, "groups": Group, "conditions": Condition, "fits": Fit}
 
 
 def _build(cls: type, table: dict) -> Any:

@@ -25,12 +25,13 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from ..agents.model_based import ModelEvolution
+from ..agents.model_based import ModelEvolution, evolve_on_model
 from ..agents.protocol import after_learning_start, run_test
 from ..agents.registry import AgentOptions, AgentPolicies, agent_spec
 from ..errors import NeurohoverError
 from ..evaluate import evaluate, evaluate_jobs, num_threads
 from ..evolution.config import optimiser_of
+from ..evolution.eonn import EonnSettings
 from ..evolution.evolve import evolve, validation_return
 from ..models import learn_ec_meno, learn_ec_mer, learn_lr, one_step_error
 from ..policies import Policy
@@ -215,7 +216,7 @@ def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
     assert flight is not None  # recorded
     t0 = time.perf_counter()
     if q.method in ("lr", "lr-gls"):  # ordinary least squares (the paper's), or the GLS option
-        model = learn_lr(flight, estimator="gls" if q.method == "lr-gls" else "ols")
+        model = learn_lr(flight, estimator="gls" if q.method == "lr-gls" else "ols", d_u=q.d_u, noise=q.noise)
     elif q.method == "ec-meno":
         model = learn_ec_meno(flight, budget=q.ec_meno_budget or None, seed=int(seeds[1]))
     else:
@@ -223,22 +224,28 @@ def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
     learn_seconds = time.perf_counter() - t0
     proto = generic if q.prototype == "generic" else "baseline"
     t1 = time.perf_counter()
-    evolved = evolve(
-        model.mdp(),
-        topology=generic.topology,
-        prototype=proto,
-        budget=q.policy_budget or None,
-        seed=int(seeds[2]),
-        n_steps=q.n_steps,
-        threads=threads,
-        device=device,
-    )
+    if q.model_policy == "authors":  # their GHH-09 agents: an SLP from the baseline by their eonn
+        authors = ModelEvolution(n_steps=q.n_steps, device=device, model_policy="authors", authors_generations=q.authors_generations)
+        champion, predicted = evolve_on_model(model.mdp(), generic, authors, int(seeds[2]))
+        policy_episodes = (q.authors_generations + 1) * EonnSettings().pop_size
+    else:
+        evolved = evolve(
+            model.mdp(),
+            topology=generic.topology,
+            prototype=proto,
+            budget=q.policy_budget or None,
+            seed=int(seeds[2]),
+            n_steps=q.n_steps,
+            threads=threads,
+            device=device,
+        )
+        champion, policy_episodes, predicted = evolved.champion, evolved.episodes, evolved.champion_return
     evolve_seconds = time.perf_counter() - t1
-    test = evaluate(evolved.champion, mdp, episodes=q.test_episodes, seed=int(seeds[3]), n_steps=q.n_steps, threads=threads, device=device)
+    test = evaluate(champion, mdp, episodes=q.test_episodes, seed=int(seeds[3]), n_steps=q.n_steps, threads=threads, device=device)
     returns = test.returns.ravel()
     checks = {}
     if q.exact_checks:
-        checks = _exact_checks(q, mdp, generic, model, flight, evolved.champion, int(seeds[3]), threads, device)
+        checks = _exact_checks(q, mdp, generic, model, flight, champion, int(seeds[3]), threads, device)
     return ModelResult(
         method=q.method,
         mdp=mdp.label,
@@ -246,11 +253,11 @@ def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
         generic_crashed=bool(data.crashed.any()),
         model_params=tuple(num(x) for x in model.params),
         model_noise_std=tuple(num(x) for x in model.noise_std),
-        predicted_return=num(evolved.champion_return),
+        predicted_return=num(predicted),
         test_returns=tuple(num(x) for x in returns),
         test_mean=num(returns.mean()),
         test_crashes=int(test.crashed.sum()),
-        policy_episodes=int(evolved.episodes),
+        policy_episodes=int(policy_episodes),
         timing=ModelTiming(learn_seconds=learn_seconds, evolve_seconds=evolve_seconds),
         **checks,
     ).to_dict()
@@ -289,7 +296,16 @@ def unit_agent(p: dict, device: str = "cpu"):
     )
     options = AgentOptions(
         evolution=ModelEvolution(
-            budget=q.model_budget, predict_episodes=q.predict_episodes, n_steps=q.n_steps, estimator=q.estimator, device=device, wind_model=q.wind_model
+            budget=q.model_budget,
+            predict_episodes=q.predict_episodes,
+            n_steps=q.n_steps,
+            estimator=q.estimator,
+            device=device,
+            wind_model=q.wind_model,
+            d_u=q.d_u,
+            noise=q.noise,
+            model_policy=q.model_policy,
+            authors_generations=q.authors_generations,
         ),
         settings=None if spec.settings is None else spec.settings.from_unit(p),  # the agent's own, typed (from its UNIT_KEY)
     )

@@ -46,7 +46,18 @@ Example
 
 from ..sim.constants import NOISE_NAMES, PARAM_NAMES
 from .ec import EC_MENO_MAX_EVALUATIONS, EC_MENO_SCALINGS, ec_meno_gene_scale, learn_ec_meno, learn_ec_mer, observed_return
-from .lr import DEFAULT_ESTIMATOR, DEFAULT_INTERCEPTS, ESTIMATORS, INTERCEPTS, learn_lr, lr_determined
+from .lr import (
+    D_U_CHOICES,
+    DEFAULT_D_U,
+    DEFAULT_ESTIMATOR,
+    DEFAULT_INTERCEPTS,
+    DEFAULT_NOISE_ESTIMATE,
+    ESTIMATORS,
+    INTERCEPTS,
+    NOISE_ESTIMATES,
+    learn_lr,
+    lr_determined,
+)
 from .model import (
     AXIS_C,
     AXIS_GAINS,
@@ -61,12 +72,16 @@ from .model import (
     one_substep_params,
     parameter_table,
 )
-from .transitions import MIN_TRANSITIONS, OneStepProblem, Transitions, noise_from_residuals, one_step_error
+from .transitions import MIN_TRANSITIONS, OneStepProblem, Transitions, authors_noise, noise_from_residuals, one_step_error
 from .wind import DEFAULT_WIND_MODEL, NO_WIND, WIND_MODELS, WindAxis, WindModel, effective_wind, fit_wind
 
 __all__ = [
+    "D_U_CHOICES",
+    "DEFAULT_D_U",
     "DEFAULT_ESTIMATOR",
     "DEFAULT_INTERCEPTS",
+    "DEFAULT_NOISE_ESTIMATE",
+    "NOISE_ESTIMATES",
     "DEFAULT_WIND_MODEL",
     "EC_MENO_SCALINGS",
     "ESTIMATORS",
@@ -104,4 +119,5 @@ __all__ = [
     "Transitions",
     "check_vector",
     "noise_from_residuals",
+    "authors_noise",
 ]

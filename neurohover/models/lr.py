@@ -65,15 +65,34 @@ from ..errors import NeurohoverError
 from ..flightdata import FlightData
 from ..sim.constants import NOISE_DECAY, NOISE_NAMES, PARAM_NAMES
 from .model import LearnedModel, one_substep_params
-from .transitions import MIN_TRANSITIONS, Transitions, noise_from_residuals
+from .transitions import MIN_TRANSITIONS, Transitions, authors_noise, noise_from_residuals
 from .wind import DEFAULT_WIND_MODEL, MIN_WIND_STEPS, NO_WIND, WIND_MODELS, body_wind, fit_wind
 
-__all__ = ["DEFAULT_ESTIMATOR", "DEFAULT_INTERCEPTS", "ESTIMATORS", "INTERCEPTS", "learn_lr", "lr_determined"]
+__all__ = [
+    "DEFAULT_D_U",
+    "DEFAULT_ESTIMATOR",
+    "DEFAULT_INTERCEPTS",
+    "DEFAULT_NOISE_ESTIMATE",
+    "D_U_CHOICES",
+    "ESTIMATORS",
+    "INTERCEPTS",
+    "NOISE_ESTIMATES",
+    "learn_lr",
+    "lr_determined",
+]
 
 INTERCEPTS = ("v", "uv", "all", "none")
 DEFAULT_INTERCEPTS = "uv"
 ESTIMATORS = ("ols", "gls")
 DEFAULT_ESTIMATOR = "ols"
+#: What becomes of the fitted u constant under ``intercepts="uv"``: kept as the model's D_u (ours) or
+#: fitted and thrown away, as the authors' ``estimate_params`` did (``"discard"``).
+D_U_CHOICES = ("keep", "discard")
+DEFAULT_D_U = "keep"
+#: How the gust-noise std comes from the one-step residuals: ``rms(r_k - 0.8 r_{k-1}) / 0.4`` (ours), or
+#: the authors' ``estimate_std``: the rms one-step error of the world velocities and the rates over 0.05.
+NOISE_ESTIMATES = ("innovations", "rms")
+DEFAULT_NOISE_ESTIMATE = "innovations"
 
 
 def _intercept(axis: int, intercepts: str) -> bool:
@@ -96,7 +115,13 @@ def lr_determined(flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS,
 
 
 def learn_lr(
-    flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS, *, estimator: str = DEFAULT_ESTIMATOR, wind_model: str = DEFAULT_WIND_MODEL
+    flight_data: FlightData,
+    intercepts: str = DEFAULT_INTERCEPTS,
+    *,
+    estimator: str = DEFAULT_ESTIMATOR,
+    wind_model: str = DEFAULT_WIND_MODEL,
+    d_u: str = DEFAULT_D_U,
+    noise: str = DEFAULT_NOISE_ESTIMATE,
 ) -> LearnedModel:
     """Learn a model by least squares (docs/model.md, Learned models, "LR"; module docstring for every detail).
 
@@ -119,6 +144,17 @@ def learn_lr(
         horizontal axis, constant or sinusoidal (:func:`neurohover.models.wind.fit_wind`); the u
         and v axes then keep the default helicopter's C_u, C_v and D_v and have no D_u, whatever
         ``intercepts`` says for them (the other axes are fitted as without a wind).
+    d_u : {"keep", "discard"}
+        With ``intercepts="uv"``: ``"keep"`` (default) the u constant as the model's D_u;
+        ``"discard"`` fits it (so C_u is the slope of a fit with a constant) and throws it away, as
+        the authors' code did (``stats["discarded_intercepts"]["u"]``; D_u = 0, and the residuals and
+        noise are those of the model without it). The other intercepts have no D_u to keep.
+    noise : {"innovations", "rms"}
+        The gust-noise estimate: ``"innovations"`` (default) ``rms(r_k - 0.8 r_{k-1}) / 0.4`` of the
+        one-step acceleration residuals r; ``"rms"`` the authors' ``estimate_std``: the rms one-step
+        error of the predicted world velocities and rates over 0.05, i.e. ``2 rms(R_k r_k)`` on the
+        velocity axes (world frame) and ``2 rms(r_k)`` on the rates. Both are kept in ``stats``
+        (``noise_std_innovations``, ``noise_std_rms``).
 
     Returns
     -------
@@ -133,6 +169,10 @@ def learn_lr(
         raise NeurohoverError(f"estimator={estimator!r} is not allowed: choose one of {', '.join(ESTIMATORS)}")
     if wind_model not in WIND_MODELS:
         raise NeurohoverError(f"wind_model={wind_model!r} is not allowed: choose one of {', '.join(WIND_MODELS)}")
+    if d_u not in D_U_CHOICES:
+        raise NeurohoverError(f"d_u={d_u!r} is not allowed: choose one of {', '.join(D_U_CHOICES)}")
+    if noise not in NOISE_ESTIMATES:
+        raise NeurohoverError(f"noise={noise!r} is not allowed: choose one of {', '.join(NOISE_ESTIMATES)}")
     tr = Transitions(flight_data)
     y = tr.targets()
     params = np.zeros(11)
@@ -159,21 +199,24 @@ def learn_lr(
                 se[i] = math.sqrt(max(cov[col, col], 0.0))
             else:
                 discarded[NOISE_NAMES[axis]] = float(theta[col])
-    d_u = discarded.pop("u", 0.0) if intercepts == "uv" else 0.0  # "uv" keeps the u constant as D_u
+    keep_d_u = intercepts == "uv" and d_u == "keep"
+    d_u_value = discarded.pop("u", 0.0) if keep_d_u else 0.0  # "uv" keeps the u constant as D_u unless told to discard it
     wind, wind_stats = NO_WIND, dict[str, float]()
     if wind_model != "none":
         blind = tr.model_residuals(params)[0]
-        blind[:, 0] -= d_u
+        blind[:, 0] -= d_u_value
         held = one_substep_params()[0]  # the default helicopter's C_u, C_v, D_v in the model's integration
         wind, params[0], params[1], wind_stats = fit_wind(tr, wind_model, float(held[0]), float(held[1]), float(held[2]))
-        params[2], d_u = held[2], 0.0
+        params[2], d_u_value = held[2], 0.0
         discarded.pop("u", None)
         wind_stats["uv_residual_rms_wind_blind"] = float(np.sqrt(np.mean(blind[:, :2] ** 2)))
     residuals = tr.model_residuals(params)[0]
-    residuals[:, 0] -= d_u
+    residuals[:, 0] -= d_u_value
     if wind_model != "none":
         residuals[:, 0:2] -= np.array([params[0], params[1]]) * body_wind(tr, wind)
-    noise, stationary = noise_from_residuals(tr, residuals)
+    innovation_std, stationary = noise_from_residuals(tr, residuals)
+    rms_std = authors_noise(tr, residuals)
+    noise_std = innovation_std if noise == "innovations" else rms_std
     seconds = time.perf_counter() - start
     stats = {
         "estimator": estimator,
@@ -184,7 +227,11 @@ def learn_lr(
         "discarded_intercepts": discarded,
         "residual_rms": np.sqrt(np.mean(residuals**2, axis=0)).tolist(),
         "noise_std_stationary": stationary.tolist(),
+        "noise_std_innovations": innovation_std.tolist(),
+        "noise_std_rms": rms_std.tolist(),
+        "noise": noise,
+        "d_u": d_u,
         "wind_model": wind_model,
         **wind_stats,
     }
-    return LearnedModel(tuple(params), tuple(noise), "lr", seconds, stats, d_u, wind)
+    return LearnedModel(tuple(params), tuple(noise_std), "lr", seconds, stats, d_u_value, wind)

@@ -1,0 +1,144 @@
+"""The authors' generational EA (their ``eonn`` package) as their GHH-09 agents ran it on a learned model.
+
+Their ``functions.evolve`` (afcarl/ATAA, ``helicopter/``) on a learned model, which both their
+GHH-09 model-based agent and their hybrid agent call with ``epochs=500``, from their ``baseline.net``
+(an SLP with the baseline's gains):
+
+==========================  ===============================================================
+their code                   here
+==========================  ===============================================================
+initial pool                 50 copies of the prototype, all but the first mutated with
+                             frac 0.5, std 0.5 (``spawn``)
+an episode's fitness         ``1 / ln(error)``, ``error = -return`` (``Evaluator.call``)
+a genome's fitness           the mean over every episode it has flown (``Organism.fitness``);
+                             every generation every genome flies one more episode, the kept
+                             ones included (``optimize`` -> ``evaluate(pool)``)
+a generation                 the 49 fittest are kept (``keep = 49``); one child of two
+                             tournament winners (5 drawn from the whole pool, the fittest
+                             wins), crossover then, with probability 0.75, mutation
+                             (frac 0.1, std 0.8, replacement 0.25)
+result                       after 500 generations, the genome of the highest mean fitness
+==========================  ===============================================================
+
+Every episode has its own noise stream: episode ``g * pop_size + i`` of ``seed`` is the one the
+i-th genome of generation ``g`` flies (as in their code, where every call drew fresh gusts).
+Their crossover (eonn's ``Genome.crossover``) is not in the published files; the paper's
+operator (:func:`~neurohover.evolution.operators.crossover`, averaging with probability 0.5) stands
+in for it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import NeurohoverError
+from ..evaluate import PolicyTable, evaluate_jobs
+from ..policies import Policy
+from ..sim.constants import EPISODE_STEPS
+from ..tasks import MDP
+from .fitness import episode_fitness
+from .operators import crossover, mutate
+
+__all__ = ["EonnResult", "EonnSettings", "eonn_evolve"]
+
+
+@dataclass(frozen=True)
+class EonnSettings:
+    """The authors' ``functions.evolve`` settings (defaults: as their GHH-09 agents called it)."""
+
+    pop_size: int = 50
+    keep: int = 49
+    generations: int = 500
+    tournament_size: int = 5
+    mutate_prob: float = 0.75
+    mutate_frac: float = 0.1
+    mutate_std: float = 0.8
+    mutate_repl: float = 0.25
+    averaging_prob: float = 0.5
+    spawn_frac: float = 0.5
+    spawn_std: float = 0.5
+
+    def __post_init__(self) -> None:
+        for name, low in (("pop_size", 2), ("keep", 0), ("generations", 1), ("tournament_size", 1)):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int) or v < low:
+                raise NeurohoverError(f"{name}={v!r} is out of range: allowed an integer >= {low}")
+        if self.keep >= self.pop_size:
+            raise NeurohoverError(f"keep={self.keep} is out of range: allowed 0..pop_size - 1 = {self.pop_size - 1} (at least one offspring a generation)")
+        if self.tournament_size > self.pop_size:
+            raise NeurohoverError(f"tournament_size={self.tournament_size} is out of range: allowed 1..pop_size = {self.pop_size}")
+        for name in ("mutate_prob", "mutate_frac", "mutate_repl", "averaging_prob", "spawn_frac"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0.0 <= v <= 1.0:
+                raise NeurohoverError(f"{name}={v!r} is out of range: allowed a probability in [0, 1]")
+        for name in ("mutate_std", "spawn_std"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not (np.isfinite(v) and v >= 0.0):
+                raise NeurohoverError(f"{name}={v!r} is out of range: allowed a finite number >= 0")
+
+
+@dataclass(frozen=True)
+class EonnResult:
+    """The champion (highest mean fitness at the end), its mean ``1/ln(error)``, and episodes flown."""
+
+    champion: Policy
+    fitness: float
+    episodes: int
+
+
+class _Variation:
+    """Mutation settings in the shape the operators read."""
+
+    def __init__(self, frac: float, std: float, repl: float, averaging: float) -> None:
+        self.mutate_frac, self.mutate_std, self.mutate_repl, self.averaging_prob = frac, std, repl, averaging
+
+
+def _child(pool: np.ndarray, fitness: np.ndarray, rng: np.random.Generator, s: EonnSettings, variation: _Variation) -> np.ndarray:
+    """One offspring: crossover of two tournament winners, then mutation with probability ``mutate_prob``."""
+    mom, dad = (max(rng.choice(len(pool), s.tournament_size, replace=False), key=lambda i: fitness[i]) for _ in range(2))
+    child = crossover(pool[mom], pool[dad], rng, variation)
+    return mutate(child, rng, variation) if rng.random() < s.mutate_prob else child
+
+
+def eonn_evolve(
+    mdp: MDP,
+    prototype: Policy,
+    *,
+    settings: EonnSettings = EonnSettings(),
+    seed: int = 0,
+    n_steps: int = EPISODE_STEPS,
+    threads: int | None = 1,
+    device: str = "cpu",
+) -> EonnResult:
+    """Evolve a policy of ``prototype``'s topology on ``mdp`` as the authors' ``eonn`` did (module docstring)."""
+    s = settings
+    rng = np.random.default_rng(seed)
+    spawn = _Variation(s.spawn_frac, s.spawn_std, s.mutate_repl, s.averaging_prob)
+    variation = _Variation(s.mutate_frac, s.mutate_std, s.mutate_repl, s.averaging_prob)
+    start = np.asarray(prototype.genome, dtype=np.float64)
+    pool = np.stack([start] + [mutate(start, rng, spawn) for _ in range(s.pop_size - 1)])
+    sums = np.zeros(s.pop_size)
+    counts = np.zeros(s.pop_size)
+    rows = np.array([mdp.row()])
+    zeros = np.zeros(s.pop_size, dtype=np.int64)
+    episodes = 0
+    for gen in range(s.generations + 1):
+        if gen:
+            fitness = sums / counts
+            children = [_child(pool, fitness, rng, s, variation) for _ in range(s.pop_size - s.keep)]
+            kept = np.argsort(-fitness, kind="stable")[: s.keep]
+            pool = np.concatenate([np.stack(children), pool[kept]])  # eonn's Pool(offspring + elite)
+            sums = np.concatenate([np.zeros(len(children)), sums[kept]])
+            counts = np.concatenate([np.zeros(len(children)), counts[kept]])
+        table = PolicyTable.from_policies([Policy(prototype.topology, g) for g in pool])
+        ev = evaluate_jobs(
+            table, rows, np.arange(s.pop_size), zeros, gen * s.pop_size + np.arange(s.pop_size), seed=seed, n_steps=n_steps, threads=threads, device=device
+        )
+        sums += episode_fitness(ev.returns, "inv-log-error")
+        counts += 1
+        episodes += s.pop_size
+    fitness = sums / counts
+    best = int(np.argmax(fitness))
+    return EonnResult(Policy(prototype.topology, pool[best], {"method": "eonn", "generations": s.generations}), float(fitness[best]), episodes)

@@ -1,0 +1,195 @@
+"""The report's sections of the LR-fit factorials (``lr-authors-table4``, ``lr-authors-fig8``; docs/model.md).
+
+Three choices where our LR and the policies evolved on it differ from the authors' code, each a
+factor with our level and theirs (:data:`FACTORS`). A factor's **main effect** pairs every cell
+with the cell that differs from it in that factor alone, on the same MDP (Table 4) or run
+(Figure 8's seeds), so each factor is measured over the other two factors' four combinations:
+the median paired difference (the authors' level minus ours; returns, so positive is better with
+theirs), how often theirs is better, and a two-sided Wilcoxon signed-rank test on the differences.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+
+import numpy as np
+from scipy import stats
+
+from .report_base import Section, fmt, fmt_p, log_errors, new_figure, table
+from .results import ModelResult, TestRunResult
+
+#: (setting, our level, the authors' level, what it is)
+FACTORS = (
+    ("d_u", "keep", "discard", "the u constant D_u"),
+    ("noise", "innovations", "rms", "the noise estimate"),
+    ("model_policy", "ours", "authors", "the policy evolved on the model"),
+)
+OURS = {name: ours for name, ours, _, _ in FACTORS}
+
+
+def levels(obj) -> dict[str, str]:
+    """A fit's or group's level of each factor."""
+    return {name: getattr(obj, name) for name, *_ in FACTORS}
+
+
+def varies(objs) -> bool:
+    """Whether any of these fits or groups takes one of the authors' choices."""
+    return any(levels(o) != OURS for o in objs)
+
+
+def main_effects(cells: Mapping[str, dict[str, str]], values: Mapping[str, Mapping[str, float]]) -> list[dict]:
+    """Each factor's paired effect.
+
+    Parameters
+    ----------
+    cells : mapping
+        Cell label -> its levels (:func:`levels`).
+    values : mapping
+        Cell label -> {pairing key (MDP, run) -> value (higher is better)}.
+
+    Returns
+    -------
+    list of dict
+        Per factor: ``factor``, ``pairs``, ``median`` (theirs - ours), ``better`` (pairs where
+        theirs is higher), ``p`` (Wilcoxon signed-rank, None without a nonzero difference).
+    """
+    out = []
+    by_levels = {tuple(sorted(lv.items())): label for label, lv in cells.items()}
+    for name, ours, theirs, what in FACTORS:
+        diffs = []
+        for label, lv in cells.items():
+            if lv[name] != theirs:
+                continue
+            partner = by_levels.get(tuple(sorted({**lv, name: ours}.items())))
+            if partner is None:
+                continue
+            a, b = values.get(label, {}), values.get(partner, {})
+            diffs += [a[k] - b[k] for k in a if k in b]
+        d = np.array(diffs, dtype=float)
+        p = float(stats.wilcoxon(d).pvalue) if d.size and np.any(d != 0) else None
+        out.append(
+            {
+                "factor": f"{what} ({name}: {ours} -> {theirs})",
+                "pairs": int(d.size),
+                "median": float(np.median(d)) if d.size else float("nan"),
+                "better": int(np.sum(d > 0)),
+                "p": p,
+            }
+        )
+    return out
+
+
+def effects_table(effects: list[dict], what: str) -> str:
+    rows = [[e["factor"], str(e["pairs"]), fmt(e["median"]), f"{e['better']} of {e['pairs']}", fmt_p(e["p"]) if e["p"] is not None else "n/a"] for e in effects]
+    return table(["factor", "pairs", f"median paired difference of {what} (theirs - ours)", "theirs better", "Wilcoxon p"], rows)
+
+
+def effect_lines(effects: list[dict], what: str) -> list[str]:
+    """One comparison line per factor: direction and significance."""
+    lines = []
+    for e in effects:
+        if e["p"] is None:
+            lines.append(f"{e['factor']}: no effect on {what} in {e['pairs']} pairs.")
+            continue
+        direction = "better" if e["median"] > 0 else "worse" if e["median"] < 0 else "no different (median)"
+        sig = "significant" if e["p"] < 0.05 else "not significant"
+        lines.append(
+            f"{e['factor']}: {what} {direction} with the authors' choice, "
+            f"median paired difference {fmt(e['median'])}, Wilcoxon p = {fmt_p(e['p'])} ({sig} at 5%)."
+        )
+    return lines
+
+
+class FitFactorial(Section):
+    """A model-learning experiment with ``fits``: each fit's Table 4 row and each factor's main effect."""
+
+    def _units(self) -> dict[str, list[ModelResult]]:
+        return {f.label: [u for m in self.s.methods for u in self.group("model", f"{m}@{f.key}")] for f in self.s.fits}
+
+    def figure(self) -> str | None:
+        data = {k: v for k, v in self._units().items() if v}
+        if not data:
+            return None
+        fig, axes = new_figure(figsize=(9, 4.2))
+        ax = axes[0, 0]
+        ax.boxplot([log_errors([float(u.test_mean) for u in v]) for v in data.values()])
+        ax.set_xticks(range(1, len(data) + 1), list(data), rotation=30, ha="right")
+        ax.set_yscale("log")
+        ax.set_ylabel("error of the evolved policy in the true MDP (log)")
+        ref = self.paper.get("table", {}).get("lr", {})
+        if "r_m" in ref:
+            ax.axhline(-ref["r_m"], color="k", ls="--", lw=1, label=f"paper's LR median ({-ref['r_m']:g})")
+            ax.legend(fontsize=8, loc="upper left")
+        ax.set_title(f"{self.cfg.title} ({self.cfg.scale} scale)", fontsize=10)
+        ax.grid(alpha=0.3, which="both")
+        return self.save(fig)
+
+    def body(self) -> str:
+        units = self._units()
+        ref = self.paper.get("table", {}).get("lr", {})
+        rows, cells, values = [], {}, {}
+        for f in self.s.fits:
+            us = units[f.label]
+            if not us:
+                continue
+            r = np.array([float(u.test_mean) for u in us])
+            predicted = np.array([float(u.predicted_return) for u in us])
+            crashes = sum(u.test_crashes for u in us)
+            episodes = sum(len(u.test_returns) for u in us)
+            cells[f.label], values[f.label] = levels(f), {u.mdp: float(u.test_mean) for u in us}
+            rows.append(
+                [
+                    f.label,
+                    f.d_u,
+                    f.noise,
+                    f.model_policy,
+                    str(len(us)),
+                    fmt(np.median(r)),
+                    fmt(r.mean()),
+                    f"{crashes} of {episodes}",
+                    str(sum(1 for u in us if u.test_crashes)),
+                    fmt(np.median(predicted)),
+                ]
+            )
+            if ref and f.label in ("ours", "authors"):
+                ratio = np.median(r) / ref["r_m"]
+                within = "within" if 0.5 <= ratio <= 2 else "not within"
+                self.comparisons.append(
+                    f"LR, fit {f.label!r}: our median {fmt(np.median(r))} vs the paper's {fmt(ref['r_m'])} ({ratio:.2g} times, {within} a factor of two); "
+                    f"our mean {fmt(r.mean())} vs {fmt(ref['r_a'])}."
+                )
+        effects = main_effects(cells, values)
+        self.comparisons += effect_lines(effects, "the evolved policy's return in the true MDP")
+        return (
+            "### Each fit\n\n"
+            + table(["fit", "D_u", "noise", "model policy", "MDPs", "r_m", "r_a", "crashed episodes", "MDPs with a crash", "median predicted return"], rows)
+            + f"\n\nr_m, r_a: median and mean over MDPs of the evolved policy's mean return over {self.s.test_episodes} episodes in the true MDP"
+            + (f" (the paper's LR: {fmt(ref['r_m'])} and {fmt(ref['r_a'])})" if ref else "")
+            + "; predicted: the policy's return on its model.\n\n### Main effects (paired by MDP)\n\n"
+            + effects_table(effects, "the mean return per MDP")
+            + "\n"
+        )
+
+
+def test_run_effects(groups, runs: Callable[[str], Mapping[str, TestRunResult]]) -> tuple[str, list[str]]:
+    """Per agent of a test-runs experiment whose groups vary the LR fit: each factor's main effect on the
+    runs' cumulative reward, paired by run (``runs(label)``: the group's runs by MDP and repetition; the
+    groups of an agent fly the same seeds); Markdown and comparison lines."""
+    from ..agents.registry import AGENTS
+
+    by_agent: dict[str, list] = {}
+    for g in groups:
+        if AGENTS[g.agent].learns_models:
+            by_agent.setdefault(g.agent, []).append(g)
+    text, lines = [], []
+    for agent, gs in by_agent.items():
+        if not varies(gs):
+            continue
+        cells = {g.label: levels(g) for g in gs}
+        values = {g.label: {k: float(r.score) for k, r in runs(g.label).items()} for g in gs}
+        effects = main_effects(cells, values)
+        text.append(f"#### {agent}\n\n" + effects_table(effects, "the cumulative reward per run") + "\n")
+        lines += [f"{agent}: {line}" for line in effect_lines(effects, "the cumulative reward")]
+    if not text:
+        return "", []
+    return "### Main effects of the LR fit (paired by run)\n\n" + "\n".join(text), lines
