@@ -3,6 +3,8 @@ their evolution on the model (an SLP from the baseline by their ``eonn``), each 
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -197,6 +199,11 @@ def test_the_factorial_reports_every_fit_and_each_factors_effect(tmp_path) -> No
         for name in ("lr-authors-table4", "lr-authors-fig8"):
             cfg = load_config(name, "quick", {"n_steps": 60} if name.endswith("table4") else {"n_steps": 60, "episodes": 4})
             assert reproduce(cfg, store, LocalExecutor(1), progress=False).status == "finished"
+        # the authors' policy set "flown": Figure 8's model-free runs of this store, each 10 better
+        runs = [u for u in store.units("lr-authors-fig8", "quick") if u["params"]["group"] == "model-free"]
+        theirs = [{"key": u["key"], "mdp": "m", "score": u["result"]["score"] + 10, "crash_episodes": [], "returns": [1.0]} for u in runs]
+        (tmp_path / "report").mkdir()
+        (tmp_path / "report" / "authors-ghh09-policies.json").write_text(json.dumps({"fig8-quick": {"model-free": theirs}}))
         report = write_report(store, tmp_path / "report").read_text()
     table4 = report[report.index("## LR as the authors fitted it: Table 4") :]
     for fit in ("ours", "du", "noise", "policy", "du-noise", "du-policy", "noise-policy", "authors"):
@@ -205,3 +212,5 @@ def test_the_factorial_reports_every_fit_and_each_factors_effect(tmp_path) -> No
     assert "LR, fit 'authors': our median" in table4  # beside the paper's LR
     fig8 = report[report.index("## LR as the authors fitted it: Figure 8") : report.index("## LR as the authors fitted it: Table 4")]
     assert "#### incremental" in fig8 and "#### hybrid" in fig8 and "incremental: the u constant D_u" in fig8
+    assert "| model-free | the authors' | 2 |" in fig8
+    assert "model-free with the authors' published policies instead of ours: better (median paired difference of the cumulative reward 10 over 2 runs" in fig8

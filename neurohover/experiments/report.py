@@ -24,7 +24,7 @@ from ..errors import NeurohoverError
 from .config import ORDER, ExperimentConfig
 from .report_base import Section, fmt, log_errors, new_figure, sd, table
 from .report_evolution import EvolutionSection
-from .report_factorial import FitFactorial, test_run_effects, varies
+from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, varies
 from .report_models import SensorModels
 from .results import ModelResult, TestRunResult, result_from_dict
 from .settings import Group, ModelLearningSettings
@@ -247,6 +247,10 @@ class _TestRuns(Section):
         self.add_tests(samples, labels, "final cumulative reward")
         effects, lines = test_run_effects(self.groups(), self.paired_runs) if varies(self.groups()) else ("", [])
         self.comparisons += lines
+        if effects:  # the LR-fit factorial: beside the authors' policy set where it was flown
+            theirs, lines = authors_policy_section(authors_policy_runs(self.out, self.cfg.scale), self.paired_runs)
+            effects += theirs and f"\n{theirs}"
+            self.comparisons += lines
         return (
             self._matrix()
             + self._wins()

@@ -193,3 +193,57 @@ def test_run_effects(groups, runs: Callable[[str], Mapping[str, TestRunResult]])
     if not text:
         return "", []
     return "### Main effects of the LR fit (paired by run)\n\n" + "\n".join(text), lines
+
+
+def authors_policy_runs(out, scale: str) -> dict[str, dict[str, dict]]:
+    """The authors' published GHH-09 policies flown through Figure 8's protocol, if measured
+    (``authors-ghh09-policies.json`` beside the report, written by docs/reproduction/authors_ghh09_policies.py):
+    group label -> {MDP/repetition -> run}."""
+    import json
+    from pathlib import Path
+
+    path = Path(out) / "authors-ghh09-policies.json"
+    if not path.is_file():
+        return {}
+    groups = json.loads(path.read_text()).get(f"fig8-{scale}", {})
+    return {g: {"/".join(r["key"].split("/")[-2:]): r for r in runs} for g, runs in groups.items()}
+
+
+def authors_policy_section(theirs: Mapping[str, Mapping[str, dict]], ours: Callable[[str], Mapping[str, TestRunResult]]) -> tuple[str, list[str]]:
+    """Each group flown with the authors' policy set beside the same group with ours, paired by run; Markdown and comparison lines."""
+    rows, lines = [], []
+    for label, runs in theirs.items():
+        mine = ours(label)
+        for name, scores, crashed, per_episode in (
+            ("the authors'", [r["score"] for r in runs.values()], [bool(r["crash_episodes"]) for r in runs.values()], _clean_mean(runs.values())),
+            (
+                "ours",
+                [float(r.score) for r in mine.values()],
+                [bool(r.crash_episodes) for r in mine.values()],
+                _clean_mean({"returns": [float(x) for x in r.returns], "crash_episodes": r.crash_episodes} for r in mine.values()),
+            ),
+        ):
+            if scores:
+                rows.append([label, name, str(len(scores)), fmt(np.mean(scores)), f"{sum(crashed)} ({np.mean(crashed):.1%})", fmt(per_episode)])
+        d = np.array([runs[k]["score"] - float(mine[k].score) for k in runs if k in mine])
+        if d.size and np.any(d != 0):
+            p = float(stats.wilcoxon(d).pvalue)
+            direction = "better" if np.median(d) > 0 else "worse"
+            lines.append(
+                f"{label} with the authors' published policies instead of ours: {direction} (median paired difference of the cumulative reward "
+                f"{fmt(float(np.median(d)))} over {d.size} runs, Wilcoxon p = {fmt_p(p)}, {'significant' if p < 0.05 else 'not significant'} at 5%)."
+            )
+    if not rows:
+        return "", []
+    return (
+        "### The authors' published GHH-09 policies\n\n"
+        + table(["group", "policy set", "runs", "mean cumulative reward", "runs with a crash", "return/episode (runs without crash)"], rows)
+        + "\n\nThe same runs (MDPs, seeds and gusts) with the authors' generic and specialised policies (their hybrid's safe pair 3 and 6), "
+        "flown by docs/reproduction/authors_ghh09_policies.py.\n"
+    ), lines
+
+
+def _clean_mean(runs) -> float:
+    """Mean return per episode over the runs without a crash (NaN when every run crashed)."""
+    flat = [x for r in runs if not r["crash_episodes"] for x in r["returns"]]
+    return float(np.mean(flat)) if flat else float("nan")
