@@ -172,6 +172,28 @@ def test_bad_lr_fit_configs_are_refused() -> None:
         make_config("y", "model_learning", "quick", {**ml, "methods": ["lr"], "fits": [{"key": "a", "model_policy": "mine"}]})
 
 
+def test_the_agents_hand_their_lr_fit_to_the_model(monkeypatch) -> None:
+    """ModelEvolution's d_u and noise reach learn_lr through every agent that learns a model."""
+    import neurohover.agents.model_based as mb
+    from neurohover.agents.model_based import IncrementalModelBasedAgent, ModelBasedAgent
+    from neurohover.agents.protocol import EpisodeOutcome
+
+    ev = evaluate(baseline_policy(), get_task_family("ghh08").training_mdps()[0], seed=SEED, record=True, n_steps=200)
+    seen = []
+
+    def spy(flight_data, estimator="ols", wind_model="none", *, d_u="keep", noise="innovations"):
+        seen.append((d_u, noise))
+        raise RuntimeError("stop before evolving")
+
+    monkeypatch.setattr(mb, "learn_model", spy)
+    for cls in (ModelBasedAgent, IncrementalModelBasedAgent):
+        agent = cls(baseline_policy(), ModelEvolution(d_u="discard", noise="rms"))
+        agent.start(get_task_family("ghh08"), np.random.default_rng(0))
+        with pytest.raises(RuntimeError, match="stop before evolving"):
+            agent.update(EpisodeOutcome(0, float(ev.returns.ravel()[0]), False, 200, -1, ev.flight_data))
+    assert seen == [("discard", "rms")] * 2
+
+
 def test_main_effects_pair_cells_that_differ_in_one_factor() -> None:
     """A known answer: discarding D_u adds 1 to every MDP's return, the other two factors nothing."""
     from itertools import product
@@ -205,12 +227,13 @@ def test_the_factorial_reports_every_fit_and_each_factors_effect(tmp_path) -> No
         (tmp_path / "report").mkdir()
         (tmp_path / "report" / "authors-ghh09-policies.json").write_text(json.dumps({"fig8-quick": {"model-free": theirs}}))
         report = write_report(store, tmp_path / "report").read_text()
-    table4 = report[report.index("## LR as the authors fitted it: Table 4") :]
+    sections = {part.split("\n", 1)[0]: part for part in report.split("\n## ")}
+    table4 = sections["LR as the authors fitted it: Table 4's protocol on GHH-08 [quick]"]
     for fit in ("ours", "du", "noise", "policy", "du-noise", "du-policy", "noise-policy", "authors"):
         assert f"\n| {fit} |" in table4
     assert "the policy evolved on the model (model_policy: ours -> authors)" in table4
     assert "LR, fit 'authors': our median" in table4  # beside the paper's LR
-    fig8 = report[report.index("## LR as the authors fitted it: Figure 8") : report.index("## LR as the authors fitted it: Table 4")]
+    fig8 = sections["LR as the authors fitted it: Figure 8's protocol on GHH-09 [quick]"]
     assert "#### incremental" in fig8 and "#### hybrid" in fig8 and "incremental: the u constant D_u" in fig8
     assert "| model-free | the authors' | 2 |" in fig8
     assert "model-free with the authors' published policies instead of ours: better (median paired difference of the cumulative reward 10 over 2 runs" in fig8
