@@ -564,11 +564,26 @@ def test_a_significant_difference_in_the_opposite_direction_does_not_agree_with_
     # The paper found hybrid better than model-free (p = 1.4e-14) and incremental better (p = 5.8e-12).
     sec.add_tests({"hybrid": worse, "model-free": better, "incremental": list(rng.normal(-300, 5, 20))}, {}, "final cumulative reward")
     by_pair = {c.split(" (")[0]: c for c in sec.comparisons}
-    assert by_pair["hybrid vs model-free"].endswith("disagrees: the opposite direction (the paper found hybrid better).")
-    assert by_pair["incremental vs model-free"].endswith("disagrees: the opposite direction (the paper found incremental better).")
+    assert by_pair["hybrid vs model-free"].endswith(": reversed (the paper found hybrid better; ours is worse).")
+    assert by_pair["incremental vs model-free"].endswith(": reversed (the paper found incremental better; ours is worse).")
     sec.comparisons.clear()
     sec.add_tests({"hybrid": better, "model-free": worse}, {}, "final cumulative reward")
-    assert sec.comparisons[0].endswith(": agrees.")
+    assert sec.comparisons[0].endswith(": holds.")
+
+
+def test_a_verdict_weighs_direction_before_significance() -> None:
+    """Figure 11's case: both p-values above 5 % but the effect reversed is not agreement; Figure 2's:
+    p = 0.03 in the paper's direction against its p < 0.0026 is weaker, not a hold."""
+    from neurohover.experiments.report_base import verdict
+
+    assert verdict("hybrid", -2.0, -1.0, 0.4, "0.2") == "reversed, not significant (the paper found hybrid better; ours is worse)"
+    assert verdict("hybrid", -1.0, -2.0, 0.4, "0.2") == "holds (same direction, neither significant)"
+    assert verdict("mlp", -1.0, -2.0, 0.03, "< 0.0026") == "same direction, weaker (p >= 0.01 here)"
+    assert verdict("mlp", -1.0, -2.0, 0.001, "< 0.0026") == "holds"
+    assert verdict("mlp", -1.0, -2.0, 0.2, "1e-5") == "same direction, not significant"
+    assert verdict("mlp", -1.0, -2.0, 0.01, "0.3") == "same direction, significant here but not in the paper"
+    assert verdict("mlp", -2.0, -1.0, 1e-9, "1e-5") == "reversed (the paper found mlp better; ours is worse)"
+    assert verdict("mlp", -1.0, -2.0, 0.01, "none (not in the paper)") is None
 
 
 def test_an_interrupt_ends_the_running_worker_processes_at_once() -> None:

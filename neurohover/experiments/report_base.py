@@ -80,11 +80,35 @@ def p_significant(p_paper: str) -> bool | None:
     text = p_paper.strip().lower()
     if text.startswith("not"):
         return False
+    value = p_value(p_paper)
+    return None if value is None else value < 0.05
+
+
+def p_value(p_paper: str) -> float | None:
+    """The number of a paper's p-value text ("5.8e-12", "< 0.0026"); None when it gives none."""
     try:
-        value = float(text.lstrip("<= ").strip())
-    except ValueError:
+        return float(p_paper.strip().lower().lstrip("<= ").split()[0])
+    except (ValueError, IndexError):
         return None
-    return value < 0.05
+
+
+def verdict(a: str, ma: float, mb: float, p_ours: float, p_paper: str) -> str | None:
+    """How our test of ``a`` against ``b`` (means ``ma``, ``mb``; Student's ``p_ours``) stands to the
+    paper's (``p_paper``, whose ``a`` is the one the paper found better), by direction first, then
+    significance: "holds", "same direction, weaker", "same direction, not significant", "reversed",
+    ... (None: the paper gives no p-value to compare with). A reversed effect never holds."""
+    expected = p_significant(p_paper)
+    if expected is None:
+        return None
+    significant = p_ours < 0.05
+    if ma <= mb:
+        return f"reversed{'' if significant else ', not significant'} (the paper found {a} better; ours is worse)"
+    if expected and significant:
+        paper = p_value(p_paper)
+        return "same direction, weaker (p >= 0.01 here)" if paper is not None and paper < 0.01 and p_ours >= 0.01 else "holds"
+    if expected:
+        return "same direction, not significant"
+    return "holds (same direction, neither significant)" if not significant else "same direction, significant here but not in the paper"
 
 
 # --------------------------------------------------------------------------------- sections
@@ -134,17 +158,12 @@ class Section:
             stat, p_student, p_welch = ttest(samples[a], samples[b])
             ma, mb = np.mean(samples[a]), np.mean(samples[b])
             self.tests.append([f"{labels.get(a, a)} vs {labels.get(b, b)}", fmt(ma), fmt(mb), fmt(stat), fmt_p(p_student), fmt_p(p_welch), str(t["p"])])
-            expected = p_significant(str(t["p"]))
-            if p_student is not None and expected is not None:
-                # Each paper test names the approach the paper found better as ``a``.
-                ours = p_student < 0.05
-                if ours and expected and ma < mb:
-                    agree = f"disagrees: the opposite direction (the paper found {labels.get(a, a)} better)"
-                else:
-                    agree = "agrees" if ours == expected else "disagrees"
+            # Each paper test names the approach the paper found better as ``a``.
+            judged = None if p_student is None else verdict(labels.get(a, a), float(ma), float(mb), p_student, str(t["p"]))
+            if p_student is not None and judged is not None:
                 self.comparisons.append(
                     f"{labels.get(a, a)} vs {labels.get(b, b)} ({what}): our Student's p = {fmt_p(p_student)} "
-                    f"({'significant' if ours else 'not significant'} at 5%; mean {fmt(ma)} vs {fmt(mb)}) vs paper p {t['p']}: {agree}."
+                    f"({'significant' if p_student < 0.05 else 'not significant'} at 5%; mean {fmt(ma)} vs {fmt(mb)}) vs paper p {t['p']}: {judged}."
                 )
 
     def figure(self) -> str | None:
