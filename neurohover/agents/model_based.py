@@ -24,7 +24,7 @@ from .spec import FGHH_GENERIC_KINDS, AgentOptions, AgentPolicies, AgentSettings
 
 #: How a policy is evolved on a learned model: ``"ours"``, steady state from the generic policy with
 #: the model budget; ``"authors"``, the authors' GHH-09 agents: an SLP from the baseline by their
-#: ``eonn`` (:mod:`neurohover.evolution.eonn`, 50 genomes, 49 kept, ``authors_generations`` generations).
+#: ``eonn`` (:mod:`neurohover.evolution.eonn`, 50 genomes, 49 kept, one offspring in each of ``authors_generations`` generations).
 MODEL_POLICIES = ("ours", "authors")
 
 
@@ -42,8 +42,8 @@ class ModelEvolution:
     ``"discard"`` (the authors': the fitted u constant thrown away); ``noise`` ``"innovations"``
     (default) or ``"rms"`` (the authors' ``rms / 0.05``) (:func:`neurohover.models.learn_lr`);
     ``model_policy`` ``"ours"`` (default: steady state from the generic policy, ``budget`` episodes)
-    or ``"authors"`` (an SLP from the baseline by the authors' ``eonn``, ``authors_generations``
-    generations of 50 episodes; :data:`MODEL_POLICIES`).
+    or ``"authors"`` (an SLP from the baseline by the authors' ``eonn``: 50 genomes, then
+    ``authors_generations`` generations of one offspring each; :data:`MODEL_POLICIES`).
     """
 
     budget: int = 2000

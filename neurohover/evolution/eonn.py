@@ -1,30 +1,29 @@
 """The authors' generational EA (their ``eonn`` package) as their GHH-09 agents ran it on a learned model.
 
-Their ``functions.evolve`` (afcarl/ATAA, ``helicopter/``) on a learned model, which both their
-GHH-09 model-based agent and their hybrid agent call with ``epochs=500``, from their ``baseline.net``
-(an SLP with the baseline's gains):
+Their ``functions.evolve`` (afcarl/ATAA at 1be44a3, ``helicopter/functions.py``, with the ``eonn`` of
+``helicopter/site-packages``) on a learned model, which both their GHH-09 model-based agent and their
+hybrid agent call with ``epochs=500``, from their ``baseline.net`` (an SLP with the baseline's gains):
 
 ==========================  ===============================================================
 their code                   here
 ==========================  ===============================================================
 initial pool                 50 copies of the prototype, all but the first mutated with
-                             frac 0.5, std 0.5 (``spawn``)
+                             frac 0.5, std 0.5 (``spawn``), each flown one episode
 an episode's fitness         ``1 / ln(error)``, ``error = -return`` (``Evaluator.call``)
-a genome's fitness           the mean over every episode it has flown (``Organism.fitness``);
-                             every generation every genome flies one more episode, the kept
-                             ones included (``optimize`` -> ``evaluate(pool)``)
+a genome's fitness           its one episode's: ``evaluate(pool, feval, evals=1)`` flies only
+                             the genomes with no episode yet, so a kept genome keeps the
+                             estimate it was first given (``Organism.fitness``)
 a generation                 the 49 fittest are kept (``keep = 49``); one child of two
                              tournament winners (5 drawn from the whole pool, the fittest
                              wins), crossover then, with probability 0.75, mutation
-                             (frac 0.1, std 0.8, replacement 0.25)
-result                       after 500 generations, the genome of the highest mean fitness
+                             (frac 0.1, std 0.8, replacement 0.25), flown one episode
+result                       after 500 generations, the genome of the highest fitness:
+                             550 model episodes in all
 ==========================  ===============================================================
 
-Every episode has its own noise stream: episode ``g * pop_size + i`` of ``seed`` is the one the
-i-th genome of generation ``g`` flies (as in their code, where every call drew fresh gusts).
-Their crossover (eonn's ``Genome.crossover``) is not in the published files; the paper's
-operator (:func:`~neurohover.evolution.operators.crossover`, averaging with probability 0.5) stands
-in for it.
+Every episode has its own noise stream (the i-th episode flown is episode ``i`` of ``seed``), as in
+their code, where every call drew fresh gusts. The later ``eonn`` of their 2014 work (``eonn/`` at
+the repository's root) flies every kept genome again each generation; their helicopter code did not.
 """
 
 from __future__ import annotations
@@ -78,10 +77,15 @@ class EonnSettings:
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not (np.isfinite(v) and v >= 0.0):
                 raise NeurohoverError(f"{name}={v!r} is out of range: allowed a finite number >= 0")
 
+    @property
+    def episodes(self) -> int:
+        """Episodes a run flies: the first pool, then the offspring of every generation."""
+        return self.pop_size + self.generations * (self.pop_size - self.keep)
+
 
 @dataclass(frozen=True)
 class EonnResult:
-    """The champion (highest mean fitness at the end), its mean ``1/ln(error)``, and episodes flown."""
+    """The champion (highest fitness at the end), its ``1/ln(error)``, and the episodes flown."""
 
     champion: Policy
     fitness: float
@@ -119,26 +123,22 @@ def eonn_evolve(
     variation = _Variation(s.mutate_frac, s.mutate_std, s.mutate_repl, s.averaging_prob)
     start = np.asarray(prototype.genome, dtype=np.float64)
     pool = np.stack([start] + [mutate(start, rng, spawn) for _ in range(s.pop_size - 1)])
-    sums = np.zeros(s.pop_size)
-    counts = np.zeros(s.pop_size)
     rows = np.array([mdp.row()])
-    zeros = np.zeros(s.pop_size, dtype=np.int64)
+    fitness = np.empty(0)
     episodes = 0
     for gen in range(s.generations + 1):
         if gen:
-            fitness = sums / counts
             children = [_child(pool, fitness, rng, s, variation) for _ in range(s.pop_size - s.keep)]
             kept = np.argsort(-fitness, kind="stable")[: s.keep]
             pool = np.concatenate([np.stack(children), pool[kept]])  # eonn's Pool(offspring + elite)
-            sums = np.concatenate([np.zeros(len(children)), sums[kept]])
-            counts = np.concatenate([np.zeros(len(children)), counts[kept]])
-        table = PolicyTable.from_policies([Policy(prototype.topology, g) for g in pool])
+            fitness = fitness[kept]
+        new = pool[: s.pop_size - fitness.size]  # the genomes without an episode yet: the offspring (all of the first pool)
+        table = PolicyTable.from_policies([Policy(prototype.topology, g) for g in new])
+        n = len(new)
         ev = evaluate_jobs(
-            table, rows, np.arange(s.pop_size), zeros, gen * s.pop_size + np.arange(s.pop_size), seed=seed, n_steps=n_steps, threads=threads, device=device
+            table, rows, np.arange(n), np.zeros(n, dtype=np.int64), episodes + np.arange(n), seed=seed, n_steps=n_steps, threads=threads, device=device
         )
-        sums += episode_fitness(ev.returns, "inv-log-error")
-        counts += 1
-        episodes += s.pop_size
-    fitness = sums / counts
+        fitness = np.concatenate([episode_fitness(ev.returns, "inv-log-error"), fitness])
+        episodes += n
     best = int(np.argmax(fitness))
     return EonnResult(Policy(prototype.topology, pool[best], {"method": "eonn", "generations": s.generations}), float(fitness[best]), episodes)

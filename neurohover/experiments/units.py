@@ -227,7 +227,7 @@ def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
     if q.model_policy == "authors":  # their GHH-09 agents: an SLP from the baseline by their eonn
         authors = ModelEvolution(n_steps=q.n_steps, device=device, model_policy="authors", authors_generations=q.authors_generations)
         champion, predicted = evolve_on_model(model.mdp(), generic, authors, int(seeds[2]))
-        policy_episodes = (q.authors_generations + 1) * EonnSettings().pop_size
+        policy_episodes = EonnSettings(generations=q.authors_generations).episodes
     else:
         evolved = evolve(
             model.mdp(),
