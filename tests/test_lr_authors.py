@@ -222,7 +222,7 @@ def test_the_factorial_reports_every_fit_and_each_factors_effect(tmp_path) -> No
             assert reproduce(cfg, store, LocalExecutor(1), progress=False).status == "finished"
         # the authors' policy set "flown": Figure 8's model-free runs of this store, each 10 better
         runs = [u for u in store.units("lr-authors-fig8", "quick") if u["params"]["group"] == "model-free"]
-        theirs = [{"key": u["key"], "mdp": "m", "score": u["result"]["score"] + 10, "crash_episodes": [], "returns": [1.0]} for u in runs]
+        theirs = [{"key": u["key"], "mdp": "m", "score": u["result"]["score"] + 10, "crash_episodes": [], "episodes": 4} for u in runs]
         (tmp_path / "report").mkdir()
         (tmp_path / "report" / "authors-ghh09-policies.json").write_text(json.dumps({"fig8-quick": {"model-free": theirs}}))
         report = write_report(store, tmp_path / "report").read_text()

@@ -14,7 +14,7 @@ run, and of the same run of ``lr-authors-fig8``). The groups:
   so that, beside ``lr-authors-fig8``'s groups, the policy set is a factor of its own.
 
 Writes its scale's entry of ``authors-ghh09-policies.json`` (per group: every run's MDP, score, crash episodes and
-returns per episode), which ``neurohover report`` reads from the report's directory::
+number of episodes), which ``neurohover report`` reads from the report's directory::
 
     python3 docs/reproduction/authors_ghh09_policies.py AUTHORS/helicopter/ghh09/policies \\
         --out docs/reproduction/authors-ghh09-policies.json [--scale quick|paper] [--jobs 2]
@@ -99,7 +99,7 @@ def main() -> None:
                 "mdp": r.mdp,
                 "score": float(r.score),
                 "crash_episodes": list(r.crash_episodes),
-                "returns": [float(f"{x:.7g}") for x in r.returns],
+                "episodes": len(r.returns),
             }
         )
     out = json.loads(args.out.read_text()) if args.out.is_file() else {}

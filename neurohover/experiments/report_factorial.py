@@ -220,7 +220,7 @@ def authors_policy_section(theirs: Mapping[str, Mapping[str, dict]], ours: Calla
                 "ours",
                 [float(r.score) for r in mine.values()],
                 [bool(r.crash_episodes) for r in mine.values()],
-                _clean_mean({"returns": [float(x) for x in r.returns], "crash_episodes": r.crash_episodes} for r in mine.values()),
+                _clean_mean({"score": float(r.score), "episodes": len(r.returns), "crash_episodes": r.crash_episodes} for r in mine.values()),
             ),
         ):
             if scores:
@@ -245,5 +245,5 @@ def authors_policy_section(theirs: Mapping[str, Mapping[str, dict]], ours: Calla
 
 def _clean_mean(runs) -> float:
     """Mean return per episode over the runs without a crash (NaN when every run crashed)."""
-    flat = [x for r in runs if not r["crash_episodes"] for x in r["returns"]]
-    return float(np.mean(flat)) if flat else float("nan")
+    clean = [r for r in runs if not r["crash_episodes"]]
+    return sum(r["score"] for r in clean) / sum(r["episodes"] for r in clean) if clean else float("nan")
