@@ -24,7 +24,7 @@ from ..errors import NeurohoverError
 from .config import ORDER, ExperimentConfig
 from .report_base import Section, fmt, log_errors, new_figure, sd, table
 from .report_evolution import EvolutionSection
-from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, varies
+from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, test_run_figure, varies
 from .report_models import SensorModels
 from .results import ModelResult, TestRunResult, result_from_dict
 from .settings import Group, ModelLearningSettings
@@ -128,6 +128,9 @@ class _TestRuns(Section):
         return dict(zip((f"{self.keys[k].mdp}/rep{self.keys[k].rep}" for k in keys), self.runs(label)))  # runs(): the same keys, in order
 
     def figure(self) -> str | None:
+        if varies(self.groups()):  # the LR-fit factorial: a panel per agent, its fits told apart by colour and line
+            fig = test_run_figure(self.groups(), self.runs, f"{self.cfg.title} ({self.cfg.scale} scale)")
+            return None if fig is None else self.save(fig)
         data = {g.label: self.runs(g.label) for g in self.groups()}
         data = {k: v for k, v in data.items() if v}
         if not data:

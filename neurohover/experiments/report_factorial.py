@@ -247,3 +247,37 @@ def _clean_mean(runs) -> float:
     """Mean return per episode over the runs without a crash (NaN when every run crashed)."""
     clean = [r for r in runs if not r["crash_episodes"]]
     return sum(r["score"] for r in clean) / sum(r["episodes"] for r in clean) if clean else float("nan")
+
+
+def test_run_figure(groups, runs: Callable[[str], list[TestRunResult]], title: str):
+    """One log-scale panel per agent whose groups vary the LR fit: each fit's mean cumulative error over
+    episodes (colour: D_u and noise; dashed: the authors' model policy), the other groups as grey
+    references, the legend below the panels. Returns the matplotlib figure, or None without data."""
+    from ..agents.registry import AGENTS
+
+    learners = [g for g in groups if AGENTS[g.agent].learns_models]
+    agents = list(dict.fromkeys(g.agent for g in learners))
+    others = [g for g in groups if not AGENTS[g.agent].learns_models]
+    if not agents or not any(runs(g.label) for g in groups):
+        return None
+    fig, axes = new_figure(len(agents), figsize=(5.5 * len(agents), 5.2))
+    colours = {("keep", "innovations"): "tab:blue", ("discard", "innovations"): "tab:orange", ("keep", "rms"): "tab:green", ("discard", "rms"): "tab:red"}
+    for ax, agent in zip(axes[0], agents):
+        for g in [*others, *(g for g in learners if g.agent == agent)]:
+            data = runs(g.label)
+            if not data:
+                continue
+            cum = -np.cumsum(np.array([[float(x) for x in r.returns] for r in data]), axis=1).mean(axis=0)
+            if g in others:
+                style = {"color": "0.5", "lw": 2.5, "alpha": 0.6}
+            else:
+                style = {"color": colours.get((g.d_u, g.noise), "k"), "ls": "--" if g.model_policy == "authors" else "-", "lw": 1.4}
+            ax.plot(np.arange(1, cum.size + 1), cum, label=g.label, **style)
+        ax.set_yscale("log")
+        ax.set_title(agent, fontsize=10)
+        ax.set_xlabel("episode")
+        ax.set_ylabel("mean cumulative error (log scale)")
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, frameon=False)
+    fig.suptitle(title + "\ncolour: D_u and noise estimate; dashed: the authors' model policy; grey: reference", fontsize=9)
+    return fig
