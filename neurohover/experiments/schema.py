@@ -331,25 +331,15 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
         if settings["target"] == "train" and settings["n_mdps"] > 10:
             raise NeurohoverError(f"{where}: n_mdps = {settings['n_mdps']} is out of range: there are 10 training MDPs")
     if kind == "model_learning" and "conditions" in settings:
-        keys = [c["key"] for c in settings["conditions"]]
-        bad = [k for k in keys if not re.fullmatch(r"[a-z0-9][a-z0-9.-]*", k)]
-        if bad or len(set(keys)) != len(keys):
-            raise NeurohoverError(f"{where}: condition keys must be unique and of lower-case letters, digits, '.' and '-', got {keys}")
+        _keyed(settings["conditions"], "condition", where)
         if "sensor" in settings:
             raise NeurohoverError(f"{where}: sensor is set by each of the conditions here: leave [settings] sensor out")
-        for c in settings["conditions"]:
-            c["label"] = c["label"] or c["key"]
     if kind == "model_learning" and "fits" in settings:
-        keys = [f["key"] for f in settings["fits"]]
-        bad = [k for k in keys if not re.fullmatch(r"[a-z0-9][a-z0-9.-]*", k)]
-        if bad or len(set(keys)) != len(keys):
-            raise NeurohoverError(f"{where}: fit keys must be unique and of lower-case letters, digits, '.' and '-', got {keys}")
+        _keyed(settings["fits"], "fit", where)
         if "conditions" in settings:
             raise NeurohoverError(f"{where}: fits and conditions cannot be combined: give one of them")
         if not set(settings["methods"]) <= {"lr", "lr-gls"}:
             raise NeurohoverError(f"{where}: fits apply to the LR methods only (lr, lr-gls), not to {sorted(set(settings['methods']) - {'lr', 'lr-gls'})}")
-        for f in settings["fits"]:
-            f["label"] = f["label"] or f["key"]
     if kind in ("model_learning", "test_runs"):
         groups = settings.get("groups", [{"mdps": settings.get("mdps"), "n_mdps": settings.get("n_mdps")}])
         for g in groups:
@@ -401,6 +391,16 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
         gr = settings["generic_resampling"]
         if set(gr) - {"fixed", "race"} or not all(_resampling()(v)[0] for v in gr.values()):
             raise NeurohoverError(f"{where}: generic_resampling must be a table with keys fixed and/or race holding fixed:K / race:DELTA")
+
+
+def _keyed(items: list[dict], what: str, where: str) -> None:
+    """Check that sub-tables' keys are unique unit-key words; a label defaults to the key."""
+    keys = [item["key"] for item in items]
+    bad = [k for k in keys if not re.fullmatch(r"[a-z0-9][a-z0-9.-]*", k)]
+    if bad or len(set(keys)) != len(keys):
+        raise NeurohoverError(f"{where}: {what} keys must be unique and of lower-case letters, digits, '.' and '-', got {keys}")
+    for item in items:
+        item["label"] = item["label"] or item["key"]
 
 
 def variant_optimizer(experiment: dict, own: dict | None) -> dict:
