@@ -211,6 +211,10 @@ def test_main_effects_pair_cells_that_differ_in_one_factor() -> None:
     assert d_u["pairs"] == 39 and d_u["median"] == 1.0 and d_u["better"] == 39 and d_u["p"] < 1e-6
     assert noise["pairs"] == 39 and noise["median"] == 0.0 and noise["p"] is None
     assert policy["pairs"] == 39 and policy["better"] == 0
+    # cells that vary one factor only measure that one
+    two = {k: cells[k] for k in ("keep-innovations-ours", "keep-rms-ours")}
+    (only,) = main_effects(two, values)
+    assert only["factor"].startswith("the noise estimate") and only["pairs"] == 9
 
 
 def test_the_factorial_reports_every_fit_and_each_factors_effect(tmp_path) -> None:

@@ -50,8 +50,8 @@ def main_effects(cells: Mapping[str, dict[str, str]], values: Mapping[str, Mappi
     Returns
     -------
     list of dict
-        Per factor: ``factor``, ``pairs``, ``median`` (theirs - ours), ``better`` (pairs where
-        theirs is higher), ``p`` (Wilcoxon signed-rank, None without a nonzero difference).
+        Per factor that the cells vary: ``factor``, ``pairs``, ``median`` (theirs - ours), ``better``
+        (pairs where theirs is higher), ``p`` (Wilcoxon signed-rank, None without a nonzero difference).
     """
     out = []
     by_levels = {tuple(sorted(lv.items())): label for label, lv in cells.items()}
@@ -66,7 +66,9 @@ def main_effects(cells: Mapping[str, dict[str, str]], values: Mapping[str, Mappi
             a, b = values.get(label, {}), values.get(partner, {})
             diffs += [a[k] - b[k] for k in a if k in b]
         d = np.array(diffs, dtype=float)
-        p = float(stats.wilcoxon(d).pvalue) if d.size and np.any(d != 0) else None
+        if not d.size:  # no two cells differ in this factor alone: it is not varied here
+            continue
+        p = float(stats.wilcoxon(d).pvalue) if np.any(d != 0) else None
         out.append(
             {
                 "factor": f"{what} ({name}: {ours} -> {theirs})",
