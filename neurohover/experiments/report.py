@@ -250,7 +250,8 @@ class _TestRuns(Section):
         self.add_tests(samples, labels, "final cumulative reward")
         effects, lines = test_run_effects(self.groups(), self.paired_runs) if varies(self.groups()) else ("", [])
         self.comparisons += lines
-        if effects:  # the LR-fit factorial: beside the authors' policy set where it was flown
+        on_fig8 = any(g.seeds_of is not None and g.seeds_of["experiment"] == "fig8" for g in self.groups())
+        if effects and on_fig8:  # the LR-fit factorial on Figure 8's runs: beside the authors' policy set flown on them
             theirs, lines = authors_policy_section(authors_policy_runs(self.out, self.cfg.scale), self.paired_runs)
             effects += theirs and f"\n{theirs}"
             self.comparisons += lines
