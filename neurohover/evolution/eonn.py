@@ -28,6 +28,7 @@ the repository's root) flies every kept genome again each generation; their heli
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -92,18 +93,11 @@ class EonnResult:
     episodes: int
 
 
-class _Variation:
-    """Mutation settings in the shape the operators read."""
-
-    def __init__(self, frac: float, std: float, repl: float, averaging: float) -> None:
-        self.mutate_frac, self.mutate_std, self.mutate_repl, self.averaging_prob = frac, std, repl, averaging
-
-
-def _child(pool: np.ndarray, fitness: np.ndarray, rng: np.random.Generator, s: EonnSettings, variation: _Variation) -> np.ndarray:
+def _child(pool: np.ndarray, fitness: np.ndarray, rng: np.random.Generator, s: EonnSettings) -> np.ndarray:
     """One offspring: crossover of two tournament winners, then mutation with probability ``mutate_prob``."""
     mom, dad = (max(rng.choice(len(pool), s.tournament_size, replace=False), key=lambda i: fitness[i]) for _ in range(2))
-    child = crossover(pool[mom], pool[dad], rng, variation)
-    return mutate(child, rng, variation) if rng.random() < s.mutate_prob else child
+    child = crossover(pool[mom], pool[dad], rng, s)
+    return mutate(child, rng, s) if rng.random() < s.mutate_prob else child
 
 
 def eonn_evolve(
@@ -119,8 +113,7 @@ def eonn_evolve(
     """Evolve a policy of ``prototype``'s topology on ``mdp`` as the authors' ``eonn`` did (module docstring)."""
     s = settings
     rng = np.random.default_rng(seed)
-    spawn = _Variation(s.spawn_frac, s.spawn_std, s.mutate_repl, s.averaging_prob)
-    variation = _Variation(s.mutate_frac, s.mutate_std, s.mutate_repl, s.averaging_prob)
+    spawn = dataclasses.replace(s, mutate_frac=s.spawn_frac, mutate_std=s.spawn_std)  # spawn's mutation of the first pool
     start = np.asarray(prototype.genome, dtype=np.float64)
     pool = np.stack([start] + [mutate(start, rng, spawn) for _ in range(s.pop_size - 1)])
     rows = np.array([mdp.row()])
@@ -128,7 +121,7 @@ def eonn_evolve(
     episodes = 0
     for gen in range(s.generations + 1):
         if gen:
-            children = [_child(pool, fitness, rng, s, variation) for _ in range(s.pop_size - s.keep)]
+            children = [_child(pool, fitness, rng, s) for _ in range(s.pop_size - s.keep)]
             kept = np.argsort(-fitness, kind="stable")[: s.keep]
             pool = np.concatenate([np.stack(children), pool[kept]])  # eonn's Pool(offspring + elite)
             fitness = fitness[kept]
