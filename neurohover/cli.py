@@ -60,7 +60,7 @@ def add_lr_fit_options(p: argparse.ArgumentParser, who: str) -> None:
     p.add_argument(
         "--noise-estimate",
         choices=NOISE_ESTIMATES,
-        help=f"{who}: the model's gust noise from the residuals' innovations / 0.4 (default) or the authors' rms one-step error / 0.05",
+        help=f"{who}: the model's gust noise from the authors' rms one-step error / 0.05 (default) or the residuals' innovations / 0.4",
     )
 
 

@@ -262,7 +262,7 @@ def _true_mdp(metadata: dict):
 def cmd_learn_model(args: argparse.Namespace) -> int:
     """Learn a helicopter model from flight data (LR, EC-MENO or EC-MER) and print its parameters."""
     from .flightdata import FlightData
-    from .models import format_parameter_table, learn_ec_meno, learn_ec_mer, learn_lr, parameter_table
+    from .models import DEFAULT_NOISE_ESTIMATE, format_parameter_table, learn_ec_meno, learn_ec_mer, learn_lr, parameter_table
     from .paths import input_file, output_file
     from .policies import load_policy
 
@@ -292,7 +292,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     extra = {} if args.budget is None else {"budget": args.budget}
     with _Ticker(f"learning a {args.method} model from {data.n_episodes} episodes ({data.n_transitions} steps)"):
         if args.method == "lr":
-            d_u, noise = ("discard", "rms") if args.as_authors else (args.d_u or "keep", args.noise_estimate or "innovations")
+            d_u, noise = ("discard", "rms") if args.as_authors else (args.d_u or "keep", args.noise_estimate or DEFAULT_NOISE_ESTIMATE)
             model = learn_lr(data, estimator=args.estimator or "ols", wind_model=args.wind_model or "none", d_u=d_u, noise=noise)
         elif args.method == "ec-meno":
             model = learn_ec_meno(data, seed=args.seed, **extra)

@@ -1,7 +1,7 @@
 """Commands of the reproduction stage: ``reproduce``, ``results`` and ``report``.
 
 - ``neurohover reproduce NAME|all|FILE.toml --scale quick|paper --store FILE [--executor local|ray]
-  [--address ADDR] [--jobs J] [--set KEY=VALUE ...] [--fresh]``: run an experiment's units
+  [--address ADDR] [--jobs J] [--set KEY=VALUE ...] [--fresh | --update]``: run an experiment's units
   (skipping those already in the store), with a progress bar over its units.
 - ``neurohover results NAME --store FILE [--scale S] [--format csv|json] [--out FILE]``: export.
 - ``neurohover report --store FILE --out DIR [--scale S] [NAME ...]``: figures and report.md.
@@ -32,6 +32,8 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         raise NeurohoverError("give an experiment NAME (" + ", ".join(experiment_names()) + "), 'all', or a .toml config file")
     if args.store is None:
         raise NeurohoverError("give the results store file with --store FILE (it is created if missing)")
+    if args.fresh and args.update:
+        raise NeurohoverError("--fresh discards every stored result and --update keeps the unchanged ones: give one of them")
     if args.executor == "ray" and args.jobs != 1:
         raise NeurohoverError("--jobs applies to --executor local; Ray runs one unit per CPU of the cluster")
     if args.address is not None and args.executor != "ray":
@@ -63,7 +65,8 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
                 try:
                     # --fresh applies to the experiments named, never to the sources run first (their results stay).
                     fresh = args.fresh and config.name not in sources_added
-                    summary = reproduce(config, store, executor, fresh=fresh, progress=args.progress, only=tuple(args.only or ()))
+                    update = args.update and config.name not in sources_added
+                    summary = reproduce(config, store, executor, fresh=fresh, update=update, progress=args.progress, only=tuple(args.only or ()))
                 except KeyboardInterrupt:
                     done = len(store.results(config.name, config.scale))
                     print(
@@ -187,6 +190,11 @@ def register(sub) -> None:
         help="run only the units whose keys match this glob (repeatable), e.g. 'run/hybrid/*/rep0'; the policies they fly are always made",
     )
     p.add_argument("--fresh", action="store_true", help="discard the experiment's stored results at this scale first")
+    p.add_argument(
+        "--update",
+        action="store_true",
+        help="the config changed: keep the stored units it plans with the same key, kind and params (seed included), run the others",
+    )
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None, help="progress bar (default: when stderr is a terminal)")
     p.add_argument("--list", action="store_true", help="list the experiments and exit")
     p.set_defaults(func=cmd_reproduce)

@@ -30,14 +30,16 @@ def windy_flight():
 
 
 def test_discarding_d_u_keeps_every_parameter_and_moves_the_constant_into_the_noise(windy_flight) -> None:
-    kept = learn_lr(windy_flight)
-    dropped = learn_lr(windy_flight, d_u="discard")
+    kept = learn_lr(windy_flight, noise="innovations")  # body-frame residuals: the u axis's noise alone moves
+    dropped = learn_lr(windy_flight, d_u="discard", noise="innovations")
     assert dropped.params == kept.params  # the same fit: the u slope is fitted with its constant either way
     assert kept.d_u != 0.0 and dropped.d_u == 0.0
     assert dropped.stats["discarded_intercepts"]["u"] == pytest.approx(kept.d_u, rel=1e-12)
     # the wind's drag the constant carried is now unexplained u acceleration: more gust noise on u only
     assert dropped.noise_std[0] > 1.2 * kept.noise_std[0]
     assert dropped.noise_std[1:] == kept.noise_std[1:]
+    rms_kept, rms_dropped = learn_lr(windy_flight), learn_lr(windy_flight, d_u="discard")  # the default: world-frame velocities
+    assert rms_dropped.noise_std[0] > 1.2 * rms_kept.noise_std[0] and rms_dropped.noise_std[3:] == rms_kept.noise_std[3:]
     assert learn_lr(windy_flight, "v", d_u="discard").params == learn_lr(windy_flight, "v").params  # no D_u to keep
 
 
@@ -69,7 +71,8 @@ def test_the_authors_noise_is_the_rms_one_step_error_of_world_velocities_and_rat
     expected = np.sqrt(np.mean(error**2, axis=0)) / 0.05
     assert np.allclose(model.noise_std, expected, rtol=1e-9)
     assert model.stats["noise"] == "rms" and model.stats["noise_std_rms"] == list(model.noise_std)
-    assert learn_lr(windy_flight).stats["noise_std_innovations"] == list(learn_lr(windy_flight).noise_std)
+    ours = learn_lr(windy_flight, d_u="discard", noise="innovations")
+    assert ours.stats["noise_std_innovations"] == list(ours.noise_std) and ours.stats["noise_std_rms"] == list(model.noise_std)
 
 
 def test_bad_lr_fit_settings_are_refused(windy_flight) -> None:

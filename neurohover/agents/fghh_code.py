@@ -37,6 +37,7 @@ from ..errors import NeurohoverError
 from ..evaluate import DangerousState
 from ..evolution.steady_state import SteadyStateSettings
 from ..flightdata import FlightData
+from ..models.lr import DEFAULT_NOISE_ESTIMATE
 from ..policies import Policy, baseline_policy, prototype
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
@@ -93,7 +94,7 @@ class CodeAgentSettings:
     estimator: str = "ols"
     wind_model: str = "none"
     d_u: str = "keep"
-    noise: str = "innovations"
+    noise: str = DEFAULT_NOISE_ESTIMATE
 
     def __post_init__(self) -> None:
         for name, low in (("evolutions", 1), ("model_budget", 50), ("n_steps", 1)):

@@ -15,7 +15,7 @@ import numpy as np
 from ..errors import NeurohoverError
 from ..evaluate import evaluate
 from ..flightdata import FlightData
-from ..models.lr import lr_determined
+from ..models.lr import DEFAULT_NOISE_ESTIMATE, lr_determined
 from ..policies import Policy, baseline_policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
@@ -39,8 +39,8 @@ class ModelEvolution:
     ``"constant"`` or ``"sinusoid"`` (:mod:`neurohover.models.wind`); ``device`` where those episodes fly (``"cpu"`` or ``"cuda"``, docs/gpu.md).
 
     How LR was fitted and used by the authors' code, each selectable: ``d_u`` ``"keep"`` (default) or
-    ``"discard"`` (the authors': the fitted u constant thrown away); ``noise`` ``"innovations"``
-    (default) or ``"rms"`` (the authors' ``rms / 0.05``) (:func:`neurohover.models.learn_lr`);
+    ``"discard"`` (the authors': the fitted u constant thrown away); ``noise`` ``"rms"``
+    (default, the authors' ``rms / 0.05``) or ``"innovations"`` (ours until 2026-12-04) (:func:`neurohover.models.learn_lr`);
     ``model_policy`` ``"ours"`` (default: steady state from the generic policy, ``budget`` episodes)
     or ``"authors"`` (an SLP from the baseline by the authors' ``eonn``: 50 genomes, then
     ``authors_generations`` generations of one offspring each; :data:`MODEL_POLICIES`).
@@ -53,7 +53,7 @@ class ModelEvolution:
     device: str = "cpu"
     wind_model: str = "none"
     d_u: str = "keep"
-    noise: str = "innovations"
+    noise: str = DEFAULT_NOISE_ESTIMATE
     model_policy: str = "ours"
     authors_generations: int = 500
 
@@ -82,15 +82,15 @@ class ModelEvolution:
         return learn_model(flight_data, self.estimator, self.wind_model, d_u=self.d_u, noise=self.noise)
 
 
-def learn_model(flight_data: FlightData, estimator: str = "ols", wind_model: str = "none", *, d_u: str = "keep", noise: str = "innovations") -> MDP:
+def learn_model(flight_data: FlightData, estimator: str = "ols", wind_model: str = "none", *, d_u: str = "keep", noise: str = DEFAULT_NOISE_ESTIMATE) -> MDP:
     """The LR model (the paper's best method) of the flight data, as an MDP.
 
     ``estimator="ols"`` (default): ordinary least squares, as the paper and the authors' code;
     ``"gls"``: the AR(1) quasi-differencing option (:func:`neurohover.models.learn_lr`). Intercepts
     are LR's default, ``"uv"`` (D_v, and the model's D_u unless ``d_u="discard"``, as the authors).
     ``wind_model``: ``"none"`` (default, the paper's), ``"constant"`` or ``"sinusoid"``, a
-    world-frame wind identified from the data. ``noise``: ``"innovations"`` (default) or the
-    authors' ``"rms"``.
+    world-frame wind identified from the data. ``noise``: the authors' ``"rms"`` (default) or
+    ``"innovations"``.
     """
     from ..models import learn_lr
 

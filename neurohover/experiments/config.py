@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import NeurohoverError
+from ..models.lr import LEGACY_NOISE_ESTIMATE
 from .schema import SCHEMAS, check_kind, validate_table
 from .settings import ExperimentSettings, typed_settings
 
@@ -67,6 +68,18 @@ def _respelled(settings: dict, old: str, new: str) -> dict:
     return out
 
 
+def _legacy_noise_dropped(settings: dict) -> dict:
+    """``settings`` without a group's (or a model-learning experiment's) ``noise = "innovations"``.
+
+    Before 2026-12-04 an absent estimate meant innovations: a config naming it now hashes as it did
+    then (its stored results resume), and one that leaves it out takes the new default, "rms".
+    """
+    out = {k: v for k, v in settings.items() if not (k == "noise" and v == LEGACY_NOISE_ESTIMATE)}
+    if "groups" in settings:
+        out["groups"] = [{k: v for k, v in g.items() if not (k == "noise" and v == LEGACY_NOISE_ESTIMATE)} for g in settings["groups"]]
+    return out
+
+
 @dataclass(frozen=True)
 class ExperimentConfig:
     """A resolved, validated experiment config at one scale."""
@@ -89,7 +102,7 @@ class ExperimentConfig:
     @property
     def hash(self) -> str:
         """Hash of everything that changes results (16 hex digits)."""
-        settings = _respelled(self.settings, "optimizer", "optimiser")
+        settings = _legacy_noise_dropped(_respelled(self.settings, "optimizer", "optimiser"))
         payload = {"kind": self.kind, "settings": settings, "units_version": UNITS_VERSION, "external": self.external_digest}
         return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
 

@@ -11,6 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass, fields
 from typing import Any
 
+from ..models.lr import LEGACY_NOISE_ESTIMATE
+
 
 @dataclass(frozen=True, kw_only=True)
 class EvolveParams:
@@ -70,7 +72,7 @@ class ModelParams:
     test_episodes: int
     data_episodes: int = 1  # episodes of the generic's flight data the model learns from
     d_u: str = "keep"  # LR as the authors fitted it, each choice apart (neurohover.agents.model_based.ModelEvolution)
-    noise: str = "innovations"
+    noise: str = LEGACY_NOISE_ESTIMATE  # absent: a unit stored before the default became "rms"
     model_policy: str = "ours"
     authors_generations: int = 500
     exact_checks: bool = False  # also check the model and its policy against exact sensors (the MDP has a sensor model)
@@ -95,7 +97,7 @@ class TestRunParams:
     estimator: str = "ols"
     wind_model: str = "none"
     d_u: str = "keep"  # LR as the authors fitted it, each choice apart (neurohover.agents.model_based.ModelEvolution)
-    noise: str = "innovations"
+    noise: str = LEGACY_NOISE_ESTIMATE  # absent: a unit stored before the default became "rms"
     model_policy: str = "ours"
     authors_generations: int = 500
     sensor: dict | None = None

@@ -27,6 +27,7 @@ import numpy as np
 from ..agents.hybrid import HybridSettings
 from ..agents.registry import HYBRID_AGENTS, agent_spec
 from ..errors import NeurohoverError
+from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..policies import baseline_policy
 from ..policysets import load_policy_set, policy_set_roles
 from ..tasks import EXACT, Sensor
@@ -341,12 +342,12 @@ class _Policies:
         return None if any(v is None for v in out.values()) else out
 
 
-def _lr_fit(d_u: str, noise: str, model_policy: str, authors_generations: int) -> dict:
-    """A unit's LR-fit params where they differ from ours (absent when ours: stored units keep their params)."""
+def _lr_fit(d_u: str, noise: str | None, model_policy: str, authors_generations: int) -> dict:
+    """A unit's LR-fit params where they differ from ours before these settings (absent then: stored units keep their params)."""
     out: dict = {}
     if d_u != "keep":
         out["d_u"] = d_u
-    if noise != "innovations":
+    if noise is not None and noise != LEGACY_NOISE_ESTIMATE:
         out["noise"] = noise
     if model_policy != "ours":
         out["model_policy"] = model_policy
@@ -452,6 +453,8 @@ def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
                 "test_episodes": s.test_episodes,
             }
             seed_key = f"model/{s.mdps}{i}"
+            if method in ("lr", "lr-gls"):  # the experiment's noise estimate (fits give their own)
+                common.update(_lr_fit("keep", s.noise, "ours", s.authors_generations))
             if not s.conditions and not s.fits:
                 units.append(_unit(cfg, UnitKey.make("model", method, f"{s.mdps}{i}"), "model", {**common, "mdp": mdp.to_dict()}, seed_key=seed_key))
             for f in s.fits:  # every fit learns from the same flight data and its policy meets the same gusts

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import fnmatch
+import json
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -62,12 +63,42 @@ def selected(key: str, only: Sequence[str]) -> bool:
     return not only or key.startswith("policy/") or any(fnmatch.fnmatchcase(key, pat) for pat in only)
 
 
+def unchanged_units(config: ExperimentConfig, store: Store) -> set[str]:
+    """The keys of the stored units of ``config``'s experiment that ``config`` plans alike: same key,
+    kind and params (the seed included), so their results stand under it.
+
+    Planning is repeated with the units kept so far, since later units (test runs) are planned from the
+    results of earlier ones (their policies). Refuses a stored config that this version of neurohover
+    does not hash alike (another ``UNITS_VERSION``): its units were computed otherwise.
+    """
+    stored_config = ExperimentConfig.from_dict(store.config(config.name, config.scale))
+    stored_hash = store.config_hash(config.name, config.scale)
+    if stored_config.hash != stored_hash:
+        raise NeurohoverError(
+            f"{config.name} ({config.scale}): its stored results were computed by another version of the units "
+            f"(config hash {stored_hash}, which this version reads as {stored_config.hash}); rerun with --fresh instead of --update"
+        )
+    stored = {u["key"]: u for u in store.units(config.name, config.scale)}
+    sources = {name: store.results(name, config.scale) for name in source_experiments(config)}
+    kept: dict[str, dict] = {}
+    while True:
+        same = [
+            u.key
+            for u in plan(config, kept, sources).units
+            if u.key not in kept and u.key in stored and stored[u.key]["kind"] == u.kind and stored[u.key]["params"] == json.loads(json.dumps(u.params))
+        ]
+        if not same:
+            return set(kept)
+        kept.update((key, stored[key]["result"]) for key in same)
+
+
 def reproduce(
     config: ExperimentConfig,
     store: Store,
     executor,
     *,
     fresh: bool = False,
+    update: bool = False,
     progress: bool | None = None,
     only: Sequence[str] = (),
     on_unit: Callable[[str, dict], None] | None = None,
@@ -77,12 +108,20 @@ def reproduce(
     ``only`` restricts the run to the units whose keys match one of these glob patterns (for example
     ``run/hybrid/*/rep0``); the others stay unfinished, and a later call can run them.
     ``on_unit(key, result)`` is called for every unit finished in this call, once it is stored.
+    ``fresh`` discards the experiment's stored results first; ``update`` takes a config that differs from
+    the stored one, keeping the stored units it plans unchanged (:func:`unchanged_units`).
     Raises KeyboardInterrupt (after recording every finished unit) when interrupted, and
     NeurohoverError when another run is writing ``store`` (see :meth:`Store.lock`).
     """
     from tqdm import tqdm
 
     store.lock()  # one writer per store: a second run would redo every unit the first has not finished
+    if fresh and update:
+        raise NeurohoverError("--fresh discards every stored result and --update keeps the unchanged ones: give one of them")
+    held = store.config_hash(config.name, config.scale)
+    if update and held is not None and held != config.hash:
+        kept = store.update(config.name, config.scale, config.hash, config.to_dict(), unchanged_units(config, store))
+        print(f"{config.name} ({config.scale}): the config changed (hash {held} -> {config.hash}); {kept} stored units stand unchanged", file=sys.stderr)
     store.begin(config.name, config.scale, config.hash, config.to_dict(), fresh=fresh)
     results = store.results(config.name, config.scale)
     sources = {name: store.results(name, config.scale) for name in source_experiments(config)}

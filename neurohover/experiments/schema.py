@@ -21,7 +21,7 @@ from ..errors import NeurohoverError
 from ..evolution.config import make_settings, optimiser_of
 from ..evolution.evolve import parse_resampling
 from ..evolution.optimisers import OPTIMISERS
-from ..models.lr import D_U_CHOICES, NOISE_ESTIMATES
+from ..models.lr import D_U_CHOICES, DEFAULT_NOISE_ESTIMATE, NOISE_ESTIMATES
 from ..policysets import FGHH_GENERIC_RESAMPLING
 from ..tasks import TASK_FAMILIES, TASK_NAMES, Drift, Sensor
 
@@ -179,7 +179,8 @@ _GROUP = {
     "hybrid": ({}, _table()),
     "estimator": ("ols", _choice("ols", "gls")),  # least squares of the LR models an agent learns
     "wind_model": (OMIT, _choice("none", "constant", "sinusoid")),  # and their wind (neurohover.models.wind; absent: none)
-    # LR as the authors fitted it, each choice apart (absent: ours; neurohover.agents.model_based.ModelEvolution)
+    # LR as the authors fitted it, each choice apart (absent: ours; neurohover.agents.model_based.ModelEvolution);
+    # noise is written into the resolved config of every group whose agents learn models (check_kind)
     "d_u": (OMIT, _choice(*D_U_CHOICES)),
     "noise": (OMIT, _choice(*NOISE_ESTIMATES)),
     "model_policy": (OMIT, _choice(*MODEL_POLICIES)),
@@ -203,7 +204,7 @@ _FIT = {
     "key": (REQUIRED, _str()),
     "label": (None, _str()),
     "d_u": ("keep", _choice(*D_U_CHOICES)),
-    "noise": ("innovations", _choice(*NOISE_ESTIMATES)),
+    "noise": (DEFAULT_NOISE_ESTIMATE, _choice(*NOISE_ESTIMATES)),
     "model_policy": ("ours", _choice(*MODEL_POLICIES)),
 }
 
@@ -240,6 +241,8 @@ SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
         "conditions": (OMIT, ("list", _CONDITION)),  # sensor conditions, each its own models of every MDP
         "fits": (OMIT, ("list", _FIT)),  # LR fits, each its own LR models of every MDP (paired with the others)
         "authors_generations": (OMIT, _int(1)),  # the authors' eonn generations (absent: 500, theirs)
+        # the LR methods' gust-noise estimate, where no fits give it (written in by check_kind when they learn LR)
+        "noise": (OMIT, _choice(*NOISE_ESTIMATES)),
     },
     "test_runs": {
         **_COMMON,
@@ -334,6 +337,13 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
         _keyed(settings["conditions"], "condition", where)
         if "sensor" in settings:
             raise NeurohoverError(f"{where}: sensor is set by each of the conditions here: leave [settings] sensor out")
+    if kind == "model_learning":
+        lr_methods = set(settings["methods"]) & {"lr", "lr-gls"}
+        if "noise" in settings and (not lr_methods or "fits" in settings):
+            why = "each of the fits gives its own" if lr_methods else f"methods {settings['methods']} learn no LR model"
+            raise NeurohoverError(f"{where}: noise = {settings['noise']!r} applies to the LR methods without fits, not here: {why}")
+        if lr_methods and "fits" not in settings:  # the estimate is part of the config (and its hash)
+            settings["noise"] = settings.get("noise", DEFAULT_NOISE_ESTIMATE)
     if kind == "model_learning" and "fits" in settings:
         _keyed(settings["fits"], "fit", where)
         if "conditions" in settings:
@@ -360,6 +370,8 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
                 raise NeurohoverError(
                     f"{where}: group {g['label']!r}: {', '.join(lr_keys)} apply to the agents that learn models ({learners}), not to {g['agent']!r}"
                 )
+            if AGENTS[g["agent"]].learns_models:  # the estimate is part of the config (and its hash)
+                g["noise"] = g.get("noise", DEFAULT_NOISE_ESTIMATE)
             if "settings" in g and g["agent"] in HYBRID_AGENTS:  # one spelling for every agent's own settings
                 if g["hybrid"]:
                     raise NeurohoverError(f"{where}: group {g['label']!r}: give the hybrid settings once, as settings (hybrid is its older name), not both")

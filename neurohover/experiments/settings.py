@@ -12,6 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass, fields
 from typing import Any
 
+from ..models.lr import DEFAULT_NOISE_ESTIMATE
+
 
 @dataclass(frozen=True, kw_only=True)
 class Variant:
@@ -41,7 +43,7 @@ class Group:
     estimator: str = "ols"
     wind_model: str = "none"  # the wind of the LR models its agents learn
     d_u: str = "keep"  # how its LR models treat the fitted u constant (the authors': discard)
-    noise: str = "innovations"  # their gust-noise estimate (the authors': rms)
+    noise: str | None = None  # their gust-noise estimate (None: the group's agents learn no models)
     model_policy: str = "ours"  # how policies are evolved on them (the authors': an SLP from the baseline by eonn)
     sensor: dict | None = None  # this group's sensors (None: the experiment's)
     drift: dict | None = None  # this group's drifting dynamics (None: the experiment's)
@@ -65,7 +67,7 @@ class Fit:
     key: str
     label: str
     d_u: str = "keep"
-    noise: str = "innovations"
+    noise: str = DEFAULT_NOISE_ESTIMATE
     model_policy: str = "ours"
 
 
@@ -109,8 +111,9 @@ class ModelLearningSettings(ExperimentSettings):
     policy_prototype: str = "generic"
     test_episodes: int = 5
     conditions: tuple[Condition, ...] = ()  # empty: one condition, the experiment's sensor and one episode of data
-    fits: tuple[Fit, ...] = ()  # empty: LR as the methods say (D_u kept, innovation noise, our evolution)
+    fits: tuple[Fit, ...] = ()  # empty: LR as the methods say (D_u kept, `noise`, our evolution)
     authors_generations: int = 500  # generations of the authors' eonn, where a fit evolves so
+    noise: str | None = None  # the LR methods' gust-noise estimate where no fits give it (None: no LR method)
 
 
 @dataclass(frozen=True, kw_only=True)

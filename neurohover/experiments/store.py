@@ -34,7 +34,7 @@ import os
 import socket
 import sqlite3
 import time
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import IO, Any
 
@@ -233,11 +233,34 @@ class Store:
                 raise NeurohoverError(
                     f"results store {str(self.path)!r} already holds experiment {name!r} at scale {scale!r} with config "
                     f"hash {row[0]}, but this config hashes to {config_hash}: the settings differ, so the results would "
-                    f"not be comparable. Use another --store file, restore the old config, or rerun with --fresh to "
-                    f"discard the stored results of {name!r} ({scale})"
+                    f"not be comparable. Use another --store file, restore the old config, rerun with --update to keep "
+                    f"the stored units the new config plans unchanged (and run the others), or with --fresh to discard "
+                    f"every stored result of {name!r} ({scale})"
                 )
             else:  # same settings: keep the latest title and paper numbers (they do not change results)
                 c.execute("UPDATE experiments SET config = ? WHERE name = ? AND scale = ?", (_dumps(config), name, scale))
+
+    def update(self, name: str, scale: str, config_hash: str, config: dict, keep: Iterable[str]) -> int:
+        """Register a changed config of experiment (name, scale), keeping the stored units named in ``keep``.
+
+        In one transaction: the units not kept and the experiment's sessions are deleted, and the kept
+        units and the experiment take ``config_hash``. The caller chooses ``keep`` (units the new config
+        plans with the same key, kind and params: :func:`neurohover.experiments.runner.unchanged_units`).
+        Returns the number of units kept.
+        """
+        self.lock()
+        c = self.conn
+        keep = set(keep)
+        with _transaction(c):
+            if c.execute("SELECT 1 FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone() is None:
+                raise NeurohoverError(self.missing_message(name, scale))
+            stored = [k for (k,) in c.execute("SELECT key FROM units WHERE name = ? AND scale = ?", (name, scale))]
+            gone = [k for k in stored if k not in keep]
+            c.executemany("DELETE FROM units WHERE name = ? AND scale = ? AND key = ?", [(name, scale, k) for k in gone])
+            c.execute("DELETE FROM sessions WHERE name = ? AND scale = ?", (name, scale))
+            c.execute("UPDATE units SET config_hash = ? WHERE name = ? AND scale = ?", (config_hash, name, scale))
+            c.execute("UPDATE experiments SET config_hash = ?, config = ? WHERE name = ? AND scale = ?", (config_hash, _dumps(config), name, scale))
+        return len(stored) - len(gone)
 
     def experiments(self) -> list[tuple[str, str, str, int]]:
         """(name, scale, config_hash, finished units) of every experiment in the store."""
@@ -248,6 +271,11 @@ class Store:
                 "FROM experiments e ORDER BY e.created"
             )
         ]
+
+    def config_hash(self, name: str, scale: str) -> str | None:
+        """The config hash of experiment (name, scale), None when the store does not hold it."""
+        row = self.conn.execute("SELECT config_hash FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
+        return None if row is None else row[0]
 
     def config(self, name: str, scale: str) -> dict:
         row = self.conn.execute("SELECT config FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
