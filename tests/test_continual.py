@@ -14,7 +14,9 @@ from neurohover.agents.spec import AgentOptions
 from neurohover.policysets import load_policy_set
 from neurohover.tasks import Drift, Sensor
 
-EVOLUTION = ModelEvolution(budget=600, n_steps=1000)
+# Our noise estimate: with the authors' (the default since 2026-12-04) this one MDP's changed helicopter crashes
+# the re-learned policy in 20 of its last 35 episodes (bench-drift-armed measures the agent at paper scale).
+EVOLUTION = ModelEvolution(budget=600, n_steps=1000, noise="innovations")
 STRONGER_ROTORS = Drift(0.0, (("D_p", 2.5), ("D_q", 2.5)), (25, 25))  # roll and pitch gains x2.5 at episode 25
 
 

@@ -36,7 +36,7 @@ from neurohover.experiments.config import CONFIG_DIR, parse_override
 from neurohover.experiments.store import SCHEMA_VERSION
 
 PAPER_EXPERIMENTS = ["fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16"]
-ABLATIONS = ["ablation-plateau", "ablation-hybrid", "ablation-fghh", "lr-authors-table4", "lr-authors-fig8", "lr-noise-fig7", "lr-noise-fig11"]
+ABLATIONS = ["ablation-plateau", "ablation-hybrid", "ablation-fghh", "fig15-rules", "lr-authors-table4", "lr-authors-fig8", "lr-noise-fig7", "lr-noise-fig11"]
 # the harder benchmarks of the paper's Section 7 (docs/benchmarks.md)
 BENCHMARKS = ["bench-sensors", "bench-sensors-fallback", "bench-sensor-models", "bench-drift", "bench-drift-armed"]
 BEYOND = ["wind-fig7", "wind-fig8", "wind-fig11", "risk-ghh09"]  # what the paper's conclusions predict and it could not run (docs/model.md)
@@ -147,7 +147,7 @@ def test_unknown_experiment_lists_the_known_ones(cli, tmp_path: Path) -> None:
         (lambda t: t.replace("runs = 12", 'runs = "twelve"'), "runs = 'twelve' is not allowed: expected an integer >= 1"),
         (lambda t: t.replace("runs = 12\n", ""), "missing required setting 'runs'"),
         (lambda t: t.replace('task = "fghh"', 'task = "ghh08"'), "sigma applies to task 'fghh' only"),
-        (lambda t: t.replace('label = "k = 1"', 'label = "k = 1"\nresampling = "race:2"'), "race:DELTA (0 < DELTA < 1)"),
+        (lambda t: t.replace('label = "k = 1"', 'label = "k = 1"\nresampling = "race:2"'), "race:DELTA[:RULE] (0 < DELTA < 1"),
         (lambda t: t.replace('kind = "evolution"', 'kind = "magic"'), "kind = 'magic' is not allowed"),
         (lambda t: t.replace("[scales.paper]", "[scales.huge]"), "unknown scale table(s) huge"),
         (lambda t: t + '\n[[settings.variants]]\nkey = "k1"\nlabel = "again"\n', "variant keys must be unique"),

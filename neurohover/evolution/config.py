@@ -22,6 +22,7 @@ from ..tasks import MDP, TaskFamily, refuse_drift
 from .generational import GENERATIONAL_PRESETS, OLD_GENERATIONAL, GenerationalSettings
 from .optimisers import NE, OPTIMISERS, optimiser_names, population_settings
 from .optimisers.cma import CMASettings
+from .races import RACE_RULES
 from .seeding import check_seed
 from .steady_state import SteadyStateSettings
 
@@ -51,36 +52,44 @@ _OLD_STEADY_STATE = {"plateau_rule": "literal", "selection": "roulette", "tourna
 @dataclass(frozen=True)
 class Resampling:
     """How a candidate's fitness is estimated: ``fixed`` (mean of ``k`` episodes) or ``race``
-    (selection race at confidence level ``delta``). ``str()`` gives the spec back."""
+    (selection race at confidence level ``delta``, deciding by ``rule``: :data:`~neurohover.evolution.races.RACE_RULES`).
+    ``str()`` gives the spec back (the prose rule unnamed, as before the rules)."""
 
     kind: str
     k: int = 1
     delta: float | None = None
+    rule: str = "prose"
 
     def __str__(self) -> str:
-        return f"fixed:{self.k}" if self.kind == "fixed" else f"race:{self.delta:g}"
+        if self.kind == "fixed":
+            return f"fixed:{self.k}"
+        return f"race:{self.delta:g}" + ("" if self.rule == "prose" else f":{self.rule}")
 
 
 def parse_resampling(spec: str | Resampling | None) -> Resampling:
-    """``"fixed:K"`` (K >= 1 episodes per candidate) or ``"race:DELTA"`` (0 < DELTA < 1); None is ``fixed:1``."""
+    """``"fixed:K"`` (K >= 1 episodes per candidate) or ``"race:DELTA[:RULE]"`` (0 < DELTA < 1; RULE one of
+    :data:`~neurohover.evolution.races.RACE_RULES`, default prose); None is ``fixed:1``."""
     if spec is None:
         return Resampling("fixed", 1)
     if isinstance(spec, Resampling):
         return spec
     text = str(spec).strip().lower()
     kind, sep, value = text.partition(":")
-    allowed = "allowed fixed:K (K >= 1 episodes per candidate) or race:DELTA (confidence level 0 < DELTA < 1)"
+    allowed = "allowed fixed:K (K >= 1 episodes per candidate) or race:DELTA[:RULE] (confidence level 0 < DELTA < 1, rule " + ", ".join(RACE_RULES) + ")"
     if kind == "fixed" and sep:
         if value.isdigit() and int(value) >= 1:
             return Resampling("fixed", int(value))
         raise NeurohoverError(f"bad resampling {spec!r}: K must be an integer >= 1; {allowed}")
     if kind == "race" and sep:
+        value, _, rule = value.partition(":")
+        if rule and rule not in RACE_RULES:
+            raise NeurohoverError(f"bad resampling {spec!r}: {rule!r} is not a race rule: allowed {', '.join(RACE_RULES)}")
         try:
             delta = float(value)
         except ValueError:
             delta = math.nan
         if 0.0 < delta < 1.0:
-            return Resampling("race", 1, delta)
+            return Resampling("race", 1, delta, rule or "prose")
         raise NeurohoverError(f"bad resampling {spec!r}: DELTA must be a number strictly between 0 and 1; {allowed}")
     raise NeurohoverError(f"unknown resampling {spec!r}: {allowed}")
 

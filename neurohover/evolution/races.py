@@ -26,6 +26,7 @@ import numpy as np
 from scipy import stats
 
 __all__ = [
+    "RACE_RULES",
     "SampleFn",
     "RaceResult",
     "ResamplingResult",
@@ -35,6 +36,12 @@ __all__ = [
 ]
 
 SampleFn = Callable[[np.ndarray], np.ndarray]
+
+#: How a race decides (:func:`selection_race`): ``"prose"`` the paper's text (every other candidate, at its last
+#: bounds; all of a round's decisions at once); ``"algorithm1"`` the printed Algorithm 1 (the undecided ones only,
+#: the thresholds lowered by the decided counts, one candidate after another); ``"authors"`` their FGHH code's loop,
+#: Algorithm 1 in a Python ``for`` over a list it removes from, so the candidate after each decision is passed over.
+RACE_RULES = ("prose", "algorithm1", "authors")
 
 
 @dataclass(frozen=True)
@@ -84,6 +91,9 @@ class RaceResult:
         rounds 1 and 2 when ``t_limit >= 2``.
     episodes_flown : int
         Samples drawn in all: ``episodes_spent`` plus look-ahead samples the race never used.
+    over_selected : int
+        Candidates the rule selected beyond ``mu`` (``"algorithm1"`` and ``"authors"`` may; the ``mu``
+        of best mean among those selected are kept).
     """
 
     selected: np.ndarray
@@ -96,6 +106,7 @@ class RaceResult:
     episodes_spent: int
     rounds: int
     episodes_flown: int = 0
+    over_selected: int = 0
 
 
 def _check_int(name: str, value: object, minimum: int) -> int:
@@ -218,6 +229,7 @@ def selection_race(
     delta: float,
     t_limit: int = 10,
     batch: int = 0,
+    rule: str = "prose",
 ) -> RaceResult:
     """Pick ``mu`` of ``n_candidates`` noisy candidates with a selection race.
 
@@ -267,6 +279,14 @@ def selection_race(
         cautious (wider bounds, more episodes).
     t_limit : int, default 10
         Maximum episodes per candidate (>= 1).
+    rule : {"prose", "algorithm1", "authors"}, default "prose"
+        ``"prose"``: as above. ``"algorithm1"``: the printed Algorithm 1 (lines 18-26), one undecided
+        candidate after another in index order: selected when its lower bound exceeds the upper bounds
+        of at least ``lambda - mu - |D|`` undecided ones, discarded when its upper bound is below the
+        lower bounds of at least ``mu - |S|`` undecided ones, ``S``, ``D`` and the undecided set
+        changing at once; the race stops when ``mu`` are selected or at ``t_limit`` (no early stop),
+        and may select more than ``mu`` in its last round (``over_selected``). ``"authors"``: the same
+        loop as their FGHH code ran it, which passes over the candidate after each decision in a round.
     batch : int, default 0
         Look-ahead for speed: when a call of ``sample_fn`` is due, each undecided candidate is
         listed for its next ``ceil(batch / undecided)`` samples at once (at most up to
@@ -286,6 +306,8 @@ def selection_race(
     delta = _check_delta(delta)
     t_limit = _check_int("t_limit", t_limit, 1)
     batch = _check_int("batch", batch, 0)
+    if rule not in RACE_RULES:
+        raise ValueError(f"rule={rule!r} is not a race rule: choose one of {', '.join(RACE_RULES)}")
 
     # Samples live in one (n, capacity) array: in round r every undecided
     # candidate has exactly r samples (columns 0..r-1 of its row). _race_round sums
@@ -328,6 +350,16 @@ def selection_race(
         q_lo, q_hi = _standard_quantiles(rounds, delta) if rounds > 1 else (math.nan, math.nan)
         # This round's bounds, then the decisions on them, all undecided candidates at once.
         _race_round(samples, active, first_new, rounds, q_lo, q_hi, need_select, need_discard, crashed, means, lower, upper, sel, dis)
+        if rule != "prose":  # Algorithm 1's decisions, one candidate after another (the bounds are this round's)
+            newly_sel, newly_dis = _sequential_decisions(active, lower, upper, n - mu, mu, len(selected), int(discarded.sum()), rule == "authors")
+            selected.extend(newly_sel.tolist())  # kept beyond mu for now: the best mu are taken below
+            undecided[newly_sel] = False
+            undecided[newly_dis] = False
+            discarded[newly_dis] = True
+            discard_order.extend(newly_dis.tolist())
+            if len(selected) >= mu or not undecided.any() or rounds >= t_limit:
+                break
+            continue
         newly_sel = active[sel[: active.size]]
         newly_dis = active[dis[: active.size]]
         if newly_sel.size:
@@ -349,6 +381,10 @@ def selection_race(
         if rounds >= t_limit:  # every undecided candidate was flown in every round
             break
 
+    over_selected = max(0, len(selected) - mu)
+    if over_selected:
+        picked = np.asarray(selected)
+        selected = picked[_best_first(means, picked)][:mu].tolist()
     n_raced = len(selected)
     for pool in (np.flatnonzero(undecided), np.flatnonzero(discarded)):
         need = mu - len(selected)
@@ -368,7 +404,33 @@ def selection_race(
         episodes_spent=int(n_samples.sum()),
         rounds=rounds,
         episodes_flown=episodes_flown,
+        over_selected=over_selected,
     )
+
+
+def _sequential_decisions(
+    active: np.ndarray, lower: np.ndarray, upper: np.ndarray, n_select: int, mu: int, n_selected: int, n_discarded: int, skip: bool
+) -> tuple[np.ndarray, np.ndarray]:
+    """One round of Algorithm 1's lines 18-26 over the undecided ``active`` (in index order): who is selected and
+    who discarded, in the order decided. ``n_select`` is lambda - mu; ``skip``: the authors' loop, whose
+    ``for i, x in enumerate(U)`` with ``U.pop(i)`` passes over the candidate after each decision."""
+    pool = active.tolist()
+    chosen: list[int] = []
+    dropped: list[int] = []
+    i = 0
+    while i < len(pool):
+        x = pool[i]
+        others_lower = lower[pool]
+        others_upper = upper[pool]
+        if np.count_nonzero(lower[x] > others_upper) >= n_select - (n_discarded + len(dropped)):
+            chosen.append(pool.pop(i))
+        elif np.count_nonzero(upper[x] < others_lower) >= mu - (n_selected + len(chosen)):
+            dropped.append(pool.pop(i))
+        else:
+            i += 1
+            continue
+        i += skip  # the element now at i took the decided one's place: their loop moves on past it
+    return np.asarray(chosen, dtype=np.int64), np.asarray(dropped, dtype=np.int64)
 
 
 @numba.njit(cache=True, error_model="numpy")

@@ -329,7 +329,8 @@ class Run:
             assert delta is not None  # every race has its delta (Run() formats it in config.to_dict() first)
             sampler = self._race_sampler(genomes, opt.settings.select_size)
             traced = None if self.flyer.trace is None else len(self.flyer.trace)
-            race = selection_race(sampler, genomes.shape[0], opt.settings.select_size, delta, t_limit=RACE_T_LIMIT, batch=sampler.batch)
+            size = (genomes.shape[0], opt.settings.select_size)
+            race = selection_race(sampler, *size, delta, t_limit=RACE_T_LIMIT, batch=sampler.batch, rule=self.resampling.rule)
             # Count the episodes the race used (parking or look-ahead flew more): what depends on no speed setting.
             self.flyer.episodes += race.episodes_spent
             used = sampler.used(race.n_samples)

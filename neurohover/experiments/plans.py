@@ -110,8 +110,9 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
         "validation_episodes": s.validation_episodes,
         "history_points": s.history_points,
     }
+    root, name = (s.seed, cfg.name) if s.seeds_of is None else (s.seeds_of["seed"], s.seeds_of["experiment"])
     if s.validation_mdps == "test":  # one seed for every run's validation: the same MDPs and gusts
-        base.update(validation_mdps="test", validation_seed=unit_seed(s.seed, cfg.name, "validation"))
+        base.update(validation_mdps="test", validation_seed=unit_seed(root, name, "validation"))
     train = family.training_mdps()[: s.n_mdps]
     for v in s.variants:
         common = {**base, "topology": v.topology, "prototype": v.prototype, "resampling": v.resampling}
@@ -121,7 +122,8 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
             for i, mdp in enumerate(train):
                 for r in range(s.runs):
                     key = UnitKey.make("evolve", v.key, f"train{i}", r)
-                    units.append(_unit(cfg, key, "evolve", {**common, "target": {"kind": "mdp", "mdp": mdp.to_dict()}}))
+                    seed = unit_seed(root, name, UnitKey.make("evolve", v.paired_with or v.key, f"train{i}", r)) if s.seeds_of else None
+                    units.append(_unit(cfg, key, "evolve", {**common, "target": {"kind": "mdp", "mdp": mdp.to_dict()}}, seed=seed))
         else:
             sigma = v.sigma if v.sigma is not None else s.sigma
             if s.target == "zero":
@@ -129,7 +131,8 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
             else:
                 target = _family_target(s, sigma)
             for r in range(s.runs):
-                units.append(_unit(cfg, UnitKey.make("evolve", v.key, rep=r), "evolve", {**common, "target": target}))
+                seed = unit_seed(root, name, UnitKey.make("evolve", v.paired_with or v.key, rep=r)) if s.seeds_of else None
+                units.append(_unit(cfg, UnitKey.make("evolve", v.key, rep=r), "evolve", {**common, "target": target}, seed=seed))
     total = len(units) + len(s.robustness_variants) * len(train)
     for vkey in s.robustness_variants:
         for i in range(len(train)):

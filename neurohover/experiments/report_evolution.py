@@ -8,10 +8,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import NeurohoverError
 from ..evolution.fitness import episode_fitness, error_of_fitness
-from .config import ExperimentConfig
+from .config import ExperimentConfig, load_config
 from .report_base import Section, fmt, new_figure, sd, table
-from .results import EvolveResult, RobustnessResult
+from .results import EvolveResult, RobustnessResult, UnitKey, result_from_dict
 from .settings import Variant
 
 
@@ -167,7 +168,66 @@ class EvolutionSection(Section):
                     + ")."
                 )
         self.add_tests(samples, labels, "mean validation 1/ln(error) of the final champions")
+        if self.s.seeds_of is not None and samples:
+            text += self._paired_block(samples, labels)
         return text
+
+    def _paired_block(self, samples: dict[str, list[float]], labels: dict[str, str]) -> str:
+        """Each variant against the runs of the other experiment's variant whose seeds it took (Wilcoxon signed-rank
+        on the run pairs' validation 1/ln(error)), and against that experiment's fixed-resampling variants (Welch's t)."""
+        from scipy import stats
+
+        source = self.s.seeds_of["experiment"]
+        try:
+            other = load_config(source, self.cfg.scale)
+        except NeurohoverError:
+            return f"\nPaired with {source}: not a shipped experiment, so not compared.\n"
+        theirs = {u["key"]: result_from_dict(u["kind"], u["result"], u["key"]) for u in self.store.units(source, self.cfg.scale)}
+
+        def scores(results: dict, vkey: str) -> dict[int | None, float]:
+            """Run number -> mean validation 1/ln(error) of the variant's runs (validated ones)."""
+            keys = [(k, UnitKey.parse(k)) for k in results if k.startswith("evolve/")]
+            runs = {key.rep: results[k] for k, key in keys if key.group == vkey}
+            return {rep: _mean_fitness([float(x) for x in r.validation or ()]) for rep, r in runs.items() if r.validation is not None}
+
+        fixed = [v for v in other.typed.variants if v.resampling.startswith("fixed")]
+        rows = []
+        for v in self.variants():
+            if v.key not in samples:
+                continue
+            mine, pair = scores(self.results, v.key), scores(theirs, v.paired_with or v.key)
+            common = sorted(set(mine) & set(pair), key=str)
+            row = [v.label, f"{source}/{v.paired_with or v.key}", str(len(common))]
+            if len(common) >= 2:
+                diff = np.array([mine[r] - pair[r] for r in common])
+                p = stats.wilcoxon(diff).pvalue if np.any(diff != 0) else 1.0
+                better = int(np.sum(diff > 0))
+                row += [fmt(np.mean([mine[r] for r in common])), fmt(np.mean([pair[r] for r in common])), f"{better} of {len(common)}", fmt(float(p))]
+            else:
+                row += ["", "", "", ""]
+            for f in fixed:
+                base = list(scores(theirs, f.key).values())
+                if len(base) >= 2 and len(samples[v.key]) >= 2:
+                    t, p = stats.ttest_ind(samples[v.key], base, equal_var=False)
+                    word = "better" if np.mean(samples[v.key]) > np.mean(base) else "worse"
+                    row.append(f"{word}, p = {fmt(float(p))}")
+                    self.comparisons.append(
+                        f"{v.label} vs {source}'s {f.label} (mean validation 1/ln(error), Welch): {fmt(np.mean(samples[v.key]))} vs "
+                        f"{fmt(np.mean(base))}, {word}, p = {fmt(float(p))}" + (" (significant at 5%)." if p < 0.05 else " (not significant).")
+                    )
+                else:
+                    row.append("")
+            rows.append(row)
+        header = ["setting", "paired with", "run pairs", "mean 1/ln(error)", "its pair's", "runs better", "Wilcoxon p"]
+        header += [f"vs {source}'s {f.label} (Welch)" for f in fixed]
+        return (
+            f"\n### Paired with {source}\n\n"
+            + table(header, [r + [""] * (len(header) - len(r)) for r in rows])
+            + f"\n\nRun r of each setting took the seed of run r of the {source} setting it is paired with (the same initial "
+            "population and noise streams) and its champion flew the same validation episodes, so the run pairs differ by the "
+            "setting alone. Wilcoxon signed-rank test on the pairs' mean validation 1/ln(error); Welch's t test against "
+            f"{source}'s fixed-resampling runs (the paper's comparison).\n"
+        )
 
     def body(self) -> str:
         if self._fghh_style():

@@ -15,6 +15,7 @@ from collections.abc import Callable, Mapping
 import numpy as np
 from scipy import stats
 
+from ..models.lr import LEGACY_NOISE_ESTIMATE
 from .report_base import Section, fmt, fmt_p, log_errors, new_figure, table
 from .results import ModelResult, TestRunResult
 
@@ -28,13 +29,19 @@ OURS = {name: ours for name, ours, _, _ in FACTORS}
 
 
 def levels(obj) -> dict[str, str]:
-    """A fit's or group's level of each factor."""
-    return {name: getattr(obj, name) for name, *_ in FACTORS}
+    """A fit's or group's level of each factor (a group's noise left out of a config written before
+    2026-12-04 was innovations: :data:`neurohover.models.lr.LEGACY_NOISE_ESTIMATE`)."""
+    out = {name: getattr(obj, name) for name, *_ in FACTORS}
+    out["noise"] = out["noise"] or LEGACY_NOISE_ESTIMATE
+    return out
 
 
 def varies(objs) -> bool:
-    """Whether any of these fits or groups takes one of the authors' choices."""
-    return any(levels(o) != OURS for o in objs)
+    """Whether these fits, or the groups among these that learn models, differ in a factor (a factorial)."""
+    from ..agents.registry import AGENTS
+
+    learners = [o for o in objs if not hasattr(o, "agent") or AGENTS[o.agent].learns_models]
+    return len({tuple(sorted(levels(o).items())) for o in learners}) > 1
 
 
 def main_effects(cells: Mapping[str, dict[str, str]], values: Mapping[str, Mapping[str, float]]) -> list[dict]:

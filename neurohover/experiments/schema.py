@@ -21,6 +21,7 @@ from ..errors import NeurohoverError
 from ..evolution.config import make_settings, optimiser_of
 from ..evolution.evolve import parse_resampling
 from ..evolution.optimisers import OPTIMISERS
+from ..evolution.races import RACE_RULES
 from ..models.lr import D_U_CHOICES, DEFAULT_NOISE_ESTIMATE, NOISE_ESTIMATES
 from ..policysets import FGHH_GENERIC_RESAMPLING
 from ..tasks import TASK_FAMILIES, TASK_NAMES, Drift, Sensor
@@ -96,7 +97,7 @@ def _resampling():
         try:
             parse_resampling(v)
         except NeurohoverError:
-            return False, "fixed:K (K >= 1) or race:DELTA (0 < DELTA < 1)"
+            return False, "fixed:K (K >= 1) or race:DELTA[:RULE] (0 < DELTA < 1, RULE " + ", ".join(RACE_RULES) + ")"
         return True, ""
 
     return check
@@ -125,17 +126,18 @@ def _drift_table():
     return _settings_table(Drift, ", ".join(f.name for f in fields(Drift) if f.init))
 
 
-def _seeds_of():
+def _seeds_of(names: tuple[str, ...] = ("experiment", "group")):
     def check(v):
         ok = (
             isinstance(v, dict)
-            and set(v) == {"experiment", "seed", "group"}
-            and all(isinstance(v[k], str) and v[k] != "" for k in ("experiment", "group"))
+            and set(v) == {*names, "seed"}
+            and all(isinstance(v[k], str) and v[k] != "" for k in names)
             and isinstance(v["seed"], int)
             and not isinstance(v["seed"], bool)
             and 0 <= v["seed"] <= 2**63 - 1
         )
-        return ok, "a table {experiment = NAME, seed = ITS ROOT SEED, group = ITS GROUP'S LABEL}"
+        fields = ", ".join(["experiment = NAME", "seed = ITS ROOT SEED", *(["group = ITS GROUP'S LABEL"] if "group" in names else [])])
+        return ok, "a table {" + fields + "}"
 
     return check
 
@@ -164,6 +166,8 @@ _VARIANT = {
     "resampling": ("fixed:1", _resampling()),
     "sigma": (None, _float(0.0, 1.0)),
     "optimizer": (OMIT, _table()),  # this variant's optimizer settings, over the experiment's `optimizer`
+    # with the experiment's seeds_of: the variant of that experiment whose runs' seeds this one's take (absent: its own key)
+    "paired_with": (OMIT, _str()),
 }
 
 _GROUP = {
@@ -223,6 +227,9 @@ SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
         "history_points": (300, _int(2)),
         "robustness_variants": ([], lambda v: (isinstance(v, list) and all(isinstance(x, str) for x in v), "a list of variant keys")),
         "robustness_episodes": (10, _int(1)),
+        # run r of each variant takes the seed of run r of another experiment's variant (paired_with), and the
+        # champions are validated on that experiment's test episodes: paired comparisons across experiments
+        "seeds_of": (OMIT, _seeds_of(("experiment",))),
         "variants": (REQUIRED, ("list", _VARIANT)),
     },
     "model_learning": {
@@ -324,6 +331,9 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
             except NeurohoverError as err:
                 whose = "" if v is None else f" of variant {v['key']!r}"
                 raise NeurohoverError(f"{where}: optimizer{whose}: {err}") from None
+        unpaired = [v["key"] for v in settings["variants"] if "paired_with" in v]
+        if unpaired and "seeds_of" not in settings:
+            raise NeurohoverError(f"{where}: variant(s) {', '.join(unpaired)} set paired_with: give the experiment's seeds_of too")
         bad = [k for k in settings["robustness_variants"] if k not in keys]
         if bad:
             raise NeurohoverError(f"{where}: robustness_variants {bad} are not variant keys ({', '.join(keys)})")

@@ -26,6 +26,7 @@ class Variant:
     resampling: str = "fixed:1"
     sigma: float | None = None
     optimizer: dict | None = None  # over the experiment's optimizer table (None: left out)
+    paired_with: str | None = None  # with the experiment's seeds_of: that experiment's variant whose seeds it takes
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -94,6 +95,7 @@ class EvolutionSettings(ExperimentSettings):
     history_points: int = 300
     robustness_variants: tuple[str, ...] = ()
     robustness_episodes: int = 10
+    seeds_of: dict | None = None  # {experiment, seed}: its runs take that experiment's seeds (None: their own)
     variants: tuple[Variant, ...]
 
 
