@@ -13,7 +13,7 @@ from ..evolution.fitness import episode_fitness, error_of_fitness
 from .config import ExperimentConfig, load_config
 from .report_base import Section, fmt, new_figure, sd, table
 from .results import EvolveResult, RobustnessResult, UnitKey, result_from_dict
-from .settings import Variant
+from .settings import EvolutionSettings, Variant
 
 
 def _curve(points: Sequence[Sequence[float | str]], grid: np.ndarray, sign: float = -1.0) -> np.ndarray:
@@ -190,6 +190,8 @@ class EvolutionSection(Section):
             runs = {key.rep: results[k] for k, key in keys if key.group == vkey}
             return {rep: _mean_fitness([float(x) for x in r.validation or ()]) for rep, r in runs.items() if r.validation is not None}
 
+        if not isinstance(other.typed, EvolutionSettings):
+            return f"\nPaired with {source}: not an evolution experiment, so not compared.\n"
         fixed = [v for v in other.typed.variants if v.resampling.startswith("fixed")]
         rows = []
         for v in self.variants():
