@@ -36,7 +36,17 @@ from neurohover.experiments.config import CONFIG_DIR, parse_override
 from neurohover.experiments.store import SCHEMA_VERSION
 
 PAPER_EXPERIMENTS = ["fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16"]
-ABLATIONS = ["ablation-plateau", "ablation-hybrid", "ablation-fghh", "fig15-rules", "lr-authors-table4", "lr-authors-fig8", "lr-noise-fig7", "lr-noise-fig11"]
+ABLATIONS = [
+    "ablation-plateau",
+    "ablation-hybrid",
+    "ablation-fghh",
+    "fig15-rules",
+    "fig15-champion",
+    "lr-authors-table4",
+    "lr-authors-fig8",
+    "lr-noise-fig7",
+    "lr-noise-fig11",
+]
 # the harder benchmarks of the paper's Section 7 (docs/benchmarks.md)
 BENCHMARKS = ["bench-sensors", "bench-sensors-fallback", "bench-sensor-models", "bench-drift", "bench-drift-armed"]
 BEYOND = ["wind-fig7", "wind-fig8", "wind-fig11", "risk-ghh09"]  # what the paper's conclusions predict and it could not run (docs/model.md)

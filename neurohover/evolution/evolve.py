@@ -85,6 +85,7 @@ from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP
 from .config import CMA_DEFAULTS, Resampling, RunConfig, parse_resampling, resolve_target
+from .fitness import episode_fitness
 from .records import (
     CHECKPOINT_FORMAT,
     HISTORY_COLUMNS,
@@ -97,7 +98,7 @@ from .records import (
     write_history_csv,
 )
 from .run import Run
-from .seeding import check_seed, validation_seeds
+from .seeding import check_seed, reevaluation_seeds, validation_seeds
 
 __all__ = [
     "CHECKPOINT_FORMAT",
@@ -111,6 +112,7 @@ __all__ = [
     "evolve",
     "parse_resampling",
     "read_history_csv",
+    "reevaluated_champion",
     "validation_return",
     "write_history_csv",
 ]
@@ -261,3 +263,38 @@ def validation_return(
         [policy], rows, np.zeros(episodes, dtype=np.int64), m_idx, np.arange(episodes), seed=noise_seed, n_steps=n_steps, threads=threads, device=device
     )
     return ev.returns
+
+
+def reevaluated_champion(
+    result: EvolutionResult, target, *, episodes: int, n_steps: int = EPISODE_STEPS, threads: int | None = None, device: str = "cpu"
+) -> tuple[Policy, np.ndarray]:
+    """The run's champion chosen again: the last generation's selected parents (``result.parents``) each flown the
+    same ``episodes`` fresh episodes (each on a fresh MDP from G, or on the MDP), the best mean fitness on the run's
+    scale winning (ties: the first parent). A generation's champion is otherwise the best of its noisy estimates,
+    the luckiest of mu short ones where no candidate is decided; these episodes come from ``SeedSequence(seed)``
+    child ``(4,)`` of the run's seed, which the run and :func:`validation_return` never use.
+
+    Returns the chosen policy (its metadata the run's champion's, with ``reevaluated_from`` = its parent's
+    index) and every parent's mean fitness over the episodes.
+    """
+    if result.parents is None or len(result.parents) == 0:
+        raise NeurohoverError("the run has no selected parents to choose from again: generational evolution keeps them, other methods do not")
+    if isinstance(episodes, bool) or not isinstance(episodes, (int, np.integer)) or episodes < 1:
+        raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
+    mdp, family, _ = resolve_target(target)
+    noise_seed, mdp_seed = reevaluation_seeds(check_seed(int(result.settings["seed"])))
+    if mdp is not None:
+        rows, m = mdp.row()[None, :], np.zeros(episodes, dtype=np.int64)
+    else:
+        assert family is not None  # resolve_target gives an MDP or a family
+        rows, m = family.sample_rows(np.random.default_rng(mdp_seed), episodes), np.arange(episodes)
+    k = len(result.parents)
+    champion = result.champion
+    policies = [Policy(champion.topology, np.array(g, dtype=float), champion.metadata) for g in result.parents]
+    p_idx, m_idx, e_idx = np.repeat(np.arange(k), episodes), np.tile(m, k), np.tile(np.arange(episodes), k)
+    ev = evaluate_jobs(policies, rows, p_idx, m_idx, e_idx, seed=noise_seed, n_steps=n_steps, threads=threads, device=device)
+    scale = result.settings.get("settings", {}).get("fitness", "return") if result.settings.get("method") == "generational" else "return"
+    means = episode_fitness(np.asarray(ev.returns).reshape(k, episodes), scale).mean(axis=1)
+    best = int(np.argmax(means))
+    chosen = policies[best]
+    return Policy(chosen.topology, chosen.genome, {**champion.metadata, "reevaluated_from": best}), means

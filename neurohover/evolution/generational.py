@@ -207,6 +207,7 @@ class GenerationalNE:
         self._generation = 0
         self._evaluations = 0
         self._champion_genome: np.ndarray | None = None
+        self._parents: np.ndarray | None = None  # the last generation's selected parents
         self._champion_return = -math.inf
         self._history: list[GenerationRecord] = []
         self._clock = Clock()
@@ -262,7 +263,8 @@ class GenerationalNE:
         self._evaluations += ep
         self._generation += 1
         self._history.append(GenerationRecord(self._generation, self._evaluations, ep, self._champion_return, self._clock()))
-        self._population = self._breed(self._population[sel])
+        self._parents = self._population[sel].copy()
+        self._population = self._breed(self._parents)
         self._asked = False
 
     def stop(self) -> bool:
@@ -324,6 +326,11 @@ class GenerationalNE:
         return None if self._champion_genome is None else self._champion_genome.copy()
 
     @property
+    def parents(self) -> np.ndarray | None:
+        """The latest generation's ``select_size`` selected parents, one genome a row (None before the first tell)."""
+        return None if self._parents is None else self._parents.copy()
+
+    @property
     def champion_return(self) -> float:
         """Best estimate of the latest generation (``-inf`` before the first tell)."""
         return self._champion_return
@@ -353,6 +360,7 @@ class GenerationalNE:
             "evaluations": self._evaluations,
             "champion_genome": enc_array(self._champion_genome),
             "champion_return": enc_float(self._champion_return),
+            "parents": enc_array(self._parents),
             "history": [
                 [
                     r.generation,
@@ -378,6 +386,7 @@ class GenerationalNE:
         opt._evaluations = int(state["evaluations"])
         opt._champion_genome = dec_array(state["champion_genome"])
         opt._champion_return = float(state["champion_return"])
+        opt._parents = dec_array(state.get("parents"))  # absent from checkpoints written before 2026-12-04
         opt._history = [GenerationRecord(int(g), int(e), int(ep), float(r), float(w)) for g, e, ep, r, w in state["history"]]
         opt._rng = rng_from_state(state["rng"])
         opt._clock = Clock(float(state["wall_seconds"]))

@@ -10,6 +10,8 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import NeurohoverError
 from ..policies import Policy
 from .common import enc_float
@@ -108,6 +110,9 @@ class EvolutionResult:
         optimiser settings, topology, seed, n_steps, budget.
     champion_crashed : bool
         Steady state: whether the champion's evaluation crashed (False for the other methods).
+    parents : np.ndarray or None
+        Generational NE: the last generation's selected parents, one genome a row (the candidates
+        :func:`~neurohover.evolution.evolve.reevaluated_champion` chooses from); None otherwise.
     """
 
     champion: Policy
@@ -122,6 +127,7 @@ class EvolutionResult:
     stop_reason: str
     settings: dict
     champion_crashed: bool = False
+    parents: np.ndarray | None = field(default=None, compare=False, repr=False)
 
     @property
     def episodes_per_second(self) -> float:

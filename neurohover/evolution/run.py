@@ -430,4 +430,5 @@ class Run:
             self.stop_reason or "",
             settings,
             bool(getattr(self.opt, "champion_crashed", False)),
+            parents=getattr(self.opt, "parents", None),
         )

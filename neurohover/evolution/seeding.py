@@ -21,9 +21,9 @@ import numpy as np
 from ..errors import NeurohoverError
 from ..sim.rng import MAX_SEED
 
-__all__ = ["MAX_SEED", "check_seed", "child_int", "mdp_rng", "noise_seed", "optimiser_seed", "validation_seeds"]
+__all__ = ["MAX_SEED", "check_seed", "child_int", "mdp_rng", "noise_seed", "optimiser_seed", "reevaluation_seeds", "validation_seeds"]
 
-_OPTIMISER, _MDPS, _NOISE, _VALIDATION = 0, 1, 2, 3
+_OPTIMISER, _MDPS, _NOISE, _VALIDATION, _REEVALUATION = 0, 1, 2, 3, 4
 
 
 def check_seed(seed) -> int:
@@ -51,6 +51,14 @@ def noise_seed(seed: int) -> int:
 def mdp_rng(seed: int) -> np.random.Generator:
     """The generator the run with root ``seed`` draws its task family's MDPs with."""
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(_MDPS,)))
+
+
+def reevaluation_seeds(seed: int) -> tuple[int, int]:
+    """``(noise seed, MDP seed)`` of the episodes that choose a run's champion again
+    (:func:`neurohover.evolution.evolve.reevaluated_champion`): the first two 63-bit words of child ``(4,)``."""
+    state = np.random.SeedSequence(seed, spawn_key=(_REEVALUATION,)).generate_state(2, np.uint64)
+    noise, mdps = (int(x >> np.uint64(1)) for x in state)
+    return noise, mdps
 
 
 def validation_seeds(seed: int) -> tuple[int, int]:

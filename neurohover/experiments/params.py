@@ -29,6 +29,7 @@ class EvolveParams:
     history_points: int = 300
     validation_mdps: str | None = None
     validation_seed: int | None = None
+    champion_reevaluation: int = 0  # fresh episodes that choose the champion again among the last parents (0: not)
     seed: int
 
 

@@ -113,6 +113,8 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
     root, name = (s.seed, cfg.name) if s.seeds_of is None else (s.seeds_of["seed"], s.seeds_of["experiment"])
     if s.validation_mdps == "test":  # one seed for every run's validation: the same MDPs and gusts
         base.update(validation_mdps="test", validation_seed=unit_seed(root, name, "validation"))
+    if s.champion_reevaluation:  # absent otherwise: stored units keep their params
+        base["champion_reevaluation"] = s.champion_reevaluation
     train = family.training_mdps()[: s.n_mdps]
     for v in s.variants:
         common = {**base, "topology": v.topology, "prototype": v.prototype, "resampling": v.resampling}

@@ -84,6 +84,8 @@ class _Record:
         for f in dataclasses.fields(self):  # type: ignore[arg-type]
             value = getattr(self, f.name)
             if f.name in self._NESTED:
+                if value is None and f.name in self._OPTIONAL:
+                    continue
                 if not isinstance(value, self._NESTED[f.name]):
                     raise NeurohoverError(f"{type(self).__name__}.{f.name} must be a {self._NESTED[f.name].__name__}, got {type(value).__name__}")
             elif f.name not in self._RAW:
@@ -135,7 +137,7 @@ class _Record:
                     + ([f"unknown key(s) {', '.join(unknown)} (written by another neurohover version?)"] if unknown else [])
                 )
             )
-        values = {n: cls._NESTED[n].from_dict(d[n], f"{what}.{n}") if n in cls._NESTED else d.get(n) for n in names}
+        values = {n: cls._NESTED[n].from_dict(d[n], f"{what}.{n}") if n in cls._NESTED and n in d else d.get(n) for n in names}
         return cls(**values)
 
     def columns(self) -> dict[str, Any]:
@@ -238,6 +240,35 @@ class TestRunTiming(_Record):
 
 
 @dataclass(frozen=True, kw_only=True)
+class Reevaluation(_Record):
+    """The champion of an ``evolve`` unit chosen again (:func:`neurohover.evolution.evolve.reevaluated_champion`).
+
+    Attributes
+    ----------
+    champion : StoredPolicy
+        The last generation's selected parent of best mean fitness over ``episodes`` fresh episodes.
+    parent : int
+        Its index among the parents.
+    episodes : int
+        Fresh episodes every parent flew.
+    estimate : Num
+        Its mean fitness over them (on the run's scale).
+    validation, validation_crashed : tuple or None
+        It flown as the run's champion is validated (None: no validation asked for).
+    """
+
+    _NESTED: ClassVar[dict[str, type[_Record]]] = {"champion": StoredPolicy}
+    _OPTIONAL: ClassVar[tuple[str, ...]] = ("validation", "validation_crashed")
+
+    champion: StoredPolicy
+    parent: int
+    episodes: int
+    estimate: Num
+    validation: tuple[Num, ...] | None = None
+    validation_crashed: tuple[bool, ...] | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
 class EvolveResult(_Record):
     """Result of an ``evolve`` unit: one evolution run (paper Section 3.1 / 5).
 
@@ -259,12 +290,14 @@ class EvolveResult(_Record):
     fitness : str or None
         The scale of ``champion_return`` and ``history`` (:mod:`neurohover.evolution.fitness`):
         ``inv-log-error`` or ``return`` (None: raw returns, as every run before the scale existed).
+    reevaluated : Reevaluation or None
+        The champion chosen again on fresh episodes (the evolution setting ``champion_reevaluation``; None: not asked for).
     timing : EvolveTiming
         Wall-clock; not part of ``==``.
     """
 
-    _NESTED: ClassVar[dict[str, type[_Record]]] = {"champion": StoredPolicy, "timing": EvolveTiming}
-    _OPTIONAL: ClassVar[tuple[str, ...]] = ("champion_crashed", "validation", "validation_crashed", "fitness")
+    _NESTED: ClassVar[dict[str, type[_Record]]] = {"champion": StoredPolicy, "timing": EvolveTiming, "reevaluated": Reevaluation}
+    _OPTIONAL: ClassVar[tuple[str, ...]] = ("champion_crashed", "validation", "validation_crashed", "fitness", "reevaluated")
 
     champion: StoredPolicy
     champion_return: Num
@@ -277,6 +310,7 @@ class EvolveResult(_Record):
     validation: tuple[Num, ...] | None = None
     validation_crashed: tuple[bool, ...] | None = None
     fitness: str | None = None
+    reevaluated: Reevaluation | None = None
     timing: EvolveTiming = field(compare=False)
 
     @property

@@ -224,6 +224,8 @@ SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
         # "fresh": each champion on fresh draws (of its MDP, or from G) of its own seed; "test": every
         # champion on the family's test MDPs with the same noise (paired comparisons)
         "validation_mdps": (OMIT, _choice("fresh", "test")),
+        # the champion chosen again: the last generation's parents each flown this many fresh episodes (generational runs)
+        "champion_reevaluation": (OMIT, _int(1)),
         "history_points": (300, _int(2)),
         "robustness_variants": ([], lambda v: (isinstance(v, list) and all(isinstance(x, str) for x in v), "a list of variant keys")),
         "robustness_episodes": (10, _int(1)),
@@ -339,6 +341,8 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
             raise NeurohoverError(f"{where}: robustness_variants {bad} are not variant keys ({', '.join(keys)})")
         if settings["robustness_variants"] and settings["target"] != "train":
             raise NeurohoverError(f"{where}: robustness_variants need target = 'train'")
+        if "champion_reevaluation" in settings and settings["target"] != "family":
+            raise NeurohoverError(f"{where}: champion_reevaluation chooses among a generational run's parents: it needs target = 'family'")
         if settings.get("validation_mdps") == "test" and settings["target"] != "family":
             raise NeurohoverError(f"{where}: validation_mdps = 'test' flies champions evolved over G on the family's test MDPs: it needs target = 'family'")
         if settings["target"] == "train" and settings["n_mdps"] > 10:

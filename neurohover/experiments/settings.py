@@ -92,6 +92,7 @@ class EvolutionSettings(ExperimentSettings):
     optimizer: dict
     validation_episodes: int = 0
     validation_mdps: str | None = None
+    champion_reevaluation: int = 0  # 0: the run's champion as it ends
     history_points: int = 300
     robustness_variants: tuple[str, ...] = ()
     robustness_episodes: int = 10

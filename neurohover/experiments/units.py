@@ -32,7 +32,7 @@ from ..errors import NeurohoverError
 from ..evaluate import evaluate, evaluate_jobs, num_threads
 from ..evolution.config import optimiser_of
 from ..evolution.eonn import EonnSettings
-from ..evolution.evolve import evolve, validation_return
+from ..evolution.evolve import evolve, reevaluated_champion, validation_return
 from ..models import learn_ec_meno, learn_ec_mer, learn_lr, one_step_error
 from ..policies import Policy
 from ..policies import prototype as make_prototype
@@ -45,6 +45,7 @@ from .results import (
     EvolveTiming,
     ModelResult,
     ModelTiming,
+    Reevaluation,
     RobustnessResult,
     SafetyResult,
     StoredPolicy,
@@ -141,13 +142,25 @@ def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:
         device=device,
     )
     history = [(int(h.episodes), num(h.champion_return)) for h in result.history]
-    validation = crashed = None
-    if q.validation_mdps == "test":  # every run's champion on the family's test MDPs, with shared noise (paired)
-        ev = fly_on_test_mdps(result.champion, target, q.validation_episodes, q.validation_seed, q.n_steps, threads, device)
-        validation, crashed = tuple(num(x) for x in ev.returns), tuple(bool(c) for c in ev.crashed)
-    elif q.validation_episodes:
-        v = validation_return(result.champion, target, episodes=q.validation_episodes, seed=q.seed, n_steps=q.n_steps, threads=threads, device=device)
-        validation = tuple(num(x) for x in v)
+
+    def validated(policy) -> tuple[tuple | None, tuple | None]:
+        if q.validation_mdps == "test":  # every run's champion on the family's test MDPs, with shared noise (paired)
+            ev = fly_on_test_mdps(policy, target, q.validation_episodes, q.validation_seed, q.n_steps, threads, device)
+            return tuple(num(x) for x in ev.returns), tuple(bool(c) for c in ev.crashed)
+        if q.validation_episodes:
+            v = validation_return(policy, target, episodes=q.validation_episodes, seed=q.seed, n_steps=q.n_steps, threads=threads, device=device)
+            return tuple(num(x) for x in v), None
+        return None, None
+
+    validation, crashed = validated(result.champion)
+    reevaluated = None
+    if q.champion_reevaluation:  # the champion chosen again among the last parents, validated alike
+        again, means = reevaluated_champion(result, target, episodes=q.champion_reevaluation, n_steps=q.n_steps, threads=threads, device=device)
+        parent = int(again.metadata["reevaluated_from"])
+        v, c = validated(again)
+        reevaluated = Reevaluation(
+            champion=StoredPolicy.of(again), parent=parent, episodes=q.champion_reevaluation, estimate=num(means[parent]), validation=v, validation_crashed=c
+        )
     scale = result.settings["settings"].get("fitness") if result.settings.get("method") == "generational" else None
     return EvolveResult(
         champion=StoredPolicy.of(result.champion),
@@ -161,6 +174,7 @@ def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:
         validation=validation,
         validation_crashed=crashed,
         fitness=scale,
+        reevaluated=reevaluated,
         timing=EvolveTiming(seconds=time.perf_counter() - t0, kernel_seconds=float(result.kernel_seconds)),
     ).to_dict()
 
