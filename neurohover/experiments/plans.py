@@ -163,14 +163,14 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
 # --------------------------------------------------------------------------------- policies of a test
 
 
-def _policy_evolution_unit(cfg: ExperimentConfig, key: str, target: dict, budget: int, resampling: str = "fixed:1") -> Unit:
+def _policy_evolution_unit(cfg: ExperimentConfig, key: str, target: dict, budget: int, resampling: str = "fixed:1", topology: str = "mlp") -> Unit:
     return _unit(
         cfg,
         key,
         "evolve",
         {
             "target": target,
-            "topology": "mlp",
+            "topology": topology,
             "prototype": "baseline",
             "resampling": resampling,
             "budget": budget,
@@ -289,7 +289,8 @@ class _Policies:
                         self._add(UnitKey.make("policy", f"generic-{kind}{j}"), _family_target(s, s.sigma), s.generic_budget, resampling)
 
     def _add(self, key: str, target: dict, budget: int, resampling: str = "fixed:1") -> None:
-        self.units.append(_policy_evolution_unit(self.cfg, key, target, budget, resampling))
+        topology = self.settings.generic_topology if key.startswith("policy/generic-") else "mlp"
+        self.units.append(_policy_evolution_unit(self.cfg, key, target, budget, resampling, topology))
         self.total += 1
 
     def _evolved(self, key: str) -> dict | None:

@@ -26,7 +26,7 @@ from .report_base import Section, fmt, log_errors, new_figure, sd, table
 from .report_evolution import EvolutionSection
 from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, test_run_figure, varies
 from .report_models import SensorModels
-from .results import ModelResult, TestRunResult, result_from_dict
+from .results import ModelResult, TestRunResult, UnitKey, result_from_dict
 from .settings import Group, ModelLearningSettings
 from .store import Store
 from .wins import DEFAULT_DRAWS, win_probabilities
@@ -278,7 +278,43 @@ class _TestRuns(Section):
                 rows,
             )
             + f"\n\nEach run: {self.s.episodes} episodes of {self.s.n_steps} control steps on one MDP; the score is the "
-            "cumulative reward of the whole run.\n" + (f"\n{effects}" if effects else "")
+            "cumulative reward of the whole run.\n" + (f"\n{effects}" if effects else "") + self._paired_elsewhere()
+        )
+
+    def _paired_elsewhere(self) -> str:
+        """Each group that flew another experiment's seeds against that experiment's group, run by run (Wilcoxon)."""
+        from scipy import stats
+
+        rows = []
+        for g in self.groups():
+            of = g.seeds_of
+            if of is None or of["experiment"] == self.cfg.name or not self.runs(g.label):
+                continue
+            theirs = {}
+            for u in self.store.units(of["experiment"], self.cfg.scale):
+                key = UnitKey.parse(u["key"])
+                if (key.stage, key.group) == ("run", of["group"]):
+                    theirs[f"{key.mdp}/rep{key.rep}"] = float(u["result"]["score"])
+            mine = {k: float(r.score) for k, r in self.paired_runs(g.label).items()}
+            common = sorted(set(mine) & set(theirs))
+            if len(common) < 2:
+                continue
+            diff = np.array([mine[k] - theirs[k] for k in common])
+            p = float(stats.wilcoxon(diff).pvalue) if np.any(diff != 0) else 1.0
+            a, b = float(np.mean([mine[k] for k in common])), float(np.mean([theirs[k] for k in common]))
+            rows.append([g.label, f"{of['experiment']}/{of['group']}", str(len(common)), fmt(a), fmt(b), f"{int((diff > 0).sum())} of {len(common)}", fmt(p)])
+            word = "better" if a > b else "worse" if a < b else "as good"
+            self.comparisons.append(
+                f"{g.label} vs {of['experiment']}'s {of['group']} on the same seeds: {word} (mean cumulative reward {fmt(a)} vs {fmt(b)}, "
+                f"Wilcoxon p = {fmt(p)}" + (", significant at 5%)." if p < 0.05 else ", not significant).")
+            )
+        if not rows:
+            return ""
+        return (
+            "\n### Paired with another experiment's runs\n\n"
+            + table(["group", "paired with", "run pairs", "mean cumulative reward", "its pair's", "runs better", "Wilcoxon p"], rows)
+            + "\n\nEach run flew the seed of the other experiment's run of that group on the same MDP (the same gusts and draws); "
+            "Wilcoxon signed-rank test on the run pairs' cumulative rewards.\n"
         )
 
 

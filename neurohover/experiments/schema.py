@@ -261,6 +261,8 @@ SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
         "generic_budget": (0, _int(0)),
         "generic_resampling": (dict(FGHH_GENERIC_RESAMPLING), _table()),
         "generics_per_agent": (1, _int(1)),
+        # the topology of the FGHH generics the experiment evolves itself (absent: MLP; the authors' were SLPs)
+        "generic_topology": (OMIT, _choice("slp", "mlp")),
         # kind -> "EXPERIMENT/VARIANT" (or "EXPERIMENT/best-race"): each run's generic drawn from the
         # final champions of another experiment's evolution runs, in the same store and scale
         "generics_from": (OMIT, _table()),
@@ -414,6 +416,8 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
                     f"{where}: generics_from = {{ {kind} = {source!r} }} is not allowed: expected keys fixed and/or race holding "
                     "'EXPERIMENT/VARIANT' or 'EXPERIMENT/best-race' (e.g. fixed = 'fig13/k5')"
                 )
+        if "generic_topology" in settings and (settings["policies"] != "evolve" or not TASK_FAMILIES[task].generic_over_distribution):
+            raise NeurohoverError(f"{where}: generic_topology applies to the FGHH generics an experiment evolves itself (policies = 'evolve', task fghh)")
         gr = settings["generic_resampling"]
         if set(gr) - {"fixed", "race"} or not all(_resampling()(v)[0] for v in gr.values()):
             raise NeurohoverError(f"{where}: generic_resampling must be a table with keys fixed and/or race holding fixed:K / race:DELTA")

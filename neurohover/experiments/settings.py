@@ -127,6 +127,7 @@ class TestRunsSettings(ExperimentSettings):
     generic_budget: int = 0
     generic_resampling: dict
     generics_per_agent: int = 1
+    generic_topology: str = "mlp"  # of the FGHH generics the experiment evolves itself
     generics_from: dict | None = None
     safety_episodes: int = 3
     model_budget: int = 2000

@@ -1,0 +1,57 @@
+"""Figure 16's zero-setting agents with an SLP generic (issue 32): the generics' topology as a setting, the runs on
+Figure 16's seeds, and the report pairing them with Figure 16's runs."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+from neurohover.errors import NeurohoverError
+from neurohover.experiments import Store, reproduce, write_report
+from neurohover.experiments.config import load_config, make_config
+from neurohover.experiments.executors import make_executor
+from neurohover.experiments.plans import plan
+from neurohover.experiments.units import unit_seed
+
+
+def test_the_zero_setting_generics_are_slps_and_the_runs_take_figure_16s_seeds() -> None:
+    cfg = load_config("fig16-slp-zero", "paper")
+    units = plan(cfg, {}).units
+    generics = [u for u in units if u.key.startswith("policy/generic-zero")]
+    assert len(generics) == 100 and all(u.params["topology"] == "slp" for u in generics)
+    mlp = [u for u in plan(load_config("fig16", "paper"), {}).units if u.key.startswith("policy/generic-zero")]
+    assert mlp and all(u.params["topology"] == "mlp" for u in mlp)  # Figure 16's own, as before
+    done = {u.key: {"champion": {"topology": "slp", "genome": [0.0] * 40}} for u in generics}
+    runs = [u for u in plan(cfg, done).units if u.kind == "test_run"]
+    assert len(runs) == 200
+    for u in runs[:5]:
+        agent = u.params["agent"]
+        assert u.params["seed"] == unit_seed(2016, "fig16", u.key.replace(f"run/{agent}/slp/", f"run/{agent}/"))
+
+
+def test_the_generics_topology_is_refused_where_no_generic_is_evolved() -> None:
+    base = {"task": "fghh", "seed": 1, "episodes": 2, "generic_topology": "slp", "groups": [{"agent": "authors-zero", "n_mdps": 1}]}
+    with pytest.raises(NeurohoverError, match="generic_topology applies to the FGHH generics an experiment evolves itself"):
+        make_config("x", "test_runs", "quick", {**base, "policies": "shipped"})
+    with pytest.raises(NeurohoverError, match="generic_topology applies"):
+        make_config("x", "test_runs", "quick", {**base, "task": "ghh08", "groups": [{"agent": "incremental", "n_mdps": 1}]})
+    with pytest.raises(NeurohoverError, match="generic_topology = 'rnn' is not allowed"):
+        make_config("x", "test_runs", "quick", {**base, "generic_topology": "rnn"})
+
+
+def test_the_report_pairs_each_run_with_figure_16s(committed_store: Path, tmp_path: Path) -> None:
+    path = tmp_path / "s.sqlite"
+    shutil.copyfile(committed_store, path)
+    with Store(path) as store:
+        executor = make_executor("local", jobs=1)
+        try:
+            reproduce(load_config("fig16-slp-zero", "quick"), store, executor, progress=False)
+        finally:
+            executor.close()
+        write_report(store, tmp_path / "out", scale="quick", names=["fig16-slp-zero"])
+    text = (tmp_path / "out" / "report.md").read_text()
+    block = text[text.index("### Paired with another experiment's runs") :]
+    assert "| authors-zero/slp | fig16/authors-zero | 3 |" in block
+    assert "authors-zero/slp vs fig16's authors-zero on the same seeds:" in text
