@@ -14,6 +14,7 @@ from neurohover.experiments.config import load_config, make_config
 from neurohover.experiments.executors import make_executor
 from neurohover.experiments.plans import plan
 from neurohover.experiments.units import unit_seed
+from neurohover.policies import Policy, load_policy, prototype, save_policy
 
 
 def test_the_zero_setting_generics_are_slps_and_the_runs_take_figure_16s_seeds() -> None:
@@ -55,3 +56,27 @@ def test_the_report_pairs_each_run_with_figure_16s(committed_store: Path, tmp_pa
     block = text[text.index("### Paired with another experiment's runs") :]
     assert "| authors-zero/slp | fig16/authors-zero | 3 |" in block
     assert "authors-zero/slp vs fig16's authors-zero on the same seeds:" in text
+
+
+def _generics(folder: Path, shift: float = 0.0) -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    base = prototype("slp", "baseline")
+    for i in range(3):
+        save_policy(Policy("slp", base.genome * (1.0 + 0.01 * i) + shift), folder / f"policy_{i:02d}.json")
+    return folder
+
+
+def test_generics_drawn_from_a_directory_of_policy_files(tmp_path: Path) -> None:
+    """Figure 16 with the authors' published generics (their .net files) is this with their folder."""
+    folder = _generics(tmp_path / "race")
+    settings = {"task": "fghh", "sigma": 0.3, "seed": 3, "episodes": 2, "generics_from": {"race": f"dir:{folder}"}}
+    cfg = make_config("x", "test_runs", "quick", {**settings, "groups": [{"agent": "authors-race", "n_mdps": 4}]})
+    runs = [u for u in plan(cfg, {}).units if u.kind == "test_run"]
+    genomes = {tuple(load_policy(folder / f"policy_{i:02d}.json").genome) for i in range(3)}
+    assert len(runs) == 4 and all(tuple(u.params["policies"]["generic"]["genome"]) in genomes for u in runs)
+    other = make_config(
+        "x", "test_runs", "quick", {**settings, "generics_from": {"race": f"dir:{_generics(tmp_path / 'other', 0.5)}"}, "groups": cfg.settings["groups"]}
+    )
+    assert cfg.hash != other.hash  # the files' genomes are part of the config
+    with pytest.raises(NeurohoverError, match="no directory of policy files"):
+        make_config("x", "test_runs", "quick", {**settings, "generics_from": {"race": f"dir:{tmp_path / 'none'}"}, "groups": cfg.settings["groups"]})

@@ -83,16 +83,38 @@ def _load_external(task: str, source: str):
 def external_digest(kind: str, s: dict) -> str:
     """Digest of policies a config reads from a directory (so results never mix policy sets)."""
     source = s.get("policies") if kind == "test_runs" else s.get("generic") if kind == "model_learning" else None
-    if source in (None, "evolve", "baseline"):
+    payload: dict = {}
+    if source not in (None, "evolve", "baseline"):
+        ps = _load_external(s["task"], source)
+        payload = {
+            "generic": policy_dict(ps.generic),
+            "specialised": [policy_dict(p) for p in ps.specialised],
+            "safe": list(ps.safe),
+            "generics": {k: policy_dict(v) for k, v in sorted(ps.generics.items())},
+        }
+    drawn = {k: v for k, v in sorted((s.get("generics_from") or {}).items()) if str(v).startswith(DIR_SOURCE)} if kind == "test_runs" else {}
+    if drawn:  # generics read from policy files: their genomes are part of the config
+        payload["generics_from"] = {k: [p for _, p in _dir_champions(v)] for k, v in drawn.items()}
+    if not payload:
         return ""
-    ps = _load_external(s["task"], source)
-    payload = {
-        "generic": policy_dict(ps.generic),
-        "specialised": [policy_dict(p) for p in ps.specialised],
-        "safe": list(ps.safe),
-        "generics": {k: policy_dict(v) for k, v in sorted(ps.generics.items())},
-    }
     return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
+
+
+#: A ``generics_from`` source that names a directory of policy files (``.net`` or ``.json``) instead of an experiment.
+DIR_SOURCE = "dir:"
+
+
+def _dir_champions(source: str) -> list[tuple[str, dict]]:
+    """``[(label, policy)]`` of the policy files in the directory ``dir:PATH`` names, in file-name order."""
+    from pathlib import Path
+
+    from ..policies import load_policy
+
+    folder = Path(source[len(DIR_SOURCE) :]).expanduser()
+    files = sorted(f for f in folder.iterdir() if f.suffix in (".net", ".json")) if folder.is_dir() else []
+    if not files:
+        raise NeurohoverError(f"generics_from {source!r}: no directory of policy files (.net or .json) there; give dir:PATH of one")
+    return [(f"{source}/{f.name}", policy_dict(load_policy(f))) for f in files]
 
 
 # --------------------------------------------------------------------------------- evolution
@@ -189,7 +211,8 @@ def _spec(agent: str):
 def source_experiments(cfg: ExperimentConfig) -> list[str]:
     """The experiments whose results a config's units need (``generics_from``), in the order named."""
     s = cfg.typed
-    names = [str(src).partition("/")[0] for src in (s.generics_from or {}).values()] if isinstance(s, TestRunsSettings) else []
+    sources = (s.generics_from or {}).values() if isinstance(s, TestRunsSettings) else ()
+    names = [str(src).partition("/")[0] for src in sources if not str(src).startswith(DIR_SOURCE)]
     return list(dict.fromkeys(names))
 
 
@@ -198,6 +221,8 @@ def _source_champions(source: str, scale: str, results: dict) -> tuple[list[tupl
     ``EXPERIMENT/best-race``: the race variant whose final champions' fitness estimates have the
     highest mean, so that no test MDP chooses it), or None and why while its runs are unfinished."""
 
+    if source.startswith(DIR_SOURCE):
+        return _dir_champions(source), ""
     name, _, want = source.partition("/")
     src = load_config(name, scale).typed
     if not isinstance(src, EvolutionSettings):

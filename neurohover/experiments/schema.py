@@ -411,10 +411,12 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
                     raise NeurohoverError(f"{where}: group {g['label']!r}: {e}") from None
         for kind, source in settings.get("generics_from", {}).items():
             name, _, variant = str(source).partition("/")
+            if str(source).startswith("dir:") and len(str(source)) > 4:
+                name = variant = "dir"  # a directory of policy files (checked when the config's digest reads them)
             if kind not in ("fixed", "race") or not isinstance(source, str) or not name or not variant:
                 raise NeurohoverError(
                     f"{where}: generics_from = {{ {kind} = {source!r} }} is not allowed: expected keys fixed and/or race holding "
-                    "'EXPERIMENT/VARIANT' or 'EXPERIMENT/best-race' (e.g. fixed = 'fig13/k5')"
+                    "'EXPERIMENT/VARIANT', 'EXPERIMENT/best-race' (e.g. fixed = 'fig13/k5') or 'dir:PATH' (a directory of policy files)"
                 )
         if "generic_topology" in settings and (settings["policies"] != "evolve" or not TASK_FAMILIES[task].generic_over_distribution):
             raise NeurohoverError(f"{where}: generic_topology applies to the FGHH generics an experiment evolves itself (policies = 'evolve', task fghh)")
