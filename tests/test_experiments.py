@@ -595,6 +595,9 @@ def test_a_verdict_weighs_direction_before_significance() -> None:
     assert verdict("mlp", -1.0, -2.0, 0.01, "0.3") == "same direction, significant here but not in the paper"
     assert verdict("mlp", -2.0, -1.0, 1e-9, "1e-5") == "reversed (the paper found mlp better; ours is worse)"
     assert verdict("mlp", -1.0, -2.0, 0.01, "none (not in the paper)") is None
+    # "not significant" with no number (Figure 2's slp-zero vs slp-baseline, Figure 16's fixed vs zero): no direction to reverse
+    assert verdict("slp-zero", -2.0, -1.0, 0.4, "not significant") == "holds (neither significant)"
+    assert verdict("slp-zero", -2.0, -1.0, 0.001, "not significant") == "differs: significant here (slp-zero worse), not in the paper"
 
 
 def test_an_interrupt_ends_the_running_worker_processes_at_once() -> None:
@@ -620,3 +623,18 @@ def test_an_interrupt_ends_the_running_worker_processes_at_once() -> None:
     # its unit and shut down exits with 0).
     assert len(workers) == 2 and all(p.exitcode is not None and p.exitcode < 0 for p in workers), [p.exitcode for p in workers]
     assert not [p for p in multiprocessing.active_children() if p.is_alive()]
+
+
+def test_the_report_opens_with_the_papers_claims_and_conclusions(committed_store: Path, tmp_path: Path) -> None:
+    """Issue 33: every claim checked at paper scale, with its verdict; a reversed effect is never counted as holding."""
+    with Store(committed_store, create=False) as store:
+        write_report(store, tmp_path, scale="paper", names=["table4", "fig8", "fig11"])
+    text = (tmp_path / "report.md").read_text()
+    top = text[text.index("## Claims and conclusions (paper scale)") : text.index("\n## Table 4")]
+    rows = [line.split(" | ") for line in top.splitlines() if line.startswith("| [")]
+    fig11 = [r for r in rows if r[0].startswith("| [fig11]") and " vs " in r[1]]
+    assert len(fig11) == 2 and all(r[-1].startswith("reversed") for r in fig11)  # the paper's hybrids better; ours worse
+    assert any(r[1] == "Table 4, LR: median r_m" and r[2] == "-142.2" for r in rows)
+    conclusions = {line.split(" | ")[0][2:]: line.split(" | ") for line in top.splitlines() if line.startswith("| (")}
+    models = conclusions["(3)-(4) model-based approaches are feasible, and superior, only with a suitable model representation"]
+    assert int(models[3]) >= 2 and "of" in models[2]  # Figure 11's two reversed tests at least

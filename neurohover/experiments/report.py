@@ -22,7 +22,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from .config import ORDER, ExperimentConfig
-from .report_base import Section, fmt, log_errors, new_figure, sd, table
+from .report_base import Section, fmt, log_errors, new_figure, ratio_verdict, sd, table
 from .report_evolution import EvolutionSection
 from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, test_run_figure, varies
 from .report_models import SensorModels
@@ -92,6 +92,7 @@ class _ModelLearning(Section):
                 ]
             )
             if p:
+                self.add_claim(f"Table 4, {m.upper()}: median r_m", fmt(p.get("r_m")), fmt(np.median(r)), ratio_verdict(float(np.median(r)), float(p["r_m"])))
                 self.comparisons.append(
                     f"{m.upper()}: our median {fmt(np.median(r))} vs paper {fmt(p.get('r_m'))}; our mean "
                     f"{fmt(r.mean())} vs paper {fmt(p.get('r_a'))}; our time to learn {fmt(t.mean())} s vs paper "
@@ -100,6 +101,15 @@ class _ModelLearning(Section):
         if ref and means:
             ours = sorted(means, key=lambda k: -means[k])
             paper = sorted((k for k in ref if k in means), key=lambda k: -ref[k]["r_a"])
+            if paper:  # conclusion (2): of the paper's methods, LR's policies are the best (by mean return)
+                mine = [k for k in ours if k in paper]
+                self.add_claim(
+                    "Table 4: the best method by mean return",
+                    paper[0].upper(),
+                    mine[0].upper(),
+                    "holds" if mine[0] == paper[0] else "differs (ours: " + " > ".join(x.upper() for x in mine) + ")",
+                    "ranking",
+                )
             self.comparisons.append(
                 "Ranking by mean return (best first): ours "
                 + " > ".join(x.upper() for x in ours)
@@ -237,6 +247,14 @@ class _TestRuns(Section):
                     fmt(np.mean([r.timing.seconds for r in runs])),
                 ]
             )
+            if "crash_rate" in p:
+                near = abs(crash_rate - p["crash_rate"]) <= 0.05
+                self.add_claim(f"{label}: runs with a crash", f"{p['crash_rate']:.1%}", f"{crash_rate:.1%}", "holds (within 5 points)" if near else "differs")
+            if "return_per_episode_no_crash" in p and clean:
+                paper_r = float(p["return_per_episode_no_crash"])
+                self.add_claim(
+                    f"{label}: return per episode (runs without a crash)", fmt(paper_r), fmt(per_episode_clean), ratio_verdict(per_episode_clean, paper_r)
+                )
             if p:
                 line = f"{label}: our crash rate {crash_rate:.1%} of {len(runs)} runs"
                 if "crash_rate" in p:
@@ -362,7 +380,7 @@ def _header(cfg: ExperimentConfig, store: Store, units: list[dict], total: int |
     )
 
 
-def _section(cfg: ExperimentConfig, store: Store, out: Path) -> str:
+def _section(cfg: ExperimentConfig, store: Store, out: Path) -> tuple[str, list[dict[str, str]]]:
     from .plans import plan
 
     units = store.units(cfg.name, cfg.scale)
@@ -395,7 +413,7 @@ def _section(cfg: ExperimentConfig, store: Store, out: Path) -> str:
         lines += [f"  - {n}" for n in notes]
     text.append("\n".join(lines) + "\n")
     text.append("### Discussion\n\n" + _discussion(cfg, out) + "\n")
-    return "\n".join(text)
+    return "\n".join(text), sec.claims
 
 
 QUICK_DISCUSSION = (
@@ -432,19 +450,72 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
     rank = {n: i for i, n in enumerate(ORDER)}
     entries.sort(key=lambda e: (rank.get(e[0], len(ORDER)), e[0], e[1]))
     sections, toc = [], []
+    claims: dict[str, tuple[str, list[dict[str, str]]]] = {}  # paper figure -> (its section's anchor, its claims)
     for name, sc in entries:
         cfg = ExperimentConfig.from_dict(store.config(name, sc))
-        sections.append(_section(cfg, store, out))
-        toc.append(f"- [{cfg.title} [{sc}]](#{_anchor(cfg.title + ' [' + sc + ']')})")
+        text, checked = _section(cfg, store, out)
+        sections.append(text)
+        anchor = _anchor(cfg.title + " [" + sc + "]")
+        toc.append(f"- [{cfg.title} [{sc}]](#{anchor})")
+        if sc == "paper" and name in PAPER_FIGURES:
+            claims[name] = (anchor, checked)
     head = (
         f"# Reproduction report: Koppejan & Whiteson (2011)\n\n"
         f"Generated {time.strftime('%Y-%m-%d %H:%M:%S')} from the results store `{store.path}`. Error is minus the "
         f"return (lower is better). Quick-scale runs use short episodes and few runs: they check the pipeline, and "
         f"their numbers are not comparable in magnitude with the paper's.\n\n" + "\n".join(toc) + "\n"
     )
+    if claims:
+        head += "\n" + claims_section(claims)
     path = out / "report.md"
     path.write_text(head + "\n" + "\n".join(sections))
     return path
+
+
+#: The paper's tables and figures, whose claims the claims table lists (at paper scale), in the paper's order.
+PAPER_FIGURES = ("fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16")
+
+#: The paper's conclusions (Section 8) and the figures whose tests bear on each.
+CONCLUSIONS = (
+    ("(1) neuroevolution can be effective for complex on-line reinforcement learning tasks", ("fig2", "fig7", "fig8")),
+    ("(2) neuroevolution excels at finding effective policies but not at learning helicopter models", ("table4",)),
+    ("(3)-(4) model-based approaches are feasible, and superior, only with a suitable model representation", ("fig7", "fig8", "fig11")),
+    ("(5) efficient resampling lets neuroevolution tackle more aggressively generalized tasks", ("fig15", "fig16")),
+)
+
+
+def claims_section(claims: dict[str, tuple[str, list[dict[str, str]]]]) -> str:
+    """The report's first section: every claim of the paper's figures checked at paper scale, then each conclusion
+    with the verdicts of the claims that bear on it. A reversed effect is counted as reversed, never as agreement."""
+    rows = [
+        [f"[{name}](#{anchor})", c["claim"], c["paper"], c["ours"], c["verdict"]]
+        for name in PAPER_FIGURES
+        if name in claims
+        for anchor, checked in [claims[name]]
+        for c in checked
+    ]
+    if not rows:
+        return ""
+    lines = []  # each conclusion with the verdicts of the t tests and rankings of its figures (not their numbers)
+    for conclusion, figures in CONCLUSIONS:
+        verdicts = [c["verdict"] for f in figures if f in claims for c in claims[f][1] if c["kind"] in ("test", "ranking")]
+        tests = [v for v in verdicts if v]
+        held = sum(v.startswith("holds") or v.startswith("within") for v in tests)
+        reversed_ = sum(v.startswith("reversed") for v in tests)
+        where = ", ".join(f"[{f}](#{claims[f][0]})" for f in figures if f in claims) or "no figure at paper scale yet"
+        lines.append(
+            [conclusion, where, f"{held} of {len(tests)}", str(reversed_), str(len(tests) - held - reversed_)] if tests else [conclusion, where, "", "", ""]
+        )
+    return (
+        "## Claims and conclusions (paper scale)\n\n"
+        + table(["figure", "claim", "paper", "ours", "verdict"], rows)
+        + "\n\nEach t test's verdict weighs direction before significance: *holds* (same direction, as significant), "
+        "*same direction, weaker* or *not significant*, *reversed* (the effect runs the other way, whatever the p-values). "
+        "Numbers: *within a factor of two* of the paper's, or how many times it. Each figure's section says why a claim differs.\n\n"
+        "### The paper's conclusions\n\n"
+        + table(["conclusion (Section 8)", "figures", "claims that hold", "reversed", "weaker, not significant or otherwise differing"], lines)
+        + "\n"
+    )
 
 
 def _anchor(title: str) -> str:

@@ -92,6 +92,14 @@ def p_value(p_paper: str) -> float | None:
         return None
 
 
+def ratio_verdict(ours: float, paper: float) -> str:
+    """A number of ours against the paper's of the same sign: within a factor of two, or how many times it is."""
+    if paper == 0 or ours == 0 or (ours > 0) != (paper > 0):
+        return "differs" if ours != paper else "holds"
+    ratio = ours / paper
+    return "within a factor of two" if 0.5 <= ratio <= 2 else f"{ratio:.2g} times the paper's"
+
+
 def verdict(a: str, ma: float, mb: float, p_ours: float, p_paper: str) -> str | None:
     """How our test of ``a`` against ``b`` (means ``ma``, ``mb``; Student's ``p_ours``) stands to the
     paper's (``p_paper``, whose ``a`` is the one the paper found better), by direction first, then
@@ -101,6 +109,8 @@ def verdict(a: str, ma: float, mb: float, p_ours: float, p_paper: str) -> str | 
     if expected is None:
         return None
     significant = p_ours < 0.05
+    if p_value(p_paper) is None:  # the paper says "not significant" and gives no number: no direction to keep or reverse
+        return "holds (neither significant)" if not significant else f"differs: significant here ({a} {'better' if ma > mb else 'worse'}), not in the paper"
     if ma <= mb:
         return f"reversed{'' if significant else ', not significant'} (the paper found {a} better; ours is worse)"
     if expected and significant:
@@ -122,6 +132,7 @@ class Section:
         self.paper = config.paper
         self.comparisons: list[str] = []
         self.tests: list[list] = []
+        self.claims: list[dict[str, str]] = []  # the paper's claims this section checks (the report's claims table)
 
     def group(self, stage: str, group: str) -> list:
         """The results of the units of ``stage`` and ``group`` (:class:`UnitKey`), in key order."""
@@ -160,11 +171,25 @@ class Section:
             self.tests.append([f"{labels.get(a, a)} vs {labels.get(b, b)}", fmt(ma), fmt(mb), fmt(stat), fmt_p(p_student), fmt_p(p_welch), str(t["p"])])
             # Each paper test names the approach the paper found better as ``a``.
             judged = None if p_student is None else verdict(labels.get(a, a), float(ma), float(mb), p_student, str(t["p"]))
+            if p_student is not None:
+                found = f"no significant difference ({t['p']})" if p_value(str(t["p"])) is None else f"{labels.get(a, a)} better, p {t['p']}"
+                self.add_claim(
+                    f"{labels.get(a, a)} vs {labels.get(b, b)} ({what})",
+                    found,
+                    f"{fmt(ma)} vs {fmt(mb)}, p = {fmt_p(p_student)}",
+                    judged or "no p-value to compare",
+                    "test",
+                )
             if p_student is not None and judged is not None:
                 self.comparisons.append(
                     f"{labels.get(a, a)} vs {labels.get(b, b)} ({what}): our Student's p = {fmt_p(p_student)} "
                     f"({'significant' if p_student < 0.05 else 'not significant'} at 5%; mean {fmt(ma)} vs {fmt(mb)}) vs paper p {t['p']}: {judged}."
                 )
+
+    def add_claim(self, claim: str, paper: str, ours: str, judged: str, kind: str = "number") -> None:
+        """One row of the report's claims table: what the paper found, what we find, and the verdict; ``kind``
+        ``"test"`` (a t test), ``"ranking"`` (an order of methods) or ``"number"`` (a figure beside the paper's)."""
+        self.claims.append({"claim": claim, "paper": paper, "ours": ours, "verdict": judged, "kind": kind})
 
     def figure(self) -> str | None:
         """Write the section's figure (each kind of section defines it); returns its file name, or None."""

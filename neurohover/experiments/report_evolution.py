@@ -11,7 +11,7 @@ import numpy as np
 from ..errors import NeurohoverError
 from ..evolution.fitness import episode_fitness, error_of_fitness
 from .config import ExperimentConfig, load_config
-from .report_base import Section, fmt, new_figure, sd, table
+from .report_base import Section, fmt, new_figure, ratio_verdict, sd, table
 from .results import EvolveResult, RobustnessResult, UnitKey, result_from_dict
 from .settings import EvolutionSettings, Variant
 
@@ -380,6 +380,9 @@ class EvolutionSection(Section):
                     str(p.get("crashes_G", "n/a")),
                 ]
             )
+            for what, ours, key in (("r (own MDP)", float(np.mean(own)), "r"), ("r_G (all training MDPs)", float(np.mean(across)), "r_G")):
+                if key in p:
+                    self.add_claim(f"Table 3, {label}: {what}", fmt(p[key]), fmt(ours), ratio_verdict(ours, float(p[key])))
             if p:
                 self.comparisons.append(
                     f"Table 3, {label}: our r = {fmt(np.mean(own))} vs paper {fmt(p.get('r'))}; "
