@@ -145,14 +145,45 @@ class _TestRuns(Section):
         data = {k: v for k, v in data.items() if v}
         if not data:
             return None
+        if len(data) > MAX_CURVES:  # too many for one panel: a panel per agent
+            return self.save(self._panels_by_agent(data))
         fig, axes = new_figure(2, figsize=(11, 4.2))
         axes = axes[0]
-        for label, runs in data.items():
+        for i, (label, runs) in enumerate(data.items()):
             cum = -np.cumsum(np.array([[float(x) for x in r.returns] for r in runs]), axis=1).mean(axis=0)
             episodes = np.arange(1, cum.size + 1)
             for ax in axes:
-                ax.plot(episodes, cum, label=f"{label} ({len(runs)} runs)")
+                ax.plot(episodes, cum, label=f"{label} ({len(runs)} runs)", **curve_style(i))
         return self.save_panels(fig, axes, "episode", ("mean cumulative error (-cumulative reward)", "mean cumulative error (log scale)"))
+
+    def _panels_by_agent(self, data: dict[str, list[TestRunResult]]):
+        """One log-scale panel per agent (its groups' mean cumulative error, told apart by colour, then line
+        style), each with its legend below it: a figure for the benchmarks' many AGENT/CONDITION groups."""
+        by_agent: dict[str, list[str]] = {}
+        for g in self.groups():
+            if g.label in data:
+                by_agent.setdefault(g.agent, []).append(g.label)
+        n = len(by_agent)
+        cols = min(n, 3)
+        rows = -(-n // cols)
+        fig, axes = new_figure(cols, figsize=(5.2 * cols, 4.8 * rows), nrows=rows)
+        flat = list(np.ravel(axes))
+        for ax, (agent, labels) in zip(flat, by_agent.items()):
+            for i, label in enumerate(labels):
+                runs = data[label]
+                cum = -np.cumsum(np.array([[float(x) for x in r.returns] for r in runs]), axis=1).mean(axis=0)
+                short = label[len(agent) + 1 :] if label.startswith(agent + "/") else label
+                ax.plot(np.arange(1, cum.size + 1), cum, label=f"{short} ({len(runs)})", **curve_style(i))
+            ax.set_yscale("log")
+            ax.set_title(agent, fontsize=10)
+            ax.set_xlabel("episode")
+            ax.set_ylabel("mean cumulative error (log scale)")
+            ax.grid(alpha=0.3, which="both")
+            ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, frameon=False)
+        for ax in flat[n:]:
+            ax.set_visible(False)
+        fig.suptitle(f"{self.cfg.title} ({self.cfg.scale} scale); legend: condition (runs)", fontsize=10)
+        return fig
 
     def _matrix(self) -> str:
         """Where every group is labelled AGENT/CONDITION (the benchmarks): agents by conditions, crash rate and median score."""
@@ -334,6 +365,15 @@ class _TestRuns(Section):
             + "\n\nEach run flew the seed of the other experiment's run of that group on the same MDP (the same gusts and draws); "
             "Wilcoxon signed-rank test on the run pairs' cumulative rewards.\n"
         )
+
+
+#: The most curves one panel of a figure holds: more are split into panels (issue 33).
+MAX_CURVES = 8
+
+
+def curve_style(i: int) -> dict:
+    """The i-th curve's colour (ten, then again) and line style (solid, dashed, dotted, dash-dot by tens)."""
+    return {"color": f"C{i % 10}", "ls": ("-", "--", ":", "-.")[(i // 10) % 4]}
 
 
 QUICK_NOTE = "a fast smoke-scale run: short episodes and few runs; magnitudes are not comparable with the paper"

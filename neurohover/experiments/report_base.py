@@ -64,8 +64,8 @@ def sd(x) -> float:
     return float(x.std(ddof=1)) if x.size > 1 else float("nan")
 
 
-def new_figure(ncols: int = 1, *, figsize: tuple[float, float]):
-    """A new figure with a 1 x ``ncols`` grid of axes (an array, always 2-d), drawn by Agg.
+def new_figure(ncols: int = 1, *, figsize: tuple[float, float], nrows: int = 1):
+    """A new figure with an ``nrows`` x ``ncols`` grid of axes (an array, always 2-d), drawn by Agg.
 
     Object-oriented matplotlib: no pyplot, so the caller's backend and pyplot's figures are untouched."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -73,7 +73,7 @@ def new_figure(ncols: int = 1, *, figsize: tuple[float, float]):
 
     fig = Figure(figsize=figsize)
     FigureCanvasAgg(fig)
-    return fig, fig.subplots(1, ncols, squeeze=False)
+    return fig, fig.subplots(nrows, ncols, squeeze=False)
 
 
 def p_significant(p_paper: str) -> bool | None:
@@ -150,16 +150,25 @@ class Section:
         return path.name
 
     def save_panels(self, fig, axes, xlabel: str, ylabels: tuple[str, str]) -> str:
-        """Label two panels (the second on a log scale), title the figure and save it."""
+        """Label two panels (the second on a log scale), title the figure, put one legend below both (so it
+        covers no curve; the figure grows by its rows) and save it."""
         axes[0].set_ylabel(ylabels[0])
         axes[1].set_ylabel(ylabels[1])
         axes[1].set_yscale("log")
         for ax in axes:
             ax.set_xlabel(xlabel)
             ax.grid(alpha=0.3, which="both")
-            ax.legend(fontsize=8)
+        handles, labels = axes[0].get_legend_handles_labels()
+        rows = -(-len(labels) // 2)
+        width, height = fig.get_size_inches()
+        extra = 0.25 * rows + 0.2
+        fig.set_size_inches(width, height + extra)
         fig.suptitle(f"{self.cfg.title} ({self.cfg.scale} scale)", fontsize=10)
-        return self.save(fig)
+        fig.legend(handles, labels, loc="lower center", ncol=2, fontsize=8, frameon=False)
+        fig.tight_layout(rect=(0, extra / (height + extra), 1, 1))
+        path = self.out / f"{self.stem}.png"
+        fig.savefig(path, dpi=110)
+        return path.name
 
     def add_tests(self, samples: dict[str, list[float]], labels: dict[str, str], what: str) -> None:
         for t in self.paper.get("ttests", []):
