@@ -420,3 +420,20 @@ def test_two_equal_runs_give_equal_results_whatever_their_wall_clock() -> None:
     p = prototype("mlp", "baseline")
     assert p == Policy("mlp", p.genome.copy(), {"note": "metadata does not count"}) and len({p, prototype("mlp", "baseline")}) == 1
     assert p != prototype("mlp", "zero") and p != prototype("slp", "baseline")
+
+
+def test_a_resume_with_other_sensors_is_refused(tmp_path: Path) -> None:
+    """Issue 34's bug: a noisy-sensor run's checkpoint recorded the same target as an exact-sensor one, so a
+    resume could silently continue it with other sensors."""
+    from neurohover.tasks import Sensor, get_task_family
+
+    exact = get_task_family("ghh08")
+    noisy = exact.with_sensor(Sensor.of(obs_noise=0.5))
+    ckpt = tmp_path / "run.ckpt.json"
+    common = dict(topology="slp", prototype="baseline", seed=3, n_steps=50)
+    evolve(noisy, budget=60, checkpoint=ckpt, **common)
+    saved = json.loads(ckpt.read_text())["config"]["target"]
+    assert saved["sensor"] == noisy.sensor.to_dict() and "sensor" not in evolve(exact, budget=60, **common).settings["target"]
+    with pytest.raises(NeurohoverError, match="written by a different run: target differ"):
+        evolve(exact, budget=120, checkpoint=ckpt, resume=True, **common)
+    assert evolve(noisy, budget=120, checkpoint=ckpt, resume=True, **common).episodes >= 60  # the same sensors resume
