@@ -319,7 +319,7 @@ def compete(
 
 def _run_order(key: str) -> tuple[int, int]:
     """Runs in the order of their MDP, then repetition (keys ``run/<agent>/<set><i>/rep<r>``)."""
-    from .experiments.results import UnitKey
+    from .experiments.keys import UnitKey
 
     parsed = UnitKey.parse(key)
     index = parsed.mdp_index

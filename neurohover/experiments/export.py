@@ -18,7 +18,8 @@ import io
 import json
 
 from ..errors import NeurohoverError
-from .results import UnitKey, flat_cells, result_from_dict
+from .keys import UnitKey
+from .results import flat_cells, result_from_dict
 from .store import Store
 
 FORMATS = ("csv", "json")

@@ -33,7 +33,7 @@ from ..policysets import load_policy_set, policy_set_roles
 from ..tasks import EXACT, Sensor
 from ..tasks.drift import Drift
 from .config import ExperimentConfig, load_config
-from .results import UnitKey
+from .keys import UnitKey
 from .schema import variant_optimizer
 from .settings import EvolutionSettings, ExperimentSettings, Group, ModelLearningSettings, TestRunsSettings
 from .units import Unit, family_of, policy_dict, unit_seed

@@ -22,11 +22,12 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from .config import ORDER, ExperimentConfig
+from .keys import UnitKey
 from .report_base import Section, fmt, log_errors, new_figure, ratio_verdict, sd, table
 from .report_evolution import EvolutionSection
 from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, test_run_figure, varies
 from .report_models import SensorModels
-from .results import ModelResult, TestRunResult, UnitKey, result_from_dict
+from .results import ModelResult, TestRunResult, result_from_dict
 from .settings import Group, ModelLearningSettings
 from .store import Store
 from .wins import DEFAULT_DRAWS, win_probabilities

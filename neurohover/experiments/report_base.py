@@ -9,7 +9,8 @@ from typing import Any
 import numpy as np
 
 from .config import ExperimentConfig
-from .results import UnitKey, UnitResult
+from .keys import UnitKey
+from .results import UnitResult
 from .store import Store
 
 # --------------------------------------------------------------------------------- formatting

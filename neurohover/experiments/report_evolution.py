@@ -11,8 +11,9 @@ import numpy as np
 from ..errors import NeurohoverError
 from ..evolution.fitness import episode_fitness, error_of_fitness
 from .config import ExperimentConfig, load_config
+from .keys import UnitKey
 from .report_base import Section, fmt, new_figure, ratio_verdict, sd, table
-from .results import EvolveResult, RobustnessResult, UnitKey, result_from_dict
+from .results import EvolveResult, RobustnessResult, result_from_dict
 from .settings import EvolutionSettings, Variant
 
 

@@ -18,7 +18,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from ..errors import NeurohoverError
-from .results import UnitKey
+from .keys import UnitKey
 
 __all__ = ["DEFAULT_DRAWS", "WinOdds", "stored_runs", "win_probabilities"]
 

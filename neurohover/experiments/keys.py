@@ -1,0 +1,97 @@
+"""Unit keys: the names the planner gives units (``run/<group>/<mdps><i>/rep<r>``, ...) and their parts."""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+__all__ = ["UnitKey"]
+
+_KEY_PATTERNS = (
+    ("evolve", re.compile(r"evolve/(?P<group>.+?)(?:/(?P<mdp>train\d+))?/run(?P<rep>\d+)")),
+    ("robust", re.compile(r"robust/(?P<group>.+)/(?P<mdp>train\d+)")),
+    ("policy", re.compile(r"policy/(?P<group>.+)")),
+    ("model", re.compile(r"model/(?P<group>.+)/(?P<mdp>[a-z]+\d+)")),
+    ("run", re.compile(r"run/(?P<group>.+)/(?P<mdp>[a-z]+\d+)/rep(?P<rep>\d+)")),
+)
+
+
+@dataclass(frozen=True)
+class UnitKey:
+    """The parts of a unit key (the scheme of :mod:`~neurohover.experiments.plans`).
+
+    ========================================  ========  =============  =========  =====
+    key                                       stage     group          mdp        rep
+    ========================================  ========  =============  =========  =====
+    ``evolve/<variant>/train<i>/run<r>``      evolve    variant        train<i>   r
+    ``evolve/<variant>/run<r>``               evolve    variant        None       r
+    ``robust/<variant>/train<i>``             robust    variant        train<i>   None
+    ``policy/<name>``                         policy    name           None       None
+    ``model/<method>/<mdps><i>``              model     method         <mdps><i>  None
+    ``run/<group>/<mdps><i>/rep<r>``          run       group label    <mdps><i>  r
+    anything else (e.g. diagnostic units)     ""        ""             None       None
+    ========================================  ========  =============  =========  =====
+
+    Attributes
+    ----------
+    key : str
+    stage : str
+    group : str
+    mdp : str or None
+        Which MDP set and index (``"train3"``, ``"test0"``, ``"sample2"``).
+    rep : int or None
+        The run or repetition number.
+    """
+
+    key: str
+    stage: str
+    group: str
+    mdp: str | None = None
+    rep: int | None = None
+
+    @property
+    def mdp_index(self) -> int | None:
+        """The index in :attr:`mdp` (``3`` of ``"train3"``), or None without one."""
+        digits = (self.mdp or "").lstrip("abcdefghijklmnopqrstuvwxyz")
+        return int(digits) if digits.isdigit() else None
+
+    @classmethod
+    def make(cls, stage: str, group: str, mdp: str | None = None, rep: int | None = None) -> str:
+        """The key of a unit with these parts (the planner's only way to name units): the inverse of :meth:`parse`.
+
+        Raises ValueError for parts outside the scheme (a part that would not parse back).
+        """
+        forms = {
+            "evolve": f"evolve/{group}/{mdp}/run{rep}" if mdp is not None else f"evolve/{group}/run{rep}",
+            "robust": f"robust/{group}/{mdp}",
+            "policy": f"policy/{group}",
+            "model": f"model/{group}/{mdp}",
+            "run": f"run/{group}/{mdp}/rep{rep}",
+        }
+        if stage not in forms:
+            raise ValueError(f"unknown unit stage {stage!r}: allowed {', '.join(forms)}")
+        key = forms[stage]
+        if cls.parse(key) != cls(key, stage, group, mdp, rep if stage in ("evolve", "run") else None):
+            raise ValueError(f"unit key parts {(stage, group, mdp, rep)!r} do not fit the key scheme")
+        return key
+
+    @classmethod
+    def parse(cls, key: str) -> UnitKey:
+        """Split a unit key into its parts.
+
+        Parameters
+        ----------
+        key : str
+            A unit key; one outside the scheme (e.g. a diagnostic unit's) gives stage and group ``""``.
+
+        Returns
+        -------
+        UnitKey
+        """
+        for stage, pattern in _KEY_PATTERNS:
+            m = pattern.fullmatch(key)
+            if m:
+                parts = m.groupdict()
+                rep = parts.get("rep")
+                return cls(key, stage, parts["group"], parts.get("mdp"), None if rep is None else int(rep))
+        return cls(key, "", "")
