@@ -41,6 +41,13 @@ def test_the_champion_chosen_again_is_the_parent_of_best_mean_on_shared_fresh_ep
     twins = dataclasses.replace(race_run, parents=np.vstack([race_run.parents[:1], race_run.parents[:1]]))
     twin_means = reevaluated_champion(twins, FAMILY, episodes=6, n_steps=80)[1]
     assert twin_means[0] == twin_means[1] == means[0]
+    # among the run's best generation champions: its own champion's estimate is the best of them, first
+    hall = race_run.hall_of_fame
+    assert hall is not None and 1 <= len(hall) <= 20 and any(np.array_equal(h, race_run.champion.genome) for h in hall)
+    best_ever, hall_means = reevaluated_champion(race_run, FAMILY, episodes=6, n_steps=80, among="best-ever")
+    assert len(hall_means) == len(hall) and np.array_equal(best_ever.genome, hall[int(np.argmax(hall_means))])
+    with pytest.raises(NeurohoverError, match="among='worst' is not allowed: choose one of last, best-ever"):
+        reevaluated_champion(race_run, FAMILY, episodes=6, among="worst")
 
 
 def test_a_steady_state_run_has_no_parents_to_choose_from() -> None:
@@ -63,9 +70,12 @@ def test_the_parents_survive_a_checkpoint_and_older_checkpoints_load() -> None:
     opt.tell(np.arange(population.shape[0], dtype=float))  # the 20 best estimates: the last 20 candidates
     assert np.array_equal(opt.parents, population[np.arange(24, 4, -1)])
     state = json.loads(json.dumps(opt.state_dict()))
-    assert np.array_equal(GenerationalNE.from_state_dict(state).parents, opt.parents)
+    restored = GenerationalNE.from_state_dict(state)
+    assert np.array_equal(restored.parents, opt.parents) and np.array_equal(restored.hall_of_fame, opt.hall_of_fame)
+    assert np.array_equal(opt.hall_of_fame, [population[24]])  # the generation's champion: the best estimate
     state.pop("parents")  # a checkpoint written before the parents were kept
-    assert GenerationalNE.from_state_dict(state).parents is None
+    state.pop("hall_of_fame")
+    assert GenerationalNE.from_state_dict(state).parents is None and GenerationalNE.from_state_dict(state).hall_of_fame is None
 
 
 def test_fig15_champion_is_figure_15s_runs_again_with_the_champion_chosen_again() -> None:
@@ -84,11 +94,12 @@ def test_an_evolve_unit_stores_the_champion_chosen_again_validated_as_its_own() 
     unit = next(u for u in plan(cfg, {}).units if u.key == "evolve/race0.5/run0")
     stored = run_evolve(unit.params, threads=1)
     result = EvolveResult.from_dict(json.loads(json.dumps(stored)))
-    again = result.reevaluated
+    again, best_ever = result.reevaluated, result.reevaluated_best_ever
     assert again is not None and again.episodes == 3 and 0 <= again.parent < 20
-    assert len(again.validation) == len(result.validation) == 4 and len(again.validation_crashed) == 4
+    assert best_ever is not None and best_ever.episodes == 3 and 0 <= best_ever.parent < 20
+    assert len(again.validation) == len(best_ever.validation) == len(result.validation) == 4 and len(again.validation_crashed) == 4
     # its validation is the stored policy flown on the run's validation episodes, as the run's own champion was
     fitness = episode_fitness(np.array([float(x) for x in again.validation]), "inv-log-error")
     assert np.all(np.isfinite(fitness))
-    older = {k: v for k, v in stored.items() if k != "reevaluated"}  # a store written before the setting
+    older = {k: v for k, v in stored.items() if not k.startswith("reevaluated")}  # a store written before the setting
     assert EvolveResult.from_dict(older).reevaluated is None and EvolveResult.from_dict(older).to_dict() == older

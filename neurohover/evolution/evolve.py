@@ -112,6 +112,7 @@ __all__ = [
     "evolve",
     "parse_resampling",
     "read_history_csv",
+    "REEVALUATION_POOLS",
     "reevaluated_champion",
     "validation_return",
     "write_history_csv",
@@ -265,19 +266,35 @@ def validation_return(
     return ev.returns
 
 
+#: The candidates :func:`reevaluated_champion` chooses among: the last generation's selected parents, or the run's
+#: best generation champions by estimate (its hall of fame).
+REEVALUATION_POOLS = ("last", "best-ever")
+
+
 def reevaluated_champion(
-    result: EvolutionResult, target, *, episodes: int, n_steps: int = EPISODE_STEPS, threads: int | None = None, device: str = "cpu"
+    result: EvolutionResult,
+    target,
+    *,
+    episodes: int,
+    among: str = "last",
+    n_steps: int = EPISODE_STEPS,
+    threads: int | None = None,
+    device: str = "cpu",
 ) -> tuple[Policy, np.ndarray]:
-    """The run's champion chosen again: the last generation's selected parents (``result.parents``) each flown the
+    """The run's champion chosen again: the last generation's selected parents (``among="last"``, ``result.parents``)
+    or the run's best generation champions by estimate (``"best-ever"``, ``result.hall_of_fame``), each flown the
     same ``episodes`` fresh episodes (each on a fresh MDP from G, or on the MDP), the best mean fitness on the run's
     scale winning (ties: the first parent). A generation's champion is otherwise the best of its noisy estimates,
     the luckiest of mu short ones where no candidate is decided; these episodes come from ``SeedSequence(seed)``
     child ``(4,)`` of the run's seed, which the run and :func:`validation_return` never use.
 
-    Returns the chosen policy (its metadata the run's champion's, with ``reevaluated_from`` = its parent's
-    index) and every parent's mean fitness over the episodes.
+    Returns the chosen policy (its metadata the run's champion's, with ``reevaluated_from`` = its index in the
+    pool) and every candidate's mean fitness over the episodes.
     """
-    if result.parents is None or len(result.parents) == 0:
+    if among not in REEVALUATION_POOLS:
+        raise NeurohoverError(f"among={among!r} is not allowed: choose one of {', '.join(REEVALUATION_POOLS)}")
+    pool = result.parents if among == "last" else result.hall_of_fame
+    if pool is None or len(pool) == 0:
         raise NeurohoverError("the run has no selected parents to choose from again: generational evolution keeps them, other methods do not")
     if isinstance(episodes, bool) or not isinstance(episodes, (int, np.integer)) or episodes < 1:
         raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
@@ -288,9 +305,9 @@ def reevaluated_champion(
     else:
         assert family is not None  # resolve_target gives an MDP or a family
         rows, m = family.sample_rows(np.random.default_rng(mdp_seed), episodes), np.arange(episodes)
-    k = len(result.parents)
+    k = len(pool)
     champion = result.champion
-    policies = [Policy(champion.topology, np.array(g, dtype=float), champion.metadata) for g in result.parents]
+    policies = [Policy(champion.topology, np.array(g, dtype=float), champion.metadata) for g in pool]
     p_idx, m_idx, e_idx = np.repeat(np.arange(k), episodes), np.tile(m, k), np.tile(np.arange(episodes), k)
     ev = evaluate_jobs(policies, rows, p_idx, m_idx, e_idx, seed=noise_seed, n_steps=n_steps, threads=threads, device=device)
     scale = result.settings.get("settings", {}).get("fitness", "return") if result.settings.get("method") == "generational" else "return"

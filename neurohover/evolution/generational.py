@@ -208,6 +208,8 @@ class GenerationalNE:
         self._evaluations = 0
         self._champion_genome: np.ndarray | None = None
         self._parents: np.ndarray | None = None  # the last generation's selected parents
+        # the run's best generation champions by estimate, best first (at most select_size): a hall of fame
+        self._hall: list[tuple[float, np.ndarray]] = []
         self._champion_return = -math.inf
         self._history: list[GenerationRecord] = []
         self._clock = Clock()
@@ -264,6 +266,7 @@ class GenerationalNE:
         self._generation += 1
         self._history.append(GenerationRecord(self._generation, self._evaluations, ep, self._champion_return, self._clock()))
         self._parents = self._population[sel].copy()
+        self._hall = sorted([*self._hall, (self._champion_return, self._champion_genome.copy())], key=lambda h: -h[0])[: s.select_size]
         self._population = self._breed(self._parents)
         self._asked = False
 
@@ -331,6 +334,12 @@ class GenerationalNE:
         return None if self._parents is None else self._parents.copy()
 
     @property
+    def hall_of_fame(self) -> np.ndarray | None:
+        """The run's best generation champions by their estimates, best first, at most ``select_size`` (a genome a
+        row; None before the first tell). Every generation's champion is its best selected parent's estimate."""
+        return np.array([g for _, g in self._hall]) if self._hall else None
+
+    @property
     def champion_return(self) -> float:
         """Best estimate of the latest generation (``-inf`` before the first tell)."""
         return self._champion_return
@@ -361,6 +370,7 @@ class GenerationalNE:
             "champion_genome": enc_array(self._champion_genome),
             "champion_return": enc_float(self._champion_return),
             "parents": enc_array(self._parents),
+            "hall_of_fame": [[enc_float(r), enc_array(g)] for r, g in self._hall],
             "history": [
                 [
                     r.generation,
@@ -387,6 +397,7 @@ class GenerationalNE:
         opt._champion_genome = dec_array(state["champion_genome"])
         opt._champion_return = float(state["champion_return"])
         opt._parents = dec_array(state.get("parents"))  # absent from checkpoints written before 2026-12-04
+        opt._hall = [(float(r), dec_array(g)) for r, g in state.get("hall_of_fame", [])]
         opt._history = [GenerationRecord(int(g), int(e), int(ep), float(r), float(w)) for g, e, ep, r, w in state["history"]]
         opt._rng = rng_from_state(state["rng"])
         opt._clock = Clock(float(state["wall_seconds"]))

@@ -113,6 +113,9 @@ class EvolutionResult:
     parents : np.ndarray or None
         Generational NE: the last generation's selected parents, one genome a row (the candidates
         :func:`~neurohover.evolution.evolve.reevaluated_champion` chooses from); None otherwise.
+    hall_of_fame : np.ndarray or None
+        Generational NE: the run's best generation champions by estimate, best first (the other candidates
+        it chooses from, ``among="best-ever"``); None otherwise.
     """
 
     champion: Policy
@@ -128,6 +131,7 @@ class EvolutionResult:
     settings: dict
     champion_crashed: bool = False
     parents: np.ndarray | None = field(default=None, compare=False, repr=False)
+    hall_of_fame: np.ndarray | None = field(default=None, compare=False, repr=False)
 
     @property
     def episodes_per_second(self) -> float:

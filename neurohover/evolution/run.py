@@ -431,4 +431,5 @@ class Run:
             settings,
             bool(getattr(self.opt, "champion_crashed", False)),
             parents=getattr(self.opt, "parents", None),
+            hall_of_fame=getattr(self.opt, "hall_of_fame", None),
         )

@@ -180,15 +180,15 @@ class EvolutionSection(Section):
         from scipy import stats
 
         rows = []
-        for v in self.variants():
-            runs = [r for r in self.runs(v.key) if r.reevaluated is not None and r.reevaluated.validation is not None and r.validation is not None]
+        for v, (among, field) in ((v, pool) for v in self.variants() for pool in (("last parents", "reevaluated"), ("best ever", "reevaluated_best_ever"))):
+            runs = [r for r in self.runs(v.key) if getattr(r, field) is not None and getattr(r, field).validation is not None and r.validation is not None]
             if not runs:
                 continue
             own = np.array([_mean_fitness([float(x) for x in r.validation or ()]) for r in runs])
-            again = np.array([_mean_fitness([float(x) for x in r.reevaluated.validation or ()]) for r in runs])  # type: ignore[union-attr]
+            again = np.array([_mean_fitness([float(x) for x in getattr(r, field).validation or ()]) for r in runs])
             diff = again - own
             p = float(stats.wilcoxon(diff).pvalue) if len(runs) >= 2 and np.any(diff != 0) else 1.0
-            same = sum(r.reevaluated.champion == r.champion for r in runs)  # type: ignore[union-attr]
+            same = sum(getattr(r, field).champion == r.champion for r in runs)
 
             def crash_rate(flags) -> str:
                 flat = [bool(c) for cs in flags for c in (cs or ())]
@@ -197,6 +197,7 @@ class EvolutionSection(Section):
             rows.append(
                 [
                     v.label,
+                    among,
                     str(len(runs)),
                     fmt(float(own.mean())),
                     fmt(float(again.mean())),
@@ -204,12 +205,12 @@ class EvolutionSection(Section):
                     str(same),
                     fmt(p),
                     crash_rate(r.validation_crashed for r in runs),
-                    crash_rate(r.reevaluated.validation_crashed for r in runs),  # type: ignore[union-attr]
+                    crash_rate(getattr(r, field).validation_crashed for r in runs),
                 ]
             )
             word = "better" if again.mean() > own.mean() else "worse" if again.mean() < own.mean() else "as good"
             self.comparisons.append(
-                f"{v.label}: the champion chosen again is {word} than the run's own (mean validation 1/ln(error) {fmt(float(again.mean()))} "
+                f"{v.label}: the champion chosen again among the {among} is {word} than the run's own (mean validation 1/ln(error) {fmt(float(again.mean()))} "
                 f"vs {fmt(float(own.mean()))}, Wilcoxon p = {fmt(p)}" + (", significant at 5%)." if p < 0.05 else ", not significant).")
             )
         if not rows:
@@ -217,11 +218,15 @@ class EvolutionSection(Section):
         n = self.s.champion_reevaluation
         return (
             "\n### The champion chosen again\n\n"
-            + table(["setting", "runs", "own champion", "chosen again", "runs better", "same policy", "Wilcoxon p", "own crash rate", "again crash rate"], rows)
+            + table(
+                ["setting", "among", "runs", "own champion", "chosen again", "runs better", "same policy", "Wilcoxon p", "own crash rate", "again crash rate"],
+                rows,
+            )
             + f"\n\nA run's own champion is the last generation's best selected parent by its estimate (the luckiest of mu short "
-            f"ones where the race decides nothing). Chosen again: each of the last generation's selected parents flown the same {n} "
-            "fresh episodes (each on a fresh MDP from G), the best mean 1/ln(error) kept; both validated on the same episodes "
-            "(mean 1/ln(error) per run, then over runs; Wilcoxon signed-rank test on the run pairs).\n"
+            f"ones where the race decides nothing). Chosen again: each candidate flown the same {n} fresh episodes (each on a fresh "
+            "MDP from G), the best mean 1/ln(error) kept; the candidates are the last generation's selected parents, or the run's "
+            "best generation champions by their estimates (best ever). Both champions validated on the same episodes (mean "
+            "1/ln(error) per run, then over runs; Wilcoxon signed-rank test on the run pairs).\n"
         )
 
     def _paired_block(self, samples: dict[str, list[float]], labels: dict[str, str]) -> str:

@@ -248,7 +248,7 @@ class Reevaluation(_Record):
     champion : StoredPolicy
         The last generation's selected parent of best mean fitness over ``episodes`` fresh episodes.
     parent : int
-        Its index among the parents.
+        Its index among the candidates (the last parents, or the run's best generation champions).
     episodes : int
         Fresh episodes every parent flew.
     estimate : Num
@@ -290,14 +290,20 @@ class EvolveResult(_Record):
     fitness : str or None
         The scale of ``champion_return`` and ``history`` (:mod:`neurohover.evolution.fitness`):
         ``inv-log-error`` or ``return`` (None: raw returns, as every run before the scale existed).
-    reevaluated : Reevaluation or None
-        The champion chosen again on fresh episodes (the evolution setting ``champion_reevaluation``; None: not asked for).
+    reevaluated, reevaluated_best_ever : Reevaluation or None
+        The champion chosen again on fresh episodes among the last generation's parents, and among the run's best
+        generation champions (the evolution setting ``champion_reevaluation``; None: not asked for).
     timing : EvolveTiming
         Wall-clock; not part of ``==``.
     """
 
-    _NESTED: ClassVar[dict[str, type[_Record]]] = {"champion": StoredPolicy, "timing": EvolveTiming, "reevaluated": Reevaluation}
-    _OPTIONAL: ClassVar[tuple[str, ...]] = ("champion_crashed", "validation", "validation_crashed", "fitness", "reevaluated")
+    _NESTED: ClassVar[dict[str, type[_Record]]] = {
+        "champion": StoredPolicy,
+        "timing": EvolveTiming,
+        "reevaluated": Reevaluation,
+        "reevaluated_best_ever": Reevaluation,
+    }
+    _OPTIONAL: ClassVar[tuple[str, ...]] = ("champion_crashed", "validation", "validation_crashed", "fitness", "reevaluated", "reevaluated_best_ever")
 
     champion: StoredPolicy
     champion_return: Num
@@ -311,6 +317,7 @@ class EvolveResult(_Record):
     validation_crashed: tuple[bool, ...] | None = None
     fitness: str | None = None
     reevaluated: Reevaluation | None = None
+    reevaluated_best_ever: Reevaluation | None = None
     timing: EvolveTiming = field(compare=False)
 
     @property

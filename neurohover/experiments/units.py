@@ -153,14 +153,18 @@ def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:
         return None, None
 
     validation, crashed = validated(result.champion)
-    reevaluated = None
-    if q.champion_reevaluation:  # the champion chosen again among the last parents, validated alike
-        again, means = reevaluated_champion(result, target, episodes=q.champion_reevaluation, n_steps=q.n_steps, threads=threads, device=device)
-        parent = int(again.metadata["reevaluated_from"])
+
+    def chosen_again(among: str) -> Reevaluation:
+        again, means = reevaluated_champion(result, target, episodes=q.champion_reevaluation, among=among, n_steps=q.n_steps, threads=threads, device=device)
+        index = int(again.metadata["reevaluated_from"])
         v, c = validated(again)
-        reevaluated = Reevaluation(
-            champion=StoredPolicy.of(again), parent=parent, episodes=q.champion_reevaluation, estimate=num(means[parent]), validation=v, validation_crashed=c
+        return Reevaluation(
+            champion=StoredPolicy.of(again), parent=index, episodes=q.champion_reevaluation, estimate=num(means[index]), validation=v, validation_crashed=c
         )
+
+    # the champion chosen again among the last parents and among the run's best generation champions, validated alike
+    reevaluated = chosen_again("last") if q.champion_reevaluation else None
+    best_ever = chosen_again("best-ever") if q.champion_reevaluation else None
     scale = result.settings["settings"].get("fitness") if result.settings.get("method") == "generational" else None
     return EvolveResult(
         champion=StoredPolicy.of(result.champion),
@@ -175,6 +179,7 @@ def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:
         validation_crashed=crashed,
         fitness=scale,
         reevaluated=reevaluated,
+        reevaluated_best_ever=best_ever,
         timing=EvolveTiming(seconds=time.perf_counter() - t0, kernel_seconds=float(result.kernel_seconds)),
     ).to_dict()
 
