@@ -42,6 +42,7 @@ ABLATIONS = [
     "ablation-fghh",
     "fig15-rules",
     "fig15-champion",
+    "fig15-bandits",
     "fig16-slp-zero",
     "lr-authors-table4",
     "lr-authors-fig8",

@@ -19,6 +19,7 @@ from ..errors import NeurohoverError
 from ..policies import TOPOLOGIES, Policy
 from ..policies import prototype as make_prototype
 from ..tasks import EXACT, MDP, TaskFamily, refuse_drift
+from .bandits import BANDITS
 from .generational import GENERATIONAL_PRESETS, OLD_GENERATIONAL, GenerationalSettings
 from .optimisers import NE, OPTIMISERS, optimiser_names, population_settings
 from .optimisers.cma import CMASettings
@@ -63,7 +64,14 @@ class Resampling:
     def __str__(self) -> str:
         if self.kind == "fixed":
             return f"fixed:{self.k}"
+        if self.kind in BANDITS:
+            return f"{self.kind}:{self.delta:g}"
         return f"race:{self.delta:g}" + ("" if self.rule == "prose" else f":{self.rule}")
+
+    @property
+    def selects(self) -> bool:
+        """Whether it selects the parents itself (a race or a bandit), so it needs generational evolution."""
+        return self.kind != "fixed"
 
 
 def parse_resampling(spec: str | Resampling | None) -> Resampling:
@@ -75,11 +83,23 @@ def parse_resampling(spec: str | Resampling | None) -> Resampling:
         return spec
     text = str(spec).strip().lower()
     kind, sep, value = text.partition(":")
-    allowed = "allowed fixed:K (K >= 1 episodes per candidate) or race:DELTA[:RULE] (confidence level 0 < DELTA < 1, rule " + ", ".join(RACE_RULES) + ")"
+    allowed = (
+        "allowed fixed:K (K >= 1 episodes per candidate), race:DELTA[:RULE] (confidence level 0 < DELTA < 1, rule "
+        + ", ".join(RACE_RULES)
+        + "), lucb:DELTA or kl-lucb:DELTA (error probability 0 < DELTA < 1)"
+    )
     if kind == "fixed" and sep:
         if value.isdigit() and int(value) >= 1:
             return Resampling("fixed", int(value))
         raise NeurohoverError(f"bad resampling {spec!r}: K must be an integer >= 1; {allowed}")
+    if kind in BANDITS and sep:
+        try:
+            delta = float(value)
+        except ValueError:
+            delta = math.nan
+        if 0.0 < delta < 1.0:
+            return Resampling(kind, 1, delta)
+        raise NeurohoverError(f"bad resampling {spec!r}: DELTA must be an error probability strictly between 0 and 1; {allowed}")
     if kind == "race" and sep:
         value, _, rule = value.partition(":")
         if rule and rule not in RACE_RULES:
@@ -243,11 +263,17 @@ class RunConfig:
             raise NeurohoverError("the steady-state method evolves on one MDP; a task family needs the generational method")
         if optimizer != NE:
             chosen = optimizer  # a population optimiser is its own method
-        if resampling.kind == "race" and chosen != "generational":
+        if resampling.selects and chosen != "generational":
             raise NeurohoverError(
-                f"resampling {resampling} (a selection race) needs the generational method (a task family as target, optimizer 'ne'); use fixed:K here"
+                f"resampling {resampling} (a selection race or bandit) needs the generational method (a task family as target, "
+                "optimizer 'ne'); use fixed:K here"
             )
         checked = make_settings("steady-state" if chosen == "steady-state" else "generational", optimizer, settings)
+        if resampling.kind in BANDITS and getattr(checked, "fitness", None) != "inv-log-error":
+            raise NeurohoverError(
+                f"resampling {resampling} (a bandit) needs rewards in [0, 1]: the fitness scale inv-log-error (1/ln(error)), "
+                f"not {getattr(checked, 'fitness', None)!r}"
+            )
         if optimizer != NE and budget is None and not OPTIMISERS[optimizer].stops_itself:
             raise NeurohoverError(f"optimizer {optimizer!r} has no stopping rule of its own: give a budget (episodes)")
         if optimizer != NE and proto.genome.size < OPTIMISERS[optimizer].min_genes:

@@ -25,6 +25,7 @@ from ..flyer import KernelFlyer
 from ..launch import Parking
 from ..policies import Policy
 from ..sim.lanes import LANES
+from .bandits import BANDITS, top_mu_bandit
 from .common import Optimiser, TellInfo, enc_float
 from .config import RACE_T_LIMIT, RunConfig, upgrade_saved_config
 from .fitness import episode_fitness
@@ -324,13 +325,16 @@ class Run:
         opt = cast(GenerationalNE, self.opt)
         before_eps = self.flyer.episodes
         genomes = opt.ask()
-        if self.resampling.kind == "race":
+        if self.resampling.selects:
             delta = self.resampling.delta
             assert delta is not None  # every race has its delta (Run() formats it in config.to_dict() first)
             sampler = self._race_sampler(genomes, opt.settings.select_size)
             traced = None if self.flyer.trace is None else len(self.flyer.trace)
             size = (genomes.shape[0], opt.settings.select_size)
-            race = selection_race(sampler, *size, delta, t_limit=RACE_T_LIMIT, batch=sampler.batch, rule=self.resampling.rule)
+            if self.resampling.kind in BANDITS:  # the two least certain candidates a round (neurohover.evolution.bandits)
+                race = top_mu_bandit(sampler, *size, delta, rule=self.resampling.kind, t_limit=RACE_T_LIMIT)
+            else:
+                race = selection_race(sampler, *size, delta, t_limit=RACE_T_LIMIT, batch=sampler.batch, rule=self.resampling.rule)
             # Count the episodes the race used (parking or look-ahead flew more): what depends on no speed setting.
             self.flyer.episodes += race.episodes_spent
             used = sampler.used(race.n_samples)

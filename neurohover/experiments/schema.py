@@ -321,8 +321,8 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
         for v in settings["variants"]:
             if v["sigma"] is not None and not TASK_FAMILIES[task].has_sigma:
                 raise NeurohoverError(f"{where}: variant {v['key']!r} sets sigma but the task is {task!r}")
-            if settings["target"] != "family" and v["resampling"].startswith("race"):
-                raise NeurohoverError(f"{where}: variant {v['key']!r}: selection races need target = 'family'")
+            if settings["target"] != "family" and parse_resampling(v["resampling"]).selects:
+                raise NeurohoverError(f"{where}: variant {v['key']!r}: selection races and bandits need target = 'family'")
 
         method = "generational" if settings["target"] == "family" else "steady-state"
         for v in [None, *settings["variants"]]:

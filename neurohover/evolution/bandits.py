@@ -1,0 +1,132 @@
+"""Top-mu selection as a multi-armed bandit problem (Section 7's open question; issue 35): LUCB and KL-LUCB.
+
+Selection races (:mod:`neurohover.evolution.races`) decide by Bayesian (Student-t) bounds that assume nothing
+about the range of a fitness. The bandit algorithms below identify the mu best of lambda candidates with
+probability at least ``1 - delta`` for rewards in [0, 1] (distribution-free), sampling only the two candidates
+that are least certain in each round:
+
+- **LUCB1** (Kalyanakrishnan, Tewari, Auer & Stone, ICML 2012): Hoeffding bounds with the exploration rate
+  ``beta(u, t) = sqrt(ln(5 n t^4 / (4 delta)) / (2 u))`` for a candidate with ``u`` samples at round ``t``.
+- **KL-LUCB** (Kaufmann & Kalyanakrishnan, COLT 2013): Chernoff bounds ``{q : u d(p, q) <= beta(t)}`` with the
+  Bernoulli divergence ``d`` and ``beta(t) = ln(k1 n t^alpha / delta)``, ``k1 = 405.5``, ``alpha = 1.1`` (their
+  Theorem 3's constants), tighter than Hoeffding's near 0 and 1.
+
+Each round: J = the mu best empirical means; l = the member of J with the lowest lower bound, u = the
+non-member with the highest upper bound; stop when u's upper bound is below l's lower bound (epsilon = 0),
+otherwise fly l and u one more episode each. As a race does, a candidate flies at most ``t_limit`` episodes; when
+both l and u have them, the selection stops on J. The reward is a candidate's episode fitness on FGHH's
+``1/ln(error)`` scale, which lies in [0, 1] for any error of at least e (a hovering error is far above): values
+above 1 are clipped, NaN and ``-inf`` count as 0.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .races import RaceResult, SampleFn, _check_int
+
+__all__ = ["BANDITS", "kl_bounds", "lucb_radius", "top_mu_bandit"]
+
+#: The bandit selection rules: resampling ``lucb:DELTA`` and ``kl-lucb:DELTA`` (DELTA the error probability).
+BANDITS = ("lucb", "kl-lucb")
+KL_K1, KL_ALPHA = 405.5, 1.1
+
+
+def lucb_radius(samples: np.ndarray, t: int, n: int, delta: float) -> np.ndarray:
+    """LUCB1's confidence radius ``sqrt(ln(5 n t^4 / (4 delta)) / (2 u))`` for candidates with ``samples`` = u episodes each."""
+    u = np.asarray(samples, dtype=np.float64)
+    return np.sqrt(math.log(5.0 * n * float(t) ** 4 / (4.0 * delta)) / (2.0 * u))
+
+
+def _bernoulli_kl(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    eps = 1e-15
+    p = np.clip(p, eps, 1 - eps)
+    q = np.clip(q, eps, 1 - eps)
+    return p * np.log(p / q) + (1 - p) * np.log((1 - p) / (1 - q))
+
+
+def kl_bounds(means: np.ndarray, samples: np.ndarray, level: float, iterations: int = 60) -> tuple[np.ndarray, np.ndarray]:
+    """The KL confidence bounds ``min / max {q in [0, 1] : u d(p, q) <= level}`` of empirical means ``p`` over ``u``
+    samples, by bisection (``iterations`` halvings: within ``2**-iterations``)."""
+    p = np.clip(np.asarray(means, dtype=np.float64), 0.0, 1.0)
+    u = np.asarray(samples, dtype=np.float64)
+    room = level / u
+    lo_up, hi_up = p.copy(), np.ones_like(p)
+    lo_dn, hi_dn = np.zeros_like(p), p.copy()
+    for _ in range(iterations):
+        mid = (lo_up + hi_up) / 2
+        inside = _bernoulli_kl(p, mid) <= room
+        lo_up, hi_up = np.where(inside, mid, lo_up), np.where(inside, hi_up, mid)
+        mid = (lo_dn + hi_dn) / 2
+        inside = _bernoulli_kl(p, mid) <= room
+        lo_dn, hi_dn = np.where(inside, lo_dn, mid), np.where(inside, mid, hi_dn)
+    return hi_dn, lo_up
+
+
+def _rewards(x: np.ndarray) -> np.ndarray:
+    """Episode fitness as a reward in [0, 1] (see the module docstring)."""
+    r = np.asarray(x, dtype=np.float64)
+    return np.clip(np.where(np.isfinite(r), r, 0.0), 0.0, 1.0)
+
+
+def top_mu_bandit(sample_fn: SampleFn, n_candidates: int, mu: int, delta: float, *, rule: str = "lucb", t_limit: int = 10) -> RaceResult:
+    """The ``mu`` best of ``n_candidates`` by LUCB1 (``rule="lucb"``) or KL-LUCB (``"kl-lucb"``) with error
+    probability ``delta``, each candidate flying at most ``t_limit`` episodes; ``sample_fn`` as for
+    :func:`~neurohover.evolution.races.selection_race` (a candidate listed twice flies two episodes).
+
+    Returns a :class:`~neurohover.evolution.races.RaceResult`: ``selected`` the mu of best mean when the rule
+    stopped (``n_raced`` = mu when its bounds separated them, 0 when the episode limit ended it), ``means``,
+    ``n_samples``, the last ``lower`` / ``upper`` bounds, ``rounds`` the rule's rounds.
+    """
+    n = _check_int("n_candidates", n_candidates, 2)
+    mu = _check_int("mu", mu, 1)
+    if mu >= n:
+        raise ValueError(f"mu={mu} must be smaller than n_candidates={n}")
+    if isinstance(delta, bool) or not isinstance(delta, (int, float)) or not 0.0 < float(delta) < 1.0:
+        raise ValueError(f"delta={delta!r} must be an error probability strictly between 0 and 1 (e.g. 0.1)")
+    if rule not in BANDITS:
+        raise ValueError(f"rule={rule!r} is not a bandit rule: choose one of {', '.join(BANDITS)}")
+    t_limit = _check_int("t_limit", t_limit, 1)
+    sums = _rewards(sample_fn(np.arange(n))).copy()  # every candidate once
+    counts = np.ones(n, dtype=np.int64)
+    rounds, separated = 0, False
+    while True:
+        t = int(counts.sum())
+        means = sums / counts
+        if rule == "lucb":
+            radius = lucb_radius(counts, t, n, float(delta))
+            lower, upper = means - radius, means + radius
+        else:
+            lower, upper = kl_bounds(means, counts, math.log(KL_K1 * n * t**KL_ALPHA / float(delta)))
+        order = np.argsort(-means, kind="stable")
+        top, rest = order[:mu], order[mu:]
+        low = int(top[np.argmin(lower[top])])
+        high = int(rest[np.argmax(upper[rest])])
+        if upper[high] < lower[low]:
+            separated = True
+            break
+        fly = [i for i in (low, high) if counts[i] < t_limit]
+        if not fly:
+            break
+        rounds += 1
+        drawn = _rewards(sample_fn(np.asarray(fly, dtype=np.int64)))
+        for i, r in zip(fly, drawn):
+            sums[i] += r
+            counts[i] += 1
+    means = sums / counts
+    selected = np.argsort(-means, kind="stable")[:mu]
+    spent = int(counts.sum())
+    return RaceResult(
+        selected=selected.astype(np.int64),
+        means=means,
+        n_samples=counts,
+        lower=lower,
+        upper=upper,
+        discarded=np.zeros(0, dtype=np.int64),
+        n_raced=mu if separated else 0,
+        episodes_spent=spent,
+        rounds=rounds,
+        episodes_flown=spent,
+    )
