@@ -21,7 +21,13 @@ from .sim.constants import EPISODE_STEPS
 from .tasks.sensor import Sensor
 
 # Modules of later pipeline stages; each has ``register(subparsers)`` adding its commands.
-COMMAND_MODULES: tuple[str, ...] = ("neurohover.commands_learning", "neurohover.commands_agents", "neurohover.commands_reproduce", "neurohover.commands_plots")
+COMMAND_MODULES: tuple[str, ...] = (
+    "neurohover.commands_learning",
+    "neurohover.commands_agents",
+    "neurohover.commands_evaluate",
+    "neurohover.commands_reproduce",
+    "neurohover.commands_plots",
+)
 
 
 def parse_floats(text: str, what: str) -> list[float]:

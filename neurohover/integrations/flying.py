@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -30,7 +31,7 @@ from ..evaluate import Evaluation
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS
 from ..tasks import MDP
 
-__all__ = ["evaluate_callable"]
+__all__ = ["AgentRow", "compare_agent", "evaluate_callable"]
 
 MAX_EPISODES = 1 << 16  # helicopters in one lockstep batch: the vector environment's arrays stay small
 
@@ -93,3 +94,41 @@ def evaluate_callable(
     return Evaluation(
         returns.reshape(shape), crashed.reshape(shape), steps.reshape(shape), np.full(shape, -1, dtype=np.int64), None, time.perf_counter() - start
     )
+
+
+@dataclass(frozen=True)
+class AgentRow:
+    """One policy's paper measures over the same episodes: the mean return per episode (the paper's), the
+    median over MDPs of the mean return on each, the crashed episodes and how many flew."""
+
+    name: str
+    return_per_episode: float
+    median_over_mdps: float
+    crashes: int
+    episodes: int
+
+    @classmethod
+    def of(cls, name: str, ev: Evaluation) -> AgentRow:
+        returns = np.asarray(ev.returns, dtype=np.float64).reshape(-1, np.asarray(ev.returns).shape[-1])
+        crashed = np.asarray(ev.crashed).reshape(returns.shape)
+        return cls(name, float(returns.mean()), float(np.median(returns.mean(axis=1))), int(crashed.sum()), int(returns.size))
+
+
+def compare_agent(
+    act: Callable[[np.ndarray], Any], mdps: Sequence[MDP], *, episodes: int = 1, seed: int = 0, n_steps: int = EPISODE_STEPS, obs_dtype: str = "float32"
+) -> list[AgentRow]:
+    """``act`` flown on ``mdps`` beside the competition's baseline and the shipped generic policy of the MDPs' task,
+    all on the same gusts (:func:`evaluate_callable` and :func:`neurohover.evaluate` number them alike): a learned
+    policy measured as the paper measured its agents (full episodes of ``n_steps``; the return per episode and
+    the crashes). Returns rows for ``agent``, ``baseline`` and ``generic``, in that order."""
+    from ..evaluate import evaluate
+    from ..policies import baseline_policy
+    from ..policysets import load_policy_set
+
+    mdps = list(mdps)
+    agent = evaluate_callable(act, mdps, episodes=episodes, seed=seed, n_steps=n_steps, obs_dtype=obs_dtype)
+    generic = load_policy_set(mdps[0].family).generic
+    rows = [AgentRow.of("agent", agent)]
+    for name, policy in (("baseline", baseline_policy()), ("generic", generic)):
+        rows.append(AgentRow.of(name, evaluate(policy, mdps, episodes=episodes, seed=seed, n_steps=n_steps)))
+    return rows

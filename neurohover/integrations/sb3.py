@@ -33,7 +33,7 @@ try:
 except ModuleNotFoundError as missing:  # the optional extra
     raise NeurohoverError(f"neurohover.integrations.sb3 needs {missing.name}: pip install 'neurohover[examples]'") from None
 
-__all__ = ["SB3VecEnv", "rl_zoo_policy"]
+__all__ = ["SB3VecEnv", "rl_zoo_policy", "sb3_policy"]
 
 
 class SB3VecEnv(VecEnv):
@@ -97,6 +97,25 @@ class SB3VecEnv(VecEnv):
         return [indices] if isinstance(indices, int) else list(indices)
 
 
+def _algorithm(algo: str):
+    from stable_baselines3 import A2C, PPO, SAC, TD3
+
+    algos = {"ppo": PPO, "sac": SAC, "td3": TD3, "a2c": A2C}
+    if algo not in algos:
+        raise NeurohoverError(f"algo={algo!r} is not supported: allowed {', '.join(algos)}")
+    return algos[algo]
+
+
+def sb3_policy(model_zip: str | Path, *, algo: str = "ppo", deterministic: bool = True) -> Callable[[np.ndarray], np.ndarray]:
+    """A saved Stable-Baselines3 model (``MODEL.zip``) as a batch function (observations as it was trained on them:
+    wrap it yourself if it learned behind a normaliser), ready for :func:`neurohover.integrations.flying.evaluate_callable`."""
+    path = Path(model_zip)
+    if not path.is_file():
+        raise NeurohoverError(f"{str(path)!r} is not a Stable-Baselines3 model file (MODEL.zip)")
+    model = _algorithm(algo).load(path, device="cpu")
+    return lambda obs: model.predict(obs, deterministic=deterministic)[0]
+
+
 def rl_zoo_policy(run: str | Path, *, algo: str = "ppo", deterministic: bool = True) -> Callable[[np.ndarray], np.ndarray]:
     """The trained policy of an RL Zoo run folder (``logs/ppo/neurohover-GHH08-Short-v0_1``), as a batch function.
 
@@ -105,18 +124,14 @@ def rl_zoo_policy(run: str | Path, *, algo: str = "ppo", deterministic: bool = T
     observations to the model's actions (the Gaussian's mean when ``deterministic``), ready for
     :func:`neurohover.integrations.flying.evaluate_callable`.
     """
-    from stable_baselines3 import A2C, PPO, SAC, TD3
-
-    algos = {"ppo": PPO, "sac": SAC, "td3": TD3, "a2c": A2C}
-    if algo not in algos:
-        raise NeurohoverError(f"algo={algo!r} is not supported: allowed {', '.join(algos)}")
+    algorithm = _algorithm(algo)
     run = Path(run)
     zips = sorted(z for z in run.glob("*.zip") if not z.name.startswith("rl_model_"))
     finals = [z for z in zips if z.name != "best_model.zip"]
     model_zip = finals[0] if len(finals) == 1 else run / "best_model.zip"
     if len(finals) > 1 or not model_zip.is_file():
         raise NeurohoverError(f"{str(run)!r} is not an RL Zoo run folder: expected one ENV.zip (or best_model.zip) in it, found {[z.name for z in zips]}")
-    model = algos[algo].load(model_zip, device="cpu")
+    model = algorithm.load(model_zip, device="cpu")
     stats_file = run / model_zip.stem / "vecnormalize.pkl"
     if model_zip.name == "best_model.zip":
         stats_file = next(run.glob("*/vecnormalize.pkl"), stats_file)

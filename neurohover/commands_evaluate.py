@@ -1,0 +1,110 @@
+"""``neurohover evaluate-agent``: any trained policy flown as the paper measured its agents, beside the baseline and
+the shipped generic on the same gusts (:func:`neurohover.integrations.flying.compare_agent`).
+
+- ``neurohover evaluate-agent --task ghh08 (--policy FILE | --callable MODULE:FUNCTION | --rl-zoo RUN | --sb3 MODEL.zip)
+  [--algo ppo] [--mdps test|train] [--n-mdps N] [--episodes E] [--seed S] [--episode-steps N] [--json FILE]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import sys
+
+import numpy as np
+
+from .errors import NeurohoverError
+
+SOURCES = ("policy", "callable", "rl_zoo", "sb3")
+ALGOS = ("ppo", "sac", "td3", "a2c")
+
+
+def _agent(args: argparse.Namespace):
+    """The batch function (observations -> actions) of the one source given."""
+    given = [s for s in SOURCES if getattr(args, s) is not None]
+    if len(given) != 1:
+        named = ", ".join("--" + s.replace("_", "-") for s in given) or "none"
+        raise NeurohoverError(f"give exactly one of --policy, --callable, --rl-zoo, --sb3 (the agent to fly); got {named}")
+    if args.policy is not None:
+        from .paths import input_file
+        from .policies import load_policy
+
+        policy = load_policy(input_file(args.policy, "--policy", "policy file"))
+        return lambda obs: np.array([policy.act(o) for o in np.asarray(obs, dtype=np.float64)])
+    if args.callable is not None:
+        module, _, name = args.callable.partition(":")
+        if not module or not name:
+            raise NeurohoverError(f"--callable {args.callable!r} is not allowed: give MODULE:FUNCTION (e.g. mypkg.agents:act), importable from here")
+        try:
+            fn = getattr(importlib.import_module(module), name)
+        except (ImportError, AttributeError) as err:
+            raise NeurohoverError(f"--callable {args.callable!r}: {err}") from None
+        if not callable(fn):
+            raise NeurohoverError(f"--callable {args.callable!r} is not a function")
+        return fn
+    if args.rl_zoo is not None:
+        from .integrations.sb3 import rl_zoo_policy
+
+        return rl_zoo_policy(args.rl_zoo, algo=args.algo)
+    from .integrations.sb3 import sb3_policy
+
+    return sb3_policy(args.sb3, algo=args.algo)
+
+
+def cmd_evaluate_agent(args: argparse.Namespace) -> int:
+    """Fly a trained policy on full paper episodes of a task's training or test MDPs, beside the competition's baseline
+    and the shipped generic policy on the same gusts, and print the paper's measures (return per episode, crashes)."""
+    from .integrations.flying import compare_agent
+    from .paths import output_file
+    from .tasks import get_task_family
+
+    family = get_task_family(args.task, args.sigma)
+    available = len(family.training_mdps() if args.mdps == "train" else family.test_mdps())
+    n = available if args.n_mdps is None else args.n_mdps
+    if not 1 <= n <= available:
+        raise NeurohoverError(f"--n-mdps {n} is out of range: {args.task} has {available} {args.mdps} MDPs")
+    for option, value, low, high in (
+        ("--episodes", args.episodes, 1, 10**4),
+        ("--episode-steps", args.episode_steps, 1, 10**7),
+        ("--seed", args.seed, 0, 2**63 - 1),
+    ):
+        if not low <= value <= high:
+            raise NeurohoverError(f"{option} {value} is out of range: allowed an integer in {low}..{high}")
+    out = None if args.json is None else output_file(args.json, "--json")
+    act = _agent(args)
+    mdps = [family.mdp(f"{args.mdps}:{i}") for i in range(n)]
+    rows = compare_agent(act, mdps, episodes=args.episodes, seed=args.seed, n_steps=args.episode_steps, obs_dtype=args.obs_dtype)
+    print(f"{args.task} {args.mdps} MDPs 0-{n - 1}, {args.episodes} episode(s) each of {args.episode_steps} steps, gusts of seed {args.seed}:")
+    print(f"{'policy':<10} {'return/episode':>15} {'median over MDPs':>17} {'crashed':>12}")
+    for r in rows:
+        print(f"{r.name:<10} {r.return_per_episode:>15.6g} {r.median_over_mdps:>17.6g} {f'{r.crashes} of {r.episodes}':>12}")
+    if out is not None:
+        out.write_text(json.dumps({"task": args.task, "mdps": args.mdps, "n_mdps": n, "episodes": args.episodes, "seed": args.seed,
+                                   "episode_steps": args.episode_steps, "rows": [r.__dict__ for r in rows]}, indent=1))  # fmt: skip
+        print(f"wrote {args.json}", file=sys.stderr)
+    return 0
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "evaluate-agent",
+        help="fly a trained policy as the paper measured its agents, beside the baseline and the generic",
+        description=cmd_evaluate_agent.__doc__,
+    )
+    p.add_argument("--task", required=True, help="ghh08, ghh09 or fghh")
+    p.add_argument("--sigma", type=float, help="FGHH breadth (default 0.3)")
+    g = p.add_argument_group("the agent (exactly one)")
+    g.add_argument("--policy", help="a neurohover policy file (.json or the competition's .net)")
+    g.add_argument("--callable", help="MODULE:FUNCTION mapping a batch of observations (B, 12) to actions (B, 4)")
+    g.add_argument("--rl-zoo", help="an RL Zoo run folder (logs/ALGO/ENV_N): its final model and frozen observation statistics")
+    g.add_argument("--sb3", help="a Stable-Baselines3 model file (MODEL.zip)")
+    p.add_argument("--algo", choices=ALGOS, default="ppo", help="the algorithm of --rl-zoo / --sb3 (default ppo)")
+    p.add_argument("--mdps", choices=("test", "train"), default="test", help="the task's test (default) or training MDPs")
+    p.add_argument("--n-mdps", type=int, help="the first N of them (default all)")
+    p.add_argument("--episodes", type=int, default=1, help="episodes per MDP (default 1)")
+    p.add_argument("--seed", type=int, default=0, help="gust seed: episode e on MDP m meets stream (seed, m * episodes + e)")
+    p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000, the paper's)")
+    p.add_argument("--obs-dtype", choices=("float32", "float64"), default="float32", help="what the agent receives (default float32)")
+    p.add_argument("--json", help="also write the rows to this JSON file")
+    p.set_defaults(func=cmd_evaluate_agent)
