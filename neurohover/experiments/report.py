@@ -352,17 +352,33 @@ class _TestRuns(Section):
             diff = np.array([mine[k] - theirs[k] for k in common])
             p = float(stats.wilcoxon(diff).pvalue) if np.any(diff != 0) else 1.0
             a, b = float(np.mean([mine[k] for k in common])), float(np.mean([theirs[k] for k in common]))
-            rows.append([g.label, f"{of['experiment']}/{of['group']}", str(len(common)), fmt(a), fmt(b), f"{int((diff > 0).sum())} of {len(common)}", fmt(p)])
-            word = "better" if a > b else "worse" if a < b else "as good"
+            median = float(np.median(diff))
+            rows.append(
+                [
+                    g.label,
+                    f"{of['experiment']}/{of['group']}",
+                    str(len(common)),
+                    fmt(a),
+                    fmt(b),
+                    f"{int((diff > 0).sum())} of {len(common)}",
+                    fmt(median),
+                    fmt(p),
+                ]
+            )
+            word = "better" if median > 0 else "worse" if median < 0 else "as good"  # by the pairs, as the test: a mean can say otherwise
             self.comparisons.append(
-                f"{g.label} vs {of['experiment']}'s {of['group']} on the same seeds: {word} (mean cumulative reward {fmt(a)} vs {fmt(b)}, "
-                f"Wilcoxon p = {fmt(p)}" + (", significant at 5%)." if p < 0.05 else ", not significant).")
+                f"{g.label} vs {of['experiment']}'s {of['group']} on the same seeds: {word} in the median pair ({int((diff > 0).sum())} of "
+                f"{len(common)} runs better, median paired difference {fmt(median)}, Wilcoxon p = {fmt(p)}"
+                + (", significant at 5%" if p < 0.05 else ", not significant")
+                + f"; mean cumulative reward {fmt(a)} vs {fmt(b)})."
             )
         if not rows:
             return ""
         return (
             "\n### Paired with another experiment's runs\n\n"
-            + table(["group", "paired with", "run pairs", "mean cumulative reward", "its pair's", "runs better", "Wilcoxon p"], rows)
+            + table(
+                ["group", "paired with", "run pairs", "mean cumulative reward", "its pair's", "runs better", "median paired difference", "Wilcoxon p"], rows
+            )
             + "\n\nEach run flew the seed of the other experiment's run of that group on the same MDP (the same gusts and draws); "
             "Wilcoxon signed-rank test on the run pairs' cumulative rewards.\n"
         )
