@@ -40,7 +40,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
     from .agents.hybrid import HybridSettings
     from .agents.registry import AGENTS, HYBRID_AGENTS
     from .cli import sensor_of
-    from .compete import compete
+    from .compete import check_sizes, compete
     from .evolution.seeding import check_seed
     from .experiments.executors import check_jobs
     from .paths import input_dir, output_dir, output_file
@@ -69,6 +69,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
     check_device(args.device)  # before the output directory is made
     check_jobs(args.jobs)
     check_seed(args.seed)
+    check_sizes(args.runs, args.episodes)
     if args.policy_dir is not None:
         input_dir(args.policy_dir, "--policy-dir")
     output_dir(args.out, "--out")

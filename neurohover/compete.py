@@ -107,6 +107,22 @@ def plot_cumulative(curves: dict[str, np.ndarray], path: Path, title: str) -> Pa
     return path
 
 
+#: The largest competition (planned in memory, each episode's results stored): runs, and episodes over all runs.
+MAX_RUNS, MAX_RUN_EPISODES = 100_000, 100_000_000
+
+
+def check_sizes(runs: int, episodes: int) -> None:
+    """Refuse a competition too large to plan in memory and store (every episode's results are kept)."""
+    for name, value in (("runs", runs), ("episodes", episodes)):
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise NeurohoverError(f"{name}={value!r} is out of range: allowed an integer >= 1")
+    if runs > MAX_RUNS or runs * episodes > MAX_RUN_EPISODES:
+        raise NeurohoverError(
+            f"runs={runs} x episodes={episodes} is out of range: at most {MAX_RUNS:,} runs and {MAX_RUN_EPISODES:,} episodes in all "
+            "(each episode's results are kept in the store); split the competition or use fewer runs"
+        )
+
+
 def _group(task: str, runs: int, mdps: str) -> dict:
     """The experiment group of ``runs`` runs on the MDP set ``mdps``, the set's MDPs in turn."""
     size = {"test": N_TEST, "train": N_TRAINING}.get(mdps)
@@ -167,9 +183,7 @@ def competition_config(
     from .agents.registry import HYBRID_AGENTS
     from .experiments.config import make_config
 
-    for name, value in (("runs", runs), ("episodes", episodes)):
-        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-            raise NeurohoverError(f"{name}={value!r} is out of range: allowed an integer >= 1")
+    check_sizes(runs, episodes)
     check_seed(seed)  # the range every command takes
     group: dict[str, object] = {"agent": agent, **_group(task, runs, mdps)}
     if agent in HYBRID_AGENTS:

@@ -56,6 +56,11 @@ CASES: list[tuple[list[str], str]] = [
     (["compete", "--task", "ghh08", "--agent", "baseline", "--safeguard-box", "0.3", "--out", "q"], "hybrid agents only"),
     # Sizes that would exhaust memory, more processes than cores, seeds out of the one range, unknown policy sources.
     (["fly", "--task", "ghh08", "--episodes", "10000000000000"], "--episodes 10000000000000 is out of range"),
+    (["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1000000000", "--out", "q"], "runs=1000000000 x episodes=1000 is out of range"),
+    (
+        ["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "100000", "--episodes", "10000", "--out", "q"],
+        "at most 100,000 runs and 100,000,000 episodes",
+    ),
     (["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--out", "q", "--jobs", "64"], "--jobs 64 is out of range"),
     (
         ["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--out", "q", "--seed", str(2**70)],
