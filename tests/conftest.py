@@ -99,3 +99,20 @@ def finish_run(proc: subprocess.Popen, timeout: float) -> tuple[str, str]:
             os.killpg(proc.pid, signal.SIGKILL)
             out, err = proc.communicate()
         pytest.fail(f"the run did not end within {timeout:g} s; its stacks and output:\n{out}\n{err}")
+
+
+def table_sampler(table):
+    """A race's ``sample_fn`` over a table of samples: candidate i's t-th episode is ``table[i, t]`` (fixed, as an
+    evolution run's is), whatever order the candidates are listed in."""
+    import numpy as np
+
+    count = np.zeros(table.shape[0], dtype=int)
+
+    def sample(idx):
+        out = np.empty(idx.size)
+        for j, i in enumerate(idx):
+            out[j] = table[i, count[i]]
+            count[i] += 1
+        return out
+
+    return sample

@@ -7,25 +7,13 @@ import math
 
 import numpy as np
 import pytest
+from conftest import table_sampler
 
 from neurohover.errors import NeurohoverError
 from neurohover.evolution.bandits import kl_bounds, lucb_radius, top_mu_bandit
 from neurohover.evolution.config import parse_resampling
 from neurohover.evolution.evolve import evolve
 from neurohover.experiments.units import family_of
-
-
-def _sampler(table: np.ndarray):
-    count = np.zeros(table.shape[0], dtype=int)
-
-    def sample(idx: np.ndarray) -> np.ndarray:
-        out = np.empty(idx.size)
-        for j, i in enumerate(idx):
-            out[j] = table[i, count[i]]
-            count[i] += 1
-        return out
-
-    return sample
 
 
 def test_lucb_radius_is_the_papers_formula() -> None:
@@ -47,7 +35,7 @@ def test_kl_bounds_solve_the_divergence_equation() -> None:
 @pytest.mark.parametrize("rule", ["lucb", "kl-lucb"])
 def test_separated_candidates_are_told_apart_before_the_limit(rule: str) -> None:
     table = np.repeat(np.array([[0.9], [0.1], [0.85], [0.15]]), 500, axis=1)  # no noise: the bounds alone decide
-    result = top_mu_bandit(_sampler(table), 4, 2, 0.1, rule=rule, t_limit=500)
+    result = top_mu_bandit(table_sampler(table), 4, 2, 0.1, rule=rule, t_limit=500)
     assert sorted(result.selected.tolist()) == [0, 2] and result.n_raced == 2
     assert result.episodes_spent < 4 * 500 and result.episodes_spent == result.n_samples.sum()
 
@@ -59,7 +47,7 @@ def test_at_a_races_limit_fifty_candidates_are_never_told_apart(rule: str) -> No
     rng = np.random.default_rng(1)
     means = rng.uniform(0.05, 0.25, 50)
     table = np.clip(means[:, None] + rng.normal(0.0, 0.02, (50, 10)), 0, 1)
-    result = top_mu_bandit(_sampler(table), 50, 20, 0.1, rule=rule, t_limit=10)
+    result = top_mu_bandit(table_sampler(table), 50, 20, 0.1, rule=rule, t_limit=10)
     assert result.n_raced == 0 and result.n_samples.max() == 10 and result.n_samples.min() >= 1
     assert len(set(result.selected.tolist()) & set(np.argsort(-means)[:20].tolist())) >= 17
 
@@ -68,7 +56,7 @@ def test_bad_bandit_settings_are_refused() -> None:
     table = np.zeros((4, 10))
     for kwargs, message in (({"delta": 1.0}, "delta=1.0 must be an error probability"), ({"rule": "ucb"}, "rule='ucb' is not a bandit rule")):
         with pytest.raises(ValueError, match=message):
-            top_mu_bandit(_sampler(table), 4, 2, **{"delta": 0.1, **kwargs})
+            top_mu_bandit(table_sampler(table), 4, 2, **{"delta": 0.1, **kwargs})
     assert str(parse_resampling("kl-lucb:0.05")) == "kl-lucb:0.05" and parse_resampling("lucb:0.1").selects
     with pytest.raises(NeurohoverError, match="DELTA must be an error probability strictly between 0 and 1"):
         parse_resampling("lucb:1.5")

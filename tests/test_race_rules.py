@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import table_sampler
 from scipy import stats
 
 from neurohover.errors import NeurohoverError
@@ -73,25 +74,12 @@ def _table(seed: int) -> np.ndarray:
     return rng.normal(0.0, 1.0, LAMBDA)[:, None] + rng.normal(0.0, 1.5, (LAMBDA, T_LIMIT))
 
 
-def _sampler(table: np.ndarray):
-    count = np.zeros(table.shape[0], dtype=int)
-
-    def sample(idx: np.ndarray) -> np.ndarray:
-        out = np.empty(idx.size)
-        for j, i in enumerate(idx):
-            out[j] = table[i, count[i]]
-            count[i] += 1
-        return out
-
-    return sample
-
-
 @pytest.mark.parametrize("rule", ["algorithm1", "authors"])
 @pytest.mark.parametrize("seed", range(12))
 def test_a_rule_matches_its_reference(rule: str, seed: int) -> None:
     table = _table(seed)
     picked, episodes, rounds = reference_race(table, MU, 0.5, skip=rule == "authors")
-    race = selection_race(_sampler(table), LAMBDA, MU, 0.5, t_limit=T_LIMIT, rule=rule)
+    race = selection_race(table_sampler(table), LAMBDA, MU, 0.5, t_limit=T_LIMIT, rule=rule)
     assert race.episodes_spent == episodes and race.rounds == rounds
     assert race.over_selected == max(0, len(picked) - MU)
     raced = sorted(picked, key=lambda i: -race.means[i])[:MU]  # the mu best of those selected
@@ -106,10 +94,10 @@ def test_the_rules_decide_differently_and_the_look_ahead_changes_nothing() -> No
     for seed in range(100):
         rng = np.random.default_rng(seed)
         table = rng.normal(0.0, 1.0, LAMBDA)[:, None] + rng.normal(0.0, 0.3, (LAMBDA, T_LIMIT))
-        prose = selection_race(_sampler(table), LAMBDA, MU, 0.5, t_limit=T_LIMIT)
-        alg1 = selection_race(_sampler(table), LAMBDA, MU, 0.5, t_limit=T_LIMIT, rule="algorithm1")
-        authors = selection_race(_sampler(table), LAMBDA, MU, 0.5, t_limit=T_LIMIT, rule="authors")
-        ahead = selection_race(_sampler(table), LAMBDA, MU, 0.5, t_limit=T_LIMIT, rule="authors", batch=200)
+        prose = selection_race(table_sampler(table), LAMBDA, MU, 0.5, t_limit=T_LIMIT)
+        alg1 = selection_race(table_sampler(table), LAMBDA, MU, 0.5, t_limit=T_LIMIT, rule="algorithm1")
+        authors = selection_race(table_sampler(table), LAMBDA, MU, 0.5, t_limit=T_LIMIT, rule="authors")
+        ahead = selection_race(table_sampler(table), LAMBDA, MU, 0.5, t_limit=T_LIMIT, rule="authors", batch=200)
         assert ahead.selected.tolist() == authors.selected.tolist() and ahead.episodes_spent == authors.episodes_spent
         differs["algorithm1"] += alg1.episodes_spent != prose.episodes_spent
         differs["authors"] += set(authors.selected) != set(alg1.selected)
@@ -124,7 +112,7 @@ def test_race_rules_are_named_in_the_resampling_spec() -> None:
     with pytest.raises(NeurohoverError, match="'fastest' is not a race rule: allowed prose, algorithm1, authors"):
         parse_resampling("race:0.5:fastest")
     with pytest.raises(ValueError, match="rule='x' is not a race rule"):
-        selection_race(_sampler(_table(0)), LAMBDA, MU, 0.5, rule="x")
+        selection_race(table_sampler(_table(0)), LAMBDA, MU, 0.5, rule="x")
 
 
 def test_fig15_rules_runs_take_the_seeds_and_validation_of_figure_15s_races() -> None:

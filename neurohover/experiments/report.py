@@ -23,7 +23,7 @@ import numpy as np
 from ..errors import NeurohoverError
 from .config import ORDER, ExperimentConfig
 from .keys import UnitKey
-from .report_base import Section, fmt, log_errors, new_figure, ratio_verdict, sd, table
+from .report_base import Section, agent_panel, fmt, log_errors, new_figure, ratio_verdict, sd, table
 from .report_evolution import EvolutionSection
 from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, test_run_figure, varies
 from .report_models import SensorModels
@@ -175,12 +175,7 @@ class _TestRuns(Section):
                 cum = -np.cumsum(np.array([[float(x) for x in r.returns] for r in runs]), axis=1).mean(axis=0)
                 short = label[len(agent) + 1 :] if label.startswith(agent + "/") else label
                 ax.plot(np.arange(1, cum.size + 1), cum, label=f"{short} ({len(runs)})", **curve_style(i))
-            ax.set_yscale("log")
-            ax.set_title(agent, fontsize=10)
-            ax.set_xlabel("episode")
-            ax.set_ylabel("mean cumulative error (log scale)")
-            ax.grid(alpha=0.3, which="both")
-            ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, frameon=False)
+            agent_panel(ax, agent)
         for ax in flat[n:]:
             ax.set_visible(False)
         fig.suptitle(f"{self.cfg.title} ({self.cfg.scale} scale); legend: condition (runs)", fontsize=10)

@@ -77,6 +77,16 @@ def new_figure(ncols: int = 1, *, figsize: tuple[float, float], nrows: int = 1):
     return fig, fig.subplots(nrows, ncols, squeeze=False)
 
 
+def agent_panel(ax, title: str) -> None:
+    """Finish one agent's panel of mean cumulative error over episodes: log scale, labels, grid, the legend below it."""
+    ax.set_yscale("log")
+    ax.set_title(title, fontsize=10)
+    ax.set_xlabel("episode")
+    ax.set_ylabel("mean cumulative error (log scale)")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, frameon=False)
+
+
 def p_significant(p_paper: str) -> bool | None:
     text = p_paper.strip().lower()
     if text.startswith("not"):

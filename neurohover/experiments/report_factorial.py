@@ -16,7 +16,7 @@ import numpy as np
 from scipy import stats
 
 from ..models.lr import LEGACY_NOISE_ESTIMATE
-from .report_base import Section, fmt, fmt_p, log_errors, new_figure, table
+from .report_base import Section, agent_panel, fmt, fmt_p, log_errors, new_figure, table
 from .results import ModelResult, TestRunResult
 
 #: (setting, our level, the authors' level, what it is)
@@ -280,13 +280,8 @@ def test_run_figure(groups, runs: Callable[[str], list[TestRunResult]], title: s
             if g in others:
                 style = {"color": "0.5", "lw": 2.5, "alpha": 0.6}
             else:
-                style = {"color": colours.get((g.d_u, g.noise), "k"), "ls": "--" if g.model_policy == "authors" else "-", "lw": 1.4}
+                style = {"color": colours.get((g.d_u, levels(g)["noise"]), "k"), "ls": "--" if g.model_policy == "authors" else "-", "lw": 1.4}
             ax.plot(np.arange(1, cum.size + 1), cum, label=g.label, **style)
-        ax.set_yscale("log")
-        ax.set_title(agent, fontsize=10)
-        ax.set_xlabel("episode")
-        ax.set_ylabel("mean cumulative error (log scale)")
-        ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, frameon=False)
+        agent_panel(ax, agent)
     fig.suptitle(title + "\ncolour: D_u and noise estimate; dashed: the authors' model policy; grey: reference", fontsize=9)
     return fig
