@@ -208,9 +208,10 @@ def test_seed_changes_the_run() -> None:
         (GHH08.mdp("train:1"), dict()),
         (GHH08.mdp("train:1"), dict(optimizer="cma")),
         (FGHH, dict(resampling="race:0.6")),
+        (FGHH, dict(resampling="race:auto")),  # its delta changes race by race: the checkpoint keeps it
         (FGHH, dict(resampling="fixed:2", optimizer="cma")),
     ],
-    ids=["steady", "cma-mdp", "race", "cma-family"],
+    ids=["steady", "cma-mdp", "race", "race-auto", "cma-family"],
 )
 def test_interrupted_and_resumed_equals_uninterrupted(tmp_path: Path, target, kwargs) -> None:
     common = dict(topology="slp", seed=3, n_steps=300, **kwargs)
@@ -437,3 +438,19 @@ def test_a_resume_with_other_sensors_is_refused(tmp_path: Path) -> None:
     with pytest.raises(NeurohoverError, match="written by a different run: target differ"):
         evolve(exact, budget=120, checkpoint=ckpt, resume=True, **common)
     assert evolve(noisy, budget=120, checkpoint=ckpt, resume=True, **common).episodes >= 60  # the same sensors resume
+
+
+def test_race_auto_matches_the_cost_of_fixed_resampling() -> None:
+    """race:auto (Section 7's automatic delta): each race's delta narrows when the last race cost more than fixed:K's
+    K x lambda episodes and widens when it cost less, within its range."""
+    from neurohover.evolution.config import AUTO_RANGE, AUTO_STEP, next_auto_delta, parse_resampling
+
+    spec = parse_resampling("race:auto")
+    assert (spec.kind, spec.auto, spec.k, str(spec)) == ("race", True, 5, "race:auto") and str(parse_resampling("race:auto:10")) == "race:auto:10"
+    with pytest.raises(NeurohoverError, match="race:auto\\[:K\\] matches fixed:K's cost, K an integer in 1..10"):
+        parse_resampling("race:auto:0")
+    assert next_auto_delta(0.5, 300, 250) == pytest.approx(0.5 * AUTO_STEP) and next_auto_delta(0.5, 200, 250) == pytest.approx(0.5 / AUTO_STEP)
+    assert next_auto_delta(AUTO_RANGE[0], 999, 250) == AUTO_RANGE[0] and next_auto_delta(AUTO_RANGE[1], 0, 250) == AUTO_RANGE[1]
+    run = evolve(FGHH, topology="slp", resampling="race:auto", budget=2000, seed=4, n_steps=100)
+    fixed_cost = 5 * 50 * run.generations
+    assert run.settings["resampling"] == "race:auto" and 0.5 * fixed_cost <= run.episodes <= 1.5 * fixed_cost

@@ -60,12 +60,15 @@ class Resampling:
     k: int = 1
     delta: float | None = None
     rule: str = "prose"
+    auto: bool = False  # race:auto: the delta of each race set so that races cost what fixed:K would (AUTO_*)
 
     def __str__(self) -> str:
         if self.kind == "fixed":
             return f"fixed:{self.k}"
         if self.kind in BANDITS:
             return f"{self.kind}:{self.delta:g}"
+        if self.auto:
+            return "race:auto" + ("" if self.k == AUTO_K else f":{self.k}")
         return f"race:{self.delta:g}" + ("" if self.rule == "prose" else f":{self.rule}")
 
     @property
@@ -74,9 +77,24 @@ class Resampling:
         return self.kind != "fixed"
 
 
+#: race:auto (the paper leaves delta open: Section 7 asks for an automatic choice). The cost a race should have is
+#: fixed:K's, K * lambda episodes a generation (K = AUTO_K, Figure 15's baseline, by default): after each race delta
+#: is multiplied by AUTO_STEP when the race spent more (narrower bounds decide sooner) and divided by it when it spent
+#: less, within AUTO_RANGE, starting at AUTO_DELTA0. Races and fixed resampling then spend the same episodes, so a
+#: race can only win by choosing better parents.
+AUTO_K, AUTO_DELTA0, AUTO_STEP, AUTO_RANGE = 5, 0.5, 0.8, (0.02, 0.98)
+
+
+def next_auto_delta(delta: float, spent: int, target: int) -> float:
+    """The delta of the next race of ``race:auto`` after one at ``delta`` spent ``spent`` episodes against ``target``."""
+    lo, hi = AUTO_RANGE
+    return float(min(hi, max(lo, delta * AUTO_STEP if spent > target else delta / AUTO_STEP)))
+
+
 def parse_resampling(spec: str | Resampling | None) -> Resampling:
-    """``"fixed:K"`` (K >= 1 episodes per candidate) or ``"race:DELTA[:RULE]"`` (0 < DELTA < 1; RULE one of
-    :data:`~neurohover.evolution.races.RACE_RULES`, default prose); None is ``fixed:1``."""
+    """``"fixed:K"`` (K >= 1 episodes per candidate), ``"race:DELTA[:RULE]"`` (0 < DELTA < 1; RULE one of
+    :data:`~neurohover.evolution.races.RACE_RULES`, default prose), ``"race:auto[:K]"`` (a delta that matches
+    fixed:K's cost, :data:`AUTO_K`) or ``"lucb:DELTA"`` / ``"kl-lucb:DELTA"``; None is ``fixed:1``."""
     if spec is None:
         return Resampling("fixed", 1)
     if isinstance(spec, Resampling):
@@ -100,6 +118,11 @@ def parse_resampling(spec: str | Resampling | None) -> Resampling:
         if 0.0 < delta < 1.0:
             return Resampling(kind, 1, delta)
         raise NeurohoverError(f"bad resampling {spec!r}: DELTA must be an error probability strictly between 0 and 1; {allowed}")
+    if kind == "race" and sep and value.partition(":")[0] == "auto":
+        k = value.partition(":")[2] or str(AUTO_K)
+        if k.isdigit() and 1 <= int(k) <= 10:
+            return Resampling("race", int(k), AUTO_DELTA0, auto=True)
+        raise NeurohoverError(f"bad resampling {spec!r}: race:auto[:K] matches fixed:K's cost, K an integer in 1..10 (a race's limit); {allowed}")
     if kind == "race" and sep:
         value, _, rule = value.partition(":")
         if rule and rule not in RACE_RULES:

@@ -27,7 +27,7 @@ from ..policies import Policy
 from ..sim.lanes import LANES
 from .bandits import BANDITS, top_mu_bandit
 from .common import Optimiser, TellInfo, enc_float
-from .config import RACE_T_LIMIT, RunConfig, upgrade_saved_config
+from .config import RACE_T_LIMIT, RunConfig, next_auto_delta, upgrade_saved_config
 from .fitness import episode_fitness
 from .generational import GenerationalNE
 from .optimisers import OPTIMISERS
@@ -121,6 +121,7 @@ class Run:
         self.champion_return = -math.inf
         self.stop_reason: str | None = None
         self._parking: Parking | None = None  # slots of a race's parked episodes, reused from race to race
+        self.race_delta = self.resampling.delta  # race:auto changes it race by race (in the checkpoint)
 
     # ----------------------------------------------------------------- checkpoints
 
@@ -142,6 +143,7 @@ class Run:
                 "kernel_seconds": self.flyer.kernel_seconds,
             },
             "mdp_stream": None if self.mdp_rng is None else self.mdp_rng.bit_generator.state,
+            "race_delta": self.race_delta,
             "champion": {"genome": None if self.champion_genome is None else self.champion_genome.tolist(), "return": enc_float(self.champion_return)},
             "history": encode_history(self.history),
             "stop_reason": self.stop_reason,
@@ -176,6 +178,7 @@ class Run:
         self.champion_genome = None if ch["genome"] is None else np.array(ch["genome"], dtype=float)
         self.champion_return = float(ch["return"])
         self.history = decode_history(state["history"])
+        self.race_delta = state.get("race_delta", self.resampling.delta)  # absent before race:auto: the fixed delta
 
     # ----------------------------------------------------------------- fitness
 
@@ -326,7 +329,7 @@ class Run:
         before_eps = self.flyer.episodes
         genomes = opt.ask()
         if self.resampling.selects:
-            delta = self.resampling.delta
+            delta = self.race_delta
             assert delta is not None  # every race has its delta (Run() formats it in config.to_dict() first)
             sampler = self._race_sampler(genomes, opt.settings.select_size)
             traced = None if self.flyer.trace is None else len(self.flyer.trace)
@@ -337,6 +340,8 @@ class Run:
                 race = selection_race(sampler, *size, delta, t_limit=RACE_T_LIMIT, batch=sampler.batch, rule=self.resampling.rule)
             # Count the episodes the race used (parking or look-ahead flew more): what depends on no speed setting.
             self.flyer.episodes += race.episodes_spent
+            if self.resampling.auto:  # the next race's delta, from this one's cost against fixed:K's
+                self.race_delta = next_auto_delta(delta, race.episodes_spent, self.resampling.k * genomes.shape[0])
             used = sampler.used(race.n_samples)
             self.flyer.steps += int(sampler.slot_steps[used].sum())
             if self.flyer.trace is not None:  # for benchmarks: the race's calls replaced by the episodes it used
