@@ -21,6 +21,8 @@ from collections import defaultdict
 import numpy as np
 from scipy import stats
 
+from neurohover.experiments.keys import UnitKey
+
 PAPER = ("table4", "fig7", "fig8", "fig11", "fig16", "ablation-hybrid", "wind-fig7", "wind-fig8", "wind-fig11", "risk-ghh09")
 BENCH = ("bench-sensor-models", "bench-sensors", "bench-sensors-fallback", "bench-drift", "bench-drift-armed")
 
@@ -46,7 +48,7 @@ def compare(before: dict, after: dict) -> list[str]:
         if old is None or old[0] == params or old[0].get("seed") != params.get("seed"):
             continue  # not re-run (kept), or not the same episodes
         b, a = score(old[1]), score(result)
-        group = key.split("/")[1]
+        group = UnitKey.parse(key).group  # a label may hold a slash (AGENT/CONDITION)
         groups[group].append((b[0], a[0], b[1], a[1]))
     lines = []
     for group, pairs in sorted(groups.items()):
