@@ -22,7 +22,7 @@ LAYERS = [
     {"agents"},
     {"experiments"},
     {"compete"},
-    {"cli", "commands_agents", "commands_learning", "commands_plots", "commands_reproduce", "bench", "bench_gpu", "__main__", "__init__"},
+    {"cli", "commands_agents", "commands_evaluate", "commands_learning", "commands_plots", "commands_reproduce", "bench", "bench_gpu", "__main__", "__init__"},
 ]
 RANK = {name: i for i, layer in enumerate(LAYERS) for name in layer}
 ENTRY_POINTS = {"neurohover/experiments/__main__.py"}  # `python -m neurohover.experiments` is the command line
