@@ -249,21 +249,24 @@ def validation_return(
     The noise and MDPs come from ``SeedSequence(seed)`` child ``(3,)``, which :func:`evolve` never
     uses, so these episodes are independent of the ones the run flew. ``device`` as in :func:`evolve`.
     """
-    mdp, family, _ = resolve_target(target)
-    if isinstance(episodes, bool) or not isinstance(episodes, (int, np.integer)) or episodes < 1:
-        raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
     noise_seed, mdp_seed = validation_seeds(check_seed(seed))
-    if mdp is not None:
-        rows = mdp.row()[None, :]
-        m_idx = np.zeros(episodes, dtype=np.int64)
-    else:
-        assert family is not None  # resolve_target gives an MDP or a family
-        rows = family.sample_rows(np.random.default_rng(mdp_seed), episodes)
-        m_idx = np.arange(episodes)
+    rows, m_idx = _fresh_episodes(target, episodes, mdp_seed)
     ev = evaluate_jobs(
         [policy], rows, np.zeros(episodes, dtype=np.int64), m_idx, np.arange(episodes), seed=noise_seed, n_steps=n_steps, threads=threads, device=device
     )
     return ev.returns
+
+
+def _fresh_episodes(target, episodes: int, mdp_seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """The kernel rows and each episode's row index of ``episodes`` fresh episodes of ``target``: all on its MDP, or
+    each on a fresh MDP from G drawn with ``mdp_seed``."""
+    mdp, family, _ = resolve_target(target)
+    if isinstance(episodes, bool) or not isinstance(episodes, (int, np.integer)) or episodes < 1:
+        raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
+    if mdp is not None:
+        return mdp.row()[None, :], np.zeros(episodes, dtype=np.int64)
+    assert family is not None  # resolve_target gives an MDP or a family
+    return family.sample_rows(np.random.default_rng(mdp_seed), episodes), np.arange(episodes)
 
 
 #: The candidates :func:`reevaluated_champion` chooses among: the last generation's selected parents, or the run's
@@ -296,15 +299,8 @@ def reevaluated_champion(
     pool = result.parents if among == "last" else result.hall_of_fame
     if pool is None or len(pool) == 0:
         raise NeurohoverError("the run has no selected parents to choose from again: generational evolution keeps them, other methods do not")
-    if isinstance(episodes, bool) or not isinstance(episodes, (int, np.integer)) or episodes < 1:
-        raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
-    mdp, family, _ = resolve_target(target)
     noise_seed, mdp_seed = reevaluation_seeds(check_seed(int(result.settings["seed"])))
-    if mdp is not None:
-        rows, m = mdp.row()[None, :], np.zeros(episodes, dtype=np.int64)
-    else:
-        assert family is not None  # resolve_target gives an MDP or a family
-        rows, m = family.sample_rows(np.random.default_rng(mdp_seed), episodes), np.arange(episodes)
+    rows, m = _fresh_episodes(target, episodes, mdp_seed)
     k = len(pool)
     champion = result.champion
     policies = [Policy(champion.topology, np.array(g, dtype=float), champion.metadata) for g in pool]

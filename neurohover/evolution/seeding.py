@@ -53,17 +53,19 @@ def mdp_rng(seed: int) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(_MDPS,)))
 
 
-def reevaluation_seeds(seed: int) -> tuple[int, int]:
-    """``(noise seed, MDP seed)`` of the episodes that choose a run's champion again
-    (:func:`neurohover.evolution.evolve.reevaluated_champion`): the first two 63-bit words of child ``(4,)``."""
-    state = np.random.SeedSequence(seed, spawn_key=(_REEVALUATION,)).generate_state(2, np.uint64)
+def _seed_pair(seed: int, child: int) -> tuple[int, int]:
+    """``(noise seed, MDP seed)``: the first two 63-bit words of child ``(child,)`` of root ``seed``."""
+    state = np.random.SeedSequence(seed, spawn_key=(child,)).generate_state(2, np.uint64)
     noise, mdps = (int(x >> np.uint64(1)) for x in state)
     return noise, mdps
+
+
+def reevaluation_seeds(seed: int) -> tuple[int, int]:
+    """``(noise seed, MDP seed)`` of the episodes that choose a run's champion again
+    (:func:`neurohover.evolution.evolve.reevaluated_champion`): child ``(4,)``."""
+    return _seed_pair(seed, _REEVALUATION)
 
 
 def validation_seeds(seed: int) -> tuple[int, int]:
-    """``(noise seed, MDP seed)`` of the validation episodes for root ``seed``: the first two
-    63-bit words of child ``(3,)``."""
-    state = np.random.SeedSequence(seed, spawn_key=(_VALIDATION,)).generate_state(2, np.uint64)
-    noise, mdps = (int(x >> np.uint64(1)) for x in state)
-    return noise, mdps
+    """``(noise seed, MDP seed)`` of the validation episodes for root ``seed``: child ``(3,)``."""
+    return _seed_pair(seed, _VALIDATION)
