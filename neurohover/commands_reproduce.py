@@ -22,6 +22,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     from .experiments import Store, load_configs, make_executor, parse_override, reproduce
     from .experiments.config import experiment_names
     from .experiments.plans import source_experiments
+    from .experiments.runner import check_restart
     from .paths import output_file
 
     if args.list:
@@ -32,8 +33,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         raise NeurohoverError("give an experiment NAME (" + ", ".join(experiment_names()) + "), 'all', or a .toml config file")
     if args.store is None:
         raise NeurohoverError("give the results store file with --store FILE (it is created if missing)")
-    if args.fresh and args.update:
-        raise NeurohoverError("--fresh discards every stored result and --update keeps the unchanged ones: give one of them")
+    check_restart(args.fresh, args.update)  # before the store file is made
     if args.executor == "ray" and args.jobs != 1:
         raise NeurohoverError("--jobs applies to --executor local; Ray runs one unit per CPU of the cluster")
     if args.address is not None and args.executor != "ray":

@@ -74,9 +74,13 @@ def _legacy_noise_dropped(settings: dict) -> dict:
     Before 2026-12-04 an absent estimate meant innovations: a config naming it now hashes as it did
     then (its stored results resume), and one that leaves it out takes the new default, "rms".
     """
-    out = {k: v for k, v in settings.items() if not (k == "noise" and v == LEGACY_NOISE_ESTIMATE)}
+
+    def dropped(table: dict) -> dict:
+        return {k: v for k, v in table.items() if not (k == "noise" and v == LEGACY_NOISE_ESTIMATE)}
+
+    out = dropped(settings)
     if "groups" in settings:
-        out["groups"] = [{k: v for k, v in g.items() if not (k == "noise" and v == LEGACY_NOISE_ESTIMATE)} for g in settings["groups"]]
+        out["groups"] = [dropped(g) for g in settings["groups"]]
     return out
 
 

@@ -34,7 +34,7 @@ from ..tasks import EXACT, Sensor
 from ..tasks.drift import Drift
 from .config import ExperimentConfig, load_config
 from .keys import UnitKey
-from .schema import variant_optimizer
+from .schema import DIR_SOURCE, variant_optimizer
 from .settings import EvolutionSettings, ExperimentSettings, Group, ModelLearningSettings, TestRunsSettings
 from .units import Unit, family_of, policy_dict, unit_seed
 
@@ -100,10 +100,6 @@ def external_digest(kind: str, s: dict) -> str:
     return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
 
 
-#: A ``generics_from`` source that names a directory of policy files (``.net`` or ``.json``) instead of an experiment.
-DIR_SOURCE = "dir:"
-
-
 def _dir_champions(source: str) -> list[tuple[str, dict]]:
     """``[(label, policy)]`` of the policy files in the directory ``dir:PATH`` names, in file-name order."""
     from pathlib import Path
@@ -133,6 +129,11 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
         "history_points": s.history_points,
     }
     root, name = (s.seed, cfg.name) if s.seeds_of is None else (s.seeds_of["seed"], s.seeds_of["experiment"])
+
+    def paired_seed(v, mdp: str | None, r: int) -> int | None:
+        """With seeds_of: the seed of run r of the other experiment's variant ``v`` pairs with (None: the unit's own)."""
+        return unit_seed(root, name, UnitKey.make("evolve", v.paired_with or v.key, mdp, r)) if s.seeds_of else None
+
     if s.validation_mdps == "test":  # one seed for every run's validation: the same MDPs and gusts
         base.update(validation_mdps="test", validation_seed=unit_seed(root, name, "validation"))
     if s.champion_reevaluation:  # absent otherwise: stored units keep their params
@@ -146,8 +147,7 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
             for i, mdp in enumerate(train):
                 for r in range(s.runs):
                     key = UnitKey.make("evolve", v.key, f"train{i}", r)
-                    seed = unit_seed(root, name, UnitKey.make("evolve", v.paired_with or v.key, f"train{i}", r)) if s.seeds_of else None
-                    units.append(_unit(cfg, key, "evolve", {**common, "target": {"kind": "mdp", "mdp": mdp.to_dict()}}, seed=seed))
+                    units.append(_unit(cfg, key, "evolve", {**common, "target": {"kind": "mdp", "mdp": mdp.to_dict()}}, seed=paired_seed(v, f"train{i}", r)))
         else:
             sigma = v.sigma if v.sigma is not None else s.sigma
             if s.target == "zero":
@@ -155,8 +155,7 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
             else:
                 target = _family_target(s, sigma)
             for r in range(s.runs):
-                seed = unit_seed(root, name, UnitKey.make("evolve", v.paired_with or v.key, rep=r)) if s.seeds_of else None
-                units.append(_unit(cfg, UnitKey.make("evolve", v.key, rep=r), "evolve", {**common, "target": target}, seed=seed))
+                units.append(_unit(cfg, UnitKey.make("evolve", v.key, rep=r), "evolve", {**common, "target": target}, seed=paired_seed(v, None, r)))
     total = len(units) + len(s.robustness_variants) * len(train)
     for vkey in s.robustness_variants:
         for i in range(len(train)):

@@ -23,7 +23,7 @@ import numpy as np
 from ..errors import NeurohoverError
 from .config import ORDER, ExperimentConfig
 from .keys import UnitKey
-from .report_base import Section, agent_panel, fmt, log_errors, new_figure, ratio_verdict, sd, table
+from .report_base import Section, agent_panel, fmt, log_errors, new_figure, paired_p, ratio_verdict, sd, table
 from .report_evolution import EvolutionSection
 from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, test_run_figure, varies
 from .report_models import SensorModels
@@ -328,8 +328,6 @@ class _TestRuns(Section):
 
     def _paired_elsewhere(self) -> str:
         """Each group that flew another experiment's seeds against that experiment's group, run by run (Wilcoxon)."""
-        from scipy import stats
-
         rows = []
         for g in self.groups():
             of = g.seeds_of
@@ -345,7 +343,7 @@ class _TestRuns(Section):
             if len(common) < 2:
                 continue
             diff = np.array([mine[k] - theirs[k] for k in common])
-            p = float(stats.wilcoxon(diff).pvalue) if np.any(diff != 0) else 1.0
+            p = paired_p(diff)
             a, b = float(np.mean([mine[k] for k in common])), float(np.mean([theirs[k] for k in common]))
             median = float(np.median(diff))
             rows.append(

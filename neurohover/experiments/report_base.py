@@ -60,6 +60,14 @@ def ttest(a, b) -> tuple[float | None, float | None, float | None]:
     return float(student.statistic), float(student.pvalue), float(welch.pvalue)
 
 
+def paired_p(diff) -> float:
+    """The Wilcoxon signed-rank p of paired differences (1 when every pair is equal: nothing to rank)."""
+    from scipy import stats
+
+    d = np.asarray(diff, dtype=float)
+    return float(stats.wilcoxon(d).pvalue) if np.any(d != 0) else 1.0
+
+
 def sd(x) -> float:
     x = np.asarray(x, dtype=float)
     return float(x.std(ddof=1)) if x.size > 1 else float("nan")

@@ -12,7 +12,7 @@ from ..errors import NeurohoverError
 from ..evolution.fitness import episode_fitness, error_of_fitness
 from .config import ExperimentConfig, load_config
 from .keys import UnitKey
-from .report_base import Section, fmt, new_figure, ratio_verdict, sd, table
+from .report_base import Section, fmt, new_figure, paired_p, ratio_verdict, sd, table, ttest
 from .results import EvolveResult, RobustnessResult, result_from_dict
 from .settings import EvolutionSettings, Variant
 
@@ -37,7 +37,7 @@ class EvolutionSection(Section):
     def final_scores(self, runs: list[EvolveResult]) -> list[float]:
         """Per run: the mean validation return, or on the 1/ln(error) scale the mean validation fitness."""
         if self._fghh_style() and all(r.validation is not None for r in runs):
-            return [_mean_fitness([float(x) for x in r.validation or ()]) for r in runs]
+            return [_validation_fitness(r.validation) for r in runs]
         return [r.final_score for r in runs]
 
     def figure(self) -> str | None:
@@ -176,43 +176,11 @@ class EvolutionSection(Section):
         return text
 
     def _reevaluation_block(self) -> str:
-        """Each run's own champion against the one chosen again from its last parents (both validated alike)."""
-        from scipy import stats
-
+        """Each run's own champion against the one chosen again from its last parents or its best ever (validated alike)."""
         rows = []
-        for v, (among, field) in ((v, pool) for v in self.variants() for pool in (("last parents", "reevaluated"), ("best ever", "reevaluated_best_ever"))):
-            runs = [r for r in self.runs(v.key) if getattr(r, field) is not None and getattr(r, field).validation is not None and r.validation is not None]
-            if not runs:
-                continue
-            own = np.array([_mean_fitness([float(x) for x in r.validation or ()]) for r in runs])
-            again = np.array([_mean_fitness([float(x) for x in getattr(r, field).validation or ()]) for r in runs])
-            diff = again - own
-            p = float(stats.wilcoxon(diff).pvalue) if len(runs) >= 2 and np.any(diff != 0) else 1.0
-            same = sum(getattr(r, field).champion == r.champion for r in runs)
-
-            def crash_rate(flags) -> str:
-                flat = [bool(c) for cs in flags for c in (cs or ())]
-                return f"{np.mean(flat):.1%}" if flat else "n/a"
-
-            rows.append(
-                [
-                    v.label,
-                    among,
-                    str(len(runs)),
-                    fmt(float(own.mean())),
-                    fmt(float(again.mean())),
-                    f"{int((diff > 0).sum())} of {len(runs)}",
-                    str(same),
-                    fmt(p),
-                    crash_rate(r.validation_crashed for r in runs),
-                    crash_rate(getattr(r, field).validation_crashed for r in runs),
-                ]
-            )
-            word = "better" if again.mean() > own.mean() else "worse" if again.mean() < own.mean() else "as good"
-            self.comparisons.append(
-                f"{v.label}: the champion chosen again among the {among} is {word} than the run's own (mean validation 1/ln(error) {fmt(float(again.mean()))} "
-                f"vs {fmt(float(own.mean()))}, Wilcoxon p = {fmt(p)}" + (", significant at 5%)." if p < 0.05 else ", not significant).")
-            )
+        for v in self.variants():
+            for among, field in (("last parents", "reevaluated"), ("best ever", "reevaluated_best_ever")):
+                rows += self._reevaluation_row(v, among, field)
         if not rows:
             return ""
         n = self.s.champion_reevaluation
@@ -229,11 +197,39 @@ class EvolutionSection(Section):
             "1/ln(error) per run, then over runs; Wilcoxon signed-rank test on the run pairs).\n"
         )
 
+    def _reevaluation_row(self, v: Variant, among: str, field: str) -> list[list[str]]:
+        """The row of variant ``v``'s runs' champions chosen again among ``among`` (their result's ``field``), if any."""
+        runs = [r for r in self.runs(v.key) if getattr(r, field) is not None and getattr(r, field).validation is not None and r.validation is not None]
+        if not runs:
+            return []
+        own = np.array([_validation_fitness(r.validation) for r in runs])
+        again = np.array([_validation_fitness(getattr(r, field).validation) for r in runs])
+        diff = again - own
+        p = paired_p(diff) if len(runs) >= 2 else 1.0
+        same = sum(getattr(r, field).champion == r.champion for r in runs)
+        word = "better" if again.mean() > own.mean() else "worse" if again.mean() < own.mean() else "as good"
+        self.comparisons.append(
+            f"{v.label}: the champion chosen again among the {among} is {word} than the run's own (mean validation 1/ln(error) {fmt(float(again.mean()))} "
+            f"vs {fmt(float(own.mean()))}, Wilcoxon p = {fmt(p)}" + (", significant at 5%)." if p < 0.05 else ", not significant).")
+        )
+        return [
+            [
+                v.label,
+                among,
+                str(len(runs)),
+                fmt(float(own.mean())),
+                fmt(float(again.mean())),
+                f"{int((diff > 0).sum())} of {len(runs)}",
+                str(same),
+                fmt(p),
+                _crash_share(r.validation_crashed for r in runs),
+                _crash_share(getattr(r, field).validation_crashed for r in runs),
+            ]
+        ]
+
     def _paired_block(self, samples: dict[str, list[float]], labels: dict[str, str]) -> str:
         """Each variant against the runs of the other experiment's variant whose seeds it took (Wilcoxon signed-rank
         on the run pairs' validation 1/ln(error)), and against that experiment's fixed-resampling variants (Welch's t)."""
-        from scipy import stats
-
         source = self.s.seeds_of["experiment"]
         try:
             other = load_config(source, self.cfg.scale)
@@ -245,7 +241,7 @@ class EvolutionSection(Section):
             """Run number -> mean validation 1/ln(error) of the variant's runs (validated ones)."""
             keys = [(k, UnitKey.parse(k)) for k in results if k.startswith("evolve/")]
             runs = {key.rep: results[k] for k, key in keys if key.group == vkey}
-            return {rep: _mean_fitness([float(x) for x in r.validation or ()]) for rep, r in runs.items() if r.validation is not None}
+            return {rep: _validation_fitness(r.validation) for rep, r in runs.items() if r.validation is not None}
 
         if not isinstance(other.typed, EvolutionSettings):
             return f"\nPaired with {source}: not an evolution experiment, so not compared.\n"
@@ -259,15 +255,16 @@ class EvolutionSection(Section):
             row = [v.label, f"{source}/{v.paired_with or v.key}", str(len(common))]
             if len(common) >= 2:
                 diff = np.array([mine[r] - pair[r] for r in common])
-                p = stats.wilcoxon(diff).pvalue if np.any(diff != 0) else 1.0
+                p = paired_p(diff)
                 better = int(np.sum(diff > 0))
                 row += [fmt(np.mean([mine[r] for r in common])), fmt(np.mean([pair[r] for r in common])), f"{better} of {len(common)}", fmt(float(p))]
             else:
                 row += ["", "", "", ""]
             for f in fixed:
                 base = list(scores(theirs, f.key).values())
-                if len(base) >= 2 and len(samples[v.key]) >= 2:
-                    t, p = stats.ttest_ind(samples[v.key], base, equal_var=False)
+                welch = ttest(samples[v.key], base)[2]
+                if welch is not None:
+                    p = welch
                     mine_mean, base_mean = np.mean(samples[v.key]), np.mean(base)
                     word = "better" if mine_mean > base_mean else "worse" if mine_mean < base_mean else "equal"
                     row.append(f"{word}, p = {fmt(float(p))}")
@@ -428,6 +425,17 @@ FITNESS_SCALE = "inv-log-error"
 def _mean_fitness(returns) -> float:
     """Mean 1/ln(error) of one policy's episode returns (a run's validation, or one authors' file's)."""
     return float(np.mean(episode_fitness(np.asarray(returns, dtype=float), FITNESS_SCALE)))
+
+
+def _validation_fitness(validation) -> float:
+    """A champion's mean 1/ln(error) over its validation returns (stored as JSON-safe numbers)."""
+    return _mean_fitness([float(x) for x in validation or ()])
+
+
+def _crash_share(flags) -> str:
+    """The share of crashed episodes over runs' per-episode crash flags (None: not recorded)."""
+    flat = [bool(c) for cs in flags for c in (cs or ())]
+    return f"{np.mean(flat):.1%}" if flat else "n/a"
 
 
 def _on_fitness_scale(runs: list[EvolveResult]) -> bool:

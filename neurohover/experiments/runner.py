@@ -63,6 +63,12 @@ def selected(key: str, only: Sequence[str]) -> bool:
     return not only or key.startswith("policy/") or any(fnmatch.fnmatchcase(key, pat) for pat in only)
 
 
+def check_restart(fresh: bool, update: bool) -> None:
+    """Refuse ``fresh`` (discard every stored result) together with ``update`` (keep the unchanged ones)."""
+    if fresh and update:
+        raise NeurohoverError("--fresh discards every stored result and --update keeps the unchanged ones: give one of them")
+
+
 def unchanged_units(config: ExperimentConfig, store: Store) -> set[str]:
     """The keys of the stored units of ``config``'s experiment that ``config`` plans alike: same key,
     kind and params (the seed included), so their results stand under it.
@@ -116,8 +122,7 @@ def reproduce(
     from tqdm import tqdm
 
     store.lock()  # one writer per store: a second run would redo every unit the first has not finished
-    if fresh and update:
-        raise NeurohoverError("--fresh discards every stored result and --update keeps the unchanged ones: give one of them")
+    check_restart(fresh, update)
     held = store.config_hash(config.name, config.scale)
     if update and held is not None and held != config.hash:
         kept = store.update(config.name, config.scale, config.hash, config.to_dict(), unchanged_units(config, store))

@@ -26,6 +26,9 @@ from ..models.lr import D_U_CHOICES, DEFAULT_NOISE_ESTIMATE, NOISE_ESTIMATES
 from ..policysets import FGHH_GENERIC_RESAMPLING
 from ..tasks import TASK_FAMILIES, TASK_NAMES, Drift, Sensor
 
+#: A ``generics_from`` source that names a directory of policy files (``.net`` or ``.json``) instead of an experiment.
+DIR_SOURCE = "dir:"
+
 REQUIRED = object()
 OMIT = object()  # default of a setting added later: absent from the resolved config unless given (older configs keep their hash)
 
@@ -411,7 +414,7 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
                     raise NeurohoverError(f"{where}: group {g['label']!r}: {e}") from None
         for kind, source in settings.get("generics_from", {}).items():
             name, _, variant = str(source).partition("/")
-            if str(source).startswith("dir:") and len(str(source)) > 4:
+            if str(source).startswith(DIR_SOURCE) and len(str(source)) > len(DIR_SOURCE):
                 name = variant = "dir"  # a directory of policy files (checked when the config's digest reads them)
             if kind not in ("fixed", "race") or not isinstance(source, str) or not name or not variant:
                 raise NeurohoverError(
