@@ -12,8 +12,6 @@ import importlib
 import json
 import sys
 
-import numpy as np
-
 from .errors import NeurohoverError
 
 SOURCES = ("policy", "callable", "rl_zoo", "sb3")
@@ -21,7 +19,8 @@ ALGOS = ("ppo", "sac", "td3", "a2c")
 
 
 def _agent(args: argparse.Namespace):
-    """The batch function (observations -> actions) of the one source given."""
+    """The agent of the one source given: a policy file's policy (flown in the kernel), or a batch function
+    (observations -> actions)."""
     given = [s for s in SOURCES if getattr(args, s) is not None]
     if len(given) != 1:
         named = ", ".join("--" + s.replace("_", "-") for s in given) or "none"
@@ -30,8 +29,7 @@ def _agent(args: argparse.Namespace):
         from .paths import input_file
         from .policies import load_policy
 
-        policy = load_policy(input_file(args.policy, "--policy", "policy file"))
-        return lambda obs: np.array([policy.act(o) for o in np.asarray(obs, dtype=np.float64)])
+        return load_policy(input_file(args.policy, "--policy", "policy file"))
     if args.callable is not None:
         module, _, name = args.callable.partition(":")
         if not module or not name:
@@ -55,6 +53,7 @@ def _agent(args: argparse.Namespace):
 def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     """Fly a trained policy on full paper episodes of a task's training or test MDPs, beside the competition's baseline
     and the shipped generic policy on the same gusts, and print the paper's measures (return per episode, crashes)."""
+    from .evolution.seeding import check_seed
     from .integrations.flying import compare_agent
     from .paths import output_file
     from .tasks import get_task_family
@@ -64,11 +63,8 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     n = available if args.n_mdps is None else args.n_mdps
     if not 1 <= n <= available:
         raise NeurohoverError(f"--n-mdps {n} is out of range: {args.task} has {available} {args.mdps} MDPs")
-    for option, value, low, high in (
-        ("--episodes", args.episodes, 1, 10**4),
-        ("--episode-steps", args.episode_steps, 1, 10**7),
-        ("--seed", args.seed, 0, 2**63 - 1),
-    ):
+    check_seed(args.seed)  # the one range every command takes
+    for option, value, low, high in (("--episodes", args.episodes, 1, 10**4), ("--episode-steps", args.episode_steps, 1, 10**7)):
         if not low <= value <= high:
             raise NeurohoverError(f"{option} {value} is out of range: allowed an integer in {low}..{high}")
     out = None if args.json is None else output_file(args.json, "--json")

@@ -28,6 +28,7 @@ import numpy as np
 from ..envs.vector import HoverVectorEnv
 from ..errors import NeurohoverError
 from ..evaluate import Evaluation
+from ..policies import Policy
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS
 from ..tasks import MDP
 
@@ -115,18 +116,28 @@ class AgentRow:
 
 
 def compare_agent(
-    act: Callable[[np.ndarray], Any], mdps: Sequence[MDP], *, episodes: int = 1, seed: int = 0, n_steps: int = EPISODE_STEPS, obs_dtype: str = "float32"
+    act: Callable[[np.ndarray], Any] | Policy,
+    mdps: Sequence[MDP],
+    *,
+    episodes: int = 1,
+    seed: int = 0,
+    n_steps: int = EPISODE_STEPS,
+    obs_dtype: str = "float32",
 ) -> list[AgentRow]:
     """``act`` flown on ``mdps`` beside the competition's baseline and the shipped generic policy of the MDPs' task,
     all on the same gusts (:func:`evaluate_callable` and :func:`neurohover.evaluate` number them alike): a learned
     policy measured as the paper measured its agents (full episodes of ``n_steps``; the return per episode and
-    the crashes). Returns rows for ``agent``, ``baseline`` and ``generic``, in that order."""
+    the crashes). A :class:`~neurohover.policies.Policy` flies in the compiled kernel, as the other two do.
+    Returns rows for ``agent``, ``baseline`` and ``generic``, in that order."""
     from ..evaluate import evaluate
     from ..policies import baseline_policy
     from ..policysets import load_policy_set
 
     mdps = list(mdps)
-    agent = evaluate_callable(act, mdps, episodes=episodes, seed=seed, n_steps=n_steps, obs_dtype=obs_dtype)
+    if isinstance(act, Policy):
+        agent = evaluate(act, mdps, episodes=episodes, seed=seed, n_steps=n_steps)
+    else:
+        agent = evaluate_callable(act, mdps, episodes=episodes, seed=seed, n_steps=n_steps, obs_dtype=obs_dtype)
     generic = load_policy_set(mdps[0].family).generic
     rows = [AgentRow.of("agent", agent)]
     for name, policy in (("baseline", baseline_policy()), ("generic", generic)):
