@@ -187,3 +187,17 @@ def test_cuda_without_a_gpu_is_one_clear_error() -> None:
 def test_unknown_device_is_refused() -> None:
     with pytest.raises(NeurohoverError, match="device='gpu' is unknown: allowed 'cpu' or 'cuda'"):
         evaluate(baseline_policy(), get_task_family("ghh08").zero(), n_steps=10, device="gpu")
+
+
+def test_cuda_module_restores_the_numpy_alias_numba_cuda_needs() -> None:
+    # numba-cuda 0.30.4 overloads np.row_stack when it builds its first kernel; NumPy 2.5 removed that alias, and
+    # on an H200 with NumPy 2.5.2 no kernel compiled. Importing the CUDA module puts the alias back.
+    script = (
+        "import numpy as np\n"
+        "if hasattr(np, 'row_stack'): del np.row_stack  # as NumPy 2.5 ships\n"
+        "import neurohover.sim.cuda\n"
+        "print(np.row_stack is np.vstack)\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert proc.stdout.split() == ["True"]
