@@ -175,7 +175,7 @@ def test_bad_lr_fit_configs_are_refused() -> None:
 
 
 def test_the_agents_hand_their_lr_fit_to_the_model(monkeypatch) -> None:
-    """ModelEvolution's d_u and noise reach learn_lr through every agent that learns a model."""
+    """ModelEvolution's d_u, noise and model substeps reach learn_model through every agent that learns a model."""
     import neurohover.agents.model_based as mb
     from neurohover.agents.model_based import IncrementalModelBasedAgent, ModelBasedAgent
     from neurohover.agents.protocol import EpisodeOutcome
@@ -183,17 +183,17 @@ def test_the_agents_hand_their_lr_fit_to_the_model(monkeypatch) -> None:
     ev = evaluate(baseline_policy(), get_task_family("ghh08").training_mdps()[0], seed=SEED, record=True, n_steps=200)
     seen = []
 
-    def spy(flight_data, estimator="ols", wind_model="none", *, d_u="keep", noise="innovations"):
-        seen.append((d_u, noise))
+    def spy(flight_data, estimator="ols", wind_model="none", *, d_u="keep", noise="innovations", substeps=1):
+        seen.append((d_u, noise, substeps))
         raise RuntimeError("stop before evolving")
 
     monkeypatch.setattr(mb, "learn_model", spy)
     for cls in (ModelBasedAgent, IncrementalModelBasedAgent):
-        agent = cls(baseline_policy(), ModelEvolution(d_u="discard", noise="rms"))
+        agent = cls(baseline_policy(), ModelEvolution(d_u="discard", noise="rms", model_substeps=10))
         agent.start(get_task_family("ghh08"), np.random.default_rng(0))
         with pytest.raises(RuntimeError, match="stop before evolving"):
             agent.update(EpisodeOutcome(0, float(ev.returns.ravel()[0]), False, 200, -1, ev.flight_data))
-    assert seen == [("discard", "rms")] * 2
+    assert seen == [("discard", "rms", 10)] * 2
 
 
 def test_main_effects_pair_cells_that_differ_in_one_factor() -> None:

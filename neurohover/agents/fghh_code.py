@@ -38,6 +38,7 @@ from ..evaluate import DangerousState
 from ..evolution.steady_state import SteadyStateSettings
 from ..flightdata import FlightData
 from ..models.lr import DEFAULT_NOISE_ESTIMATE
+from ..models.model import MODEL_SUBSTEPS
 from ..policies import Policy, baseline_policy, prototype
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
@@ -84,6 +85,8 @@ class CodeAgentSettings:
         The LR model's u constant and noise estimate (:func:`neurohover.models.learn_lr`; ours by
         default, ``"discard"`` and ``"rms"`` as the authors' code). Its evolution on the model is
         always the authors' (:data:`MODEL_EVOLUTION`), whatever a run's ``model_policy`` says.
+    model_substeps : {1, 10}
+        The model's substeps per control step (1, as the authors; :meth:`neurohover.models.LearnedModel.mdp`).
     """
 
     evolutions: int = 3
@@ -95,8 +98,11 @@ class CodeAgentSettings:
     wind_model: str = "none"
     d_u: str = "keep"
     noise: str = DEFAULT_NOISE_ESTIMATE
+    model_substeps: int = 1
 
     def __post_init__(self) -> None:
+        if self.model_substeps not in MODEL_SUBSTEPS:
+            raise NeurohoverError(f"model_substeps={self.model_substeps!r} is not allowed: choose one of {', '.join(map(str, MODEL_SUBSTEPS))}")
         for name, low in (("evolutions", 1), ("model_budget", 50), ("n_steps", 1)):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
@@ -157,7 +163,7 @@ class CodeFGHHAgent(Agent):
             self.flight_data = outcome.flight_data if self.flight_data is None else self.flight_data + outcome.flight_data
             if not enough_to_learn(self.flight_data, s.wind_model):
                 return
-            self.model = learn_model(self.flight_data, s.estimator, s.wind_model, d_u=s.d_u, noise=s.noise)
+            self.model = learn_model(self.flight_data, s.estimator, s.wind_model, d_u=s.d_u, noise=s.noise, substeps=s.model_substeps)
         elif self.flying != "generic" and self.next_trial <= len(self.candidates) - 1:
             self.next_trial += 1
         if len(self.candidates) - 1 < s.evolutions and self.next_trial == len(self.candidates):
@@ -191,7 +197,13 @@ def _build(name: str):
             CodeAgentSettings()
             if evo is None
             else CodeAgentSettings(
-                model_budget=max(50, evo.budget), n_steps=evo.n_steps, estimator=evo.estimator, wind_model=evo.wind_model, d_u=evo.d_u, noise=evo.noise
+                model_budget=max(50, evo.budget),
+                n_steps=evo.n_steps,
+                estimator=evo.estimator,
+                wind_model=evo.wind_model,
+                d_u=evo.d_u,
+                noise=evo.noise,
+                model_substeps=evo.model_substeps,
             )
         )
         agent = CodeFGHHAgent(policies.generic, settings)

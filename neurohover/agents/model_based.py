@@ -44,6 +44,10 @@ class ModelEvolution:
     ``model_policy`` ``"ours"`` (default: steady state from the generic policy, ``budget`` episodes)
     or ``"authors"`` (an SLP from the baseline by the authors' ``eonn``: 50 genomes, then
     ``authors_generations`` generations of one offspring each; :data:`MODEL_POLICIES`).
+
+    ``model_substeps``: the learned model integrates each 0.1 s control step once (1, the default: the
+    paper's and the authors' model) or in the simulator's ten substeps of its equivalent parameters (10;
+    :meth:`neurohover.models.LearnedModel.mdp`, measured in ``lr-substeps-table4``, docs/model.md).
     """
 
     budget: int = 2000
@@ -56,10 +60,12 @@ class ModelEvolution:
     noise: str = DEFAULT_NOISE_ESTIMATE
     model_policy: str = "ours"
     authors_generations: int = 500
+    model_substeps: int = 1
 
     def __post_init__(self) -> None:
         from ..evaluate import check_device
         from ..models import D_U_CHOICES, ESTIMATORS, NOISE_ESTIMATES
+        from ..models.model import MODEL_SUBSTEPS
         from ..models.wind import WIND_MODELS
 
         for name, allowed in (
@@ -68,10 +74,11 @@ class ModelEvolution:
             ("d_u", D_U_CHOICES),
             ("noise", NOISE_ESTIMATES),
             ("model_policy", MODEL_POLICIES),
+            ("model_substeps", MODEL_SUBSTEPS),
         ):
             value = getattr(self, name)
             if value not in allowed:
-                raise NeurohoverError(f"{name}={value!r} is not allowed: choose one of {', '.join(allowed)}")
+                raise NeurohoverError(f"{name}={value!r} is not allowed: choose one of {', '.join(map(str, allowed))}")
         g = self.authors_generations
         if isinstance(g, bool) or not isinstance(g, int) or g < 1:
             raise NeurohoverError(f"authors_generations={g!r} is out of range: allowed an integer >= 1")
@@ -79,10 +86,12 @@ class ModelEvolution:
 
     def learn(self, flight_data: FlightData) -> MDP:
         """The LR model of ``flight_data`` under these settings, as an MDP."""
-        return learn_model(flight_data, self.estimator, self.wind_model, d_u=self.d_u, noise=self.noise)
+        return learn_model(flight_data, self.estimator, self.wind_model, d_u=self.d_u, noise=self.noise, substeps=self.model_substeps)
 
 
-def learn_model(flight_data: FlightData, estimator: str = "ols", wind_model: str = "none", *, d_u: str = "keep", noise: str = DEFAULT_NOISE_ESTIMATE) -> MDP:
+def learn_model(
+    flight_data: FlightData, estimator: str = "ols", wind_model: str = "none", *, d_u: str = "keep", noise: str = DEFAULT_NOISE_ESTIMATE, substeps: int = 1
+) -> MDP:
     """The LR model (the paper's best method) of the flight data, as an MDP.
 
     ``estimator="ols"`` (default): ordinary least squares, as the paper and the authors' code;
@@ -90,11 +99,11 @@ def learn_model(flight_data: FlightData, estimator: str = "ols", wind_model: str
     are LR's default, ``"uv"`` (D_v, and the model's D_u unless ``d_u="discard"``, as the authors).
     ``wind_model``: ``"none"`` (default, the paper's), ``"constant"`` or ``"sinusoid"``, a
     world-frame wind identified from the data. ``noise``: the authors' ``"rms"`` (default) or
-    ``"innovations"``.
+    ``"innovations"``. ``substeps``: 1 (default, the paper's one 0.1 s step) or 10 (the simulator's substeps).
     """
     from ..models import learn_lr
 
-    return learn_lr(flight_data, estimator=estimator, wind_model=wind_model, d_u=d_u, noise=noise).mdp()
+    return learn_lr(flight_data, estimator=estimator, wind_model=wind_model, d_u=d_u, noise=noise).mdp(substeps=substeps)
 
 
 def enough_to_learn(flight_data: FlightData, wind_model: str = "none") -> bool:

@@ -76,6 +76,7 @@ class ModelParams:
     noise: str = LEGACY_NOISE_ESTIMATE  # absent: a unit stored before the default became "rms"
     model_policy: str = "ours"
     authors_generations: int = 500
+    model_substeps: int = 1  # the model integrates its control step once (the paper's) or in the simulator's 10 substeps
     exact_checks: bool = False  # also check the model and its policy against exact sensors (the MDP has a sensor model)
     seed: int
 
@@ -101,6 +102,7 @@ class TestRunParams:
     noise: str = LEGACY_NOISE_ESTIMATE  # absent: a unit stored before the default became "rms"
     model_policy: str = "ours"
     authors_generations: int = 500
+    model_substeps: int = 1  # the learned models integrate their control step once (the paper's) or in 10 substeps
     sensor: dict | None = None
     hybrid: dict | None = None
     agent_settings: dict | None = None

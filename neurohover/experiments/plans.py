@@ -372,7 +372,7 @@ class _Policies:
         return None if any(v is None for v in out.values()) else out
 
 
-def _lr_fit(d_u: str, noise: str | None, model_policy: str, authors_generations: int) -> dict:
+def _lr_fit(d_u: str, noise: str | None, model_policy: str, authors_generations: int, model_substeps: int = 1) -> dict:
     """A unit's LR-fit params where they differ from ours before these settings (absent then: stored units keep their params)."""
     out: dict = {}
     if d_u != "keep":
@@ -382,6 +382,8 @@ def _lr_fit(d_u: str, noise: str | None, model_policy: str, authors_generations:
     if model_policy != "ours":
         out["model_policy"] = model_policy
         out["authors_generations"] = authors_generations
+    if model_substeps != 1:
+        out["model_substeps"] = model_substeps
     return out
 
 
@@ -437,7 +439,7 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dic
                             "policies": policies,
                             "estimator": g.estimator,
                             **({"wind_model": g.wind_model} if g.wind_model != "none" else {}),  # absent: unit keys as before winds
-                            **_lr_fit(g.d_u, g.noise, g.model_policy, s.authors_generations),  # absent: ours, as before these settings
+                            **_lr_fit(g.d_u, g.noise, g.model_policy, s.authors_generations, g.model_substeps),  # absent: ours, as before
                             **({"sensor": sensor} if sensor is not None else {}),
                             **({"hybrid": hybrid} if hybrid else {}),
                             **({"agent_settings": g.settings} if g.settings is not None else {}),
@@ -488,7 +490,7 @@ def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
             if not s.conditions and not s.fits:
                 units.append(_unit(cfg, UnitKey.make("model", method, f"{s.mdps}{i}"), "model", {**common, "mdp": mdp.to_dict()}, seed_key=seed_key))
             for f in s.fits:  # every fit learns from the same flight data and its policy meets the same gusts
-                params = {**common, "mdp": mdp.to_dict(), **_lr_fit(f.d_u, f.noise, f.model_policy, s.authors_generations)}
+                params = {**common, "mdp": mdp.to_dict(), **_lr_fit(f.d_u, f.noise, f.model_policy, s.authors_generations, f.model_substeps)}
                 units.append(_unit(cfg, UnitKey.make("model", f"{method}@{f.key}", f"{s.mdps}{i}"), "model", params, seed_key=seed_key))
             for c in s.conditions:
                 seen = mdp.with_sensor(EXACT if c.sensor is None else Sensor.from_dict(c.sensor))

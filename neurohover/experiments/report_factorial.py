@@ -1,11 +1,12 @@
 """The report's sections of the LR-fit factorials (``lr-authors-table4``, ``lr-authors-fig8``; docs/model.md).
 
-Three choices where our LR and the policies evolved on it differ from the authors' code, each a
-factor with our level and theirs (:data:`FACTORS`). A factor's **main effect** pairs every cell
-with the cell that differs from it in that factor alone, on the same MDP (Table 4) or run
-(Figure 8's seeds), so each factor is measured over the other two factors' four combinations:
-the median paired difference (the authors' level minus ours; returns, so positive is better with
-theirs), how often theirs is better, and a two-sided Wilcoxon signed-rank test on the differences.
+Three choices where our LR and the policies evolved on it differ from the authors' code, and the
+model's substeps (``lr-substeps-table4``), each a factor with our level and another (:data:`FACTORS`).
+A factor's **main effect** pairs every cell with the cell that differs from it in that factor alone,
+on the same MDP (Table 4) or run (Figure 8's seeds), so each factor is measured over the other
+factors' combinations: the median paired difference (the other level minus ours; returns, so
+positive is better with the other level), how often the other is better, and a two-sided Wilcoxon
+signed-rank test on the differences.
 """
 
 from __future__ import annotations
@@ -19,19 +20,22 @@ from ..models.lr import LEGACY_NOISE_ESTIMATE
 from .report_base import Section, agent_panel, fmt, fmt_p, log_errors, new_figure, table
 from .results import ModelResult, TestRunResult
 
-#: (setting, our level, the authors' level, what it is)
+#: (setting, our level, the other level, what it is, whose the other level is). The first three are the authors'
+#: choices; the model's substeps is our option against the paper's and the authors' one step (lr-substeps-table4).
 FACTORS = (
-    ("d_u", "keep", "discard", "the u constant D_u"),
-    ("noise", "innovations", "rms", "the noise estimate"),
-    ("model_policy", "ours", "authors", "the policy evolved on the model"),
+    ("d_u", "keep", "discard", "the u constant D_u", "the authors' choice"),
+    ("noise", "innovations", "rms", "the noise estimate", "the authors' choice"),
+    ("model_policy", "ours", "authors", "the policy evolved on the model", "the authors' choice"),
+    ("model_substeps", 1, 10, "the model's substeps per control step", "ten substeps"),
 )
-OURS = {name: ours for name, ours, _, _ in FACTORS}
+OURS = {f[0]: f[1] for f in FACTORS}
+BAD_RETURN = -1000  # a Table 4 policy under this per episode is in the bad mode (about -14,000) rather than the good (about -150)
 
 
-def levels(obj) -> dict[str, str]:
+def levels(obj) -> dict[str, str | int]:
     """A fit's or group's level of each factor (a group's noise left out of a config written before
     2026-12-04 was innovations: :data:`neurohover.models.lr.LEGACY_NOISE_ESTIMATE`)."""
-    out = {name: getattr(obj, name) for name, *_ in FACTORS}
+    out = {name: getattr(obj, name, ours) for name, ours, *_ in FACTORS}  # a setting a group lacks is at our level
     out["noise"] = out["noise"] or LEGACY_NOISE_ESTIMATE
     return out
 
@@ -44,7 +48,7 @@ def varies(objs) -> bool:
     return len({tuple(sorted(levels(o).items())) for o in learners}) > 1
 
 
-def main_effects(cells: Mapping[str, dict[str, str]], values: Mapping[str, Mapping[str, float]]) -> list[dict]:
+def main_effects(cells: Mapping[str, dict[str, str | int]], values: Mapping[str, Mapping[str, float]]) -> list[dict]:
     """Each factor's paired effect.
 
     Parameters
@@ -57,15 +61,16 @@ def main_effects(cells: Mapping[str, dict[str, str]], values: Mapping[str, Mappi
     Returns
     -------
     list of dict
-        Per factor that the cells vary: ``factor``, ``pairs``, ``median`` (theirs - ours), ``better``
-        (pairs where theirs is higher), ``p`` (Wilcoxon signed-rank, None without a nonzero difference).
+        Per factor that the cells vary: ``factor``, ``other`` (whose the other level is), ``pairs``, ``median``
+        (the other level - ours), ``better`` (pairs where the other level is higher), ``p`` (Wilcoxon signed-rank,
+        None without a nonzero difference).
     """
     out = []
     by_levels = {tuple(sorted(lv.items())): label for label, lv in cells.items()}
-    for name, ours, theirs, what in FACTORS:
+    for name, ours, theirs, what, other in FACTORS:
         diffs = []
         for label, lv in cells.items():
-            if lv[name] != theirs:
+            if lv.get(name, ours) != theirs:
                 continue
             partner = by_levels.get(tuple(sorted({**lv, name: ours}.items())))
             if partner is None:
@@ -79,6 +84,7 @@ def main_effects(cells: Mapping[str, dict[str, str]], values: Mapping[str, Mappi
         out.append(
             {
                 "factor": f"{what} ({name}: {ours} -> {theirs})",
+                "other": other,
                 "pairs": int(d.size),
                 "median": float(np.median(d)) if d.size else float("nan"),
                 "better": int(np.sum(d > 0)),
@@ -90,7 +96,7 @@ def main_effects(cells: Mapping[str, dict[str, str]], values: Mapping[str, Mappi
 
 def effects_table(effects: list[dict], what: str) -> str:
     rows = [[e["factor"], str(e["pairs"]), fmt(e["median"]), f"{e['better']} of {e['pairs']}", fmt_p(e["p"]) if e["p"] is not None else "n/a"] for e in effects]
-    return table(["factor", "pairs", f"median paired difference of {what} (theirs - ours)", "theirs better", "Wilcoxon p"], rows)
+    return table(["factor", "pairs", f"median paired difference of {what} (other level - ours)", "other level better", "Wilcoxon p"], rows)
 
 
 def effect_lines(effects: list[dict], what: str) -> list[str]:
@@ -103,8 +109,7 @@ def effect_lines(effects: list[dict], what: str) -> list[str]:
         direction = "better" if e["median"] > 0 else "worse" if e["median"] < 0 else "no different (median)"
         sig = "significant" if e["p"] < 0.05 else "not significant"
         lines.append(
-            f"{e['factor']}: {what} {direction} with the authors' choice, "
-            f"median paired difference {fmt(e['median'])}, Wilcoxon p = {fmt_p(e['p'])} ({sig} at 5%)."
+            f"{e['factor']}: {what} {direction} with {e['other']}, median paired difference {fmt(e['median'])}, Wilcoxon p = {fmt_p(e['p'])} ({sig} at 5%)."
         )
     return lines
 
@@ -144,6 +149,7 @@ class FitFactorial(Section):
             r = np.array([float(u.test_mean) for u in us])
             predicted = np.array([float(u.predicted_return) for u in us])
             crashes = sum(u.test_crashes for u in us)
+            w_sd = [float(u.test_w_sd) for u in us if u.test_w_sd is not None]
             episodes = sum(len(u.test_returns) for u in us)
             cells[f.label], values[f.label] = levels(f), {u.mdp: float(u.test_mean) for u in us}
             rows.append(
@@ -152,15 +158,18 @@ class FitFactorial(Section):
                     f.d_u,
                     f.noise,
                     f.model_policy,
+                    str(f.model_substeps),
                     str(len(us)),
                     fmt(np.median(r)),
                     fmt(r.mean()),
+                    str(int(np.sum(r < BAD_RETURN))),
+                    fmt(np.median(w_sd)) if w_sd else "n/a",
                     f"{crashes} of {episodes}",
                     str(sum(1 for u in us if u.test_crashes)),
                     fmt(np.median(predicted)),
                 ]
             )
-            if ref and f.label in ("ours", "authors"):
+            if ref and f.key in ("ours", "authors", "substeps10"):
                 ratio = np.median(r) / ref["r_m"]
                 within = "within" if 0.5 <= ratio <= 2 else "not within"
                 self.comparisons.append(
@@ -171,10 +180,16 @@ class FitFactorial(Section):
         self.comparisons += effect_lines(effects, "the evolved policy's return in the true MDP")
         return (
             "### Each fit\n\n"
-            + table(["fit", "D_u", "noise", "model policy", "MDPs", "r_m", "r_a", "crashed episodes", "MDPs with a crash", "median predicted return"], rows)
+            + table(
+                ["fit", "D_u", "noise", "model policy", "model substeps", "MDPs", "r_m", "r_a", f"under {BAD_RETURN:,}", "median w sd", "crashed episodes"]
+                + ["MDPs with a crash", "median predicted return"],
+                rows,
+            )
             + f"\n\nr_m, r_a: median and mean over MDPs of the evolved policy's mean return over {self.s.test_episodes} episodes in the true MDP"
             + (f" (the paper's LR: {fmt(ref['r_m'])} and {fmt(ref['r_a'])})" if ref else "")
-            + "; predicted: the policy's return on its model.\n\n### Main effects (paired by MDP)\n\n"
+            + f"; under {BAD_RETURN:,}: MDPs whose policy earns less per episode (Table 4's bimodality, docs/model.md); w sd: the"
+            + " standard deviation of the vertical velocity over the test episodes (about 1.5 m/s where the collective loop oscillates;"
+            + " n/a: units stored before it was recorded); predicted: the policy's return on its model.\n\n### Main effects (paired by MDP)\n\n"
             + effects_table(effects, "the mean return per MDP")
             + "\n"
         )
@@ -280,7 +295,7 @@ def test_run_figure(groups, runs: Callable[[str], list[TestRunResult]], title: s
             if g in others:
                 style = {"color": "0.5", "lw": 2.5, "alpha": 0.6}
             else:
-                style = {"color": colours.get((g.d_u, levels(g)["noise"]), "k"), "ls": "--" if g.model_policy == "authors" else "-", "lw": 1.4}
+                style = {"color": colours.get((g.d_u, str(levels(g)["noise"])), "k"), "ls": "--" if g.model_policy == "authors" else "-", "lw": 1.4}
             ax.plot(np.arange(1, cum.size + 1), cum, label=g.label, **style)
         agent_panel(ax, agent)
     fig.suptitle(title + "\ncolour: D_u and noise estimate; dashed: the authors' model policy; grey: reference", fontsize=9)

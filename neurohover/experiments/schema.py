@@ -23,6 +23,7 @@ from ..evolution.evolve import parse_resampling
 from ..evolution.optimisers import OPTIMISERS
 from ..evolution.races import RACE_RULES
 from ..models.lr import D_U_CHOICES, DEFAULT_NOISE_ESTIMATE, NOISE_ESTIMATES
+from ..models.model import MODEL_SUBSTEPS
 from ..policysets import FGHH_GENERIC_RESAMPLING
 from ..tasks import TASK_FAMILIES, TASK_NAMES, Drift, Sensor
 
@@ -145,6 +146,10 @@ def _seeds_of(names: tuple[str, ...] = ("experiment", "group")):
     return check
 
 
+def _substeps():
+    return lambda v: (v in MODEL_SUBSTEPS and not isinstance(v, bool), " or ".join(map(str, MODEL_SUBSTEPS)))
+
+
 def _policy_source():
     def check(v):
         return isinstance(v, str) and v != "", "'evolve', 'shipped' or a directory holding <task>/ policy sets"
@@ -191,6 +196,7 @@ _GROUP = {
     "d_u": (OMIT, _choice(*D_U_CHOICES)),
     "noise": (OMIT, _choice(*NOISE_ESTIMATES)),
     "model_policy": (OMIT, _choice(*MODEL_POLICIES)),
+    "model_substeps": (OMIT, _substeps()),  # absent: 1, the paper's one step per control step
     "sensor": (OMIT, _sensor_table()),  # this group's agents fly the group's MDPs through these sensors
     "drift": (OMIT, _drift_table()),  # and with these drifting dynamics (neurohover.tasks.drift)
     # run i of MDP m takes the seed of that run of another experiment's group: the same gusts and draws (paired)
@@ -213,6 +219,8 @@ _FIT = {
     "d_u": ("keep", _choice(*D_U_CHOICES)),
     "noise": (DEFAULT_NOISE_ESTIMATE, _choice(*NOISE_ESTIMATES)),
     "model_policy": ("ours", _choice(*MODEL_POLICIES)),
+    # absent: 1, the paper's one step (OMIT keeps the hashes of the configs written before this setting)
+    "model_substeps": (OMIT, _substeps()),
 }
 
 SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
@@ -383,7 +391,7 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
             if task not in AGENTS[g["agent"]].tasks:
                 raise NeurohoverError(f"{where}: agent {g['agent']!r} does not apply to task {task!r}")
             g["label"] = g["label"] or g["agent"]
-            lr_keys = [k for k in ("d_u", "noise", "model_policy") if k in g]
+            lr_keys = [k for k in ("d_u", "noise", "model_policy", "model_substeps") if k in g]
             if lr_keys and not AGENTS[g["agent"]].learns_models:
                 learners = ", ".join(name for name, spec in AGENTS.items() if spec.learns_models)
                 raise NeurohoverError(

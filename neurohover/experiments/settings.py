@@ -46,6 +46,7 @@ class Group:
     d_u: str = "keep"  # how its LR models treat the fitted u constant (the authors': discard)
     noise: str | None = None  # their gust-noise estimate (None: the group's agents learn no models)
     model_policy: str = "ours"  # how policies are evolved on them (the authors': an SLP from the baseline by eonn)
+    model_substeps: int = 1  # the substeps of those models' control step (1: the paper's; 10: the simulator's)
     sensor: dict | None = None  # this group's sensors (None: the experiment's)
     drift: dict | None = None  # this group's drifting dynamics (None: the experiment's)
     seeds_of: dict | None = None  # {experiment, seed, group}: its runs take that group's seeds (None: its own)
@@ -70,6 +71,7 @@ class Fit:
     d_u: str = "keep"
     noise: str = DEFAULT_NOISE_ESTIMATE
     model_policy: str = "ours"
+    model_substeps: int = 1  # LearnedModel.mdp(substeps=): the policy evolves on the model in 1 or 10 substeps
 
 
 @dataclass(frozen=True, kw_only=True)

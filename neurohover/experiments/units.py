@@ -245,11 +245,11 @@ def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
     t1 = time.perf_counter()
     if q.model_policy == "authors":  # their GHH-09 agents: an SLP from the baseline by their eonn
         authors = ModelEvolution(n_steps=q.n_steps, device=device, model_policy="authors", authors_generations=q.authors_generations)
-        champion, predicted = evolve_on_model(model.mdp(), generic, authors, int(seeds[2]))
+        champion, predicted = evolve_on_model(model.mdp(substeps=q.model_substeps), generic, authors, int(seeds[2]))
         policy_episodes = EonnSettings(generations=q.authors_generations).episodes
     else:
         evolved = evolve(
-            model.mdp(),
+            model.mdp(substeps=q.model_substeps),
             topology=generic.topology,
             prototype=proto,
             budget=q.policy_budget or None,
@@ -260,8 +260,10 @@ def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
         )
         champion, policy_episodes, predicted = evolved.champion, evolved.episodes, evolved.champion_return
     evolve_seconds = time.perf_counter() - t1
-    test = evaluate(champion, mdp, episodes=q.test_episodes, seed=int(seeds[3]), n_steps=q.n_steps, threads=threads, device=device)
+    test = evaluate(champion, mdp, episodes=q.test_episodes, seed=int(seeds[3]), n_steps=q.n_steps, threads=threads, device=device, record=True)
     returns = test.returns.ravel()
+    assert test.flight_data is not None  # recorded
+    w_sd = float(np.std(np.concatenate([o[:, 2] for o in test.flight_data.observations])))  # the collective loop's oscillation
     checks = {}
     if q.exact_checks:
         checks = _exact_checks(q, mdp, generic, model, flight, champion, int(seeds[3]), threads, device)
@@ -278,6 +280,7 @@ def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
         test_crashes=int(test.crashed.sum()),
         policy_episodes=int(policy_episodes),
         timing=ModelTiming(learn_seconds=learn_seconds, evolve_seconds=evolve_seconds),
+        test_w_sd=num(w_sd),
         **checks,
     ).to_dict()
 
@@ -325,6 +328,7 @@ def unit_agent(p: dict, device: str = "cpu"):
             noise=q.noise,
             model_policy=q.model_policy,
             authors_generations=q.authors_generations,
+            model_substeps=q.model_substeps,
         ),
         settings=None if spec.settings is None else spec.settings.from_unit(p),  # the agent's own, typed (from its UNIT_KEY)
     )

@@ -46,6 +46,7 @@ __all__ = [
     "FORMAT",
     "MODEL_METHODS",
     "MODEL_DT",
+    "MODEL_SUBSTEPS",
     "LearnedModel",
     "ParamRow",
     "check_vector",
@@ -61,6 +62,9 @@ MODEL_DT = CONTROL_DT
 
 #: Per axis (u, v, w, p, q, r): index of its C parameter; the axis index is also the noise index.
 AXIS_C = (0, 1, 3, 5, 7, 9)
+#: How a learned model may integrate its 0.1 s control step: once, as the paper's and the authors' models do
+#: (the default), or in the simulator's ten substeps of its equivalent parameters (:func:`equivalent_params`).
+MODEL_SUBSTEPS = (1, SUBSTEPS)
 #: Per axis: indices of its gain parameters (D_v, D_w, D_p, D_q, D_r; u has none).
 AXIS_GAINS: tuple[tuple[int, ...], ...] = ((), (2,), (4,), (6,), (8,), (10,))
 
@@ -140,19 +144,32 @@ class LearnedModel:
         if not isinstance(self.wind, WindModel):
             raise NeurohoverError(f"wind must be a WindModel, got {self.wind!r:.80}")
 
-    def mdp(self, label: str | None = None) -> MDP:
-        """The model as an MDP for the kernel: family ``"model"``, one 0.1 s substep, its wind (if any)."""
+    def mdp(self, label: str | None = None, substeps: int = 1) -> MDP:
+        """The model as an MDP for the kernel: family ``"model"``, its wind (if any).
+
+        ``substeps=1`` (the default, the paper's and the authors' model): one 0.1 s Euler step per control
+        step. ``substeps=10``: the same model in the simulator's ten 0.01 s substeps, with the parameters,
+        D_u and noise of :func:`equivalent_params` (each axis's one-step response kept; the position then
+        integrates the velocity within the step, as the simulator does). A one-substep OLS model rates
+        policies whose collective loop oscillates in the true MDP as good hoverers (docs/model.md, "One
+        substep or ten"). Ten substeps need a wind-blind model whose every axis has an equivalent.
+        """
+        if substeps not in MODEL_SUBSTEPS:
+            raise NeurohoverError(f"substeps={substeps!r}: allowed {' or '.join(map(str, MODEL_SUBSTEPS))}")
+        label = label if label is not None else f"model/{self.method}"
         wind_kind, wind = self.wind.mdp_wind()
+        if substeps == 1:
+            return MDP("model", self.params, self.noise_std, wind_kind=wind_kind, wind=wind, substeps=1, dt=MODEL_DT, label=label, d_u=float(self.d_u))
+        if self.wind.kind != "none":
+            raise NeurohoverError(f"substeps={substeps} applies to wind-blind models; this one has a {self.wind.kind} wind")
+        params, noise = self.equivalent()
+        bad = [NOISE_NAMES[axis] for axis, ci in enumerate(AXIS_C) if not np.isfinite(params[ci])]
+        if bad:
+            raise NeurohoverError(f"substeps={substeps}: the model's {', '.join(bad)} axis has no {substeps}-substep equivalent (1 + 0.1 C <= 0)")
+        u_ratio = params[0] / self.params[0] if abs(self.params[0]) > 1e-12 else 1.0  # D_u scales with the u axis
+        d_u = float(self.d_u * u_ratio)
         return MDP(
-            "model",
-            params=self.params,
-            noise_std=self.noise_std,
-            wind_kind=wind_kind,
-            wind=wind,
-            substeps=1,
-            dt=MODEL_DT,
-            label=label if label is not None else f"model/{self.method}",
-            d_u=float(self.d_u),
+            "model", params=tuple(params), noise_std=tuple(noise), wind_kind=wind_kind, wind=wind, substeps=substeps, dt=SUBSTEP_DT, label=label, d_u=d_u
         )
 
     def equivalent(self, substeps: int = SUBSTEPS, dt: float = SUBSTEP_DT) -> tuple[np.ndarray, np.ndarray]:

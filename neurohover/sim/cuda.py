@@ -35,7 +35,7 @@ from .constants import MDP_ROW_LEN, ROW_DT, ROW_SUBSTEPS, SAFEGUARD_LIMITS, SENS
 # numba-cuda 0.30.4 (the newest) registers an overload of np.row_stack when it builds its first kernel, and
 # NumPy 2.5 removed that deprecated alias of np.vstack: without it no kernel compiles (seen on an H200, 2026-12-04).
 if not hasattr(np, "row_stack"):
-    np.row_stack = np.vstack  # type: ignore[attr-defined]
+    np.row_stack = np.vstack
 
 try:  # numba-cuda (``pip install 'neurohover[cuda]'``) or numba's built-in target; may be broken or absent
     from numba import cuda
