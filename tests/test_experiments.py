@@ -639,3 +639,17 @@ def test_the_report_opens_with_the_papers_claims_and_conclusions(committed_store
     conclusions = {line.split(" | ")[0][2:]: line.split(" | ") for line in top.splitlines() if line.startswith("| (")}
     models = conclusions["(3)-(4) model-based approaches are feasible, and superior, only with a suitable model representation"]
     assert int(models[3]) >= 2 and "of" in models[2]  # Figure 11's two reversed tests at least
+
+
+def test_a_refused_only_leaves_the_store_as_it_was(tmp_path: Path, capsys) -> None:
+    """issue 37: `--only nothing` used to record the config first, so a later run with other settings was refused."""
+    config = _write(tmp_path, SLOW_CONFIG.replace("runs = 12", "runs = 2").replace("budget = 3000", "budget = 100"))
+    store = tmp_path / "s.sqlite"
+    base = ["reproduce", str(config), "--store", str(store), "--no-progress"]
+    assert main([*base, "--only", "nothing"]) == 2
+    assert "--only 'nothing' matches no unit; unit keys look like evolve/k1/run0" in capsys.readouterr().err
+    with Store(store) as s:
+        assert s.experiments() == []  # nothing recorded
+    assert main([*base, "--set", "budget=120", "--only", "evolve/k1/run0"]) == 0  # other settings: not "settings differ"
+    with Store(store) as s:
+        assert sorted(s.results("slowtest", "quick")) == ["evolve/k1/run0"]

@@ -124,6 +124,12 @@ def reproduce(
     store.lock()  # one writer per store: a second run would redo every unit the first has not finished
     check_restart(fresh, update)
     held = store.config_hash(config.name, config.scale)
+    if only:  # refused before the store records anything: a pattern that matches no unit of a plan complete now
+        sources = {n: store.results(n, config.scale) for n in source_experiments(config)}
+        first = plan(config, store.results(config.name, config.scale) if held == config.hash else {}, sources)
+        unmatched = [pat for pat in only if not any(fnmatch.fnmatchcase(u.key, pat) for u in first.units)]
+        if unmatched and len(first.units) == first.total:
+            raise NeurohoverError(f"{config.name}: --only {unmatched[0]!r} matches no unit; unit keys look like {', '.join(u.key for u in first.units[:3])}")
     if update and held is not None and held != config.hash:
         kept = store.update(config.name, config.scale, config.hash, config.to_dict(), unchanged_units(config, store))
         print(f"{config.name} ({config.scale}): the config changed (hash {held} -> {config.hash}); {kept} stored units stand unchanged", file=sys.stderr)
