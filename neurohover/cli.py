@@ -102,7 +102,7 @@ def _family_and_mdps(args: argparse.Namespace, n: int, rng: np.random.Generator)
         return family, [explicit[0]] * n
     if args.mdp == "sample":  # a fresh MDP from G for every episode
         return family, [family.sample(rng, label=f"{family.name}/sample:{i}") for i in range(n)]
-    return family, [family.mdp(args.mdp or "zero")] * n
+    return family, [family.mdp("zero" if args.mdp is None else args.mdp)] * n  # an empty --mdp is refused, not the zero setting
 
 
 def _add_task_options(p: argparse.ArgumentParser) -> None:
@@ -180,7 +180,7 @@ def _fly(policy, mdps: list, args: argparse.Namespace, show_progress: bool):
 
 def cmd_fly(args: argparse.Namespace) -> int:
     """Fly a policy and print return statistics."""
-    from .paths import output_file
+    from .paths import output_file, writing
     from .policies import load_policy
 
     if args.episodes < 1:
@@ -203,7 +203,8 @@ def cmd_fly(args: argparse.Namespace) -> int:
         fd.metadata.update(
             {"task": family.name, "mdps": [m.to_dict() for m in mdps], "policy": str(args.policy), "seed": args.seed, "returns": returns.tolist()}
         )
-        fd.save(args.record, dtype=args.record_dtype)
+        with writing(args.record, "--record") as path:
+            fd.save(path, dtype=args.record_dtype)
     summary = {
         "task": family.name,
         **({} if family.sensor.exact else {"sensor": family.sensor.to_dict()}),
@@ -230,10 +231,13 @@ def cmd_fly(args: argparse.Namespace) -> int:
 
 def cmd_demo(args: argparse.Namespace) -> int:
     """Fly the baseline and the baseline-equivalent MLP on a few MDPs of each family; print a table."""
-    from .evaluate import evaluate
+    from .evaluate import check_episode_count, evaluate
     from .policies import baseline_policy, prototype
-    from .tasks import TASK_NAMES, get_task_family
+    from .tasks import N_TRAINING, TASK_NAMES, get_task_family
 
+    if not 0 <= args.mdps <= N_TRAINING:
+        raise NeurohoverError(f"--mdps {args.mdps} is out of range: allowed 0..{N_TRAINING} (training MDPs per family, beside the zero setting)")
+    check_episode_count(2 * (args.mdps + 1) * max(args.episodes, 0), f"2 policies x {args.mdps + 1} MDPs x episodes={args.episodes}")  # before the table
     policies = {"baseline": baseline_policy(), "mlp(baseline seed)": prototype("mlp", "baseline")}
     print(f"{'task':<6} {'mdp':<16} {'policy':<20} {'mean return':>12} {'sd':>10} {'crashes':>8}")
     for name in TASK_NAMES:
@@ -302,6 +306,10 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     forget_created_dirs()
     try:
+        if getattr(args, "seed", None) is not None:  # every command's --seed, one range, before any work
+            from .evolution.seeding import check_seed
+
+            check_seed(args.seed)
         return args.func(args)
     except NeurohoverError as err:
         print(f"neurohover {args.command}: error: {err}", file=sys.stderr)

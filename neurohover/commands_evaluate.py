@@ -55,7 +55,7 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     and the shipped generic policy on the same gusts, and print the paper's measures (return per episode, crashes)."""
     from .evolution.seeding import check_seed
     from .integrations.flying import compare_agent
-    from .paths import output_file
+    from .paths import output_file, writing
     from .tasks import get_task_family
 
     family = get_task_family(args.task, args.sigma)
@@ -76,8 +76,9 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     for r in rows:
         print(f"{r.name:<10} {r.return_per_episode:>15.6g} {r.median_over_mdps:>17.6g} {f'{r.crashes} of {r.episodes}':>12}")
     if out is not None:
-        out.write_text(json.dumps({"task": args.task, "mdps": args.mdps, "n_mdps": n, "episodes": args.episodes, "seed": args.seed,
-                                   "episode_steps": args.episode_steps, "rows": [r.__dict__ for r in rows]}, indent=1))  # fmt: skip
+        with writing(out, "--out") as path:
+            path.write_text(json.dumps({"task": args.task, "mdps": args.mdps, "n_mdps": n, "episodes": args.episodes, "seed": args.seed,
+                                        "episode_steps": args.episode_steps, "rows": [r.__dict__ for r in rows]}, indent=1))  # fmt: skip
         print(f"wrote {args.json}", file=sys.stderr)
     return 0
 

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import NeurohoverError
-from .evaluate import DEVICES, check_device
+from .evaluate import DEVICES, check_device, check_episode_count
 from .evolution.generational import GENERATIONAL_PRESETS
 from .evolution.optimisers import OPTIMISERS, optimiser_names
 
@@ -107,7 +107,7 @@ class _Bar:
 def cmd_evolve(args: argparse.Namespace) -> int:
     """Evolve a policy: steady state on one MDP, or generational over the task family's MDPs (--mdp G)."""
     from .evolution.evolve import EvolutionInterrupted, evolve, parse_resampling, validation_return, write_history_csv
-    from .paths import output_file
+    from .paths import output_file, writing
     from .policies import save_policy
 
     if args.budget is not None and args.budget < 1:
@@ -120,6 +120,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         raise NeurohoverError(f"--checkpoint-every {args.checkpoint_every} is out of range: allowed > 0 seconds")
     if args.validation_episodes < 1:
         raise NeurohoverError(f"--validation-episodes {args.validation_episodes} is out of range: allowed >= 1")
+    check_episode_count(args.validation_episodes, f"--validation-episodes {args.validation_episodes}")  # before the evolution, not after
     check_device(args.device)  # before any file is touched: a GPU missing is one clear error
     resampling = parse_resampling(args.resampling)
     target, family, mdp_desc = _target(args)
@@ -195,8 +196,10 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         meta["sigma"] = float(family.sigma)
     if mdp_desc != MDP_FAMILY:
         meta["mdp_params"] = target.to_dict()
-    save_policy(result.champion, out, **meta)
-    write_history_csv(result.history, history_path)
+    with writing(out, "--out") as path:
+        save_policy(result.champion, path, **meta)
+    with writing(history_path, "--out's history") as path:
+        write_history_csv(result.history, path)
     summary = {
         "policy": str(out),
         "history": str(history_path),
@@ -263,7 +266,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     """Learn a helicopter model from flight data (LR, EC-MENO or EC-MER) and print its parameters."""
     from .flightdata import FlightData
     from .models import DEFAULT_NOISE_ESTIMATE, format_parameter_table, learn_ec_meno, learn_ec_mer, learn_lr, parameter_table
-    from .paths import input_file, output_file
+    from .paths import input_file, output_file, writing
     from .policies import load_policy
 
     if args.budget is not None and args.budget < 1:
@@ -299,7 +302,8 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
         else:
             source = args.policy or data.metadata.get("policy") or "baseline"
             model = learn_ec_mer(data, load_policy(source), seed=args.seed, **extra)
-    model.save(out)
+    with writing(out, "--out") as path:
+        model.save(path)
     truth, why = _true_mdp(data.metadata)
     print(f"{args.method} model written to {out} ({time.perf_counter() - start:.2f} s)")
     rows = parameter_table(model, truth)

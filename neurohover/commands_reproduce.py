@@ -84,14 +84,15 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
 def cmd_results(args: argparse.Namespace) -> int:
     """Export an experiment's finished units from the results store as CSV or JSON."""
     from .experiments import Store, export_results
-    from .paths import input_file, output_file
+    from .paths import input_file, output_file, writing
 
     input_file(args.store, "--store", "results store")
     out = None if args.out is None else output_file(args.out, "--out")
     with Store(args.store, create=False) as store:
         text = export_results(store, args.name, args.format, args.scale)
     if out is not None:
-        out.write_text(text)
+        with writing(out, "--out") as path:
+            path.write_text(text)
         print(f"wrote {args.out}", file=sys.stderr)
     else:
         sys.stdout.write(text)

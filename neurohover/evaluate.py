@@ -45,6 +45,7 @@ from .tasks import MDP, Sensor, refuse_drift
 # Re-exported where they were first defined: KernelFlyer, DEVICES, check_device, num_threads, use_lanes.
 __all__ = [
     "DEVICES",
+    "MAX_EPISODES_PER_CALL",
     "DangerousState",
     "Evaluation",
     "KernelFlyer",
@@ -52,6 +53,7 @@ __all__ = [
     "Safeguard",
     "as_policies",
     "check_device",
+    "check_episode_count",
     "evaluate",
     "evaluate_jobs",
     "mdp_rows",
@@ -195,6 +197,19 @@ def _index_array(values, n_jobs: int | None, upper: int | None, what: str) -> np
     return arr
 
 
+#: The most episodes one call flies: each holds about 60 bytes of job and result arrays in memory (6 GB at
+#: this bound), so a larger run is refused up front with this number rather than failing to allocate.
+MAX_EPISODES_PER_CALL = 100_000_000
+
+
+def check_episode_count(n: int, what: str) -> None:
+    """Refuse ``n`` episodes in one call above :data:`MAX_EPISODES_PER_CALL` (``what`` names where they come from)."""
+    if n > MAX_EPISODES_PER_CALL:
+        raise NeurohoverError(
+            f"{what} is out of range: {n:,} episodes, at most {MAX_EPISODES_PER_CALL:,} in one call (their results are held in memory); use fewer"
+        )
+
+
 def evaluate_jobs(
     policies: Sequence[Policy] | PolicyTable,
     mdps: MDP | Sequence[MDP] | np.ndarray,
@@ -315,6 +330,7 @@ def evaluate(
     if not isinstance(first_episode, (int, np.integer)) or first_episode < 0:
         raise NeurohoverError(f"first_episode={first_episode!r} is out of range: allowed an integer >= 0")
     n_pol, n_mdp = len(table), rows.shape[0]
+    check_episode_count(n_pol * n_mdp * int(episodes), f"{n_pol} policies x {n_mdp} MDPs x episodes={episodes}")
     p_idx, m_idx, e = np.meshgrid(np.arange(n_pol), np.arange(n_mdp), np.arange(episodes), indexing="ij")
     episode_index = first_episode + m_idx * episodes + e
     fallback = None

@@ -14,11 +14,13 @@ from __future__ import annotations
 import os
 import sys
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from .errors import NeurohoverError
 
-__all__ = ["input_file", "input_dir", "output_dir", "output_file", "remove_created_dirs"]
+__all__ = ["input_file", "input_dir", "output_dir", "output_file", "remove_created_dirs", "writing"]
 
 _created: list[Path] = []  # directories this process's checks created, deepest first
 
@@ -68,6 +70,21 @@ def output_file(path: str | os.PathLike, option: str) -> Path:
     if not existed:
         p.unlink(missing_ok=True)
     return p
+
+
+@contextmanager
+def writing(path: str | os.PathLike, option: str) -> Iterator[Path]:
+    """Write the output file ``path`` inside this block: a failed write (disk full, read-only, permission) becomes
+    one NeurohoverError naming ``option`` and the file, and the partial file is removed (a file that was there
+    before too, once the write has touched it: its old content is gone) so that no later run takes it for a result."""
+    p = Path(path)
+    before = p.stat().st_mtime_ns if p.is_file() else None
+    try:
+        yield p
+    except OSError as err:
+        if p.is_file() and (before is None or p.stat().st_mtime_ns != before):
+            p.unlink(missing_ok=True)
+        raise NeurohoverError(f"{option} {str(path)!r}: cannot write it ({_why(err)}); no partial file is left") from None
 
 
 def output_dir(path: str | os.PathLike, option: str) -> Path:

@@ -67,6 +67,16 @@ CASES: list[tuple[list[str], str]] = [
         "is out of range: allowed an integer in 0..2**63-1",
     ),
     (["reproduce", "fig7", "--store", "s.sqlite", "--set", 'policies="bought"'], "policies = 'bought' is not allowed: give 'evolve', 'shipped' or a directory"),
+    # issue 37: sizes refused up front (not after an evolution), every --seed in one range, no silent defaults
+    (
+        ["evolve", "--task", "ghh08", "--budget", "10", "--validation-episodes", "10000000000000", "--out", "p.json"],
+        "--validation-episodes 10000000000000 is out of range: 10,000,000,000,000 episodes, at most 100,000,000 in one call",
+    ),
+    (["demo", "--episodes", "10000000000000"], "episodes=10000000000000 is out of range"),
+    (["demo", "--mdps", "-1"], "--mdps -1 is out of range: allowed 0..10"),
+    (["build-policies", "--task", "ghh08", "--budget", "10", "--seed", "-1", "--out", "q"], "seed=-1 is out of range: allowed an integer in 0..2**63-1"),
+    (["evolve", "--task", "ghh08", "--budget", "10", "--seed", "-5", "--out", "p.json"], "seed=-5 is out of range"),
+    (["fly", "--task", "ghh08", "--mdp", ""], "unknown MDP ''"),
 ]
 
 

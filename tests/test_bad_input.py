@@ -113,3 +113,34 @@ def test_the_script_prints_one_line_per_case() -> None:
     n = len(CASES[::16])
     assert len(lines) == n + 1 and all(line.startswith("ok ") for line in lines[:-1])
     assert lines[-1] == f"{n} of {n} cases refused cleanly"
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="no /dev/full on this system")
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["fly", "--task", "ghh08", "--episodes", "1", "--record", "/dev/full"],
+        ["learn-model", "--flight-data", "fd.npz", "--method", "lr", "--out", "/dev/full"],
+    ],
+)
+def test_a_full_disk_is_one_clear_line(args, workdir: Path, capsys, monkeypatch) -> None:
+    """issue 37: a write that fails (ENOSPC) was an OSError traceback."""
+    monkeypatch.chdir(workdir)
+    assert main(list(args)) == 2
+    err = capsys.readouterr().err
+    assert err.strip().splitlines()[-1].endswith("'/dev/full': cannot write it (No space left on device); no partial file is left"), err
+
+
+def test_a_write_cut_short_leaves_no_partial_file(tmp_path: Path) -> None:
+    """A file-size limit (RLIMIT_FSIZE) makes the flight data's write fail halfway, as a full disk would."""
+    script = (
+        "import resource, signal, sys\n"
+        "signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # the write then fails with EFBIG instead of killing the process\n"
+        "resource.setrlimit(resource.RLIMIT_FSIZE, (20000, 20000))\n"
+        "from neurohover.cli import main\n"
+        "sys.exit(main(['fly', '--task', 'ghh08', '--episodes', '4', '--record', 'big.npz', '--json']))\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 2, proc.stderr[-2000:]
+    assert "Traceback" not in proc.stderr and "--record 'big.npz': cannot write it (File too large); no partial file is left" in proc.stderr
+    assert not (tmp_path / "big.npz").exists()

@@ -65,3 +65,17 @@ def test_a_typo_in_the_scale_not_run_is_refused_at_once(tmp_path) -> None:
     with pytest.raises(NeurohoverError, match="at scale 'paper': unknown setting.s. agnet"):
         load_config(str(bad), "quick")
     load_config("fig7", "quick")  # the shipped one loads
+
+
+def test_sizes_that_would_exhaust_memory_are_refused_up_front() -> None:
+    """issue 37: evaluate(episodes=10**13) was a NumPy MemoryError (72.8 TiB); validation_return the same."""
+    from neurohover.evaluate import MAX_EPISODES_PER_CALL
+    from neurohover.evolution.evolve import validation_return
+
+    mdp = nh.get_task_family("ghh08").zero()
+    with pytest.raises(NeurohoverError, match=r"1 policies x 1 MDPs x episodes=10000000000000 is out of range: .* at most 100,000,000 in one call"):
+        nh.evaluate("baseline", mdp, episodes=10**13, n_steps=10)
+    with pytest.raises(NeurohoverError, match="at most 100,000,000 in one call"):
+        nh.evaluate(["baseline"] * 2, [mdp] * 5, episodes=MAX_EPISODES_PER_CALL // 10 + 1, n_steps=10)
+    with pytest.raises(NeurohoverError, match="episodes=10000000000000 is out of range"):
+        validation_return(nh.baseline_policy(), mdp, episodes=10**13, seed=0, n_steps=10)

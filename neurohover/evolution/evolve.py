@@ -80,7 +80,7 @@ import numba
 import numpy as np
 
 from ..errors import NeurohoverError
-from ..evaluate import evaluate_jobs, num_threads
+from ..evaluate import check_episode_count, evaluate_jobs, num_threads
 from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP
@@ -263,6 +263,7 @@ def _fresh_episodes(target, episodes: int, mdp_seed: int) -> tuple[np.ndarray, n
     mdp, family, _ = resolve_target(target)
     if isinstance(episodes, bool) or not isinstance(episodes, (int, np.integer)) or episodes < 1:
         raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
+    check_episode_count(int(episodes), f"episodes={episodes}")
     if mdp is not None:
         return mdp.row()[None, :], np.zeros(episodes, dtype=np.int64)
     assert family is not None  # resolve_target gives an MDP or a family
