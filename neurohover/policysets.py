@@ -109,7 +109,12 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
         raise NeurohoverError(
             f"no policy set for {family.name} in {str(root)!r} (manifest.json missing); build it with: neurohover build-policies --task {family.name}"
         )
-    manifest = json.loads(manifest_path.read_text())
+    try:
+        manifest = json.loads(manifest_path.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r} cannot be read as JSON: {err}") from None
+    if not isinstance(manifest, dict):
+        raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r} must be a JSON object, got {type(manifest).__name__}")
     if family.generic_over_distribution:
         generics = {name: _load(root / f"generic_{name}.json", f"the {name} generic policy") for name in FGHH_GENERICS}
         return PolicySet(family.name, root, generics["race"], generics=generics, manifest=manifest)

@@ -144,3 +144,20 @@ def test_a_write_cut_short_leaves_no_partial_file(tmp_path: Path) -> None:
     assert proc.returncode == 2, proc.stderr[-2000:]
     assert "Traceback" not in proc.stderr and "--record 'big.npz': cannot write it (File too large); no partial file is left" in proc.stderr
     assert not (tmp_path / "big.npz").exists()
+
+
+@pytest.mark.parametrize(
+    ("broken", "expected"), [("specialised_0.json", "is not valid JSON: Expecting value: line 2"), ("manifest.json", "cannot be read as JSON")]
+)
+def test_a_malformed_file_in_a_policy_directory_is_named(broken: str, expected: str, tmp_path: Path, capsys) -> None:
+    """issue 37: a malformed manifest was a JSONDecodeError traceback; every file is named with its path."""
+    import shutil
+
+    from neurohover.policysets import policy_dir
+
+    shutil.copytree(policy_dir("ghh08"), tmp_path / "pd" / "ghh08")
+    (tmp_path / "pd" / "ghh08" / broken).write_text('{"topology": "mlp", "genome": [1,\n')
+    args = ["compete", "--task", "ghh08", "--agent", "model-free", "--runs", "1", "--episodes", "2"]
+    assert main([*args, "--policy-dir", str(tmp_path / "pd"), "--out", str(tmp_path / "q")]) == 2
+    err = capsys.readouterr().err
+    assert f"'{tmp_path / 'pd' / 'ghh08' / broken}'" in err and expected in err, err
