@@ -327,6 +327,8 @@ def evaluate(
     rows = mdp_rows(mdps)
     if not isinstance(episodes, (int, np.integer)) or episodes < 1:
         raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
+    if not isinstance(record, (bool, np.bool_)):
+        raise NeurohoverError(f"record={record!r} is not allowed: give True or False")
     if not isinstance(first_episode, (int, np.integer)) or first_episode < 0:
         raise NeurohoverError(f"first_episode={first_episode!r} is out of range: allowed an integer >= 0")
     n_pol, n_mdp = len(table), rows.shape[0]

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -229,6 +230,8 @@ def policy_from_dict(d: dict, source: str = "policy") -> Policy:
 def load_policy(source: str | Path) -> Policy:
     """Load a policy file (JSON, or the authors' ``.net`` format: :mod:`neurohover.netfile`), or
     the baseline policy for the name ``baseline``."""
+    if not isinstance(source, (str, os.PathLike)):
+        raise NeurohoverError(f"policy source {source!r} is not allowed: give a policy file's path or 'baseline'")
     if str(source) == "baseline":
         return baseline_policy()
     path = Path(source)

@@ -79,3 +79,30 @@ def test_sizes_that_would_exhaust_memory_are_refused_up_front() -> None:
         nh.evaluate(["baseline"] * 2, [mdp] * 5, episodes=MAX_EPISODES_PER_CALL // 10 + 1, n_steps=10)
     with pytest.raises(NeurohoverError, match="episodes=10000000000000 is out of range"):
         validation_return(nh.baseline_policy(), mdp, episodes=10**13, seed=0, n_steps=10)
+
+
+@pytest.mark.parametrize(
+    ("call", "expected"),
+    [
+        (lambda: nh.get_task_family("ghh08", sensor="x"), "sensor='x' is not allowed: give a neurohover.Sensor"),
+        (lambda: nh.get_task_family("ghh08", drift="fast"), "drift='fast' is not allowed: give a neurohover.Drift"),
+        (lambda: nh.get_task_family("fghh", sigma="0.3"), "sigma='0.3' is not allowed: give a number"),
+        (lambda: nh.get_task_family("ghh08").mdp(3), "MDP 3 is not allowed: give its name as a string"),
+        (lambda: nh.get_task_family("ghh08").mdp("train:\u0663"), "unknown MDP 'train:\u0663'"),  # an Arabic-Indic 3 is not train:3
+        (lambda: nh.get_task_family("ghh08").make(["1", "2"]), "must be 2 numbers, got ['1', '2']"),
+        (lambda: nh.load_policy(None), "policy source None is not allowed"),
+        (lambda: nh.evaluate("baseline", nh.get_task_family("ghh08").zero(), n_steps=5, record="yes"), "record='yes' is not allowed: give True or False"),
+    ],
+)
+def test_the_python_api_checks_its_arguments_as_the_command_line_does(call, expected) -> None:
+    """issue 37: each of these was an AttributeError or TypeError, or was silently accepted."""
+    with pytest.raises(NeurohoverError) as err:
+        call()
+    assert expected in str(err.value)
+
+
+def test_numbers_of_numpy_types_are_still_taken() -> None:
+    fam = nh.get_task_family("ghh08")
+    assert fam.make(np.array([1, 2.0])) == fam.make([1, 2.0])
+    assert nh.get_task_family("fghh", sigma=np.float64(0.2)).sigma == 0.2
+    assert nh.evaluate("baseline", fam.zero(), n_steps=5, record=np.True_).flight_data is not None

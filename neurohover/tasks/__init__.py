@@ -25,6 +25,8 @@ from __future__ import annotations
 import importlib
 import pkgutil
 
+import numpy as np
+
 from ..errors import NeurohoverError
 from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, competition_rows, finite_vector
 from .drift import NO_DRIFT, Drift, refuse_drift
@@ -60,6 +62,10 @@ def get_task_family(name: str, sigma: float | None = None, sensor: Sensor | None
     """The task family called ``name`` (``ghh08``, ``ghh09``, ``fghh``, ...; ``sigma``: its breadth, where it has one),
     seen through ``sensor`` (:mod:`neurohover.tasks.sensor`; None: exact sensors), its dynamics drifting
     over a test run by ``drift`` (:mod:`neurohover.tasks.drift`; None: fixed)."""
+    if sensor is not None and not isinstance(sensor, Sensor):
+        raise NeurohoverError(f"sensor={sensor!r} is not allowed: give a neurohover.Sensor (Sensor.parse('obs_noise=...')) or None for exact sensors")
+    if drift is not None and not isinstance(drift, Drift):
+        raise NeurohoverError(f"drift={drift!r} is not allowed: give a neurohover.Drift or None for fixed dynamics")
     family = _family(name, sigma)
     if sensor is not None and not sensor.exact:
         family = family.with_sensor(sensor)
@@ -71,6 +77,8 @@ def _family(name: str, sigma: float | None) -> TaskFamily:
     if key not in TASK_FAMILIES:
         raise NeurohoverError(f"unknown task {name!r}: allowed {', '.join(TASK_NAMES)}")
     cls = TASK_FAMILIES[key]
+    if sigma is not None and (isinstance(sigma, (bool, np.bool_)) or not isinstance(sigma, (int, float, np.integer, np.floating))):
+        raise NeurohoverError(f"sigma={sigma!r} is not allowed: give a number (the family's breadth) or None")
     if sigma is not None and not cls.has_sigma:
         with_sigma = [n for n, c in TASK_FAMILIES.items() if c.has_sigma]
         raise NeurohoverError(f"sigma applies to the {', '.join(with_sigma)} task only, not to {name!r}")

@@ -157,6 +157,8 @@ class MDP:
 
 def finite_vector(values: Sequence[float] | np.ndarray, length: int, what: str) -> np.ndarray:
     """``values`` as a float array of ``length`` finite numbers, or a clear error naming ``what``."""
+    if isinstance(values, str) or any(isinstance(v, (str, bytes, bool, np.bool_)) for v in np.ravel(np.asarray(values, dtype=object))):
+        raise NeurohoverError(f"{what} must be {length} numbers, got {values!r}")
     try:
         arr = np.asarray(values, dtype=float)
     except (TypeError, ValueError):
@@ -375,6 +377,8 @@ class TaskFamily:
 
     def mdp(self, spec: str, rng: np.random.Generator | int | None = None) -> MDP:
         """An MDP by name: ``zero``, ``train:N``, ``test:N``, ``seeded-train:N``, ``seeded-test:N`` or ``sample``."""
+        if not isinstance(spec, str):
+            raise NeurohoverError(f"MDP {spec!r} is not allowed: give its name as a string, e.g. 'zero', 'train:3' or 'test:12'")
         if spec == "zero":
             return self.zero()
         if spec == "sample":
@@ -386,7 +390,7 @@ class TaskFamily:
             "seeded-train": (self.seeded_training_mdps, N_TRAINING),
             "seeded-test": (self.seeded_test_mdps, N_TEST),
         }
-        if kind in sets and index.isdigit():
+        if kind in sets and index.isascii() and index.isdigit():  # ASCII digits only: str.isdigit also takes other scripts' digits
             getter, n = sets[kind]
             if int(index) < n:
                 return getter()[int(index)]
