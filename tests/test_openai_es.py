@@ -72,7 +72,7 @@ def test_bad_settings_are_refused_naming_the_value(settings: dict, message: str)
 
 
 def test_the_registry_finds_it_and_evolve_needs_a_budget_for_it() -> None:
-    assert optimiser_names() == ("ne", "cma", "openai-es") and not OPTIMISERS["openai-es"].stops_itself
+    assert optimiser_names() == ("ne", "cma", "openai-es", "uh-cma") and not OPTIMISERS["openai-es"].stops_itself
     with pytest.raises(nh.NeurohoverError, match="'openai-es' has no stopping rule of its own: give a budget"):
         evolve(GHH08.mdp("train:0"), optimizer="openai-es")
     with pytest.raises(nh.NeurohoverError, match="unknown openai-es setting.*sigma0.*allowed popsize"):

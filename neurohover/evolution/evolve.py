@@ -152,7 +152,7 @@ def evolve(
         generics are SLPs) and ``"mlp"`` on one MDP.
     prototype : Policy or {"zero", "baseline"}
         The genome the initial population is built from.
-    optimizer : {"ne", "cma", "openai-es"} or another registered name
+    optimizer : {"ne", "cma", "openai-es", "uh-cma"} or another registered name
         The paper's neuroevolution, or a population optimiser (:mod:`neurohover.evolution.optimisers`)
         with the same budget and resampling.
     resampling : str, optional

@@ -1,0 +1,153 @@
+"""Uncertainty-handling CMA-ES (Hansen, Niederberger, Guzzella & Koumoutsakos 2009) through pycma's
+:class:`cma.NoiseHandler`, as an ask/tell population optimiser (issue 35: the standard baseline beside
+selection races for noisy fitness).
+
+pycma's noise handler re-evaluates a few solutions of each generation, measures how much their ranks
+move (the uncertainty), and answers by raising the step size and the evaluations per solution when the
+ranks are noise, lowering the evaluations again when they are not. pycma drives it with an objective
+function it calls itself; here the re-evaluations are one more ask/tell round, so the episodes still
+fly in the kernel in batches and the run's budget counts every one of them:
+
+1. ``ask`` returns the generation, each solution repeated ``evaluations`` times (pycma's current
+   ``NoiseHandler.evaluations``, rounded); ``tell`` takes the median return of each solution's rows
+   (pycma's ``aggregate``), tells pycma the generation and picks the solutions to re-evaluate
+   (``NoiseHandler.indices``: the first ones and the best of the rest).
+2. ``ask`` returns those, each repeated ``evaluations`` times at a point ``epsilon`` from it (pycma's
+   ``ask(1, x, epsilon)``); ``tell`` gives their medians to pycma's ``update_measure`` and ``treat``,
+   and the step size is multiplied by the factor ``treat`` returns.
+
+``NoiseHandler.indices`` rounds the number of re-evaluations at random with NumPy's global generator:
+it is called with that generator seeded from the optimiser's own (and its state restored), so runs are
+reproducible and leave ``np.random`` as they found it. The champion is the best single return told, as
+for CMA-ES, re-evaluations included.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import cma
+import numpy as np
+
+from ..cmaes import CMAES, SIGMA0
+from ..common import TellInfo, check_returns
+from . import OptimiserSpec
+
+__all__ = ["UHCMAES", "UHCMASettings"]
+
+
+@dataclass(frozen=True)
+class UHCMASettings:
+    """Settings of uncertainty-handling CMA-ES: CMA-ES's (``sigma0``, ``popsize``) and the noise handler's:
+    evaluations per solution between ``min_evaluations`` and ``max_evaluations`` (starting at the minimum),
+    ``reevaluations`` solutions re-evaluated a generation (None: pycma's ``2 + popsize / 20``) and the
+    perturbation ``epsilon`` of a re-evaluated point (pycma's 1e-7)."""
+
+    sigma0: float = SIGMA0
+    popsize: int | None = None
+    min_evaluations: int = 1
+    max_evaluations: int = 20
+    reevaluations: int | None = None
+    epsilon: float = 1e-7
+
+    def __post_init__(self) -> None:
+        s0, pop, lo, hi, re, eps = self.sigma0, self.popsize, self.min_evaluations, self.max_evaluations, self.reevaluations, self.epsilon
+
+        def integer(v) -> bool:
+            return not isinstance(v, bool) and isinstance(v, (int, np.integer))
+
+        if isinstance(s0, bool) or not isinstance(s0, (int, float)) or not (math.isfinite(s0) and s0 > 0):
+            raise ValueError(f"UH-CMA-ES sigma0={s0!r} must be a finite number > 0")
+        if pop is not None and (not integer(pop) or pop < 2):
+            raise ValueError(f"UH-CMA-ES popsize={pop!r} must be None or an integer >= 2")
+        if not integer(lo) or not integer(hi) or not 1 <= lo <= hi:
+            raise ValueError(f"UH-CMA-ES min_evaluations={lo!r} and max_evaluations={hi!r} must be integers with 1 <= min <= max")
+        if re is not None and (not integer(re) or re < 1):
+            raise ValueError(f"UH-CMA-ES reevaluations={re!r} must be None or an integer >= 1")
+        if isinstance(eps, bool) or not isinstance(eps, (int, float)) or not (math.isfinite(eps) and eps >= 0):
+            raise ValueError(f"UH-CMA-ES epsilon={eps!r} must be a finite number >= 0")
+        object.__setattr__(self, "sigma0", float(s0))
+        object.__setattr__(self, "epsilon", float(eps))
+
+
+class UHCMAES(CMAES):
+    """CMA-ES with pycma's noise handler, ask/tell in two rounds a generation (module docstring)."""
+
+    def __init__(self, prototype: np.ndarray, settings: UHCMASettings, seed: int = 0, budget: int | None = None) -> None:
+        super().__init__(prototype, sigma0=settings.sigma0, seed=seed, popsize=settings.popsize, budget=budget)
+        s = settings
+        evals = [s.min_evaluations, s.min_evaluations, s.max_evaluations]  # minimum, start, maximum
+        self._noise = cma.NoiseHandler(self._es.N, maxevals=evals, reevals=s.reevaluations, epsilon=s.epsilon)
+        self._round: dict[str, Any] | None = None  # the generation waiting for its re-evaluations
+
+    @property
+    def evaluations_per_solution(self) -> int:
+        """Episodes each solution of the next generation is flown (the noise handler's current number)."""
+        return max(1, int(round(self._noise.evaluations)))
+
+    def ask(self) -> np.ndarray:
+        """The next batch: a generation (each solution repeated), or the last generation's re-evaluations."""
+        if self._pending is not None:
+            raise RuntimeError("ask() called again before tell() of the previous batch")
+        n = self.evaluations_per_solution
+        if self._round is None:
+            solutions = [np.asarray(x, dtype=np.float64) for x in self._es.ask()]
+        else:
+            eps = self._noise.epsilon
+            solutions = [np.asarray(self._es.ask(1, self._round["X"][i], eps)[0] if eps else self._round["X"][i], dtype=np.float64) for i in self._round["idx"]]
+        self._pending = [x for x in solutions for _ in range(n)]
+        self._repeats = n
+        return np.vstack(self._pending)
+
+    def tell(self, fitness: np.ndarray, info: TellInfo | None = None) -> None:
+        """Report one return per asked row (maximised); ``info`` is not used."""
+        if self._pending is None:
+            raise RuntimeError("tell() called without a pending ask()")
+        f = check_returns(fitness, len(self._pending))
+        rows = np.vstack(self._pending)
+        losses = -np.median(f.reshape(-1, self._repeats), axis=1)  # pycma's aggregate over a solution's rows
+        bad = ~np.isfinite(losses)
+        if bad.any():  # worse than every finite loss of the batch, as CMAES.tell
+            finite = losses[~bad]
+            worst = float(finite.max()) if finite.size else 0.0
+            losses[bad] = worst + max(1.0, abs(worst))
+        self._tracker.update(rows, f, self._clock())
+        self._pending = None
+        if self._round is None:
+            X = [rows[i * self._repeats] for i in range(len(losses))]
+            self._es.tell(X, losses.tolist())
+            idx = self._indices(losses)
+            self._round = {"X": X, "fit": losses.tolist(), "idx": idx} if len(idx) else None
+            return
+        noise, r = self._noise, self._round
+        noise.fit, noise.fitre, noise.idx = list(r["fit"]), list(r["fit"]), np.asarray(r["idx"])
+        for i, loss in zip(r["idx"], losses, strict=True):
+            noise.fitre[i] = float(loss)
+        noise.update_measure()
+        self._es.sigma *= noise.treat()
+        self._round = None
+
+    def _indices(self, losses: np.ndarray) -> list[int]:
+        """The solutions to re-evaluate (``NoiseHandler.indices``), with NumPy's global generator seeded from ours."""
+        state = np.random.get_state()
+        np.random.seed(int(self._rng.integers(2**32)))
+        try:
+            return [int(i) for i in self._noise.indices(losses.tolist())]
+        finally:
+            np.random.set_state(state)
+
+    @property
+    def noise_measure(self) -> float:
+        """pycma's smoothed uncertainty measure ``noiseS`` (> 0: the ranks are noise)."""
+        return float(self._noise.noiseS)
+
+
+def _make(genome: np.ndarray, settings: UHCMASettings, seed: int) -> UHCMAES:
+    return UHCMAES(genome, settings, seed=seed)
+
+
+OPTIMISER_SPECS = (
+    OptimiserSpec("uh-cma", "uncertainty-handling CMA-ES (pycma's NoiseHandler)", UHCMASettings, _make, min_genes=2, stop_reason="cma-stop", label="uh-cma-es"),
+)
