@@ -13,21 +13,28 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
     """Evolve a task family's generic and specialised policies (the agents' policy set)."""
     from .paths import output_dir
     from .policysets import LINEAGES, build_policy_set
+    from .tasks import get_task_family
 
     if args.budget < 1:
         raise NeurohoverError(f"--budget {args.budget} is out of range: allowed >= 1")
-    if args.lineage not in LINEAGES:
-        raise NeurohoverError(f"--lineage {args.lineage!r} is not known: allowed {', '.join(LINEAGES)}")
+    lineage = "chain" if args.lineage is None else args.lineage
+    if lineage not in LINEAGES:
+        raise NeurohoverError(f"--lineage {lineage!r} is not known: allowed {', '.join(LINEAGES)}")
+    fghh = get_task_family(args.task).generic_over_distribution  # FGHH: generics over G, no specialised policies
+    if fghh and args.lineage is not None:
+        raise NeurohoverError(f"--lineage applies to the GHH tasks' specialised policies; task {args.task!r} has none")
+    if not fghh and args.fghh_budget is not None:
+        raise NeurohoverError(f"--fghh-budget applies to task fghh (its generics over G), not to {args.task!r}: give --budget")
     if args.out is not None:
         output_dir(args.out, "--out")
     ps = build_policy_set(
         args.task,
         args.out,
         budget=args.budget,
-        fghh_budget=args.fghh_budget,
+        fghh_budget=200000 if args.fghh_budget is None else args.fghh_budget,
         seed=args.seed,
         n_steps=args.episode_steps,
-        lineage=args.lineage,
+        lineage=lineage,
         optimizer=args.optimizer,
         progress=lambda msg: print(msg, file=sys.stderr, flush=True),
     )
@@ -133,13 +140,12 @@ def register(sub) -> None:
     p.add_argument("--task", required=True, help="ghh08, ghh09 or fghh")
     p.add_argument("--out", help="directory to write <task>/ into (default: the package's shipped policies)")
     p.add_argument("--budget", type=int, default=40000, help="episodes per steady-state evolution (default 40000)")
-    p.add_argument("--fghh-budget", type=int, default=200000, help="episodes per FGHH generic-policy evolution over G (default 200000)")
+    p.add_argument("--fghh-budget", type=int, help="fghh only: episodes per generic-policy evolution over G (default 200000)")
     p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument(
         "--lineage",
-        default="chain",
-        help="GHH-08/09: chain (default: every run seeded from an ancestor evolved over the training MDPs in turn, as the authors' policies were) "
+        help="GHH-08/09 only: chain (default: every run seeded from an ancestor evolved over the training MDPs in turn, as the authors' policies were) "
         "or independent (every run from the baseline policy)",
     )
     p.add_argument(

@@ -271,8 +271,9 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
 
     if args.budget is not None and args.budget < 1:
         raise NeurohoverError(f"--budget {args.budget} is out of range: allowed an integer >= 1 (evaluations)")
-    if args.seed < 0:
-        raise NeurohoverError(f"--seed {args.seed} is out of range: allowed >= 0")
+    if args.seed is not None and args.method == "lr":
+        raise NeurohoverError("--seed applies to the evolutionary methods (ec-meno, ec-mer), not to --method lr (least squares draws nothing)")
+    seed = 0 if args.seed is None else args.seed
     if args.estimator is not None and args.method != "lr":
         raise NeurohoverError(f"--estimator applies to --method lr only (least squares), not to --method {args.method}")
     if args.budget is not None and args.method == "lr":
@@ -298,10 +299,10 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
             d_u, noise = ("discard", "rms") if args.as_authors else (args.d_u or "keep", args.noise_estimate or DEFAULT_NOISE_ESTIMATE)
             model = learn_lr(data, estimator=args.estimator or "ols", wind_model=args.wind_model or "none", d_u=d_u, noise=noise)
         elif args.method == "ec-meno":
-            model = learn_ec_meno(data, seed=args.seed, **extra)
+            model = learn_ec_meno(data, seed=seed, **extra)
         else:
             source = args.policy or data.metadata.get("policy") or "baseline"
-            model = learn_ec_mer(data, load_policy(source), seed=args.seed, **extra)
+            model = learn_ec_mer(data, load_policy(source), seed=seed, **extra)
     with writing(out, "--out") as path:
         model.save(path)
     truth, why = _true_mdp(data.metadata)
@@ -479,6 +480,6 @@ def register(sub) -> None:
         action="store_true",
         help="lr: fit as the authors' code did (--d-u discard --noise-estimate rms; docs/model.md, LR as the authors fitted it)",
     )
-    p.add_argument("--seed", type=int, default=0, help="seed of the evolution (ec-meno, ec-mer)")
+    p.add_argument("--seed", type=int, help="ec-meno, ec-mer: seed of the evolution (default 0)")
     p.add_argument("--policy", help="ec-mer: the policy that flew the data (default: the flight data's metadata, else baseline)")
     p.set_defaults(func=cmd_learn_model)

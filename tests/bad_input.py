@@ -77,6 +77,9 @@ CASES: list[tuple[list[str], str]] = [
     (["build-policies", "--task", "ghh08", "--budget", "10", "--seed", "-1", "--out", "q"], "seed=-1 is out of range: allowed an integer in 0..2**63-1"),
     (["evolve", "--task", "ghh08", "--budget", "10", "--seed", "-5", "--out", "p.json"], "seed=-5 is out of range"),
     (["fly", "--task", "ghh08", "--mdp", ""], "unknown MDP ''"),
+    (["build-policies", "--task", "fghh", "--lineage", "chain", "--budget", "10", "--out", "q"], "--lineage applies to the GHH tasks' specialised policies"),
+    (["build-policies", "--task", "ghh08", "--fghh-budget", "10", "--out", "q"], "--fghh-budget applies to task fghh"),
+    (["learn-model", "--flight-data", "fd.npz", "--method", "lr", "--seed", "3", "--out", "m.json"], "--seed applies to the evolutionary methods"),
 ]
 
 

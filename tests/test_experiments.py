@@ -43,9 +43,12 @@ ABLATIONS = [
     "fig15-rules",
     "fig15-champion",
     "fig15-bandits",
+    "fig15-uh-cma",
     "fig16-slp-zero",
     "lr-authors-table4",
     "lr-authors-fig8",
+    "lr-substeps-table4",
+    "lr-substeps-fig8",
     "lr-noise-fig7",
     "lr-noise-fig11",
 ]
@@ -164,6 +167,11 @@ def test_unknown_experiment_lists_the_known_ones(cli, tmp_path: Path) -> None:
         (lambda t: t.replace("[scales.paper]", "[scales.huge]"), "unknown scale table(s) huge"),
         (lambda t: t + '\n[[settings.variants]]\nkey = "k1"\nlabel = "again"\n', "variant keys must be unique"),
         (lambda t: t.replace("runs = 12", "runs = [1"), "is not valid TOML"),
+        # issue 37: a name that escapes the report's folder, an unknown [paper] key, a paper test naming nothing
+        (lambda t: t.replace('name = "slowtest"', 'name = "../../escaped"'), "name = '../../escaped' is not allowed"),
+        (lambda t: t.replace('name = "slowtest"', 'name = ""'), "name = '' is not allowed"),
+        (lambda t: t + '\n[paper]\nnotez = ["x"]\n', "unknown [paper] key(s) notez; allowed: notes"),
+        (lambda t: t + '\n[paper]\nttests = [{ a = "k1", b = "k9", p = "0.01" }]\n', "[paper] ttests names 'k9' (b)"),
     ],
 )
 def test_bad_configs_are_refused_with_a_clear_message(tmp_path: Path, edit, message) -> None:

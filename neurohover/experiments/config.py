@@ -32,6 +32,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
+import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -48,7 +49,8 @@ KINDS = ("evolution", "model_learning", "test_runs")
 #: Experiments in report order (the shipped configs).
 ORDER = (
     "fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16", "ablation-plateau", "ablation-hybrid", "ablation-fghh",
-    "fig15-rules", "fig15-champion", "fig15-bandits", "fig16-slp-zero", "lr-authors-table4", "lr-authors-fig8", "lr-noise-fig7", "lr-noise-fig11",
+    "fig15-rules", "fig15-champion", "fig15-bandits", "fig15-uh-cma", "fig16-slp-zero", "lr-authors-table4", "lr-authors-fig8", "lr-substeps-table4",
+    "lr-substeps-fig8", "lr-noise-fig7", "lr-noise-fig11",
     "bench-sensors", "bench-sensors-fallback", "bench-sensor-models", "bench-drift", "bench-drift-armed", "wind-fig7", "wind-fig8", "wind-fig11", "risk-ghh09",
 )  # fmt: skip
 #: Bump when a unit function changes what it computes: stores written before are then refused.
@@ -212,6 +214,7 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
     kind = raw["kind"]
     if kind not in KINDS:
         raise NeurohoverError(f"{where}: kind = {kind!r} is not allowed: expected one of {', '.join(KINDS)}")
+    check_paper(raw.get("paper", {}), raw, where)
     scales = raw.get("scales", {})
     bad_scales = sorted(set(scales) - set(SCALES))
     if bad_scales:
@@ -236,6 +239,37 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
     )
 
 
+#: An experiment's name becomes file names (figures, discussions, exports): letters, digits, '.', '_' and '-',
+#: starting with a letter or digit, so that no name can reach outside the report's folder.
+_SAFE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}")
+#: What a config's [paper] table may hold (what the report reads from it).
+PAPER_KEYS = ("notes", "claims", "ttests", "groups", "table", "table3")
+
+
+def check_name(name, where: str) -> None:
+    """Refuse an experiment name that is not a safe file name (``../x``, ``""``, a slash)."""
+    if not isinstance(name, str) or not _SAFE_NAME.fullmatch(name):
+        raise NeurohoverError(f"{where}: name = {name!r} is not allowed: give 1-100 letters, digits, '.', '_' or '-', starting with a letter or digit")
+
+
+def check_paper(paper, raw: dict, where: str) -> None:
+    """Refuse an unknown [paper] key, and a paper t test that names no group, variant, method or fit at any scale."""
+    if not isinstance(paper, dict):
+        raise NeurohoverError(f"{where}: [paper] must be a table")
+    unknown = sorted(set(paper) - set(PAPER_KEYS))
+    if unknown:
+        raise NeurohoverError(f"{where}: unknown [paper] key(s) {', '.join(unknown)}; allowed: {', '.join(PAPER_KEYS)}")
+    tables = [raw.get("settings", {}), *raw.get("scales", {}).values()]
+    entries = [e for tab in tables for kind in ("groups", "variants", "fits") for e in tab.get(kind, []) if isinstance(e, dict)]
+    names = {e.get(k) for e in entries for k in ("key", "label", "agent")} | {m for tab in tables for m in tab.get("methods", [])}
+    for t in paper.get("ttests", []):
+        if not isinstance(t, dict) or not {"a", "b", "p"} <= set(t):
+            raise NeurohoverError(f"{where}: each [paper] ttests entry needs a, b and p, got {t!r}")
+        for side in ("a", "b"):
+            if t[side] not in names:
+                raise NeurohoverError(f"{where}: [paper] ttests names {t[side]!r} ({side}), which is no group, variant, method or fit of the config")
+
+
 def make_config(
     name: str,
     kind: str,
@@ -254,6 +288,7 @@ def make_config(
     experiments (``neurohover compete``) both come through here.
     """
     where = where or f"experiment {name!r}"
+    check_name(name, where)
     if kind not in KINDS:
         raise NeurohoverError(f"{where}: kind = {kind!r} is not allowed: expected one of {', '.join(KINDS)}")
     resolved = validate_table(dict(settings), SCHEMAS[kind], where)
