@@ -185,6 +185,8 @@ def mdp_rows(mdps: MDP | Sequence[MDP] | np.ndarray) -> np.ndarray:
 
 def _index_array(values, n_jobs: int | None, upper: int | None, what: str) -> np.ndarray:
     arr = np.asarray(values)
+    if arr.ndim > 1:  # one index per job: a 2-D array's jobs would be flattened in an order the caller may not mean
+        raise NeurohoverError(f"{what} must be a 1-D array of job indices, got shape {arr.shape}")
     if arr.size and not np.issubdtype(arr.dtype, np.integer):
         raise NeurohoverError(f"{what} must hold integers, got dtype {arr.dtype}")
     arr = arr.astype(np.int64).reshape(-1)

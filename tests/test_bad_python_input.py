@@ -106,3 +106,28 @@ def test_numbers_of_numpy_types_are_still_taken() -> None:
     assert fam.make(np.array([1, 2.0])) == fam.make([1, 2.0])
     assert nh.get_task_family("fghh", sigma=np.float64(0.2)).sigma == 0.2
     assert nh.evaluate("baseline", fam.zero(), n_steps=5, record=np.True_).flight_data is not None
+
+
+def test_run_test_evaluate_jobs_and_the_env_check_their_arguments() -> None:
+    """issue 37: an AttributeError/TypeError, NumPy's error, 2-D indices flattened silently, and gymnasium's own error class."""
+    import gymnasium as gym
+
+    from neurohover.agents import run_test
+    from neurohover.agents.registry import make_agent
+    from neurohover.evaluate import evaluate_jobs
+
+    fam = nh.get_task_family("ghh08")
+    agent = make_agent("baseline", fam)
+    for kwargs, expected in (
+        ({"agent": None}, "agent=None is not allowed: give an Agent"),
+        ({"mdp": "zero"}, "mdp='zero' is not allowed: give an MDP"),
+        ({"seed": -1}, "seed=-1 is out of range"),
+        ({"episodes": 10**13}, "at most 100,000,000 in one call"),
+    ):
+        args = {"agent": agent, "family": fam, "mdp": fam.zero(), "episodes": 2, "n_steps": 10, **kwargs}
+        with pytest.raises(NeurohoverError, match=expected):
+            run_test(args.pop("agent"), args.pop("family"), args.pop("mdp"), **args)
+    with pytest.raises(NeurohoverError, match=r"policy_index must be a 1-D array of job indices, got shape \(1, 1\)"):
+        evaluate_jobs([nh.baseline_policy()], [fam.zero()], [[0]], [[0]], [[0]], n_steps=5)
+    with pytest.raises(NeurohoverError, match="seed=-1 is out of range"):
+        gym.make("neurohover/GHH08-v0").reset(seed=-1)

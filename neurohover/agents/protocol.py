@@ -29,7 +29,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import NeurohoverError
-from ..evaluate import DangerousState, PolicyTable, evaluate_jobs
+from ..evaluate import DangerousState, PolicyTable, check_episode_count, evaluate_jobs
+from ..evolution.seeding import check_seed
 from ..flightdata import FlightData
 from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
@@ -162,8 +163,16 @@ def run_test(
     an MDP with drifting dynamics (``mdp.drift``: episode e flies its row e, the agent unaware). ``device``: where the
     episodes in the MDP fly (the agent's own evolutions on models follow its ``ModelEvolution``).
     """
+    if not isinstance(agent, Agent):
+        raise NeurohoverError(f"agent={agent!r:.80} is not allowed: give an Agent (neurohover.agents.registry.make_agent(name, family))")
+    if not isinstance(family, TaskFamily):
+        raise NeurohoverError(f"family={family!r:.80} is not allowed: give a TaskFamily (neurohover.get_task_family(name))")
+    if not isinstance(mdp, MDP):
+        raise NeurohoverError(f"mdp={mdp!r:.80} is not allowed: give an MDP (family.mdp('test:3'), for example)")
     if not isinstance(episodes, (int, np.integer)) or episodes < 1:
         raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
+    check_episode_count(int(episodes), f"episodes={episodes}")
+    seed = check_seed(seed)
     start_time = time.perf_counter()
     agent.start(family, np.random.default_rng(np.random.SeedSequence([seed, 0xA6E27])))
     returns = np.zeros(episodes)
