@@ -219,6 +219,13 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     else:
         for key, value in summary.items():
             print(f"{key:>20}: {value:.6g}" if isinstance(value, float) else f"{key:>20}: {value}")
+    if args.budget is not None and result.stop_reason != "budget" and result.episodes < args.budget:
+        why = " (steady state ends at the paper's plateau, 1000 evaluations without a new champion)" if result.stop_reason == "plateau" else ""
+        print(
+            f"neurohover evolve: note: stopped by {result.stop_reason} after {result.episodes:,} of the --budget {args.budget:,} episodes: the budget "
+            "is a cap, not a length" + why,
+            file=sys.stderr,
+        )
     return 0
 
 

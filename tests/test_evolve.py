@@ -454,3 +454,13 @@ def test_race_auto_matches_the_cost_of_fixed_resampling() -> None:
     run = evolve(FGHH, topology="slp", resampling="race:auto", budget=2000, seed=4, n_steps=100)
     fixed_cost = 5 * 50 * run.generations
     assert run.settings["resampling"] == "race:auto" and 0.5 * fixed_cost <= run.episodes <= 1.5 * fixed_cost
+
+
+def test_evolve_says_when_the_plateau_ends_a_run_before_its_budget(tmp_path: Path, capsys) -> None:
+    """issue 37: a --budget on one MDP is a cap; a run the plateau stopped first said nothing of it."""
+    args = ["evolve", "--task", "ghh08", "--mdp", "train:0", "--episode-steps", "20", "--validation-episodes", "1", "--out", str(tmp_path / "p.json")]
+    assert main([*args, "--budget", "100000"]) == 0
+    err = capsys.readouterr().err
+    assert "note: stopped by plateau after" in err and "of the --budget 100,000 episodes: the budget is a cap, not a length" in err
+    assert main([*args, "--budget", "60"]) == 0  # the budget ends it: no note
+    assert "the budget is a cap" not in capsys.readouterr().err
