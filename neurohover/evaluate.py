@@ -303,6 +303,7 @@ def evaluate_jobs(
         flight = FlightData(
             tuple(obs_out[i, : rec_steps[i] + 1].copy() for i in range(n_rec)),
             tuple(act_out[i, : rec_steps[i]].copy() for i in range(n_rec)),
+            {"episode_steps": int(n_steps), "crashed": [bool(c) for c in out.crashed[rec]]},  # a short episode is not a crash
         )
     return Evaluation(out.returns, out.crashed, out.steps, out.safeguard_step, flight, seconds)
 

@@ -48,7 +48,13 @@ class FlightData:
         return int(sum(a.shape[0] for a in self.actions))
 
     def __add__(self, other: FlightData) -> FlightData:
-        return FlightData(self.observations + other.observations, self.actions + other.actions, {**self.metadata, **other.metadata})
+        meta = {**self.metadata, **other.metadata}
+        a, b = self.metadata.get("crashed"), other.metadata.get("crashed")  # per-episode flags: both halves, or none
+        if isinstance(a, list) and isinstance(b, list) and len(a) == self.n_episodes and len(b) == other.n_episodes:
+            meta["crashed"] = a + b
+        else:
+            meta.pop("crashed", None)
+        return FlightData(self.observations + other.observations, self.actions + other.actions, meta)
 
     def save(self, path: str | Path, dtype: str = "float64") -> Path:
         """Write the flight data to ``path`` (``.npz``), as float64 (exact) or float32 (half the space)."""

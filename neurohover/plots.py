@@ -41,6 +41,7 @@ __all__ = [
     "attitude_angles",
     "compete_figure",
     "crashed_episode",
+    "episode_crashed",
     "flight_figure",
     "plot_compete",
     "plot_flight_data",
@@ -174,13 +175,22 @@ def _episode_title(data: FlightData, i: int, stem: str) -> str:
     return ", ".join(parts)
 
 
+def episode_crashed(data: FlightData, i: int) -> bool:
+    """Whether episode ``i`` of ``data`` crashed: its flag as flown (the ``crashed`` metadata every recording holds),
+    or, in files recorded before 2026-12-04, whether it is shorter than the metadata's ``episode_steps`` (default 6000)."""
+    meta = data.metadata if isinstance(data.metadata, dict) else {}
+    flags = meta.get("crashed")
+    if isinstance(flags, list) and len(flags) == data.n_episodes:
+        return bool(flags[i])
+    return crashed_episode(data.actions[i], int(meta.get("episode_steps", EPISODE_STEPS)))
+
+
 def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight", episodes: Sequence[int] | None = None) -> list[Path]:
     """One PNG per episode of ``data`` (:func:`flight_figure`), ``<stem>-episode<i>.png`` in ``out_dir``;
     ``episodes``: only these (0-based; default all).
 
     Titles take the MDP label, return and policy from the metadata that ``neurohover fly
-    --record`` writes (``mdps``, ``returns``, ``policy``); ``episode_steps`` in the metadata, if
-    present, sets the length of a full episode (default 6000).
+    --record`` writes (``mdps``, ``returns``, ``policy``); a crash is marked as :func:`episode_crashed` says.
 
     Returns
     -------
@@ -197,7 +207,7 @@ def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight"
     paths = []
     for i in chosen:
         obs, act = data.observations[i], data.actions[i]
-        fig = flight_figure(obs, act, title=_episode_title(data, i, stem), episode_steps=int(steps))
+        fig = flight_figure(obs, act, title=_episode_title(data, i, stem), episode_steps=int(steps), crashed=episode_crashed(data, i))
         paths.append(save_figure(fig, out_dir / f"{stem}-episode{i:0{width}d}.png"))
     return paths
 

@@ -223,3 +223,25 @@ def test_plot_draws_only_the_episodes_asked_for(tmp_path: Path, capsys) -> None:
     capsys.readouterr()
     assert main(["plot", str(flights), "--episodes", "4"]) == 2
     assert "--episodes '4' is out of range: the flight data hold episodes 0..3" in capsys.readouterr().err
+
+
+def test_a_deliberately_short_episode_is_not_marked_crashed(tmp_path) -> None:
+    """issue 37: an episode flown for fewer than 6000 steps was drawn as a crash; the recording now carries each flag."""
+    from neurohover import Policy, baseline_policy, evaluate, get_task_family
+    from neurohover.flightdata import FlightData
+    from neurohover.plots import episode_crashed
+
+    mdp = get_task_family("ghh08").zero()
+    rolling = baseline_policy().genome.copy()
+    rolling[36] += 0.5  # rolls over within a few hundred steps
+    ev = evaluate([baseline_policy(), Policy("slp", rolling)], mdp, n_steps=400, seed=1, record=True)
+    data = ev.flight_data
+    assert data.metadata["crashed"] == [bool(c) for c in ev.crashed.ravel()] == [False, True]
+    assert [episode_crashed(data, i) for i in range(2)] == [False, True]  # the short baseline episode is no crash
+    data.save(tmp_path / "f.npz")
+    again = FlightData.load(tmp_path / "f.npz")
+    assert [episode_crashed(again, i) for i in range(2)] == [False, True]
+    both = data + data  # joined recordings keep every episode's flag
+    assert both.metadata["crashed"] == [False, True, False, True]
+    old = FlightData(data.observations, data.actions, {})  # a file recorded before the flags: the length rule
+    assert [episode_crashed(old, i) for i in range(2)] == [True, True]
