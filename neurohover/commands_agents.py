@@ -69,6 +69,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
         ("--d-u", args.d_u),
         ("--noise-estimate", args.noise_estimate),
         ("--model-policy", args.model_policy),
+        ("--model-substeps", args.model_substeps),
     ):
         if value is not None and not AGENTS[args.agent].learns_models:
             learners = ", ".join(name for name, spec in AGENTS.items() if spec.learns_models)
@@ -109,7 +110,11 @@ def cmd_compete(args: argparse.Namespace) -> int:
             sensor=sensor,
             drift=None if args.drift is None else Drift.parse(args.drift),
             wind_model=args.wind_model or "none",
-            lr_fit={k: v for k, v in (("d_u", args.d_u), ("noise", args.noise_estimate), ("model_policy", args.model_policy)) if v is not None},
+            lr_fit={
+                k: v
+                for k, v in (("d_u", args.d_u), ("noise", args.noise_estimate), ("model_policy", args.model_policy), ("model_substeps", args.model_substeps))
+                if v is not None
+            },
             agent_settings=agent_settings,
         )
     except KeyboardInterrupt:
@@ -191,6 +196,12 @@ def register(sub) -> None:
         "--model-policy",
         choices=MODEL_POLICIES,
         help="model-based agents: evolve on the model from the generic policy (ours, default) or an SLP from the baseline by the authors' eonn (authors)",
+    )
+    p.add_argument(
+        "--model-substeps",
+        type=int,
+        choices=(1, 10),
+        help="model-based agents: the learned model integrates its 0.1 s step once (default, the paper's) or in the simulator's 10 substeps",
     )
     p.add_argument(
         "--agent-setting",

@@ -45,7 +45,7 @@ STORE_FILE = "results.sqlite"
 
 
 #: The LR-fit settings a competition takes (``lr_fit``): the experiment groups' keys of the same names.
-LR_FIT_KEYS = ("d_u", "noise", "model_policy")
+LR_FIT_KEYS = ("d_u", "noise", "model_policy", "model_substeps")
 
 
 def summarise(results: Sequence) -> dict:
@@ -170,7 +170,7 @@ def competition_config(
     sensor: Sensor | None = None,
     drift: Drift | None = None,
     wind_model: str = "none",
-    lr_fit: Mapping[str, str] | None = None,
+    lr_fit: Mapping[str, object] | None = None,
     agent_settings: Mapping[str, object] | None = None,
 ):
     """The inline experiment of a competition (an ``ExperimentConfig`` of kind ``test_runs``).
@@ -234,7 +234,7 @@ def compete(
     sensor: Sensor | None = None,
     drift: Drift | None = None,
     wind_model: str = "none",
-    lr_fit: Mapping[str, str] | None = None,
+    lr_fit: Mapping[str, object] | None = None,
     agent_settings: Mapping[str, object] | None = None,
 ) -> tuple[dict, list]:
     """Run ``runs`` test runs of ``agent`` as an inline experiment; write results and plot to ``out``.
@@ -265,7 +265,7 @@ def compete(
     lr_fit : mapping, optional
         How a model-based agent fits LR and evolves on it, where it differs from ours: ``d_u``
         (``"keep"``/``"discard"``), ``noise`` (``"innovations"``/``"rms"``), ``model_policy``
-        (``"ours"``/``"authors"``) (:class:`~neurohover.agents.model_based.ModelEvolution`); checked
+        (``"ours"``/``"authors"``), ``model_substeps`` (1/10) (:class:`~neurohover.agents.model_based.ModelEvolution`); checked
         with the config (a bad value is refused with the allowed ones).
     agent_settings : mapping, optional
         The agent's own settings (its spec's settings class, e.g. ``{"criterion": "lcb", "level": 3}``

@@ -83,3 +83,18 @@ def test_the_fig8_groups_take_ten_substeps_on_figure_8s_seeds() -> None:
         make_config("x", "test_runs", "quick", {**base, "groups": [{"agent": "model-free", "n_mdps": 1, "model_substeps": 10}]})
     with pytest.raises(NeurohoverError, match="model_substeps"):
         make_config("x", "test_runs", "quick", {**base, "groups": [{"agent": "incremental", "n_mdps": 1, "model_substeps": 2}]})
+
+
+def test_compete_takes_the_model_substeps_for_the_agents_that_learn_models(tmp_path, capsys) -> None:
+    import json
+    import sqlite3
+
+    from neurohover.cli import main
+
+    args = ["compete", "--task", "ghh08", "--runs", "1", "--episodes", "2", "--episode-steps", "60", "--model-substeps", "10"]
+    assert main([*args, "--agent", "model-based", "--out", str(tmp_path / "a")]) == 0
+    with sqlite3.connect(tmp_path / "a" / "results.sqlite") as conn:
+        (params,) = conn.execute("SELECT params FROM units").fetchone()
+    assert json.loads(params)["model_substeps"] == 10  # the run's unit flew the ten-substep model
+    assert main([*args, "--agent", "model-free", "--out", str(tmp_path / "b")]) == 2
+    assert "--model-substeps applies to the agents that learn models" in capsys.readouterr().err
