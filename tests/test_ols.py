@@ -76,7 +76,7 @@ def test_ols_is_the_default_of_every_agents_model_learning(windy, monkeypatch) -
     class Learned(Exception):
         pass
 
-    def spy(flight_data, estimator="ols", wind_model="none", *, d_u="keep", noise="innovations"):
+    def spy(flight_data, estimator="ols", wind_model="none", *, d_u="keep", noise="innovations", substeps=1):
         raise Learned(estimator, wind_model)
 
     monkeypatch.setattr(mb, "learn_model", spy)
