@@ -9,6 +9,7 @@ import argparse
 import importlib
 import json
 import os
+import sqlite3
 import sys
 from collections.abc import Sequence
 from dataclasses import fields
@@ -75,6 +76,7 @@ def add_sensor_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("noisy sensors (docs/benchmarks.md; default: exact sensors)")
     g.add_argument(
         "--obs-noise",
+        action="append",
         help="sensor noise on what the policy sees: a level (e.g. 0.5: std 0.05 m/s, 0.05 m, 0.05 rad/s, 0.005) or key=value pairs "
         f"of {', '.join(f.name for f in fields(Sensor) if f.name != 'delay')} or level (docs/benchmarks.md)",
     )
@@ -84,6 +86,9 @@ def add_sensor_options(p: argparse.ArgumentParser) -> None:
 def sensor_of(args: argparse.Namespace):
     """The sensor of --obs-noise/--obs-delay (None where neither is given: exact sensors)."""
     noise, delay = getattr(args, "obs_noise", None), getattr(args, "obs_delay", None)
+    if noise is not None and len(noise) > 1:  # the option is appended to catch a repeat, which would silently keep the last
+        raise NeurohoverError(f"--obs-noise is given {len(noise)} times ({', '.join(map(repr, noise))}): give it once, key=value pairs joined by commas")
+    noise = None if noise is None else noise[0]
     return None if noise is None and delay is None else Sensor.of(noise, delay)
 
 
@@ -314,6 +319,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except NeurohoverError as err:
         print(f"neurohover {args.command}: error: {err}", file=sys.stderr)
         remove_created_dirs()  # a failed command leaves no empty output directory behind
+        return 2
+    except sqlite3.DatabaseError as err:  # a store file damaged mid-file, or not a store at all
+        print(
+            f"neurohover {args.command}: error: a results store cannot be read ({err}); restore it from its copy (docs/reproduction/README.md)", file=sys.stderr
+        )
+        remove_created_dirs()
         return 2
     except KeyboardInterrupt as stop:
         from .procs import Terminated

@@ -161,3 +161,23 @@ def test_a_malformed_file_in_a_policy_directory_is_named(broken: str, expected: 
     assert main([*args, "--policy-dir", str(tmp_path / "pd"), "--out", str(tmp_path / "q")]) == 2
     err = capsys.readouterr().err
     assert f"'{tmp_path / 'pd' / 'ghh08' / broken}'" in err and expected in err, err
+
+
+def test_a_repeated_sensor_key_and_a_damaged_store_are_one_clear_line(tmp_path: Path, capsys) -> None:
+    """issue 37: a repeated --obs-noise (or key) kept the last silently; a store damaged mid-file was a sqlite3 traceback."""
+    assert main(["fly", "--task", "ghh08", "--episodes", "1", "--obs-noise", "velocity=0.1", "--obs-noise", "velocity=0.2"]) == 2
+    assert "--obs-noise is given 2 times" in capsys.readouterr().err
+    assert main(["fly", "--task", "ghh08", "--episodes", "1", "--obs-noise", "velocity=0.1,velocity=0.2"]) == 2
+    assert "sensor setting 'velocity' is given twice" in capsys.readouterr().err
+    from neurohover.experiments import LocalExecutor, Store, load_config, reproduce
+
+    good = tmp_path / "s.sqlite"
+    with Store(good) as store:
+        reproduce(load_config("fig2", "quick", {"runs": 1, "budget": 40, "n_steps": 20}), store, LocalExecutor(1), progress=False)
+    data = good.read_bytes()
+    damaged = tmp_path / "d.sqlite"
+    damaged.write_bytes(data[: len(data) // 2] + b"\x00garbage" * 512 + data[len(data) // 2 + 4096 :])
+    rc = main(["report", "--store", str(damaged), "--out", str(tmp_path / "r")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "a results store cannot be read" in err and "Traceback" not in err
+    assert not (tmp_path / "r").exists()  # the output directory it made is gone again

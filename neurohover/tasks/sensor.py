@@ -113,6 +113,8 @@ class Sensor:
             key = key.strip()
             if not eq or key not in allowed:
                 raise NeurohoverError(f"sensor setting {part!r} is not understood: {expected}")
+            if key in settings:
+                raise NeurohoverError(f"sensor setting {key!r} is given twice in {text!r}: give each key once")
             try:
                 settings[key] = float(value)
             except ValueError:
