@@ -63,9 +63,15 @@ def _parse_lines(text: str, source: str):
             continue
         try:
             if fields[0] == "n" and len(fields) == 5:
-                nodes[int(fields[1])] = (int(fields[2]), int(fields[3]), float(fields[4]), number, line.strip())
+                node = int(fields[1])
+                if node in nodes:  # a second definition would silently replace the first
+                    raise ValueError(f"node {node} is defined again (first on line {nodes[node][3]})")
+                nodes[node] = (int(fields[2]), int(fields[3]), float(fields[4]), number, line.strip())
             elif fields[0] == "s" and len(fields) == 4:
-                links[(int(fields[1]), int(fields[2]))] = (float(fields[3]), number, line.strip())
+                link = (int(fields[1]), int(fields[2]))
+                if link in links:
+                    raise ValueError(f"link {link[0]} -> {link[1]} is given again (first on line {links[link][1]})")
+                links[link] = (float(fields[3]), number, line.strip())
             else:
                 raise ValueError("expected 'n ID POSITION FUNCTION BIAS' or 's SOURCE DEST WEIGHT'")
         except ValueError as err:
