@@ -131,3 +131,13 @@ def test_run_test_evaluate_jobs_and_the_env_check_their_arguments() -> None:
         evaluate_jobs([nh.baseline_policy()], [fam.zero()], [[0]], [[0]], [[0]], n_steps=5)
     with pytest.raises(NeurohoverError, match="seed=-1 is out of range"):
         gym.make("neurohover/GHH08-v0").reset(seed=-1)
+
+
+def test_a_run_on_another_familys_mdp_is_refused() -> None:
+    """issue 37: a GHH-08 agent flew a GHH-09 MDP without a word."""
+    from neurohover.agents import run_test
+    from neurohover.agents.registry import make_agent
+
+    ghh08, ghh09 = nh.get_task_family("ghh08"), nh.get_task_family("ghh09")
+    with pytest.raises(NeurohoverError, match="is a ghh09 MDP, but the run's family is ghh08"):
+        run_test(make_agent("baseline", ghh08), ghh08, ghh09.mdp("train:0"), episodes=2, n_steps=10)

@@ -169,6 +169,8 @@ def run_test(
         raise NeurohoverError(f"family={family!r:.80} is not allowed: give a TaskFamily (neurohover.get_task_family(name))")
     if not isinstance(mdp, MDP):
         raise NeurohoverError(f"mdp={mdp!r:.80} is not allowed: give an MDP (family.mdp('test:3'), for example)")
+    if mdp.family != family.name:  # the agent prepares for its family (its policies, safe pairs): another family's MDP is a mix-up
+        raise NeurohoverError(f"mdp {mdp.label!r} is a {mdp.family} MDP, but the run's family is {family.name}: give an MDP of {family.name}")
     if not isinstance(episodes, (int, np.integer)) or episodes < 1:
         raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
     check_episode_count(int(episodes), f"episodes={episodes}")
