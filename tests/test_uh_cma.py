@@ -77,6 +77,13 @@ def test_bad_settings_are_refused_naming_the_value(settings: dict, message: str)
         evolve(GHH08.mdp("train:0"), optimizer="uh-cma", settings=settings, budget=10)
 
 
+def test_its_settings_extend_cma_es_but_are_not_taken_for_them() -> None:
+    with pytest.raises(ValueError, match="CMA-ES sigma0=0.0 must be a finite number > 0"):  # CMA-ES's own check
+        UHCMASettings(sigma0=0.0)
+    with pytest.raises(nh.NeurohoverError, match="settings for optimizer 'cma' must be a CMASettings"):
+        evolve(GHH08.mdp("train:0"), optimizer="cma", settings=UHCMASettings(), budget=10)
+
+
 def test_evolve_runs_it_and_resumes_bit_for_bit(tmp_path: Path) -> None:
     assert OPTIMISERS["uh-cma"].stops_itself
     common = dict(topology="slp", optimizer="uh-cma", seed=4, n_steps=200, settings={"max_evaluations": 4})

@@ -19,7 +19,7 @@ import numpy as np
 from . import common
 from .common import ChampionTracker, ChampionViews, Clock, TellInfo, check_prototype, check_returns
 
-__all__ = ["CMAES", "SIGMA0"]
+__all__ = ["CMAES", "SIGMA0", "losses_of"]
 
 #: The initial step size for the baseline-seeded policies: a sweep on GHH-08 train:1 (600-step
 #: episodes, 1000 episodes, SLP and MLP from the baseline) found 0.01-0.03 best and 0.1 crashing
@@ -68,6 +68,18 @@ class _Unpickler(pickle.Unpickler):
     def find_class(self, module: str, name: str):
         moved = _MOVED.get((module, name))
         return getattr(*moved) if moved is not None else super().find_class(module, name)
+
+
+def losses_of(returns: np.ndarray) -> np.ndarray:
+    """pycma's losses for maximised ``returns``: negated, a non-finite one (NaN, ``-inf``) made worse than every
+    finite loss of the batch (pycma only ranks within a batch, so its update treats it as the worst)."""
+    losses = -np.asarray(returns, dtype=np.float64)
+    bad = ~np.isfinite(losses)
+    if bad.any():
+        finite = losses[~bad]
+        worst = float(finite.max()) if finite.size else 0.0
+        losses[bad] = worst + max(1.0, abs(worst))
+    return losses
 
 
 class CMAES(ChampionViews):
@@ -144,13 +156,7 @@ class CMAES(ChampionViews):
         if self._pending is None:
             raise RuntimeError("tell() called without a pending ask()")
         f = check_returns(fitness, len(self._pending))
-        losses = -f
-        bad = ~np.isfinite(losses)
-        if bad.any():
-            finite = losses[~bad]
-            worst = float(finite.max()) if finite.size else 0.0
-            losses[bad] = worst + max(1.0, abs(worst))
-        self._es.tell(self._pending, losses.tolist())
+        self._es.tell(self._pending, losses_of(f).tolist())
         self._tracker.update(np.vstack(self._pending), f, self._clock())
         self._pending = None
 

@@ -95,7 +95,7 @@ def population_settings(name: str, settings: Any) -> Any:
     cls = OPTIMISERS[name].settings
     if settings is None:
         return cls()
-    if isinstance(settings, cls):
+    if type(settings) is cls:  # exactly its class: a subclass's settings (UH-CMA-ES's of CMA-ES's) belong to another optimiser
         return settings
     if not isinstance(settings, Mapping):
         fields = [f.name for f in dataclasses.fields(cls)]

@@ -31,44 +31,39 @@ from typing import Any
 import cma
 import numpy as np
 
-from ..cmaes import CMAES, SIGMA0
+from ..cmaes import CMAES, losses_of
 from ..common import TellInfo, check_returns
 from . import OptimiserSpec
+from .cma import CMASettings
 
 __all__ = ["UHCMAES", "UHCMASettings"]
 
 
 @dataclass(frozen=True)
-class UHCMASettings:
-    """Settings of uncertainty-handling CMA-ES: CMA-ES's (``sigma0``, ``popsize``) and the noise handler's:
-    evaluations per solution between ``min_evaluations`` and ``max_evaluations`` (starting at the minimum),
-    ``reevaluations`` solutions re-evaluated a generation (None: pycma's ``2 + popsize / 20``) and the
-    perturbation ``epsilon`` of a re-evaluated point (pycma's 1e-7)."""
+class UHCMASettings(CMASettings):
+    """Settings of uncertainty-handling CMA-ES: CMA-ES's (``sigma0``, ``popsize``: :class:`CMASettings`, which checks
+    them) and the noise handler's: evaluations per solution between ``min_evaluations`` and ``max_evaluations``
+    (starting at the minimum), ``reevaluations`` solutions re-evaluated a generation (None: pycma's
+    ``2 + popsize / 20``) and the perturbation ``epsilon`` of a re-evaluated point (pycma's 1e-7)."""
 
-    sigma0: float = SIGMA0
-    popsize: int | None = None
     min_evaluations: int = 1
     max_evaluations: int = 20
     reevaluations: int | None = None
     epsilon: float = 1e-7
 
     def __post_init__(self) -> None:
-        s0, pop, lo, hi, re, eps = self.sigma0, self.popsize, self.min_evaluations, self.max_evaluations, self.reevaluations, self.epsilon
+        super().__post_init__()
+        lo, hi, re, eps = self.min_evaluations, self.max_evaluations, self.reevaluations, self.epsilon
 
         def integer(v) -> bool:
             return not isinstance(v, bool) and isinstance(v, (int, np.integer))
 
-        if isinstance(s0, bool) or not isinstance(s0, (int, float)) or not (math.isfinite(s0) and s0 > 0):
-            raise ValueError(f"UH-CMA-ES sigma0={s0!r} must be a finite number > 0")
-        if pop is not None and (not integer(pop) or pop < 2):
-            raise ValueError(f"UH-CMA-ES popsize={pop!r} must be None or an integer >= 2")
         if not integer(lo) or not integer(hi) or not 1 <= lo <= hi:
             raise ValueError(f"UH-CMA-ES min_evaluations={lo!r} and max_evaluations={hi!r} must be integers with 1 <= min <= max")
         if re is not None and (not integer(re) or re < 1):
             raise ValueError(f"UH-CMA-ES reevaluations={re!r} must be None or an integer >= 1")
         if isinstance(eps, bool) or not isinstance(eps, (int, float)) or not (math.isfinite(eps) and eps >= 0):
             raise ValueError(f"UH-CMA-ES epsilon={eps!r} must be a finite number >= 0")
-        object.__setattr__(self, "sigma0", float(s0))
         object.__setattr__(self, "epsilon", float(eps))
 
 
@@ -107,12 +102,7 @@ class UHCMAES(CMAES):
             raise RuntimeError("tell() called without a pending ask()")
         f = check_returns(fitness, len(self._pending))
         rows = np.vstack(self._pending)
-        losses = -np.median(f.reshape(-1, self._repeats), axis=1)  # pycma's aggregate over a solution's rows
-        bad = ~np.isfinite(losses)
-        if bad.any():  # worse than every finite loss of the batch, as CMAES.tell
-            finite = losses[~bad]
-            worst = float(finite.max()) if finite.size else 0.0
-            losses[bad] = worst + max(1.0, abs(worst))
+        losses = losses_of(np.median(f.reshape(-1, self._repeats), axis=1))  # pycma's aggregate over a solution's rows
         self._tracker.update(rows, f, self._clock())
         self._pending = None
         if self._round is None:
