@@ -190,8 +190,6 @@ def cmd_fly(args: argparse.Namespace) -> int:
 
     if args.episodes < 1:
         raise NeurohoverError(f"--episodes {args.episodes} is out of range: allowed >= 1")
-    if args.seed < 0:
-        raise NeurohoverError(f"--seed {args.seed} is out of range: allowed >= 0")
     per_episode = _FLY_BYTES_PER_EPISODE + (_SAMPLED_MDP_BYTES if args.mdp == "sample" else 0) + (_RECORD_BYTES_PER_STEP * EPISODE_STEPS if args.record else 0)
     most = max_in_memory(per_episode)
     if args.episodes > most:
@@ -321,9 +319,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         remove_created_dirs()  # a failed command leaves no empty output directory behind
         return 2
     except sqlite3.DatabaseError as err:  # a store file damaged mid-file, or not a store at all
-        print(
-            f"neurohover {args.command}: error: a results store cannot be read ({err}); restore it from its copy (docs/reproduction/README.md)", file=sys.stderr
-        )
+        print(f"neurohover {args.command}: error: a results store cannot be read ({err}): the file is damaged or is no results store", file=sys.stderr)
         remove_created_dirs()
         return 2
     except KeyboardInterrupt as stop:

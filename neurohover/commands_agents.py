@@ -17,9 +17,8 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
 
     if args.budget < 1:
         raise NeurohoverError(f"--budget {args.budget} is out of range: allowed >= 1")
-    lineage = "chain" if args.lineage is None else args.lineage
-    if lineage not in LINEAGES:
-        raise NeurohoverError(f"--lineage {lineage!r} is not known: allowed {', '.join(LINEAGES)}")
+    if args.lineage is not None and args.lineage not in LINEAGES:
+        raise NeurohoverError(f"--lineage {args.lineage!r} is not known: allowed {', '.join(LINEAGES)}")
     fghh = get_task_family(args.task).generic_over_distribution  # FGHH: generics over G, no specialised policies
     if fghh and args.lineage is not None:
         raise NeurohoverError(f"--lineage applies to the GHH tasks' specialised policies; task {args.task!r} has none")
@@ -31,10 +30,9 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
         args.task,
         args.out,
         budget=args.budget,
-        fghh_budget=200000 if args.fghh_budget is None else args.fghh_budget,
         seed=args.seed,
         n_steps=args.episode_steps,
-        lineage=lineage,
+        **{k: v for k, v in (("fghh_budget", args.fghh_budget), ("lineage", args.lineage)) if v is not None},  # absent: build_policy_set's defaults
         optimizer=args.optimizer,
         progress=lambda msg: print(msg, file=sys.stderr, flush=True),
     )
@@ -48,7 +46,6 @@ def cmd_compete(args: argparse.Namespace) -> int:
     from .agents.registry import AGENTS, HYBRID_AGENTS
     from .cli import sensor_of
     from .compete import check_sizes, compete
-    from .evolution.seeding import check_seed
     from .experiments.executors import check_jobs
     from .paths import input_dir, output_dir, output_file
     from .tasks import Drift
@@ -76,7 +73,6 @@ def cmd_compete(args: argparse.Namespace) -> int:
             raise NeurohoverError(f"{option} applies to the agents that learn models ({learners}), not to --agent {args.agent}")
     check_device(args.device)  # before the output directory is made
     check_jobs(args.jobs)
-    check_seed(args.seed)
     check_sizes(args.runs, args.episodes)
     if args.policy_dir is not None:
         input_dir(args.policy_dir, "--policy-dir")

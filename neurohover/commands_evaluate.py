@@ -53,7 +53,6 @@ def _agent(args: argparse.Namespace):
 def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     """Fly a trained policy on full paper episodes of a task's training or test MDPs, beside the competition's baseline
     and the shipped generic policy on the same gusts, and print the paper's measures (return per episode, crashes)."""
-    from .evolution.seeding import check_seed
     from .integrations.flying import compare_agent
     from .paths import output_file, writing
     from .tasks import get_task_family
@@ -63,7 +62,6 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     n = available if args.n_mdps is None else args.n_mdps
     if not 1 <= n <= available:
         raise NeurohoverError(f"--n-mdps {n} is out of range: {args.task} has {available} {args.mdps} MDPs")
-    check_seed(args.seed)  # the one range every command takes
     for option, value, low, high in (("--episodes", args.episodes, 1, 10**4), ("--episode-steps", args.episode_steps, 1, 10**7)):
         if not low <= value <= high:
             raise NeurohoverError(f"{option} {value} is out of range: allowed an integer in {low}..{high}")

@@ -112,8 +112,6 @@ def cmd_evolve(args: argparse.Namespace) -> int:
 
     if args.budget is not None and args.budget < 1:
         raise NeurohoverError(f"--budget {args.budget} is out of range: allowed an integer >= 1 (episodes)")
-    if args.seed < 0:
-        raise NeurohoverError(f"--seed {args.seed} is out of range: allowed >= 0")
     if args.episode_steps < 1:
         raise NeurohoverError(f"--episode-steps {args.episode_steps} is out of range: allowed >= 1")
     if not args.checkpoint_every > 0:

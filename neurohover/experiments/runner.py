@@ -98,6 +98,11 @@ def unchanged_units(config: ExperimentConfig, store: Store) -> set[str]:
         kept.update((key, stored[key]["result"]) for key in same)
 
 
+def _matches_no_unit(config, pattern: str, units) -> NeurohoverError:
+    """The error of an ``--only`` pattern that selects nothing, with what unit keys look like."""
+    return NeurohoverError(f"{config.name}: --only {pattern!r} matches no unit; unit keys look like {', '.join(u.key for u in units[:3])}")
+
+
 def reproduce(
     config: ExperimentConfig,
     store: Store,
@@ -129,7 +134,7 @@ def reproduce(
         first = plan(config, store.results(config.name, config.scale) if held == config.hash else {}, sources)
         unmatched = [pat for pat in only if not any(fnmatch.fnmatchcase(u.key, pat) for u in first.units)]
         if unmatched and len(first.units) == first.total:
-            raise NeurohoverError(f"{config.name}: --only {unmatched[0]!r} matches no unit; unit keys look like {', '.join(u.key for u in first.units[:3])}")
+            raise _matches_no_unit(config, unmatched[0], first.units)
     if update and held is not None and held != config.hash:
         kept = store.update(config.name, config.scale, config.hash, config.to_dict(), unchanged_units(config, store))
         print(f"{config.name} ({config.scale}): the config changed (hash {held} -> {config.hash}); {kept} stored units stand unchanged", file=sys.stderr)
@@ -171,8 +176,7 @@ def reproduce(
         if summary.failed:
             summary.status = "failed"
         elif set(only) - matched:
-            keys = ", ".join(u.key for u in p.units[:3])
-            raise NeurohoverError(f"{config.name}: --only {sorted(set(only) - matched)[0]!r} matches no unit; unit keys look like {keys}")
+            raise _matches_no_unit(config, sorted(set(only) - matched)[0], p.units)
         elif only:
             summary.status = "finished" if len(results) >= summary.units_total else "selection finished"
         elif len(results) < summary.units_total:
