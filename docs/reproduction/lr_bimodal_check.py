@@ -31,6 +31,7 @@ import numpy as np
 from neurohover import evaluate
 from neurohover.evolution.evolve import evolve
 from neurohover.experiments.params import unit_params
+from neurohover.experiments.units import model_unit_seeds
 from neurohover.models.lr import learn_lr
 from neurohover.models.model import one_substep_params
 from neurohover.policies import policy_from_dict
@@ -46,7 +47,7 @@ def runs(store: str, mdps: int, seeds: int, variants: list[str]):
     for key, params, stored in rows[:mdps]:
         q = unit_params("model", json.loads(params))
         mdp, generic = MDP.from_dict(q.mdp), policy_from_dict(q.generic)
-        s = np.random.SeedSequence(q.seed).generate_state(4, np.uint64) >> np.uint64(1)  # run_model's four seeds
+        s = model_unit_seeds(q.seed)  # run_model's four seeds
         data = evaluate(generic, mdp, episodes=q.data_episodes, seed=int(s[0]), record=True, n_steps=q.n_steps, threads=1)
         model = learn_lr(data.flight_data, estimator="ols", d_u=q.d_u, noise=q.noise)
         assert np.allclose(model.params, json.loads(stored)["model_params"], rtol=1e-12), key  # the stored unit's model

@@ -218,6 +218,11 @@ def run_safety(p: dict, threads: int | None, device: str = "cpu") -> dict:
     ).to_dict()
 
 
+def model_unit_seeds(seed: int) -> np.ndarray:
+    """A model unit's four seeds from its own: flight data, model learning, the evolution on the model, the test episodes."""
+    return np.random.SeedSequence(seed).generate_state(4, np.uint64) >> np.uint64(1)
+
+
 def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
     """Table 4: fly the generic policy once (flight data), learn a model, evolve a policy on the
     model, fly that policy ``test_episodes`` times in the true MDP. Methods: ``lr`` (OLS, the
@@ -229,7 +234,7 @@ def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
 
     mdp = _mdp(q.mdp)
     generic = _policy(q.generic)
-    seeds = np.random.SeedSequence(q.seed).generate_state(4, np.uint64) >> np.uint64(1)
+    seeds = model_unit_seeds(q.seed)
     data = evaluate(generic, mdp, episodes=q.data_episodes, seed=int(seeds[0]), record=True, n_steps=q.n_steps, threads=threads, device=device)
     flight = data.flight_data
     assert flight is not None  # recorded
