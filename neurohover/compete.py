@@ -265,7 +265,8 @@ def compete(
     lr_fit : mapping, optional
         How a model-based agent fits LR and evolves on it, where it differs from ours: ``d_u``
         (``"keep"``/``"discard"``), ``noise`` (``"innovations"``/``"rms"``), ``model_policy``
-        (``"ours"``/``"authors"``), ``model_substeps`` (1/10) (:class:`~neurohover.agents.model_based.ModelEvolution`); checked
+        (``"ours"``/``"authors"``), ``model_substeps`` (10/1; absent: the task's default,
+        :func:`~neurohover.models.model.default_model_substeps`) (:class:`~neurohover.agents.model_based.ModelEvolution`); checked
         with the config (a bad value is refused with the allowed ones).
     agent_settings : mapping, optional
         The agent's own settings (its spec's settings class, e.g. ``{"criterion": "lcb", "level": 3}``

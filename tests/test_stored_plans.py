@@ -9,15 +9,23 @@ from pathlib import Path
 
 from neurohover.experiments.config import ExperimentConfig, load_config, shipped_configs
 from neurohover.experiments.plans import plan, source_experiments
+from neurohover.experiments.runner import unchanged_units
 from neurohover.experiments.store import Store
 
 #: The settings a paper-scale run may have been given on the command line (README: `--set policies=shipped`).
 POLICY_SOURCES = ("policies", "generic")
+#: Paper-scale experiments whose config changed on purpose and whose re-run (`reproduce NAME --scale paper
+#: --update`) is under way: the model-substeps default of 2026-12-04 (issue 31; docs/reproduction/README.md).
+#: Each must still be taken by --update (its unchanged units kept). Emptied as the store receives the re-runs.
+AWAITING_RERUN = {
+    "table4", "fig7", "fig8", "fig11", "ablation-hybrid", "lr-substeps-fig8", "wind-fig7", "wind-fig8", "wind-fig11", "risk-ghh09",
+    "bench-sensors", "bench-sensors-fallback", "bench-sensor-models", "bench-drift", "bench-drift-armed",
+}  # fmt: skip
 
 
 def test_every_stored_experiment_is_planned_again_with_its_stored_params(committed_store: Path) -> None:
     shipped = set(shipped_configs())
-    checked = 0
+    checked = rerun = 0
     with Store(committed_store, create=False) as store:
         for name, scale, stored_hash, _ in store.experiments():
             if name not in shipped:
@@ -28,6 +36,10 @@ def test_every_stored_experiment_is_planned_again_with_its_stored_params(committ
             # the documented override (`reproduce ... --set policies=shipped`): where the policies come from
             overrides = {k: stored[k] for k in POLICY_SOURCES if k in stored}
             cfg = load_config(name, scale, overrides)
+            if scale == "paper" and name in AWAITING_RERUN and cfg.hash != stored_hash:
+                unchanged_units(cfg, store)  # --update takes it (refused: its units were computed by other unit code)
+                rerun += 1
+                continue
             assert cfg.hash == stored_hash, f"{name} ({scale}): the config no longer hashes as stored"
             units = store.units(name, scale)
             results = {u["key"]: u["result"] for u in units}
@@ -38,3 +50,4 @@ def test_every_stored_experiment_is_planned_again_with_its_stored_params(committ
                     assert json.dumps(planned[u["key"]], sort_keys=True) == json.dumps(u["params"], sort_keys=True), f"{name} ({scale}) {u['key']}"
                     checked += 1
     assert checked > 1000
+    assert rerun <= len(AWAITING_RERUN)

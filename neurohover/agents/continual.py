@@ -40,9 +40,10 @@ import numpy as np
 from ..errors import NeurohoverError
 from ..evaluate import DangerousState
 from ..flightdata import FlightData
+from ..models.model import LearnedModel
 from ..models.transitions import one_step_error
 from ..policies import Policy
-from ..tasks import MDP, TaskFamily
+from ..tasks import TaskFamily
 from .model_based import ModelEvolution, enough_to_learn, evolve_on_model
 from .protocol import Agent, Choice, EpisodeOutcome
 from .spec import AgentOptions, AgentPolicies, AgentSettings, AgentSpec
@@ -99,7 +100,7 @@ class ContinualAgent(Agent):
         self.learning = True  # in a learning phase (else flying a kept policy and watching its model)
         self.phase_start = 0
         self.predicted: float | None = None
-        self.policy_model: MDP | None = None  # the model the flying policy was evolved on (None: the generic)
+        self.policy_model: LearnedModel | None = None  # the model the flying policy was evolved on, as fitted (None: the generic)
         self.reference_error: float | None = None  # that model's one-step error on its own data
         self.phase_best = self._candidate(-np.inf)
         self.strikes = 0
@@ -127,10 +128,11 @@ class ContinualAgent(Agent):
         data = self._data()
         if not enough_to_learn(data, self.evolution.wind_model):
             return
-        model = self.evolution.learn(data)
+        fitted = self.evolution.fit(data)  # watched by its one-step errors, flown in the evolution's substeps
         self.models += 1
-        self.policy_model = model
-        self.reference_error = float(one_step_error(model, data))
+        self.policy_model = fitted
+        self.reference_error = float(one_step_error(fitted, data))
+        model = fitted.mdp(substeps=fitted.flyable_substeps(self.evolution.model_substeps))
         self.policy, self.predicted = evolve_on_model(model, self.generic, self.evolution, int(self._rng.integers(2**62)))
         self.label = f"model:{self.models}"
 

@@ -86,7 +86,9 @@ class CodeAgentSettings:
         default, ``"discard"`` and ``"rms"`` as the authors' code). Its evolution on the model is
         always the authors' (:data:`MODEL_EVOLUTION`), whatever a run's ``model_policy`` says.
     model_substeps : {1, 10}
-        The model's substeps per control step (1, as the authors; :meth:`neurohover.models.LearnedModel.mdp`).
+        The model's substeps per control step (1: the authors' published FGHH code flies its model as
+        ``Helicopter(params, noise_std, 0.1)``, one 0.1 s step; the GHH agents' default is ten,
+        :data:`neurohover.models.model.DEFAULT_MODEL_SUBSTEPS`; :meth:`neurohover.models.LearnedModel.mdp`).
     """
 
     evolutions: int = 3

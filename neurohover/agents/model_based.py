@@ -16,6 +16,7 @@ from ..errors import NeurohoverError
 from ..evaluate import evaluate
 from ..flightdata import FlightData
 from ..models.lr import DEFAULT_NOISE_ESTIMATE, lr_determined
+from ..models.model import DEFAULT_MODEL_SUBSTEPS, LearnedModel
 from ..policies import Policy, baseline_policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
@@ -45,8 +46,9 @@ class ModelEvolution:
     or ``"authors"`` (an SLP from the baseline by the authors' ``eonn``: 50 genomes, then
     ``authors_generations`` generations of one offspring each; :data:`MODEL_POLICIES`).
 
-    ``model_substeps``: the learned model integrates each 0.1 s control step once (1, the default: the
-    paper's and the authors' model) or in the simulator's ten substeps of its equivalent parameters (10;
+    ``model_substeps``: policies evolve on the learned model in the simulator's ten substeps of its
+    equivalent parameters (10, the default: the paper's model equations run at simulator timesteps) or in
+    one 0.1 s step per control step (1, the default until 2026-12-04 and the authors' published FGHH code;
     :meth:`neurohover.models.LearnedModel.mdp`, measured in ``lr-substeps-table4``, docs/model.md).
     """
 
@@ -60,7 +62,7 @@ class ModelEvolution:
     noise: str = DEFAULT_NOISE_ESTIMATE
     model_policy: str = "ours"
     authors_generations: int = 500
-    model_substeps: int = 1
+    model_substeps: int = DEFAULT_MODEL_SUBSTEPS
 
     def __post_init__(self) -> None:
         from ..evaluate import check_device
@@ -84,13 +86,26 @@ class ModelEvolution:
             raise NeurohoverError(f"authors_generations={g!r} is out of range: allowed an integer >= 1")
         check_device(self.device)
 
+    def fit(self, flight_data: FlightData) -> LearnedModel:
+        """The LR model of ``flight_data`` under these settings, as fitted (one 0.1 s step: its one-step errors)."""
+        from ..models import learn_lr
+
+        return learn_lr(flight_data, estimator=self.estimator, wind_model=self.wind_model, d_u=self.d_u, noise=self.noise)
+
     def learn(self, flight_data: FlightData) -> MDP:
-        """The LR model of ``flight_data`` under these settings, as an MDP."""
+        """The LR model of ``flight_data`` under these settings, as the MDP its policies evolve on: in
+        ``model_substeps`` where the model has that equivalent, else as fitted (``LearnedModel.flyable_substeps``)."""
         return learn_model(flight_data, self.estimator, self.wind_model, d_u=self.d_u, noise=self.noise, substeps=self.model_substeps)
 
 
 def learn_model(
-    flight_data: FlightData, estimator: str = "ols", wind_model: str = "none", *, d_u: str = "keep", noise: str = DEFAULT_NOISE_ESTIMATE, substeps: int = 1
+    flight_data: FlightData,
+    estimator: str = "ols",
+    wind_model: str = "none",
+    *,
+    d_u: str = "keep",
+    noise: str = DEFAULT_NOISE_ESTIMATE,
+    substeps: int = DEFAULT_MODEL_SUBSTEPS,
 ) -> MDP:
     """The LR model (the paper's best method) of the flight data, as an MDP.
 
@@ -99,11 +114,13 @@ def learn_model(
     are LR's default, ``"uv"`` (D_v, and the model's D_u unless ``d_u="discard"``, as the authors).
     ``wind_model``: ``"none"`` (default, the paper's), ``"constant"`` or ``"sinusoid"``, a
     world-frame wind identified from the data. ``noise``: the authors' ``"rms"`` (default) or
-    ``"innovations"``. ``substeps``: 1 (default, the paper's one 0.1 s step) or 10 (the simulator's substeps).
+    ``"innovations"``. ``substeps``: 10 (default, the simulator's substeps) or 1 (one 0.1 s step); a model with an axis that
+    has no ten-substep equivalent is flown as fitted (:meth:`neurohover.models.LearnedModel.flyable_substeps`).
     """
     from ..models import learn_lr
 
-    return learn_lr(flight_data, estimator=estimator, wind_model=wind_model, d_u=d_u, noise=noise).mdp(substeps=substeps)
+    model = learn_lr(flight_data, estimator=estimator, wind_model=wind_model, d_u=d_u, noise=noise)
+    return model.mdp(substeps=model.flyable_substeps(substeps))
 
 
 def enough_to_learn(flight_data: FlightData, wind_model: str = "none") -> bool:

@@ -40,6 +40,7 @@ from typing import Any
 
 from ..errors import NeurohoverError
 from ..models.lr import LEGACY_NOISE_ESTIMATE
+from ..models.model import LEGACY_MODEL_SUBSTEPS
 from .schema import SCHEMAS, check_kind, validate_table
 from .settings import ExperimentSettings, typed_settings
 
@@ -70,19 +71,24 @@ def _respelled(settings: dict, old: str, new: str) -> dict:
     return out
 
 
-def _legacy_noise_dropped(settings: dict) -> dict:
-    """``settings`` without a group's (or a model-learning experiment's) ``noise = "innovations"``.
+def _legacy_dropped(settings: dict) -> dict:
+    """``settings`` without the values that an absent setting meant before its default changed: a group's
+    (or a model-learning experiment's) ``noise = "innovations"`` and a group's, a fit's or a
+    model-learning experiment's ``model_substeps = 1`` (both defaults changed on 2026-12-04).
 
-    Before 2026-12-04 an absent estimate meant innovations: a config naming it now hashes as it did
-    then (its stored results resume), and one that leaves it out takes the new default, "rms".
+    A config naming the old value hashes as it did then (its stored results resume), and one that leaves
+    it out takes the new default (the schema writes it in), so its hash changes.
     """
+    both = {"noise": LEGACY_NOISE_ESTIMATE, "model_substeps": LEGACY_MODEL_SUBSTEPS}
 
-    def dropped(table: dict) -> dict:
-        return {k: v for k, v in table.items() if not (k == "noise" and v == LEGACY_NOISE_ESTIMATE)}
+    def dropped(table: dict, legacy: dict) -> dict:
+        return {k: v for k, v in table.items() if not (k in legacy and v == legacy[k] and not isinstance(v, bool))}
 
-    out = dropped(settings)
+    out = dropped(settings, both)
     if "groups" in settings:
-        out["groups"] = [dropped(g) for g in settings["groups"]]
+        out["groups"] = [dropped(g, both) for g in settings["groups"]]
+    if "fits" in settings:  # a fit always wrote its noise estimate in: only its substeps are new
+        out["fits"] = [dropped(f, {"model_substeps": LEGACY_MODEL_SUBSTEPS}) for f in settings["fits"]]
     return out
 
 
@@ -108,7 +114,7 @@ class ExperimentConfig:
     @property
     def hash(self) -> str:
         """Hash of everything that changes results (16 hex digits)."""
-        settings = _legacy_noise_dropped(_respelled(self.settings, "optimizer", "optimiser"))
+        settings = _legacy_dropped(_respelled(self.settings, "optimizer", "optimiser"))
         payload = {"kind": self.kind, "settings": settings, "units_version": UNITS_VERSION, "external": self.external_digest}
         return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
 

@@ -12,6 +12,7 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 from ..models.lr import LEGACY_NOISE_ESTIMATE
+from ..models.model import LEGACY_MODEL_SUBSTEPS
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -76,7 +77,7 @@ class ModelParams:
     noise: str = LEGACY_NOISE_ESTIMATE  # absent: a unit stored before the default became "rms"
     model_policy: str = "ours"
     authors_generations: int = 500
-    model_substeps: int = 1  # the model integrates its control step once (the paper's) or in the simulator's 10 substeps
+    model_substeps: int = LEGACY_MODEL_SUBSTEPS  # the policy evolves on the model in one step or the simulator's 10 substeps (absent: 1)
     exact_checks: bool = False  # also check the model and its policy against exact sensors (the MDP has a sensor model)
     seed: int
 
@@ -102,7 +103,7 @@ class TestRunParams:
     noise: str = LEGACY_NOISE_ESTIMATE  # absent: a unit stored before the default became "rms"
     model_policy: str = "ours"
     authors_generations: int = 500
-    model_substeps: int = 1  # the learned models integrate their control step once (the paper's) or in 10 substeps
+    model_substeps: int = LEGACY_MODEL_SUBSTEPS  # the agents evolve on their models in one step or 10 substeps (absent: 1)
     sensor: dict | None = None
     hybrid: dict | None = None
     agent_settings: dict | None = None

@@ -28,6 +28,7 @@ from ..agents.hybrid import HybridSettings
 from ..agents.registry import HYBRID_AGENTS, agent_spec
 from ..errors import NeurohoverError
 from ..models.lr import LEGACY_NOISE_ESTIMATE
+from ..models.model import LEGACY_MODEL_SUBSTEPS
 from ..policies import baseline_policy
 from ..policysets import load_policy_set, policy_set_roles
 from ..tasks import EXACT, Sensor
@@ -372,7 +373,7 @@ class _Policies:
         return None if any(v is None for v in out.values()) else out
 
 
-def _lr_fit(d_u: str, noise: str | None, model_policy: str, authors_generations: int, model_substeps: int = 1) -> dict:
+def _lr_fit(d_u: str, noise: str | None, model_policy: str, authors_generations: int, model_substeps: int) -> dict:
     """A unit's LR-fit params where they differ from ours before these settings (absent then: stored units keep their params)."""
     out: dict = {}
     if d_u != "keep":
@@ -382,7 +383,7 @@ def _lr_fit(d_u: str, noise: str | None, model_policy: str, authors_generations:
     if model_policy != "ours":
         out["model_policy"] = model_policy
         out["authors_generations"] = authors_generations
-    if model_substeps != 1:
+    if model_substeps != LEGACY_MODEL_SUBSTEPS:
         out["model_substeps"] = model_substeps
     return out
 
@@ -486,7 +487,7 @@ def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
             }
             seed_key = f"model/{s.mdps}{i}"
             if method in ("lr", "lr-gls"):  # the experiment's noise estimate (fits give their own)
-                common.update(_lr_fit("keep", s.noise, "ours", s.authors_generations))
+                common.update(_lr_fit("keep", s.noise, "ours", s.authors_generations, s.model_substeps))
             if not s.conditions and not s.fits:
                 units.append(_unit(cfg, UnitKey.make("model", method, f"{s.mdps}{i}"), "model", {**common, "mdp": mdp.to_dict()}, seed_key=seed_key))
             for f in s.fits:  # every fit learns from the same flight data and its policy meets the same gusts

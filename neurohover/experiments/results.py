@@ -404,6 +404,9 @@ class ModelResult(_Record):
         Standard deviation of the vertical body velocity w over every step of the test episodes: about
         0.03 m/s for a policy that hovers, about 1.5 for one whose collective loop oscillates (None: a
         unit stored before it was recorded, 2026-12-04).
+    flown_substeps : int or None
+        The substeps the policy evolved on the model in, where they differ from the unit's ``model_substeps``:
+        1 for a model with an axis that has no ten-substep equivalent (``LearnedModel.flyable_substeps``).
     """
 
     _NESTED: ClassVar[dict[str, type[_Record]]] = {"timing": ModelTiming}
@@ -414,6 +417,7 @@ class ModelResult(_Record):
         "exact_test_returns",
         "exact_test_crashes",
         "test_w_sd",
+        "flown_substeps",
     )
 
     method: str
@@ -434,6 +438,7 @@ class ModelResult(_Record):
     exact_test_returns: tuple[Num, ...] | None = None
     exact_test_crashes: int | None = None
     test_w_sd: Num | None = None
+    flown_substeps: int | None = None
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -23,7 +23,7 @@ from ..evolution.evolve import parse_resampling
 from ..evolution.optimisers import OPTIMISERS
 from ..evolution.races import RACE_RULES
 from ..models.lr import D_U_CHOICES, DEFAULT_NOISE_ESTIMATE, NOISE_ESTIMATES
-from ..models.model import MODEL_SUBSTEPS
+from ..models.model import MODEL_SUBSTEPS, default_model_substeps
 from ..policysets import FGHH_GENERIC_RESAMPLING
 from ..tasks import TASK_FAMILIES, TASK_NAMES, Drift, Sensor
 
@@ -196,7 +196,7 @@ _GROUP = {
     "d_u": (OMIT, _choice(*D_U_CHOICES)),
     "noise": (OMIT, _choice(*NOISE_ESTIMATES)),
     "model_policy": (OMIT, _choice(*MODEL_POLICIES)),
-    "model_substeps": (OMIT, _substeps()),  # absent: 1, the paper's one step per control step
+    "model_substeps": (OMIT, _substeps()),  # written in by check_kind for the agents that learn models (the task's default)
     "sensor": (OMIT, _sensor_table()),  # this group's agents fly the group's MDPs through these sensors
     "drift": (OMIT, _drift_table()),  # and with these drifting dynamics (neurohover.tasks.drift)
     # run i of MDP m takes the seed of that run of another experiment's group: the same gusts and draws (paired)
@@ -219,7 +219,7 @@ _FIT = {
     "d_u": ("keep", _choice(*D_U_CHOICES)),
     "noise": (DEFAULT_NOISE_ESTIMATE, _choice(*NOISE_ESTIMATES)),
     "model_policy": ("ours", _choice(*MODEL_POLICIES)),
-    # absent: 1, the paper's one step (OMIT keeps the hashes of the configs written before this setting)
+    # written in by check_kind: the task's default (ten for GHH; an absent one in a stored config was 1)
     "model_substeps": (OMIT, _substeps()),
 }
 
@@ -263,6 +263,8 @@ SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
         "authors_generations": (OMIT, _int(1)),  # the authors' eonn generations (absent: 500, theirs)
         # the LR methods' gust-noise estimate, where no fits give it (written in by check_kind when they learn LR)
         "noise": (OMIT, _choice(*NOISE_ESTIMATES)),
+        # and the substeps their policies evolve on the models in (written in likewise: the task's default)
+        "model_substeps": (OMIT, _substeps()),
     },
     "test_runs": {
         **_COMMON,
@@ -366,11 +368,15 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
             raise NeurohoverError(f"{where}: sensor is set by each of the conditions here: leave [settings] sensor out")
     if kind == "model_learning":
         lr_methods = set(settings["methods"]) & {"lr", "lr-gls"}
-        if "noise" in settings and (not lr_methods or "fits" in settings):
-            why = "each of the fits gives its own" if lr_methods else f"methods {settings['methods']} learn no LR model"
-            raise NeurohoverError(f"{where}: noise = {settings['noise']!r} applies to the LR methods without fits, not here: {why}")
-        if lr_methods and "fits" not in settings:  # the estimate is part of the config (and its hash)
+        for key in ("noise", "model_substeps"):
+            if key in settings and (not lr_methods or "fits" in settings):
+                why = "each of the fits gives its own" if lr_methods else f"methods {settings['methods']} learn no LR model"
+                raise NeurohoverError(f"{where}: {key} = {settings[key]!r} applies to the LR methods without fits, not here: {why}")
+        if lr_methods and "fits" not in settings:  # the estimate and the substeps are part of the config (and its hash)
             settings["noise"] = settings.get("noise", DEFAULT_NOISE_ESTIMATE)
+            settings["model_substeps"] = settings.get("model_substeps", default_model_substeps(task))
+        for f in settings.get("fits", []):
+            f["model_substeps"] = f.get("model_substeps", default_model_substeps(task))
     if kind == "model_learning" and "fits" in settings:
         _keyed(settings["fits"], "fit", where)
         if "conditions" in settings:
@@ -397,8 +403,9 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
                 raise NeurohoverError(
                     f"{where}: group {g['label']!r}: {', '.join(lr_keys)} apply to the agents that learn models ({learners}), not to {g['agent']!r}"
                 )
-            if AGENTS[g["agent"]].learns_models:  # the estimate is part of the config (and its hash)
+            if AGENTS[g["agent"]].learns_models:  # the estimate and the substeps are part of the config (and its hash)
                 g["noise"] = g.get("noise", DEFAULT_NOISE_ESTIMATE)
+                g["model_substeps"] = g.get("model_substeps", default_model_substeps(task))
             if "settings" in g and g["agent"] in HYBRID_AGENTS:  # one spelling for every agent's own settings
                 if g["hybrid"]:
                     raise NeurohoverError(f"{where}: group {g['label']!r}: give the hybrid settings once, as settings (hybrid is its older name), not both")

@@ -13,6 +13,7 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 from ..models.lr import DEFAULT_NOISE_ESTIMATE
+from ..models.model import LEGACY_MODEL_SUBSTEPS
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -46,7 +47,9 @@ class Group:
     d_u: str = "keep"  # how its LR models treat the fitted u constant (the authors': discard)
     noise: str | None = None  # their gust-noise estimate (None: the group's agents learn no models)
     model_policy: str = "ours"  # how policies are evolved on them (the authors': an SLP from the baseline by eonn)
-    model_substeps: int = 1  # the substeps of those models' control step (1: the paper's; 10: the simulator's)
+    # the substeps their policies evolve on those models in (10 or 1; the schema writes the task's default in,
+    # so this default is what an absent value meant in a config stored before 2026-12-04)
+    model_substeps: int = LEGACY_MODEL_SUBSTEPS
     sensor: dict | None = None  # this group's sensors (None: the experiment's)
     drift: dict | None = None  # this group's drifting dynamics (None: the experiment's)
     seeds_of: dict | None = None  # {experiment, seed, group}: its runs take that group's seeds (None: its own)
@@ -71,7 +74,7 @@ class Fit:
     d_u: str = "keep"
     noise: str = DEFAULT_NOISE_ESTIMATE
     model_policy: str = "ours"
-    model_substeps: int = 1  # LearnedModel.mdp(substeps=): the policy evolves on the model in 1 or 10 substeps
+    model_substeps: int = LEGACY_MODEL_SUBSTEPS  # LearnedModel.mdp(substeps=): the policy evolves on the model in 1 or 10 substeps
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -119,6 +122,7 @@ class ModelLearningSettings(ExperimentSettings):
     fits: tuple[Fit, ...] = ()  # empty: LR as the methods say (D_u kept, `noise`, our evolution)
     authors_generations: int = 500  # generations of the authors' eonn, where a fit evolves so
     noise: str | None = None  # the LR methods' gust-noise estimate where no fits give it (None: no LR method)
+    model_substeps: int = LEGACY_MODEL_SUBSTEPS  # and the substeps their policies evolve on the models in
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -47,7 +47,10 @@ __all__ = [
     "MODEL_METHODS",
     "MODEL_DT",
     "MODEL_SUBSTEPS",
+    "DEFAULT_MODEL_SUBSTEPS",
+    "LEGACY_MODEL_SUBSTEPS",
     "LearnedModel",
+    "default_model_substeps",
     "ParamRow",
     "check_vector",
     "equivalent_params",
@@ -62,9 +65,26 @@ MODEL_DT = CONTROL_DT
 
 #: Per axis (u, v, w, p, q, r): index of its C parameter; the axis index is also the noise index.
 AXIS_C = (0, 1, 3, 5, 7, 9)
-#: How a learned model may integrate its 0.1 s control step: once, as the paper's and the authors' models do
-#: (the default), or in the simulator's ten substeps of its equivalent parameters (:func:`equivalent_params`).
+#: How a learned model may integrate its 0.1 s control step: once (the model as fitted; the authors' published
+#: FGHH code) or in the simulator's ten substeps of its equivalent parameters (:func:`equivalent_params`).
 MODEL_SUBSTEPS = (1, SUBSTEPS)
+#: The substeps in which the agents and experiments evolve policies on a learned model: ten, as the paper's
+#: model equations run at simulator timesteps t_s (Section 3.2) and as its Table 4 and Figure 8 figures are
+#: only reached so (``lr-substeps-table4``, ``lr-substeps-fig8``; docs/model.md, "One substep or ten").
+DEFAULT_MODEL_SUBSTEPS = SUBSTEPS
+#: What an absent ``model_substeps`` means in the configs and units stored before 2026-12-04: one step.
+LEGACY_MODEL_SUBSTEPS = 1
+
+
+def default_model_substeps(task: str) -> int:
+    """The substeps in which a task's agents evolve policies on their learned models unless told otherwise.
+
+    GHH-08 and GHH-09: :data:`DEFAULT_MODEL_SUBSTEPS` (ten; the paper's equations and figures). FGHH: one,
+    as the authors' published FGHH code flies its model (``Helicopter(params, noise_std, 0.1)``).
+    """
+    return 1 if task == "fghh" else DEFAULT_MODEL_SUBSTEPS
+
+
 #: Per axis: indices of its gain parameters (D_v, D_w, D_p, D_q, D_r; u has none).
 AXIS_GAINS: tuple[tuple[int, ...], ...] = ((), (2,), (4,), (6,), (8,), (10,))
 
@@ -147,12 +167,14 @@ class LearnedModel:
     def mdp(self, label: str | None = None, substeps: int = 1) -> MDP:
         """The model as an MDP for the kernel: family ``"model"``, its wind (if any).
 
-        ``substeps=1`` (the default, the paper's and the authors' model): one 0.1 s Euler step per control
-        step. ``substeps=10``: the same model in the simulator's ten 0.01 s substeps, with the parameters,
-        D_u and noise of :func:`equivalent_params` (each axis's one-step response kept; the position then
-        integrates the velocity within the step, as the simulator does). A one-substep OLS model rates
-        policies whose collective loop oscillates in the true MDP as good hoverers (docs/model.md, "One
-        substep or ten"). Ten substeps need a wind-blind model whose every axis has an equivalent.
+        ``substeps=1`` (the model as fitted): one 0.1 s Euler step per control step.
+        ``substeps=10`` (:data:`DEFAULT_MODEL_SUBSTEPS`, where the agents evolve their policies): the same
+        model in the simulator's ten 0.01 s substeps, with the parameters, D_u and noise of
+        :func:`equivalent_params` (each axis's one-step response kept; the position then integrates the
+        velocity within the step, as the simulator does). A one-substep OLS model rates policies whose
+        collective loop oscillates in the true MDP as good hoverers (docs/model.md, "One substep or ten").
+        Ten substeps need every axis to have an equivalent. A model's wind stays as it is: it enters the
+        drag as a velocity, ``C (u + wind)``, so it scales with C as the gains do.
         """
         if substeps not in MODEL_SUBSTEPS:
             raise NeurohoverError(f"substeps={substeps!r}: allowed {' or '.join(map(str, MODEL_SUBSTEPS))}")
@@ -160,8 +182,6 @@ class LearnedModel:
         wind_kind, wind = self.wind.mdp_wind()
         if substeps == 1:
             return MDP("model", self.params, self.noise_std, wind_kind=wind_kind, wind=wind, substeps=1, dt=MODEL_DT, label=label, d_u=float(self.d_u))
-        if self.wind.kind != "none":
-            raise NeurohoverError(f"substeps={substeps} applies to wind-blind models; this one has a {self.wind.kind} wind")
         params, noise = self.equivalent()
         bad = [NOISE_NAMES[axis] for axis, ci in enumerate(AXIS_C) if not np.isfinite(params[ci])]
         if bad:
@@ -171,6 +191,17 @@ class LearnedModel:
         return MDP(
             "model", params=tuple(params), noise_std=tuple(noise), wind_kind=wind_kind, wind=wind, substeps=substeps, dt=SUBSTEP_DT, label=label, d_u=d_u
         )
+
+    def flyable_substeps(self, substeps: int) -> int:
+        """``substeps`` where every axis of the model has a ``substeps``-substep equivalent, else 1.
+
+        An axis whose one-step multiplier ``1 + 0.1 C`` is not positive flips sign every control step:
+        no substeps reproduce it, so such a model (strong sensor noise fits one) is flown as fitted.
+        """
+        if substeps == 1:
+            return 1
+        params, _ = self.equivalent()
+        return substeps if all(np.isfinite(params[ci]) for ci in AXIS_C) else 1
 
     def equivalent(self, substeps: int = SUBSTEPS, dt: float = SUBSTEP_DT) -> tuple[np.ndarray, np.ndarray]:
         """Parameters and noise std of the same model for ``substeps`` substeps of ``dt``
