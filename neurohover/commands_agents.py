@@ -197,7 +197,7 @@ def register(sub) -> None:
         "--model-substeps",
         type=int,
         choices=(1, 10),
-        help="model-based agents: their policies evolve on the learned model in the simulator's 10 substeps (GHH's default) or in one 0.1 s step (FGHH's default, the authors' code)",
+        help="model-based agents: policies evolve on the model in the simulator's 10 substeps (GHH's default) or one 0.1 s step (FGHH's, the authors')",
     )
     p.add_argument(
         "--agent-setting",
