@@ -27,6 +27,7 @@ from .report_base import Section, agent_panel, fmt, log_errors, new_figure, pair
 from .report_evolution import EvolutionSection
 from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, test_run_figure, varies
 from .report_models import SensorModels
+from .report_readme import Status, fill_generated, linked_claims, status_table
 from .results import ModelResult, TestRunResult, result_from_dict
 from .settings import Group, ModelLearningSettings
 from .store import Store
@@ -430,7 +431,7 @@ def _header(cfg: ExperimentConfig, store: Store, units: list[dict], total: int |
     )
 
 
-def _section(cfg: ExperimentConfig, store: Store, out: Path) -> tuple[str, list[dict[str, str]]]:
+def _section(cfg: ExperimentConfig, store: Store, out: Path) -> tuple[str, list[dict[str, str]], Status]:
     from .plans import plan
 
     units = store.units(cfg.name, cfg.scale)
@@ -463,7 +464,18 @@ def _section(cfg: ExperimentConfig, store: Store, out: Path) -> tuple[str, list[
         lines += [f"  - {n}" for n in notes]
     text.append("\n".join(lines) + "\n")
     text.append("### Discussion\n\n" + _discussion(cfg, out) + "\n")
-    return "\n".join(text), sec.claims
+    sessions = store.sessions(cfg.name, cfg.scale)
+    status = Status(
+        cfg.name,
+        cfg.title,
+        cfg.scale,
+        len(units),
+        total,
+        sum(s["wall_seconds"] for s in sessions),
+        sum(u["seconds"] for u in units),
+        tuple(sorted({s["cores"] for s in sessions})),
+    )
+    return "\n".join(text), sec.claims, status
 
 
 QUICK_DISCUSSION = (
@@ -487,7 +499,10 @@ def _discussion(cfg: ExperimentConfig, out: Path) -> str:
 
 
 def write_report(store: Store, out: str | Path, *, scale: str | None = None, names: list[str] | None = None) -> Path:
-    """Write figures and ``report.md`` for the experiments in ``store`` into ``out``; returns report.md's path."""
+    """Write figures and ``report.md`` for the experiments in ``store`` into ``out``; returns report.md's path.
+
+    A ``README.md`` in ``out`` with generated blocks gets them filled from the store (:mod:`.report_readme`).
+    """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     entries = [(n, s) for n, s, _, _ in store.experiments() if (scale is None or s == scale) and (not names or n in names)]
@@ -501,9 +516,11 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
     entries.sort(key=lambda e: (rank.get(e[0], len(ORDER)), e[0], e[1]))
     sections, toc = [], []
     claims: dict[str, tuple[str, list[dict[str, str]]]] = {}  # paper figure -> (its section's anchor, its claims)
+    statuses: list[Status] = []
     for name, sc in entries:
         cfg = ExperimentConfig.from_dict(store.config(name, sc))
-        text, checked = _section(cfg, store, out)
+        text, checked, status = _section(cfg, store, out)
+        statuses.append(status)
         sections.append(text)
         anchor = _anchor(cfg.title + " [" + sc + "]")
         toc.append(f"- [{cfg.title} [{sc}]](#{anchor})")
@@ -515,10 +532,14 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
         f"return (lower is better). Quick-scale runs use short episodes and few runs: they check the pipeline, and "
         f"their numbers are not comparable in magnitude with the paper's.\n\n" + "\n".join(toc) + "\n"
     )
-    if claims:
-        head += "\n" + claims_section(claims)
+    summary = claims_section(claims) if claims else ""
+    head += "\n" + summary if summary else ""
     path = out / "report.md"
     path.write_text(head + "\n" + "\n".join(sections))
+    readme = out / "README.md"
+    fill_generated(readme, "status", status_table([s for s in statuses if s.scale == "paper"]))
+    if summary:
+        fill_generated(readme, "claims", linked_claims(summary))
     return path
 
 
