@@ -327,6 +327,10 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         print(f"neurohover {args.command}: {'terminated' if isinstance(stop, Terminated) else 'interrupted'}", file=sys.stderr)
         return 143 if isinstance(stop, Terminated) else 130  # 128 + the signal's number, as shells report
+    except BrokenPipeError:  # the reader went away (`neurohover demo | head -1`): stop quietly, as Python's docs advise
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())  # so that the interpreter's own flush at exit does not fail again
+        return 1
 
 
 if __name__ == "__main__":
