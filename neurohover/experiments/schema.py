@@ -321,126 +321,146 @@ def validate_table(values: dict, schema: dict, where: str) -> dict:
 
 
 def check_kind(settings: dict, kind: str, where: str) -> None:
-    """Cross-field checks."""
+    """Cross-field checks (and the defaults they write in), by the experiment's kind."""
     task, sigma = settings["task"], settings.get("sigma")
 
     if sigma is not None and not TASK_FAMILIES[task].has_sigma:
         with_sigma = ", ".join(repr(n) for n, c in TASK_FAMILIES.items() if c.has_sigma)
         raise NeurohoverError(f"{where}: sigma applies to task {with_sigma} only, not {task!r}")
     if kind == "evolution":
-        keys = [v["key"] for v in settings["variants"]]
-        if len(set(keys)) != len(keys):
-            raise NeurohoverError(f"{where}: variant keys must be unique, got {keys}")
-        for v in settings["variants"]:
-            if v["sigma"] is not None and not TASK_FAMILIES[task].has_sigma:
-                raise NeurohoverError(f"{where}: variant {v['key']!r} sets sigma but the task is {task!r}")
-            if settings["target"] != "family" and parse_resampling(v["resampling"]).selects:
-                raise NeurohoverError(f"{where}: variant {v['key']!r}: selection races and bandits need target = 'family'")
+        _check_evolution(settings, task, where)
+    if kind == "model_learning":
+        _check_model_learning(settings, task, where)
+    if kind in ("model_learning", "test_runs"):
+        _check_mdp_counts(settings, where)
+    if kind == "test_runs":
+        _check_test_runs(settings, task, where)
 
-        method = "generational" if settings["target"] == "family" else "steady-state"
-        for v in [None, *settings["variants"]]:
-            table = settings["optimizer"] if v is None else variant_optimizer(settings["optimizer"], v.get("optimizer"))
-            try:  # the optimizer settings are checked here, not when a unit first runs
-                name, rest = optimiser_of(table)
-                if name != "ne" and settings["budget"] == 0 and not OPTIMISERS[name].stops_itself:
-                    raise NeurohoverError(f"optimizer {name!r} has no stopping rule of its own: give the experiment a budget")
-                make_settings(method, name, rest)
-            except NeurohoverError as err:
-                whose = "" if v is None else f" of variant {v['key']!r}"
-                raise NeurohoverError(f"{where}: optimizer{whose}: {err}") from None
-        unpaired = [v["key"] for v in settings["variants"] if "paired_with" in v]
-        if unpaired and "seeds_of" not in settings:
-            raise NeurohoverError(f"{where}: variant(s) {', '.join(unpaired)} set paired_with: give the experiment's seeds_of too")
-        bad = [k for k in settings["robustness_variants"] if k not in keys]
-        if bad:
-            raise NeurohoverError(f"{where}: robustness_variants {bad} are not variant keys ({', '.join(keys)})")
-        if settings["robustness_variants"] and settings["target"] != "train":
-            raise NeurohoverError(f"{where}: robustness_variants need target = 'train'")
-        if "champion_reevaluation" in settings and settings["target"] != "family":
-            raise NeurohoverError(f"{where}: champion_reevaluation chooses among a generational run's parents: it needs target = 'family'")
-        if settings.get("validation_mdps") == "test" and settings["target"] != "family":
-            raise NeurohoverError(f"{where}: validation_mdps = 'test' flies champions evolved over G on the family's test MDPs: it needs target = 'family'")
-        if settings["target"] == "train" and settings["n_mdps"] > 10:
-            raise NeurohoverError(f"{where}: n_mdps = {settings['n_mdps']} is out of range: there are 10 training MDPs")
-    if kind == "model_learning" and "conditions" in settings:
+
+def _check_evolution(settings: dict, task: str, where: str) -> None:
+    """Variants, their optimisers (checked now, not when a unit first runs), robustness and validation targets."""
+    keys = [v["key"] for v in settings["variants"]]
+    if len(set(keys)) != len(keys):
+        raise NeurohoverError(f"{where}: variant keys must be unique, got {keys}")
+    for v in settings["variants"]:
+        if v["sigma"] is not None and not TASK_FAMILIES[task].has_sigma:
+            raise NeurohoverError(f"{where}: variant {v['key']!r} sets sigma but the task is {task!r}")
+        if settings["target"] != "family" and parse_resampling(v["resampling"]).selects:
+            raise NeurohoverError(f"{where}: variant {v['key']!r}: selection races and bandits need target = 'family'")
+
+    method = "generational" if settings["target"] == "family" else "steady-state"
+    for v in [None, *settings["variants"]]:
+        table = settings["optimizer"] if v is None else variant_optimizer(settings["optimizer"], v.get("optimizer"))
+        try:  # the optimizer settings are checked here, not when a unit first runs
+            name, rest = optimiser_of(table)
+            if name != "ne" and settings["budget"] == 0 and not OPTIMISERS[name].stops_itself:
+                raise NeurohoverError(f"optimizer {name!r} has no stopping rule of its own: give the experiment a budget")
+            make_settings(method, name, rest)
+        except NeurohoverError as err:
+            whose = "" if v is None else f" of variant {v['key']!r}"
+            raise NeurohoverError(f"{where}: optimizer{whose}: {err}") from None
+    unpaired = [v["key"] for v in settings["variants"] if "paired_with" in v]
+    if unpaired and "seeds_of" not in settings:
+        raise NeurohoverError(f"{where}: variant(s) {', '.join(unpaired)} set paired_with: give the experiment's seeds_of too")
+    bad = [k for k in settings["robustness_variants"] if k not in keys]
+    if bad:
+        raise NeurohoverError(f"{where}: robustness_variants {bad} are not variant keys ({', '.join(keys)})")
+    if settings["robustness_variants"] and settings["target"] != "train":
+        raise NeurohoverError(f"{where}: robustness_variants need target = 'train'")
+    if "champion_reevaluation" in settings and settings["target"] != "family":
+        raise NeurohoverError(f"{where}: champion_reevaluation chooses among a generational run's parents: it needs target = 'family'")
+    if settings.get("validation_mdps") == "test" and settings["target"] != "family":
+        raise NeurohoverError(f"{where}: validation_mdps = 'test' flies champions evolved over G on the family's test MDPs: it needs target = 'family'")
+    if settings["target"] == "train" and settings["n_mdps"] > 10:
+        raise NeurohoverError(f"{where}: n_mdps = {settings['n_mdps']} is out of range: there are 10 training MDPs")
+
+
+def _check_model_learning(settings: dict, task: str, where: str) -> None:
+    """Conditions or fits, and the LR methods' noise estimate and substeps (written in: part of the hash)."""
+    if "conditions" in settings:
         _keyed(settings["conditions"], "condition", where)
         if "sensor" in settings:
             raise NeurohoverError(f"{where}: sensor is set by each of the conditions here: leave [settings] sensor out")
-    if kind == "model_learning":
-        lr_methods = set(settings["methods"]) & {"lr", "lr-gls"}
-        for key in ("noise", "model_substeps"):
-            if key in settings and (not lr_methods or "fits" in settings):
-                why = "each of the fits gives its own" if lr_methods else f"methods {settings['methods']} learn no LR model"
-                raise NeurohoverError(f"{where}: {key} = {settings[key]!r} applies to the LR methods without fits, not here: {why}")
-        if lr_methods and "fits" not in settings:  # the estimate and the substeps are part of the config (and its hash)
-            settings["noise"] = settings.get("noise", DEFAULT_NOISE_ESTIMATE)
-            settings["model_substeps"] = settings.get("model_substeps", default_model_substeps(task))
-        for f in settings.get("fits", []):
-            f["model_substeps"] = f.get("model_substeps", default_model_substeps(task))
-    if kind == "model_learning" and "fits" in settings:
+    lr_methods = set(settings["methods"]) & {"lr", "lr-gls"}
+    for key in ("noise", "model_substeps"):
+        if key in settings and (not lr_methods or "fits" in settings):
+            why = "each of the fits gives its own" if lr_methods else f"methods {settings['methods']} learn no LR model"
+            raise NeurohoverError(f"{where}: {key} = {settings[key]!r} applies to the LR methods without fits, not here: {why}")
+    if lr_methods and "fits" not in settings:  # the estimate and the substeps are part of the config (and its hash)
+        settings["noise"] = settings.get("noise", DEFAULT_NOISE_ESTIMATE)
+        settings["model_substeps"] = settings.get("model_substeps", default_model_substeps(task))
+    for f in settings.get("fits", []):
+        f["model_substeps"] = f.get("model_substeps", default_model_substeps(task))
+    if "fits" in settings:
         _keyed(settings["fits"], "fit", where)
         if "conditions" in settings:
             raise NeurohoverError(f"{where}: fits and conditions cannot be combined: give one of them")
         if not set(settings["methods"]) <= {"lr", "lr-gls"}:
             raise NeurohoverError(f"{where}: fits apply to the LR methods only (lr, lr-gls), not to {sorted(set(settings['methods']) - {'lr', 'lr-gls'})}")
-    if kind in ("model_learning", "test_runs"):
-        groups = settings.get("groups", [{"mdps": settings.get("mdps"), "n_mdps": settings.get("n_mdps")}])
-        for g in groups:
-            limit = {"train": 10, "test": 100}.get(g["mdps"])
-            if limit is not None and g["n_mdps"] > limit:
-                raise NeurohoverError(f"{where}: n_mdps = {g['n_mdps']} is out of range for mdps = {g['mdps']!r} (at most {limit})")
-    if kind == "test_runs":
-        labels = [g["label"] or g["agent"] for g in settings["groups"]]
-        if len(set(labels)) != len(labels):
-            raise NeurohoverError(f"{where}: group labels must be unique (set label = ... on repeated agents), got {labels}")
-        for g in settings["groups"]:
-            if task not in AGENTS[g["agent"]].tasks:
-                raise NeurohoverError(f"{where}: agent {g['agent']!r} does not apply to task {task!r}")
-            g["label"] = g["label"] or g["agent"]
-            lr_keys = [k for k in ("d_u", "noise", "model_policy", "model_substeps") if k in g]
-            if lr_keys and not AGENTS[g["agent"]].learns_models:
-                learners = ", ".join(name for name, spec in AGENTS.items() if spec.learns_models)
-                raise NeurohoverError(
-                    f"{where}: group {g['label']!r}: {', '.join(lr_keys)} apply to the agents that learn models ({learners}), not to {g['agent']!r}"
-                )
-            if AGENTS[g["agent"]].learns_models:  # the estimate and the substeps are part of the config (and its hash)
-                g["noise"] = g.get("noise", DEFAULT_NOISE_ESTIMATE)
-                g["model_substeps"] = g.get("model_substeps", default_model_substeps(task))
-            if "settings" in g and g["agent"] in HYBRID_AGENTS:  # one spelling for every agent's own settings
-                if g["hybrid"]:
-                    raise NeurohoverError(f"{where}: group {g['label']!r}: give the hybrid settings once, as settings (hybrid is its older name), not both")
-                g["hybrid"] = g.pop("settings")  # kept under `hybrid`: configs written before keep their hash
+
+
+def _check_mdp_counts(settings: dict, where: str) -> None:
+    """A group's (or the experiment's) MDP count within the family's training or test set."""
+    groups = settings.get("groups", [{"mdps": settings.get("mdps"), "n_mdps": settings.get("n_mdps")}])
+    for g in groups:
+        limit = {"train": 10, "test": 100}.get(g["mdps"])
+        if limit is not None and g["n_mdps"] > limit:
+            raise NeurohoverError(f"{where}: n_mdps = {g['n_mdps']} is out of range for mdps = {g['mdps']!r} (at most {limit})")
+
+
+def _check_test_runs(settings: dict, task: str, where: str) -> None:
+    """Groups (agents for the task, their LR and own settings, written in where defaulted) and the generics' sources."""
+    labels = [g["label"] or g["agent"] for g in settings["groups"]]
+    if len(set(labels)) != len(labels):
+        raise NeurohoverError(f"{where}: group labels must be unique (set label = ... on repeated agents), got {labels}")
+    for g in settings["groups"]:
+        if task not in AGENTS[g["agent"]].tasks:
+            raise NeurohoverError(f"{where}: agent {g['agent']!r} does not apply to task {task!r}")
+        g["label"] = g["label"] or g["agent"]
+        lr_keys = [k for k in ("d_u", "noise", "model_policy", "model_substeps") if k in g]
+        if lr_keys and not AGENTS[g["agent"]].learns_models:
+            learners = ", ".join(name for name, spec in AGENTS.items() if spec.learns_models)
+            raise NeurohoverError(
+                f"{where}: group {g['label']!r}: {', '.join(lr_keys)} apply to the agents that learn models ({learners}), not to {g['agent']!r}"
+            )
+        if AGENTS[g["agent"]].learns_models:  # the estimate and the substeps are part of the config (and its hash)
+            g["noise"] = g.get("noise", DEFAULT_NOISE_ESTIMATE)
+            g["model_substeps"] = g.get("model_substeps", default_model_substeps(task))
+        if "settings" in g and g["agent"] in HYBRID_AGENTS:  # one spelling for every agent's own settings
             if g["hybrid"]:
-                if g["agent"] not in HYBRID_AGENTS:
-                    raise NeurohoverError(
-                        f"{where}: group {g['label']!r}: hybrid settings apply to the agents {', '.join(HYBRID_AGENTS)} only, not to {g['agent']!r}"
-                    )
-                try:
-                    g["hybrid"] = HybridSettings.from_dict(g["hybrid"]).to_dict()
-                except NeurohoverError as e:
-                    raise NeurohoverError(f"{where}: group {g['label']!r}: {e}") from None
-            if "settings" in g:  # checked here, not when a unit first runs
-                own = AGENTS[g["agent"]].settings
-                if own is None or own.UNIT_KEY != "agent_settings":
-                    raise NeurohoverError(f"{where}: group {g['label']!r}: agent {g['agent']!r} takes no settings table")
-                try:
-                    g["settings"] = own.from_dict(g["settings"]).to_dict()
-                except NeurohoverError as e:
-                    raise NeurohoverError(f"{where}: group {g['label']!r}: {e}") from None
-        for kind, source in settings.get("generics_from", {}).items():
-            name, _, variant = str(source).partition("/")
-            if str(source).startswith(DIR_SOURCE) and len(str(source)) > len(DIR_SOURCE):
-                name = variant = "dir"  # a directory of policy files (checked when the config's digest reads them)
-            if kind not in ("fixed", "race") or not isinstance(source, str) or not name or not variant:
+                raise NeurohoverError(f"{where}: group {g['label']!r}: give the hybrid settings once, as settings (hybrid is its older name), not both")
+            g["hybrid"] = g.pop("settings")  # kept under `hybrid`: configs written before keep their hash
+        if g["hybrid"]:
+            if g["agent"] not in HYBRID_AGENTS:
                 raise NeurohoverError(
-                    f"{where}: generics_from = {{ {kind} = {source!r} }} is not allowed: expected keys fixed and/or race holding "
-                    "'EXPERIMENT/VARIANT', 'EXPERIMENT/best-race' (e.g. fixed = 'fig13/k5') or 'dir:PATH' (a directory of policy files)"
+                    f"{where}: group {g['label']!r}: hybrid settings apply to the agents {', '.join(HYBRID_AGENTS)} only, not to {g['agent']!r}"
                 )
-        if "generic_topology" in settings and (settings["policies"] != "evolve" or not TASK_FAMILIES[task].generic_over_distribution):
-            raise NeurohoverError(f"{where}: generic_topology applies to the FGHH generics an experiment evolves itself (policies = 'evolve', task fghh)")
-        gr = settings["generic_resampling"]
-        if set(gr) - {"fixed", "race"} or not all(_resampling()(v)[0] for v in gr.values()):
-            raise NeurohoverError(f"{where}: generic_resampling must be a table with keys fixed and/or race holding fixed:K / race:DELTA")
+            try:
+                g["hybrid"] = HybridSettings.from_dict(g["hybrid"]).to_dict()
+            except NeurohoverError as e:
+                raise NeurohoverError(f"{where}: group {g['label']!r}: {e}") from None
+        if "settings" in g:  # checked here, not when a unit first runs
+            own = AGENTS[g["agent"]].settings
+            if own is None or own.UNIT_KEY != "agent_settings":
+                raise NeurohoverError(f"{where}: group {g['label']!r}: agent {g['agent']!r} takes no settings table")
+            try:
+                g["settings"] = own.from_dict(g["settings"]).to_dict()
+            except NeurohoverError as e:
+                raise NeurohoverError(f"{where}: group {g['label']!r}: {e}") from None
+    for kind, source in settings.get("generics_from", {}).items():
+        name, _, variant = str(source).partition("/")
+        if str(source).startswith(DIR_SOURCE) and len(str(source)) > len(DIR_SOURCE):
+            name = variant = "dir"  # a directory of policy files (checked when the config's digest reads them)
+        if kind not in ("fixed", "race") or not isinstance(source, str) or not name or not variant:
+            raise NeurohoverError(
+                f"{where}: generics_from = {{ {kind} = {source!r} }} is not allowed: expected keys fixed and/or race holding "
+                "'EXPERIMENT/VARIANT', 'EXPERIMENT/best-race' (e.g. fixed = 'fig13/k5') or 'dir:PATH' (a directory of policy files)"
+            )
+    if "generic_topology" in settings and (settings["policies"] != "evolve" or not TASK_FAMILIES[task].generic_over_distribution):
+        raise NeurohoverError(f"{where}: generic_topology applies to the FGHH generics an experiment evolves itself (policies = 'evolve', task fghh)")
+    gr = settings["generic_resampling"]
+    if set(gr) - {"fixed", "race"} or not all(_resampling()(v)[0] for v in gr.values()):
+        raise NeurohoverError(f"{where}: generic_resampling must be a table with keys fixed and/or race holding fixed:K / race:DELTA")
 
 
 def _keyed(items: list[dict], what: str, where: str) -> None:
