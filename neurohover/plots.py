@@ -8,7 +8,7 @@
 Every figure is a :class:`matplotlib.figure.Figure` on its own
 :class:`~matplotlib.backends.backend_agg.FigureCanvasAgg`: nothing here touches pyplot or the
 process's matplotlib backend, so plotting is safe in any program (and thread) that uses matplotlib
-otherwise. ``neurohover plot`` (:mod:`neurohover.commands_plots`) calls :func:`plot_flight_data`
+otherwise. ``neurohover plot`` (:mod:`neurohover.cli.plots`) calls :func:`plot_flight_data`
 and :func:`plot_compete`.
 
 Example

@@ -319,7 +319,7 @@ def test_evolve_command_over_the_family_with_races(cli, tmp_path: Path) -> None:
 
 
 def test_evolve_command_ctrl_c_saves_the_checkpoint(cli, tmp_path: Path, monkeypatch) -> None:
-    from neurohover import commands_learning
+    from neurohover.cli import learning as commands_learning
 
     def interrupt(self, info) -> None:
         raise KeyboardInterrupt

@@ -22,7 +22,7 @@ LAYERS = [
     {"agents"},
     {"experiments"},
     {"compete"},
-    {"cli", "commands_agents", "commands_evaluate", "commands_learning", "commands_plots", "commands_reproduce", "bench", "bench_gpu", "__main__", "__init__"},
+    {"cli", "bench", "bench_gpu", "__main__", "__init__"},
 ]
 RANK = {name: i for i, layer in enumerate(LAYERS) for name in layer}
 ENTRY_POINTS = {"neurohover/experiments/__main__.py"}  # `python -m neurohover.experiments` is the command line
@@ -61,3 +61,21 @@ def test_no_import_runs_back_up() -> None:
             if RANK[target] > RANK[own]:
                 upward.append(f"{path.relative_to(PACKAGE.parent)}:{line} ({own}) imports {target}")
     assert not upward, "\n".join(upward)
+
+
+def test_the_command_line_package_has_no_import_cycle() -> None:
+    """neurohover.cli: main imports the command modules, they import the shared options, and nothing imports back."""
+    cli = PACKAGE / "cli"
+    within: dict[str, set[str]] = {}
+    for path in cli.glob("*.py"):
+        names = set()
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.level == 1:
+                names |= {node.module} if node.module else {a.name for a in node.names}
+        within[path.stem] = names
+    assert within["options"] == set()  # the shared options import no command
+    commands = set(within) - {"__init__", "main", "options"}
+    assert commands == {"flying", "learning", "agents", "evaluate", "reproduce", "plots"}
+    for name in commands:
+        assert within[name] <= {"options"}, f"cli/{name}.py imports {within[name] - {'options'}}"
+    assert within["main"] == commands

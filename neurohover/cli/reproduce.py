@@ -13,17 +13,17 @@ import argparse
 import json
 import sys
 
-from .errors import NeurohoverError
-from .evaluate import DEVICES, check_device
+from ..errors import NeurohoverError
+from ..evaluate import DEVICES, check_device
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
     """Run a paper experiment (or all of them); every finished unit goes to the results store at once."""
-    from .experiments import Store, load_configs, make_executor, parse_override, reproduce
-    from .experiments.config import experiment_names
-    from .experiments.plans import source_experiments
-    from .experiments.runner import check_restart
-    from .paths import output_file
+    from ..experiments import Store, load_configs, make_executor, parse_override, reproduce
+    from ..experiments.config import experiment_names
+    from ..experiments.plans import source_experiments
+    from ..experiments.runner import check_restart
+    from ..paths import output_file
 
     if args.list:
         for name in experiment_names():
@@ -83,8 +83,8 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
 
 def cmd_results(args: argparse.Namespace) -> int:
     """Export an experiment's finished units from the results store as CSV or JSON."""
-    from .experiments import Store, export_results
-    from .paths import input_file, output_file, writing
+    from ..experiments import Store, export_results
+    from ..paths import input_file, output_file, writing
 
     input_file(args.store, "--store", "results store")
     out = None if args.out is None else output_file(args.out, "--out")
@@ -114,10 +114,10 @@ def cmd_wins(args: argparse.Namespace) -> int:
     experiment's stored test runs (neurohover.experiments.wins: the bootstrap over the MDPs every agent
     flew, one stored run per agent and MDP, ties sharing the win), so the agent or risk level to enter
     can be chosen for N. With --against LABEL, each agent against that one alone."""
-    from .experiments import Store
-    from .experiments.export import resolve_scale
-    from .experiments.wins import stored_runs, win_probabilities
-    from .paths import input_file
+    from ..experiments import Store
+    from ..experiments.export import resolve_scale
+    from ..experiments.wins import stored_runs, win_probabilities
+    from ..paths import input_file
 
     input_file(args.store, "--store", "results store")
     lengths = _positive_ints(args.runs, "--runs")
@@ -155,8 +155,8 @@ def cmd_wins(args: argparse.Namespace) -> int:
 
 def cmd_report(args: argparse.Namespace) -> int:
     """Draw the paper's figures from the results store and write a Markdown report beside the paper's numbers."""
-    from .experiments import Store, write_report
-    from .paths import input_file, output_dir
+    from ..experiments import Store, write_report
+    from ..paths import input_file, output_dir
 
     input_file(args.store, "--store", "results store")
     output_dir(args.out, "--out")
@@ -168,7 +168,7 @@ def cmd_report(args: argparse.Namespace) -> int:
 
 def register(sub) -> None:
     p = sub.add_parser("reproduce", help="run a paper experiment into a results store", description=cmd_reproduce.__doc__)
-    from .experiments.config import experiment_names
+    from ..experiments.config import experiment_names
 
     p.add_argument("name", nargs="?", help=f"experiment ({', '.join(experiment_names())}), 'all', or a .toml config")
     p.add_argument("--scale", choices=("quick", "paper"), default="quick", help="quick (minutes; the default) or paper (the paper's protocol)")

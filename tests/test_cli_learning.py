@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from neurohover.cli import main
-from neurohover.commands_learning import RELIABLE_TRANSITIONS, model_notes
+from neurohover.cli.learning import RELIABLE_TRANSITIONS, model_notes
 from neurohover.evaluate import evaluate
 from neurohover.models import LearnedModel, one_substep_params, parameter_table
 from neurohover.policies import baseline_policy

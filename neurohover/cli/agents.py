@@ -5,15 +5,15 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .errors import NeurohoverError
-from .evaluate import DEVICES, check_device
+from ..errors import NeurohoverError
+from ..evaluate import DEVICES, check_device
 
 
 def cmd_build_policies(args: argparse.Namespace) -> int:
     """Evolve a task family's generic and specialised policies (the agents' policy set)."""
-    from .paths import output_dir
-    from .policysets import LINEAGES, build_policy_set
-    from .tasks import get_task_family
+    from ..paths import output_dir
+    from ..policysets import LINEAGES, build_policy_set
+    from ..tasks import get_task_family
 
     if args.budget < 1:
         raise NeurohoverError(f"--budget {args.budget} is out of range: allowed >= 1")
@@ -42,13 +42,13 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
 
 def cmd_compete(args: argparse.Namespace) -> int:
     """Run R independent test runs of an agent; print a summary and write results and a plot."""
-    from .agents.hybrid import HybridSettings
-    from .agents.registry import AGENTS, HYBRID_AGENTS
-    from .cli import sensor_of
-    from .compete import check_sizes, compete
-    from .experiments.executors import check_jobs
-    from .paths import input_dir, output_dir, output_file
-    from .tasks import Drift
+    from ..agents.hybrid import HybridSettings
+    from ..agents.registry import AGENTS, HYBRID_AGENTS
+    from ..compete import check_sizes, compete
+    from ..experiments.executors import check_jobs
+    from ..paths import input_dir, output_dir, output_file
+    from ..tasks import Drift
+    from .options import sensor_of
 
     given = [f"--{k.replace('_', '-')}" for k in _HYBRID_OPTIONS if getattr(args, k) is not None]
     if given and args.agent not in HYBRID_AGENTS:
@@ -82,8 +82,8 @@ def cmd_compete(args: argparse.Namespace) -> int:
     sensor = sensor_of(args)
     agent_settings = None
     if args.agent_setting:
-        from .compete import check_agent_settings
-        from .experiments.config import parse_override
+        from ..compete import check_agent_settings
+        from ..experiments.config import parse_override
 
         agent_settings = check_agent_settings(args.agent, dict(parse_override(text) for text in args.agent_setting))
     try:
@@ -132,13 +132,13 @@ _HYBRID_OPTIONS = ("safeguard_rule", "safeguard_box", "safeguard_tilt", "hybrid_
 
 
 def register(sub) -> None:
-    from .agents.model_based import MODEL_POLICIES
-    from .agents.registry import AGENTS
-    from .cli import add_lr_fit_options, add_sensor_options
-    from .evolution.optimisers import optimiser_names
+    from ..agents.model_based import MODEL_POLICIES
+    from ..agents.registry import AGENTS
+    from ..evolution.optimisers import optimiser_names
+    from .options import add_lr_fit_options, add_sensor_options, add_sigma_option, add_task_option
 
     p = sub.add_parser("build-policies", help="evolve the generic and specialised policies of a task", description=cmd_build_policies.__doc__)
-    p.add_argument("--task", required=True, help="ghh08, ghh09 or fghh")
+    add_task_option(p)
     p.add_argument("--out", help="directory to write <task>/ into (default: the package's shipped policies)")
     p.add_argument("--budget", type=int, default=40000, help="episodes per steady-state evolution (default 40000)")
     p.add_argument("--fghh-budget", type=int, help="fghh only: episodes per generic-policy evolution over G (default 200000)")
@@ -158,12 +158,12 @@ def register(sub) -> None:
     p.set_defaults(func=cmd_build_policies)
 
     p = sub.add_parser("compete", help="run test runs of an on-line agent", description=cmd_compete.__doc__)
-    p.add_argument("--task", required=True, help="ghh08, ghh09 or fghh")
+    add_task_option(p)
     p.add_argument("--agent", required=True, help="; ".join(f"{name} ({', '.join(spec.tasks)}): {spec.summary}" for name, spec in AGENTS.items()))
     p.add_argument("--runs", type=int, default=10, help="independent test runs (default 10)")
     p.add_argument("--episodes", type=int, default=1000, help="episodes per run (default 1000)")
     p.add_argument("--mdps", default="test", help="test (the fixed test MDPs in turn), sample (fresh from G) or train")
-    p.add_argument("--sigma", type=float, help="FGHH breadth (default 0.3)")
+    add_sigma_option(p)
     add_sensor_options(p)
     p.add_argument(
         "--drift",

@@ -12,7 +12,8 @@ import importlib
 import json
 import sys
 
-from .errors import NeurohoverError
+from ..errors import NeurohoverError
+from .options import add_sigma_option, add_task_option
 
 SOURCES = ("policy", "callable", "rl_zoo", "sb3")
 ALGOS = ("ppo", "sac", "td3", "a2c")
@@ -26,8 +27,8 @@ def _agent(args: argparse.Namespace):
         named = ", ".join("--" + s.replace("_", "-") for s in given) or "none"
         raise NeurohoverError(f"give exactly one of --policy, --callable, --rl-zoo, --sb3 (the agent to fly); got {named}")
     if args.policy is not None:
-        from .paths import input_file
-        from .policies import load_policy
+        from ..paths import input_file
+        from ..policies import load_policy
 
         return load_policy(input_file(args.policy, "--policy", "policy file"))
     if args.callable is not None:
@@ -42,10 +43,10 @@ def _agent(args: argparse.Namespace):
             raise NeurohoverError(f"--callable {args.callable!r} is not a function")
         return fn
     if args.rl_zoo is not None:
-        from .integrations.sb3 import rl_zoo_policy
+        from ..integrations.sb3 import rl_zoo_policy
 
         return rl_zoo_policy(args.rl_zoo, algo=args.algo)
-    from .integrations.sb3 import sb3_policy
+    from ..integrations.sb3 import sb3_policy
 
     return sb3_policy(args.sb3, algo=args.algo)
 
@@ -53,9 +54,9 @@ def _agent(args: argparse.Namespace):
 def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     """Fly a trained policy on full paper episodes of a task's training or test MDPs, beside the competition's baseline
     and the shipped generic policy on the same gusts, and print the paper's measures (return per episode, crashes)."""
-    from .integrations.flying import compare_agent
-    from .paths import output_file, writing
-    from .tasks import get_task_family
+    from ..integrations.flying import compare_agent
+    from ..paths import output_file, writing
+    from ..tasks import get_task_family
 
     family = get_task_family(args.task, args.sigma)
     available = len(family.training_mdps() if args.mdps == "train" else family.test_mdps())
@@ -87,8 +88,8 @@ def register(sub) -> None:
         help="fly a trained policy as the paper measured its agents, beside the baseline and the generic",
         description=cmd_evaluate_agent.__doc__,
     )
-    p.add_argument("--task", required=True, help="ghh08, ghh09 or fghh")
-    p.add_argument("--sigma", type=float, help="FGHH breadth (default 0.3)")
+    add_task_option(p)
+    add_sigma_option(p)
     g = p.add_argument_group("the agent (exactly one)")
     g.add_argument("--policy", help="a neurohover policy file (.json or the competition's .net)")
     g.add_argument("--callable", help="MODULE:FUNCTION mapping a batch of observations (B, 12) to actions (B, 4)")

@@ -28,17 +28,17 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError
-from .evaluate import DEVICES, check_device, check_episode_count
-from .evolution.generational import GENERATIONAL_PRESETS
-from .evolution.optimisers import OPTIMISERS, optimiser_names
+from ..errors import NeurohoverError
+from ..evaluate import DEVICES, check_device, check_episode_count
+from ..evolution.generational import GENERATIONAL_PRESETS
+from ..evolution.optimisers import OPTIMISERS, optimiser_names
 
 MDP_FAMILY = "G"
 
 
 def _target(args: argparse.Namespace):
     """(target, family, mdp description for the metadata)."""
-    from .cli import explicit_mdp, task_family_of
+    from .options import explicit_mdp, task_family_of
 
     family = task_family_of(args)
     explicit = explicit_mdp(args, family)
@@ -54,7 +54,7 @@ def _target(args: argparse.Namespace):
 
 
 def _seed_policy(args: argparse.Namespace):
-    from .policies import load_policy
+    from ..policies import load_policy
 
     if args.seed_policy in ("zero", "baseline"):
         return args.topology, args.seed_policy  # None: evolve's default (SLP over a family, MLP on one MDP)
@@ -69,7 +69,7 @@ def _seed_policy(args: argparse.Namespace):
 
 def _optimiser_settings(args: argparse.Namespace, over_family: bool) -> dict | None:
     """The optimiser settings of ``evolve`` from --plateau-rule, --preset and --setting (None: the defaults)."""
-    from .experiments.config import parse_override
+    from ..experiments.config import parse_override
 
     settings: dict = {}
     if args.plateau_rule is not None:
@@ -106,9 +106,9 @@ class _Bar:
 
 def cmd_evolve(args: argparse.Namespace) -> int:
     """Evolve a policy: steady state on one MDP, or generational over the task family's MDPs (--mdp G)."""
-    from .evolution.evolve import EvolutionInterrupted, evolve, parse_resampling, validation_return, write_history_csv
-    from .paths import output_file, writing
-    from .policies import save_policy
+    from ..evolution.evolve import EvolutionInterrupted, evolve, parse_resampling, validation_return, write_history_csv
+    from ..paths import output_file, writing
+    from ..policies import save_policy
 
     if args.budget is not None and args.budget < 1:
         raise NeurohoverError(f"--budget {args.budget} is out of range: allowed an integer >= 1 (episodes)")
@@ -253,7 +253,7 @@ class _Ticker:
 
 def _true_mdp(metadata: dict):
     """The MDP the flight data was flown on, when its metadata names exactly one."""
-    from .tasks import MDP
+    from ..tasks import MDP
 
     mdps = metadata.get("mdps")
     if not isinstance(mdps, list) or not mdps:
@@ -269,10 +269,10 @@ def _true_mdp(metadata: dict):
 
 def cmd_learn_model(args: argparse.Namespace) -> int:
     """Learn a helicopter model from flight data (LR, EC-MENO or EC-MER) and print its parameters."""
-    from .flightdata import FlightData
-    from .models import DEFAULT_NOISE_ESTIMATE, format_parameter_table, learn_ec_meno, learn_ec_mer, learn_lr, parameter_table
-    from .paths import input_file, output_file, writing
-    from .policies import load_policy
+    from ..flightdata import FlightData
+    from ..models import DEFAULT_NOISE_ESTIMATE, format_parameter_table, learn_ec_meno, learn_ec_mer, learn_lr, parameter_table
+    from ..paths import input_file, output_file, writing
+    from ..policies import load_policy
 
     if args.budget is not None and args.budget < 1:
         raise NeurohoverError(f"--budget {args.budget} is out of range: allowed an integer >= 1 (evaluations)")
@@ -343,11 +343,11 @@ def model_notes(model, data, truth, rows) -> list[str]:
     """
     import numpy as np
 
-    from .evaluate import evaluate
-    from .models import PARAM_NAMES
-    from .models.wind import effective_wind, sinusoid_axes
-    from .policies import baseline_policy
-    from .sim.constants import WIND_NONE, WIND_SINUSOID
+    from ..evaluate import evaluate
+    from ..models import PARAM_NAMES
+    from ..models.wind import effective_wind, sinusoid_axes
+    from ..policies import baseline_policy
+    from ..sim.constants import WIND_NONE, WIND_SINUSOID
 
     notes = []
     nan_axes = [r.name for r in rows if not np.isfinite(r.learned)]
@@ -392,7 +392,7 @@ def model_notes(model, data, truth, rows) -> list[str]:
 
 
 def register(sub) -> None:
-    from .cli import add_lr_fit_options, add_sensor_options
+    from .options import add_lr_fit_options, add_task_options
 
     p = sub.add_parser(
         "evolve",
@@ -400,16 +400,12 @@ def register(sub) -> None:
         description=(cmd_evolve.__doc__ or "") + "\n\n" + (__doc__ or "").split("\n\n", 1)[1],
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("--task", required=True, help="task family: ghh08, ghh09 or fghh")
-    p.add_argument(
-        "--mdp",
-        help="zero, train:N, test:N, seeded-train:N, seeded-test:N, sample (one MDP drawn from G with --seed), or G: evolve over "
+    add_task_options(
+        p,
+        mdp_help="zero, train:N, test:N, seeded-train:N, seeded-test:N, sample (one MDP drawn from G with --seed), or G: evolve over "
         "the family's distribution, a fresh MDP per episode (generational). Default: G for fghh, zero otherwise",
+        verb="evolve",
     )
-    p.add_argument("--wind", help="GHH-08 only: evolve on the constant wind U,V (m/s, each in [-5, 5])")
-    p.add_argument("--params", help="evolve on explicit MDP parameters, comma-separated (GHH-08 2, GHH-09 8, FGHH 11)")
-    p.add_argument("--sigma", type=float, help="FGHH breadth sigma (default 0.3)")
-    add_sensor_options(p)
     p.add_argument("--topology", choices=("slp", "mlp"), help="network (default: the seed policy file's, else slp over a family (--mdp G) and mlp on one MDP)")
     p.add_argument("--seed-policy", default="baseline", help="prototype: zero, baseline (baseline-equivalent network; default) or a policy FILE")
     p.add_argument(

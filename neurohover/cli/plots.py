@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import argparse
 
-from .errors import NeurohoverError
+from ..errors import NeurohoverError
 
 COMPETE_PNG = "compete.png"
 
@@ -41,24 +41,24 @@ def _episodes(text: str | None, n: int) -> list[int] | None:
 
 def cmd_plot(args: argparse.Namespace) -> int:
     """Plot a recorded flight (one PNG per episode) or overlay competition results (one PNG)."""
-    from .paths import input_dir, input_file, output_dir
+    from ..paths import input_dir, input_file, output_dir
 
     if args.flight is not None and args.compete:
         raise NeurohoverError("give either a flight-data file or --compete DIR ..., not both")
     if args.flight is None and not args.compete:
         raise NeurohoverError("nothing to plot: give a flight-data file (neurohover fly --record) or --compete DIR ...")
     if args.flight is not None:
-        from .flightdata import FlightData
+        from ..flightdata import FlightData
 
         path = input_file(args.flight, "FLIGHT", "flight-data file")
         data = FlightData.load(path)  # refuses anything but flight data, with the reason
         out = output_dir(args.out if args.out is not None else path.parent, "--out")
-        from .plots import plot_flight_data
+        from ..plots import plot_flight_data
 
         written = plot_flight_data(data, out, stem=path.stem, episodes=_episodes(args.episodes, data.n_episodes))
     else:
         dirs = [input_dir(d, "--compete") for d in args.compete]
-        from .plots import compete_figure, read_compete_dir, save_figure
+        from ..plots import compete_figure, read_compete_dir, save_figure
 
         results = [read_compete_dir(d) for d in dirs]  # every directory read before anything is written
         out = output_dir(args.out if args.out is not None else dirs[0].resolve().parent, "--out")

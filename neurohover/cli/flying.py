@@ -1,0 +1,171 @@
+"""``neurohover fly``, ``demo`` and ``bench``: fly policies on MDPs and print what they return."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+import numpy as np
+
+from ..errors import NeurohoverError
+from ..sim.constants import EPISODE_STEPS
+from .options import add_task_options, family_and_mdps, max_in_memory
+
+# Episodes per kernel call of a progress-reporting fly: large enough to keep every core busy.
+FLY_CHUNK = 256
+# What one episode of ``fly`` holds in memory (its MDP's slot, index, return, crash flag and list
+# entries; a sampled MDP's object; a recorded episode's 12 + 4 float64 a step), for the cap below.
+_FLY_BYTES_PER_EPISODE = 64
+_SAMPLED_MDP_BYTES = 2000
+_RECORD_BYTES_PER_STEP = 16 * 8
+
+
+def _fly(policy, mdps: list, args: argparse.Namespace, show_progress: bool):
+    """Fly ``policy`` once on each of ``mdps`` (episode i on mdps[i]); chunked under a progress bar."""
+    from tqdm import tqdm
+
+    from ..evaluate import evaluate_jobs
+
+    unique = list(dict.fromkeys(mdps))
+    mdp_index = np.array([unique.index(m) for m in mdps])
+    n = len(mdps)
+    returns, crashed, seconds, flight = [], [], 0.0, None
+    # Every episode's gusts come from (seed, episode index), so chunking changes no result.
+    with tqdm(
+        total=n,
+        desc=f"fly {mdps[0].label if len(unique) == 1 else 'MDPs'}",
+        unit="ep",
+        file=sys.stderr,
+        disable=None if show_progress else True,
+        dynamic_ncols=True,
+    ) as bar:
+        for start in range(0, n, FLY_CHUNK if show_progress else n):
+            idx = np.arange(start, min(n, start + (FLY_CHUNK if show_progress else n)))
+            ev = evaluate_jobs(
+                [policy],
+                unique,
+                np.zeros(idx.size, dtype=np.int64),
+                mdp_index[idx],
+                idx,
+                seed=args.seed,
+                record=np.full(idx.size, args.record is not None),
+                threads=args.threads,
+            )
+            returns.append(ev.returns)
+            crashed.append(ev.crashed)
+            seconds += ev.seconds
+            if ev.flight_data is not None:
+                flight = ev.flight_data if flight is None else flight + ev.flight_data
+            bar.update(idx.size)
+    return np.concatenate(returns), np.concatenate(crashed), seconds, flight, len(unique)
+
+
+def cmd_fly(args: argparse.Namespace) -> int:
+    """Fly a policy and print return statistics."""
+    from ..paths import output_file, writing
+    from ..policies import load_policy
+
+    if args.episodes < 1:
+        raise NeurohoverError(f"--episodes {args.episodes} is out of range: allowed >= 1")
+    per_episode = _FLY_BYTES_PER_EPISODE + (_SAMPLED_MDP_BYTES if args.mdp == "sample" else 0) + (_RECORD_BYTES_PER_STEP * EPISODE_STEPS if args.record else 0)
+    most = max_in_memory(per_episode)
+    if args.episodes > most:
+        raise NeurohoverError(
+            f"--episodes {args.episodes} is out of range: about {per_episode} bytes each, at most {most} fit in half this machine's free memory"
+        )
+    policy = load_policy(args.policy)
+    rng = np.random.default_rng(args.seed)
+    family, mdps = family_and_mdps(args, args.episodes, rng)
+    if args.record is not None:
+        output_file(args.record, "--record")
+    returns, crashed, seconds, fd, n_unique = _fly(policy, mdps, args, show_progress=not args.json)
+    if fd is not None:
+        fd.metadata.update(
+            {"task": family.name, "mdps": [m.to_dict() for m in mdps], "policy": str(args.policy), "seed": args.seed, "returns": returns.tolist()}
+        )
+        with writing(args.record, "--record") as path:
+            fd.save(path, dtype=args.record_dtype)
+    summary = {
+        "task": family.name,
+        **({} if family.sensor.exact else {"sensor": family.sensor.to_dict()}),
+        "mdp": mdps[0].label if n_unique == 1 else f"{n_unique} MDPs",
+        "policy": str(args.policy),
+        "episodes": args.episodes,
+        "mean_return": float(returns.mean()),
+        "std_return": float(returns.std()),
+        "min_return": float(returns.min()),
+        "max_return": float(returns.max()),
+        "crashes": int(crashed.sum()),
+        "episodes_per_second": args.episodes / seconds if seconds > 0 else float("inf"),
+    }
+    if args.record is not None:
+        summary["flight_data"] = str(args.record)
+    if args.json:
+        print(json.dumps(summary))
+    else:
+        for key, value in summary.items():
+            label = "flight data" if key == "flight_data" else key
+            print(f"{label:>20}: {value:.6g}" if isinstance(value, float) else f"{label:>20}: {value}")
+    return 0
+
+
+def cmd_demo(args: argparse.Namespace) -> int:
+    """Fly the baseline and the baseline-equivalent MLP on a few MDPs of each family; print a table."""
+    from ..evaluate import check_episode_count, evaluate
+    from ..policies import baseline_policy, prototype
+    from ..tasks import N_TRAINING, TASK_NAMES, get_task_family
+
+    if not 0 <= args.mdps <= N_TRAINING:
+        raise NeurohoverError(f"--mdps {args.mdps} is out of range: allowed 0..{N_TRAINING} (training MDPs per family, beside the zero setting)")
+    check_episode_count(2 * (args.mdps + 1) * max(args.episodes, 0), f"2 policies x {args.mdps + 1} MDPs x episodes={args.episodes}")  # before the table
+    policies = {"baseline": baseline_policy(), "mlp(baseline seed)": prototype("mlp", "baseline")}
+    print(f"{'task':<6} {'mdp':<16} {'policy':<20} {'mean return':>12} {'sd':>10} {'crashes':>8}")
+    for name in TASK_NAMES:
+        family = get_task_family(name)
+        mdps = [family.zero()] + family.training_mdps()[: args.mdps]
+        ev = evaluate(list(policies.values()), mdps, episodes=args.episodes, seed=args.seed)
+        for i, label in enumerate(policies):
+            for m, mdp in enumerate(mdps):
+                r = ev.returns[i, m]
+                print(f"{name:<6} {mdp.label.split('/')[-1]:<16} {label:<20} {r.mean():>12.1f} {r.std():>10.1f} {int(ev.crashed[i, m].sum()):>8}")
+    return 0
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    """Measure throughput against the plain-Python reference simulator."""
+    from ..bench import format_report, run_benchmarks
+
+    report = run_benchmarks(quick=args.quick)
+    print(json.dumps(report, indent=1) if args.json else format_report(report))
+    return 0
+
+
+def register(sub) -> None:
+    """Add the fly, demo and bench commands to the ``neurohover`` subparsers ``sub``."""
+    p = sub.add_parser("fly", help="fly a policy and print return statistics", description=cmd_fly.__doc__)
+    add_task_options(p)
+    p.add_argument("--policy", default="baseline", help="'baseline' or a JSON policy file")
+    p.add_argument("--episodes", type=int, default=10, help="number of episodes (default 10)")
+    p.add_argument("--seed", type=int, default=0, help="root seed of the noise streams (default 0)")
+    p.add_argument("--threads", type=int, help="kernel threads (default: all cores)")
+    p.add_argument("--record", metavar="FILE", help="write the flight data of every episode to FILE (.npz)")
+    p.add_argument(
+        "--record-dtype",
+        choices=("float64", "float32"),
+        default="float64",
+        help="precision of the recorded flight data: float64 (exact; about 0.74 MB a 6000-step episode) or float32 (about half that)",
+    )
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=cmd_fly)
+
+    p = sub.add_parser("demo", help="fly the baseline and an MLP policy on a few MDPs and print a table", description=cmd_demo.__doc__)
+    p.add_argument("--mdps", type=int, default=3, help="training MDPs per family (default 3)")
+    p.add_argument("--episodes", type=int, default=5, help="episodes per MDP (default 5)")
+    p.add_argument("--seed", type=int, default=0)
+    p.set_defaults(func=cmd_demo)
+
+    p = sub.add_parser("bench", help="measure simulator throughput", description=cmd_bench.__doc__)
+    p.add_argument("--quick", action="store_true", help="fewer episodes (rough figures in 5-10 seconds on 2 cores)")
+    p.add_argument("--json", action="store_true", help="print the report as JSON")
+    p.set_defaults(func=cmd_bench)

@@ -1,0 +1,63 @@
+"""The ``neurohover`` command: its parser (each command module registers its commands) and ``main``.
+
+Bad input prints one clear message and exits with status 2 (never a traceback from numba).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sqlite3
+import sys
+from collections.abc import Sequence
+
+from .. import __version__
+from ..errors import NeurohoverError
+from . import agents, evaluate, flying, learning, plots, reproduce
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="neurohover", description="Generalized helicopter hovering (Koppejan & Whiteson 2011): fly, evolve, learn models, compete, reproduce."
+    )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    for module in (flying, learning, agents, evaluate, reproduce, plots):
+        module.register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    from ..paths import forget_created_dirs, remove_created_dirs
+
+    forget_created_dirs()
+    try:
+        if getattr(args, "seed", None) is not None:  # every command's --seed, one range, before any work
+            from ..evolution.seeding import check_seed
+
+            check_seed(args.seed)
+        return args.func(args)
+    except NeurohoverError as err:
+        print(f"neurohover {args.command}: error: {err}", file=sys.stderr)
+        remove_created_dirs()  # a failed command leaves no empty output directory behind
+        return 2
+    except sqlite3.DatabaseError as err:  # a store file damaged mid-file, or not a store at all
+        print(f"neurohover {args.command}: error: a results store cannot be read ({err}): the file is damaged or is no results store", file=sys.stderr)
+        remove_created_dirs()
+        return 2
+    except KeyboardInterrupt as stop:
+        from ..procs import Terminated
+
+        print(f"neurohover {args.command}: {'terminated' if isinstance(stop, Terminated) else 'interrupted'}", file=sys.stderr)
+        return 143 if isinstance(stop, Terminated) else 130  # 128 + the signal's number, as shells report
+    except BrokenPipeError:  # the reader went away (`neurohover demo | head -1`): stop quietly, as Python's docs advise
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())  # so that the interpreter's own flush at exit does not fail again
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,130 @@
+"""The options several commands share, and how they become a task family, an MDP and a sensor (one place each)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+from dataclasses import fields
+
+import numpy as np
+
+from ..errors import NeurohoverError
+from ..tasks.sensor import Sensor
+
+
+def parse_floats(text: str, what: str) -> list[float]:
+    """Comma-separated numbers of option ``what``, or one clear error."""
+    try:
+        return [float(x) for x in text.split(",") if x.strip() != ""]
+    except ValueError:
+        raise NeurohoverError(f"{what} must be comma-separated numbers, got {text!r}") from None
+
+
+def explicit_mdp(args: argparse.Namespace, family):
+    """The MDP set by --wind or --params, with its description (``"wind=..."``), or None without them.
+
+    Refuses both together, either with --mdp, and --wind for a family other than GHH-08
+    (shared by ``fly`` and ``evolve``).
+    """
+    if args.wind is not None and args.params is not None:
+        raise NeurohoverError("give either --wind (GHH-08) or --params, not both")
+    if (args.wind is not None or args.params is not None) and args.mdp is not None:
+        given = "--wind" if args.wind is not None else "--params"
+        raise NeurohoverError(f"{given} sets the MDP explicitly; it cannot be combined with --mdp {args.mdp}")
+    if args.wind is not None:
+        if family.name != "ghh08":
+            raise NeurohoverError(f"--wind U,V sets a GHH-08 MDP; task {args.task!r} takes --params")
+        return family.make(parse_floats(args.wind, "--wind")), f"wind={args.wind}"
+    if args.params is not None:
+        return family.make(parse_floats(args.params, "--params")), f"params={args.params}"
+    return None
+
+
+def add_lr_fit_options(p: argparse.ArgumentParser, who: str) -> None:
+    """--d-u and --noise-estimate: LR fitted as ours or as the authors' code did (``who`` applies them)."""
+    from ..models.lr import D_U_CHOICES, NOISE_ESTIMATES
+
+    p.add_argument("--d-u", choices=D_U_CHOICES, help=f"{who}: keep the fitted u constant as the model's D_u (default) or discard it, as the authors' code did")
+    p.add_argument(
+        "--noise-estimate",
+        choices=NOISE_ESTIMATES,
+        help=f"{who}: the model's gust noise from the authors' rms one-step error / 0.05 (default) or the residuals' innovations / 0.4",
+    )
+
+
+def add_sensor_options(p: argparse.ArgumentParser) -> None:
+    """--obs-noise and --obs-delay: the task seen through noisy or late sensors (:mod:`neurohover.tasks.sensor`)."""
+    g = p.add_argument_group("noisy sensors (docs/benchmarks.md; default: exact sensors)")
+    g.add_argument(
+        "--obs-noise",
+        action="append",
+        help="sensor noise on what the policy sees: a level (e.g. 0.5: std 0.05 m/s, 0.05 m, 0.05 rad/s, 0.005) or key=value pairs "
+        f"of {', '.join(f.name for f in fields(Sensor) if f.name != 'delay')} or level (docs/benchmarks.md)",
+    )
+    g.add_argument("--obs-delay", type=int, help="control steps (0..10, 0.1 s each) the readings arrive late (default 0)")
+
+
+def sensor_of(args: argparse.Namespace):
+    """The sensor of --obs-noise/--obs-delay (None where neither is given: exact sensors)."""
+    noise, delay = getattr(args, "obs_noise", None), getattr(args, "obs_delay", None)
+    if noise is not None and len(noise) > 1:  # the option is appended to catch a repeat, which would silently keep the last
+        raise NeurohoverError(f"--obs-noise is given {len(noise)} times ({', '.join(map(repr, noise))}): give it once, key=value pairs joined by commas")
+    noise = None if noise is None else noise[0]
+    return None if noise is None and delay is None else Sensor.of(noise, delay)
+
+
+def task_family_of(args: argparse.Namespace):
+    """The task family of --task/--sigma, seen through the sensor of --obs-noise/--obs-delay."""
+    from ..tasks import get_task_family
+
+    return get_task_family(args.task, args.sigma, sensor_of(args))
+
+
+def family_and_mdps(args: argparse.Namespace, n: int, rng: np.random.Generator):
+    """The task family and the MDP of each of ``n`` episodes, from --task/--mdp/--wind/--params/--sigma/--obs-noise/--obs-delay."""
+    family = task_family_of(args)
+    explicit = explicit_mdp(args, family)
+    if explicit is not None:
+        return family, [explicit[0]] * n
+    if args.mdp == "sample":  # a fresh MDP from G for every episode
+        return family, [family.sample(rng, label=f"{family.name}/sample:{i}") for i in range(n)]
+    return family, [family.mdp("zero" if args.mdp is None else args.mdp)] * n  # an empty --mdp is refused, not the zero setting
+
+
+def add_task_option(p: argparse.ArgumentParser) -> None:
+    """--task: one of the registered task families (every command that flies takes it)."""
+    from ..tasks import TASK_NAMES
+
+    p.add_argument("--task", required=True, help=f"task family: {', '.join(TASK_NAMES)}")
+
+
+def add_sigma_option(p: argparse.ArgumentParser) -> None:
+    """--sigma: FGHH's breadth."""
+    p.add_argument("--sigma", type=float, help="FGHH breadth sigma (default 0.3)")
+
+
+#: ``fly``'s --mdp; ``evolve`` adds G (evolution over the family's distribution).
+MDP_HELP = "zero (default), train:N, test:N (the competition sets), seeded-train:N, seeded-test:N, or sample (a fresh MDP from G per episode)"
+
+
+def add_task_options(p: argparse.ArgumentParser, mdp_help: str = MDP_HELP, verb: str = "fly") -> None:
+    """--task, --mdp, --wind, --params, --sigma and the sensor options: the task family and the MDP a command ``verb``s on."""
+    add_task_option(p)
+    p.add_argument("--mdp", help=mdp_help)
+    p.add_argument("--wind", help=f"GHH-08 only: {verb} on the constant wind U,V in m/s, each in [-5, 5] (instead of --mdp)")
+    p.add_argument(
+        "--params",
+        help=f"{verb} on explicit MDP parameters, comma-separated (instead of --mdp): GHH-08 wind_u,wind_v; "
+        "GHH-09 its 8 parameters in [0,1]; FGHH the 11 dynamics parameters",
+    )
+    add_sigma_option(p)
+    add_sensor_options(p)
+
+
+def max_in_memory(bytes_each: int) -> int:
+    """How many items of ``bytes_each`` bytes fit in half the memory free now (checked before any work)."""
+    try:
+        free = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):  # not POSIX: no cap
+        return 2**62
+    return max(1, free // 2 // bytes_each)
