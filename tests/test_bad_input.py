@@ -82,12 +82,12 @@ def test_recorded_flight_data_are_compressed(tmp_path: Path, capsys) -> None:
 
 
 def test_fly_progress_is_quiet_with_json_and_chunking_changes_no_result(tmp_path: Path, capsys, monkeypatch) -> None:
-    import neurohover.cli as cli
+    from neurohover.cli import flying
 
     assert main(["fly", "--task", "ghh08", "--mdp", "train:1", "--episodes", "7", "--json"]) == 0
     whole = capsys.readouterr()
     assert whole.err == ""
-    monkeypatch.setattr(cli, "FLY_CHUNK", 3)  # three kernel calls of 3, 3 and 1 episodes
+    monkeypatch.setattr(flying, "FLY_CHUNK", 3)  # three kernel calls of 3, 3 and 1 episodes
     monkeypatch.setattr(sys.stderr, "isatty", lambda: True, raising=False)
     assert main(["fly", "--task", "ghh08", "--mdp", "train:1", "--episodes", "7"]) == 0
     chunked = capsys.readouterr()

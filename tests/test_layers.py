@@ -64,7 +64,7 @@ def test_no_import_runs_back_up() -> None:
 
 
 def test_the_command_line_package_has_no_import_cycle() -> None:
-    """neurohover.cli: main imports the command modules, they import the shared options, and nothing imports back."""
+    """neurohover.cli: app imports the command modules, they import the shared options, and nothing imports back."""
     cli = PACKAGE / "cli"
     within: dict[str, set[str]] = {}
     for path in cli.glob("*.py"):
@@ -74,8 +74,8 @@ def test_the_command_line_package_has_no_import_cycle() -> None:
                 names |= {node.module} if node.module else {a.name for a in node.names}
         within[path.stem] = names
     assert within["options"] == set()  # the shared options import no command
-    commands = set(within) - {"__init__", "main", "options"}
+    commands = set(within) - {"__init__", "app", "options"}
     assert commands == {"flying", "learning", "agents", "evaluate", "reproduce", "plots"}
     for name in commands:
         assert within[name] <= {"options"}, f"cli/{name}.py imports {within[name] - {'options'}}"
-    assert within["main"] == commands
+    assert within["app"] == commands

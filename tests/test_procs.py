@@ -334,7 +334,7 @@ def test_a_run_that_opened_the_lock_file_as_its_writer_removed_it_locks_the_new_
 
 
 def test_a_terminated_command_exits_with_143_and_an_interrupt_with_130(monkeypatch, capsys) -> None:
-    import neurohover.cli as cli
+    import neurohover.cli.app as cli
     from neurohover.procs import Terminated
 
     def stop(exc):

@@ -3,9 +3,9 @@
 One module per group of commands (``flying``: fly, demo, bench; ``learning``: evolve, learn-model,
 build-policies; ``agents``: compete; ``evaluate``: evaluate-agent; ``reproduce``: reproduce, results,
 wins, report; ``plots``: plot), each with a ``register(subparsers)``; the options several commands
-share live in ``options``, which imports no command (no cycle); ``main`` builds the parser.
+share live in ``options``, which imports no command (no cycle); ``app`` builds the parser and runs ``main``.
 """
 
-from .main import build_parser, main
+from .app import build_parser, main
 
 __all__ = ["build_parser", "main"]
