@@ -3,13 +3,12 @@
 All optimisers MAXIMISE returns (negative in the helicopter domain) and share one ask/tell
 protocol (:class:`Optimiser`); fitness evaluation is left to the caller.
 
-Modules: ``steady_state`` and ``generational`` (the paper's neuroevolution), ``cmaes``, ``common``
+Modules: ``steady_state`` and ``generational`` (the paper's neuroevolution), ``optimisers`` (CMA-ES, OpenAI-ES, ...), ``common``
 (the protocol and what the optimisers share), ``operators`` (mutation, crossover), ``races``
 (fitness under noise); whole runs: ``evolve`` (the public entry point), ``config``, ``run``,
 ``records``, ``seeding``.
 """
 
-from .cmaes import CMAES
 from .common import ChampionRecord, Optimiser
 from .evolve import (
     EvolutionInterrupted,
@@ -23,6 +22,7 @@ from .evolve import (
 )
 from .generational import GenerationalNE, GenerationalSettings, GenerationRecord
 from .operators import crossover, mutate
+from .optimisers.cma import CMAES
 from .races import (
     RaceResult,
     ResamplingResult,

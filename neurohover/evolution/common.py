@@ -339,3 +339,40 @@ class ChampionViews:
     def history(self) -> list[ChampionRecord]:
         """One record per new champion, in order."""
         return list(self._tracker.history)
+
+
+class PopulationOptimiser(ChampionViews):
+    """Base of the registry's population optimisers (evosax-style ask/tell over flat genomes).
+
+    The base keeps the asked batch (asked again before a tell, the same batch comes back, as after a
+    resumed checkpoint), checks the returns told against it, and tracks the champion and the wall
+    clock; an optimiser writes ``_ask()`` (its next batch, shape ``(n, D)``), ``_tell(genomes, returns,
+    info)`` (its update, returns maximised and already checked), ``stop()``, ``popsize`` and its state.
+    """
+
+    def __init__(self) -> None:
+        self._tracker = ChampionTracker()
+        self._clock = Clock()
+        self._pending: np.ndarray | None = None
+
+    def _ask(self) -> np.ndarray:
+        raise NotImplementedError
+
+    def _tell(self, genomes: np.ndarray, returns: np.ndarray, info: TellInfo | None) -> None:
+        raise NotImplementedError
+
+    def ask(self) -> np.ndarray:
+        """The next batch of genomes, shape ``(n, D)``."""
+        if self._pending is None:
+            self._pending = np.asarray(self._ask(), dtype=np.float64)
+        return self._pending.copy()
+
+    def tell(self, fitness: np.ndarray, info: TellInfo | None = None) -> None:
+        """One return per asked genome (maximised; non-finite ones never become champion)."""
+        if self._pending is None:
+            raise RuntimeError("tell() called without a pending ask()")
+        genomes = self._pending
+        f = check_returns(fitness, genomes.shape[0])
+        self._tell(genomes, f, info)
+        self._tracker.update(genomes, f, self._clock())
+        self._pending = None

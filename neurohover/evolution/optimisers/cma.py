@@ -1,21 +1,213 @@
-"""CMA-ES (pycma) as a population optimiser: its settings and its registry entry."""
+"""CMA-ES (pycma) as a population optimiser: the optimiser, its settings and its registry entry.
+
+Built on :class:`cma.CMAEvolutionStrategy`. pycma minimises, so the returns told here (MAXIMISED,
+negative in the helicopter domain) are negated before being passed on (:func:`losses_of`).
+"""
 
 from __future__ import annotations
 
+import base64
+import io
 import math
+import pickle
+import sys
 from dataclasses import dataclass
+from typing import Any
 
+import cma
 import numpy as np
 
-from ..cmaes import CMAES, SIGMA0
+from .. import common
+from ..common import PopulationOptimiser, TellInfo, check_prototype
 from . import OptimiserSpec
 
-__all__ = ["CMASettings"]
+__all__ = ["CMAES", "SIGMA0", "CMASettings", "losses_of"]
+
+#: The initial step size for the baseline-seeded policies: a sweep on GHH-08 train:1 (600-step
+#: episodes, 1000 episodes, SLP and MLP from the baseline) found 0.01-0.03 best and 0.1 crashing
+#: nearly every SLP candidate (pycma's usual 0.5 belongs to problems scaled to unit boxes).
+SIGMA0 = 0.02
+
+#: Where classes pickled in earlier checkpoints now live (module, name) -> (module, name).
+_MOVED = {
+    ("neurohover.evolution.neuroevolution", "_ChampionTracker"): (common, "ChampionTracker"),
+    ("neurohover.evolution.neuroevolution", "_Clock"): (common, "Clock"),
+    ("neurohover.evolution.neuroevolution", "ChampionRecord"): (common, "ChampionRecord"),
+    ("neurohover.evolution.cmaes", "CMAES"): (sys.modules[__name__], "CMAES"),  # one file since 2026-12-04
+}
+
+
+class _Randn:
+    """pycma's ``randn`` option drawing from the CMAES wrapper's private generator (rebuilt on load)."""
+
+    def __init__(self, holder: list) -> None:
+        self.holder = holder
+
+    def __call__(self, *shape):
+        return self.holder[0].standard_normal(shape)
+
+
+class _Pickler(pickle.Pickler):
+    """Pickles a :class:`CMAES`, replacing its ``randn`` closure(s) by a persistent id."""
+
+    def __init__(self, file, randn) -> None:
+        super().__init__(file, protocol=4)
+        self._randn = randn
+
+    def persistent_id(self, obj):
+        return "randn" if obj is self._randn or isinstance(obj, _Randn) else None
+
+
+class _Unpickler(pickle.Unpickler):
+    def __init__(self, file, holder: list) -> None:
+        super().__init__(file)
+        self._randn = _Randn(holder)
+
+    def persistent_load(self, pid):
+        if pid != "randn":
+            raise pickle.UnpicklingError(f"unknown persistent id {pid!r}")
+        return self._randn
+
+    def find_class(self, module: str, name: str):
+        moved = _MOVED.get((module, name))
+        return getattr(*moved) if moved is not None else super().find_class(module, name)
+
+
+def losses_of(returns: np.ndarray) -> np.ndarray:
+    """pycma's losses for maximised ``returns``: negated, a non-finite one (NaN, ``-inf``) made worse than every
+    finite loss of the batch (pycma only ranks within a batch, so its update treats it as the worst)."""
+    losses = -np.asarray(returns, dtype=np.float64)
+    bad = ~np.isfinite(losses)
+    if bad.any():
+        finite = losses[~bad]
+        worst = float(finite.max()) if finite.size else 0.0
+        losses[bad] = worst + max(1.0, abs(worst))
+    return losses
+
+
+class CMAES(PopulationOptimiser):
+    """CMA-ES over flat genomes, ask/tell, maximising returns.
+
+    Randomness: pycma's ``seed`` option reseeds NumPy's GLOBAL random state,
+    so instead the strategy samples through its ``randn`` option from a
+    private ``numpy.random.Generator`` seeded with ``seed`` (and ``seed`` is
+    set to NaN, which tells pycma not to touch the global state). Runs are
+    reproducible and independent of other code using ``np.random``. No
+    output is printed and no files are written.
+
+    Non-finite returns (NaN, ``-inf``) are passed to pycma as a loss worse
+    than every finite loss of the batch (pycma only ranks within a batch,
+    so its update treats them as the worst); they never become champion.
+
+    Parameters
+    ----------
+    prototype : np.ndarray
+        1-D initial mean (D >= 2, a pycma requirement).
+    sigma0 : float, default :data:`SIGMA0` (0.02)
+        Initial step size (> 0).
+    seed : int, default 0
+        Seed of the private generator.
+    popsize : int, optional
+        Offspring per generation; pycma's default ``4 + 3 ln D`` if None.
+    budget : int, optional
+        Stop once this many evaluations were told.
+    """
+
+    def __init__(
+        self,
+        prototype: np.ndarray,
+        sigma0: float = SIGMA0,
+        seed: int = 0,
+        popsize: int | None = None,
+        budget: int | None = None,
+    ) -> None:
+        x0 = check_prototype(prototype)
+        if x0.size < 2:
+            raise ValueError(f"CMAES needs a genome of length >= 2, got {x0.size}")
+        if not (isinstance(sigma0, (int, float)) and math.isfinite(sigma0) and sigma0 > 0):
+            raise ValueError(f"sigma0={sigma0!r} must be a finite number > 0")
+        if popsize is not None and (not isinstance(popsize, (int, np.integer)) or popsize < 2):
+            raise ValueError(f"popsize={popsize!r} must be None or an integer >= 2")
+        if budget is not None and (not isinstance(budget, (int, np.integer)) or budget < 1):
+            raise ValueError(f"budget={budget!r} must be None or an integer >= 1")
+        self._rng = np.random.default_rng(seed)
+        rng = self._rng
+        opts: dict = {
+            "seed": float("nan"),
+            "randn": lambda *shape: rng.standard_normal(shape),
+            "verbose": -9,
+            "verb_disp": 0,
+            "verb_log": 0,
+        }
+        if popsize is not None:
+            opts["popsize"] = int(popsize)
+        super().__init__()
+        self._es = cma.CMAEvolutionStrategy(x0, float(sigma0), opts)
+        self.budget = None if budget is None else int(budget)
+
+    def _ask(self) -> np.ndarray:
+        """One generation of genomes, shape ``(popsize, D)``."""
+        return np.vstack([np.asarray(x, dtype=np.float64) for x in self._es.ask()])
+
+    def _tell(self, genomes: np.ndarray, returns: np.ndarray, info: TellInfo | None) -> None:
+        """pycma's update on the generation's losses (``info`` is not used)."""
+        self._es.tell(list(genomes), losses_of(returns).tolist())
+
+    def __setstate__(self, state: dict) -> None:
+        """A checkpoint written before the base class held the asked batch as one array (a list then)."""
+        if isinstance(state.get("_pending"), list):
+            state["_pending"] = np.vstack(state["_pending"])
+        self.__dict__.update(state)
+
+    def stop(self) -> bool:
+        """True once the budget is spent or a pycma termination criterion fired."""
+        if self.budget is not None and self._tracker.evaluations >= self.budget:
+            return True
+        return self._tracker.evaluations > 0 and bool(self._es.stop())
+
+    @property
+    def popsize(self) -> int:
+        """Genomes per :meth:`ask`."""
+        return int(self._es.popsize)
+
+    @property
+    def mean(self) -> np.ndarray:
+        """Current distribution mean."""
+        return np.array(self._es.mean, dtype=np.float64)
+
+    @property
+    def sigma(self) -> float:
+        """Current overall step size."""
+        return float(self._es.sigma)
+
+    # ----------------------------------------------------------------- checkpoint
+
+    def state_dict(self) -> dict[str, Any]:
+        """JSON-serialisable snapshot: the whole optimiser pickled (pycma's state has no plainer
+        form), base64-encoded, with the private generator's draws reconnected on load."""
+        buf = io.BytesIO()
+        _Pickler(buf, self._es.opts["randn"]).dump(self)
+        return {"type": "CMAES", "pickle": base64.b64encode(buf.getvalue()).decode("ascii")}
+
+    @classmethod
+    def from_state_dict(cls, state: dict[str, Any]) -> CMAES:
+        """Rebuild an optimiser from :meth:`state_dict`; it continues identically.
+
+        Raises
+        ------
+        pickle.UnpicklingError, ValueError, KeyError
+            A state that is not one of :meth:`state_dict` (only load states you trust: unpickling
+            runs code).
+        """
+        holder: list = [None]
+        opt = _Unpickler(io.BytesIO(base64.b64decode(state["pickle"])), holder).load()
+        holder[0] = opt._rng
+        return opt
 
 
 @dataclass(frozen=True)
 class CMASettings:
-    """CMA-ES settings: the initial step size (:data:`~neurohover.evolution.cmaes.SIGMA0`, why 0.02)
+    """CMA-ES settings: the initial step size (:data:`SIGMA0`, why 0.02)
     and the population (None: pycma's 4 + 3 ln D)."""
 
     sigma0: float = SIGMA0

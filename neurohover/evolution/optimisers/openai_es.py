@@ -26,11 +26,10 @@ import numpy as np
 from ..common import (
     STATE_VERSION,
     ChampionTracker,
-    ChampionViews,
     Clock,
+    PopulationOptimiser,
     TellInfo,
     check_prototype,
-    check_returns,
     check_state,
     dec_array,
     enc_array,
@@ -89,7 +88,7 @@ def centred_ranks(returns: np.ndarray) -> np.ndarray:
     return shaped / (n - 1) - 0.5
 
 
-class OpenAIES(ChampionViews):
+class OpenAIES(PopulationOptimiser):
     """OpenAI-ES over flat genomes, ask/tell, maximising returns.
 
     Parameters
@@ -102,6 +101,7 @@ class OpenAIES(ChampionViews):
     """
 
     def __init__(self, prototype: np.ndarray, settings: OpenAIESSettings | None = None, seed: int = 0) -> None:
+        super().__init__()
         self.settings = settings if settings is not None else OpenAIESSettings()
         self.mean = check_prototype(prototype)
         self._rng = np.random.default_rng(seed)
@@ -109,29 +109,24 @@ class OpenAIES(ChampionViews):
         self._v = np.zeros_like(self.mean)
         self.generation = 0
         self._eps: np.ndarray | None = None  # the pending generation's noise (popsize / 2, D)
-        self._tracker = ChampionTracker()
-        self._clock = Clock()
 
     @property
     def popsize(self) -> int:
         """Genomes per :meth:`ask`."""
         return self.settings.popsize
 
-    def ask(self) -> np.ndarray:
+    def _ask(self) -> np.ndarray:
         """One generation: ``popsize / 2`` perturbations and their mirrors, shape ``(popsize, D)``."""
-        if self._eps is None:  # asked again before tell (e.g. a resumed checkpoint): the same genomes
+        if self._eps is None:  # a resumed checkpoint keeps the pending generation's noise: the same genomes
             self._eps = self._rng.standard_normal((self.popsize // 2, self.mean.size))
         sigma = self.settings.sigma
         return np.vstack([self.mean + sigma * self._eps, self.mean - sigma * self._eps])
 
-    def tell(self, fitness: np.ndarray, info: TellInfo | None = None) -> None:
-        """One return per asked genome (maximised): an Adam step of the mean up the estimated gradient (``info`` unused)."""
-        if self._eps is None:
-            raise RuntimeError("tell() called without a pending ask()")
+    def _tell(self, genomes: np.ndarray, returns: np.ndarray, info: TellInfo | None) -> None:
+        """An Adam step of the mean up the gradient estimated from the returns (``info`` unused)."""
+        assert self._eps is not None  # asked
         s = self.settings
-        genomes = self.ask()
-        f = check_returns(fitness, genomes.shape[0])
-        shaped = centred_ranks(f)
+        shaped = centred_ranks(returns)
         half = self.popsize // 2
         weights = shaped[:half] - shaped[half:]  # a pair's two genomes share its noise, with opposite signs
         grad = weights @ self._eps / (self.popsize * s.sigma) - s.l2 * self.mean
@@ -141,7 +136,6 @@ class OpenAIES(ChampionViews):
         self._v = s.beta2 * self._v + (1.0 - s.beta2) * grad * grad
         step = s.learning_rate * math.sqrt(1.0 - s.beta2**t) / (1.0 - s.beta1**t)
         self.mean = self.mean + step * self._m / (np.sqrt(self._v) + s.epsilon)  # ascent: returns are maximised
-        self._tracker.update(genomes, f, self._clock())
         self._eps = None
 
     def stop(self) -> bool:

@@ -31,10 +31,9 @@ from typing import Any
 import cma
 import numpy as np
 
-from ..cmaes import CMAES, losses_of
-from ..common import TellInfo, check_returns
+from ..common import TellInfo
 from . import OptimiserSpec
-from .cma import CMASettings
+from .cma import CMAES, CMASettings, losses_of
 
 __all__ = ["UHCMAES", "UHCMASettings"]
 
@@ -82,29 +81,20 @@ class UHCMAES(CMAES):
         """Episodes each solution of the next generation is flown (the noise handler's current number)."""
         return max(1, int(round(self._noise.evaluations)))
 
-    def ask(self) -> np.ndarray:
+    def _ask(self) -> np.ndarray:
         """The next batch: a generation (each solution repeated), or the last generation's re-evaluations."""
-        if self._pending is not None:
-            raise RuntimeError("ask() called again before tell() of the previous batch")
         n = self.evaluations_per_solution
         if self._round is None:
             solutions = [np.asarray(x, dtype=np.float64) for x in self._es.ask()]
         else:
             eps = self._noise.epsilon
             solutions = [np.asarray(self._es.ask(1, self._round["X"][i], eps)[0] if eps else self._round["X"][i], dtype=np.float64) for i in self._round["idx"]]
-        self._pending = [x for x in solutions for _ in range(n)]
         self._repeats = n
-        return np.vstack(self._pending)
+        return np.vstack([x for x in solutions for _ in range(n)])
 
-    def tell(self, fitness: np.ndarray, info: TellInfo | None = None) -> None:
-        """Report one return per asked row (maximised); ``info`` is not used."""
-        if self._pending is None:
-            raise RuntimeError("tell() called without a pending ask()")
-        f = check_returns(fitness, len(self._pending))
-        rows = np.vstack(self._pending)
-        losses = losses_of(np.median(f.reshape(-1, self._repeats), axis=1))  # pycma's aggregate over a solution's rows
-        self._tracker.update(rows, f, self._clock())
-        self._pending = None
+    def _tell(self, rows: np.ndarray, returns: np.ndarray, info: TellInfo | None) -> None:
+        """pycma's update (a generation) or the noise handler's (its re-evaluations); ``info`` is not used."""
+        losses = losses_of(np.median(returns.reshape(-1, self._repeats), axis=1))  # pycma's aggregate over a solution's rows
         if self._round is None:
             X = [rows[i * self._repeats] for i in range(len(losses))]
             self._es.tell(X, losses.tolist())
