@@ -11,6 +11,34 @@ Recording the cost per generation
 Both results carry ``episodes_spent``; pass it to ``GenerationalNE.tell(means,
 TellInfo(episodes=result.episodes_spent))`` (a race: also ``selected=result.selected``) so that
 the optimiser's per-generation history records how many episodes were flown.
+
+Selection races
+---------------
+:func:`selection_race` implements the prose of Sect. 5.2 by default (Algorithm 1 with the paper's
+two changes; ``t_limit = t_min = t_max``, so no adaptation of ``t_limit``). Candidates are kept in
+selected / discarded / undecided pools. Every round recomputes an undecided candidate's bounds FROM
+SCRATCH from all its samples (so a bound may loosen again; the mean always lies inside; all undecided
+candidates have the same number of samples, so one compiled call gives exactly the values of the
+per-candidate call). Then, with ``lambda = n_candidates``:
+
+- an undecided candidate whose lower bound exceeds the upper bounds of at least ``lambda - mu``
+  others is selected;
+- one whose upper bound is below the lower bounds of at least ``mu`` others is discarded.
+
+"Others" means all other candidates whatever their pool, at their current bounds (decided candidates
+keep their last bounds). Both conditions cannot hold at once. The race stops when ``mu`` are selected,
+when every undecided candidate has ``t_limit`` samples, or when selected + undecided ``<= mu`` (the
+fill step would pick them all). If one round selects more candidates than places remain, the ones
+with the highest means are taken. Bounds with a single sample are ``(-inf, inf)``; zero-variance
+samples give ``(mean, mean)``; NaN returns count as ``-inf`` and give ``(-inf, -inf)``.
+
+``rule="algorithm1"`` is the printed Algorithm 1 (lines 18-26), one undecided candidate after another
+in index order: selected when its lower bound exceeds the upper bounds of at least
+``lambda - mu - |D|`` undecided ones, discarded when its upper bound is below the lower bounds of at
+least ``mu - |S|`` undecided ones, ``S``, ``D`` and the undecided set changing at once; it stops when
+``mu`` are selected or at ``t_limit`` (no early stop) and may select more than ``mu`` in its last round
+(``over_selected``). ``rule="authors"`` is the same loop as their FGHH code ran it, which passes over
+the candidate after each decision in a round.
 """
 
 from __future__ import annotations
@@ -231,39 +259,12 @@ def selection_race(
     batch: int = 0,
     rule: str = "prose",
 ) -> RaceResult:
-    """Pick ``mu`` of ``n_candidates`` noisy candidates with a selection race.
+    """Pick ``mu`` of ``n_candidates`` noisy candidates with a selection race (the module's "Selection races").
 
-    Implements the prose of Sect. 5.2 (Algorithm 1 with the paper's two
-    changes; ``t_limit = t_min = t_max`` so no adaptation of ``t_limit``).
-    Candidates are kept in selected / discarded / undecided pools. Round 1
-    flies every candidate once (in the same call of ``sample_fn`` as round 2,
-    since one sample decides nothing); each later round flies every undecided
-    candidate one more episode and recomputes its bounds FROM SCRATCH from all
-    its samples with :func:`bayes_mean_bounds` (so a bound may loosen again;
-    the mean always lies inside; all undecided candidates have the same number
-    of samples, so this is done for all of them in one compiled call giving
-    exactly the values of the per-candidate call). Then, with
-    ``lambda = n_candidates``:
-
-    - an undecided candidate whose lower bound exceeds the upper bounds of at
-      least ``lambda - mu`` others is selected;
-    - one whose upper bound is below the lower bounds of at least ``mu``
-      others is discarded.
-
-    "Others" means all other candidates whatever their pool, compared with
-    their current bounds (decided candidates keep their last bounds). Both
-    conditions cannot hold at once. The race stops when ``mu`` are selected,
-    when every undecided candidate has ``t_limit`` samples, or when
-    selected + undecided ``<= mu`` (then all undecided are certain to be
-    picked by the fill step, so further episodes would not change the
-    result). Remaining places are filled with the undecided candidates of
-    best mean (and, only if those run out, the discarded ones of best mean).
-    If one round selects more candidates than places remain, the ones with
-    the highest means are taken.
-
-    Bounds with a single sample are ``(-inf, inf)``; zero-variance samples give
-    ``(mean, mean)``; NaN returns are treated as ``-inf`` (worst possible) and
-    give ``(-inf, -inf)``.
+    Round 1 flies every candidate once (in the same call of ``sample_fn`` as round 2, since one sample
+    decides nothing); each later round flies every undecided candidate one more episode, recomputes
+    its bounds from all its samples (:func:`bayes_mean_bounds`), and selects or discards by ``rule``.
+    Remaining places are filled with the undecided candidates of best mean (then the discarded ones).
 
     Parameters
     ----------
@@ -280,13 +281,7 @@ def selection_race(
     t_limit : int, default 10
         Maximum episodes per candidate (>= 1).
     rule : {"prose", "algorithm1", "authors"}, default "prose"
-        ``"prose"``: as above. ``"algorithm1"``: the printed Algorithm 1 (lines 18-26), one undecided
-        candidate after another in index order: selected when its lower bound exceeds the upper bounds
-        of at least ``lambda - mu - |D|`` undecided ones, discarded when its upper bound is below the
-        lower bounds of at least ``mu - |S|`` undecided ones, ``S``, ``D`` and the undecided set
-        changing at once; the race stops when ``mu`` are selected or at ``t_limit`` (no early stop),
-        and may select more than ``mu`` in its last round (``over_selected``). ``"authors"``: the same
-        loop as their FGHH code ran it, which passes over the candidate after each decision in a round.
+        The paper's prose, the printed Algorithm 1, or its loop as the authors' code ran it (module docstring).
     batch : int, default 0
         Look-ahead for speed: when a call of ``sample_fn`` is due, each undecided candidate is
         listed for its next ``ceil(batch / undecided)`` samples at once (at most up to
@@ -299,19 +294,10 @@ def selection_race(
     -------
     RaceResult
     """
-    n = _check_int("n_candidates", n_candidates, 2)
-    mu = _check_int("mu", mu, 1)
-    if mu >= n:
-        raise ValueError(f"mu={mu} must be smaller than n_candidates={n}")
-    delta = _check_delta(delta)
-    t_limit = _check_int("t_limit", t_limit, 1)
-    batch = _check_int("batch", batch, 0)
-    if rule not in RACE_RULES:
-        raise ValueError(f"rule={rule!r} is not a race rule: choose one of {', '.join(RACE_RULES)}")
+    n, mu, delta, t_limit, batch = _race_arguments(n_candidates, mu, delta, t_limit, batch, rule)
 
-    # Samples live in one (n, capacity) array: in round r every undecided
-    # candidate has exactly r samples (columns 0..r-1 of its row). _race_round sums
-    # them in NumPy's order, so means and bounds are those of bayes_mean_bounds.
+    # Samples in one (n, capacity) array: in round r every undecided candidate has r samples (columns 0..r-1 of
+    # its row); _race_round sums them in NumPy's order, so means and bounds are those of bayes_mean_bounds.
     samples = np.empty((n, min(t_limit, 16)))
     n_samples = np.zeros(n, dtype=np.int64)
     crashed = np.zeros(n, dtype=bool)  # some sample is -inf (or was NaN)
@@ -332,18 +318,9 @@ def selection_race(
     while True:
         active = np.flatnonzero(undecided)
         if flown == rounds:  # a call is due: this round's samples, and any look-ahead
-            # Round 1 can decide nothing (one sample: bounds (-inf, inf), or (-inf, -inf) for a crash,
-            # which no lower bound of -inf exceeds), so its call flies round 2 too.
-            ahead = max(2 if rounds == 0 else 1, -(-batch // active.size))
-            ahead = min(ahead, t_limit - rounds)
-            draws = _draw(sample_fn, np.tile(active, ahead))  # listed in round order
-            if rounds + ahead > samples.shape[1]:
-                grown = np.empty((n, min(t_limit, max(2 * samples.shape[1], rounds + ahead))))
-                grown[:, : samples.shape[1]] = samples
-                samples = grown
-            samples[active, rounds : rounds + ahead] = draws.reshape(ahead, active.size).T
+            samples, ahead = _fly_ahead(sample_fn, samples, active, rounds, batch, t_limit)
             flown += ahead
-            episodes_flown += draws.size
+            episodes_flown += ahead * active.size
         first_new = rounds
         rounds += 2 if rounds == 0 and t_limit >= 2 else 1
         n_samples[active] = rounds
@@ -352,35 +329,62 @@ def selection_race(
         _race_round(samples, active, first_new, rounds, q_lo, q_hi, need_select, need_discard, crashed, means, lower, upper, sel, dis)
         if rule != "prose":  # Algorithm 1's decisions, one candidate after another (the bounds are this round's)
             newly_sel, newly_dis = _sequential_decisions(active, lower, upper, n - mu, mu, len(selected), int(discarded.sum()), rule == "authors")
-            selected.extend(newly_sel.tolist())  # kept beyond mu for now: the best mu are taken below
-            undecided[newly_sel] = False
-            undecided[newly_dis] = False
-            discarded[newly_dis] = True
-            discard_order.extend(newly_dis.tolist())
-            if len(selected) >= mu or not undecided.any() or rounds >= t_limit:
-                break
-            continue
-        newly_sel = active[sel[: active.size]]
-        newly_dis = active[dis[: active.size]]
-        if newly_sel.size:
-            room = mu - len(selected)
-            if newly_sel.size > room:
-                newly_sel = newly_sel[_best_first(means, newly_sel)][:room]
-            selected.extend(newly_sel[_best_first(means, newly_sel)].tolist())
-            undecided[newly_sel] = False
-        if newly_dis.size:
-            undecided[newly_dis] = False
-            discarded[newly_dis] = True
-            discard_order.extend(newly_dis.tolist())
-
-        if len(selected) >= mu:
-            break
+        else:  # the prose's, all at once; a round that selects more than the places left takes the best means
+            newly_sel, newly_dis = active[sel[: active.size]], active[dis[: active.size]]
+            if newly_sel.size > mu - len(selected):
+                newly_sel = newly_sel[_best_first(means, newly_sel)][: mu - len(selected)]
+            newly_sel = newly_sel[_best_first(means, newly_sel)]
+        selected.extend(newly_sel.tolist())  # Algorithm 1's kept beyond mu for now: the best mu are taken below
+        undecided[newly_sel] = False
+        undecided[newly_dis] = False
+        discarded[newly_dis] = True
+        discard_order.extend(newly_dis.tolist())
         n_undecided = int(np.count_nonzero(undecided))
-        if n_undecided == 0 or len(selected) + n_undecided <= mu:
-            break
-        if rounds >= t_limit:  # every undecided candidate was flown in every round
+        # mu selected; nothing undecided; (the prose) the undecided certain to fill the places; or t_limit reached
+        if len(selected) >= mu or n_undecided == 0 or (rule == "prose" and len(selected) + n_undecided <= mu) or rounds >= t_limit:
             break
 
+    selected, n_raced, over_selected = _filled(selected, undecided, discarded, means, mu)
+    chosen = set(selected)
+    discards = np.asarray([i for i in discard_order if i not in chosen], dtype=np.int64)
+    picked = np.asarray(selected, dtype=np.int64)
+    spent = int(n_samples.sum())
+    return RaceResult(picked, means, n_samples, lower, upper, discards, n_raced, spent, rounds, episodes_flown=episodes_flown, over_selected=over_selected)
+
+
+def _race_arguments(n_candidates, mu, delta, t_limit, batch, rule) -> tuple[int, int, float, int, int]:
+    """:func:`selection_race`'s arguments checked (ValueError naming the bad one)."""
+    n = _check_int("n_candidates", n_candidates, 2)
+    mu = _check_int("mu", mu, 1)
+    if mu >= n:
+        raise ValueError(f"mu={mu} must be smaller than n_candidates={n}")
+    if rule not in RACE_RULES:
+        raise ValueError(f"rule={rule!r} is not a race rule: choose one of {', '.join(RACE_RULES)}")
+    return n, mu, _check_delta(delta), _check_int("t_limit", t_limit, 1), _check_int("batch", batch, 0)
+
+
+def _fly_ahead(sample_fn: SampleFn, samples: np.ndarray, active: np.ndarray, rounds: int, batch: int, t_limit: int) -> tuple[np.ndarray, int]:
+    """Fly this round's samples of the undecided ``active`` and any look-ahead (``batch``) into ``samples``
+    (grown when it lacks the columns); returns the samples array and how many rounds were flown.
+
+    Round 1 can decide nothing (one sample: bounds (-inf, inf), or (-inf, -inf) for a crash, which no
+    lower bound of -inf exceeds), so its call flies round 2 too.
+    """
+    ahead = max(2 if rounds == 0 else 1, -(-batch // active.size))
+    ahead = min(ahead, t_limit - rounds)
+    draws = _draw(sample_fn, np.tile(active, ahead))  # listed in round order
+    if rounds + ahead > samples.shape[1]:
+        grown = np.empty((samples.shape[0], min(t_limit, max(2 * samples.shape[1], rounds + ahead))))
+        grown[:, : samples.shape[1]] = samples
+        samples = grown
+    samples[active, rounds : rounds + ahead] = draws.reshape(ahead, active.size).T
+    return samples, ahead
+
+
+def _filled(selected: list[int], undecided: np.ndarray, discarded: np.ndarray, means: np.ndarray, mu: int) -> tuple[list[int], int, int]:
+    """The race's ``mu`` picks: the best ``mu`` of those selected (a last round of Algorithm 1 may select more),
+    then the undecided of best mean, then (only if those run out) the discarded; with how many were raced
+    in and how many were selected beyond ``mu``."""
     over_selected = max(0, len(selected) - mu)
     if over_selected:
         picked = np.asarray(selected)
@@ -391,21 +395,7 @@ def selection_race(
         if need <= 0:
             break
         selected.extend(pool[_best_first(means, pool)][:need].tolist())
-
-    chosen = set(selected)
-    return RaceResult(
-        selected=np.asarray(selected, dtype=np.int64),
-        means=means,
-        n_samples=n_samples,
-        lower=lower,
-        upper=upper,
-        discarded=np.asarray([i for i in discard_order if i not in chosen], dtype=np.int64),
-        n_raced=n_raced,
-        episodes_spent=int(n_samples.sum()),
-        rounds=rounds,
-        episodes_flown=episodes_flown,
-        over_selected=over_selected,
-    )
+    return selected, n_raced, over_selected
 
 
 def _sequential_decisions(
