@@ -104,12 +104,8 @@ class _Bar:
         self.bar.close()
 
 
-def cmd_evolve(args: argparse.Namespace) -> int:
-    """Evolve a policy: steady state on one MDP, or generational over the task family's MDPs (--mdp G)."""
-    from ..evolution.evolve import EvolutionInterrupted, evolve, parse_resampling, validation_return, write_history_csv
-    from ..paths import output_file, writing
-    from ..policies import save_policy
-
+def _check_evolve_sizes(args: argparse.Namespace) -> None:
+    """``evolve``'s sizes and device, refused before any file is touched."""
     if args.budget is not None and args.budget < 1:
         raise NeurohoverError(f"--budget {args.budget} is out of range: allowed an integer >= 1 (episodes)")
     if args.episode_steps < 1:
@@ -119,7 +115,64 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     if args.validation_episodes < 1:
         raise NeurohoverError(f"--validation-episodes {args.validation_episodes} is out of range: allowed >= 1")
     check_episode_count(args.validation_episodes, f"--validation-episodes {args.validation_episodes}")  # before the evolution, not after
-    check_device(args.device)  # before any file is touched: a GPU missing is one clear error
+    check_device(args.device)  # a GPU missing is one clear error
+
+
+def _evolve_meta(args, family, target, mdp_desc: str, resampling, result, scale: str, validation, history_name: str) -> dict:
+    """What the champion's policy file records about its run."""
+    meta = {
+        "task": family.name,
+        **({} if family.sensor.exact else {"sensor": family.sensor.to_dict()}),
+        "mdp": mdp_desc,
+        "optimizer": args.optimizer,
+        "resampling": str(resampling),
+        "settings": result.settings["settings"],
+        "budget": args.budget,
+        "seed": args.seed,
+        "seed_policy": str(args.seed_policy),
+        "champion_return": result.champion_return,
+        "champion_fitness_scale": scale,
+        "validation_return": float(validation.mean()),
+        "validation_sd": float(validation.std()),
+        "validation_episodes": int(validation.size),
+        "episode_steps": args.episode_steps,
+        "episodes": result.episodes,
+        "evaluations": result.evaluations,
+        "generations": result.generations,
+        "seconds": round(result.seconds, 3),
+        "stop_reason": result.stop_reason,
+        "history": history_name,
+    }
+    if family.sigma is not None:
+        meta["sigma"] = float(family.sigma)
+    if mdp_desc != MDP_FAMILY:
+        meta["mdp_params"] = target.to_dict()
+    return meta
+
+
+def _print_evolve_summary(args: argparse.Namespace, summary: dict, result) -> None:
+    """The run's summary (a table or one JSON object), and a note when the run stopped before its budget."""
+    if args.json:
+        print(json.dumps(summary))
+    else:
+        for key, value in summary.items():
+            print(f"{key:>20}: {value:.6g}" if isinstance(value, float) else f"{key:>20}: {value}")
+    if args.budget is not None and result.stop_reason != "budget" and result.episodes < args.budget:
+        why = " (steady state ends at the paper's plateau, 1000 evaluations without a new champion)" if result.stop_reason == "plateau" else ""
+        print(
+            f"neurohover evolve: note: stopped by {result.stop_reason} after {result.episodes:,} of the --budget {args.budget:,} episodes: the budget "
+            "is a cap, not a length" + why,
+            file=sys.stderr,
+        )
+
+
+def cmd_evolve(args: argparse.Namespace) -> int:
+    """Evolve a policy: steady state on one MDP, or generational over the task family's MDPs (--mdp G)."""
+    from ..evolution.evolve import EvolutionInterrupted, evolve, parse_resampling, validation_return, write_history_csv
+    from ..paths import output_file, writing
+    from ..policies import save_policy
+
+    _check_evolve_sizes(args)
     resampling = parse_resampling(args.resampling)
     target, family, mdp_desc = _target(args)
     topology, proto = _seed_policy(args)
@@ -167,35 +220,8 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     validation = validation_return(
         result.champion, target, episodes=args.validation_episodes, seed=args.seed, n_steps=args.episode_steps, threads=args.threads, device=args.device
     )
-    meta = {
-        "task": family.name,
-        **({} if family.sensor.exact else {"sensor": family.sensor.to_dict()}),
-        "mdp": mdp_desc,
-        "optimizer": args.optimizer,
-        "resampling": str(resampling),
-        "settings": result.settings["settings"],
-        "budget": args.budget,
-        "seed": args.seed,
-        "seed_policy": str(args.seed_policy),
-        "champion_return": result.champion_return,
-        "champion_fitness_scale": scale,
-        "validation_return": float(validation.mean()),
-        "validation_sd": float(validation.std()),
-        "validation_episodes": int(validation.size),
-        "episode_steps": args.episode_steps,
-        "episodes": result.episodes,
-        "evaluations": result.evaluations,
-        "generations": result.generations,
-        "seconds": round(result.seconds, 3),
-        "stop_reason": result.stop_reason,
-        "history": history_path.name,
-    }
-    if family.sigma is not None:
-        meta["sigma"] = float(family.sigma)
-    if mdp_desc != MDP_FAMILY:
-        meta["mdp_params"] = target.to_dict()
     with writing(out, "--out") as path:
-        save_policy(result.champion, path, **meta)
+        save_policy(result.champion, path, **_evolve_meta(args, family, target, mdp_desc, resampling, result, scale, validation, history_path.name))
     with writing(history_path, "--out's history") as path:
         write_history_csv(result.history, path)
     summary = {
@@ -212,18 +238,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         "episodes_per_second": result.episodes_per_second,
         "stop_reason": result.stop_reason,
     }
-    if args.json:
-        print(json.dumps(summary))
-    else:
-        for key, value in summary.items():
-            print(f"{key:>20}: {value:.6g}" if isinstance(value, float) else f"{key:>20}: {value}")
-    if args.budget is not None and result.stop_reason != "budget" and result.episodes < args.budget:
-        why = " (steady state ends at the paper's plateau, 1000 evaluations without a new champion)" if result.stop_reason == "plateau" else ""
-        print(
-            f"neurohover evolve: note: stopped by {result.stop_reason} after {result.episodes:,} of the --budget {args.budget:,} episodes: the budget "
-            "is a cap, not a length" + why,
-            file=sys.stderr,
-        )
+    _print_evolve_summary(args, summary, result)
     return 0
 
 
