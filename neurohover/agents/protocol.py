@@ -145,6 +145,22 @@ def after_learning_start(policy_labels: Sequence[str]) -> int:
     return start
 
 
+def _check_run(agent, family, mdp, episodes, seed) -> int:
+    """:func:`run_test`'s arguments checked (NeurohoverError naming the bad one); returns the seed."""
+    if not isinstance(agent, Agent):
+        raise NeurohoverError(f"agent={agent!r:.80} is not allowed: give an Agent (neurohover.agents.registry.make_agent(name, family))")
+    if not isinstance(family, TaskFamily):
+        raise NeurohoverError(f"family={family!r:.80} is not allowed: give a TaskFamily (neurohover.get_task_family(name))")
+    if not isinstance(mdp, MDP):
+        raise NeurohoverError(f"mdp={mdp!r:.80} is not allowed: give an MDP (family.mdp('test:3'), for example)")
+    if mdp.family != family.name:  # the agent prepares for its family (its policies, safe pairs): another family's MDP is a mix-up
+        raise NeurohoverError(f"mdp {mdp.label!r} is a {mdp.family} MDP, but the run's family is {family.name}: give an MDP of {family.name}")
+    if not isinstance(episodes, (int, np.integer)) or episodes < 1:
+        raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
+    check_episode_count(int(episodes), f"episodes={episodes}")
+    return check_seed(seed)
+
+
 def run_test(
     agent: Agent,
     family: TaskFamily,
@@ -163,18 +179,7 @@ def run_test(
     an MDP with drifting dynamics (``mdp.drift``: episode e flies its row e, the agent unaware). ``device``: where the
     episodes in the MDP fly (the agent's own evolutions on models follow its ``ModelEvolution``).
     """
-    if not isinstance(agent, Agent):
-        raise NeurohoverError(f"agent={agent!r:.80} is not allowed: give an Agent (neurohover.agents.registry.make_agent(name, family))")
-    if not isinstance(family, TaskFamily):
-        raise NeurohoverError(f"family={family!r:.80} is not allowed: give a TaskFamily (neurohover.get_task_family(name))")
-    if not isinstance(mdp, MDP):
-        raise NeurohoverError(f"mdp={mdp!r:.80} is not allowed: give an MDP (family.mdp('test:3'), for example)")
-    if mdp.family != family.name:  # the agent prepares for its family (its policies, safe pairs): another family's MDP is a mix-up
-        raise NeurohoverError(f"mdp {mdp.label!r} is a {mdp.family} MDP, but the run's family is {family.name}: give an MDP of {family.name}")
-    if not isinstance(episodes, (int, np.integer)) or episodes < 1:
-        raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
-    check_episode_count(int(episodes), f"episodes={episodes}")
-    seed = check_seed(seed)
+    seed = _check_run(agent, family, mdp, episodes, seed)
     start_time = time.perf_counter()
     agent.start(family, np.random.default_rng(np.random.SeedSequence([seed, 0xA6E27])))
     returns = np.zeros(episodes)
