@@ -131,3 +131,23 @@ def test_source_hash_sees_every_simulator_file(tmp_path: Path) -> None:
             f.write("\n")
         assert sim_source_hash(tmp_path) != before
         before = sim_source_hash(tmp_path)
+
+
+def test_a_command_says_when_the_kernel_is_about_to_compile(monkeypatch, capsys) -> None:
+    """Issue 37: the first flight of a fresh install compiles for tens of seconds; the command says so first."""
+    import neurohover.sim as sim
+    from neurohover.cli import main
+    from neurohover.sim import _cache
+    from neurohover.sim.lanes import fly_queue
+
+    assert main(["fly", "--task", "ghh08", "--episodes", "1"]) == 0
+    capsys.readouterr()
+    assert sim.kernel_compiled() and _cache.compiled_on_disk(fly_queue)  # compiled now: no note
+    assert not _cache.compiled_on_disk(object())  # what numba's cache cannot answer counts as not compiled
+    monkeypatch.setattr(sim, "kernel_compiled", lambda: False)
+    assert main(["fly", "--task", "ghh08", "--episodes", "1"]) == 0
+    assert "compiling the simulation kernel" in capsys.readouterr().err
+    assert main(["fly", "--task", "ghh08", "--episodes", "1", "--json"]) == 0  # one JSON object, nothing else said
+    assert capsys.readouterr().err == ""
+    assert main(["results", "fig2", "--store", "absent.sqlite"]) == 2  # a command that flies nothing says nothing of it
+    assert "compiling" not in capsys.readouterr().err

@@ -15,6 +15,9 @@ from .. import __version__
 from ..errors import NeurohoverError
 from . import agents, evaluate, flying, learning, plots, reproduce
 
+#: Commands that fly the CPU kernel at once; on a fresh install they say so before it compiles.
+COMPILING = ("fly", "demo", "bench", "evolve", "build-policies", "compete", "evaluate-agent", "reproduce")
+
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
@@ -39,6 +42,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             from ..evolution.seeding import check_seed
 
             check_seed(args.seed)
+        if args.command in COMPILING and not getattr(args, "json", False):
+            from ..sim import kernel_compiled
+
+            if not kernel_compiled():  # tens of seconds without output otherwise
+                print("neurohover: compiling the simulation kernel (first use of this version on this machine; cached afterwards)", file=sys.stderr)
         return args.func(args)
     except NeurohoverError as err:
         print(f"neurohover {args.command}: error: {err}", file=sys.stderr)

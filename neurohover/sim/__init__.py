@@ -4,3 +4,11 @@ from . import _cache
 
 # Before any cached function of the package is compiled: a cached kernel must match all of sim/.
 _cache.install()
+
+
+def kernel_compiled() -> bool:
+    """Whether the CPU kernel (:func:`neurohover.sim.lanes.rollout_lanes`) is compiled in this process or in
+    numba's on-disk cache; if not, the first flight compiles it (tens of seconds, once per machine and version)."""
+    from .lanes import fly_queue
+
+    return _cache.compiled_on_disk(fly_queue)

@@ -73,3 +73,13 @@ def install() -> None:
     ``njit(cache=True)`` of the package is decorated, which ``neurohover/sim/__init__.py`` ensures."""
     if SimSourceLocator not in _CacheImpl._locator_classes:
         _CacheImpl._locator_classes.insert(0, SimSourceLocator)
+
+
+def compiled_on_disk(dispatcher) -> bool:
+    """Whether numba's on-disk cache holds a fresh compilation of ``dispatcher`` (an index whose stamp,
+    :func:`sim_source_hash` included, matches): if not, its first call compiles, which takes tens of seconds.
+    Any failure to read the cache counts as not compiled."""
+    try:
+        return bool(dispatcher.signatures) or bool(dispatcher._cache._cache_file._load_index())
+    except Exception:  # numba's cache layout is its own: never let a check of it stop a run
+        return False
