@@ -38,7 +38,7 @@ MAX_EPISODES = 1 << 16  # helicopters in one lockstep batch: the vector environm
 
 
 def evaluate_callable(
-    act: Callable[[np.ndarray], Any],
+    act: Callable[..., Any],
     mdps: MDP | Sequence[MDP],
     *,
     episodes: int = 1,
@@ -46,6 +46,7 @@ def evaluate_callable(
     first_episode: int = 0,
     n_steps: int = EPISODE_STEPS,
     obs_dtype: str = "float32",
+    indexed: bool = False,
 ) -> Evaluation:
     """Fly ``act`` for ``episodes`` episodes on every MDP; arrays are shaped (M, E).
 
@@ -61,6 +62,9 @@ def evaluate_callable(
         ``(seed, first_episode + m * episodes + e)``.
     obs_dtype : {"float32", "float64"}
         What ``act`` receives (float32 for networks trained on the ``-Short-v0`` ids).
+    indexed : bool
+        Call ``act(observations, episodes)`` with the indices ``k = m * episodes + e`` of the episodes
+        still flying, for a batch of several policies (one per episode, as a NEAT generation flies).
     """
     mdps = [mdps] if isinstance(mdps, MDP) else list(mdps)
     if not mdps or not all(isinstance(m, MDP) for m in mdps):
@@ -81,7 +85,7 @@ def evaluate_callable(
     actions = np.zeros((n, ACTION_DIM))
     while alive.any():
         live = np.flatnonzero(alive)
-        out = np.asarray(act(obs[live]), dtype=np.float64)
+        out = np.asarray(act(obs[live], live) if indexed else act(obs[live]), dtype=np.float64)
         if out.shape != (live.size, ACTION_DIM):
             raise NeurohoverError(f"act returned actions of shape {out.shape} for {live.size} observations: expected ({live.size}, {ACTION_DIM})")
         actions[live] = out

@@ -1,0 +1,349 @@
+"""Topology evolution with NEAT (neat-python): networks whose structure evolves with their weights.
+
+The paper (Section 3.1) reports that NEAT and AEONN "did not discover topologies that outperformed
+the manually designed topology", without numbers. This module runs that claim: neat-python's
+``Population`` (species, crossover, structural mutation) evolves feed-forward networks of the 12
+observations -> 4 actions, and every generation's genomes fly their episodes together in the
+native vector environment (:func:`neurohover.integrations.flying.evaluate_callable`, the same
+physics and the same (seed, episode) gust streams as the kernel), each network evaluated by a
+compiled forward pass that is neat-python's ``FeedForwardNetwork.activate`` for a whole batch.
+
+A generation's genomes each fly ``episodes`` fresh episodes (episode numbers continue across
+generations, so no two generations meet the same gusts), their fitness is the mean return. The
+run's champion is the genome of best fitness ever (neat-python's ``best_genome``); the budget counts
+episodes, as every evolution run here does. neat-python draws from Python's global ``random``: the
+run seeds it from ``seed`` and restores the caller's state afterwards, so a run is reproducible.
+
+Example::
+
+    from neurohover import get_task_family
+    from neurohover.integrations.neat import evolve_topology
+
+    result = evolve_topology(get_task_family("ghh08").mdp("train:0"), budget=20_000, seed=1)
+    print(result.champion_fitness, result.nodes, result.connections)
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import os
+import random
+import tempfile
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numba as nb
+import numpy as np
+
+from ..errors import NeurohoverError
+from ..sim.constants import ACTION_DIM, EPISODE_STEPS, OBS_DIM
+from ..tasks import MDP
+
+__all__ = ["ACTIVATIONS", "NeatSettings", "TopologyResult", "evolve_topology", "forward", "pack_networks"]
+
+#: neat-python's activation functions this forward pass computes, by id (its ``activations`` module, exactly).
+ACTIVATIONS = ("identity", "tanh", "sigmoid", "clamped", "relu")
+
+
+@dataclass(frozen=True)
+class NeatSettings:
+    """The NEAT run's settings (neat-python's config keys of the same meaning; the rest are its usual defaults).
+
+    ``initial``: the starting topology, ``"full_direct"`` (every input to every output, an SLP) or
+    ``"unconnected"``; ``activations``: those a new node may take (the first is the default).
+    """
+
+    pop_size: int = 150
+    episodes: int = 1  # per genome and generation
+    initial: str = "full_direct"
+    activations: tuple[str, ...] = ("tanh", "sigmoid", "identity")
+    node_add_prob: float = 0.2
+    conn_add_prob: float = 0.3
+    weight_mutate_power: float = 0.5
+    compatibility_threshold: float = 3.0
+
+    def __post_init__(self) -> None:
+        if isinstance(self.pop_size, bool) or not isinstance(self.pop_size, int) or self.pop_size < 4:
+            raise ValueError(f"pop_size={self.pop_size!r} must be an integer >= 4")
+        if isinstance(self.episodes, bool) or not isinstance(self.episodes, int) or self.episodes < 1:
+            raise ValueError(f"episodes={self.episodes!r} must be an integer >= 1")
+        if self.initial not in ("full_direct", "unconnected"):
+            raise ValueError(f"initial={self.initial!r}: allowed full_direct or unconnected")
+        bad = [a for a in self.activations if a not in ACTIVATIONS]
+        if not self.activations or bad:
+            raise ValueError(f"activations={self.activations!r}: allowed a non-empty tuple of {', '.join(ACTIVATIONS)}")
+        for name in ("node_add_prob", "conn_add_prob"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and 0.0 <= v <= 1.0):
+                raise ValueError(f"{name}={v!r} must be a probability in [0, 1]")
+        for name in ("weight_mutate_power", "compatibility_threshold"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise ValueError(f"{name}={v!r} must be a finite number > 0")
+
+
+_CONFIG = """
+[NEAT]
+fitness_criterion     = max
+fitness_threshold     = 1e30
+no_fitness_termination = True
+pop_size              = {pop_size}
+reset_on_extinction   = True
+
+[DefaultGenome]
+activation_default      = {activation_default}
+activation_mutate_rate  = 0.1
+activation_options      = {activations}
+aggregation_default     = sum
+aggregation_mutate_rate = 0.0
+aggregation_options     = sum
+bias_init_mean          = 0.0
+bias_init_stdev         = 0.5
+bias_max_value          = 30.0
+bias_min_value          = -30.0
+bias_mutate_power       = 0.2
+bias_mutate_rate        = 0.7
+bias_replace_rate       = 0.1
+compatibility_disjoint_coefficient = 1.0
+compatibility_weight_coefficient   = 0.5
+conn_add_prob           = {conn_add_prob}
+conn_delete_prob        = 0.2
+enabled_default         = True
+enabled_mutate_rate     = 0.01
+feed_forward            = True
+initial_connection      = {initial}
+node_add_prob           = {node_add_prob}
+node_delete_prob        = 0.1
+num_hidden              = 0
+num_inputs              = {n_inputs}
+num_outputs             = {n_outputs}
+response_init_mean      = 1.0
+response_init_stdev     = 0.0
+response_max_value      = 30.0
+response_min_value      = -30.0
+response_mutate_power   = 0.0
+response_mutate_rate    = 0.0
+response_replace_rate   = 0.0
+weight_init_mean        = 0.0
+weight_init_stdev       = 0.5
+weight_max_value        = 30
+weight_min_value        = -30
+weight_mutate_power     = {weight_mutate_power}
+weight_mutate_rate      = 0.8
+weight_replace_rate     = 0.1
+
+[DefaultSpeciesSet]
+compatibility_threshold = {compatibility_threshold}
+
+[DefaultStagnation]
+species_fitness_func = max
+max_stagnation       = 20
+species_elitism      = 2
+
+[DefaultReproduction]
+elitism            = 2
+survival_threshold = 0.2
+"""
+
+
+def neat_config(settings: NeatSettings):
+    """neat-python's ``Config`` for ``settings`` (written to a temporary file, as neat-python reads one)."""
+    import neat
+
+    text = _CONFIG.format(
+        pop_size=settings.pop_size,
+        activation_default=settings.activations[0],
+        activations=" ".join(settings.activations),
+        conn_add_prob=settings.conn_add_prob,
+        node_add_prob=settings.node_add_prob,
+        initial=settings.initial,
+        n_inputs=OBS_DIM,
+        n_outputs=ACTION_DIM,
+        weight_mutate_power=settings.weight_mutate_power,
+        compatibility_threshold=settings.compatibility_threshold,
+    )
+    fd, path = tempfile.mkstemp(suffix=".ini", prefix="neurohover-neat-")
+    try:
+        with os.fdopen(fd, "w") as f:
+            f.write(text)
+        return neat.Config(neat.DefaultGenome, neat.DefaultReproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation, path)
+    finally:
+        os.unlink(path)
+
+
+@dataclass(frozen=True)
+class PackedNetworks:
+    """Feed-forward networks as flat arrays for :func:`forward`: per network its node evaluations in
+    neat-python's order (``node_start``), per node its value slot, activation id, bias, response and
+    incoming links (``link_start``), per link its source slot and weight. Slots 0..11 of a network
+    are its inputs; ``out_slot`` gives each network's 4 output slots."""
+
+    node_start: np.ndarray
+    node_slot: np.ndarray
+    node_act: np.ndarray
+    node_bias: np.ndarray
+    node_resp: np.ndarray
+    link_start: np.ndarray
+    link_src: np.ndarray
+    link_w: np.ndarray
+    out_slot: np.ndarray
+    n_slots: int
+
+
+def pack_networks(genomes: Sequence, config) -> PackedNetworks:
+    """Pack neat-python genomes into :class:`PackedNetworks` (via ``neat.nn.FeedForwardNetwork.create``)."""
+    import neat
+
+    node_start, node_slot, node_act, node_bias, node_resp = [0], [], [], [], []
+    link_start, link_src, link_w, out_slot = [0], [], [], []
+    width = OBS_DIM + 1
+    nets = [neat.nn.FeedForwardNetwork.create(g, config) for g in genomes]
+    for net in nets:
+        width = max(width, OBS_DIM + len(net.node_evals) + ACTION_DIM)
+    for net in nets:
+        slots = {k: i for i, k in enumerate(net.input_nodes)}
+        for node, act, _agg, bias, response, links in net.node_evals:
+            slots[node] = len(slots)
+            name = act.__name__.replace("_activation", "")
+            if name not in ACTIVATIONS:
+                raise NeurohoverError(f"activation {name!r} is not computed here: allowed {', '.join(ACTIVATIONS)}")
+            node_slot.append(slots[node])
+            node_act.append(ACTIVATIONS.index(name))
+            node_bias.append(bias)
+            node_resp.append(response)
+            for src, w in links:
+                link_src.append(slots[src])
+                link_w.append(w)
+            link_start.append(len(link_src))
+        node_start.append(len(node_slot))
+        # an output no node evaluation reaches reads as 0 (neat-python's values dict default is 0.0 too)
+        out_slot.append([slots.get(k, width - 1) for k in net.output_nodes])
+    i64 = np.int64
+    return PackedNetworks(
+        np.asarray(node_start, i64),
+        np.asarray(node_slot, i64),
+        np.asarray(node_act, i64),
+        np.asarray(node_bias, float),
+        np.asarray(node_resp, float),
+        np.asarray(link_start, i64),
+        np.asarray(link_src, i64),
+        np.asarray(link_w, float),
+        np.asarray(out_slot, i64).reshape(-1, ACTION_DIM),
+        width,
+    )
+
+
+@nb.njit(cache=True)
+def _forward(node_start, node_slot, node_act, node_bias, node_resp, link_start, link_src, link_w, out_slot, width, net_of_row, obs, out):
+    values = np.zeros(width)
+    for r in range(obs.shape[0]):
+        n = net_of_row[r]
+        values[:] = 0.0
+        for i in range(obs.shape[1]):
+            values[i] = obs[r, i]
+        for j in range(node_start[n], node_start[n + 1]):
+            s = 0.0
+            for k in range(link_start[j], link_start[j + 1]):
+                s += values[link_src[k]] * link_w[k]
+            z = node_bias[j] + node_resp[j] * s
+            a = node_act[j]
+            if a == 1:  # tanh, as neat-python: tanh(2.5 z) clamped to +-60 first
+                z = math.tanh(max(-60.0, min(60.0, 2.5 * z)))
+            elif a == 2:  # sigmoid: 1 / (1 + exp(-5 z)), 5 z clamped to +-60
+                z = 1.0 / (1.0 + math.exp(-max(-60.0, min(60.0, 5.0 * z))))
+            elif a == 3:
+                z = max(-1.0, min(1.0, z))
+            elif a == 4:
+                z = z if z > 0.0 else 0.0
+            values[node_slot[j]] = z
+        for m in range(out.shape[1]):
+            out[r, m] = values[out_slot[n, m]]
+
+
+def forward(packed: PackedNetworks, net_of_row: np.ndarray, obs: np.ndarray) -> np.ndarray:
+    """The actions of network ``net_of_row[r]`` for observation row ``r``: shape (B, 4)."""
+    p = packed
+    out = np.empty((obs.shape[0], ACTION_DIM))
+    _forward(
+        p.node_start, p.node_slot, p.node_act, p.node_bias, p.node_resp, p.link_start, p.link_src, p.link_w, p.out_slot, p.n_slots,
+        np.ascontiguousarray(net_of_row, dtype=np.int64), np.ascontiguousarray(obs, dtype=np.float64), out,
+    )  # fmt: skip
+    return out
+
+
+@dataclass
+class TopologyResult:
+    """A NEAT run: its champion (a neat-python genome) and its size, the config, and one row per generation."""
+
+    champion: object
+    champion_fitness: float
+    nodes: int  # hidden and output nodes of the champion, enabled or not reached
+    connections: int  # its enabled connections
+    episodes: int
+    generations: int
+    config: object
+    history: list[dict] = field(default_factory=list)
+
+    def act(self, obs: np.ndarray) -> np.ndarray:
+        """The champion's actions for a batch of observations (B, 12) -> (B, 4)."""
+        packed = pack_networks([self.champion], self.config)
+        return forward(packed, np.zeros(len(obs), dtype=np.int64), np.asarray(obs, dtype=np.float64))
+
+
+def evolve_topology(
+    mdps: MDP | Sequence[MDP],
+    *,
+    budget: int,
+    seed: int = 0,
+    settings: NeatSettings | None = None,
+    n_steps: int = EPISODE_STEPS,
+) -> TopologyResult:
+    """Evolve a network's topology and weights with NEAT on ``mdps`` for ``budget`` episodes.
+
+    Each genome of a generation flies ``settings.episodes`` episodes (on the MDPs in turn when there are
+    several, as a run over training MDPs); fitness is its mean return.
+    """
+    import neat
+
+    from .flying import evaluate_callable
+
+    s = settings if settings is not None else NeatSettings()
+    mdp_list = [mdps] if isinstance(mdps, MDP) else list(mdps)
+    if not mdp_list or not all(isinstance(m, MDP) for m in mdp_list):
+        raise NeurohoverError("mdps must be one MDP or a non-empty sequence of MDPs of one task family")
+    if isinstance(budget, bool) or not isinstance(budget, (int, np.integer)) or budget < s.pop_size * s.episodes:
+        raise NeurohoverError(f"budget={budget!r} is out of range: allowed an integer >= one generation ({s.pop_size * s.episodes} episodes)")
+    config = neat_config(s)
+    history: list[dict] = []
+    flown = 0
+    best: list = [None, -math.inf]  # the genome of the best estimate ever, copied when told (an elite is evaluated again)
+
+    def fitness(genomes, cfg) -> None:
+        nonlocal flown
+        packed = pack_networks([g for _, g in genomes], cfg)
+        n = len(genomes) * s.episodes
+        # episode j of the generation: genome j // episodes, MDP j % len(mdps), gust stream (seed, flown + j)
+        rows = [mdp_list[j % len(mdp_list)] for j in range(n)]
+        ev = evaluate_callable(
+            lambda obs, idx: forward(packed, idx // s.episodes, obs), rows, seed=seed, first_episode=flown, n_steps=n_steps, obs_dtype="float64", indexed=True
+        )
+        returns = np.asarray(ev.returns).reshape(len(genomes), s.episodes)
+        for (_, g), r in zip(genomes, returns, strict=True):
+            g.fitness = float(r.mean())
+            if g.fitness > best[1]:
+                best[:] = [copy.deepcopy(g), g.fitness]
+        flown += n
+        history.append({"generation": len(history), "episodes": flown, "best": float(returns.mean(axis=1).max()), "crashed": int(np.sum(ev.crashed))})
+
+    state = random.getstate()
+    random.seed(seed)
+    try:
+        population = neat.Population(config)
+        generations = max(1, int(budget) // (s.pop_size * s.episodes))
+        population.run(fitness, generations)
+    finally:
+        random.setstate(state)
+    champion, champion_fitness = best
+    enabled = sum(1 for c in champion.connections.values() if c.enabled)
+    return TopologyResult(champion, float(champion_fitness), len(champion.nodes), enabled, flown, len(history), config, history)
