@@ -60,8 +60,12 @@ class NeatSettings:
     activations: tuple[str, ...] = ("tanh", "sigmoid", "identity")
     node_add_prob: float = 0.2
     conn_add_prob: float = 0.3
+    node_delete_prob: float = 0.1
+    conn_delete_prob: float = 0.2
     weight_mutate_power: float = 0.5
     compatibility_threshold: float = 3.0
+    weight_init_stdev: float = 0.5  # 0: every genome starts as the zero network, as NE's zero prototype
+    bias_init_stdev: float = 0.5
 
     def __post_init__(self) -> None:
         if isinstance(self.pop_size, bool) or not isinstance(self.pop_size, int) or self.pop_size < 4:
@@ -73,7 +77,7 @@ class NeatSettings:
         bad = [a for a in self.activations if a not in ACTIVATIONS]
         if not self.activations or bad:
             raise ValueError(f"activations={self.activations!r}: allowed a non-empty tuple of {', '.join(ACTIVATIONS)}")
-        for name in ("node_add_prob", "conn_add_prob"):
+        for name in ("node_add_prob", "conn_add_prob", "node_delete_prob", "conn_delete_prob"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and 0.0 <= v <= 1.0):
                 raise ValueError(f"{name}={v!r} must be a probability in [0, 1]")
@@ -81,6 +85,10 @@ class NeatSettings:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
                 raise ValueError(f"{name}={v!r} must be a finite number > 0")
+        for name in ("weight_init_stdev", "bias_init_stdev"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+                raise ValueError(f"{name}={v!r} must be a finite number >= 0")
 
 
 _CONFIG = """
@@ -99,7 +107,7 @@ aggregation_default     = sum
 aggregation_mutate_rate = 0.0
 aggregation_options     = sum
 bias_init_mean          = 0.0
-bias_init_stdev         = 0.5
+bias_init_stdev         = {bias_init_stdev}
 bias_max_value          = 30.0
 bias_min_value          = -30.0
 bias_mutate_power       = 0.2
@@ -108,13 +116,13 @@ bias_replace_rate       = 0.1
 compatibility_disjoint_coefficient = 1.0
 compatibility_weight_coefficient   = 0.5
 conn_add_prob           = {conn_add_prob}
-conn_delete_prob        = 0.2
+conn_delete_prob        = {conn_delete_prob}
 enabled_default         = True
 enabled_mutate_rate     = 0.01
 feed_forward            = True
 initial_connection      = {initial}
 node_add_prob           = {node_add_prob}
-node_delete_prob        = 0.1
+node_delete_prob        = {node_delete_prob}
 num_hidden              = 0
 num_inputs              = {n_inputs}
 num_outputs             = {n_outputs}
@@ -126,7 +134,7 @@ response_mutate_power   = 0.0
 response_mutate_rate    = 0.0
 response_replace_rate   = 0.0
 weight_init_mean        = 0.0
-weight_init_stdev       = 0.5
+weight_init_stdev       = {weight_init_stdev}
 weight_max_value        = 30
 weight_min_value        = -30
 weight_mutate_power     = {weight_mutate_power}
@@ -157,11 +165,15 @@ def neat_config(settings: NeatSettings):
         activations=" ".join(settings.activations),
         conn_add_prob=settings.conn_add_prob,
         node_add_prob=settings.node_add_prob,
+        conn_delete_prob=settings.conn_delete_prob,
+        node_delete_prob=settings.node_delete_prob,
         initial=settings.initial,
         n_inputs=OBS_DIM,
         n_outputs=ACTION_DIM,
         weight_mutate_power=settings.weight_mutate_power,
         compatibility_threshold=settings.compatibility_threshold,
+        weight_init_stdev=settings.weight_init_stdev,
+        bias_init_stdev=settings.bias_init_stdev,
     )
     fd, path = tempfile.mkstemp(suffix=".ini", prefix="neurohover-neat-")
     try:
