@@ -10,8 +10,9 @@ import pytest
 
 neat = pytest.importorskip("neat", reason="neat-python is not installed (pip install '.[neat]')")
 
-from neurohover import NeurohoverError, get_task_family  # noqa: E402
-from neurohover.integrations.neat import NeatSettings, evolve_topology, forward, neat_config, pack_networks  # noqa: E402
+from neurohover import NeurohoverError, baseline_policy, evaluate, get_task_family  # noqa: E402  # noqa: E402
+from neurohover.integrations.flying import evaluate_callable  # noqa: E402
+from neurohover.integrations.neat import INPUT_INDEX, NeatSettings, evolve_topology, forward, neat_config, pack_networks, seed_baseline  # noqa: E402
 
 
 def _grown_genomes(n: int, seed: int):
@@ -34,7 +35,7 @@ def test_the_compiled_forward_pass_is_neat_pythons_network() -> None:
     packed = pack_networks(genomes, config)
     ours = forward(packed, np.arange(12), obs)
     for i, g in enumerate(genomes):
-        theirs = neat.nn.FeedForwardNetwork.create(g, config).activate(obs[i].tolist())
+        theirs = neat.nn.FeedForwardNetwork.create(g, config).activate(obs[i, INPUT_INDEX].tolist())
         np.testing.assert_allclose(ours[i], theirs, rtol=1e-12, atol=1e-12)
 
 
@@ -64,3 +65,20 @@ def test_bad_settings_are_refused() -> None:
         NeatSettings(pop_size=2)
     with pytest.raises(NeurohoverError, match="mdps must be"):
         evolve_topology([], budget=1000)
+
+
+def test_a_genome_seeded_with_the_baseline_flies_the_baseline() -> None:
+    """The whole path (the network, its inputs, the vector environment's gusts) is the kernel's: a NEAT
+    genome made the baseline earns the baseline policy's returns on the same episodes."""
+    config = neat_config(NeatSettings(pop_size=4, start="baseline", activations=("identity", "tanh")))
+    random.seed(0)
+    genome = next(iter(neat.Population(config).population.values()))
+    seed_baseline(genome, config)
+    packed = pack_networks([genome], config)
+    mdps = [get_task_family("ghh09").mdp(f"train:{i}") for i in (0, 3)]
+    ours = evaluate_callable(lambda obs: forward(packed, np.zeros(len(obs), dtype=np.int64), obs), mdps, episodes=3, seed=5, obs_dtype="float64")
+    theirs = evaluate(baseline_policy(), mdps, episodes=3, seed=5)
+    np.testing.assert_allclose(ours.returns, theirs.returns[0], rtol=1e-9)  # (policies, MDPs, episodes)
+    assert not ours.crashed.any()
+    with pytest.raises(ValueError, match="start='baseline' needs"):
+        NeatSettings(start="baseline", activations=("tanh",))

@@ -2,7 +2,8 @@
 
 The paper (Section 3.1): NEAT "did not discover topologies that outperformed the manually designed
 topology", with no numbers. Here, on GHH-08 training MDP 0 at one episode budget: NEAT (neat-python,
-from a fully connected 12 -> 4 network, population 150, one episode a genome) against steady-state NE
+from a fully connected 9 -> 4 network, population 150, one episode a genome; random, zero or the
+baseline at the start) against steady-state NE
 (the paper's Table 6) evolving the SLP and the paper's MLP, each from zero and from the baseline. Every
 champion then flies the same fresh validation episodes (gust streams (VALIDATION_SEED, 0..n-1)).
 
@@ -24,6 +25,12 @@ from neurohover.integrations.neat import NeatSettings, evolve_topology
 from neurohover.policies import prototype
 
 VALIDATION_SEED = 777
+#: neat-python's usual settings; the same from the zero network (NE's zero prototype); from the baseline.
+NEAT_VARIANTS = {
+    "neat": NeatSettings(),
+    "neat-zero": NeatSettings(weight_init_stdev=0.0, bias_init_stdev=0.0),
+    "neat-baseline": NeatSettings(start="baseline", activations=("identity", "tanh", "sigmoid")),
+}
 
 
 def main() -> None:
@@ -37,15 +44,16 @@ def main() -> None:
     mdp = get_task_family("ghh08").mdp(args.mdp)
     runs = []
     for seed in range(args.seeds):
-        t0 = time.perf_counter()
-        neat = evolve_topology(mdp, budget=args.budget, seed=seed, settings=NeatSettings())
-        val = evaluate_callable(neat.act, mdp, episodes=args.validation, seed=VALIDATION_SEED, obs_dtype="float64")
-        runs.append(
-            {"method": "neat", "seed": seed, "seconds": time.perf_counter() - t0, "champion_estimate": neat.champion_fitness,
-             "nodes": neat.nodes, "connections": neat.connections, "episodes": neat.episodes,
-             "validation_mean": float(np.mean(val.returns)), "validation_crashes": int(np.sum(val.crashed))}
-        )  # fmt: skip
-        print(runs[-1], flush=True)
+        for method, settings in NEAT_VARIANTS.items():
+            t0 = time.perf_counter()
+            neat = evolve_topology(mdp, budget=args.budget, seed=seed, settings=settings)
+            val = evaluate_callable(neat.act, mdp, episodes=args.validation, seed=VALIDATION_SEED, obs_dtype="float64")
+            runs.append(
+                {"method": method, "seed": seed, "seconds": time.perf_counter() - t0, "champion_estimate": neat.champion_fitness,
+                 "nodes": neat.nodes, "connections": neat.connections, "episodes": neat.episodes,
+                 "validation_mean": float(np.mean(val.returns)), "validation_crashes": int(np.sum(val.crashed))}
+            )  # fmt: skip
+            print(runs[-1], flush=True)
         for topology in ("slp", "mlp"):
             for start in ("zero", "baseline"):
                 t0 = time.perf_counter()

@@ -2,8 +2,8 @@
 
 The paper (Section 3.1) reports that NEAT and AEONN "did not discover topologies that outperformed
 the manually designed topology", without numbers. This module runs that claim: neat-python's
-``Population`` (species, crossover, structural mutation) evolves feed-forward networks of the 12
-observations -> 4 actions, and every generation's genomes fly their episodes together in the
+``Population`` (species, crossover, structural mutation) evolves feed-forward networks of the nine
+state features the paper's networks see -> 4 actions, and every generation's genomes fly their episodes together in the
 native vector environment (:func:`neurohover.integrations.flying.evaluate_callable`, the same
 physics and the same (seed, episode) gust streams as the kernel), each network evaluated by a
 compiled forward pass that is neat-python's ``FeedForwardNetwork.activate`` for a whole batch.
@@ -37,13 +37,17 @@ import numba as nb
 import numpy as np
 
 from ..errors import NeurohoverError
-from ..sim.constants import ACTION_DIM, EPISODE_STEPS, OBS_DIM
+from ..sim.constants import ACTION_DIM, EPISODE_STEPS, OBS_NAMES
 from ..tasks import MDP
 
 __all__ = ["ACTIVATIONS", "NeatSettings", "TopologyResult", "evolve_topology", "forward", "pack_networks"]
 
 #: neat-python's activation functions this forward pass computes, by id (its ``activations`` module, exactly).
 ACTIVATIONS = ("identity", "tanh", "sigmoid", "clamped", "relu")
+#: What a network sees: the nine state features of the paper's networks (Section 3.1), as the SLP and MLP do.
+INPUTS = ("u", "v", "w", "x", "y", "z", "qx", "qy", "qz")
+INPUT_INDEX = np.array([OBS_NAMES.index(name) for name in INPUTS])
+N_INPUTS = len(INPUTS)
 
 
 @dataclass(frozen=True)
@@ -52,6 +56,9 @@ class NeatSettings:
 
     ``initial``: the starting topology, ``"full_direct"`` (every input to every output, an SLP) or
     ``"unconnected"``; ``activations``: those a new node may take (the first is the default).
+    ``start``: ``"random"`` (neat-python's initial genomes) or ``"baseline"``: every initial genome the
+    baseline policy (the SLP's gains and biases on the direct connections, identity outputs), as the
+    paper seeds its SLP and MLP; it needs ``initial = "full_direct"`` and ``"identity"`` among the activations.
     """
 
     pop_size: int = 150
@@ -66,6 +73,7 @@ class NeatSettings:
     compatibility_threshold: float = 3.0
     weight_init_stdev: float = 0.5  # 0: every genome starts as the zero network, as NE's zero prototype
     bias_init_stdev: float = 0.5
+    start: str = "random"
 
     def __post_init__(self) -> None:
         if isinstance(self.pop_size, bool) or not isinstance(self.pop_size, int) or self.pop_size < 4:
@@ -74,6 +82,10 @@ class NeatSettings:
             raise ValueError(f"episodes={self.episodes!r} must be an integer >= 1")
         if self.initial not in ("full_direct", "unconnected"):
             raise ValueError(f"initial={self.initial!r}: allowed full_direct or unconnected")
+        if self.start not in ("random", "baseline"):
+            raise ValueError(f"start={self.start!r}: allowed random or baseline")
+        if self.start == "baseline" and (self.initial != "full_direct" or "identity" not in self.activations):
+            raise ValueError("start='baseline' needs initial='full_direct' and 'identity' among the activations (the baseline is linear)")
         bad = [a for a in self.activations if a not in ACTIVATIONS]
         if not self.activations or bad:
             raise ValueError(f"activations={self.activations!r}: allowed a non-empty tuple of {', '.join(ACTIVATIONS)}")
@@ -168,7 +180,7 @@ def neat_config(settings: NeatSettings):
         conn_delete_prob=settings.conn_delete_prob,
         node_delete_prob=settings.node_delete_prob,
         initial=settings.initial,
-        n_inputs=OBS_DIM,
+        n_inputs=N_INPUTS,
         n_outputs=ACTION_DIM,
         weight_mutate_power=settings.weight_mutate_power,
         compatibility_threshold=settings.compatibility_threshold,
@@ -188,8 +200,8 @@ def neat_config(settings: NeatSettings):
 class PackedNetworks:
     """Feed-forward networks as flat arrays for :func:`forward`: per network its node evaluations in
     neat-python's order (``node_start``), per node its value slot, activation id, bias, response and
-    incoming links (``link_start``), per link its source slot and weight. Slots 0..11 of a network
-    are its inputs; ``out_slot`` gives each network's 4 output slots."""
+    incoming links (``link_start``), per link its source slot and weight. Slots 0..8 of a network
+    are its inputs (:data:`INPUTS`); ``out_slot`` gives each network's 4 output slots."""
 
     node_start: np.ndarray
     node_slot: np.ndarray
@@ -209,10 +221,10 @@ def pack_networks(genomes: Sequence, config) -> PackedNetworks:
 
     node_start, node_slot, node_act, node_bias, node_resp = [0], [], [], [], []
     link_start, link_src, link_w, out_slot = [0], [], [], []
-    width = OBS_DIM + 1
+    width = N_INPUTS + 1
     nets = [neat.nn.FeedForwardNetwork.create(g, config) for g in genomes]
     for net in nets:
-        width = max(width, OBS_DIM + len(net.node_evals) + ACTION_DIM)
+        width = max(width, N_INPUTS + len(net.node_evals) + ACTION_DIM)
     for net in nets:
         slots = {k: i for i, k in enumerate(net.input_nodes)}
         for node, act, _agg, bias, response, links in net.node_evals:
@@ -274,8 +286,9 @@ def _forward(node_start, node_slot, node_act, node_bias, node_resp, link_start, 
 
 
 def forward(packed: PackedNetworks, net_of_row: np.ndarray, obs: np.ndarray) -> np.ndarray:
-    """The actions of network ``net_of_row[r]`` for observation row ``r``: shape (B, 4)."""
+    """The actions of network ``net_of_row[r]`` for observation row ``r`` (B, 12): shape (B, 4)."""
     p = packed
+    obs = np.asarray(obs, dtype=np.float64)[:, INPUT_INDEX]
     out = np.empty((obs.shape[0], ACTION_DIM))
     _forward(
         p.node_start, p.node_slot, p.node_act, p.node_bias, p.node_resp, p.link_start, p.link_src, p.link_w, p.out_slot, p.n_slots,
@@ -301,6 +314,20 @@ class TopologyResult:
         """The champion's actions for a batch of observations (B, 12) -> (B, 4)."""
         packed = pack_networks([self.champion], self.config)
         return forward(packed, np.zeros(len(obs), dtype=np.int64), np.asarray(obs, dtype=np.float64))
+
+
+def seed_baseline(genome, config) -> None:
+    """Make ``genome`` (fully connected inputs -> outputs) the baseline policy: gains on its direct
+    connections, the biases on its outputs, identity outputs, every other weight 0."""
+    from ..policies import BASELINE_BIASES, BASELINE_GAINS
+
+    gains = {(-1 - INPUTS.index(inp), int(action[1]) - 1): g for (action, inp), g in BASELINE_GAINS.items()}
+    for key, conn in genome.connections.items():
+        conn.weight = float(gains.get(key, 0.0))
+        conn.enabled = True
+    for k in config.genome_config.output_keys:
+        node = genome.nodes[k]
+        node.bias, node.response, node.activation, node.aggregation = float(BASELINE_BIASES[k]), 1.0, "identity", "sum"
 
 
 def evolve_topology(
@@ -352,6 +379,9 @@ def evolve_topology(
     random.seed(seed)
     try:
         population = neat.Population(config)
+        if s.start == "baseline":
+            for genome in population.population.values():
+                seed_baseline(genome, config)
         generations = max(1, int(budget) // (s.pop_size * s.episodes))
         population.run(fitness, generations)
     finally:
