@@ -181,3 +181,25 @@ def test_a_repeated_sensor_key_and_a_damaged_store_are_one_clear_line(tmp_path: 
     err = capsys.readouterr().err
     assert rc == 2 and "a results store cannot be read" in err and "Traceback" not in err
     assert not (tmp_path / "r").exists()  # the output directory it made is gone again
+
+
+def test_a_damaged_row_is_named_and_the_rest_of_the_store_reported(tmp_path: Path, capsys) -> None:
+    """issue 37: a unit or config whose stored JSON is damaged was a JSONDecodeError traceback; now the command
+    names the row, and the report reports every other experiment, the damaged one in its place."""
+    import sqlite3
+
+    from neurohover.experiments import LocalExecutor, Store, load_config, reproduce, write_report
+
+    path = tmp_path / "s.sqlite"
+    with Store(path) as store:
+        for name in ("fig2", "ablation-plateau"):
+            cfg = load_config(name, "quick", {"runs": 1, "budget": 40, "n_steps": 20})
+            reproduce(cfg, store, LocalExecutor(1), progress=False)
+    with sqlite3.connect(path) as conn:
+        conn.execute("UPDATE units SET result = '{cut' WHERE name = 'fig2' AND key = (SELECT min(key) FROM units WHERE name = 'fig2')")
+    assert main(["results", "fig2", "--store", str(path), "--scale", "quick"]) == 2
+    err = capsys.readouterr().err
+    assert "experiment fig2 (quick), unit" in err and "is damaged (not JSON" in err and "Traceback" not in err
+    with Store(path, create=False) as store:
+        report = write_report(store, tmp_path / "rep").read_text()
+    assert "Not reported: the store's copy is damaged." in report and "## Ablation" in report

@@ -518,8 +518,13 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
     claims: dict[str, tuple[str, list[dict[str, str]]]] = {}  # paper figure -> (its section's anchor, its claims)
     statuses: list[Status] = []
     for name, sc in entries:
-        cfg = ExperimentConfig.from_dict(store.config(name, sc))
-        text, checked, status = _section(cfg, store, out)
+        try:
+            cfg = ExperimentConfig.from_dict(store.config(name, sc))
+            text, checked, status = _section(cfg, store, out)
+        except NeurohoverError as err:  # one damaged experiment: said in its place, the others reported as usual
+            sections.append(f"## {name} [{sc}]\n\n**Not reported: the store's copy is damaged.** {err}\n")
+            toc.append(f"- [{name} [{sc}]](#{_anchor(name + ' [' + sc + ']')}) (damaged)")
+            continue
         statuses.append(status)
         sections.append(text)
         anchor = _anchor(cfg.title + " [" + sc + "]")

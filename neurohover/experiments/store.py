@@ -281,7 +281,7 @@ class Store:
         row = self.conn.execute("SELECT config FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
         if row is None:
             raise NeurohoverError(self.missing_message(name, scale))
-        return json.loads(row[0])
+        return self._json(row[0], f"experiment {name} ({scale})'s config")
 
     def missing_message(self, name: str, scale: str | None) -> str:
         """The message for an experiment (at ``scale``, if given) this store does not hold, listing what it holds."""
@@ -296,7 +296,8 @@ class Store:
 
     def results(self, name: str, scale: str) -> dict[str, dict]:
         """key -> result of every finished unit."""
-        return {k: json.loads(r) for k, r in self.conn.execute("SELECT key, result FROM units WHERE name = ? AND scale = ?", (name, scale))}
+        rows = self.conn.execute("SELECT key, result FROM units WHERE name = ? AND scale = ?", (name, scale))
+        return {k: self._json(r, f"experiment {name} ({scale}), unit {k}'s result") for k, r in rows}
 
     def units(self, name: str, scale: str) -> list[dict]:
         """Every finished unit: key, kind, params, result, seconds, worker, finished (time)."""
@@ -304,9 +305,24 @@ class Store:
             "SELECT key, kind, params, result, seconds, worker, finished FROM units WHERE name = ? AND scale = ? ORDER BY key", (name, scale)
         )
         return [
-            {"key": k, "kind": kind, "params": json.loads(p), "result": json.loads(r), "seconds": s, "worker": w, "finished": f}
+            {
+                "key": k,
+                "kind": kind,
+                "params": self._json(p, f"experiment {name} ({scale}), unit {k}'s params"),
+                "result": self._json(r, f"experiment {name} ({scale}), unit {k}'s result"),
+                "seconds": s,
+                "worker": w,
+                "finished": f,
+            }
             for k, kind, p, r, s, w, f in rows
         ]
+
+    def _json(self, text: str, what: str):
+        """A stored JSON text, or one clear error naming the damaged row (the rest of the store stays readable)."""
+        try:
+            return json.loads(text)
+        except (json.JSONDecodeError, TypeError) as err:
+            raise NeurohoverError(f"results store {str(self.path)!r}: {what} is damaged (not JSON: {err})") from None
 
     def put(self, name: str, scale: str, config_hash: str, unit, result: dict, seconds: float, worker: str = "", session: int | None = None) -> bool:
         """Record one finished unit in its own transaction; False if it was already there."""
