@@ -661,3 +661,19 @@ def test_a_refused_only_leaves_the_store_as_it_was(tmp_path: Path, capsys) -> No
     assert main([*base, "--set", "budget=120", "--only", "evolve/k1/run0"]) == 0  # other settings: not "settings differ"
     with Store(store) as s:
         assert sorted(s.results("slowtest", "quick")) == ["evolve/k1/run0"]
+
+
+def test_an_update_that_forgets_the_policy_source_is_refused(tmp_path) -> None:
+    """--update without the run's `--set policies=shipped` would have run every unit again (and dropped the stored
+    ones): it is refused with the setting to give, and the store is left as it was."""
+    from neurohover.experiments import LocalExecutor, Store, load_config, reproduce
+
+    small = {"episodes": 2, "n_steps": 20}
+    with Store(tmp_path / "s.sqlite") as store:
+        reproduce(load_config("fig7", "quick", {**small, "policies": "shipped"}), store, LocalExecutor(1), progress=False)
+        before = store.units("fig7", "quick")
+        with pytest.raises(NeurohoverError, match=r"give --set policies=\"shipped\" as they were run, or --fresh"):
+            reproduce(load_config("fig7", "quick", {**small, "n_steps": 30}), store, LocalExecutor(1), progress=False, update=True)
+        assert store.units("fig7", "quick") == before
+        changed = reproduce(load_config("fig7", "quick", {**small, "n_steps": 30, "policies": "shipped"}), store, LocalExecutor(1), progress=False, update=True)
+        assert changed.status == "finished"

@@ -9,11 +9,9 @@ from pathlib import Path
 
 from neurohover.experiments.config import ExperimentConfig, load_config, shipped_configs
 from neurohover.experiments.plans import plan, source_experiments
-from neurohover.experiments.runner import unchanged_units
+from neurohover.experiments.runner import POLICY_SOURCES, unchanged_units
 from neurohover.experiments.store import Store
 
-#: The settings a paper-scale run may have been given on the command line (README: `--set policies=shipped`).
-POLICY_SOURCES = ("policies", "generic")
 #: Paper-scale experiments whose config changed on purpose and whose re-run (`reproduce NAME --scale paper
 #: --update`) is under way: the model-substeps default of 2026-12-04 (issue 31; docs/reproduction/README.md).
 #: Each must still be taken by --update (its unchanged units kept). Emptied as the store receives the re-runs.

@@ -98,6 +98,22 @@ def unchanged_units(config: ExperimentConfig, store: Store) -> set[str]:
         kept.update((key, stored[key]["result"]) for key in same)
 
 
+#: Settings that say where an experiment's policies come from; a paper-scale run may have set them on the
+#: command line (`--set policies=shipped`), and an --update that forgets them would run every unit again.
+POLICY_SOURCES = ("policies", "generic")
+
+
+def _check_policy_source(config: ExperimentConfig, store: Store) -> None:
+    """Refuse an ``--update`` whose policies come from elsewhere than the stored runs' (every unit would run again)."""
+    stored = store.config(config.name, config.scale)["settings"]
+    for key in POLICY_SOURCES:
+        if key in stored and stored[key] != config.settings.get(key):
+            raise NeurohoverError(
+                f"{config.name} ({config.scale}): the stored results fly {key} = {stored[key]!r}, this config {config.settings.get(key)!r}: "
+                f"an --update would run every unit again; give --set {key}={json.dumps(stored[key])} as they were run, or --fresh to start over"
+            )
+
+
 def _matches_no_unit(config, pattern: str, units) -> NeurohoverError:
     """The error of an ``--only`` pattern that selects nothing, with what unit keys look like."""
     return NeurohoverError(f"{config.name}: --only {pattern!r} matches no unit; unit keys look like {', '.join(u.key for u in units[:3])}")
@@ -136,6 +152,7 @@ def reproduce(
         if unmatched and len(first.units) == first.total:
             raise _matches_no_unit(config, unmatched[0], first.units)
     if update and held is not None and held != config.hash:
+        _check_policy_source(config, store)
         kept = store.update(config.name, config.scale, config.hash, config.to_dict(), unchanged_units(config, store))
         print(f"{config.name} ({config.scale}): the config changed (hash {held} -> {config.hash}); {kept} stored units stand unchanged", file=sys.stderr)
     store.begin(config.name, config.scale, config.hash, config.to_dict(), fresh=fresh)
