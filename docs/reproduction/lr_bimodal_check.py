@@ -5,7 +5,7 @@ the unit's model again from the same flight data (and checks it is the stored on
 on it from ``--seeds`` evolution seeds (seed 0 is the unit's own) and flies each in the true MDP on the
 unit's test gusts. Variants of the model the policies evolve on:
 
-- ``one``: the model as fitted, one 0.1 s step per control step (Table 4's, the paper's and the authors');
+- ``one``: the model as fitted, one 0.1 s step per control step (Table 4's before 2026-12-04; the authors' FGHH code);
 - ``cw-true``: the same with its w drag C_w replaced by the true MDP's (its one-substep equivalent):
   OLS fits C_w at about +2 where the simulator's is -0.49;
 - ``ten``: the fitted model in the simulator's ten substeps (``LearnedModel.mdp(substeps=10)``).

@@ -30,6 +30,8 @@ NEAT_VARIANTS = {
     "neat": NeatSettings(),
     "neat-zero": NeatSettings(weight_init_stdev=0.0, bias_init_stdev=0.0),
     "neat-baseline": NeatSettings(start="baseline", activations=("identity", "tanh", "sigmoid")),
+    # mutations of the baseline's size (its gains are 0.02-0.8), as NE's operators make them
+    "neat-baseline-fine": NeatSettings(start="baseline", activations=("identity", "tanh", "sigmoid"), weight_mutate_power=0.02),
 }
 
 
@@ -40,11 +42,14 @@ def main() -> None:
     ap.add_argument("--validation", type=int, default=20)
     ap.add_argument("--mdp", default="train:0")
     ap.add_argument("--out", required=True)
+    ap.add_argument("--methods", help="comma-separated subset of the methods (default: all)")
     args = ap.parse_args()
     mdp = get_task_family("ghh08").mdp(args.mdp)
     runs = []
     for seed in range(args.seeds):
         for method, settings in NEAT_VARIANTS.items():
+            if args.methods and method not in args.methods.split(","):
+                continue
             t0 = time.perf_counter()
             neat = evolve_topology(mdp, budget=args.budget, seed=seed, settings=settings)
             val = evaluate_callable(neat.act, mdp, episodes=args.validation, seed=VALIDATION_SEED, obs_dtype="float64")
@@ -56,6 +61,8 @@ def main() -> None:
             print(runs[-1], flush=True)
         for topology in ("slp", "mlp"):
             for start in ("zero", "baseline"):
+                if args.methods and f"{topology}-{start}" not in args.methods.split(","):
+                    continue
                 t0 = time.perf_counter()
                 r = evolve(mdp, topology=topology, prototype=prototype(topology, start), budget=args.budget, seed=seed)
                 val = evaluate(r.champion, mdp, episodes=args.validation, seed=VALIDATION_SEED)
