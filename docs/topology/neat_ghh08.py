@@ -30,8 +30,11 @@ NEAT_VARIANTS = {
     "neat": NeatSettings(),
     "neat-zero": NeatSettings(weight_init_stdev=0.0, bias_init_stdev=0.0),
     "neat-baseline": NeatSettings(start="baseline", activations=("identity", "tanh", "sigmoid")),
-    # mutations of the baseline's size (its gains are 0.02-0.8), as NE's operators make them
-    "neat-baseline-fine": NeatSettings(start="baseline", activations=("identity", "tanh", "sigmoid"), weight_mutate_power=0.02),
+    # mutations of the baseline's size (its gains are 0.02-0.8, its collective bias 0.23), as NE's operators make
+    # them, and nodes that keep their activation (a linear output stays linear)
+    "neat-baseline-fine": NeatSettings(
+        start="baseline", activations=("identity", "tanh", "sigmoid"), weight_mutate_power=0.02, bias_mutate_power=0.02, activation_mutate_rate=0.0
+    ),
 }
 
 

@@ -70,6 +70,8 @@ class NeatSettings:
     node_delete_prob: float = 0.1
     conn_delete_prob: float = 0.2
     weight_mutate_power: float = 0.5
+    bias_mutate_power: float = 0.2
+    activation_mutate_rate: float = 0.1
     compatibility_threshold: float = 3.0
     weight_init_stdev: float = 0.5  # 0: every genome starts as the zero network, as NE's zero prototype
     bias_init_stdev: float = 0.5
@@ -89,11 +91,11 @@ class NeatSettings:
         bad = [a for a in self.activations if a not in ACTIVATIONS]
         if not self.activations or bad:
             raise ValueError(f"activations={self.activations!r}: allowed a non-empty tuple of {', '.join(ACTIVATIONS)}")
-        for name in ("node_add_prob", "conn_add_prob", "node_delete_prob", "conn_delete_prob"):
+        for name in ("node_add_prob", "conn_add_prob", "node_delete_prob", "conn_delete_prob", "activation_mutate_rate"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and 0.0 <= v <= 1.0):
                 raise ValueError(f"{name}={v!r} must be a probability in [0, 1]")
-        for name in ("weight_mutate_power", "compatibility_threshold"):
+        for name in ("weight_mutate_power", "bias_mutate_power", "compatibility_threshold"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
                 raise ValueError(f"{name}={v!r} must be a finite number > 0")
@@ -113,7 +115,7 @@ reset_on_extinction   = True
 
 [DefaultGenome]
 activation_default      = {activation_default}
-activation_mutate_rate  = 0.1
+activation_mutate_rate  = {activation_mutate_rate}
 activation_options      = {activations}
 aggregation_default     = sum
 aggregation_mutate_rate = 0.0
@@ -122,7 +124,7 @@ bias_init_mean          = 0.0
 bias_init_stdev         = {bias_init_stdev}
 bias_max_value          = 30.0
 bias_min_value          = -30.0
-bias_mutate_power       = 0.2
+bias_mutate_power       = {bias_mutate_power}
 bias_mutate_rate        = 0.7
 bias_replace_rate       = 0.1
 compatibility_disjoint_coefficient = 1.0
@@ -183,6 +185,8 @@ def neat_config(settings: NeatSettings):
         n_inputs=N_INPUTS,
         n_outputs=ACTION_DIM,
         weight_mutate_power=settings.weight_mutate_power,
+        bias_mutate_power=settings.bias_mutate_power,
+        activation_mutate_rate=settings.activation_mutate_rate,
         compatibility_threshold=settings.compatibility_threshold,
         weight_init_stdev=settings.weight_init_stdev,
         bias_init_stdev=settings.bias_init_stdev,
