@@ -30,10 +30,19 @@ NEAT_VARIANTS = {
     "neat": NeatSettings(),
     "neat-zero": NeatSettings(weight_init_stdev=0.0, bias_init_stdev=0.0),
     "neat-baseline": NeatSettings(start="baseline", activations=("identity", "tanh", "sigmoid")),
-    # mutations of the baseline's size (its gains are 0.02-0.8, its collective bias 0.23), as NE's operators make
-    # them, and nodes that keep their activation (a linear output stays linear)
+    # mutations of the baseline's size (its gains are 0.02-0.8, its collective bias 0.23), a tenth of the weights at a
+    # time, as NE's operators make them: no weight drawn afresh, no connection or node deleted, a linear output kept
+    # linear; nodes and connections still added
     "neat-baseline-fine": NeatSettings(
-        start="baseline", activations=("identity", "tanh", "sigmoid"), weight_mutate_power=0.02, bias_mutate_power=0.02, activation_mutate_rate=0.0
+        start="baseline",
+        activations=("identity", "tanh", "sigmoid"),
+        weight_mutate_power=0.02,
+        weight_mutate_rate=0.1,
+        bias_mutate_power=0.01,
+        activation_mutate_rate=0.0,
+        replace_rate=0.0,
+        conn_delete_prob=0.0,
+        node_delete_prob=0.0,
     ),
 }
 

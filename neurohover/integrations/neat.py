@@ -70,8 +70,10 @@ class NeatSettings:
     node_delete_prob: float = 0.1
     conn_delete_prob: float = 0.2
     weight_mutate_power: float = 0.5
+    weight_mutate_rate: float = 0.8  # the chance that each weight is perturbed in a mutation
     bias_mutate_power: float = 0.2
     activation_mutate_rate: float = 0.1
+    replace_rate: float = 0.1  # a weight or bias drawn afresh from its initial spread instead of perturbed
     compatibility_threshold: float = 3.0
     weight_init_stdev: float = 0.5  # 0: every genome starts as the zero network, as NE's zero prototype
     bias_init_stdev: float = 0.5
@@ -91,7 +93,7 @@ class NeatSettings:
         bad = [a for a in self.activations if a not in ACTIVATIONS]
         if not self.activations or bad:
             raise ValueError(f"activations={self.activations!r}: allowed a non-empty tuple of {', '.join(ACTIVATIONS)}")
-        for name in ("node_add_prob", "conn_add_prob", "node_delete_prob", "conn_delete_prob", "activation_mutate_rate"):
+        for name in ("node_add_prob", "conn_add_prob", "node_delete_prob", "conn_delete_prob", "activation_mutate_rate", "replace_rate", "weight_mutate_rate"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and 0.0 <= v <= 1.0):
                 raise ValueError(f"{name}={v!r} must be a probability in [0, 1]")
@@ -126,7 +128,7 @@ bias_max_value          = 30.0
 bias_min_value          = -30.0
 bias_mutate_power       = {bias_mutate_power}
 bias_mutate_rate        = 0.7
-bias_replace_rate       = 0.1
+bias_replace_rate       = {replace_rate}
 compatibility_disjoint_coefficient = 1.0
 compatibility_weight_coefficient   = 0.5
 conn_add_prob           = {conn_add_prob}
@@ -152,8 +154,8 @@ weight_init_stdev       = {weight_init_stdev}
 weight_max_value        = 30
 weight_min_value        = -30
 weight_mutate_power     = {weight_mutate_power}
-weight_mutate_rate      = 0.8
-weight_replace_rate     = 0.1
+weight_mutate_rate      = {weight_mutate_rate}
+weight_replace_rate     = {replace_rate}
 
 [DefaultSpeciesSet]
 compatibility_threshold = {compatibility_threshold}
@@ -187,6 +189,8 @@ def neat_config(settings: NeatSettings):
         weight_mutate_power=settings.weight_mutate_power,
         bias_mutate_power=settings.bias_mutate_power,
         activation_mutate_rate=settings.activation_mutate_rate,
+        replace_rate=settings.replace_rate,
+        weight_mutate_rate=settings.weight_mutate_rate,
         compatibility_threshold=settings.compatibility_threshold,
         weight_init_stdev=settings.weight_init_stdev,
         bias_init_stdev=settings.bias_init_stdev,
