@@ -17,14 +17,16 @@ def main(paths: list[str]) -> None:
             data = json.load(f)
         for r in data["runs"]:
             runs[r["method"]].append(r)
-    print("| method | seeds | mean validation return | best / worst seed | crashed validation episodes | nodes / enabled connections | seconds per run |")
-    print("|---|---|---|---|---|---|---|")
+    head = ["method", "seeds", "mean validation return", "best / worst seed", "crashed validation episodes", "nodes / enabled connections"]
+    print("| " + " | ".join([*head, "episodes flown", "seconds per run"]) + " |")
+    print("|---|---|---|---|---|---|---|---|")
     for method, rs in runs.items():
         v = np.array([r["validation_mean"] for r in rs])
         size = ", ".join(f"{r['nodes']}/{r['connections']}" for r in rs) if "nodes" in rs[0] else ""
         crashes = sum(r["validation_crashes"] for r in rs)
         seconds = np.mean([r["seconds"] for r in rs])
-        print(f"| {method} | {len(rs)} | {v.mean():,.0f} | {v.max():,.0f} / {v.min():,.0f} | {crashes} | {size} | {seconds:,.0f} |")
+        flown = ", ".join(f"{r['episodes']:,}" for r in rs)
+        print(f"| {method} | {len(rs)} | {v.mean():,.0f} | {v.max():,.0f} / {v.min():,.0f} | {crashes} | {size} | {flown} | {seconds:,.0f} |")
 
 
 if __name__ == "__main__":
