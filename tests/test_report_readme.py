@@ -23,5 +23,12 @@ def test_the_readme_beside_the_report_gets_its_numbers_from_the_store(tmp_path) 
     row = status_table([Status("fig8", "Figure 8", "paper", done, done + 1, 12.0, 30.0, (2, 16))])
     assert f"{done:,} of {done + 1:,} (**incomplete**)" in row and "12 s on 2/16 cores" in row
     assert not fill_generated(tmp_path / "absent.md", "status", row)
+    stale = status_table([Status("fig8", "Figure 8", "paper", 3, 3, 1.0, 1.0, (2,), current=False)])
+    assert "complete; **to be re-run**: its config is not the shipped one" in stale
+    from neurohover.experiments.report_readme import is_current
+
+    assert is_current(load_config("fig2", "quick")) is True
+    assert is_current(load_config("fig7", "quick", {"policies": "shipped"})) is True  # the policy source a run set is its own
+    assert is_current(cfg) is False  # set otherwise
     assert not fill_generated(readme, "claims", "x")  # no such block: the file is left alone
     assert readme.read_text() == text

@@ -27,7 +27,7 @@ from .report_base import Section, agent_panel, fmt, log_errors, new_figure, pair
 from .report_evolution import EvolutionSection
 from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, test_run_figure, varies
 from .report_models import SensorModels
-from .report_readme import Status, fill_generated, linked_claims, status_table
+from .report_readme import Status, fill_generated, is_current, linked_claims, status_table
 from .results import ModelResult, TestRunResult, result_from_dict
 from .settings import Group, ModelLearningSettings
 from .store import Store
@@ -465,16 +465,8 @@ def _section(cfg: ExperimentConfig, store: Store, out: Path) -> tuple[str, list[
     text.append("\n".join(lines) + "\n")
     text.append("### Discussion\n\n" + _discussion(cfg, out) + "\n")
     sessions = store.sessions(cfg.name, cfg.scale)
-    status = Status(
-        cfg.name,
-        cfg.title,
-        cfg.scale,
-        len(units),
-        total,
-        sum(s["wall_seconds"] for s in sessions),
-        sum(u["seconds"] for u in units),
-        tuple(sorted({s["cores"] for s in sessions})),
-    )
+    wall, unit_time, cores = sum(s["wall_seconds"] for s in sessions), sum(u["seconds"] for u in units), tuple(sorted({s["cores"] for s in sessions}))
+    status = Status(cfg.name, cfg.title, cfg.scale, len(units), total, wall, unit_time, cores, current=is_current(cfg))
     return "\n".join(text), sec.claims, status
 
 

@@ -30,6 +30,18 @@ class Status(NamedTuple):
     wall_seconds: float
     unit_seconds: float
     cores: tuple[int, ...]
+    current: bool | None = None  # whether the shipped config still hashes as the stored one (None: not a shipped config)
+
+
+def is_current(cfg) -> bool | None:
+    """Whether the shipped config of ``cfg``'s experiment (with the stored policy source) hashes as ``cfg``, the
+    stored one (None: no shipped config of that name)."""
+    from .config import load_config, shipped_configs
+    from .runner import POLICY_SOURCES
+
+    if cfg.name not in shipped_configs():
+        return None
+    return load_config(cfg.name, cfg.scale, {k: cfg.settings[k] for k in POLICY_SOURCES if k in cfg.settings}).hash == cfg.hash
 
 
 def _marker(key: str) -> tuple[str, str]:
@@ -56,6 +68,8 @@ def status_table(rows: list[Status]) -> str:
     body = []
     for r in rows:
         state = "complete" if r.total is not None and r.done >= r.total else "**incomplete**"
+        if r.current is False:  # the code's config changed since: these are the last runs of the earlier one
+            state += "; **to be re-run**: its config is not the shipped one (changed since, or set otherwise; `--update` keeps the unchanged units)"
         of = f"{r.done:,} of {r.total:,}" if r.total is not None else f"{r.done:,}"
         cores = "/".join(map(str, r.cores)) or "?"
         body.append([f"`{r.name}`", r.title, f"{of} ({state})", f"{r.wall_seconds:,.0f} s on {cores} cores", f"{r.unit_seconds:,.0f} s"])
