@@ -31,7 +31,7 @@ import os
 import random
 import tempfile
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 
 import numba as nb
 import numpy as np
@@ -175,26 +175,8 @@ def neat_config(settings: NeatSettings):
     """neat-python's ``Config`` for ``settings`` (written to a temporary file, as neat-python reads one)."""
     import neat
 
-    text = _CONFIG.format(
-        pop_size=settings.pop_size,
-        activation_default=settings.activations[0],
-        activations=" ".join(settings.activations),
-        conn_add_prob=settings.conn_add_prob,
-        node_add_prob=settings.node_add_prob,
-        conn_delete_prob=settings.conn_delete_prob,
-        node_delete_prob=settings.node_delete_prob,
-        initial=settings.initial,
-        n_inputs=N_INPUTS,
-        n_outputs=ACTION_DIM,
-        weight_mutate_power=settings.weight_mutate_power,
-        bias_mutate_power=settings.bias_mutate_power,
-        activation_mutate_rate=settings.activation_mutate_rate,
-        replace_rate=settings.replace_rate,
-        weight_mutate_rate=settings.weight_mutate_rate,
-        compatibility_threshold=settings.compatibility_threshold,
-        weight_init_stdev=settings.weight_init_stdev,
-        bias_init_stdev=settings.bias_init_stdev,
-    )
+    fields = {**asdict(settings), "activations": " ".join(settings.activations), "activation_default": settings.activations[0]}
+    text = _CONFIG.format(**fields, n_inputs=N_INPUTS, n_outputs=ACTION_DIM)  # the template names the settings' fields
     fd, path = tempfile.mkstemp(suffix=".ini", prefix="neurohover-neat-")
     try:
         with os.fdopen(fd, "w") as f:
