@@ -132,7 +132,7 @@ class ContinualAgent(Agent):
         self.models += 1
         self.policy_model = fitted
         self.reference_error = float(one_step_error(fitted, data))
-        model = fitted.mdp(substeps=fitted.flyable_substeps(self.evolution.model_substeps))
+        model = fitted.flown_mdp(self.evolution.model_substeps)
         self.policy, self.predicted = evolve_on_model(model, self.generic, self.evolution, int(self._rng.integers(2**62)))
         self.label = f"model:{self.models}"
 

@@ -119,8 +119,7 @@ def learn_model(
     """
     from ..models import learn_lr
 
-    model = learn_lr(flight_data, estimator=estimator, wind_model=wind_model, d_u=d_u, noise=noise)
-    return model.mdp(substeps=model.flyable_substeps(substeps))
+    return learn_lr(flight_data, estimator=estimator, wind_model=wind_model, d_u=d_u, noise=noise).flown_mdp(substeps)
 
 
 def enough_to_learn(flight_data: FlightData, wind_model: str = "none") -> bool:

@@ -466,7 +466,8 @@ def _section(cfg: ExperimentConfig, store: Store, out: Path) -> tuple[str, list[
     text.append("### Discussion\n\n" + _discussion(cfg, out) + "\n")
     sessions = store.sessions(cfg.name, cfg.scale)
     wall, unit_time, cores = sum(s["wall_seconds"] for s in sessions), sum(u["seconds"] for u in units), tuple(sorted({s["cores"] for s in sessions}))
-    status = Status(cfg.name, cfg.title, cfg.scale, len(units), total, wall, unit_time, cores, current=is_current(cfg))
+    current = is_current(cfg) if cfg.scale == "paper" else None  # the status table lists paper scale only
+    status = Status(cfg.name, cfg.title, cfg.scale, len(units), total, wall, unit_time, cores, current=current)
     return "\n".join(text), sec.claims, status
 
 

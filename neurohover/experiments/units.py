@@ -246,16 +246,17 @@ def run_model(p: dict, threads: int | None, device: str = "cpu") -> dict:
     else:
         model = learn_ec_mer(flight, generic, float(data.returns.ravel()[0]), budget=q.model_budget, seed=int(seeds[1]), episodes=q.ec_mer_episodes)
     learn_seconds = time.perf_counter() - t0
-    flown = model.flyable_substeps(q.model_substeps)  # as fitted where an axis has no equivalent
+    flown_mdp = model.flown_mdp(q.model_substeps)  # as fitted where an axis has no equivalent
+    flown = flown_mdp.substeps
     proto = generic if q.prototype == "generic" else "baseline"
     t1 = time.perf_counter()
     if q.model_policy == "authors":  # their GHH-09 agents: an SLP from the baseline by their eonn
         authors = ModelEvolution(n_steps=q.n_steps, device=device, model_policy="authors", authors_generations=q.authors_generations)
-        champion, predicted = evolve_on_model(model.mdp(substeps=flown), generic, authors, int(seeds[2]))
+        champion, predicted = evolve_on_model(flown_mdp, generic, authors, int(seeds[2]))
         policy_episodes = EonnSettings(generations=q.authors_generations).episodes
     else:
         evolved = evolve(
-            model.mdp(substeps=flown),
+            flown_mdp,
             topology=generic.topology,
             prototype=proto,
             budget=q.policy_budget or None,

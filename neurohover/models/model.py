@@ -183,7 +183,7 @@ class LearnedModel:
         if substeps == 1:
             return MDP("model", self.params, self.noise_std, wind_kind=wind_kind, wind=wind, substeps=1, dt=MODEL_DT, label=label, d_u=float(self.d_u))
         params, noise = self.equivalent()
-        bad = [NOISE_NAMES[axis] for axis, ci in enumerate(AXIS_C) if not np.isfinite(params[ci])]
+        bad = _axes_without_equivalent(params)
         if bad:
             raise NeurohoverError(f"substeps={substeps}: the model's {', '.join(bad)} axis has no {substeps}-substep equivalent (1 + 0.1 C <= 0)")
         u_ratio = params[0] / self.params[0] if abs(self.params[0]) > 1e-12 else 1.0  # D_u scales with the u axis
@@ -200,8 +200,12 @@ class LearnedModel:
         """
         if substeps == 1:
             return 1
-        params, _ = self.equivalent()
-        return substeps if all(np.isfinite(params[ci]) for ci in AXIS_C) else 1
+        return 1 if _axes_without_equivalent(self.equivalent()[0]) else substeps
+
+    def flown_mdp(self, substeps: int, label: str | None = None) -> MDP:
+        """The MDP a policy evolves on: the model in ``substeps``, or as fitted where that has no equivalent
+        (:meth:`flyable_substeps`; the MDP's ``substeps`` says which)."""
+        return self.mdp(label, substeps=self.flyable_substeps(substeps))
 
     def equivalent(self, substeps: int = SUBSTEPS, dt: float = SUBSTEP_DT) -> tuple[np.ndarray, np.ndarray]:
         """Parameters and noise std of the same model for ``substeps`` substeps of ``dt``
@@ -264,6 +268,11 @@ class LearnedModel:
         except OSError as err:
             raise NeurohoverError(f"model file {str(path)!r} cannot be read ({err.strerror or type(err).__name__})") from None
         return cls.from_dict(data, f"model file {str(path)!r}")
+
+
+def _axes_without_equivalent(params: np.ndarray) -> list[str]:
+    """The axes whose converted C parameter is NaN (no substep equivalent; :func:`equivalent_params`)."""
+    return [NOISE_NAMES[axis] for axis, ci in enumerate(AXIS_C) if not np.isfinite(params[ci])]
 
 
 def equivalent_params(params, noise_std=None, substeps: int = SUBSTEPS, dt: float = SUBSTEP_DT) -> tuple[np.ndarray, np.ndarray]:
