@@ -26,6 +26,7 @@ Example::
 from __future__ import annotations
 
 import copy
+import functools
 import math
 import os
 import random
@@ -300,10 +301,14 @@ class TopologyResult:
     config: object
     history: list[dict] = field(default_factory=list)
 
+    @functools.cached_property
+    def packed(self) -> PackedNetworks:
+        """The champion packed for :func:`forward` once (``act`` runs every control step of a flight)."""
+        return pack_networks([self.champion], self.config)
+
     def act(self, obs: np.ndarray) -> np.ndarray:
         """The champion's actions for a batch of observations (B, 12) -> (B, 4)."""
-        packed = pack_networks([self.champion], self.config)
-        return forward(packed, np.zeros(len(obs), dtype=np.int64), np.asarray(obs, dtype=np.float64))
+        return forward(self.packed, np.zeros(len(obs), dtype=np.int64), np.asarray(obs, dtype=np.float64))
 
 
 def seed_baseline(genome, config) -> None:
