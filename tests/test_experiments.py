@@ -101,8 +101,8 @@ def test_every_experiment_of_the_paper_is_shipped_at_both_scales() -> None:
 @pytest.mark.parametrize(
     "name, total, check",
     [
-        # Figure 2: 4 approaches x 10 training MDPs x 10 runs, plus Table 3 (2 topologies x 10 MDPs).
-        ("fig2", 420, lambda s: s["runs"] == 10 and s["n_mdps"] == 10 and s["n_steps"] == 6000 and s["robustness_episodes"] == 10),
+        # Figure 2: 4 approaches x 10 training MDPs x 10 runs, plus Table 3 (2 topologies and the shipped set x 10 MDPs).
+        ("fig2", 430, lambda s: s["runs"] == 10 and s["n_mdps"] == 10 and s["n_steps"] == 6000 and s["robustness_episodes"] == 10),
         # Table 4: 3 methods + the GLS option x 100 test MDPs, 5 test episodes; + the generic policy.
         (
             "table4",
@@ -388,8 +388,9 @@ def test_quick_experiments_end_to_end(quick_store: Path, cli) -> None:
         assert len(fig8["policy/safety"]["safe"]) == 2
         models = store.results("table4", "quick")
         assert {r["method"] for k, r in models.items() if k.startswith("model/")} == {"lr", "lr-gls", "ec-meno", "ec-mer"}
-        robust = [r for k, r in store.results("fig2", "quick").items() if k.startswith("robust/")]
-        assert len(robust) == 2 and all(len(r["returns"]) == 1 and len(r["returns"][0]) == 3 for r in robust)
+        robust = {k: r for k, r in store.results("fig2", "quick").items() if k.startswith("robust/")}
+        assert sorted(robust) == ["robust/mlp-baseline/train0", "robust/policy-set/train0", "robust/slp-baseline/train0"]
+        assert all(len(r["returns"]) == 1 and len(r["returns"][0]) == 3 for r in robust.values())
     rc, out, _ = cli("reproduce", "fig8", "--scale", "quick", "--store", str(quick_store), "--no-progress")
     assert rc == 0 and "ran 0 units, 18 already in the store" in out
 
@@ -534,6 +535,24 @@ def test_policies_from_a_policy_set_directory(tmp_path: Path, capsys) -> None:
     assert "config hash" in capsys.readouterr().err
     assert main(["reproduce", "fig7", "--store", str(store), "--set", f"policies={tmp_path / 'none'}"]) == 2
     assert "build it with: neurohover build-policies" in capsys.readouterr().err
+
+
+def test_table3_flies_the_shipped_sets_specialised_policies_as_the_best_champions() -> None:
+    """Issue 33: Table 3's figures of the shipped policies come from the store, not from a manifest."""
+    from neurohover.policysets import load_policy_set
+
+    cfg = load_config("fig2", "paper")
+    units = {u.key: u for u in plan(cfg, {}).units if u.key.startswith("robust/")}
+    shipped = load_policy_set("ghh08")
+    assert sorted(units) == [f"robust/policy-set/train{i}" for i in range(10)]  # the champions' rows wait for their runs
+    for i in range(10):
+        p = units[f"robust/policy-set/train{i}"].params
+        assert p["own"] == i and p["episodes"] == 10 and len(p["mdps"]) == 10
+        assert p["policy"]["genome"] == [float(x) for x in shipped.specialised[i].genome]
+    with pytest.raises(NeurohoverError, match="robustness_policies = 'evolve' is not allowed"):
+        load_config("fig2", "quick", {"robustness_policies": "evolve"})
+    with pytest.raises(NeurohoverError, match="robustness_policies flies a set's specialised policies"):
+        load_config("fig15", "quick", {"robustness_policies": "shipped"})
 
 
 def test_the_commands_are_registered_in_the_cli(capsys) -> None:

@@ -36,7 +36,7 @@ class EvolveParams:
 
 @dataclass(frozen=True, kw_only=True)
 class RobustnessParams:
-    """One champion flown on every training MDP (Table 4)."""
+    """One champion (or a policy set's specialised policy) flown on every training MDP (Table 3)."""
 
     policy: dict
     source: str

@@ -35,7 +35,7 @@ from ..tasks import EXACT, Sensor
 from ..tasks.drift import Drift
 from .config import ExperimentConfig, load_config
 from .keys import UnitKey
-from .schema import DIR_SOURCE, variant_optimizer
+from .schema import DIR_SOURCE, POLICY_SET_GROUP, variant_optimizer
 from .settings import EvolutionSettings, ExperimentSettings, Group, ModelLearningSettings, TestRunsSettings
 from .units import Unit, family_of, policy_dict, unit_seed
 
@@ -83,7 +83,7 @@ def _load_external(task: str, source: str):
 
 def external_digest(kind: str, s: dict) -> str:
     """Digest of policies a config reads from a directory (so results never mix policy sets)."""
-    source = s.get("policies") if kind == "test_runs" else s.get("generic") if kind == "model_learning" else None
+    source = {"test_runs": s.get("policies"), "model_learning": s.get("generic"), "evolution": s.get("robustness_policies")}.get(kind)
     payload: dict = {}
     if source not in (None, "evolve", "baseline"):
         ps = _load_external(s["task"], source)
@@ -179,7 +179,27 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
                     },
                 )
             )
+    if s.robustness_policies is not None:
+        units += _policy_set_robustness(cfg, train)
+        total += len(train)
     return Plan(units, total)
+
+
+def _policy_set_robustness(cfg: ExperimentConfig, train: list) -> list[Unit]:
+    """Table 3 for a policy set: specialised policy i flown on every training MDP, as MDP i's best champion is."""
+    s = cfg.typed
+    assert isinstance(s, EvolutionSettings) and s.robustness_policies is not None
+    ps = _load_external(s.task, s.robustness_policies)
+    params = {"mdps": [m.to_dict() for m in train], "episodes": s.robustness_episodes, "n_steps": s.n_steps}
+    return [
+        _unit(
+            cfg,
+            UnitKey.make("robust", POLICY_SET_GROUP, f"train{i}"),
+            "robustness",
+            {"policy": policy_dict(ps.specialised[i]), "source": f"{s.robustness_policies}:specialised_{i}", "own": i, **params},
+        )
+        for i in range(len(train))
+    ]
 
 
 # --------------------------------------------------------------------------------- policies of a test

@@ -14,6 +14,7 @@ from .config import ExperimentConfig, load_config
 from .keys import UnitKey
 from .report_base import Section, fmt, new_figure, paired_p, ratio_verdict, sd, table, ttest
 from .results import EvolveResult, RobustnessResult, result_from_dict
+from .schema import POLICY_SET_GROUP
 from .settings import EvolutionSettings, Variant
 
 
@@ -356,8 +357,10 @@ class EvolutionSection(Section):
     def table3(self) -> str:
         rows = []
         ref = self.paper.get("table3", {})
-        for vkey in self.s.robustness_variants:
-            label = next(v.label for v in self.variants() if v.key == vkey)
+        groups = [(vkey, next(v.label for v in self.variants() if v.key == vkey), ref.get(vkey, {})) for vkey in self.s.robustness_variants]
+        if self.s.robustness_policies is not None:  # the set's specialised policies are MLPs evolved from the baseline
+            groups.append((POLICY_SET_GROUP, f"MLP, the {self.s.robustness_policies} policy set's specialised policies", ref.get("mlp-baseline", {})))
+        for vkey, label, p in groups:
             units: list[RobustnessResult] = self.group("robust", vkey)
             if not units:
                 continue
@@ -366,7 +369,6 @@ class EvolutionSection(Section):
             crashes_own = sum(u.crashes[u.own] for u in units)
             crashes_all = sum(sum(u.crashes) for u in units)
             episodes = sum(len(row) for u in units for row in u.returns)
-            p = ref.get(vkey, {})
             rows.append(
                 [
                     label,
@@ -415,7 +417,13 @@ class EvolutionSection(Section):
                 rows,
             )
             + f"\n\nThe best champion of each training MDP's runs flown {n} episodes on its own MDP (r) and on every "
-            f"training MDP used (r_G); sd over the policies' mean returns.\n"
+            f"training MDP used (r_G); sd over the policies' mean returns."
+            + (
+                f" The policy set's row (`robustness_policies = \"{self.s.robustness_policies}\"`): its specialised policy for each "
+                "training MDP flown the same way.\n"
+                if self.s.robustness_policies is not None
+                else "\n"
+            )
         )
 
 

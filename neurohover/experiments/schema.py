@@ -31,6 +31,8 @@ from ..tasks import TASK_FAMILIES, TASK_NAMES, Drift, Sensor
 DIR_SOURCE = "dir:"
 
 REQUIRED = object()
+#: The group of the robustness units that fly a policy set's specialised policies (``robustness_policies``).
+POLICY_SET_GROUP = "policy-set"
 OMIT = object()  # default of a setting added later: absent from the resolved config unless given (older configs keep their hash)
 
 
@@ -240,6 +242,9 @@ SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
         "history_points": (300, _int(2)),
         "robustness_variants": ([], lambda v: (isinstance(v, list) and all(isinstance(x, str) for x in v), "a list of variant keys")),
         "robustness_episodes": (10, _int(1)),
+        # Table 3 also for a policy set's specialised policies ("shipped" or a directory of <task>/ sets): the ones
+        # Table 4 and Figures 7, 8 and 11 fly, flown as the best champions are
+        "robustness_policies": (OMIT, _policy_source()),
         # run r of each variant takes the seed of run r of another experiment's variant (paired_with), and the
         # champions are validated on that experiment's test episodes: paired comparisons across experiments
         "seeds_of": (OMIT, _seeds_of(("experiment",))),
@@ -367,6 +372,16 @@ def _check_evolution(settings: dict, task: str, where: str) -> None:
         raise NeurohoverError(f"{where}: robustness_variants {bad} are not variant keys ({', '.join(keys)})")
     if settings["robustness_variants"] and settings["target"] != "train":
         raise NeurohoverError(f"{where}: robustness_variants need target = 'train'")
+    if "robustness_policies" in settings:
+        if settings["target"] != "train" or TASK_FAMILIES[task].generic_over_distribution:
+            raise NeurohoverError(
+                f"{where}: robustness_policies flies a set's specialised policies on the training MDPs: it needs target = 'train' and a GHH task"
+            )
+        if settings["robustness_policies"] == "evolve" or POLICY_SET_GROUP in keys:
+            raise NeurohoverError(
+                f"{where}: robustness_policies = {settings['robustness_policies']!r} is not allowed: give 'shipped' or a directory holding <task>/ "
+                f"policy sets (and no variant named {POLICY_SET_GROUP!r})"
+            )
     if "champion_reevaluation" in settings and settings["target"] != "family":
         raise NeurohoverError(f"{where}: champion_reevaluation chooses among a generational run's parents: it needs target = 'family'")
     if settings.get("validation_mdps") == "test" and settings["target"] != "family":

@@ -101,6 +101,7 @@ class EvolutionSettings(ExperimentSettings):
     history_points: int = 300
     robustness_variants: tuple[str, ...] = ()
     robustness_episodes: int = 10
+    robustness_policies: str | None = None  # a policy set whose specialised policies Table 3 also flies (None: none)
     seeds_of: dict | None = None  # {experiment, seed}: its runs take that experiment's seeds (None: their own)
     variants: tuple[Variant, ...]
 
