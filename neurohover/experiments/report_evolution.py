@@ -419,7 +419,7 @@ class EvolutionSection(Section):
             + f"\n\nThe best champion of each training MDP's runs flown {n} episodes on its own MDP (r) and on every "
             f"training MDP used (r_G); sd over the policies' mean returns."
             + (
-                f" The policy set's row (`robustness_policies = \"{self.s.robustness_policies}\"`): its specialised policy for each "
+                f' The policy set\'s row (`robustness_policies = "{self.s.robustness_policies}"`): its specialised policy for each '
                 "training MDP flown the same way.\n"
                 if self.s.robustness_policies is not None
                 else "\n"
