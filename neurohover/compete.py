@@ -284,8 +284,6 @@ def compete(
         finished run; the store keeps them, and the same call resumes.
     """
     from .agents.registry import check_agent
-    from .experiments import Store, make_executor, reproduce
-    from .experiments.results import TestRunResult
 
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise NeurohoverError(f"jobs={jobs!r} is out of range: allowed an integer >= 1")
@@ -297,6 +295,29 @@ def compete(
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     store_path = Path(store) if store is not None else out / STORE_FILE
+    ordered = _run_into_store(config, store_path, out / "episodes.csv", jobs=jobs, device=device, progress=progress, on_result=on_result)
+    summary = {
+        "task": task,
+        "agent": agent,
+        "mdps": mdps,
+        "seed": seed,
+        "store": str(store_path),
+        "experiment": config.name,
+        "scale": config.scale,
+        **summarise(ordered),
+    }
+    (out / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
+    plot_cumulative(
+        {agent: np.array([np.cumsum(np.array(r.returns, dtype=float)) for r in ordered])}, out / "cumulative.png", f"{task}: {agent}, {len(ordered)} runs"
+    )
+    return summary, ordered
+
+
+def _run_into_store(config, store_path: Path, episodes_csv: Path, *, jobs: int, device: str, progress: bool | None, on_result) -> list:
+    """Run the competition's units into the store (finished ones are reused); its runs in order, written to
+    ``episodes_csv`` also when interrupted."""
+    from .experiments import Store, make_executor, reproduce
+    from .experiments.results import TestRunResult
 
     def finished(key: str, result: dict) -> None:
         if on_result is not None and key.startswith("run/"):
@@ -314,22 +335,8 @@ def compete(
             stored = db.results(config.name, config.scale)
             keys = sorted((k for k in stored if k.startswith("run/")), key=_run_order)
             ordered = [TestRunResult.from_dict(stored[k], k) for k in keys]
-            _write_episodes(out / "episodes.csv", ordered, n_steps)
-    summary = {
-        "task": task,
-        "agent": agent,
-        "mdps": mdps,
-        "seed": seed,
-        "store": str(store_path),
-        "experiment": config.name,
-        "scale": config.scale,
-        **summarise(ordered),
-    }
-    (out / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
-    plot_cumulative(
-        {agent: np.array([np.cumsum(np.array(r.returns, dtype=float)) for r in ordered])}, out / "cumulative.png", f"{task}: {agent}, {len(ordered)} runs"
-    )
-    return summary, ordered
+            _write_episodes(episodes_csv, ordered, config.typed.n_steps)
+    return ordered
 
 
 def _run_order(key: str) -> tuple[int, int]:

@@ -27,6 +27,7 @@ with the project's own evolution (or writes a set elsewhere with ``--out``).
 
 from __future__ import annotations
 
+import functools
 import json
 import time
 from collections.abc import Callable
@@ -147,6 +148,62 @@ def choose_safe(crashes: np.ndarray, returns: np.ndarray, n: int = 2) -> tuple[i
     return tuple(int(i) for i in order[:n])
 
 
+def _write_ghh_set(
+    task: str, root: Path, manifest: dict, generic: Policy, specialised: list[Policy], crashes: np.ndarray, returns: np.ndarray, say
+) -> PolicySet:
+    """Choose a GHH set's safe policies from its crash and return matrix on the training MDPs, write its manifest
+    (with Table 3's figures of the build) and say what was chosen."""
+    safe = choose_safe(crashes, returns)
+    seconds = manifest.pop("seconds")  # the manifest's keys in the order the sets were always written
+    manifest.update(
+        {
+            "safe": list(safe),
+            "safety_episodes": manifest.pop("safety_episodes"),
+            "crashes_on_training_mdps": crashes.tolist(),
+            "mean_return_on_training_mdps": returns.round(2).tolist(),
+            "table3": table3_summary(crashes, returns),
+            "seconds": seconds,
+        }
+    )
+    (root / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n")
+    t3 = manifest["table3"]
+    say(f"{task}: safe specialised policies {safe}; Table 3 on the training MDPs: r = {t3['r']:.1f}, r_G = {t3['r_G']:.1f}")
+    say(f"{task}: {t3['crashed_episodes']} crashed episodes of {crashes.size * int(manifest['safety_episodes'])}")
+    return PolicySet(task, root, generic, tuple(specialised), safe, manifest=manifest)
+
+
+def _check_build(lineage: str, optimizer: str) -> None:
+    from .evolution.optimisers import optimiser_names
+
+    if lineage not in LINEAGES:
+        raise NeurohoverError(f"lineage {lineage!r} is not known: allowed {', '.join(LINEAGES)}")
+    if optimizer not in optimiser_names():
+        raise NeurohoverError(f"unknown optimizer {optimizer!r}: allowed {', '.join(optimiser_names())}")
+
+
+def _evolve_one(
+    target, name: str, child_seed: int, seed_policy: Policy | None = None, save: bool = True, *, family, root: Path, n_steps: int, optimizer: str, say, **kwargs
+) -> Policy:
+    """One run of a set's build from ``seed_policy`` (default: the baseline MLP), its champion saved as ``name``."""
+    from .evolution import SteadyStateSettings
+    from .evolution.evolve import evolve
+    from .evolution.optimisers import NE
+    from .policies import prototype
+
+    t0 = time.perf_counter()
+    race = str(kwargs.get("resampling", "")).startswith("race")
+    kwargs["optimizer"] = NE if race else optimizer
+    if "resampling" not in kwargs and kwargs["optimizer"] == NE:  # steady state: spend the whole budget (no plateau stop)
+        kwargs["settings"] = SteadyStateSettings(plateau_threshold=kwargs["budget"])
+    start_from = seed_policy if seed_policy is not None else prototype("mlp", "baseline")
+    result = evolve(target, topology="mlp", prototype=start_from, seed=child_seed, n_steps=n_steps, **kwargs)
+    policy = result.champion
+    if save:
+        save_policy(policy, root / f"{name}.json", task=family.name, name=name, episodes=int(result.episodes), seconds=round(time.perf_counter() - t0, 2))
+    say(f"{family.name}/{name}: champion {result.champion_return:.1f} after {result.episodes} episodes ({time.perf_counter() - t0:.0f} s)")
+    return policy
+
+
 def build_policy_set(
     task: str,
     out: str | Path | None = None,
@@ -188,15 +245,9 @@ def build_policy_set(
     progress : callable, optional
         Called with one line of text per finished run.
     """
-    from .evolution import SteadyStateSettings
-    from .evolution.evolve import evolve
-    from .evolution.optimisers import NE, optimiser_names
-    from .policies import prototype
+    from .evolution.optimisers import NE
 
-    if lineage not in LINEAGES:
-        raise NeurohoverError(f"lineage {lineage!r} is not known: allowed {', '.join(LINEAGES)}")
-    if optimizer not in optimiser_names():
-        raise NeurohoverError(f"unknown optimizer {optimizer!r}: allowed {', '.join(optimiser_names())}")
+    _check_build(lineage, optimizer)
     family = get_task_family(task)
     root = policy_dir(family.name, out)
     root.mkdir(parents=True, exist_ok=True)
@@ -208,19 +259,7 @@ def build_policy_set(
     roles = policy_set_roles(family)
     start = time.perf_counter()
 
-    def run(target, name: str, child_seed: int, seed_policy: Policy | None = None, save: bool = True, **kwargs) -> Policy:
-        t0 = time.perf_counter()
-        race = str(kwargs.get("resampling", "")).startswith("race")
-        kwargs["optimizer"] = NE if race else optimizer
-        if "resampling" not in kwargs and kwargs["optimizer"] == NE:  # steady state: spend the whole budget (no plateau stop)
-            kwargs["settings"] = SteadyStateSettings(plateau_threshold=kwargs["budget"])
-        start_from = seed_policy if seed_policy is not None else prototype("mlp", "baseline")
-        result = evolve(target, topology="mlp", prototype=start_from, seed=child_seed, n_steps=n_steps, **kwargs)
-        policy = result.champion
-        if save:
-            save_policy(policy, root / f"{name}.json", task=family.name, name=name, episodes=int(result.episodes), seconds=round(time.perf_counter() - t0, 2))
-        say(f"{family.name}/{name}: champion {result.champion_return:.1f} after {result.episodes} episodes ({time.perf_counter() - t0:.0f} s)")
-        return policy
+    run = functools.partial(_evolve_one, family=family, root=root, n_steps=n_steps, optimizer=optimizer, say=say)
 
     if family.generic_over_distribution:
         manifest.update({"sigma": family.sigma, "fghh_budget": fghh_budget})
@@ -249,19 +288,6 @@ def build_policy_set(
     ]
     generic, specialised = evolved[0], evolved[1:]
     crashes, returns = crash_matrix(specialised, train, safety_episodes, seed=int(seeds[11]), n_steps=n_steps)
-    safe = choose_safe(crashes, returns)
-    manifest.update(
-        {
-            "safe": list(safe),
-            "safety_episodes": safety_episodes,
-            "crashes_on_training_mdps": crashes.tolist(),
-            "mean_return_on_training_mdps": returns.round(2).tolist(),
-            "table3": table3_summary(crashes, returns),
-            "seconds": round(time.perf_counter() - start, 1),
-        }
-    )
-    (root / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n")
-    t3 = manifest["table3"]
-    say(f"{family.name}: safe specialised policies {safe}; Table 3 on the training MDPs: r = {t3['r']:.1f}, r_G = {t3['r_G']:.1f}")
-    say(f"{family.name}: {t3['crashed_episodes']} crashed episodes of {crashes.size * safety_episodes}")
-    return PolicySet(family.name, root, generic, tuple(specialised), safe, manifest=manifest)
+    manifest["safety_episodes"] = safety_episodes
+    manifest["seconds"] = round(time.perf_counter() - start, 1)
+    return _write_ghh_set(family.name, root, manifest, generic, specialised, crashes, returns, say)

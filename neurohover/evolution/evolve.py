@@ -119,6 +119,27 @@ __all__ = [
 ]
 
 
+def _prepare(run: Run, checkpoint, checkpoint_every_s, resume: bool, threads: int | None, device: str, trace: list | None) -> Path | None:
+    """Check the checkpoint options, restore the run from its checkpoint on ``resume``, and load (or compile) the
+    kernel before the run's clock starts (which also validates the thread count); the checkpoint's path."""
+    if not isinstance(checkpoint_every_s, (int, float)) or not checkpoint_every_s > 0:
+        raise NeurohoverError(f"checkpoint_every_s={checkpoint_every_s!r} must be a number > 0")
+    path = None if checkpoint is None else Path(checkpoint)
+    if resume:
+        if path is None:
+            raise NeurohoverError("resume=True needs the checkpoint path")
+        run.restore(read_checkpoint(path), f"checkpoint {str(path)!r}")
+        run.stop_reason = None
+    run.flyer.trace = trace
+    if run.rows is not None:
+        warm_up: np.ndarray | MDP = run.rows
+    else:
+        assert run.family is not None  # a run has one MDP (its rows) or a family
+        warm_up = run.family.zero()
+    evaluate_jobs([run.cfg.prototype], warm_up, [0], [0], [0], n_steps=1, threads=threads, device=device)
+    return path
+
+
 def evolve(
     target,
     *,
@@ -202,37 +223,12 @@ def evolve(
     EvolutionInterrupted
         On Ctrl-C or a ``KeyboardInterrupt`` from ``progress``.
     """
-    run = Run(
-        RunConfig.build(
-            target,
-            topology=topology,
-            prototype=prototype,
-            optimizer=optimizer,
-            resampling=resampling,
-            budget=budget,
-            settings=settings,
-            seed=seed,
-            n_steps=n_steps,
-            method=method,
-        ),
-        device=device,
-    )
-    if not isinstance(checkpoint_every_s, (int, float)) or not checkpoint_every_s > 0:
-        raise NeurohoverError(f"checkpoint_every_s={checkpoint_every_s!r} must be a number > 0")
-    path = None if checkpoint is None else Path(checkpoint)
-    if resume:
-        if path is None:
-            raise NeurohoverError("resume=True needs the checkpoint path")
-        run.restore(read_checkpoint(path), f"checkpoint {str(path)!r}")
-        run.stop_reason = None
-    run.flyer.trace = _trace
-    # Load (or compile) the kernel before the clock runs, and validate the thread count.
-    if run.rows is not None:
-        warm_up: np.ndarray | MDP = run.rows
-    else:
-        assert run.family is not None  # a run has one MDP (its rows) or a family
-        warm_up = run.family.zero()
-    evaluate_jobs([run.cfg.prototype], warm_up, [0], [0], [0], n_steps=1, threads=threads, device=device)
+    cfg = RunConfig.build(
+        target, topology=topology, prototype=prototype, optimizer=optimizer, resampling=resampling, budget=budget, settings=settings, seed=seed,
+        n_steps=n_steps, method=method,
+    )  # fmt: skip
+    run = Run(cfg, device=device)
+    path = _prepare(run, checkpoint, checkpoint_every_s, resume, threads, device, _trace)
     with num_threads(threads if threads is not None else numba.get_num_threads()):  # restores the count after
         run.flyer.start()
         run.run(progress, path, float(checkpoint_every_s), float(progress_every_s))

@@ -58,6 +58,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -118,6 +119,44 @@ def lr_determined(flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS,
     return all(np.linalg.matrix_rank(x) == x.shape[1] for x in (tr.regressors(axis, _intercept(axis, intercepts))[0] for axis in range(6)))
 
 
+def _check_options(**options: tuple[str, Sequence[str]]) -> None:
+    """Refuse an option whose value is not one of its allowed ones: ``name=(value, allowed)``."""
+    for name, (value, allowed) in options.items():
+        if value not in allowed:
+            raise NeurohoverError(f"{name}={value!r} is not allowed: choose one of {', '.join(allowed)}")
+
+
+def _fit_axes(tr: Transitions, intercepts: str, estimator: str) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
+    """Each axis's least-squares fit: the 11 parameters, their standard errors, and the constants of the axes
+    that have one (by axis name; none of them a parameter yet)."""
+    y = tr.targets()
+    params = np.zeros(11)
+    se = np.zeros(11)
+    discarded: dict[str, float] = {}
+    for axis in range(6):
+        x, idx = tr.regressors(axis, _intercept(axis, intercepts))
+        target = y[:, axis]
+        if estimator == "gls":
+            x = (x[1:] - NOISE_DECAY * x[:-1])[tr.pair]
+            target = (target[1:] - NOISE_DECAY * target[:-1])[tr.pair]
+        theta, _, rank, _ = np.linalg.lstsq(x, target, rcond=None)
+        if rank < x.shape[1]:
+            raise NeurohoverError(
+                f"flight data do not determine the {NOISE_NAMES[axis]} axis (regressors "
+                f"{[PARAM_NAMES[i] if i >= 0 else 'constant' for i in idx]} are collinear); fly with a policy that varies its actions"
+            )
+        dof = max(1, x.shape[0] - x.shape[1])
+        sigma2 = float(np.sum((target - x @ theta) ** 2)) / dof
+        cov = sigma2 * np.linalg.inv(x.T @ x)
+        for col, i in enumerate(idx):
+            if i >= 0:
+                params[i] = theta[col]
+                se[i] = math.sqrt(max(cov[col, col], 0.0))
+            else:
+                discarded[NOISE_NAMES[axis]] = float(theta[col])
+    return params, se, discarded
+
+
 def learn_lr(
     flight_data: FlightData,
     intercepts: str = DEFAULT_INTERCEPTS,
@@ -167,42 +206,12 @@ def learn_lr(
         the discarded intercepts, residual rms and both noise estimates.
     """
     start = time.perf_counter()
-    if intercepts not in INTERCEPTS:
-        raise NeurohoverError(f"intercepts={intercepts!r} is not allowed: choose one of {', '.join(INTERCEPTS)}")
-    if estimator not in ESTIMATORS:
-        raise NeurohoverError(f"estimator={estimator!r} is not allowed: choose one of {', '.join(ESTIMATORS)}")
-    if wind_model not in WIND_MODELS:
-        raise NeurohoverError(f"wind_model={wind_model!r} is not allowed: choose one of {', '.join(WIND_MODELS)}")
-    if d_u not in D_U_CHOICES:
-        raise NeurohoverError(f"d_u={d_u!r} is not allowed: choose one of {', '.join(D_U_CHOICES)}")
-    if noise not in NOISE_ESTIMATES:
-        raise NeurohoverError(f"noise={noise!r} is not allowed: choose one of {', '.join(NOISE_ESTIMATES)}")
+    _check_options(
+        intercepts=(intercepts, INTERCEPTS), estimator=(estimator, ESTIMATORS), wind_model=(wind_model, WIND_MODELS), d_u=(d_u, D_U_CHOICES),
+        noise=(noise, NOISE_ESTIMATES),
+    )  # fmt: skip
     tr = Transitions(flight_data)
-    y = tr.targets()
-    params = np.zeros(11)
-    se = np.zeros(11)
-    discarded: dict[str, float] = {}
-    for axis in range(6):
-        x, idx = tr.regressors(axis, _intercept(axis, intercepts))
-        target = y[:, axis]
-        if estimator == "gls":
-            x = (x[1:] - NOISE_DECAY * x[:-1])[tr.pair]
-            target = (target[1:] - NOISE_DECAY * target[:-1])[tr.pair]
-        theta, _, rank, _ = np.linalg.lstsq(x, target, rcond=None)
-        if rank < x.shape[1]:
-            raise NeurohoverError(
-                f"flight data do not determine the {NOISE_NAMES[axis]} axis (regressors "
-                f"{[PARAM_NAMES[i] if i >= 0 else 'constant' for i in idx]} are collinear); fly with a policy that varies its actions"
-            )
-        dof = max(1, x.shape[0] - x.shape[1])
-        sigma2 = float(np.sum((target - x @ theta) ** 2)) / dof
-        cov = sigma2 * np.linalg.inv(x.T @ x)
-        for col, i in enumerate(idx):
-            if i >= 0:
-                params[i] = theta[col]
-                se[i] = math.sqrt(max(cov[col, col], 0.0))
-            else:
-                discarded[NOISE_NAMES[axis]] = float(theta[col])
+    params, se, discarded = _fit_axes(tr, intercepts, estimator)
     keep_d_u = intercepts == "uv" and d_u == "keep"
     d_u_value = discarded.pop("u", 0.0) if keep_d_u else 0.0  # "uv" keeps the u constant as D_u unless told to discard it
     wind, wind_stats = NO_WIND, dict[str, float]()

@@ -251,6 +251,84 @@ def _begin(B, P, N, rngs, seen, srngs, scratch, step, total, lane, row, seed, ep
     return on
 
 
+@nb.njit(cache=True, inline="always")
+def _lane_buffers(n_sub):
+    """A thread's lanes: the packed state B (and B0, a control step's start), per-lane MDP parameters P, gust
+    noise N, actions A, substep winds W, gust streams; the sensor model's readings, streams, state and flags;
+    each lane's job (-1: idle), step and return so far."""
+    return (
+        np.zeros(ROWS * LANES),
+        np.zeros(13 * LANES),
+        np.zeros((LANES, N_PAR)),
+        np.zeros((6, LANES)),
+        np.zeros((4, LANES)),
+        np.zeros((2, n_sub, LANES)),
+        np.empty((LANES, 4), dtype=np.uint64),
+        np.zeros((LANES, 12)),
+        np.empty((LANES, 4), dtype=np.uint64),
+        np.empty((LANES, SENSOR_SCRATCH)),
+        np.zeros(LANES, dtype=np.bool_),
+        np.full(LANES, -1, dtype=np.int64),
+        np.zeros(LANES, dtype=np.int64),
+        np.zeros(LANES),
+    )
+
+
+@nb.njit(cache=True, fastmath={"contract"}, inline="always")
+def _refill(
+    B, P, N, A, rngs, seen, srngs, scratch, sensing, job, step, total, lane, nxt, queue, mdp_rows, job_mdp, seed, episodes, job_slot, park_f, park_u,
+    park_step,
+):  # fmt: skip
+    """Lane ``lane`` reset and given the queue's next job while one is left (else idle: job -1); the last job index
+    this thread took."""
+    _reset_lane(B, N, A, lane)
+    total[lane] = 0.0
+    step[lane] = 0
+    if nxt < episodes.shape[0]:
+        nxt = _take(queue)
+    if nxt < episodes.shape[0]:
+        job[lane] = nxt
+        sensing[lane] = _begin(
+            B, P, N, rngs, seen, srngs, scratch, step, total, lane, mdp_rows[job_mdp[nxt]], seed, episodes[nxt], job_slot, nxt, park_f, park_u, park_step
+        )  # fmt: skip
+    else:
+        job[lane] = -1
+    return nxt
+
+
+@nb.njit(cache=True, fastmath={"contract"}, inline="always")
+def _integrate_each(B, N, A, job, step, mdp_rows, job_mdp) -> None:
+    """A control step's substeps per lane with ``kernel.integrate`` (libm sin/cos): the large-angle fallback and
+    the queue's tail. Idle lanes stay at rest."""
+    for lane in range(LANES):
+        if job[lane] < 0:
+            continue
+        dyn, std, n_sub_l, dt, wind = unpack_mdp(mdp_rows[job_mdp[job[lane]]])
+        s = integrate(
+            _state(B, lane),
+            (N[0, lane], N[1, lane], N[2, lane], N[3, lane], N[4, lane], N[5, lane]),
+            A[0, lane],
+            A[1, lane],
+            A[2, lane],
+            A[3, lane],
+            step[lane],
+            dyn,
+            n_sub_l,
+            dt,
+            wind,
+        )
+        for m in range(13):
+            B[m * LANES + lane] = s[m]
+
+
+@nb.njit(cache=True)
+def _over(j, n_required, left, park_step, job_slot):
+    """Job ``j``'s episode is over in a parking call: one required job fewer to wait for, and its slot begins afresh."""
+    if j < n_required:
+        _fetch_add(left, -1)
+    park_step[job_slot[j]] = 0
+
+
 @nb.njit(cache=True, fastmath={"contract"})
 def fly_queue(
     mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, seed, n_steps, out_return, out_crashed, out_steps, stats,
@@ -279,32 +357,15 @@ def fly_queue(
         return
     n_sub = int(mdp_rows[job_mdp[0], ROW_SUBSTEPS])
     has_wind = int(mdp_rows[job_mdp[0], ROW_WIND_KIND]) != 0
-    B = np.zeros(ROWS * LANES)
-    B0 = np.zeros(13 * LANES)
-    P = np.zeros((LANES, N_PAR))
-    N = np.zeros((6, LANES))
-    A = np.zeros((4, LANES))
-    W = np.zeros((2, n_sub, LANES))
-    rngs = np.empty((LANES, 4), dtype=np.uint64)
-    # The sensor model (kernel.sense), scalar per lane: what each lane's policy sees, its stream and state.
-    seen = np.zeros((LANES, 12))
-    srngs = np.empty((LANES, 4), dtype=np.uint64)
-    scratch = np.empty((LANES, SENSOR_SCRATCH))
-    sensing = np.zeros(LANES, dtype=np.bool_)
-    job = np.full(LANES, -1, dtype=np.int64)
-    step = np.zeros(LANES, dtype=np.int64)
-    total = np.zeros(LANES)
+    B, B0, P, N, A, W, rngs, seen, srngs, scratch, sensing, job, step, total = _lane_buffers(n_sub)
     nxt = -1  # the last job index this thread took
     live = 0
     for lane in range(LANES):
-        _reset_lane(B, N, A, lane)
-        if nxt < n_jobs:
-            nxt = _take(queue)
-        if nxt < n_jobs:
-            job[lane] = nxt
-            sensing[lane] = _begin(
-                B, P, N, rngs, seen, srngs, scratch, step, total, lane, mdp_rows[job_mdp[nxt]], seed, episodes[nxt], job_slot, nxt, park_f, park_u, park_step
-            )  # fmt: skip
+        nxt = _refill(
+            B, P, N, A, rngs, seen, srngs, scratch, sensing, job, step, total, lane, nxt, queue, mdp_rows, job_mdp, seed, episodes, job_slot, park_f,
+            park_u, park_step,
+        )  # fmt: skip
+        if job[lane] >= 0:
             live += 1
     parking = park_step.shape[0] > 0
     while live > 0:
@@ -323,15 +384,9 @@ def fly_queue(
                 o0, o1, o2, o3, o4, o5 = seen[lane, 0], seen[lane, 1], seen[lane, 2], seen[lane, 3], seen[lane, 4], seen[lane, 5]
                 o9, o10, o11 = seen[lane, 9], seen[lane, 10], seen[lane, 11]
             else:
-                o0 = B[(ROW_OBS + 0) * LANES + lane]
-                o1 = B[(ROW_OBS + 1) * LANES + lane]
-                o2 = B[(ROW_OBS + 2) * LANES + lane]
-                o3 = B[(ROW_OBS + 3) * LANES + lane]
-                o4 = B[(ROW_OBS + 4) * LANES + lane]
-                o5 = B[(ROW_OBS + 5) * LANES + lane]
-                o9 = B[(ROW_OBS + 9) * LANES + lane]
-                o10 = B[(ROW_OBS + 10) * LANES + lane]
-                o11 = B[(ROW_OBS + 11) * LANES + lane]
+                o0, o1, o2 = B[(ROW_OBS + 0) * LANES + lane], B[(ROW_OBS + 1) * LANES + lane], B[(ROW_OBS + 2) * LANES + lane]
+                o3, o4, o5 = B[(ROW_OBS + 3) * LANES + lane], B[(ROW_OBS + 4) * LANES + lane], B[(ROW_OBS + 5) * LANES + lane]
+                o9, o10, o11 = B[(ROW_OBS + 9) * LANES + lane], B[(ROW_OBS + 10) * LANES + lane], B[(ROW_OBS + 11) * LANES + lane]
             pol = job_policy[job[lane]]
             a1, a2, a3, a4 = policy_action(policy_kinds[pol], genomes[pol], o0, o1, o2, o3, o4, o5, o9, o10, o11)
             if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
@@ -340,32 +395,21 @@ def fly_queue(
                 out_crashed[j] = True
                 out_steps[j] = k + 1
                 if parking:
-                    if j < n_required:
-                        _fetch_add(left, -1)
-                    park_step[job_slot[j]] = 0
+                    _over(j, n_required, left, park_step, job_slot)
                 job[lane] = -2  # over; the lane idles through this step (at rest, dt 0) and is refilled after it
                 _reset_lane(B, N, A, lane)
                 continue
-            a1 = clip_action(a1)
-            a2 = clip_action(a2)
-            a3 = clip_action(a3)
-            a4 = clip_action(a4)
+            a1, a2, a3, a4 = clip_action(a1), clip_action(a2), clip_action(a3), clip_action(a4)
             rng = rngs[lane]
             std = (P[lane, 0], P[lane, 1], P[lane, 2], P[lane, 3], P[lane, 4], P[lane, 5])
             n = (N[0, lane], N[1, lane], N[2, lane], N[3, lane], N[4, lane], N[5, lane])
             n = update_noise(n, std, next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng), next_normal(rng))
             for m in range(6):
                 N[m, lane] = n[m]
-            A[0, lane] = a1
-            A[1, lane] = a2
-            A[2, lane] = a3
-            A[3, lane] = a4
-            B[13 * LANES + lane] = P[lane, 6] + n[0]
-            B[14 * LANES + lane] = P[lane, 7] + n[1]
-            B[15 * LANES + lane] = P[lane, 8] * a4 + n[2]
-            B[16 * LANES + lane] = P[lane, 9] * a1 + n[3]
-            B[17 * LANES + lane] = P[lane, 10] * a2 + n[4]
-            B[18 * LANES + lane] = P[lane, 11] * a3 + n[5]
+            A[0, lane], A[1, lane], A[2, lane], A[3, lane] = a1, a2, a3, a4
+            B[13 * LANES + lane], B[14 * LANES + lane] = P[lane, 6] + n[0], P[lane, 7] + n[1]
+            B[15 * LANES + lane], B[16 * LANES + lane] = P[lane, 8] * a4 + n[2], P[lane, 9] * a1 + n[3]
+            B[17 * LANES + lane], B[18 * LANES + lane] = P[lane, 10] * a2 + n[4], P[lane, 11] * a3 + n[5]
             if has_wind:
                 wind = (int(P[lane, 12]), P[lane, 13], P[lane, 14], P[lane, 15], P[lane, 16], P[lane, 17], P[lane, 18], P[lane, 19], P[lane, 20])
                 for i in range(n_sub):
@@ -378,25 +422,7 @@ def fly_queue(
             if packed:
                 stats[1] += 1
                 B[: 13 * LANES] = B0
-            for lane in range(LANES):
-                if job[lane] < 0:
-                    continue  # idle: stays at rest
-                dyn, std, n_sub_l, dt, wind = unpack_mdp(mdp_rows[job_mdp[job[lane]]])
-                s = integrate(
-                    _state(B, lane),
-                    (N[0, lane], N[1, lane], N[2, lane], N[3, lane], N[4, lane], N[5, lane]),
-                    A[0, lane],
-                    A[1, lane],
-                    A[2, lane],
-                    A[3, lane],
-                    step[lane],
-                    dyn,
-                    n_sub_l,
-                    dt,
-                    wind,
-                )
-                for m in range(13):
-                    B[m * LANES + lane] = s[m]
+            _integrate_each(B, N, A, job, step, mdp_rows, job_mdp)
         observe_lanes(B)
         # Bookkeeping, scalar per lane: return, end of episode, refill.
         for lane in range(LANES):
@@ -419,21 +445,12 @@ def fly_queue(
                     continue
                 out_steps[j] = t
                 if parking:
-                    if j < n_required:
-                        _fetch_add(left, -1)
-                    park_step[job_slot[j]] = 0  # over: a later listing of its slot begins afresh
-            _reset_lane(B, N, A, lane)
-            total[lane] = 0.0
-            step[lane] = 0
-            if nxt < n_jobs:
-                nxt = _take(queue)
-            if nxt < n_jobs:
-                job[lane] = nxt
-                sensing[lane] = _begin(
-                B, P, N, rngs, seen, srngs, scratch, step, total, lane, mdp_rows[job_mdp[nxt]], seed, episodes[nxt], job_slot, nxt, park_f, park_u, park_step
+                    _over(j, n_required, left, park_step, job_slot)
+            nxt = _refill(
+                B, P, N, A, rngs, seen, srngs, scratch, sensing, job, step, total, lane, nxt, queue, mdp_rows, job_mdp, seed, episodes, job_slot, park_f,
+                park_u, park_step,
             )  # fmt: skip
-            else:
-                job[lane] = -1
+            if job[lane] < 0:
                 live -= 1
 
 
