@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import NeurohoverError
 from ..policies import TOPOLOGIES, Policy
 from ..policies import prototype as make_prototype
-from ..tasks import EXACT, MDP, TaskFamily, refuse_drift
+from ..tasks import MDP, TaskFamily, refuse_drift
 from .bandits import BANDITS
 from .generational import GENERATIONAL_PRESETS, OLD_GENERATIONAL, GenerationalSettings
 from .optimisers import NE, OPTIMISERS, optimiser_names, population_settings
@@ -156,13 +156,8 @@ def resolve_target(target) -> tuple[MDP | None, TaskFamily | None, dict]:
         refuse_drift(target, "evolution")
     if isinstance(target, MDP):
         return target, None, {"kind": "mdp", "mdp": target.to_dict()}
-    if isinstance(target, TaskFamily):
-        desc: dict[str, Any] = {"kind": "family", "family": target.name}
-        if target.sigma is not None:
-            desc["sigma"] = float(target.sigma)
-        if target.sensor != EXACT:  # part of the run (checkpoints, results); absent for exact sensors, as before
-            desc["sensor"] = target.sensor.to_dict()
-        return None, target, desc
+    if isinstance(target, TaskFamily):  # all it is (sensor included): part of the run's checkpoint and results
+        return None, target, {"kind": "family", **target.to_dict()}
     if callable(getattr(target, "mdp", None)) and hasattr(target, "method"):  # a LearnedModel
         mdp = target.mdp()
         return mdp, None, {"kind": "mdp", "mdp": mdp.to_dict()}

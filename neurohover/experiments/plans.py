@@ -50,7 +50,8 @@ class Plan:
 
 
 def _family_target(s: ExperimentSettings, sigma: float | None) -> dict:
-    """An evolution unit's target "over the family": its task, breadth and (when set) sensor."""
+    """An evolution unit's target "over the family": :meth:`TaskFamily.to_dict`'s table as the stored units spell it
+    (``task`` for ``family``, a ``sigma`` always; :func:`~neurohover.tasks.family_from_dict` reads both)."""
     return {"kind": "family", "task": s.task, "sigma": sigma, **({"sensor": s.sensor} if s.sensor is not None else {})}
 
 

@@ -37,7 +37,7 @@ from ..models import learn_ec_meno, learn_ec_mer, learn_lr, one_step_error
 from ..policies import Policy
 from ..policies import prototype as make_prototype
 from ..policysets import choose_safe
-from ..tasks import EXACT, MDP, Sensor, family_for
+from ..tasks import EXACT, MDP, Sensor, family_for, family_from_dict
 from .params import unit_params
 from .results import (
     DiagnosticResult,
@@ -117,7 +117,7 @@ def _evolve_target(t: dict):
     """An evolution unit's target: the MDP, or the family (its task, breadth and sensors)."""
     if t["kind"] == "mdp":
         return _mdp(t["mdp"])
-    return family_of(t["task"], t.get("sigma"), t.get("sensor"))
+    return family_from_dict({k: v for k, v in t.items() if k != "kind"})
 
 
 def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:

@@ -87,6 +87,26 @@ def _family(name: str, sigma: float | None) -> TaskFamily:
     return cls()
 
 
+#: What :func:`family_from_dict` reads; ``task`` is the experiments' name for ``family`` (their stored unit params).
+FAMILY_KEYS = ("family", "sigma", "sensor", "drift")
+
+
+def family_from_dict(d: dict) -> TaskFamily:
+    """The task family of :meth:`TaskFamily.to_dict`'s dict (``task`` is read as ``family``; unknown keys refused)."""
+    if not isinstance(d, dict):
+        raise NeurohoverError(f"a task family must be a table {{family, sigma, sensor, drift}}, got {d!r:.80}")
+    d = dict(d)
+    if "task" in d and "family" not in d:
+        d["family"] = d.pop("task")
+    unknown = sorted(set(d) - set(FAMILY_KEYS))
+    if unknown or "family" not in d:
+        what = f"unknown key(s) {', '.join(unknown)}" if unknown else "no family name"
+        raise NeurohoverError(f"task family table {d!r:.120}: {what}; allowed {', '.join(FAMILY_KEYS)} (family required)")
+    sensor = None if d.get("sensor") is None else Sensor.from_dict(d["sensor"])
+    drift = None if d.get("drift") is None else Drift.from_dict(d["drift"])
+    return get_task_family(d["family"], d.get("sigma"), sensor, drift)
+
+
 def family_for(name: str, sigma: float | None, sensor: Sensor | None = None, drift: Drift | None = None) -> TaskFamily:
     """Like :func:`get_task_family`, but a ``sigma`` is ignored for families without one (configs carry one for all)."""
     key = str(name).lower().replace("-", "")
@@ -113,7 +133,9 @@ __all__ = [
     "TASK_NAMES",
     "TaskFamily",
     "competition_rows",
+    "FAMILY_KEYS",
     "family_for",
+    "family_from_dict",
     "finite_vector",
     "get_task_family",
     "refuse_drift",

@@ -281,6 +281,19 @@ class TaskFamily:
         object.__setattr__(out, "drift", drift)
         return out
 
+    def to_dict(self) -> dict:
+        """All the family is, as one JSON-ready dict: ``family`` (its name), and where set ``sigma``, ``sensor`` and
+        ``drift`` (their tables); :func:`neurohover.tasks.family_from_dict` builds it back. Evolution checkpoints,
+        results and unit params record a family this way."""
+        d: dict = {"family": self.name}
+        if self.sigma is not None:
+            d["sigma"] = float(self.sigma)
+        if self.sensor != EXACT:
+            d["sensor"] = self.sensor.to_dict()
+        if not self.drift.none:
+            d["drift"] = self.drift.to_dict()
+        return d
+
     # -- what a family defines ------------------------------------------------------------
 
     def make(self, params: Sequence[float] | np.ndarray, label: str = "") -> MDP:  # pragma: no cover - overridden
