@@ -2,7 +2,7 @@
 the shipped generic on the same gusts (:func:`neurohover.integrations.flying.compare_agent`).
 
 - ``neurohover evaluate-agent --task ghh08 (--policy FILE | --callable MODULE:FUNCTION | --rl-zoo RUN | --sb3 MODEL.zip)
-  [--algo ppo] [--mdps test|train] [--n-mdps N] [--episodes E] [--seed S] [--episode-steps N] [--json FILE]``
+  [--algo ppo] [--rl-id] [--mdps test|train] [--n-mdps N] [--episodes E] [--seed S] [--episode-steps N] [--json FILE]``
 """
 
 from __future__ import annotations
@@ -67,7 +67,13 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
         if not low <= value <= high:
             raise NeurohoverError(f"{option} {value} is out of range: allowed an integer in {low}..{high}")
     out = None if args.json is None else output_file(args.json, "--json")
+    if args.rl_id and args.policy is not None:
+        raise NeurohoverError("--rl-id applies to an agent trained on a neurohover/<NAME>-RL-v0 id, not to a neurohover --policy file")
     act = _agent(args)
+    if args.rl_id or (args.rl_zoo is not None and "-RL-v0" in str(args.rl_zoo)):
+        from ..envs.rl import rl_policy
+
+        act = rl_policy(act)
     mdps = [family.mdp(f"{args.mdps}:{i}") for i in range(n)]
     rows = compare_agent(act, mdps, episodes=args.episodes, seed=args.seed, n_steps=args.episode_steps, obs_dtype=args.obs_dtype)
     print(f"{args.task} {args.mdps} MDPs 0-{n - 1}, {args.episodes} episode(s) each of {args.episode_steps} steps, gusts of seed {args.seed}:")
@@ -96,6 +102,12 @@ def register(sub) -> None:
     g.add_argument("--rl-zoo", help="an RL Zoo run folder (logs/ALGO/ENV_N): its final model and frozen observation statistics")
     g.add_argument("--sb3", help="a Stable-Baselines3 model file (MODEL.zip)")
     p.add_argument("--algo", choices=ALGOS, default="ppo", help="the algorithm of --rl-zoo / --sb3 (default ppo)")
+    p.add_argument(
+        "--rl-id",
+        action="store_true",
+        help="the agent learned on a neurohover/<NAME>-RL-v0 id: fly it through that id's observation and action scaling "
+        "(automatic for an RL Zoo run folder of such an id)",
+    )
     p.add_argument("--mdps", choices=("test", "train"), default="test", help="the task's test (default) or training MDPs")
     p.add_argument("--n-mdps", type=int, help="the first N of them (default all)")
     p.add_argument("--episodes", type=int, default=1, help="episodes per MDP (default 1)")

@@ -4,7 +4,9 @@ Ids: ``neurohover/GHH08-v0``, ``neurohover/GHH09-v0`` and ``neurohover/FGHH-v0``
 ``sigma``, default 0.3): one per task family, the paper's 6000-step episodes in float64; and
 ``neurohover/<NAME>-Short-v0`` for deep RL: 1000-step episodes whose crash charge counts the
 steps left of the short episode, float32 observations and actions (:class:`HoverEnv`'s docstring
-has the table); and ``neurohover/<NAME>-NoisySensors-v0``, ``-CorrelatedSensors-v0`` and
+has the table); ``neurohover/<NAME>-RL-v0``: the short ones with scaled observations and actions and the
+crash-aware reward built in, for a library's default settings (:mod:`neurohover.envs.rl`); and
+``neurohover/<NAME>-NoisySensors-v0``, ``-CorrelatedSensors-v0`` and
 ``-DelayedSensors-v0``: the paper's episodes seen through the harder sensors of its Section 7
 (:data:`SENSOR_ENV_SETTINGS`, :mod:`neurohover.tasks.sensor`); and ``-DriftingDynamics-v0`` and
 ``-AbruptChange-v0``: test runs of one MDP whose dynamics drift between episodes
@@ -20,6 +22,7 @@ import gymnasium
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import TASK_NAMES
 from .hover import HoverEnv
+from .rl import RL_SETTINGS
 from .vector import HoverVectorEnv
 
 #: One id per task family, ``neurohover/<NAME>-v0``.
@@ -28,6 +31,11 @@ SHORT_EPISODE_STEPS = 1000
 #: The deep-RL variant of each family, ``neurohover/<NAME>-Short-v0``: its settings over the family's.
 SHORT_ENV_IDS: dict[str, str] = {f"neurohover/{name.upper()}-Short-v0": name for name in TASK_NAMES}
 SHORT_SETTINGS = {"episode_steps": SHORT_EPISODE_STEPS, "obs_dtype": "float32", "action_dtype": "float32"}
+
+
+#: The deep-RL ids of each family, ``neurohover/<NAME>-RL-v0`` (:mod:`neurohover.envs.rl`): short float32 episodes with
+#: scaled observations and the crash-aware reward built in, for learning with a library's default settings.
+RL_ENV_IDS: dict[str, str] = {f"neurohover/{name.upper()}-RL-v0": name for name in TASK_NAMES}
 
 
 #: The sensor variants' settings, by the suffix of their ids (``neurohover/<NAME>-<suffix>-v0``).
@@ -54,6 +62,15 @@ def register_envs() -> None:
     ids += [(env_id, task, SHORT_SETTINGS, SHORT_EPISODE_STEPS) for env_id, task in SHORT_ENV_IDS.items()]
     ids += [(env_id, task, SENSOR_ENV_SETTINGS[env_id.split("-")[1]], EPISODE_STEPS) for env_id, task in SENSOR_ENV_IDS.items()]
     ids += [(env_id, task, DRIFT_ENV_SETTINGS[env_id.split("-")[1]], EPISODE_STEPS) for env_id, task in DRIFT_ENV_IDS.items()]
+    for env_id, task in RL_ENV_IDS.items():
+        if env_id not in gymnasium.registry:
+            gymnasium.register(
+                id=env_id,
+                entry_point="neurohover.envs.rl:make_rl_env",
+                vector_entry_point="neurohover.envs.rl:make_rl_vector_env",
+                max_episode_steps=RL_SETTINGS["episode_steps"],
+                kwargs={"task": task},
+            )
     for env_id, task, settings, limit in ids:
         if env_id in gymnasium.registry:  # re-import or reload: Gymnasium would warn about overriding
             continue
@@ -73,6 +90,7 @@ __all__ = [
     "DRIFT_ENV_IDS",
     "DRIFT_ENV_SETTINGS",
     "ENV_IDS",
+    "RL_ENV_IDS",
     "SENSOR_ENV_IDS",
     "SENSOR_ENV_SETTINGS",
     "SHORT_ENV_IDS",

@@ -1,0 +1,104 @@
+"""The deep-RL ids ``neurohover/<NAME>-RL-v0``: the hovering task made learnable with a library's default settings.
+
+By id alone (``gym.make("neurohover/GHH08-RL-v0")``, SB3's ``make_vec_env``, RL Zoo's ``--env`` without a
+``--conf-file``, CleanRL's ``--env-id``) a stock agent meets rewards of -1e7 at a crash and observations
+of very different sizes, and learns to crash (docs/deep-rl.md). These ids are the short-episode variant
+with the two transforms our recipe needed built in, so that no wrapper and no hyperparameter is asked of
+the user:
+
+=====================  ===========================================================================
+episodes               1000 control steps (100 s); a crash charges the steps left of the 1000
+observation            the 12 readings divided by the crash limits (:data:`OBS_LIMITS`: 5 m/s, 20 m,
+                       4 pi rad/s, 1), so a reading is within [-1, 1] until the helicopter crashes;
+                       float32
+action                 4 numbers in [-1, 1] (clipped), float32: the controls ``ACTION_OFFSET +
+                       ACTION_SCALE * a`` (:func:`controls`), so a = 0 is the baseline policy's
+                       action at rest (0.02, 0, 0, 0.23) and a library's usual unit exploration
+                       noise is a tenth of the controls' range, the size the hovering controls
+                       have (the baseline's and the shipped generic's stay within 0.34 of 0)
+reward                 :func:`neurohover.wrappers.crash_aware` with gamma 0.99 and scale 0.1:
+                       ``-0.1 log(1 + |r|)`` a step, a crash the squashed worst step for every
+                       step left, discounted (about -75 at the first step)
+=====================  ===========================================================================
+
+The MDP is drawn from G at every reset (``mdp="sample"``; pass ``mdp="train:3"`` for one MDP), as the
+other ids. A policy trained here flies the paper's episodes through :func:`rl_policy` (its observations
+scaled, its actions made controls): ``neurohover evaluate-agent --rl-id`` applies it, and the return it
+prints is the raw one of full 6000-step episodes, comparable with the paper's.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium.wrappers.vector import TransformAction as VectorTransformAction
+from gymnasium.wrappers.vector import TransformObservation as VectorTransformObservation
+from gymnasium.wrappers.vector import TransformReward as VectorTransformReward
+
+from ..sim.constants import MAX_POSITION, MAX_RATE, MAX_VELOCITY
+from ..wrappers import CrashAwareReward, crash_aware
+from .hover import HoverEnv
+from .vector import HoverVectorEnv
+
+#: The crash limits of the 12 readings (u, v, w; x, y, z; p, q, r; qx, qy, qz): what :func:`scale_observation` divides by.
+OBS_LIMITS = np.array((MAX_VELOCITY,) * 3 + (MAX_POSITION,) * 3 + (MAX_RATE,) * 3 + (1.0,) * 3)
+#: The controls of an RL id's action a: ``ACTION_OFFSET + ACTION_SCALE * clip(a, -1, 1)``.
+ACTION_OFFSET = np.array([0.02, 0.0, 0.0, 0.23])  # the baseline policy's action at rest
+ACTION_SCALE = 0.1
+#: The reward transform's discount and scale (those of the shipped PPO recipe, docs/deep-rl.md).
+RL_GAMMA, RL_REWARD_SCALE = 0.99, 0.1
+#: What the RL ids set over the family's environment (their reward and observation transforms come on top).
+RL_SETTINGS: dict[str, Any] = {"episode_steps": 1000, "obs_dtype": "float32", "action_dtype": "float32"}
+
+
+def scale_observation(obs: np.ndarray) -> np.ndarray:
+    """Readings (..., 12) divided by their crash limits, in their own dtype: what an RL id's policy sees."""
+    obs = np.asarray(obs)
+    return (obs / OBS_LIMITS).astype(obs.dtype if obs.dtype.kind == "f" else np.float64, copy=False)
+
+
+def controls(action: np.ndarray) -> np.ndarray:
+    """The task's controls (..., 4), float64, of an RL id's actions."""
+    return ACTION_OFFSET + ACTION_SCALE * np.clip(np.asarray(action, dtype=np.float64), -1.0, 1.0)
+
+
+def rl_policy(act):
+    """A policy of the paper's observations (a batch (n, 12) -> controls (n, 4)) from ``act``, one trained on an RL id
+    (scaled observations -> its actions): what :func:`neurohover.integrations.flying.evaluate_callable` flies."""
+
+    def policy(obs: np.ndarray) -> np.ndarray:
+        return controls(act(scale_observation(np.asarray(obs, dtype=np.float32))))
+
+    return policy
+
+
+class ScaledObservation(gym.ObservationWrapper):
+    """Observations of :func:`scale_observation` (the space keeps its shape and dtype; its bounds are infinite)."""
+
+    def observation(self, observation: np.ndarray) -> np.ndarray:
+        return scale_observation(observation)
+
+
+class ScaledAction(gym.ActionWrapper):
+    """Actions in [-1, 1] made the task's controls by :func:`controls`."""
+
+    def action(self, action: np.ndarray) -> np.ndarray:
+        return controls(action).astype(self.env.action_space.dtype)
+
+
+def make_rl_env(**kwargs: Any) -> gym.Env:
+    """The single environment of an RL id: :class:`HoverEnv` with :data:`RL_SETTINGS`, scaled observations and actions,
+    and the crash-aware reward (keyword arguments as :class:`HoverEnv`'s; the id's settings may be overridden)."""
+    env = HoverEnv(**{**RL_SETTINGS, **kwargs})
+    return CrashAwareReward(ScaledAction(ScaledObservation(env)), gamma=RL_GAMMA, scale=RL_REWARD_SCALE)
+
+
+def make_rl_vector_env(**kwargs: Any) -> gym.vector.VectorEnv:
+    """The native vector environment of an RL id (``gym.make_vec(..., vectorization_mode="vector_entry_point")``,
+    :class:`neurohover.integrations.sb3.SB3VecEnv`): the same transforms on every helicopter."""
+    env = HoverVectorEnv(**{**RL_SETTINGS, **kwargs})
+    scaled = VectorTransformObservation(env, scale_observation, env.observation_space)
+    acting = VectorTransformAction(scaled, lambda a: controls(a).astype(env.action_space.dtype), env.action_space)
+    return VectorTransformReward(acting, lambda r: crash_aware(r, RL_GAMMA, RL_REWARD_SCALE).astype(np.float64))
