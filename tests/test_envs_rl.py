@@ -13,7 +13,7 @@ from gymnasium.utils.env_checker import check_env
 
 import neurohover  # noqa: F401  (registers the environments)
 from neurohover.envs import RL_ENV_IDS
-from neurohover.envs.rl import ACTION_OFFSET, ACTION_SCALE, OBS_LIMITS, RL_GAMMA, RL_REWARD_SCALE, controls, rl_policy, scale_observation
+from neurohover.envs.rl import ACTION_AUTHORITY, ACTION_OFFSET, OBS_LIMITS, RL_GAMMA, RL_REWARD_SCALE, controls, rl_policy, scale_observation
 from neurohover.integrations.flying import compare_agent
 from neurohover.tasks import get_task_family
 from neurohover.wrappers import crash_aware
@@ -49,13 +49,9 @@ def _fly(env_id: str, actions: np.ndarray) -> tuple[list, list, bool]:
 def test_an_rl_id_is_the_short_episode_seen_through_its_scaling() -> None:
     """Action a flies controls(a); the observation is the short id's divided by the crash limits; the reward is the
     crash-aware transform of the short id's, crash included."""
-    crash = np.ones((40, 4), dtype=np.float32)  # full controls: the short id crashes within a few steps
-    for actions, short_actions in ((ACTIONS, controls(ACTIONS).astype(np.float32)), (None, crash)):
-        if actions is None:  # the RL id's action that makes those controls
-            actions = ((crash - ACTION_OFFSET) / ACTION_SCALE).astype(np.float32)
-            assert np.all(np.abs(actions) > 1)  # beyond its range: clipped, so the RL id cannot reach them
-            actions = np.clip(actions, -1, 1)
-            short_actions = controls(actions).astype(np.float32)
+    crash = np.ones((40, 4), dtype=np.float32)
+    for actions in (ACTIONS, crash):  # the second: full authority, a crash within a few steps
+        short_actions = controls(actions, "ghh08").astype(np.float32)
         seen, rewards, over = _fly("neurohover/GHH08-RL-v0", actions)
         raw, raw_rewards, raw_over = _fly("neurohover/GHH08-Short-v0", short_actions)
         assert over == raw_over and len(rewards) == len(raw_rewards)
@@ -71,8 +67,19 @@ def test_an_rl_policy_flies_the_papers_observations() -> None:
         return np.zeros((obs.shape[0], 4), dtype=np.float32)
 
     obs = np.arange(24, dtype=np.float64).reshape(2, 12)
-    np.testing.assert_allclose(rl_policy(act)(obs), np.tile(ACTION_OFFSET, (2, 1)))  # a = 0: the baseline's action at rest
+    np.testing.assert_allclose(rl_policy(act, "ghh08")(obs), np.tile(ACTION_OFFSET, (2, 1)))  # a = 0: the baseline's action at rest
     np.testing.assert_allclose(seen[0], scale_observation(obs.astype(np.float32)))
+
+
+def test_the_action_map_is_gentle_near_zero_and_reaches_the_familys_authority() -> None:
+    for task, authority in ACTION_AUTHORITY.items():
+        np.testing.assert_allclose(controls(np.zeros(4), task), ACTION_OFFSET)
+        np.testing.assert_allclose(controls(np.ones(4), task), ACTION_OFFSET + authority)
+        np.testing.assert_allclose(controls(-2 * np.ones(4), task), ACTION_OFFSET - authority)  # clipped to -1
+        small = controls(np.full(4, 1e-4), task) - ACTION_OFFSET
+        np.testing.assert_allclose(small, authority * 1e-4 / 5, rtol=1e-6)
+    a = np.linspace(-1, 1, 201)[:, None].repeat(4, axis=1)
+    assert np.all(np.diff(controls(a, "ghh09"), axis=0) > 0)  # monotone: every control reachable once
 
 
 def test_the_vector_rl_id_steps_as_the_single_one() -> None:

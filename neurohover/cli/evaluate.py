@@ -73,7 +73,7 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     if args.rl_id or (args.rl_zoo is not None and "-RL-v0" in str(args.rl_zoo)):
         from ..envs.rl import rl_policy
 
-        act = rl_policy(act)
+        act = rl_policy(act, family.name)
     mdps = [family.mdp(f"{args.mdps}:{i}") for i in range(n)]
     rows = compare_agent(act, mdps, episodes=args.episodes, seed=args.seed, n_steps=args.episode_steps, obs_dtype=args.obs_dtype)
     print(f"{args.task} {args.mdps} MDPs 0-{n - 1}, {args.episodes} episode(s) each of {args.episode_steps} steps, gusts of seed {args.seed}:")

@@ -11,11 +11,12 @@ episodes               1000 control steps (100 s); a crash charges the steps lef
 observation            the 12 readings divided by the crash limits (:data:`OBS_LIMITS`: 5 m/s, 20 m,
                        4 pi rad/s, 1), so a reading is within [-1, 1] until the helicopter crashes;
                        float32
-action                 4 numbers in [-1, 1] (clipped), float32: the controls ``ACTION_OFFSET +
-                       ACTION_SCALE * a`` (:func:`controls`), so a = 0 is the baseline policy's
-                       action at rest (0.02, 0, 0, 0.23) and a library's usual unit exploration
-                       noise is a tenth of the controls' range, the size the hovering controls
-                       have (the baseline's and the shipped generic's stay within 0.34 of 0)
+action                 4 numbers in [-1, 1] (clipped), float32: the controls ``ACTION_OFFSET + A (a +
+                       4 a^3) / 5`` (:func:`controls`), so a = 0 is the baseline policy's action at
+                       rest (0.02, 0, 0, 0.23), a small a moves a control by A a / 5 (a library's
+                       usual unit exploration noise stays survivable) and a = +-1 reaches the
+                       family's authority A (:data:`ACTION_AUTHORITY`: what the paper's policies
+                       need, measured on the test MDPs)
 reward                 :func:`neurohover.wrappers.crash_aware` with gamma 0.99 and scale 0.1:
                        ``-0.1 log(1 + |r|)`` a step, a crash the squashed worst step for every
                        step left, discounted (about -75 at the first step)
@@ -44,9 +45,17 @@ from .vector import HoverVectorEnv
 
 #: The crash limits of the 12 readings (u, v, w; x, y, z; p, q, r; qx, qy, qz): what :func:`scale_observation` divides by.
 OBS_LIMITS = np.array((MAX_VELOCITY,) * 3 + (MAX_POSITION,) * 3 + (MAX_RATE,) * 3 + (1.0,) * 3)
-#: The controls of an RL id's action a: ``ACTION_OFFSET + ACTION_SCALE * clip(a, -1, 1)``.
+#: The controls of an RL id's action a: ``ACTION_OFFSET + A * (a + CUBIC * a**3) / (1 + CUBIC)``, a clipped to [-1, 1].
 ACTION_OFFSET = np.array([0.02, 0.0, 0.0, 0.23])  # the baseline policy's action at rest
-ACTION_SCALE = 0.1
+CUBIC = 4.0  # near a = 0 a control moves by A / 5 per unit of a; at a = +-1 by A
+#: Each family's authority A: the largest control moves from ACTION_OFFSET that the paper's policies make, rounded up
+#: (GHH-08 and GHH-09 generics on their test MDPs: 0.43, 0.21, 0.018, 0.17; FGHH generics: the whole range).
+ACTION_AUTHORITY: dict[str, np.ndarray] = {
+    "ghh08": np.array([0.5, 0.25, 0.05, 0.2]),
+    "ghh09": np.array([0.5, 0.25, 0.05, 0.2]),
+    "fghh": np.array([1.0, 1.0, 0.05, 1.0]),
+}
+FULL_AUTHORITY = np.array([1.0, 1.0, 1.0, 1.0])  # a family without a measured one
 #: The reward transform's discount and scale (those of the shipped PPO recipe, docs/deep-rl.md).
 RL_GAMMA, RL_REWARD_SCALE = 0.99, 0.1
 #: What the RL ids set over the family's environment (their reward and observation transforms come on top).
@@ -59,17 +68,19 @@ def scale_observation(obs: np.ndarray) -> np.ndarray:
     return (obs / OBS_LIMITS).astype(obs.dtype if obs.dtype.kind == "f" else np.float64, copy=False)
 
 
-def controls(action: np.ndarray) -> np.ndarray:
-    """The task's controls (..., 4), float64, of an RL id's actions."""
-    return ACTION_OFFSET + ACTION_SCALE * np.clip(np.asarray(action, dtype=np.float64), -1.0, 1.0)
+def controls(action: np.ndarray, task: str) -> np.ndarray:
+    """The task's controls (..., 4), float64, of an RL id's actions on family ``task``."""
+    a = np.clip(np.asarray(action, dtype=np.float64), -1.0, 1.0)
+    return ACTION_OFFSET + ACTION_AUTHORITY.get(task, FULL_AUTHORITY) * (a + CUBIC * a**3) / (1.0 + CUBIC)
 
 
-def rl_policy(act):
-    """A policy of the paper's observations (a batch (n, 12) -> controls (n, 4)) from ``act``, one trained on an RL id
-    (scaled observations -> its actions): what :func:`neurohover.integrations.flying.evaluate_callable` flies."""
+def rl_policy(act, task: str):
+    """A policy of the paper's observations (a batch (n, 12) -> controls (n, 4)) from ``act``, one trained on the RL id
+    of family ``task`` (scaled observations -> its actions): what :func:`neurohover.integrations.flying.evaluate_callable`
+    flies."""
 
     def policy(obs: np.ndarray) -> np.ndarray:
-        return controls(act(scale_observation(np.asarray(obs, dtype=np.float32))))
+        return controls(act(scale_observation(np.asarray(obs, dtype=np.float32))), task)
 
     return policy
 
@@ -84,15 +95,19 @@ class ScaledObservation(gym.ObservationWrapper):
 class ScaledAction(gym.ActionWrapper):
     """Actions in [-1, 1] made the task's controls by :func:`controls`."""
 
+    def __init__(self, env: gym.Env, task: str) -> None:
+        super().__init__(env)
+        self.task = task
+
     def action(self, action: np.ndarray) -> np.ndarray:
-        return controls(action).astype(self.env.action_space.dtype)
+        return controls(action, self.task).astype(self.env.action_space.dtype)
 
 
 def make_rl_env(**kwargs: Any) -> gym.Env:
     """The single environment of an RL id: :class:`HoverEnv` with :data:`RL_SETTINGS`, scaled observations and actions,
     and the crash-aware reward (keyword arguments as :class:`HoverEnv`'s; the id's settings may be overridden)."""
     env = HoverEnv(**{**RL_SETTINGS, **kwargs})
-    return CrashAwareReward(ScaledAction(ScaledObservation(env)), gamma=RL_GAMMA, scale=RL_REWARD_SCALE)
+    return CrashAwareReward(ScaledAction(ScaledObservation(env), env.family.name), gamma=RL_GAMMA, scale=RL_REWARD_SCALE)
 
 
 def make_rl_vector_env(**kwargs: Any) -> gym.vector.VectorEnv:
@@ -100,5 +115,6 @@ def make_rl_vector_env(**kwargs: Any) -> gym.vector.VectorEnv:
     :class:`neurohover.integrations.sb3.SB3VecEnv`): the same transforms on every helicopter."""
     env = HoverVectorEnv(**{**RL_SETTINGS, **kwargs})
     scaled = VectorTransformObservation(env, scale_observation, env.observation_space)
-    acting = VectorTransformAction(scaled, lambda a: controls(a).astype(env.action_space.dtype), env.action_space)
+    task = env.family.name
+    acting = VectorTransformAction(scaled, lambda a: controls(a, task).astype(env.action_space.dtype), env.action_space)
     return VectorTransformReward(acting, lambda r: crash_aware(r, RL_GAMMA, RL_REWARD_SCALE).astype(np.float64))
