@@ -52,3 +52,41 @@ def test_ppo_learns_on_it() -> None:
 def test_only_neurohover_ids_are_taken() -> None:
     with pytest.raises(NeurohoverError, match="is not a neurohover environment"):
         SB3VecEnv("CartPole-v1", num_envs=2)
+
+
+def test_sb3vecenv_over_an_rl_id_steps_it_with_its_transforms() -> None:
+    """Issue 36: the RL id's scaling and crash-aware reward hold on SB3's native vector env as on gym.make."""
+    env = SB3VecEnv("neurohover/GHH08-RL-v0", num_envs=2, mdp="train:3")
+    env.seed(5)
+    obs = env.reset()
+    single = gym.make("neurohover/GHH08-RL-v0", mdp="train:3")
+    one, _ = single.reset(seed=5)
+    np.testing.assert_allclose(obs[0], one)
+    action = np.array([0.3, -0.2, 0.1, 0.05], dtype=np.float32)
+    for _ in range(5):
+        obs, rewards, _, _ = env.step(np.tile(action, (2, 1)))
+        one, r, *_ = single.step(action)
+        np.testing.assert_allclose(obs[0], one, rtol=1e-6)
+        assert rewards[0] == pytest.approx(r, rel=1e-6)
+
+
+def test_a_recurrent_model_keeps_each_episodes_state_when_flown_in_a_batch(tmp_path) -> None:
+    """Issue 36: evaluate-agent --algo ppo_lstm: a RecurrentPPO flown on several episodes at once acts in each as it
+    does flown alone from that episode's first step."""
+    sb3_contrib = pytest.importorskip("sb3_contrib", reason="sb3-contrib is not installed")
+    from neurohover.integrations.flying import evaluate_callable
+    from neurohover.integrations.sb3 import RecurrentPolicy, sb3_policy
+
+    model = sb3_contrib.RecurrentPPO("MlpLstmPolicy", gym.make("neurohover/GHH08-Short-v0"), n_steps=64, batch_size=64, seed=0, device="cpu")
+    model.learn(64)
+    model.save(tmp_path / "lstm.zip")
+    act = sb3_policy(tmp_path / "lstm.zip", algo="ppo_lstm", deterministic=True)
+    assert isinstance(act, RecurrentPolicy)
+    mdps = [neurohover.get_task_family("ghh08").mdp(f"test:{i}") for i in range(3)]
+    batch = evaluate_callable(act, mdps, episodes=1, seed=2, n_steps=40, obs_dtype="float32", indexed=True)
+    for i, mdp in enumerate(mdps):  # alone: a fresh state, the same gusts (stream (seed, i))
+        fresh = sb3_policy(tmp_path / "lstm.zip", algo="ppo_lstm")
+        alone = evaluate_callable(fresh, [mdp], episodes=1, seed=2, n_steps=40, obs_dtype="float32", indexed=True, first_episode=i)
+        assert float(np.ravel(alone.returns)[0]) == pytest.approx(float(np.ravel(batch.returns)[i]), rel=1e-9)
+    memoryless = evaluate_callable(lambda obs: model.predict(obs, deterministic=True)[0], mdps, episodes=1, seed=2, n_steps=40, obs_dtype="float32")
+    assert not np.allclose(np.ravel(memoryless.returns), np.ravel(batch.returns), rtol=1e-9, atol=0)  # the state is carried

@@ -16,7 +16,7 @@ from ..errors import NeurohoverError
 from .options import add_sigma_option, add_task_option
 
 SOURCES = ("policy", "callable", "rl_zoo", "sb3")
-ALGOS = ("ppo", "sac", "td3", "a2c")
+ALGOS = ("ppo", "sac", "td3", "a2c", "ppo_lstm", "tqc", "trpo", "crossq", "ars")  # integrations.sb3.ALGORITHMS (SB3 optional)
 
 
 def _agent(args: argparse.Namespace):

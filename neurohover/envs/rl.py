@@ -79,6 +79,14 @@ def rl_policy(act, task: str):
     of family ``task`` (scaled observations -> its actions): what :func:`neurohover.integrations.flying.evaluate_callable`
     flies."""
 
+    if getattr(act, "indexed", False):  # a recurrent policy: its episodes' indices pass through
+
+        def indexed(obs: np.ndarray, episodes: np.ndarray) -> np.ndarray:
+            return controls(act(scale_observation(np.asarray(obs, dtype=np.float32)), episodes), task)
+
+        indexed.indexed = True  # type: ignore[attr-defined]
+        return indexed
+
     def policy(obs: np.ndarray) -> np.ndarray:
         return controls(act(scale_observation(np.asarray(obs, dtype=np.float32))), task)
 

@@ -141,7 +141,8 @@ def compare_agent(
     if isinstance(act, Policy):
         agent = evaluate(act, mdps, episodes=episodes, seed=seed, n_steps=n_steps)
     else:
-        agent = evaluate_callable(act, mdps, episodes=episodes, seed=seed, n_steps=n_steps, obs_dtype=obs_dtype)
+        indexed = bool(getattr(act, "indexed", False))  # a recurrent policy keeps a state per episode
+        agent = evaluate_callable(act, mdps, episodes=episodes, seed=seed, n_steps=n_steps, obs_dtype=obs_dtype, indexed=indexed)
     generic = load_policy_set(mdps[0].family).generic
     rows = [AgentRow.of("agent", agent)]
     for name, policy in (("baseline", baseline_policy()), ("generic", generic)):

@@ -33,7 +33,7 @@ try:
 except ModuleNotFoundError as missing:  # the optional extra
     raise NeurohoverError(f"neurohover.integrations.sb3 needs {missing.name}: pip install 'neurohover[examples]'") from None
 
-__all__ = ["SB3VecEnv", "rl_zoo_policy", "sb3_policy"]
+__all__ = ["ALGORITHMS", "RecurrentPolicy", "SB3VecEnv", "rl_zoo_policy", "sb3_policy"]
 
 
 class SB3VecEnv(VecEnv):
@@ -97,13 +97,59 @@ class SB3VecEnv(VecEnv):
         return [indices] if isinstance(indices, int) else list(indices)
 
 
-def _algorithm(algo: str):
-    from stable_baselines3 import A2C, PPO, SAC, TD3
+#: The algorithms a saved model may be of: Stable-Baselines3's and sb3-contrib's (RL Zoo's names).
+ALGORITHMS = ("ppo", "sac", "td3", "a2c", "ppo_lstm", "tqc", "trpo", "crossq", "ars")
 
-    algos = {"ppo": PPO, "sac": SAC, "td3": TD3, "a2c": A2C}
-    if algo not in algos:
-        raise NeurohoverError(f"algo={algo!r} is not supported: allowed {', '.join(algos)}")
-    return algos[algo]
+
+def _algorithm(algo: str):
+    if algo not in ALGORITHMS:
+        raise NeurohoverError(f"algo={algo!r} is not supported: allowed {', '.join(ALGORITHMS)}")
+    if algo in ("ppo", "sac", "td3", "a2c"):
+        import stable_baselines3
+
+        return getattr(stable_baselines3, algo.upper())
+    try:
+        import sb3_contrib
+    except ModuleNotFoundError:
+        raise NeurohoverError(f"algo={algo!r} is sb3-contrib's: pip install sb3-contrib") from None
+    return getattr(sb3_contrib, {"ppo_lstm": "RecurrentPPO", "tqc": "TQC", "trpo": "TRPO", "crossq": "CrossQ", "ars": "ARS"}[algo])
+
+
+class RecurrentPolicy:
+    """A recurrent model (sb3-contrib's ``RecurrentPPO``) as an *indexed* batch function ``act(observations, episodes)``:
+    each episode keeps its own hidden state from its first step (:func:`neurohover.integrations.flying.evaluate_callable`
+    calls it with the indices of the episodes still flying). One object flies one flight: its episodes' states live in it."""
+
+    indexed = True
+
+    def __init__(self, model, deterministic: bool = True, prepare: Callable[[np.ndarray], np.ndarray] | None = None) -> None:
+        self.model, self.deterministic, self.prepare = model, deterministic, prepare
+        self.state: tuple[np.ndarray, ...] | None = None
+        self.started: np.ndarray | None = None
+
+    def __call__(self, obs: np.ndarray, episodes: np.ndarray) -> np.ndarray:
+        episodes = np.asarray(episodes)
+        if self.state is None or self.started is None or int(episodes.max()) >= self.started.size:  # the first step of a flight
+            _, zero = self.model.predict(obs[:1], deterministic=True)  # the state's shape, per episode
+            n = int(episodes.max()) + 1
+            self.state = tuple(np.zeros((s.shape[0], n, *s.shape[2:]), dtype=s.dtype) for s in zero)
+            self.started = np.zeros(n, dtype=bool)
+        x = self.prepare(obs) if self.prepare is not None else obs
+        state = tuple(s[:, episodes] for s in self.state)
+        actions, new = self.model.predict(x, state=state, episode_start=~self.started[episodes], deterministic=self.deterministic)
+        for s, n_ in zip(self.state, new, strict=True):
+            s[:, episodes] = n_
+        self.started[episodes] = True
+        return actions
+
+
+def _policy_of(model, deterministic: bool, prepare: Callable[[np.ndarray], np.ndarray] | None = None):
+    """A loaded model as a batch function (indexed for a recurrent one), observations first through ``prepare``."""
+    if getattr(model.policy, "lstm_actor", None) is not None:
+        return RecurrentPolicy(model, deterministic, prepare)
+    if prepare is None:
+        return lambda obs: model.predict(obs, deterministic=deterministic)[0]
+    return lambda obs: model.predict(prepare(obs), deterministic=deterministic)[0]
 
 
 def sb3_policy(model_zip: str | Path, *, algo: str = "ppo", deterministic: bool = True) -> Callable[[np.ndarray], np.ndarray]:
@@ -112,8 +158,7 @@ def sb3_policy(model_zip: str | Path, *, algo: str = "ppo", deterministic: bool 
     path = Path(model_zip)
     if not path.is_file():
         raise NeurohoverError(f"{str(path)!r} is not a Stable-Baselines3 model file (MODEL.zip)")
-    model = _algorithm(algo).load(path, device="cpu")
-    return lambda obs: model.predict(obs, deterministic=deterministic)[0]
+    return _policy_of(_algorithm(algo).load(path, device="cpu"), deterministic)
 
 
 def rl_zoo_policy(run: str | Path, *, algo: str = "ppo", deterministic: bool = True) -> Callable[[np.ndarray], np.ndarray]:
@@ -141,7 +186,4 @@ def rl_zoo_policy(run: str | Path, *, algo: str = "ppo", deterministic: bool = T
             stats = pickle.load(f)  # a VecNormalize without its environment: normalize_obs needs only its statistics
         stats.training = False
 
-    def act(obs: np.ndarray) -> np.ndarray:
-        return model.predict(stats.normalize_obs(obs) if stats is not None else obs, deterministic=deterministic)[0]
-
-    return act
+    return _policy_of(model, deterministic, None if stats is None else stats.normalize_obs)
