@@ -1,7 +1,7 @@
 """``neurohover evaluate-agent``: any trained policy flown as the paper measured its agents, beside the baseline and
 the shipped generic on the same gusts (:func:`neurohover.integrations.flying.compare_agent`).
 
-- ``neurohover evaluate-agent --task ghh08 (--policy FILE | --callable MODULE:FUNCTION | --rl-zoo RUN | --sb3 MODEL.zip)
+- ``neurohover evaluate-agent --task ghh08 (--policy FILE | --callable MODULE:FUNCTION | --rl-zoo RUN | --sb3 MODEL.zip | --cleanrl RUN)
   [--algo ppo] [--rl-id] [--mdps test|train] [--n-mdps N] [--episodes E] [--seed S] [--episode-steps N] [--json FILE]``
 """
 
@@ -15,7 +15,7 @@ import sys
 from ..errors import NeurohoverError
 from .options import add_sigma_option, add_task_option
 
-SOURCES = ("policy", "callable", "rl_zoo", "sb3")
+SOURCES = ("policy", "callable", "rl_zoo", "sb3", "cleanrl")
 ALGOS = ("ppo", "sac", "td3", "a2c", "ppo_lstm", "tqc", "trpo", "crossq", "ars")  # integrations.sb3.ALGORITHMS (SB3 optional)
 
 
@@ -25,7 +25,7 @@ def _agent(args: argparse.Namespace):
     given = [s for s in SOURCES if getattr(args, s) is not None]
     if len(given) != 1:
         named = ", ".join("--" + s.replace("_", "-") for s in given) or "none"
-        raise NeurohoverError(f"give exactly one of --policy, --callable, --rl-zoo, --sb3 (the agent to fly); got {named}")
+        raise NeurohoverError(f"give exactly one of --policy, --callable, --rl-zoo, --sb3, --cleanrl (the agent to fly); got {named}")
     if args.policy is not None:
         from ..paths import input_file
         from ..policies import load_policy
@@ -42,6 +42,10 @@ def _agent(args: argparse.Namespace):
         if not callable(fn):
             raise NeurohoverError(f"--callable {args.callable!r} is not a function")
         return fn
+    if args.cleanrl is not None:
+        from ..integrations.cleanrl import cleanrl_policy
+
+        return cleanrl_policy(args.cleanrl)
     if args.rl_zoo is not None:
         from ..integrations.sb3 import rl_zoo_policy
 
@@ -101,6 +105,7 @@ def register(sub) -> None:
     g.add_argument("--callable", help="MODULE:FUNCTION mapping a batch of observations (B, 12) to actions (B, 4)")
     g.add_argument("--rl-zoo", help="an RL Zoo run folder (logs/ALGO/ENV_N): its final model and frozen observation statistics")
     g.add_argument("--sb3", help="a Stable-Baselines3 model file (MODEL.zip)")
+    g.add_argument("--cleanrl", help="a CleanRL ppo_continuous_action run folder (runs/RUN: its model and saved obs_rms.pkl)")
     p.add_argument("--algo", choices=ALGOS, default="ppo", help="the algorithm of --rl-zoo / --sb3 (default ppo)")
     p.add_argument(
         "--rl-id",
