@@ -472,6 +472,21 @@ def test_report_draws_the_figures_and_compares_with_the_paper(quick_store: Path,
     assert rc == 2 and "holds no experiment 'fig7'" in err
 
 
+def test_the_report_takes_the_papers_table_from_the_shipped_config(quick_store: Path, tmp_path: Path, cli) -> None:
+    """Issue 33: a protocol note corrected in the shipped config reaches the report of runs stored before (the [paper]
+    table is documentation, outside the config hash), so no note contradicts the stored settings."""
+    store = tmp_path / "s.sqlite"
+    store.write_bytes(quick_store.read_bytes())
+    with sqlite3.connect(store) as db:
+        config = json.loads(db.execute("select config from experiments where name = 'fig8' and scale = 'quick'").fetchone()[0])
+        config["paper"]["notes"] = ["AN OUTDATED NOTE"]
+        db.execute("update experiments set config = ? where name = 'fig8' and scale = 'quick'", (json.dumps(config),))
+    rc, _, err = cli("report", "fig8", "--store", str(store), "--out", str(tmp_path / "report"))
+    assert rc == 0, err
+    text = (tmp_path / "report" / "report.md").read_text()
+    assert "AN OUTDATED NOTE" not in text and load_config("fig8", "quick").paper["notes"][0] in text
+
+
 def test_a_report_of_fghh_runs_without_validation_ranks_nothing_and_warns_nothing(tmp_path: Path, cli) -> None:
     # Bug: the ranking took the mean of an empty list of validation scores (numpy's "Mean of empty slice").
     config = tmp_path / "tiny.toml"
