@@ -49,7 +49,7 @@ def test_a_callable_flies_as_the_kernel_flies_the_same_policy(cli, tmp_path: Pat
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        ((), "give exactly one of --policy, --callable, --rl-zoo, --sb3 (the agent to fly); got none"),
+        ((), "give exactly one of --policy, --callable, --rl-zoo, --sb3, --cleanrl (the agent to fly); got none"),
         (("--policy", str(GENERIC), "--callable", "m:f"), "got --policy, --callable"),
         (("--callable", "nomodule"), "--callable 'nomodule' is not allowed: give MODULE:FUNCTION"),
         (("--callable", "no_such_module_here:act"), "--callable 'no_such_module_here:act': No module named"),

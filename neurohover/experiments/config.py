@@ -34,7 +34,7 @@ import hashlib
 import json
 import re
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -310,3 +310,12 @@ def load_configs(name: str, scale: str, overrides: dict[str, Any] | None = None)
     if name == "all":
         return [load_config(n, scale, overrides) for n in shipped_configs()]
     return [load_config(name, scale, overrides)]
+
+
+def with_shipped_paper(cfg: ExperimentConfig) -> ExperimentConfig:
+    """A stored config with the shipped config's ``[paper]`` table (the paper's numbers, claims and our protocol notes:
+    documentation, outside the hash), so a corrected note reaches the report without running anything again."""
+    if cfg.name not in shipped_configs():
+        return cfg
+    shipped = load_config(cfg.name, cfg.scale)
+    return replace(cfg, paper=shipped.paper, paper_ref=shipped.paper_ref)

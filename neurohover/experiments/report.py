@@ -14,7 +14,6 @@ Error is minus the return (lower is better), as in the paper's plots.
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import time
 from pathlib import Path
@@ -22,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import NeurohoverError
-from .config import ORDER, ExperimentConfig, load_config, shipped_configs
+from .config import ORDER, ExperimentConfig, with_shipped_paper
 from .keys import UnitKey
 from .report_base import Section, agent_panel, fmt, log_errors, new_figure, paired_p, ratio_verdict, sd, table
 from .report_evolution import EvolutionSection
@@ -432,15 +431,6 @@ def _header(cfg: ExperimentConfig, store: Store, units: list[dict], total: int |
     )
 
 
-def _with_shipped_paper(cfg: ExperimentConfig) -> ExperimentConfig:
-    """A stored config with the shipped config's ``[paper]`` table (the paper's numbers, claims and our protocol notes:
-    documentation, outside the hash), so a corrected note reaches the report without running anything again."""
-    if cfg.name not in shipped_configs():
-        return cfg
-    shipped = load_config(cfg.name, cfg.scale)
-    return dataclasses.replace(cfg, paper=shipped.paper, paper_ref=shipped.paper_ref)
-
-
 def _section(cfg: ExperimentConfig, store: Store, out: Path) -> tuple[str, list[dict[str, str]], Status]:
     from .plans import plan
 
@@ -522,7 +512,7 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
     statuses: list[Status] = []
     for name, sc in entries:
         try:
-            cfg = _with_shipped_paper(ExperimentConfig.from_dict(store.config(name, sc)))
+            cfg = with_shipped_paper(ExperimentConfig.from_dict(store.config(name, sc)))
             text, checked, status = _section(cfg, store, out)
         except NeurohoverError as err:  # one damaged experiment: said in its place, the others reported as usual
             sections.append(f"## {name} [{sc}]\n\n**Not reported: the store's copy is damaged.** {err}\n")
