@@ -47,3 +47,8 @@ def test_a_run_without_its_observation_statistics_is_refused_with_the_fix(tmp_pa
         cleanrl_policy(tmp_path / "run")
     with pytest.raises(NeurohoverError, match="is not a CleanRL run folder"):
         cleanrl_policy(tmp_path / "nothing")
+    (tmp_path / "bad").mkdir()
+    (tmp_path / "bad" / "x.cleanrl_model").write_text("not torch")
+    (tmp_path / "bad" / "obs_rms.pkl").write_text("not a pickle")
+    with pytest.raises(NeurohoverError, match="its model or obs_rms.pkl cannot be read"):
+        cleanrl_policy(tmp_path / "bad")

@@ -90,3 +90,12 @@ def test_a_recurrent_model_keeps_each_episodes_state_when_flown_in_a_batch(tmp_p
         assert float(np.ravel(alone.returns)[0]) == pytest.approx(float(np.ravel(batch.returns)[i]), rel=1e-9)
     memoryless = evaluate_callable(lambda obs: model.predict(obs, deterministic=True)[0], mdps, episodes=1, seed=2, n_steps=40, obs_dtype="float32")
     assert not np.allclose(np.ravel(memoryless.returns), np.ravel(batch.returns), rtol=1e-9, atol=0)  # the state is carried
+
+
+def test_a_file_that_is_no_saved_model_is_refused_by_name(tmp_path) -> None:
+    """The fuzz test's case with SB3 installed: --sb3 FILE of garbage gave zipfile's traceback."""
+    from neurohover.integrations.sb3 import sb3_policy
+
+    (tmp_path / "m.zip").write_text("garbage")
+    with pytest.raises(NeurohoverError, match="is not a Stable-Baselines3 model file"):
+        sb3_policy(tmp_path / "m.zip")

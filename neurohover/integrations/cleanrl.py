@@ -46,15 +46,21 @@ def cleanrl_policy(run: str | Path) -> Callable[[np.ndarray], np.ndarray]:
             f"{str(folder)!r} has no obs_rms.pkl: CleanRL does not save its observation statistics; save them as "
             "neurohover.integrations.cleanrl's docstring shows (two lines at the end of the script), then train again"
         )
-    state = torch.load(models[0], map_location="cpu")
+    try:
+        state = torch.load(models[0], map_location="cpu")
+        with stats.open("rb") as f:
+            mean, var = pickle.load(f)
+    except (RuntimeError, EOFError, ValueError, pickle.UnpicklingError, OSError) as err:
+        first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        raise NeurohoverError(f"{str(folder)!r}: its model or obs_rms.pkl cannot be read: {first}") from None
+    if not isinstance(state, dict):
+        raise NeurohoverError(f"{str(models[0])!r} is not a state dict of ppo_continuous_action.py's Agent")
     weights = {k[len("actor_mean.") :]: v for k, v in state.items() if k.startswith("actor_mean.")}
     if not weights:
         raise NeurohoverError(f"{str(models[0])!r} holds no actor_mean weights: not a ppo_continuous_action.py model")
     n_obs, hidden, n_act = weights["0.weight"].shape[1], weights["0.weight"].shape[0], weights["4.weight"].shape[0]
     actor = nn.Sequential(nn.Linear(n_obs, hidden), nn.Tanh(), nn.Linear(hidden, hidden), nn.Tanh(), nn.Linear(hidden, n_act))
     actor.load_state_dict(weights)
-    with stats.open("rb") as f:
-        mean, var = pickle.load(f)
     scale = 1.0 / np.sqrt(np.asarray(var, dtype=np.float64) + EPSILON)
 
     def act(obs: np.ndarray) -> np.ndarray:

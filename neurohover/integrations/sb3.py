@@ -19,6 +19,7 @@ Needs ``stable-baselines3`` (``pip install 'neurohover[examples]'``).
 from __future__ import annotations
 
 import pickle
+import zipfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -115,6 +116,16 @@ def _algorithm(algo: str):
     return getattr(sb3_contrib, {"ppo_lstm": "RecurrentPPO", "tqc": "TQC", "trpo": "TRPO", "crossq": "CrossQ", "ars": "ARS"}[algo])
 
 
+def _load(algorithm, path: Path):
+    """A saved model, or one clear error naming the file (not a zip, another algorithm's, damaged)."""
+    if not zipfile.is_zipfile(path):
+        raise NeurohoverError(f"{str(path)!r} is not a Stable-Baselines3 model file (a MODEL.zip that model.save wrote)")
+    try:
+        return algorithm.load(path, device="cpu")
+    except (zipfile.BadZipFile, KeyError, ValueError, RuntimeError, EOFError, pickle.UnpicklingError) as err:
+        raise NeurohoverError(f"{str(path)!r} cannot be loaded as a {algorithm.__name__} model: {err}") from None
+
+
 class RecurrentPolicy:
     """A recurrent model (sb3-contrib's ``RecurrentPPO``) as an *indexed* batch function ``act(observations, episodes)``:
     each episode keeps its own hidden state from its first step (:func:`neurohover.integrations.flying.evaluate_callable`
@@ -158,7 +169,7 @@ def sb3_policy(model_zip: str | Path, *, algo: str = "ppo", deterministic: bool 
     path = Path(model_zip)
     if not path.is_file():
         raise NeurohoverError(f"{str(path)!r} is not a Stable-Baselines3 model file (MODEL.zip)")
-    return _policy_of(_algorithm(algo).load(path, device="cpu"), deterministic)
+    return _policy_of(_load(_algorithm(algo), path), deterministic)
 
 
 def rl_zoo_policy(run: str | Path, *, algo: str = "ppo", deterministic: bool = True) -> Callable[[np.ndarray], np.ndarray]:
@@ -176,7 +187,7 @@ def rl_zoo_policy(run: str | Path, *, algo: str = "ppo", deterministic: bool = T
     model_zip = finals[0] if len(finals) == 1 else run / "best_model.zip"
     if len(finals) > 1 or not model_zip.is_file():
         raise NeurohoverError(f"{str(run)!r} is not an RL Zoo run folder: expected one ENV.zip (or best_model.zip) in it, found {[z.name for z in zips]}")
-    model = algorithm.load(model_zip, device="cpu")
+    model = _load(algorithm, model_zip)
     stats_file = run / model_zip.stem / "vecnormalize.pkl"
     if model_zip.name == "best_model.zip":
         stats_file = next(run.glob("*/vecnormalize.pkl"), stats_file)
