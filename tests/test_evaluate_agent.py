@@ -86,3 +86,22 @@ def test_an_sb3_model_file_is_flown(cli, tmp_path: Path) -> None:
     assert _rows(printed)["agent"][-1] == "1" or "of 1" in printed  # one episode flown
     rc, _, err = cli("evaluate-agent", "--task", "ghh08", "--sb3", str(tmp_path / "missing.zip"))
     assert rc == 2 and "is not a Stable-Baselines3 model file" in err
+
+
+def test_sensor_options_fly_every_policy_through_the_same_sensors(cli, tmp_path, monkeypatch) -> None:
+    """Issue 36: an agent trained on a sensor variant is measured through its sensors: the baseline as a batch
+    function earns exactly the kernel's baseline row through them, and not the exact sensors' return."""
+    (tmp_path / "base_act.py").write_text(
+        "import numpy as np, neurohover\n_p = neurohover.baseline_policy()\n\ndef act(obs):\n"
+        "    return np.array([_p.act(o) for o in np.asarray(obs, dtype=np.float64)])\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    rows = {}
+    for name, extra in (("sensed", ["--obs-noise", "1.0", "--obs-delay", "2"]), ("exact", [])):
+        out = tmp_path / f"{name}.json"
+        argv = ["evaluate-agent", "--task", "ghh08", "--callable", "base_act:act", "--n-mdps", "2", "--episode-steps", "200"]
+        rc, _, err = cli(*argv, "--obs-dtype", "float64", "--json", str(out), *extra)
+        assert rc == 0, err
+        rows[name] = {r["name"]: r["return_per_episode"] for r in json.loads(out.read_text())["rows"]}
+    assert rows["sensed"]["agent"] == pytest.approx(rows["sensed"]["baseline"], rel=1e-9)
+    assert rows["sensed"]["agent"] != pytest.approx(rows["exact"]["agent"], rel=1e-6)

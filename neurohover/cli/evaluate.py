@@ -15,7 +15,7 @@ import sys
 
 from ..errors import NeurohoverError
 from ..policies import Policy
-from .options import add_sigma_option, add_task_option
+from .options import add_sensor_options, add_sigma_option, add_task_option, task_family_of
 
 SOURCES = ("policy", "callable", "rl_zoo", "sb3", "cleanrl")
 ALGOS = ("ppo", "sac", "td3", "a2c", "ppo_lstm", "tqc", "trpo", "crossq", "ars")  # integrations.sb3.ALGORITHMS (SB3 optional)
@@ -88,9 +88,8 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     and the shipped generic policy on the same gusts, and print the paper's measures (return per episode, crashes)."""
     from ..integrations.flying import compare_agent
     from ..paths import output_file, writing
-    from ..tasks import get_task_family
 
-    family = get_task_family(args.task, args.sigma)
+    family = task_family_of(args)  # with --obs-noise / --obs-delay every policy flies through those sensors
     available = len(family.training_mdps() if args.mdps == "train" else family.test_mdps())
     n = available if args.n_mdps is None else args.n_mdps
     if not 1 <= n <= available:
@@ -129,6 +128,7 @@ def register(sub) -> None:
     )
     add_task_option(p)
     add_sigma_option(p)
+    add_sensor_options(p)
     g = p.add_argument_group("the agent (exactly one)")
     g.add_argument("--policy", help="a neurohover policy file (.json or the competition's .net)")
     g.add_argument("--callable", help="MODULE:FUNCTION mapping a batch of observations (B, 12) to actions (B, 4)")
