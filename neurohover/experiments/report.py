@@ -15,6 +15,7 @@ Error is minus the return (lower is better), as in the paper's plots.
 from __future__ import annotations
 
 import json
+import sys
 import time
 from pathlib import Path
 
@@ -510,7 +511,9 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
     sections, toc = [], []
     claims: dict[str, tuple[str, list[dict[str, str]]]] = {}  # paper figure -> (its section's anchor, its claims)
     statuses: list[Status] = []
-    for name, sc in entries:
+    from tqdm import tqdm
+
+    for name, sc in tqdm(entries, desc="report", unit="experiment", file=sys.stderr, disable=None, dynamic_ncols=True):  # a terminal only
         try:
             cfg = with_shipped_paper(ExperimentConfig.from_dict(store.config(name, sc)))
             text, checked, status = _section(cfg, store, out)
