@@ -53,3 +53,11 @@ def test_a_bad_family_table_is_refused_by_name(bad, message) -> None:
     with pytest.raises(NeurohoverError) as err:
         family_from_dict(bad)
     assert message in str(err.value)
+
+
+def test_a_bad_sensor_names_constructors_that_work() -> None:
+    """The message's examples build a sensor (it once suggested Sensor.parse('obs_noise=...'), which is refused)."""
+    with pytest.raises(NeurohoverError) as err:
+        get_task_family("ghh08", sensor="x")
+    assert "Sensor.of(obs_noise=1.0)" in str(err.value) and "Sensor.parse('level=1.0')" in str(err.value)
+    assert Sensor.of(obs_noise=1.0) == Sensor.parse("level=1.0") != Sensor()

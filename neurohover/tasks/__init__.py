@@ -63,7 +63,9 @@ def get_task_family(name: str, sigma: float | None = None, sensor: Sensor | None
     seen through ``sensor`` (:mod:`neurohover.tasks.sensor`; None: exact sensors), its dynamics drifting
     over a test run by ``drift`` (:mod:`neurohover.tasks.drift`; None: fixed)."""
     if sensor is not None and not isinstance(sensor, Sensor):
-        raise NeurohoverError(f"sensor={sensor!r} is not allowed: give a neurohover.Sensor (Sensor.parse('obs_noise=...')) or None for exact sensors")
+        raise NeurohoverError(
+            f"sensor={sensor!r} is not allowed: give a neurohover.Sensor (e.g. Sensor.of(obs_noise=1.0) or Sensor.parse('level=1.0')) or None for exact sensors"
+        )
     if drift is not None and not isinstance(drift, Drift):
         raise NeurohoverError(f"drift={drift!r} is not allowed: give a neurohover.Drift or None for fixed dynamics")
     family = _family(name, sigma)
