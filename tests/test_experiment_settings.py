@@ -25,6 +25,24 @@ def test_every_schema_key_is_a_field_of_its_kinds_settings_class() -> None:
                 assert set(check[1]) == {f.name for f in dataclasses.fields(nested[key])}, key
 
 
+def test_a_default_written_in_both_the_schema_and_the_settings_class_is_the_same() -> None:
+    """Issue 34: the schema (what a config gets when it leaves a setting out) and the typed settings (what the planner
+    reads) name each default twice; they must agree. (A setting the schema omits when absent, added later, has only
+    the class's default; one the schema always fills may have none in the class.)"""
+    from neurohover.experiments.schema import OMIT, REQUIRED
+
+    nested = {"variants": Variant, "groups": Group, "conditions": settings.Condition, "fits": settings.Fit}
+    tables = [(KIND_SETTINGS[kind], schema) for kind, schema in SCHEMAS.items()]
+    tables += [(nested[key], check[1]) for schema in SCHEMAS.values() for key, (_, check) in schema.items() if isinstance(check, tuple)]
+    for cls, schema in tables:
+        for f in dataclasses.fields(cls):
+            default, _ = schema[f.name]
+            ours = f.default if f.default is not dataclasses.MISSING else f.default_factory() if f.default_factory is not dataclasses.MISSING else None
+            if default is REQUIRED or default is OMIT or (ours is None and f.default is dataclasses.MISSING):
+                continue  # required; added later (the class's default is what its absence means); or always filled in
+            assert (tuple(default) if isinstance(default, list) else default) == ours, (cls.__name__, f.name, default, ours)
+
+
 @pytest.mark.parametrize("scale", ["quick", "paper"])
 def test_every_shipped_config_reads_as_its_typed_settings(scale: str) -> None:
     for name in experiment_names():
