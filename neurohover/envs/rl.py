@@ -49,7 +49,7 @@ OBS_LIMITS = np.array((MAX_VELOCITY,) * 3 + (MAX_POSITION,) * 3 + (MAX_RATE,) * 
 ACTION_OFFSET = np.array([0.02, 0.0, 0.0, 0.23])  # the baseline policy's action at rest
 CUBIC = 4.0  # near a = 0 a control moves by A / 5 per unit of a; at a = +-1 by A
 #: Each family's authority A: the largest control moves from ACTION_OFFSET that the paper's policies make, rounded up
-#: (GHH-08 and GHH-09 generics on their test MDPs: 0.43, 0.21, 0.018, 0.17; FGHH generics: the whole range).
+#: (GHH-08 and GHH-09 generics on their training and test MDPs: 0.43, 0.21, 0.018, 0.17; FGHH generics: the whole range).
 ACTION_AUTHORITY: dict[str, np.ndarray] = {
     "ghh08": np.array([0.5, 0.25, 0.05, 0.2]),
     "ghh09": np.array([0.5, 0.25, 0.05, 0.2]),
