@@ -41,6 +41,13 @@ def test_a_crashing_policy_stops_counting_at_its_crash() -> None:
         np.testing.assert_allclose(flown.returns[0, e], total, rtol=1e-12)
 
 
+def test_on_step_is_called_once_a_control_step_of_the_flight() -> None:
+    """evaluate-agent's progress bar counts these: as many as the longest episode's steps."""
+    calls = []
+    flown = evaluate_callable(lambda obs: np.ones((len(obs), 4)), GHH08.mdp("zero"), episodes=2, n_steps=300, on_step=lambda: calls.append(1))
+    assert len(calls) == flown.steps.max() < 300
+
+
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [

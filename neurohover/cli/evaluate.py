@@ -8,7 +8,6 @@ the shipped generic on the same gusts (:func:`neurohover.integrations.flying.com
 from __future__ import annotations
 
 import argparse
-import contextlib
 import importlib
 import json
 import sys
@@ -57,35 +56,11 @@ def _agent(args: argparse.Namespace):
     return sb3_policy(args.sb3, algo=args.algo)
 
 
-@contextlib.contextmanager
-def _stepping(act, n_steps: int):
-    """``act`` counting the control steps of its flight under a progress bar on stderr (a terminal only): a batch
-    function is called once a step for every episode still flying."""
-    if isinstance(act, Policy):  # flies in the kernel, one call
-        yield act
-        return
-    from tqdm import tqdm
-
-    with tqdm(total=n_steps, desc="agent's episodes", unit="step", file=sys.stderr, disable=None, dynamic_ncols=True) as bar:
-        if getattr(act, "indexed", False):
-
-            def counted(obs, episodes):
-                bar.update(1)
-                return act(obs, episodes)
-
-            counted.indexed = True  # type: ignore[attr-defined]
-        else:
-
-            def counted(obs):  # type: ignore[misc]
-                bar.update(1)
-                return act(obs)
-
-        yield counted
-
-
 def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     """Fly a trained policy on full paper episodes of a task's training or test MDPs, beside the competition's baseline
     and the shipped generic policy on the same gusts, and print the paper's measures (return per episode, crashes)."""
+    from tqdm import tqdm
+
     from ..integrations.flying import compare_agent
     from ..paths import output_file, writing
 
@@ -106,8 +81,12 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
 
         act = rl_policy(act, family.name)
     mdps = [family.mdp(f"{args.mdps}:{i}") for i in range(n)]
-    with _stepping(act, args.episode_steps) as flown:
-        rows = compare_agent(flown, mdps, episodes=args.episodes, seed=args.seed, n_steps=args.episode_steps, obs_dtype=args.obs_dtype)
+    # the agent's flight (a kernel policy flies in one call: no steps to count), on a terminal only
+    quiet = True if isinstance(act, Policy) else None
+    with tqdm(total=args.episode_steps, desc="agent's episodes", unit="step", file=sys.stderr, disable=quiet, dynamic_ncols=True) as bar:
+        rows = compare_agent(
+            act, mdps, episodes=args.episodes, seed=args.seed, n_steps=args.episode_steps, obs_dtype=args.obs_dtype, on_step=lambda: bar.update(1)
+        )
     print(f"{args.task} {args.mdps} MDPs 0-{n - 1}, {args.episodes} episode(s) each of {args.episode_steps} steps, gusts of seed {args.seed}:")
     print(f"{'policy':<10} {'return/episode':>15} {'median over MDPs':>17} {'crashed':>12}")
     for r in rows:

@@ -47,6 +47,7 @@ def evaluate_callable(
     n_steps: int = EPISODE_STEPS,
     obs_dtype: str = "float32",
     indexed: bool = False,
+    on_step: Callable[[], None] | None = None,
 ) -> Evaluation:
     """Fly ``act`` for ``episodes`` episodes on every MDP; arrays are shaped (M, E).
 
@@ -65,6 +66,8 @@ def evaluate_callable(
     indexed : bool
         Call ``act(observations, episodes)`` with the indices ``k = m * episodes + e`` of the episodes
         still flying, for a batch of several policies (one per episode, as a NEAT generation flies).
+    on_step : callable, optional
+        Called after each control step of the flight (a progress bar's update).
     """
     mdps = [mdps] if isinstance(mdps, MDP) else list(mdps)
     if not mdps or not all(isinstance(m, MDP) for m in mdps):
@@ -94,6 +97,8 @@ def evaluate_callable(
         steps[live] += 1
         crashed[live] |= terminated[live]
         alive[live] = ~(terminated[live] | truncated[live])
+        if on_step is not None:
+            on_step()
     env.close()
     shape = (len(mdps), int(episodes))
     return Evaluation(
@@ -127,6 +132,7 @@ def compare_agent(
     seed: int = 0,
     n_steps: int = EPISODE_STEPS,
     obs_dtype: str = "float32",
+    on_step: Callable[[], None] | None = None,
 ) -> list[AgentRow]:
     """``act`` flown on ``mdps`` beside the competition's baseline and the shipped generic policy of the MDPs' task,
     all on the same gusts (:func:`evaluate_callable` and :func:`neurohover.evaluate` number them alike): a learned
@@ -142,7 +148,7 @@ def compare_agent(
         agent = evaluate(act, mdps, episodes=episodes, seed=seed, n_steps=n_steps)
     else:
         indexed = bool(getattr(act, "indexed", False))  # a recurrent policy keeps a state per episode
-        agent = evaluate_callable(act, mdps, episodes=episodes, seed=seed, n_steps=n_steps, obs_dtype=obs_dtype, indexed=indexed)
+        agent = evaluate_callable(act, mdps, episodes=episodes, seed=seed, n_steps=n_steps, obs_dtype=obs_dtype, indexed=indexed, on_step=on_step)
     generic = load_policy_set(mdps[0].family).generic
     rows = [AgentRow.of("agent", agent)]
     for name, policy in (("baseline", baseline_policy()), ("generic", generic)):
