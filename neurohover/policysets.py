@@ -149,16 +149,24 @@ def choose_safe(crashes: np.ndarray, returns: np.ndarray, n: int = 2) -> tuple[i
 
 
 def _write_ghh_set(
-    task: str, root: Path, manifest: dict, generic: Policy, specialised: list[Policy], crashes: np.ndarray, returns: np.ndarray, say
+    task: str,
+    root: Path,
+    manifest: dict,
+    generic: Policy,
+    specialised: list[Policy],
+    crashes: np.ndarray,
+    returns: np.ndarray,
+    safety_episodes: int,
+    seconds: float,
+    say,
 ) -> PolicySet:
     """Choose a GHH set's safe policies from its crash and return matrix on the training MDPs, write its manifest
     (with Table 3's figures of the build) and say what was chosen."""
     safe = choose_safe(crashes, returns)
-    seconds = manifest.pop("seconds")  # the manifest's keys in the order the sets were always written
     manifest.update(
         {
             "safe": list(safe),
-            "safety_episodes": manifest.pop("safety_episodes"),
+            "safety_episodes": safety_episodes,
             "crashes_on_training_mdps": crashes.tolist(),
             "mean_return_on_training_mdps": returns.round(2).tolist(),
             "table3": table3_summary(crashes, returns),
@@ -168,7 +176,7 @@ def _write_ghh_set(
     (root / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n")
     t3 = manifest["table3"]
     say(f"{task}: safe specialised policies {safe}; Table 3 on the training MDPs: r = {t3['r']:.1f}, r_G = {t3['r_G']:.1f}")
-    say(f"{task}: {t3['crashed_episodes']} crashed episodes of {crashes.size * int(manifest['safety_episodes'])}")
+    say(f"{task}: {t3['crashed_episodes']} crashed episodes of {crashes.size * safety_episodes}")
     return PolicySet(task, root, generic, tuple(specialised), safe, manifest=manifest)
 
 
@@ -288,6 +296,5 @@ def build_policy_set(
     ]
     generic, specialised = evolved[0], evolved[1:]
     crashes, returns = crash_matrix(specialised, train, safety_episodes, seed=int(seeds[11]), n_steps=n_steps)
-    manifest["safety_episodes"] = safety_episodes
-    manifest["seconds"] = round(time.perf_counter() - start, 1)
-    return _write_ghh_set(family.name, root, manifest, generic, specialised, crashes, returns, say)
+    seconds = round(time.perf_counter() - start, 1)
+    return _write_ghh_set(family.name, root, manifest, generic, specialised, crashes, returns, safety_episodes, seconds, say)
