@@ -99,3 +99,9 @@ def test_a_file_that_is_no_saved_model_is_refused_by_name(tmp_path) -> None:
     (tmp_path / "m.zip").write_text("garbage")
     with pytest.raises(NeurohoverError, match="is not a Stable-Baselines3 model file"):
         sb3_policy(tmp_path / "m.zip")
+    pytest.importorskip("sb3_contrib", reason="sb3-contrib is not installed")
+    from stable_baselines3 import PPO
+
+    PPO("MlpPolicy", gym.make("neurohover/GHH08-Short-v0"), device="cpu").save(tmp_path / "ppo.zip")
+    with pytest.raises(NeurohoverError, match="cannot be loaded as a TQC model"):  # another algorithm's model: TQC's AttributeError
+        sb3_policy(tmp_path / "ppo.zip", algo="tqc")

@@ -13,11 +13,11 @@ import json
 import sys
 
 from ..errors import NeurohoverError
+from ..integrations import SB3_ALGORITHMS
 from ..policies import Policy
 from .options import add_sensor_options, add_sigma_option, add_task_option, task_family_of
 
 SOURCES = ("policy", "callable", "rl_zoo", "sb3", "cleanrl")
-ALGOS = ("ppo", "sac", "td3", "a2c", "ppo_lstm", "tqc", "trpo", "crossq", "ars")  # integrations.sb3.ALGORITHMS (SB3 optional)
 
 
 def _agent(args: argparse.Namespace):
@@ -114,7 +114,7 @@ def register(sub) -> None:
     g.add_argument("--rl-zoo", help="an RL Zoo run folder (logs/ALGO/ENV_N): its final model and frozen observation statistics")
     g.add_argument("--sb3", help="a Stable-Baselines3 model file (MODEL.zip)")
     g.add_argument("--cleanrl", help="a CleanRL ppo_continuous_action run folder (runs/RUN: its model and saved obs_rms.pkl)")
-    p.add_argument("--algo", choices=ALGOS, default="ppo", help="the algorithm of --rl-zoo / --sb3 (default ppo)")
+    p.add_argument("--algo", choices=tuple(SB3_ALGORITHMS), default="ppo", help="the algorithm of --rl-zoo / --sb3 (default ppo)")
     p.add_argument(
         "--rl-id",
         action="store_true",

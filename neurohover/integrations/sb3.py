@@ -18,6 +18,7 @@ Needs ``stable-baselines3`` (``pip install 'neurohover[examples]'``).
 
 from __future__ import annotations
 
+import importlib
 import pickle
 import zipfile
 from collections.abc import Callable, Sequence
@@ -28,13 +29,14 @@ import gymnasium as gym
 import numpy as np
 
 from ..errors import NeurohoverError
+from . import SB3_ALGORITHMS
 
 try:
     from stable_baselines3.common.vec_env.base_vec_env import VecEnv
 except ModuleNotFoundError as missing:  # the optional extra
     raise NeurohoverError(f"neurohover.integrations.sb3 needs {missing.name}: pip install 'neurohover[examples]'") from None
 
-__all__ = ["ALGORITHMS", "RecurrentPolicy", "SB3VecEnv", "rl_zoo_policy", "sb3_policy"]
+__all__ = ["RecurrentPolicy", "SB3VecEnv", "rl_zoo_policy", "sb3_policy"]
 
 
 class SB3VecEnv(VecEnv):
@@ -98,22 +100,14 @@ class SB3VecEnv(VecEnv):
         return [indices] if isinstance(indices, int) else list(indices)
 
 
-#: The algorithms a saved model may be of: Stable-Baselines3's and sb3-contrib's (RL Zoo's names).
-ALGORITHMS = ("ppo", "sac", "td3", "a2c", "ppo_lstm", "tqc", "trpo", "crossq", "ars")
-
-
 def _algorithm(algo: str):
-    if algo not in ALGORITHMS:
-        raise NeurohoverError(f"algo={algo!r} is not supported: allowed {', '.join(ALGORITHMS)}")
-    if algo in ("ppo", "sac", "td3", "a2c"):
-        import stable_baselines3
-
-        return getattr(stable_baselines3, algo.upper())
+    if algo not in SB3_ALGORITHMS:
+        raise NeurohoverError(f"algo={algo!r} is not supported: allowed {', '.join(SB3_ALGORITHMS)}")
+    package, name = SB3_ALGORITHMS[algo]
     try:
-        import sb3_contrib
+        return getattr(importlib.import_module(package), name)
     except ModuleNotFoundError:
-        raise NeurohoverError(f"algo={algo!r} is sb3-contrib's: pip install sb3-contrib") from None
-    return getattr(sb3_contrib, {"ppo_lstm": "RecurrentPPO", "tqc": "TQC", "trpo": "TRPO", "crossq": "CrossQ", "ars": "ARS"}[algo])
+        raise NeurohoverError(f"algo={algo!r} needs {package}: pip install {package.replace('_', '-')}") from None
 
 
 def _load(algorithm, path: Path):
@@ -122,7 +116,7 @@ def _load(algorithm, path: Path):
         raise NeurohoverError(f"{str(path)!r} is not a Stable-Baselines3 model file (a MODEL.zip that model.save wrote)")
     try:
         return algorithm.load(path, device="cpu")
-    except (zipfile.BadZipFile, KeyError, ValueError, RuntimeError, EOFError, pickle.UnpicklingError) as err:
+    except (zipfile.BadZipFile, KeyError, ValueError, RuntimeError, EOFError, AttributeError, TypeError, pickle.UnpicklingError) as err:
         raise NeurohoverError(f"{str(path)!r} cannot be loaded as a {algorithm.__name__} model: {err}") from None
 
 
@@ -141,9 +135,9 @@ class RecurrentPolicy:
     def __call__(self, obs: np.ndarray, episodes: np.ndarray) -> np.ndarray:
         episodes = np.asarray(episodes)
         if self.state is None or self.started is None or int(episodes.max()) >= self.started.size:  # the first step of a flight
-            _, zero = self.model.predict(obs[:1], deterministic=True)  # the state's shape, per episode
+            layers, _, hidden = self.model.policy.lstm_hidden_state_shape  # the actor's (h, c), one column per episode
             n = int(episodes.max()) + 1
-            self.state = tuple(np.zeros((s.shape[0], n, *s.shape[2:]), dtype=s.dtype) for s in zero)
+            self.state = (np.zeros((layers, n, hidden), dtype=np.float32), np.zeros((layers, n, hidden), dtype=np.float32))
             self.started = np.zeros(n, dtype=bool)
         x = self.prepare(obs) if self.prepare is not None else obs
         state = tuple(s[:, episodes] for s in self.state)
@@ -156,7 +150,7 @@ class RecurrentPolicy:
 
 def _policy_of(model, deterministic: bool, prepare: Callable[[np.ndarray], np.ndarray] | None = None):
     """A loaded model as a batch function (indexed for a recurrent one), observations first through ``prepare``."""
-    if getattr(model.policy, "lstm_actor", None) is not None:
+    if hasattr(model.policy, "lstm_hidden_state_shape"):
         return RecurrentPolicy(model, deterministic, prepare)
     if prepare is None:
         return lambda obs: model.predict(obs, deterministic=deterministic)[0]
