@@ -25,8 +25,9 @@ import numpy as np
 
 from .errors import NeurohoverError
 from .sim.constants import MDP_ROW_LEN, ROW_SUBSTEPS, ROW_WIND_KIND, SAFEGUARD_LIMITS
+from .sim.jobs import Extras, Flown, Jobs, Parking
 from .sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
-from .sim.lanes import LANES, PARK_F, PARK_U, rollout_lanes, rollout_lanes_parked
+from .sim.lanes import LANES, rollout_lanes, rollout_lanes_parked
 from .sim.rng import MAX_SEED
 from .sim.step import step_batch
 
@@ -113,6 +114,20 @@ class Batch:
     def n_jobs(self) -> int:
         return int(self.policy_index.shape[0])
 
+    def jobs(self) -> Jobs:
+        """The jobs in the kernel's layout (every path reads them)."""
+        return Jobs(self.rows, self.kinds, self.genomes, self.policy_index, self.mdp_index, self.episode_index, np.uint64(self.seed), self.n_steps)
+
+    def extras(self) -> Extras:
+        """The safeguard and the recording in the kernel's layout (the scalar and CUDA kernels read them)."""
+        if self.fallback is None and self.slots is None:
+            return Extras.none(self.n_jobs, self.limits)
+        none = np.full(self.n_jobs, -1, dtype=np.int64)
+        return Extras(
+            none if self.fallback is None else self.fallback, bool(self.safeguard), self.limits, none if self.slots is None else self.slots,
+            np.zeros((0, 1, 12)) if self.obs_out is None else self.obs_out, np.zeros((0, 1, 4)) if self.act_out is None else self.act_out,
+        )  # fmt: skip
+
     @classmethod
     def empty(cls) -> Batch:
         """No jobs (one zero MDP row and policy): what the warm-ups launch to load the compiled code."""
@@ -120,59 +135,13 @@ class Batch:
         return cls(np.zeros((1, MDP_ROW_LEN)), np.zeros(1, dtype=np.int64), np.zeros((1, GENOME_WIDTH)), none, none, none, 0, 1)
 
 
-@dataclass(frozen=True)
-class Flown:
-    """What a launch writes per job: return, crash flag, control steps flown, the step the safeguard fired (-1: never)."""
-
-    returns: np.ndarray
-    crashed: np.ndarray
-    steps: np.ndarray
-    safeguard_step: np.ndarray
-
-    @classmethod
-    def empty(cls, n_jobs: int) -> Flown:
-        return cls(np.empty(n_jobs), np.empty(n_jobs, dtype=np.bool_), np.empty(n_jobs, dtype=np.int64), np.empty(n_jobs, dtype=np.int64))
-
-
-@dataclass(frozen=True)
-class Parking:
-    """Episodes left in flight by :func:`launch_parked`, one slot each: what the lanes need to resume them.
-
-    ``steps[s]`` is slot ``s``'s control steps flown (0: not begun); ``floats`` and ``streams`` hold
-    its state, gust noise, return so far, sensor state and random streams
-    (:func:`neurohover.sim.lanes.park_lane`).
-    """
-
-    floats: np.ndarray
-    streams: np.ndarray
-    steps: np.ndarray
-
-    @classmethod
-    def empty(cls, n_slots: int) -> Parking:
-        return cls(np.zeros((n_slots, PARK_F)), np.zeros((n_slots, PARK_U), dtype=np.uint64), np.zeros(n_slots, dtype=np.int64))
-
-    def clear(self) -> None:
-        """Forget every parked episode (a slot then starts from its first step)."""
-        self.steps[:] = 0
-
-
 def _fly_lanes(b: Batch, out: Flown) -> None:
-    rollout_lanes(
-        b.rows, b.kinds, b.genomes, b.policy_index, b.mdp_index, b.episode_index, np.uint64(b.seed), b.n_steps, numba.get_num_threads(),
-        out.returns, out.crashed, out.steps, out.safeguard_step,
-    )  # fmt: skip
+    rollout_lanes(b.jobs(), numba.get_num_threads(), out)
 
 
 def _fly_kernel(rollout: Callable[..., None], b: Batch, out: Flown) -> None:
-    """The one call in the kernel's positional layout (``rollout``: the CPU kernel or the CUDA launcher, same arguments)."""
-    none = None if b.fallback is not None and b.slots is not None else np.full(b.n_jobs, -1, dtype=np.int64)
-    rollout(
-        b.rows, b.kinds, b.genomes, b.policy_index, b.mdp_index, b.episode_index,
-        none if b.fallback is None else b.fallback, np.uint64(b.seed), b.n_steps, bool(b.safeguard), b.limits,
-        none if b.slots is None else b.slots,
-        np.zeros((0, 1, 12)) if b.obs_out is None else b.obs_out, np.zeros((0, 1, 4)) if b.act_out is None else b.act_out,
-        out.returns, out.crashed, out.steps, out.safeguard_step,
-    )  # fmt: skip
+    """The one call of the scalar kernel (``rollout``: the CPU kernel or the CUDA launcher, same arguments)."""
+    rollout(b.jobs(), b.extras(), out)
 
 
 _loaded: set[str] = set()
@@ -261,10 +230,7 @@ def launch_parked(batch: Batch, out: Flown, slots: np.ndarray, n_required: int, 
 
 
 def _fly_parked(b: Batch, out: Flown, slots: np.ndarray, n_required: int, parking: Parking) -> None:
-    rollout_lanes_parked(
-        b.rows, b.kinds, b.genomes, b.policy_index, b.mdp_index, b.episode_index, slots, n_required, np.uint64(b.seed), b.n_steps,
-        numba.get_num_threads(), parking.floats, parking.streams, parking.steps, out.returns, out.crashed, out.steps,
-    )  # fmt: skip
+    rollout_lanes_parked(b.jobs(), slots, n_required, numba.get_num_threads(), parking, out)
 
 
 def load_parked() -> None:

@@ -12,10 +12,10 @@ import pytest
 
 from neurohover import baseline_policy, evaluate, evaluate_jobs, get_task_family, prototype
 from neurohover.evaluate import KernelFlyer, PolicyTable, num_threads
-from neurohover.launch import Flown, Parking
 from neurohover.launch import use_lanes as _use_lanes
 from neurohover.policies import GENOME_LENGTH
 from neurohover.sim.constants import ROW_DT, ROW_SUBSTEPS, ROW_WIND_KIND, SAFEGUARD_LIMITS
+from neurohover.sim.jobs import Extras, Flown, Jobs, Parking
 from neurohover.sim.kernel import POLICY_SLP, rollout_batch
 from neurohover.sim.lanes import LANES, SCALAR_TAIL, fly_lanes, rollout_lanes, rollout_lanes_parked
 from neurohover.tasks import Sensor
@@ -48,16 +48,11 @@ def _scalar(table: PolicyTable, row: np.ndarray, seed: int, episodes: np.ndarray
     the jobs' policy and row indices (default 0)."""
     n = episodes.shape[0]
     zeros = np.zeros(n, dtype=np.int64)
-    minus = np.full(n, -1, dtype=np.int64)
-    rows = np.atleast_2d(row)
     p = zeros if p is None else p
     m = zeros if m is None else m
-    r, c, s, sg = np.empty(n), np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
-    rollout_batch(
-        rows, table.kinds, table.genomes, p, m, episodes, minus, np.uint64(seed), n_steps, False, SAFEGUARD_LIMITS, minus,
-        np.zeros((0, 1, 12)), np.zeros((0, 1, 4)), r, c, s, sg,
-    )  # fmt: skip
-    return r, c, s, sg
+    out = Flown.empty(n)
+    rollout_batch(Jobs(np.atleast_2d(row), table.kinds, table.genomes, p, m, episodes, np.uint64(seed), n_steps), Extras.none(n, SAFEGUARD_LIMITS), out)
+    return tuple(out)
 
 
 def _lanes(table: PolicyTable, row: np.ndarray, seed: int, episodes: np.ndarray, n_steps: int, threads: int, p=None, m=None):
@@ -66,10 +61,10 @@ def _lanes(table: PolicyTable, row: np.ndarray, seed: int, episodes: np.ndarray,
     rows = np.atleast_2d(row).copy()
     p = zeros if p is None else p
     m = zeros if m is None else m
-    r, c, s, sg = np.empty(n), np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.int64), np.full(n, 7, dtype=np.int64)
+    out = Flown(np.empty(n), np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.int64), np.full(n, 7, dtype=np.int64))
     with num_threads(threads):
-        rollout_lanes(rows, table.kinds, table.genomes.copy(), p, m, episodes, np.uint64(seed), n_steps, threads, r, c, s, sg)
-    return r, c, s, sg
+        rollout_lanes(Jobs(rows, table.kinds, table.genomes.copy(), p, m, episodes, np.uint64(seed), n_steps), threads, out)
+    return tuple(out)
 
 
 def _assert_same(a, b) -> None:
@@ -139,8 +134,7 @@ def test_cases_cover_crashes_non_finite_actions_and_the_fallback() -> None:
         n = SCALAR_TAIL + 1  # more lanes in flight than the per-lane tail, so the steps are packed
         stats = np.zeros(2, dtype=np.int64)
         z = np.zeros(n, dtype=np.int64)
-        out = np.empty(n), np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.int64)
-        fly_lanes(row[None, :], table.kinds, table.genomes, z, z, ep[:n], np.uint64(0), 200, *out, stats)
+        fly_lanes(Jobs(row[None, :], table.kinds, table.genomes, z, z, ep[:n], np.uint64(0), 200), Flown.empty(n), stats)
         assert stats[1] > 0, name  # the large-angle scalar fallback ran
 
 
@@ -254,11 +248,8 @@ def _parked_calls(table, rows, m, episodes, n_steps, threads, plan) -> tuple:
             resumed += int((parking.steps[slot[waiting[:n_req]]] > 0).sum())
             jobs = waiting
             out = Flown.empty(jobs.size)
-            rollout_lanes_parked(
-                rows, table.kinds, table.genomes, np.zeros(jobs.size, dtype=np.int64), m[jobs], episodes[jobs], slot[jobs],
-                min(n_req, jobs.size), np.uint64(5), n_steps, threads, parking.floats, parking.streams, parking.steps,
-                out.returns, out.crashed, out.steps,
-            )  # fmt: skip
+            batch = Jobs(rows, table.kinds, table.genomes, np.zeros(jobs.size, dtype=np.int64), m[jobs], episodes[jobs], np.uint64(5), n_steps)
+            rollout_lanes_parked(batch, slot[jobs], min(n_req, jobs.size), threads, parking, out)
             done = out.steps > 0
             assert done[: min(n_req, jobs.size)].all()  # every required job is over
             r[jobs[done]], c[jobs[done]], s[jobs[done]] = out.returns[done], out.crashed[done], out.steps[done]
@@ -310,9 +301,7 @@ def test_a_parked_call_flies_optional_jobs_only_in_idle_lanes_and_counts_them_no
     parking = Parking.empty(n)
     out = Flown.empty(n)
     with num_threads(1):
-        rollout_lanes_parked(
-            np.atleast_2d(ZERO), table.kinds, table.genomes, np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64), episodes,
-            episodes, LANES, np.uint64(1), 300, 1, parking.floats, parking.streams, parking.steps, out.returns, out.crashed, out.steps,
-        )  # fmt: skip
+        zeros = np.zeros(n, dtype=np.int64)
+        rollout_lanes_parked(Jobs(np.atleast_2d(ZERO), table.kinds, table.genomes, zeros, zeros, episodes, np.uint64(1), 300), episodes, LANES, 1, parking, out)
     # The LANES required episodes fill the lanes to their common end: no optional job began.
     assert (out.steps[:LANES] == 300).all() and (out.steps[LANES:] == 0).all() and (parking.steps == 0).all()

@@ -31,6 +31,7 @@ from numba.core.registry import CPUDispatcher
 
 from . import kernel, rng, step
 from .constants import MDP_ROW_LEN, ROW_DT, ROW_SUBSTEPS, SAFEGUARD_LIMITS, SENSOR_SCRATCH
+from .jobs import Extras, Flown, Jobs
 
 # numba-cuda 0.30.4 (the newest) registers an overload of np.row_stack when it builds its first kernel, and
 # NumPy 2.5 removed that deprecated alias of np.vstack: without it no kernel compiles (seen on an H200, 2026-12-04).
@@ -127,56 +128,14 @@ def device_function(func):
     return built
 
 
-def _rollout_thread(
-    mdp_rows,
-    policy_kinds,
-    genomes,
-    job_policy,
-    job_mdp,
-    job_episode,
-    job_fallback,
-    seed,
-    n_steps,
-    safeguard,
-    limits,
-    record_slot,
-    obs_out,
-    act_out,
-    out_return,
-    out_crashed,
-    out_steps,
-    out_safeguard_step,
-):
+def _rollout_thread(jobs, extras, out):
     """One CUDA thread per job: the CPU kernel's loop body with a thread-local stream state."""
     j = cuda.grid(1)
-    if j < job_policy.shape[0]:
+    if j < jobs.policy.shape[0]:
         state = cuda.local.array(4, np.uint64)
         sensor_state = cuda.local.array(4, np.uint64)
         scratch = cuda.local.array(SENSOR_SCRATCH, np.float64)
-        fly_job(
-            j,
-            state,
-            sensor_state,
-            scratch,
-            mdp_rows,
-            policy_kinds,
-            genomes,
-            job_policy,
-            job_mdp,
-            job_episode,
-            job_fallback,
-            seed,
-            n_steps,
-            safeguard,
-            limits,
-            record_slot,
-            obs_out,
-            act_out,
-            out_return,
-            out_crashed,
-            out_steps,
-            out_safeguard_step,
-        )
+        fly_job(j, state, sensor_state, scratch, jobs, extras, out)
 
 
 fly_job = kernel.fly_job  # the CPU dispatcher; _rebind hands the kernel its device version
@@ -243,57 +202,19 @@ def load_kernel() -> None:
         one = np.zeros(1, dtype=np.int64)
         row = np.zeros((1, MDP_ROW_LEN))
         row[0, ROW_SUBSTEPS], row[0, ROW_DT] = 1.0, 0.01
-        rollout_batch_cuda(
-            row,
-            one,
-            np.zeros((1, kernel.GENOME_WIDTH)),
-            one,
-            one,
-            one,
-            one - 1,
-            np.uint64(0),
-            1,
-            False,
-            SAFEGUARD_LIMITS,
-            one - 1,
-            np.zeros((0, 2, 12)),
-            np.zeros((0, 1, 4)),
-            np.zeros(1),
-            np.zeros(1, dtype=np.bool_),
-            np.zeros(1, dtype=np.int64),
-            np.zeros(1, dtype=np.int64),
-        )
+        jobs = Jobs(row, one, np.zeros((1, kernel.GENOME_WIDTH)), one, one, one, np.uint64(0), 1)
+        rollout_batch_cuda(jobs, Extras.none(1, SAFEGUARD_LIMITS), Flown.empty(1))
         _loaded = True
 
 
-def rollout_batch_cuda(
-    mdp_rows,
-    policy_kinds,
-    genomes,
-    job_policy,
-    job_mdp,
-    job_episode,
-    job_fallback,
-    seed,
-    n_steps,
-    safeguard,
-    limits,
-    record_slot,
-    obs_out,
-    act_out,
-    out_return,
-    out_crashed,
-    out_steps,
-    out_safeguard_step,
-    threads_per_block: int | None = None,
-) -> None:
+def rollout_batch_cuda(jobs: Jobs, extras: Extras, out: Flown, threads_per_block: int | None = None) -> None:
     """:func:`~neurohover.sim.kernel.rollout_batch` on the GPU: copy in, one thread per job, copy back.
 
     Arguments and outputs are host NumPy arrays, exactly as the CPU kernel takes them; outputs
-    (and ``obs_out``/``act_out`` where jobs record) are filled in place. Raises RuntimeError when
+    (and ``extras.obs_out`` / ``extras.act_out`` where jobs record) are filled in place. Raises RuntimeError when
     no GPU (and no simulator) is usable. ``threads_per_block`` defaults to :data:`THREADS_PER_BLOCK`.
     """
-    n_jobs = job_policy.shape[0]
+    n_jobs = jobs.policy.shape[0]
     k = rollout_kernel()
     if n_jobs == 0:
         return
@@ -301,42 +222,22 @@ def rollout_batch_cuda(
     def to(a):  # to_device copies one contiguous buffer; a strided view of the caller's would not do
         return cuda.to_device(np.ascontiguousarray(a))
 
-    recording = obs_out.shape[0] > 0
+    recording = extras.obs_out.shape[0] > 0
     # A zero-size device array is avoided: no job writes flight data when none records.
-    d_obs = to(obs_out) if recording else cuda.device_array((1, 1, 12))
-    d_act = to(act_out) if recording else cuda.device_array((1, 1, 4))
-    d_ret = cuda.device_array(n_jobs, dtype=np.float64)
-    d_crash = cuda.device_array(n_jobs, dtype=np.bool_)
-    d_steps = cuda.device_array(n_jobs, dtype=np.int64)
-    d_sg = cuda.device_array(n_jobs, dtype=np.int64)
+    d_obs = to(extras.obs_out) if recording else cuda.device_array((1, 1, 12))
+    d_act = to(extras.act_out) if recording else cuda.device_array((1, 1, 4))
+    d_jobs = Jobs(
+        to(jobs.rows), to(jobs.kinds), to(jobs.genomes), to(jobs.policy), to(jobs.mdp), to(jobs.episode), np.uint64(jobs.seed), int(jobs.n_steps)
+    )  # fmt: skip
+    d_extras = Extras(to(extras.fallback), bool(extras.safeguard), to(extras.limits), to(extras.slots), d_obs, d_act)
+    d_out = [cuda.device_array(n_jobs, dtype=host.dtype) for host in out]  # returns, crash flags, steps, safeguard steps
     tpb = threads_per_block or THREADS_PER_BLOCK
-    k[(n_jobs + tpb - 1) // tpb, tpb](
-        to(mdp_rows),
-        to(policy_kinds),
-        to(genomes),
-        to(job_policy),
-        to(job_mdp),
-        to(job_episode),
-        to(job_fallback),
-        np.uint64(seed),
-        np.int64(n_steps),
-        bool(safeguard),
-        to(limits),
-        to(record_slot),
-        d_obs,
-        d_act,
-        d_ret,
-        d_crash,
-        d_steps,
-        d_sg,
-    )
-    d_ret.copy_to_host(out_return)
-    d_crash.copy_to_host(out_crashed)
-    d_steps.copy_to_host(out_steps)
-    d_sg.copy_to_host(out_safeguard_step)
+    k[(n_jobs + tpb - 1) // tpb, tpb](d_jobs, d_extras, Flown(*d_out))
+    for device_array, host in zip(d_out, out, strict=True):
+        device_array.copy_to_host(host)
     if recording:
-        d_obs.copy_to_host(obs_out)
-        d_act.copy_to_host(act_out)
+        d_obs.copy_to_host(extras.obs_out)
+        d_act.copy_to_host(extras.act_out)
     cuda.synchronize()
 
 

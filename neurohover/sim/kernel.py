@@ -391,31 +391,10 @@ def _record(obs_out, act_out, slot, k, o, a1, a2, a3, a4):
     act_out[slot, k, 3] = a4
 
 
-@nb.njit(cache=True, inline="always", fastmath={"contract"})
-def fly_job(
-    j,
-    rng,
-    srng,
-    scratch,
-    mdp_rows,
-    policy_kinds,
-    genomes,
-    job_policy,
-    job_mdp,
-    job_episode,
-    job_fallback,
-    seed,
-    n_steps,
-    safeguard,
-    limits,
-    record_slot,
-    obs_out,
-    act_out,
-    out_return,
-    out_crashed,
-    out_steps,
-    out_safeguard_step,
-):
+# Not inline="always": numba's parfor pass drops writes through a tuple's arrays in a prange body it inlines
+# (numba 0.68); called, the body stays opaque to it (LLVM may still inline it: same arithmetic, same bits).
+@nb.njit(cache=True, fastmath={"contract"})
+def fly_job(j, rng, srng, scratch, jobs, extras, out):
     """Fly job ``j`` of :func:`rollout_batch` with ``rng`` (4 uint64) as its gust stream's state.
 
     The whole episode of one job, shared by the CPU kernel (one prange iteration) and the CUDA
@@ -423,16 +402,20 @@ def fly_job(
     (4 uint64) and ``scratch`` (SENSOR_SCRATCH floats) serve the sensor model when the row has one:
     the policy, the safeguard and the recording see ``seen``; reward and crash test the true state.
     """
-    seed_stream(rng, np.uint64(seed), np.uint64(job_episode[j]))
-    dyn, std, n_sub, dt, wind = unpack_mdp(mdp_rows[job_mdp[j]])
-    sensor, sensing = unpack_sensor(mdp_rows[job_mdp[j]])
+    policy_kinds, genomes, n_steps, limits = jobs.kinds, jobs.genomes, jobs.n_steps, extras.limits
+    obs_out, act_out = extras.obs_out, extras.act_out
+    row = jobs.rows[jobs.mdp[j]]
+    seed_stream(rng, np.uint64(jobs.seed), np.uint64(jobs.episode[j]))
+    dyn, std, n_sub, dt, wind = unpack_mdp(row)
+    sensor, sensing = unpack_sensor(row)
     if sensing:
-        seed_sensor_stream(srng, np.uint64(seed), np.uint64(job_episode[j]))
-    pol = job_policy[j]
+        seed_sensor_stream(srng, np.uint64(jobs.seed), np.uint64(jobs.episode[j]))
+    pol = jobs.policy[j]
     kind = policy_kinds[pol]
     g = genomes[pol]
-    fb = job_fallback[j]
-    slot = record_slot[j]
+    fb = extras.fallback[j]
+    slot = extras.slots[j]
+    safeguard = extras.safeguard
     s = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)
     n = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     o = observe(s)
@@ -474,66 +457,25 @@ def fly_job(
     if slot >= 0:
         for i in range(12):
             obs_out[slot, t, i] = seen[i]
-    out_return[j] = total
-    out_crashed[j] = crash
-    out_steps[j] = t
-    out_safeguard_step[j] = sg_step
+    out.returns[j] = total
+    out.crashed[j] = crash
+    out.steps[j] = t
+    out.safeguard_step[j] = sg_step
 
 
 @nb.njit(cache=True, parallel=True, fastmath={"contract"})
-def rollout_batch(
-    mdp_rows,
-    policy_kinds,
-    genomes,
-    job_policy,
-    job_mdp,
-    job_episode,
-    job_fallback,
-    seed,
-    n_steps,
-    safeguard,
-    limits,
-    record_slot,
-    obs_out,
-    act_out,
-    out_return,
-    out_crashed,
-    out_steps,
-    out_safeguard_step,
-):
+def rollout_batch(jobs, extras, out):
     """Fly every job (policy, MDP, episode) and write its return, crash flag, steps and safeguard step.
 
-    Jobs run in parallel; each draws noise from its own (seed, episode) stream, so results do not
-    depend on the thread count. ``record_slot[j] >= 0`` records job j's flight data there;
-    ``job_fallback[j] >= 0`` with ``safeguard`` hands control to that policy once the state is
-    dangerous. A non-finite action counts as a crash at that step.
+    ``jobs``, ``extras`` and ``out``: a :class:`~neurohover.sim.jobs.Jobs`, :class:`~neurohover.sim.jobs.Extras`
+    and :class:`~neurohover.sim.jobs.Flown`. Jobs run in parallel; each draws noise from its own
+    (seed, episode) stream, so results do not depend on the thread count. ``extras.slots[j] >= 0``
+    records job j's flight data there; ``extras.fallback[j] >= 0`` with ``extras.safeguard`` hands
+    control to that policy once the state is dangerous. A non-finite action counts as a crash at that step.
     """
-    n_jobs = job_policy.shape[0]
+    n_jobs = jobs.policy.shape[0]
     for j in nb.prange(n_jobs):
         rng = np.empty(4, dtype=np.uint64)
         srng = np.empty(4, dtype=np.uint64)
         scratch = np.empty(SENSOR_SCRATCH)
-        fly_job(
-            j,
-            rng,
-            srng,
-            scratch,
-            mdp_rows,
-            policy_kinds,
-            genomes,
-            job_policy,
-            job_mdp,
-            job_episode,
-            job_fallback,
-            seed,
-            n_steps,
-            safeguard,
-            limits,
-            record_slot,
-            obs_out,
-            act_out,
-            out_return,
-            out_crashed,
-            out_steps,
-            out_safeguard_step,
-        )
+        fly_job(j, rng, srng, scratch, jobs, extras, out)

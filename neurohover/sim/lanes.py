@@ -38,6 +38,7 @@ from numba.core import cgutils, types
 from numba.extending import intrinsic
 
 from .constants import ROW_SUBSTEPS, ROW_WIND_KIND, SENSOR_SCRATCH
+from .jobs import PARK_F, PARK_U, Parking
 from .kernel import (
     clip_action,
     crash_charge,
@@ -155,10 +156,6 @@ def _read(B, seen, srngs, scratch, lane, t, row):
         seen[lane, m] = r[m]
 
 
-PARK_F = 13 + 12 + 6 + 1 + 12 + SENSOR_SCRATCH  # a parked episode: state, observation, gust noise, return so far, sensor reading and scratch
-PARK_U = 8  # its gust stream and its sensor stream
-
-
 @intrinsic
 def _fetch_add(typingctx, counter, delta):
     """Atomically add ``delta`` to ``counter[0]`` (an int64 array) and return its value before: a queue
@@ -198,9 +195,10 @@ def _required_over(left) -> bool:
 
 
 @nb.njit(cache=True, fastmath={"contract"})
-def park_lane(B, N, rngs, seen, srngs, scratch, step, total, sensing, lane, slot, park_f, park_u, park_step) -> None:
-    """Keep a lane's episode, between two control steps, in ``slot`` of the park arrays: everything its
+def park_lane(B, N, rngs, seen, srngs, scratch, step, total, sensing, lane, slot, parking) -> None:
+    """Keep a lane's episode, between two control steps, in ``slot`` of ``parking``: everything its
     next step reads (the drive terms, wind and packed rows are rewritten each step; P from the row)."""
+    park_f, park_u = parking.floats, parking.streams
     for m in range(13):
         park_f[slot, m] = B[m * LANES + lane]
     for m in range(12):
@@ -217,13 +215,14 @@ def park_lane(B, N, rngs, seen, srngs, scratch, step, total, sensing, lane, slot
             park_f[slot, 44 + m] = scratch[lane, m]
         for m in range(4):
             park_u[slot, 4 + m] = srngs[lane, m]
-    park_step[slot] = step[lane]
+    parking.steps[slot] = step[lane]
 
 
 @nb.njit(cache=True, fastmath={"contract"})
-def _begin(B, P, N, rngs, seen, srngs, scratch, step, total, lane, row, seed, episode, job_slot, q, park_f, park_u, park_step) -> bool:
+def _begin(B, P, N, rngs, seen, srngs, scratch, step, total, lane, row, seed, episode, job_slot, q, parking) -> bool:
     """Start job ``q``'s episode in a lane at rest: from its first step, or where it was parked. Returns whether it senses."""
     _start_lane(B, P, lane, row)
+    park_f, park_u, park_step = parking
     s = job_slot[q] if park_step.shape[0] > 0 else -1
     if s < 0 or park_step[s] == 0:
         seed_stream(rngs[lane], np.uint64(seed), np.uint64(episode))
@@ -275,21 +274,19 @@ def _lane_buffers(n_sub):
 
 
 @nb.njit(cache=True, fastmath={"contract"}, inline="always")
-def _refill(
-    B, P, N, A, rngs, seen, srngs, scratch, sensing, job, step, total, lane, nxt, queue, mdp_rows, job_mdp, seed, episodes, job_slot, park_f, park_u,
-    park_step,
-):  # fmt: skip
+def _refill(B, P, N, A, rngs, seen, srngs, scratch, sensing, job, step, total, lane, nxt, queue, jobs, job_slot, parking):
     """Lane ``lane`` reset and given the queue's next job while one is left (else idle: job -1); the last job index
     this thread took."""
     _reset_lane(B, N, A, lane)
     total[lane] = 0.0
     step[lane] = 0
-    if nxt < episodes.shape[0]:
+    n_jobs = jobs.episode.shape[0]
+    if nxt < n_jobs:
         nxt = _take(queue)
-    if nxt < episodes.shape[0]:
+    if nxt < n_jobs:
         job[lane] = nxt
         sensing[lane] = _begin(
-            B, P, N, rngs, seen, srngs, scratch, step, total, lane, mdp_rows[job_mdp[nxt]], seed, episodes[nxt], job_slot, nxt, park_f, park_u, park_step
+            B, P, N, rngs, seen, srngs, scratch, step, total, lane, jobs.rows[jobs.mdp[nxt]], jobs.seed, jobs.episode[nxt], job_slot, nxt, parking
         )  # fmt: skip
     else:
         job[lane] = -1
@@ -322,20 +319,17 @@ def _integrate_each(B, N, A, job, step, mdp_rows, job_mdp) -> None:
 
 
 @nb.njit(cache=True)
-def _over(j, n_required, left, park_step, job_slot):
+def _over(j, n_required, left, parking, job_slot):
     """Job ``j``'s episode is over in a parking call: one required job fewer to wait for, and its slot begins afresh."""
     if j < n_required:
         _fetch_add(left, -1)
-    park_step[job_slot[j]] = 0
+    parking.steps[job_slot[j]] = 0
 
 
 @nb.njit(cache=True, fastmath={"contract"})
-def fly_queue(
-    mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, seed, n_steps, out_return, out_crashed, out_steps, stats,
-    n_required, job_slot, park_f, park_u, park_step, left, queue,
-):  # fmt: skip
-    """Fly jobs j (policy ``job_policy[j]``, MDP row ``job_mdp[j]``, episode index ``episodes[j]``),
-    LANES at a time; write each job's return, crash flag and steps (as kernel.fly_job: no
+def fly_queue(jobs, out, stats, n_required, job_slot, parking, left, queue):
+    """Fly the :class:`~neurohover.sim.jobs.Jobs` ``jobs``, LANES at a time; write each job's return,
+    crash flag and steps into the :class:`~neurohover.sim.jobs.Flown` ``out`` (as kernel.fly_job: no
     recording, no safeguard). Every job's MDP row must have the substep count and the wind
     presence (kind 0 or not) of the first job's row.
 
@@ -346,13 +340,15 @@ def fly_queue(
     stats[0] counts control steps, stats[1] those flown again by the large-angle fallback. Once the queue is
     empty and at most SCALAR_TAIL lanes fly, their substeps run per lane with ``kernel.integrate``.
 
-    Parking (``park_step`` not empty): jobs ``n_required`` and later are optional. Job j's episode
-    is kept in slot ``job_slot[j]`` of ``park_f`` / ``park_u`` / ``park_step`` (:func:`park_lane`): one
-    whose ``park_step`` is above 0 resumes there. ``left[0]`` counts the call's required jobs not
+    Parking (``parking`` has slots): jobs ``n_required`` and later are optional. Job j's episode
+    is kept in slot ``job_slot[j]`` of ``parking`` (:func:`park_lane`): one
+    whose ``parking.steps`` is above 0 resumes there. ``left[0]`` counts the call's required jobs not
     yet over (every thread counts it down); once it is 0, the episodes still in flight are parked and
     the call returns (an optional job not over keeps ``out_steps`` 0).
     """
-    n_jobs = episodes.shape[0]
+    mdp_rows, job_mdp, n_steps = jobs.rows, jobs.mdp, jobs.n_steps
+    out_return, out_crashed, out_steps = out.returns, out.crashed, out.steps
+    n_jobs = jobs.episode.shape[0]
     if n_jobs == 0:
         return
     n_sub = int(mdp_rows[job_mdp[0], ROW_SUBSTEPS])
@@ -361,19 +357,16 @@ def fly_queue(
     nxt = -1  # the last job index this thread took
     live = 0
     for lane in range(LANES):
-        nxt = _refill(
-            B, P, N, A, rngs, seen, srngs, scratch, sensing, job, step, total, lane, nxt, queue, mdp_rows, job_mdp, seed, episodes, job_slot, park_f,
-            park_u, park_step,
-        )  # fmt: skip
+        nxt = _refill(B, P, N, A, rngs, seen, srngs, scratch, sensing, job, step, total, lane, nxt, queue, jobs, job_slot, parking)
         if job[lane] >= 0:
             live += 1
-    parking = park_step.shape[0] > 0
+    parks = parking.steps.shape[0] > 0
     while live > 0:
         # (a thread whose last job was required below the last one holds required jobs only: it flies on)
-        if parking and nxt >= n_required - 1 and _required_over(left):
+        if parks and nxt >= n_required - 1 and _required_over(left):
             for lane in range(LANES):
                 if job[lane] >= 0:
-                    park_lane(B, N, rngs, seen, srngs, scratch, step, total, sensing, lane, job_slot[job[lane]], park_f, park_u, park_step)
+                    park_lane(B, N, rngs, seen, srngs, scratch, step, total, sensing, lane, job_slot[job[lane]], parking)
             break
         # Control-step part, scalar per lane: policy, clipping, gust noise, drive terms, wind.
         for lane in range(LANES):
@@ -387,15 +380,15 @@ def fly_queue(
                 o0, o1, o2 = B[(ROW_OBS + 0) * LANES + lane], B[(ROW_OBS + 1) * LANES + lane], B[(ROW_OBS + 2) * LANES + lane]
                 o3, o4, o5 = B[(ROW_OBS + 3) * LANES + lane], B[(ROW_OBS + 4) * LANES + lane], B[(ROW_OBS + 5) * LANES + lane]
                 o9, o10, o11 = B[(ROW_OBS + 9) * LANES + lane], B[(ROW_OBS + 10) * LANES + lane], B[(ROW_OBS + 11) * LANES + lane]
-            pol = job_policy[job[lane]]
-            a1, a2, a3, a4 = policy_action(policy_kinds[pol], genomes[pol], o0, o1, o2, o3, o4, o5, o9, o10, o11)
+            pol = jobs.policy[job[lane]]
+            a1, a2, a3, a4 = policy_action(jobs.kinds[pol], jobs.genomes[pol], o0, o1, o2, o3, o4, o5, o9, o10, o11)
             if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
                 j = job[lane]
                 out_return[j] = total[lane] + crash_charge(n_steps, k + 1)
                 out_crashed[j] = True
                 out_steps[j] = k + 1
-                if parking:
-                    _over(j, n_required, left, park_step, job_slot)
+                if parks:
+                    _over(j, n_required, left, parking, job_slot)
                 job[lane] = -2  # over; the lane idles through this step (at rest, dt 0) and is refilled after it
                 _reset_lane(B, N, A, lane)
                 continue
@@ -444,65 +437,42 @@ def fly_queue(
                         _read(B, seen, srngs, scratch, lane, t, mdp_rows[job_mdp[j]])
                     continue
                 out_steps[j] = t
-                if parking:
-                    _over(j, n_required, left, park_step, job_slot)
-            nxt = _refill(
-                B, P, N, A, rngs, seen, srngs, scratch, sensing, job, step, total, lane, nxt, queue, mdp_rows, job_mdp, seed, episodes, job_slot, park_f,
-                park_u, park_step,
-            )  # fmt: skip
+                if parks:
+                    _over(j, n_required, left, parking, job_slot)
+            nxt = _refill(B, P, N, A, rngs, seen, srngs, scratch, sensing, job, step, total, lane, nxt, queue, jobs, job_slot, parking)
             if job[lane] < 0:
                 live -= 1
 
 
 @nb.njit(cache=True, fastmath={"contract"})
-def fly_lanes(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, seed, n_steps, out_return, out_crashed, out_steps, stats):
+def fly_lanes(jobs, out, stats):
     """:func:`fly_queue` without parking: every job is flown to its end."""
     queue = np.zeros(1, dtype=np.int64)
-    fly_shared(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, seed, n_steps, out_return, out_crashed, out_steps, stats, queue)
+    fly_shared(jobs, out, stats, queue)
 
 
 @nb.njit(cache=True, fastmath={"contract"})
-def fly_shared(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, seed, n_steps, out_return, out_crashed, out_steps, stats, queue):
+def fly_shared(jobs, out, stats, queue):
     """:func:`fly_lanes` taking its jobs from ``queue`` (shared with the call's other threads)."""
     none = np.zeros(0, dtype=np.int64)
-    fly_queue(
-        mdp_rows, policy_kinds, genomes, job_policy, job_mdp, episodes, seed, n_steps, out_return, out_crashed, out_steps, stats,
-        episodes.shape[0], none, np.zeros((0, PARK_F)), np.zeros((0, PARK_U), dtype=np.uint64), none, np.zeros(1, dtype=np.int64), queue,
-    )  # fmt: skip
+    nowhere = Parking(np.zeros((0, PARK_F)), np.zeros((0, PARK_U), dtype=np.uint64), none)
+    fly_queue(jobs, out, stats, jobs.episode.shape[0], none, nowhere, np.zeros(1, dtype=np.int64), queue)
 
 
 @nb.njit(cache=True, parallel=True, fastmath={"contract"})
-def rollout_lanes(
-    mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, seed, n_steps, n_threads, out_return, out_crashed, out_steps, out_safeguard_step
-):
-    """Fly the jobs ``(job_policy[j], job_mdp[j], job_episode[j])``, LANES per thread, in parallel.
+def rollout_lanes(jobs, n_threads, out):
+    """Fly the :class:`~neurohover.sim.jobs.Jobs` ``jobs``, LANES per thread, in parallel, into ``out``
+    (a :class:`~neurohover.sim.jobs.Flown`).
 
     The outputs are those of :func:`neurohover.sim.kernel.rollout_batch` for the same jobs with no
     recording and no safeguard, bit for bit. Each lane flies its own job's genome and MDP row;
     all rows used must share the substep count (row[ROW_SUBSTEPS]) and whether there is wind (row[ROW_WIND_KIND] != 0),
-    which the packed substep loop takes as constants (ValueError otherwise).
-
-    Parameters
-    ----------
-    mdp_rows : numpy.ndarray
-        ``(M, MDP_ROW_LEN)`` MDP rows.
-    policy_kinds : numpy.ndarray of int64
-        ``(P,)`` policy kinds (``kernel.POLICY_SLP`` or ``kernel.POLICY_MLP``).
-    genomes : numpy.ndarray
-        ``(P, 42)`` genomes, padded as in :class:`neurohover.evaluate.PolicyTable`.
-    job_policy, job_mdp, job_episode : numpy.ndarray of int64
-        Per job, its policy, its MDP row, and the episode index that with ``seed`` fixes its noise.
-    seed : numpy.uint64
-        Root seed of the noise streams.
-    n_steps : int
-        Control steps per episode.
-    n_threads : int
-        Threads to split the jobs over (``numba.get_num_threads()``; a parameter because reading
-        it in compiled code would keep this function out of the on-disk cache).
-    out_return, out_crashed, out_steps, out_safeguard_step : numpy.ndarray
-        Per job: return, crash flag, steps flown, and -1 (no safeguard), written here.
+    which the packed substep loop takes as constants (ValueError otherwise). ``n_threads``: threads
+    to split the jobs over (``numba.get_num_threads()``; a parameter because reading it in compiled
+    code would keep this function out of the on-disk cache).
     """
-    n_jobs = job_episode.shape[0]
+    mdp_rows, job_mdp = jobs.rows, jobs.mdp
+    n_jobs = jobs.episode.shape[0]
     if n_jobs > 0:
         n_sub = mdp_rows[job_mdp[0], ROW_SUBSTEPS]
         windy = mdp_rows[job_mdp[0], ROW_WIND_KIND] != 0.0
@@ -515,31 +485,29 @@ def rollout_lanes(
     queue = np.zeros(1, dtype=np.int64)
     for _ in nb.prange(n_chunks):  # one lane set per thread
         stats = np.zeros(2, dtype=np.int64)
-        fly_shared(mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, seed, n_steps, out_return, out_crashed, out_steps, stats, queue)
+        fly_shared(jobs, out, stats, queue)
     for j in range(n_jobs):
-        out_safeguard_step[j] = -1
+        out.safeguard_step[j] = -1
 
 
 @nb.njit(cache=True, parallel=True, fastmath={"contract"})
-def rollout_lanes_parked(
-    mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, job_slot, n_required, seed, n_steps, n_threads,
-    park_f, park_u, park_step, out_return, out_crashed, out_steps,
-):  # fmt: skip
+def rollout_lanes_parked(jobs, job_slot, n_required, n_threads, parking, out):
     """:func:`rollout_lanes` with optional jobs and parking: fly jobs ``0 .. n_required - 1`` to their end,
     and jobs ``n_required ..`` only in lanes the required ones leave idle.
 
     The call returns once every required job is over; an optional episode then in flight is parked in
-    its slot ``job_slot[j]`` of ``park_f`` (``(S, PARK_F)``), ``park_u`` (``(S, PARK_U)`` uint64) and
-    ``park_step`` (``(S,)``: its steps flown; 0 for an episode not begun), and a later call that lists
+    its slot ``job_slot[j]`` of ``parking`` (a :class:`~neurohover.sim.jobs.Parking`: ``steps`` its
+    steps flown, 0 for an episode not begun), and a later call that lists
     the same slot resumes it there, so an episode's return is the same bits however many calls it
     took. Every thread takes jobs in order from one shared queue, required ones first: a thread with
-    no required job left flies optional ones until every required one is over. ``out_steps[j]`` is 0 for an
-    optional job not over (parked, or not begun); otherwise the outputs are :func:`rollout_lanes`'s.
+    no required job left flies optional ones until every required one is over. ``out.steps[j]`` is 0 for an
+    optional job not over (parked, or not begun); otherwise the outputs are :func:`rollout_lanes`'s
+    (``out.safeguard_step`` is not written).
     The rows must be alike in substeps and wind, as there (not checked here: one race's rows are).
     """
-    n_jobs = job_episode.shape[0]
+    n_jobs = jobs.episode.shape[0]
     for j in range(n_jobs):
-        out_steps[j] = 0
+        out.steps[j] = 0
     # Every thread takes a lane set even for fewer than 2 * LANES jobs (unlike rollout_lanes): a race's last
     # rounds list a few required jobs, and two threads with half-full lanes end them sooner than one thread.
     n_chunks = max(1, min(n_threads, n_jobs))
@@ -547,7 +515,4 @@ def rollout_lanes_parked(
     queue = np.zeros(1, dtype=np.int64)
     for _ in nb.prange(n_chunks):  # one lane set per thread
         stats = np.zeros(2, dtype=np.int64)
-        fly_queue(
-            mdp_rows, policy_kinds, genomes, job_policy, job_mdp, job_episode, seed, n_steps, out_return, out_crashed, out_steps, stats,
-            n_required, job_slot, park_f, park_u, park_step, left, queue,
-        )  # fmt: skip
+        fly_queue(jobs, out, stats, n_required, job_slot, parking, left, queue)
