@@ -4,15 +4,31 @@ neat-python's network, and a run is reproducible from its seed. Skipped where ne
 from __future__ import annotations
 
 import random
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-neat = pytest.importorskip("neat", reason="neat-python is not installed (pip install '.[neat]')")
+neat = pytest.importorskip("neat", reason="neat-python is not installed (a dependency: pip install neat-python)")
 
 from neurohover import NeurohoverError, baseline_policy, evaluate, get_task_family  # noqa: E402  # noqa: E402
+from neurohover.evolution.evolve import validation_return  # noqa: E402
+from neurohover.experiments.config import load_config  # noqa: E402
+from neurohover.experiments.plans import plan  # noqa: E402
+from neurohover.experiments.results import UnitKey  # noqa: E402
+from neurohover.experiments.units import run_unit  # noqa: E402
 from neurohover.integrations.flying import evaluate_callable  # noqa: E402
-from neurohover.integrations.neat import INPUT_INDEX, NeatSettings, evolve_topology, forward, neat_config, pack_networks, seed_baseline  # noqa: E402
+from neurohover.integrations.neat import (  # noqa: E402
+    INPUT_INDEX,
+    NeatSettings,
+    evolve_topology,
+    forward,
+    genome_record,
+    neat_config,
+    network_of_record,
+    pack_networks,
+    seed_baseline,
+)
 
 
 def _grown_genomes(n: int, seed: int):
@@ -82,3 +98,85 @@ def test_a_genome_seeded_with_the_baseline_flies_the_baseline() -> None:
     assert not ours.crashed.any()
     with pytest.raises(ValueError, match="start='baseline' needs"):
         NeatSettings(start="baseline", activations=("tanh",))
+
+
+def test_a_stored_record_flies_as_the_genome_it_was_made_of() -> None:
+    genomes, config = _grown_genomes(8, seed=4)
+    obs = np.random.default_rng(1).normal(scale=2.0, size=(8, 12))
+    direct = forward(pack_networks(genomes, config), np.arange(8), obs)
+    for i, g in enumerate(genomes):
+        again = forward(network_of_record(genome_record(g)), np.zeros(1, dtype=np.int64), obs[i : i + 1])
+        np.testing.assert_array_equal(again[0], direct[i])
+    with pytest.raises(NeurohoverError, match="does not hold"):
+        network_of_record([2.0, 0.0, 0.1])
+
+
+def test_a_run_over_a_task_family_draws_fresh_mdps_and_scores_on_the_fitness_scale() -> None:
+    family = get_task_family("fghh", 0.3)
+    settings = NeatSettings(pop_size=6, episodes=2, fitness="inv-log-error", start="baseline", activations=("identity", "tanh"))
+    a = evolve_topology(family, budget=24, seed=3, settings=settings, n_steps=60)
+    b = evolve_topology(family, budget=24, seed=3, settings=settings, n_steps=60)
+    assert a.history == b.history and a.generations == 2
+    assert all(0.0 < h["best"] < 1.0 for h in a.history)  # 1/ln(error) of errors above e, not raw returns
+    with pytest.raises(ValueError, match="fitness="):
+        NeatSettings(fitness="median")
+
+
+def test_a_neat_variant_pairs_with_the_mlp_runs_and_its_ne_variants_are_fig2s_runs() -> None:
+    """topology-ghh08: its NE variants are planned with fig2's params and seeds (so they are fig2's runs again) and
+    each NEAT run takes the seed of fig2's MLP run on the same MDP, so it meets that champion's validation episodes."""
+    mine = {u.key: u.params for u in plan(load_config("topology-ghh08", "quick"), {}).units}
+    fig2 = {u.key: u.params for u in plan(load_config("fig2", "quick"), {}).units}
+    ne = [k for k in mine if "/neat" not in k]
+    assert ne and all(mine[k] == fig2[k] for k in ne)
+    for k in (k for k in mine if "/neat" in k):
+        key = UnitKey.parse(k)
+        assert mine[k]["seed"] == fig2[UnitKey.make("evolve", "mlp-baseline", key.mdp, key.rep)]["seed"]
+        assert mine[k]["topology"] == "neat" and mine[k]["optimiser"]["name"] == "neat"
+
+
+def test_a_neat_unit_validates_on_the_episodes_of_the_champion_it_is_paired_with() -> None:
+    """A NEAT unit's champion made the baseline (no generation can beat it: the mutations are zero-sized) flies
+    the validation episodes the baseline flies through validation_return with the same seed: the same MDP and gusts."""
+    mdp = get_task_family("ghh08").mdp("train:1")
+    frozen = {"start": "baseline", "activations": ["identity"], "weight_mutate_rate": 0.0, "bias_mutate_rate_unused": None}
+    frozen.pop("bias_mutate_rate_unused")
+    params = {
+        "target": {"kind": "mdp", "mdp": mdp.to_dict()}, "topology": "neat", "prototype": "baseline", "resampling": "fixed:1", "budget": 8,
+        "optimiser": {"name": "neat", "pop_size": 4, "node_add_prob": 0.0, "conn_add_prob": 0.0, "conn_delete_prob": 0.0, "node_delete_prob": 0.0,
+                      "bias_mutate_power": 1e-300, "replace_rate": 0.0, "activation_mutate_rate": 0.0, **frozen},
+        "n_steps": 80, "validation_episodes": 3, "seed": 17,
+    }  # fmt: skip
+    result = run_unit({"experiment": "t", "key": "evolve/neat/train1/run0", "kind": "evolve", "params": params}, threads=1)
+    expected = validation_return(baseline_policy(), mdp, episodes=3, seed=17, n_steps=80)
+    np.testing.assert_allclose([float(x) for x in result["validation"]], expected, rtol=1e-9)
+    assert result["champion"]["topology"] == "neat" and result["episodes"] == 8 and result["validation_crashed"] == [False] * 3
+
+
+@pytest.mark.parametrize(
+    ("variant", "message"),
+    [
+        ('topology = "neat"\nneat = { pop_size = 1 }', "pop_size=1"),
+        ('topology = "neat"\nneat = { colour = 1 }', "unknown NEAT setting"),
+        ('topology = "mlp"\nneat = { pop_size = 10 }', "neat applies to topology = 'neat'"),
+        ('topology = "neat"\nresampling = "fixed:5"', "takes no resampling"),
+    ],
+)
+def test_bad_neat_variants_are_refused_when_the_config_loads(tmp_path: Path, variant: str, message: str) -> None:
+    path = tmp_path / "neat-bad.toml"
+    path.write_text(
+        'name = "neat-bad"\ntitle = "t"\nkind = "evolution"\n[settings]\ntask = "ghh08"\nseed = 1\ntarget = "train"\n'
+        f'[[settings.variants]]\nkey = "x"\nlabel = "x"\n{variant}\n[scales.quick]\nbudget = 600\nruns = 1\n[scales.paper]\nbudget = 600\nruns = 1\n'
+    )
+    with pytest.raises(NeurohoverError, match=message):
+        load_config(str(path), "quick")
+
+
+def test_a_neat_run_over_the_family_must_be_validated_on_its_test_mdps(tmp_path: Path) -> None:
+    path = tmp_path / "neat-family.toml"
+    path.write_text(
+        'name = "neat-family"\ntitle = "t"\nkind = "evolution"\n[settings]\ntask = "fghh"\nsigma = 0.3\nseed = 1\ntarget = "family"\n'
+        '[[settings.variants]]\nkey = "x"\nlabel = "x"\ntopology = "neat"\n[scales.quick]\nbudget = 600\nruns = 1\n[scales.paper]\nbudget = 600\nruns = 1\n'
+    )
+    with pytest.raises(NeurohoverError, match="validation_mdps = 'test'"):
+        load_config(str(path), "quick")

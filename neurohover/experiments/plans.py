@@ -27,6 +27,7 @@ import numpy as np
 from ..agents.hybrid import HybridSettings
 from ..agents.registry import HYBRID_AGENTS, agent_spec
 from ..errors import NeurohoverError
+from ..integrations.neat import NEAT_TOPOLOGY
 from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..models.model import LEGACY_MODEL_SUBSTEPS
 from ..policies import baseline_policy
@@ -145,6 +146,8 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
         common = {**base, "topology": v.topology, "prototype": v.prototype, "resampling": v.resampling}
         if v.optimizer is not None:
             common["optimiser"] = variant_optimizer(s.optimizer, v.optimizer)
+        if v.topology == NEAT_TOPOLOGY:  # NEAT's settings travel as the run's optimiser
+            common["optimiser"] = {"name": NEAT_TOPOLOGY, **(v.neat or {})}
         if s.target == "train":
             for i, mdp in enumerate(train):
                 for r in range(s.runs):

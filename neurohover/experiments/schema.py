@@ -22,6 +22,7 @@ from ..evolution.config import make_settings, optimiser_of
 from ..evolution.evolve import parse_resampling
 from ..evolution.optimisers import OPTIMISERS
 from ..evolution.races import RACE_RULES
+from ..integrations.neat import NEAT_TOPOLOGY
 from ..models.lr import D_U_CHOICES, DEFAULT_NOISE_ESTIMATE, NOISE_ESTIMATES
 from ..models.model import MODEL_SUBSTEPS, default_model_substeps
 from ..policysets import FGHH_GENERIC_RESAMPLING
@@ -171,8 +172,10 @@ _COMMON: dict[str, tuple[Any, Any]] = {
 _VARIANT = {
     "key": (REQUIRED, _str()),
     "label": (REQUIRED, _str()),
-    "topology": ("mlp", _choice("slp", "mlp")),
+    "topology": ("mlp", _choice("slp", "mlp", NEAT_TOPOLOGY)),
     "prototype": ("baseline", _choice("zero", "baseline")),
+    # topology "neat": NEAT's settings (neurohover.integrations.neat.NeatSettings' fields; its start replaces the prototype)
+    "neat": (OMIT, _table()),
     "resampling": ("fixed:1", _resampling()),
     "sigma": (None, _float(0.0, 1.0)),
     "optimizer": (OMIT, _table()),  # this variant's optimizer settings, over the experiment's `optimizer`
@@ -342,6 +345,29 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
         _check_test_runs(settings, task, where)
 
 
+def _check_neat_variant(settings: dict, v: dict, where: str) -> None:
+    """A NEAT variant: its ``neat`` table checked now (NeatSettings), neat-python installed, one episode per
+    candidate's resampling (NEAT's own ``episodes`` setting counts them), and validation episodes NEAT can fly."""
+    if v["topology"] != NEAT_TOPOLOGY:
+        if "neat" in v:
+            raise NeurohoverError(f"{where}: variant {v['key']!r} sets neat but its topology is {v['topology']!r} (neat applies to topology = 'neat')")
+        return
+    from ..integrations.neat import NeatSettings
+
+    try:
+        import neat  # noqa: F401  # the optional extra the variant needs, refused now rather than when a unit runs
+    except ImportError:
+        raise NeurohoverError(f"{where}: variant {v['key']!r} evolves with NEAT: neat-python is missing (pip install neat-python)") from None
+    try:
+        NeatSettings.of(v.get("neat", {}))
+    except (TypeError, ValueError) as err:
+        raise NeurohoverError(f"{where}: variant {v['key']!r}: neat: {err}") from None
+    if v["resampling"] != "fixed:1" or "optimizer" in v:
+        raise NeurohoverError(f"{where}: variant {v['key']!r}: a NEAT variant takes no resampling or optimizer (its neat table's episodes and settings)")
+    if settings["target"] == "family" and settings.get("validation_mdps") != "test":
+        raise NeurohoverError(f"{where}: variant {v['key']!r}: a NEAT run over the family is validated on its test MDPs: set validation_mdps = 'test'")
+
+
 def _check_evolution(settings: dict, task: str, where: str) -> None:
     """Variants, their optimisers (checked now, not when a unit first runs), robustness and validation targets."""
     keys = [v["key"] for v in settings["variants"]]
@@ -353,8 +379,10 @@ def _check_evolution(settings: dict, task: str, where: str) -> None:
         if settings["target"] != "family" and parse_resampling(v["resampling"]).selects:
             raise NeurohoverError(f"{where}: variant {v['key']!r}: selection races and bandits need target = 'family'")
 
+    for v in settings["variants"]:
+        _check_neat_variant(settings, v, where)
     method = "generational" if settings["target"] == "family" else "steady-state"
-    for v in [None, *settings["variants"]]:
+    for v in [None, *(v for v in settings["variants"] if v["topology"] != NEAT_TOPOLOGY)]:
         table = settings["optimizer"] if v is None else variant_optimizer(settings["optimizer"], v.get("optimizer"))
         try:  # the optimizer settings are checked here, not when a unit first runs
             name, rest = optimiser_of(table)
@@ -367,9 +395,9 @@ def _check_evolution(settings: dict, task: str, where: str) -> None:
     unpaired = [v["key"] for v in settings["variants"] if "paired_with" in v]
     if unpaired and "seeds_of" not in settings:
         raise NeurohoverError(f"{where}: variant(s) {', '.join(unpaired)} set paired_with: give the experiment's seeds_of too")
-    bad = [k for k in settings["robustness_variants"] if k not in keys]
+    bad = [k for k in settings["robustness_variants"] if k not in keys or next(v for v in settings["variants"] if v["key"] == k)["topology"] == NEAT_TOPOLOGY]
     if bad:
-        raise NeurohoverError(f"{where}: robustness_variants {bad} are not variant keys ({', '.join(keys)})")
+        raise NeurohoverError(f"{where}: robustness_variants {bad} are not keys of SLP or MLP variants ({', '.join(keys)})")
     if settings["robustness_variants"] and settings["target"] != "train":
         raise NeurohoverError(f"{where}: robustness_variants need target = 'train'")
     if "robustness_policies" in settings:

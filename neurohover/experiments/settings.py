@@ -27,6 +27,7 @@ class Variant:
     resampling: str = "fixed:1"
     sigma: float | None = None
     optimizer: dict | None = None  # over the experiment's optimizer table (None: left out)
+    neat: dict | None = None  # topology "neat": NEAT's settings (NeatSettings' fields; None: its defaults)
     paired_with: str | None = None  # with the experiment's seeds_of: that experiment's variant whose seeds it takes
 
 

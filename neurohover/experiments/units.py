@@ -33,6 +33,8 @@ from ..evaluate import evaluate, evaluate_jobs, num_threads
 from ..evolution.config import optimiser_of
 from ..evolution.eonn import EonnSettings
 from ..evolution.evolve import evolve, reevaluated_champion, validation_return
+from ..evolution.seeding import validation_seeds
+from ..integrations.neat import NEAT_TOPOLOGY, genome_record
 from ..models import learn_ec_meno, learn_ec_mer, learn_lr, one_step_error
 from ..policies import Policy
 from ..policies import prototype as make_prototype
@@ -125,6 +127,8 @@ def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:
     q = unit_params("evolve", p)
 
     target = _evolve_target(q.target)
+    if q.topology == NEAT_TOPOLOGY:
+        return _run_neat(q, target)
     proto = _policy(q.prototype) if isinstance(q.prototype, dict) else make_prototype(q.topology, q.prototype)
     optimizer, settings = optimiser_of(q.optimiser)
     t0 = time.perf_counter()
@@ -181,6 +185,43 @@ def run_evolve(p: dict, threads: int | None, device: str = "cpu") -> dict:
         reevaluated=reevaluated,
         reevaluated_best_ever=best_ever,
         timing=EvolveTiming(seconds=time.perf_counter() - t0, kernel_seconds=float(result.kernel_seconds)),
+    ).to_dict()
+
+
+def _run_neat(q, target) -> dict:
+    """An evolution run whose topology evolves too (NEAT, :mod:`neurohover.integrations.neat`; the variant's
+    ``neat`` table its settings), validated on the episodes an evolution run's champion meets: the same MDPs and
+    gusts (:func:`~neurohover.evolution.evolve.validation_return` on an MDP, :func:`fly_on_test_mdps` on a family).
+    Its champion is stored as topology ``"neat"`` with :func:`~neurohover.integrations.neat.genome_record` as genome."""
+    from ..integrations.flying import evaluate_callable
+    from ..integrations.neat import NeatSettings, evolve_topology
+
+    settings = NeatSettings.of({k: v for k, v in q.optimiser.items() if k != "name"})
+    t0 = time.perf_counter()
+    result = evolve_topology(target, budget=q.budget, seed=q.seed, settings=settings, n_steps=q.n_steps)
+    if isinstance(target, MDP):
+        noise_seed, _ = validation_seeds(q.seed)
+        mdps, seed = [target] * q.validation_episodes, noise_seed  # episode i: stream (noise seed, i), as validation_return's
+    else:
+        tests = target.test_mdps()
+        mdps, seed = [tests[i % len(tests)] for i in range(q.validation_episodes)], q.validation_seed  # as fly_on_test_mdps
+    ev = evaluate_callable(result.act, mdps, seed=seed, n_steps=q.n_steps, obs_dtype="float64") if mdps else None
+    history = [(int(h["episodes"]), num(h["best"])) for h in result.history]
+    return EvolveResult(
+        champion=StoredPolicy(NEAT_TOPOLOGY, genome_record(result.champion)),
+        champion_return=num(result.champion_fitness),
+        episodes=int(result.episodes),
+        evaluations=int(result.episodes),
+        generations=int(result.generations),
+        stop_reason="budget",
+        champion_crashed=None,
+        history=tuple(subsample(history, q.history_points)),
+        validation=None if ev is None else tuple(num(x) for x in np.ravel(ev.returns)),
+        validation_crashed=None if ev is None else tuple(bool(c) for c in np.ravel(ev.crashed)),
+        fitness=settings.fitness,
+        reevaluated=None,
+        reevaluated_best_ever=None,
+        timing=EvolveTiming(seconds=time.perf_counter() - t0, kernel_seconds=0.0),
     ).to_dict()
 
 

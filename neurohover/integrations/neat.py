@@ -31,18 +31,33 @@ import math
 import os
 import random
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, field
+from dataclasses import fields as dataclass_fields
+from typing import Any
 
 import numba as nb
 import numpy as np
 
 from ..errors import NeurohoverError
+from ..evolution.fitness import FITNESS_SCALES, episode_fitness
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS, OBS_NAMES
-from ..tasks import MDP
+from ..tasks import MDP, TaskFamily
 
-__all__ = ["ACTIVATIONS", "NeatSettings", "TopologyResult", "evolve_topology", "forward", "pack_networks"]
+__all__ = [
+    "ACTIVATIONS",
+    "NEAT_TOPOLOGY",
+    "NeatSettings",
+    "TopologyResult",
+    "evolve_topology",
+    "forward",
+    "genome_record",
+    "network_of_record",
+    "pack_networks",
+]
 
+#: An evolution variant's topology that evolves with NEAT (the experiments' name; its champion is stored so).
+NEAT_TOPOLOGY = "neat"
 #: neat-python's activation functions this forward pass computes, by id (its ``activations`` module, exactly).
 ACTIVATIONS = ("identity", "tanh", "sigmoid", "clamped", "relu")
 #: What a network sees: the nine state features of the paper's networks (Section 3.1), as the SLP and MLP do.
@@ -79,6 +94,17 @@ class NeatSettings:
     weight_init_stdev: float = 0.5  # 0: every genome starts as the zero network, as NE's zero prototype
     bias_init_stdev: float = 0.5
     start: str = "random"
+    fitness: str = "return"  # a genome's fitness: its mean return, or its episodes' mean 1/ln(error) (FGHH's scale)
+
+    @classmethod
+    def of(cls, table: Mapping[str, Any]) -> NeatSettings:
+        """Settings from a config's table (TOML lists as tuples); an unknown key refused by name (ValueError)."""
+        known = {f.name for f in dataclass_fields(cls)}
+        unknown = sorted(set(table) - known)
+        if unknown:
+            raise ValueError(f"unknown NEAT setting(s) {', '.join(map(repr, unknown))}: allowed {', '.join(sorted(known))}")
+        values: dict[str, Any] = {k: tuple(v) if isinstance(v, list) else v for k, v in table.items()}
+        return cls(**values)
 
     def __post_init__(self) -> None:
         if isinstance(self.pop_size, bool) or not isinstance(self.pop_size, int) or self.pop_size < 4:
@@ -87,6 +113,8 @@ class NeatSettings:
             raise ValueError(f"episodes={self.episodes!r} must be an integer >= 1")
         if self.initial not in ("full_direct", "unconnected"):
             raise ValueError(f"initial={self.initial!r}: allowed full_direct or unconnected")
+        if self.fitness not in FITNESS_SCALES:
+            raise ValueError(f"fitness={self.fitness!r}: allowed {', '.join(FITNESS_SCALES)}")
         if self.start not in ("random", "baseline"):
             raise ValueError(f"start={self.start!r}: allowed random or baseline")
         if self.start == "baseline" and (self.initial != "full_direct" or "identity" not in self.activations):
@@ -311,6 +339,42 @@ class TopologyResult:
         return forward(self.packed, np.zeros(len(obs), dtype=np.int64), np.asarray(obs, dtype=np.float64))
 
 
+def genome_record(genome) -> tuple[float, ...]:
+    """A genome as a flat tuple of floats (what a stored result holds): the node count, then per node its key,
+    bias, response and activation id (:data:`ACTIVATIONS`), then per enabled connection its input, output and weight.
+    :func:`network_of_record` flies it again, to the same bits."""
+    out: list[float] = [float(len(genome.nodes))]
+    for key, node in genome.nodes.items():  # in the genome's order, so that a node's inputs sum in the same order
+        out += [float(key), float(node.bias), float(node.response), float(ACTIVATIONS.index(node.activation))]
+    for (i, o), conn in genome.connections.items():
+        if conn.enabled:
+            out += [float(i), float(o), float(conn.weight)]
+    return tuple(out)
+
+
+def network_of_record(record: Sequence[float]) -> PackedNetworks:
+    """The network of a :func:`genome_record`, packed for :func:`forward` (neat-python's evaluation order)."""
+    import neat
+
+    config = neat_config(NeatSettings(activations=ACTIVATIONS))
+    n_nodes = int(record[0])
+    if len(record) < 1 + 4 * n_nodes or (len(record) - 1 - 4 * n_nodes) % 3:
+        raise NeurohoverError(f"a NEAT record of {len(record)} numbers does not hold {n_nodes} nodes and whole connections")
+    genome = neat.DefaultGenome(0)
+    gc = config.genome_config
+    for j in range(n_nodes):
+        key, bias, response, act = record[1 + 4 * j : 5 + 4 * j]
+        node = gc.node_gene_type(int(key))
+        node.bias, node.response, node.activation, node.aggregation = float(bias), float(response), ACTIVATIONS[int(act)], "sum"
+        genome.nodes[int(key)] = node
+    for innovation, j in enumerate(range(1 + 4 * n_nodes, len(record), 3)):
+        i, o, w = record[j : j + 3]
+        conn = gc.connection_gene_type((int(i), int(o)), innovation=innovation)  # (a number neat-python 2 requires; unused in flight)
+        conn.weight, conn.enabled = float(w), True
+        genome.connections[(int(i), int(o))] = conn
+    return pack_networks([genome], config)
+
+
 def seed_baseline(genome, config) -> None:
     """Make ``genome`` (fully connected inputs -> outputs) the baseline policy: gains on its direct
     connections, the biases on its outputs, identity outputs, every other weight 0."""
@@ -326,7 +390,7 @@ def seed_baseline(genome, config) -> None:
 
 
 def evolve_topology(
-    mdps: MDP | Sequence[MDP],
+    mdps: MDP | Sequence[MDP] | TaskFamily,
     *,
     budget: int,
     seed: int = 0,
@@ -336,15 +400,19 @@ def evolve_topology(
     """Evolve a network's topology and weights with NEAT on ``mdps`` for ``budget`` episodes.
 
     Each genome of a generation flies ``settings.episodes`` episodes (on the MDPs in turn when there are
-    several, as a run over training MDPs); fitness is its mean return.
+    several, as a run over training MDPs; each on a fresh MDP from G when ``mdps`` is a task family, drawn
+    from ``seed``); fitness is its mean return, or on ``settings.fitness = "inv-log-error"`` the mean of its
+    episodes' 1/ln(error) (:mod:`neurohover.evolution.fitness`, FGHH's scale).
     """
     import neat
 
     from .flying import evaluate_callable
 
     s = settings if settings is not None else NeatSettings()
-    mdp_list = [mdps] if isinstance(mdps, MDP) else list(mdps)
-    if not mdp_list or not all(isinstance(m, MDP) for m in mdp_list):
+    family = mdps if isinstance(mdps, TaskFamily) else None
+    mdp_rng = np.random.default_rng([int(seed), 0x4E4]) if family is not None else None  # the MDPs from G, apart from the gusts
+    mdp_list: list = [mdps] if isinstance(mdps, MDP) else [] if isinstance(mdps, TaskFamily) else list(mdps)
+    if family is None and (not mdp_list or not all(isinstance(m, MDP) for m in mdp_list)):
         raise NeurohoverError("mdps must be one MDP or a non-empty sequence of MDPs of one task family")
     if isinstance(budget, bool) or not isinstance(budget, (int, np.integer)) or budget < s.pop_size * s.episodes:
         raise NeurohoverError(f"budget={budget!r} is out of range: allowed an integer >= one generation ({s.pop_size * s.episodes} episodes)")
@@ -357,18 +425,19 @@ def evolve_topology(
         nonlocal flown
         packed = pack_networks([g for _, g in genomes], cfg)
         n = len(genomes) * s.episodes
-        # episode j of the generation: genome j // episodes, MDP j % len(mdps), gust stream (seed, flown + j)
-        rows = [mdp_list[j % len(mdp_list)] for j in range(n)]
+        # episode j of the generation: genome j // episodes, MDP j % len(mdps) (or a fresh one from G), gust stream (seed, flown + j)
+        rows = [family.sample(mdp_rng) for _ in range(n)] if family is not None else [mdp_list[j % len(mdp_list)] for j in range(n)]
         ev = evaluate_callable(
             lambda obs, idx: forward(packed, idx // s.episodes, obs), rows, seed=seed, first_episode=flown, n_steps=n_steps, obs_dtype="float64", indexed=True
         )
         returns = np.asarray(ev.returns).reshape(len(genomes), s.episodes)
-        for (_, g), r in zip(genomes, returns, strict=True):
+        scores = episode_fitness(returns, s.fitness)
+        for (_, g), r in zip(genomes, scores, strict=True):
             g.fitness = float(r.mean())
             if g.fitness > best[1]:
                 best[:] = [copy.deepcopy(g), g.fitness]
         flown += n
-        history.append({"generation": len(history), "episodes": flown, "best": float(returns.mean(axis=1).max()), "crashed": int(np.sum(ev.crashed))})
+        history.append({"generation": len(history), "episodes": flown, "best": float(scores.mean(axis=1).max()), "crashed": int(np.sum(ev.crashed))})
 
     state = random.getstate()
     random.seed(seed)
