@@ -50,8 +50,8 @@ KINDS = ("evolution", "model_learning", "test_runs")
 #: Experiments in report order (the shipped configs).
 ORDER = (
     "fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16", "ablation-plateau", "ablation-hybrid", "ablation-fghh",
-    "fig15-rules", "fig15-champion", "fig15-bandits", "fig15-uh-cma", "fig16-slp-zero", "lr-authors-table4", "lr-authors-fig8", "lr-substeps-table4",
-    "lr-substeps-fig8", "lr-noise-fig7", "lr-noise-fig11",
+    "fig15-rules", "fig15-champion", "fig15-bandits", "fig15-uh-cma", "topology-ghh08", "topology-fghh", "fig16-slp-zero", "lr-authors-table4",
+    "lr-authors-fig8", "lr-substeps-table4", "lr-substeps-fig8", "lr-noise-fig7", "lr-noise-fig11",
     "bench-sensors", "bench-sensors-fallback", "bench-sensor-models", "bench-drift", "bench-drift-armed", "wind-fig7", "wind-fig8", "wind-fig11", "risk-ghh09",
 )  # fmt: skip
 #: Bump when a unit function changes what it computes: stores written before are then refused.
