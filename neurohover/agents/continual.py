@@ -12,22 +12,7 @@ incremental agent does: it evolves on the newest model and flies the result, unt
 its prediction or ``max_learning_episodes`` episodes pass. It flies with the generic policy as
 the safeguard's fallback (``safeguard``).
 
-==========================  =======  ==================================================================
-setting                     default  meaning
-==========================  =======  ==================================================================
-window                      5        the most recent episodes a model is fitted on
-threshold                   2.0      re-learn once an episode's one-step error exceeds this x the model's own
-patience                    2        ... in this many consecutive episodes (a crash re-learns at once)
-max_learning_episodes       10       episodes of one learning phase, then the phase's best policy is kept
-safeguard                   True     fly with the generic policy as the safeguard's fallback
-cooldown                    0        after a phase, changes (and crashes) do not start another for this
-                                     many episodes, doubled after each phase in a row that ended without
-                                     meeting its prediction (0: re-learn at once; it bounds the model
-                                     evolutions of a run where every policy crashes)
-safeguard_after             0        control steps at the start of each episode before the safeguard's
-                                     test applies (0: from the first, the authors' test; a learned
-                                     policy's start-up correction can trip it in episodes it flies well)
-==========================  =======  ==================================================================
+The settings, their defaults and meaning: :class:`ContinualSettings` (``neurohover settings continual``).
 """
 
 from __future__ import annotations
@@ -51,7 +36,28 @@ from .spec import AgentOptions, AgentPolicies, AgentSettings, AgentSpec
 
 @dataclass(frozen=True)
 class ContinualSettings(AgentSettings):
-    """The continual agent's settings (the module docstring's table; a test-runs group's ``settings`` table)."""
+    """The continual agent's settings (a test-runs group's ``settings`` table).
+
+    Attributes
+    ----------
+    window : int
+        The most recent episodes a model is fitted on.
+    threshold : float
+        Re-learn once an episode's one-step error exceeds this times the model's own (> 1).
+    patience : int
+        ... in this many consecutive episodes (a crash re-learns at once).
+    max_learning_episodes : int
+        Episodes of one learning phase, then the phase's best policy is kept.
+    safeguard : bool
+        Fly with the generic policy as the safeguard's fallback.
+    cooldown : int
+        After a phase, changes (and crashes) do not start another for this many episodes, doubled after
+        each phase in a row that ended without meeting its prediction (0: re-learn at once; it bounds the
+        model evolutions of a run where every policy crashes).
+    safeguard_after : int
+        Control steps at the start of each episode before the safeguard's test applies (0: from the
+        first, the authors' test; a learned policy's start-up correction can trip it in episodes it flies well).
+    """
 
     window: int = 5
     threshold: float = 2.0

@@ -258,9 +258,14 @@ class IncrementalModelBasedAgent(Agent):
 
 @dataclass(frozen=True)
 class IncrementalSettings(AgentSettings):
-    """The incremental agents' own settings: ``max_learning_episodes``, the episode by which it
-    stops learning at the latest (a test-run unit's ``max_learning_episodes``, a setting of the
-    whole experiment)."""
+    """The incremental agents' own settings.
+
+    Attributes
+    ----------
+    max_learning_episodes : int
+        The episode by which it stops learning at the latest (a test-run unit's ``max_learning_episodes``,
+        a setting of the whole experiment).
+    """
 
     UNIT_KEY: ClassVar[str] = "max_learning_episodes"
 

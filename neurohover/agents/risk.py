@@ -41,11 +41,21 @@ CRITERIA = ("mean", "lcb", "worst")
 
 @dataclass(frozen=True)
 class RiskSettings(AgentSettings):
-    """How a risk-sensitive agent scores its candidates (module docstring)."""
+    """How a risk-sensitive agent scores its candidates (the module docstring's table).
+
+    Attributes
+    ----------
+    criterion : {"mean", "lcb", "worst"}
+        A candidate's score from its episode values.
+    level : float
+        lcb's standard errors below the mean (>= 0).
+    trials : int
+        model-free-risk only: episodes per specialised policy before it settles (the hybrids ignore it).
+    """
 
     criterion: str = "lcb"
     level: float = 1.0
-    trials: int = 2  # model-free-risk only: episodes per specialised policy before it settles (the hybrids ignore it)
+    trials: int = 2
 
     def __post_init__(self) -> None:
         if self.criterion not in CRITERIA:

@@ -406,8 +406,57 @@ def model_notes(model, data, truth, rows) -> list[str]:
     return notes
 
 
+def settings_classes() -> dict[str, type]:
+    """Every settings class a run or an agent takes, by the name ``neurohover settings NAME`` knows it: the
+    neuroevolution's two methods, each population optimiser, the authors' eonn, NEAT, and each agent's own."""
+    from ..agents.fghh_code import CodeAgentSettings
+    from ..agents.registry import AGENTS
+    from ..evolution.eonn import EonnSettings
+    from ..evolution.generational import GenerationalSettings
+    from ..evolution.optimisers import OPTIMISERS
+    from ..evolution.steady_state import SteadyStateSettings
+    from ..integrations.neat import NeatSettings
+
+    found: dict[str, type] = {"steady-state": SteadyStateSettings, "generational": GenerationalSettings}
+    found.update({name: spec.settings for name, spec in OPTIMISERS.items()})
+    found.update({"eonn": EonnSettings, "neat": NeatSettings, "authors-fghh": CodeAgentSettings})
+    for agent in AGENTS.values():  # one entry per class, by its name: IncrementalSettings -> incremental
+        if agent.settings is not None:
+            found[agent.settings.__name__.removesuffix("Settings").lower()] = agent.settings
+    return found
+
+
+def cmd_settings(args: argparse.Namespace) -> int:
+    """Print a settings class's table (name = default [type], then its help), or list the names."""
+    from ..settingsdoc import format_settings, summary
+
+    found = settings_classes()
+    if args.name is None:
+        width = max(map(len, found))
+        for name, cls in found.items():
+            print(f"{name:<{width}}  {summary(cls)}")
+        return 0
+    if args.name not in found:
+        raise NeurohoverError(f"no settings named {args.name!r}: allowed {', '.join(found)}")
+    print(format_settings(found[args.name], args.name))
+    return 0
+
+
+def _register_settings(sub) -> None:
+    p = sub.add_parser(
+        "settings",
+        help="list the settings of a method, an optimiser or an agent, with their defaults and meaning",
+        description="Every setting of a settings class (the evolution methods, the optimisers, NEAT, the agents): its default, "
+        "type and meaning, read from the class itself. Without NAME: the names.",
+    )
+    p.add_argument("name", nargs="?", help="steady-state, generational, an optimizer (cma, ...), eonn, neat or an agent's settings")
+    p.set_defaults(func=cmd_settings)
+
+
 def register(sub) -> None:
     from .options import add_lr_fit_options, add_task_options
+
+    _register_settings(sub)
 
     p = sub.add_parser(
         "evolve",
@@ -452,7 +501,7 @@ def register(sub) -> None:
         action="append",
         metavar="KEY=VALUE",
         help="one optimiser setting (repeatable), e.g. --setting fitness=return --setting elitist=true --setting pop_size=30; "
-        "the fields of SteadyStateSettings / GenerationalSettings, or sigma0, popsize for cma",
+        "`neurohover settings steady-state` (one MDP), `... generational` (over a family) or `... OPTIMIZER` lists them with their defaults",
     )
     p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")
     p.add_argument("--seed", type=int, default=0, help="root seed of the run (default 0)")

@@ -46,7 +46,25 @@ __all__ = ["EonnResult", "EonnSettings", "eonn_evolve"]
 
 @dataclass(frozen=True)
 class EonnSettings:
-    """The authors' ``functions.evolve`` settings (defaults: as their GHH-09 agents called it)."""
+    """The authors' ``functions.evolve`` settings (defaults: as their GHH-09 agents called it).
+
+    Attributes
+    ----------
+    pop_size : int
+        Population size.
+    keep : int
+        Genomes kept each generation (the rest replaced by offspring; ``keep < pop_size``).
+    generations : int
+        Generations to run.
+    tournament_size : int
+        Genomes per tournament that picks a parent.
+    mutate_prob, mutate_frac, mutate_std, mutate_repl, averaging_prob
+        As :class:`~neurohover.evolution.steady_state.SteadyStateSettings`'s: the chance an offspring is mutated,
+        each gene's chance, the Gaussian's spread, a mutated gene's chance of being replaced; crossover's
+        per-gene chance of averaging.
+    spawn_frac, spawn_std : float
+        The mutation of the prototype's copies in the initial population (gene chance, spread).
+    """
 
     pop_size: int = 50
     keep: int = 49

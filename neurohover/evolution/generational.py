@@ -52,8 +52,18 @@ class GenerationalSettings:
         Parents selected per generation, mu (``1 <= select_size <= pop_size``).
     generations : int
         Number of generations to run (>= 1).
-    crossover_prob, averaging_prob, mutate_prob, mutate_frac, mutate_std, mutate_repl
-        As in :class:`SteadyStateSettings` (``crossover_prob`` is 1 in the paper).
+    crossover_prob : float
+        Probability that an offspring is made by crossover, else a mutated copy (1 in the paper).
+    averaging_prob : float
+        Per-gene probability that crossover averages the parents.
+    mutate_prob : float
+        Probability that a crossover child is then mutated.
+    mutate_frac : float
+        Per-gene mutation probability.
+    mutate_std : float
+        Standard deviation of the Gaussian mutation (finite, >= 0).
+    mutate_repl : float
+        Probability that a mutated gene is replaced rather than shifted.
     budget : int or None
         Optional cap on the total number of episodes (>= 1); not in the paper.
     elitist : bool

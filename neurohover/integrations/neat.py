@@ -70,15 +70,40 @@ N_INPUTS = len(INPUTS)
 class NeatSettings:
     """The NEAT run's settings (neat-python's config keys of the same meaning; the rest are its usual defaults).
 
-    ``initial``: the starting topology, ``"full_direct"`` (every input to every output, an SLP) or
-    ``"unconnected"``; ``activations``: those a new node may take (the first is the default).
-    ``start``: ``"random"`` (neat-python's initial genomes) or ``"baseline"``: every initial genome the
-    baseline policy (the SLP's gains and biases on the direct connections, identity outputs), as the
-    paper seeds its SLP and MLP; it needs ``initial = "full_direct"`` and ``"identity"`` among the activations.
+    Attributes
+    ----------
+    pop_size : int
+        Genomes per generation (>= 4).
+    episodes : int
+        Episodes each genome flies a generation.
+    initial : {"full_direct", "unconnected"}
+        The starting topology: every input to every output (an SLP), or none.
+    activations : tuple of str
+        Those a new node may take (the first is the default), of :data:`ACTIVATIONS`.
+    node_add_prob, conn_add_prob, node_delete_prob, conn_delete_prob : float
+        The chances of the structural mutations, per genome and generation.
+    weight_mutate_power, bias_mutate_power : float
+        The spread of a weight's or a bias's perturbation.
+    weight_mutate_rate : float
+        The chance that each weight is perturbed in a mutation.
+    activation_mutate_rate : float
+        The chance that a node's activation is redrawn.
+    replace_rate : float
+        The chance that a weight or bias is drawn afresh from its initial spread instead of perturbed.
+    compatibility_threshold : float
+        The genome distance that separates species.
+    weight_init_stdev, bias_init_stdev : float
+        The initial spread of weights and biases (0: every genome starts as the zero network, as NE's zero prototype).
+    start : {"random", "baseline"}
+        neat-python's initial genomes, or every initial genome the baseline policy (the SLP's gains and
+        biases on the direct connections, identity outputs), as the paper seeds its SLP and MLP; it needs
+        ``initial = "full_direct"`` and ``"identity"`` among the activations.
+    fitness : {"return", "inv-log-error"}
+        A genome's fitness: its mean return, or its episodes' mean 1/ln(error) (FGHH's scale).
     """
 
     pop_size: int = 150
-    episodes: int = 1  # per genome and generation
+    episodes: int = 1
     initial: str = "full_direct"
     activations: tuple[str, ...] = ("tanh", "sigmoid", "identity")
     node_add_prob: float = 0.2
@@ -86,15 +111,15 @@ class NeatSettings:
     node_delete_prob: float = 0.1
     conn_delete_prob: float = 0.2
     weight_mutate_power: float = 0.5
-    weight_mutate_rate: float = 0.8  # the chance that each weight is perturbed in a mutation
+    weight_mutate_rate: float = 0.8
     bias_mutate_power: float = 0.2
     activation_mutate_rate: float = 0.1
-    replace_rate: float = 0.1  # a weight or bias drawn afresh from its initial spread instead of perturbed
+    replace_rate: float = 0.1
     compatibility_threshold: float = 3.0
-    weight_init_stdev: float = 0.5  # 0: every genome starts as the zero network, as NE's zero prototype
+    weight_init_stdev: float = 0.5
     bias_init_stdev: float = 0.5
     start: str = "random"
-    fitness: str = "return"  # a genome's fitness: its mean return, or its episodes' mean 1/ln(error) (FGHH's scale)
+    fitness: str = "return"
 
     @classmethod
     def of(cls, table: Mapping[str, Any]) -> NeatSettings:

@@ -207,8 +207,15 @@ class CMAES(PopulationOptimiser):
 
 @dataclass(frozen=True)
 class CMASettings:
-    """CMA-ES settings: the initial step size (:data:`SIGMA0`, why 0.02)
-    and the population (None: pycma's 4 + 3 ln D)."""
+    """CMA-ES settings.
+
+    Attributes
+    ----------
+    sigma0 : float
+        The initial step size (> 0; 0.02: :data:`SIGMA0` says why).
+    popsize : int or None
+        Genomes per generation (>= 2; None: pycma's 4 + 3 ln D).
+    """
 
     sigma0: float = SIGMA0
     popsize: int | None = None

@@ -52,11 +52,26 @@ class OpenAIESSettings:
     :class:`~neurohover.evolution.optimisers.cma.CMASettings`) a 600-episode run on GHH-08
     train:1 (300-step episodes, seed 3) kept a champion that crashed 94 of 100 fresh episodes,
     at 0.01 none. ``learning_rate`` 0.01, Adam's betas and the L2 coefficient 0.005 are the paper's.
+
+    Attributes
+    ----------
+    popsize : int
+        Genomes per generation (even: antithetic pairs).
+    sigma : float
+        The spread of the perturbations (> 0).
+    learning_rate : float
+        Adam's step size (> 0).
+    beta1, beta2 : float
+        Adam's decay rates, in [0, 1).
+    epsilon : float
+        Adam's denominator offset (> 0).
+    l2 : float
+        The weight decay of the mean (>= 0).
     """
 
-    popsize: int = 20  # genomes per generation (even: antithetic pairs)
-    sigma: float = 0.01  # spread of the perturbations
-    learning_rate: float = 0.01  # Adam's step size
+    popsize: int = 20
+    sigma: float = 0.01
+    learning_rate: float = 0.01
     beta1: float = 0.9
     beta2: float = 0.999
     epsilon: float = 1e-8

@@ -41,9 +41,17 @@ __all__ = ["UHCMAES", "UHCMASettings"]
 @dataclass(frozen=True)
 class UHCMASettings(CMASettings):
     """Settings of uncertainty-handling CMA-ES: CMA-ES's (``sigma0``, ``popsize``: :class:`CMASettings`, which checks
-    them) and the noise handler's: evaluations per solution between ``min_evaluations`` and ``max_evaluations``
-    (starting at the minimum), ``reevaluations`` solutions re-evaluated a generation (None: pycma's
-    ``2 + popsize / 20``) and the perturbation ``epsilon`` of a re-evaluated point (pycma's 1e-7)."""
+    them) and the noise handler's.
+
+    Attributes
+    ----------
+    min_evaluations, max_evaluations : int
+        Evaluations (episodes) per solution, between these (it starts at the minimum).
+    reevaluations : int or None
+        Solutions re-evaluated a generation (None: pycma's ``2 + popsize / 20``).
+    epsilon : float
+        The perturbation of a re-evaluated point (pycma's 1e-7).
+    """
 
     min_evaluations: int = 1
     max_evaluations: int = 20
