@@ -44,6 +44,8 @@ ABLATIONS = [
     "fig15-champion",
     "fig15-bandits",
     "fig15-uh-cma",
+    "topology-ghh08",
+    "topology-fghh",
     "fig16-slp-zero",
     "lr-authors-table4",
     "lr-authors-fig8",

@@ -1,6 +1,7 @@
 """The schema of experiment configs: each kind's settings, their defaults and checks (:mod:`.config`).
 
-``SCHEMAS[kind]`` maps each setting to ``(default, check)``: the default is ``REQUIRED`` (the config
+``SCHEMAS[kind]`` maps each setting to ``(absent, check)``, read from the kind's typed settings class
+(:mod:`.settings`; :func:`~.checks.setting` declares each field): ``absent`` is ``REQUIRED`` (the config
 must give it), ``OMIT`` (a setting added later, absent from the resolved config unless given, so that
 older configs keep their hash) or a value; the check returns ``(ok, what is allowed)``; a
 ``("list", SUB_SCHEMA)`` pair is a list of sub-tables (``[[variants]]``, ``[[groups]]``).
@@ -11,291 +12,30 @@ from __future__ import annotations
 
 import json
 import re
-from dataclasses import fields
 from typing import Any
 
 from ..agents.hybrid import HybridSettings
-from ..agents.model_based import MODEL_POLICIES
 from ..agents.registry import AGENTS, HYBRID_AGENTS
 from ..errors import NeurohoverError
 from ..evolution.config import make_settings, optimiser_of
 from ..evolution.evolve import parse_resampling
 from ..evolution.optimisers import OPTIMISERS
-from ..evolution.races import RACE_RULES
 from ..integrations.neat import NEAT_TOPOLOGY
-from ..models.lr import D_U_CHOICES, DEFAULT_NOISE_ESTIMATE, NOISE_ESTIMATES
-from ..models.model import MODEL_SUBSTEPS, default_model_substeps
-from ..policysets import FGHH_GENERIC_RESAMPLING
-from ..tasks import TASK_FAMILIES, TASK_NAMES, Drift, Sensor
+from ..models.lr import DEFAULT_NOISE_ESTIMATE
+from ..models.model import default_model_substeps
+from ..tasks import TASK_FAMILIES
+from .checks import OMIT, REQUIRED, resampling, schema_of
+from .settings import KIND_SETTINGS
 
 #: A ``generics_from`` source that names a directory of policy files (``.net`` or ``.json``) instead of an experiment.
 DIR_SOURCE = "dir:"
 
-REQUIRED = object()
 #: The group of the robustness units that fly a policy set's specialised policies (``robustness_policies``).
 POLICY_SET_GROUP = "policy-set"
-OMIT = object()  # default of a setting added later: absent from the resolved config unless given (older configs keep their hash)
 
-
-def _int(minimum: int):
-    def check(v):
-        return isinstance(v, int) and not isinstance(v, bool) and v >= minimum, f"an integer >= {minimum}"
-
-    return check
-
-
-def _float(lo: float, hi: float):
-    def check(v):
-        return isinstance(v, (int, float)) and not isinstance(v, bool) and lo <= v <= hi, f"a number in [{lo:g}, {hi:g}]"
-
-    return check
-
-
-def _choice(*allowed: str):
-    def check(v):
-        return v in allowed, "one of " + ", ".join(repr(a) for a in allowed)
-
-    return check
-
-
-def _agent():
-    def check(v):
-        return v in AGENTS, "one of " + ", ".join(repr(a) for a in AGENTS)
-
-    return check
-
-
-def _str():
-    def check(v):
-        return isinstance(v, str) and v != "", "a non-empty string"
-
-    return check
-
-
-def _bool():
-    def check(v):
-        return isinstance(v, bool), "true or false"
-
-    return check
-
-
-def _table():
-    def check(v):
-        return isinstance(v, dict), "a table"
-
-    return check
-
-
-def _str_list(*allowed: str):
-    def check(v):
-        ok = isinstance(v, list) and len(v) > 0 and all(isinstance(x, str) for x in v)
-        if ok and allowed:
-            ok = all(x in allowed for x in v)
-        return ok, "a non-empty list of " + ("strings" if not allowed else "names from " + ", ".join(allowed))
-
-    return check
-
-
-def _resampling():
-    def check(v):
-        if not isinstance(v, str):
-            return False, "a string fixed:K or race:DELTA"
-
-        try:
-            parse_resampling(v)
-        except NeurohoverError:
-            return False, "fixed:K (K >= 1) or race:DELTA[:RULE] (0 < DELTA < 1, RULE " + ", ".join(RACE_RULES) + ")"
-        return True, ""
-
-    return check
-
-
-def _settings_table(cls, keys: str):
-    """A table that ``cls.from_dict`` reads (a Sensor's or a Drift's), checked by it; ``keys`` names its settings."""
-
-    def check(v):
-        if not isinstance(v, dict):
-            return False, f"a table of {cls.__name__.lower()} settings ({keys})"
-        try:
-            cls.from_dict(v)
-        except NeurohoverError as exc:
-            return False, f"a valid {cls.__name__.lower()} ({exc})"
-        return True, ""
-
-    return check
-
-
-def _sensor_table():
-    return _settings_table(Sensor, ", ".join(["level", *(f.name for f in fields(Sensor))]))
-
-
-def _drift_table():
-    return _settings_table(Drift, ", ".join(f.name for f in fields(Drift) if f.init))
-
-
-def _seeds_of(names: tuple[str, ...] = ("experiment", "group")):
-    def check(v):
-        ok = (
-            isinstance(v, dict)
-            and set(v) == {*names, "seed"}
-            and all(isinstance(v[k], str) and v[k] != "" for k in names)
-            and isinstance(v["seed"], int)
-            and not isinstance(v["seed"], bool)
-            and 0 <= v["seed"] <= 2**63 - 1
-        )
-        fields = ", ".join(["experiment = NAME", "seed = ITS ROOT SEED", *(["group = ITS GROUP'S LABEL"] if "group" in names else [])])
-        return ok, "a table {" + fields + "}"
-
-    return check
-
-
-def _substeps():
-    return lambda v: (v in MODEL_SUBSTEPS and not isinstance(v, bool), " or ".join(map(str, MODEL_SUBSTEPS)))
-
-
-def _policy_source():
-    def check(v):
-        return isinstance(v, str) and v != "", "'evolve', 'shipped' or a directory holding <task>/ policy sets"
-
-    return check
-
-
-# key -> (default or REQUIRED, check)
-_COMMON: dict[str, tuple[Any, Any]] = {
-    "task": (REQUIRED, _choice(*TASK_NAMES)),
-    "sigma": (None, _float(0.0, 1.0)),
-    "seed": (REQUIRED, lambda v: (isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= 2**63 - 1, "an integer in 0..2**63-1")),
-    "n_steps": (6000, _int(1)),
-    "sensor": (OMIT, _sensor_table()),  # every MDP of the experiment seen through these sensors (docs/benchmarks.md)
-}
-
-_VARIANT = {
-    "key": (REQUIRED, _str()),
-    "label": (REQUIRED, _str()),
-    "topology": ("mlp", _choice("slp", "mlp", NEAT_TOPOLOGY)),
-    "prototype": ("baseline", _choice("zero", "baseline")),
-    # topology "neat": NEAT's settings (neurohover.integrations.neat.NeatSettings' fields; its start replaces the prototype)
-    "neat": (OMIT, _table()),
-    "resampling": ("fixed:1", _resampling()),
-    "sigma": (None, _float(0.0, 1.0)),
-    "optimizer": (OMIT, _table()),  # this variant's optimizer settings, over the experiment's `optimizer`
-    # with the experiment's seeds_of: the variant of that experiment whose runs' seeds this one's take (absent: its own key)
-    "paired_with": (OMIT, _str()),
-}
-
-_GROUP = {
-    "agent": (REQUIRED, _agent()),
-    "label": (None, _str()),
-    "mdps": ("test", _choice("train", "test", "sample")),
-    "n_mdps": (REQUIRED, _int(1)),
-    "runs_per_mdp": (1, _int(1)),
-    "exclude_own": (False, _bool()),
-    # an agent's own typed settings (its spec's settings class); a hybrid agent's (replacement, model_from, rule,
-    # box, tilt: HybridSettings) are resolved under `hybrid`, their older name (either spelling is read)
-    "settings": (OMIT, _table()),
-    "hybrid": ({}, _table()),
-    "estimator": ("ols", _choice("ols", "gls")),  # least squares of the LR models an agent learns
-    "wind_model": (OMIT, _choice("none", "constant", "sinusoid")),  # and their wind (neurohover.models.wind; absent: none)
-    # LR as the authors fitted it, each choice apart (absent: ours; neurohover.agents.model_based.ModelEvolution);
-    # noise is written into the resolved config of every group whose agents learn models (check_kind)
-    "d_u": (OMIT, _choice(*D_U_CHOICES)),
-    "noise": (OMIT, _choice(*NOISE_ESTIMATES)),
-    "model_policy": (OMIT, _choice(*MODEL_POLICIES)),
-    "model_substeps": (OMIT, _substeps()),  # written in by check_kind for the agents that learn models (the task's default)
-    "sensor": (OMIT, _sensor_table()),  # this group's agents fly the group's MDPs through these sensors
-    "drift": (OMIT, _drift_table()),  # and with these drifting dynamics (neurohover.tasks.drift)
-    # run i of MDP m takes the seed of that run of another experiment's group: the same gusts and draws (paired)
-    "seeds_of": (OMIT, _seeds_of()),
-}
-
-# One sensor condition of a model-learning experiment: its models learn from flight data seen through
-# these sensors, and are checked against exact ones (docs/benchmarks.md, learned models under sensor noise).
-_CONDITION = {
-    "key": (REQUIRED, _str()),
-    "label": (None, _str()),
-    "sensor": (OMIT, _sensor_table()),  # absent: exact sensors
-    "data_episodes": (1, _int(1)),  # episodes of the generic policy's flight data each model learns from
-}
-
-# One way of fitting LR and evolving a policy on the model (the LR methods' units of each fit; docs/model.md)
-_FIT = {
-    "key": (REQUIRED, _str()),
-    "label": (None, _str()),
-    "d_u": ("keep", _choice(*D_U_CHOICES)),
-    "noise": (DEFAULT_NOISE_ESTIMATE, _choice(*NOISE_ESTIMATES)),
-    "model_policy": ("ours", _choice(*MODEL_POLICIES)),
-    # written in by check_kind: the task's default (ten for GHH; an absent one in a stored config was 1)
-    "model_substeps": (OMIT, _substeps()),
-}
-
-SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {
-    "evolution": {
-        **_COMMON,
-        "target": (REQUIRED, _choice("train", "zero", "family")),
-        "n_mdps": (10, _int(1)),
-        "runs": (REQUIRED, _int(1)),
-        "budget": (0, _int(0)),
-        "optimizer": ({}, _table()),
-        "validation_episodes": (0, _int(0)),
-        # "fresh": each champion on fresh draws (of its MDP, or from G) of its own seed; "test": every
-        # champion on the family's test MDPs with the same noise (paired comparisons)
-        "validation_mdps": (OMIT, _choice("fresh", "test")),
-        # the champion chosen again: the last generation's parents each flown this many fresh episodes (generational runs)
-        "champion_reevaluation": (OMIT, _int(1)),
-        "history_points": (300, _int(2)),
-        "robustness_variants": ([], lambda v: (isinstance(v, list) and all(isinstance(x, str) for x in v), "a list of variant keys")),
-        "robustness_episodes": (10, _int(1)),
-        # Table 3 also for a policy set's specialised policies ("shipped" or a directory of <task>/ sets): the ones
-        # Table 4 and Figures 7, 8 and 11 fly, flown as the best champions are
-        "robustness_policies": (OMIT, _policy_source()),
-        # run r of each variant takes the seed of run r of another experiment's variant (paired_with), and the
-        # champions are validated on that experiment's test episodes: paired comparisons across experiments
-        "seeds_of": (OMIT, _seeds_of(("experiment",))),
-        "variants": (REQUIRED, ("list", _VARIANT)),
-    },
-    "model_learning": {
-        **_COMMON,
-        "mdps": ("test", _choice("train", "test", "sample")),
-        "n_mdps": (REQUIRED, _int(1)),
-        "methods": (["ec-mer", "ec-meno", "lr"], _str_list("ec-mer", "ec-meno", "lr", "lr-gls")),
-        "generic": ("evolve", _policy_source()),
-        "generic_budget": (0, _int(0)),
-        "model_budget": (2000, _int(1)),  # EC-MER evaluations
-        "ec_meno_budget": (0, _int(0)),  # EC-MENO evaluations; 0: the plateau stop
-        "ec_mer_episodes": (1, _int(1)),
-        "policy_budget": (0, _int(0)),
-        "policy_prototype": ("generic", _choice("generic", "baseline")),
-        "test_episodes": (5, _int(1)),
-        "conditions": (OMIT, ("list", _CONDITION)),  # sensor conditions, each its own models of every MDP
-        "fits": (OMIT, ("list", _FIT)),  # LR fits, each its own LR models of every MDP (paired with the others)
-        "authors_generations": (OMIT, _int(1)),  # the authors' eonn generations (absent: 500, theirs)
-        # the LR methods' gust-noise estimate, where no fits give it (written in by check_kind when they learn LR)
-        "noise": (OMIT, _choice(*NOISE_ESTIMATES)),
-        # and the substeps their policies evolve on the models in (written in likewise: the task's default)
-        "model_substeps": (OMIT, _substeps()),
-    },
-    "test_runs": {
-        **_COMMON,
-        "episodes": (REQUIRED, _int(1)),
-        "policies": ("evolve", _policy_source()),
-        "policy_budget": (0, _int(0)),
-        "generic_budget": (0, _int(0)),
-        "generic_resampling": (dict(FGHH_GENERIC_RESAMPLING), _table()),
-        "generics_per_agent": (1, _int(1)),
-        # the topology of the FGHH generics the experiment evolves itself (absent: MLP; the authors' were SLPs)
-        "generic_topology": (OMIT, _choice("slp", "mlp")),
-        # kind -> "EXPERIMENT/VARIANT" (or "EXPERIMENT/best-race"): each run's generic drawn from the
-        # final champions of another experiment's evolution runs, in the same store and scale
-        "generics_from": (OMIT, _table()),
-        "safety_episodes": (3, _int(1)),
-        "model_budget": (2000, _int(1)),
-        "predict_episodes": (5, _int(1)),
-        "max_learning_episodes": (25, _int(1)),
-        "authors_generations": (OMIT, _int(1)),  # the authors' eonn generations on a model (absent: 500, theirs)
-        "drift": (OMIT, _drift_table()),  # every test run's MDP drifts so (neurohover.tasks.drift)
-        "groups": (REQUIRED, ("list", _GROUP)),
-    },
-}
+#: Each kind's schema, ``{setting: (absent, check)}``, built from its typed settings class (:mod:`.settings`, the one
+#: place a setting is declared).
+SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {kind: schema_of(cls) for kind, cls in KIND_SETTINGS.items()}
 
 
 def validate_table(values: dict, schema: dict, where: str) -> dict:
@@ -502,7 +242,7 @@ def _check_test_runs(settings: dict, task: str, where: str) -> None:
     if "generic_topology" in settings and (settings["policies"] != "evolve" or not TASK_FAMILIES[task].generic_over_distribution):
         raise NeurohoverError(f"{where}: generic_topology applies to the FGHH generics an experiment evolves itself (policies = 'evolve', task fghh)")
     gr = settings["generic_resampling"]
-    if set(gr) - {"fixed", "race"} or not all(_resampling()(v)[0] for v in gr.values()):
+    if set(gr) - {"fixed", "race"} or not all(resampling()(v)[0] for v in gr.values()):
         raise NeurohoverError(f"{where}: generic_resampling must be a table with keys fixed and/or race holding fixed:K / race:DELTA")
 
 
