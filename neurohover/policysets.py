@@ -212,12 +212,17 @@ def _evolve_one(
     return policy
 
 
+#: Episodes per steady-state evolution of a policy set, and per FGHH generic's evolution over G (build_policy_set's
+#: defaults; the command line's too).
+POLICY_BUDGET, FGHH_POLICY_BUDGET = 40000, 200000
+
+
 def build_policy_set(
     task: str,
     out: str | Path | None = None,
     *,
-    budget: int = 40000,
-    fghh_budget: int = 200000,
+    budget: int = POLICY_BUDGET,
+    fghh_budget: int = FGHH_POLICY_BUDGET,
     seed: int = 0,
     safety_episodes: int = 3,
     n_steps: int = 6000,

@@ -56,5 +56,7 @@ def test_a_checkpoint_of_the_code_before_the_move_continues_as_it_would_have() -
     for _ in range(2):
         x = opt.ask()
         opt.tell(_sphere(x))
-    assert opt.champion_return == OLD_RESULT["champion_return"]
-    assert opt.mean.tolist() == OLD_RESULT["mean"]
+    # To rounding, not bit for bit: the same code reads a last bit apart with another NumPy build or CPU (numpy 2.4.6
+    # here on 2026-12-04: -3.025902046773853 against the recorded -3.0259020467738487); a lost or altered state would not.
+    np.testing.assert_allclose(opt.champion_return, OLD_RESULT["champion_return"], rtol=1e-12, atol=0)
+    np.testing.assert_allclose(opt.mean, OLD_RESULT["mean"], rtol=1e-12, atol=0)

@@ -135,13 +135,14 @@ def register(sub) -> None:
     from ..agents.model_based import MODEL_POLICIES
     from ..agents.registry import AGENTS
     from ..evolution.optimisers import optimiser_names
+    from ..policysets import FGHH_POLICY_BUDGET, POLICY_BUDGET
     from .options import add_lr_fit_options, add_sensor_options, add_sigma_option, add_task_option
 
     p = sub.add_parser("build-policies", help="evolve the generic and specialised policies of a task", description=cmd_build_policies.__doc__)
     add_task_option(p)
     p.add_argument("--out", help="directory to write <task>/ into (default: the package's shipped policies)")
-    p.add_argument("--budget", type=int, default=40000, help="episodes per steady-state evolution (default 40000)")
-    p.add_argument("--fghh-budget", type=int, help="fghh only: episodes per generic-policy evolution over G (default 200000)")
+    p.add_argument("--budget", type=int, default=POLICY_BUDGET, help=f"episodes per steady-state evolution (default {POLICY_BUDGET})")
+    p.add_argument("--fghh-budget", type=int, help=f"fghh only: episodes per generic-policy evolution over G (default {FGHH_POLICY_BUDGET})")
     p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument(
