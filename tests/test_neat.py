@@ -180,3 +180,40 @@ def test_a_neat_run_over_the_family_must_be_validated_on_its_test_mdps(tmp_path:
     )
     with pytest.raises(NeurohoverError, match="validation_mdps = 'test'"):
         load_config(str(path), "quick")
+
+
+def test_the_report_pairs_each_neat_run_with_the_mlp_run_of_its_seed(tmp_path: Path) -> None:
+    """A NEAT variant paired with an NE variant of the same experiment: the section's paired block tests the run pairs
+    (same MDP, seed and validation episodes) by Wilcoxon, with the p-value scipy gives on the stored returns."""
+    from scipy import stats
+
+    from neurohover.experiments.executors import make_executor
+    from neurohover.experiments.report import write_report
+    from neurohover.experiments.runner import reproduce
+    from neurohover.experiments.store import Store
+
+    path = tmp_path / "pair.toml"
+    path.write_text(
+        'name = "pair"\ntitle = "pair"\nkind = "evolution"\n[settings]\ntask = "ghh08"\nseed = 3\ntarget = "train"\nvalidation_episodes = 2\n'
+        'seeds_of = { experiment = "pair", seed = 3 }\n'  # its own runs' seeds: the NEAT run r on MDP i takes the MLP run's
+        '[[settings.variants]]\nkey = "mlp"\nlabel = "MLP"\ntopology = "mlp"\n'
+        '[[settings.variants]]\nkey = "net"\nlabel = "NEAT"\ntopology = "neat"\npaired_with = "mlp"\n'
+        'neat = { pop_size = 4, start = "baseline", activations = ["identity", "tanh"], weight_mutate_power = 0.02 }\n'
+        "[scales.quick]\nn_mdps = 2\nruns = 2\nbudget = 8\nn_steps = 40\n[scales.paper]\nruns = 1\n"
+    )
+    with Store(tmp_path / "s.sqlite") as store:
+        executor = make_executor("local", jobs=1)
+        try:
+            reproduce(load_config(str(path), "quick"), store, executor, progress=False)
+        finally:
+            executor.close()
+        results = {u["key"]: u["result"] for u in store.units("pair", "quick")}
+        write_report(store, tmp_path / "out", scale="quick", names=["pair"])
+    report = (tmp_path / "out" / "report.md").read_text()
+    pairs = [(f"train{i}", f"run{r}") for i in range(2) for r in range(2)]
+    diff = [np.mean(results[f"evolve/net/{m}/{r}"]["validation"]) - np.mean(results[f"evolve/mlp/{m}/{r}"]["validation"]) for m, r in pairs]
+    block = report[report.index("### Paired runs") :]
+    row = next(line for line in block.splitlines() if line.startswith("| NEAT | MLP |"))
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    assert cells[2] == "4" and cells[5] == f"{sum(d > 0 for d in diff)} of 4"
+    assert float(cells[7]) == pytest.approx(stats.wilcoxon(diff).pvalue if any(diff) else 1.0, rel=1e-3)

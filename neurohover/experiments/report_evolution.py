@@ -350,9 +350,50 @@ class EvolutionSection(Section):
             order = sorted(samples, key=lambda k: -np.mean(samples[k]))
             self.comparisons.append("Ranking by " + what + " (best first): ours " + " > ".join(labels[k] for k in order) + ".")
         self.add_tests(samples, labels, what)
+        parts.append(self._paired_within())
         if self.s.robustness_variants:
             parts.append(self.table3())
         return "\n".join(parts)
+
+    def _paired_within(self) -> str:
+        """Variants paired with another variant of this experiment (``paired_with``: the same seeds, MDPs and validation
+        episodes run by run), compared pair by pair on the mean validation return (Wilcoxon signed-rank)."""
+        keys = {v.key for v in self.variants()}
+        rows = []
+        for v in self.variants():
+            other = v.paired_with
+            if other is None or other == v.key or other not in keys:
+                continue
+
+            def finals(vkey: str) -> dict[tuple, float]:
+                picked = [(k, self.keys[k]) for k in self.results if self.keys[k].stage == "evolve" and self.keys[k].group == vkey]
+                return {(key.mdp, key.rep): self.results[k].final_score for k, key in picked if self.results[k].validation is not None}
+
+            mine, theirs = finals(v.key), finals(other)
+            common = sorted(set(mine) & set(theirs), key=str)
+            if len(common) < 2:
+                continue
+            diff = np.array([mine[c] - theirs[c] for c in common])
+            p = paired_p(diff)
+            label = next(x.label for x in self.variants() if x.key == other)
+            a, b = float(np.mean([mine[c] for c in common])), float(np.mean([theirs[c] for c in common]))
+            rows.append([v.label, label, str(len(common)), fmt(a), fmt(b), f"{int(np.sum(diff > 0))} of {len(common)}", fmt(float(np.median(diff))), fmt(p)])
+            word = "better" if a > b else "worse" if a < b else "equal"
+            self.comparisons.append(
+                f"{v.label} against {label}, run by run on the same seeds and validation episodes: mean validation return {fmt(a)} vs "
+                f"{fmt(b)} ({word} on average), better in {int(np.sum(diff > 0))} of {len(common)} pairs, Wilcoxon p = {fmt(p)}"
+                + (" (significant at 5%)." if p < 0.05 else " (not significant).")
+            )
+        if not rows:
+            return ""
+        header = ["setting", "paired with", "run pairs", "mean validation return", "its pair's", "runs better", "median difference", "Wilcoxon p"]
+        return (
+            "\n### Paired runs\n\n"
+            + table(header, rows)
+            + "\n\nRun r on MDP i of each setting took the seed of run r on MDP i of the setting it is paired with, and its champion "
+            "flew the same validation episodes (MDP and gusts): each pair differs by the setting alone. Wilcoxon signed-rank test "
+            "on the pairs' mean validation returns.\n"
+        )
 
     def table3(self) -> str:
         rows = []
