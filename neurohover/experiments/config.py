@@ -312,10 +312,20 @@ def load_configs(name: str, scale: str, overrides: dict[str, Any] | None = None)
     return [load_config(name, scale, overrides)]
 
 
-def with_shipped_paper(cfg: ExperimentConfig) -> ExperimentConfig:
-    """A stored config with the shipped config's ``[paper]`` table (the paper's numbers, claims and our protocol notes:
-    documentation, outside the hash), so a corrected note reaches the report without running anything again."""
+#: Settings that say where an experiment's policies come from; a paper-scale run may have set them on the
+#: command line (`--set policies=shipped`), and an --update that forgets them would run every unit again.
+POLICY_SOURCES = ("policies", "generic")
+
+
+def shipped_counterpart(cfg: ExperimentConfig) -> ExperimentConfig | None:
+    """The shipped config of a stored config's experiment, with the stored policy source (:data:`POLICY_SOURCES`; None:
+    no shipped config of that name): what a ``reproduce`` of it would run now."""
     if cfg.name not in shipped_configs():
-        return cfg
-    shipped = load_config(cfg.name, cfg.scale)
-    return replace(cfg, paper=shipped.paper, paper_ref=shipped.paper_ref)
+        return None
+    return load_config(cfg.name, cfg.scale, {k: cfg.settings[k] for k in POLICY_SOURCES if k in cfg.settings})
+
+
+def with_shipped_paper(cfg: ExperimentConfig, shipped: ExperimentConfig | None) -> ExperimentConfig:
+    """A stored config with its shipped counterpart's ``[paper]`` table (the paper's numbers, claims and our protocol
+    notes: documentation, outside the hash), so a corrected note reaches the report without running anything again."""
+    return cfg if shipped is None else replace(cfg, paper=shipped.paper, paper_ref=shipped.paper_ref)

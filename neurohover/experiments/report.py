@@ -22,13 +22,13 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import NeurohoverError
-from .config import ORDER, ExperimentConfig, with_shipped_paper
+from .config import ORDER, ExperimentConfig, shipped_counterpart, with_shipped_paper
 from .keys import UnitKey
 from .report_base import Section, agent_panel, fmt, log_errors, new_figure, paired_p, ratio_verdict, sd, table
 from .report_evolution import EvolutionSection
 from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, test_run_figure, varies
 from .report_models import SensorModels
-from .report_readme import Status, fill_generated, is_current, linked_claims, status_table
+from .report_readme import Status, fill_generated, linked_claims, status_table
 from .results import ModelResult, TestRunResult, result_from_dict
 from .settings import Group, ModelLearningSettings
 from .store import Store
@@ -432,7 +432,9 @@ def _header(cfg: ExperimentConfig, store: Store, units: list[dict], total: int |
     )
 
 
-def _section(cfg: ExperimentConfig, store: Store, out: Path) -> tuple[str, list[dict[str, str]], Status]:
+def _section(cfg: ExperimentConfig, store: Store, out: Path, current: bool | None) -> tuple[str, list[dict[str, str]], Status]:
+    """The section of one stored experiment (``current``: whether its shipped config still hashes as stored, for the
+    status table; None: not a shipped config, or not paper scale)."""
     from .plans import plan
 
     units = store.units(cfg.name, cfg.scale)
@@ -467,7 +469,6 @@ def _section(cfg: ExperimentConfig, store: Store, out: Path) -> tuple[str, list[
     text.append("### Discussion\n\n" + _discussion(cfg, out) + "\n")
     sessions = store.sessions(cfg.name, cfg.scale)
     wall, unit_time, cores = sum(s["wall_seconds"] for s in sessions), sum(u["seconds"] for u in units), tuple(sorted({s["cores"] for s in sessions}))
-    current = is_current(cfg) if cfg.scale == "paper" else None  # the status table lists paper scale only
     status = Status(cfg.name, cfg.title, cfg.scale, len(units), total, wall, unit_time, cores, current=current)
     return "\n".join(text), sec.claims, status
 
@@ -515,8 +516,11 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
 
     for name, sc in tqdm(entries, desc="report", unit="experiment", file=sys.stderr, disable=None, dynamic_ncols=True):  # a terminal only
         try:
-            cfg = with_shipped_paper(ExperimentConfig.from_dict(store.config(name, sc)))
-            text, checked, status = _section(cfg, store, out)
+            stored = ExperimentConfig.from_dict(store.config(name, sc))
+            shipped = shipped_counterpart(stored)  # loaded once: its [paper] table, and whether it still hashes as stored
+            current = (None if shipped is None else shipped.hash == stored.hash) if sc == "paper" else None  # the status table: paper scale
+            cfg = with_shipped_paper(stored, shipped)
+            text, checked, status = _section(cfg, store, out, current)
         except NeurohoverError as err:  # one damaged experiment: said in its place, the others reported as usual
             sections.append(f"## {name} [{sc}]\n\n**Not reported: the store's copy is damaged.** {err}\n")
             toc.append(f"- [{name} [{sc}]](#{_anchor(name + ' [' + sc + ']')}) (damaged)")

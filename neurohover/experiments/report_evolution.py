@@ -366,8 +366,8 @@ class EvolutionSection(Section):
                 continue
 
             def finals(vkey: str) -> dict[tuple, float]:
-                picked = [(k, self.keys[k]) for k in self.results if self.keys[k].stage == "evolve" and self.keys[k].group == vkey]
-                return {(key.mdp, key.rep): self.results[k].final_score for k, key in picked if self.results[k].validation is not None}
+                runs = {(key.mdp, key.rep): self.results[k] for k, key in self.keys.items() if key.stage == "evolve" and key.group == vkey}
+                return {at: r.final_score for at, r in runs.items() if isinstance(r, EvolveResult) and r.validation is not None}
 
             mine, theirs = finals(v.key), finals(other)
             common = sorted(set(mine) & set(theirs), key=str)

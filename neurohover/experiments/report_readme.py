@@ -36,12 +36,10 @@ class Status(NamedTuple):
 def is_current(cfg) -> bool | None:
     """Whether the shipped config of ``cfg``'s experiment (with the stored policy source) hashes as ``cfg``, the
     stored one (None: no shipped config of that name)."""
-    from .config import load_config, shipped_configs
-    from .runner import POLICY_SOURCES
+    from .config import shipped_counterpart
 
-    if cfg.name not in shipped_configs():
-        return None
-    return load_config(cfg.name, cfg.scale, {k: cfg.settings[k] for k in POLICY_SOURCES if k in cfg.settings}).hash == cfg.hash
+    shipped = shipped_counterpart(cfg)
+    return None if shipped is None else shipped.hash == cfg.hash
 
 
 def _marker(key: str) -> tuple[str, str]:

@@ -10,7 +10,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 from ..errors import NeurohoverError
-from .config import ExperimentConfig
+from .config import POLICY_SOURCES, ExperimentConfig
 from .plans import plan, source_experiments
 from .store import Store
 
@@ -96,11 +96,6 @@ def unchanged_units(config: ExperimentConfig, store: Store) -> set[str]:
         if not same:
             return set(kept)
         kept.update((key, stored[key]["result"]) for key in same)
-
-
-#: Settings that say where an experiment's policies come from; a paper-scale run may have set them on the
-#: command line (`--set policies=shipped`), and an --update that forgets them would run every unit again.
-POLICY_SOURCES = ("policies", "generic")
 
 
 def _check_policy_source(config: ExperimentConfig, store: Store) -> None:
