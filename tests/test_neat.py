@@ -199,7 +199,7 @@ def test_the_report_pairs_each_neat_run_with_the_mlp_run_of_its_seed(tmp_path: P
         '[[settings.variants]]\nkey = "mlp"\nlabel = "MLP"\ntopology = "mlp"\n'
         '[[settings.variants]]\nkey = "net"\nlabel = "NEAT"\ntopology = "neat"\npaired_with = "mlp"\n'
         'neat = { pop_size = 4, start = "baseline", activations = ["identity", "tanh"], weight_mutate_power = 0.02 }\n'
-        "[scales.quick]\nn_mdps = 2\nruns = 2\nbudget = 8\nn_steps = 40\n[scales.paper]\nruns = 1\n"
+        "[scales.quick]\nn_mdps = 2\nruns = 2\nbudget = 8\nn_steps = 40\n[scales.paper]\nruns = 1\nbudget = 8\n"
     )
     with Store(tmp_path / "s.sqlite") as store:
         executor = make_executor("local", jobs=1)
@@ -217,3 +217,26 @@ def test_the_report_pairs_each_neat_run_with_the_mlp_run_of_its_seed(tmp_path: P
     cells = [c.strip() for c in row.strip("|").split("|")]
     assert cells[2] == "4" and cells[5] == f"{sum(d > 0 for d in diff)} of 4"
     assert float(cells[7]) == pytest.approx(stats.wilcoxon(diff).pvalue if any(diff) else 1.0, rel=1e-3)
+
+
+def test_a_neat_variant_whose_budget_is_below_one_generation_is_refused_when_the_config_loads(tmp_path: Path) -> None:
+    path = tmp_path / "neat-budget.toml"
+    path.write_text(
+        'name = "neat-budget"\ntitle = "t"\nkind = "evolution"\n[settings]\ntask = "ghh08"\nseed = 1\ntarget = "train"\n'
+        '[[settings.variants]]\nkey = "x"\nlabel = "x"\ntopology = "neat"\nneat = { pop_size = 10, episodes = 2 }\n'
+        "[scales.quick]\nbudget = 19\nruns = 1\n[scales.paper]\nbudget = 20\nruns = 1\n"
+    )
+    with pytest.raises(NeurohoverError, match=r"budget = 19 is below one NEAT generation \(10 genomes x 2 episodes = 20\)"):
+        load_config(str(path), "quick")
+
+
+def test_neat_refuses_what_neat_python_would_fail_on_later() -> None:
+    mdp = get_task_family("ghh08").mdp("train:0")
+    for bad in ({"node_add_prob": True}, {"weight_mutate_power": 1e308}, {"pop_size": 10**12}, {"activations": ("tanh", "tanh")}):
+        with pytest.raises(NeurohoverError):
+            NeatSettings.of(bad)
+    with pytest.raises(NeurohoverError, match="seed=-1 is out of range"):
+        evolve_topology(get_task_family("ghh08"), budget=4, seed=-1, settings={"pop_size": 4}, n_steps=20)
+    with pytest.raises(NeurohoverError, match="neat-python stopped the run"):  # more species than the population holds
+        evolve_topology(mdp, budget=50, seed=0, settings=NeatSettings(pop_size=10, compatibility_threshold=0.01), n_steps=20)
+    assert evolve_topology(mdp, budget=8, seed=0, settings={"pop_size": 4}, n_steps=20).episodes == 8  # a dict of settings

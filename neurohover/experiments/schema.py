@@ -99,9 +99,15 @@ def _check_neat_variant(settings: dict, v: dict, where: str) -> None:
     except ImportError:
         raise NeurohoverError(f"{where}: variant {v['key']!r} evolves with NEAT: neat-python is missing (pip install neat-python)") from None
     try:
-        NeatSettings.of(v.get("neat", {}))
+        neat = NeatSettings.of(v.get("neat", {}))
     except (TypeError, ValueError) as err:
         raise NeurohoverError(f"{where}: variant {v['key']!r}: neat: {err}") from None
+    generation = neat.pop_size * neat.episodes
+    if settings["budget"] < generation:  # refused now, not by every unit when it runs
+        raise NeurohoverError(
+            f"{where}: variant {v['key']!r}: budget = {settings['budget']} is below one NEAT generation ({neat.pop_size} genomes x "
+            f"{neat.episodes} episodes = {generation}): give the experiment a budget >= {generation}"
+        )
     if v["resampling"] != "fixed:1" or "optimizer" in v:
         raise NeurohoverError(f"{where}: variant {v['key']!r}: a NEAT variant takes no resampling or optimizer (its neat table's episodes and settings)")
     if settings["target"] == "family" and settings.get("validation_mdps") != "test":

@@ -41,6 +41,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from ..evolution.fitness import FITNESS_SCALES, episode_fitness
+from ..evolution.seeding import check_seed
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS, OBS_NAMES
 from ..tasks import MDP, TaskFamily
 
@@ -58,6 +59,8 @@ __all__ = [
 
 #: An evolution variant's topology that evolves with NEAT (the experiments' name; its champion is stored so).
 NEAT_TOPOLOGY = "neat"
+MAX_POP, MAX_EPISODES_PER_GENOME = 100_000, 10_000  # sizes beyond any budget this machine flies
+MAX_SPREAD = 100.0  # of a weight's or bias's mutation or start (neat-python clamps them to +-30)
 #: neat-python's activation functions this forward pass computes, by id (its ``activations`` module, exactly).
 ACTIVATIONS = ("identity", "tanh", "sigmoid", "clamped", "relu")
 #: What a network sees: the nine state features of the paper's networks (Section 3.1), as the SLP and MLP do.
@@ -123,42 +126,49 @@ class NeatSettings:
 
     @classmethod
     def of(cls, table: Mapping[str, Any]) -> NeatSettings:
-        """Settings from a config's table (TOML lists as tuples); an unknown key refused by name (ValueError)."""
+        """Settings from a config's table (TOML lists as tuples); an unknown key refused by name (NeurohoverError)."""
+        if not isinstance(table, Mapping):
+            raise NeurohoverError(f"NEAT settings must be a table of NeatSettings' fields, got {type(table).__name__}")
         known = {f.name for f in dataclass_fields(cls)}
         unknown = sorted(set(table) - known)
         if unknown:
-            raise ValueError(f"unknown NEAT setting(s) {', '.join(map(repr, unknown))}: allowed {', '.join(sorted(known))}")
+            raise NeurohoverError(f"unknown NEAT setting(s) {', '.join(map(repr, unknown))}: allowed {', '.join(sorted(known))}")
         values: dict[str, Any] = {k: tuple(v) if isinstance(v, list) else v for k, v in table.items()}
         return cls(**values)
 
-    def __post_init__(self) -> None:
-        if isinstance(self.pop_size, bool) or not isinstance(self.pop_size, int) or self.pop_size < 4:
-            raise ValueError(f"pop_size={self.pop_size!r} must be an integer >= 4")
-        if isinstance(self.episodes, bool) or not isinstance(self.episodes, int) or self.episodes < 1:
-            raise ValueError(f"episodes={self.episodes!r} must be an integer >= 1")
+    def __post_init__(self) -> None:  # a NeurohoverError (a ValueError) naming the value and what is allowed
+        for name, low, high in (("pop_size", 4, MAX_POP), ("episodes", 1, MAX_EPISODES_PER_GENOME)):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int) or not low <= v <= high:
+                raise NeurohoverError(f"{name}={v!r} must be an integer in {low}..{high}")
         if self.initial not in ("full_direct", "unconnected"):
-            raise ValueError(f"initial={self.initial!r}: allowed full_direct or unconnected")
+            raise NeurohoverError(f"initial={self.initial!r}: allowed full_direct or unconnected")
         if self.fitness not in FITNESS_SCALES:
-            raise ValueError(f"fitness={self.fitness!r}: allowed {', '.join(FITNESS_SCALES)}")
+            raise NeurohoverError(f"fitness={self.fitness!r}: allowed {', '.join(FITNESS_SCALES)}")
         if self.start not in ("random", "baseline"):
-            raise ValueError(f"start={self.start!r}: allowed random or baseline")
+            raise NeurohoverError(f"start={self.start!r}: allowed random or baseline")
         if self.start == "baseline" and (self.initial != "full_direct" or "identity" not in self.activations):
-            raise ValueError("start='baseline' needs initial='full_direct' and 'identity' among the activations (the baseline is linear)")
+            raise NeurohoverError("start='baseline' needs initial='full_direct' and 'identity' among the activations (the baseline is linear)")
         bad = [a for a in self.activations if a not in ACTIVATIONS]
-        if not self.activations or bad:
-            raise ValueError(f"activations={self.activations!r}: allowed a non-empty tuple of {', '.join(ACTIVATIONS)}")
+        if not self.activations or bad or len(set(self.activations)) != len(self.activations):
+            raise NeurohoverError(f"activations={self.activations!r}: allowed a non-empty tuple of distinct names from {', '.join(ACTIVATIONS)}")
+
+        def number(v) -> bool:
+            return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
         for name in ("node_add_prob", "conn_add_prob", "node_delete_prob", "conn_delete_prob", "activation_mutate_rate", "replace_rate", "weight_mutate_rate"):
             v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and 0.0 <= v <= 1.0):
-                raise ValueError(f"{name}={v!r} must be a probability in [0, 1]")
+            if not (number(v) and 0.0 <= v <= 1.0):
+                raise NeurohoverError(f"{name}={v!r} must be a probability in [0, 1]")
+        # neat-python clamps weights and biases to +-30: a larger spread only saturates them
         for name in ("weight_mutate_power", "bias_mutate_power", "compatibility_threshold"):
             v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise ValueError(f"{name}={v!r} must be a finite number > 0")
+            if not (number(v) and 0.0 < v <= MAX_SPREAD):
+                raise NeurohoverError(f"{name}={v!r} must be a number in (0, {MAX_SPREAD:g}]")
         for name in ("weight_init_stdev", "bias_init_stdev"):
             v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
-                raise ValueError(f"{name}={v!r} must be a finite number >= 0")
+            if not (number(v) and 0.0 <= v <= MAX_SPREAD):
+                raise NeurohoverError(f"{name}={v!r} must be a number in [0, {MAX_SPREAD:g}]")
 
 
 _CONFIG = """
@@ -419,7 +429,7 @@ def evolve_topology(
     *,
     budget: int,
     seed: int = 0,
-    settings: NeatSettings | None = None,
+    settings: NeatSettings | Mapping[str, Any] | None = None,
     n_steps: int = EPISODE_STEPS,
 ) -> TopologyResult:
     """Evolve a network's topology and weights with NEAT on ``mdps`` for ``budget`` episodes.
@@ -433,7 +443,10 @@ def evolve_topology(
 
     from .flying import evaluate_callable
 
-    s = settings if settings is not None else NeatSettings()
+    s = NeatSettings.of(settings) if isinstance(settings, Mapping) else settings if settings is not None else NeatSettings()
+    if not isinstance(s, NeatSettings):
+        raise NeurohoverError(f"settings must be a NeatSettings or a dict of its fields, got {type(settings).__name__}")
+    seed = check_seed(seed)
     family = mdps if isinstance(mdps, TaskFamily) else None
     mdp_rng = np.random.default_rng([int(seed), 0x4E4]) if family is not None else None  # the MDPs from G, apart from the gusts
     mdp_list: list = [mdps] if isinstance(mdps, MDP) else [] if isinstance(mdps, TaskFamily) else list(mdps)
@@ -472,7 +485,10 @@ def evolve_topology(
             for genome in population.population.values():
                 seed_baseline(genome, config)
         generations = max(1, int(budget) // (s.pop_size * s.episodes))
-        population.run(fitness, generations)
+        try:
+            population.run(fitness, generations)
+        except RuntimeError as err:  # neat-python's own refusals mid-run (e.g. more species than the population holds)
+            raise NeurohoverError(f"neat-python stopped the run: {err} (a larger pop_size or compatibility_threshold avoids it)") from None
     finally:
         random.setstate(state)
     champion, champion_fitness = best
