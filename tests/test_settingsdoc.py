@@ -83,3 +83,12 @@ def test_the_settings_command_prints_the_defaults_the_classes_hold() -> None:
     assert [line.split()[0] for line in listed.splitlines()] == list(settings_classes())
     bad = subprocess.run([sys.executable, "-m", "neurohover", "settings", "bogus"], capture_output=True, text=True)
     assert bad.returncode == 2 and "no settings named 'bogus': allowed steady-state, generational" in bad.stderr and "Traceback" not in bad.stderr
+
+
+def test_an_agents_name_shows_its_settings_class_and_one_without_settings_is_told_so() -> None:
+    from neurohover.agents.hybrid import HybridSettings
+
+    run = subprocess.run([sys.executable, "-m", "neurohover", "settings", "hybrid-baseline"], capture_output=True, text=True, check=True)
+    assert run.stdout.strip() == format_settings(HybridSettings, "hybrid").strip()
+    bad = subprocess.run([sys.executable, "-m", "neurohover", "settings", "model-free"], capture_output=True, text=True)
+    assert bad.returncode == 2 and "agent 'model-free' takes no settings of its own" in bad.stderr

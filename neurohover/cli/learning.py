@@ -436,9 +436,17 @@ def cmd_settings(args: argparse.Namespace) -> int:
         for name, cls in found.items():
             print(f"{name:<{width}}  {summary(cls)}")
         return 0
-    if args.name not in found:
-        raise NeurohoverError(f"no settings named {args.name!r}: allowed {', '.join(found)}")
-    print(format_settings(found[args.name], args.name))
+    from ..agents.registry import AGENTS
+
+    name = args.name
+    if name not in found and name in AGENTS:  # an agent's name: its settings class's entry
+        own = AGENTS[name].settings
+        if own is None:
+            raise NeurohoverError(f"agent {name!r} takes no settings of its own (agents that do: {', '.join(a for a, s in AGENTS.items() if s.settings)})")
+        name = own.__name__.removesuffix("Settings").lower()
+    if name not in found:
+        raise NeurohoverError(f"no settings named {args.name!r}: allowed {', '.join(found)}, or an agent's name")
+    print(format_settings(found[name], name))
     return 0
 
 
