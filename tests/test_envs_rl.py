@@ -113,3 +113,18 @@ def test_evaluate_agent_flies_an_rl_id_policy_through_its_scaling(cli, tmp_path,
     assert rows["agent"]["return_per_episode"] == pytest.approx(at_rest[0].return_per_episode, rel=1e-9)
     rc, _, err = cli("evaluate-agent", "--task", "ghh08", "--policy", "baseline", "--rl-id", "--n-mdps", "1")
     assert rc == 2 and "--rl-id applies to an agent trained on a neurohover/<NAME>-RL-v0 id" in err
+
+
+def test_an_rl_id_refuses_a_wrong_action_with_one_clear_error() -> None:
+    """The action map runs before the environment's own check: it checks the shape itself (bad-input trial)."""
+    from neurohover import NeurohoverError
+
+    env = gym.make("neurohover/GHH08-RL-v0", mdp="zero")
+    env.reset(seed=0)
+    for bad in (np.zeros(5, np.float32), "abcd", 1.0):
+        with pytest.raises(NeurohoverError, match="action"):
+            env.step(bad)
+    vec = gym.make_vec("neurohover/GHH08-RL-v0", num_envs=2, vectorization_mode="vector_entry_point")
+    vec.reset(seed=0)
+    with pytest.raises(NeurohoverError, match=r"action has shape \(2, 3\)"):
+        vec.step(np.zeros((2, 3)))

@@ -38,7 +38,8 @@ from gymnasium.wrappers.vector import TransformAction as VectorTransformAction
 from gymnasium.wrappers.vector import TransformObservation as VectorTransformObservation
 from gymnasium.wrappers.vector import TransformReward as VectorTransformReward
 
-from ..sim.constants import MAX_POSITION, MAX_RATE, MAX_VELOCITY
+from ..errors import NeurohoverError
+from ..sim.constants import ACTION_DIM, MAX_POSITION, MAX_RATE, MAX_VELOCITY
 from ..wrappers import CrashAwareReward, crash_aware
 from .hover import HoverEnv
 from .vector import HoverVectorEnv
@@ -70,7 +71,13 @@ def scale_observation(obs: np.ndarray) -> np.ndarray:
 
 def controls(action: np.ndarray, task: str) -> np.ndarray:
     """The task's controls (..., 4), float64, of an RL id's actions on family ``task``."""
-    a = np.clip(np.asarray(action, dtype=np.float64), -1.0, 1.0)
+    try:
+        a = np.asarray(action, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise NeurohoverError(f"action {action!r} is not allowed: give 4 numbers in [-1, 1] per helicopter") from None
+    if a.ndim == 0 or a.shape[-1] != ACTION_DIM:
+        raise NeurohoverError(f"action has shape {a.shape}, expected (..., 4): 4 numbers in [-1, 1] per helicopter")
+    a = np.clip(a, -1.0, 1.0)
     return ACTION_OFFSET + ACTION_AUTHORITY.get(task, FULL_AUTHORITY) * (a + CUBIC * a**3) / (1.0 + CUBIC)
 
 
