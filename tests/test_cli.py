@@ -139,3 +139,28 @@ def test_flight_data_can_be_recorded_in_float32_in_half_the_space(tmp_path: Path
     assert rounded.metadata["returns"] == exact.metadata["returns"]
     with pytest.raises(nh.NeurohoverError, match="flight-data dtype 'float16' is not allowed: use float64 or float32"):
         exact.save(tmp_path / "x.npz", dtype="float16")
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["fly", "--task", "ghh08", "--seed", "1", "--seed", "2"],
+        ["fly", "--task", "ghh08", "--mdp", "train:1", "--mdp", "train:2"],
+        ["evaluate-agent", "--task", "ghh08", "--obs-delay", "2", "--obs-delay", "3", "--policy", "baseline"],
+    ],
+)
+def test_a_single_valued_option_given_twice_is_refused(cli, capsys, argv: list[str]) -> None:
+    """argparse keeps the last of a repeated option without a word; every command refuses it instead (bad-input trial)."""
+    with pytest.raises(SystemExit) as stop:
+        cli(*argv)
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and "is given more than once: give it once" in err and "Traceback" not in err
+
+
+def test_a_repeated_key_of_a_key_value_option_is_refused(cli, tmp_path: Path) -> None:
+    rc, _, err = cli("evolve", "--task", "ghh08", "--out", "x.json", "--setting", "pop_size=30", "--setting", "pop_size=40")
+    assert rc == 2 and "--setting pop_size=... is given more than once (pop_size=30 and pop_size=40)" in err
+    rc, _, err = cli("evolve", "--task", "ghh08", "--out", "x.json", "--plateau-rule", "literal", "--setting", "plateau_rule=no-crash")
+    assert rc == 2 and "repeats --plateau-rule" in err
+    rc, _, err = cli("reproduce", "fig2", "--store", str(tmp_path / "s.sqlite"), "--set", "runs=2", "--set", "runs=3")
+    assert rc == 2 and "--set runs=... is given more than once" in err and not (tmp_path / "s.sqlite").exists()

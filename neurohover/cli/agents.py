@@ -83,9 +83,9 @@ def cmd_compete(args: argparse.Namespace) -> int:
     agent_settings = None
     if args.agent_setting:
         from ..compete import check_agent_settings
-        from ..experiments.config import parse_override
+        from ..experiments.config import parse_overrides
 
-        agent_settings = check_agent_settings(args.agent, dict(parse_override(text) for text in args.agent_setting))
+        agent_settings = check_agent_settings(args.agent, parse_overrides(args.agent_setting, "--agent-setting"))
     try:
         summary, _ = compete(
             args.task,

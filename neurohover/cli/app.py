@@ -19,8 +19,28 @@ from . import agents, evaluate, flying, learning, plots, reproduce
 COMPILING = ("fly", "demo", "bench", "evolve", "build-policies", "compete", "evaluate-agent", "reproduce")
 
 
+class _StoreOnce(argparse._StoreAction):
+    """An option that takes one value: given twice, it is refused (argparse would keep the last one without a word)."""
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        given = namespace.__dict__.setdefault("_given_options", set())
+        if option_string is not None and self.dest in given:
+            parser.error(f"{'/'.join(self.option_strings)} is given more than once: give it once")
+        given.add(self.dest)
+        super().__call__(parser, namespace, values, option_string)
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser with single-valued options refused when repeated (its subcommands' parsers are of this class too)."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self.register("action", None, _StoreOnce)
+        self.register("action", "store", _StoreOnce)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="neurohover", description="Generalized helicopter hovering (Koppejan & Whiteson 2011): fly, evolve, learn models, compete, reproduce."
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")

@@ -69,7 +69,7 @@ def _seed_policy(args: argparse.Namespace):
 
 def _optimiser_settings(args: argparse.Namespace, over_family: bool) -> dict | None:
     """The optimiser settings of ``evolve`` from --plateau-rule, --preset and --setting (None: the defaults)."""
-    from ..experiments.config import parse_override
+    from ..experiments.config import parse_overrides
 
     settings: dict = {}
     if args.plateau_rule is not None:
@@ -80,8 +80,9 @@ def _optimiser_settings(args: argparse.Namespace, over_family: bool) -> dict | N
         if args.optimizer != "ne" or not over_family:
             raise NeurohoverError(f"--preset {args.preset} names generational settings: it applies to evolution over a family (--mdp G, optimizer ne)")
         settings["preset"] = args.preset
-    for text in args.setting or []:
-        key, value = parse_override(text)
+    for key, value in parse_overrides(args.setting, "--setting").items():
+        if key in settings:
+            raise NeurohoverError(f"--setting {key}=... repeats --{key.replace('_', '-')}: give it once")
         settings[key] = value
     return settings or None
 

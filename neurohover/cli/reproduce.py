@@ -19,8 +19,8 @@ from ..evaluate import DEVICES, check_device
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
     """Run a paper experiment (or all of them); every finished unit goes to the results store at once."""
-    from ..experiments import Store, load_configs, make_executor, parse_override, reproduce
-    from ..experiments.config import experiment_names
+    from ..experiments import Store, load_configs, make_executor, reproduce
+    from ..experiments.config import experiment_names, parse_overrides
     from ..experiments.plans import source_experiments
     from ..experiments.runner import check_restart
     from ..paths import output_file
@@ -40,7 +40,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         raise NeurohoverError(f"--address {args.address} names a Ray cluster; add --executor ray (or leave out --address)")
     check_device(args.device)
     output_file(args.store, "--store")
-    overrides = dict(parse_override(text) for text in args.set or [])
+    overrides = parse_overrides(args.set)
     configs = load_configs(args.name, args.scale, overrides)
     named = [c.name for c in configs]
     sources_added: set[str] = set()

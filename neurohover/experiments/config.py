@@ -185,17 +185,28 @@ def resolve_name(name: str | Path) -> Path:
     return shipped[name]
 
 
-def parse_override(text: str) -> tuple[str, Any]:
-    """``KEY=VALUE`` with VALUE in TOML syntax (a bare word is taken as a string)."""
+def parse_override(text: str, option: str = "--set") -> tuple[str, Any]:
+    """``KEY=VALUE`` of command-line ``option`` with VALUE in TOML syntax (a bare word is taken as a string)."""
     key, sep, value = text.partition("=")
     key = key.strip()
     if not sep or not key:
-        raise NeurohoverError(f'bad --set {text!r}: expected KEY=VALUE (VALUE in TOML syntax, e.g. runs=3 or policies="evolve")')
+        raise NeurohoverError(f'bad {option} {text!r}: expected KEY=VALUE (VALUE in TOML syntax, e.g. runs=3 or policies="evolve")')
     try:
         parsed = tomllib.loads(f"v = {value.strip()}")["v"]
     except tomllib.TOMLDecodeError:
         parsed = value.strip()
     return key, parsed
+
+
+def parse_overrides(texts: list[str] | None, option: str = "--set") -> dict[str, Any]:
+    """Repeated ``option KEY=VALUE`` as a dict; a key given twice is refused (the last would win without a word)."""
+    out: dict[str, Any] = {}
+    for text in texts or []:
+        key, value = parse_override(text, option)
+        if key in out:
+            raise NeurohoverError(f"{option} {key}=... is given more than once ({key}={out[key]!r} and {key}={value!r}): give it once")
+        out[key] = value
+    return out
 
 
 def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None = None) -> ExperimentConfig:
