@@ -164,3 +164,18 @@ def test_a_repeated_key_of_a_key_value_option_is_refused(cli, tmp_path: Path) ->
     assert rc == 2 and "repeats --plateau-rule" in err
     rc, _, err = cli("reproduce", "fig2", "--store", str(tmp_path / "s.sqlite"), "--set", "runs=2", "--set", "runs=3")
     assert rc == 2 and "--set runs=... is given more than once" in err and not (tmp_path / "s.sqlite").exists()
+
+
+def test_a_refused_reproduce_leaves_no_store_it_made(cli, tmp_path: Path) -> None:
+    store = tmp_path / "new.sqlite"
+    rc, _, err = cli("reproduce", "fig2", "--store", str(store), "--only", "nomatch*")
+    assert rc == 2 and "matches no unit" in err and not store.exists()
+
+
+def test_a_config_of_ones_own_may_not_take_a_shipped_experiments_name(cli, tmp_path: Path) -> None:
+    from neurohover.experiments.config import shipped_configs
+
+    path = tmp_path / "mine.toml"
+    path.write_text(shipped_configs()["fig2"].read_text())
+    rc, _, err = cli("reproduce", str(path), "--store", str(tmp_path / "s.sqlite"))
+    assert rc == 2 and "name = 'fig2' is a shipped experiment's" in err and not (tmp_path / "s.sqlite").exists()

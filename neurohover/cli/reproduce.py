@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from pathlib import Path
 
 from ..errors import NeurohoverError
 from ..evaluate import DEVICES, check_device
@@ -59,6 +60,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         raise NeurohoverError(f"--only selects units of one experiment: give its NAME instead of {args.name!r}")
     executor = make_executor(args.executor, jobs=args.jobs, address=args.address, device=args.device)
     failed = False
+    new_store = not Path(args.store).exists()
     try:
         with Store(args.store) as store:
             for config in configs:
@@ -76,9 +78,23 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
                     return 130
                 print(summary.line())
                 failed = failed or not summary.succeeded
+    except NeurohoverError:
+        if new_store:  # a refusal leaves no store it made that holds no unit
+            _remove_if_empty(Path(args.store))
+        raise
     finally:
         executor.close()
     return 1 if failed else 0
+
+
+def _remove_if_empty(path: Path) -> None:
+    """Delete the store file at ``path`` if it holds no finished unit."""
+    from ..experiments import Store
+
+    with Store(path, create=False) as store:
+        empty = not any(store.units(name, scale) for name, scale, *_ in store.experiments())
+    if empty:
+        path.unlink(missing_ok=True)
 
 
 def cmd_results(args: argparse.Namespace) -> int:

@@ -228,6 +228,12 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
     for key in ("name", "kind", "settings"):
         if key not in raw:
             raise NeurohoverError(f"{where}: missing top-level key {key!r}")
+    shipped = shipped_configs()
+    if raw["name"] in (*shipped, "all") and (raw["name"] == "all" or path.resolve() != shipped[raw["name"]].resolve()):
+        raise NeurohoverError(
+            f"{where}: name = {raw['name']!r} is a shipped experiment's (or 'all'): a config of your own needs a name of its own, "
+            "or its results and report would pass for the shipped experiment's"
+        )
     kind = raw["kind"]
     if kind not in KINDS:
         raise NeurohoverError(f"{where}: kind = {kind!r} is not allowed: expected one of {', '.join(KINDS)}")
