@@ -98,3 +98,10 @@ def test_a_group_with_seeds_of_flies_the_seeds_of_the_other_experiments_group() 
 def test_a_bad_seeds_of_is_refused_when_the_config_loads(bad) -> None:
     with pytest.raises(NeurohoverError, match="seeds_of"):
         load_config("wind-fig8", "paper", {"groups": [{"agent": "hybrid", "n_mdps": 1, "seeds_of": bad}]})
+
+
+@pytest.mark.parametrize(("key", "value"), [("runs", 10**13), ("n_steps", 10**13), ("budget", 10**13), ("validation_episodes", 10**13)])
+def test_sizes_beyond_what_planning_and_memory_hold_are_refused_when_the_config_loads(key: str, value: int) -> None:
+    """`--set runs=10**13` planned for minutes and grew until stopped (bad-input trial): refused up front, the limit named."""
+    with pytest.raises(NeurohoverError, match=rf"{key} = {value} is not allowed: expected an integer in \d+\.\.\d+"):
+        load_config("fig2", "quick", {key: value})

@@ -58,11 +58,16 @@ def field_default(f: Field) -> Any:
 # ----------------------------------------------------------------------------------------------- checks
 
 
-def integer(minimum: int):
+def integer(minimum: int, maximum: int | None = None):
     def check(v):
-        return isinstance(v, int) and not isinstance(v, bool) and v >= minimum, f"an integer >= {minimum}"
+        ok = isinstance(v, int) and not isinstance(v, bool) and v >= minimum and (maximum is None or v <= maximum)
+        return ok, f"an integer >= {minimum}" if maximum is None else f"an integer in {minimum}..{maximum}"
 
     return check
+
+
+#: Caps on an experiment's sizes, far above any run of the paper's, below what planning and memory can hold.
+MAX_RUNS, MAX_EPISODES, MAX_BUDGET, MAX_STEPS = 10_000, 1_000_000, 10**10, 10**7
 
 
 def number(lo: float, hi: float):

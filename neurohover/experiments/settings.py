@@ -22,6 +22,10 @@ from ..models.model import LEGACY_MODEL_SUBSTEPS
 from ..policysets import FGHH_GENERIC_RESAMPLING
 from ..tasks import TASK_NAMES
 from .checks import (
+    MAX_BUDGET,
+    MAX_EPISODES,
+    MAX_RUNS,
+    MAX_STEPS,
     OMIT,
     agent,
     boolean,
@@ -68,7 +72,7 @@ class Group:
     label: str = setting(text(), absent=None)  # absent: the agent's name (check_kind writes it in)
     mdps: str = setting(choice("train", "test", "sample"), "test")
     n_mdps: int = setting(integer(1))
-    runs_per_mdp: int = setting(integer(1), 1)
+    runs_per_mdp: int = setting(integer(1, MAX_RUNS), 1)
     exclude_own: bool = setting(boolean(), False)
     # an agent's own typed settings (its spec's settings class); a hybrid agent's (replacement, model_from, rule,
     # box, tilt: HybridSettings) are resolved under `hybrid`, their older name (either spelling is read)
@@ -98,7 +102,7 @@ class Condition:
     key: str = setting(text())
     label: str = setting(text(), absent=None)  # absent: the key (check_kind writes it in)
     sensor: dict | None = setting(sensor_table(), None, absent=OMIT)  # None: exact sensors
-    data_episodes: int = setting(integer(1), 1)  # episodes of the generic policy's flight data each model learns from
+    data_episodes: int = setting(integer(1, MAX_EPISODES), 1)  # episodes of the generic policy's flight data each model learns from
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -123,7 +127,7 @@ class ExperimentSettings:
     task: str = setting(choice(*TASK_NAMES))
     sigma: float | None = setting(number(0.0, 1.0), None)
     seed: int = setting(seed())
-    n_steps: int = setting(integer(1), 6000)
+    n_steps: int = setting(integer(1, MAX_STEPS), 6000)
     # every MDP of the experiment seen through these sensors (None: exact; docs/benchmarks.md)
     sensor: dict | None = setting(sensor_table(), None, absent=OMIT)
 
@@ -132,18 +136,18 @@ class ExperimentSettings:
 class EvolutionSettings(ExperimentSettings):
     target: str = setting(choice("train", "zero", "family"))
     n_mdps: int = setting(integer(1), 10)
-    runs: int = setting(integer(1))
-    budget: int = setting(integer(0), 0)
+    runs: int = setting(integer(1, MAX_RUNS))
+    budget: int = setting(integer(0, MAX_BUDGET), 0)
     optimizer: dict = setting(table(), absent={})
-    validation_episodes: int = setting(integer(0), 0)
+    validation_episodes: int = setting(integer(0, MAX_EPISODES), 0)
     # "fresh": each champion on fresh draws (of its MDP, or from G) of its own seed; "test": every champion on the
     # family's test MDPs with the same noise (paired comparisons)
     validation_mdps: str | None = setting(choice("fresh", "test"), None, absent=OMIT)
     # the champion chosen again: the last generation's parents each flown this many fresh episodes (0: the run's own)
-    champion_reevaluation: int = setting(integer(1), 0, absent=OMIT)
+    champion_reevaluation: int = setting(integer(1, MAX_EPISODES), 0, absent=OMIT)
     history_points: int = setting(integer(2), 300)
     robustness_variants: tuple[str, ...] = setting(keys_list(), (), absent=[])
-    robustness_episodes: int = setting(integer(1), 10)
+    robustness_episodes: int = setting(integer(1, MAX_EPISODES), 10)
     # Table 3 also for a policy set's specialised policies ("shipped" or a directory of <task>/ sets): the ones Table 4
     # and Figures 7, 8 and 11 fly, flown as the best champions are (None: none)
     robustness_policies: str | None = setting(policy_source(), None, absent=OMIT)
@@ -159,13 +163,13 @@ class ModelLearningSettings(ExperimentSettings):
     n_mdps: int = setting(integer(1))
     methods: tuple[str, ...] = setting(text_list("ec-mer", "ec-meno", "lr", "lr-gls"), absent=["ec-mer", "ec-meno", "lr"])
     generic: str = setting(policy_source(), "evolve")
-    generic_budget: int = setting(integer(0), 0)
-    model_budget: int = setting(integer(1), 2000)  # EC-MER evaluations
-    ec_meno_budget: int = setting(integer(0), 0)  # EC-MENO evaluations; 0: the plateau stop
+    generic_budget: int = setting(integer(0, MAX_BUDGET), 0)
+    model_budget: int = setting(integer(1, MAX_BUDGET), 2000)  # EC-MER evaluations
+    ec_meno_budget: int = setting(integer(0, MAX_BUDGET), 0)  # EC-MENO evaluations; 0: the plateau stop
     ec_mer_episodes: int = setting(integer(1), 1)
-    policy_budget: int = setting(integer(0), 0)
+    policy_budget: int = setting(integer(0, MAX_BUDGET), 0)
     policy_prototype: str = setting(choice("generic", "baseline"), "generic")
-    test_episodes: int = setting(integer(1), 5)
+    test_episodes: int = setting(integer(1, MAX_EPISODES), 5)
     # sensor conditions, each its own models of every MDP (empty: one, the experiment's sensor, one episode of data)
     conditions: tuple[Condition, ...] = setting(default=(), absent=OMIT, table=Condition)
     # LR fits, each its own LR models of every MDP, paired with the others (empty: LR as the methods say)
@@ -179,10 +183,10 @@ class ModelLearningSettings(ExperimentSettings):
 
 @dataclass(frozen=True, kw_only=True)
 class TestRunsSettings(ExperimentSettings):
-    episodes: int = setting(integer(1))
+    episodes: int = setting(integer(1, MAX_EPISODES))
     policies: str = setting(policy_source(), "evolve")
-    policy_budget: int = setting(integer(0), 0)
-    generic_budget: int = setting(integer(0), 0)
+    policy_budget: int = setting(integer(0, MAX_BUDGET), 0)
+    generic_budget: int = setting(integer(0, MAX_BUDGET), 0)
     generic_resampling: dict = setting(table(), absent=dict(FGHH_GENERIC_RESAMPLING))
     generics_per_agent: int = setting(integer(1), 1)
     # the topology of the FGHH generics the experiment evolves itself (the authors' were SLPs)
@@ -190,9 +194,9 @@ class TestRunsSettings(ExperimentSettings):
     # kind -> "EXPERIMENT/VARIANT" (or "EXPERIMENT/best-race"): each run's generic drawn from the final champions of
     # another experiment's evolution runs, in the same store and scale (None: evolved or shipped)
     generics_from: dict | None = setting(table(), None, absent=OMIT)
-    safety_episodes: int = setting(integer(1), 3)
-    model_budget: int = setting(integer(1), 2000)
-    predict_episodes: int = setting(integer(1), 5)
+    safety_episodes: int = setting(integer(1, MAX_EPISODES), 3)
+    model_budget: int = setting(integer(1, MAX_BUDGET), 2000)
+    predict_episodes: int = setting(integer(1, MAX_EPISODES), 5)
     max_learning_episodes: int = setting(integer(1), 25)
     authors_generations: int = setting(integer(1), 500, absent=OMIT)  # the authors' eonn generations on a model
     drift: dict | None = setting(drift_table(), None, absent=OMIT)  # every test run's MDP drifts so (None: fixed dynamics)
