@@ -179,3 +179,11 @@ def test_a_config_of_ones_own_may_not_take_a_shipped_experiments_name(cli, tmp_p
     path.write_text(shipped_configs()["fig2"].read_text())
     rc, _, err = cli("reproduce", str(path), "--store", str(tmp_path / "s.sqlite"))
     assert rc == 2 and "name = 'fig2' is a shipped experiment's" in err and not (tmp_path / "s.sqlite").exists()
+
+
+def test_fly_refuses_empty_list_fields_and_a_record_dtype_without_a_record(cli) -> None:
+    for wind in ("1,,1", ",1,1", "1,1,"):
+        rc, _, err = cli("fly", "--task", "ghh08", "--episodes", "1", "--wind", wind)
+        assert rc == 2 and "none left empty" in err
+    rc, _, err = cli("fly", "--task", "ghh08", "--episodes", "1", "--record-dtype", "float32")
+    assert rc == 2 and "--record-dtype float32 applies to the flight data --record FILE writes" in err

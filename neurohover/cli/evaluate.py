@@ -92,7 +92,7 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     for r in rows:
         print(f"{r.name:<10} {r.return_per_episode:>15.6g} {r.median_over_mdps:>17.6g} {f'{r.crashes} of {r.episodes}':>12}")
     if out is not None:
-        with writing(out, "--out") as path:
+        with writing(out, "--json") as path:
             path.write_text(json.dumps({"task": args.task, "mdps": args.mdps, "n_mdps": n, "episodes": args.episodes, "seed": args.seed,
                                         "episode_steps": args.episode_steps, "rows": [r.__dict__ for r in rows]}, indent=1))  # fmt: skip
         print(f"wrote {args.json}", file=sys.stderr)

@@ -68,6 +68,8 @@ def cmd_fly(args: argparse.Namespace) -> int:
 
     if args.episodes < 1:
         raise NeurohoverError(f"--episodes {args.episodes} is out of range: allowed >= 1")
+    if args.record is None and args.record_dtype is not None:
+        raise NeurohoverError(f"--record-dtype {args.record_dtype} applies to the flight data --record FILE writes: give --record, or leave it out")
     per_episode = _FLY_BYTES_PER_EPISODE + (_SAMPLED_MDP_BYTES if args.mdp == "sample" else 0) + (_RECORD_BYTES_PER_STEP * EPISODE_STEPS if args.record else 0)
     most = max_in_memory(per_episode)
     if args.episodes > most:
@@ -85,7 +87,7 @@ def cmd_fly(args: argparse.Namespace) -> int:
             {"task": family.name, "mdps": [m.to_dict() for m in mdps], "policy": str(args.policy), "seed": args.seed, "returns": returns.tolist()}
         )
         with writing(args.record, "--record") as path:
-            fd.save(path, dtype=args.record_dtype)
+            fd.save(path, dtype=args.record_dtype or "float64")
     summary = {
         "task": family.name,
         **({} if family.sensor.exact else {"sensor": family.sensor.to_dict()}),
@@ -153,8 +155,7 @@ def register(sub) -> None:
     p.add_argument(
         "--record-dtype",
         choices=("float64", "float32"),
-        default="float64",
-        help="precision of the recorded flight data: float64 (exact; about 0.74 MB a 6000-step episode) or float32 (about half that)",
+        help="precision of the recorded flight data: float64 (default; exact, about 0.74 MB a 6000-step episode) or float32 (about half that)",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=cmd_fly)

@@ -14,8 +14,11 @@ from ..tasks.sensor import Sensor
 
 def parse_floats(text: str, what: str) -> list[float]:
     """Comma-separated numbers of option ``what``, or one clear error."""
+    parts = text.split(",")
+    if any(p.strip() == "" for p in parts):  # '1,,1' is no pair of numbers, nor is '1,1,'
+        raise NeurohoverError(f"{what} must be comma-separated numbers with none left empty, got {text!r}")
     try:
-        return [float(x) for x in text.split(",") if x.strip() != ""]
+        return [float(x) for x in parts]
     except ValueError:
         raise NeurohoverError(f"{what} must be comma-separated numbers, got {text!r}") from None
 
