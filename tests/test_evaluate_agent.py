@@ -105,3 +105,16 @@ def test_sensor_options_fly_every_policy_through_the_same_sensors(cli, tmp_path,
         rows[name] = {r["name"]: r["return_per_episode"] for r in json.loads(out.read_text())["rows"]}
     assert rows["sensed"]["agent"] == pytest.approx(rows["sensed"]["baseline"], rel=1e-9)
     assert rows["sensed"]["agent"] != pytest.approx(rows["exact"]["agent"], rel=1e-6)
+
+
+def test_a_callable_that_does_not_import_or_returns_no_numbers_is_refused_by_name(cli, tmp_path: Path, monkeypatch) -> None:
+    (tmp_path / "nh_strings.py").write_text('import numpy as np\n\n\ndef act(obs):\n    return np.full((len(obs), 4), "a")\n')
+    (tmp_path / "nh_broken.py").write_text("def act(:\n    pass\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    base = ("evaluate-agent", "--task", "ghh08", "--n-mdps", "1", "--episodes", "1", "--episode-steps", "20")
+    rc, _, err = cli(*base, "--callable", "nh_strings:act")
+    assert rc == 2 and "act returned ndarray" in err and "expected numbers" in err
+    rc, _, err = cli(*base, "--callable", "nh_broken:act")
+    assert rc == 2 and "--callable 'nh_broken:act': SyntaxError" in err
+    rc, out, _ = cli(*base, "--policy", "baseline")
+    assert rc == 0 and out.count("baseline") >= 1

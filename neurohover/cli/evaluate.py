@@ -31,6 +31,8 @@ def _agent(args: argparse.Namespace):
         from ..paths import input_file
         from ..policies import load_policy
 
+        if args.policy == "baseline":  # the name load_policy takes wherever a policy file is taken (README)
+            return load_policy("baseline")
         return load_policy(input_file(args.policy, "--policy", "policy file"))
     if args.callable is not None:
         module, _, name = args.callable.partition(":")
@@ -38,8 +40,8 @@ def _agent(args: argparse.Namespace):
             raise NeurohoverError(f"--callable {args.callable!r} is not allowed: give MODULE:FUNCTION (e.g. mypkg.agents:act), importable from here")
         try:
             fn = getattr(importlib.import_module(module), name)
-        except (ImportError, AttributeError) as err:
-            raise NeurohoverError(f"--callable {args.callable!r}: {err}") from None
+        except (ImportError, AttributeError, SyntaxError) as err:  # a module that does not import is named, as a missing one
+            raise NeurohoverError(f"--callable {args.callable!r}: {type(err).__name__}: {err}") from None
         if not callable(fn):
             raise NeurohoverError(f"--callable {args.callable!r} is not a function")
         return fn
@@ -109,7 +111,7 @@ def register(sub) -> None:
     add_sigma_option(p)
     add_sensor_options(p)
     g = p.add_argument_group("the agent (exactly one)")
-    g.add_argument("--policy", help="a neurohover policy file (.json or the competition's .net)")
+    g.add_argument("--policy", help="a neurohover policy file (.json or the competition's .net), or baseline")
     g.add_argument("--callable", help="MODULE:FUNCTION mapping a batch of observations (B, 12) to actions (B, 4)")
     g.add_argument("--rl-zoo", help="an RL Zoo run folder (logs/ALGO/ENV_N): its final model and frozen observation statistics")
     g.add_argument("--sb3", help="a Stable-Baselines3 model file (MODEL.zip)")

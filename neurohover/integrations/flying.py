@@ -88,7 +88,11 @@ def evaluate_callable(
     actions = np.zeros((n, ACTION_DIM))
     while alive.any():
         live = np.flatnonzero(alive)
-        out = np.asarray(act(obs[live], live) if indexed else act(obs[live]), dtype=np.float64)
+        raw = act(obs[live], live) if indexed else act(obs[live])
+        try:
+            out = np.asarray(raw, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise NeurohoverError(f"act returned {type(raw).__name__} {str(raw)[:60]!r}: expected numbers, an array ({live.size}, {ACTION_DIM})") from None
         if out.shape != (live.size, ACTION_DIM):
             raise NeurohoverError(f"act returned actions of shape {out.shape} for {live.size} observations: expected ({live.size}, {ACTION_DIM})")
         actions[live] = out
