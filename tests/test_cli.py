@@ -187,3 +187,10 @@ def test_fly_refuses_empty_list_fields_and_a_record_dtype_without_a_record(cli) 
         assert rc == 2 and "none left empty" in err
     rc, _, err = cli("fly", "--task", "ghh08", "--episodes", "1", "--record-dtype", "float32")
     assert rc == 2 and "--record-dtype float32 applies to the flight data --record FILE writes" in err
+
+
+def test_compete_refuses_bad_options_before_it_makes_its_output_directory(cli, tmp_path: Path) -> None:
+    out = tmp_path / "cq"
+    for bad in (["--agent", "Baseline"], ["--agent", "baseline", "--drift", "walk=-1"], ["--agent", "continual", "--agent-setting", "cooldown=nan"]):
+        rc, _, err = cli("compete", "--task", "ghh08", *bad, "--runs", "1", "--episodes", "2", "--out", str(out))
+        assert rc == 2 and "created directory" not in err and not out.exists(), bad

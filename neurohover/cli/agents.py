@@ -43,13 +43,14 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
 def cmd_compete(args: argparse.Namespace) -> int:
     """Run R independent test runs of an agent; print a summary and write results and a plot."""
     from ..agents.hybrid import HybridSettings
-    from ..agents.registry import AGENTS, HYBRID_AGENTS
+    from ..agents.registry import AGENTS, HYBRID_AGENTS, agent_spec
     from ..compete import check_sizes, compete
     from ..experiments.executors import check_jobs
     from ..paths import input_dir, output_dir, output_file
     from ..tasks import Drift
     from .options import sensor_of
 
+    agent_spec(args.agent, args.task)  # an unknown agent, or one for another task, before anything else is read or made
     given = [f"--{k.replace('_', '-')}" for k in _HYBRID_OPTIONS if getattr(args, k) is not None]
     if given and args.agent not in HYBRID_AGENTS:
         raise NeurohoverError(f"{', '.join(given)} apply to the hybrid agents only ({', '.join(HYBRID_AGENTS)}), not to --agent {args.agent}")
@@ -74,18 +75,19 @@ def cmd_compete(args: argparse.Namespace) -> int:
     check_device(args.device)  # before the output directory is made
     check_jobs(args.jobs)
     check_sizes(args.runs, args.episodes)
-    if args.policy_dir is not None:
-        input_dir(args.policy_dir, "--policy-dir")
-    output_dir(args.out, "--out")
-    if args.store is not None:
-        output_file(args.store, "--store")
     sensor = sensor_of(args)
+    drift = None if args.drift is None else Drift.parse(args.drift)
     agent_settings = None
     if args.agent_setting:
         from ..compete import check_agent_settings
         from ..experiments.config import parse_overrides
 
         agent_settings = check_agent_settings(args.agent, parse_overrides(args.agent_setting, "--agent-setting"))
+    if args.policy_dir is not None:
+        input_dir(args.policy_dir, "--policy-dir")
+    output_dir(args.out, "--out")  # made once every option is checked: a refusal leaves no directory behind
+    if args.store is not None:
+        output_file(args.store, "--store")
     try:
         summary, _ = compete(
             args.task,
@@ -104,7 +106,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
             progress=None,
             device=args.device,
             sensor=sensor,
-            drift=None if args.drift is None else Drift.parse(args.drift),
+            drift=drift,
             wind_model=args.wind_model or "none",
             lr_fit={
                 k: v
