@@ -40,8 +40,10 @@ def _agent(args: argparse.Namespace):
             raise NeurohoverError(f"--callable {args.callable!r} is not allowed: give MODULE:FUNCTION (e.g. mypkg.agents:act), importable from here")
         try:
             fn = getattr(importlib.import_module(module), name)
-        except (ImportError, AttributeError, SyntaxError) as err:  # a module that does not import is named, as a missing one
-            raise NeurohoverError(f"--callable {args.callable!r}: {type(err).__name__}: {err}") from None
+        except (ImportError, AttributeError) as err:
+            raise NeurohoverError(f"--callable {args.callable!r}: {err}") from None
+        except SyntaxError as err:  # a module that does not compile is named, as a missing one is
+            raise NeurohoverError(f"--callable {args.callable!r}: SyntaxError: {err}") from None
         if not callable(fn):
             raise NeurohoverError(f"--callable {args.callable!r} is not a function")
         return fn

@@ -21,7 +21,7 @@ from ..evaluate import DEVICES, check_device
 def cmd_reproduce(args: argparse.Namespace) -> int:
     """Run a paper experiment (or all of them); every finished unit goes to the results store at once."""
     from ..experiments import Store, load_configs, make_executor, reproduce
-    from ..experiments.config import experiment_names, parse_overrides
+    from ..experiments.config import check_own_name, experiment_names, parse_overrides
     from ..experiments.plans import source_experiments
     from ..experiments.runner import check_restart
     from ..paths import output_file
@@ -43,6 +43,8 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     output_file(args.store, "--store")
     overrides = parse_overrides(args.set)
     configs = load_configs(args.name, args.scale, overrides)
+    for config in configs:
+        check_own_name(config)  # before a store is made
     named = [c.name for c in configs]
     sources_added: set[str] = set()
     for config in list(configs):  # experiments that draw from others run after them (e.g. fig16 after fig13 and fig15)

@@ -185,6 +185,17 @@ def resolve_name(name: str | Path) -> Path:
     return shipped[name]
 
 
+def check_own_name(cfg: ExperimentConfig) -> None:
+    """Refuse a config file of one's own that takes a shipped experiment's name (or ``all``): stored, its results and
+    report would pass for the shipped experiment's (the report gives a shipped name the paper's claims and discussion)."""
+    shipped = shipped_configs()
+    if cfg.name == "all" or (cfg.name in shipped and Path(cfg.source).resolve() != shipped[cfg.name].resolve()):
+        raise NeurohoverError(
+            f"config {cfg.source!r}: name = {cfg.name!r} is a shipped experiment's (or 'all'): a config of your own needs a name of its own, "
+            "or its results and report would pass for the shipped experiment's"
+        )
+
+
 def parse_override(text: str, option: str = "--set") -> tuple[str, Any]:
     """``KEY=VALUE`` of command-line ``option`` with VALUE in TOML syntax (a bare word is taken as a string)."""
     key, sep, value = text.partition("=")
@@ -228,12 +239,6 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
     for key in ("name", "kind", "settings"):
         if key not in raw:
             raise NeurohoverError(f"{where}: missing top-level key {key!r}")
-    shipped = shipped_configs()
-    if raw["name"] in (*shipped, "all") and (raw["name"] == "all" or path.resolve() != shipped[raw["name"]].resolve()):
-        raise NeurohoverError(
-            f"{where}: name = {raw['name']!r} is a shipped experiment's (or 'all'): a config of your own needs a name of its own, "
-            "or its results and report would pass for the shipped experiment's"
-        )
     kind = raw["kind"]
     if kind not in KINDS:
         raise NeurohoverError(f"{where}: kind = {kind!r} is not allowed: expected one of {', '.join(KINDS)}")
