@@ -7,8 +7,6 @@ field, so the table `neurohover settings NAME` prints (and the API docs) cannot 
 from __future__ import annotations
 
 import dataclasses
-import subprocess
-import sys
 
 import pytest
 
@@ -71,24 +69,24 @@ def test_every_setting_of_every_settings_class_is_documented_once(name: str) -> 
     assert all(row.help for row in settings_rows(cls))
 
 
-def test_the_settings_command_prints_the_defaults_the_classes_hold() -> None:
-    run = subprocess.run([sys.executable, "-m", "neurohover", "settings", "generational"], capture_output=True, text=True, check=True)
+def test_the_settings_command_prints_the_defaults_the_classes_hold(cli) -> None:
     from neurohover.evolution.generational import GenerationalSettings
 
+    rc, out, _ = cli("settings", "generational")
     defaults = GenerationalSettings()
     for f in dataclasses.fields(GenerationalSettings):
-        assert f"{f.name} = {getattr(defaults, f.name)!r}" in run.stdout
-    assert run.stdout.strip() == format_settings(GenerationalSettings, "generational").strip()
-    listed = subprocess.run([sys.executable, "-m", "neurohover", "settings"], capture_output=True, text=True, check=True).stdout
-    assert [line.split()[0] for line in listed.splitlines()] == list(settings_classes())
-    bad = subprocess.run([sys.executable, "-m", "neurohover", "settings", "bogus"], capture_output=True, text=True)
-    assert bad.returncode == 2 and "no settings named 'bogus': allowed steady-state, generational" in bad.stderr and "Traceback" not in bad.stderr
+        assert f"{f.name} = {getattr(defaults, f.name)!r}" in out
+    assert rc == 0 and out.strip() == format_settings(GenerationalSettings, "generational").strip()
+    rc, listed, _ = cli("settings")
+    assert rc == 0 and [line.split()[0] for line in listed.splitlines()] == list(settings_classes())
+    rc, _, err = cli("settings", "bogus")
+    assert rc == 2 and "no settings named 'bogus': allowed steady-state, generational" in err and "Traceback" not in err
 
 
-def test_an_agents_name_shows_its_settings_class_and_one_without_settings_is_told_so() -> None:
+def test_an_agents_name_shows_its_settings_class_and_one_without_settings_is_told_so(cli) -> None:
     from neurohover.agents.hybrid import HybridSettings
 
-    run = subprocess.run([sys.executable, "-m", "neurohover", "settings", "hybrid-baseline"], capture_output=True, text=True, check=True)
-    assert run.stdout.strip() == format_settings(HybridSettings, "hybrid").strip()
-    bad = subprocess.run([sys.executable, "-m", "neurohover", "settings", "model-free"], capture_output=True, text=True)
-    assert bad.returncode == 2 and "agent 'model-free' takes no settings of its own" in bad.stderr
+    rc, out, _ = cli("settings", "hybrid-baseline")
+    assert rc == 0 and out.strip() == format_settings(HybridSettings, "hybrid").strip()
+    rc, _, err = cli("settings", "model-free")
+    assert rc == 2 and "agent 'model-free' takes no settings of its own" in err
