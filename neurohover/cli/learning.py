@@ -421,10 +421,15 @@ def settings_classes() -> dict[str, type]:
     found: dict[str, type] = {"steady-state": SteadyStateSettings, "generational": GenerationalSettings}
     found.update({name: spec.settings for name, spec in OPTIMISERS.items()})
     found.update({"eonn": EonnSettings, "neat": NeatSettings, "authors-fghh": CodeAgentSettings})
-    for agent in AGENTS.values():  # one entry per class, by its name: IncrementalSettings -> incremental
+    for agent in AGENTS.values():  # one entry per class, by its name
         if agent.settings is not None:
-            found[agent.settings.__name__.removesuffix("Settings").lower()] = agent.settings
+            found[_settings_name(agent.settings)] = agent.settings
     return found
+
+
+def _settings_name(cls: type) -> str:
+    """An agent's settings class as `neurohover settings` names it: IncrementalSettings -> incremental."""
+    return cls.__name__.removesuffix("Settings").lower()
 
 
 def cmd_settings(args: argparse.Namespace) -> int:
@@ -444,7 +449,7 @@ def cmd_settings(args: argparse.Namespace) -> int:
         own = AGENTS[name].settings
         if own is None:
             raise NeurohoverError(f"agent {name!r} takes no settings of its own (agents that do: {', '.join(a for a, s in AGENTS.items() if s.settings)})")
-        name = own.__name__.removesuffix("Settings").lower()
+        name = _settings_name(own)
     if name not in found:
         raise NeurohoverError(f"no settings named {args.name!r}: allowed {', '.join(found)}, or an agent's name")
     print(format_settings(found[name], name))

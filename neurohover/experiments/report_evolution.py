@@ -355,6 +355,11 @@ class EvolutionSection(Section):
             parts.append(self.table3())
         return "\n".join(parts)
 
+    def _validated_finals(self, vkey: str) -> dict[tuple, float]:
+        """(MDP, run) -> mean validation return of variant ``vkey``'s validated runs."""
+        runs = {(key.mdp, key.rep): self.results[k] for k, key in self.keys.items() if key.stage == "evolve" and key.group == vkey}
+        return {at: r.final_score for at, r in runs.items() if isinstance(r, EvolveResult) and r.validation is not None}
+
     def _paired_within(self) -> str:
         """Variants paired with another variant of this experiment (``paired_with``: the same seeds, MDPs and validation
         episodes run by run), compared pair by pair on the mean validation return (Wilcoxon signed-rank)."""
@@ -364,12 +369,7 @@ class EvolutionSection(Section):
             other = v.paired_with
             if other is None or other == v.key or other not in keys:
                 continue
-
-            def finals(vkey: str) -> dict[tuple, float]:
-                runs = {(key.mdp, key.rep): self.results[k] for k, key in self.keys.items() if key.stage == "evolve" and key.group == vkey}
-                return {at: r.final_score for at, r in runs.items() if isinstance(r, EvolveResult) and r.validation is not None}
-
-            mine, theirs = finals(v.key), finals(other)
+            mine, theirs = self._validated_finals(v.key), self._validated_finals(other)
             common = sorted(set(mine) & set(theirs), key=str)
             if len(common) < 2:
                 continue
