@@ -157,6 +157,22 @@ def test_a_single_valued_option_given_twice_is_refused(cli, capsys, argv: list[s
     assert stop.value.code == 2 and "is given more than once: give it once" in err and "Traceback" not in err
 
 
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["fly", "--task", "ghh08", "--episodes", "\u0663"],  # Arabic-Indic 3: int() reads it as 3
+        ["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "\u0661", "--episodes", "2"],
+        ["evolve", "--task", "ghh08", "--out", "x.json", "--checkpoint-every", "\u0661.5"],
+    ],
+)
+def test_a_number_in_other_scripts_digits_is_refused(cli, capsys, argv: list[str]) -> None:
+    """Python's int() and float() read any script's digits; the command line takes ASCII digits only (bad-input trial)."""
+    with pytest.raises(SystemExit) as stop:
+        cli(*argv)
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and "is not allowed: give a number in ASCII digits" in err and "Traceback" not in err
+
+
 def test_a_repeated_key_of_a_key_value_option_is_refused(cli, tmp_path: Path) -> None:
     rc, _, err = cli("evolve", "--task", "ghh08", "--out", "x.json", "--setting", "pop_size=30", "--setting", "pop_size=40")
     assert rc == 2 and "--setting pop_size=... is given more than once (pop_size=30 and pop_size=40)" in err

@@ -66,7 +66,8 @@ def test_it_runs_on_every_family_and_takes_a_config_groups_settings(tmp_path) ->
     config = tmp_path / "c.toml"
     config.write_text(
         'name = "c"\ntitle = "t"\nkind = "test_runs"\n[settings]\ntask = "ghh09"\nseed = 1\nepisodes = 2\npolicies = "shipped"\n'
-        'drift = { change = { D_w = 0.8 } }\n[[settings.groups]]\nagent = "continual"\nn_mdps = 1\nsettings = { window = 3, threshold = 1.5 }\n'
+        "drift = { change = { D_w = 0.8 }, change_at = [1, 1] }\n"
+        '[[settings.groups]]\nagent = "continual"\nn_mdps = 1\nsettings = { window = 3, threshold = 1.5 }\n'
         "[scales.quick]\n"
     )
     (unit,) = plan(load_config(str(config), "quick"), {}, {}).units

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import sqlite3
 
 import numpy as np
@@ -55,12 +56,22 @@ def test_drifted_rows_start_at_the_mdp_change_once_and_walk_by_the_stated_std() 
         (lambda: Drift.from_dict({"walk": "abc"}), "walk='abc' is out of range"),
         (lambda: Drift.from_dict({"walk": True}), "walk=True is out of range"),
         (lambda: Drift.from_dict({"change_at": 5}), "change_at=5 is not allowed"),
+        (lambda: Drift.from_dict({"walk": 0.01, "change_at": [3, 5]}), "change_at=[3, 5] is given without a change"),  # was ignored
+        (lambda: Drift.parse("walk=0.01@3-5"), "change_at=[3, 5] is given without a change"),
         (lambda: get_task_family("ghh08").with_drift("slow"), "must be a neurohover Drift"),  # type: ignore[arg-type]
     ],
 )
 def test_bad_drift_settings_get_one_clear_message(make, message: str) -> None:
-    with pytest.raises(NeurohoverError, match=message.replace("(", r"\(").replace(")", r"\)")):
+    with pytest.raises(NeurohoverError, match=re.escape(message)):
         make()
+
+
+def test_a_test_run_too_short_for_its_change_is_refused() -> None:
+    """run_test flew a change due at episode 200..800 in 12 episodes as if fixed (bad-input trial); the last possible episode is allowed."""
+    mdp = get_task_family("ghh08").mdp("test:3")
+    with pytest.raises(NeurohoverError, match=re.escape("drift change_at=[200, 800] can come after the last of a test run's 12 episodes")):
+        _generic_run(mdp.with_drift(Drift.parse("D_w=0.8")))
+    assert _generic_run(mdp.with_drift(Drift.parse("D_w=0.8@11")), episodes=12).returns.shape == (12,)
 
 
 def test_parse_reads_the_command_lines_form() -> None:
@@ -95,13 +106,17 @@ def test_test_runs_config_and_groups_carry_the_drift_into_their_units(tmp_path) 
         'name = "drift"\ntitle = "t"\nkind = "test_runs"\n[settings]\ntask = "ghh08"\nseed = 3\nepisodes = 2\npolicies = "shipped"\n'
         "drift = { walk = 0.01 }\n"
         '[[settings.groups]]\nagent = "generic"\nn_mdps = 1\n'
-        '[[settings.groups]]\nagent = "generic"\nlabel = "stepped"\nn_mdps = 1\ndrift = { change = { D_w = 0.8 }, change_at = [5, 9] }\n[scales.quick]\n'
+        '[[settings.groups]]\nagent = "generic"\nlabel = "stepped"\nn_mdps = 1\ndrift = { change = { D_w = 0.8 }, change_at = [0, 1] }\n[scales.quick]\n'
     )
     units = {u.key: u for u in plan(load_config(str(config), "quick"), {}, {}).units}
     assert MDP.from_dict(units["run/generic/test0/rep0"].params["mdp"]).drift == Drift(0.01)
-    assert MDP.from_dict(units["run/stepped/test0/rep0"].params["mdp"]).drift == Drift(0.0, (("D_w", 0.8),), (5, 9))
+    assert MDP.from_dict(units["run/stepped/test0/rep0"].params["mdp"]).drift == Drift(0.0, (("D_w", 0.8),), (0, 1))
     config.write_text(config.read_text().replace("walk = 0.01", "walk = -1"))
     with pytest.raises(NeurohoverError, match="drift"):
+        load_config(str(config), "quick")
+    # A change some 2-episode runs would never reach was silently never flown (bad-input trial): refused by name.
+    config.write_text(config.read_text().replace("walk = -1", "walk = 0.01").replace("[0, 1]", "[1, 2]"))
+    with pytest.raises(NeurohoverError, match=re.escape("group 'stepped': drift change_at=[1, 2] can come after the last of a test run's 2 episodes")):
         load_config(str(config), "quick")
 
 

@@ -69,6 +69,39 @@ def test_fghh_sigma_kwarg() -> None:
     assert gym.make("neurohover/FGHH-v0", sigma=0.2).unwrapped.family.sigma == 0.2
 
 
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: gym.make("neurohover/GHH08-v0", task="ghh09"),
+        lambda: gym.make("neurohover/GHH08-RL-v0", task="fghh"),
+        lambda: gym.make_vec("neurohover/GHH08-v0", num_envs=2, vectorization_mode="vector_entry_point", task="ghh09"),
+    ],
+)
+def test_a_task_that_is_not_the_ids_is_refused(make) -> None:
+    """Gymnasium merges make()'s kwargs over the id's: a GHH-09 env under a GHH-08 id was built without a word (bad-input trial)."""
+    with pytest.raises(NeurohoverError, match="is the ghh08 task family: task='(ghh09|fghh)' conflicts with it"):
+        make()
+    assert gym.make("neurohover/GHH08-v0", task="ghh08").unwrapped.family.name == "ghh08"  # the id's own task is no conflict
+
+
+def test_episodes_longer_than_the_ids_time_limit_are_warned_of() -> None:
+    """An episode_steps above the id's TimeLimit was truncated silently (bad-input trial); with the limit raised too, no warning."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        gym.make("neurohover/GHH08-Short-v0", episode_steps=6000)
+        gym.make_vec("neurohover/GHH08-Short-v0", num_envs=2, vectorization_mode="vector_entry_point", episode_steps=6000)
+    said = [str(w.message) for w in caught if "longer than the id's time limit of 1000 steps" in str(w.message)]
+    assert len(said) == 2 and "max_episode_steps=6000" in said[0]
+    _, rewards, terminated, truncated, _ = _fly(
+        gym.make("neurohover/GHH08-Short-v0", episode_steps=6000, mdp="zero"), lambda o: _baseline(o.astype(float)).astype(np.float32), seed=0
+    )
+    assert len(rewards) == 1000 and truncated and not terminated  # what the warning says: the id's limit cuts the episode
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        gym.make_vec("neurohover/GHH08-Short-v0", num_envs=2, vectorization_mode="vector_entry_point", episode_steps=6000, max_episode_steps=6000)
+    assert not [w for w in caught if "time limit" in str(w.message)]
+
+
 def test_reimport_does_not_register_twice() -> None:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

@@ -160,6 +160,7 @@ def test_a_neat_unit_validates_on_the_episodes_of_the_champion_it_is_paired_with
         ('topology = "neat"\nneat = { colour = 1 }', "unknown NEAT setting"),
         ('topology = "mlp"\nneat = { pop_size = 10 }', "neat applies to topology = 'neat'"),
         ('topology = "neat"\nresampling = "fixed:5"', "takes no resampling"),
+        ('topology = "neat"\nprototype = "zero"', "prototype = 'zero' does nothing for topology = 'neat'"),  # was ignored (bad-input trial)
     ],
 )
 def test_bad_neat_variants_are_refused_when_the_config_loads(tmp_path: Path, variant: str, message: str) -> None:

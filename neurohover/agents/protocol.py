@@ -158,6 +158,7 @@ def _check_run(agent, family, mdp, episodes, seed) -> int:
     if not isinstance(episodes, (int, np.integer)) or episodes < 1:
         raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
     check_episode_count(int(episodes), f"episodes={episodes}")
+    mdp.drift.check_run(int(episodes))
     return check_seed(seed)
 
 

@@ -108,6 +108,32 @@ def sensed_family(task: str, sigma: float | None, obs_noise: Any, obs_delay: Any
     return get_task_family(task, sigma, sensor=Sensor.of(obs_noise, obs_delay))
 
 
+def check_against_id(spec: Any, family: TaskFamily, episode_steps: int, limit: int | None = None) -> None:
+    """What ``gymnasium.make(id, **kwargs)`` built, checked against the id (``spec``, set once the env is made): a
+    ``task`` that is not the id's is refused; episodes longer than the id's time limit are warned of (``limit``:
+    the truncation the environment applies itself, where it knows it: the vector environment's)."""
+    registered = gym.registry.get(getattr(spec, "id", None) or "")
+    if registered is None:  # made directly, or from an unregistered spec
+        return
+    task = registered.kwargs.get("task")
+    if task is not None and task != family.name:
+        ids = [
+            i
+            for i, r in gym.registry.items()
+            if i.startswith("neurohover/") and r.kwargs.get("task") == family.name and r.entry_point == registered.entry_point
+        ]
+        raise NeurohoverError(
+            f"{spec.id} is the {task} task family: task={family.name!r} conflicts with it; make a {family.name} id instead ({', '.join(ids[:3])})"
+        )
+    applied = registered.max_episode_steps if limit is None else limit
+    if applied is not None and applied == registered.max_episode_steps and episode_steps > applied:
+        limit = applied
+        gym.logger.warn(
+            f"{spec.id}: episode_steps={episode_steps} is longer than the id's time limit of {limit} steps: every episode is "
+            f"truncated at {limit} unless make() or make_vec() is given max_episode_steps={episode_steps} too"
+        )
+
+
 def check_no_unknown_kwargs(unknown: dict[str, Any], allowed: Sequence[str]) -> None:
     """A clear error for keyword arguments an environment does not take (a typo would be a TypeError)."""
     if unknown:
@@ -299,7 +325,9 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
       family's mean MDP), ``"train:N"`` / ``"test:N"`` (the family's fixed training and test
       MDPs), or an explicit :class:`neurohover.MDP`.
     - ``episode_steps``: control steps per episode (6000). ``gymnasium.make`` also adds a
-      ``TimeLimit`` of 6000 steps; pass ``max_episode_steps`` to ``make`` for longer episodes.
+      ``TimeLimit`` of the id's episode length; pass ``max_episode_steps`` to ``make`` for longer
+      episodes (a longer ``episode_steps`` alone is warned of). ``task`` is the id's: another task
+      under an id is refused.
     - ``obs_dtype``: ``"float64"`` (default) or ``"float32"`` (for deep-RL libraries): the
       observation space's dtype and the returned observations'. The simulation itself always
       runs in float64, so the episodes are the same, observations rounded to float32.
@@ -417,6 +445,18 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         self._trail: list[np.ndarray] = []
         self._renderer: Any = None
         self._window: Any = None
+
+    _env_spec: Any = None
+
+    @property
+    def spec(self) -> Any:
+        """Gymnasium's ``EnvSpec`` of the environment (None unless made by ``gymnasium.make``)."""
+        return self._env_spec
+
+    @spec.setter
+    def spec(self, value: Any) -> None:  # gymnasium.make sets it on the env it built: the kwargs it merged are checked here
+        check_against_id(value, self.family, self.episode_steps)
+        self._env_spec = value
 
     @property
     def mdp(self) -> MDP | None:

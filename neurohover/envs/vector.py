@@ -39,6 +39,7 @@ from .hover import (
     MdpSpec,
     action_space,
     check_action_dtype,
+    check_against_id,
     check_episode_steps,
     check_no_unknown_kwargs,
     check_noise_stream,
@@ -196,6 +197,18 @@ class HoverVectorEnv(VectorEnv):
         self._stepper = stepper(device, self._rows, self._index, self._state, self._noise, self._rng, self._steps)
 
     # -- read-only views -------------------------------------------------------------------
+
+    _env_spec: Any = None
+
+    @property
+    def spec(self) -> Any:
+        """Gymnasium's ``EnvSpec`` of the environment (None unless made by ``gymnasium.make_vec``)."""
+        return self._env_spec
+
+    @spec.setter
+    def spec(self, value: Any) -> None:  # make_vec sets it on the env it built: the kwargs it merged are checked here
+        check_against_id(value, self.family, self.episode_steps, self.max_episode_steps)
+        self._env_spec = value
 
     @property
     def mdps(self) -> list[MDP | None]:

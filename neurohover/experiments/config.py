@@ -41,7 +41,7 @@ from typing import Any
 from ..errors import NeurohoverError
 from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..models.model import LEGACY_MODEL_SUBSTEPS
-from .schema import SCHEMAS, check_kind, validate_table
+from .schema import SCHEMAS, check_given, check_kind, validate_table
 from .settings import ExperimentSettings, typed_settings
 
 CONFIG_DIR = Path(__file__).parent / "configs"
@@ -320,6 +320,7 @@ def make_config(
     if kind not in KINDS:
         raise NeurohoverError(f"{where}: kind = {kind!r} is not allowed: expected one of {', '.join(KINDS)}")
     resolved = validate_table(dict(settings), SCHEMAS[kind], where)
+    check_given(settings, where)
     check_kind(resolved, kind, where)
     from .plans import external_digest
 

@@ -23,7 +23,7 @@ from ..evolution.optimisers import OPTIMISERS
 from ..integrations.neat import NEAT_TOPOLOGY
 from ..models.lr import DEFAULT_NOISE_ESTIMATE
 from ..models.model import default_model_substeps
-from ..tasks import TASK_FAMILIES
+from ..tasks import TASK_FAMILIES, Drift
 from .checks import OMIT, REQUIRED, resampling, schema_of
 from .settings import KIND_SETTINGS
 
@@ -83,6 +83,17 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
         _check_mdp_counts(settings, where)
     if kind == "test_runs":
         _check_test_runs(settings, task, where)
+
+
+def check_given(settings: dict, where: str) -> None:
+    """Refuse a setting given where it does nothing (``settings`` as written, before defaults fill them in):
+    a NEAT variant's ``prototype`` (NEAT starts from its own genomes: its neat table's ``start``)."""
+    for i, v in enumerate(settings.get("variants") or []):
+        if isinstance(v, dict) and v.get("topology") == NEAT_TOPOLOGY and "prototype" in v:
+            raise NeurohoverError(
+                f"{where}, variants[{i}]: prototype = {v['prototype']!r} does nothing for topology = 'neat': NEAT starts from its own "
+                "genomes; give neat = { start = 'baseline' } for the baseline-equivalent start, or leave prototype out"
+            )
 
 
 def _check_neat_variant(settings: dict, v: dict, where: str) -> None:
@@ -206,6 +217,9 @@ def _check_test_runs(settings: dict, task: str, where: str) -> None:
         if task not in AGENTS[g["agent"]].tasks:
             raise NeurohoverError(f"{where}: agent {g['agent']!r} does not apply to task {task!r}")
         g["label"] = g["label"] or g["agent"]
+        drift = g.get("drift") or settings.get("drift")
+        if drift:  # a table checked by Drift (drift_table()); its change must come within the runs
+            Drift.from_dict(drift).check_run(settings["episodes"], f"{where}: group {g['label']!r}")
         lr_keys = [k for k in ("d_u", "noise", "model_policy", "model_substeps") if k in g]
         if lr_keys and not AGENTS[g["agent"]].learns_models:
             learners = ", ".join(name for name, spec in AGENTS.items() if spec.learns_models)

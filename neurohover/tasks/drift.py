@@ -68,7 +68,18 @@ class Drift:
             raise NeurohoverError(f"drift change_at={self.change_at!r} is not allowed: give two episode numbers lo, hi with 0 <= lo <= hi") from None
         if not 0 <= lo <= hi or list(self.change_at) != [lo, hi]:
             raise NeurohoverError(f"drift change_at={self.change_at!r} is out of range: allowed whole episode numbers 0 <= lo <= hi")
+        if not self.change and (lo, hi) != CHANGE_AT:  # said when, but no change to happen then: nothing would
+            raise NeurohoverError(f"drift change_at={[lo, hi]} is given without a change: {_PARSE_FORM}")
         object.__setattr__(self, "change_at", (lo, hi))
+
+    def check_run(self, episodes: int, where: str = "") -> None:
+        """Refuse an abrupt change that some test runs of ``episodes`` episodes would never reach (``where``: a prefix naming the run)."""
+        if self.change and self.change_at[1] >= episodes:
+            lo, hi = self.change_at
+            raise NeurohoverError(
+                f"{where + ': ' if where else ''}drift change_at={[lo, hi]} can come after the last of a test run's {episodes} episodes, so some "
+                f"runs would never change: give change_at within 0..{episodes - 1} (e.g. D_w=0.8@{min(lo, episodes - 1)}-{episodes - 1}) or more episodes"
+            )
 
     @property
     def none(self) -> bool:

@@ -15,10 +15,10 @@ until the first one arrives). Reward and crash test stay on the true state, as i
 =============  =======  ==========================================================
 setting        unit     meaning
 =============  =======  ==========================================================
-velocity       m/s      std of the noise on u, v, w (body frame)
-position       m        std of the noise on x, y, z (body frame)
-rates          rad/s    std of the noise on p, q, r
-attitude       1        std of the noise on the quaternion's qx, qy, qz
+velocity       m/s      std of the noise on u, v, w (body frame), 0..100
+position       m        std of the noise on x, y, z (body frame), 0..100
+rates          rad/s    std of the noise on p, q, r, 0..100
+attitude       1        std of the noise on the quaternion's qx, qy, qz, 0..100
 correlation    1        AR(1) coefficient rho of the noise, 0 <= rho < 1
 delay          steps    control steps (0.1 s each) the readings arrive late, 0..10
 =============  =======  ==========================================================
@@ -37,6 +37,11 @@ from ..sim.constants import MAX_SENSOR_DELAY, SENSOR_GROUPS
 
 #: The std of each group at noise level 1 (velocity m/s, position m, rates rad/s, attitude).
 LEVEL_PROFILE = (0.1, 0.1, 0.1, 0.01)
+#: The largest std of a group: 100 m/s, m or rad/s is twenty times the crash box's 5 m/s (and 20 m), so readings
+#: carry nothing of the state; a larger value is a typo (e.g. 1e300 would overflow a policy's hidden layer).
+MAX_STD = 100.0
+#: The largest noise level: the one whose profile reaches MAX_STD.
+MAX_LEVEL = MAX_STD / max(LEVEL_PROFILE)
 
 
 @dataclass(frozen=True)
@@ -55,6 +60,8 @@ class Sensor:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
                 raise NeurohoverError(f"sensor {name}={value!r} is out of range: allowed a finite number >= 0")
+            if name != "correlation" and value > MAX_STD:
+                raise NeurohoverError(f"sensor {name}={value!r} is out of range: allowed a std in 0..{MAX_STD:g}")
             object.__setattr__(self, name, float(value))
         if self.correlation >= 1.0:
             raise NeurohoverError(f"sensor correlation={self.correlation!r} is out of range: allowed 0 <= correlation < 1")
@@ -87,8 +94,8 @@ class Sensor:
     @classmethod
     def at_level(cls, level: float, correlation: float = 0.0, delay: int = 0) -> Sensor:
         """The sensor of noise level ``level``: :data:`LEVEL_PROFILE` scaled by it."""
-        if isinstance(level, bool) or not isinstance(level, (int, float)) or not math.isfinite(level) or level < 0:
-            raise NeurohoverError(f"sensor noise level={level!r} is out of range: allowed a finite number >= 0")
+        if isinstance(level, bool) or not isinstance(level, (int, float)) or not math.isfinite(level) or not 0 <= level <= MAX_LEVEL:
+            raise NeurohoverError(f"sensor noise level={level!r} is out of range: allowed a number in 0..{MAX_LEVEL:g}")
         v, p, r, a = (level * s for s in LEVEL_PROFILE)
         return cls(v, p, r, a, correlation=correlation, delay=delay)
 
