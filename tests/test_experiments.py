@@ -671,11 +671,15 @@ def test_an_interrupt_ends_the_running_worker_processes_at_once() -> None:
 
 
 def test_the_report_opens_with_the_papers_claims_and_conclusions(committed_store: Path, tmp_path: Path) -> None:
-    """Issue 33: every claim checked at paper scale, with its verdict; a reversed effect is never counted as holding."""
+    """Issue 33: every claim checked at paper scale, with its verdict; a reversed effect is never counted as holding.
+    The hand-written account of the conclusions (issue 32) follows their table."""
+    (tmp_path / "discussion").mkdir()
+    (tmp_path / "discussion" / "conclusions-paper.md").write_text("**(5)** what the measurements say.\n")
     with Store(committed_store, create=False) as store:
         write_report(store, tmp_path, scale="paper", names=["table4", "fig8", "fig11"])
     text = (tmp_path / "report.md").read_text()
     top = text[text.index("## Claims and conclusions (paper scale)") : text.index("\n## Table 4")]
+    assert top.index("### The paper's conclusions") < top.index("### The conclusions, measured\n\n**(5)** what the measurements say.")
     rows = [line.split(" | ") for line in top.splitlines() if line.startswith("| [")]
     fig11 = [r for r in rows if r[0].startswith("| [fig11]") and " vs " in r[1]]
     assert len(fig11) == 2 and all(r[-1].startswith("reversed") for r in fig11)  # the paper's hybrids better; ours worse

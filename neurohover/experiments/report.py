@@ -25,6 +25,7 @@ from ..errors import NeurohoverError
 from .config import ORDER, ExperimentConfig, shipped_counterpart, with_shipped_paper
 from .keys import UnitKey
 from .report_base import Section, agent_panel, fmt, log_errors, new_figure, paired_p, ratio_verdict, sd, table
+from .report_claims import PAPER_FIGURES, claims_section, conclusions_discussion
 from .report_evolution import EvolutionSection
 from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, test_run_figure, varies
 from .report_models import SensorModels
@@ -538,7 +539,7 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
         f"their numbers are not comparable in magnitude with the paper's.\n\n" + "\n".join(toc) + "\n"
     )
     summary = claims_section(claims) if claims else ""
-    head += "\n" + summary if summary else ""
+    head += "\n" + summary + conclusions_discussion(out) if summary else ""
     path = out / "report.md"
     path.write_text(head + "\n" + "\n".join(sections))
     readme = out / "README.md"
@@ -546,52 +547,6 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
     if summary:
         fill_generated(readme, "claims", linked_claims(summary))
     return path
-
-
-#: The paper's tables and figures, whose claims the claims table lists (at paper scale), in the paper's order.
-PAPER_FIGURES = ("fig2", "table4", "fig7", "fig8", "fig11", "fig12", "fig13", "fig15", "fig16")
-
-#: The paper's conclusions (Section 8) and the figures whose tests bear on each.
-CONCLUSIONS = (
-    ("(1) neuroevolution can be effective for complex on-line reinforcement learning tasks", ("fig2", "fig7", "fig8")),
-    ("(2) neuroevolution excels at finding effective policies but not at learning helicopter models", ("table4",)),
-    ("(3)-(4) model-based approaches are feasible, and superior, only with a suitable model representation", ("fig7", "fig8", "fig11")),
-    ("(5) efficient resampling lets neuroevolution tackle more aggressively generalized tasks", ("fig15", "fig16")),
-)
-
-
-def claims_section(claims: dict[str, tuple[str, list[dict[str, str]]]]) -> str:
-    """The report's first section: every claim of the paper's figures checked at paper scale, then each conclusion
-    with the verdicts of the claims that bear on it. A reversed effect is counted as reversed, never as agreement."""
-    rows = [
-        [f"[{name}](#{anchor})", c["claim"], c["paper"], c["ours"], c["verdict"]]
-        for name in PAPER_FIGURES
-        if name in claims
-        for anchor, checked in [claims[name]]
-        for c in checked
-    ]
-    if not rows:
-        return ""
-    lines = []  # each conclusion with the verdicts of the t tests and rankings of its figures (not their numbers)
-    for conclusion, figures in CONCLUSIONS:
-        verdicts = [c["verdict"] for f in figures if f in claims for c in claims[f][1] if c["kind"] in ("test", "ranking")]
-        tests = [v for v in verdicts if v]
-        held = sum(v.startswith("holds") or v.startswith("within") for v in tests)
-        reversed_ = sum(v.startswith("reversed") for v in tests)
-        where = ", ".join(f"[{f}](#{claims[f][0]})" for f in figures if f in claims) or "no figure at paper scale yet"
-        lines.append(
-            [conclusion, where, f"{held} of {len(tests)}", str(reversed_), str(len(tests) - held - reversed_)] if tests else [conclusion, where, "", "", ""]
-        )
-    return (
-        "## Claims and conclusions (paper scale)\n\n"
-        + table(["figure", "claim", "paper", "ours", "verdict"], rows)
-        + "\n\nEach t test's verdict weighs direction before significance: *holds* (same direction, as significant), "
-        "*same direction, weaker* or *not significant*, *reversed* (the effect runs the other way, whatever the p-values). "
-        "Numbers: *within a factor of two* of the paper's, or how many times it. Each figure's section says why a claim differs.\n\n"
-        "### The paper's conclusions\n\n"
-        + table(["conclusion (Section 8)", "figures", "claims that hold", "reversed", "weaker, not significant or otherwise differing"], lines)
-        + "\n"
-    )
 
 
 def _anchor(title: str) -> str:
