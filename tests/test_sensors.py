@@ -47,7 +47,7 @@ def test_exact_sensor_is_the_default_and_leaves_rows_and_dicts_as_they_were() ->
     assert "sensor" not in mdp.to_dict()  # older dicts (and the store's unit params) read the same
     noisy = mdp.with_sensor(CORRELATED)
     assert noisy != mdp and MDP.from_dict(noisy.to_dict()) == noisy
-    assert noisy.row()[ROW_SENSOR].tolist() == [0.2, 0.3, 0.1, 0.02, 0.9, 0.0]
+    assert noisy.row()[ROW_SENSOR].tolist() == [0.2, 0.3, 0.1, 0.02, 0.9, 0.0, 0.0]
 
 
 @pytest.mark.parametrize(
@@ -70,6 +70,17 @@ def test_exact_sensor_is_the_default_and_leaves_rows_and_dicts_as_they_were() ->
 def test_bad_sensor_settings_get_one_clear_message(make, message: str) -> None:
     with pytest.raises(NeurohoverError, match=re.escape(message)):
         make()
+
+
+def test_a_dropout_is_read_from_text_and_tables_and_left_out_of_dicts_without_one() -> None:
+    sensor = Sensor.parse("level=1,dropout=0.2", delay=1)
+    assert sensor == Sensor(0.1, 0.1, 0.1, 0.01, delay=1, dropout=0.2) and Sensor.from_dict(sensor.to_dict()) == sensor
+    assert sensor.row_values()[-1] == 0.2 and Sensor.from_row_values(sensor.row_values()) == sensor
+    assert "dropout" not in Sensor.at_level(1.0).to_dict()  # the store's unit params of sensors before it read the same
+    assert not Sensor(dropout=0.2).exact
+    for bad in (1.0, -0.1, float("nan"), True):
+        with pytest.raises(NeurohoverError, match="dropout=.* is out of range: allowed a probability 0 <= dropout < 1"):
+            Sensor(dropout=bad)
 
 
 def test_sensor_text_and_levels() -> None:
@@ -102,7 +113,17 @@ def test_kernel_refuses_raw_rows_with_an_invalid_sensor_model(slot: int, value: 
 # -- the kernel against the reference simulator, and what the sensors may not change -------
 
 
-@pytest.mark.parametrize("sensor", [Sensor.at_level(1.0), CORRELATED, Sensor.at_level(0.5, correlation=0.5, delay=3), Sensor(delay=10)])
+@pytest.mark.parametrize(
+    "sensor",
+    [
+        Sensor.at_level(1.0),
+        CORRELATED,
+        Sensor.at_level(0.5, correlation=0.5, delay=3),
+        Sensor(delay=10),
+        Sensor(dropout=0.3),
+        Sensor(0.1, 0.1, 0.1, 0.01, correlation=0.8, delay=2, dropout=0.5),
+    ],
+)
 def test_kernel_agrees_with_the_reference_simulator_under_sensor_noise(sensor: Sensor) -> None:
     mdp = get_task_family("ghh09").training_mdps()[2].with_sensor(sensor)
     n = 300
@@ -112,7 +133,7 @@ def test_kernel_agrees_with_the_reference_simulator_under_sensor_noise(sensor: S
         baseline_policy().act,
         episode_normals(np.uint64(SEED), np.uint64(EPISODE), n).tolist(),
         n,
-        sensor_normals(np.uint64(SEED), np.uint64(EPISODE), n + 1).tolist(),
+        sensor_normals(np.uint64(SEED), np.uint64(EPISODE), n + 1, per_reading=13 if sensor.dropout else 12).tolist(),
     )
     readings = ev.flight_data.observations[0]
     assert bool(ev.crashed[0]) == ref_crash and readings.shape == (len(ref_readings), 12)
@@ -136,6 +157,22 @@ def test_a_delay_shifts_the_readings_by_that_many_steps() -> None:
     late = fly(mdp.with_sensor(Sensor(delay=3)), open_loop(), 100).flight_data.observations[0]
     expected = np.concatenate([np.repeat(true_obs[:1], 3, axis=0), true_obs[:-3]])
     assert np.array_equal(late, expected)
+
+
+def test_a_dropout_loses_the_stated_share_of_readings_and_holds_the_last_one() -> None:
+    """Each reading after the reset's is lost with probability p: the policy sees the one delivered last again."""
+    mdp = get_task_family("ghh08").mdp("train:1")
+    episodes = range(20)
+    exact = fly(mdp, open_loop(), 150, episodes).flight_data.observations
+    dropped = fly(mdp.with_sensor(Sensor(dropout=0.3)), open_loop(), 150, episodes).flight_data.observations
+    held = []
+    for true_obs, seen in zip(exact, dropped):
+        assert np.array_equal(seen[0], true_obs[0])  # the reset's reading always arrives
+        fresh = np.all(seen == true_obs, axis=1)  # exact sensors otherwise: a reading either arrives or is a repeat
+        repeat = np.r_[False, np.all(seen[1:] == seen[:-1], axis=1)]
+        assert np.all(fresh | repeat)
+        held.append(~fresh[1:])
+    assert np.mean(np.concatenate(held)) == pytest.approx(0.3, abs=0.03)  # 3,000 readings: std of the share 0.008
 
 
 def test_the_noise_has_the_stated_std_and_correlation() -> None:

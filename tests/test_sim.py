@@ -9,7 +9,7 @@ import pytest
 from scipy import stats
 
 from neurohover import MDP, DangerousState, NeurohoverError, Policy, Safeguard, baseline_policy, evaluate, evaluate_jobs, get_task_family, prototype
-from neurohover.sim.constants import CRASH_STEP_PENALTY, EPISODE_STEPS, MAX_RATE, MAX_VELOCITY, MIN_QW
+from neurohover.sim.constants import CRASH_STEP_PENALTY, EPISODE_STEPS, MAX_RATE, MAX_VELOCITY, MDP_ROW_LEN, MIN_QW
 from neurohover.sim.reference import fly_episode
 from neurohover.sim.rng import episode_normals
 
@@ -170,7 +170,7 @@ def test_crash_limits_are_spec_values() -> None:
         (lambda: evaluate_jobs([baseline_policy()], get_task_family("ghh08").zero(), [0], [0, 0], [0]), "mdp_index has 2 entries"),
         (lambda: evaluate(baseline_policy(), get_task_family("ghh08").zero(), episodes=0), "episodes=0"),
         (lambda: evaluate(baseline_policy(), get_task_family("ghh08").zero(), seed=-1), "seed=-1"),
-        (lambda: evaluate(baseline_policy(), np.zeros((1, 5))), "shape (M, 35)"),
+        (lambda: evaluate(baseline_policy(), np.zeros((1, 5))), f"shape (M, {MDP_ROW_LEN})"),
         (lambda: evaluate(baseline_policy(), get_task_family("ghh08").zero(), threads=999), "threads=999"),
         (lambda: Policy("mlp", np.zeros(40)), "mlp genome has 42 genes"),
         (lambda: Policy("rnn", np.zeros(40)), "unknown policy topology 'rnn'"),

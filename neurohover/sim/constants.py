@@ -64,13 +64,14 @@ ROW_WIND_START = 20  # (the kernel indexes from it: numba folds module-level int
 ROW_WIND = slice(ROW_WIND_START, ROW_WIND_START + 8)
 ROW_D_U = 28  # constant u acceleration: 0 in every true MDP; the paper's D_u of a learned model
 # The sensor model (docs/benchmarks.md, Sensor noise): what the policy, the safeguard and the flight
-# data see is the observation plus noise, read ``delay`` control steps late; all zero: exact sensors.
-ROW_SENSOR_START = 29  # std of the velocity, position, rate and attitude entries; AR(1) coefficient; delay
-ROW_SENSOR = slice(ROW_SENSOR_START, ROW_SENSOR_START + 6)
-MDP_ROW_LEN = 35
+# data see is the observation plus noise, read ``delay`` control steps late, each reading lost with
+# probability ``dropout`` (the last one delivered held instead); all zero: exact sensors.
+ROW_SENSOR_START = 29  # std of the velocity, position, rate and attitude entries; AR(1) coefficient; delay; dropout
+ROW_SENSOR = slice(ROW_SENSOR_START, ROW_SENSOR_START + 7)
+MDP_ROW_LEN = 36
 
 MAX_SENSOR_DELAY = 10  # control steps (1 s): the kernel's per-episode ring buffer holds MAX_SENSOR_DELAY + 1 readings
-SENSOR_SCRATCH = 12 * (MAX_SENSOR_DELAY + 2)  # floats a sensing episode keeps: the noise, then the ring buffer
+SENSOR_SCRATCH = 12 * (MAX_SENSOR_DELAY + 3)  # floats a sensing episode keeps: the noise, the reading held, the ring buffer
 SENSOR_GROUPS: tuple[str, ...] = ("velocity", "position", "rates", "attitude")  # 3 observation entries each
 
 OBS_NAMES: tuple[str, ...] = ("u", "v", "w", "x", "y", "z", "p", "q", "r", "qx", "qy", "qz")

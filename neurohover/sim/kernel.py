@@ -53,6 +53,7 @@ POLICY_SLP = 0
 POLICY_MLP = 1
 GENOME_WIDTH = 42  # genome rows are padded to the MLP's length
 SERIES_MAX_ANGLE = 0.5  # Taylor series below this rotation angle, libm above
+SQRT_HALF = math.sqrt(0.5)  # the normal CDF: Phi(z) = erfc(-z sqrt(1/2)) / 2 (a sensor dropout's uniform draw)
 
 
 @nb.njit(cache=True, inline="always", fastmath={"contract"})
@@ -289,10 +290,11 @@ def unpack_mdp(row):
 
 @nb.njit(cache=True)
 def unpack_sensor(row):
-    """The sensor model of an MDP row: (velocity, position, rate, attitude std, AR(1) coefficient, delay), and whether it senses at all."""
+    """The sensor model of an MDP row: (velocity, position, rate, attitude std, AR(1) coefficient, delay, dropout), and whether it senses at all."""
     s = ROW_SENSOR_START
-    sensor = (row[s], row[s + 1], row[s + 2], row[s + 3], row[s + 4], min(max(row[s + 5], 0.0), float(MAX_SENSOR_DELAY)))  # clamped: the buffer's size
-    on = row[s] != 0.0 or row[s + 1] != 0.0 or row[s + 2] != 0.0 or row[s + 3] != 0.0 or row[s + 5] != 0.0
+    delay = min(max(row[s + 5], 0.0), float(MAX_SENSOR_DELAY))  # clamped: the buffer's size
+    sensor = (row[s], row[s + 1], row[s + 2], row[s + 3], row[s + 4], delay, row[s + 6])
+    on = row[s] != 0.0 or row[s + 1] != 0.0 or row[s + 2] != 0.0 or row[s + 3] != 0.0 or row[s + 5] != 0.0 or row[s + 6] != 0.0
     return sensor, on
 
 
@@ -302,20 +304,28 @@ def sense(o, k, sensor, srng, scratch):
 
     The reading is ``o`` plus noise e, e_0 = std z and e_k = rho e_(k-1) + sqrt(1 - rho^2) std z
     (stationary std per entry group, 12 normals from the sensor stream ``srng`` per reading),
-    delivered ``delay`` readings late (the first reading until then). ``scratch``
-    (SENSOR_SCRATCH floats) holds e and the ring buffer of the last delay + 1 readings.
+    delivered ``delay`` readings late (the first reading until then). With a dropout p a 13th normal
+    z' per reading loses it when Phi(z') < p (never the reset's): the reading delivered last is held.
+    ``scratch`` (SENSOR_SCRATCH floats) holds e, the reading held and the ring buffer of the last delay + 1 readings.
     """
-    s_v, s_p, s_r, s_a, rho, d = sensor
+    s_v, s_p, s_r, s_a, rho, d, dropout = sensor
     delay = int(d)
     gain = math.sqrt(1.0 - rho * rho)
-    put = 12 + (k % (delay + 1)) * 12
+    put = 24 + (k % (delay + 1)) * 12
     for i in range(12):
         std = s_v if i < 3 else (s_p if i < 6 else (s_r if i < 9 else s_a))
         z = next_normal(srng)
         e = std * z if k == 0 else rho * scratch[i] + gain * (std * z)
         scratch[i] = e
         scratch[put + i] = o[i] + e
-    b = 12 + (max(k - delay, 0) % (delay + 1)) * 12
+    b = 24 + (max(k - delay, 0) % (delay + 1)) * 12
+    if dropout > 0.0:
+        lost = 0.5 * math.erfc(-next_normal(srng) * SQRT_HALF) < dropout and k > 0
+        if lost:
+            b = 12  # the reading held
+        else:
+            for i in range(12):
+                scratch[12 + i] = scratch[b + i]
     return (
         scratch[b], scratch[b + 1], scratch[b + 2], scratch[b + 3], scratch[b + 4], scratch[b + 5],
         scratch[b + 6], scratch[b + 7], scratch[b + 8], scratch[b + 9], scratch[b + 10], scratch[b + 11],

@@ -86,7 +86,7 @@ class ReferenceMDP:
     substeps: int = 10
     dt: float = 0.01
     d_u: float = 0.0  # constant u acceleration of a learned model (0 in every true MDP)
-    sensor: Sequence[float] = (0.0,) * 6  # noise std of velocity, position, rates, attitude; AR(1) coefficient; delay
+    sensor: Sequence[float] = (0.0,) * 7  # noise std of velocity, position, rates, attitude; AR(1) coefficient; delay; dropout
 
     def wind_at(self, t: float) -> Vec:
         """World-frame wind (m/s) at time t (for GHH-09, t as :func:`competition_time` floors it)."""
@@ -169,23 +169,28 @@ class ReferenceHelicopter:
 
 @dataclass
 class ReferenceSensors:
-    """The sensor model of docs/benchmarks.md, literally: noise e_k on each reading, delivered ``delay`` readings late."""
+    """The sensor model of docs/benchmarks.md, literally: noise e_k on each reading, delivered ``delay`` readings late,
+    each reading but the reset's lost with probability ``dropout`` (the one delivered last held instead)."""
 
     sensor: Sequence[float]
-    normals: Sequence[Sequence[float]]  # 12 standard normals per reading (rng.sensor_normals)
+    normals: Sequence[Sequence[float]]  # 12 standard normals per reading, 13 with a dropout (rng.sensor_normals)
     noise: list[float] = field(default_factory=lambda: [0.0] * 12)
     readings: list[list[float]] = field(default_factory=list)
+    delivered: list[float] = field(default_factory=list)
 
     def read(self, observation: Sequence[float]) -> list[float]:
         """The reading the policy gets now, of the true ``observation`` just made."""
         k = len(self.readings)
-        rho, delay = self.sensor[4], int(self.sensor[5])
+        rho, delay, dropout = self.sensor[4], int(self.sensor[5]), self.sensor[6]
         for i in range(12):
             std = self.sensor[i // 3]  # groups of three entries: velocity, position, rates, attitude
             z = self.normals[k][i]
             self.noise[i] = std * z if k == 0 else rho * self.noise[i] + math.sqrt(1.0 - rho * rho) * std * z
         self.readings.append([o + e for o, e in zip(observation, self.noise)])
-        return self.readings[max(k - delay, 0)]
+        lost = dropout > 0 and k > 0 and 0.5 * math.erfc(-self.normals[k][12] / math.sqrt(2.0)) < dropout  # Phi(z) < p
+        if not lost:
+            self.delivered = self.readings[max(k - delay, 0)]
+        return self.delivered
 
 
 def fly_episode(
@@ -197,7 +202,7 @@ def fly_episode(
 ) -> tuple[float, bool, list[list[float]]]:
     """Fly one episode; returns (return, crashed, observations after reset and every step).
 
-    With ``sensor_normals`` (n_steps + 1 rows of 12, :func:`neurohover.sim.rng.sensor_normals`)
+    With ``sensor_normals`` (n_steps + 1 rows of 12, or 13 with a dropout: :func:`neurohover.sim.rng.sensor_normals`)
     the policy flies on the readings of ``mdp.sensor``, and those readings are returned (as the
     kernel records them); the reward stays on the true observation.
     """

@@ -147,16 +147,17 @@ def seed_sensor_stream(state: np.ndarray, seed: np.uint64, episode: np.uint64) -
 
 
 @nb.njit(cache=True)
-def sensor_normals(seed: np.uint64, episode: np.uint64, n_readings: int) -> np.ndarray:
-    """The (n_readings, 12) standard normals that episode ``episode`` of ``seed`` feeds the sensor noise.
+def sensor_normals(seed: np.uint64, episode: np.uint64, n_readings: int, per_reading: int = 12) -> np.ndarray:
+    """The (n_readings, per_reading) standard normals that episode ``episode`` of ``seed`` feeds the sensor model.
 
     One row per reading: the reset's, then one after every control step, from
-    :func:`seed_sensor_stream`'s stream, so sensor noise never shifts the gusts.
+    :func:`seed_sensor_stream`'s stream, so sensor noise never shifts the gusts: 12 for the noise,
+    and a 13th (``per_reading=13``) that decides a dropout, where the sensor has one.
     """
     state = np.empty(4, dtype=np.uint64)
     seed_sensor_stream(state, seed, episode)
-    out = np.empty((n_readings, 12))
+    out = np.empty((n_readings, per_reading))
     for k in range(n_readings):
-        for j in range(12):
+        for j in range(per_reading):
             out[k, j] = next_normal(state)
     return out

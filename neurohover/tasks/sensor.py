@@ -8,7 +8,10 @@ observation entries that the policy, the safeguard and the recorded flight data 
 
 (z_k: 12 standard normals from the episode's own sensor stream, so noise never shifts the gusts;
 std: one per group of three entries), delivered ``delay`` control steps late (the reset's reading
-until the first one arrives). Reward and crash test stay on the true state, as in the simulator.
+until the first one arrives), and each reading after the reset's lost with probability ``dropout``
+(a 13th normal of the stream decides; the policy keeps the reading delivered last, as a controller
+holds its last motion-capture frame through an occlusion). Reward and crash test stay on the true
+state, as in the simulator.
 ``rho = 0`` is white noise; ``rho`` near 1 drifts as motion-capture errors do. The exact sensor
 (all zero) leaves every result bit-identical to a simulator without one.
 
@@ -21,6 +24,7 @@ rates          rad/s    std of the noise on p, q, r, 0..100
 attitude       1        std of the noise on the quaternion's qx, qy, qz, 0..100
 correlation    1        AR(1) coefficient rho of the noise, 0 <= rho < 1
 delay          steps    control steps (0.1 s each) the readings arrive late, 0..10
+dropout        1        probability that a reading is lost (the last one held), 0 <= p < 1
 =============  =======  ==========================================================
 
 A noise *level* L is the profile ``L * (0.1 m/s, 0.1 m, 0.1 rad/s, 0.01)``: at level 1 each
@@ -54,6 +58,7 @@ class Sensor:
     attitude: float = 0.0
     correlation: float = 0.0
     delay: int = 0
+    dropout: float = 0.0
 
     def __post_init__(self) -> None:
         for name in (*SENSOR_GROUPS, "correlation"):
@@ -65,6 +70,10 @@ class Sensor:
             object.__setattr__(self, name, float(value))
         if self.correlation >= 1.0:
             raise NeurohoverError(f"sensor correlation={self.correlation!r} is out of range: allowed 0 <= correlation < 1")
+        p = self.dropout
+        if isinstance(p, bool) or not isinstance(p, (int, float)) or not 0 <= p < 1:  # NaN fails the comparison too
+            raise NeurohoverError(f"sensor dropout={p!r} is out of range: allowed a probability 0 <= dropout < 1")
+        object.__setattr__(self, "dropout", float(p))
         d = self.delay
         if isinstance(d, bool) or not isinstance(d, int) or not 0 <= d <= MAX_SENSOR_DELAY:
             raise NeurohoverError(f"sensor delay={d!r} is out of range: allowed an integer number of control steps in 0..{MAX_SENSOR_DELAY}")
@@ -80,16 +89,16 @@ class Sensor:
         return (self.velocity, self.position, self.rates, self.attitude)
 
     def row_values(self) -> tuple[float, ...]:
-        """The six numbers of an MDP row's sensor slots (``sim.constants.ROW_SENSOR``)."""
-        return (*self.stds, self.correlation, float(self.delay))
+        """The seven numbers of an MDP row's sensor slots (``sim.constants.ROW_SENSOR``)."""
+        return (*self.stds, self.correlation, float(self.delay), self.dropout)
 
     @classmethod
     def from_row_values(cls, values) -> Sensor:
-        """The sensor of an MDP row's six sensor slots (refused clearly when they are not a valid sensor)."""
+        """The sensor of an MDP row's seven sensor slots (refused clearly when they are not a valid sensor)."""
         v = [float(x) for x in values]
         if not float(v[5]).is_integer():
             raise NeurohoverError(f"sensor delay={v[5]!r} in an MDP row is not a whole number of control steps")
-        return cls(v[0], v[1], v[2], v[3], correlation=v[4], delay=int(v[5]))
+        return cls(v[0], v[1], v[2], v[3], correlation=v[4], delay=int(v[5]), dropout=v[6])
 
     @classmethod
     def at_level(cls, level: float, correlation: float = 0.0, delay: int = 0) -> Sensor:
@@ -165,7 +174,11 @@ class Sensor:
         return replace(sensor, delay=delay)
 
     def to_dict(self) -> dict:
-        return asdict(self)
+        """The settings as a dict (``dropout`` only when set: a sensor's dict reads as it did before it existed)."""
+        d = asdict(self)
+        if not self.dropout:
+            del d["dropout"]
+        return d
 
     @classmethod
     def from_dict(cls, d: dict) -> Sensor:
