@@ -15,7 +15,6 @@ Example
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from typing import Any
 
 import gymnasium as gym
@@ -34,137 +33,30 @@ from ..sim.constants import (
 from ..sim.reference import competition_time
 from ..sim.rng import seed_stream
 from ..sim.step import ENV_NOISE_WIDTH, ENV_RNG_WIDTH, start_readings, step_batch
-from ..tasks import MDP, TASK_FAMILIES, TaskFamily, get_task_family
+from ..tasks import MDP, TASK_FAMILIES, TaskFamily
 from ..tasks.drift import Drift, DriftRun
-from ..tasks.sensor import Sensor
+from .arguments import (
+    SAMPLE,
+    MdpSpec,
+    check_action_dtype,
+    check_against_id,
+    check_episode_steps,
+    check_no_unknown_kwargs,
+    check_noise_stream,
+    check_obs_dtype,
+    check_reset_options,
+    draw_stream_seed,
+    resolve_mdp,
+    sensed_family,
+)
 
 RENDER_FPS = 10  # control rate (Hz)
 RENDER_MODES = ("human", "rgb_array")
 TRAIL_STEPS = 100  # positions kept for the rendered track: the last 10 s of flight
-OBS_DTYPES = ("float64", "float32")
-MAX_EPISODE_STEPS = 10**7
-MAX_NOISE_SEED = 2**63 - 1  # the largest seed ``neurohover.evaluate_jobs`` accepts
-SAMPLE = "sample"
-MDP_OPTIONS = ("zero", "sample", "train:N", "test:N")
-RESET_OPTION_KEYS = ("mdp", "noise")
-
-MdpSpec = str | MDP
-
-
-def resolve_mdp(family: TaskFamily, spec: Any, cache: dict[str, MDP] | None = None) -> MDP | str:
-    """The MDP that ``spec`` names, or ``SAMPLE`` for a fresh MDP from G at every reset.
-
-    Parameters
-    ----------
-    family : TaskFamily
-        The environment's task family (it resolves ``zero``, ``train:N`` and ``test:N``).
-    spec : str or MDP
-        ``"zero"``, ``"sample"``, ``"train:N"``, ``"test:N"`` or an explicit :class:`MDP` of the
-        family, or a learned model's (an MDP of another family is refused).
-    cache : dict, optional
-        Already resolved names; building the fixed sets is not free, so a vector environment
-        with many sub-environments resolves each name once.
-    """
-    if isinstance(spec, MDP):
-        if spec.family not in (family.name, "model"):
-            raise NeurohoverError(
-                f"mdp {spec.label or spec.family!r} is an MDP of {spec.family}, not of this environment's family {family.name}: "
-                f"give one of {family.name}'s MDPs (or a learned model)"
-            )
-        row = spec.row()
-        if row.shape != (MDP_ROW_LEN,) or not np.all(np.isfinite(row)) or spec.substeps < 1:
-            raise NeurohoverError(f"MDP {spec.label or spec!r} is not flyable: its parameters must be finite and substeps >= 1")
-        return spec
-    if not isinstance(spec, str):
-        raise NeurohoverError(f"mdp={spec!r} is not allowed: use one of {', '.join(MDP_OPTIONS)} or an MDP instance")
-    if spec == SAMPLE:
-        return SAMPLE
-    if cache is not None and spec in cache:
-        return cache[spec]
-    mdp = family.mdp(spec)  # raises NeurohoverError naming the allowed names
-    if cache is not None:
-        cache[spec] = mdp
-    return mdp
-
-
-def check_noise_stream(value: Any, what: str = "noise") -> tuple[int, int]:
-    """A ``(seed, episode)`` pair naming one gust-noise stream of the kernel, validated."""
-    try:
-        seed, episode = value
-    except (TypeError, ValueError):
-        raise NeurohoverError(f"{what}={value!r} is not allowed: give a (seed, episode) pair of integers") from None
-    for name, v, hi in (("seed", seed, MAX_NOISE_SEED), ("episode", episode, MAX_NOISE_SEED)):
-        if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or not 0 <= int(v) <= hi:
-            raise NeurohoverError(f"{what} {name}={v!r} is out of range: allowed an integer in 0..2**63-1")
-    return int(seed), int(episode)
 
 
 #: What ``gymnasium.make`` may pass to :class:`HoverEnv` (its ``max_episode_steps`` is Gymnasium's own).
 ENV_KWARGS = ("task", "sigma", "mdp", "episode_steps", "render_mode", "obs_dtype", "action_dtype", "obs_noise", "obs_delay", "drift")
-
-
-def sensed_family(task: str, sigma: float | None, obs_noise: Any, obs_delay: Any) -> TaskFamily:
-    """The environment's task family, seen through the sensor of ``obs_noise`` / ``obs_delay`` (:meth:`Sensor.of`)."""
-    return get_task_family(task, sigma, sensor=Sensor.of(obs_noise, obs_delay))
-
-
-def check_against_id(spec: Any, family: TaskFamily, episode_steps: int, limit: int | None = None) -> None:
-    """What ``gymnasium.make(id, **kwargs)`` built, checked against the id (``spec``, set once the env is made): a
-    ``task`` that is not the id's is refused; episodes longer than the id's time limit are warned of (``limit``:
-    the truncation the environment applies itself, where it knows it: the vector environment's)."""
-    registered = gym.registry.get(getattr(spec, "id", None) or "")
-    if registered is None:  # made directly, or from an unregistered spec
-        return
-    task = registered.kwargs.get("task")
-    if task is not None and task != family.name:
-        ids = [
-            i
-            for i, r in gym.registry.items()
-            if i.startswith("neurohover/") and r.kwargs.get("task") == family.name and r.entry_point == registered.entry_point
-        ]
-        raise NeurohoverError(
-            f"{spec.id} is the {task} task family: task={family.name!r} conflicts with it; make a {family.name} id instead ({', '.join(ids[:3])})"
-        )
-    applied = registered.max_episode_steps if limit is None else limit
-    if applied is not None and applied == registered.max_episode_steps and episode_steps > applied:
-        limit = applied
-        gym.logger.warn(
-            f"{spec.id}: episode_steps={episode_steps} is longer than the id's time limit of {limit} steps: every episode is "
-            f"truncated at {limit} unless make() or make_vec() is given max_episode_steps={episode_steps} too"
-        )
-
-
-def check_no_unknown_kwargs(unknown: dict[str, Any], allowed: Sequence[str]) -> None:
-    """A clear error for keyword arguments an environment does not take (a typo would be a TypeError)."""
-    if unknown:
-        raise NeurohoverError(f"unknown argument(s) {', '.join(sorted(unknown))}: allowed {', '.join(allowed)}")
-
-
-def check_episode_steps(episode_steps: Any) -> int:
-    """``episode_steps`` as an int, or a clear error."""
-    if isinstance(episode_steps, (bool, np.bool_)) or not isinstance(episode_steps, (int, np.integer)) or not 1 <= episode_steps <= MAX_EPISODE_STEPS:
-        raise NeurohoverError(f"episode_steps={episode_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
-    return int(episode_steps)
-
-
-def check_reset_options(options: dict[str, Any] | None, extra: Sequence[str] = ()) -> dict[str, Any]:
-    """``options`` as a dict whose keys are all known (a typo would otherwise be silently ignored)."""
-    if options is None:
-        return {}
-    if not isinstance(options, dict):
-        raise NeurohoverError(f"options={options!r} is not allowed: give a dict or None")
-    allowed = RESET_OPTION_KEYS + tuple(extra)
-    unknown = sorted(str(k) for k in options if k not in allowed)
-    if unknown:
-        raise NeurohoverError(f"unknown reset option(s) {', '.join(unknown)}: allowed {', '.join(allowed)}")
-    return options
-
-
-def draw_stream_seed(rng: np.random.Generator) -> int:
-    """A noise-stream seed (0..2**63-1) drawn from an environment's generator."""
-    # 63 raw bits: a tenth of the cost of Generator.integers, which matters when a vector
-    # environment resets hundreds of crashed helicopters per step.
-    return int(rng.bit_generator.random_raw()) >> 1
 
 
 def initial_state() -> np.ndarray:
@@ -172,21 +64,6 @@ def initial_state() -> np.ndarray:
     state = np.zeros(STATE_DIM)
     state[12] = 1.0
     return state
-
-
-def _check_dtype(value: Any, name: str) -> np.dtype:
-    try:
-        dtype = np.dtype(value)
-    except TypeError:
-        dtype = None
-    if value is None or dtype is None or dtype.name not in OBS_DTYPES:
-        raise NeurohoverError(f"{name}={value!r} is not allowed: use {' or '.join(map(repr, OBS_DTYPES))}")
-    return dtype
-
-
-def check_obs_dtype(obs_dtype: Any) -> np.dtype:
-    """``obs_dtype`` (``"float64"``, ``"float32"`` or the NumPy type) as a dtype, or a clear error."""
-    return _check_dtype(obs_dtype, "obs_dtype")
 
 
 def check_render_mode(render_mode: Any) -> str | None:
@@ -222,11 +99,6 @@ def observation_space(dtype: Any = np.float64) -> spaces.Box:
 
 def action_space(dtype: Any = np.float64) -> spaces.Box:
     return spaces.Box(-1.0, 1.0, (ACTION_DIM,), dtype)
-
-
-def check_action_dtype(action_dtype: Any) -> np.dtype:
-    """``action_dtype`` (``"float64"``, ``"float32"`` or the NumPy type) as a dtype, or a clear error."""
-    return _check_dtype(action_dtype, "action_dtype")
 
 
 class HoverEnv(gym.Env[np.ndarray, np.ndarray]):

@@ -33,11 +33,9 @@ from ..sim.constants import ACTION_DIM, EPISODE_STEPS, MDP_ROW_LEN, OBS_DIM
 from ..sim.rng import seed_stream
 from ..sim.step import ENV_NOISE_WIDTH, ENV_RNG_WIDTH, start_readings
 from ..tasks import MDP, TaskFamily, refuse_drift
-from .hover import (
-    RENDER_FPS,
+from .arguments import (
     SAMPLE,
     MdpSpec,
-    action_space,
     check_action_dtype,
     check_against_id,
     check_episode_steps,
@@ -46,12 +44,10 @@ from .hover import (
     check_obs_dtype,
     check_reset_options,
     draw_stream_seed,
-    initial_state,
-    mdp_info,
-    observation_space,
     resolve_mdp,
     sensed_family,
 )
+from .hover import RENDER_FPS, action_space, initial_state, mdp_info, observation_space
 
 MAX_NUM_ENVS = 10**7
 #: What ``gymnasium.make_vec`` may pass to :class:`HoverVectorEnv`.
