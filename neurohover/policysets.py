@@ -29,9 +29,10 @@ from __future__ import annotations
 
 import functools
 import json
+import shutil
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -258,13 +259,33 @@ def build_policy_set(
     progress : callable, optional
         Called with one line of text per finished run.
     """
-    from .evolution.optimisers import NE
 
     _check_build(lineage, optimizer)
     family = get_task_family(task)
-    root = policy_dir(family.name, out)
-    root.mkdir(parents=True, exist_ok=True)
-    say = progress or (lambda _msg: None)
+    final = policy_dir(family.name, out)
+    # Built beside the set it replaces, which it replaces only once complete: an interrupted build (or a
+    # failed one) leaves the old set, shipped or not, as it was.
+    root = final.with_name(final.name + ".building")
+    shutil.rmtree(root, ignore_errors=True)
+    root.mkdir(parents=True)
+    try:
+        built = _build(family, root, budget, fghh_budget, seed, safety_episodes, n_steps, lineage, optimizer, progress or (lambda _msg: None))
+    except BaseException:  # stopped or failed: nothing half-built is left (a killed build's is removed by the next)
+        shutil.rmtree(root, ignore_errors=True)
+        raise
+    old = final.with_name(final.name + ".replaced")
+    shutil.rmtree(old, ignore_errors=True)
+    if final.exists():
+        final.rename(old)
+    root.rename(final)
+    shutil.rmtree(old, ignore_errors=True)
+    return replace(built, directory=final)
+
+
+def _build(family, root: Path, budget, fghh_budget, seed, safety_episodes, n_steps, lineage, optimizer, say) -> PolicySet:
+    """:func:`build_policy_set`'s runs, written into ``root``."""
+    from .evolution.optimisers import NE
+
     manifest: dict = {"task": family.name, "budget": budget, "seed": seed, "n_steps": n_steps, "built": time.strftime("%Y-%m-%d %H:%M:%S")}
     if optimizer != NE:
         manifest["optimizer"] = optimizer
@@ -287,7 +308,6 @@ def build_policy_set(
     train = family.training_mdps()
     manifest["lineage"] = lineage
     ancestor = None
-    (root / "ancestor.json").unlink(missing_ok=True)  # never a stale one beside a rebuilt set
     if lineage == "chain":  # the ancestor: runs over the training MDPs in turn, each from the last champion
         for i, mdp in enumerate(train):
             ancestor = run(mdp, f"ancestor (stage {i + 1} of {len(train)}, training MDP {i})", int(seeds[12 + i]), ancestor, save=False, budget=budget)

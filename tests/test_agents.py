@@ -70,6 +70,7 @@ def test_run_rejects_bad_episode_counts() -> None:
 
 import csv  # noqa: E402
 import json  # noqa: E402
+import shutil  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 from neurohover.agents.hybrid import DISCARD_RETURN, HybridAgent, HybridSettings  # noqa: E402
@@ -98,6 +99,24 @@ def test_build_policies_writes_a_loadable_set_with_computed_safe_policies(tiny_p
     returns = np.array(manifest["mean_return_on_training_mdps"])
     assert tuple(manifest["safe"]) == choose_safe(crashes, returns) == ps.safe
     assert manifest["table3"] == table3_summary(crashes, returns)
+
+
+def test_a_stopped_rebuild_leaves_the_old_set_as_it_was(tiny_policy_dir: Path, tmp_path: Path) -> None:
+    """A rebuild of the shipped sets stopped after a minute had deleted their ancestor.json (bad-input trial):
+    a set is built beside the old one and replaces it only when complete."""
+    shutil.copytree(tiny_policy_dir / "ghh08", tmp_path / "ghh08")
+    before = {p.name: p.read_bytes() for p in (tmp_path / "ghh08").iterdir()}
+
+    def stop(_message: str) -> None:
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        build_policy_set("ghh08", tmp_path, budget=30, n_steps=100, safety_episodes=1, progress=stop)
+    assert {p.name: p.read_bytes() for p in (tmp_path / "ghh08").iterdir()} == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ghh08"]  # nothing half-built beside it
+    built = build_policy_set("ghh08", tmp_path, budget=30, n_steps=100, safety_episodes=1, lineage="independent")
+    assert built.directory == tmp_path / "ghh08" and sorted(p.name for p in tmp_path.iterdir()) == ["ghh08"]
+    assert not (tmp_path / "ghh08" / "ancestor.json").exists()  # the new set replaced the old one whole
 
 
 def test_table3_summary_averages_own_mdp_and_all_mdps() -> None:
