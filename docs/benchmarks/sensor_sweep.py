@@ -1,6 +1,6 @@
 """docs/benchmarks.md, "Where the policies start to crash": the baseline and each family's shipped
 generic policy on its first 20 test MDPs, 3 episodes each (seed 7), over sensor-noise levels,
-correlated noise and delays. Writes sensor_sweep.json beside this script (about 2 minutes on 2 cores).
+correlated noise, delays and dropouts. Writes sensor_sweep.json beside this script (about 2 minutes on 2 cores).
 
     python docs/benchmarks/sensor_sweep.py
 """
@@ -21,6 +21,7 @@ SENSORS = (
     + [(f"white, level {level:g}", Sensor.at_level(level)) for level in (0.5, 1, 2, 4)]
     + [(f"AR(1) 0.95, level {level:g}", Sensor.at_level(level, correlation=0.95)) for level in (0.5, 1, 2)]
     + [(f"delay {d} ({d / 10:g} s)", Sensor(delay=d)) for d in (1, 2, 3, 5)]
+    + [(f"dropout {p:g}", Sensor(dropout=p)) for p in (0.1, 0.3, 0.5, 0.8)]
 )
 
 
