@@ -116,5 +116,11 @@ def test_a_callable_that_does_not_import_or_returns_no_numbers_is_refused_by_nam
     assert rc == 2 and "act returned ndarray" in err and "expected numbers" in err
     rc, _, err = cli(*base, "--callable", "nh_broken:act")
     assert rc == 2 and "--callable 'nh_broken:act': SyntaxError" in err
+    # A function of the wrong signature, or one that raises, was a traceback (bad-input trial): its error, named.
+    (tmp_path / "nh_raises.py").write_text('def act(obs):\n    raise RuntimeError("boom")\n')
+    rc, _, err = cli(*base, "--callable", "nh_raises:act")
+    assert rc == 2 and "--callable 'nh_raises:act' raised RuntimeError: boom when called with a batch of observations" in err
+    rc, _, err = cli(*base, "--callable", "os:getcwd")
+    assert rc == 2 and "--callable 'os:getcwd' raised TypeError" in err and "Traceback" not in err
     rc, out, _ = cli(*base, "--policy", "baseline")
     assert rc == 0 and out.count("baseline") >= 1

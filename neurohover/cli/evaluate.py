@@ -20,6 +20,21 @@ from .options import add_sensor_options, add_sigma_option, add_task_option, task
 SOURCES = ("policy", "callable", "rl_zoo", "sb3", "cleanrl")
 
 
+def _reported(fn, spec: str):
+    """``fn`` whose failure (a wrong signature, an exception of its own) is one clear message naming it, not a traceback."""
+
+    def act(observations):
+        try:
+            return fn(observations)
+        except Exception as err:  # the user's code: what it raised, and what it is called with
+            raise NeurohoverError(
+                f"--callable {spec!r} raised {type(err).__name__}: {err} when called with a batch of observations, an array of shape "
+                f"{getattr(observations, 'shape', '?')}: it must take one such array and return actions of shape (B, 4)"
+            ) from None
+
+    return act
+
+
 def _agent(args: argparse.Namespace):
     """The agent of the one source given: a policy file's policy (flown in the kernel), or a batch function
     (observations -> actions)."""
@@ -46,7 +61,7 @@ def _agent(args: argparse.Namespace):
             raise NeurohoverError(f"--callable {args.callable!r}: SyntaxError: {err}") from None
         if not callable(fn):
             raise NeurohoverError(f"--callable {args.callable!r} is not a function")
-        return fn
+        return _reported(fn, args.callable)
     if args.cleanrl is not None:
         from ..integrations.cleanrl import cleanrl_policy
 
