@@ -75,6 +75,8 @@ def test_the_wins_command_gives_each_agents_odds_from_a_stores_test_runs(cli, tm
         (("--runs", "0,5"), "--runs '0,5' is not allowed: give whole numbers >= 1"),
         (("--agents", "hybrid,nobody"), "agent 'nobody' has no test runs in 'fig11' (quick): allowed"),
         (("--against", "nobody"), "agent 'nobody' has no test runs"),
+        (("--against", "hybrid", "--agents", "hybrid"), "--against hybrid leaves no other agent to compare with it"),  # was a traceback
+        (("--agents", "hybrid,hybrid"), "--agents 'hybrid,hybrid' names an agent twice"),
     ):
         rc, _, err = cli("wins", "fig11", "--store", store, *args)
         assert rc == 2 and message in err, err

@@ -148,8 +148,12 @@ def cmd_wins(args: argparse.Namespace) -> int:
     for label in [*chosen, *([args.against] if args.against else [])]:
         if label not in runs:
             raise NeurohoverError(f"agent {label!r} has no test runs in {args.name!r} ({scale}): allowed {', '.join(runs)}")
+    if len(set(chosen)) != len(chosen):
+        raise NeurohoverError(f"--agents {args.agents!r} names an agent twice: give each once")
     if args.against:
         fields = {a: {args.against: runs[args.against], a: runs[a]} for a in chosen if a != args.against}
+        if not fields:
+            raise NeurohoverError(f"--against {args.against} leaves no other agent to compare with it: give --agents others of {', '.join(runs)}")
     else:
         fields = {"all": {a: runs[a] for a in chosen}}
     rows = []
