@@ -57,8 +57,12 @@ def output_file(path: str | os.PathLike, option: str) -> Path:
     creates missing parent directories (saying so on standard error).
     """
     p = Path(path)
-    if str(path) == "" or p.is_dir():
+    if str(path) == "":
+        raise NeurohoverError(f"{option} is empty; give a file path")
+    if p.is_dir():
         raise NeurohoverError(f"{option} {str(path)!r} is a directory; give a file path")
+    if p.exists() and not p.is_file():  # written by replacing it, a device node (/dev/full) would become a file
+        raise NeurohoverError(f"{option} {str(path)!r} is not a regular file (a device, pipe or socket); give a file path")
     _make_dirs(p.parent, option, str(path))
     existed = p.exists()
     try:
@@ -106,6 +110,8 @@ def output_dir(path: str | os.PathLike, option: str) -> Path:
 def input_file(path: str | os.PathLike, option: str, what: str = "file") -> Path:
     """Check that ``path`` is an existing, readable regular file."""
     p = Path(path)
+    if str(path) == "":
+        raise NeurohoverError(f"{option} is empty; give a {what}")
     if not p.exists():
         raise NeurohoverError(f"{option} {str(path)!r}: no such {what}")
     if p.is_dir():

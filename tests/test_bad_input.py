@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from bad_input import CASES, run_case, setup
 
+from neurohover import NeurohoverError, get_task_family
 from neurohover.cli import main
 from neurohover.flightdata import FlightData
 
@@ -123,12 +124,26 @@ def test_the_script_prints_one_line_per_case() -> None:
         ["learn-model", "--flight-data", "fd.npz", "--method", "lr", "--out", "/dev/full"],
     ],
 )
-def test_a_full_disk_is_one_clear_line(args, workdir: Path, capsys, monkeypatch) -> None:
-    """issue 37: a write that fails (ENOSPC) was an OSError traceback."""
+def test_a_device_is_refused_as_an_output_file(args, workdir: Path, capsys, monkeypatch) -> None:
+    """issue 37: writing to /dev/full was an OSError traceback, to /dev/null a struct.error, and a checkpoint written by
+    replacing its file turned the device node into a regular file (second trial). A full disk: the RLIMIT test below."""
     monkeypatch.chdir(workdir)
     assert main(list(args)) == 2
     err = capsys.readouterr().err
-    assert err.strip().splitlines()[-1].endswith("'/dev/full': cannot write it (No space left on device); no partial file is left"), err
+    assert err.strip().splitlines()[-1].endswith("'/dev/full' is not a regular file (a device, pipe or socket); give a file path"), err
+    assert Path("/dev/full").is_char_device()
+
+
+def test_an_evolution_checkpoint_is_never_written_over_a_device_or_an_empty_path(tmp_path: Path) -> None:
+    from neurohover.evolution.evolve import evolve
+
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    zero = get_task_family("ghh08").zero()
+    for bad, message in ((fifo, "is not a regular file"), ("", "checkpoint is empty; give a file path"), (tmp_path, "is a directory")):
+        with pytest.raises(NeurohoverError, match=message):
+            evolve(zero, budget=5, n_steps=10, checkpoint=bad)
+    assert fifo.is_fifo()
 
 
 def test_a_write_cut_short_leaves_no_partial_file(tmp_path: Path) -> None:

@@ -62,6 +62,8 @@ def test_exact_sensor_is_the_default_and_leaves_rows_and_dicts_as_they_were() ->
         (lambda: Sensor.at_level(-1), "level=-1 is out of range"),
         (lambda: Sensor(velocity=1e300), "velocity=1e+300 is out of range: allowed a std in 0..100"),  # bad-input trial: was accepted
         (lambda: Sensor.parse("1e9"), "level=1000000000.0 is out of range: allowed a number in 0..1000"),
+        (lambda: Sensor.parse("velocity=0.1,,position=0.1"), "has an empty setting between commas"),  # was ignored (second trial)
+        (lambda: Sensor.parse("velocity=\u0661"), "give numbers in ASCII digits"),
         (lambda: Sensor.from_dict({"levle": 1}), "unknown sensor setting"),
         (lambda: Sensor.of(Sensor(delay=3), 2), "conflicts"),
         (lambda: get_task_family("ghh08").with_sensor("noisy"), "must be a neurohover Sensor"),  # type: ignore[arg-type]

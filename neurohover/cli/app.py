@@ -9,6 +9,7 @@ import argparse
 import os
 import sqlite3
 import sys
+import unicodedata
 from collections.abc import Sequence
 
 from .. import __version__
@@ -66,8 +67,20 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _other_scripts_digits(argv: Sequence[str]) -> str | None:
+    """The first argument that holds a digit of another script (Python's int() and float() read '\u0661' as 1, inside
+    --wind lists, KEY=VALUE settings and sensor text alike), or None."""
+    for arg in argv:
+        if any(not ch.isascii() and unicodedata.decimal(ch, None) is not None for ch in str(arg)):
+            return str(arg)
+    return None
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
+    odd = _other_scripts_digits(sys.argv[1:] if argv is None else argv)
+    if odd is not None:
+        parser.error(f"argument {odd!r} holds digits of another script: give numbers in ASCII digits")
     args = parser.parse_args(argv)
     from ..paths import forget_created_dirs, remove_created_dirs
 

@@ -106,6 +106,8 @@ def parse_resampling(spec: str | Resampling | None) -> Resampling:
         + ", ".join(RACE_RULES)
         + "), lucb:DELTA or kl-lucb:DELTA (error probability 0 < DELTA < 1)"
     )
+    if not text.isascii():  # int() and float() read other scripts' digits ('fixed:\u0661' would be fixed:1)
+        raise NeurohoverError(f"resampling {spec!r} is not allowed: numbers in ASCII digits; {allowed}")
     if kind == "fixed" and sep:
         if value.isdigit() and int(value) >= 1:
             return Resampling("fixed", int(value))

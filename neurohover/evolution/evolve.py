@@ -81,6 +81,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from ..evaluate import check_episode_count, evaluate_jobs, num_threads
+from ..paths import output_file
 from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP
@@ -124,7 +125,7 @@ def _prepare(run: Run, checkpoint, checkpoint_every_s, resume: bool, threads: in
     kernel before the run's clock starts (which also validates the thread count); the checkpoint's path."""
     if not isinstance(checkpoint_every_s, (int, float)) or not checkpoint_every_s > 0:
         raise NeurohoverError(f"checkpoint_every_s={checkpoint_every_s!r} must be a number > 0")
-    path = None if checkpoint is None else Path(checkpoint)
+    path = None if checkpoint is None else (Path(checkpoint) if resume else output_file(checkpoint, "checkpoint"))  # checked before the run
     if resume:
         if path is None:
             raise NeurohoverError("resume=True needs the checkpoint path")

@@ -142,8 +142,16 @@ class Drift:
     def parse(cls, text: str) -> Drift:
         """A drift from the command line: ``walk=0.01``, ``D_w=0.8@200-800`` (a change, at an episode in 200..800), or both, comma-separated."""
         walk, change, at = 0.0, {}, CHANGE_AT
-        for part in filter(None, (p.strip() for p in str(text).split(","))):
+        if not str(text).isascii() or not str(text).strip():  # float() and int() read other scripts' digits
+            raise NeurohoverError(f"drift {text!r} is not understood: {_PARSE_FORM}, numbers in ASCII digits")
+        seen: set[str] = set()
+        for part in (p.strip() for p in str(text).split(",")):
+            if not part:
+                raise NeurohoverError(f"drift {text!r} has an empty setting between commas: {_PARSE_FORM}")
             key, eq, value = part.partition("=")
+            if key.strip() in seen:
+                raise NeurohoverError(f"drift {text!r} sets {key.strip()} twice: give each once")
+            seen.add(key.strip())
             value, _, when = value.partition("@")
             try:
                 number = float(value)

@@ -117,6 +117,8 @@ class Sensor:
         """
         text = str(text).strip()
         allowed = ("level", *(f.name for f in fields(cls)))
+        if not text.isascii():  # float() reads other scripts' digits
+            raise NeurohoverError(f"sensor {text!r} is not understood: give numbers in ASCII digits")
         try:
             return cls.at_level(float(text), delay=delay)
         except ValueError as exc:
@@ -124,9 +126,11 @@ class Sensor:
                 raise
         settings: dict[str, float] = {}
         expected = f"allowed a noise level (e.g. 0.5) or key=value pairs with keys {', '.join(allowed)}"
-        for part in filter(None, (p.strip() for p in text.split(","))):
+        for part in (p.strip() for p in text.split(",")):
             key, eq, value = part.partition("=")
             key = key.strip()
+            if not part:
+                raise NeurohoverError(f"sensor {text!r} has an empty setting between commas: {expected}")
             if not eq or key not in allowed:
                 raise NeurohoverError(f"sensor setting {part!r} is not understood: {expected}")
             if key in settings:
