@@ -181,9 +181,16 @@ def _write_ghh_set(
     return PolicySet(task, root, generic, tuple(specialised), safe, manifest=manifest)
 
 
-def _check_build(lineage: str, optimizer: str) -> None:
+def _check_build(lineage: str, optimizer: str, **sizes) -> None:
+    """The build's settings checked before any run (a bad FGHH budget was refused only after the first generic was written)."""
     from .evolution.optimisers import optimiser_names
+    from .evolution.seeding import check_seed
 
+    for name, value in sizes.items():
+        if name == "seed":
+            check_seed(value)
+        elif isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+            raise NeurohoverError(f"{name}={value!r} is out of range: allowed a whole number >= 1")
     if lineage not in LINEAGES:
         raise NeurohoverError(f"lineage {lineage!r} is not known: allowed {', '.join(LINEAGES)}")
     if optimizer not in optimiser_names():
@@ -260,7 +267,7 @@ def build_policy_set(
         Called with one line of text per finished run.
     """
 
-    _check_build(lineage, optimizer)
+    _check_build(lineage, optimizer, budget=budget, fghh_budget=fghh_budget, seed=seed, safety_episodes=safety_episodes, n_steps=n_steps)
     family = get_task_family(task)
     final = policy_dir(family.name, out)
     # Built beside the set it replaces, which it replaces only once complete: an interrupted build (or a

@@ -79,6 +79,7 @@ CASES: list[tuple[list[str], str]] = [
     (["fly", "--task", "ghh08", "--mdp", ""], "unknown MDP ''"),
     (["build-policies", "--task", "fghh", "--lineage", "chain", "--budget", "10", "--out", "q"], "--lineage applies to the GHH tasks' specialised policies"),
     (["build-policies", "--task", "ghh08", "--fghh-budget", "10", "--out", "q"], "--fghh-budget applies to task fghh"),
+    (["build-policies", "--task", "fghh", "--budget", "20", "--fghh-budget", "0", "--out", "q"], "--fghh-budget 0 is out of range: allowed >= 1"),
     (["learn-model", "--flight-data", "fd.npz", "--method", "lr", "--seed", "3", "--out", "m.json"], "--seed applies to the evolutionary methods"),
 ]
 

@@ -145,6 +145,11 @@ def test_chain_lineage_seeds_every_run_from_the_ancestor_and_independent_from_th
         assert np.sum(policy.genome == base) > 30  # a 30-episode run from the baseline keeps most of its genes
     with pytest.raises(NeurohoverError, match="lineage 'tree' is not known: allowed chain, independent"):
         build_policy_set("ghh08", tmp_path, budget=30, lineage="tree")
+    # Refused before any run (a bad FGHH budget was refused only after the first generic was written; seed -1 was NumPy's error).
+    for kwargs, message in (({"seed": -1}, "seed=-1 is out of range"), ({"fghh_budget": 0}, "fghh_budget=0 is out of range")):
+        with pytest.raises(NeurohoverError, match=message):
+            build_policy_set("fghh", tmp_path / "refused", budget=30, **kwargs)
+    assert not (tmp_path / "refused").exists()
 
 
 def test_build_policies_and_the_planner_evolve_the_policies_of_one_recipe() -> None:

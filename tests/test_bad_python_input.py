@@ -131,6 +131,10 @@ def test_run_test_evaluate_jobs_and_the_env_check_their_arguments() -> None:
         evaluate_jobs([nh.baseline_policy()], [fam.zero()], [[0]], [[0]], [[0]], n_steps=5)
     with pytest.raises(NeurohoverError, match="seed=-1 is out of range"):
         gym.make("neurohover/GHH08-v0").reset(seed=-1)
+    # A task's name where a family goes was an AttributeError (issue 37, still there in the second trial): taken, as agent_spec takes it.
+    assert type(make_agent("incremental", "ghh08")) is type(make_agent("incremental", fam))
+    with pytest.raises(NeurohoverError, match="family=3 is not allowed: give a task family"):
+        make_agent("baseline", 3)  # type: ignore[arg-type]
 
 
 def test_a_run_on_another_familys_mdp_is_refused() -> None:

@@ -85,8 +85,14 @@ def check_agent(name: str, family: TaskFamily, policy_dir: str | None = None) ->
         spec.build(policies_from_set(spec, _policy_set(family, policy_dir)), AgentOptions())
 
 
-def make_agent(name: str, family: TaskFamily, *, policy_dir: str | None = None, options: AgentOptions = AgentOptions()) -> Agent:
-    """A fresh agent called ``name`` for ``family``, flying the policies of its policy set."""
+def make_agent(name: str, family: TaskFamily | str, *, policy_dir: str | None = None, options: AgentOptions = AgentOptions()) -> Agent:
+    """A fresh agent called ``name`` for ``family`` (a task family or its name), flying the policies of its policy set."""
+    if isinstance(family, str):  # a task's name, as agent_spec takes it (was an AttributeError; bad-input trial)
+        family = get_task_family(family)
+    if not isinstance(family, TaskFamily):
+        raise NeurohoverError(f"family={family!r:.80} is not allowed: give a task family (neurohover.get_task_family('ghh08')) or its name")
+    if not isinstance(options, AgentOptions):
+        raise NeurohoverError(f"options={options!r:.80} is not allowed: give an AgentOptions")
     spec = agent_spec(name, family)
     policies = policies_from_set(spec, _policy_set(family, policy_dir)) if spec.needs else AgentPolicies()
     return spec.build(policies, options)

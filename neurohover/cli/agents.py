@@ -17,6 +17,8 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
 
     if args.budget < 1:
         raise NeurohoverError(f"--budget {args.budget} is out of range: allowed >= 1")
+    if args.fghh_budget is not None and args.fghh_budget < 1:  # refused before the first run, not after it
+        raise NeurohoverError(f"--fghh-budget {args.fghh_budget} is out of range: allowed >= 1")
     if args.lineage is not None and args.lineage not in LINEAGES:
         raise NeurohoverError(f"--lineage {args.lineage!r} is not known: allowed {', '.join(LINEAGES)}")
     fghh = get_task_family(args.task).generic_over_distribution  # FGHH: generics over G, no specialised policies
