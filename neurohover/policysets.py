@@ -117,6 +117,8 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
         raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r} cannot be read as JSON: {err}") from None
     if not isinstance(manifest, dict):
         raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r} must be a JSON object, got {type(manifest).__name__}")
+    if manifest.get("task", family.name) != family.name:  # another task's set copied under this name: its policies fly the wrong task
+        raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r} is of task {manifest['task']!r}, not {family.name!r}")
     if family.generic_over_distribution:
         generics = {name: _load(root / f"generic_{name}.json", f"the {name} generic policy") for name in FGHH_GENERICS}
         return PolicySet(family.name, root, generics["race"], generics=generics, manifest=manifest)

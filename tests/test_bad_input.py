@@ -178,6 +178,17 @@ def test_a_malformed_file_in_a_policy_directory_is_named(broken: str, expected: 
     assert f"'{tmp_path / 'pd' / 'ghh08' / broken}'" in err and expected in err, err
 
 
+def test_another_tasks_policy_set_under_a_tasks_name_is_refused(tmp_path: Path) -> None:
+    """A GHH-09 set copied in as ghh08/ was flown on GHH-08 without a word (second trial)."""
+    import shutil
+
+    from neurohover.policysets import load_policy_set, policy_dir
+
+    shutil.copytree(policy_dir("ghh09"), tmp_path / "ghh08")
+    with pytest.raises(NeurohoverError, match="manifest .* is of task 'ghh09', not 'ghh08'"):
+        load_policy_set("ghh08", tmp_path)
+
+
 def test_a_repeated_sensor_key_and_a_damaged_store_are_one_clear_line(tmp_path: Path, capsys) -> None:
     """issue 37: a repeated --obs-noise (or key) kept the last silently; a store damaged mid-file was a sqlite3 traceback."""
     assert main(["fly", "--task", "ghh08", "--episodes", "1", "--obs-noise", "velocity=0.1", "--obs-noise", "velocity=0.2"]) == 2

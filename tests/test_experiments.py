@@ -174,6 +174,9 @@ def test_unknown_experiment_lists_the_known_ones(cli, tmp_path: Path) -> None:
         (lambda t: t.replace('name = "slowtest"', 'name = ""'), "name = '' is not allowed"),
         (lambda t: t + '\n[paper]\nnotez = ["x"]\n', "unknown [paper] key(s) notez; allowed: notes"),
         (lambda t: t + '\n[paper]\nttests = [{ a = "k1", b = "k9", p = "0.01" }]\n', "[paper] ttests names 'k9' (b)"),
+        # second trial: a string of claims was reported letter by letter, a p-value of "banana" printed as the paper's
+        (lambda t: t + '\n[paper]\nclaims = "hello"\n', "[paper] claims = 'hello' is not allowed: give a list of strings"),
+        (lambda t: t + '\n[paper]\nttests = [{ a = "k1", b = "k1", p = "banana" }]\n', "[paper] ttests p = 'banana' is not allowed"),
     ],
 )
 def test_bad_configs_are_refused_with_a_clear_message(tmp_path: Path, edit, message) -> None:

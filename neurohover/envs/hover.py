@@ -376,7 +376,7 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
         if seed is not None and (isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0):
             raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer >= 0")  # as the vector env says it
-        super().reset(seed=seed)
+        super().reset(seed=None if seed is None else int(seed))  # Gymnasium's seeding takes a Python int, not np.int64
         options = check_reset_options(options)
         # Validate every option before touching the episode, so a bad call leaves it as it was.
         spec = resolve_mdp(self.family, options["mdp"]) if "mdp" in options else self._spec

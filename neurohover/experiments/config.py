@@ -280,6 +280,19 @@ def check_name(name, where: str) -> None:
         raise NeurohoverError(f"{where}: name = {name!r} is not allowed: give 1-100 letters, digits, '.', '_' or '-', starting with a letter or digit")
 
 
+def _paper_p(p) -> bool:
+    """Whether ``p`` reads as a paper's p-value: a number in 0..1 (after '<' or '<='; words may follow it), 'not
+    significant', or 'none' (a test the paper did not make, with why)."""
+    if not isinstance(p, str):
+        return False
+    if p.strip().lower().startswith(("not significant", "none")):
+        return True
+    try:
+        return 0 <= float(p.strip().lower().lstrip("<= ").split()[0]) <= 1
+    except (ValueError, IndexError):
+        return False
+
+
 def check_paper(paper, raw: dict, where: str) -> None:
     """Refuse an unknown [paper] key, and a paper t test that names no group, variant, method or fit at any scale."""
     if not isinstance(paper, dict):
@@ -290,9 +303,18 @@ def check_paper(paper, raw: dict, where: str) -> None:
     tables = [raw.get("settings", {}), *raw.get("scales", {}).values()]
     entries = [e for tab in tables for kind in ("groups", "variants", "fits") for e in tab.get(kind, []) if isinstance(e, dict)]
     names = {e.get(k) for e in entries for k in ("key", "label", "agent")} | {m for tab in tables for m in tab.get("methods", [])}
+    for key in ("notes", "claims"):  # lists of sentences (a string here was reported letter by letter)
+        value = paper.get(key, [])
+        if not isinstance(value, list) or not all(isinstance(x, str) for x in value):
+            raise NeurohoverError(f"{where}: [paper] {key} = {value!r:.60} is not allowed: give a list of strings")
     for t in paper.get("ttests", []):
         if not isinstance(t, dict) or not {"a", "b", "p"} <= set(t):
             raise NeurohoverError(f"{where}: each [paper] ttests entry needs a, b and p, got {t!r}")
+        if not _paper_p(t["p"]):
+            raise NeurohoverError(
+                f"{where}: [paper] ttests p = {t['p']!r} is not allowed: give the paper's p-value as text, "
+                "e.g. '5.8e-12', '< 0.0026', 'not significant' or 'none (why)'"
+            )
         for side in ("a", "b"):
             if t[side] not in names:
                 raise NeurohoverError(f"{where}: [paper] ttests names {t[side]!r} ({side}), which is no group, variant, method or fit of the config")
