@@ -151,3 +151,19 @@ def test_a_run_on_another_familys_mdp_is_refused() -> None:
     ghh08, ghh09 = nh.get_task_family("ghh08"), nh.get_task_family("ghh09")
     with pytest.raises(NeurohoverError, match="is a ghh09 MDP, but the run's family is ghh08"):
         run_test(make_agent("baseline", ghh08), ghh08, ghh09.mdp("train:0"), episodes=2, n_steps=10)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"substeps": 0}, "substeps=0 is out of range: allowed an integer in 1..1000"),  # flew as a perfect 0.0 (second trial)
+        ({"params": (1, 2)}, "params=(1, 2) is not allowed: give 11 finite numbers"),
+        ({"dt": -1}, "dt=-1.0 is out of range"),
+        ({"wind_kind": 9}, "wind_kind=9 is not allowed"),
+        ({"noise_std": (-1.0,) * 6}, "noise_std=.* is out of range: allowed stds >= 0"),
+        ({"params": (float("nan"),) * 11}, "give 11 finite numbers"),
+    ],
+)
+def test_an_mdp_is_checked_when_it_is_made(kwargs: dict, message: str) -> None:
+    with pytest.raises(NeurohoverError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        nh.MDP("ghh08", **kwargs)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import copy
 import functools
 import json
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
@@ -34,6 +35,7 @@ from .sensor import EXACT, Sensor
 
 N_TRAINING = 10
 N_TEST = 100
+MAX_SUBSTEPS = 1000  # substeps per 0.1 s control step (the simulator takes 10): more is a typo, and a slow one
 _SET_ENTROPY = 20110401  # fixed root of the seeded training and test sets (the paper's year)
 _FIXED_SETS: dict[tuple[str, int, int, Sensor, Drift], tuple[MDP, ...]] = {}
 _ROW_LAYOUTS: dict[tuple[str, int, Sensor], np.ndarray] = {}
@@ -87,11 +89,32 @@ class MDP:
             raise NeurohoverError(f"sensor must be a neurohover Sensor, got {self.sensor!r}")
         if not isinstance(self.drift, Drift):
             raise NeurohoverError(f"drift must be a neurohover Drift, got {self.drift!r}")
+        if not isinstance(self.family, str) or not self.family:
+            raise NeurohoverError(f"MDP family={self.family!r} is not allowed: give a task family's name (or 'model')")
         # Plain Python numbers (the same values): reprs read MDP(params=(-0.18, ...)), not np.float64(-0.18).
-        for name in ("params", "noise_std", "wind"):
-            object.__setattr__(self, name, tuple(float(x) for x in getattr(self, name)))
-        object.__setattr__(self, "dt", float(self.dt))
-        object.__setattr__(self, "d_u", float(self.d_u))
+        for name, length in (("params", len(DEFAULT_PARAMS)), ("noise_std", len(DEFAULT_NOISE_STD)), ("wind", None)):
+            values = getattr(self, name)
+            try:
+                numbers = tuple(float(x) for x in values)
+            except (TypeError, ValueError):
+                raise NeurohoverError(f"MDP {name}={values!r:.80} is not allowed: give {length or 'up to 8'} numbers") from None
+            if (len(numbers) != length if length else len(numbers) > 8) or not all(math.isfinite(x) for x in numbers):
+                raise NeurohoverError(f"MDP {name}={values!r:.80} is not allowed: give {length or 'up to 8'} finite numbers")
+            object.__setattr__(self, name, numbers)
+        if min(self.noise_std) < 0:
+            raise NeurohoverError(f"MDP noise_std={self.noise_std!r} is out of range: allowed stds >= 0")
+        if self.wind_kind not in (WIND_NONE, 1, 2):
+            raise NeurohoverError(f"MDP wind_kind={self.wind_kind!r} is not allowed: 0 (none), 1 (constant, GHH-08) or 2 (sinusoidal, GHH-09)")
+        if isinstance(self.substeps, bool) or not isinstance(self.substeps, (int, np.integer)) or not 1 <= self.substeps <= MAX_SUBSTEPS:
+            raise NeurohoverError(f"MDP substeps={self.substeps!r} is out of range: allowed an integer in 1..{MAX_SUBSTEPS}")
+        object.__setattr__(self, "substeps", int(self.substeps))
+        for name in ("dt", "d_u"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) or not math.isfinite(value):
+                raise NeurohoverError(f"MDP {name}={value!r} is not allowed: give a finite number")
+            object.__setattr__(self, name, float(value))
+        if not self.dt > 0:
+            raise NeurohoverError(f"MDP dt={self.dt!r} is out of range: allowed a substep length > 0")
 
     def row(self) -> np.ndarray:
         """The float64 row the compiled kernel reads (layout in ``sim.constants``)."""
