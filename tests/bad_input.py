@@ -35,7 +35,7 @@ CASES: list[tuple[list[str], str]] = [
     (["report", "--store", "store.sqlite", "--out", "afile"], "is a file; give a directory"),
     (["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--out", "afile"], "is a file; give a directory"),
     (
-        ["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--out", "q", "--policy-dir", "afile"],
+        ["compete", "--task", "ghh08", "--agent", "model-free", "--runs", "1", "--episodes", "2", "--out", "q", "--policy-dir", "afile"],
         "is a file; give a directory",
     ),
     (["build-policies", "--task", "ghh08", "--budget", "10", "--out", "afile"], "is a file; give a directory"),
@@ -80,6 +80,11 @@ CASES: list[tuple[list[str], str]] = [
     (["build-policies", "--task", "fghh", "--lineage", "chain", "--budget", "10", "--out", "q"], "--lineage applies to the GHH tasks' specialised policies"),
     (["build-policies", "--task", "ghh08", "--fghh-budget", "10", "--out", "q"], "--fghh-budget applies to task fghh"),
     (["build-policies", "--task", "fghh", "--budget", "20", "--fghh-budget", "0", "--out", "q"], "--fghh-budget 0 is out of range: allowed >= 1"),
+    (["evaluate-agent", "--task", "ghh08", "--policy", "baseline", "--algo", "sac"], "--algo sac applies to --rl-zoo and --sb3 models, not to --policy"),
+    (
+        ["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--policy-dir", ".", "--out", "q"],
+        "--policy-dir applies to agents that fly a policy set's policies, not to --agent baseline",
+    ),
     (["learn-model", "--flight-data", "fd.npz", "--method", "lr", "--seed", "3", "--out", "m.json"], "--seed applies to the evolutionary methods"),
 ]
 

@@ -86,6 +86,8 @@ def cmd_compete(args: argparse.Namespace) -> int:
 
         agent_settings = check_agent_settings(args.agent, parse_overrides(args.agent_setting, "--agent-setting"))
     if args.policy_dir is not None:
+        if not AGENTS[args.agent].needs:  # it flies no policy of a set: the option would be ignored (second trial)
+            raise NeurohoverError(f"--policy-dir applies to agents that fly a policy set's policies, not to --agent {args.agent}")
         input_dir(args.policy_dir, "--policy-dir")
     output_dir(args.out, "--out")  # made once every option is checked: a refusal leaves no directory behind
     if args.store is not None:

@@ -42,6 +42,9 @@ def _agent(args: argparse.Namespace):
     if len(given) != 1:
         named = ", ".join("--" + s.replace("_", "-") for s in given) or "none"
         raise NeurohoverError(f"give exactly one of --policy, --callable, --rl-zoo, --sb3, --cleanrl (the agent to fly); got {named}")
+    if args.algo is not None and args.rl_zoo is None and args.sb3 is None:  # ignored otherwise (second trial)
+        raise NeurohoverError(f"--algo {args.algo} applies to --rl-zoo and --sb3 models, not to --{given[0].replace('_', '-')}")
+    algo = args.algo or "ppo"
     if args.policy is not None:
         from ..paths import input_file
         from ..policies import load_policy
@@ -69,10 +72,10 @@ def _agent(args: argparse.Namespace):
     if args.rl_zoo is not None:
         from ..integrations.sb3 import rl_zoo_policy
 
-        return rl_zoo_policy(args.rl_zoo, algo=args.algo)
+        return rl_zoo_policy(args.rl_zoo, algo=algo)
     from ..integrations.sb3 import sb3_policy
 
-    return sb3_policy(args.sb3, algo=args.algo)
+    return sb3_policy(args.sb3, algo=algo)
 
 
 def cmd_evaluate_agent(args: argparse.Namespace) -> int:
@@ -133,7 +136,7 @@ def register(sub) -> None:
     g.add_argument("--rl-zoo", help="an RL Zoo run folder (logs/ALGO/ENV_N): its final model and frozen observation statistics")
     g.add_argument("--sb3", help="a Stable-Baselines3 model file (MODEL.zip)")
     g.add_argument("--cleanrl", help="a CleanRL ppo_continuous_action run folder (runs/RUN: its model and saved obs_rms.pkl)")
-    p.add_argument("--algo", choices=tuple(SB3_ALGORITHMS), default="ppo", help="the algorithm of --rl-zoo / --sb3 (default ppo)")
+    p.add_argument("--algo", choices=tuple(SB3_ALGORITHMS), help="the algorithm of --rl-zoo / --sb3 (default ppo)")
     p.add_argument(
         "--rl-id",
         action="store_true",
