@@ -176,6 +176,8 @@ def test_unknown_experiment_lists_the_known_ones(cli, tmp_path: Path) -> None:
         (lambda t: t + '\n[paper]\nttests = [{ a = "k1", b = "k9", p = "0.01" }]\n', "[paper] ttests names 'k9' (b)"),
         # second trial: a string of claims was reported letter by letter, a p-value of "banana" printed as the paper's
         (lambda t: t + '\n[paper]\nclaims = "hello"\n', "[paper] claims = 'hello' is not allowed: give a list of strings"),
+        # the settings before the [paper] table: an unknown variant resampling is named, not a t test that names nothing
+        (lambda t: t.replace('key = "k1"', 'key = "k1"\nresampling = "fixed:0"') + '\n[paper]\nttests = [{ a = "k1", b = "k9", p = "0.01" }]\n', "fixed:K"),
         (lambda t: t + '\n[paper]\nttests = [{ a = "k1", b = "k1", p = "banana" }]\n', "[paper] ttests p = 'banana' is not allowed"),
     ],
 )

@@ -242,7 +242,6 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
     kind = raw["kind"]
     if kind not in KINDS:
         raise NeurohoverError(f"{where}: kind = {kind!r} is not allowed: expected one of {', '.join(KINDS)}")
-    check_paper(raw.get("paper", {}), raw, where)
     scales = raw.get("scales", {})
     bad_scales = sorted(set(scales) - set(SCALES))
     if bad_scales:
@@ -254,7 +253,7 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
             resolved = validate_table({**raw["settings"], **scales[other]}, SCHEMAS[kind], f"{where} at scale {other!r}")
             check_kind(resolved, kind, f"{where} at scale {other!r}")
     merged = {**raw["settings"], **scales[scale], **(overrides or {})}
-    return make_config(
+    config = make_config(
         raw["name"],
         kind,
         scale,
@@ -265,6 +264,8 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
         source=str(path),
         where=f"{where} at scale {scale!r}",
     )
+    check_paper(raw.get("paper", {}), raw, where)  # after the settings: a bad agent is named as such, not as a t test naming nothing
+    return config
 
 
 #: An experiment's name becomes file names (figures, discussions, exports): letters, digits, '.', '_' and '-',
