@@ -463,5 +463,7 @@ def test_evolve_says_when_the_plateau_ends_a_run_before_its_budget(tmp_path: Pat
     assert main([*args, "--budget", "100000"]) == 0
     err = capsys.readouterr().err
     assert "note: stopped by plateau after" in err and "of the --budget 100,000 episodes: the budget is a cap, not a length" in err
-    assert main([*args, "--budget", "60"]) == 0  # the budget ends it: no note
-    assert "the budget is a cap" not in capsys.readouterr().err
+    assert main([*args, "--budget", "100"]) == 0  # the budget ends it, at a generation's boundary: no note
+    assert "note:" not in capsys.readouterr().err
+    assert main([*args, "--budget", "20"]) == 0  # below the first population of 50: flown whole, and said (second trial)
+    assert "note: flew 50 episodes for the --budget 20" in capsys.readouterr().err

@@ -165,6 +165,12 @@ def _print_evolve_summary(args: argparse.Namespace, summary: dict, result) -> No
             "is a cap, not a length" + why,
             file=sys.stderr,
         )
+    if args.budget is not None and result.episodes > args.budget:  # a generation (or the first population) is flown whole
+        print(
+            f"neurohover evolve: note: flew {result.episodes:,} episodes for the --budget {args.budget:,}: the run stops at the first "
+            "generation boundary at or past its budget (its first population, or a generation, is flown whole)",
+            file=sys.stderr,
+        )
 
 
 def cmd_evolve(args: argparse.Namespace) -> int:
