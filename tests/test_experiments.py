@@ -694,6 +694,25 @@ def test_the_report_opens_with_the_papers_claims_and_conclusions(committed_store
     assert int(models[3]) >= 2 and "of" in models[2]  # Figure 11's two reversed tests at least
 
 
+@pytest.mark.parametrize("name", ["fig7", "fig8", "fig11", "bench-drift", "bench-sensors"])
+def test_the_run_keys_of_a_test_runs_config_are_its_plans(name: str) -> None:
+    """run_keys lists a test-runs experiment's runs before their policies exist (what --only is checked against)."""
+    from neurohover.experiments.plans import run_keys
+
+    cfg = load_config(name, "quick", {"policies": "shipped"})
+    planned = {u.key for u in plan(cfg, {}, {}).units if u.key.startswith("run/")}
+    assert planned and set(run_keys(cfg)) == planned
+
+
+def test_an_only_that_matches_no_later_unit_is_refused_before_any_unit_runs(tmp_path: Path, capsys) -> None:
+    """Second trial: with policies evolved first, `--only nothing` ran and stored the policy units, then refused."""
+    store = tmp_path / "s.sqlite"
+    assert main(["reproduce", "fig7", "--only", "nothing", "--store", str(store), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "--only 'nothing' matches no unit; unit keys look like policy/generic" in err and "run/model-free/test0/rep0" in err
+    assert not store.exists()
+
+
 def test_a_refused_only_leaves_the_store_as_it_was(tmp_path: Path, capsys) -> None:
     """issue 37: `--only nothing` used to record the config first, so a later run with other settings was refused."""
     config = _write(tmp_path, SLOW_CONFIG.replace("runs = 12", "runs = 2").replace("budget = 3000", "budget = 100"))

@@ -32,7 +32,7 @@ from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..models.model import LEGACY_MODEL_SUBSTEPS
 from ..policies import baseline_policy
 from ..policysets import load_policy_set, policy_set_roles
-from ..tasks import EXACT, Sensor
+from ..tasks import EXACT, N_TEST, N_TRAINING, Sensor
 from ..tasks.drift import Drift
 from .config import ExperimentConfig, load_config
 from .keys import UnitKey
@@ -476,6 +476,22 @@ def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dic
 
 
 # --------------------------------------------------------------------------------- model learning
+
+
+def run_keys(cfg: ExperimentConfig) -> list[str]:
+    """Every run unit's key of a test-runs experiment, without planning it: the keys follow from its groups, not from
+    the policies they fly, which a staged plan waits for (``reproduce --only`` is checked against them); empty for
+    the other kinds."""
+    s = cfg.typed
+    if not isinstance(s, TestRunsSettings):
+        return []
+    available = {"train": N_TRAINING, "test": N_TEST}  # _mdps' slices; "sample" draws n
+    return [
+        UnitKey.make("run", g.label, f"{g.mdps}{i}", rep)
+        for g in s.groups
+        for i in range(min(g.n_mdps, available.get(g.mdps, g.n_mdps)))
+        for rep in range(g.runs_per_mdp)
+    ]
 
 
 def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:

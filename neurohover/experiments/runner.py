@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 from ..errors import NeurohoverError
 from .config import POLICY_SOURCES, ExperimentConfig
-from .plans import plan, source_experiments
+from .plans import plan, run_keys, source_experiments
 from .store import Store
 
 
@@ -110,8 +110,13 @@ def _check_policy_source(config: ExperimentConfig, store: Store) -> None:
 
 
 def _matches_no_unit(config, pattern: str, units) -> NeurohoverError:
-    """The error of an ``--only`` pattern that selects nothing, with what unit keys look like."""
-    return NeurohoverError(f"{config.name}: --only {pattern!r} matches no unit; unit keys look like {', '.join(u.key for u in units[:3])}")
+    """The error of an ``--only`` pattern that selects nothing, with what unit keys look like (of every stage)."""
+    keys = [u.key for u in units] + run_keys(config)
+    stages: dict[str, list[str]] = {}
+    for key in keys:
+        stages.setdefault(key.split("/")[0], []).append(key)
+    examples = [k for ks in stages.values() for k in ks[:2]]
+    return NeurohoverError(f"{config.name}: --only {pattern!r} matches no unit; unit keys look like {', '.join(examples[:6])}")
 
 
 def reproduce(
@@ -143,8 +148,9 @@ def reproduce(
     if only:  # refused before the store records anything: a pattern that matches no unit of a plan complete now
         sources = {n: store.results(n, config.scale) for n in source_experiments(config)}
         first = plan(config, store.results(config.name, config.scale) if held == config.hash else {}, sources)
-        unmatched = [pat for pat in only if not any(fnmatch.fnmatchcase(u.key, pat) for u in first.units)]
-        if unmatched and len(first.units) == first.total:
+        later = run_keys(config)  # a test-runs plan lists its runs once their policies are stored: their keys, now
+        unmatched = [pat for pat in only if not any(fnmatch.fnmatchcase(k, pat) for k in [*(u.key for u in first.units), *later])]
+        if unmatched and (len(first.units) == first.total or later):
             raise _matches_no_unit(config, unmatched[0], first.units)
     if update and held is not None and held != config.hash:
         _check_policy_source(config, store)
