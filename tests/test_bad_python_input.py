@@ -167,3 +167,22 @@ def test_a_run_on_another_familys_mdp_is_refused() -> None:
 def test_an_mdp_is_checked_when_it_is_made(kwargs: dict, message: str) -> None:
     with pytest.raises(NeurohoverError, match=message.replace("(", r"\(").replace(")", r"\)")):
         nh.MDP("ghh08", **kwargs)
+
+
+def test_a_checkpoint_write_that_fails_leaves_the_last_checkpoint_and_no_partial_file(tmp_path) -> None:
+    """Second trial: SIGINT mid-write left a truncated PATH.tmp beside the checkpoint."""
+    from neurohover.evolution.records import read_checkpoint, write_checkpoint
+
+    path = tmp_path / "run.checkpoint.json"
+    write_checkpoint(path, {"generation": 1})
+    with pytest.raises(ValueError):  # strict JSON: a NaN fails mid-write, as an interrupt would
+        write_checkpoint(path, {"generation": 2, "champion": float("nan")})
+    assert read_checkpoint(path) == {"generation": 1} and sorted(p.name for p in tmp_path.iterdir()) == [path.name]
+
+
+def test_an_ec_model_refuses_a_negative_seed_by_name() -> None:
+    from neurohover.models.ec import learn_ec_meno
+
+    ev = nh.evaluate(nh.baseline_policy(), nh.get_task_family("ghh08").zero(), episodes=1, n_steps=30, record=True)
+    with pytest.raises(NeurohoverError, match=r"seed=-1 is out of range: allowed an integer in 0..2\*\*63-1"):
+        learn_ec_meno(ev.flight_data, budget=5, seed=-1)  # was NumPy's "expected non-negative integer"

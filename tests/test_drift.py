@@ -53,8 +53,10 @@ def test_drifted_rows_start_at_the_mdp_change_once_and_walk_by_the_stated_std() 
         (lambda: Drift(0.0, (), (9, 3)), "change_at=(9, 3) is out of range"),
         (lambda: Drift.parse("D_w=abc"), "'D_w=abc' is not understood"),
         (lambda: Drift.from_dict({"wlak": 0.1}), "unknown drift setting"),
-        (lambda: Drift.from_dict({"walk": "abc"}), "walk='abc' is out of range"),
-        (lambda: Drift.from_dict({"walk": True}), "walk=True is out of range"),
+        (lambda: Drift.from_dict({"walk": "abc"}), "walk='abc' is not a number"),
+        (lambda: Drift.from_dict({"walk": True}), "walk=True is not a number"),
+        (lambda: Drift(change=(("D_w",),)), "drift change=(('D_w',),) is not allowed: give parameter factors as a table"),  # second trial
+        (lambda: Drift(change="D_w=0.8"), "change='D_w=0.8' is not allowed"),  # type: ignore[arg-type]
         (lambda: Drift.from_dict({"change_at": 5}), "change_at=5 is not allowed"),
         (lambda: Drift.from_dict({"walk": 0.01, "change_at": [3, 5]}), "change_at=[3, 5] is given without a change"),  # was ignored
         (lambda: Drift.parse("walk=0.01@3-5"), "change_at=[3, 5] is given without a change"),

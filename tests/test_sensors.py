@@ -74,6 +74,13 @@ def test_bad_sensor_settings_get_one_clear_message(make, message: str) -> None:
         make()
 
 
+def test_numpy_numbers_are_numbers_and_text_is_not() -> None:
+    """Second trial: np.float32(0.1) and np.int64(3) were refused as out of range, '0.1' as out of range too."""
+    assert Sensor(velocity=np.float32(0.5), delay=np.int64(3)) == Sensor(velocity=0.5, delay=3)  # type: ignore[arg-type]
+    with pytest.raises(NeurohoverError, match="sensor velocity='0.1' is not a number"):
+        Sensor(velocity="0.1")  # type: ignore[arg-type]
+
+
 def test_a_dropout_is_read_from_text_and_tables_and_left_out_of_dicts_without_one() -> None:
     sensor = Sensor.parse("level=1,dropout=0.2", delay=1)
     assert sensor == Sensor(0.1, 0.1, 0.1, 0.01, delay=1, dropout=0.2) and Sensor.from_dict(sensor.to_dict()) == sensor

@@ -205,11 +205,15 @@ def write_checkpoint(path: Path, state: dict) -> None:
     """Write a checkpoint atomically: strict JSON to ``PATH.tmp``, synced, then renamed over ``path``."""
     tmp = path.with_name(path.name + ".tmp")
     path.parent.mkdir(parents=True, exist_ok=True)
-    with open(tmp, "w") as f:
-        json.dump(state, f, allow_nan=False)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
+    try:
+        with open(tmp, "w") as f:
+            json.dump(state, f, allow_nan=False)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:  # interrupted or failed mid-write: no truncated PATH.tmp is left (the last checkpoint stands)
+        tmp.unlink(missing_ok=True)
+        raise
 
 
 def read_checkpoint(path: Path) -> dict:

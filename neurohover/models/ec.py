@@ -54,8 +54,9 @@ def _evolve(
     """Run steady-state NE on genes ``params / scale`` from ``proto_params``; returns champion
     params, its fitness, evaluations, history. ``max_evaluations`` caps a run without a budget."""
     from ..evolution import SteadyStateNE
+    from ..evolution.seeding import check_seed
 
-    opt = SteadyStateNE(proto_params / scale, _ec_settings(settings, budget), seed=seed)
+    opt = SteadyStateNE(proto_params / scale, _ec_settings(settings, budget), seed=check_seed(seed))  # -1: one clear message, not NumPy's
     while not opt.stop() and (max_evaluations is None or opt.evaluations < max_evaluations):
         genes = opt.ask()
         opt.tell(fitness(genes * scale))

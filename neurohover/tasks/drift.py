@@ -26,6 +26,7 @@ change_at      (200, 800)  the change happens at an episode drawn uniformly from
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -49,10 +50,18 @@ class Drift:
 
     def __post_init__(self) -> None:
         w = self.walk
-        if isinstance(w, bool) or not isinstance(w, (int, float)) or not math.isfinite(w) or not 0 <= w <= 1:
+        if isinstance(w, bool) or not isinstance(w, numbers.Real):  # NumPy's numbers are Real too
+            raise NeurohoverError(f"drift walk={w!r} is not a number: allowed a number in 0..1 (a per-episode log std)")
+        if not math.isfinite(w) or not 0 <= w <= 1:
             raise NeurohoverError(f"drift walk={w!r} is out of range: allowed a number in 0..1 (a per-episode log std)")
         object.__setattr__(self, "walk", float(w))
-        change = dict(self.change) if not isinstance(self.change, dict) else self.change
+        try:
+            change = dict(self.change) if not isinstance(self.change, (dict, str)) else self.change
+            assert isinstance(change, dict) and all(isinstance(n, str) for n in change)
+        except (TypeError, ValueError, AssertionError):
+            raise NeurohoverError(
+                f"drift change={self.change!r} is not allowed: give parameter factors as a table, e.g. {{'D_w': 0.8}} (Drift.parse reads 'D_w=0.8')"
+            ) from None
         factors = np.ones(len(PARAM_NAMES))
         for name, factor in change.items():
             if name not in PARAM_NAMES:

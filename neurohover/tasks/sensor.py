@@ -34,6 +34,7 @@ entry's noise is about the size of the baseline policy's typical hovering error 
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import asdict, dataclass, fields, replace
 
 from ..errors import NeurohoverError
@@ -63,7 +64,9 @@ class Sensor:
     def __post_init__(self) -> None:
         for name in (*SENSOR_GROUPS, "correlation"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+            if isinstance(value, bool) or not isinstance(value, numbers.Real):  # NumPy's numbers are Real too
+                raise NeurohoverError(f"sensor {name}={value!r} is not a number: allowed a finite number >= 0")
+            if not math.isfinite(value) or value < 0:
                 raise NeurohoverError(f"sensor {name}={value!r} is out of range: allowed a finite number >= 0")
             if name != "correlation" and value > MAX_STD:
                 raise NeurohoverError(f"sensor {name}={value!r} is out of range: allowed a std in 0..{MAX_STD:g}")
@@ -71,10 +74,12 @@ class Sensor:
         if self.correlation >= 1.0:
             raise NeurohoverError(f"sensor correlation={self.correlation!r} is out of range: allowed 0 <= correlation < 1")
         p = self.dropout
-        if isinstance(p, bool) or not isinstance(p, (int, float)) or not 0 <= p < 1:  # NaN fails the comparison too
+        if isinstance(p, bool) or not isinstance(p, numbers.Real) or not 0 <= p < 1:  # NaN fails the comparison too
             raise NeurohoverError(f"sensor dropout={p!r} is out of range: allowed a probability 0 <= dropout < 1")
         object.__setattr__(self, "dropout", float(p))
         d = self.delay
+        if isinstance(d, numbers.Integral) and not isinstance(d, bool):
+            object.__setattr__(self, "delay", d := int(d))  # a NumPy integer as the int it is
         if isinstance(d, bool) or not isinstance(d, int) or not 0 <= d <= MAX_SENSOR_DELAY:
             raise NeurohoverError(f"sensor delay={d!r} is out of range: allowed an integer number of control steps in 0..{MAX_SENSOR_DELAY}")
 
