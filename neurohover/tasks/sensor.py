@@ -66,11 +66,12 @@ class Sensor:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, numbers.Real):  # NumPy's numbers are Real too
                 raise NeurohoverError(f"sensor {name}={value!r} is not a number: allowed a finite number >= 0")
-            if not math.isfinite(value) or value < 0:
+            number = float(value)
+            if not math.isfinite(number) or number < 0:
                 raise NeurohoverError(f"sensor {name}={value!r} is out of range: allowed a finite number >= 0")
-            if name != "correlation" and value > MAX_STD:
+            if name != "correlation" and number > MAX_STD:
                 raise NeurohoverError(f"sensor {name}={value!r} is out of range: allowed a std in 0..{MAX_STD:g}")
-            object.__setattr__(self, name, float(value))
+            object.__setattr__(self, name, number)
         if self.correlation >= 1.0:
             raise NeurohoverError(f"sensor correlation={self.correlation!r} is out of range: allowed 0 <= correlation < 1")
         p = self.dropout
