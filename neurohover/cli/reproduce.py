@@ -124,6 +124,8 @@ def _positive_ints(text: str, option: str) -> list[int]:
         values = []
     if not values or min(values) < 1:
         raise NeurohoverError(f"{option} {text!r} is not allowed: give whole numbers >= 1, comma-separated (e.g. 1,5,20)")
+    if len(set(values)) != len(values):  # a column printed twice (second trial)
+        raise NeurohoverError(f"{option} {text!r} names a number twice: give each once")
     return values
 
 
@@ -144,6 +146,8 @@ def cmd_wins(args: argparse.Namespace) -> int:
         runs = stored_runs(store.results(args.name, scale))
     if not runs:
         raise NeurohoverError(f"experiment {args.name!r} ({scale}) has no stored test runs: wins compares the agents of a test-runs experiment")
+    if args.agents is not None and not all(args.agents.split(",")) or args.against == "":  # '' entered every agent (second trial)
+        raise NeurohoverError(f"--agents {args.agents!r} / --against {args.against!r}: an agent's label is empty; allowed {', '.join(runs)}")
     chosen = args.agents.split(",") if args.agents else list(runs)
     for label in [*chosen, *([args.against] if args.against else [])]:
         if label not in runs:
