@@ -176,8 +176,8 @@ def mdp_rows(mdps: MDP | Sequence[MDP] | np.ndarray) -> np.ndarray:
                     i = int(np.flatnonzero((sensors == values).all(axis=1))[0])
                     raise NeurohoverError(f"MDP row {i} has an invalid sensor model {values.tolist()}: {err}") from None
         return np.ascontiguousarray(mdps, dtype=float)
-    if len(mdps) == 0 or not all(isinstance(m, MDP) for m in mdps):
-        raise NeurohoverError("mdps must be an MDP or a non-empty sequence of MDPs")
+    if isinstance(mdps, (str, bytes)) or not hasattr(mdps, "__len__") or len(mdps) == 0 or not all(isinstance(m, MDP) for m in mdps):
+        raise NeurohoverError(f"mdps={mdps!r:.60} is not allowed: give an MDP, a non-empty sequence of MDPs or an array of MDP rows")
     for m in mdps:
         refuse_drift(m, "this batch")
     return np.stack([m.row() for m in mdps])
@@ -328,12 +328,14 @@ def evaluate(
     """
     table = policies if isinstance(policies, PolicyTable) else PolicyTable.from_policies(as_policies(policies))
     rows = mdp_rows(mdps)
-    if not isinstance(episodes, (int, np.integer)) or episodes < 1:
+    if isinstance(episodes, (bool, np.bool_)) or not isinstance(episodes, (int, np.integer)) or episodes < 1:  # True is an int
         raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
     if not isinstance(record, (bool, np.bool_)):
         raise NeurohoverError(f"record={record!r} is not allowed: give True or False")
-    if not isinstance(first_episode, (int, np.integer)) or first_episode < 0:
-        raise NeurohoverError(f"first_episode={first_episode!r} is out of range: allowed an integer >= 0")
+    if isinstance(first_episode, (bool, np.bool_)) or not isinstance(first_episode, (int, np.integer)) or not 0 <= first_episode < 2**62:
+        raise NeurohoverError(f"first_episode={first_episode!r} is out of range: allowed an integer in 0..2**62-1")
+    if safeguard is not None and not isinstance(safeguard, Safeguard):
+        raise NeurohoverError(f"safeguard={safeguard!r:.60} is not allowed: give a neurohover.evaluate.Safeguard(fallback_policy) or None")
     n_pol, n_mdp = len(table), rows.shape[0]
     check_episode_count(n_pol * n_mdp * int(episodes), f"{n_pol} policies x {n_mdp} MDPs x episodes={episodes}")
     p_idx, m_idx, e = np.meshgrid(np.arange(n_pol), np.arange(n_mdp), np.arange(episodes), indexing="ij")
@@ -423,3 +425,9 @@ class Safeguard:
 
     fallback: Policy
     dangerous: DangerousState = DangerousState()
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.fallback, Policy):  # 'baseline' was an AttributeError when first flown (second trial)
+            raise NeurohoverError(f"Safeguard fallback={self.fallback!r:.60} is not allowed: give a Policy (e.g. neurohover.baseline_policy())")
+        if not isinstance(self.dangerous, DangerousState):
+            raise NeurohoverError(f"Safeguard dangerous={self.dangerous!r:.60} is not allowed: give a DangerousState (e.g. DangerousState(rule='paper'))")

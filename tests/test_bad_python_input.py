@@ -186,3 +186,21 @@ def test_an_ec_model_refuses_a_negative_seed_by_name() -> None:
     ev = nh.evaluate(nh.baseline_policy(), nh.get_task_family("ghh08").zero(), episodes=1, n_steps=30, record=True)
     with pytest.raises(NeurohoverError, match=r"seed=-1 is out of range: allowed an integer in 0..2\*\*63-1"):
         learn_ec_meno(ev.flight_data, budget=5, seed=-1)  # was NumPy's "expected non-negative integer"
+
+
+def test_evaluate_and_the_safeguard_check_their_arguments() -> None:
+    """Second trial: TypeError, OverflowError or an AttributeError when the batch was first flown."""
+    from neurohover.evaluate import DangerousState, Safeguard
+
+    b, zero = nh.baseline_policy(), nh.get_task_family("ghh08").zero()
+    for call, message in (
+        (lambda: nh.evaluate(b, zero, episodes=True), "episodes=True is out of range"),
+        (lambda: nh.evaluate(b, zero, first_episode=10**20), "first_episode=100000000000000000000 is out of range"),
+        (lambda: nh.evaluate(b, None), "mdps=None is not allowed"),
+        (lambda: nh.evaluate(b, zero, safeguard="x"), "safeguard='x' is not allowed"),
+        (lambda: Safeguard("baseline"), "Safeguard fallback='baseline' is not allowed: give a Policy"),
+        (lambda: Safeguard(b, dangerous="code"), "Safeguard dangerous='code' is not allowed"),
+    ):
+        with pytest.raises(NeurohoverError, match=message):
+            call()
+    assert Safeguard(b, DangerousState(rule="paper")).fallback is b
