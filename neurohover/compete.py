@@ -205,6 +205,10 @@ def competition_config(
         "policies": policy_dir if policy_dir is not None else "shipped",
         "groups": [group],
     }
+    if sensor is not None and not isinstance(sensor, Sensor):  # 'x' was an AttributeError (second trial)
+        raise NeurohoverError(f"sensor={sensor!r:.60} is not allowed: give a neurohover.Sensor (e.g. Sensor.of(obs_noise=1.0)) or None")
+    if drift is not None and not isinstance(drift, Drift):
+        raise NeurohoverError(f"drift={drift!r:.60} is not allowed: give a neurohover.Drift (e.g. Drift.parse('walk=0.01')) or None")
     if sensor is not None and not sensor.exact:
         settings["sensor"] = sensor.to_dict()
     if drift is not None and not drift.none:
@@ -292,6 +296,8 @@ def compete(
         task, agent, runs=runs, episodes=episodes, mdps=mdps, seed=seed, sigma=sigma, n_steps=n_steps, policy_dir=policy_dir, hybrid=hybrid,
         sensor=sensor, drift=drift, wind_model=wind_model, lr_fit=lr_fit, agent_settings=agent_settings,
     )  # fmt: skip
+    if not isinstance(out, (str, Path)) or str(out) == "":  # None was a TypeError (second trial)
+        raise NeurohoverError(f"out={out!r} is not allowed: give the directory to write the competition's results into")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     store_path = Path(store) if store is not None else out / STORE_FILE

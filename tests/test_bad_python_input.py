@@ -204,3 +204,12 @@ def test_evaluate_and_the_safeguard_check_their_arguments() -> None:
         with pytest.raises(NeurohoverError, match=message):
             call()
     assert Safeguard(b, DangerousState(rule="paper")).fallback is b
+
+
+def test_compete_names_a_missing_out_and_a_sensor_of_the_wrong_type(tmp_path) -> None:
+    from neurohover.compete import compete
+
+    for kwargs, message in (({"out": None}, "out=None is not allowed"), ({"out": tmp_path / "c", "sensor": "x"}, "sensor='x' is not allowed")):
+        with pytest.raises(NeurohoverError, match=message):  # TypeError and AttributeError before (second trial)
+            compete("ghh08", "baseline", runs=1, episodes=2, n_steps=10, **kwargs)
+    assert not (tmp_path / "c").exists()
