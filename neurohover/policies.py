@@ -258,10 +258,21 @@ def load_policy(source: str | Path) -> Policy:
 
 
 def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
-    """Write ``policy`` (and extra metadata) as a JSON policy file; returns the path."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    """Write ``policy`` (and extra metadata: strict JSON values under keys of their own) as a JSON policy file; returns the path."""
+    from .paths import output_file, writing
+
+    if not isinstance(policy, Policy):
+        raise NeurohoverError(f"policy={policy!r:.60} is not allowed: give a Policy (load_policy('baseline') for the baseline's)")
     data = policy_to_dict(policy)
+    taken = sorted({"topology", "genome"} & set(metadata))  # the policy's metadata may be updated, its network not
+    if taken:  # they would overwrite the policy itself and write a file load_policy refuses (second trial)
+        raise NeurohoverError(f"metadata key(s) {', '.join(taken)} are the policy's own: give the metadata other names")
     data.update(metadata)
-    path.write_text(json.dumps(data, indent=1) + "\n")
+    try:
+        text = json.dumps(data, indent=1, allow_nan=False) + "\n"
+    except (TypeError, ValueError) as err:  # an object, or a NaN that other JSON readers refuse
+        raise NeurohoverError(f"policy metadata must be strict JSON values (numbers finite): {err}") from None
+    path = output_file(path, "policy file")  # refuses '', a directory and a device; makes missing parents
+    with writing(path, "policy file"):
+        path.write_text(text)
     return path

@@ -213,3 +213,19 @@ def test_compete_names_a_missing_out_and_a_sensor_of_the_wrong_type(tmp_path) ->
         with pytest.raises(NeurohoverError, match=message):  # TypeError and AttributeError before (second trial)
             compete("ghh08", "baseline", runs=1, episodes=2, n_steps=10, **kwargs)
     assert not (tmp_path / "c").exists()
+
+
+def test_save_policy_refuses_what_it_cannot_write_as_a_policy_file(tmp_path) -> None:
+    """Second trial: OSError, AttributeError or TypeError; metadata named genome overwrote the policy; NaN written as NaN."""
+    b = nh.baseline_policy()
+    for call, message in (
+        (lambda: nh.save_policy(b, tmp_path), "is a directory; give a file path"),
+        (lambda: nh.save_policy(b, ""), "policy file is empty"),
+        (lambda: nh.save_policy("baseline", tmp_path / "a.json"), "policy='baseline' is not allowed: give a Policy"),
+        (lambda: nh.save_policy(b, tmp_path / "a.json", genome=[1]), "metadata key\\(s\\) genome are the policy's own"),
+        (lambda: nh.save_policy(b, tmp_path / "a.json", r=float("nan")), "strict JSON values"),
+    ):
+        with pytest.raises(NeurohoverError, match=message):
+            call()
+    assert not (tmp_path / "a.json").exists()
+    assert nh.load_policy(nh.save_policy(b, tmp_path / "b.json", note="kept")).genome.tolist() == b.genome.tolist()
