@@ -229,3 +229,17 @@ def test_save_policy_refuses_what_it_cannot_write_as_a_policy_file(tmp_path) -> 
             call()
     assert not (tmp_path / "a.json").exists()
     assert nh.load_policy(nh.save_policy(b, tmp_path / "b.json", note="kept")).genome.tolist() == b.genome.tolist()
+
+
+def test_a_familys_draws_check_their_generator_and_count() -> None:
+    """Second trial: NumPy's TypeError/ValueError, a MemoryError for 10**13 draws, an AttributeError for a seed."""
+    fam = nh.get_task_family("ghh08")
+    for call, message in (
+        (lambda: fam.mdp("sample", rng="x"), "rng='x' is not allowed"),
+        (lambda: fam.sample(-1), "rng=-1 is not allowed"),
+        (lambda: fam.sample_params(np.random.default_rng(0), 10**13), "n=10000000000000 is out of range"),
+        (lambda: fam.sample_params(0, 3), "rng=0 is not allowed: give a numpy Generator"),
+    ):
+        with pytest.raises(NeurohoverError, match=message):
+            call()
+    assert fam.sample(5) == fam.sample(np.random.default_rng(5))  # a seed is the Generator it seeds

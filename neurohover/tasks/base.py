@@ -220,6 +220,32 @@ def _through_sensor(method):
     return made
 
 
+MAX_SAMPLES = 10**7  # MDPs drawn in one call (their rows: 2.9 GB)
+
+
+def generator(rng, what: str = "rng") -> np.random.Generator:
+    """``rng`` as a NumPy Generator: a Generator, a seed (an integer >= 0) or None (fresh entropy); else a clear error."""
+    if rng is None or isinstance(rng, np.random.Generator):
+        return np.random.default_rng(rng)
+    if isinstance(rng, (bool, np.bool_)) or not isinstance(rng, (int, np.integer)) or rng < 0:
+        raise NeurohoverError(f"{what}={rng!r} is not allowed: give a numpy Generator, a seed (an integer >= 0) or None")
+    return np.random.default_rng(int(rng))
+
+
+def _checked_draws(method):
+    """A family's ``sample_params`` with its arguments checked (it is the family's own code)."""
+
+    @functools.wraps(method)
+    def draws(self, rng, n):
+        if not isinstance(rng, np.random.Generator):
+            raise NeurohoverError(f"rng={rng!r} is not allowed: give a numpy Generator (np.random.default_rng(seed))")
+        if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)) or not 0 <= n <= MAX_SAMPLES:
+            raise NeurohoverError(f"n={n!r} is out of range: allowed an integer in 0..{MAX_SAMPLES:,} (MDPs drawn in one call)")
+        return method(self, rng, int(n))
+
+    return draws
+
+
 def _family_eq(self, other) -> bool:
     if type(other) is not type(self):
         return NotImplemented
@@ -283,6 +309,8 @@ class TaskFamily:
         for name in ("make", "zero"):  # the one place a family's MDPs get its sensor
             if name in cls.__dict__:
                 setattr(cls, name, _through_sensor(cls.__dict__[name]))
+        if "sample_params" in cls.__dict__:
+            cls.sample_params = _checked_draws(cls.__dict__["sample_params"])  # type: ignore[method-assign]
         # Defined before the dataclass decorator runs, so it keeps them: equality includes the sensor.
         cls.__eq__ = _family_eq  # type: ignore[method-assign]
         cls.__hash__ = _family_hash  # type: ignore[method-assign]
@@ -350,7 +378,7 @@ class TaskFamily:
 
     def sample(self, rng: np.random.Generator | int | None = None, label: str = "") -> MDP:
         """A fresh MDP drawn from G."""
-        rng = np.random.default_rng(rng)
+        rng = generator(rng)
         return self.make(self.sample_params(rng, 1)[0], label=label or f"{self.name}/sample")
 
     def row_template(self) -> np.ndarray:
