@@ -60,10 +60,11 @@ class FlightData:
         """Write the flight data to ``path`` (``.npz``), as float64 (exact) or float32 (half the space)."""
         if dtype not in SAVE_DTYPES:
             raise NeurohoverError(f"flight-data dtype {dtype!r} is not allowed: use {' or '.join(SAVE_DTYPES)}")
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
+        from .paths import output_file, writing
+
+        path = output_file(path, "flight-data file")  # refuses '', a directory and a device (/dev/null was a struct.error)
         lengths = np.array([a.shape[0] for a in self.actions], dtype=np.int64)
-        with open(path, "wb") as f:  # a file object keeps numpy from appending ".npz"
+        with writing(path, "flight-data file"), open(path, "wb") as f:  # a file object keeps numpy from appending ".npz"
             np.savez_compressed(
                 f,
                 format=np.array(FORMAT),
@@ -77,9 +78,11 @@ class FlightData:
     @classmethod
     def load(cls, path: str | Path) -> FlightData:
         """Read flight data written by :meth:`save`; other files are refused with a clear message."""
-        path = Path(path)
-        if not path.is_file():
-            raise NeurohoverError(f"flight-data file {str(path)!r} does not exist")
+        from .paths import input_file
+
+        if not isinstance(path, (str, Path)):  # None was a TypeError (second trial)
+            raise NeurohoverError(f"flight-data file {path!r} is not allowed: give a path")
+        path = input_file(path, "flight-data file")  # an empty path, a directory: named as such, not as missing
         if not zipfile.is_zipfile(path):  # np.load would try (and refuse) to unpickle anything else
             raise NeurohoverError(
                 f"{str(path)!r} is not a neurohover flight-data file: flight data are .npz archives (written by neurohover fly --record or FlightData.save)"

@@ -243,3 +243,19 @@ def test_a_familys_draws_check_their_generator_and_count() -> None:
         with pytest.raises(NeurohoverError, match=message):
             call()
     assert fam.sample(5) == fam.sample(np.random.default_rng(5))  # a seed is the Generator it seeds
+
+
+def test_flight_data_files_are_checked_as_the_command_line_checks_them(tmp_path) -> None:
+    """Second trial: saving to /dev/null was a struct.error, to a directory an OSError; loading None a TypeError."""
+    from neurohover.flightdata import FlightData
+
+    fd = nh.evaluate(nh.baseline_policy(), nh.get_task_family("ghh08").zero(), episodes=1, n_steps=20, record=True).flight_data
+    for call, message in (
+        (lambda: fd.save(tmp_path), "is a directory; give a file path"),
+        (lambda: fd.save(""), "flight-data file is empty"),
+        (lambda: FlightData.load(None), "flight-data file None is not allowed"),
+        (lambda: FlightData.load(tmp_path), "is a directory; give a file"),
+    ):
+        with pytest.raises(NeurohoverError, match=message):
+            call()
+    assert FlightData.load(fd.save(tmp_path / "fd.npz")).actions[0].shape == (20, 4)
