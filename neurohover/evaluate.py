@@ -189,6 +189,8 @@ def _index_array(values, n_jobs: int | None, upper: int | None, what: str) -> np
         raise NeurohoverError(f"{what} must be a 1-D array of job indices, got shape {arr.shape}")
     if arr.size and not np.issubdtype(arr.dtype, np.integer):
         raise NeurohoverError(f"{what} must hold integers, got dtype {arr.dtype}")
+    if arr.size and np.issubdtype(arr.dtype, np.unsignedinteger) and arr.max() > np.iinfo(np.int64).max:  # would wrap negative
+        raise NeurohoverError(f"{what} holds {arr.max()}, out of range: allowed 0..2**63-1")
     arr = arr.astype(np.int64).reshape(-1)
     if n_jobs is not None and arr.shape[0] != n_jobs:
         raise NeurohoverError(f"{what} has {arr.shape[0]} entries but there are {n_jobs} jobs")

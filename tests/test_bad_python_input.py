@@ -259,3 +259,9 @@ def test_flight_data_files_are_checked_as_the_command_line_checks_them(tmp_path)
         with pytest.raises(NeurohoverError, match=message):
             call()
     assert FlightData.load(fd.save(tmp_path / "fd.npz")).actions[0].shape == (20, 4)
+
+
+def test_an_episode_index_past_2_63_is_named_as_it_was_given() -> None:
+    """Second trial: it wrapped to a negative number and was reported as such."""
+    with pytest.raises(NeurohoverError, match=r"episode_index holds 9223372036854775808, out of range: allowed 0..2\*\*63-1"):
+        nh.evaluate_jobs([nh.baseline_policy()], [nh.get_task_family("ghh08").zero()], [0], [0], [2**63], n_steps=5)

@@ -351,6 +351,7 @@ def test_vector_mdp_and_noise_options() -> None:
         (lambda: HoverVectorEnv(2, render_mode="rgb_array"), "render_mode='rgb_array' is not supported"),
         (lambda: HoverVectorEnv(0), "num_envs=0 is out of range"),
         (lambda: HoverVectorEnv(2, mdp=["zero"]), "mdp has 1 entries but there are num_envs=2"),
+        (lambda: HoverVectorEnv(2, max_episode_steps=0), "max_episode_steps=0 is out of range"),  # was named episode_steps (second trial)
         (lambda: gym.make_vec("neurohover/GHH08-v0", num_envs=2, vectorization_mode="vector_entry_point", task="x"), "unknown task 'x'"),
     ],
 )

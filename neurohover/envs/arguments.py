@@ -108,10 +108,10 @@ def check_no_unknown_kwargs(unknown: dict[str, Any], allowed: Sequence[str]) -> 
         raise NeurohoverError(f"unknown argument(s) {', '.join(sorted(unknown))}: allowed {', '.join(allowed)}")
 
 
-def check_episode_steps(episode_steps: Any) -> int:
-    """``episode_steps`` as an int, or a clear error."""
+def check_episode_steps(episode_steps: Any, name: str = "episode_steps") -> int:
+    """``episode_steps`` (the argument ``name``) as an int, or a clear error."""
     if isinstance(episode_steps, (bool, np.bool_)) or not isinstance(episode_steps, (int, np.integer)) or not 1 <= episode_steps <= MAX_EPISODE_STEPS:
-        raise NeurohoverError(f"episode_steps={episode_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
+        raise NeurohoverError(f"{name}={episode_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
     return int(episode_steps)
 
 

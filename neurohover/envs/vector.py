@@ -155,7 +155,7 @@ class HoverVectorEnv(VectorEnv):
         self.obs_dtype = check_obs_dtype(obs_dtype)
         self.family: TaskFamily = sensed_family(task, sigma, obs_noise, obs_delay)
         self.episode_steps = check_episode_steps(episode_steps)
-        self.max_episode_steps = self.episode_steps if max_episode_steps is None else check_episode_steps(max_episode_steps)
+        self.max_episode_steps = self.episode_steps if max_episode_steps is None else check_episode_steps(max_episode_steps, "max_episode_steps")
         self._limit = min(self.episode_steps, self.max_episode_steps)
         self._specs: list[MDP | str] = self._resolve_specs(mdp)
         self.render_mode = None
