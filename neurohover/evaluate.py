@@ -87,6 +87,15 @@ class PolicyTable:
     kinds: np.ndarray  # (P,) int64
     genomes: np.ndarray  # (P, 42) float64
 
+    def __post_init__(self) -> None:
+        """A table built by hand, checked for what the kernel would misread (a kind 9 flew as an SLP; second trial). A
+        non-finite genome is allowed: its non-finite actions crash, as the simulator defines (the tests fly that path)."""
+        kinds, genomes = np.asarray(self.kinds), np.asarray(self.genomes)
+        if kinds.ndim != 1 or not np.issubdtype(kinds.dtype, np.integer) or not np.isin(kinds, list(KIND.values())).all():
+            raise NeurohoverError(f"PolicyTable kinds must be a 1-D integer array of {sorted(KIND.values())} ({', '.join(KIND)}), got {kinds!r:.80}")
+        if genomes.shape != (kinds.shape[0], GENOME_WIDTH):
+            raise NeurohoverError(f"PolicyTable genomes must be an array of shape ({kinds.shape[0]}, {GENOME_WIDTH}), got shape {genomes.shape}")
+
     @classmethod
     def from_policies(cls, policies: Sequence[Policy]) -> PolicyTable:
         if len(policies) == 0:

@@ -99,6 +99,8 @@ class Policy:
     def __post_init__(self) -> None:
         if self.topology not in TOPOLOGIES:
             raise NeurohoverError(f"unknown policy topology {self.topology!r}: allowed {', '.join(TOPOLOGIES)}")
+        if not isinstance(self.metadata, dict):  # [1] was kept, and failed when the policy was saved (second trial)
+            raise NeurohoverError(f"policy metadata={self.metadata!r:.60} is not allowed: give a dict")
         genome = check_genome(self.genome, self.topology)
         genome.setflags(write=False)
         object.__setattr__(self, "genome", genome)

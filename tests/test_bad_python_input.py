@@ -265,3 +265,16 @@ def test_an_episode_index_past_2_63_is_named_as_it_was_given() -> None:
     """Second trial: it wrapped to a negative number and was reported as such."""
     with pytest.raises(NeurohoverError, match=r"episode_index holds 9223372036854775808, out of range: allowed 0..2\*\*63-1"):
         nh.evaluate_jobs([nh.baseline_policy()], [nh.get_task_family("ghh08").zero()], [0], [0], [2**63], n_steps=5)
+
+
+def test_a_policy_table_or_policy_built_by_hand_is_checked() -> None:
+    """Second trial: a kind 9 was flown, a genome of the wrong width and metadata [1] were kept."""
+    from neurohover.evaluate import PolicyTable
+
+    for call, message in (
+        (lambda: PolicyTable(np.array([9]), np.zeros((1, 42))), "PolicyTable kinds must be a 1-D integer array of \\[0, 1\\]"),
+        (lambda: PolicyTable(np.array([0]), np.zeros((1, 40))), "PolicyTable genomes must be an array of shape \\(1, 42\\)"),
+        (lambda: nh.Policy("slp", nh.baseline_policy().genome, metadata=[1]), "policy metadata=\\[1\\] is not allowed: give a dict"),
+    ):
+        with pytest.raises(NeurohoverError, match=message):
+            call()

@@ -58,6 +58,7 @@ def test_drifted_rows_start_at_the_mdp_change_once_and_walk_by_the_stated_std() 
         (lambda: Drift(change=(("D_w",),)), "drift change=(('D_w',),) is not allowed: give parameter factors as a table"),  # second trial
         (lambda: Drift(change="D_w=0.8"), "change='D_w=0.8' is not allowed"),  # type: ignore[arg-type]
         (lambda: Drift.from_dict({"change_at": 5}), "change_at=5 is not allowed"),
+        (lambda: Drift(0.0, (("D_w", 0.8),), (True, 2)), "change_at=(True, 2) is not allowed"),
         (lambda: Drift.from_dict({"walk": 0.01, "change_at": [3, 5]}), "change_at=[3, 5] is given without a change"),  # was ignored
         (lambda: Drift.parse("walk=0.01@3-5"), "change_at=[3, 5] is given without a change"),
         (lambda: Drift.parse("D_w=0.8@0-1,D_w=0.9@0-1"), "sets D_w twice: give each once"),  # kept the last (second trial)

@@ -72,6 +72,8 @@ class Drift:
         object.__setattr__(self, "change", tuple(sorted((n, float(f)) for n, f in change.items())))
         object.__setattr__(self, "_factors", factors)
         try:
+            if any(isinstance(x, bool) for x in self.change_at):  # True was read as episode 1 (second trial)
+                raise TypeError
             lo, hi = (int(x) for x in self.change_at)
         except (TypeError, ValueError):
             raise NeurohoverError(f"drift change_at={self.change_at!r} is not allowed: give two episode numbers lo, hi with 0 <= lo <= hi") from None
