@@ -60,7 +60,8 @@ def _seed_policy(args: argparse.Namespace):
         return args.topology, args.seed_policy  # None: evolve's default (SLP over a family, MLP on one MDP)
     path = Path(args.seed_policy)
     if not path.is_file():
-        raise NeurohoverError(f"--seed-policy {args.seed_policy!r}: no such file (give zero, baseline or a policy file)")
+        what = "is empty" if args.seed_policy == "" else ("is a directory" if path.is_dir() else "no such file")
+        raise NeurohoverError(f"--seed-policy {args.seed_policy!r}: {what} (give zero, baseline or a policy file)")
     policy = load_policy(path)
     if args.topology is not None and args.topology != policy.topology:
         raise NeurohoverError(f"--seed-policy {args.seed_policy!r} is an {policy.topology} policy but --topology is {args.topology}")
