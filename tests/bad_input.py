@@ -19,7 +19,7 @@ CASES: list[tuple[list[str], str]] = [
     (["fly", "--task", "ghh08", "--episodes", "1", "--record", "afile/x.npz"], "is a file, not a directory"),
     (["fly", "--task", "ghh08", "--episodes", "1", "--record", "/proc/x.npz"], "cannot create a file in '/proc'"),
     (["fly", "--task", "ghh08", "--policy", "/proc/self/mem"], "cannot be read"),
-    (["fly", "--task", "ghh08", "--policy", "adir"], "is not a file"),
+    (["fly", "--task", "ghh08", "--policy", "adir"], "is a directory"),
     (["evolve", "--task", "ghh08", "--budget", "1000000000", "--out", "adir"], "is a directory"),
     (["evolve", "--task", "ghh08", "--budget", "1000000000", "--out", "/proc/p.json"], "cannot create a file in '/proc'"),
     (["evolve", "--task", "ghh08", "--budget", "1000000000", "--out", "afile/p.json"], "is a file, not a directory"),

@@ -157,7 +157,7 @@ def test_a_write_cut_short_leaves_no_partial_file(tmp_path: Path) -> None:
     )
     proc = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 2, proc.stderr[-2000:]
-    assert "Traceback" not in proc.stderr and "--record 'big.npz': cannot write it (File too large); no partial file is left" in proc.stderr
+    assert "Traceback" not in proc.stderr and "'big.npz': cannot write it (File too large); no partial file is left" in proc.stderr
     assert not (tmp_path / "big.npz").exists()
 
 
