@@ -92,9 +92,9 @@ def test_episodes_longer_than_the_ids_time_limit_are_warned_of() -> None:
         gym.make_vec("neurohover/GHH08-Short-v0", num_envs=2, vectorization_mode="vector_entry_point", episode_steps=6000)
     said = [str(w.message) for w in caught if "longer than the id's time limit of 1000 steps" in str(w.message)]
     assert len(said) == 2 and "max_episode_steps=6000" in said[0]
-    _, rewards, terminated, truncated, _ = _fly(
-        gym.make("neurohover/GHH08-Short-v0", episode_steps=6000, mdp="zero"), lambda o: _baseline(o.astype(float)).astype(np.float32), seed=0
-    )
+    with pytest.warns(UserWarning, match="longer than the id's time limit"):
+        short = gym.make("neurohover/GHH08-Short-v0", episode_steps=6000, mdp="zero")
+    _, rewards, terminated, truncated, _ = _fly(short, lambda o: _baseline(o.astype(float)).astype(np.float32), seed=0)
     assert len(rewards) == 1000 and truncated and not terminated  # what the warning says: the id's limit cuts the episode
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
