@@ -98,8 +98,13 @@ class PolicyTable:
 
     @classmethod
     def from_policies(cls, policies: Sequence[Policy]) -> PolicyTable:
-        if len(policies) == 0:
-            raise NeurohoverError("no policies given: need at least one")
+        if isinstance(policies, Policy):  # one policy where a sequence goes (was a TypeError; second trial)
+            policies = [policies]
+        if not isinstance(policies, Sequence) or isinstance(policies, str) or len(policies) == 0:
+            raise NeurohoverError(f"policies={policies!r:.60} is not allowed: give a non-empty sequence of Policy objects")
+        bad = next((p for p in policies if not isinstance(p, Policy)), None)
+        if bad is not None:  # 'baseline' was an AttributeError (second trial)
+            raise NeurohoverError(f"policy {bad!r:.60} is not a Policy: load one with neurohover.load_policy (e.g. load_policy('baseline'))")
         kinds = np.array([KIND[p.topology] for p in policies], dtype=np.int64)
         genomes = np.zeros((len(policies), GENOME_WIDTH))
         for i, p in enumerate(policies):

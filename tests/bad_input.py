@@ -82,6 +82,7 @@ CASES: list[tuple[list[str], str]] = [
     (["build-policies", "--task", "fghh", "--budget", "20", "--fghh-budget", "0", "--out", "q"], "--fghh-budget 0 is out of range: allowed >= 1"),
     (["evaluate-agent", "--task", "ghh08", "--policy", "baseline", "--algo", "sac"], "--algo sac applies to --rl-zoo and --sb3 models, not to --policy"),
     (["fly", "--task", "ghh08", "--policy", ""], "policy file is empty"),  # was "'.' is not a file" (second trial)
+    (["learn-model", "--flight-data", "fd.npz", "--method", "ec-mer", "--out", "m.json", "--policy", ""], "--policy is empty"),
     (["evolve", "--task", "ghh08", "--out", "x.json", "--seed-policy", "/tmp"], "--seed-policy '/tmp': is a directory"),
     (
         ["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--policy-dir", ".", "--out", "q"],

@@ -278,3 +278,13 @@ def test_a_policy_table_or_policy_built_by_hand_is_checked() -> None:
     ):
         with pytest.raises(NeurohoverError, match=message):
             call()
+
+
+def test_a_policy_where_a_sequence_goes_and_a_name_where_a_policy_goes() -> None:
+    """Second trial: evaluate_jobs(policy, ...) was a TypeError, validation_return('baseline', ...) an AttributeError."""
+    from neurohover.evolution.evolve import validation_return
+
+    b, zero = nh.baseline_policy(), nh.get_task_family("ghh08").zero()
+    assert nh.evaluate_jobs(b, [zero], [0], [0], [0], n_steps=5).returns.shape == (1,)  # one policy is a table of one
+    with pytest.raises(NeurohoverError, match="policy 'baseline' is not a Policy: load one with neurohover.load_policy"):
+        validation_return("baseline", zero, episodes=1, n_steps=5)  # type: ignore[arg-type]

@@ -147,6 +147,7 @@ def test_flight_data_can_be_recorded_in_float32_in_half_the_space(tmp_path: Path
         ["fly", "--task", "ghh08", "--seed", "1", "--seed", "2"],
         ["fly", "--task", "ghh08", "--mdp", "train:1", "--mdp", "train:2"],
         ["evaluate-agent", "--task", "ghh08", "--obs-delay", "2", "--obs-delay", "3", "--policy", "baseline"],
+        ["fly", "--task", "ghh08", "--json", "--json"],  # a flag too (second trial)
     ],
 )
 def test_a_single_valued_option_given_twice_is_refused(cli, capsys, argv: list[str]) -> None:

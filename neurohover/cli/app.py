@@ -20,14 +20,27 @@ from . import agents, evaluate, flying, learning, plots, reproduce
 COMPILING = ("fly", "demo", "bench", "evolve", "build-policies", "compete", "evaluate-agent", "reproduce")
 
 
+def _once(action, parser, namespace, option_string) -> None:
+    """Refuse an option given a second time (argparse would keep the last one, or the flag, without a word)."""
+    given = namespace.__dict__.setdefault("_given_options", set())
+    if option_string is not None and action.dest in given:
+        parser.error(f"{'/'.join(action.option_strings)} is given more than once: give it once")
+    given.add(action.dest)
+
+
 class _StoreOnce(argparse._StoreAction):
-    """An option that takes one value: given twice, it is refused (argparse would keep the last one without a word)."""
+    """An option that takes one value: given twice, it is refused."""
 
     def __call__(self, parser, namespace, values, option_string=None) -> None:
-        given = namespace.__dict__.setdefault("_given_options", set())
-        if option_string is not None and self.dest in given:
-            parser.error(f"{'/'.join(self.option_strings)} is given more than once: give it once")
-        given.add(self.dest)
+        _once(self, parser, namespace, option_string)
+        super().__call__(parser, namespace, values, option_string)
+
+
+class _FlagOnce(argparse._StoreTrueAction):
+    """A flag: given twice (fly --json --json), it is refused as a repeated option is."""
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        _once(self, parser, namespace, option_string)
         super().__call__(parser, namespace, values, option_string)
 
 
@@ -51,6 +64,7 @@ class _Parser(argparse.ArgumentParser):
         super().__init__(*args, **kwargs)
         self.register("action", None, _StoreOnce)
         self.register("action", "store", _StoreOnce)
+        self.register("action", "store_true", _FlagOnce)
         for kind in (int, float):  # every type=int / type=float option goes through the registry's converter
             self.register("type", kind, _ascii_number(kind))
 

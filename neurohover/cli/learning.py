@@ -316,6 +316,8 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
             raise NeurohoverError(f"{option} applies to --method lr only (least squares), not to --method {args.method}")
     if args.as_authors and (args.d_u, args.noise_estimate) != (None, None):
         raise NeurohoverError("--as-authors sets --d-u discard and --noise-estimate rms: give either it or those options, not both")
+    if args.policy == "":  # '' fell through to the flight data's policy (second trial)
+        raise NeurohoverError("--policy is empty: give the policy file that flew the data, or 'baseline'")
     if args.policy is not None and args.method != "ec-mer":
         raise NeurohoverError(f"--policy applies to --method ec-mer only (the policy that flew the data), not to --method {args.method}")
     data = FlightData.load(input_file(args.flight_data, "--flight-data", "flight-data file"))
