@@ -205,10 +205,7 @@ def competition_config(
         "policies": policy_dir if policy_dir is not None else "shipped",
         "groups": [group],
     }
-    if sensor is not None and not isinstance(sensor, Sensor):  # 'x' was an AttributeError (second trial)
-        raise NeurohoverError(f"sensor={sensor!r:.60} is not allowed: give a neurohover.Sensor (e.g. Sensor.of(obs_noise=1.0)) or None")
-    if drift is not None and not isinstance(drift, Drift):
-        raise NeurohoverError(f"drift={drift!r:.60} is not allowed: give a neurohover.Drift (e.g. Drift.parse('walk=0.01')) or None")
+    get_task_family(task, sigma, sensor, drift)  # the family's own checks of the sensor and drift ('x' was an AttributeError)
     if sensor is not None and not sensor.exact:
         settings["sensor"] = sensor.to_dict()
     if drift is not None and not drift.none:

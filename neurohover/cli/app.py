@@ -44,29 +44,15 @@ class _FlagOnce(argparse._StoreTrueAction):
         super().__call__(parser, namespace, values, option_string)
 
 
-def _ascii_number(kind: type):
-    """``kind`` (int or float) of ASCII text only: Python's int() and float() also read other scripts' digits ('\u0663' is 3)."""
-
-    def convert(text: str):
-        if not text.isascii():
-            raise argparse.ArgumentTypeError(f"{text!r} is not allowed: give a number in ASCII digits")
-        return kind(text)
-
-    convert.__name__ = kind.__name__  # argparse names the type in its other messages ("invalid int value")
-    return convert
-
-
 class _Parser(argparse.ArgumentParser):
-    """argparse's parser with single-valued options refused when repeated and numbers read from ASCII digits only
-    (its subcommands' parsers are of this class too)."""
+    """argparse's parser with single-valued options and flags refused when repeated (its subcommands' parsers are of
+    this class too; other scripts' digits are refused by main, in every argument)."""
 
     def __init__(self, *args, **kwargs) -> None:
         super().__init__(*args, **kwargs)
         self.register("action", None, _StoreOnce)
         self.register("action", "store", _StoreOnce)
         self.register("action", "store_true", _FlagOnce)
-        for kind in (int, float):  # every type=int / type=float option goes through the registry's converter
-            self.register("type", kind, _ascii_number(kind))
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -63,7 +63,7 @@ def _fly(policy, mdps: list, args: argparse.Namespace, show_progress: bool):
 
 def cmd_fly(args: argparse.Namespace) -> int:
     """Fly a policy and print return statistics."""
-    from ..paths import output_file, writing
+    from ..paths import output_file
     from ..policies import load_policy
 
     if args.episodes < 1:
@@ -86,8 +86,7 @@ def cmd_fly(args: argparse.Namespace) -> int:
         fd.metadata.update(
             {"task": family.name, "mdps": [m.to_dict() for m in mdps], "policy": str(args.policy), "seed": args.seed, "returns": returns.tolist()}
         )
-        with writing(args.record, "--record") as path:
-            fd.save(path, dtype=args.record_dtype or "float64")
+        fd.save(args.record, dtype=args.record_dtype or "float64")  # a failed write: one message, no partial file
     summary = {
         "task": family.name,
         **({} if family.sensor.exact else {"sensor": family.sensor.to_dict()}),

@@ -228,8 +228,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     validation = validation_return(
         result.champion, target, episodes=args.validation_episodes, seed=args.seed, n_steps=args.episode_steps, threads=args.threads, device=args.device
     )
-    with writing(out, "--out") as path:
-        save_policy(result.champion, path, **_evolve_meta(args, family, target, mdp_desc, resampling, result, scale, validation, history_path.name))
+    save_policy(result.champion, out, **_evolve_meta(args, family, target, mdp_desc, resampling, result, scale, validation, history_path.name))
     with writing(history_path, "--out's history") as path:
         write_history_csv(result.history, path)
     summary = {
