@@ -277,13 +277,18 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
         raise NeurohoverError(f"--compete {str(csv_path)!r} holds no episodes")
     n = min(len(rows) for rows in runs.values())
     returns = np.array([[r for _, r in sorted(rows)[:n]] for _, rows in sorted(runs.items())])
-    label = path.resolve().name
-    try:
-        summary = json.loads((path / COMPETE_SUMMARY).read_text())
-        if isinstance(summary, dict) and summary.get("agent"):
-            label = f"{summary['agent']} ({summary.get('task', '?')})"
-    except (OSError, ValueError):
-        pass  # no summary (an interrupted competition): the directory's name labels it
+    label = path.resolve().name  # no summary (an interrupted competition): the directory's name labels it
+    summary_path = path / COMPETE_SUMMARY
+    if summary_path.exists():
+        try:
+            summary = json.loads(summary_path.read_text())
+        except (OSError, ValueError) as err:  # damaged: refused, not silently relabelled (second trial)
+            raise NeurohoverError(
+                f"--compete {str(summary_path)!r} cannot be read ({err}); remove it to label the curve by its directory's name"
+            ) from None
+        if not (isinstance(summary, dict) and isinstance(summary.get("agent"), str) and isinstance(summary.get("task", ""), str)):
+            raise NeurohoverError(f"--compete {str(summary_path)!r} is not a compete summary: no agent and task names")
+        label = f"{summary['agent']} ({summary.get('task', '?')})"
     return CompeteResult(label, returns, crashes, path)
 
 

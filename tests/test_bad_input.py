@@ -106,6 +106,19 @@ def test_version_names_the_installed_package(capsys) -> None:
     assert capsys.readouterr().out.strip() == f"neurohover {version('neurohover')}"
 
 
+def test_version_with_other_arguments_is_refused(capsys) -> None:
+    with pytest.raises(SystemExit) as stop:
+        main(["--version", "extra"])  # argparse printed the version and dropped 'extra' (second trial)
+    assert stop.value.code == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and "--version takes no other arguments, got 'extra'" in captured.err
+
+
+def test_demo_refuses_zero_episodes_before_its_table(capsys) -> None:
+    assert main(["demo", "--episodes", "0"]) == 2
+    assert capsys.readouterr().out == ""  # the header was printed before the refusal (second trial)
+
+
 def test_the_script_prints_one_line_per_case() -> None:
     # Every 16th case in fresh processes (the script runs all of them by hand; each case runs in-process above).
     proc = subprocess.run([sys.executable, str(Path(__file__).with_name("bad_input.py")), "--every", "16"], capture_output=True, text=True, timeout=900)

@@ -179,6 +179,10 @@ def bad(files, tmp_path: Path) -> dict[str, str]:
     (tmp_path / "empty").mkdir()
     (tmp_path / "badcsv").mkdir()
     (tmp_path / "badcsv" / "episodes.csv").write_text("a,b\n1,2\n")
+    for name, summary in (("badsummary", "{not json"), ("oddsummary", '{"agent": 5}')):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "episodes.csv").write_text("run,mdp,episode,return,crashed\n0,m,0,-1,0\n")
+        (tmp_path / name / "summary.json").write_text(summary)
     return {"dir": str(tmp_path), "flight": str(files["flight"]), "compete": str(files["baseline"])}
 
 
@@ -194,6 +198,11 @@ def bad(files, tmp_path: Path) -> dict[str, str]:
         (["--compete", "{compete}", "{dir}/nothere"], "--compete '{dir}/nothere': no such directory"),
         (["--compete", "{dir}/badcsv"], "is not a compete episodes file: no column run, episode, return"),
         (["--compete", "{compete}", "--out", "/proc/plots"], "--out '/proc/plots': cannot"),
+        (["--compete", "{dir}/badsummary"], "summary.json' cannot be read (Expecting property name"),
+        (["--compete", "{dir}/oddsummary"], "summary.json' is not a compete summary: no agent and task names"),
+        (["--compete", "{compete}", "--episodes", "0"], "--episodes picks episodes of a flight-data file; it does not apply to --compete"),
+        (["{flight}", "--episodes", "0,0"], "--episodes '0,0' names episode 0 more than once"),
+        (["{flight}", "--episodes", "0-1,1"], "--episodes '0-1,1' names episode 1 more than once"),
         ([], "nothing to plot"),
         (["{flight}", "--compete", "{compete}"], "not both"),
     ],

@@ -77,10 +77,17 @@ def _other_scripts_digits(argv: Sequence[str]) -> str | None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
-    odd = _other_scripts_digits(sys.argv[1:] if argv is None else argv)
+    try:  # the command modules import NumPy and the like: a Ctrl-C there is an interruption, not a traceback
+        parser = build_parser()
+    except KeyboardInterrupt:
+        print("neurohover: interrupted", file=sys.stderr)
+        return 130
+    given = list(sys.argv[1:] if argv is None else argv)
+    odd = _other_scripts_digits(given)
     if odd is not None:
         parser.error(f"argument {odd!r} holds digits of another script: give numbers in ASCII digits")
+    if "--version" in given and len(given) > 1:  # argparse prints the version and drops the rest without a word
+        parser.error(f"--version takes no other arguments, got {' '.join(a for a in given if a != '--version')!r}")
     args = parser.parse_args(argv)
     from ..paths import forget_created_dirs, remove_created_dirs
 

@@ -119,7 +119,9 @@ def cmd_demo(args: argparse.Namespace) -> int:
 
     if not 0 <= args.mdps <= N_TRAINING:
         raise NeurohoverError(f"--mdps {args.mdps} is out of range: allowed 0..{N_TRAINING} (training MDPs per family, beside the zero setting)")
-    check_episode_count(2 * (args.mdps + 1) * max(args.episodes, 0), f"2 policies x {args.mdps + 1} MDPs x episodes={args.episodes}")  # before the table
+    if args.episodes < 1:  # refused before the table's header is printed (second trial)
+        raise NeurohoverError(f"--episodes {args.episodes} is out of range: allowed an integer >= 1")
+    check_episode_count(2 * (args.mdps + 1) * args.episodes, f"2 policies x {args.mdps + 1} MDPs x episodes={args.episodes}")  # before the table
     policies = {"baseline": baseline_policy(), "mlp(baseline seed)": prototype("mlp", "baseline")}
     print(f"{'task':<6} {'mdp':<16} {'policy':<20} {'mean return':>12} {'sd':>10} {'crashes':>8}")
     for name in TASK_NAMES:

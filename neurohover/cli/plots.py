@@ -35,6 +35,9 @@ def _episodes(text: str | None, n: int) -> list[int] | None:
             raise NeurohoverError(f"--episodes {text!r} is not allowed: give episode numbers and ranges, e.g. 0,3,10-12") from None
         if not (0 <= first <= last < n):
             raise NeurohoverError(f"--episodes {part.strip()!r} is out of range: the flight data hold episodes 0..{n - 1}")
+        twice = sorted(set(out) & set(range(first, last + 1)))
+        if twice:  # '0,0' would draw the same file twice
+            raise NeurohoverError(f"--episodes {text!r} names episode {twice[0]} more than once: give each episode once")
         out.extend(range(first, last + 1))
     return out
 
@@ -45,6 +48,8 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
     if args.flight is not None and args.compete:
         raise NeurohoverError("give either a flight-data file or --compete DIR ..., not both")
+    if args.compete and args.episodes is not None:
+        raise NeurohoverError("--episodes picks episodes of a flight-data file; it does not apply to --compete")
     if args.flight is None and not args.compete:
         raise NeurohoverError("nothing to plot: give a flight-data file (neurohover fly --record) or --compete DIR ...")
     if args.flight is not None:
