@@ -283,9 +283,7 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
         try:
             summary = json.loads(summary_path.read_text())
         except (OSError, ValueError) as err:  # damaged: refused, not silently relabelled (second trial)
-            raise NeurohoverError(
-                f"--compete {str(summary_path)!r} cannot be read ({err}); remove it to label the curve by its directory's name"
-            ) from None
+            raise NeurohoverError(f"--compete {str(summary_path)!r} cannot be read ({err}); remove it to label the curve by its directory's name") from None
         if not (isinstance(summary, dict) and isinstance(summary.get("agent"), str) and isinstance(summary.get("task", ""), str)):
             raise NeurohoverError(f"--compete {str(summary_path)!r} is not a compete summary: no agent and task names")
         label = f"{summary['agent']} ({summary.get('task', '?')})"
