@@ -166,7 +166,7 @@ def competition_config(
     sigma: float | None = None,
     n_steps: int = EPISODE_STEPS,
     policy_dir: str | None = None,
-    hybrid: HybridSettings = HybridSettings(),
+    hybrid: HybridSettings | Mapping[str, object] = HybridSettings(),
     sensor: Sensor | None = None,
     drift: Drift | None = None,
     wind_model: str = "none",
@@ -186,8 +186,15 @@ def competition_config(
     check_sizes(runs, episodes)
     check_seed(seed)  # the range every command takes
     group: dict[str, object] = {"agent": agent, **_group(task, runs, mdps)}
+    if isinstance(hybrid, Mapping):  # the plain settings a config's hybrid table holds
+        hybrid = HybridSettings.from_dict(dict(hybrid))
+    if not isinstance(hybrid, HybridSettings):  # 'x' was an AttributeError (second trial)
+        allowed = ", ".join(HybridSettings().to_dict())
+        raise NeurohoverError(f"hybrid={hybrid!r:.60} is not allowed: give a HybridSettings or a dict of its settings ({allowed})")
     if agent in HYBRID_AGENTS:
         group["hybrid"] = hybrid.to_dict()
+    elif hybrid != HybridSettings():  # would be ignored without a word
+        raise NeurohoverError(f"hybrid settings apply to the hybrid agents only ({', '.join(HYBRID_AGENTS)}), not to agent {agent!r}")
     if wind_model != "none":  # the wind of the LR models the agent learns (absent: the digest of older competitions)
         group["wind_model"] = wind_model
     for key, choice in (lr_fit or {}).items():  # LR as the authors fitted it (absent: ours, the digest of older competitions)
@@ -227,7 +234,7 @@ def compete(
     sigma: float | None = None,
     n_steps: int = EPISODE_STEPS,
     policy_dir: str | None = None,
-    hybrid: HybridSettings = HybridSettings(),
+    hybrid: HybridSettings | Mapping[str, object] = HybridSettings(),
     store: str | Path | None = None,
     progress: bool | None = False,
     on_result: Callable[[str, object], None] | None = None,
@@ -252,8 +259,9 @@ def compete(
         Local worker processes.
     store : path, optional
         Results store (default ``out/results.sqlite``); finished runs in it are not flown again.
-    hybrid : HybridSettings
-        Safeguard and replacement rule of the hybrid agents (refused for the others by the CLI).
+    hybrid : HybridSettings or mapping
+        Safeguard and replacement rule of the hybrid agents (a dict of :meth:`HybridSettings.to_dict`'s
+        keys is read as such); other than the default, refused for the other agents.
     on_result : callable, optional
         ``on_result(unit key, TestRunResult)`` after each run finished in this call.
     device : {"cpu", "cuda"}

@@ -183,20 +183,28 @@ def _write_ghh_set(
     return PolicySet(task, root, generic, tuple(specialised), safe, manifest=manifest)
 
 
-def _check_build(lineage: str, optimizer: str, **sizes) -> None:
-    """The build's settings checked before any run (a bad FGHH budget was refused only after the first generic was written)."""
+def check_build(family, lineage: str | None, fghh_budget: int | None, optimizer: str, **sizes) -> tuple[str, int]:
+    """:func:`build_policy_set`'s settings for ``family``, checked before any run (a bad FGHH budget was refused only
+    after the first generic was written); the lineage and FGHH budget it runs with (None: the defaults, where they apply)."""
     from .evolution.optimisers import optimiser_names
     from .evolution.seeding import check_seed
 
-    for name, value in sizes.items():
+    fghh = family.generic_over_distribution  # FGHH: generics over G, no specialised policies
+    if fghh and lineage is not None:  # would be ignored without a word (second trial)
+        raise NeurohoverError(f"lineage applies to the GHH tasks' specialised policies; task {family.name!r} has none")
+    if not fghh and fghh_budget is not None:
+        raise NeurohoverError(f"fghh_budget (--fghh-budget) applies to task fghh (its generics over G), not to {family.name!r}: give budget")
+    for name, value in {**sizes, "fghh_budget": FGHH_POLICY_BUDGET if fghh_budget is None else fghh_budget}.items():
         if name == "seed":
             check_seed(value)
         elif isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
             raise NeurohoverError(f"{name}={value!r} is out of range: allowed a whole number >= 1")
+    lineage = "chain" if lineage is None else lineage
     if lineage not in LINEAGES:
         raise NeurohoverError(f"lineage {lineage!r} is not known: allowed {', '.join(LINEAGES)}")
     if optimizer not in optimiser_names():
         raise NeurohoverError(f"unknown optimizer {optimizer!r}: allowed {', '.join(optimiser_names())}")
+    return lineage, FGHH_POLICY_BUDGET if fghh_budget is None else fghh_budget
 
 
 def _evolve_one(
@@ -232,11 +240,11 @@ def build_policy_set(
     out: str | Path | None = None,
     *,
     budget: int = POLICY_BUDGET,
-    fghh_budget: int = FGHH_POLICY_BUDGET,
+    fghh_budget: int | None = None,
     seed: int = 0,
     safety_episodes: int = 3,
     n_steps: int = 6000,
-    lineage: str = "chain",
+    lineage: str | None = None,
     optimizer: str = "ne",
     progress: Callable[[str], None] | None = None,
 ) -> PolicySet:
@@ -250,17 +258,18 @@ def build_policy_set(
         Directory to write ``<task>/`` into (default: the shipped sets).
     budget : int
         Episodes of each steady-state run (the whole budget is spent: no plateau stop).
-    fghh_budget : int
-        Episodes of each FGHH generic-policy run over G.
+    fghh_budget : int, optional
+        FGHH only: episodes of each generic-policy run over G (default :data:`FGHH_POLICY_BUDGET`);
+        refused for the GHH tasks.
     seed : int
         Root seed of every run.
     safety_episodes : int
         Episodes of each specialised policy on each training MDP for the safe-policy rule.
     n_steps : int
         Control steps per episode.
-    lineage : {"chain", "independent"}
-        GHH-08/09: seed every run from an ancestor evolved over the training MDPs in turn
-        (default; see the module doc), or from the baseline policy.
+    lineage : {"chain", "independent"}, optional
+        GHH-08/09 only: seed every run from an ancestor evolved over the training MDPs in turn
+        (``"chain"``, the default; see the module doc), or from the baseline policy; refused for FGHH.
     optimizer : str
         ``ne`` (the paper's neuroevolution) or a population optimiser of
         :mod:`neurohover.evolution.optimisers` for every run on one MDP and FGHH's fixed-resampling
@@ -269,8 +278,8 @@ def build_policy_set(
         Called with one line of text per finished run.
     """
 
-    _check_build(lineage, optimizer, budget=budget, fghh_budget=fghh_budget, seed=seed, safety_episodes=safety_episodes, n_steps=n_steps)
     family = get_task_family(task)
+    lineage, fghh_budget = check_build(family, lineage, fghh_budget, optimizer, budget=budget, seed=seed, safety_episodes=safety_episodes, n_steps=n_steps)
     final = policy_dir(family.name, out)
     # Built beside the set it replaces, which it replaces only once complete: an interrupted build (or a
     # failed one) leaves the old set, shipped or not, as it was.

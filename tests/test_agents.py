@@ -149,6 +149,13 @@ def test_chain_lineage_seeds_every_run_from_the_ancestor_and_independent_from_th
     for kwargs, message in (({"seed": -1}, "seed=-1 is out of range"), ({"fghh_budget": 0}, "fghh_budget=0 is out of range")):
         with pytest.raises(NeurohoverError, match=message):
             build_policy_set("fghh", tmp_path / "refused", budget=30, **kwargs)
+    # Settings that would be ignored without a word (second trial): refused before any run.
+    for task, kwargs, message in (
+        ("fghh", {"lineage": "chain"}, "lineage applies to the GHH tasks' specialised policies; task 'fghh' has none"),
+        ("ghh08", {"fghh_budget": 7}, "fghh_budget .--fghh-budget. applies to task fghh"),
+    ):
+        with pytest.raises(NeurohoverError, match=message):
+            build_policy_set(task, tmp_path / "refused", budget=30, **kwargs)
     assert not (tmp_path / "refused").exists()
 
 

@@ -162,6 +162,7 @@ def test_a_run_on_another_familys_mdp_is_refused() -> None:
         ({"wind_kind": 9}, "wind_kind=9 is not allowed"),
         ({"noise_std": (-1.0,) * 6}, "noise_std=.* is out of range: allowed stds >= 0"),
         ({"params": (float("nan"),) * 11}, "give 11 finite numbers"),
+        ({"label": 5}, "label=5 is not allowed: give a string"),  # kept as the number (second trial)
     ],
 )
 def test_an_mdp_is_checked_when_it_is_made(kwargs: dict, message: str) -> None:
@@ -288,3 +289,34 @@ def test_a_policy_where_a_sequence_goes_and_a_name_where_a_policy_goes() -> None
     assert nh.evaluate_jobs(b, [zero], [0], [0], [0], n_steps=5).returns.shape == (1,)  # one policy is a table of one
     with pytest.raises(NeurohoverError, match="policy 'baseline' is not a Policy: load one with neurohover.load_policy"):
         validation_return("baseline", zero, episodes=1, n_steps=5)  # type: ignore[arg-type]
+
+
+def test_the_last_python_api_leftovers_of_the_second_trial_are_refused_by_name(tmp_path) -> None:
+    """issue 37: an AttributeError, a TypeError mid-run, a misleading message, and settings ignored without a word."""
+    import gymnasium as gym
+
+    from neurohover.compete import compete
+    from neurohover.evolution.evolve import evolve
+
+    fam = nh.get_task_family("ghh08")
+    calls = (
+        (lambda: compete("ghh08", "hybrid", runs=1, episodes=1, hybrid="x", out=tmp_path / "c"), "hybrid='x' is not allowed: give a HybridSettings"),
+        (lambda: compete("ghh08", "baseline", runs=1, episodes=1, hybrid={"box": 0.3}, out=tmp_path / "c"), "apply to the hybrid agents only"),
+        (lambda: evolve(fam.zero(), budget=2, n_steps=5, progress_every_s=-1), "progress_every_s=-1 is out of range"),
+        (lambda: evolve(fam.zero(), budget=2, n_steps=5, progress=3), "progress=3 is not allowed: give a callable"),
+        (lambda: evolve(fam.zero(), budget=2, n_steps=5, settings="x"), "a preset's name is for the generational method"),
+    )
+    for call, expected in calls:
+        with pytest.raises(NeurohoverError, match=expected):
+            call()
+    assert not (tmp_path / "c").exists()
+    env = gym.make("neurohover/GHH08-v0")
+    env.reset(seed=0)
+    for action in (np.array([1j, 0, 0, 0]), ["0.1", "0", "0", "0"]):  # cut to its real part with a warning; read as numbers
+        with pytest.raises(NeurohoverError, match="is not allowed: give 4 real numbers"):
+            env.step(action)
+    vec = gym.make_vec("neurohover/GHH08-v0", num_envs=2, vectorization_mode="vector_entry_point")
+    vec.reset(seed=0)
+    with pytest.raises(NeurohoverError, match=r"actions must be a \(2, 4\) array of real numbers"):
+        vec.step(np.zeros((2, 4), dtype=complex))
+    assert env.step([0, 0, 0, 0])[0].shape == (12,)  # integers and lists still fly

@@ -12,21 +12,15 @@ from ..evaluate import DEVICES, check_device
 def cmd_build_policies(args: argparse.Namespace) -> int:
     """Evolve a task family's generic and specialised policies (the agents' policy set)."""
     from ..paths import output_dir
-    from ..policysets import LINEAGES, build_policy_set
+    from ..policysets import build_policy_set, check_build
     from ..tasks import get_task_family
 
     if args.budget < 1:
         raise NeurohoverError(f"--budget {args.budget} is out of range: allowed >= 1")
     if args.fghh_budget is not None and args.fghh_budget < 1:  # refused before the first run, not after it
         raise NeurohoverError(f"--fghh-budget {args.fghh_budget} is out of range: allowed >= 1")
-    if args.lineage is not None and args.lineage not in LINEAGES:
-        raise NeurohoverError(f"--lineage {args.lineage!r} is not known: allowed {', '.join(LINEAGES)}")
-    fghh = get_task_family(args.task).generic_over_distribution  # FGHH: generics over G, no specialised policies
-    if fghh and args.lineage is not None:
-        raise NeurohoverError(f"--lineage applies to the GHH tasks' specialised policies; task {args.task!r} has none")
-    if not fghh and args.fghh_budget is not None:
-        raise NeurohoverError(f"--fghh-budget applies to task fghh (its generics over G), not to {args.task!r}: give --budget")
-    if args.out is not None:
+    check_build(get_task_family(args.task), args.lineage, args.fghh_budget, args.optimizer, budget=args.budget, seed=args.seed, n_steps=args.episode_steps)
+    if args.out is not None:  # made once every option is checked
         output_dir(args.out, "--out")
     ps = build_policy_set(
         args.task,
@@ -34,7 +28,8 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
         budget=args.budget,
         seed=args.seed,
         n_steps=args.episode_steps,
-        **{k: v for k, v in (("fghh_budget", args.fghh_budget), ("lineage", args.lineage)) if v is not None},  # absent: build_policy_set's defaults
+        fghh_budget=args.fghh_budget,  # None: the default, where it applies (build_policy_set refuses it elsewhere)
+        lineage=args.lineage,
         optimizer=args.optimizer,
         progress=lambda msg: print(msg, file=sys.stderr, flush=True),
     )

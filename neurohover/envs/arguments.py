@@ -131,6 +131,18 @@ def draw_stream_seed(rng: np.random.Generator) -> int:
     return int(rng.bit_generator.random_raw()) >> 1
 
 
+def real_values(values: Any, message: str) -> np.ndarray:
+    """``values`` (actions) as float64, or NeurohoverError(``message``): text and complex numbers are refused, which
+    NumPy would read ('1' as 1.0) or cut to their real part with only a warning."""
+    try:
+        raw = np.asarray(values)
+        if raw.dtype.kind not in "biuf":
+            raise TypeError(raw.dtype)
+        return raw.astype(np.float64, copy=False)
+    except (TypeError, ValueError):
+        raise NeurohoverError(message) from None
+
+
 def _check_dtype(value: Any, name: str) -> np.dtype:
     try:
         dtype = np.dtype(value)

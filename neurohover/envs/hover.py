@@ -46,6 +46,7 @@ from .arguments import (
     check_obs_dtype,
     check_reset_options,
     draw_stream_seed,
+    real_values,
     resolve_mdp,
     sensed_family,
 )
@@ -408,10 +409,7 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         if self._done:
             raise NeurohoverError("step() called on a finished episode (or before reset()): call reset() first")
-        try:
-            a = np.asarray(action, dtype=np.float64)
-        except (TypeError, ValueError):
-            raise NeurohoverError(f"action {action!r} is not allowed: give 4 numbers (aileron, elevator, rudder, collective)") from None
+        a = real_values(action, f"action {action!r:.80} is not allowed: give 4 real numbers (aileron, elevator, rudder, collective)")
         if a.shape != (ACTION_DIM,):
             raise NeurohoverError(f"action has shape {a.shape}, expected (4,): aileron, elevator, rudder, collective in [-1, 1]")
         self._action[0] = a

@@ -41,6 +41,7 @@ from gymnasium.wrappers.vector import TransformReward as VectorTransformReward
 from ..errors import NeurohoverError
 from ..sim.constants import ACTION_DIM, MAX_POSITION, MAX_RATE, MAX_VELOCITY
 from ..wrappers import CrashAwareReward, crash_aware
+from .arguments import real_values
 from .hover import HoverEnv
 from .vector import HoverVectorEnv
 
@@ -71,10 +72,7 @@ def scale_observation(obs: np.ndarray) -> np.ndarray:
 
 def controls(action: np.ndarray, task: str) -> np.ndarray:
     """The task's controls (..., 4), float64, of an RL id's actions on family ``task``."""
-    try:
-        a = np.asarray(action, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise NeurohoverError(f"action {action!r} is not allowed: give 4 numbers in [-1, 1] per helicopter") from None
+    a = real_values(action, f"action {action!r:.80} is not allowed: give 4 real numbers in [-1, 1] per helicopter")
     if a.ndim == 0 or a.shape[-1] != ACTION_DIM:
         raise NeurohoverError(f"action has shape {a.shape}, expected (..., 4): 4 numbers in [-1, 1] per helicopter")
     a = np.clip(a, -1.0, 1.0)

@@ -44,6 +44,7 @@ from .arguments import (
     check_obs_dtype,
     check_reset_options,
     draw_stream_seed,
+    real_values,
     resolve_mdp,
     sensed_family,
 )
@@ -298,10 +299,7 @@ class HoverVectorEnv(VectorEnv):
         return mask.copy()
 
     def _coerce_actions(self, actions: Any) -> np.ndarray:
-        try:
-            a = np.asarray(actions, dtype=np.float64)
-        except (TypeError, ValueError):
-            raise NeurohoverError(f"actions must be a ({self.num_envs}, 4) array of numbers, got {actions!r:.80}") from None
+        a = real_values(actions, f"actions must be a ({self.num_envs}, 4) array of real numbers, got {actions!r:.80}")
         if a.shape != (self.num_envs, ACTION_DIM):
             raise NeurohoverError(f"actions have shape {a.shape}, expected ({self.num_envs}, 4): aileron, elevator, rudder, collective per helicopter")
         np.copyto(self._actions, a)

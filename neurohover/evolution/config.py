@@ -188,6 +188,11 @@ def make_settings(method: str, optimizer: str, settings) -> Any:
     if settings is None:
         return cls()
     if isinstance(settings, str):  # a preset's name
+        if cls is not GenerationalSettings:  # was "unknown steady-state setting(s) preset" (second trial)
+            raise NeurohoverError(
+                f"settings={settings!r:.60} is not allowed: a preset's name is for the generational method; "
+                f"{method} takes a {cls.__name__} or a dict of its fields"
+            )
         settings = {"preset": settings}
     if isinstance(settings, cls):
         return dataclasses.replace(settings, budget=None)

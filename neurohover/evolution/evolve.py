@@ -73,6 +73,7 @@ Example
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from pathlib import Path
 
@@ -120,11 +121,17 @@ __all__ = [
 ]
 
 
-def _prepare(run: Run, checkpoint, checkpoint_every_s, resume: bool, threads: int | None, device: str, trace: list | None) -> Path | None:
-    """Check the checkpoint options, restore the run from its checkpoint on ``resume``, and load (or compile) the
+def _prepare(
+    run: Run, checkpoint, checkpoint_every_s, progress, progress_every_s, resume: bool, threads: int | None, device: str, trace: list | None
+) -> Path | None:
+    """Check the checkpoint and progress options, restore the run from its checkpoint on ``resume``, and load (or compile) the
     kernel before the run's clock starts (which also validates the thread count); the checkpoint's path."""
     if not isinstance(checkpoint_every_s, (int, float)) or not checkpoint_every_s > 0:
         raise NeurohoverError(f"checkpoint_every_s={checkpoint_every_s!r} must be a number > 0")
+    if isinstance(progress_every_s, bool) or not isinstance(progress_every_s, (int, float)) or not 0 <= progress_every_s < math.inf:
+        raise NeurohoverError(f"progress_every_s={progress_every_s!r} is out of range: allowed a finite number of seconds >= 0 (0: every generation)")
+    if progress is not None and not callable(progress):  # progress=3 was "'int' object is not callable" mid-run (second trial)
+        raise NeurohoverError(f"progress={progress!r:.60} is not allowed: give a callable taking a ProgressInfo, or None")
     path = None if checkpoint is None else (Path(checkpoint) if resume else output_file(checkpoint, "checkpoint"))  # checked before the run
     if resume:
         if path is None:
@@ -229,7 +236,7 @@ def evolve(
         n_steps=n_steps, method=method,
     )  # fmt: skip
     run = Run(cfg, device=device)
-    path = _prepare(run, checkpoint, checkpoint_every_s, resume, threads, device, _trace)
+    path = _prepare(run, checkpoint, checkpoint_every_s, progress, progress_every_s, resume, threads, device, _trace)
     with num_threads(threads if threads is not None else numba.get_num_threads()):  # restores the count after
         run.flyer.start()
         run.run(progress, path, float(checkpoint_every_s), float(progress_every_s))

@@ -28,6 +28,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from ..envs.arguments import real_values
 from ..errors import NeurohoverError
 from . import SB3_ALGORITHMS
 
@@ -59,7 +60,7 @@ class SB3VecEnv(VecEnv):
         return obs
 
     def step_async(self, actions: np.ndarray) -> None:
-        self._actions = np.asarray(actions, dtype=np.float64).reshape(self.num_envs, -1)
+        self._actions = real_values(actions, f"actions must be a ({self.num_envs}, 4) array of real numbers, got {actions!r:.80}").reshape(self.num_envs, -1)
 
     def step_wait(self):
         assert self._actions is not None  # step_async first, as SB3's VecEnv.step does

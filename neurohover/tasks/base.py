@@ -89,6 +89,8 @@ class MDP:
             raise NeurohoverError(f"sensor must be a neurohover Sensor, got {self.sensor!r}")
         if not isinstance(self.drift, Drift):
             raise NeurohoverError(f"drift must be a neurohover Drift, got {self.drift!r}")
+        if not isinstance(self.label, str):  # make(label=5) was kept as the number (second trial)
+            raise NeurohoverError(f"MDP label={self.label!r:.60} is not allowed: give a string")
         if not isinstance(self.family, str) or not self.family:
             raise NeurohoverError(f"MDP family={self.family!r} is not allowed: give a task family's name (or 'model')")
         # Plain Python numbers (the same values): reprs read MDP(params=(-0.18, ...)), not np.float64(-0.18).
