@@ -301,7 +301,9 @@ def evaluate_jobs(
             f"threshold, the kind 0 or 1, the ratio threshold, 12 ratio limits, all > 0 but the kind; then the arming step, a whole "
             f"number >= 0), got {limits.tolist()}"
         )
-    rec = np.zeros(n_jobs, dtype=bool) if record is None else np.asarray(record, dtype=bool).reshape(-1)
+    rec = np.zeros(n_jobs, dtype=bool) if record is None else np.asarray(record).reshape(-1)
+    if rec.dtype != bool:  # record='x' was read as True (second trial)
+        raise NeurohoverError(f"record={record!r:.60} is not allowed: give one True/False flag per job ({n_jobs})")
     if rec.shape[0] != n_jobs:
         raise NeurohoverError(f"record must have one flag per job ({n_jobs}), got {rec.shape[0]}")
     slots = np.full(n_jobs, -1, dtype=np.int64)

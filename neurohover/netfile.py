@@ -49,6 +49,14 @@ def _role(topology: str, name: str) -> tuple[int, int]:
     return position, function
 
 
+def _finite(text: str, what: str) -> float:
+    """A bias or weight: a finite number (a NaN was refused later by Policy, without the file and line)."""
+    value = float(text)
+    if not np.isfinite(value):
+        raise ValueError(f"{what} {text} is not a finite number")
+    return value
+
+
 def _parse_lines(text: str, source: str):
     """Node and link lines with their line numbers, and the comment lines."""
     nodes: dict[int, tuple[int, int, float, int, str]] = {}
@@ -66,12 +74,12 @@ def _parse_lines(text: str, source: str):
                 node = int(fields[1])
                 if node in nodes:  # a second definition would silently replace the first
                     raise ValueError(f"node {node} is defined again (first on line {nodes[node][3]})")
-                nodes[node] = (int(fields[2]), int(fields[3]), float(fields[4]), number, line.strip())
+                nodes[node] = (int(fields[2]), int(fields[3]), _finite(fields[4], "bias"), number, line.strip())
             elif fields[0] == "s" and len(fields) == 4:
                 link = (int(fields[1]), int(fields[2]))
                 if link in links:
                     raise ValueError(f"link {link[0]} -> {link[1]} is given again (first on line {links[link][1]})")
-                links[link] = (float(fields[3]), number, line.strip())
+                links[link] = (_finite(fields[3], "weight"), number, line.strip())
             else:
                 raise ValueError("expected 'n ID POSITION FUNCTION BIAS' or 's SOURCE DEST WEIGHT'")
         except ValueError as err:

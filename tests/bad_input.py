@@ -75,6 +75,7 @@ CASES: list[tuple[list[str], str]] = [
     (["demo", "--episodes", "10000000000000"], "episodes=10000000000000 is out of range"),
     (["demo", "--mdps", "-1"], "--mdps -1 is out of range: allowed 0..10"),
     (["demo", "--episodes", "0"], "--episodes 0 is out of range: allowed an integer >= 1"),
+    (["reproduce", "fig2", "--store", "s.sqlite", "--set", "sensor={noise=1, noise=2}"], "VALUE is not valid TOML (Duplicate inline table key 'noise')"),
     (["build-policies", "--task", "ghh08", "--budget", "10", "--seed", "-1", "--out", "q"], "seed=-1 is out of range: allowed an integer in 0..2**63-1"),
     (["evolve", "--task", "ghh08", "--budget", "10", "--seed", "-5", "--out", "p.json"], "seed=-5 is out of range"),
     (["fly", "--task", "ghh08", "--mdp", ""], "unknown MDP ''"),

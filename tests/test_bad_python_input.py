@@ -92,6 +92,10 @@ def test_sizes_that_would_exhaust_memory_are_refused_up_front() -> None:
         (lambda: nh.get_task_family("ghh08").make(["1", "2"]), "must be 2 numbers, got ['1', '2']"),
         (lambda: nh.load_policy(None), "policy source None is not allowed"),
         (lambda: nh.evaluate("baseline", nh.get_task_family("ghh08").zero(), n_steps=5, record="yes"), "record='yes' is not allowed: give True or False"),
+        (
+            lambda: nh.evaluate_jobs([nh.baseline_policy()], [nh.get_task_family("ghh08").zero()], [0], [0], [0], n_steps=5, record="x"),
+            "give one True/False flag per job",
+        ),
     ],
 )
 def test_the_python_api_checks_its_arguments_as_the_command_line_does(call, expected) -> None:

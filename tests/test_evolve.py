@@ -290,6 +290,12 @@ def test_evolve_command_writes_policy_history_and_resumes(cli, tmp_path: Path) -
     assert rc == 0
     np.testing.assert_array_equal(resumed.genome, load_policy(direct).genome)
     assert read_history_csv(Path(f"{out}.history.csv"))[-1].episodes == 600
+    # Without --resume a run starts afresh and says so, but only once it is under way: a refused one overwrites nothing.
+    before = Path(f"{out}.checkpoint.json").read_bytes()
+    rc, _, err = cli(*args, "--budget", "300", "--setting", "pop_size=1")
+    assert rc == 2 and "starting afresh" not in err and Path(f"{out}.checkpoint.json").read_bytes() == before
+    rc, _, err = cli(*args, "--budget", "300")
+    assert rc == 0 and "starting afresh" in err
 
 
 def test_evolve_command_over_the_family_with_races(cli, tmp_path: Path) -> None:

@@ -102,8 +102,10 @@ def test_writing_and_reading_a_net_file_keeps_every_gene_and_its_place() -> None
         (BASELINE_NET.replace("s 2 16 -0.0367", "s 2 16 heavy"), "line 29"),
         (BASELINE_NET + "s 23 27 +0.5\n", "link 23 -> 27 is given again (first on line"),  # issue 37: kept the later value
         (BASELINE_NET + "n 27 2 0 +0.9\n", "node 27 is defined again (first on line"),
+        (BASELINE_NET.replace("s 2 16 -0.0367", "s 2 16 nan"), "x.net, line 29: weight nan is not a finite number"),  # no file or line before
+        (BASELINE_NET.replace("n 20 2 1 +0.0000", "n 20 2 1 inf"), "x.net, line 20: bias inf is not a finite number"),
     ],
-    ids=["missing-link", "extra-link", "extra-node", "bad-number", "repeated-link", "repeated-node"],
+    ids=["missing-link", "extra-link", "extra-node", "bad-number", "repeated-link", "repeated-node", "nan-weight", "inf-bias"],
 )
 def test_a_file_that_is_not_the_papers_mlp_is_refused_with_the_line(text: str, message: str) -> None:
     with pytest.raises(NeurohoverError, match=re.escape(message)):

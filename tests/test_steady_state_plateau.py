@@ -154,8 +154,11 @@ def test_tournament_selection_and_initial_mutation_options() -> None:
         g = opt.ask()
         opt.tell(-np.sum((g - 1.0) ** 2, axis=1))
     assert opt.champion_return > -20.0 * 0.5
-    with pytest.raises(ValueError, match="tournament_size=11"):
-        SteadyStateSettings(pop_size=10, elite_size=9, tournament_size=11)
+    with pytest.raises(ValueError, match=r"tournament_size=11 must be in \[1, pop_size=10\]"):
+        SteadyStateSettings(pop_size=10, elite_size=9, selection="tournament", tournament_size=11)
+    with pytest.raises(ValueError, match="tournament_size=3 applies to selection='tournament' only, not to selection='roulette'"):
+        SteadyStateSettings(tournament_size=3)  # ignored without a word (second trial)
+    assert SteadyStateSettings(pop_size=3, elite_size=2).pop_size == 3  # roulette's unused tournament size is no bound on the population
 
 
 def test_checkpoint_from_before_the_plateau_rule_resumes_under_the_literal_rule(tmp_path) -> None:

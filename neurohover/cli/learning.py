@@ -91,12 +91,16 @@ def _optimiser_settings(args: argparse.Namespace, over_family: bool) -> dict | N
 class _Bar:
     """tqdm progress bar on stderr (silent when stderr is not a terminal)."""
 
-    def __init__(self, total: int | None, desc: str) -> None:
+    def __init__(self, total: int | None, desc: str, note: str | None = None) -> None:
         from tqdm import tqdm
 
         self.bar = tqdm(total=total, desc=desc, unit="ep", file=sys.stderr, disable=None, dynamic_ncols=True)
+        self.note = note  # said once the run is under way: a run refused at its start overwrites nothing
 
     def __call__(self, info) -> None:
+        if self.note is not None:
+            self.bar.write(self.note, file=sys.stderr)
+            self.note = None
         if info.episodes > self.bar.n:
             self.bar.update(info.episodes - self.bar.n)
         champion = f"{info.champion_return:.5g}" if math.isfinite(info.champion_return) else "-"
@@ -189,10 +193,11 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     checkpoint = output_file(f"{out}.checkpoint.json", "--out (its checkpoint file)")
     if args.resume and not checkpoint.is_file():
         raise NeurohoverError(f"--resume: no checkpoint {str(checkpoint)!r} (it is written next to --out by an earlier run)")
+    note = None
     if not args.resume and checkpoint.is_file():
-        print(f"neurohover evolve: starting afresh; {checkpoint} will be overwritten (use --resume to continue it)", file=sys.stderr)
+        note = f"neurohover evolve: starting afresh; {checkpoint} will be overwritten (use --resume to continue it)"
     settings = _optimiser_settings(args, mdp_desc == MDP_FAMILY)
-    bar = _Bar(args.budget, f"evolve {family.name}/{mdp_desc}")
+    bar = _Bar(args.budget, f"evolve {family.name}/{mdp_desc}", note)
     try:
         result = evolve(
             target,

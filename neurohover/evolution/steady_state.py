@@ -61,6 +61,9 @@ PLATEAU_RULES = ("no-crash", "literal")
 #: uniformly, as in the authors' ``eonn`` code; docs/model.md, Neuroevolution).
 SELECTIONS = ("roulette", "tournament")
 
+#: Genomes per tournament by default (the authors' ``eonn``); the only value roulette selection takes.
+TOURNAMENT_SIZE = 5
+
 
 @dataclass(frozen=True)
 class SteadyStateSettings:
@@ -103,7 +106,8 @@ class SteadyStateSettings:
         Parent selection: ``"roulette"`` (default, Appendix A) or ``"tournament"`` (the best of
         ``tournament_size`` distinct genomes drawn uniformly; the authors' ``eonn`` code).
     tournament_size : int
-        Genomes per tournament (``1 <= tournament_size <= pop_size``; default 5, as in ``eonn``).
+        Genomes per tournament (``1 <= tournament_size <= pop_size``; default 5, as in ``eonn``); with
+        roulette selection another value is refused, as it would be ignored.
     init_mutate_frac, init_mutate_std : float or None
         Mutation of the prototype's copies in the initial population; None (default): as
         ``mutate_frac`` / ``mutate_std`` (Appendix A). ``eonn`` used 0.5 and 0.5.
@@ -127,7 +131,7 @@ class SteadyStateSettings:
     budget: int | None = None
     plateau_rule: str = "no-crash"
     selection: str = "roulette"
-    tournament_size: int = 5
+    tournament_size: int = TOURNAMENT_SIZE
     init_mutate_frac: float | None = None
     init_mutate_std: float | None = None
     mutation_floor: float | None = None
@@ -144,7 +148,9 @@ class SteadyStateSettings:
         if not isinstance(self.selection, str) or self.selection not in SELECTIONS:
             raise NeurohoverError(f"unknown selection {self.selection!r}: allowed {', '.join(SELECTIONS)}")
         size = require_int("tournament_size", self.tournament_size, 1)
-        if size > self.pop_size:
+        if self.selection != "tournament" and size != TOURNAMENT_SIZE:  # ignored without a word (second trial)
+            raise NeurohoverError(f"tournament_size={size} applies to selection='tournament' only, not to selection={self.selection!r}")
+        if self.selection == "tournament" and size > self.pop_size:  # under roulette the unused default is no limit on pop_size
             raise ValueError(f"tournament_size={size} must be in [1, pop_size={self.pop_size}]")
         set_field(self, "tournament_size", size)
         if self.init_mutate_frac is not None:

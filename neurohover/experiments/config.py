@@ -204,7 +204,10 @@ def parse_override(text: str, option: str = "--set") -> tuple[str, Any]:
         raise NeurohoverError(f'bad {option} {text!r}: expected KEY=VALUE (VALUE in TOML syntax, e.g. runs=3 or policies="evolve")')
     try:
         parsed = tomllib.loads(f"v = {value.strip()}")["v"]
-    except tomllib.TOMLDecodeError:
+    except tomllib.TOMLDecodeError as err:
+        if value.strip()[:1] in ("{", "[", '"', "'"):  # meant as TOML, not a bare word: say why it is not (a repeated key, ...)
+            why = re.sub(r" \(at (line \d+, column \d+|end of document)\)$", "", str(err))  # positions in our wrapper, not in VALUE
+            raise NeurohoverError(f"bad {option} {text!r}: VALUE is not valid TOML ({why})") from None
         parsed = value.strip()
     return key, parsed
 
