@@ -161,8 +161,10 @@ def test_factorial_test_runs_take_figure_8s_seeds() -> None:
 
 def test_bad_lr_fit_configs_are_refused() -> None:
     base = {"task": "ghh09", "seed": 1, "episodes": 2, "policies": "shipped"}
-    with pytest.raises(NeurohoverError, match="d_u apply to the agents that learn models"):
+    with pytest.raises(NeurohoverError, match="d_u applies to the agents that learn models"):
         make_config("x", "test_runs", "quick", {**base, "groups": [{"agent": "model-free", "n_mdps": 1, "d_u": "discard"}]})
+    with pytest.raises(NeurohoverError, match="wind_model applies to the agents that learn models"):  # ignored before
+        make_config("x", "test_runs", "quick", {**base, "groups": [{"agent": "model-free", "n_mdps": 1, "wind_model": "sinusoid"}]})
     with pytest.raises(NeurohoverError, match="noise"):
         make_config("x", "test_runs", "quick", {**base, "groups": [{"agent": "incremental", "n_mdps": 1, "noise": "loud"}]})
     ml = {"task": "ghh08", "seed": 1, "n_mdps": 1, "generic": "shipped"}

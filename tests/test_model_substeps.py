@@ -106,7 +106,7 @@ def test_the_fig8_groups_take_ten_substeps_on_figure_8s_seeds() -> None:
         assert u.params["seed"] == unit_seed(fig8.typed.seed, "fig8", f"run/{agent}/train3/rep2")  # paired with Figure 8's run
         assert u.params.get("model_substeps") == substeps
     base = {"task": "ghh09", "seed": 1, "episodes": 2, "policies": "shipped"}
-    with pytest.raises(NeurohoverError, match="model_substeps apply to the agents that learn models"):
+    with pytest.raises(NeurohoverError, match="model_substeps applies to the agents that learn models"):
         make_config("x", "test_runs", "quick", {**base, "groups": [{"agent": "model-free", "n_mdps": 1, "model_substeps": 10}]})
     with pytest.raises(NeurohoverError, match="model_substeps"):
         make_config("x", "test_runs", "quick", {**base, "groups": [{"agent": "incremental", "n_mdps": 1, "model_substeps": 2}]})

@@ -221,10 +221,12 @@ def _check_test_runs(settings: dict, task: str, where: str) -> None:
         if drift:  # a table checked by Drift (drift_table()); its change must come within the runs
             Drift.from_dict(drift).check_run(settings["episodes"], f"{where}: group {g['label']!r}")
         lr_keys = [k for k in ("d_u", "noise", "model_policy", "model_substeps") if k in g]
+        lr_keys += ["wind_model"] if g.get("wind_model", "none") != "none" else []  # the LR model's wind (was ignored for others)
         if lr_keys and not AGENTS[g["agent"]].learns_models:
             learners = ", ".join(name for name, spec in AGENTS.items() if spec.learns_models)
             raise NeurohoverError(
-                f"{where}: group {g['label']!r}: {', '.join(lr_keys)} apply to the agents that learn models ({learners}), not to {g['agent']!r}"
+                f"{where}: group {g['label']!r}: {', '.join(lr_keys)} {'applies' if len(lr_keys) == 1 else 'apply'} to the agents that learn models "
+                f"({learners}), not to {g['agent']!r}"
             )
         if AGENTS[g["agent"]].learns_models:  # the estimate and the substeps are part of the config (and its hash)
             g["noise"] = g.get("noise", DEFAULT_NOISE_ESTIMATE)
