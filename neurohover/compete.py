@@ -260,8 +260,7 @@ def compete(
     store : path, optional
         Results store (default ``out/results.sqlite``); finished runs in it are not flown again.
     hybrid : HybridSettings or mapping
-        Safeguard and replacement rule of the hybrid agents (a dict of :meth:`HybridSettings.to_dict`'s
-        keys is read as such); other than the default, refused for the other agents.
+        The hybrid agents' safeguard and replacement rule (or a dict of its ``to_dict`` keys); refused for other agents.
     on_result : callable, optional
         ``on_result(unit key, TestRunResult)`` after each run finished in this call.
     device : {"cpu", "cuda"}

@@ -33,23 +33,39 @@ MODEL_POLICIES = ("ours", "authors")
 class ModelEvolution:
     """How an agent learns a model and evolves a policy on it.
 
-    ``budget`` episodes on the model per evolution (steady state, paper Table 6 otherwise);
-    ``predict_episodes`` model episodes to predict the evolved policy's return; ``estimator`` the
-    least-squares estimator of the LR model (:func:`learn_model`): ``"ols"`` (default, the paper's)
-    or ``"gls"``; ``wind_model`` its wind: ``"none"`` (default, the paper's wind-blind model),
-    ``"constant"`` or ``"sinusoid"`` (:mod:`neurohover.models.wind`); ``device`` where those episodes fly (``"cpu"`` or ``"cuda"``, docs/gpu.md).
-
-    How LR was fitted and used by the authors' code, each selectable: ``d_u`` ``"keep"`` (default) or
-    ``"discard"`` (the authors': the fitted u constant thrown away); ``noise`` ``"rms"``
-    (default, the authors' ``rms / 0.05``) or ``"innovations"`` (ours until 2026-12-04) (:func:`neurohover.models.learn_lr`);
-    ``model_policy`` ``"ours"`` (default: steady state from the generic policy, ``budget`` episodes)
-    or ``"authors"`` (an SLP from the baseline by the authors' ``eonn``: 50 genomes, then
-    ``authors_generations`` generations of one offspring each; :data:`MODEL_POLICIES`).
-
-    ``model_substeps``: policies evolve on the learned model in the simulator's ten substeps of its
-    equivalent parameters (10, the default: the paper's model equations run at simulator timesteps) or in
-    one 0.1 s step per control step (1, the default until 2026-12-04 and the authors' published FGHH code;
-    :meth:`neurohover.models.LearnedModel.mdp`, measured in ``lr-substeps-table4``, docs/model.md).
+    Parameters
+    ----------
+    budget : int
+        Episodes on the model per evolution (steady state, paper Table 6 otherwise).
+    predict_episodes : int
+        Model episodes to predict the evolved policy's return.
+    n_steps : int
+        Control steps of each model episode.
+    estimator : {"ols", "gls"}
+        The least-squares estimator of the LR model (:func:`learn_model`): ``"ols"`` (default, the paper's) or ``"gls"``.
+    device : {"cpu", "cuda"}
+        Where the model episodes fly (docs/gpu.md).
+    wind_model : {"none", "constant", "sinusoid"}
+        The wind of the LR models the agent learns: ``"none"`` (default, the paper's wind-blind model),
+        ``"constant"`` or ``"sinusoid"`` (:mod:`neurohover.models.wind`; docs/model.md, Wind-aware models).
+    d_u : {"keep", "discard"}
+        Keep the fitted u constant as the model's D_u (default) or discard it, as the authors' code did
+        (:func:`neurohover.models.learn_lr`).
+    noise : {"rms", "innovations"}
+        The model's gust noise from the authors' rms one-step error / 0.05 (default) or from the
+        residuals' innovations / 0.4 (ours until 2026-12-04).
+    model_policy : {"ours", "authors"}
+        Evolve on the model from the generic policy (``"ours"``, default: steady state, ``budget``
+        episodes) or an SLP from the baseline by the authors' eonn (``"authors"``: 50 genomes, then
+        ``authors_generations`` generations of one offspring each; :data:`MODEL_POLICIES`).
+    authors_generations : int
+        Generations of the authors' eonn when ``model_policy`` is ``"authors"``.
+    model_substeps : {10, 1}
+        Policies evolve on the learned model in the simulator's 10 substeps of its equivalent
+        parameters (the paper's model equations run at simulator timesteps; GHH's default) or in one
+        0.1 s step per control step (FGHH's default: the authors' published FGHH code; the default
+        everywhere until 2026-12-04) (:meth:`neurohover.models.LearnedModel.mdp`, measured in
+        ``lr-substeps-table4``, docs/model.md).
     """
 
     budget: int = 2000

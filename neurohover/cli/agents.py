@@ -40,35 +40,26 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
 def cmd_compete(args: argparse.Namespace) -> int:
     """Run R independent test runs of an agent; print a summary and write results and a plot."""
     from ..agents.hybrid import HybridSettings
+    from ..agents.model_based import ModelEvolution
     from ..agents.registry import AGENTS, HYBRID_AGENTS, agent_spec
     from ..compete import check_sizes, compete
     from ..experiments.executors import check_jobs
     from ..paths import input_dir, output_dir, output_file
     from ..tasks import Drift
-    from .options import sensor_of
+    from .options import check_given, given_settings, sensor_of
 
     agent_spec(args.agent, args.task)  # an unknown agent, or one for another task, before anything else is read or made
-    given = [f"--{k.replace('_', '-')}" for k in _HYBRID_OPTIONS if getattr(args, k) is not None]
+    given = [o.flag for o in args.hybrid_options if getattr(args, o.dest) is not None]
     if given and args.agent not in HYBRID_AGENTS:
         raise NeurohoverError(f"{', '.join(given)} apply to the hybrid agents only ({', '.join(HYBRID_AGENTS)}), not to --agent {args.agent}")
-    given_values = {
-        "rule": args.safeguard_rule,
-        "box": args.safeguard_box,
-        "tilt": args.safeguard_tilt,
-        "replacement": args.hybrid_replacement,
-        "model_from": args.hybrid_model_from,
-    }
-    hybrid = HybridSettings.from_dict({k: v for k, v in given_values.items() if v is not None})
-    for option, value in (
-        ("--wind-model", args.wind_model),
-        ("--d-u", args.d_u),
-        ("--noise-estimate", args.noise_estimate),
-        ("--model-policy", args.model_policy),
-        ("--model-substeps", args.model_substeps),
-    ):
-        if value is not None and not AGENTS[args.agent].learns_models:
+    hybrid = HybridSettings.from_dict(given_settings(args, args.hybrid_options))  # the option's field names are its keys
+    model = given_settings(args, args.model_options)
+    for option in args.model_options:
+        if option.field in model and not AGENTS[args.agent].learns_models:
             learners = ", ".join(name for name, spec in AGENTS.items() if spec.learns_models)
-            raise NeurohoverError(f"{option} applies to the agents that learn models ({learners}), not to --agent {args.agent}")
+            raise NeurohoverError(f"{option.flag} applies to the agents that learn models ({learners}), not to --agent {args.agent}")
+    check_given(ModelEvolution, model, args.model_options)
+    wind_model = str(model.pop("wind_model", "none"))
     check_device(args.device)  # before the output directory is made
     check_jobs(args.jobs)
     check_sizes(args.runs, args.episodes)
@@ -106,12 +97,8 @@ def cmd_compete(args: argparse.Namespace) -> int:
             device=args.device,
             sensor=sensor,
             drift=drift,
-            wind_model=args.wind_model or "none",
-            lr_fit={
-                k: v
-                for k, v in (("d_u", args.d_u), ("noise", args.noise_estimate), ("model_policy", args.model_policy), ("model_substeps", args.model_substeps))
-                if v is not None
-            },
+            wind_model=wind_model,
+            lr_fit=model,  # d_u, noise, model_policy, model_substeps where given (ModelEvolution checks them)
             agent_settings=agent_settings,
         )
     except KeyboardInterrupt:
@@ -129,15 +116,16 @@ def cmd_compete(args: argparse.Namespace) -> int:
     return 0
 
 
-_HYBRID_OPTIONS = ("safeguard_rule", "safeguard_box", "safeguard_tilt", "hybrid_replacement", "hybrid_model_from")
-
-
 def register(sub) -> None:
-    from ..agents.model_based import MODEL_POLICIES
+    from ..agents.hybrid import HybridSettings
+    from ..agents.model_based import ModelEvolution
     from ..agents.registry import AGENTS
+    from ..compete import LR_FIT_KEYS
+    from ..evaluate import DangerousState
     from ..evolution.optimisers import optimiser_names
+    from ..models.model import default_model_substeps
     from ..policysets import FGHH_POLICY_BUDGET, POLICY_BUDGET
-    from .options import add_lr_fit_options, add_sensor_options, add_sigma_option, add_task_option
+    from .options import add_sensor_options, add_setting_options, add_sigma_option, add_task_option
 
     p = sub.add_parser("build-policies", help="evolve the generic and specialised policies of a task", description=cmd_build_policies.__doc__)
     add_task_option(p)
@@ -184,22 +172,13 @@ def register(sub) -> None:
     p.add_argument("--policy-dir", help="policy sets directory (default: the shipped ones)")
     p.add_argument("--out", required=True, help="output directory (episodes.csv, summary.json, cumulative.png, results.sqlite)")
     p.add_argument("--store", help="results store to keep the runs in (default: OUT/results.sqlite); finished runs are not flown again")
-    p.add_argument(
-        "--wind-model",
-        choices=("none", "constant", "sinusoid"),
-        help="model-based agents: the wind of the LR models they learn (default none, the paper's; docs/model.md, Wind-aware models)",
-    )
-    add_lr_fit_options(p, "model-based agents")
-    p.add_argument(
-        "--model-policy",
-        choices=MODEL_POLICIES,
-        help="model-based agents: evolve on the model from the generic policy (ours, default) or an SLP from the baseline by the authors' eonn (authors)",
-    )
-    p.add_argument(
-        "--model-substeps",
-        type=int,
-        choices=(1, 10),
-        help="model-based agents: policies evolve on the model in the simulator's 10 substeps (GHH's default) or one 0.1 s step (FGHH's, the authors')",
+    model_options = add_setting_options(
+        p,
+        ModelEvolution,
+        ("wind_model", *LR_FIT_KEYS),
+        flags={"noise": "noise-estimate"},
+        who="model-based agents",
+        default_text={"model_substeps": f"{default_model_substeps('ghh08')} on GHH-08/09, {default_model_substeps('fghh')} on FGHH"},
     )
     p.add_argument(
         "--agent-setting",
@@ -209,9 +188,7 @@ def register(sub) -> None:
         "--agent-setting level=3, or --agent continual --agent-setting cooldown=10 (docs/model.md, docs/benchmarks.md)",
     )
     g = p.add_argument_group("hybrid agents (defaults: the authors' code; see docs/model.md, Safeguard)")
-    g.add_argument("--safeguard-rule", help="code (tilted and outside the box, default) or paper (outside the box)")
-    g.add_argument("--safeguard-box", type=float, help="bound on |u|..|r| of a safe state (default 0.5)")
-    g.add_argument("--safeguard-tilt", type=float, help="qw below this is tilted, in (0, 1] (default 0.99)")
-    g.add_argument("--hybrid-replacement", help="rerank (charge 1e6, fly the best remaining policy; default) or evolve (evolve a replacement)")
-    g.add_argument("--hybrid-model-from", help="first-safe (default) or both trial episodes")
+    hybrid_options = add_setting_options(g, DangerousState, ("rule", "box", "tilt"), prefix="safeguard-")
+    hybrid_options += add_setting_options(g, HybridSettings, ("replacement", "model_from"), prefix="hybrid-")
+    p.set_defaults(model_options=model_options, hybrid_options=hybrid_options)  # the generated options, for cmd_compete
     p.set_defaults(func=cmd_compete)

@@ -296,10 +296,12 @@ def _true_mdp(metadata: dict):
 
 def cmd_learn_model(args: argparse.Namespace) -> int:
     """Learn a helicopter model from flight data (LR, EC-MENO or EC-MER) and print its parameters."""
+    from ..agents.model_based import ModelEvolution
     from ..flightdata import FlightData
     from ..models import DEFAULT_NOISE_ESTIMATE, format_parameter_table, learn_ec_meno, learn_ec_mer, learn_lr, parameter_table
     from ..paths import input_file, output_file, writing
     from ..policies import load_policy
+    from .options import check_given, given_settings
 
     if args.budget is not None and args.budget < 1:
         raise NeurohoverError(f"--budget {args.budget} is out of range: allowed an integer >= 1 (evaluations)")
@@ -318,6 +320,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     ):
         if value is not None and args.method != "lr":
             raise NeurohoverError(f"{option} applies to --method lr only (least squares), not to --method {args.method}")
+    check_given(ModelEvolution, given_settings(args, args.lr_options), args.lr_options)  # named by their options, before anything is read
     if args.as_authors and (args.d_u, args.noise_estimate) != (None, None):
         raise NeurohoverError("--as-authors sets --d-u discard and --noise-estimate rms: give either it or those options, not both")
     if args.policy == "":  # '' fell through to the flight data's policy (second trial)
@@ -481,7 +484,9 @@ def _register_settings(sub) -> None:
 
 
 def register(sub) -> None:
-    from .options import add_lr_fit_options, add_task_options
+    from ..agents.model_based import ModelEvolution
+    from ..evolution.steady_state import SteadyStateSettings
+    from .options import add_setting_options, add_task_options
 
     _register_settings(sub)
 
@@ -511,12 +516,7 @@ def register(sub) -> None:
         help="fixed:K (mean of K episodes per candidate; default fixed:1) or race:DELTA (selection races at confidence 0<DELTA<1; generational only)",
     )
     p.add_argument("--budget", type=int, help="episodes to fly (default: the paper's stop: plateau for steady state, 4000 generations for generational)")
-    p.add_argument(
-        "--plateau-rule",
-        choices=("no-crash", "literal"),
-        help="steady state: no-crash (default) counts the plateau only once the champion completed an episode "
-        "without crashing (a run whose champion still crashes ends at --budget only); literal: Appendix A as written",
-    )
+    add_setting_options(p, SteadyStateSettings, ("plateau_rule",), who="steady state")  # the rest through --setting
     p.add_argument(
         "--preset",
         choices=tuple(GENERATIONAL_PRESETS),
@@ -555,18 +555,7 @@ def register(sub) -> None:
         type=int,
         help="evaluations for ec-meno / ec-mer (defaults: ec-meno runs to the paper's plateau stop, 1000 evaluations without a new champion; ec-mer 500)",
     )
-    p.add_argument(
-        "--estimator",
-        choices=("ols", "gls"),
-        help="lr: ols, ordinary least squares (default, as the paper), or gls, quasi-differencing by the gusts' AR(1) coefficient",
-    )
-    p.add_argument(
-        "--wind-model",
-        choices=("none", "constant", "sinusoid"),
-        help="lr: none (default, the paper's wind-blind model), or a world-frame wind per horizontal axis, constant or sinusoidal, "
-        "identified from the data (docs/model.md, Wind-aware models)",
-    )
-    add_lr_fit_options(p, "lr")
+    lr_options = add_setting_options(p, ModelEvolution, ("estimator", "wind_model", "d_u", "noise"), flags={"noise": "noise-estimate"}, who="lr")
     p.add_argument(
         "--as-authors",
         action="store_true",
@@ -574,4 +563,4 @@ def register(sub) -> None:
     )
     p.add_argument("--seed", type=int, help="ec-meno, ec-mer: seed of the evolution (default 0)")
     p.add_argument("--policy", help="ec-mer: the policy that flew the data (default: the flight data's metadata, else baseline)")
-    p.set_defaults(func=cmd_learn_model)
+    p.set_defaults(func=cmd_learn_model, lr_options=lr_options)

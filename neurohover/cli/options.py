@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import argparse
 import os
-from dataclasses import fields
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -43,16 +45,86 @@ def explicit_mdp(args: argparse.Namespace, family):
     return None
 
 
-def add_lr_fit_options(p: argparse.ArgumentParser, who: str) -> None:
-    """--d-u and --noise-estimate: LR fitted as ours or as the authors' code did (``who`` applies them)."""
-    from ..models.lr import D_U_CHOICES, NOISE_ESTIMATES
+@dataclass(frozen=True)
+class SettingOption:
+    """A command-line option made from one field of a settings dataclass: ``--flag`` sets ``field``."""
 
-    p.add_argument("--d-u", choices=D_U_CHOICES, help=f"{who}: keep the fitted u constant as the model's D_u (default) or discard it, as the authors' code did")
-    p.add_argument(
-        "--noise-estimate",
-        choices=NOISE_ESTIMATES,
-        help=f"{who}: the model's gust noise from the authors' rms one-step error / 0.05 (default) or the residuals' innovations / 0.4",
-    )
+    flag: str
+    field: str
+
+    @property
+    def dest(self) -> str:
+        return self.flag[2:].replace("-", "_")
+
+
+def _converter(default):
+    """The argparse ``type`` of a field from its default (a bool reads true/false, as TOML writes it)."""
+    if isinstance(default, bool):
+
+        def boolean(text: str) -> bool:
+            if text not in ("true", "false"):
+                raise argparse.ArgumentTypeError(f"invalid value {text!r}: give true or false")
+            return text == "true"
+
+        return boolean
+    return type(default) if isinstance(default, (int, float)) else str
+
+
+def add_setting_options(
+    p,
+    cls: type,
+    names: Sequence[str],
+    *,
+    prefix: str = "",
+    flags: Mapping[str, str] | None = None,
+    who: str = "",
+    default_text: Mapping[str, str] | None = None,
+) -> tuple[SettingOption, ...]:
+    """Add one option per field ``names`` of the settings dataclass ``cls`` to ``p`` (a parser or group).
+
+    Everything an option says comes from the class, so it cannot drift from it: its type from the
+    field's default, its choices (as metavar) and help from the class's NumPy docstring entry, its
+    default from the field (or ``default_text``, where the default depends on the task). The flag
+    is ``--{prefix}{name}`` (``flags`` renames one); an option not given is None, so the class's
+    default applies. The values are checked by the class (:func:`check_given`), as a config's are.
+    """
+    from dataclasses import MISSING
+
+    from ..settingsdoc import plain, settings_rows
+
+    rows = {row.name: row for row in settings_rows(cls)}
+    fields_of = {f.name: f for f in fields(cls)}
+    made = []
+    for name in names:
+        row, f = rows[name], fields_of[name]
+        default = f.default if f.default is not MISSING else None
+        flag = f"--{(flags or {}).get(name) or prefix + name.replace('_', '-')}"
+        text = plain(row.help)
+        first = text.rstrip(".")
+        first = first[:1].lower() + first[1:] if who and first[1:2].islower() else first  # "who: keep ..." reads as one sentence
+        shown = (default_text or {}).get(name, str(default).lower() if isinstance(default, bool) else str(default))
+        choices = re.fullmatch(r"\{(.*)\}", row.type.strip())
+        metavar = "{" + ",".join(c.strip().strip('"') for c in choices[1].split(",")) + "}" if choices else None
+        option = SettingOption(flag, name)
+        described = f"{who}: {first} (default {shown})" if who else f"{first} (default {shown})"
+        p.add_argument(flag, dest=option.dest, type=_converter(default), metavar=metavar, help=described.replace("%", "%%"))  # argparse formats help
+        made.append(option)
+    return tuple(made)
+
+
+def given_settings(args: argparse.Namespace, options: Sequence[SettingOption]) -> dict[str, object]:
+    """Field -> value of the generated ``options`` given on the command line."""
+    return {o.field: getattr(args, o.dest) for o in options if getattr(args, o.dest) is not None}
+
+
+def check_given(cls: type, values: Mapping[str, object], options: Sequence[SettingOption]) -> None:
+    """Check the generated ``options``' ``values`` with their class up front (before any output is made), the
+    message naming the options given."""
+    try:
+        cls(**values)
+    except (NeurohoverError, ValueError, TypeError) as err:
+        given = ", ".join(f"{o.flag} {values[o.field]}" for o in options if o.field in values)
+        raise NeurohoverError(f"{given}: {err}") from None
 
 
 def add_sensor_options(p: argparse.ArgumentParser) -> None:
