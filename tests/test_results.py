@@ -209,3 +209,15 @@ def test_a_crash_rate_is_never_shown_as_zero_when_an_episode_crashed() -> None:
     from neurohover.experiments.report import crash_rate
 
     assert [crash_rate(c, 20_000) for c in (0, 1, 30, 200, 10_687, 20_000)] == ["0%", "0.005%", "0.15%", "1%", "53%", "100%"]
+
+
+def test_runs_paired_with_their_own_copies_are_called_the_same_runs(committed_store: Path, tmp_path: Path) -> None:
+    """wind-fig8's wind-blind groups are Figure 8's runs again: the report said "as good in the median pair (0 of 80
+    runs better, ..., Wilcoxon p = 1, not significant)", a test where there is nothing to test."""
+    from neurohover.experiments import Store, write_report
+
+    with Store(committed_store, create=False) as store:
+        report = write_report(store, tmp_path / "report", scale="paper", names=["wind-fig8"]).read_text()
+    assert "model-free/wind-blind vs fig8's model-free on the same seeds: the same runs, all 80 pairs equal" in report
+    assert "| model-free/wind-blind | fig8/model-free | 80 |" in report and "none: all 80 equal" in report
+    assert re.search(r"incremental/wind-aware vs fig8's incremental on the same seeds: (better|worse) in the median pair", report)

@@ -356,11 +356,17 @@ class _TestRuns(Section):
                     str(len(common)),
                     fmt(a),
                     fmt(b),
-                    f"{int((diff > 0).sum())} of {len(common)}",
+                    f"{int((diff > 0).sum())} of {len(common)}" if diff.any() else f"none: all {len(common)} equal",
                     fmt(median),
-                    fmt(p),
+                    fmt(p) if diff.any() else "n/a",
                 ]
             )
+            if not diff.any():  # the same runs again (same seeds, gusts and settings): no test to run
+                self.comparisons.append(
+                    f"{g.label} vs {of['experiment']}'s {of['group']} on the same seeds: the same runs, all {len(common)} pairs equal "
+                    f"(mean cumulative reward {fmt(a)})."
+                )
+                continue
             word = "better" if median > 0 else "worse" if median < 0 else "as good"  # by the pairs, as the test: a mean can say otherwise
             self.comparisons.append(
                 f"{g.label} vs {of['experiment']}'s {of['group']} on the same seeds: {word} in the median pair ({int((diff > 0).sum())} of "
