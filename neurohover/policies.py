@@ -236,14 +236,9 @@ def load_policy(source: str | Path) -> Policy:
         raise NeurohoverError(f"policy source {source!r} is not allowed: give a policy file's path or 'baseline'")
     if str(source) == "baseline":
         return baseline_policy()
-    if str(source) == "":  # Path('') is '.', which was reported as "'.' is not a file" (second trial)
-        raise NeurohoverError("policy file is empty: give a JSON policy file, an authors' .net file or 'baseline'")
-    path = Path(source)
-    if path.is_dir():
-        raise NeurohoverError(f"policy file {str(path)!r} is a directory (give a JSON policy file, an authors' .net file or 'baseline')")
-    if not path.is_file():
-        what = "is not a file" if path.exists() else "does not exist"
-        raise NeurohoverError(f"policy file {str(path)!r} {what} (give a JSON policy file, an authors' .net file or 'baseline')")
+    from .paths import input_file
+
+    path = input_file(source, "policy file", "policy file (JSON, an authors' .net file, or 'baseline')")  # the one check of a file read
     net = path.suffix == ".net"
     name = f"{'network' if net else 'policy'} file {str(path)!r}"
     try:

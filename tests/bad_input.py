@@ -18,7 +18,7 @@ CASES: list[tuple[list[str], str]] = [
     (["fly", "--task", "ghh08", "--episodes", "1", "--record", "adir"], "is a directory"),
     (["fly", "--task", "ghh08", "--episodes", "1", "--record", "afile/x.npz"], "is a file, not a directory"),
     (["fly", "--task", "ghh08", "--episodes", "1", "--record", "/proc/x.npz"], "cannot create a file in '/proc'"),
-    (["fly", "--task", "ghh08", "--policy", "/proc/self/mem"], "cannot be read"),
+    (["fly", "--task", "ghh08", "--policy", "/proc/self/mem"], "cannot read this policy file"),
     (["fly", "--task", "ghh08", "--policy", "adir"], "is a directory"),
     (["evolve", "--task", "ghh08", "--budget", "1000000000", "--out", "adir"], "is a directory"),
     (["evolve", "--task", "ghh08", "--budget", "1000000000", "--out", "/proc/p.json"], "cannot create a file in '/proc'"),

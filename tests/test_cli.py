@@ -60,7 +60,7 @@ def test_fly_record_writes_flight_data(cli, tmp_path: Path) -> None:
         (["fly", "--task", "ghh08", "--mdp", "train:10"], "allowed 0..9"),
         (["fly", "--task", "ghh08", "--mdp", "windy"], "unknown MDP 'windy'"),
         (["fly", "--task", "ghh08", "--episodes", "0"], "--episodes 0 is out of range"),
-        (["fly", "--task", "ghh08", "--policy", "missing.json"], "does not exist"),
+        (["fly", "--task", "ghh08", "--policy", "missing.json"], "no such policy file (JSON"),
     ],
 )
 def test_bad_input_exits_2_with_one_clear_message(cli, argv, message: str) -> None:
