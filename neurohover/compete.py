@@ -292,19 +292,19 @@ def compete(
         finished run; the store keeps them, and the same call resumes.
     """
     from .agents.registry import check_agent
+    from .paths import output_dir, output_file
 
-    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
-        raise NeurohoverError(f"jobs={jobs!r} is out of range: allowed an integer >= 1")
+    _check_run(jobs, device, on_result, progress)  # every check before the output directory is made (third trial)
     check_agent(agent, get_task_family(task, sigma), policy_dir)
     config = competition_config(
         task, agent, runs=runs, episodes=episodes, mdps=mdps, seed=seed, sigma=sigma, n_steps=n_steps, policy_dir=policy_dir, hybrid=hybrid,
         sensor=sensor, drift=drift, wind_model=wind_model, lr_fit=lr_fit, agent_settings=agent_settings,
     )  # fmt: skip
-    if not isinstance(out, (str, Path)) or str(out) == "":  # None was a TypeError (second trial)
-        raise NeurohoverError(f"out={out!r} is not allowed: give the directory to write the competition's results into")
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    store_path = Path(store) if store is not None else out / STORE_FILE
+    if isinstance(out, (str, Path)) and Path(out).exists() and not Path(out).is_dir():  # /dev/full was a FileExistsError (third trial)
+        raise NeurohoverError(f"out {str(out)!r} is a file; give a directory")
+    store_path = output_file(store, "store") if store is not None else None
+    out = output_dir(out, "out")  # made once every setting is checked (None was a TypeError; second trial)
+    store_path = store_path or out / STORE_FILE
     ordered = _run_into_store(config, store_path, out / "episodes.csv", jobs=jobs, device=device, progress=progress, on_result=on_result)
     summary = {
         "task": task,
@@ -321,6 +321,19 @@ def compete(
         {agent: np.array([np.cumsum(np.array(r.returns, dtype=float)) for r in ordered])}, out / "cumulative.png", f"{task}: {agent}, {len(ordered)} runs"
     )
     return summary, ordered
+
+
+def _check_run(jobs, device, on_result, progress) -> None:
+    """:func:`compete`'s run settings, refused by name (a bad on_result was a TypeError after the first run)."""
+    from .evaluate import check_device
+    from .experiments.executors import check_jobs
+
+    check_jobs(jobs)
+    check_device(device)
+    if on_result is not None and not callable(on_result):
+        raise NeurohoverError(f"on_result={on_result!r:.60} is not allowed: give a callable (unit key, TestRunResult), or None")
+    if progress not in (None, True, False):
+        raise NeurohoverError(f"progress={progress!r:.60} is not allowed: give True, False or None (a bar only on a terminal)")
 
 
 def _run_into_store(config, store_path: Path, episodes_csv: Path, *, jobs: int, device: str, progress: bool | None, on_result) -> list:

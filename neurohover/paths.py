@@ -11,6 +11,7 @@ or failed run leaves nothing behind (a directory holding any result stays).
 
 from __future__ import annotations
 
+import json
 import os
 import sys
 import tempfile
@@ -20,7 +21,7 @@ from pathlib import Path
 
 from .errors import NeurohoverError
 
-__all__ = ["input_file", "input_dir", "output_dir", "output_file", "remove_created_dirs", "writing"]
+__all__ = ["checked_path", "parse_json", "input_file", "input_dir", "output_dir", "output_file", "remove_created_dirs", "writing"]
 
 _created: list[Path] = []  # directories this process's checks created, deepest first
 
@@ -50,15 +51,57 @@ def _make_dirs(directory: Path, option: str, given: str) -> None:
     print(f"neurohover: created directory {str(missing[-1])!r}" + (f" and {len(missing) - 1} below it" if len(missing) > 1 else ""), file=sys.stderr)
 
 
-def output_file(path: str | os.PathLike, option: str) -> Path:
-    """Check that the file ``path`` can be written (an existing file is kept as it is).
-
-    Refuses a directory, a parent that is a file, and any place where a file cannot be created;
-    creates missing parent directories (saying so on standard error).
-    """
-    p = Path(path)
+def checked_path(path, option: str) -> Path:
+    """``path`` (a str or path object) as a Path: empty, another type or a NUL byte refused by name (the OS's TypeError
+    and ValueError before)."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise NeurohoverError(f"{option}={path!r:.60} is not allowed: give a file path")
     if str(path) == "":
         raise NeurohoverError(f"{option} is empty; give a file path")
+    if "\x00" in str(path):
+        raise NeurohoverError(f"{option} {str(path)!r:.80} holds a NUL character: give a file path")
+    return Path(path)
+
+
+def _unique_keys(pairs: list) -> dict:
+    keys = [k for k, _ in pairs]
+    twice = sorted({k for k in keys if keys.count(k) > 1})
+    if twice:
+        raise ValueError(f"key {twice[0]!r} is given more than once")
+    return dict(pairs)
+
+
+def parse_json(text: str, name: str):
+    """The JSON ``text`` of the file ``name``, strictly: a key given twice (Python keeps the last without a word), nesting
+    deeper than Python can follow and numbers past a float's range are refused by name (third trial)."""
+    try:
+        return json.loads(text, object_pairs_hook=_unique_keys, parse_int=_json_int)
+    except RecursionError:
+        raise NeurohoverError(f"{name} is not allowed: its JSON is nested too deeply") from None
+    except ValueError as err:  # json.JSONDecodeError too
+        raise NeurohoverError(f"{name} is not valid JSON: {err}") from None
+
+
+def _json_int(text: str) -> int:
+    value = int(text)
+    try:
+        float(value)  # past a float's range no genome or parameter can hold it (an OverflowError later)
+    except OverflowError:
+        raise ValueError(f"the number {text[:20]}... ({len(text)} digits) is out of range") from None
+    return value
+
+
+def output_file(path: str | os.PathLike, option: str, inputs: dict[str, str | os.PathLike | None] | None = None) -> Path:
+    """Check that the file ``path`` can be written (an existing file is kept as it is).
+
+    Refuses a directory, a parent that is a file, any place where a file cannot be created, and the
+    file of one of ``inputs`` (option -> path: writing it would destroy what the command reads);
+    creates missing parent directories (saying so on standard error).
+    """
+    p = checked_path(path, option)
+    for name, given in (inputs or {}).items():
+        if given is not None and str(given) != "" and p.exists() and Path(given).exists() and p.samefile(given):
+            raise NeurohoverError(f"{option} {str(path)!r} is the file of {name}: give another path (writing it would destroy what is read)")
     if p.is_dir():
         raise NeurohoverError(f"{option} {str(path)!r} is a directory; give a file path")
     if p.exists() and not p.is_file():  # written by replacing it, a device node (/dev/full) would become a file
@@ -93,9 +136,9 @@ def writing(path: str | os.PathLike, option: str) -> Iterator[Path]:
 
 def output_dir(path: str | os.PathLike, option: str) -> Path:
     """Check that files can be written in the directory ``path``, creating it (saying so) if missing."""
-    p = Path(path)
-    if str(path) == "":
+    if isinstance(path, (str, os.PathLike)) and str(path) == "":
         raise NeurohoverError(f"{option} is empty; give a directory")
+    p = checked_path(path, option)
     if p.exists() and not p.is_dir():
         raise NeurohoverError(f"{option} {str(path)!r} is a file; give a directory")
     _make_dirs(p, option, str(path))
@@ -109,9 +152,9 @@ def output_dir(path: str | os.PathLike, option: str) -> Path:
 
 def input_file(path: str | os.PathLike, option: str, what: str = "file") -> Path:
     """Check that ``path`` is an existing, readable regular file."""
-    p = Path(path)
-    if str(path) == "":
+    if isinstance(path, (str, os.PathLike)) and str(path) == "":
         raise NeurohoverError(f"{option} is empty; give a {what}")
+    p = checked_path(path, option)
     if not p.exists():
         raise NeurohoverError(f"{option} {str(path)!r}: no such {what}")
     if p.is_dir():

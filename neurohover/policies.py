@@ -153,8 +153,8 @@ def check_genome(genome, topology: str) -> np.ndarray:
     """Return ``genome`` as a float64 vector of the topology's length, or raise a clear error."""
     try:
         arr = np.array(genome, dtype=float).reshape(-1) if np.ndim(genome) <= 1 else np.array(genome, dtype=float)
-    except (TypeError, ValueError):
-        raise NeurohoverError(f"a {topology} genome must be a list of numbers, got {genome!r:.80}") from None
+    except (TypeError, ValueError, OverflowError):  # an integer past a float's range was an OverflowError (third trial)
+        raise NeurohoverError(f"a {topology} genome must be a list of finite numbers, got {genome!r:.80}") from None
     n = GENOME_LENGTH[topology]
     if arr.ndim != 1 or arr.shape[0] != n:
         raise NeurohoverError(f"a {topology} genome has {n} genes, got shape {arr.shape}")
@@ -251,11 +251,9 @@ def load_policy(source: str | Path) -> Policy:
         from .netfile import policy_from_net
 
         return policy_from_net(text, name)
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as err:
-        raise NeurohoverError(f"{name} is not valid JSON: {err}") from None
-    return policy_from_dict(data, name)
+    from .paths import parse_json
+
+    return policy_from_dict(parse_json(text, name), name)
 
 
 def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:

@@ -207,6 +207,20 @@ def check_build(family, lineage: str | None, fghh_budget: int | None, optimizer:
     return lineage, FGHH_POLICY_BUDGET if fghh_budget is None else fghh_budget
 
 
+def replaceable_set(task: str, out: str | Path | None) -> Path:
+    """The directory ``out/<task>`` a build writes, refused where replacing it would lose what is not a policy set: a file
+    of that name, or a directory without a set's manifest.json that holds anything (the build replaced it whole; third
+    trial)."""
+    from .paths import checked_path
+
+    final = policy_dir(task, None if out is None else checked_path(out, "out"))
+    if final.exists() and not final.is_dir():
+        raise NeurohoverError(f"{str(final)!r} is a file, not a policy set: give another out directory, or remove it")
+    if final.is_dir() and not (final / "manifest.json").is_file() and any(final.iterdir()):
+        raise NeurohoverError(f"{str(final)!r} holds files but no policy set (no manifest.json): give another out directory, or empty it")
+    return final
+
+
 def _evolve_one(
     target, name: str, child_seed: int, seed_policy: Policy | None = None, save: bool = True, *, family, root: Path, n_steps: int, optimizer: str, say, **kwargs
 ) -> Policy:
@@ -280,7 +294,9 @@ def build_policy_set(
 
     family = get_task_family(task)
     lineage, fghh_budget = check_build(family, lineage, fghh_budget, optimizer, budget=budget, seed=seed, safety_episodes=safety_episodes, n_steps=n_steps)
-    final = policy_dir(family.name, out)
+    if progress is not None and not callable(progress):  # progress=3 was a TypeError after the first run (third trial)
+        raise NeurohoverError(f"progress={progress!r:.60} is not allowed: give a callable taking one line of text, or None")
+    final = replaceable_set(family.name, out)
     # Built beside the set it replaces, which it replaces only once complete: an interrupted build (or a
     # failed one) leaves the old set, shipped or not, as it was.
     root = final.with_name(final.name + ".building")

@@ -75,6 +75,9 @@ CASES: list[tuple[list[str], str]] = [
     (["demo", "--episodes", "10000000000000"], "episodes=10000000000000 is out of range"),
     (["demo", "--mdps", "-1"], "--mdps -1 is out of range: allowed 0..10"),
     (["demo", "--episodes", "0"], "--episodes 0 is out of range: allowed an integer >= 1"),
+    # third trial: an output onto an input destroyed it (the store became CSV, the flight data a model)
+    (["results", "fig2", "--store", "store.sqlite", "--out", "store.sqlite"], "--out 'store.sqlite' is the file of --store"),
+    (["learn-model", "--flight-data", "fd.npz", "--method", "lr", "--out", "fd.npz"], "--out 'fd.npz' is the file of --flight-data"),
     (["reproduce", "fig2", "--store", "s.sqlite", "--set", "sensor={noise=1, noise=2}"], "VALUE is not valid TOML (Duplicate inline table key 'noise')"),
     (["build-policies", "--task", "ghh08", "--budget", "10", "--seed", "-1", "--out", "q"], "seed=-1 is out of range: allowed an integer in 0..2**63-1"),
     (["evolve", "--task", "ghh08", "--budget", "10", "--seed", "-5", "--out", "p.json"], "seed=-5 is out of range"),

@@ -95,6 +95,13 @@ def test_fly_progress_is_quiet_with_json_and_chunking_changes_no_result(tmp_path
     assert "7/7" in chunked.err  # the progress bar ran to the end
     mean = float(next(line for line in chunked.out.splitlines() if "mean_return" in line).split(":")[1])
     np.testing.assert_allclose(mean, json.loads(whole.out)["mean_return"], rtol=1e-6)
+    # --json flies in chunks too: a Ctrl-C is heard between them (one call of every episode ignored it; third trial)
+    evaluate_module = sys.modules["neurohover.evaluate"]  # the package's name `evaluate` is the function
+    calls = []
+    real = evaluate_module.evaluate_jobs
+    monkeypatch.setattr(evaluate_module, "evaluate_jobs", lambda *a, **k: calls.append(1) or real(*a, **k))
+    assert main(["fly", "--task", "ghh08", "--mdp", "train:1", "--episodes", "7", "--json"]) == 0
+    assert len(calls) == 3 and json.loads(capsys.readouterr().out)["mean_return"] == json.loads(whole.out)["mean_return"]
 
 
 def test_version_names_the_installed_package(capsys) -> None:

@@ -324,3 +324,58 @@ def test_the_last_python_api_leftovers_of_the_second_trial_are_refused_by_name(t
     with pytest.raises(NeurohoverError, match=r"actions must be a \(2, 4\) array of real numbers"):
         vec.step(np.zeros((2, 4), dtype=complex))
     assert env.step([0, 0, 0, 0])[0].shape == (12,)  # integers and lists still fly
+
+
+def test_the_third_trials_files_and_paths_are_refused_by_name(tmp_path) -> None:
+    """issue 37, third trial: tracebacks (OverflowError, RecursionError, TypeError, FileExistsError), a duplicated key kept
+    without a word, and refusals that left an output directory or deleted the user's files."""
+    import json
+
+    from neurohover.compete import compete
+    from neurohover.models.model import LearnedModel
+    from neurohover.policysets import build_policy_set
+
+    genome = [0.0] * 39
+    files = {
+        "big.json": '{"topology": "slp", "genome": [' + ", ".join(["0"] * 39) + ", " + "9" * 400 + "]}",
+        "deep.json": "[" * 100_000 + "]" * 100_000,
+        "dup.json": json.dumps({"topology": "slp", "genome": genome + [0.0]})[:-1] + ', "topology": "mlp"}',
+    }
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+    for name, message in (
+        ("big.json", "400 digits. is out of range"),
+        ("deep.json", "nested too deeply"),
+        ("dup.json", "key 'topology' is given more than once"),
+    ):
+        with pytest.raises(NeurohoverError, match=message):
+            nh.load_policy(tmp_path / name)
+    with pytest.raises(NeurohoverError, match="nested too deeply"):
+        LearnedModel.load(tmp_path / "deep.json")
+    b = nh.baseline_policy()
+    for call, message in (
+        (lambda: LearnedModel.load(None), "model file=None is not allowed"),
+        (lambda: nh.save_policy(b, 3), "policy file=3 is not allowed: give a file path"),
+        (lambda: nh.save_policy(b, "x\x00.json"), "holds a NUL character"),
+    ):
+        with pytest.raises(NeurohoverError, match=message):
+            call()
+    (tmp_path / "afile").write_text("x")
+    kw = {"runs": 1, "episodes": 1, "n_steps": 5}
+    for extra, message in (
+        ({"out": tmp_path / "afile"}, "is a file; give a directory"),
+        ({"out": tmp_path / "c", "on_result": 3}, "on_result=3 is not allowed"),
+        ({"out": tmp_path / "c", "progress": "yes"}, "progress='yes' is not allowed"),
+        ({"out": tmp_path / "c", "device": "gpu"}, "gpu"),
+    ):
+        with pytest.raises(NeurohoverError, match=message):
+            compete("ghh08", "baseline", **kw, **extra)
+    assert not (tmp_path / "c").exists()  # refused before the directory is made
+    mine = tmp_path / "bp" / "ghh08"
+    mine.mkdir(parents=True)
+    (mine / "mine.txt").write_text("keep")
+    with pytest.raises(NeurohoverError, match="holds files but no policy set"):
+        build_policy_set("ghh08", tmp_path / "bp", budget=2, n_steps=5)
+    assert (mine / "mine.txt").read_text() == "keep"  # the build replaced the directory whole (third trial)
+    with pytest.raises(NeurohoverError, match="progress=3 is not allowed"):
+        build_policy_set("ghh08", tmp_path / "bp2", budget=2, n_steps=5, progress=3)

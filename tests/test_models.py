@@ -214,7 +214,7 @@ def test_bad_model_files_are_refused(tmp_path, zero_flight) -> None:
     zero_flight.flight_data.save(tmp_path / "flight.npz")  # binary, another neurohover format
     with pytest.raises(NeurohoverError, match="not valid JSON"):
         LearnedModel.load(tmp_path / "flight.npz")
-    with pytest.raises(NeurohoverError, match="does not exist"):
+    with pytest.raises(NeurohoverError, match="no such model file"):
         LearnedModel.load(tmp_path / "nowhere.json")
 
 

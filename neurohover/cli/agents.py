@@ -12,7 +12,7 @@ from ..evaluate import DEVICES, check_device
 def cmd_build_policies(args: argparse.Namespace) -> int:
     """Evolve a task family's generic and specialised policies (the agents' policy set)."""
     from ..paths import output_dir
-    from ..policysets import build_policy_set, check_build
+    from ..policysets import build_policy_set, check_build, replaceable_set
     from ..tasks import get_task_family
 
     if args.budget < 1:
@@ -20,8 +20,11 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
     if args.fghh_budget is not None and args.fghh_budget < 1:  # refused before the first run, not after it
         raise NeurohoverError(f"--fghh-budget {args.fghh_budget} is out of range: allowed >= 1")
     check_build(get_task_family(args.task), args.lineage, args.fghh_budget, args.optimizer, budget=args.budget, seed=args.seed, n_steps=args.episode_steps)
+    final = replaceable_set(args.task, args.out)
     if args.out is not None:  # made once every option is checked
         output_dir(args.out, "--out")
+    elif final.exists():  # the documented default, said before hours of work replace what the package ships
+        print(f"neurohover build-policies: note: no --out: the package's shipped set {final} is replaced once the build completes", file=sys.stderr)
     ps = build_policy_set(
         args.task,
         args.out,
@@ -44,7 +47,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
     from ..agents.registry import AGENTS, HYBRID_AGENTS, agent_spec
     from ..compete import check_sizes, compete
     from ..experiments.executors import check_jobs
-    from ..paths import input_dir, output_dir, output_file
+    from ..paths import input_dir, output_file
     from ..tasks import Drift
     from .options import check_given, given_settings, sensor_of
 
@@ -75,9 +78,8 @@ def cmd_compete(args: argparse.Namespace) -> int:
         if not AGENTS[args.agent].needs:  # it flies no policy of a set: the option would be ignored (second trial)
             raise NeurohoverError(f"--policy-dir applies to agents that fly a policy set's policies, not to --agent {args.agent}")
         input_dir(args.policy_dir, "--policy-dir")
-    output_dir(args.out, "--out")  # made once every option is checked: a refusal leaves no directory behind
     if args.store is not None:
-        output_file(args.store, "--store")
+        output_file(args.store, "--store")  # --out is made by compete once it has checked every setting
     try:
         summary, _ = compete(
             args.task,

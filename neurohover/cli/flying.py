@@ -40,8 +40,8 @@ def _fly(policy, mdps: list, args: argparse.Namespace, show_progress: bool):
         disable=None if show_progress else True,
         dynamic_ncols=True,
     ) as bar:
-        for start in range(0, n, FLY_CHUNK if show_progress else n):
-            idx = np.arange(start, min(n, start + (FLY_CHUNK if show_progress else n)))
+        for start in range(0, n, FLY_CHUNK):  # chunked with or without the bar: Ctrl-C is heard between chunks (--json ignored it)
+            idx = np.arange(start, min(n, start + FLY_CHUNK))
             ev = evaluate_jobs(
                 [policy],
                 unique,
@@ -80,7 +80,7 @@ def cmd_fly(args: argparse.Namespace) -> int:
     rng = np.random.default_rng(args.seed)
     family, mdps = family_and_mdps(args, args.episodes, rng)
     if args.record is not None:
-        output_file(args.record, "--record")
+        output_file(args.record, "--record", {"--policy": args.policy})
     returns, crashed, seconds, fd, n_unique = _fly(policy, mdps, args, show_progress=not args.json)
     if fd is not None:
         fd.metadata.update(

@@ -188,7 +188,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     resampling = parse_resampling(args.resampling)
     target, family, mdp_desc = _target(args)
     topology, proto = _seed_policy(args)
-    out = output_file(args.out, "--out")
+    out = output_file(args.out, "--out", {"--seed-policy": args.seed_policy})
     history_path = output_file(f"{out}.history.csv", "--out (its history file)")
     checkpoint = output_file(f"{out}.checkpoint.json", "--out (its checkpoint file)")
     if args.resume and not checkpoint.is_file():
@@ -328,7 +328,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     if args.policy is not None and args.method != "ec-mer":
         raise NeurohoverError(f"--policy applies to --method ec-mer only (the policy that flew the data), not to --method {args.method}")
     data = FlightData.load(input_file(args.flight_data, "--flight-data", "flight-data file"))
-    out = output_file(args.out, "--out")
+    out = output_file(args.out, "--out", {"--flight-data": args.flight_data, "--policy": args.policy})
     start = time.perf_counter()
     extra = {} if args.budget is None else {"budget": args.budget}
     with _Ticker(f"learning a {args.method} model from {data.n_episodes} episodes ({data.n_transitions} steps)"):

@@ -250,24 +250,27 @@ class LearnedModel:
 
     def save(self, path: str | Path) -> Path:
         """Write the model as JSON (format tag ``neurohover-model/1``); returns the path."""
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(json.dumps(self.to_dict(), indent=1, allow_nan=False) + "\n")
-        return path
+        from ..paths import output_file, writing
+
+        text = json.dumps(self.to_dict(), indent=1, allow_nan=False) + "\n"
+        with writing(output_file(path, "model file"), "model file") as out:  # /dev/full, a directory: one clear error
+            out.write_text(text)
+        return out
 
     @classmethod
     def load(cls, path: str | Path) -> LearnedModel:
         """Read a model written by :meth:`save`; other files are refused with a clear message."""
-        path = Path(path)
-        if not path.is_file():
-            raise NeurohoverError(f"model file {str(path)!r} does not exist")
+        from ..paths import input_file, parse_json
+
+        path = input_file(path, "model file", "model file (JSON, from learn-model --out)")
+        name = f"model file {str(path)!r}"
         try:
-            data = json.loads(path.read_text())
-        except (json.JSONDecodeError, UnicodeDecodeError) as err:
-            raise NeurohoverError(f"model file {str(path)!r} is not valid JSON (truncated or not a model file?): {err}") from None
+            text = path.read_text()
+        except UnicodeDecodeError as err:
+            raise NeurohoverError(f"{name} is not valid JSON (truncated or not a model file?): {err}") from None
         except OSError as err:
-            raise NeurohoverError(f"model file {str(path)!r} cannot be read ({err.strerror or type(err).__name__})") from None
-        return cls.from_dict(data, f"model file {str(path)!r}")
+            raise NeurohoverError(f"{name} cannot be read ({err.strerror or type(err).__name__})") from None
+        return cls.from_dict(parse_json(text, name), name)
 
 
 def _axes_without_equivalent(params: np.ndarray) -> list[str]:
