@@ -427,6 +427,14 @@ class DangerousState:
             raise NeurohoverError(f"safeguard threshold={self.threshold!r} is out of range: allowed a finite number > 0")
         if isinstance(self.arm_after, bool) or not isinstance(self.arm_after, int) or not 0 <= self.arm_after <= 10**6:
             raise NeurohoverError(f"safeguard arm_after={self.arm_after!r} is out of range: allowed an integer in 0..1000000 (control steps)")
+        unused = {  # a setting the rule does not read, set anyway, would be ignored without a word (third trial)
+            "box": self.rule == "ratio-sum" and self.box != SAFEGUARD_BOX,
+            "tilt": self.rule != "code" and self.tilt != SAFEGUARD_TILT,
+            "threshold": self.rule != "ratio-sum" and self.threshold != SAFEGUARD_RATIO_THRESHOLD,
+        }
+        for name, ignored in unused.items():
+            if ignored:
+                raise NeurohoverError(f"safeguard {name}={getattr(self, name)!r} is not read by rule {self.rule!r}: leave it out, or take a rule that uses it")
 
     def limits(self) -> np.ndarray:
         """The test in the kernel's layout (sim/constants.SAFEGUARD_LIMITS): 9 box limits, the tilt

@@ -118,7 +118,8 @@ class Policy:
 
         Raises NeurohoverError for an observation that is not 12 finite numbers (a NaN would give NaN actions silently)."""
         try:
-            obs = np.asarray(observation, dtype=np.float64).ravel()
+            raw = np.asarray(observation)
+            obs = raw.astype(np.float64).ravel() if raw.dtype.kind in "iuf" else np.zeros(0)  # not text, booleans or complex
         except (TypeError, ValueError):
             obs = np.zeros(0)
         if obs.size != 12 or not np.all(np.isfinite(obs)):
@@ -152,9 +153,12 @@ class Policy:
 def check_genome(genome, topology: str) -> np.ndarray:
     """Return ``genome`` as a float64 vector of the topology's length, or raise a clear error."""
     try:
-        arr = np.array(genome, dtype=float).reshape(-1) if np.ndim(genome) <= 1 else np.array(genome, dtype=float)
+        raw = np.array(genome)
+        if raw.dtype.kind not in "iuf":  # text, booleans and complex numbers were read as numbers (third trial)
+            raise TypeError(raw.dtype)
+        arr = raw.astype(float).reshape(-1) if raw.ndim <= 1 else raw.astype(float)
     except (TypeError, ValueError, OverflowError):  # an integer past a float's range was an OverflowError (third trial)
-        raise NeurohoverError(f"a {topology} genome must be a list of finite numbers, got {genome!r:.80}") from None
+        raise NeurohoverError(f"a {topology} genome must be a list of finite real numbers, got {genome!r:.80}") from None
     n = GENOME_LENGTH[topology]
     if arr.ndim != 1 or arr.shape[0] != n:
         raise NeurohoverError(f"a {topology} genome has {n} genes, got shape {arr.shape}")
@@ -262,6 +266,8 @@ def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
 
     if not isinstance(policy, Policy):
         raise NeurohoverError(f"policy={policy!r:.60} is not allowed: give a Policy (load_policy('baseline') for the baseline's)")
+    if isinstance(path, (str, os.PathLike)) and Path(path).suffix == ".net":  # JSON under .net could not be read back (third trial)
+        raise NeurohoverError(f"policy file {str(path)!r}: save_policy writes JSON; give a .json name, or write the authors' format with netfile.policy_to_net")
     data = policy_to_dict(policy)
     taken = sorted({"topology", "genome"} & set(metadata))  # the policy's metadata may be updated, its network not
     if taken:  # they would overwrite the policy itself and write a file load_policy refuses (second trial)

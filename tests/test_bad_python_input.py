@@ -379,3 +379,41 @@ def test_the_third_trials_files_and_paths_are_refused_by_name(tmp_path) -> None:
     assert (mine / "mine.txt").read_text() == "keep"  # the build replaced the directory whole (third trial)
     with pytest.raises(NeurohoverError, match="progress=3 is not allowed"):
         build_policy_set("ghh08", tmp_path / "bp2", budget=2, n_steps=5, progress=3)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "unread"), [({"rule": "paper", "tilt": 0.5}, "tilt"), ({"rule": "ratio-sum", "box": 0.3}, "box"), ({"threshold": 0.2}, "threshold")]
+)
+def test_a_safeguard_setting_its_rule_does_not_read_is_refused(kwargs: dict, unread: str) -> None:
+    """issue 37, third trial: ignored without a word; the defaults of the unread settings still pass."""
+    with pytest.raises(NeurohoverError, match=f"safeguard {unread}=.* is not read by rule"):
+        nh.DangerousState(**kwargs)
+    assert nh.DangerousState(rule=kwargs.get("rule", "code")).rule == kwargs.get("rule", "code")
+
+
+def test_seeds_past_2_63_and_real_numbers_that_are_not_numbers_are_refused(tmp_path) -> None:
+    """issue 37, third trial: a seed of 2**64 was taken where every other seed is refused past 2**63-1; text, booleans and
+    complex numbers were read as numbers (a complex one cut to its real part with a warning); a .net name got JSON."""
+    import gymnasium as gym
+
+    fam = nh.get_task_family("ghh08")
+    with pytest.raises(NeurohoverError, match=r"an integer in 0..2\*\*63-1"):
+        fam.sample(2**64)
+    with pytest.raises(NeurohoverError, match=r"an integer in 0..2\*\*63-1"):
+        gym.make("neurohover/GHH08-v0").reset(seed=2**64)
+    with pytest.raises(NeurohoverError, match=r"out of range: allowed an integer in 0..2\*\*63-2"):
+        gym.make_vec("neurohover/GHH08-v0", num_envs=2, vectorization_mode="vector_entry_point").reset(seed=2**63 - 1)
+    b = nh.baseline_policy()
+    for genome in (np.full(40, 1j), np.array(["0"] * 40), [True] * 40):
+        with pytest.raises(NeurohoverError, match="must be a list of finite real numbers"):
+            nh.Policy("slp", genome)
+    for obs in ([True] * 12, np.full(12, 1j)):
+        with pytest.raises(NeurohoverError, match="give 12 finite numbers"):
+            b.act(obs)
+    env = gym.make("neurohover/GHH08-v0")
+    env.reset(seed=0)
+    with pytest.raises(NeurohoverError, match="give 4 real numbers"):
+        env.step([True] * 4)
+    with pytest.raises(NeurohoverError, match="save_policy writes JSON; give a .json name"):
+        nh.save_policy(b, tmp_path / "x.net")
+    assert nh.Policy("slp", [0] * 40).genome.dtype == np.float64 and b.act([0] * 12) == b.act(np.zeros(12))  # integers still are numbers

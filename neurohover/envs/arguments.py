@@ -132,11 +132,11 @@ def draw_stream_seed(rng: np.random.Generator) -> int:
 
 
 def real_values(values: Any, message: str) -> np.ndarray:
-    """``values`` (actions) as float64, or NeurohoverError(``message``): text and complex numbers are refused, which
+    """``values`` (actions) as float64, or NeurohoverError(``message``): text, booleans and complex numbers are refused, which
     NumPy would read ('1' as 1.0) or cut to their real part with only a warning."""
     try:
         raw = np.asarray(values)
-        if raw.dtype.kind not in "biuf":
+        if raw.dtype.kind not in "iuf":  # booleans too: [True] * 4 is no action
             raise TypeError(raw.dtype)
         return raw.astype(np.float64, copy=False)
     except (TypeError, ValueError):

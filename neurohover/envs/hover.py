@@ -375,8 +375,8 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         return self._run_mdp, self._run.row(self._run_episode)
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
-        if seed is not None and (isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0):
-            raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer >= 0")  # as the vector env says it
+        if seed is not None and (isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or not 0 <= seed <= 2**63 - 1):
+            raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer in 0..2**63-1")  # every seed's range, as the vector env says it
         super().reset(seed=None if seed is None else int(seed))  # Gymnasium's seeding takes a Python int, not np.int64
         options = check_reset_options(options)
         # Validate every option before touching the episode, so a bad call leaves it as it was.

@@ -267,16 +267,16 @@ class HoverVectorEnv(VectorEnv):
         if seed is None:
             return [None] * n
         if isinstance(seed, (int, np.integer)) and not isinstance(seed, (bool, np.bool_)):
-            if seed < 0:
-                raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer >= 0")
+            if not 0 <= seed <= 2**63 - n:  # every seed's range (the last helicopter's seed + n - 1 too)
+                raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer in 0..2**63-{n}")
             return [int(seed) + i for i in range(n)]
         if (
             isinstance(seed, (list, tuple, np.ndarray))
             and len(seed) == n
-            and all(s is None or (isinstance(s, (int, np.integer)) and not isinstance(s, (bool, np.bool_)) and s >= 0) for s in seed)
+            and all(s is None or (isinstance(s, (int, np.integer)) and not isinstance(s, (bool, np.bool_)) and 0 <= s <= 2**63 - 1) for s in seed)
         ):
             return [None if s is None else int(s) for s in seed]
-        raise NeurohoverError(f"seed={seed!r} is not allowed: give None, an integer >= 0, or a list of {n} such integers (or None)")
+        raise NeurohoverError(f"seed={seed!r} is not allowed: give None, an integer in 0..2**63-1, or a list of {n} such integers (or None)")
 
     def _check_streams(self, value: Any) -> list[tuple[int, int]]:
         n = self.num_envs

@@ -229,8 +229,8 @@ def generator(rng, what: str = "rng") -> np.random.Generator:
     """``rng`` as a NumPy Generator: a Generator, a seed (an integer >= 0) or None (fresh entropy); else a clear error."""
     if rng is None or isinstance(rng, np.random.Generator):
         return np.random.default_rng(rng)
-    if isinstance(rng, (bool, np.bool_)) or not isinstance(rng, (int, np.integer)) or rng < 0:
-        raise NeurohoverError(f"{what}={rng!r} is not allowed: give a numpy Generator, a seed (an integer >= 0) or None")
+    if isinstance(rng, (bool, np.bool_)) or not isinstance(rng, (int, np.integer)) or not 0 <= rng <= 2**63 - 1:  # every seed's range
+        raise NeurohoverError(f"{what}={rng!r} is not allowed: give a numpy Generator, a seed (an integer in 0..2**63-1) or None")
     return np.random.default_rng(int(rng))
 
 
