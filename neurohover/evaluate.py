@@ -201,6 +201,7 @@ def _index_array(values, n_jobs: int | None, upper: int | None, what: str) -> np
     arr = np.asarray(values)
     if arr.ndim > 1:  # one index per job: a 2-D array's jobs would be flattened in an order the caller may not mean
         raise NeurohoverError(f"{what} must be a 1-D array of job indices, got shape {arr.shape}")
+    check_episode_count(arr.size, f"{what} of {arr.size:,} jobs")  # before its int64 copy (10**10 int8 indices: 75 GiB; third trial)
     if arr.size and not np.issubdtype(arr.dtype, np.integer):
         raise NeurohoverError(f"{what} must hold integers, got dtype {arr.dtype}")
     if arr.size and np.issubdtype(arr.dtype, np.unsignedinteger) and arr.max() > np.iinfo(np.int64).max:  # would wrap negative

@@ -417,3 +417,13 @@ def test_seeds_past_2_63_and_real_numbers_that_are_not_numbers_are_refused(tmp_p
     with pytest.raises(NeurohoverError, match="save_policy writes JSON; give a .json name"):
         nh.save_policy(b, tmp_path / "x.net")
     assert nh.Policy("slp", [0] * 40).genome.dtype == np.float64 and b.act([0] * 12) == b.act(np.zeros(12))  # integers still are numbers
+
+
+def test_sizes_that_would_exhaust_memory_before_the_check_are_refused() -> None:
+    """issue 37, third trial: fixed:100000000000 and 10**9 one-byte job indices were MemoryErrors, not refusals."""
+    from neurohover.evolution.evolve import evolve
+
+    with pytest.raises(NeurohoverError, match="K must be an integer in 1..100,000"):
+        evolve(nh.get_task_family("ghh08").zero(), budget=2, n_steps=5, resampling="fixed:100000000000")
+    with pytest.raises(NeurohoverError, match="policy_index of 1,000,000,000 jobs is out of range"):
+        nh.evaluate_jobs([nh.baseline_policy()], [nh.get_task_family("ghh08").zero()], np.zeros(10**9, dtype=np.int8), [0], [0], n_steps=5)

@@ -342,7 +342,7 @@ def test_evolve_command_ctrl_c_saves_the_checkpoint(cli, tmp_path: Path, monkeyp
     "argv,words",
     [
         (["--resampling", "race:1.5"], "strictly between 0 and 1"),
-        (["--resampling", "fixed:0"], "K must be an integer >= 1"),
+        (["--resampling", "fixed:0"], "K must be an integer in 1..100,000"),
         (["--budget", "0"], "--budget 0 is out of range"),
         (["--seed-policy", "nope.json"], "no such file"),
         (["--resume"], "no checkpoint"),

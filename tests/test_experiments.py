@@ -725,6 +725,12 @@ def test_a_refused_only_leaves_the_store_as_it_was(tmp_path: Path, capsys) -> No
     assert main([*base, "--set", "budget=120", "--only", "evolve/k1/run0"]) == 0  # other settings: not "settings differ"
     with Store(store) as s:
         assert sorted(s.results("slowtest", "quick")) == ["evolve/k1/run0"]
+    # Third trial: in a store that already held another experiment, a staged plan's refusal (fig2's robustness units
+    # wait for its evolutions) registered fig2 with no unit, which `results fig2` then printed as empty.
+    assert main(["reproduce", "fig2", "--store", str(store), "--no-progress", "--only", "zzz"]) == 2
+    assert "--only 'zzz' matches no unit" in capsys.readouterr().err
+    with Store(store) as s:
+        assert [e[0] for e in s.experiments()] == ["slowtest"]
 
 
 def test_an_update_that_forgets_the_policy_source_is_refused(tmp_path) -> None:

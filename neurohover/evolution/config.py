@@ -91,6 +91,10 @@ def next_auto_delta(delta: float, spent: int, target: int) -> float:
     return float(min(hi, max(lo, delta * AUTO_STEP if spent > target else delta / AUTO_STEP)))
 
 
+#: The most episodes fixed resampling flies per candidate (a generation of 50 candidates is then 5,000,000 episodes).
+MAX_RESAMPLING = 100_000
+
+
 def parse_resampling(spec: str | Resampling | None) -> Resampling:
     """``"fixed:K"`` (K >= 1 episodes per candidate), ``"race:DELTA[:RULE]"`` (0 < DELTA < 1; RULE one of
     :data:`~neurohover.evolution.races.RACE_RULES`, default prose), ``"race:auto[:K]"`` (a delta that matches
@@ -109,9 +113,9 @@ def parse_resampling(spec: str | Resampling | None) -> Resampling:
     if not text.isascii():  # int() and float() read other scripts' digits ('fixed:\u0661' would be fixed:1)
         raise NeurohoverError(f"resampling {spec!r} is not allowed: numbers in ASCII digits; {allowed}")
     if kind == "fixed" and sep:
-        if value.isdigit() and int(value) >= 1:
+        if value.isdigit() and 1 <= int(value) <= MAX_RESAMPLING:  # fixed:100000000000 was a MemoryError (third trial)
             return Resampling("fixed", int(value))
-        raise NeurohoverError(f"bad resampling {spec!r}: K must be an integer >= 1; {allowed}")
+        raise NeurohoverError(f"bad resampling {spec!r}: K must be an integer in 1..{MAX_RESAMPLING:,}; {allowed}")
     if kind in BANDITS and sep:
         try:
             delta = float(value)

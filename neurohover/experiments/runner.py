@@ -194,6 +194,8 @@ def reproduce(
         if summary.failed:
             summary.status = "failed"
         elif set(only) - matched:
+            if held is None:  # registered by this call only: a refused run leaves the store as it was (third trial)
+                store.forget_if_empty(config.name, config.scale)
             raise _matches_no_unit(config, sorted(set(only) - matched)[0], p.units)
         elif only:
             summary.status = "finished" if len(results) >= summary.units_total else "selection finished"

@@ -262,6 +262,18 @@ class Store:
             c.execute("UPDATE experiments SET config_hash = ?, config = ? WHERE name = ? AND scale = ?", (config_hash, _dumps(config), name, scale))
         return len(stored) - len(gone)
 
+    def forget_if_empty(self, name: str, scale: str) -> bool:
+        """Remove experiment (name, scale) and its sessions if it holds no unit (a run refused after it was registered
+        leaves the store as it was); whether it was removed."""
+        self.lock()
+        c = self.conn
+        with _transaction(c):
+            if c.execute("SELECT 1 FROM units WHERE name = ? AND scale = ? LIMIT 1", (name, scale)).fetchone() is not None:
+                return False
+            c.execute("DELETE FROM sessions WHERE name = ? AND scale = ?", (name, scale))
+            c.execute("DELETE FROM experiments WHERE name = ? AND scale = ?", (name, scale))
+        return True
+
     def experiments(self) -> list[tuple[str, str, str, int]]:
         """(name, scale, config_hash, finished units) of every experiment in the store."""
         return [
