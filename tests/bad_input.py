@@ -75,6 +75,9 @@ CASES: list[tuple[list[str], str]] = [
     (["demo", "--episodes", "10000000000000"], "episodes=10000000000000 is out of range"),
     (["demo", "--mdps", "-1"], "--mdps -1 is out of range: allowed 0..10"),
     (["demo", "--episodes", "0"], "--episodes 0 is out of range: allowed an integer >= 1"),
+    (["evaluate-agent", "--task", "ghh08", "--rl-zoo", "nonexist"], "--rl-zoo 'nonexist': no such directory"),  # was "needs SB3"
+    (["evaluate-agent", "--task", "ghh08", "--sb3", "nonexist.zip"], "--sb3 'nonexist.zip': no such SB3 model file"),
+    (["fly", "--task", "fghh", "--params=1e300,1,1,1,1,1,1,1,1,1,1"], "must lie in [-10000, 10000]"),  # flew NaN returns
     # third trial: an output onto an input destroyed it (the store became CSV, the flight data a model)
     (["results", "fig2", "--store", "store.sqlite", "--out", "store.sqlite"], "--out 'store.sqlite' is the file of --store"),
     (["learn-model", "--flight-data", "fd.npz", "--method", "lr", "--out", "fd.npz"], "--out 'fd.npz' is the file of --flight-data"),

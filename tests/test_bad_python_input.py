@@ -427,3 +427,11 @@ def test_sizes_that_would_exhaust_memory_before_the_check_are_refused() -> None:
         evolve(nh.get_task_family("ghh08").zero(), budget=2, n_steps=5, resampling="fixed:100000000000")
     with pytest.raises(NeurohoverError, match="policy_index of 1,000,000,000 jobs is out of range"):
         nh.evaluate_jobs([nh.baseline_policy()], [nh.get_task_family("ghh08").zero()], np.zeros(10**9, dtype=np.int8), [0], [0], n_steps=5)
+
+
+def test_fghh_parameters_past_what_the_simulation_holds_are_refused() -> None:
+    """issue 37, third trial: 1e300 was taken and flew NaN returns."""
+    fam = nh.get_task_family("fghh")
+    with pytest.raises(NeurohoverError, match=r"must lie in \[-10000, 10000\]"):
+        fam.make([1e300] + [1.0] * 10)
+    assert np.isfinite(nh.evaluate("baseline", fam.make([1e4] * 11), episodes=1, n_steps=20).returns).all()  # the bound itself flies

@@ -160,6 +160,24 @@ def test_the_workers_of_a_killed_compete_exit(tmp_path: Path, sig: int) -> None:
         _end_group(proc)
 
 
+def test_a_terminated_build_leaves_no_half_built_set(tmp_path: Path) -> None:
+    """issue 37, third trial: SIGTERM (timeout, kill) left <out>/ghh08.building until the next build; Ctrl-C did not."""
+    out = tmp_path / "bp"
+    proc = _start(tmp_path, "build-policies", "--task", "ghh08", "--budget", "1000000", "--out", str(out))
+    try:
+        building = out / "ghh08.building"
+        for _ in range(600):  # the build under way (its kernel loaded from the cache)
+            if building.is_dir() or proc.poll() is not None:
+                break
+            time.sleep(0.1)
+        assert building.is_dir(), (tmp_path / "stderr.txt").read_text()[-2000:]
+        os.kill(proc.pid, signal.SIGTERM)
+        assert proc.wait(timeout=60) in (130, 143)  # terminated (143), or interrupted mid-evolution (130)
+        assert not building.exists() and not (out / "ghh08").exists()
+    finally:
+        _end_group(proc)
+
+
 # --------------------------------------------------------------------------------- Ray addresses
 
 

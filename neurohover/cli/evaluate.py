@@ -11,6 +11,7 @@ import argparse
 import importlib
 import json
 import sys
+from pathlib import Path
 
 from ..errors import NeurohoverError
 from ..integrations import SB3_ALGORITHMS
@@ -69,10 +70,15 @@ def _agent(args: argparse.Namespace):
         from ..integrations.cleanrl import cleanrl_policy
 
         return cleanrl_policy(args.cleanrl)
+    from ..paths import input_dir, input_file
+
     if args.rl_zoo is not None:
+        input_dir(args.rl_zoo, "--rl-zoo")  # the path before the library: a typo read as "SB3 is not installed" (third trial)
         from ..integrations.sb3 import rl_zoo_policy
 
         return rl_zoo_policy(args.rl_zoo, algo=algo)
+    if not Path(f"{args.sb3}.zip").is_file():  # SB3's load adds .zip to a name without it
+        input_file(args.sb3, "--sb3", "SB3 model file (.zip)")
     from ..integrations.sb3 import sb3_policy
 
     return sb3_policy(args.sb3, algo=algo)

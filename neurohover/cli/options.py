@@ -186,11 +186,12 @@ def add_task_options(p: argparse.ArgumentParser, mdp_help: str = MDP_HELP, verb:
     """--task, --mdp, --wind, --params, --sigma and the sensor options: the task family and the MDP a command ``verb``s on."""
     add_task_option(p)
     p.add_argument("--mdp", help=mdp_help)
-    p.add_argument("--wind", help=f"GHH-08 only: {verb} on the constant wind U,V in m/s, each in [-5, 5] (instead of --mdp)")
+    p.add_argument("--wind", help=f"GHH-08 only: {verb} on the constant wind U,V in m/s, each in [-5, 5] (instead of --mdp; a negative U: --wind=-3,1)")
     p.add_argument(
         "--params",
         help=f"{verb} on explicit MDP parameters, comma-separated (instead of --mdp): GHH-08 wind_u,wind_v; "
-        "GHH-09 its 8 parameters in [0,1]; FGHH the 11 dynamics parameters",
+        "GHH-09 its 8 parameters in [0,1]; FGHH the 11 dynamics parameters (a list that starts with a minus sign "
+        "is written --params=-0.18,...)",
     )
     add_sigma_option(p)
     add_sensor_options(p)

@@ -15,6 +15,11 @@ from .base import MDP, TaskFamily, finite_vector
 COMPETITION_FGHH_SIGMA = 0.3  # the only FGHH sigma the authors' code lists MDPs for
 
 
+#: The largest magnitude of an FGHH dynamics parameter make() takes: 140 times the defaults' largest (sigma <= 1 draws
+#: stay far inside); at it a crash is flown at once, and far past it (1e300) the simulation overflowed to NaN.
+MAX_PARAM = 10_000.0
+
+
 @dataclass(frozen=True)
 class FGHH(TaskFamily):
     """Fully generalized: no wind; each of the 11 dynamics parameters ~ N(d, (|d| sigma)^2)."""
@@ -35,6 +40,8 @@ class FGHH(TaskFamily):
 
     def make(self, params: Sequence[float] | np.ndarray, label: str = "") -> MDP:
         p = finite_vector(params, 11, "FGHH dynamics parameters " + "/".join(PARAM_NAMES))
+        if np.abs(p).max() > MAX_PARAM:  # 1e300 overflowed the simulation to NaN returns (third trial)
+            raise NeurohoverError(f"FGHH dynamics parameters must lie in [-{MAX_PARAM:g}, {MAX_PARAM:g}] (the defaults' largest is 70.54), got {p.tolist()}")
         return MDP("fghh", params=tuple(p.tolist()), label=label or "fghh/custom")
 
     def zero(self) -> MDP:
