@@ -435,3 +435,18 @@ def test_fghh_parameters_past_what_the_simulation_holds_are_refused() -> None:
     with pytest.raises(NeurohoverError, match=r"must lie in \[-10000, 10000\]"):
         fam.make([1e300] + [1.0] * 10)
     assert np.isfinite(nh.evaluate("baseline", fam.make([1e4] * 11), episodes=1, n_steps=20).returns).all()  # the bound itself flies
+
+
+@pytest.mark.parametrize(
+    ("optimizer", "settings", "message"),
+    [
+        ("ne", {"pop_size": 10**9}, "pop_size=1000000000 must be an integer in 2..100,000"),
+        ("cma", {"popsize": 10**11}, "popsize=100000000000 must be None or an integer in 2..100,000"),
+    ],
+)
+def test_a_population_that_would_never_finish_a_generation_is_refused(optimizer: str, settings: dict, message: str) -> None:
+    """issue 37, third trial: these hung or ran on without a word."""
+    from neurohover.evolution.evolve import evolve
+
+    with pytest.raises(NeurohoverError, match=message):
+        evolve(nh.get_task_family("ghh08"), optimizer=optimizer, settings=settings, budget=4, n_steps=5)

@@ -41,6 +41,8 @@ __all__ = [
     "enc_float",
     "rank",
     "require_int",
+    "require_population",
+    "MAX_POPULATION",
     "require_prob",
     "require_std",
     "rng_from_state",
@@ -133,9 +135,22 @@ def set_field(obj: Any, name: str, value: Any) -> None:
     object.__setattr__(obj, name, value)
 
 
+#: The largest population any optimiser takes: a generation of it fits in one kernel call's episodes and in memory
+#: (pop_size 1,000,000,000 hung, popsize 100,000,000,000 ran on without a word; third trial).
+MAX_POPULATION = 100_000
+
+
+def require_population(name: str, value: Any) -> int:
+    """A population size: an integer in 2..:data:`MAX_POPULATION`, or ValueError."""
+    size = require_int(name, value, 2)
+    if size > MAX_POPULATION:
+        raise ValueError(f"{name}={size} must be an integer in 2..{MAX_POPULATION:,}")
+    return size
+
+
 def validate_variation_settings(obj: Any) -> None:
     """Check and normalise the fields both neuroevolution settings share (population, variation, budget)."""
-    set_field(obj, "pop_size", require_int("pop_size", obj.pop_size, 2))
+    set_field(obj, "pop_size", require_population("pop_size", obj.pop_size))
     for name in ("crossover_prob", "averaging_prob", "mutate_prob", "mutate_frac", "mutate_repl"):
         set_field(obj, name, require_prob(name, getattr(obj, name)))
     set_field(obj, "mutate_std", require_std("mutate_std", obj.mutate_std))

@@ -18,7 +18,7 @@ import cma
 import numpy as np
 
 from .. import common
-from ..common import PopulationOptimiser, TellInfo, check_prototype
+from ..common import MAX_POPULATION, PopulationOptimiser, TellInfo, check_prototype
 from . import OptimiserSpec
 
 __all__ = ["CMAES", "SIGMA0", "CMASettings", "losses_of"]
@@ -224,8 +224,8 @@ class CMASettings:
         s0, pop = self.sigma0, self.popsize
         if isinstance(s0, bool) or not isinstance(s0, (int, float)) or not (math.isfinite(s0) and s0 > 0):
             raise ValueError(f"CMA-ES sigma0={s0!r} must be a finite number > 0")
-        if pop is not None and (isinstance(pop, bool) or not isinstance(pop, (int, np.integer)) or pop < 2):
-            raise ValueError(f"CMA-ES popsize={pop!r} must be None or an integer >= 2")
+        if pop is not None and (isinstance(pop, bool) or not isinstance(pop, (int, np.integer)) or not 2 <= pop <= MAX_POPULATION):
+            raise ValueError(f"CMA-ES popsize={pop!r} must be None or an integer in 2..{MAX_POPULATION:,}")
         object.__setattr__(self, "sigma0", float(s0))
         object.__setattr__(self, "popsize", None if pop is None else int(pop))
 

@@ -34,7 +34,7 @@ from ..common import (
     dec_array,
     enc_array,
     rank,
-    require_int,
+    require_population,
     require_std,
     rng_from_state,
     set_field,
@@ -78,7 +78,7 @@ class OpenAIESSettings:
     l2: float = 0.005  # weight decay of the mean
 
     def __post_init__(self) -> None:
-        popsize = require_int("popsize", self.popsize, 2)
+        popsize = require_population("popsize", self.popsize)
         if popsize % 2:
             raise ValueError(f"popsize={popsize} must be even: OpenAI-ES asks antithetic pairs")
         set_field(self, "popsize", popsize)
