@@ -7,12 +7,34 @@ Data flows one way: task family -> MDP -> batched rollouts of policies -> return
 from __future__ import annotations
 
 import importlib.metadata
+import os
+import sys
 
-from .errors import NeurohoverError
-from .evaluate import DangerousState, Evaluation, PolicyTable, Safeguard, evaluate, evaluate_jobs
-from .flightdata import FlightData
-from .policies import Policy, baseline_policy, load_policy, prototype, save_policy
-from .tasks import FGHH, GHH08, GHH09, MDP, Drift, Sensor, get_task_family
+
+def _as_command() -> bool:
+    """This process is the ``neurohover`` command (its script, or ``python -m neurohover``), not a program importing us."""
+    argv = list(getattr(sys, "orig_argv", ()))
+    return (argv[argv.index("-m") + 1 : argv.index("-m") + 2] == ["neurohover"] if "-m" in argv else False) or (
+        os.path.basename(sys.argv[0] if sys.argv else "") == "neurohover"
+    )
+
+
+def _interrupted(kind, value, tb) -> None:
+    if issubclass(kind, KeyboardInterrupt):  # Ctrl-C while NumPy and numba import, before main() can catch it (third trial)
+        print("neurohover: interrupted", file=sys.stderr, flush=True)
+        os._exit(130)  # as main() ends an interruption (Python would end by SIGINT: -2)
+    else:
+        sys.__excepthook__(kind, value, tb)
+
+
+if _as_command():
+    sys.excepthook = _interrupted
+
+from .errors import NeurohoverError  # noqa: E402
+from .evaluate import DangerousState, Evaluation, PolicyTable, Safeguard, evaluate, evaluate_jobs  # noqa: E402
+from .flightdata import FlightData  # noqa: E402
+from .policies import Policy, baseline_policy, load_policy, prototype, save_policy  # noqa: E402
+from .tasks import FGHH, GHH08, GHH09, MDP, Drift, Sensor, get_task_family  # noqa: E402
 
 try:
     __version__ = importlib.metadata.version("neurohover")  # one source of truth: pyproject.toml, as installed

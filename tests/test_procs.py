@@ -160,6 +160,17 @@ def test_the_workers_of_a_killed_compete_exit(tmp_path: Path, sig: int) -> None:
         _end_group(proc)
 
 
+@pytest.mark.parametrize("delay", [0.4, 0.8, 2.0])  # from the package's import on (before it, Python itself is starting)
+def test_ctrl_c_at_any_moment_ends_with_one_line_and_130(delay: float) -> None:
+    """issue 37, third trial: a Ctrl-C while the package imported NumPy and numba was a KeyboardInterrupt traceback (the
+    package is imported before main() runs); later ones were already one line."""
+    proc = subprocess.Popen([sys.executable, "-m", "neurohover", "fly", "--task", "ghh08", "--episodes", "100000"], stderr=subprocess.PIPE, text=True, env=ENV)
+    time.sleep(delay)  # wherever it lands, the outcome must be the same
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and "Traceback" not in err and err.strip().splitlines()[-1].endswith("interrupted"), err[-1500:]
+
+
 def test_a_terminated_build_leaves_no_half_built_set(tmp_path: Path) -> None:
     """issue 37, third trial: SIGTERM (timeout, kill) left <out>/ghh08.building until the next build; Ctrl-C did not."""
     out = tmp_path / "bp"
