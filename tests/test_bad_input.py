@@ -121,6 +121,19 @@ def test_version_with_other_arguments_is_refused(capsys) -> None:
     assert captured.out == "" and "--version takes no other arguments, got 'extra'" in captured.err
 
 
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["fly", "--task", "ghh08", "--bogus"], "unrecognized arguments: --bogus"),
+        (["fly", "--episodes", "\u0661"], "argument '\u0661' holds digits of another script"),
+    ],
+)
+def test_a_commands_parse_errors_name_the_command(capsys, args: list[str], message: str) -> None:
+    with pytest.raises(SystemExit) as stop:
+        main(args)  # said "neurohover: error:" without the command (third trial)
+    assert stop.value.code == 2 and f"neurohover fly: error: {message}" in capsys.readouterr().err
+
+
 def test_demo_refuses_zero_episodes_before_its_table(capsys) -> None:
     assert main(["demo", "--episodes", "0"]) == 2
     assert capsys.readouterr().out == ""  # the header was printed before the refusal (second trial)

@@ -376,7 +376,7 @@ def test_a_terminated_command_exits_with_143_and_an_interrupt_with_130(monkeypat
         parser = cli.build_parser()
         args = parser.parse_args(["demo"])
         monkeypatch.setattr(cli, "build_parser", lambda p=parser: p)
-        monkeypatch.setattr(parser, "parse_args", lambda argv=None, a=args: a)
+        monkeypatch.setattr(parser, "parse_known_args", lambda argv=None, namespace=None, a=args: (a, []))
         args.func = stop(exc)
         assert cli.main(["demo"]) == status
         assert capsys.readouterr().err.strip() == f"neurohover demo: {word}"

@@ -80,15 +80,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:  # the command modules import NumPy and the like: a Ctrl-C there is an interruption, not a traceback
         parser = build_parser()
     except KeyboardInterrupt:
-        print("neurohover: interrupted", file=sys.stderr)
-        return 130
+        print("neurohover: interrupted", file=sys.stderr, flush=True)
+        os._exit(130)  # nothing made yet; a half-imported numba must not run its exit handlers (they died by SIGINT: -2)
     given = list(sys.argv[1:] if argv is None else argv)
+    action = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    commands: dict[str, argparse.ArgumentParser] = dict(action.choices or {})
+    named = next((commands[a] for a in given if a in commands), parser)  # its errors say "neurohover CMD: error:" (third trial)
     odd = _other_scripts_digits(given)
     if odd is not None:
-        parser.error(f"argument {odd!r} holds digits of another script: give numbers in ASCII digits")
+        named.error(f"argument {odd!r} holds digits of another script: give numbers in ASCII digits")
     if "--version" in given and len(given) > 1:  # argparse prints the version and drops the rest without a word
         parser.error(f"--version takes no other arguments, got {' '.join(a for a in given if a != '--version')!r}")
-    args = parser.parse_args(argv)
+    args, extra = parser.parse_known_args(argv)
+    if extra:  # argparse reports them from the top parser, without the command's name
+        named.error(f"unrecognized arguments: {' '.join(extra)}")
     from ..paths import forget_created_dirs, remove_created_dirs
 
     forget_created_dirs()
