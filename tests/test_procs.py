@@ -160,7 +160,7 @@ def test_the_workers_of_a_killed_compete_exit(tmp_path: Path, sig: int) -> None:
         _end_group(proc)
 
 
-@pytest.mark.parametrize("delay", [0.4, 0.8, 2.0])  # from the package's import on (before it, Python itself is starting)
+@pytest.mark.parametrize("delay", [0.6, 1.2, 2.5])  # from the package's import on (before it, Python itself is starting)
 def test_ctrl_c_at_any_moment_ends_with_one_line_and_130(delay: float) -> None:
     """issue 37, third trial: a Ctrl-C while the package imported NumPy and numba was a KeyboardInterrupt traceback (the
     package is imported before main() runs); later ones were already one line."""
@@ -174,6 +174,9 @@ def test_ctrl_c_at_any_moment_ends_with_one_line_and_130(delay: float) -> None:
 def test_a_terminated_build_leaves_no_half_built_set(tmp_path: Path) -> None:
     """issue 37, third trial: SIGTERM (timeout, kill) left <out>/ghh08.building until the next build; Ctrl-C did not."""
     out = tmp_path / "bp"
+    # The kernel compiled (or loaded) first, as the installed copy's cache may be cold: a SIGTERM during numba's
+    # compilation is not heard until it ends (noted in issue 37), which is not what this test measures.
+    subprocess.run([sys.executable, "-m", "neurohover", "fly", "--task", "ghh08", "--episodes", "1"], cwd=ROOT, env=ENV, capture_output=True, check=True)
     proc = _start(tmp_path, "build-policies", "--task", "ghh08", "--budget", "1000000", "--out", str(out))
     try:
         building = out / "ghh08.building"
