@@ -1,12 +1,7 @@
 """``python -m neurohover``: the same command line as ``neurohover``."""
 
-import os
 import sys
 
-try:
-    from .cli import main
-except KeyboardInterrupt:  # Ctrl-C while the package imports: an interruption, not a traceback
-    print("neurohover: interrupted", file=sys.stderr, flush=True)
-    os._exit(130)  # as the package's hook does: a half-imported numba's exit handlers died by SIGINT (-2)
+from .cli import main  # a Ctrl-C while it imports: the package's hook (neurohover/__init__.py) ends it with one line
 
 sys.exit(main())

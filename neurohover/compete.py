@@ -300,10 +300,8 @@ def compete(
         task, agent, runs=runs, episodes=episodes, mdps=mdps, seed=seed, sigma=sigma, n_steps=n_steps, policy_dir=policy_dir, hybrid=hybrid,
         sensor=sensor, drift=drift, wind_model=wind_model, lr_fit=lr_fit, agent_settings=agent_settings,
     )  # fmt: skip
-    if isinstance(out, (str, Path)) and Path(out).exists() and not Path(out).is_dir():  # /dev/full was a FileExistsError (third trial)
-        raise NeurohoverError(f"out {str(out)!r} is a file; give a directory")
-    store_path = output_file(store, "store") if store is not None else None
-    out = output_dir(out, "out")  # made once every setting is checked (None was a TypeError; second trial)
+    store_path = output_file(store, "store") if store is not None else None  # a bad store refused before out is made
+    out = output_dir(out, "out")  # made once every setting is checked (None was a TypeError, /dev/full a FileExistsError)
     store_path = store_path or out / STORE_FILE
     ordered = _run_into_store(config, store_path, out / "episodes.csv", jobs=jobs, device=device, progress=progress, on_result=on_result)
     summary = {

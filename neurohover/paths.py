@@ -51,15 +51,15 @@ def _make_dirs(directory: Path, option: str, given: str) -> None:
     print(f"neurohover: created directory {str(missing[-1])!r}" + (f" and {len(missing) - 1} below it" if len(missing) > 1 else ""), file=sys.stderr)
 
 
-def checked_path(path, option: str) -> Path:
+def checked_path(path, option: str, what: str = "file path") -> Path:
     """``path`` (a str or path object) as a Path: empty, another type or a NUL byte refused by name (the OS's TypeError
-    and ValueError before)."""
+    and ValueError before); ``what`` says what to give instead."""
     if not isinstance(path, (str, os.PathLike)):
-        raise NeurohoverError(f"{option}={path!r:.60} is not allowed: give a file path")
+        raise NeurohoverError(f"{option}={path!r:.60} is not allowed: give a {what}")
     if str(path) == "":
-        raise NeurohoverError(f"{option} is empty; give a file path")
+        raise NeurohoverError(f"{option} is empty; give a {what}")
     if "\x00" in str(path):
-        raise NeurohoverError(f"{option} {str(path)!r:.80} holds a NUL character: give a file path")
+        raise NeurohoverError(f"{option} {str(path)!r:.80} holds a NUL character: give a {what}")
     return Path(path)
 
 
@@ -136,9 +136,7 @@ def writing(path: str | os.PathLike, option: str) -> Iterator[Path]:
 
 def output_dir(path: str | os.PathLike, option: str) -> Path:
     """Check that files can be written in the directory ``path``, creating it (saying so) if missing."""
-    if isinstance(path, (str, os.PathLike)) and str(path) == "":
-        raise NeurohoverError(f"{option} is empty; give a directory")
-    p = checked_path(path, option)
+    p = checked_path(path, option, "directory")
     if p.exists() and not p.is_dir():
         raise NeurohoverError(f"{option} {str(path)!r} is a file; give a directory")
     _make_dirs(p, option, str(path))
@@ -152,9 +150,7 @@ def output_dir(path: str | os.PathLike, option: str) -> Path:
 
 def input_file(path: str | os.PathLike, option: str, what: str = "file") -> Path:
     """Check that ``path`` is an existing, readable regular file."""
-    if isinstance(path, (str, os.PathLike)) and str(path) == "":
-        raise NeurohoverError(f"{option} is empty; give a {what}")
-    p = checked_path(path, option)
+    p = checked_path(path, option, what)
     if not p.exists():
         raise NeurohoverError(f"{option} {str(path)!r}: no such {what}")
     if p.is_dir():

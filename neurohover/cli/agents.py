@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from ..errors import NeurohoverError
-from ..evaluate import DEVICES, check_device
+from ..evaluate import DEVICES
 
 
 def cmd_build_policies(args: argparse.Namespace) -> int:
@@ -48,7 +48,6 @@ def cmd_compete(args: argparse.Namespace) -> int:
     from ..agents.model_based import ModelEvolution
     from ..agents.registry import AGENTS, HYBRID_AGENTS, agent_spec
     from ..compete import check_sizes, compete
-    from ..experiments.executors import check_jobs
     from ..paths import input_dir, output_file
     from ..tasks import Drift
     from .options import check_given, given_settings, sensor_of
@@ -65,8 +64,6 @@ def cmd_compete(args: argparse.Namespace) -> int:
             raise NeurohoverError(f"{option.flag} applies to the agents that learn models ({learners}), not to --agent {args.agent}")
     check_given(ModelEvolution, model, args.model_options)
     wind_model = str(model.pop("wind_model", "none"))
-    check_device(args.device)  # before the output directory is made
-    check_jobs(args.jobs)
     check_sizes(args.runs, args.episodes)
     sensor = sensor_of(args)
     drift = None if args.drift is None else Drift.parse(args.drift)

@@ -77,11 +77,7 @@ def _other_scripts_digits(argv: Sequence[str]) -> str | None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    try:  # the command modules import NumPy and the like: a Ctrl-C there is an interruption, not a traceback
-        parser = build_parser()
-    except KeyboardInterrupt:
-        print("neurohover: interrupted", file=sys.stderr, flush=True)
-        os._exit(130)  # nothing made yet; a half-imported numba must not run its exit handlers (they died by SIGINT: -2)
+    parser = build_parser()  # a Ctrl-C while it imports the command modules: the package's hook (neurohover/__init__.py)
     given = list(sys.argv[1:] if argv is None else argv)
     action = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
     commands: dict[str, argparse.ArgumentParser] = dict(action.choices or {})

@@ -99,14 +99,13 @@ def add_setting_options(
         row, f = rows[name], fields_of[name]
         default = f.default if f.default is not MISSING else None
         flag = f"--{(flags or {}).get(name) or prefix + name.replace('_', '-')}"
-        text = plain(row.help)
-        first = text.rstrip(".")
-        first = first[:1].lower() + first[1:] if who and first[1:2].islower() else first  # "who: keep ..." reads as one sentence
+        text = plain(row.help).rstrip(".")
+        text = text[:1].lower() + text[1:] if who and text[1:2].islower() else text  # "who: keep ..." reads as one sentence
         shown = (default_text or {}).get(name, str(default).lower() if isinstance(default, bool) else str(default))
         choices = re.fullmatch(r"\{(.*)\}", row.type.strip())
         metavar = "{" + ",".join(c.strip().strip('"') for c in choices[1].split(",")) + "}" if choices else None
         option = SettingOption(flag, name)
-        described = f"{who}: {first} (default {shown})" if who else f"{first} (default {shown})"
+        described = f"{who}: {text} (default {shown})" if who else f"{text} (default {shown})"
         p.add_argument(flag, dest=option.dest, type=_converter(default), metavar=metavar, help=described.replace("%", "%%"))  # argparse formats help
         made.append(option)
     return tuple(made)

@@ -31,7 +31,7 @@ from ..sim.constants import (
     STATE_DIM,
 )
 from ..sim.reference import competition_time
-from ..sim.rng import seed_stream
+from ..sim.rng import MAX_SEED, seed_stream
 from ..sim.step import ENV_NOISE_WIDTH, ENV_RNG_WIDTH, start_readings, step_batch
 from ..tasks import MDP, TASK_FAMILIES, TaskFamily
 from ..tasks.drift import Drift, DriftRun
@@ -375,7 +375,7 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         return self._run_mdp, self._run.row(self._run_episode)
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
-        if seed is not None and (isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or not 0 <= seed <= 2**63 - 1):
+        if seed is not None and (isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or not 0 <= seed <= MAX_SEED):
             raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer in 0..2**63-1")  # every seed's range, as the vector env says it
         super().reset(seed=None if seed is None else int(seed))  # Gymnasium's seeding takes a Python int, not np.int64
         options = check_reset_options(options)

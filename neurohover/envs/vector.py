@@ -30,7 +30,7 @@ from gymnasium.vector.utils import batch_space
 from ..errors import NeurohoverError
 from ..launch import check_device, stepper
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS, MDP_ROW_LEN, OBS_DIM
-from ..sim.rng import seed_stream
+from ..sim.rng import MAX_SEED, seed_stream
 from ..sim.step import ENV_NOISE_WIDTH, ENV_RNG_WIDTH, start_readings
 from ..tasks import MDP, TaskFamily, refuse_drift
 from .arguments import (
@@ -267,13 +267,13 @@ class HoverVectorEnv(VectorEnv):
         if seed is None:
             return [None] * n
         if isinstance(seed, (int, np.integer)) and not isinstance(seed, (bool, np.bool_)):
-            if not 0 <= seed <= 2**63 - n:  # every seed's range (the last helicopter's seed + n - 1 too)
+            if not 0 <= seed <= MAX_SEED + 1 - n:  # every seed's range (the last helicopter's seed + n - 1 too)
                 raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer in 0..2**63-{n}")
             return [int(seed) + i for i in range(n)]
         if (
             isinstance(seed, (list, tuple, np.ndarray))
             and len(seed) == n
-            and all(s is None or (isinstance(s, (int, np.integer)) and not isinstance(s, (bool, np.bool_)) and 0 <= s <= 2**63 - 1) for s in seed)
+            and all(s is None or (isinstance(s, (int, np.integer)) and not isinstance(s, (bool, np.bool_)) and 0 <= s <= MAX_SEED) for s in seed)
         ):
             return [None if s is None else int(s) for s in seed]
         raise NeurohoverError(f"seed={seed!r} is not allowed: give None, an integer in 0..2**63-1, or a list of {n} such integers (or None)")

@@ -30,6 +30,7 @@ from ..sim.constants import (
     WIND_NONE,
 )
 from ..sim.reference import ReferenceMDP
+from ..sim.rng import MAX_SEED
 from .drift import NO_DRIFT, Drift
 from .sensor import EXACT, Sensor
 
@@ -229,7 +230,7 @@ def generator(rng, what: str = "rng") -> np.random.Generator:
     """``rng`` as a NumPy Generator: a Generator, a seed (an integer >= 0) or None (fresh entropy); else a clear error."""
     if rng is None or isinstance(rng, np.random.Generator):
         return np.random.default_rng(rng)
-    if isinstance(rng, (bool, np.bool_)) or not isinstance(rng, (int, np.integer)) or not 0 <= rng <= 2**63 - 1:  # every seed's range
+    if isinstance(rng, (bool, np.bool_)) or not isinstance(rng, (int, np.integer)) or not 0 <= rng <= MAX_SEED:  # every seed's range
         raise NeurohoverError(f"{what}={rng!r} is not allowed: give a numpy Generator, a seed (an integer in 0..2**63-1) or None")
     return np.random.default_rng(int(rng))
 
