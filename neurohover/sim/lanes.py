@@ -326,6 +326,36 @@ def _over(j, n_required, left, parking, job_slot):
     parking.steps[job_slot[j]] = 0
 
 
+@nb.njit(cache=True)
+def _end_job(out, j, ret, crashed, steps, parks, n_required, left, parking, job_slot) -> None:
+    """Job ``j``'s episode is over (once per episode, so not inlined): its return, crash flag and steps written."""
+    out.returns[j] = ret
+    out.crashed[j] = crashed
+    out.steps[j] = steps
+    if parks:
+        _over(j, n_required, left, parking, job_slot)
+
+
+@nb.njit(cache=True, fastmath={"contract"})
+def _fill_lanes(B, P, N, A, rngs, seen, srngs, scratch, sensing, job, step, total, queue, jobs, job_slot, parking):
+    """Every lane given a job while the queue has one: the last job index this thread took and the lanes in flight."""
+    nxt = -1
+    live = 0
+    for lane in range(LANES):
+        nxt = _refill(B, P, N, A, rngs, seen, srngs, scratch, sensing, job, step, total, lane, nxt, queue, jobs, job_slot, parking)
+        if job[lane] >= 0:
+            live += 1
+    return nxt, live
+
+
+@nb.njit(cache=True, fastmath={"contract"})
+def _park_lanes(B, N, rngs, seen, srngs, scratch, step, total, sensing, job, job_slot, parking) -> None:
+    """Every episode in flight parked (the call's required jobs are over)."""
+    for lane in range(LANES):
+        if job[lane] >= 0:
+            park_lane(B, N, rngs, seen, srngs, scratch, step, total, sensing, lane, job_slot[job[lane]], parking)
+
+
 @nb.njit(cache=True, fastmath={"contract"})
 def fly_queue(jobs, out, stats, n_required, job_slot, parking, left, queue):
     """Fly the :class:`~neurohover.sim.jobs.Jobs` ``jobs``, LANES at a time; write each job's return,
@@ -347,26 +377,18 @@ def fly_queue(jobs, out, stats, n_required, job_slot, parking, left, queue):
     the call returns (an optional job not over keeps ``out_steps`` 0).
     """
     mdp_rows, job_mdp, n_steps = jobs.rows, jobs.mdp, jobs.n_steps
-    out_return, out_crashed, out_steps = out.returns, out.crashed, out.steps
     n_jobs = jobs.episode.shape[0]
     if n_jobs == 0:
         return
     n_sub = int(mdp_rows[job_mdp[0], ROW_SUBSTEPS])
     has_wind = int(mdp_rows[job_mdp[0], ROW_WIND_KIND]) != 0
     B, B0, P, N, A, W, rngs, seen, srngs, scratch, sensing, job, step, total = _lane_buffers(n_sub)
-    nxt = -1  # the last job index this thread took
-    live = 0
-    for lane in range(LANES):
-        nxt = _refill(B, P, N, A, rngs, seen, srngs, scratch, sensing, job, step, total, lane, nxt, queue, jobs, job_slot, parking)
-        if job[lane] >= 0:
-            live += 1
+    nxt, live = _fill_lanes(B, P, N, A, rngs, seen, srngs, scratch, sensing, job, step, total, queue, jobs, job_slot, parking)
     parks = parking.steps.shape[0] > 0
     while live > 0:
         # (a thread whose last job was required below the last one holds required jobs only: it flies on)
         if parks and nxt >= n_required - 1 and _required_over(left):
-            for lane in range(LANES):
-                if job[lane] >= 0:
-                    park_lane(B, N, rngs, seen, srngs, scratch, step, total, sensing, lane, job_slot[job[lane]], parking)
+            _park_lanes(B, N, rngs, seen, srngs, scratch, step, total, sensing, job, job_slot, parking)
             break
         # Control-step part, scalar per lane: policy, clipping, gust noise, drive terms, wind.
         for lane in range(LANES):
@@ -383,12 +405,7 @@ def fly_queue(jobs, out, stats, n_required, job_slot, parking, left, queue):
             pol = jobs.policy[job[lane]]
             a1, a2, a3, a4 = policy_action(jobs.kinds[pol], jobs.genomes[pol], o0, o1, o2, o3, o4, o5, o9, o10, o11)
             if not (math.isfinite(a1) and math.isfinite(a2) and math.isfinite(a3) and math.isfinite(a4)):
-                j = job[lane]
-                out_return[j] = total[lane] + crash_charge(n_steps, k + 1)
-                out_crashed[j] = True
-                out_steps[j] = k + 1
-                if parks:
-                    _over(j, n_required, left, parking, job_slot)
+                _end_job(out, job[lane], total[lane] + crash_charge(n_steps, k + 1), True, k + 1, parks, n_required, left, parking, job_slot)
                 job[lane] = -2  # over; the lane idles through this step (at rest, dt 0) and is refilled after it
                 _reset_lane(B, N, A, lane)
                 continue
@@ -426,19 +443,14 @@ def fly_queue(jobs, out, stats, n_required, job_slot, parking, left, queue):
                 t = step[lane] + 1
                 step[lane] = t
                 if B[ROW_CRASH * LANES + lane] != 0.0:
-                    out_return[j] = total[lane] + crash_charge(n_steps, t)
-                    out_crashed[j] = True
+                    _end_job(out, j, total[lane] + crash_charge(n_steps, t), True, t, parks, n_required, left, parking, job_slot)
                 elif t == n_steps:
-                    out_return[j] = total[lane] + B[ROW_REWARD * LANES + lane]
-                    out_crashed[j] = False
+                    _end_job(out, j, total[lane] + B[ROW_REWARD * LANES + lane], False, t, parks, n_required, left, parking, job_slot)
                 else:
                     total[lane] += B[ROW_REWARD * LANES + lane]
                     if sensing[lane]:
                         _read(B, seen, srngs, scratch, lane, t, mdp_rows[job_mdp[j]])
                     continue
-                out_steps[j] = t
-                if parks:
-                    _over(j, n_required, left, parking, job_slot)
             nxt = _refill(B, P, N, A, rngs, seen, srngs, scratch, sensing, job, step, total, lane, nxt, queue, jobs, job_slot, parking)
             if job[lane] < 0:
                 live -= 1
