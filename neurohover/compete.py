@@ -301,6 +301,10 @@ def compete(
         sensor=sensor, drift=drift, wind_model=wind_model, lr_fit=lr_fit, agent_settings=agent_settings,
     )  # fmt: skip
     store_path = output_file(store, "store") if store is not None else None  # a bad store refused before out is made
+    if store_path is not None and store_path.is_file():
+        from .experiments import Store
+
+        Store(store_path, create=False).close()  # a file that is not a store, refused before out is made (third trial)
     out = output_dir(out, "out")  # made once every setting is checked (None was a TypeError, /dev/full a FileExistsError)
     store_path = store_path or out / STORE_FILE
     ordered = _run_into_store(config, store_path, out / "episodes.csv", jobs=jobs, device=device, progress=progress, on_result=on_result)

@@ -27,6 +27,7 @@ from .launch import DEVICES, KIND, MAX_SEED, Batch, Flown, check_device, launch,
 from .policies import GENOME_LENGTH, TOPOLOGIES, Policy, load_policy
 from .sim.constants import (
     EPISODE_STEPS,
+    MAX_EPISODE_STEPS,
     MDP_ROW_LEN,
     ROW_SENSOR,
     SAFEGUARD_ARM,
@@ -277,8 +278,8 @@ def evaluate_jobs(
     rows = mdp_rows(mdps)
     if not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= MAX_SEED:
         raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer in 0..2**63-1")
-    if not isinstance(n_steps, (int, np.integer)) or not 1 <= n_steps <= 10**7:
-        raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..10000000")
+    if not isinstance(n_steps, (int, np.integer)) or not 1 <= n_steps <= MAX_EPISODE_STEPS:
+        raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
     p_idx = _index_array(policy_index, None, len(table), "policy_index")
     n_jobs = p_idx.shape[0]
     m_idx = _index_array(mdp_index, n_jobs, rows.shape[0], "mdp_index")

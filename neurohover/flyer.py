@@ -8,7 +8,7 @@ import numpy as np
 from .errors import NeurohoverError
 from .launch import KIND, MAX_SEED, Batch, Flown, Parking, check_device, launch, launch_parked, rows_alike
 from .policies import GENOME_LENGTH, TOPOLOGIES
-from .sim.constants import SAFEGUARD_LIMITS
+from .sim.constants import MAX_EPISODE_STEPS, SAFEGUARD_LIMITS
 from .sim.kernel import GENOME_WIDTH
 
 __all__ = ["KernelFlyer"]
@@ -67,8 +67,8 @@ class KernelFlyer:
             raise NeurohoverError(f"unknown policy topology {topology!r}: allowed {', '.join(TOPOLOGIES)}")
         if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= MAX_SEED:
             raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer in 0..2**63-1")
-        if isinstance(n_steps, bool) or not isinstance(n_steps, (int, np.integer)) or not 1 <= n_steps <= 10**7:
-            raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..10000000")
+        if isinstance(n_steps, bool) or not isinstance(n_steps, (int, np.integer)) or not 1 <= n_steps <= MAX_EPISODE_STEPS:
+            raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
         self.kind = KIND[topology]
         self.dim = GENOME_LENGTH[topology]
         self.seed = np.uint64(seed)

@@ -38,8 +38,9 @@ from pathlib import Path
 import numpy as np
 
 from .errors import NeurohoverError
-from .evaluate import evaluate
+from .evaluate import MAX_EPISODES_PER_CALL, evaluate
 from .policies import Policy, load_policy, save_policy
+from .sim.constants import MAX_EPISODE_STEPS
 from .tasks import get_task_family
 
 SHIPPED = Path(__file__).parent / "data" / "policies"
@@ -186,6 +187,7 @@ def _write_ghh_set(
 def check_build(family, lineage: str | None, fghh_budget: int | None, optimizer: str, **sizes) -> tuple[str, int]:
     """:func:`build_policy_set`'s settings for ``family``, checked before any run (a bad FGHH budget was refused only
     after the first generic was written); the lineage and FGHH budget it runs with (None: the defaults, where they apply)."""
+    from .evolution.config import MAX_BUDGET
     from .evolution.optimisers import optimiser_names
     from .evolution.seeding import check_seed
 
@@ -194,11 +196,18 @@ def check_build(family, lineage: str | None, fghh_budget: int | None, optimizer:
         raise NeurohoverError(f"lineage applies to the GHH tasks' specialised policies; task {family.name!r} has none")
     if not fghh and fghh_budget is not None:
         raise NeurohoverError(f"fghh_budget (--fghh-budget) applies to task fghh (its generics over G), not to {family.name!r}: give budget")
+    n_train = 0 if fghh else len(family.training_mdps())
+    highest = {  # what one run or one call can hold (a larger size failed after the out directory was made: third trial)
+        "budget": MAX_BUDGET,
+        "fghh_budget": MAX_BUDGET,
+        "n_steps": MAX_EPISODE_STEPS,
+        "safety_episodes": MAX_EPISODES_PER_CALL // max(1, n_train * n_train),  # every specialised policy on every training MDP at once
+    }
     for name, value in {**sizes, "fghh_budget": FGHH_POLICY_BUDGET if fghh_budget is None else fghh_budget}.items():
         if name == "seed":
             check_seed(value)
-        elif isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-            raise NeurohoverError(f"{name}={value!r} is out of range: allowed a whole number >= 1")
+        elif isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 1 <= value <= highest[name]:
+            raise NeurohoverError(f"{name}={value!r} is out of range: allowed a whole number in 1..{highest[name]:,}")
     lineage = "chain" if lineage is None else lineage
     if lineage not in LINEAGES:
         raise NeurohoverError(f"lineage {lineage!r} is not known: allowed {', '.join(LINEAGES)}")

@@ -14,6 +14,7 @@ busy with a unit nobody will record, then idles as an orphan. The pools made her
 
 from __future__ import annotations
 
+import _thread
 import contextlib
 import multiprocessing
 import os
@@ -105,6 +106,40 @@ def _raise_terminated(signum, frame) -> None:
     raise Terminated(f"signal {signum}")
 
 
+#: How long a dropped Ctrl-C or SIGTERM waits before it is delivered again (time to leave the C callback).
+REDELIVER_SECONDS = 0.05
+
+
+@contextlib.contextmanager
+def interrupts_survive_callbacks() -> Iterator[None]:
+    """While inside, a Ctrl-C or SIGTERM whose exception was raised inside a C callback is delivered again.
+
+    Python can only print and drop an exception raised in a ctypes callback; numba's compilation runs one
+    (llvmlite's object-cache notify) for every function it compiles, so a signal landing there was lost and
+    the command ran on (third trial). The dropped interrupt is re-sent to the main thread from a helper
+    thread a moment later, until it lands in Python code.
+    """
+    previous = sys.unraisablehook
+
+    def hook(unraisable) -> None:
+        if not isinstance(unraisable.exc_value, KeyboardInterrupt):
+            previous(unraisable)
+            return
+        signum = signal.SIGTERM if isinstance(unraisable.exc_value, Terminated) else signal.SIGINT
+        threading.Thread(target=_deliver_again, args=(signum,), daemon=True).start()
+
+    sys.unraisablehook = hook
+    try:
+        yield
+    finally:
+        sys.unraisablehook = previous
+
+
+def _deliver_again(signum: int) -> None:
+    time.sleep(REDELIVER_SECONDS)
+    _thread.interrupt_main(signum)
+
+
 @contextlib.contextmanager
 def sigterm_as_interrupt() -> Iterator[None]:
     """While inside, SIGTERM raises :class:`Terminated` in the main thread.
@@ -116,6 +151,7 @@ def sigterm_as_interrupt() -> Iterator[None]:
         return
     signal.signal(signal.SIGTERM, _raise_terminated)
     try:
-        yield
+        with interrupts_survive_callbacks():
+            yield
     finally:
         signal.signal(signal.SIGTERM, signal.SIG_DFL)

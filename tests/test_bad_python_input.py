@@ -450,3 +450,25 @@ def test_a_population_that_would_never_finish_a_generation_is_refused(optimizer:
 
     with pytest.raises(NeurohoverError, match=message):
         evolve(nh.get_task_family("ghh08"), optimizer=optimizer, settings=settings, budget=4, n_steps=5)
+
+
+def test_the_third_trials_last_sizes_and_stores_are_refused_before_anything_is_made(tmp_path) -> None:
+    """issue 37, third trial's leftovers: an EC-MER budget of 10**15 ran on; a safety_episodes of 10**12 and a store that
+    is not a store were refused only after the output directory was made."""
+    from neurohover.compete import compete
+    from neurohover.evolution import evolve
+    from neurohover.models import learn_ec_mer
+    from neurohover.policysets import build_policy_set
+
+    flights = nh.evaluate(nh.baseline_policy(), nh.get_task_family("ghh08").zero(), episodes=1, record=True, n_steps=30).flight_data
+    with pytest.raises(NeurohoverError, match=r"budget=1000000000000000 is out of range: allowed an integer in 1..10,000,000,000 \(evaluations\)"):
+        learn_ec_mer(flights, nh.baseline_policy(), budget=10**15)
+    with pytest.raises(NeurohoverError, match=r"budget=100000000000 is out of range: allowed an integer in 1..10,000,000,000 \(episodes\)"):
+        evolve(nh.get_task_family("ghh08").zero(), topology="slp", budget=10**11, n_steps=10)
+    with pytest.raises(NeurohoverError, match=r"safety_episodes=1000000000000 is out of range: allowed a whole number in 1..1,000,000"):
+        build_policy_set("ghh08", tmp_path / "bp", safety_episodes=10**12)
+    notes = tmp_path / "notes.txt"
+    notes.write_text("not a store\n")
+    with pytest.raises(NeurohoverError, match="is not a neurohover results store"):
+        compete("ghh08", "baseline", out=tmp_path / "out", runs=1, episodes=1, store=notes)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"] and notes.read_text() == "not a store\n"

@@ -76,9 +76,18 @@ def test_bad_drift_settings_get_one_clear_message(make, message: str) -> None:
 def test_a_test_run_too_short_for_its_change_is_refused() -> None:
     """run_test flew a change due at episode 200..800 in 12 episodes as if fixed (bad-input trial); the last possible episode is allowed."""
     mdp = get_task_family("ghh08").mdp("test:3")
-    with pytest.raises(NeurohoverError, match=re.escape("drift change_at=[200, 800] can come after the last of a test run's 12 episodes")):
+    default = "drift change_at=[200, 800] (the default where no @LO-HI is given) can come after the last of a test run's 12 episodes"
+    with pytest.raises(NeurohoverError, match=re.escape(default)):
         _generic_run(mdp.with_drift(Drift.parse("D_w=0.8")))
     assert _generic_run(mdp.with_drift(Drift.parse("D_w=0.8@11")), episodes=12).returns.shape == (12,)
+
+
+def test_compete_names_a_drift_too_late_for_its_episodes_by_its_options(cli, tmp_path) -> None:
+    """issue 37, third trial: --drift D_w=0.8 with 2 episodes was refused naming an inline experiment's group, not the options,
+    and its example used another parameter than the one given."""
+    rc, _, err = cli("compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--drift", "D_v=1.1", "--out", str(tmp_path / "o"))
+    assert rc == 2 and "--drift 'D_v=1.1' with --episodes 2: drift change_at=[200, 800] (the default where no @LO-HI is given)" in err
+    assert "(e.g. D_v=1.1@1-1)" in err and not (tmp_path / "o").exists()
 
 
 def test_parse_reads_the_command_lines_form() -> None:

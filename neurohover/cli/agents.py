@@ -67,6 +67,8 @@ def cmd_compete(args: argparse.Namespace) -> int:
     check_sizes(args.runs, args.episodes)
     sensor = sensor_of(args)
     drift = None if args.drift is None else Drift.parse(args.drift)
+    if drift is not None:
+        drift.check_run(args.episodes, f"--drift {args.drift!r} with --episodes {args.episodes}")  # named by its options
     agent_settings = None
     if args.agent_setting:
         from ..compete import check_agent_settings

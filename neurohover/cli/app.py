@@ -103,7 +103,10 @@ def main(argv: Sequence[str] | None = None) -> int:
 
             if not kernel_compiled():  # tens of seconds without output otherwise
                 print("neurohover: compiling the simulation kernel (first use of this version on this machine; cached afterwards)", file=sys.stderr)
-        return args.func(args)
+        from ..procs import interrupts_survive_callbacks
+
+        with interrupts_survive_callbacks():  # a Ctrl-C landing in numba's compilation is not lost
+            return args.func(args)
     except NeurohoverError as err:
         print(f"neurohover {args.command}: error: {err}", file=sys.stderr)
         remove_created_dirs()  # a failed command leaves no empty output directory behind

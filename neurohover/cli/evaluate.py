@@ -16,6 +16,7 @@ from pathlib import Path
 from ..errors import NeurohoverError
 from ..integrations import SB3_ALGORITHMS
 from ..policies import Policy
+from ..sim.constants import MAX_EPISODE_STEPS
 from .options import add_sensor_options, add_sigma_option, add_task_option, task_family_of
 
 SOURCES = ("policy", "callable", "rl_zoo", "sb3", "cleanrl")
@@ -97,7 +98,7 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     n = available if args.n_mdps is None else args.n_mdps
     if not 1 <= n <= available:
         raise NeurohoverError(f"--n-mdps {n} is out of range: {args.task} has {available} {args.mdps} MDPs")
-    for option, value, low, high in (("--episodes", args.episodes, 1, 10**4), ("--episode-steps", args.episode_steps, 1, 10**7)):
+    for option, value, low, high in (("--episodes", args.episodes, 1, 10**4), ("--episode-steps", args.episode_steps, 1, MAX_EPISODE_STEPS)):
         if not low <= value <= high:
             raise NeurohoverError(f"{option} {value} is out of range: allowed an integer in {low}..{high}")
     out = None if args.json is None else output_file(args.json, "--json")

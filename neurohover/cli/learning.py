@@ -30,6 +30,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from ..evaluate import DEVICES, check_device, check_episode_count
+from ..evolution.config import MAX_BUDGET
 from ..evolution.generational import GENERATIONAL_PRESETS
 from ..evolution.optimisers import OPTIMISERS, optimiser_names
 
@@ -112,8 +113,8 @@ class _Bar:
 
 def _check_evolve_sizes(args: argparse.Namespace) -> None:
     """``evolve``'s sizes and device, refused before any file is touched."""
-    if args.budget is not None and args.budget < 1:
-        raise NeurohoverError(f"--budget {args.budget} is out of range: allowed an integer >= 1 (episodes)")
+    if args.budget is not None and not 1 <= args.budget <= MAX_BUDGET:
+        raise NeurohoverError(f"--budget {args.budget} is out of range: allowed an integer in 1..{MAX_BUDGET:,} (episodes)")
     if args.episode_steps < 1:
         raise NeurohoverError(f"--episode-steps {args.episode_steps} is out of range: allowed >= 1")
     if not args.checkpoint_every > 0:
@@ -303,8 +304,8 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     from ..policies import load_policy
     from .options import check_given, given_settings
 
-    if args.budget is not None and args.budget < 1:
-        raise NeurohoverError(f"--budget {args.budget} is out of range: allowed an integer >= 1 (evaluations)")
+    if args.budget is not None and not 1 <= args.budget <= MAX_BUDGET:
+        raise NeurohoverError(f"--budget {args.budget} is out of range: allowed an integer in 1..{MAX_BUDGET:,} (evaluations)")
     if args.seed is not None and args.method == "lr":
         raise NeurohoverError("--seed applies to the evolutionary methods (ec-meno, ec-mer), not to --method lr (least squares draws nothing)")
     seed = 0 if args.seed is None else args.seed

@@ -10,11 +10,11 @@ import gymnasium as gym
 import numpy as np
 
 from ..errors import NeurohoverError
+from ..sim.constants import MAX_EPISODE_STEPS
 from ..tasks import MDP, TaskFamily, get_task_family
 from ..tasks.sensor import Sensor
 
 OBS_DTYPES = ("float64", "float32")
-MAX_EPISODE_STEPS = 10**7
 MAX_NOISE_SEED = 2**63 - 1  # the largest seed ``neurohover.evaluate_jobs`` accepts
 SAMPLE = "sample"
 MDP_OPTIONS = ("zero", "sample", "train:N", "test:N")

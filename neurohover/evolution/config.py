@@ -18,6 +18,7 @@ import numpy as np
 from ..errors import NeurohoverError
 from ..policies import TOPOLOGIES, Policy
 from ..policies import prototype as make_prototype
+from ..sim.constants import MAX_EPISODE_STEPS
 from ..tasks import MDP, TaskFamily, refuse_drift
 from .bandits import BANDITS
 from .generational import GENERATIONAL_PRESETS, OLD_GENERATIONAL, GenerationalSettings
@@ -30,9 +31,11 @@ from .steady_state import SteadyStateSettings
 __all__ = [
     "CMA_DEFAULTS",
     "EVOLUTION_METHODS",
+    "MAX_BUDGET",
     "RACE_T_LIMIT",
     "Resampling",
     "RunConfig",
+    "check_budget",
     "make_settings",
     "optimiser_of",
     "parse_resampling",
@@ -48,6 +51,17 @@ RACE_T_LIMIT = 10  # docs/model.md, Fitness under noise: t_limit = t_min = t_max
 EVOLUTION_METHODS = ("steady-state", "generational", *OPTIMISERS)
 #: Steady-state settings that checkpoints written before they existed ran with.
 _OLD_STEADY_STATE = {"plateau_rule": "literal", "selection": "roulette", "tournament_size": 5, "init_mutate_frac": None, "init_mutate_std": None}
+
+#: Cap on a run's budget (episodes, or a model's evaluations): far above any run of the paper's (10**10 episodes
+#: are 77 days at 1,500 episodes/s), below what a run's counters and history can hold.
+MAX_BUDGET = 10**10
+
+
+def check_budget(budget, unit: str = "episodes", alternative: str = "") -> int:
+    """``budget`` as an int; NeurohoverError unless an integer in 1..MAX_BUDGET (``alternative``: what else the caller allows)."""
+    if isinstance(budget, bool) or not isinstance(budget, (int, np.integer)) or not 1 <= budget <= MAX_BUDGET:
+        raise NeurohoverError(f"budget={budget!r} is out of range: allowed an integer in 1..{MAX_BUDGET:,} ({unit}){alternative}")
+    return int(budget)
 
 
 @dataclass(frozen=True)
@@ -280,11 +294,11 @@ class RunConfig:
         resampling = parse_resampling(resampling)
         if budget is None and isinstance(settings, (SteadyStateSettings, GenerationalSettings)):
             budget = settings.budget
-        if budget is not None and (isinstance(budget, bool) or not isinstance(budget, (int, np.integer)) or budget < 1):
-            raise NeurohoverError(f"budget={budget!r} is out of range: allowed an integer >= 1 (episodes)")
+        if budget is not None:
+            budget = check_budget(budget)
         seed = check_seed(seed)
-        if isinstance(n_steps, bool) or not isinstance(n_steps, (int, np.integer)) or not 1 <= n_steps <= 10**7:
-            raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..10000000")
+        if isinstance(n_steps, bool) or not isinstance(n_steps, (int, np.integer)) or not 1 <= n_steps <= MAX_EPISODE_STEPS:
+            raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
         chosen = ("steady-state" if mdp is not None else "generational") if method is None else method
         if chosen not in ("steady-state", "generational"):
             raise NeurohoverError(f"unknown method {method!r}: allowed steady-state, generational")

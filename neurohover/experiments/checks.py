@@ -19,6 +19,7 @@ from ..errors import NeurohoverError
 from ..evolution.evolve import parse_resampling
 from ..evolution.races import RACE_RULES
 from ..models.model import MODEL_SUBSTEPS
+from ..sim.constants import MAX_EPISODE_STEPS
 from ..tasks import Drift, Sensor
 
 REQUIRED = object()
@@ -67,7 +68,7 @@ def integer(minimum: int, maximum: int | None = None):
 
 
 #: Caps on an experiment's sizes, far above any run of the paper's, below what planning and memory can hold.
-MAX_RUNS, MAX_EPISODES, MAX_BUDGET, MAX_STEPS = 10_000, 1_000_000, 10**10, 10**7
+MAX_RUNS, MAX_EPISODES, MAX_STEPS = 10_000, 1_000_000, MAX_EPISODE_STEPS
 
 
 def number(lo: float, hi: float):

@@ -16,13 +16,13 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 from ..agents.model_based import MODEL_POLICIES
+from ..evolution.config import MAX_BUDGET
 from ..integrations.neat import NEAT_TOPOLOGY
 from ..models.lr import D_U_CHOICES, DEFAULT_NOISE_ESTIMATE, NOISE_ESTIMATES
 from ..models.model import LEGACY_MODEL_SUBSTEPS
 from ..policysets import FGHH_GENERIC_RESAMPLING
 from ..tasks import TASK_NAMES
 from .checks import (
-    MAX_BUDGET,
     MAX_EPISODES,
     MAX_RUNS,
     MAX_STEPS,

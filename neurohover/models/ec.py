@@ -34,9 +34,10 @@ def _ec_settings(settings, budget: int | None):
     ``budget`` as the evaluation cap; ``budget=None`` keeps the settings' own cap (the defaults
     have none: the paper's plateau stop alone)."""
     from ..evolution import SteadyStateSettings
+    from ..evolution.config import check_budget
 
-    if budget is not None and (not isinstance(budget, (int, np.integer)) or isinstance(budget, bool) or budget < 1):
-        raise NeurohoverError(f"budget={budget!r} is out of range: allowed an integer >= 1 (evaluations), or None (the plateau stop)")
+    if budget is not None:
+        budget = check_budget(budget, "evaluations", ", or None (the plateau stop)")
     if settings is None:
         settings = SteadyStateSettings()
     elif not isinstance(settings, SteadyStateSettings):

@@ -34,6 +34,7 @@ CONTROL_DT = 0.1
 SUBSTEPS = 10
 SUBSTEP_DT = 0.01
 EPISODE_STEPS = 6000
+MAX_EPISODE_STEPS = 10**7  # the most control steps of one episode anything accepts (far beyond the paper's 6000)
 NOISE_DECAY = 0.8  # AR(1) gust noise: n <- 0.8 n + 0.2 * N(0,1) * std * 2
 NOISE_GAIN = 0.2 * 2.0
 

@@ -87,9 +87,12 @@ class Drift:
         """Refuse an abrupt change that some test runs of ``episodes`` episodes would never reach (``where``: a prefix naming the run)."""
         if self.change and self.change_at[1] >= episodes:
             lo, hi = self.change_at
+            default = " (the default where no @LO-HI is given)" if (lo, hi) == CHANGE_AT else ""
+            factors = ",".join(f"{name}={factor:g}" for name, factor in self.change)
             raise NeurohoverError(
-                f"{where + ': ' if where else ''}drift change_at={[lo, hi]} can come after the last of a test run's {episodes} episodes, so some "
-                f"runs would never change: give change_at within 0..{episodes - 1} (e.g. D_w=0.8@{min(lo, episodes - 1)}-{episodes - 1}) or more episodes"
+                f"{where + ': ' if where else ''}drift change_at={[lo, hi]}{default} can come after the last of a test run's {episodes} episodes, "
+                f"so some runs would never change: give change_at within 0..{episodes - 1} "
+                f"(e.g. {factors}@{min(lo, episodes - 1)}-{episodes - 1}) or more episodes"
             )
 
     @property
