@@ -135,7 +135,7 @@ def interrupts_survive_callbacks() -> Iterator[None]:
         sys.unraisablehook = previous
 
 
-def _deliver_again(signum: int) -> None:
+def _deliver_again(signum: signal.Signals) -> None:
     time.sleep(REDELIVER_SECONDS)
     _thread.interrupt_main(signum)
 
