@@ -650,6 +650,17 @@ def test_a_verdict_weighs_direction_before_significance() -> None:
     assert verdict("slp-zero", -2.0, -1.0, 0.001, "not significant") == "differs: significant here (slp-zero worse), not in the paper"
 
 
+def test_paired_runs_mostly_equal_are_described_by_the_pairs_that_differ() -> None:
+    """risk-ghh09's hybrid-worst: 0 of 60 runs better, median difference 0, Wilcoxon p = 1e-5 was "as good in the median
+    pair ... significant", a sentence that says nothing of which way the significant difference goes."""
+    from neurohover.experiments.report_base import paired_verdict
+
+    assert paired_verdict(np.r_[np.zeros(58), -3.0, -5.0]) == "equal in 58 of 60 pairs and worse where they differ (0 better, 2 worse"
+    assert paired_verdict(np.r_[np.zeros(3), 2.0, -1.0]) == "equal in 3 of 5 pairs and neither better nor worse where they differ (1 better, 1 worse"
+    assert paired_verdict(np.array([1.0, 2.0, -1.0])) == "better in the median pair (2 of 3 runs better, median paired difference 1"
+    assert paired_verdict(np.array([-1.0, -2.0, 1.0])).startswith("worse in the median pair (1 of 3 runs better")
+
+
 def test_an_interrupt_ends_the_running_worker_processes_at_once() -> None:
     import multiprocessing
 

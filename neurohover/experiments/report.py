@@ -24,7 +24,7 @@ import numpy as np
 from ..errors import NeurohoverError
 from .config import ORDER, ExperimentConfig, shipped_counterpart, with_shipped_paper
 from .keys import UnitKey
-from .report_base import Section, agent_panel, fmt, log_errors, new_figure, paired_p, ratio_verdict, sd, table
+from .report_base import Section, agent_panel, fmt, log_errors, new_figure, paired_p, paired_verdict, ratio_verdict, sd, table
 from .report_claims import PAPER_FIGURES, claims_section, conclusions_discussion
 from .report_evolution import EvolutionSection
 from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, test_run_figure, varies
@@ -367,10 +367,8 @@ class _TestRuns(Section):
                     f"(mean cumulative reward {fmt(a)})."
                 )
                 continue
-            word = "better" if median > 0 else "worse" if median < 0 else "as good"  # by the pairs, as the test: a mean can say otherwise
             self.comparisons.append(
-                f"{g.label} vs {of['experiment']}'s {of['group']} on the same seeds: {word} in the median pair ({int((diff > 0).sum())} of "
-                f"{len(common)} runs better, median paired difference {fmt(median)}, Wilcoxon p = {fmt(p)}"
+                f"{g.label} vs {of['experiment']}'s {of['group']} on the same seeds: {paired_verdict(diff)}, Wilcoxon p = {fmt(p)}"
                 + (", significant at 5%" if p < 0.05 else ", not significant")
                 + f"; mean cumulative reward {fmt(a)} vs {fmt(b)})."
             )

@@ -68,6 +68,18 @@ def paired_p(diff) -> float:
     return float(stats.wilcoxon(d).pvalue) if np.any(d != 0) else 1.0
 
 
+def paired_verdict(diff) -> str:
+    """How paired differences (ours minus theirs) go, for a sentence the Wilcoxon p follows: by the median pair, or,
+    where most pairs are equal (median 0; the test drops them), by the pairs that differ. Leaves a parenthesis open."""
+    d = np.asarray(diff, dtype=float)
+    better, worse, median = int((d > 0).sum()), int((d < 0).sum()), float(np.median(d))
+    if median != 0:
+        word = "better" if median > 0 else "worse"
+        return f"{word} in the median pair ({better} of {d.size} runs better, median paired difference {fmt(median)}"
+    word = "better" if better > worse else "worse" if worse > better else "neither better nor worse"
+    return f"equal in {d.size - better - worse} of {d.size} pairs and {word} where they differ ({better} better, {worse} worse"
+
+
 def sd(x) -> float:
     x = np.asarray(x, dtype=float)
     return float(x.std(ddof=1)) if x.size > 1 else float("nan")
