@@ -20,15 +20,25 @@ def _as_command() -> bool:
 
 
 def _interrupted(kind, value, tb) -> None:
-    if issubclass(kind, KeyboardInterrupt):  # Ctrl-C while NumPy and numba import, before main() can catch it (third trial)
-        print("neurohover: interrupted", file=sys.stderr, flush=True)
-        os._exit(130)  # as main() ends an interruption (Python would end by SIGINT: -2)
+    if issubclass(kind, KeyboardInterrupt):  # Ctrl-C or SIGTERM while NumPy and numba import, before main() can catch it
+        terminated = kind.__name__ == "Terminated"
+        print(f"neurohover: {'terminated' if terminated else 'interrupted'}", file=sys.stderr, flush=True)
+        os._exit(143 if terminated else 130)  # as main() ends them (Python would end by the signal itself)
     else:
         sys.__excepthook__(kind, value, tb)
 
 
+def _terminate(signum, frame) -> None:
+    from .errors import Terminated
+
+    raise Terminated(f"signal {signum}")
+
+
 if _as_command():
+    import signal
+
     sys.excepthook = _interrupted
+    signal.signal(signal.SIGTERM, _terminate)  # from the first import on, SIGTERM ends the command as Ctrl-C does (fourth trial)
 
 from .errors import NeurohoverError  # noqa: E402
 from .evaluate import DangerousState, Evaluation, PolicyTable, Safeguard, evaluate, evaluate_jobs  # noqa: E402

@@ -37,6 +37,7 @@ import numpy as np
 from .agents.hybrid import HybridSettings
 from .errors import NeurohoverError
 from .evolution.seeding import check_seed
+from .paths import write_png
 from .sim.constants import EPISODE_STEPS
 from .tasks import N_TEST, N_TRAINING, Drift, Sensor, get_task_family
 
@@ -103,8 +104,7 @@ def plot_cumulative(curves: dict[str, np.ndarray], path: Path, title: str) -> Pa
     fig.suptitle(title)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    return path
+    return write_png(fig, path, "plot file", dpi=110)
 
 
 #: The largest competition (planned in memory, each episode's results stored): runs, and episodes over all runs.

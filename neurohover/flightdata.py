@@ -64,7 +64,7 @@ class FlightData:
 
         path = output_file(path, "flight-data file")  # refuses '', a directory and a device (/dev/null was a struct.error)
         lengths = np.array([a.shape[0] for a in self.actions], dtype=np.int64)
-        with writing(path, "flight-data file"), open(path, "wb") as f:  # a file object keeps numpy from appending ".npz"
+        with writing(path, "flight-data file") as partial, open(partial, "wb") as f:  # a file object keeps numpy from appending ".npz"
             np.savez_compressed(
                 f,
                 format=np.array(FORMAT),

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from .errors import NeurohoverError
 
-__all__ = ["checked_path", "parse_json", "input_file", "input_dir", "output_dir", "output_file", "remove_created_dirs", "writing"]
+__all__ = ["checked_path", "parse_json", "input_file", "input_dir", "output_dir", "output_file", "remove_created_dirs", "write_png", "writing"]
 
 _created: list[Path] = []  # directories this process's checks created, deepest first
 
@@ -51,16 +51,30 @@ def _make_dirs(directory: Path, option: str, given: str) -> None:
     print(f"neurohover: created directory {str(missing[-1])!r}" + (f" and {len(missing) - 1} below it" if len(missing) > 1 else ""), file=sys.stderr)
 
 
+#: The longest name of one file or directory, and of a whole path, in bytes (Linux's NAME_MAX and PATH_MAX).
+NAME_MAX, PATH_MAX = 255, 4096
+
+
 def checked_path(path, option: str, what: str = "file path") -> Path:
-    """``path`` (a str or path object) as a Path: empty, another type or a NUL byte refused by name (the OS's TypeError
-    and ValueError before); ``what`` says what to give instead."""
+    """``path`` (a str or path object) as a Path: empty, another type, a NUL byte or a name longer than the file system
+    takes refused by name (the OS's TypeError, ValueError and OSError before); ``what`` says what to give instead."""
     if not isinstance(path, (str, os.PathLike)):
         raise NeurohoverError(f"{option}={path!r:.60} is not allowed: give a {what}")
-    if str(path) == "":
+    text = os.fspath(path)
+    if not isinstance(text, str):
+        raise NeurohoverError(f"{option}={path!r:.60} is not allowed: give a {what} as text")
+    if text == "":
         raise NeurohoverError(f"{option} is empty; give a {what}")
-    if "\x00" in str(path):
-        raise NeurohoverError(f"{option} {str(path)!r:.80} holds a NUL character: give a {what}")
-    return Path(path)
+    if "\x00" in text:
+        raise NeurohoverError(f"{option} {text!r:.80} holds a NUL character: give a {what}")
+    longest = max(Path(text).parts, key=lambda part: len(os.fsencode(part)))
+    if len(os.fsencode(longest)) > NAME_MAX or len(os.fsencode(text)) > PATH_MAX:
+        shown = repr(text) if len(text) <= 80 else repr(text[:40]) + " ... " + repr(text[-20:])
+        raise NeurohoverError(
+            f"{option} {shown} is too long: at most {NAME_MAX} bytes in one file or directory name "
+            f"(here {len(os.fsencode(longest)):,}) and {PATH_MAX} in the whole path (here {len(os.fsencode(text)):,})"
+        )
+    return Path(text)
 
 
 def _unique_keys(pairs: list) -> dict:
@@ -121,17 +135,27 @@ def output_file(path: str | os.PathLike, option: str, inputs: dict[str, str | os
 
 @contextmanager
 def writing(path: str | os.PathLike, option: str) -> Iterator[Path]:
-    """Write the output file ``path`` inside this block: a failed write (disk full, read-only, permission) becomes
-    one NeurohoverError naming ``option`` and the file, and the partial file is removed (a file that was there
-    before too, once the write has touched it: its old content is gone) so that no later run takes it for a result."""
+    """Write the output file ``path`` inside this block, through the path it yields (a temporary file beside it, moved
+    onto ``path`` once the block ends): a failed write (disk full, read-only, permission) becomes one NeurohoverError
+    naming ``option`` and the file, and an interrupted one (Ctrl-C, SIGTERM) stops as it was; either way the temporary
+    file is removed and ``path`` is as it was before, so that no later run takes a partial file for a result."""
     p = Path(path)
-    before = p.stat().st_mtime_ns if p.is_file() else None
+    partial = p.with_name(f".{p.name}.{os.getpid()}.partial")
     try:
-        yield p
+        yield partial
+        os.replace(partial, p)
     except OSError as err:
-        if p.is_file() and (before is None or p.stat().st_mtime_ns != before):
-            p.unlink(missing_ok=True)
         raise NeurohoverError(f"{option} {str(path)!r}: cannot write it ({_why(err)}); no partial file is left") from None
+    finally:
+        partial.unlink(missing_ok=True)
+
+
+def write_png(fig, path: str | os.PathLike, what: str, dpi: float | None = None) -> Path:
+    """Write the matplotlib figure ``fig`` as a PNG to ``path`` through :func:`writing` (whole or not at all: a full
+    disk left an empty PNG and a traceback)."""
+    with writing(path, what) as partial:
+        fig.savefig(partial, format="png", dpi=dpi)
+    return Path(path)
 
 
 def output_dir(path: str | os.PathLike, option: str) -> Path:

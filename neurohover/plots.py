@@ -64,9 +64,9 @@ def new_figure(width: float, height: float, dpi: int = 100) -> Figure:
 
 def save_figure(fig: Figure, path: str | Path) -> Path:
     """Write ``fig`` as a PNG to ``path`` (parent directories must exist)."""
-    path = Path(path)
-    fig.savefig(path, format="png")
-    return path
+    from .paths import write_png
+
+    return write_png(fig, path, "plot file")
 
 
 # -- flight data ------------------------------------------------------------------------------

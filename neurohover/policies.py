@@ -278,6 +278,6 @@ def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
     except (TypeError, ValueError) as err:  # an object, or a NaN that other JSON readers refuse
         raise NeurohoverError(f"policy metadata must be strict JSON values (numbers finite): {err}") from None
     path = output_file(path, "policy file")  # refuses '', a directory and a device; makes missing parents
-    with writing(path, "policy file"):
-        path.write_text(text)
+    with writing(path, "policy file") as partial:
+        partial.write_text(text)
     return path

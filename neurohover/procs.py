@@ -25,13 +25,14 @@ import time
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
 
+from .errors import Terminated
+
 WATCH_SECONDS = 0.5  # how often a worker checks that its parent is alive
 
 _PR_SET_PDEATHSIG = 1  # from <linux/prctl.h>
 
 
-class Terminated(KeyboardInterrupt):
-    """SIGTERM arrived while a worker pool was running (handled like Ctrl-C)."""
+__all__ = ["Terminated", "interrupts_survive_callbacks", "sigterm_as_interrupt", "stop_pool", "stop_words", "watch_parent", "worker_pool"]
 
 
 def _die_with_parent() -> bool:
@@ -100,6 +101,17 @@ def stop_pool(pool: ProcessPoolExecutor) -> None:
         process.join(timeout=max(0.0, deadline - time.monotonic()))
         while process.is_alive() and time.monotonic() < deadline:
             time.sleep(0.01)
+
+
+def stop_words(stop: BaseException) -> tuple[str, int]:
+    """How a command says it was stopped by ``stop`` (a KeyboardInterrupt, or one raised while handling it) and its
+    exit status: ("terminated", 143) for SIGTERM, ("interrupted", 130) for Ctrl-C (128 + the signal, as shells report)."""
+    cause: BaseException | None = stop
+    while cause is not None:
+        if isinstance(cause, Terminated):
+            return "terminated", 143
+        cause = cause.__cause__ or cause.__context__
+    return "interrupted", 130
 
 
 def _raise_terminated(signum, frame) -> None:

@@ -236,10 +236,13 @@ def test_a_repeated_sensor_key_and_a_damaged_store_are_one_clear_line(tmp_path: 
     data = good.read_bytes()
     damaged = tmp_path / "d.sqlite"
     damaged.write_bytes(data[: len(data) // 2] + b"\x00garbage" * 512 + data[len(data) // 2 + 4096 :])
-    rc = main(["report", "--store", str(damaged), "--out", str(tmp_path / "r")])
-    err = capsys.readouterr().err
-    assert rc == 2 and "a results store cannot be read" in err and "Traceback" not in err
-    assert not (tmp_path / "r").exists()  # the output directory it made is gone again
+    rc = main(["report", "--store", str(damaged), "--out", str(tmp_path / "r")])  # the damaged experiment reported in its place
+    report = (tmp_path / "r" / "report.md").read_text()
+    assert rc == 0 and "**Not reported: the store's copy is damaged.**" in report and f"results store {str(damaged)!r} is damaged" in report
+    for argv in (["results", "fig2"], ["wins", "fig2"]):
+        rc = main([*argv, "--store", str(damaged)])
+        err = capsys.readouterr().err
+        assert rc == 2 and "Traceback" not in err and "cannot be read" in err and str(damaged) in err and len(err) < 400, err
 
 
 def test_a_damaged_row_is_named_and_the_rest_of_the_store_reported(tmp_path: Path, capsys) -> None:
@@ -262,3 +265,13 @@ def test_a_damaged_row_is_named_and_the_rest_of_the_store_reported(tmp_path: Pat
     with Store(path, create=False) as store:
         report = write_report(store, tmp_path / "rep").read_text()
     assert "Not reported: the store's copy is damaged." in report and "## Ablation" in report
+
+
+def test_evaluate_agent_refuses_to_write_its_rows_onto_the_policy_it_flies(tmp_path: Path, capsys) -> None:
+    """issue 37, fourth trial: evaluate-agent --json onto its own --policy file overwrote the policy with the rows."""
+    from neurohover.policies import baseline_policy, save_policy
+
+    policy = save_policy(baseline_policy(), tmp_path / "p.json")
+    before = policy.read_bytes()
+    rc = main(["evaluate-agent", "--task", "ghh08", "--policy", str(policy), "--n-mdps", "1", "--episode-steps", "20", "--json", str(policy)])
+    assert rc == 2 and "is the file of --policy" in capsys.readouterr().err and policy.read_bytes() == before

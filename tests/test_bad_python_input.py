@@ -472,3 +472,13 @@ def test_the_third_trials_last_sizes_and_stores_are_refused_before_anything_is_m
     with pytest.raises(NeurohoverError, match="is not a neurohover results store"):
         compete("ghh08", "baseline", out=tmp_path / "out", runs=1, episodes=1, store=notes)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"] and notes.read_text() == "not a store\n"
+
+
+def test_a_store_read_with_a_name_that_is_not_text_is_refused(tmp_path) -> None:
+    """issue 37, fourth trial: Store.results(None, None) returned {} as if the experiment held nothing."""
+    from neurohover.experiments import Store
+
+    with Store(tmp_path / "s.sqlite") as store:
+        for call in (lambda: store.results(None, None), lambda: store.units("fig7", 3), lambda: store.config(["fig7"], "paper")):
+            with pytest.raises(NeurohoverError, match="is not allowed as an experiment name or scale: give text"):
+                call()

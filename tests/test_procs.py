@@ -136,9 +136,9 @@ def test_the_workers_of_a_killed_reproduce_exit(tmp_path: Path, sig: int) -> Non
         os.kill(proc.pid, sig)
         rc = proc.wait(timeout=30)
         assert not _gone_within(children, 10), "worker processes outlived their parent"
-        if sig == signal.SIGTERM:  # handled like Ctrl-C: the run is marked interrupted
-            assert rc == 130, (tmp_path / "stderr.txt").read_text()[-2000:]
-            assert "interrupted" in (tmp_path / "stderr.txt").read_text()
+        if sig == signal.SIGTERM:  # handled like Ctrl-C: the run is marked interrupted; the command says terminated, 143
+            assert rc == 143, (tmp_path / "stderr.txt").read_text()[-2000:]
+            assert "reproduce: terminated" in (tmp_path / "stderr.txt").read_text()
             with Store(store) as s:
                 assert [x["status"] for x in s.sessions("longtest", "quick")] == ["interrupted"]
         else:
@@ -157,7 +157,7 @@ def test_the_workers_of_a_killed_compete_exit(tmp_path: Path, sig: int) -> None:
         os.kill(proc.pid, sig)
         rc = proc.wait(timeout=30)
         assert not _gone_within(children, 10), "worker processes outlived their parent"
-        assert rc == (130 if sig == signal.SIGTERM else -signal.SIGKILL), (tmp_path / "stderr.txt").read_text()[-2000:]
+        assert rc == (143 if sig == signal.SIGTERM else -signal.SIGKILL), (tmp_path / "stderr.txt").read_text()[-2000:]
     finally:
         _end_group(proc)
 
@@ -171,6 +171,30 @@ def test_ctrl_c_at_any_moment_ends_with_one_line_and_130(delay: float) -> None:
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130 and "Traceback" not in err and err.strip().splitlines()[-1].endswith("interrupted"), err[-1500:]
+
+
+@pytest.mark.parametrize("delay", [1.0, 2.5, 6.0])  # from the package import on (before it, Python itself starts), then while it flies
+def test_sigterm_at_any_moment_ends_any_command_with_one_line_and_143(delay: float) -> None:
+    """issue 37, fourth trial: SIGTERM (a timeout, kill) ended fly, evolve, compete and reproduce without a line."""
+    proc = subprocess.Popen([sys.executable, "-m", "neurohover", "fly", "--task", "ghh08", "--episodes", "100000"], stderr=subprocess.PIPE, text=True, env=ENV)
+    time.sleep(delay)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 143 and "Traceback" not in err and err.strip().splitlines()[-1].endswith("terminated"), err[-1500:]
+
+
+def test_a_stop_is_named_by_its_signal_also_when_raised_while_handling_it() -> None:
+    from neurohover.evolution import EvolutionInterrupted
+    from neurohover.procs import stop_words
+
+    assert stop_words(KeyboardInterrupt()) == ("interrupted", 130) and stop_words(Terminated("signal 15")) == ("terminated", 143)
+    try:
+        try:
+            raise Terminated("signal 15")
+        except KeyboardInterrupt:
+            raise EvolutionInterrupted(None, 3) from None  # as the evolution turns a stop into its own, with a checkpoint
+    except EvolutionInterrupted as err:
+        assert stop_words(err) == ("terminated", 143)  # build-policies said "interrupted", 130 for a SIGTERM (fourth trial)
 
 
 def test_a_terminated_build_leaves_no_half_built_set(tmp_path: Path) -> None:
@@ -189,7 +213,7 @@ def test_a_terminated_build_leaves_no_half_built_set(tmp_path: Path) -> None:
             time.sleep(0.1)
         assert building.is_dir(), (tmp_path / "stderr.txt").read_text()[-2000:]
         os.kill(proc.pid, signal.SIGTERM)
-        assert proc.wait(timeout=60) in (130, 143)  # terminated (143), or interrupted mid-evolution (130)
+        assert proc.wait(timeout=60) == 143  # terminated, also when the stop lands mid-evolution (it said interrupted, 130)
         assert not building.exists() and not (out / "ghh08").exists()
     finally:
         _end_group(proc)

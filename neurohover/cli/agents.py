@@ -104,12 +104,15 @@ def cmd_compete(args: argparse.Namespace) -> int:
             lr_fit=model,  # d_u, noise, model_policy, model_substeps where given (ModelEvolution checks them)
             agent_settings=agent_settings,
         )
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as stop:
+        from ..procs import stop_words
+
+        how, status = stop_words(stop)
         print(
-            f"neurohover compete: interrupted; the finished runs are in {args.out}/episodes.csv and the results store; run the same command again to resume",
+            f"neurohover compete: {how}; the finished runs are in {args.out}/episodes.csv and the results store; run the same command again to resume",
             file=sys.stderr,
         )
-        return 130
+        return status
     print(f"{'agent':<18} {'runs':>5} {'mean cum. return':>17} {'sd':>12} {'crash rate':>11} {'return/ep after learning':>25}")
     print(
         f"{summary['agent']:<18} {summary['runs']:>5} {summary['mean_cumulative_return']:>17.5g} {summary['sd_cumulative_return']:>12.4g} "

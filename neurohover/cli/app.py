@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sqlite3
 import sys
 import unicodedata
@@ -77,6 +78,17 @@ def _other_scripts_digits(argv: Sequence[str]) -> str | None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """The command line: ``neurohover ARGS`` (``argv``: the arguments, default ``sys.argv[1:]``); the exit status."""
+    status = _run(argv)
+    if argv is None:  # the process's own command line (not a call from Python, whose signals stay as they are)
+        # The command is over and has said so: a Ctrl-C or SIGTERM now would kill the interpreter while it exits, with
+        # no line and a status saying that the finished command was stopped (fourth trial).
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    return status
+
+
+def _run(argv: Sequence[str] | None) -> int:
     parser = build_parser()  # a Ctrl-C while it imports the command modules: the package's hook (neurohover/__init__.py)
     given = list(sys.argv[1:] if argv is None else argv)
     action = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
@@ -103,27 +115,41 @@ def main(argv: Sequence[str] | None = None) -> int:
 
             if not kernel_compiled():  # tens of seconds without output otherwise
                 print("neurohover: compiling the simulation kernel (first use of this version on this machine; cached afterwards)", file=sys.stderr)
-        from ..procs import interrupts_survive_callbacks
+        from ..procs import interrupts_survive_callbacks, sigterm_as_interrupt
 
-        with interrupts_survive_callbacks():  # a Ctrl-C landing in numba's compilation is not lost
+        # SIGTERM (a timeout, kill) ends every command as Ctrl-C does: one line, its cleanup run, no partial file (a
+        # bare SIGTERM killed fly, evolve, compete and reproduce without a word; fourth trial); a Ctrl-C landing in
+        # numba's compilation is not lost.
+        with sigterm_as_interrupt(), interrupts_survive_callbacks():
             return args.func(args)
     except NeurohoverError as err:
         print(f"neurohover {args.command}: error: {err}", file=sys.stderr)
         remove_created_dirs()  # a failed command leaves no empty output directory behind
         return 2
     except sqlite3.DatabaseError as err:  # a store file damaged mid-file, or not a store at all
-        print(f"neurohover {args.command}: error: a results store cannot be read ({err}): the file is damaged or is no results store", file=sys.stderr)
+        which = f" {str(args.store)!r}" if getattr(args, "store", None) else ""
+        print(
+            f"neurohover {args.command}: error: the results store{which} cannot be read ({str(err)[:60]}): it is damaged or is no results store",
+            file=sys.stderr,
+        )
         remove_created_dirs()
         return 2
     except KeyboardInterrupt as stop:
-        from ..procs import Terminated
+        from ..procs import stop_words
 
-        print(f"neurohover {args.command}: {'terminated' if isinstance(stop, Terminated) else 'interrupted'}", file=sys.stderr)
-        return 143 if isinstance(stop, Terminated) else 130  # 128 + the signal's number, as shells report
+        how, status = stop_words(stop)
+        print(f"neurohover {args.command}: {how}", file=sys.stderr)
+        remove_created_dirs()  # an output directory it made and left empty (an interrupted build-policies; fourth trial)
+        return status
     except BrokenPipeError:  # the reader went away (`neurohover demo | head -1`): stop quietly, as Python's docs advise
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())  # so that the interpreter's own flush at exit does not fail again
         return 1
+    except OSError as err:  # what no check foresaw (a name too long, a full disk inside a library): one line, not a traceback
+        where = f": {str(err.filename)!r:.120}" if err.filename else ""
+        print(f"neurohover {args.command}: error: {err.strerror or err}{where}", file=sys.stderr)
+        remove_created_dirs()
+        return 2
 
 
 if __name__ == "__main__":

@@ -101,7 +101,8 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     for option, value, low, high in (("--episodes", args.episodes, 1, 10**4), ("--episode-steps", args.episode_steps, 1, MAX_EPISODE_STEPS)):
         if not low <= value <= high:
             raise NeurohoverError(f"{option} {value} is out of range: allowed an integer in {low}..{high}")
-    out = None if args.json is None else output_file(args.json, "--json")
+    inputs = {"--policy": args.policy, "--sb3": args.sb3}  # writing one would destroy what is flown (fourth trial)
+    out = None if args.json is None else output_file(args.json, "--json", inputs)
     if args.rl_id and args.policy is not None:
         raise NeurohoverError("--rl-id applies to an agent trained on a neurohover/<NAME>-RL-v0 id, not to a neurohover --policy file")
     act = _agent(args)

@@ -218,16 +218,19 @@ def cmd_evolve(args: argparse.Namespace) -> int:
             settings=settings,
         )
     except EvolutionInterrupted as err:
+        from ..procs import stop_words
+
         bar.close()
+        how, status = stop_words(err)
         if err.checkpoint is not None:
             print(
-                f"neurohover evolve: interrupted after {err.episodes} episodes; checkpoint saved to {err.checkpoint} "
+                f"neurohover evolve: {how} after {err.episodes} episodes; checkpoint saved to {err.checkpoint} "
                 "(run the same command with --resume to continue)",
                 file=sys.stderr,
             )
         else:
-            print(f"neurohover evolve: interrupted mid-generation; the last periodic checkpoint (if any) is {checkpoint}", file=sys.stderr)
-        return 130
+            print(f"neurohover evolve: {how} mid-generation; the last periodic checkpoint (if any) is {checkpoint}", file=sys.stderr)
+        return status
     bar.close()
     # The champion's estimate is on the run's fitness scale (1/ln(error) over a family by default).
     scale = result.settings["settings"].get("fitness", "return") if result.settings.get("method") == "generational" else "return"
@@ -235,8 +238,11 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         result.champion, target, episodes=args.validation_episodes, seed=args.seed, n_steps=args.episode_steps, threads=args.threads, device=args.device
     )
     save_policy(result.champion, out, **_evolve_meta(args, family, target, mdp_desc, resampling, result, scale, validation, history_path.name))
-    with writing(history_path, "--out's history") as path:
-        write_history_csv(result.history, path)
+    try:
+        with writing(history_path, "--out's history") as path:
+            write_history_csv(result.history, path)
+    except NeurohoverError as err:  # said what was written and what was not (fourth trial: "no partial file" beside two files)
+        raise NeurohoverError(f"{err}; the champion is written to {str(out)!r} and the run's checkpoint kept in {str(checkpoint)!r}") from None
     summary = {
         "policy": str(out),
         "history": str(history_path),
@@ -300,7 +306,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     from ..agents.model_based import ModelEvolution
     from ..flightdata import FlightData
     from ..models import DEFAULT_NOISE_ESTIMATE, format_parameter_table, learn_ec_meno, learn_ec_mer, learn_lr, parameter_table
-    from ..paths import input_file, output_file, writing
+    from ..paths import input_file, output_file
     from ..policies import load_policy
     from .options import check_given, given_settings
 
@@ -341,8 +347,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
         else:
             source = args.policy or data.metadata.get("policy") or "baseline"
             model = learn_ec_mer(data, load_policy(source), seed=seed, **extra)
-    with writing(out, "--out") as path:
-        model.save(path)
+    model.save(out)  # written whole or not at all (a failed write: one message, the old file as it was)
     truth, why = _true_mdp(data.metadata)
     print(f"{args.method} model written to {out} ({time.perf_counter() - start:.2f} s)")
     rows = parameter_table(model, truth)

@@ -25,6 +25,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     from ..experiments.plans import source_experiments
     from ..experiments.runner import check_restart
     from ..paths import output_file
+    from ..procs import stop_words
 
     if args.list:
         for name in experiment_names():
@@ -71,13 +72,14 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
                     fresh = args.fresh and config.name not in sources_added
                     update = args.update and config.name not in sources_added
                     summary = reproduce(config, store, executor, fresh=fresh, update=update, progress=args.progress, only=tuple(args.only or ()))
-                except KeyboardInterrupt:
+                except KeyboardInterrupt as stop:
                     done = len(store.results(config.name, config.scale))
+                    how, status = stop_words(stop)
                     print(
-                        f"neurohover reproduce: interrupted; {done} finished units of {config.name} are in {args.store}; run the same command again to resume",
+                        f"neurohover reproduce: {how}; {done} finished units of {config.name} are in {args.store}; run the same command again to resume",
                         file=sys.stderr,
                     )
-                    return 130
+                    return status
                 print(summary.line())
                 failed = failed or not summary.succeeded
     except NeurohoverError:
@@ -93,6 +95,8 @@ def _remove_if_empty(path: Path) -> None:
     """Delete the store file at ``path`` if it holds no finished unit."""
     from ..experiments import Store
 
+    if not path.exists():  # a store that could not be made (a full disk) is already gone
+        return
     with Store(path, create=False) as store:
         empty = not any(store.units(name, scale) for name, scale, *_ in store.experiments())
     if empty:

@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from ..paths import write_png
 from .config import ExperimentConfig
 from .keys import UnitKey
 from .results import UnitResult
@@ -176,9 +177,7 @@ class Section:
     def save(self, fig) -> str:
         """Write the section's figure next to the report; returns its file name."""
         fig.tight_layout()
-        path = self.out / f"{self.stem}.png"
-        fig.savefig(path, dpi=110)
-        return path.name
+        return write_png(fig, self.out / f"{self.stem}.png", "report figure", dpi=110).name
 
     def save_panels(self, fig, axes, xlabel: str, ylabels: tuple[str, str]) -> str:
         """Label two panels (the second on a log scale), title the figure, put one legend below both (so it
@@ -197,9 +196,7 @@ class Section:
         fig.suptitle(f"{self.cfg.title} ({self.cfg.scale} scale)", fontsize=10)
         fig.legend(handles, labels, loc="lower center", ncol=2, fontsize=8, frameon=False)
         fig.tight_layout(rect=(0, extra / (height + extra), 1, 1))
-        path = self.out / f"{self.stem}.png"
-        fig.savefig(path, dpi=110)
-        return path.name
+        return write_png(fig, self.out / f"{self.stem}.png", "report figure", dpi=110).name
 
     def add_tests(self, samples: dict[str, list[float]], labels: dict[str, str], what: str) -> None:
         for t in self.paper.get("ttests", []):

@@ -92,19 +92,34 @@ class Store:
     """
 
     def __init__(self, path: str | Path, *, create: bool = True) -> None:
-        self.path = Path(path)
+        from ..paths import checked_path
+
+        self.path = checked_path(path, "results store", "results store's file path")  # None, 3, NUL, a name too long
         if not self.path.exists() and not create:
             raise NeurohoverError(f"results store {str(self.path)!r} does not exist")
         if self.path.exists() and self.path.is_dir():
             raise NeurohoverError(f"results store {str(self.path)!r} is a directory; give a file name")
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._lock: IO[str] | None = None
+        new = not self.path.exists() or self.path.stat().st_size == 0
         try:
             self.conn = sqlite3.connect(str(self.path), timeout=30.0, isolation_level=None)
             self.conn.execute("PRAGMA synchronous = FULL")
             self._check_schema()
+        except (sqlite3.OperationalError, OSError) as err:
+            if new:  # it could not be made (disk full, read-only): no empty file left that a later run takes for a store
+                self._close_quietly()
+                self.path.unlink(missing_ok=True)
+                raise NeurohoverError(f"cannot create the results store {str(self.path)!r} ({err}); no file is left") from None
+            raise NeurohoverError(f"results store {str(self.path)!r} cannot be read ({err})") from None
         except sqlite3.DatabaseError as err:
             raise NeurohoverError(f"{str(self.path)!r} is not a neurohover results store (SQLite says: {err})") from None
+
+    def _close_quietly(self) -> None:
+        """Close the connection if one was opened (a failed open's cleanup)."""
+        conn = getattr(self, "conn", None)
+        if conn is not None:
+            conn.close()
 
     def close(self) -> None:
         self.conn.close()
@@ -274,26 +289,35 @@ class Store:
             c.execute("DELETE FROM experiments WHERE name = ? AND scale = ?", (name, scale))
         return True
 
+    def _rows(self, sql: str, params: tuple, what: str) -> list[tuple]:
+        """The rows of a read, a damaged file named with what could not be read (SQLite's message named a column and
+        printed raw bytes; fourth trial). Names and scales must be text."""
+        for value in params:
+            if not isinstance(value, str):
+                raise NeurohoverError(f"{value!r:.60} is not allowed as an experiment name or scale: give text (e.g. 'fig7', 'paper')")
+        try:
+            return self.conn.execute(sql, params).fetchall()
+        except sqlite3.DatabaseError as err:
+            raise NeurohoverError(f"results store {str(self.path)!r} is damaged: {what} cannot be read ({str(err)[:60]})") from None
+
     def experiments(self) -> list[tuple[str, str, str, int]]:
         """(name, scale, config_hash, finished units) of every experiment in the store."""
-        return [
-            tuple(r)
-            for r in self.conn.execute(
-                "SELECT e.name, e.scale, e.config_hash, (SELECT count(*) FROM units u WHERE u.name = e.name AND u.scale = e.scale) "
-                "FROM experiments e ORDER BY e.created"
-            )
-        ]
+        sql = (
+            "SELECT e.name, e.scale, e.config_hash, (SELECT count(*) FROM units u WHERE u.name = e.name AND u.scale = e.scale) "
+            "FROM experiments e ORDER BY e.created"
+        )
+        return [tuple(r) for r in self._rows(sql, (), "its list of experiments")]
 
     def config_hash(self, name: str, scale: str) -> str | None:
         """The config hash of experiment (name, scale), None when the store does not hold it."""
-        row = self.conn.execute("SELECT config_hash FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
-        return None if row is None else row[0]
+        rows = self._rows("SELECT config_hash FROM experiments WHERE name = ? AND scale = ?", (name, scale), f"experiment {name} ({scale})")
+        return rows[0][0] if rows else None
 
     def config(self, name: str, scale: str) -> dict:
-        row = self.conn.execute("SELECT config FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
-        if row is None:
+        rows = self._rows("SELECT config FROM experiments WHERE name = ? AND scale = ?", (name, scale), f"experiment {name} ({scale})'s config")
+        if not rows:
             raise NeurohoverError(self.missing_message(name, scale))
-        return self._json(row[0], f"experiment {name} ({scale})'s config")
+        return self._json(rows[0][0], f"experiment {name} ({scale})'s config")
 
     def missing_message(self, name: str, scale: str | None) -> str:
         """The message for an experiment (at ``scale``, if given) this store does not hold, listing what it holds."""
@@ -302,19 +326,21 @@ class Store:
         return f"results store {str(self.path)!r} holds no experiment {what}; it holds: " + (", ".join(present) if present else "nothing yet")
 
     def scales(self, name: str) -> list[str]:
-        return [r[0] for r in self.conn.execute("SELECT scale FROM experiments WHERE name = ? ORDER BY created", (name,))]
+        return [r[0] for r in self._rows("SELECT scale FROM experiments WHERE name = ? ORDER BY created", (name,), f"experiment {name}'s scales")]
 
     # ------------------------------------------------------------------ units
 
     def results(self, name: str, scale: str) -> dict[str, dict]:
         """key -> result of every finished unit."""
-        rows = self.conn.execute("SELECT key, result FROM units WHERE name = ? AND scale = ?", (name, scale))
+        rows = self._rows("SELECT key, result FROM units WHERE name = ? AND scale = ?", (name, scale), f"experiment {name} ({scale})'s results")
         return {k: self._json(r, f"experiment {name} ({scale}), unit {k}'s result") for k, r in rows}
 
     def units(self, name: str, scale: str) -> list[dict]:
         """Every finished unit: key, kind, params, result, seconds, worker, finished (time)."""
-        rows = self.conn.execute(
-            "SELECT key, kind, params, result, seconds, worker, finished FROM units WHERE name = ? AND scale = ? ORDER BY key", (name, scale)
+        rows = self._rows(
+            "SELECT key, kind, params, result, seconds, worker, finished FROM units WHERE name = ? AND scale = ? ORDER BY key",
+            (name, scale),
+            f"experiment {name} ({scale})'s units",
         )
         return [
             {
@@ -371,7 +397,9 @@ class Store:
 
     def sessions(self, name: str, scale: str) -> list[dict]:
         cols = ("id", "executor", "cores", "started", "wall_seconds", "units_run", "units_before", "status")
-        rows = self.conn.execute(f"SELECT {', '.join(cols)} FROM sessions WHERE name = ? AND scale = ? ORDER BY id", (name, scale))
+        rows = self._rows(
+            f"SELECT {', '.join(cols)} FROM sessions WHERE name = ? AND scale = ? ORDER BY id", (name, scale), f"experiment {name} ({scale})'s sessions"
+        )
         return [dict(zip(cols, r)) for r in rows]
 
 

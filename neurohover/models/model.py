@@ -253,8 +253,9 @@ class LearnedModel:
         from ..paths import output_file, writing
 
         text = json.dumps(self.to_dict(), indent=1, allow_nan=False) + "\n"
-        with writing(output_file(path, "model file"), "model file") as out:  # /dev/full, a directory: one clear error
-            out.write_text(text)
+        out = output_file(path, "model file")  # /dev/full, a directory: one clear error
+        with writing(out, "model file") as partial:
+            partial.write_text(text)
         return out
 
     @classmethod
