@@ -96,6 +96,10 @@ class PolicyTable:
             raise NeurohoverError(f"PolicyTable kinds must be a 1-D integer array of {sorted(KIND.values())} ({', '.join(KIND)}), got {kinds!r:.80}")
         if genomes.shape != (kinds.shape[0], GENOME_WIDTH):
             raise NeurohoverError(f"PolicyTable genomes must be an array of shape ({kinds.shape[0]}, {GENOME_WIDTH}), got shape {genomes.shape}")
+        if genomes.dtype == bool or not (np.issubdtype(genomes.dtype, np.floating) or np.issubdtype(genomes.dtype, np.integer)):
+            raise NeurohoverError(f"PolicyTable genomes must be real numbers, got dtype {genomes.dtype} (complex and objects were a ValueError in the kernel)")
+        object.__setattr__(self, "kinds", kinds.astype(np.int64, copy=False))  # uint8 kinds were refused by the kernel's batch
+        object.__setattr__(self, "genomes", genomes.astype(np.float64, copy=False))
 
     @classmethod
     def from_policies(cls, policies: Sequence[Policy]) -> PolicyTable:
@@ -217,6 +221,10 @@ def _index_array(values, n_jobs: int | None, upper: int | None, what: str) -> np
     return arr
 
 
+#: The most control steps one call flies (about a day of the kernel on two cores), and the most memory its recorded
+#: flight data may take (12 readings and 4 actions a step, float64).
+MAX_STEPS_PER_CALL, MAX_RECORD_BYTES, RECORD_BYTES_PER_STEP = 10**12, 8 * 2**30, 16 * 8
+
 #: The most episodes one call flies: each holds about 60 bytes of job and result arrays in memory (6 GB at
 #: this bound), so a larger run is refused up front with this number rather than failing to allocate.
 MAX_EPISODES_PER_CALL = 100_000_000
@@ -276,12 +284,17 @@ def evaluate_jobs(
     check_device(device)
     table = policies if isinstance(policies, PolicyTable) else PolicyTable.from_policies(policies)
     rows = mdp_rows(mdps)
-    if not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= MAX_SEED:
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= MAX_SEED:  # True was seed 1
         raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer in 0..2**63-1")
-    if not isinstance(n_steps, (int, np.integer)) or not 1 <= n_steps <= MAX_EPISODE_STEPS:
+    if isinstance(n_steps, bool) or not isinstance(n_steps, (int, np.integer)) or not 1 <= n_steps <= MAX_EPISODE_STEPS:
         raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
     p_idx = _index_array(policy_index, None, len(table), "policy_index")
     n_jobs = p_idx.shape[0]
+    if n_jobs * int(n_steps) > MAX_STEPS_PER_CALL:  # 10**8 episodes of 10**7 steps passed every check and ran for years
+        raise NeurohoverError(
+            f"{n_jobs:,} episodes of n_steps={n_steps:,} are {n_jobs * int(n_steps):,} control steps, more than one call flies "
+            f"(at most {MAX_STEPS_PER_CALL:,}, about a day on two cores): use fewer episodes or steps"
+        )
     m_idx = _index_array(mdp_index, n_jobs, rows.shape[0], "mdp_index")
     e_idx = _index_array(episode_index, n_jobs, None, "episode_index")
     if fallback_index is None:
@@ -308,9 +321,14 @@ def evaluate_jobs(
         raise NeurohoverError(f"record={record!r:.60} is not allowed: give one True/False flag per job ({n_jobs})")
     if rec.shape[0] != n_jobs:
         raise NeurohoverError(f"record must have one flag per job ({n_jobs}), got {rec.shape[0]}")
-    slots = np.full(n_jobs, -1, dtype=np.int64)
-    slots[rec] = np.arange(int(rec.sum()))
     n_rec = int(rec.sum())
+    if n_rec * (int(n_steps) + 1) * RECORD_BYTES_PER_STEP > MAX_RECORD_BYTES:  # held in memory whole (53.7 GiB was a MemoryError)
+        raise NeurohoverError(
+            f"recording {n_rec:,} episodes of n_steps={n_steps:,} takes {n_rec * (int(n_steps) + 1) * RECORD_BYTES_PER_STEP / 2**30:.1f} GiB "
+            f"of memory, more than {MAX_RECORD_BYTES / 2**30:.0f} GiB: record fewer episodes or steps (several calls, each saved)"
+        )
+    slots = np.full(n_jobs, -1, dtype=np.int64)
+    slots[rec] = np.arange(n_rec)
     obs_out = np.zeros((n_rec, n_steps + 1, 12))
     act_out = np.zeros((n_rec, n_steps, 4))
     batch = Batch(rows, table.kinds, table.genomes, p_idx, m_idx, e_idx, seed, n_steps, fb, limits, slots, obs_out, act_out)

@@ -33,6 +33,13 @@ class FlightData:
     metadata: dict = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
+        for name in ("observations", "actions"):  # a string was an AttributeError (fourth trial)
+            arrays = getattr(self, name)
+            if isinstance(arrays, (str, bytes, np.ndarray)) or not isinstance(arrays, (tuple, list)):
+                raise NeurohoverError(f"flight data {name}={arrays!r:.60} is not allowed: give a sequence of arrays, one per episode")
+            if not all(isinstance(a, np.ndarray) and a.dtype.kind in "fi" for a in arrays):
+                raise NeurohoverError(f"flight data {name} must be arrays of real numbers, one per episode")
+            object.__setattr__(self, name, tuple(arrays))
         if len(self.observations) != len(self.actions):
             raise NeurohoverError(f"flight data needs one action array per observation array, got {len(self.observations)} and {len(self.actions)}")
         for i, (obs, act) in enumerate(zip(self.observations, self.actions)):
@@ -48,6 +55,8 @@ class FlightData:
         return int(sum(a.shape[0] for a in self.actions))
 
     def __add__(self, other: FlightData) -> FlightData:
+        if not isinstance(other, FlightData):
+            return NotImplemented  # Python's TypeError ("unsupported operand"), as for any sum it cannot make
         meta = {**self.metadata, **other.metadata}
         a, b = self.metadata.get("crashed"), other.metadata.get("crashed")  # per-episode flags: both halves, or none
         if isinstance(a, list) and isinstance(b, list) and len(a) == self.n_episodes and len(b) == other.n_episodes:

@@ -47,7 +47,7 @@ def num_threads(threads: int | None) -> Iterator[None]:
         yield
         return
     limit = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # numba.config sets it at import, from the environment
-    if not isinstance(threads, int) or not 1 <= threads <= limit:
+    if isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= limit:  # True was one thread
         raise NeurohoverError(f"threads={threads!r} is out of range: allowed 1..{limit} on this machine")
     previous = numba.get_num_threads()
     numba.set_num_threads(threads)

@@ -222,6 +222,11 @@ def replaceable_set(task: str, out: str | Path | None) -> Path:
     trial)."""
     from .paths import checked_path
 
+    if out is not None:
+        given = checked_path(out, "out", "directory")
+        above = next((p for p in (given, *given.parents) if p.exists()), None)  # the nearest part of it that exists
+        if above is not None and not above.is_dir():  # '/dev/full' or a file: a NotADirectoryError once made (fourth trial)
+            raise NeurohoverError(f"out {str(out)!r}: {str(above)!r} is not a directory; give a directory to write the {task} set into")
     final = policy_dir(task, None if out is None else checked_path(out, "out"))
     if final.exists() and not final.is_dir():
         raise NeurohoverError(f"{str(final)!r} is a file, not a policy set: give another out directory, or remove it")

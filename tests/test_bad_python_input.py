@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -482,3 +484,49 @@ def test_a_store_read_with_a_name_that_is_not_text_is_refused(tmp_path) -> None:
         for call in (lambda: store.results(None, None), lambda: store.units("fig7", 3), lambda: store.config(["fig7"], "paper")):
             with pytest.raises(NeurohoverError, match="is not allowed as an experiment name or scale: give text"):
                 call()
+
+
+def _fourth_trial_calls(tmp_path):
+    """The fourth trial's Python API cases that raised TypeError, AttributeError, MemoryError or NumPy's errors, or were
+    accepted without a word: (call, the message's start)."""
+    from neurohover.agents import run_test
+    from neurohover.agents.registry import make_agent
+    from neurohover.agents.spec import AgentOptions
+    from neurohover.experiments import Store, load_config, reproduce
+    from neurohover.flightdata import FlightData
+    from neurohover.models import learn_ec_mer
+    from neurohover.policysets import build_policy_set
+
+    fam, mdp, base = nh.get_task_family("ghh08"), nh.get_task_family("ghh08").mdp("train:0"), nh.baseline_policy()
+    (tmp_path / "junk.bin").write_bytes(b"x")
+    return [
+        (lambda: nh.evaluate(base, mdp, episodes=1, n_steps=True), "n_steps=True is out of range"),
+        (lambda: nh.evaluate(base, mdp, episodes=1, seed=True), "seed=True is out of range"),
+        (lambda: nh.evaluate(base, mdp, episodes=1, threads=True), "threads=True is out of range"),
+        (lambda: nh.evaluate(base, mdp, episodes=10**8, n_steps=10**7), "100,000,000 episodes of n_steps=10,000,000 are"),
+        (lambda: nh.evaluate(base, mdp, episodes=10**5, n_steps=6000, record=True), "recording 100,000 episodes of n_steps=6,000 takes 71.5 GiB"),
+        (lambda: nh.evaluate(nh.PolicyTable(np.array([1]), np.zeros((1, 42), complex)), mdp, episodes=1, n_steps=20), "PolicyTable genomes must be real"),
+        (lambda: run_test(make_agent("baseline", fam), fam, mdp, episodes=True, n_steps=20), "episodes=True is out of range"),
+        (lambda: make_agent("generic", fam, policy_dir=3), "policy_dir=3 is not allowed"),
+        (lambda: make_agent("model-based", fam, options=AgentOptions(evolution="x")), "AgentOptions evolution='x' is not allowed"),
+        (lambda: make_agent("generic", fam, options=AgentOptions(settings={"criterion": "lcb"})), "agent 'generic' takes no settings"),
+        (lambda: make_agent("hybrid-risk", fam, options=AgentOptions(settings={"criterion": "best"})), "bad RiskSettings: risk criterion 'best'"),
+        (lambda: make_agent("hybrid-risk", fam, options=AgentOptions(settings=3)), "agent 'hybrid-risk' takes settings of RiskSettings"),
+        (lambda: build_policy_set("ghh08", "/dev/full", budget=5, n_steps=10), "out '/dev/full': '/dev/full' is not a directory"),
+        (lambda: build_policy_set("ghh08", tmp_path / "junk.bin", budget=5, n_steps=10), "is not a directory; give a directory"),
+        (lambda: load_config("fig7", "quick", [1]), "overrides=[1] is not allowed: give a dict"),
+        (lambda: reproduce(load_config("fig2", "quick"), "x", "local"), "store='x' is not allowed: give a Store"),
+        (lambda: reproduce(load_config("fig2", "quick"), Store(tmp_path / "s.sqlite"), None), "executor=None is not allowed"),
+        (lambda: FlightData(observations=[np.zeros((51, 12))], actions="x"), "flight data actions='x' is not allowed"),
+        (
+            lambda: learn_ec_mer(nh.evaluate(base, mdp, episodes=1, record=True, n_steps=30).flight_data, base, budget=3, episodes=10**13),
+            "episodes=10000000000000",
+        ),
+    ]
+
+
+def test_the_fourth_trials_python_api_cases_are_refused_by_name(tmp_path) -> None:
+    for call, message in _fourth_trial_calls(tmp_path):
+        with pytest.raises(NeurohoverError, match=re.escape(message)):
+            call()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["junk.bin", "s.sqlite"]  # nothing made but the store given

@@ -155,7 +155,7 @@ def _check_run(agent, family, mdp, episodes, seed) -> int:
         raise NeurohoverError(f"mdp={mdp!r:.80} is not allowed: give an MDP (family.mdp('test:3'), for example)")
     if mdp.family != family.name:  # the agent prepares for its family (its policies, safe pairs): another family's MDP is a mix-up
         raise NeurohoverError(f"mdp {mdp.label!r} is a {mdp.family} MDP, but the run's family is {family.name}: give an MDP of {family.name}")
-    if not isinstance(episodes, (int, np.integer)) or episodes < 1:
+    if isinstance(episodes, bool) or not isinstance(episodes, (int, np.integer)) or episodes < 1:  # True was one episode
         raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
     check_episode_count(int(episodes), f"episodes={episodes}")
     mdp.drift.check_run(int(episodes))

@@ -7,6 +7,7 @@ this package (see the README's contributor section).
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import pkgutil
 
@@ -94,8 +95,33 @@ def make_agent(name: str, family: TaskFamily | str, *, policy_dir: str | None = 
     if not isinstance(options, AgentOptions):
         raise NeurohoverError(f"options={options!r:.80} is not allowed: give an AgentOptions")
     spec = agent_spec(name, family)
+    options = _checked_options(spec, options)
+    if policy_dir is not None:
+        from ..paths import checked_path
+
+        policy_dir = str(checked_path(policy_dir, "policy_dir", "policy set's directory"))  # 3 was a TypeError (fourth trial)
     policies = policies_from_set(spec, _policy_set(family, policy_dir)) if spec.needs else AgentPolicies()
     return spec.build(policies, options)
+
+
+def _checked_options(spec: AgentSpec, options: AgentOptions) -> AgentOptions:
+    """``options`` as ``spec``'s build reads them: an evolution that is a ModelEvolution, settings of the agent's own class
+    (a dict is read by that class); settings for an agent without any, or of another class, refused (fourth trial: they
+    were accepted and ignored, or an AttributeError once the agent learned)."""
+    from .model_based import ModelEvolution
+
+    if options.evolution is not None and not isinstance(options.evolution, ModelEvolution):
+        raise NeurohoverError(f"AgentOptions evolution={options.evolution!r:.60} is not allowed: give a ModelEvolution, or None (its defaults)")
+    given = options.settings
+    if given is None:
+        return options
+    if spec.settings is None:
+        raise NeurohoverError(f"agent {spec.name!r} takes no settings, got {given!r:.60}")
+    if isinstance(given, dict):
+        return dataclasses.replace(options, settings=spec.settings.from_dict(given))
+    if not isinstance(given, spec.settings):
+        raise NeurohoverError(f"agent {spec.name!r} takes settings of {spec.settings.__name__} (or a dict of its fields), got {given!r:.60}")
+    return options
 
 
 __all__ = ["AGENTS", "HYBRID_AGENTS", "AgentOptions", "AgentPolicies", "AgentSpec", "agent_spec", "check_agent", "discover", "make_agent", "policies_from_set"]

@@ -227,6 +227,8 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
     """Load, resolve and validate an experiment config at ``scale`` (``quick`` or ``paper``)."""
     if scale not in SCALES:
         raise NeurohoverError(f"unknown scale {scale!r}: allowed {', '.join(SCALES)}")
+    if overrides is not None and not (isinstance(overrides, dict) and all(isinstance(k, str) for k in overrides)):  # a TypeError (fourth trial)
+        raise NeurohoverError(f"overrides={overrides!r:.60} is not allowed: give a dict of settings, e.g. {{'episodes': 3}} (the CLI's --set episodes=3)")
     path = resolve_name(name_or_path)
     try:
         raw = tomllib.loads(path.read_text())

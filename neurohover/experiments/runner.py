@@ -142,6 +142,11 @@ def reproduce(
     """
     from tqdm import tqdm
 
+    for value, want, what in ((config, ExperimentConfig, "config: give load_config(NAME, SCALE)"), (store, Store, "store: give a Store(PATH)")):
+        if not isinstance(value, want):  # a name or a path was an AttributeError (fourth trial)
+            raise NeurohoverError(f"{what.split(':')[0]}={value!r:.60} is not allowed:{what.split(':')[1]}")
+    if not callable(getattr(executor, "run", None)):
+        raise NeurohoverError(f"executor={executor!r:.60} is not allowed: give an executor, make_executor('local', jobs=N) or LocalExecutor(N)")
     store.lock()  # one writer per store: a second run would redo every unit the first has not finished
     check_restart(fresh, update)
     held = store.config_hash(config.name, config.scale)

@@ -210,6 +210,10 @@ def _model_rows(params: np.ndarray, noise: np.ndarray) -> np.ndarray:
     return rows
 
 
+#: EC-MER's episodes per candidate at most (the paper: one); 10**13 was a 3.55 PiB allocation (fourth trial).
+MAX_EC_MER_EPISODES = 10_000
+
+
 def learn_ec_mer(
     flight_data: FlightData,
     generic_policy,
@@ -240,8 +244,8 @@ def learn_ec_mer(
     start = time.perf_counter()
     if not isinstance(generic_policy, Policy):
         raise NeurohoverError(f"generic_policy must be a Policy, got {type(generic_policy).__name__}")
-    if not isinstance(episodes, (int, np.integer)) or episodes < 1:
-        raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
+    if isinstance(episodes, bool) or not isinstance(episodes, (int, np.integer)) or not 1 <= episodes <= MAX_EC_MER_EPISODES:
+        raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer in 1..{MAX_EC_MER_EPISODES:,} (per candidate)")
     tr = Transitions(flight_data)
     if true_return is None:
         true_return = observed_return(flight_data, 0)
