@@ -275,3 +275,16 @@ def test_evaluate_agent_refuses_to_write_its_rows_onto_the_policy_it_flies(tmp_p
     before = policy.read_bytes()
     rc = main(["evaluate-agent", "--task", "ghh08", "--policy", str(policy), "--n-mdps", "1", "--episode-steps", "20", "--json", str(policy)])
     assert rc == 2 and "is the file of --policy" in capsys.readouterr().err and policy.read_bytes() == before
+
+
+@pytest.mark.parametrize(
+    "command", [["compete", "--agent", "baseline", "--runs", "1", "--episodes", "2"], ["evolve", "--mdp", "train:0", "--budget", "20"], ["build-policies"]]
+)
+def test_episode_steps_out_of_range_are_named_by_their_option(command: list[str], tmp_path: Path, capsys) -> None:
+    """issue 37, fourth trial: compete said "experiment 'compete-ghh08-baseline': n_steps = 0", evolve and build-policies
+    "n_steps=..." for --episode-steps."""
+    out = ["--out", str(tmp_path / ("o.json" if command[0] == "evolve" else "o"))]
+    for steps in ("0", "10000001"):
+        assert main([command[0], "--task", "ghh08", *command[1:], "--episode-steps", steps, *out]) == 2
+        assert f"--episode-steps {steps} is out of range: allowed an integer in 1..10,000,000" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []

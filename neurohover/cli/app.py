@@ -110,6 +110,12 @@ def _run(argv: Sequence[str] | None) -> int:
             from ..evolution.seeding import check_seed
 
             check_seed(args.seed)
+        steps = getattr(args, "episode_steps", None)
+        if steps is not None:  # every command's --episode-steps, one range, named by its option (it said n_steps; fourth trial)
+            from ..sim.constants import MAX_EPISODE_STEPS
+
+            if not 1 <= steps <= MAX_EPISODE_STEPS:
+                raise NeurohoverError(f"--episode-steps {steps} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS:,}")
         if args.command in COMPILING and not getattr(args, "json", False):
             from ..sim import kernel_compiled
 
