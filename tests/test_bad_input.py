@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import subprocess
@@ -288,3 +289,24 @@ def test_episode_steps_out_of_range_are_named_by_their_option(command: list[str]
         assert main([command[0], "--task", "ghh08", *command[1:], "--episode-steps", steps, *out]) == 2
         assert f"--episode-steps {steps} is out of range: allowed an integer in 1..10,000,000" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_fourth_trials_ignored_options_are_refused(tmp_path: Path, capsys) -> None:
+    """issue 37, fourth trial: options accepted and then ignored or overridden without a word."""
+    from neurohover.agents.risk import RiskSettings
+
+    cases = [
+        (["reproduce", "fig7", "--progress", "--no-progress", "--store", str(tmp_path / "s.sqlite")], "--progress and --no-progress are both given"),
+        (["reproduce", "--list", "fig7"], "--list lists every experiment and takes no NAME (got 'fig7')"),
+        (["fly", "--task", "fghh", "--episodes", "1", "--params=-0.18,-0.43,-0.54,-0.49,-42.15,-12.78,33.04,-10.12,-33.32,-10.5,1", "--sigma", "0.2"],
+         "--sigma is the breadth of the MDPs drawn from FGHH's distribution; --params sets the MDP itself"),
+        (["plot", "--compete", str(tmp_path), str(tmp_path / "." / ""), "--out", str(tmp_path / "p")], "--compete names"),
+    ]  # fmt: skip
+    for argv, message in cases:
+        with pytest.raises(SystemExit) if argv[0] == "reproduce" and "--progress" in argv else contextlib.nullcontext():
+            rc = main(argv)
+            assert rc == 2
+        assert message in capsys.readouterr().err, argv
+    with pytest.raises(NeurohoverError, match="risk trials=10000000000000 is out of range: allowed an integer in 1..1,000,000"):
+        RiskSettings(trials=10**13)
+    assert not (tmp_path / "p").exists() and not (tmp_path / "s.sqlite").exists()

@@ -36,6 +36,9 @@ from .model_free import ModelFreeAgent
 from .protocol import Agent, Choice, EpisodeOutcome
 from .spec import AgentOptions, AgentPolicies, AgentSettings, AgentSpec
 
+#: The most trials of each specialised policy: a run's episodes (1,000,000 at most) cannot hold more (10**13 was accepted).
+MAX_TRIALS = 1_000_000
+
 CRITERIA = ("mean", "lcb", "worst")
 
 
@@ -62,8 +65,8 @@ class RiskSettings(AgentSettings):
             raise NeurohoverError(f"risk criterion {self.criterion!r} is not allowed: choose one of {', '.join(CRITERIA)}")
         if isinstance(self.level, bool) or not isinstance(self.level, (int, float)) or not math.isfinite(self.level) or self.level < 0:
             raise NeurohoverError(f"risk level={self.level!r} is out of range: allowed a finite number >= 0 (standard errors below the mean)")
-        if isinstance(self.trials, bool) or not isinstance(self.trials, int) or self.trials < 1:
-            raise NeurohoverError(f"risk trials={self.trials!r} is out of range: allowed an integer >= 1")
+        if isinstance(self.trials, bool) or not isinstance(self.trials, int) or not 1 <= self.trials <= MAX_TRIALS:
+            raise NeurohoverError(f"risk trials={self.trials!r} is out of range: allowed an integer in 1..{MAX_TRIALS:,}")
 
     def score(self, values: Sequence[float]) -> float:
         """The candidate's score from its episode values (higher is better)."""

@@ -41,6 +41,8 @@ def explicit_mdp(args: argparse.Namespace, family):
             raise NeurohoverError(f"--wind U,V sets a GHH-08 MDP; task {args.task!r} takes --params")
         return family.make(parse_floats(args.wind, "--wind")), f"wind={args.wind}"
     if args.params is not None:
+        if getattr(args, "sigma", None) is not None:  # it changed nothing (fourth trial)
+            raise NeurohoverError("--sigma is the breadth of the MDPs drawn from FGHH's distribution; --params sets the MDP itself: give one")
         return family.make(parse_floats(args.params, "--params")), f"params={args.params}"
     return None
 

@@ -63,6 +63,9 @@ def cmd_plot(args: argparse.Namespace) -> int:
         written = plot_flight_data(data, out, stem=path.stem, episodes=_episodes(args.episodes, data.n_episodes))
     else:
         dirs = [input_dir(d, "--compete") for d in args.compete]
+        twice = [str(d) for i, d in enumerate(dirs) if any(d.resolve() == e.resolve() for e in dirs[:i])]
+        if twice:  # one run overlaid on itself (fourth trial)
+            raise NeurohoverError(f"--compete names {twice[0]!r} more than once: give each competition's directory once")
         from ..plots import compete_figure, read_compete_dir, save_figure
 
         results = [read_compete_dir(d) for d in dirs]  # every directory read before anything is written

@@ -28,6 +28,8 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     from ..procs import stop_words
 
     if args.list:
+        if args.name is not None:  # the name was ignored (fourth trial)
+            raise NeurohoverError(f"--list lists every experiment and takes no NAME (got {args.name!r}): give one or the other")
         for name in experiment_names():
             print(name)
         return 0
