@@ -530,3 +530,9 @@ def test_the_fourth_trials_python_api_cases_are_refused_by_name(tmp_path) -> Non
         with pytest.raises(NeurohoverError, match=re.escape(message)):
             call()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["junk.bin", "s.sqlite"]  # nothing made but the store given
+
+
+def test_a_complex_mdp_parameter_is_refused_not_cut_to_its_real_part() -> None:
+    """issue 37, fourth trial: fam.make(np.array([1+2j, 0])) flew wind (1, 0) after a NumPy ComplexWarning."""
+    with pytest.raises(NeurohoverError, match=re.escape("GHH-08 wind (wind_u, wind_v) must be 2 numbers, got array([1.+2.j, 0.+0.j])")):
+        nh.get_task_family("ghh08").make(np.array([1 + 2j, 0]))

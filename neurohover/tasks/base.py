@@ -183,7 +183,10 @@ class MDP:
 
 def finite_vector(values: Sequence[float] | np.ndarray, length: int, what: str) -> np.ndarray:
     """``values`` as a float array of ``length`` finite numbers, or a clear error naming ``what``."""
-    if isinstance(values, str) or any(isinstance(v, (str, bytes, bool, np.bool_)) for v in np.ravel(np.asarray(values, dtype=object))):
+    # complex numbers too: NumPy dropped their imaginary part with a warning only (fourth trial)
+    if isinstance(values, str) or any(
+        isinstance(v, (str, bytes, bool, np.bool_, complex, np.complexfloating)) for v in np.ravel(np.asarray(values, dtype=object))
+    ):
         raise NeurohoverError(f"{what} must be {length} numbers, got {values!r}")
     try:
         arr = np.asarray(values, dtype=float)
