@@ -310,3 +310,11 @@ def test_the_fourth_trials_ignored_options_are_refused(tmp_path: Path, capsys) -
     with pytest.raises(NeurohoverError, match="risk trials=10000000000000 is out of range: allowed an integer in 1..1,000,000"):
         RiskSettings(trials=10**13)
     assert not (tmp_path / "p").exists() and not (tmp_path / "s.sqlite").exists()
+
+
+def test_a_build_says_it_replaces_the_set_in_its_out_directory(tmp_path: Path, capsys) -> None:
+    """issue 37, fourth trial: a build into --out replaced the 13-file set there without a word (only the shipped set's
+    replacement was said)."""
+    argv = ["build-policies", "--task", "ghh08", "--budget", "2", "--episode-steps", "10", "--out", str(tmp_path)]
+    assert main(argv) == 0 and "is replaced" not in capsys.readouterr().err
+    assert main(argv) == 0 and f"note: the set {tmp_path / 'ghh08'} is replaced once the build completes" in capsys.readouterr().err

@@ -13,7 +13,6 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
     """Evolve a task family's generic and specialised policies (the agents' policy set)."""
     from ..paths import output_dir
     from ..policysets import build_policy_set, check_build, replaceable_set
-    from ..procs import sigterm_as_interrupt
     from ..tasks import get_task_family
 
     if args.budget < 1:
@@ -24,20 +23,20 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
     final = replaceable_set(args.task, args.out)
     if args.out is not None:  # made once every option is checked
         output_dir(args.out, "--out")
-    elif final.exists():  # the documented default, said before hours of work replace what the package ships
-        print(f"neurohover build-policies: note: no --out: the package's shipped set {final} is replaced once the build completes", file=sys.stderr)
-    with sigterm_as_interrupt():  # SIGTERM (timeout, kill) ends it as Ctrl-C does: the half-built set is removed (third trial)
-        ps = build_policy_set(
-            args.task,
-            args.out,
-            budget=args.budget,
-            seed=args.seed,
-            n_steps=args.episode_steps,
-            fghh_budget=args.fghh_budget,  # None: the default, where it applies (build_policy_set refuses it elsewhere)
-            lineage=args.lineage,
-            optimizer=args.optimizer,
-            progress=lambda msg: print(msg, file=sys.stderr, flush=True),
-        )
+    if final.exists():  # said before hours of work replace it (a set in --out was replaced without a word; fourth trial)
+        whose = "the package's shipped set" if args.out is None else "the set"
+        print(f"neurohover build-policies: note: {whose} {final} is replaced once the build completes", file=sys.stderr)
+    ps = build_policy_set(
+        args.task,
+        args.out,
+        budget=args.budget,
+        seed=args.seed,
+        n_steps=args.episode_steps,
+        fghh_budget=args.fghh_budget,  # None: the default, where it applies (build_policy_set refuses it elsewhere)
+        lineage=args.lineage,
+        optimizer=args.optimizer,
+        progress=lambda msg: print(msg, file=sys.stderr, flush=True),
+    )
     print(f"policy set written to {ps.directory}")
     return 0
 
