@@ -244,6 +244,13 @@ def _evolve_one(
     from .evolution.optimisers import NE
     from .policies import prototype
 
+    stage = _stage_file(root, str(child_seed))  # the run's seed names it: each run of a build has its own
+    if stage.is_file():  # finished before the build was stopped: the same run again would give the same champion
+        policy = load_policy(stage)
+        if save:
+            save_policy(policy, root / f"{name}.json", task=family.name, name=name, **{k: policy.metadata[k] for k in ("episodes", "seconds")})
+        say(f"{family.name}/{name}: kept from the interrupted build")
+        return policy
     t0 = time.perf_counter()
     race = str(kwargs.get("resampling", "")).startswith("race")
     kwargs["optimizer"] = NE if race else optimizer
@@ -252,10 +259,25 @@ def _evolve_one(
     start_from = seed_policy if seed_policy is not None else prototype("mlp", "baseline")
     result = evolve(target, topology="mlp", prototype=start_from, seed=child_seed, n_steps=n_steps, **kwargs)
     policy = result.champion
+    meta = {"episodes": int(result.episodes), "seconds": round(time.perf_counter() - t0, 2)}
     if save:
-        save_policy(policy, root / f"{name}.json", task=family.name, name=name, episodes=int(result.episodes), seconds=round(time.perf_counter() - t0, 2))
+        save_policy(policy, root / f"{name}.json", task=family.name, name=name, **meta)
+    save_policy(policy, stage, task=family.name, name=name, **meta)
     say(f"{family.name}/{name}: champion {result.champion_return:.1f} after {result.episodes} episodes ({time.perf_counter() - t0:.0f} s)")
     return policy
+
+
+STAGES = "stages"  # a build's finished runs, kept while it is under way (build_policy_set resumes from them)
+
+
+def _stage_file(root: Path, key: str) -> Path:
+    return root / STAGES / f"{key}.json"
+
+
+def _version() -> str:
+    from . import __version__
+
+    return __version__
 
 
 #: Episodes per steady-state evolution of a policy set, and per FGHH generic's evolution over G (build_policy_set's
@@ -311,16 +333,28 @@ def build_policy_set(
     if progress is not None and not callable(progress):  # progress=3 was a TypeError after the first run (third trial)
         raise NeurohoverError(f"progress={progress!r:.60} is not allowed: give a callable taking one line of text, or None")
     final = replaceable_set(family.name, out)
-    # Built beside the set it replaces, which it replaces only once complete: an interrupted build (or a
-    # failed one) leaves the old set, shipped or not, as it was.
+    say = progress or (lambda _msg: None)
+    # Built beside the set it replaces, which it replaces only once complete: an interrupted build (or a failed one)
+    # leaves the old set, shipped or not, as it was. Each finished run is kept in root's stages/, and the same build
+    # run again resumes from them (fourth trial: an interrupted build lost every finished stage).
     root = final.with_name(final.name + ".building")
-    shutil.rmtree(root, ignore_errors=True)
-    root.mkdir(parents=True)
+    build = {"task": family.name, "sigma": family.sigma, "budget": budget, "fghh_budget": fghh_budget, "seed": seed, "n_steps": n_steps,
+             "safety_episodes": safety_episodes, "lineage": lineage, "optimizer": optimizer, "version": _version()}  # fmt: skip
+    if _stage_file(root, "build").is_file() and json.loads(_stage_file(root, "build").read_text()) == build:
+        say(f"{family.name}: resuming the interrupted build in {root} ({len(list((root / STAGES).glob('*.json'))) - 1} runs finished)")
+    else:
+        shutil.rmtree(root, ignore_errors=True)
+        (root / STAGES).mkdir(parents=True)
+        _stage_file(root, "build").write_text(json.dumps(build) + "\n")
     try:
-        built = _build(family, root, budget, fghh_budget, seed, safety_episodes, n_steps, lineage, optimizer, progress or (lambda _msg: None))
-    except BaseException:  # stopped or failed: nothing half-built is left (a killed build's is removed by the next)
+        built = _build(family, root, budget, fghh_budget, seed, safety_episodes, n_steps, lineage, optimizer, say)
+    except KeyboardInterrupt:  # stopped: the finished runs stay for the same build to resume
+        say(f"{family.name}: stopped; the finished runs are kept in {root}: run the same build again to resume")
+        raise
+    except BaseException:  # failed: nothing half-built is left
         shutil.rmtree(root, ignore_errors=True)
         raise
+    shutil.rmtree(root / STAGES)
     old = final.with_name(final.name + ".replaced")
     shutil.rmtree(old, ignore_errors=True)
     if final.exists():

@@ -113,10 +113,33 @@ def test_a_stopped_rebuild_leaves_the_old_set_as_it_was(tiny_policy_dir: Path, t
     with pytest.raises(KeyboardInterrupt):
         build_policy_set("ghh08", tmp_path, budget=30, n_steps=100, safety_episodes=1, progress=stop)
     assert {p.name: p.read_bytes() for p in (tmp_path / "ghh08").iterdir()} == before
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["ghh08"]  # nothing half-built beside it
-    built = build_policy_set("ghh08", tmp_path, budget=30, n_steps=100, safety_episodes=1, lineage="independent")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ghh08", "ghh08.building"]  # its finished run kept beside it
+    built = build_policy_set("ghh08", tmp_path, budget=30, n_steps=100, safety_episodes=1, lineage="independent")  # another build
     assert built.directory == tmp_path / "ghh08" and sorted(p.name for p in tmp_path.iterdir()) == ["ghh08"]
     assert not (tmp_path / "ghh08" / "ancestor.json").exists()  # the new set replaced the old one whole
+    assert not (tmp_path / "ghh08" / "stages").exists()
+
+
+def test_a_stopped_build_resumes_from_its_finished_runs_to_the_same_set(tmp_path: Path) -> None:
+    """issue 37, fourth trial: a build stopped after some stages started over at stage 1 when run again."""
+    whole = build_policy_set("ghh08", tmp_path / "whole", budget=20, n_steps=30, safety_episodes=1)
+    said: list[str] = []
+
+    def stop_after_three(message: str) -> None:
+        said.append(message)
+        if len(said) == 3:
+            raise KeyboardInterrupt
+
+    args = {"budget": 20, "n_steps": 30, "safety_episodes": 1}
+    with pytest.raises(KeyboardInterrupt):
+        build_policy_set("ghh08", tmp_path / "stopped", progress=stop_after_three, **args)
+    said.clear()
+    resumed = build_policy_set("ghh08", tmp_path / "stopped", progress=said.append, **args)
+    assert said[0].startswith("ghh08: resuming the interrupted build") and sum("kept from the interrupted build" in m for m in said) == 3
+    for a, b in zip((whole.generic, *whole.specialised), (resumed.generic, *resumed.specialised), strict=True):
+        np.testing.assert_array_equal(a.genome, b.genome)
+    assert sorted(p.name for p in (tmp_path / "stopped").iterdir()) == ["ghh08"]
+    assert sorted(p.name for p in (tmp_path / "stopped" / "ghh08").iterdir()) == sorted(p.name for p in (tmp_path / "whole" / "ghh08").iterdir())
 
 
 def test_table3_summary_averages_own_mdp_and_all_mdps() -> None:

@@ -198,7 +198,8 @@ def test_a_stop_is_named_by_its_signal_also_when_raised_while_handling_it() -> N
 
 
 def test_a_terminated_build_leaves_no_half_built_set(tmp_path: Path) -> None:
-    """issue 37, third trial: SIGTERM (timeout, kill) left <out>/ghh08.building until the next build; Ctrl-C did not."""
+    """issue 37, third trial: SIGTERM (timeout, kill) left <out>/ghh08.building without a word; now it ends as Ctrl-C
+    does, keeping only the finished runs beside the set, which the same build resumes from (fourth trial)."""
     out = tmp_path / "bp"
     # The build's kernels compiled (or loaded) first by a tiny build, so the SIGTERM lands in the evolution; one landing in
     # numba's compilation is test_an_interrupt_dropped_in_a_c_callback_is_delivered_again's case.
@@ -214,7 +215,9 @@ def test_a_terminated_build_leaves_no_half_built_set(tmp_path: Path) -> None:
         assert building.is_dir(), (tmp_path / "stderr.txt").read_text()[-2000:]
         os.kill(proc.pid, signal.SIGTERM)
         assert proc.wait(timeout=60) == 143  # terminated, also when the stop lands mid-evolution (it said interrupted, 130)
-        assert not building.exists() and not (out / "ghh08").exists()
+        err = (tmp_path / "stderr.txt").read_text()
+        assert "the finished runs are kept in" in err and err.strip().splitlines()[-1].endswith("terminated"), err[-1500:]
+        assert not (out / "ghh08").exists() and sorted(p.name for p in building.iterdir()) == ["stages"]  # no half-built set
     finally:
         _end_group(proc)
 

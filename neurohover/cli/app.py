@@ -99,9 +99,9 @@ def _run(argv: Sequence[str] | None) -> int:
         named.error(f"argument {odd!r} holds digits of another script: give numbers in ASCII digits")
     if "--version" in given and len(given) > 1:  # argparse prints the version and drops the rest without a word
         parser.error(f"--version takes no other arguments, got {' '.join(a for a in given if a != '--version')!r}")
-    for action in named._actions:  # argparse keeps the last of --x --no-x without a word (fourth trial)
-        if isinstance(action, argparse.BooleanOptionalAction) and all(any(g.split("=")[0] == o for g in given) for o in action.option_strings):
-            named.error(f"{' and '.join(action.option_strings)} are both given: give one")
+    for option in named._actions:  # argparse keeps the last of --x --no-x without a word (fourth trial)
+        if isinstance(option, argparse.BooleanOptionalAction) and all(any(g.split("=")[0] == o for g in given) for o in option.option_strings):
+            named.error(f"{' and '.join(option.option_strings)} are both given: give one")
     args, extra = parser.parse_known_args(argv)
     if extra:  # argparse reports them from the top parser, without the command's name
         named.error(f"unrecognized arguments: {' '.join(extra)}")
