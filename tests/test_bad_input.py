@@ -318,3 +318,14 @@ def test_a_build_says_it_replaces_the_set_in_its_out_directory(tmp_path: Path, c
     argv = ["build-policies", "--task", "ghh08", "--budget", "2", "--episode-steps", "10", "--out", str(tmp_path)]
     assert main(argv) == 0 and "is replaced" not in capsys.readouterr().err
     assert main(argv) == 0 and f"note: the set {tmp_path / 'ghh08'} is replaced once the build completes" in capsys.readouterr().err
+
+
+def test_a_negative_value_is_named_by_its_option_not_taken_for_one(tmp_path: Path, capsys) -> None:
+    """issue 37, fourth trial: `wins --runs -1,5` said only "argument --runs: expected one argument"."""
+    from neurohover.experiments import Store
+
+    Store(tmp_path / "s.sqlite").close()
+    assert main(["wins", "fig7", "--store", str(tmp_path / "s.sqlite"), "--runs", "-1,5"]) == 2
+    assert "--runs '-1,5' is not allowed: give whole numbers >= 1" in capsys.readouterr().err
+    assert main(["fly", "--task", "ghh08", "--episodes", "-1"]) == 2
+    assert "--episodes -1 is out of range" in capsys.readouterr().err

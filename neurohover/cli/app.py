@@ -88,6 +88,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     return status
 
 
+def _negative_values_attached(parser: argparse.ArgumentParser, given: list[str]) -> list[str]:
+    """``--runs -1,5`` as ``--runs=-1,5``: argparse takes a value that starts with '-' and is not a plain number for an
+    option and says only "expected one argument" (fourth trial); attached, the option's own check names it."""
+    takes_value = {o for a in parser._actions if a.nargs is None for o in a.option_strings}
+    out: list[str] = []
+    for arg in given:
+        if out and out[-1] in takes_value and len(arg) > 1 and arg[0] == "-" and (arg[1].isdigit() or arg[1] == "."):
+            out[-1] = f"{out[-1]}={arg}"
+        else:
+            out.append(arg)
+    return out
+
+
 def _run(argv: Sequence[str] | None) -> int:
     parser = build_parser()  # a Ctrl-C while it imports the command modules: the package's hook (neurohover/__init__.py)
     given = list(sys.argv[1:] if argv is None else argv)
@@ -102,7 +115,8 @@ def _run(argv: Sequence[str] | None) -> int:
     for option in named._actions:  # argparse keeps the last of --x --no-x without a word (fourth trial)
         if isinstance(option, argparse.BooleanOptionalAction) and all(any(g.split("=")[0] == o for g in given) for o in option.option_strings):
             named.error(f"{' and '.join(option.option_strings)} are both given: give one")
-    args, extra = parser.parse_known_args(argv)
+    given = _negative_values_attached(named, given)
+    args, extra = parser.parse_known_args(given)
     if extra:  # argparse reports them from the top parser, without the command's name
         named.error(f"unrecognized arguments: {' '.join(extra)}")
     from ..paths import forget_created_dirs, remove_created_dirs
