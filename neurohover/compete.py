@@ -292,7 +292,7 @@ def compete(
         finished run; the store keeps them, and the same call resumes.
     """
     from .agents.registry import check_agent
-    from .paths import output_dir, output_file
+    from .paths import output_dir
 
     _check_run(jobs, device, on_result, progress)  # every check before the output directory is made (third trial)
     check_agent(agent, get_task_family(task, sigma), policy_dir)
@@ -300,11 +300,7 @@ def compete(
         task, agent, runs=runs, episodes=episodes, mdps=mdps, seed=seed, sigma=sigma, n_steps=n_steps, policy_dir=policy_dir, hybrid=hybrid,
         sensor=sensor, drift=drift, wind_model=wind_model, lr_fit=lr_fit, agent_settings=agent_settings,
     )  # fmt: skip
-    store_path = output_file(store, "store") if store is not None else None  # a bad store refused before out is made
-    if store_path is not None and store_path.is_file():
-        from .experiments import Store
-
-        Store(store_path, create=False).close()  # a file that is not a store, refused before out is made (third trial)
+    store_path = _checked_store(store)
     out = output_dir(out, "out")  # made once every setting is checked (None was a TypeError, /dev/full a FileExistsError)
     store_path = store_path or out / STORE_FILE
     ordered = _run_into_store(config, store_path, out / "episodes.csv", jobs=jobs, device=device, progress=progress, on_result=on_result)
@@ -323,6 +319,20 @@ def compete(
         {agent: np.array([np.cumsum(np.array(r.returns, dtype=float)) for r in ordered])}, out / "cumulative.png", f"{task}: {agent}, {len(ordered)} runs"
     )
     return summary, ordered
+
+
+def _checked_store(store) -> Path | None:
+    """The store's path, refused before the output directory is made: a bad path, or a file that is no store (third trial)."""
+    from .paths import output_file
+
+    if store is None:
+        return None
+    path = output_file(store, "store")
+    if path.is_file():
+        from .experiments import Store
+
+        Store(path, create=False).close()
+    return path
 
 
 def _check_run(jobs, device, on_result, progress) -> None:

@@ -230,6 +230,21 @@ MAX_STEPS_PER_CALL, MAX_RECORD_BYTES, RECORD_BYTES_PER_STEP = 10**12, 8 * 2**30,
 MAX_EPISODES_PER_CALL = 100_000_000
 
 
+def _check_call_size(n_jobs: int, n_steps: int, n_rec: int) -> None:
+    """Refuse a call that could not finish (10**8 episodes of 10**7 steps passed every check and ran for years) or whose
+    recorded flight data memory cannot hold (53.7 GiB was a MemoryError); fourth trial."""
+    if n_jobs * n_steps > MAX_STEPS_PER_CALL:
+        raise NeurohoverError(
+            f"{n_jobs:,} episodes of n_steps={n_steps:,} are {n_jobs * n_steps:,} control steps, more than one call flies "
+            f"(at most {MAX_STEPS_PER_CALL:,}, about a day on two cores): use fewer episodes or steps"
+        )
+    if n_rec * (n_steps + 1) * RECORD_BYTES_PER_STEP > MAX_RECORD_BYTES:
+        raise NeurohoverError(
+            f"recording {n_rec:,} episodes of n_steps={n_steps:,} takes {n_rec * (n_steps + 1) * RECORD_BYTES_PER_STEP / 2**30:.1f} GiB "
+            f"of memory, more than {MAX_RECORD_BYTES / 2**30:.0f} GiB: record fewer episodes or steps (several calls, each saved)"
+        )
+
+
 def check_episode_count(n: int, what: str) -> None:
     """Refuse ``n`` episodes in one call above :data:`MAX_EPISODES_PER_CALL` (``what`` names where they come from)."""
     if n > MAX_EPISODES_PER_CALL:
@@ -290,11 +305,6 @@ def evaluate_jobs(
         raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
     p_idx = _index_array(policy_index, None, len(table), "policy_index")
     n_jobs = p_idx.shape[0]
-    if n_jobs * int(n_steps) > MAX_STEPS_PER_CALL:  # 10**8 episodes of 10**7 steps passed every check and ran for years
-        raise NeurohoverError(
-            f"{n_jobs:,} episodes of n_steps={n_steps:,} are {n_jobs * int(n_steps):,} control steps, more than one call flies "
-            f"(at most {MAX_STEPS_PER_CALL:,}, about a day on two cores): use fewer episodes or steps"
-        )
     m_idx = _index_array(mdp_index, n_jobs, rows.shape[0], "mdp_index")
     e_idx = _index_array(episode_index, n_jobs, None, "episode_index")
     if fallback_index is None:
@@ -322,11 +332,7 @@ def evaluate_jobs(
     if rec.shape[0] != n_jobs:
         raise NeurohoverError(f"record must have one flag per job ({n_jobs}), got {rec.shape[0]}")
     n_rec = int(rec.sum())
-    if n_rec * (int(n_steps) + 1) * RECORD_BYTES_PER_STEP > MAX_RECORD_BYTES:  # held in memory whole (53.7 GiB was a MemoryError)
-        raise NeurohoverError(
-            f"recording {n_rec:,} episodes of n_steps={n_steps:,} takes {n_rec * (int(n_steps) + 1) * RECORD_BYTES_PER_STEP / 2**30:.1f} GiB "
-            f"of memory, more than {MAX_RECORD_BYTES / 2**30:.0f} GiB: record fewer episodes or steps (several calls, each saved)"
-        )
+    _check_call_size(n_jobs, int(n_steps), n_rec)
     slots = np.full(n_jobs, -1, dtype=np.int64)
     slots[rec] = np.arange(n_rec)
     obs_out = np.zeros((n_rec, n_steps + 1, 12))

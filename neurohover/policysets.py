@@ -226,7 +226,8 @@ def replaceable_set(task: str, out: str | Path | None) -> Path:
         given = checked_path(out, "out", "directory")
         above = next((p for p in (given, *given.parents) if p.exists()), None)  # the nearest part of it that exists
         if above is not None and not above.is_dir():  # '/dev/full' or a file: a NotADirectoryError once made (fourth trial)
-            raise NeurohoverError(f"out {str(out)!r}: {str(above)!r} is not a directory; give a directory to write the {task} set into")
+            kind = "a file" if above.is_file() else "not a directory"
+            raise NeurohoverError(f"out {str(out)!r}: {str(above)!r} is {kind}; give a directory to write the {task} set into")
     final = policy_dir(task, None if out is None else checked_path(out, "out"))
     if final.exists() and not final.is_dir():
         raise NeurohoverError(f"{str(final)!r} is a file, not a policy set: give another out directory, or remove it")
@@ -275,9 +276,13 @@ def _stage_file(root: Path, key: str) -> Path:
 
 
 def _version() -> str:
-    from . import __version__
+    """The installed neurohover's version (a build resumes only runs of the same code)."""
+    import importlib.metadata
 
-    return __version__
+    try:
+        return importlib.metadata.version("neurohover")
+    except importlib.metadata.PackageNotFoundError:
+        return "0+unknown"
 
 
 #: Episodes per steady-state evolution of a policy set, and per FGHH generic's evolution over G (build_policy_set's

@@ -513,7 +513,7 @@ def _fourth_trial_calls(tmp_path):
         (lambda: make_agent("hybrid-risk", fam, options=AgentOptions(settings={"criterion": "best"})), "bad RiskSettings: risk criterion 'best'"),
         (lambda: make_agent("hybrid-risk", fam, options=AgentOptions(settings=3)), "agent 'hybrid-risk' takes settings of RiskSettings"),
         (lambda: build_policy_set("ghh08", "/dev/full", budget=5, n_steps=10), "out '/dev/full': '/dev/full' is not a directory"),
-        (lambda: build_policy_set("ghh08", tmp_path / "junk.bin", budget=5, n_steps=10), "is not a directory; give a directory"),
+        (lambda: build_policy_set("ghh08", tmp_path / "junk.bin", budget=5, n_steps=10), "is a file; give a directory"),
         (lambda: load_config("fig7", "quick", [1]), "overrides=[1] is not allowed: give a dict"),
         (lambda: reproduce(load_config("fig2", "quick"), "x", "local"), "store='x' is not allowed: give a Store"),
         (lambda: reproduce(load_config("fig2", "quick"), Store(tmp_path / "s.sqlite"), None), "executor=None is not allowed"),

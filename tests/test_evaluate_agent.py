@@ -85,7 +85,10 @@ def test_an_sb3_model_file_is_flown(cli, tmp_path: Path) -> None:
     assert rc == 0, err
     assert _rows(printed)["agent"][-1] == "1" or "of 1" in printed  # one episode flown
     rc, _, err = cli("evaluate-agent", "--task", "ghh08", "--sb3", str(tmp_path / "missing.zip"))
-    assert rc == 2 and "is not a Stable-Baselines3 model file" in err
+    assert rc == 2 and "no such SB3 model file (.zip)" in err
+    np.savez(tmp_path / "flight.npz", x=np.zeros(3))  # a zip, but no model (fourth trial: SB3's AssertionError)
+    rc, _, err = cli("evaluate-agent", "--task", "ghh08", "--sb3", str(tmp_path / "flight.npz"))
+    assert rc == 2 and "is a zip file but not a Stable-Baselines3 model" in err
 
 
 def test_sensor_options_fly_every_policy_through_the_same_sensors(cli, tmp_path, monkeypatch) -> None:

@@ -119,6 +119,16 @@ def _matches_no_unit(config, pattern: str, units) -> NeurohoverError:
     return NeurohoverError(f"{config.name}: --only {pattern!r} matches no unit; unit keys look like {', '.join(examples[:6])}")
 
 
+def _check_arguments(config, store, executor) -> None:
+    """:func:`reproduce`'s arguments of the right kinds (a name or a path was an AttributeError; fourth trial)."""
+    if not isinstance(config, ExperimentConfig):
+        raise NeurohoverError(f"config={config!r:.60} is not allowed: give load_config(NAME, SCALE)")
+    if not isinstance(store, Store):
+        raise NeurohoverError(f"store={store!r:.60} is not allowed: give a Store(PATH)")
+    if not callable(getattr(executor, "run", None)):
+        raise NeurohoverError(f"executor={executor!r:.60} is not allowed: give an executor, make_executor('local', jobs=N) or LocalExecutor(N)")
+
+
 def reproduce(
     config: ExperimentConfig,
     store: Store,
@@ -142,11 +152,7 @@ def reproduce(
     """
     from tqdm import tqdm
 
-    for value, want, what in ((config, ExperimentConfig, "config: give load_config(NAME, SCALE)"), (store, Store, "store: give a Store(PATH)")):
-        if not isinstance(value, want):  # a name or a path was an AttributeError (fourth trial)
-            raise NeurohoverError(f"{what.split(':')[0]}={value!r:.60} is not allowed:{what.split(':')[1]}")
-    if not callable(getattr(executor, "run", None)):
-        raise NeurohoverError(f"executor={executor!r:.60} is not allowed: give an executor, make_executor('local', jobs=N) or LocalExecutor(N)")
+    _check_arguments(config, store, executor)
     store.lock()  # one writer per store: a second run would redo every unit the first has not finished
     check_restart(fresh, update)
     held = store.config_hash(config.name, config.scale)

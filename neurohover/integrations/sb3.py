@@ -119,6 +119,8 @@ def _load(algorithm, path: Path):
         return algorithm.load(path, device="cpu")
     except (zipfile.BadZipFile, KeyError, ValueError, RuntimeError, EOFError, AttributeError, TypeError, pickle.UnpicklingError) as err:
         raise NeurohoverError(f"{str(path)!r} cannot be loaded as a {algorithm.__name__} model: {err}") from None
+    except AssertionError:  # another zip (a flight-data .npz): SB3 asserts that it found its data (fourth trial)
+        raise NeurohoverError(f"{str(path)!r} is a zip file but not a Stable-Baselines3 model (no model data in it)") from None
 
 
 class RecurrentPolicy:
