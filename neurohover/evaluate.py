@@ -313,7 +313,10 @@ def evaluate_jobs(
         fb = np.asarray(fallback_index, dtype=np.int64).reshape(-1)
         if fb.shape[0] != n_jobs or (fb.size and (fb.min() < -1 or fb.max() >= len(table))):
             raise NeurohoverError(f"fallback_index must have {n_jobs} entries in -1..{len(table) - 1}")
-    limits = SAFEGUARD_LIMITS if safeguard_limits is None else np.asarray(safeguard_limits, dtype=float)
+    try:
+        limits = SAFEGUARD_LIMITS if safeguard_limits is None else np.asarray(safeguard_limits, dtype=float)
+    except (TypeError, ValueError):  # 'x' was NumPy's ValueError (fourth trial)
+        limits = np.full(1, np.nan)  # refused below with the layout
     if (
         limits.shape != (SAFEGUARD_LAYOUT_LEN,)
         or np.isnan(limits).any()

@@ -70,3 +70,16 @@ def test_a_full_disk_leaves_no_empty_figure_store_or_partial_file(tmp_path: Path
         assert sorted(p.name for p in disk.iterdir()) == ["pad"]
     finally:
         subprocess.run(["umount", str(disk)], check=False)
+
+
+def test_a_config_file_name_too_long_and_bad_safeguard_limits_are_named() -> None:
+    """fourth trial: `reproduce <300 x's>.toml` was an OSError, safeguard_limits='x' NumPy's ValueError."""
+    from neurohover import evaluate_jobs, get_task_family
+    from neurohover.experiments import load_config
+    from neurohover.policies import baseline_policy
+
+    with pytest.raises(NeurohoverError, match="config file .* is too long"):
+        load_config("x" * 300 + ".toml", "quick")
+    jobs = [0]
+    with pytest.raises(NeurohoverError, match="safeguard_limits must be 25 numbers"):
+        evaluate_jobs([baseline_policy()], [get_task_family("ghh08").zero()], jobs, jobs, jobs, n_steps=20, fallback_index=jobs, safeguard_limits="x")

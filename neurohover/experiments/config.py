@@ -175,6 +175,9 @@ def resolve_name(name: str | Path) -> Path:
     name = str(name)  # a pathlib.Path of a .toml file too
     path = Path(name)
     if name.endswith(".toml"):
+        from ..paths import checked_path
+
+        checked_path(name, "config file")  # a name too long was an OSError (fourth trial)
         if not path.is_file():
             raise NeurohoverError(f"config file {name!r} does not exist")
         return path
