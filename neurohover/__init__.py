@@ -11,14 +11,6 @@ import os
 import sys
 
 
-def _as_command() -> bool:
-    """This process is the ``neurohover`` command (its script, or ``python -m neurohover``), not a program importing us."""
-    argv = list(getattr(sys, "orig_argv", ()))
-    return (argv[argv.index("-m") + 1 : argv.index("-m") + 2] == ["neurohover"] if "-m" in argv else False) or (
-        os.path.basename(sys.argv[0] if sys.argv else "") == "neurohover"
-    )
-
-
 def _interrupted(kind, value, tb) -> None:
     if issubclass(kind, KeyboardInterrupt):  # Ctrl-C or SIGTERM while NumPy and numba import, before main() can catch it
         terminated = kind.__name__ == "Terminated"
@@ -34,7 +26,9 @@ def _terminate(signum, frame) -> None:
     raise Terminated(f"signal {signum}")
 
 
-if _as_command():
+from .command import running_as_command  # noqa: E402  (stdlib only: before NumPy and numba import)
+
+if running_as_command():
     import signal
 
     sys.excepthook = _interrupted

@@ -162,11 +162,19 @@ def test_the_workers_of_a_killed_compete_exit(tmp_path: Path, sig: int) -> None:
         _end_group(proc)
 
 
+def _ctrl_c_as_in_a_terminal() -> None:
+    """The child starts with Ctrl-C's default disposition, as a terminal's command does, whatever this worker's is."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 @pytest.mark.parametrize("delay", [0.6, 1.2, 2.5])  # from the package's import on (before it, Python itself is starting)
 def test_ctrl_c_at_any_moment_ends_with_one_line_and_130(delay: float) -> None:
     """issue 37, third trial: a Ctrl-C while the package imported NumPy and numba was a KeyboardInterrupt traceback (the
     package is imported before main() runs); later ones were already one line."""
-    proc = subprocess.Popen([sys.executable, "-m", "neurohover", "fly", "--task", "ghh08", "--episodes", "100000"], stderr=subprocess.PIPE, text=True, env=ENV)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "neurohover", "fly", "--task", "ghh08", "--episodes", "100000"], stderr=subprocess.PIPE, text=True, env=ENV,
+        preexec_fn=_ctrl_c_as_in_a_terminal,
+    )  # fmt: skip
     time.sleep(delay)  # wherever it lands, the outcome must be the same
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
@@ -231,6 +239,14 @@ def test_an_interrupt_dropped_in_a_c_callback_is_delivered_again(stop: BaseExcep
     """issue 37, third trial: a SIGTERM landing in numba's compilation was raised inside llvmlite's ctypes callback,
     where Python prints and drops it, and the command ran on (3 of 10 terminated compile loops ran on before the fix)."""
     callback = ctypes.CFUNCTYPE(None)(lambda: _raise(stop))
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)  # Python's Ctrl-C, whatever this worker's is
+    try:
+        _deliver_again_and_wait(callback, stop)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _deliver_again_and_wait(callback, stop: BaseException) -> None:
     with pytest.raises(type(stop)), sigterm_as_interrupt():
         callback()  # the exception is dropped here, as in llvmlite's object-cache notify
         deadline = time.monotonic() + 30
@@ -458,3 +474,14 @@ def test_a_ctrl_c_just_after_a_unit_commits_stays_a_ctrl_c_and_keeps_the_unit(tm
             store.put("exp", "quick", "h" * 16, Unit("exp", "u0", "diagnostic", {"value": 1}), {"value": 1}, 0.1)
         store.conn = conn
         assert list(store.results("exp", "quick")) == ["u0"]  # committed: kept
+
+
+def test_main_called_in_a_program_leaves_its_signals_as_they_were(monkeypatch, capsys) -> None:
+    """The command ignores Ctrl-C and SIGTERM once it is done (so they cannot kill it while it exits), but only as the
+    ``neurohover`` process itself: main() called from Python without arguments left a test worker deaf to Ctrl-C."""
+    from neurohover.cli import main
+
+    monkeypatch.setattr(sys, "argv", ["a-program", "settings"])
+    before = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
+    assert main() == 0
+    assert (signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)) == before

@@ -14,6 +14,7 @@ import unicodedata
 from collections.abc import Sequence
 
 from .. import __version__
+from ..command import running_as_command
 from ..errors import NeurohoverError
 from . import agents, evaluate, flying, learning, plots, reproduce
 
@@ -80,7 +81,7 @@ def _other_scripts_digits(argv: Sequence[str]) -> str | None:
 def main(argv: Sequence[str] | None = None) -> int:
     """The command line: ``neurohover ARGS`` (``argv``: the arguments, default ``sys.argv[1:]``); the exit status."""
     status = _run(argv)
-    if argv is None:  # the process's own command line (not a call from Python, whose signals stay as they are)
+    if argv is None and running_as_command():  # the command's own process (a program calling main() keeps its signals)
         # The command is over and has said so: a Ctrl-C or SIGTERM now would kill the interpreter while it exits, with
         # no line and a status saying that the finished command was stopped (fourth trial).
         signal.signal(signal.SIGINT, signal.SIG_IGN)
