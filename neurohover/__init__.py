@@ -13,26 +13,21 @@ import sys
 
 def _interrupted(kind, value, tb) -> None:
     if issubclass(kind, KeyboardInterrupt):  # Ctrl-C or SIGTERM while NumPy and numba import, before main() can catch it
-        terminated = kind.__name__ == "Terminated"
+        terminated = issubclass(kind, Terminated)
         print(f"neurohover: {'terminated' if terminated else 'interrupted'}", file=sys.stderr, flush=True)
         os._exit(143 if terminated else 130)  # as main() ends them (Python would end by the signal itself)
     else:
         sys.__excepthook__(kind, value, tb)
 
 
-def _terminate(signum, frame) -> None:
-    from .errors import Terminated
-
-    raise Terminated(f"signal {signum}")
-
-
 from .command import running_as_command  # noqa: E402  (stdlib only: before NumPy and numba import)
+from .errors import Terminated, raise_terminated  # noqa: E402
 
 if running_as_command():
     import signal
 
     sys.excepthook = _interrupted
-    signal.signal(signal.SIGTERM, _terminate)  # from the first import on, SIGTERM ends the command as Ctrl-C does (fourth trial)
+    signal.signal(signal.SIGTERM, raise_terminated)  # from the first import on, SIGTERM ends the command as Ctrl-C does (fourth trial)
 
 from .errors import NeurohoverError  # noqa: E402
 from .evaluate import DangerousState, Evaluation, PolicyTable, Safeguard, evaluate, evaluate_jobs  # noqa: E402

@@ -14,6 +14,11 @@ class Terminated(KeyboardInterrupt):
     """SIGTERM arrived where the command handles it (like Ctrl-C: finished work kept, one line, status 143)."""
 
 
+def raise_terminated(signum, frame) -> None:
+    """A SIGTERM handler: the signal as :class:`Terminated` in the main thread."""
+    raise Terminated(f"signal {signum}")
+
+
 def settings_from_dict(cls: type, values: Any, *, unknown_what: str, bad_what: str) -> Any:
     """An instance of the settings dataclass ``cls`` from a dict of some of its fields: unknown keys and
     values ``cls`` refuses (TypeError, ValueError) become one NeurohoverError each, naming them."""

@@ -25,7 +25,7 @@ import time
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
 
-from .errors import Terminated
+from .errors import Terminated, raise_terminated
 
 WATCH_SECONDS = 0.5  # how often a worker checks that its parent is alive
 
@@ -114,10 +114,6 @@ def stop_words(stop: BaseException) -> tuple[str, int]:
     return "interrupted", 130
 
 
-def _raise_terminated(signum, frame) -> None:
-    raise Terminated(f"signal {signum}")
-
-
 #: How long a dropped Ctrl-C or SIGTERM waits before it is delivered again (time to leave the C callback).
 REDELIVER_SECONDS = 0.05
 
@@ -161,7 +157,7 @@ def sigterm_as_interrupt() -> Iterator[None]:
     if threading.current_thread() is not threading.main_thread() or signal.getsignal(signal.SIGTERM) != signal.SIG_DFL:
         yield
         return
-    signal.signal(signal.SIGTERM, _raise_terminated)
+    signal.signal(signal.SIGTERM, raise_terminated)
     try:
         with interrupts_survive_callbacks():
             yield
