@@ -473,3 +473,48 @@ def test_evolve_says_when_the_plateau_ends_a_run_before_its_budget(tmp_path: Pat
     assert "note:" not in capsys.readouterr().err
     assert main([*args, "--budget", "20"]) == 0  # below the first population of 50: flown whole, and said (second trial)
     assert "note: flew 50 episodes for the --budget 20" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "damage, message",
+    [
+        (lambda s: [s], "is not an evolution checkpoint"),
+        (lambda s: s.pop("config"), "damaged checkpoint: it has no 'config' entry"),
+        (lambda s: s.update(optimizer_state="x"), "cannot restore the optimiser \\(ValueError: state dict is a str"),
+        (lambda s: s["optimizer_state"].update(population={"shape": [50, 3], "data": [0.0] * 150}), "population has shape \\(50, 3\\), expected \\(n, 42\\)"),
+        (lambda s: s["optimizer_state"].update(champion_genome={"shape": [3], "data": [0.0] * 3}), "optimiser \\(ValueError: champion genome has shape"),
+        (lambda s: s["optimizer_state"].update(rng={"bit_generator": "XX"}), "not one of a numpy bit generator"),
+        (lambda s: s.pop("counters"), "it has no 'counters' entry"),
+        (lambda s: s["counters"].update(episodes=-5), "counter 'episodes' is -5, not a count"),
+        (lambda s: s["counters"].update(wall_seconds=-1.0), "counter 'wall_seconds' is -1.0"),
+        (lambda s: s["champion"].update(genome=[1.0, 2.0, 3.0]), "champion genome has shape \\(3,\\), expected \\(42,\\)"),
+        (lambda s: s["champion"].update(genome=None, **{"return": "abc"}), "ValueError: could not convert string to float"),
+        (lambda s: s.update(history=["x"]), "damaged checkpoint: ValueError"),
+        (lambda s: s.update(mdp_stream=None), "damaged checkpoint: TypeError"),
+    ],
+)
+def test_a_damaged_checkpoint_is_refused_by_name(tmp_path: Path, damage, message) -> None:
+    """Issue 37's fifth trial: a hand-damaged checkpoint raised AttributeError, KeyError or TypeError from inside the
+    restore, or was accepted (negative counters, a short champion genome, a population of other genomes)."""
+    ckpt = tmp_path / "run.ckpt.json"
+    common = dict(topology="mlp", prototype="baseline", seed=3, n_steps=20)
+    evolve(GHH08, budget=60, checkpoint=ckpt, **common)
+    state = json.loads(ckpt.read_text())
+    out = damage(state)
+    ckpt.write_text(json.dumps(out if isinstance(out, list) else state))
+    with pytest.raises(NeurohoverError, match=message):
+        evolve(GHH08, budget=120, checkpoint=ckpt, resume=True, **common)
+
+
+def test_a_steady_state_optimiser_refuses_a_state_of_other_genomes() -> None:
+    from neurohover.evolution.steady_state import SteadyStateNE
+
+    opt = SteadyStateNE(np.zeros(5), seed=1)
+    opt.tell(np.zeros(len(opt.ask())))
+    state = opt.state_dict()
+    back = SteadyStateNE.from_state_dict(json.loads(json.dumps(state))).state_dict()
+    assert {k: v for k, v in back.items() if k != "wall_seconds"} == {k: v for k, v in state.items() if k != "wall_seconds"}
+    with pytest.raises(ValueError, match="fitness has shape \\(2,\\): one return per genome of the population"):
+        SteadyStateNE.from_state_dict({**state, "fitness": {"shape": [2], "data": [0.0, 0.0]}})
+    with pytest.raises(ValueError, match="pending genomes has shape \\(1, 4\\), expected \\(n, 5\\)"):
+        SteadyStateNE.from_state_dict({**state, "pending": {"shape": [1, 4], "data": [0.0] * 4}})

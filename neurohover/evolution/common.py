@@ -35,6 +35,7 @@ __all__ = [
     "TellInfo",
     "check_prototype",
     "check_returns",
+    "check_genomes",
     "check_state",
     "dec_array",
     "enc_array",
@@ -220,8 +221,31 @@ def dec_array(d: dict[str, Any] | None) -> np.ndarray | None:
     return np.array([float(v) for v in d["data"]], dtype=np.float64).reshape(d["shape"])
 
 
+@overload
+def check_genomes(a: np.ndarray, size: int, name: str, rows: int | None = None) -> np.ndarray: ...
+@overload
+def check_genomes(a: None, size: int, name: str, rows: int | None = None) -> None: ...
+@overload
+def check_genomes(a: np.ndarray | None, size: int, name: str, rows: int | None = None) -> np.ndarray | None: ...
+def check_genomes(a: np.ndarray | None, size: int, name: str, rows: int | None = None) -> np.ndarray | None:
+    """``a`` (a state's decoded array) unless it is not genomes of ``size`` genes (``rows`` of them, or one genome when
+    ``rows`` is 0): ValueError naming ``name``, so that a damaged checkpoint is refused on reading, not mid-run."""
+    if a is None:
+        return None
+    if rows == 0:
+        ok, expected = a.shape == (size,), f"({size},)"
+    else:
+        ok = a.ndim == 2 and a.shape[1] == size and (rows is None or a.shape[0] == rows)
+        expected = f"({'n' if rows is None else rows}, {size})"
+    if not ok:
+        raise ValueError(f"{name} has shape {a.shape}, expected {expected} (genomes of {size} genes)")
+    return a
+
+
 def rng_from_state(state: dict[str, Any]) -> np.random.Generator:
     """A ``numpy.random.Generator`` in the saved ``bit_generator.state``."""
+    if not isinstance(state, dict) or state.get("bit_generator") not in ("PCG64", "PCG64DXSM", "MT19937", "Philox", "SFC64"):
+        raise ValueError(f"random state {state!r:.80} is not one of a numpy bit generator")
     bit_generator = getattr(np.random, state["bit_generator"])()
     bit_generator.state = state
     return np.random.Generator(bit_generator)
@@ -229,6 +253,8 @@ def rng_from_state(state: dict[str, Any]) -> np.random.Generator:
 
 def check_state(state: dict[str, Any], kind: str) -> None:
     """ValueError unless ``state`` is a ``state_dict`` of type ``kind`` in :data:`STATE_VERSION`."""
+    if not isinstance(state, dict):
+        raise ValueError(f"state dict is a {type(state).__name__}, not a dict")
     if state.get("type") != kind:
         raise ValueError(f"state dict is for {state.get('type')!r}, not {kind!r}")
     if state.get("version") != STATE_VERSION:

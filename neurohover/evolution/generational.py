@@ -20,6 +20,7 @@ from .common import (
     STATE_VERSION,
     Clock,
     TellInfo,
+    check_genomes,
     check_prototype,
     check_returns,
     check_state,
@@ -400,14 +401,15 @@ class GenerationalNE:
         """Rebuild an optimiser from :meth:`state_dict`; it continues identically."""
         check_state(state, "GenerationalNE")
         opt = cls(dec_array(state["prototype"]), GenerationalSettings(**{**OLD_GENERATIONAL, **state["settings"]}))
-        opt._population = dec_array(state["population"])
+        d = opt._prototype.size
+        opt._population = check_genomes(dec_array(state["population"]), d, "population")
         opt._asked = bool(state["asked"])
         opt._generation = int(state["generation"])
         opt._evaluations = int(state["evaluations"])
-        opt._champion_genome = dec_array(state["champion_genome"])
+        opt._champion_genome = check_genomes(dec_array(state["champion_genome"]), d, "champion genome", rows=0)
         opt._champion_return = float(state["champion_return"])
-        opt._parents = dec_array(state.get("parents"))  # absent from checkpoints written before 2026-12-04
-        opt._hall = [(float(r), dec_array(g)) for r, g in state.get("hall_of_fame", [])]
+        opt._parents = check_genomes(dec_array(state.get("parents")), d, "parents")  # absent from checkpoints written before 2026-12-04
+        opt._hall = [(float(r), check_genomes(dec_array(g), d, "hall of fame genome", rows=0)) for r, g in state.get("hall_of_fame", [])]
         opt._history = [GenerationRecord(int(g), int(e), int(ep), float(r), float(w)) for g, e, ep, r, w in state["history"]]
         opt._rng = rng_from_state(state["rng"])
         opt._clock = Clock(float(state["wall_seconds"]))

@@ -151,10 +151,15 @@ class Run:
 
     def restore(self, state: dict, source: str) -> None:
         """Continue from checkpoint ``state`` (read from ``source``, named in errors); its run must
-        be this one, except the budget."""
-        if state.get("format") != CHECKPOINT_FORMAT:
+        be this one, except the budget. A damaged checkpoint is refused by name, nothing restored."""
+        if not isinstance(state, dict) or state.get("format") != CHECKPOINT_FORMAT:
             raise NeurohoverError(f"{source} is not an evolution checkpoint (expected format {CHECKPOINT_FORMAT!r})")
-        saved = upgrade_saved_config(state["config"])
+        try:
+            saved = upgrade_saved_config(state["config"])
+            if not isinstance(saved, dict):
+                raise TypeError(f"its config is a {type(saved).__name__}, not a table")
+        except (KeyError, TypeError, ValueError, AttributeError) as err:
+            raise NeurohoverError(f"{source} is a damaged checkpoint: {_damage(err)}; resume from an undamaged copy or start again without resuming") from None
         if saved != self.config:
             diff = sorted(k for k in set(saved) | set(self.config) if saved.get(k) != self.config.get(k))
             raise NeurohoverError(
@@ -162,23 +167,26 @@ class Run:
                 "target, method, optimizer, resampling, topology, prototype, seed, episode steps and settings (only the budget may change)"
             )
         try:
-            self.opt = type(self.opt).from_state_dict(state["optimizer_state"])
-        except (ValueError, KeyError, TypeError, pickle.UnpicklingError) as err:
-            raise NeurohoverError(f"{source}: cannot restore the optimiser ({err})") from None
-        c = state["counters"]
-        self.flyer.episodes, self.flyer.steps = int(c["episodes"]), int(c["steps"])
-        # Checkpoints before races reserved indices: every index flown was counted.
-        self.flyer.next_index, self.flyer.flown = int(c.get("next_index", c["episodes"])), int(c.get("flown", c["episodes"]))
-        self.flyer.kernel_seconds = float(c["kernel_seconds"])
-        self.generation, self.evaluations = int(c["generation"]), int(c["evaluations"])
-        self.elapsed = float(c["wall_seconds"])
+            opt = type(self.opt).from_state_dict(state["optimizer_state"])
+        except (ValueError, KeyError, TypeError, AttributeError, IndexError, OverflowError, pickle.UnpicklingError) as err:
+            raise NeurohoverError(f"{source}: cannot restore the optimiser ({_damage(err)})") from None
+        try:
+            parts = _restored_parts(state, self.resampling.delta, self.cfg.prototype.genome.size)
+            if self.mdp_rng is not None:
+                stream = np.random.Generator(type(self.mdp_rng.bit_generator)())
+                stream.bit_generator.state = state["mdp_stream"]
+        except (KeyError, TypeError, ValueError, AttributeError, IndexError, OverflowError) as err:
+            raise NeurohoverError(f"{source} is a damaged checkpoint: {_damage(err)}; resume from an undamaged copy or start again without resuming") from None
+        self.opt = opt
         if self.mdp_rng is not None:
-            self.mdp_rng.bit_generator.state = state["mdp_stream"]
-        ch = state["champion"]
-        self.champion_genome = None if ch["genome"] is None else np.array(ch["genome"], dtype=float)
-        self.champion_return = float(ch["return"])
-        self.history = decode_history(state["history"])
-        self.race_delta = state.get("race_delta", self.resampling.delta)  # absent before race:auto: the fixed delta
+            self.mdp_rng = stream
+        counts, seconds = parts["counters"], parts["seconds"]
+        self.flyer.episodes, self.flyer.steps, self.flyer.next_index, self.flyer.flown = (counts[k] for k in ("episodes", "steps", "next_index", "flown"))
+        self.generation, self.evaluations = counts["generation"], counts["evaluations"]
+        self.flyer.kernel_seconds, self.elapsed = seconds["kernel_seconds"], seconds["wall_seconds"]
+        self.champion_genome, self.champion_return = parts["champion"]
+        self.history = parts["history"]
+        self.race_delta = parts["race_delta"]
 
     # ----------------------------------------------------------------- fitness
 
@@ -442,3 +450,33 @@ class Run:
             parents=getattr(self.opt, "parents", None),
             hall_of_fame=getattr(self.opt, "hall_of_fame", None),
         )
+
+
+def _damage(err: Exception) -> str:
+    """What a damaged checkpoint's error says, in a few words."""
+    return f"it has no {err.args[0]!r} entry" if isinstance(err, KeyError) else f"{type(err).__name__}: {err}"
+
+
+def _restored_parts(state: dict, delta: Any, genome_size: int) -> dict[str, Any]:
+    """The run's counters, champion, history and race delta read from checkpoint ``state``, each checked (ValueError,
+    TypeError or KeyError naming what is wrong), before any of them is restored."""
+    c = state["counters"]
+    counts = {k: c[k] for k in ("episodes", "steps", "generation", "evaluations")}
+    # Checkpoints before races reserved indices: every index flown was counted.
+    counts["next_index"], counts["flown"] = c.get("next_index", c["episodes"]), c.get("flown", c["episodes"])
+    for k, v in counts.items():
+        if isinstance(v, bool) or not isinstance(v, int) or v < 0:
+            raise ValueError(f"counter {k!r} is {v!r}, not a count (an integer >= 0)")
+    seconds = {k: float(c[k]) for k in ("wall_seconds", "kernel_seconds")}
+    for k, v in seconds.items():
+        if not (math.isfinite(v) and v >= 0):
+            raise ValueError(f"counter {k!r} is {v!r}, not a number of seconds >= 0")
+    ch = state["champion"]
+    genome = None if ch["genome"] is None else np.array(ch["genome"], dtype=float)
+    if genome is not None and genome.shape != (genome_size,):
+        raise ValueError(f"the champion genome has shape {genome.shape}, expected ({genome_size},)")
+    race_delta = state.get("race_delta", delta)  # absent before race:auto: the fixed delta
+    if race_delta is not None and (isinstance(race_delta, bool) or not isinstance(race_delta, (int, float)) or not 0 < race_delta < 1):
+        raise ValueError(f"race_delta is {race_delta!r}, not a confidence level in (0, 1)")
+    history = decode_history(state["history"])
+    return {"counters": counts, "seconds": seconds, "champion": (genome, float(ch["return"])), "history": history, "race_delta": race_delta}

@@ -23,6 +23,7 @@ from .common import (
     ChampionViews,
     Clock,
     TellInfo,
+    check_genomes,
     check_prototype,
     check_returns,
     check_state,
@@ -420,9 +421,12 @@ class SteadyStateNE(ChampionViews):
         # States written before the plateau rule existed followed the literal rule.
         settings = {"plateau_rule": "literal", **state["settings"]}
         opt = cls(dec_array(state["prototype"]), SteadyStateSettings(**settings))
-        opt._population = dec_array(state["population"])
+        d = opt._prototype.size
+        opt._population = check_genomes(dec_array(state["population"]), d, "population")
         opt._fitness = dec_array(state["fitness"])
-        opt._pending = dec_array(state["pending"])
+        if (opt._population is None) != (opt._fitness is None) or (opt._fitness is not None and opt._fitness.shape != (len(opt._population),)):
+            raise ValueError(f"fitness has shape {None if opt._fitness is None else opt._fitness.shape}: one return per genome of the population")
+        opt._pending = check_genomes(dec_array(state["pending"]), d, "pending genomes")
         opt._generation = int(state["generation"])
         opt._rng = rng_from_state(state["rng"])
         opt._tracker = ChampionTracker.from_dict(state["tracker"])

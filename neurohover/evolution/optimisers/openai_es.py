@@ -29,6 +29,7 @@ from ..common import (
     Clock,
     PopulationOptimiser,
     TellInfo,
+    check_genomes,
     check_prototype,
     check_state,
     dec_array,
@@ -179,9 +180,10 @@ class OpenAIES(PopulationOptimiser):
         """The optimiser :meth:`state_dict` saved; it continues bit-for-bit identically."""
         check_state(state, "OpenAIES")
         opt = cls(dec_array(state["mean"]), OpenAIESSettings(**state["settings"]))
-        opt._m, opt._v = dec_array(state["adam"][0]), dec_array(state["adam"][1])
+        d = opt.mean.size
+        opt._m, opt._v = (check_genomes(dec_array(state["adam"][i]), d, "Adam moment", rows=0) for i in (0, 1))
         opt.generation = int(state["generation"])
-        opt._eps = dec_array(state["pending"])
+        opt._eps = check_genomes(dec_array(state["pending"]), d, "pending noise", rows=opt.popsize // 2)
         opt._rng = rng_from_state(state["rng"])
         opt._tracker = ChampionTracker.from_dict(state["tracker"])
         opt._clock = Clock(float(state["wall_seconds"]))
