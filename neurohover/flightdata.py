@@ -106,6 +106,13 @@ class FlightData:
             if isinstance(err, NeurohoverError):
                 raise
             raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file ({type(err).__name__}: {err})") from None
+        if not isinstance(metadata, dict):  # a list was an AttributeError in learn-model (fifth trial)
+            raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file: its metadata is a {type(metadata).__name__}, not a JSON object")
+        if lengths.ndim != 1 or lengths.dtype.kind not in "iu" or (lengths < 0).any():  # float or text lengths were NumPy errors
+            raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file: its episode lengths are not one count (an integer >= 0) per episode")
+        if obs.dtype.kind != "f" or act.dtype.kind != "f":
+            kinds = f"{obs.dtype} and {act.dtype}"
+            raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file: its observations and actions are {kinds}, not real numbers")
         if lengths.size == 0 or lengths.sum() == 0:
             raise NeurohoverError(f"flight-data file {str(path)!r} holds no transitions")
         if obs.shape != (int(lengths.sum() + lengths.size), 12) or act.shape != (int(lengths.sum()), 4):

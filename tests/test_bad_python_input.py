@@ -536,3 +536,27 @@ def test_a_complex_mdp_parameter_is_refused_not_cut_to_its_real_part() -> None:
     """issue 37, fourth trial: fam.make(np.array([1+2j, 0])) flew wind (1, 0) after a NumPy ComplexWarning."""
     with pytest.raises(NeurohoverError, match=re.escape("GHH-08 wind (wind_u, wind_v) must be 2 numbers, got array([1.+2.j, 0.+0.j])")):
         nh.get_task_family("ghh08").make(np.array([1 + 2j, 0]))
+
+
+def test_a_flight_data_file_with_damaged_parts_is_refused_by_name(tmp_path) -> None:
+    """Fifth trial: metadata that is a list, episode lengths in floats or text, and text observations were an
+    AttributeError in learn-model and NumPy errors (split, sum) in FlightData.load."""
+    import json
+
+    from neurohover.flightdata import FORMAT, FlightData
+
+    fd = nh.evaluate(nh.baseline_policy(), nh.get_task_family("ghh08").zero(), episodes=2, n_steps=10, record=True).flight_data
+    good = dict(np.load(fd.save(tmp_path / "fd.npz")))
+    assert str(good["format"]) == FORMAT
+    for name, change, message in (
+        ("meta", {"metadata": np.array(json.dumps([1, 2]))}, "its metadata is a list, not a JSON object"),
+        ("lenfloat", {"lengths": np.array([10.0, 10.0])}, "episode lengths are not one count"),
+        ("lentext", {"lengths": np.array(["10", "10"])}, "episode lengths are not one count"),
+        ("len2d", {"lengths": np.array([[10, 10]])}, "episode lengths are not one count"),
+        ("lenneg", {"lengths": np.array([-1, 21])}, "episode lengths are not one count"),
+        ("obstext", {"observations": good["observations"].astype(str)}, "observations and actions are <U32 and float64, not real numbers"),
+    ):
+        path = tmp_path / f"{name}.npz"
+        np.savez(path, **{**good, **change})
+        with pytest.raises(NeurohoverError, match=message):
+            FlightData.load(path)
