@@ -120,12 +120,20 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
         raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r} must be a JSON object, got {type(manifest).__name__}")
     if manifest.get("task", family.name) != family.name:  # another task's set copied under this name: its policies fly the wrong task
         raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r} is of task {manifest['task']!r}, not {family.name!r}")
+    if manifest.get("sigma") is not None and (isinstance(manifest["sigma"], bool) or not isinstance(manifest["sigma"], (int, float))):
+        raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r}: sigma={manifest['sigma']!r:.40} is not allowed: give the breadth it was built for")
     if family.generic_over_distribution:
         generics = {name: _load(root / f"generic_{name}.json", f"the {name} generic policy") for name in FGHH_GENERICS}
         return PolicySet(family.name, root, generics["race"], generics=generics, manifest=manifest)
     generic = _load(root / "generic.json", "the generic policy")
     specialised = tuple(_load(root / f"specialised_{i}.json", f"specialised policy {i}") for i in range(10))
-    return PolicySet(family.name, root, generic, specialised, tuple(manifest.get("safe", ())), manifest=manifest)
+    safe = manifest.get("safe", [])
+    if not isinstance(safe, list) or not all(type(i) is int and 0 <= i < len(specialised) for i in safe):  # "x" was a TypeError (fifth trial)
+        raise NeurohoverError(
+            f"policy-set manifest {str(manifest_path)!r}: safe={safe!r:.60} is not allowed: give a list of the safe specialised "
+            f"policies' indices, each in 0..{len(specialised) - 1}"
+        )
+    return PolicySet(family.name, root, generic, specialised, tuple(safe), manifest=manifest)
 
 
 def crash_matrix(policies: list[Policy], mdps: list, episodes: int, seed: int, n_steps: int = 6000) -> tuple[np.ndarray, np.ndarray]:

@@ -223,6 +223,20 @@ def test_another_tasks_policy_set_under_a_tasks_name_is_refused(tmp_path: Path) 
         load_policy_set("ghh08", tmp_path)
 
 
+@pytest.mark.parametrize(("task", "key", "value"), [("ghh08", "safe", "x"), ("ghh08", "safe", [99, 100]), ("ghh08", "safe", [1.0]), ("ghh08", "sigma", "x")])
+def test_a_policy_set_manifest_with_bad_entries_is_refused(task: str, key: str, value, tmp_path: Path) -> None:
+    """Fifth trial: a manifest's safe entry "x" or [99, 100] was a TypeError or IndexError when the hybrid agent was made."""
+    import shutil
+
+    from neurohover.policysets import load_policy_set, policy_dir
+
+    shutil.copytree(policy_dir(task), tmp_path / task)
+    manifest = json.loads((tmp_path / task / "manifest.json").read_text())
+    (tmp_path / task / "manifest.json").write_text(json.dumps({**manifest, key: value}))
+    with pytest.raises(NeurohoverError, match=f"manifest .*: {key}=.* is not allowed"):
+        load_policy_set(task, tmp_path)
+
+
 def test_a_repeated_sensor_key_and_a_damaged_store_are_one_clear_line(tmp_path: Path, capsys) -> None:
     """issue 37: a repeated --obs-noise (or key) kept the last silently; a store damaged mid-file was a sqlite3 traceback."""
     assert main(["fly", "--task", "ghh08", "--episodes", "1", "--obs-noise", "velocity=0.1", "--obs-noise", "velocity=0.2"]) == 2
@@ -329,3 +343,21 @@ def test_a_negative_value_is_named_by_its_option_not_taken_for_one(tmp_path: Pat
     assert "--runs '-1,5' is not allowed: give whole numbers >= 1" in capsys.readouterr().err
     assert main(["fly", "--task", "ghh08", "--episodes", "-1"]) == 2
     assert "--episodes -1 is out of range" in capsys.readouterr().err
+
+
+def test_a_stored_run_or_config_of_the_wrong_shape_is_named(tmp_path: Path) -> None:
+    """Fifth trial: a stored test run's result that is a list or lacks its MDP, and a stored config without a title,
+    were TypeError and KeyError tracebacks in `wins` and `report`."""
+    from neurohover.experiments.config import ExperimentConfig, load_config
+    from neurohover.experiments.wins import stored_runs
+
+    key = "run/model-free/test0/rep0"
+    assert stored_runs({key: {"mdp": "ghh08/test:0", "score": -2}}) == {"model-free": {"ghh08/test:0": [-2.0]}}
+    for bad in ([1, 2], {"score": -1.0}, {"mdp": "ghh08/test:0", "score": "x"}, {"mdp": "ghh08/test:0", "score": True}):
+        with pytest.raises(NeurohoverError, match="the stored result of unit 'run/model-free/test0/rep0' is damaged"):
+            stored_runs({key: bad})
+    stored = load_config("fig7", "quick").to_dict()
+    assert ExperimentConfig.from_dict(stored).hash == load_config("fig7", "quick").hash
+    for bad, named in (({**stored, "title": 3}, "title"), ({k: v for k, v in stored.items() if k != "settings"}, "settings"), ([1], "the whole config")):
+        with pytest.raises(NeurohoverError, match=f"a stored experiment config is damaged: {named} missing or of the wrong kind"):
+            ExperimentConfig.from_dict(bad)  # type: ignore[arg-type]

@@ -134,7 +134,12 @@ class ExperimentConfig:
 
     @classmethod
     def from_dict(cls, d: dict) -> ExperimentConfig:
-        """A config as :meth:`to_dict` wrote it (a store's), in today's spelling (:func:`_respelled`)."""
+        """A config as :meth:`to_dict` wrote it (a store's), in today's spelling (:func:`_respelled`); NeurohoverError
+        naming what is missing or of the wrong kind in a damaged one."""
+        kinds = {"name": str, "title": str, "kind": str, "scale": str, "settings": dict}
+        if not isinstance(d, dict) or any(not isinstance(d.get(k), t) for k, t in kinds.items()):  # a KeyError in report (fifth trial)
+            bad = [k for k, t in kinds.items() if not isinstance(d.get(k), t)] if isinstance(d, dict) else ["the whole config"]
+            raise NeurohoverError(f"a stored experiment config is damaged: {', '.join(bad)} missing or of the wrong kind")
         return cls(
             d["name"],
             d["title"],

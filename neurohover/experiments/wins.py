@@ -97,5 +97,8 @@ def stored_runs(results: Mapping[str, dict]) -> dict[str, dict[str, list[float]]
     for key, result in results.items():
         unit = UnitKey.parse(key)
         if unit.stage == "run":
-            runs.setdefault(unit.group, {}).setdefault(str(result["mdp"]), []).append(float(result["score"]))
+            score = result.get("score") if isinstance(result, dict) else None
+            if isinstance(score, bool) or not isinstance(score, (int, float)) or "mdp" not in result:  # fifth trial: KeyError, TypeError
+                raise NeurohoverError(f"the stored result of unit {key!r} is damaged: a test run's result names its MDP and a real score")
+            runs.setdefault(unit.group, {}).setdefault(str(result["mdp"]), []).append(float(score))
     return runs
