@@ -67,7 +67,7 @@ def checked_path(path, option: str, what: str = "file path") -> Path:
         raise NeurohoverError(f"{option} is empty; give a {what}")
     if "\x00" in text:
         raise NeurohoverError(f"{option} {text!r:.80} holds a NUL character: give a {what}")
-    longest = max(Path(text).parts, key=lambda part: len(os.fsencode(part)))
+    longest = max(Path(text).parts, key=lambda part: len(os.fsencode(part)), default="")  # "." has no parts (fifth trial)
     if len(os.fsencode(longest)) > NAME_MAX or len(os.fsencode(text)) > PATH_MAX:
         shown = repr(text) if len(text) <= 80 else repr(text[:40]) + " ... " + repr(text[-20:])
         raise NeurohoverError(
@@ -190,8 +190,8 @@ def input_file(path: str | os.PathLike, option: str, what: str = "file") -> Path
 
 
 def input_dir(path: str | os.PathLike, option: str) -> Path:
-    """Check that ``path`` is an existing directory."""
-    p = Path(path)
+    """Check that ``path`` is an existing directory ('' refused by name: Path('') is the current one; fifth trial)."""
+    p = checked_path(path, option, "directory")
     if not p.exists():
         raise NeurohoverError(f"{option} {str(path)!r}: no such directory")
     if not p.is_dir():

@@ -91,7 +91,10 @@ class PolicySet:
 
 
 def policy_dir(task: str, directory: str | Path | None = None) -> Path:
-    return (Path(directory) if directory is not None else SHIPPED) / task
+    """The directory of ``task``'s policy set in ``directory`` (the shipped sets when None; '' refused by name)."""
+    from .paths import checked_path
+
+    return (checked_path(directory, "policy directory", "directory") if directory is not None else SHIPPED) / task
 
 
 def _load(path: Path, what: str) -> Policy:
@@ -110,7 +113,8 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
     manifest_path = root / "manifest.json"
     if not manifest_path.is_file():
         raise NeurohoverError(
-            f"no policy set for {family.name} in {str(root)!r} (manifest.json missing); build it with: neurohover build-policies --task {family.name}"
+            f"no policy set for {family.name} in {str(root)!r} (manifest.json missing); build it with: neurohover build-policies "
+            f"--task {family.name} --out {str(root.parent)!r}"
         )
     try:
         manifest = json.loads(manifest_path.read_text())
@@ -300,7 +304,7 @@ POLICY_BUDGET, FGHH_POLICY_BUDGET = 40000, 200000
 
 def build_policy_set(
     task: str,
-    out: str | Path | None = None,
+    out: str | Path,
     *,
     budget: int = POLICY_BUDGET,
     fghh_budget: int | None = None,
@@ -317,8 +321,9 @@ def build_policy_set(
     ----------
     task : str
         Task family name.
-    out : path, optional
-        Directory to write ``<task>/`` into (default: the shipped sets).
+    out : path
+        Directory to write ``<task>/`` into; :data:`SHIPPED` rebuilds the shipped sets (given by name only: a build
+        with no directory overwrote them, even at a budget of 1; fifth trial).
     budget : int
         Episodes of each steady-state run (the whole budget is spent: no plateau stop).
     fghh_budget : int, optional

@@ -361,3 +361,44 @@ def test_a_stored_run_or_config_of_the_wrong_shape_is_named(tmp_path: Path) -> N
     for bad, named in (({**stored, "title": 3}, "title"), ({k: v for k, v in stored.items() if k != "settings"}, "settings"), ([1], "the whole config")):
         with pytest.raises(NeurohoverError, match=f"a stored experiment config is damaged: {named} missing or of the wrong kind"):
             ExperimentConfig.from_dict(bad)  # type: ignore[arg-type]
+
+
+def test_the_current_directory_as_a_path_and_an_empty_directory_option_are_named(tmp_path: Path, capsys, monkeypatch) -> None:
+    """Fifth trial: a path of '.' was `max() arg is an empty sequence` in every path check; --policy-dir '' and plot
+    --compete '' were taken for the current directory."""
+    monkeypatch.chdir(tmp_path)
+    for argv, message in (
+        (["fly", "--task", "ghh08", "--policy", ".", "--episodes", "1"], "policy file '.' is a directory"),
+        (["results", "fig7", "--store", "."], "--store '.' is a directory"),
+        (["fly", "--task", "ghh08", "--episodes", "1", "--record", "./"], "--record './' is a directory"),
+        (["compete", "--task", "ghh08", "--agent", "model-free", "--runs", "1", "--episodes", "1", "--policy-dir", "", "--out", "o"], "--policy-dir is empty"),
+        (["plot", "--compete", ""], "--compete is empty; give a directory"),
+    ):
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert message in err and "Traceback" not in err, (argv, err)
+    with pytest.raises(SystemExit) as stop:  # argparse's own refusal
+        main(["build-policies", "--task", "ghh08", "--budget", "1"])
+    assert stop.value.code == 2 and "the following arguments are required: --out" in capsys.readouterr().err
+
+
+def test_a_store_is_never_made_of_a_device_and_a_build_never_defaults_onto_the_shipped_set(tmp_path: Path) -> None:
+    """Fifth trial: Store() on a character device took it for a new store and deleted the device node when SQLite
+    could not write it; build-policies without --out overwrote the package's shipped policies, even at a budget of 1."""
+    import inspect
+    import os
+    import stat
+
+    from neurohover.experiments import Store
+    from neurohover.policysets import build_policy_set
+
+    device = tmp_path / "full"
+    try:
+        os.mknod(device, 0o666 | stat.S_IFCHR, os.makedev(1, 7))  # /dev/full's numbers
+    except PermissionError:
+        pytest.skip("making a device node needs root")
+    for create in (True, False):
+        with pytest.raises(NeurohoverError, match="is not a regular file \\(a device, pipe or socket\\)"):
+            Store(device, create=create)
+    assert stat.S_ISCHR(device.stat().st_mode) and sorted(p.name for p in tmp_path.iterdir()) == ["full"]
+    assert inspect.signature(build_policy_set).parameters["out"].default is inspect.Parameter.empty

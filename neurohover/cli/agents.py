@@ -12,7 +12,7 @@ from ..evaluate import DEVICES
 def cmd_build_policies(args: argparse.Namespace) -> int:
     """Evolve a task family's generic and specialised policies (the agents' policy set)."""
     from ..paths import output_dir
-    from ..policysets import build_policy_set, check_build, replaceable_set
+    from ..policysets import SHIPPED, build_policy_set, check_build, replaceable_set
     from ..tasks import get_task_family
 
     if args.budget < 1:
@@ -21,10 +21,9 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
         raise NeurohoverError(f"--fghh-budget {args.fghh_budget} is out of range: allowed >= 1")
     check_build(get_task_family(args.task), args.lineage, args.fghh_budget, args.optimizer, budget=args.budget, seed=args.seed, n_steps=args.episode_steps)
     final = replaceable_set(args.task, args.out)
-    if args.out is not None:  # made once every option is checked
-        output_dir(args.out, "--out")
+    output_dir(args.out, "--out")  # made once every option is checked
     if final.exists():  # said before hours of work replace it (a set in --out was replaced without a word; fourth trial)
-        whose = "the package's shipped set" if args.out is None else "the set"
+        whose = "the package's shipped set" if final.resolve().parent == SHIPPED.resolve() else "the set"
         print(f"neurohover build-policies: note: {whose} {final} is replaced once the build completes", file=sys.stderr)
     ps = build_policy_set(
         args.task,
@@ -134,7 +133,11 @@ def register(sub) -> None:
 
     p = sub.add_parser("build-policies", help="evolve the generic and specialised policies of a task", description=cmd_build_policies.__doc__)
     add_task_option(p)
-    p.add_argument("--out", help="directory to write <task>/ into (default: the package's shipped policies)")
+    p.add_argument(
+        "--out",
+        required=True,
+        help="directory to write <task>/ into (neurohover/data/policies, the package's own, rebuilds the shipped set)",
+    )
     p.add_argument("--budget", type=int, default=POLICY_BUDGET, help=f"episodes per steady-state evolution (default {POLICY_BUDGET})")
     p.add_argument("--fghh-budget", type=int, help=f"fghh only: episodes per generic-policy evolution over G (default {FGHH_POLICY_BUDGET})")
     p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")

@@ -99,6 +99,8 @@ class Store:
             raise NeurohoverError(f"results store {str(self.path)!r} does not exist")
         if self.path.exists() and self.path.is_dir():
             raise NeurohoverError(f"results store {str(self.path)!r} is a directory; give a file name")
+        if self.path.exists() and not self.path.is_file():  # a device was taken for a new store, and deleted (fifth trial)
+            raise NeurohoverError(f"results store {str(self.path)!r} is not a regular file (a device, pipe or socket); give a file name")
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._lock: IO[str] | None = None
         new = not self.path.exists() or self.path.stat().st_size == 0
@@ -109,7 +111,8 @@ class Store:
         except (sqlite3.OperationalError, OSError) as err:
             if new:  # it could not be made (disk full, read-only): no empty file left that a later run takes for a store
                 self._close_quietly()
-                self.path.unlink(missing_ok=True)
+                for made in (self.path, self.path.with_name(self.path.name + "-journal")):
+                    made.unlink(missing_ok=True)
                 raise NeurohoverError(f"cannot create the results store {str(self.path)!r} ({err}); no file is left") from None
             raise NeurohoverError(f"results store {str(self.path)!r} cannot be read ({err})") from None
         except sqlite3.DatabaseError as err:
