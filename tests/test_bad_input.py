@@ -279,7 +279,18 @@ def test_a_damaged_row_is_named_and_the_rest_of_the_store_reported(tmp_path: Pat
     assert "experiment fig2 (quick), unit" in err and "is damaged (not JSON" in err and "Traceback" not in err
     with Store(path, create=False) as store:
         report = write_report(store, tmp_path / "rep").read_text()
+        # Fifth trial: reproduce counted the damaged unit as finished ("9/9 done", exit 0) and never ran it again.
+        cfg = load_config("fig2", "quick", {"runs": 1, "budget": 40, "n_steps": 20})
+        with pytest.raises(NeurohoverError, match="experiment fig2 \\(quick\\), unit .*'s result is damaged \\(not JSON"):
+            reproduce(cfg, store, LocalExecutor(1), progress=False)
     assert "Not reported: the store's copy is damaged." in report and "## Ablation" in report
+    with sqlite3.connect(path) as conn:
+        conn.execute("UPDATE units SET result = '[1, 2]' WHERE name = 'fig2'")
+    with (
+        Store(path, create=False) as store,
+        pytest.raises(NeurohoverError, match="experiment fig2 \\(quick\\), is damaged: result of evolve unit .*expected a JSON object, got list"),
+    ):
+        reproduce(cfg, store, LocalExecutor(1), progress=False)
 
 
 def test_evaluate_agent_refuses_to_write_its_rows_onto_the_policy_it_flies(tmp_path: Path, capsys) -> None:

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from ..errors import NeurohoverError
 from .config import POLICY_SOURCES, ExperimentConfig
 from .plans import plan, run_keys, source_experiments
+from .results import result_from_dict
 from .store import Store
 
 
@@ -119,6 +120,19 @@ def _matches_no_unit(config, pattern: str, units) -> NeurohoverError:
     return NeurohoverError(f"{config.name}: --only {pattern!r} matches no unit; unit keys look like {', '.join(examples[:6])}")
 
 
+def _check_stored(config: ExperimentConfig, store: Store) -> None:
+    """Refuse a store whose copy of the experiment is damaged, naming the row: its config and every stored unit's params
+    and result must read back (a damaged unit was counted as finished and never run again; fifth trial)."""
+    ExperimentConfig.from_dict(store.config(config.name, config.scale))
+    for unit in store.units(config.name, config.scale):
+        if not isinstance(unit["params"], dict):
+            raise NeurohoverError(f"results store {str(store.path)!r}: experiment {config.name} ({config.scale}), unit {unit['key']}'s params are damaged")
+        try:
+            result_from_dict(unit["kind"], unit["result"], unit["key"])
+        except NeurohoverError as err:
+            raise NeurohoverError(f"results store {str(store.path)!r}, experiment {config.name} ({config.scale}), is damaged: {err}") from None
+
+
 def _check_arguments(config, store, executor) -> None:
     """:func:`reproduce`'s arguments of the right kinds (a name or a path was an AttributeError; fourth trial)."""
     if not isinstance(config, ExperimentConfig):
@@ -168,6 +182,7 @@ def reproduce(
         kept = store.update(config.name, config.scale, config.hash, config.to_dict(), unchanged_units(config, store))
         print(f"{config.name} ({config.scale}): the config changed (hash {held} -> {config.hash}); {kept} stored units stand unchanged", file=sys.stderr)
     store.begin(config.name, config.scale, config.hash, config.to_dict(), fresh=fresh)
+    _check_stored(config, store)
     results = store.results(config.name, config.scale)
     sources = {name: store.results(name, config.scale) for name in source_experiments(config)}
     summary = RunSummary(config.name, config.scale, executor.name, executor.cores, units_before=len(results))
