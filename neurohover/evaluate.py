@@ -121,7 +121,10 @@ class PolicyTable:
         """A table of genomes (P, D) of one topology (the evolution fast path)."""
         if topology not in TOPOLOGIES:
             raise NeurohoverError(f"unknown policy topology {topology!r}: allowed {', '.join(TOPOLOGIES)}")
-        g = np.asarray(genomes, dtype=float)
+        raw = np.asarray(genomes)
+        if raw.dtype.kind not in "iuf":  # text was NumPy's ValueError, complex numbers lost their imaginary part (fifth trial)
+            raise NeurohoverError(f"{topology} genomes of {raw.dtype} are not allowed: give an array of real numbers (P, {GENOME_LENGTH[topology]})")
+        g = raw.astype(float)
         n = GENOME_LENGTH[topology]
         if g.ndim != 2 or g.shape[1] != n or g.shape[0] == 0:
             raise NeurohoverError(f"{topology} genomes must be an array of shape (P >= 1, {n}), got {g.shape}")
@@ -310,7 +313,10 @@ def evaluate_jobs(
     if fallback_index is None:
         fb = np.full(n_jobs, -1, dtype=np.int64)
     else:
-        fb = np.asarray(fallback_index, dtype=np.int64).reshape(-1)
+        fb = np.asarray(fallback_index)
+        if fb.dtype.kind not in "iu" and fb.size:  # ["x"] was NumPy's ValueError (fifth trial); 1.5 was cut to 1
+            raise NeurohoverError(f"fallback_index={fallback_index!r:.60} is not allowed: give {n_jobs} integers in -1..{len(table) - 1}")
+        fb = fb.astype(np.int64).reshape(-1)
         if fb.shape[0] != n_jobs or (fb.size and (fb.min() < -1 or fb.max() >= len(table))):
             raise NeurohoverError(f"fallback_index must have {n_jobs} entries in -1..{len(table) - 1}")
     try:

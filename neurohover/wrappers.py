@@ -32,6 +32,14 @@ __all__ = ["CrashAwareReward", "crash_aware"]
 WORST_STEP = math.log1p(CRASH_STEP_PENALTY)  # the squashed worst step, about 7.47
 
 
+def check_discount_and_scale(gamma, scale) -> None:
+    """Refuse a discount outside (0, 1] or a scale that is not a finite number > 0, by name."""
+    if isinstance(gamma, bool) or not isinstance(gamma, (int, float)) or not 0.0 < gamma <= 1.0:
+        raise NeurohoverError(f"gamma={gamma!r} is out of range: allowed a discount in (0, 1]")
+    if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not (math.isfinite(scale) and scale > 0):
+        raise NeurohoverError(f"scale={scale!r} is out of range: allowed a finite number > 0")
+
+
 def crash_aware(reward, gamma: float = 0.99, scale: float = 1.0):
     """The crash-aware squash of a reward (a float, or an array of them).
 
@@ -39,7 +47,11 @@ def crash_aware(reward, gamma: float = 0.99, scale: float = 1.0):
     ``left = |r| / CRASH_STEP_PENALTY`` steps charged) ``-log(1 + CRASH_STEP_PENALTY) * (1 -
     gamma**left) / (1 - gamma)``; times ``scale``.
     """
-    r = np.abs(np.asarray(reward, dtype=np.float64))
+    check_discount_and_scale(gamma, scale)  # gamma=2 or scale=-1 were taken here and refused by the wrapper (fifth trial)
+    raw = np.asarray(reward)
+    if raw.dtype.kind not in "iuf":  # None was nan, "x" NumPy's ValueError
+        raise NeurohoverError(f"reward={reward!r:.60} is not allowed: give a real number or an array of them")
+    r = np.abs(raw.astype(np.float64))
     left = r / CRASH_STEP_PENALTY
     crash = -WORST_STEP * (left if gamma == 1.0 else (1.0 - gamma**left) / (1.0 - gamma))
     out = scale * np.where(r >= CRASH_STEP_PENALTY, crash, -np.log1p(r))
@@ -50,10 +62,7 @@ class CrashAwareReward(gym.RewardWrapper):
     """Rewards of :func:`crash_aware` (``gamma``: the learner's discount, in (0, 1]; ``scale`` > 0)."""
 
     def __init__(self, env: gym.Env, gamma: float = 0.99, scale: float = 1.0) -> None:
-        if isinstance(gamma, bool) or not isinstance(gamma, (int, float)) or not 0.0 < gamma <= 1.0:
-            raise NeurohoverError(f"gamma={gamma!r} is out of range: allowed a discount in (0, 1]")
-        if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not (math.isfinite(scale) and scale > 0):
-            raise NeurohoverError(f"scale={scale!r} is out of range: allowed a finite number > 0")
+        check_discount_and_scale(gamma, scale)
         super().__init__(env)
         self.gamma, self.scale = float(gamma), float(scale)
 

@@ -560,3 +560,29 @@ def test_a_flight_data_file_with_damaged_parts_is_refused_by_name(tmp_path) -> N
         np.savez(path, **{**good, **change})
         with pytest.raises(NeurohoverError, match=message):
             FlightData.load(path)
+
+
+def test_the_python_leftovers_of_the_fifth_trial_are_refused_by_name() -> None:
+    """Fifth trial: OverflowError, NumPy's ValueError, a None reward that became nan, a crash-aware discount of 2 and a
+    complex genome whose imaginary part was dropped."""
+    from neurohover.evaluate import PolicyTable
+    from neurohover.wrappers import crash_aware
+
+    bp, fam = nh.baseline_policy(), nh.get_task_family("ghh08")
+    for call, message in (
+        (lambda: fam.make([10**400, 0]), "wind \\(wind_u, wind_v\\) must be 2 finite numbers"),
+        (lambda: nh.Sensor.parse("level=0.5", delay="x"), "sensor delay='x' is not allowed"),
+        (lambda: nh.evaluate_jobs([bp], [fam.zero()], [0], [0], [0], n_steps=10, fallback_index=["x"]), "fallback_index=\\['x'\\] is not allowed"),
+        (lambda: nh.evaluate_jobs([bp], [fam.zero()], [0], [0], [0], n_steps=10, fallback_index=[0.5]), "fallback_index=\\[0.5\\] is not allowed"),
+        (lambda: PolicyTable.from_genomes([["a"] * 40], "slp"), "slp genomes of <U1 are not allowed"),
+        (lambda: PolicyTable.from_genomes(np.ones((1, 40)) * 1j, "slp"), "slp genomes of complex128 are not allowed"),
+        (lambda: crash_aware("x"), "reward='x' is not allowed"),
+        (lambda: crash_aware(None), "reward=None is not allowed"),
+        (lambda: crash_aware(1.0, gamma=2), "gamma=2 is out of range"),
+        (lambda: crash_aware(1.0, scale=-1), "scale=-1 is out of range"),
+    ):
+        with pytest.raises(NeurohoverError, match=message):
+            call()
+    assert crash_aware(3) == pytest.approx(-np.log(4.0)) and nh.evaluate_jobs(
+        [bp], [fam.zero()], [0], [0], [0], n_steps=10, fallback_index=[0]
+    ).returns.shape == (1,)

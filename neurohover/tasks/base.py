@@ -190,8 +190,8 @@ def finite_vector(values: Sequence[float] | np.ndarray, length: int, what: str) 
         raise NeurohoverError(f"{what} must be {length} numbers, got {values!r}")
     try:
         arr = np.asarray(values, dtype=float)
-    except (TypeError, ValueError):
-        raise NeurohoverError(f"{what} must be {length} numbers, got {values!r}") from None
+    except (TypeError, ValueError, OverflowError):  # 10**400: OverflowError (fifth trial)
+        raise NeurohoverError(f"{what} must be {length} finite numbers, got {values!r:.80}") from None
     if arr.shape != (length,):
         raise NeurohoverError(f"{what} must be {length} numbers, got {arr.size}: {values!r}")
     if not np.all(np.isfinite(arr)):

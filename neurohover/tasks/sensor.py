@@ -148,6 +148,8 @@ class Sensor:
         if not settings:
             raise NeurohoverError(f"sensor {text!r} is empty: {expected}")
         values: dict[str, float | int] = {"delay": delay} | settings
+        if isinstance(values["delay"], bool) or not isinstance(values["delay"], numbers.Real):  # "x" was a ValueError (fifth trial)
+            raise NeurohoverError(f"sensor delay={values['delay']!r:.40} is not allowed: give a whole number of control steps")
         if not float(values["delay"]).is_integer():
             raise NeurohoverError(f"sensor delay={values['delay']!r} is not a whole number of control steps")
         values["delay"] = int(values["delay"])
