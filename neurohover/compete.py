@@ -145,7 +145,11 @@ def check_agent_settings(agent: str, values: Mapping[str, object]) -> dict:
     if spec.settings is None or spec.settings.UNIT_KEY != "agent_settings":
         hybrid = " (the hybrid agents' settings are the --safeguard-*/--hybrid-* options)" if spec.settings is not None else ""
         raise NeurohoverError(f"agent {agent!r} takes no settings table of its own{hybrid}; agents that do: {', '.join(agents_with_settings())}")
-    return spec.settings.from_dict(dict(values)).to_dict()
+    settings = spec.settings.from_dict(dict(values)).to_dict()
+    why = spec.settings.unused(agent, dict(values))
+    if why is not None:
+        raise NeurohoverError(f"agent {agent!r}: {why}")
+    return settings
 
 
 def agents_with_settings() -> list[str]:

@@ -68,6 +68,17 @@ class RiskSettings(AgentSettings):
         if isinstance(self.trials, bool) or not isinstance(self.trials, int) or not 1 <= self.trials <= MAX_TRIALS:
             raise NeurohoverError(f"risk trials={self.trials!r} is out of range: allowed an integer in 1..{MAX_TRIALS:,}")
 
+    @classmethod
+    def unused(cls, agent: str, given: dict) -> str | None:
+        """``trials`` beside a hybrid, ``level`` beside another criterion than lcb: each would be ignored (fifth trial)."""
+        given = {k: v for k, v in given.items() if v != getattr(cls, k, None)}  # at its default: said nothing
+        if "trials" in given and agent != "model-free-risk":
+            return f"trials applies to model-free-risk only, not to {agent} (it scores its candidates from the model)"
+        criterion = given.get("criterion", cls.criterion)
+        if "level" in given and criterion != "lcb":
+            return f"level applies to criterion lcb only, not to criterion {criterion!r}"
+        return None
+
     def score(self, values: Sequence[float]) -> float:
         """The candidate's score from its episode values (higher is better)."""
         v = np.asarray(values, dtype=float)

@@ -69,6 +69,12 @@ class AgentSettings:
     def from_unit(cls, params: dict) -> Any:
         return cls.from_dict(params.get(cls.UNIT_KEY) or {})
 
+    @classmethod
+    def unused(cls, agent: str, given: dict) -> str | None:
+        """Why one of the ``given`` settings would do nothing for ``agent`` (refused rather than ignored), or None; a setting
+        given at its default says nothing (a table written whole, as compete's, names every one)."""
+        return None
+
 
 @dataclass(frozen=True)
 class AgentSpec:

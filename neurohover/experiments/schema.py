@@ -249,9 +249,13 @@ def _check_test_runs(settings: dict, task: str, where: str) -> None:
             if own is None or own.UNIT_KEY != "agent_settings":
                 raise NeurohoverError(f"{where}: group {g['label']!r}: agent {g['agent']!r} takes no settings table")
             try:
-                g["settings"] = own.from_dict(g["settings"]).to_dict()
+                given = g["settings"]
+                g["settings"] = own.from_dict(given).to_dict()
             except NeurohoverError as e:
                 raise NeurohoverError(f"{where}: group {g['label']!r}: {e}") from None
+            why = own.unused(g["agent"], given)
+            if why is not None:  # a setting the agent would ignore (fifth trial)
+                raise NeurohoverError(f"{where}: group {g['label']!r}: {why}")
     for kind, source in settings.get("generics_from", {}).items():
         name, _, variant = str(source).partition("/")
         if str(source).startswith(DIR_SOURCE) and len(str(source)) > len(DIR_SOURCE):
