@@ -331,7 +331,7 @@ def _checked_store(store) -> Path | None:
 
     if store is None:
         return None
-    path = output_file(store, "store")
+    path = output_file(store, "store", store=True)
     if path.is_file():
         from .experiments import Store
 

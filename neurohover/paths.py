@@ -105,14 +105,26 @@ def _json_int(text: str) -> int:
     return value
 
 
-def output_file(path: str | os.PathLike, option: str, inputs: dict[str, str | os.PathLike | None] | None = None) -> Path:
+SQLITE_HEADER = b"SQLite format 3\x00"  # the first bytes of every SQLite database: a results store
+
+
+def output_file(path: str | os.PathLike, option: str, inputs: dict[str, str | os.PathLike | None] | None = None, *, store: bool = False) -> Path:
     """Check that the file ``path`` can be written (an existing file is kept as it is).
 
-    Refuses a directory, a parent that is a file, any place where a file cannot be created, and the
-    file of one of ``inputs`` (option -> path: writing it would destroy what the command reads);
-    creates missing parent directories (saying so on standard error).
+    Refuses a directory, a parent that is a file, any place where a file cannot be created, the
+    file of one of ``inputs`` (option -> path: writing it would destroy what the command reads) and,
+    unless ``store`` (the path is a results store's own), an existing results store; creates missing
+    parent directories (saying so on standard error).
     """
     p = checked_path(path, option)
+    if not store and p.is_file():
+        try:
+            with open(p, "rb") as f:
+                head = f.read(len(SQLITE_HEADER))
+        except OSError:
+            head = b""  # unreadable: the write check below names it
+        if head == SQLITE_HEADER:  # results --out onto another store turned it into CSV (fifth trial)
+            raise NeurohoverError(f"{option} {str(path)!r} is a results store (SQLite): give another path (writing it would destroy its results)")
     for name, given in (inputs or {}).items():
         if given is not None and str(given) != "" and p.exists() and Path(given).exists() and p.samefile(given):
             raise NeurohoverError(f"{option} {str(path)!r} is the file of {name}: give another path (writing it would destroy what is read)")

@@ -413,3 +413,28 @@ def test_a_store_is_never_made_of_a_device_and_a_build_never_defaults_onto_the_s
             Store(device, create=create)
     assert stat.S_ISCHR(device.stat().st_mode) and sorted(p.name for p in tmp_path.iterdir()) == ["full"]
     assert inspect.signature(build_policy_set).parameters["out"].default is inspect.Parameter.empty
+
+
+def test_the_command_line_leftovers_of_the_fifth_trial(tmp_path: Path, capsys) -> None:
+    """Fifth trial: --obs-dtype beside a --policy file and a sensor correlation without noise were ignored, results --out
+    onto another results store turned it into CSV, a directory given as a config was called missing, and wins named an
+    option that was not given."""
+    import shutil
+    import sqlite3
+
+    store = tmp_path / "s.sqlite"
+    with sqlite3.connect(store) as conn:
+        conn.execute("CREATE TABLE t (x)")
+    victim = tmp_path / "victim.sqlite"
+    shutil.copy(store, victim)
+    (tmp_path / "dir.toml").mkdir()
+    for argv, message in (
+        (["evaluate-agent", "--task", "ghh08", "--n-mdps", "1", "--policy", "baseline", "--obs-dtype", "float64"], "--obs-dtype applies to an agent that"),
+        (["fly", "--task", "ghh08", "--obs-noise=correlation=0.9", "--episodes", "1"], "sensor correlation=0.9 applies to noise"),
+        (["results", "fig7", "--store", str(store), "--out", str(victim)], "is a results store (SQLite): give another path"),
+        (["reproduce", str(tmp_path / "dir.toml"), "--store", str(tmp_path / "x.sqlite")], "dir.toml' is a directory; give a .toml config file"),
+    ):
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert message in err and "Traceback" not in err, (argv, err)
+    assert victim.read_bytes() == store.read_bytes()

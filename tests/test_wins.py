@@ -78,10 +78,11 @@ def test_the_wins_command_gives_each_agents_odds_from_a_stores_test_runs(cli, tm
         (("--against", "hybrid", "--agents", "hybrid"), "--against hybrid leaves no other agent to compare with it"),  # was a traceback
         (("--agents", "hybrid,hybrid"), "--agents 'hybrid,hybrid' names an agent twice"),
         (("--runs", "5,5"), "--runs '5,5' names a number twice"),
-        (("--agents", ""), "an agent's label is empty"),
-        (("--against", ""), "an agent's label is empty"),
+        (("--agents", ""), "--agents '': an agent's label is empty"),
+        (("--against", ""), "--against '': an agent's label is empty"),
     ):
         rc, _, err = cli("wins", "fig11", "--store", store, *args)
         assert rc == 2 and message in err, err
+        assert "None" not in err  # the option not given is not named (fifth trial)
     rc, _, err = cli("wins", "fig2", "--store", store)
     assert rc == 2 and "fig2" in err

@@ -78,7 +78,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
             raise NeurohoverError(f"--policy-dir applies to agents that fly a policy set's policies, not to --agent {args.agent}")
         input_dir(args.policy_dir, "--policy-dir")
     if args.store is not None:
-        output_file(args.store, "--store")  # --out is made by compete once it has checked every setting
+        output_file(args.store, "--store", store=True)  # --out is made by compete once it has checked every setting
     try:
         summary, _ = compete(
             args.task,

@@ -103,6 +103,8 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
             raise NeurohoverError(f"{option} {value} is out of range: allowed an integer in {low}..{high}")
     inputs = {"--policy": args.policy, "--sb3": args.sb3}  # writing one would destroy what is flown (fourth trial)
     out = None if args.json is None else output_file(args.json, "--json", inputs)
+    if args.obs_dtype is not None and args.policy is not None:  # the kernel flies a policy file on float64: ignored (fifth trial)
+        raise NeurohoverError("--obs-dtype applies to an agent that receives observations (--callable, --sb3, --rl-zoo, --cleanrl), not to a --policy file")
     if args.rl_id and args.policy is not None:
         raise NeurohoverError("--rl-id applies to an agent trained on a neurohover/<NAME>-RL-v0 id, not to a neurohover --policy file")
     act = _agent(args)
@@ -115,7 +117,7 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     quiet = True if isinstance(act, Policy) else None
     with tqdm(total=args.episode_steps, desc="agent's episodes", unit="step", file=sys.stderr, disable=quiet, dynamic_ncols=True) as bar:
         rows = compare_agent(
-            act, mdps, episodes=args.episodes, seed=args.seed, n_steps=args.episode_steps, obs_dtype=args.obs_dtype, on_step=lambda: bar.update(1)
+            act, mdps, episodes=args.episodes, seed=args.seed, n_steps=args.episode_steps, obs_dtype=args.obs_dtype or "float32", on_step=lambda: bar.update(1)
         )
     print(f"{args.task} {args.mdps} MDPs 0-{n - 1}, {args.episodes} episode(s) each of {args.episode_steps} steps, gusts of seed {args.seed}:")
     print(f"{'policy':<10} {'return/episode':>15} {'median over MDPs':>17} {'crashed':>12}")
@@ -156,6 +158,6 @@ def register(sub) -> None:
     p.add_argument("--episodes", type=int, default=1, help="episodes per MDP (default 1)")
     p.add_argument("--seed", type=int, default=0, help="gust seed: episode e on MDP m meets stream (seed, m * episodes + e)")
     p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000, the paper's)")
-    p.add_argument("--obs-dtype", choices=("float32", "float64"), default="float32", help="what the agent receives (default float32)")
+    p.add_argument("--obs-dtype", choices=("float32", "float64"), help="what an agent other than a --policy file receives (default float32)")
     p.add_argument("--json", help="also write the rows to this JSON file")
     p.set_defaults(func=cmd_evaluate_agent)

@@ -43,7 +43,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     if args.address is not None and args.executor != "ray":
         raise NeurohoverError(f"--address {args.address} names a Ray cluster; add --executor ray (or leave out --address)")
     check_device(args.device)
-    output_file(args.store, "--store")
+    output_file(args.store, "--store", store=True)
     overrides = parse_overrides(args.set)
     configs = load_configs(args.name, args.scale, overrides)
     for config in configs:
@@ -152,8 +152,9 @@ def cmd_wins(args: argparse.Namespace) -> int:
         runs = stored_runs(store.results(args.name, scale))
     if not runs:
         raise NeurohoverError(f"experiment {args.name!r} ({scale}) has no stored test runs: wins compares the agents of a test-runs experiment")
-    if args.agents is not None and not all(args.agents.split(",")) or args.against == "":  # '' entered every agent (second trial)
-        raise NeurohoverError(f"--agents {args.agents!r} / --against {args.against!r}: an agent's label is empty; allowed {', '.join(runs)}")
+    for option, value in (("--agents", args.agents), ("--against", args.against)):  # '' entered every agent (second trial)
+        if value is not None and not all(value.split(",")):  # named alone: the other may not have been given (fifth trial)
+            raise NeurohoverError(f"{option} {value!r}: an agent's label is empty; allowed {', '.join(runs)}")
     chosen = args.agents.split(",") if args.agents else list(runs)
     for label in [*chosen, *([args.against] if args.against else [])]:
         if label not in runs:

@@ -183,8 +183,10 @@ def resolve_name(name: str | Path) -> Path:
         from ..paths import checked_path
 
         checked_path(name, "config file")  # a name too long was an OSError (fourth trial)
+        if path.is_dir():  # it was called missing (fifth trial)
+            raise NeurohoverError(f"config file {name!r} is a directory; give a .toml config file")
         if not path.is_file():
-            raise NeurohoverError(f"config file {name!r} does not exist")
+            raise NeurohoverError(f"config file {name!r} does not exist" if not path.exists() else f"config file {name!r} is not a regular file")
         return path
     shipped = shipped_configs()
     name = _aliases().get(name, name)

@@ -74,6 +74,8 @@ class Sensor:
             object.__setattr__(self, name, number)
         if self.correlation >= 1.0:
             raise NeurohoverError(f"sensor correlation={self.correlation!r} is out of range: allowed 0 <= correlation < 1")
+        if self.correlation > 0 and not any(getattr(self, name) for name in SENSOR_GROUPS):  # it did nothing (fifth trial)
+            raise NeurohoverError(f"sensor correlation={self.correlation!r} applies to noise: give a level or the stds beside it")
         p = self.dropout
         if isinstance(p, bool) or not isinstance(p, numbers.Real) or not 0 <= p < 1:  # NaN fails the comparison too
             raise NeurohoverError(f"sensor dropout={p!r} is out of range: allowed a probability 0 <= dropout < 1")
