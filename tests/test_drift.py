@@ -66,6 +66,8 @@ def test_drifted_rows_start_at_the_mdp_change_once_and_walk_by_the_stated_std() 
         (lambda: Drift.parse(""), "drift '' is not understood"),
         (lambda: Drift.parse("walk=\u0661"), "numbers in ASCII digits"),
         (lambda: get_task_family("ghh08").with_drift("slow"), "must be a neurohover Drift"),  # type: ignore[arg-type]
+        (lambda: Drift(0.01, (("D_w", 1e300),)), "D_w=1e+300 is out of range: allowed a factor in 0.01..100"),  # flown (fifth trial)
+        (lambda: Drift.parse("D_w=0.001@0-1"), "D_w=0.001 is out of range: allowed a factor in 0.01..100"),
     ],
 )
 def test_bad_drift_settings_get_one_clear_message(make, message: str) -> None:

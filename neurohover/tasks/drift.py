@@ -17,8 +17,9 @@ setting        default     meaning
 =============  ==========  =========================================================================
 walk           0           per-episode std of each parameter's log random walk (0.01: about the
                            breadth of FGHH's G, sigma 0.3, after 1000 episodes)
-change         {}          factors of named parameters at the change, e.g. ``{"D_w": 0.8}``: the
-                           collective's gain loses 20 %, as under a heavier load
+change         {}          factors (0.01..100) of named parameters at the change, e.g.
+                           ``{"D_w": 0.8}``: the collective's gain loses 20 %, as under a
+                           heavier load
 change_at      (200, 800)  the change happens at an episode drawn uniformly from lo..hi
 =============  ==========  =========================================================================
 """
@@ -36,6 +37,9 @@ from ..sim.constants import PARAM_NAMES, ROW_PARAMS
 
 _DRIFT_TAG = 0xD81F7  # separates a run's drift stream from its agent's and its gusts'
 CHANGE_AT = (200, 800)  # the default range of the abrupt change's episode
+#: The factors a change may apply: a parameter 100 times larger (or smaller) is already no helicopter; 1e300 was flown
+#: as dynamics far outside what --params allows (fifth trial).
+MIN_FACTOR, MAX_FACTOR = 0.01, 100.0
 _PARSE_FORM = "give walk=STD or PARAM=FACTOR[@LO-HI], e.g. walk=0.01,D_w=0.8@200-800"
 
 
@@ -66,8 +70,8 @@ class Drift:
         for name, factor in change.items():
             if name not in PARAM_NAMES:
                 raise NeurohoverError(f"drift change of {name!r}: not a dynamics parameter; allowed {', '.join(PARAM_NAMES)}")
-            if isinstance(factor, bool) or not isinstance(factor, (int, float)) or not math.isfinite(factor) or factor <= 0:
-                raise NeurohoverError(f"drift change {name}={factor!r} is out of range: allowed a factor > 0")
+            if isinstance(factor, bool) or not isinstance(factor, (int, float)) or not MIN_FACTOR <= factor <= MAX_FACTOR:  # NaN fails too
+                raise NeurohoverError(f"drift change {name}={factor!r} is out of range: allowed a factor in {MIN_FACTOR:g}..{MAX_FACTOR:g}")
             factors[PARAM_NAMES.index(name)] = float(factor)
         object.__setattr__(self, "change", tuple(sorted((n, float(f)) for n, f in change.items())))
         object.__setattr__(self, "_factors", factors)
