@@ -104,9 +104,17 @@ def policy_from_net(text: str, source: str = "network file") -> Policy:
     nodes, links, comments = _parse_lines(text, source)
     topology = _topology(nodes, source)
     names = NODE_NAMES[topology]
+    absent = [i for i in _INPUTS if i not in nodes]  # the authors' files list all twelve (fifth trial: none was accepted)
+    if absent:
+        raise NeurohoverError(f"{source}: not {_DESCRIPTION[topology]}: input node(s) {', '.join(map(str, absent))} missing ('n ID 0 0 +0.0000')")
     biases: dict[str, float] = {}
     for node, (pos, func, bias, number, line) in nodes.items():
         if node in _INPUTS:
+            if (pos, func, bias) != (0, 0, 0.0):  # position 7, function 9 or a bias of 5 were read as a plain input, the bias dropped
+                raise NeurohoverError(
+                    f"{source}, line {number}: input node {node} ({names[node]}) must have position 0, function 0 and bias 0 "
+                    f"(an input passes its reading on), not {pos}, {func} and {bias:g}: {line!r}"
+                )
             continue
         if (pos, func) != _role(topology, names[node]):
             want = _role(topology, names[node])

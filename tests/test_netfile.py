@@ -104,8 +104,15 @@ def test_writing_and_reading_a_net_file_keeps_every_gene_and_its_place() -> None
         (BASELINE_NET + "n 27 2 0 +0.9\n", "node 27 is defined again (first on line"),
         (BASELINE_NET.replace("s 2 16 -0.0367", "s 2 16 nan"), "x.net, line 29: weight nan is not a finite number"),  # no file or line before
         (BASELINE_NET.replace("n 20 2 1 +0.0000", "n 20 2 1 inf"), "x.net, line 20: bias inf is not a finite number"),
+        # Fifth trial: an input line of another role or with a bias was read as a plain input (the bias dropped); none at all too.
+        (BASELINE_NET.replace("n 1 0 0 +0.0000", "n 1 7 9 +0.0000"), "x.net, line 1: input node 1 (u) must have position 0, function 0 and bias 0"),
+        (BASELINE_NET.replace("n 1 0 0 +0.0000", "n 1 0 0 +5.0000"), "not 0, 0 and 5"),
+        ("".join(line + "\n" for line in BASELINE_NET.splitlines() if not line.startswith(("n 1 ", "n 2 "))), "input node(s) 1, 2 missing"),
     ],
-    ids=["missing-link", "extra-link", "extra-node", "bad-number", "repeated-link", "repeated-node", "nan-weight", "inf-bias"],
+    ids=[
+        *("missing-link", "extra-link", "extra-node", "bad-number", "repeated-link", "repeated-node", "nan-weight", "inf-bias"),
+        *("input-role", "input-bias", "no-input"),
+    ],
 )
 def test_a_file_that_is_not_the_papers_mlp_is_refused_with_the_line(text: str, message: str) -> None:
     with pytest.raises(NeurohoverError, match=re.escape(message)):
