@@ -255,6 +255,7 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
     if not csv_path.is_file():
         raise NeurohoverError(f"--compete {str(path)!r} holds no {COMPETE_FILE}: give directories written by neurohover compete --out")
     runs: dict[int, list[tuple[int, float]]] = {}
+    seen: dict[int, set[int]] = {}  # each run's episode numbers so far
     crashes = 0
     try:
         with open(csv_path, newline="") as f:
@@ -270,6 +271,12 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
                     raise NeurohoverError(f"--compete {str(csv_path)!r}, line {line}: run, episode and return must be numbers") from None
                 if not math.isfinite(ret):
                     raise NeurohoverError(f"--compete {str(csv_path)!r}, line {line}: return {row['return']!r} is not finite")
+                if run < 0 or episode < 0 or episode in seen.setdefault(run, set()):  # plotted without a word (fifth trial)
+                    raise NeurohoverError(
+                        f"--compete {str(csv_path)!r}, line {line}: run {run}, episode {episode} is negative or given twice: "
+                        "each run's episodes are numbered once each from 0"
+                    )
+                seen[run].add(episode)
                 runs.setdefault(run, []).append((episode, ret))
     except (OSError, UnicodeDecodeError, csv.Error) as err:
         raise NeurohoverError(f"--compete {str(csv_path)!r}: cannot read it ({err})") from None

@@ -16,6 +16,7 @@ import pytest
 
 import neurohover as nh
 from neurohover.cli import main
+from neurohover.errors import NeurohoverError
 from neurohover.flightdata import FlightData
 from neurohover.plots import (
     CRASH_COLOR,
@@ -167,6 +168,14 @@ def test_compete_runs_of_unequal_length_are_cut_to_the_shortest(tmp_path: Path) 
     result = read_compete_dir(tmp_path)
     assert result.returns.tolist() == [[-1.0], [-3.0]] and result.crashes == 1
     assert result.label == tmp_path.name  # no summary.json: the directory's name
+
+
+@pytest.mark.parametrize("rows", ["0,m,-5,-1,0\n", "0,m,0,-1,0\n0,m,0,-2,0\n", "-1,m,0,-1,0\n"], ids=["negative", "repeated", "negative-run"])
+def test_compete_episodes_numbered_impossibly_are_refused_with_the_line(rows: str, tmp_path: Path) -> None:
+    """Fifth trial: a negative or repeated episode number was plotted without a word."""
+    (tmp_path / "episodes.csv").write_text("run,mdp,episode,return,crashed\n" + rows)
+    with pytest.raises(NeurohoverError, match="episodes.csv', line [23]: run -?[01], episode -?[05] is negative or given twice"):
+        read_compete_dir(tmp_path)
 
 
 # -- bad input: one message, exit status 2 ----------------------------------------------------
