@@ -485,3 +485,23 @@ def test_main_called_in_a_program_leaves_its_signals_as_they_were(monkeypatch, c
     before = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
     assert main() == 0
     assert (signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)) == before
+
+
+def test_a_large_demo_hears_sigterm_between_its_calls() -> None:
+    """Fifth trial: demo --episodes 4000000 flew each family in one kernel call and heard neither SIGTERM nor Ctrl-C for
+    minutes (SIGKILL ended it). Now it flies in calls of a few thousand episodes and stops at the next one."""
+    proc = subprocess.Popen([sys.executable, "-m", "neurohover", "demo", "--episodes", "4000000"], stderr=subprocess.PIPE, text=True, env=ENV)
+    time.sleep(6.0)  # compiled and flying (the kernel cache is warm in the suite)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)  # one call of 4,000,000 episodes takes hours here
+    assert proc.returncode == 143 and "Traceback" not in err and err.strip().splitlines()[-1].endswith("terminated"), err[-1500:]
+
+
+def test_demo_in_calls_prints_what_one_call_prints(monkeypatch, capsys) -> None:
+    from neurohover.cli import flying, main
+
+    assert main(["demo", "--episodes", "20", "--mdps", "1"]) == 0
+    whole = capsys.readouterr().out
+    monkeypatch.setattr(flying, "FLY_CHUNK", 1)  # 8 episodes a call: three calls per MDP, the last one short
+    assert main(["demo", "--episodes", "20", "--mdps", "1"]) == 0
+    assert capsys.readouterr().out == whole and len(whole.splitlines()) == 1 + 3 * 2 * 2
