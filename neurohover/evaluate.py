@@ -248,6 +248,19 @@ def _check_call_size(n_jobs: int, n_steps: int, n_rec: int) -> None:
         )
 
 
+def _fallback_array(fallback_index, n_jobs: int, n_policies: int) -> np.ndarray:
+    """Each job's fallback policy (-1: none) as an int64 array, checked: ``n_jobs`` integers in -1..n_policies-1."""
+    if fallback_index is None:
+        return np.full(n_jobs, -1, dtype=np.int64)
+    fb = np.asarray(fallback_index)
+    if fb.dtype.kind not in "iu" and fb.size:  # ["x"] was NumPy's ValueError (fifth trial); 1.5 was cut to 1
+        raise NeurohoverError(f"fallback_index={fallback_index!r:.60} is not allowed: give {n_jobs} integers in -1..{n_policies - 1}")
+    fb = fb.astype(np.int64).reshape(-1)
+    if fb.shape[0] != n_jobs or (fb.size and (fb.min() < -1 or fb.max() >= n_policies)):
+        raise NeurohoverError(f"fallback_index must have {n_jobs} entries in -1..{n_policies - 1}")
+    return fb
+
+
 def check_episode_count(n: int, what: str) -> None:
     """Refuse ``n`` episodes in one call above :data:`MAX_EPISODES_PER_CALL` (``what`` names where they come from)."""
     if n > MAX_EPISODES_PER_CALL:
@@ -310,15 +323,7 @@ def evaluate_jobs(
     n_jobs = p_idx.shape[0]
     m_idx = _index_array(mdp_index, n_jobs, rows.shape[0], "mdp_index")
     e_idx = _index_array(episode_index, n_jobs, None, "episode_index")
-    if fallback_index is None:
-        fb = np.full(n_jobs, -1, dtype=np.int64)
-    else:
-        fb = np.asarray(fallback_index)
-        if fb.dtype.kind not in "iu" and fb.size:  # ["x"] was NumPy's ValueError (fifth trial); 1.5 was cut to 1
-            raise NeurohoverError(f"fallback_index={fallback_index!r:.60} is not allowed: give {n_jobs} integers in -1..{len(table) - 1}")
-        fb = fb.astype(np.int64).reshape(-1)
-        if fb.shape[0] != n_jobs or (fb.size and (fb.min() < -1 or fb.max() >= len(table))):
-            raise NeurohoverError(f"fallback_index must have {n_jobs} entries in -1..{len(table) - 1}")
+    fb = _fallback_array(fallback_index, n_jobs, len(table))
     try:
         limits = SAFEGUARD_LIMITS if safeguard_limits is None else np.asarray(safeguard_limits, dtype=float)
     except (TypeError, ValueError):  # 'x' was NumPy's ValueError (fourth trial)
