@@ -117,6 +117,9 @@ def output_file(path: str | os.PathLike, option: str, inputs: dict[str, str | os
     parent directories (saying so on standard error).
     """
     p = checked_path(path, option)
+    for name, given in (inputs or {}).items():
+        if given is not None and str(given) != "" and p.exists() and Path(given).exists() and p.samefile(given):
+            raise NeurohoverError(f"{option} {str(path)!r} is the file of {name}: give another path (writing it would destroy what is read)")
     if not store and p.is_file():
         try:
             with open(p, "rb") as f:
@@ -125,9 +128,6 @@ def output_file(path: str | os.PathLike, option: str, inputs: dict[str, str | os
             head = b""  # unreadable: the write check below names it
         if head == SQLITE_HEADER:  # results --out onto another store turned it into CSV (fifth trial)
             raise NeurohoverError(f"{option} {str(path)!r} is a results store (SQLite): give another path (writing it would destroy its results)")
-    for name, given in (inputs or {}).items():
-        if given is not None and str(given) != "" and p.exists() and Path(given).exists() and p.samefile(given):
-            raise NeurohoverError(f"{option} {str(path)!r} is the file of {name}: give another path (writing it would destroy what is read)")
     if p.is_dir():
         raise NeurohoverError(f"{option} {str(path)!r} is a directory; give a file path")
     if p.exists() and not p.is_file():  # written by replacing it, a device node (/dev/full) would become a file

@@ -162,6 +162,20 @@ def test_the_workers_of_a_killed_compete_exit(tmp_path: Path, sig: int) -> None:
         _end_group(proc)
 
 
+def _importing_the_package(proc: subprocess.Popen, timeout: float = 120) -> None:
+    """Wait until the child has begun the package's import (NumPy's core is mapped): before it, Python itself is starting,
+    where a signal ends it without a word (a documented choice); on a loaded machine that took over a second."""
+    maps = Path(f"/proc/{proc.pid}/maps")
+    end = time.monotonic() + timeout
+    while time.monotonic() < end and proc.poll() is None:
+        try:
+            if "_multiarray_umath" in maps.read_text():
+                return
+        except OSError:
+            return  # no /proc (another system): the fixed delays alone
+        time.sleep(0.02)
+
+
 def _ctrl_c_as_in_a_terminal() -> None:
     """The child starts with Ctrl-C's default disposition, as a terminal's command does, whatever this worker's is."""
     signal.signal(signal.SIGINT, signal.SIG_DFL)
@@ -175,7 +189,8 @@ def test_ctrl_c_at_any_moment_ends_with_one_line_and_130(delay: float) -> None:
         [sys.executable, "-m", "neurohover", "fly", "--task", "ghh08", "--episodes", "100000"], stderr=subprocess.PIPE, text=True, env=ENV,
         preexec_fn=_ctrl_c_as_in_a_terminal,
     )  # fmt: skip
-    time.sleep(delay)  # wherever it lands, the outcome must be the same
+    _importing_the_package(proc)
+    time.sleep(delay - 0.6)  # wherever it lands, the outcome must be the same
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130 and "Traceback" not in err and err.strip().splitlines()[-1].endswith("interrupted"), err[-1500:]
@@ -185,7 +200,8 @@ def test_ctrl_c_at_any_moment_ends_with_one_line_and_130(delay: float) -> None:
 def test_sigterm_at_any_moment_ends_any_command_with_one_line_and_143(delay: float) -> None:
     """issue 37, fourth trial: SIGTERM (a timeout, kill) ended fly, evolve, compete and reproduce without a line."""
     proc = subprocess.Popen([sys.executable, "-m", "neurohover", "fly", "--task", "ghh08", "--episodes", "100000"], stderr=subprocess.PIPE, text=True, env=ENV)
-    time.sleep(delay)
+    _importing_the_package(proc)
+    time.sleep(delay - 1.0)
     proc.send_signal(signal.SIGTERM)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 143 and "Traceback" not in err and err.strip().splitlines()[-1].endswith("terminated"), err[-1500:]
