@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import zipfile
+import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -18,6 +19,26 @@ from .errors import NeurohoverError
 
 FORMAT = "neurohover-flight-data/1"
 SAVE_DTYPES = ("float64", "float32")
+
+
+def _check_declared_size(path: Path) -> None:
+    """Refuse an archive whose arrays declare more than half the free memory, before reading them (a header declaring
+    (1e11, 12) was a MemoryError of 8.73 TiB; sixth trial). Members it cannot read are left to np.load to name."""
+    from .procs import half_free_memory
+
+    total = 0
+    with zipfile.ZipFile(path) as archive:
+        for name in archive.namelist():
+            with archive.open(name) as f:
+                try:
+                    version = np.lib.format.read_magic(f)
+                    read = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
+                    shape, _, dtype = read(f)  # the header only, not the data
+                except ValueError:
+                    continue
+            total += int(np.prod(shape, dtype=object)) * dtype.itemsize
+    if total > half_free_memory():
+        raise NeurohoverError(f"{str(path)!r} declares arrays of {total:,} bytes: more than half the memory free now; give a smaller file")
 
 
 @dataclass(frozen=True)
@@ -97,12 +118,13 @@ class FlightData:
                 f"{str(path)!r} is not a neurohover flight-data file: flight data are .npz archives (written by neurohover fly --record or FlightData.save)"
             )
         try:
+            _check_declared_size(path)
             with np.load(path, allow_pickle=False) as z:
                 if "format" not in z.files or str(z["format"]) != FORMAT:
                     raise NeurohoverError(f"{str(path)!r} is not a neurohover flight-data file (expected format {FORMAT})")
                 lengths, obs, act = z["lengths"], z["observations"], z["actions"]
                 metadata = json.loads(str(z["metadata"]))
-        except (OSError, ValueError, zipfile.BadZipFile, EOFError, KeyError) as err:
+        except (OSError, ValueError, zipfile.BadZipFile, EOFError, KeyError, zlib.error) as err:  # zlib: damaged bytes (sixth trial)
             if isinstance(err, NeurohoverError):
                 raise
             raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file ({type(err).__name__}: {err})") from None

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import functools
 import json
+import os
 import shutil
 import time
 from collections.abc import Callable
@@ -346,6 +347,8 @@ def build_policy_set(
         Called with one line of text per finished run.
     """
 
+    if not isinstance(out, (str, os.PathLike)):  # None wrote into the installed package's shipped set (sixth trial)
+        raise NeurohoverError(f"out={out!r:.60} is not allowed: give the directory to write the set into (SHIPPED rebuilds the shipped sets)")
     family = get_task_family(task)
     lineage, fghh_budget = check_build(family, lineage, fghh_budget, optimizer, budget=budget, seed=seed, safety_episodes=safety_episodes, n_steps=n_steps)
     if progress is not None and not callable(progress):  # progress=3 was a TypeError after the first run (third trial)

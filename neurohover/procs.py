@@ -163,3 +163,11 @@ def sigterm_as_interrupt() -> Iterator[None]:
             yield
     finally:
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def half_free_memory() -> int:
+    """Half the memory free now, in bytes (2**62 where the system does not say): what one command may fill."""
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") // 2
+    except (ValueError, OSError, AttributeError):  # not POSIX: no cap
+        return 2**62

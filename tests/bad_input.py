@@ -80,6 +80,7 @@ CASES: list[tuple[list[str], str]] = [
     (["fly", "--task", "fghh", "--params=1e300,1,1,1,1,1,1,1,1,1,1"], "must lie in [-10000, 10000]"),  # flew NaN returns
     # third trial: an output onto an input destroyed it (the store became CSV, the flight data a model)
     (["results", "fig2", "--store", "store.sqlite", "--out", "store.sqlite"], "--out 'store.sqlite' is the file of --store"),
+    (["reproduce", "fig2", "--store", "store.sqlite", "--fresh", "--only", "x"], "--fresh discards every stored result, and --only"),  # sixth trial
     (["learn-model", "--flight-data", "fd.npz", "--method", "lr", "--out", "fd.npz"], "--out 'fd.npz' is the file of --flight-data"),
     (["reproduce", "fig2", "--store", "s.sqlite", "--set", "sensor={noise=1, noise=2}"], "VALUE is not valid TOML (Duplicate inline table key 'noise')"),
     (["build-policies", "--task", "ghh08", "--budget", "10", "--seed", "-1", "--out", "q"], "seed=-1 is out of range: allowed an integer in 0..2**63-1"),

@@ -586,3 +586,38 @@ def test_the_python_leftovers_of_the_fifth_trial_are_refused_by_name() -> None:
     assert crash_aware(3) == pytest.approx(-np.log(4.0)) and nh.evaluate_jobs(
         [bp], [fam.zero()], [0], [0], [0], n_steps=10, fallback_index=[0]
     ).returns.shape == (1,)
+
+
+def test_the_sixth_trials_severe_cases(tmp_path) -> None:
+    """Sixth trial: build_policy_set(task, None) rebuilt the installed package's shipped set; a flight-data archive whose
+    header declared (1e11, 12) was a MemoryError of 8.73 TiB, one with damaged compressed bytes a zlib.error."""
+    import io
+    import zipfile
+
+    from neurohover.flightdata import FlightData
+    from neurohover.policysets import build_policy_set
+
+    with pytest.raises(NeurohoverError, match="out=None is not allowed: give the directory to write the set into"):
+        build_policy_set("ghh08", None, budget=1, n_steps=5)  # type: ignore[arg-type]
+    fd = nh.evaluate(nh.baseline_policy(), nh.get_task_family("ghh08").zero(), episodes=2, n_steps=10, record=True).flight_data
+    arrays = dict(np.load(fd.save(tmp_path / "fd.npz")))
+    header = io.BytesIO()
+    np.lib.format.write_array_header_1_0(header, {"descr": "<f8", "fortran_order": False, "shape": (10**11, 12)})
+    with zipfile.ZipFile(tmp_path / "bomb.npz", "w") as archive:
+        for key, value in arrays.items():
+            member = io.BytesIO()
+            np.save(member, value)
+            archive.writestr(f"{key}.npy", header.getvalue() if key == "observations" else member.getvalue())
+    with pytest.raises(NeurohoverError, match="declares arrays of 9,600,000,000,944 bytes: more than half the memory free now"):
+        FlightData.load(tmp_path / "bomb.npz")
+    with zipfile.ZipFile(tmp_path / "deflated.npz", "w", zipfile.ZIP_DEFLATED) as archive:
+        for key, value in arrays.items():
+            member = io.BytesIO()
+            np.save(member, value)
+            archive.writestr(f"{key}.npy", member.getvalue())
+    data = bytearray((tmp_path / "deflated.npz").read_bytes())
+    start = data.index(b"observations.npy") + 40  # inside the member's compressed bytes
+    data[start : start + 200] = bytes(range(200))
+    (tmp_path / "damaged.npz").write_bytes(bytes(data))
+    with pytest.raises(NeurohoverError, match="damaged.npz' is not a readable flight-data file"):
+        FlightData.load(tmp_path / "damaged.npz")

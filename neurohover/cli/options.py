@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import os
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, fields
@@ -200,8 +199,6 @@ def add_task_options(p: argparse.ArgumentParser, mdp_help: str = MDP_HELP, verb:
 
 def max_in_memory(bytes_each: int) -> int:
     """How many items of ``bytes_each`` bytes fit in half the memory free now (checked before any work)."""
-    try:
-        free = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):  # not POSIX: no cap
-        return 2**62
-    return max(1, free // 2 // bytes_each)
+    from ..procs import half_free_memory
+
+    return max(1, half_free_memory() // bytes_each)

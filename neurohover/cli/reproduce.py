@@ -37,7 +37,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         raise NeurohoverError("give an experiment NAME (" + ", ".join(experiment_names()) + "), 'all', or a .toml config file")
     if args.store is None:
         raise NeurohoverError("give the results store file with --store FILE (it is created if missing)")
-    check_restart(args.fresh, args.update)  # before the store file is made
+    check_restart(args.fresh, args.update, args.only or ())  # before the store file is made
     if args.executor == "ray" and args.jobs != 1:
         raise NeurohoverError("--jobs applies to --executor local; Ray runs one unit per CPU of the cluster")
     if args.address is not None and args.executor != "ray":

@@ -64,10 +64,16 @@ def selected(key: str, only: Sequence[str]) -> bool:
     return not only or key.startswith("policy/") or any(fnmatch.fnmatchcase(key, pat) for pat in only)
 
 
-def check_restart(fresh: bool, update: bool) -> None:
-    """Refuse ``fresh`` (discard every stored result) together with ``update`` (keep the unchanged ones)."""
+def check_restart(fresh: bool, update: bool, only: Sequence[str] = ()) -> None:
+    """Refuse ``fresh`` (discard every stored result) together with ``update`` (keep the unchanged ones) or ``only`` (run a
+    selection: the stored units outside it were lost; sixth trial)."""
     if fresh and update:
         raise NeurohoverError("--fresh discards every stored result and --update keeps the unchanged ones: give one of them")
+    if fresh and only:
+        raise NeurohoverError(
+            "--fresh discards every stored result, and --only would run again only some of them: give one of them "
+            "(--fresh alone runs the whole experiment again)"
+        )
 
 
 def unchanged_units(config: ExperimentConfig, store: Store) -> set[str]:
@@ -168,7 +174,7 @@ def reproduce(
 
     _check_arguments(config, store, executor)
     store.lock()  # one writer per store: a second run would redo every unit the first has not finished
-    check_restart(fresh, update)
+    check_restart(fresh, update, only)
     held = store.config_hash(config.name, config.scale)
     if only:  # refused before the store records anything: a pattern that matches no unit of a plan complete now
         sources = {n: store.results(n, config.scale) for n in source_experiments(config)}
