@@ -92,6 +92,12 @@ class FlightData:
             raise NeurohoverError(f"flight-data dtype {dtype!r} is not allowed: use {' or '.join(SAVE_DTYPES)}")
         from .paths import output_file, writing
 
+        try:  # what load() reads back: JSON-object metadata (an object() was a TypeError mid-write; 5 was written, then refused)
+            meta_text = json.dumps(self.metadata) if isinstance(self.metadata, dict) else None
+        except (TypeError, ValueError) as err:
+            raise NeurohoverError(f"flight data metadata cannot be saved as JSON ({err})") from None
+        if meta_text is None or not self.actions or self.n_transitions == 0:
+            raise NeurohoverError("flight data to save needs a dict of metadata and at least one step flown (load() refuses any other file)")
         path = output_file(path, "flight-data file")  # refuses '', a directory and a device (/dev/null was a struct.error)
         lengths = np.array([a.shape[0] for a in self.actions], dtype=np.int64)
         with writing(path, "flight-data file") as partial, open(partial, "wb") as f:  # a file object keeps numpy from appending ".npz"
@@ -101,7 +107,7 @@ class FlightData:
                 lengths=lengths,
                 observations=(np.concatenate(self.observations) if self.observations else np.zeros((0, 12))).astype(dtype),
                 actions=(np.concatenate(self.actions) if self.actions else np.zeros((0, 4))).astype(dtype),
-                metadata=np.array(json.dumps(self.metadata)),
+                metadata=np.array(meta_text),
             )
         return path
 

@@ -101,6 +101,8 @@ def _topology(nodes: dict, source: str) -> str:
 
 def policy_from_net(text: str, source: str = "network file") -> Policy:
     """Parse an authors' ``.net`` network (MLP or SLP) into a :class:`Policy` (comments become metadata)."""
+    if not isinstance(text, str):  # None, 5 or bytes were AttributeError and TypeError (sixth trial)
+        raise NeurohoverError(f"{source}: {type(text).__name__} {text!r:.40} is not allowed: give the file's text (str)")
     nodes, links, comments = _parse_lines(text, source)
     topology = _topology(nodes, source)
     names = NODE_NAMES[topology]
@@ -144,6 +146,8 @@ def policy_from_net(text: str, source: str = "network file") -> Policy:
 
 def policy_to_net(policy: Policy) -> str:
     """Write an MLP or SLP policy in the authors' ``.net`` format (the inverse of :func:`policy_from_net`)."""
+    if not isinstance(policy, Policy):  # None, 'baseline' or 5 were AttributeError (sixth trial)
+        raise NeurohoverError(f"policy {policy!r:.60} is not a Policy: load one with neurohover.load_policy (e.g. load_policy('baseline'))")
     topology = policy.topology
     if topology not in NODE_NAMES:
         raise NeurohoverError(f"no .net form for topology {topology!r}: allowed {', '.join(NODE_NAMES)}")

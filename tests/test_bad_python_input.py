@@ -621,3 +621,39 @@ def test_the_sixth_trials_severe_cases(tmp_path) -> None:
     (tmp_path / "damaged.npz").write_bytes(bytes(data))
     with pytest.raises(NeurohoverError, match="damaged.npz' is not a readable flight-data file"):
         FlightData.load(tmp_path / "damaged.npz")
+
+
+def test_the_sixth_trials_python_cases_are_refused_by_name(tmp_path) -> None:
+    """Sixth trial: OverflowError, TypeError, AttributeError and plain ValueError from the Python API, and silent
+    acceptances (a drift setting a parameter twice, create='no', write_report('') into the current directory, a
+    name read letter by letter, flight data saved that load() refuses)."""
+    from neurohover.evolution.steady_state import SteadyStateSettings
+    from neurohover.experiments import Store, write_report
+    from neurohover.flightdata import FlightData
+    from neurohover.integrations.flying import evaluate_callable
+    from neurohover.netfile import policy_from_net, policy_to_net
+
+    fam = nh.get_task_family("ghh08")
+    fd = nh.evaluate(nh.baseline_policy(), fam.zero(), episodes=1, n_steps=5, record=True).flight_data
+    with Store(tmp_path / "s.sqlite") as store:
+        for call, message in (
+            (lambda: nh.get_task_family("fghh", sigma=10**400), "sigma=1000.* is out of range"),
+            (lambda: nh.Sensor.at_level(10**400), "sensor noise level=1000.* is out of range"),
+            (lambda: nh.Drift(0.0, (("D_w", 0.8), ("D_w", 0.9))), "sets a parameter twice"),
+            (lambda: Store(tmp_path / "t.sqlite", create="no"), "create='no' is not allowed"),  # type: ignore[arg-type]
+            (lambda: nh.MDP.from_dict(5), "an MDP's dict 5 is not allowed"),  # type: ignore[arg-type]
+            (lambda: evaluate_callable(None, fam.zero()), "act=None is not allowed"),  # type: ignore[arg-type]
+            (lambda: evaluate_callable(lambda o: o[:, :4], fam.zero(), indexed="yes"), "indexed='yes' is not allowed"),  # type: ignore[arg-type]
+            (lambda: FlightData(fd.observations, fd.actions, {"x": object()}).save(tmp_path / "m.npz"), "metadata cannot be saved as JSON"),
+            (lambda: FlightData(fd.observations, fd.actions, 5).save(tmp_path / "m.npz"), "needs a dict of metadata"),  # type: ignore[arg-type]
+            (lambda: FlightData((), (), {}).save(tmp_path / "m.npz"), "at least one step flown"),
+            (lambda: write_report(None, tmp_path / "r"), "store=None is not allowed"),  # type: ignore[arg-type]
+            (lambda: write_report(store, ""), "report directory is empty"),
+            (lambda: write_report(store, tmp_path / "r", names="fig2"), "names='fig2' is not allowed"),  # type: ignore[arg-type]
+            (lambda: SteadyStateSettings(pop_size=10, elite_size=10), "elite_size=10 must be smaller than pop_size=10"),
+            (lambda: policy_from_net(None), "NoneType None is not allowed: give the file's text"),  # type: ignore[arg-type]
+            (lambda: policy_to_net("baseline"), "policy 'baseline' is not a Policy"),  # type: ignore[arg-type]
+        ):
+            with pytest.raises(NeurohoverError, match=message):
+                call()
+    assert not (tmp_path / "m.npz").exists() and not (tmp_path / "t.sqlite").exists() and not (tmp_path / "r").exists()

@@ -25,6 +25,8 @@ from typing import Any, Protocol, overload
 
 import numpy as np
 
+from ..errors import NeurohoverError
+
 __all__ = [
     "STATE_VERSION",
     "ChampionRecord",
@@ -112,21 +114,21 @@ class Optimiser(Protocol):
 def require_int(name: str, value: Any, minimum: int) -> int:
     """``value`` as an int, or ValueError unless it is an integer (not a bool) ``>= minimum``."""
     if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < minimum:
-        raise ValueError(f"{name}={value!r} must be an integer >= {minimum}")
+        raise NeurohoverError(f"{name}={value!r} must be an integer >= {minimum}")
     return int(value)
 
 
 def require_prob(name: str, value: Any) -> float:
     """``value`` as a float, or ValueError unless it is a probability in [0, 1]."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real) or not 0.0 <= float(value) <= 1.0:
-        raise ValueError(f"{name}={value!r} must be a probability in [0, 1]")
+        raise NeurohoverError(f"{name}={value!r} must be a probability in [0, 1]")
     return float(value)
 
 
 def require_std(name: str, value: Any) -> float:
     """``value`` as a float, or ValueError unless it is a finite number >= 0."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(float(value)) or float(value) < 0.0:
-        raise ValueError(f"{name}={value!r} must be a finite number >= 0")
+        raise NeurohoverError(f"{name}={value!r} must be a finite number >= 0")
     return float(value)
 
 
@@ -145,7 +147,7 @@ def require_population(name: str, value: Any) -> int:
     """A population size: an integer in 2..:data:`MAX_POPULATION`, or ValueError."""
     size = require_int(name, value, 2)
     if size > MAX_POPULATION:
-        raise ValueError(f"{name}={size} must be an integer in 2..{MAX_POPULATION:,}")
+        raise NeurohoverError(f"{name}={size} must be an integer in 2..{MAX_POPULATION:,}")
     return size
 
 
@@ -166,9 +168,9 @@ def check_prototype(prototype: np.ndarray) -> np.ndarray:
     """A float64 copy of a non-empty, finite 1-D genome (ValueError otherwise)."""
     p = np.array(prototype, dtype=np.float64)
     if p.ndim != 1 or p.size == 0:
-        raise ValueError(f"prototype must be a non-empty 1-D genome, got shape {p.shape}")
+        raise NeurohoverError(f"prototype must be a non-empty 1-D genome, got shape {p.shape}")
     if not np.all(np.isfinite(p)):
-        raise ValueError("prototype must be finite")
+        raise NeurohoverError("prototype must be finite")
     return p
 
 
@@ -176,9 +178,9 @@ def check_returns(values: Any, n: int, what: str = "fitness") -> np.ndarray:
     """``n`` returns as float64, one per asked genome; ``+inf`` is refused (ValueError)."""
     f = np.array(values, dtype=np.float64)
     if f.shape != (n,):
-        raise ValueError(f"{what} must have shape ({n},), one return per asked genome; got shape {f.shape}")
+        raise NeurohoverError(f"{what} must have shape ({n},), one return per asked genome; got shape {f.shape}")
     if np.count_nonzero(f == np.inf):
-        raise ValueError(f"{what} contains +inf; returns must be finite, NaN or -inf")
+        raise NeurohoverError(f"{what} contains +inf; returns must be finite, NaN or -inf")
     return f
 
 
@@ -238,14 +240,14 @@ def check_genomes(a: np.ndarray | None, size: int, name: str, rows: int | None =
         ok = a.ndim == 2 and a.shape[1] == size and (rows is None or a.shape[0] == rows)
         expected = f"({'n' if rows is None else rows}, {size})"
     if not ok:
-        raise ValueError(f"{name} has shape {a.shape}, expected {expected} (genomes of {size} genes)")
+        raise NeurohoverError(f"{name} has shape {a.shape}, expected {expected} (genomes of {size} genes)")
     return a
 
 
 def rng_from_state(state: dict[str, Any]) -> np.random.Generator:
     """A ``numpy.random.Generator`` in the saved ``bit_generator.state``."""
     if not isinstance(state, dict) or state.get("bit_generator") not in ("PCG64", "PCG64DXSM", "MT19937", "Philox", "SFC64"):
-        raise ValueError(f"random state {state!r:.80} is not one of a numpy bit generator")
+        raise NeurohoverError(f"random state {state!r:.80} is not one of a numpy bit generator")
     bit_generator = getattr(np.random, state["bit_generator"])()
     bit_generator.state = state
     return np.random.Generator(bit_generator)
@@ -254,11 +256,11 @@ def rng_from_state(state: dict[str, Any]) -> np.random.Generator:
 def check_state(state: dict[str, Any], kind: str) -> None:
     """ValueError unless ``state`` is a ``state_dict`` of type ``kind`` in :data:`STATE_VERSION`."""
     if not isinstance(state, dict):
-        raise ValueError(f"state dict is a {type(state).__name__}, not a dict")
+        raise NeurohoverError(f"state dict is a {type(state).__name__}, not a dict")
     if state.get("type") != kind:
-        raise ValueError(f"state dict is for {state.get('type')!r}, not {kind!r}")
+        raise NeurohoverError(f"state dict is for {state.get('type')!r}, not {kind!r}")
     if state.get("version") != STATE_VERSION:
-        raise ValueError(f"unsupported state version {state.get('version')!r}")
+        raise NeurohoverError(f"unsupported state version {state.get('version')!r}")
 
 
 # --------------------------------------------------------------------------- champions

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import NeurohoverError
 from .common import (
     STATE_VERSION,
     Clock,
@@ -103,16 +104,16 @@ class GenerationalSettings:
     def __post_init__(self) -> None:
         validate_variation_settings(self)
         if not isinstance(self.elitist, bool):
-            raise ValueError(f"elitist={self.elitist!r} must be True or False")
+            raise NeurohoverError(f"elitist={self.elitist!r} must be True or False")
         if self.fitness not in FITNESS_SCALES:
-            raise ValueError(f"fitness={self.fitness!r} is not a fitness scale: allowed {', '.join(FITNESS_SCALES)}")
+            raise NeurohoverError(f"fitness={self.fitness!r} is not a fitness scale: allowed {', '.join(FITNESS_SCALES)}")
         if self.init_mutate_frac is not None:
             set_field(self, "init_mutate_frac", require_prob("init_mutate_frac", self.init_mutate_frac))
         if self.init_mutate_std is not None:
             set_field(self, "init_mutate_std", require_std("init_mutate_std", self.init_mutate_std))
         sel = require_int("select_size", self.select_size, 1)
         if sel > self.pop_size:
-            raise ValueError(f"select_size={sel} must be in [1, pop_size={self.pop_size}]")
+            raise NeurohoverError(f"select_size={sel} must be in [1, pop_size={self.pop_size}]")
         set_field(self, "select_size", sel)
         set_field(self, "generations", require_int("generations", self.generations, 1))
 
@@ -299,7 +300,7 @@ class GenerationalNE:
             or sel.min() < 0
             or sel.max() >= s.pop_size
         ):
-            raise ValueError(f"selected must be {s.select_size} distinct integer indices in [0, {s.pop_size}), got {selected!r}")
+            raise NeurohoverError(f"selected must be {s.select_size} distinct integer indices in [0, {s.pop_size}), got {selected!r}")
         return sel
 
     def _breed(self, parents: np.ndarray) -> np.ndarray:

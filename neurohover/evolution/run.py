@@ -454,7 +454,9 @@ class Run:
 
 def _damage(err: Exception) -> str:
     """What a damaged checkpoint's error says, in a few words."""
-    return f"it has no {err.args[0]!r} entry" if isinstance(err, KeyError) else f"{type(err).__name__}: {err}"
+    if isinstance(err, KeyError):
+        return f"it has no {err.args[0]!r} entry"
+    return str(err) if isinstance(err, NeurohoverError) else f"{type(err).__name__}: {err}"
 
 
 def _restored_parts(state: dict, delta: Any, genome_size: int) -> dict[str, Any]:

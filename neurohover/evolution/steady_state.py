@@ -152,7 +152,7 @@ class SteadyStateSettings:
         if self.selection != "tournament" and size != TOURNAMENT_SIZE:  # ignored without a word (second trial)
             raise NeurohoverError(f"tournament_size={size} applies to selection='tournament' only, not to selection={self.selection!r}")
         if self.selection == "tournament" and size > self.pop_size:  # under roulette the unused default is no limit on pop_size
-            raise ValueError(f"tournament_size={size} must be in [1, pop_size={self.pop_size}]")
+            raise NeurohoverError(f"tournament_size={size} must be in [1, pop_size={self.pop_size}]")
         set_field(self, "tournament_size", size)
         if self.init_mutate_frac is not None:
             set_field(self, "init_mutate_frac", require_prob("init_mutate_frac", self.init_mutate_frac))
@@ -160,7 +160,7 @@ class SteadyStateSettings:
             set_field(self, "init_mutate_std", require_std("init_mutate_std", self.init_mutate_std))
         elite = require_int("elite_size", self.elite_size, 0)
         if elite >= self.pop_size:
-            raise ValueError(f"elite_size={elite} must be smaller than pop_size={self.pop_size}")
+            raise NeurohoverError(f"elite_size={elite} must be smaller than pop_size={self.pop_size}")
         set_field(self, "elite_size", elite)
         set_field(self, "plateau_threshold", require_int("plateau_threshold", self.plateau_threshold, 1))
 
@@ -318,7 +318,7 @@ class SteadyStateNE(ChampionViews):
         if crashed is not None:
             c = np.asarray(crashed)
             if c.shape != f.shape or not (c.dtype == np.bool_ or np.issubdtype(c.dtype, np.integer)):
-                raise ValueError(f"crashed must be {f.size} booleans, one per asked genome; got {crashed!r}")
+                raise NeurohoverError(f"crashed must be {f.size} booleans, one per asked genome; got {crashed!r}")
             crashed = c.astype(bool)
         if self._population is None:
             self._population, self._fitness = self._pending, f
@@ -425,7 +425,7 @@ class SteadyStateNE(ChampionViews):
         opt._population = check_genomes(dec_array(state["population"]), d, "population")
         opt._fitness = dec_array(state["fitness"])
         if (opt._population is None) != (opt._fitness is None) or (opt._fitness is not None and opt._fitness.shape != (len(opt._population),)):
-            raise ValueError(f"fitness has shape {None if opt._fitness is None else opt._fitness.shape}: one return per genome of the population")
+            raise NeurohoverError(f"fitness has shape {None if opt._fitness is None else opt._fitness.shape}: one return per genome of the population")
         opt._pending = check_genomes(dec_array(state["pending"]), d, "pending genomes")
         opt._generation = int(state["generation"])
         opt._rng = rng_from_state(state["rng"])

@@ -503,8 +503,13 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
 
     A ``README.md`` in ``out`` with generated blocks gets them filled from the store (:mod:`.report_readme`).
     """
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    from ..paths import output_dir
+
+    if not isinstance(store, Store):  # None was an AttributeError (sixth trial)
+        raise NeurohoverError(f"store={store!r:.60} is not allowed: give a Store(PATH)")
+    if isinstance(names, str) or (names is not None and not all(isinstance(n, str) for n in names)):  # 'fig2' was read as f, i, g, 2
+        raise NeurohoverError(f"names={names!r:.60} is not allowed: give a list of experiment names, e.g. ['fig2']")
+    out = output_dir(out, "report directory")  # '' wrote into the current directory; a file, a device or 5: OSError, TypeError
     entries = [(n, s) for n, s, _, _ in store.experiments() if (scale is None or s == scale) and (not names or n in names)]
     if names:
         missing = [n for n in names if n not in {e[0] for e in entries}]

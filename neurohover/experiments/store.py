@@ -94,6 +94,9 @@ class Store:
     def __init__(self, path: str | Path, *, create: bool = True) -> None:
         from ..paths import checked_path
 
+        if not isinstance(create, bool):  # create='no' was true (sixth trial)
+            raise NeurohoverError(f"create={create!r:.40} is not allowed: give True (make the store if missing) or False")
+
         self.path = checked_path(path, "results store", "results store's file path")  # None, 3, NUL, a name too long
         if not self.path.exists() and not create:
             raise NeurohoverError(f"results store {str(self.path)!r} does not exist")

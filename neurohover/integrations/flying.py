@@ -69,6 +69,10 @@ def evaluate_callable(
     on_step : callable, optional
         Called after each control step of the flight (a progress bar's update).
     """
+    if not callable(act):  # None was a TypeError at the first step (sixth trial)
+        raise NeurohoverError(f"act={act!r:.60} is not allowed: give a function of a batch of observations (B, 12) -> actions (B, 4)")
+    if not isinstance(indexed, (bool, np.bool_)):  # 'yes' was taken as true
+        raise NeurohoverError(f"indexed={indexed!r:.40} is not allowed: give True (act takes the episodes' indices too) or False")
     mdps = [mdps] if isinstance(mdps, MDP) else list(mdps)
     if not mdps or not all(isinstance(m, MDP) for m in mdps):
         raise NeurohoverError("mdps must be one MDP or a non-empty sequence of MDPs (e.g. get_task_family('ghh08').mdp('train:3'))")

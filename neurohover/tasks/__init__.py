@@ -85,7 +85,11 @@ def _family(name: str, sigma: float | None) -> TaskFamily:
         with_sigma = [n for n, c in TASK_FAMILIES.items() if c.has_sigma]
         raise NeurohoverError(f"sigma applies to the {', '.join(with_sigma)} task only, not to {name!r}")
     if cls.has_sigma and sigma is not None:
-        return cls(sigma=float(sigma))  # type: ignore[call-arg]
+        try:
+            value = float(sigma)
+        except OverflowError:  # 10**400 (sixth trial)
+            raise NeurohoverError(f"sigma={sigma!r:.40} is out of range: give a finite number (the family's breadth)") from None
+        return cls(sigma=value)  # type: ignore[call-arg]
     return cls()
 
 

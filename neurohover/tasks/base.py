@@ -166,6 +166,8 @@ class MDP:
 
     @classmethod
     def from_dict(cls, d: dict) -> MDP:
+        if not isinstance(d, dict):  # 5 was a TypeError (sixth trial)
+            raise NeurohoverError(f"an MDP's dict {d!r:.60} is not allowed: give MDP.to_dict()'s table")
         return cls(
             d["family"],
             tuple(map(float, d["params"])),

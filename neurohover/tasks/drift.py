@@ -66,6 +66,8 @@ class Drift:
             raise NeurohoverError(
                 f"drift change={self.change!r} is not allowed: give parameter factors as a table, e.g. {{'D_w': 0.8}} (Drift.parse reads 'D_w=0.8')"
             ) from None
+        if not isinstance(self.change, dict) and len(change) != len(self.change):  # (D_w, 0.8), (D_w, 0.9): the last kept (sixth trial)
+            raise NeurohoverError(f"drift change={self.change!r:.80} sets a parameter twice: give each once")
         factors = np.ones(len(PARAM_NAMES))
         for name, factor in change.items():
             if name not in PARAM_NAMES:

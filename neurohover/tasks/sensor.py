@@ -111,7 +111,7 @@ class Sensor:
     @classmethod
     def at_level(cls, level: float, correlation: float = 0.0, delay: int = 0) -> Sensor:
         """The sensor of noise level ``level``: :data:`LEVEL_PROFILE` scaled by it."""
-        if isinstance(level, bool) or not isinstance(level, (int, float)) or not math.isfinite(level) or not 0 <= level <= MAX_LEVEL:
+        if isinstance(level, bool) or not isinstance(level, (int, float)) or not 0 <= level <= MAX_LEVEL:  # 10**400: no float() (sixth trial)
             raise NeurohoverError(f"sensor noise level={level!r} is out of range: allowed a number in 0..{MAX_LEVEL:g}")
         v, p, r, a = (level * s for s in LEVEL_PROFILE)
         return cls(v, p, r, a, correlation=correlation, delay=delay)
