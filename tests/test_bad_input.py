@@ -288,7 +288,7 @@ def test_a_damaged_row_is_named_and_the_rest_of_the_store_reported(tmp_path: Pat
         conn.execute("UPDATE units SET result = '[1, 2]' WHERE name = 'fig2'")
     with (
         Store(path, create=False) as store,
-        pytest.raises(NeurohoverError, match="experiment fig2 \\(quick\\), is damaged: result of evolve unit .*expected a JSON object, got list"),
+        pytest.raises(NeurohoverError, match="experiment fig2 \\(quick\\), unit .*'s result is damaged \\(a JSON list, not an object\\)"),
     ):
         reproduce(cfg, store, LocalExecutor(1), progress=False)
 
@@ -438,3 +438,25 @@ def test_the_command_line_leftovers_of_the_fifth_trial(tmp_path: Path, capsys) -
         err = capsys.readouterr().err
         assert message in err and "Traceback" not in err, (argv, err)
     assert victim.read_bytes() == store.read_bytes()
+
+
+def test_a_stored_row_that_is_no_json_object_is_named(tmp_path: Path, capsys) -> None:
+    """Sixth trial: a result stored as a non-UTF-8 BLOB was a UnicodeDecodeError, a config stored as [] a TypeError."""
+    import sqlite3
+
+    from neurohover.experiments import LocalExecutor, Store, load_config, reproduce
+
+    path = tmp_path / "s.sqlite"
+    with Store(path) as store:
+        reproduce(load_config("fig2", "quick", {"runs": 1, "budget": 40, "n_steps": 20}), store, LocalExecutor(1), progress=False)
+    for sql, what in (
+        ("UPDATE units SET result = X'80FF00' WHERE key = (SELECT min(key) FROM units)", "'s result is damaged (not JSON"),
+        ("UPDATE experiments SET config = '[]'", "'s config is damaged (a JSON list, not an object)"),
+    ):
+        damaged = tmp_path / "d.sqlite"
+        damaged.write_bytes(path.read_bytes())
+        with sqlite3.connect(damaged) as conn:
+            conn.execute(sql)
+        assert main(["results", "fig2", "--store", str(damaged), "--scale", "quick", "--format", "json"]) == 2
+        err = capsys.readouterr().err
+        assert what in err and "Traceback" not in err, err

@@ -361,12 +361,16 @@ class Store:
             for k, kind, p, r, s, w, f in rows
         ]
 
-    def _json(self, text: str, what: str):
-        """A stored JSON text, or one clear error naming the damaged row (the rest of the store stays readable)."""
+    def _json(self, text: str, what: str) -> dict:
+        """A stored JSON object, or one clear error naming the damaged row (the rest of the store stays readable): every
+        config, params and result is one (a list was a TypeError in results, a BLOB a UnicodeDecodeError; sixth trial)."""
         try:
-            return json.loads(text)
-        except (json.JSONDecodeError, TypeError) as err:
-            raise NeurohoverError(f"results store {str(self.path)!r}: {what} is damaged (not JSON: {err})") from None
+            value = json.loads(text)
+        except (json.JSONDecodeError, TypeError, UnicodeDecodeError) as err:
+            raise NeurohoverError(f"results store {str(self.path)!r}: {what} is damaged (not JSON: {str(err)[:80]})") from None
+        if not isinstance(value, dict):
+            raise NeurohoverError(f"results store {str(self.path)!r}: {what} is damaged (a JSON {type(value).__name__}, not an object)")
+        return value
 
     def put(self, name: str, scale: str, config_hash: str, unit, result: dict, seconds: float, worker: str = "", session: int | None = None) -> bool:
         """Record one finished unit in its own transaction; False if it was already there."""
