@@ -60,7 +60,10 @@ def test_drifted_rows_start_at_the_mdp_change_once_and_walk_by_the_stated_std() 
         (lambda: Drift.from_dict({"change_at": 5}), "change_at=5 is not allowed"),
         (lambda: Drift(0.0, (("D_w", 0.8),), (True, 2)), "change_at=(True, 2) is not allowed"),
         (lambda: Drift.from_dict({"walk": 0.01, "change_at": [3, 5]}), "change_at=[3, 5] is given without a change"),  # was ignored
-        (lambda: Drift.parse("walk=0.01@3-5"), "change_at=[3, 5] is given without a change"),
+        (lambda: Drift.parse("walk=0.01@3-5"), "the walk has no window (it drifts every episode)"),
+        (lambda: Drift.parse("walk=0.01@0-1,D_w=0.8"), "the walk has no window"),  # gave the change its window (sixth trial)
+        (lambda: Drift.parse("D_w=0.8@0-1,C_u=0.9@2-2"), "gives its changes different windows"),  # both took the last (sixth trial)
+        (lambda: Drift(0.0, (("D_w", 0.8), ("D_w", 0.9))), "sets a parameter twice"),  # kept the last (sixth trial)
         (lambda: Drift.parse("D_w=0.8@0-1,D_w=0.9@0-1"), "sets D_w twice: give each once"),  # kept the last (second trial)
         (lambda: Drift.parse("walk=0.01,,D_w=0.8"), "has an empty setting between commas"),
         (lambda: Drift.parse(""), "drift '' is not understood"),

@@ -165,6 +165,7 @@ class Drift:
         if not str(text).isascii() or not str(text).strip():  # float() and int() read other scripts' digits
             raise NeurohoverError(f"drift {text!r} is not understood: {_PARSE_FORM}, numbers in ASCII digits")
         seen: set[str] = set()
+        windows: set[tuple[int, int]] = set()  # every change happens at one episode: windows that differ were the last's (sixth trial)
         for part in (p.strip() for p in str(text).split(",")):
             if not part:
                 raise NeurohoverError(f"drift {text!r} has an empty setting between commas: {_PARSE_FORM}")
@@ -182,6 +183,12 @@ class Drift:
                 raise NeurohoverError(f"drift {part!r} is not understood: {_PARSE_FORM}") from None
             if not eq:
                 raise NeurohoverError(f"drift {part!r} is not understood: {_PARSE_FORM}")
+            if when and key.strip() == "walk":  # walk=0.01@0-1 beside a change gave the change its window
+                raise NeurohoverError(f"drift {part!r}: the walk has no window (it drifts every episode); a window '@LO-HI' follows a change")
+            if when:
+                windows.add(at)
+            if len(windows) > 1:
+                raise NeurohoverError(f"drift {text!r} gives its changes different windows: they happen together, at one episode; give one window")
             if key.strip() == "walk":
                 walk = number
             else:
