@@ -133,10 +133,14 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
     generic = _load(root / "generic.json", "the generic policy")
     specialised = tuple(_load(root / f"specialised_{i}.json", f"specialised policy {i}") for i in range(10))
     safe = manifest.get("safe", [])
-    if not isinstance(safe, list) or not all(type(i) is int and 0 <= i < len(specialised) for i in safe):  # "x" was a TypeError (fifth trial)
+    if (
+        not isinstance(safe, list)
+        or not all(type(i) is int and 0 <= i < len(specialised) for i in safe)  # "x" was a TypeError (fifth trial)
+        or len(set(safe)) != len(safe)  # [6, 6]: one policy flown as both safe ones (sixth trial)
+    ):
         raise NeurohoverError(
             f"policy-set manifest {str(manifest_path)!r}: safe={safe!r:.60} is not allowed: give a list of the safe specialised "
-            f"policies' indices, each in 0..{len(specialised) - 1}"
+            f"policies' distinct indices, each in 0..{len(specialised) - 1}"
         )
     return PolicySet(family.name, root, generic, specialised, tuple(safe), manifest=manifest)
 

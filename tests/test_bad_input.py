@@ -223,7 +223,7 @@ def test_another_tasks_policy_set_under_a_tasks_name_is_refused(tmp_path: Path) 
         load_policy_set("ghh08", tmp_path)
 
 
-@pytest.mark.parametrize(("task", "key", "value"), [("ghh08", "safe", "x"), ("ghh08", "safe", [99, 100]), ("ghh08", "safe", [1.0]), ("ghh08", "sigma", "x")])
+@pytest.mark.parametrize(("task", "key", "value"), [("ghh08", "safe", bad) for bad in ("x", [99, 100], [1.0], [6, 6])] + [("ghh08", "sigma", "x")])
 def test_a_policy_set_manifest_with_bad_entries_is_refused(task: str, key: str, value, tmp_path: Path) -> None:
     """Fifth trial: a manifest's safe entry "x" or [99, 100] was a TypeError or IndexError when the hybrid agent was made."""
     import shutil
@@ -370,7 +370,7 @@ def test_a_stored_run_or_config_of_the_wrong_shape_is_named(tmp_path: Path) -> N
     stored = load_config("fig7", "quick").to_dict()
     assert ExperimentConfig.from_dict(stored).hash == load_config("fig7", "quick").hash
     for bad, named in (({**stored, "title": 3}, "title"), ({k: v for k, v in stored.items() if k != "settings"}, "settings"), ([1], "the whole config")):
-        with pytest.raises(NeurohoverError, match=f"a stored experiment config is damaged: {named} missing or of the wrong kind"):
+        with pytest.raises(NeurohoverError, match=f"a stored experiment config is damaged: {named}.* missing or of the wrong kind"):
             ExperimentConfig.from_dict(bad)  # type: ignore[arg-type]
 
 

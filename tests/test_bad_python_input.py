@@ -67,6 +67,11 @@ def test_a_typo_in_the_scale_not_run_is_refused_at_once(tmp_path) -> None:
     with pytest.raises(NeurohoverError, match="at scale 'paper': unknown setting.s. agnet"):
         load_config(str(bad), "quick")
     load_config("fig7", "quick")  # the shipped one loads
+    titled = tmp_path / "mine.toml"  # sixth trial: title = 5 was stored, then called a damaged store's config
+    lines = ["title = 5" if line.startswith("title = ") else line for line in text.replace('name = "fig7"', 'name = "mine"', 1).splitlines()]
+    titled.write_text("\n".join(lines) + "\n")
+    with pytest.raises(NeurohoverError, match="mine.toml.*: title = 5 is not allowed: give text"):
+        load_config(str(titled), "quick")
 
 
 def test_sizes_that_would_exhaust_memory_are_refused_up_front() -> None:

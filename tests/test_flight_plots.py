@@ -176,6 +176,9 @@ def test_compete_episodes_numbered_impossibly_are_refused_with_the_line(rows: st
     (tmp_path / "episodes.csv").write_text("run,mdp,episode,return,crashed\n" + rows)
     with pytest.raises(NeurohoverError, match="episodes.csv', line [23]: run -?[01], episode -?[05] is negative or given twice"):
         read_compete_dir(tmp_path)
+    (tmp_path / "episodes.csv").write_text("run,mdp,episode,return,crashed\n0,m,0,-1,0\n0,m,2,-1,0\n")
+    with pytest.raises(NeurohoverError, match="run 0 lacks episode 1: each run's episodes are numbered 0, 1, 2"):
+        read_compete_dir(tmp_path)  # plotted as 0, 1 (sixth trial)
 
 
 # -- bad input: one message, exit status 2 ----------------------------------------------------

@@ -138,7 +138,7 @@ class ExperimentConfig:
         naming what is missing or of the wrong kind in a damaged one."""
         kinds = {"name": str, "title": str, "kind": str, "scale": str, "settings": dict}
         if not isinstance(d, dict) or any(not isinstance(d.get(k), t) for k, t in kinds.items()):  # a KeyError in report (fifth trial)
-            bad = [k for k, t in kinds.items() if not isinstance(d.get(k), t)] if isinstance(d, dict) else ["the whole config"]
+            bad = [f"{k} ({d.get(k)!r:.30})" for k, t in kinds.items() if not isinstance(d.get(k), t)] if isinstance(d, dict) else ["the whole config"]
             raise NeurohoverError(f"a stored experiment config is damaged: {', '.join(bad)} missing or of the wrong kind")
         return cls(
             d["name"],
@@ -254,6 +254,9 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
     for key in ("name", "kind", "settings"):
         if key not in raw:
             raise NeurohoverError(f"{where}: missing top-level key {key!r}")
+    for key in ("title", "paper_ref"):  # title = 5 was stored, then refused as a damaged store's (sixth trial)
+        if key in raw and not isinstance(raw[key], str):
+            raise NeurohoverError(f"{where}: {key} = {raw[key]!r:.40} is not allowed: give text")
     kind = raw["kind"]
     if kind not in KINDS:
         raise NeurohoverError(f"{where}: kind = {kind!r} is not allowed: expected one of {', '.join(KINDS)}")
