@@ -284,8 +284,8 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
         raise NeurohoverError(f"--compete {str(csv_path)!r} holds no episodes")
     for run, numbers in seen.items():  # 0, 2, 3 was plotted as 0, 1, 2 (sixth trial)
         if max(numbers) != len(numbers) - 1:
-            missing = min(set(range(max(numbers))) - numbers)
-            raise NeurohoverError(f"--compete {str(csv_path)!r}: run {run} lacks episode {missing}: each run's episodes are numbered 0, 1, 2, ...")
+            gap = min(set(range(max(numbers))) - numbers)
+            raise NeurohoverError(f"--compete {str(csv_path)!r}: run {run} lacks episode {gap}: each run's episodes are numbered 0, 1, 2, ...")
     n = min(len(rows) for rows in runs.values())
     returns = np.array([[r for _, r in sorted(rows)[:n]] for _, rows in sorted(runs.items())])
     label = path.resolve().name  # no summary (an interrupted competition): the directory's name labels it

@@ -339,3 +339,11 @@ def test_cuda_build_senses_as_the_cpu_kernel_under_the_simulator() -> None:
     np.testing.assert_allclose(out["cuda"]["returns"], out["cpu"]["returns"], rtol=1e-9)
     np.testing.assert_allclose(out["cuda"]["obs"], out["cpu"]["obs"], rtol=0, atol=1e-9)
     np.testing.assert_allclose(out["cuda"]["env"], out["cpu"]["env"], rtol=0, atol=1e-9)
+
+
+def test_a_delay_named_in_the_noise_and_again_as_obs_delay_is_refused() -> None:
+    """Sixth trial: --obs-noise level=0.5,delay=0 --obs-delay 2 flew a delay of 2 without a word."""
+    for noise in ("level=0.5,delay=0", {"level": 0.5, "delay": 0}, "level=0.5, delay = 1"):
+        with pytest.raises(NeurohoverError, match="obs_delay=2 conflicts with the delay=[01] that obs_noise sets"):
+            Sensor.of(noise, 2)
+    assert Sensor.of("level=0.5", 2).delay == 2 and Sensor.of("level=0.5,delay=2", 2).delay == 2

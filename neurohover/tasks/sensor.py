@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import re
 from dataclasses import asdict, dataclass, fields, replace
 
 from ..errors import NeurohoverError
@@ -183,7 +184,9 @@ class Sensor:
             sensor = cls.at_level(obs_noise)
         if delay is None:
             return sensor
-        if sensor.delay not in (0, delay):
+        named = isinstance(obs_noise, dict) and "delay" in obs_noise
+        named = named or (isinstance(obs_noise, str) and re.search(r"(^|,)\s*delay\s*=", obs_noise) is not None)
+        if sensor.delay != delay and (sensor.delay != 0 or named):  # an explicit delay=0 lost to obs_delay=2 without a word (sixth trial)
             raise NeurohoverError(f"obs_delay={delay} conflicts with the delay={sensor.delay} that obs_noise sets: give the delay once")
         return replace(sensor, delay=delay)
 
