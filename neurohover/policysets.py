@@ -112,6 +112,8 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
     family = get_task_family(task)
     root = policy_dir(family.name, directory)
     manifest_path = root / "manifest.json"
+    if directory is not None and (root.parent.exists() and not root.parent.is_dir()):  # a file was told to hold a set (sixth trial)
+        raise NeurohoverError(f"policy directory {str(directory)!r} is not a directory: give the directory that holds {family.name}/")
     if not manifest_path.is_file():
         raise NeurohoverError(
             f"no policy set for {family.name} in {str(root)!r} (manifest.json missing); build it with: neurohover build-policies "

@@ -212,6 +212,15 @@ def test_a_malformed_file_in_a_policy_directory_is_named(broken: str, expected: 
     assert f"'{tmp_path / 'pd' / 'ghh08' / broken}'" in err and expected in err, err
 
 
+def test_a_file_given_as_a_policy_directory_is_named(tmp_path: Path) -> None:
+    """Sixth trial: a file given as the policy directory was told "manifest.json missing; build it" inside the file."""
+    from neurohover.policysets import load_policy_set
+
+    (tmp_path / "base.json").write_text("{}")
+    with pytest.raises(NeurohoverError, match="base.json' is not a directory: give the directory that holds ghh08/"):
+        load_policy_set("ghh08", tmp_path / "base.json")
+
+
 def test_another_tasks_policy_set_under_a_tasks_name_is_refused(tmp_path: Path) -> None:
     """A GHH-09 set copied in as ghh08/ was flown on GHH-08 without a word (second trial)."""
     import shutil
