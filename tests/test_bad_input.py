@@ -469,3 +469,24 @@ def test_a_stored_row_that_is_no_json_object_is_named(tmp_path: Path, capsys) ->
         assert main(["results", "fig2", "--store", str(damaged), "--scale", "quick", "--format", "json"]) == 2
         err = capsys.readouterr().err
         assert what in err and "Traceback" not in err, err
+
+
+def test_a_stored_value_of_the_wrong_kind_is_named_by_report_results_and_wins(tmp_path: Path, capsys) -> None:
+    """Sixth trial: a stored test run's score "x" was a ValueError in report (leaving a lone figure), exported by results
+    --format json with exit 0."""
+    import sqlite3
+
+    out = tmp_path / "c"
+    assert main(["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--episode-steps", "20", "--out", str(out)]) == 0
+    name = json.loads((out / "summary.json").read_text())["experiment"]
+    capsys.readouterr()
+    damaged = tmp_path / "d.sqlite"
+    damaged.write_bytes((out / "results.sqlite").read_bytes())
+    with sqlite3.connect(damaged) as conn:
+        conn.execute("UPDATE units SET result = json_set(result, '$.score', 'x') WHERE key LIKE 'run/%'")
+    assert main(["report", "--store", str(damaged), "--out", str(tmp_path / "rep")]) == 0
+    assert "score = 'x' is not Num" in (tmp_path / "rep" / "report.md").read_text()
+    for argv in (["results", name, "--store", str(damaged), "--format", "json"], ["wins", name, "--store", str(damaged)]):
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert "run/baseline/test0/rep0" in err and "Traceback" not in err, err

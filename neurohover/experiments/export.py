@@ -18,6 +18,7 @@ import io
 import json
 
 from ..errors import NeurohoverError
+from .config import ExperimentConfig
 from .keys import UnitKey
 from .results import flat_cells, result_from_dict
 from .store import Store
@@ -46,6 +47,9 @@ def export_results(store: Store, name: str, fmt: str = "csv", scale: str | None 
     scale = resolve_scale(store, name, scale)
     units = store.units(name, scale)
     config = store.config(name, scale)
+    ExperimentConfig.from_dict(config)  # a damaged one named, as CSV's rows are (sixth trial); exported as stored
+    for u in units:  # JSON exports what CSV does, no damaged result (it exported a list, a score "x"; sixth trial)
+        result_from_dict(u["kind"], u["result"], u["key"])
     if fmt == "json":
         return (
             json.dumps(

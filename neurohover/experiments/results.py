@@ -137,6 +137,10 @@ class _Record:
                     + ([f"unknown key(s) {', '.join(unknown)} (written by another neurohover version?)"] if unknown else [])
                 )
             )
+        for f in dataclasses.fields(cls):  # type: ignore[arg-type]
+            check = _KIND_CHECKS.get(str(f.type))
+            if check is not None and f.name in d and not check(d[f.name]):  # a score "x" was a ValueError in report (sixth trial)
+                raise NeurohoverError(f"{what}: {f.name} = {d[f.name]!r:.40} is not {f.type}")
         values = {n: cls._NESTED[n].from_dict(d[n], f"{what}.{n}") if n in cls._NESTED and n in d else d.get(n) for n in names}
         return cls(**values)
 
@@ -149,6 +153,26 @@ class _Record:
 
 
 # --------------------------------------------------------------------------------- parts
+
+
+def _num(v) -> bool:
+    """A stored number: an int or float, or a non-finite one as :func:`enc_float`-style text."""
+    return (isinstance(v, (int, float)) and not isinstance(v, bool)) or v in ("nan", "inf", "-inf")
+
+
+def _int(v) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+#: Checks of a stored value by its field's annotation (the simple ones; others are read as they are).
+_KIND_CHECKS: dict[str, Any] = {
+    "str": lambda v: isinstance(v, str),
+    "int": _int,
+    "Num": _num,
+    "tuple[Num, ...]": lambda v: isinstance(v, list) and all(map(_num, v)),
+    "tuple[int, ...]": lambda v: isinstance(v, list) and all(map(_int, v)),
+    "tuple[int, ...] | None": lambda v: v is None or (isinstance(v, list) and all(map(_int, v))),
+}
 
 
 SHORT_LIST = 8  # lists up to this long (an MDP's parameters, the safe policies) get a column per entry
