@@ -475,8 +475,9 @@ def test_report_draws_the_figures_and_compares_with_the_paper(quick_store: Path,
     with Store(quick_store) as store:
         write_report(store, tmp_path / "one", names=["fig15"])
     assert "Figure 2" not in (tmp_path / "one" / "report.md").read_text()
-    rc, _, err = cli("report", "fig7", "--store", str(quick_store), "--out", str(tmp_path / "x"))
+    rc, _, err = cli("report", "fig7", "--store", str(quick_store), "--out", str(tmp_path / "x" / "y"))
     assert rc == 2 and "holds no experiment 'fig7'" in err
+    assert "removed" not in err and str(tmp_path / "x") not in err and not (tmp_path / "x").exists()  # none made and removed (sixth trial)
 
 
 def test_the_report_takes_the_papers_table_from_the_shipped_config(quick_store: Path, tmp_path: Path, cli) -> None:

@@ -192,8 +192,12 @@ def cmd_report(args: argparse.Namespace) -> int:
     from ..paths import input_file, output_dir
 
     input_file(args.store, "--store", "results store")
-    output_dir(args.out, "--out")
     with Store(args.store, create=False) as store:
+        held = {n for n, s, _, _ in store.experiments() if args.scale is None or s == args.scale}
+        missing = [n for n in args.names or () if n not in held]
+        if missing:  # before --out is made: one line, not a directory made and removed around it (sixth trial)
+            raise NeurohoverError(store.missing_message(missing[0], args.scale))
+        output_dir(args.out, "--out")
         path = write_report(store, args.out, scale=args.scale, names=args.names or None)
     print(f"report written to {path}")
     return 0
