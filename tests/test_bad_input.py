@@ -490,3 +490,11 @@ def test_a_stored_value_of_the_wrong_kind_is_named_by_report_results_and_wins(tm
         assert main(argv) == 2, argv
         err = capsys.readouterr().err
         assert "run/baseline/test0/rep0" in err and "Traceback" not in err, err
+
+
+def test_sigma_beside_the_zero_setting_is_refused(capsys) -> None:
+    """Sixth trial: fly or evolve --task fghh --mdp zero --sigma 0.5 was accepted; the zero setting is the same at every sigma."""
+    for argv in (["fly", "--task", "fghh", "--mdp", "zero", "--sigma", "0.5"], ["fly", "--task", "fghh", "--sigma", "0.5"],
+                 ["evolve", "--task", "fghh", "--mdp", "zero", "--sigma", "0.5", "--budget", "10", "--out", "e.json"]):  # fmt: skip
+        assert main(argv) == 2
+        assert "the zero setting is the same at every sigma" in capsys.readouterr().err

@@ -39,13 +39,14 @@ MDP_FAMILY = "G"
 
 def _target(args: argparse.Namespace):
     """(target, family, mdp description for the metadata)."""
-    from .options import explicit_mdp, task_family_of
+    from .options import explicit_mdp, refuse_sigma_on_zero, task_family_of
 
     family = task_family_of(args)
     explicit = explicit_mdp(args, family)
     if explicit is not None:
         return explicit[0], family, explicit[1]
     spec = args.mdp if args.mdp is not None else (MDP_FAMILY if family.generic_over_distribution else "zero")
+    refuse_sigma_on_zero(args, spec)
     if spec == MDP_FAMILY:
         return family, family, MDP_FAMILY
     if spec == "sample":  # one MDP drawn from G with the run's seed

@@ -46,6 +46,12 @@ def explicit_mdp(args: argparse.Namespace, family):
     return None
 
 
+def refuse_sigma_on_zero(args: argparse.Namespace, mdp: str | None) -> None:
+    """Refuse --sigma beside the zero setting ``mdp``, the same MDP at every breadth (it changed nothing; sixth trial)."""
+    if getattr(args, "sigma", None) is not None and mdp == "zero":
+        raise NeurohoverError("--sigma is the breadth of the MDPs drawn from FGHH's G; the zero setting is the same at every sigma: give another --mdp")
+
+
 @dataclass(frozen=True)
 class SettingOption:
     """A command-line option made from one field of a settings dataclass: ``--flag`` sets ``field``."""
@@ -161,6 +167,7 @@ def family_and_mdps(args: argparse.Namespace, n: int, rng: np.random.Generator):
     explicit = explicit_mdp(args, family)
     if explicit is not None:
         return family, [explicit[0]] * n
+    refuse_sigma_on_zero(args, "zero" if args.mdp is None else args.mdp)
     if args.mdp == "sample":  # a fresh MDP from G for every episode
         return family, [family.sample(rng, label=f"{family.name}/sample:{i}") for i in range(n)]
     return family, [family.mdp("zero" if args.mdp is None else args.mdp)] * n  # an empty --mdp is refused, not the zero setting
