@@ -490,6 +490,12 @@ def test_a_stored_value_of_the_wrong_kind_is_named_by_report_results_and_wins(tm
         assert main(argv) == 2, argv
         err = capsys.readouterr().err
         assert "run/baseline/test0/rep0" in err and "Traceback" not in err, err
+    foreign = tmp_path / "f.sqlite"  # sixth trial: a unit of no planned group was entered as agent "bogus"
+    foreign.write_bytes((out / "results.sqlite").read_bytes())
+    with sqlite3.connect(foreign) as conn:
+        conn.execute("INSERT INTO units SELECT name, scale, 'run/bogus/test0/rep0', kind, config_hash, params, result, seconds, worker, finished FROM units")
+    assert main(["wins", name, "--store", str(foreign)]) == 2
+    assert "it holds test runs of group 'bogus', which" in capsys.readouterr().err
 
 
 def test_sigma_beside_the_zero_setting_is_refused(capsys) -> None:

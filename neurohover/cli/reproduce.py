@@ -150,6 +150,12 @@ def cmd_wins(args: argparse.Namespace) -> int:
     with Store(args.store, create=False) as store:
         scale = resolve_scale(store, args.name, args.scale)
         runs = stored_runs(store.results(args.name, scale))
+        groups = store.config(args.name, scale).get("settings", {}).get("groups", [])
+    planned = {g.get("label") for g in groups if isinstance(g, dict)} if isinstance(groups, list) else set()
+    foreign = sorted(set(runs) - planned)
+    if foreign:  # a unit of no planned group was entered as an agent (sixth trial)
+        where = f"results store {str(args.store)!r}"
+        raise NeurohoverError(f"{where} is damaged: it holds test runs of group {foreign[0]!r}, which {args.name} ({scale}) does not plan")
     if not runs:
         raise NeurohoverError(f"experiment {args.name!r} ({scale}) has no stored test runs: wins compares the agents of a test-runs experiment")
     for option, value in (("--agents", args.agents), ("--against", args.against)):  # '' entered every agent (second trial)
