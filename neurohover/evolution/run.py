@@ -159,7 +159,7 @@ class Run:
             if not isinstance(saved, dict):
                 raise TypeError(f"its config is a {type(saved).__name__}, not a table")
         except (KeyError, TypeError, ValueError, AttributeError) as err:
-            raise NeurohoverError(f"{source} is a damaged checkpoint: {_damage(err)}; resume from an undamaged copy or start again without resuming") from None
+            raise _damaged(source, err) from None
         if saved != self.config:
             diff = sorted(k for k in set(saved) | set(self.config) if saved.get(k) != self.config.get(k))
             raise NeurohoverError(
@@ -176,7 +176,7 @@ class Run:
                 stream = np.random.Generator(type(self.mdp_rng.bit_generator)())
                 stream.bit_generator.state = state["mdp_stream"]
         except (KeyError, TypeError, ValueError, AttributeError, IndexError, OverflowError) as err:
-            raise NeurohoverError(f"{source} is a damaged checkpoint: {_damage(err)}; resume from an undamaged copy or start again without resuming") from None
+            raise _damaged(source, err) from None
         self.opt = opt
         if self.mdp_rng is not None:
             self.mdp_rng = stream
@@ -457,6 +457,11 @@ def _damage(err: Exception) -> str:
     if isinstance(err, KeyError):
         return f"it has no {err.args[0]!r} entry"
     return str(err) if isinstance(err, NeurohoverError) else f"{type(err).__name__}: {err}"
+
+
+def _damaged(source: str, err: Exception) -> NeurohoverError:
+    """The error of a checkpoint ``source`` that cannot be read back (``err`` says what is wrong)."""
+    return NeurohoverError(f"{source} is a damaged checkpoint: {_damage(err)}; resume from an undamaged copy or start again without resuming")
 
 
 def _restored_parts(state: dict, delta: Any, genome_size: int) -> dict[str, Any]:

@@ -126,17 +126,19 @@ def _matches_no_unit(config, pattern: str, units) -> NeurohoverError:
     return NeurohoverError(f"{config.name}: --only {pattern!r} matches no unit; unit keys look like {', '.join(examples[:6])}")
 
 
-def _check_stored(config: ExperimentConfig, store: Store) -> None:
-    """Refuse a store whose copy of the experiment is damaged, naming the row: its config and every stored unit's params
-    and result must read back (a damaged unit was counted as finished and never run again; fifth trial)."""
+def _checked_results(config: ExperimentConfig, store: Store) -> dict[str, dict]:
+    """Key -> result of every stored unit of the experiment, each read back (the store refuses a row that is no JSON
+    object; the result's fields are checked here): a damaged unit was counted as finished and never run again (fifth
+    trial). Its config must read back too."""
     ExperimentConfig.from_dict(store.config(config.name, config.scale))
+    results = {}
     for unit in store.units(config.name, config.scale):
-        if not isinstance(unit["params"], dict):
-            raise NeurohoverError(f"results store {str(store.path)!r}: experiment {config.name} ({config.scale}), unit {unit['key']}'s params are damaged")
         try:
             result_from_dict(unit["kind"], unit["result"], unit["key"])
         except NeurohoverError as err:
             raise NeurohoverError(f"results store {str(store.path)!r}, experiment {config.name} ({config.scale}), is damaged: {err}") from None
+        results[unit["key"]] = unit["result"]
+    return results
 
 
 def _check_arguments(config, store, executor) -> None:
@@ -188,8 +190,7 @@ def reproduce(
         kept = store.update(config.name, config.scale, config.hash, config.to_dict(), unchanged_units(config, store))
         print(f"{config.name} ({config.scale}): the config changed (hash {held} -> {config.hash}); {kept} stored units stand unchanged", file=sys.stderr)
     store.begin(config.name, config.scale, config.hash, config.to_dict(), fresh=fresh)
-    _check_stored(config, store)
-    results = store.results(config.name, config.scale)
+    results = _checked_results(config, store)  # read once: checked, then the finished units
     sources = {name: store.results(name, config.scale) for name in source_experiments(config)}
     summary = RunSummary(config.name, config.scale, executor.name, executor.cores, units_before=len(results))
     session = store.start_session(config.name, config.scale, config.hash, executor.name, summary.cores, len(results))
