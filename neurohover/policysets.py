@@ -107,6 +107,31 @@ def _load(path: Path, what: str) -> Policy:
     return load_policy(path)
 
 
+# What a manifest's descriptive fields may hold (they are shown and compared, never flown): name -> (kinds, what is allowed).
+_COUNT = ((int,), "an integer >= 0")
+_MANIFEST_FIELDS: dict[str, tuple[tuple[type, ...], str]] = {
+    "sigma": ((int, float), "the breadth it was built for, a finite number"),
+    "budget": _COUNT, "fghh_budget": _COUNT, "seed": _COUNT, "n_steps": _COUNT, "safety_episodes": _COUNT,
+    "seconds": ((int, float), "a number of seconds >= 0"),
+    "lineage": ((str,), f"one of {', '.join(LINEAGES)}"),
+    "optimizer": ((str,), "an optimiser's name"), "built": ((str,), "a date as text"), "version": ((str,), "a version as text"),
+}  # fmt: skip
+
+
+def _check_manifest_fields(manifest: dict, path: Path) -> None:
+    """Refuse a descriptive field of the wrong kind by name (sixth trial: n_steps "x", a lineage 5 were shown as given)."""
+    for name, (kinds, allowed) in _MANIFEST_FIELDS.items():
+        value = manifest.get(name)
+        if value is None:
+            continue
+        bad = isinstance(value, bool) or not isinstance(value, kinds)
+        if not bad and kinds != (str,):
+            bad = not np.isfinite(value) or (name != "sigma" and value < 0)
+        bad = bad or (name == "lineage" and value not in LINEAGES)
+        if bad:
+            raise NeurohoverError(f"policy-set manifest {str(path)!r}: {name}={value!r:.40} is not allowed: give {allowed}")
+
+
 def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet:
     """Load the policy set of ``task`` (the shipped one unless ``directory`` is given)."""
     family = get_task_family(task)
@@ -127,8 +152,7 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
         raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r} must be a JSON object, got {type(manifest).__name__}")
     if manifest.get("task", family.name) != family.name:  # another task's set copied under this name: its policies fly the wrong task
         raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r} is of task {manifest['task']!r}, not {family.name!r}")
-    if manifest.get("sigma") is not None and (isinstance(manifest["sigma"], bool) or not isinstance(manifest["sigma"], (int, float))):
-        raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r}: sigma={manifest['sigma']!r:.40} is not allowed: give the breadth it was built for")
+    _check_manifest_fields(manifest, manifest_path)
     if family.generic_over_distribution:
         generics = {name: _load(root / f"generic_{name}.json", f"the {name} generic policy") for name in FGHH_GENERICS}
         return PolicySet(family.name, root, generics["race"], generics=generics, manifest=manifest)

@@ -52,6 +52,8 @@ def crash_aware(reward, gamma: float = 0.99, scale: float = 1.0):
     if raw.dtype.kind not in "iuf":  # None was nan, "x" NumPy's ValueError
         raise NeurohoverError(f"reward={reward!r:.60} is not allowed: give a real number or an array of them")
     r = np.abs(raw.astype(np.float64))
+    if not np.all(np.isfinite(r)):  # nan came out as nan, inf as a crash of endless steps
+        raise NeurohoverError(f"reward={reward!r:.60} is not allowed: give finite numbers (a crash is a finite charge)")
     left = r / CRASH_STEP_PENALTY
     crash = -WORST_STEP * (left if gamma == 1.0 else (1.0 - gamma**left) / (1.0 - gamma))
     out = scale * np.where(r >= CRASH_STEP_PENALTY, crash, -np.log1p(r))

@@ -232,9 +232,16 @@ def test_another_tasks_policy_set_under_a_tasks_name_is_refused(tmp_path: Path) 
         load_policy_set("ghh08", tmp_path)
 
 
-@pytest.mark.parametrize(("task", "key", "value"), [("ghh08", "safe", bad) for bad in ("x", [99, 100], [1.0], [6, 6])] + [("ghh08", "sigma", "x")])
+@pytest.mark.parametrize(
+    ("task", "key", "value"),
+    [("ghh08", "safe", bad) for bad in ("x", [99, 100], [1.0], [6, 6])] + [("ghh08", "sigma", "x")] + [
+        ("ghh08", "n_steps", "x"), ("ghh08", "seed", -1), ("ghh08", "budget", 1.5), ("ghh08", "lineage", 5), ("ghh08", "lineage", "other"),
+        ("fghh", "seconds", float("nan")), ("fghh", "sigma", float("inf")), ("fghh", "fghh_budget", True), ("fghh", "built", 5),
+    ],
+)  # fmt: skip
 def test_a_policy_set_manifest_with_bad_entries_is_refused(task: str, key: str, value, tmp_path: Path) -> None:
-    """Fifth trial: a manifest's safe entry "x" or [99, 100] was a TypeError or IndexError when the hybrid agent was made."""
+    """Fifth trial: a manifest's safe entry "x" or [99, 100] was a TypeError or IndexError when the hybrid agent was made;
+    its descriptive fields (n_steps "x", a lineage 5) were taken and shown as given."""
     import shutil
 
     from neurohover.policysets import load_policy_set, policy_dir

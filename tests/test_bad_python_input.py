@@ -585,6 +585,8 @@ def test_the_python_leftovers_of_the_fifth_trial_are_refused_by_name() -> None:
         (lambda: crash_aware(None), "reward=None is not allowed"),
         (lambda: crash_aware(1.0, gamma=2), "gamma=2 is out of range"),
         (lambda: crash_aware(1.0, scale=-1), "scale=-1 is out of range"),
+        (lambda: crash_aware(float("nan")), "reward=nan is not allowed: give finite numbers"),
+        (lambda: crash_aware(np.array([1.0, np.inf])), "give finite numbers"),
     ):
         with pytest.raises(NeurohoverError, match=message):
             call()
