@@ -332,7 +332,7 @@ def _checked_store(store) -> Path | None:
     if store is None:
         return None
     path = output_file(store, "store", store=True)
-    if path.is_file():
+    if path.is_file() and path.stat().st_size:  # an empty file becomes the store
         from .experiments import Store
 
         Store(path, create=False).close()

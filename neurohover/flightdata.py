@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import NeurohoverError
+from .sim.constants import MAX_EPISODE_STEPS
 
 FORMAT = "neurohover-flight-data/1"
 SAVE_DTYPES = ("float64", "float32")
@@ -141,6 +142,10 @@ class FlightData:
         if obs.dtype.kind != "f" or act.dtype.kind != "f":
             kinds = f"{obs.dtype} and {act.dtype}"
             raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file: its observations and actions are {kinds}, not real numbers")
+        if lengths.size and int(lengths.max()) > MAX_EPISODE_STEPS:  # 2**62 twice summed to a negative count (seventh trial)
+            longest = int(lengths.max())
+            raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file: an episode of {longest:,} steps (at most {MAX_EPISODE_STEPS:,})")
+        _check_metadata(path, metadata, lengths.size)
         if lengths.size == 0 or lengths.sum() == 0:
             raise NeurohoverError(f"flight-data file {str(path)!r} holds no transitions")
         if obs.shape != (int(lengths.sum() + lengths.size), 12) or act.shape != (int(lengths.sum()), 4):
@@ -152,3 +157,16 @@ class FlightData:
         obs_split = np.split(obs, np.cumsum(lengths + 1)[:-1])
         act_split = np.split(act, np.cumsum(lengths)[:-1])
         return cls(tuple(obs_split), tuple(act_split), metadata)
+
+
+def _check_metadata(path: Path, metadata: dict, n_episodes: int) -> None:
+    """Refuse the metadata fields plots and crash marks read when they are of the wrong kind, by name (an episode_steps
+    "a" was a ValueError in plot; seventh trial)."""
+    steps = metadata.get("episode_steps")
+    if steps is not None and (type(steps) is not int or not 1 <= steps <= MAX_EPISODE_STEPS):
+        allowed = f"an integer in 1..{MAX_EPISODE_STEPS:,}"
+        raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata episode_steps={steps!r:.40} is not allowed: {allowed}")
+    crashed = metadata.get("crashed")
+    if crashed is not None and (not isinstance(crashed, list) or len(crashed) != n_episodes or not all(type(c) is bool for c in crashed)):
+        allowed = f"one true or false per episode ({n_episodes})"
+        raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata crashed={crashed!r:.40} is not allowed: {allowed}")

@@ -130,6 +130,8 @@ def output_file(path: str | os.PathLike, option: str, inputs: dict[str, str | os
             raise NeurohoverError(f"{option} {str(path)!r} is a results store (SQLite): give another path (writing it would destroy its results)")
     if p.is_dir():
         raise NeurohoverError(f"{option} {str(path)!r} is a directory; give a file path")
+    if os.fspath(path).endswith(("/", os.sep)):  # Path() drops the slash: 'x.json/' was written as the file x.json (seventh trial)
+        raise NeurohoverError(f"{option} {str(path)!r} ends in '/', which names a directory: give a file path")
     if p.exists() and not p.is_file():  # written by replacing it, a device node (/dev/full) would become a file
         raise NeurohoverError(f"{option} {str(path)!r} is not a regular file (a device, pipe or socket); give a file path")
     _make_dirs(p.parent, option, str(path))

@@ -101,6 +101,9 @@ class Policy:
             raise NeurohoverError(f"unknown policy topology {self.topology!r}: allowed {', '.join(TOPOLOGIES)}")
         if not isinstance(self.metadata, dict):  # [1] was kept, and failed when the policy was saved (second trial)
             raise NeurohoverError(f"policy metadata={self.metadata!r:.60} is not allowed: give a dict")
+        taken = sorted({"topology", "genome"} & set(self.metadata))  # saved, they overwrote the network itself (seventh trial)
+        if taken:
+            raise NeurohoverError(f"policy metadata key(s) {', '.join(taken)} are the policy's own: give the metadata other names")
         genome = check_genome(self.genome, self.topology)
         genome.setflags(write=False)
         object.__setattr__(self, "genome", genome)

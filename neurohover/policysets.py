@@ -40,6 +40,7 @@ import numpy as np
 
 from .errors import NeurohoverError
 from .evaluate import MAX_EPISODES_PER_CALL, evaluate
+from .paths import writing
 from .policies import Policy, load_policy, save_policy
 from .sim.constants import MAX_EPISODE_STEPS
 from .tasks import get_task_family
@@ -318,6 +319,20 @@ def _stage_file(root: Path, key: str) -> Path:
     return root / STAGES / f"{key}.json"
 
 
+def _build_state(root: Path) -> dict:
+    """The settings of the interrupted build in ``root``; a damaged state refused by name (an empty one, which a full disk
+    left, was a JSONDecodeError; seventh trial), since its finished runs cannot be told to be of this build."""
+    state = _stage_file(root, "build")
+    try:
+        value = json.loads(state.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+        value = err
+    if not isinstance(value, dict):
+        why = str(value)[:60] if isinstance(value, Exception) else f"a JSON {type(value).__name__}, not an object"
+        raise NeurohoverError(f"the interrupted build's state {str(state)!r} is damaged ({why}): delete {str(root)!r} to start the build over")
+    return value
+
+
 def _version() -> str:
     """The installed neurohover's version (a build resumes only runs of the same code)."""
     import importlib.metadata
@@ -391,19 +406,29 @@ def build_policy_set(
     root = final.with_name(final.name + ".building")
     build = {"task": family.name, "sigma": family.sigma, "budget": budget, "fghh_budget": fghh_budget, "seed": seed, "n_steps": n_steps,
              "safety_episodes": safety_episodes, "lineage": lineage, "optimizer": optimizer, "version": _version()}  # fmt: skip
-    if _stage_file(root, "build").is_file() and json.loads(_stage_file(root, "build").read_text()) == build:
+    if _stage_file(root, "build").is_file() and _build_state(root) == build:
         say(f"{family.name}: resuming the interrupted build in {root} ({len(list((root / STAGES).glob('*.json'))) - 1} runs finished)")
     else:
+        if root.exists():
+            say(f"{family.name}: {root} holds an interrupted build of other settings; it is started over")
         shutil.rmtree(root, ignore_errors=True)
-        (root / STAGES).mkdir(parents=True)
-        _stage_file(root, "build").write_text(json.dumps(build) + "\n")
+        try:
+            (root / STAGES).mkdir(parents=True)
+            with writing(_stage_file(root, "build"), "the build's state") as partial:  # a full disk left it empty (seventh trial)
+                partial.write_text(json.dumps(build) + "\n")
+        except BaseException:
+            shutil.rmtree(root, ignore_errors=True)
+            raise
     try:
         built = _build(family, root, budget, fghh_budget, seed, safety_episodes, n_steps, lineage, optimizer, say)
     except KeyboardInterrupt:  # stopped: the finished runs stay for the same build to resume
         say(f"{family.name}: stopped; the finished runs are kept in {root}: run the same build again to resume")
         raise
-    except BaseException:  # failed: nothing half-built is left
+    except BaseException as err:  # failed: nothing half-built is left
         shutil.rmtree(root, ignore_errors=True)
+        if isinstance(err, OSError):  # a full disk said only "No space left on device" (seventh trial)
+            why = err.strerror or err
+            raise NeurohoverError(f"out {str(final.parent)!r}: cannot write the {family.name} set ({why}); nothing half-built is left") from None
         raise
     shutil.rmtree(root / STAGES)
     old = final.with_name(final.name + ".replaced")

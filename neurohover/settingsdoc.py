@@ -107,7 +107,10 @@ def format_settings(cls: type, title: str) -> str:
     import textwrap
 
     out = [f"{title}: {summary(cls)} ({cls.__module__}.{cls.__qualname__})", ""]
-    for row in settings_rows(cls):
+    rows = settings_rows(cls)
+    for i, row in enumerate(rows):
         out.append(f"{row.name} = {row.default}    [{plain(row.type)}]")
+        if i + 1 < len(rows) and row.help and rows[i + 1].help == row.help:
+            continue  # one entry documents several settings (a, b : float): its text once, under the last of them
         out += textwrap.wrap(plain(row.help) or "(undocumented)", width=100, initial_indent="    ", subsequent_indent="    ")
     return "\n".join(out)

@@ -53,7 +53,7 @@ def test_a_callable_flies_as_the_kernel_flies_the_same_policy(cli, tmp_path: Pat
         (("--policy", str(GENERIC), "--callable", "m:f"), "got --policy, --callable"),
         (("--callable", "nomodule"), "--callable 'nomodule' is not allowed: give MODULE:FUNCTION"),
         (("--callable", "no_such_module_here:act"), "--callable 'no_such_module_here:act': No module named"),
-        (("--policy", str(GENERIC), "--n-mdps", "11", "--mdps", "train"), "--n-mdps 11 is out of range: ghh08 has 10 train MDPs"),
+        (("--policy", str(GENERIC), "--n-mdps", "11", "--mdps", "train"), "--n-mdps 11 is out of range: allowed 1..10 (ghh08 has 10 train MDPs)"),
         (("--policy", str(GENERIC), "--episodes", "0"), "--episodes 0 is out of range"),
         (("--policy", str(GENERIC), "--seed", "-1"), "seed=-1 is out of range: allowed an integer in 0..2**63-1"),
     ],

@@ -197,7 +197,7 @@ def test_badgroup_hybrid_settings_in_configs_are_refused(tmp_path: Path, extra: 
         (["--agent", "hybrid", "--safeguard-box", "-0.5"], "box=-0.5 is out of range"),
         (["--agent", "hybrid", "--safeguard-rule", "text"], "unknown safeguard rule 'text'"),
         (["--agent", "hybrid", "--hybrid-replacement", "x"], "unknown hybrid replacement 'x'"),
-        (["--agent", "model-free", "--safeguard-rule", "paper"], "--safeguard-rule apply to the hybrid agents only"),
+        (["--agent", "model-free", "--safeguard-rule", "paper"], "--safeguard-rule applies to the hybrid agents only"),
     ],
 )
 def test_compete_refuses_bad_hybrid_options(tmp_path: Path, capsys, argv: list[str], message: str) -> None:

@@ -82,6 +82,13 @@ class ContinualSettings(AgentSettings):
         if not isinstance(self.safeguard, bool):
             raise NeurohoverError(f"continual safeguard={self.safeguard!r} is not allowed: true or false")
 
+    @classmethod
+    def unused(cls, agent: str, given: dict) -> str | None:
+        """``safeguard_after`` beside ``safeguard = false``: it would be ignored (seventh trial)."""
+        if given.get("safeguard", cls.safeguard) is False and given.get("safeguard_after", cls.safeguard_after) != cls.safeguard_after:
+            return "safeguard_after applies with safeguard = true only (without the safeguard there is no test to delay)"
+        return None
+
     def to_dict(self) -> dict:
         d = super().to_dict()
         if d["safeguard_after"] == 0:  # added later: left out at its default, so configs written before keep their hash

@@ -53,7 +53,12 @@ def cmd_compete(args: argparse.Namespace) -> int:
     agent_spec(args.agent, args.task)  # an unknown agent, or one for another task, before anything else is read or made
     given = [o.flag for o in args.hybrid_options if getattr(args, o.dest) is not None]
     if given and args.agent not in HYBRID_AGENTS:
-        raise NeurohoverError(f"{', '.join(given)} apply to the hybrid agents only ({', '.join(HYBRID_AGENTS)}), not to --agent {args.agent}")
+        settings = AGENTS[args.agent].settings
+        own = settings is not None and settings.UNIT_KEY == "agent_settings"
+        raise NeurohoverError(
+            f"{', '.join(given)} appl{'ies' if len(given) == 1 else 'y'} to the hybrid agents only ({', '.join(HYBRID_AGENTS)}), not to --agent {args.agent}"
+            + (f" (its own settings are --agent-setting KEY=VALUE: neurohover settings {args.agent})" if own else "")
+        )
     hybrid = HybridSettings.from_dict(given_settings(args, args.hybrid_options))  # the option's field names are its keys
     model = given_settings(args, args.model_options)
     for option in args.model_options:

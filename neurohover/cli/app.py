@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import signal
 import sqlite3
 import sys
@@ -147,7 +148,7 @@ def _run(argv: Sequence[str] | None) -> int:
         with sigterm_as_interrupt(), interrupts_survive_callbacks():
             return args.func(args)
     except NeurohoverError as err:
-        print(f"neurohover {args.command}: error: {err}", file=sys.stderr)
+        print(f"neurohover {args.command}: error: {shorter_numbers(str(err))}", file=sys.stderr)
         remove_created_dirs()  # a failed command leaves no empty output directory behind
         return 2
     except sqlite3.DatabaseError as err:  # a store file damaged mid-file, or not a store at all
@@ -174,6 +175,12 @@ def _run(argv: Sequence[str] | None) -> int:
         print(f"neurohover {args.command}: error: {err.strerror or err}{where}", file=sys.stderr)
         remove_created_dirs()
         return 2
+
+
+def shorter_numbers(message: str) -> str:
+    """``message`` with every number of more than 30 digits shown by its first ten and its length (a 400-digit --budget
+    was echoed whole; seventh trial)."""
+    return re.sub(r"\d{31,}", lambda m: f"{m[0][:10]}...({len(m[0])} digits)", message)
 
 
 if __name__ == "__main__":

@@ -17,7 +17,7 @@ from ..errors import NeurohoverError
 from ..integrations import SB3_ALGORITHMS
 from ..policies import Policy
 from ..sim.constants import MAX_EPISODE_STEPS
-from .options import add_sensor_options, add_sigma_option, add_task_option, task_family_of
+from .options import add_sensor_options, add_sigma_option, add_task_option, note_policy_task, task_family_of
 
 SOURCES = ("policy", "callable", "rl_zoo", "sb3", "cleanrl")
 
@@ -97,7 +97,7 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     available = len(family.training_mdps() if args.mdps == "train" else family.test_mdps())
     n = available if args.n_mdps is None else args.n_mdps
     if not 1 <= n <= available:
-        raise NeurohoverError(f"--n-mdps {n} is out of range: {args.task} has {available} {args.mdps} MDPs")
+        raise NeurohoverError(f"--n-mdps {n} is out of range: allowed 1..{available} ({args.task} has {available} {args.mdps} MDPs)")
     for option, value, low, high in (("--episodes", args.episodes, 1, 10**4), ("--episode-steps", args.episode_steps, 1, MAX_EPISODE_STEPS)):
         if not low <= value <= high:
             raise NeurohoverError(f"{option} {value} is out of range: allowed an integer in {low}..{high}")
@@ -108,6 +108,8 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     if args.rl_id and args.policy is not None:
         raise NeurohoverError("--rl-id applies to an agent trained on a neurohover/<NAME>-RL-v0 id, not to a neurohover --policy file")
     act = _agent(args)
+    if isinstance(act, Policy):
+        note_policy_task(act, family.name, f"--policy {args.policy}")
     if args.rl_id or (args.rl_zoo is not None and "-RL-v0" in str(args.rl_zoo)):
         from ..envs.rl import rl_policy
 

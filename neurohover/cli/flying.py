@@ -10,7 +10,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from ..sim.constants import EPISODE_STEPS
-from .options import add_task_options, family_and_mdps, max_in_memory
+from .options import add_task_options, family_and_mdps, max_in_memory, note_policy_task
 
 # Episodes per kernel call of a progress-reporting fly: large enough to keep every core busy.
 FLY_CHUNK = 256
@@ -79,6 +79,7 @@ def cmd_fly(args: argparse.Namespace) -> int:
     policy = load_policy(args.policy)
     rng = np.random.default_rng(args.seed)
     family, mdps = family_and_mdps(args, args.episodes, rng)
+    note_policy_task(policy, family.name, f"--policy {args.policy}")
     if args.record is not None:
         output_file(args.record, "--record", {"--policy": args.policy})
     returns, crashed, seconds, fd, n_unique = _fly(policy, mdps, args, show_progress=not args.json)

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import math
 import re
+import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, fields
 
@@ -180,9 +182,19 @@ def add_task_option(p: argparse.ArgumentParser) -> None:
     p.add_argument("--task", required=True, help=f"task family: {', '.join(TASK_NAMES)}")
 
 
+def real(text: str) -> float:
+    """A command-line number: one past a float's range is refused as typed (a 400-digit --sigma became sigma=inf;
+    seventh trial); 'nan' and 'inf' as written are left to the option's own range check."""
+    value = float(text)
+    if math.isinf(value) and "inf" not in text.lower():
+        shown = text if len(text) <= 30 else f"{text[:10]}...({len(text)} characters)"
+        raise argparse.ArgumentTypeError(f"{shown} is past a float's range (about 1.8e308)")
+    return value
+
+
 def add_sigma_option(p: argparse.ArgumentParser) -> None:
     """--sigma: FGHH's breadth."""
-    p.add_argument("--sigma", type=float, help="FGHH breadth sigma (default 0.3)")
+    p.add_argument("--sigma", type=real, help="FGHH breadth sigma (default 0.3)")
 
 
 #: ``fly``'s --mdp; ``evolve`` adds G (evolution over the family's distribution).
@@ -209,3 +221,15 @@ def max_in_memory(bytes_each: int) -> int:
     from ..procs import half_free_memory
 
     return max(1, half_free_memory() // bytes_each)
+
+
+def note_policy_task(policy, task: str, option: str) -> None:
+    """Say on standard error when a policy file was evolved for another task than the one it flies (a transfer can be
+    meant, so it is flown; a `task` of the wrong kind in its metadata is refused; seventh trial)."""
+    own = policy.metadata.get("task")
+    if own is None:
+        return
+    if not isinstance(own, str):
+        raise NeurohoverError(f"{option}: the policy's metadata task={own!r:.40} is not allowed: give a task family's name")
+    if own != task:
+        print(f"neurohover: note: {option} was evolved for {own}; flying it on {task}", file=sys.stderr)

@@ -33,6 +33,8 @@ def _episodes(text: str | None, n: int) -> list[int] | None:
             first, last = int(lo), int(hi) if sep else int(lo)
         except ValueError:
             raise NeurohoverError(f"--episodes {text!r} is not allowed: give episode numbers and ranges, e.g. 0,3,10-12") from None
+        if first > last:  # both ends may be in range: "out of range" misled (seventh trial)
+            raise NeurohoverError(f"--episodes {part.strip()!r} is a reversed range: give FIRST-LAST with FIRST <= LAST, e.g. {last}-{first}")
         if not (0 <= first <= last < n):
             raise NeurohoverError(f"--episodes {part.strip()!r} is out of range: the flight data hold episodes 0..{n - 1}")
         twice = sorted(set(out) & set(range(first, last + 1)))

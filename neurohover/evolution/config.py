@@ -222,7 +222,10 @@ def make_settings(method: str, optimizer: str, settings) -> Any:
     presets = GENERATIONAL_PRESETS if cls is GenerationalSettings else {}
     unknown = sorted(set(settings) - fields - ({"preset"} if presets else set()))
     if unknown:
-        raise NeurohoverError(f"unknown {method} setting(s) {', '.join(unknown)}: allowed {', '.join(sorted(fields | ({'preset'} if presets else set())))}")
+        budget = "; the run's budget is its own option (--budget, evolve(budget=...)), counted in episodes" if "budget" in unknown else ""
+        raise NeurohoverError(
+            f"unknown {method} setting(s) {', '.join(unknown)}: allowed {', '.join(sorted(fields | ({'preset'} if presets else set())))}{budget}"
+        )
     values = dict(settings)
     if "preset" in values:
         name = values.pop("preset")

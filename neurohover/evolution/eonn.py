@@ -58,12 +58,20 @@ class EonnSettings:
         Generations to run.
     tournament_size : int
         Genomes per tournament that picks a parent.
-    mutate_prob, mutate_frac, mutate_std, mutate_repl, averaging_prob
-        As :class:`~neurohover.evolution.steady_state.SteadyStateSettings`'s: the chance an offspring is mutated,
-        each gene's chance, the Gaussian's spread, a mutated gene's chance of being replaced; crossover's
-        per-gene chance of averaging.
-    spawn_frac, spawn_std : float
-        The mutation of the prototype's copies in the initial population (gene chance, spread).
+    mutate_prob : float
+        The chance an offspring is mutated (as :class:`~neurohover.evolution.steady_state.SteadyStateSettings`'s).
+    mutate_frac : float
+        Each gene's chance of mutating in a mutated offspring.
+    mutate_std : float
+        The spread of a mutation's Gaussian.
+    mutate_repl : float
+        A mutated gene's chance of being replaced by the Gaussian draw (else the draw is added).
+    averaging_prob : float
+        Crossover's per-gene chance of averaging the two parents' genes (else one parent's is taken).
+    spawn_frac : float
+        Each gene's chance of mutating in the prototype's copies that make the initial population.
+    spawn_std : float
+        The spread of that initial mutation's Gaussian.
     """
 
     pop_size: int = 50

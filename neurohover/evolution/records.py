@@ -211,8 +211,11 @@ def write_checkpoint(path: Path, state: dict) -> None:
             f.flush()
             os.fsync(f.fileno())
         os.replace(tmp, path)
-    except BaseException:  # interrupted or failed mid-write: no truncated PATH.tmp is left (the last checkpoint stands)
+    except BaseException as err:  # interrupted or failed mid-write: no truncated PATH.tmp is left (the last checkpoint stands)
         tmp.unlink(missing_ok=True)
+        if isinstance(err, OSError):  # a full disk said only "No space left on device" (seventh trial)
+            why = err.strerror or err
+            raise NeurohoverError(f"checkpoint {str(path)!r}: cannot write it ({why}); no partial file is left, an earlier one stands") from None
         raise
 
 

@@ -177,10 +177,14 @@ class Run:
                 stream.bit_generator.state = state["mdp_stream"]
         except (KeyError, TypeError, ValueError, AttributeError, IndexError, OverflowError) as err:
             raise _damaged(source, err) from None
+        counts, seconds = parts["counters"], parts["seconds"]
+        if self.budget is not None and counts["episodes"] > self.budget:  # it stopped at once "by budget", a plateau's run (seventh trial)
+            raise NeurohoverError(
+                f"budget {self.budget:,} is below the {counts['episodes']:,} episodes {source}'s run has flown: a resumed run's budget may only be raised"
+            )
         self.opt = opt
         if self.mdp_rng is not None:
             self.mdp_rng = stream
-        counts, seconds = parts["counters"], parts["seconds"]
         self.flyer.episodes, self.flyer.steps, self.flyer.next_index, self.flyer.flown = (counts[k] for k in ("episodes", "steps", "next_index", "flown"))
         self.generation, self.evaluations = counts["generation"], counts["evaluations"]
         self.flyer.kernel_seconds, self.elapsed = seconds["kernel_seconds"], seconds["wall_seconds"]

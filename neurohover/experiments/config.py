@@ -214,6 +214,8 @@ def parse_override(text: str, option: str = "--set") -> tuple[str, Any]:
         raise NeurohoverError(f'bad {option} {text!r}: expected KEY=VALUE (VALUE in TOML syntax, e.g. runs=3 or policies="evolve")')
     try:
         parsed = tomllib.loads(f"v = {value.strip()}")["v"]
+    except RecursionError:  # tomllib follows nesting by recursion (seventh trial)
+        raise NeurohoverError(f"bad {option} {text[:40]!r}...: VALUE is nested too deeply") from None
     except tomllib.TOMLDecodeError as err:
         if value.strip()[:1] in ("{", "[", '"', "'"):  # meant as TOML, not a bare word: say why it is not (a repeated key, ...)
             why = re.sub(r" \(at (line \d+, column \d+|end of document)\)$", "", str(err))  # positions in our wrapper, not in VALUE
@@ -244,6 +246,8 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
         raw = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as err:
         raise NeurohoverError(f"config {str(path)!r} is not valid TOML: {err}") from None
+    except RecursionError:  # a value nested thousands deep (seventh trial)
+        raise NeurohoverError(f"config {str(path)!r} is not allowed: its TOML is nested too deeply") from None
     except (OSError, UnicodeDecodeError) as err:
         raise NeurohoverError(f"config {str(path)!r} cannot be read ({getattr(err, 'strerror', None) or type(err).__name__})") from None
     where = f"config {str(path)!r}"
@@ -254,6 +258,10 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
     for key in ("name", "kind", "settings"):
         if key not in raw:
             raise NeurohoverError(f"{where}: missing top-level key {key!r}")
+    own = path.resolve().parent != CONFIG_DIR.resolve()
+    if own and "aliases" in raw and raw.get("name") not in shipped_configs():  # only the shipped configs' are read (seventh trial);
+        # a copy of a shipped config keeps its name and aliases: check_own_name refuses the name first, the clearer message
+        raise NeurohoverError(f"{where}: aliases apply to the shipped experiments only (a config of your own is named by its path): remove the key")
     for key in ("title", "paper_ref"):  # title = 5 was stored, then refused as a damaged store's (sixth trial)
         if key in raw and not isinstance(raw[key], str):
             raise NeurohoverError(f"{where}: {key} = {raw[key]!r:.40} is not allowed: give text")
@@ -283,7 +291,21 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
         where=f"{where} at scale {scale!r}",
     )
     check_paper(raw.get("paper", {}), raw, where)  # after the settings: a bad agent is named as such, not as a t test naming nothing
+    _check_seeds_of(config, where)
     return config
+
+
+def _check_seeds_of(config: ExperimentConfig, where: str) -> None:
+    """Refuse a ``seeds_of`` naming an experiment that is neither shipped nor this one: its seeds are derived from the
+    name, so a typo ("fig1l") paired nothing without a word (seventh trial). Its group is a name the seeds are derived
+    from too (bench-drift's conditions), not necessarily a group the experiment runs."""
+    tables = [config.settings.get("seeds_of"), *(g.get("seeds_of") for g in config.settings.get("groups", []))]
+    known = [*shipped_configs(), config.name]
+    for table in tables:
+        if table is not None and table["experiment"] not in known:
+            raise NeurohoverError(
+                f"{where}: seeds_of names experiment {table['experiment']!r:.60}, which is neither shipped nor this one: give one of {', '.join(known)}"
+            )
 
 
 #: An experiment's name becomes file names (figures, discussions, exports): letters, digits, '.', '_' and '-',

@@ -42,10 +42,14 @@ def resolve_scale(store: Store, name: str, scale: str | None) -> str:
 
 def export_results(store: Store, name: str, fmt: str = "csv", scale: str | None = None) -> str:
     """The finished units of ``name`` as CSV (one row per unit, one plain value per cell) or JSON (everything)."""
+    if not isinstance(store, Store):  # a path was an AttributeError (seventh trial)
+        raise NeurohoverError(f"store={store!r:.60} is not allowed: give a Store(PATH)")
     if fmt not in FORMATS:
         raise NeurohoverError(f"unknown format {fmt!r}: allowed {', '.join(FORMATS)}")
     scale = resolve_scale(store, name, scale)
     units = store.units(name, scale)
+    if not units:  # it printed an empty line (seventh trial)
+        raise NeurohoverError(f"experiment {name} ({scale}) has no finished unit yet: nothing to export (neurohover reproduce runs its units)")
     config = store.config(name, scale)
     ExperimentConfig.from_dict(config)  # a damaged one named, as CSV's rows are (sixth trial); exported as stored
     for u in units:  # JSON exports what CSV does, no damaged result (it exported a list, a score "x"; sixth trial)

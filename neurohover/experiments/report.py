@@ -30,7 +30,7 @@ from .report_evolution import EvolutionSection
 from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, test_run_figure, varies
 from .report_models import SensorModels
 from .report_readme import Status, fill_generated, linked_claims, status_table
-from .results import ModelResult, TestRunResult, result_from_dict
+from .results import ModelResult, TestRunResult, check_run_lengths, result_from_dict
 from .settings import Group, ModelLearningSettings
 from .store import Store
 from .wins import DEFAULT_DRAWS, win_probabilities
@@ -448,6 +448,7 @@ def _section(cfg: ExperimentConfig, store: Store, out: Path, current: bool | Non
     except NeurohoverError:
         total = None
     results = {u["key"]: result_from_dict(u["kind"], u["result"], u["key"]) for u in units}
+    check_run_lengths(cfg.settings.get("episodes") if cfg.kind == "test_runs" else None, results)
     kind = _SECTIONS[cfg.kind]
     if isinstance(cfg.typed, ModelLearningSettings):
         kind = SensorModels if cfg.typed.conditions else FitFactorial if cfg.typed.fits else kind
@@ -503,12 +504,16 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
 
     A ``README.md`` in ``out`` with generated blocks gets them filled from the store (:mod:`.report_readme`).
     """
-    from ..paths import output_dir
+    from ..paths import output_dir, writing
 
     if not isinstance(store, Store):  # None was an AttributeError (sixth trial)
         raise NeurohoverError(f"store={store!r:.60} is not allowed: give a Store(PATH)")
     if isinstance(names, str) or (names is not None and not all(isinstance(n, str) for n in names)):  # 'fig2' was read as f, i, g, 2
         raise NeurohoverError(f"names={names!r:.60} is not allowed: give a list of experiment names, e.g. ['fig2']")
+    given = list(names or ())
+    twice = sorted({n for n in given if given.count(n) > 1})
+    if twice:  # taken once without a word (seventh trial)
+        raise NeurohoverError(f"experiment {twice[0]!r} is named more than once: give each once")
     out = output_dir(out, "report directory")  # '' wrote into the current directory; a file, a device or 5: OSError, TypeError
     entries = [(n, s) for n, s, _, _ in store.experiments() if (scale is None or s == scale) and (not names or n in names)]
     if names:
@@ -550,7 +555,8 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
     summary = claims_section(claims) if claims else ""
     head += "\n" + summary + conclusions_discussion(out) if summary else ""
     path = out / "report.md"
-    path.write_text(head + "\n" + "\n".join(sections))
+    with writing(path, "report") as partial:  # a full disk left an empty report.md and an unnamed error (seventh trial)
+        partial.write_text(head + "\n" + "\n".join(sections))
     readme = out / "README.md"
     fill_generated(readme, "status", status_table([s for s in statuses if s.scale == "paper"]))
     if summary:

@@ -57,7 +57,10 @@ def fill_generated(path: Path, key: str, text: str) -> bool:
         return False
     new = pattern.sub(lambda _: f"{begin}\n{text.rstrip()}\n{end}", old, count=1)
     if new != old:
-        path.write_text(new)
+        from ..paths import writing
+
+        with writing(path, "README") as partial:  # whole or not at all: a full disk must not cut the README short
+            partial.write_text(new)
     return True
 
 

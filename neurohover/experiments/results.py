@@ -508,6 +508,30 @@ class TestRunResult(_Record):
     crash_steps: tuple[int, ...] | None = None
     timing: TestRunTiming = field(compare=False)
 
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        problem = self._inconsistency()
+        if problem:  # a stored run with returns [] was a NumPy ValueError in report (seventh trial)
+            raise NeurohoverError(f"test run of {self.agent} on {self.mdp} is inconsistent: {problem}")
+
+    def _inconsistency(self) -> str:
+        """What in this run does not fit together ('' when all does): the score is the sum of the returns, the episodes
+        named are among them, one crash step per crash."""
+        n = len(self.returns)
+        if n == 0:
+            return "it holds no episode's return"
+        if not math.isclose(float(self.score), math.fsum(float(r) for r in self.returns), rel_tol=1e-9, abs_tol=1e-6):
+            return f"its score {self.score!r:.20} is not the sum of its {n} returns"
+        for name in ("crash_episodes", "safeguard_episodes"):
+            outside = [e for e in getattr(self, name) if not 0 <= e < n]
+            if outside:
+                return f"{name} names episode {outside[0]!r}, outside 0..{n - 1}"
+        if self.crash_steps is not None and len(self.crash_steps) != len(self.crash_episodes):
+            return f"{len(self.crash_steps)} crash steps for {len(self.crash_episodes)} crash episodes"
+        if not 0 <= self.learning_episodes <= n:
+            return f"learning_episodes {self.learning_episodes!r} is outside 0..{n}"
+        return ""
+
 
 @dataclass(frozen=True, kw_only=True)
 class DiagnosticResult(_Record):
@@ -557,6 +581,16 @@ def result_from_dict(kind: str, d: dict, key: str | None = None) -> UnitResult:
     if cls is None:
         raise NeurohoverError(f"unknown unit kind {kind!r}: allowed {', '.join(RESULT_TYPES)}")
     return cls.from_dict(d, f"result of {kind} unit {key!r}" if key else None)
+
+
+def check_run_lengths(episodes: Any, results: dict[str, Any]) -> None:
+    """Refuse a stored test run whose episodes are not the experiment's ``episodes`` (None: not a test-runs experiment), by
+    its key: the report stacks every run's returns (a shorter one was a NumPy ValueError there; seventh trial)."""
+    if episodes is None:
+        return
+    for key, result in results.items():
+        if isinstance(result, TestRunResult) and len(result.returns) != episodes:
+            raise NeurohoverError(f"test run {key!r} holds {len(result.returns)} episodes' returns where its experiment flies {episodes}")
 
 
 # --------------------------------------------------------------------------------- unit keys

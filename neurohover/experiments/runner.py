@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from ..errors import NeurohoverError
 from .config import POLICY_SOURCES, ExperimentConfig
 from .plans import plan, run_keys, source_experiments
-from .results import result_from_dict
+from .results import check_run_lengths, result_from_dict
 from .store import Store
 
 
@@ -131,14 +131,25 @@ def _checked_results(config: ExperimentConfig, store: Store) -> dict[str, dict]:
     object; the result's fields are checked here): a damaged unit was counted as finished and never run again (fifth
     trial). Its config must read back too."""
     ExperimentConfig.from_dict(store.config(config.name, config.scale))
-    results = {}
-    for unit in store.units(config.name, config.scale):
-        try:
-            result_from_dict(unit["kind"], unit["result"], unit["key"])
-        except NeurohoverError as err:
-            raise NeurohoverError(f"results store {str(store.path)!r}, experiment {config.name} ({config.scale}), is damaged: {err}") from None
-        results[unit["key"]] = unit["result"]
-    return results
+    units = store.units(config.name, config.scale)
+    try:
+        typed = {unit["key"]: result_from_dict(unit["kind"], unit["result"], unit["key"]) for unit in units}
+        check_run_lengths(config.settings.get("episodes") if config.kind == "test_runs" else None, typed)
+    except NeurohoverError as err:
+        raise NeurohoverError(f"results store {str(store.path)!r}, experiment {config.name} ({config.scale}), is damaged: {err}") from None
+    return {unit["key"]: unit["result"] for unit in units}
+
+
+def _refuse_stray_units(config: ExperimentConfig, store: Store, results: dict[str, dict], sources: dict) -> None:
+    """Refuse a stored unit the config does not plan (it was counted as done: "5/4 done"; seventh trial). Every stored
+    unit's prerequisites are stored too, so the plan from all of them names every unit that belongs."""
+    known = {u.key for u in plan(config, results, sources).units} | set(run_keys(config))
+    stray = sorted(set(results) - known)
+    if stray:
+        raise NeurohoverError(
+            f"results store {str(store.path)!r}, experiment {config.name} ({config.scale}), is damaged: it holds unit {stray[0]!r}"
+            f"{f' (and {len(stray) - 1} more)' if len(stray) > 1 else ''}, which the config does not plan (--fresh starts it over)"
+        )
 
 
 def _check_arguments(config, store, executor) -> None:
@@ -192,6 +203,7 @@ def reproduce(
     store.begin(config.name, config.scale, config.hash, config.to_dict(), fresh=fresh)
     results = _checked_results(config, store)  # read once: checked, then the finished units
     sources = {name: store.results(name, config.scale) for name in source_experiments(config)}
+    _refuse_stray_units(config, store, results, sources)
     summary = RunSummary(config.name, config.scale, executor.name, executor.cores, units_before=len(results))
     session = store.start_session(config.name, config.scale, config.hash, executor.name, summary.cores, len(results))
     start = time.perf_counter()

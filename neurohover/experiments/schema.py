@@ -211,6 +211,12 @@ def _check_mdp_counts(settings: dict, where: str) -> None:
 def _check_test_runs(settings: dict, task: str, where: str) -> None:
     """Groups (agents for the task, their LR and own settings, written in where defaulted) and the generics' sources."""
     labels = [g["label"] or g["agent"] for g in settings["groups"]]
+    for label in labels:  # a group's label is part of its units' keys, whose parts '/' separates (seventh trial: "../x")
+        if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._+=-]*(/[A-Za-z0-9][A-Za-z0-9._+=-]*)*", label):
+            raise NeurohoverError(
+                f"{where}: group label {label!r:.60} is not allowed: give words of letters, digits, '.', '_', '+', '=' or '-', each starting "
+                "with a letter or digit, joined by '/' (it names the group's units, run/LABEL/MDP/REP)"
+            )
     if len(set(labels)) != len(labels):
         raise NeurohoverError(f"{where}: group labels must be unique (set label = ... on repeated agents), got {labels}")
     for g in settings["groups"]:

@@ -30,6 +30,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import json
+import math
 import os
 import socket
 import sqlite3
@@ -104,6 +105,8 @@ class Store:
             raise NeurohoverError(f"results store {str(self.path)!r} is a directory; give a file name")
         if self.path.exists() and not self.path.is_file():  # a device was taken for a new store, and deleted (fifth trial)
             raise NeurohoverError(f"results store {str(self.path)!r} is not a regular file (a device, pipe or socket); give a file name")
+        if not create and self.path.stat().st_size == 0:  # read, it was given the schema: a refused command changed it (seventh trial)
+            raise NeurohoverError(f"results store {str(self.path)!r} is empty (0 bytes): it holds no experiment yet")
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._lock: IO[str] | None = None
         new = not self.path.exists() or self.path.stat().st_size == 0
@@ -354,12 +357,18 @@ class Store:
                 "kind": kind,
                 "params": self._json(p, f"experiment {name} ({scale}), unit {k}'s params"),
                 "result": self._json(r, f"experiment {name} ({scale}), unit {k}'s result"),
-                "seconds": s,
+                "seconds": self._seconds(s, f"experiment {name} ({scale}), unit {k}'s seconds"),
                 "worker": w,
                 "finished": f,
             }
             for k, kind, p, r, s, w, f in rows
         ]
+
+    def _seconds(self, value: Any, what: str) -> float:
+        """A stored duration, or one clear error naming the damaged row (text was a TypeError in report; seventh trial)."""
+        if isinstance(value, (int, float)) and math.isfinite(value) and value >= 0:
+            return value
+        raise NeurohoverError(f"results store {str(self.path)!r}: {what} is damaged ({value!r:.40} is no number of seconds >= 0)")
 
     def _json(self, text: str, what: str) -> dict:
         """A stored JSON object, or one clear error naming the damaged row (the rest of the store stays readable): every
@@ -410,7 +419,13 @@ class Store:
         rows = self._rows(
             f"SELECT {', '.join(cols)} FROM sessions WHERE name = ? AND scale = ? ORDER BY id", (name, scale), f"experiment {name} ({scale})'s sessions"
         )
-        return [dict(zip(cols, r)) for r in rows]
+        sessions = [dict(zip(cols, r)) for r in rows]
+        for session in sessions:  # what the report sums and prints: numbers, or the damaged row named
+            session["wall_seconds"] = self._seconds(session["wall_seconds"], f"experiment {name} ({scale}), session {session['id']}'s wall seconds")
+            if type(session["cores"]) is not int or session["cores"] < 1:
+                what = f"experiment {name} ({scale}), session {session['id']}'s cores"
+                raise NeurohoverError(f"results store {str(self.path)!r}: {what} are damaged ({session['cores']!r:.40})")
+        return sessions
 
 
 def worker_name() -> str:

@@ -85,8 +85,10 @@ class NeatSettings:
         Those a new node may take (the first is the default), of :data:`ACTIVATIONS`.
     node_add_prob, conn_add_prob, node_delete_prob, conn_delete_prob : float
         The chances of the structural mutations, per genome and generation.
-    weight_mutate_power, bias_mutate_power : float
-        The spread of a weight's or a bias's perturbation.
+    weight_mutate_power : float
+        The spread of a weight's perturbation.
+    bias_mutate_power : float
+        The spread of a bias's perturbation.
     weight_mutate_rate : float
         The chance that each weight is perturbed in a mutation.
     activation_mutate_rate : float

@@ -179,6 +179,8 @@ def rl_zoo_policy(run: str | Path, *, algo: str = "ppo", deterministic: bool = T
     """
     algorithm = _algorithm(algo)
     run = Path(run)
+    if not run.is_dir():  # "found []" for a folder that is not there (seventh trial)
+        raise NeurohoverError(f"RL Zoo run folder {str(run)!r}: {'no such directory' if not run.exists() else 'not a directory'}")
     zips = sorted(z for z in run.glob("*.zip") if not z.name.startswith("rl_model_"))
     finals = [z for z in zips if z.name != "best_model.zip"]
     model_zip = finals[0] if len(finals) == 1 else run / "best_model.zip"
