@@ -5,11 +5,13 @@ The runs of docs/deep-rl.md ("SAC"), 2026-12-05::
     OMP_NUM_THREADS=1 python docs/benchmarks/sac_by_id.py default 15000 1
     OMP_NUM_THREADS=1 python docs/benchmarks/sac_by_id.py ent01 100000 1 '{"ent_coef": 0.01}'
     OMP_NUM_THREADS=1 python docs/benchmarks/sac_by_id.py ent01-8env 300000 8 '{"ent_coef": 0.01}'
+    OMP_NUM_THREADS=1 python docs/benchmarks/sac_by_id.py tent0 100000 1 '{"target_entropy": 0.0}'
 
-Arguments: a name for the run, its environment steps, its environments (``make_vec_env``) and SAC's keyword arguments as
-JSON (every other setting SB3's default, seed 0). Every 25,000 steps (10,000 with one environment) it prints the mean length
-and return of the last training episodes, the entropy coefficient, and the steps the deterministic policy flies on test
-MDPs 0-4 (1000-step episodes). Needs stable-baselines3 (``pip install '.[examples]'``).
+Arguments: a name for the run, its environment steps, its environments (``make_vec_env``), SAC's keyword arguments as
+JSON and the environment's (``env_kwargs``, e.g. ``'{"obs_delay": 2}'``); every other setting SB3's default, seed 0.
+Every 25,000 steps (10,000 with one environment) it prints the mean length and return of the last training episodes,
+the entropy coefficient, and the steps the deterministic policy flies on test MDPs 0-4 (1000-step episodes). Needs
+stable-baselines3 (``pip install '.[examples]'``).
 """
 
 from __future__ import annotations
@@ -69,8 +71,9 @@ class Log(BaseCallback):
 def main() -> None:
     name, steps, n_envs = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
     settings = json.loads(sys.argv[4]) if len(sys.argv) > 4 else {}
+    env_kwargs = json.loads(sys.argv[5]) if len(sys.argv) > 5 else {}
     torch.set_num_threads(1)
-    model = SAC("MlpPolicy", make_vec_env(ENV_ID, n_envs=n_envs, seed=0), seed=0, device="cpu", **settings)
+    model = SAC("MlpPolicy", make_vec_env(ENV_ID, n_envs=n_envs, seed=0, env_kwargs=env_kwargs), seed=0, device="cpu", **settings)
     model.learn(steps, callback=Log(name, 10_000 if n_envs == 1 else 25_000))
     model.save(f"sac-{name}")
 
