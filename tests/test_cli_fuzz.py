@@ -12,9 +12,10 @@ import subprocess
 import sys
 
 from neurohover.cli import build_parser, main
+from neurohover.cli.options import real
 
 #: Values every option is fed; for an int or float option the first four must be refused.
-BAD = ("-1", "abc", "nan", "1e15", "inf", "", "0")
+BAD = ("-1", "abc", "nan", "1e15", "inf", "", "0", "1" + "0" * 400)
 #: Options for which an infinite or huge value has a meaning (seconds between checkpoints: never).
 UNBOUNDED = {("evolve", "--checkpoint-every")}
 
@@ -64,8 +65,9 @@ def test_no_option_of_any_command_ends_in_a_traceback(tmp_path, monkeypatch, cap
             assert rc in (0, 2), f"{name} {opt} {value!r}: exit {rc}"
             if rc == 2:
                 assert err.strip().splitlines()[-1].startswith(("neurohover", "usage")), f"{name} {opt} {value!r}: {err[-300:]}"
-            numeric = kind in (int, float)
-            must_refuse = value in ("-1", "abc", "nan") or (value in ("inf", "1e15") and (name, opt) not in UNBOUNDED)
+            assert "0" * 100 not in err, f"{name} {opt}: a 400-digit value echoed whole: {err[-300:]}"
+            numeric = kind in (int, float, real)
+            must_refuse = value in ("-1", "abc", "nan") or (value in ("inf", "1e15", BAD[-1]) and (name, opt) not in UNBOUNDED)
             if numeric and must_refuse and rc != 2:
                 silent.append(f"{name} {opt} {value}")
     assert not silent, f"accepted without a word: {silent}"

@@ -172,7 +172,7 @@ def _run(argv: Sequence[str] | None) -> int:
         return 1
     except OSError as err:  # what no check foresaw (a name too long, a full disk inside a library): one line, not a traceback
         where = f": {str(err.filename)!r:.120}" if err.filename else ""
-        print(f"neurohover {args.command}: error: {err.strerror or err}{where}", file=sys.stderr)
+        print(f"neurohover {args.command}: error: {shorter_numbers(f'{err.strerror or err}{where}')}", file=sys.stderr)
         remove_created_dirs()
         return 2
 

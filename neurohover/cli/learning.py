@@ -60,7 +60,9 @@ def _seed_policy(args: argparse.Namespace):
 
     if args.seed_policy in ("zero", "baseline"):
         return args.topology, args.seed_policy  # None: evolve's default (SLP over a family, MLP on one MDP)
-    path = Path(args.seed_policy)
+    from ..paths import checked_path
+
+    path = checked_path(args.seed_policy, "--seed-policy", "policy file (or zero, baseline)") if args.seed_policy else Path("")
     if not path.is_file():
         what = "is empty" if args.seed_policy == "" else ("is a directory" if path.is_dir() else "no such file")
         raise NeurohoverError(f"--seed-policy {args.seed_policy!r}: {what} (give zero, baseline or a policy file)")
