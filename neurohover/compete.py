@@ -307,6 +307,7 @@ def compete(
     store_path = _checked_store(store)
     out = output_dir(out, "out")  # made once every setting is checked (None was a TypeError, /dev/full a FileExistsError)
     store_path = store_path or out / STORE_FILE
+    _note_replaced(out / "summary.json", task, agent)
     ordered = _run_into_store(config, store_path, out / "episodes.csv", jobs=jobs, device=device, progress=progress, on_result=on_result)
     summary = {
         "task": task,
@@ -376,6 +377,22 @@ def _run_into_store(config, store_path: Path, episodes_csv: Path, *, jobs: int, 
             ordered = [TestRunResult.from_dict(stored[k], k) for k in keys]
             _write_episodes(episodes_csv, ordered, config.typed.n_steps)
     return ordered
+
+
+def _note_replaced(summary_path: Path, task: str, agent: str) -> None:
+    """Say when ``out`` holds another competition, whose files this one replaces (without a word before; eighth trial);
+    its runs stay in the store."""
+    try:
+        before = json.loads(summary_path.read_text())
+        held = (before["task"], before["agent"])
+    except (OSError, ValueError, RecursionError, KeyError, TypeError):
+        return  # none, or not a summary: nothing to name
+    if held != (task, agent):
+        print(
+            f"neurohover compete: note: {str(summary_path.parent)!r} held the competition of {held[1]} on {held[0]}; its episodes.csv, "
+            "summary.json and plot are replaced (its runs stay in the store)",
+            file=sys.stderr,
+        )
 
 
 def _run_order(key: str) -> tuple[int, int]:

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import dataclasses
+import math
+import numbers
 from typing import Any
 
 
@@ -10,8 +12,34 @@ class NeurohoverError(ValueError):
     """Bad input: the message names the bad value and what is allowed."""
 
 
+class OutputError(NeurohoverError):
+    """An output file could not be written (a full disk, a read-only place): the output's fault, not the input's."""
+
+
 class Terminated(KeyboardInterrupt):
     """SIGTERM arrived where the command handles it (like Ctrl-C: finished work kept, one line, status 143)."""
+
+
+def finite_real(value: object) -> bool:
+    """Whether ``value`` is a real number (not a bool) that a float holds finitely: an int past a float's range (10**400)
+    is not (``math.isfinite`` raised OverflowError on it; eighth trial)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
+
+
+def float_of(text: str) -> float:
+    """``float(text)``, but a number past a float's range is a ValueError naming it, not inf: '1' and 400 zeros was
+    read as inf and reported as a value the user never typed (eighth trial). 'inf' written as such stays inf."""
+    value = float(text)
+    if math.isinf(value) and "inf" not in str(text).lower():
+        shown = str(text).strip()
+        shown = shown if len(shown) <= 30 else f"{shown[:10]}...({len(shown)} characters)"
+        raise ValueError(f"{shown} is past a float's range (about 1.8e308)")
+    return value
 
 
 def raise_terminated(signum, frame) -> None:
@@ -28,5 +56,5 @@ def settings_from_dict(cls: type, values: Any, *, unknown_what: str, bad_what: s
         raise NeurohoverError(f"unknown {unknown_what} setting(s) {', '.join(unknown)}: allowed {', '.join(fields)}")
     try:
         return cls(**values)
-    except (TypeError, ValueError) as err:
+    except (TypeError, ValueError, OverflowError) as err:  # OverflowError: an int past a float's range (eighth trial)
         raise NeurohoverError(f"bad {bad_what}: {err}") from None

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError
+from .errors import NeurohoverError, finite_real
 from .sim.constants import MAX_EPISODE_STEPS
 
 FORMAT = "neurohover-flight-data/1"
@@ -166,6 +166,16 @@ def _check_metadata(path: Path, metadata: dict, n_episodes: int) -> None:
     if steps is not None and (type(steps) is not int or not 1 <= steps <= MAX_EPISODE_STEPS):
         allowed = f"an integer in 1..{MAX_EPISODE_STEPS:,}"
         raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata episode_steps={steps!r:.40} is not allowed: {allowed}")
+    for name in ("task", "policy"):  # shown in titles and notes (a task 5 or a policy 123 was taken; eighth trial)
+        if metadata.get(name) is not None and not isinstance(metadata[name], str):
+            raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata {name}={metadata[name]!r:.40} is not allowed: give text")
+    returns, mdps = metadata.get("returns"), metadata.get("mdps")
+    if returns is not None and (not isinstance(returns, list) or len(returns) != n_episodes or not all(finite_real(r) for r in returns)):
+        allowed = f"one number per episode ({n_episodes})"
+        raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata returns={returns!r:.40} is not allowed: {allowed}")
+    if mdps is not None and (not isinstance(mdps, list) or len(mdps) != n_episodes or not all(isinstance(m, dict) for m in mdps)):
+        allowed = f"one MDP (a table) per episode ({n_episodes})"
+        raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata mdps={mdps!r:.40} is not allowed: {allowed}")
     crashed = metadata.get("crashed")
     if crashed is not None and (not isinstance(crashed, list) or len(crashed) != n_episodes or not all(type(c) is bool for c in crashed)):
         allowed = f"one true or false per episode ({n_episodes})"

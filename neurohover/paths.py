@@ -19,7 +19,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from .errors import NeurohoverError
+from .errors import NeurohoverError, OutputError
 
 __all__ = ["checked_path", "parse_json", "input_file", "input_dir", "output_dir", "output_file", "remove_created_dirs", "write_png", "writing"]
 
@@ -159,7 +159,7 @@ def writing(path: str | os.PathLike, option: str) -> Iterator[Path]:
         yield partial
         os.replace(partial, p)
     except OSError as err:
-        raise NeurohoverError(f"{option} {str(path)!r}: cannot write it ({_why(err)}); no partial file is left") from None
+        raise OutputError(f"{option} {str(path)!r}: cannot write it ({_why(err)}); no partial file is left") from None
     finally:
         partial.unlink(missing_ok=True)
 

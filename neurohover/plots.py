@@ -34,7 +34,7 @@ from matplotlib.ticker import MaxNLocator
 
 from .errors import NeurohoverError
 from .flightdata import FlightData
-from .sim.constants import ACTION_NAMES, CONTROL_DT, EPISODE_STEPS
+from .sim.constants import ACTION_NAMES, CONTROL_DT, CRASH_STEP_PENALTY, EPISODE_STEPS, MAX_EPISODE_STEPS
 
 __all__ = [
     "CompeteResult",
@@ -53,6 +53,7 @@ CRASH_COLOR = "tab:red"
 COMPETE_FILE = "episodes.csv"
 COMPETE_SUMMARY = "summary.json"
 COMPETE_COLUMNS = ("run", "episode", "return")  # the columns of compete's episodes.csv read here
+WORST_RETURN = CRASH_STEP_PENALTY * MAX_EPISODE_STEPS  # no episode loses more: a crash charges the worst step for every step left
 
 
 def new_figure(width: float, height: float, dpi: int = 100) -> Figure:
@@ -269,8 +270,10 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
                     crashes += int(row.get("crashed") or 0)
                 except (TypeError, ValueError):
                     raise NeurohoverError(f"--compete {str(csv_path)!r}, line {line}: run, episode and return must be numbers") from None
-                if not math.isfinite(ret):
-                    raise NeurohoverError(f"--compete {str(csv_path)!r}, line {line}: return {row['return']!r} is not finite")
+                if not math.isfinite(ret) or abs(ret) > WORST_RETURN:  # -1e308 overflowed the plot (eighth trial)
+                    raise NeurohoverError(
+                        f"--compete {str(csv_path)!r}, line {line}: return {row['return']!r:.30} is not an episode's (finite, >= {-WORST_RETURN:.3g})"
+                    )
                 if run < 0 or episode < 0 or episode in seen.setdefault(run, set()):  # plotted without a word (fifth trial)
                     raise NeurohoverError(
                         f"--compete {str(csv_path)!r}, line {line}: run {run}, episode {episode} is negative or given twice: "
@@ -293,7 +296,7 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
     if summary_path.exists():
         try:
             summary = json.loads(summary_path.read_text())
-        except (OSError, ValueError) as err:  # damaged: refused, not silently relabelled (second trial)
+        except (OSError, ValueError, RecursionError) as err:  # damaged: refused, not silently relabelled (second trial)
             raise NeurohoverError(f"--compete {str(summary_path)!r} cannot be read ({err}); remove it to label the curve by its directory's name") from None
         if not (isinstance(summary, dict) and isinstance(summary.get("agent"), str) and isinstance(summary.get("task", ""), str)):
             raise NeurohoverError(f"--compete {str(summary_path)!r} is not a compete summary: no agent and task names")

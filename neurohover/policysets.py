@@ -290,8 +290,8 @@ def _evolve_one(
     from .policies import prototype
 
     stage = _stage_file(root, str(child_seed))  # the run's seed names it: each run of a build has its own
-    if stage.is_file():  # finished before the build was stopped: the same run again would give the same champion
-        policy = load_policy(stage)
+    policy = _finished_stage(stage, f"{family.name}/{name}", say)
+    if policy is not None:  # finished before the build was stopped: the same run again would give the same champion
         if save:
             save_policy(policy, root / f"{name}.json", task=family.name, name=name, **{k: policy.metadata[k] for k in ("episodes", "seconds")})
         say(f"{family.name}/{name}: kept from the interrupted build")
@@ -310,6 +310,22 @@ def _evolve_one(
     save_policy(policy, stage, task=family.name, name=name, **meta)
     say(f"{family.name}/{name}: champion {result.champion_return:.1f} after {result.episodes} episodes ({time.perf_counter() - t0:.0f} s)")
     return policy
+
+
+def _finished_stage(stage: Path, what: str, say) -> Policy | None:
+    """The champion a finished run of an interrupted build left in ``stage``, None when there is none; a damaged one is
+    said and removed, and the run flown again (it failed the whole build, which then deleted every finished run;
+    eighth trial)."""
+    if not stage.is_file():
+        return None
+    try:
+        policy = load_policy(stage)
+        policy.metadata["episodes"], policy.metadata["seconds"]  # noqa: B018  (what the set's file takes from it)
+        return policy
+    except (NeurohoverError, KeyError):
+        say(f"{what}: the interrupted build's stage {stage.name} is damaged; this run is flown again")
+        stage.unlink()
+        return None
 
 
 STAGES = "stages"  # a build's finished runs, kept while it is under way (build_policy_set resumes from them)

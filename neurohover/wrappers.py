@@ -24,7 +24,7 @@ import math
 import gymnasium as gym
 import numpy as np
 
-from .errors import NeurohoverError
+from .errors import NeurohoverError, finite_real
 from .sim.constants import CRASH_STEP_PENALTY
 
 __all__ = ["CrashAwareReward", "crash_aware"]
@@ -36,7 +36,7 @@ def check_discount_and_scale(gamma, scale) -> None:
     """Refuse a discount outside (0, 1] or a scale that is not a finite number > 0, by name."""
     if isinstance(gamma, bool) or not isinstance(gamma, (int, float)) or not 0.0 < gamma <= 1.0:
         raise NeurohoverError(f"gamma={gamma!r} is out of range: allowed a discount in (0, 1]")
-    if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not (math.isfinite(scale) and scale > 0):
+    if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not (finite_real(scale) and scale > 0):
         raise NeurohoverError(f"scale={scale!r} is out of range: allowed a finite number > 0")
 
 

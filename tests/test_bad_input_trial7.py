@@ -167,7 +167,7 @@ def test_a_full_disk_names_the_file_for_evolve_report_and_build_policies(tiny_st
         rc, _, err = cli("evolve", "--task", "ghh08", "--budget", "3", "--episode-steps", "20", "--out", str(disk / "e.json"))
         assert rc == 2 and "cannot write it (No space left on device)" in err and str(disk) in err, err
         rc, _, err = cli("report", "--store", str(tiny_store), "--out", str(disk / "rep"))
-        assert rc == 2 and "report.md': cannot write it (No space left on device); no partial file is left" in err, err
+        assert rc == 2 and "': cannot write it (No space left on device); no partial file is left" in err and "damaged" not in err, err
         rc, _, err = cli("build-policies", "--task", "ghh08", "--out", str(disk / "bp"), "--budget", "2", "--episode-steps", "10")
         assert rc == 2 and "build.json': cannot write it (No space left on device)" in err, err
         assert sorted(p.name for p in disk.iterdir()) == ["fill", "pad"]

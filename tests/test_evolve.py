@@ -489,6 +489,8 @@ def test_evolve_says_when_the_plateau_ends_a_run_before_its_budget(tmp_path: Pat
         (lambda s: s["counters"].update(wall_seconds=-1.0), "counter 'wall_seconds' is -1.0"),
         (lambda s: s["champion"].update(genome=[1.0, 2.0, 3.0]), "champion genome has shape \\(3,\\), expected \\(42,\\)"),
         (lambda s: s["champion"].update(genome=None, **{"return": "abc"}), "ValueError: could not convert string to float"),
+        (lambda s: s["champion"].update(genome=[float("nan")] * 42), "champion genome holds a number that is not finite"),  # eighth trial
+        (lambda s: s["champion"].update(**{"return": "nan"}), "the champion's return is nan"),
         (lambda s: s.update(history=["x"]), "damaged checkpoint: ValueError"),
         (lambda s: s.update(mdp_stream=None), "damaged checkpoint: TypeError"),
     ],

@@ -17,12 +17,11 @@ The settings, their defaults and meaning: :class:`ContinualSettings` (``neurohov
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, finite_real
 from ..evaluate import DangerousState
 from ..flightdata import FlightData
 from ..models.model import LearnedModel
@@ -77,7 +76,7 @@ class ContinualSettings(AgentSettings):
             if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v <= 10**6:
                 raise NeurohoverError(f"continual {name}={v!r} is out of range: allowed an integer in 0..1000000 ({unit})")
         t = self.threshold
-        if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t <= 1:
+        if isinstance(t, bool) or not isinstance(t, (int, float)) or not finite_real(t) or t <= 1:
             raise NeurohoverError(f"continual threshold={t!r} is out of range: allowed a number > 1 (a ratio of one-step errors)")
         if not isinstance(self.safeguard, bool):
             raise NeurohoverError(f"continual safeguard={self.safeguard!r} is not allowed: true or false")

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, finite_real
 from ..policies import Policy, baseline_policy
 from .hybrid import HybridAgent
 from .model_based import ModelEvolution
@@ -63,7 +63,9 @@ class RiskSettings(AgentSettings):
     def __post_init__(self) -> None:
         if self.criterion not in CRITERIA:
             raise NeurohoverError(f"risk criterion {self.criterion!r} is not allowed: choose one of {', '.join(CRITERIA)}")
-        if isinstance(self.level, bool) or not isinstance(self.level, (int, float)) or not math.isfinite(self.level) or self.level < 0:
+        if isinstance(self.level, bool) or not isinstance(self.level, (int, float)):  # 'abc' was called "out of range" (eighth trial)
+            raise NeurohoverError(f"risk level={self.level!r} is not a number: allowed a finite number >= 0 (standard errors below the mean)")
+        if not finite_real(self.level) or self.level < 0:
             raise NeurohoverError(f"risk level={self.level!r} is out of range: allowed a finite number >= 0 (standard errors below the mean)")
         if isinstance(self.trials, bool) or not isinstance(self.trials, int) or not 1 <= self.trials <= MAX_TRIALS:
             raise NeurohoverError(f"risk trials={self.trials!r} is out of range: allowed an integer in 1..{MAX_TRIALS:,}")

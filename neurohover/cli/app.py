@@ -153,6 +153,10 @@ def _run(argv: Sequence[str] | None) -> int:
         return 2
     except sqlite3.DatabaseError as err:  # a store file damaged mid-file, or not a store at all
         which = f" {str(args.store)!r}" if getattr(args, "store", None) else ""
+        if "full" in str(err):  # SQLITE_FULL: the disk, not the store (it was called damaged; eighth trial)
+            print(f"neurohover {args.command}: error: cannot write the results store{which} ({err}); its finished units are kept", file=sys.stderr)
+            remove_created_dirs()
+            return 2
         print(
             f"neurohover {args.command}: error: the results store{which} cannot be read ({str(err)[:60]}): it is damaged or is no results store",
             file=sys.stderr,
@@ -180,7 +184,7 @@ def _run(argv: Sequence[str] | None) -> int:
 def shorter_numbers(message: str) -> str:
     """``message`` with every number of more than 30 digits shown by its first ten and its length (a 400-digit --budget
     was echoed whole; seventh trial)."""
-    return re.sub(r"\d{31,}", lambda m: f"{m[0][:10]}...({len(m[0])} digits)", message)
+    return re.sub(r"\d(?:,?\d){30,}", lambda m: f"{m[0][:10]}...({len(m[0].replace(',', ''))} digits)", message)  # 1,000,...: too
 
 
 if __name__ == "__main__":

@@ -495,7 +495,7 @@ def _register_settings(sub) -> None:
 def register(sub) -> None:
     from ..agents.model_based import ModelEvolution
     from ..evolution.steady_state import SteadyStateSettings
-    from .options import add_setting_options, add_task_options
+    from .options import add_setting_options, add_task_options, real
 
     _register_settings(sub)
 
@@ -550,7 +550,7 @@ def register(sub) -> None:
     )
     p.add_argument("--out", required=True, metavar="FILE", help="champion policy file; FILE.history.csv and FILE.checkpoint.json go next to it")
     p.add_argument("--resume", action="store_true", help="continue the run from FILE.checkpoint.json (same options; the budget may be raised)")
-    p.add_argument("--checkpoint-every", type=float, default=60.0, metavar="SECONDS", help="checkpoint interval (default 60 s)")
+    p.add_argument("--checkpoint-every", type=real, default=60.0, metavar="SECONDS", help="checkpoint interval (default 60 s)")
     p.add_argument("--validation-episodes", type=int, default=10, help="fresh episodes to validate the champion (default 10)")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.set_defaults(func=cmd_evolve)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import math
 import re
 import sys
 from collections.abc import Mapping, Sequence
@@ -11,7 +10,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, float_of
 from ..tasks.sensor import Sensor
 
 
@@ -21,9 +20,10 @@ def parse_floats(text: str, what: str) -> list[float]:
     if any(p.strip() == "" for p in parts):  # '1,,1' is no pair of numbers, nor is '1,1,'
         raise NeurohoverError(f"{what} must be comma-separated numbers with none left empty, got {text!r}")
     try:
-        return [float(x) for x in parts]
-    except ValueError:
-        raise NeurohoverError(f"{what} must be comma-separated numbers, got {text!r}") from None
+        return [float_of(x) for x in parts]
+    except ValueError as err:
+        why = str(err) if "past a float's range" in str(err) else f"got {text!r}"
+        raise NeurohoverError(f"{what} must be comma-separated numbers, {why}") from None
 
 
 def explicit_mdp(args: argparse.Namespace, family):
@@ -76,7 +76,7 @@ def _converter(default):
             return text == "true"
 
         return boolean
-    return type(default) if isinstance(default, (int, float)) else str
+    return real if isinstance(default, float) else type(default) if isinstance(default, int) else str
 
 
 def add_setting_options(
@@ -185,11 +185,12 @@ def add_task_option(p: argparse.ArgumentParser) -> None:
 def real(text: str) -> float:
     """A command-line number: one past a float's range is refused as typed (a 400-digit --sigma became sigma=inf;
     seventh trial); 'nan' and 'inf' as written are left to the option's own range check."""
-    value = float(text)
-    if math.isinf(value) and "inf" not in text.lower():
-        shown = text if len(text) <= 30 else f"{text[:10]}...({len(text)} characters)"
-        raise argparse.ArgumentTypeError(f"{shown} is past a float's range (about 1.8e308)")
-    return value
+    try:
+        return float_of(text)
+    except ValueError as err:
+        if "past a float's range" in str(err):
+            raise argparse.ArgumentTypeError(str(err)) from None
+        raise
 
 
 def add_sigma_option(p: argparse.ArgumentParser) -> None:

@@ -25,7 +25,7 @@ from typing import Any, Protocol, overload
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, finite_real
 
 __all__ = [
     "STATE_VERSION",
@@ -127,7 +127,7 @@ def require_prob(name: str, value: Any) -> float:
 
 def require_std(name: str, value: Any) -> float:
     """``value`` as a float, or ValueError unless it is a finite number >= 0."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(float(value)) or float(value) < 0.0:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not finite_real(value) or float(value) < 0.0:
         raise NeurohoverError(f"{name}={value!r} must be a finite number >= 0")
     return float(value)
 

@@ -215,7 +215,7 @@ def write_checkpoint(path: Path, state: dict) -> None:
         tmp.unlink(missing_ok=True)
         if isinstance(err, OSError):  # a full disk said only "No space left on device" (seventh trial)
             why = err.strerror or err
-            raise NeurohoverError(f"checkpoint {str(path)!r}: cannot write it ({why}); no partial file is left, an earlier one stands") from None
+            raise NeurohoverError(f"checkpoint {str(path)!r}: cannot write it ({why}); no partial file is left (nor changed an earlier checkpoint)") from None
         raise
 
 
@@ -227,3 +227,5 @@ def read_checkpoint(path: Path) -> dict:
         return json.loads(path.read_text())
     except (json.JSONDecodeError, UnicodeDecodeError) as err:
         raise NeurohoverError(f"checkpoint {str(path)!r} is not valid JSON: {err}") from None
+    except RecursionError:  # nested thousands deep (eighth trial)
+        raise NeurohoverError(f"checkpoint {str(path)!r} is not a checkpoint: its JSON is nested too deeply") from None

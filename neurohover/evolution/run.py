@@ -486,6 +486,10 @@ def _restored_parts(state: dict, delta: Any, genome_size: int) -> dict[str, Any]
     genome = None if ch["genome"] is None else np.array(ch["genome"], dtype=float)
     if genome is not None and genome.shape != (genome_size,):
         raise ValueError(f"the champion genome has shape {genome.shape}, expected ({genome_size},)")
+    if genome is not None and not np.all(np.isfinite(genome)):  # a NaN gene was resumed without a word (eighth trial)
+        raise ValueError("the champion genome holds a number that is not finite")
+    if math.isnan(float(ch["return"])):
+        raise ValueError("the champion's return is nan")
     race_delta = state.get("race_delta", delta)  # absent before race:auto: the fixed delta
     if race_delta is not None and (isinstance(race_delta, bool) or not isinstance(race_delta, (int, float)) or not 0 < race_delta < 1):
         raise ValueError(f"race_delta is {race_delta!r}, not a confidence level in (0, 1)")

@@ -9,14 +9,13 @@ convention and the checkpoint format).
 from __future__ import annotations
 
 import dataclasses
-import math
 from bisect import bisect_right
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, finite_real
 from .common import (
     STATE_VERSION,
     ChampionTracker,
@@ -141,7 +140,7 @@ class SteadyStateSettings:
         validate_variation_settings(self)
         if self.mutation_floor is not None:
             floor = self.mutation_floor
-            if isinstance(floor, bool) or not isinstance(floor, (int, float)) or not (math.isfinite(floor) and floor > 0):
+            if isinstance(floor, bool) or not isinstance(floor, (int, float)) or not (finite_real(floor) and floor > 0):
                 raise NeurohoverError(f"mutation_floor={floor!r} is out of range: allowed None or a finite number > 0")
             set_field(self, "mutation_floor", float(floor))
         if not isinstance(self.plateau_rule, str) or self.plateau_rule not in PLATEAU_RULES:

@@ -119,10 +119,10 @@ def table():
 
 def text_list(*allowed: str):
     def check(v):
-        ok = isinstance(v, list) and len(v) > 0 and all(isinstance(x, str) for x in v)
+        ok = isinstance(v, list) and len(v) > 0 and all(isinstance(x, str) for x in v) and len(set(v)) == len(v)  # ["lr", "lr"]: eighth trial
         if ok and allowed:
             ok = all(x in allowed for x in v)
-        return ok, "a non-empty list of " + ("strings" if not allowed else "names from " + ", ".join(allowed))
+        return ok, "a non-empty list of distinct " + ("strings" if not allowed else "names from " + ", ".join(allowed))
 
     return check
 

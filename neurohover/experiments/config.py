@@ -140,7 +140,9 @@ class ExperimentConfig:
         if not isinstance(d, dict) or any(not isinstance(d.get(k), t) for k, t in kinds.items()):  # a KeyError in report (fifth trial)
             bad = [f"{k} ({d.get(k)!r:.30})" for k, t in kinds.items() if not isinstance(d.get(k), t)] if isinstance(d, dict) else ["the whole config"]
             raise NeurohoverError(f"a stored experiment config is damaged: {', '.join(bad)} missing or of the wrong kind")
-        return cls(
+        if d["kind"] not in KINDS:  # a KeyError in report (eighth trial)
+            raise NeurohoverError(f"a stored experiment config is damaged: kind {d['kind']!r:.30} is none of {', '.join(KINDS)}")
+        cfg = cls(
             d["name"],
             d["title"],
             d["kind"],
@@ -151,6 +153,11 @@ class ExperimentConfig:
             d.get("source", ""),
             d.get("external_digest", ""),
         )
+        try:
+            cfg.typed  # noqa: B018  (groups "x" was a RuntimeError in report; eighth trial)
+        except (RuntimeError, TypeError, ValueError, AttributeError, KeyError) as err:
+            raise NeurohoverError(f"a stored experiment config is damaged: its settings do not read as a {cfg.kind} experiment's ({str(err)[:80]})") from None
+        return cfg
 
 
 def shipped_configs() -> dict[str, Path]:
@@ -208,6 +215,8 @@ def check_own_name(cfg: ExperimentConfig) -> None:
 
 def parse_override(text: str, option: str = "--set") -> tuple[str, Any]:
     """``KEY=VALUE`` of command-line ``option`` with VALUE in TOML syntax (a bare word is taken as a string)."""
+    if not isinstance(text, str):  # None was an AttributeError (eighth trial)
+        raise NeurohoverError(f"{option} {text!r:.40} is not allowed: give KEY=VALUE as text (VALUE in TOML syntax)")
     key, sep, value = text.partition("=")
     key = key.strip()
     if not sep or not key:

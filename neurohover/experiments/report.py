@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, OutputError
 from .config import ORDER, ExperimentConfig, shipped_counterpart, with_shipped_paper
 from .keys import UnitKey
 from .report_base import Section, agent_panel, fmt, log_errors, new_figure, paired_p, paired_verdict, ratio_verdict, sd, table
@@ -536,6 +536,8 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
             current = (None if shipped is None else shipped.hash == stored.hash) if sc == "paper" else None  # the status table: paper scale
             cfg = with_shipped_paper(stored, shipped)
             text, checked, status = _section(cfg, store, out, current)
+        except OutputError:  # a full disk is no damaged store (it was reported as one, exit 0; eighth trial)
+            raise
         except NeurohoverError as err:  # one damaged experiment: said in its place, the others reported as usual
             sections.append(f"## {name} [{sc}]\n\n**Not reported: the store's copy is damaged.** {err}\n")
             toc.append(f"- [{name} [{sc}]](#{_anchor(name + ' [' + sc + ']')}) (damaged)")

@@ -126,10 +126,10 @@ def _matches_no_unit(config, pattern: str, units) -> NeurohoverError:
     return NeurohoverError(f"{config.name}: --only {pattern!r} matches no unit; unit keys look like {', '.join(examples[:6])}")
 
 
-def _checked_results(config: ExperimentConfig, store: Store) -> dict[str, dict]:
+def _checked_results(config: ExperimentConfig, store: Store) -> tuple[dict[str, dict], dict[str, tuple[str, dict]]]:
     """Key -> result of every stored unit of the experiment, each read back (the store refuses a row that is no JSON
     object; the result's fields are checked here): a damaged unit was counted as finished and never run again (fifth
-    trial). Its config must read back too."""
+    trial). Its config must read back too. Also key -> (kind, params) of each, for :func:`_refuse_stray_units`."""
     ExperimentConfig.from_dict(store.config(config.name, config.scale))
     units = store.units(config.name, config.scale)
     try:
@@ -137,19 +137,25 @@ def _checked_results(config: ExperimentConfig, store: Store) -> dict[str, dict]:
         check_run_lengths(config.settings.get("episodes") if config.kind == "test_runs" else None, typed)
     except NeurohoverError as err:
         raise NeurohoverError(f"results store {str(store.path)!r}, experiment {config.name} ({config.scale}), is damaged: {err}") from None
-    return {unit["key"]: unit["result"] for unit in units}
+    return {unit["key"]: unit["result"] for unit in units}, {unit["key"]: (unit["kind"], unit["params"]) for unit in units}
 
 
-def _refuse_stray_units(config: ExperimentConfig, store: Store, results: dict[str, dict], sources: dict) -> None:
-    """Refuse a stored unit the config does not plan (it was counted as done: "5/4 done"; seventh trial). Every stored
-    unit's prerequisites are stored too, so the plan from all of them names every unit that belongs."""
-    known = {u.key for u in plan(config, results, sources).units} | set(run_keys(config))
+def _refuse_stray_units(config: ExperimentConfig, store: Store, results: dict[str, dict], stored: dict[str, tuple[str, dict]], sources: dict) -> None:
+    """Refuse a stored unit the config does not plan (it was counted as done: "5/4 done"; seventh trial), or one whose
+    kind or params are not those planned for its key (an agent "foo" was reused; eighth trial). Every stored unit's
+    prerequisites are stored too, so the plan from all of them names every unit that belongs."""
+    planned = plan(config, results, sources).units
+    known = {u.key for u in planned} | set(run_keys(config))
     stray = sorted(set(results) - known)
+    where = f"results store {str(store.path)!r}, experiment {config.name} ({config.scale}), is damaged"
     if stray:
         raise NeurohoverError(
-            f"results store {str(store.path)!r}, experiment {config.name} ({config.scale}), is damaged: it holds unit {stray[0]!r}"
-            f"{f' (and {len(stray) - 1} more)' if len(stray) > 1 else ''}, which the config does not plan (--fresh starts it over)"
+            f"{where}: it holds unit {stray[0]!r}{f' (and {len(stray) - 1} more)' if len(stray) > 1 else ''}, which the config does not plan "
+            "(--fresh starts it over)"
         )
+    for u in planned:
+        if u.key in stored and stored[u.key] != (u.kind, json.loads(json.dumps(u.params))):
+            raise NeurohoverError(f"{where}: unit {u.key!r} holds other settings than its config plans for it (--fresh starts it over)")
 
 
 def _check_arguments(config, store, executor) -> None:
@@ -201,9 +207,9 @@ def reproduce(
         kept = store.update(config.name, config.scale, config.hash, config.to_dict(), unchanged_units(config, store))
         print(f"{config.name} ({config.scale}): the config changed (hash {held} -> {config.hash}); {kept} stored units stand unchanged", file=sys.stderr)
     store.begin(config.name, config.scale, config.hash, config.to_dict(), fresh=fresh)
-    results = _checked_results(config, store)  # read once: checked, then the finished units
+    results, stored = _checked_results(config, store)  # read once: checked, then the finished units
     sources = {name: store.results(name, config.scale) for name in source_experiments(config)}
-    _refuse_stray_units(config, store, results, sources)
+    _refuse_stray_units(config, store, results, stored, sources)
     summary = RunSummary(config.name, config.scale, executor.name, executor.cores, units_before=len(results))
     session = store.start_session(config.name, config.scale, config.hash, executor.name, summary.cores, len(results))
     start = time.perf_counter()

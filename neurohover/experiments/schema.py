@@ -130,6 +130,10 @@ def _check_evolution(settings: dict, task: str, where: str) -> None:
     keys = [v["key"] for v in settings["variants"]]
     if len(set(keys)) != len(keys):
         raise NeurohoverError(f"{where}: variant keys must be unique, got {keys}")
+    for key in keys:  # a key is one part of its units' keys (evolve/KEY/...): "../x" was taken (eighth trial)
+        if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._+=-]*", key):
+            allowed = "letters, digits, '.', '_', '+', '=' or '-', starting with a letter or digit"
+            raise NeurohoverError(f"{where}: variant key {key!r:.60} is not allowed: give {allowed}")
     for v in settings["variants"]:
         if v["sigma"] is not None and not TASK_FAMILIES[task].has_sigma:
             raise NeurohoverError(f"{where}: variant {v['key']!r} sets sigma but the task is {task!r}")

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from .keys import UnitKey
+from .results import TestRunResult
 
 __all__ = ["DEFAULT_DRAWS", "WinOdds", "stored_runs", "win_probabilities"]
 
@@ -97,8 +98,9 @@ def stored_runs(results: Mapping[str, dict]) -> dict[str, dict[str, list[float]]
     for key, result in results.items():
         unit = UnitKey.parse(key)
         if unit.stage == "run":
-            score = result.get("score") if isinstance(result, dict) else None
-            if isinstance(score, bool) or not isinstance(score, (int, float)) or "mdp" not in result:  # fifth trial: KeyError, TypeError
-                raise NeurohoverError(f"the stored result of unit {key!r} is damaged: a test run's result names its MDP and a real score")
-            runs.setdefault(unit.group, {}).setdefault(str(result["mdp"]), []).append(float(score))
+            try:  # read as results, report and reproduce read it (only its score was checked; eighth trial)
+                run = TestRunResult.from_dict(result, f"result of test_run unit {key!r}")
+            except NeurohoverError as err:
+                raise NeurohoverError(f"the stored result of unit {key!r} is damaged: {err}") from None
+            runs.setdefault(unit.group, {}).setdefault(str(run.mdp), []).append(float(run.score))
     return runs

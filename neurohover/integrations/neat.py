@@ -39,7 +39,7 @@ from typing import Any
 import numba as nb
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, finite_real
 from ..evolution.fitness import FITNESS_SCALES, episode_fitness
 from ..evolution.seeding import check_seed
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS, OBS_NAMES
@@ -156,7 +156,7 @@ class NeatSettings:
             raise NeurohoverError(f"activations={self.activations!r}: allowed a non-empty tuple of distinct names from {', '.join(ACTIVATIONS)}")
 
         def number(v) -> bool:
-            return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+            return isinstance(v, (int, float)) and not isinstance(v, bool) and finite_real(v)
 
         for name in ("node_add_prob", "conn_add_prob", "node_delete_prob", "conn_delete_prob", "activation_mutate_rate", "replace_rate", "weight_mutate_rate"):
             v = getattr(self, name)

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, finite_real
 from ..sim.constants import CONTROL_DT, SUBSTEP_DT, SUBSTEPS, WIND_CONSTANT, WIND_NONE, WIND_SINUSOID
 
 __all__ = ["DEFAULT_WIND_MODEL", "NO_WIND", "WIND_MODELS", "WindAxis", "WindModel", "body_wind", "effective_wind", "fit_wind", "model_times", "sinusoid_axes"]
@@ -63,7 +63,7 @@ class WindAxis:
     def __post_init__(self) -> None:
         for name in ("amplitude", "omega", "phase", "offset"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not finite_real(value):
                 raise NeurohoverError(f"wind {name}={value!r} must be a finite number")
             object.__setattr__(self, name, float(value))
         if self.omega < 0:

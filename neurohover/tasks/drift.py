@@ -26,13 +26,12 @@ change_at      (200, 800)  the change happens at an episode drawn uniformly from
 
 from __future__ import annotations
 
-import math
 import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, finite_real, float_of
 from ..sim.constants import PARAM_NAMES, ROW_PARAMS
 
 _DRIFT_TAG = 0xD81F7  # separates a run's drift stream from its agent's and its gusts'
@@ -56,7 +55,7 @@ class Drift:
         w = self.walk
         if isinstance(w, bool) or not isinstance(w, numbers.Real):  # NumPy's numbers are Real too
             raise NeurohoverError(f"drift walk={w!r} is not a number: allowed a number in 0..1 (a per-episode log std)")
-        if not math.isfinite(w) or not 0 <= w <= 1:
+        if not finite_real(w) or not 0 <= w <= 1:
             raise NeurohoverError(f"drift walk={w!r} is out of range: allowed a number in 0..1 (a per-episode log std)")
         object.__setattr__(self, "walk", float(w))
         try:
@@ -175,12 +174,13 @@ class Drift:
             seen.add(key.strip())
             value, _, when = value.partition("@")
             try:
-                number = float(value)
+                number = float_of(value)
                 if when:
                     lo, _, hi = when.partition("-")
                     at = (int(lo), int(hi or lo))
-            except ValueError:
-                raise NeurohoverError(f"drift {part!r} is not understood: {_PARSE_FORM}") from None
+            except ValueError as err:
+                why = f" ({err})" if "past a float's range" in str(err) else ""
+                raise NeurohoverError(f"drift {part[:40]!r} is not understood{why}: {_PARSE_FORM}") from None
             if not eq:
                 raise NeurohoverError(f"drift {part!r} is not understood: {_PARSE_FORM}")
             if when and key.strip() == "walk":  # walk=0.01@0-1 beside a change gave the change its window

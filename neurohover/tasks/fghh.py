@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, finite_real
 from ..sim.constants import DEFAULT_PARAMS, PARAM_NAMES, ROW_PARAMS
 from .base import MDP, TaskFamily, finite_vector
 
@@ -35,7 +34,7 @@ class FGHH(TaskFamily):
 
     def __post_init__(self) -> None:
         s = self.sigma
-        if not (isinstance(s, (int, float)) and math.isfinite(s) and 0.0 <= s <= 1.0):
+        if not (isinstance(s, (int, float)) and finite_real(s) and 0.0 <= s <= 1.0):
             raise NeurohoverError(f"FGHH sigma={s!r} is out of range: allowed 0 <= sigma <= 1 (the paper uses 0.2 and 0.3)")
 
     def make(self, params: Sequence[float] | np.ndarray, label: str = "") -> MDP:

@@ -38,7 +38,7 @@ import numbers
 import re
 from dataclasses import asdict, dataclass, fields, replace
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, float_of
 from ..sim.constants import MAX_SENSOR_DELAY, SENSOR_GROUPS
 
 #: The std of each group at noise level 1 (velocity m/s, position m, rates rad/s, attitude).
@@ -129,10 +129,12 @@ class Sensor:
         if not text.isascii():  # float() reads other scripts' digits
             raise NeurohoverError(f"sensor {text!r} is not understood: give numbers in ASCII digits")
         try:
-            return cls.at_level(float(text), delay=delay)
+            return cls.at_level(float_of(text), delay=delay)
         except ValueError as exc:
             if isinstance(exc, NeurohoverError):
                 raise
+            if "past a float's range" in str(exc):
+                raise NeurohoverError(f"sensor level {exc}: allowed a noise level in 0..{MAX_LEVEL:g}") from None
         settings: dict[str, float] = {}
         expected = f"allowed a noise level (e.g. 0.5) or key=value pairs with keys {', '.join(allowed)}"
         for part in (p.strip() for p in text.split(",")):
@@ -145,9 +147,10 @@ class Sensor:
             if key in settings:
                 raise NeurohoverError(f"sensor setting {key!r} is given twice in {text!r}: give each key once")
             try:
-                settings[key] = float(value)
-            except ValueError:
-                raise NeurohoverError(f"sensor setting {part!r} needs a number after '='") from None
+                settings[key] = float_of(value)
+            except ValueError as err:
+                why = f": {err}" if "past a float's range" in str(err) else ""
+                raise NeurohoverError(f"sensor setting {part[:40]!r} needs a number after '='{why}") from None
         if not settings:
             raise NeurohoverError(f"sensor {text!r} is empty: {expected}")
         values: dict[str, float | int] = {"delay": delay} | settings

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import base64
 import io
-import math
 import pickle
 import sys
 from dataclasses import dataclass
@@ -17,6 +16,7 @@ from typing import Any
 import cma
 import numpy as np
 
+from ...errors import finite_real
 from .. import common
 from ..common import MAX_POPULATION, PopulationOptimiser, TellInfo, check_prototype
 from . import OptimiserSpec
@@ -124,7 +124,7 @@ class CMAES(PopulationOptimiser):
         x0 = check_prototype(prototype)
         if x0.size < 2:
             raise ValueError(f"CMAES needs a genome of length >= 2, got {x0.size}")
-        if not (isinstance(sigma0, (int, float)) and math.isfinite(sigma0) and sigma0 > 0):
+        if not (isinstance(sigma0, (int, float)) and finite_real(sigma0) and sigma0 > 0):
             raise ValueError(f"sigma0={sigma0!r} must be a finite number > 0")
         if popsize is not None and (not isinstance(popsize, (int, np.integer)) or popsize < 2):
             raise ValueError(f"popsize={popsize!r} must be None or an integer >= 2")
@@ -222,7 +222,7 @@ class CMASettings:
 
     def __post_init__(self) -> None:
         s0, pop = self.sigma0, self.popsize
-        if isinstance(s0, bool) or not isinstance(s0, (int, float)) or not (math.isfinite(s0) and s0 > 0):
+        if isinstance(s0, bool) or not isinstance(s0, (int, float)) or not (finite_real(s0) and s0 > 0):
             raise ValueError(f"CMA-ES sigma0={s0!r} must be a finite number > 0")
         if pop is not None and (isinstance(pop, bool) or not isinstance(pop, (int, np.integer)) or not 2 <= pop <= MAX_POPULATION):
             raise ValueError(f"CMA-ES popsize={pop!r} must be None or an integer in 2..{MAX_POPULATION:,}")

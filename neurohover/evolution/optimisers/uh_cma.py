@@ -24,13 +24,13 @@ for CMA-ES, re-evaluations included.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
 import cma
 import numpy as np
 
+from ...errors import finite_real
 from ..common import TellInfo
 from . import OptimiserSpec
 from .cma import CMAES, CMASettings, losses_of
@@ -69,7 +69,7 @@ class UHCMASettings(CMASettings):
             raise ValueError(f"UH-CMA-ES min_evaluations={lo!r} and max_evaluations={hi!r} must be integers with 1 <= min <= max")
         if re is not None and (not integer(re) or re < 1):
             raise ValueError(f"UH-CMA-ES reevaluations={re!r} must be None or an integer >= 1")
-        if isinstance(eps, bool) or not isinstance(eps, (int, float)) or not (math.isfinite(eps) and eps >= 0):
+        if isinstance(eps, bool) or not isinstance(eps, (int, float)) or not (finite_real(eps) and eps >= 0):
             raise ValueError(f"UH-CMA-ES epsilon={eps!r} must be a finite number >= 0")
         object.__setattr__(self, "epsilon", float(eps))
 
