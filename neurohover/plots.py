@@ -289,7 +289,14 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
         if max(numbers) != len(numbers) - 1:
             gap = min(set(range(max(numbers))) - numbers)
             raise NeurohoverError(f"--compete {str(csv_path)!r}: run {run} lacks episode {gap}: each run's episodes are numbered 0, 1, 2, ...")
-    n = min(len(rows) for rows in runs.values())
+    lengths = {run: len(rows) for run, rows in runs.items()}
+    if len(set(lengths.values())) > 1:  # compete writes whole runs: a shorter one is a file cut short (plotted cut; eighth trial)
+        short = min(lengths, key=lengths.__getitem__)
+        raise NeurohoverError(
+            f"--compete {str(csv_path)!r}: run {short} has {lengths[short]} episodes where run {max(lengths, key=lengths.__getitem__)} has "
+            f"{max(lengths.values())}: the file is cut short (compete writes whole runs; run it again to rewrite it)"
+        )
+    n = min(lengths.values())
     returns = np.array([[r for _, r in sorted(rows)[:n]] for _, rows in sorted(runs.items())])
     label = path.resolve().name  # no summary (an interrupted competition): the directory's name labels it
     summary_path = path / COMPETE_SUMMARY

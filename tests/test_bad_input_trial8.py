@@ -208,3 +208,16 @@ def test_a_competition_into_a_folder_of_another_says_it_replaces_its_files(tmp_p
     assert rc == 0 and "held the competition" not in err, err
     rc, _, err = cli(*base, "--agent", "model-free")
     assert rc == 0 and "held the competition of baseline on ghh08; its episodes.csv, summary.json and plot are replaced" in err, err
+
+
+def test_a_compete_file_cut_short_is_refused_not_plotted_short(tmp_path, cli) -> None:
+    """S9: an episodes.csv whose last run was cut mid-way was plotted with every run cut to the shortest."""
+    folder = tmp_path / "c"
+    folder.mkdir()
+    rows = "".join(f"{run},m,{e},-{e + 1}.0,0,20\n" for run in (0, 1) for e in range(3))
+    (folder / "episodes.csv").write_text("run,mdp,episode,return,crashed,steps\n" + rows.rsplit("\n", 2)[0] + "\n")
+    rc, _, err = cli("plot", "--compete", str(folder), "--out", str(tmp_path / "p.png"))
+    assert rc == 2 and "run 1 has 2 episodes where run 0 has 3: the file is cut short" in err, err
+    (folder / "episodes.csv").write_text("run,mdp,episode,return,crashed,steps\n" + rows)
+    rc, _, err = cli("plot", "--compete", str(folder), "--out", str(tmp_path / "p.png"))
+    assert rc == 0 and (tmp_path / "p.png").stat().st_size > 0, err
