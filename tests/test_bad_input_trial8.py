@@ -221,3 +221,12 @@ def test_a_compete_file_cut_short_is_refused_not_plotted_short(tmp_path, cli) ->
     (folder / "episodes.csv").write_text("run,mdp,episode,return,crashed,steps\n" + rows)
     rc, _, err = cli("plot", "--compete", str(folder), "--out", str(tmp_path / "p.png"))
     assert rc == 0 and (tmp_path / "p.png").stat().st_size > 0, err
+
+
+def test_a_missing_generic_source_is_named_as_generic(tmp_path, cli) -> None:
+    """U6: a model-learning config's generic = "nope" was refused as "policies = 'nope'", without 'baseline'."""
+    path = tmp_path / "ml.toml"
+    path.write_text('name = "myml"\nkind = "model_learning"\n[settings]\ntask = "ghh08"\nseed = 1\ngeneric = "nope"\n[scales.quick]\nn_mdps = 1\n')
+    rc, _, err = cli("reproduce", str(path), "--store", str(tmp_path / "s.sqlite"))
+    assert rc == 2 and "generic = 'nope' is not allowed: give 'evolve', 'baseline', 'shipped' or a directory" in err, err
+    assert not (tmp_path / "s.sqlite").exists()

@@ -72,12 +72,17 @@ def _unit(cfg: ExperimentConfig, key: str, kind: str, params: dict, seed_key: st
 # --------------------------------------------------------------------------------- external policies
 
 
-def _load_external(task: str, source: str):
+#: What each setting naming a policy source takes besides 'shipped' and a directory (the message names the setting given).
+_SOURCE_WORDS = {"policies": "'evolve', ", "generic": "'evolve', 'baseline', ", "robustness_policies": ""}
+_SOURCE_KEYS = {"test_runs": "policies", "model_learning": "generic", "evolution": "robustness_policies"}
+
+
+def _load_external(task: str, source: str, key: str = "policies"):
     from pathlib import Path
 
-    if source != "shipped" and not Path(source).is_dir():
+    if source != "shipped" and not Path(source).is_dir():  # a generic "nope" was named as policies (eighth trial)
         raise NeurohoverError(
-            f"policies = {source!r} is not allowed: give 'evolve', 'shipped' or a directory holding <task>/ policy sets "
+            f"{key} = {source!r} is not allowed: give {_SOURCE_WORDS[key]}'shipped' or a directory holding <task>/ policy sets "
             f"(no such directory; build it with: neurohover build-policies --task {task} --out {source})"
         )
     return load_policy_set(task, None if source == "shipped" else source)
@@ -85,10 +90,11 @@ def _load_external(task: str, source: str):
 
 def external_digest(kind: str, s: dict) -> str:
     """Digest of policies a config reads from a directory (so results never mix policy sets)."""
-    source = {"test_runs": s.get("policies"), "model_learning": s.get("generic"), "evolution": s.get("robustness_policies")}.get(kind)
+    key = _SOURCE_KEYS.get(kind, "policies")
+    source = s.get(key)
     payload: dict = {}
     if source not in (None, "evolve", "baseline"):
-        ps = _load_external(s["task"], source)
+        ps = _load_external(s["task"], source, key)
         payload = {
             "generic": policy_dict(ps.generic),
             "specialised": [policy_dict(p) for p in ps.specialised],
@@ -193,7 +199,7 @@ def _policy_set_robustness(cfg: ExperimentConfig, train: list) -> list[Unit]:
     """Table 3 for a policy set: specialised policy i flown on every training MDP, as MDP i's best champion is."""
     s = cfg.typed
     assert isinstance(s, EvolutionSettings) and s.robustness_policies is not None
-    ps = _load_external(s.task, s.robustness_policies)
+    ps = _load_external(s.task, s.robustness_policies, "robustness_policies")
     params = {"mdps": [m.to_dict() for m in train], "episodes": s.robustness_episodes, "n_steps": s.n_steps}
     return [
         _unit(
@@ -507,7 +513,7 @@ def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
     elif s.generic == "baseline":
         generic = policy_dict(baseline_policy())
     else:
-        generic = policy_dict(_load_external(s.task, s.generic).generic)
+        generic = policy_dict(_load_external(s.task, s.generic, "generic").generic)
     if generic is None:
         return Plan(units, total)
     for i, mdp in enumerate(_mdps(family, s.mdps, s.n_mdps, s.seed)):
