@@ -90,7 +90,9 @@ class Group:
     model_substeps: int = setting(substeps(), LEGACY_MODEL_SUBSTEPS, absent=OMIT)
     sensor: dict | None = setting(sensor_table(), None, absent=OMIT)  # this group's sensors (None: the experiment's)
     drift: dict | None = setting(drift_table(), None, absent=OMIT)  # this group's drifting dynamics (None: the experiment's)
-    # run i of MDP m takes the seed of that run of another experiment's group: the same gusts and draws (paired)
+    # run i of MDP m takes the seed of that run of another experiment's group: the same gusts and draws (paired). The
+    # seed is derived from (experiment, seed, group), so group may be any name several groups share (bench-drift's
+    # conditions), not only a group that experiment runs; the experiment must be shipped or this one (load_config checks)
     seeds_of: dict | None = setting(seeds_of(), None, absent=OMIT)
 
 
