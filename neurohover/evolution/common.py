@@ -241,6 +241,8 @@ def check_genomes(a: np.ndarray | None, size: int, name: str, rows: int | None =
         expected = f"({'n' if rows is None else rows}, {size})"
     if not ok:
         raise NeurohoverError(f"{name} has shape {a.shape}, expected {expected} (genomes of {size} genes)")
+    if a.dtype.kind != "f" or not np.all(np.isfinite(a)):  # a NaN gene was resumed without a word (eighth trial)
+        raise NeurohoverError(f"{name} holds a gene that is not a finite number")
     return a
 
 

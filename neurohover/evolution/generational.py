@@ -407,6 +407,8 @@ class GenerationalNE:
         opt._asked = bool(state["asked"])
         opt._generation = int(state["generation"])
         opt._evaluations = int(state["evaluations"])
+        if opt._generation < 0 or opt._evaluations < 0:  # generation -1 was taken (eighth trial)
+            raise NeurohoverError(f"generation {opt._generation} or evaluations {opt._evaluations} is negative: not a count")
         opt._champion_genome = check_genomes(dec_array(state["champion_genome"]), d, "champion genome", rows=0)
         opt._champion_return = float(state["champion_return"])
         opt._parents = check_genomes(dec_array(state.get("parents")), d, "parents")  # absent from checkpoints written before 2026-12-04
