@@ -319,7 +319,10 @@ def compete(
         "scale": config.scale,
         **summarise(ordered),
     }
-    (out / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
+    from .paths import writing
+
+    with writing(out / "summary.json", "summary file") as partial:
+        partial.write_text(json.dumps(summary, indent=1) + "\n")
     plot_cumulative(
         {agent: np.array([np.cumsum(np.array(r.returns, dtype=float)) for r in ordered])}, out / "cumulative.png", f"{task}: {agent}, {len(ordered)} runs"
     )
@@ -405,7 +408,9 @@ def _run_order(key: str) -> tuple[int, int]:
 
 
 def _write_episodes(path: Path, results: Sequence, n_steps: int) -> None:
-    with open(path, "w", newline="") as f:
+    from .paths import writing
+
+    with writing(path, "episodes file") as partial, open(partial, "w", newline="") as f:  # whole or not at all (a full disk: eighth trial)
         writer = csv.writer(f)
         writer.writerow(CSV_COLUMNS)
         for run, result in enumerate(results):
