@@ -319,10 +319,7 @@ def compete(
         "scale": config.scale,
         **summarise(ordered),
     }
-    from .paths import writing
-
-    with writing(out / "summary.json", "summary file") as partial:
-        partial.write_text(json.dumps(summary, indent=1) + "\n")
+    _write_summary(out / "summary.json", summary)
     plot_cumulative(
         {agent: np.array([np.cumsum(np.array(r.returns, dtype=float)) for r in ordered])}, out / "cumulative.png", f"{task}: {agent}, {len(ordered)} runs"
     )
@@ -380,6 +377,13 @@ def _run_into_store(config, store_path: Path, episodes_csv: Path, *, jobs: int, 
             ordered = [TestRunResult.from_dict(stored[k], k) for k in keys]
             _write_episodes(episodes_csv, ordered, config.typed.n_steps)
     return ordered
+
+
+def _write_summary(path: Path, summary: dict) -> None:
+    from .paths import writing
+
+    with writing(path, "summary file") as partial:  # whole or not at all
+        partial.write_text(json.dumps(summary, indent=1) + "\n")
 
 
 def _note_replaced(summary_path: Path, task: str, agent: str) -> None:

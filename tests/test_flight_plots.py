@@ -163,10 +163,14 @@ def test_plot_compete_command(files, capsys) -> None:
     assert png_size(out / "compete.png") == (1100, 450)
 
 
-def test_compete_runs_of_unequal_length_are_cut_to_the_shortest(tmp_path: Path) -> None:
+def test_compete_runs_of_unequal_length_are_refused_and_equal_ones_read(tmp_path: Path) -> None:
+    """compete writes whole runs: a shorter one is a file cut short, refused (it was plotted cut; eighth trial)."""
     (tmp_path / "episodes.csv").write_text("run,mdp,episode,return,crashed\n0,m,0,-1,0\n0,m,1,-2,1\n1,m,0,-3,0\n")
+    with pytest.raises(NeurohoverError, match="run 1 has 1 episodes where run 0 has 2: the file is cut short"):
+        read_compete_dir(tmp_path)
+    (tmp_path / "episodes.csv").write_text("run,mdp,episode,return,crashed\n0,m,0,-1,0\n0,m,1,-2,1\n1,m,0,-3,0\n1,m,1,-4,0\n")
     result = read_compete_dir(tmp_path)
-    assert result.returns.tolist() == [[-1.0], [-3.0]] and result.crashes == 1
+    assert result.returns.tolist() == [[-1.0, -2.0], [-3.0, -4.0]] and result.crashes == 1
     assert result.label == tmp_path.name  # no summary.json: the directory's name
 
 
