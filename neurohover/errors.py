@@ -31,14 +31,19 @@ def finite_real(value: object) -> bool:
         return False
 
 
+class FloatRangeError(ValueError):
+    """A number written past a float's range (:func:`float_of`)."""
+
+
 def float_of(text: str) -> float:
-    """``float(text)``, but a number past a float's range is a ValueError naming it, not inf: '1' and 400 zeros was
-    read as inf and reported as a value the user never typed (eighth trial). 'inf' written as such stays inf."""
+    """``float(text)``, but a number past a float's range is a :class:`FloatRangeError` naming it, not inf: '1' and 400
+    zeros was read as inf and reported as a value the user never typed (eighth trial). 'inf' written as such stays inf;
+    text that is no number is float()'s own ValueError."""
     value = float(text)
     if math.isinf(value) and "inf" not in str(text).lower():
         shown = str(text).strip()
         shown = shown if len(shown) <= 30 else f"{shown[:10]}...({len(shown)} characters)"
-        raise ValueError(f"{shown} is past a float's range (about 1.8e308)")
+        raise FloatRangeError(f"{shown} is past a float's range (about 1.8e308)")
     return value
 
 

@@ -159,6 +159,14 @@ class FlightData:
         return cls(tuple(obs_split), tuple(act_split), metadata)
 
 
+#: The metadata lists of one entry per episode: name -> (what an entry must be, what it is called).
+_PER_EPISODE = {
+    "returns": (finite_real, "one number"),
+    "mdps": (lambda m: isinstance(m, dict), "one MDP (a table)"),
+    "crashed": (lambda c: type(c) is bool, "one true or false"),
+}
+
+
 def _check_metadata(path: Path, metadata: dict, n_episodes: int) -> None:
     """Refuse the metadata fields plots and crash marks read when they are of the wrong kind, by name (an episode_steps
     "a" was a ValueError in plot; seventh trial)."""
@@ -169,14 +177,7 @@ def _check_metadata(path: Path, metadata: dict, n_episodes: int) -> None:
     for name in ("task", "policy"):  # shown in titles and notes (a task 5 or a policy 123 was taken; eighth trial)
         if metadata.get(name) is not None and not isinstance(metadata[name], str):
             raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata {name}={metadata[name]!r:.40} is not allowed: give text")
-    returns, mdps = metadata.get("returns"), metadata.get("mdps")
-    if returns is not None and (not isinstance(returns, list) or len(returns) != n_episodes or not all(finite_real(r) for r in returns)):
-        allowed = f"one number per episode ({n_episodes})"
-        raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata returns={returns!r:.40} is not allowed: {allowed}")
-    if mdps is not None and (not isinstance(mdps, list) or len(mdps) != n_episodes or not all(isinstance(m, dict) for m in mdps)):
-        allowed = f"one MDP (a table) per episode ({n_episodes})"
-        raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata mdps={mdps!r:.40} is not allowed: {allowed}")
-    crashed = metadata.get("crashed")
-    if crashed is not None and (not isinstance(crashed, list) or len(crashed) != n_episodes or not all(type(c) is bool for c in crashed)):
-        allowed = f"one true or false per episode ({n_episodes})"
-        raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata crashed={crashed!r:.40} is not allowed: {allowed}")
+    for name, (fits, each) in _PER_EPISODE.items():  # lists of one entry per episode (returns "x" was taken; eighth trial)
+        value = metadata.get(name)
+        if value is not None and (not isinstance(value, list) or len(value) != n_episodes or not all(fits(v) for v in value)):
+            raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata {name}={value!r:.40} is not allowed: {each} per episode ({n_episodes})")

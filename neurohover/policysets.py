@@ -38,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError
+from .errors import NeurohoverError, finite_real
 from .evaluate import MAX_EPISODES_PER_CALL, evaluate
 from .paths import writing
 from .policies import Policy, load_policy, save_policy
@@ -127,7 +127,7 @@ def _check_manifest_fields(manifest: dict, path: Path) -> None:
             continue
         bad = isinstance(value, bool) or not isinstance(value, kinds)
         if not bad and kinds != (str,):
-            bad = not np.isfinite(value) or (name != "sigma" and value < 0)
+            bad = not finite_real(value) or (name != "sigma" and value < 0)
         bad = bad or (name == "lineage" and value not in LINEAGES)
         if bad:
             raise NeurohoverError(f"policy-set manifest {str(path)!r}: {name}={value!r:.40} is not allowed: give {allowed}")
@@ -319,13 +319,14 @@ def _finished_stage(stage: Path, what: str, say) -> Policy | None:
     if not stage.is_file():
         return None
     try:
-        policy = load_policy(stage)
-        policy.metadata["episodes"], policy.metadata["seconds"]  # noqa: B018  (what the set's file takes from it)
+        policy: Policy | None = load_policy(stage)
+    except NeurohoverError:
+        policy = None
+    if policy is not None and {"episodes", "seconds"} <= policy.metadata.keys():  # what the set's file takes from it
         return policy
-    except (NeurohoverError, KeyError):
-        say(f"{what}: the interrupted build's stage {stage.name} is damaged; this run is flown again")
-        stage.unlink()
-        return None
+    say(f"{what}: the interrupted build's stage {stage.name} is damaged; this run is flown again")
+    stage.unlink()
+    return None
 
 
 STAGES = "stages"  # a build's finished runs, kept while it is under way (build_policy_set resumes from them)

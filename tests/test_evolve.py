@@ -489,7 +489,7 @@ def test_evolve_says_when_the_plateau_ends_a_run_before_its_budget(tmp_path: Pat
         (lambda s: s["counters"].update(wall_seconds=-1.0), "counter 'wall_seconds' is -1.0"),
         (lambda s: s["champion"].update(genome=[1.0, 2.0, 3.0]), "champion genome has shape \\(3,\\), expected \\(42,\\)"),
         (lambda s: s["champion"].update(genome=None, **{"return": "abc"}), "ValueError: could not convert string to float"),
-        (lambda s: s["champion"].update(genome=[float("nan")] * 42), "champion genome holds a number that is not finite"),  # eighth trial
+        (lambda s: s["champion"].update(genome=[float("nan")] * 42), "the champion genome holds a gene that is not a finite number"),  # eighth trial
         (lambda s: s["champion"].update(**{"return": "nan"}), "the champion's return is nan"),
         (lambda s: s["optimizer_state"].update(population={"shape": [1, 42], "data": [float("nan")] * 42}), "population holds a gene that is not a finite"),
         (lambda s: s.update(history=["x"]), "damaged checkpoint: ValueError"),

@@ -10,7 +10,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from ..errors import NeurohoverError, float_of
+from ..errors import FloatRangeError, NeurohoverError, float_of
 from ..tasks.sensor import Sensor
 
 
@@ -22,7 +22,7 @@ def parse_floats(text: str, what: str) -> list[float]:
     try:
         return [float_of(x) for x in parts]
     except ValueError as err:
-        why = str(err) if "past a float's range" in str(err) else f"got {text!r}"
+        why = str(err) if isinstance(err, FloatRangeError) else f"got {text!r}"
         raise NeurohoverError(f"{what} must be comma-separated numbers, {why}") from None
 
 
@@ -187,10 +187,8 @@ def real(text: str) -> float:
     seventh trial); 'nan' and 'inf' as written are left to the option's own range check."""
     try:
         return float_of(text)
-    except ValueError as err:
-        if "past a float's range" in str(err):
-            raise argparse.ArgumentTypeError(str(err)) from None
-        raise
+    except FloatRangeError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
 
 
 def add_sigma_option(p: argparse.ArgumentParser) -> None:

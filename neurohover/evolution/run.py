@@ -26,7 +26,7 @@ from ..launch import Parking
 from ..policies import Policy
 from ..sim.lanes import LANES
 from .bandits import BANDITS, top_mu_bandit
-from .common import Optimiser, TellInfo, enc_float
+from .common import Optimiser, TellInfo, check_genomes, enc_float
 from .config import RACE_T_LIMIT, RunConfig, next_auto_delta, upgrade_saved_config
 from .fitness import episode_fitness
 from .generational import GenerationalNE
@@ -483,11 +483,7 @@ def _restored_parts(state: dict, delta: Any, genome_size: int) -> dict[str, Any]
         if not (math.isfinite(v) and v >= 0):
             raise ValueError(f"counter {k!r} is {v!r}, not a number of seconds >= 0")
     ch = state["champion"]
-    genome = None if ch["genome"] is None else np.array(ch["genome"], dtype=float)
-    if genome is not None and genome.shape != (genome_size,):
-        raise ValueError(f"the champion genome has shape {genome.shape}, expected ({genome_size},)")
-    if genome is not None and not np.all(np.isfinite(genome)):  # a NaN gene was resumed without a word (eighth trial)
-        raise ValueError("the champion genome holds a number that is not finite")
+    genome = check_genomes(None if ch["genome"] is None else np.array(ch["genome"], dtype=float), genome_size, "the champion genome", rows=0)
     if math.isnan(float(ch["return"])):
         raise ValueError("the champion's return is nan")
     race_delta = state.get("race_delta", delta)  # absent before race:auto: the fixed delta

@@ -125,15 +125,19 @@ def _check_neat_variant(settings: dict, v: dict, where: str) -> None:
         raise NeurohoverError(f"{where}: variant {v['key']!r}: a NEAT run over the family is validated on its test MDPs: set validation_mdps = 'test'")
 
 
+#: One word of a unit key that a config names (a variant's key, a part of a group's label): nothing that reads as a path.
+_KEY_WORD = r"[A-Za-z0-9][A-Za-z0-9._+=-]*"
+_KEY_WORD_ALLOWED = "letters, digits, '.', '_', '+', '=' or '-', starting with a letter or digit"
+
+
 def _check_evolution(settings: dict, task: str, where: str) -> None:
     """Variants, their optimisers (checked now, not when a unit first runs), robustness and validation targets."""
     keys = [v["key"] for v in settings["variants"]]
     if len(set(keys)) != len(keys):
         raise NeurohoverError(f"{where}: variant keys must be unique, got {keys}")
     for key in keys:  # a key is one part of its units' keys (evolve/KEY/...): "../x" was taken (eighth trial)
-        if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._+=-]*", key):
-            allowed = "letters, digits, '.', '_', '+', '=' or '-', starting with a letter or digit"
-            raise NeurohoverError(f"{where}: variant key {key!r:.60} is not allowed: give {allowed}")
+        if not re.fullmatch(_KEY_WORD, key):
+            raise NeurohoverError(f"{where}: variant key {key!r:.60} is not allowed: give {_KEY_WORD_ALLOWED}")
     for v in settings["variants"]:
         if v["sigma"] is not None and not TASK_FAMILIES[task].has_sigma:
             raise NeurohoverError(f"{where}: variant {v['key']!r} sets sigma but the task is {task!r}")
@@ -216,10 +220,10 @@ def _check_test_runs(settings: dict, task: str, where: str) -> None:
     """Groups (agents for the task, their LR and own settings, written in where defaulted) and the generics' sources."""
     labels = [g["label"] or g["agent"] for g in settings["groups"]]
     for label in labels:  # a group's label is part of its units' keys, whose parts '/' separates (seventh trial: "../x")
-        if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._+=-]*(/[A-Za-z0-9][A-Za-z0-9._+=-]*)*", label):
+        if not re.fullmatch(f"{_KEY_WORD}(/{_KEY_WORD})*", label):
             raise NeurohoverError(
-                f"{where}: group label {label!r:.60} is not allowed: give words of letters, digits, '.', '_', '+', '=' or '-', each starting "
-                "with a letter or digit, joined by '/' (it names the group's units, run/LABEL/MDP/REP)"
+                f"{where}: group label {label!r:.60} is not allowed: give words of {_KEY_WORD_ALLOWED}, joined by '/' (it names the group's "
+                "units, run/LABEL/MDP/REP)"
             )
     if len(set(labels)) != len(labels):
         raise NeurohoverError(f"{where}: group labels must be unique (set label = ... on repeated agents), got {labels}")

@@ -30,7 +30,6 @@ from __future__ import annotations
 import contextlib
 import errno
 import json
-import math
 import os
 import socket
 import sqlite3
@@ -39,7 +38,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import IO, Any
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, finite_real
 
 LOCK_ATTEMPTS = 100  # tries to lock STORE.lock while earlier writers remove it as they close
 
@@ -366,7 +365,7 @@ class Store:
 
     def _seconds(self, value: Any, what: str) -> float:
         """A stored duration, or one clear error naming the damaged row (text was a TypeError in report; seventh trial)."""
-        if isinstance(value, (int, float)) and math.isfinite(value) and value >= 0:
+        if finite_real(value) and value >= 0:
             return value
         raise NeurohoverError(f"results store {str(self.path)!r}: {what} is damaged ({value!r:.40} is no number of seconds >= 0)")
 

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import NeurohoverError, finite_real, float_of
+from ..errors import FloatRangeError, NeurohoverError, finite_real, float_of
 from ..sim.constants import PARAM_NAMES, ROW_PARAMS
 
 _DRIFT_TAG = 0xD81F7  # separates a run's drift stream from its agent's and its gusts'
@@ -179,7 +179,7 @@ class Drift:
                     lo, _, hi = when.partition("-")
                     at = (int(lo), int(hi or lo))
             except ValueError as err:
-                why = f" ({err})" if "past a float's range" in str(err) else ""
+                why = f" ({err})" if isinstance(err, FloatRangeError) else ""
                 raise NeurohoverError(f"drift {part[:40]!r} is not understood{why}: {_PARSE_FORM}") from None
             if not eq:
                 raise NeurohoverError(f"drift {part!r} is not understood: {_PARSE_FORM}")

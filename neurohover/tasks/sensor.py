@@ -38,7 +38,7 @@ import numbers
 import re
 from dataclasses import asdict, dataclass, fields, replace
 
-from ..errors import NeurohoverError, float_of
+from ..errors import FloatRangeError, NeurohoverError, float_of
 from ..sim.constants import MAX_SENSOR_DELAY, SENSOR_GROUPS
 
 #: The std of each group at noise level 1 (velocity m/s, position m, rates rad/s, attitude).
@@ -133,7 +133,7 @@ class Sensor:
         except ValueError as exc:
             if isinstance(exc, NeurohoverError):
                 raise
-            if "past a float's range" in str(exc):
+            if isinstance(exc, FloatRangeError):
                 raise NeurohoverError(f"sensor level {exc}: allowed a noise level in 0..{MAX_LEVEL:g}") from None
         settings: dict[str, float] = {}
         expected = f"allowed a noise level (e.g. 0.5) or key=value pairs with keys {', '.join(allowed)}"
@@ -149,7 +149,7 @@ class Sensor:
             try:
                 settings[key] = float_of(value)
             except ValueError as err:
-                why = f": {err}" if "past a float's range" in str(err) else ""
+                why = f": {err}" if isinstance(err, FloatRangeError) else ""
                 raise NeurohoverError(f"sensor setting {part[:40]!r} needs a number after '='{why}") from None
         if not settings:
             raise NeurohoverError(f"sensor {text!r} is empty: {expected}")
