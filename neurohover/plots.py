@@ -307,8 +307,26 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
             raise NeurohoverError(f"--compete {str(summary_path)!r} cannot be read ({err}); remove it to label the curve by its directory's name") from None
         if not (isinstance(summary, dict) and isinstance(summary.get("agent"), str) and isinstance(summary.get("task", ""), str)):
             raise NeurohoverError(f"--compete {str(summary_path)!r} is not a compete summary: no agent and task names")
+        _check_summary_matches(summary_path, summary, returns.shape)
         label = f"{summary['agent']} ({summary.get('task', '?')})"
     return CompeteResult(label, returns, crashes, path)
+
+
+def _check_summary_matches(path: Path, summary: dict, shape: tuple[int, ...]) -> None:
+    """A summary naming no task family, or other runs or episodes than its episodes.csv, is another competition's
+    (it labelled the curve without a word; eighth trial)."""
+    from .tasks import TASK_NAMES
+
+    task = summary.get("task")
+    if task is not None and task not in TASK_NAMES:
+        raise NeurohoverError(f"--compete {str(path)!r} names task {task!r:.40}, not one of {', '.join(TASK_NAMES)}: it is no compete summary")
+    for key, found in (("runs", shape[0]), ("episodes", shape[1])):
+        given = summary.get(key)
+        if given is not None and (not isinstance(given, int) or isinstance(given, bool) or given != found):
+            raise NeurohoverError(
+                f"--compete {str(path)!r} says {key} {given!r:.40} where its episodes.csv holds {found}: "
+                "the two are of different competitions (run compete again, or remove summary.json)"
+            )
 
 
 def compete_figure(results: Sequence[CompeteResult], title: str = "") -> Figure:

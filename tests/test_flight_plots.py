@@ -195,7 +195,13 @@ def bad(files, tmp_path: Path) -> dict[str, str]:
     (tmp_path / "empty").mkdir()
     (tmp_path / "badcsv").mkdir()
     (tmp_path / "badcsv" / "episodes.csv").write_text("a,b\n1,2\n")
-    for name, summary in (("badsummary", "{not json"), ("oddsummary", '{"agent": 5}')):
+    for name, summary in (
+        ("badsummary", "{not json"),
+        ("oddsummary", '{"agent": 5}'),
+        ("ghh10summary", '{"agent": "baseline", "task": "ghh10"}'),  # another task's or competition's summary (eighth trial)
+        ("runssummary", '{"agent": "baseline", "task": "ghh08", "runs": 2, "episodes": 1}'),
+        ("episodessummary", '{"agent": "baseline", "task": "ghh08", "runs": 1, "episodes": 1.0}'),
+    ):
         (tmp_path / name).mkdir()
         (tmp_path / name / "episodes.csv").write_text("run,mdp,episode,return,crashed\n0,m,0,-1,0\n")
         (tmp_path / name / "summary.json").write_text(summary)
@@ -216,6 +222,9 @@ def bad(files, tmp_path: Path) -> dict[str, str]:
         (["--compete", "{compete}", "--out", "/proc/plots"], "--out '/proc/plots': cannot"),
         (["--compete", "{dir}/badsummary"], "summary.json' cannot be read (Expecting property name"),
         (["--compete", "{dir}/oddsummary"], "summary.json' is not a compete summary: no agent and task names"),
+        (["--compete", "{dir}/ghh10summary"], "summary.json' names task 'ghh10', not one of ghh08, "),
+        (["--compete", "{dir}/runssummary"], "summary.json' says runs 2 where its episodes.csv holds 1: the two are of different"),
+        (["--compete", "{dir}/episodessummary"], "summary.json' says episodes 1.0 where its episodes.csv holds 1"),
         (["--compete", "{compete}", "--episodes", "0"], "--episodes picks episodes of a flight-data file; it does not apply to --compete"),
         (["{flight}", "--episodes", "0,0"], "--episodes '0,0' names episode 0 more than once"),
         (["{flight}", "--episodes", "0-1,1"], "--episodes '0-1,1' names episode 1 more than once"),

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 from ..errors import NeurohoverError
 from .config import POLICY_SOURCES, ExperimentConfig
-from .plans import plan, run_keys, source_experiments
+from .plans import Plan, plan, run_keys, source_experiments
 from .results import check_run_lengths, result_from_dict
 from .store import Store
 
@@ -140,11 +140,13 @@ def _checked_results(config: ExperimentConfig, store: Store) -> tuple[dict[str, 
     return {unit["key"]: unit["result"] for unit in units}, {unit["key"]: (unit["kind"], unit["params"]) for unit in units}
 
 
-def _refuse_stray_units(config: ExperimentConfig, store: Store, results: dict[str, dict], stored: dict[str, tuple[str, dict]], sources: dict) -> None:
+def _refuse_stray_units(config: ExperimentConfig, store: Store, results: dict[str, dict], stored: dict[str, tuple[str, dict]], sources: dict) -> Plan:
     """Refuse a stored unit the config does not plan (it was counted as done: "5/4 done"; seventh trial), or one whose
     kind or params are not those planned for its key (an agent "foo" was reused; eighth trial). Every stored unit's
-    prerequisites are stored too, so the plan from all of them names every unit that belongs."""
-    planned = plan(config, results, sources).units
+    prerequisites are stored too, so the plan from all of them names every unit that belongs; it is returned, the
+    run's first plan."""
+    planned_from_all = plan(config, results, sources)
+    planned = planned_from_all.units
     known = {u.key for u in planned} | set(run_keys(config))
     stray = sorted(set(results) - known)
     where = f"results store {str(store.path)!r}, experiment {config.name} ({config.scale}), is damaged"
@@ -156,6 +158,7 @@ def _refuse_stray_units(config: ExperimentConfig, store: Store, results: dict[st
     for u in planned:
         if u.key in stored and stored[u.key] != (u.kind, json.loads(json.dumps(u.params))):
             raise NeurohoverError(f"{where}: unit {u.key!r} holds other settings than its config plans for it (--fresh starts it over)")
+    return planned_from_all
 
 
 def _check_arguments(config, store, executor) -> None:
@@ -209,7 +212,7 @@ def reproduce(
     store.begin(config.name, config.scale, config.hash, config.to_dict(), fresh=fresh)
     results, stored = _checked_results(config, store)  # read once: checked, then the finished units
     sources = {name: store.results(name, config.scale) for name in source_experiments(config)}
-    _refuse_stray_units(config, store, results, stored, sources)
+    first_round: Plan | None = _refuse_stray_units(config, store, results, stored, sources)  # planned once, not twice
     summary = RunSummary(config.name, config.scale, executor.name, executor.cores, units_before=len(results))
     session = store.start_session(config.name, config.scale, config.hash, executor.name, summary.cores, len(results))
     start = time.perf_counter()
@@ -231,7 +234,8 @@ def reproduce(
     matched: set[str] = set()
     try:
         while True:
-            p = plan(config, results, sources)
+            p = first_round if first_round is not None else plan(config, results, sources)
+            first_round = None
             matched.update(pat for pat in only for u in p.units if fnmatch.fnmatchcase(u.key, pat))
             summary.units_total = p.total
             bar.total = p.total
