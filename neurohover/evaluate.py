@@ -233,6 +233,11 @@ MAX_STEPS_PER_CALL, MAX_RECORD_BYTES, RECORD_BYTES_PER_STEP = 10**12, 8 * 2**30,
 MAX_EPISODES_PER_CALL = 100_000_000
 
 
+def _check_n_steps(n_steps) -> None:
+    if isinstance(n_steps, bool) or not isinstance(n_steps, (int, np.integer)) or not 1 <= n_steps <= MAX_EPISODE_STEPS:
+        raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
+
+
 def _check_call_size(n_jobs: int, n_steps: int, n_rec: int) -> None:
     """Refuse a call that could not finish (10**8 episodes of 10**7 steps passed every check and ran for years) or whose
     recorded flight data memory cannot hold (53.7 GiB was a MemoryError); fourth trial."""
@@ -317,8 +322,7 @@ def evaluate_jobs(
     rows = mdp_rows(mdps)
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= MAX_SEED:  # True was seed 1
         raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer in 0..2**63-1")
-    if isinstance(n_steps, bool) or not isinstance(n_steps, (int, np.integer)) or not 1 <= n_steps <= MAX_EPISODE_STEPS:
-        raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
+    _check_n_steps(n_steps)
     p_idx = _index_array(policy_index, None, len(table), "policy_index")
     n_jobs = p_idx.shape[0]
     m_idx = _index_array(mdp_index, n_jobs, rows.shape[0], "mdp_index")
@@ -396,6 +400,8 @@ def evaluate(
         raise NeurohoverError(f"safeguard={safeguard!r:.60} is not allowed: give a neurohover.evaluate.Safeguard(fallback_policy) or None")
     n_pol, n_mdp = len(table), rows.shape[0]
     check_episode_count(n_pol * n_mdp * int(episodes), f"{n_pol} policies x {n_mdp} MDPs x episodes={episodes}")
+    _check_n_steps(n_steps)  # both before the job arrays are made (10**8 episodes of 10**7 steps took 50 s to refuse)
+    _check_call_size(n_pol * n_mdp * int(episodes), int(n_steps), n_pol * n_mdp * int(episodes) if record else 0)
     p_idx, m_idx, e = np.meshgrid(np.arange(n_pol), np.arange(n_mdp), np.arange(episodes), indexing="ij")
     episode_index = first_episode + m_idx * episodes + e
     fallback = None

@@ -664,3 +664,20 @@ def test_the_sixth_trials_python_cases_are_refused_by_name(tmp_path) -> None:
             with pytest.raises(NeurohoverError, match=message):
                 call()
     assert not (tmp_path / "m.npz").exists() and not (tmp_path / "t.sqlite").exists() and not (tmp_path / "r").exists()
+
+
+def test_a_call_too_large_to_fly_is_refused_before_its_job_arrays_are_made() -> None:
+    """evaluate(episodes=10**8, n_steps=10**7) built 10**8-long job arrays (GBs, 50 s) before refusing the call's size."""
+    import tracemalloc
+
+    mdp = nh.get_task_family("ghh08").mdp("train:0")
+    tracemalloc.start()
+    try:
+        with pytest.raises(NeurohoverError, match="control steps, more than one call flies"):
+            nh.evaluate(nh.baseline_policy(), mdp, episodes=10**8, n_steps=10**7)
+        with pytest.raises(NeurohoverError, match="n_steps=0 is out of range"):
+            nh.evaluate(nh.baseline_policy(), mdp, episodes=10**8, n_steps=0)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 2**27, f"{peak / 2**20:.0f} MiB allocated before the refusal"
