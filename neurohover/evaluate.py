@@ -118,7 +118,12 @@ class PolicyTable:
 
     @classmethod
     def from_genomes(cls, genomes: np.ndarray, topology: str) -> PolicyTable:
-        """A table of genomes (P, D) of one topology (the evolution fast path)."""
+        """A table of genomes (P, D) of one topology (the evolution fast path).
+
+        Non-finite genes are allowed here, unlike in :class:`Policy`: an optimiser's diverged sample is flown and
+        crashes at once, as the simulator defines, instead of stopping the run (a policy file, meant to be flown as
+        it is, is refused instead).
+        """
         if topology not in TOPOLOGIES:
             raise NeurohoverError(f"unknown policy topology {topology!r}: allowed {', '.join(TOPOLOGIES)}")
         raw = np.asarray(genomes)

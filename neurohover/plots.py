@@ -259,7 +259,7 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
     seen: dict[int, set[int]] = {}  # each run's episode numbers so far
     crashes = 0
     try:
-        with open(csv_path, newline="") as f:
+        with open(csv_path, newline="", encoding="utf-8-sig") as f:
             reader = csv.DictReader(f)
             missing = [c for c in COMPETE_COLUMNS if c not in (reader.fieldnames or [])]
             if missing:
@@ -270,9 +270,10 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
                     crashes += int(row.get("crashed") or 0)
                 except (TypeError, ValueError):
                     raise NeurohoverError(f"--compete {str(csv_path)!r}, line {line}: run, episode and return must be numbers") from None
-                if not math.isfinite(ret) or abs(ret) > WORST_RETURN:  # -1e308 overflowed the plot (eighth trial)
+                if not (math.isfinite(ret) and -WORST_RETURN <= ret <= 0):  # -1e308 overflowed the plot (eighth trial); every reward is <= 0 (ninth)
                     raise NeurohoverError(
-                        f"--compete {str(csv_path)!r}, line {line}: return {row['return']!r:.30} is not an episode's (finite, >= {-WORST_RETURN:.3g})"
+                        f"--compete {str(csv_path)!r}, line {line}: return {row['return']!r:.30} is not an episode's "
+                        f"(finite, in [{-WORST_RETURN:.3g}, 0]: every reward is minus a sum of squares)"
                     )
                 if run < 0 or episode < 0 or episode in seen.setdefault(run, set()):  # plotted without a word (fifth trial)
                     raise NeurohoverError(

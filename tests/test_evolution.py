@@ -42,7 +42,7 @@ def run_to_stop(opt, fitness=sphere_return) -> None:
     ("cls", "kwargs", "message"),
     [
         (SteadyStateSettings, {"elite_size": 60}, r"elite_size=60 must be smaller than pop_size=50"),
-        (SteadyStateSettings, {"pop_size": 10}, r"elite_size=49 must be smaller than pop_size=10"),
+        (SteadyStateSettings, {"pop_size": 10}, r"elite_size=49 \(its default\) must be smaller than pop_size=10: give elite_size below it too"),
         (SteadyStateSettings, {"pop_size": 1, "elite_size": 0}, r"pop_size=1 must be an integer >= 2"),
         (SteadyStateSettings, {"crossover_prob": 1.5}, r"crossover_prob=1.5 must be a probability in \[0, 1\]"),
         (SteadyStateSettings, {"mutate_frac": -0.1}, r"mutate_frac=-0.1 must be a probability"),

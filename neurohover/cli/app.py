@@ -81,6 +81,10 @@ def _other_scripts_digits(argv: Sequence[str]) -> str | None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """The command line: ``neurohover ARGS`` (``argv``: the arguments, default ``sys.argv[1:]``); the exit status."""
+    if argv is None:  # a path of undecodable bytes printed under a strict UTF-8 stdout was a traceback after the results (ninth trial)
+        for stream in (sys.stdout, sys.stderr):
+            if hasattr(stream, "reconfigure"):
+                stream.reconfigure(errors="backslashreplace")
     status = _run(argv)
     if argv is None and running_as_command():  # the command's own process (a program calling main() keeps its signals)
         # The command is over and has said so: a Ctrl-C or SIGTERM now would kill the interpreter while it exits, with

@@ -57,7 +57,13 @@ DRIFT_ENV_IDS: dict[str, str] = {f"neurohover/{name.upper()}-{suffix}-v0": name 
 
 
 def register_envs() -> None:
-    """Register the environments with Gymnasium; ids already registered are left alone."""
+    """Register the environments with Gymnasium; ids already registered are left alone.
+
+    Gymnasium's passive checker is off for them (``disable_env_checker``): in Gymnasium 1.4 it marks its reset check
+    done before the first reset returns, so after a refused first reset (a bad seed or MDP) the first step of a
+    corrected episode raised a TypeError of its own (ninth trial). The tests run Gymnasium's full ``check_env`` on
+    every id instead.
+    """
     ids: list[tuple[str, str, dict, int]] = [(env_id, task, {}, EPISODE_STEPS) for env_id, task in ENV_IDS.items()]
     ids += [(env_id, task, SHORT_SETTINGS, SHORT_EPISODE_STEPS) for env_id, task in SHORT_ENV_IDS.items()]
     ids += [(env_id, task, SENSOR_ENV_SETTINGS[env_id.split("-")[1]], EPISODE_STEPS) for env_id, task in SENSOR_ENV_IDS.items()]
@@ -70,6 +76,7 @@ def register_envs() -> None:
                 vector_entry_point="neurohover.envs.rl:make_rl_vector_env",
                 max_episode_steps=RL_SETTINGS["episode_steps"],
                 kwargs={"task": task},
+                disable_env_checker=True,
             )
     for env_id, task, settings, limit in ids:
         if env_id in gymnasium.registry:  # re-import or reload: Gymnasium would warn about overriding
@@ -81,6 +88,7 @@ def register_envs() -> None:
             vector_entry_point=vector,
             max_episode_steps=limit,
             kwargs={"task": task, **settings},
+            disable_env_checker=True,
         )
 
 

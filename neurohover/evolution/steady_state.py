@@ -159,7 +159,10 @@ class SteadyStateSettings:
             set_field(self, "init_mutate_std", require_std("init_mutate_std", self.init_mutate_std))
         elite = require_int("elite_size", self.elite_size, 0)
         if elite >= self.pop_size:
-            raise NeurohoverError(f"elite_size={elite} must be smaller than pop_size={self.pop_size}")
+            default = " (its default)" if elite == type(self).elite_size else ""  # a default the user never set, named as such (ninth trial)
+            raise NeurohoverError(
+                f"elite_size={elite}{default} must be smaller than pop_size={self.pop_size}: give elite_size below it too (the paper's is pop_size - 1)"
+            )
         set_field(self, "elite_size", elite)
         set_field(self, "plateau_threshold", require_int("plateau_threshold", self.plateau_threshold, 1))
 

@@ -171,7 +171,7 @@ def _aliases() -> dict[str, str]:
     out = {}
     for name, path in shipped_configs().items():
         try:
-            for alias in tomllib.loads(path.read_text()).get("aliases", []):
+            for alias in tomllib.loads(path.read_text(encoding="utf-8")).get("aliases", []):
                 out[alias] = name
         except tomllib.TOMLDecodeError:
             pass
@@ -252,7 +252,7 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
         raise NeurohoverError(f"overrides={overrides!r:.60} is not allowed: give a dict of settings, e.g. {{'episodes': 3}} (the CLI's --set episodes=3)")
     path = resolve_name(name_or_path)
     try:
-        raw = tomllib.loads(path.read_text())
+        raw = tomllib.loads(path.read_text(encoding="utf-8-sig"))  # TOML is UTF-8; a byte-order mark (Windows editors) was "Invalid statement" (ninth trial)
     except tomllib.TOMLDecodeError as err:
         raise NeurohoverError(f"config {str(path)!r} is not valid TOML: {err}") from None
     except RecursionError:  # a value nested thousands deep (seventh trial)

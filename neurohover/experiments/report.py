@@ -25,7 +25,7 @@ from ..errors import NeurohoverError, OutputError
 from .config import ORDER, ExperimentConfig, shipped_counterpart, with_shipped_paper
 from .keys import UnitKey
 from .report_base import Section, agent_panel, fmt, log_errors, new_figure, paired_p, paired_verdict, ratio_verdict, sd, table
-from .report_claims import PAPER_FIGURES, claims_section, conclusions_discussion
+from .report_claims import PAPER_FIGURES, DiscussionError, claims_section, conclusions_discussion, read_discussion
 from .report_evolution import EvolutionSection
 from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, test_run_figure, varies
 from .report_models import SensorModels
@@ -489,8 +489,9 @@ QUICK_DISCUSSION = (
 def _discussion(cfg: ExperimentConfig, out: Path) -> str:
     """The hand-written discussion ``discussion/<name>-<scale>.md`` beside the report, kept across regenerations."""
     path = out / "discussion" / f"{cfg.name}-{cfg.scale}.md"
-    if path.is_file():
-        return path.read_text().strip()
+    text = read_discussion(path)
+    if text is not None:
+        return text
     if cfg.scale == "quick":
         return QUICK_DISCUSSION
     return (
@@ -536,7 +537,7 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
             current = (None if shipped is None else shipped.hash == stored.hash) if sc == "paper" else None  # the status table: paper scale
             cfg = with_shipped_paper(stored, shipped)
             text, checked, status = _section(cfg, store, out, current)
-        except OutputError:  # a full disk is no damaged store (it was reported as one, exit 0; eighth trial)
+        except (OutputError, DiscussionError):  # a full disk or an unreadable discussion is no damaged store (eighth, ninth trial)
             raise
         except NeurohoverError as err:  # one damaged experiment: said in its place, the others reported as usual
             sections.append(f"## {name} [{sc}]\n\n**Not reported: the store's copy is damaged.** {err}\n")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..errors import NeurohoverError
 from .report_base import table
 
 #: The paper's tables and figures, whose claims the claims table lists (at paper scale), in the paper's order.
@@ -59,7 +60,27 @@ CONCLUSIONS_DISCUSSION = Path("discussion") / "conclusions-paper.md"
 def conclusions_discussion(out: Path) -> str:
     """``discussion/conclusions-paper.md`` beside the report, under the conclusions table: each conclusion read from
     the measurements (its figures' sections and the experiments beyond the paper that measured why a claim differs)."""
-    path = Path(out) / CONCLUSIONS_DISCUSSION
-    if not path.is_file():
-        return ""
-    return "\n### The conclusions, measured\n\n" + path.read_text().strip() + "\n"
+    text = read_discussion(Path(out) / CONCLUSIONS_DISCUSSION)
+    return "" if text is None else "\n### The conclusions, measured\n\n" + text + "\n"
+
+
+class DiscussionError(NeurohoverError):
+    """A hand-written discussion that cannot be read: the user's file, not a damaged store."""
+
+
+def read_discussion(path: Path) -> str | None:
+    """A hand-written discussion's text (a byte-order mark dropped), None where there is none.
+
+    Raises
+    ------
+    DiscussionError
+        If something is there that is no readable UTF-8 file (a directory was skipped without a word, other bytes a
+        traceback; ninth trial).
+    """
+    if not (path.exists() or path.is_symlink()):
+        return None
+    try:
+        return path.read_text(encoding="utf-8-sig").strip()
+    except (OSError, UnicodeDecodeError) as err:
+        reason = "it is not UTF-8 text" if isinstance(err, UnicodeDecodeError) else (err.strerror or str(err))
+        raise DiscussionError(f"discussion {str(path)!r} cannot be read ({reason}): give a Markdown file in UTF-8, or remove it") from None
