@@ -88,3 +88,19 @@ def test_an_episode_after_a_refused_first_reset_flies(env_id: str) -> None:
     env.reset(seed=0)
     _, reward, *_ = env.step(np.zeros(env.action_space.shape, dtype=env.action_space.dtype))
     assert np.isfinite(reward) and reward <= 0
+
+
+@pytest.mark.parametrize("mdps", ["test", "sample"])
+def test_exclude_own_on_mdps_without_specialised_policies_is_refused(mdps: str, tmp_path: Path) -> None:
+    """S10: exclude_own = true on test or sampled MDPs (only training MDPs have specialised policies) did nothing."""
+    from neurohover.experiments import load_config
+
+    path = tmp_path / "x.toml"
+    path.write_text(
+        f'name = "x"\nkind = "test_runs"\n[settings]\ntask = "ghh08"\nseed = 1\nepisodes = 2\nn_steps = 20\npolicies = "shipped"\n'
+        f'[[settings.groups]]\nagent = "model-free"\nmdps = "{mdps}"\nn_mdps = 2\nexclude_own = true\n[scales.quick]\n'
+    )
+    with pytest.raises(NeurohoverError, match=f"groups\\[0\\]: exclude_own = true does nothing on mdps = '{mdps}'"):
+        load_config(str(path), "quick")
+    path.write_text(path.read_text().replace(f'mdps = "{mdps}"', 'mdps = "train"'))
+    assert load_config(str(path), "quick").typed.groups[0].exclude_own is True

@@ -87,7 +87,17 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
 
 def check_given(settings: dict, where: str) -> None:
     """Refuse a setting given where it does nothing (``settings`` as written, before defaults fill them in):
-    a NEAT variant's ``prototype`` (NEAT starts from its own genomes: its neat table's ``start``)."""
+    a NEAT variant's ``prototype`` (NEAT starts from its own genomes: its neat table's ``start``), a group's
+    ``exclude_own`` on MDPs other than the training MDPs (only those have a specialised policy of their own).
+
+    The policy-evolution settings (``policy_budget``, ``generic_budget``, ...) are not refused with ``policies`` other
+    than "evolve": one config serves both sources, and the paper-scale runs switch with ``--set policies=shipped``."""
+    for i, g in enumerate(settings.get("groups") or []):
+        if isinstance(g, dict) and g.get("exclude_own") is True and g.get("mdps", "test") != "train":  # accepted without a word (ninth trial)
+            raise NeurohoverError(
+                f"{where}, groups[{i}]: exclude_own = true does nothing on mdps = {g.get('mdps', 'test')!r}: only the training MDPs have "
+                "specialised policies of their own to leave out (give mdps = 'train', or leave exclude_own out)"
+            )
     for i, v in enumerate(settings.get("variants") or []):
         if isinstance(v, dict) and v.get("topology") == NEAT_TOPOLOGY and "prototype" in v:
             raise NeurohoverError(
