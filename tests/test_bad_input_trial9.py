@@ -104,3 +104,20 @@ def test_exclude_own_on_mdps_without_specialised_policies_is_refused(mdps: str, 
         load_config(str(path), "quick")
     path.write_text(path.read_text().replace(f'mdps = "{mdps}"', 'mdps = "train"'))
     assert load_config(str(path), "quick").typed.groups[0].exclude_own is True
+
+
+def test_ec_mer_learns_with_the_policy_that_flew_the_data_not_a_file_of_its_name(tmp_path, cli, monkeypatch) -> None:
+    """S6: learn-model --method ec-mer looked the flight data's policy file name up from its own directory, so another
+    p.json there was the closed loop it learned (or, with none there, the command failed)."""
+    import json
+
+    (tmp_path / "pa").mkdir()
+    (tmp_path / "pb").mkdir()
+    (tmp_path / "pa" / "p.json").write_text(json.dumps({"topology": "slp", "genome": [0.0] * 36 + [0.02, 0, 0, 0.23]}))
+    (tmp_path / "pb" / "p.json").write_text("not the policy that flew")
+    monkeypatch.chdir(tmp_path / "pa")
+    rc, _, err = cli("fly", "--task", "ghh08", "--episodes", "1", "--policy", "p.json", "--record", "f.npz")
+    assert rc == 0, err
+    monkeypatch.chdir(tmp_path / "pb")
+    rc, out, err = cli("learn-model", "--flight-data", "../pa/f.npz", "--method", "ec-mer", "--budget", "2", "--out", "m.json")
+    assert rc == 0 and "ec-mer model written to m.json" in out, err

@@ -87,6 +87,8 @@ def cmd_fly(args: argparse.Namespace) -> int:
         fd.metadata.update(
             {"task": family.name, "mdps": [m.to_dict() for m in mdps], "policy": str(args.policy), "seed": args.seed, "returns": returns.tolist()}
         )
+        # the policy itself: its file's name alone was looked up from learn-model's directory, another file there (ninth trial)
+        fd.metadata["policy_flown"] = {"topology": policy.topology, "genome": policy.genome.tolist()}
         fd.save(args.record, dtype=args.record_dtype or "float64")  # a failed write: one message, no partial file
     summary = {
         "task": family.name,

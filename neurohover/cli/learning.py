@@ -310,7 +310,6 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     from ..flightdata import FlightData
     from ..models import DEFAULT_NOISE_ESTIMATE, format_parameter_table, learn_ec_meno, learn_ec_mer, learn_lr, parameter_table
     from ..paths import input_file, output_file
-    from ..policies import load_policy
     from .options import check_given, given_settings
 
     if args.budget is not None and not 1 <= args.budget <= MAX_BUDGET:
@@ -348,8 +347,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
         elif args.method == "ec-meno":
             model = learn_ec_meno(data, seed=seed, **extra)
         else:
-            source = args.policy or data.metadata.get("policy") or "baseline"
-            model = learn_ec_mer(data, load_policy(source), seed=seed, **extra)
+            model = learn_ec_mer(data, _policy_that_flew(args.policy, data.metadata, args.flight_data), seed=seed, **extra)
     model.save(out)  # written whole or not at all (a failed write: one message, the old file as it was)
     truth, why = _true_mdp(data.metadata)
     print(f"{args.method} model written to {out} ({time.perf_counter() - start:.2f} s)")
@@ -362,6 +360,22 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     for line in model_notes(model, data, truth, rows):
         print(f"neurohover learn-model: {line}", file=sys.stderr)
     return 0
+
+
+def _policy_that_flew(given: str | None, metadata: dict, flight_data: str):
+    """EC-MER's policy: --policy, else the policy the flight data record (fly writes it in, ``policy_flown``), else the
+    file their metadata names (older files; a relative name was read from this directory: said so when it fails)."""
+    from ..policies import load_policy, policy_from_dict
+
+    if given is not None:
+        return load_policy(given)
+    if "policy_flown" in metadata:
+        return policy_from_dict(metadata["policy_flown"], f"flight data {flight_data!r}, metadata policy_flown")
+    source = metadata.get("policy") or "baseline"
+    try:
+        return load_policy(source)
+    except NeurohoverError as err:
+        raise NeurohoverError(f"{err} (the policy that flight data {flight_data!r} name in their metadata; give --policy FILE)") from None
 
 
 def _wind_text(x, y) -> str:
@@ -571,5 +585,8 @@ def register(sub) -> None:
         help="lr: fit as the authors' code did (--d-u discard --noise-estimate rms; docs/model.md, LR as the authors fitted it)",
     )
     p.add_argument("--seed", type=int, help="ec-meno, ec-mer: seed of the evolution (default 0)")
-    p.add_argument("--policy", help="ec-mer: the policy that flew the data (default: the flight data's metadata, else baseline)")
+    p.add_argument(
+        "--policy",
+        help="ec-mer: the policy that flew the data (default: the one fly --record stored in the flight data, else the file named there, else baseline)",
+    )
     p.set_defaults(func=cmd_learn_model, lr_options=lr_options)
