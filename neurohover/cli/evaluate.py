@@ -85,6 +85,23 @@ def _agent(args: argparse.Namespace):
     return sb3_policy(args.sb3, algo=algo)
 
 
+def _files_read(args: argparse.Namespace) -> dict[str, str | Path | None]:
+    """Every file the agent was read from (option -> path), once it is loaded: --json onto an RL Zoo run's model or
+    statistics, a CleanRL run's files or the --callable's module overwrote them (ninth trial)."""
+    files: dict[str, str | Path | None] = {"--policy": args.policy, "--sb3": args.sb3}
+    if args.callable is not None:
+        files["--callable"] = getattr(sys.modules.get(args.callable.partition(":")[0]), "__file__", None)
+    if args.rl_zoo is not None:
+        from ..integrations.sb3 import rl_zoo_files
+
+        files["--rl-zoo (its model)"], files["--rl-zoo (its statistics)"] = rl_zoo_files(args.rl_zoo, args.algo or "ppo")
+    if args.cleanrl is not None:
+        from ..integrations.cleanrl import cleanrl_files
+
+        files["--cleanrl (its model)"], files["--cleanrl (its obs_rms.pkl)"] = cleanrl_files(args.cleanrl)
+    return files
+
+
 def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     """Fly a trained policy on full paper episodes of a task's training or test MDPs, beside the competition's baseline
     and the shipped generic policy on the same gusts, and print the paper's measures (return per episode, crashes)."""
@@ -108,6 +125,8 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     if args.rl_id and args.policy is not None:
         raise NeurohoverError("--rl-id applies to an agent trained on a neurohover/<NAME>-RL-v0 id, not to a neurohover --policy file")
     act = _agent(args)
+    if out is not None:
+        output_file(args.json, "--json", _files_read(args))
     if isinstance(act, Policy):
         note_policy_task(act, family.name, f"--policy {args.policy}")
     if args.rl_id or (args.rl_zoo is not None and "-RL-v0" in str(args.rl_zoo)):

@@ -18,24 +18,23 @@ from __future__ import annotations
 import pickle
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from ..errors import NeurohoverError
+from ..sim.constants import ACTION_DIM, OBS_DIM
+from .flying import checked_obs_statistics
 
-__all__ = ["cleanrl_policy"]
+__all__ = ["cleanrl_files", "cleanrl_policy"]
 
 OBS_CLIP = 10.0  # the script's TransformObservation clip after NormalizeObservation
 EPSILON = 1e-8  # NormalizeObservation's
+LAYERS = ("0.weight", "0.bias", "2.weight", "2.bias", "4.weight", "4.bias")  # the actor's Linear layers, between Tanh
 
 
-def cleanrl_policy(run: str | Path) -> Callable[[np.ndarray], np.ndarray]:
-    """The actor of a CleanRL PPO run folder (``*.cleanrl_model`` and ``obs_rms.pkl``) as a batch function."""
-    try:
-        import torch
-        from torch import nn
-    except ModuleNotFoundError:
-        raise NeurohoverError("a CleanRL run needs torch: pip install torch==2.13.0 (a CPU build)") from None
+def cleanrl_files(run: str | Path) -> tuple[Path, Path]:
+    """The files :func:`cleanrl_policy` reads in the CleanRL run folder ``run``: its ``*.cleanrl_model`` and ``obs_rms.pkl``."""
     folder = Path(run)
     models = sorted(folder.glob("*.cleanrl_model")) if folder.is_dir() else []
     if len(models) != 1:
@@ -46,22 +45,59 @@ def cleanrl_policy(run: str | Path) -> Callable[[np.ndarray], np.ndarray]:
             f"{str(folder)!r} has no obs_rms.pkl: CleanRL does not save its observation statistics; save them as "
             "neurohover.integrations.cleanrl's docstring shows (two lines at the end of the script), then train again"
         )
-    try:
-        state = torch.load(models[0], map_location="cpu")
-        with stats.open("rb") as f:
-            mean, var = pickle.load(f)
-    except (RuntimeError, EOFError, ValueError, pickle.UnpicklingError, OSError) as err:
-        first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
-        raise NeurohoverError(f"{str(folder)!r}: its model or obs_rms.pkl cannot be read: {first}") from None
+    return models[0], stats
+
+
+def _actor_weights(state: Any, model: Path, torch) -> dict[str, Any]:
+    """The actor's layers of the state dict ``state``, checked: a missing layer, values that are no tensors, NaN weights
+    and an actor of other inputs or outputs were tracebacks or flown as a crashing agent (ninth trial)."""
     if not isinstance(state, dict):
-        raise NeurohoverError(f"{str(models[0])!r} is not a state dict of ppo_continuous_action.py's Agent")
-    weights = {k[len("actor_mean.") :]: v for k, v in state.items() if k.startswith("actor_mean.")}
+        raise NeurohoverError(f"{str(model)!r} is not a state dict of ppo_continuous_action.py's Agent")
+    weights = {k[len("actor_mean.") :]: v for k, v in state.items() if isinstance(k, str) and k.startswith("actor_mean.")}
     if not weights:
-        raise NeurohoverError(f"{str(models[0])!r} holds no actor_mean weights: not a ppo_continuous_action.py model")
-    n_obs, hidden, n_act = weights["0.weight"].shape[1], weights["0.weight"].shape[0], weights["4.weight"].shape[0]
-    actor = nn.Sequential(nn.Linear(n_obs, hidden), nn.Tanh(), nn.Linear(hidden, hidden), nn.Tanh(), nn.Linear(hidden, n_act))
-    actor.load_state_dict(weights)
-    scale = 1.0 / np.sqrt(np.asarray(var, dtype=np.float64) + EPSILON)
+        raise NeurohoverError(f"{str(model)!r} holds no actor_mean weights: not a ppo_continuous_action.py model")
+    if sorted(weights) != sorted(LAYERS):
+        raise NeurohoverError(
+            f"{str(model)!r} holds actor_mean layers {', '.join(sorted(weights))}: expected {', '.join(LAYERS)} (ppo_continuous_action.py's actor)"
+        )
+    for key in LAYERS:
+        value = weights[key]
+        if not isinstance(value, torch.Tensor) or not value.is_floating_point() or value.dim() != (2 if key.endswith("weight") else 1):
+            raise NeurohoverError(f"{str(model)!r}: actor_mean.{key} is {type(value).__name__} {str(value)[:40]!r}, not a tensor of real weights")
+        if not torch.isfinite(value).all():
+            raise NeurohoverError(f"{str(model)!r}: actor_mean.{key} holds non-finite weights (NaN or inf): the model is damaged")
+    n_obs, n_act = weights["0.weight"].shape[1], weights["4.weight"].shape[0]
+    if (n_obs, n_act) != (OBS_DIM, ACTION_DIM):
+        raise NeurohoverError(f"{str(model)!r}: the model's actor takes {n_obs} inputs and gives {n_act} actions, not {OBS_DIM} and {ACTION_DIM}")
+    return weights
+
+
+def cleanrl_policy(run: str | Path) -> Callable[[np.ndarray], np.ndarray]:
+    """The actor of a CleanRL PPO run folder (``*.cleanrl_model`` and ``obs_rms.pkl``) as a batch function."""
+    try:
+        import torch
+        from torch import nn
+    except ModuleNotFoundError:
+        raise NeurohoverError("a CleanRL run needs torch: pip install torch==2.13.0 (a CPU build)") from None
+    model, stats = cleanrl_files(run)
+    try:
+        state = torch.load(model, map_location="cpu")
+        with stats.open("rb") as f:
+            loaded = pickle.load(f)
+    except Exception as err:  # damaged bytes unpickle into any of a dozen exception types
+        first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        raise NeurohoverError(f"{str(run)!r}: its model or obs_rms.pkl cannot be read: {first}") from None
+    weights = _actor_weights(state, model, torch)
+    if not isinstance(loaded, (tuple, list)) or len(loaded) != 2:  # 5 or a dict of two keys was a traceback (ninth trial)
+        raise NeurohoverError(f"{str(stats)!r} holds {str(loaded)[:60]}, not (mean, var) arrays of {OBS_DIM}")
+    mean, var = checked_obs_statistics(loaded[0], loaded[1], OBS_DIM, repr(str(stats)))
+    h1, h2 = weights["0.weight"].shape[0], weights["4.weight"].shape[1]
+    actor = nn.Sequential(nn.Linear(OBS_DIM, h1), nn.Tanh(), nn.Linear(h1, h2), nn.Tanh(), nn.Linear(h2, ACTION_DIM))
+    try:
+        actor.load_state_dict(weights)
+    except RuntimeError as err:  # the layers' sizes do not chain
+        raise NeurohoverError(f"{str(model)!r}: its actor's layers do not fit together: {str(err).strip().splitlines()[-1].strip()}") from None
+    scale = 1.0 / np.sqrt(var + EPSILON)
 
     def act(obs: np.ndarray) -> np.ndarray:
         x = np.clip((np.asarray(obs, dtype=np.float64) - mean) * scale, -OBS_CLIP, OBS_CLIP)

@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from ..envs.arguments import real_values
 from ..envs.vector import HoverVectorEnv
 from ..errors import NeurohoverError
 from ..evaluate import Evaluation
@@ -32,7 +33,7 @@ from ..policies import Policy
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS
 from ..tasks import MDP
 
-__all__ = ["AgentRow", "compare_agent", "evaluate_callable"]
+__all__ = ["AgentRow", "checked_obs_statistics", "compare_agent", "evaluate_callable"]
 
 MAX_EPISODES = 1 << 16  # helicopters in one lockstep batch: the vector environment's arrays stay small
 
@@ -93,10 +94,9 @@ def evaluate_callable(
     while alive.any():
         live = np.flatnonzero(alive)
         raw = act(obs[live], live) if indexed else act(obs[live])
-        try:
-            out = np.asarray(raw, dtype=np.float64)
-        except (TypeError, ValueError):
-            raise NeurohoverError(f"act returned {type(raw).__name__} {str(raw)[:60]!r}: expected numbers, an array ({live.size}, {ACTION_DIM})") from None
+        # complex, text, None and bool were read as numbers, as the environments do not (ninth trial)
+        what = f"act returned {type(raw).__name__} {str(raw)[:60]!r}"
+        out = real_values(raw, f"{what}: expected numbers (real ones: not text, booleans, complex or None), an array ({live.size}, {ACTION_DIM})")
         if out.shape != (live.size, ACTION_DIM):
             raise NeurohoverError(f"act returned actions of shape {out.shape} for {live.size} observations: expected ({live.size}, {ACTION_DIM})")
         actions[live] = out
@@ -112,6 +112,30 @@ def evaluate_callable(
     return Evaluation(
         returns.reshape(shape), crashed.reshape(shape), steps.reshape(shape), np.full(shape, -1, dtype=np.int64), None, time.perf_counter() - start
     )
+
+
+def checked_obs_statistics(mean: Any, var: Any, n_obs: int, what: str) -> tuple[np.ndarray, np.ndarray]:
+    """The observation statistics ``(mean, var)`` an agent's observations are normalised with, as float64 arrays of
+    ``n_obs``, or one NeurohoverError naming ``what`` (the file): NaN, inf and negative variances were flown and
+    reported as the agent crashing, other shapes were tracebacks (ninth trial)."""
+    checked = []
+    for name, value in (("mean", mean), ("var", var)):
+        try:
+            a = np.asarray(value)
+        except (TypeError, ValueError):  # a ragged nesting
+            a = np.asarray(None)
+        if a.dtype.kind not in "iuf" or a.shape != (n_obs,):
+            shown = f"shape {a.shape} of {a.dtype}" if a.dtype.kind != "O" else f"{str(value)[:40]!r}"
+            raise NeurohoverError(f"{what} holds a {name} of {shown}, not an array of {n_obs} real numbers")
+        a = a.astype(np.float64)
+        bad = np.flatnonzero(~np.isfinite(a) | ((a < 0) if name == "var" else False))
+        if bad.size:
+            raise NeurohoverError(
+                f"{what} holds a {name} of {a[bad[0]]} at observation {bad[0]}: "
+                f"expected finite numbers{', variances >= 0' if name == 'var' else ''} ({bad.size} of {n_obs} are not)"
+            )
+        checked.append(a)
+    return checked[0], checked[1]
 
 
 @dataclass(frozen=True)

@@ -23,48 +23,84 @@ import pickle
 import zipfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import gymnasium as gym
 import numpy as np
 
-from ..envs.arguments import real_values
-from ..errors import NeurohoverError
+from ..envs.arguments import check_noise_stream, check_reset_options, real_values
+from ..envs.vector import HoverVectorEnv
+from ..errors import NeurohoverError, finite_real
+from ..sim.constants import ACTION_DIM
+from ..sim.rng import MAX_SEED
 from . import SB3_ALGORITHMS
+from .flying import checked_obs_statistics
 
 try:
     from stable_baselines3.common.vec_env.base_vec_env import VecEnv
 except ModuleNotFoundError as missing:  # the optional extra
     raise NeurohoverError(f"neurohover.integrations.sb3 needs {missing.name}: pip install 'neurohover[examples]'") from None
 
-__all__ = ["RecurrentPolicy", "SB3VecEnv", "rl_zoo_policy", "sb3_policy"]
+__all__ = ["RecurrentPolicy", "SB3VecEnv", "rl_zoo_files", "rl_zoo_policy", "sb3_policy"]
 
 
 class SB3VecEnv(VecEnv):
     """An SB3 ``VecEnv`` of ``num_envs`` helicopters of a registered id (``gym.make_vec`` keyword
-    arguments, e.g. ``mdp="train:3"``, pass through to :class:`~neurohover.envs.HoverVectorEnv`)."""
+    arguments, e.g. ``mdp="train:3"``, pass through to :class:`~neurohover.envs.HoverVectorEnv`).
+
+    :meth:`seed` and ``set_options`` apply to the next :meth:`reset` only, as in SB3's own vector environments;
+    options are each helicopter's, as ``HoverEnv.reset`` takes them: ``{"mdp": spec}`` (kept for later episodes)
+    and ``{"noise": (seed, episode)}`` (that very gust stream, given to every helicopter a dict is given to)."""
 
     def __init__(self, env_id: str, num_envs: int, **kwargs: Any) -> None:
         if env_id not in gym.registry or not str(gym.registry[env_id].entry_point).startswith("neurohover."):
             raise NeurohoverError(f"env_id={env_id!r} is not a neurohover environment: use one of the neurohover/* ids")
         self.venv = gym.make_vec(env_id, num_envs=num_envs, vectorization_mode="vector_entry_point", **kwargs)
-        self.native = self.venv.unwrapped
+        self.native = cast(HoverVectorEnv, self.venv.unwrapped)
         super().__init__(num_envs, self.native.single_observation_space, self.native.single_action_space)
         self._actions: np.ndarray | None = None
         self._seed: int | None = None
+        self._reset_with: dict[str, Any] = {}  # the native reset options of set_options, checked
 
     def reset(self) -> np.ndarray:
-        obs, info = self.venv.reset(seed=self._seed)
-        self._seed = None
+        obs, info = self.venv.reset(seed=self._seed, options=self._reset_with or None)
+        self._seed, self._reset_with = None, {}
+        self._reset_options()  # SB3's: options apply to one reset
         self.reset_infos = [{"mdp": info["mdp"][i]} for i in range(self.num_envs)]
         return obs
 
+    def set_options(self, options: list[dict] | dict | None = None) -> None:
+        """The options of the next :meth:`reset` (a dict for every helicopter, or a list of one per helicopter),
+        checked now: they were ignored, bad ones too (SB3's VecEnv keeps them for a reset this one replaces; ninth trial)."""
+        if options is None:
+            options = {}
+        if isinstance(options, dict):
+            options = [options] * self.num_envs
+        if not isinstance(options, (list, tuple)) or len(options) != self.num_envs:
+            raise NeurohoverError(f"options={options!r:.80} is not allowed: give None, a dict, or a list of {self.num_envs} dicts (one per helicopter)")
+        per_env = [check_reset_options(o) for o in options]  # unknown keys and non-dicts refused, naming them
+        native: dict[str, Any] = {}
+        if any("mdp" in o for o in per_env):  # a helicopter given none keeps its own
+            native["mdp"] = self.native._resolve_specs([o.get("mdp", spec) for o, spec in zip(per_env, self.native._specs, strict=True)])
+        given = [i for i, o in enumerate(per_env) if "noise" in o]
+        if given and len(given) != self.num_envs:
+            raise NeurohoverError(f"options give noise to helicopter(s) {given} only: give it to all {self.num_envs} or to none")
+        if given:
+            native["noise"] = [check_noise_stream(o["noise"], f"options[{i}] noise") for i, o in enumerate(per_env)]
+        self._options = [dict(o) for o in per_env]
+        self._reset_with = native
+
     def step_async(self, actions: np.ndarray) -> None:
-        self._actions = real_values(actions, f"actions must be a ({self.num_envs}, 4) array of real numbers, got {actions!r:.80}").reshape(self.num_envs, -1)
+        a = real_values(actions, f"actions must be a ({self.num_envs}, {ACTION_DIM}) array of real numbers, got {actions!r:.80}")
+        if a.shape != (self.num_envs, ACTION_DIM):  # a (4, 2) or (8,) array was reshaped and flown (ninth trial)
+            raise NeurohoverError(f"actions have shape {a.shape}, expected ({self.num_envs}, {ACTION_DIM}): one row per helicopter")
+        self._actions = a
 
     def step_wait(self):
-        assert self._actions is not None  # step_async first, as SB3's VecEnv.step does
-        obs, rewards, terminated, truncated, info = self.venv.step(self._actions)
+        if self._actions is None:  # a bare AssertionError before (ninth trial)
+            raise NeurohoverError("step_wait() without a pending step_async(actions): call step_async first, or step(actions)")
+        actions, self._actions = self._actions, None
+        obs, rewards, terminated, truncated, info = self.venv.step(actions)
         done = terminated | truncated
         infos: list[dict[str, Any]] = [{"crashed": bool(terminated[i])} for i in range(self.num_envs)]
         if done.any():
@@ -80,8 +116,12 @@ class SB3VecEnv(VecEnv):
 
     def seed(self, seed: int | None = None) -> Sequence[None | int]:
         """The seed of the next :meth:`reset` (sub-environment i: ``seed + i``, as Gymnasium's vector envs)."""
-        self._seed = seed
-        return [None if seed is None else seed + i for i in range(self.num_envs)]
+        n = self.num_envs
+        if seed is not None and (isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or not 0 <= seed <= MAX_SEED + 1 - n):
+            # 'a' was kept and failed every later reset; -1 was refused only there (ninth trial)
+            raise NeurohoverError(f"seed={seed!r:.40} is not allowed: give None or an integer in 0..2**63-{n} (helicopter i gets seed + i)")
+        self._seed = None if seed is None else int(seed)
+        return [None if seed is None else int(seed) + i for i in range(n)]
 
     def get_attr(self, attr_name: str, indices=None) -> list[Any]:
         return [getattr(self.native, attr_name)] * len(self._indices(indices))
@@ -169,6 +209,52 @@ def sb3_policy(model_zip: str | Path, *, algo: str = "ppo", deterministic: bool 
     return _policy_of(_load(_algorithm(algo), path), deterministic)
 
 
+def rl_zoo_files(run: str | Path, algo: str = "ppo") -> tuple[Path, Path | None]:
+    """The files :func:`rl_zoo_policy` reads in the RL Zoo run folder ``run``: its model (``ENV.zip``, or
+    ``best_model.zip`` when there is no final one) and its observation statistics (``ENV/vecnormalize.pkl``; None
+    when there are none)."""
+    _algorithm(algo)
+    run = Path(run)
+    if not run.is_dir():  # "found []" for a folder that is not there (seventh trial)
+        raise NeurohoverError(f"RL Zoo run folder {str(run)!r}: {'no such directory' if not run.exists() else 'not a directory'}")
+    zips = sorted(z for z in run.glob("*.zip") if not z.name.startswith("rl_model_"))
+    finals = [z for z in zips if z.name != "best_model.zip"]
+    model_zip = finals[0] if len(finals) == 1 else run / "best_model.zip"
+    if len(finals) > 1 or not model_zip.is_file():
+        raise NeurohoverError(f"{str(run)!r} is not an RL Zoo run folder: expected one ENV.zip (or best_model.zip) in it, found {[z.name for z in zips]}")
+    stats_file = run / model_zip.stem / "vecnormalize.pkl"
+    if model_zip.name == "best_model.zip":
+        stats_file = next(run.glob("*/vecnormalize.pkl"), stats_file)
+    if stats_file.exists() and not stats_file.is_file():  # a directory was skipped: the policy flew unnormalised (ninth trial)
+        raise NeurohoverError(f"{str(stats_file)!r} is not a file: expected the run's VecNormalize statistics (or nothing, for a run without them)")
+    return model_zip, stats_file if stats_file.exists() else None
+
+
+def _vecnormalize(path: Path, n_obs: int):
+    """The frozen VecNormalize statistics pickled in ``path``, checked: a damaged file, another object, or statistics of
+    another shape, non-finite or negative variances, were tracebacks or flown as a crashing agent (ninth trial)."""
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    try:
+        with path.open("rb") as f:
+            stats = pickle.load(f)  # a VecNormalize without its environment: normalize_obs needs only its statistics
+    except Exception as err:  # damaged bytes unpickle into any of a dozen exception types
+        raise NeurohoverError(f"{str(path)!r} cannot be read as VecNormalize statistics ({type(err).__name__}: {str(err)[:80]})") from None
+    if not isinstance(stats, VecNormalize):
+        raise NeurohoverError(f"{str(path)!r} cannot be read as VecNormalize statistics (it holds {type(stats).__name__} {str(stats)[:60]!r})")
+    if getattr(stats, "norm_obs", None) is not False:
+        rms = getattr(stats, "obs_rms", None)
+        checked_obs_statistics(getattr(rms, "mean", None), getattr(rms, "var", None), n_obs, f"{str(path)!r} (its obs_rms)")
+        for name, allowed, ok in (("clip_obs", "> 0", lambda v: v > 0), ("epsilon", ">= 0", lambda v: v >= 0)):
+            value = getattr(stats, name, None)
+            if not finite_real(value) or not ok(value):
+                raise NeurohoverError(
+                    f"{str(path)!r} cannot be read as VecNormalize statistics (its {name} is {value!r:.40}: expected a finite number {allowed})"
+                )
+    stats.training = False
+    return stats
+
+
 def rl_zoo_policy(run: str | Path, *, algo: str = "ppo", deterministic: bool = True) -> Callable[[np.ndarray], np.ndarray]:
     """The trained policy of an RL Zoo run folder (``logs/ppo/neurohover-GHH08-Short-v0_1``), as a batch function.
 
@@ -178,22 +264,7 @@ def rl_zoo_policy(run: str | Path, *, algo: str = "ppo", deterministic: bool = T
     :func:`neurohover.integrations.flying.evaluate_callable`.
     """
     algorithm = _algorithm(algo)
-    run = Path(run)
-    if not run.is_dir():  # "found []" for a folder that is not there (seventh trial)
-        raise NeurohoverError(f"RL Zoo run folder {str(run)!r}: {'no such directory' if not run.exists() else 'not a directory'}")
-    zips = sorted(z for z in run.glob("*.zip") if not z.name.startswith("rl_model_"))
-    finals = [z for z in zips if z.name != "best_model.zip"]
-    model_zip = finals[0] if len(finals) == 1 else run / "best_model.zip"
-    if len(finals) > 1 or not model_zip.is_file():
-        raise NeurohoverError(f"{str(run)!r} is not an RL Zoo run folder: expected one ENV.zip (or best_model.zip) in it, found {[z.name for z in zips]}")
+    model_zip, stats_file = rl_zoo_files(run, algo)
     model = _load(algorithm, model_zip)
-    stats_file = run / model_zip.stem / "vecnormalize.pkl"
-    if model_zip.name == "best_model.zip":
-        stats_file = next(run.glob("*/vecnormalize.pkl"), stats_file)
-    stats = None
-    if stats_file.is_file():
-        with stats_file.open("rb") as f:
-            stats = pickle.load(f)  # a VecNormalize without its environment: normalize_obs needs only its statistics
-        stats.training = False
-
+    stats = None if stats_file is None else _vecnormalize(stats_file, int(np.prod(model.observation_space.shape)))
     return _policy_of(model, deterministic, None if stats is None else stats.normalize_obs)
