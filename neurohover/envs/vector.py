@@ -158,7 +158,7 @@ class HoverVectorEnv(VectorEnv):
         self.episode_steps = check_episode_steps(episode_steps)
         self.max_episode_steps = self.episode_steps if max_episode_steps is None else check_episode_steps(max_episode_steps, "max_episode_steps")
         self._limit = min(self.episode_steps, self.max_episode_steps)
-        self._specs: list[MDP | str] = self._resolve_specs(mdp)
+        self._specs: list[MDP | str] = self.resolve_mdps(mdp)
         self.render_mode = None
         self.single_observation_space = observation_space(self.obs_dtype)
         self.single_action_space = action_space(check_action_dtype(action_dtype))
@@ -247,7 +247,14 @@ class HoverVectorEnv(VectorEnv):
 
     # -- argument checks -------------------------------------------------------------------
 
-    def _resolve_specs(self, value: Any) -> list[MDP | str]:
+    @property
+    def mdp_specs(self) -> tuple[MDP | str, ...]:
+        """Each helicopter's MDP setting as its next reset reads it: an MDP, or ``"sample"`` (a fresh draw each episode)."""
+        return tuple(self._specs)
+
+    def resolve_mdps(self, value: Any) -> list[MDP | str]:
+        """The ``mdp`` option of :meth:`reset` (one MDP, a name, or one per helicopter) as one setting per helicopter,
+        checked: a name the family does not know, a wrong count or a drifting MDP raise NeurohoverError."""
         cache: dict[str, MDP] = {}
         if isinstance(value, (str, MDP)):
             specs = [resolve_mdp(self.family, value, cache)] * self.num_envs
@@ -381,7 +388,7 @@ class HoverVectorEnv(VectorEnv):
         # Validate everything before changing anything, so a bad call leaves the env as it was.
         seeds = self._check_seeds(seed)
         mask = self._check_mask(options["reset_mask"]) if "reset_mask" in options else self._all
-        specs = self._resolve_specs(options["mdp"]) if "mdp" in options else self._specs
+        specs = self.resolve_mdps(options["mdp"]) if "mdp" in options else self._specs
         streams = self._check_streams(options["noise"]) if "noise" in options else None
         if not self._ready and not mask.all():
             raise NeurohoverError("the first reset() must reset every sub-environment: leave out reset_mask")

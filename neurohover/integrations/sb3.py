@@ -81,7 +81,7 @@ class SB3VecEnv(VecEnv):
         per_env = [check_reset_options(o) for o in options]  # unknown keys and non-dicts refused, naming them
         native: dict[str, Any] = {}
         if any("mdp" in o for o in per_env):  # a helicopter given none keeps its own
-            native["mdp"] = self.native._resolve_specs([o.get("mdp", spec) for o, spec in zip(per_env, self.native._specs, strict=True)])
+            native["mdp"] = self.native.resolve_mdps([o.get("mdp", spec) for o, spec in zip(per_env, self.native.mdp_specs, strict=True)])
         given = [i for i, o in enumerate(per_env) if "noise" in o]
         if given and len(given) != self.num_envs:
             raise NeurohoverError(f"options give noise to helicopter(s) {given} only: give it to all {self.num_envs} or to none")
