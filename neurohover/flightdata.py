@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import NeurohoverError, finite_real
+from .paths import strict_json
 from .sim.constants import MAX_EPISODE_STEPS
 
 FORMAT = "neurohover-flight-data/1"
@@ -80,11 +81,17 @@ class FlightData:
         if not isinstance(other, FlightData):
             return NotImplemented  # Python's TypeError ("unsupported operand"), as for any sum it cannot make
         meta = {**self.metadata, **other.metadata}
-        a, b = self.metadata.get("crashed"), other.metadata.get("crashed")  # per-episode flags: both halves, or none
-        if isinstance(a, list) and isinstance(b, list) and len(a) == self.n_episodes and len(b) == other.n_episodes:
-            meta["crashed"] = a + b
-        else:
-            meta.pop("crashed", None)
+        for name in _PER_EPISODE:  # one entry per episode: both halves, or none (load() refuses a list of the wrong length)
+            a, b = self.metadata.get(name), other.metadata.get(name)
+            if isinstance(a, list) and isinstance(b, list) and len(a) == self.n_episodes and len(b) == other.n_episodes:
+                meta[name] = a + b
+            else:
+                meta.pop(name, None)
+        a, b = self.metadata.get("episode_steps"), other.metadata.get("episode_steps")
+        if type(a) is int and type(b) is int:  # every episode within the budget load() checks (ninth trial)
+            meta["episode_steps"] = max(a, b)
+        if self.metadata.get("task") != other.metadata.get("task"):  # two tasks' episodes: neither names them all
+            meta.pop("task", None)
         return FlightData(self.observations + other.observations, self.actions + other.actions, meta)
 
     def save(self, path: str | Path, dtype: str = "float64") -> Path:
@@ -130,7 +137,7 @@ class FlightData:
                 if "format" not in z.files or str(z["format"]) != FORMAT:
                     raise NeurohoverError(f"{str(path)!r} is not a neurohover flight-data file (expected format {FORMAT})")
                 lengths, obs, act = z["lengths"], z["observations"], z["actions"]
-                metadata = json.loads(str(z["metadata"]))
+                metadata = strict_json(str(z["metadata"]))  # nesting 100,000 deep was a RecursionError (ninth trial)
         except (OSError, ValueError, zipfile.BadZipFile, EOFError, KeyError, zlib.error) as err:  # zlib: damaged bytes (sixth trial)
             if isinstance(err, NeurohoverError):
                 raise
@@ -145,7 +152,11 @@ class FlightData:
         if lengths.size and int(lengths.max()) > MAX_EPISODE_STEPS:  # 2**62 twice summed to a negative count (seventh trial)
             longest = int(lengths.max())
             raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file: an episode of {longest:,} steps (at most {MAX_EPISODE_STEPS:,})")
-        _check_metadata(path, metadata, lengths.size)
+        if (lengths == 0).any():  # a flown episode has at least one step, even one that crashes at once (ninth trial)
+            raise NeurohoverError(
+                f"{str(path)!r} is not a readable flight-data file: episode {int(np.argmin(lengths))} has 0 steps (a flown one has at least 1)"
+            )
+        _check_metadata(path, metadata, lengths)
         if lengths.size == 0 or lengths.sum() == 0:
             raise NeurohoverError(f"flight-data file {str(path)!r} holds no transitions")
         if obs.shape != (int(lengths.sum() + lengths.size), 12) or act.shape != (int(lengths.sum()), 4):
@@ -167,13 +178,20 @@ _PER_EPISODE = {
 }
 
 
-def _check_metadata(path: Path, metadata: dict, n_episodes: int) -> None:
+def _check_metadata(path: Path, metadata: dict, lengths: np.ndarray) -> None:
     """Refuse the metadata fields plots and crash marks read when they are of the wrong kind, by name (an episode_steps
-    "a" was a ValueError in plot; seventh trial)."""
+    "a" was a ValueError in plot; seventh trial), and metadata the episodes contradict (ninth trial)."""
+    n_episodes = lengths.size
     steps = metadata.get("episode_steps")
     if steps is not None and (type(steps) is not int or not 1 <= steps <= MAX_EPISODE_STEPS):
         allowed = f"an integer in 1..{MAX_EPISODE_STEPS:,}"
         raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata episode_steps={steps!r:.40} is not allowed: {allowed}")
+    if steps is not None and n_episodes and int(lengths.max()) > steps:  # an episode of 12,000 steps spanned a reset (ninth trial)
+        longest = int(np.argmax(lengths))
+        raise NeurohoverError(
+            f"flight-data file {str(path)!r}: episode {longest} has {int(lengths[longest]):,} steps, more than its metadata's "
+            f"episode_steps={steps:,} (every episode ends at that budget): its lengths and metadata contradict"
+        )
     for name in ("task", "policy"):  # shown in titles and notes (a task 5 or a policy 123 was taken; eighth trial)
         if metadata.get(name) is not None and not isinstance(metadata[name], str):
             raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata {name}={metadata[name]!r:.40} is not allowed: give text")
@@ -181,3 +199,10 @@ def _check_metadata(path: Path, metadata: dict, n_episodes: int) -> None:
         value = metadata.get(name)
         if value is not None and (not isinstance(value, list) or len(value) != n_episodes or not all(fits(v) for v in value)):
             raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata {name}={value!r:.40} is not allowed: {each} per episode ({n_episodes})")
+    task, mdps = metadata.get("task"), metadata.get("mdps") or []
+    families = [(i, m.get("family")) for i, m in enumerate(mdps) if isinstance(m.get("family"), str)]
+    for i, family in families:  # a task 'ghh09' over ghh08's MDPs was plotted under the wrong name (ninth trial)
+        if task is not None and family != task:
+            raise NeurohoverError(
+                f"flight-data file {str(path)!r}: its metadata task {task!r:.40} is not its MDPs' family: episode {i} flew a {family!r:.40} MDP"
+            )

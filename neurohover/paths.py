@@ -15,13 +15,25 @@ import json
 import os
 import sys
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
 
 from .errors import NeurohoverError, OutputError
 
-__all__ = ["checked_path", "parse_json", "input_file", "input_dir", "output_dir", "output_file", "remove_created_dirs", "write_png", "writing"]
+__all__ = [
+    "JSONError",
+    "checked_path",
+    "parse_json",
+    "strict_json",
+    "input_file",
+    "input_dir",
+    "output_dir",
+    "output_file",
+    "remove_created_dirs",
+    "write_png",
+    "writing",
+]
 
 _created: list[Path] = []  # directories this process's checks created, deepest first
 
@@ -78,25 +90,47 @@ def checked_path(path, option: str, what: str = "file path") -> Path:
 
 
 def _unique_keys(pairs: list) -> dict:
-    keys = [k for k, _ in pairs]
-    twice = sorted({k for k in keys if keys.count(k) > 1})
-    if twice:
+    value = dict(pairs)
+    if len(value) < len(pairs):  # counted once per object, not once per key: a store's large rows stay quick (ninth trial)
+        keys = [k for k, _ in pairs]
+        twice = sorted({k for k in keys if keys.count(k) > 1})
         raise ValueError(f"key {twice[0]!r} is given more than once")
-    return dict(pairs)
+    return value
 
 
-def parse_json(text: str, name: str):
-    """The JSON ``text`` of the file ``name``, strictly: a key given twice (Python keeps the last without a word), nesting
-    deeper than Python can follow and numbers past a float's range are refused by name (third trial)."""
+class JSONError(ValueError):
+    """JSON text :func:`strict_json` refuses; the message says why in words (``deep``: it is nested too deeply)."""
+
+    def __init__(self, why: str, deep: bool = False) -> None:
+        super().__init__(why)
+        self.deep = deep
+
+
+def strict_json(text: str | bytes):
+    """The value of the JSON ``text``, strictly, or one :class:`JSONError` saying why not: text that is no JSON, a key
+    given twice (Python keeps the last without a word), nesting deeper than Python can follow and integers past a
+    float's range (4,301 digits and more were int()'s own ValueError). The one decision every reader of a JSON file or
+    stored row shares, each wrapping the reason in its own message (ninth trial)."""
     try:
         return json.loads(text, object_pairs_hook=_unique_keys, parse_int=_json_int)
     except RecursionError:
-        raise NeurohoverError(f"{name} is not allowed: its JSON is nested too deeply") from None
-    except ValueError as err:  # json.JSONDecodeError too
-        raise NeurohoverError(f"{name} is not valid JSON: {err}") from None
+        raise JSONError("its JSON is nested too deeply", deep=True) from None
+    except (ValueError, TypeError) as err:  # json.JSONDecodeError, UnicodeDecodeError (bytes), TypeError (no text at all)
+        raise JSONError(str(err)) from None
+
+
+def parse_json(text: str, name: str):
+    """The JSON ``text`` of the file ``name``, strictly (:func:`strict_json`): a key given twice, nesting deeper than
+    Python can follow and numbers past a float's range are refused by name (third trial)."""
+    try:
+        return strict_json(text)
+    except JSONError as err:
+        raise NeurohoverError(f"{name} is not allowed: {err}" if err.deep else f"{name} is not valid JSON: {err}") from None
 
 
 def _json_int(text: str) -> int:
+    if len(text) > 400:  # past a float's range, and past int()'s 4,300 digits a ValueError of its own (ninth trial)
+        raise ValueError(f"the number {text[:20]}... ({len(text)} digits) is out of range")
     value = int(text)
     try:
         float(value)  # past a float's range no genome or parameter can hold it (an OverflowError later)
@@ -108,7 +142,7 @@ def _json_int(text: str) -> int:
 SQLITE_HEADER = b"SQLite format 3\x00"  # the first bytes of every SQLite database: a results store
 
 
-def output_file(path: str | os.PathLike, option: str, inputs: dict[str, str | os.PathLike | None] | None = None, *, store: bool = False) -> Path:
+def output_file(path: str | os.PathLike, option: str, inputs: Mapping[str, str | os.PathLike | None] | None = None, *, store: bool = False) -> Path:
     """Check that the file ``path`` can be written (an existing file is kept as it is).
 
     Refuses a directory, a parent that is a file, any place where a file cannot be created, the

@@ -40,7 +40,7 @@ import numpy as np
 
 from .errors import NeurohoverError, finite_real
 from .evaluate import MAX_EPISODES_PER_CALL, evaluate
-from .paths import writing
+from .paths import JSONError, strict_json, writing
 from .policies import Policy, load_policy, save_policy
 from .sim.constants import MAX_EPISODE_STEPS
 from .tasks import get_task_family
@@ -99,13 +99,29 @@ def policy_dir(task: str, directory: str | Path | None = None) -> Path:
     return (checked_path(directory, "policy directory", "directory") if directory is not None else SHIPPED) / task
 
 
-def _load(path: Path, what: str) -> Policy:
+def _load(path: Path, what: str, task: str, target: str) -> Policy:
+    """The policy ``what`` of ``task``'s set, from ``path``, evolved on ``target`` (an MDP's label, or ``TASK/G`` over G)."""
     if not path.is_file():
         raise NeurohoverError(
             f"policy set {str(path.parent)!r} is missing {what} ({path.name}); "
             f"build it with: neurohover build-policies --task {path.parent.name} --out {path.parent.parent}"
         )
-    return load_policy(path)
+    policy = load_policy(path)
+    _check_place(policy, path, what, {"task": task, "name": path.stem, "target": target})
+    return policy
+
+
+def _check_place(policy: Policy, path: Path, what: str, place: dict[str, str]) -> None:
+    """Refuse a policy whose file records another place than the one it holds in its set (task, name, target: each where
+    recorded): specialised_4.json copied over specialised_3.json, or another task's generic, was flown (ninth trial)."""
+    for key, want in place.items():
+        have = policy.metadata.get(key)
+        fits = have is None or have == want or (want.endswith("/G") and isinstance(have, str) and have.startswith(want))  # /G(sigma=0.3)
+        if not fits:
+            raise NeurohoverError(
+                f"policy set {str(path.parent)!r}: {path.name} ({what}) records {key} {have!r:.60}, not {want!r} (a policy of another "
+                f"place copied in?): give the policy evolved for it, or rebuild the set with: neurohover build-policies --task {place['task']}"
+            )
 
 
 # What a manifest's descriptive fields may hold (they are shown and compared, never flown): name -> (kinds, what is allowed).
@@ -145,20 +161,23 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
             f"no policy set for {family.name} in {str(root)!r} (manifest.json missing); build it with: neurohover build-policies "
             f"--task {family.name} --out {str(root.parent)!r}"
         )
-    try:
-        manifest = json.loads(manifest_path.read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+    try:  # strictly: an integer of 5,000 digits, nesting 100,000 deep or "safe" given twice (the last kept; ninth trial)
+        manifest = strict_json(manifest_path.read_bytes())
+    except (OSError, JSONError) as err:
         raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r} cannot be read as JSON: {err}") from None
     if not isinstance(manifest, dict):
         raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r} must be a JSON object, got {type(manifest).__name__}")
     if manifest.get("task", family.name) != family.name:  # another task's set copied under this name: its policies fly the wrong task
         raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r} is of task {manifest['task']!r}, not {family.name!r}")
     _check_manifest_fields(manifest, manifest_path)
+    targets = {"zero": family.zero().label, "family": f"{family.name}/G"}  # what each role's run evolved on
     if family.generic_over_distribution:
-        generics = {name: _load(root / f"generic_{name}.json", f"the {name} generic policy") for name in FGHH_GENERICS}
+        roles = {role.kind: role.target for role in policy_set_roles(family)}
+        generics = {name: _load(root / f"generic_{name}.json", f"the {name} generic policy", family.name, targets[roles[name]]) for name in FGHH_GENERICS}
         return PolicySet(family.name, root, generics["race"], generics=generics, manifest=manifest)
-    generic = _load(root / "generic.json", "the generic policy")
-    specialised = tuple(_load(root / f"specialised_{i}.json", f"specialised policy {i}") for i in range(10))
+    generic = _load(root / "generic.json", "the generic policy", family.name, targets["zero"])
+    train = family.training_mdps()
+    specialised = tuple(_load(root / f"specialised_{i}.json", f"specialised policy {i}", family.name, train[i].label) for i in range(10))
     safe = manifest.get("safe", [])
     if (
         not isinstance(safe, list)
@@ -340,12 +359,12 @@ def _build_state(root: Path) -> dict:
     """The settings of the interrupted build in ``root``; a damaged state refused by name (an empty one, which a full disk
     left, was a JSONDecodeError; seventh trial), since its finished runs cannot be told to be of this build."""
     state = _stage_file(root, "build")
-    try:
-        value = json.loads(state.read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+    try:  # strictly: an integer of 5,000 digits or nesting 100,000 deep was a traceback (ninth trial)
+        value = strict_json(state.read_bytes())
+    except (OSError, JSONError) as err:
         value = err
     if not isinstance(value, dict):
-        why = str(value)[:60] if isinstance(value, Exception) else f"a JSON {type(value).__name__}, not an object"
+        why = str(value)[:100] if isinstance(value, Exception) else f"a JSON {type(value).__name__}, not an object"
         raise NeurohoverError(f"the interrupted build's state {str(state)!r} is damaged ({why}): delete {str(root)!r} to start the build over")
     return value
 

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import NeurohoverError
+from ..paths import JSONError, strict_json
 from ..policies import Policy
 from .common import enc_float
 
@@ -223,9 +224,9 @@ def read_checkpoint(path: Path) -> dict:
     """The JSON a checkpoint file holds (NeurohoverError if it is missing or not JSON)."""
     if not path.is_file():
         raise NeurohoverError(f"no checkpoint to resume from: {str(path)!r} does not exist")
-    try:
-        return json.loads(path.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as err:
-        raise NeurohoverError(f"checkpoint {str(path)!r} is not valid JSON: {err}") from None
-    except RecursionError:  # nested thousands deep (eighth trial)
-        raise NeurohoverError(f"checkpoint {str(path)!r} is not a checkpoint: its JSON is nested too deeply") from None
+    try:  # strictly: nested thousands deep (eighth trial), an integer of 5,000 digits (ninth trial), a key twice
+        return strict_json(path.read_bytes())
+    except JSONError as err:
+        raise NeurohoverError(
+            f"checkpoint {str(path)!r} is not a checkpoint: {err}" if err.deep else f"checkpoint {str(path)!r} is not valid JSON: {err}"
+        ) from None

@@ -39,6 +39,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from ..errors import NeurohoverError, finite_real
+from ..paths import JSONError, strict_json
 
 LOCK_ATTEMPTS = 100  # tries to lock STORE.lock while earlier writers remove it as they close
 
@@ -372,9 +373,9 @@ class Store:
     def _json(self, text: str, what: str) -> dict:
         """A stored JSON object, or one clear error naming the damaged row (the rest of the store stays readable): every
         config, params and result is one (a list was a TypeError in results, a BLOB a UnicodeDecodeError; sixth trial)."""
-        try:
-            value = json.loads(text)
-        except (json.JSONDecodeError, TypeError, UnicodeDecodeError) as err:
+        try:  # strictly: nested 100,000 deep or an integer of 5,000 digits was a traceback (ninth trial)
+            value = strict_json(text)
+        except JSONError as err:
             raise NeurohoverError(f"results store {str(self.path)!r}: {what} is damaged (not JSON: {str(err)[:80]})") from None
         if not isinstance(value, dict):
             raise NeurohoverError(f"results store {str(self.path)!r}: {what} is damaged (a JSON {type(value).__name__}, not an object)")

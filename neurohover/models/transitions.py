@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from ..flightdata import FlightData
-from ..sim.constants import GRAVITY, NOISE_DECAY, NOISE_GAIN, NOISE_NAMES, PARAM_NAMES
+from ..sim.constants import GRAVITY, NOISE_DECAY, NOISE_GAIN, NOISE_NAMES, OBS_NAMES, PARAM_NAMES
 from ..tasks import MDP
 from .model import AXIS_C, AXIS_GAINS, MODEL_DT, LearnedModel, check_vector
 from .wind import NO_WIND, WindModel, body_wind
@@ -49,6 +49,24 @@ def _rotation_matrices(qx, qy, qz, qw) -> np.ndarray:
     r[:, 2, 1] = 2.0 * (yz + wx)
     r[:, 2, 2] = 1.0 - 2.0 * (xx + yy)
     return r
+
+
+#: The largest reading of any observed variable flight data may hold: a helicopter crashes long before it moves 1e6 m
+#: from its spot or at 1e6 m/s (or rad/s), so a larger one is a damaged reading, not flight (1e300 was taken and called
+#: collinear regressors by LR; ninth trial).
+MAX_READING = 1e6
+
+
+def _check_readings(flight_data: FlightData, what: str) -> None:
+    """Refuse an observation past :data:`MAX_READING`, naming its episode, step and variable."""
+    for e, obs in enumerate(flight_data.observations):
+        bad = np.argwhere(np.abs(obs) > MAX_READING)
+        if bad.size:
+            k, i = (int(x) for x in bad[0])
+            raise NeurohoverError(
+                f"{what}: episode {e}, step {k} reads {OBS_NAMES[i]} = {obs[k, i]:.6g}, past any flight (at most {MAX_READING:g} in size): "
+                "a damaged reading; give flight data as flown"
+            )
 
 
 class Transitions:
@@ -90,6 +108,7 @@ class Transitions:
         act = np.concatenate([a for _, a in episodes]).astype(float, copy=False)
         if not (np.all(np.isfinite(obs)) and np.all(np.isfinite(nxt)) and np.all(np.isfinite(act))):
             raise NeurohoverError(f"{what} holds non-finite observations or actions")
+        _check_readings(flight_data, what)
         for arr in (obs, nxt):
             norm2 = np.einsum("ij,ij->i", arr[:, 9:12], arr[:, 9:12])
             if np.any(norm2 > _MAX_QUAT_NORM2):

@@ -39,6 +39,9 @@ CHANGE_AT = (200, 800)  # the default range of the abrupt change's episode
 #: The factors a change may apply: a parameter 100 times larger (or smaller) is already no helicopter; 1e300 was flown
 #: as dynamics far outside what --params allows (fifth trial).
 MIN_FACTOR, MAX_FACTOR = 0.01, 100.0
+#: The latest episode a change may come at: a trillion episodes of 6000 steps outlast any test run (run_test refuses a
+#: window past its last episode), and below NumPy's int64, in which the episode is drawn.
+MAX_CHANGE_AT = 10**12
 _PARSE_FORM = "give walk=STD or PARAM=FACTOR[@LO-HI], e.g. walk=0.01,D_w=0.8@200-800"
 
 
@@ -82,8 +85,8 @@ class Drift:
             lo, hi = (int(x) for x in self.change_at)
         except (TypeError, ValueError):
             raise NeurohoverError(f"drift change_at={self.change_at!r} is not allowed: give two episode numbers lo, hi with 0 <= lo <= hi") from None
-        if not 0 <= lo <= hi or list(self.change_at) != [lo, hi]:
-            raise NeurohoverError(f"drift change_at={self.change_at!r} is out of range: allowed whole episode numbers 0 <= lo <= hi")
+        if not 0 <= lo <= hi <= MAX_CHANGE_AT or list(self.change_at) != [lo, hi]:  # 10**30 was NumPy's int64 error at reset (ninth trial)
+            raise NeurohoverError(f"drift change_at={self.change_at!r:.80} is out of range: allowed whole episode numbers 0 <= lo <= hi <= {MAX_CHANGE_AT:,}")
         if not self.change and (lo, hi) != CHANGE_AT:  # said when, but no change to happen then: nothing would
             raise NeurohoverError(f"drift change_at={[lo, hi]} is given without a change: {_PARSE_FORM}")
         object.__setattr__(self, "change_at", (lo, hi))
@@ -172,12 +175,16 @@ class Drift:
             if key.strip() in seen:
                 raise NeurohoverError(f"drift {text!r} sets {key.strip()} twice: give each once")
             seen.add(key.strip())
-            value, _, when = value.partition("@")
+            value, after, when = value.partition("@")
+            if after and not when.strip():  # 'D_w=0.8@' was read as the default window (ninth trial)
+                raise NeurohoverError(
+                    f"drift {text!r:.80}: empty window after '@' in {part!r:.40}: give @LO-HI (or leave out '@' for {CHANGE_AT[0]}-{CHANGE_AT[1]})"
+                )
             try:
                 number = float_of(value)
                 if when:
-                    lo, _, hi = when.partition("-")
-                    at = (int(lo), int(hi or lo))
+                    lo, dash, hi = when.partition("-")
+                    at = (int(lo), int(hi if dash else lo))  # '@200-' is no window: int('') refuses it
             except ValueError as err:
                 why = f" ({err})" if isinstance(err, FloatRangeError) else ""
                 raise NeurohoverError(f"drift {part[:40]!r} is not understood{why}: {_PARSE_FORM}") from None
