@@ -21,7 +21,6 @@ Example
 from __future__ import annotations
 
 import csv
-import json
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -34,6 +33,7 @@ from matplotlib.ticker import MaxNLocator
 
 from .errors import NeurohoverError
 from .flightdata import FlightData
+from .paths import strict_json
 from .sim.constants import ACTION_NAMES, CONTROL_DT, CRASH_STEP_PENALTY, EPISODE_STEPS, MAX_EPISODE_STEPS
 
 __all__ = [
@@ -303,8 +303,8 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
     summary_path = path / COMPETE_SUMMARY
     if summary_path.exists():
         try:
-            summary = json.loads(summary_path.read_text())
-        except (OSError, ValueError, RecursionError) as err:  # damaged: refused, not silently relabelled (second trial)
+            summary = strict_json(summary_path.read_text(encoding="utf-8-sig"))  # a key given twice too (ninth trial)
+        except (OSError, ValueError) as err:  # damaged: refused, not silently relabelled (second trial)
             raise NeurohoverError(f"--compete {str(summary_path)!r} cannot be read ({err}); remove it to label the curve by its directory's name") from None
         if not (isinstance(summary, dict) and isinstance(summary.get("agent"), str) and isinstance(summary.get("task", ""), str)):
             raise NeurohoverError(f"--compete {str(summary_path)!r} is not a compete summary: no agent and task names")

@@ -201,6 +201,7 @@ def bad(files, tmp_path: Path) -> dict[str, str]:
         ("ghh10summary", '{"agent": "baseline", "task": "ghh10"}'),  # another task's or competition's summary (eighth trial)
         ("runssummary", '{"agent": "baseline", "task": "ghh08", "runs": 2, "episodes": 1}'),
         ("episodessummary", '{"agent": "baseline", "task": "ghh08", "runs": 1, "episodes": 1.0}'),
+        ("twicesummary", '{"agent": "baseline", "agent": "model-free", "task": "ghh08"}'),  # the last was kept (ninth trial)
     ):
         (tmp_path / name).mkdir()
         (tmp_path / name / "episodes.csv").write_text("run,mdp,episode,return,crashed\n0,m,0,-1,0\n")
@@ -225,6 +226,7 @@ def bad(files, tmp_path: Path) -> dict[str, str]:
         (["--compete", "{dir}/ghh10summary"], "summary.json' names task 'ghh10', not one of ghh08, "),
         (["--compete", "{dir}/runssummary"], "summary.json' says runs 2 where its episodes.csv holds 1: the two are of different"),
         (["--compete", "{dir}/episodessummary"], "summary.json' says episodes 1.0 where its episodes.csv holds 1"),
+        (["--compete", "{dir}/twicesummary"], "summary.json' cannot be read (key 'agent' is given more than once)"),
         (["--compete", "{compete}", "--episodes", "0"], "--episodes picks episodes of a flight-data file; it does not apply to --compete"),
         (["{flight}", "--episodes", "0,0"], "--episodes '0,0' names episode 0 more than once"),
         (["{flight}", "--episodes", "0-1,1"], "--episodes '0-1,1' names episode 1 more than once"),
