@@ -168,16 +168,22 @@ def output_file(path: str | os.PathLike, option: str, inputs: Mapping[str, str |
         raise NeurohoverError(f"{option} {str(path)!r} ends in '/', which names a directory: give a file path")
     if p.exists() and not p.is_file():  # written by replacing it, a device node (/dev/full) would become a file
         raise NeurohoverError(f"{option} {str(path)!r} is not a regular file (a device, pipe or socket); give a file path")
+    real = Path(os.path.realpath(p))
+    if p.is_symlink() and not real.parent.is_dir():  # was "cannot create a file in '.'", a directory that exists (ninth trial)
+        raise NeurohoverError(
+            f"{option} {str(path)!r} is a symbolic link to {os.readlink(p)!r}, whose directory {str(real.parent)!r} does not exist: "
+            "give another path, or make that directory"
+        )
     _make_dirs(p.parent, option, str(path))
-    existed = p.exists()
+    existed = real.exists()
     try:
-        with open(p, "ab"):  # appending nothing leaves an existing file's content and time as they are
+        with open(real, "ab"):  # appending nothing leaves an existing file's content and time as they are
             pass
     except OSError as err:
-        what = "write this file" if existed else f"create a file in {str(p.parent)!r}"
+        what = "write this file" if existed else f"create a file in {str(real.parent)!r}"
         raise NeurohoverError(f"{option} {str(path)!r}: cannot {what} ({_why(err)})") from None
     if not existed:
-        p.unlink(missing_ok=True)
+        real.unlink(missing_ok=True)  # the file the check made, not a link to it (which unlink would remove instead)
     return p
 
 
@@ -187,7 +193,7 @@ def writing(path: str | os.PathLike, option: str) -> Iterator[Path]:
     onto ``path`` once the block ends): a failed write (disk full, read-only, permission) becomes one NeurohoverError
     naming ``option`` and the file, and an interrupted one (Ctrl-C, SIGTERM) stops as it was; either way the temporary
     file is removed and ``path`` is as it was before, so that no later run takes a partial file for a result."""
-    p = Path(path)
+    p = Path(os.path.realpath(path))  # through a symbolic link: its file is written, the link kept (not replaced by a file)
     partial = p.with_name(f".{p.name}.{os.getpid()}.partial")
     try:
         yield partial

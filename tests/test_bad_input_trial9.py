@@ -121,3 +121,30 @@ def test_ec_mer_learns_with_the_policy_that_flew_the_data_not_a_file_of_its_name
     monkeypatch.chdir(tmp_path / "pb")
     rc, out, err = cli("learn-model", "--flight-data", "../pa/f.npz", "--method", "ec-mer", "--budget", "2", "--out", "m.json")
     assert rc == 0 and "ec-mer model written to m.json" in out, err
+
+
+def test_a_store_given_through_a_symbolic_link_has_the_same_writer_lock(tmp_path: Path) -> None:
+    """S8: through a link to the store, a second run locked a lock file of the link's name and wrote beside the first
+    (it then said "finished ... 7/41 done")."""
+    from neurohover.experiments import Store
+
+    (tmp_path / "link.sqlite").symlink_to(tmp_path / "s.sqlite")
+    with Store(tmp_path / "s.sqlite") as first:
+        first.lock()
+        with Store(tmp_path / "link.sqlite") as second:
+            assert second.lock_path == first.lock_path == tmp_path / "s.sqlite.lock"
+            with pytest.raises(NeurohoverError, match=f"results store '{tmp_path}/link.sqlite' is in use: another run \\(pid {os.getpid()} "):
+                second.lock()
+
+
+def test_an_output_through_a_symbolic_link_writes_its_file_and_a_dangling_one_is_named(tmp_path: Path, cli) -> None:
+    """U3: --store given as a link whose target's directory is missing was "cannot create a file in '.'"; a result
+    written through a link replaced the link by a file."""
+    (tmp_path / "dangling.sqlite").symlink_to("nowhere/x.sqlite")
+    rc, _, err = cli("reproduce", "fig2", "--store", str(tmp_path / "dangling.sqlite"))
+    assert rc == 2 and f"is a symbolic link to 'nowhere/x.sqlite', whose directory '{tmp_path}/nowhere' does not exist" in err, err
+    (tmp_path / "real").mkdir()
+    (tmp_path / "p.json").symlink_to(tmp_path / "real" / "p.json")
+    rc, _, err = cli("evolve", "--task", "ghh08", "--mdp", "train:0", "--budget", "3", "--episode-steps", "20", "--out", str(tmp_path / "p.json"))
+    assert rc == 0, err
+    assert (tmp_path / "p.json").is_symlink() and (tmp_path / "real" / "p.json").is_file()

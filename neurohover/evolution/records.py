@@ -204,6 +204,7 @@ def decode_history(rows) -> list[HistoryRecord]:
 
 def write_checkpoint(path: Path, state: dict) -> None:
     """Write a checkpoint atomically: strict JSON to ``PATH.tmp``, synced, then renamed over ``path``."""
+    path = Path(os.path.realpath(path))  # through a symbolic link: its file is written, the link kept (ninth trial)
     tmp = path.with_name(path.name + ".tmp")
     path.parent.mkdir(parents=True, exist_ok=True)
     try:

@@ -146,8 +146,12 @@ class Store:
 
     @property
     def lock_path(self) -> Path:
-        """The lock file beside the store (``STORE.lock``), there while a run writes the store."""
-        return self.path.with_name(self.path.name + ".lock")
+        """The lock file beside the store's own file (``STORE.lock``, symbolic links followed), there while a run writes it.
+
+        Through a link to the store, a second run locked a lock file of the link's name and wrote beside the first
+        (ninth trial); two hard links to one file are still two names (give one store one name)."""
+        real = Path(os.path.realpath(self.path))
+        return real.with_name(real.name + ".lock")
 
     def lock(self) -> None:
         """Make this Store the file's only writer until :meth:`close` (does nothing if it already is).
