@@ -30,6 +30,23 @@ if running_as_command():
     signal.signal(signal.SIGTERM, raise_terminated)  # from the first import on, SIGTERM ends the command as Ctrl-C does (fourth trial)
 
 from .errors import NeurohoverError  # noqa: E402
+
+
+def _check_numba_threads() -> None:
+    """NUMBA_NUM_THREADS, read by numba as it imports: 0 or less was numba's traceback from every command, --help too,
+    and text its warning, then its default (tenth trial)."""
+    value = os.environ.get("NUMBA_NUM_THREADS")
+    if value is None or (value.strip().isascii() and value.strip().isdigit() and int(value) >= 1):
+        return
+    message = f"environment variable NUMBA_NUM_THREADS={value!r:.40} is not allowed: give a whole number >= 1 (numba's threads), or unset it"
+    if running_as_command():
+        print(f"neurohover: error: {message}", file=sys.stderr, flush=True)
+        sys.exit(2)
+    raise NeurohoverError(message)
+
+
+_check_numba_threads()
+
 from .evaluate import DangerousState, Evaluation, PolicyTable, Safeguard, evaluate, evaluate_jobs  # noqa: E402
 from .flightdata import FlightData  # noqa: E402
 from .policies import Policy, baseline_policy, load_policy, prototype, save_policy  # noqa: E402

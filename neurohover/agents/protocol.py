@@ -87,6 +87,9 @@ class Agent:
     """Base class of on-line agents. ``start`` is called once per test run, before episode 0."""
 
     name: str = "agent"
+    #: The task family (name, sigma) :func:`~neurohover.agents.registry.make_agent` made it for, its policies that
+    #: family's; :func:`run_test` refuses another (None: an agent built by hand, run on any family).
+    made_for: tuple[str, float | None] | None = None
 
     def start(self, family: TaskFamily, rng: np.random.Generator) -> None:
         """Prepare for a new run on an unknown MDP of ``family`` (reset any per-run state)."""
@@ -145,6 +148,10 @@ def after_learning_start(policy_labels: Sequence[str]) -> int:
     return start
 
 
+def _family_label(name: str, sigma: float | None) -> str:
+    return name if sigma is None else f"{name} (sigma {sigma:g})"
+
+
 def _check_run(agent, family, mdp, episodes, seed) -> int:
     """:func:`run_test`'s arguments checked (NeurohoverError naming the bad one); returns the seed."""
     if not isinstance(agent, Agent):
@@ -153,6 +160,12 @@ def _check_run(agent, family, mdp, episodes, seed) -> int:
         raise NeurohoverError(f"family={family!r:.80} is not allowed: give a TaskFamily (neurohover.get_task_family(name))")
     if not isinstance(mdp, MDP):
         raise NeurohoverError(f"mdp={mdp!r:.80} is not allowed: give an MDP (family.mdp('test:3'), for example)")
+    made = agent.made_for
+    if made is not None and made != (family.name, family.sigma):  # GHH-08's policies flew FGHH without a word (tenth trial)
+        raise NeurohoverError(
+            f"agent {agent.name!r} was made for {_family_label(*made)}, but the run's family is {_family_label(family.name, family.sigma)}: "
+            f"make the agent for it (make_agent(name, family))"
+        )
     if mdp.family != family.name:  # the agent prepares for its family (its policies, safe pairs): another family's MDP is a mix-up
         raise NeurohoverError(f"mdp {mdp.label!r} is a {mdp.family} MDP, but the run's family is {family.name}: give an MDP of {family.name}")
     if isinstance(episodes, bool) or not isinstance(episodes, (int, np.integer)) or episodes < 1:  # True was one episode

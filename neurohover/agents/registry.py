@@ -101,7 +101,9 @@ def make_agent(name: str, family: TaskFamily | str, *, policy_dir: str | None = 
 
         policy_dir = str(checked_path(policy_dir, "policy_dir", "policy set's directory"))  # 3 was a TypeError (fourth trial)
     policies = policies_from_set(spec, _policy_set(family, policy_dir)) if spec.needs else AgentPolicies()
-    return spec.build(policies, options)
+    agent = spec.build(policies, options)
+    agent.made_for = (family.name, family.sigma)  # run_test refuses another family (tenth trial)
+    return agent
 
 
 def _checked_options(spec: AgentSpec, options: AgentOptions) -> AgentOptions:
