@@ -141,9 +141,12 @@ class PolicyTable:
         return self.kinds.shape[0]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # eq=False: the generated == compared arrays as tuples, NumPy's ValueError (tenth trial)
 class Evaluation:
     """Outcome of a batch of episodes; arrays share the shape of the jobs.
+
+    ``==`` compares outcomes: the same arrays (shape, dtype and values, NaN equal to NaN) and equal flight data,
+    ``seconds`` left out. An Evaluation is unhashable (it holds arrays), as a list is.
 
     Attributes
     ----------
@@ -166,6 +169,19 @@ class Evaluation:
     safeguard_step: np.ndarray
     flight_data: FlightData | None
     seconds: float = field(compare=False)  # wall-clock, not part of the outcome
+
+    __hash__ = None  # type: ignore[assignment]  # mutable arrays: the generated hash was a TypeError on ndarray (tenth trial)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Evaluation):
+            return NotImplemented
+        mine = (self.returns, self.crashed, self.steps, self.safeguard_step)
+        theirs = (other.returns, other.crashed, other.steps, other.safeguard_step)
+        same = all(
+            a.shape == b.shape and a.dtype == b.dtype and np.array_equal(a, b, equal_nan=a.dtype.kind in "fc")
+            for a, b in zip(map(np.asarray, mine), map(np.asarray, theirs), strict=True)
+        )
+        return same and self.flight_data == other.flight_data
 
     @property
     def episodes(self) -> int:

@@ -43,17 +43,47 @@ def _check_declared_size(path: Path) -> None:
         raise NeurohoverError(f"{str(path)!r} declares arrays of {total:,} bytes: more than half the memory free now; give a smaller file")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # eq=False: the generated == compared arrays as tuples, NumPy's ValueError (tenth trial)
 class FlightData:
     """Flown episodes: ``observations[i]`` is (steps_i + 1, 12), ``actions[i]`` is (steps_i, 4).
 
     ``observations[i][k]`` is what the policy saw before choosing ``actions[i][k]`` (the clipped
     action the simulator applied); the last observation follows the last action.
+
+    ``==`` compares recordings: the same episodes (each array's shape, dtype and values, NaN equal to NaN) and
+    equal metadata. Flight data are unhashable (they hold arrays), as a list is.
     """
 
     observations: tuple[np.ndarray, ...]
     actions: tuple[np.ndarray, ...]
-    metadata: dict = field(default_factory=dict, compare=False)
+    metadata: dict = field(default_factory=dict)
+
+    __hash__ = None  # type: ignore[assignment]  # mutable arrays: the generated hash was a TypeError on ndarray (tenth trial)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, FlightData):
+            return NotImplemented
+        return (
+            FlightData._same(self.observations, other.observations)
+            and FlightData._same(self.actions, other.actions)
+            and FlightData._same(self.metadata, other.metadata)
+        )
+
+    @staticmethod
+    def _same(a: object, b: object) -> bool:
+        """Value equality through dicts, lists and tuples, arrays compared whole (metadata may hold arrays too)."""
+        if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):  # an array equals an array only, as a list a list
+            if not (isinstance(a, np.ndarray) and isinstance(b, np.ndarray)):
+                return False
+            return a.shape == b.shape and a.dtype == b.dtype and np.array_equal(a, b, equal_nan=a.dtype.kind in "fc")
+        if isinstance(a, dict) and isinstance(b, dict):
+            return a.keys() == b.keys() and all(FlightData._same(a[k], b[k]) for k in a)
+        if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
+            return type(a) is type(b) and len(a) == len(b) and all(FlightData._same(x, y) for x, y in zip(a, b))
+        try:
+            return bool(a == b)
+        except (ValueError, TypeError):  # a NumPy scalar against a list compares elementwise: not the same value
+            return False
 
     def __post_init__(self) -> None:
         for name in ("observations", "actions"):  # a string was an AttributeError (fourth trial)

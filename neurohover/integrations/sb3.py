@@ -41,7 +41,17 @@ try:
 except ModuleNotFoundError as missing:  # the optional extra
     raise NeurohoverError(f"neurohover.integrations.sb3 needs {missing.name}: pip install 'neurohover[examples]'") from None
 
-__all__ = ["RecurrentPolicy", "SB3VecEnv", "rl_zoo_files", "rl_zoo_policy", "sb3_policy"]
+__all__ = ["RecurrentPolicy", "SB3VecEnv", "UnknownAttributeError", "rl_zoo_files", "rl_zoo_policy", "sb3_policy"]
+
+
+class UnknownAttributeError(NeurohoverError, AttributeError):
+    """:meth:`SB3VecEnv.get_attr` of a name the environment lacks: an AttributeError too, which SB3 catches (has_attr)."""
+
+
+#: Attributes of the native vector env that hold one entry per helicopter: get_attr gives helicopter i entry i.
+_PER_HELICOPTER = ("mdps", "mdp_specs", "noise_streams", "steps")
+#: Spaces the native vector env holds batched: get_attr gives each helicopter its own (SB3's DummyVecEnv does).
+_SINGLE_SPACES = {"observation_space": "single_observation_space", "action_space": "single_action_space"}
 
 
 class SB3VecEnv(VecEnv):
@@ -124,7 +134,23 @@ class SB3VecEnv(VecEnv):
         return [None if seed is None else int(seed) + i for i in range(n)]
 
     def get_attr(self, attr_name: str, indices=None) -> list[Any]:
-        return [getattr(self.native, attr_name)] * len(self._indices(indices))
+        """One value per helicopter of ``indices``, read from the native vector environment: its per-helicopter attributes
+        (``mdps``, ``mdp_specs``, ``noise_streams``, ``steps``) give each helicopter its own entry, ``observation_space``
+        and ``action_space`` each helicopter's own space, and its other attributes (``render_mode``, ``family``,
+        ``episode_steps``, ...) the same value for each. A name it lacks raises :class:`UnknownAttributeError`."""
+        chosen = self._indices(indices)
+        native = self.native
+        if not isinstance(attr_name, str) or not hasattr(native, _SINGLE_SPACES.get(attr_name, attr_name)):
+            # a bare AttributeError naming HoverVectorEnv, which the user never made (tenth trial)
+            public = sorted(n for n in dir(native) if not n.startswith("_") and not callable(getattr(type(native), n, None)))
+            raise UnknownAttributeError(
+                f"get_attr({attr_name!r:.60}): the helicopters' vector environment has no such attribute; "
+                f"per helicopter: {', '.join(_PER_HELICOPTER)}; shared: {', '.join(n for n in public if n not in _PER_HELICOPTER)}"
+            )
+        value = getattr(native, _SINGLE_SPACES.get(attr_name, attr_name))
+        if attr_name in _PER_HELICOPTER:  # each helicopter's own entry, as DummyVecEnv reads each env (tenth trial)
+            return [value[i] for i in chosen]
+        return [value] * len(chosen)
 
     def set_attr(self, attr_name: str, value: Any, indices=None) -> None:
         raise NeurohoverError(f"set_attr({attr_name!r}) is not supported: the helicopters share one native vector environment")
@@ -133,12 +159,37 @@ class SB3VecEnv(VecEnv):
         raise NeurohoverError(f"env_method({method_name!r}) is not supported: the helicopters share one native vector environment")
 
     def env_is_wrapped(self, wrapper_class, indices=None) -> list[bool]:
+        """False for each helicopter of ``indices``: no Gymnasium wrapper sits between them and SB3."""
         return [False] * len(self._indices(indices))
 
+    def get_images(self) -> Sequence[np.ndarray | None]:
+        # SB3's contract is a NotImplementedError, but an empty one did not say why or what to do (tenth trial)
+        raise NotImplementedError(
+            "SB3VecEnv draws no images (its helicopters fly in one kernel call, render_mode=None): to watch one, "
+            "make a single environment with gymnasium.make(env_id, render_mode='rgb_array') and call its render()"
+        )
+
     def _indices(self, indices) -> list[int]:
+        """SB3's ``indices`` (None: every helicopter; an int; or an iterable of ints), each in 0..num_envs-1: 5 of 2 and
+        'abc' gave lists of 1 and 3 values (tenth trial)."""
+        n = self.num_envs
+        allowed = f"give None, an int or an iterable of ints in 0..{n - 1} (the helicopters)"
         if indices is None:
-            return list(range(self.num_envs))
-        return [indices] if isinstance(indices, int) else list(indices)
+            return list(range(n))
+        chosen: list[Any] | None = None
+        if isinstance(indices, (int, np.integer)):
+            chosen = [indices]
+        elif not isinstance(indices, (str, bytes, dict)):
+            try:
+                chosen = list(indices)
+            except TypeError:  # not iterable: a float, a 0-d array
+                pass
+        if chosen is None:
+            raise NeurohoverError(f"indices={indices!r:.60} is not allowed: {allowed}")
+        bad = [i for i in chosen if isinstance(i, (bool, np.bool_)) or not isinstance(i, (int, np.integer)) or not 0 <= i < n]
+        if bad:
+            raise NeurohoverError(f"indices={indices!r:.60} is not allowed ({bad[0]!r:.30} is no helicopter): {allowed}")
+        return [int(i) for i in chosen]
 
 
 def _algorithm(algo: str):
