@@ -81,12 +81,22 @@ def as_policies(policies) -> list[Policy]:
     raise NeurohoverError(f"policies={policies!r} is not allowed: give a Policy, a policy file's path or 'baseline' (or a sequence of these, or a PolicyTable)")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class PolicyTable:
-    """Policies as the kernel reads them: a kind per row and genomes padded to 42 columns."""
+    """Policies as the kernel reads them: a kind per row and genomes padded to 42 columns.
+
+    ``==`` compares the kinds and genomes bit for bit (NaN equals NaN); like a list, a table is not hashable.
+    """
 
     kinds: np.ndarray  # (P,) int64
     genomes: np.ndarray  # (P, 42) float64
+
+    def __eq__(self, other: object) -> bool:  # the generated one raised NumPy's "truth value is ambiguous" (tenth trial)
+        if not isinstance(other, PolicyTable):
+            return NotImplemented
+        return np.array_equal(self.kinds, other.kinds) and np.array_equal(self.genomes, other.genomes, equal_nan=True)
+
+    __hash__ = None  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         """A table built by hand, checked for what the kernel would misread (a kind 9 flew as an SLP; second trial). A

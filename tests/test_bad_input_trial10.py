@@ -41,3 +41,46 @@ def test_an_agent_made_for_one_family_is_not_run_on_another() -> None:
     with pytest.raises(NeurohoverError, match=r"agent 'model-free' was made for ghh08, but the run's family is fghh \(sigma 0.3\): make the agent"):
         run_test(agent, fghh, fghh.test_mdps()[0], episodes=1, n_steps=10)
     assert run_test(agent, g8, g8.test_mdps()[0], episodes=1, n_steps=10).returns.shape == (1,)
+
+
+def test_resume_names_the_checkpoints_value_and_the_given_one(tmp_path: Path, cli) -> None:
+    """U2: a changed option on --resume was "seed differ" or "target differ", neither value named."""
+    argv = ["evolve", "--task", "ghh08", "--episode-steps", "20", "--out", str(tmp_path / "b.json"), "--validation-episodes", "1"]
+    assert cli(*argv, "--budget", "6")[0] == 0
+    rc, _, err = cli(*argv, "--budget", "100", "--resume", "--seed", "1")
+    assert rc == 2 and "was written by a different run (seed: the checkpoint's 0, given 1); resume with the same" in err, err
+    rc, _, err = cli(*argv, "--budget", "100", "--resume", "--mdp", "train:1")
+    assert rc == 2 and "(target.mdp.label: the checkpoint's 'ghh08/zero', given 'ghh08/train:1')" in err, err
+
+
+def test_a_hybrid_agent_without_two_safe_policies_names_the_manifest(tmp_path: Path, cli) -> None:
+    """U3: "the hybrid agent needs exactly 2 safe specialised policies, got 1" named no file."""
+    import json
+    import shutil
+
+    from neurohover.policysets import policy_dir
+
+    shutil.copytree(policy_dir("ghh08"), tmp_path / "pd" / "ghh08")
+    manifest = tmp_path / "pd" / "ghh08" / "manifest.json"
+    manifest.write_text(json.dumps({**json.loads(manifest.read_text()), "safe": [6]}))
+    argv = ["compete", "--task", "ghh08", "--agent", "hybrid", "--runs", "1", "--episodes", "2", "--episode-steps", "20"]
+    rc, _, err = cli(*argv, "--out", str(tmp_path / "c"), "--policy-dir", str(tmp_path / "pd"))
+    assert rc == 2 and f"policy-set manifest '{manifest}': safe=[6] is not allowed for agent 'hybrid': it flies exactly 2 safe" in err, err
+
+
+def test_sigma_beside_the_zero_setting_says_which_mdps_take_it(cli) -> None:
+    """U4: fly --task fghh --sigma 0.5 was refused with "give another --mdp", not saying zero is the default or what is."""
+    rc, _, err = cli("fly", "--task", "fghh", "--sigma", "0.5", "--episodes", "1")
+    assert rc == 2 and "--sigma 0.5 does nothing with --mdp zero (the default)" in err and "give --mdp sample, train:N or test:N" in err, err
+
+
+def test_policy_tables_compare_by_value() -> None:
+    """T2 (PolicyTable): == raised NumPy's "truth value of an array is ambiguous"."""
+    import numpy as np
+
+    from neurohover.evaluate import PolicyTable
+
+    a = PolicyTable.from_genomes(np.full((2, 40), np.nan), "slp")
+    assert a == PolicyTable.from_genomes(np.full((2, 40), np.nan), "slp") and a != PolicyTable.from_genomes(np.zeros((2, 40)), "slp")
+    with pytest.raises(TypeError, match="unhashable"):
+        hash(a)

@@ -238,7 +238,7 @@ def test_interrupted_and_resumed_equals_uninterrupted(tmp_path: Path, target, kw
 def test_resume_refuses_another_run(tmp_path: Path) -> None:
     ckpt = tmp_path / "c.json"
     evolve(GHH08.zero(), topology="slp", budget=60, seed=1, n_steps=50, checkpoint=ckpt)
-    with pytest.raises(NeurohoverError, match="seed differ"):
+    with pytest.raises(NeurohoverError, match=r"\(seed: the checkpoint.s 1, given 2\)"):
         evolve(GHH08.zero(), topology="slp", budget=100, seed=2, n_steps=50, checkpoint=ckpt, resume=True)
     with pytest.raises(NeurohoverError, match="does not exist"):
         evolve(GHH08.zero(), topology="slp", budget=100, seed=1, n_steps=50, checkpoint=tmp_path / "none.json", resume=True)
@@ -442,7 +442,7 @@ def test_a_resume_with_other_sensors_is_refused(tmp_path: Path) -> None:
     evolve(noisy, budget=60, checkpoint=ckpt, **common)
     saved = json.loads(ckpt.read_text())["config"]["target"]
     assert saved["sensor"] == noisy.sensor.to_dict() and "sensor" not in evolve(exact, budget=60, **common).settings["target"]
-    with pytest.raises(NeurohoverError, match="written by a different run: target differ"):
+    with pytest.raises(NeurohoverError, match=r"written by a different run \(target.sensor: the checkpoint.s \{.*, given None\)"):
         evolve(exact, budget=120, checkpoint=ckpt, resume=True, **common)
     assert evolve(noisy, budget=120, checkpoint=ckpt, resume=True, **common).episodes >= 60  # the same sensors resume
 

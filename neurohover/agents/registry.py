@@ -60,6 +60,11 @@ def policies_from_set(spec: AgentSpec, ps: PolicySet) -> AgentPolicies:
     if "generic" in spec.needs:
         kind = spec.generic_kind if ps.generics else None
         generic = ps.generics[kind] if kind is not None and ps.generics else ps.generic
+    if "safe" in spec.needs and len(ps.safe) != 2:  # the agent's own refusal named no file (tenth trial)
+        raise NeurohoverError(
+            f"policy-set manifest {str(ps.directory / 'manifest.json')!r}: safe={list(ps.safe)} is not allowed for agent {spec.name!r}: "
+            "it flies exactly 2 safe specialised policies (give two indices of its specialised policies)"
+        )
     return AgentPolicies(
         generic=generic,
         specialised=tuple(ps.specialised) if "specialised" in spec.needs else (),

@@ -51,7 +51,11 @@ def explicit_mdp(args: argparse.Namespace, family):
 def refuse_sigma_on_zero(args: argparse.Namespace, mdp: str | None) -> None:
     """Refuse --sigma beside the zero setting ``mdp``, the same MDP at every breadth (it changed nothing; sixth trial)."""
     if getattr(args, "sigma", None) is not None and mdp == "zero":
-        raise NeurohoverError("--sigma is the breadth of the MDPs drawn from FGHH's G; the zero setting is the same at every sigma: give another --mdp")
+        given = "--mdp zero" if getattr(args, "mdp", None) == "zero" else "--mdp zero (the default)"  # which values take it, named (tenth trial)
+        raise NeurohoverError(
+            f"--sigma {args.sigma:g} does nothing with {given}: sigma is the breadth of the MDPs drawn from FGHH's G, and the zero "
+            "setting is the same at every sigma; give --mdp sample, train:N or test:N, or leave --sigma out"
+        )
 
 
 @dataclass(frozen=True)

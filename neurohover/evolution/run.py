@@ -53,6 +53,20 @@ __all__ = ["InterruptFlag", "Run"]
 RACE_BATCH_PER_THREAD = 4 * LANES
 
 
+def _first_difference(path: str, saved, given) -> str:
+    """Where a checkpoint's setting and the given one first differ, with both values (cut at 60 characters)."""
+    if isinstance(saved, dict) and isinstance(given, dict):
+        for key in sorted(set(saved) | set(given), key=str):
+            if saved.get(key) != given.get(key):
+                return _first_difference(f"{path}.{key}", saved.get(key), given.get(key))
+
+    def brief(value) -> str:
+        text = repr(value)
+        return text if len(text) <= 60 else text[:57] + "..."
+
+    return f"{path}: the checkpoint's {brief(saved)}, given {brief(given)}"
+
+
 class InterruptFlag:
     """Context manager: a first Ctrl-C (SIGINT) sets :attr:`set`, so that the run stops at the next
     generation boundary; a second one raises ``KeyboardInterrupt`` at once. Outside the main
@@ -162,8 +176,9 @@ class Run:
             raise _damaged(source, err) from None
         if saved != self.config:
             diff = sorted(k for k in set(saved) | set(self.config) if saved.get(k) != self.config.get(k))
-            raise NeurohoverError(
-                f"{source} was written by a different run: {', '.join(diff)} differ; resume with the same "
+            values = "; ".join(_first_difference(k, saved.get(k), self.config.get(k)) for k in diff)
+            raise NeurohoverError(  # the values named, not only their keys (tenth trial)
+                f"{source} was written by a different run ({values}); resume with the same "
                 "target, method, optimizer, resampling, topology, prototype, seed, episode steps and settings (only the budget may change)"
             )
         try:
