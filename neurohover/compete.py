@@ -307,6 +307,7 @@ def compete(
     store_path = _checked_store(store)
     out = output_dir(out, "out")  # made once every setting is checked (None was a TypeError, /dev/full a FileExistsError)
     store_path = store_path or out / STORE_FILE
+    _refuse_other_settings(config, store_path)
     _note_replaced(out / "summary.json", task, agent)
     ordered = _run_into_store(config, store_path, out / "episodes.csv", jobs=jobs, device=device, progress=progress, on_result=on_result)
     summary = {
@@ -363,6 +364,10 @@ def _run_into_store(config, store_path: Path, episodes_csv: Path, *, jobs: int, 
         if on_result is not None and key.startswith("run/"):
             on_result(key, TestRunResult.from_dict(result, key))
 
+    def stored_runs(db) -> list:
+        stored = db.results(config.name, config.scale)
+        return [TestRunResult.from_dict(stored[k], k) for k in sorted((k for k in stored if k.startswith("run/")), key=_run_order)]
+
     executor = make_executor("local", jobs=jobs, device=device)
     with Store(store_path) as db:
         try:
@@ -370,13 +375,40 @@ def _run_into_store(config, store_path: Path, episodes_csv: Path, *, jobs: int, 
             if run.units_before:  # say so, as reproduce does: these runs were not flown again
                 reused = f"{run.units_before} of {run.units_total} units (runs and the policies they fly)"
                 print(f"neurohover compete: {reused} were already in {store_path}: reused", file=sys.stderr)
+        except KeyboardInterrupt:  # the finished runs written, for the user to see (the same call resumes them)
+            executor.close()
+            ordered = stored_runs(db)
+            if ordered:  # none: the folder stays as it was (an earlier competition's rows were replaced by a header; tenth trial)
+                _write_episodes(episodes_csv, ordered, config.typed.n_steps)
+            raise
         finally:
             executor.close()
-            stored = db.results(config.name, config.scale)
-            keys = sorted((k for k in stored if k.startswith("run/")), key=_run_order)
-            ordered = [TestRunResult.from_dict(stored[k], k) for k in keys]
-            _write_episodes(episodes_csv, ordered, config.typed.n_steps)
+        ordered = stored_runs(db)  # a failure (a full disk) left above: the folder as it was
+        _write_episodes(episodes_csv, ordered, config.typed.n_steps)
     return ordered
+
+
+def _refuse_other_settings(config, store_path: Path) -> None:
+    """A store holding this competition run with other settings (another policy set, say), refused before anything
+    is written, saying what differs; reproduce's refusal named two hashes and --update / --fresh, which compete does not
+    take (tenth trial)."""
+    from .errors import first_difference
+    from .experiments import Store
+
+    if not store_path.is_file():
+        return
+    with Store(store_path, create=False) as db:
+        held = db.config_hash(config.name, config.scale)
+        if held is None or held == config.hash:
+            return
+        stored = db.config(config.name, config.scale)
+    diff = first_difference("config", stored, config.to_dict())
+    if diff.startswith("config.external_digest:"):  # the policy files' digest: said in words
+        diff = "the policy set's files differ from those its runs flew, " + diff.removeprefix("config.external_digest: ").replace("the stored", "digest")
+    raise NeurohoverError(
+        f"results store {str(store_path)!r} holds this competition ({config.name}) run with other settings ({diff}): its runs would "
+        "not be comparable; give another --store (or --out), or the settings it was run with (its runs stay in the store)"
+    )
 
 
 def _write_summary(path: Path, summary: dict) -> None:

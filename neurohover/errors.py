@@ -63,3 +63,18 @@ def settings_from_dict(cls: type, values: Any, *, unknown_what: str, bad_what: s
         return cls(**values)
     except (TypeError, ValueError, OverflowError) as err:  # OverflowError: an int past a float's range (eighth trial)
         raise NeurohoverError(f"bad {bad_what}: {err}") from None
+
+
+def first_difference(path: str, saved: Any, given: Any, saved_as: str = "the stored") -> str:
+    """Where a stored setting ``saved`` and the ``given`` one first differ (tables compared key by key), with both
+    values cut at 60 characters: for messages that refuse a resume or a store of other settings (tenth trial)."""
+    if isinstance(saved, dict) and isinstance(given, dict):
+        for key in sorted(set(saved) | set(given), key=str):
+            if saved.get(key) != given.get(key):
+                return first_difference(f"{path}.{key}", saved.get(key), given.get(key), saved_as)
+
+    def brief(value: Any) -> str:
+        text = repr(value)
+        return text if len(text) <= 60 else text[:57] + "..."
+
+    return f"{path}: {saved_as} {brief(saved)}, given {brief(given)}"

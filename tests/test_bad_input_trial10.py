@@ -84,3 +84,26 @@ def test_policy_tables_compare_by_value() -> None:
     assert a == PolicyTable.from_genomes(np.full((2, 40), np.nan), "slp") and a != PolicyTable.from_genomes(np.zeros((2, 40)), "slp")
     with pytest.raises(TypeError, match="unhashable"):
         hash(a)
+
+
+def test_a_store_of_the_competition_run_with_another_policy_set_is_refused_and_the_folder_kept(tmp_path: Path, cli) -> None:
+    """U1, S3: the refusal named two hashes and --update / --fresh, which compete does not take; a failed competition
+    rewrote its --out folder's episodes.csv (a header only, or another competition's rows under its summary)."""
+    import json
+    import shutil
+
+    from neurohover.policysets import policy_dir
+
+    shutil.copytree(policy_dir("ghh08"), tmp_path / "pd" / "ghh08")
+    argv = ["compete", "--task", "ghh08", "--agent", "generic", "--runs", "1", "--episodes", "2", "--episode-steps", "20", "--policy-dir", str(tmp_path / "pd")]
+    assert cli(*argv, "--out", str(tmp_path / "c1"))[0] == 0
+    other = ["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "3", "--episode-steps", "20"]
+    assert cli(*other, "--out", str(tmp_path / "c2"))[0] == 0
+    before = {p.name: p.read_bytes() for p in (tmp_path / "c2").iterdir() if p.is_file()}
+    generic = tmp_path / "pd" / "ghh08" / "generic.json"
+    policy = json.loads(generic.read_text())
+    generic.write_text(json.dumps({**policy, "genome": [g * 0.5 for g in policy["genome"]]}))
+    rc, _, err = cli(*argv, "--out", str(tmp_path / "c2"), "--store", str(tmp_path / "c1" / "results.sqlite"))
+    assert rc == 2 and "holds this competition (compete-ghh08-generic) run with other settings (the policy set's files differ" in err, err
+    assert "--update" not in err and "--fresh" not in err
+    assert {p.name: p.read_bytes() for p in (tmp_path / "c2").iterdir() if p.is_file()} == before

@@ -203,9 +203,9 @@ def decode_history(rows) -> list[HistoryRecord]:
 
 
 def write_checkpoint(path: Path, state: dict) -> None:
-    """Write a checkpoint atomically: strict JSON to ``PATH.tmp``, synced, then renamed over ``path``."""
+    """Write a checkpoint atomically: strict JSON to ``PATH.PID.tmp``, synced, then renamed over ``path``."""
     path = Path(os.path.realpath(path))  # through a symbolic link: its file is written, the link kept (ninth trial)
-    tmp = path.with_name(path.name + ".tmp")
+    tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")  # one per process: two runs on one --out truncated each other's (tenth trial)
     path.parent.mkdir(parents=True, exist_ok=True)
     try:
         with open(tmp, "w") as f:
@@ -213,7 +213,7 @@ def write_checkpoint(path: Path, state: dict) -> None:
             f.flush()
             os.fsync(f.fileno())
         os.replace(tmp, path)
-    except BaseException as err:  # interrupted or failed mid-write: no truncated PATH.tmp is left (the last checkpoint stands)
+    except BaseException as err:  # interrupted or failed mid-write: no truncated temporary file is left (the last checkpoint stands)
         tmp.unlink(missing_ok=True)
         if isinstance(err, OSError):  # a full disk said only "No space left on device" (seventh trial)
             why = err.strerror or err

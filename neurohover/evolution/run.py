@@ -20,7 +20,7 @@ from typing import Any, cast
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, first_difference
 from ..flyer import KernelFlyer
 from ..launch import Parking
 from ..policies import Policy
@@ -51,20 +51,6 @@ __all__ = ["InterruptFlag", "Run"]
 #: A race's look-ahead per kernel thread where it cannot park (:class:`RaceSampler`): 4 lane loads of LANES episodes, the
 #: best of 0-32 lane loads measured on FGHH (docs/performance.md): more fills the lanes but flies samples never used.
 RACE_BATCH_PER_THREAD = 4 * LANES
-
-
-def _first_difference(path: str, saved, given) -> str:
-    """Where a checkpoint's setting and the given one first differ, with both values (cut at 60 characters)."""
-    if isinstance(saved, dict) and isinstance(given, dict):
-        for key in sorted(set(saved) | set(given), key=str):
-            if saved.get(key) != given.get(key):
-                return _first_difference(f"{path}.{key}", saved.get(key), given.get(key))
-
-    def brief(value) -> str:
-        text = repr(value)
-        return text if len(text) <= 60 else text[:57] + "..."
-
-    return f"{path}: the checkpoint's {brief(saved)}, given {brief(given)}"
 
 
 class InterruptFlag:
@@ -176,7 +162,7 @@ class Run:
             raise _damaged(source, err) from None
         if saved != self.config:
             diff = sorted(k for k in set(saved) | set(self.config) if saved.get(k) != self.config.get(k))
-            values = "; ".join(_first_difference(k, saved.get(k), self.config.get(k)) for k in diff)
+            values = "; ".join(first_difference(k, saved.get(k), self.config.get(k), "the checkpoint's") for k in diff)
             raise NeurohoverError(  # the values named, not only their keys (tenth trial)
                 f"{source} was written by a different run ({values}); resume with the same "
                 "target, method, optimizer, resampling, topology, prototype, seed, episode steps and settings (only the budget may change)"
