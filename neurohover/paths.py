@@ -11,6 +11,7 @@ or failed run leaves nothing behind (a directory holding any result stays).
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import sys
@@ -20,6 +21,11 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .errors import NeurohoverError, OutputError
+
+try:
+    import fcntl
+except ImportError:  # not POSIX: no output lock; one run per output is then the user's care
+    fcntl = None  # type: ignore[assignment]
 
 __all__ = [
     "JSONError",
@@ -271,3 +277,41 @@ def remove_created_dirs() -> list[Path]:
 def forget_created_dirs() -> None:
     """Start a command afresh: what earlier commands in this process created is theirs."""
     _created.clear()
+
+
+@contextmanager
+def sole_writer(path: Path, option: str) -> Iterator[None]:
+    """Be the only run writing the output ``path`` (and the files named after it) inside this block: a second run on
+    the same output is refused, naming the first's pid. Two evolve runs on one --out both said they finished and left
+    one's policy beside the other's checkpoint (tenth trial). An OS advisory lock on ``.NAME.lock`` beside it, released
+    when the block ends or the process does; a filesystem that cannot lock is written unguarded."""
+    lock = path.with_name(f".{path.name}.lock")
+    fd = -1
+    for _ in range(3) if fcntl is not None else ():
+        fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as err:
+            holder = os.read(fd, 64).decode(errors="replace").split()
+            os.close(fd)
+            fd = -1
+            if err.errno not in (errno.EAGAIN, errno.EWOULDBLOCK, errno.EACCES):
+                break  # the filesystem cannot lock
+            who = f"pid {holder[0]}" if holder else "another process"
+            raise NeurohoverError(f"{option} {str(path)!r} is being written by another run ({who}): wait for it to end, or give another {option}") from None
+        try:
+            if os.fstat(fd).st_ino == os.stat(lock).st_ino:  # still the path's file, not one the previous holder removed
+                break
+        except FileNotFoundError:
+            pass
+        os.close(fd)
+        fd = -1
+    if fd >= 0:
+        os.ftruncate(fd, 0)
+        os.write(fd, f"{os.getpid()}\n".encode())
+    try:
+        yield
+    finally:
+        if fd >= 0:
+            lock.unlink(missing_ok=True)
+            os.close(fd)

@@ -107,3 +107,18 @@ def test_a_store_of_the_competition_run_with_another_policy_set_is_refused_and_t
     assert rc == 2 and "holds this competition (compete-ghh08-generic) run with other settings (the policy set's files differ" in err, err
     assert "--update" not in err and "--fresh" not in err
     assert {p.name: p.read_bytes() for p in (tmp_path / "c2").iterdir() if p.is_file()} == before
+
+
+def test_a_second_evolve_on_an_output_being_written_is_refused(tmp_path: Path, cli) -> None:
+    """S1: two evolve runs on one --out both said they finished, leaving one's policy beside the other's checkpoint."""
+    from neurohover.paths import sole_writer
+
+    out = tmp_path / "k.json"
+    argv = ["evolve", "--task", "ghh08", "--mdp", "train:0", "--budget", "30", "--episode-steps", "20", "--out", str(out)]
+    with sole_writer(out, "--out"):  # another run writing it (the lock is the OS's: another process's alike)
+        (tmp_path / ".k.json.lock").write_text("4242\n")
+        rc, _, err = cli(*argv)
+        assert rc == 2 and f"--out '{out}' is being written by another run (pid 4242): wait for it to end, or give another --out" in err, err
+        assert not out.exists()
+    rc, _, err = cli(*argv)
+    assert rc == 0 and out.is_file() and not (tmp_path / ".k.json.lock").exists(), err

@@ -19,6 +19,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import sys
@@ -184,8 +185,13 @@ def _print_evolve_summary(args: argparse.Namespace, summary: dict, result) -> No
 
 def cmd_evolve(args: argparse.Namespace) -> int:
     """Evolve a policy: steady state on one MDP, or generational over the task family's MDPs (--mdp G)."""
+    with contextlib.ExitStack() as held:  # the output's writer lock, held until the command ends
+        return _evolve_command(args, held)
+
+
+def _evolve_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int:
     from ..evolution.evolve import EvolutionInterrupted, evolve, parse_resampling, validation_return, write_history_csv
-    from ..paths import output_file, writing
+    from ..paths import output_file, sole_writer, writing
     from ..policies import save_policy
 
     _check_evolve_sizes(args)
@@ -193,6 +199,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     target, family, mdp_desc = _target(args)
     topology, proto = _seed_policy(args)
     out = output_file(args.out, "--out", {"--seed-policy": args.seed_policy})
+    held.enter_context(sole_writer(out, "--out"))
     history_path = output_file(f"{out}.history.csv", "--out (its history file)")
     checkpoint = output_file(f"{out}.checkpoint.json", "--out (its checkpoint file)")
     if args.resume and not checkpoint.is_file():
