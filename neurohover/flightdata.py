@@ -122,6 +122,9 @@ class FlightData:
             meta["episode_steps"] = max(a, b)
         if self.metadata.get("task") != other.metadata.get("task"):  # two tasks' episodes: neither names them all
             meta.pop("task", None)
+        flown = self.metadata.get("policy_flown"), other.metadata.get("policy_flown")
+        if any(f is not None for f in flown) and flown[0] != flown[1]:  # two policies flew them: EC-MER must not take one for both
+            meta["policy_flown"] = None
         return FlightData(self.observations + other.observations, self.actions + other.actions, meta)
 
     def save(self, path: str | Path, dtype: str = "float64") -> Path:

@@ -148,3 +148,19 @@ def test_an_output_through_a_symbolic_link_writes_its_file_and_a_dangling_one_is
     rc, _, err = cli("evolve", "--task", "ghh08", "--mdp", "train:0", "--budget", "3", "--episode-steps", "20", "--out", str(tmp_path / "p.json"))
     assert rc == 0, err
     assert (tmp_path / "p.json").is_symlink() and (tmp_path / "real" / "p.json").is_file()
+
+
+def test_joined_recordings_of_two_policies_name_no_one_policy_for_ec_mer(tmp_path, cli) -> None:
+    """S6 (continued): the sum of two recordings kept the second's policy for every episode."""
+    import json
+
+    from neurohover.flightdata import FlightData
+
+    (tmp_path / "p.json").write_text(json.dumps({"topology": "slp", "genome": [0.0] * 36 + [0.02, 0, 0, 0.23]}))
+    for name, policy in (("a.npz", "baseline"), ("b.npz", str(tmp_path / "p.json"))):
+        assert cli("fly", "--task", "ghh08", "--episodes", "1", "--policy", policy, "--record", str(tmp_path / name))[0] == 0
+    a, b = FlightData.load(tmp_path / "a.npz"), FlightData.load(tmp_path / "b.npz")
+    assert (a + a).metadata["policy_flown"] == a.metadata["policy_flown"]
+    (a + b).save(tmp_path / "ab.npz")
+    rc, _, err = cli("learn-model", "--flight-data", str(tmp_path / "ab.npz"), "--method", "ec-mer", "--budget", "2", "--out", str(tmp_path / "m.json"))
+    assert rc == 2 and "were flown by more than one policy (joined recordings): EC-MER learns one closed loop; give --policy FILE" in err, err

@@ -376,6 +376,10 @@ def _policy_that_flew(given: str | None, metadata: dict, flight_data: str):
 
     if given is not None:
         return load_policy(given)
+    if "policy_flown" in metadata and metadata["policy_flown"] is None:  # joined recordings of two policies
+        raise NeurohoverError(
+            f"flight data {flight_data!r} were flown by more than one policy (joined recordings): EC-MER learns one closed loop; give --policy FILE"
+        )
     if "policy_flown" in metadata:
         return policy_from_dict(metadata["policy_flown"], f"flight data {flight_data!r}, metadata policy_flown")
     source = metadata.get("policy") or "baseline"
