@@ -127,6 +127,22 @@ class FlightData:
             meta["policy_flown"] = None
         return FlightData(self.observations + other.observations, self.actions + other.actions, meta)
 
+    def recorded_policy(self, name: str = "flight data"):
+        """The policy that flew these episodes as ``fly --record`` keeps it (metadata ``policy_flown``), for EC-MER; None
+        where none is recorded. A file's name alone was looked up from another directory (ninth trial).
+
+        Raises
+        ------
+        NeurohoverError
+            If joined recordings of two policies record none (``policy_flown`` None), or the record is damaged.
+        """
+        from .policies import policy_from_dict
+
+        flown = self.metadata.get("policy_flown", False)
+        if flown is None:
+            raise NeurohoverError(f"{name} were flown by more than one policy (joined recordings): EC-MER learns one closed loop; give --policy FILE")
+        return None if flown is False else policy_from_dict(flown, f"{name}, metadata policy_flown")
+
     def save(self, path: str | Path, dtype: str = "float64") -> Path:
         """Write the flight data to ``path`` (``.npz``), as float64 (exact) or float32 (half the space)."""
         if dtype not in SAVE_DTYPES:

@@ -288,7 +288,10 @@ def sole_writer(path: Path, option: str) -> Iterator[None]:
     lock = path.with_name(f".{path.name}.lock")
     fd = -1
     for _ in range(3) if fcntl is not None else ():
-        fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError:  # a full disk or a read-only folder: the output's own write names it
+            break
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as err:
@@ -307,8 +310,11 @@ def sole_writer(path: Path, option: str) -> Iterator[None]:
         os.close(fd)
         fd = -1
     if fd >= 0:
-        os.ftruncate(fd, 0)
-        os.write(fd, f"{os.getpid()}\n".encode())
+        try:
+            os.ftruncate(fd, 0)
+            os.write(fd, f"{os.getpid()}\n".encode())
+        except OSError:  # no room for the pid: the lock holds all the same
+            pass
     try:
         yield
     finally:

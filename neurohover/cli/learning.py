@@ -354,7 +354,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
         elif args.method == "ec-meno":
             model = learn_ec_meno(data, seed=seed, **extra)
         else:
-            model = learn_ec_mer(data, _policy_that_flew(args.policy, data.metadata, args.flight_data), seed=seed, **extra)
+            model = learn_ec_mer(data, _policy_that_flew(args.policy, data, args.flight_data), seed=seed, **extra)
     model.save(out)  # written whole or not at all (a failed write: one message, the old file as it was)
     truth, why = _true_mdp(data.metadata)
     print(f"{args.method} model written to {out} ({time.perf_counter() - start:.2f} s)")
@@ -369,24 +369,17 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     return 0
 
 
-def _policy_that_flew(given: str | None, metadata: dict, flight_data: str):
-    """EC-MER's policy: --policy, else the policy the flight data record (fly writes it in, ``policy_flown``), else the
-    file their metadata names (older files; a relative name was read from this directory: said so when it fails)."""
-    from ..policies import load_policy, policy_from_dict
+def _policy_that_flew(given: str | None, data, flight_data: str):
+    """EC-MER's policy: --policy, else the one the flight data record, else the file their metadata names (older files)."""
+    from ..policies import load_policy
 
-    if given is not None:
-        return load_policy(given)
-    if "policy_flown" in metadata and metadata["policy_flown"] is None:  # joined recordings of two policies
-        raise NeurohoverError(
-            f"flight data {flight_data!r} were flown by more than one policy (joined recordings): EC-MER learns one closed loop; give --policy FILE"
-        )
-    if "policy_flown" in metadata:
-        return policy_from_dict(metadata["policy_flown"], f"flight data {flight_data!r}, metadata policy_flown")
-    source = metadata.get("policy") or "baseline"
+    recorded = None if given is not None else data.recorded_policy(f"flight data {flight_data!r}")
+    if recorded is not None:
+        return recorded
     try:
-        return load_policy(source)
+        return load_policy(given or data.metadata.get("policy") or "baseline")
     except NeurohoverError as err:
-        raise NeurohoverError(f"{err} (the policy that flight data {flight_data!r} name in their metadata; give --policy FILE)") from None
+        raise NeurohoverError(f"{err} (the policy the flight data's metadata name; give --policy FILE)" if given is None else str(err)) from None
 
 
 def _wind_text(x, y) -> str:
