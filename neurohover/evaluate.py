@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import NeurohoverError
-from .flightdata import FlightData
+from .flightdata import FlightData, same_values
 from .flyer import KernelFlyer
 from .launch import DEVICES, KIND, MAX_SEED, Batch, Flown, check_device, launch, num_threads, use_lanes
 from .policies import GENOME_LENGTH, TOPOLOGIES, Policy, load_policy
@@ -94,7 +94,7 @@ class PolicyTable:
     def __eq__(self, other: object) -> bool:  # the generated one raised NumPy's "truth value is ambiguous" (tenth trial)
         if not isinstance(other, PolicyTable):
             return NotImplemented
-        return np.array_equal(self.kinds, other.kinds) and np.array_equal(self.genomes, other.genomes, equal_nan=True)
+        return same_values((self.kinds, self.genomes), (other.kinds, other.genomes))  # int64 and float64 both, after __post_init__
 
     __hash__ = None  # type: ignore[assignment]
 
@@ -185,13 +185,9 @@ class Evaluation:
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Evaluation):
             return NotImplemented
-        mine = (self.returns, self.crashed, self.steps, self.safeguard_step)
-        theirs = (other.returns, other.crashed, other.steps, other.safeguard_step)
-        same = all(
-            a.shape == b.shape and a.dtype == b.dtype and np.array_equal(a, b, equal_nan=a.dtype.kind in "fc")
-            for a, b in zip(map(np.asarray, mine), map(np.asarray, theirs), strict=True)
-        )
-        return same and self.flight_data == other.flight_data
+        mine = tuple(map(np.asarray, (self.returns, self.crashed, self.steps, self.safeguard_step)))
+        theirs = tuple(map(np.asarray, (other.returns, other.crashed, other.steps, other.safeguard_step)))
+        return same_values(mine, theirs) and self.flight_data == other.flight_data
 
     @property
     def episodes(self) -> int:

@@ -43,6 +43,23 @@ def _check_declared_size(path: Path) -> None:
         raise NeurohoverError(f"{str(path)!r} declares arrays of {total:,} bytes: more than half the memory free now; give a smaller file")
 
 
+def same_values(a: object, b: object) -> bool:
+    """Value equality through dicts, lists and tuples, arrays compared whole: the same shape, dtype and values, NaN
+    equal to NaN (the ``==`` of FlightData, Evaluation and PolicyTable, whose generated one was NumPy's ValueError)."""
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):  # an array equals an array only, as a list a list
+        if not (isinstance(a, np.ndarray) and isinstance(b, np.ndarray)):
+            return False
+        return a.shape == b.shape and a.dtype == b.dtype and np.array_equal(a, b, equal_nan=a.dtype.kind in "fc")
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(same_values(a[k], b[k]) for k in a)
+    if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
+        return type(a) is type(b) and len(a) == len(b) and all(same_values(x, y) for x, y in zip(a, b, strict=True))
+    try:
+        return bool(a == b)
+    except (ValueError, TypeError):  # a NumPy scalar against a list compares elementwise: not the same value
+        return False
+
+
 @dataclass(frozen=True, eq=False)  # eq=False: the generated == compared arrays as tuples, NumPy's ValueError (tenth trial)
 class FlightData:
     """Flown episodes: ``observations[i]`` is (steps_i + 1, 12), ``actions[i]`` is (steps_i, 4).
@@ -63,27 +80,7 @@ class FlightData:
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, FlightData):
             return NotImplemented
-        return (
-            FlightData._same(self.observations, other.observations)
-            and FlightData._same(self.actions, other.actions)
-            and FlightData._same(self.metadata, other.metadata)
-        )
-
-    @staticmethod
-    def _same(a: object, b: object) -> bool:
-        """Value equality through dicts, lists and tuples, arrays compared whole (metadata may hold arrays too)."""
-        if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):  # an array equals an array only, as a list a list
-            if not (isinstance(a, np.ndarray) and isinstance(b, np.ndarray)):
-                return False
-            return a.shape == b.shape and a.dtype == b.dtype and np.array_equal(a, b, equal_nan=a.dtype.kind in "fc")
-        if isinstance(a, dict) and isinstance(b, dict):
-            return a.keys() == b.keys() and all(FlightData._same(a[k], b[k]) for k in a)
-        if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
-            return type(a) is type(b) and len(a) == len(b) and all(FlightData._same(x, y) for x, y in zip(a, b))
-        try:
-            return bool(a == b)
-        except (ValueError, TypeError):  # a NumPy scalar against a list compares elementwise: not the same value
-            return False
+        return same_values((self.observations, self.actions, self.metadata), (other.observations, other.actions, other.metadata))
 
     def __post_init__(self) -> None:
         for name in ("observations", "actions"):  # a string was an AttributeError (fourth trial)
