@@ -37,6 +37,7 @@ __all__ = [
     "output_dir",
     "output_file",
     "remove_created_dirs",
+    "sole_writer",
     "write_png",
     "writing",
 ]
