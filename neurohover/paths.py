@@ -14,9 +14,10 @@ from __future__ import annotations
 import errno
 import json
 import os
+import socket
 import sys
 import tempfile
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -29,6 +30,7 @@ except ImportError:  # not POSIX: no output lock; one run per output is then the
 
 __all__ = [
     "JSONError",
+    "WriterLock",
     "checked_path",
     "parse_json",
     "strict_json",
@@ -280,45 +282,93 @@ def forget_created_dirs() -> None:
     _created.clear()
 
 
+class WriterLock:
+    """One process writing an output at a time: an OS advisory lock (``flock``) on a lock file beside it.
+
+    The holder writes its pid and host into the file. The kernel drops the lock when its process ends in any way, so a
+    killed run never blocks the next one; :meth:`release` removes the file while still holding the lock, and a run that
+    opened the old file meanwhile sees, once it gets the lock, that the path names another file and starts over. Used by
+    :func:`sole_writer` (evolve's ``--out``) and by the results store (``STORE.lock``).
+    """
+
+    def __init__(self, path: Path, attempts: int = 100) -> None:
+        self.path = path  # the lock file
+        self.attempts = attempts
+        self.fd = -1
+
+    @property
+    def held(self) -> bool:
+        return self.fd >= 0
+
+    def open_file(self) -> int:
+        """The lock file, created if missing, opened for reading and writing (an OSError where it cannot be)."""
+        return os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+
+    def acquire(self, busy: Callable[[str], str]) -> bool:
+        """Take the lock (nothing if this object holds it). Another process holding it raises NeurohoverError with
+        ``busy(who)``, ``who`` naming the holder ("pid 12 on host h"). False where the lock cannot be taken at all (not
+        POSIX, or a filesystem without locks): the output is then written unguarded. Opening the file may raise OSError."""
+        if self.held:
+            return True
+        if fcntl is None:
+            return False
+        for _ in range(self.attempts):
+            fd = self.open_file()
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError as err:
+                holder = os.read(fd, 256).decode(errors="replace").split()
+                os.close(fd)
+                if err.errno not in (errno.EAGAIN, errno.EWOULDBLOCK, errno.EACCES):
+                    return False  # ENOLCK and the like: the filesystem cannot lock
+                who = f"pid {holder[0]} on host {holder[1]}" if len(holder) >= 2 else f"pid {holder[0]}" if holder else "another process"
+                raise NeurohoverError(busy(who)) from None
+            if self._names(fd):
+                break
+            os.close(fd)  # the previous holder removed it as it released: lock the path's new file
+        else:
+            raise NeurohoverError(f"could not lock {str(self.path)!r}: it kept being replaced by other runs")
+        self.fd = fd
+        try:
+            os.ftruncate(fd, 0)
+            os.write(fd, f"{os.getpid()} {socket.gethostname()}\n".encode())
+        except OSError:  # no room for the pid: the lock holds all the same
+            pass
+        return True
+
+    def _names(self, fd: int) -> bool:
+        """Whether the lock path still is the file ``fd`` holds (not removed or replaced since it was opened)."""
+        try:
+            now = os.stat(self.path)
+        except FileNotFoundError:
+            return False
+        held = os.fstat(fd)
+        return (now.st_dev, now.st_ino) == (held.st_dev, held.st_ino)
+
+    def release(self) -> None:
+        """Remove the lock file, then drop the lock (nothing if not held)."""
+        if not self.held:
+            return
+        try:
+            self.path.unlink()
+        except OSError:
+            pass
+        os.close(self.fd)
+        self.fd = -1
+
+
 @contextmanager
 def sole_writer(path: Path, option: str) -> Iterator[None]:
     """Be the only run writing the output ``path`` (and the files named after it) inside this block: a second run on
     the same output is refused, naming the first's pid. Two evolve runs on one --out both said they finished and left
-    one's policy beside the other's checkpoint (tenth trial). An OS advisory lock on ``.NAME.lock`` beside it, released
-    when the block ends or the process does; a filesystem that cannot lock is written unguarded."""
-    lock = path.with_name(f".{path.name}.lock")
-    fd = -1
-    for _ in range(3) if fcntl is not None else ():
-        try:
-            fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
-        except OSError:  # a full disk or a read-only folder: the output's own write names it
-            break
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError as err:
-            holder = os.read(fd, 64).decode(errors="replace").split()
-            os.close(fd)
-            fd = -1
-            if err.errno not in (errno.EAGAIN, errno.EWOULDBLOCK, errno.EACCES):
-                break  # the filesystem cannot lock
-            who = f"pid {holder[0]}" if holder else "another process"
-            raise NeurohoverError(f"{option} {str(path)!r} is being written by another run ({who}): wait for it to end, or give another {option}") from None
-        try:
-            if os.fstat(fd).st_ino == os.stat(lock).st_ino:  # still the path's file, not one the previous holder removed
-                break
-        except FileNotFoundError:
-            pass
-        os.close(fd)
-        fd = -1
-    if fd >= 0:
-        try:
-            os.ftruncate(fd, 0)
-            os.write(fd, f"{os.getpid()}\n".encode())
-        except OSError:  # no room for the pid: the lock holds all the same
-            pass
+    one's policy beside the other's checkpoint (tenth trial). A :class:`WriterLock` on ``.NAME.lock`` beside it; a
+    folder where it cannot be made (full, read-only) is left to the output's own write to name."""
+    lock = WriterLock(path.with_name(f".{path.name}.lock"))
+    try:
+        lock.acquire(lambda who: f"{option} {str(path)!r} is being written by another run ({who}): wait for it to end, or give another {option}")
+    except OSError:
+        pass
     try:
         yield
     finally:
-        if fd >= 0:
-            lock.unlink(missing_ok=True)
-            os.close(fd)
+        lock.release()

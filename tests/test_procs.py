@@ -420,20 +420,22 @@ def test_two_stores_on_one_file_in_one_process_take_turns(tmp_path: Path) -> Non
 
 
 def test_a_run_that_opened_the_lock_file_as_its_writer_removed_it_locks_the_new_one(tmp_path: Path, monkeypatch) -> None:
+    from neurohover.paths import WriterLock
+
     path = tmp_path / "s.sqlite"
     first = Store(path)
     first.lock()
-    stale = open(first.lock_path)  # the next run opened the file while the first still held it
+    stale = os.open(first.lock_path, os.O_RDWR)  # the next run opened the file while the first still held it
     first.close()  # removes the file, then releases the lock: flock on `stale` would now succeed
     second = Store(path)
     opened = []
-    real_open = Store._open_lock_file
+    real_open = WriterLock.open_file
 
-    def open_lock_file(self):
+    def open_file(self):
         opened.append(1)
         return stale if len(opened) == 1 else real_open(self)
 
-    monkeypatch.setattr(Store, "_open_lock_file", open_lock_file)
+    monkeypatch.setattr(WriterLock, "open_file", open_file)
     second.lock()
     assert len(opened) == 2  # it saw that its first file was gone and locked the path's new one
     third = Store(path)

@@ -28,7 +28,6 @@ Readers (``results``, ``report``) take no lock.
 from __future__ import annotations
 
 import contextlib
-import errno
 import json
 import os
 import socket
@@ -36,17 +35,10 @@ import sqlite3
 import time
 from collections.abc import Iterable, Iterator
 from pathlib import Path
-from typing import IO, Any
+from typing import Any
 
 from ..errors import NeurohoverError, finite_real
-from ..paths import JSONError, strict_json
-
-LOCK_ATTEMPTS = 100  # tries to lock STORE.lock while earlier writers remove it as they close
-
-try:
-    import fcntl
-except ImportError:  # not POSIX: no writer lock; one run per store is then the user's care
-    fcntl = None  # type: ignore[assignment]
+from ..paths import JSONError, WriterLock, strict_json
 
 SCHEMA_VERSION = 1
 APPLICATION_ID = 0x4E484F56  # "NHOV"
@@ -108,7 +100,7 @@ class Store:
         if not create and self.path.stat().st_size == 0:  # read, it was given the schema: a refused command changed it (seventh trial)
             raise NeurohoverError(f"results store {str(self.path)!r} is empty (0 bytes): it holds no experiment yet")
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._lock: IO[str] | None = None
+        self._lock = WriterLock(self.lock_path)
         new = not self.path.exists() or self.path.stat().st_size == 0
         try:
             self.conn = sqlite3.connect(str(self.path), timeout=30.0, isolation_level=None)
@@ -132,15 +124,7 @@ class Store:
 
     def close(self) -> None:
         self.conn.close()
-        if self._lock is not None:
-            # Unlink while still holding the lock: a run that opened the file meanwhile finds, once
-            # it gets the lock, that the path no longer names its file, and starts over (lock()).
-            try:
-                self.lock_path.unlink()
-            except OSError:
-                pass
-            self._lock.close()  # closing the file releases the lock
-            self._lock = None
+        self._lock.release()
 
     # ------------------------------------------------------------------ one writer
 
@@ -166,47 +150,15 @@ class Store:
             If another live process (or another Store in this one) holds the lock; the message names
             the store and the holder's pid.
         """
-        if self._lock is not None or fcntl is None:
-            return
-        for _ in range(LOCK_ATTEMPTS):
-            file = self._open_lock_file()
-            try:
-                fcntl.flock(file.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except OSError as err:
-                holder = file.read().split()
-                file.close()
-                if err.errno not in (errno.EAGAIN, errno.EWOULDBLOCK, errno.EACCES):
-                    return  # the filesystem cannot lock (ENOLCK, ...): write unguarded, as without a lock
-                who = f"pid {holder[0]} on host {holder[1]}" if len(holder) == 2 else f"see {str(self.lock_path)!r}"
-                raise NeurohoverError(
+        try:
+            self._lock.acquire(
+                lambda who: (
                     f"results store {str(self.path)!r} is in use: another run ({who}) is writing it; wait for that run "
                     f"to end (or stop it), or give another --store file. Reading it (results, report) works meanwhile"
-                ) from None
-            if self._names_the_lock_file(file):
-                break
-            file.close()  # the previous writer removed it as it closed: lock the path's new file
-        else:
-            raise NeurohoverError(f"could not lock {str(self.lock_path)!r}, the writer lock of results store {str(self.path)!r}: it kept being replaced")
-        file.seek(0)
-        file.truncate()
-        file.write(f"{os.getpid()} {socket.gethostname()}\n")
-        file.flush()
-        self._lock = file
-
-    def _open_lock_file(self) -> IO[str]:
-        try:
-            return os.fdopen(os.open(self.lock_path, os.O_RDWR | os.O_CREAT, 0o644), "r+")
+                )
+            )
         except OSError as err:
             raise NeurohoverError(f"cannot open {str(self.lock_path)!r}, the writer lock of results store {str(self.path)!r}: {err.strerror}") from None
-
-    def _names_the_lock_file(self, file: IO[str]) -> bool:
-        """Whether :attr:`lock_path` still is the file ``file`` holds (not removed or replaced since it was opened)."""
-        try:
-            now = os.stat(self.lock_path)
-        except FileNotFoundError:
-            return False
-        held = os.fstat(file.fileno())
-        return (now.st_dev, now.st_ino) == (held.st_dev, held.st_ino)
 
     def __enter__(self) -> Store:
         return self
