@@ -32,20 +32,34 @@ if running_as_command():
 from .errors import NeurohoverError  # noqa: E402
 
 
-def _check_numba_threads() -> None:
-    """NUMBA_NUM_THREADS, read by numba as it imports: 0 or less was numba's traceback from every command, --help too,
-    and text its warning, then its default (tenth trial)."""
-    value = os.environ.get("NUMBA_NUM_THREADS")
-    if value is None or (value.strip().isascii() and value.strip().isdigit() and int(value) >= 1):
-        return
-    message = f"environment variable NUMBA_NUM_THREADS={value!r:.40} is not allowed: give a whole number >= 1 (numba's threads), or unset it"
-    if running_as_command():
-        print(f"neurohover: error: {message}", file=sys.stderr, flush=True)
-        sys.exit(2)
-    raise NeurohoverError(message)
+def _whole_at_least_1(value: str) -> bool:
+    return value.strip().isascii() and value.strip().isdigit() and int(value) >= 1
 
 
-_check_numba_threads()
+#: The numba variables our docs name, read by numba as it imports: each one's test and what it allows. A value numba
+#: cannot parse was its warning with a traceback, then its default (tenth trial: NUMBA_NUM_THREADS; eleventh: CUDASIM).
+_NUMBA_VARIABLES = {
+    "NUMBA_NUM_THREADS": (_whole_at_least_1, "give a whole number >= 1 (numba's threads), or unset it"),
+    "NUMBA_ENABLE_CUDASIM": (lambda value: value.strip() in ("0", "1"), "give 0 or 1 (1: numba's CUDA simulator stands in for a GPU), or unset it"),
+}
+
+
+def _check_numba_variables() -> None:
+    """The numba variables of :data:`_NUMBA_VARIABLES` set in the environment, each refused by name where it does not
+    pass its test (the command line's exit 2, a NeurohoverError on import): 0 threads or less was numba's traceback
+    from every command, --help too, and other text its warning, then its default."""
+    for name, (allowed, what) in _NUMBA_VARIABLES.items():
+        value = os.environ.get(name)
+        if value is None or allowed(value):
+            continue
+        message = f"environment variable {name}={value!r:.40} is not allowed: {what}"
+        if running_as_command():
+            print(f"neurohover: error: {message}", file=sys.stderr, flush=True)
+            sys.exit(2)
+        raise NeurohoverError(message)
+
+
+_check_numba_variables()
 
 from .evaluate import DangerousState, Evaluation, PolicyTable, Safeguard, evaluate, evaluate_jobs  # noqa: E402
 from .flightdata import FlightData  # noqa: E402
