@@ -32,12 +32,14 @@ __all__ = [
     "JSONError",
     "WriterLock",
     "checked_path",
+    "created_dirs_removed_on_failure",
     "parse_json",
     "strict_json",
     "input_file",
     "input_dir",
     "output_dir",
     "output_file",
+    "printable",
     "remove_created_dirs",
     "sole_writer",
     "write_png",
@@ -151,14 +153,30 @@ def _json_int(text: str) -> int:
 SQLITE_HEADER = b"SQLite format 3\x00"  # the first bytes of every SQLite database: a results store
 
 
-def output_file(path: str | os.PathLike, option: str, inputs: Mapping[str, str | os.PathLike | None] | None = None, *, store: bool = False) -> Path:
+def _no_dash(path: str | os.PathLike, option: str, what: str, stdout: bool) -> None:
+    """Refuse ``-``, which by custom means standard output, as a name: it was written as a hidden-looking file named '-'
+    (eleventh trial); ``stdout``: leaving ``option`` out writes to standard output."""
+    if isinstance(path, (str, os.PathLike)) and os.fspath(path) == "-":
+        instead = f"leave {option} out for standard output" if stdout else f"give a {what} name (./- for one called '-')"
+        raise NeurohoverError(f"{option} '-' is not a {what} name here: {instead}")
+
+
+def output_file(
+    path: str | os.PathLike,
+    option: str,
+    inputs: Mapping[str, str | os.PathLike | None] | None = None,
+    *,
+    store: bool = False,
+    stdout: bool = False,
+) -> Path:
     """Check that the file ``path`` can be written (an existing file is kept as it is).
 
-    Refuses a directory, a parent that is a file, any place where a file cannot be created, the
-    file of one of ``inputs`` (option -> path: writing it would destroy what the command reads) and,
-    unless ``store`` (the path is a results store's own), an existing results store; creates missing
-    parent directories (saying so on standard error).
+    Refuses ``-`` (standard output, which ``stdout`` says leaving ``option`` out gives), a directory, a parent that is
+    a file, any place where a file cannot be created, the file of one of ``inputs`` (option -> path: writing it would
+    destroy what the command reads) and, unless ``store`` (the path is a results store's own), an existing results
+    store; creates missing parent directories (saying so on standard error).
     """
+    _no_dash(path, option, "file", stdout)
     p = checked_path(path, option)
     for name, given in (inputs or {}).items():
         if given is not None and str(given) != "" and p.exists() and Path(given).exists() and p.samefile(given):
@@ -222,7 +240,8 @@ def write_png(fig, path: str | os.PathLike, what: str, dpi: float | None = None)
 
 
 def output_dir(path: str | os.PathLike, option: str) -> Path:
-    """Check that files can be written in the directory ``path``, creating it (saying so) if missing."""
+    """Check that files can be written in the directory ``path`` (not ``-``), creating it (saying so) if missing."""
+    _no_dash(path, option, "directory", False)
     p = checked_path(path, option, "directory")
     if p.exists() and not p.is_dir():
         raise NeurohoverError(f"{option} {str(path)!r} is a file; give a directory")
@@ -262,19 +281,44 @@ def input_dir(path: str | os.PathLike, option: str) -> Path:
     return p
 
 
-def remove_created_dirs() -> list[Path]:
-    """Remove the directories the checks above created that are still empty (a failed command's); returns them."""
+def remove_created_dirs(since: int | None = None) -> list[Path]:
+    """Remove the directories the checks above created that are still empty (a failed command's); returns them.
+    ``since``: only those created after :func:`created_count` gave it (one failed API call's, not earlier calls')."""
+    mine = list(_created) if since is None else _created[: len(_created) - since]  # newest first
     removed = []
-    for directory in list(_created):
+    for directory in mine:
         try:
             directory.rmdir()  # only an empty directory goes
         except OSError:
             continue
         removed.append(directory)
-    _created.clear()
+    del _created[: len(mine)]
     if removed:
         print(f"neurohover: removed the empty directory {str(removed[-1])!r} it had created", file=sys.stderr)
     return removed
+
+
+def created_count() -> int:
+    """How many directories the checks have created so far in this process (see :func:`remove_created_dirs`)."""
+    return len(_created)
+
+
+@contextmanager
+def created_dirs_removed_on_failure() -> Iterator[None]:
+    """Inside this block, a failure removes the directories the checks created in it that are still empty, as the
+    command line does for a failed command: an API call (write_report) left the directory it announced (eleventh trial)."""
+    since = created_count()
+    try:
+        yield
+    except BaseException:
+        remove_created_dirs(since)
+        raise
+
+
+def printable(text: str | os.PathLike) -> str:
+    """``text`` (a path) with bytes that are no UTF-8 (kept by Python as surrogates) written as escapes, the way
+    messages show them: such a name in a report or a plot title was a UnicodeEncodeError or matplotlib's TypeError."""
+    return os.fspath(text).encode("utf-8", "backslashreplace").decode("utf-8")
 
 
 def forget_created_dirs() -> None:

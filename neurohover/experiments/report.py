@@ -505,7 +505,7 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
 
     A ``README.md`` in ``out`` with generated blocks gets them filled from the store (:mod:`.report_readme`).
     """
-    from ..paths import output_dir, writing
+    from ..paths import created_dirs_removed_on_failure, output_dir
 
     if not isinstance(store, Store):  # None was an AttributeError (sixth trial)
         raise NeurohoverError(f"store={store!r:.60} is not allowed: give a Store(PATH)")
@@ -515,14 +515,21 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
     twice = sorted({n for n in given if given.count(n) > 1})
     if twice:  # taken once without a word (seventh trial)
         raise NeurohoverError(f"experiment {twice[0]!r} is named more than once: give each once")
-    out = output_dir(out, "report directory")  # '' wrote into the current directory; a file, a device or 5: OSError, TypeError
+    with created_dirs_removed_on_failure():  # a failure leaves no directory it made, as on the command line (eleventh trial)
+        out = output_dir(out, "report directory")  # '' wrote into the current directory; a file, a device or 5: OSError, TypeError
+        return _write_report(store, out, scale, names)
+
+
+def _write_report(store: Store, out: Path, scale: str | None, names: list[str] | None) -> Path:
+    from ..paths import printable, writing
+
     entries = [(n, s) for n, s, _, _ in store.experiments() if (scale is None or s == scale) and (not names or n in names)]
     if names:
         missing = [n for n in names if n not in {e[0] for e in entries}]
         if missing:
             raise NeurohoverError(store.missing_message(missing[0], scale))
     if not entries:
-        raise NeurohoverError(store.missing_message("(any)", scale))
+        raise NeurohoverError(store.missing_message(None, scale))
     rank = {n: i for i, n in enumerate(ORDER)}
     entries.sort(key=lambda e: (rank.get(e[0], len(ORDER)), e[0], e[1]))
     sections, toc = [], []
@@ -551,7 +558,7 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
             claims[name] = (anchor, checked)
     head = (
         f"# Reproduction report: Koppejan & Whiteson (2011)\n\n"
-        f"Generated {time.strftime('%Y-%m-%d %H:%M:%S')} from the results store `{store.path}`. Error is minus the "
+        f"Generated {time.strftime('%Y-%m-%d %H:%M:%S')} from the results store `{printable(store.path)}`. Error is minus the "
         f"return (lower is better). Quick-scale runs use short episodes and few runs: they check the pipeline, and "
         f"their numbers are not comparable in magnitude with the paper's.\n\n" + "\n".join(toc) + "\n"
     )
@@ -559,7 +566,7 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
     head += "\n" + summary + conclusions_discussion(out) if summary else ""
     path = out / "report.md"
     with writing(path, "report") as partial:  # a full disk left an empty report.md and an unnamed error (seventh trial)
-        partial.write_text(head + "\n" + "\n".join(sections))
+        partial.write_text(head + "\n" + "\n".join(sections), errors="backslashreplace")  # no text can fail it half-way
     readme = out / "README.md"
     fill_generated(readme, "status", status_table([s for s in statuses if s.scale == "paper"]))
     if summary:

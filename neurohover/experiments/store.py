@@ -116,15 +116,33 @@ class Store:
         except sqlite3.DatabaseError as err:
             raise NeurohoverError(f"{str(self.path)!r} is not a neurohover results store (SQLite says: {err})") from None
 
+    _closed = False
+
+    @property
+    def conn(self) -> sqlite3.Connection:
+        """The store's open connection; once :meth:`close` ran, one NeurohoverError saying so (a closed Store was
+        reported as a damaged file, which may lead a user to delete a good store; eleventh trial)."""
+        if self._closed:
+            raise NeurohoverError(f"this Store ({str(self.path)!r}) was closed: open it again with Store(path)")
+        return self._conn
+
+    @conn.setter
+    def conn(self, value: sqlite3.Connection) -> None:
+        self._conn = value
+
     def _close_quietly(self) -> None:
         """Close the connection if one was opened (a failed open's cleanup)."""
-        conn = getattr(self, "conn", None)
+        conn = getattr(self, "_conn", None)
         if conn is not None:
             conn.close()
 
     def close(self) -> None:
+        """Close the file and drop the writer lock; closing again does nothing."""
+        if self._closed:
+            return
         self.conn.close()
         self._lock.release()
+        self._closed = True
 
     # ------------------------------------------------------------------ one writer
 
@@ -150,6 +168,7 @@ class Store:
             If another live process (or another Store in this one) holds the lock; the message names
             the store and the holder's pid.
         """
+        self.conn  # noqa: B018  (a closed Store refused by name before it locks the file)
         try:
             self._lock.acquire(
                 lambda who: (
@@ -284,11 +303,15 @@ class Store:
             raise NeurohoverError(self.missing_message(name, scale))
         return self._json(rows[0][0], f"experiment {name} ({scale})'s config")
 
-    def missing_message(self, name: str, scale: str | None) -> str:
-        """The message for an experiment (at ``scale``, if given) this store does not hold, listing what it holds."""
+    def missing_message(self, name: str | None, scale: str | None) -> str:
+        """The message for an experiment (None: any experiment; at ``scale``, if given) this store does not hold,
+        listing what it holds (any was "holds no experiment '(any)'"; eleventh trial)."""
         present = [f"{n} ({s})" for n, s, _, _ in self.experiments()]
-        what = f"{name!r}" + (f" at scale {scale!r}" if scale else "")
-        return f"results store {str(self.path)!r} holds no experiment {what}; it holds: " + (", ".join(present) if present else "nothing yet")
+        at = f" at scale {scale!r}" if scale else ""
+        if name is None and not present:
+            return f"results store {str(self.path)!r} holds no experiment yet"
+        what = f"no experiment {name!r}{at}" if name is not None else f"nothing{at}"
+        return f"results store {str(self.path)!r} holds {what}; it holds: " + (", ".join(present) if present else "nothing yet")
 
     def scales(self, name: str) -> list[str]:
         return [r[0] for r in self._rows("SELECT scale FROM experiments WHERE name = ? ORDER BY created", (name,), f"experiment {name}'s scales")]
