@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import csv
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -33,7 +34,7 @@ from matplotlib.ticker import MaxNLocator
 
 from .errors import NeurohoverError
 from .flightdata import FlightData
-from .paths import strict_json
+from .paths import checked_path, input_dir, printable, strict_json
 from .sim.constants import ACTION_NAMES, CONTROL_DT, CRASH_STEP_PENALTY, EPISODE_STEPS, MAX_EPISODE_STEPS
 
 __all__ = [
@@ -46,6 +47,7 @@ __all__ = [
     "plot_compete",
     "plot_flight_data",
     "read_compete_dir",
+    "read_compete_dirs",
     "save_figure",
 ]
 
@@ -156,6 +158,7 @@ def flight_figure(
     axes[-1].set_ylim(-1.05, 1.05)
     axes[-1].set_xlabel("time (s)")
     end = f"crashed at {t_obs[-1]:.1f} s (step {act.shape[0]})" if crashed else f"{act.shape[0]} steps, no crash"
+    title = printable(title)  # a file or policy name that is no UTF-8 was matplotlib's TypeError (eleventh trial)
     fig.suptitle(f"{title}\n{end}" if title else end, color=CRASH_COLOR if crashed else "black")
     fig.tight_layout()
     return fig
@@ -198,7 +201,11 @@ def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight"
     list of Path
         The files written, in episode order.
     """
-    out_dir = Path(out_dir)
+    out_dir = checked_path(out_dir, "out_dir", "directory")
+    if not isinstance(stem, str) or stem == "" or "\x00" in stem or any(sep and sep in stem for sep in (os.sep, os.altsep)):
+        raise NeurohoverError(  # '../zz' wrote outside out_dir, '' the file '-episode0.png' (eleventh trial)
+            f"stem={stem!r:.60} is not allowed: give a non-empty file-name prefix without a path separator, e.g. 'flight'"
+        )
     steps = data.metadata.get("episode_steps", EPISODE_STEPS) if isinstance(data.metadata, dict) else EPISODE_STEPS
     width = len(str(max(data.n_episodes - 1, 0)))
     chosen = range(data.n_episodes) if episodes is None else list(episodes)
@@ -249,9 +256,9 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
     Raises
     ------
     NeurohoverError
-        If the directory has no ``episodes.csv`` or it is not one compete wrote.
+        If ``path`` is no directory, or it has no ``episodes.csv`` or not one compete wrote.
     """
-    path = Path(path)
+    path = input_dir(path, "--compete")  # None or 5 was pathlib's TypeError (eleventh trial)
     csv_path = path / COMPETE_FILE
     if not csv_path.is_file():
         raise NeurohoverError(f"--compete {str(path)!r} holds no {COMPETE_FILE}: give directories written by neurohover compete --out")
@@ -330,6 +337,18 @@ def _check_summary_matches(path: Path, summary: dict, shape: tuple[int, ...]) ->
             )
 
 
+def read_compete_dirs(dirs: Sequence[str | Path]) -> list[CompeteResult]:
+    """:func:`read_compete_dir` of each of ``dirs``, every one checked before any is read: none, or one given twice
+    (one run overlaid on itself; fourth trial), refused as ``neurohover plot --compete`` refuses them."""
+    if isinstance(dirs, (str, os.PathLike)) or not isinstance(dirs, Sequence) or len(dirs) == 0:  # [] drew an empty figure (eleventh trial)
+        raise NeurohoverError(f"--compete {dirs!r:.60} is not allowed: give a list of one or more directories written by neurohover compete --out")
+    paths = [input_dir(d, "--compete") for d in dirs]
+    twice = [str(d) for i, d in enumerate(paths) if any(d.resolve() == e.resolve() for e in paths[:i])]
+    if twice:
+        raise NeurohoverError(f"--compete names {twice[0]!r} more than once: give each competition's directory once")
+    return [read_compete_dir(d) for d in paths]
+
+
 def compete_figure(results: Sequence[CompeteResult], title: str = "") -> Figure:
     """Mean cumulative error per episode of each result, linear (left) and log scale (right).
 
@@ -344,7 +363,7 @@ def compete_figure(results: Sequence[CompeteResult], title: str = "") -> Figure:
         error = r.cumulative_error
         episodes = np.arange(1, error.size + 1)
         for ax in axes:
-            ax.plot(episodes, error, label=f"{name}: {r.returns.shape[0]} runs, {r.crashes} crashes")
+            ax.plot(episodes, error, label=printable(f"{name}: {r.returns.shape[0]} runs, {r.crashes} crashes"))  # names that are no UTF-8
     axes[0].set_ylabel("cumulative error (-cumulative reward)")
     axes[1].set_yscale("log")
     axes[1].set_ylabel("cumulative error (log scale)")
@@ -353,13 +372,14 @@ def compete_figure(results: Sequence[CompeteResult], title: str = "") -> Figure:
         ax.xaxis.set_major_locator(MaxNLocator(integer=True))
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=8)
-    fig.suptitle(title or "mean cumulative error over runs")
+    fig.suptitle(printable(title) or "mean cumulative error over runs")
     fig.tight_layout()
     return fig
 
 
 def plot_compete(dirs: Sequence[str | Path], out: str | Path) -> tuple[Path, Figure]:
-    """Overlay the compete results in ``dirs`` (:func:`compete_figure`) and write the PNG ``out``."""
-    results = [read_compete_dir(d) for d in dirs]
+    """Overlay the compete results in ``dirs`` (:func:`compete_figure`) and write the PNG ``out``; ``dirs`` is checked
+    as :func:`read_compete_dirs` says."""
+    results = read_compete_dirs(dirs)
     fig = compete_figure(results)
     return save_figure(fig, out), fig

@@ -46,7 +46,7 @@ def _episodes(text: str | None, n: int) -> list[int] | None:
 
 def cmd_plot(args: argparse.Namespace) -> int:
     """Plot a recorded flight (one PNG per episode) or overlay competition results (one PNG)."""
-    from ..paths import input_dir, input_file, output_dir
+    from ..paths import input_file, output_dir
 
     if args.flight is not None and args.compete:
         raise NeurohoverError("give either a flight-data file or --compete DIR ..., not both")
@@ -64,14 +64,10 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
         written = plot_flight_data(data, out, stem=path.stem, episodes=_episodes(args.episodes, data.n_episodes))
     else:
-        dirs = [input_dir(d, "--compete") for d in args.compete]
-        twice = [str(d) for i, d in enumerate(dirs) if any(d.resolve() == e.resolve() for e in dirs[:i])]
-        if twice:  # one run overlaid on itself (fourth trial)
-            raise NeurohoverError(f"--compete names {twice[0]!r} more than once: give each competition's directory once")
-        from ..plots import compete_figure, read_compete_dir, save_figure
+        from ..plots import compete_figure, read_compete_dirs, save_figure
 
-        results = [read_compete_dir(d) for d in dirs]  # every directory read before anything is written
-        out = output_dir(args.out if args.out is not None else dirs[0].resolve().parent, "--out")
+        results = read_compete_dirs(args.compete)  # every directory checked and read before anything is written
+        out = output_dir(args.out if args.out is not None else results[0].path.resolve().parent, "--out")
         written = [save_figure(compete_figure(results), out / COMPETE_PNG)]
     for p in written:
         print(p)
