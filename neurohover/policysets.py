@@ -93,10 +93,12 @@ class PolicySet:
 
 
 def policy_dir(task: str, directory: str | Path | None = None) -> Path:
-    """The directory of ``task``'s policy set in ``directory`` (the shipped sets when None; '' refused by name)."""
+    """The directory of ``task``'s policy set in ``directory`` (the shipped sets when None; '' refused by name). A task
+    that is no task family's name is refused by name (None was pathlib's TypeError; eleventh trial)."""
     from .paths import checked_path
 
-    return (checked_path(directory, "policy directory", "directory") if directory is not None else SHIPPED) / task
+    name = get_task_family(task).name
+    return (checked_path(directory, "policy directory", "directory") if directory is not None else SHIPPED) / name
 
 
 def _load(path: Path, what: str, task: str, target: str) -> Policy:
@@ -258,7 +260,10 @@ def check_build(family, lineage: str | None, fghh_budget: int | None, optimizer:
     if fghh and lineage is not None:  # would be ignored without a word (second trial)
         raise NeurohoverError(f"lineage applies to the GHH tasks' specialised policies; task {family.name!r} has none")
     if not fghh and fghh_budget is not None:
-        raise NeurohoverError(f"fghh_budget (--fghh-budget) applies to task fghh (its generics over G), not to {family.name!r}: give budget")
+        raise NeurohoverError(
+            f"fghh_budget (--fghh-budget) applies to task fghh (its generics over G), not to {family.name!r}: "
+            "leave it out (budget, --budget on the command line, sizes every policy of this task)"
+        )
     n_train = 0 if fghh else len(family.training_mdps())
     highest = {  # what one run or one call can hold (a larger size failed after the out directory was made: third trial)
         "budget": MAX_BUDGET,
