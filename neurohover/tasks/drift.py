@@ -43,6 +43,7 @@ MIN_FACTOR, MAX_FACTOR = 0.01, 100.0
 #: window past its last episode), and below NumPy's int64, in which the episode is drawn.
 MAX_CHANGE_AT = 10**12
 _PARSE_FORM = "give walk=STD or PARAM=FACTOR[@LO-HI], e.g. walk=0.01,D_w=0.8@200-800"
+_NOTHING = "give walk > 0 (up to 1) or a change of a factor other than 1, or leave it out (fixed dynamics)"
 
 
 @dataclass(frozen=True)
@@ -76,6 +77,10 @@ class Drift:
                 raise NeurohoverError(f"drift change of {name!r}: not a dynamics parameter; allowed {', '.join(PARAM_NAMES)}")
             if isinstance(factor, bool) or not isinstance(factor, (int, float)) or not MIN_FACTOR <= factor <= MAX_FACTOR:  # NaN fails too
                 raise NeurohoverError(f"drift change {name}={factor!r} is out of range: allowed a factor in {MIN_FACTOR:g}..{MAX_FACTOR:g}")
+            if factor == 1:  # flown as another experiment with results identical to none (eleventh trial, S3)
+                raise NeurohoverError(
+                    f"drift change {name}={factor!r} changes nothing: give a factor other than 1 (in {MIN_FACTOR:g}..{MAX_FACTOR:g}) or leave {name} out"
+                )
             factors[PARAM_NAMES.index(name)] = float(factor)
         object.__setattr__(self, "change", tuple(sorted((n, float(f)) for n, f in change.items())))
         object.__setattr__(self, "_factors", factors)
@@ -144,7 +149,10 @@ class Drift:
         change = d.get("change", {})
         if not isinstance(change, dict):
             raise NeurohoverError(f"drift change={change!r} is not allowed: give a table of parameter factors, e.g. {{D_w = 0.8}}")
-        return cls(d.get("walk", 0.0), tuple(change.items()), d.get("change_at", CHANGE_AT))  # checked in __post_init__
+        drift = cls(d.get("walk", 0.0), tuple(change.items()), d.get("change_at", CHANGE_AT))  # checked in __post_init__
+        if "walk" in d and drift.none:  # {walk = 0}: a drift table that drifts nothing (eleventh trial, S3)
+            raise NeurohoverError(f"drift walk={d['walk']!r} changes nothing: {_NOTHING}")
+        return drift
 
     @classmethod
     def of(cls, value) -> Drift:
@@ -197,6 +205,8 @@ class Drift:
             if len(windows) > 1:
                 raise NeurohoverError(f"drift {text!r} gives its changes different windows: they happen together, at one episode; give one window")
             if key.strip() == "walk":
+                if number == 0:  # 'walk=0' was flown as a drift that drifts nothing (eleventh trial, S3)
+                    raise NeurohoverError(f"drift {part!r} changes nothing: {_NOTHING}")
                 walk = number
             else:
                 change[key.strip()] = number
