@@ -211,6 +211,12 @@ def check_own_name(cfg: ExperimentConfig) -> None:
             f"config {cfg.source!r}: name = {cfg.name!r} is a shipped experiment's (or 'all'): a config of your own needs a name of its own, "
             "or its results and report would pass for the shipped experiment's"
         )
+    alias_of = _aliases().get(cfg.name)
+    if alias_of is not None:  # `reproduce table3` ran fig2 while `results table3` showed this config's (eleventh trial, S8)
+        raise NeurohoverError(
+            f"config {cfg.source!r}: name = {cfg.name!r} is an alias of the shipped experiment {alias_of!r}: a config of your own needs a name "
+            f"of its own, or `reproduce {cfg.name}` would run {alias_of} while its results pass under the same name"
+        )
 
 
 def parse_override(text: str, option: str = "--set") -> tuple[str, Any]:
