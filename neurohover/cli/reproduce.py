@@ -30,6 +30,9 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     if args.list:
         if args.name is not None:  # the name was ignored (fourth trial)
             raise NeurohoverError(f"--list lists every experiment and takes no NAME (got {args.name!r}): give one or the other")
+        others = _options_beside_list(args)
+        if others:  # --store, --set, --fresh ... were dropped without a word (eleventh trial, S1)
+            raise NeurohoverError(f"--list lists every experiment and takes no other options (got {', '.join(others)}): give one or the other")
         for name in experiment_names():
             print(name)
         return 0
@@ -91,6 +94,16 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     finally:
         executor.close()
     return 1 if failed else 0
+
+
+def _options_beside_list(args: argparse.Namespace) -> list[str]:
+    """The options given beside ``reproduce --list``, as typed (single-valued ones and flags are recorded as they are parsed)."""
+    given = sorted(getattr(args, "_given_options", set()) - {"list", "name"})  # NAME: refused above
+    given += [d for d in ("set", "only") if getattr(args, d, None)]  # repeatable: not recorded
+    names = [f"--{d.replace('_', '-')}" for d in given]
+    if args.progress is not None:
+        names.append("--progress" if args.progress else "--no-progress")
+    return names
 
 
 def _remove_if_empty(path: Path) -> None:
@@ -203,6 +216,8 @@ def cmd_report(args: argparse.Namespace) -> int:
         missing = [n for n in args.names or () if n not in held]
         if missing:  # before --out is made: one line, not a directory made and removed around it (sixth trial)
             raise NeurohoverError(store.missing_message(missing[0], args.scale))
+        if not held and args.scale is not None:  # a scale the store lacks, before --out is made too (eleventh trial)
+            raise NeurohoverError(store.missing_message(None, args.scale))
         output_dir(args.out, "--out")
         path = write_report(store, args.out, scale=args.scale, names=args.names or None)
     print(f"report written to {path}")
@@ -246,7 +261,7 @@ def register(sub) -> None:
     p = sub.add_parser("results", help="export an experiment's results as CSV or JSON", description=cmd_results.__doc__)
     p.add_argument("name", help="experiment name")
     p.add_argument("--store", required=True, help="results store file")
-    p.add_argument("--scale", choices=("quick", "paper"), help="which scale (needed when the store holds both)")
+    p.add_argument("--scale", metavar="SCALE", help="which scale: quick, paper or a compete run's settings-HASH (needed when the store holds several)")
     p.add_argument(
         "--format",
         choices=("csv", "json"),
@@ -259,7 +274,7 @@ def register(sub) -> None:
     p = sub.add_parser("wins", help="each agent's odds of winning an N-run competition, from stored test runs", description=cmd_wins.__doc__)
     p.add_argument("name", help="experiment name (a test-runs experiment)")
     p.add_argument("--store", required=True, help="results store file")
-    p.add_argument("--scale", choices=("quick", "paper"), help="which scale (needed when the store holds both)")
+    p.add_argument("--scale", metavar="SCALE", help="which scale: quick, paper or a compete run's settings-HASH (needed when the store holds several)")
     p.add_argument("--runs", default="1,5,20", help="competition lengths N, comma-separated (default 1,5,20)")
     p.add_argument("--agents", help="group labels to enter, comma-separated (default: every group of the experiment)")
     p.add_argument("--against", metavar="LABEL", help="each agent against this group alone (head to head)")
@@ -272,5 +287,5 @@ def register(sub) -> None:
     p.add_argument("names", nargs="*", help="experiments to include (default: all in the store)")
     p.add_argument("--store", required=True, help="results store file")
     p.add_argument("--out", required=True, help="output directory")
-    p.add_argument("--scale", choices=("quick", "paper"), help="only this scale (default: every scale in the store)")
+    p.add_argument("--scale", metavar="SCALE", help="only this scale: quick, paper or a compete run's settings-HASH (default: every scale in the store)")
     p.set_defaults(func=cmd_report)

@@ -33,7 +33,7 @@ def resolve_scale(store: Store, name: str, scale: str | None) -> str:
         raise NeurohoverError(store.missing_message(name, None))
     if scale is None:
         if len(scales) > 1:
-            raise NeurohoverError(f"experiment {name!r} is in the store at scales {', '.join(scales)}: choose one with --scale")
+            raise NeurohoverError(f"experiment {name!r} is in the store at scales {', '.join(scales)}: choose one with --scale (e.g. --scale {scales[-1]})")
         return scales[0]
     if scale not in scales:
         raise NeurohoverError(store.missing_message(name, scale))
