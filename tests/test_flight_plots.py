@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import csv
+import shutil
 import struct
 import subprocess
 import sys
@@ -146,7 +147,9 @@ def test_compete_overlay_has_one_line_per_directory(files) -> None:
 
 
 def test_compete_overlay_of_three_directories(files, tmp_path: Path) -> None:
-    dirs = [files["baseline"], files["model-free"], files["baseline"]]
+    again = tmp_path / "baseline-again"  # the same agent twice (a directory given twice is refused)
+    shutil.copytree(files["baseline"], again)
+    dirs = [files["baseline"], files["model-free"], again]
     path, fig = plot_compete(dirs, tmp_path / "three.png")
     assert all(len(ax.lines) == 3 for ax in fig.axes)
     assert png_size(path) == (1100, 450)
