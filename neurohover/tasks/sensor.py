@@ -190,7 +190,10 @@ class Sensor:
         named = isinstance(obs_noise, dict) and "delay" in obs_noise
         named = named or (isinstance(obs_noise, str) and re.search(r"(^|,)\s*delay\s*=", obs_noise) is not None)
         if sensor.delay != delay and (sensor.delay != 0 or named):  # an explicit delay=0 lost to obs_delay=2 without a word (sixth trial)
-            raise NeurohoverError(f"obs_delay={delay} conflicts with the delay={sensor.delay} that obs_noise sets: give the delay once")
+            raise NeurohoverError(  # the options as the command line spells them too (eleventh trial, U8)
+                f"obs_delay={delay} conflicts with the delay={sensor.delay} that obs_noise sets: give the delay once "
+                "(on the command line: --obs-delay, or delay= in --obs-noise)"
+            )
         return replace(sensor, delay=delay)
 
     def to_dict(self) -> dict:
