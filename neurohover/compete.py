@@ -40,6 +40,7 @@ from .evolution.seeding import check_seed
 from .paths import write_png
 from .sim.constants import EPISODE_STEPS
 from .tasks import N_TEST, N_TRAINING, Drift, Sensor, get_task_family
+from .tasks.base import echoed
 
 CSV_COLUMNS = ("run", "mdp", "episode", "return", "crashed", "steps", "policy", "safeguard_fired")
 STORE_FILE = "results.sqlite"
@@ -137,13 +138,31 @@ def _group(task: str, runs: int, mdps: str) -> dict:
     return {"mdps": mdps, "n_mdps": size, "runs_per_mdp": runs // size}
 
 
+#: The UNIT_KEYs of agents' settings classes that are settings of the whole experiment, not a group's own table (the
+#: incremental agents' max_learning_episodes): compete's one group takes them as such.
+_EXPERIMENT_WIDE = ("max_learning_episodes",)
+
+
+def check_agent_name(agent: object) -> None:
+    """Refuse an agent that is not registered, a long name shortened (a 100,000-character --agent was echoed whole;
+    eleventh trial, U6)."""
+    from .agents.registry import AGENTS
+
+    if not isinstance(agent, str) or agent not in AGENTS:
+        raise NeurohoverError(f"unknown agent {echoed(agent)}: allowed {', '.join(AGENTS)}")
+
+
 def check_agent_settings(agent: str, values: Mapping[str, object]) -> dict:
-    """``values`` as the agent's own settings table, checked by its spec's settings class (one clear message)."""
+    """``values`` as the agent's own settings table, checked by its spec's settings class (one clear message): every
+    agent that ``neurohover settings`` lists settings for takes them here, but the hybrid agents, whose settings are
+    the ``hybrid`` argument (the --safeguard-*/--hybrid-* options)."""
     from .agents.registry import agent_spec
 
+    check_agent_name(agent)
     spec = agent_spec(agent)
-    if spec.settings is None or spec.settings.UNIT_KEY != "agent_settings":
-        hybrid = " (the hybrid agents' settings are the --safeguard-*/--hybrid-* options)" if spec.settings is not None else ""
+    if spec.settings is None or spec.settings.UNIT_KEY not in ("agent_settings", *_EXPERIMENT_WIDE):
+        # incremental's max_learning_episodes was refused here while `neurohover settings incremental` listed it (eleventh trial, U2)
+        hybrid = " (its settings, `neurohover settings hybrid`, are the --safeguard-*/--hybrid-* options, hybrid= in Python)" if spec.settings else ""
         raise NeurohoverError(f"agent {agent!r} takes no settings table of its own{hybrid}; agents that do: {', '.join(agents_with_settings())}")
     settings = spec.settings.from_dict(dict(values)).to_dict()
     why = spec.settings.unused(agent, dict(values))
@@ -153,10 +172,10 @@ def check_agent_settings(agent: str, values: Mapping[str, object]) -> dict:
 
 
 def agents_with_settings() -> list[str]:
-    """The registered agents that take settings of their own (their spec's settings class)."""
+    """The registered agents that take --agent-setting (agent_settings=): those with settings of their own but the hybrid agents."""
     from .agents.registry import AGENTS
 
-    return sorted(name for name, spec in AGENTS.items() if spec.settings is not None and spec.settings.UNIT_KEY == "agent_settings")
+    return sorted(name for name, spec in AGENTS.items() if spec.settings is not None and spec.settings.UNIT_KEY in ("agent_settings", *_EXPERIMENT_WIDE))
 
 
 def competition_config(
@@ -205,8 +224,12 @@ def competition_config(
         if key not in LR_FIT_KEYS:
             raise NeurohoverError(f"lr_fit key {key!r} is not allowed: choose from {', '.join(LR_FIT_KEYS)}")
         group[key] = choice
+    wide: dict[str, object] = {}  # the incremental agents' max_learning_episodes: a setting of the whole experiment
     if agent_settings:  # the agent's own typed settings, checked by its spec's class (absent: as before)
-        group["settings"] = check_agent_settings(agent, agent_settings)
+        own = check_agent_settings(agent, agent_settings)
+        wide = {k: v for k, v in own.items() if k in _EXPERIMENT_WIDE}
+        if not wide:
+            group["settings"] = own
     settings: dict[str, object] = {
         "task": task,
         "sigma": sigma,
@@ -215,6 +238,7 @@ def competition_config(
         "episodes": episodes,
         "policies": policy_dir if policy_dir is not None else "shipped",
         "groups": [group],
+        **wide,
     }
     get_task_family(task, sigma, sensor, drift)  # the family's own checks of the sensor and drift ('x' was an AttributeError)
     if sensor is not None and not sensor.exact:
@@ -299,6 +323,7 @@ def compete(
     from .paths import output_dir
 
     _check_run(jobs, device, on_result, progress)  # every check before the output directory is made (third trial)
+    check_agent_name(agent)
     check_agent(agent, get_task_family(task, sigma), policy_dir)
     config = competition_config(
         task, agent, runs=runs, episodes=episodes, mdps=mdps, seed=seed, sigma=sigma, n_steps=n_steps, policy_dir=policy_dir, hybrid=hybrid,

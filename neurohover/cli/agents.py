@@ -45,16 +45,16 @@ def cmd_compete(args: argparse.Namespace) -> int:
     from ..agents.hybrid import HybridSettings
     from ..agents.model_based import ModelEvolution
     from ..agents.registry import AGENTS, HYBRID_AGENTS, agent_spec
-    from ..compete import check_sizes, compete
-    from ..paths import input_dir, output_file
+    from ..compete import agents_with_settings, check_agent_name, check_sizes, compete
+    from ..paths import checked_path, input_dir, output_file
     from ..tasks import Drift
     from .options import check_given, given_settings, sensor_of
 
+    check_agent_name(args.agent)  # its name shortened where long (the registry's message echoes it whole)
     agent_spec(args.agent, args.task)  # an unknown agent, or one for another task, before anything else is read or made
     given = [o.flag for o in args.hybrid_options if getattr(args, o.dest) is not None]
     if given and args.agent not in HYBRID_AGENTS:
-        settings = AGENTS[args.agent].settings
-        own = settings is not None and settings.UNIT_KEY == "agent_settings"
+        own = args.agent in agents_with_settings()
         raise NeurohoverError(
             f"{', '.join(given)} appl{'ies' if len(given) == 1 else 'y'} to the hybrid agents only ({', '.join(HYBRID_AGENTS)}), not to --agent {args.agent}"
             + (f" (its own settings are --agent-setting KEY=VALUE: neurohover settings {args.agent})" if own else "")
@@ -84,6 +84,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
         input_dir(args.policy_dir, "--policy-dir")
     if args.store is not None:
         output_file(args.store, "--store", store=True)  # --out is made by compete once it has checked every setting
+    checked_path(args.out, "--out", "directory path")  # named as typed: compete() calls it out (eleventh trial, U8)
     try:
         summary, _ = compete(
             args.task,
@@ -198,7 +199,8 @@ def register(sub) -> None:
         action="append",
         metavar="KEY=VALUE",
         help='one of the agent\'s own settings (repeatable; VALUE in TOML syntax), e.g. --agent hybrid-risk --agent-setting criterion="lcb" '
-        "--agent-setting level=3, or --agent continual --agent-setting cooldown=10 (docs/model.md, docs/benchmarks.md)",
+        "--agent-setting level=3, --agent continual --agent-setting cooldown=10, or --agent incremental --agent-setting max_learning_episodes=10 "
+        "(neurohover settings AGENT lists them; the hybrid agents' are the --safeguard-*/--hybrid-* options; docs/model.md, docs/benchmarks.md)",
     )
     g = p.add_argument_group("hybrid agents (defaults: the authors' code; see docs/model.md, Safeguard)")
     hybrid_options = add_setting_options(g, DangerousState, ("rule", "box", "tilt"), prefix="safeguard-")
