@@ -96,11 +96,18 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _negative_values_attached(parser: argparse.ArgumentParser, given: list[str]) -> list[str]:
     """``--runs -1,5`` as ``--runs=-1,5``: argparse takes a value that starts with '-' and is not a plain number for an
-    option and says only "expected one argument" (fourth trial); attached, the option's own check names it."""
+    option and says only "expected one argument" (fourth trial); attached, the option's own check names it. A unique
+    abbreviation (``--win -3,1``) is joined too: argparse accepts abbreviations everywhere else."""
     takes_value = {o for a in parser._actions if a.nargs is None for o in a.option_strings}
+    every = {o for a in parser._actions for o in a.option_strings}
+
+    def spelled_out(arg: str) -> str:  # '--win' as argparse reads it, '--wind' (an abbreviation was "expected one argument"; eleventh trial, U7)
+        matches = [o for o in every if o.startswith(arg)] if arg.startswith("--") and "=" not in arg and arg not in every else []
+        return matches[0] if len(matches) == 1 else arg
+
     out: list[str] = []
     for arg in given:
-        if out and out[-1] in takes_value and len(arg) > 1 and arg[0] == "-" and (arg[1].isdigit() or arg[1] == "."):
+        if out and spelled_out(out[-1]) in takes_value and len(arg) > 1 and arg[0] == "-" and (arg[1].isdigit() or arg[1] == "."):
             out[-1] = f"{out[-1]}={arg}"
         else:
             out.append(arg)
