@@ -306,7 +306,9 @@ def compete(
         with the config (a bad value is refused with the allowed ones).
     agent_settings : mapping, optional
         The agent's own settings (its spec's settings class, e.g. ``{"criterion": "lcb", "level": 3}``
-        for ``hybrid-risk``, ``{"cooldown": 10}`` for ``continual``); refused for an agent without one.
+        for ``hybrid-risk``, ``{"cooldown": 10}`` for ``continual``, ``{"max_learning_episodes": 10}`` for the incremental
+        agents, as ``neurohover settings AGENT`` lists them); refused for an agent without one and for the hybrid agents
+        (their settings are ``hybrid``).
 
     Returns
     -------
