@@ -57,6 +57,10 @@ class _Parser(argparse.ArgumentParser):
         self.register("action", "store", _StoreOnce)
         self.register("action", "store_true", _FlagOnce)
 
+    def error(self, message: str):  # type: ignore[override]
+        """argparse's error, a 100,000-character value shortened (its "invalid choice: 'ggg...'" echoed it whole)."""
+        super().error(shorter_numbers(message))
+
 
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
@@ -194,8 +198,10 @@ def _run(argv: Sequence[str] | None) -> int:
 
 def shorter_numbers(message: str) -> str:
     """``message`` with every number of more than 30 digits shown by its first ten and its length (a 400-digit --budget
-    was echoed whole; seventh trial)."""
-    return re.sub(r"\d(?:,?\d){30,}", lambda m: f"{m[0][:10]}...({len(m[0].replace(',', ''))} digits)", message)  # 1,000,...: too
+    was echoed whole; seventh trial), then every other word of more than 200 characters (a path seldom is) by its first 40 and last 20 and
+    its length (a 100,000-character name: a settings or agent-setting name, a store's experiment; eleventh trial, U6)."""
+    message = re.sub(r"\d(?:,?\d){30,}", lambda m: f"{m[0][:10]}...({len(m[0].replace(',', ''))} digits)", message)  # 1,000,...: too
+    return re.sub(r"\S{201,}?(?=[:;,.)]*(?:\s|$))", lambda m: f"{m[0][:40]} ... {m[0][-20:]} ({len(m[0]):,} characters)", message)
 
 
 if __name__ == "__main__":
