@@ -13,6 +13,7 @@ import sqlite3
 import sys
 import unicodedata
 from collections.abc import Sequence
+from typing import NoReturn
 
 from .. import __version__
 from ..command import running_as_command
@@ -57,7 +58,7 @@ class _Parser(argparse.ArgumentParser):
         self.register("action", "store", _StoreOnce)
         self.register("action", "store_true", _FlagOnce)
 
-    def error(self, message: str):  # type: ignore[override]
+    def error(self, message: str) -> NoReturn:
         """argparse's error, a 100,000-character value shortened (its "invalid choice: 'ggg...'" echoed it whole)."""
         super().error(shorter_numbers(message))
 
