@@ -31,6 +31,23 @@ def finite_real(value: object) -> bool:
         return False
 
 
+def brief(value: object) -> str:
+    """``repr(value)`` for a message: an int of more than 30 digits as its first ten and its length, any other repr
+    cut at 60 characters (a settings class echoed 10**400 whole, a 400-character line; eleventh trial)."""
+    if isinstance(value, numbers.Integral) and not isinstance(value, bool):
+        try:
+            digits = str(abs(int(value)))
+        except ValueError:  # past Python's int_max_str_digits (4300): no str() at all
+            return f"an integer of about {int(int(value).bit_length() * math.log10(2)) + 1} digits"
+        if len(digits) > 30:
+            return f"{'-' if value < 0 else ''}{digits[:10]}...({len(digits)} digits)"
+    try:
+        text = repr(value)
+    except ValueError:  # a container of such an int
+        text = f"a {type(value).__name__}"
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
 class FloatRangeError(ValueError):
     """A number written past a float's range (:func:`float_of`)."""
 

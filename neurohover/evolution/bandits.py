@@ -25,6 +25,7 @@ import math
 
 import numpy as np
 
+from ..errors import NeurohoverError, brief, finite_real
 from .races import RaceResult, SampleFn, _check_int
 
 __all__ = ["BANDITS", "kl_bounds", "lucb_radius", "top_mu_bandit"]
@@ -84,11 +85,11 @@ def top_mu_bandit(sample_fn: SampleFn, n_candidates: int, mu: int, delta: float,
     n = _check_int("n_candidates", n_candidates, 2)
     mu = _check_int("mu", mu, 1)
     if mu >= n:
-        raise ValueError(f"mu={mu} must be smaller than n_candidates={n}")
-    if isinstance(delta, bool) or not isinstance(delta, (int, float)) or not 0.0 < float(delta) < 1.0:
-        raise ValueError(f"delta={delta!r} must be an error probability strictly between 0 and 1 (e.g. 0.1)")
-    if rule not in BANDITS:
-        raise ValueError(f"rule={rule!r} is not a bandit rule: choose one of {', '.join(BANDITS)}")
+        raise NeurohoverError(f"mu={mu} must be smaller than n_candidates={n}")
+    if not finite_real(delta) or not 0.0 < float(delta) < 1.0:
+        raise NeurohoverError(f"delta={brief(delta)} must be an error probability strictly between 0 and 1 (e.g. 0.1)")
+    if not isinstance(rule, str) or rule not in BANDITS:
+        raise NeurohoverError(f"rule={brief(rule)} is not a bandit rule: choose one of {', '.join(BANDITS)}")
     t_limit = _check_int("t_limit", t_limit, 1)
     sums = _rewards(sample_fn(np.arange(n))).copy()  # every candidate once
     counts = np.ones(n, dtype=np.int64)

@@ -25,16 +25,18 @@ from typing import Any, Protocol, overload
 
 import numpy as np
 
-from ..errors import NeurohoverError, finite_real
+from ..errors import NeurohoverError, brief, finite_real
 
 __all__ = [
     "STATE_VERSION",
+    "AskTellOrderError",
     "ChampionRecord",
     "ChampionTracker",
     "ChampionViews",
     "Clock",
     "Optimiser",
     "TellInfo",
+    "as_floats",
     "check_prototype",
     "check_returns",
     "check_genomes",
@@ -46,6 +48,8 @@ __all__ = [
     "require_int",
     "require_population",
     "MAX_POPULATION",
+    "MAX_SPREAD",
+    "require_spread",
     "require_prob",
     "require_std",
     "rng_from_state",
@@ -108,27 +112,51 @@ class Optimiser(Protocol):
         """The optimiser :meth:`state_dict` saved; it continues bit-for-bit identically."""
 
 
+class AskTellOrderError(NeurohoverError, RuntimeError):
+    """ask() and tell() called out of order: a NeurohoverError, and still the RuntimeError it was for callers that catch that."""
+
+
+#: What an out-of-order call is told to do (eleventh trial: a bare RuntimeError, which ``except NeurohoverError`` missed).
+TELL_FIRST = "tell() called without a pending ask(): call ask() first, then tell() one return per genome it gave"
+ASK_AGAIN = "ask() called again before tell() of the previous {what}: tell() its returns first, one per genome it gave"
+
+
 # --------------------------------------------------------------------------- settings checks
 
 
 def require_int(name: str, value: Any, minimum: int) -> int:
-    """``value`` as an int, or ValueError unless it is an integer (not a bool) ``>= minimum``."""
+    """``value`` as an int, or NeurohoverError unless it is an integer (not a bool) ``>= minimum``."""
     if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < minimum:
-        raise NeurohoverError(f"{name}={value!r} must be an integer >= {minimum}")
+        raise NeurohoverError(f"{name}={brief(value)} must be an integer >= {minimum}")
     return int(value)
 
 
 def require_prob(name: str, value: Any) -> float:
-    """``value`` as a float, or ValueError unless it is a probability in [0, 1]."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not 0.0 <= float(value) <= 1.0:
-        raise NeurohoverError(f"{name}={value!r} must be a probability in [0, 1]")
+    """``value`` as a float, or NeurohoverError unless it is a probability in [0, 1]."""
+    if not finite_real(value) or not 0.0 <= float(value) <= 1.0:  # finite_real first: float(10**400) overflowed (eleventh trial)
+        raise NeurohoverError(f"{name}={brief(value)} must be a probability in [0, 1]")
     return float(value)
 
 
 def require_std(name: str, value: Any) -> float:
-    """``value`` as a float, or ValueError unless it is a finite number >= 0."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not finite_real(value) or float(value) < 0.0:
-        raise NeurohoverError(f"{name}={value!r} must be a finite number >= 0")
+    """``value`` as a float, or NeurohoverError unless it is a finite number >= 0."""
+    if not finite_real(value) or float(value) < 0.0:
+        raise NeurohoverError(f"{name}={brief(value)} must be a finite number >= 0")
+    return float(value)
+
+
+#: The largest spread (a mutation's or a search distribution's standard deviation, a step size) any optimiser takes:
+#: far below a float's 1.8e308, so that genes drawn at that spread, and pycma's adaptation of it, stay finite
+#: (sigma0=1e308 was pycma's AssertionError, sigma and mutate_std=1e308 a late "genome must hold finite numbers"; eleventh trial).
+MAX_SPREAD = 1e100
+
+
+def require_spread(name: str, value: Any, *, positive: bool = False, what: str = "") -> float:
+    """``value`` as a float, or NeurohoverError unless it is a spread in [0, :data:`MAX_SPREAD`] (``(0, ...]`` if
+    ``positive``); ``what`` leads the message (the optimiser's name)."""
+    if not finite_real(value) or not (0.0 < float(value) if positive else 0.0 <= float(value)) or float(value) > MAX_SPREAD:
+        low = "> 0" if positive else ">= 0"
+        raise NeurohoverError(f"{what}{name}={brief(value)} must be a finite number {low} and <= {MAX_SPREAD:g} (a larger one overflows the genes)")
     return float(value)
 
 
@@ -147,7 +175,7 @@ def require_population(name: str, value: Any) -> int:
     """A population size: an integer in 2..:data:`MAX_POPULATION`, or ValueError."""
     size = require_int(name, value, 2)
     if size > MAX_POPULATION:
-        raise NeurohoverError(f"{name}={size} must be an integer in 2..{MAX_POPULATION:,}")
+        raise NeurohoverError(f"{name}={brief(size)} must be an integer in 2..{MAX_POPULATION:,}")
     return size
 
 
@@ -156,7 +184,7 @@ def validate_variation_settings(obj: Any) -> None:
     set_field(obj, "pop_size", require_population("pop_size", obj.pop_size))
     for name in ("crossover_prob", "averaging_prob", "mutate_prob", "mutate_frac", "mutate_repl"):
         set_field(obj, name, require_prob(name, getattr(obj, name)))
-    set_field(obj, "mutate_std", require_std("mutate_std", obj.mutate_std))
+    set_field(obj, "mutate_std", require_spread("mutate_std", obj.mutate_std))
     if obj.budget is not None:
         set_field(obj, "budget", require_int("budget", obj.budget, 1))
 
@@ -164,9 +192,18 @@ def validate_variation_settings(obj: Any) -> None:
 # --------------------------------------------------------------------------- genomes and returns
 
 
+def as_floats(values: Any, name: str, allowed: str) -> np.ndarray:
+    """A float64 copy of ``values``, or NeurohoverError naming ``name`` and what is ``allowed`` where NumPy cannot make
+    numbers of them (SteadyStateNE("abc") and tell(["a", ...]) were NumPy's own "could not convert"; eleventh trial)."""
+    try:
+        return np.array(values, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError):
+        raise NeurohoverError(f"{name}={brief(values)} is not allowed: give {allowed}") from None
+
+
 def check_prototype(prototype: np.ndarray) -> np.ndarray:
     """A float64 copy of a non-empty, finite 1-D genome (ValueError otherwise)."""
-    p = np.array(prototype, dtype=np.float64)
+    p = as_floats(prototype, "prototype", "a non-empty 1-D genome of finite numbers")
     if p.ndim != 1 or p.size == 0:
         raise NeurohoverError(f"prototype must be a non-empty 1-D genome, got shape {p.shape}")
     if not np.all(np.isfinite(p)):
@@ -176,7 +213,7 @@ def check_prototype(prototype: np.ndarray) -> np.ndarray:
 
 def check_returns(values: Any, n: int, what: str = "fitness") -> np.ndarray:
     """``n`` returns as float64, one per asked genome; ``+inf`` is refused (ValueError)."""
-    f = np.array(values, dtype=np.float64)
+    f = as_floats(values, what, f"{n} returns, one per asked genome")
     if f.shape != (n,):
         raise NeurohoverError(f"{what} must have shape ({n},), one return per asked genome; got shape {f.shape}")
     if np.count_nonzero(f == np.inf):
@@ -415,7 +452,7 @@ class PopulationOptimiser(ChampionViews):
     def tell(self, fitness: np.ndarray, info: TellInfo | None = None) -> None:
         """One return per asked genome (maximised; non-finite ones never become champion)."""
         if self._pending is None:
-            raise RuntimeError("tell() called without a pending ask()")
+            raise AskTellOrderError(TELL_FIRST)
         genomes = self._pending
         f = check_returns(fitness, genomes.shape[0])
         self._tell(genomes, f, info)

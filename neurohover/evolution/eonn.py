@@ -33,11 +33,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief, finite_real
 from ..evaluate import PolicyTable, evaluate_jobs
 from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP
+from .common import MAX_SPREAD
 from .fitness import episode_fitness
 from .operators import crossover, mutate
 
@@ -63,7 +64,7 @@ class EonnSettings:
     mutate_frac : float
         Each gene's chance of mutating in a mutated offspring.
     mutate_std : float
-        The spread of a mutation's Gaussian.
+        The spread of a mutation's Gaussian (0 to 1e100, :data:`~neurohover.evolution.common.MAX_SPREAD`).
     mutate_repl : float
         A mutated gene's chance of being replaced by the Gaussian draw (else the draw is added).
     averaging_prob : float
@@ -71,7 +72,7 @@ class EonnSettings:
     spawn_frac : float
         Each gene's chance of mutating in the prototype's copies that make the initial population.
     spawn_std : float
-        The spread of that initial mutation's Gaussian.
+        The spread of that initial mutation's Gaussian (0 to 1e100).
     """
 
     pop_size: int = 50
@@ -90,19 +91,21 @@ class EonnSettings:
         for name, low in (("pop_size", 2), ("keep", 0), ("generations", 1), ("tournament_size", 1)):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, int) or v < low:
-                raise NeurohoverError(f"{name}={v!r} is out of range: allowed an integer >= {low}")
+                raise NeurohoverError(f"{name}={brief(v)} is out of range: allowed an integer >= {low}")
         if self.keep >= self.pop_size:
-            raise NeurohoverError(f"keep={self.keep} is out of range: allowed 0..pop_size - 1 = {self.pop_size - 1} (at least one offspring a generation)")
+            raise NeurohoverError(
+                f"keep={brief(self.keep)} is out of range: allowed 0..pop_size - 1 = {self.pop_size - 1} (at least one offspring a generation)"
+            )
         if self.tournament_size > self.pop_size:
-            raise NeurohoverError(f"tournament_size={self.tournament_size} is out of range: allowed 1..pop_size = {self.pop_size}")
+            raise NeurohoverError(f"tournament_size={brief(self.tournament_size)} is out of range: allowed 1..pop_size = {self.pop_size}")
         for name in ("mutate_prob", "mutate_frac", "mutate_repl", "averaging_prob", "spawn_frac"):
             v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0.0 <= v <= 1.0:
-                raise NeurohoverError(f"{name}={v!r} is out of range: allowed a probability in [0, 1]")
-        for name in ("mutate_std", "spawn_std"):
+            if not finite_real(v) or not 0.0 <= v <= 1.0:
+                raise NeurohoverError(f"{name}={brief(v)} is out of range: allowed a probability in [0, 1]")
+        for name in ("mutate_std", "spawn_std"):  # 10**400 was NumPy's TypeError, 1e308 overflowed the genes (eleventh trial)
             v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not (np.isfinite(v) and v >= 0.0):
-                raise NeurohoverError(f"{name}={v!r} is out of range: allowed a finite number >= 0")
+            if not finite_real(v) or not 0.0 <= v <= MAX_SPREAD:
+                raise NeurohoverError(f"{name}={brief(v)} is out of range: allowed a number in [0, {MAX_SPREAD:g}] (a larger one overflows the genes)")
 
     @property
     def episodes(self) -> int:

@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import NeurohoverError, brief
+
 __all__ = ["ERROR_FLOOR", "FITNESS_SCALES", "episode_fitness", "error_of_fitness"]
 
 #: What a generational run's ``fitness`` setting may be.
@@ -30,7 +32,7 @@ def episode_fitness(returns: np.ndarray, scale: str) -> np.ndarray:
     if scale == "return":
         return np.where(np.isnan(r), -np.inf, r)
     if scale != "inv-log-error":
-        raise ValueError(f"unknown fitness scale {scale!r}: allowed {', '.join(FITNESS_SCALES)}")
+        raise NeurohoverError(f"unknown fitness scale {brief(scale)}: allowed {', '.join(FITNESS_SCALES)}")
     error = np.maximum(np.where(np.isnan(r), np.inf, -r), ERROR_FLOOR)
     return np.where(np.isnan(r), -np.inf, 1.0 / np.log(error))
 

@@ -16,9 +16,12 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from .common import (
+    ASK_AGAIN,
     STATE_VERSION,
+    TELL_FIRST,
+    AskTellOrderError,
     Clock,
     TellInfo,
     check_genomes,
@@ -31,7 +34,7 @@ from .common import (
     rank,
     require_int,
     require_prob,
-    require_std,
+    require_spread,
     rng_from_state,
     set_field,
     validate_variation_settings,
@@ -63,7 +66,7 @@ class GenerationalSettings:
     mutate_frac : float
         Per-gene mutation probability.
     mutate_std : float
-        Standard deviation of the Gaussian mutation (finite, >= 0).
+        Standard deviation of the Gaussian mutation (0 to 1e100, :data:`~neurohover.evolution.common.MAX_SPREAD`).
     mutate_repl : float
         Probability that a mutated gene is replaced rather than shifted.
     budget : int or None
@@ -104,16 +107,16 @@ class GenerationalSettings:
     def __post_init__(self) -> None:
         validate_variation_settings(self)
         if not isinstance(self.elitist, bool):
-            raise NeurohoverError(f"elitist={self.elitist!r} must be True or False")
+            raise NeurohoverError(f"elitist={brief(self.elitist)} must be True or False")
         if self.fitness not in FITNESS_SCALES:
-            raise NeurohoverError(f"fitness={self.fitness!r} is not a fitness scale: allowed {', '.join(FITNESS_SCALES)}")
+            raise NeurohoverError(f"fitness={brief(self.fitness)} is not a fitness scale: allowed {', '.join(FITNESS_SCALES)}")
         if self.init_mutate_frac is not None:
             set_field(self, "init_mutate_frac", require_prob("init_mutate_frac", self.init_mutate_frac))
         if self.init_mutate_std is not None:
-            set_field(self, "init_mutate_std", require_std("init_mutate_std", self.init_mutate_std))
+            set_field(self, "init_mutate_std", require_spread("init_mutate_std", self.init_mutate_std))
         sel = require_int("select_size", self.select_size, 1)
         if sel > self.pop_size:
-            raise NeurohoverError(f"select_size={sel} must be in [1, pop_size={self.pop_size}]")
+            raise NeurohoverError(f"select_size={brief(sel)} must be in [1, pop_size={brief(self.pop_size)}]")
         set_field(self, "select_size", sel)
         set_field(self, "generations", require_int("generations", self.generations, 1))
 
@@ -231,7 +234,7 @@ class GenerationalNE:
     def ask(self) -> np.ndarray:
         """Return the current population, shape ``(pop_size, D)``."""
         if self._asked:
-            raise RuntimeError("ask() called again before tell() of the previous population")
+            raise AskTellOrderError(ASK_AGAIN.format(what="population"))
         self._asked = True
         return self._population.copy()
 
@@ -258,7 +261,7 @@ class GenerationalNE:
             (e.g. ``RaceResult.episodes_spent``); default ``pop_size``.
         """
         if not self._asked:
-            raise RuntimeError("tell() called without a pending ask()")
+            raise AskTellOrderError(TELL_FIRST)
         if info is not None:
             selected = info.selected if selected is None else selected
             episodes = info.episodes if episodes is None else episodes

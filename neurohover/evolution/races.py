@@ -53,6 +53,9 @@ import numba
 import numpy as np
 from scipy import stats
 
+from ..errors import NeurohoverError, brief, finite_real
+from .common import as_floats
+
 __all__ = [
     "RACE_RULES",
     "SampleFn",
@@ -139,25 +142,25 @@ class RaceResult:
 
 def _check_int(name: str, value: object, minimum: int) -> int:
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise ValueError(f"{name}={value!r} must be an integer >= {minimum}")
+        raise NeurohoverError(f"{name}={brief(value)} must be an integer >= {minimum}")
     if value < minimum:
-        raise ValueError(f"{name}={value!r} must be an integer >= {minimum}")
+        raise NeurohoverError(f"{name}={brief(value)} must be an integer >= {minimum}")
     return int(value)
 
 
 def _check_delta(delta: object) -> float:
-    if isinstance(delta, bool) or not isinstance(delta, numbers.Real) or not 0.0 < float(delta) < 1.0:
-        raise ValueError(f"delta={delta!r} must be a confidence level strictly between 0 and 1 (e.g. 0.9 for 90% confidence bounds)")
+    if not (isinstance(delta, numbers.Real) and finite_real(delta) and 0.0 < float(delta) < 1.0):  # finite_real: float(10**400) overflowed
+        raise NeurohoverError(f"delta={brief(delta)} must be a confidence level strictly between 0 and 1 (e.g. 0.9 for 90% confidence bounds)")
     return float(delta)
 
 
 def _draw(sample_fn: SampleFn, indices: np.ndarray) -> np.ndarray:
     """Call ``sample_fn`` and check its answer; NaN returns become ``-inf`` (worst)."""
-    out = np.asarray(sample_fn(indices.copy()), dtype=np.float64)
+    out = as_floats(sample_fn(indices.copy()), "sample_fn's returns", f"{indices.size} numbers, one per candidate")
     if out.shape != indices.shape:
-        raise ValueError(f"sample_fn returned shape {out.shape} for {indices.size} candidates; expected {indices.shape}")
+        raise NeurohoverError(f"sample_fn returned shape {out.shape} for {indices.size} candidates; expected {indices.shape}")
     if np.any(out == np.inf):
-        raise ValueError("sample_fn returned +inf; returns must be finite, NaN or -inf")
+        raise NeurohoverError("sample_fn returned +inf; returns must be finite, NaN or -inf")
     return np.where(np.isnan(out), -np.inf, out)
 
 
@@ -209,7 +212,7 @@ def bayes_mean_bounds(samples: np.ndarray, delta: float) -> tuple[float, float]:
     x = np.asarray(samples, dtype=np.float64).ravel()
     n = x.size
     if n == 0:
-        raise ValueError("bayes_mean_bounds needs at least one sample")
+        raise NeurohoverError("bayes_mean_bounds needs at least one sample")
     if np.any(np.isneginf(x)):
         return -math.inf, -math.inf
     if n == 1:
@@ -353,13 +356,13 @@ def selection_race(
 
 
 def _race_arguments(n_candidates, mu, delta, t_limit, batch, rule) -> tuple[int, int, float, int, int]:
-    """:func:`selection_race`'s arguments checked (ValueError naming the bad one)."""
+    """:func:`selection_race`'s arguments checked (NeurohoverError naming the bad one)."""
     n = _check_int("n_candidates", n_candidates, 2)
     mu = _check_int("mu", mu, 1)
     if mu >= n:
-        raise ValueError(f"mu={mu} must be smaller than n_candidates={n}")
-    if rule not in RACE_RULES:
-        raise ValueError(f"rule={rule!r} is not a race rule: choose one of {', '.join(RACE_RULES)}")
+        raise NeurohoverError(f"mu={mu} must be smaller than n_candidates={n}")
+    if not isinstance(rule, str) or rule not in RACE_RULES:
+        raise NeurohoverError(f"rule={brief(rule)} is not a race rule: choose one of {', '.join(RACE_RULES)}")
     return n, mu, _check_delta(delta), _check_int("t_limit", t_limit, 1), _check_int("batch", batch, 0)
 
 

@@ -15,13 +15,18 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import NeurohoverError, finite_real
+from ..errors import NeurohoverError, brief, finite_real
 from .common import (
+    ASK_AGAIN,
+    MAX_SPREAD,
     STATE_VERSION,
+    TELL_FIRST,
+    AskTellOrderError,
     ChampionTracker,
     ChampionViews,
     Clock,
     TellInfo,
+    as_floats,
     check_genomes,
     check_prototype,
     check_returns,
@@ -31,7 +36,7 @@ from .common import (
     rank,
     require_int,
     require_prob,
-    require_std,
+    require_spread,
     rng_from_state,
     set_field,
     validate_variation_settings,
@@ -85,7 +90,7 @@ class SteadyStateSettings:
     mutate_frac : float
         Per-gene mutation probability.
     mutate_std : float
-        Standard deviation of the Gaussian mutation (finite, >= 0).
+        Standard deviation of the Gaussian mutation (0 to 1e100, :data:`~neurohover.evolution.common.MAX_SPREAD`).
     mutate_repl : float
         Probability that a mutated gene is replaced rather than shifted.
     plateau_threshold : int
@@ -113,7 +118,7 @@ class SteadyStateSettings:
         ``mutate_frac`` / ``mutate_std`` (Appendix A). ``eonn`` used 0.5 and 0.5.
     mutation_floor : float or None
         None (default): Appendix A's mutation, the same absolute size for every gene. A number
-        > 0: gene i's perturbation (and replacement value) is scaled by
+        in (0, 1e100]: gene i's perturbation (and replacement value) is scaled by
         ``max(|prototype gene i|, mutation_floor)`` (an experimental deviation: from the baseline
         seed, the paper's N(0, 0.8) cannot move gains of size 0.02 smoothly; see
         docs/reproduction/discussion/fig2-paper.md).
@@ -140,28 +145,28 @@ class SteadyStateSettings:
         validate_variation_settings(self)
         if self.mutation_floor is not None:
             floor = self.mutation_floor
-            if isinstance(floor, bool) or not isinstance(floor, (int, float)) or not (finite_real(floor) and floor > 0):
-                raise NeurohoverError(f"mutation_floor={floor!r} is out of range: allowed None or a finite number > 0")
+            if isinstance(floor, bool) or not isinstance(floor, (int, float)) or not (finite_real(floor) and 0 < floor <= MAX_SPREAD):
+                raise NeurohoverError(f"mutation_floor={brief(floor)} is out of range: allowed None or a number in (0, {MAX_SPREAD:g}]")
             set_field(self, "mutation_floor", float(floor))
         if not isinstance(self.plateau_rule, str) or self.plateau_rule not in PLATEAU_RULES:
-            raise NeurohoverError(f"unknown plateau_rule {self.plateau_rule!r}: allowed {', '.join(PLATEAU_RULES)}")
+            raise NeurohoverError(f"unknown plateau_rule {brief(self.plateau_rule)}: allowed {', '.join(PLATEAU_RULES)}")
         if not isinstance(self.selection, str) or self.selection not in SELECTIONS:
-            raise NeurohoverError(f"unknown selection {self.selection!r}: allowed {', '.join(SELECTIONS)}")
+            raise NeurohoverError(f"unknown selection {brief(self.selection)}: allowed {', '.join(SELECTIONS)}")
         size = require_int("tournament_size", self.tournament_size, 1)
         if self.selection != "tournament" and size != TOURNAMENT_SIZE:  # ignored without a word (second trial)
-            raise NeurohoverError(f"tournament_size={size} applies to selection='tournament' only, not to selection={self.selection!r}")
+            raise NeurohoverError(f"tournament_size={brief(size)} applies to selection='tournament' only, not to selection={brief(self.selection)}")
         if self.selection == "tournament" and size > self.pop_size:  # under roulette the unused default is no limit on pop_size
-            raise NeurohoverError(f"tournament_size={size} must be in [1, pop_size={self.pop_size}]")
+            raise NeurohoverError(f"tournament_size={brief(size)} must be in [1, pop_size={brief(self.pop_size)}]")
         set_field(self, "tournament_size", size)
         if self.init_mutate_frac is not None:
             set_field(self, "init_mutate_frac", require_prob("init_mutate_frac", self.init_mutate_frac))
         if self.init_mutate_std is not None:
-            set_field(self, "init_mutate_std", require_std("init_mutate_std", self.init_mutate_std))
+            set_field(self, "init_mutate_std", require_spread("init_mutate_std", self.init_mutate_std))
         elite = require_int("elite_size", self.elite_size, 0)
         if elite >= self.pop_size:
             default = " (its default)" if elite == type(self).elite_size else ""  # a default the user never set, named as such (ninth trial)
             raise NeurohoverError(
-                f"elite_size={elite}{default} must be smaller than pop_size={self.pop_size}: give elite_size below it too (the paper's is pop_size - 1)"
+                f"elite_size={brief(elite)}{default} must be smaller than pop_size={self.pop_size}: give elite_size below it too (the paper's is pop_size - 1)"
             )
         set_field(self, "elite_size", elite)
         set_field(self, "plateau_threshold", require_int("plateau_threshold", self.plateau_threshold, 1))
@@ -185,7 +190,7 @@ def roulette_weights(returns: np.ndarray) -> np.ndarray:
     np.ndarray
         Non-negative weights, same shape.
     """
-    r = np.asarray(returns, dtype=np.float64)
+    r = as_floats(returns, "returns", "an array of returns (numbers)")
     w = np.where(np.isfinite(r), episode_fitness(r, "inv-log-error"), 0.0)
     if not np.count_nonzero(w):
         w = np.ones_like(r)
@@ -281,11 +286,11 @@ class SteadyStateNE(ChampionViews):
 
         Raises
         ------
-        RuntimeError
-            If the previous batch has not been told yet.
+        AskTellOrderError
+            If the previous batch has not been told yet (a NeurohoverError and a RuntimeError).
         """
         if self._pending is not None:
-            raise RuntimeError("ask() called again before tell() of the previous batch")
+            raise AskTellOrderError(ASK_AGAIN.format(what="batch"))
         if self._population is None:
             s = self.settings
             init = s
@@ -315,7 +320,7 @@ class SteadyStateNE(ChampionViews):
         """
         crashed = None if info is None else info.crashed
         if self._pending is None:
-            raise RuntimeError("tell() called without a pending ask()")
+            raise AskTellOrderError(TELL_FIRST)
         f = check_returns(fitness, len(self._pending))
         if crashed is not None:
             c = np.asarray(crashed)

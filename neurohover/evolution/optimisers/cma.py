@@ -16,9 +16,9 @@ from typing import Any
 import cma
 import numpy as np
 
-from ...errors import finite_real
+from ...errors import NeurohoverError, brief
 from .. import common
-from ..common import MAX_POPULATION, PopulationOptimiser, TellInfo, check_prototype
+from ..common import MAX_POPULATION, PopulationOptimiser, TellInfo, check_prototype, require_spread
 from . import OptimiserSpec
 
 __all__ = ["CMAES", "SIGMA0", "CMASettings", "losses_of"]
@@ -104,7 +104,7 @@ class CMAES(PopulationOptimiser):
     prototype : np.ndarray
         1-D initial mean (D >= 2, a pycma requirement).
     sigma0 : float, default :data:`SIGMA0` (0.02)
-        Initial step size (> 0).
+        Initial step size (> 0 and <= 1e100).
     seed : int, default 0
         Seed of the private generator.
     popsize : int, optional
@@ -123,13 +123,12 @@ class CMAES(PopulationOptimiser):
     ) -> None:
         x0 = check_prototype(prototype)
         if x0.size < 2:
-            raise ValueError(f"CMAES needs a genome of length >= 2, got {x0.size}")
-        if not (isinstance(sigma0, (int, float)) and finite_real(sigma0) and sigma0 > 0):
-            raise ValueError(f"sigma0={sigma0!r} must be a finite number > 0")
+            raise NeurohoverError(f"CMAES needs a genome of length >= 2, got {x0.size}")
+        sigma0 = require_spread("sigma0", sigma0, positive=True)
         if popsize is not None and (not isinstance(popsize, (int, np.integer)) or popsize < 2):
-            raise ValueError(f"popsize={popsize!r} must be None or an integer >= 2")
+            raise NeurohoverError(f"popsize={brief(popsize)} must be None or an integer >= 2")
         if budget is not None and (not isinstance(budget, (int, np.integer)) or budget < 1):
-            raise ValueError(f"budget={budget!r} must be None or an integer >= 1")
+            raise NeurohoverError(f"budget={brief(budget)} must be None or an integer >= 1")
         self._rng = np.random.default_rng(seed)
         rng = self._rng
         opts: dict = {
@@ -212,7 +211,7 @@ class CMASettings:
     Attributes
     ----------
     sigma0 : float
-        The initial step size (> 0; 0.02: :data:`SIGMA0` says why).
+        The initial step size (> 0 and <= 1e100, :data:`~neurohover.evolution.common.MAX_SPREAD`; 0.02: :data:`SIGMA0` says why).
     popsize : int or None
         Genomes per generation (>= 2; None: pycma's 4 + 3 ln D).
     """
@@ -221,12 +220,11 @@ class CMASettings:
     popsize: int | None = None
 
     def __post_init__(self) -> None:
-        s0, pop = self.sigma0, self.popsize
-        if isinstance(s0, bool) or not isinstance(s0, (int, float)) or not (finite_real(s0) and s0 > 0):
-            raise ValueError(f"CMA-ES sigma0={s0!r} must be a finite number > 0")
+        pop = self.popsize
+        s0 = require_spread("sigma0", self.sigma0, positive=True, what="CMA-ES ")  # 1e308 was pycma's AssertionError (eleventh trial)
         if pop is not None and (isinstance(pop, bool) or not isinstance(pop, (int, np.integer)) or not 2 <= pop <= MAX_POPULATION):
-            raise ValueError(f"CMA-ES popsize={pop!r} must be None or an integer in 2..{MAX_POPULATION:,}")
-        object.__setattr__(self, "sigma0", float(s0))
+            raise NeurohoverError(f"CMA-ES popsize={brief(pop)} must be None or an integer in 2..{MAX_POPULATION:,}")
+        object.__setattr__(self, "sigma0", s0)
         object.__setattr__(self, "popsize", None if pop is None else int(pop))
 
 

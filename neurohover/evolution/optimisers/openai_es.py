@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from ...errors import NeurohoverError
 from ..common import (
     STATE_VERSION,
     ChampionTracker,
@@ -36,6 +37,7 @@ from ..common import (
     enc_array,
     rank,
     require_population,
+    require_spread,
     require_std,
     rng_from_state,
     set_field,
@@ -59,9 +61,9 @@ class OpenAIESSettings:
     popsize : int
         Genomes per generation (even: antithetic pairs).
     sigma : float
-        The spread of the perturbations (> 0).
+        The spread of the perturbations (> 0 and <= 1e100, :data:`~neurohover.evolution.common.MAX_SPREAD`).
     learning_rate : float
-        Adam's step size (> 0).
+        Adam's step size (> 0 and <= 1e100).
     beta1, beta2 : float
         Adam's decay rates, in [0, 1).
     epsilon : float
@@ -81,17 +83,18 @@ class OpenAIESSettings:
     def __post_init__(self) -> None:
         popsize = require_population("popsize", self.popsize)
         if popsize % 2:
-            raise ValueError(f"popsize={popsize} must be even: OpenAI-ES asks antithetic pairs")
+            raise NeurohoverError(f"popsize={popsize} must be even: OpenAI-ES asks antithetic pairs")
         set_field(self, "popsize", popsize)
-        for name in ("sigma", "learning_rate", "epsilon"):
-            value = require_std(name, getattr(self, name))
-            if value <= 0.0:
-                raise ValueError(f"{name}={value!r} must be a finite number > 0")
-            set_field(self, name, value)
+        for name in ("sigma", "learning_rate"):  # steps in genome units: 1e308 overflowed the genes late in the run (eleventh trial)
+            set_field(self, name, require_spread(name, require_std(name, getattr(self, name)), positive=True))  # as a float: sigma=0.0
+        value = require_std("epsilon", self.epsilon)
+        if value <= 0.0:
+            raise NeurohoverError(f"epsilon={value!r} must be a finite number > 0")
+        set_field(self, "epsilon", value)
         for name in ("beta1", "beta2"):
             value = require_std(name, getattr(self, name))
             if not value < 1.0:
-                raise ValueError(f"{name}={value!r} must be in [0, 1)")
+                raise NeurohoverError(f"{name}={value!r} must be in [0, 1)")
             set_field(self, name, value)
         set_field(self, "l2", require_std("l2", self.l2))
 

@@ -30,7 +30,7 @@ from typing import Any
 import cma
 import numpy as np
 
-from ...errors import finite_real
+from ...errors import NeurohoverError, brief, finite_real
 from ..common import TellInfo
 from . import OptimiserSpec
 from .cma import CMAES, CMASettings, losses_of
@@ -48,7 +48,7 @@ class UHCMASettings(CMASettings):
     min_evaluations, max_evaluations : int
         Evaluations (episodes) per solution, between these (it starts at the minimum).
     reevaluations : int or None
-        Solutions re-evaluated a generation (None: pycma's ``2 + popsize / 20``).
+        Solutions re-evaluated a generation (1 to popsize; None: pycma's ``2 + popsize / 20``).
     epsilon : float
         The perturbation of a re-evaluated point (pycma's 1e-7).
     """
@@ -66,11 +66,13 @@ class UHCMASettings(CMASettings):
             return not isinstance(v, bool) and isinstance(v, (int, np.integer))
 
         if not integer(lo) or not integer(hi) or not 1 <= lo <= hi:
-            raise ValueError(f"UH-CMA-ES min_evaluations={lo!r} and max_evaluations={hi!r} must be integers with 1 <= min <= max")
+            raise NeurohoverError(f"UH-CMA-ES min_evaluations={brief(lo)} and max_evaluations={brief(hi)} must be integers with 1 <= min <= max")
         if re is not None and (not integer(re) or re < 1):
-            raise ValueError(f"UH-CMA-ES reevaluations={re!r} must be None or an integer >= 1")
+            raise NeurohoverError(f"UH-CMA-ES reevaluations={brief(re)} must be None or an integer >= 1")
+        if re is not None and self.popsize is not None and re > self.popsize:  # pycma indexed past the generation (eleventh trial)
+            raise NeurohoverError(f"UH-CMA-ES reevaluations={brief(re)} must be at most popsize={self.popsize}: it re-evaluates solutions of one generation")
         if isinstance(eps, bool) or not isinstance(eps, (int, float)) or not (finite_real(eps) and eps >= 0):
-            raise ValueError(f"UH-CMA-ES epsilon={eps!r} must be a finite number >= 0")
+            raise NeurohoverError(f"UH-CMA-ES epsilon={brief(eps)} must be a finite number >= 0")
         object.__setattr__(self, "epsilon", float(eps))
 
 
@@ -80,6 +82,12 @@ class UHCMAES(CMAES):
     def __init__(self, prototype: np.ndarray, settings: UHCMASettings, seed: int = 0, budget: int | None = None) -> None:
         super().__init__(prototype, sigma0=settings.sigma0, seed=seed, popsize=settings.popsize, budget=budget)
         s = settings
+        if s.reevaluations is not None and s.reevaluations > self.popsize:  # pycma's default popsize is known only here
+            why = "" if s.popsize is not None else f" (pycma's 4 + 3 ln D for D={self._es.N} genes)"
+            raise NeurohoverError(
+                f"UH-CMA-ES reevaluations={s.reevaluations} must be at most popsize={self.popsize}{why}: it re-evaluates solutions of one"
+                " generation; give a smaller reevaluations or a larger popsize"
+            )
         evals = [s.min_evaluations, s.min_evaluations, s.max_evaluations]  # minimum, start, maximum
         self._noise = cma.NoiseHandler(self._es.N, maxevals=evals, reevals=s.reevaluations, epsilon=s.epsilon)
         self._round: dict[str, Any] | None = None  # the generation waiting for its re-evaluations
