@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError, finite_real
+from ..errors import NeurohoverError, brief, finite_real
 from ..evaluate import DangerousState
 from ..flightdata import FlightData
 from ..models.model import LearnedModel
@@ -70,16 +70,16 @@ class ContinualSettings(AgentSettings):
         for name in ("window", "patience", "max_learning_episodes"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, int) or v < 1:
-                raise NeurohoverError(f"continual {name}={v!r} is out of range: allowed an integer >= 1")
+                raise NeurohoverError(f"continual {name}={brief(v)} is out of range: allowed an integer >= 1")
         for name, unit in (("cooldown", "episodes"), ("safeguard_after", "control steps")):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v <= 10**6:
-                raise NeurohoverError(f"continual {name}={v!r} is out of range: allowed an integer in 0..1000000 ({unit})")
+                raise NeurohoverError(f"continual {name}={brief(v)} is out of range: allowed an integer in 0..1000000 ({unit})")
         t = self.threshold
         if isinstance(t, bool) or not isinstance(t, (int, float)) or not finite_real(t) or t <= 1:
-            raise NeurohoverError(f"continual threshold={t!r} is out of range: allowed a number > 1 (a ratio of one-step errors)")
+            raise NeurohoverError(f"continual threshold={brief(t)} is out of range: allowed a number > 1 (a ratio of one-step errors)")
         if not isinstance(self.safeguard, bool):
-            raise NeurohoverError(f"continual safeguard={self.safeguard!r} is not allowed: true or false")
+            raise NeurohoverError(f"continual safeguard={brief(self.safeguard)} is not allowed: true or false")
 
     @classmethod
     def unused(cls, agent: str, given: dict) -> str | None:

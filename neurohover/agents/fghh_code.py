@@ -33,12 +33,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief, finite_real
 from ..evaluate import DangerousState
 from ..evolution.steady_state import SteadyStateSettings
 from ..flightdata import FlightData
-from ..models.lr import DEFAULT_NOISE_ESTIMATE
+from ..models.lr import D_U_CHOICES, DEFAULT_NOISE_ESTIMATE, ESTIMATORS, NOISE_ESTIMATES
 from ..models.model import MODEL_SUBSTEPS
+from ..models.wind import WIND_MODELS
 from ..policies import Policy, baseline_policy, prototype
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
@@ -103,14 +104,21 @@ class CodeAgentSettings:
     model_substeps: int = 1
 
     def __post_init__(self) -> None:
-        if self.model_substeps not in MODEL_SUBSTEPS:
-            raise NeurohoverError(f"model_substeps={self.model_substeps!r} is not allowed: choose one of {', '.join(map(str, MODEL_SUBSTEPS))}")
+        sub = self.model_substeps
+        if isinstance(sub, bool) or not isinstance(sub, int) or sub not in MODEL_SUBSTEPS:  # True == 1 was taken as 1 (eleventh trial)
+            raise NeurohoverError(f"model_substeps={brief(sub)} is not allowed: choose one of {', '.join(map(str, MODEL_SUBSTEPS))}")
         for name, low in (("evolutions", 1), ("model_budget", 50), ("n_steps", 1)):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
-                raise NeurohoverError(f"{name}={value!r} is out of range: allowed an integer >= {low}")
-        if not (isinstance(self.fired_error, (int, float)) and np.isfinite(self.fired_error) and self.fired_error >= 0):
-            raise NeurohoverError(f"fired_error={self.fired_error!r} is out of range: allowed a finite number >= 0")
+                raise NeurohoverError(f"{name}={brief(value)} is out of range: allowed an integer >= {low}")
+        if not (finite_real(self.fired_error) and self.fired_error >= 0):  # finite_real: NumPy's isfinite raised TypeError on 10**400
+            raise NeurohoverError(f"fired_error={brief(self.fired_error)} is out of range: allowed a finite number >= 0")
+        if not isinstance(self.dangerous, DangerousState):  # anything was taken, then an AttributeError after an episode (eleventh trial)
+            raise NeurohoverError(f"dangerous={brief(self.dangerous)} is not allowed: give a DangerousState (neurohover.evaluate.DangerousState)")
+        for name, allowed in (("estimator", ESTIMATORS), ("wind_model", WIND_MODELS), ("d_u", D_U_CHOICES), ("noise", NOISE_ESTIMATES)):
+            value = getattr(self, name)
+            if not isinstance(value, str) or value not in allowed:  # checked here, not first in the run's model learning
+                raise NeurohoverError(f"{name}={brief(value)} is not allowed: choose one of {', '.join(allowed)}")
 
 
 class CodeFGHHAgent(Agent):

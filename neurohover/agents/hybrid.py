@@ -18,7 +18,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..evaluate import DangerousState
 from ..flightdata import FlightData
 from ..policies import Policy, baseline_policy
@@ -65,9 +65,11 @@ class HybridSettings(AgentSettings):
 
     def __post_init__(self) -> None:
         if self.replacement not in REPLACEMENTS:
-            raise NeurohoverError(f"unknown hybrid replacement {self.replacement!r}: allowed {', '.join(REPLACEMENTS)}")
+            raise NeurohoverError(f"unknown hybrid replacement {brief(self.replacement)}: allowed {', '.join(REPLACEMENTS)}")
         if self.model_from not in MODEL_DATA:
-            raise NeurohoverError(f"unknown hybrid model_from {self.model_from!r}: allowed {', '.join(MODEL_DATA)}")
+            raise NeurohoverError(f"unknown hybrid model_from {brief(self.model_from)}: allowed {', '.join(MODEL_DATA)}")
+        if not isinstance(self.dangerous, DangerousState):  # anything was taken, then an AttributeError mid-run (eleventh trial)
+            raise NeurohoverError(f"dangerous={brief(self.dangerous)} is not allowed: give a DangerousState (neurohover.evaluate.DangerousState)")
 
     def to_dict(self) -> dict:
         """Plain settings: replacement, model_from, rule, box, tilt (as experiment configs write them)."""

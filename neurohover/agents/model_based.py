@@ -12,7 +12,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..evaluate import evaluate
 from ..flightdata import FlightData
 from ..models.lr import DEFAULT_NOISE_ESTIMATE, lr_determined
@@ -290,7 +290,7 @@ class IncrementalSettings(AgentSettings):
     def __post_init__(self) -> None:
         m = self.max_learning_episodes
         if isinstance(m, bool) or not isinstance(m, int) or m < 1:
-            raise ValueError(f"max_learning_episodes={m!r} is out of range: allowed an integer >= 1")
+            raise NeurohoverError(f"max_learning_episodes={brief(m)} is out of range: allowed an integer >= 1")
 
     @classmethod
     def from_unit(cls, params: dict) -> IncrementalSettings:

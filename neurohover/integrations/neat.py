@@ -39,7 +39,7 @@ from typing import Any
 import numba as nb
 import numpy as np
 
-from ..errors import NeurohoverError, finite_real
+from ..errors import NeurohoverError, brief, finite_real
 from ..evolution.fitness import FITNESS_SCALES, episode_fitness
 from ..evolution.seeding import check_seed
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS, OBS_NAMES
@@ -142,18 +142,20 @@ class NeatSettings:
         for name, low, high in (("pop_size", 4, MAX_POP), ("episodes", 1, MAX_EPISODES_PER_GENOME)):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, int) or not low <= v <= high:
-                raise NeurohoverError(f"{name}={v!r} must be an integer in {low}..{high}")
+                raise NeurohoverError(f"{name}={brief(v)} must be an integer in {low}..{high}")
         if self.initial not in ("full_direct", "unconnected"):
-            raise NeurohoverError(f"initial={self.initial!r}: allowed full_direct or unconnected")
+            raise NeurohoverError(f"initial={brief(self.initial)}: allowed full_direct or unconnected")
         if self.fitness not in FITNESS_SCALES:
-            raise NeurohoverError(f"fitness={self.fitness!r}: allowed {', '.join(FITNESS_SCALES)}")
+            raise NeurohoverError(f"fitness={brief(self.fitness)}: allowed {', '.join(FITNESS_SCALES)}")
         if self.start not in ("random", "baseline"):
-            raise NeurohoverError(f"start={self.start!r}: allowed random or baseline")
+            raise NeurohoverError(f"start={brief(self.start)}: allowed random or baseline")
+        acts = self.activations  # checked before any use: activations=5 was "'int' object is not iterable" (eleventh trial)
+        names = isinstance(acts, (tuple, list)) and all(isinstance(a, str) for a in acts)
+        if not names or not acts or any(a not in ACTIVATIONS for a in acts) or len(set(acts)) != len(acts):
+            raise NeurohoverError(f"activations={brief(acts)}: allowed a non-empty tuple of distinct names from {', '.join(ACTIVATIONS)}")
+        object.__setattr__(self, "activations", tuple(acts))
         if self.start == "baseline" and (self.initial != "full_direct" or "identity" not in self.activations):
             raise NeurohoverError("start='baseline' needs initial='full_direct' and 'identity' among the activations (the baseline is linear)")
-        bad = [a for a in self.activations if a not in ACTIVATIONS]
-        if not self.activations or bad or len(set(self.activations)) != len(self.activations):
-            raise NeurohoverError(f"activations={self.activations!r}: allowed a non-empty tuple of distinct names from {', '.join(ACTIVATIONS)}")
 
         def number(v) -> bool:
             return isinstance(v, (int, float)) and not isinstance(v, bool) and finite_real(v)
@@ -161,16 +163,16 @@ class NeatSettings:
         for name in ("node_add_prob", "conn_add_prob", "node_delete_prob", "conn_delete_prob", "activation_mutate_rate", "replace_rate", "weight_mutate_rate"):
             v = getattr(self, name)
             if not (number(v) and 0.0 <= v <= 1.0):
-                raise NeurohoverError(f"{name}={v!r} must be a probability in [0, 1]")
+                raise NeurohoverError(f"{name}={brief(v)} must be a probability in [0, 1]")
         # neat-python clamps weights and biases to +-30: a larger spread only saturates them
         for name in ("weight_mutate_power", "bias_mutate_power", "compatibility_threshold"):
             v = getattr(self, name)
             if not (number(v) and 0.0 < v <= MAX_SPREAD):
-                raise NeurohoverError(f"{name}={v!r} must be a number in (0, {MAX_SPREAD:g}]")
+                raise NeurohoverError(f"{name}={brief(v)} must be a number in (0, {MAX_SPREAD:g}]")
         for name in ("weight_init_stdev", "bias_init_stdev"):
             v = getattr(self, name)
             if not (number(v) and 0.0 <= v <= MAX_SPREAD):
-                raise NeurohoverError(f"{name}={v!r} must be a number in [0, {MAX_SPREAD:g}]")
+                raise NeurohoverError(f"{name}={brief(v)} must be a number in [0, {MAX_SPREAD:g}]")
 
 
 _CONFIG = """
