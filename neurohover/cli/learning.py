@@ -34,6 +34,7 @@ from ..evaluate import DEVICES, check_device, check_episode_count
 from ..evolution.config import MAX_BUDGET
 from ..evolution.generational import GENERATIONAL_PRESETS
 from ..evolution.optimisers import OPTIMISERS, optimiser_names
+from .learning_checks import policy_that_flew
 
 MDP_FAMILY = "G"
 
@@ -354,7 +355,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
         elif args.method == "ec-meno":
             model = learn_ec_meno(data, seed=seed, **extra)
         else:
-            model = learn_ec_mer(data, _policy_that_flew(args.policy, data, args.flight_data), seed=seed, **extra)
+            model = learn_ec_mer(data, policy_that_flew(args.policy, data, args.flight_data), seed=seed, **extra)
     model.save(out)  # written whole or not at all (a failed write: one message, the old file as it was)
     truth, why = _true_mdp(data.metadata)
     print(f"{args.method} model written to {out} ({time.perf_counter() - start:.2f} s)")
@@ -367,19 +368,6 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     for line in model_notes(model, data, truth, rows):
         print(f"neurohover learn-model: {line}", file=sys.stderr)
     return 0
-
-
-def _policy_that_flew(given: str | None, data, flight_data: str):
-    """EC-MER's policy: --policy, else the one the flight data record, else the file their metadata names (older files)."""
-    from ..policies import load_policy
-
-    recorded = None if given is not None else data.recorded_policy(f"flight data {flight_data!r}")
-    if recorded is not None:
-        return recorded
-    try:
-        return load_policy(given or data.metadata.get("policy") or "baseline")
-    except NeurohoverError as err:
-        raise NeurohoverError(f"{err} (the policy the flight data's metadata name; give --policy FILE)" if given is None else str(err)) from None
 
 
 def _wind_text(x, y) -> str:
@@ -591,6 +579,7 @@ def register(sub) -> None:
     p.add_argument("--seed", type=int, help="ec-meno, ec-mer: seed of the evolution (default 0)")
     p.add_argument(
         "--policy",
-        help="ec-mer: the policy that flew the data (default: the one fly --record stored in the flight data, else the file named there, else baseline)",
+        help="ec-mer: the policy that flew the data (default: the one fly --record stored in the flight data, else the file named there, else "
+        "baseline); where the data record one, --policy must be that one",
     )
     p.set_defaults(func=cmd_learn_model, lr_options=lr_options)
