@@ -66,6 +66,23 @@ def test_a_config_named_after_a_shipped_alias_is_refused(tmp_path: Path, cli) ->
     rc, _, err = cli("reproduce", str(config), "--store", str(store), "--no-progress")
     assert rc == 2 and not store.exists(), err
     assert f"config '{config}': name = 'table3' is an alias of the shipped experiment 'fig2': a config of your own needs a name of its own" in err, err
+    from neurohover.experiments import Store, load_config, make_executor, reproduce
+
+    with Store(store) as db, pytest.raises(NeurohoverError, match="name = 'table3' is an alias of the shipped experiment 'fig2'"):
+        reproduce(load_config(config, "quick"), db, make_executor("local", jobs=1), progress=False)  # Python checks it as the CLI does
+    with Store(store) as db:
+        assert db.experiments() == []
+
+
+def test_results_out_dash_points_to_standard_output(tmp_path: Path, cli) -> None:
+    """S7: `results --out -` wrote a file named '-'; its default is standard output, which the message now names."""
+    from neurohover.experiments import Store
+
+    with Store(tmp_path / "s.sqlite") as db:
+        db.begin("fig2", "quick", "h", {})
+    rc, _, err = cli("results", "fig2", "--store", str(tmp_path / "s.sqlite"), "--out", "-")
+    assert rc == 2 and "--out '-' is not a file name here: leave --out out for standard output" in err, err
+    assert not (tmp_path / "-").exists() and not Path("-").exists()
 
 
 def test_results_and_wins_take_the_scales_a_compete_store_holds(tmp_path: Path, cli) -> None:

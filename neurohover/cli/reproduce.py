@@ -124,7 +124,7 @@ def cmd_results(args: argparse.Namespace) -> int:
     from ..paths import input_file, output_file, writing
 
     input_file(args.store, "--store", "results store")
-    out = None if args.out is None else output_file(args.out, "--out", {"--store": args.store})
+    out = None if args.out is None else output_file(args.out, "--out", {"--store": args.store}, stdout=True)
     with Store(args.store, create=False) as store:
         text = export_results(store, args.name, args.format, args.scale)
     if out is not None:

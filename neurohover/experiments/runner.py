@@ -10,7 +10,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 from ..errors import NeurohoverError
-from .config import POLICY_SOURCES, ExperimentConfig
+from .config import POLICY_SOURCES, ExperimentConfig, check_own_name
 from .plans import Plan, plan, run_keys, source_experiments
 from .results import check_run_lengths, result_from_dict
 from .store import Store
@@ -169,6 +169,7 @@ def _check_arguments(config, store, executor) -> None:
         raise NeurohoverError(f"store={store!r:.60} is not allowed: give a Store(PATH)")
     if not callable(getattr(executor, "run", None)):
         raise NeurohoverError(f"executor={executor!r:.60} is not allowed: give an executor, make_executor('local', jobs=N) or LocalExecutor(N)")
+    check_own_name(config)  # a config of one's own named fig2 or its alias table3 was stored as the shipped one (eleventh trial, S8)
 
 
 def reproduce(
