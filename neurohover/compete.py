@@ -343,6 +343,11 @@ def compete(
         "mdps": mdps,
         "seed": seed,
         "store": str(store_path),
+        # what the episodes were flown under, so that `plot --compete` names where overlaid runs differ (eleventh trial, S4)
+        "episode_steps": n_steps,
+        "sigma": sigma,
+        "sensor": None if sensor is None else sensor.to_dict(),
+        "drift": None if drift is None else drift.to_dict(),
         "experiment": config.name,
         "scale": config.scale,
         **summarise(ordered),

@@ -21,10 +21,11 @@ Example
 from __future__ import annotations
 
 import csv
+import json
 import math
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -54,6 +55,7 @@ __all__ = [
 CRASH_COLOR = "tab:red"
 COMPETE_FILE = "episodes.csv"
 COMPETE_SUMMARY = "summary.json"
+COMPETE_CONDITIONS = ("episode_steps", "sigma", "sensor", "drift")  # summary.json keys: curves that differ in one are labelled with it
 COMPETE_COLUMNS = ("run", "episode", "return")  # the columns of compete's episodes.csv read here
 WORST_RETURN = CRASH_STEP_PENALTY * MAX_EPISODE_STEPS  # no episode loses more: a crash charges the worst step for every step left
 
@@ -237,12 +239,15 @@ class CompeteResult:
         Crashed episodes over all runs (the ``crashed`` column, where present).
     path : Path
         The directory.
+    conditions : dict
+        What its episodes were flown under, from ``summary.json`` (:data:`COMPETE_CONDITIONS`; empty without one).
     """
 
     label: str
     returns: np.ndarray
     crashes: int
     path: Path
+    conditions: dict = field(default_factory=dict)
 
     @property
     def cumulative_error(self) -> np.ndarray:
@@ -317,6 +322,8 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
             raise NeurohoverError(f"--compete {str(summary_path)!r} is not a compete summary: no agent and task names")
         _check_summary_matches(summary_path, summary, returns.shape)
         label = f"{summary['agent']} ({summary.get('task', '?')})"
+        conditions = {key: summary[key] for key in COMPETE_CONDITIONS if key in summary}
+        return CompeteResult(label, returns, crashes, path, conditions)
     return CompeteResult(label, returns, crashes, path)
 
 
@@ -358,8 +365,11 @@ def compete_figure(results: Sequence[CompeteResult], title: str = "") -> Figure:
     fig = new_figure(11.0, 4.5)
     axes = fig.subplots(1, 2)
     labels = [r.label for r in results]
+    differ = _differing_conditions(results)
     for r in results:
         name = r.label if labels.count(r.label) == 1 else f"{r.label} [{r.path.name}]"  # same agent twice
+        if differ:  # 50-step drifting episodes beside 6000-step ones were overlaid without a word (eleventh trial, S4)
+            name += ", " + ", ".join(f"{key} {_condition_text(r.conditions.get(key, '?'))}" for key in differ)
         error = r.cumulative_error
         episodes = np.arange(1, error.size + 1)
         for ax in axes:
@@ -372,9 +382,22 @@ def compete_figure(results: Sequence[CompeteResult], title: str = "") -> Figure:
         ax.xaxis.set_major_locator(MaxNLocator(integer=True))
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=8)
-    fig.suptitle(printable(title) or "mean cumulative error over runs")
+    heading = printable(title) or "mean cumulative error over runs"
+    if differ:
+        heading += f" (flown under different {', '.join(differ)}: see the legend)"
+    fig.suptitle(heading)
     fig.tight_layout()
     return fig
+
+
+def _differing_conditions(results: Sequence[CompeteResult]) -> list[str]:
+    """The :data:`COMPETE_CONDITIONS` whose values differ between ``results`` (a result without a summary differs)."""
+    return [key for key in COMPETE_CONDITIONS if len({json.dumps(r.conditions.get(key, "?"), sort_keys=True) for r in results}) > 1]
+
+
+def _condition_text(value) -> str:
+    text = "none" if value is None else value if isinstance(value, str) else json.dumps(value, sort_keys=True, separators=(",", ":"))
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def plot_compete(dirs: Sequence[str | Path], out: str | Path) -> tuple[Path, Figure]:

@@ -1,4 +1,4 @@
-"""Issue 38, the eleventh fresh trial: its findings about the command line, compete and the task names (S1, S3, S8, U1,
+"""Issue 37, the eleventh fresh trial: its findings about the command line, compete and the task names (S1, S3, S8, U1,
 U2, U6, U7, U8 in part) each give one clear message (exit 2 / NeurohoverError) or are taken as a user would expect."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Issue 38, the eleventh fresh trial: its findings about files, paths, plots, reports and the environment (T3, T4, T5,
+"""Issue 37, the eleventh fresh trial: its findings about files, paths, plots, reports and the environment (T3, T4, T5,
 T9, S5, S7, S9, U3, U8 in part) each give one clear message (exit 2 / NeurohoverError) or are taken as a user would
 expect."""
 
@@ -197,3 +197,24 @@ def test_fghh_budget_beside_another_task_says_to_leave_it_out(cli, tmp_path: Pat
         )
         in err
     ), err
+
+
+def test_overlaid_competitions_name_the_conditions_they_differ_in(tmp_path: Path) -> None:
+    """S4: 50-step drifting episodes were overlaid on 6000-step ones as if comparable; summary.json kept neither."""
+    import json
+
+    from neurohover.compete import compete
+    from neurohover.plots import plot_compete
+    from neurohover.tasks.drift import Drift
+
+    compete("ghh08", "baseline", runs=1, episodes=2, n_steps=20, out=tmp_path / "a")
+    compete("ghh08", "baseline", runs=1, episodes=2, n_steps=30, out=tmp_path / "b", drift=Drift.parse("walk=0.1"))
+    summary = json.loads((tmp_path / "b" / "summary.json").read_text())
+    assert summary["episode_steps"] == 30 and summary["drift"] == Drift.parse("walk=0.1").to_dict() and summary["sensor"] is None
+    _, fig = plot_compete([tmp_path / "a", tmp_path / "b"], tmp_path / "ab.png")
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert labels[0].startswith("baseline (ghh08) [a], episode_steps 20, drift none: 1 runs") and "episode_steps 30, drift {" in labels[1], labels
+    assert "(flown under different episode_steps, drift: see the legend)" in fig.texts[0].get_text()
+    compete("ghh08", "model-free", runs=1, episodes=2, n_steps=20, out=tmp_path / "c")
+    _, fig = plot_compete([tmp_path / "a", tmp_path / "c"], tmp_path / "ac.png")  # alike: labelled as before
+    assert [t.get_text() for t in fig.axes[0].get_legend().get_texts()] == ["baseline (ghh08): 1 runs, 0 crashes", "model-free (ghh08): 1 runs, 0 crashes"]
