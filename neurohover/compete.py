@@ -35,12 +35,11 @@ from pathlib import Path
 import numpy as np
 
 from .agents.hybrid import HybridSettings
-from .errors import NeurohoverError
+from .errors import NeurohoverError, brief
 from .evolution.seeding import check_seed
 from .paths import write_png
 from .sim.constants import EPISODE_STEPS
 from .tasks import N_TEST, N_TRAINING, Drift, Sensor, get_task_family
-from .tasks.base import echoed
 
 CSV_COLUMNS = ("run", "mdp", "episode", "return", "crashed", "steps", "policy", "safeguard_fired")
 STORE_FILE = "results.sqlite"
@@ -149,7 +148,7 @@ def check_agent_name(agent: object) -> None:
     from .agents.registry import AGENTS
 
     if not isinstance(agent, str) or agent not in AGENTS:
-        raise NeurohoverError(f"unknown agent {echoed(agent)}: allowed {', '.join(AGENTS)}")
+        raise NeurohoverError(f"unknown agent {brief(agent)}: allowed {', '.join(AGENTS)}")
 
 
 def check_agent_settings(agent: str, values: Mapping[str, object]) -> dict:

@@ -32,8 +32,11 @@ def finite_real(value: object) -> bool:
 
 
 def brief(value: object) -> str:
-    """``repr(value)`` for a message: an int of more than 30 digits as its first ten and its length, any other repr
-    cut at 60 characters (a settings class echoed 10**400 whole, a 400-character line; eleventh trial)."""
+    """``repr(value)`` for a message: an int of more than 30 digits as its first ten and its length, a text of more than
+    60 characters as paths are shown (its first 40 and last 20 and its length), any other repr cut at 60 characters (a
+    settings class echoed 10**400 whole, a 100,000-character task or agent name a 100 kB line; eleventh trial)."""
+    if isinstance(value, str) and len(value) > 60:
+        return f"{value[:40]!r} ... {value[-20:]!r} ({len(value):,} characters)"
     if isinstance(value, numbers.Integral) and not isinstance(value, bool):
         try:
             digits = str(abs(int(value)))
@@ -75,7 +78,8 @@ def settings_from_dict(cls: type, values: Any, *, unknown_what: str, bad_what: s
     fields = [f.name for f in dataclasses.fields(cls)]
     unknown = sorted(set(values) - set(fields))
     if unknown:
-        raise NeurohoverError(f"unknown {unknown_what} setting(s) {', '.join(unknown)}: allowed {', '.join(fields)}")
+        named = ", ".join(k if isinstance(k, str) and len(k) <= 60 else brief(k) for k in unknown)  # a 100,000-character key shortened
+        raise NeurohoverError(f"unknown {unknown_what} setting(s) {named}: allowed {', '.join(fields)}")
     try:
         return cls(**values)
     except (TypeError, ValueError, OverflowError) as err:  # OverflowError: an int past a float's range (eighth trial)
@@ -89,9 +93,4 @@ def first_difference(path: str, saved: Any, given: Any, saved_as: str = "the sto
         for key in sorted(set(saved) | set(given), key=str):
             if saved.get(key) != given.get(key):
                 return first_difference(f"{path}.{key}", saved.get(key), given.get(key), saved_as)
-
-    def brief(value: Any) -> str:
-        text = repr(value)
-        return text if len(text) <= 60 else text[:57] + "..."
-
     return f"{path}: {saved_as} {brief(saved)}, given {brief(given)}"

@@ -126,7 +126,7 @@ def test_compete_takes_the_settings_that_neurohover_settings_lists(tmp_path: Pat
         (["fly", "--task", "ghh08", "--mdp", "g" * 100_000], "unknown MDP 'gggg"),
         (["fly", "--task", "ghh08", "--mdp", "train:" + "1" * 5000], "MDP index 1111111111...(5000 digits) in 'train:"),
         (["compete", "--task", "ghh08", "--agent", "g" * 100_000, "--out", "c"], "unknown agent 'gggg"),
-        (["compete", "--task", "ghh08", "--agent", "continual", "--agent-setting", "g" * 100_000 + "=1", "--out", "c"], "setting(s) gggg"),
+        (["compete", "--task", "ghh08", "--agent", "continual", "--agent-setting", "g" * 100_000 + "=1", "--out", "c"], "setting(s) 'gggg"),
         (["settings", "g" * 100_000], "no settings named 'gggg"),
         (["reproduce", "g" * 100_000, "--store", "s.sqlite"], "unknown experiment 'gggg"),
     ],
@@ -169,3 +169,29 @@ def test_messages_name_the_options_as_typed(tmp_path: Path, cli, monkeypatch) ->
     monkeypatch.chdir(tmp_path)
     rc, _, err = cli(*COMPETE, "--episodes", "1", "--out", "a" * 300)
     assert rc == 2 and "error: --out 'aaaa" in err and "is too long: at most 255 bytes" in err and list(tmp_path.iterdir()) == [], err
+
+
+def test_long_names_are_shortened_in_python_too(tmp_path: Path) -> None:
+    """U6: the command line shortened a 100,000-character name, but Python's messages (unknown task, MDP, agent, stored
+    experiment, settings key) still held it whole: one helper (errors.brief) shortens them all."""
+    import neurohover as nh
+    from neurohover.agents.registry import agent_spec
+    from neurohover.agents.model_based import IncrementalSettings
+    from neurohover.errors import settings_from_dict
+    from neurohover.experiments import Store
+
+    long = "g" * 100_000
+    calls = [
+        lambda: nh.get_task_family(long),
+        lambda: nh.get_task_family("ghh08").mdp(long),
+        lambda: agent_spec(long),
+        lambda: settings_from_dict(IncrementalSettings, {long: 1}, unknown_what="incremental", bad_what="incremental"),
+    ]
+    with Store(tmp_path / "s.sqlite") as db:
+        messages = [db.missing_message(long, "quick")]
+    for call in calls:
+        with pytest.raises(NeurohoverError) as err:
+            call()
+        messages.append(str(err.value))
+    for message in messages:
+        assert len(message) < 400 and "'gggggggggggggggggggggggggggggggggggggggg' ... 'gggggggggggggggggggg' (100,000 characters)" in message, message

@@ -11,7 +11,7 @@ import dataclasses
 import importlib
 import pkgutil
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..policysets import PolicySet, load_policy_set
 from ..tasks import TaskFamily, get_task_family
 from .protocol import Agent
@@ -45,7 +45,7 @@ HYBRID_AGENTS: tuple[str, ...] = tuple(name for name, spec in AGENTS.items() if 
 def agent_spec(name: str, task: str | TaskFamily | None = None) -> AgentSpec:
     """The spec of agent ``name``; refuses unknown names and, given ``task`` (a name or a family), agents for other tasks."""
     if name not in AGENTS:
-        raise NeurohoverError(f"unknown agent {name!r}: allowed {', '.join(AGENTS)}")
+        raise NeurohoverError(f"unknown agent {brief(name)}: allowed {', '.join(AGENTS)}")
     spec = AGENTS[name]
     if task is not None:
         family = get_task_family(task) if isinstance(task, str) else task

@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..evaluate import DEVICES, check_device, check_episode_count
 from ..evolution.config import MAX_BUDGET
 from ..evolution.generational import GENERATIONAL_PRESETS
@@ -482,7 +482,7 @@ def cmd_settings(args: argparse.Namespace) -> int:
             raise NeurohoverError(f"agent {name!r} takes no settings of its own (agents that do: {', '.join(a for a, s in AGENTS.items() if s.settings)})")
         name = _settings_name(own)
     if name not in found:
-        raise NeurohoverError(f"no settings named {args.name!r}: allowed {', '.join(found)}, or an agent's name")
+        raise NeurohoverError(f"no settings named {brief(args.name)}: allowed {', '.join(found)}, or an agent's name")
     print(format_settings(found[name], name))
     return 0
 

@@ -37,7 +37,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
-from ..errors import NeurohoverError, finite_real
+from ..errors import NeurohoverError, brief, finite_real
 from ..paths import JSONError, WriterLock, strict_json
 
 SCHEMA_VERSION = 1
@@ -310,7 +310,7 @@ class Store:
         at = f" at scale {scale!r}" if scale else ""
         if name is None and not present:
             return f"results store {str(self.path)!r} holds no experiment yet"
-        what = f"no experiment {name!r}{at}" if name is not None else f"nothing{at}"
+        what = f"no experiment {brief(name)}{at}" if name is not None else f"nothing{at}"
         return f"results store {str(self.path)!r} holds {what}; it holds: " + (", ".join(present) if present else "nothing yet")
 
     def scales(self, name: str) -> list[str]:

@@ -27,8 +27,8 @@ import pkgutil
 
 import numpy as np
 
-from ..errors import NeurohoverError
-from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, competition_rows, echoed, finite_vector
+from ..errors import NeurohoverError, brief
+from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, competition_rows, finite_vector
 from .drift import NO_DRIFT, Drift, refuse_drift
 from .fghh import COMPETITION_FGHH_SIGMA, FGHH
 from .ghh08 import GHH08, MAX_WIND
@@ -77,13 +77,13 @@ def get_task_family(name: str, sigma: float | None = None, sensor: Sensor | None
 def _family(name: str, sigma: float | None) -> TaskFamily:
     key = str(name).lower().replace("-", "")
     if key not in TASK_FAMILIES:
-        raise NeurohoverError(f"unknown task {echoed(name)}: allowed {', '.join(TASK_NAMES)}")
+        raise NeurohoverError(f"unknown task {brief(name)}: allowed {', '.join(TASK_NAMES)}")
     cls = TASK_FAMILIES[key]
     if sigma is not None and (isinstance(sigma, (bool, np.bool_)) or not isinstance(sigma, (int, float, np.integer, np.floating))):
         raise NeurohoverError(f"sigma={sigma!r} is not allowed: give a number (the family's breadth) or None")
     if sigma is not None and not cls.has_sigma:
         with_sigma = [n for n, c in TASK_FAMILIES.items() if c.has_sigma]
-        raise NeurohoverError(f"sigma applies to the {', '.join(with_sigma)} task only, not to {echoed(name)}")
+        raise NeurohoverError(f"sigma applies to the {', '.join(with_sigma)} task only, not to {brief(name)}")
     if cls.has_sigma and sigma is not None:
         try:
             value = float(sigma)

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..sim.constants import (
     DEFAULT_NOISE_STD,
     DEFAULT_PARAMS,
@@ -33,16 +33,6 @@ from ..sim.reference import ReferenceMDP
 from ..sim.rng import MAX_SEED
 from .drift import NO_DRIFT, Drift
 from .sensor import EXACT, Sensor
-
-
-def echoed(value: object) -> str:
-    """``repr(value)`` for a message, a long text shown as paths are (its first 40 and last 20 characters), any other
-    long repr cut at 80: a 100,000-character task or MDP name was echoed whole (eleventh trial, U6)."""
-    if isinstance(value, str) and len(value) > 80:
-        return f"{value[:40]!r} ... {value[-20:]!r} ({len(value):,} characters)"
-    text = repr(value)
-    return text if len(text) <= 80 else text[:77] + "..."
-
 
 N_TRAINING = 10
 N_TEST = 100
@@ -103,7 +93,7 @@ class MDP:
         if not isinstance(self.label, str):  # make(label=5) was kept as the number (second trial)
             raise NeurohoverError(f"MDP label={self.label!r:.60} is not allowed: give a string")
         if not isinstance(self.family, str) or not self.family:
-            raise NeurohoverError(f"MDP family={echoed(self.family)} is not allowed: give a task family's name (or 'model')")
+            raise NeurohoverError(f"MDP family={brief(self.family)} is not allowed: give a task family's name (or 'model')")
         # Plain Python numbers (the same values): reprs read MDP(params=(-0.18, ...)), not np.float64(-0.18).
         for name, length in (("params", len(DEFAULT_PARAMS)), ("noise_std", len(DEFAULT_NOISE_STD)), ("wind", None)):
             values = getattr(self, name)
@@ -460,7 +450,7 @@ class TaskFamily:
     def mdp(self, spec: str, rng: np.random.Generator | int | None = None) -> MDP:
         """An MDP by name: ``zero``, ``train:N``, ``test:N``, ``seeded-train:N``, ``seeded-test:N`` or ``sample``."""
         if not isinstance(spec, str):
-            raise NeurohoverError(f"MDP {echoed(spec)} is not allowed: give its name as a string, e.g. 'zero', 'train:3' or 'test:12'")
+            raise NeurohoverError(f"MDP {brief(spec)} is not allowed: give its name as a string, e.g. 'zero', 'train:3' or 'test:12'")
         if spec == "zero":
             return self.zero()
         if spec == "sample":
@@ -478,7 +468,7 @@ class TaskFamily:
             if len(digits) <= 6 and int(digits) < n:
                 return getter()[int(digits)]
             shown = index if len(index) <= 30 else f"{index[:10]}...({len(index)} digits)"  # as the command line shows numbers
-            raise NeurohoverError(f"MDP index {shown} in {echoed(spec)} is out of range: allowed 0..{n - 1}")
+            raise NeurohoverError(f"MDP index {shown} in {brief(spec)} is out of range: allowed 0..{n - 1}")
         raise NeurohoverError(
-            f"unknown MDP {echoed(spec)}: allowed zero, sample, train:N and seeded-train:N (0..{N_TRAINING - 1}), test:N and seeded-test:N (0..{N_TEST - 1})"
+            f"unknown MDP {brief(spec)}: allowed zero, sample, train:N and seeded-train:N (0..{N_TRAINING - 1}), test:N and seeded-test:N (0..{N_TEST - 1})"
         )
