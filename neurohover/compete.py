@@ -336,26 +336,24 @@ def compete(
     _refuse_other_settings(config, store_path)
     _note_replaced(out / "summary.json", task, agent)
     ordered = _run_into_store(config, store_path, out / "episodes.csv", jobs=jobs, device=device, progress=progress, on_result=on_result)
-    summary = {
-        "task": task,
-        "agent": agent,
-        "mdps": mdps,
-        "seed": seed,
-        "store": str(store_path),
-        # what the episodes were flown under, so that `plot --compete` names where overlaid runs differ (eleventh trial, S4)
-        "episode_steps": n_steps,
-        "sigma": sigma,
-        "sensor": None if sensor is None else sensor.to_dict(),
-        "drift": None if drift is None else drift.to_dict(),
-        "experiment": config.name,
-        "scale": config.scale,
-        **summarise(ordered),
-    }
+    summary = {"task": task, "agent": agent, "mdps": mdps, "seed": seed, "store": str(store_path), **_flown_under(n_steps, sigma, sensor, drift)}
+    summary |= {"experiment": config.name, "scale": config.scale, **summarise(ordered)}
     _write_summary(out / "summary.json", summary)
     plot_cumulative(
         {agent: np.array([np.cumsum(np.array(r.returns, dtype=float)) for r in ordered])}, out / "cumulative.png", f"{task}: {agent}, {len(ordered)} runs"
     )
     return summary, ordered
+
+
+def _flown_under(n_steps: int, sigma: float | None, sensor: Sensor | None, drift: Drift | None) -> dict:
+    """What the episodes were flown under, kept in summary.json so that ``plot --compete`` names where overlaid runs
+    differ (50-step drifting episodes were overlaid on 6000-step ones without a word; eleventh trial, S4)."""
+    return {
+        "episode_steps": n_steps,
+        "sigma": sigma,
+        "sensor": None if sensor is None else sensor.to_dict(),
+        "drift": None if drift is None else drift.to_dict(),
+    }
 
 
 def _checked_store(store) -> Path | None:

@@ -34,7 +34,6 @@ from ..evaluate import DEVICES, check_device, check_episode_count
 from ..evolution.config import MAX_BUDGET
 from ..evolution.generational import GENERATIONAL_PRESETS
 from ..evolution.optimisers import OPTIMISERS, optimiser_names
-from .learning_checks import policy_that_flew
 
 MDP_FAMILY = "G"
 
@@ -316,7 +315,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     """Learn a helicopter model from flight data (LR, EC-MENO or EC-MER) and print its parameters."""
     from ..agents.model_based import ModelEvolution
     from ..flightdata import FlightData
-    from ..models import DEFAULT_NOISE_ESTIMATE, format_parameter_table, learn_ec_meno, learn_ec_mer, learn_lr, parameter_table
+    from ..models import DEFAULT_NOISE_ESTIMATE, ec_mer_policy, format_parameter_table, learn_ec_meno, learn_ec_mer, learn_lr, parameter_table
     from ..paths import input_file, output_file
     from .options import check_given, given_settings
 
@@ -355,7 +354,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
         elif args.method == "ec-meno":
             model = learn_ec_meno(data, seed=seed, **extra)
         else:
-            model = learn_ec_mer(data, policy_that_flew(args.policy, data, args.flight_data), seed=seed, **extra)
+            model = learn_ec_mer(data, ec_mer_policy(args.policy, data, args.flight_data), seed=seed, **extra)
     model.save(out)  # written whole or not at all (a failed write: one message, the old file as it was)
     truth, why = _true_mdp(data.metadata)
     print(f"{args.method} model written to {out} ({time.perf_counter() - start:.2f} s)")

@@ -45,7 +45,7 @@ Example
 """
 
 from ..sim.constants import NOISE_NAMES, PARAM_NAMES
-from .ec import EC_MENO_MAX_EVALUATIONS, EC_MENO_SCALINGS, ec_meno_gene_scale, learn_ec_meno, learn_ec_mer, observed_return
+from .ec import EC_MENO_MAX_EVALUATIONS, EC_MENO_SCALINGS, ec_meno_gene_scale, ec_mer_policy, learn_ec_meno, learn_ec_mer, observed_return
 from .lr import (
     D_U_CHOICES,
     DEFAULT_D_U,
@@ -100,6 +100,7 @@ __all__ = [
     "fit_wind",
     "equivalent_params",
     "format_parameter_table",
+    "ec_mer_policy",
     "learn_ec_mer",
     "learn_ec_meno",
     "learn_lr",

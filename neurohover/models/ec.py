@@ -13,14 +13,14 @@ import time
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..flightdata import FlightData
 from ..sim.constants import DEFAULT_PARAMS, ROW_NOISE, ROW_PARAMS
 from ..tasks import MDP
 from .model import MODEL_DT, LearnedModel, check_vector
 from .transitions import OneStepProblem, Transitions, noise_from_residuals
 
-__all__ = ["EC_MENO_MAX_EVALUATIONS", "EC_MENO_SCALINGS", "ec_meno_gene_scale", "learn_ec_mer", "learn_ec_meno", "observed_return"]
+__all__ = ["EC_MENO_MAX_EVALUATIONS", "EC_MENO_SCALINGS", "ec_mer_policy", "ec_meno_gene_scale", "learn_ec_mer", "learn_ec_meno", "observed_return"]
 
 _PARAM_AXIS = np.array([0, 1, 1, 2, 2, 3, 3, 4, 4, 5, 5])  # the axis of each parameter
 # Genes of EC-MER (and of EC-MENO with scaling="default") are parameters divided by |default|, so
@@ -290,3 +290,35 @@ def learn_ec_mer(
         "history": history,
     }
     return LearnedModel(tuple(best), tuple(noise), "ec-mer", time.perf_counter() - start, stats)
+
+
+def ec_mer_policy(given: str | None, data: FlightData, flight_data: str):
+    """EC-MER's policy for ``data`` (read from the file ``flight_data``): the one the flight data record
+    (``policy_flown``), else the file their metadata names (older files), else the baseline; ``--policy`` (``given``)
+    where they record none, and refused where it is not the recorded one (a policy that never flew the data was fitted
+    without a word; eleventh trial, S2)."""
+    from ..policies import load_policy
+
+    where = f"flight data {flight_data!r}"
+    if given is None:
+        recorded = data.recorded_policy(where)
+        if recorded is not None:
+            return recorded
+        try:
+            return load_policy(data.metadata.get("policy") or "baseline")
+        except NeurohoverError as err:
+            raise NeurohoverError(f"{err} (the policy the flight data's metadata name; give --policy FILE)") from None
+    policy = load_policy(given)
+    if data.metadata.get("policy_flown") is None:  # none recorded (older files) or joined recordings of several: --policy says
+        return policy
+    try:
+        recorded = data.recorded_policy(where)
+    except NeurohoverError:  # a damaged record: the given policy is all there is
+        return policy
+    if recorded is not None and recorded != policy:
+        name = brief(str(data.metadata.get("policy", "a policy")))
+        raise NeurohoverError(
+            f"--policy {given!r} is not the policy that flew {where} (they record {name}, a different network): EC-MER fits "
+            "the closed loop of the policy that flew the data; leave --policy out to use the recorded one"
+        )
+    return policy
