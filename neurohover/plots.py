@@ -24,6 +24,7 @@ import csv
 import json
 import math
 import os
+import textwrap
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -368,12 +369,14 @@ def compete_figure(results: Sequence[CompeteResult], title: str = "") -> Figure:
     differ = _differing_conditions(results)
     for r in results:
         name = r.label if labels.count(r.label) == 1 else f"{r.label} [{r.path.name}]"  # same agent twice
+        label = f"{name}: {r.returns.shape[0]} runs, {r.crashes} crashes"
         if differ:  # 50-step drifting episodes beside 6000-step ones were overlaid without a word (eleventh trial, S4)
-            name += ", " + ", ".join(f"{key} {_condition_text(r.conditions.get(key, '?'))}" for key in differ)
+            flown = ", ".join(f"{key} {_condition_text(r.conditions.get(key, '?'))}" for key in differ)
+            label += "\n" + textwrap.fill(flown, 70)  # lines of their own: one long line ran off the figure's edge
         error = r.cumulative_error
         episodes = np.arange(1, error.size + 1)
         for ax in axes:
-            ax.plot(episodes, error, label=printable(f"{name}: {r.returns.shape[0]} runs, {r.crashes} crashes"))  # names that are no UTF-8
+            ax.plot(episodes, error, label=printable(label))  # names that are no UTF-8
     axes[0].set_ylabel("cumulative error (-cumulative reward)")
     axes[1].set_yscale("log")
     axes[1].set_ylabel("cumulative error (log scale)")

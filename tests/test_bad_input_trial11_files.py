@@ -213,7 +213,7 @@ def test_overlaid_competitions_name_the_conditions_they_differ_in(tmp_path: Path
     assert summary["episode_steps"] == 30 and summary["drift"] == Drift.parse("walk=0.1").to_dict() and summary["sensor"] is None
     _, fig = plot_compete([tmp_path / "a", tmp_path / "b"], tmp_path / "ab.png")
     labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
-    assert labels[0].startswith("baseline (ghh08) [a], episode_steps 20, drift none: 1 runs") and "episode_steps 30, drift {" in labels[1], labels
+    assert labels[0] == "baseline (ghh08) [a]: 1 runs, 0 crashes\nepisode_steps 20, drift none" and "\nepisode_steps 30, drift {" in labels[1], labels
     assert "(flown under different episode_steps, drift: see the legend)" in fig.texts[0].get_text()
     compete("ghh08", "model-free", runs=1, episodes=2, n_steps=20, out=tmp_path / "c")
     _, fig = plot_compete([tmp_path / "a", tmp_path / "c"], tmp_path / "ac.png")  # alike: labelled as before
