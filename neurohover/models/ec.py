@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
 import time
 
 import numpy as np
@@ -197,8 +198,13 @@ def _thin(history: list, keep: int = 200) -> list:
 def observed_return(flight_data: FlightData, episode: int = 0) -> float:
     """Return of one recorded episode recomputed from its observations: ``-sum_k |obs_k|^2``
     over the observations after each action (valid for an episode that did not crash)."""
-    if not isinstance(flight_data, FlightData) or not 0 <= episode < flight_data.n_episodes:
-        raise NeurohoverError(f"episode {episode!r} is not in the flight data")
+    if not isinstance(flight_data, FlightData):
+        raise NeurohoverError(f"flight data must be a FlightData, got {type(flight_data).__name__}")
+    # a float was a TypeError from indexing, True taken as episode 1 (twelfth trial T4)
+    if isinstance(episode, bool) or not isinstance(episode, numbers.Integral):
+        raise NeurohoverError(f"episode={brief(episode)} is not allowed: give an integer in 0..{flight_data.n_episodes - 1}")
+    if not 0 <= episode < flight_data.n_episodes:
+        raise NeurohoverError(f"episode {brief(episode)} is not in the flight data: give an integer in 0..{flight_data.n_episodes - 1}")
     obs = flight_data.observations[episode][1:]
     return -float(np.einsum("ij,ij->", obs, obs))
 

@@ -111,6 +111,10 @@ def lr_determined(flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS,
     for a sinusoidal wind, span the control steps its frequency needs (``MIN_WIND_STEPS``).
 
     GLS (quasi-differenced regressors) may still find an axis undetermined where this says yes."""
+    # learn_lr's own checks: an unknown intercepts or wind_model answered True (twelfth trial S6)
+    _check_options(intercepts=(intercepts, INTERCEPTS), wind_model=(wind_model, WIND_MODELS))
+    if not isinstance(flight_data, FlightData):
+        raise NeurohoverError(f"flight data must be a FlightData, got {type(flight_data).__name__}")
     if flight_data.n_transitions < MIN_TRANSITIONS:
         return False
     if wind_model == "sinusoid" and max(a.shape[0] for a in flight_data.actions) < MIN_WIND_STEPS:

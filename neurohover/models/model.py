@@ -28,14 +28,14 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..sim.constants import CONTROL_DT, DEFAULT_NOISE_STD, DEFAULT_PARAMS, NOISE_NAMES, PARAM_NAMES, SUBSTEP_DT, SUBSTEPS
 from ..tasks import MDP, finite_vector
 from .wind import NO_WIND, WindModel
@@ -383,6 +383,13 @@ def parameter_table(
 
 def format_parameter_table(rows: Sequence[ParamRow]) -> str:
     """The rows of :func:`parameter_table` as aligned text."""
+    # other rows were an AttributeError or TypeError from the formatting (twelfth trial T4)
+    if isinstance(rows, (str, bytes)) or not isinstance(rows, Iterable):
+        raise NeurohoverError(f"rows={brief(rows)} is not allowed: give the list of ParamRow that parameter_table returns")
+    rows = list(rows)
+    bad = next((r for r in rows if not isinstance(r, ParamRow)), None)
+    if bad is not None:
+        raise NeurohoverError(f"row {brief(bad)} is not allowed: give the ParamRow rows that parameter_table returns")
     lines = [f"{'name':>6} {'learned':>11} {'true':>11} {'rel.err':>8}"]
     lines += [f"{r.name:>6} {r.learned:>11.4f} {r.true:>11.4f} {100 * r.rel_error:>7.1f}%" for r in rows]
     return "\n".join(lines)

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..flightdata import FlightData
 from ..sim.constants import GRAVITY, NOISE_DECAY, NOISE_GAIN, NOISE_NAMES, OBS_NAMES, PARAM_NAMES
 from ..tasks import MDP
@@ -366,7 +366,12 @@ def _params_of(model) -> np.ndarray:
         if model.substeps != 1 or abs(model.dt - MODEL_DT) > 1e-12 or model.wind_kind != 0:
             raise NeurohoverError("one-step prediction needs a one-substep model MDP without wind (substeps=1, dt=0.1)")
         return np.array(model.params, dtype=float)
-    return np.asarray(model, dtype=float)
+    try:  # text or objects were NumPy's "could not convert string to float" (twelfth trial T4)
+        return np.asarray(model, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise NeurohoverError(
+            f"model={brief(model)} is not allowed: give a LearnedModel, a one-substep model MDP, 11 parameters or an (n, 11) array of them"
+        ) from None
 
 
 def one_step_error(model, flight_data: FlightData | OneStepProblem):
