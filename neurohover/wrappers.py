@@ -20,11 +20,12 @@ Report the unwrapped environment's returns (``RecordEpisodeStatistics`` inside t
 from __future__ import annotations
 
 import math
+import numbers
 
 import gymnasium as gym
 import numpy as np
 
-from .errors import NeurohoverError, finite_real
+from .errors import NeurohoverError, brief, finite_real
 from .sim.constants import CRASH_STEP_PENALTY
 
 __all__ = ["CrashAwareReward", "crash_aware"]
@@ -33,11 +34,14 @@ WORST_STEP = math.log1p(CRASH_STEP_PENALTY)  # the squashed worst step, about 7.
 
 
 def check_discount_and_scale(gamma, scale) -> None:
-    """Refuse a discount outside (0, 1] or a scale that is not a finite number > 0, by name."""
-    if isinstance(gamma, bool) or not isinstance(gamma, (int, float)) or not 0.0 < gamma <= 1.0:
-        raise NeurohoverError(f"gamma={gamma!r} is out of range: allowed a discount in (0, 1]")
-    if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not (finite_real(scale) and scale > 0):
-        raise NeurohoverError(f"scale={scale!r} is out of range: allowed a finite number > 0")
+    """Refuse a discount outside (0, 1] or a scale that is not a finite number > 0, by name: any real type (NumPy
+    scalars, Fraction) is taken; np.float32(0.9) was "out of range" (twelfth trial U1), so a wrong type says so."""
+    for name, value, allowed in (("gamma", gamma, "a discount in (0, 1]"), ("scale", scale, "a finite number > 0")):
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+            raise NeurohoverError(f"{name}={brief(value)} is not allowed: give a real number, {allowed}")
+        number = float(value) if finite_real(value) else math.nan  # nan: out of range either way
+        if not (0.0 < number <= 1.0 if name == "gamma" else number > 0):
+            raise NeurohoverError(f"{name}={brief(value)} is out of range: allowed {allowed}")
 
 
 def crash_aware(reward, gamma: float = 0.99, scale: float = 1.0):
@@ -48,7 +52,11 @@ def crash_aware(reward, gamma: float = 0.99, scale: float = 1.0):
     gamma**left) / (1 - gamma)``; times ``scale``.
     """
     check_discount_and_scale(gamma, scale)  # gamma=2 or scale=-1 were taken here and refused by the wrapper (fifth trial)
-    raw = np.asarray(reward)
+    gamma, scale = float(gamma), float(scale)  # a Fraction would make object arrays
+    try:
+        raw = np.asarray(reward)
+    except ValueError:  # a ragged list was NumPy's "inhomogeneous shape" (twelfth trial T6)
+        raw = np.asarray(None)
     if raw.dtype.kind not in "iuf":  # None was nan, "x" NumPy's ValueError
         raise NeurohoverError(f"reward={reward!r:.60} is not allowed: give a real number or an array of them")
     r = np.abs(raw.astype(np.float64))
