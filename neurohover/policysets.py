@@ -38,12 +38,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError, finite_real
+from .errors import NeurohoverError, brief, finite_real
 from .evaluate import MAX_EPISODES_PER_CALL, evaluate
 from .paths import JSONError, strict_json, writing
 from .policies import Policy, load_policy, save_policy
 from .sim.constants import MAX_EPISODE_STEPS
-from .tasks import get_task_family
+from .tasks import TaskFamily, get_task_family
 
 SHIPPED = Path(__file__).parent / "data" / "policies"
 FGHH_GENERICS = ("zero", "fixed", "race")
@@ -71,9 +71,13 @@ class Role:
     resampling: str = "fixed:1"
 
 
-def policy_set_roles(family) -> tuple[Role, ...]:
-    """The policies of ``family``'s set, in the order they are evolved (``build-policies`` seeds the
-    k-th from the k-th child of its root seed)."""
+def policy_set_roles(family: TaskFamily | str) -> tuple[Role, ...]:
+    """The policies of ``family``'s set (a TaskFamily or a task's name, as the other functions here take), in the order
+    they are evolved (``build-policies`` seeds the k-th from the k-th child of its root seed)."""
+    if isinstance(family, str):  # "ghh08" was an AttributeError (twelfth trial, T7)
+        family = get_task_family(family)
+    if not isinstance(family, TaskFamily):
+        raise NeurohoverError(f"family={brief(family)} is not allowed: give a task's name or a TaskFamily (neurohover.get_task_family(name))")
     if family.generic_over_distribution:
         return (Role("zero", 0, "zero"), *(Role(kind, 0, "family", FGHH_GENERIC_RESAMPLING[kind]) for kind in ("fixed", "race")))
     return (Role("generic", 0, "zero"), *(Role("specialised", i, "train") for i in range(len(family.training_mdps()))))
@@ -208,13 +212,32 @@ def table3_summary(crashes: np.ndarray, returns: np.ndarray) -> dict:
 
 def choose_safe(crashes: np.ndarray, returns: np.ndarray, n: int = 2) -> tuple[int, ...]:
     """The paper's rule: specialised policies that never crashed on the *other* training MDPs;
-    the ``n`` with the best mean return there. Fewer qualify: the fewest crashes, then return."""
+    the ``n`` with the best mean return there. Fewer qualify: the fewest crashes, then return. ``crashes`` and
+    ``returns``: (P, P) arrays of real numbers (policy i trained on MDP i), P >= 2; ``n`` in 1..P."""
+    crashes, returns = _square(crashes, "crashes"), _square(returns, "returns")
     p = crashes.shape[0]
+    if returns.shape != crashes.shape:
+        raise NeurohoverError(f"returns of shape {returns.shape} is not allowed beside crashes of shape {crashes.shape}: give both (P, P)")
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 1 <= n <= p:  # n=-1 chose P-1, n=0 none (twelfth trial, S8)
+        raise NeurohoverError(f"n={brief(n)} is out of range: allowed an integer in 1..{p} (the number of policies)")
     others = ~np.eye(p, dtype=bool)
     crash_others = np.array([crashes[i][others[i]].sum() for i in range(p)])
     return_others = np.array([returns[i][others[i]].mean() for i in range(p)])
     order = np.lexsort((-return_others, crash_others))  # fewest crashes first, then best return
     return tuple(int(i) for i in order[:n])
+
+
+def _square(values: object, name: str) -> np.ndarray:
+    """``values`` as a (P, P) float array, P >= 2, or a NeurohoverError naming its shape (a list was an AttributeError, a
+    (3, 2) array an IndexError; twelfth trial, T7)."""
+    try:
+        array = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        array = None
+    if array is None or array.ndim != 2 or array.shape[0] != array.shape[1] or array.shape[0] < 2:
+        shape = f"of shape {array.shape}" if array is not None else brief(values)
+        raise NeurohoverError(f"{name} {shape} is not allowed: give a (P, P) array of numbers, P >= 2 (policy i on training MDP j)")
+    return array
 
 
 def _write_ghh_set(
