@@ -122,10 +122,12 @@ def parse_resampling(spec: str | Resampling | None) -> Resampling:
     allowed = (
         "allowed fixed:K (K >= 1 episodes per candidate), race:DELTA[:RULE] (confidence level 0 < DELTA < 1, rule "
         + ", ".join(RACE_RULES)
-        + "), lucb:DELTA or kl-lucb:DELTA (error probability 0 < DELTA < 1)"
+        + "), race:auto[:K] (a DELTA that matches fixed:K's cost, K in 1..10), lucb:DELTA or kl-lucb:DELTA (error probability 0 < DELTA < 1)"
     )
     if not text.isascii():  # int() and float() read other scripts' digits ('fixed:\u0661' would be fixed:1)
         raise NeurohoverError(f"resampling {spec!r} is not allowed: numbers in ASCII digits; {allowed}")
+    if sep and value and "" in value.split(":"):  # 'race:0.5:' and 'race:auto:' were read as race:0.5 and race:auto (twelfth trial, S8)
+        raise NeurohoverError(f"resampling {spec!r} is not allowed: it has an empty field (a ':' with nothing after it); {allowed}")
     if kind == "fixed" and sep:
         if value.isdigit() and 1 <= int(value) <= MAX_RESAMPLING:  # fixed:100000000000 was a MemoryError (third trial)
             return Resampling("fixed", int(value))
