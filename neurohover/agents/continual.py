@@ -81,6 +81,14 @@ class ContinualSettings(AgentSettings):
         if not isinstance(self.safeguard, bool):
             raise NeurohoverError(f"continual safeguard={brief(self.safeguard)} is not allowed: true or false")
 
+    def check_episode_steps(self, n_steps: int) -> None:
+        """``safeguard_after`` at or past the episode length: the safeguard would never test (twelfth trial, S3)."""
+        if self.safeguard and self.safeguard_after >= n_steps:
+            raise NeurohoverError(
+                f"continual safeguard_after={self.safeguard_after} is not below the episode's {n_steps} control steps (--episode-steps, "
+                f"n_steps): the safeguard would never test; give safeguard_after below {n_steps}, or safeguard=false"
+            )
+
     @classmethod
     def unused(cls, agent: str, given: dict) -> str | None:
         """``safeguard_after`` beside ``safeguard = false``: it would be ignored (seventh trial)."""

@@ -35,6 +35,7 @@ from ..flightdata import FlightData
 from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
+from .spec import AgentSettings
 
 REPEAT_CHUNK = 64  # most episodes per kernel call for a repeated choice
 
@@ -194,6 +195,9 @@ def run_test(
     episodes in the MDP fly (the agent's own evolutions on models follow its ``ModelEvolution``).
     """
     seed = _check_run(agent, family, mdp, episodes, seed)
+    settings = getattr(agent, "settings", None)
+    if isinstance(settings, AgentSettings) and isinstance(n_steps, (int, np.integer)) and not isinstance(n_steps, bool):
+        settings.check_episode_steps(int(n_steps))  # settings that cannot act in episodes this long (twelfth trial, S3)
     start_time = time.perf_counter()
     agent.start(family, np.random.default_rng(np.random.SeedSequence([seed, 0xA6E27])))
     returns = np.zeros(episodes)

@@ -69,6 +69,10 @@ class AgentSettings:
     def from_unit(cls, params: dict) -> Any:
         return cls.from_dict(params.get(cls.UNIT_KEY) or {})
 
+    def check_episode_steps(self, n_steps: int) -> None:
+        """Refuse settings that cannot act in episodes of ``n_steps`` control steps (a NeurohoverError naming both): the
+        settings class cannot see the episode length, so the run checks it here before any episode flies."""
+
     @classmethod
     def unused(cls, agent: str, given: dict) -> str | None:
         """Why one of the ``given`` settings would do nothing for ``agent`` (refused rather than ignored), or None; a setting
