@@ -14,7 +14,7 @@ import json
 import sys
 from pathlib import Path
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..evaluate import DEVICES, check_device
 
 
@@ -124,9 +124,10 @@ def cmd_results(args: argparse.Namespace) -> int:
     from ..paths import input_file, output_file, writing
 
     input_file(args.store, "--store", "results store")
+    fmt = _results_format(args.format, args.out)  # before output_file makes --out's directory
     out = None if args.out is None else output_file(args.out, "--out", {"--store": args.store}, stdout=True)
     with Store(args.store, create=False) as store:
-        text = export_results(store, args.name, args.format, args.scale)
+        text = export_results(store, args.name, fmt, args.scale)
     if out is not None:
         with writing(out, "--out") as path:
             path.write_text(text)
@@ -134,6 +135,16 @@ def cmd_results(args: argparse.Namespace) -> int:
     else:
         sys.stdout.write(text)
     return 0
+
+
+def _results_format(given: str | None, out) -> str:
+    """--format, or the one --out's .csv/.json suffix names (else csv); a suffix that names the other format refused (CSV
+    was written into r2.json without a word; twelfth trial, S2)."""
+    suffix = "" if out is None else Path(out).suffix.lower().lstrip(".")
+    named = suffix if suffix in ("csv", "json") else None
+    if given is not None and named is not None and given != named:
+        raise NeurohoverError(f"--format {given} is not allowed beside --out {brief(str(out))}, whose name says {named}: give one that agrees")
+    return given or named or "csv"
 
 
 def _positive_ints(text: str, option: str) -> list[int]:
@@ -180,6 +191,9 @@ def cmd_wins(args: argparse.Namespace) -> int:
             raise NeurohoverError(f"agent {label!r} has no test runs in {args.name!r} ({scale}): allowed {', '.join(runs)}")
     if len(set(chosen)) != len(chosen):
         raise NeurohoverError(f"--agents {args.agents!r} names an agent twice: give each once")
+    if args.against and args.agents and args.against in chosen:  # it was dropped from the table without a word (twelfth trial, S4)
+        others = ",".join([a for a in chosen if a != args.against] or [a for a in runs if a != args.against]) or "of other groups"
+        raise NeurohoverError(f"--against {args.against} is also in --agents {args.agents!r}: an agent is not compared with itself; give --agents {others}")
     if args.against:
         fields = {a: {args.against: runs[args.against], a: runs[a]} for a in chosen if a != args.against}
         if not fields:
@@ -265,8 +279,8 @@ def register(sub) -> None:
     p.add_argument(
         "--format",
         choices=("csv", "json"),
-        default="csv",
-        help="csv: one row per unit, one plain value per cell (a long list as its count and mean); json: every unit in full",
+        help="csv: one row per unit, one plain value per cell (a long list as its count and mean); json: every unit in full "
+        "(default: what --out's .csv/.json suffix names, else csv; a suffix naming the other is refused)",
     )
     p.add_argument("--out", help="output file (default: standard output)")
     p.set_defaults(func=cmd_results)
@@ -277,7 +291,7 @@ def register(sub) -> None:
     p.add_argument("--scale", metavar="SCALE", help="which scale: quick, paper or a compete run's settings-HASH (needed when the store holds several)")
     p.add_argument("--runs", default="1,5,20", help="competition lengths N, comma-separated (default 1,5,20)")
     p.add_argument("--agents", help="group labels to enter, comma-separated (default: every group of the experiment)")
-    p.add_argument("--against", metavar="LABEL", help="each agent against this group alone (head to head)")
+    p.add_argument("--against", metavar="LABEL", help="each agent against this group alone (head to head); not also one of --agents")
     p.add_argument("--draws", type=int, default=10_000, help="simulated competitions (default 10,000)")
     p.add_argument("--seed", type=int, default=0, help="seed of the bootstrap (default 0)")
     p.add_argument("--json", action="store_true", help="print JSON")
