@@ -5,10 +5,11 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..sim.constants import EPISODE_STEPS
 from .options import add_task_options, family_and_mdps, max_in_memory, note_policy_task
 
@@ -61,6 +62,16 @@ def _fly(policy, mdps: list, args: argparse.Namespace, show_progress: bool):
     return np.concatenate(returns), np.concatenate(crashed), seconds, flight, len(unique)
 
 
+def _npz_name(record: str) -> None:
+    """Refuse a --record FILE whose name does not end .npz: rx.csv held an .npz archive (twelfth trial, S2)."""
+    path = Path(record)
+    if path.suffix.lower() != ".npz":
+        like = str(path.with_suffix(".npz")) if path.name else "flight.npz"
+        raise NeurohoverError(
+            f"--record {brief(str(record))} is not allowed: the flight data are a NumPy archive; give a FILE ending .npz (e.g. {brief(like)})"
+        )
+
+
 def cmd_fly(args: argparse.Namespace) -> int:
     """Fly a policy and print return statistics."""
     from ..paths import output_file
@@ -81,7 +92,10 @@ def cmd_fly(args: argparse.Namespace) -> int:
     family, mdps = family_and_mdps(args, args.episodes, rng)
     note_policy_task(policy, family.name, f"--policy {args.policy}")
     if args.record is not None:
+        if Path(args.record).suffix:  # another suffix is refused before output_file makes its directory
+            _npz_name(args.record)
         output_file(args.record, "--record", {"--policy": args.policy})
+        _npz_name(args.record)  # no suffix: after output_file's own refusals ('-', a directory, a device)
     returns, crashed, seconds, fd, n_unique = _fly(policy, mdps, args, show_progress=not args.json)
     if fd is not None:
         fd.metadata.update(
@@ -177,7 +191,7 @@ def register(sub) -> None:
     p.add_argument("--episodes", type=int, default=10, help="number of episodes (default 10)")
     p.add_argument("--seed", type=int, default=0, help="root seed of the noise streams (default 0)")
     p.add_argument("--threads", type=int, help="kernel threads (default: all cores)")
-    p.add_argument("--record", metavar="FILE", help="write the flight data of every episode to FILE (.npz)")
+    p.add_argument("--record", metavar="FILE", help="write the flight data of every episode to FILE (its name ending .npz)")
     p.add_argument(
         "--record-dtype",
         choices=("float64", "float32"),
