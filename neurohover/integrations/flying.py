@@ -18,16 +18,17 @@ the paper's policies are compared on the same episodes::
 
 from __future__ import annotations
 
+import numbers
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from ..envs.arguments import real_values
+from ..envs.arguments import check_obs_dtype, real_values
 from ..envs.vector import HoverVectorEnv
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..evaluate import Evaluation
 from ..policies import Policy
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS
@@ -36,6 +37,27 @@ from ..tasks import MDP
 __all__ = ["AgentRow", "checked_obs_statistics", "compare_agent", "evaluate_callable"]
 
 MAX_EPISODES = 1 << 16  # helicopters in one lockstep batch: the vector environment's arrays stay small
+
+
+def _checked_mdps(mdps: Any) -> tuple[list[MDP], str]:
+    """``mdps`` (one MDP or a sequence of them, of one task family) as a list, with their family: the one check of
+    :func:`evaluate_callable` and :func:`compare_agent` (a Policy flew MDPs of mixed families; twelfth trial S5)."""
+    if isinstance(mdps, MDP):
+        mdps = [mdps]
+    elif isinstance(mdps, Iterable) and not isinstance(mdps, (str, bytes)):
+        mdps = list(mdps)
+    if not isinstance(mdps, list) or not mdps or not all(isinstance(m, MDP) for m in mdps):
+        raise NeurohoverError("mdps must be one MDP or a non-empty sequence of MDPs (e.g. get_task_family('ghh08').mdp('train:3'))")
+    families = sorted({m.family for m in mdps})
+    if len(families) != 1 or families[0] == "model":
+        raise NeurohoverError(f"mdps must all be MDPs of one task family (got {', '.join(families)})")
+    return mdps, families[0]
+
+
+def _check_on_step(on_step: Any) -> None:
+    """Refuse an ``on_step`` that cannot be called before anything flies (5 was a TypeError after the first step; twelfth trial T5)."""
+    if on_step is not None and not callable(on_step):
+        raise NeurohoverError(f"on_step={brief(on_step)} is not allowed: give a function of no arguments (called after each step) or None")
 
 
 def evaluate_callable(
@@ -74,18 +96,19 @@ def evaluate_callable(
         raise NeurohoverError(f"act={act!r:.60} is not allowed: give a function of a batch of observations (B, 12) -> actions (B, 4)")
     if not isinstance(indexed, (bool, np.bool_)):  # 'yes' was taken as true
         raise NeurohoverError(f"indexed={indexed!r:.40} is not allowed: give True (act takes the episodes' indices too) or False")
-    mdps = [mdps] if isinstance(mdps, MDP) else list(mdps)
-    if not mdps or not all(isinstance(m, MDP) for m in mdps):
-        raise NeurohoverError("mdps must be one MDP or a non-empty sequence of MDPs (e.g. get_task_family('ghh08').mdp('train:3'))")
-    families = sorted({m.family for m in mdps})
-    if len(families) != 1 or families[0] == "model":
-        raise NeurohoverError(f"mdps must all be MDPs of one task family (got {', '.join(families)})")
+    mdps, family = _checked_mdps(mdps)
+    _check_on_step(on_step)
+    # text was a TypeError from first_episode + k, True taken as 1 (twelfth trial T5); evaluate's range
+    if isinstance(first_episode, (bool, np.bool_)) or not isinstance(first_episode, numbers.Integral):
+        raise NeurohoverError(f"first_episode={brief(first_episode)} is not allowed: give an integer in 0..2**62-1")
+    if not 0 <= first_episode < 2**62:
+        raise NeurohoverError(f"first_episode={first_episode!r} is out of range: allowed an integer in 0..2**62-1")
     if isinstance(episodes, (bool, np.bool_)) or not isinstance(episodes, (int, np.integer)) or not 1 <= episodes * len(mdps) <= MAX_EPISODES:
         raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1 with episodes x MDPs <= {MAX_EPISODES}")
     n = len(mdps) * int(episodes)
     sigma = getattr(mdps[0], "sigma", None)
-    env = HoverVectorEnv(n, task=families[0], sigma=sigma, mdp=[m for m in mdps for _ in range(episodes)], episode_steps=n_steps, obs_dtype=obs_dtype)
-    streams = [(seed, first_episode + k) for k in range(n)]  # k = m * episodes + e, as evaluate numbers them
+    env = HoverVectorEnv(n, task=family, sigma=sigma, mdp=[m for m in mdps for _ in range(episodes)], episode_steps=n_steps, obs_dtype=obs_dtype)
+    streams = [(seed, int(first_episode) + k) for k in range(n)]  # k = m * episodes + e, as evaluate numbers them
     start = time.perf_counter()
     obs, _ = env.reset(seed=seed, options={"noise": streams})
     returns, steps = np.zeros(n), np.zeros(n, dtype=np.int64)
@@ -158,30 +181,42 @@ class AgentRow:
 
 def compare_agent(
     act: Callable[[np.ndarray], Any] | Policy,
-    mdps: Sequence[MDP],
+    mdps: MDP | Sequence[MDP],
     *,
     episodes: int = 1,
     seed: int = 0,
     n_steps: int = EPISODE_STEPS,
-    obs_dtype: str = "float32",
+    obs_dtype: str | None = None,
     on_step: Callable[[], None] | None = None,
 ) -> list[AgentRow]:
     """``act`` flown on ``mdps`` beside the competition's baseline and the shipped generic policy of the MDPs' task,
     all on the same gusts (:func:`evaluate_callable` and :func:`neurohover.evaluate` number them alike): a learned
     policy measured as the paper measured its agents (full episodes of ``n_steps``; the return per episode and
-    the crashes). A :class:`~neurohover.policies.Policy` flies in the compiled kernel, as the other two do.
-    Returns rows for ``agent``, ``baseline`` and ``generic``, in that order."""
+    the crashes). ``mdps``: one MDP or a sequence of MDPs of one task family, as for :func:`evaluate_callable`.
+    ``obs_dtype`` (default ``"float32"``) and ``on_step`` as there for a callable; a
+    :class:`~neurohover.policies.Policy` flies in the compiled kernel, as the other two do, in one call (``on_step``
+    is not called) on float64 observations, so ``obs_dtype`` beside it is refused, as the CLI refuses ``--obs-dtype``
+    beside ``--policy``. Returns rows for ``agent``, ``baseline`` and ``generic``, in that order."""
     from ..evaluate import evaluate
     from ..policies import baseline_policy
     from ..policysets import load_policy_set
 
-    mdps = list(mdps)
+    mdps, family = _checked_mdps(mdps)  # one MDP was "'MDP' object is not iterable" (twelfth trial T5)
+    _check_on_step(on_step)
+    if obs_dtype is not None:  # checked for a Policy too, which ignored obs_dtype='x' (twelfth trial S5)
+        check_obs_dtype(obs_dtype)
     if isinstance(act, Policy):
+        if obs_dtype is not None:
+            raise NeurohoverError(
+                f"obs_dtype={obs_dtype!r} applies to a callable that receives observations, not to a Policy (it flies in the compiled kernel on float64)"
+            )
         agent = evaluate(act, mdps, episodes=episodes, seed=seed, n_steps=n_steps)
     else:
         indexed = bool(getattr(act, "indexed", False))  # a recurrent policy keeps a state per episode
-        agent = evaluate_callable(act, mdps, episodes=episodes, seed=seed, n_steps=n_steps, obs_dtype=obs_dtype, indexed=indexed, on_step=on_step)
-    generic = load_policy_set(mdps[0].family).generic
+        agent = evaluate_callable(
+            act, mdps, episodes=episodes, seed=seed, n_steps=n_steps, obs_dtype="float32" if obs_dtype is None else obs_dtype, indexed=indexed, on_step=on_step
+        )
+    generic = load_policy_set(family).generic
     rows = [AgentRow.of("agent", agent)]
     for name, policy in (("baseline", baseline_policy()), ("generic", generic)):
         rows.append(AgentRow.of(name, evaluate(policy, mdps, episodes=episodes, seed=seed, n_steps=n_steps)))
