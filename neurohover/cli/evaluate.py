@@ -28,7 +28,7 @@ def _reported(fn, spec: str):
     def act(observations):
         try:
             return fn(observations)
-        except Exception as err:  # the user's code: what it raised, and what it is called with
+        except (Exception, SystemExit) as err:  # the user's code: what it raised (a sys.exit(0) was the command's silent success; twelfth trial S1)
             raise NeurohoverError(
                 f"--callable {spec!r} raised {type(err).__name__}: {err} when called with a batch of observations, an array of shape "
                 f"{getattr(observations, 'shape', '?')}: it must take one such array and return actions of shape (B, 4)"
@@ -64,6 +64,8 @@ def _agent(args: argparse.Namespace):
             raise NeurohoverError(f"--callable {args.callable!r}: {err}") from None
         except SyntaxError as err:  # a module that does not compile is named, as a missing one is
             raise NeurohoverError(f"--callable {args.callable!r}: SyntaxError: {err}") from None
+        except (Exception, SystemExit) as err:  # its own code at import: a traceback, or sys.exit(0) a silent success (twelfth trial S1)
+            raise NeurohoverError(f"--callable {args.callable!r}: importing {module} raised {type(err).__name__}: {err}") from None
         if not callable(fn):
             raise NeurohoverError(f"--callable {args.callable!r} is not a function")
         return _reported(fn, args.callable)
@@ -138,7 +140,7 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     quiet = True if isinstance(act, Policy) else None
     with tqdm(total=args.episode_steps, desc="agent's episodes", unit="step", file=sys.stderr, disable=quiet, dynamic_ncols=True) as bar:
         rows = compare_agent(
-            act, mdps, episodes=args.episodes, seed=args.seed, n_steps=args.episode_steps, obs_dtype=args.obs_dtype or "float32", on_step=lambda: bar.update(1)
+            act, mdps, episodes=args.episodes, seed=args.seed, n_steps=args.episode_steps, obs_dtype=args.obs_dtype, on_step=lambda: bar.update(1)
         )
     print(f"{args.task} {args.mdps} MDPs 0-{n - 1}, {args.episodes} episode(s) each of {args.episode_steps} steps, gusts of seed {args.seed}:")
     print(f"{'policy':<10} {'return/episode':>15} {'median over MDPs':>17} {'crashed':>12}")
