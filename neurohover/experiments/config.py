@@ -38,7 +38,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief, finite_real
 from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..models.model import LEGACY_MODEL_SUBSTEPS
 from .schema import SCHEMAS, check_given, check_kind, validate_table
@@ -326,6 +326,8 @@ def _check_seeds_of(config: ExperimentConfig, where: str) -> None:
 #: An experiment's name becomes file names (figures, discussions, exports): letters, digits, '.', '_' and '-',
 #: starting with a letter or digit, so that no name can reach outside the report's folder.
 _SAFE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}")
+#: The scale of a compete run's experiment (neurohover.compete): its settings' digest, 10 hex digits.
+_COMPETE_SCALE = re.compile(r"settings-[0-9a-f]{10}")
 #: What a config's [paper] table may hold (what the report reads from it).
 PAPER_KEYS = ("notes", "claims", "ttests", "groups", "table", "table3")
 
@@ -349,28 +351,92 @@ def _paper_p(p) -> bool:
         return False
 
 
-def check_paper(paper, raw: dict, where: str) -> None:
-    """Refuse an unknown [paper] key, and a paper t test that names no group, variant, method or fit at any scale."""
+#: The numbers each entry of a [paper] table may give (what the report reads), the required ones first.
+_PAPER_NUMBERS = {
+    "table": (("r_m", "r_a"), ("t", "sd")),  # Table 4's: method -> t, r_m, r_a, sd
+    "groups": ((), ("crash_rate", "return_per_episode_no_crash")),  # test runs': group -> ...
+    "table3": ((), ("r", "sd", "r_G", "sd_G", "crashes_G")),  # Table 3's: variant -> ...
+}
+
+
+def _json_value(value, path: str, where: str) -> None:
+    """Refuse a value under [paper] that the store's JSON cannot hold (inf, nan, 10**400, an object), by its key path:
+    it was a json error once the store file was made (twelfth trial, T3)."""
+    if isinstance(value, dict):
+        for k, v in value.items():
+            if not isinstance(k, str):
+                raise NeurohoverError(f"{where}: [paper] {path} has key {brief(k)}: give text keys")
+            _json_value(v, f"{path}.{k}", where)
+    elif isinstance(value, list | tuple):
+        for i, v in enumerate(value):
+            _json_value(v, f"{path}[{i}]", where)
+    elif isinstance(value, float | int) and not isinstance(value, bool) and not finite_real(value):
+        raise NeurohoverError(f"{where}: [paper] {path} = {brief(value)} is not allowed: give a finite number")
+    elif not isinstance(value, str | bool | int | float):
+        raise NeurohoverError(f"{where}: [paper] {path} = {brief(value)} is not allowed: give text, a Python int or float, a list or a table (what JSON holds)")
+
+
+def check_paper_table(paper, where: str) -> None:
+    """Refuse a [paper] table the report cannot read: unknown keys, values the store's JSON cannot hold, and entries of the
+    wrong shape (a text where the report formats a number was a traceback in `report`, after reproduce had run; twelfth
+    trial, T1-T3). Shared by config files and :func:`make_config`."""
     if not isinstance(paper, dict):
-        raise NeurohoverError(f"{where}: [paper] must be a table")
-    unknown = sorted(set(paper) - set(PAPER_KEYS))
+        raise NeurohoverError(f"{where}: [paper] = {brief(paper)} is not allowed: give a table (a dict) of {', '.join(PAPER_KEYS)}")
+    unknown = sorted(set(paper) - set(PAPER_KEYS), key=str)
     if unknown:
-        raise NeurohoverError(f"{where}: unknown [paper] key(s) {', '.join(unknown)}; allowed: {', '.join(PAPER_KEYS)}")
-    tables = [raw.get("settings", {}), *raw.get("scales", {}).values()]
-    entries = [e for tab in tables for kind in ("groups", "variants", "fits") for e in tab.get(kind, []) if isinstance(e, dict)]
-    names = {e.get(k) for e in entries for k in ("key", "label", "agent")} | {m for tab in tables for m in tab.get("methods", [])}
+        named = ", ".join(brief(k) if not isinstance(k, str) or len(k) > 60 else k for k in unknown)
+        raise NeurohoverError(f"{where}: unknown [paper] key(s) {named}; allowed: {', '.join(PAPER_KEYS)}")
     for key in ("notes", "claims"):  # lists of sentences (a string here was reported letter by letter)
         value = paper.get(key, [])
         if not isinstance(value, list) or not all(isinstance(x, str) for x in value):
-            raise NeurohoverError(f"{where}: [paper] {key} = {value!r:.60} is not allowed: give a list of strings")
-    for t in paper.get("ttests", []):
+            raise NeurohoverError(f"{where}: [paper] {key} = {brief(value)} is not allowed: give a list of strings")
+    ttests = paper.get("ttests", [])
+    if not isinstance(ttests, list):  # 5 was a TypeError, 'x' read letter by letter (twelfth trial, T2)
+        raise NeurohoverError(f"{where}: [paper] ttests = {brief(ttests)} is not allowed: give a list of tables with a, b and p")
+    for t in ttests:
         if not isinstance(t, dict) or not {"a", "b", "p"} <= set(t):
-            raise NeurohoverError(f"{where}: each [paper] ttests entry needs a, b and p, got {t!r}")
+            raise NeurohoverError(f"{where}: each [paper] ttests entry needs a, b and p, got {brief(t)}")
         if not _paper_p(t["p"]):
             raise NeurohoverError(
-                f"{where}: [paper] ttests p = {t['p']!r} is not allowed: give the paper's p-value as text, "
+                f"{where}: [paper] ttests p = {brief(t['p'])} is not allowed: give the paper's p-value as text, "
                 "e.g. '5.8e-12', '< 0.0026', 'not significant' or 'none (why)'"
             )
+        for side in ("a", "b"):  # a list was a TypeError where the names are looked up
+            if not isinstance(t[side], str):
+                raise NeurohoverError(f"{where}: [paper] ttests {side} = {brief(t[side])} is not allowed: give a group, variant, method or fit by name")
+    for key, (required, optional) in _PAPER_NUMBERS.items():
+        _check_paper_numbers(paper.get(key, {}), key, required, optional, where)
+    for key, value in paper.items():  # what the shapes leave open (a t test's other keys)
+        _json_value(value, key, where)
+
+
+def _check_paper_numbers(table, key: str, required: tuple[str, ...], optional: tuple[str, ...], where: str) -> None:
+    """A [paper] ``table`` / ``groups`` / ``table3``: names, each a table of the numbers ``required`` and ``optional``."""
+    allowed = ", ".join((*required, *optional)) + (f" ({' and '.join(required)} required)" if required else "")
+    shape = f"give a table of names, each a table of numbers {allowed}"
+    if not isinstance(table, dict):
+        raise NeurohoverError(f"{where}: [paper] {key} = {brief(table)} is not allowed: {shape}")
+    for name, entry in table.items():
+        if not isinstance(entry, dict):
+            raise NeurohoverError(f"{where}: [paper] {key}.{name} = {brief(entry)} is not allowed: {shape}")
+        unknown = sorted(map(str, set(entry) - {*required, *optional}))
+        missing = [k for k in required if k not in entry]
+        if unknown or missing:
+            what = f"unknown number(s) {', '.join(unknown)}" if unknown else f"no {' or '.join(missing)}"
+            raise NeurohoverError(f"{where}: [paper] {key}.{name} has {what}: allowed {allowed}")
+        for k, v in entry.items():
+            if not finite_real(v) or (k == "crash_rate" and not 0 <= v <= 1) or (k == "crashes_G" and not (isinstance(v, int) and v >= 0)):
+                want = "a rate in 0..1" if k == "crash_rate" else "an integer >= 0" if k == "crashes_G" else "a finite number"
+                raise NeurohoverError(f"{where}: [paper] {key}.{name}.{k} = {brief(v)} is not allowed: give {want}")
+
+
+def check_paper(paper, raw: dict, where: str) -> None:
+    """Refuse a paper t test that names no group, variant, method or fit at any scale (its shape was checked by
+    :func:`make_config`, :func:`check_paper_table`)."""
+    tables = [raw.get("settings", {}), *raw.get("scales", {}).values()]
+    entries = [e for tab in tables for kind in ("groups", "variants", "fits") for e in tab.get(kind, []) if isinstance(e, dict)]
+    names = {e.get(k) for e in entries for k in ("key", "label", "agent")} | {m for tab in tables for m in tab.get("methods", [])}
+    for t in paper.get("ttests", []):
         for side in ("a", "b"):
             if t[side] not in names:
                 raise NeurohoverError(f"{where}: [paper] ttests names {t[side]!r} ({side}), which is no group, variant, method or fit of the config")
@@ -397,13 +463,20 @@ def make_config(
     check_name(name, where)
     if kind not in KINDS:
         raise NeurohoverError(f"{where}: kind = {kind!r} is not allowed: expected one of {', '.join(KINDS)}")
+    if scale not in SCALES and not (isinstance(scale, str) and _COMPETE_SCALE.fullmatch(scale)):  # 'weird' was stored (twelfth trial, S7)
+        raise NeurohoverError(f"{where}: scale = {brief(scale)} is not allowed: give one of {', '.join(SCALES)} (or a compete run's settings-HASH)")
+    for key, text in (("title", title), ("paper_ref", paper_ref), ("source", source)):  # title=5 was later called a damaged store (twelfth trial, U2)
+        if not isinstance(text, str):
+            raise NeurohoverError(f"{where}: {key} = {brief(text)} is not allowed: give text")
     resolved = validate_table(dict(settings), SCHEMAS[kind], where)
     check_given(settings, where)
     check_kind(resolved, kind, where)
+    paper = {} if paper is None else paper
+    check_paper_table(paper, where)  # after the settings: a bad agent is named as such
     from .plans import external_digest
 
     digest = external_digest(kind, resolved)
-    return ExperimentConfig(name, title or name, kind, scale, resolved, paper or {}, paper_ref, source, digest)
+    return ExperimentConfig(name, title or name, kind, scale, resolved, paper, paper_ref, source, digest)
 
 
 def load_configs(name: str, scale: str, overrides: dict[str, Any] | None = None) -> list[ExperimentConfig]:

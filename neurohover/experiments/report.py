@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import NeurohoverError, OutputError
-from .config import ORDER, ExperimentConfig, shipped_counterpart, with_shipped_paper
+from .config import ORDER, ExperimentConfig, check_paper_table, shipped_counterpart, with_shipped_paper
 from .keys import UnitKey
 from .report_base import Section, agent_panel, fmt, log_errors, new_figure, paired_p, paired_verdict, ratio_verdict, sd, table
 from .report_claims import PAPER_FIGURES, DiscussionError, claims_section, conclusions_discussion, read_discussion
@@ -543,6 +543,7 @@ def _write_report(store: Store, out: Path, scale: str | None, names: list[str] |
             shipped = shipped_counterpart(stored)  # loaded once: its [paper] table, and whether it still hashes as stored
             current = (None if shipped is None else shipped.hash == stored.hash) if sc == "paper" else None  # the status table: paper scale
             cfg = with_shipped_paper(stored, shipped)
+            check_paper_table(cfg.paper, "the stored config")  # a store written before twelfth trial T1's check: said here, not a traceback
             text, checked, status = _section(cfg, store, out, current)
         except (OutputError, DiscussionError):  # a full disk or an unreadable discussion is no damaged store (eighth, ninth trial)
             raise
