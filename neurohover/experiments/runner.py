@@ -9,8 +9,8 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
-from ..errors import NeurohoverError
-from .config import POLICY_SOURCES, ExperimentConfig, check_own_name
+from ..errors import NeurohoverError, brief
+from .config import POLICY_SOURCES, ExperimentConfig, check_own_name, check_paper_table
 from .plans import Plan, plan, run_keys, source_experiments
 from .results import check_run_lengths, result_from_dict
 from .store import Store
@@ -161,15 +161,25 @@ def _refuse_stray_units(config: ExperimentConfig, store: Store, results: dict[st
     return planned_from_all
 
 
-def _check_arguments(config, store, executor) -> None:
-    """:func:`reproduce`'s arguments of the right kinds (a name or a path was an AttributeError; fourth trial)."""
+def _check_arguments(config, store, executor, progress, on_unit, only) -> tuple[str, ...]:
+    """:func:`reproduce`'s arguments of the right kinds (a name or a path was an AttributeError; fourth trial); returns
+    ``only`` as a tuple of patterns, a single pattern as one ('run/*' was taken as r, u, n, ...; twelfth trial, U3)."""
     if not isinstance(config, ExperimentConfig):
         raise NeurohoverError(f"config={config!r:.60} is not allowed: give load_config(NAME, SCALE)")
     if not isinstance(store, Store):
         raise NeurohoverError(f"store={store!r:.60} is not allowed: give a Store(PATH)")
     if not callable(getattr(executor, "run", None)):
         raise NeurohoverError(f"executor={executor!r:.60} is not allowed: give an executor, make_executor('local', jobs=N) or LocalExecutor(N)")
+    check_paper_table(config.paper, f"experiment {config.name!r}")  # a config made without make_config: refused before the store is written
     check_own_name(config)  # a config of one's own named fig2 or its alias table3 was stored as the shipped one (eleventh trial, S8)
+    if progress not in (None, True, False):  # "no" drew the bar (twelfth trial, S7)
+        raise NeurohoverError(f"progress={brief(progress)} is not allowed: give True, False or None (a bar on a terminal only)")
+    if on_unit is not None and not callable(on_unit):  # 5 was a TypeError once the first unit had run (twelfth trial, T7)
+        raise NeurohoverError(f"on_unit={brief(on_unit)} is not allowed: give a callable (unit key, result), or None")
+    patterns = (only,) if isinstance(only, str) else only
+    if not isinstance(patterns, Sequence) or not all(isinstance(p, str) for p in patterns):
+        raise NeurohoverError(f"only={brief(only)} is not allowed: give a glob pattern of unit keys or a list of them, e.g. ['run/hybrid/*']")
+    return tuple(patterns)
 
 
 def reproduce(
@@ -180,12 +190,12 @@ def reproduce(
     fresh: bool = False,
     update: bool = False,
     progress: bool | None = None,
-    only: Sequence[str] = (),
+    only: str | Sequence[str] = (),
     on_unit: Callable[[str, dict], None] | None = None,
 ) -> RunSummary:
     """Run every unfinished unit of ``config``; each finished unit is written to ``store`` at once.
 
-    ``only`` restricts the run to the units whose keys match one of these glob patterns (for example
+    ``only`` restricts the run to the units whose keys match this glob pattern or one of these (for example
     ``run/hybrid/*/rep0``); the others stay unfinished, and a later call can run them.
     ``on_unit(key, result)`` is called for every unit finished in this call, once it is stored.
     ``fresh`` discards the experiment's stored results first; ``update`` takes a config that differs from
@@ -195,7 +205,7 @@ def reproduce(
     """
     from tqdm import tqdm
 
-    _check_arguments(config, store, executor)
+    only = _check_arguments(config, store, executor, progress, on_unit, only)
     store.lock()  # one writer per store: a second run would redo every unit the first has not finished
     check_restart(fresh, update, only)
     held = store.config_hash(config.name, config.scale)
