@@ -17,6 +17,7 @@ everything else is a deterministic function of the params.
 from __future__ import annotations
 
 import hashlib
+import numbers
 import os
 import time
 from collections.abc import Sequence
@@ -28,7 +29,7 @@ import numpy as np
 from ..agents.model_based import ModelEvolution, evolve_on_model
 from ..agents.protocol import after_learning_start, run_test
 from ..agents.registry import AgentOptions, AgentPolicies, agent_spec
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..evaluate import evaluate, evaluate_jobs, num_threads
 from ..evolution.config import optimiser_of
 from ..evolution.eonn import EonnSettings
@@ -74,6 +75,11 @@ class Unit:
 
 def unit_seed(root: int, experiment: str, key: str) -> int:
     """A 63-bit seed for unit ``key``: ``SeedSequence([root, *sha256(experiment/key) words])``."""
+    if not isinstance(root, numbers.Integral) or isinstance(root, bool) or root < 0:  # 'x' and -1 were int()'s and NumPy's errors (twelfth trial, T7)
+        raise NeurohoverError(f"root={brief(root)} is not allowed: give the config's seed, an integer >= 0")
+    for name, value in (("experiment", experiment), ("key", key)):
+        if not isinstance(value, str):
+            raise NeurohoverError(f"{name}={brief(value)} is not allowed: give text")
     digest = hashlib.sha256(f"{experiment}/{key}".encode()).digest()
     words = [int(w) for w in np.frombuffer(digest, dtype="<u4")]
     state = np.random.SeedSequence([int(root), *words]).generate_state(1, np.uint64)[0]
@@ -452,9 +458,13 @@ def run_unit(unit: Unit | dict, threads: int | None = 1, device: str = "cpu") ->
     part of the unit's params or the config hash: results agree across devices to within
     docs/gpu.md's tolerance.
     """
-    if isinstance(unit, dict):
+    if isinstance(unit, dict) and set(unit) == {"experiment", "key", "kind", "params"}:
         unit = Unit(unit["experiment"], unit["key"], unit["kind"], unit["params"])
-
+    if not isinstance(unit, Unit) or not isinstance(unit.params, dict):  # {} was a KeyError, 'x' an AttributeError (twelfth trial, T7)
+        raise NeurohoverError(
+            f"unit={brief(unit)} is not allowed: give a Unit of a plan (neurohover.experiments.plans.plan) or its to_dict(), "
+            "a dict of experiment, key, kind and params"
+        )
     runner = _RUNNERS.get(unit.kind)
     if runner is None:
         raise NeurohoverError(f"unknown unit kind {unit.kind!r}: allowed {', '.join(_RUNNERS)}")
