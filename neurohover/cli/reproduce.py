@@ -191,8 +191,8 @@ def cmd_wins(args: argparse.Namespace) -> int:
             raise NeurohoverError(f"agent {label!r} has no test runs in {args.name!r} ({scale}): allowed {', '.join(runs)}")
     if len(set(chosen)) != len(chosen):
         raise NeurohoverError(f"--agents {args.agents!r} names an agent twice: give each once")
-    if args.against and args.agents and args.against in chosen:  # it was dropped from the table without a word (twelfth trial, S4)
-        others = ",".join([a for a in chosen if a != args.against] or [a for a in runs if a != args.against]) or "of other groups"
+    others = ",".join(a for a in chosen if a != args.against)
+    if args.against and args.agents and args.against in chosen and others:  # it was dropped from the table without a word (twelfth trial, S4)
         raise NeurohoverError(f"--against {args.against} is also in --agents {args.agents!r}: an agent is not compared with itself; give --agents {others}")
     if args.against:
         fields = {a: {args.against: runs[args.against], a: runs[a]} for a in chosen if a != args.against}
