@@ -151,10 +151,10 @@ def check_agent_name(agent: object) -> None:
         raise NeurohoverError(f"unknown agent {brief(agent)}: allowed {', '.join(AGENTS)}")
 
 
-def check_agent_settings(agent: str, values: Mapping[str, object]) -> dict:
+def check_agent_settings(agent: str, values: Mapping[str, object], n_steps: int | None = None) -> dict:
     """``values`` as the agent's own settings table, checked by its spec's settings class (one clear message): every
     agent that ``neurohover settings`` lists settings for takes them here, but the hybrid agents, whose settings are
-    the ``hybrid`` argument (the --safeguard-*/--hybrid-* options)."""
+    the ``hybrid`` argument (the --safeguard-*/--hybrid-* options). ``n_steps``: the episode length they must act in."""
     from .agents.registry import agent_spec
 
     check_agent_name(agent)
@@ -163,11 +163,13 @@ def check_agent_settings(agent: str, values: Mapping[str, object]) -> dict:
         # incremental's max_learning_episodes was refused here while `neurohover settings incremental` listed it (eleventh trial, U2)
         hybrid = " (its settings, `neurohover settings hybrid`, are the --safeguard-*/--hybrid-* options, hybrid= in Python)" if spec.settings else ""
         raise NeurohoverError(f"agent {agent!r} takes no settings table of its own{hybrid}; agents that do: {', '.join(agents_with_settings())}")
-    settings = spec.settings.from_dict(dict(values)).to_dict()
+    checked = spec.settings.from_dict(dict(values))
     why = spec.settings.unused(agent, dict(values))
     if why is not None:
         raise NeurohoverError(f"agent {agent!r}: {why}")
-    return settings
+    if n_steps is not None:  # before any run: continual's safeguard_after past the episode would never test (twelfth trial, S3)
+        checked.check_episode_steps(n_steps)
+    return checked.to_dict()
 
 
 def agents_with_settings() -> list[str]:
@@ -202,7 +204,7 @@ def competition_config(
     """
     import hashlib
 
-    from .agents.registry import HYBRID_AGENTS
+    from .agents.registry import AGENTS, HYBRID_AGENTS
     from .experiments.config import make_config
 
     check_sizes(runs, episodes)
@@ -225,9 +227,10 @@ def competition_config(
         group[key] = choice
     wide: dict[str, object] = {}  # the incremental agents' max_learning_episodes: a setting of the whole experiment
     if agent_settings:  # the agent's own typed settings, checked by its spec's class (absent: as before)
-        own = check_agent_settings(agent, agent_settings)
-        wide = {k: v for k, v in own.items() if k in _EXPERIMENT_WIDE}
-        if not wide:
+        own = check_agent_settings(agent, agent_settings, n_steps)
+        if AGENTS[agent].settings.UNIT_KEY in _EXPERIMENT_WIDE:  # by the class, not by its keys: continual has one of the same name
+            wide = own
+        else:
             group["settings"] = own
     settings: dict[str, object] = {
         "task": task,

@@ -175,8 +175,8 @@ def test_long_names_are_shortened_in_python_too(tmp_path: Path) -> None:
     """U6: the command line shortened a 100,000-character name, but Python's messages (unknown task, MDP, agent, stored
     experiment, settings key) still held it whole: one helper (errors.brief) shortens them all."""
     import neurohover as nh
-    from neurohover.agents.registry import agent_spec
     from neurohover.agents.model_based import IncrementalSettings
+    from neurohover.agents.registry import agent_spec
     from neurohover.errors import settings_from_dict
     from neurohover.experiments import Store
 
@@ -195,3 +195,19 @@ def test_long_names_are_shortened_in_python_too(tmp_path: Path) -> None:
         messages.append(str(err.value))
     for message in messages:
         assert len(message) < 400 and "'gggggggggggggggggggggggggggggggggggggggg' ... 'gggggggggggggggggggg' (100,000 characters)" in message, message
+
+
+def test_compete_keeps_the_continual_agents_own_settings(tmp_path: Path, cli) -> None:
+    """Twelfth trial, S3: compete dropped every continual setting without a word (the incremental agents' one setting of
+    the whole experiment, max_learning_episodes, was picked out by key, and continual has a key of that name), and a
+    safeguard_after past the episode was refused only once a run had started."""
+    from neurohover.compete import competition_config
+
+    config = competition_config("ghh08", "continual", runs=1, episodes=2, n_steps=50, agent_settings={"window": 1, "safeguard_after": 10})
+    (group,) = config.settings["groups"]
+    assert group["settings"]["window"] == 1 and group["settings"]["safeguard_after"] == 10, group
+    with pytest.raises(NeurohoverError, match="continual safeguard_after=50 is not below the episode's 50 control steps"):
+        competition_config("ghh08", "continual", runs=1, episodes=2, n_steps=50, agent_settings={"safeguard_after": 50})
+    argv = ["compete", "--task", "ghh08", "--agent", "continual", "--runs", "1", "--episodes", "1", "--episode-steps", "20"]
+    rc, _, err = cli(*argv, "--agent-setting", "safeguard_after=20", "--out", str(tmp_path / "c"))
+    assert rc == 2 and "continual safeguard_after=20 is not below the episode's 20 control steps" in err and not (tmp_path / "c").exists(), err

@@ -77,7 +77,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
         from ..compete import check_agent_settings
         from ..experiments.config import parse_overrides
 
-        agent_settings = check_agent_settings(args.agent, parse_overrides(args.agent_setting, "--agent-setting"))
+        agent_settings = check_agent_settings(args.agent, parse_overrides(args.agent_setting, "--agent-setting"), args.episode_steps)
     if args.policy_dir is not None:
         if not AGENTS[args.agent].needs:  # it flies no policy of a set: the option would be ignored (second trial)
             raise NeurohoverError(f"--policy-dir applies to agents that fly a policy set's policies, not to --agent {args.agent}")
