@@ -211,3 +211,17 @@ def test_compete_keeps_the_continual_agents_own_settings(tmp_path: Path, cli) ->
     argv = ["compete", "--task", "ghh08", "--agent", "continual", "--runs", "1", "--episodes", "1", "--episode-steps", "20"]
     rc, _, err = cli(*argv, "--agent-setting", "safeguard_after=20", "--out", str(tmp_path / "c"))
     assert rc == 2 and "continual safeguard_after=20 is not below the episode's 20 control steps" in err and not (tmp_path / "c").exists(), err
+
+
+def test_a_config_whose_continual_safeguard_never_tests_is_refused_before_it_runs(tmp_path: Path, cli) -> None:
+    """Twelfth trial, S3: a test-runs config giving continual a safeguard_after past its episodes failed in its first unit
+    (exit 1) instead of being refused with the config (exit 2)."""
+    config = tmp_path / "c.toml"
+    config.write_text(
+        'name = "mine"\ntitle = "t"\nkind = "test_runs"\n[settings]\ntask = "ghh08"\nseed = 1\npolicies = "shipped"\n'
+        '[[settings.groups]]\nagent = "continual"\nmdps = "test"\nn_mdps = 1\nsettings = { safeguard_after = 20 }\n'
+        "[scales.quick]\nepisodes = 1\nn_steps = 20\n"
+    )
+    store = tmp_path / "s.sqlite"
+    rc, _, err = cli("reproduce", str(config), "--store", str(store), "--no-progress")
+    assert rc == 2 and "group 'continual': continual safeguard_after=20 is not below the episode's 20 control steps" in err and not store.exists(), err

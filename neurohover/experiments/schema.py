@@ -274,7 +274,9 @@ def _check_test_runs(settings: dict, task: str, where: str) -> None:
                 raise NeurohoverError(f"{where}: group {g['label']!r}: agent {g['agent']!r} takes no settings table")
             try:
                 given = g["settings"]
-                g["settings"] = own.from_dict(given).to_dict()
+                checked = own.from_dict(given)
+                checked.check_episode_steps(settings["n_steps"])  # refused before any run, not in one (twelfth trial, S3)
+                g["settings"] = checked.to_dict()
             except NeurohoverError as e:
                 raise NeurohoverError(f"{where}: group {g['label']!r}: {e}") from None
             why = own.unused(g["agent"], given)
