@@ -14,13 +14,14 @@ Example
 
 from __future__ import annotations
 
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError
+from .errors import NeurohoverError, brief
 from .flightdata import FlightData, same_values
 from .flyer import KernelFlyer
 from .launch import DEVICES, KIND, MAX_SEED, Batch, Flown, check_device, launch, num_threads, use_lanes
@@ -46,6 +47,7 @@ from .tasks import MDP, Sensor, refuse_drift
 # Re-exported where they were first defined: KernelFlyer, DEVICES, check_device, num_threads, use_lanes.
 __all__ = [
     "DEVICES",
+    "check_first_episode",
     "MAX_EPISODES_PER_CALL",
     "DangerousState",
     "Evaluation",
@@ -397,6 +399,17 @@ def evaluate_jobs(
     return Evaluation(out.returns, out.crashed, out.steps, out.safeguard_step, flight, seconds)
 
 
+def check_first_episode(first_episode) -> int:
+    """The index of a batch's first episode (its gust streams are (seed, first_episode + k)) as an int in 0..2**62-1;
+    text or True (taken as 1) refused by type, anything else by range: one check for every entry that takes it."""
+    if isinstance(first_episode, (bool, np.bool_)) or not isinstance(first_episode, numbers.Integral):
+        raise NeurohoverError(f"first_episode={brief(first_episode)} is not allowed: give an integer in 0..2**62-1")
+    index = int(first_episode)
+    if not 0 <= index < 2**62:
+        raise NeurohoverError(f"first_episode={brief(index)} is out of range: allowed an integer in 0..2**62-1")
+    return index
+
+
 def evaluate(
     policies: Policy | Sequence[Policy] | PolicyTable,
     mdps: MDP | Sequence[MDP] | np.ndarray,
@@ -421,8 +434,7 @@ def evaluate(
         raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
     if not isinstance(record, (bool, np.bool_)):
         raise NeurohoverError(f"record={record!r} is not allowed: give True or False")
-    if isinstance(first_episode, (bool, np.bool_)) or not isinstance(first_episode, (int, np.integer)) or not 0 <= first_episode < 2**62:
-        raise NeurohoverError(f"first_episode={first_episode!r} is out of range: allowed an integer in 0..2**62-1")
+    check_first_episode(first_episode)
     if safeguard is not None and not isinstance(safeguard, Safeguard):
         raise NeurohoverError(f"safeguard={safeguard!r:.60} is not allowed: give a neurohover.evaluate.Safeguard(fallback_policy) or None")
     n_pol, n_mdp = len(table), rows.shape[0]

@@ -18,7 +18,6 @@ the paper's policies are compared on the same episodes::
 
 from __future__ import annotations
 
-import numbers
 import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
@@ -29,7 +28,7 @@ import numpy as np
 from ..envs.arguments import check_obs_dtype, real_values
 from ..envs.vector import HoverVectorEnv
 from ..errors import NeurohoverError, brief
-from ..evaluate import Evaluation
+from ..evaluate import Evaluation, check_first_episode
 from ..policies import Policy
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS
 from ..tasks import MDP
@@ -98,11 +97,7 @@ def evaluate_callable(
         raise NeurohoverError(f"indexed={indexed!r:.40} is not allowed: give True (act takes the episodes' indices too) or False")
     mdps, family = _checked_mdps(mdps)
     _check_on_step(on_step)
-    # text was a TypeError from first_episode + k, True taken as 1 (twelfth trial T5); evaluate's range
-    if isinstance(first_episode, (bool, np.bool_)) or not isinstance(first_episode, numbers.Integral):
-        raise NeurohoverError(f"first_episode={brief(first_episode)} is not allowed: give an integer in 0..2**62-1")
-    if not 0 <= first_episode < 2**62:
-        raise NeurohoverError(f"first_episode={first_episode!r} is out of range: allowed an integer in 0..2**62-1")
+    first_episode = check_first_episode(first_episode)  # text was a TypeError from first_episode + k, True taken as 1 (twelfth trial T5)
     if isinstance(episodes, (bool, np.bool_)) or not isinstance(episodes, (int, np.integer)) or not 1 <= episodes * len(mdps) <= MAX_EPISODES:
         raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1 with episodes x MDPs <= {MAX_EPISODES}")
     n = len(mdps) * int(episodes)
