@@ -202,10 +202,8 @@ def competition_config(
     Its scale is a digest of the settings, so competitions with other settings in the same store
     are kept apart and the same settings resume.
     """
-    import hashlib
-
     from .agents.registry import AGENTS, HYBRID_AGENTS
-    from .experiments.config import make_config
+    from .experiments.config import make_config, settings_scale
 
     check_sizes(runs, episodes)
     check_seed(seed)  # the range every command takes
@@ -228,7 +226,7 @@ def competition_config(
     wide: dict[str, object] = {}  # the incremental agents' max_learning_episodes: a setting of the whole experiment
     if agent_settings:  # the agent's own typed settings, checked by its spec's class (absent: as before)
         own = check_agent_settings(agent, agent_settings, n_steps)
-        if AGENTS[agent].settings.UNIT_KEY in _EXPERIMENT_WIDE:  # by the class, not by its keys: continual has one of the same name
+        if getattr(AGENTS[agent].settings, "UNIT_KEY", None) in _EXPERIMENT_WIDE:  # by the class, not by its keys: continual has one of the same name
             wide = own
         else:
             group["settings"] = own
@@ -247,8 +245,7 @@ def competition_config(
         settings["sensor"] = sensor.to_dict()
     if drift is not None and not drift.none:
         settings["drift"] = drift.to_dict()
-    digest = hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()[:10]
-    return make_config(f"compete-{task}-{agent}", "test_runs", f"settings-{digest}", settings, title=f"compete: {agent} on {task}")
+    return make_config(f"compete-{task}-{agent}", "test_runs", settings_scale(settings), settings, title=f"compete: {agent} on {task}")
 
 
 def compete(

@@ -326,8 +326,16 @@ def _check_seeds_of(config: ExperimentConfig, where: str) -> None:
 #: An experiment's name becomes file names (figures, discussions, exports): letters, digits, '.', '_' and '-',
 #: starting with a letter or digit, so that no name can reach outside the report's folder.
 _SAFE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}")
-#: The scale of a compete run's experiment (neurohover.compete): its settings' digest, 10 hex digits.
+#: The scale of a compete run's experiment (neurohover.compete): its settings' digest, 10 hex digits (settings_scale).
 _COMPETE_SCALE = re.compile(r"settings-[0-9a-f]{10}")
+
+
+def settings_scale(settings: dict) -> str:
+    """The scale of an experiment run inline (``compete``) with ``settings``: a digest of them, so that competitions of
+    other settings in one store are kept apart and the same settings resume."""
+    return f"settings-{hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()[:10]}"
+
+
 #: What a config's [paper] table may hold (what the report reads from it).
 PAPER_KEYS = ("notes", "claims", "ttests", "groups", "table", "table3")
 
