@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError, OutputError
+from ..errors import NeurohoverError, OutputError, brief
 from .config import ORDER, ExperimentConfig, check_paper_table, shipped_counterpart, with_shipped_paper
 from .keys import UnitKey
 from .report_base import Section, agent_panel, fmt, log_errors, new_figure, paired_p, paired_verdict, ratio_verdict, sd, table
@@ -511,6 +511,8 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
         raise NeurohoverError(f"store={store!r:.60} is not allowed: give a Store(PATH)")
     if isinstance(names, str) or (names is not None and not all(isinstance(n, str) for n in names)):  # 'fig2' was read as f, i, g, 2
         raise NeurohoverError(f"names={names!r:.60} is not allowed: give a list of experiment names, e.g. ['fig2']")
+    if names is not None and not list(names):  # [] was read as None and reported every experiment (thirteenth trial, F21)
+        raise NeurohoverError(f"names={brief(names)} is not allowed: give one or more experiment names, or None for all")
     given = list(names or ())
     twice = sorted({n for n in given if given.count(n) > 1})
     if twice:  # taken once without a word (seventh trial)
