@@ -31,8 +31,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import FloatRangeError, NeurohoverError, finite_real, float_of
-from ..sim.constants import PARAM_NAMES, ROW_PARAMS
+from ..errors import FloatRangeError, NeurohoverError, brief, finite_real, float_of
+from ..sim.constants import MDP_ROW_LEN, PARAM_NAMES, ROW_PARAMS
+from ..sim.rng import MAX_SEED
 
 _DRIFT_TAG = 0xD81F7  # separates a run's drift stream from its agent's and its gusts'
 CHANGE_AT = (200, 800)  # the default range of the abrupt change's episode
@@ -75,7 +76,7 @@ class Drift:
         for name, factor in change.items():
             if name not in PARAM_NAMES:
                 raise NeurohoverError(f"drift change of {name!r}: not a dynamics parameter; allowed {', '.join(PARAM_NAMES)}")
-            if isinstance(factor, bool) or not isinstance(factor, (int, float)) or not MIN_FACTOR <= factor <= MAX_FACTOR:  # NaN fails too
+            if not finite_real(factor) or not MIN_FACTOR <= factor <= MAX_FACTOR:  # np.float32(0.8), Fraction(4, 5) in range too (thirteenth trial)
                 raise NeurohoverError(f"drift change {name}={factor!r} is out of range: allowed a factor in {MIN_FACTOR:g}..{MAX_FACTOR:g}")
             if factor == 1:  # flown as another experiment with results identical to none (eleventh trial, S3)
                 raise NeurohoverError(
@@ -98,6 +99,7 @@ class Drift:
 
     def check_run(self, episodes: int, where: str = "") -> None:
         """Refuse an abrupt change that some test runs of ``episodes`` episodes would never reach (``where``: a prefix naming the run)."""
+        episodes = _whole("episodes", episodes, "a whole number of episodes >= 1", 1)  # 0 suggested the window 0..-1 (thirteenth trial)
         if self.change and self.change_at[1] >= episodes:
             lo, hi = self.change_at
             default = " (the default where no @LO-HI is given)" if (lo, hi) == CHANGE_AT else ""
@@ -115,15 +117,17 @@ class Drift:
 
     def change_episode(self, seed: int) -> int | None:
         """The episode at which run ``seed`` changes abruptly (None: no abrupt change)."""
+        seed = _seed(seed)
         if not self.change:
             return None
         return int(self._rng(seed).integers(self.change_at[0], self.change_at[1] + 1))
 
     def rows(self, row: np.ndarray, episodes: int, seed: int) -> np.ndarray:
         """The (episodes, MDP_ROW_LEN) rows that episodes 0..episodes-1 of run ``seed`` fly, from the MDP's ``row``."""
-        rng = self._rng(seed)
+        row, episodes = _row(row), _whole("episodes", episodes, "a whole number of episodes >= 1", 1)
+        rng = self._rng(_seed(seed))
         change = int(rng.integers(self.change_at[0], self.change_at[1] + 1)) if self.change else episodes
-        out = np.repeat(np.asarray(row, dtype=float)[None, :], episodes, axis=0)
+        out = np.repeat(row[None, :], episodes, axis=0)
         if self.walk:
             walk = np.cumsum(rng.standard_normal((episodes, len(PARAM_NAMES))), axis=0)
             walk[0] = 0.0  # episode 0 flies the MDP as given
@@ -216,15 +220,41 @@ class Drift:
 NO_DRIFT = Drift()
 
 
+def _whole(name: str, value, what: str, low: int, high: int | None = None) -> int:
+    """``value`` as an int in ``low..high`` (NumPy integers too), or a NeurohoverError naming it (thirteenth trial, F9)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not low <= value or (high is not None and value > high):
+        raise NeurohoverError(f"{name}={brief(value)} is not allowed: give {what}")
+    return int(value)
+
+
+def _seed(seed) -> int:
+    """A run's seed, checked as every seed is: -1 was NumPy's error, 1.5 silently seed 1 (thirteenth trial, F9)."""
+    return _whole("seed", seed, f"a whole number in 0..{MAX_SEED}", 0, MAX_SEED)
+
+
+def _row(row) -> np.ndarray:
+    """An MDP's row (``MDP_ROW_LEN`` finite numbers) as a float array, or a NeurohoverError saying what it is not."""
+    try:
+        out = np.asarray(row, dtype=float)
+    except (TypeError, ValueError):
+        out = None
+    if out is None or out.shape != (MDP_ROW_LEN,) or not np.isfinite(out).all():
+        raise NeurohoverError(f"row={brief(row)} is not allowed: give an MDP's row of {MDP_ROW_LEN} finite numbers (MDP.row())")
+    return out
+
+
 class DriftRun:
     """The rows that the episodes of one test run of a drifting MDP fly, one at a time (an environment
     resets through them): ``row(e)`` is ``drift.rows(row, e + 1, seed)[e]``, computed in growing blocks."""
 
     def __init__(self, drift: Drift, row: np.ndarray, seed: int) -> None:
-        self.drift, self._row, self.seed = drift, np.asarray(row, dtype=float), int(seed)
+        if not isinstance(drift, Drift):
+            raise NeurohoverError(f"drift={brief(drift)} is not allowed: give a Drift (Drift.of reads its other forms)")
+        self.drift, self._row, self.seed = drift, _row(row), _seed(seed)
         self._rows = np.zeros((0, self._row.shape[0]))
 
     def row(self, episode: int) -> np.ndarray:
+        episode = _whole("episode", episode, "an episode number, a whole number >= 0", 0)  # -1 was the last row computed, 1.5 an IndexError
         if episode >= self._rows.shape[0]:  # a longer prefix of the same draws: the earlier rows do not change
             self._rows = self.drift.rows(self._row, max(2 * self._rows.shape[0], episode + 1, 1024), self.seed)
         return self._rows[episode]

@@ -38,7 +38,7 @@ import numbers
 import re
 from dataclasses import asdict, dataclass, fields, replace
 
-from ..errors import FloatRangeError, NeurohoverError, float_of
+from ..errors import FloatRangeError, NeurohoverError, brief, finite_real, float_of
 from ..sim.constants import MAX_SENSOR_DELAY, SENSOR_GROUPS
 
 #: The std of each group at noise level 1 (velocity m/s, position m, rates rad/s, attitude).
@@ -104,7 +104,15 @@ class Sensor:
     @classmethod
     def from_row_values(cls, values) -> Sensor:
         """The sensor of an MDP row's seven sensor slots (refused clearly when they are not a valid sensor)."""
-        v = [float(x) for x in values]
+        try:  # 3 values were an IndexError, None a TypeError, 9 values a sensor of the first seven (thirteenth trial, F10)
+            v = [float(x) for x in values]
+        except (TypeError, ValueError, OverflowError):
+            v = []
+        if len(v) != 7:
+            raise NeurohoverError(
+                f"sensor row values {brief(values)} are not allowed: give the 7 numbers of an MDP row's sensor slots "
+                "(velocity, position, rates, attitude, correlation, delay, dropout)"
+            )
         if not float(v[5]).is_integer():
             raise NeurohoverError(f"sensor delay={v[5]!r} in an MDP row is not a whole number of control steps")
         return cls(v[0], v[1], v[2], v[3], correlation=v[4], delay=int(v[5]), dropout=v[6])
@@ -112,9 +120,9 @@ class Sensor:
     @classmethod
     def at_level(cls, level: float, correlation: float = 0.0, delay: int = 0) -> Sensor:
         """The sensor of noise level ``level``: :data:`LEVEL_PROFILE` scaled by it."""
-        if isinstance(level, bool) or not isinstance(level, (int, float)) or not 0 <= level <= MAX_LEVEL:  # 10**400: no float() (sixth trial)
+        if not finite_real(level) or not 0 <= level <= MAX_LEVEL:  # np.float32(0.5), Fraction(1, 2) in range too (thirteenth trial, F8)
             raise NeurohoverError(f"sensor noise level={level!r} is out of range: allowed a number in 0..{MAX_LEVEL:g}")
-        v, p, r, a = (level * s for s in LEVEL_PROFILE)
+        v, p, r, a = (float(level) * s for s in LEVEL_PROFILE)
         return cls(v, p, r, a, correlation=correlation, delay=delay)
 
     @classmethod
@@ -171,7 +179,7 @@ class Sensor:
         """
         if obs_delay is None:
             delay = None
-        elif isinstance(obs_delay, bool) or not isinstance(obs_delay, int) and not (isinstance(obs_delay, float) and obs_delay.is_integer()):
+        elif not finite_real(obs_delay) or not float(obs_delay).is_integer():  # np.int64(2) as Sensor(delay=) takes it (thirteenth trial, F8)
             raise NeurohoverError(f"obs_delay={obs_delay!r} is not allowed: give a whole number of control steps in 0..{MAX_SENSOR_DELAY}")
         else:
             delay = int(obs_delay)
