@@ -70,6 +70,8 @@ def _parse_lines(text: str, source: str):
             comments.append(line.lstrip("# ").strip())
             continue
         try:
+            if not line.isascii():  # int() and float() read other scripts' digits: '٣' was weight 3 (thirteenth trial, F2)
+                raise ValueError("characters other than ASCII are not allowed: give numbers in ASCII digits")
             if fields[0] == "n" and len(fields) == 5:
                 node = int(fields[1])
                 if node in nodes:  # a second definition would silently replace the first

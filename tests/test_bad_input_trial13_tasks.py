@@ -87,3 +87,15 @@ def test_sensor_from_row_values_refuses_what_is_not_seven_numbers(values) -> Non
     with pytest.raises(NeurohoverError, match=r"sensor row values .* are not allowed: give the 7 numbers of an MDP row's sensor slots"):
         Sensor.from_row_values(values)
     assert Sensor.from_row_values(Sensor.at_level(1, delay=2).row_values()) == Sensor.at_level(1, delay=2)
+
+
+@pytest.mark.parametrize(("old", "new"), [("s 12 16 +0", "s 12 16 ٣"), ("n 1 0 0", "n ١ 0 0")])
+def test_net_files_take_ascii_digits_only(old: str, new: str) -> None:
+    """F2: a .net file's Arabic-Indic digits were read as numbers: weight '٣' as 3, node id '١' as node 1."""
+    from neurohover.netfile import policy_from_net, policy_to_net
+    from neurohover.policies import baseline_policy
+
+    text = policy_to_net(baseline_policy())
+    assert old in text
+    with pytest.raises(NeurohoverError, match=r"network file, line \d+: characters other than ASCII are not allowed: give numbers in ASCII digits"):
+        policy_from_net(text.replace(old, new, 1))
