@@ -16,7 +16,7 @@ non-member with the highest upper bound; stop when u's upper bound is below l's 
 otherwise fly l and u one more episode each. As a race does, a candidate flies at most ``t_limit`` episodes; when
 both l and u have them, the selection stops on J. The reward is a candidate's episode fitness on FGHH's
 ``1/ln(error)`` scale, which lies in [0, 1] for any error of at least e (a hovering error is far above): values
-above 1 are clipped, NaN and ``-inf`` count as 0.
+above 1 are clipped, NaN and ``-inf`` count as 0; ``+inf`` and an answer of another shape are refused, as in a race.
 """
 
 from __future__ import annotations
@@ -26,7 +26,8 @@ import math
 import numpy as np
 
 from ..errors import NeurohoverError, brief, finite_real
-from .races import RaceResult, SampleFn, _check_int
+from .common import as_floats
+from .races import RaceResult, SampleFn, _check_int, _check_sample_fn, _draw
 
 __all__ = ["BANDITS", "kl_bounds", "lucb_radius", "top_mu_bandit"]
 
@@ -37,8 +38,25 @@ KL_K1, KL_ALPHA = 405.5, 1.1
 
 def lucb_radius(samples: np.ndarray, t: int, n: int, delta: float) -> np.ndarray:
     """LUCB1's confidence radius ``sqrt(ln(5 n t^4 / (4 delta)) / (2 u))`` for candidates with ``samples`` = u episodes each."""
-    u = np.asarray(samples, dtype=np.float64)
+    u = _sample_counts(samples)
+    t, n = _check_int("t", t, 1), _check_int("n", n, 1)  # t=0 was a math domain error (thirteenth trial, F15)
+    delta = _check_probability(delta)
     return np.sqrt(math.log(5.0 * n * float(t) ** 4 / (4.0 * delta)) / (2.0 * u))
+
+
+def _sample_counts(samples: object) -> np.ndarray:
+    """Each candidate's number of samples as float64, all >= 1 (0 was a ZeroDivisionError; thirteenth trial, F15)."""
+    u = np.atleast_1d(as_floats(samples, "samples", "a 1-D array of sample counts >= 1"))
+    if u.ndim != 1 or not np.all(np.isfinite(u) & (u >= 1)):
+        raise NeurohoverError(f"samples={brief(u.tolist())} is not allowed: give a 1-D array of sample counts >= 1")
+    return u
+
+
+def _check_probability(delta: object) -> float:
+    """An error probability strictly between 0 and 1 (lucb_radius took 2.0; thirteenth trial, F15)."""
+    if not finite_real(delta) or not 0.0 < float(delta) < 1.0:  # type: ignore[arg-type]
+        raise NeurohoverError(f"delta={brief(delta)} must be an error probability strictly between 0 and 1 (e.g. 0.1)")
+    return float(delta)  # type: ignore[arg-type]
 
 
 _EPS = 1e-15  # the KL divergence's means are kept this far inside (0, 1)
@@ -50,9 +68,16 @@ def kl_bounds(means: np.ndarray, samples: np.ndarray, level: float, iterations: 
 
     Both bounds of every candidate are bisected in one array (upper bounds first), so that each halving is one
     set of NumPy calls: each element takes the same operations as alone, and so the same bits."""
-    p = np.clip(np.asarray(means, dtype=np.float64), 0.0, 1.0)
+    p = np.atleast_1d(as_floats(means, "means", "a 1-D array of empirical means"))
+    u = _sample_counts(samples)
+    if p.shape != u.shape or not np.all(np.isfinite(p)):  # other lengths were NumPy's broadcast error (thirteenth trial, F15)
+        raise NeurohoverError(f"means={brief(p.tolist())} is not allowed: give {u.size} finite mean(s), one per entry of samples")
+    if not finite_real(level) or level < 0:  # a negative level was taken silently
+        raise NeurohoverError(f"level={brief(level)} is not allowed: give a finite number >= 0")
+    iterations = _check_int("iterations", iterations, 1)  # -1 was taken silently: no halving at all
+    p = np.clip(p, 0.0, 1.0)
     n = p.size
-    room = np.tile(level / np.asarray(samples, dtype=np.float64), 2)
+    room = np.tile(float(level) / u, 2)
     up = np.arange(2 * n) < n  # the first half bisects upper bounds, the second lower ones
     lo = np.concatenate([p, np.zeros_like(p)])
     hi = np.concatenate([np.ones_like(p), p])
@@ -86,22 +111,22 @@ def top_mu_bandit(sample_fn: SampleFn, n_candidates: int, mu: int, delta: float,
     mu = _check_int("mu", mu, 1)
     if mu >= n:
         raise NeurohoverError(f"mu={mu} must be smaller than n_candidates={n}")
-    if not finite_real(delta) or not 0.0 < float(delta) < 1.0:
-        raise NeurohoverError(f"delta={brief(delta)} must be an error probability strictly between 0 and 1 (e.g. 0.1)")
+    delta = _check_probability(delta)
     if not isinstance(rule, str) or rule not in BANDITS:
         raise NeurohoverError(f"rule={brief(rule)} is not a bandit rule: choose one of {', '.join(BANDITS)}")
     t_limit = _check_int("t_limit", t_limit, 1)
-    sums = _rewards(sample_fn(np.arange(n))).copy()  # every candidate once
+    _check_sample_fn(sample_fn)  # None was a TypeError (thirteenth trial, F14)
+    sums = _rewards(_draw(sample_fn, np.arange(n))).copy()  # _draw: a race's check of the answer (its shape, +inf)  # every candidate once
     counts = np.ones(n, dtype=np.int64)
     rounds, separated = 0, False
     while True:
         t = int(counts.sum())
         means = sums / counts
         if rule == "lucb":
-            radius = lucb_radius(counts, t, n, float(delta))
+            radius = lucb_radius(counts, t, n, delta)
             lower, upper = means - radius, means + radius
         else:
-            lower, upper = kl_bounds(means, counts, math.log(KL_K1 * n * t**KL_ALPHA / float(delta)))
+            lower, upper = kl_bounds(means, counts, math.log(KL_K1 * n * t**KL_ALPHA / delta))
         order = np.argsort(-means, kind="stable")
         top, rest = order[:mu], order[mu:]
         low = int(top[np.argmin(lower[top])])
@@ -113,7 +138,7 @@ def top_mu_bandit(sample_fn: SampleFn, n_candidates: int, mu: int, delta: float,
         if not fly:
             break
         rounds += 1
-        drawn = _rewards(sample_fn(np.asarray(fly, dtype=np.int64)))
+        drawn = _rewards(_draw(sample_fn, np.asarray(fly, dtype=np.int64)))
         for i, r in zip(fly, drawn):
             sums[i] += r
             counts[i] += 1

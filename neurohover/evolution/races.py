@@ -154,8 +154,14 @@ def _check_delta(delta: object) -> float:
     return float(delta)
 
 
+def _check_sample_fn(sample_fn: object) -> None:
+    """Refuse a ``sample_fn`` that cannot be called before anything is flown (None was a TypeError mid-run; thirteenth trial, F14)."""
+    if not callable(sample_fn):
+        raise NeurohoverError(f"sample_fn={brief(sample_fn)} is not allowed: give a function of an array of candidate indices returning one return per index")
+
+
 def _draw(sample_fn: SampleFn, indices: np.ndarray) -> np.ndarray:
-    """Call ``sample_fn`` and check its answer; NaN returns become ``-inf`` (worst)."""
+    """Call ``sample_fn`` and check its answer (races and bandits alike); NaN returns become ``-inf`` (worst)."""
     out = as_floats(sample_fn(indices.copy()), "sample_fn's returns", f"{indices.size} numbers, one per candidate")
     if out.shape != indices.shape:
         raise NeurohoverError(f"sample_fn returned shape {out.shape} for {indices.size} candidates; expected {indices.shape}")
@@ -209,10 +215,13 @@ def bayes_mean_bounds(samples: np.ndarray, delta: float) -> tuple[float, float]:
     tuple of float
         ``(lower, upper)``.
     """
-    x = np.asarray(samples, dtype=np.float64).ravel()
+    delta = _check_delta(delta)  # 1.5 gave (nan, nan) silently (thirteenth trial, F15)
+    x = as_floats(samples, "samples", "an array of returns").ravel()
     n = x.size
     if n == 0:
         raise NeurohoverError("bayes_mean_bounds needs at least one sample")
+    if np.any(np.isnan(x) | (x == np.inf)):  # NaN gave (nan, nan) silently; -inf is a crash (the races map NaN to it)
+        raise NeurohoverError(f"samples={brief(x.tolist())} is not allowed: give finite returns or -inf, no NaN and no +inf")
     if np.any(np.isneginf(x)):
         return -math.inf, -math.inf
     if n == 1:
@@ -223,7 +232,7 @@ def bayes_mean_bounds(samples: np.ndarray, delta: float) -> tuple[float, float]:
     xbar = float(x.mean())
     var = float(x.var())
     scale = math.sqrt(var / n) if n > 1000 else math.sqrt(var / (n - 1))
-    q_lo, q_hi = _standard_quantiles(n, float(delta))
+    q_lo, q_hi = _standard_quantiles(n, delta)
     return q_lo * scale + xbar, q_hi * scale + xbar
 
 
@@ -245,6 +254,7 @@ def fixed_resampling(sample_fn: SampleFn, n_candidates: int, k: int) -> Resampli
     -------
     ResamplingResult
     """
+    _check_sample_fn(sample_fn)
     n = _check_int("n_candidates", n_candidates, 1)
     k = _check_int("k", k, 1)
     idx = np.arange(n)
@@ -297,6 +307,7 @@ def selection_race(
     -------
     RaceResult
     """
+    _check_sample_fn(sample_fn)
     n, mu, delta, t_limit, batch = _race_arguments(n_candidates, mu, delta, t_limit, batch, rule)
 
     # Samples in one (n, capacity) array: in round r every undecided candidate has r samples (columns 0..r-1 of
