@@ -131,3 +131,38 @@ def test_kl_bounds_refuses_mismatched_arrays_a_negative_level_and_no_halving(mea
 
     with pytest.raises(NeurohoverError, match=fragment):
         kl_bounds(np.array(means), np.array(samples), **kwargs)
+
+
+@pytest.mark.parametrize(
+    ("crashes", "episodes", "fragment"),
+    [
+        (1, 0, r"episodes=0 is not allowed: give a whole number of episodes >= 1"),
+        (5, 2, r"crashes=5 is not allowed: give a whole number of crashed episodes from 0 to episodes=2"),
+        (-1, 2, r"crashes=-1 is not allowed: give a whole number of crashed episodes from 0 to episodes=2"),
+        (1.5, 2, r"crashes=1\.5 is not allowed"),
+    ],
+)
+def test_crash_rate_refuses_counts_that_are_no_fraction(crashes, episodes, fragment: str) -> None:
+    """F20: crash_rate(1, 0) was a ZeroDivisionError, (5, 2) gave '250%' and (-1, 2) '-50%' silently."""
+    from neurohover.experiments.report import crash_rate
+
+    with pytest.raises(NeurohoverError, match=fragment):
+        crash_rate(crashes, episodes)
+    assert crash_rate(np.int64(1), np.int64(20_000)) == "0.005%"  # NumPy counts taken
+
+
+@pytest.mark.parametrize(
+    ("runs", "fragment"),
+    [
+        ({"a": {"m": ["x"]}, "b": {"m": [1.0]}}, r"agent 'a' has a run whose score is not a finite number: \['x'\] on MDP 'm'"),
+        ([1, 2], r"runs=\[1, 2\] is not allowed: give a dict of agent -> \{MDP -> cumulative rewards of its runs\}"),
+        ({"a": [1.0], "b": {"m": [1.0]}}, r"runs=\{'a': \[1\.0\], 'b': \{'m': \[1\.0\]\}\} is not allowed: give a dict of agent"),
+    ],
+)
+def test_win_probabilities_refuses_text_scores_and_runs_that_are_no_table(runs, fragment: str) -> None:
+    """F20: a text score was NumPy's "could not convert string to float" (NaN was refused clearly), and runs=[1, 2]
+    an AttributeError 'items'."""
+    from neurohover.experiments.wins import win_probabilities
+
+    with pytest.raises(NeurohoverError, match=fragment):
+        win_probabilities(runs, 2, draws=10)

@@ -17,7 +17,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from .keys import UnitKey
 from .results import TestRunResult
 
@@ -62,9 +62,11 @@ def win_probabilities(runs: Mapping[str, Mapping[str, Sequence[float]]], n_runs:
     """
     for name, value, low in (("n_runs", n_runs, 1), ("draws", draws, 1), ("seed", seed, 0)):
         if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < low:
-            raise NeurohoverError(f"{name}={value!r} is out of range: allowed an integer >= {low}")
+            raise NeurohoverError(f"{name}={brief(value)} is out of range: allowed an integer >= {low}")
     if draws * n_runs > _MAX_CELLS:
         raise NeurohoverError(f"draws x n_runs = {draws * n_runs:,} is too large: at most {_MAX_CELLS:,} simulated runs per agent at once")
+    if not isinstance(runs, Mapping) or not all(isinstance(r, Mapping) for r in runs.values()):  # [1, 2] was an AttributeError (thirteenth trial, F20)
+        raise NeurohoverError(f"runs={brief(runs)} is not allowed: give a dict of agent -> {{MDP -> cumulative rewards of its runs}}")
     agents = list(runs)
     if len(agents) < 2:
         raise NeurohoverError(f"a competition needs at least two agents, got {agents}")
@@ -75,9 +77,7 @@ def win_probabilities(runs: Mapping[str, Mapping[str, Sequence[float]]], n_runs:
     picks = rng.integers(len(common), size=(draws, n_runs))
     totals = np.empty((len(agents), draws))
     for i, agent in enumerate(agents):
-        pools = [np.asarray(runs[agent][m], dtype=float) for m in common]
-        if not all(np.all(np.isfinite(p)) for p in pools):
-            raise NeurohoverError(f"agent {agent!r} has a run whose score is not a finite number")
+        pools = [_scores(agent, m, runs[agent][m]) for m in common]
         counts = np.array([p.size for p in pools])
         flat = np.concatenate(pools)
         start = np.concatenate([[0], np.cumsum(counts)[:-1]])
@@ -89,6 +89,17 @@ def win_probabilities(runs: Mapping[str, Mapping[str, Sequence[float]]], n_runs:
     odds = WinOdds({a: float(share[i].mean()) for i, a in enumerate(agents)})
     odds.n_runs, odds.draws, odds.mdps = n_runs, draws, len(common)
     return odds
+
+
+def _scores(agent: str, mdp: str, scores: Sequence[float]) -> np.ndarray:
+    """One agent's scores on one MDP as float64, all finite (NaN was refused; text was NumPy's "could not convert")."""
+    try:
+        pool = np.asarray(scores, dtype=float).ravel()
+    except (TypeError, ValueError, OverflowError):  # thirteenth trial, F20
+        pool = None
+    if pool is None or not np.all(np.isfinite(pool)):
+        raise NeurohoverError(f"agent {agent!r} has a run whose score is not a finite number: {brief(scores)} on MDP {mdp!r}")
+    return pool
 
 
 def stored_runs(results: Mapping[str, dict]) -> dict[str, dict[str, list[float]]]:
