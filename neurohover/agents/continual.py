@@ -29,7 +29,7 @@ from ..models.transitions import one_step_error
 from ..policies import Policy
 from ..tasks import TaskFamily
 from .model_based import ModelEvolution, enough_to_learn, evolve_on_model
-from .protocol import Agent, Choice, EpisodeOutcome
+from .protocol import Agent, Choice, EpisodeOutcome, check_agent_policy
 from .spec import AgentOptions, AgentPolicies, AgentSettings, AgentSpec
 
 
@@ -109,6 +109,7 @@ class ContinualAgent(Agent):
     name = "continual"
 
     def __init__(self, generic: Policy, evolution: ModelEvolution = ModelEvolution(), settings: ContinualSettings = ContinualSettings()) -> None:
+        check_agent_policy("generic", generic)
         self.generic, self.evolution, self.settings = generic, evolution, settings
         self._dangerous = DangerousState(arm_after=settings.safeguard_after)
         self._reset(np.random.default_rng(0))

@@ -44,7 +44,7 @@ from ..policies import Policy, baseline_policy, prototype
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
 from .model_based import enough_to_learn, learn_model
-from .protocol import Agent, Choice, EpisodeOutcome
+from .protocol import Agent, Choice, EpisodeOutcome, check_agent_policy
 from .spec import FGHH_GENERIC_KINDS, AgentOptions, AgentPolicies, AgentSpec
 
 #: The authors' ``eonn`` settings on the model (their FGHH agent): 49 of 50 kept, one offspring a
@@ -127,6 +127,7 @@ class CodeFGHHAgent(Agent):
     name = "authors"
 
     def __init__(self, generic: Policy, settings: CodeAgentSettings = CodeAgentSettings()) -> None:
+        check_agent_policy("generic", generic)
         self.generic = generic
         self.settings = settings
         self.fallback = baseline_policy()

@@ -24,7 +24,7 @@ from ..flightdata import FlightData
 from ..policies import Policy, baseline_policy
 from ..tasks import MDP, TaskFamily
 from .model_based import ModelEvolution, enough_to_learn, evolve_on_model
-from .protocol import Agent, Choice, EpisodeOutcome
+from .protocol import Agent, Choice, EpisodeOutcome, check_agent_policies, check_agent_policy
 from .spec import AgentOptions, AgentPolicies, AgentSettings, AgentSpec
 
 N_EVOLVED = 3
@@ -107,8 +107,9 @@ class HybridAgent(Agent):
         name: str = "hybrid",
         hybrid: HybridSettings = HybridSettings(),
     ) -> None:
-        if len(safe) != 2:
-            raise NeurohoverError(f"the hybrid agent needs exactly 2 safe specialised policies, got {len(safe)}")
+        check_agent_policies("safe", safe, exactly=2)
+        check_agent_policy("generic", generic)
+        check_agent_policy("fallback", fallback)
         self.safe = list(safe)
         self.generic = generic
         self.fallback = fallback

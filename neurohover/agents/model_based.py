@@ -20,7 +20,7 @@ from ..models.model import DEFAULT_MODEL_SUBSTEPS, LearnedModel
 from ..policies import Policy, baseline_policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
-from .protocol import Agent, Choice, EpisodeOutcome
+from .protocol import Agent, Choice, EpisodeOutcome, check_agent_policy
 from .spec import FGHH_GENERIC_KINDS, AgentOptions, AgentPolicies, AgentSettings, AgentSpec
 
 #: How a policy is evolved on a learned model: ``"ours"``, steady state from the generic policy with
@@ -187,6 +187,7 @@ class ModelBasedAgent(Agent):
     name = "model-based"
 
     def __init__(self, generic: Policy, settings: ModelEvolution = ModelEvolution()) -> None:
+        check_agent_policy("generic", generic)
         self.generic = generic
         self.settings = settings
         self.policy: Policy | None = None
@@ -223,6 +224,7 @@ class IncrementalModelBasedAgent(Agent):
     name = "incremental"
 
     def __init__(self, generic: Policy, settings: ModelEvolution = ModelEvolution(), max_learning_episodes: int = 25) -> None:
+        check_agent_policy("generic", generic)
         self.generic = generic
         self.settings = settings
         self.max_learning_episodes = max_learning_episodes

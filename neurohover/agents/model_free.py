@@ -6,10 +6,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..errors import NeurohoverError
 from ..policies import Policy
 from ..tasks import TaskFamily
-from .protocol import Agent, Choice, EpisodeOutcome
+from .protocol import Agent, Choice, EpisodeOutcome, check_agent_policies
 from .spec import AgentSpec
 
 
@@ -25,8 +24,7 @@ class ModelFreeAgent(Agent):
     name = "model-free"
 
     def __init__(self, specialised: Sequence[Policy]) -> None:
-        if len(specialised) == 0:
-            raise NeurohoverError("the model-free agent needs at least one specialised policy")
+        check_agent_policies("specialised", specialised)
         self.specialised = list(specialised)
         self.trial_returns = np.full(len(self.specialised), -np.inf)
 

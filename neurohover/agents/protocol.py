@@ -22,13 +22,15 @@ lets the harness fly the rest of the run in one parallel batch (same results, fa
 
 from __future__ import annotations
 
+import functools
+import numbers
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief, finite_real
 from ..evaluate import DangerousState, PolicyTable, check_episode_count, evaluate_jobs
 from ..evolution.seeding import check_seed
 from ..flightdata import FlightData
@@ -71,6 +73,31 @@ class Choice:
     final: bool = False
     repeat: bool = False
 
+    def __post_init__(self) -> None:
+        # A hand-written agent's bad Choice was an AttributeError in the harness, or an int label in the records (thirteenth trial, F11).
+        if not isinstance(self.policy, Policy):
+            raise NeurohoverError(f"Choice policy={brief(self.policy)} is not allowed: give a Policy (neurohover.policies.baseline_policy(), for example)")
+        if not isinstance(self.label, str) or not self.label.strip():
+            raise NeurohoverError(f"Choice label={brief(self.label)} is not allowed: give a non-empty text naming the policy (e.g. 'specialised:3')")
+        if self.fallback is not None and not isinstance(self.fallback, Policy):
+            raise NeurohoverError(f"Choice fallback={brief(self.fallback)} is not allowed: give a Policy or None")
+        if not isinstance(self.dangerous, DangerousState):
+            raise NeurohoverError(f"Choice dangerous={brief(self.dangerous)} is not allowed: give a DangerousState")
+        for name in ("record", "final", "repeat"):
+            flag = getattr(self, name)
+            if not isinstance(flag, (bool, np.bool_)):
+                raise NeurohoverError(f"Choice {name}={brief(flag)} is not allowed: give True or False")
+            object.__setattr__(self, name, bool(flag))
+        if self.final and self.repeat:
+            raise NeurohoverError(
+                "Choice final=True with repeat=True is not allowed: final keeps the choice for the rest of the run, repeat until an event; give one"
+            )
+
+
+def _check_count(what: str, value: object, least: int) -> None:
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < least:
+        raise NeurohoverError(f"{what}={brief(value)} is out of range: allowed an integer >= {least}")
+
 
 @dataclass(frozen=True)
 class EpisodeOutcome:
@@ -83,6 +110,76 @@ class EpisodeOutcome:
     safeguard_step: int  # control step at which the fallback took over, or -1
     flight_data: FlightData | None
 
+    def __post_init__(self) -> None:
+        # EpisodeOutcome('a', 'b', ...) was made, then refused by some agents with a TypeError and taken by others (thirteenth trial, F12).
+        _check_count("EpisodeOutcome episode", self.episode, 0)
+        if not finite_real(self.ret):
+            raise NeurohoverError(f"EpisodeOutcome ret={brief(self.ret)} is not allowed: give the episode's return, a finite number")
+        if not isinstance(self.crashed, (bool, np.bool_)):
+            raise NeurohoverError(f"EpisodeOutcome crashed={brief(self.crashed)} is not allowed: give True or False")
+        _check_count("EpisodeOutcome steps", self.steps, 0)
+        _check_count("EpisodeOutcome safeguard_step", self.safeguard_step, -1)
+        if self.flight_data is not None and not isinstance(self.flight_data, FlightData):
+            raise NeurohoverError(f"EpisodeOutcome flight_data={brief(self.flight_data)} is not allowed: give the episode's FlightData or None")
+
+
+def check_agent_policy(what: str, value: object) -> None:
+    """An agent's constructor argument ``what`` checked to be a Policy: None was an AttributeError deep in the first
+    flight (thirteenth trial, F11)."""
+    if not isinstance(value, Policy):
+        raise NeurohoverError(f"{what}={brief(value)} is not allowed: give a Policy (neurohover.policies.load_policy(path), for example)")
+
+
+def check_agent_policies(what: str, value: object, exactly: int | None = None) -> None:
+    """An agent's constructor argument ``what`` checked to be a list of Policies (``exactly`` of them, or at least one):
+    None was a TypeError from len() (thirteenth trial, F12)."""
+    wanted = f"exactly {exactly}" if exactly is not None else "at least one"
+    if isinstance(value, (str, bytes)) or not isinstance(value, Sequence) or not all(isinstance(p, Policy) for p in value):
+        raise NeurohoverError(f"{what}={brief(value)} is not allowed: give a list of {wanted} Policy")
+    if (len(value) != exactly) if exactly is not None else not value:
+        raise NeurohoverError(f"{what} has {len(value)} policies, which is not allowed: give {wanted} {what} {'policies' if exactly else 'policy'}")
+
+
+_CHECKED: set = set()  # the wrapped methods (a subclass's own method is wrapped once)
+
+
+def _checked_start(start):
+    @functools.wraps(start)
+    def checked(self, family, rng):
+        if not isinstance(family, TaskFamily):
+            raise NeurohoverError(f"family={brief(family)} is not allowed: give a TaskFamily (neurohover.get_task_family(name))")
+        if not isinstance(rng, np.random.Generator):
+            raise NeurohoverError(f"rng={brief(rng)} is not allowed: give a numpy Generator (np.random.default_rng(seed))")
+        self._asked_record = False
+        return start(self, family, rng)
+
+    return checked
+
+
+def _checked_choose(choose):
+    @functools.wraps(choose)
+    def checked(self, episode):
+        _check_count("episode", episode, 0)
+        choice = choose(self, int(episode))
+        if not isinstance(choice, Choice):
+            raise NeurohoverError(f"agent {self.name!r} chose {brief(choice)} for episode {episode}: its choose must return a Choice")
+        self._asked_record = choice.record
+        return choice
+
+    return checked
+
+
+def _checked_update(update):
+    @functools.wraps(update)
+    def checked(self, outcome):
+        if not isinstance(outcome, EpisodeOutcome):
+            raise NeurohoverError(f"outcome={brief(outcome)} is not allowed: give an EpisodeOutcome")
+        if getattr(self, "_asked_record", False) and outcome.flight_data is None:  # the incremental agent's bare AssertionError
+            raise NeurohoverError(f"outcome of episode {outcome.episode} has no flight data, but agent {self.name!r} chose to record it: give its FlightData")
+        return update(self, outcome)
+
+    return checked
+
 
 class Agent:
     """Base class of on-line agents. ``start`` is called once per test run, before episode 0."""
@@ -92,6 +189,15 @@ class Agent:
     #: family's; :func:`run_test` refuses another (None: an agent built by hand, run on any family).
     made_for: tuple[str, float | None] | None = None
 
+    def __init_subclass__(cls, **kwargs) -> None:
+        # Every agent's start/choose/update goes through one check of its arguments and answer (thirteenth trial, F11, F12).
+        super().__init_subclass__(**kwargs)
+        for name, wrap in (("start", _checked_start), ("choose", _checked_choose), ("update", _checked_update)):
+            if name in cls.__dict__ and cls.__dict__[name] not in _CHECKED:
+                checked = wrap(cls.__dict__[name])
+                _CHECKED.add(checked)
+                setattr(cls, name, checked)
+
     def start(self, family: TaskFamily, rng: np.random.Generator) -> None:
         """Prepare for a new run on an unknown MDP of ``family`` (reset any per-run state)."""
 
@@ -100,6 +206,10 @@ class Agent:
 
     def update(self, outcome: EpisodeOutcome) -> None:  # pragma: no cover - abstract
         raise NotImplementedError
+
+
+Agent.start = _checked_start(Agent.start)  # type: ignore[method-assign]  # agents that keep the base start are checked too
+_CHECKED.add(Agent.start)
 
 
 @dataclass
@@ -219,6 +329,8 @@ def run_test(
     chunk = 1
     while e < episodes:
         choice = agent.choose(e)
+        if not isinstance(choice, Choice):  # a Policy was an AttributeError on .final (thirteenth trial, F11)
+            raise NeurohoverError(f"agent {agent.name!r} chose {brief(choice)} for episode {e}: its choose must return a Choice")
         if choice.final:
             # The choice holds for the rest of the run: fly it in one parallel batch.
             rest = np.arange(e, episodes)

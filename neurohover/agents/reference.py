@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..policies import Policy, baseline_policy
-from .protocol import Agent, Choice, EpisodeOutcome
+from .protocol import Agent, Choice, EpisodeOutcome, check_agent_policy
 from .spec import AgentOptions, AgentPolicies, AgentSpec
 
 
@@ -25,6 +25,7 @@ class GenericAgent(Agent):
     name = "generic"
 
     def __init__(self, generic: Policy) -> None:
+        check_agent_policy("generic", generic)
         self.generic = generic
 
     def choose(self, episode: int) -> Choice:
