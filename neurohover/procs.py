@@ -17,6 +17,7 @@ from __future__ import annotations
 import _thread
 import contextlib
 import multiprocessing
+import numbers
 import os
 import signal
 import sys
@@ -25,7 +26,7 @@ import time
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
 
-from .errors import Terminated, raise_terminated
+from .errors import NeurohoverError, Terminated, brief, raise_terminated
 
 WATCH_SECONDS = 0.5  # how often a worker checks that its parent is alive
 
@@ -80,6 +81,9 @@ def worker_pool(jobs: int) -> ProcessPoolExecutor:
 
     Spawned, not forked: numba's thread pools are not fork-safe.
     """
+    if isinstance(jobs, bool) or not isinstance(jobs, numbers.Integral) or jobs < 1:  # 0 was concurrent.futures' error, '2' a TypeError (thirteenth trial, F16)
+        raise NeurohoverError(f"jobs={brief(jobs)} is not allowed: give a whole number of worker processes >= 1")
+    jobs = int(jobs)
     main = threading.current_thread() is threading.main_thread()
     return ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("spawn"), initializer=watch_parent, initargs=(os.getpid(), main))
 
@@ -90,6 +94,8 @@ def stop_pool(pool: ProcessPoolExecutor) -> None:
     Interrupted work is never recorded, so letting a worker finish its task (which the pool's own
     shutdown does, for up to a task's whole run time) would only keep the command waiting.
     """
+    if not isinstance(pool, ProcessPoolExecutor):  # None was an AttributeError (thirteenth trial, F16)
+        raise NeurohoverError(f"pool={brief(pool)} is not allowed: give the ProcessPoolExecutor that worker_pool made")
     workers = list((getattr(pool, "_processes", None) or {}).values())
     pool.shutdown(wait=False, cancel_futures=True)
     for process in workers:

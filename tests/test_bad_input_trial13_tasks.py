@@ -99,3 +99,21 @@ def test_net_files_take_ascii_digits_only(old: str, new: str) -> None:
     assert old in text
     with pytest.raises(NeurohoverError, match=r"network file, line \d+: characters other than ASCII are not allowed: give numbers in ASCII digits"):
         policy_from_net(text.replace(old, new, 1))
+
+
+@pytest.mark.parametrize("jobs", [0, -1, "2", 1.5, None, True])
+def test_worker_pool_names_a_bad_worker_count(jobs) -> None:
+    """F16: worker_pool(0) / (-1) was concurrent.futures' 'max_workers must be greater than 0', '2' and 1.5 TypeErrors."""
+    from neurohover import procs
+
+    with pytest.raises(NeurohoverError, match=rf"jobs={jobs!r} is not allowed: give a whole number of worker processes >= 1"):
+        procs.worker_pool(jobs)
+
+
+def test_stop_pool_names_what_is_not_a_pool() -> None:
+    """F16: stop_pool(None) was an AttributeError; a pool of np.int64(1) workers is made and stopped."""
+    from neurohover import procs
+
+    with pytest.raises(NeurohoverError, match=r"pool=None is not allowed: give the ProcessPoolExecutor that worker_pool made"):
+        procs.stop_pool(None)  # type: ignore[arg-type]
+    procs.stop_pool(procs.worker_pool(np.int64(1)))
