@@ -8,6 +8,7 @@ The workload is the issue's: full 6000-step episodes of the MLP policy in the ze
 from __future__ import annotations
 
 import math
+import numbers
 import platform
 import random
 import time
@@ -16,12 +17,20 @@ from collections.abc import Callable
 import numba
 import numpy as np
 
+from .errors import NeurohoverError, brief
 from .evaluate import PolicyTable, evaluate_jobs
 from .policies import prototype
 from .policysets import load_policy_set
 from .sim.constants import EPISODE_STEPS, SUBSTEPS
 from .sim.reference import fly_episode
 from .tasks import get_task_family
+
+
+def _count(name: str, value: object, what: str) -> int:
+    """``value`` as an int >= 1 (NumPy integers too): 0 and negative sizes were rates of 0.0 or tracebacks (thirteenth trial, F3 F4)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:
+        raise NeurohoverError(f"{name}={brief(value)} is not allowed: give a whole number of {what} >= 1")
+    return int(value)
 
 
 def _best_rate(run: Callable[[], float], repeats: int) -> float:
@@ -37,6 +46,7 @@ def _best_rate(run: Callable[[], float], repeats: int) -> float:
 def reference_episodes_per_second(episodes: int = 1, n_steps: int = EPISODE_STEPS) -> float:
     """Plain-Python reference: MLP episodes of ``n_steps`` control steps, noise drawn with Python's
     ``random``; the rate is in full (6000-step) episodes per second."""
+    episodes, n_steps = _count("episodes", episodes, "episodes"), _count("n_steps", n_steps, "control steps")
     policy = prototype("mlp", "baseline")
     mdp = get_task_family("fghh").zero().to_reference()
 
@@ -52,6 +62,7 @@ def reference_episodes_per_second(episodes: int = 1, n_steps: int = EPISODE_STEP
 
 def kernel_episodes_per_second(episodes: int, threads: int, repeats: int = 3) -> float:
     """Compiled kernel: full MLP episodes in the zero setting on ``threads`` threads."""
+    episodes, repeats = _count("episodes", episodes, "episodes"), _count("repeats", repeats, "repeats")
     policy = prototype("mlp", "baseline")
     mdp = get_task_family("fghh").zero()
     p_idx = np.zeros(episodes, dtype=np.int64)
@@ -71,6 +82,7 @@ def vector_env_steps_per_second(num_envs: int = 1024, steps: int = 1000) -> floa
     The helicopters fly the baseline policy (computed in NumPy, outside the timed region) on the
     zero setting, so they hover rather than crash and reset.
     """
+    steps = _count("steps", steps, "control steps")  # num_envs is HoverVectorEnv's to check
     from .envs.vector import HoverVectorEnv
     from .policies import slp_baseline_genome
 
@@ -153,7 +165,7 @@ def benchmark_evolution(quick: bool = False, repeats: int | None = None) -> dict
     from .evolution.seeding import noise_seed
 
     cores = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # numba.config sets it at import, from the environment
-    repeats = (1 if quick else 3) if repeats is None else repeats
+    repeats = (1 if quick else 3) if repeats is None else _count("repeats", repeats, "repeats")
     # 20,000 episodes from the race generic average about 2,600 steps an episode, as a paper-scale run
     # does over its 500,000 (a Figure 15 run flies them in 60-330 s of one core); its first 5,000
     # average about 860 (crashing candidates), where a race's rounds wait on a few long episodes.
@@ -251,6 +263,11 @@ def run_benchmarks(quick: bool = False) -> dict:
 
 def format_report(report: dict) -> str:
     """Human-readable table of a benchmark report."""
+    machine = report.get("machine") if isinstance(report, dict) else None
+    if not isinstance(machine, dict) or not {"cores", "cpu"} <= set(machine) or not {"workload", "reference_episodes_per_second"} <= set(report):
+        raise NeurohoverError(  # {} was a KeyError, None a TypeError (thirteenth trial, F3); checked, not caught: a formatter's bug stays visible
+            f"report={brief(report)} is not allowed: give the table that run_benchmarks returns (machine, workload, reference_episodes_per_second, ...)"
+        )
     lines = [f"neurohover bench on {report['machine']['cores']} cores ({report['machine']['cpu']}); {report['workload']}"]
     lines.append(f"  {'reference (plain Python)':<34} {report['reference_episodes_per_second']:>12.3f} episodes/s")
     for key, value in report.items():

@@ -117,3 +117,33 @@ def test_stop_pool_names_what_is_not_a_pool() -> None:
     with pytest.raises(NeurohoverError, match=r"pool=None is not allowed: give the ProcessPoolExecutor that worker_pool made"):
         procs.stop_pool(None)  # type: ignore[arg-type]
     procs.stop_pool(procs.worker_pool(np.int64(1)))
+
+
+def test_bench_functions_refuse_sizes_below_one() -> None:
+    """F3, F4: steps=0 was a ZeroDivisionError, repeats=0 an UnboundLocalError, episodes=-2 NumPy's error, 1.5 a TypeError,
+    and episodes=0 / n_steps=0 / repeats=0 rates of 0.0."""
+    from neurohover import bench
+
+    cases = [
+        (lambda: bench.vector_env_steps_per_second(2, 0), "steps=0", "control steps"),
+        (lambda: bench.benchmark_evolution(quick=True, repeats=0), "repeats=0", "repeats"),
+        (lambda: bench.benchmark_evolution(quick=True, repeats=1.5), "repeats=1.5", "repeats"),
+        (lambda: bench.kernel_episodes_per_second(-2, 1, 1), "episodes=-2", "episodes"),
+        (lambda: bench.kernel_episodes_per_second(0, 1, 1), "episodes=0", "episodes"),
+        (lambda: bench.kernel_episodes_per_second(1, 1, 0), "repeats=0", "repeats"),
+        (lambda: bench.reference_episodes_per_second(1.5, 20), "episodes=1.5", "episodes"),
+        (lambda: bench.reference_episodes_per_second(-1, 20), "episodes=-1", "episodes"),
+        (lambda: bench.reference_episodes_per_second(1, 0), "n_steps=0", "control steps"),
+    ]
+    for call, named, what in cases:
+        with pytest.raises(NeurohoverError, match=rf"^{named} is not allowed: give a whole number of {what} >= 1$"):
+            call()
+
+
+@pytest.mark.parametrize("report", [{}, None, {"machine": 5, "workload": "w", "reference_episodes_per_second": 1.0}])
+def test_bench_format_report_names_what_is_not_a_report(report) -> None:
+    """F3: format_report({}) was a KeyError 'machine', format_report(None) a TypeError."""
+    from neurohover.bench import format_report
+
+    with pytest.raises(NeurohoverError, match=r"is not allowed: give the table that run_benchmarks returns"):
+        format_report(report)
