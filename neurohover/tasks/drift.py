@@ -222,7 +222,7 @@ NO_DRIFT = Drift()
 
 def _whole(name: str, value, what: str, low: int, high: int | None = None) -> int:
     """``value`` as an int in ``low..high`` (NumPy integers too), or a NeurohoverError naming it (thirteenth trial, F9)."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not low <= value or (high is not None and value > high):
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not low <= int(value) or (high is not None and int(value) > high):
         raise NeurohoverError(f"{name}={brief(value)} is not allowed: give {what}")
     return int(value)
 
