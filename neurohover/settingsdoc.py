@@ -15,6 +15,8 @@ import inspect
 import re
 from dataclasses import dataclass
 
+from .errors import NeurohoverError, brief
+
 __all__ = ["SettingRow", "documented", "format_settings", "plain", "settings_rows", "summary"]
 
 _SECTIONS = ("Attributes", "Parameters")
@@ -63,8 +65,17 @@ def _entries(doc: str) -> dict[str, tuple[str, str]]:
     return out
 
 
+def _settings_class(cls: object) -> type:
+    """``cls`` if it is a dataclass type (a settings class), else NeurohoverError naming it: None and int were
+    AttributeErrors and dataclasses' TypeError, and summary(None) was '.' (thirteenth trial, F5)."""
+    if not (isinstance(cls, type) and dataclasses.is_dataclass(cls)):
+        raise NeurohoverError(f"cls={brief(cls)} is not allowed: give a settings class (a dataclass type), e.g. SteadyStateSettings")
+    return cls
+
+
 def documented(cls: type) -> dict[str, tuple[str, str]]:
     """The documented settings of ``cls`` and of its dataclass bases (the class's own entry wins)."""
+    cls = _settings_class(cls)
     out: dict[str, tuple[str, str]] = {}
     for klass in reversed(cls.__mro__):
         if dataclasses.is_dataclass(klass) and klass.__doc__:
@@ -74,6 +85,7 @@ def documented(cls: type) -> dict[str, tuple[str, str]]:
 
 def settings_rows(cls: type) -> list[SettingRow]:
     """One row per field of the settings dataclass ``cls``, in field order (help empty where undocumented)."""
+    cls = _settings_class(cls)
     docs = documented(cls)
     rows = []
     for f in dataclasses.fields(cls):
@@ -92,12 +104,15 @@ def settings_rows(cls: type) -> list[SettingRow]:
 
 def plain(text: str) -> str:
     """Docstring markup as plain text: ``x`` -> x, :class:`~a.b.X` -> X."""
+    if not isinstance(text, str):
+        raise NeurohoverError(f"text={brief(text)} is not allowed: give a docstring's text")
     text = re.sub(r":[a-z]+:`~?(?:[\w.]+\.)?([^`]+)`", r"\1", text)
     return text.replace("``", "")
 
 
 def summary(cls: type) -> str:
     """The first sentence of the class's docstring, as plain text."""
+    cls = _settings_class(cls)
     first = inspect.cleandoc(cls.__doc__ or "").split("\n\n")[0].replace("\n", " ")
     return plain(first.split(". ")[0].rstrip(".") + ".")
 
@@ -106,6 +121,9 @@ def format_settings(cls: type, title: str) -> str:
     """The settings table of ``cls`` as plain text: name, default and type, then the help, wrapped."""
     import textwrap
 
+    cls = _settings_class(cls)
+    if not isinstance(title, str):
+        raise NeurohoverError(f"title={brief(title)} is not allowed: give text")
     out = [f"{title}: {summary(cls)} ({cls.__module__}.{cls.__qualname__})", ""]
     rows = settings_rows(cls)
     for i, row in enumerate(rows):
