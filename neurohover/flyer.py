@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import numbers
+
 import numba
 import numpy as np
 
-from .errors import NeurohoverError
+from .errors import NeurohoverError, brief
 from .launch import KIND, MAX_SEED, Batch, Flown, Parking, check_device, launch, launch_parked, rows_alike
 from .policies import GENOME_LENGTH, TOPOLOGIES
 from .sim.constants import MAX_EPISODE_STEPS, SAFEGUARD_LIMITS
@@ -126,6 +128,9 @@ class KernelFlyer:
 
     def reserve(self, n: int) -> int:
         """Reserve the next ``n`` episode indices for calls with explicit ``episode_index``; returns the first."""
+        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 0:  # -5 handed out flown indices again, 1.5 a float one (thirteenth trial, F17)
+            raise NeurohoverError(f"n={brief(n)} is not allowed: give the number of episode indices to reserve, an integer >= 0")
+        n = int(n)
         first = self.next_index
         self.next_index += n
         return first
@@ -170,6 +175,8 @@ class KernelFlyer:
         numpy.ndarray
             The jobs' returns: a view of the flyer's buffer, valid until the next call.
         """
+        if isinstance(n_jobs, bool) or not isinstance(n_jobs, numbers.Integral) or n_jobs < 0:  # -1 flew all but one buffer slot
+            raise NeurohoverError(f"n_jobs={brief(n_jobs)} is not allowed: give the number of jobs, an integer >= 0")
         self._load_genomes(genomes)
         zeros, arange, e, minus, returns, crashed, steps, sg = self._views_for(n_jobs)
         p = zeros if policy_index is None else (arange if isinstance(policy_index, str) else policy_index)
@@ -182,7 +189,10 @@ class KernelFlyer:
             self._set_threads(n_jobs)
         # (CUDA: the launcher copies the inputs to the GPU and the results back on every call,
         # acceptable while a generation's jobs are few; the thread count does not apply.)
-        batch = Batch(rows, self._kinds, self._genomes, p, m, e, self.seed, self.n_steps, minus, self._limits, minus, safeguard=False, recording=False)
+        n_pol = genomes.shape[0]  # only the genomes given: the buffer's later rows are stale (a policy_index past them is refused)
+        batch = Batch(
+            rows, self._kinds[:n_pol], self._genomes[:n_pol], p, m, e, self.seed, self.n_steps, minus, self._limits, minus, safeguard=False, recording=False
+        )
         self.kernel_seconds += launch(batch, Flown(returns, crashed, steps, sg), self.device)
         if self.trace is not None:
             self.trace.append((genomes.copy(), rows, p.copy(), m.copy(), e.copy()))
@@ -220,7 +230,8 @@ class KernelFlyer:
         before = parking.steps[slots]
         self._set_threads(n_jobs)
         m = zeros if mdp_index is None else mdp_index
-        batch = Batch(rows, self._kinds, self._genomes, policy_index, m, e, self.seed, self.n_steps, safeguard=False, recording=False)
+        n_pol = genomes.shape[0]
+        batch = Batch(rows, self._kinds[:n_pol], self._genomes[:n_pol], policy_index, m, e, self.seed, self.n_steps, safeguard=False, recording=False)
         self.kernel_seconds += launch_parked(batch, Flown(returns, crashed, steps, minus), slots, n_required, parking)
         over = steps > 0
         self.flown += int(over.sum())

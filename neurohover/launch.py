@@ -16,6 +16,7 @@ every path without a new argument.
 from __future__ import annotations
 
 import contextlib
+import numbers
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -23,8 +24,8 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
-from .errors import NeurohoverError
-from .sim.constants import MDP_ROW_LEN, ROW_SUBSTEPS, ROW_WIND_KIND, SAFEGUARD_LIMITS
+from .errors import NeurohoverError, brief
+from .sim.constants import MAX_EPISODE_STEPS, MDP_ROW_LEN, ROW_SUBSTEPS, ROW_WIND_KIND, SAFEGUARD_LIMITS
 from .sim.jobs import Extras, Flown, Jobs, Parking
 from .sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
 from .sim.lanes import LANES, rollout_lanes, rollout_lanes_parked
@@ -32,7 +33,7 @@ from .sim.rng import MAX_SEED
 from .sim.step import step_batch
 
 __all__ = [
-    "DEVICES", "KIND", "MAX_SEED", "Batch", "Flown", "Parking", "check_device", "launch", "launch_parked", "load_kernel", "num_threads",
+    "DEVICES", "KIND", "MAX_SEED", "Batch", "Flown", "Parking", "check_device", "check_job_indices", "launch", "launch_parked", "load_kernel", "num_threads",
     "rows_alike", "Stepper", "stepper", "use_lanes",
 ]  # fmt: skip
 
@@ -55,6 +56,40 @@ def num_threads(threads: int | None) -> Iterator[None]:
         yield
     finally:
         numba.set_num_threads(previous)
+
+
+def check_job_indices(index: np.ndarray, low: int, upper: int | None, what: str) -> None:
+    """Refuse a 1-D int64 array of job indices holding a value below ``low`` or at or above ``upper`` (None: no bound):
+    the one range check of every launch's indices (:class:`Batch`; :func:`neurohover.evaluate_jobs` reaches it there)."""
+    if not index.size:
+        return
+    lowest = index.min()
+    if lowest < low and low == 0:
+        raise NeurohoverError(f"{what} holds negative values (min {lowest}); allowed >= 0")
+    highest = index.max()
+    if lowest < low or (upper is not None and highest >= upper):
+        raise NeurohoverError(f"{what} holds {lowest if lowest < low else highest}, out of range: allowed {low}..{'' if upper is None else upper - 1}")
+
+
+#: Each array of a :class:`Batch`: its dimensions, dtype and column count (None: any).
+_LAYOUT = {
+    "rows": (2, np.float64, MDP_ROW_LEN),
+    "kinds": (1, np.int64, None),
+    "genomes": (2, np.float64, GENOME_WIDTH),
+    "policy_index": (1, np.int64, None),
+    "mdp_index": (1, np.int64, None),
+    "episode_index": (1, np.int64, None),
+    "limits": (1, np.float64, None),
+}
+
+
+def _check_array(what: str, a: object, ndim: int, dtype: type, width: int | None) -> None:
+    """Refuse anything but a numpy array of the layout the kernel reads (a list was an AttributeError, a wrong width a
+    plain ValueError; thirteenth trial, F18)."""
+    if not isinstance(a, np.ndarray) or a.ndim != ndim or a.dtype != dtype or (width is not None and a.shape[1] != width):
+        shown = f"a {a.ndim}-d {a.dtype} array of shape {a.shape}" if isinstance(a, np.ndarray) else brief(a)
+        columns = f" with {width} columns" if width else ""
+        raise NeurohoverError(f"{what}={shown} is not allowed: give a {ndim}-d {np.dtype(dtype)} numpy array{columns}")
 
 
 @dataclass(frozen=True)
@@ -86,29 +121,48 @@ class Batch:
     recording: bool | None = None
 
     def __post_init__(self) -> None:
+        for name in ("rows", "kinds", "genomes", "policy_index", "mdp_index", "episode_index", "limits"):
+            _check_array(f"Batch.{name}", getattr(self, name), *_LAYOUT[name])
         n = self.policy_index.shape[0]
-        checks = (
-            ("rows", self.rows, 2, np.float64, MDP_ROW_LEN),
-            ("kinds", self.kinds, 1, np.int64, None),
-            ("genomes", self.genomes, 2, np.float64, GENOME_WIDTH),
-            ("policy_index", self.policy_index, 1, np.int64, None),
-            ("mdp_index", self.mdp_index, 1, np.int64, None),
-            ("episode_index", self.episode_index, 1, np.int64, None),
-            ("limits", self.limits, 1, np.float64, None),
-        )
-        for name, a, ndim, dtype, width in checks:
-            if a.ndim != ndim or a.dtype != dtype or (width is not None and a.shape[1] != width):
-                columns = f" with {width} columns" if width else ""
-                raise ValueError(f"Batch.{name}: {a.ndim}-d {a.dtype} of shape {a.shape}, expected {ndim}-d {np.dtype(dtype)}{columns}")
         for name, per_job in (("mdp_index", self.mdp_index), ("episode_index", self.episode_index), ("fallback", self.fallback), ("slots", self.slots)):
+            if per_job is not None and (not isinstance(per_job, np.ndarray) or per_job.dtype != np.int64):
+                raise NeurohoverError(f"Batch.{name}={brief(per_job)} is not allowed: give a 1-D int64 numpy array, one entry per job")
             if per_job is not None and per_job.shape != (n,):
-                raise ValueError(f"Batch.{name} has shape {per_job.shape}, expected ({n},): one entry per job")
+                raise NeurohoverError(f"Batch.{name} has shape {per_job.shape}, expected ({n},): one entry per job")
         if self.safeguard is None:
             object.__setattr__(self, "safeguard", self.fallback is not None and bool((self.fallback >= 0).any()))
         if self.recording is None:
             object.__setattr__(self, "recording", self.slots is not None and bool((self.slots >= 0).any()))
         if self.recording and (self.obs_out is None or self.act_out is None):
-            raise ValueError("Batch: jobs record flight data but obs_out / act_out are missing")
+            raise NeurohoverError("Batch: jobs record flight data but obs_out / act_out are missing: give both")
+        self._check_values()
+
+    def _check_values(self) -> None:
+        """The values the kernel indexes by, checked in one vectorised pass each before it runs: an index out of range
+        read past an array and killed the process (SIGSEGV), a kind 99 flew, n_steps=-5 flew nothing (thirteenth trial, F1)."""
+        if isinstance(self.n_steps, bool) or not isinstance(self.n_steps, numbers.Integral) or not 1 <= self.n_steps <= MAX_EPISODE_STEPS:
+            raise NeurohoverError(f"n_steps={brief(self.n_steps)} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, numbers.Integral) or not 0 <= self.seed <= MAX_SEED:
+            raise NeurohoverError(f"seed={brief(self.seed)} is out of range: allowed an integer in 0..2**63-1")
+        kinds = self.kinds
+        if kinds.shape[0] != self.genomes.shape[0]:
+            raise NeurohoverError(f"Batch.kinds has {kinds.shape[0]} entries but genomes {self.genomes.shape[0]} rows: give one kind per genome")
+        if kinds.size and (kinds.min() < min(KIND.values()) or kinds.max() > max(KIND.values())):
+            bad = kinds[(kinds < min(KIND.values())) | (kinds > max(KIND.values()))][0]
+            raise NeurohoverError(f"Batch.kinds holds {bad}, not a policy kind: allowed {', '.join(f'{v} ({k})' for k, v in KIND.items())}")
+        check_job_indices(self.policy_index, 0, kinds.shape[0], "policy_index")
+        check_job_indices(self.mdp_index, 0, self.rows.shape[0], "mdp_index")
+        check_job_indices(self.episode_index, 0, None, "episode_index")
+        if self.safeguard and self.fallback is not None:  # without the safeguard the kernel never reads it
+            check_job_indices(self.fallback, -1, kinds.shape[0], "fallback")
+        if self.recording and self.slots is not None and self.obs_out is not None and self.act_out is not None:
+            n_rec = min(self.obs_out.shape[0], self.act_out.shape[0])
+            check_job_indices(self.slots, -1, n_rec, "slots")
+            if self.obs_out.shape[1:] != (self.n_steps + 1, 12) or self.act_out.shape[1:] != (self.n_steps, 4):
+                raise NeurohoverError(
+                    f"Batch.obs_out / act_out of shapes {self.obs_out.shape} / {self.act_out.shape} are not allowed: "
+                    f"give ({n_rec}, {self.n_steps + 1}, 12) and ({n_rec}, {self.n_steps}, 4)"
+                )
 
     @property
     def n_jobs(self) -> int:
@@ -172,6 +226,10 @@ def use_lanes(device: str, rows: np.ndarray, m_idx: np.ndarray, fb: np.ndarray |
     values would turn it into per-lane branches that no longer vectorize. Results are the same
     bits either way.
     """
+    if device not in DEVICES:
+        raise NeurohoverError(f"device={brief(device)} is unknown: allowed 'cpu' or 'cuda'")
+    if not isinstance(m_idx, np.ndarray) or m_idx.ndim != 1:  # None was an AttributeError (thirteenth trial, F18)
+        raise NeurohoverError(f"m_idx={brief(m_idx)} is not allowed: give a 1-D numpy array of each job's MDP row")
     n_jobs = m_idx.shape[0]
     if device != "cpu" or n_jobs < LANES or (fb is not None and (fb >= 0).any()) or (rec is not None and rec.any()):
         return False
@@ -181,12 +239,20 @@ def use_lanes(device: str, rows: np.ndarray, m_idx: np.ndarray, fb: np.ndarray |
 def rows_alike(rows: np.ndarray, m_idx: np.ndarray | None = None) -> bool:
     """Whether the MDP rows (those ``m_idx`` lists, if given) share the substep count and whether there is
     wind: what one call of the lanes needs."""
+    if not isinstance(rows, np.ndarray) or rows.ndim != 2 or rows.shape[0] == 0 or rows.shape[1] != MDP_ROW_LEN:  # thirteenth trial, F18
+        shown = f"an array of shape {rows.shape}" if isinstance(rows, np.ndarray) else brief(rows)
+        raise NeurohoverError(f"rows={shown} is not allowed: give a numpy array of MDP rows, shape (M >= 1, {MDP_ROW_LEN}) (neurohover.evaluate.mdp_rows)")
     sub, windy = rows[:, ROW_SUBSTEPS], rows[:, ROW_WIND_KIND] != 0.0
     if (sub == sub[0]).all() and (windy == windy[0]).all():
         return True  # every row alike: no need to look at the jobs
     if m_idx is None:
         return False
-    used = np.unique(m_idx)
+    used = np.unique(m_idx)  # sorted: its ends are the range
+    if used.size == 0:
+        return True  # no jobs: nothing differs
+    if used.dtype.kind not in "iu" or used[0] < 0 or used[-1] >= rows.shape[0]:
+        bad = used[-1] if used.dtype.kind not in "iu" or used[0] >= 0 else used[0]
+        raise NeurohoverError(f"m_idx holds {brief(bad)}, not allowed: give integers in 0..{rows.shape[0] - 1}, rows of rows")
     return bool((sub[used] == sub[used[0]]).all()) and bool((windy[used] == windy[used[0]]).all())
 
 
