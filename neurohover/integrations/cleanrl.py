@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import NeurohoverError
+from ..paths import checked_path
 from ..sim.constants import ACTION_DIM, OBS_DIM
 from .flying import checked_obs_statistics
 
@@ -35,7 +36,7 @@ LAYERS = ("0.weight", "0.bias", "2.weight", "2.bias", "4.weight", "4.bias")  # t
 
 def cleanrl_files(run: str | Path) -> tuple[Path, Path]:
     """The files :func:`cleanrl_policy` reads in the CleanRL run folder ``run``: its ``*.cleanrl_model`` and ``obs_rms.pkl``."""
-    folder = Path(run)
+    folder = checked_path(run, "run", "path of a CleanRL run folder")  # None, 5 were pathlib's TypeError (thirteenth trial, F13)
     models = sorted(folder.glob("*.cleanrl_model")) if folder.is_dir() else []
     if len(models) != 1:
         raise NeurohoverError(f"{str(folder)!r} is not a CleanRL run folder: expected one *.cleanrl_model in it (run the script with --save-model)")

@@ -343,10 +343,36 @@ def _forward(node_start, node_slot, node_act, node_bias, node_resp, link_start, 
             out[r, m] = values[out_slot[n, m]]
 
 
+def observation_batch(obs: object) -> np.ndarray:
+    """``obs`` as a (B, 12) float array, or a NeurohoverError: a (12,) or (2, 5) array was an IndexError and NaN
+    flew silently, where Policy.act refuses both (thirteenth trial, F19)."""
+    try:
+        raw = np.asarray(obs)
+        batch = raw.astype(np.float64) if raw.dtype.kind in "iuf" else None  # not text, booleans or complex
+    except (TypeError, ValueError):
+        batch = None
+    if batch is None or batch.ndim != 2 or batch.shape[1] != 12 or not np.all(np.isfinite(batch)):
+        if batch is None:
+            shown = brief(obs)
+        else:  # an array's repr runs over lines: its shape, and whether it holds NaN or inf, say what is wrong
+            shown = f"of shape {batch.shape}" + (" holding NaN or inf" if batch.size and not np.all(np.isfinite(batch)) else "")
+        raise NeurohoverError(
+            f"observations {shown} are not allowed: give a (B, 12) array of finite numbers, one row (u, v, w, x, y, z, p, q, r, qx, qy, qz) per helicopter"
+        )
+    return batch
+
+
 def forward(packed: PackedNetworks, net_of_row: np.ndarray, obs: np.ndarray) -> np.ndarray:
     """The actions of network ``net_of_row[r]`` for observation row ``r`` (B, 12): shape (B, 4)."""
+    if not isinstance(packed, PackedNetworks):  # None was an AttributeError (thirteenth trial, F19)
+        raise NeurohoverError(f"packed={brief(packed)} is not allowed: give PackedNetworks (pack_networks, network_of_record)")
     p = packed
-    obs = np.asarray(obs, dtype=np.float64)[:, INPUT_INDEX]
+    obs = observation_batch(obs)
+    rows = np.asarray(net_of_row)
+    n_nets = len(p.node_start) - 1
+    if rows.shape != (obs.shape[0],) or rows.dtype.kind not in "iu" or (rows.size and not (0 <= rows.min() and rows.max() < n_nets)):
+        raise NeurohoverError(f"net_of_row={brief(net_of_row)} is not allowed: give one network index 0..{n_nets - 1} per observation row ({obs.shape[0]})")
+    obs = obs[:, INPUT_INDEX]
     out = np.empty((obs.shape[0], ACTION_DIM))
     _forward(
         p.node_start, p.node_slot, p.node_act, p.node_bias, p.node_resp, p.link_start, p.link_src, p.link_w, p.out_slot, p.n_slots,
@@ -375,13 +401,16 @@ class TopologyResult:
 
     def act(self, obs: np.ndarray) -> np.ndarray:
         """The champion's actions for a batch of observations (B, 12) -> (B, 4)."""
-        return forward(self.packed, np.zeros(len(obs), dtype=np.int64), np.asarray(obs, dtype=np.float64))
+        batch = observation_batch(obs)
+        return forward(self.packed, np.zeros(len(batch), dtype=np.int64), batch)
 
 
 def genome_record(genome) -> tuple[float, ...]:
     """A genome as a flat tuple of floats (what a stored result holds): the node count, then per node its key,
     bias, response and activation id (:data:`ACTIVATIONS`), then per enabled connection its input, output and weight.
     :func:`network_of_record` flies it again, to the same bits."""
+    if not isinstance(getattr(genome, "nodes", None), Mapping) or not isinstance(getattr(genome, "connections", None), Mapping):
+        raise NeurohoverError(f"genome={brief(genome)} is not allowed: give a neat-python genome (a TopologyResult's champion)")  # thirteenth trial, F19
     out: list[float] = [float(len(genome.nodes))]
     for key, node in genome.nodes.items():  # in the genome's order, so that a node's inputs sum in the same order
         out += [float(key), float(node.bias), float(node.response), float(ACTIVATIONS.index(node.activation))]
@@ -395,8 +424,15 @@ def network_of_record(record: Sequence[float]) -> PackedNetworks:
     """The network of a :func:`genome_record`, packed for :func:`forward` (neat-python's evaluation order)."""
     import neat
 
+    # [] was an IndexError, None a TypeError (thirteenth trial, F19)
+    if isinstance(record, (str, bytes)) or not isinstance(record, Sequence | np.ndarray) or len(record) == 0 or not all(finite_real(v) for v in record):
+        raise NeurohoverError(f"record={brief(record)} is not allowed: give a genome_record (a non-empty list of finite numbers)")
+    if not all(float(record[j]).is_integer() and 0 <= record[j] < len(ACTIVATIONS) for j in range(4, min(len(record), 1 + 4 * max(int(record[0]), 0)), 4)):
+        raise NeurohoverError(f"record={brief(record)} is not allowed: its activation ids must be whole numbers 0..{len(ACTIVATIONS) - 1}")
     config = neat_config(NeatSettings(activations=ACTIVATIONS))
     n_nodes = int(record[0])
+    if n_nodes < 0 or not float(record[0]).is_integer():
+        raise NeurohoverError(f"a NEAT record's node count {brief(record[0])} is not allowed: give a whole number >= 0")
     if len(record) < 1 + 4 * n_nodes or (len(record) - 1 - 4 * n_nodes) % 3:
         raise NeurohoverError(f"a NEAT record of {len(record)} numbers does not hold {n_nodes} nodes and whole connections")
     genome = neat.DefaultGenome(0)

@@ -30,7 +30,8 @@ import numpy as np
 
 from ..envs.arguments import check_noise_stream, check_reset_options, real_values
 from ..envs.vector import HoverVectorEnv
-from ..errors import NeurohoverError, finite_real
+from ..errors import NeurohoverError, brief, finite_real
+from ..paths import checked_path
 from ..sim.constants import ACTION_DIM
 from ..sim.rng import MAX_SEED
 from . import SB3_ALGORITHMS
@@ -193,8 +194,8 @@ class SB3VecEnv(VecEnv):
 
 
 def _algorithm(algo: str):
-    if algo not in SB3_ALGORITHMS:
-        raise NeurohoverError(f"algo={algo!r} is not supported: allowed {', '.join(SB3_ALGORITHMS)}")
+    if not isinstance(algo, str) or algo not in SB3_ALGORITHMS:  # ['ppo'] was a TypeError "unhashable" (thirteenth trial, F13)
+        raise NeurohoverError(f"algo={brief(algo)} is not supported: allowed {', '.join(SB3_ALGORITHMS)}")
     package, name = SB3_ALGORITHMS[algo]
     try:
         return getattr(importlib.import_module(package), name)
@@ -222,6 +223,11 @@ class RecurrentPolicy:
     indexed = True
 
     def __init__(self, model, deterministic: bool = True, prepare: Callable[[np.ndarray], np.ndarray] | None = None) -> None:
+        if not hasattr(getattr(model, "policy", None), "lstm_hidden_state_shape") or not callable(getattr(model, "predict", None)):
+            # None was an AttributeError at the first step (thirteenth trial, F13)
+            raise NeurohoverError(f"model={brief(model)} is not allowed: give a recurrent Stable-Baselines3 model (sb3-contrib's RecurrentPPO)")
+        if prepare is not None and not callable(prepare):
+            raise NeurohoverError(f"prepare={brief(prepare)} is not allowed: give a function of the observations, or None")
         self.model, self.deterministic, self.prepare = model, deterministic, prepare
         self.state: tuple[np.ndarray, ...] | None = None
         self.started: np.ndarray | None = None
@@ -254,7 +260,7 @@ def _policy_of(model, deterministic: bool, prepare: Callable[[np.ndarray], np.nd
 def sb3_policy(model_zip: str | Path, *, algo: str = "ppo", deterministic: bool = True) -> Callable[[np.ndarray], np.ndarray]:
     """A saved Stable-Baselines3 model (``MODEL.zip``) as a batch function (observations as it was trained on them:
     wrap it yourself if it learned behind a normaliser), ready for :func:`neurohover.integrations.flying.evaluate_callable`."""
-    path = Path(model_zip)
+    path = checked_path(model_zip, "model_zip", "MODEL.zip file path")  # None, 5, b'x.zip' were pathlib's TypeError (thirteenth trial, F13)
     if not path.is_file():
         raise NeurohoverError(f"{str(path)!r} is not a Stable-Baselines3 model file (MODEL.zip)")
     return _policy_of(_load(_algorithm(algo), path), deterministic)
@@ -265,7 +271,7 @@ def rl_zoo_files(run: str | Path, algo: str = "ppo") -> tuple[Path, Path | None]
     ``best_model.zip`` when there is no final one) and its observation statistics (``ENV/vecnormalize.pkl``; None
     when there are none)."""
     _algorithm(algo)
-    run = Path(run)
+    run = checked_path(run, "run", "path of an RL Zoo run folder")  # None was pathlib's TypeError (thirteenth trial, F13)
     if not run.is_dir():  # "found []" for a folder that is not there (seventh trial)
         raise NeurohoverError(f"RL Zoo run folder {str(run)!r}: {'no such directory' if not run.exists() else 'not a directory'}")
     zips = sorted(z for z in run.glob("*.zip") if not z.name.startswith("rl_model_"))
