@@ -11,13 +11,18 @@ readable form) and the environments its wind formula for their ``info`` (:func:`
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
+import numpy as np
+
+from ..errors import NeurohoverError, brief, finite_real
 from .constants import (
     CRASH_STEP_PENALTY,
     EPISODE_STEPS,
     GRAVITY,
+    MAX_EPISODE_STEPS,
     MAX_POSITION,
     MAX_RATE,
     MAX_VELOCITY,
@@ -60,6 +65,11 @@ def rotate_inverse(q: Quat, v: Vec) -> Vec:
 
 def rotation_vector_quaternion(rv: Vec) -> Quat:
     """Unit quaternion of a rotation vector; first-order form below an angle of 1e-4 (docs/model.md, Simulator)."""
+    return _rotation_vector_quaternion(_reals(rv, 3, "rv"))  # type: ignore[arg-type]
+
+
+def _rotation_vector_quaternion(rv: Vec) -> Quat:
+    """:func:`rotation_vector_quaternion` unchecked, for the substep loop."""
     angle = math.sqrt(rv[0] ** 2 + rv[1] ** 2 + rv[2] ** 2)
     if angle < 1e-4:
         half = (rv[0] / 2, rv[1] / 2, rv[2] / 2)
@@ -71,6 +81,14 @@ def rotation_vector_quaternion(rv: Vec) -> Quat:
 def competition_time(step: int, substep: int) -> float:
     """Time (s) of a substep as the competition software computed it: ``t = 0.1*step + 0.01*substep``
     in floating point, floored to 0.01 s by ``int(t*100)/100.0`` (so some land 0.01 s early)."""
+    for name, value in (("step", step), ("substep", substep)):  # -1 was a time of -0.1 s, 'a' a TypeError (thirteenth trial, F6, F7)
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 0:
+            raise NeurohoverError(f"{name}={brief(value)} is not allowed: give an integer >= 0 (control steps, substeps)")
+    return _competition_time(int(step), int(substep))
+
+
+def _competition_time(step: int, substep: int) -> float:
+    """:func:`competition_time` unchecked, for the substep loop."""
     t = 0.1 * step + 0.01 * substep
     return int(t * 100) / 100.0
 
@@ -87,6 +105,22 @@ class ReferenceMDP:
     dt: float = 0.01
     d_u: float = 0.0  # constant u acceleration of a learned model (0 in every true MDP)
     sensor: Sequence[float] = (0.0,) * 7  # noise std of velocity, position, rates, attitude; AR(1) coefficient; delay; dropout
+
+    def __post_init__(self) -> None:
+        """Refuse what the simulator cannot fly: 3 params were an unpack ValueError mid-episode, substeps=0 flew no
+        physics and returned 0.0 (thirteenth trial, F6, F7)."""
+        _reals(self.params, 11, "params")
+        _reals(self.noise_std, 6, "noise_std")
+        _reals(self.wind, 8, "wind")
+        _reals(self.sensor, 7, "sensor")
+        if self.wind_kind not in (0, WIND_CONSTANT, WIND_SINUSOID) or isinstance(self.wind_kind, bool):
+            raise NeurohoverError(f"wind_kind={brief(self.wind_kind)} is not allowed: give 0 (none), {WIND_CONSTANT} (constant) or {WIND_SINUSOID} (sinusoid)")
+        if isinstance(self.substeps, bool) or not isinstance(self.substeps, numbers.Integral) or self.substeps < 1:
+            raise NeurohoverError(f"substeps={brief(self.substeps)} is not allowed: give an integer >= 1 (physics substeps of a control step)")
+        if not finite_real(self.dt) or self.dt <= 0:
+            raise NeurohoverError(f"dt={brief(self.dt)} is not allowed: give a finite number > 0 (seconds of a substep)")
+        if not finite_real(self.d_u):
+            raise NeurohoverError(f"d_u={brief(self.d_u)} is not allowed: give a finite number")
 
     def wind_at(self, t: float) -> Vec:
         """World-frame wind (m/s) at time t (for GHH-09, t as :func:`competition_time` floors it)."""
@@ -141,7 +175,7 @@ class ReferenceHelicopter:
         n_u, n_v, n_w, n_p, n_q, n_r = self.noise
         dt = self.mdp.dt
         for i in range(self.mdp.substeps):
-            t = competition_time(self.steps - 1, i)
+            t = _competition_time(self.steps - 1, i)
             x, y, z = (p + dt * v for p, v in zip(self.position, self.velocity))
             self.position = (x, y, z)
             q = self.orientation
@@ -156,7 +190,7 @@ class ReferenceHelicopter:
             u, v, w = (vel + dt * f for vel, f in zip(self.velocity, fw))
             self.velocity = (u, v, w + dt * GRAVITY)
             p, q_rate, r = self.rates
-            self.orientation = quat_mul(q, rotation_vector_quaternion((dt * p, dt * q_rate, dt * r)))
+            self.orientation = quat_mul(q, _rotation_vector_quaternion((dt * p, dt * q_rate, dt * r)))
             self.rates = (
                 p + dt * (c_p * p + d_p * a1 + n_p),
                 q_rate + dt * (c_q * q_rate + d_q * a2 + n_q),
@@ -206,6 +240,7 @@ def fly_episode(
     the policy flies on the readings of ``mdp.sensor``, and those readings are returned (as the
     kernel records them); the reward stays on the true observation.
     """
+    _check_episode(mdp, policy, normals, n_steps, sensor_normals)
     heli = ReferenceHelicopter(mdp, episode_steps=n_steps)
     sensors = None if sensor_normals is None else ReferenceSensors(mdp.sensor, sensor_normals)
 
@@ -215,9 +250,53 @@ def fly_episode(
     observations = [seen(heli.observation())]
     total = 0.0
     for k in range(n_steps):
-        reward, crash = heli.step(policy(observations[-1]), normals[k])
+        reward, crash = heli.step(_action(policy, observations[-1], k), normals[k])
         total += reward
         observations.append(seen(heli.observation()))
         if crash:
             return total, True, observations
     return total, False, observations
+
+
+def _reals(values: object, n: int, what: str) -> tuple[float, ...]:
+    """``values`` as ``n`` real numbers (not bools; NaN and inf allowed, as the simulator defines them), or a NeurohoverError naming ``what``."""
+    try:
+        items: tuple = tuple(values)  # type: ignore[arg-type]
+    except TypeError:
+        items = ()
+    if len(items) != n or not all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in items):
+        raise NeurohoverError(f"{what}={brief(values)} is not allowed: give {n} real numbers")
+    return tuple(float(v) for v in items)
+
+
+def _check_episode(mdp: object, policy: object, normals: object, n_steps: object, sensor_normals: object) -> None:
+    """Refuse what :func:`fly_episode` cannot fly, before it flies (short normals were an IndexError mid-episode, n_steps=-1
+    returned (0.0, False); thirteenth trial, F6, F7): one vectorised look at each array of normals."""
+    if not isinstance(mdp, ReferenceMDP):
+        raise NeurohoverError(f"mdp={brief(mdp)} is not allowed: give a ReferenceMDP (an MDP's to_reference())")
+    if not callable(policy):
+        raise NeurohoverError(f"policy={brief(policy)} is not allowed: give a function of an observation (12 numbers) to 4 actions")
+    if isinstance(n_steps, bool) or not isinstance(n_steps, numbers.Integral) or not 1 <= int(n_steps) <= MAX_EPISODE_STEPS:
+        raise NeurohoverError(f"n_steps={brief(n_steps)} is not allowed: give an integer in 1..{MAX_EPISODE_STEPS}")
+    width = 13 if mdp.sensor[6] > 0 else 12
+    for name, given, rows, widths in (("normals", normals, int(n_steps), (6,)), ("sensor_normals", sensor_normals, int(n_steps) + 1, (width, 13))):
+        if name == "sensor_normals" and given is None:
+            continue
+        try:
+            shape = np.asarray(given, dtype=float).shape
+        except (TypeError, ValueError):  # ragged rows, text
+            shape = ()
+        if len(shape) != 2 or shape[0] < rows or shape[1] not in widths:
+            raise NeurohoverError(f"{name} of shape {shape} is not allowed: give at least {rows} rows of {widths[0]} numbers (neurohover.sim.rng)")
+
+
+def _action(policy: Callable[[list[float]], Sequence[float]], observation: list[float], k: int) -> Sequence[float]:
+    """The policy's action, refused unless it is 4 numbers (3 were an unpack ValueError; thirteenth trial, F6)."""
+    action = policy(observation)
+    try:
+        ok = len(action) == 4 and all(isinstance(a, numbers.Real) for a in action)
+    except TypeError:
+        ok = False
+    if not ok:
+        raise NeurohoverError(f"the policy's action at step {k} is {brief(action)}, not allowed: a policy gives 4 numbers")
+    return action

@@ -10,9 +10,12 @@ than Box-Muller; the gust noise needs 6 draws per control step, 36,000 per episo
 from __future__ import annotations
 
 import math
+import numbers
 
 import numba as nb
 import numpy as np
+
+from ..errors import NeurohoverError, brief
 
 _U64 = np.uint64
 _GOLDEN = _U64(0x9E3779B97F4A7C15)
@@ -128,8 +131,27 @@ def next_normal(state: np.ndarray) -> float:
     return _normal_slow(state, i, u)
 
 
+#: The most rows of normals one call draws (the longest episode anything accepts, with its reset's reading).
+MAX_COUNT = 10**7 + 1
+
+
+def _check_stream(seed, episode, count, what: str) -> tuple[np.uint64, np.uint64, int]:
+    """Refuse a seed, an episode index or a count the streams have no meaning for (a negative seed wrapped, 0.5 was numba's
+    typing dump, 2**64 an OverflowError, a count -1 NumPy's negative dimensions; thirteenth trial, F6 and F7)."""
+    for name, value, low, top in (("seed", seed, 0, MAX_SEED), ("episode", episode, 0, MAX_SEED), (what, count, 1, MAX_COUNT)):
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not low <= int(value) <= top:
+            shown = "2**63-1" if top == MAX_SEED else f"{top:,}"
+            raise NeurohoverError(f"{name}={brief(value)} is not allowed: give an integer in {low}..{shown}")
+    return np.uint64(seed), np.uint64(episode), int(count)
+
+
+def episode_normals(seed: int | np.uint64, episode: int | np.uint64, n_steps: int) -> np.ndarray:
+    """The (n_steps, 6) standard normals that episode ``episode`` of ``seed`` feeds the gust noise (checked, then :func:`_episode_normals`)."""
+    return _episode_normals(*_check_stream(seed, episode, n_steps, "n_steps"))
+
+
 @nb.njit(cache=True)
-def episode_normals(seed: np.uint64, episode: np.uint64, n_steps: int) -> np.ndarray:
+def _episode_normals(seed: np.uint64, episode: np.uint64, n_steps: int) -> np.ndarray:
     """The (n_steps, 6) standard normals that episode ``episode`` of ``seed`` feeds the gust noise."""
     state = np.empty(4, dtype=np.uint64)
     seed_stream(state, seed, episode)
@@ -146,8 +168,17 @@ def seed_sensor_stream(state: np.ndarray, seed: np.uint64, episode: np.uint64) -
     seed_stream(state, np.uint64(seed) ^ SENSOR_STREAM_KEY, np.uint64(episode))
 
 
+def sensor_normals(seed: int | np.uint64, episode: int | np.uint64, n_readings: int, per_reading: int = 12) -> np.ndarray:
+    """The (n_readings, per_reading) standard normals that episode ``episode`` of ``seed`` feeds the sensor model
+    (checked, then :func:`_sensor_normals`): ``per_reading`` 12, or 13 with a dropout."""
+    checked = _check_stream(seed, episode, n_readings, "n_readings")
+    if isinstance(per_reading, bool) or per_reading not in (12, 13):  # 0 gave rows of nothing (thirteenth trial, F7)
+        raise NeurohoverError(f"per_reading={brief(per_reading)} is not allowed: give 12, or 13 where the sensor has a dropout")
+    return _sensor_normals(*checked, int(per_reading))
+
+
 @nb.njit(cache=True)
-def sensor_normals(seed: np.uint64, episode: np.uint64, n_readings: int, per_reading: int = 12) -> np.ndarray:
+def _sensor_normals(seed: np.uint64, episode: np.uint64, n_readings: int, per_reading: int = 12) -> np.ndarray:
     """The (n_readings, per_reading) standard normals that episode ``episode`` of ``seed`` feeds the sensor model.
 
     One row per reading: the reset's, then one after every control step, from
