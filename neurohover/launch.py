@@ -48,10 +48,12 @@ def num_threads(threads: int | None) -> Iterator[None]:
         yield
         return
     limit = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # numba.config sets it at import, from the environment
-    if isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= limit:  # True was one thread
-        raise NeurohoverError(f"threads={threads!r} is out of range: allowed 1..{limit} on this machine")
+    if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):  # True was one thread; np.int64(1) is one (thirteenth trial, F8)
+        raise NeurohoverError(f"threads={brief(threads)} is not allowed: give an integer in 1..{limit} on this machine")
+    if not 1 <= threads <= limit:
+        raise NeurohoverError(f"threads={brief(threads)} is out of range: allowed 1..{limit} on this machine")
     previous = numba.get_num_threads()
-    numba.set_num_threads(threads)
+    numba.set_num_threads(int(threads))
     try:
         yield
     finally:

@@ -158,7 +158,8 @@ def neat_result():
 @pytest.mark.parametrize("obs", [np.zeros(12), np.zeros((2, 5)), "x", np.full((1, 12), np.nan)])
 def test_a_neat_result_refuses_observations_as_policy_act_does(neat_result, obs) -> None:
     """F19: r.act(np.zeros(12)) and (2, 5) were an IndexError, 'x' a ValueError, and NaN observations flew to [[1, 1, 1, 1]]."""
-    with pytest.raises(NeurohoverError, match=r"observations (of shape \(12,\)|of shape \(2, 5\)|'x'|of shape \(1, 12\) holding NaN or inf) are not allowed: give a \(B, 12\) array of finite numbers"):
+    shapes = r"(of shape \(12,\)|of shape \(2, 5\)|'x'|of shape \(1, 12\) holding NaN or inf)"
+    with pytest.raises(NeurohoverError, match=rf"observations {shapes} are not allowed: give a \(B, 12\) array of finite numbers"):
         neat_result.act(obs)
     assert neat_result.act(np.zeros((2, 12))).shape == (2, 4)
 

@@ -7,6 +7,7 @@ MDPs (task-family MDPs or learned models) is a plain 2-D array.
 from __future__ import annotations
 
 import math
+import numbers
 
 import numpy as np
 
@@ -101,8 +102,16 @@ SAFEGUARD_LIMITS = np.array([SAFEGUARD_BOX] * 9 + [SAFEGUARD_TILT, SAFEGUARD_KIN
 
 
 def crash_penalty(steps_taken: int, episode_steps: int = EPISODE_STEPS) -> float:
-    """Reward of the crashing control step when ``steps_taken`` steps (including it) were flown."""
-    return -CRASH_STEP_PENALTY * (episode_steps - steps_taken)
+    """Reward of the crashing control step when ``steps_taken`` steps (including it) were flown, of an episode of
+    ``episode_steps`` (a NeurohoverError where they are no whole numbers with 1 <= steps_taken <= episode_steps:
+    (10, 5) was a positive "penalty"; thirteenth trial)."""
+    from ..errors import NeurohoverError, brief
+
+    if isinstance(episode_steps, bool) or not isinstance(episode_steps, numbers.Integral) or episode_steps < 1:
+        raise NeurohoverError(f"episode_steps={brief(episode_steps)} is not allowed: give a whole number of control steps >= 1")
+    if isinstance(steps_taken, bool) or not isinstance(steps_taken, numbers.Integral) or not 1 <= steps_taken <= episode_steps:
+        raise NeurohoverError(f"steps_taken={brief(steps_taken)} is not allowed: give a whole number of steps from 1 to episode_steps={episode_steps}")
+    return -CRASH_STEP_PENALTY * (int(episode_steps) - int(steps_taken))
 
 
 #: The MLP's steepened logistic sigma(s) = 1 / (1 + exp(-MLP_STEEPNESS s)) (docs/model.md, Policies).
