@@ -507,7 +507,7 @@ def _fourth_trial_calls(tmp_path):
     return [
         (lambda: nh.evaluate(base, mdp, episodes=1, n_steps=True), "n_steps=True is out of range"),
         (lambda: nh.evaluate(base, mdp, episodes=1, seed=True), "seed=True is out of range"),
-        (lambda: nh.evaluate(base, mdp, episodes=1, threads=True), "threads=True is out of range"),
+        (lambda: nh.evaluate(base, mdp, episodes=1, threads=True), "threads=True is not allowed: give an integer in 1"),
         (lambda: nh.evaluate(base, mdp, episodes=10**8, n_steps=10**7), "100,000,000 episodes of n_steps=10,000,000 are"),
         (lambda: nh.evaluate(base, mdp, episodes=10**5, n_steps=6000, record=True), "recording 100,000 episodes of n_steps=6,000 takes 71.5 GiB"),
         (lambda: nh.evaluate(nh.PolicyTable(np.array([1]), np.zeros((1, 42), complex)), mdp, episodes=1, n_steps=20), "PolicyTable genomes must be real"),

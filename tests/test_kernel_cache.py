@@ -111,9 +111,12 @@ def test_every_cached_function_of_the_package_is_keyed_on_the_simulator_sources(
 
 
 def test_simulator_modules_import_nothing_of_the_package_outside_sim() -> None:
-    # The hash covers sim/*.py only, so compiled code there must not depend on other modules of ours.
+    # The hash covers sim/*.py only, so compiled code there must not depend on other modules of ours. The one exception,
+    # neurohover.errors, holds no compiled code: the Python entry points' argument checks raise its NeurohoverError.
     for path in (PACKAGE / "sim").glob("*.py"):
         for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.level == 2 and node.module == "errors":
+                continue
             if isinstance(node, ast.ImportFrom):
                 assert node.level <= 1, f"{path.name} imports from outside sim/: {ast.unparse(node)}"
                 assert node.level == 1 or not (node.module or "").startswith("neurohover"), ast.unparse(node)

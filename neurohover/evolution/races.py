@@ -307,26 +307,22 @@ def selection_race(
     -------
     RaceResult
     """
-    _check_sample_fn(sample_fn)
-    n, mu, delta, t_limit, batch = _race_arguments(n_candidates, mu, delta, t_limit, batch, rule)
+    n, mu, delta, t_limit, batch = _race_arguments(sample_fn, n_candidates, mu, delta, t_limit, batch, rule)
 
     # Samples in one (n, capacity) array: in round r every undecided candidate has r samples (columns 0..r-1 of
     # its row); _race_round sums them in NumPy's order, so means and bounds are those of bayes_mean_bounds.
     samples = np.empty((n, min(t_limit, 16)))
     n_samples = np.zeros(n, dtype=np.int64)
     crashed = np.zeros(n, dtype=bool)  # some sample is -inf (or was NaN)
-    lower = np.full(n, -np.inf)
-    upper = np.full(n, np.inf)
+    lower, upper = np.full(n, -np.inf), np.full(n, np.inf)
     means = np.full(n, np.nan)
     undecided = np.ones(n, dtype=bool)
     discarded = np.zeros(n, dtype=bool)
     selected: list[int] = []
     discard_order: list[int] = []
-    rounds = 0
-    episodes_flown = 0
+    rounds = episodes_flown = 0
     need_select, need_discard = n - mu, mu
-    sel = np.zeros(n, dtype=np.bool_)  # per undecided candidate of a round: selected, discarded
-    dis = np.zeros(n, dtype=np.bool_)
+    sel, dis = np.zeros(n, dtype=np.bool_), np.zeros(n, dtype=np.bool_)  # per undecided candidate of a round: selected, discarded
 
     flown = 0  # samples drawn so far by every undecided candidate (they stay in lockstep)
     while True:
@@ -366,8 +362,9 @@ def selection_race(
     return RaceResult(picked, means, n_samples, lower, upper, discards, n_raced, spent, rounds, episodes_flown=episodes_flown, over_selected=over_selected)
 
 
-def _race_arguments(n_candidates, mu, delta, t_limit, batch, rule) -> tuple[int, int, float, int, int]:
+def _race_arguments(sample_fn, n_candidates, mu, delta, t_limit, batch, rule) -> tuple[int, int, float, int, int]:
     """:func:`selection_race`'s arguments checked (NeurohoverError naming the bad one)."""
+    _check_sample_fn(sample_fn)
     n = _check_int("n_candidates", n_candidates, 2)
     mu = _check_int("mu", mu, 1)
     if mu >= n:
