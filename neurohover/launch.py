@@ -60,15 +60,22 @@ def num_threads(threads: int | None) -> Iterator[None]:
         numba.set_num_threads(previous)
 
 
+@numba.njit(cache=True)
+def _ends(index: np.ndarray) -> tuple[int, int]:  # min and max in one compiled pass: NumPy's two calls cost more than small batches fly
+    lowest = highest = index[0]
+    for v in index[1:]:
+        lowest, highest = min(lowest, v), max(highest, v)
+    return lowest, highest
+
+
 def check_job_indices(index: np.ndarray, low: int, upper: int | None, what: str) -> None:
     """Refuse a 1-D int64 array of job indices holding a value below ``low`` or at or above ``upper`` (None: no bound):
     the one range check of every launch's indices (:class:`Batch`; :func:`neurohover.evaluate_jobs` reaches it there)."""
     if not index.size:
         return
-    lowest = index.min()
+    lowest, highest = _ends(index)
     if lowest < low and low == 0:
         raise NeurohoverError(f"{what} holds negative values (min {lowest}); allowed >= 0")
-    highest = index.max()
     if lowest < low or (upper is not None and highest >= upper):
         raise NeurohoverError(f"{what} holds {lowest if lowest < low else highest}, out of range: allowed {low}..{'' if upper is None else upper - 1}")
 
@@ -149,7 +156,8 @@ class Batch:
         kinds = self.kinds
         if kinds.shape[0] != self.genomes.shape[0]:
             raise NeurohoverError(f"Batch.kinds has {kinds.shape[0]} entries but genomes {self.genomes.shape[0]} rows: give one kind per genome")
-        if kinds.size and (kinds.min() < min(KIND.values()) or kinds.max() > max(KIND.values())):
+        lowest, highest = _ends(kinds) if kinds.size else (0, 0)
+        if not min(KIND.values()) <= lowest <= highest <= max(KIND.values()):
             bad = kinds[(kinds < min(KIND.values())) | (kinds > max(KIND.values()))][0]
             raise NeurohoverError(f"Batch.kinds holds {bad}, not a policy kind: allowed {', '.join(f'{v} ({k})' for k, v in KIND.items())}")
         check_job_indices(self.policy_index, 0, kinds.shape[0], "policy_index")
