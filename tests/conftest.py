@@ -24,6 +24,17 @@ os.environ["PYTHONPATH"] = os.pathsep.join([str(ROOT), *filter(None, [os.environ
 CliRun = Callable[..., tuple[int, str, str]]
 
 
+def tiny_test_runs(*agents: str, name: str = "tr1", settings: str = "") -> str:
+    """A test-runs config (TOML) flying each of ``agents`` on one GHH-08 test MDP, two episodes of 20 steps at the quick
+    scale; ``settings``, if given, is every group's own settings table (TOML, e.g. "{ safeguard_after = 20 }")."""
+    own = f"settings = {settings}\n" if settings else ""
+    groups = "".join(f'[[settings.groups]]\nagent = "{a}"\nmdps = "test"\nn_mdps = 1\n{own}' for a in agents)
+    return (
+        f'name = "{name}"\ntitle = "tiny"\nkind = "test_runs"\n[settings]\ntask = "ghh08"\nseed = 1\npolicies = "shipped"\n'
+        f"{groups}[scales.quick]\nepisodes = 2\nn_steps = 20\n"
+    )
+
+
 #: A ``reproduce`` whose plan is twelve diagnostic units (argv: GATES EXPERIMENT reproduce ...): unit i waits
 #: until the file GATES/i exists, so a test, not the machine's speed, decides how far the run gets.
 GATED_RUN = """

@@ -7,6 +7,7 @@ import sqlite3
 from pathlib import Path
 
 import pytest
+from conftest import tiny_test_runs
 
 from neurohover.errors import NeurohoverError
 
@@ -58,10 +59,7 @@ def test_compete_refuses_a_drift_that_changes_nothing(tmp_path: Path, cli) -> No
 def test_a_config_named_after_a_shipped_alias_is_refused(tmp_path: Path, cli) -> None:
     """S8: a config named table3 (fig2's alias) ran; `reproduce table3` then meant fig2 and `results table3` this one."""
     config = tmp_path / "fake.toml"
-    config.write_text(
-        'name = "table3"\ntitle = "t"\nkind = "test_runs"\n[settings]\ntask = "ghh08"\nseed = 1\npolicies = "shipped"\n'
-        '[[settings.groups]]\nagent = "baseline"\nmdps = "test"\nn_mdps = 1\n[scales.quick]\nepisodes = 1\nn_steps = 20\n'
-    )
+    config.write_text(tiny_test_runs("baseline", name="table3"))
     store = tmp_path / "s.sqlite"
     rc, _, err = cli("reproduce", str(config), "--store", str(store), "--no-progress")
     assert rc == 2 and not store.exists(), err
@@ -217,11 +215,7 @@ def test_a_config_whose_continual_safeguard_never_tests_is_refused_before_it_run
     """Twelfth trial, S3: a test-runs config giving continual a safeguard_after past its episodes failed in its first unit
     (exit 1) instead of being refused with the config (exit 2)."""
     config = tmp_path / "c.toml"
-    config.write_text(
-        'name = "mine"\ntitle = "t"\nkind = "test_runs"\n[settings]\ntask = "ghh08"\nseed = 1\npolicies = "shipped"\n'
-        '[[settings.groups]]\nagent = "continual"\nmdps = "test"\nn_mdps = 1\nsettings = { safeguard_after = 20 }\n'
-        "[scales.quick]\nepisodes = 1\nn_steps = 20\n"
-    )
+    config.write_text(tiny_test_runs("continual", name="mine", settings="{ safeguard_after = 20 }"))
     store = tmp_path / "s.sqlite"
     rc, _, err = cli("reproduce", str(config), "--store", str(store), "--no-progress")
     assert rc == 2 and "group 'continual': continual safeguard_after=20 is not below the episode's 20 control steps" in err and not store.exists(), err

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import tiny_test_runs
 
 from neurohover.errors import NeurohoverError
 
@@ -27,32 +28,11 @@ def test_the_cuda_simulator_variable_numba_cannot_take_is_named(value: str, tmp_
     )
 
 
-TINY_CONFIG = """
-name = "tr1"
-title = "tiny"
-kind = "test_runs"
-
-[settings]
-task = "ghh08"
-seed = 1
-policies = "shipped"
-
-[[settings.groups]]
-agent = "baseline"
-mdps = "test"
-n_mdps = 1
-
-[scales.quick]
-episodes = 2
-n_steps = 20
-"""
-
-
 @pytest.fixture
 def tiny_store(tmp_path: Path, cli) -> Path:
     """A store holding one tiny experiment (tr1, quick scale), its file name holding a byte that is no UTF-8."""
     config = tmp_path / "tr1.toml"
-    config.write_text(TINY_CONFIG)
+    config.write_text(tiny_test_runs("baseline"))
     store = tmp_path / "s\udcff.sqlite"  # the byte 0xff, as Python keeps it
     rc, _, err = cli("reproduce", str(config), "--store", str(store), "--no-progress")
     assert rc == 0, err

@@ -7,39 +7,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import tiny_test_runs
 
 from neurohover.errors import NeurohoverError
-
-TINY_TEST_RUNS = """name = "tr1"
-title = "tiny"
-kind = "test_runs"
-
-[settings]
-task = "ghh08"
-seed = 1
-policies = "shipped"
-
-[[settings.groups]]
-agent = "baseline"
-mdps = "test"
-n_mdps = 1
-
-[[settings.groups]]
-agent = "generic"
-mdps = "test"
-n_mdps = 1
-
-[scales.quick]
-episodes = 2
-n_steps = 20
-"""
 
 
 @pytest.fixture
 def tiny_store(tmp_path: Path, cli) -> Path:
     """A store holding a tiny test-runs experiment of two groups (baseline, generic)."""
     config, store = tmp_path / "tr1.toml", tmp_path / "tr1.sqlite"
-    config.write_text(TINY_TEST_RUNS)
+    config.write_text(tiny_test_runs("baseline", "generic"))
     assert cli("reproduce", str(config), "--store", str(store), "--no-progress")[0] == 0
     return store
 
