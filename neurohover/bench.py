@@ -8,7 +8,6 @@ The workload is the issue's: full 6000-step episodes of the MLP policy in the ze
 from __future__ import annotations
 
 import math
-import numbers
 import platform
 import random
 import time
@@ -17,7 +16,7 @@ from collections.abc import Callable
 import numba
 import numpy as np
 
-from .errors import NeurohoverError, brief
+from .errors import NeurohoverError, brief, whole_number
 from .evaluate import PolicyTable, evaluate_jobs
 from .policies import prototype
 from .policysets import load_policy_set
@@ -28,7 +27,7 @@ from .tasks import get_task_family
 
 def _count(name: str, value: object, what: str) -> int:
     """``value`` as an int >= 1 (NumPy integers too): 0 and negative sizes were rates of 0.0 or tracebacks (thirteenth trial, F3 F4)."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:
+    if not whole_number(value) or value < 1:
         raise NeurohoverError(f"{name}={brief(value)} is not allowed: give a whole number of {what} >= 1")
     return int(value)
 

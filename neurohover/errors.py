@@ -5,7 +5,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
-from typing import Any
+from typing import Any, TypeGuard
 
 
 class NeurohoverError(ValueError):
@@ -18,6 +18,12 @@ class OutputError(NeurohoverError):
 
 class Terminated(KeyboardInterrupt):
     """SIGTERM arrived where the command handles it (like Ctrl-C: finished work kept, one line, status 143)."""
+
+
+def whole_number(value: object) -> TypeGuard[int]:
+    """Whether ``value`` is an integer, NumPy's included, and not a bool (True is an int, and was taken as 1). The one
+    test of every integer argument; the type checker takes it as an int (NumPy's integers compare and index alike)."""
+    return isinstance(value, numbers.Integral) and not isinstance(value, bool)
 
 
 def finite_real(value: object) -> bool:

@@ -14,14 +14,13 @@ Example
 
 from __future__ import annotations
 
-import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError, brief
+from .errors import NeurohoverError, brief, whole_number
 from .flightdata import FlightData, same_values
 from .flyer import KernelFlyer
 from .launch import DEVICES, KIND, MAX_SEED, Batch, Flown, check_device, launch, num_threads, use_lanes
@@ -400,7 +399,7 @@ def evaluate_jobs(
 def check_first_episode(first_episode) -> int:
     """The index of a batch's first episode (its gust streams are (seed, first_episode + k)) as an int in 0..2**62-1;
     text or True (taken as 1) refused by type, anything else by range: one check for every entry that takes it."""
-    if isinstance(first_episode, (bool, np.bool_)) or not isinstance(first_episode, numbers.Integral):
+    if not whole_number(first_episode):
         raise NeurohoverError(f"first_episode={brief(first_episode)} is not allowed: give an integer in 0..2**62-1")
     index = int(first_episode)
     if not 0 <= index < 2**62:

@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-import numbers
-
 import numba
 import numpy as np
 
-from .errors import NeurohoverError, brief
+from .errors import NeurohoverError, brief, whole_number
 from .launch import KIND, MAX_SEED, Batch, Flown, Parking, check_device, launch, launch_parked, rows_alike
 from .policies import GENOME_LENGTH, TOPOLOGIES
 from .sim.constants import MAX_EPISODE_STEPS, SAFEGUARD_LIMITS
@@ -128,7 +126,7 @@ class KernelFlyer:
 
     def reserve(self, n: int) -> int:
         """Reserve the next ``n`` episode indices for calls with explicit ``episode_index``; returns the first."""
-        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 0:  # -5 handed out flown indices again, 1.5 a float one (thirteenth trial, F17)
+        if not whole_number(n) or n < 0:  # -5 handed out flown indices again, 1.5 a float one (thirteenth trial, F17)
             raise NeurohoverError(f"n={brief(n)} is not allowed: give the number of episode indices to reserve, an integer >= 0")
         n = int(n)
         first = self.next_index
@@ -175,7 +173,7 @@ class KernelFlyer:
         numpy.ndarray
             The jobs' returns: a view of the flyer's buffer, valid until the next call.
         """
-        if isinstance(n_jobs, bool) or not isinstance(n_jobs, numbers.Integral) or n_jobs < 0:  # -1 flew all but one buffer slot
+        if not whole_number(n_jobs) or n_jobs < 0:  # -1 flew all but one buffer slot
             raise NeurohoverError(f"n_jobs={brief(n_jobs)} is not allowed: give the number of jobs, an integer >= 0")
         self._load_genomes(genomes)
         zeros, arange, e, minus, returns, crashed, steps, sg = self._views_for(n_jobs)

@@ -16,7 +16,6 @@ every path without a new argument.
 from __future__ import annotations
 
 import contextlib
-import numbers
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -24,7 +23,7 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
-from .errors import NeurohoverError, brief
+from .errors import NeurohoverError, brief, whole_number
 from .sim.constants import MAX_EPISODE_STEPS, MDP_ROW_LEN, ROW_SUBSTEPS, ROW_WIND_KIND, SAFEGUARD_LIMITS
 from .sim.jobs import Extras, Flown, Jobs, Parking
 from .sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
@@ -48,7 +47,7 @@ def num_threads(threads: int | None) -> Iterator[None]:
         yield
         return
     limit = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # numba.config sets it at import, from the environment
-    if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):  # True was one thread; np.int64(1) is one (thirteenth trial, F8)
+    if not whole_number(threads):  # True was one thread; np.int64(1) is one (thirteenth trial, F8)
         raise NeurohoverError(f"threads={brief(threads)} is not allowed: give an integer in 1..{limit} on this machine")
     if not 1 <= threads <= limit:
         raise NeurohoverError(f"threads={brief(threads)} is out of range: allowed 1..{limit} on this machine")
@@ -149,9 +148,9 @@ class Batch:
     def _check_values(self) -> None:
         """The values the kernel indexes by, checked in one vectorised pass each before it runs: an index out of range
         read past an array and killed the process (SIGSEGV), a kind 99 flew, n_steps=-5 flew nothing (thirteenth trial, F1)."""
-        if isinstance(self.n_steps, bool) or not isinstance(self.n_steps, numbers.Integral) or not 1 <= self.n_steps <= MAX_EPISODE_STEPS:
+        if not whole_number(self.n_steps) or not 1 <= self.n_steps <= MAX_EPISODE_STEPS:
             raise NeurohoverError(f"n_steps={brief(self.n_steps)} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
-        if isinstance(self.seed, bool) or not isinstance(self.seed, numbers.Integral) or not 0 <= self.seed <= MAX_SEED:
+        if not whole_number(self.seed) or not 0 <= self.seed <= MAX_SEED:
             raise NeurohoverError(f"seed={brief(self.seed)} is out of range: allowed an integer in 0..2**63-1")
         kinds = self.kinds
         if kinds.shape[0] != self.genomes.shape[0]:

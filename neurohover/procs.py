@@ -17,7 +17,6 @@ from __future__ import annotations
 import _thread
 import contextlib
 import multiprocessing
-import numbers
 import os
 import signal
 import sys
@@ -26,7 +25,7 @@ import time
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
 
-from .errors import NeurohoverError, Terminated, brief, raise_terminated
+from .errors import NeurohoverError, Terminated, brief, raise_terminated, whole_number
 
 WATCH_SECONDS = 0.5  # how often a worker checks that its parent is alive
 
@@ -81,7 +80,7 @@ def worker_pool(jobs: int) -> ProcessPoolExecutor:
 
     Spawned, not forked: numba's thread pools are not fork-safe.
     """
-    if isinstance(jobs, bool) or not isinstance(jobs, numbers.Integral) or jobs < 1:  # 0 was concurrent.futures' error, '2' a TypeError (thirteenth trial, F16)
+    if not whole_number(jobs) or jobs < 1:  # 0 was concurrent.futures' error, '2' a TypeError (thirteenth trial, F16)
         raise NeurohoverError(f"jobs={brief(jobs)} is not allowed: give a whole number of worker processes >= 1")
     jobs = int(jobs)
     main = threading.current_thread() is threading.main_thread()

@@ -23,14 +23,13 @@ lets the harness fly the rest of the run in one parallel batch (same results, fa
 from __future__ import annotations
 
 import functools
-import numbers
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real
+from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..evaluate import DangerousState, PolicyTable, check_episode_count, evaluate_jobs
 from ..evolution.seeding import check_seed
 from ..flightdata import FlightData
@@ -95,7 +94,7 @@ class Choice:
 
 
 def _check_count(what: str, value: object, least: int) -> None:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < least:
+    if not whole_number(value) or value < least:
         raise NeurohoverError(f"{what}={brief(value)} is out of range: allowed an integer >= {least}")
 
 

@@ -18,14 +18,13 @@ and ``tell()``.
 from __future__ import annotations
 
 import math
-import numbers
 import time
 from dataclasses import dataclass
 from typing import Any, Protocol, overload
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real
+from ..errors import NeurohoverError, brief, finite_real, whole_number
 
 __all__ = [
     "STATE_VERSION",
@@ -126,7 +125,7 @@ ASK_AGAIN = "ask() called again before tell() of the previous {what}: tell() its
 
 def require_int(name: str, value: Any, minimum: int) -> int:
     """``value`` as an int, or NeurohoverError unless it is an integer (not a bool) ``>= minimum``."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < minimum:
+    if not whole_number(value) or value < minimum:
         raise NeurohoverError(f"{name}={brief(value)} must be an integer >= {minimum}")
     return int(value)
 

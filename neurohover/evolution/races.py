@@ -53,7 +53,7 @@ import numba
 import numpy as np
 from scipy import stats
 
-from ..errors import NeurohoverError, brief, finite_real
+from ..errors import NeurohoverError, brief, finite_real, whole_number
 from .common import as_floats
 
 __all__ = [
@@ -141,7 +141,7 @@ class RaceResult:
 
 
 def _check_int(name: str, value: object, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+    if not whole_number(value):
         raise NeurohoverError(f"{name}={brief(value)} must be an integer >= {minimum}")
     if value < minimum:
         raise NeurohoverError(f"{name}={brief(value)} must be an integer >= {minimum}")

@@ -15,7 +15,6 @@ Results and seeds are the same on every executor: a unit carries its own seed (d
 
 from __future__ import annotations
 
-import numbers
 import os
 import socket
 import time
@@ -24,7 +23,7 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, whole_number
 from ..evaluate import DEVICES, check_device
 from ..procs import sigterm_as_interrupt, stop_pool, worker_pool
 from .store import worker_name
@@ -46,7 +45,7 @@ def timed_run(unit: dict, threads: int | None = 1, device: str = "cpu") -> tuple
 def check_jobs(jobs) -> int:
     """``jobs`` local worker processes: an integer from 1 to this machine's cores (NeurohoverError otherwise)."""
     cores = os.cpu_count() or 1
-    if not isinstance(jobs, numbers.Integral) or isinstance(jobs, bool):  # '2' was called out of range (twelfth trial, U1)
+    if not whole_number(jobs):  # '2' was called out of range (twelfth trial, U1)
         raise NeurohoverError(f"--jobs {brief(jobs)} is not allowed: give an integer in 1..{cores} (the cores of this machine)")
     if not 1 <= int(jobs) <= cores:
         raise NeurohoverError(f"--jobs {brief(jobs)} is out of range: allowed an integer in 1..{cores} (the cores of this machine)")

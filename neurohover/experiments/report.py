@@ -15,14 +15,13 @@ Error is minus the return (lower is better), as in the paper's plots.
 from __future__ import annotations
 
 import json
-import numbers
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError, OutputError, brief
+from ..errors import NeurohoverError, OutputError, brief, whole_number
 from .config import ORDER, ExperimentConfig, check_paper_table, shipped_counterpart, with_shipped_paper
 from .keys import UnitKey
 from .report_base import Section, agent_panel, fmt, log_errors, new_figure, paired_p, paired_verdict, ratio_verdict, sd, table
@@ -43,9 +42,9 @@ WIN_RUNS = (1, 5, 20)
 def crash_rate(crashes: int, episodes: int) -> str:
     """A crash fraction as a percentage that is never 0 % when some episode crashed (1 of 20,000: 0.005%)."""
     # (1, 0) was a ZeroDivisionError, (5, 2) '250%' and (-1, 2) '-50%' (thirteenth trial, F20)
-    if isinstance(episodes, bool) or not isinstance(episodes, numbers.Integral) or episodes < 1:
+    if not whole_number(episodes) or episodes < 1:
         raise NeurohoverError(f"episodes={brief(episodes)} is not allowed: give a whole number of episodes >= 1")
-    if isinstance(crashes, bool) or not isinstance(crashes, numbers.Integral) or not 0 <= crashes <= episodes:
+    if not whole_number(crashes) or not 0 <= crashes <= episodes:
         raise NeurohoverError(f"crashes={brief(crashes)} is not allowed: give a whole number of crashed episodes from 0 to episodes={episodes}")
     rate = int(crashes) / int(episodes)
     return f"{rate:.0%}" if rate == 0 or rate >= 0.01 else f"{100 * rate:.2g}%"

@@ -17,7 +17,6 @@ everything else is a deterministic function of the params.
 from __future__ import annotations
 
 import hashlib
-import numbers
 import os
 import time
 from collections.abc import Sequence
@@ -29,7 +28,7 @@ import numpy as np
 from ..agents.model_based import ModelEvolution, evolve_on_model
 from ..agents.protocol import after_learning_start, run_test
 from ..agents.registry import AgentOptions, AgentPolicies, agent_spec
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, whole_number
 from ..evaluate import evaluate, evaluate_jobs, num_threads
 from ..evolution.config import optimiser_of
 from ..evolution.eonn import EonnSettings
@@ -75,7 +74,7 @@ class Unit:
 
 def unit_seed(root: int, experiment: str, key: str) -> int:
     """A 63-bit seed for unit ``key``: ``SeedSequence([root, *sha256(experiment/key) words])``."""
-    if not isinstance(root, numbers.Integral) or isinstance(root, bool) or root < 0:  # 'x' and -1 were int()'s and NumPy's errors (twelfth trial, T7)
+    if not whole_number(root) or root < 0:  # 'x' and -1 were int()'s and NumPy's errors (twelfth trial, T7)
         raise NeurohoverError(f"root={brief(root)} is not allowed: give the config's seed, an integer >= 0")
     for name, value in (("experiment", experiment), ("key", key)):
         if not isinstance(value, str):

@@ -12,12 +12,11 @@ win. Drawing MDPs first keeps the agents paired on the same MDPs, as in a compet
 
 from __future__ import annotations
 
-import numbers
 from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, whole_number
 from .keys import UnitKey
 from .results import TestRunResult
 
@@ -61,7 +60,7 @@ def win_probabilities(runs: Mapping[str, Mapping[str, Sequence[float]]], n_runs:
         Agent -> probability; the probabilities sum to 1.
     """
     for name, value, low in (("n_runs", n_runs, 1), ("draws", draws, 1), ("seed", seed, 0)):
-        if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < low:
+        if not whole_number(value) or value < low:
             raise NeurohoverError(f"{name}={brief(value)} is out of range: allowed an integer >= {low}")
     if draws * n_runs > _MAX_CELLS:
         raise NeurohoverError(f"draws x n_runs = {draws * n_runs:,} is too large: at most {_MAX_CELLS:,} simulated runs per agent at once")

@@ -9,12 +9,11 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import numbers
 import time
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, whole_number
 from ..flightdata import FlightData
 from ..sim.constants import DEFAULT_PARAMS, ROW_NOISE, ROW_PARAMS
 from ..tasks import MDP
@@ -201,7 +200,7 @@ def observed_return(flight_data: FlightData, episode: int = 0) -> float:
     if not isinstance(flight_data, FlightData):
         raise NeurohoverError(f"flight data must be a FlightData, got {type(flight_data).__name__}")
     # a float was a TypeError from indexing, True taken as episode 1 (twelfth trial T4)
-    if isinstance(episode, bool) or not isinstance(episode, numbers.Integral):
+    if not whole_number(episode):
         raise NeurohoverError(f"episode={brief(episode)} is not allowed: give an integer in 0..{flight_data.n_episodes - 1}")
     if not 0 <= episode < flight_data.n_episodes:
         raise NeurohoverError(f"episode {brief(episode)} is not in the flight data: give an integer in 0..{flight_data.n_episodes - 1}")

@@ -7,7 +7,6 @@ MDPs (task-family MDPs or learned models) is a plain 2-D array.
 from __future__ import annotations
 
 import math
-import numbers
 
 import numpy as np
 
@@ -105,11 +104,11 @@ def crash_penalty(steps_taken: int, episode_steps: int = EPISODE_STEPS) -> float
     """Reward of the crashing control step when ``steps_taken`` steps (including it) were flown, of an episode of
     ``episode_steps`` (a NeurohoverError where they are no whole numbers with 1 <= steps_taken <= episode_steps:
     (10, 5) was a positive "penalty"; thirteenth trial)."""
-    from ..errors import NeurohoverError, brief
+    from ..errors import NeurohoverError, brief, whole_number
 
-    if isinstance(episode_steps, bool) or not isinstance(episode_steps, numbers.Integral) or episode_steps < 1:
+    if not whole_number(episode_steps) or episode_steps < 1:
         raise NeurohoverError(f"episode_steps={brief(episode_steps)} is not allowed: give a whole number of control steps >= 1")
-    if isinstance(steps_taken, bool) or not isinstance(steps_taken, numbers.Integral) or not 1 <= steps_taken <= episode_steps:
+    if not whole_number(steps_taken) or not 1 <= steps_taken <= episode_steps:
         raise NeurohoverError(f"steps_taken={brief(steps_taken)} is not allowed: give a whole number of steps from 1 to episode_steps={episode_steps}")
     return -CRASH_STEP_PENALTY * (int(episode_steps) - int(steps_taken))
 

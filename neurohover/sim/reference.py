@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real
+from ..errors import NeurohoverError, brief, finite_real, whole_number
 from .constants import (
     CRASH_STEP_PENALTY,
     EPISODE_STEPS,
@@ -82,7 +82,7 @@ def competition_time(step: int, substep: int) -> float:
     """Time (s) of a substep as the competition software computed it: ``t = 0.1*step + 0.01*substep``
     in floating point, floored to 0.01 s by ``int(t*100)/100.0`` (so some land 0.01 s early)."""
     for name, value in (("step", step), ("substep", substep)):  # -1 was a time of -0.1 s, 'a' a TypeError (thirteenth trial, F6, F7)
-        if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 0:
+        if not whole_number(value) or value < 0:
             raise NeurohoverError(f"{name}={brief(value)} is not allowed: give an integer >= 0 (control steps, substeps)")
     return _competition_time(int(step), int(substep))
 
@@ -115,7 +115,7 @@ class ReferenceMDP:
         _reals(self.sensor, 7, "sensor")
         if self.wind_kind not in (0, WIND_CONSTANT, WIND_SINUSOID) or isinstance(self.wind_kind, bool):
             raise NeurohoverError(f"wind_kind={brief(self.wind_kind)} is not allowed: give 0 (none), {WIND_CONSTANT} (constant) or {WIND_SINUSOID} (sinusoid)")
-        if isinstance(self.substeps, bool) or not isinstance(self.substeps, numbers.Integral) or self.substeps < 1:
+        if not whole_number(self.substeps) or self.substeps < 1:
             raise NeurohoverError(f"substeps={brief(self.substeps)} is not allowed: give an integer >= 1 (physics substeps of a control step)")
         if not finite_real(self.dt) or self.dt <= 0:
             raise NeurohoverError(f"dt={brief(self.dt)} is not allowed: give a finite number > 0 (seconds of a substep)")
@@ -276,7 +276,7 @@ def _check_episode(mdp: object, policy: object, normals: object, n_steps: object
         raise NeurohoverError(f"mdp={brief(mdp)} is not allowed: give a ReferenceMDP (an MDP's to_reference())")
     if not callable(policy):
         raise NeurohoverError(f"policy={brief(policy)} is not allowed: give a function of an observation (12 numbers) to 4 actions")
-    if isinstance(n_steps, bool) or not isinstance(n_steps, numbers.Integral) or not 1 <= int(n_steps) <= MAX_EPISODE_STEPS:
+    if not whole_number(n_steps) or not 1 <= int(n_steps) <= MAX_EPISODE_STEPS:
         raise NeurohoverError(f"n_steps={brief(n_steps)} is not allowed: give an integer in 1..{MAX_EPISODE_STEPS}")
     width = 13 if mdp.sensor[6] > 0 else 12
     for name, given, rows, widths in (("normals", normals, int(n_steps), (6,)), ("sensor_normals", sensor_normals, int(n_steps) + 1, (width, 13))):

@@ -10,12 +10,11 @@ than Box-Muller; the gust noise needs 6 draws per control step, 36,000 per episo
 from __future__ import annotations
 
 import math
-import numbers
 
 import numba as nb
 import numpy as np
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, whole_number
 
 _U64 = np.uint64
 _GOLDEN = _U64(0x9E3779B97F4A7C15)
@@ -139,7 +138,7 @@ def _check_stream(seed, episode, count, what: str) -> tuple[np.uint64, np.uint64
     """Refuse a seed, an episode index or a count the streams have no meaning for (a negative seed wrapped, 0.5 was numba's
     typing dump, 2**64 an OverflowError, a count -1 NumPy's negative dimensions; thirteenth trial, F6 and F7)."""
     for name, value, low, top in (("seed", seed, 0, MAX_SEED), ("episode", episode, 0, MAX_SEED), (what, count, 1, MAX_COUNT)):
-        if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not low <= int(value) <= top:
+        if not whole_number(value) or not low <= int(value) <= top:
             shown = "2**63-1" if top == MAX_SEED else f"{top:,}"
             raise NeurohoverError(f"{name}={brief(value)} is not allowed: give an integer in {low}..{shown}")
     return np.uint64(seed), np.uint64(episode), int(count)

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import FloatRangeError, NeurohoverError, brief, finite_real, float_of
+from ..errors import FloatRangeError, NeurohoverError, brief, finite_real, float_of, whole_number
 from ..sim.constants import MDP_ROW_LEN, PARAM_NAMES, ROW_PARAMS
 from ..sim.rng import MAX_SEED
 
@@ -222,7 +222,7 @@ NO_DRIFT = Drift()
 
 def _whole(name: str, value, what: str, low: int, high: int | None = None) -> int:
     """``value`` as an int in ``low..high`` (NumPy integers too), or a NeurohoverError naming it (thirteenth trial, F9)."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not low <= int(value) or (high is not None and int(value) > high):
+    if not whole_number(value) or not low <= int(value) or (high is not None and int(value) > high):
         raise NeurohoverError(f"{name}={brief(value)} is not allowed: give {what}")
     return int(value)
 

@@ -38,7 +38,7 @@ import numbers
 import re
 from dataclasses import asdict, dataclass, fields, replace
 
-from ..errors import FloatRangeError, NeurohoverError, brief, finite_real, float_of
+from ..errors import FloatRangeError, NeurohoverError, brief, finite_real, float_of, whole_number
 from ..sim.constants import MAX_SENSOR_DELAY, SENSOR_GROUPS
 
 #: The std of each group at noise level 1 (velocity m/s, position m, rates rad/s, attitude).
@@ -82,7 +82,7 @@ class Sensor:
             raise NeurohoverError(f"sensor dropout={p!r} is out of range: allowed a probability 0 <= dropout < 1")
         object.__setattr__(self, "dropout", float(p))
         d = self.delay
-        if isinstance(d, numbers.Integral) and not isinstance(d, bool):
+        if whole_number(d):
             object.__setattr__(self, "delay", d := int(d))  # a NumPy integer as the int it is
         if isinstance(d, bool) or not isinstance(d, int) or not 0 <= d <= MAX_SENSOR_DELAY:
             raise NeurohoverError(f"sensor delay={d!r} is out of range: allowed an integer number of control steps in 0..{MAX_SENSOR_DELAY}")
