@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from .agents.hybrid import HybridSettings
-from .errors import NeurohoverError, brief
+from .errors import NeurohoverError
 from .evolution.seeding import check_seed
 from .paths import write_png
 from .sim.constants import EPISODE_STEPS
@@ -142,22 +142,12 @@ def _group(task: str, runs: int, mdps: str) -> dict:
 _EXPERIMENT_WIDE = ("max_learning_episodes",)
 
 
-def check_agent_name(agent: object) -> None:
-    """Refuse an agent that is not registered, a long name shortened (a 100,000-character --agent was echoed whole;
-    eleventh trial, U6)."""
-    from .agents.registry import AGENTS
-
-    if not isinstance(agent, str) or agent not in AGENTS:
-        raise NeurohoverError(f"unknown agent {brief(agent)}: allowed {', '.join(AGENTS)}")
-
-
 def check_agent_settings(agent: str, values: Mapping[str, object], n_steps: int | None = None) -> dict:
     """``values`` as the agent's own settings table, checked by its spec's settings class (one clear message): every
     agent that ``neurohover settings`` lists settings for takes them here, but the hybrid agents, whose settings are
     the ``hybrid`` argument (the --safeguard-*/--hybrid-* options). ``n_steps``: the episode length they must act in."""
     from .agents.registry import agent_spec
 
-    check_agent_name(agent)
     spec = agent_spec(agent)
     if spec.settings is None or spec.settings.UNIT_KEY not in ("agent_settings", *_EXPERIMENT_WIDE):
         # incremental's max_learning_episodes was refused here while `neurohover settings incremental` listed it (eleventh trial, U2)
@@ -320,11 +310,11 @@ def compete(
         When interrupted (SIGTERM too while ``jobs > 1``), after writing ``episodes.csv`` of every
         finished run; the store keeps them, and the same call resumes.
     """
-    from .agents.registry import check_agent
+    from .agents.registry import agent_spec, check_agent
     from .paths import output_dir
 
     _check_run(jobs, device, on_result, progress)  # every check before the output directory is made (third trial)
-    check_agent_name(agent)
+    agent_spec(agent)  # an unknown agent named before the task is looked at
     check_agent(agent, get_task_family(task, sigma), policy_dir)
     config = competition_config(
         task, agent, runs=runs, episodes=episodes, mdps=mdps, seed=seed, sigma=sigma, n_steps=n_steps, policy_dir=policy_dir, hybrid=hybrid,

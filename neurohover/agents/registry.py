@@ -44,7 +44,7 @@ HYBRID_AGENTS: tuple[str, ...] = tuple(name for name, spec in AGENTS.items() if 
 
 def agent_spec(name: str, task: str | TaskFamily | None = None) -> AgentSpec:
     """The spec of agent ``name``; refuses unknown names and, given ``task`` (a name or a family), agents for other tasks."""
-    if name not in AGENTS:
+    if not isinstance(name, str) or name not in AGENTS:  # a list was unhashable's TypeError
         raise NeurohoverError(f"unknown agent {brief(name)}: allowed {', '.join(AGENTS)}")
     spec = AGENTS[name]
     if task is not None:

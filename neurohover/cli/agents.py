@@ -45,12 +45,11 @@ def cmd_compete(args: argparse.Namespace) -> int:
     from ..agents.hybrid import HybridSettings
     from ..agents.model_based import ModelEvolution
     from ..agents.registry import AGENTS, HYBRID_AGENTS, agent_spec
-    from ..compete import agents_with_settings, check_agent_name, check_sizes, compete
+    from ..compete import agents_with_settings, check_sizes, compete
     from ..paths import checked_path, input_dir, output_file
     from ..tasks import Drift
     from .options import check_given, given_settings, sensor_of
 
-    check_agent_name(args.agent)  # its name shortened where long (the registry's message echoes it whole)
     agent_spec(args.agent, args.task)  # an unknown agent, or one for another task, before anything else is read or made
     given = [o.flag for o in args.hybrid_options if getattr(args, o.dest) is not None]
     if given and args.agent not in HYBRID_AGENTS:
