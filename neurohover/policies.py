@@ -263,14 +263,23 @@ def load_policy(source: str | Path) -> Policy:
     return policy_from_dict(parse_json(text, name), name)
 
 
+def check_json_policy_name(path: object, option: str) -> None:
+    """Refuse a ``.net`` name for a JSON policy file: :func:`load_policy` reads ``.net`` as the authors' format, so the
+    file could not be read back (third trial; evolve checks its ``--out`` with this before it evolves)."""
+    if isinstance(path, (str, os.PathLike)) and Path(path).suffix == ".net":
+        raise NeurohoverError(
+            f"{option} {str(path)!r}: a policy is written as JSON, which load_policy would misread under the .net suffix "
+            "(the authors' format); give a .json name, or write the authors' format with netfile.policy_to_net"
+        )
+
+
 def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
     """Write ``policy`` (and extra metadata: strict JSON values under keys of their own) as a JSON policy file; returns the path."""
     from .paths import output_file, writing
 
     if not isinstance(policy, Policy):
         raise NeurohoverError(f"policy={policy!r:.60} is not allowed: give a Policy (load_policy('baseline') for the baseline's)")
-    if isinstance(path, (str, os.PathLike)) and Path(path).suffix == ".net":  # JSON under .net could not be read back (third trial)
-        raise NeurohoverError(f"policy file {str(path)!r}: save_policy writes JSON; give a .json name, or write the authors' format with netfile.policy_to_net")
+    check_json_policy_name(path, "policy file")
     data = policy_to_dict(policy)
     taken = sorted({"topology", "genome"} & set(metadata))  # the policy's metadata may be updated, its network not
     if taken:  # they would overwrite the policy itself and write a file load_policy refuses (second trial)

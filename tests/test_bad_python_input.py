@@ -421,7 +421,7 @@ def test_seeds_past_2_63_and_real_numbers_that_are_not_numbers_are_refused(tmp_p
     env.reset(seed=0)
     with pytest.raises(NeurohoverError, match="give 4 real numbers"):
         env.step([True] * 4)
-    with pytest.raises(NeurohoverError, match="save_policy writes JSON; give a .json name"):
+    with pytest.raises(NeurohoverError, match="written as JSON, which load_policy would misread"):
         nh.save_policy(b, tmp_path / "x.net")
     assert nh.Policy("slp", [0] * 40).genome.dtype == np.float64 and b.act([0] * 12) == b.act(np.zeros(12))  # integers still are numbers
 

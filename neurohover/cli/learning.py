@@ -192,9 +192,10 @@ def cmd_evolve(args: argparse.Namespace) -> int:
 def _evolve_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int:
     from ..evolution.evolve import EvolutionInterrupted, evolve, parse_resampling, validation_return, write_history_csv
     from ..paths import output_file, sole_writer, writing
-    from ..policies import save_policy
+    from ..policies import check_json_policy_name, save_policy
 
     _check_evolve_sizes(args)
+    check_json_policy_name(args.out, "--out")  # before evolving: refused only at the save, the run was lost
     resampling = parse_resampling(args.resampling)
     target, family, mdp_desc = _target(args)
     topology, proto = _seed_policy(args)
