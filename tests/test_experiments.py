@@ -174,6 +174,7 @@ def test_unknown_experiment_lists_the_known_ones(cli, tmp_path: Path) -> None:
         (lambda t: t.replace('name = "slowtest"', 'name = ""'), "name = '' is not allowed"),
         (lambda t: t + '\n[paper]\nnotez = ["x"]\n', "unknown [paper] key(s) notez; allowed: notes"),
         (lambda t: t + '\n[paper]\nttests = [{ a = "k1", b = "k9", p = "0.01" }]\n', "[paper] ttests names 'k9' (b)"),
+        (lambda t: t + "\n[paper]\ntable3 = { k9 = { r = 1.0 } }\n", "[paper] table3 names 'k9', which is no group"),  # was never shown
         # second trial: a string of claims was reported letter by letter, a p-value of "banana" printed as the paper's
         (lambda t: t + '\n[paper]\nclaims = "hello"\n', "[paper] claims = 'hello' is not allowed: give a list of strings"),
         # the settings before the [paper] table: an unknown variant resampling is named, not a t test that names nothing

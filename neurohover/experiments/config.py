@@ -439,7 +439,7 @@ def _check_paper_numbers(table, key: str, required: tuple[str, ...], optional: t
 
 
 def check_paper(paper, raw: dict, where: str) -> None:
-    """Refuse a paper t test that names no group, variant, method or fit at any scale (its shape was checked by
+    """Refuse a paper t test or number table entry that names no group, variant, method or fit at any scale (its shape was checked by
     :func:`make_config`, :func:`check_paper_table`)."""
     tables = [raw.get("settings", {}), *raw.get("scales", {}).values()]
     entries = [e for tab in tables for kind in ("groups", "variants", "fits") for e in tab.get(kind, []) if isinstance(e, dict)]
@@ -448,6 +448,11 @@ def check_paper(paper, raw: dict, where: str) -> None:
         for side in ("a", "b"):
             if t[side] not in names:
                 raise NeurohoverError(f"{where}: [paper] ttests names {t[side]!r} ({side}), which is no group, variant, method or fit of the config")
+    for key in _PAPER_NUMBERS:  # an entry of no name the report looks up was never shown, without a word
+        allowed = names | ({"mlp-baseline"} if key == "table3" else set())  # table3's row for a policy set's specialised MLPs
+        for name in paper.get(key, {}):
+            if name not in allowed:
+                raise NeurohoverError(f"{where}: [paper] {key} names {brief(name)}, which is no group, variant, method or fit of the config")
 
 
 def make_config(
