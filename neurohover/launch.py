@@ -25,7 +25,7 @@ import numpy as np
 
 from .errors import NeurohoverError, brief, whole_number
 from .sim.constants import MAX_EPISODE_STEPS, MDP_ROW_LEN, ROW_SUBSTEPS, ROW_WIND_KIND, SAFEGUARD_LIMITS
-from .sim.jobs import Extras, Flown, Jobs, Parking
+from .sim.jobs import PARK_F, PARK_U, Extras, Flown, Jobs, Parking
 from .sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
 from .sim.lanes import LANES, rollout_lanes, rollout_lanes_parked
 from .sim.rng import MAX_SEED
@@ -77,6 +77,41 @@ def check_job_indices(index: np.ndarray, low: int, upper: int | None, what: str)
         raise NeurohoverError(f"{what} holds negative values (min {lowest}); allowed >= 0")
     if lowest < low or (upper is not None and highest >= upper):
         raise NeurohoverError(f"{what} holds {lowest if lowest < low else highest}, out of range: allowed {low}..{'' if upper is None else upper - 1}")
+
+
+def _check_out(out: object, n_jobs: int) -> None:
+    """Refuse an ``out`` the kernel cannot write one entry per job into: an array shorter than the batch was written
+    past its end, corrupting memory (the process aborted; fourteenth session, beside the thirteenth trial's F1)."""
+    if not isinstance(out, Flown):
+        raise NeurohoverError(f"out={brief(out)} is not allowed: give a Flown of four 1-d arrays, one entry per job (Flown.empty(n_jobs))")
+    for name, dtype in (("returns", np.float64), ("crashed", np.bool_), ("steps", np.int64), ("safeguard_step", np.int64)):
+        a = getattr(out, name)
+        if not isinstance(a, np.ndarray) or a.ndim != 1 or a.dtype != dtype or a.shape[0] < n_jobs or not a.flags.writeable:
+            shown = f"a {'' if a.flags.writeable else 'read-only '}{a.ndim}-d {a.dtype} array of shape {a.shape}" if isinstance(a, np.ndarray) else brief(a)
+            raise NeurohoverError(
+                f"Flown.{name}={shown} is not allowed: give a writeable 1-d {np.dtype(dtype)} array of at least {n_jobs} entries (one per job)"
+            )
+
+
+def _check_parking(slots: object, n_required: object, parking: object, n_jobs: int) -> None:
+    """Refuse parking arguments the lanes would index past: a slot outside ``parking`` or a wrong-sized state was read and
+    written out of bounds (issue 37's last note left these unchecked)."""
+    if not isinstance(parking, Parking):
+        raise NeurohoverError(f"parking={brief(parking)} is not allowed: give a Parking (Parking.empty(n_slots))")
+    n_slots = parking.steps.shape[0] if isinstance(parking.steps, np.ndarray) else -1
+    for name, a, shape, dtype in (
+        ("floats", parking.floats, (n_slots, PARK_F), np.float64),
+        ("streams", parking.streams, (n_slots, PARK_U), np.uint64),
+        ("steps", parking.steps, (n_slots,), np.int64),
+    ):
+        if not isinstance(a, np.ndarray) or a.shape != shape or a.dtype != dtype or not a.flags.writeable:
+            shown = f"a {a.dtype} array of shape {a.shape}" if isinstance(a, np.ndarray) else brief(a)
+            raise NeurohoverError(f"Parking.{name}={shown} is not allowed: give a writeable {np.dtype(dtype)} array of shape {shape} (Parking.empty)")
+    if not isinstance(slots, np.ndarray) or slots.dtype != np.int64 or slots.shape != (n_jobs,):
+        raise NeurohoverError(f"slots={brief(slots)} is not allowed: give a 1-d int64 numpy array, one parking slot per job ({n_jobs})")
+    check_job_indices(slots, 0, n_slots, "slots")
+    if not whole_number(n_required) or not 0 <= n_required <= n_jobs:
+        raise NeurohoverError(f"n_required={brief(n_required)} is out of range: allowed an integer in 0..{n_jobs} (the batch's jobs)")
 
 
 #: Each array of a :class:`Batch`: its dimensions, dtype and column count (None: any).
@@ -164,7 +199,13 @@ class Batch:
         check_job_indices(self.episode_index, 0, None, "episode_index")
         if self.safeguard and self.fallback is not None:  # without the safeguard the kernel never reads it
             check_job_indices(self.fallback, -1, kinds.shape[0], "fallback")
+            if self.limits.shape != SAFEGUARD_LIMITS.shape:  # a shorter one was read past its end
+                raise NeurohoverError(
+                    f"Batch.limits of shape {self.limits.shape} is not allowed: give {SAFEGUARD_LIMITS.shape[0]} limits (sim.constants.SAFEGUARD_LIMITS)"
+                )
         if self.recording and self.slots is not None and self.obs_out is not None and self.act_out is not None:
+            _check_array("Batch.obs_out", self.obs_out, 3, np.float64, None)  # another dtype was numba's TypingError
+            _check_array("Batch.act_out", self.act_out, 3, np.float64, None)
             n_rec = min(self.obs_out.shape[0], self.act_out.shape[0])
             check_job_indices(self.slots, -1, n_rec, "slots")
             if self.obs_out.shape[1:] != (self.n_steps + 1, 12) or self.act_out.shape[1:] != (self.n_steps, 4):
@@ -298,6 +339,8 @@ def launch_parked(batch: Batch, out: Flown, slots: np.ndarray, n_required: int, 
     ``out.steps[j]`` is 0 for an optional job not over. CPU only, with rows alike in substeps and
     wind and no safeguard or recording (:func:`use_lanes`; the caller checks).
     """
+    _check_out(out, batch.n_jobs)
+    _check_parking(slots, n_required, parking, batch.n_jobs)
     load_parked()
     t0 = time.perf_counter()
     _fly_parked(batch, out, slots, n_required, parking)
@@ -322,6 +365,7 @@ def launch(batch: Batch, out: Flown, device: str = "cpu") -> float:
     lanes (:func:`use_lanes`), the rest in the scalar kernel, or on the GPU with ``device="cuda"``.
     The compiled code is loaded (compiled or read from the cache) before the clock starts.
     """
+    _check_out(out, batch.n_jobs)
     if not batch.safeguard and not batch.recording and use_lanes(device, batch.rows, batch.mdp_index):
         load_lanes()
         t0 = time.perf_counter()
