@@ -23,6 +23,8 @@ node ids    MLP                                                    SLP
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from .errors import NeurohoverError
@@ -49,8 +51,23 @@ def _role(topology: str, name: str) -> tuple[int, int]:
     return position, function
 
 
+#: A number as the authors' files write one: ASCII digits, a sign, a point and an exponent; 'nan' and 'inf' match so that they are
+#: named as not finite. float() and int() also read '1_0' as 10 and other scripts' digits (thirteenth trial F2; fourteenth T14-20).
+_NUMBER = re.compile(r"[+-]?(?:(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|inf|infinity|nan)", re.IGNORECASE)
+_INTEGER = re.compile(r"[+-]?[0-9]+")
+
+
+def _integer(text: str, what: str) -> int:
+    """A node id, position or function: an integer in plain ASCII digits."""
+    if not _INTEGER.fullmatch(text):
+        raise ValueError(f"{what} {text!r} is not allowed: give an integer in ASCII digits (no '_')")
+    return int(text)
+
+
 def _finite(text: str, what: str) -> float:
     """A bias or weight: a finite number (a NaN was refused later by Policy, without the file and line)."""
+    if not _NUMBER.fullmatch(text):
+        raise ValueError(f"{what} {text!r} is not allowed: give a decimal number in ASCII digits (like +0.0367 or -1.5e-3; no '_')")
     value = float(text)
     if not np.isfinite(value):
         raise ValueError(f"{what} {text} is not a finite number")
@@ -73,12 +90,12 @@ def _parse_lines(text: str, source: str):
             if not line.isascii():  # int() and float() read other scripts' digits: '٣' was weight 3 (thirteenth trial, F2)
                 raise ValueError("characters other than ASCII are not allowed: give numbers in ASCII digits")
             if fields[0] == "n" and len(fields) == 5:
-                node = int(fields[1])
+                node = _integer(fields[1], "node id")
                 if node in nodes:  # a second definition would silently replace the first
                     raise ValueError(f"node {node} is defined again (first on line {nodes[node][3]})")
-                nodes[node] = (int(fields[2]), int(fields[3]), _finite(fields[4], "bias"), number, line.strip())
+                nodes[node] = (_integer(fields[2], "position"), _integer(fields[3], "function"), _finite(fields[4], "bias"), number, line.strip())
             elif fields[0] == "s" and len(fields) == 4:
-                link = (int(fields[1]), int(fields[2]))
+                link = (_integer(fields[1], "source node"), _integer(fields[2], "destination node"))
                 if link in links:
                     raise ValueError(f"link {link[0]} -> {link[1]} is given again (first on line {links[link][1]})")
                 links[link] = (_finite(fields[3], "weight"), number, line.strip())

@@ -32,7 +32,7 @@ WATCH_SECONDS = 0.5  # how often a worker checks that its parent is alive
 _PR_SET_PDEATHSIG = 1  # from <linux/prctl.h>
 
 
-__all__ = ["Terminated", "interrupts_survive_callbacks", "sigterm_as_interrupt", "stop_pool", "stop_words", "watch_parent", "worker_pool"]
+__all__ = ["Terminated", "interrupts_survive_callbacks", "max_jobs", "sigterm_as_interrupt", "stop_pool", "stop_words", "watch_parent", "worker_pool"]
 
 
 def _die_with_parent() -> bool:
@@ -75,13 +75,20 @@ def watch_parent(parent: int, pdeathsig: bool = True) -> None:
     threading.Thread(target=_watch, args=(parent,), name="neurohover-parent-watch", daemon=True).start()
 
 
+def max_jobs() -> int:
+    """The most worker processes a pool may have: this machine's cores (``reproduce --jobs`` is bounded alike)."""
+    return os.cpu_count() or 1
+
+
 def worker_pool(jobs: int) -> ProcessPoolExecutor:
-    """A pool of ``jobs`` spawned worker processes that exit when this process dies.
+    """A pool of ``jobs`` (1 to :func:`max_jobs`) spawned worker processes that exit when this process dies.
 
     Spawned, not forked: numba's thread pools are not fork-safe.
     """
     if not whole_number(jobs) or jobs < 1:  # 0 was concurrent.futures' error, '2' a TypeError (thirteenth trial, F16)
         raise NeurohoverError(f"jobs={brief(jobs)} is not allowed: give a whole number of worker processes >= 1")
+    if jobs > max_jobs():  # 10**6 was taken, each worker started as work arrived (fourteenth trial T14-21)
+        raise NeurohoverError(f"jobs={brief(jobs)} is not allowed: give at most {max_jobs()} worker processes (the cores of this machine)")
     jobs = int(jobs)
     main = threading.current_thread() is threading.main_thread()
     return ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("spawn"), initializer=watch_parent, initargs=(os.getpid(), main))

@@ -35,7 +35,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, finite_real, whole_number
+from ..paths import strict_json
 from ..sim.constants import CONTROL_DT, DEFAULT_NOISE_STD, DEFAULT_PARAMS, NOISE_NAMES, PARAM_NAMES, SUBSTEP_DT, SUBSTEPS
 from ..tasks import MDP, finite_vector
 from .wind import NO_WIND, WindModel
@@ -52,6 +53,7 @@ __all__ = [
     "LearnedModel",
     "default_model_substeps",
     "ParamRow",
+    "check_stats",
     "check_vector",
     "equivalent_params",
     "format_parameter_table",
@@ -107,14 +109,35 @@ def check_vector(values, length: int, what: str, nonnegative: bool = False) -> t
     -------
     tuple of float
     """
-    try:
-        flat = np.asarray(values, dtype=float).reshape(-1)
+    if not whole_number(length) or length < 1:  # '2' was "x must be 2 numbers, got 2" (fourteenth trial T14-13)
+        raise NeurohoverError(f"length={brief(length)} is not allowed: give a whole number >= 1 (how many numbers {what} holds)")
+    try:  # as objects: a float conversion read '1' as 1.0 and True as 1.0, and 10**400 was an OverflowError (T14-13)
+        flat = np.asarray(values, dtype=object).reshape(-1)
     except (TypeError, ValueError):
-        raise NeurohoverError(f"{what} must be {length} numbers, got {values!r:.80}") from None
-    arr = finite_vector(flat, length, what)  # the one finite-vector check (neurohover.tasks)
+        raise NeurohoverError(f"{what} must be {length} numbers, got {brief(values)}") from None
+    if flat.size != length:  # here, so the message shows the values shortened
+        raise NeurohoverError(f"{what} must be {length} numbers, got {flat.size}: {brief(values)}")
+    arr = finite_vector(flat.tolist(), length, what)  # the one finite-vector check (neurohover.tasks): text, bools, 10**400
     if nonnegative and np.any(arr < 0):
         raise NeurohoverError(f"{what} must be >= 0, got {arr.tolist()}")
     return tuple(float(x) for x in arr)
+
+
+def check_stats(stats: dict) -> None:
+    """Refuse a model's ``stats`` unless :meth:`LearnedModel.save` can write them and :meth:`LearnedModel.load` read them
+    back: strict JSON values, numbers finite (an object() or a NaN was json's TypeError or ValueError at the save;
+    fourteenth trial T14-12), as ``save_policy`` and ``FlightData.save`` refuse their metadata."""
+    try:
+        strict_json(json.dumps(stats, allow_nan=False))  # the round trip: load() reads what its parser takes
+    except (TypeError, ValueError, RecursionError) as err:  # RecursionError: nesting too deep to write
+        subject = "model stats"
+        for key, value in stats.items():  # name the first entry at fault (json's message names no key, and no NaN)
+            try:
+                strict_json(json.dumps({key: value}, allow_nan=False))
+            except (TypeError, ValueError, RecursionError):
+                subject = f"model stats entry {brief(key)} = {brief(value)}"
+                break
+        raise NeurohoverError(f"{subject} is not allowed: give strict JSON values, numbers finite ({err})") from None
 
 
 @dataclass(frozen=True)
@@ -155,12 +178,13 @@ class LearnedModel:
         object.__setattr__(self, "noise_std", check_vector(self.noise_std, 6, "model noise std (u, v, w, p, q, r)", nonnegative=True))
         if self.method not in MODEL_METHODS:
             raise NeurohoverError(f"unknown model-learning method {self.method!r}: allowed {', '.join(MODEL_METHODS)}")
-        if not isinstance(self.seconds, (int, float)) or not math.isfinite(self.seconds) or self.seconds < 0:
-            raise NeurohoverError(f"seconds={self.seconds!r} must be a finite number >= 0")
+        if not finite_real(self.seconds) or self.seconds < 0:
+            raise NeurohoverError(f"seconds={brief(self.seconds)} must be a finite number >= 0")
         if not isinstance(self.stats, dict):
             raise NeurohoverError("stats must be a dict")
-        if not isinstance(self.d_u, (int, float)) or not math.isfinite(self.d_u):
-            raise NeurohoverError(f"d_u={self.d_u!r} must be a finite number")
+        check_stats(self.stats)
+        if not finite_real(self.d_u):
+            raise NeurohoverError(f"d_u={brief(self.d_u)} must be a finite number")
         if not isinstance(self.wind, WindModel):
             raise NeurohoverError(f"wind must be a WindModel, got {self.wind!r:.80}")
 
@@ -279,6 +303,14 @@ def _axes_without_equivalent(params: np.ndarray) -> list[str]:
     return [NOISE_NAMES[axis] for axis, ci in enumerate(AXIS_C) if not np.isfinite(params[ci])]
 
 
+def _check_integration(substeps: object, dt: object) -> None:
+    """Refuse ``substeps`` x ``dt`` unless a whole number >= 1 of finite steps > 0 covering a control step ('0.01' was a TypeError)."""
+    if not whole_number(substeps) or substeps < 1 or not finite_real(dt) or dt <= 0 or abs(substeps * dt - MODEL_DT) > 1e-9:  # type: ignore[operator]
+        raise NeurohoverError(
+            f"substeps={brief(substeps)} x dt={brief(dt)} is not allowed: give a whole number of substeps >= 1 and a finite step > 0 (s) covering {MODEL_DT} s"
+        )
+
+
 def equivalent_params(params, noise_std=None, substeps: int = SUBSTEPS, dt: float = SUBSTEP_DT) -> tuple[np.ndarray, np.ndarray]:
     """Convert one-substep model parameters to ``substeps`` Euler substeps of ``dt`` (same 0.1 s).
 
@@ -289,9 +321,8 @@ def equivalent_params(params, noise_std=None, substeps: int = SUBSTEPS, dt: floa
     and come back as NaN.
     """
     p = np.array(check_vector(params, 11, "model parameters"))
-    n = np.array(DEFAULT_NOISE_STD if noise_std is None else check_vector(noise_std, 6, "noise std"), dtype=float)
-    if not isinstance(substeps, (int, np.integer)) or substeps < 1 or not dt > 0 or abs(substeps * dt - MODEL_DT) > 1e-9:
-        raise NeurohoverError(f"substeps={substeps!r} x dt={dt!r} must be a positive integer and a positive step covering {MODEL_DT} s")
+    n = np.array(DEFAULT_NOISE_STD if noise_std is None else check_vector(noise_std, 6, "noise std", nonnegative=True), dtype=float)
+    _check_integration(substeps, dt)
     out_p, out_n = p.copy(), n.copy()
     if substeps == 1:
         return out_p, out_n
@@ -318,9 +349,8 @@ def one_substep_params(params=None, noise_std=None, substeps: int = SUBSTEPS, dt
     ``C_model = ((1 + dt C)^substeps - 1) / 0.1`` and gains, D_v and noise scaled by ``C_model / C``.
     Useful as an informed prototype for the EC methods."""
     p = np.array(DEFAULT_PARAMS if params is None else check_vector(params, 11, "parameters"))
-    n = np.array(DEFAULT_NOISE_STD if noise_std is None else check_vector(noise_std, 6, "noise std"), dtype=float)
-    if not isinstance(substeps, (int, np.integer)) or substeps < 1 or not dt > 0 or abs(substeps * dt - MODEL_DT) > 1e-9:
-        raise NeurohoverError(f"substeps={substeps!r} x dt={dt!r} must be a positive integer and a positive step covering {MODEL_DT} s")
+    n = np.array(DEFAULT_NOISE_STD if noise_std is None else check_vector(noise_std, 6, "noise std", nonnegative=True), dtype=float)
+    _check_integration(substeps, dt)
     out_p, out_n = p.copy(), n.copy()
     for axis, (ci, gains) in enumerate(zip(AXIS_C, AXIS_GAINS)):
         c = p[ci]

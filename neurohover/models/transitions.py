@@ -179,6 +179,22 @@ class Transitions:
         return (series[..., 1:, :] - NOISE_DECAY * series[..., :-1, :])[..., self.pair, :]
 
 
+def _checked_residuals(tr: object, residuals: object, batched: bool) -> np.ndarray:
+    """``residuals`` as a float array (N, 6), or (..., N, 6) where ``batched``, N being ``tr``'s transitions; else one
+    NeurohoverError (None was an AttributeError, 3 numbers an IndexError or einsum's ValueError; fourteenth trial T14-13)."""
+    if not isinstance(tr, Transitions):
+        raise NeurohoverError(f"tr={brief(tr)} is not allowed: give the Transitions the residuals belong to")
+    try:
+        arr = np.asarray(residuals)
+    except ValueError:  # ragged rows
+        arr = np.asarray(None)
+    shape = "(..., N, 6)" if batched else "(N, 6)"
+    if arr.dtype.kind not in "iuf" or arr.ndim < 2 or (arr.ndim > 2 and not batched) or arr.shape[-2:] != (tr.n, 6):
+        given = f" of shape {arr.shape} and dtype {arr.dtype}" if isinstance(residuals, np.ndarray) else f"={brief(residuals)}"
+        raise NeurohoverError(f"residuals{given} is not allowed: give a real array {shape} with N = {tr.n}, the transitions of tr")
+    return arr.astype(float, copy=False)
+
+
 def noise_from_residuals(tr: Transitions, residuals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Gust-noise standard deviations of a model from its one-step residuals.
 
@@ -195,6 +211,7 @@ def noise_from_residuals(tr: Transitions, residuals: np.ndarray) -> tuple[np.nda
         (..., 6): the innovation estimate ``rms(r_k - 0.8 r_{k-1}) / 0.4`` (the model's noise) and
         the stationary-rms estimate ``rms(r) * 0.6 / 0.4`` (reported in ``stats``).
     """
+    residuals = _checked_residuals(tr, residuals, batched=True)
     innov = tr.innovations(residuals)
     std = np.sqrt(np.mean(innov**2, axis=-2)) / NOISE_GAIN
     stationary = np.sqrt(np.mean(residuals**2, axis=-2)) * math.sqrt(1.0 - NOISE_DECAY**2) / NOISE_GAIN
@@ -210,6 +227,7 @@ def authors_noise(tr: Transitions, residuals: np.ndarray) -> np.ndarray:
     residual that is pure AR(1) gust noise of std s has rms ``0.4 s / 0.6``, so this reads 4/3 s,
     and any misfit the model leaves (a discarded D_u, a wind) counts in full.
     """
+    residuals = _checked_residuals(tr, residuals, batched=False)
     world = np.empty_like(residuals)
     world[:, 0:3] = np.einsum("nij,nj->ni", tr.R, residuals[:, 0:3])
     world[:, 3:6] = residuals[:, 3:6]

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError, finite_real
+from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..sim.constants import CONTROL_DT, SUBSTEP_DT, SUBSTEPS, WIND_CONSTANT, WIND_NONE, WIND_SINUSOID
 
 __all__ = ["DEFAULT_WIND_MODEL", "NO_WIND", "WIND_MODELS", "WindAxis", "WindModel", "body_wind", "effective_wind", "fit_wind", "model_times", "sinusoid_axes"]
@@ -152,6 +152,8 @@ def effective_wind(axis: WindAxis) -> WindAxis:
     """The wind a one-substep model sampled at 10 Hz sees of the simulator's ``axis`` (module
     docstring, Aliasing): the step average over the ten substeps, then the frequency folded into
     [0, 10 pi] rad/s."""
+    if not isinstance(axis, WindAxis):  # None was an AttributeError (fourteenth trial T14-13)
+        raise NeurohoverError(f"axis={brief(axis)} is not allowed: give a WindAxis (a WindModel's x or y)")
     w = axis.omega
     if w == 0.0 or axis.amplitude == 0.0:
         return WindAxis(offset=axis.offset + (axis.amplitude * math.sin(axis.phase) if w == 0.0 else 0.0))
@@ -252,8 +254,17 @@ def fit_wind(tr, kind: str, c_u: float, c_v: float, d_v: float, *, fit_drags: bo
     stats : dict
         Rounds of alternating least squares run, and the rms of the u and v residual accelerations.
     """
+    from .transitions import Transitions  # here: transitions imports this module
+
+    if not isinstance(tr, Transitions):  # None was an AttributeError (fourteenth trial T14-13)
+        raise NeurohoverError(f"tr={brief(tr)} is not allowed: give the flight data as Transitions (neurohover.models.Transitions)")
     if kind not in ("constant", "sinusoid"):
-        raise NeurohoverError(f"wind model {kind!r} cannot be fitted: choose constant or sinusoid")
+        raise NeurohoverError(f"wind model {brief(kind)} cannot be fitted: choose constant or sinusoid")
+    for name, value in (("c_u", c_u), ("c_v", c_v), ("d_v", d_v)):
+        if not finite_real(value):
+            raise NeurohoverError(f"{name}={brief(value)} is not allowed: give a finite number")
+    if not whole_number(iterations) or iterations < 1:
+        raise NeurohoverError(f"iterations={brief(iterations)} is not allowed: give a whole number >= 1 (rounds of alternating least squares)")
     y = tr.targets()
     yu, yv = y[:, 0], y[:, 1] - d_v
     u, v = tr.obs[:, 0], tr.obs[:, 1]

@@ -110,7 +110,7 @@ class ReferenceMDP:
         """Refuse what the simulator cannot fly: 3 params were an unpack ValueError mid-episode, substeps=0 flew no
         physics and returned 0.0 (thirteenth trial, F6, F7)."""
         _reals(self.params, 11, "params")
-        _reals(self.noise_std, 6, "noise_std")
+        _reals(self.noise_std, 6, "noise_std", nonnegative=True)  # standard deviations, as the MDP's (fourteenth trial T14-21)
         _reals(self.wind, 8, "wind")
         _reals(self.sensor, 7, "sensor")
         if self.wind_kind not in (0, WIND_CONSTANT, WIND_SINUSOID) or isinstance(self.wind_kind, bool):
@@ -258,14 +258,16 @@ def fly_episode(
     return total, False, observations
 
 
-def _reals(values: object, n: int, what: str) -> tuple[float, ...]:
-    """``values`` as ``n`` real numbers (not bools; NaN and inf allowed, as the simulator defines them), or a NeurohoverError naming ``what``."""
+def _reals(values: object, n: int, what: str, nonnegative: bool = False) -> tuple[float, ...]:
+    """``values`` as ``n`` finite real numbers (not bools; >= 0 where ``nonnegative``), or a NeurohoverError naming ``what``:
+    a NaN flew a NaN return called "not crashed", a negative std flew (fourteenth trial T14-21)."""
     try:
         items: tuple = tuple(values)  # type: ignore[arg-type]
     except TypeError:
         items = ()
-    if len(items) != n or not all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in items):
-        raise NeurohoverError(f"{what}={brief(values)} is not allowed: give {n} real numbers")
+    if len(items) != n or not all(finite_real(v) and not (nonnegative and v < 0) for v in items):
+        allowed = "finite and >= 0" if nonnegative else "finite"
+        raise NeurohoverError(f"{what}={brief(values)} is not allowed: give {n} real numbers, all {allowed}")
     return tuple(float(v) for v in items)
 
 
@@ -282,12 +284,16 @@ def _check_episode(mdp: object, policy: object, normals: object, n_steps: object
     for name, given, rows, widths in (("normals", normals, int(n_steps), (6,)), ("sensor_normals", sensor_normals, int(n_steps) + 1, (width, 13))):
         if name == "sensor_normals" and given is None:
             continue
+        want = f"give at least {rows} rows of {widths[0]} numbers (neurohover.sim.rng)"
         try:
-            shape = np.asarray(given, dtype=float).shape
-        except (TypeError, ValueError):  # ragged rows, text
-            shape = ()
-        if len(shape) != 2 or shape[0] < rows or shape[1] not in widths:
-            raise NeurohoverError(f"{name} of shape {shape} is not allowed: give at least {rows} rows of {widths[0]} numbers (neurohover.sim.rng)")
+            arr = np.asarray(given, dtype=float)
+        except (TypeError, ValueError, OverflowError):  # ragged rows, text, 10**400 (an OverflowError)
+            raise NeurohoverError(f"{name}={brief(given)} is not allowed: {want}") from None
+        if arr.ndim != 2 or arr.shape[0] < rows or arr.shape[1] not in widths:
+            raise NeurohoverError(f"{name} of shape {arr.shape} is not allowed: {want}")
+        if not np.isfinite(arr[:rows]).all():  # a NaN gust flew a NaN return called "not crashed" (fourteenth trial T14-21)
+            row, col = (int(i) for i in np.argwhere(~np.isfinite(arr[:rows]))[0])
+            raise NeurohoverError(f"{name}[{row}][{col}] = {arr[row, col]} is not allowed: give finite standard normals (neurohover.sim.rng)")
 
 
 def _action(policy: Callable[[list[float]], Sequence[float]], observation: list[float], k: int) -> Sequence[float]:
