@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError, finite_real
+from .errors import NeurohoverError, brief, finite_real
 from .paths import strict_json
 from .sim.constants import MAX_EPISODE_STEPS
 
@@ -202,7 +202,7 @@ class FlightData:
             raise NeurohoverError(
                 f"{str(path)!r} is not a readable flight-data file: episode {int(np.argmin(lengths))} has 0 steps (a flown one has at least 1)"
             )
-        _check_metadata(path, metadata, lengths)
+        check_metadata(metadata, lengths, f"flight-data file {str(path)!r}")
         if lengths.size == 0 or lengths.sum() == 0:
             raise NeurohoverError(f"flight-data file {str(path)!r} holds no transitions")
         if obs.shape != (int(lengths.sum() + lengths.size), 12) or act.shape != (int(lengths.sum()), 4):
@@ -224,31 +224,42 @@ _PER_EPISODE = {
 }
 
 
-def _check_metadata(path: Path, metadata: dict, lengths: np.ndarray) -> None:
+def check_metadata(metadata: object, lengths: np.ndarray, where: str) -> None:
     """Refuse the metadata fields plots and crash marks read when they are of the wrong kind, by name (an episode_steps
-    "a" was a ValueError in plot; seventh trial), and metadata the episodes contradict (ninth trial)."""
+    "a" was a ValueError in plot; seventh trial), and metadata the episodes contradict (ninth trial).
+
+    Parameters
+    ----------
+    metadata : dict
+        The flight data's metadata (anything else is refused).
+    lengths : (episodes,) int array
+        The steps of each episode.
+    where : str
+        What the messages name: ``"flight-data file 'f.npz'"`` (:meth:`FlightData.load`) or ``"flight data"`` (flight data
+        built in Python, checked before a plot: fourteenth trial).
+    """
+    if not isinstance(metadata, dict):
+        raise NeurohoverError(f"{where}: its metadata {brief(metadata)} is not allowed: give a dict (a JSON object)")
     n_episodes = lengths.size
     steps = metadata.get("episode_steps")
     if steps is not None and (type(steps) is not int or not 1 <= steps <= MAX_EPISODE_STEPS):
         allowed = f"an integer in 1..{MAX_EPISODE_STEPS:,}"
-        raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata episode_steps={steps!r:.40} is not allowed: {allowed}")
+        raise NeurohoverError(f"{where}: its metadata episode_steps={steps!r:.40} is not allowed: {allowed}")
     if steps is not None and n_episodes and int(lengths.max()) > steps:  # an episode of 12,000 steps spanned a reset (ninth trial)
         longest = int(np.argmax(lengths))
         raise NeurohoverError(
-            f"flight-data file {str(path)!r}: episode {longest} has {int(lengths[longest]):,} steps, more than its metadata's "
+            f"{where}: episode {longest} has {int(lengths[longest]):,} steps, more than its metadata's "
             f"episode_steps={steps:,} (every episode ends at that budget): its lengths and metadata contradict"
         )
     for name in ("task", "policy"):  # shown in titles and notes (a task 5 or a policy 123 was taken; eighth trial)
         if metadata.get(name) is not None and not isinstance(metadata[name], str):
-            raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata {name}={metadata[name]!r:.40} is not allowed: give text")
+            raise NeurohoverError(f"{where}: its metadata {name}={metadata[name]!r:.40} is not allowed: give text")
     for name, (fits, each) in _PER_EPISODE.items():  # lists of one entry per episode (returns "x" was taken; eighth trial)
         value = metadata.get(name)
         if value is not None and (not isinstance(value, list) or len(value) != n_episodes or not all(fits(v) for v in value)):
-            raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata {name}={value!r:.40} is not allowed: {each} per episode ({n_episodes})")
+            raise NeurohoverError(f"{where}: its metadata {name}={value!r:.40} is not allowed: {each} per episode ({n_episodes})")
     task, mdps = metadata.get("task"), metadata.get("mdps") or []
     families = [(i, m.get("family")) for i, m in enumerate(mdps) if isinstance(m.get("family"), str)]
     for i, family in families:  # a task 'ghh09' over ghh08's MDPs was plotted under the wrong name (ninth trial)
         if task is not None and family != task:
-            raise NeurohoverError(
-                f"flight-data file {str(path)!r}: its metadata task {task!r:.40} is not its MDPs' family: episode {i} flew a {family!r:.40} MDP"
-            )
+            raise NeurohoverError(f"{where}: its metadata task {task!r:.40} is not its MDPs' family: episode {i} flew a {family!r:.40} MDP")

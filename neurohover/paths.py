@@ -40,6 +40,7 @@ __all__ = [
     "output_dir",
     "output_file",
     "printable",
+    "refuse_special_file",
     "remove_created_dirs",
     "sole_writer",
     "write_png",
@@ -193,8 +194,7 @@ def output_file(
         raise NeurohoverError(f"{option} {str(path)!r} is a directory; give a file path")
     if os.fspath(path).endswith(("/", os.sep)):  # Path() drops the slash: 'x.json/' was written as the file x.json (seventh trial)
         raise NeurohoverError(f"{option} {str(path)!r} ends in '/', which names a directory: give a file path")
-    if p.exists() and not p.is_file():  # written by replacing it, a device node (/dev/full) would become a file
-        raise NeurohoverError(f"{option} {str(path)!r} is not a regular file (a device, pipe or socket); give a file path")
+    refuse_special_file(p, option, path)
     real = Path(os.path.realpath(p))
     if p.is_symlink() and not real.parent.is_dir():  # was "cannot create a file in '.'", a directory that exists (ninth trial)
         raise NeurohoverError(
@@ -214,16 +214,27 @@ def output_file(
     return p
 
 
+def refuse_special_file(path: str | os.PathLike, option: str, given: str | os.PathLike | None = None) -> None:
+    """Refuse an existing ``path`` that is neither a regular file nor a directory: written by replacing it, a device node
+    (/dev/full, as root) or a FIFO became a PNG (fourteenth trial). ``given``: the path as the user gave it (default ``path``)."""
+    p = Path(path)
+    if p.exists() and not p.is_file() and not p.is_dir():
+        raise NeurohoverError(f"{option} {str(path if given is None else given)!r} is not a regular file (a device, pipe or socket); give a file path")
+
+
 @contextmanager
 def writing(path: str | os.PathLike, option: str) -> Iterator[Path]:
     """Write the output file ``path`` inside this block, through the path it yields (a temporary file beside it, moved
     onto ``path`` once the block ends): a failed write (disk full, read-only, permission) becomes one NeurohoverError
     naming ``option`` and the file, and an interrupted one (Ctrl-C, SIGTERM) stops as it was; either way the temporary
-    file is removed and ``path`` is as it was before, so that no later run takes a partial file for a result."""
+    file is removed and ``path`` is as it was before, so that no later run takes a partial file for a result. A device,
+    pipe or socket at ``path`` is refused (:func:`refuse_special_file`), before the block and again before the move."""
     p = Path(os.path.realpath(path))  # through a symbolic link: its file is written, the link kept (not replaced by a file)
+    refuse_special_file(p, option, path)  # every writer, not only those checked by output_file first (fourteenth trial)
     partial = p.with_name(f".{p.name}.{os.getpid()}.partial")
     try:
         yield partial
+        refuse_special_file(p, option, path)  # made while the block ran
         os.replace(partial, p)
     except OSError as err:
         raise OutputError(f"{option} {str(path)!r}: cannot write it ({_why(err)}); no partial file is left") from None
@@ -316,9 +327,16 @@ def created_dirs_removed_on_failure() -> Iterator[None]:
 
 
 def printable(text: str | os.PathLike) -> str:
-    """``text`` (a path) with bytes that are no UTF-8 (kept by Python as surrogates) written as escapes, the way
-    messages show them: such a name in a report or a plot title was a UnicodeEncodeError or matplotlib's TypeError."""
-    return os.fspath(text).encode("utf-8", "backslashreplace").decode("utf-8")
+    """``text`` (a path) with every character that does not print as itself written as an escape, the way messages
+    (``repr``) show it: bytes that are no UTF-8 (kept by Python as surrogates; a UnicodeEncodeError in a report, matplotlib's
+    TypeError in a plot title), control characters (a newline split a result line; fourteenth trial) and format characters
+    such as U+202E, RIGHT-TO-LEFT OVERRIDE (which showed the rest of the line reversed)."""
+    text = os.fspath(text)
+    if not isinstance(text, str):
+        raise NeurohoverError(f"{text!r:.60} is not allowed: give a name as text")
+    if text.isprintable():  # the common case, at C speed
+        return text
+    return "".join(ch if ch.isprintable() else repr(ch)[1:-1] for ch in text)
 
 
 def forget_created_dirs() -> None:

@@ -34,9 +34,9 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
-from .errors import NeurohoverError
-from .flightdata import FlightData
-from .paths import checked_path, input_dir, printable, strict_json
+from .errors import NeurohoverError, brief, whole_number
+from .flightdata import FlightData, check_metadata
+from .paths import input_dir, output_dir, output_file, printable, strict_json
 from .sim.constants import ACTION_NAMES, CONTROL_DT, CRASH_STEP_PENALTY, EPISODE_STEPS, MAX_EPISODE_STEPS
 
 __all__ = [
@@ -69,10 +69,43 @@ def new_figure(width: float, height: float, dpi: int = 100) -> Figure:
 
 
 def save_figure(fig: Figure, path: str | Path) -> Path:
-    """Write ``fig`` as a PNG to ``path`` (parent directories must exist)."""
+    """Write ``fig`` as a PNG to ``path``, checked as every output file is (:func:`~neurohover.paths.output_file`:
+    not a directory, device, pipe or socket; missing parent directories are created, saying so)."""
     from .paths import write_png
 
+    if not isinstance(fig, Figure):  # None was an AttributeError mid-write
+        raise NeurohoverError(f"fig={brief(fig)} is not allowed: give a matplotlib Figure (e.g. from flight_figure or compete_figure)")
+    path = output_file(path, "plot file")  # a FIFO or /dev/full was replaced by the PNG (fourteenth trial, T14-1)
     return write_png(fig, path, "plot file")
+
+
+def _title(title: object) -> str:
+    """A figure's ``title`` as shown: text, its unprintable characters escaped (:func:`~neurohover.paths.printable`)."""
+    if not isinstance(title, str):  # None or b"x" was a TypeError or AttributeError (fourteenth trial, T14-11)
+        raise NeurohoverError(f"title={brief(title)} is not allowed: give text ('' for none)")
+    return printable(title)
+
+
+def _real_array(values: object, name: str, columns: int, shape: str) -> np.ndarray:
+    """``values`` as a 2-D float64 array of ``columns`` columns, or one message naming ``name`` and the ``shape`` expected."""
+    try:
+        array = np.asarray(values)
+    except (ValueError, TypeError):  # ragged nested lists
+        array = np.asarray(None)
+    if array.dtype.kind not in "fiu" or array.ndim != 2 or array.shape[1] != columns:  # 'abc', None or (3, 5) were NumPy's errors
+        if array.dtype.kind in "fiu":
+            got = f" of shape {array.shape}"
+        else:
+            got = f" of dtype {array.dtype}" if isinstance(values, np.ndarray) else f"={brief(values)}"
+        raise NeurohoverError(f"{name}{got} is not allowed: give a {shape} array of real numbers")
+    return array.astype(np.float64, copy=False)
+
+
+def _check_episode_steps(episode_steps: object) -> int:
+    """``episode_steps`` (a full episode's control steps) as an int, or one message saying what is allowed."""
+    if not whole_number(episode_steps) or not 1 <= episode_steps <= MAX_EPISODE_STEPS:  # nan or -1 said "no crash" (T14-11)
+        raise NeurohoverError(f"episode_steps={brief(episode_steps)} is not allowed: give an integer in 1..{MAX_EPISODE_STEPS:,}")
+    return int(episode_steps)
 
 
 # -- flight data ------------------------------------------------------------------------------
@@ -92,7 +125,7 @@ def attitude_angles(observations: np.ndarray) -> np.ndarray:
     (T, 3) array
         Roll, pitch, yaw in degrees.
     """
-    q = np.asarray(observations, dtype=np.float64)[:, 9:12]
+    q = _real_array(observations, "observations", 12, "(T, 12)")[:, 9:12]
     qx, qy, qz = q[:, 0], q[:, 1], q[:, 2]
     qw = np.sqrt(np.clip(1.0 - (qx * qx + qy * qy + qz * qz), 0.0, 1.0))
     roll = np.arctan2(2.0 * (qw * qx + qy * qz), 1.0 - 2.0 * (qx * qx + qy * qy))
@@ -102,8 +135,10 @@ def attitude_angles(observations: np.ndarray) -> np.ndarray:
 
 
 def crashed_episode(actions: np.ndarray, episode_steps: int = EPISODE_STEPS) -> bool:
-    """Whether an episode of ``actions`` crashed: it ended before ``episode_steps`` control steps."""
-    return len(actions) < episode_steps
+    """Whether an episode of ``actions`` (a (T, 4) array) crashed: it ended before ``episode_steps`` control steps
+    (an integer in 1..MAX_EPISODE_STEPS)."""
+    steps = _check_episode_steps(episode_steps)
+    return _real_array(actions, "actions", 4, "(T, 4)").shape[0] < steps
 
 
 def flight_figure(
@@ -135,10 +170,16 @@ def flight_figure(
     matplotlib.figure.Figure
         Five panels sharing the time axis (seconds at 10 Hz).
     """
-    obs = np.asarray(observations, dtype=np.float64)
-    act = np.asarray(actions, dtype=np.float64)
+    obs = _real_array(observations, "observations", 12, "(T + 1, 12)")
+    act = _real_array(actions, "actions", 4, "(T, 4)")
+    if act.shape[0] < 1 or obs.shape[0] != act.shape[0] + 1:  # (0, 12) was an IndexError (T14-11)
+        raise NeurohoverError(f"observations of shape {obs.shape} and actions of shape {act.shape} are not one episode: give (T + 1, 12) and (T, 4), T >= 1")
+    title = _title(title)  # a file or policy name that is no UTF-8 was matplotlib's TypeError (eleventh trial)
+    steps = _check_episode_steps(episode_steps)
     if crashed is None:
-        crashed = crashed_episode(act, episode_steps)
+        crashed = crashed_episode(act, steps)
+    elif not isinstance(crashed, (bool, np.bool_)):
+        raise NeurohoverError(f"crashed={brief(crashed)} is not allowed: give True, False or None (by the episode's length)")
     t_obs = np.arange(obs.shape[0]) * CONTROL_DT
     t_act = np.arange(act.shape[0]) * CONTROL_DT
     fig = new_figure(10.0, 11.0)
@@ -161,7 +202,6 @@ def flight_figure(
     axes[-1].set_ylim(-1.05, 1.05)
     axes[-1].set_xlabel("time (s)")
     end = f"crashed at {t_obs[-1]:.1f} s (step {act.shape[0]})" if crashed else f"{act.shape[0]} steps, no crash"
-    title = printable(title)  # a file or policy name that is no UTF-8 was matplotlib's TypeError (eleventh trial)
     fig.suptitle(f"{title}\n{end}" if title else end, color=CRASH_COLOR if crashed else "black")
     fig.tight_layout()
     return fig
@@ -189,12 +229,13 @@ def episode_crashed(data: FlightData, i: int) -> bool:
     flags = meta.get("crashed")
     if isinstance(flags, list) and len(flags) == data.n_episodes:
         return bool(flags[i])
-    return crashed_episode(data.actions[i], int(meta.get("episode_steps", EPISODE_STEPS)))
+    return crashed_episode(data.actions[i], meta.get("episode_steps", EPISODE_STEPS))  # checked there: "x" was int()'s ValueError
 
 
 def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight", episodes: Sequence[int] | None = None) -> list[Path]:
     """One PNG per episode of ``data`` (:func:`flight_figure`), ``<stem>-episode<i>.png`` in ``out_dir``;
-    ``episodes``: only these (0-based; default all).
+    ``episodes``: only these (a list of distinct 0-based indices; default all). ``out_dir`` is created, saying so, if
+    missing; the flight data's metadata is checked as :meth:`FlightData.load` checks a file's.
 
     Titles take the MDP label, return and policy from the metadata that ``neurohover fly
     --record`` writes (``mdps``, ``returns``, ``policy``); a crash is marked as :func:`episode_crashed` says.
@@ -204,23 +245,40 @@ def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight"
     list of Path
         The files written, in episode order.
     """
-    out_dir = checked_path(out_dir, "out_dir", "directory")
+    if not isinstance(data, FlightData):  # None was an AttributeError (fourteenth trial, T14-10)
+        raise NeurohoverError(f"data={brief(data)} is not allowed: give FlightData (e.g. FlightData.load('flight.npz'))")
     if not isinstance(stem, str) or stem == "" or "\x00" in stem or any(sep and sep in stem for sep in (os.sep, os.altsep)):
         raise NeurohoverError(  # '../zz' wrote outside out_dir, '' the file '-episode0.png' (eleventh trial)
             f"stem={stem!r:.60} is not allowed: give a non-empty file-name prefix without a path separator, e.g. 'flight'"
         )
-    steps = data.metadata.get("episode_steps", EPISODE_STEPS) if isinstance(data.metadata, dict) else EPISODE_STEPS
+    check_metadata(data.metadata, np.array([a.shape[0] for a in data.actions], dtype=np.int64), "flight data")  # episode_steps 'x' (T14-10)
+    steps = data.metadata.get("episode_steps", EPISODE_STEPS)
     width = len(str(max(data.n_episodes - 1, 0)))
-    chosen = range(data.n_episodes) if episodes is None else list(episodes)
-    bad = [i for i in chosen if not (isinstance(i, int) and 0 <= i < data.n_episodes)]
-    if bad:
-        raise NeurohoverError(f"episode {bad[0]!r} is out of range: the flight data hold episodes 0..{data.n_episodes - 1}")
+    chosen = range(data.n_episodes) if episodes is None else _episode_list(episodes, data.n_episodes)
+    out_dir = output_dir(out_dir, "out_dir")  # a file, FIFO or /dev/null was NotADirectoryError (T14-10); made, saying so, if missing
     paths = []
     for i in chosen:
         obs, act = data.observations[i], data.actions[i]
         fig = flight_figure(obs, act, title=_episode_title(data, i, stem), episode_steps=int(steps), crashed=episode_crashed(data, i))
         paths.append(save_figure(fig, out_dir / f"{stem}-episode{i:0{width}d}.png"))
     return paths
+
+
+def _episode_list(episodes: object, n: int) -> list[int]:
+    """``episodes`` as distinct indices of the ``n`` episodes, or one message saying what is allowed."""
+    if isinstance(episodes, (str, bytes)) or not isinstance(episodes, (Sequence, np.ndarray)) or getattr(episodes, "ndim", 1) != 1:  # 0 was a TypeError
+        raise NeurohoverError(f"episodes={brief(episodes)} is not allowed: give a list of episode indices, e.g. [0, 2], or None for all")
+    chosen = list(episodes)
+    bad = [i for i in chosen if not (whole_number(i) and 0 <= i < n)]
+    if bad:
+        why = "is out of range" if whole_number(bad[0]) else "is not allowed: give integer indices"  # True was taken as 1
+        raise NeurohoverError(f"episode {brief(bad[0])} {why}: the flight data hold episodes 0..{n - 1}")
+    seen: set[int] = set()
+    for i in map(int, chosen):
+        if i in seen:  # one file drawn twice, as neurohover plot --episodes 0,0 refuses
+            raise NeurohoverError(f"episodes names episode {i} more than once: give each episode once")
+        seen.add(i)
+    return [int(i) for i in chosen]
 
 
 # -- competitions -----------------------------------------------------------------------------
@@ -363,20 +421,25 @@ def compete_figure(results: Sequence[CompeteResult], title: str = "") -> Figure:
     Each axes holds exactly one line per result, in order; a legend names each with its runs
     and crashes.
     """
+    if isinstance(results, (str, bytes)) or not isinstance(results, Sequence) or not results or not all(isinstance(r, CompeteResult) for r in results):
+        raise NeurohoverError(  # [None] was an AttributeError, [] an empty figure (fourteenth trial, T14-11)
+            f"results={brief(results)} is not allowed: give a list of one or more CompeteResult (read_compete_dir or read_compete_dirs)"
+        )
+    heading = _title(title) or "mean cumulative error over runs"
     fig = new_figure(11.0, 4.5)
     axes = fig.subplots(1, 2)
     labels = [r.label for r in results]
     differ = _differing_conditions(results)
     for r in results:
         name = r.label if labels.count(r.label) == 1 else f"{r.label} [{r.path.name}]"  # same agent twice
-        label = f"{name}: {r.returns.shape[0]} runs, {r.crashes} crashes"
+        label = f"{printable(name)}: {r.returns.shape[0]} runs, {r.crashes} crashes"  # names that are no UTF-8
         if differ:  # 50-step drifting episodes beside 6000-step ones were overlaid without a word (eleventh trial, S4)
             flown = ", ".join(f"{key} {_condition_text(r.conditions.get(key, '?'))}" for key in differ)
-            label += "\n" + textwrap.fill(flown, 70)  # lines of their own: one long line ran off the figure's edge
+            label += "\n" + textwrap.fill(printable(flown), 70)  # lines of their own: one long line ran off the figure's edge
         error = r.cumulative_error
         episodes = np.arange(1, error.size + 1)
         for ax in axes:
-            ax.plot(episodes, error, label=printable(label))  # names that are no UTF-8
+            ax.plot(episodes, error, label=label)
     axes[0].set_ylabel("cumulative error (-cumulative reward)")
     axes[1].set_yscale("log")
     axes[1].set_ylabel("cumulative error (log scale)")
@@ -385,7 +448,6 @@ def compete_figure(results: Sequence[CompeteResult], title: str = "") -> Figure:
         ax.xaxis.set_major_locator(MaxNLocator(integer=True))
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=8)
-    heading = printable(title) or "mean cumulative error over runs"
     if differ:
         heading += f" (flown under different {', '.join(differ)}: see the legend)"
     fig.suptitle(heading)

@@ -11,7 +11,7 @@ from ..evaluate import DEVICES
 
 def cmd_build_policies(args: argparse.Namespace) -> int:
     """Evolve a task family's generic and specialised policies (the agents' policy set)."""
-    from ..paths import output_dir
+    from ..paths import output_dir, printable
     from ..policysets import SHIPPED, build_policy_set, check_build, replaceable_set
     from ..tasks import get_task_family
 
@@ -24,7 +24,7 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
     output_dir(args.out, "--out")  # made once every option is checked
     if final.exists():  # said before hours of work replace it (a set in --out was replaced without a word; fourth trial)
         whose = "the package's shipped set" if final.resolve().parent == SHIPPED.resolve() else "the set"
-        print(f"neurohover build-policies: note: {whose} {final} is replaced once the build completes", file=sys.stderr)
+        print(f"neurohover build-policies: note: {whose} {printable(final)} is replaced once the build completes", file=sys.stderr)
     ps = build_policy_set(
         args.task,
         args.out,
@@ -36,7 +36,7 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
         optimizer=args.optimizer,
         progress=lambda msg: print(msg, file=sys.stderr, flush=True),
     )
-    print(f"policy set written to {ps.directory}")
+    print(f"policy set written to {printable(ps.directory)}")  # names escaped as messages show them (fourteenth trial, T14-24)
     return 0
 
 
@@ -46,7 +46,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
     from ..agents.model_based import ModelEvolution
     from ..agents.registry import AGENTS, HYBRID_AGENTS, agent_spec
     from ..compete import agents_with_settings, check_sizes, compete
-    from ..paths import checked_path, input_dir, output_file
+    from ..paths import checked_path, input_dir, output_file, printable
     from ..tasks import Drift
     from .options import check_given, given_settings, sensor_of
 
@@ -112,7 +112,8 @@ def cmd_compete(args: argparse.Namespace) -> int:
 
         how, status = stop_words(stop)
         print(
-            f"neurohover compete: {how}; the finished runs are in {args.out}/episodes.csv and the results store; run the same command again to resume",
+            f"neurohover compete: {how}; the finished runs are in {printable(args.out)}/episodes.csv and the results store; "
+            "run the same command again to resume",
             file=sys.stderr,
         )
         return status
@@ -121,7 +122,8 @@ def cmd_compete(args: argparse.Namespace) -> int:
         f"{summary['agent']:<18} {summary['runs']:>5} {summary['mean_cumulative_return']:>17.5g} {summary['sd_cumulative_return']:>12.4g} "
         f"{summary['crash_rate_runs']:>11.1%} {summary['mean_return_after_learning']:>25.5g}"
     )
-    print(f"results: {args.out}/episodes.csv, {args.out}/summary.json, {args.out}/cumulative.png; store: {summary['store']}")
+    out = printable(args.out)  # a newline or U+202E in --out split or reversed the line (fourteenth trial, T14-24)
+    print(f"results: {out}/episodes.csv, {out}/summary.json, {out}/cumulative.png; store: {printable(summary['store'])}")
     return 0
 
 

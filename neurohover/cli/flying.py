@@ -74,7 +74,7 @@ def _npz_name(record: str) -> None:
 
 def cmd_fly(args: argparse.Namespace) -> int:
     """Fly a policy and print return statistics."""
-    from ..paths import output_file
+    from ..paths import output_file, printable
     from ..policies import load_policy
 
     if args.episodes < 1:
@@ -124,7 +124,8 @@ def cmd_fly(args: argparse.Namespace) -> int:
     else:
         for key, value in summary.items():
             label = "flight data" if key == "flight_data" else key
-            print(f"{label:>20}: {value:.6g}" if isinstance(value, float) else f"{label:>20}: {value}")
+            shown = printable(value) if isinstance(value, str) else value  # a newline or U+202E in a name split or reversed the line (T14-24)
+            print(f"{label:>20}: {value:.6g}" if isinstance(value, float) else f"{label:>20}: {shown}")
     return 0
 
 

@@ -46,7 +46,7 @@ def _episodes(text: str | None, n: int) -> list[int] | None:
 
 def cmd_plot(args: argparse.Namespace) -> int:
     """Plot a recorded flight (one PNG per episode) or overlay competition results (one PNG)."""
-    from ..paths import input_file, output_dir
+    from ..paths import input_file, output_dir, printable
 
     if args.flight is not None and args.compete:
         raise NeurohoverError("give either a flight-data file or --compete DIR ..., not both")
@@ -70,7 +70,7 @@ def cmd_plot(args: argparse.Namespace) -> int:
         out = output_dir(args.out if args.out is not None else results[0].path.resolve().parent, "--out")
         written = [save_figure(compete_figure(results), out / COMPETE_PNG)]
     for p in written:
-        print(p)
+        print(printable(p))  # a newline or U+202E in --out split or reversed the line (fourteenth trial, T14-24)
     return 0
 
 
