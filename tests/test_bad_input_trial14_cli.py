@@ -14,3 +14,14 @@ def test_evolve_refuses_a_net_out_before_evolving(tmp_path: Path, cli) -> None:
     assert rc == 2
     assert f"--out {str(out)!r}: a policy is written as JSON" in err and "give a .json name" in err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_written_names_are_printed_escaped(tmp_path: Path, cli) -> None:
+    """T14-24 (the lines outside the plots and fly): evaluate-agent's 'wrote', report's 'report written to' printed a
+    newline or a RIGHT-TO-LEFT OVERRIDE in the name raw, splitting the line or showing it reversed."""
+    out = tmp_path / "a\nb\u202ec.json"
+    rc, _, err = cli(
+        "evaluate-agent", "--task", "ghh08", "--policy", "baseline", "--n-mdps", "1", "--episodes", "1", "--episode-steps", "20", "--json", str(out)
+    )
+    assert rc == 0 and out.is_file()
+    assert f"wrote {tmp_path}/a\\nb\\u202ec.json" in err and "\u202e" not in err

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from ..errors import NeurohoverError
 from ..integrations import SB3_ALGORITHMS
+from ..paths import printable
 from ..policies import Policy
 from ..sim.constants import MAX_EPISODE_STEPS
 from .options import add_sensor_options, add_sigma_option, add_task_option, note_policy_task, task_family_of
@@ -150,7 +151,7 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
         with writing(out, "--json") as path:
             path.write_text(json.dumps({"task": args.task, "mdps": args.mdps, "n_mdps": n, "episodes": args.episodes, "seed": args.seed,
                                         "episode_steps": args.episode_steps, "rows": [r.__dict__ for r in rows]}, indent=1))  # fmt: skip
-        print(f"wrote {args.json}", file=sys.stderr)
+        print(f"wrote {printable(args.json)}", file=sys.stderr)
     return 0
 
 

@@ -34,6 +34,7 @@ from ..evaluate import DEVICES, check_device, check_episode_count
 from ..evolution.config import MAX_BUDGET
 from ..evolution.generational import GENERATIONAL_PRESETS
 from ..evolution.optimisers import OPTIMISERS, optimiser_names
+from ..paths import printable
 
 MDP_FAMILY = "G"
 
@@ -167,7 +168,7 @@ def _print_evolve_summary(args: argparse.Namespace, summary: dict, result) -> No
         print(json.dumps(summary))
     else:
         for key, value in summary.items():
-            print(f"{key:>20}: {value:.6g}" if isinstance(value, float) else f"{key:>20}: {value}")
+            print(f"{key:>20}: {value:.6g}" if isinstance(value, float) else f"{key:>20}: {printable(value) if isinstance(value, str) else value}")
     if args.budget is not None and result.stop_reason != "budget" and result.episodes < args.budget:
         why = " (steady state ends at the paper's plateau, 1000 evaluations without a new champion)" if result.stop_reason == "plateau" else ""
         print(
@@ -240,7 +241,7 @@ def _evolve_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int
                 file=sys.stderr,
             )
         else:
-            print(f"neurohover evolve: {how} mid-generation; the last periodic checkpoint (if any) is {checkpoint}", file=sys.stderr)
+            print(f"neurohover evolve: {how} mid-generation; the last periodic checkpoint (if any) is {printable(checkpoint)}", file=sys.stderr)
         return status
     bar.close()
     # The champion's estimate is on the run's fitness scale (1/ln(error) over a family by default).
@@ -358,7 +359,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
             model = learn_ec_mer(data, ec_mer_policy(args.policy, data, args.flight_data), seed=seed, **extra)
     model.save(out)  # written whole or not at all (a failed write: one message, the old file as it was)
     truth, why = _true_mdp(data.metadata)
-    print(f"{args.method} model written to {out} ({time.perf_counter() - start:.2f} s)")
+    print(f"{args.method} model written to {printable(out)} ({time.perf_counter() - start:.2f} s)")
     rows = parameter_table(model, truth)
     if truth is not None:
         print(f"learned parameters (converted to the simulator's 10 substeps) next to the true ones of {truth.label or 'the MDP'}:")

@@ -16,6 +16,7 @@ from pathlib import Path
 
 from ..errors import NeurohoverError, brief
 from ..evaluate import DEVICES, check_device
+from ..paths import printable
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
@@ -131,7 +132,7 @@ def cmd_results(args: argparse.Namespace) -> int:
     if out is not None:
         with writing(out, "--out") as path:
             path.write_text(text)
-        print(f"wrote {args.out}", file=sys.stderr)
+        print(f"wrote {printable(args.out)}", file=sys.stderr)
     else:
         sys.stdout.write(text)
     return 0
@@ -234,7 +235,7 @@ def cmd_report(args: argparse.Namespace) -> int:
             raise NeurohoverError(store.missing_message(None, args.scale))
         output_dir(args.out, "--out")
         path = write_report(store, args.out, scale=args.scale, names=args.names or None)
-    print(f"report written to {path}")
+    print(f"report written to {printable(path)}")
     return 0
 
 
