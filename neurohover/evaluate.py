@@ -41,7 +41,7 @@ from .sim.constants import (
     SAFEGUARD_TILT,
 )
 from .sim.kernel import GENOME_WIDTH
-from .tasks import MDP, Sensor, refuse_drift
+from .tasks import MDP, Sensor, check_rows, refuse_drift
 
 # Re-exported where they were first defined: KernelFlyer, DEVICES, check_device, num_threads, use_lanes.
 __all__ = [
@@ -199,8 +199,16 @@ class Evaluation:
         return self.episodes / self.seconds if self.seconds > 0 else float("inf")
 
     def reshape(self, shape: tuple[int, ...]) -> Evaluation:
+        """The same outcome with its arrays reshaped to ``shape`` (of as many episodes; NumPy's -1 allowed)."""
+        try:
+            returns = self.returns.reshape(shape)
+        except (TypeError, ValueError):  # (3,) of 2 episodes was NumPy's ValueError, 'x' a TypeError (T14-19)
+            raise NeurohoverError(
+                f"shape={brief(shape)} is not allowed: give a shape of {self.episodes} episodes, e.g. ({self.episodes},) "
+                f"(the arrays' shape is {self.returns.shape})"
+            ) from None
         return Evaluation(
-            self.returns.reshape(shape),
+            returns,
             self.crashed.reshape(shape),
             self.steps.reshape(shape),
             self.safeguard_step.reshape(shape),
@@ -217,6 +225,7 @@ def mdp_rows(mdps: MDP | Sequence[MDP] | np.ndarray) -> np.ndarray:
     if isinstance(mdps, np.ndarray):
         if mdps.ndim != 2 or mdps.shape[1] != MDP_ROW_LEN or not np.all(np.isfinite(mdps)):
             raise NeurohoverError(f"MDP rows must be a finite array of shape (M, {MDP_ROW_LEN}), got {mdps.shape}")
+        check_rows(mdps)  # substeps, dt, noise and wind kind: an all-zero row flew as a perfect 0.0 (T14-18)
         sensors = mdps[:, ROW_SENSOR]
         if sensors.any():  # the rows' sensor models, each distinct one checked by Sensor's own rules
             for values in np.unique(sensors, axis=0):

@@ -21,7 +21,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..sim.constants import (
     ACTION_DIM,
     EPISODE_STEPS,
@@ -74,6 +74,13 @@ def check_render_mode(render_mode: Any) -> str | None:
     return render_mode
 
 
+def _an_mdp(mdp: Any, where: str) -> MDP:
+    """``mdp`` if it is an MDP (None and 'zero' were AttributeErrors in :func:`mdp_info` and :func:`world_wind`; T14-14)."""
+    if not isinstance(mdp, MDP):
+        raise NeurohoverError(f"{where}: mdp={brief(mdp)} is not allowed: give a neurohover.MDP (e.g. get_task_family('ghh08').mdp('zero'))")
+    return mdp
+
+
 def mdp_info(mdp: MDP) -> dict[str, Any]:
     """The MDP's family, label and parameters, as ``info["mdp_info"]`` carries them.
 
@@ -81,7 +88,7 @@ def mdp_info(mdp: MDP) -> dict[str, Any]:
     parameters; FGHH: the 11 dynamics parameters), named by ``param_names``. An MDP of no task
     family (a learned model) gives its 11 dynamics parameters and D_u.
     """
-    cls = TASK_FAMILIES.get(mdp.family)
+    cls = TASK_FAMILIES.get(_an_mdp(mdp, "mdp_info").family)
     if cls is not None:
         params, names = mdp.row()[cls.row_slice], tuple(cls.param_names)
     else:
@@ -91,7 +98,7 @@ def mdp_info(mdp: MDP) -> dict[str, Any]:
 
 def world_wind(mdp: MDP, steps: int) -> tuple[float, float, float]:
     """World wind (m/s, north-east-down) of ``mdp`` after ``steps`` control steps, as the kernel flies it."""
-    return mdp.to_reference().wind_at(competition_time(steps, 0))
+    return _an_mdp(mdp, "world_wind").to_reference().wind_at(competition_time(steps, 0))
 
 
 def observation_space(dtype: Any = np.float64) -> spaces.Box:

@@ -24,17 +24,23 @@ and then to the crash box (20 m) when the helicopter leaves it.
 from __future__ import annotations
 
 import math
+import numbers
 import warnings
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
+from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..sim.constants import MAX_POSITION
+from .arguments import real_values
 
 #: Frame size in pixels (width, height); both even, as video encoders want.
 FRAME_WIDTH = 720
 FRAME_HEIGHT = 340
+#: The largest side of a frame (pixels): an 8K frame; Agg draws up to 65535, but a frame that size takes 17 GB.
+MAX_FRAME_SIDE = 8192
+PARTS = ("top", "side", "wind", "text")  # what pixel_box() locates
 _DPI = 80
 _TEXT_BAND = 0.09  # top share of the frame holding the text line (the axes' titles sit below it)
 #: Half-widths (m) of the views; the smallest that holds the helicopter (with a margin) is used.
@@ -53,8 +59,21 @@ _TAIL_ROTOR = np.stack([-1.1 + 0.16 * np.cos(_ANGLES), np.full(_ANGLES.size, 0.0
 _NOSE = np.array([[0.55, 0.0, 0.05]])
 
 
+def _real_vector(values: Any, lengths: tuple[int, ...], what: str, meaning: str) -> np.ndarray:
+    """``values`` as a float64 vector of one of ``lengths`` real numbers, or a NeurohoverError naming ``what`` (T14-14:
+    short or text values were IndexErrors, TypeErrors and NumPy's reshape errors)."""
+    message = f"{what}={' '.join(brief(values).split())} is not allowed: give {' or '.join(map(str, lengths))} real numbers ({meaning})"
+    arr = real_values(values, message)
+    if arr.ndim != 1 or arr.shape[0] not in lengths:
+        raise NeurohoverError(message)
+    return arr
+
+
 def rotation_matrix(qx: float, qy: float, qz: float, qw: float) -> np.ndarray:
     """Body-to-world rotation matrix of a unit quaternion (the kernel's convention)."""
+    for name, q in (("qx", qx), ("qy", qy), ("qz", qz), ("qw", qw)):
+        if isinstance(q, bool) or not isinstance(q, numbers.Real):  # 'a' was a TypeError (T14-14)
+            raise NeurohoverError(f"rotation_matrix {name}={brief(q)} is not allowed: give a quaternion's 4 real numbers qx, qy, qz, qw")
     return np.array(
         [
             [1.0 - 2.0 * (qy * qy + qz * qz), 2.0 * (qx * qy - qw * qz), 2.0 * (qx * qz + qw * qy)],
@@ -66,6 +85,7 @@ def rotation_matrix(qx: float, qy: float, qz: float, qw: float) -> np.ndarray:
 
 def view_range(position: Sequence[float] | np.ndarray) -> float:
     """Half-width (m) of the views for a helicopter at world ``position``."""
+    position = _real_vector(position, (3,), "view_range position", "a world position x, y, z")  # [] was an IndexError (T14-14)
     reach = max(abs(float(position[0])), abs(float(position[1])), abs(float(position[2]))) + _MARGIN
     for r in VIEW_RANGES:
         if reach <= r:
@@ -87,6 +107,9 @@ class HoverRenderer:
         from matplotlib.figure import Figure
         from matplotlib.patches import Circle, FancyArrow
 
+        for name, side in (("width", width), ("height", height)):  # 0 was a ZeroDivisionError, -5 and 'a' matplotlib's ValueErrors (T14-14)
+            if not whole_number(side) or not 1 <= side <= MAX_FRAME_SIDE:
+                raise NeurohoverError(f"HoverRenderer {name}={brief(side)} is not allowed: give a whole number of pixels in 1..{MAX_FRAME_SIDE}")
         self.width, self.height = int(width), int(height)
         self.figure = Figure(figsize=(self.width / _DPI, self.height / _DPI), dpi=_DPI)
         self.canvas = FigureCanvasAgg(self.figure)
@@ -136,6 +159,8 @@ class HoverRenderer:
     def pixel_box(self, part: str) -> tuple[int, int, int, int]:
         """Pixel box (row0, row1, col0, col1) of a part of every frame: ``"top"``, ``"side"``,
         ``"wind"`` (the compass and its speed) or ``"text"`` (the band of the text line)."""
+        if part not in PARTS:  # 'nope' was a KeyError (T14-14)
+            raise NeurohoverError(f"pixel_box part={brief(part)} is not allowed: give one of {', '.join(PARTS)}")
         if part == "text":
             return 0, int(math.ceil(_TEXT_BAND * self.height)), 0, self.width
         ax = {"top": self.top, "side": self.side, "wind": self.wind}[part]
@@ -178,7 +203,14 @@ class HoverRenderer:
         trail : (n, 3) array, optional
             Recent world positions, oldest first.
         """
-        s = np.asarray(state, dtype=np.float64)
+        s = _real_vector(state, (13,), "draw state", "velocity, position, body rates, quaternion qx, qy, qz, qw")  # 3 numbers were an IndexError (T14-14)
+        w = _real_vector(wind, (2, 3), "draw wind", "the world wind north, east and down in m/s")
+        if not isinstance(text, str):
+            raise NeurohoverError(f"draw text={brief(text)} is not allowed: give a string (the line above the views)")
+        track = np.zeros((0, 3)) if trail is None else real_values(trail, f"draw trail={brief(trail)} is not allowed: give an (n, 3) array of positions")
+        if track.size and (track.ndim != 2 or track.shape[1] != 3):  # (2, 2) was NumPy's reshape error (T14-14)
+            raise NeurohoverError(f"draw trail of shape {track.shape} is not allowed: give an (n, 3) array of world positions, oldest first")
+        track = track.astype(np.float64, copy=False).reshape(-1, 3)
         pos = s[3:6]
         rot = rotation_matrix(s[9], s[10], s[11], s[12])
         self._set_range(view_range(pos))
@@ -187,7 +219,6 @@ class HoverRenderer:
             return points @ rot.T + pos
 
         shapes = [world(_ROTOR), world(_FUSELAGE), world(_MAST_LINE), world(_TAIL_ROTOR), world(_NOSE)]
-        track = np.asarray(trail, dtype=np.float64).reshape(-1, 3) if trail is not None else np.zeros((0, 3))
         for ax, (_box, trail_line, *parts) in self._views.items():
             # Top view: (east, north); side view: (north, altitude).
             project = (lambda p: (p[:, 1], p[:, 0])) if ax is self.top else (lambda p: (p[:, 0], -p[:, 2]))
@@ -195,7 +226,7 @@ class HoverRenderer:
             for artist, points in zip(parts, shapes, strict=True):
                 artist.set_data(*project(points))
 
-        north, east = -float(wind[0]), -float(wind[1])  # the air moves along -W
+        north, east = -float(w[0]), -float(w[1])  # the air moves along -W
         speed = math.hypot(north, east)
         if self._arrow is not None:
             self._arrow.remove()
@@ -260,12 +291,18 @@ class HumanWindow:
     """
 
     def __init__(self, fps: float) -> None:
+        if not finite_real(fps) or not fps > 0:  # 0 and NaN were taken (and 0 divided by at the first frame; T14-14)
+            raise NeurohoverError(f"HumanWindow fps={brief(fps)} is not allowed: give a finite number of frames per second > 0")
         self.fps = float(fps)
         self._figure: Any = None
         self._image: Any = None
         self._warned = False
 
     def show(self, frame: np.ndarray) -> None:
+        """Show ``frame``, an (height, width, 3) uint8 RGB image (or RGBA) as :meth:`HoverRenderer.draw` gives."""
+        if not isinstance(frame, np.ndarray) or frame.dtype != np.uint8 or frame.ndim != 3 or frame.shape[2] not in (3, 4) or not frame.size:
+            shown = f"an array of shape {frame.shape} and dtype {frame.dtype}" if isinstance(frame, np.ndarray) else brief(frame)
+            raise NeurohoverError(f"HumanWindow frame {shown} is not allowed: give an (height, width, 3) uint8 RGB image (HoverRenderer.draw)")  # T14-14
         import matplotlib
         import matplotlib.pyplot as plt  # a window needs pyplot's figure manager
 

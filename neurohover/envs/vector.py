@@ -23,6 +23,7 @@ from typing import Any
 
 import numba as nb
 import numpy as np
+from gymnasium import logger
 from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
@@ -113,7 +114,8 @@ class HoverVectorEnv(VectorEnv):
     episodes, bit for bit, as ``HoverEnv`` after ``reset(seed=s + i)`` and then plain
     ``reset()`` calls, given the same actions.
 
-    ``reset`` options: ``"mdp"`` (as the ``mdp`` argument; kept for later episodes),
+    ``reset`` options: ``"mdp"`` (as the ``mdp`` argument; kept for later episodes: with ``reset_mask``, a
+    sub-environment not reset now keeps flying its episode and takes its entry at its next reset, automatic or not),
     ``"noise"`` (this reset only: one ``(seed, episode)`` pair, which gives sub-environment i the
     stream ``(seed, episode + i)`` like ``neurohover.evaluate_jobs`` with consecutive episode
     indices, or a sequence of ``num_envs`` pairs) and ``"reset_mask"`` (a (num_envs,) bool array:
@@ -399,7 +401,8 @@ class HoverVectorEnv(VectorEnv):
         for i in idx.tolist():
             if seeds[i] is not None or self._gens[i] is None:
                 self._gens[i], _ = seeding.np_random(seeds[i])
-            self._specs[i] = specs[i]
+        if "mdp" in options:  # every entry: those of sub-environments masked out were dropped (T14-15)
+            self._specs = list(specs)
         self._reset_envs(idx, streams)
         self._autoreset[idx] = False
         self._any_autoreset = bool(self._autoreset.any())
@@ -414,6 +417,14 @@ class HoverVectorEnv(VectorEnv):
             "_mdp_info": label_mask.copy(),
         }
         return self._obs.astype(self.obs_dtype), info
+
+    def render(self) -> None:
+        """No frame: this environment has no rendering (``render_mode`` is None), so, as :class:`HoverEnv` without a render
+        mode does, it warns and returns None (Gymnasium's NotImplementedError before; T14-14)."""
+        logger.warn(
+            "HoverVectorEnv has no rendering (its render_mode is None): render a single environment instead, "
+            'e.g. gym.make("neurohover/GHH08-v0", render_mode="rgb_array")'
+        )
 
     def step(self, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         if not self._ready:

@@ -28,7 +28,7 @@ import pkgutil
 import numpy as np
 
 from ..errors import NeurohoverError, brief
-from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, competition_rows, finite_vector
+from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, check_rows, competition_rows, finite_vector
 from .drift import NO_DRIFT, Drift, refuse_drift
 from .fghh import COMPETITION_FGHH_SIGMA, FGHH
 from .ghh08 import GHH08, MAX_WIND
@@ -138,6 +138,7 @@ __all__ = [
     "TASK_FAMILIES",
     "TASK_NAMES",
     "TaskFamily",
+    "check_rows",
     "competition_rows",
     "FAMILY_KEYS",
     "family_for",

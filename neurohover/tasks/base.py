@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, whole_number
 from ..sim.constants import (
     DEFAULT_NOISE_STD,
     DEFAULT_PARAMS,
@@ -27,7 +27,9 @@ from ..sim.constants import (
     ROW_WIND_START,
     SUBSTEP_DT,
     SUBSTEPS,
+    WIND_CONSTANT,
     WIND_NONE,
+    WIND_SINUSOID,
 )
 from ..sim.reference import ReferenceMDP
 from ..sim.rng import MAX_SEED
@@ -42,6 +44,12 @@ _FIXED_SETS: dict[tuple[str, int, int, Sensor, Drift], tuple[MDP, ...]] = {}
 _ROW_LAYOUTS: dict[tuple[str, int, Sensor], np.ndarray] = {}
 COMPETITION_MDPS_FILE = Path(__file__).parent.parent / "data" / "competition-mdps.json"
 _COMPETITION: dict[str, dict] = {}
+LEARNED_MODEL = "model"  # the family name of a learned model's MDP, which may fly any wind
+#: The wind kinds the MDPs of each family may have, by family name: each TaskFamily subclass registers its own as it is
+#: defined (none, or none and its ``wind_kind``); an unknown family, or ghh09's wind under ghh08's name, was flown (T14-17).
+_WIND_KINDS: dict[str, tuple[int, ...]] = {LEARNED_MODEL: (WIND_NONE, WIND_CONSTANT, WIND_SINUSOID)}
+#: The keys of :meth:`MDP.to_dict`'s table that :meth:`MDP.from_dict` needs (``label``, ``d_u``, ``sensor``, ``drift`` may be left out).
+MDP_KEYS = ("family", "params", "noise_std", "wind_kind", "wind", "substeps", "dt")
 
 
 @dataclass(frozen=True)
@@ -92,8 +100,9 @@ class MDP:
             raise NeurohoverError(f"drift must be a neurohover Drift, got {self.drift!r}")
         if not isinstance(self.label, str):  # make(label=5) was kept as the number (second trial)
             raise NeurohoverError(f"MDP label={self.label!r:.60} is not allowed: give a string")
-        if not isinstance(self.family, str) or not self.family:
-            raise NeurohoverError(f"MDP family={brief(self.family)} is not allowed: give a task family's name (or 'model')")
+        if not isinstance(self.family, str) or self.family not in _WIND_KINDS:
+            names = [n for n in _WIND_KINDS if n != LEARNED_MODEL]
+            raise NeurohoverError(f"MDP family={brief(self.family)} is not allowed: give a task family's name ({', '.join(names)}) or {LEARNED_MODEL!r}")
         # Plain Python numbers (the same values): reprs read MDP(params=(-0.18, ...)), not np.float64(-0.18).
         for name, length in (("params", len(DEFAULT_PARAMS)), ("noise_std", len(DEFAULT_NOISE_STD)), ("wind", None)):
             values = getattr(self, name)
@@ -106,8 +115,12 @@ class MDP:
             object.__setattr__(self, name, numbers)
         if min(self.noise_std) < 0:
             raise NeurohoverError(f"MDP noise_std={self.noise_std!r} is out of range: allowed stds >= 0")
-        if self.wind_kind not in (WIND_NONE, 1, 2):
+        if not whole_number(self.wind_kind) or self.wind_kind not in (WIND_NONE, WIND_CONSTANT, WIND_SINUSOID):
             raise NeurohoverError(f"MDP wind_kind={self.wind_kind!r} is not allowed: 0 (none), 1 (constant, GHH-08) or 2 (sinusoidal, GHH-09)")
+        object.__setattr__(self, "wind_kind", int(self.wind_kind))
+        if self.wind_kind not in _WIND_KINDS[self.family]:
+            allowed = " or ".join(map(str, _WIND_KINDS[self.family]))
+            raise NeurohoverError(f"MDP wind_kind={self.wind_kind} is not allowed in family {self.family!r}: its MDPs have wind_kind {allowed}")
         if isinstance(self.substeps, bool) or not isinstance(self.substeps, (int, np.integer)) or not 1 <= self.substeps <= MAX_SUBSTEPS:
             raise NeurohoverError(f"MDP substeps={self.substeps!r} is out of range: allowed an integer in 1..{MAX_SUBSTEPS}")
         object.__setattr__(self, "substeps", int(self.substeps))
@@ -166,18 +179,22 @@ class MDP:
 
     @classmethod
     def from_dict(cls, d: dict) -> MDP:
+        """The MDP of :meth:`to_dict`'s table (its values checked as the MDP's own: a missing key is named)."""
         if not isinstance(d, dict):  # 5 was a TypeError (sixth trial)
             raise NeurohoverError(f"an MDP's dict {d!r:.60} is not allowed: give MDP.to_dict()'s table")
-        return cls(
+        missing = [k for k in MDP_KEYS if k not in d]
+        if missing:  # {} was a KeyError (T14-17)
+            raise NeurohoverError(f"an MDP's dict {brief(d)} lacks {', '.join(missing)}: give MDP.to_dict()'s table (keys {', '.join(MDP_KEYS)})")
+        return cls(  # the values as they are: the MDP checks each (int() cut substeps 10.7 to 10, float() read '0.01')
             d["family"],
-            tuple(map(float, d["params"])),
-            tuple(map(float, d["noise_std"])),
-            int(d["wind_kind"]),
-            tuple(map(float, d["wind"])),
-            int(d["substeps"]),
-            float(d["dt"]),
+            d["params"],
+            d["noise_std"],
+            d["wind_kind"],
+            d["wind"],
+            d["substeps"],
+            d["dt"],
             d.get("label", ""),
-            float(d.get("d_u", 0.0)),
+            d.get("d_u", 0.0),
             Sensor.from_dict(d["sensor"]) if "sensor" in d else EXACT,
             Drift.from_dict(d["drift"]) if "drift" in d else NO_DRIFT,
         )
@@ -199,6 +216,28 @@ def finite_vector(values: Sequence[float] | np.ndarray, length: int, what: str) 
     if not np.all(np.isfinite(arr)):
         raise NeurohoverError(f"{what} must be finite numbers, got {arr.tolist()}")
     return arr
+
+
+def check_rows(rows: np.ndarray) -> None:
+    """Refuse kernel rows, an (M, MDP_ROW_LEN) float array already found finite, that no MDP has: substeps not a whole
+    number in 1..MAX_SUBSTEPS, dt <= 0, a negative noise std or an unknown wind kind (the MDP's own checks, in a few
+    NumPy operations: evaluate() calls it on every array). An all-zero row (substeps 0) flew as a perfect 0.0 (T14-18)."""
+    sub, dt, kind = rows[:, ROW_SUBSTEPS], rows[:, ROW_DT], rows[:, ROW_WIND_KIND]
+    ok = (sub >= 1) & (sub <= MAX_SUBSTEPS) & (sub == np.floor(sub)) & (dt > 0) & (rows[:, ROW_NOISE].min(axis=1) >= 0)
+    ok &= (kind == WIND_NONE) | (kind == WIND_CONSTANT) | (kind == WIND_SINUSOID)
+    if ok.all():
+        return
+    i = int(np.flatnonzero(~ok)[0])
+    r = rows[i]
+    fields_ = (
+        ("substeps", r[ROW_SUBSTEPS], 1 <= r[ROW_SUBSTEPS] <= MAX_SUBSTEPS and float(r[ROW_SUBSTEPS]).is_integer(), f"a whole number in 1..{MAX_SUBSTEPS}"),
+        ("dt", r[ROW_DT], r[ROW_DT] > 0, "a substep length > 0"),
+        ("noise_std", r[ROW_NOISE].tolist(), r[ROW_NOISE].min() >= 0, "stds >= 0"),
+        ("wind_kind", r[ROW_WIND_KIND], r[ROW_WIND_KIND] in (WIND_NONE, WIND_CONSTANT, WIND_SINUSOID), "0 (none), 1 (constant) or 2 (sinusoidal)"),
+    )
+    name, value, _, allowed = next(f for f in fields_ if not f[2])
+    shown = value if isinstance(value, list) else float(value)
+    raise NeurohoverError(f"MDP row {i} has {name}={shown!r}, which no MDP has: allowed {allowed} (rows as MDP.row() gives them)")
 
 
 def competition_rows(family: str) -> dict:
@@ -292,6 +331,9 @@ class TaskFamily:
         Distinguishes its seeded fixed sets from other families'.
     has_sigma : bool
         Whether it has a breadth ``sigma`` (FGHH).
+    wind_kind : int
+        The wind its MDPs fly besides none (``sim.constants``: WIND_CONSTANT for GHH-08, WIND_SINUSOID for GHH-09;
+        WIND_NONE: no wind); an MDP of its name with another is refused.
     generic_over_distribution : bool
         Whether its generic policies are evolved over G (FGHH: fixed resampling and races) rather
         than on the zero setting (GHH-08, GHH-09); decides the layout of its policy set.
@@ -307,6 +349,7 @@ class TaskFamily:
     row_slice: slice = slice(0, 0)
     set_code: int = 0
     has_sigma: bool = False
+    wind_kind: int = WIND_NONE
     sigma: float | None = None  # the breadth of G, for families with has_sigma
     generic_over_distribution: bool = False
     sensor: Sensor = EXACT  # set on a copy by with_sensor(); part of the family's identity
@@ -314,6 +357,8 @@ class TaskFamily:
 
     def __init_subclass__(cls, **kwargs) -> None:
         super().__init_subclass__(**kwargs)
+        if cls.__dict__.get("name"):  # the wind kinds an MDP of its name may have (MDP's own check)
+            _WIND_KINDS[cls.name] = (WIND_NONE,) if cls.wind_kind == WIND_NONE else (WIND_NONE, cls.wind_kind)
         for name in ("make", "zero"):  # the one place a family's MDPs get its sensor
             if name in cls.__dict__:
                 setattr(cls, name, _through_sensor(cls.__dict__[name]))
@@ -403,8 +448,20 @@ class TaskFamily:
         return _ROW_LAYOUTS[key].copy()
 
     def rows(self, params: np.ndarray) -> np.ndarray:
-        """Kernel rows of the MDPs of ``params`` (n, n_params), as ``make(p).row()`` gives, unvalidated."""
-        params = np.asarray(params, dtype=float)
+        """Kernel rows of the MDPs of ``params`` (n, n_params), as ``make(p).row()`` gives: their shape and finiteness are
+        checked, their ranges not (:meth:`make` checks those)."""
+        try:
+            raw = np.asarray(params)
+            arr = raw.astype(float, copy=False) if raw.dtype.kind in "iuf" else None  # numbers only: NumPy reads '1' as 1.0
+        except (TypeError, ValueError):
+            arr = None
+        # NaN rows were returned, (2, 3) a broadcast error (T14-18)
+        if arr is None or arr.ndim != 2 or arr.shape[1] != self.n_params or not np.isfinite(arr).all():
+            shown = f"of shape {arr.shape}" if arr is not None and (arr.ndim != 2 or arr.shape[1] != self.n_params) else " ".join(brief(params).split())
+            raise NeurohoverError(
+                f"{self.name} parameters {shown} are not allowed: give an array of shape (n, {self.n_params}) of finite numbers ({', '.join(self.param_names)})"
+            )
+        params = arr
         out = np.repeat(self.row_template()[None, :], params.shape[0], axis=0)
         out[:, self.row_slice] = params
         return out

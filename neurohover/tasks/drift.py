@@ -43,6 +43,9 @@ MIN_FACTOR, MAX_FACTOR = 0.01, 100.0
 #: The latest episode a change may come at: a trillion episodes of 6000 steps outlast any test run (run_test refuses a
 #: window past its last episode), and below NumPy's int64, in which the episode is drawn.
 MAX_CHANGE_AT = 10**12
+#: The most episodes whose rows one call makes (36 floats each: 29 GB at this bound, compete's bound on a call's episodes);
+#: past NumPy's int64 (10**20) the count was an OverflowError (fourteenth trial, T14-21).
+MAX_RUN_EPISODES = 10**8
 _PARSE_FORM = "give walk=STD or PARAM=FACTOR[@LO-HI], e.g. walk=0.01,D_w=0.8@200-800"
 _NOTHING = "give walk > 0 (up to 1) or a change of a factor other than 1, or leave it out (fixed dynamics)"
 
@@ -76,6 +79,8 @@ class Drift:
         for name, factor in change.items():
             if name not in PARAM_NAMES:
                 raise NeurohoverError(f"drift change of {name!r}: not a dynamics parameter; allowed {', '.join(PARAM_NAMES)}")
+            if isinstance(factor, bool) or not isinstance(factor, numbers.Real):  # '0.8' and Decimal('0.8') were called "out of range" (T14-21)
+                raise NeurohoverError(f"drift change {name}={factor!r} is not a number: allowed a factor in {MIN_FACTOR:g}..{MAX_FACTOR:g}")
             if not finite_real(factor) or not MIN_FACTOR <= factor <= MAX_FACTOR:  # np.float32(0.8), Fraction(4, 5) in range too (thirteenth trial)
                 raise NeurohoverError(f"drift change {name}={factor!r} is out of range: allowed a factor in {MIN_FACTOR:g}..{MAX_FACTOR:g}")
             if factor == 1:  # flown as another experiment with results identical to none (eleventh trial, S3)
@@ -124,7 +129,7 @@ class Drift:
 
     def rows(self, row: np.ndarray, episodes: int, seed: int) -> np.ndarray:
         """The (episodes, MDP_ROW_LEN) rows that episodes 0..episodes-1 of run ``seed`` fly, from the MDP's ``row``."""
-        row, episodes = _row(row), _whole("episodes", episodes, "a whole number of episodes >= 1", 1)
+        row, episodes = _row(row), _whole("episodes", episodes, f"a whole number of episodes >= 1 (at most {MAX_RUN_EPISODES:,})", 1, MAX_RUN_EPISODES)
         rng = self._rng(_seed(seed))
         change = int(rng.integers(self.change_at[0], self.change_at[1] + 1)) if self.change else episodes
         out = np.repeat(row[None, :], episodes, axis=0)
@@ -254,9 +259,10 @@ class DriftRun:
         self._rows = np.zeros((0, self._row.shape[0]))
 
     def row(self, episode: int) -> np.ndarray:
-        episode = _whole("episode", episode, "an episode number, a whole number >= 0", 0)  # -1 was the last row computed, 1.5 an IndexError
+        # -1 was the last row computed, 1.5 an IndexError, 10**20 an OverflowError (T14-21)
+        episode = _whole("episode", episode, f"an episode number, a whole number >= 0 (below {MAX_RUN_EPISODES:,})", 0, MAX_RUN_EPISODES - 1)
         if episode >= self._rows.shape[0]:  # a longer prefix of the same draws: the earlier rows do not change
-            self._rows = self.drift.rows(self._row, max(2 * self._rows.shape[0], episode + 1, 1024), self.seed)
+            self._rows = self.drift.rows(self._row, min(max(2 * self._rows.shape[0], episode + 1, 1024), MAX_RUN_EPISODES), self.seed)
         return self._rows[episode]
 
 

@@ -36,6 +36,7 @@ class FGHH(TaskFamily):
         s = self.sigma
         if not (isinstance(s, (int, float)) and finite_real(s) and 0.0 <= s <= 1.0):
             raise NeurohoverError(f"FGHH sigma={s!r} is out of range: allowed 0 <= sigma <= 1 (the paper uses 0.2 and 0.3)")
+        object.__setattr__(self, "sigma", abs(float(s)))  # -0.0 passes 0 <= sigma but was NumPy's "scale < 0" at the first draw (T14-2)
 
     def make(self, params: Sequence[float] | np.ndarray, label: str = "") -> MDP:
         p = finite_vector(params, 11, "FGHH dynamics parameters " + "/".join(PARAM_NAMES))

@@ -32,6 +32,7 @@ class GHH09(TaskFamily):
     param_names = GHH09_PARAM_NAMES
     row_slice = slice(ROW_WIND.start, ROW_WIND.start + 8)
     set_code = 9
+    wind_kind = WIND_SINUSOID
 
     def make(self, params: Sequence[float] | np.ndarray, label: str = "") -> MDP:
         p = finite_vector(params, 8, "GHH-09 parameters " + "/".join(GHH09_PARAM_NAMES))

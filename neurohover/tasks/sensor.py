@@ -105,8 +105,10 @@ class Sensor:
     def from_row_values(cls, values) -> Sensor:
         """The sensor of an MDP row's seven sensor slots (refused clearly when they are not a valid sensor)."""
         try:  # 3 values were an IndexError, None a TypeError, 9 values a sensor of the first seven (thirteenth trial, F10)
-            v = [float(x) for x in values]
-        except (TypeError, ValueError, OverflowError):
+            items = list(values)
+            # Numbers only: text such as '1' was read as 1.0 and then refused as "correlation=1.0" (T14-21).
+            v = [float(x) for x in items] if all(isinstance(x, numbers.Real) and not isinstance(x, bool) for x in items) else []
+        except (TypeError, OverflowError):
             v = []
         if len(v) != 7:
             raise NeurohoverError(
