@@ -47,8 +47,8 @@ def lucb_radius(samples: np.ndarray, t: int, n: int, delta: float) -> np.ndarray
 def _sample_counts(samples: object) -> np.ndarray:
     """Each candidate's number of samples as float64, all >= 1 (0 was a ZeroDivisionError; thirteenth trial, F15)."""
     u = np.atleast_1d(as_floats(samples, "samples", "a 1-D array of sample counts >= 1"))
-    if u.ndim != 1 or not np.all(np.isfinite(u) & (u >= 1)):
-        raise NeurohoverError(f"samples={brief(u.tolist())} is not allowed: give a 1-D array of sample counts >= 1")
+    if u.ndim != 1 or not np.all(np.isfinite(u) & (u >= 1) & (u == np.floor(u))):  # 1.5 samples was taken (fourteenth trial)
+        raise NeurohoverError(f"samples={brief(u.tolist())} is not allowed: give a 1-D array of sample counts >= 1 (whole numbers)")
     return u
 
 
@@ -70,12 +70,14 @@ def kl_bounds(means: np.ndarray, samples: np.ndarray, level: float, iterations: 
     set of NumPy calls: each element takes the same operations as alone, and so the same bits."""
     p = np.atleast_1d(as_floats(means, "means", "a 1-D array of empirical means"))
     u = _sample_counts(samples)
-    if p.shape != u.shape or not np.all(np.isfinite(p)):  # other lengths were NumPy's broadcast error (thirteenth trial, F15)
-        raise NeurohoverError(f"means={brief(p.tolist())} is not allowed: give {u.size} finite mean(s), one per entry of samples")
+    # Other lengths were NumPy's broadcast error (thirteenth trial, F15); 1.5 was clipped to 1, its lower bound below it (fourteenth).
+    if p.shape != u.shape or not np.all((p >= 0.0) & (p <= 1.0)):
+        raise NeurohoverError(
+            f"means={brief(p.tolist())} is not allowed: give {u.size} finite mean(s), one per entry of samples, each in [0, 1] (rewards' range)"
+        )
     if not finite_real(level) or level < 0:  # a negative level was taken silently
         raise NeurohoverError(f"level={brief(level)} is not allowed: give a finite number >= 0")
     iterations = _check_int("iterations", iterations, 1)  # -1 was taken silently: no halving at all
-    p = np.clip(p, 0.0, 1.0)
     n = p.size
     room = np.tile(float(level) / u, 2)
     up = np.arange(2 * n) < n  # the first half bisects upper bounds, the second lower ones

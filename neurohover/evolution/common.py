@@ -18,32 +18,41 @@ and ``tell()``.
 from __future__ import annotations
 
 import math
+import pickle
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Protocol, overload
+from typing import Any, Protocol, TypeVar, overload
 
 import numpy as np
 
 from ..errors import NeurohoverError, brief, finite_real, whole_number
 
 __all__ = [
+    "STATE_DAMAGE",
     "STATE_VERSION",
     "AskTellOrderError",
     "ChampionRecord",
     "ChampionTracker",
     "ChampionViews",
     "Clock",
+    "EntryError",
     "Optimiser",
     "TellInfo",
     "as_floats",
     "check_prototype",
     "check_returns",
+    "check_settings",
     "check_genomes",
     "check_state",
+    "damage_text",
     "dec_array",
     "enc_array",
     "enc_float",
     "rank",
+    "read_entry",
+    "read_count",
+    "read_seconds",
     "require_int",
     "require_population",
     "MAX_POPULATION",
@@ -138,10 +147,10 @@ def require_prob(name: str, value: Any) -> float:
 
 
 def require_std(name: str, value: Any) -> float:
-    """``value`` as a float, or NeurohoverError unless it is a finite number >= 0."""
+    """``value`` as a float (-0.0 as 0.0), or NeurohoverError unless it is a finite number >= 0."""
     if not finite_real(value) or float(value) < 0.0:
         raise NeurohoverError(f"{name}={brief(value)} must be a finite number >= 0")
-    return float(value)
+    return float(value) + 0.0  # -0.0 + 0.0 is 0.0, any other float unchanged: NumPy's normal() refused a scale of -0.0 (fourteenth trial)
 
 
 #: The largest spread (a mutation's or a search distribution's standard deviation, a step size) any optimiser takes:
@@ -156,7 +165,7 @@ def require_spread(name: str, value: Any, *, positive: bool = False, what: str =
     if not finite_real(value) or not (0.0 < float(value) if positive else 0.0 <= float(value)) or float(value) > MAX_SPREAD:
         low = "> 0" if positive else ">= 0"
         raise NeurohoverError(f"{what}{name}={brief(value)} must be a finite number {low} and <= {MAX_SPREAD:g} (a larger one overflows the genes)")
-    return float(value)
+    return float(value) + 0.0  # -0.0 made 0.0: mutate_std=-0.0 was taken, then NumPy's "scale < 0" mid-run (fourteenth trial)
 
 
 def set_field(obj: Any, name: str, value: Any) -> None:
@@ -191,13 +200,44 @@ def validate_variation_settings(obj: Any) -> None:
 # --------------------------------------------------------------------------- genomes and returns
 
 
+#: What values of each refused NumPy dtype kind are, for the message (real numbers are kinds "f", "i" and "u").
+_NOT_REAL = {"b": "booleans", "c": "complex numbers", "M": "dates", "m": "time spans", "U": "text", "S": "bytes", "O": "Python objects", "V": "raw records"}
+
+
+def _not_floats(values: Any, name: str, allowed: str, what: str) -> NeurohoverError:
+    """:func:`as_floats`' error: ``values`` shown on one line (an array's repr breaks its rows over lines)."""
+    shown = " ".join(brief(values).split())
+    return NeurohoverError(f"{name}={shown} is not allowed: give {allowed}" + (f" (real numbers, not {what})" if what else ""))
+
+
 def as_floats(values: Any, name: str, allowed: str) -> np.ndarray:
-    """A float64 copy of ``values``, or NeurohoverError naming ``name`` and what is ``allowed`` where NumPy cannot make
-    numbers of them (SteadyStateNE("abc") and tell(["a", ...]) were NumPy's own "could not convert"; eleventh trial)."""
+    """A float64 copy of ``values`` if they are real numbers (a NumPy dtype of kind float, int or unsigned int), or
+    NeurohoverError naming ``name``, what they are and what is ``allowed``: the one check of every return, genome and
+    sample told. Text, booleans, dates, Python objects (None, Decimal), complex numbers and masked arrays are refused
+    (SteadyStateNE("abc") was NumPy's "could not convert", eleventh trial; a date was taken as its day number, None as
+    NaN, '-1' as -1, a complex number's imaginary part dropped and a mask ignored, fourteenth trial)."""
+    if isinstance(values, np.ma.MaskedArray):  # np.asarray drops the mask: the masked entries would count
+        raise _not_floats(values, name, allowed, "a masked array")
     try:
-        return np.array(values, dtype=np.float64)
-    except (TypeError, ValueError, OverflowError):
-        raise NeurohoverError(f"{name}={brief(values)} is not allowed: give {allowed}") from None
+        a = np.asarray(values)
+    except (TypeError, ValueError, OverflowError):  # a ragged list
+        raise _not_floats(values, name, allowed, "") from None
+    if a.dtype.kind not in "fiu":  # one dtype test: this runs at every tell()
+        raise _not_floats(values, name, allowed, _NOT_REAL.get(a.dtype.kind, a.dtype.name))
+    return np.array(a, dtype=np.float64)
+
+
+_Settings = TypeVar("_Settings")
+
+
+def check_settings(settings: Any, cls: type[_Settings]) -> _Settings:
+    """``settings``, or ``cls()`` for None; NeurohoverError unless it is a ``cls`` (another optimiser's settings or a
+    dict were an AttributeError at construction or at the first ask(); fourteenth trial)."""
+    if settings is None:
+        return cls()
+    if not isinstance(settings, cls):
+        raise NeurohoverError(f"settings={brief(settings)} is not allowed: give a {cls.__name__} (or None for its defaults)")
+    return settings
 
 
 def check_prototype(prototype: np.ndarray) -> np.ndarray:
@@ -296,9 +336,61 @@ def check_state(state: dict[str, Any], kind: str) -> None:
     if not isinstance(state, dict):
         raise NeurohoverError(f"state dict is a {type(state).__name__}, not a dict")
     if state.get("type") != kind:
-        raise NeurohoverError(f"state dict is for {state.get('type')!r}, not {kind!r}")
-    if state.get("version") != STATE_VERSION:
-        raise NeurohoverError(f"unsupported state version {state.get('version')!r}")
+        raise NeurohoverError(f"state dict is for {brief(state.get('type'))}, not {kind!r}")
+    version = state.get("version")
+    if isinstance(version, bool) or version != STATE_VERSION:  # True == 1 was taken as version 1 (fourteenth trial)
+        raise NeurohoverError(f"unsupported state version {brief(version)}: allowed {STATE_VERSION}")
+
+
+#: What reading back a damaged entry of a state raises besides NeurohoverError: a value of the wrong type, a missing
+#: key inside it, text that is no number, no base64 or no pickle.
+STATE_DAMAGE = (KeyError, TypeError, ValueError, AttributeError, IndexError, OverflowError, EOFError, ImportError, pickle.UnpicklingError)
+
+_T = TypeVar("_T")
+_REQUIRED = object()
+
+
+class EntryError(ValueError):
+    """What a reader of :func:`read_entry` raises for a value of the wrong kind; its message says what is allowed."""
+
+
+def damage_text(err: BaseException) -> str:
+    """What an error reading back a damaged state or checkpoint says, in a few words."""
+    if isinstance(err, KeyError):
+        return f"it has no {brief(err.args[0]) if err.args else 'such'} entry"
+    return str(err) if isinstance(err, (NeurohoverError, EntryError)) else f"{type(err).__name__}: {err}"
+
+
+def read_entry(state: dict[str, Any], kind: str, key: str, read: Callable[[Any], _T], default: Any = _REQUIRED) -> _T:
+    """``read(state[key])`` (``default`` for a missing entry, if given): entry ``key`` of a ``kind`` state dict read
+    back, or one NeurohoverError naming the entry when it is missing or damaged ('x' as a generation or a tracker was a
+    bare ValueError, TypeError or KeyError; fourteenth trial). A NeurohoverError of ``read`` (it names what it read)
+    goes through as it is."""
+    if key not in state and default is _REQUIRED:
+        raise NeurohoverError(f"{kind} state dict has no {key!r} entry: give a dict that {kind}.state_dict() returned")
+    value = state.get(key, default)
+    try:
+        return read(value)
+    except NeurohoverError:
+        raise
+    except STATE_DAMAGE as err:
+        raise NeurohoverError(
+            f"{kind} state dict's {key!r} entry {brief(value)} is damaged ({damage_text(err)}): give a dict that {kind}.state_dict() returned"
+        ) from None
+
+
+def read_count(value: Any) -> int:
+    """A state's count (a generation, evaluations): an integer >= 0, not a bool, else :class:`EntryError`."""
+    if not whole_number(value) or value < 0:
+        raise EntryError("not a count: allowed an integer >= 0")
+    return int(value)
+
+
+def read_seconds(value: Any) -> float:
+    """A state's seconds: a finite number >= 0, not a bool, else :class:`EntryError`."""
+    if not finite_real(value) or float(value) < 0.0:
+        raise EntryError("not a number of seconds: allowed a finite number >= 0")
+    return float(value)
 
 
 # --------------------------------------------------------------------------- champions

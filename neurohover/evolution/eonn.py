@@ -38,9 +38,10 @@ from ..evaluate import PolicyTable, evaluate_jobs
 from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP
-from .common import MAX_SPREAD
+from .common import MAX_SPREAD, require_spread, set_field
 from .fitness import episode_fitness
 from .operators import crossover, mutate
+from .seeding import check_seed
 
 __all__ = ["EonnResult", "EonnSettings", "eonn_evolve"]
 
@@ -106,6 +107,7 @@ class EonnSettings:
             v = getattr(self, name)
             if not finite_real(v) or not 0.0 <= v <= MAX_SPREAD:
                 raise NeurohoverError(f"{name}={brief(v)} is out of range: allowed a number in [0, {MAX_SPREAD:g}] (a larger one overflows the genes)")
+            set_field(self, name, require_spread(name, v))  # -0.0 as 0.0: NumPy's normal() refused it mid-run (fourteenth trial)
 
     @property
     def episodes(self) -> int:
@@ -141,7 +143,7 @@ def eonn_evolve(
 ) -> EonnResult:
     """Evolve a policy of ``prototype``'s topology on ``mdp`` as the authors' ``eonn`` did (module docstring)."""
     s = settings
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(check_seed(seed))
     spawn = dataclasses.replace(s, mutate_frac=s.spawn_frac, mutate_std=s.spawn_std)  # spawn's mutation of the first pool
     start = np.asarray(prototype.genome, dtype=np.float64)
     pool = np.stack([start] + [mutate(start, rng, spawn) for _ in range(s.pop_size - 1)])

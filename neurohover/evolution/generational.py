@@ -23,15 +23,20 @@ from .common import (
     TELL_FIRST,
     AskTellOrderError,
     Clock,
+    EntryError,
     TellInfo,
     check_genomes,
     check_prototype,
     check_returns,
+    check_settings,
     check_state,
     dec_array,
     enc_array,
     enc_float,
     rank,
+    read_count,
+    read_entry,
+    read_seconds,
     require_int,
     require_prob,
     require_spread,
@@ -41,6 +46,7 @@ from .common import (
 )
 from .fitness import FITNESS_SCALES
 from .operators import crossover, mutate
+from .seeding import check_seed
 
 __all__ = ["GENERATIONAL_PRESETS", "OLD_GENERATIONAL", "GenerationRecord", "GenerationalNE", "GenerationalSettings"]
 
@@ -212,9 +218,9 @@ class GenerationalNE:
         settings: GenerationalSettings | None = None,
         seed: int = 0,
     ) -> None:
-        self.settings = settings if settings is not None else GenerationalSettings()
+        self.settings = check_settings(settings, GenerationalSettings)
         self._prototype = check_prototype(prototype)
-        self._rng = np.random.default_rng(seed)
+        self._rng = np.random.default_rng(check_seed(seed))
         # The prototype plus copies of it, each put through the (initial) mutation once, not gated by mutate_prob.
         init = self.settings.initial_mutation()
         self._population = np.vstack([self._prototype] + [mutate(self._prototype, self._rng, init) for _ in range(self.settings.pop_size - 1)])
@@ -402,21 +408,37 @@ class GenerationalNE:
 
     @classmethod
     def from_state_dict(cls, state: dict[str, Any]) -> GenerationalNE:
-        """Rebuild an optimiser from :meth:`state_dict`; it continues identically."""
+        """Rebuild an optimiser from :meth:`state_dict`; it continues identically.
+
+        Raises
+        ------
+        NeurohoverError
+            A state that is not one of :meth:`state_dict`, naming its missing or damaged entry.
+        """
         check_state(state, "GenerationalNE")
-        opt = cls(dec_array(state["prototype"]), GenerationalSettings(**{**OLD_GENERATIONAL, **state["settings"]}))
+        kind = "GenerationalNE"
+        settings = read_entry(state, kind, "settings", lambda s: GenerationalSettings(**{**OLD_GENERATIONAL, **s}))
+        opt = cls(read_entry(state, kind, "prototype", dec_array), settings)
         d = opt._prototype.size
-        opt._population = check_genomes(dec_array(state["population"]), d, "population")
-        opt._asked = bool(state["asked"])
-        opt._generation = int(state["generation"])
-        opt._evaluations = int(state["evaluations"])
-        if opt._generation < 0 or opt._evaluations < 0:  # generation -1 was taken (eighth trial)
-            raise NeurohoverError(f"generation {opt._generation} or evaluations {opt._evaluations} is negative: not a count")
-        opt._champion_genome = check_genomes(dec_array(state["champion_genome"]), d, "champion genome", rows=0)
-        opt._champion_return = float(state["champion_return"])
-        opt._parents = check_genomes(dec_array(state.get("parents")), d, "parents")  # absent from checkpoints written before 2026-12-04
-        opt._hall = [(float(r), check_genomes(dec_array(g), d, "hall of fame genome", rows=0)) for r, g in state.get("hall_of_fame", [])]
-        opt._history = [GenerationRecord(int(g), int(e), int(ep), float(r), float(w)) for g, e, ep, r, w in state["history"]]
-        opt._rng = rng_from_state(state["rng"])
-        opt._clock = Clock(float(state["wall_seconds"]))
+        opt._population = read_entry(state, kind, "population", lambda a: check_genomes(dec_array(a), d, "population"))
+        opt._asked = read_entry(state, kind, "asked", _flag)
+        opt._generation = read_entry(state, kind, "generation", read_count)  # generation -1 was taken (eighth trial)
+        opt._evaluations = read_entry(state, kind, "evaluations", read_count)
+        opt._champion_genome = read_entry(state, kind, "champion_genome", lambda a: check_genomes(dec_array(a), d, "champion genome", rows=0))
+        opt._champion_return = read_entry(state, kind, "champion_return", float)
+        # "parents" and "hall_of_fame" are absent from checkpoints written before 2026-12-04
+        opt._parents = read_entry(state, kind, "parents", lambda a: check_genomes(dec_array(a), d, "parents"), None)
+        opt._hall = read_entry(
+            state, kind, "hall_of_fame", lambda h: [(float(r), check_genomes(dec_array(g), d, "hall of fame genome", rows=0)) for r, g in h], []
+        )
+        opt._history = read_entry(state, kind, "history", lambda h: [GenerationRecord(int(g), int(e), int(ep), float(r), float(w)) for g, e, ep, r, w in h])
+        opt._rng = read_entry(state, kind, "rng", rng_from_state)
+        opt._clock = Clock(read_entry(state, kind, "wall_seconds", read_seconds))
         return opt
+
+
+def _flag(value: Any) -> bool:
+    """A state's flag: True or False, else :class:`~neurohover.evolution.common.EntryError`."""
+    if not isinstance(value, bool):
+        raise EntryError("not a flag: allowed true or false")
+    return value

@@ -216,7 +216,9 @@ def bayes_mean_bounds(samples: np.ndarray, delta: float) -> tuple[float, float]:
         ``(lower, upper)``.
     """
     delta = _check_delta(delta)  # 1.5 gave (nan, nan) silently (thirteenth trial, F15)
-    x = as_floats(samples, "samples", "an array of returns").ravel()
+    x = as_floats(samples, "samples", "an array of returns")
+    if x.ndim != 1:  # a 2-D array was flattened and taken as one candidate's returns (fourteenth trial)
+        raise NeurohoverError(f"samples of shape {x.shape} is not allowed: give a 1-D array of returns, one candidate's")
     n = x.size
     if n == 0:
         raise NeurohoverError("bayes_mean_bounds needs at least one sample")

@@ -9,7 +9,6 @@ and :meth:`Run.restore` continues from one bit-for-bit.
 from __future__ import annotations
 
 import math
-import pickle
 import signal
 import threading
 import time
@@ -26,7 +25,7 @@ from ..launch import Parking
 from ..policies import Policy
 from ..sim.lanes import LANES
 from .bandits import BANDITS, top_mu_bandit
-from .common import Optimiser, TellInfo, check_genomes, enc_float
+from .common import STATE_DAMAGE, Optimiser, TellInfo, check_genomes, damage_text, enc_float
 from .config import RACE_T_LIMIT, RunConfig, next_auto_delta, upgrade_saved_config
 from .fitness import episode_fitness
 from .generational import GenerationalNE
@@ -169,8 +168,8 @@ class Run:
             )
         try:
             opt = type(self.opt).from_state_dict(state["optimizer_state"])
-        except (ValueError, KeyError, TypeError, AttributeError, IndexError, OverflowError, pickle.UnpicklingError) as err:
-            raise NeurohoverError(f"{source}: cannot restore the optimiser ({_damage(err)})") from None
+        except STATE_DAMAGE as err:  # from_state_dict names the damaged entry; a state's own class may raise more
+            raise NeurohoverError(f"{source}: cannot restore the optimiser ({damage_text(err)})") from None
         try:
             parts = _restored_parts(state, self.resampling.delta, self.cfg.prototype.genome.size)
             if self.mdp_rng is not None:
@@ -457,16 +456,9 @@ class Run:
         )
 
 
-def _damage(err: Exception) -> str:
-    """What a damaged checkpoint's error says, in a few words."""
-    if isinstance(err, KeyError):
-        return f"it has no {err.args[0]!r} entry"
-    return str(err) if isinstance(err, NeurohoverError) else f"{type(err).__name__}: {err}"
-
-
 def _damaged(source: str, err: Exception) -> NeurohoverError:
     """The error of a checkpoint ``source`` that cannot be read back (``err`` says what is wrong)."""
-    return NeurohoverError(f"{source} is a damaged checkpoint: {_damage(err)}; resume from an undamaged copy or start again without resuming")
+    return NeurohoverError(f"{source} is a damaged checkpoint: {damage_text(err)}; resume from an undamaged copy or start again without resuming")
 
 
 def _restored_parts(state: dict, delta: Any, genome_size: int) -> dict[str, Any]:

@@ -30,10 +30,14 @@ from .common import (
     check_genomes,
     check_prototype,
     check_returns,
+    check_settings,
     check_state,
     dec_array,
     enc_array,
     rank,
+    read_count,
+    read_entry,
+    read_seconds,
     require_int,
     require_prob,
     require_spread,
@@ -43,6 +47,7 @@ from .common import (
 )
 from .fitness import ERROR_FLOOR, episode_fitness
 from .operators import crossover, mutate
+from .seeding import check_seed
 
 __all__ = [
     "PLATEAU_RULES",
@@ -267,11 +272,11 @@ class SteadyStateNE(ChampionViews):
         settings: SteadyStateSettings | None = None,
         seed: int = 0,
     ) -> None:
-        self.settings = settings if settings is not None else SteadyStateSettings()
+        self.settings = check_settings(settings, SteadyStateSettings)
         self._prototype = check_prototype(prototype)
         floor = self.settings.mutation_floor
         self._scale = None if floor is None else np.maximum(np.abs(self._prototype), floor)
-        self._rng = np.random.default_rng(seed)
+        self._rng = np.random.default_rng(check_seed(seed))
         self._population: np.ndarray | None = None
         self._fitness: np.ndarray | None = None
         self._pending: np.ndarray | None = None
@@ -423,19 +428,26 @@ class SteadyStateNE(ChampionViews):
 
     @classmethod
     def from_state_dict(cls, state: dict[str, Any]) -> SteadyStateNE:
-        """Rebuild an optimiser from :meth:`state_dict`; it continues identically."""
+        """Rebuild an optimiser from :meth:`state_dict`; it continues identically.
+
+        Raises
+        ------
+        NeurohoverError
+            A state that is not one of :meth:`state_dict`, naming its missing or damaged entry.
+        """
         check_state(state, "SteadyStateNE")
+        kind = "SteadyStateNE"
         # States written before the plateau rule existed followed the literal rule.
-        settings = {"plateau_rule": "literal", **state["settings"]}
-        opt = cls(dec_array(state["prototype"]), SteadyStateSettings(**settings))
+        settings = read_entry(state, kind, "settings", lambda s: SteadyStateSettings(**{"plateau_rule": "literal", **s}))
+        opt = cls(read_entry(state, kind, "prototype", dec_array), settings)
         d = opt._prototype.size
-        opt._population = check_genomes(dec_array(state["population"]), d, "population")
-        opt._fitness = dec_array(state["fitness"])
+        opt._population = read_entry(state, kind, "population", lambda a: check_genomes(dec_array(a), d, "population"))
+        opt._fitness = read_entry(state, kind, "fitness", dec_array)
         if (opt._population is None) != (opt._fitness is None) or (opt._fitness is not None and opt._fitness.shape != (len(opt._population),)):
             raise NeurohoverError(f"fitness has shape {None if opt._fitness is None else opt._fitness.shape}: one return per genome of the population")
-        opt._pending = check_genomes(dec_array(state["pending"]), d, "pending genomes")
-        opt._generation = int(state["generation"])
-        opt._rng = rng_from_state(state["rng"])
-        opt._tracker = ChampionTracker.from_dict(state["tracker"])
-        opt._clock = Clock(float(state["wall_seconds"]))
+        opt._pending = read_entry(state, kind, "pending", lambda a: check_genomes(dec_array(a), d, "pending genomes"))
+        opt._generation = read_entry(state, kind, "generation", read_count)
+        opt._rng = read_entry(state, kind, "rng", rng_from_state)
+        opt._tracker = read_entry(state, kind, "tracker", ChampionTracker.from_dict)
+        opt._clock = Clock(read_entry(state, kind, "wall_seconds", read_seconds))
         return opt

@@ -7,6 +7,7 @@ negative in the helicopter domain) are negated before being passed on (:func:`lo
 from __future__ import annotations
 
 import base64
+import binascii
 import io
 import pickle
 import sys
@@ -18,7 +19,8 @@ import numpy as np
 
 from ...errors import NeurohoverError, brief
 from .. import common
-from ..common import MAX_POPULATION, PopulationOptimiser, TellInfo, check_prototype, require_spread
+from ..common import MAX_POPULATION, EntryError, PopulationOptimiser, TellInfo, check_prototype, read_entry, require_spread
+from ..seeding import check_seed
 from . import OptimiserSpec
 
 __all__ = ["CMAES", "SIGMA0", "CMASettings", "losses_of"]
@@ -129,7 +131,7 @@ class CMAES(PopulationOptimiser):
             raise NeurohoverError(f"popsize={brief(popsize)} must be None or an integer >= 2")
         if budget is not None and (not isinstance(budget, (int, np.integer)) or budget < 1):
             raise NeurohoverError(f"budget={brief(budget)} must be None or an integer >= 1")
-        self._rng = np.random.default_rng(seed)
+        self._rng = np.random.default_rng(check_seed(seed))
         rng = self._rng
         opts: dict = {
             "seed": float("nan"),
@@ -194,12 +196,26 @@ class CMAES(PopulationOptimiser):
 
         Raises
         ------
-        pickle.UnpicklingError, ValueError, KeyError
-            A state that is not one of :meth:`state_dict` (only load states you trust: unpickling
-            runs code).
+        NeurohoverError
+            A state that is not one of :meth:`state_dict`, naming its missing or damaged entry (only load states
+            you trust: unpickling runs code).
         """
+        kind = cls.__name__
+        if not isinstance(state, dict):
+            raise NeurohoverError(f"state dict is a {type(state).__name__}, not a dict")
         holder: list = [None]
-        opt = _Unpickler(io.BytesIO(base64.b64decode(state["pickle"])), holder).load()
+
+        def unpickle(text: str) -> CMAES:
+            try:
+                data = base64.b64decode(text, validate=True)
+            except binascii.Error:  # its type's name, "Error", would say nothing
+                raise EntryError("not base64 text: allowed the text state_dict() wrote") from None
+            opt = _Unpickler(io.BytesIO(data), holder).load()
+            if not isinstance(opt, cls):  # a pickle of something else was returned as it was
+                raise TypeError(f"it holds a {type(opt).__name__}, not a {kind}")
+            return opt
+
+        opt = read_entry(state, kind, "pickle", unpickle)  # {}, 'x': a bare KeyError, binascii.Error (fourteenth trial)
         holder[0] = opt._rng
         return opt
 

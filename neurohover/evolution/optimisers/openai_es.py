@@ -32,16 +32,21 @@ from ..common import (
     TellInfo,
     check_genomes,
     check_prototype,
+    check_settings,
     check_state,
     dec_array,
     enc_array,
     rank,
+    read_count,
+    read_entry,
+    read_seconds,
     require_population,
     require_spread,
     require_std,
     rng_from_state,
     set_field,
 )
+from ..seeding import check_seed
 from . import OptimiserSpec
 
 __all__ = ["OpenAIES", "OpenAIESSettings"]
@@ -121,9 +126,9 @@ class OpenAIES(PopulationOptimiser):
 
     def __init__(self, prototype: np.ndarray, settings: OpenAIESSettings | None = None, seed: int = 0) -> None:
         super().__init__()
-        self.settings = settings if settings is not None else OpenAIESSettings()
+        self.settings = check_settings(settings, OpenAIESSettings)
         self.mean = check_prototype(prototype)
-        self._rng = np.random.default_rng(seed)
+        self._rng = np.random.default_rng(check_seed(seed))
         self._m = np.zeros_like(self.mean)  # Adam's moments
         self._v = np.zeros_like(self.mean)
         self.generation = 0
@@ -180,16 +185,24 @@ class OpenAIES(PopulationOptimiser):
 
     @classmethod
     def from_state_dict(cls, state: dict[str, Any]) -> OpenAIES:
-        """The optimiser :meth:`state_dict` saved; it continues bit-for-bit identically."""
+        """The optimiser :meth:`state_dict` saved; it continues bit-for-bit identically.
+
+        Raises
+        ------
+        NeurohoverError
+            A state that is not one of :meth:`state_dict`, naming its missing or damaged entry.
+        """
         check_state(state, "OpenAIES")
-        opt = cls(dec_array(state["mean"]), OpenAIESSettings(**state["settings"]))
+        kind = "OpenAIES"
+        settings = read_entry(state, kind, "settings", lambda s: OpenAIESSettings(**s))
+        opt = cls(read_entry(state, kind, "mean", dec_array), settings)
         d = opt.mean.size
-        opt._m, opt._v = (check_genomes(dec_array(state["adam"][i]), d, "Adam moment", rows=0) for i in (0, 1))
-        opt.generation = int(state["generation"])
-        opt._eps = check_genomes(dec_array(state["pending"]), d, "pending noise", rows=opt.popsize // 2)
-        opt._rng = rng_from_state(state["rng"])
-        opt._tracker = ChampionTracker.from_dict(state["tracker"])
-        opt._clock = Clock(float(state["wall_seconds"]))
+        opt._m, opt._v = read_entry(state, kind, "adam", lambda a: tuple(check_genomes(dec_array(a[i]), d, "Adam moment", rows=0) for i in (0, 1)))
+        opt.generation = read_entry(state, kind, "generation", read_count)
+        opt._eps = read_entry(state, kind, "pending", lambda a: check_genomes(dec_array(a), d, "pending noise", rows=opt.popsize // 2))
+        opt._rng = read_entry(state, kind, "rng", rng_from_state)
+        opt._tracker = read_entry(state, kind, "tracker", ChampionTracker.from_dict)
+        opt._clock = Clock(read_entry(state, kind, "wall_seconds", read_seconds))
         return opt
 
 

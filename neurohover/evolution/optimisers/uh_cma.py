@@ -30,8 +30,8 @@ from typing import Any
 import cma
 import numpy as np
 
-from ...errors import NeurohoverError, brief, finite_real
-from ..common import TellInfo
+from ...errors import NeurohoverError, brief
+from ..common import TellInfo, check_settings, require_std
 from . import OptimiserSpec
 from .cma import CMAES, CMASettings, losses_of
 
@@ -71,15 +71,14 @@ class UHCMASettings(CMASettings):
             raise NeurohoverError(f"UH-CMA-ES reevaluations={brief(re)} must be None or an integer >= 1")
         if re is not None and self.popsize is not None and re > self.popsize:  # pycma indexed past the generation (eleventh trial)
             raise NeurohoverError(f"UH-CMA-ES reevaluations={brief(re)} must be at most popsize={self.popsize}: it re-evaluates solutions of one generation")
-        if isinstance(eps, bool) or not isinstance(eps, (int, float)) or not (finite_real(eps) and eps >= 0):
-            raise NeurohoverError(f"UH-CMA-ES epsilon={brief(eps)} must be a finite number >= 0")
-        object.__setattr__(self, "epsilon", float(eps))
+        object.__setattr__(self, "epsilon", require_std("UH-CMA-ES epsilon", eps))  # -0.0 as 0.0, as every spread
 
 
 class UHCMAES(CMAES):
     """CMA-ES with pycma's noise handler, ask/tell in two rounds a generation (module docstring)."""
 
     def __init__(self, prototype: np.ndarray, settings: UHCMASettings, seed: int = 0, budget: int | None = None) -> None:
+        settings = check_settings(settings, UHCMASettings)  # CMASettings() was an AttributeError (fourteenth trial)
         super().__init__(prototype, sigma0=settings.sigma0, seed=seed, popsize=settings.popsize, budget=budget)
         s = settings
         if s.reevaluations is not None and s.reevaluations > self.popsize:  # pycma's default popsize is known only here
