@@ -185,3 +185,12 @@ def test_sensor_row_values_are_numbers_not_text() -> None:
     ):
         nh.Sensor.from_row_values(np.array(["1"] * 7))
     assert nh.Sensor.from_row_values(np.array([0.1, 0, 0, 0, 0.5, 1, 0])) == nh.Sensor(0.1, correlation=0.5, delay=1)
+
+
+def test_a_vector_of_the_wrong_length_is_shown_briefly() -> None:
+    """T14-13's follow-up: finite_vector echoed the whole value (a 100,000-number list made a line as long)."""
+    from neurohover.tasks.base import finite_vector
+
+    with pytest.raises(NeurohoverError, match=r"y must be 2 numbers, got 100000: \[0, 1, 2, ") as err:
+        finite_vector(list(range(100_000)), 2, "y")
+    assert len(str(err.value)) < 120

@@ -206,15 +206,15 @@ def finite_vector(values: Sequence[float] | np.ndarray, length: int, what: str) 
     if isinstance(values, str) or any(
         isinstance(v, (str, bytes, bool, np.bool_, complex, np.complexfloating)) for v in np.ravel(np.asarray(values, dtype=object))
     ):
-        raise NeurohoverError(f"{what} must be {length} numbers, got {values!r}")
+        raise NeurohoverError(f"{what} must be {length} numbers, got {brief(values)}")
     try:
         arr = np.asarray(values, dtype=float)
     except (TypeError, ValueError, OverflowError):  # 10**400: OverflowError (fifth trial)
-        raise NeurohoverError(f"{what} must be {length} finite numbers, got {values!r:.80}") from None
+        raise NeurohoverError(f"{what} must be {length} finite numbers, got {brief(values)}") from None
     if arr.shape != (length,):
-        raise NeurohoverError(f"{what} must be {length} numbers, got {arr.size}: {values!r}")
+        raise NeurohoverError(f"{what} must be {length} numbers, got {arr.size}: {brief(values)}")
     if not np.all(np.isfinite(arr)):
-        raise NeurohoverError(f"{what} must be finite numbers, got {arr.tolist()}")
+        raise NeurohoverError(f"{what} must be finite numbers, got {brief(arr.tolist())}")
     return arr
 
 
