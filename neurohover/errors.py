@@ -52,6 +52,7 @@ def brief(value: object) -> str:
             return f"{'-' if value < 0 else ''}{digits[:10]}...({len(digits)} digits)"
     try:
         text = repr(value)
+        text = " ".join(text.split()) if "\n" in text else text  # an array's repr spans lines: one line in a message
     except ValueError:  # a container of such an int
         text = f"a {type(value).__name__}"
     return text if len(text) <= 60 else text[:57] + "..."

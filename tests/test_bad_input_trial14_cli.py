@@ -25,3 +25,12 @@ def test_written_names_are_printed_escaped(tmp_path: Path, cli) -> None:
     )
     assert rc == 0 and out.is_file()
     assert f"wrote {tmp_path}/a\\nb\\u202ec.json" in err and "\u202e" not in err
+
+
+def test_an_array_in_a_message_is_shown_on_one_line() -> None:
+    """The evolution fixer's note on T14-6: brief() of a NumPy array kept its repr's line breaks, splitting a message."""
+    import numpy as np
+
+    from neurohover.errors import brief
+
+    assert brief(np.zeros((2, 2))) == "array([[0., 0.], [0., 0.]])"
