@@ -34,14 +34,12 @@ def _ec_settings(settings, budget: int | None):
     ``budget`` as the evaluation cap; ``budget=None`` keeps the settings' own cap (the defaults
     have none: the paper's plateau stop alone)."""
     from ..evolution import SteadyStateSettings
+    from ..evolution.common import check_settings
     from ..evolution.config import check_budget
 
     if budget is not None:
         budget = check_budget(budget, "evaluations", ", or None (the plateau stop)")
-    if settings is None:
-        settings = SteadyStateSettings()
-    elif not isinstance(settings, SteadyStateSettings):
-        raise NeurohoverError(f"settings must be a SteadyStateSettings, got {type(settings).__name__}")
+    settings = check_settings(settings, SteadyStateSettings)
     return settings if budget is None else dataclasses.replace(settings, budget=int(budget))
 
 
@@ -55,9 +53,8 @@ def _evolve(
     """Run steady-state NE on genes ``params / scale`` from ``proto_params``; returns champion
     params, its fitness, evaluations, history. ``max_evaluations`` caps a run without a budget."""
     from ..evolution import SteadyStateNE
-    from ..evolution.seeding import check_seed
 
-    opt = SteadyStateNE(proto_params / scale, _ec_settings(settings, budget), seed=check_seed(seed))  # -1: one clear message, not NumPy's
+    opt = SteadyStateNE(proto_params / scale, _ec_settings(settings, budget), seed=seed)  # checks the seed itself
     while not opt.stop() and (max_evaluations is None or opt.evaluations < max_evaluations):
         genes = opt.ask()
         opt.tell(fitness(genes * scale))
