@@ -149,6 +149,8 @@ def ray_endpoint(address: str, source: str = "--address") -> tuple[str, int] | N
     NeurohoverError
         For any other form, naming the address and the forms allowed.
     """
+    if not isinstance(address, str):  # 5 was an AttributeError (fourteenth trial, T14-22)
+        raise NeurohoverError(f"{source} {brief(address)} is not a Ray cluster address: allowed {RAY_ADDRESS_FORMS}")
     if address in ("auto", "local"):
         return None
     rest = address[len("ray://") :] if address.startswith("ray://") else address
@@ -205,6 +207,8 @@ class RayExecutor:
     def __init__(self, address: str | None = None, *, max_retries: int = 3, num_cpus: int | None = None, device: str = "cpu") -> None:
         if device not in DEVICES:
             raise NeurohoverError(f"device={device!r} is unknown: allowed 'cpu' or 'cuda'")
+        if address is not None:  # its form before Ray is imported or started (address=5 was an AttributeError; T14-22)
+            ray_endpoint(address)
         self.device = device
         ray = import_ray()
         self.ray = ray

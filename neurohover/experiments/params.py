@@ -8,9 +8,10 @@ planner and these declarations cannot drift apart). Optional keys the planner le
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import MISSING, dataclass, fields
 from typing import Any
 
+from ..errors import NeurohoverError, brief
 from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..models.model import LEGACY_MODEL_SUBSTEPS
 
@@ -120,9 +121,25 @@ PARAMS: dict[str, type] = {
 
 
 def unit_params(kind: str, params: dict) -> Any:
-    """The params of a unit of ``kind`` as its typed params (a key the class does not declare is refused)."""
-    cls = PARAMS[kind]
-    unknown = sorted(set(params) - {f.name for f in fields(cls)})
-    if unknown:
-        raise ValueError(f"a {kind!r} unit's params hold {', '.join(unknown)}, which {cls.__name__} does not declare")
+    """The params of a unit of ``kind`` as its typed params.
+
+    Raises
+    ------
+    NeurohoverError
+        For a kind of no params class, params that are no dict, or params that hold a key the class does not
+        declare or lack one it needs: all of them named in one message (the missing ones were a TypeError of
+        ``__init__``; fourteenth trial, T14-23).
+    """
+    cls = PARAMS.get(kind) if isinstance(kind, str) else None
+    if cls is None:
+        raise NeurohoverError(f"unit kind {brief(kind)} is not allowed here: give one of {', '.join(PARAMS)}")
+    if not isinstance(params, dict):
+        raise NeurohoverError(f"a {kind!r} unit's params = {brief(params)} are not allowed: give a dict of {cls.__name__}'s fields")
+    declared = fields(cls)
+    unknown = sorted((k if isinstance(k, str) and len(k) <= 60 else brief(k) for k in set(params) - {f.name for f in declared}), key=str)
+    missing = [f.name for f in declared if f.name not in params and f.default is MISSING and f.default_factory is MISSING]
+    if unknown or missing:
+        wrong = [f"hold {', '.join(unknown)}, which {cls.__name__} does not declare"] if unknown else []
+        wrong += [f"lack {', '.join(missing)}, which {cls.__name__} needs"] if missing else []
+        raise NeurohoverError(f"a {kind!r} unit's params {' and '.join(wrong)}")
     return cls(**params)

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..agents.hybrid import HybridSettings
 from ..agents.registry import HYBRID_AGENTS, agent_spec
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..integrations.neat import NEAT_TOPOLOGY
 from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..models.model import LEGACY_MODEL_SUBSTEPS
@@ -549,10 +549,28 @@ def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
 _PLANNERS = {"evolution": _plan_evolution, "test_runs": _plan_test_runs, "model_learning": _plan_model_learning}
 
 
+def _results_table(value) -> bool:
+    """Whether ``value`` is key -> result (text -> dict), as the store's results are."""
+    return isinstance(value, dict) and all(isinstance(k, str) and isinstance(v, dict) for k, v in value.items())
+
+
+def _check_plan_arguments(cfg, results, sources) -> None:
+    """:func:`plan`'s arguments of the right kinds (None, [] or a config of None were AttributeErrors; fourteenth trial, T14-23)."""
+    if not isinstance(cfg, ExperimentConfig):
+        raise NeurohoverError(f"plan: cfg = {brief(cfg)} is not allowed: give an experiment's config, load_config(NAME, SCALE)")
+    if not _results_table(results):
+        raise NeurohoverError(f"plan: results = {brief(results)} is not allowed: give a dict of unit key -> result dict ({{}}: none finished)")
+    if sources is not None and not (isinstance(sources, dict) and all(isinstance(k, str) and _results_table(v) for k, v in sources.items())):
+        raise NeurohoverError(
+            f"plan: sources = {brief(sources)} is not allowed: give None or a dict of experiment name -> its results (unit key -> result dict)"
+        )
+
+
 def plan(cfg: ExperimentConfig, results: dict[str, dict], sources: dict[str, dict[str, dict]] | None = None) -> Plan:
     """Every unit that can be defined given ``results`` (key -> result) and the results of the
     experiments it draws from (``sources``: name -> results, :func:`source_experiments`), and the
     final unit count."""
+    _check_plan_arguments(cfg, results, sources)
     if cfg.kind == "test_runs":
         return _plan_test_runs(cfg, results, sources)
     return _PLANNERS[cfg.kind](cfg, results)

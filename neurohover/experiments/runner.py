@@ -13,7 +13,7 @@ from ..errors import NeurohoverError, brief
 from .config import POLICY_SOURCES, ExperimentConfig, check_own_name, check_paper_table
 from .plans import Plan, plan, run_keys, source_experiments
 from .results import check_run_lengths, result_from_dict
-from .store import Store
+from .store import Store, check_flag
 
 
 @dataclass
@@ -161,7 +161,7 @@ def _refuse_stray_units(config: ExperimentConfig, store: Store, results: dict[st
     return planned_from_all
 
 
-def _check_arguments(config, store, executor, progress, on_unit, only) -> tuple[str, ...]:
+def _check_arguments(config, store, executor, progress, on_unit, only, fresh, update) -> tuple[str, ...]:
     """:func:`reproduce`'s arguments of the right kinds (a name or a path was an AttributeError; fourth trial); returns
     ``only`` as a tuple of patterns, a single pattern as one ('run/*' was taken as r, u, n, ...; twelfth trial, U3)."""
     if not isinstance(config, ExperimentConfig):
@@ -172,6 +172,8 @@ def _check_arguments(config, store, executor, progress, on_unit, only) -> tuple[
         raise NeurohoverError(f"executor={executor!r:.60} is not allowed: give an executor, make_executor('local', jobs=N) or LocalExecutor(N)")
     check_paper_table(config.paper, f"experiment {config.name!r}")  # a config made without make_config: refused before the store is written
     check_own_name(config)  # a config of one's own named fig2 or its alias table3 was stored as the shipped one (eleventh trial, S8)
+    check_flag(fresh, "fresh", "discard the stored results first")  # 'no' was True: every stored unit was deleted (T14-4)
+    check_flag(update, "update", "keep the stored units a changed config plans alike")
     if progress not in (None, True, False):  # "no" drew the bar (twelfth trial, S7)
         raise NeurohoverError(f"progress={brief(progress)} is not allowed: give True, False or None (a bar on a terminal only)")
     if on_unit is not None and not callable(on_unit):  # 5 was a TypeError once the first unit had run (twelfth trial, T7)
@@ -205,7 +207,7 @@ def reproduce(
     """
     from tqdm import tqdm
 
-    only = _check_arguments(config, store, executor, progress, on_unit, only)
+    only = _check_arguments(config, store, executor, progress, on_unit, only, fresh, update)
     store.lock()  # one writer per store: a second run would redo every unit the first has not finished
     check_restart(fresh, update, only)
     held = store.config_hash(config.name, config.scale)

@@ -30,6 +30,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import re
 import socket
 import sqlite3
 import time
@@ -37,8 +38,10 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
-from ..errors import NeurohoverError, brief, finite_real
+from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..paths import JSONError, WriterLock, strict_json
+from .config import SCALES, check_name
+from .units import Unit
 
 SCHEMA_VERSION = 1
 APPLICATION_ID = 0x4E484F56  # "NHOV"
@@ -61,6 +64,55 @@ CREATE TABLE sessions (
 
 def _dumps(obj: Any) -> str:
     return json.dumps(obj, separators=(",", ":"), allow_nan=False)
+
+
+#: A compete run's scale, :func:`~neurohover.experiments.config.settings_scale`'s names (the pattern make_config checks too).
+_COMPETE_SCALE = re.compile(r"settings-[0-9a-f]{10}")
+
+
+def check_flag(value: Any, name: str, meaning: str) -> None:
+    """Refuse a flag that is not a bool: any truthy value counted as True, and ``fresh='no'`` deleted every stored unit
+    (fourteenth trial, T14-4). The one check of the Store's flags (and :func:`~neurohover.experiments.runner.reproduce`'s)."""
+    if not isinstance(value, bool):
+        raise NeurohoverError(f"{name}={brief(value)} is not allowed: give True ({meaning}) or False")
+
+
+def check_experiment(name: Any, scale: Any, where: str) -> None:
+    """Refuse an experiment name or scale that no config has (5 was stored as '5', '' and NUL were taken; fourteenth
+    trial, T14-5): names as :func:`~neurohover.experiments.config.check_name` allows, scales quick, paper or settings-HASH."""
+    check_name(name, where)
+    if scale not in SCALES and not (isinstance(scale, str) and _COMPETE_SCALE.fullmatch(scale)):
+        raise NeurohoverError(f"{where}: scale = {brief(scale)} is not allowed: give one of {', '.join(SCALES)} (or a compete run's settings-HASH)")
+
+
+def _check_text(value: Any, what: str, where: str, empty: bool = False) -> None:
+    """Refuse a stored text field that is no text, empty (unless ``empty``) or holding NUL (None was an IntegrityError)."""
+    if not isinstance(value, str) or (not value and not empty) or "\x00" in value:
+        allowed = "text" if empty else "non-empty text"
+        raise NeurohoverError(f"{where}: {what} = {brief(value)} is not allowed: give {allowed} without NUL characters")
+
+
+def _count(value: Any, what: str, where: str, least: int) -> int:
+    """``value`` as an int of at least ``least``, or one error naming it (cores=0 was stored, and read back as damaged)."""
+    if not whole_number(value) or value < least:
+        raise NeurohoverError(f"{where}: {what} = {brief(value)} is not allowed: give a whole number >= {least}")
+    return int(value)
+
+
+def _object_text(value: Any, what: str, where: str) -> str:
+    """``value``'s JSON text, if it is a JSON object that reads back (:func:`~neurohover.paths.strict_json`), or one error
+    naming it: a list was stored and every later read called the store damaged, NaN was json's ValueError (T14-5)."""
+    if not isinstance(value, dict):
+        raise NeurohoverError(f"{where}: {what} = {brief(value)} is not allowed: give a dict (a JSON object)")
+    try:
+        text = _dumps(value)
+        strict_json(text)  # what is written reads back: no key twice ({1: .., '1': ..}), no integer past a float's range
+    except (TypeError, ValueError, RecursionError) as err:  # JSONError is a ValueError
+        raise NeurohoverError(
+            f"{where}: {what} = {brief(value)} is not allowed: give a JSON object of text, finite numbers, bools, None, lists and such objects "
+            f"({str(err)[:80]})"
+        ) from None
+    return text
 
 
 @contextlib.contextmanager
@@ -87,8 +139,7 @@ class Store:
     def __init__(self, path: str | Path, *, create: bool = True) -> None:
         from ..paths import checked_path
 
-        if not isinstance(create, bool):  # create='no' was true (sixth trial)
-            raise NeurohoverError(f"create={create!r:.40} is not allowed: give True (make the store if missing) or False")
+        check_flag(create, "create", "make the store if missing")  # create='no' was true (sixth trial)
 
         self.path = checked_path(path, "results store", "results store's file path")  # None, 3, NUL, a name too long
         if not self.path.exists() and not create:
@@ -219,6 +270,11 @@ class Store:
         ``fresh`` deletes the experiment's stored units and sessions first (a deliberate restart).
         Takes the writer lock first (see :meth:`lock`).
         """
+        where = self._where("begin")
+        check_experiment(name, scale, where)
+        _check_text(config_hash, "config_hash", where)
+        text = _object_text(config, "config", where)
+        check_flag(fresh, "fresh", "delete the experiment's stored units first")
         self.lock()
         c = self.conn
         with _transaction(c):
@@ -227,7 +283,7 @@ class Store:
                     c.execute(f"DELETE FROM {table} WHERE name = ? AND scale = ?", (name, scale))
             row = c.execute("SELECT config_hash FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
             if row is None:
-                c.execute("INSERT INTO experiments VALUES (?, ?, ?, ?, ?)", (name, scale, config_hash, _dumps(config), time.time()))
+                c.execute("INSERT INTO experiments VALUES (?, ?, ?, ?, ?)", (name, scale, config_hash, text, time.time()))
             elif row[0] != config_hash:
                 raise NeurohoverError(
                     f"results store {str(self.path)!r} already holds experiment {name!r} at scale {scale!r} with config "
@@ -237,7 +293,7 @@ class Store:
                     f"every stored result of {name!r} ({scale})"
                 )
             else:  # same settings: keep the latest title and paper numbers (they do not change results)
-                c.execute("UPDATE experiments SET config = ? WHERE name = ? AND scale = ?", (_dumps(config), name, scale))
+                c.execute("UPDATE experiments SET config = ? WHERE name = ? AND scale = ?", (text, name, scale))
 
     def update(self, name: str, scale: str, config_hash: str, config: dict, keep: Iterable[str]) -> int:
         """Register a changed config of experiment (name, scale), keeping the stored units named in ``keep``.
@@ -247,23 +303,31 @@ class Store:
         plans with the same key, kind and params: :func:`neurohover.experiments.runner.unchanged_units`).
         Returns the number of units kept.
         """
+        where = self._where("update")
+        check_experiment(name, scale, where)
+        _check_text(config_hash, "config_hash", where)
+        text = _object_text(config, "config", where)
+        given = list(keep) if isinstance(keep, Iterable) and not isinstance(keep, (str, bytes, dict)) else None
+        if given is None or not all(isinstance(k, str) for k in given):  # None was a TypeError; a text would be kept letter by letter
+            raise NeurohoverError(f"{where}: keep = {brief(keep)} is not allowed: give a list or set of unit keys (text) to keep")
+        kept = set(given)
         self.lock()
         c = self.conn
-        keep = set(keep)
         with _transaction(c):
             if c.execute("SELECT 1 FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone() is None:
                 raise NeurohoverError(self.missing_message(name, scale))
             stored = [k for (k,) in c.execute("SELECT key FROM units WHERE name = ? AND scale = ?", (name, scale))]
-            gone = [k for k in stored if k not in keep]
+            gone = [k for k in stored if k not in kept]
             c.executemany("DELETE FROM units WHERE name = ? AND scale = ? AND key = ?", [(name, scale, k) for k in gone])
             c.execute("DELETE FROM sessions WHERE name = ? AND scale = ?", (name, scale))
             c.execute("UPDATE units SET config_hash = ? WHERE name = ? AND scale = ?", (config_hash, name, scale))
-            c.execute("UPDATE experiments SET config_hash = ?, config = ? WHERE name = ? AND scale = ?", (config_hash, _dumps(config), name, scale))
+            c.execute("UPDATE experiments SET config_hash = ?, config = ? WHERE name = ? AND scale = ?", (config_hash, text, name, scale))
         return len(stored) - len(gone)
 
     def forget_if_empty(self, name: str, scale: str) -> bool:
         """Remove experiment (name, scale) and its sessions if it holds no unit (a run refused after it was registered
         leaves the store as it was); whether it was removed."""
+        check_experiment(name, scale, self._where("forget_if_empty"))
         self.lock()
         c = self.conn
         with _transaction(c):
@@ -360,10 +424,31 @@ class Store:
             raise NeurohoverError(f"results store {str(self.path)!r}: {what} is damaged (a JSON {type(value).__name__}, not an object)")
         return value
 
+    def _where(self, method: str) -> str:
+        """Where a write's arguments are refused, for its messages."""
+        return f"results store {str(self.path)!r}, {method}"
+
     def put(self, name: str, scale: str, config_hash: str, unit, result: dict, seconds: float, worker: str = "", session: int | None = None) -> bool:
-        """Record one finished unit in its own transaction; False if it was already there."""
+        """Record one finished unit in its own transaction; False if it was already there.
+
+        Every argument is checked before anything is written (a NaN ``seconds`` bound as NULL, and the unit was
+        dropped without a word: a lost result; fourteenth trial, T14-5).
+        """
+        where = self._where("put")
+        check_experiment(name, scale, where)
+        _check_text(config_hash, "config_hash", where)
+        if not isinstance(unit, Unit):
+            raise NeurohoverError(f"{where}: unit = {brief(unit)} is not allowed: give the Unit that finished (a plan's)")
+        _check_text(unit.key, "the unit's key", where)
+        _check_text(unit.kind, "the unit's kind", where)
+        params = _object_text(unit.params, f"unit {unit.key}'s params", where)
+        text = _object_text(result, f"unit {unit.key}'s result", where)
+        if not (finite_real(seconds) and seconds >= 0):
+            raise NeurohoverError(f"{where}: seconds = {brief(seconds)} is not allowed: give a finite number of seconds >= 0")
+        _check_text(worker, "worker", where, empty=True)
+        if session is not None:
+            session = _count(session, "session", where, 1)
         c = self.conn
-        text = _dumps(result)
         with _transaction(c):
             row = c.execute("SELECT config_hash FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
             if row is None or row[0] != config_hash:
@@ -373,7 +458,7 @@ class Store:
                 )
             cur = c.execute(
                 "INSERT OR IGNORE INTO units VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                (name, scale, unit.key, unit.kind, config_hash, _dumps(unit.params), text, float(seconds), worker, time.time()),
+                (name, scale, unit.key, unit.kind, config_hash, params, text, float(seconds), worker, time.time()),
             )
             if session is not None and cur.rowcount:
                 c.execute("UPDATE sessions SET units_run = units_run + 1, wall_seconds = ? - started WHERE id = ?", (time.time(), session))
@@ -382,15 +467,28 @@ class Store:
     # ------------------------------------------------------------------ sessions
 
     def start_session(self, name: str, scale: str, config_hash: str, executor: str, cores: int, units_before: int) -> int:
+        """Record the start of a run of experiment (name, scale) on ``cores`` cores of ``executor``; its session id.
+
+        Arguments are checked first (cores=0 was stored, and :meth:`sessions` then called the store damaged; T14-5)."""
+        where = self._where("start_session")
+        check_experiment(name, scale, where)
+        _check_text(config_hash, "config_hash", where)
+        _check_text(executor, "executor", where)
+        cores = _count(cores, "cores", where, 1)
+        units_before = _count(units_before, "units_before", where, 0)
         cur = self.conn.execute(
             "INSERT INTO sessions (name, scale, config_hash, executor, cores, started, wall_seconds, units_run, units_before, status) "
             "VALUES (?, ?, ?, ?, ?, ?, 0, 0, ?, 'running')",
-            (name, scale, config_hash, executor, int(cores), time.time(), units_before),
+            (name, scale, config_hash, executor, cores, time.time(), units_before),
         )
         assert cur.lastrowid is not None  # an INSERT always sets it
         return cur.lastrowid
 
     def end_session(self, session: int, status: str) -> None:
+        """Record how session ``session`` (:meth:`start_session`'s id) ended: ``status`` and its wall time."""
+        where = self._where("end_session")
+        session = _count(session, "session", where, 1)
+        _check_text(status, "status", where)  # object() was sqlite3's ProgrammingError (T14-5)
         self.conn.execute("UPDATE sessions SET status = ?, wall_seconds = ? - started WHERE id = ?", (status, time.time(), session))
 
     def sessions(self, name: str, scale: str) -> list[dict]:
