@@ -40,6 +40,7 @@ from .evolution.seeding import check_seed
 from .paths import write_png
 from .sim.constants import EPISODE_STEPS
 from .tasks import N_TEST, N_TRAINING, Drift, Sensor, get_task_family
+from .tasks.drift import MAX_RUN_EPISODES  # a run's episodes, the bound of a drifting MDP's episodes too
 
 CSV_COLUMNS = ("run", "mdp", "episode", "return", "crashed", "steps", "policy", "safeguard_fired")
 STORE_FILE = "results.sqlite"
@@ -107,8 +108,8 @@ def plot_cumulative(curves: dict[str, np.ndarray], path: Path, title: str) -> Pa
     return write_png(fig, path, "plot file", dpi=110)
 
 
-#: The largest competition (planned in memory, each episode's results stored): runs, and episodes over all runs.
-MAX_RUNS, MAX_RUN_EPISODES = 100_000, 100_000_000
+#: The largest competition (planned in memory, each episode's results stored): its runs (MAX_RUN_EPISODES: its episodes over all runs).
+MAX_RUNS = 100_000
 
 
 def check_sizes(runs: int, episodes: int) -> None:

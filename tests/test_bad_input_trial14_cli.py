@@ -34,3 +34,15 @@ def test_an_array_in_a_message_is_shown_on_one_line() -> None:
     from neurohover.errors import brief
 
     assert brief(np.zeros((2, 2))) == "array([[0., 0.], [0., 0.]])"
+
+
+def test_a_long_bad_experiment_name_is_shown_briefly() -> None:
+    """The store fixer's note: check_name echoed a bad name whole ({name!r}), so a 100,000-character name made a line as long."""
+    import pytest
+
+    from neurohover.errors import NeurohoverError
+    from neurohover.experiments.config import check_name
+
+    with pytest.raises(NeurohoverError, match=r"name = '//////////.*\(100,000 characters\) is not allowed") as err:
+        check_name("/" * 100_000, "here")
+    assert len(str(err.value)) < 250

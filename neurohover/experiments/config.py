@@ -343,7 +343,14 @@ PAPER_KEYS = ("notes", "claims", "ttests", "groups", "table", "table3")
 def check_name(name, where: str) -> None:
     """Refuse an experiment name that is not a safe file name (``../x``, ``""``, a slash)."""
     if not isinstance(name, str) or not _SAFE_NAME.fullmatch(name):
-        raise NeurohoverError(f"{where}: name = {name!r} is not allowed: give 1-100 letters, digits, '.', '_' or '-', starting with a letter or digit")
+        raise NeurohoverError(f"{where}: name = {brief(name)} is not allowed: give 1-100 letters, digits, '.', '_' or '-', starting with a letter or digit")
+
+
+def check_scale(scale, where: str) -> None:
+    """Refuse a scale no experiment has: quick, paper, or a compete run's settings-HASH (:func:`settings_scale`); 'weird'
+    was stored (twelfth trial, S7). Shared by :func:`make_config` and the store's writes."""
+    if scale not in SCALES and not (isinstance(scale, str) and _COMPETE_SCALE.fullmatch(scale)):
+        raise NeurohoverError(f"{where}: scale = {brief(scale)} is not allowed: give one of {', '.join(SCALES)} (or a compete run's settings-HASH)")
 
 
 def _paper_p(p) -> bool:
@@ -476,8 +483,7 @@ def make_config(
     check_name(name, where)
     if kind not in KINDS:
         raise NeurohoverError(f"{where}: kind = {kind!r} is not allowed: expected one of {', '.join(KINDS)}")
-    if scale not in SCALES and not (isinstance(scale, str) and _COMPETE_SCALE.fullmatch(scale)):  # 'weird' was stored (twelfth trial, S7)
-        raise NeurohoverError(f"{where}: scale = {brief(scale)} is not allowed: give one of {', '.join(SCALES)} (or a compete run's settings-HASH)")
+    check_scale(scale, where)
     for key, text in (("title", title), ("paper_ref", paper_ref), ("source", source)):  # title=5 was later called a damaged store (twelfth trial, U2)
         if not isinstance(text, str):
             raise NeurohoverError(f"{where}: {key} = {brief(text)} is not allowed: give text")

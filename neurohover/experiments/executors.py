@@ -25,7 +25,7 @@ from typing import Any
 
 from ..errors import NeurohoverError, brief, whole_number
 from ..evaluate import DEVICES, check_device
-from ..procs import sigterm_as_interrupt, stop_pool, worker_pool
+from ..procs import max_jobs, sigterm_as_interrupt, stop_pool, worker_pool
 from .store import worker_name
 from .units import Unit, run_unit
 
@@ -44,7 +44,7 @@ def timed_run(unit: dict, threads: int | None = 1, device: str = "cpu") -> tuple
 
 def check_jobs(jobs) -> int:
     """``jobs`` local worker processes: an integer from 1 to this machine's cores (NeurohoverError otherwise)."""
-    cores = os.cpu_count() or 1
+    cores = max_jobs()
     if not whole_number(jobs):  # '2' was called out of range (twelfth trial, U1)
         raise NeurohoverError(f"--jobs {brief(jobs)} is not allowed: give an integer in 1..{cores} (the cores of this machine)")
     if not 1 <= int(jobs) <= cores:

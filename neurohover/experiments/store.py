@@ -30,7 +30,6 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-import re
 import socket
 import sqlite3
 import time
@@ -40,7 +39,7 @@ from typing import Any
 
 from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..paths import JSONError, WriterLock, strict_json
-from .config import SCALES, check_name
+from .config import check_name, check_scale
 from .units import Unit
 
 SCHEMA_VERSION = 1
@@ -66,10 +65,6 @@ def _dumps(obj: Any) -> str:
     return json.dumps(obj, separators=(",", ":"), allow_nan=False)
 
 
-#: A compete run's scale, :func:`~neurohover.experiments.config.settings_scale`'s names (the pattern make_config checks too).
-_COMPETE_SCALE = re.compile(r"settings-[0-9a-f]{10}")
-
-
 def check_flag(value: Any, name: str, meaning: str) -> None:
     """Refuse a flag that is not a bool: any truthy value counted as True, and ``fresh='no'`` deleted every stored unit
     (fourteenth trial, T14-4). The one check of the Store's flags (and :func:`~neurohover.experiments.runner.reproduce`'s)."""
@@ -81,8 +76,7 @@ def check_experiment(name: Any, scale: Any, where: str) -> None:
     """Refuse an experiment name or scale that no config has (5 was stored as '5', '' and NUL were taken; fourteenth
     trial, T14-5): names as :func:`~neurohover.experiments.config.check_name` allows, scales quick, paper or settings-HASH."""
     check_name(name, where)
-    if scale not in SCALES and not (isinstance(scale, str) and _COMPETE_SCALE.fullmatch(scale)):
-        raise NeurohoverError(f"{where}: scale = {brief(scale)} is not allowed: give one of {', '.join(SCALES)} (or a compete run's settings-HASH)")
+    check_scale(scale, where)
 
 
 def _check_text(value: Any, what: str, where: str, empty: bool = False) -> None:
