@@ -65,7 +65,10 @@ class FloatRangeError(ValueError):
 def float_of(text: str) -> float:
     """``float(text)``, but a number past a float's range is a :class:`FloatRangeError` naming it, not inf: '1' and 400
     zeros was read as inf and reported as a value the user never typed (eighth trial). 'inf' written as such stays inf;
-    text that is no number is float()'s own ValueError."""
+    text that is no number is float()'s own ValueError, as is one with '_' between its digits, which float() reads
+    ('1_0' as 10: a sensor flew at level 10 for "level=1_0"; fifteenth trial, T15-13)."""
+    if isinstance(text, str) and "_" in text:
+        raise ValueError(f"could not convert string to float: {text!r} (no '_' between digits)")
     value = float(text)
     if math.isinf(value) and "inf" not in str(text).lower():
         shown = str(text).strip()

@@ -1,0 +1,32 @@
+"""The fifteenth bad-input trial's findings in the numbers the command line and the settings texts read: each gives one
+clear message (exit 2 / NeurohoverError) naming the value and what is allowed."""
+
+from __future__ import annotations
+
+import pytest
+
+from neurohover.errors import NeurohoverError
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (("--obs-noise", "level=1_0"), "sensor setting 'level=1_0' needs a number after '='"),
+        (("--obs-noise", "1_0"), "sensor setting '1_0' is not understood"),
+        (("--params", "1_0,2"), "--params must be comma-separated numbers, got '1_0,2'"),
+    ],
+)
+def test_a_number_with_an_underscore_is_refused(cli, args, message: str) -> None:
+    """T15-13: float() reads '1_0' as 10, so a sensor flew at level 10 and a wind was called [10.0, 2.0]."""
+    rc, _, err = cli("fly", "--task", "ghh08", "--episodes", "1", *args)
+    assert rc == 2 and message in err
+
+
+def test_settings_texts_refuse_a_number_with_an_underscore() -> None:
+    """T15-13, the Python side of the same parsers (Sensor.parse, Drift.parse)."""
+    from neurohover.tasks import Drift, Sensor
+
+    with pytest.raises(NeurohoverError, match="'level=1_0' needs a number after '='"):
+        Sensor.parse("level=1_0")
+    with pytest.raises(NeurohoverError, match="drift 'walk=1_0' is not understood"):
+        Drift.parse("walk=1_0")
