@@ -44,6 +44,12 @@ def check_discount_and_scale(gamma, scale) -> None:
             raise NeurohoverError(f"{name}={brief(value)} is out of range: allowed {allowed}")
 
 
+def check_env(env) -> None:
+    """Refuse a wrapper's ``env`` that is no gymnasium Env by name (None was Gymnasium's TypeError; fifteenth trial T15-11)."""
+    if not isinstance(env, gym.Env):
+        raise NeurohoverError(f"env={brief(env)} is not allowed: give a gymnasium Env (gymnasium.make('neurohover/GHH08-Short-v0'), a HoverEnv)")
+
+
 def crash_aware(reward, gamma: float = 0.99, scale: float = 1.0):
     """The crash-aware squash of a reward (a float, or an array of them).
 
@@ -72,6 +78,7 @@ class CrashAwareReward(gym.RewardWrapper):
     """Rewards of :func:`crash_aware` (``gamma``: the learner's discount, in (0, 1]; ``scale`` > 0)."""
 
     def __init__(self, env: gym.Env, gamma: float = 0.99, scale: float = 1.0) -> None:
+        check_env(env)
         check_discount_and_scale(gamma, scale)
         super().__init__(env)
         self.gamma, self.scale = float(gamma), float(scale)

@@ -9,7 +9,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief, whole_number
 from ..sim.constants import MAX_EPISODE_STEPS
 from ..tasks import MDP, TaskFamily, get_task_family
 from ..tasks.sensor import Sensor
@@ -56,15 +56,15 @@ def resolve_mdp(family: TaskFamily, spec: Any, cache: dict[str, MDP] | None = No
 
 
 def check_noise_stream(value: Any, what: str = "noise") -> tuple[int, int]:
-    """A ``(seed, episode)`` pair naming one gust-noise stream of the kernel, validated."""
-    try:
-        seed, episode = value
-    except (TypeError, ValueError):
-        raise NeurohoverError(f"{what}={value!r} is not allowed: give a (seed, episode) pair of integers") from None
-    for name, v, hi in (("seed", seed, MAX_NOISE_SEED), ("episode", episode, MAX_NOISE_SEED)):
-        if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or not 0 <= int(v) <= hi:
-            raise NeurohoverError(f"{what} {name}={v!r} is out of range: allowed an integer in 0..2**63-1")
-    return int(seed), int(episode)
+    """A ``(seed, episode)`` pair naming one gust-noise stream of the kernel, validated: a tuple, list or 1-D array of two
+    integers (a dict was unpacked to its keys and "12" to '1' and '2'; fifteenth trial T15-19)."""
+    pair = isinstance(value, (tuple, list)) or (isinstance(value, np.ndarray) and value.ndim == 1)
+    if not pair or len(value) != 2 or not all(whole_number(v) for v in value):
+        raise NeurohoverError(f"{what}={brief(value)} is not allowed: give a (seed, episode) pair of integers in 0..2**63-1")
+    for name, v in zip(("seed", "episode"), value):
+        if not 0 <= int(v) <= MAX_NOISE_SEED:
+            raise NeurohoverError(f"{what} {name}={brief(v)} is out of range: allowed an integer in 0..2**63-1")
+    return int(value[0]), int(value[1])
 
 
 def sensed_family(task: str, sigma: float | None, obs_noise: Any, obs_delay: Any) -> TaskFamily:

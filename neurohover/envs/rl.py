@@ -38,9 +38,10 @@ from gymnasium.wrappers.vector import TransformAction as VectorTransformAction
 from gymnasium.wrappers.vector import TransformObservation as VectorTransformObservation
 from gymnasium.wrappers.vector import TransformReward as VectorTransformReward
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..sim.constants import ACTION_DIM, MAX_POSITION, MAX_RATE, MAX_VELOCITY
-from ..wrappers import CrashAwareReward, crash_aware
+from ..tasks import get_task_family
+from ..wrappers import CrashAwareReward, check_env, crash_aware
 from .arguments import real_values
 from .hover import HoverEnv
 from .vector import HoverVectorEnv
@@ -66,23 +67,41 @@ RL_SETTINGS: dict[str, Any] = {"episode_steps": 1000, "obs_dtype": "float32", "a
 
 def scale_observation(obs: np.ndarray) -> np.ndarray:
     """Readings (..., 12) divided by their crash limits, in their own dtype: what an RL id's policy sees."""
-    obs = np.asarray(obs)
+    given = obs
+    try:
+        obs = np.asarray(obs)
+    except ValueError:  # ragged
+        obs = np.asarray(None)
+    if obs.dtype.kind not in "iuf" or obs.ndim == 0 or obs.shape[-1] != OBS_LIMITS.size:  # 11 readings were a broadcast error (T15-6)
+        shape = f" (shape {obs.shape})" if obs.dtype.kind in "iuf" else ""
+        raise NeurohoverError(f"observation {brief(given)}{shape} is not allowed: observations must be (..., 12) real numbers")
     return (obs / OBS_LIMITS).astype(obs.dtype if obs.dtype.kind == "f" else np.float64, copy=False)
+
+
+def authority(task: str) -> np.ndarray:
+    """The action authority of family ``task`` (any spelling :func:`neurohover.tasks.get_task_family` takes): an unknown
+    task is refused, where it silently had full authority (fifteenth trial T15-18)."""
+    found = ACTION_AUTHORITY.get(task) if isinstance(task, str) else None  # the usual spelling: a dict look-up a step
+    return found if found is not None else ACTION_AUTHORITY.get(get_task_family(task).name, FULL_AUTHORITY)
 
 
 def controls(action: np.ndarray, task: str) -> np.ndarray:
     """The task's controls (..., 4), float64, of an RL id's actions on family ``task``."""
+    scale = authority(task)
     a = real_values(action, f"action {action!r:.80} is not allowed: give 4 real numbers in [-1, 1] per helicopter")
     if a.ndim == 0 or a.shape[-1] != ACTION_DIM:
         raise NeurohoverError(f"action has shape {a.shape}, expected (..., 4): 4 numbers in [-1, 1] per helicopter")
     a = np.clip(a, -1.0, 1.0)
-    return ACTION_OFFSET + ACTION_AUTHORITY.get(task, FULL_AUTHORITY) * (a + CUBIC * a**3) / (1.0 + CUBIC)
+    return ACTION_OFFSET + scale * (a + CUBIC * a**3) / (1.0 + CUBIC)
 
 
 def rl_policy(act, task: str):
     """A policy of the paper's observations (a batch (n, 12) -> controls (n, 4)) from ``act``, one trained on the RL id
     of family ``task`` (scaled observations -> its actions): what :func:`neurohover.integrations.flying.evaluate_callable`
     flies."""
+    if not callable(act):  # it failed only when the policy was flown (T15-18)
+        raise NeurohoverError(f"act={brief(act)} is not allowed: give a callable (scaled observations (n, 12) -> actions (n, 4))")
+    task = get_task_family(task).name  # an unknown task refused here, not at the first step
 
     if getattr(act, "indexed", False):  # a recurrent policy: its episodes' indices pass through
 
@@ -101,6 +120,10 @@ def rl_policy(act, task: str):
 class ScaledObservation(gym.ObservationWrapper):
     """Observations of :func:`scale_observation` (the space keeps its shape and dtype; its bounds are infinite)."""
 
+    def __init__(self, env: gym.Env) -> None:
+        check_env(env)
+        super().__init__(env)
+
     def observation(self, observation: np.ndarray) -> np.ndarray:
         return scale_observation(observation)
 
@@ -109,8 +132,9 @@ class ScaledAction(gym.ActionWrapper):
     """Actions in [-1, 1] made the task's controls by :func:`controls`."""
 
     def __init__(self, env: gym.Env, task: str) -> None:
+        check_env(env)
+        self.task = get_task_family(task).name  # refused by name, not flown with full authority (T15-18)
         super().__init__(env)
-        self.task = task
 
     def action(self, action: np.ndarray) -> np.ndarray:
         return controls(action, self.task).astype(self.env.action_space.dtype)
