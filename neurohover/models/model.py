@@ -48,6 +48,7 @@ __all__ = [
     "MODEL_METHODS",
     "MODEL_DT",
     "MODEL_SUBSTEPS",
+    "check_model_substeps",
     "DEFAULT_MODEL_SUBSTEPS",
     "LEGACY_MODEL_SUBSTEPS",
     "LearnedModel",
@@ -76,6 +77,13 @@ MODEL_SUBSTEPS = (1, SUBSTEPS)
 DEFAULT_MODEL_SUBSTEPS = SUBSTEPS
 #: What an absent ``model_substeps`` means in the configs and units stored before 2026-12-04: one step.
 LEGACY_MODEL_SUBSTEPS = 1
+
+
+def check_model_substeps(substeps: object) -> None:
+    """Refuse ``substeps`` unless it is one of :data:`MODEL_SUBSTEPS` (a NumPy integer too; True, 10.0 and 'x' not):
+    the one check of a learned model's substeps."""
+    if not whole_number(substeps) or substeps not in MODEL_SUBSTEPS:
+        raise NeurohoverError(f"substeps={brief(substeps)}: allowed {' or '.join(map(str, MODEL_SUBSTEPS))} (integrations of a learned model's control step)")
 
 
 def default_model_substeps(task: str) -> int:
@@ -200,8 +208,7 @@ class LearnedModel:
         Ten substeps need every axis to have an equivalent. A model's wind stays as it is: it enters the
         drag as a velocity, ``C (u + wind)``, so it scales with C as the gains do.
         """
-        if substeps not in MODEL_SUBSTEPS:
-            raise NeurohoverError(f"substeps={substeps!r}: allowed {' or '.join(map(str, MODEL_SUBSTEPS))}")
+        check_model_substeps(substeps)
         label = label if label is not None else f"model/{self.method}"
         wind_kind, wind = self.wind.mdp_wind()
         if substeps == 1:
@@ -222,6 +229,7 @@ class LearnedModel:
         An axis whose one-step multiplier ``1 + 0.1 C`` is not positive flips sign every control step:
         no substeps reproduce it, so such a model (strong sensor noise fits one) is flown as fitted.
         """
+        check_model_substeps(substeps)  # 'x' returned 1 (fifteenth trial T15-29)
         if substeps == 1:
             return 1
         return 1 if _axes_without_equivalent(self.equivalent()[0]) else substeps

@@ -63,8 +63,8 @@ class WindAxis:
     def __post_init__(self) -> None:
         for name in ("amplitude", "omega", "phase", "offset"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not finite_real(value):
-                raise NeurohoverError(f"wind {name}={value!r} must be a finite number")
+            if not finite_real(value):  # NumPy reals (np.float32(1)) are numbers too; bools are not (fifteenth trial T15-17)
+                raise NeurohoverError(f"wind {name}={brief(value)} must be a finite number")
             object.__setattr__(self, name, float(value))
         if self.omega < 0:
             raise NeurohoverError(f"wind omega={self.omega!r} must be >= 0 (rad/s); a negative frequency is a phase of pi")

@@ -25,17 +25,20 @@ from .constants import (
     MAX_EPISODE_STEPS,
     MAX_POSITION,
     MAX_RATE,
+    MAX_SENSOR_DELAY,
     MAX_VELOCITY,
     MIN_QW,
     WIND_CONSTANT,
     WIND_SINUSOID,
 )
 
+__all__ = ["Quat", "ReferenceHelicopter", "ReferenceMDP", "ReferenceSensors", "Vec", "competition_time", "fly_episode", "rotation_vector_quaternion"]
+
 Vec = tuple[float, float, float]
 Quat = tuple[float, float, float, float]  # (x, y, z, w)
 
 
-def quat_mul(a: Quat, b: Quat) -> Quat:
+def _quat_mul(a: Quat, b: Quat) -> Quat:
     """Hamilton product a * b of quaternions stored as (x, y, z, w)."""
     ax, ay, az, aw = a
     bx, by, bz, bw = b
@@ -47,19 +50,19 @@ def quat_mul(a: Quat, b: Quat) -> Quat:
     )
 
 
-def quat_conj(q: Quat) -> Quat:
+def _quat_conj(q: Quat) -> Quat:
     return (-q[0], -q[1], -q[2], q[3])
 
 
-def rotate(q: Quat, v: Vec) -> Vec:
+def _rotate(q: Quat, v: Vec) -> Vec:
     """Rotate v by q (body frame to world frame): q v q*."""
-    x, y, z, _ = quat_mul(quat_mul(q, (v[0], v[1], v[2], 0.0)), quat_conj(q))
+    x, y, z, _ = _quat_mul(_quat_mul(q, (v[0], v[1], v[2], 0.0)), _quat_conj(q))
     return (x, y, z)
 
 
-def rotate_inverse(q: Quat, v: Vec) -> Vec:
+def _rotate_inverse(q: Quat, v: Vec) -> Vec:
     """Rotate v by the inverse of q (world frame to body frame): q* v q."""
-    x, y, z, _ = quat_mul(quat_mul(quat_conj(q), (v[0], v[1], v[2], 0.0)), q)
+    x, y, z, _ = _quat_mul(_quat_mul(_quat_conj(q), (v[0], v[1], v[2], 0.0)), q)
     return (x, y, z)
 
 
@@ -112,7 +115,8 @@ class ReferenceMDP:
         _reals(self.params, 11, "params")
         _reals(self.noise_std, 6, "noise_std", nonnegative=True)  # standard deviations, as the MDP's (fourteenth trial T14-21)
         _reals(self.wind, 8, "wind")
-        _reals(self.sensor, 7, "sensor")
+        sensor = _reals(self.sensor, 7, "sensor")
+        _check_sensor(sensor)
         if self.wind_kind not in (0, WIND_CONSTANT, WIND_SINUSOID) or isinstance(self.wind_kind, bool):
             raise NeurohoverError(f"wind_kind={brief(self.wind_kind)} is not allowed: give 0 (none), {WIND_CONSTANT} (constant) or {WIND_SINUSOID} (sinusoid)")
         if not whole_number(self.substeps) or self.substeps < 1:
@@ -152,7 +156,7 @@ class ReferenceHelicopter:
     def observation(self) -> list[float]:
         """Body-frame velocity, body-frame position, angular rates, quaternion vector part."""
         q = self.orientation
-        return [*rotate_inverse(q, self.velocity), *rotate_inverse(q, self.position), *self.rates, *q[:3]]
+        return [*_rotate_inverse(q, self.velocity), *_rotate_inverse(q, self.position), *self.rates, *q[:3]]
 
     def crashed(self) -> bool:
         return (
@@ -179,18 +183,18 @@ class ReferenceHelicopter:
             x, y, z = (p + dt * v for p, v in zip(self.position, self.velocity))
             self.position = (x, y, z)
             q = self.orientation
-            vb = rotate_inverse(q, self.velocity)
-            wb = rotate_inverse(q, self.mdp.wind_at(t))
+            vb = _rotate_inverse(q, self.velocity)
+            wb = _rotate_inverse(q, self.mdp.wind_at(t))
             force = (
                 c_u * (vb[0] + wb[0]) + self.mdp.d_u + n_u,
                 c_v * (vb[1] + wb[1]) + d_v + n_v,
                 c_w * vb[2] + d_w * a4 + n_w,
             )
-            fw = rotate(q, force)
+            fw = _rotate(q, force)
             u, v, w = (vel + dt * f for vel, f in zip(self.velocity, fw))
             self.velocity = (u, v, w + dt * GRAVITY)
             p, q_rate, r = self.rates
-            self.orientation = quat_mul(q, _rotation_vector_quaternion((dt * p, dt * q_rate, dt * r)))
+            self.orientation = _quat_mul(q, _rotation_vector_quaternion((dt * p, dt * q_rate, dt * r)))
             self.rates = (
                 p + dt * (c_p * p + d_p * a1 + n_p),
                 q_rate + dt * (c_q * q_rate + d_q * a2 + n_q),
@@ -240,7 +244,7 @@ def fly_episode(
     the policy flies on the readings of ``mdp.sensor``, and those readings are returned (as the
     kernel records them); the reward stays on the true observation.
     """
-    _check_episode(mdp, policy, normals, n_steps, sensor_normals)
+    normals, sensor_normals = _check_episode(mdp, policy, normals, n_steps, sensor_normals)
     heli = ReferenceHelicopter(mdp, episode_steps=n_steps)
     sensors = None if sensor_normals is None else ReferenceSensors(mdp.sensor, sensor_normals)
 
@@ -271,9 +275,21 @@ def _reals(values: object, n: int, what: str, nonnegative: bool = False) -> tupl
     return tuple(float(v) for v in items)
 
 
-def _check_episode(mdp: object, policy: object, normals: object, n_steps: object, sensor_normals: object) -> None:
+def _check_sensor(sensor: tuple[float, ...]) -> None:
+    """Refuse a sensor the simulator cannot read: a delay of 1.5 steps flew as 1 without a word (fifteenth trial T15-27),
+    a correlation of 1 or more took the root of a negative number."""
+    if min(sensor[:4]) < 0 or not 0 <= sensor[4] < 1 or not 0 <= sensor[6] < 1:
+        raise NeurohoverError(
+            f"sensor={brief(sensor)} is not allowed: give 4 stds >= 0, a correlation in [0, 1), a delay in 0..{MAX_SENSOR_DELAY} and a dropout in [0, 1)"
+        )
+    if not sensor[5].is_integer() or not 0 <= sensor[5] <= MAX_SENSOR_DELAY:
+        raise NeurohoverError(f"sensor delay={brief(sensor[5])} is not allowed: give a whole number of control steps in 0..{MAX_SENSOR_DELAY}")
+
+
+def _check_episode(mdp: object, policy: object, normals: object, n_steps: object, sensor_normals: object) -> tuple[list[list[float]], list[list[float]] | None]:
     """Refuse what :func:`fly_episode` cannot fly, before it flies (short normals were an IndexError mid-episode, n_steps=-1
-    returned (0.0, False); thirteenth trial, F6, F7): one vectorised look at each array of normals."""
+    returned (0.0, False); thirteenth trial, F6, F7): one vectorised look at each array of normals. Returns the normals
+    as Python floats (float32 normals flew in float32; fifteenth trial T15-27)."""
     if not isinstance(mdp, ReferenceMDP):
         raise NeurohoverError(f"mdp={brief(mdp)} is not allowed: give a ReferenceMDP (an MDP's to_reference())")
     if not callable(policy):
@@ -281,7 +297,10 @@ def _check_episode(mdp: object, policy: object, normals: object, n_steps: object
     if not whole_number(n_steps) or not 1 <= int(n_steps) <= MAX_EPISODE_STEPS:
         raise NeurohoverError(f"n_steps={brief(n_steps)} is not allowed: give an integer in 1..{MAX_EPISODE_STEPS}")
     width = 13 if mdp.sensor[6] > 0 else 12
-    for name, given, rows, widths in (("normals", normals, int(n_steps), (6,)), ("sensor_normals", sensor_normals, int(n_steps) + 1, (width, 13))):
+    checked: list[list[list[float]] | None] = [None, None]
+    for j, (name, given, rows, widths) in enumerate(
+        (("normals", normals, int(n_steps), (6,)), ("sensor_normals", sensor_normals, int(n_steps) + 1, (width, 13)))
+    ):
         if name == "sensor_normals" and given is None:
             continue
         want = f"give at least {rows} rows of {widths[0]} numbers (neurohover.sim.rng)"
@@ -294,6 +313,11 @@ def _check_episode(mdp: object, policy: object, normals: object, n_steps: object
         if not np.isfinite(arr[:rows]).all():  # a NaN gust flew a NaN return called "not crashed" (fourteenth trial T14-21)
             row, col = (int(i) for i in np.argwhere(~np.isfinite(arr[:rows]))[0])
             raise NeurohoverError(f"{name}[{row}][{col}] = {arr[row, col]} is not allowed: give finite standard normals (neurohover.sim.rng)")
+        checked[j] = arr[:rows].tolist()
+    if sensor_normals is not None and not any(mdp.sensor):  # they were ignored without a word (fifteenth trial T15-27)
+        raise NeurohoverError(f"sensor_normals are not allowed with the exact sensor {brief(tuple(mdp.sensor))}: they apply to a noisy or late sensor only")
+    assert checked[0] is not None
+    return checked[0], checked[1]
 
 
 def _action(policy: Callable[[list[float]], Sequence[float]], observation: list[float], k: int) -> Sequence[float]:
