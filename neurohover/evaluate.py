@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError, brief, whole_number
+from .errors import NeurohoverError, brief, finite_real, whole_number
 from .flightdata import FlightData, same_values
 from .flyer import KernelFlyer
 from .launch import DEVICES, KIND, MAX_SEED, Batch, Flown, check_device, launch, num_threads, use_lanes
@@ -28,7 +28,6 @@ from .policies import GENOME_LENGTH, TOPOLOGIES, Policy, load_policy
 from .sim.constants import (
     EPISODE_STEPS,
     MAX_EPISODE_STEPS,
-    MDP_ROW_LEN,
     ROW_SENSOR,
     SAFEGUARD_ARM,
     SAFEGUARD_BOX,
@@ -223,9 +222,7 @@ def mdp_rows(mdps: MDP | Sequence[MDP] | np.ndarray) -> np.ndarray:
         refuse_drift(mdps, "this batch")
         return mdps.row()[None, :]
     if isinstance(mdps, np.ndarray):
-        if mdps.ndim != 2 or mdps.shape[1] != MDP_ROW_LEN or not np.all(np.isfinite(mdps)):
-            raise NeurohoverError(f"MDP rows must be a finite array of shape (M, {MDP_ROW_LEN}), got {mdps.shape}")
-        check_rows(mdps)  # substeps, dt, noise and wind kind: an all-zero row flew as a perfect 0.0 (T14-18)
+        check_rows(mdps)  # shape, finiteness, substeps, dt, noise and wind kind: an all-zero row flew as a perfect 0.0 (T14-18)
         sensors = mdps[:, ROW_SENSOR]
         if sensors.any():  # the rows' sensor models, each distinct one checked by Sensor's own rules
             for values in np.unique(sensors, axis=0):
@@ -435,6 +432,8 @@ def evaluate(
     so all policies meet the same gusts. ``device="cuda"`` flies them on a GPU (:func:`evaluate_jobs`).
     """
     table = policies if isinstance(policies, PolicyTable) else PolicyTable.from_policies(as_policies(policies))
+    if len(table) == 0:  # an empty table returned an empty Evaluation, where [] is refused (T15-20)
+        raise NeurohoverError("policies=PolicyTable of 0 policies is not allowed: give a non-empty sequence of Policy objects or a non-empty PolicyTable")
     rows = mdp_rows(mdps)
     if isinstance(episodes, (bool, np.bool_)) or not isinstance(episodes, (int, np.integer)) or episodes < 1:  # True is an int
         raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
@@ -510,14 +509,18 @@ class DangerousState:
     def __post_init__(self) -> None:
         if self.rule not in SAFEGUARD_RULES:
             raise NeurohoverError(f"unknown safeguard rule {self.rule!r}: allowed {', '.join(SAFEGUARD_RULES)}")
-        if not (isinstance(self.box, (int, float)) and np.isfinite(self.box) and self.box > 0):
-            raise NeurohoverError(f"safeguard box={self.box!r} is out of range: allowed a finite number > 0")
-        if not (isinstance(self.tilt, (int, float)) and 0 < self.tilt <= 1):
-            raise NeurohoverError(f"safeguard tilt={self.tilt!r} is out of range: allowed 0 < tilt <= 1 (qw threshold)")
-        if not (isinstance(self.threshold, (int, float)) and np.isfinite(self.threshold) and self.threshold > 0):
-            raise NeurohoverError(f"safeguard threshold={self.threshold!r} is out of range: allowed a finite number > 0")
-        if isinstance(self.arm_after, bool) or not isinstance(self.arm_after, int) or not 0 <= self.arm_after <= 10**6:
-            raise NeurohoverError(f"safeguard arm_after={self.arm_after!r} is out of range: allowed an integer in 0..1000000 (control steps)")
+        # finite_real/whole_number: 10**400 was a TypeError, True taken as 1, np.float32(0.5) refused (T15-2, T15-17)
+        if not (finite_real(self.box) and self.box > 0):
+            raise NeurohoverError(f"safeguard box={brief(self.box)} is out of range: allowed a finite number > 0")
+        if not (finite_real(self.tilt) and 0 < self.tilt <= 1):
+            raise NeurohoverError(f"safeguard tilt={brief(self.tilt)} is out of range: allowed 0 < tilt <= 1 (qw threshold)")
+        if not (finite_real(self.threshold) and self.threshold > 0):
+            raise NeurohoverError(f"safeguard threshold={brief(self.threshold)} is out of range: allowed a finite number > 0")
+        if not (whole_number(self.arm_after) and 0 <= self.arm_after <= 10**6):
+            raise NeurohoverError(f"safeguard arm_after={brief(self.arm_after)} is out of range: allowed an integer in 0..1000000 (control steps)")
+        for name in ("box", "tilt", "threshold"):  # plain Python numbers: the repr and equality of the Python values
+            object.__setattr__(self, name, float(getattr(self, name)))
+        object.__setattr__(self, "arm_after", int(self.arm_after))
         unused = {  # a setting the rule does not read, set anyway, would be ignored without a word (third trial)
             "box": self.rule == "ratio-sum" and self.box != SAFEGUARD_BOX,
             "tilt": self.rule != "code" and self.tilt != SAFEGUARD_TILT,

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError
+from .errors import NeurohoverError, brief
 from .sim.constants import MLP_STEEPNESS
 
 TOPOLOGIES = ("slp", "mlp")
@@ -122,11 +122,13 @@ class Policy:
         Raises NeurohoverError for an observation that is not 12 finite numbers (a NaN would give NaN actions silently)."""
         try:
             raw = np.asarray(observation)
-            obs = raw.astype(np.float64).ravel() if raw.dtype.kind in "iuf" else np.zeros(0)  # not text, booleans or complex
+            obs = raw.astype(np.float64) if raw.dtype.kind in "iuf" else np.zeros(0)  # not text, booleans or complex
         except (TypeError, ValueError):
             obs = np.zeros(0)
-        if obs.size != 12 or not np.all(np.isfinite(obs)):
-            raise NeurohoverError(f"observation {observation!r} is not allowed: give 12 finite numbers (u, v, w, x, y, z, p, q, r, qx, qy, qz)")
+        if obs.shape != (12,) or not np.all(np.isfinite(obs)):  # the shape: (3, 4) was flown flattened as one observation (T15-28)
+            raise NeurohoverError(
+                f"observation {brief(observation)} is not allowed: give 12 finite numbers of shape (12,) (u, v, w, x, y, z, p, q, r, qx, qy, qz)"
+            )
         u, v, w, x, y, z, _p, _q, _r, qx, qy, qz = obs.tolist()
         g = self.genome.tolist()
         if self.topology == "slp":

@@ -50,6 +50,14 @@ LEARNED_MODEL = "model"  # the family name of a learned model's MDP, which may f
 _WIND_KINDS: dict[str, tuple[int, ...]] = {LEARNED_MODEL: (WIND_NONE, WIND_CONSTANT, WIND_SINUSOID)}
 #: The keys of :meth:`MDP.to_dict`'s table that :meth:`MDP.from_dict` needs (``label``, ``d_u``, ``sensor``, ``drift`` may be left out).
 MDP_KEYS = ("family", "params", "noise_std", "wind_kind", "wind", "substeps", "dt")
+#: The keys :meth:`MDP.from_dict` also reads; any other is refused.
+MDP_OPTIONAL_KEYS = ("label", "d_u", "sensor", "drift")
+#: How many wind numbers each wind kind reads (MDP.row() packs them into ROW_WIND), and what to give.
+WIND_SLOTS = {
+    WIND_NONE: (0, "no wind numbers: wind=()"),
+    WIND_CONSTANT: (2, "2 finite numbers: wind_u, wind_v in m/s"),
+    WIND_SINUSOID: (8, "8 finite numbers: maxf, freq, phase, center for x, then for y"),
+}
 
 
 @dataclass(frozen=True)
@@ -103,24 +111,27 @@ class MDP:
         if not isinstance(self.family, str) or self.family not in _WIND_KINDS:
             names = [n for n in _WIND_KINDS if n != LEARNED_MODEL]
             raise NeurohoverError(f"MDP family={brief(self.family)} is not allowed: give a task family's name ({', '.join(names)}) or {LEARNED_MODEL!r}")
-        # Plain Python numbers (the same values): reprs read MDP(params=(-0.18, ...)), not np.float64(-0.18).
-        for name, length in (("params", len(DEFAULT_PARAMS)), ("noise_std", len(DEFAULT_NOISE_STD)), ("wind", None)):
-            values = getattr(self, name)
-            try:
-                numbers = tuple(float(x) for x in values)
-            except (TypeError, ValueError):
-                raise NeurohoverError(f"MDP {name}={values!r:.80} is not allowed: give {length or 'up to 8'} numbers") from None
-            if (len(numbers) != length if length else len(numbers) > 8) or not all(math.isfinite(x) for x in numbers):
-                raise NeurohoverError(f"MDP {name}={values!r:.80} is not allowed: give {length or 'up to 8'} finite numbers")
-            object.__setattr__(self, name, numbers)
-        if min(self.noise_std) < 0:
-            raise NeurohoverError(f"MDP noise_std={self.noise_std!r} is out of range: allowed stds >= 0")
-        if not whole_number(self.wind_kind) or self.wind_kind not in (WIND_NONE, WIND_CONSTANT, WIND_SINUSOID):
-            raise NeurohoverError(f"MDP wind_kind={self.wind_kind!r} is not allowed: 0 (none), 1 (constant, GHH-08) or 2 (sinusoidal, GHH-09)")
+        if not whole_number(self.wind_kind) or self.wind_kind not in WIND_SLOTS:
+            raise NeurohoverError(f"MDP wind_kind={brief(self.wind_kind)} is not allowed: 0 (none), 1 (constant, GHH-08) or 2 (sinusoidal, GHH-09)")
         object.__setattr__(self, "wind_kind", int(self.wind_kind))
         if self.wind_kind not in _WIND_KINDS[self.family]:
             allowed = " or ".join(map(str, _WIND_KINDS[self.family]))
             raise NeurohoverError(f"MDP wind_kind={self.wind_kind} is not allowed in family {self.family!r}: its MDPs have wind_kind {allowed}")
+        # finite_vector refuses text, bools and dicts, which float() read as numbers ('12' as 1.0, 2.0); the wind as its kind reads it (T15-14, T15-15)
+        wind_length, wind_allowed = WIND_SLOTS[self.wind_kind]
+        for name, length, allowed in (
+            ("params", len(DEFAULT_PARAMS), f"give {len(DEFAULT_PARAMS)} finite numbers"),
+            ("noise_std", len(DEFAULT_NOISE_STD), f"give {len(DEFAULT_NOISE_STD)} finite numbers"),
+            ("wind", wind_length, f"with wind_kind {self.wind_kind} give {wind_allowed}"),
+        ):
+            values = getattr(self, name)
+            try:
+                vector = finite_vector(values, length, f"MDP {name}")
+            except NeurohoverError:
+                raise NeurohoverError(f"MDP {name}={brief(values)} is not allowed: {allowed}") from None
+            object.__setattr__(self, name, tuple(vector.tolist()))  # plain Python numbers: reprs read MDP(params=(-0.18, ...))
+        if min(self.noise_std) < 0:
+            raise NeurohoverError(f"MDP noise_std={self.noise_std!r} is out of range: allowed stds >= 0")
         if isinstance(self.substeps, bool) or not isinstance(self.substeps, (int, np.integer)) or not 1 <= self.substeps <= MAX_SUBSTEPS:
             raise NeurohoverError(f"MDP substeps={self.substeps!r} is out of range: allowed an integer in 1..{MAX_SUBSTEPS}")
         object.__setattr__(self, "substeps", int(self.substeps))
@@ -185,6 +196,9 @@ class MDP:
         missing = [k for k in MDP_KEYS if k not in d]
         if missing:  # {} was a KeyError (T14-17)
             raise NeurohoverError(f"an MDP's dict {brief(d)} lacks {', '.join(missing)}: give MDP.to_dict()'s table (keys {', '.join(MDP_KEYS)})")
+        unknown = [k for k in d if k not in MDP_KEYS + MDP_OPTIONAL_KEYS]
+        if unknown:  # a misspelt key ('lable') was ignored without a word (T15-14)
+            raise NeurohoverError(f"an MDP's dict has unknown keys {', '.join(brief(k) for k in unknown)}: allowed {', '.join(MDP_KEYS + MDP_OPTIONAL_KEYS)}")
         return cls(  # the values as they are: the MDP checks each (int() cut substeps 10.7 to 10, float() read '0.01')
             d["family"],
             d["params"],
@@ -219,9 +233,16 @@ def finite_vector(values: Sequence[float] | np.ndarray, length: int, what: str) 
 
 
 def check_rows(rows: np.ndarray) -> None:
-    """Refuse kernel rows, an (M, MDP_ROW_LEN) float array already found finite, that no MDP has: substeps not a whole
-    number in 1..MAX_SUBSTEPS, dt <= 0, a negative noise std or an unknown wind kind (the MDP's own checks, in a few
+    """Refuse kernel rows that no MDP has: anything but an (M, MDP_ROW_LEN) array of finite real numbers, substeps not a
+    whole number in 1..MAX_SUBSTEPS, dt <= 0, a negative noise std or an unknown wind kind (the MDP's own checks, in a few
     NumPy operations: evaluate() calls it on every array). An all-zero row (substeps 0) flew as a perfect 0.0 (T14-18)."""
+    # type and shape first, the cheap tests: a list was a TypeError, a 1-D row an IndexError (T15-4)
+    if not isinstance(rows, np.ndarray) or rows.ndim != 2 or rows.shape[1] != MDP_ROW_LEN or rows.dtype.kind not in "iuf":
+        got = f"shape {rows.shape}, dtype {rows.dtype}" if isinstance(rows, np.ndarray) else brief(rows)
+        raise NeurohoverError(f"MDP rows must be a float array of shape (M, {MDP_ROW_LEN}), rows as MDP.row() gives them; got {got}")
+    if not np.isfinite(rows).all():
+        i = int(np.flatnonzero(~np.isfinite(rows).all(axis=1))[0])
+        raise NeurohoverError(f"MDP rows must be a float array of shape (M, {MDP_ROW_LEN}) of finite numbers; got row {i}: {brief(rows[i].tolist())}")
     sub, dt, kind = rows[:, ROW_SUBSTEPS], rows[:, ROW_DT], rows[:, ROW_WIND_KIND]
     ok = (sub >= 1) & (sub <= MAX_SUBSTEPS) & (sub == np.floor(sub)) & (dt > 0) & (rows[:, ROW_NOISE].min(axis=1) >= 0)
     ok &= (kind == WIND_NONE) | (kind == WIND_CONSTANT) | (kind == WIND_SINUSOID)
@@ -293,6 +314,18 @@ def _checked_draws(method):
     return draws
 
 
+def _checked_competition_row(method):
+    """A family's ``competition_params`` with its row checked: the family's ``n_params`` finite numbers ('ab' was a
+    TypeError, [1] scaled to [5.0] for a two-number GHH-08 row; T15-5)."""
+
+    @functools.wraps(method)
+    def scaled(self, row):
+        values = finite_vector(row, self.n_params, f"a {self.name} competition row ({', '.join(self.param_names)})")
+        return method(self, values.tolist())
+
+    return scaled
+
+
 def _family_eq(self, other) -> bool:
     if type(other) is not type(self):
         return NotImplemented
@@ -362,6 +395,8 @@ class TaskFamily:
         for name in ("make", "zero"):  # the one place a family's MDPs get its sensor
             if name in cls.__dict__:
                 setattr(cls, name, _through_sensor(cls.__dict__[name]))
+        if "competition_params" in cls.__dict__:
+            cls.competition_params = _checked_competition_row(cls.__dict__["competition_params"])  # type: ignore[method-assign]
         if "sample_params" in cls.__dict__:
             cls.sample_params = _checked_draws(cls.__dict__["sample_params"])  # type: ignore[method-assign]
         # Defined before the dataclass decorator runs, so it keeps them: equality includes the sensor.
@@ -419,8 +454,10 @@ class TaskFamily:
         """Distinguishes seeded fixed sets of one family (FGHH: by sigma)."""
         return 0
 
+    @_checked_competition_row
     def competition_params(self, row: Sequence[float]) -> Sequence[float]:
-        """The MDP parameters of one row of the competition file (GHH-08 scales it to m/s)."""
+        """The MDP parameters of one row of the competition file (GHH-08 scales it to m/s): a row of ``n_params`` finite
+        numbers, else a clear error."""
         return row
 
     @property
