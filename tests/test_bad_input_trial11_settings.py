@@ -63,7 +63,7 @@ def test_a_bool_is_not_a_number_of_model_substeps() -> None:
     """S6: CodeAgentSettings(model_substeps=True) was taken as 1 (True == 1), though evolutions=True was refused."""
     from neurohover.agents.fghh_code import CodeAgentSettings
 
-    with pytest.raises(NeurohoverError, match=r"model_substeps=True is not allowed: choose one of 1, 10"):
+    with pytest.raises(NeurohoverError, match=r"model_substeps=True: allowed 1 or 10"):
         CodeAgentSettings(model_substeps=True)
     assert CodeAgentSettings(model_substeps=10).model_substeps == 10
 

@@ -30,3 +30,15 @@ def test_settings_texts_refuse_a_number_with_an_underscore() -> None:
         Sensor.parse("level=1_0")
     with pytest.raises(NeurohoverError, match="drift 'walk=1_0' is not understood"):
         Drift.parse("walk=1_0")
+
+
+def test_the_model_based_agents_refuse_model_substeps_true() -> None:
+    """The models fixer's note on T15-29: ModelEvolution(model_substeps=True) was taken as 1 (True in (1, 10)); the
+    agents' settings now share the learned model's one check of its substeps."""
+    from neurohover.agents.fghh_code import CodeAgentSettings
+    from neurohover.agents.model_based import ModelEvolution
+
+    for cls in (ModelEvolution, CodeAgentSettings):
+        with pytest.raises(NeurohoverError, match=r"model_substeps=True: allowed 1 or 10"):
+            cls(model_substeps=True)
+    assert ModelEvolution(model_substeps=10).model_substeps == 10

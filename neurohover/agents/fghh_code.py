@@ -38,7 +38,7 @@ from ..evaluate import DangerousState
 from ..evolution.steady_state import SteadyStateSettings
 from ..flightdata import FlightData
 from ..models.lr import D_U_CHOICES, DEFAULT_NOISE_ESTIMATE, ESTIMATORS, NOISE_ESTIMATES
-from ..models.model import MODEL_SUBSTEPS
+from ..models.model import check_model_substeps
 from ..models.wind import WIND_MODELS
 from ..policies import Policy, baseline_policy, prototype
 from ..sim.constants import EPISODE_STEPS
@@ -104,9 +104,7 @@ class CodeAgentSettings:
     model_substeps: int = 1
 
     def __post_init__(self) -> None:
-        sub = self.model_substeps
-        if isinstance(sub, bool) or not isinstance(sub, int) or sub not in MODEL_SUBSTEPS:  # True == 1 was taken as 1 (eleventh trial)
-            raise NeurohoverError(f"model_substeps={brief(sub)} is not allowed: choose one of {', '.join(map(str, MODEL_SUBSTEPS))}")
+        check_model_substeps(self.model_substeps, "model_substeps")  # True == 1 was taken as 1 (eleventh trial)
         for name, low in (("evolutions", 1), ("model_budget", 50), ("n_steps", 1)):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < low:

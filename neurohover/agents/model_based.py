@@ -83,7 +83,7 @@ class ModelEvolution:
     def __post_init__(self) -> None:
         from ..evaluate import check_device
         from ..models import D_U_CHOICES, ESTIMATORS, NOISE_ESTIMATES
-        from ..models.model import MODEL_SUBSTEPS
+        from ..models.model import check_model_substeps
         from ..models.wind import WIND_MODELS
 
         for name, allowed in (
@@ -92,11 +92,11 @@ class ModelEvolution:
             ("d_u", D_U_CHOICES),
             ("noise", NOISE_ESTIMATES),
             ("model_policy", MODEL_POLICIES),
-            ("model_substeps", MODEL_SUBSTEPS),
         ):
             value = getattr(self, name)
             if value not in allowed:
                 raise NeurohoverError(f"{name}={value!r} is not allowed: choose one of {', '.join(map(str, allowed))}")
+        check_model_substeps(self.model_substeps, "model_substeps")  # True was taken as 1 (True in (1, 10))
         g = self.authors_generations
         if isinstance(g, bool) or not isinstance(g, int) or g < 1:
             raise NeurohoverError(f"authors_generations={g!r} is out of range: allowed an integer >= 1")

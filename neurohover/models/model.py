@@ -79,11 +79,11 @@ DEFAULT_MODEL_SUBSTEPS = SUBSTEPS
 LEGACY_MODEL_SUBSTEPS = 1
 
 
-def check_model_substeps(substeps: object) -> None:
-    """Refuse ``substeps`` unless it is one of :data:`MODEL_SUBSTEPS` (a NumPy integer too; True, 10.0 and 'x' not):
-    the one check of a learned model's substeps."""
+def check_model_substeps(substeps: object, name: str = "substeps") -> None:
+    """Refuse ``substeps`` (the setting ``name``) unless it is one of :data:`MODEL_SUBSTEPS` (a NumPy integer too; True,
+    10.0 and 'x' not): the one check of a learned model's substeps, the agents' ``model_substeps`` settings' too."""
     if not whole_number(substeps) or substeps not in MODEL_SUBSTEPS:
-        raise NeurohoverError(f"substeps={brief(substeps)}: allowed {' or '.join(map(str, MODEL_SUBSTEPS))} (integrations of a learned model's control step)")
+        raise NeurohoverError(f"{name}={brief(substeps)}: allowed {' or '.join(map(str, MODEL_SUBSTEPS))} (integrations of a learned model's control step)")
 
 
 def default_model_substeps(task: str) -> int:
