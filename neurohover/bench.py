@@ -162,7 +162,9 @@ def benchmark_evolution(quick: bool = False, repeats: int | None = None) -> dict
     """
     from .evolution.evolve import evolve
     from .evolution.seeding import noise_seed
+    from .experiments.store import check_flag
 
+    check_flag(quick, "quick", "a short run")  # quick="no" was true (fifteenth trial, T15-26)
     cores = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # numba.config sets it at import, from the environment
     repeats = (1 if quick else 3) if repeats is None else _count("repeats", repeats, "repeats")
     # 20,000 episodes from the race generic average about 2,600 steps an episode, as a paper-scale run
@@ -224,7 +226,10 @@ ESTIMATED_LIMIT_PER_CORE = (3000.0, 5000.0)
 
 
 def run_benchmarks(quick: bool = False) -> dict:
-    """Measure everything and return a JSON-able report."""
+    """Measure everything and return a JSON-able report (``quick``: True for a short run)."""
+    from .experiments.store import check_flag
+
+    check_flag(quick, "quick", "a short run")  # quick="no" ran the short benchmarks (fifteenth trial, T15-26)
     cores = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # numba.config sets it at import, from the environment
     episodes = 100 if quick else 1000
     repeats = 1 if quick else 3

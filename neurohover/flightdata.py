@@ -90,6 +90,7 @@ class FlightData:
             if not all(isinstance(a, np.ndarray) and a.dtype.kind in "fi" for a in arrays):
                 raise NeurohoverError(f"flight data {name} must be arrays of real numbers, one per episode")
             object.__setattr__(self, name, tuple(arrays))
+        _check_dict(self.metadata, "flight data")  # None or [1] was taken, and refused only by save() (fifteenth trial, T15-29)
         if len(self.observations) != len(self.actions):
             raise NeurohoverError(f"flight data needs one action array per observation array, got {len(self.observations)} and {len(self.actions)}")
         for i, (obs, act) in enumerate(zip(self.observations, self.actions)):
@@ -141,7 +142,8 @@ class FlightData:
         return None if flown is False else policy_from_dict(flown, f"{name}, metadata policy_flown")
 
     def save(self, path: str | Path, dtype: str = "float64") -> Path:
-        """Write the flight data to ``path`` (``.npz``), as float64 (exact) or float32 (half the space)."""
+        """Write the flight data to ``path`` (``.npz``), as float64 (exact) or float32 (half the space; a finite value past
+        float32's range is refused, not written as inf)."""
         if dtype not in SAVE_DTYPES:
             raise NeurohoverError(f"flight-data dtype {dtype!r} is not allowed: use {' or '.join(SAVE_DTYPES)}")
         from .paths import output_file, writing
@@ -154,6 +156,11 @@ class FlightData:
             raise NeurohoverError("flight data to save needs a dict of metadata and at least one step flown (load() refuses any other file)")
         path = output_file(path, "flight-data file")  # refuses '', a directory and a device (/dev/null was a struct.error)
         lengths = np.array([a.shape[0] for a in self.actions], dtype=np.int64)
+        largest = float(np.finfo(dtype).max)
+        for name in ("observations", "actions"):  # 1e300 was written as float32's inf, without a word (fifteenth trial, T15-29)
+            big = max((float(np.abs(a[np.isfinite(a)]).max(initial=0.0)) for a in getattr(self, name)), default=0.0)
+            if big > largest:
+                raise NeurohoverError(f"flight data {name} hold {big:.3g}, past {dtype}'s largest value {largest:.4g}: save them as float64, or scale them")
         with writing(path, "flight-data file") as partial, open(partial, "wb") as f:  # a file object keeps numpy from appending ".npz"
             np.savez_compressed(
                 f,
@@ -224,6 +231,13 @@ _PER_EPISODE = {
 }
 
 
+def _check_dict(metadata: object, where: str) -> dict:
+    """``metadata`` if it is a dict, as flight data and their files hold; else one error naming it."""
+    if not isinstance(metadata, dict):
+        raise NeurohoverError(f"{where}: its metadata {brief(metadata)} is not allowed: give a dict (a JSON object)")
+    return metadata
+
+
 def check_metadata(metadata: object, lengths: np.ndarray, where: str) -> None:
     """Refuse the metadata fields plots and crash marks read when they are of the wrong kind, by name (an episode_steps
     "a" was a ValueError in plot; seventh trial), and metadata the episodes contradict (ninth trial).
@@ -238,8 +252,7 @@ def check_metadata(metadata: object, lengths: np.ndarray, where: str) -> None:
         What the messages name: ``"flight-data file 'f.npz'"`` (:meth:`FlightData.load`) or ``"flight data"`` (flight data
         built in Python, checked before a plot: fourteenth trial).
     """
-    if not isinstance(metadata, dict):
-        raise NeurohoverError(f"{where}: its metadata {brief(metadata)} is not allowed: give a dict (a JSON object)")
+    metadata = _check_dict(metadata, where)
     n_episodes = lengths.size
     steps = metadata.get("episode_steps")
     if steps is not None and (type(steps) is not int or not 1 <= steps <= MAX_EPISODE_STEPS):

@@ -37,6 +37,7 @@ __all__ = [
     "strict_json",
     "input_file",
     "input_dir",
+    "make_dirs",
     "output_dir",
     "output_file",
     "printable",
@@ -54,8 +55,18 @@ def _why(err: OSError) -> str:
     return err.strerror or type(err).__name__
 
 
-def _make_dirs(directory: Path, option: str, given: str) -> None:
-    """Create ``directory`` and any missing parents, saying so; refuse a file in the way."""
+def make_dirs(directory: Path, option: str, given: str) -> None:
+    """Create ``directory`` and any missing parents, saying so on standard error; refuse a file in the way, naming it.
+
+    Parameters
+    ----------
+    directory : Path
+        The directory to have.
+    option : str
+        What the messages call the path (``"results store"``, ``"--out"``).
+    given : str
+        The path as the user gave it (a file in it, or the file's directory), shown in the messages.
+    """
     missing = []
     here = directory
     while not here.exists():
@@ -64,7 +75,7 @@ def _make_dirs(directory: Path, option: str, given: str) -> None:
             break
         here = here.parent
     if here.exists() and not here.is_dir():
-        raise NeurohoverError(f"{option} {given!r}: {str(here)!r} is a file, not a directory")
+        raise NeurohoverError(f"{option} {given!r}: {str(here)!r} is a file, not a directory: give a path in a directory")
     if not missing:
         return
     try:
@@ -201,7 +212,7 @@ def output_file(
             f"{option} {str(path)!r} is a symbolic link to {os.readlink(p)!r}, whose directory {str(real.parent)!r} does not exist: "
             "give another path, or make that directory"
         )
-    _make_dirs(p.parent, option, str(path))
+    make_dirs(p.parent, option, str(path))
     existed = real.exists()
     try:
         with open(real, "ab"):  # appending nothing leaves an existing file's content and time as they are
@@ -256,7 +267,7 @@ def output_dir(path: str | os.PathLike, option: str) -> Path:
     p = checked_path(path, option, "directory")
     if p.exists() and not p.is_dir():
         raise NeurohoverError(f"{option} {str(path)!r} is a file; give a directory")
-    _make_dirs(p, option, str(path))
+    make_dirs(p, option, str(path))
     try:
         with tempfile.TemporaryFile(dir=p):
             pass

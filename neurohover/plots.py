@@ -225,6 +225,8 @@ def _episode_title(data: FlightData, i: int, stem: str) -> str:
 def episode_crashed(data: FlightData, i: int) -> bool:
     """Whether episode ``i`` of ``data`` crashed: its flag as flown (the ``crashed`` metadata every recording holds),
     or, in files recorded before 2026-12-04, whether it is shorter than the metadata's ``episode_steps`` (default 6000)."""
+    _check_flight_data(data)  # None was an AttributeError, episode 5 of 2 an IndexError (fifteenth trial, T15-9)
+    i = _episode_list([i], data.n_episodes)[0]
     meta = data.metadata if isinstance(data.metadata, dict) else {}
     flags = meta.get("crashed")
     if isinstance(flags, list) and len(flags) == data.n_episodes:
@@ -245,8 +247,7 @@ def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight"
     list of Path
         The files written, in episode order.
     """
-    if not isinstance(data, FlightData):  # None was an AttributeError (fourteenth trial, T14-10)
-        raise NeurohoverError(f"data={brief(data)} is not allowed: give FlightData (e.g. FlightData.load('flight.npz'))")
+    _check_flight_data(data)  # None was an AttributeError (fourteenth trial, T14-10)
     if not isinstance(stem, str) or stem == "" or "\x00" in stem or any(sep and sep in stem for sep in (os.sep, os.altsep)):
         raise NeurohoverError(  # '../zz' wrote outside out_dir, '' the file '-episode0.png' (eleventh trial)
             f"stem={stem!r:.60} is not allowed: give a non-empty file-name prefix without a path separator, e.g. 'flight'"
@@ -264,11 +265,19 @@ def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight"
     return paths
 
 
+def _check_flight_data(data: object) -> None:
+    """Refuse anything but :class:`FlightData`, naming it."""
+    if not isinstance(data, FlightData):
+        raise NeurohoverError(f"data={brief(data)} is not allowed: give FlightData (e.g. FlightData.load('flight.npz'))")
+
+
 def _episode_list(episodes: object, n: int) -> list[int]:
     """``episodes`` as distinct indices of the ``n`` episodes, or one message saying what is allowed."""
     if isinstance(episodes, (str, bytes)) or not isinstance(episodes, (Sequence, np.ndarray)) or getattr(episodes, "ndim", 1) != 1:  # 0 was a TypeError
         raise NeurohoverError(f"episodes={brief(episodes)} is not allowed: give a list of episode indices, e.g. [0, 2], or None for all")
     chosen = list(episodes)
+    if not chosen:  # [] wrote nothing and returned [] without a word (fifteenth trial, T15-25)
+        raise NeurohoverError(f"episodes={brief(episodes)} selects no episode: give at least one index of 0..{n - 1}, or None for all")
     bad = [i for i in chosen if not (whole_number(i) and 0 <= i < n)]
     if bad:
         why = "is out of range" if whole_number(bad[0]) else "is not allowed: give integer indices"  # True was taken as 1

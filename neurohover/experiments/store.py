@@ -43,6 +43,9 @@ from .config import check_name, check_scale
 from .units import Unit
 
 SCHEMA_VERSION = 1
+
+#: How a session can end (:meth:`Store.end_session`; the runner's statuses). A session is "running" until then.
+SESSION_STATUSES = ("finished", "selection finished", "interrupted", "failed")
 APPLICATION_ID = 0x4E484F56  # "NHOV"
 
 _SCHEMA = """
@@ -131,7 +134,7 @@ class Store:
     """
 
     def __init__(self, path: str | Path, *, create: bool = True) -> None:
-        from ..paths import checked_path
+        from ..paths import checked_path, make_dirs
 
         check_flag(create, "create", "make the store if missing")  # create='no' was true (sixth trial)
 
@@ -144,7 +147,7 @@ class Store:
             raise NeurohoverError(f"results store {str(self.path)!r} is not a regular file (a device, pipe or socket); give a file name")
         if not create and self.path.stat().st_size == 0:  # read, it was given the schema: a refused command changed it (seventh trial)
             raise NeurohoverError(f"results store {str(self.path)!r} is empty (0 bytes): it holds no experiment yet")
-        self.path.parent.mkdir(parents=True, exist_ok=True)
+        make_dirs(self.path.parent, "results store", str(path))  # a file as its parent was pathlib's FileExistsError (fifteenth trial, T15-10)
         self._lock = WriterLock(self.lock_path)
         new = not self.path.exists() or self.path.stat().st_size == 0
         try:
@@ -479,11 +482,15 @@ class Store:
         return cur.lastrowid
 
     def end_session(self, session: int, status: str) -> None:
-        """Record how session ``session`` (:meth:`start_session`'s id) ended: ``status`` and its wall time."""
+        """Record how session ``session`` (:meth:`start_session`'s id) ended: ``status`` (one of :data:`SESSION_STATUSES`) and its wall time."""
         where = self._where("end_session")
         session = _count(session, "session", where, 1)
         _check_text(status, "status", where)  # object() was sqlite3's ProgrammingError (T14-5)
-        self.conn.execute("UPDATE sessions SET status = ?, wall_seconds = ? - started WHERE id = ?", (status, time.time(), session))
+        if status not in SESSION_STATUSES:  # free text was stored, and shown by the report as a session's end (fifteenth trial, T15-22)
+            raise NeurohoverError(f"{where}: status = {brief(status)} is not allowed: give one of {', '.join(map(repr, SESSION_STATUSES))}")
+        cur = self.conn.execute("UPDATE sessions SET status = ?, wall_seconds = ? - started WHERE id = ?", (status, time.time(), session))
+        if cur.rowcount == 0:  # an id start_session never gave matched nothing, without a word (T15-22)
+            raise NeurohoverError(f"{where}: session = {session} is not allowed: {str(self.path)!r} has no such session (start_session gives the id)")
 
     def sessions(self, name: str, scale: str) -> list[dict]:
         cols = ("id", "executor", "cores", "started", "wall_seconds", "units_run", "units_before", "status")
