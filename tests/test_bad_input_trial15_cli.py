@@ -42,3 +42,11 @@ def test_the_model_based_agents_refuse_model_substeps_true() -> None:
         with pytest.raises(NeurohoverError, match=r"model_substeps=True: allowed 1 or 10"):
             cls(model_substeps=True)
     assert ModelEvolution(model_substeps=10).model_substeps == 10
+
+
+def test_the_gpu_benchmarks_refuse_a_flag_that_is_no_bool() -> None:
+    """T15-26 on the GPU side (the plots fixer's note): gpu_benchmarks(quick='no') was true."""
+    from neurohover.bench_gpu import gpu_benchmarks
+
+    with pytest.raises(NeurohoverError, match=r"quick='no' is not allowed: give True \(a short run\) or False"):
+        gpu_benchmarks(quick="no")  # type: ignore[arg-type]

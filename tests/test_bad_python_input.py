@@ -652,7 +652,7 @@ def test_the_sixth_trials_python_cases_are_refused_by_name(tmp_path) -> None:
             (lambda: evaluate_callable(None, fam.zero()), "act=None is not allowed"),  # type: ignore[arg-type]
             (lambda: evaluate_callable(lambda o: o[:, :4], fam.zero(), indexed="yes"), "indexed='yes' is not allowed"),  # type: ignore[arg-type]
             (lambda: FlightData(fd.observations, fd.actions, {"x": object()}).save(tmp_path / "m.npz"), "metadata cannot be saved as JSON"),
-            (lambda: FlightData(fd.observations, fd.actions, 5).save(tmp_path / "m.npz"), "needs a dict of metadata"),  # type: ignore[arg-type]
+            (lambda: FlightData(fd.observations, fd.actions, 5), "its metadata 5 is not allowed: give a dict"),  # type: ignore[arg-type]
             (lambda: FlightData((), (), {}).save(tmp_path / "m.npz"), "at least one step flown"),
             (lambda: write_report(None, tmp_path / "r"), "store=None is not allowed"),  # type: ignore[arg-type]
             (lambda: write_report(store, ""), "report directory is empty"),
