@@ -40,6 +40,9 @@ __all__ = [
     "Optimiser",
     "TellInfo",
     "as_floats",
+    "as_returns",
+    "check_entries",
+    "check_info",
     "check_prototype",
     "check_returns",
     "check_settings",
@@ -230,6 +233,17 @@ def as_floats(values: Any, name: str, allowed: str) -> np.ndarray:
 _Settings = TypeVar("_Settings")
 
 
+def as_returns(values: Any, name: str, allowed: str, minimum: int = 1) -> np.ndarray:
+    """:func:`as_floats` of a population's returns that must also be a 1-D array of at least ``minimum`` of them
+    (``allowed`` says what else, for values that are no numbers); NeurohoverError naming the shape otherwise (an empty
+    or 2-D array came back as empty or 2-D weights; fifteenth trial)."""
+    r = as_floats(values, name, allowed)
+    if r.ndim != 1 or r.size < minimum:
+        allowed = "a non-empty 1-D array of returns" if minimum == 1 else f"a 1-D array of {minimum} or more returns"
+        raise NeurohoverError(f"{name} has shape {r.shape}: give {allowed} (real numbers)")
+    return r
+
+
 def check_settings(settings: Any, cls: type[_Settings]) -> _Settings:
     """``settings``, or ``cls()`` for None; NeurohoverError unless it is a ``cls`` (another optimiser's settings or a
     dict were an AttributeError at construction or at the first ask(); fourteenth trial)."""
@@ -250,8 +264,17 @@ def check_prototype(prototype: np.ndarray) -> np.ndarray:
     return p
 
 
-def check_returns(values: Any, n: int, what: str = "fitness") -> np.ndarray:
-    """``n`` returns as float64, one per asked genome; ``+inf`` is refused (ValueError)."""
+def check_info(info: Any) -> None:
+    """NeurohoverError unless ``info`` (what a ``tell`` is told besides the returns) is a :class:`TellInfo` or None (a dict
+    was an AttributeError; fifteenth trial)."""
+    if info is not None and not isinstance(info, TellInfo):
+        raise NeurohoverError(f"info={brief(info)} is not allowed: give a TellInfo (its crashed, selected, episodes) or None")
+
+
+def check_returns(values: Any, n: int, what: str = "fitness", info: Any = None) -> np.ndarray:
+    """``n`` returns as float64, one per asked genome; ``+inf`` is refused (ValueError). The one check of a ``tell``'s
+    arguments: ``info`` too (:func:`check_info`)."""
+    check_info(info)
     f = as_floats(values, what, f"{n} returns, one per asked genome")
     if f.shape != (n,):
         raise NeurohoverError(f"{what} must have shape ({n},), one return per asked genome; got shape {f.shape}")
@@ -340,6 +363,15 @@ def check_state(state: dict[str, Any], kind: str) -> None:
     version = state.get("version")
     if isinstance(version, bool) or version != STATE_VERSION:  # True == 1 was taken as version 1 (fourteenth trial)
         raise NeurohoverError(f"unsupported state version {brief(version)}: allowed {STATE_VERSION}")
+
+
+def check_entries(state: dict[str, Any], kind: str, entries: tuple[str, ...]) -> None:
+    """NeurohoverError naming the entries of a ``kind`` state dict that are none of ``entries`` (every entry any
+    version of its ``state_dict`` wrote): an unknown one was ignored without a word (fifteenth trial)."""
+    unknown = [key for key in state if key not in entries]
+    if unknown:
+        shown = ", ".join(brief(key) for key in unknown[:5]) + (f" and {len(unknown) - 5} more" if len(unknown) > 5 else "")
+        raise NeurohoverError(f"{kind} state dict has unknown entries {shown}: allowed {', '.join(entries)}; give a dict that {kind}.state_dict() returned")
 
 
 #: What reading back a damaged entry of a state raises besides NeurohoverError: a value of the wrong type, a missing
@@ -545,7 +577,7 @@ class PopulationOptimiser(ChampionViews):
         if self._pending is None:
             raise AskTellOrderError(TELL_FIRST)
         genomes = self._pending
-        f = check_returns(fitness, genomes.shape[0])
+        f = check_returns(fitness, genomes.shape[0], info=info)
         self._tell(genomes, f, info)
         self._tracker.update(genomes, f, self._clock())
         self._pending = None

@@ -25,6 +25,7 @@ from .common import (
     Clock,
     EntryError,
     TellInfo,
+    check_entries,
     check_genomes,
     check_prototype,
     check_returns,
@@ -146,6 +147,12 @@ GENERATIONAL_PRESETS: dict[str, GenerationalSettings] = {
     "raw-elitist": GenerationalSettings(elitist=True, fitness="return", init_mutate_frac=None, init_mutate_std=None),
 }
 #: Settings a checkpoint written before a field existed ran with.
+#: Every entry a :meth:`GenerationalNE.state_dict` has held ("parents" and "hall_of_fame" since 2026-12-04).
+STATE_ENTRIES = (
+    "type", "version", "settings", "prototype", "population", "asked", "generation", "evaluations", "champion_genome", "champion_return",
+    "parents", "hall_of_fame", "history", "rng", "wall_seconds",
+)  # fmt: skip
+
 OLD_GENERATIONAL = {"elitist": True, "fitness": "return", "init_mutate_frac": None, "init_mutate_std": None}
 
 
@@ -268,11 +275,11 @@ class GenerationalNE:
         """
         if not self._asked:
             raise AskTellOrderError(TELL_FIRST)
+        s = self.settings
+        f = check_returns(fitness_estimates, s.pop_size, "fitness_estimates", info)
         if info is not None:
             selected = info.selected if selected is None else selected
             episodes = info.episodes if episodes is None else episodes
-        s = self.settings
-        f = check_returns(fitness_estimates, s.pop_size, "fitness_estimates")
         order = rank(f)
         if selected is None:
             sel = order[: s.select_size]
@@ -417,6 +424,7 @@ class GenerationalNE:
         """
         check_state(state, "GenerationalNE")
         kind = "GenerationalNE"
+        check_entries(state, kind, STATE_ENTRIES)
         settings = read_entry(state, kind, "settings", lambda s: GenerationalSettings(**{**OLD_GENERATIONAL, **s}))
         opt = cls(read_entry(state, kind, "prototype", dec_array), settings)
         d = opt._prototype.size

@@ -17,6 +17,9 @@ from typing import Protocol
 import numba
 import numpy as np
 
+from ..errors import NeurohoverError, brief
+from .common import MAX_SPREAD, as_floats, require_prob, require_spread
+
 __all__ = ["MutationParams", "CrossoverParams", "mutate", "crossover"]
 
 
@@ -66,14 +69,35 @@ def mutate(genome: np.ndarray, rng: np.random.Generator, settings: MutationParam
     -------
     np.ndarray
         New float64 array of the same shape as ``genome``.
+
+    Raises
+    ------
+    NeurohoverError
+        A genome or scale that is no real numbers, a scale of another size, an ``rng`` that is no Generator, or
+        settings without the three fields in range (checked before any draw).
     """
-    g = np.asarray(genome, dtype=np.float64)
-    hit_r = rng.random(g.size)
-    delta = rng.normal(0.0, settings.mutate_std, g.size)
+    g = genome if type(genome) is np.ndarray and genome.dtype is _F64 else _genes(genome, "genome")
+    if not isinstance(rng, np.random.Generator):
+        raise _bad_rng(rng)
+    try:
+        frac, std, repl = settings.mutate_frac, settings.mutate_std, settings.mutate_repl
+    except AttributeError:
+        raise _bad_settings(settings, "mutate_frac, mutate_std and mutate_repl") from None
+    if not (type(frac) is float and type(std) is float and type(repl) is float and 0.0 <= frac <= 1.0 and 0.0 <= repl <= 1.0 and 0.0 <= std <= MAX_SPREAD):
+        require_prob("mutate_frac", frac)  # the settings classes' checks, for what the fast test above does not pass
+        require_prob("mutate_repl", repl)
+        std = require_spread("mutate_std", std)
+    std += 0.0  # -0.0 as 0.0: NumPy's normal() refuses it
     if scale is not None:
-        delta *= np.asarray(scale, dtype=np.float64).reshape(-1)
+        scale = _genes(scale, "scale")
+        if scale.size != g.size:  # was NumPy's broadcast error after the draws
+            raise NeurohoverError(f"scale has shape {scale.shape}: give one number per gene of the genome, shape {g.shape}")
+    hit_r = rng.random(g.size)
+    delta = rng.normal(0.0, std, g.size)
+    if scale is not None:
+        delta *= scale.reshape(-1)
     replace_r = rng.random(g.size)
-    return _mutate_genes(g, hit_r, delta, replace_r, settings.mutate_frac, settings.mutate_repl)
+    return _mutate_genes(g, hit_r, delta, replace_r, frac, repl)
 
 
 def crossover(a: np.ndarray, b: np.ndarray, rng: np.random.Generator, settings: CrossoverParams) -> np.ndarray:
@@ -99,16 +123,44 @@ def crossover(a: np.ndarray, b: np.ndarray, rng: np.random.Generator, settings: 
 
     Raises
     ------
-    ValueError
-        If the parents' shapes differ.
+    NeurohoverError
+        Parents that are no real numbers or differ in shape, an ``rng`` that is no Generator, or settings without
+        ``averaging_prob`` in [0, 1] (checked before any draw).
     """
-    a = np.asarray(a, dtype=np.float64)
-    b = np.asarray(b, dtype=np.float64)
+    a = a if type(a) is np.ndarray and a.dtype is _F64 else _genes(a, "a")
+    b = b if type(b) is np.ndarray and b.dtype is _F64 else _genes(b, "b")
     if a.shape != b.shape:
-        raise ValueError(f"crossover parents must have the same shape, got {a.shape} and {b.shape}")
+        raise NeurohoverError(f"crossover parents must have the same shape, got {a.shape} and {b.shape}")
+    if not isinstance(rng, np.random.Generator):
+        raise _bad_rng(rng)
+    try:
+        averaging = settings.averaging_prob
+    except AttributeError:
+        raise _bad_settings(settings, "averaging_prob") from None
+    if type(averaging) is not float or not 0.0 <= averaging <= 1.0:
+        require_prob("averaging_prob", averaging)
     average_r = rng.random(a.size)
     take_a_r = rng.random(a.size)
-    return _crossover_genes(a, b, average_r, take_a_r, settings.averaging_prob)
+    return _crossover_genes(a, b, average_r, take_a_r, averaging)
+
+
+# The checks run at every offspring (fifteenth trial: a bad argument was an AttributeError, NumPy's or numba's error):
+# O(1) type tests inline first, and the shared checks (their messages) only for what fails them.
+
+_F64 = np.dtype(np.float64)
+
+
+def _genes(values, name: str) -> np.ndarray:
+    """``values`` as float64 genes, or :func:`~neurohover.evolution.common.as_floats`' error."""
+    return as_floats(values, name, "a genome: an array of real numbers")
+
+
+def _bad_rng(rng) -> NeurohoverError:
+    return NeurohoverError(f"rng={brief(rng)} is not allowed: give a numpy.random.Generator (np.random.default_rng(seed))")
+
+
+def _bad_settings(settings, fields: str) -> NeurohoverError:
+    return NeurohoverError(f"settings={brief(settings)} is not allowed: give settings with {fields} (e.g. a SteadyStateSettings)")
 
 
 # Gene i in C order (``.flat[i]``) gets draw i, as if the draws had been made in the genome's shape.

@@ -27,6 +27,7 @@ from .common import (
     Clock,
     TellInfo,
     as_floats,
+    check_entries,
     check_genomes,
     check_prototype,
     check_returns,
@@ -177,6 +178,10 @@ class SteadyStateSettings:
         set_field(self, "plateau_threshold", require_int("plateau_threshold", self.plateau_threshold, 1))
 
 
+#: Every entry a :meth:`SteadyStateNE.state_dict` has held (the format only ever gained entries).
+STATE_ENTRIES = ("type", "version", "settings", "prototype", "population", "fitness", "pending", "generation", "rng", "tracker", "wall_seconds")
+
+
 def roulette_weights(returns: np.ndarray) -> np.ndarray:
     """Positive roulette-wheel weights ``1 / ln(error)`` with ``error = -return``.
 
@@ -323,10 +328,10 @@ class SteadyStateNE(ChampionViews):
             several episodes: whether any of them crashed). Only the ``no-crash`` plateau rule uses
             them; none: no crash.
         """
-        crashed = None if info is None else info.crashed
         if self._pending is None:
             raise AskTellOrderError(TELL_FIRST)
-        f = check_returns(fitness, len(self._pending))
+        f = check_returns(fitness, len(self._pending), info=info)
+        crashed = None if info is None else info.crashed
         if crashed is not None:
             c = np.asarray(crashed)
             if c.shape != f.shape or not (c.dtype == np.bool_ or np.issubdtype(c.dtype, np.integer)):
@@ -437,6 +442,7 @@ class SteadyStateNE(ChampionViews):
         """
         check_state(state, "SteadyStateNE")
         kind = "SteadyStateNE"
+        check_entries(state, kind, STATE_ENTRIES)
         # States written before the plateau rule existed followed the literal rule.
         settings = read_entry(state, kind, "settings", lambda s: SteadyStateSettings(**{"plateau_rule": "literal", **s}))
         opt = cls(read_entry(state, kind, "prototype", dec_array), settings)

@@ -19,7 +19,18 @@ import numpy as np
 
 from ...errors import NeurohoverError, brief
 from .. import common
-from ..common import MAX_POPULATION, EntryError, PopulationOptimiser, TellInfo, check_prototype, read_entry, require_spread
+from ..common import (
+    MAX_POPULATION,
+    EntryError,
+    PopulationOptimiser,
+    TellInfo,
+    check_entries,
+    check_prototype,
+    read_entry,
+    require_int,
+    require_population,
+    require_spread,
+)
 from ..seeding import check_seed
 from . import OptimiserSpec
 
@@ -127,10 +138,10 @@ class CMAES(PopulationOptimiser):
         if x0.size < 2:
             raise NeurohoverError(f"CMAES needs a genome of length >= 2, got {x0.size}")
         sigma0 = require_spread("sigma0", sigma0, positive=True)
-        if popsize is not None and (not isinstance(popsize, (int, np.integer)) or popsize < 2):
-            raise NeurohoverError(f"popsize={brief(popsize)} must be None or an integer >= 2")
-        if budget is not None and (not isinstance(budget, (int, np.integer)) or budget < 1):
-            raise NeurohoverError(f"budget={brief(budget)} must be None or an integer >= 1")
+        if popsize is not None:  # 10**12 ran on in pycma's constructor (fifteenth trial)
+            require_population("popsize", popsize)
+        if budget is not None:  # True was taken as a budget of 1 (fifteenth trial)
+            require_int("budget", budget, 1)
         self._rng = np.random.default_rng(check_seed(seed))
         rng = self._rng
         opts: dict = {
@@ -203,6 +214,7 @@ class CMAES(PopulationOptimiser):
         kind = cls.__name__
         if not isinstance(state, dict):
             raise NeurohoverError(f"state dict is a {type(state).__name__}, not a dict")
+        check_entries(state, kind, ("type", "pickle"))
         holder: list = [None]
 
         def unpickle(text: str) -> CMAES:

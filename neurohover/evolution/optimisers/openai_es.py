@@ -30,6 +30,8 @@ from ..common import (
     Clock,
     PopulationOptimiser,
     TellInfo,
+    as_returns,
+    check_entries,
     check_genomes,
     check_prototype,
     check_settings,
@@ -104,8 +106,19 @@ class OpenAIESSettings:
         set_field(self, "l2", require_std("l2", self.l2))
 
 
+#: Every entry an :meth:`OpenAIES.state_dict` has held.
+STATE_ENTRIES = ("type", "version", "settings", "mean", "adam", "generation", "pending", "rng", "tracker", "wall_seconds")
+
+
 def centred_ranks(returns: np.ndarray) -> np.ndarray:
-    """Each return's rank scaled to [-0.5, 0.5], best highest (ties, NaN and ``-inf`` by :func:`~neurohover.evolution.common.rank`)."""
+    """Each return's rank scaled to [-0.5, 0.5], best highest (ties, NaN and ``-inf`` by :func:`~neurohover.evolution.common.rank`).
+
+    Raises
+    ------
+    NeurohoverError
+        Unless ``returns`` is a 1-D array of two or more real numbers (one return has no rank to scale).
+    """
+    returns = as_returns(returns, "returns", "a 1-D array of 2 or more returns", minimum=2)
     n = returns.size
     shaped = np.empty(n)
     shaped[rank(returns)] = np.arange(n - 1, -1, -1, dtype=np.float64)  # best gets n - 1
@@ -194,6 +207,7 @@ class OpenAIES(PopulationOptimiser):
         """
         check_state(state, "OpenAIES")
         kind = "OpenAIES"
+        check_entries(state, kind, STATE_ENTRIES)
         settings = read_entry(state, kind, "settings", lambda s: OpenAIESSettings(**s))
         opt = cls(read_entry(state, kind, "mean", dec_array), settings)
         d = opt.mean.size
