@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from neurohover.errors import NeurohoverError
-from neurohover.evolution import SteadyStateNE, SteadyStateSettings, evolve
+from neurohover.evolution import SteadyStateNE, SteadyStateSettings, evolve, roulette_weights
 from neurohover.evolution.common import TellInfo
 from neurohover.evolution.generational import GenerationalNE, GenerationalSettings
 from neurohover.evolution.operators import crossover, mutate
@@ -149,3 +149,12 @@ def test_generational_state_of_before_the_hall_of_fame_still_loads() -> None:
     opt = _optimisers()[1]
     state = {k: v for k, v in opt.state_dict().items() if k not in ("parents", "hall_of_fame")}
     assert GenerationalNE.from_state_dict(state).generation == 0
+
+
+def test_roulette_weights_refuses_an_empty_or_2d_array() -> None:
+    """T15-24: roulette_weights(np.zeros(0)) returned empty weights, roulette_weights(np.zeros((2, 2))) 2-D ones."""
+    with _raises("returns has shape (0,): give a non-empty 1-D array of returns (real numbers)"):
+        roulette_weights(np.zeros(0))
+    with _raises("returns has shape (2, 2): give a non-empty 1-D array of returns"):
+        roulette_weights(np.zeros((2, 2)))
+    assert roulette_weights([-10.0]).shape == (1,)

@@ -26,7 +26,7 @@ from .common import (
     ChampionViews,
     Clock,
     TellInfo,
-    as_floats,
+    as_returns,
     check_entries,
     check_genomes,
     check_prototype,
@@ -200,7 +200,7 @@ def roulette_weights(returns: np.ndarray) -> np.ndarray:
     np.ndarray
         Non-negative weights, same shape.
     """
-    r = as_floats(returns, "returns", "an array of returns (numbers)")
+    r = as_returns(returns, "returns", "an array of returns (numbers)")
     w = np.where(np.isfinite(r), episode_fitness(r, "inv-log-error"), 0.0)
     if not np.count_nonzero(w):
         w = np.ones_like(r)
