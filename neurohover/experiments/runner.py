@@ -227,7 +227,7 @@ def reproduce(
     sources = {name: store.results(name, config.scale) for name in source_experiments(config)}
     first_round: Plan | None = _refuse_stray_units(config, store, results, stored, sources)  # planned once, not twice
     summary = RunSummary(config.name, config.scale, executor.name, executor.cores, units_before=len(results))
-    session = store.start_session(config.name, config.scale, config.hash, executor.name, summary.cores, len(results))
+    session: int | None = store.start_session(config.name, config.scale, config.hash, executor.name, summary.cores, len(results))
     start = time.perf_counter()
     disable = None if progress is None else not progress
     bar = tqdm(total=0, initial=len(results), desc=f"{config.name} ({config.scale})", unit="unit", file=sys.stderr, disable=disable, dynamic_ncols=True)
@@ -262,8 +262,10 @@ def reproduce(
         if summary.failed:
             summary.status = "failed"
         elif set(only) - matched:
-            if held is None:  # registered by this call only: a refused run leaves the store as it was (third trial)
-                store.forget_if_empty(config.name, config.scale)
+            if held is None and store.forget_if_empty(
+                config.name, config.scale
+            ):  # registered by this call only: a refused run leaves the store as it was (third trial)
+                session = None  # forgotten with its experiment: nothing to end
             raise _matches_no_unit(config, sorted(set(only) - matched)[0], p.units)
         elif only:
             summary.status = "finished" if len(results) >= summary.units_total else "selection finished"
@@ -281,5 +283,6 @@ def reproduce(
     finally:
         summary.wall_seconds = time.perf_counter() - start
         bar.close()
-        store.end_session(session, summary.status)
+        if session is not None:
+            store.end_session(session, summary.status)
     return summary
