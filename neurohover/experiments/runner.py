@@ -184,6 +184,16 @@ def _check_arguments(config, store, executor, progress, on_unit, only, fresh, up
     return tuple(patterns)
 
 
+def _refuse_unmatched(config: ExperimentConfig, store: Store, held: str | None, only: tuple[str, ...]) -> None:
+    """Refuse an ``only`` pattern that matches no unit of a plan complete now (or of the test runs to come)."""
+    sources = {n: store.results(n, config.scale) for n in source_experiments(config)}
+    first = plan(config, store.results(config.name, config.scale) if held == config.hash else {}, sources)
+    later = run_keys(config)  # a test-runs plan lists its runs once their policies are stored: their keys, now
+    unmatched = [pat for pat in only if not any(fnmatch.fnmatchcase(k, pat) for k in [*(u.key for u in first.units), *later])]
+    if unmatched and (len(first.units) == first.total or later):
+        raise _matches_no_unit(config, unmatched[0], first.units)
+
+
 def reproduce(
     config: ExperimentConfig,
     store: Store,
@@ -211,13 +221,8 @@ def reproduce(
     store.lock()  # one writer per store: a second run would redo every unit the first has not finished
     check_restart(fresh, update, only)
     held = store.config_hash(config.name, config.scale)
-    if only:  # refused before the store records anything: a pattern that matches no unit of a plan complete now
-        sources = {n: store.results(n, config.scale) for n in source_experiments(config)}
-        first = plan(config, store.results(config.name, config.scale) if held == config.hash else {}, sources)
-        later = run_keys(config)  # a test-runs plan lists its runs once their policies are stored: their keys, now
-        unmatched = [pat for pat in only if not any(fnmatch.fnmatchcase(k, pat) for k in [*(u.key for u in first.units), *later])]
-        if unmatched and (len(first.units) == first.total or later):
-            raise _matches_no_unit(config, unmatched[0], first.units)
+    if only:  # refused before the store records anything
+        _refuse_unmatched(config, store, held, only)
     if update and held is not None and held != config.hash:
         _check_policy_source(config, store)
         kept = store.update(config.name, config.scale, config.hash, config.to_dict(), unchanged_units(config, store))
