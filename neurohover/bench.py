@@ -160,9 +160,9 @@ def benchmark_evolution(quick: bool = False, repeats: int | None = None) -> dict
     the best of the repeats. A run's episodes are fixed by its seed, so every repeat flies the same
     ones. ``flown_steps_per_used`` is the race's overhead in control steps flown.
     """
+    from .errors import check_flag
     from .evolution.evolve import evolve
     from .evolution.seeding import noise_seed
-    from .experiments.store import check_flag
 
     check_flag(quick, "quick", "a short run")  # quick="no" was true (fifteenth trial, T15-26)
     cores = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # numba.config sets it at import, from the environment
@@ -227,7 +227,7 @@ ESTIMATED_LIMIT_PER_CORE = (3000.0, 5000.0)
 
 def run_benchmarks(quick: bool = False) -> dict:
     """Measure everything and return a JSON-able report (``quick``: True for a short run)."""
-    from .experiments.store import check_flag
+    from .errors import check_flag
 
     check_flag(quick, "quick", "a short run")  # quick="no" ran the short benchmarks (fifteenth trial, T15-26)
     cores = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # numba.config sets it at import, from the environment

@@ -123,7 +123,7 @@ def gpu_benchmarks(quick: bool = False, cpu_episodes_per_second: float | None = 
     ``cpu_episodes_per_second``: the CPU kernel on all cores on the same workload, for the ratio
     (measured here, briefly, when not given).
     """
-    from .experiments.store import check_flag
+    from .errors import check_flag
 
     check_flag(quick, "quick", "a short run")  # before the device: quick="no" was true (fifteenth trial, T15-26)
     device = gpu_device()

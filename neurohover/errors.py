@@ -77,6 +77,13 @@ def float_of(text: str) -> float:
     return value
 
 
+def check_flag(value: Any, name: str, meaning: str) -> None:
+    """Refuse a flag that is not a bool: any truthy value counted as True (``fresh='no'`` deleted every stored unit,
+    T14-4; ``quick='no'``, ``fit_drags='no'``, fifteenth trial). The one check of a True/False argument."""
+    if not isinstance(value, bool):
+        raise NeurohoverError(f"{name}={brief(value)} is not allowed: give True ({meaning}) or False")
+
+
 def raise_terminated(signum, frame) -> None:
     """A SIGTERM handler: the signal as :class:`Terminated` in the main thread."""
     raise Terminated(f"signal {signum}")

@@ -50,3 +50,30 @@ def test_the_gpu_benchmarks_refuse_a_flag_that_is_no_bool() -> None:
 
     with pytest.raises(NeurohoverError, match=r"quick='no' is not allowed: give True \(a short run\) or False"):
         gpu_benchmarks(quick="no")  # type: ignore[arg-type]
+
+
+def test_flags_of_the_python_api_take_true_or_false_only() -> None:
+    """After T15-16 and T15-26 (truthy text taken as True), the same class elsewhere: fit_wind(fit_drags='no') fitted the
+    drags; one check, errors.check_flag."""
+    from neurohover.models.wind import fit_wind
+
+    with pytest.raises(NeurohoverError, match=r"fit_drags='no' is not allowed: give True \(fit the u and v drags too\) or False"):
+        fit_wind(_transitions(), "constant", 0.1, 0.1, 0.1, fit_drags="no")  # type: ignore[arg-type]
+
+
+def test_sb3_loaders_take_a_deterministic_flag_of_true_or_false_only() -> None:
+    """The same class: sb3_policy/rl_zoo_policy(deterministic='no') were deterministic."""
+    pytest.importorskip("stable_baselines3", reason="the examples extra (Stable-Baselines3) is not installed")
+    from neurohover.integrations.sb3 import rl_zoo_policy, sb3_policy
+
+    for load in (sb3_policy, rl_zoo_policy):  # checked before the file (and Stable-Baselines3) is needed
+        with pytest.raises(NeurohoverError, match=r"deterministic='no' is not allowed: give True \(the Gaussian's mean\) or False"):
+            load("missing.zip", deterministic="no")  # type: ignore[arg-type]
+
+
+def _transitions():
+    import neurohover as nh
+    from neurohover.models import Transitions
+
+    fd = nh.evaluate(nh.baseline_policy(), nh.get_task_family("ghh08").mdp("train:1"), episodes=1, record=True, n_steps=30).flight_data
+    return Transitions(fd)

@@ -9,11 +9,11 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, check_flag
 from .config import POLICY_SOURCES, ExperimentConfig, check_own_name, check_paper_table
 from .plans import Plan, plan, run_keys, source_experiments
 from .results import check_run_lengths, result_from_dict
-from .store import Store, check_flag
+from .store import Store
 
 
 @dataclass

@@ -37,7 +37,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
-from ..errors import NeurohoverError, brief, finite_real, whole_number
+from ..errors import NeurohoverError, brief, check_flag, finite_real, whole_number
 from ..paths import JSONError, WriterLock, strict_json
 from .config import check_name, check_scale
 from .units import Unit
@@ -66,13 +66,6 @@ CREATE TABLE sessions (
 
 def _dumps(obj: Any) -> str:
     return json.dumps(obj, separators=(",", ":"), allow_nan=False)
-
-
-def check_flag(value: Any, name: str, meaning: str) -> None:
-    """Refuse a flag that is not a bool: any truthy value counted as True, and ``fresh='no'`` deleted every stored unit
-    (fourteenth trial, T14-4). The one check of the Store's flags (and :func:`~neurohover.experiments.runner.reproduce`'s)."""
-    if not isinstance(value, bool):
-        raise NeurohoverError(f"{name}={brief(value)} is not allowed: give True ({meaning}) or False")
 
 
 def check_experiment(name: Any, scale: Any, where: str) -> None:

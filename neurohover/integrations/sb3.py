@@ -30,7 +30,7 @@ import numpy as np
 
 from ..envs.arguments import check_noise_stream, check_reset_options, real_values
 from ..envs.vector import HoverVectorEnv
-from ..errors import NeurohoverError, brief, finite_real
+from ..errors import NeurohoverError, brief, check_flag, finite_real
 from ..paths import checked_path
 from ..sim.constants import ACTION_DIM
 from ..sim.rng import MAX_SEED
@@ -260,6 +260,7 @@ def _policy_of(model, deterministic: bool, prepare: Callable[[np.ndarray], np.nd
 def sb3_policy(model_zip: str | Path, *, algo: str = "ppo", deterministic: bool = True) -> Callable[[np.ndarray], np.ndarray]:
     """A saved Stable-Baselines3 model (``MODEL.zip``) as a batch function (observations as it was trained on them:
     wrap it yourself if it learned behind a normaliser), ready for :func:`neurohover.integrations.flying.evaluate_callable`."""
+    check_flag(deterministic, "deterministic", "the Gaussian's mean")  # 'no' was true
     path = checked_path(model_zip, "model_zip", "MODEL.zip file path")  # None, 5, b'x.zip' were pathlib's TypeError (thirteenth trial, F13)
     if not path.is_file():
         raise NeurohoverError(f"{str(path)!r} is not a Stable-Baselines3 model file (MODEL.zip)")
@@ -320,6 +321,7 @@ def rl_zoo_policy(run: str | Path, *, algo: str = "ppo", deterministic: bool = T
     observations to the model's actions (the Gaussian's mean when ``deterministic``), ready for
     :func:`neurohover.integrations.flying.evaluate_callable`.
     """
+    check_flag(deterministic, "deterministic", "the Gaussian's mean")  # 'no' was true
     algorithm = _algorithm(algo)
     model_zip, stats_file = rl_zoo_files(run, algo)
     model = _load(algorithm, model_zip)

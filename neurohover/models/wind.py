@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, whole_number
+from ..errors import NeurohoverError, brief, check_flag, finite_real, whole_number
 from ..sim.constants import CONTROL_DT, SUBSTEP_DT, SUBSTEPS, WIND_CONSTANT, WIND_NONE, WIND_SINUSOID
 
 __all__ = ["DEFAULT_WIND_MODEL", "NO_WIND", "WIND_MODELS", "WindAxis", "WindModel", "body_wind", "effective_wind", "fit_wind", "model_times", "sinusoid_axes"]
@@ -263,6 +263,7 @@ def fit_wind(tr, kind: str, c_u: float, c_v: float, d_v: float, *, fit_drags: bo
     for name, value in (("c_u", c_u), ("c_v", c_v), ("d_v", d_v)):
         if not finite_real(value):
             raise NeurohoverError(f"{name}={brief(value)} is not allowed: give a finite number")
+    check_flag(fit_drags, "fit_drags", "fit the u and v drags too")  # 'no' was true
     if not whole_number(iterations) or iterations < 1:
         raise NeurohoverError(f"iterations={brief(iterations)} is not allowed: give a whole number >= 1 (rounds of alternating least squares)")
     y = tr.targets()
