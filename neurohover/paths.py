@@ -34,6 +34,7 @@ __all__ = [
     "checked_path",
     "created_dirs_removed_on_failure",
     "parse_json",
+    "json_text",
     "strict_json",
     "input_file",
     "input_dir",
@@ -140,6 +141,15 @@ def strict_json(text: str | bytes):
         raise JSONError("its JSON is nested too deeply", deep=True) from None
     except (ValueError, TypeError) as err:  # json.JSONDecodeError, UnicodeDecodeError (bytes), TypeError (no text at all)
         raise JSONError(str(err)) from None
+
+
+def json_text(value, **dumps) -> str:
+    """``value`` written as strict JSON (``json.dumps(value, allow_nan=False, **dumps)``) that :func:`strict_json` reads
+    back, or the TypeError / ValueError / RecursionError saying why not (an object, a NaN, a key twice as 1 and '1', an
+    integer past a float's range, nesting too deep): the one test of a value about to be stored, each caller naming it."""
+    text = json.dumps(value, allow_nan=False, **dumps)
+    strict_json(text)
+    return text
 
 
 def parse_json(text: str, name: str):

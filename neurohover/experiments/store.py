@@ -38,7 +38,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import NeurohoverError, brief, check_flag, finite_real, whole_number
-from ..paths import JSONError, WriterLock, strict_json
+from ..paths import JSONError, WriterLock, json_text, strict_json
 from .config import check_name, check_scale
 from .units import Unit
 
@@ -95,8 +95,7 @@ def _object_text(value: Any, what: str, where: str) -> str:
     if not isinstance(value, dict):
         raise NeurohoverError(f"{where}: {what} = {brief(value)} is not allowed: give a dict (a JSON object)")
     try:
-        text = _dumps(value)
-        strict_json(text)  # what is written reads back: no key twice ({1: .., '1': ..}), no integer past a float's range
+        text = json_text(value, separators=(",", ":"))  # what is written reads back: no key twice ({1: .., '1': ..}), no NaN
     except (TypeError, ValueError, RecursionError) as err:  # JSONError is a ValueError
         raise NeurohoverError(
             f"{where}: {what} = {brief(value)} is not allowed: give a JSON object of text, finite numbers, bools, None, lists and such objects "

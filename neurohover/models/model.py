@@ -36,7 +36,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import NeurohoverError, brief, finite_real, whole_number
-from ..paths import strict_json
+from ..paths import json_text
 from ..sim.constants import CONTROL_DT, DEFAULT_NOISE_STD, DEFAULT_PARAMS, NOISE_NAMES, PARAM_NAMES, SUBSTEP_DT, SUBSTEPS
 from ..tasks import MDP, finite_vector
 from .wind import NO_WIND, WindModel
@@ -136,12 +136,12 @@ def check_stats(stats: dict) -> None:
     back: strict JSON values, numbers finite (an object() or a NaN was json's TypeError or ValueError at the save;
     fourteenth trial T14-12), as ``save_policy`` and ``FlightData.save`` refuse their metadata."""
     try:
-        strict_json(json.dumps(stats, allow_nan=False))  # the round trip: load() reads what its parser takes
+        json_text(stats)  # the round trip: load() reads what its parser takes
     except (TypeError, ValueError, RecursionError) as err:  # RecursionError: nesting too deep to write
         subject = "model stats"
         for key, value in stats.items():  # name the first entry at fault (json's message names no key, and no NaN)
             try:
-                strict_json(json.dumps({key: value}, allow_nan=False))
+                json_text({key: value})
             except (TypeError, ValueError, RecursionError):
                 subject = f"model stats entry {brief(key)} = {brief(value)}"
                 break
