@@ -80,7 +80,7 @@ from pathlib import Path
 import numba
 import numpy as np
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, check_flag
 from ..evaluate import check_episode_count, evaluate_jobs, num_threads
 from ..paths import output_file
 from ..policies import Policy
@@ -132,9 +132,7 @@ def _prepare(
         raise NeurohoverError(f"progress_every_s={progress_every_s!r} is out of range: allowed a finite number of seconds >= 0 (0: every generation)")
     if progress is not None and not callable(progress):  # progress=3 was "'int' object is not callable" mid-run (second trial)
         raise NeurohoverError(f"progress={progress!r:.60} is not allowed: give a callable taking a ProgressInfo, or None")
-    if not isinstance(resume, (bool, np.bool_)):  # resume="no" resumed (its truth), and "yes" was reported as True (fifteenth trial)
-        raise NeurohoverError(f"resume={brief(resume)} is not allowed: give True (continue from the checkpoint) or False")
-    resume = bool(resume)
+    check_flag(resume, "resume", "continue from the checkpoint")  # resume="no" resumed (its truth), fifteenth trial
     path = None if checkpoint is None else (Path(checkpoint) if resume else output_file(checkpoint, "checkpoint"))  # checked before the run
     if resume:
         if path is None:
