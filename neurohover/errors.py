@@ -7,6 +7,8 @@ import math
 import numbers
 from typing import Any, TypeGuard
 
+import numpy as np
+
 
 class NeurohoverError(ValueError):
     """Bad input: the message names the bad value and what is allowed."""
@@ -111,3 +113,31 @@ def first_difference(path: str, saved: Any, given: Any, saved_as: str = "the sto
             if saved.get(key) != given.get(key):
                 return first_difference(f"{path}.{key}", saved.get(key), given.get(key), saved_as)
     return f"{path}: {saved_as} {brief(saved)}, given {brief(given)}"
+
+
+#: What values of each refused NumPy dtype kind are, for the message (real numbers are kinds "f", "i" and "u").
+_NOT_REAL = {"b": "booleans", "c": "complex numbers", "M": "dates", "m": "time spans", "U": "text", "S": "bytes", "O": "Python objects", "V": "raw records"}
+
+
+def _not_floats(values: Any, name: str, allowed: str, what: str) -> NeurohoverError:
+    """:func:`as_floats`' error: ``values`` shown on one line (an array's repr breaks its rows over lines)."""
+    shown = " ".join(brief(values).split())
+    return NeurohoverError(f"{name}={shown} is not allowed: give {allowed}" + (f" (real numbers, not {what})" if what else ""))
+
+
+def as_floats(values: Any, name: str, allowed: str) -> np.ndarray:
+    """A float64 copy of ``values`` if they are real numbers (a NumPy dtype of kind float, int or unsigned int), or
+    NeurohoverError naming ``name``, what they are and what is ``allowed``: the one check of every array of real
+    numbers given (returns, genomes, samples, MDP parameters, actions). Text, booleans, dates, Python objects (None,
+    Decimal), complex numbers and masked arrays are refused (SteadyStateNE("abc") was NumPy's "could not convert",
+    eleventh trial; a date was taken as its day number, None as
+    NaN, '-1' as -1, a complex number's imaginary part dropped and a mask ignored, fourteenth trial)."""
+    if isinstance(values, np.ma.MaskedArray):  # np.asarray drops the mask: the masked entries would count
+        raise _not_floats(values, name, allowed, "a masked array")
+    try:
+        a = np.asarray(values)
+    except (TypeError, ValueError, OverflowError):  # a ragged list
+        raise _not_floats(values, name, allowed, "") from None
+    if a.dtype.kind not in "fiu":  # one dtype test: this runs at every tell()
+        raise _not_floats(values, name, allowed, _NOT_REAL.get(a.dtype.kind, a.dtype.name))
+    return np.array(a, dtype=np.float64)
