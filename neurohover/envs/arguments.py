@@ -3,7 +3,7 @@ noise stream, the sensors, the id they were made under, sizes, dtypes and reset 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import gymnasium as gym
@@ -55,10 +55,32 @@ def resolve_mdp(family: TaskFamily, spec: Any, cache: dict[str, MDP] | None = No
     return mdp
 
 
+def refuse_idle_sigma(sigma: Any, mdp: Any, *, flags: bool = False, default: bool = False) -> None:
+    """Refuse a breadth ``sigma`` (not None) beside an ``mdp`` setting it does not change: ``"zero"`` (the family's mean
+    MDP, the same at every sigma), or a sequence of only such settings (one per sub-environment). ``sigma=0.2,
+    mdp='zero'`` made an environment whose sigma did nothing (sixteenth trial T16-6). The one rule of the environments
+    and the command line: ``flags`` names them as ``--sigma`` and ``--mdp``; ``default``: the zero setting was not given
+    but is ``--mdp``'s default. Explicit MDPs are left to their callers (a batch flier passes its MDPs' family sigma)."""
+    if sigma is None:
+        return
+    specs = list(mdp) if isinstance(mdp, (list, tuple)) else [mdp]
+    if not specs or not all(isinstance(s, str) and s == "zero" for s in specs):
+        return
+    if flags:
+        given = f"--sigma {sigma:g}", "--mdp zero" + (" (the default)" if default else ""), "--mdp sample, train:N or test:N", "--sigma"
+    else:
+        given = f"sigma={brief(sigma)}", f"mdp={brief(mdp)}", "mdp='sample', 'train:N' or 'test:N'", "sigma"
+    raise NeurohoverError(
+        f"{given[0]} does nothing with {given[1]}: sigma is the breadth of the MDPs drawn from FGHH's G, and the zero "
+        f"setting is the same at every sigma; give {given[2]}, or leave {given[3]} out"
+    )
+
+
 def check_noise_stream(value: Any, what: str = "noise") -> tuple[int, int]:
     """A ``(seed, episode)`` pair naming one gust-noise stream of the kernel, validated: a tuple, list or 1-D array of two
     integers (a dict was unpacked to its keys and "12" to '1' and '2'; fifteenth trial T15-19)."""
-    pair = isinstance(value, (tuple, list)) or (isinstance(value, np.ndarray) and value.ndim == 1)
+    # a masked array's masked entry was flown as its hidden value (sixteenth trial T16-9)
+    pair = isinstance(value, (tuple, list)) or (isinstance(value, np.ndarray) and value.ndim == 1 and not isinstance(value, np.ma.MaskedArray))
     if not pair or len(value) != 2 or not all(whole_number(v) for v in value):
         raise NeurohoverError(f"{what}={brief(value)} is not allowed: give a (seed, episode) pair of integers in 0..2**63-1")
     for name, v in zip(("seed", "episode"), value):
@@ -131,16 +153,24 @@ def draw_stream_seed(rng: np.random.Generator) -> int:
     return int(rng.bit_generator.random_raw()) >> 1
 
 
-def real_values(values: Any, message: str) -> np.ndarray:
-    """``values`` (actions) as float64, or NeurohoverError(``message``): text, booleans and complex numbers are refused, which
-    NumPy would read ('1' as 1.0) or cut to their real part with only a warning."""
+def real_values(values: Any, message: str | Callable[[], str]) -> np.ndarray:
+    """``values`` (actions) as float64, or NeurohoverError(``message``; a function giving it, called only then: an array's
+    repr at every step was half a step's time): text, booleans and complex numbers are refused, which NumPy would read
+    ('1' as 1.0) or cut to their real part with only a warning, and masked arrays, whose masked entries NumPy would fly
+    at their hidden values (sixteenth trial T16-9)."""
+
+    def refused(why: str = "") -> NeurohoverError:
+        return NeurohoverError((message if isinstance(message, str) else message()) + why)
+
+    if isinstance(values, np.ma.MaskedArray):  # one isinstance test: this runs at every step
+        raise refused(" (not a masked array: its masked entries would be flown at their hidden values)")
     try:
         raw = np.asarray(values)
         if raw.dtype.kind not in "iuf":  # booleans too: [True] * 4 is no action
             raise TypeError(raw.dtype)
         return raw.astype(np.float64, copy=False)
     except (TypeError, ValueError):
-        raise NeurohoverError(message) from None
+        raise refused() from None
 
 
 def _check_dtype(value: Any, name: str) -> np.dtype:

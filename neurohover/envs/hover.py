@@ -47,6 +47,7 @@ from .arguments import (
     check_reset_options,
     draw_stream_seed,
     real_values,
+    refuse_idle_sigma,
     resolve_mdp,
     sensed_family,
 )
@@ -178,8 +179,9 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
     ## Arguments
 
     ``gymnasium.make("neurohover/GHH08-v0")``, ``"neurohover/GHH09-v0"`` or
-    ``"neurohover/FGHH-v0"`` (which takes ``sigma``, default 0.3), with the arguments below. Each
-    family also has a variant for deep RL, whose id alone sets it up:
+    ``"neurohover/FGHH-v0"`` (which takes ``sigma``, default 0.3; refused beside ``mdp="zero"``, the
+    same MDP at every sigma), with the arguments below. Each family also has a variant for deep RL,
+    whose id alone sets it up:
 
     | Id                               | episode_steps, time limit | obs_dtype, action_dtype |
     |----------------------------------|---------------------------|-------------------------|
@@ -300,6 +302,7 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         self.family: TaskFamily = sensed_family(task, sigma, obs_noise, obs_delay)
         self.episode_steps = check_episode_steps(episode_steps)
         self._spec: MDP | str = resolve_mdp(self.family, mdp)
+        refuse_idle_sigma(sigma, mdp)
         self.observation_space = observation_space(self.obs_dtype)
         self.action_space = action_space(self.action_dtype)
         # The kernel steps batches; this environment is a batch of one.
@@ -416,7 +419,7 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         if self._done:
             raise NeurohoverError("step() called on a finished episode (or before reset()): call reset() first")
-        a = real_values(action, f"action {action!r:.80} is not allowed: give 4 real numbers (aileron, elevator, rudder, collective)")
+        a = real_values(action, lambda: f"action {brief(action)} is not allowed: give 4 real numbers (aileron, elevator, rudder, collective)")
         if a.shape != (ACTION_DIM,):
             raise NeurohoverError(f"action has shape {a.shape}, expected (4,): aileron, elevator, rudder, collective in [-1, 1]")
         self._action[0] = a

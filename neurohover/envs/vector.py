@@ -28,7 +28,7 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..launch import check_device, stepper
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS, MDP_ROW_LEN, OBS_DIM
 from ..sim.rng import MAX_SEED, seed_stream
@@ -46,6 +46,7 @@ from .arguments import (
     check_reset_options,
     draw_stream_seed,
     real_values,
+    refuse_idle_sigma,
     resolve_mdp,
     sensed_family,
 )
@@ -82,7 +83,8 @@ class HoverVectorEnv(VectorEnv):
     task : {"ghh08", "ghh09", "fghh"}
         Task family.
     sigma : float, optional
-        FGHH only: relative standard deviation of the dynamics parameters (default 0.3).
+        FGHH only: relative standard deviation of the dynamics parameters (default 0.3); refused when every
+        sub-environment's ``mdp`` is ``"zero"`` (the same MDP at every sigma).
     mdp : str, MDP or sequence of them
         ``"sample"`` (default: each sub-environment draws its own fresh MDP from G at every
         reset), ``"zero"``, ``"train:N"``, ``"test:N"`` or an :class:`~neurohover.MDP`, for all
@@ -161,6 +163,7 @@ class HoverVectorEnv(VectorEnv):
         self.max_episode_steps = self.episode_steps if max_episode_steps is None else check_episode_steps(max_episode_steps, "max_episode_steps")
         self._limit = min(self.episode_steps, self.max_episode_steps)
         self._specs: list[MDP | str] = self.resolve_mdps(mdp)
+        refuse_idle_sigma(sigma, mdp)
         self.render_mode = None
         self.single_observation_space = observation_space(self.obs_dtype)
         self.single_action_space = action_space(check_action_dtype(action_dtype))
@@ -279,8 +282,8 @@ class HoverVectorEnv(VectorEnv):
             if not 0 <= seed <= MAX_SEED + 1 - n:  # every seed's range (the last helicopter's seed + n - 1 too)
                 raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer in 0..2**63-{n}")
             return [int(seed) + i for i in range(n)]
-        if (
-            isinstance(seed, (list, tuple, np.ndarray))
+        if (  # an array: 1-D and plain (a 0-d one was len()'s TypeError, T16-5; a masked one's mask would be dropped)
+            (isinstance(seed, (list, tuple)) or (isinstance(seed, np.ndarray) and not isinstance(seed, np.ma.MaskedArray) and seed.ndim == 1))
             and len(seed) == n
             and all(s is None or (isinstance(s, (int, np.integer)) and not isinstance(s, (bool, np.bool_)) and 0 <= s <= MAX_SEED) for s in seed)
         ):
@@ -289,6 +292,8 @@ class HoverVectorEnv(VectorEnv):
 
     def _check_streams(self, value: Any) -> list[tuple[int, int]]:
         n = self.num_envs
+        if isinstance(value, np.ma.MaskedArray):  # its masked entries would be read at their hidden values (T16-9)
+            raise NeurohoverError(f"noise={brief(value)} is not allowed: give a (seed, episode) pair or {n} of them, not a masked array")
         try:
             per_env = np.ndim(value) == 2
         except ValueError:  # ragged nesting
@@ -303,12 +308,21 @@ class HoverVectorEnv(VectorEnv):
         return [(seed, episode + i) for i in range(n)]
 
     def _check_mask(self, mask: Any) -> np.ndarray:
-        if not isinstance(mask, np.ndarray) or mask.dtype != np.bool_ or mask.shape != (self.num_envs,) or not mask.any():
-            raise NeurohoverError(f"reset_mask must be a bool numpy array of shape ({self.num_envs},) with at least one True, got {mask!r:.80}")
+        # a masked array's masked entries were reset at their hidden values (sixteenth trial T16-9)
+        if (
+            not isinstance(mask, np.ndarray)
+            or isinstance(mask, np.ma.MaskedArray)
+            or mask.dtype != np.bool_
+            or mask.shape != (self.num_envs,)
+            or not mask.any()
+        ):
+            raise NeurohoverError(
+                f"reset_mask must be a bool numpy array of shape ({self.num_envs},) with at least one True (not a masked array), got {brief(mask)}"
+            )
         return mask.copy()
 
     def _coerce_actions(self, actions: Any) -> np.ndarray:
-        a = real_values(actions, f"actions must be a ({self.num_envs}, 4) array of real numbers, got {actions!r:.80}")
+        a = real_values(actions, lambda: f"actions must be a ({self.num_envs}, 4) array of real numbers, got {brief(actions)}")
         if a.shape != (self.num_envs, ACTION_DIM):
             raise NeurohoverError(f"actions have shape {a.shape}, expected ({self.num_envs}, 4): aileron, elevator, rudder, collective per helicopter")
         np.copyto(self._actions, a)

@@ -16,7 +16,8 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, whole_number
+from ..errors import NeurohoverError, as_floats, brief, whole_number
+from ..evolution.seeding import check_seed
 from .keys import UnitKey
 from .results import TestRunResult
 
@@ -59,9 +60,10 @@ def win_probabilities(runs: Mapping[str, Mapping[str, Sequence[float]]], n_runs:
     WinOdds
         Agent -> probability; the probabilities sum to 1.
     """
-    for name, value, low in (("n_runs", n_runs, 1), ("draws", draws, 1), ("seed", seed, 0)):
-        if not whole_number(value) or value < low:
-            raise NeurohoverError(f"{name}={brief(value)} is out of range: allowed an integer >= {low}")
+    for name, value in (("n_runs", n_runs), ("draws", draws)):
+        if not whole_number(value) or value < 1:
+            raise NeurohoverError(f"{name}={brief(value)} is out of range: allowed an integer >= 1")
+    seed = check_seed(seed)  # every seed's range, 0..2**63-1: 2**64 was taken (sixteenth trial T16-17)
     if draws * n_runs > _MAX_CELLS:
         raise NeurohoverError(f"draws x n_runs = {draws * n_runs:,} is too large: at most {_MAX_CELLS:,} simulated runs per agent at once")
     if not isinstance(runs, Mapping) or not all(isinstance(r, Mapping) for r in runs.values()):  # [1, 2] was an AttributeError (thirteenth trial, F20)
@@ -92,11 +94,12 @@ def win_probabilities(runs: Mapping[str, Mapping[str, Sequence[float]]], n_runs:
 
 def _scores(agent: str, mdp: str, scores: Sequence[float]) -> np.ndarray:
     """One agent's scores on one MDP as float64, all finite (NaN was refused; text was NumPy's "could not convert")."""
-    try:
-        pool = np.asarray(scores, dtype=float).ravel()
-    except (TypeError, ValueError, OverflowError):  # thirteenth trial, F20
-        pool = None
-    if pool is None or not np.all(np.isfinite(pool)):
+    try:  # the one array check: '12' was read as 12.0, True as 1.0 and a masked array's hidden values used (T16-9, T16-11)
+        pool = as_floats(scores, "scores", "real numbers").ravel()
+    except NeurohoverError as err:
+        why = str(err).rpartition(" (")[2].rstrip(")") or "real numbers"
+        raise NeurohoverError(f"agent {agent!r} has a run whose score is not a finite number: {brief(scores)} on MDP {mdp!r} (give {why})") from None
+    if not np.all(np.isfinite(pool)):
         raise NeurohoverError(f"agent {agent!r} has a run whose score is not a finite number: {brief(scores)} on MDP {mdp!r}")
     return pool
 

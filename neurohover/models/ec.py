@@ -13,7 +13,7 @@ import time
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, whole_number
+from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..flightdata import FlightData
 from ..sim.constants import DEFAULT_PARAMS, ROW_NOISE, ROW_PARAMS
 from ..tasks import MDP
@@ -251,8 +251,9 @@ def learn_ec_mer(
     tr = Transitions(flight_data)
     if true_return is None:
         true_return = observed_return(flight_data, 0)
-    if not isinstance(true_return, (int, float, np.floating)) or not math.isfinite(true_return):
-        raise NeurohoverError(f"true_return={true_return!r} must be a finite number (the observed return of the episode)")
+    if not finite_real(true_return):  # True was taken as 1.0 (sixteenth trial T16-18)
+        raise NeurohoverError(f"true_return={brief(true_return)} must be a finite number (the observed return of the episode)")
+    true_return = float(true_return)
     n_steps = int(flight_data.actions[0].shape[0])
     if n_steps < 1:
         raise NeurohoverError("the flight data's first episode has no steps; EC-MER needs it to define the episode length")

@@ -35,7 +35,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, whole_number
+from ..errors import NeurohoverError, as_floats, brief, finite_real, whole_number
 from ..paths import json_text
 from ..sim.constants import CONTROL_DT, DEFAULT_NOISE_STD, DEFAULT_PARAMS, NOISE_NAMES, PARAM_NAMES, SUBSTEP_DT, SUBSTEPS
 from ..tasks import MDP, finite_vector
@@ -119,6 +119,9 @@ def check_vector(values, length: int, what: str, nonnegative: bool = False) -> t
     """
     if not whole_number(length) or length < 1:  # '2' was "x must be 2 numbers, got 2" (fourteenth trial T14-13)
         raise NeurohoverError(f"length={brief(length)} is not allowed: give a whole number >= 1 (how many numbers {what} holds)")
+    # the one array check: a masked array's mask was dropped and its hidden values used (T16-9); objects are checked below
+    if isinstance(values, np.ma.MaskedArray) or (isinstance(values, np.ndarray) and values.dtype.kind != "O"):
+        as_floats(values, what, f"{length} real numbers")
     try:  # as objects: a float conversion read '1' as 1.0 and True as 1.0, and 10**400 was an OverflowError (T14-13)
         flat = np.asarray(values, dtype=object).reshape(-1)
     except (TypeError, ValueError):
@@ -402,7 +405,7 @@ def parameter_table(
     if isinstance(true_params, MDP):
         mdp = true_params
         truth = np.array(mdp.params, dtype=float)
-        noise = np.array(mdp.noise_std if true_noise_std is None else true_noise_std, dtype=float)
+        noise = np.array(mdp.noise_std if true_noise_std is None else check_vector(true_noise_std, 6, "true noise std"))
         substeps = mdp.substeps if substeps is None else substeps
         dt = mdp.dt if dt is None else dt
     else:
