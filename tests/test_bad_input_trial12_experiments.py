@@ -130,10 +130,11 @@ def test_reproduce_takes_a_single_only_pattern_as_one(tmp_path: Path) -> None:
 def test_unit_seed_and_run_unit_name_what_they_take() -> None:
     """Twelfth trial T7: unit_seed('x') / (-1) were int()'s and NumPy's ValueErrors; run_unit({}) a KeyError,
     run_unit('x') an AttributeError."""
-    for root in ("x", -1):
-        with pytest.raises(NeurohoverError, match=rf"root={root!r} is not allowed: give the config's seed, an integer >= 0"):
+    for root in ("x", -1, 2**63, 2**64):  # 2**64 was taken (sixteenth trial, T16-17)
+        with pytest.raises(NeurohoverError, match=rf"root={root!r} is not allowed: give the config's seed, an integer in 0..2\*\*63-1"):
             unit_seed(root, "a", "b")
     assert unit_seed(np.int64(3), "a", "b") == unit_seed(3, "a", "b")
+    unit_seed(2**63 - 1, "a", "b")  # the largest seed is still taken
     for unit in ({}, "x"):
         with pytest.raises(NeurohoverError, match=r"is not allowed: give a Unit of a plan .* a dict of experiment, key, kind and params"):
             run_unit(unit)

@@ -33,7 +33,7 @@ from ..evaluate import evaluate, evaluate_jobs, num_threads
 from ..evolution.config import optimiser_of
 from ..evolution.eonn import EonnSettings
 from ..evolution.evolve import evolve, reevaluated_champion, validation_return
-from ..evolution.seeding import validation_seeds
+from ..evolution.seeding import MAX_SEED, validation_seeds
 from ..integrations.neat import NEAT_TOPOLOGY, genome_record
 from ..models import learn_ec_meno, learn_ec_mer, learn_lr, one_step_error
 from ..policies import Policy
@@ -74,8 +74,8 @@ class Unit:
 
 def unit_seed(root: int, experiment: str, key: str) -> int:
     """A 63-bit seed for unit ``key``: ``SeedSequence([root, *sha256(experiment/key) words])``."""
-    if not whole_number(root) or root < 0:  # 'x' and -1 were int()'s and NumPy's errors (twelfth trial, T7)
-        raise NeurohoverError(f"root={brief(root)} is not allowed: give the config's seed, an integer >= 0")
+    if not whole_number(root) or not 0 <= root <= MAX_SEED:  # 'x', -1 were NumPy's errors (twelfth trial, T7); 2**64 taken (T16-17)
+        raise NeurohoverError(f"root={brief(root)} is not allowed: give the config's seed, an integer in 0..2**63-1")
     for name, value in (("experiment", experiment), ("key", key)):
         if not isinstance(value, str):
             raise NeurohoverError(f"{name}={brief(value)} is not allowed: give text")

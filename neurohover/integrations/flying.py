@@ -18,6 +18,7 @@ the paper's policies are compared on the same episodes::
 
 from __future__ import annotations
 
+import functools
 import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
@@ -113,8 +114,10 @@ def evaluate_callable(
         live = np.flatnonzero(alive)
         raw = act(obs[live], live) if indexed else act(obs[live])
         # complex, text, None and bool were read as numbers, as the environments do not (ninth trial)
-        what = f"act returned {type(raw).__name__} {str(raw)[:60]!r}"
-        out = real_values(raw, f"{what}: expected numbers (real ones: not text, booleans, complex or None), an array ({live.size}, {ACTION_DIM})")
+        out = real_values(  # the message is built only when refused: str(raw) at every step was half a step's time
+            raw,
+            functools.partial(_bad_actions, raw, live.size),
+        )
         if out.shape != (live.size, ACTION_DIM):
             raise NeurohoverError(f"act returned actions of shape {out.shape} for {live.size} observations: expected ({live.size}, {ACTION_DIM})")
         actions[live] = out
@@ -216,3 +219,10 @@ def compare_agent(
     for name, policy in (("baseline", baseline_policy()), ("generic", generic)):
         rows.append(AgentRow.of(name, evaluate(policy, mdps, episodes=episodes, seed=seed, n_steps=n_steps)))
     return rows
+
+
+def _bad_actions(raw: Any, n: int) -> str:
+    """What ``act`` returned, when it is no array of ``n`` actions (built only then)."""
+    return (
+        f"act returned {type(raw).__name__} {str(raw)[:60]!r}: expected numbers (real ones: not text, booleans, complex or None), an array ({n}, {ACTION_DIM})"
+    )
