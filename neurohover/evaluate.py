@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError, brief, finite_real, whole_number
+from .errors import NeurohoverError, as_floats, brief, finite_real, whole_number
 from .flightdata import FlightData, same_values
 from .flyer import KernelFlyer
 from .launch import DEVICES, KIND, MAX_SEED, Batch, Flown, check_device, launch, num_threads, use_lanes
@@ -101,6 +101,9 @@ class PolicyTable:
     def __post_init__(self) -> None:
         """A table built by hand, checked for what the kernel would misread (a kind 9 flew as an SLP; second trial). A
         non-finite genome is allowed: its non-finite actions crash, as the simulator defines (the tests fly that path)."""
+        for name in ("kinds", "genomes"):  # np.asarray dropped the mask: the hidden values were flown (T16-9)
+            if isinstance(getattr(self, name), np.ma.MaskedArray):
+                raise NeurohoverError(f"PolicyTable {name}={brief(getattr(self, name))} is not allowed: give a plain array, not a masked one")
         kinds, genomes = np.asarray(self.kinds), np.asarray(self.genomes)
         if kinds.ndim != 1 or not np.issubdtype(kinds.dtype, np.integer) or not np.isin(kinds, list(KIND.values())).all():
             raise NeurohoverError(f"PolicyTable kinds must be a 1-D integer array of {sorted(KIND.values())} ({', '.join(KIND)}), got {kinds!r:.80}")
@@ -134,11 +137,13 @@ class PolicyTable:
         crashes at once, as the simulator defines, instead of stopping the run (a policy file, meant to be flown as
         it is, is refused instead).
         """
-        if topology not in TOPOLOGIES:
-            raise NeurohoverError(f"unknown policy topology {topology!r}: allowed {', '.join(TOPOLOGIES)}")
+        if not isinstance(topology, str) or topology not in TOPOLOGIES:  # an array was NumPy's "truth value is ambiguous" (T16-12)
+            raise NeurohoverError(f"unknown policy topology {brief(topology)}: allowed {', '.join(TOPOLOGIES)}")
         raw = np.asarray(genomes)
-        if raw.dtype.kind not in "iuf":  # text was NumPy's ValueError, complex numbers lost their imaginary part (fifth trial)
-            raise NeurohoverError(f"{topology} genomes of {raw.dtype} are not allowed: give an array of real numbers (P, {GENOME_LENGTH[topology]})")
+        # text was NumPy's ValueError, complex numbers lost their imaginary part (fifth trial), a mask was dropped (T16-9)
+        if raw.dtype.kind not in "iuf" or isinstance(genomes, np.ma.MaskedArray):
+            what = "a masked array" if isinstance(genomes, np.ma.MaskedArray) else raw.dtype
+            raise NeurohoverError(f"{topology} genomes of {what} are not allowed: give an array of real numbers (P, {GENOME_LENGTH[topology]})")
         g = raw.astype(float)
         n = GENOME_LENGTH[topology]
         if g.ndim != 2 or g.shape[1] != n or g.shape[0] == 0:
@@ -242,6 +247,8 @@ def mdp_rows(mdps: MDP | Sequence[MDP] | np.ndarray) -> np.ndarray:
 def _index_array(values, n_jobs: int | None, what: str) -> np.ndarray:
     """``values`` as a 1-D int64 array of job indices; their range is checked where every launch's is (launch.check_job_indices,
     from :class:`Batch`), so a KernelFlyer's or a hand-made Batch's indices cannot segfault either (thirteenth trial, F1)."""
+    if isinstance(values, np.ma.MaskedArray):  # np.asarray dropped the mask: the hidden indices were flown (T16-9)
+        raise NeurohoverError(f"{what}={brief(values)} is not allowed: give a plain array of job indices, not a masked one")
     arr = np.asarray(values)
     if arr.ndim > 1:  # one index per job: a 2-D array's jobs would be flattened in an order the caller may not mean
         raise NeurohoverError(f"{what} must be a 1-D array of job indices, got shape {arr.shape}")
@@ -290,7 +297,8 @@ def _fallback_array(fallback_index, n_jobs: int, n_policies: int) -> np.ndarray:
     if fallback_index is None:
         return np.full(n_jobs, -1, dtype=np.int64)
     fb = np.asarray(fallback_index)
-    if fb.dtype.kind not in "iu" and fb.size:  # ["x"] was NumPy's ValueError (fifth trial); 1.5 was cut to 1
+    masked = isinstance(fallback_index, np.ma.MaskedArray)  # np.asarray dropped the mask (T16-9)
+    if (fb.dtype.kind not in "iu" and fb.size) or masked:  # ["x"] was NumPy's ValueError (fifth trial); 1.5 was cut to 1
         raise NeurohoverError(f"fallback_index={fallback_index!r:.60} is not allowed: give {n_jobs} integers in -1..{n_policies - 1}")
     fb = fb.astype(np.int64).reshape(-1)
     if fb.shape[0] != n_jobs or (fb.size and (fb.min() < -1 or fb.max() >= n_policies)):
@@ -361,8 +369,8 @@ def evaluate_jobs(
     e_idx = _index_array(episode_index, n_jobs, "episode_index")
     fb = _fallback_array(fallback_index, n_jobs, len(table))
     try:
-        limits = SAFEGUARD_LIMITS if safeguard_limits is None else np.asarray(safeguard_limits, dtype=float)
-    except (TypeError, ValueError):  # 'x' was NumPy's ValueError (fourth trial)
+        limits = SAFEGUARD_LIMITS if safeguard_limits is None else as_floats(safeguard_limits, "safeguard_limits", "")
+    except NeurohoverError:  # 'x' was NumPy's ValueError (fourth trial), a masked array's hidden values were used (T16-9)
         limits = np.full(1, np.nan)  # refused below with the layout
     if (
         limits.shape != (SAFEGUARD_LAYOUT_LEN,)
@@ -377,7 +385,7 @@ def evaluate_jobs(
             f"number >= 0), got {limits.tolist()}"
         )
     rec = np.zeros(n_jobs, dtype=bool) if record is None else np.asarray(record).reshape(-1)
-    if rec.dtype != bool:  # record='x' was read as True (second trial)
+    if rec.dtype != bool or isinstance(record, np.ma.MaskedArray):  # record='x' was read as True (second trial); a mask dropped (T16-9)
         raise NeurohoverError(f"record={record!r:.60} is not allowed: give one True/False flag per job ({n_jobs})")
     if rec.shape[0] != n_jobs:
         raise NeurohoverError(f"record must have one flag per job ({n_jobs}), got {rec.shape[0]}")
@@ -507,8 +515,8 @@ class DangerousState:
     arm_after: int = 0
 
     def __post_init__(self) -> None:
-        if self.rule not in SAFEGUARD_RULES:
-            raise NeurohoverError(f"unknown safeguard rule {self.rule!r}: allowed {', '.join(SAFEGUARD_RULES)}")
+        if not isinstance(self.rule, str) or self.rule not in SAFEGUARD_RULES:  # an array: NumPy's "truth value is ambiguous" (T16-12)
+            raise NeurohoverError(f"unknown safeguard rule {brief(self.rule)}: allowed {', '.join(SAFEGUARD_RULES)}")
         # finite_real/whole_number: 10**400 was a TypeError, True taken as 1, np.float32(0.5) refused (T15-2, T15-17)
         if not (finite_real(self.box) and self.box > 0):
             raise NeurohoverError(f"safeguard box={brief(self.box)} is out of range: allowed a finite number > 0")

@@ -7,7 +7,6 @@ lengths kept, so a file of any number of episodes loads back exactly; or, with
 
 from __future__ import annotations
 
-import json
 import zipfile
 import zlib
 from dataclasses import dataclass, field
@@ -16,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real
-from .paths import strict_json
+from .paths import json_text, strict_json
 from .sim.constants import MAX_EPISODE_STEPS
 
 FORMAT = "neurohover-flight-data/1"
@@ -87,8 +86,9 @@ class FlightData:
             arrays = getattr(self, name)
             if isinstance(arrays, (str, bytes, np.ndarray)) or not isinstance(arrays, (tuple, list)):
                 raise NeurohoverError(f"flight data {name}={arrays!r:.60} is not allowed: give a sequence of arrays, one per episode")
-            if not all(isinstance(a, np.ndarray) and a.dtype.kind in "fi" for a in arrays):
-                raise NeurohoverError(f"flight data {name} must be arrays of real numbers, one per episode")
+            # a masked array was stored as it was, its hidden values learned from (T16-9)
+            if not all(isinstance(a, np.ndarray) and not isinstance(a, np.ma.MaskedArray) and a.dtype.kind in "fi" for a in arrays):
+                raise NeurohoverError(f"flight data {name} must be arrays of real numbers (plain, not masked), one per episode")
             object.__setattr__(self, name, tuple(arrays))
         _check_dict(self.metadata, "flight data")  # None or [1] was taken, and refused only by save() (fifteenth trial, T15-29)
         if len(self.observations) != len(self.actions):
@@ -144,14 +144,16 @@ class FlightData:
     def save(self, path: str | Path, dtype: str = "float64") -> Path:
         """Write the flight data to ``path`` (``.npz``), as float64 (exact) or float32 (half the space; a finite value past
         float32's range is refused, not written as inf)."""
-        if dtype not in SAVE_DTYPES:
-            raise NeurohoverError(f"flight-data dtype {dtype!r} is not allowed: use {' or '.join(SAVE_DTYPES)}")
+        if not isinstance(dtype, str) or dtype not in SAVE_DTYPES:  # an array was NumPy's "truth value is ambiguous" (T16-12)
+            raise NeurohoverError(f"flight-data dtype {brief(dtype)} is not allowed: use {' or '.join(SAVE_DTYPES)}")
         from .paths import output_file, writing
 
-        try:  # what load() reads back: JSON-object metadata (an object() was a TypeError mid-write; 5 was written, then refused)
-            meta_text = json.dumps(self.metadata) if isinstance(self.metadata, dict) else None
-        except (TypeError, ValueError) as err:
-            raise NeurohoverError(f"flight data metadata cannot be saved as JSON ({err})") from None
+        # what load() reads back: JSON-object metadata (an object() was a TypeError mid-write; 5 was written, then refused),
+        # strict as a policy file's (a NaN was written and read back; T16-24)
+        try:
+            meta_text = json_text(self.metadata) if isinstance(self.metadata, dict) else None
+        except (TypeError, ValueError, RecursionError) as err:
+            raise NeurohoverError(f"flight data metadata cannot be saved as JSON: give strict JSON values (numbers finite) ({err})") from None
         if meta_text is None or not self.actions or self.n_transitions == 0:
             raise NeurohoverError("flight data to save needs a dict of metadata and at least one step flown (load() refuses any other file)")
         path = output_file(path, "flight-data file")  # refuses '', a directory and a device (/dev/null was a struct.error)

@@ -276,7 +276,7 @@ def use_lanes(device: str, rows: np.ndarray, m_idx: np.ndarray, fb: np.ndarray |
     values would turn it into per-lane branches that no longer vectorize. Results are the same
     bits either way.
     """
-    if device not in DEVICES:
+    if not isinstance(device, str) or device not in DEVICES:  # an array: NumPy's "truth value is ambiguous" (T16-12)
         raise NeurohoverError(f"device={brief(device)} is unknown: allowed 'cpu' or 'cuda'")
     if not isinstance(m_idx, np.ndarray) or m_idx.ndim != 1:  # None was an AttributeError (thirteenth trial, F18)
         raise NeurohoverError(f"m_idx={brief(m_idx)} is not allowed: give a 1-D numpy array of each job's MDP row")
@@ -317,8 +317,8 @@ def check_device(device: str) -> None:
     NeurohoverError
         With one message that names the problem; ``"cpu"`` never imports numba.cuda.
     """
-    if device not in DEVICES:
-        raise NeurohoverError(f"device={device!r} is unknown: allowed 'cpu' or 'cuda'")
+    if not isinstance(device, str) or device not in DEVICES:  # an array was NumPy's "truth value is ambiguous" (T16-12)
+        raise NeurohoverError(f"device={brief(device)} is unknown: allowed 'cpu' or 'cuda'")
     if device == "cuda":
         from .sim import cuda as sim_cuda  # numba.cuda is imported only when asked for
 

@@ -92,8 +92,11 @@ def _real_array(values: object, name: str, columns: int, shape: str) -> np.ndarr
         array = np.asarray(values)
     except (ValueError, TypeError):  # ragged nested lists
         array = np.asarray(None)
-    if array.dtype.kind not in "fiu" or array.ndim != 2 or array.shape[1] != columns:  # 'abc', None or (3, 5) were NumPy's errors
-        if array.dtype.kind in "fiu":
+    masked = isinstance(values, np.ma.MaskedArray)  # np.asarray dropped the mask: the hidden values were plotted (T16-9)
+    if masked or array.dtype.kind not in "fiu" or array.ndim != 2 or array.shape[1] != columns:  # 'abc', None or (3, 5) were NumPy's errors
+        if masked:
+            got = f"={brief(values)} (a masked array)"
+        elif array.dtype.kind in "fiu":
             got = f" of shape {array.shape}"
         else:
             got = f" of dtype {array.dtype}" if isinstance(values, np.ndarray) else f"={brief(values)}"
@@ -273,7 +276,8 @@ def _check_flight_data(data: object) -> None:
 
 def _episode_list(episodes: object, n: int) -> list[int]:
     """``episodes`` as distinct indices of the ``n`` episodes, or one message saying what is allowed."""
-    if isinstance(episodes, (str, bytes)) or not isinstance(episodes, (Sequence, np.ndarray)) or getattr(episodes, "ndim", 1) != 1:  # 0 was a TypeError
+    # 0 was a TypeError; a masked array's masked entries are no indices (T16-9)
+    if isinstance(episodes, (str, bytes, np.ma.MaskedArray)) or not isinstance(episodes, (Sequence, np.ndarray)) or getattr(episodes, "ndim", 1) != 1:
         raise NeurohoverError(f"episodes={brief(episodes)} is not allowed: give a list of episode indices, e.g. [0, 2], or None for all")
     chosen = list(episodes)
     if not chosen:  # [] wrote nothing and returned [] without a word (fifteenth trial, T15-25)

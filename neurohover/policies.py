@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError, brief
+from .errors import NeurohoverError, as_floats, brief
 from .sim.constants import MLP_STEEPNESS
 
 TOPOLOGIES = ("slp", "mlp")
@@ -97,8 +97,7 @@ class Policy:
     metadata: dict = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
-        if self.topology not in TOPOLOGIES:
-            raise NeurohoverError(f"unknown policy topology {self.topology!r}: allowed {', '.join(TOPOLOGIES)}")
+        _check_topology(self.topology)
         if not isinstance(self.metadata, dict):  # [1] was kept, and failed when the policy was saved (second trial)
             raise NeurohoverError(f"policy metadata={self.metadata!r:.60} is not allowed: give a dict")
         taken = sorted({"topology", "genome"} & set(self.metadata))  # saved, they overwrote the network itself (seventh trial)
@@ -120,9 +119,9 @@ class Policy:
         """Actions for a 12-number observation, computed in plain Python (the readable definition).
 
         Raises NeurohoverError for an observation that is not 12 finite numbers (a NaN would give NaN actions silently)."""
-        try:
+        try:  # not text, booleans or complex numbers; not a masked array, whose hidden values were flown (T16-9)
             raw = np.asarray(observation)
-            obs = raw.astype(np.float64) if raw.dtype.kind in "iuf" else np.zeros(0)  # not text, booleans or complex
+            obs = raw.astype(np.float64) if raw.dtype.kind in "iuf" and not isinstance(observation, np.ma.MaskedArray) else np.zeros(0)
         except (TypeError, ValueError):
             obs = np.zeros(0)
         if obs.shape != (12,) or not np.all(np.isfinite(obs)):  # the shape: (3, 4) was flown flattened as one observation (T15-28)
@@ -152,18 +151,17 @@ class Policy:
 
     def with_genome(self, genome: np.ndarray, **metadata) -> Policy:
         """A policy of the same topology with another genome."""
-        return Policy(self.topology, np.array(genome, dtype=float), {**self.metadata, **metadata})
+        return Policy(self.topology, genome, {**self.metadata, **metadata})  # uncast: float() read '0.5', dates and bools (T16-10)
 
 
 def check_genome(genome, topology: str) -> np.ndarray:
     """Return ``genome`` as a float64 vector of the topology's length, or raise a clear error."""
-    try:
-        raw = np.array(genome)
-        if raw.dtype.kind not in "iuf":  # text, booleans and complex numbers were read as numbers (third trial)
-            raise TypeError(raw.dtype)
-        arr = raw.astype(float).reshape(-1) if raw.ndim <= 1 else raw.astype(float)
-    except (TypeError, ValueError, OverflowError):  # an integer past a float's range was an OverflowError (third trial)
-        raise NeurohoverError(f"a {topology} genome must be a list of finite real numbers, got {genome!r:.80}") from None
+    try:  # text, booleans, complex numbers (third trial), objects, dates and masked arrays (T16-9, T16-10): as_floats
+        arr = as_floats(genome, "genome", "")
+    except NeurohoverError:
+        masked = " (a masked array: give its values, e.g. .filled())" if isinstance(genome, np.ma.MaskedArray) else ""
+        raise NeurohoverError(f"a {topology} genome must be a list of finite real numbers, got {brief(genome)}{masked}") from None
+    arr = arr.reshape(-1) if arr.ndim <= 1 else arr
     n = GENOME_LENGTH[topology]
     if arr.ndim != 1 or arr.shape[0] != n:
         raise NeurohoverError(f"a {topology} genome has {n} genes, got shape {arr.shape}")
@@ -172,10 +170,15 @@ def check_genome(genome, topology: str) -> np.ndarray:
     return arr
 
 
+def _check_topology(topology: object) -> None:
+    """Refuse a topology that is not ``"slp"`` or ``"mlp"`` (an array was NumPy's "truth value is ambiguous"; T16-12)."""
+    if not isinstance(topology, str) or topology not in TOPOLOGIES:
+        raise NeurohoverError(f"unknown policy topology {brief(topology)}: allowed {', '.join(TOPOLOGIES)}")
+
+
 def zero_genome(topology: str) -> np.ndarray:
     """The all-zero prototype of a topology."""
-    if topology not in TOPOLOGIES:
-        raise NeurohoverError(f"unknown policy topology {topology!r}: allowed {', '.join(TOPOLOGIES)}")
+    _check_topology(topology)
     return np.zeros(GENOME_LENGTH[topology])
 
 
@@ -208,12 +211,13 @@ def baseline_policy() -> Policy:
 
 def prototype(topology: str, seed: str = "baseline") -> Policy:
     """A prototype network: ``seed`` is ``"zero"`` or ``"baseline"`` (baseline-equivalent)."""
+    _check_topology(topology)  # both as text first: an array was NumPy's "truth value is ambiguous" (T16-12)
+    if not isinstance(seed, str) or seed not in ("zero", "baseline"):
+        raise NeurohoverError(f"unknown prototype {brief(seed)}: allowed zero, baseline")
     if seed == "zero":
         return Policy(topology, zero_genome(topology), {"prototype": "zero"})
-    if seed == "baseline":
-        genome = slp_baseline_genome() if topology == "slp" else mlp_baseline_genome()
-        return Policy(topology, genome, {"prototype": "baseline"})
-    raise NeurohoverError(f"unknown prototype {seed!r}: allowed zero, baseline")
+    genome = slp_baseline_genome() if topology == "slp" else mlp_baseline_genome()
+    return Policy(topology, genome, {"prototype": "baseline"})
 
 
 def policy_to_dict(policy: Policy) -> dict:
@@ -227,8 +231,8 @@ def policy_from_dict(d: dict, source: str = "policy") -> Policy:
     missing = [k for k in ("topology", "genome") if k not in d]
     if missing:
         raise NeurohoverError(f"{source}: missing key(s) {', '.join(missing)}; a policy file needs 'topology' (slp|mlp) and 'genome'")
-    if d["topology"] not in TOPOLOGIES:
-        raise NeurohoverError(f"{source}: unknown topology {d['topology']!r}: allowed {', '.join(TOPOLOGIES)}")
+    if not isinstance(d["topology"], str) or d["topology"] not in TOPOLOGIES:
+        raise NeurohoverError(f"{source}: unknown topology {brief(d['topology'])}: allowed {', '.join(TOPOLOGIES)}")
     if not isinstance(d["genome"], list) or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in d["genome"]):
         raise NeurohoverError(f"{source}: 'genome' must be a list of numbers")
     try:

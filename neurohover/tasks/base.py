@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, whole_number
+from ..errors import NeurohoverError, as_floats, brief, whole_number
 from ..sim.constants import (
     DEFAULT_NOISE_STD,
     DEFAULT_PARAMS,
@@ -221,10 +221,11 @@ def finite_vector(values: Sequence[float] | np.ndarray, length: int, what: str) 
         isinstance(v, (str, bytes, bool, np.bool_, complex, np.complexfloating)) for v in np.ravel(np.asarray(values, dtype=object))
     ):
         raise NeurohoverError(f"{what} must be {length} numbers, got {brief(values)}")
-    try:
-        arr = np.asarray(values, dtype=float)
-    except (TypeError, ValueError, OverflowError):  # 10**400: OverflowError (fifth trial)
-        raise NeurohoverError(f"{what} must be {length} finite numbers, got {brief(values)}") from None
+    try:  # as_floats: a masked array's hidden values and a date's day number were taken as numbers (T16-9, T16-11)
+        arr = as_floats(values, what, "")  # its message is replaced by this function's own
+    except NeurohoverError:  # objects such as 10**400, dates, ragged lists; a masked array
+        masked = " (a masked array: give its values, e.g. .filled())" if isinstance(values, np.ma.MaskedArray) else ""
+        raise NeurohoverError(f"{what} must be {length} finite numbers, got {brief(values)}{masked}") from None
     if arr.shape != (length,):
         raise NeurohoverError(f"{what} must be {length} numbers, got {arr.size}: {brief(values)}")
     if not np.all(np.isfinite(arr)):
@@ -232,13 +233,27 @@ def finite_vector(values: Sequence[float] | np.ndarray, length: int, what: str) 
     return arr
 
 
+def mdp_label(label: object, default: str) -> str:
+    """A family's ``make(label=...)``: text, or ``default`` where it is None or ''; anything else refused (0, {} and -0.0
+    became the default without a word, an array was NumPy's "truth value is ambiguous"; T16-14, T16-12)."""
+    if label is not None and not isinstance(label, str):
+        raise NeurohoverError(f"MDP label={brief(label)} is not allowed: give a string (or leave it out for {default!r})")
+    return label or default
+
+
 def check_rows(rows: np.ndarray) -> None:
     """Refuse kernel rows that no MDP has: anything but an (M, MDP_ROW_LEN) array of finite real numbers, substeps not a
     whole number in 1..MAX_SUBSTEPS, dt <= 0, a negative noise std or an unknown wind kind (the MDP's own checks, in a few
     NumPy operations: evaluate() calls it on every array). An all-zero row (substeps 0) flew as a perfect 0.0 (T14-18)."""
-    # type and shape first, the cheap tests: a list was a TypeError, a 1-D row an IndexError (T15-4)
-    if not isinstance(rows, np.ndarray) or rows.ndim != 2 or rows.shape[1] != MDP_ROW_LEN or rows.dtype.kind not in "iuf":
-        got = f"shape {rows.shape}, dtype {rows.dtype}" if isinstance(rows, np.ndarray) else brief(rows)
+    # type and shape first, the cheap tests: a list was a TypeError, a 1-D row an IndexError (T15-4), a mask dropped (T16-9)
+    if (
+        not isinstance(rows, np.ndarray)
+        or isinstance(rows, np.ma.MaskedArray)
+        or rows.ndim != 2
+        or rows.shape[1] != MDP_ROW_LEN
+        or rows.dtype.kind not in "iuf"
+    ):
+        got = brief(rows) if isinstance(rows, np.ma.MaskedArray) or not isinstance(rows, np.ndarray) else f"shape {rows.shape}, dtype {rows.dtype}"
         raise NeurohoverError(f"MDP rows must be a float array of shape (M, {MDP_ROW_LEN}), rows as MDP.row() gives them; got {got}")
     if not np.isfinite(rows).all():
         i = int(np.flatnonzero(~np.isfinite(rows).all(axis=1))[0])
@@ -469,7 +484,7 @@ class TaskFamily:
     def sample(self, rng: np.random.Generator | int | None = None, label: str = "") -> MDP:
         """A fresh MDP drawn from G."""
         rng = generator(rng)
-        return self.make(self.sample_params(rng, 1)[0], label=label or f"{self.name}/sample")
+        return self.make(self.sample_params(rng, 1)[0], label=mdp_label(label, f"{self.name}/sample"))
 
     def row_template(self) -> np.ndarray:
         """The kernel row every sampled MDP shares outside :attr:`row_slice` (checked once against :meth:`make`)."""
@@ -487,10 +502,9 @@ class TaskFamily:
     def rows(self, params: np.ndarray) -> np.ndarray:
         """Kernel rows of the MDPs of ``params`` (n, n_params), as ``make(p).row()`` gives: their shape and finiteness are
         checked, their ranges not (:meth:`make` checks those)."""
-        try:
-            raw = np.asarray(params)
-            arr = raw.astype(float, copy=False) if raw.dtype.kind in "iuf" else None  # numbers only: NumPy reads '1' as 1.0
-        except (TypeError, ValueError):
+        try:  # numbers only (NumPy reads '1' as 1.0), not a masked array, whose hidden values were used (T16-9)
+            arr: np.ndarray | None = as_floats(params, "params", "")
+        except NeurohoverError:
             arr = None
         # NaN rows were returned, (2, 3) a broadcast error (T14-18)
         if arr is None or arr.ndim != 2 or arr.shape[1] != self.n_params or not np.isfinite(arr).all():

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import FloatRangeError, NeurohoverError, brief, finite_real, float_of, whole_number
+from ..errors import FloatRangeError, NeurohoverError, as_floats, brief, finite_real, float_of, whole_number
 from ..sim.constants import MDP_ROW_LEN, PARAM_NAMES, ROW_PARAMS
 from ..sim.rng import MAX_SEED
 
@@ -91,11 +91,12 @@ class Drift:
         object.__setattr__(self, "change", tuple(sorted((n, float(f)) for n, f in change.items())))
         object.__setattr__(self, "_factors", factors)
         try:
-            if any(isinstance(x, bool) for x in self.change_at):  # True was read as episode 1 (second trial)
+            # True was read as episode 1 (second trial); a masked array's masked entry was NumPy's MaskError (T16-13)
+            if isinstance(self.change_at, np.ma.MaskedArray) or not all(isinstance(x, numbers.Real) and not isinstance(x, bool) for x in self.change_at):
                 raise TypeError
             lo, hi = (int(x) for x in self.change_at)
         except (TypeError, ValueError):
-            raise NeurohoverError(f"drift change_at={self.change_at!r} is not allowed: give two episode numbers lo, hi with 0 <= lo <= hi") from None
+            raise NeurohoverError(f"drift change_at={brief(self.change_at)} is not allowed: give two episode numbers lo, hi with 0 <= lo <= hi") from None
         if not 0 <= lo <= hi <= MAX_CHANGE_AT or list(self.change_at) != [lo, hi]:  # 10**30 was NumPy's int64 error at reset (ninth trial)
             raise NeurohoverError(f"drift change_at={self.change_at!r:.80} is out of range: allowed whole episode numbers 0 <= lo <= hi <= {MAX_CHANGE_AT:,}")
         if not self.change and (lo, hi) != CHANGE_AT:  # said when, but no change to happen then: nothing would
@@ -239,9 +240,9 @@ def _seed(seed) -> int:
 
 def _row(row) -> np.ndarray:
     """An MDP's row (``MDP_ROW_LEN`` finite numbers) as a float array, or a NeurohoverError saying what it is not."""
-    try:
-        out = np.asarray(row, dtype=float)
-    except (TypeError, ValueError):
+    try:  # real numbers only: a masked array's hidden values, text and dates were read as numbers (T16-9)
+        out: np.ndarray | None = as_floats(row, "row", "")
+    except NeurohoverError:
         out = None
     if out is None or out.shape != (MDP_ROW_LEN,) or not np.isfinite(out).all():
         raise NeurohoverError(f"row={brief(row)} is not allowed: give an MDP's row of {MDP_ROW_LEN} finite numbers (MDP.row())")

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..errors import NeurohoverError, finite_real
 from ..sim.constants import DEFAULT_PARAMS, PARAM_NAMES, ROW_PARAMS
-from .base import MDP, TaskFamily, finite_vector
+from .base import MDP, TaskFamily, finite_vector, mdp_label
 
 COMPETITION_FGHH_SIGMA = 0.3  # the only FGHH sigma the authors' code lists MDPs for
 
@@ -42,7 +42,7 @@ class FGHH(TaskFamily):
         p = finite_vector(params, 11, "FGHH dynamics parameters " + "/".join(PARAM_NAMES))
         if np.abs(p).max() > MAX_PARAM:  # 1e300 overflowed the simulation to NaN returns (third trial)
             raise NeurohoverError(f"FGHH dynamics parameters must lie in [-{MAX_PARAM:g}, {MAX_PARAM:g}] (the defaults' largest is 70.54), got {p.tolist()}")
-        return MDP("fghh", params=tuple(p.tolist()), label=label or "fghh/custom")
+        return MDP("fghh", params=tuple(p.tolist()), label=mdp_label(label, "fghh/custom"))
 
     def zero(self) -> MDP:
         return MDP("fghh", label="fghh/zero")

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from ..sim.constants import ROW_WIND, WIND_CONSTANT
-from .base import MDP, TaskFamily, finite_vector
+from .base import MDP, TaskFamily, finite_vector, mdp_label
 
 MAX_WIND = 5.0
 
@@ -29,7 +29,7 @@ class GHH08(TaskFamily):
         wind = finite_vector(params, 2, "GHH-08 wind (wind_u, wind_v)")
         if np.any(np.abs(wind) > MAX_WIND):
             raise NeurohoverError(f"GHH-08 wind {wind.tolist()} m/s is out of range: each component must lie in [-5, 5]")
-        return MDP("ghh08", wind_kind=WIND_CONSTANT, wind=tuple(wind.tolist()), label=label or f"ghh08/wind={wind.tolist()}")
+        return MDP("ghh08", wind_kind=WIND_CONSTANT, wind=tuple(wind.tolist()), label=mdp_label(label, f"ghh08/wind={wind.tolist()}"))
 
     def zero(self) -> MDP:
         return MDP("ghh08", label="ghh08/zero")  # no wind: the zero setting is the same MDP in every family

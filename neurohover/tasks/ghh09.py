@@ -9,7 +9,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from ..sim.constants import ROW_WIND, WIND_SINUSOID
-from .base import MDP, TaskFamily, finite_vector
+from .base import MDP, TaskFamily, finite_vector, mdp_label
 
 GHH09_PARAM_NAMES = (
     "x_maxf",
@@ -39,7 +39,7 @@ class GHH09(TaskFamily):
         bad = [f"{n}={v}" for n, v in zip(GHH09_PARAM_NAMES, p) if not 0.0 <= v <= 1.0]
         if bad:
             raise NeurohoverError(f"GHH-09 parameters out of range ({', '.join(bad)}): each must lie in [0, 1]")
-        return MDP("ghh09", wind_kind=WIND_SINUSOID, wind=tuple(p.tolist()), label=label or "ghh09/custom")
+        return MDP("ghh09", wind_kind=WIND_SINUSOID, wind=tuple(p.tolist()), label=mdp_label(label, "ghh09/custom"))
 
     def zero(self) -> MDP:
         return MDP("ghh09", label="ghh09/zero")
