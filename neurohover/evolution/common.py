@@ -18,6 +18,7 @@ and ``tell()``.
 from __future__ import annotations
 
 import math
+import numbers
 import pickle
 import time
 from collections.abc import Callable
@@ -50,6 +51,7 @@ __all__ = [
     "check_state",
     "damage_text",
     "dec_array",
+    "dec_float",
     "enc_array",
     "enc_float",
     "rank",
@@ -282,17 +284,42 @@ def enc_array(a: np.ndarray | None) -> dict[str, Any] | None:
     return {"shape": list(a.shape), "data": [enc_float(v) for v in a.ravel()]}
 
 
+#: What :func:`enc_float` writes for a non-finite float, read back as it (other text is no number of a state).
+_NON_FINITE = {"nan": math.nan, "inf": math.inf, "-inf": -math.inf}
+_STORED = "real numbers or 'nan', 'inf', '-inf' as state_dict() wrote them"
+
+
+def dec_float(value: Any) -> float:
+    """The float :func:`enc_float` encoded: a real number (not a bool) or ``"nan"``, ``"inf"``, ``"-inf"``; other text
+    (``'1.5'``) a ValueError, anything else an :class:`EntryError` (float() took both, and True as 1.0; sixteenth trial)."""
+    if isinstance(value, str):
+        if value in _NON_FINITE:
+            return _NON_FINITE[value]
+        raise ValueError(f"could not convert string to float: {brief(value)} (a stored number is no text, but for 'nan', 'inf', '-inf')")
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise EntryError(f"{brief(value)} is no number: allowed {_STORED}")
+    return float(value)
+
+
 @overload
-def dec_array(d: dict[str, Any]) -> np.ndarray: ...
+def dec_array(d: dict[str, Any], name: str = "array") -> np.ndarray: ...
 @overload
-def dec_array(d: None) -> None: ...
+def dec_array(d: None, name: str = "array") -> None: ...
 @overload
-def dec_array(d: dict[str, Any] | None) -> np.ndarray | None: ...
-def dec_array(d: dict[str, Any] | None) -> np.ndarray | None:
-    """The array :func:`enc_array` encoded."""
+def dec_array(d: dict[str, Any] | None, name: str = "array") -> np.ndarray | None: ...
+def dec_array(d: dict[str, Any] | None, name: str = "array") -> np.ndarray | None:
+    """The array :func:`enc_array` encoded; NeurohoverError naming ``name`` unless every value is a real number (not a
+    bool) or a non-finite float's text: bools and numeric text were read as numbers (every gene True as 1.0, a return
+    '1.5' as 1.5; sixteenth trial), so each value is checked before any is cast."""
     if d is None:
         return None
-    return np.array([float(v) for v in d["data"]], dtype=np.float64).reshape(d["shape"])
+    data, shape = d["data"], [read_count(n) for n in d["shape"]]
+    values = [_NON_FINITE.get(v, v) if isinstance(v, str) else v for v in data]
+    for v in values:
+        if type(v) is not float and type(v) is not int and (isinstance(v, bool) or not isinstance(v, numbers.Real)):
+            as_floats(v, f"{name} data entry", _STORED)  # text, a bool, None: named as every array of real numbers is
+            raise EntryError(f"{name} data entry {brief(v)} is no number: allowed {_STORED}")  # a list in the list
+    return as_floats(values, f"{name} data", _STORED).reshape(shape)
 
 
 @overload
@@ -309,12 +336,13 @@ def check_genomes(a: np.ndarray | None, size: int, name: str, rows: int | None =
     if rows == 0:
         ok, expected = a.shape == (size,), f"({size},)"
     else:
-        ok = a.ndim == 2 and a.shape[1] == size and (rows is None or a.shape[0] == rows)
-        expected = f"({'n' if rows is None else rows}, {size})"
+        ok, expected = a.ndim == 2 and a.shape[1] == size, f"(n, {size})"
     if not ok:
         raise NeurohoverError(f"{name} has shape {a.shape}, expected {expected} (genomes of {size} genes)")
     if a.dtype.kind != "f" or not np.all(np.isfinite(a)):  # a NaN gene was resumed without a word (eighth trial)
         raise NeurohoverError(f"{name} holds a gene that is not a finite number")
+    if rows and a.shape[0] != rows:  # a pop_size of 60 over 50 genomes was run on (sixteenth trial)
+        raise NeurohoverError(f"{name} has {a.shape[0]} genomes where the state's settings make {rows}")
     return a
 
 
@@ -338,13 +366,15 @@ def check_state(state: dict[str, Any], kind: str) -> None:
         raise NeurohoverError(f"unsupported state version {brief(version)}: allowed {STATE_VERSION}")
 
 
-def check_entries(state: dict[str, Any], kind: str, entries: tuple[str, ...]) -> None:
+def check_entries(state: dict[str, Any], kind: str, entries: tuple[str, ...], what: str = "", remedy: str = "") -> None:
     """NeurohoverError naming the entries of a ``kind`` state dict that are none of ``entries`` (every entry any
-    version of its ``state_dict`` wrote): an unknown one was ignored without a word (fifteenth trial)."""
+    version of its ``state_dict`` wrote): an unknown one was ignored without a word (fifteenth trial). ``what`` and
+    ``remedy`` replace the message's "KIND state dict" and its advice (a checkpoint's own tables; sixteenth trial)."""
     unknown = [key for key in state if key not in entries]
     if unknown:
         shown = ", ".join(brief(key) for key in unknown[:5]) + (f" and {len(unknown) - 5} more" if len(unknown) > 5 else "")
-        raise NeurohoverError(f"{kind} state dict has unknown entries {shown}: allowed {', '.join(entries)}; give a dict that {kind}.state_dict() returned")
+        remedy = remedy or f"give a dict that {kind}.state_dict() returned"
+        raise NeurohoverError(f"{what or kind + ' state dict'} has unknown entries {shown}: allowed {', '.join(entries)}; {remedy}")
 
 
 #: What reading back a damaged entry of a state raises besides NeurohoverError: a value of the wrong type, a missing
@@ -472,15 +502,28 @@ class ChampionTracker:
         }
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> ChampionTracker:
-        """The tracker :meth:`to_dict` saved."""
+    def from_dict(cls, d: dict[str, Any], size: int | None = None) -> ChampionTracker:
+        """The tracker :meth:`to_dict` saved, its champion a genome of ``size`` genes (any size if None); EntryError or
+        NeurohoverError for a damaged one (evaluations -1, True as a count and a genome of bools were taken; sixteenth trial)."""
         t = cls()
-        t.evaluations = int(d["evaluations"])
-        t.genome = dec_array(d["genome"])
-        t.best = float(d["best"])
-        t.since = int(d["since"])
-        t.history = [ChampionRecord(int(h[0]), float(h[1]), float(h[2]), bool(h[3]) if len(h) > 3 else False) for h in d["history"]]
+        t.evaluations, t.since = read_count(d["evaluations"]), read_count(d["since"])
+        if t.since > t.evaluations:
+            raise EntryError(f"since={t.since} is more than its evaluations ({t.evaluations}): allowed 0..evaluations")
+        t.genome = dec_array(d["genome"], "tracker genome")
+        if t.genome is not None:
+            check_genomes(t.genome, t.genome.size if size is None else size, "tracker genome", rows=0)
+        t.best = dec_float(d["best"])
+        if math.isnan(t.best) or t.best == math.inf or (t.genome is None) != (t.best == -math.inf):
+            raise EntryError(f"best={brief(d['best'])} is not allowed: a finite return with a champion genome, -inf without one")
+        t.history = [_champion_record(h) for h in d["history"]]
         return t
+
+
+def _champion_record(h: Any) -> ChampionRecord:
+    """One :class:`ChampionRecord` of a saved tracker's history: evaluations, return, seconds and, if crashed, true."""
+    if not isinstance(h, list) or len(h) not in (3, 4) or (len(h) == 4 and h[3] is not True):
+        raise EntryError(f"history record {brief(h)} is not allowed: [evaluations, return, seconds] or, for a crashed champion, [..., true]")
+    return ChampionRecord(read_count(h[0]), dec_float(h[1]), read_seconds(h[2]), len(h) == 4)
 
 
 class ChampionViews:

@@ -32,6 +32,7 @@ from .common import (
     check_settings,
     check_state,
     dec_array,
+    dec_float,
     enc_array,
     enc_float,
     rank,
@@ -115,7 +116,7 @@ class GenerationalSettings:
         validate_variation_settings(self)
         if not isinstance(self.elitist, bool):
             raise NeurohoverError(f"elitist={brief(self.elitist)} must be True or False")
-        if self.fitness not in FITNESS_SCALES:
+        if not isinstance(self.fitness, str) or self.fitness not in FITNESS_SCALES:  # text first: an array's `in` was NumPy's error (sixteenth trial)
             raise NeurohoverError(f"fitness={brief(self.fitness)} is not a fitness scale: allowed {', '.join(FITNESS_SCALES)}")
         if self.init_mutate_frac is not None:
             set_field(self, "init_mutate_frac", require_prob("init_mutate_frac", self.init_mutate_frac))
@@ -426,23 +427,35 @@ class GenerationalNE:
         kind = "GenerationalNE"
         check_entries(state, kind, STATE_ENTRIES)
         settings = read_entry(state, kind, "settings", lambda s: GenerationalSettings(**{**OLD_GENERATIONAL, **s}))
-        opt = cls(read_entry(state, kind, "prototype", dec_array), settings)
-        d = opt._prototype.size
-        opt._population = read_entry(state, kind, "population", lambda a: check_genomes(dec_array(a), d, "population"))
+        opt = cls(read_entry(state, kind, "prototype", lambda a: dec_array(a, "prototype")), settings)
+        d, n, mu = opt._prototype.size, settings.pop_size, settings.select_size
+        # Each array's rows as the settings make them: a pop_size that disagreed with the population was run on (sixteenth trial).
+        opt._population = read_entry(state, kind, "population", lambda a: check_genomes(dec_array(a, "population"), d, "population", rows=n))
         opt._asked = read_entry(state, kind, "asked", _flag)
         opt._generation = read_entry(state, kind, "generation", read_count)  # generation -1 was taken (eighth trial)
         opt._evaluations = read_entry(state, kind, "evaluations", read_count)
-        opt._champion_genome = read_entry(state, kind, "champion_genome", lambda a: check_genomes(dec_array(a), d, "champion genome", rows=0))
-        opt._champion_return = read_entry(state, kind, "champion_return", float)
-        # "parents" and "hall_of_fame" are absent from checkpoints written before 2026-12-04
-        opt._parents = read_entry(state, kind, "parents", lambda a: check_genomes(dec_array(a), d, "parents"), None)
-        opt._hall = read_entry(
-            state, kind, "hall_of_fame", lambda h: [(float(r), check_genomes(dec_array(g), d, "hall of fame genome", rows=0)) for r, g in h], []
+        opt._champion_genome = read_entry(
+            state, kind, "champion_genome", lambda a: check_genomes(dec_array(a, "champion genome"), d, "champion genome", rows=0)
         )
-        opt._history = read_entry(state, kind, "history", lambda h: [GenerationRecord(int(g), int(e), int(ep), float(r), float(w)) for g, e, ep, r, w in h])
+        opt._champion_return = read_entry(state, kind, "champion_return", dec_float)
+        # "parents" and "hall_of_fame" are absent from checkpoints written before 2026-12-04
+        opt._parents = read_entry(state, kind, "parents", lambda a: check_genomes(dec_array(a, "parents"), d, "parents", rows=mu), None)
+        opt._hall = read_entry(
+            state,
+            kind,
+            "hall_of_fame",
+            lambda h: [(dec_float(r), check_genomes(dec_array(g, "hall of fame genome"), d, "hall of fame genome", rows=0)) for r, g in h],
+            [],
+        )
+        opt._history = read_entry(state, kind, "history", lambda h: [_generation_record(g, e, ep, r, w) for g, e, ep, r, w in h])
         opt._rng = read_entry(state, kind, "rng", rng_from_state)
         opt._clock = Clock(read_entry(state, kind, "wall_seconds", read_seconds))
         return opt
+
+
+def _generation_record(generation: Any, evaluations: Any, episodes: Any, champion_return: Any, wall_seconds: Any) -> GenerationRecord:
+    """One :class:`GenerationRecord` of a saved history, each count checked (True and -1 were taken; sixteenth trial)."""
+    return GenerationRecord(read_count(generation), read_count(evaluations), read_count(episodes), dec_float(champion_return), read_seconds(wall_seconds))
 
 
 def _flag(value: Any) -> bool:

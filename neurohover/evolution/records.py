@@ -15,7 +15,7 @@ import numpy as np
 from ..errors import NeurohoverError
 from ..paths import JSONError, strict_json
 from ..policies import Policy
-from .common import enc_float
+from .common import dec_float, enc_float, read_count, read_seconds
 
 __all__ = [
     "CHECKPOINT_FORMAT",
@@ -199,7 +199,8 @@ def encode_history(history) -> list[list]:
 
 def decode_history(rows) -> list[HistoryRecord]:
     """The records :func:`encode_history` encoded."""
-    return [HistoryRecord(int(g), int(e), int(ep), int(gep), float(r), float(w)) for g, e, ep, gep, r, w in rows]
+    # each count and number checked: True was read as 1 and '1.5' as 1.5 (sixteenth trial)
+    return [HistoryRecord(read_count(g), read_count(e), read_count(ep), read_count(gep), dec_float(r), read_seconds(w)) for g, e, ep, gep, r, w in rows]
 
 
 def write_checkpoint(path: Path, state: dict) -> None:

@@ -19,14 +19,14 @@ from typing import Any, cast
 
 import numpy as np
 
-from ..errors import NeurohoverError, first_difference
+from ..errors import NeurohoverError, brief, finite_real, first_difference, whole_number
 from ..flyer import KernelFlyer
 from ..launch import Parking
 from ..policies import Policy
 from ..sim.lanes import LANES
 from .bandits import BANDITS, top_mu_bandit
-from .common import STATE_DAMAGE, Optimiser, TellInfo, check_genomes, damage_text, enc_float
-from .config import RACE_T_LIMIT, RunConfig, next_auto_delta, upgrade_saved_config
+from .common import STATE_DAMAGE, EntryError, Optimiser, TellInfo, check_entries, check_genomes, damage_text, dec_array, dec_float, enc_float
+from .config import MAX_BUDGET, RACE_T_LIMIT, RunConfig, next_auto_delta, upgrade_saved_config
 from .fitness import episode_fitness
 from .generational import GenerationalNE
 from .optimisers import OPTIMISERS
@@ -153,6 +153,7 @@ class Run:
         be this one, except the budget. A damaged checkpoint is refused by name, nothing restored."""
         if not isinstance(state, dict) or state.get("format") != CHECKPOINT_FORMAT:
             raise NeurohoverError(f"{source} is not an evolution checkpoint (expected format {CHECKPOINT_FORMAT!r})")
+        _check_tables(state, source)
         try:
             saved = upgrade_saved_config(state["config"])
             if not isinstance(saved, dict):
@@ -172,6 +173,7 @@ class Run:
             raise NeurohoverError(f"{source}: cannot restore the optimiser ({damage_text(err)})") from None
         try:
             parts = _restored_parts(state, self.resampling.delta, self.cfg.prototype.genome.size)
+            _check_run_entries(state, self.mdp_rng is None)
             if self.mdp_rng is not None:
                 stream = np.random.Generator(type(self.mdp_rng.bit_generator)())
                 stream.bit_generator.state = state["mdp_stream"]
@@ -461,6 +463,35 @@ def _damaged(source: str, err: Exception) -> NeurohoverError:
     return NeurohoverError(f"{source} is a damaged checkpoint: {damage_text(err)}; resume from an undamaged copy or start again without resuming")
 
 
+#: Every entry a checkpoint (:meth:`Run.state`) has held, and every entry of its counters and champion tables.
+CHECKPOINT_ENTRIES = ("format", "config", "budget", "optimizer_state", "counters", "mdp_stream", "race_delta", "champion", "history", "stop_reason")
+COUNTERS = ("episodes", "next_index", "flown", "steps", "generation", "evaluations", "wall_seconds", "kernel_seconds")
+#: Why a run stopped, as :meth:`Run._should_stop` says it.
+STOP_REASONS = ("budget", "plateau", "generations", *sorted({spec.stop_reason for spec in OPTIMISERS.values()}))
+
+
+def _check_tables(state: dict, source: str) -> None:
+    """NeurohoverError naming an unknown entry of checkpoint ``state`` or of its counters or champion: one was ignored
+    without a word, as the optimiser state's were before (sixteenth trial)."""
+    remedy = "resume from an undamaged copy or start again without resuming"
+    check_entries(state, "checkpoint", CHECKPOINT_ENTRIES, what=source, remedy=remedy)
+    for name, entries in (("counters", COUNTERS), ("champion", ("genome", "return"))):
+        if isinstance(state.get(name), dict):
+            check_entries(state[name], "checkpoint", entries, what=f"the {name} table of {source}", remedy=remedy)
+
+
+def _check_run_entries(state: dict, one_mdp: bool) -> None:
+    """EntryError unless checkpoint ``state``'s budget, stop reason and MDP stream are what :meth:`Run.state` writes
+    (a budget of '100', a stop_reason of 5 and an mdp_stream of 'x' on one MDP were taken; sixteenth trial)."""
+    budget, reason, stream = state["budget"], state["stop_reason"], state["mdp_stream"]
+    if budget is not None and not (whole_number(budget) and 1 <= budget <= MAX_BUDGET):
+        raise EntryError(f"budget={brief(budget)} is not allowed: allowed null or an integer in 1..{MAX_BUDGET:,}")
+    if reason is not None and (not isinstance(reason, str) or reason not in STOP_REASONS):
+        raise EntryError(f"stop_reason={brief(reason)} is not allowed: allowed null or one of {', '.join(STOP_REASONS)}")
+    if one_mdp and stream is not None:  # (a family's stream is the bit generator's to refuse)
+        raise EntryError(f"mdp_stream={brief(stream)} is not allowed: allowed null (a run on one MDP draws no MDPs)")
+
+
 def _restored_parts(state: dict, delta: Any, genome_size: int) -> dict[str, Any]:
     """The run's counters, champion, history and race delta read from checkpoint ``state``, each checked (ValueError,
     TypeError or KeyError naming what is wrong), before any of them is restored."""
@@ -471,16 +502,19 @@ def _restored_parts(state: dict, delta: Any, genome_size: int) -> dict[str, Any]
     for k, v in counts.items():
         if isinstance(v, bool) or not isinstance(v, int) or v < 0:
             raise ValueError(f"counter {k!r} is {v!r}, not a count (an integer >= 0)")
-    seconds = {k: float(c[k]) for k in ("wall_seconds", "kernel_seconds")}
+    seconds = {k: c[k] for k in ("wall_seconds", "kernel_seconds")}
     for k, v in seconds.items():
-        if not (math.isfinite(v) and v >= 0):
-            raise ValueError(f"counter {k!r} is {v!r}, not a number of seconds >= 0")
+        if not (finite_real(v) and v >= 0):  # finite_real: '1.5' was read as 1.5 (sixteenth trial)
+            raise ValueError(f"counter {k!r} is {brief(v)}, not a number of seconds >= 0")
     ch = state["champion"]
-    genome = check_genomes(None if ch["genome"] is None else np.array(ch["genome"], dtype=float), genome_size, "the champion genome", rows=0)
-    if math.isnan(float(ch["return"])):
+    genes = ch["genome"]  # a list of numbers, checked one by one as an optimiser's arrays are: True was read as 1.0 (sixteenth trial)
+    genome = check_genomes(
+        None if genes is None else dec_array({"shape": [len(genes)], "data": genes}, "the champion genome"), genome_size, "the champion genome", rows=0
+    )
+    if math.isnan(dec_float(ch["return"])):
         raise ValueError("the champion's return is nan")
     race_delta = state.get("race_delta", delta)  # absent before race:auto: the fixed delta
     if race_delta is not None and (isinstance(race_delta, bool) or not isinstance(race_delta, (int, float)) or not 0 < race_delta < 1):
         raise ValueError(f"race_delta is {race_delta!r}, not a confidence level in (0, 1)")
     history = decode_history(state["history"])
-    return {"counters": counts, "seconds": seconds, "champion": (genome, float(ch["return"])), "history": history, "race_delta": race_delta}
+    return {"counters": counts, "seconds": seconds, "champion": (genome, dec_float(ch["return"])), "history": history, "race_delta": race_delta}

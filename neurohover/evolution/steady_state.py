@@ -445,15 +445,19 @@ class SteadyStateNE(ChampionViews):
         check_entries(state, kind, STATE_ENTRIES)
         # States written before the plateau rule existed followed the literal rule.
         settings = read_entry(state, kind, "settings", lambda s: SteadyStateSettings(**{"plateau_rule": "literal", **s}))
-        opt = cls(read_entry(state, kind, "prototype", dec_array), settings)
-        d = opt._prototype.size
-        opt._population = read_entry(state, kind, "population", lambda a: check_genomes(dec_array(a), d, "population"))
-        opt._fitness = read_entry(state, kind, "fitness", dec_array)
-        if (opt._population is None) != (opt._fitness is None) or (opt._fitness is not None and opt._fitness.shape != (len(opt._population),)):
+        opt = cls(read_entry(state, kind, "prototype", lambda a: dec_array(a, "prototype")), settings)
+        d, n = opt._prototype.size, settings.pop_size
+        # Each array's rows as the settings make them: a pop_size that disagreed with the population was run on (sixteenth trial).
+        opt._population = read_entry(state, kind, "population", lambda a: check_genomes(dec_array(a, "population"), d, "population", rows=n))
+        opt._fitness = read_entry(state, kind, "fitness", lambda a: dec_array(a, "fitness"))
+        if (opt._population is None) != (opt._fitness is None) or (opt._fitness is not None and opt._fitness.shape != (n,)):
             raise NeurohoverError(f"fitness has shape {None if opt._fitness is None else opt._fitness.shape}: one return per genome of the population")
-        opt._pending = read_entry(state, kind, "pending", lambda a: check_genomes(dec_array(a), d, "pending genomes"))
+        if opt._fitness is not None and np.any(opt._fitness == np.inf):  # tell() refuses +inf
+            raise NeurohoverError("fitness holds +inf: returns are finite, NaN or -inf")
+        rows = n if opt._population is None else n - settings.elite_size
+        opt._pending = read_entry(state, kind, "pending", lambda a: check_genomes(dec_array(a, "pending genomes"), d, "pending genomes", rows=rows))
         opt._generation = read_entry(state, kind, "generation", read_count)
         opt._rng = read_entry(state, kind, "rng", rng_from_state)
-        opt._tracker = read_entry(state, kind, "tracker", ChampionTracker.from_dict)
+        opt._tracker = read_entry(state, kind, "tracker", lambda t: ChampionTracker.from_dict(t, d))
         opt._clock = Clock(read_entry(state, kind, "wall_seconds", read_seconds))
         return opt

@@ -21,6 +21,7 @@ from ...errors import NeurohoverError, brief
 from .. import common
 from ..common import (
     MAX_POPULATION,
+    ChampionTracker,
     EntryError,
     PopulationOptimiser,
     TellInfo,
@@ -225,6 +226,8 @@ class CMAES(PopulationOptimiser):
             opt = _Unpickler(io.BytesIO(data), holder).load()
             if not isinstance(opt, cls):  # a pickle of something else was returned as it was
                 raise TypeError(f"it holds a {type(opt).__name__}, not a {kind}")
+            # its champion tracking read back as SteadyStateNE's is: evaluations -1 was taken (sixteenth trial)
+            ChampionTracker.from_dict(opt._tracker.to_dict(), int(opt._es.N))
             return opt
 
         opt = read_entry(state, kind, "pickle", unpickle)  # {}, 'x': a bare KeyError, binascii.Error (fourteenth trial)

@@ -209,13 +209,15 @@ class OpenAIES(PopulationOptimiser):
         kind = "OpenAIES"
         check_entries(state, kind, STATE_ENTRIES)
         settings = read_entry(state, kind, "settings", lambda s: OpenAIESSettings(**s))
-        opt = cls(read_entry(state, kind, "mean", dec_array), settings)
+        opt = cls(read_entry(state, kind, "mean", lambda a: dec_array(a, "mean")), settings)
         d = opt.mean.size
-        opt._m, opt._v = read_entry(state, kind, "adam", lambda a: tuple(check_genomes(dec_array(a[i]), d, "Adam moment", rows=0) for i in (0, 1)))
+        opt._m, opt._v = read_entry(
+            state, kind, "adam", lambda a: tuple(check_genomes(dec_array(a[i], "Adam moment"), d, "Adam moment", rows=0) for i in (0, 1))
+        )
         opt.generation = read_entry(state, kind, "generation", read_count)
-        opt._eps = read_entry(state, kind, "pending", lambda a: check_genomes(dec_array(a), d, "pending noise", rows=opt.popsize // 2))
+        opt._eps = read_entry(state, kind, "pending", lambda a: check_genomes(dec_array(a, "pending noise"), d, "pending noise", rows=opt.popsize // 2))
         opt._rng = read_entry(state, kind, "rng", rng_from_state)
-        opt._tracker = read_entry(state, kind, "tracker", ChampionTracker.from_dict)
+        opt._tracker = read_entry(state, kind, "tracker", lambda t: ChampionTracker.from_dict(t, d))
         opt._clock = Clock(read_entry(state, kind, "wall_seconds", read_seconds))
         return opt
 
