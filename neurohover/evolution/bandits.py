@@ -27,7 +27,7 @@ import numpy as np
 
 from ..errors import NeurohoverError, brief, finite_real
 from .common import as_floats
-from .races import RaceResult, SampleFn, _check_int, _check_sample_fn, _draw
+from .races import MAX_RESAMPLING, RaceResult, SampleFn, _check_int, _check_sample_fn, _draw
 
 __all__ = ["BANDITS", "kl_bounds", "lucb_radius", "top_mu_bandit"]
 
@@ -102,7 +102,8 @@ def _rewards(x: np.ndarray) -> np.ndarray:
 
 def top_mu_bandit(sample_fn: SampleFn, n_candidates: int, mu: int, delta: float, *, rule: str = "lucb", t_limit: int = 10) -> RaceResult:
     """The ``mu`` best of ``n_candidates`` by LUCB1 (``rule="lucb"``) or KL-LUCB (``"kl-lucb"``) with error
-    probability ``delta``, each candidate flying at most ``t_limit`` episodes; ``sample_fn`` as for
+    probability ``delta``, each candidate flying at most ``t_limit`` episodes (1 to 100,000,
+    :data:`~neurohover.evolution.races.MAX_RESAMPLING`); ``sample_fn`` as for
     :func:`~neurohover.evolution.races.selection_race` (a candidate listed twice flies two episodes).
 
     Returns a :class:`~neurohover.evolution.races.RaceResult`: ``selected`` the mu of best mean when the rule
@@ -116,7 +117,7 @@ def top_mu_bandit(sample_fn: SampleFn, n_candidates: int, mu: int, delta: float,
     delta = _check_probability(delta)
     if not isinstance(rule, str) or rule not in BANDITS:
         raise NeurohoverError(f"rule={brief(rule)} is not a bandit rule: choose one of {', '.join(BANDITS)}")
-    t_limit = _check_int("t_limit", t_limit, 1)
+    t_limit = _check_int("t_limit", t_limit, 1, MAX_RESAMPLING)
     _check_sample_fn(sample_fn)  # None was a TypeError (thirteenth trial, F14)
     sums = _rewards(_draw(sample_fn, np.arange(n))).copy()  # _draw: a race's check of the answer (its shape, +inf)  # every candidate once
     counts = np.ones(n, dtype=np.int64)

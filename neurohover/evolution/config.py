@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..policies import TOPOLOGIES, Policy
 from ..policies import prototype as make_prototype
 from ..sim.constants import MAX_EPISODE_STEPS
@@ -24,7 +24,7 @@ from .bandits import BANDITS
 from .generational import GENERATIONAL_PRESETS, OLD_GENERATIONAL, GenerationalSettings
 from .optimisers import NE, OPTIMISERS, optimiser_names, population_settings
 from .optimisers.cma import CMASettings
-from .races import RACE_RULES
+from .races import MAX_RESAMPLING, RACE_RULES  # MAX_RESAMPLING: a generation of 50 candidates is then 5,000,000 episodes
 from .seeding import check_seed
 from .steady_state import SteadyStateSettings
 
@@ -105,10 +105,6 @@ def next_auto_delta(delta: float, spent: int, target: int) -> float:
     return float(min(hi, max(lo, delta * AUTO_STEP if spent > target else delta / AUTO_STEP)))
 
 
-#: The most episodes fixed resampling flies per candidate (a generation of 50 candidates is then 5,000,000 episodes).
-MAX_RESAMPLING = 100_000
-
-
 def parse_resampling(spec: str | Resampling | None) -> Resampling:
     """``"fixed:K"`` (K >= 1 episodes per candidate), ``"race:DELTA[:RULE]"`` (0 < DELTA < 1; RULE one of
     :data:`~neurohover.evolution.races.RACE_RULES`, default prose), ``"race:auto[:K]"`` (a delta that matches
@@ -161,8 +157,8 @@ def parse_resampling(spec: str | Resampling | None) -> Resampling:
 
 def resolve_prototype(prototype, topology: str) -> Policy:
     """The prototype policy: a :class:`Policy` of ``topology``, or ``"zero"`` / ``"baseline"``."""
-    if topology not in TOPOLOGIES:
-        raise NeurohoverError(f"unknown topology {topology!r}: allowed {', '.join(TOPOLOGIES)}")
+    if not isinstance(topology, str) or topology not in TOPOLOGIES:  # text first: an array's `in` was NumPy's "truth value" error (sixteenth trial)
+        raise NeurohoverError(f"unknown topology {brief(topology)}: allowed {', '.join(TOPOLOGIES)}")
     if isinstance(prototype, Policy):
         if prototype.topology != topology:
             raise NeurohoverError(f"the prototype is an {prototype.topology} policy but topology={topology!r}")
@@ -191,8 +187,8 @@ def optimiser_of(table: Mapping[str, Any]) -> tuple[str, dict[str, Any]]:
     key, default ``ne``) and its settings; an unknown name is refused."""
     rest = dict(table)
     name = rest.pop("name", NE)
-    if name not in optimiser_names():
-        raise NeurohoverError(f"unknown optimizer name = {name!r}: allowed {', '.join(optimiser_names())}")
+    if not isinstance(name, str) or name not in optimiser_names():
+        raise NeurohoverError(f"unknown optimizer name = {brief(name)}: allowed {', '.join(optimiser_names())}")
     return name, rest
 
 
@@ -294,8 +290,8 @@ class RunConfig:
         if topology is None:  # the prototype's, else the authors' choice: SLP generics over a family, MLPs on one MDP
             topology = prototype.topology if isinstance(prototype, Policy) else ("slp" if family is not None else "mlp")
         proto = resolve_prototype(prototype, topology)
-        if optimizer not in optimiser_names():
-            raise NeurohoverError(f"unknown optimizer {optimizer!r}: allowed {', '.join(optimiser_names())}")
+        if not isinstance(optimizer, str) or optimizer not in optimiser_names():
+            raise NeurohoverError(f"unknown optimizer {brief(optimizer)}: allowed {', '.join(optimiser_names())}")
         resampling = parse_resampling(resampling)
         if budget is None and isinstance(settings, (SteadyStateSettings, GenerationalSettings)):
             budget = settings.budget
@@ -305,8 +301,8 @@ class RunConfig:
         if isinstance(n_steps, bool) or not isinstance(n_steps, (int, np.integer)) or not 1 <= n_steps <= MAX_EPISODE_STEPS:
             raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
         chosen = ("steady-state" if mdp is not None else "generational") if method is None else method
-        if chosen not in ("steady-state", "generational"):
-            raise NeurohoverError(f"unknown method {method!r}: allowed steady-state, generational")
+        if not isinstance(chosen, str) or chosen not in ("steady-state", "generational"):
+            raise NeurohoverError(f"unknown method {brief(method)}: allowed steady-state, generational")
         if chosen == "steady-state" and family is not None:
             raise NeurohoverError("the steady-state method evolves on one MDP; a task family needs the generational method")
         if optimizer != NE:

@@ -80,7 +80,7 @@ from pathlib import Path
 import numba
 import numpy as np
 
-from ..errors import NeurohoverError, check_flag
+from ..errors import NeurohoverError, brief, check_flag
 from ..evaluate import check_episode_count, evaluate_jobs, num_threads
 from ..paths import output_file
 from ..policies import Policy
@@ -300,8 +300,8 @@ def reevaluated_champion(
     Returns the chosen policy (its metadata the run's champion's, with ``reevaluated_from`` = its index in the
     pool) and every candidate's mean fitness over the episodes.
     """
-    if among not in REEVALUATION_POOLS:
-        raise NeurohoverError(f"among={among!r} is not allowed: choose one of {', '.join(REEVALUATION_POOLS)}")
+    if not isinstance(among, str) or among not in REEVALUATION_POOLS:  # text first: an array's `in` was NumPy's error (sixteenth trial)
+        raise NeurohoverError(f"among={brief(among)} is not allowed: choose one of {', '.join(REEVALUATION_POOLS)}")
     pool = result.parents if among == "last" else result.hall_of_fame
     if pool is None or len(pool) == 0:
         raise NeurohoverError("the run has no selected parents to choose from again: generational evolution keeps them, other methods do not")

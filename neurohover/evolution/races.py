@@ -140,11 +140,16 @@ class RaceResult:
     over_selected: int = 0
 
 
-def _check_int(name: str, value: object, minimum: int) -> int:
-    if not whole_number(value):
+#: The most episodes a candidate flies in one estimate: fixed resampling's K (``fixed:K``) and a race's or bandit's
+#: ``t_limit`` (k=10**13 built sample arrays until killed, t_limit=10**13 raced tied candidates on; sixteenth trial).
+MAX_RESAMPLING = 100_000
+
+
+def _check_int(name: str, value: object, minimum: int, maximum: int | None = None) -> int:
+    if not whole_number(value) or value < minimum:
         raise NeurohoverError(f"{name}={brief(value)} must be an integer >= {minimum}")
-    if value < minimum:
-        raise NeurohoverError(f"{name}={brief(value)} must be an integer >= {minimum}")
+    if maximum is not None and value > maximum:
+        raise NeurohoverError(f"{name}={brief(value)} must be an integer in {minimum}..{maximum:,} (episodes per candidate)")
     return int(value)
 
 
@@ -250,7 +255,7 @@ def fixed_resampling(sample_fn: SampleFn, n_candidates: int, k: int) -> Resampli
     n_candidates : int
         Number of candidates (>= 1).
     k : int
-        Episodes per candidate (>= 1).
+        Episodes per candidate (1 to :data:`MAX_RESAMPLING`, 100,000).
 
     Returns
     -------
@@ -258,7 +263,7 @@ def fixed_resampling(sample_fn: SampleFn, n_candidates: int, k: int) -> Resampli
     """
     _check_sample_fn(sample_fn)
     n = _check_int("n_candidates", n_candidates, 1)
-    k = _check_int("k", k, 1)
+    k = _check_int("k", k, 1, MAX_RESAMPLING)
     idx = np.arange(n)
     samples = np.stack([_draw(sample_fn, idx) for _ in range(k)], axis=1)
     means = np.array([_mean(row) for row in samples])
@@ -294,7 +299,7 @@ def selection_race(
         Confidence level of the bounds, in (0, 1) exclusive; larger is more
         cautious (wider bounds, more episodes).
     t_limit : int, default 10
-        Maximum episodes per candidate (>= 1).
+        Maximum episodes per candidate (1 to :data:`MAX_RESAMPLING`, 100,000).
     rule : {"prose", "algorithm1", "authors"}, default "prose"
         The paper's prose, the printed Algorithm 1, or its loop as the authors' code ran it (module docstring).
     batch : int, default 0
@@ -373,7 +378,7 @@ def _race_arguments(sample_fn, n_candidates, mu, delta, t_limit, batch, rule) ->
         raise NeurohoverError(f"mu={mu} must be smaller than n_candidates={n}")
     if not isinstance(rule, str) or rule not in RACE_RULES:
         raise NeurohoverError(f"rule={brief(rule)} is not a race rule: choose one of {', '.join(RACE_RULES)}")
-    return n, mu, _check_delta(delta), _check_int("t_limit", t_limit, 1), _check_int("batch", batch, 0)
+    return n, mu, _check_delta(delta), _check_int("t_limit", t_limit, 1, MAX_RESAMPLING), _check_int("batch", batch, 0)
 
 
 def _fly_ahead(sample_fn: SampleFn, samples: np.ndarray, active: np.ndarray, rounds: int, batch: int, t_limit: int) -> tuple[np.ndarray, int]:

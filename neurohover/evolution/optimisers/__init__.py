@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import NeurohoverError, settings_from_dict
+from ...errors import NeurohoverError, brief, settings_from_dict
 
 __all__ = ["NE", "OPTIMISERS", "OptimiserSpec", "optimiser_names", "population_settings"]
 
@@ -90,8 +90,8 @@ def optimiser_names() -> tuple[str, ...]:
 def population_settings(name: str, settings: Any) -> Any:
     """The checked settings object of population optimiser ``name`` from None (the defaults), an
     object of its settings class, or a dict of overrides (NeurohoverError on a bad key or value)."""
-    if name not in OPTIMISERS:
-        raise NeurohoverError(f"unknown optimizer {name!r}: allowed {', '.join(optimiser_names())}")
+    if not isinstance(name, str) or name not in OPTIMISERS:  # a list or an array was "unhashable type" (sixteenth trial)
+        raise NeurohoverError(f"unknown optimizer {brief(name)}: allowed {', '.join(optimiser_names())}")
     cls = OPTIMISERS[name].settings
     if settings is None:
         return cls()
