@@ -40,6 +40,7 @@ import numba as nb
 import numpy as np
 
 from ..errors import NeurohoverError, brief, finite_real
+from ..evolution.config import check_budget
 from ..evolution.fitness import FITNESS_SCALES, episode_fitness
 from ..evolution.seeding import check_seed
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS, OBS_NAMES
@@ -143,11 +144,12 @@ class NeatSettings:
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, int) or not low <= v <= high:
                 raise NeurohoverError(f"{name}={brief(v)} must be an integer in {low}..{high}")
-        if self.initial not in ("full_direct", "unconnected"):
+        # text first: an array's `in` was NumPy's "truth value ... is ambiguous" (sixteenth trial)
+        if not isinstance(self.initial, str) or self.initial not in ("full_direct", "unconnected"):
             raise NeurohoverError(f"initial={brief(self.initial)}: allowed full_direct or unconnected")
-        if self.fitness not in FITNESS_SCALES:
+        if not isinstance(self.fitness, str) or self.fitness not in FITNESS_SCALES:
             raise NeurohoverError(f"fitness={brief(self.fitness)}: allowed {', '.join(FITNESS_SCALES)}")
-        if self.start not in ("random", "baseline"):
+        if not isinstance(self.start, str) or self.start not in ("random", "baseline"):
             raise NeurohoverError(f"start={brief(self.start)}: allowed random or baseline")
         acts = self.activations  # checked before any use: activations=5 was "'int' object is not iterable" (eleventh trial)
         names = isinstance(acts, (tuple, list)) and all(isinstance(a, str) for a in acts)
@@ -425,7 +427,9 @@ def network_of_record(record: Sequence[float]) -> PackedNetworks:
     import neat
 
     # [] was an IndexError, None a TypeError (thirteenth trial, F19)
-    if isinstance(record, (str, bytes)) or not isinstance(record, Sequence | np.ndarray) or len(record) == 0 or not all(finite_real(v) for v in record):
+    # np.array(3) has no len() (sixteenth trial): an array must be 1-D
+    listed = (isinstance(record, Sequence) and not isinstance(record, (str, bytes))) or (isinstance(record, np.ndarray) and record.ndim == 1)
+    if not listed or len(record) == 0 or not all(finite_real(v) for v in record):
         raise NeurohoverError(f"record={brief(record)} is not allowed: give a genome_record (a non-empty list of finite numbers)")
     if not all(float(record[j]).is_integer() and 0 <= record[j] < len(ACTIVATIONS) for j in range(4, min(len(record), 1 + 4 * max(int(record[0]), 0)), 4)):
         raise NeurohoverError(f"record={brief(record)} is not allowed: its activation ids must be whole numbers 0..{len(ACTIVATIONS) - 1}")
@@ -477,7 +481,8 @@ def evolve_topology(
     Each genome of a generation flies ``settings.episodes`` episodes (on the MDPs in turn when there are
     several, as a run over training MDPs; each on a fresh MDP from G when ``mdps`` is a task family, drawn
     from ``seed``); fitness is its mean return, or on ``settings.fitness = "inv-log-error"`` the mean of its
-    episodes' 1/ln(error) (:mod:`neurohover.evolution.fitness`, FGHH's scale).
+    episodes' 1/ln(error) (:mod:`neurohover.evolution.fitness`, FGHH's scale). ``budget`` is an integer in 1..10**10
+    episodes (:data:`~neurohover.evolution.config.MAX_BUDGET`, as for ``evolve``) and at least one generation's.
     """
     import neat
 
@@ -489,10 +494,13 @@ def evolve_topology(
     seed = check_seed(seed)
     family = mdps if isinstance(mdps, TaskFamily) else None
     mdp_rng = np.random.default_rng([int(seed), 0x4E4]) if family is not None else None  # the MDPs from G, apart from the gusts
-    mdp_list: list = [mdps] if isinstance(mdps, MDP) else [] if isinstance(mdps, TaskFamily) else list(mdps)
+    mdp_list: list = [mdps] if isinstance(mdps, MDP) else []
+    if isinstance(mdps, Sequence) and not isinstance(mdps, (str, bytes)):  # None, 3, np.array(3): list() raised TypeError (sixteenth trial)
+        mdp_list = list(mdps)
     if family is None and (not mdp_list or not all(isinstance(m, MDP) for m in mdp_list)):
-        raise NeurohoverError("mdps must be one MDP or a non-empty sequence of MDPs of one task family")
-    if isinstance(budget, bool) or not isinstance(budget, (int, np.integer)) or budget < s.pop_size * s.episodes:
+        raise NeurohoverError(f"mdps={brief(mdps)} is not allowed: mdps must be one MDP or a non-empty sequence of MDPs of one task family, or a TaskFamily")
+    check_budget(budget)  # evolve's range first: 10**13 ran on without a cap (sixteenth trial)
+    if budget < s.pop_size * s.episodes:
         raise NeurohoverError(f"budget={budget!r} is out of range: allowed an integer >= one generation ({s.pop_size * s.episodes} episodes)")
     config = neat_config(s)
     history: list[dict] = []
