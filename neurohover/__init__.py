@@ -6,7 +6,9 @@ Data flows one way: task family -> MDP -> batched rollouts of policies -> return
 
 from __future__ import annotations
 
+import importlib
 import importlib.metadata
+import importlib.util
 import os
 import sys
 
@@ -36,12 +38,38 @@ def _whole_at_least_1(value: str) -> bool:
     return value.strip().isascii() and value.strip().isdigit() and int(value) >= 1
 
 
-#: The numba variables our docs name, read by numba as it imports: each one's test and what it allows. A value numba
-#: cannot parse was its warning with a traceback, then its default (tenth trial: NUMBA_NUM_THREADS; eleventh: CUDASIM).
+def _zero_or_one(value: str) -> bool:
+    return value.strip() in ("0", "1")
+
+
+#: The threading layers numba takes (NUMBA_THREADING_LAYER, any case), and the pools some of them need, one of which
+#: must load: TBB is no dependency of ours, and numba said "No threading layer could be loaded" at the first flight.
+_THREADING_LAYERS = ("default", "safe", "threadsafe", "forksafe", "omp", "tbb", "workqueue")
+_LAYER_POOLS = {"tbb": ("tbbpool",), "safe": ("tbbpool",), "omp": ("omppool",), "threadsafe": ("tbbpool", "omppool")}
+
+#: The numba variables our docs name or users set, read by numba as it imports: each one's test and what it allows. A
+#: value numba cannot parse was its warning with a traceback, then its default (tenth trial: NUMBA_NUM_THREADS; eleventh:
+#: CUDASIM; sixteenth, T16-3: DISABLE_JIT, OPT, BOUNDSCHECK), or its traceback at the first flight (T16-2: THREADING_LAYER).
 _NUMBA_VARIABLES = {
     "NUMBA_NUM_THREADS": (_whole_at_least_1, "give a whole number >= 1 (numba's threads), or unset it"),
-    "NUMBA_ENABLE_CUDASIM": (lambda value: value.strip() in ("0", "1"), "give 0 or 1 (1: numba's CUDA simulator stands in for a GPU), or unset it"),
+    "NUMBA_ENABLE_CUDASIM": (_zero_or_one, "give 0 or 1 (1: numba's CUDA simulator stands in for a GPU), or unset it"),
+    "NUMBA_DISABLE_JIT": (_zero_or_one, "give 0 or 1 (1: the kernels run as plain Python, very slowly), or unset it"),
+    "NUMBA_BOUNDSCHECK": (_zero_or_one, "give 0 or 1 (1: every array index is checked), or unset it"),
+    "NUMBA_OPT": (lambda value: value in ("0", "1", "2", "3", "max"), "give 0, 1, 2, 3 or max (the compiler's optimisation level), or unset it"),
+    "NUMBA_THREADING_LAYER": (lambda value: value.lower() in _THREADING_LAYERS, f"give one of {', '.join(_THREADING_LAYERS)}, or unset it"),
+    "NUMBA_THREADING_LAYER_PRIORITY": (
+        lambda value: sorted(value.split()) == ["omp", "tbb", "workqueue"],
+        "give tbb, omp and workqueue in the order numba tries them, separated by spaces, or unset it",
+    ),
 }
+
+
+def _refuse_setting(message: str) -> None:
+    """The command line's exit 2 with ``message`` on one line; a NeurohoverError on import."""
+    if running_as_command():
+        print(f"neurohover: error: {message}", file=sys.stderr, flush=True)
+        sys.exit(2)
+    raise NeurohoverError(message)
 
 
 def _check_numba_variables() -> None:
@@ -52,14 +80,82 @@ def _check_numba_variables() -> None:
         value = os.environ.get(name)
         if value is None or allowed(value):
             continue
-        message = f"environment variable {name}={value!r:.40} is not allowed: {what}"
-        if running_as_command():
-            print(f"neurohover: error: {message}", file=sys.stderr, flush=True)
-            sys.exit(2)
-        raise NeurohoverError(message)
+        _refuse_setting(f"environment variable {name}={value!r:.40} is not allowed: {what}")
+
+
+def _import_numba() -> None:
+    """Import numba, a variable it cannot parse refused by name: it warned with a traceback and took its default (any
+    NUMBA_ variable besides those of :data:`_NUMBA_VARIABLES`, NUMBA_DEBUG=x...; T16-3). Numba's other warnings are
+    passed on."""
+    import re
+    import warnings
+
+    if "numba" in sys.modules:  # imported before us: it has read (and warned about) its variables already
+        return
+    with warnings.catch_warnings(record=True) as caught:
+        import numba  # noqa: F401
+    for w in caught:
+        bad = re.match(r"Environment variable '(\w+)' is defined but its associated value '(.*)' could not be parsed", str(w.message), re.S)
+        if bad is None:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+            continue
+        why = [line for line in str(w.message).splitlines() if line.strip()][-1]  # the parse's exception, its last line
+        given = f"{bad[1]}={bad[2]!r:.40}"
+        given = f"environment variable {given}" if bad[1] in os.environ else f"{given} of .numba_config.yaml"
+        _refuse_setting(f"{given} is not allowed: numba cannot read it ({why.strip():.80}); give what numba's docs allow, or unset it")
+
+
+def _check_threading_layer() -> None:
+    """Refuse a NUMBA_THREADING_LAYER whose pool cannot load here (tbb without TBB): numba's traceback at the first
+    flight, "No threading layer could be loaded" (sixteenth trial, T16-2)."""
+    layer = os.environ.get("NUMBA_THREADING_LAYER", "default").lower()
+    pools = _LAYER_POOLS.get(layer, ())
+    if pools and not any(_loads(f"numba.np.ufunc.{pool}") for pool in pools):
+        needs = " or ".join({"tbbpool": "Intel TBB (pip install tbb)", "omppool": "OpenMP"}[pool] for pool in pools)
+        _refuse_setting(
+            f"environment variable NUMBA_THREADING_LAYER={layer!r} names a threading layer numba cannot load here: it needs {needs}; "
+            "install that, or give default, forksafe or workqueue, or unset it"
+        )
+
+
+def _loads(module: str) -> bool:
+    try:
+        importlib.import_module(module)
+    except ImportError:  # its shared library is missing (libtbb.so)
+        return False
+    return True
+
+
+def _check_matplotlib_backend() -> None:
+    """Refuse an MPLBACKEND that matplotlib does not know, naming those it does: matplotlib's ValueError at its import
+    was a traceback from every command, --help too (pycma imports it; sixteenth trial, T16-1). Matplotlib is imported
+    here only where MPLBACKEND is set, without it (which would raise), then given the backend as it does itself."""
+    value = os.environ.get("MPLBACKEND")
+    if not value or "matplotlib" in sys.modules or importlib.util.find_spec("matplotlib") is None:
+        return
+    del os.environ["MPLBACKEND"]
+    try:
+        import matplotlib
+        from matplotlib.rcsetup import validate_backend
+    finally:
+        os.environ["MPLBACKEND"] = value
+    try:
+        validate_backend(value)
+    except ValueError:
+        try:
+            from matplotlib.backends import backend_registry
+
+            known = backend_registry.list_all()
+        except ImportError:  # matplotlib 3.8
+            known = list(getattr(matplotlib.rcsetup, "all_backends", ()))
+        _refuse_setting(f"environment variable MPLBACKEND={value!r:.40} is not allowed: give one of matplotlib's backends ({', '.join(known)}), or unset it")
+    matplotlib.rcParams["backend"] = value  # what matplotlib does with MPLBACKEND as it imports
 
 
 _check_numba_variables()
+_check_matplotlib_backend()
+_import_numba()
+_check_threading_layer()
 
 from .evaluate import DangerousState, Evaluation, PolicyTable, Safeguard, evaluate, evaluate_jobs  # noqa: E402
 from .flightdata import FlightData  # noqa: E402
