@@ -107,6 +107,7 @@ def policy_dir(task: str, directory: str | Path | None = None) -> Path:
 
 def _load(path: Path, what: str, task: str, target: str) -> Policy:
     """The policy ``what`` of ``task``'s set, from ``path``, evolved on ``target`` (an MDP's label, or ``TASK/G`` over G)."""
+    _refuse_not_a_file(path, what)
     if not path.is_file():
         raise NeurohoverError(
             f"policy set {str(path.parent)!r} is missing {what} ({path.name}); "
@@ -115,6 +116,21 @@ def _load(path: Path, what: str, task: str, target: str) -> Policy:
     policy = load_policy(path)
     _check_place(policy, path, what, {"task": task, "name": path.stem, "target": target})
     return policy
+
+
+def _refuse_not_a_file(path: Path, what: str) -> None:
+    """Refuse a file of a set that is there but is no regular file, in the words of :mod:`neurohover.paths`: a directory
+    or a symbolic-link loop as generic.json was called missing (sixteenth trial, T16-7)."""
+    try:
+        path.stat()
+    except FileNotFoundError:
+        return  # missing (or a link to nothing): the caller says so
+    except OSError as err:  # ELOOP: too many levels of symbolic links
+        raise NeurohoverError(f"policy set {str(path.parent)!r}: {path.name} ({what}) cannot be read ({(err.strerror or str(err)).lower()})") from None
+    if path.is_dir():
+        raise NeurohoverError(f"policy set {str(path.parent)!r}: {path.name} ({what}) is a directory; give a JSON file")
+    if not path.is_file():
+        raise NeurohoverError(f"policy set {str(path.parent)!r}: {path.name} ({what}) is not a regular file (a device, pipe or socket)")
 
 
 def _check_place(policy: Policy, path: Path, what: str, place: dict[str, str]) -> None:
@@ -162,6 +178,7 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
     manifest_path = root / "manifest.json"
     if directory is not None and (root.parent.exists() and not root.parent.is_dir()):  # a file was told to hold a set (sixth trial)
         raise NeurohoverError(f"policy directory {str(directory)!r} is not a directory: give the directory that holds {family.name}/")
+    _refuse_not_a_file(manifest_path, "its manifest")
     if not manifest_path.is_file():
         raise NeurohoverError(
             f"no policy set for {family.name} in {str(root)!r} (manifest.json missing); build it with: neurohover build-policies "
