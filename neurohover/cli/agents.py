@@ -136,7 +136,7 @@ def register(sub) -> None:
     from ..evolution.optimisers import optimiser_names
     from ..models.model import default_model_substeps
     from ..policysets import FGHH_POLICY_BUDGET, POLICY_BUDGET
-    from .options import add_sensor_options, add_setting_options, add_sigma_option, add_task_option
+    from .options import add_sensor_options, add_setting_options, add_sigma_option, add_task_option, integer
 
     p = sub.add_parser("build-policies", help="evolve the generic and specialised policies of a task", description=cmd_build_policies.__doc__)
     add_task_option(p)
@@ -145,10 +145,10 @@ def register(sub) -> None:
         required=True,
         help="directory to write <task>/ into (neurohover/data/policies, the package's own, rebuilds the shipped set)",
     )
-    p.add_argument("--budget", type=int, default=POLICY_BUDGET, help=f"episodes per steady-state evolution (default {POLICY_BUDGET})")
-    p.add_argument("--fghh-budget", type=int, help=f"fghh only: episodes per generic-policy evolution over G (default {FGHH_POLICY_BUDGET})")
-    p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--budget", type=integer, default=POLICY_BUDGET, help=f"episodes per steady-state evolution (default {POLICY_BUDGET})")
+    p.add_argument("--fghh-budget", type=integer, help=f"fghh only: episodes per generic-policy evolution over G (default {FGHH_POLICY_BUDGET})")
+    p.add_argument("--episode-steps", type=integer, default=6000, help="control steps per episode (default 6000)")
+    p.add_argument("--seed", type=integer, default=0)
     p.add_argument(
         "--lineage",
         help="GHH-08/09 only: chain (default: every run seeded from an ancestor evolved over the training MDPs in turn, as the authors' policies were) "
@@ -165,8 +165,8 @@ def register(sub) -> None:
     p = sub.add_parser("compete", help="run test runs of an on-line agent", description=cmd_compete.__doc__)
     add_task_option(p)
     p.add_argument("--agent", required=True, help="; ".join(f"{name} ({', '.join(spec.tasks)}): {spec.summary}" for name, spec in AGENTS.items()))
-    p.add_argument("--runs", type=int, default=10, help="independent test runs (default 10)")
-    p.add_argument("--episodes", type=int, default=1000, help="episodes per run (default 1000)")
+    p.add_argument("--runs", type=integer, default=10, help="independent test runs (default 10)")
+    p.add_argument("--episodes", type=integer, default=1000, help="episodes per run (default 1000)")
     p.add_argument("--mdps", default="test", help="test (the fixed test MDPs in turn), sample (fresh from G) or train")
     add_sigma_option(p)
     add_sensor_options(p)
@@ -175,15 +175,15 @@ def register(sub) -> None:
         help="drifting dynamics over each run (docs/benchmarks.md): walk=STD (a log random walk of the 11 dynamics parameters per episode) "
         "and/or PARAM=FACTOR@LO-HI (an abrupt change at an episode drawn from LO..HI), e.g. D_w=0.8@200-800",
     )
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--jobs", type=int, default=1, help="runs in parallel processes (default 1)")
+    p.add_argument("--seed", type=integer, default=0)
+    p.add_argument("--jobs", type=integer, default=1, help="runs in parallel processes (default 1)")
     p.add_argument(
         "--device",
         choices=DEVICES,
         default="cpu",
         help="where the units' episodes fly: cpu (default) or cuda (docs/gpu.md; the agents' test runs themselves still fly on the CPU)",
     )
-    p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")
+    p.add_argument("--episode-steps", type=integer, default=6000, help="control steps per episode (default 6000)")
     p.add_argument("--policy-dir", help="policy sets directory (default: the shipped ones)")
     p.add_argument("--out", required=True, help="output directory (episodes.csv, summary.json, cumulative.png, results.sqlite)")
     p.add_argument("--store", help="results store to keep the runs in (default: OUT/results.sqlite); finished runs are not flown again")

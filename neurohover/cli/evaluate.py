@@ -18,7 +18,7 @@ from ..integrations import SB3_ALGORITHMS
 from ..paths import printable
 from ..policies import Policy
 from ..sim.constants import MAX_EPISODE_STEPS
-from .options import add_sensor_options, add_sigma_option, add_task_option, note_policy_task, task_family_of
+from .options import add_sensor_options, add_sigma_option, add_task_option, integer, note_policy_task, task_family_of
 
 SOURCES = ("policy", "callable", "rl_zoo", "sb3", "cleanrl")
 
@@ -178,10 +178,10 @@ def register(sub) -> None:
         "(automatic for an RL Zoo run folder of such an id)",
     )
     p.add_argument("--mdps", choices=("test", "train"), default="test", help="the task's test (default) or training MDPs")
-    p.add_argument("--n-mdps", type=int, help="the first N of them (default all)")
-    p.add_argument("--episodes", type=int, default=1, help="episodes per MDP (default 1)")
-    p.add_argument("--seed", type=int, default=0, help="gust seed: episode e on MDP m meets stream (seed, m * episodes + e)")
-    p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000, the paper's)")
+    p.add_argument("--n-mdps", type=integer, help="the first N of them (default all)")
+    p.add_argument("--episodes", type=integer, default=1, help="episodes per MDP (default 1)")
+    p.add_argument("--seed", type=integer, default=0, help="gust seed: episode e on MDP m meets stream (seed, m * episodes + e)")
+    p.add_argument("--episode-steps", type=integer, default=6000, help="control steps per episode (default 6000, the paper's)")
     p.add_argument("--obs-dtype", choices=("float32", "float64"), help="what an agent other than a --policy file receives (default float32)")
     p.add_argument("--json", help="also write the rows to this JSON file")
     p.set_defaults(func=cmd_evaluate_agent)

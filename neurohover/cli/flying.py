@@ -11,7 +11,7 @@ import numpy as np
 
 from ..errors import NeurohoverError, brief
 from ..sim.constants import EPISODE_STEPS
-from .options import add_task_options, family_and_mdps, max_in_memory, note_policy_task
+from .options import add_task_options, family_and_mdps, integer, max_in_memory, note_policy_task
 
 # Episodes per kernel call of a progress-reporting fly: large enough to keep every core busy.
 FLY_CHUNK = 256
@@ -189,9 +189,9 @@ def register(sub) -> None:
     p = sub.add_parser("fly", help="fly a policy and print return statistics", description=cmd_fly.__doc__)
     add_task_options(p)
     p.add_argument("--policy", default="baseline", help="'baseline' or a JSON policy file")
-    p.add_argument("--episodes", type=int, default=10, help="number of episodes (default 10)")
-    p.add_argument("--seed", type=int, default=0, help="root seed of the noise streams (default 0)")
-    p.add_argument("--threads", type=int, help="kernel threads (default: all cores)")
+    p.add_argument("--episodes", type=integer, default=10, help="number of episodes (default 10)")
+    p.add_argument("--seed", type=integer, default=0, help="root seed of the noise streams (default 0)")
+    p.add_argument("--threads", type=integer, help="kernel threads (default: all cores)")
     p.add_argument("--record", metavar="FILE", help="write the flight data of every episode to FILE (its name ending .npz)")
     p.add_argument(
         "--record-dtype",
@@ -202,9 +202,9 @@ def register(sub) -> None:
     p.set_defaults(func=cmd_fly)
 
     p = sub.add_parser("demo", help="fly the baseline and an MLP policy on a few MDPs and print a table", description=cmd_demo.__doc__)
-    p.add_argument("--mdps", type=int, default=3, help="training MDPs per family (default 3)")
-    p.add_argument("--episodes", type=int, default=5, help="episodes per MDP (default 5)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--mdps", type=integer, default=3, help="training MDPs per family (default 3)")
+    p.add_argument("--episodes", type=integer, default=5, help="episodes per MDP (default 5)")
+    p.add_argument("--seed", type=integer, default=0)
     p.set_defaults(func=cmd_demo)
 
     p = sub.add_parser("bench", help="measure simulator throughput", description=cmd_bench.__doc__)

@@ -502,7 +502,7 @@ def _register_settings(sub) -> None:
 def register(sub) -> None:
     from ..agents.model_based import ModelEvolution
     from ..evolution.steady_state import SteadyStateSettings
-    from .options import add_setting_options, add_task_options, real
+    from .options import add_setting_options, add_task_options, integer, real
 
     _register_settings(sub)
 
@@ -531,7 +531,7 @@ def register(sub) -> None:
         default="fixed:1",
         help="fixed:K (mean of K episodes per candidate; default fixed:1) or race:DELTA (selection races at confidence 0<DELTA<1; generational only)",
     )
-    p.add_argument("--budget", type=int, help="episodes to fly (default: the paper's stop: plateau for steady state, 4000 generations for generational)")
+    p.add_argument("--budget", type=integer, help="episodes to fly (default: the paper's stop: plateau for steady state, 4000 generations for generational)")
     add_setting_options(p, SteadyStateSettings, ("plateau_rule",), who="steady state")  # the rest through --setting
     p.add_argument(
         "--preset",
@@ -546,9 +546,9 @@ def register(sub) -> None:
         help="one optimiser setting (repeatable), e.g. --setting fitness=return --setting elitist=true --setting pop_size=30; "
         "`neurohover settings steady-state` (one MDP), `... generational` (over a family) or `... OPTIMIZER` lists them with their defaults",
     )
-    p.add_argument("--episode-steps", type=int, default=6000, help="control steps per episode (default 6000)")
-    p.add_argument("--seed", type=int, default=0, help="root seed of the run (default 0)")
-    p.add_argument("--threads", type=int, help="kernel threads (default: all cores; results do not depend on it)")
+    p.add_argument("--episode-steps", type=integer, default=6000, help="control steps per episode (default 6000)")
+    p.add_argument("--seed", type=integer, default=0, help="root seed of the run (default 0)")
+    p.add_argument("--threads", type=integer, help="kernel threads (default: all cores; results do not depend on it)")
     p.add_argument(
         "--device",
         choices=DEVICES,
@@ -558,7 +558,7 @@ def register(sub) -> None:
     p.add_argument("--out", required=True, metavar="FILE", help="champion policy file; FILE.history.csv and FILE.checkpoint.json go next to it")
     p.add_argument("--resume", action="store_true", help="continue the run from FILE.checkpoint.json (same options; the budget may be raised)")
     p.add_argument("--checkpoint-every", type=real, default=60.0, metavar="SECONDS", help="checkpoint interval (default 60 s)")
-    p.add_argument("--validation-episodes", type=int, default=10, help="fresh episodes to validate the champion (default 10)")
+    p.add_argument("--validation-episodes", type=integer, default=10, help="fresh episodes to validate the champion (default 10)")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.set_defaults(func=cmd_evolve)
 
@@ -568,7 +568,7 @@ def register(sub) -> None:
     p.add_argument("--out", required=True, metavar="FILE", help="model file to write (JSON)")
     p.add_argument(
         "--budget",
-        type=int,
+        type=integer,
         help="evaluations for ec-meno / ec-mer (defaults: ec-meno runs to the paper's plateau stop, 1000 evaluations without a new champion; ec-mer 500)",
     )
     lr_options = add_setting_options(p, ModelEvolution, ("estimator", "wind_model", "d_u", "noise"), flags={"noise": "noise-estimate"}, who="lr")
@@ -577,7 +577,7 @@ def register(sub) -> None:
         action="store_true",
         help="lr: fit as the authors' code did (--d-u discard --noise-estimate rms; docs/model.md, LR as the authors fitted it)",
     )
-    p.add_argument("--seed", type=int, help="ec-meno, ec-mer: seed of the evolution (default 0)")
+    p.add_argument("--seed", type=integer, help="ec-meno, ec-mer: seed of the evolution (default 0)")
     p.add_argument(
         "--policy",
         help="ec-mer: the policy that flew the data (default: the one fly --record stored in the flight data, else the file named there, else "

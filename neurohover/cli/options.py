@@ -80,7 +80,7 @@ def _converter(default):
             return text == "true"
 
         return boolean
-    return real if isinstance(default, float) else type(default) if isinstance(default, int) else str
+    return real if isinstance(default, float) else integer if isinstance(default, int) else str
 
 
 def add_setting_options(
@@ -148,7 +148,7 @@ def add_sensor_options(p: argparse.ArgumentParser) -> None:
         help="sensor noise on what the policy sees: a level (e.g. 0.5: std 0.05 m/s, 0.05 m, 0.05 rad/s, 0.005) or key=value pairs "
         f"of {', '.join(f.name for f in fields(Sensor) if f.name != 'delay')} or level (docs/benchmarks.md)",
     )
-    g.add_argument("--obs-delay", type=int, help="control steps (0..10, 0.1 s each) the readings arrive late (default 0)")
+    g.add_argument("--obs-delay", type=integer, help="control steps (0..10, 0.1 s each) the readings arrive late (default 0)")
 
 
 def sensor_of(args: argparse.Namespace):
@@ -193,6 +193,18 @@ def real(text: str) -> float:
         return float_of(text)
     except FloatRangeError as err:
         raise argparse.ArgumentTypeError(str(err)) from None
+
+
+_INTEGER = re.compile(r"\s*[+-]?[0-9]+\s*")
+
+
+def integer(text: str) -> int:
+    """A command-line whole number, in the digits 0-9: int() also reads '1_0' as 10 (``--episodes 1_0`` flew 10
+    episodes, every integer option alike; sixteenth trial, T16-4), which :func:`~neurohover.errors.float_of` refuses
+    for a real number. The type of every integer option (argparse: "invalid integer value: '1_0'")."""
+    if not isinstance(text, str) or not _INTEGER.fullmatch(text):
+        raise ValueError(f"invalid literal for an integer: {text!r:.60} (digits 0-9 only, no '_')")
+    return int(text)
 
 
 def add_sigma_option(p: argparse.ArgumentParser) -> None:

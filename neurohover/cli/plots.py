@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 
 from ..errors import NeurohoverError
+from .options import integer
 
 COMPETE_PNG = "compete.png"
 
@@ -30,7 +31,7 @@ def _episodes(text: str | None, n: int) -> list[int] | None:
     for part in text.split(","):
         lo, sep, hi = part.strip().partition("-")
         try:
-            first, last = int(lo), int(hi) if sep else int(lo)
+            first, last = integer(lo), integer(hi) if sep else integer(lo)
         except ValueError:
             raise NeurohoverError(f"--episodes {text!r} is not allowed: give episode numbers and ranges, e.g. 0,3,10-12") from None
         if first > last:  # both ends may be in range: "out of range" misled (seventh trial)

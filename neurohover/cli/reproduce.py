@@ -11,12 +11,14 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from pathlib import Path
 
 from ..errors import NeurohoverError, brief
 from ..evaluate import DEVICES, check_device
 from ..paths import printable
+from .options import integer
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
@@ -69,7 +71,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         raise NeurohoverError(f"--only selects units of one experiment: give its NAME instead of {args.name!r}")
     executor = make_executor(args.executor, jobs=args.jobs, address=args.address, device=args.device)
     failed = False
-    new_store = not Path(args.store).exists()
+    was = Path(args.store).stat().st_size if Path(args.store).is_file() else None  # None: no file yet; 0: an empty one
     try:
         with Store(args.store) as store:
             for config in configs:
@@ -89,8 +91,8 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
                 print(summary.line())
                 failed = failed or not summary.succeeded
     except NeurohoverError:
-        if new_store:  # a refusal leaves no store it made that holds no unit
-            _remove_if_empty(Path(args.store))
+        if was in (None, 0):  # a refusal leaves no store it made that holds no unit (an empty file stays empty; T16-8)
+            _remove_if_empty(Path(args.store), keep_file=was == 0)
         raise
     finally:
         executor.close()
@@ -107,15 +109,18 @@ def _options_beside_list(args: argparse.Namespace) -> list[str]:
     return names
 
 
-def _remove_if_empty(path: Path) -> None:
-    """Delete the store file at ``path`` if it holds no finished unit."""
+def _remove_if_empty(path: Path, keep_file: bool = False) -> None:
+    """Delete the store file at ``path`` if it holds no finished unit (``keep_file``: empty it to 0 bytes instead, as
+    the user's empty file was)."""
     from ..experiments import Store
 
-    if not path.exists():  # a store that could not be made (a full disk) is already gone
+    if not path.exists() or path.stat().st_size == 0:  # a store that could not be made (a full disk) is already gone, or never written
         return
     with Store(path, create=False) as store:
         empty = not any(store.units(name, scale) for name, scale, *_ in store.experiments())
-    if empty:
+    if empty and keep_file:
+        os.truncate(path, 0)
+    elif empty:
         path.unlink(missing_ok=True)
 
 
@@ -150,7 +155,7 @@ def _results_format(given: str | None, out) -> str:
 
 def _positive_ints(text: str, option: str) -> list[int]:
     try:
-        values = [int(v) for v in text.split(",")]
+        values = [integer(v) for v in text.split(",")]
     except ValueError:
         values = []
     if not values or min(values) < 1:
@@ -248,7 +253,7 @@ def register(sub) -> None:
     p.add_argument("--store", help="results store file (SQLite; created if missing; finished units are skipped)")
     p.add_argument("--executor", choices=("local", "ray"), default="local", help="local processes (default) or a Ray cluster")
     p.add_argument("--address", help="Ray cluster address (default: start a local Ray instance)")
-    p.add_argument("--jobs", type=int, default=1, help="local worker processes (default 1: this process, kernel on all cores)")
+    p.add_argument("--jobs", type=integer, default=1, help="local worker processes (default 1: this process, kernel on all cores)")
     p.add_argument(
         "--device",
         choices=DEVICES,
@@ -293,8 +298,8 @@ def register(sub) -> None:
     p.add_argument("--runs", default="1,5,20", help="competition lengths N, comma-separated (default 1,5,20)")
     p.add_argument("--agents", help="group labels to enter, comma-separated (default: every group of the experiment)")
     p.add_argument("--against", metavar="LABEL", help="each agent against this group alone (head to head); not also one of --agents")
-    p.add_argument("--draws", type=int, default=10_000, help="simulated competitions (default 10,000)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the bootstrap (default 0)")
+    p.add_argument("--draws", type=integer, default=10_000, help="simulated competitions (default 10,000)")
+    p.add_argument("--seed", type=integer, default=0, help="seed of the bootstrap (default 0)")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=cmd_wins)
 
