@@ -5,9 +5,10 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
-from typing import Any, TypeGuard
+from typing import TYPE_CHECKING, Any, TypeGuard
 
-import numpy as np
+if TYPE_CHECKING:  # numpy is imported where used: the package installs its signal handlers after this module, before numpy
+    import numpy as np
 
 
 class NeurohoverError(ValueError):
@@ -132,6 +133,8 @@ def as_floats(values: Any, name: str, allowed: str) -> np.ndarray:
     Decimal), complex numbers and masked arrays are refused (SteadyStateNE("abc") was NumPy's "could not convert",
     eleventh trial; a date was taken as its day number, None as
     NaN, '-1' as -1, a complex number's imaginary part dropped and a mask ignored, fourteenth trial)."""
+    import numpy as np
+
     if isinstance(values, np.ma.MaskedArray):  # np.asarray drops the mask: the masked entries would count
         raise _not_floats(values, name, allowed, "a masked array")
     try:
