@@ -10,6 +10,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from ..envs.arguments import refuse_idle_sigma
 from ..errors import FloatRangeError, NeurohoverError, float_of
 from ..tasks.sensor import Sensor
 
@@ -49,13 +50,9 @@ def explicit_mdp(args: argparse.Namespace, family):
 
 
 def refuse_sigma_on_zero(args: argparse.Namespace, mdp: str | None) -> None:
-    """Refuse --sigma beside the zero setting ``mdp``, the same MDP at every breadth (it changed nothing; sixth trial)."""
-    if getattr(args, "sigma", None) is not None and mdp == "zero":
-        given = "--mdp zero" if getattr(args, "mdp", None) == "zero" else "--mdp zero (the default)"  # which values take it, named (tenth trial)
-        raise NeurohoverError(
-            f"--sigma {args.sigma:g} does nothing with {given}: sigma is the breadth of the MDPs drawn from FGHH's G, and the zero "
-            "setting is the same at every sigma; give --mdp sample, train:N or test:N, or leave --sigma out"
-        )
+    """Refuse --sigma beside the zero setting ``mdp``, the same MDP at every breadth (it changed nothing; sixth trial):
+    the environments' rule (:func:`~neurohover.envs.arguments.refuse_idle_sigma`), in the option's words."""
+    refuse_idle_sigma(getattr(args, "sigma", None), mdp, flags=True, default=getattr(args, "mdp", None) != "zero")  # tenth trial: the default named
 
 
 @dataclass(frozen=True)
