@@ -26,13 +26,17 @@ class Terminated(KeyboardInterrupt):
 def whole_number(value: object) -> TypeGuard[int]:
     """Whether ``value`` is an integer, NumPy's included, and not a bool (True is an int, and was taken as 1). The one
     test of every integer argument; the type checker takes it as an int (NumPy's integers compare and index alike)."""
-    return isinstance(value, numbers.Integral) and not isinstance(value, bool)
+    return isinstance(value, numbers.Integral) and not isinstance(value, bool) and type(value).__name__ not in _TIMES
+
+
+#: NumPy's time types: np.timedelta64 is a np.signedinteger (so Integral) whose int() raises (seventeenth trial, T17-1).
+_TIMES = ("timedelta64", "datetime64")
 
 
 def finite_real(value: object) -> bool:
     """Whether ``value`` is a real number (not a bool) that a float holds finitely: an int past a float's range (10**400)
     is not (``math.isfinite`` raised OverflowError on it; eighth trial)."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or type(value).__name__ in _TIMES:
         return False
     try:
         return math.isfinite(value)
@@ -46,7 +50,7 @@ def brief(value: object) -> str:
     settings class echoed 10**400 whole, a 100,000-character task or agent name a 100 kB line; eleventh trial)."""
     if isinstance(value, str) and len(value) > 60:
         return f"{value[:40]!r} ... {value[-20:]!r} ({len(value):,} characters)"
-    if isinstance(value, numbers.Integral) and not isinstance(value, bool):
+    if whole_number(value):
         try:
             digits = str(abs(int(value)))
         except ValueError:  # past Python's int_max_str_digits (4300): no str() at all
@@ -56,7 +60,7 @@ def brief(value: object) -> str:
     try:
         text = repr(value)
         text = " ".join(text.split()) if "\n" in text else text  # an array's repr spans lines: one line in a message
-    except ValueError:  # a container of such an int
+    except Exception:  # a container of such an int; any repr that raises: a message must not (T17-1)
         text = f"a {type(value).__name__}"
     return text if len(text) <= 60 else text[:57] + "..."
 
