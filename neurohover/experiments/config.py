@@ -241,6 +241,8 @@ def parse_override(text: str, option: str = "--set") -> tuple[str, Any]:
 
 def parse_overrides(texts: list[str] | None, option: str = "--set") -> dict[str, Any]:
     """Repeated ``option KEY=VALUE`` as a dict; a key given twice is refused (the last would win without a word)."""
+    if texts is not None and not isinstance(texts, (list, tuple)):  # 5 was a TypeError, 'a=1' read as a, =, 1 (T17-5)
+        raise NeurohoverError(f"{option} {brief(texts)} is not allowed: give a list of KEY=VALUE texts, or None")
     out: dict[str, Any] = {}
     for text in texts or []:
         key, value = parse_override(text, option)

@@ -514,8 +514,9 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
 
     if not isinstance(store, Store):  # None was an AttributeError (sixth trial)
         raise NeurohoverError(f"store={store!r:.60} is not allowed: give a Store(PATH)")
-    if isinstance(names, str) or (names is not None and not all(isinstance(n, str) for n in names)):  # 'fig2' was read as f, i, g, 2
-        raise NeurohoverError(f"names={names!r:.60} is not allowed: give a list of experiment names, e.g. ['fig2']")
+    # 'fig2' was read as f, i, g, 2; 5 (any number, np.ma.masked) was a TypeError (seventeenth trial, T17-5)
+    if names is not None and (not isinstance(names, (list, tuple)) or not all(isinstance(n, str) for n in names)):
+        raise NeurohoverError(f"names={brief(names)} is not allowed: give a list of experiment names, e.g. ['fig2']")
     if names is not None and not list(names):  # [] was read as None and reported every experiment (thirteenth trial, F21)
         raise NeurohoverError(f"names={brief(names)} is not allowed: give one or more experiment names, or None for all")
     given = list(names or ())
