@@ -38,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError, brief, finite_real
+from .errors import NeurohoverError, brief, finite_real, whole_number
 from .evaluate import MAX_EPISODES_PER_CALL, evaluate
 from .paths import JSONError, strict_json, writing
 from .policies import Policy, load_policy, save_policy
@@ -235,7 +235,7 @@ def choose_safe(crashes: np.ndarray, returns: np.ndarray, n: int = 2) -> tuple[i
     p = crashes.shape[0]
     if returns.shape != crashes.shape:
         raise NeurohoverError(f"returns of shape {returns.shape} is not allowed beside crashes of shape {crashes.shape}: give both (P, P)")
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 1 <= n <= p:  # n=-1 chose P-1, n=0 none (twelfth trial, S8)
+    if not whole_number(n) or not 1 <= n <= p:  # n=-1 chose P-1, n=0 none (twelfth trial, S8); np.timedelta64 a TypeError (T17-1)
         raise NeurohoverError(f"n={brief(n)} is out of range: allowed an integer in 1..{p} (the number of policies)")
     others = ~np.eye(p, dtype=bool)
     crash_others = np.array([crashes[i][others[i]].sum() for i in range(p)])
@@ -314,8 +314,8 @@ def check_build(family, lineage: str | None, fghh_budget: int | None, optimizer:
     for name, value in {**sizes, "fghh_budget": FGHH_POLICY_BUDGET if fghh_budget is None else fghh_budget}.items():
         if name == "seed":
             check_seed(value)
-        elif isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 1 <= value <= highest[name]:
-            raise NeurohoverError(f"{name}={value!r} is out of range: allowed a whole number in 1..{highest[name]:,}")
+        elif not whole_number(value) or not 1 <= value <= highest[name]:  # np.timedelta64 passed as an integer (T17-1)
+            raise NeurohoverError(f"{name}={brief(value)} is out of range: allowed a whole number in 1..{highest[name]:,}")
     lineage = "chain" if lineage is None else lineage
     if lineage not in LINEAGES:
         raise NeurohoverError(f"lineage {lineage!r} is not known: allowed {', '.join(LINEAGES)}")

@@ -8,10 +8,11 @@ planner and these declarations cannot drift apart). Optional keys the planner le
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import MISSING, dataclass, fields
 from typing import Any
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..models.model import LEGACY_MODEL_SUBSTEPS
 
@@ -128,7 +129,8 @@ def unit_params(kind: str, params: dict) -> Any:
     NeurohoverError
         For a kind of no params class, params that are no dict, or params that hold a key the class does not
         declare or lack one it needs: all of them named in one message (the missing ones were a TypeError of
-        ``__init__``; fourteenth trial, T14-23).
+        ``__init__``; fourteenth trial, T14-23), and for a number param of another type (an int param given 5.5 or
+        np.timedelta64; seventeenth trial, T17-1).
     """
     cls = PARAMS.get(kind) if isinstance(kind, str) else None
     if cls is None:
@@ -142,4 +144,18 @@ def unit_params(kind: str, params: dict) -> Any:
         wrong = [f"hold {', '.join(unknown)}, which {cls.__name__} does not declare"] if unknown else []
         wrong += [f"lack {', '.join(missing)}, which {cls.__name__} needs"] if missing else []
         raise NeurohoverError(f"a {kind!r} unit's params {' and '.join(wrong)}")
+    for f in declared:  # a number's type, before a runner uses it (np.timedelta64 passed as an int into NumPy's TypeError; T17-1)
+        value = params.get(f.name)  # None: left to the runner, as before (a structure-only check passes None everywhere)
+        number = _NUMBERS.get(str(f.type))
+        if value is not None and number is not None and not number[0](value):
+            raise NeurohoverError(f"a {kind!r} unit's params: {f.name} = {brief(value)} is not allowed: give {number[1]}")
     return cls(**params)
+
+
+# A number field's annotation -> its test and what it allows.
+_NUMBERS: dict[str, tuple[Callable[[object], bool], str]] = {
+    "int": (whole_number, "a whole number"),
+    "int | None": (whole_number, "a whole number or None"),
+    "float": (finite_real, "a finite real number"),
+    "float | None": (finite_real, "a finite real number or None"),
+}
