@@ -165,6 +165,14 @@ def _positive_ints(text: str, option: str) -> list[int]:
     return values
 
 
+def stored_scale(text: str) -> str:
+    """``--scale`` of wins, results and report: a stored scale's name ('' read as none given and said the store held no
+    experiment it then listed; seventeenth trial, T17-10)."""
+    if text.strip() == "":
+        raise argparse.ArgumentTypeError(f"{text!r} is not allowed: give quick, paper or a compete run's settings-HASH")
+    return text
+
+
 def cmd_wins(args: argparse.Namespace) -> int:
     """Each agent's probability of winning a competition of N runs against the others, simulated from an
     experiment's stored test runs (neurohover.experiments.wins: the bootstrap over the MDPs every agent
@@ -281,7 +289,9 @@ def register(sub) -> None:
     p = sub.add_parser("results", help="export an experiment's results as CSV or JSON", description=cmd_results.__doc__)
     p.add_argument("name", help="experiment name")
     p.add_argument("--store", required=True, help="results store file")
-    p.add_argument("--scale", metavar="SCALE", help="which scale: quick, paper or a compete run's settings-HASH (needed when the store holds several)")
+    p.add_argument(
+        "--scale", metavar="SCALE", type=stored_scale, help="which scale: quick, paper or a compete run's settings-HASH (needed when the store holds several)"
+    )
     p.add_argument(
         "--format",
         choices=("csv", "json"),
@@ -294,7 +304,9 @@ def register(sub) -> None:
     p = sub.add_parser("wins", help="each agent's odds of winning an N-run competition, from stored test runs", description=cmd_wins.__doc__)
     p.add_argument("name", help="experiment name (a test-runs experiment)")
     p.add_argument("--store", required=True, help="results store file")
-    p.add_argument("--scale", metavar="SCALE", help="which scale: quick, paper or a compete run's settings-HASH (needed when the store holds several)")
+    p.add_argument(
+        "--scale", metavar="SCALE", type=stored_scale, help="which scale: quick, paper or a compete run's settings-HASH (needed when the store holds several)"
+    )
     p.add_argument("--runs", default="1,5,20", help="competition lengths N, comma-separated (default 1,5,20)")
     p.add_argument("--agents", help="group labels to enter, comma-separated (default: every group of the experiment)")
     p.add_argument("--against", metavar="LABEL", help="each agent against this group alone (head to head); not also one of --agents")
@@ -307,5 +319,7 @@ def register(sub) -> None:
     p.add_argument("names", nargs="*", help="experiments to include (default: all in the store)")
     p.add_argument("--store", required=True, help="results store file")
     p.add_argument("--out", required=True, help="output directory")
-    p.add_argument("--scale", metavar="SCALE", help="only this scale: quick, paper or a compete run's settings-HASH (default: every scale in the store)")
+    p.add_argument(
+        "--scale", metavar="SCALE", type=stored_scale, help="only this scale: quick, paper or a compete run's settings-HASH (default: every scale in the store)"
+    )
     p.set_defaults(func=cmd_report)

@@ -360,7 +360,7 @@ class Store:
         """The message for an experiment (None: any experiment; at ``scale``, if given) this store does not hold,
         listing what it holds (any was "holds no experiment '(any)'"; eleventh trial)."""
         present = [f"{n} ({s})" for n, s, _, _ in self.experiments()]
-        at = f" at scale {scale!r}" if scale else ""
+        at = f" at scale {scale!r}" if scale is not None else ""  # '' too: its clause dropped, the message contradicted itself (T17-10)
         if name is None and not present:
             return f"results store {str(self.path)!r} holds no experiment yet"
         what = f"no experiment {brief(name)}{at}" if name is not None else f"nothing{at}"
