@@ -42,6 +42,7 @@ __all__ = [
     "output_dir",
     "output_file",
     "printable",
+    "refuse_link_loop",
     "refuse_special_file",
     "remove_created_dirs",
     "sole_writer",
@@ -110,7 +111,19 @@ def checked_path(path, option: str, what: str = "file path") -> Path:
             f"{option} {shown} is too long: at most {NAME_MAX} bytes in one file or directory name "
             f"(here {len(os.fsencode(longest)):,}) and {PATH_MAX} in the whole path (here {len(os.fsencode(text)):,})"
         )
+    refuse_link_loop(text, option)
     return Path(text)
+
+
+def refuse_link_loop(path: str | os.PathLike, option: str) -> None:
+    """Refuse a ``path`` that a symbolic-link loop makes unreachable, which no command can read or write: Path.exists()
+    is False for one, so a loop was "no such results store" or "cannot create the directory (File exists)" (seventeenth
+    trial, T17-11); the words are the policy sets' (:mod:`neurohover.policysets`)."""
+    try:
+        os.stat(path)
+    except OSError as err:
+        if err.errno == errno.ELOOP:
+            raise NeurohoverError(f"{option} {os.fspath(path)!r} cannot be read (too many levels of symbolic links)") from None
 
 
 def _unique_keys(pairs: list) -> dict:
