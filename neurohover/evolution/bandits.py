@@ -27,13 +27,15 @@ import numpy as np
 
 from ..errors import NeurohoverError, brief, finite_real
 from .common import as_floats
-from .races import MAX_RESAMPLING, RaceResult, SampleFn, _check_int, _check_sample_fn, _draw
+from .races import MAX_RESAMPLING, RaceResult, SampleFn, _check_int, _check_room, _check_sample_fn, _draw
 
-__all__ = ["BANDITS", "kl_bounds", "lucb_radius", "top_mu_bandit"]
+__all__ = ["BANDITS", "MAX_BISECTIONS", "kl_bounds", "lucb_radius", "top_mu_bandit"]
 
 #: The bandit selection rules: resampling ``lucb:DELTA`` and ``kl-lucb:DELTA`` (DELTA the error probability).
 BANDITS = ("lucb", "kl-lucb")
 KL_K1, KL_ALPHA = 405.5, 1.1
+#: The most halvings :func:`kl_bounds` takes: 60 reach a float's precision, 1,100 its smallest step (10**13 ran on; T17-4).
+MAX_BISECTIONS = 10_000
 
 
 def lucb_radius(samples: np.ndarray, t: int, n: int, delta: float) -> np.ndarray:
@@ -64,7 +66,7 @@ _EPS = 1e-15  # the KL divergence's means are kept this far inside (0, 1)
 
 def kl_bounds(means: np.ndarray, samples: np.ndarray, level: float, iterations: int = 60) -> tuple[np.ndarray, np.ndarray]:
     """The KL confidence bounds ``min / max {q in [0, 1] : u d(p, q) <= level}`` of empirical means ``p`` over ``u``
-    samples, by bisection (``iterations`` halvings: within ``2**-iterations``).
+    samples, by bisection (``iterations`` halvings, 1 to :data:`MAX_BISECTIONS`: within ``2**-iterations``).
 
     Both bounds of every candidate are bisected in one array (upper bounds first), so that each halving is one
     set of NumPy calls: each element takes the same operations as alone, and so the same bits."""
@@ -77,7 +79,7 @@ def kl_bounds(means: np.ndarray, samples: np.ndarray, level: float, iterations: 
         )
     if not finite_real(level) or level < 0:  # a negative level was taken silently
         raise NeurohoverError(f"level={brief(level)} is not allowed: give a finite number >= 0")
-    iterations = _check_int("iterations", iterations, 1)  # -1 was taken silently: no halving at all
+    iterations = _check_int("iterations", iterations, 1, MAX_BISECTIONS, "halvings")  # -1 was taken silently: no halving at all
     n = p.size
     room = np.tile(float(level) / u, 2)
     up = np.arange(2 * n) < n  # the first half bisects upper bounds, the second lower ones
@@ -102,7 +104,8 @@ def _rewards(x: np.ndarray) -> np.ndarray:
 
 def top_mu_bandit(sample_fn: SampleFn, n_candidates: int, mu: int, delta: float, *, rule: str = "lucb", t_limit: int = 10) -> RaceResult:
     """The ``mu`` best of ``n_candidates`` by LUCB1 (``rule="lucb"``) or KL-LUCB (``"kl-lucb"``) with error
-    probability ``delta``, each candidate flying at most ``t_limit`` episodes (1 to 100,000,
+    probability ``delta`` (``n_candidates`` >= 2, as many as fit in half the memory free), each candidate flying at
+    most ``t_limit`` episodes (1 to 100,000,
     :data:`~neurohover.evolution.races.MAX_RESAMPLING`); ``sample_fn`` as for
     :func:`~neurohover.evolution.races.selection_race` (a candidate listed twice flies two episodes).
 
@@ -118,6 +121,7 @@ def top_mu_bandit(sample_fn: SampleFn, n_candidates: int, mu: int, delta: float,
     if not isinstance(rule, str) or rule not in BANDITS:
         raise NeurohoverError(f"rule={brief(rule)} is not a bandit rule: choose one of {', '.join(BANDITS)}")
     t_limit = _check_int("t_limit", t_limit, 1, MAX_RESAMPLING)
+    _check_room(n, 0)  # per candidate arrays only: a round flies two candidates (10**13 was a MemoryError; T17-3)
     _check_sample_fn(sample_fn)  # None was a TypeError (thirteenth trial, F14)
     sums = _rewards(_draw(sample_fn, np.arange(n))).copy()  # _draw: a race's check of the answer (its shape, +inf)  # every candidate once
     counts = np.ones(n, dtype=np.int64)

@@ -8,14 +8,11 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, check_flag, finite_real, float_of, whole_number
 from ..policies import TOPOLOGIES, Policy
 from ..policies import prototype as make_prototype
 from ..sim.constants import MAX_EPISODE_STEPS
@@ -59,22 +56,30 @@ MAX_BUDGET = 10**10
 
 def check_budget(budget, unit: str = "episodes", alternative: str = "") -> int:
     """``budget`` as an int; NeurohoverError unless an integer in 1..MAX_BUDGET (``alternative``: what else the caller allows)."""
-    if isinstance(budget, bool) or not isinstance(budget, (int, np.integer)) or not 1 <= budget <= MAX_BUDGET:
-        raise NeurohoverError(f"budget={budget!r} is out of range: allowed an integer in 1..{MAX_BUDGET:,} ({unit}){alternative}")
+    if not whole_number(budget) or not 1 <= budget <= MAX_BUDGET:  # whole_number: np.timedelta64 is a np.integer (T17-1)
+        raise NeurohoverError(f"budget={brief(budget)} is out of range: allowed an integer in 1..{MAX_BUDGET:,} ({unit}){alternative}")
     return int(budget)
 
 
 @dataclass(frozen=True)
 class Resampling:
-    """How a candidate's fitness is estimated: ``fixed`` (mean of ``k`` episodes) or ``race``
-    (selection race at confidence level ``delta``, deciding by ``rule``: :data:`~neurohover.evolution.races.RACE_RULES`).
-    ``str()`` gives the spec back (the prose rule unnamed, as before the rules)."""
+    """How a candidate's fitness is estimated: ``fixed`` (mean of ``k`` episodes, 1..100,000), ``race`` (selection race
+    at confidence level ``delta`` in (0, 1), deciding by ``rule``: :data:`~neurohover.evolution.races.RACE_RULES`; with
+    ``auto=True`` delta is set race by race to match fixed:``k``'s cost, ``k`` in 1..10) or a bandit ``lucb`` /
+    ``kl-lucb`` (error probability ``delta`` in (0, 1)). The fields are checked as :func:`parse_resampling` checks a
+    spec's; a field the kind does not use must keep its default. ``str()`` gives the spec back (the prose rule unnamed,
+    as before the rules)."""
 
     kind: str
     k: int = 1
     delta: float | None = None
     rule: str = "prose"
     auto: bool = False  # race:auto: the delta of each race set so that races cost what fixed:K would (AUTO_*)
+
+    def __post_init__(self) -> None:  # nothing was checked: k=-5 was NumPy's "negative dimensions", kind='nope' a TypeError in str() (T17-2)
+        k, delta = _checked_resampling(self.kind, self.k, self.delta, self.rule, self.auto)
+        object.__setattr__(self, "k", k)  # NumPy's integers and floats as Python's: str() and the checkpoint's JSON
+        object.__setattr__(self, "delta", delta)
 
     def __str__(self) -> str:
         if self.kind == "fixed":
@@ -105,6 +110,55 @@ def next_auto_delta(delta: float, spent: int, target: int) -> float:
     return float(min(hi, max(lo, delta * AUTO_STEP if spent > target else delta / AUTO_STEP)))
 
 
+#: What each field of a :class:`Resampling` may be, for the messages of :func:`_checked_resampling`.
+_KINDS = ("fixed", "race", *BANDITS)
+_K_OF = {"fixed": f"fixed resampling's K, an integer in 1..{MAX_RESAMPLING:,} (episodes per candidate)", "auto": "race:auto's K, an integer in 1..10"}
+
+
+def _checked_resampling(kind: Any, k: Any, delta: Any, rule: Any, auto: Any) -> tuple[int, float | None]:
+    """``(k, delta)`` of a :class:`Resampling` as ints and floats, or NeurohoverError naming the field that is not
+    allowed: the one check of a resampling, whether built from a spec or by hand."""
+    if not isinstance(kind, str) or kind not in _KINDS:
+        raise NeurohoverError(f"Resampling kind={brief(kind)} is not allowed: allowed {', '.join(_KINDS)}")
+    check_flag(auto, "Resampling auto", "race:auto, a delta matching fixed:K's cost")
+    if auto and kind != "race":
+        raise NeurohoverError(f"Resampling auto=True is for kind='race' (race:auto), not kind={kind!r}")
+    if not isinstance(rule, str) or rule not in RACE_RULES or (rule != "prose" and (kind != "race" or auto)):
+        raise NeurohoverError(
+            f"Resampling rule={brief(rule)} is not allowed: a race's (not race:auto's) rule is one of {', '.join(RACE_RULES)}; other kinds keep 'prose'"
+        )
+    top = MAX_RESAMPLING if kind == "fixed" else 10 if auto else 1
+    if not whole_number(k) or not 1 <= k <= top:
+        wanted = _K_OF["fixed" if kind == "fixed" else "auto"] if top > 1 else f"1 (kind={kind!r} uses no K)"
+        raise NeurohoverError(f"Resampling k={brief(k)} is not allowed: give {wanted}")
+    if kind == "fixed":
+        if delta is not None:
+            raise NeurohoverError(f"Resampling delta={brief(delta)} is not allowed: fixed resampling has none (give None)")
+        return int(k), None
+    if not finite_real(delta) or not 0.0 < float(delta) < 1.0:
+        what = "confidence level" if kind == "race" else "error probability"
+        raise NeurohoverError(f"Resampling delta={brief(delta)} is not allowed: give a number strictly between 0 and 1 ({kind}'s {what})")
+    return int(k), float(delta)
+
+
+def _resampling_of(spec: Any, reason: str, allowed: str, *fields: Any, **named: Any) -> Resampling:
+    """The :class:`Resampling` of ``fields`` read from ``spec``, its check's refusal as ``spec``'s (``reason``, ``allowed``)."""
+    try:
+        return Resampling(*fields, **named)
+    except NeurohoverError:
+        raise NeurohoverError(f"bad resampling {spec!r}: {reason}; {allowed}") from None
+
+
+def _number(text: str, read: Any) -> Any:
+    """``read(text)``, or None where it is no number (then the check refuses it)."""
+    if read is int:  # digits only ('+5', ' 5' and '5_0' are no K); 12 at most: int() of 5,000 digits raised
+        return int(text) if text.isdigit() and len(text.lstrip("0")) <= 12 else None
+    try:
+        return read(text)
+    except ValueError:
+        return None
+
+
 def parse_resampling(spec: str | Resampling | None) -> Resampling:
     """``"fixed:K"`` (K >= 1 episodes per candidate), ``"race:DELTA[:RULE]"`` (0 < DELTA < 1; RULE one of
     :data:`~neurohover.evolution.races.RACE_RULES`, default prose), ``"race:auto[:K]"`` (a delta that matches
@@ -124,34 +178,19 @@ def parse_resampling(spec: str | Resampling | None) -> Resampling:
         raise NeurohoverError(f"resampling {spec!r} is not allowed: numbers in ASCII digits; {allowed}")
     if sep and value and "" in value.split(":"):  # 'race:0.5:' and 'race:auto:' were read as race:0.5 and race:auto (twelfth trial, S8)
         raise NeurohoverError(f"resampling {spec!r} is not allowed: it has an empty field (a ':' with nothing after it); {allowed}")
-    if kind == "fixed" and sep:
-        if value.isdigit() and 1 <= int(value) <= MAX_RESAMPLING:  # fixed:100000000000 was a MemoryError (third trial)
-            return Resampling("fixed", int(value))
-        raise NeurohoverError(f"bad resampling {spec!r}: K must be an integer in 1..{MAX_RESAMPLING:,}; {allowed}")
+    if kind == "fixed" and sep:  # fixed:100000000000 was a MemoryError (third trial)
+        return _resampling_of(spec, f"K must be an integer in 1..{MAX_RESAMPLING:,}", allowed, "fixed", _number(value, int))
     if kind in BANDITS and sep:
-        try:
-            delta = float(value)
-        except ValueError:
-            delta = math.nan
-        if 0.0 < delta < 1.0:
-            return Resampling(kind, 1, delta)
-        raise NeurohoverError(f"bad resampling {spec!r}: DELTA must be an error probability strictly between 0 and 1; {allowed}")
+        return _resampling_of(spec, "DELTA must be an error probability strictly between 0 and 1", allowed, kind, 1, _number(value, float_of))
     if kind == "race" and sep and value.partition(":")[0] == "auto":
         k = value.partition(":")[2] or str(AUTO_K)
-        if k.isdigit() and 1 <= int(k) <= 10:
-            return Resampling("race", int(k), AUTO_DELTA0, auto=True)
-        raise NeurohoverError(f"bad resampling {spec!r}: race:auto[:K] matches fixed:K's cost, K an integer in 1..10 (a race's limit); {allowed}")
+        reason = "race:auto[:K] matches fixed:K's cost, K an integer in 1..10 (a race's limit)"
+        return _resampling_of(spec, reason, allowed, "race", _number(k, int), AUTO_DELTA0, auto=True)
     if kind == "race" and sep:
         value, _, rule = value.partition(":")
         if rule and rule not in RACE_RULES:
             raise NeurohoverError(f"bad resampling {spec!r}: {rule!r} is not a race rule: allowed {', '.join(RACE_RULES)}")
-        try:
-            delta = float(value)
-        except ValueError:
-            delta = math.nan
-        if 0.0 < delta < 1.0:
-            return Resampling("race", 1, delta, rule or "prose")
-        raise NeurohoverError(f"bad resampling {spec!r}: DELTA must be a number strictly between 0 and 1; {allowed}")
+        return _resampling_of(spec, "DELTA must be a number strictly between 0 and 1", allowed, "race", 1, _number(value, float_of), rule or "prose")
     raise NeurohoverError(f"unknown resampling {spec!r}: {allowed}")
 
 
@@ -298,8 +337,8 @@ class RunConfig:
         if budget is not None:
             budget = check_budget(budget)
         seed = check_seed(seed)
-        if isinstance(n_steps, bool) or not isinstance(n_steps, (int, np.integer)) or not 1 <= n_steps <= MAX_EPISODE_STEPS:
-            raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
+        if not whole_number(n_steps) or not 1 <= n_steps <= MAX_EPISODE_STEPS:
+            raise NeurohoverError(f"n_steps={brief(n_steps)} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
         chosen = ("steady-state" if mdp is not None else "generational") if method is None else method
         if not isinstance(chosen, str) or chosen not in ("steady-state", "generational"):
             raise NeurohoverError(f"unknown method {brief(method)}: allowed steady-state, generational")

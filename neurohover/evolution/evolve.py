@@ -80,7 +80,7 @@ from pathlib import Path
 import numba
 import numpy as np
 
-from ..errors import NeurohoverError, brief, check_flag
+from ..errors import NeurohoverError, brief, check_flag, whole_number
 from ..evaluate import check_episode_count, evaluate_jobs, num_threads
 from ..paths import output_file
 from ..policies import Policy
@@ -121,15 +121,34 @@ __all__ = [
 ]
 
 
-def _prepare(
-    run: Run, checkpoint, checkpoint_every_s, progress, progress_every_s, resume: bool, threads: int | None, device: str, trace: list | None
-) -> Path | None:
+#: What ``checkpoint_every_s=None`` and ``progress_every_s=None`` stand for (seconds).
+CHECKPOINT_EVERY_S, PROGRESS_EVERY_S = 60.0, 0.2
+
+
+def _intervals(checkpoint, checkpoint_every_s, progress, progress_every_s) -> tuple[float, float]:
+    """The seconds between checkpoints and between progress calls, checked: a number (not a bool: True was 1 second),
+    and given only with its ``checkpoint`` / ``progress`` (alone it was ignored without a word; T17-9)."""
+    if checkpoint_every_s is None:
+        checkpoint_every_s = CHECKPOINT_EVERY_S
+    elif isinstance(checkpoint_every_s, bool) or not isinstance(checkpoint_every_s, (int, float)) or not checkpoint_every_s > 0:
+        raise NeurohoverError(f"checkpoint_every_s={brief(checkpoint_every_s)} must be a number > 0 (seconds), or None ({CHECKPOINT_EVERY_S:g})")
+    elif checkpoint is None:
+        raise NeurohoverError(f"checkpoint_every_s={brief(checkpoint_every_s)} needs checkpoint= (the file it writes): give both, or neither")
+    if progress_every_s is None:
+        progress_every_s = PROGRESS_EVERY_S
+    elif isinstance(progress_every_s, bool) or not isinstance(progress_every_s, (int, float)) or not 0 <= progress_every_s < math.inf:
+        raise NeurohoverError(
+            f"progress_every_s={brief(progress_every_s)} is out of range: allowed a finite number of seconds >= 0 (0: every generation), "
+            f"or None ({PROGRESS_EVERY_S:g})"
+        )
+    elif progress is None:
+        raise NeurohoverError(f"progress_every_s={brief(progress_every_s)} needs progress= (the callable it paces): give both, or neither")
+    return float(checkpoint_every_s), float(progress_every_s)
+
+
+def _prepare(run: Run, checkpoint, progress, resume: bool, threads: int | None, device: str, trace: list | None) -> Path | None:
     """Check the checkpoint and progress options, restore the run from its checkpoint on ``resume``, and load (or compile) the
     kernel before the run's clock starts (which also validates the thread count); the checkpoint's path."""
-    if not isinstance(checkpoint_every_s, (int, float)) or not checkpoint_every_s > 0:
-        raise NeurohoverError(f"checkpoint_every_s={checkpoint_every_s!r} must be a number > 0")
-    if isinstance(progress_every_s, bool) or not isinstance(progress_every_s, (int, float)) or not 0 <= progress_every_s < math.inf:
-        raise NeurohoverError(f"progress_every_s={progress_every_s!r} is out of range: allowed a finite number of seconds >= 0 (0: every generation)")
     if progress is not None and not callable(progress):  # progress=3 was "'int' object is not callable" mid-run (second trial)
         raise NeurohoverError(f"progress={progress!r:.60} is not allowed: give a callable taking a ProgressInfo, or None")
     check_flag(resume, "resume", "continue from the checkpoint")  # resume="no" resumed (its truth), fifteenth trial
@@ -164,10 +183,10 @@ def evolve(
     device: str = "cpu",
     progress: Callable[[ProgressInfo], None] | None = None,
     checkpoint: str | Path | None = None,
-    checkpoint_every_s: float = 60.0,
+    checkpoint_every_s: float | None = None,
     resume: bool = False,
     method: str | None = None,
-    progress_every_s: float = 0.2,
+    progress_every_s: float | None = None,
     _trace: list | None = None,
     _flown: dict | None = None,
 ) -> EvolutionResult:
@@ -210,14 +229,18 @@ def evolve(
         tolerance. Not part of the run's config: a checkpoint resumes on either device.
     progress : callable, optional
         Called with a :class:`ProgressInfo` after a generation at most every ``progress_every_s``
-        seconds (default 0.2; 0: every generation) and at the end; may raise ``KeyboardInterrupt``
-        to stop the run (the checkpoint is written first).
+        seconds and at the end; may raise ``KeyboardInterrupt`` to stop the run (the checkpoint is
+        written first).
     checkpoint : path, optional
         Checkpoint file, written every ``checkpoint_every_s`` seconds, at the end and on interrupt.
+    checkpoint_every_s : float, optional
+        Seconds between checkpoints (> 0); None: 60. Only with ``checkpoint``.
     resume : bool
         Continue from ``checkpoint`` (which must exist).
     method : {"steady-state", "generational"}, optional
         Default: steady state for an MDP, generational for a family.
+    progress_every_s : float, optional
+        Seconds between ``progress`` calls (>= 0; 0: every generation); None: 0.2. Only with ``progress``.
     _trace : list, optional
         For benchmarks: receives every kernel call's jobs (:attr:`KernelFlyer.trace
         <neurohover.flyer.KernelFlyer>`).
@@ -236,11 +259,12 @@ def evolve(
         target, topology=topology, prototype=prototype, optimizer=optimizer, resampling=resampling, budget=budget, settings=settings, seed=seed,
         n_steps=n_steps, method=method,
     )  # fmt: skip
+    every_checkpoint, every_progress = _intervals(checkpoint, checkpoint_every_s, progress, progress_every_s)
     run = Run(cfg, device=device)
-    path = _prepare(run, checkpoint, checkpoint_every_s, progress, progress_every_s, resume, threads, device, _trace)
+    path = _prepare(run, checkpoint, progress, resume, threads, device, _trace)
     with num_threads(threads if threads is not None else numba.get_num_threads()):  # restores the count after
         run.flyer.start()
-        run.run(progress, path, float(checkpoint_every_s), float(progress_every_s))
+        run.run(progress, path, every_checkpoint, every_progress)
     if _flown is not None:
         _flown["steps"] = run.flyer.flown_steps
     return run.result()
@@ -266,8 +290,8 @@ def _fresh_episodes(target, episodes: int, mdp_seed: int) -> tuple[np.ndarray, n
     """The kernel rows and each episode's row index of ``episodes`` fresh episodes of ``target``: all on its MDP, or
     each on a fresh MDP from G drawn with ``mdp_seed``."""
     mdp, family, _ = resolve_target(target)
-    if isinstance(episodes, bool) or not isinstance(episodes, (int, np.integer)) or episodes < 1:
-        raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
+    if not whole_number(episodes) or episodes < 1:  # whole_number: np.timedelta64 is a np.integer (T17-1)
+        raise NeurohoverError(f"episodes={brief(episodes)} is out of range: allowed an integer >= 1")
     check_episode_count(int(episodes), f"episodes={episodes}")
     if mdp is not None:
         return mdp.row()[None, :], np.zeros(episodes, dtype=np.int64)

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, as_floats, brief
 
 __all__ = ["ERROR_FLOOR", "FITNESS_SCALES", "episode_fitness", "error_of_fitness"]
 
@@ -26,19 +26,26 @@ FITNESS_SCALES = ("inv-log-error", "return")
 ERROR_FLOOR = 1.0 + 1e-6
 
 
+def _check_scale(scale: object) -> None:
+    """Refuse a ``scale`` that is not one of :data:`FITNESS_SCALES`: text first, as a comparison with ``np.ma.masked``
+    is masked, so neither ``== "return"`` nor ``!= "inv-log-error"`` held and it was taken as inv-log-error (T17-6)."""
+    if not isinstance(scale, str) or scale not in FITNESS_SCALES:
+        raise NeurohoverError(f"unknown fitness scale {brief(scale)}: allowed {', '.join(FITNESS_SCALES)}")
+
+
 def episode_fitness(returns: np.ndarray, scale: str) -> np.ndarray:
     """The fitness of each episode's return on ``scale`` (one of :data:`FITNESS_SCALES`); NaN -> ``-inf``."""
-    r = np.asarray(returns, dtype=np.float64)
+    _check_scale(scale)
+    r = as_floats(returns, "returns", "episode returns")  # np.asarray(dtype=float) read time spans as numbers (T17-1)
     if scale == "return":
         return np.where(np.isnan(r), -np.inf, r)
-    if scale != "inv-log-error":
-        raise NeurohoverError(f"unknown fitness scale {brief(scale)}: allowed {', '.join(FITNESS_SCALES)}")
     error = np.maximum(np.where(np.isnan(r), np.inf, -r), ERROR_FLOOR)
     return np.where(np.isnan(r), -np.inf, 1.0 / np.log(error))
 
 
 def error_of_fitness(fitness: np.ndarray | float, scale: str) -> np.ndarray:
     """The error (``-return``) whose fitness on ``scale`` is ``fitness``: ``exp(1/f)`` or ``-f``."""
+    _check_scale(scale)  # any other scale was read as inv-log-error
     f = np.asarray(fitness, dtype=np.float64)
     if scale == "return":
         return -f

@@ -54,6 +54,7 @@ import numpy as np
 from scipy import stats
 
 from ..errors import NeurohoverError, brief, finite_real, whole_number
+from ..procs import half_free_memory
 from .common import as_floats
 
 __all__ = [
@@ -145,12 +146,30 @@ class RaceResult:
 MAX_RESAMPLING = 100_000
 
 
-def _check_int(name: str, value: object, minimum: int, maximum: int | None = None) -> int:
+def _check_int(name: str, value: object, minimum: int, maximum: int | None = None, unit: str = "episodes per candidate") -> int:
     if not whole_number(value) or value < minimum:
         raise NeurohoverError(f"{name}={brief(value)} must be an integer >= {minimum}")
     if maximum is not None and value > maximum:
-        raise NeurohoverError(f"{name}={brief(value)} must be an integer in {minimum}..{maximum:,} (episodes per candidate)")
+        raise NeurohoverError(f"{name}={brief(value)} must be an integer in {minimum}..{maximum:,} ({unit})")
     return int(value)
+
+
+#: Bytes a race, a bandit or fixed resampling holds per candidate (bounds, means, flags, indices) and per episode
+#: sample (the samples, a grown copy, a call's indices and returns), for :func:`_check_room`.
+_CANDIDATE_BYTES, _SAMPLE_BYTES = 256, 32
+
+
+def _check_room(n: int, episodes: int) -> None:
+    """Refuse ``n`` candidates of at most ``episodes`` kept samples each (0: none kept) whose arrays would not fit in half
+    the memory free now (10**13 candidates were a MemoryError of 72.8 TiB, 2**63 an empty result of 2**64 episodes; T17-3)."""
+    room = half_free_memory()
+    most = room // (_CANDIDATE_BYTES + _SAMPLE_BYTES * episodes)
+    if n > most:
+        each = f" of up to {episodes:,} episodes each" if episodes else ""
+        raise NeurohoverError(
+            f"n_candidates={brief(n)} is too many: at most {most:,} candidates{each} fit in half the memory free now ({room / 2**30:.1f} GiB); "
+            "give fewer candidates"
+        )
 
 
 def _check_delta(delta: object) -> float:
@@ -253,7 +272,7 @@ def fixed_resampling(sample_fn: SampleFn, n_candidates: int, k: int) -> Resampli
     sample_fn : callable
         ``sample_fn(indices) -> returns``, one fresh episode per index.
     n_candidates : int
-        Number of candidates (>= 1).
+        Number of candidates (>= 1; their samples must fit in half the memory free).
     k : int
         Episodes per candidate (1 to :data:`MAX_RESAMPLING`, 100,000).
 
@@ -264,6 +283,7 @@ def fixed_resampling(sample_fn: SampleFn, n_candidates: int, k: int) -> Resampli
     _check_sample_fn(sample_fn)
     n = _check_int("n_candidates", n_candidates, 1)
     k = _check_int("k", k, 1, MAX_RESAMPLING)
+    _check_room(n, k)
     idx = np.arange(n)
     samples = np.stack([_draw(sample_fn, idx) for _ in range(k)], axis=1)
     means = np.array([_mean(row) for row in samples])
@@ -292,7 +312,7 @@ def selection_race(
         ``sample_fn(indices) -> returns``: flies each listed candidate one more
         episode on a fresh MDP and returns one return per index.
     n_candidates : int
-        Population size ``lambda`` (>= 2).
+        Population size ``lambda`` (>= 2; ``t_limit`` samples of each must fit in half the memory free).
     mu : int
         Number to select, ``1 <= mu < n_candidates``.
     delta : float
@@ -378,7 +398,9 @@ def _race_arguments(sample_fn, n_candidates, mu, delta, t_limit, batch, rule) ->
         raise NeurohoverError(f"mu={mu} must be smaller than n_candidates={n}")
     if not isinstance(rule, str) or rule not in RACE_RULES:
         raise NeurohoverError(f"rule={brief(rule)} is not a race rule: choose one of {', '.join(RACE_RULES)}")
-    return n, mu, _check_delta(delta), _check_int("t_limit", t_limit, 1, MAX_RESAMPLING), _check_int("batch", batch, 0)
+    t_limit = _check_int("t_limit", t_limit, 1, MAX_RESAMPLING)
+    _check_room(n, t_limit)
+    return n, mu, _check_delta(delta), t_limit, _check_int("batch", batch, 0)
 
 
 def _fly_ahead(sample_fn: SampleFn, samples: np.ndarray, active: np.ndarray, rounds: int, batch: int, t_limit: int) -> tuple[np.ndarray, int]:

@@ -17,7 +17,7 @@ from typing import Any
 import cma
 import numpy as np
 
-from ...errors import NeurohoverError, brief
+from ...errors import NeurohoverError, brief, whole_number
 from .. import common
 from ..common import (
     MAX_POPULATION,
@@ -253,7 +253,7 @@ class CMASettings:
     def __post_init__(self) -> None:
         pop = self.popsize
         s0 = require_spread("sigma0", self.sigma0, positive=True, what="CMA-ES ")  # 1e308 was pycma's AssertionError (eleventh trial)
-        if pop is not None and (isinstance(pop, bool) or not isinstance(pop, (int, np.integer)) or not 2 <= pop <= MAX_POPULATION):
+        if pop is not None and (not whole_number(pop) or not 2 <= pop <= MAX_POPULATION):
             raise NeurohoverError(f"CMA-ES popsize={brief(pop)} must be None or an integer in 2..{MAX_POPULATION:,}")
         object.__setattr__(self, "sigma0", s0)
         object.__setattr__(self, "popsize", None if pop is None else int(pop))

@@ -30,7 +30,7 @@ from typing import Any
 import cma
 import numpy as np
 
-from ...errors import NeurohoverError, brief
+from ...errors import NeurohoverError, brief, whole_number
 from ..common import TellInfo, check_settings, require_std
 from . import OptimiserSpec
 from .cma import CMAES, CMASettings, losses_of
@@ -63,7 +63,7 @@ class UHCMASettings(CMASettings):
         lo, hi, re, eps = self.min_evaluations, self.max_evaluations, self.reevaluations, self.epsilon
 
         def integer(v) -> bool:
-            return not isinstance(v, bool) and isinstance(v, (int, np.integer))
+            return whole_number(v)  # np.timedelta64 is a np.integer (T17-1)
 
         if not integer(lo) or not integer(hi) or not 1 <= lo <= hi:
             raise NeurohoverError(f"UH-CMA-ES min_evaluations={brief(lo)} and max_evaluations={brief(hi)} must be integers with 1 <= min <= max")
