@@ -105,11 +105,11 @@ class PolicyTable:
             if isinstance(getattr(self, name), np.ma.MaskedArray):
                 raise NeurohoverError(f"PolicyTable {name}={brief(getattr(self, name))} is not allowed: give a plain array, not a masked one")
         kinds, genomes = np.asarray(self.kinds), np.asarray(self.genomes)
-        if kinds.ndim != 1 or not np.issubdtype(kinds.dtype, np.integer) or not np.isin(kinds, list(KIND.values())).all():
+        if kinds.ndim != 1 or kinds.dtype.kind not in "iu" or not np.isin(kinds, list(KIND.values())).all():
             raise NeurohoverError(f"PolicyTable kinds must be a 1-D integer array of {sorted(KIND.values())} ({', '.join(KIND)}), got {kinds!r:.80}")
         if genomes.shape != (kinds.shape[0], GENOME_WIDTH):
             raise NeurohoverError(f"PolicyTable genomes must be an array of shape ({kinds.shape[0]}, {GENOME_WIDTH}), got shape {genomes.shape}")
-        if genomes.dtype == bool or not (np.issubdtype(genomes.dtype, np.floating) or np.issubdtype(genomes.dtype, np.integer)):
+        if genomes.dtype.kind not in "iuf":  # not issubdtype(np.integer): time spans are NumPy integers (T17-1); booleans are kind 'b'
             raise NeurohoverError(f"PolicyTable genomes must be real numbers, got dtype {genomes.dtype} (complex and objects were a ValueError in the kernel)")
         object.__setattr__(self, "kinds", kinds.astype(np.int64, copy=False))  # uint8 kinds were refused by the kernel's batch
         object.__setattr__(self, "genomes", genomes.astype(np.float64, copy=False))
@@ -253,7 +253,7 @@ def _index_array(values, n_jobs: int | None, what: str) -> np.ndarray:
     if arr.ndim > 1:  # one index per job: a 2-D array's jobs would be flattened in an order the caller may not mean
         raise NeurohoverError(f"{what} must be a 1-D array of job indices, got shape {arr.shape}")
     check_episode_count(arr.size, f"{what} of {arr.size:,} jobs")  # before its int64 copy (10**10 int8 indices: 75 GiB; third trial)
-    if arr.size and not np.issubdtype(arr.dtype, np.integer):
+    if arr.size and arr.dtype.kind not in "iu":  # not issubdtype(np.integer): a time span's array is one (T17-1)
         raise NeurohoverError(f"{what} must hold integers, got dtype {arr.dtype}")
     if arr.size and np.issubdtype(arr.dtype, np.unsignedinteger) and arr.max() > np.iinfo(np.int64).max:  # would wrap negative
         raise NeurohoverError(f"{what} holds {arr.max()}, out of range: allowed 0..2**63-1")
@@ -273,8 +273,8 @@ MAX_EPISODES_PER_CALL = 100_000_000
 
 
 def _check_n_steps(n_steps) -> None:
-    if isinstance(n_steps, bool) or not isinstance(n_steps, (int, np.integer)) or not 1 <= n_steps <= MAX_EPISODE_STEPS:
-        raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
+    if not whole_number(n_steps) or not 1 <= n_steps <= MAX_EPISODE_STEPS:  # np.timedelta64 was int()'s TypeError (T17-1)
+        raise NeurohoverError(f"n_steps={brief(n_steps)} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
 
 
 def _check_call_size(n_jobs: int, n_steps: int, n_rec: int) -> None:
@@ -360,8 +360,8 @@ def evaluate_jobs(
     check_device(device)
     table = policies if isinstance(policies, PolicyTable) else PolicyTable.from_policies(policies)
     rows = mdp_rows(mdps)
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= MAX_SEED:  # True was seed 1
-        raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer in 0..2**63-1")
+    if not whole_number(seed) or not 0 <= int(seed) <= MAX_SEED:  # True was seed 1; np.timedelta64 int()'s TypeError (T17-1)
+        raise NeurohoverError(f"seed={brief(seed)} is out of range: allowed an integer in 0..2**63-1")
     _check_n_steps(n_steps)
     p_idx = _index_array(policy_index, None, "policy_index")
     n_jobs = p_idx.shape[0]
@@ -443,8 +443,8 @@ def evaluate(
     if len(table) == 0:  # an empty table returned an empty Evaluation, where [] is refused (T15-20)
         raise NeurohoverError("policies=PolicyTable of 0 policies is not allowed: give a non-empty sequence of Policy objects or a non-empty PolicyTable")
     rows = mdp_rows(mdps)
-    if isinstance(episodes, (bool, np.bool_)) or not isinstance(episodes, (int, np.integer)) or episodes < 1:  # True is an int
-        raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
+    if not whole_number(episodes) or episodes < 1:  # True is an int; np.timedelta64 a NumPy integer (T17-1)
+        raise NeurohoverError(f"episodes={brief(episodes)} is out of range: allowed an integer >= 1")
     if not isinstance(record, (bool, np.bool_)):
         raise NeurohoverError(f"record={record!r} is not allowed: give True or False")
     check_first_episode(first_episode)

@@ -278,8 +278,8 @@ def _check_run(agent, family, mdp, episodes, seed) -> int:
         )
     if mdp.family != family.name:  # the agent prepares for its family (its policies, safe pairs): another family's MDP is a mix-up
         raise NeurohoverError(f"mdp {mdp.label!r} is a {mdp.family} MDP, but the run's family is {family.name}: give an MDP of {family.name}")
-    if isinstance(episodes, bool) or not isinstance(episodes, (int, np.integer)) or episodes < 1:  # True was one episode
-        raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
+    if not whole_number(episodes) or episodes < 1:  # True was one episode; np.timedelta64 int()'s TypeError (T17-1)
+        raise NeurohoverError(f"episodes={brief(episodes)} is out of range: allowed an integer >= 1")
     check_episode_count(int(episodes), f"episodes={episodes}")
     mdp.drift.check_run(int(episodes))
     return check_seed(seed)
@@ -305,7 +305,7 @@ def run_test(
     """
     seed = _check_run(agent, family, mdp, episodes, seed)
     settings = getattr(agent, "settings", None)
-    if isinstance(settings, AgentSettings) and isinstance(n_steps, (int, np.integer)) and not isinstance(n_steps, bool):
+    if isinstance(settings, AgentSettings) and whole_number(n_steps):  # others are refused where the episodes fly
         settings.check_episode_steps(int(n_steps))  # settings that cannot act in episodes this long (twelfth trial, S3)
     start_time = time.perf_counter()
     agent.start(family, np.random.default_rng(np.random.SeedSequence([seed, 0xA6E27])))

@@ -84,15 +84,28 @@ def _policy_set(family: TaskFamily, policy_dir: str | None) -> PolicySet:
     return ps
 
 
+def _refuse_idle_policy_dir(spec: AgentSpec, policy_dir: object) -> None:
+    """Refuse a policy directory for an agent that flies no policy set: it was ignored without a word (T17-8)."""
+    if policy_dir is not None and not spec.needs:
+        idle = ", ".join(name for name, s in AGENTS.items() if not s.needs)  # a few: the rest (16 now) is a long list
+        raise NeurohoverError(
+            f"policy_dir={brief(policy_dir)} is not allowed for agent {spec.name!r}: it flies no policy set, so leave it out "
+            f"(a policy set's directory applies to every agent but {idle})"
+        )
+
+
 def check_agent(name: str, family: TaskFamily, policy_dir: str | None = None) -> None:
-    """Refuse unknown agents, agents for another task, and missing or mismatched policy sets, with clear messages."""
+    """Refuse unknown agents, agents for another task, a policy directory for an agent that flies no policy set, and
+    missing or mismatched policy sets, with clear messages."""
     spec = agent_spec(name, family)
+    _refuse_idle_policy_dir(spec, policy_dir)
     if spec.needs:
         spec.build(policies_from_set(spec, _policy_set(family, policy_dir)), AgentOptions())
 
 
 def make_agent(name: str, family: TaskFamily | str, *, policy_dir: str | None = None, options: AgentOptions = AgentOptions()) -> Agent:
-    """A fresh agent called ``name`` for ``family`` (a task family or its name), flying the policies of its policy set."""
+    """A fresh agent called ``name`` for ``family`` (a task family or its name), flying the policies of its policy set
+    (``policy_dir``: the directory of policy sets, default the shipped ones; only for an agent that flies a policy set)."""
     if isinstance(family, str):  # a task's name, as agent_spec takes it (was an AttributeError; bad-input trial)
         family = get_task_family(family)
     if not isinstance(family, TaskFamily):
@@ -100,6 +113,7 @@ def make_agent(name: str, family: TaskFamily | str, *, policy_dir: str | None = 
     if not isinstance(options, AgentOptions):
         raise NeurohoverError(f"options={options!r:.80} is not allowed: give an AgentOptions")
     spec = agent_spec(name, family)
+    _refuse_idle_policy_dir(spec, policy_dir)
     options = _checked_options(spec, options)
     if policy_dir is not None:
         from ..paths import checked_path

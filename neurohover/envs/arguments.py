@@ -128,8 +128,8 @@ def check_no_unknown_kwargs(unknown: dict[str, Any], allowed: Sequence[str]) -> 
 
 def check_episode_steps(episode_steps: Any, name: str = "episode_steps") -> int:
     """``episode_steps`` (the argument ``name``) as an int, or a clear error."""
-    if isinstance(episode_steps, (bool, np.bool_)) or not isinstance(episode_steps, (int, np.integer)) or not 1 <= episode_steps <= MAX_EPISODE_STEPS:
-        raise NeurohoverError(f"{name}={episode_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
+    if not whole_number(episode_steps) or not 1 <= episode_steps <= MAX_EPISODE_STEPS:  # np.timedelta64 was int()'s TypeError (T17-1)
+        raise NeurohoverError(f"{name}={brief(episode_steps)} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
     return int(episode_steps)
 
 
@@ -174,12 +174,12 @@ def real_values(values: Any, message: str | Callable[[], str]) -> np.ndarray:
 
 
 def _check_dtype(value: Any, name: str) -> np.dtype:
-    try:
-        dtype = np.dtype(value)
+    try:  # a name, a dtype or a type only: np.dtype() reads any value's .dtype (np.float32('nan') was float32; T17-7)
+        dtype = np.dtype(value) if isinstance(value, (str, np.dtype, type)) else None
     except TypeError:
         dtype = None
     if value is None or dtype is None or dtype.name not in OBS_DTYPES:
-        raise NeurohoverError(f"{name}={value!r} is not allowed: use {' or '.join(map(repr, OBS_DTYPES))}")
+        raise NeurohoverError(f"{name}={brief(value)} is not allowed: use {' or '.join(map(repr, OBS_DTYPES))}")
     return dtype
 
 

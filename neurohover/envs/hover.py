@@ -21,7 +21,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, whole_number
 from ..sim.constants import (
     ACTION_DIM,
     EPISODE_STEPS,
@@ -385,8 +385,8 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         return self._run_mdp, self._run.row(self._run_episode)
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
-        if seed is not None and (isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or not 0 <= seed <= MAX_SEED):
-            raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer in 0..2**63-1")  # every seed's range, as the vector env says it
+        if seed is not None and (not whole_number(seed) or not 0 <= seed <= MAX_SEED):  # np.timedelta64: int()'s TypeError (T17-1)
+            raise NeurohoverError(f"seed={brief(seed)} is out of range: allowed an integer in 0..2**63-1")  # every seed's range, as the vector env says it
         super().reset(seed=None if seed is None else int(seed))  # Gymnasium's seeding takes a Python int, not np.int64
         options = check_reset_options(options)
         # Validate every option before touching the episode, so a bad call leaves it as it was.

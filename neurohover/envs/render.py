@@ -24,7 +24,6 @@ and then to the crash box (20 m) when the helicopter leaves it.
 from __future__ import annotations
 
 import math
-import numbers
 import warnings
 from collections.abc import Sequence
 from typing import Any
@@ -72,7 +71,7 @@ def _real_vector(values: Any, lengths: tuple[int, ...], what: str, meaning: str)
 def rotation_matrix(qx: float, qy: float, qz: float, qw: float) -> np.ndarray:
     """Body-to-world rotation matrix of a unit quaternion (the kernel's convention)."""
     for name, q in (("qx", qx), ("qy", qy), ("qz", qz), ("qw", qw)):
-        if isinstance(q, bool) or not isinstance(q, numbers.Real):  # 'a' was a TypeError (T14-14)
+        if not (finite_real(q) or isinstance(q, (float, np.floating))):  # 'a', np.timedelta64 were TypeErrors (T14-14, T17-1); NaN kept
             raise NeurohoverError(f"rotation_matrix {name}={brief(q)} is not allowed: give a quaternion's 4 real numbers qx, qy, qz, qw")
     return np.array(
         [

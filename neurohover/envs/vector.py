@@ -28,7 +28,7 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, whole_number
 from ..launch import check_device, stepper
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS, MDP_ROW_LEN, OBS_DIM
 from ..sim.rng import MAX_SEED, seed_stream
@@ -151,8 +151,8 @@ class HoverVectorEnv(VectorEnv):
     ) -> None:
         check_no_unknown_kwargs(unknown, VECTOR_ENV_KWARGS)
         check_device(device)
-        if isinstance(num_envs, (bool, np.bool_)) or not isinstance(num_envs, (int, np.integer)) or not 1 <= num_envs <= MAX_NUM_ENVS:
-            raise NeurohoverError(f"num_envs={num_envs!r} is out of range: allowed an integer in 1..{MAX_NUM_ENVS}")
+        if not whole_number(num_envs) or not 1 <= num_envs <= MAX_NUM_ENVS:  # np.timedelta64 was int()'s TypeError (T17-1)
+            raise NeurohoverError(f"num_envs={brief(num_envs)} is out of range: allowed an integer in 1..{MAX_NUM_ENVS}")
         if render_mode is not None:
             raise NeurohoverError(f"render_mode={render_mode!r} is not supported: this environment has no rendering (use None)")
         n = int(num_envs)
@@ -278,17 +278,17 @@ class HoverVectorEnv(VectorEnv):
         n = self.num_envs
         if seed is None:
             return [None] * n
-        if isinstance(seed, (int, np.integer)) and not isinstance(seed, (bool, np.bool_)):
+        if whole_number(seed):  # np.timedelta64, a NumPy integer, was int()'s TypeError (T17-1)
             if not 0 <= seed <= MAX_SEED + 1 - n:  # every seed's range (the last helicopter's seed + n - 1 too)
-                raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer in 0..2**63-{n}")
+                raise NeurohoverError(f"seed={brief(seed)} is out of range: allowed an integer in 0..2**63-{n}")
             return [int(seed) + i for i in range(n)]
         if (  # an array: 1-D and plain (a 0-d one was len()'s TypeError, T16-5; a masked one's mask would be dropped)
             (isinstance(seed, (list, tuple)) or (isinstance(seed, np.ndarray) and not isinstance(seed, np.ma.MaskedArray) and seed.ndim == 1))
             and len(seed) == n
-            and all(s is None or (isinstance(s, (int, np.integer)) and not isinstance(s, (bool, np.bool_)) and 0 <= s <= MAX_SEED) for s in seed)
+            and all(s is None or (whole_number(s) and 0 <= s <= MAX_SEED) for s in seed)
         ):
             return [None if s is None else int(s) for s in seed]
-        raise NeurohoverError(f"seed={seed!r} is not allowed: give None, an integer in 0..2**63-1, or a list of {n} such integers (or None)")
+        raise NeurohoverError(f"seed={brief(seed)} is not allowed: give None, an integer in 0..2**63-1, or a list of {n} such integers (or None)")
 
     def _check_streams(self, value: Any) -> list[tuple[int, int]]:
         n = self.num_envs
@@ -409,7 +409,7 @@ class HoverVectorEnv(VectorEnv):
         if not self._ready and not mask.all():
             raise NeurohoverError("the first reset() must reset every sub-environment: leave out reset_mask")
         self._make_room_for_sensors(specs)
-        if isinstance(seed, (int, np.integer)):
+        if whole_number(seed):
             super().reset(seed=int(seed))
         idx = np.flatnonzero(mask)
         for i in idx.tolist():

@@ -246,8 +246,8 @@ def learn_ec_mer(
     start = time.perf_counter()
     if not isinstance(generic_policy, Policy):
         raise NeurohoverError(f"generic_policy must be a Policy, got {type(generic_policy).__name__}")
-    if isinstance(episodes, bool) or not isinstance(episodes, (int, np.integer)) or not 1 <= episodes <= MAX_EC_MER_EPISODES:
-        raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer in 1..{MAX_EC_MER_EPISODES:,} (per candidate)")
+    if not whole_number(episodes) or not 1 <= episodes <= MAX_EC_MER_EPISODES:  # np.timedelta64 was int()'s TypeError (T17-1)
+        raise NeurohoverError(f"episodes={brief(episodes)} is out of range: allowed an integer in 1..{MAX_EC_MER_EPISODES:,} (per candidate)")
     tr = Transitions(flight_data)
     if true_return is None:
         true_return = observed_return(flight_data, 0)

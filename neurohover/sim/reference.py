@@ -11,7 +11,6 @@ readable form) and the environments its wind formula for their ``info`` (:func:`
 from __future__ import annotations
 
 import math
-import numbers
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
@@ -324,7 +323,8 @@ def _action(policy: Callable[[list[float]], Sequence[float]], observation: list[
     """The policy's action, refused unless it is 4 numbers (3 were an unpack ValueError; thirteenth trial, F6)."""
     action = policy(observation)
     try:
-        ok = len(action) == 4 and all(isinstance(a, numbers.Real) for a in action)
+        # real numbers, NaN too (it crashes): np.timedelta64, a numbers.Real, was float()'s TypeError (T17-1)
+        ok = len(action) == 4 and all(finite_real(a) or isinstance(a, (float, np.floating)) for a in action)
     except TypeError:
         ok = False
     if not ok:

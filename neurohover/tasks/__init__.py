@@ -27,7 +27,7 @@ import pkgutil
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, whole_number
 from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, check_rows, competition_rows, finite_vector
 from .drift import NO_DRIFT, Drift, refuse_drift
 from .fghh import COMPETITION_FGHH_SIGMA, FGHH
@@ -79,8 +79,8 @@ def _family(name: str, sigma: float | None) -> TaskFamily:
     if key not in TASK_FAMILIES:
         raise NeurohoverError(f"unknown task {brief(name)}: allowed {', '.join(TASK_NAMES)}")
     cls = TASK_FAMILIES[key]
-    if sigma is not None and (isinstance(sigma, (bool, np.bool_)) or not isinstance(sigma, (int, float, np.integer, np.floating))):
-        raise NeurohoverError(f"sigma={sigma!r} is not allowed: give a number (the family's breadth) or None")
+    if sigma is not None and not (whole_number(sigma) or isinstance(sigma, (float, np.floating))):  # np.timedelta64 was float()'s TypeError (T17-1)
+        raise NeurohoverError(f"sigma={brief(sigma)} is not allowed: give a number (the family's breadth) or None")
     if sigma is not None and not cls.has_sigma:
         with_sigma = [n for n, c in TASK_FAMILIES.items() if c.has_sigma]
         raise NeurohoverError(f"sigma applies to the {', '.join(with_sigma)} task only, not to {brief(name)}")

@@ -5,14 +5,13 @@ from __future__ import annotations
 import copy
 import functools
 import json
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError, as_floats, brief, whole_number
+from ..errors import NeurohoverError, as_floats, brief, finite_real, whole_number
 from ..sim.constants import (
     DEFAULT_NOISE_STD,
     DEFAULT_PARAMS,
@@ -132,13 +131,13 @@ class MDP:
             object.__setattr__(self, name, tuple(vector.tolist()))  # plain Python numbers: reprs read MDP(params=(-0.18, ...))
         if min(self.noise_std) < 0:
             raise NeurohoverError(f"MDP noise_std={self.noise_std!r} is out of range: allowed stds >= 0")
-        if isinstance(self.substeps, bool) or not isinstance(self.substeps, (int, np.integer)) or not 1 <= self.substeps <= MAX_SUBSTEPS:
-            raise NeurohoverError(f"MDP substeps={self.substeps!r} is out of range: allowed an integer in 1..{MAX_SUBSTEPS}")
+        if not whole_number(self.substeps) or not 1 <= self.substeps <= MAX_SUBSTEPS:  # np.timedelta64 was int()'s TypeError (T17-1)
+            raise NeurohoverError(f"MDP substeps={brief(self.substeps)} is out of range: allowed an integer in 1..{MAX_SUBSTEPS}")
         object.__setattr__(self, "substeps", int(self.substeps))
         for name in ("dt", "d_u"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) or not math.isfinite(value):
-                raise NeurohoverError(f"MDP {name}={value!r} is not allowed: give a finite number")
+            if not finite_real(value):  # np.timedelta64 was float()'s TypeError (T17-1), 10**400 an OverflowError
+                raise NeurohoverError(f"MDP {name}={brief(value)} is not allowed: give a finite number")
             object.__setattr__(self, name, float(value))
         if not self.dt > 0:
             raise NeurohoverError(f"MDP dt={self.dt!r} is out of range: allowed a substep length > 0")
@@ -310,8 +309,8 @@ def generator(rng, what: str = "rng") -> np.random.Generator:
     """``rng`` as a NumPy Generator: a Generator, a seed (an integer >= 0) or None (fresh entropy); else a clear error."""
     if rng is None or isinstance(rng, np.random.Generator):
         return np.random.default_rng(rng)
-    if isinstance(rng, (bool, np.bool_)) or not isinstance(rng, (int, np.integer)) or not 0 <= rng <= MAX_SEED:  # every seed's range
-        raise NeurohoverError(f"{what}={rng!r} is not allowed: give a numpy Generator, a seed (an integer in 0..2**63-1) or None")
+    if not whole_number(rng) or not 0 <= rng <= MAX_SEED:  # every seed's range; np.timedelta64 was int()'s TypeError (T17-1)
+        raise NeurohoverError(f"{what}={brief(rng)} is not allowed: give a numpy Generator, a seed (an integer in 0..2**63-1) or None")
     return np.random.default_rng(int(rng))
 
 
@@ -322,8 +321,8 @@ def _checked_draws(method):
     def draws(self, rng, n):
         if not isinstance(rng, np.random.Generator):
             raise NeurohoverError(f"rng={rng!r} is not allowed: give a numpy Generator (np.random.default_rng(seed))")
-        if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)) or not 0 <= n <= MAX_SAMPLES:
-            raise NeurohoverError(f"n={n!r} is out of range: allowed an integer in 0..{MAX_SAMPLES:,} (MDPs drawn in one call)")
+        if not whole_number(n) or not 0 <= n <= MAX_SAMPLES:  # np.timedelta64 was int()'s TypeError (T17-1)
+            raise NeurohoverError(f"n={brief(n)} is out of range: allowed an integer in 0..{MAX_SAMPLES:,} (MDPs drawn in one call)")
         return method(self, rng, int(n))
 
     return draws

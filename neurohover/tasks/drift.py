@@ -64,7 +64,7 @@ class Drift:
         if isinstance(w, bool) or not isinstance(w, numbers.Real):  # NumPy's numbers are Real too
             raise NeurohoverError(f"drift walk={w!r} is not a number: allowed a number in 0..1 (a per-episode log std)")
         if not finite_real(w) or not 0 <= w <= 1:
-            raise NeurohoverError(f"drift walk={w!r} is out of range: allowed a number in 0..1 (a per-episode log std)")
+            raise NeurohoverError(f"drift walk={brief(w)} is out of range: allowed a number in 0..1 (a per-episode log std)")
         object.__setattr__(self, "walk", float(w))
         try:
             change = dict(self.change) if not isinstance(self.change, (dict, str)) else self.change
@@ -82,7 +82,7 @@ class Drift:
             if isinstance(factor, bool) or not isinstance(factor, numbers.Real):  # '0.8' and Decimal('0.8') were called "out of range" (T14-21)
                 raise NeurohoverError(f"drift change {name}={factor!r} is not a number: allowed a factor in {MIN_FACTOR:g}..{MAX_FACTOR:g}")
             if not finite_real(factor) or not MIN_FACTOR <= factor <= MAX_FACTOR:  # np.float32(0.8), Fraction(4, 5) in range too (thirteenth trial)
-                raise NeurohoverError(f"drift change {name}={factor!r} is out of range: allowed a factor in {MIN_FACTOR:g}..{MAX_FACTOR:g}")
+                raise NeurohoverError(f"drift change {name}={brief(factor)} is out of range: allowed a factor in {MIN_FACTOR:g}..{MAX_FACTOR:g}")
             if factor == 1:  # flown as another experiment with results identical to none (eleventh trial, S3)
                 raise NeurohoverError(
                     f"drift change {name}={factor!r} changes nothing: give a factor other than 1 (in {MIN_FACTOR:g}..{MAX_FACTOR:g}) or leave {name} out"
@@ -92,7 +92,8 @@ class Drift:
         object.__setattr__(self, "_factors", factors)
         try:
             # True was read as episode 1 (second trial); a masked array's masked entry was NumPy's MaskError (T16-13)
-            if isinstance(self.change_at, np.ma.MaskedArray) or not all(isinstance(x, numbers.Real) and not isinstance(x, bool) for x in self.change_at):
+            # finite_real: np.timedelta64(4) was read as episode 4, inf was int()'s OverflowError (T17-1)
+            if isinstance(self.change_at, np.ma.MaskedArray) or not all(finite_real(x) for x in self.change_at):
                 raise TypeError
             lo, hi = (int(x) for x in self.change_at)
         except (TypeError, ValueError):

@@ -33,7 +33,6 @@ entry's noise is about the size of the baseline policy's typical hovering error 
 
 from __future__ import annotations
 
-import math
 import numbers
 import re
 from dataclasses import asdict, dataclass, fields, replace
@@ -67,9 +66,9 @@ class Sensor:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, numbers.Real):  # NumPy's numbers are Real too
                 raise NeurohoverError(f"sensor {name}={value!r} is not a number: allowed a finite number >= 0")
+            if not finite_real(value) or value < 0:  # np.timedelta64 was float()'s TypeError (T17-1), 10**400 an OverflowError
+                raise NeurohoverError(f"sensor {name}={brief(value)} is out of range: allowed a finite number >= 0")
             number = float(value)
-            if not math.isfinite(number) or number < 0:
-                raise NeurohoverError(f"sensor {name}={value!r} is out of range: allowed a finite number >= 0")
             if name != "correlation" and number > MAX_STD:
                 raise NeurohoverError(f"sensor {name}={value!r} is out of range: allowed a std in 0..{MAX_STD:g}")
             object.__setattr__(self, name, number)
@@ -78,14 +77,14 @@ class Sensor:
         if self.correlation > 0 and not any(getattr(self, name) for name in SENSOR_GROUPS):  # it did nothing (fifth trial)
             raise NeurohoverError(f"sensor correlation={self.correlation!r} applies to noise: give a level or the stds beside it")
         p = self.dropout
-        if isinstance(p, bool) or not isinstance(p, numbers.Real) or not 0 <= p < 1:  # NaN fails the comparison too
-            raise NeurohoverError(f"sensor dropout={p!r} is out of range: allowed a probability 0 <= dropout < 1")
+        if not finite_real(p) or not 0 <= p < 1:  # NaN fails the comparison too; np.timedelta64 is no number (T17-1)
+            raise NeurohoverError(f"sensor dropout={brief(p)} is out of range: allowed a probability 0 <= dropout < 1")
         object.__setattr__(self, "dropout", float(p))
         d = self.delay
         if whole_number(d):
             object.__setattr__(self, "delay", d := int(d))  # a NumPy integer as the int it is
         if isinstance(d, bool) or not isinstance(d, int) or not 0 <= d <= MAX_SENSOR_DELAY:
-            raise NeurohoverError(f"sensor delay={d!r} is out of range: allowed an integer number of control steps in 0..{MAX_SENSOR_DELAY}")
+            raise NeurohoverError(f"sensor delay={brief(d)} is out of range: allowed an integer number of control steps in 0..{MAX_SENSOR_DELAY}")
 
     @property
     def exact(self) -> bool:
