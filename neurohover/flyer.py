@@ -67,7 +67,7 @@ class KernelFlyer:
             raise NeurohoverError(f"unknown policy topology {topology!r}: allowed {', '.join(TOPOLOGIES)}")
         if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= MAX_SEED:
             raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer in 0..2**63-1")
-        if isinstance(n_steps, bool) or not isinstance(n_steps, (int, np.integer)) or not 1 <= n_steps <= MAX_EPISODE_STEPS:
+        if not whole_number(n_steps) or not 1 <= n_steps <= MAX_EPISODE_STEPS:  # np.timedelta64 is a np.integer (T17-1)
             raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
         self.kind = KIND[topology]
         self.dim = GENOME_LENGTH[topology]

@@ -187,6 +187,8 @@ class Batch:
             raise NeurohoverError(f"n_steps={brief(self.n_steps)} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
         if not whole_number(self.seed) or not 0 <= self.seed <= MAX_SEED:
             raise NeurohoverError(f"seed={brief(self.seed)} is out of range: allowed an integer in 0..2**63-1")
+        # the kernel compiles once per argument type: np.uint16(5) steps compiled it again, 30-50 s (eighteenth trial, T18-1)
+        object.__setattr__(self, "n_steps", int(self.n_steps))  # (the seed goes to the kernel as np.uint64 always: jobs())
         kinds = self.kinds
         if kinds.shape[0] != self.genomes.shape[0]:
             raise NeurohoverError(f"Batch.kinds has {kinds.shape[0]} entries but genomes {self.genomes.shape[0]} rows: give one kind per genome")

@@ -13,7 +13,7 @@ import pytest
 from neurohover.errors import NeurohoverError
 
 
-@pytest.mark.parametrize("value", ["0", "-3", "abc", "", "٣"])
+@pytest.mark.parametrize("value", ["0", "-3", "abc", "", "٣", "99999"])  # 99999: numba's SIGSEGV without a word (T18-2)
 def test_numba_threads_of_the_environment_that_numba_cannot_take_are_named(value: str, tmp_path: Path) -> None:
     """T1: NUMBA_NUM_THREADS=0 was numba's traceback from every command, --help too; 'abc' its warning, then its default."""
     env = {**os.environ, "NUMBA_NUM_THREADS": value}
@@ -21,12 +21,12 @@ def test_numba_threads_of_the_environment_that_numba_cannot_take_are_named(value
     assert proc.returncode == 2 and proc.stdout == "", proc.stderr
     assert (
         proc.stderr
-        == f"neurohover: error: environment variable NUMBA_NUM_THREADS={value!r} is not allowed: give a whole number >= 1 (numba's threads), or unset it\n"
+        == f"neurohover: error: environment variable NUMBA_NUM_THREADS={value!r} is not allowed: give a whole number in 1..4096 (numba's threads), or unset it\n"
     )
     code = "import neurohover"
     proc = subprocess.run([sys.executable, "-c", code], env=env, cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 1 and proc.stderr.strip().endswith(
-        f"NeurohoverError: environment variable NUMBA_NUM_THREADS={value!r} is not allowed: give a whole number >= 1 (numba's threads), or unset it"
+        f"NeurohoverError: environment variable NUMBA_NUM_THREADS={value!r} is not allowed: give a whole number in 1..4096 (numba's threads), or unset it"
     )
 
 
