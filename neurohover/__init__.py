@@ -33,12 +33,11 @@ if running_as_command():
 
 from .errors import NeurohoverError  # noqa: E402
 
-
 #: The most threads NUMBA_NUM_THREADS may ask for: 4096 ran, 99999 killed the process without a word (SIGSEGV, T18-2).
 MAX_NUMBA_THREADS = 4096
 
 
-def _whole_at_least_1(value: str) -> bool:
+def _thread_count(value: str) -> bool:
     return value.strip().isascii() and value.strip().isdigit() and 1 <= int(value) <= MAX_NUMBA_THREADS
 
 
@@ -55,7 +54,7 @@ _LAYER_POOLS = {"tbb": ("tbbpool",), "safe": ("tbbpool",), "omp": ("omppool",), 
 #: value numba cannot parse was its warning with a traceback, then its default (tenth trial: NUMBA_NUM_THREADS; eleventh:
 #: CUDASIM; sixteenth, T16-3: DISABLE_JIT, OPT, BOUNDSCHECK), or its traceback at the first flight (T16-2: THREADING_LAYER).
 _NUMBA_VARIABLES = {
-    "NUMBA_NUM_THREADS": (_whole_at_least_1, f"give a whole number in 1..{MAX_NUMBA_THREADS} (numba's threads), or unset it"),
+    "NUMBA_NUM_THREADS": (_thread_count, f"give a whole number in 1..{MAX_NUMBA_THREADS} (numba's threads), or unset it"),
     "NUMBA_ENABLE_CUDASIM": (_zero_or_one, "give 0 or 1 (1: numba's CUDA simulator stands in for a GPU), or unset it"),
     "NUMBA_DISABLE_JIT": (_zero_or_one, "give 0 or 1 (1: the kernels run as plain Python, very slowly), or unset it"),
     "NUMBA_BOUNDSCHECK": (_zero_or_one, "give 0 or 1 (1: every array index is checked), or unset it"),
