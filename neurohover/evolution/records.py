@@ -12,10 +12,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..paths import JSONError, strict_json
 from ..policies import Policy
-from .common import dec_float, enc_float, read_count, read_seconds
+from .common import EntryError, dec_float, enc_float, read_count, read_seconds
 
 __all__ = [
     "CHECKPOINT_FORMAT",
@@ -197,10 +197,27 @@ def encode_history(history) -> list[list]:
     return [[h.generation, h.evaluations, h.episodes, h.generation_episodes, enc_float(h.champion_return), h.wall_seconds] for h in history]
 
 
+#: How each cell of a checkpoint's history row is read back, in :data:`HISTORY_COLUMNS` order.
+_HISTORY_READERS = (read_count, read_count, read_count, read_count, dec_float, read_seconds)
+
+
 def decode_history(rows) -> list[HistoryRecord]:
-    """The records :func:`encode_history` encoded."""
-    # each count and number checked: True was read as 1 and '1.5' as 1.5 (sixteenth trial)
-    return [HistoryRecord(read_count(g), read_count(e), read_count(ep), read_count(gep), dec_float(r), read_seconds(w)) for g, e, ep, gep, r, w in rows]
+    """The records :func:`encode_history` encoded; an :class:`~neurohover.evolution.common.EntryError` naming the row,
+    its column and value for a damaged one (a bare "too many values to unpack" named neither; T18-6)."""
+    if not isinstance(rows, list):
+        raise EntryError(f"history is {brief(rows)}: allowed a list of rows of {', '.join(HISTORY_COLUMNS)}")
+    records = []
+    for n, row in enumerate(rows):
+        if not isinstance(row, list) or len(row) != len(HISTORY_COLUMNS):
+            raise EntryError(f"history row {n} (from 0) is {brief(row)}: allowed a list of {len(HISTORY_COLUMNS)} values, {', '.join(HISTORY_COLUMNS)}")
+        cells: list = []
+        for column, read, value in zip(HISTORY_COLUMNS, _HISTORY_READERS, row):
+            try:  # each count and number checked: True was read as 1 and '1.5' as 1.5 (sixteenth trial)
+                cells.append(read(value))
+            except (TypeError, ValueError) as err:
+                raise EntryError(f"history row {n} (from 0): {column}={brief(value)} is not allowed ({err})") from None
+        records.append(HistoryRecord(*cells))
+    return records
 
 
 def write_checkpoint(path: Path, state: dict) -> None:

@@ -27,6 +27,7 @@ from ..common import (
     TellInfo,
     check_entries,
     check_prototype,
+    check_state,
     read_entry,
     require_int,
     require_population,
@@ -200,7 +201,7 @@ class CMAES(PopulationOptimiser):
         form), base64-encoded, with the private generator's draws reconnected on load."""
         buf = io.BytesIO()
         _Pickler(buf, self._es.opts["randn"]).dump(self)
-        return {"type": "CMAES", "pickle": base64.b64encode(buf.getvalue()).decode("ascii")}
+        return {"type": type(self).__name__, "version": common.STATE_VERSION, "pickle": base64.b64encode(buf.getvalue()).decode("ascii")}
 
     @classmethod
     def from_state_dict(cls, state: dict[str, Any]) -> CMAES:
@@ -215,7 +216,11 @@ class CMAES(PopulationOptimiser):
         kind = cls.__name__
         if not isinstance(state, dict):
             raise NeurohoverError(f"state dict is a {type(state).__name__}, not a dict")
-        check_entries(state, kind, ("type", "pickle"))
+        # its type checked as the others' are: 'SteadyStateNE', None or no type was taken (T18-5); states written
+        # before 2026-12-06 have no version, and a UHCMAES one then said 'CMAES'
+        legacy = kind != "CMAES" and isinstance(state.get("type"), str) and state["type"] == "CMAES"
+        check_state({"version": common.STATE_VERSION, **state, **({"type": kind} if legacy else {})}, kind)
+        check_entries(state, kind, ("type", "version", "pickle"))
         holder: list = [None]
 
         def unpickle(text: str) -> CMAES:
