@@ -245,10 +245,10 @@ def test_a_state_version_of_true_is_not_version_1(name: str) -> None:
 @pytest.mark.parametrize(
     ("state", "fragment"),
     [
-        ({}, r"CMAES state dict has no 'pickle' entry: give a dict that CMAES\.state_dict\(\) returned"),
-        ({"pickle": "x"}, r"CMAES state dict's 'pickle' entry 'x' is damaged \(not base64 text: allowed the text state_dict\(\) wrote\)"),
-        ({"pickle": "AAAA"}, r"CMAES state dict's 'pickle' entry 'AAAA' is damaged \(UnpicklingError: "),
-        ({"pickle": 5}, r"CMAES state dict's 'pickle' entry 5 is damaged \(TypeError: "),
+        ({"type": "CMAES"}, r"CMAES state dict has no 'pickle' entry: give a dict that CMAES\.state_dict\(\) returned"),
+        ({"type": "CMAES", "pickle": "x"}, r"CMAES state dict's 'pickle' entry 'x' is damaged \(not base64 text: allowed the text state_dict\(\) wrote\)"),
+        ({"type": "CMAES", "pickle": "AAAA"}, r"CMAES state dict's 'pickle' entry 'AAAA' is damaged \(UnpicklingError: "),
+        ({"type": "CMAES", "pickle": 5}, r"CMAES state dict's 'pickle' entry 5 is damaged \(TypeError: "),
         ("x", r"state dict is a str, not a dict"),
     ],
 )
