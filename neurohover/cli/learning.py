@@ -62,12 +62,13 @@ def _seed_policy(args: argparse.Namespace):
 
     if args.seed_policy in ("zero", "baseline"):
         return args.topology, args.seed_policy  # None: evolve's default (SLP over a family, MLP on one MDP)
-    from ..paths import checked_path
+    from ..paths import checked_path, input_file
 
     path = checked_path(args.seed_policy, "--seed-policy", "policy file (or zero, baseline)") if args.seed_policy else Path("")
-    if not path.is_file():
+    if args.seed_policy == "" or path.is_dir() or not path.exists():
         what = "is empty" if args.seed_policy == "" else ("is a directory" if path.is_dir() else "no such file")
         raise NeurohoverError(f"--seed-policy {args.seed_policy!r}: {what} (give zero, baseline or a policy file)")
+    path = input_file(path, "--seed-policy", "policy file (or zero, baseline)")  # a FIFO was 'no such file', as fly --policy (T18-7)
     policy = load_policy(path)
     if args.topology is not None and args.topology != policy.topology:
         raise NeurohoverError(f"--seed-policy {args.seed_policy!r} is an {policy.topology} policy but --topology is {args.topology}")

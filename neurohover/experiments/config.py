@@ -254,8 +254,8 @@ def parse_overrides(texts: list[str] | None, option: str = "--set") -> dict[str,
 
 def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None = None) -> ExperimentConfig:
     """Load, resolve and validate an experiment config at ``scale`` (``quick`` or ``paper``)."""
-    if scale not in SCALES:
-        raise NeurohoverError(f"unknown scale {scale!r}: allowed {', '.join(SCALES)}")
+    if not isinstance(scale, str) or scale not in SCALES:  # an array was numpy's 'truth value is ambiguous' (T18-3)
+        raise NeurohoverError(f"unknown scale {brief(scale)}: allowed {', '.join(SCALES)}")
     if overrides is not None and not (isinstance(overrides, dict) and all(isinstance(k, str) for k in overrides)):  # a TypeError (fourth trial)
         raise NeurohoverError(f"overrides={overrides!r:.60} is not allowed: give a dict of settings, e.g. {{'episodes': 3}} (the CLI's --set episodes=3)")
     path = resolve_name(name_or_path)
@@ -351,7 +351,7 @@ def check_name(name, where: str) -> None:
 def check_scale(scale, where: str) -> None:
     """Refuse a scale no experiment has: quick, paper, or a compete run's settings-HASH (:func:`settings_scale`); 'weird'
     was stored (twelfth trial, S7). Shared by :func:`make_config` and the store's writes."""
-    if scale not in SCALES and not (isinstance(scale, str) and _COMPETE_SCALE.fullmatch(scale)):
+    if not isinstance(scale, str) or (scale not in SCALES and not _COMPETE_SCALE.fullmatch(scale)):
         raise NeurohoverError(f"{where}: scale = {brief(scale)} is not allowed: give one of {', '.join(SCALES)} (or a compete run's settings-HASH)")
 
 
@@ -483,8 +483,8 @@ def make_config(
     """
     where = where or f"experiment {name!r}"
     check_name(name, where)
-    if kind not in KINDS:
-        raise NeurohoverError(f"{where}: kind = {kind!r} is not allowed: expected one of {', '.join(KINDS)}")
+    if not isinstance(kind, str) or kind not in KINDS:  # an array was numpy's 'truth value is ambiguous' (T18-3)
+        raise NeurohoverError(f"{where}: kind = {brief(kind)} is not allowed: expected one of {', '.join(KINDS)}")
     check_scale(scale, where)
     for key, text in (("title", title), ("paper_ref", paper_ref), ("source", source)):  # title=5 was later called a damaged store (twelfth trial, U2)
         if not isinstance(text, str):

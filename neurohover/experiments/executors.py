@@ -205,8 +205,8 @@ class RayExecutor:
     name = "ray"
 
     def __init__(self, address: str | None = None, *, max_retries: int = 3, num_cpus: int | None = None, device: str = "cpu") -> None:
-        if device not in DEVICES:
-            raise NeurohoverError(f"device={device!r} is unknown: allowed 'cpu' or 'cuda'")
+        if not isinstance(device, str) or device not in DEVICES:  # an array was numpy's 'truth value is ambiguous' (T18-3)
+            raise NeurohoverError(f"device={brief(device)} is unknown: allowed 'cpu' or 'cuda'")
         if address is not None:  # its form before Ray is imported or started (address=5 was an AttributeError; T14-22)
             ray_endpoint(address)
         self.device = device
@@ -263,10 +263,12 @@ class RayExecutor:
 
 
 def make_executor(kind: str, *, jobs: int = 1, address: str | None = None, device: str = "cpu"):
+    if not isinstance(kind, str):  # an array was numpy's 'truth value is ambiguous' (T18-3)
+        raise NeurohoverError(f"unknown executor {brief(kind)}: allowed local, ray")
     if kind == "local":
         if address is not None:
             raise NeurohoverError("--address applies to --executor ray only")
         return LocalExecutor(jobs, device)
     if kind == "ray":
         return RayExecutor(address, device=device)
-    raise NeurohoverError(f"unknown executor {kind!r}: allowed local, ray")
+    raise NeurohoverError(f"unknown executor {brief(kind)}: allowed local, ray")

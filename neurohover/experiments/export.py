@@ -17,7 +17,7 @@ import csv
 import io
 import json
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from .config import ExperimentConfig
 from .keys import UnitKey
 from .results import flat_cells, result_from_dict
@@ -35,6 +35,8 @@ def resolve_scale(store: Store, name: str, scale: str | None) -> str:
         if len(scales) > 1:
             raise NeurohoverError(f"experiment {name!r} is in the store at scales {', '.join(scales)}: choose one with --scale (e.g. --scale {scales[-1]})")
         return scales[0]
+    if not isinstance(scale, str):  # an array was numpy's 'truth value is ambiguous' (T18-3)
+        raise NeurohoverError(f"scale={brief(scale)} is not allowed: give one of {', '.join(scales)}")
     if scale not in scales:
         raise NeurohoverError(store.missing_message(name, scale))
     return scale
@@ -44,8 +46,8 @@ def export_results(store: Store, name: str, fmt: str = "csv", scale: str | None 
     """The finished units of ``name`` as CSV (one row per unit, one plain value per cell) or JSON (everything)."""
     if not isinstance(store, Store):  # a path was an AttributeError (seventh trial)
         raise NeurohoverError(f"store={store!r:.60} is not allowed: give a Store(PATH)")
-    if fmt not in FORMATS:
-        raise NeurohoverError(f"unknown format {fmt!r}: allowed {', '.join(FORMATS)}")
+    if not isinstance(fmt, str) or fmt not in FORMATS:  # an array was numpy's 'truth value is ambiguous' (T18-3)
+        raise NeurohoverError(f"unknown format {brief(fmt)}: allowed {', '.join(FORMATS)}")
     scale = resolve_scale(store, name, scale)
     units = store.units(name, scale)
     if not units:  # it printed an empty line (seventh trial)

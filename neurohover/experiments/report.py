@@ -517,6 +517,8 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
     # 'fig2' was read as f, i, g, 2; 5 (any number, np.ma.masked) was a TypeError (seventeenth trial, T17-5)
     if names is not None and (not isinstance(names, (list, tuple)) or not all(isinstance(n, str) for n in names)):
         raise NeurohoverError(f"names={brief(names)} is not allowed: give a list of experiment names, e.g. ['fig2']")
+    if scale is not None and not isinstance(scale, str):  # an array was numpy's 'truth value is ambiguous' (T18-3)
+        raise NeurohoverError(f"scale={brief(scale)} is not allowed: give a scale's name, e.g. 'quick', or None for all")
     if names is not None and not list(names):  # [] was read as None and reported every experiment (thirteenth trial, F21)
         raise NeurohoverError(f"names={brief(names)} is not allowed: give one or more experiment names, or None for all")
     given = list(names or ())

@@ -148,8 +148,8 @@ def learn_ec_meno(flight_data: FlightData, *, budget: int | None = None, seed: i
     the simulator's parameters (:mod:`neurohover.models.lr`, estimator), and has no D_u.
     """
     start = time.perf_counter()
-    if scaling not in EC_MENO_SCALINGS:
-        raise NeurohoverError(f"scaling={scaling!r} is not allowed: choose one of {', '.join(EC_MENO_SCALINGS)}")
+    if not isinstance(scaling, str) or scaling not in EC_MENO_SCALINGS:  # an array was numpy's 'truth value is ambiguous' (T18-3)
+        raise NeurohoverError(f"scaling={brief(scaling)} is not allowed: choose one of {', '.join(EC_MENO_SCALINGS)}")
     problem = OneStepProblem(flight_data)
     proto_params = _prototype_params(prototype)
     scale = ec_meno_gene_scale(problem, proto_params) if scaling == "data" else _GENE_SCALE

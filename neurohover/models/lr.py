@@ -62,7 +62,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..flightdata import FlightData
 from ..sim.constants import NOISE_DECAY, NOISE_NAMES, PARAM_NAMES
 from .model import LearnedModel, one_substep_params
@@ -126,8 +126,8 @@ def lr_determined(flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS,
 def _check_options(**options: tuple[str, Sequence[str]]) -> None:
     """Refuse an option whose value is not one of its allowed ones: ``name=(value, allowed)``."""
     for name, (value, allowed) in options.items():
-        if value not in allowed:
-            raise NeurohoverError(f"{name}={value!r} is not allowed: choose one of {', '.join(allowed)}")
+        if not isinstance(value, str) or value not in allowed:  # an array was numpy's 'truth value is ambiguous' (T18-3)
+            raise NeurohoverError(f"{name}={brief(value)} is not allowed: choose one of {', '.join(allowed)}")
 
 
 def _fit_axes(tr: Transitions, intercepts: str, estimator: str) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
