@@ -34,6 +34,15 @@ n_steps = 30
 """
 
 
+def _save_unchecked(path, obs, act, meta: dict) -> None:
+    """A flight-data file with ``meta`` as it is: FlightData refuses such metadata when made (T18-4), load() must too."""
+    from neurohover.flightdata import FORMAT
+
+    lengths = np.array([a.shape[0] for a in act], dtype=np.int64)
+    arrays = {"lengths": lengths, "observations": np.concatenate(obs), "actions": np.concatenate(act)}
+    np.savez_compressed(path, format=np.array(FORMAT), metadata=np.array(json.dumps(meta)), **arrays)
+
+
 def _config(tmp_path: Path, extra: str = "", tail: str = "") -> Path:
     path = tmp_path / "my.toml"
     path.write_text(TINY.format(extra=extra) + tail)
@@ -225,7 +234,9 @@ def test_flight_data_metadata_of_the_wrong_kind_and_overflowing_lengths_are_name
         ({"crashed": [True, False]}, "crashed=.* is not allowed"),
     ):
         path = tmp_path / "bad.npz"
-        FlightData((obs,), (act,), meta).save(path)
+        with pytest.raises(NeurohoverError, match=message):  # refused when made too (T18-4)
+            FlightData((obs,), (act,), meta)
+        _save_unchecked(path, (obs,), (act,), meta)
         with pytest.raises(NeurohoverError, match=message):
             FlightData.load(path)
         rc, _, err = cli("plot", str(path), "--out", str(tmp_path / "p"))

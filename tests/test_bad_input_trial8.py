@@ -7,7 +7,7 @@ from pathlib import Path
 
 import gymnasium as gym
 import pytest
-from test_bad_input_trial7 import _config, _damaged, tiny_store  # noqa: F401  (tiny_store: the fixture)
+from test_bad_input_trial7 import _config, _damaged, _save_unchecked, tiny_store  # noqa: F401  (tiny_store: the fixture)
 
 import neurohover as nh
 from neurohover.errors import NeurohoverError, finite_real, float_of
@@ -185,7 +185,9 @@ def test_flight_data_metadata_that_titles_and_model_checks_read_is_checked(meta,
 
     from neurohover.flightdata import FlightData
 
-    FlightData((np.zeros((3, 12)),), (np.zeros((2, 4)),), meta).save(tmp_path / "f.npz")
+    with pytest.raises(NeurohoverError, match=message):  # refused when made too (T18-4)
+        FlightData((np.zeros((3, 12)),), (np.zeros((2, 4)),), meta)
+    _save_unchecked(tmp_path / "f.npz", (np.zeros((3, 12)),), (np.zeros((2, 4)),), meta)
     with pytest.raises(NeurohoverError, match=message):
         FlightData.load(tmp_path / "f.npz")
 

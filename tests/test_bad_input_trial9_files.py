@@ -209,7 +209,7 @@ def test_joined_flight_data_keeps_metadata_its_episodes_fit(flight, tmp_path) ->
     assert both.metadata["episode_steps"] == 40 and "task" not in both.metadata and both.metadata["returns"] == [-1.0, -2.0, 0.5]
     both.save(tmp_path / "both.npz")
     assert nh.FlightData.load(tmp_path / "both.npz").metadata["mdps"][2] == {}
-    short = nh.FlightData(a.observations, a.actions, {"episode_steps": 5})
+    short = nh.FlightData((a.observations[0][:6],), (a.actions[0][:5],), {"episode_steps": 5})  # 5 steps: within its budget (T18-4)
     assert (a + short).metadata["episode_steps"] == 30
 
 
