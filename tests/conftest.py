@@ -84,6 +84,18 @@ def committed_store(tmp_path_factory) -> Path:
     return path
 
 
+@pytest.fixture(scope="session")
+def tiny_checkpoint(tmp_path_factory) -> Path:
+    """A sound checkpoint of a 5-episode steady-state run on GHH-08's zero MDP (slp from the baseline, seed 3, 20 steps):
+    tests read it and damage a copy (they must not write it)."""
+    from neurohover.evolution.evolve import evolve
+    from neurohover.tasks import get_task_family
+
+    ckpt = tmp_path_factory.mktemp("tiny-checkpoint") / "run.ckpt.json"
+    evolve(get_task_family("ghh08").zero(), budget=5, checkpoint=ckpt, topology="slp", prototype="baseline", seed=3, n_steps=20)
+    return ckpt
+
+
 @pytest.fixture
 def cli(capsys) -> CliRun:
     """``neurohover ARGS...`` run in this process: returns (exit status, stdout, stderr)."""

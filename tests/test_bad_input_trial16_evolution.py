@@ -127,15 +127,6 @@ def test_non_finite_values_of_a_state_still_read_back() -> None:
 # --------------------------------------------------------------------------- T16-16: a checkpoint's own entries
 
 
-@pytest.fixture(scope="module")
-def checkpoint(tmp_path_factory) -> Path:
-    from neurohover.evolution.evolve import evolve
-
-    ckpt = tmp_path_factory.mktemp("t16") / "run.ckpt.json"
-    evolve(GHH08.zero(), budget=5, checkpoint=ckpt, topology="slp", prototype="baseline", seed=3, n_steps=20)
-    return ckpt
-
-
 @pytest.mark.parametrize(
     ("edit", "fragment"),
     [
@@ -150,13 +141,13 @@ def checkpoint(tmp_path_factory) -> Path:
         (lambda c: c["history"][0].__setitem__(0, True), "not a count: allowed an integer >= 0"),
     ],
 )
-def test_a_checkpoints_entries_are_checked_on_resume(checkpoint: Path, tmp_path: Path, edit, fragment: str) -> None:
+def test_a_checkpoints_entries_are_checked_on_resume(tiny_checkpoint: Path, tmp_path: Path, edit, fragment: str) -> None:
     """T16-16: evolve(..., resume=True) took a checkpoint with an unknown top-level entry or counter, a budget of '100',
     an mdp_stream of 'x' and a stop_reason of 5; now each is refused by name."""
     from neurohover.evolution.evolve import evolve
 
     common = dict(topology="slp", prototype="baseline", seed=3, n_steps=20)
-    state = json.loads(checkpoint.read_text())
+    state = json.loads(tiny_checkpoint.read_text())
     ckpt = tmp_path / "run.ckpt.json"
     ckpt.write_text(json.dumps(state))
     flown = state["counters"]["episodes"]  # resumed with it as the budget, the run stops at once

@@ -75,13 +75,6 @@ def test_a_uhcmaes_state_keeps_its_type() -> None:
 # --------------------------------------------------------------------------- T18-6: damaged history rows
 
 
-@pytest.fixture(scope="module")
-def checkpoint(tmp_path_factory) -> Path:
-    ckpt = tmp_path_factory.mktemp("t18") / "run.ckpt.json"
-    evolve(GHH08.zero(), budget=5, checkpoint=ckpt, topology="slp", prototype="baseline", seed=3, n_steps=20)
-    return ckpt
-
-
 @pytest.mark.parametrize(
     ("edit", "fragment"),
     [
@@ -93,11 +86,11 @@ def checkpoint(tmp_path_factory) -> Path:
         (lambda h: h.__setitem__(0, {"a": 1}), "history row 0 (from 0) is {'a': 1}: allowed a list of 6 values"),
     ],
 )
-def test_a_damaged_history_row_is_named(checkpoint: Path, tmp_path: Path, edit, fragment: str) -> None:
+def test_a_damaged_history_row_is_named(tiny_checkpoint: Path, tmp_path: Path, edit, fragment: str) -> None:
     """T18-6: a history row of seven values said only 'ValueError: too many values to unpack (expected 6)', and one of
     'a's only 'not a count': neither named the history table, the row or the value; now each does."""
     common = dict(topology="slp", prototype="baseline", seed=3, n_steps=20)
-    state = json.loads(checkpoint.read_text())
+    state = json.loads(tiny_checkpoint.read_text())
     assert state["history"]
     ckpt = tmp_path / "run.ckpt.json"
     ckpt.write_text(json.dumps(state))
