@@ -33,10 +33,16 @@ def whole_number(value: object) -> TypeGuard[int]:
 _TIMES = ("timedelta64", "datetime64")
 
 
+def real_number(value: object) -> TypeGuard[float]:
+    """Whether ``value`` is a real number, NumPy's included: not a bool (True is an int) nor a NumPy time (an Integral
+    whose float() and int() raise, T17-1). The one test of a number argument; :func:`finite_real` adds finiteness."""
+    return isinstance(value, numbers.Real) and not isinstance(value, bool) and type(value).__name__ not in _TIMES
+
+
 def finite_real(value: object) -> bool:
     """Whether ``value`` is a real number (not a bool) that a float holds finitely: an int past a float's range (10**400)
     is not (``math.isfinite`` raised OverflowError on it; eighth trial)."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or type(value).__name__ in _TIMES:
+    if not real_number(value):
         return False
     try:
         return math.isfinite(value)

@@ -18,7 +18,6 @@ and ``tell()``.
 from __future__ import annotations
 
 import math
-import numbers
 import pickle
 import time
 from collections.abc import Callable
@@ -27,7 +26,7 @@ from typing import Any, Protocol, TypeVar, overload
 
 import numpy as np
 
-from ..errors import NeurohoverError, as_floats, brief, finite_real, whole_number
+from ..errors import NeurohoverError, as_floats, brief, finite_real, real_number, whole_number
 
 __all__ = [
     "STATE_DAMAGE",
@@ -296,7 +295,7 @@ def dec_float(value: Any) -> float:
         if value in _NON_FINITE:
             return _NON_FINITE[value]
         raise ValueError(f"could not convert string to float: {brief(value)} (a stored number is no text, but for 'nan', 'inf', '-inf')")
-    if isinstance(value, (bool, np.timedelta64)) or not isinstance(value, numbers.Real):  # a time span is Real to numbers (T17-1)
+    if not real_number(value):  # a bool, or a time span (Real to numbers, T17-1)
         raise EntryError(f"{brief(value)} is no number: allowed {_STORED}")
     return float(value)
 
@@ -316,7 +315,7 @@ def dec_array(d: dict[str, Any] | None, name: str = "array") -> np.ndarray | Non
     data, shape = d["data"], [read_count(n) for n in d["shape"]]
     values = [_NON_FINITE.get(v, v) if isinstance(v, str) else v for v in data]
     for v in values:
-        if type(v) is not float and type(v) is not int and (isinstance(v, (bool, np.timedelta64)) or not isinstance(v, numbers.Real)):
+        if type(v) is not float and type(v) is not int and not real_number(v):
             as_floats(v, f"{name} data entry", _STORED)  # text, a bool, None: named as every array of real numbers is
             raise EntryError(f"{name} data entry {brief(v)} is no number: allowed {_STORED}")  # a list in the list
     return as_floats(values, f"{name} data", _STORED).reshape(shape)
