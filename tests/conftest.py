@@ -35,6 +35,16 @@ def tiny_test_runs(*agents: str, name: str = "tr1", settings: str = "") -> str:
     )
 
 
+def tiny_model_learning(name: str, generic: str) -> str:
+    """A model-learning config (TOML) learning LR on one GHH-08 test MDP, 20 steps and budgets of 10 at the quick scale,
+    its generic policy ``generic`` ("baseline", or "evolve": its own policy/ units first)."""
+    return (
+        f'name = "{name}"\nkind = "model_learning"\n\n[settings]\ntask = "ghh08"\nseed = 1\nmdps = "test"\nmethods = ["lr"]\n'
+        f'generic = "{generic}"\npolicy_prototype = "generic"\ntest_episodes = 1\n\n[scales.quick]\nn_mdps = 1\nn_steps = 20\n'
+        "generic_budget = 10\nmodel_budget = 10\nec_meno_budget = 10\npolicy_budget = 10\n"
+    )
+
+
 #: A ``reproduce`` whose plan is twelve diagnostic units (argv: GATES EXPERIMENT reproduce ...): unit i waits
 #: until the file GATES/i exists, so a test, not the machine's speed, decides how far the run gets.
 GATED_RUN = """

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import tiny_model_learning
 
 from neurohover.errors import NeurohoverError
 from neurohover.experiments import Store, reproduce, run_unit, unit_seed
@@ -16,28 +17,7 @@ from neurohover.experiments.executors import LocalExecutor
 
 SETTINGS = dict(task="ghh08", seed=1, policies="shipped", episodes=2, n_steps=20, groups=[dict(agent="baseline", mdps="test", n_mdps=1)])
 
-ML_CONFIG = """name = "ml1"
-kind = "model_learning"
-
-[settings]
-task = "ghh08"
-seed = 1
-mdps = "test"
-methods = ["lr"]
-generic = "baseline"
-policy_prototype = "generic"
-test_episodes = 1
-
-[scales.quick]
-n_mdps = 1
-n_steps = 20
-generic_budget = 10
-model_budget = 10
-ec_meno_budget = 10
-policy_budget = 10
-
-[paper]
-"""
+ML_CONFIG = tiny_model_learning("ml1", "baseline") + "\n[paper]\n"
 
 
 @pytest.mark.parametrize(

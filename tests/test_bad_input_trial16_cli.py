@@ -13,6 +13,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from conftest import tiny_model_learning
 
 import neurohover
 from neurohover.errors import NeurohoverError
@@ -164,26 +165,7 @@ def test_a_policy_file_that_is_no_file_is_named(tmp_path: Path, damage: str) -> 
         load_policy_set("ghh08", tmp_path)
 
 
-ML_CONFIG = """name = "ml16"
-kind = "model_learning"
-
-[settings]
-task = "ghh08"
-seed = 1
-mdps = "test"
-methods = ["lr"]
-generic = "evolve"
-policy_prototype = "generic"
-test_episodes = 1
-
-[scales.quick]
-n_mdps = 1
-n_steps = 20
-generic_budget = 10
-model_budget = 10
-ec_meno_budget = 10
-policy_budget = 10
-"""
+ML_CONFIG = tiny_model_learning("ml16", "evolve")
 
 
 class _UnitRan(Exception):
