@@ -160,6 +160,7 @@ class FlightData:
             raise NeurohoverError("flight data to save needs a dict of metadata and at least one step flown (load() refuses any other file)")
         path = output_file(path, "flight-data file")  # refuses '', a directory and a device (/dev/null was a struct.error)
         lengths = np.array([a.shape[0] for a in self.actions], dtype=np.int64)
+        check_metadata(self.metadata, lengths, "flight data")  # metadata changed after making (episode_steps -5) was written, then refused by load()
         largest = float(np.finfo(dtype).max)
         for name in ("observations", "actions"):  # 1e300 was written as float32's inf, without a word (fifteenth trial, T15-29)
             big = max((float(np.abs(a[np.isfinite(a)]).max(initial=0.0)) for a in getattr(self, name)), default=0.0)

@@ -83,6 +83,16 @@ def test_flight_data_metadata_checked_when_made(metadata: dict, message: str, tm
     assert FlightData.load(tmp_path / "f.npz").metadata["crashed"] == [False]
 
 
+def test_flight_data_metadata_changed_after_making_is_refused_by_save(tmp_path: Path) -> None:
+    """T18-4 follow-up: metadata is a dict, changeable after the check when made; save() wrote episode_steps -5 and load()
+    refused the file. Now save() checks it again and writes nothing."""
+    flight = _flight({"episode_steps": 20})
+    flight.metadata["episode_steps"] = -5
+    with pytest.raises(NeurohoverError, match=re.escape("flight data: its metadata episode_steps=-5 is not allowed")):
+        flight.save(tmp_path / "f.npz")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_seed_policy_fifo_is_no_regular_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """T18-7: ``evolve --seed-policy FIFO`` said "no such file" of a FIFO that exists; now, as ``fly --policy``, "is not a
     regular file" (and a missing file is still "no such file")."""
