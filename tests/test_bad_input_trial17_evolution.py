@@ -95,6 +95,15 @@ def test_resampling_checks_its_fields(fields: dict, fragment: str) -> None:
         parse_resampling("fixed:0")
 
 
+@pytest.mark.parametrize("spec", ["race:" + "9" * 5000, "x" * 5000, "race:0.5:" + "q" * 5000, "\u0661" * 5000])
+def test_resampling_refusal_shortens_a_long_spec(spec: str) -> None:
+    """A 5,000-character resampling spec was echoed whole (twice for a bad rule): now shortened as every echoed value is
+    (errors.brief), with its length named."""
+    with pytest.raises(NeurohoverError) as refused:
+        parse_resampling(spec)
+    assert len(str(refused.value)) < 700 and "(5,0" in str(refused.value)
+
+
 # --------------------------------------------------------------------------- T17-3, T17-4: caps on sizes and halvings
 
 

@@ -146,7 +146,7 @@ def _resampling_of(spec: Any, reason: str, allowed: str, *fields: Any, **named: 
     try:
         return Resampling(*fields, **named)
     except NeurohoverError:
-        raise NeurohoverError(f"bad resampling {spec!r}: {reason}; {allowed}") from None
+        raise NeurohoverError(f"bad resampling {brief(spec)}: {reason}; {allowed}") from None
 
 
 def _number(text: str, read: Any) -> Any:
@@ -175,9 +175,9 @@ def parse_resampling(spec: str | Resampling | None) -> Resampling:
         + "), race:auto[:K] (a DELTA that matches fixed:K's cost, K in 1..10), lucb:DELTA or kl-lucb:DELTA (error probability 0 < DELTA < 1)"
     )
     if not text.isascii():  # int() and float() read other scripts' digits ('fixed:\u0661' would be fixed:1)
-        raise NeurohoverError(f"resampling {spec!r} is not allowed: numbers in ASCII digits; {allowed}")
+        raise NeurohoverError(f"resampling {brief(spec)} is not allowed: numbers in ASCII digits; {allowed}")
     if sep and value and "" in value.split(":"):  # 'race:0.5:' and 'race:auto:' were read as race:0.5 and race:auto (twelfth trial, S8)
-        raise NeurohoverError(f"resampling {spec!r} is not allowed: it has an empty field (a ':' with nothing after it); {allowed}")
+        raise NeurohoverError(f"resampling {brief(spec)} is not allowed: it has an empty field (a ':' with nothing after it); {allowed}")
     if kind == "fixed" and sep:  # fixed:100000000000 was a MemoryError (third trial)
         return _resampling_of(spec, f"K must be an integer in 1..{MAX_RESAMPLING:,}", allowed, "fixed", _number(value, int))
     if kind in BANDITS and sep:
@@ -189,9 +189,9 @@ def parse_resampling(spec: str | Resampling | None) -> Resampling:
     if kind == "race" and sep:
         value, _, rule = value.partition(":")
         if rule and rule not in RACE_RULES:
-            raise NeurohoverError(f"bad resampling {spec!r}: {rule!r} is not a race rule: allowed {', '.join(RACE_RULES)}")
+            raise NeurohoverError(f"bad resampling {brief(spec)}: {brief(rule)} is not a race rule: allowed {', '.join(RACE_RULES)}")
         return _resampling_of(spec, "DELTA must be a number strictly between 0 and 1", allowed, "race", 1, _number(value, float_of), rule or "prose")
-    raise NeurohoverError(f"unknown resampling {spec!r}: {allowed}")
+    raise NeurohoverError(f"unknown resampling {brief(spec)}: {allowed}")
 
 
 def resolve_prototype(prototype, topology: str) -> Policy:
