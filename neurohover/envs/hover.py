@@ -21,7 +21,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from ..errors import NeurohoverError, brief, whole_number
+from ..errors import NeurohoverError, brief
 from ..sim.constants import (
     ACTION_DIM,
     EPISODE_STEPS,
@@ -31,7 +31,7 @@ from ..sim.constants import (
     STATE_DIM,
 )
 from ..sim.reference import competition_time
-from ..sim.rng import MAX_SEED, seed_stream
+from ..sim.rng import check_seed, seed_stream
 from ..sim.step import ENV_NOISE_WIDTH, ENV_RNG_WIDTH, start_readings, step_batch
 from ..tasks import MDP, TASK_FAMILIES, TaskFamily
 from ..tasks.drift import Drift, DriftRun
@@ -385,9 +385,8 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         return self._run_mdp, self._run.row(self._run_episode)
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
-        if seed is not None and (not whole_number(seed) or not 0 <= seed <= MAX_SEED):  # np.timedelta64: int()'s TypeError (T17-1)
-            raise NeurohoverError(f"seed={brief(seed)} is out of range: allowed an integer in 0..2**63-1")  # every seed's range, as the vector env says it
-        super().reset(seed=None if seed is None else int(seed))  # Gymnasium's seeding takes a Python int, not np.int64
+        # check_seed: every seed's range, as the vector env says it; Gymnasium's seeding takes a Python int, not np.int64
+        super().reset(seed=None if seed is None else check_seed(seed))
         options = check_reset_options(options)
         # Validate every option before touching the episode, so a bad call leaves it as it was.
         spec = resolve_mdp(self.family, options["mdp"]) if "mdp" in options else self._spec

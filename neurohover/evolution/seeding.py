@@ -18,19 +18,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, whole_number
-from ..sim.rng import MAX_SEED
+from ..sim.rng import MAX_SEED, check_seed  # the one seed check; envs use it too
 
 __all__ = ["MAX_SEED", "check_seed", "child_int", "mdp_rng", "noise_seed", "optimiser_seed", "reevaluation_seeds", "validation_seeds"]
 
 _OPTIMISER, _MDPS, _NOISE, _VALIDATION, _REEVALUATION = 0, 1, 2, 3, 4
-
-
-def check_seed(seed) -> int:
-    """``seed`` as an int; NeurohoverError unless it is an integer in ``0..2**63-1`` (not a bool)."""
-    if not whole_number(seed) or not 0 <= int(seed) <= MAX_SEED:  # whole_number: np.timedelta64(4) was taken as 4 (T17-1)
-        raise NeurohoverError(f"seed={brief(seed)} is out of range: allowed an integer in 0..2**63-1")
-    return int(seed)
 
 
 def child_int(seed: int, key: int) -> int:

@@ -27,6 +27,13 @@ _TWO_POW_M53 = 1.0 / 9007199254740992.0
 MAX_SEED = 2**63 - 1
 
 
+def check_seed(seed) -> int:
+    """``seed`` as an int; NeurohoverError unless it is an integer in ``0..2**63-1`` (not a bool)."""
+    if not whole_number(seed) or not 0 <= int(seed) <= MAX_SEED:  # whole_number: np.timedelta64(4) was taken as 4 (T17-1)
+        raise NeurohoverError(f"seed={brief(seed)} is out of range: allowed an integer in 0..2**63-1")
+    return int(seed)
+
+
 @nb.njit(cache=True, inline="always")
 def splitmix64(x: np.uint64) -> np.uint64:
     """SplitMix64 finaliser of ``x + golden``: a 64-bit hash used to expand seeds."""
