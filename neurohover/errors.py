@@ -136,6 +136,13 @@ def _not_floats(values: Any, name: str, allowed: str, what: str) -> NeurohoverEr
     return NeurohoverError(f"{name}={shown} is not allowed: give {allowed}" + (f" (real numbers, not {what})" if what else ""))
 
 
+def masked_note(values: Any) -> str:
+    """The note a refusal of ``values`` ends with when they are a masked array (whose hidden values would be used), else ''."""
+    import numpy as np
+
+    return " (a masked array: give its values, e.g. .filled())" if isinstance(values, np.ma.MaskedArray) else ""
+
+
 def as_floats(values: Any, name: str, allowed: str) -> np.ndarray:
     """A float64 copy of ``values`` if they are real numbers (a NumPy dtype of kind float, int or unsigned int), or
     NeurohoverError naming ``name``, what they are and what is ``allowed``: the one check of every array of real

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError, as_floats, brief
+from .errors import NeurohoverError, as_floats, brief, masked_note
 from .sim.constants import MLP_STEEPNESS
 
 TOPOLOGIES = ("slp", "mlp")
@@ -159,8 +159,7 @@ def check_genome(genome, topology: str) -> np.ndarray:
     try:  # text, booleans, complex numbers (third trial), objects, dates and masked arrays (T16-9, T16-10): as_floats
         arr = as_floats(genome, "genome", "")
     except NeurohoverError:
-        masked = " (a masked array: give its values, e.g. .filled())" if isinstance(genome, np.ma.MaskedArray) else ""
-        raise NeurohoverError(f"a {topology} genome must be a list of finite real numbers, got {brief(genome)}{masked}") from None
+        raise NeurohoverError(f"a {topology} genome must be a list of finite real numbers, got {brief(genome)}{masked_note(genome)}") from None
     arr = arr.reshape(-1) if arr.ndim <= 1 else arr
     n = GENOME_LENGTH[topology]
     if arr.ndim != 1 or arr.shape[0] != n:

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError, as_floats, brief, finite_real, whole_number
+from ..errors import NeurohoverError, as_floats, brief, finite_real, masked_note, whole_number
 from ..sim.constants import (
     DEFAULT_NOISE_STD,
     DEFAULT_PARAMS,
@@ -223,8 +223,7 @@ def finite_vector(values: Sequence[float] | np.ndarray, length: int, what: str) 
     try:  # as_floats: a masked array's hidden values and a date's day number were taken as numbers (T16-9, T16-11)
         arr = as_floats(values, what, "")  # its message is replaced by this function's own
     except NeurohoverError:  # objects such as 10**400, dates, ragged lists; a masked array
-        masked = " (a masked array: give its values, e.g. .filled())" if isinstance(values, np.ma.MaskedArray) else ""
-        raise NeurohoverError(f"{what} must be {length} finite numbers, got {brief(values)}{masked}") from None
+        raise NeurohoverError(f"{what} must be {length} finite numbers, got {brief(values)}{masked_note(values)}") from None
     if arr.shape != (length,):
         raise NeurohoverError(f"{what} must be {length} numbers, got {arr.size}: {brief(values)}")
     if not np.all(np.isfinite(arr)):
