@@ -20,12 +20,11 @@ Report the unwrapped environment's returns (``RecordEpisodeStatistics`` inside t
 from __future__ import annotations
 
 import math
-import numbers
 
 import gymnasium as gym
 import numpy as np
 
-from .errors import NeurohoverError, brief, finite_real
+from .errors import NeurohoverError, brief, finite_real, real_number
 from .sim.constants import CRASH_STEP_PENALTY
 
 __all__ = ["CrashAwareReward", "crash_aware"]
@@ -37,7 +36,7 @@ def check_discount_and_scale(gamma, scale) -> None:
     """Refuse a discount outside (0, 1] or a scale that is not a finite number > 0, by name: any real type (NumPy
     scalars, Fraction) is taken; np.float32(0.9) was "out of range" (twelfth trial U1), so a wrong type says so."""
     for name, value, allowed in (("gamma", gamma, "a discount in (0, 1]"), ("scale", scale, "a finite number > 0")):
-        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        if not real_number(value):
             raise NeurohoverError(f"{name}={brief(value)} is not allowed: give a real number, {allowed}")
         number = float(value) if finite_real(value) else math.nan  # nan: out of range either way
         if not (0.0 < number <= 1.0 if name == "gamma" else number > 0):

@@ -54,11 +54,12 @@ CASES: dict[str, tuple[Callable[[object], object], str, object]] = {
     "plot_flight_data episodes": (lambda v: plot_flight_data(_flight(), OUT[0], episodes=[v]), "episode {} is not allowed", 0),
     "DangerousState box": (lambda v: DangerousState(box=v), "safeguard box={} is out of range", 0.5),
     "DangerousState arm_after": (lambda v: DangerousState(arm_after=v), "safeguard arm_after={} is out of range", 5),
-    "Sensor velocity": (lambda v: Sensor(velocity=v), "sensor velocity={} is out of range", 0.5),
+    "Sensor velocity": (lambda v: Sensor(velocity=v), "sensor velocity={} is not a number", 0.5),
     "Sensor dropout": (lambda v: Sensor(dropout=v), "sensor dropout={} is out of range", 0.1),
     "Sensor delay": (lambda v: Sensor(delay=v), "sensor delay={} is out of range", 2),
-    "Drift walk": (lambda v: Drift(walk=v), "drift walk={} is out of range", 0.1),
-    "Drift change": (lambda v: Drift(change={"D_w": v}), "drift change D_w={} is out of range", 0.8),
+    "Sensor.parse delay": (lambda v: Sensor.parse("position=0.1", delay=v), "sensor delay={} is not allowed", 2),  # 4 was taken as delay 4
+    "Drift walk": (lambda v: Drift(walk=v), "drift walk={} is not a number", 0.1),
+    "Drift change": (lambda v: Drift(change={"D_w": v}), "drift change D_w={} is not a number", 0.8),
     "Drift change_at": (lambda v: Drift(change={"D_w": 0.8}, change_at=(v, 5)), "drift change_at=({}, 5) is not allowed", 2),
 }
 OUT: list[Path] = []  # plot_flight_data's output directory, set by the test

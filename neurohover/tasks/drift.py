@@ -26,12 +26,11 @@ change_at      (200, 800)  the change happens at an episode drawn uniformly from
 
 from __future__ import annotations
 
-import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import FloatRangeError, NeurohoverError, as_floats, brief, finite_real, float_of, whole_number
+from ..errors import FloatRangeError, NeurohoverError, as_floats, brief, finite_real, float_of, real_number, whole_number
 from ..sim.constants import MDP_ROW_LEN, PARAM_NAMES, ROW_PARAMS
 from ..sim.rng import MAX_SEED
 
@@ -61,8 +60,8 @@ class Drift:
 
     def __post_init__(self) -> None:
         w = self.walk
-        if isinstance(w, bool) or not isinstance(w, numbers.Real):  # NumPy's numbers are Real too
-            raise NeurohoverError(f"drift walk={w!r} is not a number: allowed a number in 0..1 (a per-episode log std)")
+        if not real_number(w):  # NumPy's numbers are numbers too; not a bool, nor a NumPy time (T17-1)
+            raise NeurohoverError(f"drift walk={brief(w)} is not a number: allowed a number in 0..1 (a per-episode log std)")
         if not finite_real(w) or not 0 <= w <= 1:
             raise NeurohoverError(f"drift walk={brief(w)} is out of range: allowed a number in 0..1 (a per-episode log std)")
         object.__setattr__(self, "walk", float(w))
@@ -79,8 +78,8 @@ class Drift:
         for name, factor in change.items():
             if name not in PARAM_NAMES:
                 raise NeurohoverError(f"drift change of {name!r}: not a dynamics parameter; allowed {', '.join(PARAM_NAMES)}")
-            if isinstance(factor, bool) or not isinstance(factor, numbers.Real):  # '0.8' and Decimal('0.8') were called "out of range" (T14-21)
-                raise NeurohoverError(f"drift change {name}={factor!r} is not a number: allowed a factor in {MIN_FACTOR:g}..{MAX_FACTOR:g}")
+            if not real_number(factor):  # '0.8' and Decimal('0.8') were called "out of range" (T14-21)
+                raise NeurohoverError(f"drift change {name}={brief(factor)} is not a number: allowed a factor in {MIN_FACTOR:g}..{MAX_FACTOR:g}")
             if not finite_real(factor) or not MIN_FACTOR <= factor <= MAX_FACTOR:  # np.float32(0.8), Fraction(4, 5) in range too (thirteenth trial)
                 raise NeurohoverError(f"drift change {name}={brief(factor)} is out of range: allowed a factor in {MIN_FACTOR:g}..{MAX_FACTOR:g}")
             if factor == 1:  # flown as another experiment with results identical to none (eleventh trial, S3)

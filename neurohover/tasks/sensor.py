@@ -33,11 +33,10 @@ entry's noise is about the size of the baseline policy's typical hovering error 
 
 from __future__ import annotations
 
-import numbers
 import re
 from dataclasses import asdict, dataclass, fields, replace
 
-from ..errors import FloatRangeError, NeurohoverError, brief, finite_real, float_of, whole_number
+from ..errors import FloatRangeError, NeurohoverError, brief, finite_real, float_of, real_number, whole_number
 from ..sim.constants import MAX_SENSOR_DELAY, SENSOR_GROUPS
 
 #: The std of each group at noise level 1 (velocity m/s, position m, rates rad/s, attitude).
@@ -64,8 +63,8 @@ class Sensor:
     def __post_init__(self) -> None:
         for name in (*SENSOR_GROUPS, "correlation"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, numbers.Real):  # NumPy's numbers are Real too
-                raise NeurohoverError(f"sensor {name}={value!r} is not a number: allowed a finite number >= 0")
+            if not real_number(value):  # NumPy's numbers are numbers too; not a bool, nor a NumPy time (T17-1)
+                raise NeurohoverError(f"sensor {name}={brief(value)} is not a number: allowed a finite number >= 0")
             if not finite_real(value) or value < 0:  # np.timedelta64 was float()'s TypeError (T17-1), 10**400 an OverflowError
                 raise NeurohoverError(f"sensor {name}={brief(value)} is out of range: allowed a finite number >= 0")
             number = float(value)
@@ -106,7 +105,7 @@ class Sensor:
         try:  # 3 values were an IndexError, None a TypeError, 9 values a sensor of the first seven (thirteenth trial, F10)
             items = list(values)
             # Numbers only: text such as '1' was read as 1.0 and then refused as "correlation=1.0" (T14-21).
-            v = [float(x) for x in items] if all(isinstance(x, numbers.Real) and not isinstance(x, bool) for x in items) else []
+            v = [float(x) for x in items] if all(real_number(x) for x in items) else []
         except (TypeError, OverflowError):
             v = []
         if len(v) != 7:
@@ -163,7 +162,7 @@ class Sensor:
         if not settings:
             raise NeurohoverError(f"sensor {text!r} is empty: {expected}")
         values: dict[str, float | int] = {"delay": delay} | settings
-        if isinstance(values["delay"], bool) or not isinstance(values["delay"], numbers.Real):  # "x" was a ValueError (fifth trial)
+        if not real_number(values["delay"]):  # "x" was a ValueError (fifth trial), np.timedelta64(2) delay 2
             raise NeurohoverError(f"sensor delay={values['delay']!r:.40} is not allowed: give a whole number of control steps")
         if not float(values["delay"]).is_integer():
             raise NeurohoverError(f"sensor delay={values['delay']!r} is not a whole number of control steps")
