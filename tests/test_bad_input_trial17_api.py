@@ -13,11 +13,14 @@ import numpy as np
 import pytest
 
 import neurohover as nh
+from neurohover.agents.continual import ContinualSettings
 from neurohover.agents.protocol import run_test
 from neurohover.agents.registry import check_agent, make_agent
+from neurohover.agents.risk import RiskSettings
 from neurohover.envs import HoverEnv, HoverVectorEnv
 from neurohover.errors import NeurohoverError, brief
 from neurohover.evaluate import DangerousState, evaluate
+from neurohover.evolution.steady_state import SteadyStateSettings
 from neurohover.plots import plot_flight_data
 from neurohover.tasks.drift import Drift
 from neurohover.tasks.sensor import Sensor
@@ -109,3 +112,22 @@ def test_a_policy_dir_for_an_agent_without_a_policy_set_is_refused(policy_dir: s
     check_agent("baseline", FAMILY, None)
     with pytest.raises(NeurohoverError, match=re.escape("no policy set for ghh08 in ")):
         make_agent("generic", "ghh08", policy_dir="/nonexistent/dir")
+
+
+@pytest.mark.parametrize(
+    "make, field",
+    [
+        (lambda v: ContinualSettings(threshold=v), "threshold"),
+        (lambda v: RiskSettings(level=v), "level"),
+        (lambda v: SteadyStateSettings(mutation_floor=v), "mutation_floor"),
+        (lambda v: nh.get_task_family("fghh", sigma=v), "sigma"),
+    ],
+    ids=["continual threshold", "risk level", "mutation_floor", "fghh sigma"],
+)
+def test_any_real_number_type_is_a_number(make: Callable[[object], object], field: str) -> None:
+    """Settings that tested ``isinstance(x, (int, float))`` called np.float32(1.5) "out of range" or "not a number" (as the
+    twelfth trial's U1 found for gamma); they now test errors.real_number, so a NumPy float is taken as its value and a
+    time span is still refused."""
+    assert getattr(make(np.float32(1.5 if field == "threshold" else 0.25)), field) == pytest.approx(1.5 if field == "threshold" else 0.25)
+    with pytest.raises(NeurohoverError, match=re.escape(brief(np.timedelta64(4)))):
+        make(np.timedelta64(4))

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real
+from ..errors import NeurohoverError, brief, finite_real, real_number
 from ..evaluate import DangerousState
 from ..flightdata import FlightData
 from ..models.model import LearnedModel
@@ -76,7 +76,7 @@ class ContinualSettings(AgentSettings):
             if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v <= 10**6:
                 raise NeurohoverError(f"continual {name}={brief(v)} is out of range: allowed an integer in 0..1000000 ({unit})")
         t = self.threshold
-        if isinstance(t, bool) or not isinstance(t, (int, float)) or not finite_real(t) or t <= 1:
+        if not real_number(t) or not finite_real(t) or t <= 1:
             raise NeurohoverError(f"continual threshold={brief(t)} is out of range: allowed a number > 1 (a ratio of one-step errors)")
         if not isinstance(self.safeguard, bool):
             raise NeurohoverError(f"continual safeguard={brief(self.safeguard)} is not allowed: true or false")

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real
+from ..errors import NeurohoverError, brief, finite_real, real_number
 from ..policies import Policy, baseline_policy
 from .hybrid import HybridAgent
 from .model_based import ModelEvolution
@@ -63,7 +63,7 @@ class RiskSettings(AgentSettings):
     def __post_init__(self) -> None:
         if self.criterion not in CRITERIA:
             raise NeurohoverError(f"risk criterion {brief(self.criterion)} is not allowed: choose one of {', '.join(CRITERIA)}")
-        if isinstance(self.level, bool) or not isinstance(self.level, (int, float)):  # 'abc' was called "out of range" (eighth trial)
+        if not real_number(self.level):  # 'abc' was called "out of range" (eighth trial)
             raise NeurohoverError(f"risk level={brief(self.level)} is not a number: allowed a finite number >= 0 (standard errors below the mean)")
         if not finite_real(self.level) or self.level < 0:
             raise NeurohoverError(f"risk level={brief(self.level)} is out of range: allowed a finite number >= 0 (standard errors below the mean)")

@@ -80,7 +80,7 @@ from pathlib import Path
 import numba
 import numpy as np
 
-from ..errors import NeurohoverError, brief, check_flag, whole_number
+from ..errors import NeurohoverError, brief, check_flag, real_number, whole_number
 from ..evaluate import check_episode_count, evaluate_jobs, num_threads
 from ..paths import output_file
 from ..policies import Policy
@@ -130,13 +130,13 @@ def _intervals(checkpoint, checkpoint_every_s, progress, progress_every_s) -> tu
     and given only with its ``checkpoint`` / ``progress`` (alone it was ignored without a word; T17-9)."""
     if checkpoint_every_s is None:
         checkpoint_every_s = CHECKPOINT_EVERY_S
-    elif isinstance(checkpoint_every_s, bool) or not isinstance(checkpoint_every_s, (int, float)) or not checkpoint_every_s > 0:
+    elif not real_number(checkpoint_every_s) or not checkpoint_every_s > 0:
         raise NeurohoverError(f"checkpoint_every_s={brief(checkpoint_every_s)} must be a number > 0 (seconds), or None ({CHECKPOINT_EVERY_S:g})")
     elif checkpoint is None:
         raise NeurohoverError(f"checkpoint_every_s={brief(checkpoint_every_s)} needs checkpoint= (the file it writes): give both, or neither")
     if progress_every_s is None:
         progress_every_s = PROGRESS_EVERY_S
-    elif isinstance(progress_every_s, bool) or not isinstance(progress_every_s, (int, float)) or not 0 <= progress_every_s < math.inf:
+    elif not real_number(progress_every_s) or not 0 <= progress_every_s < math.inf:
         raise NeurohoverError(
             f"progress_every_s={brief(progress_every_s)} is out of range: allowed a finite number of seconds >= 0 (0: every generation), "
             f"or None ({PROGRESS_EVERY_S:g})"

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real
+from ..errors import NeurohoverError, brief, finite_real, real_number
 from .common import (
     ASK_AGAIN,
     MAX_SPREAD,
@@ -151,7 +151,7 @@ class SteadyStateSettings:
         validate_variation_settings(self)
         if self.mutation_floor is not None:
             floor = self.mutation_floor
-            if isinstance(floor, bool) or not isinstance(floor, (int, float)) or not (finite_real(floor) and 0 < floor <= MAX_SPREAD):
+            if not real_number(floor) or not (finite_real(floor) and 0 < float(floor) <= MAX_SPREAD):
                 raise NeurohoverError(f"mutation_floor={brief(floor)} is out of range: allowed None or a number in (0, {MAX_SPREAD:g}]")
             set_field(self, "mutation_floor", float(floor))
         if not isinstance(self.plateau_rule, str) or self.plateau_rule not in PLATEAU_RULES:

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError, finite_real
+from ..errors import NeurohoverError, brief, finite_real
 from ..sim.constants import DEFAULT_PARAMS, PARAM_NAMES, ROW_PARAMS
 from .base import MDP, TaskFamily, finite_vector, mdp_label
 
@@ -34,8 +34,8 @@ class FGHH(TaskFamily):
 
     def __post_init__(self) -> None:
         s = self.sigma
-        if not (isinstance(s, (int, float)) and finite_real(s) and 0.0 <= s <= 1.0):
-            raise NeurohoverError(f"FGHH sigma={s!r} is out of range: allowed 0 <= sigma <= 1 (the paper uses 0.2 and 0.3)")
+        if not (finite_real(s) and 0.0 <= s <= 1.0):  # any real number type, np.float32 too
+            raise NeurohoverError(f"FGHH sigma={brief(s)} is out of range: allowed 0 <= sigma <= 1 (the paper uses 0.2 and 0.3)")
         object.__setattr__(self, "sigma", abs(float(s)))  # -0.0 passes 0 <= sigma but was NumPy's "scale < 0" at the first draw (T14-2)
 
     def make(self, params: Sequence[float] | np.ndarray, label: str = "") -> MDP:
