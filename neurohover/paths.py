@@ -6,7 +6,9 @@ an unwritable place is found even where permission bits do not tell (``/proc``, 
 running as root). Missing parent directories of an output are created, and a note on standard
 error says so: a typo in a path shows up at once instead of silently. When the command then
 fails, :func:`remove_created_dirs` takes away those it created that are still empty, so a refused
-or failed run leaves nothing behind (a directory holding any result stays).
+or failed run leaves nothing behind (a directory holding any result stays). An output is never
+written through a symbolic link to a missing target, and a '..' may climb out of an existing
+directory only, never out of one the check would create (left empty beside the output; T19-12).
 """
 
 from __future__ import annotations
@@ -42,6 +44,7 @@ __all__ = [
     "output_dir",
     "output_file",
     "printable",
+    "refuse_dangling_link",
     "refuse_link_loop",
     "refuse_special_file",
     "remove_created_dirs",
@@ -58,7 +61,8 @@ def _why(err: OSError) -> str:
 
 
 def make_dirs(directory: Path, option: str, given: str) -> None:
-    """Create ``directory`` and any missing parents, saying so on standard error; refuse a file in the way, naming it.
+    """Create ``directory`` and any missing parents, saying so on standard error; refuse a file in the way, naming it,
+    a symbolic link to a missing target on the way and a '..' that would climb out of a directory it creates.
 
     Parameters
     ----------
@@ -69,6 +73,7 @@ def make_dirs(directory: Path, option: str, given: str) -> None:
     given : str
         The path as the user gave it (a file in it, or the file's directory), shown in the messages.
     """
+    _refuse_climb_or_dangling(directory, option, given)
     missing = []
     here = directory
     while not here.exists():
@@ -86,6 +91,37 @@ def make_dirs(directory: Path, option: str, given: str) -> None:
         raise NeurohoverError(f"{option} {given!r}: cannot create the directory {str(directory)!r} ({_why(err)})") from None
     _created[:0] = missing
     print(f"neurohover: created directory {str(missing[-1])!r}" + (f" and {len(missing) - 1} below it" if len(missing) > 1 else ""), file=sys.stderr)
+
+
+def _refuse_climb_or_dangling(directory: Path, option: str, given: str) -> None:
+    """Refuse a ``directory`` to be made that holds a dangling symbolic link (mkdir's "File exists", T19-12) or a '..'
+    right after a part that does not exist yet. The rule: a '..' may climb out of a directory that exists, never out of
+    one this check would create, which would be left behind empty while the files went above it ('pp/x/..' made pp/x
+    and wrote into pp; T19-12); '..' is not dropped lexically, since after a symbolic link it names another place."""
+    parts = directory.parts
+    for i in range(1, len(parts) + 1):
+        here = Path(*parts[:i])
+        if parts[i - 1] == ".." and not os.path.lexists(here.parent):
+            raise NeurohoverError(
+                f"{option} {given!r}: '..' climbs out of {str(here.parent)!r}, which does not exist: it would be created "
+                f"only to be left empty; give the path without it ({os.path.realpath(given)!r})"
+            )
+        refuse_dangling_link(here, option, given)
+
+
+def refuse_dangling_link(path: str | os.PathLike, option: str, given: str | os.PathLike | None = None) -> None:
+    """Refuse an output ``path`` that is a symbolic link to a missing target: written through, a file appeared wherever
+    the link pointed (outside the work folder) and a directory was "File exists" (T19-12, T19-16). ``given``: the path
+    as the user gave it (default ``path``)."""
+    if os.path.islink(path) and not os.path.exists(path):
+        target, shown = os.readlink(os.fspath(path)), os.fspath(path if given is None else given)
+        real = Path(os.path.realpath(path))
+        where = f", whose directory {str(real.parent)!r} does not exist" if not real.parent.is_dir() else ""
+        link = f"{str(path)!r}, a symbolic link" if os.fspath(path) != shown else "a symbolic link"
+        raise NeurohoverError(
+            f"{option} {shown!r} is {link} to {target!r}{where}: a symbolic link to a missing target is not written "
+            "through; give another path, or remove the link"
+        )
 
 
 #: The longest name of one file or directory, and of a whole path, in bytes (Linux's NAME_MAX and PATH_MAX).
@@ -207,7 +243,8 @@ def output_file(
     """Check that the file ``path`` can be written (an existing file is kept as it is).
 
     Refuses ``-`` (standard output, which ``stdout`` says leaving ``option`` out gives), a directory, a parent that is
-    a file, any place where a file cannot be created, the file of one of ``inputs`` (option -> path: writing it would
+    a file, a symbolic link to a missing target (:func:`refuse_dangling_link`), a '..' after a missing directory
+    (:func:`make_dirs`), any place where a file cannot be created, the file of one of ``inputs`` (option -> path: writing it would
     destroy what the command reads) and, unless ``store`` (the path is a results store's own), an existing results
     store; creates missing parent directories (saying so on standard error).
     """
@@ -229,13 +266,9 @@ def output_file(
     if os.fspath(path).endswith(("/", os.sep)):  # Path() drops the slash: 'x.json/' was written as the file x.json (seventh trial)
         raise NeurohoverError(f"{option} {str(path)!r} ends in '/', which names a directory: give a file path")
     refuse_special_file(p, option, path)
-    real = Path(os.path.realpath(p))
-    if p.is_symlink() and not real.parent.is_dir():  # was "cannot create a file in '.'", a directory that exists (ninth trial)
-        raise NeurohoverError(
-            f"{option} {str(path)!r} is a symbolic link to {os.readlink(p)!r}, whose directory {str(real.parent)!r} does not exist: "
-            "give another path, or make that directory"
-        )
+    refuse_dangling_link(p, option, path)  # a link to nothing was written through, wherever it pointed (T19-12)
     make_dirs(p.parent, option, str(path))
+    real = Path(os.path.realpath(p))
     existed = real.exists()
     try:
         with open(real, "ab"):  # appending nothing leaves an existing file's content and time as they are
@@ -262,7 +295,9 @@ def writing(path: str | os.PathLike, option: str) -> Iterator[Path]:
     onto ``path`` once the block ends): a failed write (disk full, read-only, permission) becomes one NeurohoverError
     naming ``option`` and the file, and an interrupted one (Ctrl-C, SIGTERM) stops as it was; either way the temporary
     file is removed and ``path`` is as it was before, so that no later run takes a partial file for a result. A device,
-    pipe or socket at ``path`` is refused (:func:`refuse_special_file`), before the block and again before the move."""
+    pipe or socket at ``path`` is refused (:func:`refuse_special_file`), before the block and again before the move, and
+    so is a symbolic link to a missing target (:func:`refuse_dangling_link`); a link to a file writes that file."""
+    refuse_dangling_link(path, option)  # every writer: one to nothing wrote wherever it pointed (T19-12)
     p = Path(os.path.realpath(path))  # through a symbolic link: its file is written, the link kept (not replaced by a file)
     refuse_special_file(p, option, path)  # every writer, not only those checked by output_file first (fourteenth trial)
     partial = p.with_name(f".{p.name}.{os.getpid()}.partial")
@@ -285,7 +320,8 @@ def write_png(fig, path: str | os.PathLike, what: str, dpi: float | None = None)
 
 
 def output_dir(path: str | os.PathLike, option: str) -> Path:
-    """Check that files can be written in the directory ``path`` (not ``-``), creating it (saying so) if missing."""
+    """Check that files can be written in the directory ``path`` (not ``-``), creating it (saying so) if missing; a
+    symbolic link to a missing target and a '..' after a missing directory are refused (:func:`make_dirs`)."""
     _no_dash(path, option, "directory", False)
     p = checked_path(path, option, "directory")
     if p.exists() and not p.is_dir():

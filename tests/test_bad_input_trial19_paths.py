@@ -1,0 +1,57 @@
+"""Bad-input trial 19, paths and files: '..' out of a directory to be made, dangling links as outputs, unknown manifest
+keys, a config that is no UTF-8, progress on a terminal that reports no width (T19-11, T19-12, T19-13, T19-15, T19-16)."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import pytest
+
+from neurohover.errors import NeurohoverError
+from neurohover.paths import output_dir, output_file, writing
+
+FLY = ("fly", "--task", "ghh08", "--mdp", "train:0", "--episodes", "1")
+EVOLVE = ("evolve", "--task", "ghh08", "--mdp", "train:0", "--budget", "3", "--episode-steps", "10")
+
+
+def test_a_dotdot_out_of_a_directory_to_be_made_is_refused_and_nothing_is_made(tmp_path: Path, monkeypatch, cli) -> None:
+    """T19-12: compete --out 'pp/../pp/x/..' made the stray directory pp/x and wrote into pp."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "pp").mkdir()
+    with pytest.raises(NeurohoverError, match=r"--out 'pp/\.\./pp/x/\.\.': '\.\.' climbs out of 'pp/\.\./pp/x', which does not exist"):
+        output_dir("pp/../pp/x/..", "--out")
+    with pytest.raises(NeurohoverError, match=f"'..' climbs out of 'pp/q', which does not exist: .*give the path without it \\('{tmp_path}/pp/f.csv'\\)"):
+        output_file("pp/q/../f.csv", "--out")
+    argv = ("--agent", "baseline", "--runs", "1", "--episodes", "1", "--episode-steps", "10", "--out", "pp/../pp/x/..")
+    rc, _, err = cli("compete", "--task", "ghh08", *argv)
+    assert rc == 2 and "climbs out of 'pp/../pp/x'" in err, err
+    assert sorted(os.listdir(tmp_path / "pp")) == []  # no pp/x, no results
+    (tmp_path / "pp" / "x").mkdir()  # out of a directory that exists, '..' is the parent as ever
+    assert output_dir("pp/x/..", "--out") == Path("pp/x/..") and output_file("pp/x/../f.csv", "--out") == Path("pp/x/../f.csv")
+
+
+def test_a_dangling_link_is_refused_as_every_output_and_nothing_is_written_through_it(tmp_path: Path, monkeypatch, cli) -> None:
+    """T19-12, T19-16: results --out LINK wrote its CSV where the link pointed (outside the work folder), compete and
+    report said "File exists", evolve "a file, not a directory"; fly --record LINK wrote through it too."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "pp").mkdir()
+    target = tmp_path / "outside_target"
+    (tmp_path / "pp" / "out_link").symlink_to(target)
+    why = f"is a symbolic link to '{target}': a symbolic link to a missing target is not written through"
+    for check in (lambda: output_file("pp/out_link", "--out"), lambda: output_dir("pp/out_link", "--out")):
+        with pytest.raises(NeurohoverError, match=f"--out 'pp/out_link' {why}"):
+            check()
+    with pytest.raises(NeurohoverError, match=f"--out 'pp/out_link/r.csv' is 'pp/out_link', a symbolic link to '{target}'"):
+        output_file("pp/out_link/r.csv", "--out")
+    with pytest.raises(NeurohoverError, match=f"--out 'pp/out_link' {why}"):
+        with writing("pp/out_link", "--out") as partial:
+            partial.write_text("x")
+    for argv in ((*FLY, "--record", "pp/out_link"), (*EVOLVE, "--out", "pp/out_link"), (*EVOLVE, "--out", "pp/out_link/p.json")):
+        rc, _, err = cli(*argv)
+        assert rc == 2 and "a symbolic link to a missing target is not written through" in err and "a file, not a directory" not in err, err
+    assert not target.exists() and not os.path.lexists("pp/out_link.history.csv")
+    target.write_text("{}")  # a link to a file that exists is written through, the link kept
+    rc, _, err = cli(*EVOLVE, "--out", "pp/out_link")
+    assert rc == 0 and (tmp_path / "pp" / "out_link").is_symlink() and json.loads(target.read_text())["genome"], err
