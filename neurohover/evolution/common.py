@@ -39,7 +39,10 @@ from .state_codec import (
     enc_float,
     read_count,
     read_entry,
+    read_return,
     read_seconds,
+    read_settings,
+    required,
     rng_from_state,
 )
 
@@ -71,7 +74,12 @@ __all__ = [
     "rank",
     "read_entry",
     "read_count",
+    "read_return",
+    "read_settings",
     "read_seconds",
+    "required",
+    "require_episodes",
+    "MAX_EPISODES",
     "require_int",
     "require_population",
     "MAX_POPULATION",
@@ -97,12 +105,33 @@ class TellInfo:
     selected : np.ndarray of int, optional
         The parents a selection race chose (generational NE).
     episodes : int, optional
-        Episodes the generation cost (generational NE's history).
+        Episodes the generation cost (generational NE's history): an integer in 0..:data:`MAX_EPISODES`.
+
+    Raises
+    ------
+    NeurohoverError
+        For episodes that are no such integer.
     """
 
     crashed: np.ndarray | None = None
     selected: np.ndarray | None = None
     episodes: int | None = None
+
+    def __post_init__(self) -> None:
+        if self.episodes is not None:
+            object.__setattr__(self, "episodes", require_episodes(self.episodes))
+
+
+#: The most episodes one generation may cost: a run's largest budget, evolution.config.MAX_BUDGET (not imported: config
+#: imports the optimisers, which import this module). 10**30 was taken and made a run's evaluations 1e30 (T19-10).
+MAX_EPISODES = 10**10
+
+
+def require_episodes(value: Any, name: str = "episodes") -> int:
+    """The episodes a generation cost as an int, or NeurohoverError unless an integer (not a bool) in 0..:data:`MAX_EPISODES`."""
+    if not whole_number(value) or not 0 <= value <= MAX_EPISODES:
+        raise NeurohoverError(f"{name}={brief(value)} is out of range: allowed an integer in 0..{MAX_EPISODES:,} (the episodes one generation cost)")
+    return int(value)
 
 
 class Optimiser(Protocol):
@@ -362,7 +391,10 @@ class ChampionTracker:
         t.best = dec_float(d["best"])
         if math.isnan(t.best) or t.best == math.inf or (t.genome is None) != (t.best == -math.inf):
             raise EntryError(f"best={brief(d['best'])} is not allowed: a finite return with a champion genome, -inf without one")
+        if not isinstance(d["history"], list):  # {} was read as no history (T19-09)
+            raise EntryError(f"history={brief(d['history'])} is not allowed: a list of [evaluations, return, seconds] records")
         t.history = [_champion_record(h) for h in d["history"]]
+        _check_history(t)
         return t
 
 
@@ -371,6 +403,34 @@ def _champion_record(h: Any) -> ChampionRecord:
     if not isinstance(h, list) or len(h) not in (3, 4) or (len(h) == 4 and h[3] is not True):
         raise EntryError(f"history record {brief(h)} is not allowed: [evaluations, return, seconds] or, for a crashed champion, [..., true]")
     return ChampionRecord(read_count(h[0]), dec_float(h[1]), read_seconds(h[2]), len(h) == 4)
+
+
+def _check_history(t: ChampionTracker) -> None:
+    """EntryError unless ``t``'s history is what :meth:`ChampionTracker.update` makes of its counts and champion: one
+    record per strictly better finite return, the last one the champion ``since`` evaluations ago (NaN, 'nan' and
+    disordered returns, and a best that disagreed with them, were taken; T19-09)."""
+    if t.genome is None:
+        if t.history or t.since != t.evaluations:
+            raise EntryError(
+                f"without a champion there is no history and since equals evaluations ({t.evaluations}); got {len(t.history)} records, since={t.since}"
+            )
+        return
+    if not t.history:
+        raise EntryError("a champion without a history record: every champion has one")
+    previous = ChampionRecord(0, -math.inf, 0.0)
+    for h in t.history:
+        if not (previous.evaluations < h.evaluations <= t.evaluations and previous.champion_return < h.champion_return < math.inf):
+            raise EntryError(
+                f"history record [{h.evaluations}, {enc_float(h.champion_return)}, ...] is not allowed: each record's evaluations and return"
+                f" are above the one before ({previous.evaluations}, {enc_float(previous.champion_return)}),"
+                f" its evaluations at most {t.evaluations}, its return finite"
+            )
+        previous = h
+    if previous.champion_return != t.best or previous.evaluations != t.evaluations - t.since:
+        raise EntryError(
+            f"the last history record [{previous.evaluations}, {enc_float(previous.champion_return)}, ...] is not the champion's: best={enc_float(t.best)}"
+            f" found at evaluation {t.evaluations - t.since} (evaluations - since)"
+        )
 
 
 class ChampionViews:

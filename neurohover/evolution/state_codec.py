@@ -26,9 +26,14 @@ __all__ = [
     "dec_float",
     "enc_array",
     "enc_float",
+    "MAX_COUNT",
+    "MAX_SECONDS",
     "read_count",
     "read_entry",
+    "read_return",
+    "read_settings",
     "read_seconds",
+    "required",
     "rng_from_state",
 ]
 
@@ -183,15 +188,53 @@ def read_entry(state: dict[str, Any], kind: str, key: str, read: Callable[[Any],
         ) from None
 
 
+#: The largest count a state holds, what an int64 holds: a generation of 2**70 was taken and ended a resumed run at once (T19-08).
+MAX_COUNT = 2**63 - 1
+
+#: The most seconds a state records, 100 years: a run's clock at 1e308 seconds was taken (T19-09).
+MAX_SECONDS = 100 * 365.25 * 86400.0
+
+
 def read_count(value: Any) -> int:
-    """A state's count (a generation, evaluations): an integer >= 0, not a bool, else :class:`EntryError`."""
+    """A state's count (a generation, evaluations): an integer in 0..:data:`MAX_COUNT`, not a bool, else :class:`EntryError`."""
     if not whole_number(value) or value < 0:
         raise EntryError("not a count: allowed an integer >= 0")
+    if value > MAX_COUNT:
+        raise EntryError(f"a count past {MAX_COUNT} (2**63 - 1): allowed an integer in 0..{MAX_COUNT}")
     return int(value)
 
 
 def read_seconds(value: Any) -> float:
-    """A state's seconds: a finite number >= 0, not a bool, else :class:`EntryError`."""
+    """A state's seconds: a finite number in [0, :data:`MAX_SECONDS`] (100 years), not a bool, else :class:`EntryError`."""
     if not finite_real(value) or float(value) < 0.0:
         raise EntryError("not a number of seconds: allowed a finite number >= 0")
+    if float(value) > MAX_SECONDS:
+        raise EntryError(f"more seconds than 100 years: allowed a number in [0, {MAX_SECONDS:.6g}]")
     return float(value)
+
+
+def read_return(value: Any) -> float:
+    """A return an optimiser keeps as a champion's (:func:`dec_float`): a finite number or ``-inf`` (a NaN estimate is
+    kept as ``-inf``, +inf is never told), else :class:`EntryError` ('nan' was taken as a champion's return; T19-09)."""
+    r = dec_float(value)
+    if math.isnan(r) or r == math.inf:
+        raise EntryError(f"{brief(value)} is no champion's return: allowed a finite number or '-inf'")
+    return r
+
+
+def read_settings(values: Any, cls: Callable[..., _T], names: tuple[str, ...], old: dict[str, Any]) -> _T:
+    """``cls(**values)`` of a state's settings table ``values``, whose fields ``names`` that a checkpoint written before
+    one existed lacks default to ``old``'s; every other field must be given ({} was read as the defaults, T19-03).
+    EntryError for a missing field; no table and a bad value are ``cls``'s error."""
+    missing = [name for name in names if isinstance(values, dict) and name not in values and name not in old]  # no dict: cls's TypeError
+    if missing:
+        raise EntryError(f"settings lack {', '.join(missing)}: allowed every field, as state_dict() wrote them")
+    return cls(**{**old, **values})
+
+
+def required(value: _T | None, what: str) -> _T:
+    """``value`` unless it is None, else :class:`EntryError` naming ``what`` (a population of None was an
+    AttributeError at the first ask(); T19-02)."""
+    if value is None:
+        raise EntryError(f"no {what}: allowed what state_dict() wrote, not null")
+    return value
