@@ -19,6 +19,7 @@ import numpy as np
 from ..errors import NeurohoverError, brief
 from .common import (
     ASK_AGAIN,
+    MAX_EPISODES,
     STATE_VERSION,
     TELL_FIRST,
     AskTellOrderError,
@@ -32,16 +33,19 @@ from .common import (
     check_settings,
     check_state,
     dec_array,
-    dec_float,
     enc_array,
     enc_float,
     rank,
     read_count,
     read_entry,
+    read_return,
     read_seconds,
+    read_settings,
+    require_episodes,
     require_int,
     require_prob,
     require_spread,
+    required,
     rng_from_state,
     set_field,
     validate_variation_settings,
@@ -286,7 +290,7 @@ class GenerationalNE:
             sel = order[: s.select_size]
         else:
             sel = self._check_selected(selected)
-        ep = s.pop_size if episodes is None else require_int("episodes", episodes, 0)
+        ep = s.pop_size if episodes is None else require_episodes(episodes)  # 10**30 made evaluations 1e30 (T19-10)
 
         best = int(sel[rank(f[sel])[0]])  # the best selected parent (a race may select below a discarded mean)
         self._champion_genome = self._population[best].copy()
@@ -426,36 +430,88 @@ class GenerationalNE:
         check_state(state, "GenerationalNE")
         kind = "GenerationalNE"
         check_entries(state, kind, STATE_ENTRIES)
-        settings = read_entry(state, kind, "settings", lambda s: GenerationalSettings(**{**OLD_GENERATIONAL, **s}))
+        names = tuple(f.name for f in dataclasses.fields(GenerationalSettings))  # {}: the defaults were run (T19-09)
+        settings = read_entry(state, kind, "settings", lambda s: read_settings(s, GenerationalSettings, names, OLD_GENERATIONAL))
         opt = cls(read_entry(state, kind, "prototype", lambda a: dec_array(a, "prototype")), settings)
         d, n, mu = opt._prototype.size, settings.pop_size, settings.select_size
         # Each array's rows as the settings make them: a pop_size that disagreed with the population was run on (sixteenth trial).
-        opt._population = read_entry(state, kind, "population", lambda a: check_genomes(dec_array(a, "population"), d, "population", rows=n))
+        opt._population = read_entry(  # None was an AttributeError at the first ask() (T19-02)
+            state, kind, "population", lambda a: check_genomes(required(dec_array(a, "population"), "population"), d, "population", rows=n)
+        )
         opt._asked = read_entry(state, kind, "asked", _flag)
         opt._generation = read_entry(state, kind, "generation", read_count)  # generation -1 was taken (eighth trial)
         opt._evaluations = read_entry(state, kind, "evaluations", read_count)
         opt._champion_genome = read_entry(
             state, kind, "champion_genome", lambda a: check_genomes(dec_array(a, "champion genome"), d, "champion genome", rows=0)
         )
-        opt._champion_return = read_entry(state, kind, "champion_return", dec_float)
+        opt._champion_return = read_entry(state, kind, "champion_return", read_return)  # 'nan' was taken (T19-09)
         # "parents" and "hall_of_fame" are absent from checkpoints written before 2026-12-04
         opt._parents = read_entry(state, kind, "parents", lambda a: check_genomes(dec_array(a, "parents"), d, "parents", rows=mu), None)
         opt._hall = read_entry(
             state,
             kind,
             "hall_of_fame",
-            lambda h: [(dec_float(r), check_genomes(dec_array(g, "hall of fame genome"), d, "hall of fame genome", rows=0)) for r, g in h],
+            lambda h: [
+                (read_return(r), check_genomes(required(dec_array(g, "hall of fame genome"), "hall of fame genome"), d, "hall of fame genome", rows=0))
+                for r, g in _rows(h)
+            ],
             [],
         )
-        opt._history = read_entry(state, kind, "history", lambda h: [_generation_record(g, e, ep, r, w) for g, e, ep, r, w in h])
+        opt._history = read_entry(state, kind, "history", lambda h: [_generation_record(g, e, ep, r, w) for g, e, ep, r, w in _rows(h)])
         opt._rng = read_entry(state, kind, "rng", rng_from_state)
         opt._clock = Clock(read_entry(state, kind, "wall_seconds", read_seconds))
+        _check_progress(opt)
         return opt
 
 
+def _rows(value: Any) -> list:
+    """A state's list of rows; :class:`~neurohover.evolution.common.EntryError` for a table ({} was read as no rows; T19-09),
+    the unpacking's error for other values."""
+    if isinstance(value, dict):
+        raise EntryError("a table, not a list: allowed a list of rows as state_dict() wrote it")
+    return value
+
+
 def _generation_record(generation: Any, evaluations: Any, episodes: Any, champion_return: Any, wall_seconds: Any) -> GenerationRecord:
-    """One :class:`GenerationRecord` of a saved history, each count checked (True and -1 were taken; sixteenth trial)."""
-    return GenerationRecord(read_count(generation), read_count(evaluations), read_count(episodes), dec_float(champion_return), read_seconds(wall_seconds))
+    """One :class:`GenerationRecord` of a saved history, each count checked (True and -1 were taken; sixteenth trial; a NaN return, T19-09)."""
+    ep = read_count(episodes)
+    if ep > MAX_EPISODES:
+        raise EntryError(f"episodes={ep} is more than a generation may cost ({MAX_EPISODES:,})")
+    return GenerationRecord(read_count(generation), read_count(evaluations), ep, read_return(champion_return), read_seconds(wall_seconds))
+
+
+def _check_progress(opt: GenerationalNE) -> None:
+    """NeurohoverError unless a restored optimiser's history, counts, champion and hall of fame agree as :meth:`GenerationalNE.tell`
+    makes them: fewer history rows than generations, a generation of 2**70, and a hall of fame longer than select_size or
+    of returns no generation had were taken (T19-08, T19-09)."""
+    gen, history, what = opt._generation, opt._history, "GenerationalNE state dict"
+    if len(history) != gen:
+        raise NeurohoverError(f"{what} has {len(history)} history rows for generation={gen}: one row per generation")
+    total = 0
+    for number, row in enumerate(history, 1):
+        total += row.episodes
+        if row.generation != number or row.evaluations != total:
+            raise NeurohoverError(
+                f"{what}'s history row {number} says generation {row.generation}, evaluations {row.evaluations}: expected generation {number}"
+                f" and evaluations {total} (the episodes of its rows so far)"
+            )
+    if opt._evaluations != total:
+        raise NeurohoverError(f"{what} has evaluations={opt._evaluations} where its history's episodes add up to {total}")
+    champion = history[-1].champion_return if history else -math.inf
+    if (opt._champion_genome is None) != (gen == 0) or opt._champion_return != champion:
+        raise NeurohoverError(
+            f"{what}'s champion (return {enc_float(opt._champion_return)}, genome {'none' if opt._champion_genome is None else 'given'}) is not"
+            f" its last generation's: {'none before the first generation' if gen == 0 else f'return {enc_float(champion)} and a genome'}"
+        )
+    if opt._parents is not None and gen == 0:
+        raise NeurohoverError(f"{what} has parents before its first generation")
+    returns = [r for r, _ in opt._hall]
+    seen = {row.champion_return for row in history}
+    if len(returns) > min(gen, opt.settings.select_size) or returns != sorted(returns, reverse=True) or not seen.issuperset(returns):
+        raise NeurohoverError(
+            f"{what}'s hall_of_fame returns {brief([enc_float(r) for r in returns])} are not allowed: at most select_size"
+            f" ({opt.settings.select_size}) and generation ({gen}) of its generations' champion returns, best first"
+        )
 
 
 def _flag(value: Any) -> bool:
