@@ -35,10 +35,12 @@ from .common import (
     check_state,
     dec_array,
     enc_array,
+    enc_float,
     rank,
     read_count,
     read_entry,
     read_seconds,
+    read_settings,
     require_int,
     require_prob,
     require_spread,
@@ -178,6 +180,15 @@ class SteadyStateSettings:
         set_field(self, "plateau_threshold", require_int("plateau_threshold", self.plateau_threshold, 1))
 
 
+#: The settings a state written before a field existed ran with (the class's defaults, but the literal plateau rule).
+_OLD_SETTINGS = {
+    "plateau_rule": "literal",
+    "selection": "roulette",
+    "tournament_size": TOURNAMENT_SIZE,
+    "init_mutate_frac": None,
+    "init_mutate_std": None,
+    "mutation_floor": None,
+}
 #: Every entry a :meth:`SteadyStateNE.state_dict` has held (the format only ever gained entries).
 STATE_ENTRIES = ("type", "version", "settings", "prototype", "population", "fitness", "pending", "generation", "rng", "tracker", "wall_seconds")
 
@@ -443,8 +454,9 @@ class SteadyStateNE(ChampionViews):
         check_state(state, "SteadyStateNE")
         kind = "SteadyStateNE"
         check_entries(state, kind, STATE_ENTRIES)
-        # States written before the plateau rule existed followed the literal rule.
-        settings = read_entry(state, kind, "settings", lambda s: SteadyStateSettings(**{"plateau_rule": "literal", **s}))
+        # States written before the plateau rule existed followed the literal rule; {} was read as the defaults (T19-09).
+        names = tuple(f.name for f in dataclasses.fields(SteadyStateSettings))
+        settings = read_entry(state, kind, "settings", lambda s: read_settings(s, SteadyStateSettings, names, _OLD_SETTINGS))
         opt = cls(read_entry(state, kind, "prototype", lambda a: dec_array(a, "prototype")), settings)
         d, n = opt._prototype.size, settings.pop_size
         # Each array's rows as the settings make them: a pop_size that disagreed with the population was run on (sixteenth trial).
@@ -460,4 +472,27 @@ class SteadyStateNE(ChampionViews):
         opt._rng = read_entry(state, kind, "rng", rng_from_state)
         opt._tracker = read_entry(state, kind, "tracker", lambda t: ChampionTracker.from_dict(t, d))
         opt._clock = Clock(read_entry(state, kind, "wall_seconds", read_seconds))
+        _check_progress(opt)
         return opt
+
+
+def _check_progress(opt: SteadyStateNE) -> None:
+    """NeurohoverError unless a restored optimiser's generation, evaluations, population and champion agree as
+    :meth:`SteadyStateNE.tell` makes them: a generation of 2**70, an all-NaN fitness beside a finite champion and a
+    champion's return of -1 below the population's best were taken (T19-08, T19-09)."""
+    s, gen, t, what = opt.settings, opt._generation, opt._tracker, "SteadyStateNE state dict"
+    evaluations = 0 if gen == 0 else s.pop_size + (gen - 1) * (s.pop_size - s.elite_size)  # the first batch is the whole population
+    if (opt._population is None) != (gen == 0) or t.evaluations != evaluations:
+        raise NeurohoverError(
+            f"{what} has generation={gen}, tracker evaluations={t.evaluations} and {'no' if opt._population is None else 'a'} population:"
+            f" generation {gen} is {evaluations} evaluations (pop_size {s.pop_size}, then {s.pop_size - s.elite_size} a generation),"
+            " with a population after the first"
+        )
+    if opt._fitness is None:
+        return
+    best = float(np.max(np.fmax(opt._fitness, -np.inf)))  # NaN as -inf, as the tracker ranks it
+    if best > t.best or (s.elite_size and best != t.best):  # the elite keeps the champion in the population
+        raise NeurohoverError(
+            f"{what}'s fitness (best {enc_float(best)}) disagrees with its champion's return {enc_float(t.best)}:"
+            f" {'the population keeps the champion' if s.elite_size else 'no return is above the champion'}"
+        )
