@@ -18,7 +18,7 @@ and its state is part of :meth:`OpenAIES.state_dict`, so a resumed run continues
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields
 from typing import Any
 
 import numpy as np
@@ -28,6 +28,7 @@ from ..common import (
     STATE_VERSION,
     ChampionTracker,
     Clock,
+    EntryError,
     PopulationOptimiser,
     TellInfo,
     as_returns,
@@ -42,9 +43,11 @@ from ..common import (
     read_count,
     read_entry,
     read_seconds,
+    read_settings,
     require_population,
     require_spread,
     require_std,
+    required,
     rng_from_state,
     set_field,
 )
@@ -208,18 +211,33 @@ class OpenAIES(PopulationOptimiser):
         check_state(state, "OpenAIES")
         kind = "OpenAIES"
         check_entries(state, kind, STATE_ENTRIES)
-        settings = read_entry(state, kind, "settings", lambda s: OpenAIESSettings(**s))
-        opt = cls(read_entry(state, kind, "mean", lambda a: dec_array(a, "mean")), settings)
+        names = tuple(f.name for f in fields(OpenAIESSettings))
+        settings = read_entry(state, kind, "settings", lambda s: read_settings(s, OpenAIESSettings, names, {}))  # {}: the defaults (T19-03)
+        opt = cls(read_entry(state, kind, "mean", lambda a: required(dec_array(a, "mean"), "mean")), settings)
         d = opt.mean.size
-        opt._m, opt._v = read_entry(
-            state, kind, "adam", lambda a: tuple(check_genomes(dec_array(a[i], "Adam moment"), d, "Adam moment", rows=0) for i in (0, 1))
-        )
+        opt._m, opt._v = read_entry(state, kind, "adam", lambda a: _moments(a, d))
         opt.generation = read_entry(state, kind, "generation", read_count)
         opt._eps = read_entry(state, kind, "pending", lambda a: check_genomes(dec_array(a, "pending noise"), d, "pending noise", rows=opt.popsize // 2))
         opt._rng = read_entry(state, kind, "rng", rng_from_state)
         opt._tracker = read_entry(state, kind, "tracker", lambda t: ChampionTracker.from_dict(t, d))
         opt._clock = Clock(read_entry(state, kind, "wall_seconds", read_seconds))
+        if opt._tracker.evaluations != opt.generation * opt.popsize:  # each generation tells popsize returns
+            raise NeurohoverError(
+                f"OpenAIES state dict has generation={opt.generation} and tracker evaluations={opt._tracker.evaluations}:"
+                f" each generation is popsize={opt.popsize} evaluations, so {opt.generation * opt.popsize}"
+            )
         return opt
+
+
+def _moments(value: Any, size: int) -> tuple[np.ndarray, np.ndarray]:
+    """Adam's two moments of a saved state: genomes of ``size`` finite numbers, the second >= 0 (a moment of None was a
+    TypeError at the first tell(); T19-03)."""
+    if isinstance(value, (list, dict)) and len(value) != 2:  # other values fail at indexing
+        raise EntryError("not Adam's two moments: allowed a list of the two arrays state_dict() wrote")
+    m, v = (check_genomes(required(dec_array(value[i], "Adam moment"), "Adam moment"), size, "Adam moment", rows=0) for i in (0, 1))
+    if np.any(v < 0.0):  # a running mean of squares: its square root is taken
+        raise EntryError("Adam's second moment holds a negative number: allowed numbers >= 0")
+    return m, v
 
 
 def _make(genome: np.ndarray, settings: OpenAIESSettings, seed: int) -> OpenAIES:
