@@ -157,8 +157,17 @@ _MANIFEST_FIELDS: dict[str, tuple[tuple[type, ...], str]] = {
 }  # fmt: skip
 
 
+# Every key a build writes into a manifest, of a GHH or an FGHH set, and the descriptive fields above.
+_MANIFEST_KEYS = ("task", *_MANIFEST_FIELDS, "safe", "crashes_on_training_mdps", "mean_return_on_training_mdps", "table3")
+
+
 def _check_manifest_fields(manifest: dict, path: Path) -> None:
-    """Refuse a descriptive field of the wrong kind by name (sixth trial: n_steps "x", a lineage 5 were shown as given)."""
+    """Refuse a key no build writes and a descriptive field of the wrong kind by name (sixth trial: n_steps "x", a
+    lineage 5 were shown as given)."""
+    unknown = [key for key in manifest if key not in _MANIFEST_KEYS]
+    if unknown:  # "bogus": 1, or a misspelt "saef", was ignored without a word (T19-13)
+        shown = ", ".join(brief(key) for key in unknown[:5]) + (f" and {len(unknown) - 5} more" if len(unknown) > 5 else "")
+        raise NeurohoverError(f"policy-set manifest {str(path)!r} has unknown keys {shown}: allowed {', '.join(_MANIFEST_KEYS)}")
     for name, (kinds, allowed) in _MANIFEST_FIELDS.items():
         value = manifest.get(name)
         if value is None:

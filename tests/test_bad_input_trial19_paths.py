@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 from pathlib import Path
 
 import pytest
@@ -55,3 +56,30 @@ def test_a_dangling_link_is_refused_as_every_output_and_nothing_is_written_throu
     target.write_text("{}")  # a link to a file that exists is written through, the link kept
     rc, _, err = cli(*EVOLVE, "--out", "pp/out_link")
     assert rc == 0 and (tmp_path / "pp" / "out_link").is_symlink() and json.loads(target.read_text())["genome"], err
+
+
+def _set_with(tmp_path: Path, task: str, **extra) -> Path:
+    from neurohover.policysets import policy_dir
+
+    shutil.copytree(policy_dir(task), tmp_path / task)
+    manifest = tmp_path / task / "manifest.json"
+    manifest.write_text(json.dumps({**json.loads(manifest.read_text()), **extra}))
+    return manifest
+
+
+@pytest.mark.parametrize(("task", "key"), [("ghh08", "bogus"), ("ghh09", "saef"), ("fghh", "Sigma")])
+def test_an_unknown_manifest_key_is_refused_naming_the_file_and_the_allowed_keys(tmp_path: Path, task: str, key: str) -> None:
+    """T19-13: a policy set's manifest with "bogus": 1 was flown without a word (a misspelt key is lost the same way)."""
+    from neurohover.policysets import load_policy_set
+
+    manifest = _set_with(tmp_path, task, **{key: 1})
+    with pytest.raises(NeurohoverError, match=f"policy-set manifest '{manifest}' has unknown keys '{key}': allowed task, sigma, budget, .*table3$"):
+        load_policy_set(task, tmp_path)
+
+
+def test_compete_refuses_a_policy_set_whose_manifest_has_an_unknown_key(tmp_path: Path, cli) -> None:
+    """T19-13, as found: compete --policy-dir D ran without a word."""
+    manifest = _set_with(tmp_path / "pd", "ghh08", bogus=1)
+    argv = ("--agent", "model-free", "--runs", "1", "--episodes", "1", "--episode-steps", "10", "--out", str(tmp_path / "o"))
+    rc, _, err = cli("compete", "--task", "ghh08", *argv, "--policy-dir", str(tmp_path / "pd"))
+    assert rc == 2 and f"policy-set manifest '{manifest}' has unknown keys 'bogus': allowed task," in err and "safe" in err, err
