@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 from pathlib import Path
 
@@ -83,3 +84,16 @@ def test_compete_refuses_a_policy_set_whose_manifest_has_an_unknown_key(tmp_path
     argv = ("--agent", "model-free", "--runs", "1", "--episodes", "1", "--episode-steps", "10", "--out", str(tmp_path / "o"))
     rc, _, err = cli("compete", "--task", "ghh08", *argv, "--policy-dir", str(tmp_path / "pd"))
     assert rc == 2 and f"policy-set manifest '{manifest}' has unknown keys 'bogus': allowed task," in err and "safe" in err, err
+
+
+@pytest.mark.parametrize(("text", "where"), [(b'name = "\xe9"\n', "line 1, column 9"), (b'\xef\xbb\xbfname = "a"\n# caf\xe9\n', "line 2, column 6")])
+def test_a_config_that_is_no_utf8_names_the_rule_and_the_byte(tmp_path: Path, cli, text: bytes, where: str) -> None:
+    """T19-15: a Latin-1 config was "cannot be read (UnicodeDecodeError)"; the place counts from after a byte-order mark."""
+    from neurohover.experiments.config import load_config
+
+    (tmp_path / "bad.toml").write_bytes(text)
+    why = f"config '{tmp_path}/bad.toml' cannot be read: a config must be UTF-8 text, and byte 0xe9 at {where} is not"
+    with pytest.raises(NeurohoverError, match=re.escape(why)):
+        load_config(str(tmp_path / "bad.toml"), "quick")
+    rc, _, err = cli("reproduce", str(tmp_path / "bad.toml"), "--store", str(tmp_path / "s.sqlite"))
+    assert rc == 2 and why in err and not (tmp_path / "s.sqlite").exists(), err

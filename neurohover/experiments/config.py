@@ -252,6 +252,15 @@ def parse_overrides(texts: list[str] | None, option: str = "--set") -> dict[str,
     return out
 
 
+def _bad_byte(err: UnicodeDecodeError) -> str:
+    """Where ``err`` found the first byte that is no UTF-8 in the text it decoded: "byte 0xe9 at line 1, column 9"."""
+    data = bytes(err.object)  # utf-8-sig: the text after a byte-order mark, which the line and column count from
+    start = max(0, min(err.start, len(data) - 1))
+    line = data.count(b"\n", 0, start) + 1
+    column = start - (data.rfind(b"\n", 0, start) + 1) + 1
+    return f"byte {data[start]:#04x} at line {line}, column {column}"
+
+
 def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None = None) -> ExperimentConfig:
     """Load, resolve and validate an experiment config at ``scale`` (``quick`` or ``paper``)."""
     if not isinstance(scale, str) or scale not in SCALES:  # an array was numpy's 'truth value is ambiguous' (T18-3)
@@ -265,8 +274,10 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
         raise NeurohoverError(f"config {str(path)!r} is not valid TOML: {err}") from None
     except RecursionError:  # a value nested thousands deep (seventh trial)
         raise NeurohoverError(f"config {str(path)!r} is not allowed: its TOML is nested too deeply") from None
-    except (OSError, UnicodeDecodeError) as err:
-        raise NeurohoverError(f"config {str(path)!r} cannot be read ({getattr(err, 'strerror', None) or type(err).__name__})") from None
+    except UnicodeDecodeError as err:  # was "cannot be read (UnicodeDecodeError)", naming neither the rule nor the place (T19-15)
+        raise NeurohoverError(f"config {str(path)!r} cannot be read: a config must be UTF-8 text, and {_bad_byte(err)} is not (save it as UTF-8)") from None
+    except OSError as err:
+        raise NeurohoverError(f"config {str(path)!r} cannot be read ({err.strerror or type(err).__name__})") from None
     where = f"config {str(path)!r}"
     allowed_top = {"name", "title", "kind", "paper_ref", "aliases", "settings", "scales", "paper"}
     unknown = sorted(set(raw) - allowed_top)
