@@ -86,9 +86,9 @@ def test_compete_refuses_a_policy_set_whose_manifest_has_an_unknown_key(tmp_path
     assert rc == 2 and f"policy-set manifest '{manifest}' has unknown keys 'bogus': allowed task," in err and "safe" in err, err
 
 
-@pytest.mark.parametrize(("text", "where"), [(b'name = "\xe9"\n', "line 1, column 9"), (b'\xef\xbb\xbfname = "a"\n# caf\xe9\n', "line 2, column 6")])
+@pytest.mark.parametrize(("text", "where"), [(b'name = "\xe9"\n', "line 1, column 9"), (b'\xef\xbb\xbfname = "a"\n# \xc3\xa9t\xe9\n', "line 2, column 5")])
 def test_a_config_that_is_no_utf8_names_the_rule_and_the_byte(tmp_path: Path, cli, text: bytes, where: str) -> None:
-    """T19-15: a Latin-1 config was "cannot be read (UnicodeDecodeError)"; the place counts from after a byte-order mark."""
+    """T19-15: a Latin-1 config was "cannot be read (UnicodeDecodeError)"; the place counts characters, from after a byte-order mark."""
     from neurohover.experiments.config import load_config
 
     (tmp_path / "bad.toml").write_bytes(text)

@@ -257,7 +257,7 @@ def _bad_byte(err: UnicodeDecodeError) -> str:
     data = bytes(err.object)  # utf-8-sig: the text after a byte-order mark, which the line and column count from
     start = max(0, min(err.start, len(data) - 1))
     line = data.count(b"\n", 0, start) + 1
-    column = start - (data.rfind(b"\n", 0, start) + 1) + 1
+    column = len(data[data.rfind(b"\n", 0, start) + 1 : start].decode()) + 1  # in characters: all before it is UTF-8
     return f"byte {data[start]:#04x} at line {line}, column {column}"
 
 
