@@ -11,7 +11,10 @@ from .policies import GENOME_LENGTH, TOPOLOGIES
 from .sim.constants import MAX_EPISODE_STEPS, SAFEGUARD_LIMITS
 from .sim.kernel import GENOME_WIDTH
 
-__all__ = ["KernelFlyer"]
+__all__ = ["MAX_EPISODE_INDEX", "KernelFlyer"]
+
+#: The last episode index the kernel holds (its episode indices are int64): past it np.add overflowed (T19-01).
+MAX_EPISODE_INDEX = 2**63 - 1
 
 
 class KernelFlyer:
@@ -125,13 +128,24 @@ class KernelFlyer:
         return views
 
     def reserve(self, n: int) -> int:
-        """Reserve the next ``n`` episode indices for calls with explicit ``episode_index``; returns the first."""
+        """Reserve the next ``n`` episode indices for calls with explicit ``episode_index``; returns the first
+        (NeurohoverError where they would pass :data:`MAX_EPISODE_INDEX`, as :meth:`fly` gives)."""
         if not whole_number(n) or n < 0:  # -5 handed out flown indices again, 1.5 a float one (thirteenth trial, F17)
             raise NeurohoverError(f"n={brief(n)} is not allowed: give the number of episode indices to reserve, an integer >= 0")
         n = int(n)
         first = self.next_index
+        self._check_room(n)
         self.next_index += n
         return first
+
+    def _check_room(self, n: int) -> None:
+        """NeurohoverError unless ``n`` more episode indices from :attr:`next_index` stay within :data:`MAX_EPISODE_INDEX`
+        (a resumed next_index of 2**70 was an OverflowError, and 2**63-1 wrapped to negative indices; T19-01)."""
+        if self.next_index > MAX_EPISODE_INDEX + 1 - n:
+            raise NeurohoverError(
+                f"episode indices run out: {n:,} more episodes from index {self.next_index:,} pass the kernel's last episode index 2**63-1; "
+                "start a new run instead"
+            )
 
     def _load_genomes(self, genomes: np.ndarray) -> None:
         n_pol = genomes.shape[0]
@@ -180,6 +194,7 @@ class KernelFlyer:
         p = zeros if policy_index is None else (arange if isinstance(policy_index, str) else policy_index)
         m = zeros if mdp_index is None else (arange if isinstance(mdp_index, str) else mdp_index)
         if episode_index is None:
+            self._check_room(n_jobs)
             np.add(arange, self.next_index, out=e)
         else:
             e[:] = episode_index

@@ -9,10 +9,11 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, first_difference, whole_number
 from ..paths import JSONError, strict_json
 from ..policies import Policy
 from .common import EntryError, dec_float, enc_float, read_count, read_seconds
@@ -24,6 +25,9 @@ __all__ = [
     "EvolutionResult",
     "HistoryRecord",
     "ProgressInfo",
+    "check_history",
+    "check_stream",
+    "config_difference",
     "decode_history",
     "encode_history",
     "read_checkpoint",
@@ -249,3 +253,71 @@ def read_checkpoint(path: Path) -> dict:
         raise NeurohoverError(
             f"checkpoint {str(path)!r} is not a checkpoint: {err}" if err.deep else f"checkpoint {str(path)!r} is not valid JSON: {err}"
         ) from None
+
+
+def check_history(records: list[HistoryRecord], counts: dict[str, int], per_generation: bool) -> None:
+    """EntryError unless ``records`` can be the history of a run at checkpoint counters ``counts``: generations rising
+    from 1, evaluations and episodes never falling nor past the counters, and, where the run records every generation
+    (``per_generation``), one row each (a history of three copies of its one row was resumed and written out; T19-08)."""
+    last = None
+    for n, h in enumerate(records):
+        if h.generation < 1 or (last is not None and h.generation <= last.generation):
+            after = "generations start at 1" if last is None else f"after row {n - 1}'s generation {last.generation:,}: generations rise row by row"
+            raise EntryError(f"history row {n} (from 0): generation={h.generation:,} is not allowed ({after})")
+        for column in ("evaluations", "episodes"):
+            if last is not None and getattr(h, column) < getattr(last, column):
+                raise EntryError(f"history row {n} (from 0): {column}={getattr(h, column):,} is not allowed (below row {n - 1}'s {getattr(last, column):,})")
+        if h.generation_episodes > h.episodes:
+            raise EntryError(f"history row {n} (from 0): generation_episodes={h.generation_episodes:,} is not allowed (more than its {h.episodes:,} episodes)")
+        last = h
+    if last is not None:
+        for column in ("generation", "evaluations", "episodes"):
+            if getattr(last, column) > counts[column]:
+                raise EntryError(f"history's last row has {column}={getattr(last, column):,}, past the checkpoint's {column} counter {counts[column]:,}")
+    if per_generation and len(records) != counts["generation"]:
+        raise EntryError(f"history has {len(records):,} rows for {counts['generation']:,} generations: this run records every generation, one row each")
+
+
+#: The entries of a PCG64 bit generator's state (numpy's ``bit_generator.state``): the largest value of each, and as text.
+_STREAM_TOPS = {"state": (2**128 - 1, "2**128-1"), "inc": (2**128 - 1, "2**128-1"), "has_uint32": (1, "1"), "uinteger": (2**32 - 1, "2**32-1")}
+
+
+def check_stream(stream: Any, kind: str) -> None:
+    """TypeError or ValueError unless ``stream`` is a state of the ``kind`` (PCG64) bit generator as numpy writes it:
+    its setter took a state or inc of True, 1.5 or 2**70 and a has_uint32 of -1 (T19-08)."""
+    entries = ("bit_generator", "state", "has_uint32", "uinteger")
+    if kind != "PCG64" or not isinstance(stream, dict) or sorted(stream) != sorted(entries) or stream["bit_generator"] != kind:
+        raise TypeError(f"mdp_stream={brief(stream)} is not allowed: allowed a {kind} state table ({', '.join(entries)}) as the run wrote it")
+    inner = stream["state"]
+    if not isinstance(inner, dict) or sorted(inner) != ["inc", "state"]:
+        raise TypeError(f"mdp_stream's state={brief(inner)} is not allowed: allowed a table of state and inc")
+    for name, value in (("state.state", inner["state"]), ("state.inc", inner["inc"]), ("has_uint32", stream["has_uint32"]), ("uinteger", stream["uinteger"])):
+        top, text = _STREAM_TOPS[name.rpartition(".")[2]]
+        if not whole_number(value) or not 0 <= value <= top:
+            raise ValueError(f"mdp_stream's {name}={brief(value)} is not allowed: allowed an integer in 0..{text}")
+    if inner["inc"] % 2 == 0:  # numpy sets (seed sequence << 1) | 1
+        raise ValueError(f"mdp_stream's state.inc={brief(inner['inc'])} is not allowed: a PCG64 increment is odd")
+
+
+def _same(saved: Any, given: Any) -> bool:
+    """Whether a checkpoint's config value ``saved`` is the run's ``given`` one, a bool never a number: True == 1 took
+    crossover_prob=true for 1.0 (T19-08)."""
+    if isinstance(saved, dict) and isinstance(given, dict):
+        return saved.keys() == given.keys() and all(_same(saved[k], given[k]) for k in saved)
+    if isinstance(saved, (list, tuple)) and isinstance(given, (list, tuple)):
+        return len(saved) == len(given) and all(_same(a, b) for a, b in zip(saved, given))
+    if isinstance(saved, (dict, list, tuple)) or isinstance(given, (dict, list, tuple)):
+        return False
+    return isinstance(saved, (bool, np.bool_)) == isinstance(given, (bool, np.bool_)) and bool(saved == given)
+
+
+def config_difference(path: str, saved: Any, given: Any) -> str | None:
+    """Where a checkpoint's config value ``saved`` (at ``path``) first differs from the ``given`` one of the run
+    resuming it (:func:`_same`): the message part that names both, or None where they agree."""
+    if isinstance(saved, dict) and isinstance(given, dict):
+        for key in sorted(set(saved) | set(given), key=str):
+            found = config_difference(f"{path}.{key}", saved.get(key), given.get(key))
+            if found is not None:
+                return found
+        return None
+    return None if _same(saved, given) else first_difference(path, saved, given, "the checkpoint's")

@@ -19,15 +19,15 @@ from typing import Any, cast
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, first_difference, whole_number
-from ..flyer import KernelFlyer
+from ..errors import NeurohoverError, brief, finite_real, whole_number
+from ..flyer import MAX_EPISODE_INDEX, KernelFlyer
 from ..launch import Parking
 from ..policies import Policy
 from ..sim.lanes import LANES
 from .bandits import BANDITS, top_mu_bandit
 from .common import STATE_DAMAGE, EntryError, Optimiser, TellInfo, check_entries, check_genomes, damage_text, dec_array, dec_float, enc_float
 from .config import MAX_BUDGET, RACE_T_LIMIT, RunConfig, next_auto_delta, upgrade_saved_config
-from .fitness import episode_fitness
+from .fitness import ERROR_FLOOR, episode_fitness
 from .generational import GenerationalNE
 from .optimisers import OPTIMISERS
 from .race_sampler import RaceSampler
@@ -38,6 +38,9 @@ from .records import (
     EvolutionResult,
     HistoryRecord,
     ProgressInfo,
+    check_history,
+    check_stream,
+    config_difference,
     decode_history,
     encode_history,
     write_checkpoint,
@@ -160,9 +163,9 @@ class Run:
                 raise TypeError(f"its config is a {type(saved).__name__}, not a table")
         except (KeyError, TypeError, ValueError, AttributeError) as err:
             raise _damaged(source, err) from None
-        if saved != self.config:
-            diff = sorted(k for k in set(saved) | set(self.config) if saved.get(k) != self.config.get(k))
-            values = "; ".join(first_difference(k, saved.get(k), self.config.get(k), "the checkpoint's") for k in diff)
+        found = [d for k in sorted(set(saved) | set(self.config), key=str) if (d := config_difference(k, saved.get(k), self.config.get(k))) is not None]
+        if found:
+            values = "; ".join(found)
             raise NeurohoverError(  # the values named, not only their keys (tenth trial)
                 f"{source} was written by a different run ({values}); resume with the same "
                 "target, method, optimizer, resampling, topology, prototype, seed, episode steps and settings (only the budget may change)"
@@ -172,9 +175,10 @@ class Run:
         except STATE_DAMAGE as err:  # from_state_dict names the damaged entry; a state's own class may raise more
             raise NeurohoverError(f"{source}: cannot restore the optimiser ({damage_text(err)})") from None
         try:
-            parts = _restored_parts(state, self.resampling.delta, self.cfg.prototype.genome.size)
+            parts = _restored_parts(state, self)
             _check_run_entries(state, self.mdp_rng is None)
             if self.mdp_rng is not None:
+                check_stream(state["mdp_stream"], type(self.mdp_rng.bit_generator).__name__)
                 stream = np.random.Generator(type(self.mdp_rng.bit_generator)())
                 stream.bit_generator.state = state["mdp_stream"]
         except (KeyError, TypeError, ValueError, AttributeError, IndexError, OverflowError) as err:
@@ -492,29 +496,70 @@ def _check_run_entries(state: dict, one_mdp: bool) -> None:
         raise EntryError(f"mdp_stream={brief(stream)} is not allowed: allowed null (a run on one MDP draws no MDPs)")
 
 
-def _restored_parts(state: dict, delta: Any, genome_size: int) -> dict[str, Any]:
-    """The run's counters, champion, history and race delta read from checkpoint ``state``, each checked (ValueError,
+def _restored_parts(state: dict, run: Run) -> dict[str, Any]:
+    """The counters, champion, history and race delta of checkpoint ``state`` for ``run``, each checked (ValueError,
     TypeError or KeyError naming what is wrong), before any of them is restored."""
     c = state["counters"]
-    counts = {k: c[k] for k in ("episodes", "steps", "generation", "evaluations")}
-    # Checkpoints before races reserved indices: every index flown was counted.
-    counts["next_index"], counts["flown"] = c.get("next_index", c["episodes"]), c.get("flown", c["episodes"])
-    for k, v in counts.items():
-        if isinstance(v, bool) or not isinstance(v, int) or v < 0:
-            raise ValueError(f"counter {k!r} is {v!r}, not a count (an integer >= 0)")
+    counts = _checked_counts(c, run.cfg.n_steps)
     seconds = {k: c[k] for k in ("wall_seconds", "kernel_seconds")}
     for k, v in seconds.items():
         if not (finite_real(v) and v >= 0):  # finite_real: '1.5' was read as 1.5 (sixteenth trial)
             raise ValueError(f"counter {k!r} is {brief(v)}, not a number of seconds >= 0")
-    ch = state["champion"]
+    champion = _checked_champion(state["champion"], run.cfg.prototype.genome.size, run.fitness)
+    race_delta = state.get("race_delta", run.resampling.delta)  # absent before race:auto: the fixed delta
+    if race_delta is not None and (isinstance(race_delta, bool) or not isinstance(race_delta, (int, float)) or not 0 < race_delta < 1):
+        raise ValueError(f"race_delta is {race_delta!r}, not a confidence level in (0, 1)")
+    history = decode_history(state["history"])
+    # Generational runs and population optimisers on a family record every generation; the others each new champion.
+    check_history(history, counts, per_generation=run.method == "generational" or (run.method in OPTIMISERS and run.family is not None))
+    return {"counters": counts, "seconds": seconds, "champion": champion, "history": history, "race_delta": race_delta}
+
+
+def _checked_counts(c: dict, n_steps: int) -> dict[str, int]:
+    """Checkpoint counters ``c`` of a run of ``n_steps``-step episodes, each a count in 0..:data:`MAX_COUNT` and in
+    step with the others (2**70 as next_index was an OverflowError mid-run, as flown or generation taken; T19-01, T19-08)."""
+    counts = {k: c[k] for k in ("episodes", "steps", "generation", "evaluations")}
+    # Checkpoints before races reserved indices: every index flown was counted.
+    counts["next_index"], counts["flown"] = c.get("next_index", c["episodes"]), c.get("flown", c["episodes"])
+    for k, v in counts.items():
+        if not whole_number(v) or v < 0 or (k != "steps" and v > MAX_COUNT):  # (the steps are bounded by the episodes, below)
+            raise ValueError(f"counter {k!r} is {brief(v)}, not a count: allowed an integer in 0..2**62 ({_COUNT_LIMIT})")
+    # Rules every run keeps: each counted episode was flown, each flown one had its own index, an episode has at most
+    # n_steps steps, and a generation evaluates at least one candidate.
+    for k, v, bound, why in (
+        ("flown", counts["flown"], counts["episodes"], f"below the {counts['episodes']:,} episodes counted (each was flown)"),
+        ("next_index", counts["next_index"], counts["flown"], f"below the {counts['flown']:,} episodes flown (each flew its own index)"),
+        ("evaluations", counts["evaluations"], counts["generation"], f"below the {counts['generation']:,} generations (each evaluates a candidate)"),
+    ):
+        if v < bound:
+            raise ValueError(f"counter {k!r} is {v:,}, {why}")
+    if counts["steps"] > counts["episodes"] * n_steps:
+        raise ValueError(f"counter 'steps' is {counts['steps']:,}, more than {counts['episodes']:,} episodes of {n_steps:,} steps can have")
+    return counts
+
+
+#: The most a checkpoint's counters may be (T19-01): half the kernel's episode indices (0..2**63-1), the other half room
+#: for the resumed run's episodes (4.6e18: centuries of flying, where the most a budget may be is 1e10).
+MAX_COUNT = (MAX_EPISODE_INDEX + 1) // 2
+_COUNT_LIMIT = "half the kernel's episode indices 0..2**63-1: the rest is room for the resumed run's episodes"
+
+
+def _checked_champion(ch: dict, genome_size: int, scale: str) -> tuple[np.ndarray | None, float]:
+    """The champion table ``ch`` of a checkpoint: its genome (or None) and its fitness on ``scale`` (a return of 2**70,
+    which no episode can score, was taken; T19-08)."""
     genes = ch["genome"]  # a list of numbers, checked one by one as an optimiser's arrays are: True was read as 1.0 (sixteenth trial)
     genome = check_genomes(
         None if genes is None else dec_array({"shape": [len(genes)], "data": genes}, "the champion genome"), genome_size, "the champion genome", rows=0
     )
-    if math.isnan(dec_float(ch["return"])):
+    value = dec_float(ch["return"])
+    if math.isnan(value):
         raise ValueError("the champion's return is nan")
-    race_delta = state.get("race_delta", delta)  # absent before race:auto: the fixed delta
-    if race_delta is not None and (isinstance(race_delta, bool) or not isinstance(race_delta, (int, float)) or not 0 < race_delta < 1):
-        raise ValueError(f"race_delta is {race_delta!r}, not a confidence level in (0, 1)")
-    history = decode_history(state["history"])
-    return {"counters": counts, "seconds": seconds, "champion": (genome, dec_float(ch["return"])), "history": history, "race_delta": race_delta}
+    if genome is None and value != -math.inf:
+        raise ValueError(f"the champion's return is {brief(ch['return'])} without a champion genome: allowed '-inf' (no champion yet)")
+    # A return is minus a sum of squares (<= 0); an inv-log-error fitness 1/ln(error) with error >= ERROR_FLOOR (fitness.py).
+    low, high, allowed = (
+        (0.0, 1.0 / math.log(ERROR_FLOOR), "'-inf' or a number in 0..1/ln(1+1e-6)") if scale == "inv-log-error" else (-math.inf, 0.0, "'-inf' or a number <= 0")
+    )
+    if value != -math.inf and not (low <= value <= high * (1 + 1e-9)):  # (a mean may round an ulp past its largest value)
+        raise ValueError(f"the champion's return is {brief(ch['return'])}: allowed {allowed} on the run's fitness scale {scale!r}")
+    return genome, value
