@@ -179,7 +179,7 @@ def cmd_wins(args: argparse.Namespace) -> int:
     flew, one stored run per agent and MDP, ties sharing the win), so the agent or risk level to enter
     can be chosen for N. With --against LABEL, each agent against that one alone."""
     from ..experiments import Store
-    from ..experiments.export import resolve_scale
+    from ..experiments.export import checked_units, resolve_scale
     from ..experiments.wins import stored_runs, win_probabilities
     from ..paths import input_file
 
@@ -187,8 +187,9 @@ def cmd_wins(args: argparse.Namespace) -> int:
     lengths = _positive_ints(args.runs, "--runs")
     with Store(args.store, create=False) as store:
         scale = resolve_scale(store, args.name, args.scale)
-        runs = stored_runs(store.results(args.name, scale))
-        groups = store.config(args.name, scale).get("settings", {}).get("groups", [])
+        config, units, _ = checked_units(store, args.name, scale)  # results' check: a unit of kind 'bogus' was a test run here (T19-05)
+        runs = stored_runs({u["key"]: u["result"] for u in units})
+        groups = config.settings.get("groups", [])
     planned = {g.get("label") for g in groups if isinstance(g, dict)} if isinstance(groups, list) else set()
     foreign = sorted(set(runs) - planned)
     if foreign:  # a unit of no planned group was entered as an agent (sixth trial)

@@ -20,7 +20,7 @@ import json
 from ..errors import NeurohoverError, brief
 from .config import ExperimentConfig
 from .keys import UnitKey
-from .results import flat_cells, result_from_dict
+from .results import UnitResult, check_run_lengths, flat_cells, result_from_dict
 from .store import Store
 
 FORMATS = ("csv", "json")
@@ -42,6 +42,46 @@ def resolve_scale(store: Store, name: str, scale: str | None) -> str:
     return scale
 
 
+def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig, list[dict], dict[str, UnitResult]]:
+    """Experiment (name, scale)'s stored config and finished units, each read back and checked: the one check of a stored
+    experiment that results, wins, report and reproduce (compete too) share.
+
+    Returns
+    -------
+    config : ExperimentConfig
+        The stored config.
+    units : list of dict
+        The finished units, as :meth:`~neurohover.experiments.Store.units` gives them.
+    results : dict
+        Unit key -> its typed result (:func:`~neurohover.experiments.results.result_from_dict`).
+
+    Raises
+    ------
+    NeurohoverError
+        One message naming the store, the experiment and the damaged unit (where one is): wins took a unit of kind
+        'bogus' for a test run (T19-05), and results' messages named neither the store nor the unit (T19-14).
+    """
+    where = f"results store {str(store.path)!r}, experiment {name} ({scale}), is damaged"
+    stored = store.config(name, scale)  # the store names a row that is no JSON object itself, as for the units below
+    try:
+        config = ExperimentConfig.from_dict(stored)
+    except NeurohoverError as err:
+        raise NeurohoverError(f"{where}: {err}") from None
+    units = store.units(name, scale)
+    results: dict[str, UnitResult] = {}
+    for u in units:
+        try:
+            results[u["key"]] = result_from_dict(u["kind"], u["result"], u["key"])
+        except NeurohoverError as err:
+            unit = "" if repr(u["key"]) in str(err) else f"unit {u['key']!r}: "
+            raise NeurohoverError(f"{where}: {unit}{err}") from None
+    try:
+        check_run_lengths(config.settings.get("episodes") if config.kind == "test_runs" else None, results)
+    except NeurohoverError as err:
+        raise NeurohoverError(f"{where}: {err}") from None
+    return config, units, results
+
+
 def export_results(store: Store, name: str, fmt: str = "csv", scale: str | None = None) -> str:
     """The finished units of ``name`` as CSV (one row per unit, one plain value per cell) or JSON (everything)."""
     if not isinstance(store, Store):  # a path was an AttributeError (seventh trial)
@@ -49,13 +89,10 @@ def export_results(store: Store, name: str, fmt: str = "csv", scale: str | None 
     if not isinstance(fmt, str) or fmt not in FORMATS:  # an array was numpy's 'truth value is ambiguous' (T18-3)
         raise NeurohoverError(f"unknown format {brief(fmt)}: allowed {', '.join(FORMATS)}")
     scale = resolve_scale(store, name, scale)
-    units = store.units(name, scale)
-    if not units:  # it printed an empty line (seventh trial)
+    if not any(n for e, s, _, n in store.experiments() if (e, s) == (name, scale)):  # it printed an empty line (seventh trial)
         raise NeurohoverError(f"experiment {name} ({scale}) has no finished unit yet: nothing to export (neurohover reproduce runs its units)")
-    config = store.config(name, scale)
-    ExperimentConfig.from_dict(config)  # a damaged one named, as CSV's rows are (sixth trial); exported as stored
-    for u in units:  # JSON exports what CSV does, no damaged result (it exported a list, a score "x"; sixth trial)
-        result_from_dict(u["kind"], u["result"], u["key"])
+    _, units, typed = checked_units(store, name, scale)  # JSON exports what CSV does: no damaged config or unit (sixth trial)
+    config = store.config(name, scale)  # exported as stored
     if fmt == "json":
         return (
             json.dumps(
@@ -79,7 +116,7 @@ def export_results(store: Store, name: str, fmt: str = "csv", scale: str | None 
             "worker": u["worker"],
         }
         flat_cells("param", u["params"], row)
-        row.update({f"result.{k}": v for k, v in result_from_dict(u["kind"], u["result"], u["key"]).columns().items()})
+        row.update({f"result.{k}": v for k, v in typed[u["key"]].columns().items()})
         rows.append(row)
     columns: list[str] = []
     for row in rows:
