@@ -3,11 +3,15 @@ keys, a config that is no UTF-8, progress on a terminal that reports no width (T
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import re
+import select
 import shutil
+import sys
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 
@@ -97,3 +101,42 @@ def test_a_config_that_is_no_utf8_names_the_rule_and_the_byte(tmp_path: Path, cl
         load_config(str(tmp_path / "bad.toml"), "quick")
     rc, _, err = cli("reproduce", str(tmp_path / "bad.toml"), "--store", str(tmp_path / "s.sqlite"))
     assert rc == 2 and why in err and not (tmp_path / "s.sqlite").exists(), err
+
+
+def _drawn(master: int) -> str:
+    """What the pseudo-terminal ``master`` has been sent so far."""
+    out = b""
+    while select.select([master], [], [], 0.2)[0]:
+        chunk = os.read(master, 65536)
+        if not chunk:
+            break
+        out += chunk
+    return out.decode(errors="replace")
+
+
+def test_progress_is_drawn_on_a_terminal_that_reports_no_width_and_not_on_a_pipe(monkeypatch) -> None:
+    """T19-11: on a pseudo-terminal nobody sized (width 0: script, docker exec -t), learn-model's and evolve's progress
+    bars drew nothing, and the commands sat silent for minutes; a stream that is no terminal still sees nothing."""
+    from neurohover.cli import learning
+
+    master, slave = os.openpty()
+    assert os.get_terminal_size(slave).columns == 0  # a fresh pseudo-terminal is never sized
+    with os.fdopen(slave, "w") as terminal:
+        monkeypatch.setattr(sys, "stderr", terminal)
+        with learning._Ticker("learning a model"):
+            pass
+        bar = learning._Bar(40, "evolve ghh08/train:0")
+        bar(SimpleNamespace(episodes=10, champion_return=-5.0, evaluations=10, episodes_per_second=100.0))
+        bar.close()
+        terminal.flush()
+        drawn = _drawn(master)
+    os.close(master)
+    assert "learning a model: 00:00" in drawn and "evolve ghh08/train:0" in drawn and "10/40" in drawn, drawn
+    pipe = io.StringIO()
+    monkeypatch.setattr(sys, "stderr", pipe)
+    with learning._Ticker("learning a model"):
+        pass
+    bar = learning._Bar(40, "evolve")
+    bar(SimpleNamespace(episodes=10, champion_return=-5.0, evaluations=10, episodes_per_second=100.0))
+    bar.close()
+    assert pipe.getvalue() == ""

@@ -96,12 +96,12 @@ def _optimiser_settings(args: argparse.Namespace, over_family: bool) -> dict | N
 
 
 class _Bar:
-    """tqdm progress bar on stderr (silent when stderr is not a terminal)."""
+    """tqdm progress bar on stderr (silent when stderr is not a terminal; :func:`~.options.progress_bar`)."""
 
     def __init__(self, total: int | None, desc: str, note: str | None = None) -> None:
-        from tqdm import tqdm
+        from .options import progress_bar
 
-        self.bar = tqdm(total=total, desc=desc, unit="ep", file=sys.stderr, disable=None, dynamic_ncols=True)
+        self.bar = progress_bar(total=total, desc=desc, unit="ep", dynamic_ncols=True)
         self.note = note  # said once the run is under way: a run refused at its start overwrites nothing
 
     def __call__(self, info) -> None:
@@ -275,12 +275,12 @@ def _evolve_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int
 
 
 class _Ticker:
-    """An elapsed-time tqdm bar for steps without progress reports (learning a model)."""
+    """An elapsed-time tqdm bar for steps without progress reports (learning a model; :func:`~.options.progress_bar`)."""
 
     def __init__(self, desc: str) -> None:
-        from tqdm import tqdm
+        from .options import progress_bar
 
-        self.bar = tqdm(desc=desc, total=None, file=sys.stderr, disable=None, bar_format="{desc}: {elapsed}")
+        self.bar = progress_bar(desc=desc, total=None, bar_format="{desc}: {elapsed}")
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, daemon=True)
 
