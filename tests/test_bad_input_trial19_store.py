@@ -12,6 +12,9 @@ from pathlib import Path
 import pytest
 from conftest import CliRun, tiny_test_runs
 
+from neurohover.errors import NeurohoverError
+from neurohover.experiments import LocalExecutor, Store, reproduce
+
 RUN = "run/baseline/test0/rep0"
 COMPETE = ("compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--episode-steps", "20")
 
@@ -62,6 +65,36 @@ def _error(err: str, command: str) -> str:
     return line.removeprefix(f"neurohover {command}: error: ")
 
 
+@pytest.mark.parametrize("sql", ["ALTER TABLE units DROP COLUMN result", "DROP TABLE units", "ALTER TABLE sessions DROP COLUMN status"])
+def test_a_refused_reproduce_leaves_a_store_of_damaged_tables_as_it_was(tiny, tmp_path: Path, cli: CliRun, sql: str) -> None:
+    """T19-04: reproduce into a store whose units table lacked a column wrote a new experiments row, then said the store
+    was damaged; now the damage is found when the store is opened, before anything is written."""
+    config, good = tiny
+    store = _damaged(good, tmp_path / "s.sqlite", sql)
+    before = _dump(store)
+    other = tmp_path / "other.toml"  # an experiment the store does not hold yet: its row was the one written
+    other.write_text(config.read_text().replace('name = "tr1"', 'name = "tr2"'))
+    rc, _, err = cli("reproduce", str(other), "--store", str(store), "--no-progress")
+    assert rc == 2 and f"results store {str(store)!r} is damaged: its table" in err, err
+    assert _dump(store) == before
+
+
+def test_a_refused_reproduce_of_damaged_units_writes_nothing(tiny, tmp_path: Path) -> None:
+    """T19-04: a stored unit that does not read back was found after begin() had rewritten the experiment's config;
+    now the stored units are checked first."""
+    config, good = tiny
+    path = _damaged(good, tmp_path / "s.sqlite", f"UPDATE units SET kind = 'bogus' WHERE key = '{RUN}'")
+    with sqlite3.connect(path) as conn:
+        conn.execute("UPDATE experiments SET config = json_set(config, '$.title', 'older title')")
+    conn.close()
+    before = _dump(path)
+    from neurohover.experiments import load_config
+
+    with Store(path) as store, pytest.raises(NeurohoverError, match=f"experiment tr1 \\(quick\\), is damaged: unit '{RUN}': unknown unit kind 'bogus'"):
+        reproduce(load_config(str(config), "quick"), store, LocalExecutor(1), progress=False)
+    assert _dump(path) == before
+
+
 @pytest.mark.parametrize(
     ("sql", "says"),
     [
@@ -79,6 +112,25 @@ def test_wins_refuses_the_damage_results_refuses(tiny, tmp_path: Path, cli: CliR
     assert rc == 2 and out == "" and says in err and str(store) in err, err
     rc, _, err_results = cli("results", "tr1", "--store", str(store))
     assert rc == 2 and _error(err_results, "results") == _error(err, "wins")
+
+
+@pytest.mark.parametrize(
+    ("sql", "says"),
+    [
+        ("UPDATE experiments SET config = 'nope'", "'s config is damaged (not JSON"),
+        ("UPDATE experiments SET config = '[]'", "'s config is damaged (a JSON list, not an object)"),
+        ("UPDATE experiments SET config = '{}'", "is damaged: a stored experiment config is damaged"),
+        ("DELETE FROM experiments", "is damaged: it holds 1 finished unit(s) of it but no record of its config"),
+    ],
+)
+def test_compete_refuses_a_damaged_config_and_leaves_the_store_as_it_was(competed: Path, tmp_path: Path, cli: CliRun, sql: str, says: str) -> None:
+    """T19-06: compete took a store whose config was 'nope' or '[]', or whose experiments row was gone while its units
+    stayed, said "1 of 1 units reused" and wrote the config anew; now it refuses, writing nothing."""
+    store = _damaged(competed, tmp_path / "s.sqlite", sql)
+    before = _dump(store)
+    rc, _, err = cli(*COMPETE, "--out", str(tmp_path / "c"), "--store", str(store))
+    assert rc == 2 and says in err and str(store) in err and "reused" not in err, err
+    assert _dump(store) == before
 
 
 @pytest.mark.parametrize(

@@ -12,7 +12,6 @@ from dataclasses import dataclass, field
 from ..errors import NeurohoverError, brief, check_flag
 from .config import POLICY_SOURCES, ExperimentConfig, check_own_name, check_paper_table
 from .plans import Plan, plan, run_keys, source_experiments
-from .results import check_run_lengths, result_from_dict
 from .store import Store
 
 
@@ -126,17 +125,23 @@ def _matches_no_unit(config, pattern: str, units) -> NeurohoverError:
     return NeurohoverError(f"{config.name}: --only {pattern!r} matches no unit; unit keys look like {', '.join(examples[:6])}")
 
 
-def _checked_results(config: ExperimentConfig, store: Store) -> tuple[dict[str, dict], dict[str, tuple[str, dict]]]:
-    """Key -> result of every stored unit of the experiment, each read back (the store refuses a row that is no JSON
-    object; the result's fields are checked here): a damaged unit was counted as finished and never run again (fifth
-    trial). Its config must read back too. Also key -> (kind, params) of each, for :func:`_refuse_stray_units`."""
-    ExperimentConfig.from_dict(store.config(config.name, config.scale))
-    units = store.units(config.name, config.scale)
-    try:
-        typed = {unit["key"]: result_from_dict(unit["kind"], unit["result"], unit["key"]) for unit in units}
-        check_run_lengths(config.settings.get("episodes") if config.kind == "test_runs" else None, typed)
-    except NeurohoverError as err:
-        raise NeurohoverError(f"results store {str(store.path)!r}, experiment {config.name} ({config.scale}), is damaged: {err}") from None
+def _checked_results(config: ExperimentConfig, store: Store, held: str | None) -> tuple[dict[str, dict], dict[str, tuple[str, dict]]]:
+    """Key -> result of every stored unit of the experiment, each read back and checked (:func:`~.export.checked_units`,
+    results' check): a damaged unit was counted as finished and never run again (fifth trial). Also key -> (kind, params)
+    of each, for :func:`_refuse_stray_units`. Called before anything is written (``held``: the stored config hash, None:
+    no config stored), so a refused run leaves the store as it was: a damaged config was rewritten, and units whose config
+    was gone were taken in, by compete (T19-06)."""
+    from .export import checked_units
+
+    if held is None:
+        orphans = store.units(config.name, config.scale)
+        if orphans:
+            raise NeurohoverError(
+                f"results store {str(store.path)!r}, experiment {config.name} ({config.scale}), is damaged: it holds {len(orphans)} finished "
+                "unit(s) of it but no record of its config, so they cannot be checked: give another store (reproduce --fresh discards them)"
+            )
+        return {}, {}
+    units = checked_units(store, config.name, config.scale)[1]
     return {unit["key"]: unit["result"] for unit in units}, {unit["key"]: (unit["kind"], unit["params"]) for unit in units}
 
 
@@ -241,12 +246,14 @@ def reproduce(
     held = store.config_hash(config.name, config.scale)
     if only:  # refused before the store records anything
         _refuse_unmatched(config, store, held, only)
+    checked = None if fresh else _checked_results(config, store, held)  # before anything is written (T19-04, T19-06)
     if update and held is not None and held != config.hash:
         _check_policy_source(config, store)
         kept = store.update(config.name, config.scale, config.hash, config.to_dict(), unchanged_units(config, store))
         print(f"{config.name} ({config.scale}): the config changed (hash {held} -> {config.hash}); {kept} stored units stand unchanged", file=sys.stderr)
+        checked = None  # fewer units now: read again
     store.begin(config.name, config.scale, config.hash, config.to_dict(), fresh=fresh)
-    results, stored = _checked_results(config, store)  # read once: checked, then the finished units
+    results, stored = checked if checked is not None else _checked_results(config, store, config.hash)  # read once: checked, then the finished units
     sources = {name: store.results(name, config.scale) for name in source_experiments(config)}
     first_round: Plan | None = _refuse_stray_units(config, store, results, stored, sources)  # planned once, not twice
     summary = RunSummary(config.name, config.scale, executor.name, executor.cores, units_before=len(results))

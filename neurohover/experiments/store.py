@@ -28,6 +28,7 @@ Readers (``results``, ``report``) take no lock.
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import os
 import socket
@@ -62,6 +63,15 @@ CREATE TABLE sessions (
     wall_seconds REAL NOT NULL, units_run INTEGER NOT NULL, units_before INTEGER NOT NULL,
     status TEXT NOT NULL);
 """
+
+
+@functools.cache
+def _columns() -> dict[str, list[str]]:
+    """Each table's columns, as :data:`_SCHEMA` makes them (read from an empty store in memory: written down once)."""
+    with contextlib.closing(sqlite3.connect(":memory:")) as c:
+        c.executescript(_SCHEMA)
+        tables = [t for (t,) in c.execute("SELECT name FROM sqlite_master WHERE type = 'table' AND name NOT LIKE 'sqlite_%'")]
+        return {t: [r[1] for r in c.execute(f"PRAGMA table_info({t})")] for t in tables}
 
 
 def _dumps(obj: Any) -> str:
@@ -155,6 +165,9 @@ class Store:
             raise NeurohoverError(f"results store {str(self.path)!r} cannot be read ({err})") from None
         except sqlite3.DatabaseError as err:
             raise NeurohoverError(f"{str(self.path)!r} is not a neurohover results store (SQLite says: {err})") from None
+        except NeurohoverError:
+            self._close_quietly()  # refused (another schema, a damaged table): its file not left open
+            raise
 
     _closed = False
 
@@ -250,6 +263,12 @@ class Store:
                 f"this version reads schema version {SCHEMA_VERSION}. Use a new --store file "
                 f"(or the neurohover version that wrote it); results of different schemas are never mixed"
             )
+        for table, columns in _columns().items():  # a dropped column was found only after reproduce had written (T19-04)
+            have = {r[1] for r in c.execute(f"PRAGMA table_info({table})")}
+            lacking = [col for col in columns if col not in have]
+            if lacking:
+                what = "is missing" if not have else f"lacks column(s) {', '.join(lacking)}"
+                raise NeurohoverError(f"results store {str(self.path)!r} is damaged: its table {table} {what}; give another --store file")
 
     # ------------------------------------------------------------------ experiments
 
