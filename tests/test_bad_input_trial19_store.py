@@ -14,6 +14,7 @@ from conftest import CliRun, tiny_test_runs
 
 from neurohover.errors import NeurohoverError
 from neurohover.experiments import LocalExecutor, Store, reproduce
+from neurohover.experiments.config import make_config
 
 RUN = "run/baseline/test0/rep0"
 COMPETE = ("compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--episode-steps", "20")
@@ -131,6 +132,28 @@ def test_compete_refuses_a_damaged_config_and_leaves_the_store_as_it_was(compete
     rc, _, err = cli(*COMPETE, "--out", str(tmp_path / "c"), "--store", str(store))
     assert rc == 2 and says in err and str(store) in err and "reused" not in err, err
     assert _dump(store) == before
+
+
+def test_report_warns_of_each_damaged_experiment_and_exits_2_when_none_is_reported(tiny, tmp_path: Path, cli: CliRun) -> None:
+    """T19-07: a report of a store whose every experiment was damaged exited 0 with "report written", the damage said
+    only inside report.md; now each damaged experiment is one warning line on stderr, and nothing reported is exit 2."""
+    store = _damaged(tiny[1], tmp_path / "s.sqlite", f"UPDATE units SET kind = 'bogus' WHERE key = '{RUN}'")
+    rc, out, err = cli("report", "--store", str(store), "--out", str(tmp_path / "r"))
+    warning = f"neurohover report: warning: tr1 (quick) is not reported: results store {str(store)!r}, experiment tr1 (quick), is damaged: unit '{RUN}'"
+    assert rc == 2 and out == "" and warning in err and "nothing could be reported" in err, err
+    assert not (tmp_path / "r").exists()
+    with Store(store) as held:  # a second experiment, undamaged: reported as before, the damaged one warned of
+        cfg = make_config(
+            "e2",
+            "test_runs",
+            "quick",
+            dict(task="ghh08", seed=1, policies="shipped", episodes=2, n_steps=20, groups=[dict(agent="baseline", mdps="test", n_mdps=1)]),
+        )
+        reproduce(cfg, held, LocalExecutor(1), progress=False)
+    rc, out, err = cli("report", "--store", str(store), "--out", str(tmp_path / "r"))
+    assert rc == 0 and "report written" in out and err.count("warning:") == 1 and warning in err, err
+    text = (tmp_path / "r" / "report.md").read_text()
+    assert "## e2 [quick]" in text and "**Not reported: the store's copy is damaged.**" in text
 
 
 @pytest.mark.parametrize(

@@ -248,7 +248,7 @@ def cmd_report(args: argparse.Namespace) -> int:
         if not held and args.scale is not None:  # a scale the store lacks, before --out is made too (eleventh trial)
             raise NeurohoverError(store.missing_message(None, args.scale))
         output_dir(args.out, "--out")
-        path = write_report(store, args.out, scale=args.scale, names=args.names or None)
+        path = write_report(store, args.out, scale=args.scale, names=args.names or None, refuse_all_damaged=True)  # exit 2 (T19-07)
     print(f"report written to {printable(path)}")
     return 0
 

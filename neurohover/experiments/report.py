@@ -21,8 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError, OutputError, brief, whole_number
+from ..errors import NeurohoverError, OutputError, brief, check_flag, whole_number
 from .config import ORDER, ExperimentConfig, check_paper_table, shipped_counterpart, with_shipped_paper
+from .export import checked_units
 from .keys import UnitKey
 from .report_base import Section, agent_panel, fmt, log_errors, new_figure, paired_p, paired_verdict, ratio_verdict, sd, table
 from .report_claims import PAPER_FIGURES, DiscussionError, claims_section, conclusions_discussion, read_discussion
@@ -30,7 +31,7 @@ from .report_evolution import EvolutionSection
 from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, test_run_figure, varies
 from .report_models import SensorModels
 from .report_readme import Status, fill_generated, linked_claims, status_table
-from .results import ModelResult, TestRunResult, check_run_lengths, result_from_dict
+from .results import ModelResult, TestRunResult
 from .settings import Group, ModelLearningSettings
 from .store import Store
 from .wins import DEFAULT_DRAWS, win_probabilities
@@ -447,13 +448,11 @@ def _section(cfg: ExperimentConfig, store: Store, out: Path, current: bool | Non
     status table; None: not a shipped config, or not paper scale)."""
     from .plans import plan
 
-    units = store.units(cfg.name, cfg.scale)
+    _, units, results = checked_units(store, cfg.name, cfg.scale)  # results' check, and its messages
     try:
         total = plan(cfg, {u["key"]: u["result"] for u in units}).total
     except NeurohoverError:
         total = None
-    results = {u["key"]: result_from_dict(u["kind"], u["result"], u["key"]) for u in units}
-    check_run_lengths(cfg.settings.get("episodes") if cfg.kind == "test_runs" else None, results)
     kind = _SECTIONS[cfg.kind]
     if isinstance(cfg.typed, ModelLearningSettings):
         kind = SensorModels if cfg.typed.conditions else FitFactorial if cfg.typed.fits else kind
@@ -505,10 +504,12 @@ def _discussion(cfg: ExperimentConfig, out: Path) -> str:
     )
 
 
-def write_report(store: Store, out: str | Path, *, scale: str | None = None, names: list[str] | None = None) -> Path:
+def write_report(store: Store, out: str | Path, *, scale: str | None = None, names: list[str] | None = None, refuse_all_damaged: bool = False) -> Path:
     """Write figures and ``report.md`` for the experiments in ``store`` into ``out``; returns report.md's path.
 
-    A ``README.md`` in ``out`` with generated blocks gets them filled from the store (:mod:`.report_readme`).
+    A ``README.md`` in ``out`` with generated blocks gets them filled from the store (:mod:`.report_readme`). A damaged
+    experiment is said in its place and in a warning line on stderr; ``refuse_all_damaged`` (the command line's): when
+    every experiment asked for is damaged, NeurohoverError and nothing written, not a report of the damage alone.
     """
     from ..paths import created_dirs_removed_on_failure, output_dir
 
@@ -525,12 +526,13 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
     twice = sorted({n for n in given if given.count(n) > 1})
     if twice:  # taken once without a word (seventh trial)
         raise NeurohoverError(f"experiment {twice[0]!r} is named more than once: give each once")
+    check_flag(refuse_all_damaged, "refuse_all_damaged", "write nothing when every experiment is damaged")
     with created_dirs_removed_on_failure():  # a failure leaves no directory it made, as on the command line (eleventh trial)
         out = output_dir(out, "report directory")  # '' wrote into the current directory; a file, a device or 5: OSError, TypeError
-        return _write_report(store, out, scale, names)
+        return _write_report(store, out, scale, names, refuse_all_damaged)
 
 
-def _write_report(store: Store, out: Path, scale: str | None, names: list[str] | None) -> Path:
+def _write_report(store: Store, out: Path, scale: str | None, names: list[str] | None, refuse_all_damaged: bool) -> Path:
     from ..paths import printable, writing
 
     entries = [(n, s) for n, s, _, _ in store.experiments() if (scale is None or s == scale) and (not names or n in names)]
@@ -560,6 +562,7 @@ def _write_report(store: Store, out: Path, scale: str | None, names: list[str] |
         except NeurohoverError as err:  # one damaged experiment: said in its place, the others reported as usual
             sections.append(f"## {name} [{sc}]\n\n**Not reported: the store's copy is damaged.** {err}\n")
             toc.append(f"- [{name} [{sc}]](#{_anchor(name + ' [' + sc + ']')}) (damaged)")
+            tqdm.write(f"neurohover report: warning: {name} ({sc}) is not reported: {err}", file=sys.stderr)  # said only in report.md (T19-07)
             continue
         statuses.append(status)
         sections.append(text)
@@ -567,6 +570,8 @@ def _write_report(store: Store, out: Path, scale: str | None, names: list[str] |
         toc.append(f"- [{cfg.title} [{sc}]](#{anchor})")
         if sc == "paper" and name in PAPER_FIGURES:
             claims[name] = (anchor, checked)
+    if refuse_all_damaged and not statuses:  # the command said "report written" and exited 0, the damage only inside (T19-07)
+        raise NeurohoverError(f"nothing could be reported from {str(store.path)!r}: every experiment asked for is damaged (said above); no report written")
     head = (
         f"# Reproduction report: Koppejan & Whiteson (2011)\n\n"
         f"Generated {time.strftime('%Y-%m-%d %H:%M:%S')} from the results store `{printable(store.path)}`. Error is minus the "
