@@ -267,9 +267,9 @@ def test_a_repeated_sensor_key_and_a_damaged_store_are_one_clear_line(tmp_path: 
     data = good.read_bytes()
     damaged = tmp_path / "d.sqlite"
     damaged.write_bytes(data[: len(data) // 2] + b"\x00garbage" * 512 + data[len(data) // 2 + 4096 :])
-    rc = main(["report", "--store", str(damaged), "--out", str(tmp_path / "r")])  # the damaged experiment reported in its place
-    report = (tmp_path / "r" / "report.md").read_text()
-    assert rc == 0 and "**Not reported: the store's copy is damaged.**" in report and f"results store {str(damaged)!r} is damaged" in report
+    rc = main(["report", "--store", str(damaged), "--out", str(tmp_path / "r")])  # its only experiment damaged: nothing to report (T19-07)
+    err = capsys.readouterr().err
+    assert rc == 2 and "nothing could be reported" in err and f"results store {str(damaged)!r} is damaged" in err
     for argv in (["results", "fig2"], ["wins", "fig2"]):
         rc = main([*argv, "--store", str(damaged)])
         err = capsys.readouterr().err
@@ -495,8 +495,8 @@ def test_a_stored_value_of_the_wrong_kind_is_named_by_report_results_and_wins(tm
     damaged.write_bytes((out / "results.sqlite").read_bytes())
     with sqlite3.connect(damaged) as conn:
         conn.execute("UPDATE units SET result = json_set(result, '$.score', 'x') WHERE key LIKE 'run/%'")
-    assert main(["report", "--store", str(damaged), "--out", str(tmp_path / "rep")]) == 0
-    assert "score = 'x' is not Num" in (tmp_path / "rep" / "report.md").read_text()
+    assert main(["report", "--store", str(damaged), "--out", str(tmp_path / "rep")]) == 2  # nothing else to report (T19-07)
+    assert "score = 'x' is not Num" in capsys.readouterr().err
     for argv in (["results", name, "--store", str(damaged), "--format", "json"], ["wins", name, "--store", str(damaged)]):
         assert main(argv) == 2, argv
         err = capsys.readouterr().err
