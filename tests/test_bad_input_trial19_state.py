@@ -21,6 +21,7 @@ from neurohover.evolution.evolve import evolve
 from neurohover.evolution.generational import GenerationalNE, GenerationalSettings
 from neurohover.evolution.optimisers.cma import CMAES
 from neurohover.evolution.optimisers.openai_es import OpenAIES, OpenAIESSettings
+from neurohover.evolution.optimisers.uh_cma import UHCMAES, UHCMASettings
 from neurohover.evolution.steady_state import SteadyStateNE, SteadyStateSettings
 from neurohover.tasks import get_task_family
 
@@ -228,6 +229,31 @@ def test_a_cma_states_tracker_is_checked_on_loading() -> None:
     opt._tracker.history = []
     with _raises("a champion without a history record"):
         CMAES.from_state_dict(opt.state_dict())
+
+
+@pytest.mark.parametrize(
+    ("name", "value", "fragment"),
+    [
+        ("_rng", None, "its generator None or clock"),
+        ("_clock", None, "or clock None is of the wrong kind"),
+        ("budget", -1, "its budget=-1 is not allowed"),
+        ("budget", True, "its budget=True is not allowed"),
+        ("_pending", "x", "its pending batch 'x' is not allowed"),
+        ("_pending", np.full((4, 4), np.nan), "pending genomes holds a gene that is not a finite number"),
+        ("_pending", np.zeros((4, 3)), "pending genomes has shape (4, 3), expected (n, 4)"),
+    ],
+)
+@pytest.mark.parametrize("cls", [CMAES, UHCMAES])
+def test_a_cma_states_pickled_parts_are_checked_on_loading(cls, name: str, value, fragment: str) -> None:
+    """T19-03: a CMA-ES (or UH-CMA-ES) state whose pickled generator or clock was None, or whose pending batch was
+    text, loaded and failed at the first ask() or tell() with a traceback; a budget of -1 or True was taken. Now the
+    optimiser's own parts are checked on loading."""
+    opt = CMAES(np.zeros(4), popsize=4, seed=1) if cls is CMAES else UHCMAES(np.zeros(4), UHCMASettings(popsize=4), seed=1)
+    opt.ask()
+    assert isinstance(cls.from_state_dict(opt.state_dict()), cls)  # the sound state (between ask and tell) loads
+    setattr(opt, name, value)
+    with _raises(fragment):
+        cls.from_state_dict(opt.state_dict())
 
 
 # --------------------------------------------------------------------------- T19-10: a generation's episodes

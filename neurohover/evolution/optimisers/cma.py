@@ -22,10 +22,12 @@ from .. import common
 from ..common import (
     MAX_POPULATION,
     ChampionTracker,
+    Clock,
     EntryError,
     PopulationOptimiser,
     TellInfo,
     check_entries,
+    check_genomes,
     check_prototype,
     check_state,
     read_entry,
@@ -233,11 +235,24 @@ class CMAES(PopulationOptimiser):
                 raise TypeError(f"it holds a {type(opt).__name__}, not a {kind}")
             # its champion tracking read back as SteadyStateNE's is: evaluations -1 was taken (sixteenth trial)
             ChampionTracker.from_dict(opt._tracker.to_dict(), int(opt._es.N))
+            _check_parts(opt)
             return opt
 
         opt = read_entry(state, kind, "pickle", unpickle)  # {}, 'x': a bare KeyError, binascii.Error (fourteenth trial)
         holder[0] = opt._rng
         return opt
+
+
+def _check_parts(opt: CMAES) -> None:
+    """EntryError unless an unpickled optimiser's own parts are of their kinds: a generator of None, a clock of None
+    or a pending batch of text was a traceback at the first ask() or tell(), a budget of -1 or True was taken (T19-03)."""
+    if not isinstance(opt._rng, np.random.Generator) or not isinstance(opt._clock, Clock):
+        raise EntryError(f"its generator {brief(opt._rng)} or clock {brief(opt._clock)} is of the wrong kind: allowed what state_dict() pickled")
+    if opt.budget is not None and not (whole_number(opt.budget) and opt.budget >= 1):
+        raise EntryError(f"its budget={brief(opt.budget)} is not allowed: None or an integer >= 1")
+    if opt._pending is not None and not (isinstance(opt._pending, np.ndarray) and opt._pending.ndim == 2):
+        raise EntryError(f"its pending batch {brief(opt._pending)} is not allowed: None or genomes, one a row")
+    check_genomes(opt._pending, int(opt._es.N), "pending genomes")
 
 
 @dataclass(frozen=True)
