@@ -140,3 +140,18 @@ def test_progress_is_drawn_on_a_terminal_that_reports_no_width_and_not_on_a_pipe
     bar(SimpleNamespace(episodes=10, champion_return=-5.0, evaluations=10, episodes_per_second=100.0))
     bar.close()
     assert pipe.getvalue() == ""
+
+
+def test_every_commands_bar_is_drawn_on_a_terminal_that_reports_no_width(monkeypatch) -> None:
+    """T19-11, the rest: fly, demo, evaluate-agent, reproduce (compete) and report each built their own tqdm bar, which
+    drew nothing on an unsized pseudo-terminal; every bar now comes from neurohover.progress. fly shows it."""
+    from neurohover.cli import main
+
+    master, slave = os.openpty()
+    with os.fdopen(slave, "w") as terminal:
+        monkeypatch.setattr(sys, "stderr", terminal)
+        assert main(["fly", "--task", "ghh08", "--mdp", "train:0", "--episodes", "3"]) == 0
+        terminal.flush()
+        drawn = _drawn(master)
+    os.close(master)
+    assert "fly ghh08/train:0" in drawn and "3/3" in drawn, drawn

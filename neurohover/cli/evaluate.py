@@ -108,10 +108,9 @@ def _files_read(args: argparse.Namespace) -> dict[str, str | Path | None]:
 def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     """Fly a trained policy on full paper episodes of a task's training or test MDPs, beside the competition's baseline
     and the shipped generic policy on the same gusts, and print the paper's measures (return per episode, crashes)."""
-    from tqdm import tqdm
-
     from ..integrations.flying import compare_agent
     from ..paths import output_file, writing
+    from ..progress import progress_bar
 
     family = task_family_of(args)  # with --obs-noise / --obs-delay every policy flies through those sensors
     available = len(family.training_mdps() if args.mdps == "train" else family.test_mdps())
@@ -139,7 +138,7 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     mdps = [family.mdp(f"{args.mdps}:{i}") for i in range(n)]
     # the agent's flight (a kernel policy flies in one call: no steps to count), on a terminal only
     quiet = True if isinstance(act, Policy) else None
-    with tqdm(total=args.episode_steps, desc="agent's episodes", unit="step", file=sys.stderr, disable=quiet, dynamic_ncols=True) as bar:
+    with progress_bar(total=args.episode_steps, desc="agent's episodes", unit="step", disable=quiet, dynamic_ncols=True) as bar:
         rows = compare_agent(
             act, mdps, episodes=args.episodes, seed=args.seed, n_steps=args.episode_steps, obs_dtype=args.obs_dtype, on_step=lambda: bar.update(1)
         )

@@ -24,20 +24,18 @@ _RECORD_BYTES_PER_STEP = 16 * 8
 
 def _fly(policy, mdps: list, args: argparse.Namespace, show_progress: bool):
     """Fly ``policy`` once on each of ``mdps`` (episode i on mdps[i]); chunked under a progress bar."""
-    from tqdm import tqdm
-
     from ..evaluate import evaluate_jobs
+    from ..progress import progress_bar
 
     unique = list(dict.fromkeys(mdps))
     mdp_index = np.array([unique.index(m) for m in mdps])
     n = len(mdps)
     returns, crashed, seconds, flight = [], [], 0.0, None
     # Every episode's gusts come from (seed, episode index), so chunking changes no result.
-    with tqdm(
+    with progress_bar(
         total=n,
         desc=f"fly {mdps[0].label if len(unique) == 1 else 'MDPs'}",
         unit="ep",
-        file=sys.stderr,
         disable=None if show_progress else True,
         dynamic_ncols=True,
     ) as bar:
@@ -150,10 +148,9 @@ def _demo_stats(policies: list, mdp, m: int, args: argparse.Namespace, bar) -> n
 
 def cmd_demo(args: argparse.Namespace) -> int:
     """Fly the baseline and the baseline-equivalent MLP on a few MDPs of each family; print a table."""
-    from tqdm import tqdm
-
     from ..evaluate import check_episode_count
     from ..policies import baseline_policy, prototype
+    from ..progress import progress_bar
     from ..tasks import N_TRAINING, TASK_NAMES, get_task_family
 
     if not 0 <= args.mdps <= N_TRAINING:
@@ -164,7 +161,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
     policies = {"baseline": baseline_policy(), "mlp(baseline seed)": prototype("mlp", "baseline")}
     print(f"{'task':<6} {'mdp':<16} {'policy':<20} {'mean return':>12} {'sd':>10} {'crashes':>8}")
     total = len(TASK_NAMES) * (args.mdps + 1) * args.episodes * len(policies)
-    with tqdm(total=total, desc="demo", unit="episode", file=sys.stderr, disable=None, leave=False, dynamic_ncols=True) as bar:  # a terminal only
+    with progress_bar(total=total, desc="demo", unit="episode", leave=False, dynamic_ncols=True) as bar:  # a terminal only
         for name in TASK_NAMES:
             family = get_task_family(name)
             mdps = [family.zero()] + family.training_mdps()[: args.mdps]

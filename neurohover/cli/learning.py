@@ -96,10 +96,10 @@ def _optimiser_settings(args: argparse.Namespace, over_family: bool) -> dict | N
 
 
 class _Bar:
-    """tqdm progress bar on stderr (silent when stderr is not a terminal; :func:`~.options.progress_bar`)."""
+    """tqdm progress bar on stderr (silent when stderr is not a terminal; :func:`~neurohover.progress.progress_bar`)."""
 
     def __init__(self, total: int | None, desc: str, note: str | None = None) -> None:
-        from .options import progress_bar
+        from ..progress import progress_bar
 
         self.bar = progress_bar(total=total, desc=desc, unit="ep", dynamic_ncols=True)
         self.note = note  # said once the run is under way: a run refused at its start overwrites nothing
@@ -275,10 +275,10 @@ def _evolve_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int
 
 
 class _Ticker:
-    """An elapsed-time tqdm bar for steps without progress reports (learning a model; :func:`~.options.progress_bar`)."""
+    """An elapsed-time tqdm bar for steps without progress reports (learning a model; :func:`~neurohover.progress.progress_bar`)."""
 
     def __init__(self, desc: str) -> None:
-        from .options import progress_bar
+        from ..progress import progress_bar
 
         self.bar = progress_bar(desc=desc, total=None, bar_format="{desc}: {elapsed}")
         self._stop = threading.Event()

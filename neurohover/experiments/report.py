@@ -547,9 +547,10 @@ def _write_report(store: Store, out: Path, scale: str | None, names: list[str] |
     sections, toc = [], []
     claims: dict[str, tuple[str, list[dict[str, str]]]] = {}  # paper figure -> (its section's anchor, its claims)
     statuses: list[Status] = []
-    from tqdm import tqdm
+    from ..progress import progress_bar
 
-    for name, sc in tqdm(entries, desc="report", unit="experiment", file=sys.stderr, disable=None, dynamic_ncols=True):  # a terminal only
+    bar = progress_bar(iterable=entries, desc="report", unit="experiment", dynamic_ncols=True)  # a terminal only
+    for name, sc in bar:
         try:
             stored = ExperimentConfig.from_dict(store.config(name, sc))
             shipped = shipped_counterpart(stored)  # loaded once: its [paper] table, and whether it still hashes as stored
@@ -562,7 +563,7 @@ def _write_report(store: Store, out: Path, scale: str | None, names: list[str] |
         except NeurohoverError as err:  # one damaged experiment: said in its place, the others reported as usual
             sections.append(f"## {name} [{sc}]\n\n**Not reported: the store's copy is damaged.** {err}\n")
             toc.append(f"- [{name} [{sc}]](#{_anchor(name + ' [' + sc + ']')}) (damaged)")
-            tqdm.write(f"neurohover report: warning: {name} ({sc}) is not reported: {err}", file=sys.stderr)  # said only in report.md (T19-07)
+            bar.write(f"neurohover report: warning: {name} ({sc}) is not reported: {err}", file=sys.stderr)  # said only in report.md (T19-07)
             continue
         statuses.append(status)
         sections.append(text)

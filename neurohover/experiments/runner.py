@@ -238,7 +238,7 @@ def reproduce(
     Raises KeyboardInterrupt (after recording every finished unit) when interrupted, and
     NeurohoverError when another run is writing ``store`` (see :meth:`Store.lock`).
     """
-    from tqdm import tqdm
+    from ..progress import progress_bar
 
     only = _check_arguments(config, store, executor, progress, on_unit, only, fresh, update)
     store.lock()  # one writer per store: a second run would redo every unit the first has not finished
@@ -260,7 +260,7 @@ def reproduce(
     session: int | None = store.start_session(config.name, config.scale, config.hash, executor.name, summary.cores, len(results))
     start = time.perf_counter()
     disable = None if progress is None else not progress
-    bar = tqdm(total=0, initial=len(results), desc=f"{config.name} ({config.scale})", unit="unit", file=sys.stderr, disable=disable, dynamic_ncols=True)
+    bar = progress_bar(total=0, initial=len(results), desc=f"{config.name} ({config.scale})", unit="unit", disable=disable, dynamic_ncols=True)
 
     def on_result(unit, result, seconds, worker) -> None:
         if store.put(config.name, config.scale, config.hash, unit, result, seconds, worker, session):
