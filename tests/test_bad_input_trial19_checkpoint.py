@@ -234,3 +234,16 @@ def test_a_number_written_as_an_integer_is_the_same_setting(family_checkpoint: P
     ckpt.write_text(json.dumps(state))
     flown = state["counters"]["episodes"]
     assert evolve(GHH08, budget=flown, checkpoint=ckpt, resume=True, **FAMILY_RUN).episodes == flown
+
+
+@pytest.mark.parametrize("which", ["steady state", "generational"])
+def test_an_optimiser_state_whose_settings_are_not_the_configs_is_refused(which: str, tiny_checkpoint: Path, family_checkpoint: Path, tmp_path: Path) -> None:
+    """T19-08 follow-up: resume compared the checkpoint's config with the run's, but the optimiser state carries its own
+    copy of the settings, and that copy was flown (crossover_prob 0.9 in it, the default in the config, resumed without a word)."""
+    source, target, run = (tiny_checkpoint, GHH08.zero(), MDP_RUN) if which == "steady state" else (family_checkpoint, GHH08, FAMILY_RUN)
+
+    def edit(state: dict) -> None:
+        state["optimizer_state"]["settings"]["crossover_prob"] = 0.9
+
+    given = 0.5 if which == "steady state" else 1.0  # each method's default
+    _resume_damaged(source, tmp_path, edit, target, run, f"optimizer_state.settings.crossover_prob: the checkpoint's 0.9, given {given}")

@@ -8,6 +8,7 @@ and :meth:`Run.restore` continues from one bit-for-bit.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import signal
 import threading
@@ -174,6 +175,13 @@ class Run:
             opt = type(self.opt).from_state_dict(state["optimizer_state"])
         except STATE_DAMAGE as err:  # from_state_dict names the damaged entry; a state's own class may raise more
             raise NeurohoverError(f"{source}: cannot restore the optimiser ({damage_text(err)})") from None
+        mine, theirs = (getattr(o, "settings", None) for o in (self.opt, opt))  # the state's own copy was flown, unchecked
+        if dataclasses.is_dataclass(mine) and dataclasses.is_dataclass(theirs) and not isinstance(mine, type) and not isinstance(theirs, type):
+            differs = config_difference("optimizer_state.settings", dataclasses.asdict(theirs), dataclasses.asdict(mine))
+            if differs is not None:
+                raise NeurohoverError(
+                    f"{source} was written by a different run ({differs}): its optimiser's settings are not its config's; resume from an undamaged copy"
+                )
         try:
             parts = _restored_parts(state, self)
             _check_run_entries(state, self.mdp_rng is None)
