@@ -247,3 +247,20 @@ def test_an_optimiser_state_whose_settings_are_not_the_configs_is_refused(which:
 
     given = 0.5 if which == "steady state" else 1.0  # each method's default
     _resume_damaged(source, tmp_path, edit, target, run, f"optimizer_state.settings.crossover_prob: the checkpoint's 0.9, given {given}")
+
+
+# --------------------------------------------------------------------------- T20-01: a NaN champion return in the history
+
+
+@pytest.mark.parametrize("value", ["nan", "inf"])
+def test_a_history_row_with_a_champion_return_no_run_records_is_refused(tiny_checkpoint: Path, family_checkpoint: Path, tmp_path: Path, value: str) -> None:
+    """T20-01: a history row's champion return of 'nan' was resumed and written to history.csv as nan; a run records a
+    finite return or '-inf' (no champion yet), and anything else is now refused as damage, naming the row."""
+
+    def edit(s):
+        s["history"][0][4] = value
+
+    fragment = f"is a damaged checkpoint: history row 0 (from 0): champion_return='{value}' is not allowed ('{value}' is no champion's return"
+    _resume_damaged(tiny_checkpoint, tmp_path, edit, GHH08.zero(), MDP_RUN, fragment)
+    _resume_damaged(family_checkpoint, tmp_path, edit, GHH08, FAMILY_RUN, fragment)
+

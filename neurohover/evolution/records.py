@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import NeurohoverError, brief, first_difference, whole_number
 from ..paths import JSONError, strict_json
 from ..policies import Policy
-from .common import EntryError, dec_float, enc_float, read_count, read_seconds
+from .common import EntryError, enc_float, read_count, read_return, read_seconds
 
 __all__ = [
     "CHECKPOINT_FORMAT",
@@ -201,8 +201,9 @@ def encode_history(history) -> list[list]:
     return [[h.generation, h.evaluations, h.episodes, h.generation_episodes, enc_float(h.champion_return), h.wall_seconds] for h in history]
 
 
-#: How each cell of a checkpoint's history row is read back, in :data:`HISTORY_COLUMNS` order.
-_HISTORY_READERS = (read_count, read_count, read_count, read_count, dec_float, read_seconds)
+#: How each cell of a checkpoint's history row is read back, in :data:`HISTORY_COLUMNS` order: a champion's return is
+#: finite or '-inf' (no champion yet), as the run records it ('nan' was resumed and written to history.csv; T20-01).
+_HISTORY_READERS = (read_count, read_count, read_count, read_count, read_return, read_seconds)
 
 
 def decode_history(rows) -> list[HistoryRecord]:
