@@ -264,3 +264,48 @@ def test_a_history_row_with_a_champion_return_no_run_records_is_refused(tiny_che
     _resume_damaged(tiny_checkpoint, tmp_path, edit, GHH08.zero(), MDP_RUN, fragment)
     _resume_damaged(family_checkpoint, tmp_path, edit, GHH08, FAMILY_RUN, fragment)
 
+
+# --------------------------------------------------------------------------- T20-02: a race delta the resampling has not
+
+#: Tiny generational runs on the family that race their candidates: at a fixed delta and at race:auto's.
+RACE_RUN = {**FAMILY_RUN, "resampling": "race:0.1"}
+AUTO_RUN = {**FAMILY_RUN, "resampling": "race:auto"}
+
+
+@pytest.fixture(scope="module")
+def race_checkpoints(tmp_path_factory) -> dict[str, Path]:
+    """Sound checkpoints of RACE_RUN and AUTO_RUN (tests damage copies)."""
+    out = {}
+    for name, run in (("race", RACE_RUN), ("auto", AUTO_RUN)):
+        out[name] = tmp_path_factory.mktemp(f"{name}-checkpoint") / "run.ckpt.json"
+        evolve(GHH08, budget=8, checkpoint=out[name], **run)
+    return out
+
+
+@pytest.mark.parametrize(
+    "which, value, fragment",
+    [
+        ("steady", 0.5, "race_delta is 0.5: allowed null (fixed resampling races no candidates)"),
+        ("fixed", 0.5, "race_delta is 0.5: allowed null (fixed resampling races no candidates)"),
+        ("race", 0.5, "race_delta is 0.5: allowed 0.1, the delta of race:0.1"),
+        ("race", None, "race_delta is None: allowed 0.1, the delta of race:0.1"),
+        ("auto", 1.5, "race_delta is 1.5: allowed a confidence level in (0, 1) (race:auto sets one race by race)"),
+        ("auto", None, "race_delta is None: allowed a confidence level in (0, 1)"),
+    ],
+)
+def test_a_race_delta_the_resampling_does_not_have_is_refused(
+    which: str, value, fragment: str, tiny_checkpoint: Path, family_checkpoint: Path, race_checkpoints: dict[str, Path], tmp_path: Path
+) -> None:
+    """T20-02: a race_delta of 0.5 in a fixed:1 run's checkpoint was taken and written back beside fixed:1; only a race
+    has a delta, a fixed race exactly its own, race:auto one in (0, 1) (the sound ones still resume)."""
+    source, target, run = {
+        "steady": (tiny_checkpoint, GHH08.zero(), MDP_RUN),
+        "fixed": (family_checkpoint, GHH08, FAMILY_RUN),
+        "race": (race_checkpoints["race"], GHH08, RACE_RUN),
+        "auto": (race_checkpoints["auto"], GHH08, AUTO_RUN),
+    }[which]
+
+    def edit(s):
+        s["race_delta"] = value
+
+    _resume_damaged(source, tmp_path, edit, target, run, f"is a damaged checkpoint: {fragment}")

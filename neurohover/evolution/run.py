@@ -27,7 +27,7 @@ from ..policies import Policy
 from ..sim.lanes import LANES
 from .bandits import BANDITS, top_mu_bandit
 from .common import STATE_DAMAGE, EntryError, Optimiser, TellInfo, check_entries, check_genomes, damage_text, dec_array, dec_float, enc_float
-from .config import MAX_BUDGET, RACE_T_LIMIT, RunConfig, next_auto_delta, upgrade_saved_config
+from .config import MAX_BUDGET, RACE_T_LIMIT, Resampling, RunConfig, next_auto_delta, upgrade_saved_config
 from .fitness import ERROR_FLOOR, episode_fitness
 from .generational import GenerationalNE
 from .optimisers import OPTIMISERS
@@ -514,13 +514,26 @@ def _restored_parts(state: dict, run: Run) -> dict[str, Any]:
         if not (finite_real(v) and v >= 0):  # finite_real: '1.5' was read as 1.5 (sixteenth trial)
             raise ValueError(f"counter {k!r} is {brief(v)}, not a number of seconds >= 0")
     champion = _checked_champion(state["champion"], run.cfg.prototype.genome.size, run.fitness)
-    race_delta = state.get("race_delta", run.resampling.delta)  # absent before race:auto: the fixed delta
-    if race_delta is not None and (isinstance(race_delta, bool) or not isinstance(race_delta, (int, float)) or not 0 < race_delta < 1):
-        raise ValueError(f"race_delta is {race_delta!r}, not a confidence level in (0, 1)")
+    race_delta = _checked_race_delta(state.get("race_delta", run.resampling.delta), run.resampling)  # absent before race:auto
     history = decode_history(state["history"])
     # Generational runs and population optimisers on a family record every generation; the others each new champion.
     check_history(history, counts, per_generation=run.method == "generational" or (run.method in OPTIMISERS and run.family is not None))
     return {"counters": counts, "seconds": seconds, "champion": champion, "history": history, "race_delta": race_delta}
+
+
+def _checked_race_delta(delta: Any, resampling: Resampling) -> float | None:
+    """A checkpoint's race delta for a run of ``resampling``: none but a race's, a fixed race's (or bandit's) its own
+    delta, race:auto's a level in (0, 1) (0.5 beside fixed:1 was kept and written back; T20-02)."""
+    if resampling.auto:
+        if not finite_real(delta) or not 0 < delta < 1:
+            raise EntryError(f"race_delta is {brief(delta)}: allowed a confidence level in (0, 1) (race:auto sets one race by race)")
+        return float(delta)
+    if delta is None and resampling.delta is None:
+        return None
+    if not finite_real(delta) or float(delta) != resampling.delta:
+        allowed = "null (fixed resampling races no candidates)" if resampling.delta is None else f"{resampling.delta!r}, the delta of {resampling}"
+        raise EntryError(f"race_delta is {brief(delta)}: allowed {allowed}")
+    return float(delta)
 
 
 def _checked_counts(c: dict, n_steps: int) -> dict[str, int]:
