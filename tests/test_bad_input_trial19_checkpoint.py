@@ -309,3 +309,38 @@ def test_a_race_delta_the_resampling_does_not_have_is_refused(
         s["race_delta"] = value
 
     _resume_damaged(source, tmp_path, edit, target, run, f"is a damaged checkpoint: {fragment}")
+
+
+# --------------------------------------------------------------------------- T20-03: an optimiser state asked and not told
+
+
+def _steady_pending(s):
+    """The steady-state optimiser's pending batch: the population's first rows, as many as a generation breeds."""
+    opt = s["optimizer_state"]
+    (n, d), rows = opt["population"]["shape"], opt["settings"]["pop_size"] - opt["settings"]["elite_size"]
+    opt["pending"] = {"shape": [rows, d], "data": opt["population"]["data"][: rows * d]}
+    assert n >= rows
+
+
+@pytest.mark.parametrize("which", ["generational", "steady state"])
+def test_an_optimiser_state_asked_and_not_told_is_a_damaged_checkpoint(which: str, tiny_checkpoint: Path, family_checkpoint: Path, tmp_path: Path) -> None:
+    """T20-03: a checkpoint whose optimiser state was asked and not told (asked=true) failed with the API's "ask() called
+    again before tell()", naming no checkpoint; a run checkpoints between generations, so it is now refused as damage."""
+    if which == "generational":
+        _resume_damaged(
+            family_checkpoint,
+            tmp_path,
+            lambda s: s["optimizer_state"].update(asked=True),
+            GHH08,
+            FAMILY_RUN,
+            "is a damaged checkpoint: optimizer_state's asked=true is not allowed: a run's checkpoint is written between generations (allowed false)",
+        )
+    else:
+        _resume_damaged(
+            tiny_checkpoint,
+            tmp_path,
+            _steady_pending,
+            GHH08.zero(),
+            MDP_RUN,
+            "is a damaged checkpoint: optimizer_state's pending batch is not allowed: a run's checkpoint is written between generations (allowed null)",
+        )

@@ -183,6 +183,7 @@ class Run:
                     f"{source} was written by a different run ({differs}): its optimiser's settings are not its config's; resume from an undamaged copy"
                 )
         try:
+            _check_between_generations(opt)
             parts = _restored_parts(state, self)
             _check_run_entries(state, self.mdp_rng is None)
             if self.mdp_rng is not None:
@@ -502,6 +503,15 @@ def _check_run_entries(state: dict, one_mdp: bool) -> None:
         raise EntryError(f"stop_reason={brief(reason)} is not allowed: allowed null or one of {', '.join(STOP_REASONS)}")
     if one_mdp and stream is not None:  # (a family's stream is the bit generator's to refuse)
         raise EntryError(f"mdp_stream={brief(stream)} is not allowed: allowed null (a run on one MDP draws no MDPs)")
+
+
+def _check_between_generations(opt: Optimiser) -> None:
+    """EntryError if restored optimiser ``opt`` holds a batch asked and not told: a run checkpoints between
+    generations only (asked=true was the API's "ask() called again before tell()", naming no checkpoint; T20-03)."""
+    if isinstance(opt, GenerationalNE) and opt._asked:
+        raise EntryError("optimizer_state's asked=true is not allowed: a run's checkpoint is written between generations (allowed false)")
+    if isinstance(opt, SteadyStateNE) and opt._pending is not None:
+        raise EntryError("optimizer_state's pending batch is not allowed: a run's checkpoint is written between generations (allowed null)")
 
 
 def _restored_parts(state: dict, run: Run) -> dict[str, Any]:
