@@ -254,9 +254,7 @@ def load_policy(source: str | Path) -> Policy:
     net = path.suffix == ".net"
     name = f"{'network' if net else 'policy'} file {str(path)!r}"
     try:
-        text = path.read_text()
-    except UnicodeDecodeError as err:
-        raise NeurohoverError(f"{name} cannot be read (UnicodeDecodeError)" if net else f"{name} is not valid JSON: {err}") from None
+        text = utf8_text(path.read_bytes(), name, "a network file" if net else "a policy file")
     except OSError as err:
         raise NeurohoverError(f"{name} cannot be read ({err.strerror or type(err).__name__})") from None
     if net:
@@ -266,6 +264,21 @@ def load_policy(source: str | Path) -> Policy:
     from .paths import parse_json
 
     return policy_from_dict(parse_json(text, name), name)
+
+
+def utf8_text(data: bytes, name: str, what: str) -> str:
+    """``data`` (a file's bytes) as UTF-8 text, after a byte-order mark if any, or a NeurohoverError saying that ``what``
+    must be UTF-8 and where the first other byte is, in the words of the configs' (T19-15): a policy file or manifest of
+    bytes ff fe was "is not valid JSON: 'utf-8' codec ..." or "Expecting value" (T20-08)."""
+    body = data.removeprefix(b"\xef\xbb\xbf")  # the place counts from after a byte-order mark
+    try:
+        return body.decode("utf-8")
+    except UnicodeDecodeError as err:
+        start = err.start
+        line, column = body.count(b"\n", 0, start) + 1, len(body[body.rfind(b"\n", 0, start) + 1 : start].decode()) + 1
+        raise NeurohoverError(
+            f"{name} cannot be read: {what} must be UTF-8 text, and byte {body[start]:#04x} at line {line}, column {column} is not (save it as UTF-8)"
+        ) from None
 
 
 def check_json_policy_name(path: object, option: str) -> None:

@@ -41,7 +41,7 @@ import numpy as np
 from .errors import NeurohoverError, brief, finite_real, whole_number
 from .evaluate import MAX_EPISODES_PER_CALL, evaluate
 from .paths import JSONError, strict_json, writing
-from .policies import Policy, load_policy, save_policy
+from .policies import Policy, load_policy, save_policy, utf8_text
 from .sim.constants import MAX_EPISODE_STEPS
 from .tasks import TaskFamily, get_task_family
 
@@ -105,6 +105,11 @@ def policy_dir(task: str, directory: str | Path | None = None) -> Path:
     return (checked_path(directory, "policy directory", "directory") if directory is not None else SHIPPED) / name
 
 
+# Every key a build writes into a set's policy file: the network, the evolution's record of the run, and its place.
+_POLICY_KEYS = ("topology", "genome", "prototype", "method", "optimizer", "resampling", "target", "seed", "budget", "episodes",
+                "evaluations", "generations", "champion_return", "n_steps", "stop_reason", "task", "name", "seconds")  # fmt: skip
+
+
 def _load(path: Path, what: str, task: str, target: str) -> Policy:
     """The policy ``what`` of ``task``'s set, from ``path``, evolved on ``target`` (an MDP's label, or ``TASK/G`` over G)."""
     _refuse_not_a_file(path, what)
@@ -114,6 +119,10 @@ def _load(path: Path, what: str, task: str, target: str) -> Policy:
             f"build it with: neurohover build-policies --task {path.parent.name} --out {path.parent.parent}"
         )
     policy = load_policy(path)
+    unknown = sorted(set(policy.metadata) - set(_POLICY_KEYS))
+    if unknown:  # "zzz_extra": 1 was flown without a word, where a manifest's unknown key is refused (T20-07)
+        shown = ", ".join(brief(key) for key in unknown[:5]) + (f" and {len(unknown) - 5} more" if len(unknown) > 5 else "")
+        raise NeurohoverError(f"policy set {str(path.parent)!r}: {path.name} ({what}) has unknown keys {shown}: allowed {', '.join(_POLICY_KEYS)}")
     _check_place(policy, path, what, {"task": task, "name": path.stem, "target": target})
     return policy
 
@@ -180,6 +189,23 @@ def _check_manifest_fields(manifest: dict, path: Path) -> None:
             raise NeurohoverError(f"policy-set manifest {str(path)!r}: {name}={value!r:.40} is not allowed: give {allowed}")
 
 
+def _check_tables(manifest: dict, path: Path, rows: int, columns: int) -> None:
+    """Refuse a GHH manifest's table that is not ``rows`` (specialised policies) x ``columns`` (training MDPs) of numbers,
+    counts of crashes whole and >= 0: [[0]] for the shipped set's 10 x 10 was accepted without a word (T20-06)."""
+    for name in ("crashes_on_training_mdps", "mean_return_on_training_mdps"):
+        table, counts = manifest.get(name), name.startswith("crashes")
+        if table is None:
+            continue
+        fits = isinstance(table, list) and len(table) == rows and all(isinstance(row, list) and len(row) == columns for row in table)
+        fits = fits and all(finite_real(v) and (not counts or (whole_number(v) and v >= 0)) for row in table for v in row)
+        if not fits:
+            what = "whole numbers >= 0 (crashed episodes)" if counts else "finite numbers (mean returns)"
+            raise NeurohoverError(
+                f"policy-set manifest {str(path)!r}: {name}={brief(table)} is not allowed: give {rows} rows (one per specialised "
+                f"policy) of {columns} {what}, one per training MDP"
+            )
+
+
 def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet:
     """Load the policy set of ``task`` (the shipped one unless ``directory`` is given)."""
     family = get_task_family(task)
@@ -194,7 +220,7 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
             f"--task {family.name} --out {str(root.parent)!r}"
         )
     try:  # strictly: an integer of 5,000 digits, nesting 100,000 deep or "safe" given twice (the last kept; ninth trial)
-        manifest = strict_json(manifest_path.read_bytes())
+        manifest = strict_json(utf8_text(manifest_path.read_bytes(), f"policy-set manifest {str(manifest_path)!r}", "a manifest"))  # T20-08
     except (OSError, JSONError) as err:
         raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r} cannot be read as JSON: {err}") from None
     if not isinstance(manifest, dict):
@@ -220,6 +246,7 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
             f"policy-set manifest {str(manifest_path)!r}: safe={safe!r:.60} is not allowed: give a list of the safe specialised "
             f"policies' distinct indices, each in 0..{len(specialised) - 1}"
         )
+    _check_tables(manifest, manifest_path, len(specialised), len(train))
     return PolicySet(family.name, root, generic, specialised, tuple(safe), manifest=manifest)
 
 

@@ -1,5 +1,7 @@
 """Bad-input trial 19, paths and files: '..' out of a directory to be made, dangling links as outputs, unknown manifest
-keys, a config that is no UTF-8, progress on a terminal that reports no width (T19-11, T19-12, T19-13, T19-15, T19-16)."""
+keys, a config that is no UTF-8, progress on a terminal that reports no width (T19-11, T19-12, T19-13, T19-15, T19-16);
+and from the twentieth: a policy set's manifest tables, its files' unknown keys, files that are no UTF-8, bench's progress
+(T20-06 to T20-09)."""
 
 from __future__ import annotations
 
@@ -155,3 +157,58 @@ def test_every_commands_bar_is_drawn_on_a_terminal_that_reports_no_width(monkeyp
         drawn = _drawn(master)
     os.close(master)
     assert "fly ghh08/train:0" in drawn and "3/3" in drawn, drawn
+
+
+@pytest.mark.parametrize(
+    ("table", "value", "why"),
+    [
+        ("crashes_on_training_mdps", [[0]], "give 10 rows .* of 10 whole numbers >= 0"),
+        ("crashes_on_training_mdps", [[0] * 10] * 9 + [[0] * 9 + [-1]], "give 10 rows .* of 10 whole numbers >= 0"),
+        ("mean_return_on_training_mdps", [[1.5] * 10] * 10 + [[1.5] * 10], "give 10 rows .* of 10 finite numbers"),
+    ],
+)
+def test_a_manifest_table_of_another_shape_than_the_set_is_refused(tmp_path: Path, cli, table: str, value, why: str) -> None:
+    """T20-06: crashes_on_training_mdps=[[0]] in a set of 10 specialised policies on 10 training MDPs was accepted."""
+    from neurohover.policysets import load_policy_set
+
+    manifest = _set_with(tmp_path / "pd", "ghh08", **{table: value})
+    with pytest.raises(NeurohoverError, match=f"policy-set manifest '{manifest}': {table}=.* is not allowed: {why}"):
+        load_policy_set("ghh08", tmp_path / "pd")
+    argv = ("--agent", "model-free", "--runs", "1", "--episodes", "2", "--episode-steps", "20", "--out", str(tmp_path / "o"))
+    rc, _, err = cli("compete", "--task", "ghh08", *argv, "--policy-dir", str(tmp_path / "pd"))
+    assert rc == 2 and f"{table}=" in err and "Traceback" not in err, err
+
+
+def test_a_set_policy_file_with_an_unknown_key_is_refused_and_the_shipped_ones_are_not(tmp_path: Path, cli) -> None:
+    """T20-07: generic.json with "zzz_extra": 1 in a policy directory was flown, where a manifest's unknown key is refused."""
+    from neurohover.policysets import load_policy_set
+
+    for task in ("ghh08", "ghh09", "fghh"):  # every key the shipped files (and so the builds) write is allowed
+        load_policy_set(task)
+    _set_with(tmp_path / "pd", "ghh08")
+    generic = tmp_path / "pd" / "ghh08" / "generic.json"
+    generic.write_text(json.dumps({**json.loads(generic.read_text()), "zzz_extra": 1}))
+    why = f"policy set '{generic.parent}': generic.json (the generic policy) has unknown keys 'zzz_extra': allowed topology, genome,"
+    with pytest.raises(NeurohoverError, match=re.escape(why)):
+        load_policy_set("ghh08", tmp_path / "pd")
+    argv = ("--agent", "model-free", "--runs", "1", "--episodes", "2", "--episode-steps", "20", "--out", str(tmp_path / "o"))
+    rc, _, err = cli("compete", "--task", "ghh08", *argv, "--policy-dir", str(tmp_path / "pd"))
+    assert rc == 2 and why in err, err
+
+
+def test_a_manifest_or_policy_file_that_is_no_utf8_names_the_rule_and_the_byte(tmp_path: Path) -> None:
+    """T20-08: a manifest of bytes ff fe was "cannot be read as JSON: Expecting value", a policy file's Latin-1
+    "is not valid JSON: 'utf-8' codec can't decode"; both now say the rule and the place, as configs do (T19-15)."""
+    from neurohover.policies import load_policy
+    from neurohover.policysets import load_policy_set
+
+    manifest = _set_with(tmp_path / "pd", "ghh08")
+    manifest.write_bytes(b"\xff\xfe{}")
+    why = f"policy-set manifest '{manifest}' cannot be read: a manifest must be UTF-8 text, and byte 0xff at line 1, column 1 is not"
+    with pytest.raises(NeurohoverError, match=re.escape(why)):
+        load_policy_set("ghh08", tmp_path / "pd")
+    policy = tmp_path / "p.json"
+    policy.write_bytes(b'\xef\xbb\xbf{"topology": "mlp",\n "note": "\xc3\xa9t\xe9"}')
+    why = f"policy file '{policy}' cannot be read: a policy file must be UTF-8 text, and byte 0xe9 at line 2, column 13 is not"
+    with pytest.raises(NeurohoverError, match=re.escape(why)):
+        load_policy(policy)
