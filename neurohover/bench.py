@@ -142,7 +142,7 @@ def _replay_seconds(trace: list, topology: str, noise_seed: int, n_steps: int, t
     return ev.seconds
 
 
-def benchmark_evolution(quick: bool = False, repeats: int | None = None) -> dict:
+def benchmark_evolution(quick: bool = False, repeats: int | None = None, progress: Callable[[str], None] | None = None) -> dict:
     """Throughput of :func:`~neurohover.evolution.evolve.evolve` against the raw kernel flying the
     same episodes (``neurohover bench``).
 
@@ -158,7 +158,8 @@ def benchmark_evolution(quick: bool = False, repeats: int | None = None) -> dict
     seconds / evolve seconds of one run and its replay, flown side by side (every other pair the
     replay first), the median over ``repeats`` pairs (``_lowest``: the lowest pair); the rates are
     the best of the repeats. A run's episodes are fixed by its seed, so every repeat flies the same
-    ones. ``flown_steps_per_used`` is the race's overhead in control steps flown.
+    ones. ``flown_steps_per_used`` is the race's overhead in control steps flown. ``progress``, when given, is called
+    with the name of each stage (the warm-up, then each case) as it starts.
     """
     from .errors import check_flag
     from .evolution.evolve import evolve
@@ -177,7 +178,8 @@ def benchmark_evolution(quick: bool = False, repeats: int | None = None) -> dict
     for threads in sorted({1, cores}):
         cases.append((f"evolve_generational_fixed5_{threads}_cores", fghh, threads, budget_gen, "fixed:5", generic))
         cases.append((f"evolve_generational_race0.5_{threads}_cores", fghh, threads, budget_gen, "race:0.5", generic))
-    # Load every compiled function (kernel, genome operators) before any clock starts.
+    say = progress or (lambda _name: None)
+    say("evolve: compiling")  # Load every compiled function (kernel, genome operators) before any clock starts.
     evolve(get_task_family("fghh").zero(), budget=60, seed=0, n_steps=10, threads=1)
     evolve(fghh, topology="mlp", prototype=generic, budget=200, resampling="race:0.5", seed=0, n_steps=10, threads=1)
     out: dict = {}
@@ -185,6 +187,7 @@ def benchmark_evolution(quick: bool = False, repeats: int | None = None) -> dict
         best_evolve, best_raw = math.inf, math.inf
         ratios = []
         used: list = []  # the episodes a run used: fixed by its seed, the same in every repeat
+        say(name)
         for i in range(repeats):
             flown: dict = {}
             # Every other pair flies the replay first, so that a machine speeding up or slowing down evens out.
@@ -206,18 +209,41 @@ def benchmark_evolution(quick: bool = False, repeats: int | None = None) -> dict
     return out
 
 
-def _extra_benchmarks(quick: bool) -> dict:
-    """Benchmarks of later pipeline stages."""
+def _extra_benchmarks(quick: bool, stage: Callable[[str], None]) -> dict:
+    """Benchmarks of later pipeline stages (``stage`` called with each one's name as it starts)."""
+    stage("vector env")
     out = {"vector_env_1024_control_steps_per_second_1_core": vector_env_steps_per_second(1024, 200 if quick else 1000)}
     # evolve() against the raw kernel flying the very same episodes (ratio_vs_raw_kernel).
-    out.update(benchmark_evolution(quick))
+    out.update(benchmark_evolution(quick, progress=stage))
+    stage("learning a model")
     out["lr_seconds_6000_samples"] = lr_seconds_per_episode_of_flight_data()
     episodes = 100 if quick else 1000
     for agent in ("model-free", "incremental"):
+        stage(f"test run {agent}")
         out[f"test_run_{agent}_{episodes}_episodes_seconds_1_core"] = test_run_seconds(agent, episodes)
-    # the hybrid agent with the authors' safeguard (the paper's box test fired in most episodes)
+    stage("test run hybrid")  # the hybrid agent with the authors' safeguard (the paper's box test fired in most episodes)
     out["test_run_ghh09_hybrid_100_episodes_seconds_1_core"] = test_run_seconds("hybrid", 100, "ghh09")
     return out
+
+
+class _Stages:
+    """``neurohover bench``'s progress on standard error, a terminal only: a bar over its stages, named as each starts
+    (it printed nothing for 40 s and more; T20-09). Called with a stage's name, it counts the one before as done."""
+
+    def __init__(self, total: int) -> None:
+        from .progress import progress_bar
+
+        self.bar, self.started = progress_bar(total=total, desc="bench", unit="stage"), False
+
+    def __call__(self, name: str) -> None:
+        self.bar.update(int(self.started))
+        self.started = True
+        self.bar.set_description_str(f"bench: {name}")
+
+    def close(self) -> None:
+        self.bar.update(int(self.started))
+        self.bar.set_description_str("bench")
+        self.bar.close()
 
 
 #: Estimated limit of one core on the benchmark workload (episodes/s): a full episode is 60,000
@@ -226,16 +252,30 @@ ESTIMATED_LIMIT_PER_CORE = (3000.0, 5000.0)
 
 
 def run_benchmarks(quick: bool = False) -> dict:
-    """Measure everything and return a JSON-able report (``quick``: True for a short run)."""
+    """Measure everything and return a JSON-able report (``quick``: True for a short run); on a terminal, a bar over the
+    stages on standard error shows which one is under way."""
     from .errors import check_flag
 
     check_flag(quick, "quick", "a short run")  # quick="no" ran the short benchmarks (fifteenth trial, T15-26)
     cores = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # numba.config sets it at import, from the environment
+    # reference, 2 kernels, vector env, evolve's warm-up and 1 + 2 x thread counts cases, learning, 3 test runs, GPU
+    stage = _Stages(11 + 2 * len({1, cores}))
+    try:
+        report = _measure(quick, cores, stage)
+    finally:
+        stage.close()
+    return report
+
+
+def _measure(quick: bool, cores: int, stage: _Stages) -> dict:
+    """:func:`run_benchmarks`' measurements, each stage named to ``stage`` as it starts."""
     episodes = 100 if quick else 1000
     repeats = 1 if quick else 3
-    # The hovering baseline costs the same every step, so a sixth of an episode gives the rate.
+    stage("reference (plain Python)")  # The hovering baseline costs the same every step, so a sixth of an episode gives the rate.
     ref = reference_episodes_per_second(1, EPISODE_STEPS // 6 if quick else EPISODE_STEPS)
+    stage("kernel, 1 core")
     one = kernel_episodes_per_second(episodes, 1, repeats)
+    stage(f"kernel, {cores} cores")
     many = kernel_episodes_per_second(episodes * cores, cores, repeats)
     per_episode = EPISODE_STEPS
     report = {
@@ -257,8 +297,8 @@ def run_benchmarks(quick: bool = False) -> dict:
             "speedup_vs_1_core": many / one,
         },
     }
-    report.update(_extra_benchmarks(quick))
-    # The CUDA build of the kernel when a GPU is present ({"status": "no CUDA device"} otherwise).
+    report.update(_extra_benchmarks(quick, stage))
+    stage("GPU")  # The CUDA build of the kernel when a GPU is present ({"status": "no CUDA device"} otherwise).
     from .bench_gpu import gpu_benchmarks
 
     report["gpu"] = gpu_benchmarks(quick, cpu_episodes_per_second=many)

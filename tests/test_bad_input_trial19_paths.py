@@ -212,3 +212,38 @@ def test_a_manifest_or_policy_file_that_is_no_utf8_names_the_rule_and_the_byte(t
     why = f"policy file '{policy}' cannot be read: a policy file must be UTF-8 text, and byte 0xe9 at line 2, column 13 is not"
     with pytest.raises(NeurohoverError, match=re.escape(why)):
         load_policy(policy)
+
+
+def test_bench_shows_its_stages_on_a_terminal_and_nothing_on_a_pipe(monkeypatch) -> None:
+    """T20-09: neurohover bench (not --quick) printed nothing on a terminal for 40 s and more; it now draws a bar over
+    its stages on standard error, on a terminal only (its output, --json's too, is unchanged). Every measurement is a
+    stub here: the stages are counted as run_benchmarks and benchmark_evolution go through them."""
+    import importlib
+
+    from neurohover import bench, bench_gpu
+
+    evolve_module = importlib.import_module("neurohover.evolution.evolve")  # the module: the package exports the function
+
+    def fake_evolve(*_args, _trace=None, _flown=None, **_kw):
+        if _flown is not None:
+            _flown["steps"] = 1
+        return SimpleNamespace(seconds=1.0, episodes=1, steps=1)
+
+    for name in ("reference_episodes_per_second", "kernel_episodes_per_second", "vector_env_steps_per_second", "test_run_seconds"):
+        monkeypatch.setattr(bench, name, lambda *_a, **_k: 1.0)
+    monkeypatch.setattr(bench, "lr_seconds_per_episode_of_flight_data", lambda: 1.0)
+    monkeypatch.setattr(bench, "_replay_seconds", lambda *_a: 1.0)
+    monkeypatch.setattr(evolve_module, "evolve", fake_evolve)
+    monkeypatch.setattr(bench_gpu, "gpu_benchmarks", lambda *_a, **_k: {"status": "no CUDA device"})
+    total = 11 + 2 * len({1, bench.numba.config.NUMBA_NUM_THREADS})
+    master, slave = os.openpty()
+    with os.fdopen(slave, "w") as terminal:
+        monkeypatch.setattr(sys, "stderr", terminal)
+        report = bench.run_benchmarks(quick=True)
+        terminal.flush()
+        drawn = _drawn(master)
+    os.close(master)
+    assert "bench: 100%" in drawn and f" {total}/{total} [" in drawn and "bench: evolve_generational_fixed5_1_cores" in drawn, drawn
+    pipe = io.StringIO()
+    monkeypatch.setattr(sys, "stderr", pipe)
+    assert bench.run_benchmarks(quick=True) == report and pipe.getvalue() == ""
