@@ -172,3 +172,66 @@ def test_results_names_the_store_and_the_unit(tiny, tmp_path: Path, cli: CliRun,
     store = _damaged(tiny[1], tmp_path / "s.sqlite", sql)
     rc, _, err = cli("results", "tr1", "--store", str(store))
     assert rc == 2 and f"results store {str(store)!r}, experiment tr1 (quick), is damaged: unit '{RUN}': " in err and says in err, err
+
+
+@pytest.mark.parametrize(
+    ("sql", "says"),
+    [
+        ("UPDATE experiments SET config_hash = 'deadbeef'", "but the store records config hash 'deadbeef'"),
+        ("UPDATE experiments SET config = json_remove(config, '$.hash')", "(its config: None)"),
+        (
+            "UPDATE experiments SET config = json_set(config, '$.settings.seed', 2)",
+            "the config or its hash was changed after its units were run",
+        ),
+        (f"UPDATE units SET config_hash = 'x' WHERE key = '{RUN}'", f"unit '{RUN}' was run under config hash 'x', not the experiment's"),
+    ],
+)
+def test_every_command_refuses_a_config_hash_that_is_not_its_configs(tiny, tmp_path: Path, cli: CliRun, sql: str, says: str) -> None:
+    """T20-04: an experiment whose config_hash was 'deadbeef' was exported and reported (rc 0), and a unit run under
+    hash 'x' was reused by reproduce; now the shared check refuses both, in results, wins, report and reproduce alike."""
+    config, good = tiny
+    store = _damaged(good, tmp_path / "s.sqlite", sql)
+    before = _dump(store)
+    where = f"results store {str(store)!r}, experiment tr1 (quick), is damaged: "
+    rc, out, err = cli("results", "tr1", "--store", str(store), "--format", "json")
+    assert rc == 2 and out == "" and where in err and says in err, err
+    rc, _, err = cli("wins", "tr1", "--store", str(store), "--runs", "1", "--draws", "10")
+    assert rc == 2 and where in err and says in err, err
+    rc, _, err = cli("report", "--store", str(store), "--out", str(tmp_path / "r"))
+    assert rc == 2 and where in err and says in err and not (tmp_path / "r").exists(), err
+    rc, _, err = cli("reproduce", str(config), "--store", str(store), "--no-progress")
+    assert rc == 2 and where in err and says in err and "already in the store" not in err, err
+    assert _dump(store) == before
+
+
+@pytest.mark.parametrize("key", ["run/../../x", "run/baseline/test0/rep00", "model/lr/test0", "u00"])
+def test_every_command_refuses_a_unit_key_of_no_planned_shape(tiny, tmp_path: Path, cli: CliRun, key: str) -> None:
+    """T20-05: a unit key changed to 'run/../../x' was exported by results and drawn by report (rc 0), and wins said "no
+    stored test runs"; now the shared check refuses a key of no shape the experiment's kind plans, naming the unit."""
+    store = _damaged(tiny[1], tmp_path / "s.sqlite", f"UPDATE units SET key = '{key}' WHERE key = 'run/generic/test0/rep0'")
+    says = f"experiment tr1 (quick), is damaged: unit {key!r}: its key is of no shape a test_runs experiment plans"
+    for argv in (
+        ("results", "tr1", "--store", str(store)),
+        ("results", "tr1", "--store", str(store), "--format", "json"),
+        ("wins", "tr1", "--store", str(store), "--runs", "1", "--draws", "10"),
+        ("report", "--store", str(store), "--out", str(tmp_path / "r")),
+    ):
+        rc, out, err = cli(*argv)
+        assert rc == 2 and says in err and "report written" not in out, (argv, err)
+    assert not (tmp_path / "r").exists()
+
+
+def test_the_shared_check_keeps_a_sound_store_and_a_diagnostic_units_own_key(tiny, tmp_path: Path) -> None:
+    """T20-04, T20-05: the sound store reads back whole, and a 'diagnostic' unit (the tests' own plans name them
+    freely) is not refused for its key."""
+    from neurohover.experiments.export import checked_units
+
+    with Store(tiny[1], create=False) as store:
+        config, units, results = checked_units(store, "tr1", "quick")
+    assert config.hash and sorted(results) == [RUN, "run/generic/test0/rep0"] and len(units) == 2
+    store_path = _damaged(tiny[1], tmp_path / "s.sqlite", f"DELETE FROM units WHERE key != '{RUN}'")
+    with sqlite3.connect(store_path) as conn:
+        conn.execute("UPDATE units SET key = 'u00', kind = 'diagnostic', result = '{\"value\":1,\"seed\":3}'")
+    conn.close()
+    with Store(store_path, create=False) as store:
+        assert list(checked_units(store, "tr1", "quick")[2]) == ["u00"]

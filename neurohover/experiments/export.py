@@ -42,6 +42,53 @@ def resolve_scale(store: Store, name: str, scale: str | None) -> str:
     return scale
 
 
+#: The unit key stages (:class:`~neurohover.experiments.keys.UnitKey`) each experiment kind's plan names its units with.
+PLANNED_STAGES = {"evolution": ("evolve", "robust"), "model_learning": ("policy", "model"), "test_runs": ("policy", "run")}
+_KEY_FORMS = {
+    "evolve": "evolve/<variant>[/train<i>]/run<r>",
+    "robust": "robust/<variant>/train<i>",
+    "policy": "policy/<name>",
+    "model": "model/<method>/<mdps><i>",
+    "run": "run/<group>/<mdps><i>/rep<r>",
+}
+
+
+def _check_hashes(store: Store, name: str, scale: str, stored: dict, config: ExperimentConfig) -> None:
+    """Refuse an experiment whose recorded config hash is not its config's, or a unit run under another hash: a
+    config_hash set to 'deadbeef' was exported and reported, a unit's set to 'x' reused by reproduce (T20-04).
+    ``store.update`` gives every kept unit the new hash, so a unit of another hash is never one a run left."""
+    held = store.config_hash(name, scale)
+    if held != config.hash or stored.get("hash") != held:
+        raise NeurohoverError(
+            f"its config hashes to {config.hash}, but the store records config hash {brief(held)} (its config: {brief(stored.get('hash'))}): "
+            "the config or its hash was changed after its units were run, or another version of neurohover wrote it, so its units "
+            "cannot be told to be this config's (reproduce --fresh runs it again)"
+        )
+    for key, unit_hash in sorted(store.unit_config_hashes(name, scale).items()):
+        if unit_hash != held:
+            raise NeurohoverError(
+                f"unit {key!r} was run under config hash {brief(unit_hash)}, not the experiment's {held}: its result is not this config's "
+                "(reproduce --fresh runs it again)"
+            )
+
+
+def _check_key(config: ExperimentConfig, unit: dict) -> None:
+    """Refuse a unit key of no shape the experiment's plan gives (e.g. 'run/../../x' was exported and drawn, and left out
+    by wins; T20-05): a stage its kind plans, its parts written back as the key. A 'diagnostic' unit (the tests' own
+    plans) may have any key."""
+    if unit["kind"] == "diagnostic":
+        return
+    key = UnitKey.parse(unit["key"])
+    stages = PLANNED_STAGES[config.kind]
+    try:
+        fits = key.stage in stages and UnitKey.make(key.stage, key.group, key.mdp, key.rep) == unit["key"]
+    except ValueError:
+        fits = False
+    if not fits:
+        forms = " or ".join(_KEY_FORMS[s] for s in stages)
+        raise NeurohoverError(f"its key is of no shape a {config.kind} experiment plans: its unit keys are {forms}")  # the caller names the unit
+
+
 def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig, list[dict], dict[str, UnitResult]]:
     """Experiment (name, scale)'s stored config and finished units, each read back and checked: the one check of a stored
     experiment that results, wins, report and reproduce (compete too) share.
@@ -59,7 +106,9 @@ def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig
     ------
     NeurohoverError
         One message naming the store, the experiment and the damaged unit (where one is): wins took a unit of kind
-        'bogus' for a test run (T19-05), and results' messages named neither the store nor the unit (T19-14).
+        'bogus' for a test run (T19-05), and results' messages named neither the store nor the unit (T19-14). Also a
+        config that does not hash to its recorded hash, a unit run under another hash (T20-04), and a unit key of no
+        shape the experiment's plan gives (T20-05).
     """
     where = f"results store {str(store.path)!r}, experiment {name} ({scale}), is damaged"
     stored = store.config(name, scale)  # the store names a row that is no JSON object itself, as for the units below
@@ -72,10 +121,12 @@ def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig
     for u in units:
         try:
             results[u["key"]] = result_from_dict(u["kind"], u["result"], u["key"])
+            _check_key(config, u)
         except NeurohoverError as err:
             unit = "" if repr(u["key"]) in str(err) else f"unit {u['key']!r}: "
             raise NeurohoverError(f"{where}: {unit}{err}") from None
     try:
+        _check_hashes(store, name, scale, stored, config)
         check_run_lengths(config.settings.get("episodes") if config.kind == "test_runs" else None, results)
     except NeurohoverError as err:
         raise NeurohoverError(f"{where}: {err}") from None

@@ -83,13 +83,7 @@ def unchanged_units(config: ExperimentConfig, store: Store) -> set[str]:
     results of earlier ones (their policies). Refuses a stored config that this version of neurohover
     does not hash alike (another ``UNITS_VERSION``): its units were computed otherwise.
     """
-    stored_config = ExperimentConfig.from_dict(store.config(config.name, config.scale))
-    stored_hash = store.config_hash(config.name, config.scale)
-    if stored_config.hash != stored_hash:
-        raise NeurohoverError(
-            f"{config.name} ({config.scale}): its stored results were computed by another version of the units "
-            f"(config hash {stored_hash}, which this version reads as {stored_config.hash}); rerun with --fresh instead of --update"
-        )
+    _refuse_other_version(config, store, ExperimentConfig.from_dict(store.config(config.name, config.scale)))
     stored = {u["key"]: u for u in store.units(config.name, config.scale)}
     sources = {name: store.results(name, config.scale) for name in source_experiments(config)}
     kept: dict[str, dict] = {}
@@ -102,6 +96,29 @@ def unchanged_units(config: ExperimentConfig, store: Store) -> set[str]:
         if not same:
             return set(kept)
         kept.update((key, stored[key]["result"]) for key in same)
+
+
+def _refuse_other_version(config: ExperimentConfig, store: Store, stored_config: ExperimentConfig) -> None:
+    """Refuse an ``--update`` of stored results whose config does not hash to its recorded hash (another ``UNITS_VERSION``)."""
+    stored_hash = store.config_hash(config.name, config.scale)
+    if stored_config.hash != stored_hash:
+        raise NeurohoverError(
+            f"{config.name} ({config.scale}): its stored results were computed by another version of the units "
+            f"(config hash {stored_hash}, which this version reads as {stored_config.hash}); rerun with --fresh instead of --update"
+        )
+
+
+def _refuse_other_version_first(config: ExperimentConfig, store: Store, held: str | None, update: bool) -> None:
+    """:func:`_refuse_other_version` before the shared check, which calls such a store damaged (T20-04): an ``--update``
+    of a changed config (``held``: the stored hash) is told why (--fresh, not --update). A config that does not read back
+    is left to the shared check to name."""
+    if not update or held is None or held == config.hash:
+        return
+    try:
+        stored_config = ExperimentConfig.from_dict(store.config(config.name, config.scale))
+    except NeurohoverError:
+        return
+    _refuse_other_version(config, store, stored_config)
 
 
 def _check_policy_source(config: ExperimentConfig, store: Store) -> None:
@@ -246,6 +263,7 @@ def reproduce(
     held = store.config_hash(config.name, config.scale)
     if only:  # refused before the store records anything
         _refuse_unmatched(config, store, held, only)
+    _refuse_other_version_first(config, store, held, update)
     checked = None if fresh else _checked_results(config, store, held)  # before anything is written (T19-04, T19-06)
     if update and held is not None and held != config.hash:
         _check_policy_source(config, store)

@@ -395,6 +395,11 @@ class Store:
         rows = self._rows("SELECT key, result FROM units WHERE name = ? AND scale = ?", (name, scale), f"experiment {name} ({scale})'s results")
         return {k: self._json(r, f"experiment {name} ({scale}), unit {k}'s result") for k, r in rows}
 
+    def unit_config_hashes(self, name: str, scale: str) -> dict[str, Any]:
+        """key -> the config hash each finished unit was run under (as stored: a damaged one may be no text)."""
+        rows = self._rows("SELECT key, config_hash FROM units WHERE name = ? AND scale = ?", (name, scale), f"experiment {name} ({scale})'s units")
+        return dict(rows)
+
     def units(self, name: str, scale: str) -> list[dict]:
         """Every finished unit: key, kind, params, result, seconds, worker, finished (time)."""
         rows = self._rows(
