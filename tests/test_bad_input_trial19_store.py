@@ -1,7 +1,9 @@
 """The nineteenth bad-input trial's findings in damaged results stores: a refused reproduce leaves the store as it was
 (T19-04); wins refuses the damage results refuses, by the same check (T19-05); compete refuses a damaged config or units
 whose config is gone, and does not rewrite it (T19-06); report says each damaged experiment on stderr and exits 2 when
-nothing could be reported (T19-07); results' messages name the store and the unit (T19-14)."""
+nothing could be reported (T19-07); results' messages name the store and the unit (T19-14). The twentieth trial's: every
+command refuses a config hash that is not its config's, or a unit's that is not its experiment's (T20-04), and a unit key
+of no shape the experiment's plan gives (T20-05)."""
 
 from __future__ import annotations
 
