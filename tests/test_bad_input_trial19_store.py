@@ -237,3 +237,12 @@ def test_the_shared_check_keeps_a_sound_store_and_a_diagnostic_units_own_key(tin
     conn.close()
     with Store(store_path, create=False) as store:
         assert list(checked_units(store, "tr1", "quick")[2]) == ["u00"]
+
+
+def test_an_experiment_row_whose_config_is_of_another_scale_is_refused(tiny, tmp_path: Path, cli: CliRun) -> None:
+    """T21-01: a copy of a quick experiment's row at scale 'paper' was reported as a paper-scale section, its quick
+    numbers printed under "Claims and conclusions (paper scale)"; the shared check now refuses the row."""
+    store = _damaged(tiny[1], tmp_path / "s.sqlite", "INSERT INTO experiments SELECT name, 'paper', config_hash, config, created FROM experiments")
+    says = f"results store {str(store)!r}, experiment tr1 (paper), is damaged: its row is at scale 'paper' but its config is the 'quick' one"
+    rc, _, err = cli("report", "--store", str(store), "--out", str(tmp_path / "r"), "--scale", "paper")
+    assert rc == 2 and says in err, err

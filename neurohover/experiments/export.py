@@ -116,6 +116,8 @@ def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig
         config = ExperimentConfig.from_dict(stored)
     except NeurohoverError as err:
         raise NeurohoverError(f"{where}: {err}") from None
+    if config.scale != scale:  # a quick config under a 'paper' row was reported as the paper's claims (T21-01)
+        raise NeurohoverError(f"{where}: its row is at scale {scale!r} but its config is the {brief(config.scale)} one")
     units = store.units(name, scale)
     results: dict[str, UnitResult] = {}
     for u in units:

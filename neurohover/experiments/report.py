@@ -553,6 +553,8 @@ def _write_report(store: Store, out: Path, scale: str | None, names: list[str] |
     for name, sc in bar:
         try:
             stored = ExperimentConfig.from_dict(store.config(name, sc))
+            if stored.scale != sc:  # a quick config in a 'paper' row was reported as the paper's claims (T21-01)
+                checked_units(store, name, sc)  # refuses it, in the shared check's words
             shipped = shipped_counterpart(stored)  # loaded once: its [paper] table, and whether it still hashes as stored
             current = (None if shipped is None else shipped.hash == stored.hash) if sc == "paper" else None  # the status table: paper scale
             cfg = with_shipped_paper(stored, shipped)
