@@ -116,6 +116,15 @@ def _drawn(master: int) -> str:
     return out.decode(errors="replace")
 
 
+def _show_both_bars(learning, desc: str) -> None:
+    """learn-model's elapsed-time bar, then evolve's bar at 10 of 40 episodes, on sys.stderr."""
+    with learning._Ticker("learning a model"):
+        pass
+    bar = learning._Bar(40, desc)
+    bar(SimpleNamespace(episodes=10, champion_return=-5.0, evaluations=10, episodes_per_second=100.0))
+    bar.close()
+
+
 def test_progress_is_drawn_on_a_terminal_that_reports_no_width_and_not_on_a_pipe(monkeypatch) -> None:
     """T19-11: on a pseudo-terminal nobody sized (width 0: script, docker exec -t), learn-model's and evolve's progress
     bars drew nothing, and the commands sat silent for minutes; a stream that is no terminal still sees nothing."""
@@ -125,22 +134,14 @@ def test_progress_is_drawn_on_a_terminal_that_reports_no_width_and_not_on_a_pipe
     assert os.get_terminal_size(slave).columns == 0  # a fresh pseudo-terminal is never sized
     with os.fdopen(slave, "w") as terminal:
         monkeypatch.setattr(sys, "stderr", terminal)
-        with learning._Ticker("learning a model"):
-            pass
-        bar = learning._Bar(40, "evolve ghh08/train:0")
-        bar(SimpleNamespace(episodes=10, champion_return=-5.0, evaluations=10, episodes_per_second=100.0))
-        bar.close()
+        _show_both_bars(learning, "evolve ghh08/train:0")
         terminal.flush()
         drawn = _drawn(master)
     os.close(master)
     assert "learning a model: 00:00" in drawn and "evolve ghh08/train:0" in drawn and "10/40" in drawn, drawn
     pipe = io.StringIO()
     monkeypatch.setattr(sys, "stderr", pipe)
-    with learning._Ticker("learning a model"):
-        pass
-    bar = learning._Bar(40, "evolve")
-    bar(SimpleNamespace(episodes=10, champion_return=-5.0, evaluations=10, episodes_per_second=100.0))
-    bar.close()
+    _show_both_bars(learning, "evolve")
     assert pipe.getvalue() == ""
 
 
