@@ -443,12 +443,12 @@ def _header(cfg: ExperimentConfig, store: Store, units: list[dict], total: int |
     )
 
 
-def _section(cfg: ExperimentConfig, store: Store, out: Path, current: bool | None) -> tuple[str, list[dict[str, str]], Status]:
-    """The section of one stored experiment (``current``: whether its shipped config still hashes as stored, for the
+def _section(cfg: ExperimentConfig, store: Store, out: Path, current: bool | None, scale: str) -> tuple[str, list[dict[str, str]], Status]:
+    """The section of one stored experiment at the store row's ``scale`` (``current``: whether its shipped config still hashes as stored, for the
     status table; None: not a shipped config, or not paper scale)."""
     from .plans import plan
 
-    _, units, results = checked_units(store, cfg.name, cfg.scale)  # results' check, and its messages
+    _, units, results = checked_units(store, cfg.name, scale)  # results' check (the row's scale: T21-01), and its messages
     try:
         total = plan(cfg, {u["key"]: u["result"] for u in units}).total
     except NeurohoverError:
@@ -553,13 +553,11 @@ def _write_report(store: Store, out: Path, scale: str | None, names: list[str] |
     for name, sc in bar:
         try:
             stored = ExperimentConfig.from_dict(store.config(name, sc))
-            if stored.scale != sc:  # a quick config in a 'paper' row was reported as the paper's claims (T21-01)
-                checked_units(store, name, sc)  # refuses it, in the shared check's words
             shipped = shipped_counterpart(stored)  # loaded once: its [paper] table, and whether it still hashes as stored
             current = (None if shipped is None else shipped.hash == stored.hash) if sc == "paper" else None  # the status table: paper scale
             cfg = with_shipped_paper(stored, shipped)
             check_paper_table(cfg.paper, "the stored config")  # a store written before twelfth trial T1's check: said here, not a traceback
-            text, checked, status = _section(cfg, store, out, current)
+            text, checked, status = _section(cfg, store, out, current, sc)
         except (OutputError, DiscussionError):  # a full disk or an unreadable discussion is no damaged store (eighth, ninth trial)
             raise
         except NeurohoverError as err:  # one damaged experiment: said in its place, the others reported as usual
