@@ -3,7 +3,7 @@
 A :class:`Run` holds one run's whole state: its optimiser (any :class:`~.common.Optimiser`), the
 :class:`~neurohover.flyer.KernelFlyer` that flies the candidates and counts the episodes, the
 generator of the task family's MDPs, counters and history. :meth:`Run.state` is the checkpoint
-and :meth:`Run.restore` continues from one bit-for-bit.
+and :meth:`Run.restore` continues from one bit-for-bit, after :mod:`~neurohover.evolution.restore`'s checks of it.
 """
 
 from __future__ import annotations
@@ -20,15 +20,15 @@ from typing import Any, cast
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, whole_number
-from ..flyer import MAX_EPISODE_INDEX, KernelFlyer
+from ..errors import NeurohoverError
+from ..flyer import KernelFlyer
 from ..launch import Parking
 from ..policies import Policy
 from ..sim.lanes import LANES
 from .bandits import BANDITS, top_mu_bandit
-from .common import STATE_DAMAGE, EntryError, Optimiser, TellInfo, check_entries, check_genomes, damage_text, dec_array, dec_float, enc_float
-from .config import MAX_BUDGET, RACE_T_LIMIT, Resampling, RunConfig, next_auto_delta, upgrade_saved_config
-from .fitness import ERROR_FLOOR, episode_fitness
+from .common import STATE_DAMAGE, Optimiser, TellInfo, damage_text, enc_float
+from .config import RACE_T_LIMIT, RunConfig, next_auto_delta, upgrade_saved_config
+from .fitness import episode_fitness
 from .generational import GenerationalNE
 from .optimisers import OPTIMISERS
 from .race_sampler import RaceSampler
@@ -39,13 +39,12 @@ from .records import (
     EvolutionResult,
     HistoryRecord,
     ProgressInfo,
-    check_history,
     check_stream,
     config_difference,
-    decode_history,
     encode_history,
     write_checkpoint,
 )
+from .restore import _check_between_generations, _check_run_entries, _check_tables, _damaged, _restored_parts
 from .seeding import mdp_rng, noise_seed, optimiser_seed
 from .steady_state import SteadyStateNE
 
@@ -469,128 +468,3 @@ class Run:
             parents=getattr(self.opt, "parents", None),
             hall_of_fame=getattr(self.opt, "hall_of_fame", None),
         )
-
-
-def _damaged(source: str, err: Exception) -> NeurohoverError:
-    """The error of a checkpoint ``source`` that cannot be read back (``err`` says what is wrong)."""
-    return NeurohoverError(f"{source} is a damaged checkpoint: {damage_text(err)}; resume from an undamaged copy or start again without resuming")
-
-
-#: Every entry a checkpoint (:meth:`Run.state`) has held, and every entry of its counters and champion tables.
-CHECKPOINT_ENTRIES = ("format", "config", "budget", "optimizer_state", "counters", "mdp_stream", "race_delta", "champion", "history", "stop_reason")
-COUNTERS = ("episodes", "next_index", "flown", "steps", "generation", "evaluations", "wall_seconds", "kernel_seconds")
-#: Why a run stopped, as :meth:`Run._should_stop` says it.
-STOP_REASONS = ("budget", "plateau", "generations", *sorted({spec.stop_reason for spec in OPTIMISERS.values()}))
-
-
-def _check_tables(state: dict, source: str) -> None:
-    """NeurohoverError naming an unknown entry of checkpoint ``state`` or of its counters or champion: one was ignored
-    without a word, as the optimiser state's were before (sixteenth trial)."""
-    remedy = "resume from an undamaged copy or start again without resuming"
-    check_entries(state, "checkpoint", CHECKPOINT_ENTRIES, what=source, remedy=remedy)
-    for name, entries in (("counters", COUNTERS), ("champion", ("genome", "return"))):
-        if isinstance(state.get(name), dict):
-            check_entries(state[name], "checkpoint", entries, what=f"the {name} table of {source}", remedy=remedy)
-
-
-def _check_run_entries(state: dict, one_mdp: bool) -> None:
-    """EntryError unless checkpoint ``state``'s budget, stop reason and MDP stream are what :meth:`Run.state` writes
-    (a budget of '100', a stop_reason of 5 and an mdp_stream of 'x' on one MDP were taken; sixteenth trial)."""
-    budget, reason, stream = state["budget"], state["stop_reason"], state["mdp_stream"]
-    if budget is not None and not (whole_number(budget) and 1 <= budget <= MAX_BUDGET):
-        raise EntryError(f"budget={brief(budget)} is not allowed: allowed null or an integer in 1..{MAX_BUDGET:,}")
-    if reason is not None and (not isinstance(reason, str) or reason not in STOP_REASONS):
-        raise EntryError(f"stop_reason={brief(reason)} is not allowed: allowed null or one of {', '.join(STOP_REASONS)}")
-    if one_mdp and stream is not None:  # (a family's stream is the bit generator's to refuse)
-        raise EntryError(f"mdp_stream={brief(stream)} is not allowed: allowed null (a run on one MDP draws no MDPs)")
-
-
-def _check_between_generations(opt: Optimiser) -> None:
-    """EntryError if restored optimiser ``opt`` holds a batch asked and not told: a run checkpoints between
-    generations only (asked=true was the API's "ask() called again before tell()", naming no checkpoint; T20-03)."""
-    if isinstance(opt, GenerationalNE) and opt._asked:
-        raise EntryError("optimizer_state's asked=true is not allowed: a run's checkpoint is written between generations (allowed false)")
-    if isinstance(opt, SteadyStateNE) and opt._pending is not None:
-        raise EntryError("optimizer_state's pending batch is not allowed: a run's checkpoint is written between generations (allowed null)")
-
-
-def _restored_parts(state: dict, run: Run) -> dict[str, Any]:
-    """The counters, champion, history and race delta of checkpoint ``state`` for ``run``, each checked (ValueError,
-    TypeError or KeyError naming what is wrong), before any of them is restored."""
-    c = state["counters"]
-    counts = _checked_counts(c, run.cfg.n_steps)
-    seconds = {k: c[k] for k in ("wall_seconds", "kernel_seconds")}
-    for k, v in seconds.items():
-        if not (finite_real(v) and v >= 0):  # finite_real: '1.5' was read as 1.5 (sixteenth trial)
-            raise ValueError(f"counter {k!r} is {brief(v)}, not a number of seconds >= 0")
-    champion = _checked_champion(state["champion"], run.cfg.prototype.genome.size, run.fitness)
-    race_delta = _checked_race_delta(state.get("race_delta", run.resampling.delta), run.resampling)  # absent before race:auto
-    history = decode_history(state["history"])
-    # Generational runs and population optimisers on a family record every generation; the others each new champion.
-    check_history(history, counts, per_generation=run.method == "generational" or (run.method in OPTIMISERS and run.family is not None))
-    return {"counters": counts, "seconds": seconds, "champion": champion, "history": history, "race_delta": race_delta}
-
-
-def _checked_race_delta(delta: Any, resampling: Resampling) -> float | None:
-    """A checkpoint's race delta for a run of ``resampling``: none but a race's, a fixed race's (or bandit's) its own
-    delta, race:auto's a level in (0, 1) (0.5 beside fixed:1 was kept and written back; T20-02)."""
-    if resampling.auto:
-        if not finite_real(delta) or not 0 < delta < 1:
-            raise EntryError(f"race_delta is {brief(delta)}: allowed a confidence level in (0, 1) (race:auto sets one race by race)")
-        return float(delta)
-    if delta is None and resampling.delta is None:
-        return None
-    if not finite_real(delta) or float(delta) != resampling.delta:
-        allowed = "null (fixed resampling races no candidates)" if resampling.delta is None else f"{resampling.delta!r}, the delta of {resampling}"
-        raise EntryError(f"race_delta is {brief(delta)}: allowed {allowed}")
-    return float(delta)
-
-
-def _checked_counts(c: dict, n_steps: int) -> dict[str, int]:
-    """Checkpoint counters ``c`` of a run of ``n_steps``-step episodes, each a count in 0..:data:`MAX_COUNT` and in
-    step with the others (2**70 as next_index was an OverflowError mid-run, as flown or generation taken; T19-01, T19-08)."""
-    counts = {k: c[k] for k in ("episodes", "steps", "generation", "evaluations")}
-    # Checkpoints before races reserved indices: every index flown was counted.
-    counts["next_index"], counts["flown"] = c.get("next_index", c["episodes"]), c.get("flown", c["episodes"])
-    for k, v in counts.items():
-        if not whole_number(v) or v < 0 or (k != "steps" and v > MAX_COUNT):  # (the steps are bounded by the episodes, below)
-            raise ValueError(f"counter {k!r} is {brief(v)}, not a count: allowed an integer in 0..2**62 ({_COUNT_LIMIT})")
-    # Rules every run keeps: each counted episode was flown, each flown one had its own index, an episode has at most
-    # n_steps steps, and a generation evaluates at least one candidate.
-    for k, v, bound, why in (
-        ("flown", counts["flown"], counts["episodes"], f"below the {counts['episodes']:,} episodes counted (each was flown)"),
-        ("next_index", counts["next_index"], counts["flown"], f"below the {counts['flown']:,} episodes flown (each flew its own index)"),
-        ("evaluations", counts["evaluations"], counts["generation"], f"below the {counts['generation']:,} generations (each evaluates a candidate)"),
-    ):
-        if v < bound:
-            raise ValueError(f"counter {k!r} is {v:,}, {why}")
-    if counts["steps"] > counts["episodes"] * n_steps:
-        raise ValueError(f"counter 'steps' is {counts['steps']:,}, more than {counts['episodes']:,} episodes of {n_steps:,} steps can have")
-    return counts
-
-
-#: The most a checkpoint's counters may be (T19-01): half the kernel's episode indices (0..2**63-1), the other half room
-#: for the resumed run's episodes (4.6e18: centuries of flying, where the most a budget may be is 1e10).
-MAX_COUNT = (MAX_EPISODE_INDEX + 1) // 2
-_COUNT_LIMIT = "half the kernel's episode indices 0..2**63-1: the rest is room for the resumed run's episodes"
-
-
-def _checked_champion(ch: dict, genome_size: int, scale: str) -> tuple[np.ndarray | None, float]:
-    """The champion table ``ch`` of a checkpoint: its genome (or None) and its fitness on ``scale`` (a return of 2**70,
-    which no episode can score, was taken; T19-08)."""
-    genes = ch["genome"]  # a list of numbers, checked one by one as an optimiser's arrays are: True was read as 1.0 (sixteenth trial)
-    genome = check_genomes(
-        None if genes is None else dec_array({"shape": [len(genes)], "data": genes}, "the champion genome"), genome_size, "the champion genome", rows=0
-    )
-    value = dec_float(ch["return"])
-    if math.isnan(value):
-        raise ValueError("the champion's return is nan")
-    if genome is None and value != -math.inf:
-        raise ValueError(f"the champion's return is {brief(ch['return'])} without a champion genome: allowed '-inf' (no champion yet)")
-    # A return is minus a sum of squares (<= 0); an inv-log-error fitness 1/ln(error) with error >= ERROR_FLOOR (fitness.py).
-    low, high, allowed = (
-        (0.0, 1.0 / math.log(ERROR_FLOOR), "'-inf' or a number in 0..1/ln(1+1e-6)") if scale == "inv-log-error" else (-math.inf, 0.0, "'-inf' or a number <= 0")
-    )
-    if value != -math.inf and not (low <= value <= high * (1 + 1e-9)):  # (a mean may round an ulp past its largest value)
-        raise ValueError(f"the champion's return is {brief(ch['return'])}: allowed {allowed} on the run's fitness scale {scale!r}")
-    return genome, value
