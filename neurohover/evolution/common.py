@@ -64,6 +64,7 @@ __all__ = [
     "check_prototype",
     "check_returns",
     "check_settings",
+    "crash_flags",
     "check_genomes",
     "check_state",
     "damage_text",
@@ -85,6 +86,7 @@ __all__ = [
     "MAX_POPULATION",
     "MAX_SPREAD",
     "require_spread",
+    "selected_indices",
     "require_prob",
     "require_std",
     "rng_from_state",
@@ -110,7 +112,8 @@ class TellInfo:
     Raises
     ------
     NeurohoverError
-        For episodes that are no such integer.
+        For episodes that are no such integer; every ``tell`` refuses crashed and selected that do not fit the genomes
+        it asked (:meth:`check`).
     """
 
     crashed: np.ndarray | None = None
@@ -120,6 +123,52 @@ class TellInfo:
     def __post_init__(self) -> None:
         if self.episodes is not None:
             object.__setattr__(self, "episodes", require_episodes(self.episodes))
+
+    def check(self, asked: int) -> None:
+        """NeurohoverError naming the field unless ``crashed`` and ``selected`` fit a tell of ``asked`` genomes: the one
+        check of both, which every ``tell`` makes (through :func:`check_returns`), also of a field it does not read (one
+        crash flag for four genomes, selected index -1 or 4 of four were taken; T21-10)."""
+        if self.crashed is not None:
+            crash_flags(self.crashed, asked)
+        if self.selected is not None:
+            selected_indices(self.selected, asked)
+
+
+def crash_flags(values: Any, asked: int, name: str = "TellInfo crashed") -> np.ndarray:
+    """``values`` as a bool array, or NeurohoverError unless one flag per asked genome: booleans (or the integers 0 and 1)."""
+    c = _array(values)
+    if c is None or c.ndim != 1 or c.size != asked:
+        got = "no array" if c is None else f"shape {c.shape}" if c.ndim != 1 else f"{c.size} flag{'' if c.size == 1 else 's'}"
+        raise NeurohoverError(f"{name} must be {asked} booleans, one per asked genome; got {got}: {brief(values)}")
+    if c.dtype != np.bool_ and not (c.dtype.kind in "iu" and np.isin(c, (0, 1)).all()):
+        raise NeurohoverError(f"{name} must be {asked} booleans, one per asked genome; got {c.dtype} values: {brief(values)}")
+    return c.astype(bool)
+
+
+def selected_indices(values: Any, asked: int, name: str = "TellInfo selected") -> np.ndarray:
+    """``values`` as an int array, or NeurohoverError unless distinct integer indices of the ``asked`` genomes (1 to ``asked`` of them)."""
+    s = _array(values)
+    allowed = f"{name} must be distinct integer indices in 0..{asked - 1} of the {asked} asked genomes (1 to {asked} of them)"
+    if s is None or s.ndim != 1 or not 1 <= s.size <= asked:
+        got = "no array" if s is None else f"shape {s.shape}" if s.ndim != 1 else f"{s.size} {'index' if s.size == 1 else 'indices'}"
+        raise NeurohoverError(f"{allowed}; got {got}: {brief(values)}")
+    if s.dtype.kind not in "iu":
+        raise NeurohoverError(f"{allowed}; got {s.dtype} values: {brief(values)}")
+    outside = s[(s < 0) | (s >= asked)]
+    if outside.size:
+        raise NeurohoverError(f"{allowed}; got index {int(outside[0])}: {brief(values)}")
+    if np.unique(s).size != s.size:
+        twice = int(next(v for k, v in enumerate(s) if v in s[:k]))
+        raise NeurohoverError(f"{allowed}; got index {twice} twice: {brief(values)}")
+    return s.astype(np.int64)
+
+
+def _array(values: Any) -> np.ndarray | None:
+    """``np.asarray(values)``, or None for what NumPy makes no array of (a ragged list)."""
+    try:
+        return np.asarray(values)
+    except (TypeError, ValueError, OverflowError):
+        return None
 
 
 #: The most episodes one generation may cost: a run's largest budget, evolution.config.MAX_BUDGET (not imported: config
@@ -279,22 +328,25 @@ def check_prototype(prototype: np.ndarray) -> np.ndarray:
     return p
 
 
-def check_info(info: Any) -> None:
+def check_info(info: Any, asked: int | None = None) -> None:
     """NeurohoverError unless ``info`` (what a ``tell`` is told besides the returns) is a :class:`TellInfo` or None (a dict
-    was an AttributeError; fifteenth trial)."""
+    was an AttributeError; fifteenth trial) whose fields fit a tell of ``asked`` genomes (:meth:`TellInfo.check`)."""
     if info is not None and not isinstance(info, TellInfo):
         raise NeurohoverError(f"info={brief(info)} is not allowed: give a TellInfo (its crashed, selected, episodes) or None")
+    if info is not None and asked is not None:
+        info.check(asked)
 
 
 def check_returns(values: Any, n: int, what: str = "fitness", info: Any = None) -> np.ndarray:
     """``n`` returns as float64, one per asked genome; ``+inf`` is refused (ValueError). The one check of a ``tell``'s
-    arguments: ``info`` too (:func:`check_info`)."""
+    arguments: ``info`` too (:func:`check_info`), its fields against the ``n`` genomes asked."""
     check_info(info)
     f = as_floats(values, what, f"{n} returns, one per asked genome")
     if f.shape != (n,):
         raise NeurohoverError(f"{what} must have shape ({n},), one return per asked genome; got shape {f.shape}")
     if np.count_nonzero(f == np.inf):
         raise NeurohoverError(f"{what} contains +inf; returns must be finite, NaN or -inf")
+    check_info(info, n)
     return f
 
 

@@ -47,6 +47,7 @@ from .common import (
     require_spread,
     required,
     rng_from_state,
+    selected_indices,
     set_field,
     validate_variation_settings,
 )
@@ -311,17 +312,14 @@ class GenerationalNE:
         return s.budget is not None and self._evaluations >= s.budget
 
     def _check_selected(self, selected: np.ndarray) -> np.ndarray:
+        """``selected`` as indices of the population (:func:`~neurohover.evolution.common.selected_indices`, which checks
+        TellInfo's too), ``select_size`` of them."""
         s = self.settings
-        sel = np.asarray(selected)
-        if (
-            sel.ndim != 1
-            or sel.size != s.select_size
-            or not np.issubdtype(sel.dtype, np.integer)
-            or np.unique(sel).size != sel.size
-            or sel.min() < 0
-            or sel.max() >= s.pop_size
-        ):
-            raise NeurohoverError(f"selected must be {s.select_size} distinct integer indices in [0, {s.pop_size}), got {selected!r}")
+        sel = selected_indices(selected, s.pop_size, "selected")
+        if sel.size != s.select_size:
+            raise NeurohoverError(
+                f"selected must be {s.select_size} (select_size) distinct integer indices in 0..{s.pop_size - 1}; got {sel.size}: {brief(selected)}"
+            )
         return sel
 
     def _breed(self, parents: np.ndarray) -> np.ndarray:

@@ -341,13 +341,8 @@ class SteadyStateNE(ChampionViews):
         """
         if self._pending is None:
             raise AskTellOrderError(TELL_FIRST)
-        f = check_returns(fitness, len(self._pending), info=info)
-        crashed = None if info is None else info.crashed
-        if crashed is not None:
-            c = np.asarray(crashed)
-            if c.shape != f.shape or not (c.dtype == np.bool_ or np.issubdtype(c.dtype, np.integer)):
-                raise NeurohoverError(f"crashed must be {f.size} booleans, one per asked genome; got {crashed!r}")
-            crashed = c.astype(bool)
+        f = check_returns(fitness, len(self._pending), info=info)  # and the info's crash flags, one per genome (T21-10)
+        crashed = None if info is None or info.crashed is None else np.asarray(info.crashed).astype(bool)
         if self._population is None:
             self._population, self._fitness = self._pending, f
         else:

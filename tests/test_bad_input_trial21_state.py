@@ -1,0 +1,74 @@
+"""Bad input of the twenty-first trial: the ask/tell optimisers' TellInfo and saved states (T21-10, T21-11, T21-13)."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from neurohover.errors import NeurohoverError
+from neurohover.evolution.common import TellInfo
+from neurohover.evolution.generational import GenerationalNE, GenerationalSettings
+from neurohover.evolution.optimisers import OPTIMISERS
+from neurohover.evolution.steady_state import SteadyStateNE, SteadyStateSettings
+
+
+def _asked(name: str):
+    """An optimiser of 4 genomes a generation whose batch is asked (one of ``generational``, ``steady``, ``openai-es``)."""
+    if name == "generational":
+        opt = GenerationalNE(np.zeros(3), GenerationalSettings(pop_size=4, select_size=2))
+    elif name == "steady":
+        opt = SteadyStateNE(np.zeros(3), SteadyStateSettings(pop_size=4, elite_size=3))
+    else:
+        spec = OPTIMISERS[name]
+        opt = spec.make(np.zeros(3), spec.settings(popsize=4), 0)
+    assert len(opt.ask()) == 4
+    return opt
+
+
+@pytest.mark.parametrize("name", ["generational", "steady", "openai-es"])
+@pytest.mark.parametrize(
+    ("info", "message"),
+    [
+        (TellInfo(crashed=np.array([True])), "TellInfo crashed must be 4 booleans, one per asked genome; got 1 flag: array([ True])"),
+        (TellInfo(crashed=[False] * 5), "TellInfo crashed must be 4 booleans, one per asked genome; got 5 flags: [False, False"),
+        (TellInfo(crashed=np.ones((4, 1), bool)), "TellInfo crashed must be 4 booleans, one per asked genome; got shape (4, 1)"),
+        (TellInfo(crashed=np.array([5, 0, 0, 0])), "TellInfo crashed must be 4 booleans, one per asked genome; got int64 values: array([5, 0, 0, 0])"),
+        (
+            TellInfo(selected=np.array([-1, 0])),
+            "TellInfo selected must be distinct integer indices in 0..3 of the 4 asked genomes (1 to 4 of them); got index -1",
+        ),
+        (
+            TellInfo(selected=np.array([0, 4])),
+            "TellInfo selected must be distinct integer indices in 0..3 of the 4 asked genomes (1 to 4 of them); got index 4",
+        ),
+        (
+            TellInfo(selected=[0, 1, 2, 3, 0]),
+            "TellInfo selected must be distinct integer indices in 0..3 of the 4 asked genomes (1 to 4 of them); got 5 indices",
+        ),
+        (
+            TellInfo(selected=np.array([2, 2])),
+            "TellInfo selected must be distinct integer indices in 0..3 of the 4 asked genomes (1 to 4 of them); got index 2 twice",
+        ),
+        (
+            TellInfo(selected=np.array([0.0, 1.0])),
+            "TellInfo selected must be distinct integer indices in 0..3 of the 4 asked genomes (1 to 4 of them); got float64 values",
+        ),
+    ],
+)
+def test_a_tell_info_that_does_not_fit_the_asked_batch_is_refused_by_name(name: str, info: TellInfo, message: str) -> None:
+    """T21-10: crash flags of the wrong length and selected indices out of range were taken by the tell() of each
+    optimiser that does not read them (and integer flags of 5 by steady state's); every tell now checks both fields
+    against the genomes asked, in TellInfo.check, and the refused tell leaves the batch pending."""
+    opt = _asked(name)
+    with pytest.raises(NeurohoverError, match=re.escape(message)):
+        opt.tell(-np.arange(1.0, 5.0), info)
+    opt.tell(-np.arange(1.0, 5.0), TellInfo(crashed=np.array([True, False, False, True]), selected=[1, 0]))
+
+
+def test_a_generational_tell_names_a_selection_of_another_size() -> None:
+    """T21-10: the generational optimiser's own check (select_size indices) names the size given."""
+    opt = _asked("generational")
+    with pytest.raises(NeurohoverError, match=re.escape("selected must be 2 (select_size) distinct integer indices in 0..3; got 3: array([0, 1, 2])")):
+        opt.tell(-np.arange(1.0, 5.0), selected=np.array([0, 1, 2]))
