@@ -72,3 +72,73 @@ def test_a_generational_tell_names_a_selection_of_another_size() -> None:
     opt = _asked("generational")
     with pytest.raises(NeurohoverError, match=re.escape("selected must be 2 (select_size) distinct integer indices in 0..3; got 3: array([0, 1, 2])")):
         opt.tell(-np.arange(1.0, 5.0), selected=np.array([0, 1, 2]))
+
+
+def _generational_state() -> dict:
+    """The state of a GenerationalNE (4 genomes of 3 genes, 2 parents) after two generations."""
+    opt = GenerationalNE(np.zeros(3), GenerationalSettings(pop_size=4, select_size=2))
+    for k in range(2):
+        opt.ask()
+        opt.tell(-np.arange(1.0, 5.0) - k)
+    return opt.state_dict()
+
+
+def _steady_state() -> dict:
+    """The state of a SteadyStateNE (4 genomes of 3 genes) after its first generation."""
+    opt = SteadyStateNE(np.zeros(3), SteadyStateSettings(pop_size=4, elite_size=3))
+    opt.ask()
+    opt.tell(-np.arange(1.0, 5.0))
+    return opt.state_dict()
+
+
+@pytest.mark.parametrize(
+    ("make", "damage", "message"),
+    [
+        (
+            _generational_state,
+            lambda s: s["population"]["data"].__setitem__(7, "nan"),
+            "population holds a gene that is not a finite number: data entry 7 (genome 2, gene 1) is nan",
+        ),
+        (
+            _generational_state,
+            lambda s: s["population"]["data"].__setitem__(2, float("inf")),
+            "population holds a gene that is not a finite number: data entry 2 (genome 0, gene 2) is inf",
+        ),
+        (
+            _generational_state,
+            lambda s: s["champion_genome"]["data"].__setitem__(1, "-inf"),
+            "champion genome holds a gene that is not a finite number: gene 1 is -inf",
+        ),
+        (
+            _generational_state,
+            lambda s: s["population"]["data"].__setitem__(5, "NaN"),
+            "population data entry='NaN' is not allowed: give real numbers or 'nan', 'inf', '-inf' as state_dict() wrote them (real numbers, not text);"
+            " it is data entry 5 of 12",
+        ),
+        (
+            _generational_state,
+            lambda s: s["parents"]["data"].__setitem__(4, None),
+            "parents data entry=None is not allowed: give real numbers or 'nan', 'inf', '-inf' as state_dict() wrote them"
+            " (real numbers, not Python objects); it is data entry 4 of 6",
+        ),
+        (
+            _steady_state,
+            lambda s: s["tracker"]["genome"]["data"].__setitem__(2, "nan"),
+            "tracker genome holds a gene that is not a finite number: gene 2 is nan",
+        ),
+        (
+            _steady_state,
+            lambda s: s["population"]["data"].__setitem__(slice(3, 5), ["inf", "nan"]),
+            "population holds a gene that is not a finite number: data entry 3 (genome 1, gene 0) is inf, and 1 more",
+        ),
+    ],
+)
+def test_a_state_gene_that_is_no_finite_number_is_named_by_its_place_and_value(make, damage, message: str) -> None:
+    """T21-13: a genome of a state holding 'nan', 'inf' or a JSON NaN was refused as "holds a gene that is not a finite
+    number" without saying which of its genes; now the message names the data entry (genome and gene) and its value,
+    and a data entry that is no number at all ('NaN', None) names its place among the data too."""
+    state = make()
+    damage(state)
+    cls = GenerationalNE if state["type"] == "GenerationalNE" else SteadyStateNE
+    with pytest.raises(NeurohoverError, match=re.escape(message)):
+        cls.from_state_dict(state)

@@ -89,10 +89,14 @@ def dec_array(d: dict[str, Any] | None, name: str = "array") -> np.ndarray | Non
         return None
     data, shape = d["data"], [read_count(n) for n in d["shape"]]
     values = [_NON_FINITE.get(v, v) if isinstance(v, str) else v for v in data]
-    for v in values:
+    for k, v in enumerate(values):
         if type(v) is not float and type(v) is not int and not real_number(v):
-            as_floats(v, f"{name} data entry", _STORED)  # text, a bool, None: named as every array of real numbers is
-            raise EntryError(f"{name} data entry {brief(v)} is no number: allowed {_STORED}")  # a list in the list
+            where = f"; it is data entry {k} of {len(values)}"  # which of a genome's thousands (T21-13)
+            try:
+                as_floats(v, f"{name} data entry", _STORED)  # text, a bool, None: named as every array of real numbers is
+            except NeurohoverError as err:
+                raise NeurohoverError(f"{err}{where}") from None
+            raise EntryError(f"{name} data entry {brief(v)} is no number: allowed {_STORED}{where}")  # a list in the list
     return as_floats(values, f"{name} data", _STORED).reshape(shape)
 
 
@@ -113,8 +117,14 @@ def check_genomes(a: np.ndarray | None, size: int, name: str, rows: int | None =
         ok, expected = a.ndim == 2 and a.shape[1] == size, f"(n, {size})"
     if not ok:
         raise NeurohoverError(f"{name} has shape {a.shape}, expected {expected} (genomes of {size} genes)")
-    if a.dtype.kind != "f" or not np.all(np.isfinite(a)):  # a NaN gene was resumed without a word (eighth trial)
-        raise NeurohoverError(f"{name} holds a gene that is not a finite number")
+    if a.dtype.kind != "f":
+        raise NeurohoverError(f"{name} holds a gene that is not a finite number: its genes are {a.dtype} values, allowed finite floats")
+    bad = np.flatnonzero(~np.isfinite(a))  # a NaN gene was resumed without a word (eighth trial); which one, T21-13
+    if bad.size:
+        k = int(bad[0])
+        where = f"gene {k}" if a.ndim == 1 else f"data entry {k} (genome {k // size}, gene {k % size})"
+        more = f", and {bad.size - 1} more" if bad.size > 1 else ""
+        raise NeurohoverError(f"{name} holds a gene that is not a finite number: {where} is {brief(float(a.flat[k]))}{more}; allowed finite numbers")
     if rows and a.shape[0] != rows:  # a pop_size of 60 over 50 genomes was run on (sixteenth trial)
         raise NeurohoverError(f"{name} has {a.shape[0]} genomes where the state's settings make {rows}")
     return a
