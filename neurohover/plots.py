@@ -37,7 +37,7 @@ from matplotlib.ticker import MaxNLocator
 from .errors import NeurohoverError, brief, whole_number
 from .flightdata import FlightData, check_metadata
 from .paths import input_dir, output_dir, output_file, printable, strict_json
-from .sim.constants import ACTION_NAMES, CONTROL_DT, CRASH_STEP_PENALTY, EPISODE_STEPS, MAX_EPISODE_STEPS
+from .sim.constants import ACTION_NAMES, CONTROL_DT, CRASH_STEP_PENALTY, EPISODE_STEPS, MAX_EPISODE_STEPS, OBS_NAMES
 
 __all__ = [
     "CompeteResult",
@@ -157,9 +157,9 @@ def flight_figure(
     Parameters
     ----------
     observations : (T + 1, 12) array
-        The episode's observations (the first one before the first action).
+        The episode's observations (the first one before the first action), finite.
     actions : (T, 4) array
-        The actions applied (aileron, elevator, rudder, collective).
+        The actions applied (aileron, elevator, rudder, collective), finite but a crashed episode's last.
     title : str
         Figure title.
     crashed : bool, optional
@@ -183,6 +183,7 @@ def flight_figure(
         crashed = crashed_episode(act, steps)
     elif not isinstance(crashed, (bool, np.bool_)):
         raise NeurohoverError(f"crashed={brief(crashed)} is not allowed: give True, False or None (by the episode's length)")
+    _check_flown(obs, act, bool(crashed), "flight_figure")
     t_obs = np.arange(obs.shape[0]) * CONTROL_DT
     t_act = np.arange(act.shape[0]) * CONTROL_DT
     fig = new_figure(10.0, 11.0)
@@ -208,6 +209,22 @@ def flight_figure(
     fig.suptitle(f"{title}\n{end}" if title else end, color=CRASH_COLOR if crashed else "black")
     fig.tight_layout()
     return fig
+
+
+def _check_flown(observations: np.ndarray, actions: np.ndarray, crashed: bool, where: str) -> None:
+    """Refuse an episode's readings that no flight gives, naming ``where``, the step, the variable and its value: a NaN
+    or infinite observation (the simulator's are finite, a crash's last one too, out of bounds as it may be), or a
+    non-finite action but the last of a ``crashed`` episode (a policy's NaN action is recorded as given, and crashes
+    the episode there). A file of NaN observations drew empty panels and exited 0, while learn-model refused it (T21-04)."""
+    for kind, values, names, last in (("observation", observations, OBS_NAMES, 0), ("action", actions, ACTION_NAMES, int(crashed))):
+        bad = np.argwhere(~np.isfinite(values[: values.shape[0] - last]))
+        if bad.size:
+            k, i = (int(x) for x in bad[0])
+            count = f" ({len(bad) - 1:,} more of the episode's {kind} readings are NaN or infinite)" if len(bad) > 1 else ""
+            but = "but as a crashed episode's last" if kind == "action" else "a crash's last one included"
+            raise NeurohoverError(
+                f"{where}: step {k} reads {names[i]} = {values[k, i]}{count}: no flight records a NaN or infinite {kind}, {but}; give flight data as flown"
+            )
 
 
 def _episode_title(data: FlightData, i: int, stem: str) -> str:
@@ -257,6 +274,8 @@ def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight"
         )
     check_metadata(data.metadata, np.array([a.shape[0] for a in data.actions], dtype=np.int64), "flight data")  # episode_steps 'x' (T14-10)
     steps = data.metadata.get("episode_steps", EPISODE_STEPS)
+    for i in range(data.n_episodes):  # every episode before any file is written, as learn-model reads them all
+        _check_flown(data.observations[i], data.actions[i], episode_crashed(data, i), f"flight data, episode {i}")
     width = len(str(max(data.n_episodes - 1, 0)))
     chosen = range(data.n_episodes) if episodes is None else _episode_list(episodes, data.n_episodes)
     out_dir = output_dir(out_dir, "out_dir")  # a file, FIFO or /dev/null was NotADirectoryError (T14-10); made, saying so, if missing
