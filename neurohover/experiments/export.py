@@ -17,9 +17,10 @@ import csv
 import io
 import json
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, first_difference
 from .config import ExperimentConfig
 from .keys import UnitKey
+from .plans import external_digest, plan, run_keys, source_experiments
 from .results import UnitResult, check_run_lengths, flat_cells, result_from_dict
 from .store import Store
 
@@ -89,6 +90,45 @@ def _check_key(config: ExperimentConfig, unit: dict) -> None:
         raise NeurohoverError(f"its key is of no shape a {config.kind} experiment plans: its unit keys are {forms}")  # the caller names the unit
 
 
+def _replannable(config: ExperimentConfig) -> bool:
+    """Whether ``config``'s plan can be made again as its units were: the policies it reads from outside the store (the
+    shipped set, a directory) digest as they did when it was stored. A policy directory since removed or changed (the
+    paper-scale fig16-authors-generics reads 'dir:AUTHORS/...') leaves its units checked by key, kind and result alone."""
+    try:
+        return external_digest(config.kind, config.settings) == config.external_digest
+    except NeurohoverError:  # the directory is gone
+        return False
+
+
+def _check_planned(store: Store, config: ExperimentConfig, units: list[dict]) -> None:
+    """Refuse a stored unit its stored config does not plan, or one whose kind or params (the seed, the episodes) are not
+    those the config plans for its key: reproduce refused both (seventh, eighth trial) while results and report exported
+    a unit whose seed was edited in the store (T21-02). The plan is made from every stored unit (a later stage is planned
+    from earlier results); a test run planned only once its policies are stored is checked by its key alone. A
+    'diagnostic' unit (the tests' own plans) is not planned by any config."""
+    checked = [u for u in units if u["kind"] != "diagnostic"]
+    if not checked or not _replannable(config):
+        return
+    sources = {n: store.results(n, config.scale) for n in source_experiments(config)}
+    planned = {u.key: u for u in plan(config, {u["key"]: u["result"] for u in units}, sources).units}
+    known = set(planned) | set(run_keys(config))
+    stray = sorted(u["key"] for u in checked if u["key"] not in known)
+    if stray:
+        more = f" (and {len(stray) - 1} more)" if len(stray) > 1 else ""
+        raise NeurohoverError(f"it holds unit {stray[0]!r}{more}, which the config does not plan (reproduce --fresh starts it over)")
+    for u in checked:
+        p = planned.get(u["key"])
+        if p is None:
+            continue
+        want = {"kind": p.kind, "params": json.loads(json.dumps(p.params))}  # as the store writes them (tuples as lists)
+        if want != {"kind": u["kind"], "params": u["params"]}:
+            differ = first_difference("unit", {"kind": u["kind"], "params": u["params"]}, want)
+            raise NeurohoverError(
+                f"unit {u['key']!r} holds other settings than its config plans for it ({differ.replace(', given ', ', planned ')}): "
+                "it was changed in the store (reproduce --fresh starts it over)"
+            )
+
+
 def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig, list[dict], dict[str, UnitResult]]:
     """Experiment (name, scale)'s stored config and finished units, each read back and checked: the one check of a stored
     experiment that results, wins, report and reproduce (compete too) share.
@@ -107,8 +147,9 @@ def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig
     NeurohoverError
         One message naming the store, the experiment and the damaged unit (where one is): wins took a unit of kind
         'bogus' for a test run (T19-05), and results' messages named neither the store nor the unit (T19-14). Also a
-        config that does not hash to its recorded hash, a unit run under another hash (T20-04), and a unit key of no
-        shape the experiment's plan gives (T20-05).
+        config that does not hash to its recorded hash, a unit run under another hash (T20-04), a unit key of no
+        shape the experiment's plan gives (T20-05), and a unit the stored config does not plan, or plans with other
+        kind or params (T21-02; :func:`_check_planned`).
     """
     where = f"results store {str(store.path)!r}, experiment {name} ({scale}), is damaged"
     stored = store.config(name, scale)  # the store names a row that is no JSON object itself, as for the units below
@@ -130,6 +171,7 @@ def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig
     try:
         _check_hashes(store, name, scale, stored, config)
         check_run_lengths(config.settings.get("episodes") if config.kind == "test_runs" else None, results)
+        _check_planned(store, config, units)
     except NeurohoverError as err:
         raise NeurohoverError(f"{where}: {err}") from None
     return config, units, results

@@ -142,12 +142,12 @@ def _matches_no_unit(config, pattern: str, units) -> NeurohoverError:
     return NeurohoverError(f"{config.name}: --only {pattern!r} matches no unit; unit keys look like {', '.join(examples[:6])}")
 
 
-def _checked_results(config: ExperimentConfig, store: Store, held: str | None) -> tuple[dict[str, dict], dict[str, tuple[str, dict]]]:
+def _checked_results(config: ExperimentConfig, store: Store, held: str | None) -> dict[str, dict]:
     """Key -> result of every stored unit of the experiment, each read back and checked (:func:`~.export.checked_units`,
-    results' check): a damaged unit was counted as finished and never run again (fifth trial). Also key -> (kind, params)
-    of each, for :func:`_refuse_stray_units`. Called before anything is written (``held``: the stored config hash, None:
-    no config stored), so a refused run leaves the store as it was: a damaged config was rewritten, and units whose config
-    was gone were taken in, by compete (T19-06)."""
+    results' check): a damaged unit was counted as finished and never run again (fifth trial), a unit the config does
+    not plan was counted as done (seventh trial), one of other params reused (eighth trial). Called before anything is
+    written (``held``: the stored config hash, None: no config stored), so a refused run leaves the store as it was: a
+    damaged config was rewritten, and units whose config was gone were taken in, by compete (T19-06)."""
     from .export import checked_units
 
     if held is None:
@@ -157,30 +157,8 @@ def _checked_results(config: ExperimentConfig, store: Store, held: str | None) -
                 f"results store {str(store.path)!r}, experiment {config.name} ({config.scale}), is damaged: it holds {len(orphans)} finished "
                 "unit(s) of it but no record of its config, so they cannot be checked: give another store (reproduce --fresh discards them)"
             )
-        return {}, {}
-    units = checked_units(store, config.name, config.scale)[1]
-    return {unit["key"]: unit["result"] for unit in units}, {unit["key"]: (unit["kind"], unit["params"]) for unit in units}
-
-
-def _refuse_stray_units(config: ExperimentConfig, store: Store, results: dict[str, dict], stored: dict[str, tuple[str, dict]], sources: dict) -> Plan:
-    """Refuse a stored unit the config does not plan (it was counted as done: "5/4 done"; seventh trial), or one whose
-    kind or params are not those planned for its key (an agent "foo" was reused; eighth trial). Every stored unit's
-    prerequisites are stored too, so the plan from all of them names every unit that belongs; it is returned, the
-    run's first plan."""
-    planned_from_all = plan(config, results, sources)
-    planned = planned_from_all.units
-    known = {u.key for u in planned} | set(run_keys(config))
-    stray = sorted(set(results) - known)
-    where = f"results store {str(store.path)!r}, experiment {config.name} ({config.scale}), is damaged"
-    if stray:
-        raise NeurohoverError(
-            f"{where}: it holds unit {stray[0]!r}{f' (and {len(stray) - 1} more)' if len(stray) > 1 else ''}, which the config does not plan "
-            "(--fresh starts it over)"
-        )
-    for u in planned:
-        if u.key in stored and stored[u.key] != (u.kind, json.loads(json.dumps(u.params))):
-            raise NeurohoverError(f"{where}: unit {u.key!r} holds other settings than its config plans for it (--fresh starts it over)")
-    return planned_from_all
+        return {}
+    return {unit["key"]: unit["result"] for unit in checked_units(store, config.name, config.scale)[1]}
 
 
 def _check_arguments(config, store, executor, progress, on_unit, only, fresh, update) -> tuple[str, ...]:
@@ -271,9 +249,9 @@ def reproduce(
         print(f"{config.name} ({config.scale}): the config changed (hash {held} -> {config.hash}); {kept} stored units stand unchanged", file=sys.stderr)
         checked = None  # fewer units now: read again
     store.begin(config.name, config.scale, config.hash, config.to_dict(), fresh=fresh)
-    results, stored = checked if checked is not None else _checked_results(config, store, config.hash)  # read once: checked, then the finished units
+    results = checked if checked is not None else _checked_results(config, store, config.hash)  # read once: checked, then the finished units
     sources = {name: store.results(name, config.scale) for name in source_experiments(config)}
-    first_round: Plan | None = _refuse_stray_units(config, store, results, stored, sources)  # planned once, not twice
+    first_round: Plan | None = plan(config, results, sources)
     summary = RunSummary(config.name, config.scale, executor.name, executor.cores, units_before=len(results))
     session: int | None = store.start_session(config.name, config.scale, config.hash, executor.name, summary.cores, len(results))
     start = time.perf_counter()

@@ -1,0 +1,94 @@
+"""The twenty-first bad-input trial's findings in results stores: every command refuses a stored unit whose params were
+changed, as reproduce did (T21-02)."""
+
+from __future__ import annotations
+
+import shutil
+import sqlite3
+from pathlib import Path
+
+import pytest
+from conftest import CliRun, tiny_test_runs
+
+from neurohover.errors import NeurohoverError
+from neurohover.experiments import Store
+from neurohover.experiments.export import checked_units
+
+RUN = "run/baseline/test0/rep0"
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory) -> tuple[Path, Path]:
+    """A config of two agents (tr1: baseline and generic, one 20-step run of 2 episodes each) and a store holding its
+    two finished test runs; tests damage copies of the store."""
+    from neurohover.cli import main
+
+    where = tmp_path_factory.mktemp("tiny21")
+    config = where / "tr1.toml"
+    config.write_text(tiny_test_runs("baseline", "generic"))
+    assert main(["reproduce", str(config), "--store", str(where / "s.sqlite"), "--no-progress"]) == 0
+    return config, where / "s.sqlite"
+
+
+def _damaged(store: Path, at: Path, sql: str) -> Path:
+    """A copy of ``store`` at ``at`` with ``sql`` run on it."""
+    shutil.copyfile(store, at)
+    with sqlite3.connect(at) as conn:
+        conn.execute(sql)
+    conn.close()
+    return at
+
+
+def _dump(path: Path) -> list[str]:
+    with sqlite3.connect(path) as conn:
+        rows = list(conn.iterdump())
+    conn.close()
+    return rows
+
+
+def _error(err: str, command: str) -> str:
+    """The message of ``neurohover COMMAND: error: ...`` on stderr."""
+    line = next(ln for ln in err.splitlines() if ln.startswith(f"neurohover {command}: error: "))
+    return line.removeprefix(f"neurohover {command}: error: ")
+
+
+@pytest.mark.parametrize(
+    ("edit", "says"),
+    [
+        ("'$.seed', 12345", "unit.params.seed: the stored 12345, planned "),
+        ("'$.episodes', 3", "unit.params.episodes: the stored 3, planned 2"),
+    ],
+)
+def test_every_command_refuses_a_unit_whose_params_were_changed(tiny, tmp_path: Path, cli: CliRun, edit: str, says: str) -> None:
+    """T21-02: a finished unit whose stored seed or episode count was edited (its key kept) was refused by reproduce but
+    exported by results and reported by report; now the shared check refuses it everywhere, in one message naming the
+    store, the experiment, the unit and the setting changed."""
+    config, good = tiny
+    store = _damaged(good, tmp_path / "s.sqlite", f"UPDATE units SET params = json_set(params, {edit}) WHERE key = '{RUN}'")
+    before = _dump(store)
+    message = f"results store {str(store)!r}, experiment tr1 (quick), is damaged: unit '{RUN}' holds other settings than its config plans for it ("
+    rc, out, err = cli("results", "tr1", "--store", str(store))
+    assert rc == 2 and out == "" and message in err and says in err, err
+    line = _error(err, "results")
+    for argv, command in (
+        (("results", "tr1", "--store", str(store), "--format", "json"), "results"),
+        (("wins", "tr1", "--store", str(store), "--runs", "1", "--draws", "10"), "wins"),
+        (("reproduce", str(config), "--store", str(store), "--no-progress"), "reproduce"),
+    ):
+        rc, out, err = cli(*argv)
+        assert rc == 2 and _error(err, command) == line, (argv, err)
+    rc, out, err = cli("report", "--store", str(store), "--out", str(tmp_path / "r"))
+    assert rc == 2 and f"is not reported: {line}" in err and not (tmp_path / "r").exists(), err
+    with Store(store, create=False) as held, pytest.raises(NeurohoverError) as caught:
+        checked_units(held, "tr1", "quick")
+    assert str(caught.value) == line
+    assert _dump(store) == before
+
+
+@pytest.mark.paper
+def test_the_committed_store_passes_the_shared_check(committed_store: Path) -> None:
+    """T21-02: every experiment of the committed paper-scale store (written by earlier versions) passes the shared
+    check with its plan check (about half a minute: the paper suite)."""
+    with Store(committed_store, create=False) as store:
+        for name, scale, _, _ in store.experiments():
+            checked_units(store, name, scale)
