@@ -258,8 +258,9 @@ def read_checkpoint(path: Path) -> dict:
 
 def check_history(records: list[HistoryRecord], counts: dict[str, int], per_generation: bool) -> None:
     """EntryError unless ``records`` can be the history of a run at checkpoint counters ``counts``: generations rising
-    from 1, evaluations and episodes never falling nor past the counters, and, where the run records every generation
-    (``per_generation``), one row each (a history of three copies of its one row was resumed and written out; T19-08)."""
+    from 1, evaluations and episodes never falling nor past the counters nor below a row's generations and evaluations,
+    and, where the run records every generation (``per_generation``), one row each (a history of three copies of its
+    one row was resumed and written out; T19-08)."""
     last = None
     for n, h in enumerate(records):
         if h.generation < 1 or (last is not None and h.generation <= last.generation):
@@ -270,6 +271,12 @@ def check_history(records: list[HistoryRecord], counts: dict[str, int], per_gene
                 raise EntryError(f"history row {n} (from 0): {column}={getattr(h, column):,} is not allowed (below row {n - 1}'s {getattr(last, column):,})")
         if h.generation_episodes > h.episodes:
             raise EntryError(f"history row {n} (from 0): generation_episodes={h.generation_episodes:,} is not allowed (more than its {h.episodes:,} episodes)")
+        for column, v, bound, why in (  # as the counters (evolution.restore): a row holds them as they were (T21-03)
+            ("evaluations", h.evaluations, h.generation, f"below its {h.generation:,} generations: each evaluates a candidate"),
+            ("episodes", h.episodes, h.evaluations, f"below its {h.evaluations:,} evaluations: each flies an episode or more"),
+        ):
+            if v < bound:
+                raise EntryError(f"history row {n} (from 0): {column}={v:,} is not allowed ({why})")
         last = h
     if last is not None:
         for column in ("generation", "evaluations", "episodes"):

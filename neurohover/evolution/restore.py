@@ -76,7 +76,10 @@ def _restored_parts(state: dict, run: Run) -> dict[str, Any]:
     seconds = {k: c[k] for k in ("wall_seconds", "kernel_seconds")}
     for k, v in seconds.items():
         if not (finite_real(v) and v >= 0):  # finite_real: '1.5' was read as 1.5 (sixteenth trial)
-            raise ValueError(f"counter {k!r} is {brief(v)}, not a number of seconds >= 0")
+            raise EntryError(f"counter {k!r} is {brief(v)}, not a number of seconds >= 0")
+    kernel, wall = seconds["kernel_seconds"], seconds["wall_seconds"]
+    if kernel > wall:  # (each kernel call is timed inside the run's wall time; T21-03)
+        raise EntryError(f"counter 'kernel_seconds' is {kernel!r}, more than the run's wall_seconds {wall!r} (its kernel time is part of them)")
     champion = _checked_champion(state["champion"], run.cfg.prototype.genome.size, run.fitness)
     race_delta = _checked_race_delta(state.get("race_delta", run.resampling.delta), run.resampling)  # absent before race:auto
     history = decode_history(state["history"])
@@ -102,24 +105,29 @@ def _checked_race_delta(delta: Any, resampling: Resampling) -> float | None:
 
 def _checked_counts(c: dict, n_steps: int) -> dict[str, int]:
     """Checkpoint counters ``c`` of a run of ``n_steps``-step episodes, each a count in 0..:data:`MAX_COUNT` and in
-    step with the others (2**70 as next_index was an OverflowError mid-run, as flown or generation taken; T19-01, T19-08)."""
+    step with the others (2**70 as next_index was an OverflowError mid-run, as flown or generation taken; T19-01, T19-08),
+    or an EntryError naming the counter (its message as it is: a ValueError's was prefixed "ValueError: "; T21-03)."""
     counts = {k: c[k] for k in ("episodes", "steps", "generation", "evaluations")}
     # Checkpoints before races reserved indices: every index flown was counted.
     counts["next_index"], counts["flown"] = c.get("next_index", c["episodes"]), c.get("flown", c["episodes"])
     for k, v in counts.items():
         if not whole_number(v) or v < 0 or (k != "steps" and v > MAX_COUNT):  # (the steps are bounded by the episodes, below)
-            raise ValueError(f"counter {k!r} is {brief(v)}, not a count: allowed an integer in 0..2**62 ({_COUNT_LIMIT})")
-    # Rules every run keeps: each counted episode was flown, each flown one had its own index, an episode has at most
-    # n_steps steps, and a generation evaluates at least one candidate.
+            raise EntryError(f"counter {k!r} is {brief(v)}, not a count: allowed an integer in 0..2**62 ({_COUNT_LIMIT})")
+    # Rules every run keeps: each counted episode was flown, each flown one had its own index, a generation evaluates at
+    # least one candidate, an episode has 1 to n_steps steps (the kernel counts the step an episode crashes on, its first
+    # included: steps 3 for 40 episodes was resumed; T21-03) and an evaluation flies at least one episode.
+    episodes, evaluations = counts["episodes"], counts["evaluations"]
     for k, v, bound, why in (
-        ("flown", counts["flown"], counts["episodes"], f"below the {counts['episodes']:,} episodes counted (each was flown)"),
+        ("flown", counts["flown"], episodes, f"below the {episodes:,} episodes counted (each was flown)"),
         ("next_index", counts["next_index"], counts["flown"], f"below the {counts['flown']:,} episodes flown (each flew its own index)"),
-        ("evaluations", counts["evaluations"], counts["generation"], f"below the {counts['generation']:,} generations (each evaluates a candidate)"),
+        ("evaluations", evaluations, counts["generation"], f"below the {counts['generation']:,} generations (each evaluates a candidate)"),
+        ("steps", counts["steps"], episodes, f"below the {episodes:,} episodes counted (each has a step or more, a crash on its first too)"),
+        ("episodes", episodes, evaluations, f"below the {evaluations:,} evaluations (each flies an episode or more)"),
     ):
         if v < bound:
-            raise ValueError(f"counter {k!r} is {v:,}, {why}")
+            raise EntryError(f"counter {k!r} is {v:,}, {why}")
     if counts["steps"] > counts["episodes"] * n_steps:
-        raise ValueError(f"counter 'steps' is {counts['steps']:,}, more than {counts['episodes']:,} episodes of {n_steps:,} steps can have")
+        raise EntryError(f"counter 'steps' is {counts['steps']:,}, more than {counts['episodes']:,} episodes of {n_steps:,} steps can have")
     return counts
 
 
