@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import re
 
 import numpy as np
@@ -142,3 +143,48 @@ def test_a_state_gene_that_is_no_finite_number_is_named_by_its_place_and_value(m
     cls = GenerationalNE if state["type"] == "GenerationalNE" else SteadyStateNE
     with pytest.raises(NeurohoverError, match=re.escape(message)):
         cls.from_state_dict(state)
+
+
+@pytest.mark.parametrize(
+    ("damage", "message"),
+    [
+        (
+            lambda s: s.update(hall_of_fame=[]),
+            "GenerationalNE state dict's hall_of_fame is [] at generation=2 beside its parents and a champion (return -2.0): every tell() keeps both",
+        ),
+        (
+            lambda s: s.update(parents=None),
+            "GenerationalNE state dict's parents are null at generation=2 beside its hall_of_fame and a champion (return -2.0): every tell() keeps both",
+        ),
+        (
+            lambda s: s.update(hall_of_fame=s["hall_of_fame"][:1]),
+            "hall_of_fame returns [-1.0] leave out its champion's return -2.0: every generation's champion enters the hall, unless select_size (2)",
+        ),
+        (
+            lambda s: s["parents"]["data"].__setitem__(0, s["parents"]["data"][0] + 1.0) or s["parents"]["data"].__setitem__(3, s["parents"]["data"][3] + 1.0),
+            "GenerationalNE state dict's champion genome is none of its 2 parents: the champion is its generation's best parent",
+        ),
+    ],
+)
+def test_a_generational_states_champion_parents_and_hall_of_fame_must_agree(damage, message: str) -> None:
+    """T21-11: a GenerationalNE state past its first generation with "hall_of_fame": [] beside its champion was taken
+    (and so were null parents, a hall of fame without the last champion and a champion none of the parents); now the
+    champion must be one of the parents and in the hall (unless select_size better ones are), as tell() keeps them."""
+    state = _generational_state()
+    GenerationalNE.from_state_dict(copy.deepcopy(state))  # the sound state loads
+    damage(state)
+    with pytest.raises(NeurohoverError, match=re.escape(message)):
+        GenerationalNE.from_state_dict(state)
+
+
+def test_a_generational_state_without_parents_and_hall_of_fame_still_loads() -> None:
+    """T21-11: a checkpoint of before 2026-12-04 has neither, and one saved after resuming it before a generation was
+    told holds them as null and []: both still load, and the next tell() fills them in."""
+    state = _generational_state()
+    del state["parents"], state["hall_of_fame"]
+    resumed = GenerationalNE.from_state_dict(state)
+    again = GenerationalNE.from_state_dict(resumed.state_dict())
+    assert (again.parents, again.hall_of_fame) == (None, None)
+    again.ask()
+    again.tell(-np.arange(1.0, 5.0))
+    assert GenerationalNE.from_state_dict(again.state_dict()).hall_of_fame.shape == (1, 3)

@@ -510,6 +510,34 @@ def _check_progress(opt: GenerationalNE) -> None:
             f"{what}'s hall_of_fame returns {brief([enc_float(r) for r in returns])} are not allowed: at most select_size"
             f" ({opt.settings.select_size}) and generation ({gen}) of its generations' champion returns, best first"
         )
+    if gen:
+        _check_kept(opt, returns, what)
+
+
+def _check_kept(opt: GenerationalNE, returns: list[float], what: str) -> None:
+    """NeurohoverError unless the parents and hall of fame (``returns``, best first) of a restored optimiser past its first
+    generation hold its champion as :meth:`GenerationalNE.tell` keeps it: the champion is one of the parents, and it
+    entered the hall unless select_size better ones were there ("hall_of_fame": [] beside a champion and its parents
+    was taken; T21-11). A checkpoint written before 2026-12-04 has neither (nor does one saved after resuming it but
+    before a generation was told): both absent, or null and [], are no contradiction."""
+    champion, mu = opt._champion_return, opt.settings.select_size
+    if opt._parents is None or not returns:
+        if opt._parents is not None or returns:
+            given, empty = ("parents", "hall_of_fame is []") if opt._parents is not None else ("hall_of_fame", "parents are null")
+            raise NeurohoverError(
+                f"{what}'s {empty} at generation={opt._generation} beside its {given} and a champion (return {enc_float(champion)}):"
+                " every tell() keeps both, the champion among its parents and in its hall_of_fame (a checkpoint of before"
+                " 2026-12-04 has neither)"
+            )
+        return
+    assert opt._champion_genome is not None  # a generation past 0 has a champion (checked above)
+    if not any(np.array_equal(parent, opt._champion_genome) for parent in opt._parents):
+        raise NeurohoverError(f"{what}'s champion genome is none of its {len(opt._parents)} parents: the champion is its generation's best parent")
+    if champion not in returns and not (len(returns) == mu and returns[-1] >= champion):
+        raise NeurohoverError(
+            f"{what}'s hall_of_fame returns {brief([enc_float(r) for r in returns])} leave out its champion's return {enc_float(champion)}:"
+            f" every generation's champion enters the hall, unless select_size ({mu}) better ones are there"
+        )
 
 
 def _flag(value: Any) -> bool:
