@@ -1,5 +1,5 @@
 """The twenty-first bad-input trial's findings in results stores: every command refuses a stored unit whose params were
-changed, as reproduce did (T21-02)."""
+changed, as reproduce did (T21-02). And a budget refused says that 0 is no cap (T21-14)."""
 
 from __future__ import annotations
 
@@ -83,6 +83,23 @@ def test_every_command_refuses_a_unit_whose_params_were_changed(tiny, tmp_path: 
         checked_units(held, "tr1", "quick")
     assert str(caught.value) == line
     assert _dump(store) == before
+
+
+@pytest.mark.parametrize(
+    ("name", "setting", "says"),
+    [
+        ("fig2", "budget=-1", "budget = -1 is not allowed: expected an integer in 0..10000000000 (0: no cap, each evolution run stops by"),
+        ("table4", "ec_meno_budget=-1", "ec_meno_budget = -1 is not allowed: expected an integer in 0..10000000000 (0: no cap, EC-MENO stops at its plateau)"),
+    ],
+)
+def test_a_refused_budget_says_that_0_is_no_cap(tmp_path: Path, cli: CliRun, name: str, setting: str, says: str) -> None:
+    """T21-14: --set budget=-1 (meant as "unlimited") was refused as "expected an integer in 0..10000000000", not told
+    that 0 is the way to ask for no cap; a budget that 0 is not allowed for (model_budget) says nothing of it."""
+    rc, out, err = cli("reproduce", name, "--set", setting, "--store", str(tmp_path / "s.sqlite"), "--no-progress")
+    assert rc == 2 and out == "" and says in err and "Traceback" not in err, err
+    rc, _, err = cli("reproduce", "table4", "--set", "model_budget=0", "--store", str(tmp_path / "s.sqlite"), "--no-progress")
+    assert rc == 2 and "model_budget = 0 is not allowed: expected an integer in 1..10000000000" in err and "no cap" not in err, err
+    assert not (tmp_path / "s.sqlite").exists()
 
 
 @pytest.mark.paper

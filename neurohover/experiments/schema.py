@@ -38,6 +38,14 @@ POLICY_SET_GROUP = "policy-set"
 SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {kind: schema_of(cls) for kind, cls in KIND_SETTINGS.items()}
 
 
+#: What 0 means for the budget settings that take it: no cap, the run stopped by its own rule (the units pass 0 on as no
+#: budget, ``budget or None``): told where one is refused, for a -1 or "unlimited" meant as no cap (T21-14).
+ZERO_MEANS = dict.fromkeys(
+    ("budget", "policy_budget", "generic_budget"),
+    " (0: no cap, each evolution run stops by its optimizer's own rule: the plateau stop, or the generations setting)",
+) | {"ec_meno_budget": " (0: no cap, EC-MENO stops at its plateau)"}
+
+
 def validate_table(values: dict, schema: dict, where: str) -> dict:
     unknown = sorted(set(values) - set(schema))
     if unknown:
@@ -63,7 +71,8 @@ def validate_table(values: dict, schema: dict, where: str) -> dict:
             continue
         ok, allowed = check(value)
         if not ok:
-            raise NeurohoverError(f"{where}: {key} = {value!r} is not allowed: expected {allowed}")
+            no_cap = ZERO_MEANS.get(key, "") if check(0)[0] else ""  # -1 for "unlimited" was refused without the way to say it (T21-14)
+            raise NeurohoverError(f"{where}: {key} = {value!r} is not allowed: expected {allowed}{no_cap}")
         out[key] = value
     return out
 
