@@ -1,5 +1,6 @@
 """The twenty-first bad-input trial's findings in results stores: every command refuses a stored unit whose params were
-changed, as reproduce did (T21-02). And a budget refused says that 0 is no cap (T21-14)."""
+changed, as reproduce did (T21-02). And a budget refused says that 0 is no cap (T21-14). Units stored at a scale of no
+config row (orphans) are named as damage, not ignored (T21-15)."""
 
 from __future__ import annotations
 
@@ -83,6 +84,48 @@ def test_every_command_refuses_a_unit_whose_params_were_changed(tiny, tmp_path: 
         checked_units(held, "tr1", "quick")
     assert str(caught.value) == line
     assert _dump(store) == before
+
+
+#: A copy of RUN's row under another name or scale ({name}, {scale}: SQL, a column's name keeps it).
+COPY = f"INSERT INTO units SELECT {{name}}, {{scale}}, key, kind, config_hash, params, result, seconds, worker, finished FROM units WHERE key = '{RUN}'"
+
+
+def test_every_command_names_units_at_a_scale_of_no_config_as_damage(tiny, tmp_path: Path, cli: CliRun) -> None:
+    """T21-15: a quick unit copied to scale 'paper', where the store holds no config of tr1, was ignored: results and
+    report exported the quick experiment, reproduce ran it (rc 0); now each calls the store damaged, naming the rows."""
+    config, good = tiny
+    store = _damaged(good, tmp_path / "s.sqlite", COPY.format(name="name", scale="'paper'"))
+    before = _dump(store)
+    says = (
+        f"results store {str(store)!r}, experiment tr1 (paper), is damaged: it holds 1 finished unit(s) of it but no record of its config, "
+        f"so they cannot be checked (the first: unit '{RUN}')"
+    )
+    for argv, command in (
+        (("results", "tr1", "--store", str(store)), "results"),
+        (("results", "tr1", "--store", str(store), "--scale", "paper"), "results"),
+        (("wins", "tr1", "--store", str(store), "--runs", "1", "--draws", "10"), "wins"),
+        (("reproduce", str(config), "--store", str(store), "--no-progress"), "reproduce"),
+    ):
+        rc, out, err = cli(*argv)
+        assert rc == 2 and out == "" and _error(err, command).startswith(says), (argv, err)
+    rc, out, err = cli("report", "--store", str(store), "--out", str(tmp_path / "r"))
+    assert rc == 2 and f"tr1 (quick) is not reported: {says}" in err and not (tmp_path / "r").exists(), err
+    assert _dump(store) == before
+
+
+def test_report_warns_of_units_of_an_experiment_it_holds_no_config_of(tiny, tmp_path: Path, cli: CliRun) -> None:
+    """T21-15: units of an experiment 'ghost' with no config row at all were left out of the report without a word;
+    now one warning line names them (the report of the sound experiments written), and asked for alone they are refused."""
+    store = _damaged(tiny[1], tmp_path / "s.sqlite", COPY.format(name="'ghost'", scale="scale"))
+    says = f"ghost (quick) is not reported: results store {str(store)!r}, experiment ghost (quick), is damaged: it holds 1 finished unit(s) of it"
+    rc, out, err = cli("report", "--store", str(store), "--out", str(tmp_path / "r"))
+    assert rc == 0 and "report written" in out and f"neurohover report: warning: {says}" in err, err
+    rc, out, err = cli("report", "ghost", "--store", str(store), "--out", str(tmp_path / "r2"))
+    assert rc == 2 and "experiment ghost (quick), is damaged: it holds 1 finished unit(s)" in err and not (tmp_path / "r2").exists(), err
+    rc, out, err = cli("results", "ghost", "--store", str(store))
+    assert rc == 2 and "experiment ghost (quick), is damaged: it holds 1 finished unit(s)" in err, err
+    rc, out, err = cli("results", "tr1", "--store", str(store))  # another experiment's orphans are not this one's damage
+    assert rc == 0 and RUN in out, err
 
 
 @pytest.mark.parametrize(

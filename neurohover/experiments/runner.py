@@ -148,15 +148,10 @@ def _checked_results(config: ExperimentConfig, store: Store, held: str | None) -
     not plan was counted as done (seventh trial), one of other params reused (eighth trial). Called before anything is
     written (``held``: the stored config hash, None: no config stored), so a refused run leaves the store as it was: a
     damaged config was rewritten, and units whose config was gone were taken in, by compete (T19-06)."""
-    from .export import checked_units
+    from .export import checked_units, refuse_orphans
 
-    if held is None:
-        orphans = store.units(config.name, config.scale)
-        if orphans:
-            raise NeurohoverError(
-                f"results store {str(store.path)!r}, experiment {config.name} ({config.scale}), is damaged: it holds {len(orphans)} finished "
-                "unit(s) of it but no record of its config, so they cannot be checked: give another store (reproduce --fresh discards them)"
-            )
+    if held is None:  # units of it at a scale of no config row, this one's or another's (T21-15)
+        refuse_orphans(store, config.name)
         return {}
     return {unit["key"]: unit["result"] for unit in checked_units(store, config.name, config.scale)[1]}
 
