@@ -28,13 +28,14 @@ import textwrap
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NoReturn
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
-from .errors import NeurohoverError, brief, whole_number
+from .errors import NeurohoverError, brief, finite_real, whole_number
 from .flightdata import FlightData, check_metadata
 from .paths import input_dir, output_dir, output_file, printable, strict_json
 from .sim.constants import ACTION_NAMES, CONTROL_DT, CRASH_STEP_PENALTY, EPISODE_STEPS, MAX_EPISODE_STEPS, OBS_NAMES
@@ -346,13 +347,26 @@ class CompeteResult:
         return -np.cumsum(self.returns, axis=1).mean(axis=0)
 
 
+@dataclass
+class _Rows:
+    """What the summary check compares of an episodes.csv, kept small (a file may hold 10**8 rows): the line each MDP
+    label and each (crashed, steps) first appears on, the crashes and the runs with one."""
+
+    mdps: dict[str, int] = field(default_factory=dict)
+    steps: dict[tuple[bool, int], int] = field(default_factory=dict)
+    crashes: int = 0
+    crashed_runs: set[int] = field(default_factory=set)
+    has_crashed: bool = False
+
+
 def read_compete_dir(path: str | Path) -> CompeteResult:
     """Read ``episodes.csv`` (and ``summary.json``, for the label) of a compete output directory.
 
     Raises
     ------
     NeurohoverError
-        If ``path`` is no directory, or it has no ``episodes.csv`` or not one compete wrote.
+        If ``path`` is no directory, or it has no ``episodes.csv`` or not one compete wrote, or a ``summary.json`` that
+        contradicts it (:func:`_check_summary_matches`).
     """
     path = input_dir(path, "--compete")  # None or 5 was pathlib's TypeError (eleventh trial)
     csv_path = path / COMPETE_FILE
@@ -360,19 +374,20 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
         raise NeurohoverError(f"--compete {str(path)!r} holds no {COMPETE_FILE}: give directories written by neurohover compete --out")
     runs: dict[int, list[tuple[int, float]]] = {}
     seen: dict[int, set[int]] = {}  # each run's episode numbers so far
-    crashes = 0
+    facts = _Rows()
     try:
         with open(csv_path, newline="", encoding="utf-8-sig") as f:
             reader = csv.DictReader(f)
             missing = [c for c in COMPETE_COLUMNS if c not in (reader.fieldnames or [])]
             if missing:
                 raise NeurohoverError(f"--compete {str(csv_path)!r} is not a compete episodes file: no column {', '.join(missing)}")
+            facts.has_crashed = "crashed" in (reader.fieldnames or [])
             for line, row in enumerate(reader, start=2):
                 try:
                     run, episode, ret = int(row["run"]), int(row["episode"]), float(row["return"])
-                    crashes += int(row.get("crashed") or 0)
+                    crashed, steps = int(row.get("crashed") or 0), int(row["steps"]) if row.get("steps") else None
                 except (TypeError, ValueError):
-                    raise NeurohoverError(f"--compete {str(csv_path)!r}, line {line}: run, episode and return must be numbers") from None
+                    raise NeurohoverError(f"--compete {str(csv_path)!r}, line {line}: run, episode, return, crashed and steps must be numbers") from None
                 if not (math.isfinite(ret) and -WORST_RETURN <= ret <= 0):  # -1e308 overflowed the plot (eighth trial); every reward is <= 0 (ninth)
                     raise NeurohoverError(
                         f"--compete {str(csv_path)!r}, line {line}: return {row['return']!r:.30} is not an episode's "
@@ -385,6 +400,12 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
                     )
                 seen[run].add(episode)
                 runs.setdefault(run, []).append((episode, ret))
+                facts.crashes += crashed
+                facts.mdps.setdefault(row.get("mdp") or "", line)
+                if crashed:
+                    facts.crashed_runs.add(run)
+                if steps is not None:
+                    facts.steps.setdefault((bool(crashed), steps), line)
     except (OSError, UnicodeDecodeError, csv.Error) as err:
         raise NeurohoverError(f"--compete {str(csv_path)!r}: cannot read it ({err})") from None
     if not runs:
@@ -411,28 +432,65 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
             raise NeurohoverError(f"--compete {str(summary_path)!r} cannot be read ({err}); remove it to label the curve by its directory's name") from None
         if not (isinstance(summary, dict) and isinstance(summary.get("agent"), str) and isinstance(summary.get("task", ""), str)):
             raise NeurohoverError(f"--compete {str(summary_path)!r} is not a compete summary: no agent and task names")
-        _check_summary_matches(summary_path, summary, returns.shape)
+        _check_summary_matches(summary_path, summary, returns, facts)
         label = f"{summary['agent']} ({summary.get('task', '?')})"
         conditions = {key: summary[key] for key in COMPETE_CONDITIONS if key in summary}
-        return CompeteResult(label, returns, crashes, path, conditions)
-    return CompeteResult(label, returns, crashes, path)
+        return CompeteResult(label, returns, facts.crashes, path, conditions)
+    return CompeteResult(label, returns, facts.crashes, path)
 
 
-def _check_summary_matches(path: Path, summary: dict, shape: tuple[int, ...]) -> None:
-    """A summary naming no task family, or other runs or episodes than its episodes.csv, is another competition's
-    (it labelled the curve without a word; eighth trial)."""
+def _check_summary_matches(path: Path, summary: dict, returns: np.ndarray, rows: _Rows) -> None:
+    """Refuse a summary whose parts contradict each other or its episodes.csv, naming the field and both values: it is
+    another competition's, or edited, and labelled the curve without a word (eighth trial; a task edited from ghh08 to
+    ghh09 over ghh08's rows, T21-07). Checked, each where the summary holds it: task (a task family, that of every
+    row's MDP and of its experiment ``compete-<task>-<agent>``), agent (its experiment's), mdps (every row's MDP set),
+    runs and episodes, episode_steps (every uncrashed episode's steps, no crash later), crash figures and the mean and
+    sd of the cumulative return (the rows')."""
     from .tasks import TASK_NAMES
 
-    task = summary.get("task")
+    def refuse(key: str, found: str) -> NoReturn:
+        raise NeurohoverError(
+            f"--compete {str(path)!r} says {key} {brief(summary[key])} where {found}: "
+            "the two are of different competitions, or one was edited (run compete again, or remove summary.json)"
+        )
+
+    task, experiment = summary.get("task"), summary.get("experiment")
     if task is not None and task not in TASK_NAMES:
         raise NeurohoverError(f"--compete {str(path)!r} names task {task!r:.40}, not one of {', '.join(TASK_NAMES)}: it is no compete summary")
-    for key, found in (("runs", shape[0]), ("episodes", shape[1])):
+    for label, line in rows.mdps.items():  # compete's MDP labels: '<task>/<set>:<i>'
+        family, slash, rest = label.partition("/")
+        if slash and task is not None and family != task:
+            refuse("task", f"its episodes.csv holds {family} MDPs (line {line}: mdp {brief(label)})")
+        if slash and ":" in rest and "mdps" in summary and rest.partition(":")[0] != summary["mdps"]:
+            refuse("mdps", f"its episodes.csv holds {rest.partition(':')[0]} MDPs (line {line}: mdp {brief(label)})")
+    if isinstance(experiment, str) and task is not None and experiment != f"compete-{task}-{summary['agent']}":  # task names hold no '-'
+        refuse("task" if experiment.split("-")[1:2] != [task] else "agent", f"its experiment is {brief(experiment)} (compete-TASK-AGENT)")
+    for key, count in (("runs", returns.shape[0]), ("episodes", returns.shape[1])):
         given = summary.get(key)
-        if given is not None and (not isinstance(given, int) or isinstance(given, bool) or given != found):
-            raise NeurohoverError(
-                f"--compete {str(path)!r} says {key} {given!r:.40} where its episodes.csv holds {found}: "
-                "the two are of different competitions (run compete again, or remove summary.json)"
-            )
+        if given is not None and (not whole_number(given) or given != count):
+            refuse(key, f"its episodes.csv holds {count}")
+    if summary.get("episode_steps") is not None and not (whole_number(summary["episode_steps"]) and 1 <= summary["episode_steps"] <= MAX_EPISODE_STEPS):
+        shown = brief(summary["episode_steps"])
+        raise NeurohoverError(
+            f"--compete {str(path)!r} says episode_steps {shown}, not a number of steps (an integer in 1..{MAX_EPISODE_STEPS:,}): it is no compete summary"
+        )
+    limit = int(summary.get("episode_steps") or 0)
+    for (crashed, steps), line in rows.steps.items() if limit else ():
+        if steps > limit or (steps != limit and not crashed):
+            refuse("episode_steps", f"its episodes.csv holds {'a crash at' if crashed else 'an uncrashed episode of'} {steps} steps (line {line})")
+    totals = returns.sum(axis=1)
+    mean, sd = float(totals.mean()), float(totals.std(ddof=1)) if totals.size > 1 else 0.0
+    runs, crashed_runs, crashes = returns.shape[0], len(rows.crashed_runs), f"{rows.crashes} crash{'es' * (rows.crashes != 1)}"
+    figures = [  # tolerance: results.TestRunResult's check of a score against its returns; crash figures are ratios of counts
+        ("mean_cumulative_return", mean, 1e-6, f"its episodes.csv's runs return {mean:.10g} in all on average"),
+        ("sd_cumulative_return", sd, 1e-6, f"its episodes.csv's runs' cumulative returns have an sd of {sd:.10g}"),
+        ("crashes_per_episode", rows.crashes / returns.size, 0.0, f"its episodes.csv holds {crashes} in {returns.size} episodes"),
+        ("crash_rate_runs", crashed_runs / runs, 0.0, f"its episodes.csv holds {crashed_runs} of {runs} runs with a crash"),
+    ]
+    for key, value, tolerance, found in figures if rows.has_crashed else figures[:2]:
+        given = summary.get(key)
+        if given is not None and not (finite_real(given) and math.isclose(given, value, rel_tol=1e-9, abs_tol=tolerance)):
+            refuse(key, found)
 
 
 def read_compete_dirs(dirs: Sequence[str | Path]) -> list[CompeteResult]:

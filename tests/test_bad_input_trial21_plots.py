@@ -4,6 +4,7 @@ command line."""
 
 from __future__ import annotations
 
+import json
 import re
 from pathlib import Path
 
@@ -12,7 +13,7 @@ import pytest
 
 from neurohover.errors import NeurohoverError
 from neurohover.flightdata import FlightData
-from neurohover.plots import flight_figure, plot_flight_data
+from neurohover.plots import flight_figure, plot_flight_data, read_compete_dir
 
 NOT_FLOWN = "no flight records a NaN or infinite observation, a crash's last one included; give flight data as flown"
 
@@ -60,3 +61,58 @@ def test_flight_figure_refuses_a_nan_action_but_a_crashed_episodes_last(tmp_path
     with pytest.raises(NeurohoverError, match="step 4 reads aileron = nan"):
         flight_figure(obs, act, crashed=False)
     assert flight_figure(obs, act, crashed=True) is not None
+
+
+#: A competition as ``neurohover compete --out`` writes it: 2 runs of 2 episodes of 20 steps, one crash at step 7.
+EPISODES = """run,mdp,episode,return,crashed,steps,policy,safeguard_fired
+0,ghh08/test:0,0,-10.0,0,20,baseline,0
+0,ghh08/test:0,1,-12.5,0,20,baseline,0
+1,ghh08/test:1,0,-30.0,0,20,baseline,0
+1,ghh08/test:1,1,-1000.0,1,7,baseline,0
+"""
+TOTALS = np.array([-22.5, -1030.0])
+SUMMARY = {
+    "task": "ghh08", "agent": "baseline", "mdps": "test", "seed": 0, "store": "results.sqlite", "episode_steps": 20, "sigma": None,
+    "sensor": None, "drift": None, "experiment": "compete-ghh08-baseline", "scale": "settings-4a8d2c2c96", "runs": 2, "episodes": 2,
+    "mean_cumulative_return": float(TOTALS.mean()), "sd_cumulative_return": float(TOTALS.std(ddof=1)), "crash_rate_runs": 0.5,
+    "crashes_per_episode": 0.25, "mean_return_after_learning": -263.125, "mean_seconds_per_run": 0.1, "mean_offline_seconds_per_run": 0.0,
+}  # fmt: skip
+
+
+def _competition(folder: Path, **edits: object) -> Path:
+    folder.mkdir()
+    (folder / "episodes.csv").write_text(EPISODES)
+    (folder / "summary.json").write_text(json.dumps(SUMMARY | edits, indent=1))
+    return folder
+
+
+def test_plot_refuses_a_compete_summary_whose_task_its_rows_contradict(tmp_path: Path, cli) -> None:
+    """T21-07: a summary's task edited from ghh08 to ghh09 over ghh08's rows was plotted as ghh09's, without a word;
+    the summary as written is plotted."""
+    rc, out, err = cli("plot", "--compete", str(_competition(tmp_path / "a")), "--out", str(tmp_path / "p"))
+    assert rc == 0 and out.strip().endswith("compete.png"), err
+    rc, out, err = cli("plot", "--compete", str(_competition(tmp_path / "b", task="ghh09")), "--out", str(tmp_path / "q"))
+    assert rc == 2 and "Traceback" not in err and out == "", err
+    assert "summary.json' says task 'ghh09' where its episodes.csv holds ghh08 MDPs (line 2: mdp 'ghh08/test:0'): the two are of different" in err
+
+
+@pytest.mark.parametrize(
+    ("edits", "message"),
+    [
+        ({"agent": "model-free"}, "says agent 'model-free' where its experiment is 'compete-ghh08-baseline' (compete-TASK-AGENT)"),
+        ({"experiment": "compete-ghh09-baseline"}, "says task 'ghh08' where its experiment is 'compete-ghh09-baseline'"),
+        ({"mdps": "train"}, "says mdps 'train' where its episodes.csv holds test MDPs (line 2: mdp 'ghh08/test:0')"),
+        ({"runs": 3}, "says runs 3 where its episodes.csv holds 2"),
+        ({"episode_steps": 6000}, "says episode_steps 6000 where its episodes.csv holds an uncrashed episode of 20 steps (line 2)"),
+        ({"episode_steps": 5}, "says episode_steps 5 where its episodes.csv holds an uncrashed episode of 20 steps (line 2)"),
+        ({"episode_steps": "20"}, "says episode_steps '20', not a number of steps (an integer in 1..10,000,000): it is no compete summary"),
+        ({"crashes_per_episode": 0.0}, "says crashes_per_episode 0.0 where its episodes.csv holds 1 crash in 4 episodes"),
+        ({"crash_rate_runs": 1.0}, "says crash_rate_runs 1.0 where its episodes.csv holds 1 of 2 runs with a crash"),
+        ({"mean_cumulative_return": -526.0}, "says mean_cumulative_return -526.0 where its episodes.csv's runs return -526.25 in all on average"),
+        ({"sd_cumulative_return": "x"}, "says sd_cumulative_return 'x' where its episodes.csv's runs' cumulative returns have an sd of 712.4"),
+    ],
+)
+def test_read_compete_dir_refuses_a_summary_whose_parts_contradict(tmp_path: Path, edits: dict, message: str) -> None:
+    """T21-07: every field of a summary the rows or its own experiment name contradict is refused, naming both values."""
+    with pytest.raises(NeurohoverError, match=re.escape(message)):
+        read_compete_dir(_competition(tmp_path / "c", **edits))

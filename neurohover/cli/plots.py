@@ -8,7 +8,9 @@ steps) marked in red. ``DIR`` defaults to the file's directory.
 ``neurohover plot --compete DIR [DIR ...] [--out OUTDIR]`` overlays the mean cumulative error of
 several ``neurohover compete --out DIR`` results (their ``episodes.csv``; agent and task from
 ``summary.json``) on one figure, linear and log scale, written to ``OUTDIR/compete.png``;
-``OUTDIR`` defaults to the directory holding the first DIR.
+``OUTDIR`` defaults to the directory holding the first DIR. A ``summary.json`` that its
+``episodes.csv`` contradicts (another task's or MDP set's rows, other runs, episodes, episode
+steps, crashes or returns) is refused, naming the field and both values.
 
 The files written are printed, one per line.
 """
