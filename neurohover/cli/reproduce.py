@@ -237,7 +237,7 @@ def cmd_wins(args: argparse.Namespace) -> int:
 def cmd_report(args: argparse.Namespace) -> int:
     """Draw the paper's figures from the results store and write a Markdown report beside the paper's numbers."""
     from ..experiments import Store, write_report
-    from ..experiments.export import orphan_message, orphan_units
+    from ..experiments.export import orphan_message
     from ..paths import input_file, output_dir
 
     input_file(args.store, "--store", "results store")
@@ -245,7 +245,8 @@ def cmd_report(args: argparse.Namespace) -> int:
         held = {n for n, s, _, _ in store.experiments() if args.scale is None or s == args.scale}
         missing = [n for n in args.names or () if n not in held]
         # units of an experiment that has no config row to report them under (T21-15; those of one reported are its section's damage)
-        orphans = [o for o in orphan_units(store) if o[0] not in held and (args.scale is None or o[1] == args.scale) and (not args.names or o[0] in args.names)]
+        asked = [o for o in store.orphan_units() if (args.scale is None or o[1] == args.scale) and (not args.names or o[0] in args.names)]
+        orphans = [o for o in asked if o[0] not in held]
         if orphans and (missing or not held):  # asked for, or all there is: refused before --out is made
             raise NeurohoverError(orphan_message(store, *orphans[0]))
         for o in orphans:

@@ -27,26 +27,8 @@ from .store import Store
 FORMATS = ("csv", "json")
 
 
-def orphan_units(store: Store, name: str | None = None) -> list[tuple[str, str, int, str]]:
-    """``(name, scale, count, first key)`` of the finished units stored at an experiment and scale the store holds no
-    config row for (of experiment ``name`` only, if given): orphans, whose config is gone, so nothing can check them.
-
-    The choice (T21-15: a unit copied to scale 'paper' with no paper config was ignored by results and report and left
-    alone by reproduce): the shared check :func:`checked_units` refuses an experiment that has orphans at any scale, so
-    results, wins, report's section of it, reproduce and compete all call it damaged; :func:`resolve_scale` names them
-    rather than "holds no experiment"; and ``neurohover report`` warns of orphans of an experiment it has no section for,
-    by one line on stderr each (refused, exit 2, when they are all it was asked for)."""
-    sql = (
-        "SELECT u.name, u.scale, count(*), min(u.key) FROM units u WHERE NOT EXISTS "
-        "(SELECT 1 FROM experiments e WHERE e.name = u.name AND e.scale = u.scale)"
-        + (" AND u.name = ?" if name is not None else "")
-        + " GROUP BY u.name, u.scale ORDER BY u.name, u.scale"
-    )
-    return [tuple(r) for r in store._rows(sql, () if name is None else (name,), "its list of units")]
-
-
 def orphan_message(store: Store, name: str, scale: str, count: int, key: str) -> str:
-    """The damage of :func:`orphan_units`' row ``(name, scale, count, key)``, naming the store, the experiment and a unit."""
+    """The damage of :meth:`Store.orphan_units`' row ``(name, scale, count, key)``, naming the store, the experiment and a unit."""
     return (
         f"results store {str(store.path)!r}, experiment {name} ({scale}), is damaged: it holds {count} finished unit(s) of it but no record "
         f"of its config, so they cannot be checked (the first: unit {key!r}): give another store (reproduce --fresh discards them)"
@@ -54,15 +36,22 @@ def orphan_message(store: Store, name: str, scale: str, count: int, key: str) ->
 
 
 def refuse_orphans(store: Store, name: str) -> None:
-    """NeurohoverError (:func:`orphan_message`) when experiment ``name`` has orphan units at any scale (:func:`orphan_units`)."""
-    found = orphan_units(store, name)
+    """NeurohoverError (:func:`orphan_message`) when experiment ``name`` has orphan units at any scale
+    (:meth:`Store.orphan_units`: units whose config row is gone, so nothing can check them).
+
+    The choice (T21-15: a unit copied to scale 'paper' with no paper config was ignored by results and report and left
+    alone by reproduce): the shared check :func:`checked_units` refuses an experiment that has orphans at any scale, so
+    results, wins, report's section of it, reproduce and compete all call it damaged; :func:`resolve_scale` names them
+    rather than "holds no experiment"; and ``neurohover report`` warns of orphans of an experiment it has no section for,
+    by one line on stderr each (refused, exit 2, when they are all it was asked for)."""
+    found = store.orphan_units(name)
     if found:
         raise NeurohoverError(orphan_message(store, *found[0]))
 
 
 def resolve_scale(store: Store, name: str, scale: str | None) -> str:
     """The scale of experiment ``name`` in the store: ``scale``, or its only one (a clear error otherwise; units of it
-    at a scale of no config row are damage: :func:`orphan_units`)."""
+    at a scale of no config row are damage: :meth:`Store.orphan_units`)."""
     scales = store.scales(name)
     refuse_orphans(store, name)
     if not scales:
@@ -185,10 +174,10 @@ def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig
         config that does not hash to its recorded hash, a unit run under another hash (T20-04), a unit key of no
         shape the experiment's plan gives (T20-05), and a unit the stored config does not plan, or plans with other
         kind or params (T21-02; :func:`_check_planned`), and units of the experiment at a scale of no config row
-        (T21-15; :func:`orphan_units`).
+        (T21-15; :meth:`Store.orphan_units`).
     """
     where = f"results store {str(store.path)!r}, experiment {name} ({scale}), is damaged"
-    refuse_orphans(store, name)  # its units at a scale of no config row, ignored (T21-15): orphan_units says why here
+    refuse_orphans(store, name)  # its units at a scale of no config row, ignored (T21-15): refuse_orphans says why
     stored = store.config(name, scale)  # the store names a row that is no JSON object itself, as for the units below
     try:
         config = ExperimentConfig.from_dict(stored)

@@ -356,6 +356,17 @@ class Store:
         except sqlite3.DatabaseError as err:
             raise NeurohoverError(f"results store {str(self.path)!r} is damaged: {what} cannot be read ({str(err)[:60]})") from None
 
+    def orphan_units(self, name: str | None = None) -> list[tuple[str, str, int, str]]:
+        """``(name, scale, count, first key)`` of the finished units stored at an experiment and scale the store holds no
+        config row for (of experiment ``name`` only, if given): units whose config is gone, so nothing can check them."""
+        sql = (
+            "SELECT u.name, u.scale, count(*), min(u.key) FROM units u WHERE NOT EXISTS "
+            "(SELECT 1 FROM experiments e WHERE e.name = u.name AND e.scale = u.scale)"
+            + (" AND u.name = ?" if name is not None else "")
+            + " GROUP BY u.name, u.scale ORDER BY u.name, u.scale"
+        )
+        return [tuple(r) for r in self._rows(sql, () if name is None else (name,), "its list of units")]
+
     def experiments(self) -> list[tuple[str, str, str, int]]:
         """(name, scale, config_hash, finished units) of every experiment in the store."""
         sql = (
