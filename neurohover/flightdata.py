@@ -90,7 +90,7 @@ class FlightData:
             if not all(isinstance(a, np.ndarray) and not isinstance(a, np.ma.MaskedArray) and a.dtype.kind in "fi" for a in arrays):
                 raise NeurohoverError(f"flight data {name} must be arrays of real numbers (plain, not masked), one per episode")
             object.__setattr__(self, name, tuple(arrays))
-        _check_dict(self.metadata, "flight data")  # None or [1] was taken, and refused only by save() (fifteenth trial, T15-29)
+        _metadata_text(self.metadata, "flight data")  # None, [1], {1: 2}, a NaN were taken, and refused or changed by save() (T15-29, T21-08)
         if len(self.observations) != len(self.actions):
             raise NeurohoverError(f"flight data needs one action array per observation array, got {len(self.observations)} and {len(self.actions)}")
         for i, (obs, act) in enumerate(zip(self.observations, self.actions)):
@@ -150,14 +150,9 @@ class FlightData:
             raise NeurohoverError(f"flight-data dtype {brief(dtype)} is not allowed: use {' or '.join(SAVE_DTYPES)}")
         from .paths import output_file, writing
 
-        # what load() reads back: JSON-object metadata (an object() was a TypeError mid-write; 5 was written, then refused),
-        # strict as a policy file's (a NaN was written and read back; T16-24)
-        try:
-            meta_text = json_text(self.metadata) if isinstance(self.metadata, dict) else None
-        except (TypeError, ValueError, RecursionError) as err:
-            raise NeurohoverError(f"flight data metadata cannot be saved as JSON: give strict JSON values (numbers finite) ({err})") from None
-        if meta_text is None or not self.actions or self.n_transitions == 0:
-            raise NeurohoverError("flight data to save needs a dict of metadata and at least one step flown (load() refuses any other file)")
+        meta_text = _metadata_text(self.metadata, "flight data")  # checked again: metadata may be changed after making
+        if not self.actions or self.n_transitions == 0:
+            raise NeurohoverError("flight data to save needs at least one step flown (load() refuses any other file)")
         path = output_file(path, "flight-data file")  # refuses '', a directory and a device (/dev/null was a struct.error)
         lengths = np.array([a.shape[0] for a in self.actions], dtype=np.int64)
         check_metadata(self.metadata, lengths, "flight data")  # metadata changed after making (episode_steps -5) was written, then refused by load()
@@ -241,6 +236,56 @@ def _check_dict(metadata: object, where: str) -> dict:
     if not isinstance(metadata, dict):
         raise NeurohoverError(f"{where}: its metadata {brief(metadata)} is not allowed: give a dict (a JSON object)")
     return metadata
+
+
+def _metadata_text(metadata: object, where: str) -> str:
+    """The JSON text :meth:`FlightData.save` writes of ``metadata``, or one error naming what load() would not read back
+    as given: metadata that is no dict (5 was written, then refused), a value that is no strict JSON (an object() was a
+    TypeError mid-write, a NaN written and read back; T16-24) and a key that is not text (JSON writes {1: 2} as {'1': 2},
+    other metadata; T21-08). The one check of metadata, when flight data are made and when they are saved."""
+    metadata = _check_dict(metadata, where)
+    stack: list[tuple[object, object]] = [(None, metadata)]  # (the top-level key it is under, a value)
+    seen: set[int] = set()  # a dict that holds itself: json_text names it below
+    while stack:
+        top, value = stack.pop()
+        value = value.tolist() if isinstance(value, np.ndarray) and value.dtype.kind == "O" else value  # its dicts' keys too
+        if isinstance(value, (dict, list, tuple)) and id(value) not in seen:
+            seen.add(id(value))
+            items = value.items() if isinstance(value, dict) else ((None, item) for item in value)
+            for key, item in items:
+                if isinstance(value, dict) and not isinstance(key, str):
+                    under = "" if top is None else f" (under {brief(top)})"
+                    raise NeurohoverError(
+                        f"{where} metadata key {brief(key)}{under} is not allowed: give text keys (JSON writes every key as text, "
+                        "so the file would load back with other metadata)"
+                    )
+                stack.append((key if top is None else top, item))
+    try:
+        text = json_text(metadata, default=_plain)
+    except (TypeError, ValueError, RecursionError) as err:
+        bad = next((k for k, v in metadata.items() if not _json_ok({k: v})), None)  # the entry to name, where one alone fails
+        shown = f", not {bad if len(bad) <= 60 else brief(bad)}={brief(metadata[bad])}" if isinstance(bad, str) else ""
+        raise NeurohoverError(f"{where} metadata cannot be saved as JSON: give strict JSON values (numbers finite){shown} ({err})") from None
+    return text
+
+
+def _plain(value: object) -> object:
+    """A NumPy number or (unmasked) array in metadata as the plain number or list JSON writes (``json.dumps``' default):
+    flight data made in Python may hold them (``==`` compares them whole); anything else is json's TypeError."""
+    if isinstance(value, (np.generic, np.ndarray)) and not isinstance(value, np.ma.MaskedArray):
+        plain = value.tolist()  # a date or a complex number stays one, and is refused as such
+        if not isinstance(plain, (np.generic, np.ndarray)):
+            return plain
+    raise TypeError(f"Object of type {type(value).__name__} is not JSON serializable")
+
+
+def _json_ok(value: object) -> bool:
+    """Whether :func:`_metadata_text`'s JSON writes ``value``."""
+    try:
+        json_text(value, default=_plain)
+    except (TypeError, ValueError, RecursionError):
+        return False
+    return True
 
 
 def check_metadata(metadata: object, lengths: np.ndarray, where: str) -> None:

@@ -1,0 +1,46 @@
+"""Bad-input trial 21, flight data: metadata JSON cannot write back as given (T21-08)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from neurohover.errors import NeurohoverError
+from neurohover.flightdata import FlightData
+
+OBS, ACTS = (np.zeros((3, 12)),), (np.zeros((2, 4)),)
+
+
+@pytest.mark.parametrize(
+    ("metadata", "named"),
+    [
+        ({1: 2}, "metadata key 1 is not allowed: give text keys"),
+        ({"a": {"b": [{2.5: 1}]}}, r"metadata key 2\.5 \(under 'a'\) is not allowed: give text keys"),
+        ({"x": float("nan")}, r"metadata cannot be saved as JSON: give strict JSON values \(numbers finite\), not x=nan "),
+        ({"x": object()}, "metadata cannot be saved as JSON: .*, not x=<object object at .*> "),
+        ({"x": np.array([1.0, np.nan])}, r"metadata cannot be saved as JSON: .*, not x=array\(\[ 1., nan\]\) "),
+        ({"x": np.array([{3: 1}], dtype=object)}, r"metadata key 3 \(under 'x'\) is not allowed"),
+    ],
+)
+def test_metadata_json_would_not_read_back_is_refused_when_made_and_when_saved(tmp_path: Path, metadata: dict, named: str) -> None:
+    """T21-08: {1: 2} was taken and saved as {'1': 2} (other metadata when loaded); a NaN or an object() was refused by
+    save() only. Now one check refuses each when the flight data are made, and again at save() (metadata may change)."""
+    with pytest.raises(NeurohoverError, match=f"^flight data {named}"):
+        FlightData(OBS, ACTS, metadata)
+    data = FlightData(OBS, ACTS, {"task": "ghh08"})
+    data.metadata.update(metadata)  # changed after making
+    with pytest.raises(NeurohoverError, match=f"^flight data {named}"):
+        data.save(tmp_path / "f.npz")
+    assert not (tmp_path / "f.npz").exists()
+
+
+def test_metadata_callers_write_still_round_trips(tmp_path: Path) -> None:
+    """T21-08: what fly --record, evaluate(record=True) and a join write (text keys, lists, NumPy floats) is taken, and
+    NumPy numbers and arrays, which flight data made in Python may hold (``==`` compares them), are saved as plain JSON."""
+    metadata = {"task": "ghh08", "seed": 3, "returns": [np.float64(-1.5)], "crashed": [False], "nested": {"a": [1, {"b": None}]}}
+    data = FlightData(OBS, ACTS, {**metadata, "n": np.int64(2), "ok": np.bool_(True), "x": np.ones(2), "t": (1, 2)})
+    loaded = FlightData.load((data + data).save(tmp_path / "f.npz")).metadata
+    assert loaded["returns"] == [-1.5, -1.5] and loaded["nested"] == metadata["nested"]
+    assert (loaded["n"], loaded["ok"], loaded["x"], loaded["t"]) == (2, True, [1.0, 1.0], [1, 2])
