@@ -7,6 +7,7 @@ lengths kept, so a file of any number of episodes loads back exactly; or, with
 
 from __future__ import annotations
 
+import os
 import zipfile
 import zlib
 from dataclasses import dataclass, field
@@ -144,8 +145,8 @@ class FlightData:
         return None if flown is False else policy_from_dict(flown, f"{name}, metadata policy_flown")
 
     def save(self, path: str | Path, dtype: str = "float64") -> Path:
-        """Write the flight data to ``path`` (``.npz``), as float64 (exact) or float32 (half the space; a finite value past
-        float32's range is refused, not written as inf)."""
+        """Write the flight data to ``path`` (a name ending ``.npz``, as ``fly --record`` takes), as float64 (exact) or
+        float32 (half the space; a finite value past float32's range is refused, not written as inf)."""
         if not isinstance(dtype, str) or dtype not in SAVE_DTYPES:  # an array was NumPy's "truth value is ambiguous" (T16-12)
             raise NeurohoverError(f"flight-data dtype {brief(dtype)} is not allowed: use {' or '.join(SAVE_DTYPES)}")
         from .paths import output_file, writing
@@ -153,7 +154,11 @@ class FlightData:
         meta_text = _metadata_text(self.metadata, "flight data")  # checked again: metadata may be changed after making
         if not self.actions or self.n_transitions == 0:
             raise NeurohoverError("flight data to save needs at least one step flown (load() refuses any other file)")
+        new = isinstance(path, (str, Path)) and str(path) not in ("", "-") and not str(path).endswith("/") and not os.path.exists(path)
+        if new:
+            _npz_name(path)  # before output_file makes its directory; '', '-', 'dir/' and what exists it names as such
         path = output_file(path, "flight-data file")  # refuses '', a directory and a device (/dev/null was a struct.error)
+        _npz_name(path)
         lengths = np.array([a.shape[0] for a in self.actions], dtype=np.int64)
         check_metadata(self.metadata, lengths, "flight data")  # metadata changed after making (episode_steps -5) was written, then refused by load()
         largest = float(np.finfo(dtype).max)
@@ -221,6 +226,16 @@ class FlightData:
         obs_split = np.split(obs, np.cumsum(lengths + 1)[:-1])
         act_split = np.split(act, np.cumsum(lengths)[:-1])
         return cls(tuple(obs_split), tuple(act_split), metadata)
+
+
+def _npz_name(path: str | Path) -> None:
+    """Refuse a flight-data file whose name does not end .npz, as ``fly --record`` does: 'x.txt' was written as a NumPy
+    archive under that name (T21-09)."""
+    if Path(path).suffix.lower() != ".npz":
+        like = Path(path).with_suffix(".npz").name if Path(path).name else "flight.npz"
+        raise NeurohoverError(
+            f"flight-data file {brief(str(path))} is not allowed: flight data are a NumPy archive; give a path ending .npz (e.g. {brief(like)})"
+        )
 
 
 #: The metadata lists of one entry per episode: name -> (what an entry must be, what it is called).

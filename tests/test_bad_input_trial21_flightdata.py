@@ -1,4 +1,4 @@
-"""Bad-input trial 21, flight data: metadata JSON cannot write back as given (T21-08)."""
+"""Bad-input trial 21, flight data: metadata JSON cannot write back as given (T21-08), a file name not ending .npz (T21-09)."""
 
 from __future__ import annotations
 
@@ -44,3 +44,15 @@ def test_metadata_callers_write_still_round_trips(tmp_path: Path) -> None:
     loaded = FlightData.load((data + data).save(tmp_path / "f.npz")).metadata
     assert loaded["returns"] == [-1.5, -1.5] and loaded["nested"] == metadata["nested"]
     assert (loaded["n"], loaded["ok"], loaded["x"], loaded["t"]) == (2, True, [1.0, 1.0], [1, 2])
+
+
+@pytest.mark.parametrize("name", ["x.txt", "flight", "new/flight"])
+def test_a_flight_data_file_not_named_npz_is_refused_as_fly_record_refuses_it(tmp_path: Path, monkeypatch, name: str) -> None:
+    """T21-09: save('x.txt') wrote a NumPy archive under that name; fly --record refuses any FILE not ending .npz."""
+    monkeypatch.chdir(tmp_path)
+    data = FlightData(OBS, ACTS)
+    like = Path(name).with_suffix(".npz").name
+    with pytest.raises(NeurohoverError, match=f"^flight-data file '{name}' is not allowed: .*give a path ending .npz \\(e.g. '{like}'\\)"):
+        data.save(name)
+    assert sorted(p.name for p in tmp_path.iterdir()) == []  # nothing written, no directory made
+    assert FlightData.load(data.save(tmp_path / "f.NPZ")) == data
