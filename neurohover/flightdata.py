@@ -86,7 +86,7 @@ class FlightData:
         for name in ("observations", "actions"):  # a string was an AttributeError (fourth trial)
             arrays = getattr(self, name)
             if isinstance(arrays, (str, bytes, np.ndarray)) or not isinstance(arrays, (tuple, list)):
-                raise NeurohoverError(f"flight data {name}={arrays!r:.60} is not allowed: give a sequence of arrays, one per episode")
+                raise NeurohoverError(f"flight data {name}={brief(arrays)} is not allowed: give a sequence of arrays, one per episode")
             # a masked array was stored as it was, its hidden values learned from (T16-9)
             if not all(isinstance(a, np.ndarray) and not isinstance(a, np.ma.MaskedArray) and a.dtype.kind in "fi" for a in arrays):
                 raise NeurohoverError(f"flight data {name} must be arrays of real numbers (plain, not masked), one per episode")
@@ -200,10 +200,12 @@ class FlightData:
             if isinstance(err, NeurohoverError):
                 raise
             raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file ({type(err).__name__}: {err})") from None
-        if not isinstance(metadata, dict):  # a list was an AttributeError in learn-model (fifth trial)
-            raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file: its metadata is a {type(metadata).__name__}, not a JSON object")
         if lengths.ndim != 1 or lengths.dtype.kind not in "iu" or (lengths < 0).any():  # float or text lengths were NumPy errors
             raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file: its episode lengths are not one count (an integer >= 0) per episode")
+        if lengths.size == 0:  # first: its metadata's lists, one entry per episode, were refused for not being empty (T21-12)
+            raise NeurohoverError(f"flight-data file {str(path)!r} holds no transitions")
+        if not isinstance(metadata, dict):  # a list was an AttributeError in learn-model (fifth trial)
+            raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file: its metadata is a {type(metadata).__name__}, not a JSON object")
         if obs.dtype.kind != "f" or act.dtype.kind != "f":
             kinds = f"{obs.dtype} and {act.dtype}"
             raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file: its observations and actions are {kinds}, not real numbers")
@@ -215,8 +217,6 @@ class FlightData:
                 f"{str(path)!r} is not a readable flight-data file: episode {int(np.argmin(lengths))} has 0 steps (a flown one has at least 1)"
             )
         check_metadata(metadata, lengths, f"flight-data file {str(path)!r}")
-        if lengths.size == 0 or lengths.sum() == 0:
-            raise NeurohoverError(f"flight-data file {str(path)!r} holds no transitions")
         if obs.shape != (int(lengths.sum() + lengths.size), 12) or act.shape != (int(lengths.sum()), 4):
             raise NeurohoverError(
                 f"flight-data file {str(path)!r} is truncated or inconsistent: {lengths.size} episodes of {lengths.sum()} steps "
@@ -322,7 +322,7 @@ def check_metadata(metadata: object, lengths: np.ndarray, where: str) -> None:
     steps = metadata.get("episode_steps")
     if steps is not None and (type(steps) is not int or not 1 <= steps <= MAX_EPISODE_STEPS):
         allowed = f"an integer in 1..{MAX_EPISODE_STEPS:,}"
-        raise NeurohoverError(f"{where}: its metadata episode_steps={steps!r:.40} is not allowed: {allowed}")
+        raise NeurohoverError(f"{where}: its metadata episode_steps={brief(steps)} is not allowed: {allowed}")
     if steps is not None and n_episodes and int(lengths.max()) > steps:  # an episode of 12,000 steps spanned a reset (ninth trial)
         longest = int(np.argmax(lengths))
         raise NeurohoverError(
@@ -331,13 +331,13 @@ def check_metadata(metadata: object, lengths: np.ndarray, where: str) -> None:
         )
     for name in ("task", "policy"):  # shown in titles and notes (a task 5 or a policy 123 was taken; eighth trial)
         if metadata.get(name) is not None and not isinstance(metadata[name], str):
-            raise NeurohoverError(f"{where}: its metadata {name}={metadata[name]!r:.40} is not allowed: give text")
+            raise NeurohoverError(f"{where}: its metadata {name}={brief(metadata[name])} is not allowed: give text")
     for name, (fits, each) in _PER_EPISODE.items():  # lists of one entry per episode (returns "x" was taken; eighth trial)
         value = metadata.get(name)
         if value is not None and (not isinstance(value, list) or len(value) != n_episodes or not all(fits(v) for v in value)):
-            raise NeurohoverError(f"{where}: its metadata {name}={value!r:.40} is not allowed: {each} per episode ({n_episodes})")
+            raise NeurohoverError(f"{where}: its metadata {name}={brief(value)} is not allowed: {each} per episode ({n_episodes})")
     task, mdps = metadata.get("task"), metadata.get("mdps") or []
     families = [(i, m.get("family")) for i, m in enumerate(mdps) if isinstance(m.get("family"), str)]
     for i, family in families:  # a task 'ghh09' over ghh08's MDPs was plotted under the wrong name (ninth trial)
         if task is not None and family != task:
-            raise NeurohoverError(f"{where}: its metadata task {task!r:.40} is not its MDPs' family: episode {i} flew a {family!r:.40} MDP")
+            raise NeurohoverError(f"{where}: its metadata task {brief(task)} is not its MDPs' family: episode {i} flew a {brief(family)} MDP")

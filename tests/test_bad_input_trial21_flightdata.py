@@ -1,7 +1,9 @@
-"""Bad-input trial 21, flight data: metadata JSON cannot write back as given (T21-08), a file name not ending .npz (T21-09)."""
+"""Bad-input trial 21, flight data: metadata JSON cannot write back as given (T21-08), a file name not ending .npz (T21-09), a
+file of no episodes refused for its metadata first (T21-12)."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -56,3 +58,35 @@ def test_a_flight_data_file_not_named_npz_is_refused_as_fly_record_refuses_it(tm
         data.save(name)
     assert sorted(p.name for p in tmp_path.iterdir()) == []  # nothing written, no directory made
     assert FlightData.load(data.save(tmp_path / "f.NPZ")) == data
+
+
+def _rewritten(path: Path, out: Path, metadata: dict | None = None, **arrays: np.ndarray) -> Path:
+    """The flight-data file ``path`` written again to ``out`` with some of its arrays (and its metadata) replaced."""
+    with np.load(path) as z:
+        members = {name: z[name] for name in z.files}
+    members.update(arrays)
+    if metadata is not None:
+        members["metadata"] = np.array(json.dumps(metadata))
+    np.savez(out, **members)
+    return out
+
+
+def test_a_file_of_no_episodes_is_refused_as_such_before_its_metadata(tmp_path: Path, cli) -> None:
+    """T21-12: a file of zero episodes was refused for its metadata (a list printed half, cut at 40 characters) before
+    saying it holds no transitions."""
+    returns = [-1062.845583996776, -1001.1944074392666]
+    full = FlightData(OBS * 2, ACTS * 2, {"task": "ghh08", "returns": returns}).save(tmp_path / "full.npz")
+    empty = {"lengths": np.zeros(0, dtype=np.int64), "observations": np.zeros((0, 12)), "actions": np.zeros((0, 4))}
+    path = _rewritten(full, tmp_path / "zero.npz", **empty)
+    with pytest.raises(NeurohoverError, match=f"^flight-data file '{path}' holds no transitions$"):
+        FlightData.load(path)
+    rc, _, err = cli("plot", str(path), "--out", str(tmp_path / "p"))
+    assert rc == 2 and err.strip().endswith("holds no transitions"), err
+
+
+def test_metadata_values_in_messages_are_shown_briefly_not_cut_mid_number() -> None:
+    """T21-12: messages cut a metadata value at 40 characters ('returns=[-1062.845583996776, -1001.1944074392666 is not')."""
+    with pytest.raises(NeurohoverError, match=r"returns=\[-1062\.845583996776, -1001\.1944074392666, 3\.5\] is not allowed: one number per"):
+        FlightData(OBS, ACTS, {"returns": [-1062.845583996776, -1001.1944074392666, 3.5]})
+    with pytest.raises(NeurohoverError, match=r"returns=\[1\.5, 1\.5, .*\.\.\. is not allowed: one number per episode \(1\)"):
+        FlightData(OBS, ACTS, {"returns": [1.5] * 40})
