@@ -333,11 +333,31 @@ def check_metadata(metadata: object, lengths: np.ndarray, where: str) -> None:
         if metadata.get(name) is not None and not isinstance(metadata[name], str):
             raise NeurohoverError(f"{where}: its metadata {name}={brief(metadata[name])} is not allowed: give text")
     for name, (fits, each) in _PER_EPISODE.items():  # lists of one entry per episode (returns "x" was taken; eighth trial)
-        value = metadata.get(name)
-        if value is not None and (not isinstance(value, list) or len(value) != n_episodes or not all(fits(v) for v in value)):
-            raise NeurohoverError(f"{where}: its metadata {name}={brief(value)} is not allowed: {each} per episode ({n_episodes})")
-    task, mdps = metadata.get("task"), metadata.get("mdps") or []
-    families = [(i, m.get("family")) for i, m in enumerate(mdps) if isinstance(m.get("family"), str)]
-    for i, family in families:  # a task 'ghh09' over ghh08's MDPs was plotted under the wrong name (ninth trial)
-        if task is not None and family != task:
-            raise NeurohoverError(f"{where}: its metadata task {brief(task)} is not its MDPs' family: episode {i} flew a {brief(family)} MDP")
+        value = metadata.get(name)  # present as null: refused by name, not taken as absent (mdps null, T21-05)
+        if name in metadata and (not isinstance(value, list) or len(value) != n_episodes or not all(fits(v) for v in value)):
+            raise NeurohoverError(f"{where}: its metadata {name}={brief(value)} is not allowed: {each} per episode ({n_episodes}), or no {name} entry")
+    task, mdps = metadata.get("task"), _checked_mdps(metadata.get("mdps") or [], where)
+    for i, mdp in enumerate(mdps):  # a task 'ghh09' over ghh08's MDPs was plotted under the wrong name (ninth trial)
+        if task is not None and mdp is not None and mdp.family != task:
+            raise NeurohoverError(f"{where}: its metadata task {brief(task)} is not its MDPs' family: episode {i} flew a {brief(mdp.family)} MDP")
+
+
+def _checked_mdps(tables: list, where: str) -> list:
+    """The MDP of each table of a metadata ``mdps`` list (None for ``{}``, an MDP not recorded), its values checked as
+    the MDP's own (:meth:`MDP.from_dict`): a dt 0 or a NaN parameter was plotted and learned from without a word (T21-05)."""
+    from .tasks import MDP
+
+    mdps: list = []
+    known: dict[str, object] = {}  # the same table once: fly --record writes one per episode, most of them alike
+    for i, table in enumerate(tables):
+        try:
+            text = json_text(table, default=_plain, sort_keys=True)
+        except (TypeError, ValueError, RecursionError):  # no JSON (changed after making): checked here, named by save()
+            text = ""
+        if not text or text not in known:
+            try:
+                known[text] = MDP.from_dict(table) if table else None
+            except NeurohoverError as err:
+                raise NeurohoverError(f"{where}: its metadata mdps entry {i} is not allowed: {err}") from None
+        mdps.append(known[text])
+    return mdps

@@ -1,5 +1,6 @@
 """Bad-input trial 21, flight data: metadata JSON cannot write back as given (T21-08), a file name not ending .npz (T21-09), a
-file of no episodes refused for its metadata first (T21-12)."""
+file of no episodes refused for its metadata first (T21-12), metadata mdps null or
+of an MDP of dt 0 (T21-05)."""
 
 from __future__ import annotations
 
@@ -90,3 +91,42 @@ def test_metadata_values_in_messages_are_shown_briefly_not_cut_mid_number() -> N
         FlightData(OBS, ACTS, {"returns": [-1062.845583996776, -1001.1944074392666, 3.5]})
     with pytest.raises(NeurohoverError, match=r"returns=\[1\.5, 1\.5, .*\.\.\. is not allowed: one number per episode \(1\)"):
         FlightData(OBS, ACTS, {"returns": [1.5] * 40})
+
+
+@pytest.mark.parametrize(
+    ("change", "named"),
+    [
+        ({"mdps": None}, r"its metadata mdps=None is not allowed: one MDP \(a table\) per episode \(2\), or no mdps entry"),
+        ({"mdps": "abc"}, r"its metadata mdps='abc' is not allowed: one MDP"),
+        ({"returns": None}, r"its metadata returns=None is not allowed: one number per episode \(2\)"),
+        ({"dt": 0}, r"its metadata mdps entry 1 is not allowed: MDP dt=0\.0 is out of range: allowed a substep length > 0"),
+        ({"dt": float("nan")}, r"its metadata mdps entry 1 is not allowed: MDP dt=nan is not allowed: give a finite number"),
+        ({"substeps": -3}, r"its metadata mdps entry 1 is not allowed: MDP substeps=-3 is out of range"),
+    ],
+)
+def test_metadata_mdps_null_or_of_a_bad_mdp_is_refused_by_plot_and_learn_model(tmp_path: Path, cli, change: dict, named: str) -> None:
+    """T21-05: a file whose metadata held "mdps": null, or an MDP of dt 0, was plotted and learned from (learn-model said
+    only that the MDP metadata were unreadable); each is refused by name, as a file and as flight data made in Python."""
+    from neurohover.tasks import get_task_family
+
+    table = get_task_family("ghh08").zero().to_dict()
+    metadata = {"task": "ghh08", "mdps": [table, table], "returns": [1.0, 2.0]}
+    full = FlightData(OBS * 2, ACTS * 2, metadata).save(tmp_path / "full.npz")  # as recorded: taken
+    if "mdps" in change or "returns" in change:
+        metadata.update(change)
+    else:
+        metadata["mdps"] = [table, {**table, **change}]
+    path = _rewritten(full, tmp_path / "bad.npz", metadata)
+    with pytest.raises(NeurohoverError, match=f"^flight-data file '{path}': {named}"):
+        FlightData.load(path)
+    if change.get("dt") == 0 or "mdps" in change:
+        for argv in (
+            ("plot", str(path), "--out", str(tmp_path / "p")),
+            ("learn-model", "--flight-data", str(path), "--method", "lr", "--out", str(tmp_path / "m.json")),
+        ):
+            rc, out, err = cli(*argv)
+            assert rc == 2 and out == "" and f"'{path}': its metadata mdps" in err and len(err.strip().splitlines()) == 1, err
+    if not any(isinstance(v, float) and v != v for v in change.values()):  # a NaN is refused first as no strict JSON
+        with pytest.raises(NeurohoverError, match=f"^flight data: {named}"):
+            FlightData(OBS * 2, ACTS * 2, metadata)
+    assert FlightData(OBS * 2, ACTS * 2, {"mdps": [{}, table]}).metadata["mdps"][0] == {}  # {}: an MDP not recorded, as joins keep it
