@@ -506,7 +506,7 @@ def test_a_stored_value_of_the_wrong_kind_is_named_by_report_results_and_wins(tm
     with sqlite3.connect(foreign) as conn:
         conn.execute("INSERT INTO units SELECT name, scale, 'run/bogus/test0/rep0', kind, config_hash, params, result, seconds, worker, finished FROM units")
     assert main(["wins", name, "--store", str(foreign)]) == 2
-    assert "it holds test runs of group 'bogus', which" in capsys.readouterr().err
+    assert "it holds unit 'run/bogus/test0/rep0', which the config does not plan" in capsys.readouterr().err  # one check for every command (T21-02)
 
 
 def test_sigma_beside_the_zero_setting_is_refused(capsys) -> None:
