@@ -156,9 +156,9 @@ class FlightData:
             raise NeurohoverError("flight data to save needs at least one step flown (load() refuses any other file)")
         new = isinstance(path, (str, Path)) and str(path) not in ("", "-") and not str(path).endswith("/") and not os.path.exists(path)
         if new:
-            _npz_name(path)  # before output_file makes its directory; '', '-', 'dir/' and what exists it names as such
+            check_npz_name(path)  # before output_file makes its directory; '', '-', 'dir/' and what exists it names as such
         path = output_file(path, "flight-data file")  # refuses '', a directory and a device (/dev/null was a struct.error)
-        _npz_name(path)
+        check_npz_name(path)
         lengths = np.array([a.shape[0] for a in self.actions], dtype=np.int64)
         check_metadata(self.metadata, lengths, "flight data")  # metadata changed after making (episode_steps -5) was written, then refused by load()
         largest = float(np.finfo(dtype).max)
@@ -228,14 +228,12 @@ class FlightData:
         return cls(tuple(obs_split), tuple(act_split), metadata)
 
 
-def _npz_name(path: str | Path) -> None:
-    """Refuse a flight-data file whose name does not end .npz, as ``fly --record`` does: 'x.txt' was written as a NumPy
-    archive under that name (T21-09)."""
+def check_npz_name(path: str | Path, what: str = "flight-data file") -> None:
+    """Refuse a flight-data file whose name does not end .npz, naming it as ``what`` (``fly --record`` passes its
+    option): 'x.txt' was written as a NumPy archive under that name (T21-09), rx.csv held one (twelfth trial, S2)."""
     if Path(path).suffix.lower() != ".npz":
-        like = Path(path).with_suffix(".npz").name if Path(path).name else "flight.npz"
-        raise NeurohoverError(
-            f"flight-data file {brief(str(path))} is not allowed: flight data are a NumPy archive; give a path ending .npz (e.g. {brief(like)})"
-        )
+        like = str(Path(path).with_suffix(".npz")) if Path(path).name else "flight.npz"
+        raise NeurohoverError(f"{what} {brief(str(path))} is not allowed: flight data are a NumPy archive; give a path ending .npz (e.g. {brief(like)})")
 
 
 #: The metadata lists of one entry per episode: name -> (what an entry must be, what it is called).

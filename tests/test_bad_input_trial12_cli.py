@@ -136,5 +136,5 @@ def test_fly_record_refuses_a_name_not_ending_npz(name: str, tmp_path: Path, mon
     rc, _, err = cli("fly", "--task", "ghh08", "--episodes", "1", "--mdp", "train:1", "--policy", str(SHIPPED / "ghh08" / "generic.json"), "--record", name)
     assert rc == 2, err
     like = str(Path(name).with_suffix(".npz"))
-    assert f"--record {name!r} is not allowed: the flight data are a NumPy archive; give a FILE ending .npz (e.g. {like!r})" in err, err
+    assert f"--record {name!r} is not allowed: flight data are a NumPy archive; give a path ending .npz (e.g. {like!r})" in err, err
     assert list(tmp_path.iterdir()) == []

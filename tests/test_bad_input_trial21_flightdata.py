@@ -54,7 +54,7 @@ def test_a_flight_data_file_not_named_npz_is_refused_as_fly_record_refuses_it(tm
     """T21-09: save('x.txt') wrote a NumPy archive under that name; fly --record refuses any FILE not ending .npz."""
     monkeypatch.chdir(tmp_path)
     data = FlightData(OBS, ACTS)
-    like = Path(name).with_suffix(".npz").name
+    like = str(Path(name).with_suffix(".npz"))  # the path as given, as fly --record says it
     with pytest.raises(NeurohoverError, match=f"^flight-data file '{name}' is not allowed: .*give a path ending .npz \\(e.g. '{like}'\\)"):
         data.save(name)
     assert sorted(p.name for p in tmp_path.iterdir()) == []  # nothing written, no directory made

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError
 from ..sim.constants import EPISODE_STEPS
 from .options import add_task_options, family_and_mdps, integer, max_in_memory, note_policy_task
 
@@ -60,18 +60,9 @@ def _fly(policy, mdps: list, args: argparse.Namespace, show_progress: bool):
     return np.concatenate(returns), np.concatenate(crashed), seconds, flight, len(unique)
 
 
-def _npz_name(record: str) -> None:
-    """Refuse a --record FILE whose name does not end .npz: rx.csv held an .npz archive (twelfth trial, S2)."""
-    path = Path(record)
-    if path.suffix.lower() != ".npz":
-        like = str(path.with_suffix(".npz")) if path.name else "flight.npz"
-        raise NeurohoverError(
-            f"--record {brief(str(record))} is not allowed: the flight data are a NumPy archive; give a FILE ending .npz (e.g. {brief(like)})"
-        )
-
-
 def cmd_fly(args: argparse.Namespace) -> int:
     """Fly a policy and print return statistics."""
+    from ..flightdata import check_npz_name
     from ..paths import output_file, printable
     from ..policies import load_policy
 
@@ -91,9 +82,9 @@ def cmd_fly(args: argparse.Namespace) -> int:
     note_policy_task(policy, family.name, f"--policy {args.policy}")
     if args.record is not None:
         if Path(args.record).suffix:  # another suffix is refused before output_file makes its directory
-            _npz_name(args.record)
+            check_npz_name(args.record, "--record")
         output_file(args.record, "--record", {"--policy": args.policy})
-        _npz_name(args.record)  # no suffix: after output_file's own refusals ('-', a directory, a device)
+        check_npz_name(args.record, "--record")  # no suffix: after output_file's own refusals ('-', a directory, a device)
     returns, crashed, seconds, fd, n_unique = _fly(policy, mdps, args, show_progress=not args.json)
     if fd is not None:
         fd.metadata.update(
