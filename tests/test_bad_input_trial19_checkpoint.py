@@ -199,15 +199,16 @@ def test_a_damaged_mdp_stream_is_refused(family_checkpoint: Path, tmp_path: Path
 
 def test_a_champion_return_no_run_can_have_is_refused(tiny_checkpoint: Path, cma_checkpoint: Path, tmp_path: Path) -> None:
     """T19-08: a champion return of 2**70 was taken; a return is minus a sum of squares (<= 0), and a run without a
-    champion genome has none (-inf), so either is refused as damaged."""
+    champion genome has none (-inf), so either is refused as damaged (its message no longer starts "ValueError: ")."""
 
     def edit(value):
         return lambda s: s["champion"].update(**{"return": value})
 
-    _resume_damaged(tiny_checkpoint, tmp_path, edit(2**70), GHH08.zero(), MDP_RUN, "the champion's return is 1180591620717411303424 without a champion genome")
+    fragment = "damaged checkpoint: the champion's return is 1180591620717411303424 without a champion genome"
+    _resume_damaged(tiny_checkpoint, tmp_path, edit(2**70), GHH08.zero(), MDP_RUN, fragment)
     assert json.loads(cma_checkpoint.read_text())["champion"]["genome"] is not None
     for value in (2**70, 1e-300, "inf"):
-        fragment = f"the champion's return is {value!r}: allowed '-inf' or a number <= 0 on the run's fitness scale 'return'"
+        fragment = f"damaged checkpoint: the champion's return is {value!r}: allowed '-inf' or a number <= 0 on the run's fitness scale 'return'"
         _resume_damaged(cma_checkpoint, tmp_path, edit(value), GHH08, CMA_RUN, fragment)
 
 

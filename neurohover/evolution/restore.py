@@ -146,13 +146,13 @@ def _checked_champion(ch: dict, genome_size: int, scale: str) -> tuple[np.ndarra
     )
     value = dec_float(ch["return"])
     if math.isnan(value):
-        raise ValueError("the champion's return is nan")
+        raise EntryError("the champion's return is nan")
     if genome is None and value != -math.inf:
-        raise ValueError(f"the champion's return is {brief(ch['return'])} without a champion genome: allowed '-inf' (no champion yet)")
+        raise EntryError(f"the champion's return is {brief(ch['return'])} without a champion genome: allowed '-inf' (no champion yet)")
     # A return is minus a sum of squares (<= 0); an inv-log-error fitness 1/ln(error) with error >= ERROR_FLOOR (fitness.py).
     low, high, allowed = (
         (0.0, 1.0 / math.log(ERROR_FLOOR), "'-inf' or a number in 0..1/ln(1+1e-6)") if scale == "inv-log-error" else (-math.inf, 0.0, "'-inf' or a number <= 0")
     )
     if value != -math.inf and not (low <= value <= high * (1 + 1e-9)):  # (a mean may round an ulp past its largest value)
-        raise ValueError(f"the champion's return is {brief(ch['return'])}: allowed {allowed} on the run's fitness scale {scale!r}")
+        raise EntryError(f"the champion's return is {brief(ch['return'])}: allowed {allowed} on the run's fitness scale {scale!r}")
     return genome, value
