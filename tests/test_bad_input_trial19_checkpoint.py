@@ -57,8 +57,9 @@ def _resume_damaged(source: Path, tmp_path: Path, edit, target, run: dict, fragm
     assert evolve(target, budget=flown, checkpoint=ckpt, resume=True, **run).episodes == flown  # the sound checkpoint resumes
     edit(state)
     ckpt.write_text(json.dumps(state))
-    with _raises(fragment):
+    with _raises(fragment) as refused:
         evolve(target, budget=flown + 8, checkpoint=ckpt, resume=True, **run)
+    assert "Error: " not in str(refused.value), refused.value  # said plainly, not "damaged checkpoint: ValueError: ..."
 
 
 # --------------------------------------------------------------------------- T19-01: next_index past the kernel's indices
@@ -193,7 +194,8 @@ def test_counters_out_of_range_or_out_of_step_are_refused(tiny_checkpoint: Path,
 )
 def test_a_damaged_mdp_stream_is_refused(family_checkpoint: Path, tmp_path: Path, edit, fragment: str) -> None:
     """T19-08: numpy's bit generator took a stream state or inc of True, 1.5 or 2**70 and a has_uint32 of -1 or 1.5,
-    and the run went on drawing other MDPs; now each entry of the PCG64 state is checked before it is set."""
+    and the run went on drawing other MDPs; now each entry of the PCG64 state is checked before it is set. The message
+    says it plainly, not "damaged checkpoint: ValueError: mdp_stream's ..."."""
     _resume_damaged(family_checkpoint, tmp_path, lambda s: edit(s["mdp_stream"]), GHH08, FAMILY_RUN, fragment)
 
 

@@ -291,20 +291,21 @@ _STREAM_TOPS = {"state": (2**128 - 1, "2**128-1"), "inc": (2**128 - 1, "2**128-1
 
 
 def check_stream(stream: Any, kind: str) -> None:
-    """TypeError or ValueError unless ``stream`` is a state of the ``kind`` (PCG64) bit generator as numpy writes it:
-    its setter took a state or inc of True, 1.5 or 2**70 and a has_uint32 of -1 (T19-08)."""
+    """EntryError (a ValueError, said plainly in a damaged checkpoint's message) unless ``stream`` is a state of the
+    ``kind`` (PCG64) bit generator as numpy writes it: its setter took a state or inc of True, 1.5 or 2**70 and a
+    has_uint32 of -1 (T19-08)."""
     entries = ("bit_generator", "state", "has_uint32", "uinteger")
     if kind != "PCG64" or not isinstance(stream, dict) or sorted(stream) != sorted(entries) or stream["bit_generator"] != kind:
-        raise TypeError(f"mdp_stream={brief(stream)} is not allowed: allowed a {kind} state table ({', '.join(entries)}) as the run wrote it")
+        raise EntryError(f"mdp_stream={brief(stream)} is not allowed: allowed a {kind} state table ({', '.join(entries)}) as the run wrote it")
     inner = stream["state"]
     if not isinstance(inner, dict) or sorted(inner) != ["inc", "state"]:
-        raise TypeError(f"mdp_stream's state={brief(inner)} is not allowed: allowed a table of state and inc")
+        raise EntryError(f"mdp_stream's state={brief(inner)} is not allowed: allowed a table of state and inc")
     for name, value in (("state.state", inner["state"]), ("state.inc", inner["inc"]), ("has_uint32", stream["has_uint32"]), ("uinteger", stream["uinteger"])):
         top, text = _STREAM_TOPS[name.rpartition(".")[2]]
         if not whole_number(value) or not 0 <= value <= top:
-            raise ValueError(f"mdp_stream's {name}={brief(value)} is not allowed: allowed an integer in 0..{text}")
+            raise EntryError(f"mdp_stream's {name}={brief(value)} is not allowed: allowed an integer in 0..{text}")
     if inner["inc"] % 2 == 0:  # numpy sets (seed sequence << 1) | 1
-        raise ValueError(f"mdp_stream's state.inc={brief(inner['inc'])} is not allowed: a PCG64 increment is odd")
+        raise EntryError(f"mdp_stream's state.inc={brief(inner['inc'])} is not allowed: a PCG64 increment is odd")
 
 
 def _same(saved: Any, given: Any) -> bool:
