@@ -178,8 +178,11 @@ MAX_EPISODES = 10**10
 
 def require_episodes(value: Any, name: str = "episodes") -> int:
     """The episodes a generation cost as an int, or NeurohoverError unless an integer (not a bool) in 0..:data:`MAX_EPISODES`."""
-    if not whole_number(value) or not 0 <= value <= MAX_EPISODES:
-        raise NeurohoverError(f"{name}={brief(value)} is out of range: allowed an integer in 0..{MAX_EPISODES:,} (the episodes one generation cost)")
+    allowed = f"allowed an integer in 0..{MAX_EPISODES:,} (the episodes one generation cost)"
+    if not whole_number(value):  # a type problem, not a range one: 3.0 was "out of range" (T22-14)
+        raise NeurohoverError(f"{name}={brief(value)} is not allowed: {allowed}")
+    if not 0 <= value <= MAX_EPISODES:
+        raise NeurohoverError(f"{name}={brief(value)} is out of range: {allowed}")
     return int(value)
 
 
