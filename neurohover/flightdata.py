@@ -121,6 +121,9 @@ class FlightData:
         a, b = self.metadata.get("episode_steps"), other.metadata.get("episode_steps")
         if type(a) is int and type(b) is int:  # every episode within the budget load() checks (ninth trial)
             meta["episode_steps"] = max(a, b)
+            flags, lengths = meta.get("crashed"), [n.shape[0] for n in self.actions + other.actions]
+            if isinstance(flags, list) and any(not c and n < meta["episode_steps"] for c, n in zip(flags, lengths)):
+                del meta["episode_steps"]  # a shorter budget's full episodes: no one budget holds for all (T22-01)
         if self.metadata.get("task") != other.metadata.get("task"):  # two tasks' episodes: neither names them all
             meta.pop("task", None)
         flown = self.metadata.get("policy_flown"), other.metadata.get("policy_flown")
@@ -303,7 +306,10 @@ def _json_ok(value: object) -> bool:
 
 def check_metadata(metadata: object, lengths: np.ndarray, where: str) -> None:
     """Refuse the metadata fields plots and crash marks read when they are of the wrong kind, by name (an episode_steps
-    "a" was a ValueError in plot; seventh trial), and metadata the episodes contradict (ninth trial).
+    "a" was a ValueError in plot; seventh trial), and metadata the episodes contradict (ninth trial): an episode longer
+    than ``episode_steps``, or one shorter whose ``crashed`` flag is false (T22-01; a crash may come on the last step, so
+    a crashed episode of ``episode_steps`` steps is one). Files without either entry (recorded before ``crashed`` was)
+    are checked as far as they go.
 
     Parameters
     ----------
@@ -334,6 +340,14 @@ def check_metadata(metadata: object, lengths: np.ndarray, where: str) -> None:
         value = metadata.get(name)  # present as null: refused by name, not taken as absent (mdps null, T21-05)
         if name in metadata and (not isinstance(value, list) or len(value) != n_episodes or not all(fits(v) for v in value)):
             raise NeurohoverError(f"{where}: its metadata {name}={brief(value)} is not allowed: {each} per episode ({n_episodes}), or no {name} entry")
+    flags = metadata.get("crashed")
+    uncrashed = [i for i, c in enumerate(flags) if not c and lengths[i] < steps] if steps is not None and flags is not None else []
+    if uncrashed:  # 3000 steps of a 6000-step budget, crashed false, were drawn as "3000 steps, no crash" and learned from (T22-01)
+        i = uncrashed[0]
+        raise NeurohoverError(
+            f"{where}: episode {i} has {int(lengths[i]):,} steps, fewer than its metadata's episode_steps={steps:,}, yet its crashed "
+            "flag is false (an episode that does not crash flies the whole budget): its lengths and metadata contradict"
+        )
     task, mdps = metadata.get("task"), _checked_mdps(metadata.get("mdps") or [], where)
     for i, mdp in enumerate(mdps):  # a task 'ghh09' over ghh08's MDPs was plotted under the wrong name (ninth trial)
         if task is not None and mdp is not None and mdp.family != task:

@@ -1,0 +1,70 @@
+"""Bad-input trial 22, flight data and compete directories as ``neurohover plot`` and ``learn-model`` read them: an
+uncrashed episode shorter than its budget (T22-01)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from neurohover.errors import NeurohoverError
+from neurohover.flightdata import FORMAT, FlightData
+
+
+def _episodes(*lengths: int) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
+    """Observations and actions of episodes of ``lengths`` steps, hovering about the spot (finite, unit quaternions)."""
+    return tuple(np.full((n + 1, 12), 0.01) for n in lengths), tuple(np.zeros((n, 4)) for n in lengths)
+
+
+def _write(path: Path, lengths: list[int], metadata: dict, obs: np.ndarray | None = None, act: np.ndarray | None = None) -> Path:
+    """A flight-data file written as save() writes one, its metadata as given (not checked): an edited recording."""
+    observations, actions = _episodes(*lengths)
+    np.savez_compressed(
+        path,
+        format=np.array(FORMAT),
+        lengths=np.array(lengths, dtype=np.int64),
+        observations=np.concatenate(observations) if obs is None else obs,
+        actions=np.concatenate(actions) if act is None else act,
+        metadata=np.array(json.dumps(metadata)),
+    )
+    return path
+
+
+SHORT = r"episode 0 has 30 steps, fewer than its metadata's episode_steps=60, yet its crashed flag is false"
+
+
+def test_an_uncrashed_episode_shorter_than_its_budget_is_refused_by_plot_and_learn_model(tmp_path: Path, cli) -> None:
+    """T22-01: a 6000-step recording cut to 3000 steps, its metadata unchanged (episode_steps 6000, crashed false), was
+    drawn as "3000 steps, no crash" and learned from; now the file is refused naming the episode, its length, the
+    budget and the flag, by FlightData.load, plot and learn-model."""
+    path = _write(tmp_path / "short_nocrash.npz", [30, 60], {"episode_steps": 60, "crashed": [False, False], "returns": [-1.0, -2.0]})
+    with pytest.raises(NeurohoverError, match=f"^flight-data file '{path}': {SHORT} "):
+        FlightData.load(path)
+    for argv in (
+        ["plot", str(path), "--episodes", "0", "--out", str(tmp_path / "p")],
+        ["learn-model", "--flight-data", str(path), "--method", "lr", "--out", str(tmp_path / "m.json")],
+    ):
+        rc, out, err = cli(*argv)
+        assert rc == 2 and "Traceback" not in err and SHORT.replace("\\", "") in err, err
+        assert out == "" and not list(tmp_path.glob("p/*.png")) and not (tmp_path / "m.json").exists()
+    obs, act = _episodes(30, 60)
+    with pytest.raises(NeurohoverError, match=f"^flight data: {SHORT}"):
+        FlightData(obs, act, {"episode_steps": 60, "crashed": [False, False]})
+
+
+def test_what_fly_and_older_files_record_of_short_episodes_is_taken(tmp_path: Path) -> None:
+    """T22-01: what is not refused: a crash on the budget's last step (the kernel tests it after every step), a crashed
+    shorter episode, a file with no crashed flags (recorded before they were) or no budget, and recordings of two budgets
+    joined (their shorter full episodes: the joined data keep no budget, as none holds for all)."""
+    obs, act = _episodes(30, 60)
+    FlightData.load(_write(tmp_path / "a.npz", [30, 60], {"episode_steps": 60, "crashed": [True, True]}))
+    FlightData.load(_write(tmp_path / "b.npz", [30, 60], {"episode_steps": 60}))
+    FlightData.load(_write(tmp_path / "c.npz", [30, 60], {"crashed": [False, False]}))
+    short = FlightData(obs[:1], act[:1], {"episode_steps": 30, "crashed": [False]})
+    long = FlightData(obs[1:], act[1:], {"episode_steps": 60, "crashed": [False]})
+    assert "episode_steps" not in (short + long).metadata and (short + long).metadata["crashed"] == [False, False]
+    crashed = FlightData(obs[:1], act[:1], {"episode_steps": 30, "crashed": [True]})
+    assert (crashed + long).metadata["episode_steps"] == 60  # every episode fits the longer budget
+    assert FlightData.load((short + long).save(tmp_path / "joined.npz")).n_episodes == 2
