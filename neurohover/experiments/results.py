@@ -30,6 +30,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from .keys import UnitKey  # re-exported: results are read by key
+from .result_checks import KIND_CHECKS, run_inconsistency
 
 __all__ = [
     "DiagnosticResult",
@@ -138,7 +139,7 @@ class _Record:
                 )
             )
         for f in dataclasses.fields(cls):  # type: ignore[arg-type]
-            check = _KIND_CHECKS.get(str(f.type))
+            check = KIND_CHECKS.get(str(f.type))
             if check is not None and f.name in d and not check(d[f.name]):  # a score "x" was a ValueError in report (sixth trial)
                 raise NeurohoverError(f"{what}: {f.name} = {d[f.name]!r:.40} is not {f.type}")
         values = {n: cls._NESTED[n].from_dict(d[n], f"{what}.{n}") if n in cls._NESTED and n in d else d.get(n) for n in names}
@@ -153,26 +154,6 @@ class _Record:
 
 
 # --------------------------------------------------------------------------------- parts
-
-
-def _num(v) -> bool:
-    """A stored number: an int or float, or a non-finite one as :func:`enc_float`-style text."""
-    return (isinstance(v, (int, float)) and not isinstance(v, bool)) or v in ("nan", "inf", "-inf")
-
-
-def _int(v) -> bool:
-    return isinstance(v, int) and not isinstance(v, bool)
-
-
-#: Checks of a stored value by its field's annotation (the simple ones; others are read as they are).
-_KIND_CHECKS: dict[str, Any] = {
-    "str": lambda v: isinstance(v, str),
-    "int": _int,
-    "Num": _num,
-    "tuple[Num, ...]": lambda v: isinstance(v, list) and all(map(_num, v)),
-    "tuple[int, ...]": lambda v: isinstance(v, list) and all(map(_int, v)),
-    "tuple[int, ...] | None": lambda v: v is None or (isinstance(v, list) and all(map(_int, v))),
-}
 
 
 SHORT_LIST = 8  # lists up to this long (an MDP's parameters, the safe policies) get a column per entry
@@ -510,31 +491,9 @@ class TestRunResult(_Record):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        problem = self._inconsistency()
+        problem = run_inconsistency(self)
         if problem:  # a stored run with returns [] was a NumPy ValueError in report (seventh trial)
             raise NeurohoverError(f"test run of {self.agent} on {self.mdp} is inconsistent: {problem}")
-
-    def _inconsistency(self) -> str:
-        """What in this run does not fit together ('' when all does): the score is the sum of the returns, the episodes
-        named are among them, one crash step per crash."""
-        n = len(self.returns)
-        if n == 0:
-            return "it holds no episode's return"
-        try:
-            total = math.fsum(float(r) for r in self.returns)
-        except OverflowError:  # returns of 1e308 (eighth trial)
-            return "its returns sum past a float's range"
-        if not math.isclose(float(self.score), total, rel_tol=1e-9, abs_tol=1e-6):
-            return f"its score {self.score!r:.20} is not the sum of its {n} returns"
-        for name in ("crash_episodes", "safeguard_episodes"):
-            outside = [e for e in getattr(self, name) if not 0 <= e < n]
-            if outside:
-                return f"{name} names episode {outside[0]!r}, outside 0..{n - 1}"
-        if self.crash_steps is not None and len(self.crash_steps) != len(self.crash_episodes):
-            return f"{len(self.crash_steps)} crash steps for {len(self.crash_episodes)} crash episodes"
-        if not 0 <= self.learning_episodes <= n:
-            return f"learning_episodes {self.learning_episodes!r} is outside 0..{n}"
-        return ""
 
 
 @dataclass(frozen=True, kw_only=True)

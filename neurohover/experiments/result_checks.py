@@ -1,0 +1,53 @@
+"""Checks of stored results (:mod:`~neurohover.experiments.results`): a stored value against its field's annotation,
+and a test run's parts against each other."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .results import TestRunResult
+
+
+def _num(v) -> bool:
+    """A stored number: an int or float, or a non-finite one as :func:`enc_float`-style text."""
+    return (isinstance(v, (int, float)) and not isinstance(v, bool)) or v in ("nan", "inf", "-inf")
+
+
+def _int(v) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+#: Checks of a stored value by its field's annotation (the simple ones; others are read as they are).
+KIND_CHECKS: dict[str, Any] = {
+    "str": lambda v: isinstance(v, str),
+    "int": _int,
+    "Num": _num,
+    "tuple[Num, ...]": lambda v: isinstance(v, list) and all(map(_num, v)),
+    "tuple[int, ...]": lambda v: isinstance(v, list) and all(map(_int, v)),
+    "tuple[int, ...] | None": lambda v: v is None or (isinstance(v, list) and all(map(_int, v))),
+}
+
+
+def run_inconsistency(run: TestRunResult) -> str:
+    """What in test run ``run`` does not fit together ('' when all does): the score is the sum of the returns, the episodes
+    named are among them, one crash step per crash."""
+    n = len(run.returns)
+    if n == 0:
+        return "it holds no episode's return"
+    try:
+        total = math.fsum(float(r) for r in run.returns)
+    except OverflowError:  # returns of 1e308 (eighth trial)
+        return "its returns sum past a float's range"
+    if not math.isclose(float(run.score), total, rel_tol=1e-9, abs_tol=1e-6):
+        return f"its score {run.score!r:.20} is not the sum of its {n} returns"
+    for name in ("crash_episodes", "safeguard_episodes"):
+        outside = [e for e in getattr(run, name) if not 0 <= e < n]
+        if outside:
+            return f"{name} names episode {outside[0]!r}, outside 0..{n - 1}"
+    if run.crash_steps is not None and len(run.crash_steps) != len(run.crash_episodes):
+        return f"{len(run.crash_steps)} crash steps for {len(run.crash_episodes)} crash episodes"
+    if not 0 <= run.learning_episodes <= n:
+        return f"learning_episodes {run.learning_episodes!r} is outside 0..{n}"
+    return ""
