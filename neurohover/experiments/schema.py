@@ -16,7 +16,7 @@ from typing import Any
 
 from ..agents.hybrid import HybridSettings
 from ..agents.registry import AGENTS, HYBRID_AGENTS
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..evolution.config import make_settings, optimiser_of
 from ..evolution.evolve import parse_resampling
 from ..evolution.optimisers import OPTIMISERS
@@ -24,7 +24,7 @@ from ..integrations.neat import NEAT_TOPOLOGY
 from ..models.lr import DEFAULT_NOISE_ESTIMATE
 from ..models.model import default_model_substeps
 from ..tasks import TASK_FAMILIES, Drift
-from .checks import OMIT, REQUIRED, resampling, schema_of
+from .checks import OMIT, REQUIRED, schema_of
 from .settings import KIND_SETTINGS
 
 #: A ``generics_from`` source that names a directory of policy files (``.net`` or ``.json``) instead of an experiment.
@@ -302,9 +302,27 @@ def _check_test_runs(settings: dict, task: str, where: str) -> None:
             )
     if "generic_topology" in settings and (settings["policies"] != "evolve" or not TASK_FAMILIES[task].generic_over_distribution):
         raise NeurohoverError(f"{where}: generic_topology applies to the FGHH generics an experiment evolves itself (policies = 'evolve', task fghh)")
-    gr = settings["generic_resampling"]
-    if set(gr) - {"fixed", "race"} or not all(resampling()(v)[0] for v in gr.values()):
-        raise NeurohoverError(f"{where}: generic_resampling must be a table with keys fixed and/or race holding fixed:K / race:DELTA")
+    _check_generic_resampling(settings["generic_resampling"], where)
+
+
+def _check_generic_resampling(table: dict, where: str) -> None:
+    """Each ``generic_resampling`` key a kind of FGHH generic and its value a resampling, naming the bad key or value
+    (the message named neither, and ``{}`` was taken; twenty-second trial, T22-15)."""
+    head = f"{where}: generic_resampling"
+    if not table:
+        raise NeurohoverError(
+            f"{head} = {{}} is not allowed: give keys fixed and/or race, each holding a resampling (e.g. "
+            "{ fixed = 'fixed:5', race = 'race:0.2' }), or leave the setting out (the recipe's own resampling)"
+        )
+    for key, value in table.items():
+        if key not in ("fixed", "race"):
+            raise NeurohoverError(f"{head} has the key {brief(key)}: allowed keys fixed and race (the kinds of generic policy)")
+        if not isinstance(value, str):
+            raise NeurohoverError(f"{head}.{key} = {brief(value)} is not allowed: give a text such as 'fixed:5' or 'race:0.2'")
+        try:
+            parse_resampling(value)
+        except NeurohoverError as e:
+            raise NeurohoverError(f"{head}.{key}: {e}") from None
 
 
 def _keyed(items: list[dict], what: str, where: str) -> None:
