@@ -107,7 +107,8 @@ class TellInfo:
     selected : np.ndarray of int, optional
         The parents a selection race chose (generational NE).
     episodes : int, optional
-        Episodes the generation cost (generational NE's history): an integer in 0..:data:`MAX_EPISODES`.
+        Episodes the generation cost (generational NE's history and budget): an integer in 0..:data:`MAX_EPISODES`, and
+        at a ``tell`` no fewer than the genomes asked (:meth:`check`).
 
     Raises
     ------
@@ -125,9 +126,16 @@ class TellInfo:
             object.__setattr__(self, "episodes", require_episodes(self.episodes))
 
     def check(self, asked: int) -> None:
-        """NeurohoverError naming the field unless ``crashed`` and ``selected`` fit a tell of ``asked`` genomes: the one
-        check of both, which every ``tell`` makes (through :func:`check_returns`), also of a field it does not read (one
-        crash flag for four genomes, selected index -1 or 4 of four were taken; T21-10)."""
+        """NeurohoverError naming the field unless ``crashed``, ``selected`` and ``episodes`` fit a tell of ``asked``
+        genomes: the one check of the three, which every ``tell`` makes (through :func:`check_returns`), also of a field
+        it does not read (one crash flag for four genomes, selected index -1 or 4 of four were taken; T21-10). Each
+        genome's evaluation flies one episode or more, so a generation costs at least ``asked`` episodes: episodes=0
+        left a GenerationalNE's evaluations (the episodes its budget counts) at 0 and its run never stopped (T22-13)."""
+        if self.episodes is not None and self.episodes < asked:
+            raise NeurohoverError(
+                f"TellInfo episodes={self.episodes:,} is not allowed: fewer than the {asked:,} genomes asked, each of whose evaluations"
+                f" flies an episode or more; allowed an integer in {asked:,}..{MAX_EPISODES:,}"
+            )
         if self.crashed is not None:
             crash_flags(self.crashed, asked)
         if self.selected is not None:
