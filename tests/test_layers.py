@@ -18,7 +18,7 @@ LAYERS = [
     {"launch", "flyer", "plots"},
     {"evaluate"},
     {"evolution", "envs"},
-    {"models", "policysets", "integrations"},
+    {"models", "policysets", "manifest", "integrations"},
     {"agents"},
     {"experiments"},
     {"compete"},
