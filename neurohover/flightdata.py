@@ -17,7 +17,7 @@ import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real
 from .paths import json_text, strict_json
-from .sim.constants import MAX_EPISODE_STEPS
+from .sim.constants import ACTION_NAMES, EPISODE_STEPS, MAX_EPISODE_STEPS, OBS_NAMES
 
 FORMAT = "neurohover-flight-data/1"
 SAVE_DTYPES = ("float64", "float32")
@@ -228,7 +228,40 @@ class FlightData:
         obs, act = obs.astype(np.float64), act.astype(np.float64)  # a float32 file loads as float64, like every array here
         obs_split = np.split(obs, np.cumsum(lengths + 1)[:-1])
         act_split = np.split(act, np.cumsum(lengths)[:-1])
-        return cls(tuple(obs_split), tuple(act_split), metadata)
+        data = cls(tuple(obs_split), tuple(act_split), metadata)
+        for i, crashed in enumerate(crash_flags(data)):  # a NaN was named by plot, not by learn-model, and neither named the file (T22-02)
+            check_flown(data.observations[i], data.actions[i], crashed, f"flight-data file {str(path)!r}, episode {i}")
+        return data
+
+
+def crash_flags(data: FlightData) -> list[bool]:
+    """Whether each episode of ``data`` crashed: its flag as flown (the ``crashed`` metadata every recording holds), or,
+    in files recorded before 2026-12-04, whether it is shorter than the metadata's ``episode_steps`` (default 6000)."""
+    meta = data.metadata if isinstance(data.metadata, dict) else {}
+    flags = meta.get("crashed")
+    if isinstance(flags, list) and len(flags) == data.n_episodes:
+        return [bool(c) for c in flags]
+    steps = meta.get("episode_steps")
+    steps = steps if type(steps) is int else EPISODE_STEPS  # checked where the metadata are (check_metadata)
+    return [a.shape[0] < steps for a in data.actions]
+
+
+def check_flown(observations: np.ndarray, actions: np.ndarray, crashed: bool, where: str) -> None:
+    """Refuse an episode's readings that no flight gives, naming ``where`` (the file and episode), the step, the variable
+    and its value: a NaN or infinite observation (the simulator's are finite, a crash's last one too, out of bounds as it
+    may be), or a non-finite action but the last of a ``crashed`` episode (a policy's NaN action is recorded as given,
+    and crashes the episode there). The one check of flight data as flown: :meth:`FlightData.load`, plots and learned
+    models' transitions (a file of NaN observations drew empty panels, T21-04; learn-model named no file, episode or
+    step, T22-02)."""
+    for kind, values, names, last in (("observation", observations, OBS_NAMES, 0), ("action", actions, ACTION_NAMES, int(crashed))):
+        bad = np.argwhere(~np.isfinite(values[: values.shape[0] - last]))
+        if bad.size:
+            k, i = (int(x) for x in bad[0])
+            count = f" ({len(bad) - 1:,} more of the episode's {kind} readings are NaN or infinite)" if len(bad) > 1 else ""
+            but = "but as a crashed episode's last" if kind == "action" else "a crash's last one included"
+            raise NeurohoverError(
+                f"{where}: step {k} reads {names[i]} = {values[k, i]}{count}: no flight records a NaN or infinite {kind}, {but}; give flight data as flown"
+            )
 
 
 def check_npz_name(path: str | Path, what: str = "flight-data file") -> None:

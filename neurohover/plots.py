@@ -36,9 +36,9 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
 from .errors import NeurohoverError, brief, finite_real, whole_number
-from .flightdata import FlightData, check_metadata
+from .flightdata import FlightData, check_flown, check_metadata, crash_flags
 from .paths import input_dir, output_dir, output_file, printable, strict_json
-from .sim.constants import ACTION_NAMES, CONTROL_DT, CRASH_STEP_PENALTY, EPISODE_STEPS, MAX_EPISODE_STEPS, OBS_NAMES
+from .sim.constants import ACTION_NAMES, CONTROL_DT, CRASH_STEP_PENALTY, EPISODE_STEPS, MAX_EPISODE_STEPS
 
 __all__ = [
     "CompeteResult",
@@ -184,7 +184,7 @@ def flight_figure(
         crashed = crashed_episode(act, steps)
     elif not isinstance(crashed, (bool, np.bool_)):
         raise NeurohoverError(f"crashed={brief(crashed)} is not allowed: give True, False or None (by the episode's length)")
-    _check_flown(obs, act, bool(crashed), "flight_figure")
+    check_flown(obs, act, bool(crashed), "flight_figure")
     t_obs = np.arange(obs.shape[0]) * CONTROL_DT
     t_act = np.arange(act.shape[0]) * CONTROL_DT
     fig = new_figure(10.0, 11.0)
@@ -212,22 +212,6 @@ def flight_figure(
     return fig
 
 
-def _check_flown(observations: np.ndarray, actions: np.ndarray, crashed: bool, where: str) -> None:
-    """Refuse an episode's readings that no flight gives, naming ``where``, the step, the variable and its value: a NaN
-    or infinite observation (the simulator's are finite, a crash's last one too, out of bounds as it may be), or a
-    non-finite action but the last of a ``crashed`` episode (a policy's NaN action is recorded as given, and crashes
-    the episode there). A file of NaN observations drew empty panels and exited 0, while learn-model refused it (T21-04)."""
-    for kind, values, names, last in (("observation", observations, OBS_NAMES, 0), ("action", actions, ACTION_NAMES, int(crashed))):
-        bad = np.argwhere(~np.isfinite(values[: values.shape[0] - last]))
-        if bad.size:
-            k, i = (int(x) for x in bad[0])
-            count = f" ({len(bad) - 1:,} more of the episode's {kind} readings are NaN or infinite)" if len(bad) > 1 else ""
-            but = "but as a crashed episode's last" if kind == "action" else "a crash's last one included"
-            raise NeurohoverError(
-                f"{where}: step {k} reads {names[i]} = {values[k, i]}{count}: no flight records a NaN or infinite {kind}, {but}; give flight data as flown"
-            )
-
-
 def _episode_title(data: FlightData, i: int, stem: str) -> str:
     """'stem: episode i, MDP label, return R, policy P', from what the metadata holds."""
     meta = data.metadata if isinstance(data.metadata, dict) else {}
@@ -248,11 +232,10 @@ def episode_crashed(data: FlightData, i: int) -> bool:
     or, in files recorded before 2026-12-04, whether it is shorter than the metadata's ``episode_steps`` (default 6000)."""
     _check_flight_data(data)  # None was an AttributeError, episode 5 of 2 an IndexError (fifteenth trial, T15-9)
     i = _episode_list([i], data.n_episodes)[0]
-    meta = data.metadata if isinstance(data.metadata, dict) else {}
-    flags = meta.get("crashed")
-    if isinstance(flags, list) and len(flags) == data.n_episodes:
-        return bool(flags[i])
-    return crashed_episode(data.actions[i], meta.get("episode_steps", EPISODE_STEPS))  # checked there: "x" was int()'s ValueError
+    flags = data.metadata.get("crashed") if isinstance(data.metadata, dict) else None
+    if not (isinstance(flags, list) and len(flags) == data.n_episodes):  # by length: episode_steps "x" was int()'s ValueError
+        _check_episode_steps(data.metadata.get("episode_steps", EPISODE_STEPS) if isinstance(data.metadata, dict) else EPISODE_STEPS)
+    return crash_flags(data)[i]
 
 
 def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight", episodes: Sequence[int] | None = None) -> list[Path]:
@@ -276,7 +259,7 @@ def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight"
     check_metadata(data.metadata, np.array([a.shape[0] for a in data.actions], dtype=np.int64), "flight data")  # episode_steps 'x' (T14-10)
     steps = data.metadata.get("episode_steps", EPISODE_STEPS)
     for i in range(data.n_episodes):  # every episode before any file is written, as learn-model reads them all
-        _check_flown(data.observations[i], data.actions[i], episode_crashed(data, i), f"flight data, episode {i}")
+        check_flown(data.observations[i], data.actions[i], episode_crashed(data, i), f"flight data, episode {i}")
     width = len(str(max(data.n_episodes - 1, 0)))
     chosen = range(data.n_episodes) if episodes is None else _episode_list(episodes, data.n_episodes)
     out_dir = output_dir(out_dir, "out_dir")  # a file, FIFO or /dev/null was NotADirectoryError (T14-10); made, saying so, if missing

@@ -1,5 +1,5 @@
 """Bad-input trial 22, flight data and compete directories as ``neurohover plot`` and ``learn-model`` read them: an
-uncrashed episode shorter than its budget (T22-01)."""
+uncrashed episode shorter than its budget (T22-01), a NaN reading named by learn-model as by plot (T22-02)."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ import pytest
 
 from neurohover.errors import NeurohoverError
 from neurohover.flightdata import FORMAT, FlightData
+from neurohover.models.transitions import Transitions
 
 
 def _episodes(*lengths: int) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
@@ -68,3 +69,42 @@ def test_what_fly_and_older_files_record_of_short_episodes_is_taken(tmp_path: Pa
     crashed = FlightData(obs[:1], act[:1], {"episode_steps": 30, "crashed": [True]})
     assert (crashed + long).metadata["episode_steps"] == 60  # every episode fits the longer budget
     assert FlightData.load((short + long).save(tmp_path / "joined.npz")).n_episodes == 2
+
+
+NAN_X = "episode 0: step 5 reads x = nan: no flight records a NaN or infinite observation, a crash's last one included; give flight data as flown"
+
+
+def test_a_nan_reading_is_named_with_its_file_episode_step_and_variable_by_learn_model_and_plot(tmp_path: Path, cli) -> None:
+    """T22-02: learn-model said only "flight data holds non-finite observations or actions" of a file whose
+    observations[5, 3] was NaN, while plot named the episode, step and variable; now both name the file too."""
+    obs = np.concatenate(_episodes(30, 30)[0])
+    obs[5, 3] = np.nan
+    path = _write(tmp_path / "nanobs.npz", [30, 30], {"episode_steps": 30, "crashed": [False, False]}, obs=obs)
+    for argv in (
+        ["learn-model", "--flight-data", str(path), "--method", "lr", "--out", str(tmp_path / "m.json")],
+        ["plot", str(path), "--out", str(tmp_path / "p")],
+    ):
+        rc, out, err = cli(*argv)
+        assert rc == 2 and "Traceback" not in err and f"flight-data file '{path}', {NAN_X}" in err, err
+        assert out == "" and not (tmp_path / "m.json").exists() and not list(tmp_path.glob("p/*.png"))
+
+
+def test_transitions_name_a_non_finite_reading_and_drop_a_crashed_episodes_last_nan_action() -> None:
+    """T22-02: flight data made in Python are checked by the same function as a file, by Transitions (so every learner):
+    a NaN observation or a NaN action but a crashed episode's last is refused by name; that last one's transition is
+    dropped, not learned from (the simulator never flew it)."""
+    obs, act = _episodes(30, 30)
+    nan_obs = (obs[0].copy(), obs[1])
+    nan_obs[0][5, 3] = np.nan
+    with pytest.raises(NeurohoverError, match=f"^flight data, {NAN_X}"):
+        Transitions(FlightData(nan_obs, act, {"episode_steps": 30, "crashed": [False, False]}))
+    nan_act = (act[0], act[1].copy())
+    nan_act[1][-1, 2] = np.inf
+    with pytest.raises(
+        NeurohoverError, match="^flight data, episode 1: step 29 reads rudder = inf: no flight records a NaN or infinite action, but as a crashed"
+    ):
+        Transitions(FlightData(obs, nan_act, {"episode_steps": 30, "crashed": [False, False]}))
+    short = (act[0], act[1][:20].copy())
+    short[1][-1] = np.nan
+    tr = Transitions(FlightData((obs[0], obs[1][:21]), short, {"episode_steps": 30, "crashed": [False, True]}))
+    assert tr.n == 30 + 19 and np.isfinite(tr.act).all() and tr.n_episodes == 2

@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from ..errors import NeurohoverError, brief
-from ..flightdata import FlightData
+from ..flightdata import FlightData, check_flown, crash_flags
 from ..sim.constants import GRAVITY, NOISE_DECAY, NOISE_GAIN, NOISE_NAMES, OBS_NAMES, PARAM_NAMES
 from ..tasks import MDP
 from .model import AXIS_C, AXIS_GAINS, MODEL_DT, LearnedModel, check_vector
@@ -76,7 +76,11 @@ class Transitions:
     ----------
     flight_data : FlightData
         At least ``MIN_TRANSITIONS`` transitions of finite observations with unit quaternions and
-        actions in [-1, 1]; anything else is refused with a NeurohoverError.
+        actions in [-1, 1]; anything else is refused with a NeurohoverError naming the episode, step, variable and
+        value (:func:`~neurohover.flightdata.check_flown`). One non-finite action is taken: the last of a crashed
+        episode (a policy's NaN action, recorded as given, crashes the episode there). Its transition is dropped, not
+        learned from: the simulator never flew it (the episode's last observation repeats the one before), and a model
+        cannot learn from a NaN action.
     what : str
         What the data are, for error messages.
 
@@ -99,15 +103,19 @@ class Transitions:
     def __init__(self, flight_data: FlightData, what: str = "flight data") -> None:
         if not isinstance(flight_data, FlightData):
             raise NeurohoverError(f"{what} must be a FlightData, got {type(flight_data).__name__}")
-        episodes = [(o, a) for o, a in zip(flight_data.observations, flight_data.actions) if a.shape[0] > 0]
+        episodes = []
+        for e, (o, a, crashed) in enumerate(zip(flight_data.observations, flight_data.actions, crash_flags(flight_data))):
+            check_flown(o, a, crashed, f"{what}, episode {e}")  # "holds non-finite observations or actions" named none (T22-02)
+            if crashed and a.shape[0] and not np.isfinite(a[-1]).all():
+                o, a = o[:-1], a[:-1]  # the simulator never flew it: its next observation repeats the last
+            if a.shape[0] > 0:
+                episodes.append((o, a))
         n = sum(a.shape[0] for _, a in episodes)
         if n < MIN_TRANSITIONS:
             raise NeurohoverError(f"{what} holds {n} transitions in {flight_data.n_episodes} episodes; learning a model needs at least {MIN_TRANSITIONS}")
         obs = np.concatenate([o[:-1] for o, _ in episodes]).astype(float, copy=False)
         nxt = np.concatenate([o[1:] for o, _ in episodes]).astype(float, copy=False)
         act = np.concatenate([a for _, a in episodes]).astype(float, copy=False)
-        if not (np.all(np.isfinite(obs)) and np.all(np.isfinite(nxt)) and np.all(np.isfinite(act))):
-            raise NeurohoverError(f"{what} holds non-finite observations or actions")
         _check_readings(flight_data, what)
         for arr in (obs, nxt):
             norm2 = np.einsum("ij,ij->i", arr[:, 9:12], arr[:, 9:12])
