@@ -186,6 +186,11 @@ def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig
     if config.scale != scale:  # a quick config under a 'paper' row was reported as the paper's claims (T21-01)
         raise NeurohoverError(f"{where}: its row is at scale {scale!r} but its config is the {brief(config.scale)} one")
     units = store.units(name, scale)
+    runs = {u["key"]: u["result"] for u in units if u["kind"] == "test_run"}
+    try:  # before the results are read: a run of another length is named as such (T22-05)
+        check_run_lengths(config.settings.get("episodes") if config.kind == "test_runs" else None, runs)
+    except NeurohoverError as err:
+        raise NeurohoverError(f"{where}: {err}") from None
     results: dict[str, UnitResult] = {}
     for u in units:
         try:
@@ -196,7 +201,6 @@ def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig
             raise NeurohoverError(f"{where}: {unit}{err}") from None
     try:
         _check_hashes(store, name, scale, stored, config)
-        check_run_lengths(config.settings.get("episodes") if config.kind == "test_runs" else None, results)
         _check_planned(store, config, units)
     except NeurohoverError as err:
         raise NeurohoverError(f"{where}: {err}") from None

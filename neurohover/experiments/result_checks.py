@@ -6,8 +6,14 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
+from ..errors import brief
+from ..sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS
+
 if TYPE_CHECKING:
     from .results import TestRunResult
+
+#: No episode loses more: a crash charges the worst step for every step left (plots.WORST_RETURN, compete's reader's bound).
+WORST_RETURN = CRASH_STEP_PENALTY * MAX_EPISODE_STEPS
 
 
 def _num(v) -> bool:
@@ -32,7 +38,8 @@ KIND_CHECKS: dict[str, Any] = {
 
 def run_inconsistency(run: TestRunResult) -> str:
     """What in test run ``run`` does not fit together ('' when all does): the score is the sum of the returns, the episodes
-    named are among them, one crash step per crash."""
+    named are among them, one crash step per crash; each return is an episode's (finite, at most 0: returns [5, 7, 1] were
+    reported as a mean; T22-05)."""
     n = len(run.returns)
     if n == 0:
         return "it holds no episode's return"
@@ -42,6 +49,10 @@ def run_inconsistency(run: TestRunResult) -> str:
         return "its returns sum past a float's range"
     if not math.isclose(float(run.score), total, rel_tol=1e-9, abs_tol=1e-6):
         return f"its score {run.score!r:.20} is not the sum of its {n} returns"
+    for i, r in enumerate(run.returns):
+        if not (math.isfinite(float(r)) and -WORST_RETURN <= float(r) <= 0):
+            allowed = f"allowed a finite number in [{-WORST_RETURN:.3g}, 0] (every reward is minus a sum of squares)"
+            return f"returns[{i}] = {brief(r)} is no episode's return: {allowed}"
     for name in ("crash_episodes", "safeguard_episodes"):
         outside = [e for e in getattr(run, name) if not 0 <= e < n]
         if outside:

@@ -548,12 +548,15 @@ def result_from_dict(kind: str, d: dict, key: str | None = None) -> UnitResult:
 
 def check_run_lengths(episodes: Any, results: dict[str, Any]) -> None:
     """Refuse a stored test run whose episodes are not the experiment's ``episodes`` (None: not a test-runs experiment), by
-    its key: the report stacks every run's returns (a shorter one was a NumPy ValueError there; seventh trial)."""
+    its key: the report stacks every run's returns (a shorter one was a NumPy ValueError there; seventh trial). ``results``
+    are the test runs' results as stored (key -> dict), checked before :func:`result_from_dict` reads them, so a run of
+    another length is named as such rather than for a return it holds (T22-05); one of no returns is left to that check."""
     if episodes is None:
         return
     for key, result in results.items():
-        if isinstance(result, TestRunResult) and len(result.returns) != episodes:
-            raise NeurohoverError(f"test run {key!r} holds {len(result.returns)} episodes' returns where its experiment flies {episodes}")
+        returns = result.get("returns") if isinstance(result, dict) else None
+        if isinstance(returns, list) and returns and len(returns) != episodes:
+            raise NeurohoverError(f"test run {key!r} holds {len(returns)} episodes' returns where its experiment flies {episodes}")
 
 
 # --------------------------------------------------------------------------------- unit keys

@@ -1,0 +1,78 @@
+"""The twenty-second bad-input trial's findings in stored test runs: a result whose returns are positive (T22-05), whose
+derived figures contradict its returns (T22-06), whose crashes are named twice or at steps no episode has (T22-07), that
+contradicts its unit's params (T22-08), or whose policy changes, timing or experiment row are out of range (T22-09) was
+exported, counted and reported; the shared check (checked_units -> result_from_dict) now refuses each in one message
+naming the store, the experiment, the unit, the field, the value and what is allowed."""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+import sqlite3
+from pathlib import Path
+from typing import Any
+
+import pytest
+from conftest import CliRun, tiny_test_runs
+
+from neurohover.errors import NeurohoverError
+from neurohover.experiments import Store
+from neurohover.experiments.export import checked_units
+
+RUN = "run/model-free/test0/rep0"
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory) -> Path:
+    """A store holding one finished test run of model-free (two 20-step episodes on a GHH-08 test MDP); tests edit
+    copies of it."""
+    from neurohover.cli import main
+
+    where = tmp_path_factory.mktemp("tiny22")
+    config = where / "tr1.toml"
+    config.write_text(tiny_test_runs("model-free"))
+    assert main(["reproduce", str(config), "--store", str(where / "s.sqlite"), "--no-progress"]) == 0
+    return where / "s.sqlite"
+
+
+def _edited(store: Path, at: Path, **changes: Any) -> Path:
+    """A copy of ``store`` at ``at`` whose RUN result has ``changes`` (a callable: of the stored result)."""
+    shutil.copyfile(store, at)
+    with sqlite3.connect(at) as conn:
+        result = json.loads(conn.execute("SELECT result FROM units WHERE key = ?", (RUN,)).fetchone()[0])
+        result.update({k: v(result) if callable(v) else v for k, v in changes.items()})
+        conn.execute("UPDATE units SET result = ? WHERE key = ?", (json.dumps(result), RUN))
+    conn.close()
+    return at
+
+
+def _refused(store: Path, says: str) -> str:
+    """The shared check's message on ``store``, asserted to name the store, the experiment, RUN and ``says``."""
+    with Store(store, create=False) as held, pytest.raises(NeurohoverError) as caught:
+        checked_units(held, "tr1", "quick")
+    message = str(caught.value)
+    assert message.startswith(f"results store {str(store)!r}, experiment tr1 (quick), is damaged: unit '{RUN}': ") and says in message, message
+    return message
+
+
+def _refused_by_results(cli: CliRun, store: Path, says: str) -> None:
+    """``neurohover results`` refuses ``store`` with exit status 2 and the shared check's message."""
+    message = _refused(store, says)
+    rc, out, err = cli("results", "tr1", "--store", str(store))
+    assert rc == 2 and out == "" and err.strip() == f"neurohover results: error: {message}", err
+
+
+@pytest.mark.parametrize(
+    ("returns", "says"),
+    [
+        ([5.0, 7.0], "returns[0] = 5.0 is no episode's return: allowed a finite number in [-1.75e+10, 0]"),
+        ([-5.0, 1e-3], "returns[1] = 0.001 is no episode's return"),
+        ([-5.0, -1e300], "returns[1] = -1e+300 is no episode's return"),
+    ],
+)
+def test_a_run_of_positive_returns_is_refused(tiny: Path, tmp_path: Path, cli: CliRun, returns: list[float], says: str) -> None:
+    """T22-05: returns [5, 7, 1] (score 13) were reported as model-free's mean; compete's reader refuses a return > 0
+    (every reward is minus a sum of squares), and now the stored run is refused too."""
+    store = _edited(tiny, tmp_path / "s.sqlite", returns=returns, score=math.fsum(returns), learning_episodes=0, mean_return_after_learning=sum(returns) / 2)
+    _refused_by_results(cli, store, says)
