@@ -5,16 +5,20 @@ integer are "not allowed", not "out of range"."""
 
 from __future__ import annotations
 
+import json
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from neurohover.errors import NeurohoverError
 from neurohover.evolution.common import TellInfo
+from neurohover.evolution.evolve import evolve
 from neurohover.evolution.generational import GenerationalNE, GenerationalSettings
 from neurohover.evolution.optimisers import OPTIMISERS
 from neurohover.evolution.steady_state import SteadyStateNE
+from neurohover.tasks import get_task_family
 
 
 def _raises(fragment: str):
@@ -66,3 +70,78 @@ def test_every_optimiser_refuses_fewer_episodes_than_genomes(name: str) -> None:
     with _raises(f"TellInfo episodes={n - 1} is not allowed: fewer than the {n} genomes asked"):
         opt.tell(-np.ones(n), TellInfo(episodes=n - 1))
     opt.tell(-np.ones(n), TellInfo(episodes=n))  # the same batch, told as flown
+
+
+# --------------------------------------------------------------------------- checkpoints
+
+GHH08 = get_task_family("ghh08")
+#: The run behind the tiny_checkpoint fixture (conftest.py): steady state on GHH-08's zero MDP, 50 episodes of 20 steps.
+MDP_RUN = dict(topology="slp", prototype="baseline", seed=3, n_steps=20)
+#: The same run on the command line (resumed from a copy of the fixture's checkpoint).
+CLI_RUN = ("evolve", "--task", "ghh08", "--mdp", "zero", "--topology", "slp", "--seed-policy", "baseline", "--seed", "3", "--episode-steps", "20")
+#: A tiny generational run on the GHH-08 family, and a tiny CMA-ES one (a population optimiser keeps its own champion).
+FAMILY_RUN = dict(topology="slp", prototype="baseline", seed=3, n_steps=10, settings=GenerationalSettings(pop_size=4, select_size=2))
+CMA_RUN = dict(topology="slp", prototype="baseline", seed=3, n_steps=10, optimizer="cma", settings={"sigma0": 0.1, "popsize": 4})
+
+
+@pytest.fixture(scope="module")
+def family_checkpoints(tmp_path_factory) -> dict[str, Path]:
+    """Sound checkpoints of two generations of FAMILY_RUN and of CMA_RUN (tests damage a copy)."""
+    out = {}
+    for name, run in (("generational", FAMILY_RUN), ("cma", CMA_RUN)):
+        out[name] = tmp_path_factory.mktemp(f"{name}-checkpoint") / "run.ckpt.json"
+        evolve(GHH08, budget=8, checkpoint=out[name], **run)
+    return out
+
+
+def _runs(which: str, tiny: Path, family: dict[str, Path]) -> tuple[Path, object, dict]:
+    """The checkpoint, target and run of ``which``: steady state, generational or cma."""
+    return (tiny, GHH08.zero(), MDP_RUN) if which == "steady-state" else (family[which], GHH08, FAMILY_RUN if which == "generational" else CMA_RUN)
+
+
+def _resume_damaged(source: Path, tmp_path: Path, edit, target, run: dict, fragment: str) -> None:
+    """The checkpoint ``source`` resumes (with its episodes as the budget: it stops at once); damaged by ``edit``, it is
+    refused as a damaged checkpoint with a message holding ``fragment``."""
+    state = json.loads(source.read_text())
+    ckpt = tmp_path / "run.ckpt.json"
+    ckpt.write_text(json.dumps(state))
+    flown = state["counters"]["episodes"]
+    assert evolve(target, budget=flown, checkpoint=ckpt, resume=True, **run).episodes == flown  # the sound checkpoint resumes
+    state = json.loads(source.read_text())
+    edit(state)
+    ckpt.write_text(json.dumps(state))
+    with _raises(f"is a damaged checkpoint: {fragment}"):
+        evolve(target, budget=flown + 8, checkpoint=ckpt, resume=True, **run)
+
+
+# --------------------------------------------------------------------------- T22-11: a history without the champion's row
+
+
+def test_an_empty_history_beside_a_champion_is_refused_on_the_command_line(tiny_checkpoint: Path, tmp_path: Path, cli) -> None:
+    """T22-11: a steady-state checkpoint's history of [] at generation 1 (its optimiser's champion found there) was
+    resumed (exit 0) and its history.csv lacked the generation-1 row; a run records a row whenever its champion changes,
+    so now the checkpoint is refused as damaged, with exit status 2 and no traceback."""
+    state = json.loads(tiny_checkpoint.read_text())
+    assert state["counters"]["generation"] == 1 and len(state["history"]) == 1
+    champion = state["history"][0][4]
+    state["history"] = []
+    (tmp_path / "run.json.checkpoint.json").write_text(json.dumps(state))
+    rc, _, err = cli(*CLI_RUN, "--budget", "60", "--out", str(tmp_path / "run.json"), "--resume")
+    assert rc == 2 and "Traceback" not in err, err
+    assert (
+        f"is a damaged checkpoint: history is not the champion's: it has no rows where the run's champion (at generation 1) has return {champion!r}"
+        in " ".join(err.split())
+    )
+
+
+@pytest.mark.parametrize("which", ["steady-state", "generational", "cma"])
+def test_a_history_whose_last_row_is_not_the_champions_is_refused(which: str, tiny_checkpoint: Path, family_checkpoints, tmp_path: Path) -> None:
+    """T22-11: the last history row holds the run's champion's return (the optimiser's, or for a population optimiser
+    on a family its own champion table's); another one is refused, naming both."""
+    source, target, run = _runs(which, tiny_checkpoint, family_checkpoints)
+    state = json.loads(source.read_text())
+    last, generation = state["history"][-1][4], state["counters"]["generation"]
+    fragment = (
+        f"history is not the champion's: its last row's champion_return is -12345.5 where the run's champion (at generation {generation}) has return {last!r}"
+    )
+    _resume_damaged(source, tmp_path, lambda s: s["history"][-1].__setitem__(4, -12345.5), target, run, fragment)

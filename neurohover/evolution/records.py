@@ -256,11 +256,13 @@ def read_checkpoint(path: Path) -> dict:
         ) from None
 
 
-def check_history(records: list[HistoryRecord], counts: dict[str, int], per_generation: bool) -> None:
+def check_history(records: list[HistoryRecord], counts: dict[str, int], per_generation: bool, champion: float | None = None) -> None:
     """EntryError unless ``records`` can be the history of a run at checkpoint counters ``counts``: generations rising
     from 1, evaluations and episodes never falling nor past the counters nor below a row's generations and evaluations,
     and, where the run records every generation (``per_generation``), one row each (a history of three copies of its
-    one row was resumed and written out; T19-08)."""
+    one row was resumed and written out; T19-08). Where ``champion`` (the run's champion's return) is given, the last
+    row holds it: every run records a row when its champion changes (the others each generation), so only a run
+    without a champion ('-inf') has no row (an empty history beside a champion was resumed without its rows; T22-11)."""
     last = None
     for n, h in enumerate(records):
         if h.generation < 1 or (last is not None and h.generation <= last.generation):
@@ -284,6 +286,12 @@ def check_history(records: list[HistoryRecord], counts: dict[str, int], per_gene
                 raise EntryError(f"history's last row has {column}={getattr(last, column):,}, past the checkpoint's {column} counter {counts[column]:,}")
     if per_generation and len(records) != counts["generation"]:
         raise EntryError(f"history has {len(records):,} rows for {counts['generation']:,} generations: this run records every generation, one row each")
+    if champion is not None and (last.champion_return if last is not None else -math.inf) != champion:
+        held = "it has no rows" if last is None else f"its last row's champion_return is {enc_float(last.champion_return)!r}"
+        raise EntryError(
+            f"history is not the champion's: {held} where the run's champion (at generation {counts['generation']:,}) has return"
+            f" {enc_float(champion)!r}; a run records a row whenever its champion changes, so its last row holds the champion's return"
+        )
 
 
 #: The entries of a PCG64 bit generator's state (numpy's ``bit_generator.state``): the largest value of each, and as text.

@@ -68,9 +68,9 @@ def _check_between_generations(opt: Optimiser) -> None:
         raise EntryError("optimizer_state's pending batch is not allowed: a run's checkpoint is written between generations (allowed null)")
 
 
-def _restored_parts(state: dict, run: Run) -> dict[str, Any]:
-    """The counters, champion, history and race delta of checkpoint ``state`` for ``run``, each checked (ValueError,
-    TypeError or KeyError naming what is wrong), before any of them is restored."""
+def _restored_parts(state: dict, run: Run, opt: Optimiser) -> dict[str, Any]:
+    """The counters, champion, history and race delta of checkpoint ``state`` for ``run`` (whose restored optimiser is
+    ``opt``), each checked (ValueError, TypeError or KeyError naming what is wrong), before any of them is restored."""
     c = state["counters"]
     counts = _checked_counts(c, run.cfg.n_steps)
     seconds = {k: c[k] for k in ("wall_seconds", "kernel_seconds")}
@@ -84,7 +84,10 @@ def _restored_parts(state: dict, run: Run) -> dict[str, Any]:
     race_delta = _checked_race_delta(state.get("race_delta", run.resampling.delta), run.resampling)  # absent before race:auto
     history = decode_history(state["history"])
     # Generational runs and population optimisers on a family record every generation; the others each new champion.
-    check_history(history, counts, per_generation=run.method == "generational" or (run.method in OPTIMISERS and run.family is not None))
+    # A population optimiser on a family keeps its champion (the best of the last generation) in the champion table;
+    # every other run's is its optimiser's (Run._champion_return).
+    own = run.method in OPTIMISERS and run.family is not None
+    check_history(history, counts, per_generation=run.method == "generational" or own, champion=champion[1] if own else float(opt.champion_return))
     return {"counters": counts, "seconds": seconds, "champion": champion, "history": history, "race_delta": race_delta}
 
 

@@ -183,7 +183,7 @@ class Run:
                 )
         try:
             _check_between_generations(opt)
-            parts = _restored_parts(state, self)
+            parts = _restored_parts(state, self, opt)
             _check_run_entries(state, self.mdp_rng is None)
             if self.mdp_rng is not None:
                 check_stream(state["mdp_stream"], type(self.mdp_rng.bit_generator).__name__)
