@@ -47,6 +47,14 @@ def _edited(store: Path, at: Path, **changes: Any) -> Path:
     return at
 
 
+def _stored(store: Path) -> dict:
+    """RUN's result as ``store`` holds it."""
+    with sqlite3.connect(store) as conn:
+        result = json.loads(conn.execute("SELECT result FROM units WHERE key = ?", (RUN,)).fetchone()[0])
+    conn.close()
+    return result
+
+
 def _refused(store: Path, says: str) -> str:
     """The shared check's message on ``store``, asserted to name the store, the experiment, RUN and ``says``."""
     with Store(store, create=False) as held, pytest.raises(NeurohoverError) as caught:
@@ -76,3 +84,24 @@ def test_a_run_of_positive_returns_is_refused(tiny: Path, tmp_path: Path, cli: C
     (every reward is minus a sum of squares), and now the stored run is refused too."""
     store = _edited(tiny, tmp_path / "s.sqlite", returns=returns, score=math.fsum(returns), learning_episodes=0, mean_return_after_learning=sum(returns) / 2)
     _refused_by_results(cli, store, says)
+
+
+@pytest.mark.parametrize(
+    ("changes", "says"),
+    [
+        ({"mean_return_after_learning": math.nan}, "mean_return_after_learning = nan is not the mean of its returns after its 1 learning episode(s): allowed "),
+        ({"mean_return_after_learning": "nan"}, "mean_return_after_learning = 'nan' is not the mean of its returns"),
+        ({"mean_return_after_learning": -1e9}, "mean_return_after_learning = -1000000000.0 is not the mean of its returns"),
+        ({"learning_episodes": 2}, "learning_episodes = 2 is outside 0..1 (the episode from which its policy no longer changed)"),
+    ],
+)
+def test_a_mean_after_learning_that_contradicts_the_returns_is_refused(tiny: Path, tmp_path: Path, cli: CliRun, changes: dict, says: str) -> None:
+    """T22-06: a mean return after learning of NaN (printed as bare NaN by results --format json, shown n/a by report)
+    or -1e9, contradicting the returns after the learning episodes, was accepted; now it must be their mean."""
+    store = _edited(tiny, tmp_path / "s.sqlite", **changes)
+    message = _refused(store, says)
+    sound = _stored(tiny)
+    assert sound["learning_episodes"] == 1 and sound["mean_return_after_learning"] == sound["returns"][1]  # what the edits contradict
+    assert "learning_episodes" in changes or message.endswith(f"allowed {sound['returns'][1]!r}"), message
+    rc, out, err = cli("results", "tr1", "--store", str(store), "--format", "json")
+    assert rc == 2 and out == "" and err.strip() == f"neurohover results: error: {message}", err

@@ -59,6 +59,20 @@ def run_inconsistency(run: TestRunResult) -> str:
             return f"{name} names episode {outside[0]!r}, outside 0..{n - 1}"
     if run.crash_steps is not None and len(run.crash_steps) != len(run.crash_episodes):
         return f"{len(run.crash_steps)} crash steps for {len(run.crash_episodes)} crash episodes"
-    if not 0 <= run.learning_episodes <= n:
-        return f"learning_episodes {run.learning_episodes!r} is outside 0..{n}"
+    return _after_learning_problem(run)
+
+
+def _after_learning_problem(run: TestRunResult) -> str:
+    """'' when the run's learning episodes are among its episodes (the episode from which its policy no longer changed)
+    and its mean return after learning is the mean of its returns from there; else what contradicts them (a NaN or -1e9
+    mean was exported, printed as bare NaN in JSON; T22-06)."""
+    n, start = len(run.returns), run.learning_episodes
+    if not 0 <= start < n:
+        return f"learning_episodes = {start!r} is outside 0..{n - 1} (the episode from which its policy no longer changed)"
+    mean = math.fsum(float(r) for r in run.returns[start:]) / (n - start)
+    if not math.isclose(float(run.mean_return_after_learning), mean, rel_tol=1e-9, abs_tol=1e-6):
+        return (
+            f"mean_return_after_learning = {brief(run.mean_return_after_learning)} is not the mean of its returns after its "
+            f"{start} learning episode(s): allowed {mean!r}"
+        )
     return ""
