@@ -105,3 +105,34 @@ def test_a_mean_after_learning_that_contradicts_the_returns_is_refused(tiny: Pat
     assert "learning_episodes" in changes or message.endswith(f"allowed {sound['returns'][1]!r}"), message
     rc, out, err = cli("results", "tr1", "--store", str(store), "--format", "json")
     assert rc == 2 and out == "" and err.strip() == f"neurohover results: error: {message}", err
+
+
+@pytest.mark.parametrize(
+    ("changes", "says"),
+    [
+        (
+            {"crash_episodes": [1, 1], "crash_steps": [5, -3]},
+            "test run of model-free on ghh08/test:0 is inconsistent: crash_episodes = [1, 1] is not allowed: each episode of 0..1 at most once, in order",
+        ),
+        ({"crash_episodes": [1, 0], "crash_steps": [5, 6]}, "crash_episodes = [1, 0] is not allowed: each episode of 0..1 at most once, in order"),
+        ({"safeguard_episodes": [0, 0]}, "safeguard_episodes = [0, 0] is not allowed: each episode of 0..1 at most once, in order"),
+        ({"crash_episodes": [0, 1], "crash_steps": [5, -3]}, "crash_steps[1] = -3 is not allowed: a crash ends its episode at control step 1 or later"),
+        ({"crash_episodes": [1], "crash_steps": [0]}, "crash_steps[0] = 0 is not allowed"),
+        (
+            {"crash_episodes": [1], "crash_steps": [999999]},
+            "its result contradicts its params: crash_steps[0] = 999999 is not allowed: its unit's episodes are 20 control steps long: allowed 1..20",
+        ),
+    ],
+)
+def test_crashes_named_twice_or_at_steps_no_episode_has_are_refused(tiny: Path, tmp_path: Path, cli: CliRun, changes: dict, says: str) -> None:
+    """T22-07: crash_episodes [1, 1] with crash_steps [5, -3] were counted as two crashes of the run, a crash step 999999
+    of a 20-step episode accepted; now crash (and safeguard) episodes are each named once, in order, and a crash step is
+    one of its unit's episodes' control steps (the kernel counts them from 1; a crash on the last one is one)."""
+    _refused_by_results(cli, _edited(tiny, tmp_path / "s.sqlite", **changes), says)
+
+
+def test_a_crash_on_an_episodes_last_step_is_taken(tiny: Path, tmp_path: Path) -> None:
+    """T22-07: the bound is the kernel's: a crash at control step n_steps (20) is one a run records."""
+    store = _edited(tiny, tmp_path / "s.sqlite", crash_episodes=[0, 1], crash_steps=[20, 1])
+    with Store(store, create=False) as held:
+        assert checked_units(held, "tr1", "quick")[2][RUN].crash_steps == (20, 1)

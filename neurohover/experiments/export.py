@@ -21,6 +21,7 @@ from ..errors import NeurohoverError, brief, first_difference
 from .config import ExperimentConfig
 from .keys import UnitKey
 from .plans import external_digest, plan, run_keys, source_experiments
+from .result_checks import params_problem
 from .results import UnitResult, check_run_lengths, flat_cells, result_from_dict
 from .store import Store
 
@@ -195,6 +196,9 @@ def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig
     for u in units:
         try:
             results[u["key"]] = result_from_dict(u["kind"], u["result"], u["key"])
+            problem = params_problem(results[u["key"]], u["params"])  # a result must be its unit's (T22-07)
+            if problem:
+                raise NeurohoverError(f"its result contradicts its params: {problem}")
             _check_key(config, u)
         except NeurohoverError as err:
             unit = "" if repr(u["key"]) in str(err) else f"unit {u['key']!r}: "

@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
-from ..errors import brief
+from ..errors import brief, whole_number
 from ..sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS
 
 if TYPE_CHECKING:
@@ -54,11 +54,17 @@ def run_inconsistency(run: TestRunResult) -> str:
             allowed = f"allowed a finite number in [{-WORST_RETURN:.3g}, 0] (every reward is minus a sum of squares)"
             return f"returns[{i}] = {brief(r)} is no episode's return: {allowed}"
     for name in ("crash_episodes", "safeguard_episodes"):
-        outside = [e for e in getattr(run, name) if not 0 <= e < n]
+        episodes = getattr(run, name)
+        outside = [e for e in episodes if not 0 <= e < n]
         if outside:
             return f"{name} names episode {outside[0]!r}, outside 0..{n - 1}"
+        if list(episodes) != sorted(set(episodes)):  # [1, 1] was counted as two crashes (T22-07)
+            return f"{name} = {brief(list(episodes))} is not allowed: each episode of 0..{n - 1} at most once, in order"
     if run.crash_steps is not None and len(run.crash_steps) != len(run.crash_episodes):
         return f"{len(run.crash_steps)} crash steps for {len(run.crash_episodes)} crash episodes"
+    for i, step in enumerate(run.crash_steps or ()):
+        if step < 1:  # the kernel counts the crashing control step from 1 (its unit's params bound it: params_problem)
+            return f"crash_steps[{i}] = {step!r} is not allowed: a crash ends its episode at control step 1 or later"
     return _after_learning_problem(run)
 
 
@@ -75,4 +81,20 @@ def _after_learning_problem(run: TestRunResult) -> str:
             f"mean_return_after_learning = {brief(run.mean_return_after_learning)} is not the mean of its returns after its "
             f"{start} learning episode(s): allowed {mean!r}"
         )
+    return ""
+
+
+def params_problem(result: Any, params: Any) -> str:
+    """What in a stored unit's ``result`` contradicts the unit's own ``params`` ('' when nothing does, or when they
+    are not those of a test run: the plan check names damaged params): a crash at a step past its episodes' ``n_steps``
+    (999999 of 20 was reported; T22-07)."""
+    from .results import TestRunResult
+
+    if not (isinstance(result, TestRunResult) and isinstance(params, dict)):
+        return ""
+    n_steps = params.get("n_steps")
+    if whole_number(n_steps):
+        for i, step in enumerate(result.crash_steps or ()):
+            if not 1 <= step <= n_steps:
+                return f"crash_steps[{i}] = {step!r} is not allowed: its unit's episodes are {n_steps} control steps long: allowed 1..{n_steps}"
     return ""
