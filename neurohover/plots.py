@@ -371,6 +371,10 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
                     crashed, steps = int(row.get("crashed") or 0), int(row["steps"]) if row.get("steps") else None
                 except (TypeError, ValueError):
                     raise NeurohoverError(f"--compete {str(csv_path)!r}, line {line}: run, episode, return, crashed and steps must be numbers") from None
+                if crashed not in (0, 1):  # -1 was counted as -1 crashes, in the legend too (T22-03)
+                    raise NeurohoverError(
+                        f"--compete {str(csv_path)!r}, line {line}: crashed {row['crashed']!r:.30} is not allowed: 0 or 1 (whether the episode crashed)"
+                    )
                 if not (math.isfinite(ret) and -WORST_RETURN <= ret <= 0):  # -1e308 overflowed the plot (eighth trial); every reward is <= 0 (ninth)
                     raise NeurohoverError(
                         f"--compete {str(csv_path)!r}, line {line}: return {row['return']!r:.30} is not an episode's "

@@ -4,6 +4,7 @@ uncrashed episode shorter than its budget (T22-01), a NaN reading named by learn
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -108,3 +109,40 @@ def test_transitions_name_a_non_finite_reading_and_drop_a_crashed_episodes_last_
     short[1][-1] = np.nan
     tr = Transitions(FlightData((obs[0], obs[1][:21]), short, {"episode_steps": 30, "crashed": [False, True]}))
     assert tr.n == 30 + 19 and np.isfinite(tr.act).all() and tr.n_episodes == 2
+
+
+def _competition(folder: Path, rows: str, **summary: object) -> Path:
+    """A compete output directory as ``compete --task ghh08 --agent baseline --runs 2 --episodes 2 --episode-steps 20``
+    writes one (its crash figures left out of the summary, as a hand edit may), with the episodes.csv rows given."""
+    folder.mkdir()
+    (folder / "episodes.csv").write_text("run,mdp,episode,return,crashed,steps,policy,safeguard_fired\n" + rows)
+    base = {"task": "ghh08", "agent": "baseline", "mdps": "test", "episode_steps": 20, "sigma": None, "sensor": None, "drift": None, "runs": 2}
+    (folder / "summary.json").write_text(json.dumps({**base, "experiment": "compete-ghh08-baseline", "episodes": 2, **summary}))
+    return folder
+
+
+ROWS = ["0,ghh08/test:0,0,-58.5,0,20,baseline,0", "0,ghh08/test:0,1,-66.4,0,20,baseline,0", "1,ghh08/test:1,0,-35.4,0,20,baseline,0"]
+ROWS += ["1,ghh08/test:1,1,-49.2,0,20,baseline,0"]
+
+
+def _rows(line: int = 0, value: str = "", column: int = 0) -> str:
+    """The four rows of :data:`ROWS`, row ``line`` (2: the first) with ``column`` set to ``value``."""
+    rows = [r.split(",") for r in ROWS]
+    if line:
+        rows[line - 2][column] = value
+    return "".join(",".join(r) + "\n" for r in rows)
+
+
+@pytest.mark.parametrize("value", ["-1", "5"])
+def test_a_compete_crash_flag_other_than_0_or_1_is_refused_with_its_line(tmp_path: Path, cli, value: str) -> None:
+    """T22-03: episodes.csv line 2's crashed set to -1 (the summary's crash figures removed) was plotted as "-1 crashes"
+    and read as CompeteResult.crashes == -1; now refused, naming the line and the value, status 2 on the command line."""
+    from neurohover.plots import read_compete_dir
+
+    assert read_compete_dir(_competition(tmp_path / "ok", _rows())).crashes == 0
+    folder = _competition(tmp_path / "c1", _rows(2, value, 4))
+    message = f"--compete '{folder / 'episodes.csv'}', line 2: crashed '{value}' is not allowed: 0 or 1 (whether the episode crashed)"
+    with pytest.raises(NeurohoverError, match=f"^{re.escape(message)}$"):
+        read_compete_dir(folder)
+    rc, out, err = cli("plot", "--compete", str(folder), "--out", str(tmp_path / "p"))
+    assert rc == 2 and "Traceback" not in err and message in err and out == "", err
