@@ -136,3 +136,37 @@ def test_a_crash_on_an_episodes_last_step_is_taken(tiny: Path, tmp_path: Path) -
     store = _edited(tiny, tmp_path / "s.sqlite", crash_episodes=[0, 1], crash_steps=[20, 1])
     with Store(store, create=False) as held:
         assert checked_units(held, "tr1", "quick")[2][RUN].crash_steps == (20, 1)
+
+
+@pytest.mark.parametrize(
+    ("changes", "says"),
+    [
+        (
+            {"agent": "baseline"},
+            "its result contradicts its params: agent = 'baseline' is not allowed: its unit's params.agent is 'model-free', and a result must be its unit's",
+        ),
+        ({"mdp": "ghh09/test:7"}, "mdp = 'ghh09/test:7' is not allowed: its unit's params.mdp.label is 'ghh08/test:0', and a result must be its unit's"),
+    ],
+)
+def test_a_result_that_contradicts_its_units_params_is_refused(tiny: Path, tmp_path: Path, cli: CliRun, changes: dict, says: str) -> None:
+    """T22-08: a run whose key and params say model-free on ghh08/test:0 holding agent 'baseline' and mdp 'ghh09/test:7'
+    was exported (group model-free, result.agent baseline), counted by wins and reported; now the result must be its unit's."""
+    store = _edited(tiny, tmp_path / "s.sqlite", **changes)
+    _refused_by_results(cli, store, says)
+    rc, out, err = cli("wins", "tr1", "--store", str(store), "--runs", "1", "--draws", "10")
+    assert rc == 2 and says in err, err
+
+
+def test_a_model_result_that_contradicts_its_units_params_is_refused() -> None:
+    """T22-08: the same rule for a model unit's method and MDP (checked_units calls it for every unit)."""
+    from neurohover.experiments.result_checks import params_problem
+    from neurohover.experiments.results import ModelResult, ModelTiming
+
+    model = ModelResult(
+        method="lr", mdp="ghh08/test:0", generic_return=-1.0, generic_crashed=False, model_params=(), model_noise_std=(), predicted_return=-1.0,
+        test_returns=(-1.0,), test_mean=-1.0, test_crashes=0, policy_episodes=1, timing=ModelTiming(learn_seconds=0.0, evolve_seconds=0.0),
+    )  # fmt: skip
+    params = {"method": "lr", "mdp": {"label": "ghh08/test:0"}}
+    assert params_problem(model, params) == ""
+    assert params_problem(model, {**params, "method": "ec-mer"}).startswith("method = 'lr' is not allowed: its unit's params.method is 'ec-mer'")
+    assert "mdp = 'ghh08/test:0' is not allowed: its unit's params.mdp.label is 'x'" in params_problem(model, {**params, "mdp": {"label": "x"}})

@@ -196,7 +196,7 @@ def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig
     for u in units:
         try:
             results[u["key"]] = result_from_dict(u["kind"], u["result"], u["key"])
-            problem = params_problem(results[u["key"]], u["params"])  # a result must be its unit's (T22-07)
+            problem = params_problem(results[u["key"]], u["params"])  # a result must be its unit's (T22-07, T22-08)
             if problem:
                 raise NeurohoverError(f"its result contradicts its params: {problem}")
             _check_key(config, u)

@@ -84,16 +84,30 @@ def _after_learning_problem(run: TestRunResult) -> str:
     return ""
 
 
-def params_problem(result: Any, params: Any) -> str:
-    """What in a stored unit's ``result`` contradicts the unit's own ``params`` ('' when nothing does, or when they
-    are not those of a test run: the plan check names damaged params): a crash at a step past its episodes' ``n_steps``
-    (999999 of 20 was reported; T22-07)."""
-    from .results import TestRunResult
+def _params_says(params: dict, name: str) -> Any:
+    """What a unit's params say its result's ``name`` is (the MDP: its table's label; None where they do not say)."""
+    if name == "mdp":
+        mdp = params.get("mdp")
+        return mdp.get("label") if isinstance(mdp, dict) else None
+    return params.get(name)
 
-    if not (isinstance(result, TestRunResult) and isinstance(params, dict)):
+
+def params_problem(result: Any, params: Any) -> str:
+    """What in a stored unit's ``result`` contradicts the unit's own ``params`` ('' when nothing does; params of another
+    shape are the plan check's to name): a test run's agent or MDP, or a model's method or MDP, other than its params
+    say (a run of model-free on ghh08/test:0 holding agent 'baseline' and mdp 'ghh09/test:7' was exported; T22-08), or a
+    crash at a step past its episodes' ``n_steps`` (999999 of 20 was reported; T22-07)."""
+    from .results import ModelResult, TestRunResult
+
+    if not (isinstance(result, (TestRunResult, ModelResult)) and isinstance(params, dict)):
         return ""
+    for name in ("agent", "mdp") if isinstance(result, TestRunResult) else ("method", "mdp"):
+        says = _params_says(params, name)
+        if isinstance(says, str) and getattr(result, name) != says:
+            where = "params.mdp.label" if name == "mdp" else f"params.{name}"
+            return f"{name} = {brief(getattr(result, name))} is not allowed: its unit's {where} is {brief(says)}, and a result must be its unit's"
     n_steps = params.get("n_steps")
-    if whole_number(n_steps):
+    if isinstance(result, TestRunResult) and whole_number(n_steps):
         for i, step in enumerate(result.crash_steps or ()):
             if not 1 <= step <= n_steps:
                 return f"crash_steps[{i}] = {step!r} is not allowed: its unit's episodes are {n_steps} control steps long: allowed 1..{n_steps}"
