@@ -100,3 +100,109 @@ def _square(values: object, name: str) -> np.ndarray:
         shape = f"of shape {array.shape}" if array is not None else brief(values)
         raise NeurohoverError(f"{name} {shape} is not allowed: give a (P, P) array of numbers, P >= 2 (policy i on training MDP j)")
     return array
+
+
+#: The keys of a GHH-08/09 set's manifest only (its specialised policies' figures), and of an FGHH set's only (its
+#: generics over G): a build writes each into its own kind's manifest, and the other kind's set has no use for them.
+GHH_ONLY = ("lineage", "safe", "safety_episodes", "crashes_on_training_mdps", "mean_return_on_training_mdps", "table3")
+FGHH_ONLY = ("sigma", "fghh_budget")
+
+#: How far a manifest's figures may stray from those its tables give: its mean returns are rounded to 0.01 (T22-16).
+_ROUNDING = 0.02
+
+
+def check_kind_keys(manifest: dict, path: Path, fghh: bool) -> None:
+    """Refuse the other kind of set's keys by name: an FGHH manifest's tables of crashes and returns were accepted and
+    never read (T22-16)."""
+    given = [key for key in (GHH_ONLY if fghh else FGHH_ONLY) if key in manifest]
+    if given:
+        what = "a GHH-08/09 set's specialised policies (an FGHH set has none)" if fghh else "an FGHH set's generics over G"
+        raise NeurohoverError(f"policy-set manifest {str(path)!r} has {', '.join(given)}: they apply to {what}; remove them")
+
+
+def check_ghh_manifest(manifest: dict, path: Path, n_policies: int, n_mdps: int) -> tuple[int, ...]:
+    """The safe specialised policies a GHH set's manifest lists, its tables checked, and checked against each other: the
+    safe list against the paper's rule (:func:`choose_safe`) on them, the crash counts against ``safety_episodes`` and
+    ``table3`` against both (a safe policy that crashed 3 times on another training MDP was flown as safe; T22-16)."""
+    where = f"policy-set manifest {str(path)!r}"
+    safe = manifest.get("safe", [])
+    if (
+        not isinstance(safe, list)
+        or not all(type(i) is int and 0 <= i < n_policies for i in safe)  # "x" was a TypeError (fifth trial)
+        or len(set(safe)) != len(safe)  # [6, 6]: one policy flown as both safe ones (sixth trial)
+    ):
+        raise NeurohoverError(
+            f"{where}: safe={safe!r:.60} is not allowed: give a list of the safe specialised policies' distinct indices, each in 0..{n_policies - 1}"
+        )
+    _check_tables(manifest, path, n_policies, n_mdps)
+    crashes, returns = manifest.get("crashes_on_training_mdps"), manifest.get("mean_return_on_training_mdps")
+    episodes = manifest.get("safety_episodes")
+    if crashes is not None and episodes is not None:
+        over = next(((i, j) for i, row in enumerate(crashes) for j, c in enumerate(row) if c > episodes), None)
+        if over is not None:
+            i, j = over
+            raise NeurohoverError(
+                f"{where}: crashes_on_training_mdps[{i}][{j}] = {crashes[i][j]} is more than safety_episodes = {episodes}, the episodes "
+                f"each specialised policy flew on each training MDP"
+            )
+    if crashes is not None and safe:
+        _check_safe(safe, np.array(crashes, dtype=float), None if returns is None else np.array(returns, dtype=float), where, path.parent.name)
+    _check_table3(manifest.get("table3"), crashes, returns, where)
+    return tuple(safe)
+
+
+def _check_safe(safe: list[int], crashes: np.ndarray, returns: np.ndarray | None, where: str, task: str) -> None:
+    """Refuse a safe policy the paper's rule would not choose from the manifest's own tables: one that crashed on the other
+    training MDPs more often than a policy not listed, or (as rarely) returned less there, beyond rounding."""
+    others = ~np.eye(crashes.shape[0], crashes.shape[1], dtype=bool)
+    crash_others = np.where(others, crashes, 0).sum(axis=1)
+    unlisted = [i for i in range(len(crashes)) if i not in safe]
+    rule = (
+        "safe policies are those that never crashed on the other training MDPs, the ones with the best mean return there "
+        "when more qualify and the fewest crashes there when fewer do: give safe policies the tables agree with, or rebuild "
+        f"the set (neurohover build-policies --task {task})"
+    )
+    for s in safe:
+        better = [u for u in unlisted if crash_others[u] < crash_others[s]]
+        if better:
+            j = next(j for j in range(crashes.shape[1]) if j != s and crashes[s, j] > 0)
+            raise NeurohoverError(
+                f"{where}: safe lists specialised policy {s}, but crashes_on_training_mdps[{s}][{j}] = {int(crashes[s, j])}: it crashed "
+                f"in {int(crashes[s, j])} episodes on training MDP {j} ({int(crash_others[s])} on the other training MDPs in all), while "
+                f"policy {better[0]}, not listed, crashed in {int(crash_others[better[0]])} there; {rule}"
+            )
+        if returns is None:
+            continue
+        mean = np.array([returns[i][others[i]].mean() for i in range(len(returns))])
+        better = [u for u in unlisted if crash_others[u] == crash_others[s] and mean[u] > mean[s] + _ROUNDING]
+        if better:
+            best = max(better, key=lambda u: mean[u])
+            raise NeurohoverError(
+                f"{where}: safe lists specialised policy {s}, whose mean return on the other training MDPs is {mean[s]:.2f}, but not "
+                f"policy {best}, which crashed there as rarely ({int(crash_others[s])} episodes) and returned {mean[best]:.2f}; {rule}"
+            )
+
+
+def _check_table3(table3: object, crashes: list | None, returns: list | None, where: str) -> None:
+    """Refuse a ``table3`` that is no table of Table 3's figures, or whose figures its manifest's tables do not give."""
+    if table3 is None:
+        return
+    if (
+        not isinstance(table3, dict)
+        or set(table3) != {"r", "r_G", "crashed_episodes"}
+        or not (finite_real(table3["r"]) and finite_real(table3["r_G"]) and _count(table3["crashed_episodes"]))
+    ):
+        raise NeurohoverError(
+            f"{where}: table3={brief(table3)} is not allowed: give a table of r and r_G (finite numbers: mean returns on the own "
+            "and on all training MDPs) and crashed_episodes (a whole number >= 0)"
+        )
+    given = table3_summary(np.array(crashes if crashes is not None else [[0]]), np.array(returns if returns is not None else [[0.0]]))
+    for name, table in (("crashed_episodes", crashes), ("r", returns), ("r_G", returns)):
+        if table is not None and abs(table3[name] - given[name]) > (0 if name == "crashed_episodes" else _ROUNDING):
+            source = "crashes_on_training_mdps" if name == "crashed_episodes" else "mean_return_on_training_mdps"
+            raise NeurohoverError(f"{where}: table3's {name} = {brief(table3[name])} is not what {source} gives ({given[name]})")
+
+
+def _count(value: object) -> bool:
+    """Whether ``value`` is a whole number >= 0 (a count of crashed episodes)."""
+    return whole_number(value) and value >= 0

@@ -5,7 +5,11 @@ A policy set is a directory ``<task>/`` holding JSON policy files and a ``manife
 - GHH-08 and GHH-09: ``generic.json`` (evolved on the zero setting) and ``specialised_<i>.json``
   (evolved on training MDP i, i = 0..9). The manifest lists the two ``safe`` specialised policies
   for the hybrid agent, computed by the paper's rule: policies that never crashed on the other
-  training MDPs (the two with the best mean return there when more qualify).
+  training MDPs (the two with the best mean return there when more qualify). It also holds the
+  table of crashed episodes (``crashes_on_training_mdps``, of ``safety_episodes`` per cell) and of
+  mean returns (``mean_return_on_training_mdps``) of every specialised policy on every training MDP
+  that the rule was applied to, and Table 3's figures of them (``table3``): a manifest whose safe
+  list, counts or figures contradict its tables is refused (:mod:`neurohover.manifest`).
 
   **Lineage.** By default (``lineage="chain"``) every run is seeded from one *ancestor*, and the
   ancestor is itself a chain of runs from the baseline policy over the training MDPs in turn (run
@@ -19,7 +23,9 @@ A policy set is a directory ``<task>/`` holding JSON policy files and a ``manife
   Every run uses the paper's operators and settings. ``lineage="independent"`` seeds every run from
   the baseline policy, as the paper's text reads.
 - FGHH (sigma 0.3): ``generic_zero.json`` (evolved on the zero setting), ``generic_fixed.json``
-  (fixed resampling over G) and ``generic_race.json`` (selection races over G).
+  (fixed resampling over G) and ``generic_race.json`` (selection races over G). Its manifest holds
+  none of the GHH keys above (it has no specialised policies), and a GHH manifest none of its
+  ``sigma`` and ``fghh_budget``: each is refused by name.
 
 The shipped sets live in ``neurohover/data/policies``; ``neurohover build-policies`` rebuilds them
 with the project's own evolution (or writes a set elsewhere with ``--out``).
@@ -40,7 +46,7 @@ import numpy as np
 
 from .errors import NeurohoverError, brief, whole_number
 from .evaluate import MAX_EPISODES_PER_CALL, evaluate
-from .manifest import LINEAGES, _check_manifest_fields, _check_tables, choose_safe, table3_summary
+from .manifest import LINEAGES, _check_manifest_fields, check_ghh_manifest, check_kind_keys, choose_safe, table3_summary
 from .paths import JSONError, strict_json, writing
 from .policies import Policy, load_policy, save_policy, utf8_text
 from .sim.constants import MAX_EPISODE_STEPS
@@ -176,6 +182,7 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
     if manifest.get("task", family.name) != family.name:  # another task's set copied under this name: its policies fly the wrong task
         raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r} is of task {manifest['task']!r}, not {family.name!r}")
     _check_manifest_fields(manifest, manifest_path)
+    check_kind_keys(manifest, manifest_path, family.generic_over_distribution)
     targets = {"zero": family.zero().label, "family": f"{family.name}/G"}  # what each role's run evolved on
     if family.generic_over_distribution:
         roles = {role.kind: role.target for role in policy_set_roles(family)}
@@ -184,18 +191,8 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
     generic = _load(root / "generic.json", "the generic policy", family.name, targets["zero"])
     train = family.training_mdps()
     specialised = tuple(_load(root / f"specialised_{i}.json", f"specialised policy {i}", family.name, train[i].label) for i in range(10))
-    safe = manifest.get("safe", [])
-    if (
-        not isinstance(safe, list)
-        or not all(type(i) is int and 0 <= i < len(specialised) for i in safe)  # "x" was a TypeError (fifth trial)
-        or len(set(safe)) != len(safe)  # [6, 6]: one policy flown as both safe ones (sixth trial)
-    ):
-        raise NeurohoverError(
-            f"policy-set manifest {str(manifest_path)!r}: safe={safe!r:.60} is not allowed: give a list of the safe specialised "
-            f"policies' distinct indices, each in 0..{len(specialised) - 1}"
-        )
-    _check_tables(manifest, manifest_path, len(specialised), len(train))
-    return PolicySet(family.name, root, generic, specialised, tuple(safe), manifest=manifest)
+    safe = check_ghh_manifest(manifest, manifest_path, len(specialised), len(train))
+    return PolicySet(family.name, root, generic, specialised, safe, manifest=manifest)
 
 
 def crash_matrix(policies: list[Policy], mdps: list, episodes: int, seed: int, n_steps: int = 6000) -> tuple[np.ndarray, np.ndarray]:

@@ -1,8 +1,13 @@
 """The twenty-second bad-input trial's findings in experiment settings and policy-set manifests: a bad
 ``generic_resampling`` is named by its key and value with the resampling parser's own message, and ``{}`` is refused
-(T22-15)."""
+(T22-15). A policy-set manifest whose safe list, crash counts or Table 3 figures contradict its own tables is refused,
+and an FGHH manifest's GHH tables (accepted and never read) too (T22-16)."""
 
 from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
 
 import pytest
 
@@ -42,3 +47,75 @@ def test_a_good_generic_resampling_is_kept() -> None:
 
     cfg = load_config("fig16", "quick", {"generic_resampling": {"race": "race:0.3"}})
     assert cfg.settings["generic_resampling"] == {"race": "race:0.3"}
+
+
+def _set(tmp_path: Path, task: str, change) -> Path:
+    """A copy of the shipped ``task`` set under ``tmp_path/pd`` whose manifest ``change`` (a function of the dict) edited."""
+    from neurohover.policysets import SHIPPED
+
+    shutil.copytree(SHIPPED / task, tmp_path / "pd" / task)
+    path = tmp_path / "pd" / task / "manifest.json"
+    manifest = json.loads(path.read_text())
+    change(manifest)
+    path.write_text(json.dumps(manifest))
+    return tmp_path / "pd"
+
+
+def _cell(name: str, i: int, j: int, value):
+    return lambda m: m[name][i].__setitem__(j, value)
+
+
+@pytest.mark.parametrize(
+    ("task", "change", "message"),
+    [
+        (  # as found: policy 6 is listed as safe
+            "ghh08",
+            _cell("crashes_on_training_mdps", 6, 0, 3),
+            r"safe lists specialised policy 6, but crashes_on_training_mdps\[6\]\[0\] = 3: it crashed in 3 episodes on training MDP 0 "
+            r"\(3 on the other training MDPs in all\), while policy 0, not listed, crashed in 0 there; safe policies are those that never",
+        ),
+        (
+            "ghh08",
+            lambda m: m.__setitem__("safe", [6, 7]),
+            r"safe lists specialised policy 7, whose mean return on the other training MDPs is -3313\.48, but not policy 2, which "
+            r"crashed there as rarely \(0 episodes\) and returned -828\.70",
+        ),
+        ("ghh08", _cell("crashes_on_training_mdps", 0, 0, 4), r"crashes_on_training_mdps\[0\]\[0\] = 4 is more than safety_episodes = 3"),
+        ("ghh08", _cell("crashes_on_training_mdps", 0, 0, 1), r"table3's crashed_episodes = 0 is not what crashes_on_training_mdps gives \(1\)"),
+        ("ghh08", lambda m: m["table3"].__setitem__("r_G", -2001.89), r"table3's r_G = -2001\.89 is not what mean_return_on_training_mdps gives \(-1204\.34\)"),
+        ("ghh08", lambda m: m.__setitem__("table3", "x"), r"table3='x' is not allowed: give a table of r and r_G"),
+        ("ghh08", lambda m: m.__setitem__("fghh_budget", 10), r"has fghh_budget: they apply to an FGHH set's generics over G; remove them"),
+        (
+            "fghh",
+            lambda m: m.__setitem__("crashes_on_training_mdps", [[3]]),
+            r"has crashes_on_training_mdps: they apply to a GHH-08/09 set's specialised policies \(an FGHH set has none\)",
+        ),
+    ],
+)
+def test_a_manifest_that_contradicts_itself_is_refused(tmp_path: Path, task: str, change, message: str) -> None:
+    """T22-16: a safe policy with crashes on another training MDP (where policies without any were not listed) was flown
+    as safe; Table 3's figures and the crash counts were never compared with the tables; an FGHH manifest's GHH tables were
+    accepted and ignored."""
+    from neurohover.policysets import load_policy_set
+
+    pd = _set(tmp_path, task, change)
+    with pytest.raises(NeurohoverError, match=message):
+        load_policy_set(task, pd)
+
+
+def test_a_safe_policy_that_crashed_on_the_command_line_is_one_line_and_status_2(cli, tmp_path: Path) -> None:
+    """T22-16 as found: compete --agent hybrid --policy-dir with such a set ran (status 0)."""
+    pd = _set(tmp_path, "ghh08", _cell("crashes_on_training_mdps", 6, 0, 3))
+    argv = ["compete", "--task", "ghh08", "--agent", "hybrid", "--runs", "1", "--episodes", "2", "--episode-steps", "20"]
+    rc, _, err = cli(*argv, "--policy-dir", str(pd), "--out", str(tmp_path / "X"))
+    assert rc == 2 and "Traceback" not in err
+    assert "safe lists specialised policy 6, but crashes_on_training_mdps[6][0] = 3" in err
+
+
+def test_the_shipped_manifests_and_safe_lists_in_another_order_are_taken(tmp_path: Path) -> None:
+    """The rule's checks take what a build writes (its returns rounded to 0.01) and the safe policies in either order."""
+    from neurohover.policysets import load_policy_set
+
+    for task in ("ghh08", "ghh09", "fghh"):
+        load_policy_set(task)
+    assert load_policy_set("ghh08", _set(tmp_path, "ghh08", lambda m: m.__setitem__("safe", [2, 6]))).safe == (2, 6)
