@@ -145,3 +145,46 @@ def test_a_history_whose_last_row_is_not_the_champions_is_refused(which: str, ti
         f"history is not the champion's: its last row's champion_return is -12345.5 where the run's champion (at generation {generation}) has return {last!r}"
     )
     _resume_damaged(source, tmp_path, lambda s: s["history"][-1].__setitem__(4, -12345.5), target, run, fragment)
+
+
+# --------------------------------------------------------------------------- T22-10: a champion table the run keeps none in
+
+
+def test_a_champion_table_of_a_steady_state_run_is_refused_on_the_command_line(tiny_checkpoint: Path, tmp_path: Path, cli) -> None:
+    """T22-10: a steady-state checkpoint's champion {genome: 42 zeros, return: 0.0} (the run writes null and '-inf':
+    its champion is its optimiser's) was accepted and ignored (exit 0); now it is refused as damaged, naming the
+    optimiser's champion, with exit status 2 and no traceback."""
+    state = json.loads(tiny_checkpoint.read_text())
+    assert state["champion"] == {"genome": None, "return": "-inf"}
+    state["champion"] = {"genome": [0.0] * len(state["config"]["prototype"]), "return": 0.0}
+    (tmp_path / "run.json.checkpoint.json").write_text(json.dumps(state))
+    rc, _, err = cli(*CLI_RUN, "--budget", "60", "--out", str(tmp_path / "run.json"), "--resume")
+    assert rc == 2 and "Traceback" not in err, err
+    champion = state["history"][-1][4]
+    assert (
+        "is a damaged checkpoint: the champion table holds a genome and return 0.0 where a steady-state run keeps none (allowed genome null and"
+        f" return '-inf'): its champion is its optimiser's, in optimizer_state (return {champion!r})" in " ".join(err.split())
+    )
+
+
+@pytest.mark.parametrize("which", ["steady-state", "generational"])
+def test_a_champion_genome_beside_the_optimisers_is_refused(which: str, tiny_checkpoint: Path, family_checkpoints, tmp_path: Path) -> None:
+    """T22-10: steady-state and generational runs keep their champion in the optimiser state; a genome in the
+    checkpoint's champion table (with '-inf' as its return too) is refused."""
+    source, target, run = _runs(which, tiny_checkpoint, family_checkpoints)
+    size = len(json.loads(source.read_text())["config"]["prototype"])
+    fragment = f"the champion table holds a genome and return '-inf' where a {which} run keeps none (allowed genome null and return '-inf')"
+    _resume_damaged(source, tmp_path, lambda s: s["champion"].update(genome=[0.0] * size), target, run, fragment)
+
+
+def test_a_population_optimiser_on_a_family_keeps_its_champion_in_the_table(family_checkpoints, tmp_path: Path) -> None:
+    """T22-10: CMA-ES on a family keeps the best of its last generation in the champion table: its genome is there once
+    a generation is flown, and its return is the last history row's (T22-11's check)."""
+    source = family_checkpoints["cma"]
+    state = json.loads(source.read_text())
+    assert state["champion"]["genome"] is not None and state["champion"]["return"] == state["history"][-1][4]
+    fragment = "the champion table holds no champion genome at generation 2: a population optimiser on a task family has one exactly once"
+    _resume_damaged(source, tmp_path, lambda s: s["champion"].update(genome=None, **{"return": "-inf"}), GHH08, CMA_RUN, fragment)
+    last = state["history"][-1][4]
+    fragment = f"history is not the champion's: its last row's champion_return is {last!r} where the run's champion (at generation 2) has return -5.5"
+    _resume_damaged(source, tmp_path, lambda s: s["champion"].update(**{"return": -5.5}), GHH08, CMA_RUN, fragment)

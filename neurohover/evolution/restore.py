@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..flyer import MAX_EPISODE_INDEX
-from .common import EntryError, Optimiser, check_entries, check_genomes, damage_text, dec_array, dec_float
+from .common import EntryError, Optimiser, check_entries, check_genomes, damage_text, dec_array, dec_float, enc_float
 from .config import MAX_BUDGET, Resampling
 from .fitness import ERROR_FLOOR
 from .generational import GenerationalNE
@@ -81,14 +81,36 @@ def _restored_parts(state: dict, run: Run, opt: Optimiser) -> dict[str, Any]:
     if kernel > wall:  # (each kernel call is timed inside the run's wall time; T21-03)
         raise EntryError(f"counter 'kernel_seconds' is {kernel!r}, more than the run's wall_seconds {wall!r} (its kernel time is part of them)")
     champion = _checked_champion(state["champion"], run.cfg.prototype.genome.size, run.fitness)
+    own = run.method in OPTIMISERS and run.family is not None
+    _check_run_champion(champion, own, counts["generation"], run.method, opt)
     race_delta = _checked_race_delta(state.get("race_delta", run.resampling.delta), run.resampling)  # absent before race:auto
     history = decode_history(state["history"])
     # Generational runs and population optimisers on a family record every generation; the others each new champion.
     # A population optimiser on a family keeps its champion (the best of the last generation) in the champion table;
     # every other run's is its optimiser's (Run._champion_return).
-    own = run.method in OPTIMISERS and run.family is not None
     check_history(history, counts, per_generation=run.method == "generational" or own, champion=champion[1] if own else float(opt.champion_return))
     return {"counters": counts, "seconds": seconds, "champion": champion, "history": history, "race_delta": race_delta}
+
+
+def _check_run_champion(champion: tuple[np.ndarray | None, float], own: bool, generation: int, method: str, opt: Optimiser) -> None:
+    """EntryError unless a checkpoint's ``champion`` table is what the run keeps in it: a population optimiser on a
+    family (``own``) its champion of the last generation (a genome once a generation is flown; its return is the last
+    history row's, :func:`~.records.check_history`); every other run none (genome null, return '-inf'), its champion
+    being its optimiser's, in the optimiser state. A zero genome of return 0.0 in a steady-state checkpoint was taken
+    and ignored (T22-10): the table is redundant with the history there and with the optimiser state elsewhere."""
+    genome, value = champion
+    if not own and (genome is not None or value != -math.inf):
+        held = f"{'a genome' if genome is not None else 'no genome'} and return {brief(enc_float(value))}"
+        raise EntryError(
+            f"the champion table holds {held} where a {method} run keeps none (allowed genome null and return '-inf'): its champion is its"
+            f" optimiser's, in optimizer_state (return {brief(enc_float(opt.champion_return))}); the table is a population optimiser's on a task family"
+        )
+    if own and (genome is None) != (generation == 0):
+        held = "no champion genome" if genome is None else "a champion genome"
+        raise EntryError(
+            f"the champion table holds {held} at generation {generation:,}: a population optimiser on a task family has one"
+            " exactly once it has flown a generation"
+        )
 
 
 def _checked_race_delta(delta: Any, resampling: Resampling) -> float | None:
