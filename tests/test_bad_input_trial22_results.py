@@ -170,3 +170,53 @@ def test_a_model_result_that_contradicts_its_units_params_is_refused() -> None:
     assert params_problem(model, params) == ""
     assert params_problem(model, {**params, "method": "ec-mer"}).startswith("method = 'lr' is not allowed: its unit's params.method is 'ec-mer'")
     assert "mdp = 'ghh08/test:0' is not allowed: its unit's params.mdp.label is 'x'" in params_problem(model, {**params, "mdp": {"label": "x"}})
+
+
+@pytest.mark.parametrize(
+    ("changes", "says"),
+    [
+        (
+            {"policy_changes": [[50, "x"], [-1, ""]]},
+            "inconsistent: policy_changes[0] = [50, 'x'] is not allowed: give [episode, policy name], its episodes among 0..1, in order, each once",
+        ),
+        ({"policy_changes": [[0, "a"], [-1, ""]]}, "policy_changes[1] = [-1, ''] is not allowed"),
+        ({"policy_changes": [[0, "a"], [0, "b"]]}, "policy_changes[1] = [0, 'b'] is not allowed"),
+        ({"policy_changes": [[0, "a"], [1, ""]]}, "policy_changes[1] = [1, ''] is not allowed"),
+        ({"policy_changes": [[0, 3]]}, "policy_changes[0] = [0, 3] is not allowed"),
+        ({"policy_changes": ["x"]}, "policy_changes[0] = 'x' is not allowed"),
+        ({"timing": {"seconds": -5, "offline_seconds": 0.0}}, "timing.seconds = -5 is not allowed: give a finite number of seconds >= 0"),
+        ({"timing": {"seconds": 1.0, "offline_seconds": "x"}}, "timing.offline_seconds = 'x' is not allowed: give a finite number of seconds >= 0"),
+    ],
+)
+def test_policy_changes_outside_the_run_and_negative_seconds_are_refused(tiny: Path, tmp_path: Path, cli: CliRun, changes: dict, says: str) -> None:
+    """T22-09: policy_changes [[50, 'x'], [-1, '']] of a run of episodes 0..2 and a timing of -5 seconds were accepted."""
+    _refused_by_results(cli, _edited(tiny, tmp_path / "s.sqlite", **changes), says)
+
+
+def test_an_experiment_created_at_no_number_is_named_as_damage(tiny: Path, tmp_path: Path, cli: CliRun) -> None:
+    """T22-09: experiments.created = 'yesterday' (the time that orders a store's experiments) was taken by results,
+    wins and report; the store now names it as damage where it reads it, and reproduce --fresh starts the experiment over."""
+    store = tmp_path / "s.sqlite"
+    shutil.copyfile(tiny, store)
+    with sqlite3.connect(store) as conn:
+        conn.execute("UPDATE experiments SET created = 'yesterday'")
+    conn.close()
+    says = (
+        f"results store {str(store)!r} is damaged: experiment 'tr1' ('quick')'s created time 'yesterday' is no number: allowed seconds "
+        "since 1970 (give another --store file, or reproduce --fresh to start it over)"
+    )
+    with Store(store, create=False) as held, pytest.raises(NeurohoverError) as caught:
+        held.experiments()
+    assert str(caught.value) == says
+    for argv, command in ((("results", "tr1"), "results"), (("wins", "tr1", "--runs", "1", "--draws", "10"), "wins")):
+        rc, out, err = cli(*argv, "--store", str(store))
+        assert rc == 2 and out == "" and err.strip() == f"neurohover {command}: error: {says}", err
+    rc, out, err = cli("report", "--store", str(store), "--out", str(tmp_path / "r"))
+    assert rc == 2 and says in err and not (tmp_path / "r").exists(), err
+    config = tmp_path / "tr1.toml"
+    config.write_text(tiny_test_runs("model-free"))
+    rc, out, err = cli("reproduce", str(config), "--store", str(store), "--no-progress")
+    assert rc == 2 and err.strip() == f"neurohover reproduce: error: {says}", err
+    with Store(store, create=False) as held:  # begin(fresh=True), as reproduce --fresh calls it: the row is made again
+        held.begin("tr1", "quick", held.config_hash("tr1", "quick") or "", held.config("tr1", "quick"), fresh=True)
+        assert [n for n, _, _, _ in held.experiments()] == ["tr1"]

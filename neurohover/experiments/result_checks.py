@@ -3,10 +3,11 @@ and a test run's parts against each other."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import TYPE_CHECKING, Any
 
-from ..errors import brief, whole_number
+from ..errors import brief, finite_real, whole_number
 from ..sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS
 
 if TYPE_CHECKING:
@@ -60,12 +61,37 @@ def run_inconsistency(run: TestRunResult) -> str:
             return f"{name} names episode {outside[0]!r}, outside 0..{n - 1}"
         if list(episodes) != sorted(set(episodes)):  # [1, 1] was counted as two crashes (T22-07)
             return f"{name} = {brief(list(episodes))} is not allowed: each episode of 0..{n - 1} at most once, in order"
+    problem = _changes_problem(run.policy_changes, n)
+    if problem:
+        return problem
     if run.crash_steps is not None and len(run.crash_steps) != len(run.crash_episodes):
         return f"{len(run.crash_steps)} crash steps for {len(run.crash_episodes)} crash episodes"
     for i, step in enumerate(run.crash_steps or ()):
         if step < 1:  # the kernel counts the crashing control step from 1 (its unit's params bound it: params_problem)
             return f"crash_steps[{i}] = {step!r} is not allowed: a crash ends its episode at control step 1 or later"
     return _after_learning_problem(run)
+
+
+def _changes_problem(changes: Any, n: int) -> str:
+    """'' when ``changes`` are a run of ``n`` episodes' policy changes: (episode, policy) pairs of episodes in 0..n-1, in
+    order, each once, and a policy's name; else what is wrong ([[50, 'x'], [-1, '']] of a 3-episode run was taken; T22-09)."""
+    last = -1
+    for i, change in enumerate(changes):
+        episode, policy = change if isinstance(change, tuple) and len(change) == 2 else (None, None)
+        if not (whole_number(episode) and last < episode < n and isinstance(policy, str) and policy):
+            shown = brief(list(change) if isinstance(change, tuple) else change)
+            return f"policy_changes[{i}] = {shown} is not allowed: give [episode, policy name], its episodes among 0..{n - 1}, in order, each once"
+        last = episode
+    return ""
+
+
+def seconds_problem(timing: Any) -> str:
+    """'' when every field of the record ``timing`` is a finite number of seconds >= 0, else which is not (T22-09)."""
+    for f in dataclasses.fields(timing):
+        value = getattr(timing, f.name)
+        if not (finite_real(value) and value >= 0):
+            return f"timing.{f.name} = {brief(value)} is not allowed: give a finite number of seconds >= 0"
+    return ""
 
 
 def _after_learning_problem(run: TestRunResult) -> str:

@@ -30,7 +30,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from .keys import UnitKey  # re-exported: results are read by key
-from .result_checks import KIND_CHECKS, run_inconsistency
+from .result_checks import KIND_CHECKS, run_inconsistency, seconds_problem
 
 __all__ = [
     "DiagnosticResult",
@@ -215,8 +215,18 @@ class StoredPolicy(_Record):
         return Policy(self.topology, np.array(self.genome, dtype=float))
 
 
+class _Timing(_Record):
+    """Wall-clock seconds, each a finite number >= 0 (a test run's seconds -5 was exported; T22-09)."""
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        problem = seconds_problem(self)
+        if problem:
+            raise NeurohoverError(problem)
+
+
 @dataclass(frozen=True)
-class EvolveTiming(_Record):
+class EvolveTiming(_Timing):
     """Wall-clock seconds of an evolution run, and of its kernel calls."""
 
     seconds: float
@@ -224,7 +234,7 @@ class EvolveTiming(_Record):
 
 
 @dataclass(frozen=True)
-class ModelTiming(_Record):
+class ModelTiming(_Timing):
     """Wall-clock seconds to learn the model and to evolve the policy on it."""
 
     learn_seconds: float
@@ -232,7 +242,7 @@ class ModelTiming(_Record):
 
 
 @dataclass(frozen=True)
-class TestRunTiming(_Record):
+class TestRunTiming(_Timing):
     """Wall-clock seconds of a test run, and of the agent's work between episodes."""
 
     __test__ = False  # not a pytest test class

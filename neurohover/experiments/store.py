@@ -283,6 +283,8 @@ class Store:
         _check_text(config_hash, "config_hash", where)
         text = _object_text(config, "config", where)
         check_flag(fresh, "fresh", "delete the experiment's stored units first")
+        if not fresh:  # its row kept: a damaged one named (T22-09)
+            self._check_created(name)
         self.lock()
         c = self.conn
         with _transaction(c):
@@ -373,7 +375,20 @@ class Store:
             "SELECT e.name, e.scale, e.config_hash, (SELECT count(*) FROM units u WHERE u.name = e.name AND u.scale = e.scale) "
             "FROM experiments e ORDER BY e.created"
         )
+        self._check_created()
         return [tuple(r) for r in self._rows(sql, (), "its list of experiments")]
+
+    def _check_created(self, name: str | None = None) -> None:
+        """Refuse an experiment row (of ``name`` only, if given) whose created time, which orders the experiments, is no
+        number: 'yesterday' was taken, and sorted after every number (T22-09)."""
+        sql = "SELECT name, scale, created FROM experiments WHERE typeof(created) NOT IN ('integer', 'real')"
+        rows = self._rows(sql + (" AND name = ?" if name is not None else "") + " LIMIT 1", () if name is None else (name,), "its list of experiments")
+        if rows:
+            bad, scale, created = rows[0]
+            raise NeurohoverError(
+                f"results store {str(self.path)!r} is damaged: experiment {brief(bad)} ({brief(scale)})'s created time {brief(created)} is "
+                "no number: allowed seconds since 1970 (give another --store file, or reproduce --fresh to start it over)"
+            )
 
     def config_hash(self, name: str, scale: str) -> str | None:
         """The config hash of experiment (name, scale), None when the store does not hold it."""
@@ -397,6 +412,7 @@ class Store:
         return f"results store {str(self.path)!r} holds {what}; it holds: " + (", ".join(present) if present else "nothing yet")
 
     def scales(self, name: str) -> list[str]:
+        self._check_created(name)
         return [r[0] for r in self._rows("SELECT scale FROM experiments WHERE name = ? ORDER BY created", (name,), f"experiment {name}'s scales")]
 
     # ------------------------------------------------------------------ units
