@@ -175,7 +175,8 @@ def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig
         config that does not hash to its recorded hash, a unit run under another hash (T20-04), a unit key of no
         shape the experiment's plan gives (T20-05), and a unit the stored config does not plan, or plans with other
         kind or params (T21-02; :func:`_check_planned`), and units of the experiment at a scale of no config row
-        (T21-15; :meth:`Store.orphan_units`).
+        (T21-15; :meth:`Store.orphan_units`), and a result that contradicts its unit's params (an agent, MDP or crash
+        step of none they name; T22-07, T22-08: :func:`~neurohover.experiments.result_checks.params_problem`).
     """
     where = f"results store {str(store.path)!r}, experiment {name} ({scale}), is damaged"
     refuse_orphans(store, name)  # its units at a scale of no config row, ignored (T21-15): refuse_orphans says why
@@ -196,9 +197,6 @@ def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig
     for u in units:
         try:
             results[u["key"]] = result_from_dict(u["kind"], u["result"], u["key"])
-            problem = params_problem(results[u["key"]], u["params"])  # a result must be its unit's (T22-07, T22-08)
-            if problem:
-                raise NeurohoverError(f"its result contradicts its params: {problem}")
             _check_key(config, u)
         except NeurohoverError as err:
             unit = "" if repr(u["key"]) in str(err) else f"unit {u['key']!r}: "
@@ -208,6 +206,10 @@ def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig
         _check_planned(store, config, units)
     except NeurohoverError as err:
         raise NeurohoverError(f"{where}: {err}") from None
+    for u in units:  # a result must be its unit's (T22-07, T22-08); after the plan check, which names params changed
+        problem = params_problem(results[u["key"]], u["params"])
+        if problem:
+            raise NeurohoverError(f"{where}: unit {u['key']!r}: its result contradicts its params: {problem}")
     return config, units, results
 
 
