@@ -340,6 +340,21 @@ class _Rows:
     crashes: int = 0
     crashed_runs: set[int] = field(default_factory=set)
     has_crashed: bool = False
+    run_lines: dict[int, int] = field(default_factory=dict)
+
+
+def _check_row(where: str, row: dict, crashed: int, steps: int | None) -> None:
+    """Refuse a row's values compete never writes, naming ``where`` (the file and line) and the value: a crashed or
+    safeguard_fired flag other than 0 or 1 (crashed -1 was counted as -1 crashes, T22-03; safeguard_fired 7 and steps
+    -5 were taken, T22-04), steps not in 1..MAX_EPISODE_STEPS."""
+    for name, value, meaning in (
+        ("crashed", crashed, "the episode crashed"),
+        ("safeguard_fired", row.get("safeguard_fired") or "0", "the safeguard took over"),
+    ):
+        if value not in (0, 1, "0", "1"):
+            raise NeurohoverError(f"{where}: {name} {row[name]!r:.30} is not allowed: 0 or 1 (whether {meaning})")
+    if steps is not None and not 1 <= steps <= MAX_EPISODE_STEPS:
+        raise NeurohoverError(f"{where}: steps {row['steps']!r:.30} is not allowed: an episode's steps, an integer in 1..{MAX_EPISODE_STEPS:,}")
 
 
 def read_compete_dir(path: str | Path) -> CompeteResult:
@@ -371,10 +386,7 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
                     crashed, steps = int(row.get("crashed") or 0), int(row["steps"]) if row.get("steps") else None
                 except (TypeError, ValueError):
                     raise NeurohoverError(f"--compete {str(csv_path)!r}, line {line}: run, episode, return, crashed and steps must be numbers") from None
-                if crashed not in (0, 1):  # -1 was counted as -1 crashes, in the legend too (T22-03)
-                    raise NeurohoverError(
-                        f"--compete {str(csv_path)!r}, line {line}: crashed {row['crashed']!r:.30} is not allowed: 0 or 1 (whether the episode crashed)"
-                    )
+                _check_row(f"--compete {str(csv_path)!r}, line {line}", row, crashed, steps)
                 if not (math.isfinite(ret) and -WORST_RETURN <= ret <= 0):  # -1e308 overflowed the plot (eighth trial); every reward is <= 0 (ninth)
                     raise NeurohoverError(
                         f"--compete {str(csv_path)!r}, line {line}: return {row['return']!r:.30} is not an episode's "
@@ -386,6 +398,7 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
                         "each run's episodes are numbered once each from 0"
                     )
                 seen[run].add(episode)
+                facts.run_lines.setdefault(run, line)
                 runs.setdefault(run, []).append((episode, ret))
                 facts.crashes += crashed
                 facts.mdps.setdefault(row.get("mdp") or "", line)
@@ -397,6 +410,13 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
         raise NeurohoverError(f"--compete {str(csv_path)!r}: cannot read it ({err})") from None
     if not runs:
         raise NeurohoverError(f"--compete {str(csv_path)!r} holds no episodes")
+    absent = next((r for r in range(len(runs)) if r not in runs), None)  # run 10**30 was plotted as a second run (T22-04)
+    if absent is not None:
+        odd = max(runs)
+        raise NeurohoverError(
+            f"--compete {str(csv_path)!r}, line {facts.run_lines[odd]}: run {brief(odd)} is not allowed: compete numbers its runs 0, 1, 2, ... "
+            f"(the file's {len(runs)} runs: 0..{len(runs) - 1}; it has no run {absent})"
+        )
     for run, numbers in seen.items():  # 0, 2, 3 was plotted as 0, 1, 2 (sixth trial)
         if max(numbers) != len(numbers) - 1:
             gap = min(set(range(max(numbers))) - numbers)
@@ -461,6 +481,7 @@ def _check_summary_matches(path: Path, summary: dict, returns: np.ndarray, rows:
         raise NeurohoverError(
             f"--compete {str(path)!r} says episode_steps {shown}, not a number of steps (an integer in 1..{MAX_EPISODE_STEPS:,}): it is no compete summary"
         )
+    _check_conditions(path, summary)
     limit = int(summary.get("episode_steps") or 0)
     for (crashed, steps), line in rows.steps.items() if limit else ():
         if steps > limit or (steps != limit and not crashed):
@@ -478,6 +499,30 @@ def _check_summary_matches(path: Path, summary: dict, returns: np.ndarray, rows:
         given = summary.get(key)
         if given is not None and not (finite_real(given) and math.isclose(given, value, rel_tol=1e-9, abs_tol=tolerance)):
             refuse(key, found)
+    for label, line in rows.mdps.items() if task is not None else ():  # mdp 'zzz' was plotted as ghh08's (T22-04)
+        _, slash, rest = label.partition("/")
+        kind, _, index = rest.partition(":")
+        if label and not (slash and kind in ("test", "train", "sample") and index.isascii() and index.isdigit()):
+            where = f"--compete {str(path.with_name(COMPETE_FILE))!r}, line {line}"
+            raise NeurohoverError(f"{where}: mdp {brief(label)} is not allowed: a {task} MDP's label, {task}/SET:I (SET test, train or sample)")
+
+
+def _check_conditions(path: Path, summary: dict) -> None:
+    """Refuse a summary's sigma, sensor or drift that compete cannot have flown under, naming it (a sigma NaN, a sensor
+    {"level": -5} and a drift "junk" labelled the curves without a word; T22-04): sigma finite and >= 0, a sensor and a
+    drift as their parsers read them (Sensor.from_dict, Drift.from_dict; no drift as compete writes Drift() too)."""
+    from .tasks import Drift, Sensor
+
+    for key, value in ((k, summary.get(k)) for k in ("sigma", "sensor", "drift")):
+        try:
+            if key == "sigma" and value is not None and not (finite_real(value) and value >= 0):
+                raise NeurohoverError("a family's breadth is a finite number >= 0, or null")
+            if key == "sensor" and value is not None:
+                Sensor.from_dict(value)
+            if key == "drift" and value is not None:  # {walk 0, change {}}: compete's Drift(), which from_dict calls no drift
+                Drift.from_dict({k: v for k, v in value.items() if k != "walk" or v != 0} if isinstance(value, dict) else value)
+        except NeurohoverError as err:
+            raise NeurohoverError(f"--compete {str(path)!r} says {key} {brief(value)}, which compete never flies under: {err}") from None
 
 
 def read_compete_dirs(dirs: Sequence[str | Path]) -> list[CompeteResult]:

@@ -146,3 +146,41 @@ def test_a_compete_crash_flag_other_than_0_or_1_is_refused_with_its_line(tmp_pat
         read_compete_dir(folder)
     rc, out, err = cli("plot", "--compete", str(folder), "--out", str(tmp_path / "p"))
     assert rc == 2 and "Traceback" not in err and message in err and out == "", err
+
+
+COMPETE_ROWS = "episodes.csv', line 2: "
+
+
+@pytest.mark.parametrize(
+    ("column", "value", "summary", "message"),
+    [
+        (5, "-5", {"episode_steps": None}, f"{COMPETE_ROWS}steps '-5' is not allowed: an episode's steps, an integer in 1..10,000,000"),
+        (0, str(10**30), {}, f"{COMPETE_ROWS}run 1000000000...(31 digits) is not allowed: compete numbers its runs 0, 1, 2, ..."),
+        (1, "zzz", {}, f"{COMPETE_ROWS}mdp 'zzz' is not allowed: a ghh08 MDP's label, ghh08/SET:I (SET test, train or sample)"),
+        (7, "7", {}, f"{COMPETE_ROWS}safeguard_fired '7' is not allowed: 0 or 1 (whether the safeguard took over)"),
+        (0, "0", {"sigma": float("nan")}, "summary.json' says sigma nan, which compete never flies under: a family's breadth is a finite number >= 0"),
+        (0, "0", {"sensor": {"level": -5}}, "summary.json' says sensor {'level': -5}, which compete never flies under: sensor noise level=-5 is out of range"),
+        (0, "0", {"drift": "junk"}, "summary.json' says drift 'junk', which compete never flies under: a drift must be a table of settings"),
+    ],
+    ids=["steps", "run", "mdp", "safeguard_fired", "sigma", "sensor", "drift"],
+)
+def test_compete_rows_and_conditions_compete_never_writes_are_refused_by_name(tmp_path: Path, column: int, value: str, summary: dict, message: str) -> None:
+    """T22-04: in episodes.csv steps -5 (a summary without episode_steps), run 10**30, mdp 'zzz' and safeguard_fired 7, and
+    in summary.json sigma NaN, sensor {"level": -5} and drift "junk" were all plotted without a word; each is refused,
+    naming the file, line or key and the value."""
+    from neurohover.plots import read_compete_dir
+
+    with pytest.raises(NeurohoverError, match=f"^--compete '{re.escape(str(tmp_path / 'c'))}/{re.escape(message)}"):
+        read_compete_dir(_competition(tmp_path / "c", _rows(2, value, column), **summary))
+
+
+def test_compete_conditions_compete_writes_are_read(tmp_path: Path) -> None:
+    """T22-04: what compete writes is read: a sigma, a sensor's and a drift's settings, and no drift written as Drift()
+    writes itself (walk 0, no change), which Drift.from_dict alone would call a drift of nothing."""
+    from neurohover.plots import read_compete_dir
+    from neurohover.tasks import Drift, Sensor
+
+    for i, (name, value) in enumerate(
+        (("sigma", 0.5), ("sensor", Sensor.at_level(1.0).to_dict()), ("drift", Drift().to_dict()), ("drift", Drift(0.01).to_dict()))
+    ):
+        assert read_compete_dir(_competition(tmp_path / str(i), _rows(), **{name: value})).conditions[name] == value
