@@ -188,3 +188,79 @@ def test_a_population_optimiser_on_a_family_keeps_its_champion_in_the_table(fami
     last = state["history"][-1][4]
     fragment = f"history is not the champion's: its last row's champion_return is {last!r} where the run's champion (at generation 2) has return -5.5"
     _resume_damaged(source, tmp_path, lambda s: s["champion"].update(**{"return": -5.5}), GHH08, CMA_RUN, fragment)
+
+
+# --------------------------------------------------------------------------- T22-12: a prototype or stop reason not the run's
+
+
+def test_an_optimiser_prototype_not_the_configs_is_refused_on_the_command_line(tiny_checkpoint: Path, tmp_path: Path, cli) -> None:
+    """T22-12: optimizer_state.prototype.data[0]=9.0 beside the config's unchanged prototype was accepted (exit 0); the
+    optimiser's first population was bred from the config's, so now it is refused as damaged, naming the gene."""
+    state = json.loads(tiny_checkpoint.read_text())
+    config = state["config"]["prototype"][0]
+    state["optimizer_state"]["prototype"]["data"][0] = 9.0
+    (tmp_path / "run.json.checkpoint.json").write_text(json.dumps(state))
+    rc, _, err = cli(*CLI_RUN, "--budget", "60", "--out", str(tmp_path / "run.json"), "--resume")
+    assert rc == 2 and "Traceback" not in err, err
+    assert f"is a damaged checkpoint: optimizer_state's prototype is not the config's: gene 0 is 9.0 where the config's prototype has {config!r}" in " ".join(
+        err.split()
+    )
+
+
+def test_a_generational_prototype_not_the_configs_is_refused(family_checkpoints, tmp_path: Path) -> None:
+    """T22-12: generational NE keeps its prototype too; a gene of it changed (and then all of them) is refused."""
+    source = family_checkpoints["generational"]
+    state = json.loads(source.read_text())
+    genes = state["config"]["prototype"]
+
+    def shifted(s):
+        s["optimizer_state"]["prototype"]["data"] = [g + 1.0 for g in genes]
+
+    fragment = f"optimizer_state's prototype is not the config's: gene 0 is {genes[0] + 1.0!r} where the config's prototype has {genes[0]!r}"
+    fragment += f" (and {len(genes) - 1} more genes differ)"
+    _resume_damaged(source, tmp_path, shifted, GHH08, FAMILY_RUN, fragment)
+
+
+def test_a_stop_reason_the_run_does_not_stop_by_is_refused_on_the_command_line(tiny_checkpoint: Path, tmp_path: Path, cli) -> None:
+    """T22-12: stop_reason 'plateau' on a run that stopped by its budget was accepted and the run went on (exit 0). A
+    resume continues a budget stop under a larger budget, but stops a plateau at once, so a stop reason that is not the
+    one the checkpoint's state stops by is refused as damaged, naming what it stops by."""
+    state = json.loads(tiny_checkpoint.read_text())
+    assert state["stop_reason"] == "budget" and state["budget"] == 5
+    state["stop_reason"] = "plateau"
+    (tmp_path / "run.json.checkpoint.json").write_text(json.dumps(state))
+    rc, _, err = cli(*CLI_RUN, "--budget", "60", "--out", str(tmp_path / "run.json"), "--resume")
+    assert rc == 2 and "Traceback" not in err, err
+    assert (
+        "is a damaged checkpoint: stop_reason='plateau' is not allowed: the run it holds stops by 'budget' (its 50 episodes reached its budget of 5);"
+        " allowed 'budget' or null" in " ".join(err.split())
+    )
+
+
+@pytest.mark.parametrize(
+    ("reason", "fragment"),
+    [
+        ("budget", "stop_reason='budget' is not allowed: the run it holds stops by 'plateau' (its optimiser's own stop() is true); allowed 'plateau' or null"),
+        ("generations", "stop_reason='generations' is not allowed: the run it holds stops by 'plateau'"),
+    ],
+)
+def test_a_plateau_stays_a_plateau(tmp_path_factory, tmp_path: Path, reason: str, fragment: str) -> None:
+    """T22-12, the choice documented in evolution.restore: a run stopped by its plateau, resumed with a larger budget,
+    stops again at once by it (a budget stop goes on); a checkpoint that says it stopped by anything else is refused."""
+    run = dict(MDP_RUN, n_steps=10, settings={"pop_size": 4, "elite_size": 3, "plateau_threshold": 3})
+    source = tmp_path_factory.mktemp("plateau") / "run.ckpt.json"
+    result = evolve(GHH08.zero(), budget=200, checkpoint=source, **run)
+    assert result.stop_reason == "plateau" and json.loads(source.read_text())["stop_reason"] == "plateau"
+    resumed = evolve(GHH08.zero(), budget=400, checkpoint=source, resume=True, **run)
+    assert (resumed.stop_reason, resumed.episodes) == ("plateau", result.episodes)
+    _resume_damaged(source, tmp_path, lambda s: s.update(stop_reason=reason), GHH08.zero(), run, fragment)
+
+
+def test_a_stop_reason_of_a_run_that_went_on_is_refused(family_checkpoints, tmp_path: Path) -> None:
+    """T22-12: a checkpoint written while the run went on says null; a stop reason beside counters short of its budget
+    (and an optimiser that has not stopped) is refused."""
+    fragment = (
+        "stop_reason='budget' is not allowed: the run it holds has not stopped (its 8 episodes are short of its budget of 100 and its optimiser's"
+        " stop() is false); allowed null"
+    )
+    _resume_damaged(family_checkpoints["generational"], tmp_path, lambda s: s.update(budget=100), GHH08, FAMILY_RUN, fragment)

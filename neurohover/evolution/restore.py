@@ -1,7 +1,10 @@
 """Reading a checkpoint back: each part of it checked before a run (:class:`~.run.Run`) restores any of it.
 
 :meth:`Run.restore <neurohover.evolution.run.Run.restore>` refuses a damaged checkpoint by name through these checks:
-its entries, counters, champion, history, race delta, budget, stop reason and MDP stream.
+its entries, counters, champion, history, race delta, budget, stop reason and MDP stream, each against the others and
+against the restored optimiser (its prototype, its champion). A resume continues a stopped run: a run stopped by its
+budget goes on under a larger one; one stopped by its optimiser (plateau, generations, cma-stop, optimiser-stop) stops
+again at once, so a checkpoint's stop reason must be the one its state stops by (:func:`_check_stop_reason`).
 """
 
 from __future__ import annotations
@@ -33,8 +36,23 @@ def _damaged(source: str, err: Exception) -> NeurohoverError:
 #: Every entry a checkpoint (:meth:`Run.state`) has held, and every entry of its counters and champion tables.
 CHECKPOINT_ENTRIES = ("format", "config", "budget", "optimizer_state", "counters", "mdp_stream", "race_delta", "champion", "history", "stop_reason")
 COUNTERS = ("episodes", "next_index", "flown", "steps", "generation", "evaluations", "wall_seconds", "kernel_seconds")
-#: Why a run stopped, as :meth:`Run._should_stop` says it.
+#: Why a run stopped, as :func:`stop_reason` says it.
 STOP_REASONS = ("budget", "plateau", "generations", *sorted({spec.stop_reason for spec in OPTIMISERS.values()}))
+
+
+def stop_reason(method: str, opt: Optimiser, budget: int | None, episodes: int, generation: int) -> str | None:
+    """Why a run of ``method`` whose optimiser is ``opt`` stops after ``episodes`` episodes and ``generation``
+    generations under ``budget`` (None: it goes on): its budget first, then its optimiser's own stop. What
+    :meth:`Run._should_stop` asks at each generation boundary, and what a checkpoint's stop reason is checked against."""
+    if budget is not None and episodes >= budget:
+        return "budget"
+    if generation == 0:
+        return None
+    if method in OPTIMISERS:
+        return OPTIMISERS[method].stop_reason if opt.stop() else None
+    if opt.stop():
+        return "plateau" if method == "steady-state" else "generations"
+    return None
 
 
 def _check_tables(state: dict, source: str) -> None:
@@ -66,6 +84,46 @@ def _check_between_generations(opt: Optimiser) -> None:
         raise EntryError("optimizer_state's asked=true is not allowed: a run's checkpoint is written between generations (allowed false)")
     if isinstance(opt, SteadyStateNE) and opt._pending is not None:
         raise EntryError("optimizer_state's pending batch is not allowed: a run's checkpoint is written between generations (allowed null)")
+
+
+def _check_prototype(opt: Optimiser, genome: np.ndarray) -> None:
+    """EntryError unless restored optimiser ``opt``'s prototype (steady state's and generational NE's keep one) is the
+    config's ``genome``, which bred its first population: a prototype gene of 9.0 beside the config's 0.0 was taken (T22-12)."""
+    mine = getattr(opt, "_prototype", None)
+    if not isinstance(mine, np.ndarray):
+        return
+    if mine.shape != genome.shape:
+        raise EntryError(f"optimizer_state's prototype has {mine.size:,} genes where the config's prototype has {genome.size:,}")
+    differ = np.flatnonzero(mine != genome)
+    if differ.size:
+        k = int(differ[0])
+        raise EntryError(
+            f"optimizer_state's prototype is not the config's: gene {k} is {brief(float(mine[k]))} where the config's prototype has"
+            f" {brief(float(genome[k]))}{f' (and {differ.size - 1} more genes differ)' if differ.size > 1 else ''}; the optimiser's first population"
+            " was bred from the config's"
+        )
+
+
+def _check_stop_reason(state: dict, method: str, opt: Optimiser, counts: dict[str, int]) -> None:
+    """EntryError unless checkpoint ``state``'s stop reason is null (written while the run went on) or the one its
+    restored run stops by under its own budget (:func:`stop_reason`): 'plateau' on a run that stopped by its budget was
+    taken, and the run went on (T22-12). A resume after a stop continues the run: past a budget stop with a larger
+    budget; after the optimiser's own stop (plateau, generations, cma-stop, optimiser-stop) it stops again at once, by
+    the same reason, whatever the budget."""
+    reason = state["stop_reason"]
+    if reason is None:
+        return
+    found = stop_reason(method, opt, state["budget"], counts["episodes"], counts["generation"])
+    if reason != found:
+        budget, episodes = state["budget"], counts["episodes"]
+        if found is None:
+            short = "it has no budget" if budget is None else f"its {episodes:,} episodes are short of its budget of {budget:,}"
+            held = f"has not stopped ({short} and its optimiser's stop() is false); allowed null"
+        elif found == "budget":
+            held = f"stops by 'budget' (its {episodes:,} episodes reached its budget of {budget:,}); allowed 'budget' or null"
+        else:
+            held = f"stops by {found!r} (its optimiser's own stop() is true); allowed {found!r} or null"
+        raise EntryError(f"stop_reason={brief(reason)} is not allowed: the run it holds {held}")
 
 
 def _restored_parts(state: dict, run: Run, opt: Optimiser) -> dict[str, Any]:

@@ -44,7 +44,7 @@ from .records import (
     encode_history,
     write_checkpoint,
 )
-from .restore import _check_between_generations, _check_run_entries, _check_tables, _damaged, _restored_parts
+from .restore import _check_between_generations, _check_prototype, _check_run_entries, _check_stop_reason, _check_tables, _damaged, _restored_parts, stop_reason
 from .seeding import mdp_rng, noise_seed, optimiser_seed
 from .steady_state import SteadyStateNE
 
@@ -183,8 +183,10 @@ class Run:
                 )
         try:
             _check_between_generations(opt)
+            _check_prototype(opt, self.cfg.prototype.genome)
             parts = _restored_parts(state, self, opt)
             _check_run_entries(state, self.mdp_rng is None)
+            _check_stop_reason(state, self.method, opt, parts["counters"])
             if self.mdp_rng is not None:
                 check_stream(state["mdp_stream"], type(self.mdp_rng.bit_generator).__name__)
                 stream = np.random.Generator(type(self.mdp_rng.bit_generator)())
@@ -320,15 +322,7 @@ class Run:
         return ProgressInfo(self.generation, self.evaluations, eps, budget, self._champion_return(), wall, eps / wall if wall > 0 else 0.0, done)
 
     def _should_stop(self) -> str | None:
-        if self.budget is not None and self.flyer.episodes >= self.budget:
-            return "budget"
-        if self.generation == 0:
-            return None
-        if self.method in OPTIMISERS:
-            return OPTIMISERS[self.method].stop_reason if self.opt.stop() else None
-        if self.opt.stop():
-            return "plateau" if self.method == "steady-state" else "generations"
-        return None
+        return stop_reason(self.method, self.opt, self.budget, self.flyer.episodes, self.generation)
 
     def _record(self, before_eps: int, champion: float, start: float) -> None:
         self.history.append(
