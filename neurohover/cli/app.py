@@ -59,8 +59,9 @@ class _Parser(argparse.ArgumentParser):
         self.register("action", "store_true", _FlagOnce)
 
     def error(self, message: str) -> NoReturn:
-        """argparse's error, a 100,000-character value shortened (its "invalid choice: 'ggg...'" echoed it whole)."""
-        super().error(shorter_numbers(message))
+        """argparse's error in one line, as every other refusal (its usage block made 3-7 lines; T22-18), pointing to
+        --help for the usage; a 100,000-character value shortened (its "invalid choice: 'ggg...'" echoed it whole)."""
+        self.exit(2, f"{self.prog}: error: {shorter_numbers(message)} (usage: {self.prog} --help)\n")
 
 
 def build_parser() -> argparse.ArgumentParser:
