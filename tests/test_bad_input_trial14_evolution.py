@@ -213,7 +213,7 @@ def _state(name: str) -> dict:
         ("GenerationalNE", "evaluations", "not a count: allowed an integer >= 0"),
         ("GenerationalNE", "asked", "not a flag: allowed true or false"),
         ("GenerationalNE", "history", "ValueError: not enough values to unpack"),
-        ("GenerationalNE", "champion_return", "ValueError: could not convert string to float: 'x'"),
+        ("GenerationalNE", "champion_return", "could not convert string to float: 'x'"),
         ("OpenAIES", "generation", "not a count: allowed an integer >= 0"),
         ("OpenAIES", "adam", "TypeError: string indices must be integers"),
         ("OpenAIES", "tracker", "TypeError: string indices must be integers"),

@@ -65,11 +65,12 @@ _STORED = "real numbers or 'nan', 'inf', '-inf' as state_dict() wrote them"
 
 def dec_float(value: Any) -> float:
     """The float :func:`enc_float` encoded: a real number (not a bool) or ``"nan"``, ``"inf"``, ``"-inf"``; other text
-    (``'1.5'``) a ValueError, anything else an :class:`EntryError` (float() took both, and True as 1.0; sixteenth trial)."""
+    (``'1.5'``) or anything else an :class:`EntryError` (float() took both, and True as 1.0; sixteenth trial; a damaged
+    state's message said "ValueError: could not convert ...")."""
     if isinstance(value, str):
         if value in _NON_FINITE:
             return _NON_FINITE[value]
-        raise ValueError(f"could not convert string to float: {brief(value)} (a stored number is no text, but for 'nan', 'inf', '-inf')")
+        raise EntryError(f"could not convert string to float: {brief(value)} (a stored number is no text, but for 'nan', 'inf', '-inf')")
     if not real_number(value):  # a bool, or a time span (Real to numbers, T17-1)
         raise EntryError(f"{brief(value)} is no number: allowed {_STORED}")
     return float(value)
