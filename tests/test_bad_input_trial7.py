@@ -226,7 +226,7 @@ def test_flight_data_metadata_of_the_wrong_kind_and_overflowing_lengths_are_name
     from neurohover.flightdata import FlightData
 
     obs, act = np.zeros((3, 12)), np.zeros((2, 4))
-    good = FlightData((obs,), (act,), {"episode_steps": 6000, "crashed": [False]})
+    good = FlightData((obs,), (act,), {"episode_steps": 2, "crashed": [False]})
     for meta, message in (
         ({"episode_steps": "a"}, "episode_steps='a' is not allowed"),
         ({"episode_steps": 0}, "episode_steps=0 is not allowed"),

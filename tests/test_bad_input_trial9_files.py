@@ -199,14 +199,14 @@ def test_flight_data_nested_deeply_or_contradicting_its_metadata_is_refused(flig
 
 
 def test_joined_flight_data_keeps_metadata_its_episodes_fit(flight, tmp_path) -> None:
-    """The checks above hold for two recordings joined and saved: the per-episode lists of both halves, the longer
-    episode_steps, and no task where the halves' differ."""
+    """The checks above hold for two recordings joined and saved: the per-episode lists of both halves, and no task
+    where the halves' differ; no episode_steps where a shorter budget's full episodes would read as cut short (T22-01)."""
     a = nh.FlightData.load(flight)
     b = nh.FlightData(
-        a.observations[:1], a.actions[:1], {**a.metadata, "episode_steps": 40, "task": "ghh09", "returns": [0.5], "mdps": [{}], "crashed": [False]}
+        a.observations[:1], a.actions[:1], {**a.metadata, "episode_steps": 40, "task": "ghh09", "returns": [0.5], "mdps": [{}], "crashed": [True]}
     )
     both = a + b
-    assert both.metadata["episode_steps"] == 40 and "task" not in both.metadata and both.metadata["returns"] == [-1.0, -2.0, 0.5]
+    assert "episode_steps" not in both.metadata and "task" not in both.metadata and both.metadata["returns"] == [-1.0, -2.0, 0.5]
     both.save(tmp_path / "both.npz")
     assert nh.FlightData.load(tmp_path / "both.npz").metadata["mdps"][2] == {}
     short = nh.FlightData((a.observations[0][:6],), (a.actions[0][:5],), {"episode_steps": 5})  # 5 steps: within its budget (T18-4)

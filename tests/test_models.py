@@ -228,7 +228,7 @@ def test_bad_flight_data_and_options_are_refused(zero_flight) -> None:
         learn_lr(fd.observations[0])
     bad = fd.observations[0].copy()
     bad[10, 3] = np.nan
-    with pytest.raises(NeurohoverError, match="non-finite"):
+    with pytest.raises(NeurohoverError, match="^flight data, episode 0: step 10 reads x = nan: no flight records a NaN or infinite observation"):
         learn_lr(FlightData((bad,), (fd.actions[0],)))
     bad = fd.observations[0].copy()
     bad[10, 9:12] = 0.9
