@@ -61,6 +61,17 @@ def test_a_generation_of_fewer_episodes_than_genomes_is_refused() -> None:
     assert g.evaluations == 100 and g.stop()
 
 
+def test_a_generation_of_fewer_episodes_given_directly_is_refused() -> None:
+    """T22-13 through GenerationalNE.tell's own episodes argument, which skipped TellInfo's check."""
+    g = GenerationalNE(np.zeros(40), GenerationalSettings(budget=100, pop_size=10, select_size=3))
+    x = g.ask()
+    with _raises("episodes=0 is not allowed: fewer than the 10 genomes asked"):
+        g.tell(-np.ones(len(x)), episodes=0)
+    assert g.generation == 0
+    g.tell(-np.ones(len(x)), episodes=10)
+    assert g.evaluations == 10
+
+
 @pytest.mark.parametrize("name", ["steady-state", *sorted(OPTIMISERS)])
 def test_every_optimiser_refuses_fewer_episodes_than_genomes(name: str) -> None:
     """T22-13: the check is TellInfo's (at every tell), also for optimisers that do not read its episodes."""

@@ -292,6 +292,7 @@ class GenerationalNE:
         else:
             sel = self._check_selected(selected)
         ep = s.pop_size if episodes is None else require_episodes(episodes)  # 10**30 made evaluations 1e30 (T19-10)
+        TellInfo(episodes=ep).check(s.pop_size)  # given directly too: tell(f, episodes=0) never stopped its run (T22-13)
 
         best = int(sel[rank(f[sel])[0]])  # the best selected parent (a race may select below a discarded mean)
         self._champion_genome = self._population[best].copy()
