@@ -97,6 +97,8 @@ class FlightData:
         for i, (obs, act) in enumerate(zip(self.observations, self.actions)):
             if obs.ndim != 2 or obs.shape[1] != 12 or act.ndim != 2 or act.shape[1] != 4 or obs.shape[0] != act.shape[0] + 1:
                 raise NeurohoverError(f"flight-data episode {i}: observations must be (T+1, 12) and actions (T, 4), got {obs.shape} and {act.shape}")
+            if act.shape[0] == 0:  # written by save(), then refused by load() (T22-19)
+                raise NeurohoverError(f"flight data: episode {i} has 0 steps (a flown one has at least 1)")
         # metadata load() refuses (episode_steps -5, crashed 'x') was taken here and written by save() (T18-4)
         check_metadata(self.metadata, np.array([a.shape[0] for a in self.actions], dtype=np.int64), "flight data")
 
