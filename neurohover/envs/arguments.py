@@ -126,10 +126,18 @@ def check_no_unknown_kwargs(unknown: dict[str, Any], allowed: Sequence[str]) -> 
         raise NeurohoverError(f"unknown argument(s) {', '.join(sorted(unknown))}: allowed {', '.join(allowed)}")
 
 
+def check_count(value: Any, name: str, largest: int) -> None:
+    """Refuse ``value`` (the argument ``name``) unless it is an integer in 1..``largest``: a non-integer (20.0, '20', True)
+    as not allowed, an integer past the range as out of range (20.0 was called out of range, T22-14)."""
+    if not whole_number(value):  # np.timedelta64 was int()'s TypeError (T17-1)
+        raise NeurohoverError(f"{name}={brief(value)} is not allowed: allowed an integer in 1..{largest}")
+    if not 1 <= value <= largest:
+        raise NeurohoverError(f"{name}={brief(value)} is out of range: allowed an integer in 1..{largest}")
+
+
 def check_episode_steps(episode_steps: Any, name: str = "episode_steps") -> int:
     """``episode_steps`` (the argument ``name``) as an int, or a clear error."""
-    if not whole_number(episode_steps) or not 1 <= episode_steps <= MAX_EPISODE_STEPS:  # np.timedelta64 was int()'s TypeError (T17-1)
-        raise NeurohoverError(f"{name}={brief(episode_steps)} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
+    check_count(episode_steps, name, MAX_EPISODE_STEPS)
     return int(episode_steps)
 
 

@@ -39,6 +39,7 @@ from .arguments import (
     MdpSpec,
     check_action_dtype,
     check_against_id,
+    check_count,
     check_episode_steps,
     check_no_unknown_kwargs,
     check_noise_stream,
@@ -151,8 +152,7 @@ class HoverVectorEnv(VectorEnv):
     ) -> None:
         check_no_unknown_kwargs(unknown, VECTOR_ENV_KWARGS)
         check_device(device)
-        if not whole_number(num_envs) or not 1 <= num_envs <= MAX_NUM_ENVS:  # np.timedelta64 was int()'s TypeError (T17-1)
-            raise NeurohoverError(f"num_envs={brief(num_envs)} is out of range: allowed an integer in 1..{MAX_NUM_ENVS}")
+        check_count(num_envs, "num_envs", MAX_NUM_ENVS)  # 8.0 was called out of range (T22-14)
         if render_mode is not None:
             raise NeurohoverError(f"render_mode={render_mode!r} is not supported: this environment has no rendering (use None)")
         n = int(num_envs)
