@@ -166,6 +166,8 @@ class FlightData:
         check_npz_name(path)
         lengths = np.array([a.shape[0] for a in self.actions], dtype=np.int64)
         check_metadata(self.metadata, lengths, "flight data")  # metadata changed after making (episode_steps -5) was written, then refused by load()
+        for i, crashed in enumerate(crash_flags(self)):  # NaN readings were written, then refused by load() (T22-02's check)
+            check_flown(self.observations[i], self.actions[i], crashed, f"flight data to save, episode {i}")
         largest = float(np.finfo(dtype).max)
         for name in ("observations", "actions"):  # 1e300 was written as float32's inf, without a word (fifteenth trial, T15-29)
             big = max((float(np.abs(a[np.isfinite(a)]).max(initial=0.0)) for a in getattr(self, name)), default=0.0)

@@ -107,5 +107,7 @@ def test_float32_save_refuses_values_past_its_range(tmp_path: Path) -> None:
     with pytest.raises(NeurohoverError, match=re.escape("flight data actions hold 1e+39, past float32's largest value")):
         FlightData((OBS,), (act,), {}).save(tmp_path / "f.npz", "float32")
     assert FlightData.load(data.save(tmp_path / "f.npz")) == data
-    nan = FlightData((np.full((6, 12), np.nan),), (ACT,), {})
-    assert FlightData.load(nan.save(tmp_path / "n.npz", "float32")) == nan
+    nan = FlightData((np.full((6, 12), np.nan),), (ACT,), {})  # no overflow, but no flight: refused as load() refuses it
+    with pytest.raises(NeurohoverError, match=re.escape("flight data to save, episode 0: step 0 reads u = nan")):
+        nan.save(tmp_path / "n.npz", "float32")
+    assert not (tmp_path / "n.npz").exists()
