@@ -38,7 +38,7 @@ from matplotlib.ticker import MaxNLocator
 from .errors import NeurohoverError, brief, finite_real, whole_number
 from .flightdata import FlightData, check_flown, check_metadata, crash_flags
 from .paths import input_dir, output_dir, output_file, printable, strict_json
-from .sim.constants import ACTION_NAMES, CONTROL_DT, CRASH_STEP_PENALTY, EPISODE_STEPS, MAX_EPISODE_STEPS
+from .sim.constants import ACTION_NAMES, CONTROL_DT, EPISODE_STEPS, MAX_EPISODE_STEPS, WORST_RETURN
 
 __all__ = [
     "CompeteResult",
@@ -59,7 +59,6 @@ COMPETE_FILE = "episodes.csv"
 COMPETE_SUMMARY = "summary.json"
 COMPETE_CONDITIONS = ("episode_steps", "sigma", "sensor", "drift")  # summary.json keys: curves that differ in one are labelled with it
 COMPETE_COLUMNS = ("run", "episode", "return")  # the columns of compete's episodes.csv read here
-WORST_RETURN = CRASH_STEP_PENALTY * MAX_EPISODE_STEPS  # no episode loses more: a crash charges the worst step for every step left
 
 
 def new_figure(width: float, height: float, dpi: int = 100) -> Figure:

@@ -8,13 +8,10 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from ..errors import brief, finite_real, whole_number
-from ..sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS
+from ..sim.constants import WORST_RETURN
 
 if TYPE_CHECKING:
     from .results import TestRunResult
-
-#: No episode loses more: a crash charges the worst step for every step left (plots.WORST_RETURN, compete's reader's bound).
-WORST_RETURN = CRASH_STEP_PENALTY * MAX_EPISODE_STEPS
 
 
 def _num(v) -> bool:

@@ -47,6 +47,9 @@ MIN_QW = math.cos(math.radians(15.0))  # |qw| below this: more than 30 degrees f
 # Reward of one remaining step at the worst possible state; a crash is charged it for every
 # step left in the episode, including the crashing one.
 CRASH_STEP_PENALTY = 3 * MAX_POSITION**2 + 3 * MAX_RATE**2 + 3 * MAX_VELOCITY**2 + (1.0 - MIN_QW**2)
+# No episode's return is below -WORST_RETURN: a crash charges the worst step for every step left (stored results and
+# compete's files are checked against it; every reward is minus a sum of squares, so none is above 0).
+WORST_RETURN = CRASH_STEP_PENALTY * MAX_EPISODE_STEPS
 
 # Wind models.
 WIND_NONE = 0
