@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from neurohover.errors import NeurohoverError
+from neurohover.experiments.store import Store
 from neurohover.flightdata import FlightData
 
 
@@ -47,3 +48,39 @@ def test_env_count_of_wrong_type_not_allowed(name, value):
         make(value)
     with pytest.raises(NeurohoverError, match=rf"^{name}=0 is out of range: allowed an integer in 1\.\."):
         make(0)
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ("units_run = 99", "units_before 0 and units_run 99 are not allowed: together at most the 0 units the experiment stores"),
+        ("units_before = -5", "units_before -5 is not allowed: allowed a whole number >= 0"),
+        ("units_run = 1.5", "units_run 1.5 is not allowed: allowed a whole number >= 0"),
+        ("status = 'zzz'", "status 'zzz' is not allowed: allowed 'running', 'finished'"),
+        ("executor = 'zzz'", "executor 'zzz' is not allowed: allowed 'local', 'ray'"),
+        ("started = -1e300", "started -1e+300 is not allowed: allowed a time (seconds since 1970) from 2001 to now"),
+        ("started = 1e12", "started 1000000000000.0 is not allowed: allowed a time"),
+        ("started = 'x'", "started 'x' is not allowed"),
+    ],
+)
+def test_impossible_session_row_is_store_damage(change, message, tmp_path):
+    """T22-21: sessions rows of units_run 99 (of no unit), units_before -5, status 'zzz', executor 'zzz' or a start in
+    1e12 were read, and printed by results and report; Store.sessions() now names the session, field and value."""
+    with Store(tmp_path / "s.sqlite") as store:
+        session = store.start_session("e", "quick", "h", "local", 1, 0)
+        assert store.sessions("e", "quick")[0]["status"] == "running"  # a run killed by SIGKILL stays 'running': allowed
+        store.conn.execute(f"UPDATE sessions SET {change} WHERE id = ?", (session,))
+        with pytest.raises(NeurohoverError, match=re.escape(f"experiment e (quick), session {session} is damaged: {message}")):
+            store.sessions("e", "quick")
+
+
+def test_repeated_session_row_is_store_damage(tmp_path):
+    """T22-21: a sessions row copied (a new id, every other field the same) counted one run twice."""
+    with Store(tmp_path / "s.sqlite") as store:
+        first = store.start_session("e", "quick", "h", "local", 1, 0)
+        store.end_session(first, "finished")
+        store.conn.execute(
+            "INSERT INTO sessions SELECT NULL, name, scale, config_hash, executor, cores, started, wall_seconds, units_run, units_before, status FROM sessions"
+        )
+        with pytest.raises(NeurohoverError, match=re.escape(f"session {first + 1} is damaged: it repeats session {first} field for field")):
+            store.sessions("e", "quick")

@@ -47,6 +47,8 @@ SCHEMA_VERSION = 1
 
 #: How a session can end (:meth:`Store.end_session`; the runner's statuses). A session is "running" until then.
 SESSION_STATUSES = ("finished", "selection finished", "interrupted", "failed")
+#: The executors that run sessions (the ``name`` of executors.LocalExecutor and RayExecutor; importing them here is slow).
+EXECUTORS = ("local", "ray")
 APPLICATION_ID = 0x4E484F56  # "NHOV"
 
 _SCHEMA = """
@@ -541,12 +543,43 @@ class Store:
             f"SELECT {', '.join(cols)} FROM sessions WHERE name = ? AND scale = ? ORDER BY id", (name, scale), f"experiment {name} ({scale})'s sessions"
         )
         sessions = [dict(zip(cols, r)) for r in rows]
+        stored = self._rows("SELECT COUNT(*) FROM units WHERE name = ? AND scale = ?", (name, scale), f"experiment {name} ({scale})'s units")[0][0]
+        seen: dict[tuple, int] = {}
         for session in sessions:  # what the report sums and prints: numbers, or the damaged row named
             session["wall_seconds"] = self._seconds(session["wall_seconds"], f"experiment {name} ({scale}), session {session['id']}'s wall seconds")
             if type(session["cores"]) is not int or session["cores"] < 1:
                 what = f"experiment {name} ({scale}), session {session['id']}'s cores"
                 raise NeurohoverError(f"results store {str(self.path)!r}: {what} are damaged ({session['cores']!r:.40})")
+            bad = _bad_session(session, stored)  # units_run 99 of 4, status 'zzz', started 1e12 were reported (T22-21)
+            twin = seen.setdefault(tuple(session[c] for c in cols[1:]), session["id"])
+            bad = bad or (f"it repeats session {twin} field for field (one run is recorded once)" if twin != session["id"] else "")
+            if bad:
+                raise NeurohoverError(f"results store {str(self.path)!r}: experiment {name} ({scale}), session {session['id']} is damaged: {bad}")
         return sessions
+
+
+def _bad_session(session: dict, stored: int) -> str:
+    """What is impossible in a sessions row (checked by :meth:`Store.sessions`), or '': a status no run ends with, an
+    executor that runs none, a start before 2001 or in the future (a day of clock difference allowed), unit counts
+    below 0, or more units before and run than the experiment stores (only ``update`` and ``fresh`` delete units, and
+    both delete the sessions with them). A session killed by SIGKILL stays 'running', and is allowed."""
+    statuses = ("running", *SESSION_STATUSES)
+    value = session["status"]
+    if not isinstance(value, str) or value not in statuses:
+        return f"status {brief(value)} is not allowed: allowed {', '.join(map(repr, statuses))}"
+    value = session["executor"]
+    if not isinstance(value, str) or value not in EXECUTORS:
+        return f"executor {brief(value)} is not allowed: allowed {', '.join(map(repr, EXECUTORS))}"
+    value = session["started"]
+    if not finite_real(value) or not 1e9 <= value <= time.time() + 86400:
+        return f"started {brief(value)} is not allowed: allowed a time (seconds since 1970) from 2001 to now"
+    for field in ("units_before", "units_run"):
+        if not whole_number(session[field]) or session[field] < 0:
+            return f"{field} {brief(session[field])} is not allowed: allowed a whole number >= 0"
+    if session["units_before"] + session["units_run"] > stored:
+        counts = f"units_before {session['units_before']} and units_run {session['units_run']}"
+        return f"{counts} are not allowed: together at most the {stored} units the experiment stores"
+    return ""
 
 
 def worker_name() -> str:
