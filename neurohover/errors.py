@@ -33,6 +33,18 @@ def whole_number(value: object) -> TypeGuard[int]:
 _TIMES = ("timedelta64", "datetime64")
 
 
+def whole_in(value: object, name: str, low: int, high: int, high_text: str | None = None) -> int:
+    """``value`` (the argument ``name``) as an int, or one NeurohoverError: a non-integer (20.0, '20', True, a NumPy time
+    span) "is not allowed", an integer outside ``low..high`` "is out of range", each with the allowed integers
+    (``high_text`` writes ``high``, e.g. '2**63-1'). 20.0 was called out of range (T22-14)."""
+    allowed = f"allowed an integer in {low}..{high_text or high}"
+    if not whole_number(value):
+        raise NeurohoverError(f"{name}={brief(value)} is not allowed: {allowed}")
+    if not low <= value <= high:
+        raise NeurohoverError(f"{name}={brief(value)} is out of range: {allowed}")
+    return int(value)
+
+
 def real_number(value: object) -> TypeGuard[float]:
     """Whether ``value`` is a real number, NumPy's included: not a bool (True is an int) nor a NumPy time (an Integral
     whose float() and int() raise, T17-1). The one test of a number argument; :func:`finite_real` adds finiteness."""

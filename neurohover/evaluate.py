@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError, as_floats, brief, finite_real, whole_number
+from .errors import NeurohoverError, as_floats, brief, finite_real, whole_in, whole_number
 from .flightdata import FlightData, same_values
 from .flyer import KernelFlyer
 from .launch import DEVICES, KIND, MAX_SEED, Batch, Flown, check_device, launch, num_threads, use_lanes
@@ -273,8 +273,7 @@ MAX_EPISODES_PER_CALL = 100_000_000
 
 
 def _check_n_steps(n_steps) -> None:
-    if not whole_number(n_steps) or not 1 <= n_steps <= MAX_EPISODE_STEPS:  # np.timedelta64 was int()'s TypeError (T17-1)
-        raise NeurohoverError(f"n_steps={brief(n_steps)} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
+    whole_in(n_steps, "n_steps", 1, MAX_EPISODE_STEPS)  # np.timedelta64 was int()'s TypeError (T17-1)
 
 
 def _check_call_size(n_jobs: int, n_steps: int, n_rec: int) -> None:
@@ -360,8 +359,7 @@ def evaluate_jobs(
     check_device(device)
     table = policies if isinstance(policies, PolicyTable) else PolicyTable.from_policies(policies)
     rows = mdp_rows(mdps)
-    if not whole_number(seed) or not 0 <= int(seed) <= MAX_SEED:  # True was seed 1; np.timedelta64 int()'s TypeError (T17-1)
-        raise NeurohoverError(f"seed={brief(seed)} is out of range: allowed an integer in 0..2**63-1")
+    whole_in(seed, "seed", 0, MAX_SEED, "2**63-1")  # True was seed 1; np.timedelta64 int()'s TypeError (T17-1)
     _check_n_steps(n_steps)
     p_idx = _index_array(policy_index, None, "policy_index")
     n_jobs = p_idx.shape[0]
@@ -524,8 +522,7 @@ class DangerousState:
             raise NeurohoverError(f"safeguard tilt={brief(self.tilt)} is out of range: allowed 0 < tilt <= 1 (qw threshold)")
         if not (finite_real(self.threshold) and self.threshold > 0):
             raise NeurohoverError(f"safeguard threshold={brief(self.threshold)} is out of range: allowed a finite number > 0")
-        if not (whole_number(self.arm_after) and 0 <= self.arm_after <= 10**6):
-            raise NeurohoverError(f"safeguard arm_after={brief(self.arm_after)} is out of range: allowed an integer in 0..1000000 (control steps)")
+        whole_in(self.arm_after, "safeguard arm_after", 0, 10**6, "1000000 (control steps)")
         for name in ("box", "tilt", "threshold"):  # plain Python numbers: the repr and equality of the Python values
             object.__setattr__(self, name, float(getattr(self, name)))
         object.__setattr__(self, "arm_after", int(self.arm_after))

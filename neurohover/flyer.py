@@ -5,7 +5,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from .errors import NeurohoverError, brief, whole_number
+from .errors import NeurohoverError, brief, whole_in, whole_number
 from .launch import KIND, MAX_SEED, Batch, Flown, Parking, check_device, launch, launch_parked, rows_alike
 from .policies import GENOME_LENGTH, TOPOLOGIES
 from .sim.constants import MAX_EPISODE_STEPS, SAFEGUARD_LIMITS
@@ -68,8 +68,7 @@ class KernelFlyer:
         check_device(device)
         if topology not in TOPOLOGIES:
             raise NeurohoverError(f"unknown policy topology {topology!r}: allowed {', '.join(TOPOLOGIES)}")
-        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= MAX_SEED:
-            raise NeurohoverError(f"seed={seed!r} is out of range: allowed an integer in 0..2**63-1")
+        whole_in(seed, "seed", 0, MAX_SEED, "2**63-1")
         if not whole_number(n_steps) or not 1 <= n_steps <= MAX_EPISODE_STEPS:  # np.timedelta64 is a np.integer (T17-1)
             raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
         self.kind = KIND[topology]

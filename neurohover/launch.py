@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
-from .errors import NeurohoverError, brief, whole_number
+from .errors import NeurohoverError, brief, whole_in, whole_number
 from .sim.constants import MAX_EPISODE_STEPS, MDP_ROW_LEN, ROW_SUBSTEPS, ROW_WIND_KIND, SAFEGUARD_LIMITS
 from .sim.jobs import PARK_F, PARK_U, Extras, Flown, Jobs, Parking
 from .sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
@@ -110,8 +110,7 @@ def _check_parking(slots: object, n_required: object, parking: object, n_jobs: i
     if not isinstance(slots, np.ndarray) or slots.dtype != np.int64 or slots.shape != (n_jobs,):
         raise NeurohoverError(f"slots={brief(slots)} is not allowed: give a 1-d int64 numpy array, one parking slot per job ({n_jobs})")
     check_job_indices(slots, 0, n_slots, "slots")
-    if not whole_number(n_required) or not 0 <= n_required <= n_jobs:
-        raise NeurohoverError(f"n_required={brief(n_required)} is out of range: allowed an integer in 0..{n_jobs} (the batch's jobs)")
+    whole_in(n_required, "n_required", 0, n_jobs, f"{n_jobs} (the batch's jobs)")
 
 
 #: Each array of a :class:`Batch`: its dimensions, dtype and column count (None: any).
@@ -185,8 +184,7 @@ class Batch:
         read past an array and killed the process (SIGSEGV), a kind 99 flew, n_steps=-5 flew nothing (thirteenth trial, F1)."""
         if not whole_number(self.n_steps) or not 1 <= self.n_steps <= MAX_EPISODE_STEPS:
             raise NeurohoverError(f"n_steps={brief(self.n_steps)} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
-        if not whole_number(self.seed) or not 0 <= self.seed <= MAX_SEED:
-            raise NeurohoverError(f"seed={brief(self.seed)} is out of range: allowed an integer in 0..2**63-1")
+        whole_in(self.seed, "seed", 0, MAX_SEED, "2**63-1")
         # the kernel compiles once per argument type: np.uint16(5) steps compiled it again, 30-50 s (eighteenth trial, T18-1)
         object.__setattr__(self, "n_steps", int(self.n_steps))  # (the seed goes to the kernel as np.uint64 always: jobs())
         kinds = self.kinds

@@ -63,7 +63,7 @@ def test_launch_refuses_a_read_only_out_and_still_flies_a_good_one() -> None:
         (np.array([0, -1, 2]), 3, launch.Parking.empty(3), r"slots holds negative values \(min -1\); allowed >= 0"),
         (np.array([0, 1]), 3, launch.Parking.empty(3), r"slots=.* give a 1-d int64 numpy array, one parking slot per job \(3\)"),
         (np.array([0, 1, 2]), 4, launch.Parking.empty(3), r"n_required=4 is out of range: allowed an integer in 0..3"),
-        (np.array([0, 1, 2]), True, launch.Parking.empty(3), r"n_required=True is out of range"),
+        (np.array([0, 1, 2]), True, launch.Parking.empty(3), r"n_required=True is not allowed"),
         (
             np.array([0, 1, 2]),
             3,

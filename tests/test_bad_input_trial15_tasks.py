@@ -27,7 +27,7 @@ def test_a_safeguard_box_past_a_floats_range_is_refused_by_name() -> None:
         ({"box": True}, "safeguard box=True is out of range: allowed a finite number > 0"),
         ({"tilt": True}, "safeguard tilt=True is out of range: allowed 0 < tilt <= 1"),
         ({"rule": "ratio-sum", "threshold": True}, "safeguard threshold=True is out of range: allowed a finite number > 0"),
-        ({"arm_after": True}, "safeguard arm_after=True is out of range: allowed an integer in 0..1000000"),
+        ({"arm_after": True}, "safeguard arm_after=True is not allowed: allowed an integer in 0..1000000"),
     ],
 )
 def test_a_safeguard_refuses_bools(kwargs: dict, message: str) -> None:

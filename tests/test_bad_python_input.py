@@ -505,8 +505,8 @@ def _fourth_trial_calls(tmp_path):
     fam, mdp, base = nh.get_task_family("ghh08"), nh.get_task_family("ghh08").mdp("train:0"), nh.baseline_policy()
     (tmp_path / "junk.bin").write_bytes(b"x")
     return [
-        (lambda: nh.evaluate(base, mdp, episodes=1, n_steps=True), "n_steps=True is out of range"),
-        (lambda: nh.evaluate(base, mdp, episodes=1, seed=True), "seed=True is out of range"),
+        (lambda: nh.evaluate(base, mdp, episodes=1, n_steps=True), "n_steps=True is not allowed"),
+        (lambda: nh.evaluate(base, mdp, episodes=1, seed=True), "seed=True is not allowed"),
         (lambda: nh.evaluate(base, mdp, episodes=1, threads=True), "threads=True is not allowed: give an integer in 1"),
         (lambda: nh.evaluate(base, mdp, episodes=10**8, n_steps=10**7), "100,000,000 episodes of n_steps=10,000,000 are"),
         (lambda: nh.evaluate(base, mdp, episodes=10**5, n_steps=6000, record=True), "recording 100,000 episodes of n_steps=6,000 takes 71.5 GiB"),

@@ -122,7 +122,7 @@ def test_the_ratio_sum_rule_fires_at_the_first_step_whose_signed_ratio_sum_excee
         ({"tilt": 0}, "tilt=0 is out of range"),
         ({"box": float("nan")}, "box=nan is out of range"),
         ({"arm_after": -1}, r"arm_after=-1 is out of range: allowed an integer in 0..1000000"),
-        ({"arm_after": 2.5}, "arm_after=2.5 is out of range"),
+        ({"arm_after": 2.5}, "arm_after=2.5 is not allowed"),
     ],
 )
 def test_bad_settings_are_refused(kwargs: dict, message: str) -> None:

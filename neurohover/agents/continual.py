@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, real_number
+from ..errors import NeurohoverError, brief, finite_real, real_number, whole_in
 from ..evaluate import DangerousState
 from ..flightdata import FlightData
 from ..models.model import LearnedModel
@@ -73,8 +73,9 @@ class ContinualSettings(AgentSettings):
                 raise NeurohoverError(f"continual {name}={brief(v)} is out of range: allowed an integer >= 1")
         for name, unit in (("cooldown", "episodes"), ("safeguard_after", "control steps")):
             v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v <= 10**6:
-                raise NeurohoverError(f"continual {name}={brief(v)} is out of range: allowed an integer in 0..1000000 ({unit})")
+            if type(v) is not int:  # a Python int only: the settings are stored as JSON (a NumPy integer is no JSON number)
+                raise NeurohoverError(f"continual {name}={brief(v)} is not allowed: allowed an integer in 0..1000000 ({unit})")
+            whole_in(v, f"continual {name}", 0, 10**6, f"1000000 ({unit})")
         t = self.threshold
         if not real_number(t) or not finite_real(t) or t <= 1:
             raise NeurohoverError(f"continual threshold={brief(t)} is out of range: allowed a number > 1 (a ratio of one-step errors)")

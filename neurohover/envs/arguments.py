@@ -9,7 +9,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from ..errors import NeurohoverError, brief, whole_number
+from ..errors import NeurohoverError, brief, whole_in, whole_number
 from ..sim.constants import MAX_EPISODE_STEPS
 from ..tasks import MDP, TaskFamily, get_task_family
 from ..tasks.sensor import Sensor
@@ -127,12 +127,8 @@ def check_no_unknown_kwargs(unknown: dict[str, Any], allowed: Sequence[str]) -> 
 
 
 def check_count(value: Any, name: str, largest: int) -> None:
-    """Refuse ``value`` (the argument ``name``) unless it is an integer in 1..``largest``: a non-integer (20.0, '20', True)
-    as not allowed, an integer past the range as out of range (20.0 was called out of range, T22-14)."""
-    if not whole_number(value):  # np.timedelta64 was int()'s TypeError (T17-1)
-        raise NeurohoverError(f"{name}={brief(value)} is not allowed: allowed an integer in 1..{largest}")
-    if not 1 <= value <= largest:
-        raise NeurohoverError(f"{name}={brief(value)} is out of range: allowed an integer in 1..{largest}")
+    """Refuse ``value`` (the argument ``name``) unless it is an integer in 1..``largest`` (:func:`~neurohover.errors.whole_in`)."""
+    whole_in(value, name, 1, largest)
 
 
 def check_episode_steps(episode_steps: Any, name: str = "episode_steps") -> int:

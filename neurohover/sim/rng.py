@@ -14,7 +14,7 @@ import math
 import numba as nb
 import numpy as np
 
-from ..errors import NeurohoverError, brief, whole_number
+from ..errors import NeurohoverError, brief, whole_in, whole_number
 
 _U64 = np.uint64
 _GOLDEN = _U64(0x9E3779B97F4A7C15)
@@ -29,9 +29,7 @@ MAX_SEED = 2**63 - 1
 
 def check_seed(seed) -> int:
     """``seed`` as an int; NeurohoverError unless it is an integer in ``0..2**63-1`` (not a bool)."""
-    if not whole_number(seed) or not 0 <= int(seed) <= MAX_SEED:  # whole_number: np.timedelta64(4) was taken as 4 (T17-1)
-        raise NeurohoverError(f"seed={brief(seed)} is out of range: allowed an integer in 0..2**63-1")
-    return int(seed)
+    return whole_in(seed, "seed", 0, MAX_SEED, "2**63-1")  # np.timedelta64(4) was taken as 4 (T17-1); 1.5 "out of range" (T22-14)
 
 
 @nb.njit(cache=True, inline="always")

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError, as_floats, brief, finite_real, masked_note, whole_number
+from ..errors import NeurohoverError, as_floats, brief, finite_real, masked_note, whole_in, whole_number
 from ..sim.constants import (
     DEFAULT_NOISE_STD,
     DEFAULT_PARAMS,
@@ -320,8 +320,7 @@ def _checked_draws(method):
     def draws(self, rng, n):
         if not isinstance(rng, np.random.Generator):
             raise NeurohoverError(f"rng={rng!r} is not allowed: give a numpy Generator (np.random.default_rng(seed))")
-        if not whole_number(n) or not 0 <= n <= MAX_SAMPLES:  # np.timedelta64 was int()'s TypeError (T17-1)
-            raise NeurohoverError(f"n={brief(n)} is out of range: allowed an integer in 0..{MAX_SAMPLES:,} (MDPs drawn in one call)")
+        whole_in(n, "n", 0, MAX_SAMPLES, f"{MAX_SAMPLES:,} (MDPs drawn in one call)")  # np.timedelta64 was int()'s TypeError (T17-1)
         return method(self, rng, int(n))
 
     return draws
