@@ -7,12 +7,12 @@ of no shape the experiment's plan gives (T20-05)."""
 
 from __future__ import annotations
 
-import shutil
 import sqlite3
 from pathlib import Path
 
 import pytest
 from conftest import CliRun, tiny_test_runs
+from store_edits import damaged, dump, error
 
 from neurohover.errors import NeurohoverError
 from neurohover.experiments import LocalExecutor, Store, reproduce
@@ -45,57 +45,34 @@ def competed(tmp_path_factory) -> Path:
     return where / "s.sqlite"
 
 
-def _damaged(store: Path, at: Path, sql: str) -> Path:
-    """A copy of ``store`` at ``at`` with ``sql`` run on it."""
-    shutil.copyfile(store, at)
-    with sqlite3.connect(at) as conn:
-        conn.execute(sql)
-    conn.close()
-    return at
-
-
-def _dump(path: Path) -> list[str]:
-    """Every row and table of the store, to see that a refused command left it as it was."""
-    with sqlite3.connect(path) as conn:
-        rows = list(conn.iterdump())
-    conn.close()
-    return rows
-
-
-def _error(err: str, command: str) -> str:
-    """The message of ``neurohover COMMAND: error: ...`` on stderr."""
-    line = next(ln for ln in err.splitlines() if ln.startswith(f"neurohover {command}: error: "))
-    return line.removeprefix(f"neurohover {command}: error: ")
-
-
 @pytest.mark.parametrize("sql", ["ALTER TABLE units DROP COLUMN result", "DROP TABLE units", "ALTER TABLE sessions DROP COLUMN status"])
 def test_a_refused_reproduce_leaves_a_store_of_damaged_tables_as_it_was(tiny, tmp_path: Path, cli: CliRun, sql: str) -> None:
     """T19-04: reproduce into a store whose units table lacked a column wrote a new experiments row, then said the store
     was damaged; now the damage is found when the store is opened, before anything is written."""
     config, good = tiny
-    store = _damaged(good, tmp_path / "s.sqlite", sql)
-    before = _dump(store)
+    store = damaged(good, tmp_path / "s.sqlite", sql)
+    before = dump(store)
     other = tmp_path / "other.toml"  # an experiment the store does not hold yet: its row was the one written
     other.write_text(config.read_text().replace('name = "tr1"', 'name = "tr2"'))
     rc, _, err = cli("reproduce", str(other), "--store", str(store), "--no-progress")
     assert rc == 2 and f"results store {str(store)!r} is damaged: its table" in err, err
-    assert _dump(store) == before
+    assert dump(store) == before
 
 
 def test_a_refused_reproduce_of_damaged_units_writes_nothing(tiny, tmp_path: Path) -> None:
     """T19-04: a stored unit that does not read back was found after begin() had rewritten the experiment's config;
     now the stored units are checked first."""
     config, good = tiny
-    path = _damaged(good, tmp_path / "s.sqlite", f"UPDATE units SET kind = 'bogus' WHERE key = '{RUN}'")
+    path = damaged(good, tmp_path / "s.sqlite", f"UPDATE units SET kind = 'bogus' WHERE key = '{RUN}'")
     with sqlite3.connect(path) as conn:
         conn.execute("UPDATE experiments SET config = json_set(config, '$.title', 'older title')")
     conn.close()
-    before = _dump(path)
+    before = dump(path)
     from neurohover.experiments import load_config
 
     with Store(path) as store, pytest.raises(NeurohoverError, match=f"experiment tr1 \\(quick\\), is damaged: unit '{RUN}': unknown unit kind 'bogus'"):
         reproduce(load_config(str(config), "quick"), store, LocalExecutor(1), progress=False)
-    assert _dump(path) == before
+    assert dump(path) == before
 
 
 @pytest.mark.parametrize(
@@ -110,11 +87,11 @@ def test_a_refused_reproduce_of_damaged_units_writes_nothing(tiny, tmp_path: Pat
 def test_wins_refuses_the_damage_results_refuses(tiny, tmp_path: Path, cli: CliRun, sql: str, says: str) -> None:
     """T19-05: wins printed a full table (a unit of kind 'bogus' counted as a test run) where results called the store
     damaged; now both read the experiment through one check and say the same."""
-    store = _damaged(tiny[1], tmp_path / "s.sqlite", sql)
+    store = damaged(tiny[1], tmp_path / "s.sqlite", sql)
     rc, out, err = cli("wins", "tr1", "--store", str(store), "--runs", "1", "--draws", "10")
     assert rc == 2 and out == "" and says in err and str(store) in err, err
     rc, _, err_results = cli("results", "tr1", "--store", str(store))
-    assert rc == 2 and _error(err_results, "results") == _error(err, "wins")
+    assert rc == 2 and error(err_results, "results") == error(err, "wins")
 
 
 @pytest.mark.parametrize(
@@ -129,17 +106,17 @@ def test_wins_refuses_the_damage_results_refuses(tiny, tmp_path: Path, cli: CliR
 def test_compete_refuses_a_damaged_config_and_leaves_the_store_as_it_was(competed: Path, tmp_path: Path, cli: CliRun, sql: str, says: str) -> None:
     """T19-06: compete took a store whose config was 'nope' or '[]', or whose experiments row was gone while its units
     stayed, said "1 of 1 units reused" and wrote the config anew; now it refuses, writing nothing."""
-    store = _damaged(competed, tmp_path / "s.sqlite", sql)
-    before = _dump(store)
+    store = damaged(competed, tmp_path / "s.sqlite", sql)
+    before = dump(store)
     rc, _, err = cli(*COMPETE, "--out", str(tmp_path / "c"), "--store", str(store))
     assert rc == 2 and says in err and str(store) in err and "reused" not in err, err
-    assert _dump(store) == before
+    assert dump(store) == before
 
 
 def test_report_warns_of_each_damaged_experiment_and_exits_2_when_none_is_reported(tiny, tmp_path: Path, cli: CliRun) -> None:
     """T19-07: a report of a store whose every experiment was damaged exited 0 with "report written", the damage said
     only inside report.md; now each damaged experiment is one warning line on stderr, and nothing reported is exit 2."""
-    store = _damaged(tiny[1], tmp_path / "s.sqlite", f"UPDATE units SET kind = 'bogus' WHERE key = '{RUN}'")
+    store = damaged(tiny[1], tmp_path / "s.sqlite", f"UPDATE units SET kind = 'bogus' WHERE key = '{RUN}'")
     rc, out, err = cli("report", "--store", str(store), "--out", str(tmp_path / "r"))
     warning = f"neurohover report: warning: tr1 (quick) is not reported: results store {str(store)!r}, experiment tr1 (quick), is damaged: unit '{RUN}'"
     assert rc == 2 and out == "" and warning in err and "nothing could be reported" in err, err
@@ -171,7 +148,7 @@ def test_report_warns_of_each_damaged_experiment_and_exits_2_when_none_is_report
 def test_results_names_the_store_and_the_unit(tiny, tmp_path: Path, cli: CliRun, sql: str, says: str) -> None:
     """T19-14: results said "unknown unit kind 'bogus'" and "test run of baseline on ... is inconsistent" naming neither
     the store nor the unit."""
-    store = _damaged(tiny[1], tmp_path / "s.sqlite", sql)
+    store = damaged(tiny[1], tmp_path / "s.sqlite", sql)
     rc, _, err = cli("results", "tr1", "--store", str(store))
     assert rc == 2 and f"results store {str(store)!r}, experiment tr1 (quick), is damaged: unit '{RUN}': " in err and says in err, err
 
@@ -192,8 +169,8 @@ def test_every_command_refuses_a_config_hash_that_is_not_its_configs(tiny, tmp_p
     """T20-04: an experiment whose config_hash was 'deadbeef' was exported and reported (rc 0), and a unit run under
     hash 'x' was reused by reproduce; now the shared check refuses both, in results, wins, report and reproduce alike."""
     config, good = tiny
-    store = _damaged(good, tmp_path / "s.sqlite", sql)
-    before = _dump(store)
+    store = damaged(good, tmp_path / "s.sqlite", sql)
+    before = dump(store)
     where = f"results store {str(store)!r}, experiment tr1 (quick), is damaged: "
     rc, out, err = cli("results", "tr1", "--store", str(store), "--format", "json")
     assert rc == 2 and out == "" and where in err and says in err, err
@@ -203,14 +180,14 @@ def test_every_command_refuses_a_config_hash_that_is_not_its_configs(tiny, tmp_p
     assert rc == 2 and where in err and says in err and not (tmp_path / "r").exists(), err
     rc, _, err = cli("reproduce", str(config), "--store", str(store), "--no-progress")
     assert rc == 2 and where in err and says in err and "already in the store" not in err, err
-    assert _dump(store) == before
+    assert dump(store) == before
 
 
 @pytest.mark.parametrize("key", ["run/../../x", "run/baseline/test0/rep00", "model/lr/test0", "u00"])
 def test_every_command_refuses_a_unit_key_of_no_planned_shape(tiny, tmp_path: Path, cli: CliRun, key: str) -> None:
     """T20-05: a unit key changed to 'run/../../x' was exported by results and drawn by report (rc 0), and wins said "no
     stored test runs"; now the shared check refuses a key of no shape the experiment's kind plans, naming the unit."""
-    store = _damaged(tiny[1], tmp_path / "s.sqlite", f"UPDATE units SET key = '{key}' WHERE key = 'run/generic/test0/rep0'")
+    store = damaged(tiny[1], tmp_path / "s.sqlite", f"UPDATE units SET key = '{key}' WHERE key = 'run/generic/test0/rep0'")
     says = f"experiment tr1 (quick), is damaged: unit {key!r}: its key is of no shape a test_runs experiment plans"
     for argv in (
         ("results", "tr1", "--store", str(store)),
@@ -231,7 +208,7 @@ def test_the_shared_check_keeps_a_sound_store_and_a_diagnostic_units_own_key(tin
     with Store(tiny[1], create=False) as store:
         config, units, results = checked_units(store, "tr1", "quick")
     assert config.hash and sorted(results) == [RUN, "run/generic/test0/rep0"] and len(units) == 2
-    store_path = _damaged(tiny[1], tmp_path / "s.sqlite", f"DELETE FROM units WHERE key != '{RUN}'")
+    store_path = damaged(tiny[1], tmp_path / "s.sqlite", f"DELETE FROM units WHERE key != '{RUN}'")
     with sqlite3.connect(store_path) as conn:
         conn.execute("UPDATE units SET key = 'u00', kind = 'diagnostic', result = '{\"value\":1,\"seed\":3}'")
     conn.close()
@@ -242,7 +219,7 @@ def test_the_shared_check_keeps_a_sound_store_and_a_diagnostic_units_own_key(tin
 def test_an_experiment_row_whose_config_is_of_another_scale_is_refused(tiny, tmp_path: Path, cli: CliRun) -> None:
     """T21-01: a copy of a quick experiment's row at scale 'paper' was reported as a paper-scale section, its quick
     numbers printed under "Claims and conclusions (paper scale)"; the shared check now refuses the row."""
-    store = _damaged(tiny[1], tmp_path / "s.sqlite", "INSERT INTO experiments SELECT name, 'paper', config_hash, config, created FROM experiments")
+    store = damaged(tiny[1], tmp_path / "s.sqlite", "INSERT INTO experiments SELECT name, 'paper', config_hash, config, created FROM experiments")
     says = f"results store {str(store)!r}, experiment tr1 (paper), is damaged: its row is at scale 'paper' but its config is the 'quick' one"
     rc, _, err = cli("report", "--store", str(store), "--out", str(tmp_path / "r"), "--scale", "paper")
     assert rc == 2 and says in err, err

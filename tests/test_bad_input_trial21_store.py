@@ -4,12 +4,11 @@ config row (orphans) are named as damage, not ignored (T21-15)."""
 
 from __future__ import annotations
 
-import shutil
-import sqlite3
 from pathlib import Path
 
 import pytest
 from conftest import CliRun, tiny_test_runs
+from store_edits import damaged, dump, error
 
 from neurohover.errors import NeurohoverError
 from neurohover.experiments import Store
@@ -31,28 +30,6 @@ def tiny(tmp_path_factory) -> tuple[Path, Path]:
     return config, where / "s.sqlite"
 
 
-def _damaged(store: Path, at: Path, sql: str) -> Path:
-    """A copy of ``store`` at ``at`` with ``sql`` run on it."""
-    shutil.copyfile(store, at)
-    with sqlite3.connect(at) as conn:
-        conn.execute(sql)
-    conn.close()
-    return at
-
-
-def _dump(path: Path) -> list[str]:
-    with sqlite3.connect(path) as conn:
-        rows = list(conn.iterdump())
-    conn.close()
-    return rows
-
-
-def _error(err: str, command: str) -> str:
-    """The message of ``neurohover COMMAND: error: ...`` on stderr."""
-    line = next(ln for ln in err.splitlines() if ln.startswith(f"neurohover {command}: error: "))
-    return line.removeprefix(f"neurohover {command}: error: ")
-
-
 @pytest.mark.parametrize(
     ("edit", "says"),
     [
@@ -65,25 +42,25 @@ def test_every_command_refuses_a_unit_whose_params_were_changed(tiny, tmp_path: 
     exported by results and reported by report; now the shared check refuses it everywhere, in one message naming the
     store, the experiment, the unit and the setting changed."""
     config, good = tiny
-    store = _damaged(good, tmp_path / "s.sqlite", f"UPDATE units SET params = json_set(params, {edit}) WHERE key = '{RUN}'")
-    before = _dump(store)
+    store = damaged(good, tmp_path / "s.sqlite", f"UPDATE units SET params = json_set(params, {edit}) WHERE key = '{RUN}'")
+    before = dump(store)
     message = f"results store {str(store)!r}, experiment tr1 (quick), is damaged: unit '{RUN}' holds other settings than its config plans for it ("
     rc, out, err = cli("results", "tr1", "--store", str(store))
     assert rc == 2 and out == "" and message in err and says in err, err
-    line = _error(err, "results")
+    line = error(err, "results")
     for argv, command in (
         (("results", "tr1", "--store", str(store), "--format", "json"), "results"),
         (("wins", "tr1", "--store", str(store), "--runs", "1", "--draws", "10"), "wins"),
         (("reproduce", str(config), "--store", str(store), "--no-progress"), "reproduce"),
     ):
         rc, out, err = cli(*argv)
-        assert rc == 2 and _error(err, command) == line, (argv, err)
+        assert rc == 2 and error(err, command) == line, (argv, err)
     rc, out, err = cli("report", "--store", str(store), "--out", str(tmp_path / "r"))
     assert rc == 2 and f"is not reported: {line}" in err and not (tmp_path / "r").exists(), err
     with Store(store, create=False) as held, pytest.raises(NeurohoverError) as caught:
         checked_units(held, "tr1", "quick")
     assert str(caught.value) == line
-    assert _dump(store) == before
+    assert dump(store) == before
 
 
 #: A copy of RUN's row under another name or scale ({name}, {scale}: SQL, a column's name keeps it).
@@ -94,8 +71,8 @@ def test_every_command_names_units_at_a_scale_of_no_config_as_damage(tiny, tmp_p
     """T21-15: a quick unit copied to scale 'paper', where the store holds no config of tr1, was ignored: results and
     report exported the quick experiment, reproduce ran it (rc 0); now each calls the store damaged, naming the rows."""
     config, good = tiny
-    store = _damaged(good, tmp_path / "s.sqlite", COPY.format(name="name", scale="'paper'"))
-    before = _dump(store)
+    store = damaged(good, tmp_path / "s.sqlite", COPY.format(name="name", scale="'paper'"))
+    before = dump(store)
     says = (
         f"results store {str(store)!r}, experiment tr1 (paper), is damaged: it holds 1 finished unit(s) of it but no record of its config, "
         f"so they cannot be checked (the first: unit '{RUN}')"
@@ -107,16 +84,16 @@ def test_every_command_names_units_at_a_scale_of_no_config_as_damage(tiny, tmp_p
         (("reproduce", str(config), "--store", str(store), "--no-progress"), "reproduce"),
     ):
         rc, out, err = cli(*argv)
-        assert rc == 2 and out == "" and _error(err, command).startswith(says), (argv, err)
+        assert rc == 2 and out == "" and error(err, command).startswith(says), (argv, err)
     rc, out, err = cli("report", "--store", str(store), "--out", str(tmp_path / "r"))
     assert rc == 2 and f"tr1 (quick) is not reported: {says}" in err and not (tmp_path / "r").exists(), err
-    assert _dump(store) == before
+    assert dump(store) == before
 
 
 def test_report_warns_of_units_of_an_experiment_it_holds_no_config_of(tiny, tmp_path: Path, cli: CliRun) -> None:
     """T21-15: units of an experiment 'ghost' with no config row at all were left out of the report without a word;
     now one warning line names them (the report of the sound experiments written), and asked for alone they are refused."""
-    store = _damaged(tiny[1], tmp_path / "s.sqlite", COPY.format(name="'ghost'", scale="scale"))
+    store = damaged(tiny[1], tmp_path / "s.sqlite", COPY.format(name="'ghost'", scale="scale"))
     says = f"ghost (quick) is not reported: results store {str(store)!r}, experiment ghost (quick), is damaged: it holds 1 finished unit(s) of it"
     rc, out, err = cli("report", "--store", str(store), "--out", str(tmp_path / "r"))
     assert rc == 0 and "report written" in out and f"neurohover report: warning: {says}" in err, err
