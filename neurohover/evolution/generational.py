@@ -346,6 +346,11 @@ class GenerationalNE:
         return self._prototype.size
 
     @property
+    def prototype(self) -> np.ndarray:
+        """The genome the first population was bred from (a copy)."""
+        return self._prototype.copy()
+
+    @property
     def generation(self) -> int:
         """Generations completed (tells so far)."""
         return self._generation

@@ -89,7 +89,7 @@ def _check_between_generations(opt: Optimiser) -> None:
 def _check_prototype(opt: Optimiser, genome: np.ndarray) -> None:
     """EntryError unless restored optimiser ``opt``'s prototype (steady state's and generational NE's keep one) is the
     config's ``genome``, which bred its first population: a prototype gene of 9.0 beside the config's 0.0 was taken (T22-12)."""
-    mine = getattr(opt, "_prototype", None)
+    mine = opt.prototype if isinstance(opt, (GenerationalNE, SteadyStateNE)) else None
     if not isinstance(mine, np.ndarray):
         return
     if mine.shape != genome.shape:

@@ -405,6 +405,11 @@ class SteadyStateNE(ChampionViews):
         return self._prototype.size
 
     @property
+    def prototype(self) -> np.ndarray:
+        """The genome the first population was bred from (a copy)."""
+        return self._prototype.copy()
+
+    @property
     def generation(self) -> int:
         """Number of :meth:`tell` calls so far (the initial population is generation 1)."""
         return self._generation
