@@ -26,7 +26,7 @@ from typing import Any
 from ..errors import NeurohoverError, brief, whole_number
 from ..evaluate import DEVICES, check_device
 from ..procs import max_jobs, sigterm_as_interrupt, stop_pool, worker_pool
-from .store import worker_name
+from .store import EXECUTORS, worker_name
 from .units import Unit, run_unit
 
 OnResult = Callable[[Unit, dict, float, str], None]
@@ -56,7 +56,7 @@ class LocalExecutor:
     """Run units here (``jobs=1``) or in ``jobs`` spawned processes, flying on ``device``
     (``"cpu"`` or ``"cuda"``; with ``jobs > 1`` every worker process uses the same GPU)."""
 
-    name = "local"
+    name = EXECUTORS[0]  # the names a store's sessions may hold
 
     def __init__(self, jobs: int = 1, device: str = "cpu") -> None:
         jobs = check_jobs(jobs)
@@ -202,7 +202,7 @@ class RayExecutor:
     ``device`` is where the tasks fly (``"cuda"``: each node needs a GPU; it is checked there).
     """
 
-    name = "ray"
+    name = EXECUTORS[1]
 
     def __init__(self, address: str | None = None, *, max_retries: int = 3, num_cpus: int | None = None, device: str = "cpu") -> None:
         if not isinstance(device, str) or device not in DEVICES:  # an array was numpy's 'truth value is ambiguous' (T18-3)
