@@ -54,6 +54,32 @@ _MOVED = {
 }
 
 
+#: The globals a CMA or UH-CMA state's pickle names besides pycma's classes (found by loading real states; numpy.core is
+#: NumPy 1's name of numpy._core): nothing else is looked up when a state is read back (T23-12).
+_PICKLED = frozenset(
+    {
+        ("cma.evolution_strategy", "_pass"),
+        ("cma.options_parameters", "is_feasible"),
+        ("neurohover.evolution.common", "ChampionRecord"),
+        ("neurohover.evolution.common", "ChampionTracker"),
+        ("neurohover.evolution.common", "Clock"),
+        ("neurohover.evolution.optimisers.cma", "CMAES"),
+        ("neurohover.evolution.optimisers.uh_cma", "UHCMAES"),
+        ("numpy", "dtype"),
+        ("numpy", "median"),
+        ("numpy", "ndarray"),
+        ("numpy.linalg", "eigh"),
+        ("numpy.random._pcg64", "PCG64"),
+        ("numpy.random._pickle", "__bit_generator_ctor"),
+        ("numpy.random._pickle", "__generator_ctor"),
+        ("numpy.random.bit_generator", "SeedSequence"),
+        ("numpy.random.bit_generator", "__pyx_unpickle_SeedSequence"),
+        *((core, name) for core in ("numpy._core.multiarray", "numpy.core.multiarray") for name in ("_reconstruct", "scalar")),
+        *(("builtins", name) for name in ("range", "slice", "complex", "set", "frozenset", "bytearray", "object")),  # plain data
+    }
+)
+
+
 class _Randn:
     """pycma's ``randn`` option drawing from the CMAES wrapper's private generator (rebuilt on load)."""
 
@@ -86,8 +112,18 @@ class _Unpickler(pickle.Unpickler):
         return self._randn
 
     def find_class(self, module: str, name: str):
+        """Only what a CMA state holds: pycma's classes, the few functions and NumPy and neurohover names it pickles
+        (:data:`_PICKLED`). Any other global was looked up and called as the pickle said: a checkpoint's pickle of
+        os.mkdir made its directory before the resume was refused (T23-12)."""
         moved = _MOVED.get((module, name))
-        return getattr(*moved) if moved is not None else super().find_class(module, name)
+        if moved is not None:
+            return getattr(*moved)
+        if (module, name) not in _PICKLED and not module.startswith("cma."):
+            raise EntryError(f"its pickle names {brief(f'{module}.{name}')}, which no CMA state holds: allowed the pickle state_dict() wrote")
+        found = super().find_class(module, name)
+        if module.startswith("cma.") and (module, name) not in _PICKLED and not (isinstance(found, type) and found.__module__ == module):
+            raise EntryError(f"its pickle names {brief(f'{module}.{name}')}, no class of pycma: allowed the pickle state_dict() wrote")
+        return found
 
 
 def losses_of(returns: np.ndarray) -> np.ndarray:
