@@ -238,9 +238,11 @@ def cmd_report(args: argparse.Namespace) -> int:
     """Draw the paper's figures from the results store and write a Markdown report beside the paper's numbers."""
     from ..experiments import Store, write_report
     from ..experiments.export import orphan_message
+    from ..experiments.report import check_names
     from ..paths import input_file, output_dir
 
     input_file(args.store, "--store", "results store")
+    check_names(args.names or None)  # before anything is opened or made (T23-18)
     with Store(args.store, create=False) as store:
         held = {n for n, s, _, _ in store.experiments() if args.scale is None or s == args.scale}
         missing = [n for n in args.names or () if n not in held]

@@ -42,8 +42,7 @@ WIN_RUNS = (1, 5, 20)
 
 def crash_rate(crashes: int, episodes: int) -> str:
     """A crash fraction as a percentage that is never 0 % when some episode crashed (1 of 20,000: 0.005%)."""
-    # (1, 0) was a ZeroDivisionError, (5, 2) '250%' and (-1, 2) '-50%' (thirteenth trial, F20)
-    if not whole_number(episodes) or episodes < 1:
+    if not whole_number(episodes) or episodes < 1:  # (1, 0) was a ZeroDivisionError, (5, 2) '250%' (thirteenth trial, F20)
         raise NeurohoverError(f"episodes={brief(episodes)} is not allowed: give a whole number of episodes >= 1")
     if not whole_number(crashes) or not 0 <= crashes <= episodes:
         raise NeurohoverError(f"crashes={brief(crashes)} is not allowed: give a whole number of crashed episodes from 0 to episodes={episodes}")
@@ -504,6 +503,19 @@ def _discussion(cfg: ExperimentConfig, out: Path) -> str:
     )
 
 
+def check_names(names: object) -> None:
+    """NeurohoverError unless ``names`` (:func:`write_report`'s) is None or a non-empty list of experiment names, each
+    given once; ``neurohover report`` asks it before making --out (T23-18: 'fig2 fig2' made the folder, then removed it).
+    'fig2' was read as f, i, g, 2; 5 (any number, np.ma.masked) was a TypeError (seventeenth trial, T17-5)."""
+    if names is not None and (not isinstance(names, (list, tuple)) or not all(isinstance(n, str) for n in names)):
+        raise NeurohoverError(f"names={brief(names)} is not allowed: give a list of experiment names, e.g. ['fig2']")
+    if names is not None and not names:  # [] was read as None and reported every experiment (thirteenth trial, F21)
+        raise NeurohoverError(f"names={brief(names)} is not allowed: give one or more experiment names, or None for all")
+    twice = sorted({n for n in names or () if list(names or ()).count(n) > 1})
+    if twice:  # taken once without a word (seventh trial)
+        raise NeurohoverError(f"experiment {twice[0]!r} is named more than once: give each once")
+
+
 def write_report(store: Store, out: str | Path, *, scale: str | None = None, names: list[str] | None = None, refuse_all_damaged: bool = False) -> Path:
     """Write figures and ``report.md`` for the experiments in ``store`` into ``out``; returns report.md's path.
 
@@ -515,17 +527,9 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
 
     if not isinstance(store, Store):  # None was an AttributeError (sixth trial)
         raise NeurohoverError(f"store={store!r:.60} is not allowed: give a Store(PATH)")
-    # 'fig2' was read as f, i, g, 2; 5 (any number, np.ma.masked) was a TypeError (seventeenth trial, T17-5)
-    if names is not None and (not isinstance(names, (list, tuple)) or not all(isinstance(n, str) for n in names)):
-        raise NeurohoverError(f"names={brief(names)} is not allowed: give a list of experiment names, e.g. ['fig2']")
     if scale is not None and not isinstance(scale, str):  # an array was numpy's 'truth value is ambiguous' (T18-3)
         raise NeurohoverError(f"scale={brief(scale)} is not allowed: give a scale's name, e.g. 'quick', or None for all")
-    if names is not None and not list(names):  # [] was read as None and reported every experiment (thirteenth trial, F21)
-        raise NeurohoverError(f"names={brief(names)} is not allowed: give one or more experiment names, or None for all")
-    given = list(names or ())
-    twice = sorted({n for n in given if given.count(n) > 1})
-    if twice:  # taken once without a word (seventh trial)
-        raise NeurohoverError(f"experiment {twice[0]!r} is named more than once: give each once")
+    check_names(names)
     check_flag(refuse_all_damaged, "refuse_all_damaged", "write nothing when every experiment is damaged")
     with created_dirs_removed_on_failure():  # a failure leaves no directory it made, as on the command line (eleventh trial)
         out = output_dir(out, "report directory")  # '' wrote into the current directory; a file, a device or 5: OSError, TypeError
