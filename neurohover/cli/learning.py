@@ -358,10 +358,13 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
             model = learn_ec_meno(data, seed=seed, **extra)
         else:
             model = learn_ec_mer(data, ec_mer_policy(args.policy, data, args.flight_data), seed=seed, **extra)
-    model.save(out)  # written whole or not at all (a failed write: one message, the old file as it was)
     truth, why = _true_mdp(data.metadata)
+    try:  # before the model is written: a refused MDP left m.json behind its refusal (T23-01)
+        rows = parameter_table(model, truth)
+    except NeurohoverError as err:
+        raise NeurohoverError(f"flight-data file {args.flight_data!r}: its metadata's MDP {brief(truth.label if truth else '')}: {err}") from None
+    model.save(out)  # written whole or not at all (a failed write: one message, the old file as it was)
     print(f"{args.method} model written to {printable(out)} ({time.perf_counter() - start:.2f} s)")
-    rows = parameter_table(model, truth)
     if truth is not None:
         print(f"learned parameters (converted to the simulator's 10 substeps) next to the true ones of {truth.label or 'the MDP'}:")
     else:
