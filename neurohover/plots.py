@@ -257,8 +257,8 @@ def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight"
         )
     check_metadata(data.metadata, np.array([a.shape[0] for a in data.actions], dtype=np.int64), "flight data")  # episode_steps 'x' (T14-10)
     steps = data.metadata.get("episode_steps", EPISODE_STEPS)
-    for i in range(data.n_episodes):  # every episode before any file is written, as learn-model reads them all
-        check_flown(data.observations[i], data.actions[i], episode_crashed(data, i), f"flight data, episode {i}")
+    for i, crashed in enumerate(crash_flags(data)):  # every episode before any file is written, as learn-model reads them all
+        check_flown(data.observations[i], data.actions[i], crashed, f"flight data, episode {i}")
     width = len(str(max(data.n_episodes - 1, 0)))
     chosen = range(data.n_episodes) if episodes is None else _episode_list(episodes, data.n_episodes)
     out_dir = output_dir(out_dir, "out_dir")  # a file, FIFO or /dev/null was NotADirectoryError (T14-10); made, saying so, if missing
@@ -351,9 +351,9 @@ def _check_row(where: str, row: dict, crashed: int, steps: int | None) -> None:
         ("safeguard_fired", row.get("safeguard_fired") or "0", "the safeguard took over"),
     ):
         if value not in (0, 1, "0", "1"):
-            raise NeurohoverError(f"{where}: {name} {row[name]!r:.30} is not allowed: 0 or 1 (whether {meaning})")
+            raise NeurohoverError(f"{where}: {name} {brief(row[name])} is not allowed: 0 or 1 (whether {meaning})")
     if steps is not None and not 1 <= steps <= MAX_EPISODE_STEPS:
-        raise NeurohoverError(f"{where}: steps {row['steps']!r:.30} is not allowed: an episode's steps, an integer in 1..{MAX_EPISODE_STEPS:,}")
+        raise NeurohoverError(f"{where}: steps {brief(row['steps'])} is not allowed: an episode's steps, an integer in 1..{MAX_EPISODE_STEPS:,}")
 
 
 def read_compete_dir(path: str | Path) -> CompeteResult:
