@@ -20,7 +20,7 @@ import json
 from ..errors import NeurohoverError, brief, first_difference
 from .config import ExperimentConfig
 from .keys import UnitKey
-from .plans import external_digest, plan, run_keys, source_experiments
+from .plans import Plan, external_digest, plan, run_keys, source_experiments
 from .result_checks import params_problem
 from .results import UnitResult, check_run_lengths, flat_cells, result_from_dict
 from .store import Store
@@ -125,17 +125,18 @@ def _replannable(config: ExperimentConfig) -> bool:
         return False
 
 
-def _check_planned(store: Store, config: ExperimentConfig, units: list[dict]) -> None:
+def _check_planned(store: Store, config: ExperimentConfig, units: list[dict]) -> Plan | None:
     """Refuse a stored unit its stored config does not plan, or one whose kind or params (the seed, the episodes) are not
     those the config plans for its key: reproduce refused both (seventh, eighth trial) while results and report exported
     a unit whose seed was edited in the store (T21-02). The plan is made from every stored unit (a later stage is planned
     from earlier results); a test run planned only once its policies are stored is checked by its key alone. A
-    'diagnostic' unit (the tests' own plans) is not planned by any config."""
+    'diagnostic' unit (the tests' own plans) is not planned by any config. Returns the plan (None where none was made)."""
     checked = [u for u in units if u["kind"] != "diagnostic"]
     if not checked or not _replannable(config):
-        return
+        return None
     sources = {n: store.results(n, config.scale) for n in source_experiments(config)}
-    planned = {u.key: u for u in plan(config, {u["key"]: u["result"] for u in units}, sources).units}
+    made = plan(config, {u["key"]: u["result"] for u in units}, sources)
+    planned = {u.key: u for u in made.units}
     known = set(planned) | set(run_keys(config))
     stray = sorted(u["key"] for u in checked if u["key"] not in known)
     if stray:
@@ -152,6 +153,7 @@ def _check_planned(store: Store, config: ExperimentConfig, units: list[dict]) ->
                 f"unit {u['key']!r} holds other settings than its config plans for it ({differ.replace(', given ', ', planned ')}): "
                 "it was changed in the store (reproduce --fresh starts it over)"
             )
+    return made
 
 
 def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig, list[dict], dict[str, UnitResult]]:
@@ -178,6 +180,13 @@ def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig
         (T21-15; :meth:`Store.orphan_units`), and a result that contradicts its unit's params (an agent, MDP or crash
         step of none they name; T22-07, T22-08: :func:`~neurohover.experiments.result_checks.params_problem`).
     """
+    return checked_experiment(store, name, scale)[:3]
+
+
+def checked_experiment(store: Store, name: str, scale: str) -> tuple[ExperimentConfig, list[dict], dict[str, UnitResult], Plan | None]:
+    """:func:`checked_units`' config, units and results, and the plan its check made of the stored config and units
+    (None where it made none: no units, or policies from outside the store that changed): reproduce's first round, so a
+    resumed experiment is planned once, not again after its check."""
     where = f"results store {str(store.path)!r}, experiment {name} ({scale}), is damaged"
     refuse_orphans(store, name)  # its units at a scale of no config row, ignored (T21-15): refuse_orphans says why
     stored = store.config(name, scale)  # the store names a row that is no JSON object itself, as for the units below
@@ -203,14 +212,14 @@ def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig
             raise NeurohoverError(f"{where}: {unit}{err}") from None
     try:
         _check_hashes(store, name, scale, stored, config)
-        _check_planned(store, config, units)
+        made = _check_planned(store, config, units)
     except NeurohoverError as err:
         raise NeurohoverError(f"{where}: {err}") from None
     for u in units:  # a result must be its unit's (T22-07, T22-08); after the plan check, which names params changed
         problem = params_problem(results[u["key"]], u["params"])
         if problem:
             raise NeurohoverError(f"{where}: unit {u['key']!r}: its result contradicts its params: {problem}")
-    return config, units, results
+    return config, units, results, made
 
 
 def export_results(store: Store, name: str, fmt: str = "csv", scale: str | None = None) -> str:

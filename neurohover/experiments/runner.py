@@ -142,18 +142,20 @@ def _matches_no_unit(config, pattern: str, units) -> NeurohoverError:
     return NeurohoverError(f"{config.name}: --only {pattern!r} matches no unit; unit keys look like {', '.join(examples[:6])}")
 
 
-def _checked_results(config: ExperimentConfig, store: Store, held: str | None) -> dict[str, dict]:
+def _checked_results(config: ExperimentConfig, store: Store, held: str | None) -> tuple[dict[str, dict], Plan | None]:
     """Key -> result of every stored unit of the experiment, each read back and checked (:func:`~.export.checked_units`,
     results' check): a damaged unit was counted as finished and never run again (fifth trial), a unit the config does
     not plan was counted as done (seventh trial), one of other params reused (eighth trial). Called before anything is
     written (``held``: the stored config hash, None: no config stored), so a refused run leaves the store as it was: a
-    damaged config was rewritten, and units whose config was gone were taken in, by compete (T19-06)."""
-    from .export import checked_units, refuse_orphans
+    damaged config was rewritten, and units whose config was gone were taken in, by compete (T19-06). Also the plan the
+    check made of them (None where it made none), the run's first round: a resumed experiment is planned once."""
+    from .export import checked_experiment, refuse_orphans
 
     if held is None:  # units of it at a scale of no config row, this one's or another's (T21-15)
         refuse_orphans(store, config.name)
-        return {}
-    return {unit["key"]: unit["result"] for unit in checked_units(store, config.name, config.scale)[1]}
+        return {}, None
+    _, units, _, made = checked_experiment(store, config.name, config.scale)
+    return {unit["key"]: unit["result"] for unit in units}, made
 
 
 def _check_arguments(config, store, executor, progress, on_unit, only, fresh, update) -> tuple[str, ...]:
@@ -244,9 +246,9 @@ def reproduce(
         print(f"{config.name} ({config.scale}): the config changed (hash {held} -> {config.hash}); {kept} stored units stand unchanged", file=sys.stderr)
         checked = None  # fewer units now: read again
     store.begin(config.name, config.scale, config.hash, config.to_dict(), fresh=fresh)
-    results = checked if checked is not None else _checked_results(config, store, config.hash)  # read once: checked, then the finished units
+    results, made = checked if checked is not None else _checked_results(config, store, config.hash)  # read and planned once
     sources = {name: store.results(name, config.scale) for name in source_experiments(config)}
-    first_round: Plan | None = plan(config, results, sources)
+    first_round: Plan | None = made if made is not None else plan(config, results, sources)
     summary = RunSummary(config.name, config.scale, executor.name, executor.cores, units_before=len(results))
     session: int | None = store.start_session(config.name, config.scale, config.hash, executor.name, summary.cores, len(results))
     start = time.perf_counter()
