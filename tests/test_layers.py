@@ -14,8 +14,8 @@ PACKAGE = Path(neurohover.__file__).resolve().parent
 LAYERS = [
     {"command", "errors", "paths", "procs", "progress", "settingsdoc"},
     {"sim"},
-    {"tasks", "flightdata", "policies", "netfile", "wrappers"},
-    {"launch", "flyer", "plots"},
+    {"tasks", "flightdata", "flightmeta", "policies", "netfile", "wrappers"},
+    {"launch", "flyer", "plots", "compete_files"},
     {"evaluate"},
     {"evolution", "envs"},
     {"models", "policysets", "manifest", "integrations"},
