@@ -114,7 +114,7 @@ def test_compete_curves_named_with_bytes_that_are_no_utf8_are_plotted(tmp_path: 
 @pytest.mark.parametrize("value", [None, 5])
 def test_read_compete_dir_and_policy_dir_name_a_value_that_is_no_path(value) -> None:
     """T9: read_compete_dir(None) and (5) were pathlib's TypeError, policy_dir(None) a TypeError on '/'."""
-    from neurohover.plots import read_compete_dir
+    from neurohover.compete_files import read_compete_dir
     from neurohover.policysets import policy_dir
 
     with pytest.raises(NeurohoverError, match=rf"^--compete={value!r} is not allowed: give a directory$"):

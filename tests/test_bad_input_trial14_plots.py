@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from neurohover.compete_files import read_compete_dir
 from neurohover.errors import NeurohoverError
 from neurohover.flightdata import FlightData
 from neurohover.paths import printable, write_png, writing
@@ -23,7 +24,6 @@ from neurohover.plots import (
     new_figure,
     plot_compete,
     plot_flight_data,
-    read_compete_dir,
     save_figure,
 )
 

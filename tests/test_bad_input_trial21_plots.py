@@ -11,9 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from neurohover.compete_files import read_compete_dir
 from neurohover.errors import NeurohoverError
 from neurohover.flightdata import FlightData
-from neurohover.plots import flight_figure, plot_flight_data, read_compete_dir
+from neurohover.plots import flight_figure, plot_flight_data
 
 NOT_FLOWN = "no flight records a NaN or infinite observation, a crash's last one included; give flight data as flown"
 

@@ -137,7 +137,7 @@ def _rows(line: int = 0, value: str = "", column: int = 0) -> str:
 def test_a_compete_crash_flag_other_than_0_or_1_is_refused_with_its_line(tmp_path: Path, cli, value: str) -> None:
     """T22-03: episodes.csv line 2's crashed set to -1 (the summary's crash figures removed) was plotted as "-1 crashes"
     and read as CompeteResult.crashes == -1; now refused, naming the line and the value, status 2 on the command line."""
-    from neurohover.plots import read_compete_dir
+    from neurohover.compete_files import read_compete_dir
 
     assert read_compete_dir(_competition(tmp_path / "ok", _rows())).crashes == 0
     folder = _competition(tmp_path / "c1", _rows(2, value, 4))
@@ -168,7 +168,7 @@ def test_compete_rows_and_conditions_compete_never_writes_are_refused_by_name(tm
     """T22-04: in episodes.csv steps -5 (a summary without episode_steps), run 10**30, mdp 'zzz' and safeguard_fired 7, and
     in summary.json sigma NaN, sensor {"level": -5} and drift "junk" were all plotted without a word; each is refused,
     naming the file, line or key and the value."""
-    from neurohover.plots import read_compete_dir
+    from neurohover.compete_files import read_compete_dir
 
     with pytest.raises(NeurohoverError, match=f"^--compete '{re.escape(str(tmp_path / 'c'))}/{re.escape(message)}"):
         read_compete_dir(_competition(tmp_path / "c", _rows(2, value, column), **summary))
@@ -177,7 +177,7 @@ def test_compete_rows_and_conditions_compete_never_writes_are_refused_by_name(tm
 def test_compete_conditions_compete_writes_are_read(tmp_path: Path) -> None:
     """T22-04: what compete writes is read: a sigma, a sensor's and a drift's settings, and no drift written as Drift()
     writes itself (walk 0, no change), which Drift.from_dict alone would call a drift of nothing."""
-    from neurohover.plots import read_compete_dir
+    from neurohover.compete_files import read_compete_dir
     from neurohover.tasks import Drift, Sensor
 
     for i, (name, value) in enumerate(

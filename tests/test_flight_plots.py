@@ -17,6 +17,7 @@ import pytest
 
 import neurohover as nh
 from neurohover.cli import main
+from neurohover.compete_files import read_compete_dir
 from neurohover.errors import NeurohoverError
 from neurohover.flightdata import FlightData
 from neurohover.plots import (
@@ -27,7 +28,6 @@ from neurohover.plots import (
     flight_figure,
     plot_compete,
     plot_flight_data,
-    read_compete_dir,
 )
 from neurohover.policies import prototype, save_policy
 

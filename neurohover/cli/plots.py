@@ -67,7 +67,8 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
         written = plot_flight_data(data, out, stem=path.stem, episodes=_episodes(args.episodes, data.n_episodes))
     else:
-        from ..plots import compete_figure, read_compete_dirs, save_figure
+        from ..compete_files import read_compete_dirs
+        from ..plots import compete_figure, save_figure
 
         results = read_compete_dirs(args.compete)  # every directory checked and read before anything is written
         out = output_dir(args.out if args.out is not None else results[0].path.resolve().parent, "--out")
