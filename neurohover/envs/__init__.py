@@ -13,6 +13,11 @@ crash-aware reward built in, for a library's default settings (:mod:`neurohover.
 (:data:`DRIFT_ENV_SETTINGS`, :mod:`neurohover.tasks.drift`). ``gymnasium.make`` builds :class:`HoverEnv`;
 ``gymnasium.make_vec(..., vectorization_mode="vector_entry_point")`` builds
 :class:`HoverVectorEnv`, which steps every helicopter in one kernel call.
+
+Each id's time limit (``max_episode_steps``) is its ``episode_steps``. A time limit that cuts episodes before their
+``episode_steps``, the id's beside a longer ``episode_steps`` or one given to ``make``/``make_vec`` below it, is warned of,
+not refused: the episodes are truncated there while a crash is still charged for the steps left of ``episode_steps``
+(:func:`~neurohover.envs.arguments.check_against_id`; T23-17).
 """
 
 from __future__ import annotations

@@ -3,7 +3,9 @@ noise stream, the sensors, the id they were made under, sizes, dtypes and reset 
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable, Sequence
+from types import FrameType
 from typing import Any
 
 import gymnasium as gym
@@ -96,8 +98,12 @@ def sensed_family(task: str, sigma: float | None, obs_noise: Any, obs_delay: Any
 
 def check_against_id(spec: Any, family: TaskFamily, episode_steps: int, limit: int | None = None) -> None:
     """What ``gymnasium.make(id, **kwargs)`` built, checked against the id (``spec``, set once the env is made): a
-    ``task`` that is not the id's is refused; episodes longer than the id's time limit are warned of (``limit``:
-    the truncation the environment applies itself, where it knows it: the vector environment's)."""
+    ``task`` that is not the id's is refused; episodes that the time limit cuts before their ``episode_steps`` are warned
+    of, whether the limit is the id's or one given to make() or make_vec() (``limit``: the truncation the environment
+    applies itself, where it knows it: the vector environment's). A warning, not a refusal, for both: truncating before
+    ``episode_steps`` is allowed (the vector environment's ``max_episode_steps`` documents it), but a crash is still
+    charged for the steps left of ``episode_steps``, so the returns are not those of the shorter episodes (T23-17:
+    ``make(id, episode_steps=100, max_episode_steps=50)`` said nothing)."""
     registered = gym.registry.get(getattr(spec, "id", None) or "")
     if registered is None:  # made directly, or from an unregistered spec
         return
@@ -111,13 +117,38 @@ def check_against_id(spec: Any, family: TaskFamily, episode_steps: int, limit: i
         raise NeurohoverError(
             f"{spec.id} is the {task} task family: task={family.name!r} conflicts with it; make a {family.name} id instead ({', '.join(ids[:3])})"
         )
-    applied = registered.max_episode_steps if limit is None else limit
-    if applied is not None and applied == registered.max_episode_steps and episode_steps > applied:
-        limit = applied
+    applied = _make_time_limit(registered.max_episode_steps) if limit is None else limit
+    if applied is None or episode_steps <= applied:
+        return
+    if applied == registered.max_episode_steps:
         gym.logger.warn(
-            f"{spec.id}: episode_steps={episode_steps} is longer than the id's time limit of {limit} steps: every episode is "
-            f"truncated at {limit} unless make() or make_vec() is given max_episode_steps={episode_steps} too"
+            f"{spec.id}: episode_steps={episode_steps} is longer than the id's time limit of {applied} steps: every episode is "
+            f"truncated at {applied} unless make() or make_vec() is given max_episode_steps={episode_steps} too"
         )
+    else:  # T23-17: a limit given below episode_steps truncated every episode without a word
+        gym.logger.warn(
+            f"{spec.id}: max_episode_steps={applied} is shorter than episode_steps={episode_steps}: every episode is truncated at "
+            f"{applied} steps while a crash is still charged for the steps left of {episode_steps}; give episode_steps={applied} "
+            f"for episodes of {applied} steps, or max_episode_steps={episode_steps}"
+        )
+
+
+def _make_time_limit(registered: int | None) -> int | None:
+    """The ``TimeLimit`` that the ``gymnasium.make`` call now building the environment applies: its ``max_episode_steps``
+    argument (None for -1, no limit) or else its spec's, read from that call's frame, since make() adds the wrapper after it
+    sets the spec and passes the environment neither (T23-17); the id's ``registered`` limit where no make() call is found
+    (the spec set by other code)."""
+    make_code = getattr(getattr(gym.envs.registration, "make", None), "__code__", None)
+    frame: FrameType | None = sys._getframe(1)
+    while frame is not None and frame.f_code is not make_code:
+        frame = frame.f_back
+    if frame is None:
+        return registered
+    given = frame.f_locals.get("max_episode_steps")
+    if given is not None:
+        return None if given == -1 else given if whole_number(given) else registered
+    made = getattr(frame.f_locals.get("env_spec"), "max_episode_steps", registered)
+    return made if made is None or whole_number(made) else registered
 
 
 def check_no_unknown_kwargs(unknown: dict[str, Any], allowed: Sequence[str]) -> None:
