@@ -138,6 +138,7 @@ def _restored_parts(state: dict, run: Run, opt: Optimiser) -> dict[str, Any]:
     kernel, wall = seconds["kernel_seconds"], seconds["wall_seconds"]
     if kernel > wall:  # (each kernel call is timed inside the run's wall time; T21-03)
         raise EntryError(f"counter 'kernel_seconds' is {kernel!r}, more than the run's wall_seconds {wall!r} (its kernel time is part of them)")
+    _check_tracker_kept(opt)
     champion = _checked_champion(state["champion"], run.cfg.prototype.genome.size, run.fitness)
     own = run.method in OPTIMISERS and run.family is not None
     _check_run_champion(champion, own, counts["generation"], run.method, opt)
@@ -148,6 +149,33 @@ def _restored_parts(state: dict, run: Run, opt: Optimiser) -> dict[str, Any]:
     # every other run's is its optimiser's (Run._champion_return).
     check_history(history, counts, per_generation=run.method == "generational" or own, champion=champion[1] if own else float(opt.champion_return))
     return {"counters": counts, "seconds": seconds, "champion": champion, "history": history, "race_delta": race_delta}
+
+
+def _check_tracker_kept(opt: Optimiser) -> None:
+    """EntryError unless a restored steady-state optimiser with an elite keeps its champion (its tracker's genome) in its
+    population, at a row of the champion's return, as :meth:`SteadyStateNE.tell` does (the elite keeps the best rows,
+    ties in order, so the first of the best is never dropped). A tracker genome found in no row was resumed and written
+    as the run's champion (T23-09). Not required without an elite (the champion may have been replaced), nor of CMA-ES
+    or OpenAI-ES (they keep no population; their champion is a past sample) or generational NE (its own check: the
+    champion is one of its parents)."""
+    if not isinstance(opt, SteadyStateNE) or opt.settings.elite_size == 0:
+        return
+    genome, population, fitness = opt._tracker.genome, opt._population, opt._fitness
+    if genome is None or population is None or fitness is None:  # (no champion yet, or none: the optimiser's own checks)
+        return
+    best = opt._tracker.best
+    if not any(f == best and np.array_equal(row, genome) for row, f in zip(population, fitness)):
+        k = int(np.flatnonzero(fitness == best)[0]) if np.any(fitness == best) else None
+        row = population[k] if k is not None else None
+        differ = (
+            ""
+            if row is None or row.shape != genome.shape
+            else next((f" (gene {i} is {brief(float(genome[i]))}, row {k}'s {brief(float(row[i]))})" for i in np.flatnonzero(row != genome)[:1]), "")
+        )
+        raise EntryError(
+            f"optimizer_state.tracker.genome is not allowed: it is no genome of the population with the champion's return {enc_float(best)}{differ};"
+            f" allowed the population's row of that return (the elite of {opt.settings.elite_size} keeps the champion)"
+        )
 
 
 def _check_run_champion(champion: tuple[np.ndarray | None, float], own: bool, generation: int, method: str, opt: Optimiser) -> None:
