@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real
+from .flightmeta import check_meaning
 from .paths import json_text, strict_json
 from .sim.constants import ACTION_NAMES, EPISODE_STEPS, MAX_EPISODE_STEPS, OBS_NAMES
 
@@ -100,7 +101,7 @@ class FlightData:
             if act.shape[0] == 0:  # written by save(), then refused by load() (T22-19)
                 raise NeurohoverError(f"flight data: episode {i} has 0 steps (a flown one has at least 1)")
         # metadata load() refuses (episode_steps -5, crashed 'x') was taken here and written by save() (T18-4)
-        check_metadata(self.metadata, np.array([a.shape[0] for a in self.actions], dtype=np.int64), "flight data")
+        check_metadata(self.metadata, np.array([a.shape[0] for a in self.actions], dtype=np.int64), "flight data", (self.observations, self.actions))
 
     @property
     def n_episodes(self) -> int:
@@ -165,7 +166,9 @@ class FlightData:
         path = output_file(path, "flight-data file")  # refuses '', a directory and a device (/dev/null was a struct.error)
         check_npz_name(path)
         lengths = np.array([a.shape[0] for a in self.actions], dtype=np.int64)
-        check_metadata(self.metadata, lengths, "flight data")  # metadata changed after making (episode_steps -5) was written, then refused by load()
+        check_metadata(
+            self.metadata, lengths, "flight data", (self.observations, self.actions)
+        )  # metadata changed after making (episode_steps -5) was written, then refused by load()
         for i, crashed in enumerate(crash_flags(self)):  # NaN readings were written, then refused by load() (T22-02's check)
             check_flown(self.observations[i], self.actions[i], crashed, f"flight data to save, episode {i}")
         largest = float(np.finfo(dtype).max)
@@ -223,7 +226,7 @@ class FlightData:
             raise NeurohoverError(
                 f"{str(path)!r} is not a readable flight-data file: episode {int(np.argmin(lengths))} has 0 steps (a flown one has at least 1)"
             )
-        check_metadata(metadata, lengths, f"flight-data file {str(path)!r}")
+        check_metadata(metadata, lengths, f"flight-data file {str(path)!r}")  # what the lengths contradict, before the arrays
         if obs.shape != (int(lengths.sum() + lengths.size), 12) or act.shape != (int(lengths.sum()), 4):
             raise NeurohoverError(
                 f"flight-data file {str(path)!r} is truncated or inconsistent: {lengths.size} episodes of {lengths.sum()} steps "
@@ -232,6 +235,7 @@ class FlightData:
         obs, act = obs.astype(np.float64), act.astype(np.float64)  # a float32 file loads as float64, like every array here
         obs_split = np.split(obs, np.cumsum(lengths + 1)[:-1])
         act_split = np.split(act, np.cumsum(lengths)[:-1])
+        check_metadata(metadata, lengths, f"flight-data file {str(path)!r}", (tuple(obs_split), tuple(act_split)))  # and the readings (T23-03, T23-19)
         data = cls(tuple(obs_split), tuple(act_split), metadata)
         for i, crashed in enumerate(crash_flags(data)):  # a NaN was named by plot, not by learn-model, and neither named the file (T22-02)
             check_flown(data.observations[i], data.actions[i], crashed, f"flight-data file {str(path)!r}, episode {i}")
@@ -241,13 +245,18 @@ class FlightData:
 def crash_flags(data: FlightData) -> list[bool]:
     """Whether each episode of ``data`` crashed: its flag as flown (the ``crashed`` metadata every recording holds), or,
     in files recorded before 2026-12-04, whether it is shorter than the metadata's ``episode_steps`` (default 6000)."""
-    meta = data.metadata if isinstance(data.metadata, dict) else {}
+    return _flags(data.metadata, [a.shape[0] for a in data.actions])
+
+
+def _flags(metadata: object, lengths) -> list[bool]:
+    """:func:`crash_flags` of metadata and episode lengths (check_metadata's, before the flight data are made)."""
+    meta = metadata if isinstance(metadata, dict) else {}
     flags = meta.get("crashed")
-    if isinstance(flags, list) and len(flags) == data.n_episodes:
+    if isinstance(flags, list) and len(flags) == len(lengths):
         return [bool(c) for c in flags]
     steps = meta.get("episode_steps")
     steps = steps if type(steps) is int else EPISODE_STEPS  # checked where the metadata are (check_metadata)
-    return [a.shape[0] < steps for a in data.actions]
+    return [int(n) < steps for n in lengths]
 
 
 def check_flown(observations: np.ndarray, actions: np.ndarray, crashed: bool, where: str) -> None:
@@ -341,7 +350,7 @@ def _json_ok(value: object) -> bool:
     return True
 
 
-def check_metadata(metadata: object, lengths: np.ndarray, where: str) -> None:
+def check_metadata(metadata: object, lengths: np.ndarray, where: str, episodes: tuple[tuple, tuple] | None = None) -> None:
     """Refuse the metadata fields plots and crash marks read when they are of the wrong kind, by name (an episode_steps
     "a" was a ValueError in plot; seventh trial), and metadata the episodes contradict (ninth trial): an episode longer
     than ``episode_steps``, or one shorter whose ``crashed`` flag is false (T22-01; a crash may come on the last step, so
@@ -357,6 +366,9 @@ def check_metadata(metadata: object, lengths: np.ndarray, where: str) -> None:
     where : str
         What the messages name: ``"flight-data file 'f.npz'"`` (:meth:`FlightData.load`) or ``"flight data"`` (flight data
         built in Python, checked before a plot: fourteenth trial).
+    episodes : (observations, actions), optional
+        Each episode's arrays, where they are known: the metadata are also checked against them (returns, crash flags).
+        The metadata against themselves and the episodes: :func:`neurohover.flightmeta.check_meaning` (T23-02..T23-19).
     """
     metadata = _check_dict(metadata, where)
     n_episodes = lengths.size
@@ -389,6 +401,8 @@ def check_metadata(metadata: object, lengths: np.ndarray, where: str) -> None:
     for i, mdp in enumerate(mdps):  # a task 'ghh09' over ghh08's MDPs was plotted under the wrong name (ninth trial)
         if task is not None and mdp is not None and mdp.family != task:
             raise NeurohoverError(f"{where}: its metadata task {brief(task)} is not its MDPs' family: episode {i} flew a {brief(mdp.family)} MDP")
+    checked = None if episodes is None else (*episodes, _flags(metadata, lengths.tolist()))
+    check_meaning(metadata, mdps, checked, where)  # what the fields say, against each other and the readings (T23-02..T23-19)
 
 
 def _checked_mdps(tables: list, where: str) -> list:

@@ -110,7 +110,7 @@ def test_metadata_mdps_null_or_of_a_bad_mdp_is_refused_by_plot_and_learn_model(t
     from neurohover.tasks import get_task_family
 
     table = get_task_family("ghh08").zero().to_dict()
-    metadata = {"task": "ghh08", "mdps": [table, table], "returns": [1.0, 2.0]}
+    metadata = {"task": "ghh08", "mdps": [table, table], "returns": [0.0, 0.0]}  # what still readings give (T23-03: 1.0 was taken)
     full = FlightData(OBS * 2, ACTS * 2, metadata).save(tmp_path / "full.npz")  # as recorded: taken
     if "mdps" in change or "returns" in change:
         metadata.update(change)

@@ -156,8 +156,9 @@ def flight(tmp_path_factory) -> Path:
     path = tmp_path_factory.mktemp("flight") / "flight.npz"
     policy = nh.load_policy(Path(nh.__file__).parent / "data" / "policies" / "ghh08" / "generic.json")
     zero = nh.get_task_family("ghh08").zero()
-    fd = nh.evaluate(policy, zero, episodes=2, record=True, n_steps=30).flight_data
-    fd.metadata.update({"task": "ghh08", "mdps": [zero.to_dict()] * 2, "policy": "generic", "seed": 0, "returns": [-1.0, -2.0]})
+    ev = nh.evaluate(policy, zero, episodes=2, record=True, n_steps=30)
+    fd, returns = ev.flight_data, ev.returns.ravel().tolist()  # as flown: returns [-1.0, -2.0] are refused (T23-03)
+    fd.metadata.update({"task": "ghh08", "mdps": [zero.to_dict()] * 2, "policy": "generic", "seed": 0, "returns": returns})
     fd.save(path)
     return path
 
@@ -203,10 +204,10 @@ def test_joined_flight_data_keeps_metadata_its_episodes_fit(flight, tmp_path) ->
     where the halves' differ; no episode_steps where a shorter budget's full episodes would read as cut short (T22-01)."""
     a = nh.FlightData.load(flight)
     b = nh.FlightData(
-        a.observations[:1], a.actions[:1], {**a.metadata, "episode_steps": 40, "task": "ghh09", "returns": [0.5], "mdps": [{}], "crashed": [True]}
+        a.observations[:1], a.actions[:1], {**a.metadata, "episode_steps": 40, "task": "ghh09", "returns": [-0.5], "mdps": [{}], "crashed": [True]}
     )
     both = a + b
-    assert "episode_steps" not in both.metadata and "task" not in both.metadata and both.metadata["returns"] == [-1.0, -2.0, 0.5]
+    assert "episode_steps" not in both.metadata and "task" not in both.metadata and both.metadata["returns"] == [*a.metadata["returns"], -0.5]
     both.save(tmp_path / "both.npz")
     assert nh.FlightData.load(tmp_path / "both.npz").metadata["mdps"][2] == {}
     short = nh.FlightData((a.observations[0][:6],), (a.actions[0][:5],), {"episode_steps": 5})  # 5 steps: within its budget (T18-4)

@@ -1,0 +1,157 @@
+"""Flight-data metadata checked against itself and against the episodes it describes (docs/model.md, Learned models).
+
+:func:`neurohover.flightdata.check_metadata` checks each field's kind; this module checks what the fields say, the way
+:mod:`neurohover.experiments.result_checks` checks a stored test run against itself: each MDP is one its task family
+holds (T23-02) and is the MDP its label names (T23-04), the seed is a seed (T23-05), no return is above 0 and each is
+what the episode's observations give (T23-03), and no episode is flagged crashed whose last reading shows none
+(T23-19). What the readings cannot prove (an MDP not recorded, a sensor model between the state and the readings) is
+left unchecked: a file ``fly --record`` wrote is never refused.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import fields, replace
+
+import numpy as np
+
+from .errors import NeurohoverError, brief, finite_real, whole_in
+from .sim.constants import CRASH_STEP_PENALTY, MAX_POSITION, MAX_RATE, MAX_VELOCITY, MIN_QW, WORST_RETURN
+from .sim.rng import MAX_SEED
+from .tasks import MDP, TASK_FAMILIES, get_task_family
+
+#: A label naming one of a family's MDPs by :meth:`TaskFamily.mdp`'s names, as its fixed sets and zero label them.
+_SET_LABEL = re.compile(r"(?:(?P<family>[^/]+)/)?(?P<spec>zero|(?:seeded-)?(?:train|test):[0-9]+)")
+#: Readings within the crash bounds by this fraction of each bound: float32 files round them (about 6e-8 relative).
+_CRASH_MARGIN = 1e-5
+#: How far a return may lie from what the observations give, relative to the sums it is made of: a float32 file
+#: rounds each reading (its square by about 1.2e-7 relative), the kernel sums in its own order (about 1e-12).
+_RETURN_RTOL = 1e-6
+
+
+def check_meaning(metadata: dict, mdps: list, episodes: tuple[tuple, tuple, list[bool]] | None, where: str) -> None:
+    """Refuse metadata that contradicts itself or the episodes, naming ``where``, the field, its value and what it
+    contradicts. ``mdps`` are the MDPs of the metadata's ``mdps`` tables (None for an entry ``{}``), as flightdata
+    checked them; ``episodes`` the observations, actions and crash flags (flightdata.crash_flags) of each episode, or
+    None where only their lengths are known."""
+    seed = metadata.get("seed")
+    if seed is not None:  # 'abc' and -5 were taken (T23-05); every seed's range is sim.rng's
+        whole_in(seed, f"{where}: its metadata seed", 0, MAX_SEED, "2**63-1")
+    seen: set[int] = set()  # fly --record writes one table per episode, most of them one MDP
+    for i, mdp in enumerate(mdps):
+        if mdp is not None and id(mdp) not in seen:
+            seen.add(id(mdp))
+            _check_held(mdp, i, where)
+    returns = metadata.get("returns")
+    returns = returns if isinstance(returns, list) else []
+    for i, value in enumerate(returns):  # [5.0, 3.0] was taken (T23-03): every reward is minus a sum of squares
+        if finite_real(value) and not -WORST_RETURN <= value <= 0:
+            raise NeurohoverError(
+                f"{where}: its metadata returns={brief(returns)} is not allowed: episode {i}'s return {value!r} is not in "
+                f"-{WORST_RETURN:.4g}..0 (every reward is minus a sum of squares, a crash's charge at worst)"
+            )
+    if episodes is None:
+        return
+    observations, actions, flags = episodes
+    steps = metadata.get("episode_steps")
+    for i, mdp in enumerate(mdps):  # the readings are the state only where the sensors are exact and the MDP recorded
+        if mdp is None or not mdp.sensor.exact or not np.isfinite(observations[i]).all():
+            continue  # non-finite readings: flightdata.check_flown names them
+        if flags[i] and "crashed" in metadata:  # not a length taken for a crash (files before crashed was recorded)
+            _check_crash(metadata["crashed"], observations[i], actions[i], i, where)
+        if i < len(returns) and finite_real(returns[i]):
+            _check_return(returns, i, observations[i], flags[i], steps if type(steps) is int else None, where)
+
+
+def _differences(a: MDP, b: MDP) -> list[str]:
+    """The fields (but label, sensor and drift) in which MDP ``a`` differs from ``b``, as ``name=value``."""
+    return [
+        f"{f.name}={brief(getattr(a, f.name))}" for f in fields(MDP) if f.name not in ("label", "sensor", "drift") and getattr(a, f.name) != getattr(b, f.name)
+    ]
+
+
+def _check_held(mdp: MDP, i: int, where: str) -> None:
+    """Refuse an MDP of a task family that the family does not hold (its parameters out of the family's range, or its
+    other fields not the family's: T23-02), or whose label names one of the family's MDPs with other parameters
+    (T23-04). No family method tells whether it holds a given MDP: its :meth:`make` checks the ranges of the
+    parameters at its ``row_slice``, so the MDP is held where it is the family's zero or what make gives of them."""
+    cls = TASK_FAMILIES.get(mdp.family)
+    if cls is None:  # a learned model's MDP: any wind, any dynamics
+        return
+    family = get_task_family(mdp.family)  # a sigma only widens FGHH's draws, not what make() takes
+    shown = f"{where}: its metadata mdps entry {i} ({brief(mdp.label)})"
+    zero = replace(family.zero(), sensor=mdp.sensor, drift=mdp.drift)
+    if mdp != zero:
+        try:
+            made = family.make(mdp.row()[cls.row_slice])
+        except NeurohoverError as err:
+            raise NeurohoverError(f"{shown} is not allowed: it is no {mdp.family} MDP: {err}") from None
+        made = replace(made, sensor=mdp.sensor, drift=mdp.drift)
+        if mdp != made:
+            raise NeurohoverError(
+                f"{shown} is not allowed: it is no {mdp.family} MDP: its {', '.join(_differences(mdp, made))} differ from every "
+                f"{mdp.family} MDP's ({', '.join(_differences(made, mdp))}), whose parameters are {', '.join(cls.param_names)}"
+            )
+    match = _SET_LABEL.fullmatch(mdp.label)
+    if match is None:
+        return
+    named, spec = match.group("family") or mdp.family, match.group("spec")
+    if named != mdp.family:
+        raise NeurohoverError(f"{shown} is not allowed: its label names a {brief(named)} MDP, but the MDP's family is {brief(mdp.family)}")
+    if family.has_sigma and spec.startswith("seeded-"):  # FGHH's seeded sets depend on a sigma the metadata does not record
+        return
+    try:
+        named_mdp = family.mdp(spec)
+    except NeurohoverError as err:
+        raise NeurohoverError(f"{shown} is not allowed: its label names no {mdp.family} MDP: {err}") from None
+    if mdp != replace(named_mdp, sensor=mdp.sensor, drift=mdp.drift):
+        theirs = ", ".join(_differences(named_mdp, mdp))
+        raise NeurohoverError(f"{shown} is not allowed: its {', '.join(_differences(mdp, named_mdp))} contradict its label: {mdp.family}'s {spec} has {theirs}")
+
+
+def _check_crash(flags: list, obs: np.ndarray, act: np.ndarray, i: int, where: str) -> None:
+    """Refuse a crashed flag that the episode's last reading and action disprove (T23-19): the kernel tests the crash on
+    the state after every step and ends the episode there, so a crash leaves its last reading out of the bounds (body
+    frame: a norm bounds each world component) or follows a non-finite action, whose reading is the one before."""
+    last = obs[-1]
+    if not np.isfinite(act[-1]).all():
+        return
+    within = 1.0 - _CRASH_MARGIN
+    calm = (
+        np.linalg.norm(last[0:3]) <= MAX_VELOCITY * within
+        and np.linalg.norm(last[3:6]) <= MAX_POSITION * within
+        and np.abs(last[6:9]).max() <= MAX_RATE * within
+        and float(last[9:12] @ last[9:12]) <= (1.0 - MIN_QW**2) * within
+    )
+    if calm:
+        raise NeurohoverError(
+            f"{where}: its metadata crashed={brief(flags)} is not allowed: episode {i} is flagged crashed, yet after its last "
+            f"step ({act.shape[0]:,}) it flies within every crash bound (speed {np.linalg.norm(last[0:3]):.3g} m/s, distance "
+            f"{np.linalg.norm(last[3:6]):.3g} m, rates under {MAX_RATE:.3g} rad/s, tilt under 15 degrees) after a finite action: "
+            "a crash leaves the helicopter out of bounds; its flags and observations contradict"
+        )
+
+
+def _check_return(returns: list, i: int, obs: np.ndarray, crashed: bool, steps: int | None, where: str) -> None:
+    """Refuse a return that is not minus the sum of the episode's rewards as its observations give them (T23-03): each
+    step's reward is minus the sum of squares of the 12 readings after it (sim.kernel.reward_of); a crash's step is
+    charged CRASH_STEP_PENALTY for each step left of the budget instead (0 of them for a crash on the last step)."""
+    value, flown = float(returns[i]), obs.shape[0] - 1
+    squares = np.einsum("ij,ij->i", obs[1:], obs[1:])
+    earned = -float(squares[: flown - 1].sum() if crashed else squares.sum())
+    tolerance = _RETURN_RTOL * abs(earned) + 1e-12 * abs(value) + 1e-9  # a crash's charge is no reading: exact to float64
+    if not crashed:
+        if abs(value - earned) <= tolerance:
+            return
+        gives = f"{earned!r}, minus the sum of squares of its 12 readings over its {flown:,} steps"
+    else:
+        left = (earned - value) / CRASH_STEP_PENALTY  # the steps charged: 0..steps - flown
+        most = np.inf if steps is None else steps - flown
+        if abs(left - round(left)) * CRASH_STEP_PENALTY <= tolerance and -0.5 < left < most + 0.5:
+            return
+        budget = "the steps left of its budget" if steps is None else f"each of the {most:,} steps left of its budget"
+        gives = f"{earned!r} (its first {flown - 1:,} steps' rewards) less {CRASH_STEP_PENALTY:.6g} for {budget} (a crash's charge)"
+    raise NeurohoverError(
+        f"{where}: its metadata returns={brief(returns)} is not allowed: episode {i}'s return {value!r} is not what its "
+        f"observations give: {gives}; its returns and observations contradict"
+    )
