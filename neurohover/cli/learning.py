@@ -318,7 +318,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     """Learn a helicopter model from flight data (LR, EC-MENO or EC-MER) and print its parameters."""
     from ..agents.model_based import ModelEvolution
     from ..flightdata import FlightData
-    from ..models import DEFAULT_NOISE_ESTIMATE, ec_mer_policy, format_parameter_table, learn_ec_meno, learn_ec_mer, learn_lr, parameter_table
+    from ..models import DEFAULT_NOISE_ESTIMATE, LearnedModel, ec_mer_policy, format_parameter_table, learn_ec_meno, learn_ec_mer, learn_lr, parameter_table
     from ..paths import input_file, output_file
     from .options import check_given, given_settings
 
@@ -347,7 +347,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     if args.policy is not None and args.method != "ec-mer":
         raise NeurohoverError(f"--policy applies to --method ec-mer only (the policy that flew the data), not to --method {args.method}")
     data = FlightData.load(input_file(args.flight_data, "--flight-data", "flight-data file"))
-    out = output_file(args.out, "--out", {"--flight-data": args.flight_data, "--policy": args.policy})
+    out = LearnedModel.check_name(output_file(args.out, "--out", {"--flight-data": args.flight_data, "--policy": args.policy}), "--out")  # T23-16
     start = time.perf_counter()
     extra = {} if args.budget is None else {"budget": args.budget}
     with _Ticker(f"learning a {args.method} model from {data.n_episodes} episodes ({data.n_transitions} steps)"):

@@ -238,7 +238,8 @@ def learn_ec_mer(
     candidate's noise std come from its own one-step residuals (as in LR), so the model's gusts
     match what the candidate cannot explain. Prototype and settings as in EC-MENO; genes are the
     parameters divided by |default| (EC-MENO's ``"default"`` scaling; its ``"data"`` scale is
-    derived for a quadratic one-step objective and was not measured on this one).
+    derived for a quadratic one-step objective and was not measured on this one). ``generic_policy`` must be the
+    policy that flew the flight data: it must give their first episode's recorded actions (:func:`check_policy_flew`).
     """
     from ..evaluate import PolicyTable, evaluate_jobs
     from ..policies import Policy
@@ -249,6 +250,8 @@ def learn_ec_mer(
     if not whole_number(episodes) or not 1 <= episodes <= MAX_EC_MER_EPISODES:  # np.timedelta64 was int()'s TypeError (T17-1)
         raise NeurohoverError(f"episodes={brief(episodes)} is out of range: allowed an integer in 1..{MAX_EC_MER_EPISODES:,} (per candidate)")
     tr = Transitions(flight_data)
+    # T23-15: the command line checked this (ec_mer_policy), the Python API fitted any policy's closed loop without a word
+    check_policy_flew(generic_policy, flight_data, "flight data", "generic_policy", "give the policy that flew them as generic_policy")
     if true_return is None:
         true_return = observed_return(flight_data, 0)
     if not finite_real(true_return):  # True was taken as 1.0 (sixteenth trial T16-18)
@@ -313,7 +316,13 @@ def ec_mer_policy(given: str | None, data: FlightData, flight_data: str):
     return policy
 
 
-def check_policy_flew(policy, data: FlightData, where: str, named: str = "the policy") -> None:
+def check_policy_flew(
+    policy,
+    data: FlightData,
+    where: str,
+    named: str = "the policy",
+    remedy: str = "give --policy FILE of the policy that flew them, or record them again with fly --record",
+) -> None:
     """NeurohoverError unless ``policy`` gives the actions recorded in ``data``'s first episode (its first
     :data:`CHECKED_STEPS` steps, clipped to [-1, 1] as the kernel flies them, within :data:`ACTION_TOLERANCE`), where
     they are finite (a crash's NaN action is recorded as given). Recordings see what the policy saw (a sensor's readings)
@@ -327,8 +336,7 @@ def check_policy_flew(policy, data: FlightData, where: str, named: str = "the po
         if abs(flown[i] - act[k, i]) > ACTION_TOLERANCE:
             raise NeurohoverError(
                 f"{where}: {named} did not fly them (EC-MER fits the closed loop of the policy that did): at step {k} of "
-                f"episode 0 it gives action {i} = {flown[i]:.6g} where they record {act[k, i]:.6g}; give --policy FILE of the policy that flew "
-                "them, or record them again with fly --record"
+                f"episode 0 it gives action {i} = {flown[i]:.6g} where they record {act[k, i]:.6g}; {remedy}"
             )
 
 
