@@ -1,5 +1,6 @@
 """Checks of stored results (:mod:`~neurohover.experiments.results`): a stored value against its field's annotation,
-and a test run's parts against each other."""
+a test run's, an evolution run's and a robustness unit's parts against each other, and a result against its unit's
+params."""
 
 from __future__ import annotations
 
@@ -7,11 +8,11 @@ import dataclasses
 import math
 from typing import TYPE_CHECKING, Any
 
-from ..errors import brief, finite_real, whole_number
+from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..sim.constants import WORST_RETURN
 
 if TYPE_CHECKING:
-    from .results import TestRunResult
+    from .results import EvolveResult, RobustnessResult, TestRunResult
 
 
 def _num(v) -> bool:
@@ -66,6 +67,14 @@ def run_inconsistency(run: TestRunResult) -> str:
     for i, step in enumerate(run.crash_steps or ()):
         if step < 1:  # the kernel counts the crashing control step from 1 (its unit's params bound it: params_problem)
             return f"crash_steps[{i}] = {step!r} is not allowed: a crash ends its episode at control step 1 or later"
+    if run.agent == "baseline" and run.safeguard_episodes:  # the baseline's run was stored with safeguard episodes (T23-14)
+        return f"safeguard_episodes = {brief(list(run.safeguard_episodes))} is not allowed: the baseline flies with no safeguard: allowed []"
+    seconds, offline = float(run.timing.seconds), float(run.timing.offline_seconds)
+    if offline > seconds * (1 + 1e-9) + 1e-6:  # the agent's work between episodes is part of the run's time (T23-14)
+        return (
+            f"timing.offline_seconds = {brief(run.timing.offline_seconds)} is not allowed: it is "
+            f"part of the run's timing.seconds {brief(run.timing.seconds)}: allowed at most that"
+        )
     return _after_learning_problem(run)
 
 
@@ -119,9 +128,15 @@ def params_problem(result: Any, params: Any) -> str:
     """What in a stored unit's ``result`` contradicts the unit's own ``params`` ('' when nothing does; params of another
     shape are the plan check's to name): a test run's agent or MDP, or a model's method or MDP, other than its params
     say (a run of model-free on ghh08/test:0 holding agent 'baseline' and mdp 'ghh09/test:7' was exported; T22-08), or a
-    crash at a step past its episodes' ``n_steps`` (999999 of 20 was reported; T22-07)."""
-    from .results import ModelResult, TestRunResult
+    crash at a step past its episodes' ``n_steps`` (999999 of 20 was reported; T22-07); an evolution run's or a
+    robustness unit's figures that contradict its params (T23-08: :func:`evolve_params_problem`,
+    :func:`robustness_params_problem`)."""
+    from .results import EvolveResult, ModelResult, RobustnessResult, TestRunResult
 
+    if isinstance(result, EvolveResult) and isinstance(params, dict):
+        return evolve_params_problem(result, params)
+    if isinstance(result, RobustnessResult) and isinstance(params, dict):
+        return robustness_params_problem(result, params)
     if not (isinstance(result, (TestRunResult, ModelResult)) and isinstance(params, dict)):
         return ""
     for name in ("agent", "mdp") if isinstance(result, TestRunResult) else ("method", "mdp"):
@@ -134,4 +149,252 @@ def params_problem(result: Any, params: Any) -> str:
         for i, step in enumerate(result.crash_steps or ()):
             if not 1 <= step <= n_steps:
                 return f"crash_steps[{i}] = {step!r} is not allowed: its unit's episodes are {n_steps} control steps long: allowed 1..{n_steps}"
+    return ""
+
+
+def _lists(value: Any) -> Any:
+    """Tuples (nested) as lists, to show a stored value as the store holds it."""
+    return [_lists(v) for v in value] if isinstance(value, tuple) else value
+
+
+def _close(a: float, b: float) -> bool:
+    """Whether two stored figures are one (floats round; infinities of one sign are equal, NaNs are not)."""
+    return a == b or math.isclose(a, b, rel_tol=1e-9, abs_tol=1e-6)
+
+
+def _returns_problem(name: str, returns: Any) -> str:
+    """'' when ``returns`` are episodes' returns (each a number in [-WORST_RETURN, 0], or NaN: a numerical blow-up, which
+    stored validations keep as 'nan'), else which is not."""
+    for i, r in enumerate(returns):
+        if not (_num(r) and (math.isnan(float(r)) or -WORST_RETURN <= float(r) <= 0)):
+            allowed = f"allowed a number in [{-WORST_RETURN:.3g}, 0] or nan (every reward is minus a sum of squares)"
+            return f"{name}[{i}] = {brief(r)} is no episode's return: {allowed}"
+    return ""
+
+
+def _validation_problem(where: str, validation: Any, crashed: Any) -> str:
+    """'' when ``validation`` (None: none asked for) are episodes' returns and ``crashed`` (None: not recorded) one flag
+    each of them, else what is not."""
+    if validation is None:
+        return "" if crashed is None else f"{where}validation_crashed = {brief(_lists(crashed))} is not allowed: it holds no validation: allowed null"
+    problem = _returns_problem(f"{where}validation", validation)
+    if problem or crashed is None:
+        return problem
+    if not (isinstance(crashed, tuple) and len(crashed) == len(validation) and all(isinstance(c, bool) for c in crashed)):
+        return (
+            f"{where}validation_crashed = {brief(_lists(crashed))} is not allowed: give one true or false for each of its {len(validation)} validation episodes"
+        )
+    return ""
+
+
+def _fitness_problem(name: str, value: Any, scale: Any) -> str:
+    """'' when ``value`` is a fitness on ``scale`` (the result's ``fitness``; None: raw returns), else why not: on
+    inv-log-error ``1/ln(error)`` is in (0, 1/ln(ERROR_FLOOR)], on returns every value is at most 0; -inf (a NaN episode's
+    fitness) and NaN are not refused."""
+    from ..evolution.fitness import ERROR_FLOOR
+
+    v = float(value)
+    if scale == "inv-log-error":
+        top = 1.0 / math.log(ERROR_FLOOR)
+        if v == -math.inf or 0 < v <= top * (1 + 1e-9) or math.isnan(v):
+            return ""
+        return (
+            f"{name} = {brief(value)} is not allowed: on its fitness scale inv-log-error a fitness is 1/ln(error): allowed a number in (0, {top:.7g}] or -inf"
+        )
+    if v > 0 or -WORST_RETURN > v > -math.inf:
+        what = "its fitness scale return" if scale == "return" else "raw returns (no fitness scale)"
+        return f"{name} = {brief(value)} is not allowed: on {what} it is a mean return: allowed a number in [{-WORST_RETURN:.3g}, 0] or -inf"
+    return ""
+
+
+def _history_problem(run: EvolveResult) -> str:
+    """'' when the run's history is its (episodes, champion fitness) records, their episodes increasing within
+    1..its episodes and the last at its episodes (its last generation), else what is not."""
+    episodes, last = run.episodes, 0
+    if not run.history:
+        return "its history is empty: a run records its last generation at least"
+    for i, entry in enumerate(run.history):
+        if not (isinstance(entry, tuple) and len(entry) == 2 and _int(entry[0]) and last < entry[0] <= episodes and _num(entry[1])):
+            shown = brief(list(entry) if isinstance(entry, tuple) else entry)
+            return (
+                f"history[{i}] = {shown} is not allowed: give [episodes, champion fitness], its episodes increasing within 1..{episodes} (the run's episodes)"
+            )
+        problem = _fitness_problem(f"history[{i}]'s champion fitness", entry[1], run.fitness)
+        if problem:
+            return problem
+        last = entry[0]
+    if last != episodes:
+        return (
+            f"history[{len(run.history) - 1}] = {brief(list(run.history[-1]))} is not allowed: "
+            f"a run's history ends at its last generation, at its {episodes} episodes"
+        )
+    return ""
+
+
+def evolve_inconsistency(run: EvolveResult) -> str:
+    """What in evolution run ``run`` does not fit together ('' when all does; T23-08: a hand-edited run was exported and
+    reported): a stop reason the evolution gives (:data:`~neurohover.evolution.restore.STOP_REASONS`), a fitness scale
+    it knows, one generation at least, evaluating a candidate at least each and flying an episode at least per
+    evaluation; a history of increasing episodes ending at the run's; a champion fitness on its scale that is its
+    history's last (NEAT's: the best genome ever, at least its history's best generation); validation returns that are
+    episodes' returns, with one crash flag each."""
+    from ..evolution.fitness import FITNESS_SCALES
+    from ..evolution.restore import STOP_REASONS
+
+    if run.stop_reason not in STOP_REASONS:
+        return f"stop_reason = {brief(run.stop_reason)} is not allowed: allowed one of {', '.join(STOP_REASONS)} (why the evolution stops)"
+    if run.fitness is not None and run.fitness not in FITNESS_SCALES:
+        return f"fitness = {brief(run.fitness)} is not allowed: allowed one of {', '.join(FITNESS_SCALES)}, or none (raw returns)"
+    if run.champion_crashed is not None and not isinstance(run.champion_crashed, bool):
+        return f"champion_crashed = {brief(run.champion_crashed)} is not allowed: allowed true, false or none (not recorded)"
+    g, ev, e = run.generations, run.evaluations, run.episodes
+    if not 1 <= g <= e:
+        return (
+            f"generations = {g!r} is not allowed: a run stops at a generation boundary, after one generation "
+            f"at least, each flying an episode at least, and it flew {e} episodes: allowed 1..{e}"
+        )
+    if not g <= ev <= e:
+        return (
+            f"evaluations = {ev!r} is not allowed: each of its {g} generations evaluates a candidate at "
+            f"least, each evaluation flies an episode at least, and it flew {e} episodes: allowed {g}..{e}"
+        )
+    problem = _fitness_problem("champion_return", run.champion_return, run.fitness) or _history_problem(run)
+    if problem:
+        return problem
+    champion, returns = float(run.champion_return), [float(r) for _, r in run.history]
+    if run.champion.topology == "neat":  # NEAT's champion is the best genome ever; its history each generation's best
+        if champion < max(returns) and not _close(champion, max(returns)):
+            return (
+                f"champion_return = {brief(run.champion_return)} is not allowed: its history's best generation "
+                f"reached {max(returns)!r}, and a NEAT champion is the best genome ever: allowed at least that"
+            )
+    elif not (_close(champion, returns[-1]) or (math.isnan(champion) and math.isnan(returns[-1]))):
+        return (
+            f"champion_return = {brief(run.champion_return)} is not allowed: its history "
+            f"ends at {run.history[-1][1]!r}, the champion's fitness at its last generation"
+        )
+    problem = _validation_problem("", run.validation, run.validation_crashed)
+    for name in ("reevaluated", "reevaluated_best_ever"):
+        again = getattr(run, name)
+        if again is not None and not problem:
+            problem = _validation_problem(f"{name}.", again.validation, again.validation_crashed)
+    return problem
+
+
+def _policies(run: EvolveResult) -> list[tuple[str, Any]]:
+    """The run's stored policies by name: its champion, and the champions chosen again."""
+    found = [("champion", run.champion)]
+    for name in ("reevaluated", "reevaluated_best_ever"):
+        again = getattr(run, name)
+        if again is not None:
+            found.append((f"{name}.champion", again.champion))
+    return found
+
+
+def _budget_problem(run: EvolveResult, params: dict) -> str:
+    """'' when the run's episodes fit its unit's budget, resampling and stop reason, else what contradicts them: a run
+    stops at the first generation boundary at or past its budget (by 'budget'), or before it by its optimiser; its last
+    generation flew at most its resampling's episodes (fixed:K: K; a race or bandit: RACE_T_LIMIT) for each of its
+    evaluations that its earlier generations (one at least each) did not have. NEAT flies whole generations within it."""
+    from ..evolution.config import RACE_T_LIMIT, parse_resampling
+
+    budget, e, ev, g = params.get("budget"), run.episodes, run.evaluations, run.generations
+    try:
+        resampling = parse_resampling(params.get("resampling"))
+    except (NeurohoverError, TypeError):  # params of another shape are the plan check's to name
+        return ""
+    if resampling.kind == "fixed" and e != resampling.k * ev:
+        return (
+            f"episodes = {e!r} is not allowed: its unit's resampling is {resampling}, {resampling.k} "
+            f"episode(s) an evaluation, and it made {ev} evaluations: allowed {resampling.k * ev}"
+        )
+    if not (whole_number(budget) and budget >= 0):
+        return ""
+    if run.champion.topology == "neat":
+        if budget and e > budget:
+            return (
+                f"episodes = {e!r} is not allowed: its unit's budget is {budget} episodes, and NEAT flies whole generations within it: allowed at most {budget}"
+            )
+        return ""
+    if not budget:
+        return f"stop_reason = 'budget' is not allowed: its unit has no budget (params.budget {budget!r})" if run.stop_reason == "budget" else ""
+    if run.stop_reason != "budget":
+        if e >= budget:
+            return (
+                f"episodes = {e!r} is not allowed: it stopped by {run.stop_reason!r} before its unit's budget "
+                f"of {budget} episodes (a run at or past it stops by 'budget'): allowed fewer than {budget}"
+            )
+        return ""
+    top = budget - 1 + (RACE_T_LIMIT if resampling.selects else resampling.k) * (ev - g + 1)
+    if not budget <= e <= top:
+        return (
+            f"episodes = {e!r} is not allowed: it stopped by its unit's budget of {budget} episodes, at the first generation boundary at or past it, "
+            f"its last generation flying at most {top - budget + 1} ({resampling}, {ev} evaluations in {g} generations): allowed {budget}..{top}"
+        )
+    return ""
+
+
+def evolve_params_problem(run: EvolveResult, params: dict) -> str:
+    """What in evolution run ``run`` contradicts its unit's ``params`` ('' when nothing does; T23-08): a champion of
+    another topology, or a genome not of its topology's length; validations of other counts than its validation
+    episodes, or champions chosen again over other episodes than its ``champion_reevaluation``; episodes that do not fit
+    its budget and resampling (:func:`_budget_problem`)."""
+    from ..policies import GENOME_LENGTH
+
+    topology = params.get("topology")
+    for name, policy in _policies(run):
+        if isinstance(topology, str) and policy.topology != topology:
+            return (
+                f"{name}.topology = {brief(policy.topology)} is not allowed: its unit's params.topology is {brief(topology)}, and a result must be its unit's"
+            )
+        n = GENOME_LENGTH.get(policy.topology)
+        genome = policy.genome
+        if n is not None and not (isinstance(genome, tuple) and len(genome) == n and all(finite_real(x) for x in genome)):
+            return f"{name}.genome = {brief(genome)} is not allowed: a {policy.topology} genome is {n} finite numbers"
+    episodes, again = params.get("validation_episodes"), params.get("champion_reevaluation")
+    for where, held in [("", run), *((f"{n}.", getattr(run, n)) for n in ("reevaluated", "reevaluated_best_ever"))]:
+        if held is None:
+            continue
+        if held.validation is not None and whole_number(episodes) and len(held.validation) != episodes:
+            return (
+                f"{where}validation = {brief(list(held.validation))} is not allowed: its "
+                f"unit's params.validation_episodes is {episodes}: allowed {episodes} returns"
+            )
+        if where and whole_number(again) and held.episodes != again:
+            return f"{where}episodes = {brief(held.episodes)} is not allowed: its unit's params.champion_reevaluation is {again}: allowed {again}"
+    return _budget_problem(run, params)
+
+
+def robustness_inconsistency(result: RobustnessResult) -> str:
+    """What in robustness result ``result`` does not fit together ('' when all does; T23-08): a row of returns per MDP,
+    each an episode's return (a positive one was reported), a crash count per row within its episodes, its own MDP
+    among them."""
+    rows = result.returns
+    if not rows or not all(isinstance(row, tuple) and row for row in rows):
+        return f"returns = {brief(_lists(rows))} is not allowed: give a non-empty row of episode returns for each MDP"
+    for i, row in enumerate(rows):
+        problem = _returns_problem(f"returns[{i}]", row)
+        if problem:
+            return problem
+    if len(result.crashes) != len(rows):
+        return f"crashes = {brief(list(result.crashes))} is not allowed: give one crash count for each of its {len(rows)} MDPs' rows of returns"
+    for i, (count, row) in enumerate(zip(result.crashes, rows, strict=True)):
+        if not 0 <= count <= len(row):
+            return f"crashes[{i}] = {count!r} is not allowed: its MDP's row holds {len(row)} episodes: allowed 0..{len(row)}"
+    if not 0 <= result.own < len(rows):
+        return f"own = {result.own!r} is not allowed: it holds {len(rows)} MDPs' rows: allowed 0..{len(rows) - 1}"
+    return ""
+
+
+def robustness_params_problem(result: RobustnessResult, params: dict) -> str:
+    """What in robustness result ``result`` contradicts its unit's ``params`` ('' when nothing does; T23-08): a row per
+    MDP of its ``mdps``, ``episodes`` returns each, its ``own`` MDP."""
+    mdps, episodes, own = params.get("mdps"), params.get("episodes"), params.get("own")
+    if isinstance(mdps, list) and len(result.returns) != len(mdps):
+        return f"returns = {brief(_lists(result.returns))} is not allowed: its unit flies {len(mdps)} MDPs (params.mdps): allowed a row of returns each"
+    for i, row in enumerate(result.returns):
+        if whole_number(episodes) and len(row) != episodes:
+            return f"returns[{i}] = {brief(list(row))} is not allowed: its unit's params.episodes is {episodes}: allowed {episodes} returns"
+    if whole_number(own) and result.own != own:
+        return f"own = {result.own!r} is not allowed: its unit's params.own is {own}, and a result must be its unit's"
     return ""

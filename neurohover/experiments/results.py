@@ -30,7 +30,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from .keys import UnitKey  # re-exported: results are read by key
-from .result_checks import KIND_CHECKS, run_inconsistency, seconds_problem
+from .result_checks import KIND_CHECKS, evolve_inconsistency, robustness_inconsistency, run_inconsistency, seconds_problem
 
 __all__ = [
     "DiagnosticResult",
@@ -335,6 +335,12 @@ class EvolveResult(_Record):
     reevaluated_best_ever: Reevaluation | None = None
     timing: EvolveTiming = field(compare=False)
 
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        problem = evolve_inconsistency(self)
+        if problem:  # a hand-edited run (stop_reason 'bogus', a champion its history contradicts) was reported (T23-08)
+            raise NeurohoverError(f"evolution run is inconsistent: {problem}")
+
     @property
     def final_score(self) -> float:
         """The run's score: mean validation return if validated, else the champion's return."""
@@ -360,6 +366,12 @@ class RobustnessResult(_Record):
     returns: tuple[tuple[Num, ...], ...]
     crashes: tuple[int, ...]
     own: int
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        problem = robustness_inconsistency(self)
+        if problem:  # positive returns, more crashes than episodes were reported (T23-08)
+            raise NeurohoverError(f"robustness result is inconsistent: {problem}")
 
 
 @dataclass(frozen=True, kw_only=True)
