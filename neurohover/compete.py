@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from .agents.hybrid import HybridSettings
+from .compete_files import CSV_COLUMNS  # the columns plot --compete reads, each checked (T23-07)
 from .errors import NeurohoverError
 from .evolution.seeding import check_seed
 from .paths import write_png
@@ -42,7 +43,6 @@ from .sim.constants import EPISODE_STEPS
 from .tasks import N_TEST, N_TRAINING, Drift, Sensor, get_task_family
 from .tasks.drift import MAX_RUN_EPISODES  # a run's episodes, the bound of a drifting MDP's episodes too
 
-CSV_COLUMNS = ("run", "mdp", "episode", "return", "crashed", "steps", "policy", "safeguard_fired")
 STORE_FILE = "results.sqlite"
 
 

@@ -2,6 +2,13 @@
 what compete writes and against each other (:func:`read_compete_dir`, :func:`read_compete_dirs`), as ``neurohover plot
 --compete`` (:func:`neurohover.plots.plot_compete`) reads them.
 
+A row is checked as it is read (a value compete never writes: a flag other than 0 or 1, a column it never writes, a
+run on two MDPs); a summary in one place, :func:`_check_summary`, against itself and its rows: each key compete writes
+for its kind and range (:data:`SUMMARY_FIELDS`), each figure against the one its rows give, the conditions its task
+can fly under, the MDPs its runs fly and the rows its agent writes. A key compete never writes is refused, not
+ignored (a misspelt one would leave a curve unlabelled without a word); one compete writes may be absent (older
+summaries hold fewer), as may the columns after run, episode and return in older episodes files.
+
 Example
 -------
 >>> from neurohover.compete_files import read_compete_dir
@@ -15,7 +22,8 @@ from __future__ import annotations
 import csv
 import math
 import os
-from collections.abc import Sequence
+import re
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NoReturn
@@ -25,13 +33,68 @@ import numpy as np
 from .errors import NeurohoverError, brief, finite_real, whole_number
 from .paths import input_dir, strict_json
 from .sim.constants import MAX_EPISODE_STEPS, WORST_RETURN
+from .sim.rng import MAX_SEED
 
-__all__ = ["COMPETE_COLUMNS", "COMPETE_CONDITIONS", "COMPETE_FILE", "COMPETE_SUMMARY", "CompeteResult", "read_compete_dir", "read_compete_dirs"]
+__all__ = [
+    "COMPETE_COLUMNS",
+    "COMPETE_CONDITIONS",
+    "COMPETE_FILE",
+    "COMPETE_SUMMARY",
+    "CSV_COLUMNS",
+    "NO_SAFEGUARD",
+    "ONE_POLICY",
+    "SUMMARY_FIELDS",
+    "CompeteResult",
+    "read_compete_dir",
+    "read_compete_dirs",
+]
 
 COMPETE_FILE = "episodes.csv"
 COMPETE_SUMMARY = "summary.json"
 COMPETE_CONDITIONS = ("episode_steps", "sigma", "sensor", "drift")  # summary.json keys: curves that differ in one are labelled with it
 COMPETE_COLUMNS = ("run", "episode", "return")  # the columns of compete's episodes.csv read here
+#: Every column compete writes to episodes.csv (compete.CSV_COLUMNS is this); older files hold fewer, none holds others (T23-07).
+CSV_COLUMNS = ("run", "mdp", "episode", "return", "crashed", "steps", "policy", "safeguard_fired")
+#: The agents that fly under no safeguard (no Choice of theirs has a fallback), whose safeguard_fired is 0 in every row
+#: (T23-07). The agents' specs do not declare it, and this layer may not read them: tests/test_bad_input_trial23_compete.py
+#: checks that every other registered agent is one with a safeguard.
+NO_SAFEGUARD = frozenset(
+    {"baseline", "generic", "model-free", "model-based", "incremental", "incremental-zero", "incremental-fixed", "incremental-race", "model-free-risk"}
+)
+#: The agents that fly one policy throughout, and its label in every row's policy column (T23-07).
+ONE_POLICY = {"baseline": "baseline", "generic": "generic"}
+_SCALE = re.compile(r"settings-[0-9a-f]{10}")  # experiments.config.settings_scale: a competition's scale, a digest of its settings
+
+
+def _real_in(low: float, high: float) -> Callable[[object], bool]:
+    return lambda value: finite_real(value) and low <= value <= high  # type: ignore[operator]
+
+
+_SECONDS = (_real_in(0.0, math.inf), "a finite number of seconds >= 0")
+#: Every key compete writes to summary.json, in order, with its check and what it allows (None: checked against the
+#: rows, or as a condition, by the checks that say so); a key compete never writes is refused (T23-06).
+SUMMARY_FIELDS: dict[str, tuple[Callable[[object], bool] | None, str]] = {
+    "task": (None, "a task's name"),
+    "agent": (lambda v: isinstance(v, str) and v != "", "an agent's name"),
+    "mdps": (lambda v: v in ("test", "train", "sample"), "test, train or sample (the MDP set)"),
+    "seed": (lambda v: whole_number(v) and 0 <= v <= MAX_SEED, "an integer in 0..2**63-1"),
+    "store": (lambda v: isinstance(v, str) and v != "", "the results store's path"),
+    "episode_steps": (None, "a number of control steps"),
+    "sigma": (None, "a family's breadth"),
+    "sensor": (None, "a sensor's settings"),
+    "drift": (None, "a drift's settings"),
+    "experiment": (lambda v: isinstance(v, str) and v.startswith("compete-"), "compete-TASK-AGENT"),
+    "scale": (lambda v: isinstance(v, str) and _SCALE.fullmatch(v) is not None, "settings- and 10 hex digits (a digest of the settings)"),
+    "runs": (lambda v: whole_number(v) and v >= 1, "an integer >= 1"),
+    "episodes": (lambda v: whole_number(v) and v >= 1, "an integer >= 1"),
+    "mean_cumulative_return": (_real_in(-math.inf, 0.0), "a finite number <= 0 (every reward is minus a sum of squares)"),
+    "sd_cumulative_return": (_real_in(0.0, math.inf), "a finite number >= 0"),
+    "crash_rate_runs": (_real_in(0.0, 1.0), "a share in [0, 1]"),
+    "crashes_per_episode": (_real_in(0.0, 1.0), "a share in [0, 1]"),
+    "mean_return_after_learning": (_real_in(-WORST_RETURN, 0.0), f"an episode's mean return, in [{-WORST_RETURN:.3g}, 0]"),
+    "mean_seconds_per_run": _SECONDS,
+    "mean_offline_seconds_per_run": _SECONDS,
+}
 
 
 @dataclass(frozen=True)
@@ -67,7 +130,8 @@ class CompeteResult:
 @dataclass
 class _Rows:
     """What the summary check compares of an episodes.csv, kept small (a file may hold 10**8 rows): the line each MDP
-    label and each (crashed, steps) first appears on, the crashes and the runs with one."""
+    label, each (crashed, steps) and each policy label first appears on, the crashes and the runs with one, the first
+    line whose safeguard fired, and the mean return after learning where the policy column gives it."""
 
     mdps: dict[str, int] = field(default_factory=dict)
     steps: dict[tuple[bool, int], int] = field(default_factory=dict)
@@ -75,6 +139,11 @@ class _Rows:
     crashed_runs: set[int] = field(default_factory=set)
     has_crashed: bool = False
     run_lines: dict[int, int] = field(default_factory=dict)
+    run_mdps: dict[int, tuple[str, int]] = field(default_factory=dict)
+    policies: dict[str, int] = field(default_factory=dict)
+    fired_line: int | None = None
+    split_run: str | None = None  # the refusal of the first row of a run on a second MDP, said once the labels are checked
+    after_learning: float | None = None
 
 
 def _check_row(where: str, row: dict, crashed: int, steps: int | None) -> None:
@@ -91,6 +160,77 @@ def _check_row(where: str, row: dict, crashed: int, steps: int | None) -> None:
         raise NeurohoverError(f"{where}: steps {brief(row['steps'])} is not allowed: an episode's steps, an integer in 1..{MAX_EPISODE_STEPS:,}")
 
 
+def _after_learning_start(labels: list[str]) -> int:
+    """The first episode from which a run's policy no longer changes: agents.protocol.after_learning_start, which
+    compete's summary takes (this layer may not import the agents)."""
+    start = len(labels) - 1
+    while start > 0 and labels[start - 1] == labels[-1]:
+        start -= 1
+    return start
+
+
+def _read_rows(csv_path: Path) -> tuple[dict[int, list[tuple[int, float, str]]], dict[int, set[int]], _Rows]:
+    """Each run's (episode, return, policy) rows of the episodes file ``csv_path``, each run's episode numbers, and the
+    facts the summary check compares; a row compete never writes refused, naming the line."""
+    runs: dict[int, list[tuple[int, float, str]]] = {}
+    seen: dict[int, set[int]] = {}  # each run's episode numbers so far
+    facts = _Rows()
+    labels: dict[str, str] = {}  # one string per policy label (a file may hold 10**8 rows)
+    try:
+        with open(csv_path, newline="", encoding="utf-8-sig") as f:
+            reader = csv.DictReader(f)
+            columns = list(reader.fieldnames or [])
+            missing = [c for c in COMPETE_COLUMNS if c not in columns]
+            if missing:
+                raise NeurohoverError(f"--compete {str(csv_path)!r} is not a compete episodes file: no column {', '.join(missing)}")
+            odd = next((c for c in columns if c not in CSV_COLUMNS or columns.count(c) > 1), None)
+            if odd is not None:  # T23-07: an extra column was ignored without a word
+                raise NeurohoverError(
+                    f"--compete {str(csv_path)!r}, line 1: column {brief(odd)} is not allowed: compete writes the columns {', '.join(CSV_COLUMNS)}, each once"
+                )
+            facts.has_crashed = "crashed" in columns
+            for line, row in enumerate(reader, start=2):
+                where = f"--compete {str(csv_path)!r}, line {line}"
+                if None in row or None in row.values():  # T23-07: values past the header's columns were ignored
+                    count = len(columns) + len(row.get(None) or ()) - sum(v is None for k, v in row.items() if k is not None)
+                    raise NeurohoverError(f"{where}: it holds {count} values where the header names {len(columns)} columns: give one value per column")
+                try:
+                    run, episode, ret = int(row["run"]), int(row["episode"]), float(row["return"])
+                    crashed, steps = int(row.get("crashed") or 0), int(row["steps"]) if row.get("steps") else None
+                except (TypeError, ValueError):
+                    raise NeurohoverError(f"{where}: run, episode, return, crashed and steps must be numbers") from None
+                _check_row(where, row, crashed, steps)
+                if not (math.isfinite(ret) and -WORST_RETURN <= ret <= 0):  # -1e308 overflowed the plot (eighth trial); every reward is <= 0 (ninth)
+                    raise NeurohoverError(
+                        f"{where}: return {row['return']!r:.30} is not an episode's "
+                        f"(finite, in [{-WORST_RETURN:.3g}, 0]: every reward is minus a sum of squares)"
+                    )
+                if run < 0 or episode < 0 or episode in seen.setdefault(run, set()):  # plotted without a word (fifth trial)
+                    raise NeurohoverError(
+                        f"{where}: run {run}, episode {episode} is negative or given twice: each run's episodes are numbered once each from 0"
+                    )
+                mdp = row.get("mdp") or ""
+                first = facts.run_mdps.setdefault(run, (mdp, line))
+                if first[0] != mdp and facts.split_run is None:  # T23-07: one run on two MDPs was plotted as one run
+                    facts.split_run = f"{where}: mdp {brief(mdp)} is not allowed: run {run} flies {brief(first[0])} (line {first[1]}), and a run flies one MDP"
+                policy = labels.setdefault(row.get("policy") or "", row.get("policy") or "")
+                seen[run].add(episode)
+                facts.run_lines.setdefault(run, line)
+                runs.setdefault(run, []).append((episode, ret, policy))
+                facts.crashes += crashed
+                facts.mdps.setdefault(mdp, line)
+                facts.policies.setdefault(policy, line)
+                if facts.fired_line is None and row.get("safeguard_fired") == "1":
+                    facts.fired_line = line
+                if crashed:
+                    facts.crashed_runs.add(run)
+                if steps is not None:
+                    facts.steps.setdefault((bool(crashed), steps), line)
+    except (OSError, UnicodeDecodeError, csv.Error) as err:
+        raise NeurohoverError(f"--compete {str(csv_path)!r}: cannot read it ({err})") from None
+    return runs, seen, facts
+
+
 def read_compete_dir(path: str | Path) -> CompeteResult:
     """Read ``episodes.csv`` (and ``summary.json``, for the label) of a compete output directory.
 
@@ -98,50 +238,13 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
     ------
     NeurohoverError
         If ``path`` is no directory, or it has no ``episodes.csv`` or not one compete wrote, or a ``summary.json`` that
-        contradicts it (:func:`_check_summary_matches`).
+        compete never writes or that contradicts it (:func:`_check_summary`).
     """
     path = input_dir(path, "--compete")  # None or 5 was pathlib's TypeError (eleventh trial)
     csv_path = path / COMPETE_FILE
     if not csv_path.is_file():
         raise NeurohoverError(f"--compete {str(path)!r} holds no {COMPETE_FILE}: give directories written by neurohover compete --out")
-    runs: dict[int, list[tuple[int, float]]] = {}
-    seen: dict[int, set[int]] = {}  # each run's episode numbers so far
-    facts = _Rows()
-    try:
-        with open(csv_path, newline="", encoding="utf-8-sig") as f:
-            reader = csv.DictReader(f)
-            missing = [c for c in COMPETE_COLUMNS if c not in (reader.fieldnames or [])]
-            if missing:
-                raise NeurohoverError(f"--compete {str(csv_path)!r} is not a compete episodes file: no column {', '.join(missing)}")
-            facts.has_crashed = "crashed" in (reader.fieldnames or [])
-            for line, row in enumerate(reader, start=2):
-                try:
-                    run, episode, ret = int(row["run"]), int(row["episode"]), float(row["return"])
-                    crashed, steps = int(row.get("crashed") or 0), int(row["steps"]) if row.get("steps") else None
-                except (TypeError, ValueError):
-                    raise NeurohoverError(f"--compete {str(csv_path)!r}, line {line}: run, episode, return, crashed and steps must be numbers") from None
-                _check_row(f"--compete {str(csv_path)!r}, line {line}", row, crashed, steps)
-                if not (math.isfinite(ret) and -WORST_RETURN <= ret <= 0):  # -1e308 overflowed the plot (eighth trial); every reward is <= 0 (ninth)
-                    raise NeurohoverError(
-                        f"--compete {str(csv_path)!r}, line {line}: return {row['return']!r:.30} is not an episode's "
-                        f"(finite, in [{-WORST_RETURN:.3g}, 0]: every reward is minus a sum of squares)"
-                    )
-                if run < 0 or episode < 0 or episode in seen.setdefault(run, set()):  # plotted without a word (fifth trial)
-                    raise NeurohoverError(
-                        f"--compete {str(csv_path)!r}, line {line}: run {run}, episode {episode} is negative or given twice: "
-                        "each run's episodes are numbered once each from 0"
-                    )
-                seen[run].add(episode)
-                facts.run_lines.setdefault(run, line)
-                runs.setdefault(run, []).append((episode, ret))
-                facts.crashes += crashed
-                facts.mdps.setdefault(row.get("mdp") or "", line)
-                if crashed:
-                    facts.crashed_runs.add(run)
-                if steps is not None:
-                    facts.steps.setdefault((bool(crashed), steps), line)
-    except (OSError, UnicodeDecodeError, csv.Error) as err:
-        raise NeurohoverError(f"--compete {str(csv_path)!r}: cannot read it ({err})") from None
+    runs, seen, facts = _read_rows(csv_path)
     if not runs:
         raise NeurohoverError(f"--compete {str(csv_path)!r} holds no episodes")
     absent = next((r for r in range(len(runs)) if r not in runs), None)  # run 10**30 was plotted as a second run (T22-04)
@@ -162,10 +265,13 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
             f"--compete {str(csv_path)!r}: run {short} has {lengths[short]} episodes where run {max(lengths, key=lengths.__getitem__)} has "
             f"{max(lengths.values())}: the file is cut short (compete writes whole runs; run it again to rewrite it)"
         )
-    n = min(lengths.values())
-    returns = np.array([[r for _, r in sorted(rows)[:n]] for _, rows in sorted(runs.items())])
+    ordered = [sorted(rows) for _, rows in sorted(runs.items())]
+    returns = np.array([[r for _, r, _ in rows] for rows in ordered])
+    if "" not in facts.policies:  # every row names its policy: the mean return after learning, as compete.summarise takes it
+        after = [ret for rows in ordered for _, ret, _ in rows[_after_learning_start([p for _, _, p in rows]) :]]
+        facts.after_learning = math.fsum(after) / len(after)
     label = path.resolve().name  # no summary (an interrupted competition): the directory's name labels it
-    summary_path = path / COMPETE_SUMMARY
+    summary_path, conditions = path / COMPETE_SUMMARY, {}
     if summary_path.exists():
         try:
             summary = strict_json(summary_path.read_text(encoding="utf-8-sig"))  # a key given twice too (ninth trial)
@@ -173,11 +279,42 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
             raise NeurohoverError(f"--compete {str(summary_path)!r} cannot be read ({err}); remove it to label the curve by its directory's name") from None
         if not (isinstance(summary, dict) and isinstance(summary.get("agent"), str) and isinstance(summary.get("task", ""), str)):
             raise NeurohoverError(f"--compete {str(summary_path)!r} is not a compete summary: no agent and task names")
-        _check_summary_matches(summary_path, summary, returns, facts)
+        _check_summary(summary_path, summary, returns, facts)
         label = f"{summary['agent']} ({summary.get('task', '?')})"
         conditions = {key: summary[key] for key in COMPETE_CONDITIONS if key in summary}
-        return CompeteResult(label, returns, facts.crashes, path, conditions)
-    return CompeteResult(label, returns, facts.crashes, path)
+    if facts.split_run is not None:  # after the summary's check of each label: a label of no MDP is named as such first
+        raise NeurohoverError(facts.split_run)
+    return CompeteResult(label, returns, facts.crashes, path, conditions)
+
+
+def _check_summary(path: Path, summary: dict, returns: np.ndarray, rows: _Rows) -> None:
+    """The one check of a summary.json, against itself and its episodes.csv: no key compete never writes (T23-06), a task's
+    name, then the rows its agent never writes (:func:`_check_rows_of_agent`), what its rows contradict
+    (:func:`_check_summary_matches`: named with what they hold), each value's kind and range (:func:`_check_fields`),
+    the conditions its task can fly under (:func:`_check_conditions`) and the MDPs (:func:`_check_mdp_labels`)."""
+    from .tasks import TASK_NAMES
+
+    unknown = next((key for key in summary if key not in SUMMARY_FIELDS), None)
+    if unknown is not None:
+        raise NeurohoverError(f"--compete {str(path)!r}: its key {brief(unknown)} is not allowed: compete writes the keys {', '.join(SUMMARY_FIELDS)}")
+    task = summary.get("task")
+    if task is not None and task not in TASK_NAMES:
+        raise NeurohoverError(f"--compete {str(path)!r} names task {task!r:.40}, not one of {', '.join(TASK_NAMES)}: it is no compete summary")
+    _check_rows_of_agent(path, summary, rows)  # first: a row's own fault (a policy, say) named, not the figures it moves
+    _check_summary_matches(path, summary, returns, rows)  # then a value the rows contradict, named with what they hold
+    _check_fields(path, summary)
+    _check_conditions(path, summary)
+    _check_mdp_labels(path, summary, returns.shape[0], rows)
+
+
+def _check_fields(path: Path, summary: dict) -> None:
+    """Refuse a value of a kind or range compete never writes, naming the key, the value and what is allowed (T23-06: seed
+    'x', scale 'paper', seconds -5 or NaN, a positive mean return were taken). A key compete writes may be absent (older
+    summaries hold fewer); a key it never writes is refused by :func:`_check_summary`, not ignored: a misspelt
+    condition ('sgima') would otherwise leave the curve unlabelled without a word."""
+    for key, (fits, allowed) in SUMMARY_FIELDS.items():
+        if key in summary and fits is not None and not fits(summary[key]):
+            raise NeurohoverError(f"--compete {str(path)!r}: its {key} {brief(summary[key])} is not allowed: {allowed} (what compete writes)")
 
 
 def _check_summary_matches(path: Path, summary: dict, returns: np.ndarray, rows: _Rows) -> None:
@@ -185,9 +322,8 @@ def _check_summary_matches(path: Path, summary: dict, returns: np.ndarray, rows:
     another competition's, or edited, and labelled the curve without a word (eighth trial; a task edited from ghh08 to
     ghh09 over ghh08's rows, T21-07). Checked, each where the summary holds it: task (a task family, that of every
     row's MDP and of its experiment ``compete-<task>-<agent>``), agent (its experiment's), mdps (every row's MDP set),
-    runs and episodes, episode_steps (every uncrashed episode's steps, no crash later), crash figures and the mean and
-    sd of the cumulative return (the rows')."""
-    from .tasks import TASK_NAMES
+    runs and episodes, episode_steps (every uncrashed episode's steps, no crash later), crash figures, the mean and
+    sd of the cumulative return and the mean return after learning (the rows', where they name each episode's policy)."""
 
     def refuse(key: str, found: str) -> NoReturn:
         raise NeurohoverError(
@@ -196,8 +332,6 @@ def _check_summary_matches(path: Path, summary: dict, returns: np.ndarray, rows:
         )
 
     task, experiment = summary.get("task"), summary.get("experiment")
-    if task is not None and task not in TASK_NAMES:
-        raise NeurohoverError(f"--compete {str(path)!r} names task {task!r:.40}, not one of {', '.join(TASK_NAMES)}: it is no compete summary")
     for label, line in rows.mdps.items():  # compete's MDP labels: '<task>/<set>:<i>'
         family, slash, rest = label.partition("/")
         if slash and task is not None and family != task:
@@ -215,7 +349,6 @@ def _check_summary_matches(path: Path, summary: dict, returns: np.ndarray, rows:
         raise NeurohoverError(
             f"--compete {str(path)!r} says episode_steps {shown}, not a number of steps (an integer in 1..{MAX_EPISODE_STEPS:,}): it is no compete summary"
         )
-    _check_conditions(path, summary)
     limit = int(summary.get("episode_steps") or 0)
     for (crashed, steps), line in rows.steps.items() if limit else ():
         if steps > limit or (steps != limit and not crashed):
@@ -229,34 +362,74 @@ def _check_summary_matches(path: Path, summary: dict, returns: np.ndarray, rows:
         ("crashes_per_episode", rows.crashes / returns.size, 0.0, f"its episodes.csv holds {crashes} in {returns.size} episodes"),
         ("crash_rate_runs", crashed_runs / runs, 0.0, f"its episodes.csv holds {crashed_runs} of {runs} runs with a crash"),
     ]
-    for key, value, tolerance, found in figures if rows.has_crashed else figures[:2]:
+    if rows.after_learning is not None:  # T23-06: 5.0 was taken; compete.summarise's mean of each run's returns from its last policy on
+        after = f"its episodes.csv's returns average {rows.after_learning:.10g} from each run's last policy on"
+        figures.append(("mean_return_after_learning", rows.after_learning, 1e-6, after))
+    for key, value, tolerance, found in figures if rows.has_crashed else (f for f in figures if not f[0].startswith("crash")):
         given = summary.get(key)
         if given is not None and not (finite_real(given) and math.isclose(given, value, rel_tol=1e-9, abs_tol=tolerance)):
             refuse(key, found)
-    for label, line in rows.mdps.items() if task is not None else ():  # mdp 'zzz' was plotted as ghh08's (T22-04)
-        _, slash, rest = label.partition("/")
-        kind, _, index = rest.partition(":")
-        if label and not (slash and kind in ("test", "train", "sample") and index.isascii() and index.isdigit()):
-            where = f"--compete {str(path.with_name(COMPETE_FILE))!r}, line {line}"
-            raise NeurohoverError(f"{where}: mdp {brief(label)} is not allowed: a {task} MDP's label, {task}/SET:I (SET test, train or sample)")
 
 
 def _check_conditions(path: Path, summary: dict) -> None:
     """Refuse a summary's sigma, sensor or drift that compete cannot have flown under, naming it (a sigma NaN, a sensor
     {"level": -5} and a drift "junk" labelled the curves without a word; T22-04): sigma finite and >= 0, a sensor and a
-    drift as their parsers read them (Sensor.from_dict, Drift.from_dict; no drift as compete writes Drift() too)."""
-    from .tasks import Drift, Sensor
+    drift as their parsers read them (Sensor.from_dict, Drift.from_dict; no drift as compete writes Drift() too), and
+    each one that its task takes (a sigma on ghh08 was taken, T23-06: compete asks the task family, as here)."""
+    from .tasks import TASK_NAMES, Drift, Sensor, get_task_family
 
+    task = summary.get("task")
+    flown: dict[str, object] = {}  # the conditions read so far, as compete hands them to get_task_family
     for key, value in ((k, summary.get(k)) for k in ("sigma", "sensor", "drift")):
         try:
             if key == "sigma" and value is not None and not (finite_real(value) and value >= 0):
                 raise NeurohoverError("a family's breadth is a finite number >= 0, or null")
+            if key == "sigma":
+                flown[key] = value
             if key == "sensor" and value is not None:
-                Sensor.from_dict(value)
+                flown[key] = Sensor.from_dict(value)
             if key == "drift" and value is not None:  # {walk 0, change {}}: compete's Drift(), which from_dict calls no drift
-                Drift.from_dict({k: v for k, v in value.items() if k != "walk" or v != 0} if isinstance(value, dict) else value)
+                flown[key] = Drift.from_dict({k: v for k, v in value.items() if k != "walk" or v != 0} if isinstance(value, dict) else value)
+            if task in TASK_NAMES:
+                get_task_family(task, **flown)  # type: ignore[arg-type]
         except NeurohoverError as err:
             raise NeurohoverError(f"--compete {str(path)!r} says {key} {brief(value)}, which compete never flies under: {err}") from None
+
+
+def _check_mdp_labels(path: Path, summary: dict, runs: int, rows: _Rows) -> None:
+    """Refuse an MDP that is no label of the summary's task (mdp 'zzz', T22-04) or none of the MDPs its runs fly
+    (test:999 of a 2-run competition, T23-07), naming the line, the value and what is allowed."""
+    from .tasks import N_TEST, N_TRAINING
+
+    task = summary.get("task")
+    for label, line in rows.mdps.items() if task is not None else ():
+        _, slash, rest = label.partition("/")
+        kind, _, index = rest.partition(":")
+        where = f"--compete {str(path.with_name(COMPETE_FILE))!r}, line {line}"
+        if label and not (slash and kind in ("test", "train", "sample") and index.isascii() and index.isdigit()):
+            raise NeurohoverError(f"{where}: mdp {brief(label)} is not allowed: a {task} MDP's label, {task}/SET:I (SET test, train or sample)")
+        flown = min(runs, {"test": N_TEST, "train": N_TRAINING}.get(kind, runs))  # compete._group: a run per MDP, or the whole set
+        if label and (len(index) > 9 or int(index) >= flown):
+            raise NeurohoverError(
+                f"{where}: mdp {brief(label)} is not allowed: a competition of {runs} runs on {task}'s {kind} MDPs "
+                f"flies {task}/{kind}:0 to {task}/{kind}:{flown - 1}"
+            )
+
+
+def _check_rows_of_agent(path: Path, summary: dict, rows: _Rows) -> None:
+    """Refuse a row that the summary's agent never writes, naming the line, the value and what is allowed: a safeguard
+    that fired for an agent that flies under none, a policy other than the one a one-policy agent flies (T23-07)."""
+    agent = summary.get("agent")
+    csv_path = path.with_name(COMPETE_FILE)
+    if rows.fired_line is not None and agent in NO_SAFEGUARD:
+        raise NeurohoverError(
+            f"--compete {str(csv_path)!r}, line {rows.fired_line}: safeguard_fired '1' is not allowed: agent {agent} flies under no safeguard "
+            "(0 for each of its episodes; agents with one: the hybrid agents, continual, authors-*)"
+        )
+    fixed = ONE_POLICY.get(agent) if isinstance(agent, str) else None
+    for label, line in rows.policies.items() if fixed else ():
+        if label not in ("", fixed):
+            raise NeurohoverError(f"--compete {str(csv_path)!r}, line {line}: policy {brief(label)} is not allowed: agent {agent} flies {fixed!r} only")
 
 
 def read_compete_dirs(dirs: Sequence[str | Path]) -> list[CompeteResult]:

@@ -181,6 +181,7 @@ def test_compete_conditions_compete_writes_are_read(tmp_path: Path) -> None:
     from neurohover.tasks import Drift, Sensor
 
     for i, (name, value) in enumerate(
-        (("sigma", 0.5), ("sensor", Sensor.at_level(1.0).to_dict()), ("drift", Drift().to_dict()), ("drift", Drift(0.01).to_dict()))
+        # sigma None: what compete writes for ghh08, which has no breadth (its 0.5 was read; T23-06: fghh's in trial 23's tests)
+        (("sigma", None), ("sensor", Sensor.at_level(1.0).to_dict()), ("drift", Drift().to_dict()), ("drift", Drift(0.01).to_dict()))
     ):
         assert read_compete_dir(_competition(tmp_path / str(i), _rows(), **{name: value})).conditions[name] == value

@@ -10,7 +10,10 @@ several ``neurohover compete --out DIR`` results (their ``episodes.csv``; agent 
 ``summary.json``) on one figure, linear and log scale, written to ``OUTDIR/compete.png``;
 ``OUTDIR`` defaults to the directory holding the first DIR. A ``summary.json`` that its
 ``episodes.csv`` contradicts (another task's or MDP set's rows, other runs, episodes, episode
-steps, crashes or returns) is refused, naming the field and both values.
+steps, crashes or returns) is refused, naming the field and both values; so is what compete never
+writes: a key or column of another name, a value of another kind or range (a positive mean return, a
+sigma on a task without one, a seed 'x'), a run on two MDPs or on an MDP its runs never fly, a
+safeguard firing or another policy for an agent without one (neurohover.compete_files).
 
 The files written are printed, one per line.
 """
