@@ -1,14 +1,20 @@
 """What a policy set's ``manifest.json`` holds (:mod:`neurohover.policysets`): its descriptive fields, its GHH tables of
 crashes and mean returns on the training MDPs, Table 3's figures of them and the paper's rule for the safe policies, and
-the checks :func:`~neurohover.policysets.load_policy_set` makes of them."""
+the checks :func:`~neurohover.policysets.load_policy_set` makes of them; and the check of a policy file's record of the
+run that evolved it (:func:`policy_record_problem`), which :func:`~neurohover.policies.load_policy` applies to every
+policy file: each file kind checked against itself in one place."""
 
 from __future__ import annotations
 
+import math
+import re
 from pathlib import Path
 
 import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real, whole_number
+from .policies import RECORD_CHECKS
+from .sim.constants import MAX_EPISODE_STEPS, WORST_RETURN
 
 #: How GHH-08/09 policy sets seed their runs (see the doc of :mod:`neurohover.policysets`).
 LINEAGES = ("chain", "independent")
@@ -25,6 +31,22 @@ _MANIFEST_FIELDS: dict[str, tuple[tuple[type, ...], str]] = {
 }  # fmt: skip
 
 
+def _manifest_sizes() -> dict[str, tuple[int, int, str]]:
+    """The sizes a build takes (:func:`~neurohover.policysets.check_build`), as a manifest records them: name -> (lowest,
+    highest, the range in words). A budget or n_steps of 0 was accepted as a count >= 0 (T23-11)."""
+    from .evaluate import MAX_EPISODES_PER_CALL
+    from .evolution.config import MAX_BUDGET
+    from .sim.rng import MAX_SEED
+
+    return {
+        "budget": (1, MAX_BUDGET, f"1..{MAX_BUDGET:,} (episodes of each run)"),
+        "fghh_budget": (1, MAX_BUDGET, f"1..{MAX_BUDGET:,} (episodes of each FGHH generic's run over G)"),
+        "n_steps": (1, MAX_EPISODE_STEPS, f"1..{MAX_EPISODE_STEPS:,} (control steps per episode)"),
+        "safety_episodes": (1, MAX_EPISODES_PER_CALL, f"1..{MAX_EPISODES_PER_CALL:,} (episodes of each specialised policy on each training MDP)"),
+        "seed": (0, MAX_SEED, "0..2**63-1 (the build's root seed)"),
+    }
+
+
 # Every key a build writes into a manifest, of a GHH or an FGHH set, and the descriptive fields above.
 _MANIFEST_KEYS = ("task", *_MANIFEST_FIELDS, "safe", "crashes_on_training_mdps", "mean_return_on_training_mdps", "table3")
 
@@ -36,6 +58,7 @@ def _check_manifest_fields(manifest: dict, path: Path) -> None:
     if unknown:  # "bogus": 1, or a misspelt "saef", was ignored without a word (T19-13)
         shown = ", ".join(brief(key) for key in unknown[:5]) + (f" and {len(unknown) - 5} more" if len(unknown) > 5 else "")
         raise NeurohoverError(f"policy-set manifest {str(path)!r} has unknown keys {shown}: allowed {', '.join(_MANIFEST_KEYS)}")
+    sizes = _manifest_sizes()
     for name, (kinds, allowed) in _MANIFEST_FIELDS.items():
         value = manifest.get(name)
         if value is None:
@@ -46,6 +69,9 @@ def _check_manifest_fields(manifest: dict, path: Path) -> None:
         bad = bad or (name == "lineage" and value not in LINEAGES)
         if bad:
             raise NeurohoverError(f"policy-set manifest {str(path)!r}: {name}={value!r:.40} is not allowed: give {allowed}")
+        size = sizes.get(name)
+        if size is not None and not size[0] <= value <= size[1]:  # T23-11: a budget or n_steps of 0 was taken as a count >= 0
+            raise NeurohoverError(f"policy-set manifest {str(path)!r}: its {name} {brief(value)} is not allowed: allowed an integer in {size[2]}")
 
 
 def _check_tables(manifest: dict, path: Path, rows: int, columns: int) -> None:
@@ -206,3 +232,88 @@ def _check_table3(table3: object, crashes: list | None, returns: list | None, wh
 def _count(value: object) -> bool:
     """Whether ``value`` is a whole number >= 0 (a count of crashed episodes)."""
     return whole_number(value) and value >= 0
+
+
+#: What a policy file's record of its run says the run was over: a task family (``ghh08/G``, ``fghh/G(sigma=0.3)``), not one MDP.
+_FAMILY_TARGET = re.compile(r"[a-z0-9]+/G(\(sigma=[^()]*\))?")
+
+
+def policy_record_problem(meta: dict) -> str:
+    """What in a policy file's record of the run that evolved it contradicts itself ('' when nothing does): the keys
+    :meth:`Run.result <neurohover.evolution.run.Run.result>` writes, each checked where present, against the evolution's
+    own ranges and words and against each other, as :mod:`neurohover.experiments.result_checks` checks a stored test run.
+    A budget of -5, n_steps of 0, more evaluations than episodes, a steady-state run over a family, a return of 5.0, a
+    stop reason 'zzz' or a seed of -3 were all accepted after hand edits (T23-11)."""
+    from .evolution.config import MAX_BUDGET, parse_resampling
+    from .evolution.fitness import ERROR_FLOOR
+    from .evolution.optimisers import NE, OPTIMISERS
+    from .evolution.restore import STOP_REASONS
+    from .sim.rng import MAX_SEED
+
+    counts = {"seed": (0, MAX_SEED, "in 0..2**63-1 (the run's root seed)"), "budget": (1, MAX_BUDGET, f"in 1..{MAX_BUDGET:,} (episodes), or null"),
+              "n_steps": (1, MAX_EPISODE_STEPS, f"in 1..{MAX_EPISODE_STEPS:,} (control steps per episode)"),
+              "episodes": (1, None, ">= 1 (episodes flown)"), "evaluations": (1, None, ">= 1 (candidates evaluated)"),
+              "generations": (0, None, ">= 0 (generations bred)")}  # fmt: skip
+    for name, (low, high, allowed) in counts.items():
+        value = meta.get(name)
+        if name not in meta or (value is None and name == "budget") or (whole_number(value) and low <= value <= (high or value)):
+            continue
+        return f"its {name} {brief(value)} is not allowed: allowed an integer {allowed}"
+    for small, large, why in (("evaluations", "episodes", "each evaluation flies at least one episode"),
+                              ("generations", "evaluations", "each generation evaluates at least one candidate")):  # fmt: skip
+        if meta.get(small) is not None and meta.get(large) is not None and meta[small] > meta[large]:
+            return f"its {small} {brief(meta[small])} is not allowed: more than its {large} {brief(meta[large])}, and {why}"
+    own_stop = {"steady-state": "plateau", "generational": "generations", **{spec.label: spec.stop_reason for spec in OPTIMISERS.values()}}
+    method, optimizer = meta.get("method"), meta.get("optimizer")
+    if method is not None and (not isinstance(method, str) or method not in own_stop):
+        return f"its method {brief(method)} is not allowed: allowed {', '.join(own_stop)}"
+    names = {NE: ("steady-state", "generational"), **{name: (spec.label,) for name, spec in OPTIMISERS.items()}}
+    if optimizer is not None and (not isinstance(optimizer, str) or optimizer not in names):
+        return f"its optimizer {brief(optimizer)} is not allowed: allowed {', '.join(names)}"
+    if method is not None and optimizer is not None and method not in names[optimizer]:
+        return f"its method {brief(method)} is not allowed: optimizer {optimizer!r} evolves by {' or '.join(names[optimizer])}"
+    return _run_words_problem(meta, own_stop, STOP_REASONS, parse_resampling, (1 + 1e-9) / math.log(ERROR_FLOOR))
+
+
+def _run_words_problem(meta: dict, own_stop: dict, stop_reasons: tuple, parse_resampling, best_fitness: float) -> str:
+    """:func:`policy_record_problem`'s checks of a record's target, resampling, champion_return and stop_reason against its
+    method, budget and episodes ('' when they agree)."""
+    method, target = meta.get("method"), meta.get("target")
+    if target is not None and not isinstance(target, str):
+        return f"its target {brief(target)} is not allowed: give the label of the MDP or task family it was evolved on"
+    if method == "steady-state" and target is not None and _FAMILY_TARGET.fullmatch(target):
+        why = "steady state evolves on one MDP, a task family needs the generational method"
+        return f"its method 'steady-state' is not allowed beside its target {brief(target)}: {why}"
+    if meta.get("resampling") is not None:
+        try:
+            selects = parse_resampling(meta["resampling"]).selects if isinstance(meta["resampling"], str) else None
+        except ValueError:  # NeurohoverError among them
+            selects = None
+        if selects is None:
+            return f"its resampling {brief(meta['resampling'])} is not allowed: allowed fixed:K, race:DELTA, lucb:DELTA or kl-lucb:DELTA"
+        if selects and method is not None and method != "generational":
+            return (
+                f"its resampling {brief(meta['resampling'])} is not allowed beside its method {brief(method)}: a race or bandit needs the generational method"
+            )
+    ret = meta.get("champion_return")
+    if ret is not None:
+        fitness = method in (None, "generational")  # a generational run's champion is on its fitness scale, 1/ln(error) by default
+        if not (finite_real(ret) and (-WORST_RETURN <= ret <= 0 or (fitness and 0 < ret <= best_fitness))):
+            allowed = f"a return in [{-WORST_RETURN:.3g}, 0] (every reward is minus a sum of squares)"
+            allowed += f", or a fitness 1/ln(error) in (0, {best_fitness:.8g}]" if fitness else f" for a {method} run (on the return scale)"
+            return f"its champion_return {brief(ret)} is not allowed: allowed {allowed}"
+    reason = meta.get("stop_reason")
+    if reason is None:
+        return ""
+    if not isinstance(reason, str) or reason not in stop_reasons:
+        return f"its stop_reason {brief(reason)} is not allowed: allowed {', '.join(stop_reasons)} (why the run stopped)"
+    budget, episodes = meta.get("budget"), meta.get("episodes")
+    if reason == "budget" and "budget" in meta and (budget is None or (episodes is not None and episodes < budget)):
+        has = "it has no budget" if budget is None else f"its {episodes:,} episodes are fewer than its budget {budget:,}"
+        return f"its stop_reason 'budget' is not allowed: {has} (a run stops by its budget once it has flown it)"
+    if reason != "budget" and method is not None and reason != own_stop[method]:
+        return f"its stop_reason {brief(reason)} is not allowed beside its method {method!r}: allowed budget or {own_stop[method]}"
+    return ""
+
+
+RECORD_CHECKS["policy_record_problem"] = policy_record_problem  # every policy file load_policy reads is checked by it (T23-11)

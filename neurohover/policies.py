@@ -13,7 +13,7 @@ from __future__ import annotations
 import json
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -70,6 +70,13 @@ BASELINE_GAINS = {
     ("a4", "w"): 0.1348,
 }
 BASELINE_BIASES = (0.02, 0.0, 0.0, 0.23)
+
+
+#: Checks of a policy file's record of the run that evolved it, by name: each takes the policy's metadata and says what in
+#: it contradicts itself ('' when nothing does). :func:`load_policy` applies them to every JSON policy file it reads.
+#: :mod:`neurohover.manifest` installs its ``policy_record_problem`` as it is imported: it reads the evolution's words (its
+#: stop reasons and methods), which this layer may not import (T23-11).
+RECORD_CHECKS: dict[str, Callable[[dict], str]] = {}
 
 
 def _sigmoid(s: float) -> float:
@@ -263,7 +270,12 @@ def load_policy(source: str | Path) -> Policy:
         return policy_from_net(text, name)
     from .paths import parse_json
 
-    return policy_from_dict(parse_json(text, name), name)
+    policy = policy_from_dict(parse_json(text, name), name)
+    for check in RECORD_CHECKS.values():  # its record of its run against itself: a budget of -5 or a stop reason 'zzz' was taken (T23-11)
+        problem = check(policy.metadata)
+        if problem:
+            raise NeurohoverError(f"{name}: {problem}")
+    return policy
 
 
 def utf8_text(data: bytes, name: str, what: str) -> str:

@@ -115,8 +115,9 @@ _POLICY_KEYS = ("topology", "genome", "prototype", "method", "optimizer", "resam
                 "evaluations", "generations", "champion_return", "n_steps", "stop_reason", "task", "name", "seconds")  # fmt: skip
 
 
-def _load(path: Path, what: str, task: str, target: str) -> Policy:
-    """The policy ``what`` of ``task``'s set, from ``path``, evolved on ``target`` (an MDP's label, or ``TASK/G`` over G)."""
+def _load(path: Path, what: str, task: str, target: str, built: dict | None = None) -> Policy:
+    """The policy ``what`` of ``task``'s set, from ``path``, evolved on ``target`` (an MDP's label, or ``TASK/G`` over G)
+    by the run that ``built`` (:func:`_built_as`) says its manifest's build made."""
     _refuse_not_a_file(path, what)
     if not path.is_file():
         raise NeurohoverError(
@@ -129,7 +130,21 @@ def _load(path: Path, what: str, task: str, target: str) -> Policy:
         shown = ", ".join(brief(key) for key in unknown[:5]) + (f" and {len(unknown) - 5} more" if len(unknown) > 5 else "")
         raise NeurohoverError(f"policy set {str(path.parent)!r}: {path.name} ({what}) has unknown keys {shown}: allowed {', '.join(_POLICY_KEYS)}")
     _check_place(policy, path, what, {"task": task, "name": path.stem, "target": target})
+    _check_place(policy, path, what, built or {}, "what its manifest.json says the build ran: a policy of another build copied in, or a hand edit?")
     return policy
+
+
+def _built_as(manifest: dict, role: Role) -> dict:
+    """What the run of ``role`` recorded, as the set's ``manifest`` says its build ran it (where it says): its episode
+    length, its budget and its method (a steady-state generic recording a generational run, or n_steps 999 in a set of
+    20, was flown; T23-11)."""
+    from .evolution.optimisers import NE, OPTIMISERS
+
+    family = role.target == "family"
+    optimizer = NE if role.kind == "race" else manifest.get("optimizer", NE)  # a race is NE's (build_policy_set)
+    method = ("generational" if family else "steady-state") if optimizer == NE else getattr(OPTIMISERS.get(optimizer), "label", None)
+    built = {"n_steps": manifest.get("n_steps"), "budget": manifest.get("fghh_budget" if family else "budget"), "method": method}
+    return {key: value for key, value in built.items() if value is not None}
 
 
 def _refuse_not_a_file(path: Path, what: str) -> None:
@@ -147,16 +162,17 @@ def _refuse_not_a_file(path: Path, what: str) -> None:
         raise NeurohoverError(f"policy set {str(path.parent)!r}: {path.name} ({what}) is not a regular file (a device, pipe or socket)")
 
 
-def _check_place(policy: Policy, path: Path, what: str, place: dict[str, str]) -> None:
+def _check_place(policy: Policy, path: Path, what: str, place: dict, why: str = "a policy of another place copied in?") -> None:
     """Refuse a policy whose file records another place than the one it holds in its set (task, name, target: each where
-    recorded): specialised_4.json copied over specialised_3.json, or another task's generic, was flown (ninth trial)."""
+    recorded): specialised_4.json copied over specialised_3.json, or another task's generic, was flown (ninth trial); or
+    (``why`` says so) another run than its manifest's build made (T23-11)."""
     for key, want in place.items():
         have = policy.metadata.get(key)
-        fits = have is None or have == want or (want.endswith("/G") and isinstance(have, str) and have.startswith(want))  # /G(sigma=0.3)
-        if not fits:
+        over_g = isinstance(want, str) and want.endswith("/G") and isinstance(have, str) and have.startswith(want)  # /G(sigma=0.3)
+        if not (have is None or (have == want and type(have) is type(want)) or over_g):
             raise NeurohoverError(
-                f"policy set {str(path.parent)!r}: {path.name} ({what}) records {key} {have!r:.60}, not {want!r} (a policy of another "
-                f"place copied in?): give the policy evolved for it, or rebuild the set with: neurohover build-policies --task {place['task']}"
+                f"policy set {str(path.parent)!r}: {path.name} ({what}) records {key} {brief(have)}, not {want!r} ({why}): give the "
+                f"policy evolved for it, or rebuild the set with: neurohover build-policies --task {path.parent.name}"
             )
 
 
@@ -185,12 +201,19 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
     check_kind_keys(manifest, manifest_path, family.generic_over_distribution)
     targets = {"zero": family.zero().label, "family": f"{family.name}/G"}  # what each role's run evolved on
     if family.generic_over_distribution:
-        roles = {role.kind: role.target for role in policy_set_roles(family)}
-        generics = {name: _load(root / f"generic_{name}.json", f"the {name} generic policy", family.name, targets[roles[name]]) for name in FGHH_GENERICS}
+        roles = {role.kind: role for role in policy_set_roles(family)}
+        generics = {
+            name: _load(root / f"generic_{name}.json", f"the {name} generic policy", family.name, targets[roles[name].target], _built_as(manifest, roles[name]))
+            for name in FGHH_GENERICS
+        }
         return PolicySet(family.name, root, generics["race"], generics=generics, manifest=manifest)
-    generic = _load(root / "generic.json", "the generic policy", family.name, targets["zero"])
+    generic_role, *specialised_roles = policy_set_roles(family)
+    generic = _load(root / "generic.json", "the generic policy", family.name, targets["zero"], _built_as(manifest, generic_role))
     train = family.training_mdps()
-    specialised = tuple(_load(root / f"specialised_{i}.json", f"specialised policy {i}", family.name, train[i].label) for i in range(10))
+    specialised = tuple(
+        _load(root / f"specialised_{i}.json", f"specialised policy {i}", family.name, train[i].label, _built_as(manifest, specialised_roles[i]))
+        for i in range(10)
+    )
     safe = check_ghh_manifest(manifest, manifest_path, len(specialised), len(train))
     return PolicySet(family.name, root, generic, specialised, safe, manifest=manifest)
 
