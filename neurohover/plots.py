@@ -246,7 +246,8 @@ def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight"
         raise NeurohoverError(  # '../zz' wrote outside out_dir, '' the file '-episode0.png' (eleventh trial)
             f"stem={stem!r:.60} is not allowed: give a non-empty file-name prefix without a path separator, e.g. 'flight'"
         )
-    check_metadata(data.metadata, np.array([a.shape[0] for a in data.actions], dtype=np.int64), "flight data")  # episode_steps 'x' (T14-10)
+    lengths = np.array([a.shape[0] for a in data.actions], dtype=np.int64)  # episode_steps 'x' (T14-10); returns after making (T23-03)
+    check_metadata(data.metadata, lengths, "flight data", (data.observations, data.actions))
     steps = data.metadata.get("episode_steps", EPISODE_STEPS)
     for i, crashed in enumerate(crash_flags(data)):  # every episode before any file is written, as learn-model reads them all
         check_flown(data.observations[i], data.actions[i], crashed, f"flight data, episode {i}")
