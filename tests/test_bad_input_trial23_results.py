@@ -264,6 +264,7 @@ def test_a_baseline_run_with_safeguard_episodes_or_offline_time_beyond_its_own_i
     assert rc == 2 and out == "" and err.strip() == f"neurohover results: error: {message}", err
 
 
+@pytest.mark.paper  # about 10 s over the whole store: run with the store's other checks when it is committed (-m paper)
 def test_every_stored_evolution_and_robustness_result_of_the_committed_store_is_taken(committed_store: Path) -> None:
     """T23-08: the checks refuse only what is contradictory: every evolve, robustness and test-run unit of the
     committed paper store (all its experiments, both scales) passes them."""
