@@ -247,7 +247,7 @@ def test_a_crashed_champion_of_any_return_is_taken(ev1, tmp_path: Path) -> None:
     [
         (
             {"safeguard_episodes": [0]},
-            "test run of baseline on ghh08/test:0 is inconsistent: safeguard_episodes = [0] is not allowed: the baseline flies with no safeguard: allowed []",
+            "test run of baseline on ghh08/test:0 is inconsistent: safeguard_episodes = [0] is not allowed: agent baseline flies under no safeguard: allowed []",
         ),
         (
             {"timing": lambda r: {"seconds": 1.0, "offline_seconds": 2.5}},
@@ -276,3 +276,11 @@ def test_every_stored_evolution_and_robustness_result_of_the_committed_store_is_
         assert params_problem(result_from_dict(kind, json.loads(result), key), json.loads(params)) == "", key
         checked += 1
     assert checked > 1000
+
+
+def test_any_agent_without_a_safeguard_is_refused_safeguard_episodes(tmp_path: Path) -> None:
+    """T23-14: not only the baseline: a generic run (no safeguard either; compete_files.NO_SAFEGUARD, as plot --compete
+    reads rows) stored with safeguard episodes is refused; a hybrid run's are its own (checked elsewhere)."""
+    config, store = _reproduced(tmp_path, tiny_test_runs("generic"))
+    edited = _edited(store, tmp_path / "e.sqlite", "run/generic/test0/rep0", safeguard_episodes=[1])
+    _refused(edited, "tr1", "run/generic/test0/rep0", "safeguard_episodes = [1] is not allowed: agent generic flies under no safeguard")

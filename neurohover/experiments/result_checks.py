@@ -8,6 +8,7 @@ import dataclasses
 import math
 from typing import TYPE_CHECKING, Any
 
+from ..compete_files import NO_SAFEGUARD
 from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..sim.constants import WORST_RETURN
 
@@ -67,8 +68,8 @@ def run_inconsistency(run: TestRunResult) -> str:
     for i, step in enumerate(run.crash_steps or ()):
         if step < 1:  # the kernel counts the crashing control step from 1 (its unit's params bound it: params_problem)
             return f"crash_steps[{i}] = {step!r} is not allowed: a crash ends its episode at control step 1 or later"
-    if run.agent == "baseline" and run.safeguard_episodes:  # the baseline's run was stored with safeguard episodes (T23-14)
-        return f"safeguard_episodes = {brief(list(run.safeguard_episodes))} is not allowed: the baseline flies with no safeguard: allowed []"
+    if run.agent in NO_SAFEGUARD and run.safeguard_episodes:  # the baseline's run was stored with safeguard episodes (T23-14)
+        return f"safeguard_episodes = {brief(list(run.safeguard_episodes))} is not allowed: agent {run.agent} flies under no safeguard: allowed []"
     seconds, offline = float(run.timing.seconds), float(run.timing.offline_seconds)
     if offline > seconds * (1 + 1e-9) + 1e-6:  # the agent's work between episodes is part of the run's time (T23-14)
         return (
