@@ -247,7 +247,8 @@ def test_a_crashed_champion_of_any_return_is_taken(ev1, tmp_path: Path) -> None:
     [
         (
             {"safeguard_episodes": [0]},
-            "test run of baseline on ghh08/test:0 is inconsistent: safeguard_episodes = [0] is not allowed: agent baseline flies under no safeguard: allowed []",
+            "test run of baseline on ghh08/test:0 is inconsistent: safeguard_episodes = [0] is not allowed: "
+            "agent baseline flies under no safeguard: allowed []",
         ),
         (
             {"timing": lambda r: {"seconds": 1.0, "offline_seconds": 2.5}},
