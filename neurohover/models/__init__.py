@@ -22,6 +22,8 @@ Modules
 ``model``
     :class:`LearnedModel`, its file format, :func:`equivalent_params` (the model's parameters in
     the simulator's integration) and :func:`parameter_table`; the helpers the others share.
+``model_checks``
+    :func:`~neurohover.models.model_checks.model_file_problem`: a model file checked against itself when it is read.
 ``transitions``
     Flight data as transitions, noise from residuals, :class:`OneStepProblem` and :func:`one_step_error`.
 ``lr``
