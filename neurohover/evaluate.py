@@ -441,8 +441,8 @@ def evaluate(
     if len(table) == 0:  # an empty table returned an empty Evaluation, where [] is refused (T15-20)
         raise NeurohoverError("policies=PolicyTable of 0 policies is not allowed: give a non-empty sequence of Policy objects or a non-empty PolicyTable")
     rows = mdp_rows(mdps)
-    if not whole_number(episodes) or episodes < 1:  # True is an int; np.timedelta64 a NumPy integer (T17-1)
-        raise NeurohoverError(f"episodes={brief(episodes)} is out of range: allowed an integer >= 1")
+    # T24-11: whole_in, so 1.5 or True "is not allowed" (a type) and 0 "is out of range"; both once said out of range
+    whole_in(episodes, "episodes", 1, MAX_EPISODES_PER_CALL, f"{MAX_EPISODES_PER_CALL:,} (policies x MDPs x episodes in one call)")
     if not isinstance(record, (bool, np.bool_)):
         raise NeurohoverError(f"record={record!r} is not allowed: give True or False")
     check_first_episode(first_episode)

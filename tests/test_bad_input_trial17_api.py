@@ -40,7 +40,7 @@ CASES: dict[str, tuple[Callable[[object], object], str, object]] = {
     "get_task_family name": (lambda v: nh.get_task_family(v), "unknown task {}", "ghh08"),
     "get_task_family sigma": (lambda v: nh.get_task_family("fghh", sigma=v), "sigma={} is not allowed", 0.5),
     "make_agent name": (lambda v: make_agent(v, FAMILY), "unknown agent {}", "baseline"),
-    "evaluate episodes": (lambda v: evaluate(POLICY, MDP, episodes=v, n_steps=5), "episodes={} is out of range", 1),
+    "evaluate episodes": (lambda v: evaluate(POLICY, MDP, episodes=v, n_steps=5), "episodes={} is not allowed", 1),  # not a range (T24-11)
     "evaluate seed": (lambda v: evaluate(POLICY, MDP, seed=v, n_steps=5), "seed={} is not allowed", 3),
     "evaluate n_steps": (lambda v: evaluate(POLICY, MDP, n_steps=v), "n_steps={} is not allowed", 5),
     "run_test episodes": (lambda v: run_test(make_agent("baseline", FAMILY), FAMILY, MDP, episodes=v, n_steps=5), "episodes={} is out of range", 1),

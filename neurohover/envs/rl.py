@@ -12,7 +12,8 @@ observation            the 12 readings divided by the crash limits (:data:`OBS_L
                        4 pi rad/s, 1), so a reading is within [-1, 1] until the helicopter crashes;
                        float32
 action                 4 numbers in [-1, 1] (clipped), float32: the controls ``ACTION_OFFSET + A (a +
-                       4 a^3) / 5`` (:func:`controls`), so a = 0 is the baseline policy's action at
+                       4 a^3) / 5`` (:func:`controls`); a non-finite number (NaN or infinity) is a
+                       crash, as on the plain ids; a = 0 is the baseline policy's action at
                        rest (0.02, 0, 0, 0.23), a small a moves a control by A a / 5 (a library's
                        usual unit exploration noise stays survivable) and a = +-1 reaches the
                        family's authority A (:data:`ACTION_AUTHORITY`: what the paper's policies
@@ -86,12 +87,14 @@ def authority(task: str) -> np.ndarray:
 
 
 def controls(action: np.ndarray, task: str) -> np.ndarray:
-    """The task's controls (..., 4), float64, of an RL id's actions on family ``task``."""
+    """The task's controls (..., 4), float64, of an RL id's actions on family ``task``: an action clipped to [-1, 1], a
+    non-finite one (NaN or infinity) NaN controls, which crash the helicopter as on the plain ids."""
     scale = authority(task)
     a = real_values(action, f"action {action!r:.80} is not allowed: give 4 real numbers in [-1, 1] per helicopter")
     if a.ndim == 0 or a.shape[-1] != ACTION_DIM:
         raise NeurohoverError(f"action has shape {a.shape}, expected (..., 4): 4 numbers in [-1, 1] per helicopter")
-    a = np.clip(a, -1.0, 1.0)
+    # T24-10: clipping made an infinite action full control; a non-finite action is a crash, as on the plain ids (NaN).
+    a = np.where(np.isinf(a), np.nan, np.clip(a, -1.0, 1.0))
     return ACTION_OFFSET + scale * (a + CUBIC * a**3) / (1.0 + CUBIC)
 
 
