@@ -41,6 +41,7 @@ __all__ = [
     "COMPETE_FILE",
     "COMPETE_SUMMARY",
     "CSV_COLUMNS",
+    "NO_OFFLINE",
     "NO_SAFEGUARD",
     "ONE_POLICY",
     "SUMMARY_FIELDS",
@@ -63,6 +64,10 @@ NO_SAFEGUARD = frozenset(
 )
 #: The agents that fly one policy throughout, and its label in every row's policy column (T23-07).
 ONE_POLICY = {"baseline": "baseline", "generic": "generic"}
+#: The agents whose first Choice is final: agents.protocol.run_test never calls their update, so every run's offline
+#: seconds are 0.0 exactly (T24-07; every stored baseline and generic run of the committed store holds 0.0, every
+#: other agent's more). tests/test_bad_input_trial24_results.py checks that each one's first choice is final.
+NO_OFFLINE = frozenset({"baseline", "generic"})
 _SCALE = re.compile(r"settings-[0-9a-f]{10}")  # experiments.config.settings_scale: a competition's scale, a digest of its settings
 
 
@@ -70,7 +75,10 @@ def _real_in(low: float, high: float) -> Callable[[object], bool]:
     return lambda value: finite_real(value) and low <= value <= high  # type: ignore[operator]
 
 
-_SECONDS = (_real_in(0.0, math.inf), "a finite number of seconds >= 0")
+#: The most seconds a run's timing may say, 100 years, as evolution.state_codec.MAX_SECONDS (T19-09), which this layer
+#: may not import: no run lasts longer, and 1e300 was taken (T24-07).
+MAX_SECONDS = 100 * 365.25 * 86400.0
+_SECONDS = (_real_in(0.0, math.inf), "a finite number of seconds >= 0")  # at most MAX_SECONDS: _check_seconds
 #: Every key compete writes to summary.json, in order, with its check and what it allows (None: checked against the
 #: rows, or as a condition, by the checks that say so); a key compete never writes is refused (T23-06).
 SUMMARY_FIELDS: dict[str, tuple[Callable[[object], bool] | None, str]] = {
@@ -291,7 +299,8 @@ def _check_summary(path: Path, summary: dict, returns: np.ndarray, rows: _Rows) 
     """The one check of a summary.json, against itself and its episodes.csv: no key compete never writes (T23-06), a task's
     name, then the rows its agent never writes (:func:`_check_rows_of_agent`), what its rows contradict
     (:func:`_check_summary_matches`: named with what they hold), each value's kind and range (:func:`_check_fields`),
-    the conditions its task can fly under (:func:`_check_conditions`) and the MDPs (:func:`_check_mdp_labels`)."""
+    its offline seconds against its seconds and agent (:func:`_check_seconds`), the conditions its task can fly under
+    (:func:`_check_conditions`) and the MDPs (:func:`_check_mdp_labels`)."""
     from .tasks import TASK_NAMES
 
     unknown = next((key for key in summary if key not in SUMMARY_FIELDS), None)
@@ -303,6 +312,7 @@ def _check_summary(path: Path, summary: dict, returns: np.ndarray, rows: _Rows) 
     _check_rows_of_agent(path, summary, rows)  # first: a row's own fault (a policy, say) named, not the figures it moves
     _check_summary_matches(path, summary, returns, rows)  # then a value the rows contradict, named with what they hold
     _check_fields(path, summary)
+    _check_seconds(path, summary)
     _check_conditions(path, summary)
     _check_mdp_labels(path, summary, returns.shape[0], rows)
 
@@ -315,6 +325,24 @@ def _check_fields(path: Path, summary: dict) -> None:
     for key, (fits, allowed) in SUMMARY_FIELDS.items():
         if key in summary and fits is not None and not fits(summary[key]):
             raise NeurohoverError(f"--compete {str(path)!r}: its {key} {brief(summary[key])} is not allowed: {allowed} (what compete writes)")
+
+
+def _check_seconds(path: Path, summary: dict) -> None:
+    """Refuse seconds past :data:`MAX_SECONDS` (1e300 was taken), offline seconds that are not part of the run's seconds,
+    or above 0 for an agent that does no work between episodes (:data:`NO_OFFLINE`; 5.0 of a 0.14-second baseline run
+    was taken), naming the values (T24-07). Tolerance: result_checks.run_inconsistency's of a stored run's offline
+    seconds against its seconds, whose means these are."""
+    for key in ("mean_seconds_per_run", "mean_offline_seconds_per_run"):
+        if summary.get(key, 0) > MAX_SECONDS:
+            raise NeurohoverError(
+                f"--compete {str(path)!r}: its {key} {brief(summary[key])} is not allowed: at most {MAX_SECONDS:.6g} seconds (100 years: no run lasts longer)"
+            )
+    offline, seconds, agent = summary.get("mean_offline_seconds_per_run"), summary.get("mean_seconds_per_run"), summary.get("agent")
+    where = f"--compete {str(path)!r}: its mean_offline_seconds_per_run {brief(offline)} is not allowed"
+    if offline is not None and seconds is not None and offline > seconds * (1 + 1e-9) + 1e-6:
+        raise NeurohoverError(f"{where}: the agent's work between episodes is part of the run's mean_seconds_per_run {brief(seconds)}: allowed at most that")
+    if offline is not None and agent in NO_OFFLINE and offline != 0:
+        raise NeurohoverError(f"{where}: agent {agent} does no work between episodes (its first choice holds for the whole run): allowed 0")
 
 
 def _check_summary_matches(path: Path, summary: dict, returns: np.ndarray, rows: _Rows) -> None:

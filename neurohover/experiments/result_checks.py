@@ -8,8 +8,10 @@ import dataclasses
 import math
 from typing import TYPE_CHECKING, Any
 
-from ..compete_files import NO_SAFEGUARD
+from ..compete_files import NO_OFFLINE, NO_SAFEGUARD
 from ..errors import NeurohoverError, brief, finite_real, whole_number
+from ..evolution.state_codec import MAX_SECONDS
+from ..integrations.neat import NEAT_TOPOLOGY
 from ..sim.constants import WORST_RETURN
 
 if TYPE_CHECKING:
@@ -93,11 +95,14 @@ def _changes_problem(changes: Any, n: int) -> str:
 
 
 def seconds_problem(timing: Any) -> str:
-    """'' when every field of the record ``timing`` is a finite number of seconds >= 0, else which is not (T22-09)."""
+    """'' when every field of the record ``timing`` is a finite number of seconds >= 0 (T22-09) and at most MAX_SECONDS
+    (100 years, as a checkpoint's: 1e300 was taken, T24-07), else which is not."""
     for f in dataclasses.fields(timing):
         value = getattr(timing, f.name)
         if not (finite_real(value) and value >= 0):
             return f"timing.{f.name} = {brief(value)} is not allowed: give a finite number of seconds >= 0"
+        if value > MAX_SECONDS:
+            return f"timing.{f.name} = {brief(value)} is not allowed: at most {MAX_SECONDS:.6g} seconds (100 years: no run lasts longer)"
     return ""
 
 
@@ -128,8 +133,9 @@ def _params_says(params: dict, name: str) -> Any:
 def params_problem(result: Any, params: Any) -> str:
     """What in a stored unit's ``result`` contradicts the unit's own ``params`` ('' when nothing does; params of another
     shape are the plan check's to name): a test run's agent or MDP, or a model's method or MDP, other than its params
-    say (a run of model-free on ghh08/test:0 holding agent 'baseline' and mdp 'ghh09/test:7' was exported; T22-08), or a
-    crash at a step past its episodes' ``n_steps`` (999999 of 20 was reported; T22-07); an evolution run's or a
+    say (a run of model-free on ghh08/test:0 holding agent 'baseline' and mdp 'ghh09/test:7' was exported; T22-08), offline
+    seconds of an agent that does none (:data:`~neurohover.compete_files.NO_OFFLINE`; T24-07), or a crash at a step past
+    its episodes' ``n_steps`` (999999 of 20 was reported; T22-07); an evolution run's or a
     robustness unit's figures that contradict its params (T23-08: :func:`evolve_params_problem`,
     :func:`robustness_params_problem`)."""
     from .results import EvolveResult, ModelResult, RobustnessResult, TestRunResult
@@ -145,6 +151,11 @@ def params_problem(result: Any, params: Any) -> str:
         if isinstance(says, str) and getattr(result, name) != says:
             where = "params.mdp.label" if name == "mdp" else f"params.{name}"
             return f"{name} = {brief(getattr(result, name))} is not allowed: its unit's {where} is {brief(says)}, and a result must be its unit's"
+    if isinstance(result, TestRunResult) and result.agent in NO_OFFLINE and float(result.timing.offline_seconds) != 0:
+        return (  # its update is never called (T24-07: as plot --compete reads a summary); after its agent against its params
+            f"timing.offline_seconds = {brief(result.timing.offline_seconds)} is not allowed: agent {result.agent} does no work between "
+            "episodes (its first choice holds for the whole run): allowed 0"
+        )
     n_steps = params.get("n_steps")
     if isinstance(result, TestRunResult) and whole_number(n_steps):
         for i, step in enumerate(result.crash_steps or ()):
@@ -237,8 +248,8 @@ def evolve_inconsistency(run: EvolveResult) -> str:
     reported): a stop reason the evolution gives (:data:`~neurohover.evolution.restore.STOP_REASONS`), a fitness scale
     it knows, one generation at least, evaluating a candidate at least each and flying an episode at least per
     evaluation; a history of increasing episodes ending at the run's; a champion fitness on its scale that is its
-    history's last (NEAT's: the best genome ever, at least its history's best generation); validation returns that are
-    episodes' returns, with one crash flag each."""
+    history's last (NEAT's: the best genome ever, at least its history's best generation); kernel seconds within its
+    seconds; validation returns that are episodes' returns, with one crash flag each."""
     from ..evolution.fitness import FITNESS_SCALES
     from ..evolution.restore import STOP_REASONS
 
@@ -273,6 +284,12 @@ def evolve_inconsistency(run: EvolveResult) -> str:
         return (
             f"champion_return = {brief(run.champion_return)} is not allowed: its history "
             f"ends at {run.history[-1][1]!r}, the champion's fitness at its last generation"
+        )
+    seconds, kernel = float(run.timing.seconds), float(run.timing.kernel_seconds)
+    if kernel > seconds * (1 + 1e-9) + 1e-6:  # each kernel call is timed within the run (T24-09; a checkpoint's too, T21-03)
+        return (
+            f"timing.kernel_seconds = {brief(run.timing.kernel_seconds)} is not allowed: it is part of the run's "
+            f"timing.seconds {brief(run.timing.seconds)}: allowed at most that"
         )
     problem = _validation_problem("", run.validation, run.validation_crashed)
     for name in ("reevaluated", "reevaluated_best_ever"):
@@ -338,8 +355,9 @@ def _budget_problem(run: EvolveResult, params: dict) -> str:
 def evolve_params_problem(run: EvolveResult, params: dict) -> str:
     """What in evolution run ``run`` contradicts its unit's ``params`` ('' when nothing does; T23-08): a champion of
     another topology, or a genome not of its topology's length; validations of other counts than its validation
-    episodes, or champions chosen again over other episodes than its ``champion_reevaluation``; episodes that do not fit
-    its budget and resampling (:func:`_budget_problem`)."""
+    episodes, or champions chosen again over other episodes than its ``champion_reevaluation``; a champion's fitness
+    that falls where it cannot (:func:`_history_fall_problem`); episodes that do not fit its budget and resampling
+    (:func:`_budget_problem`)."""
     from ..policies import GENOME_LENGTH
 
     topology = params.get("topology")
@@ -363,7 +381,28 @@ def evolve_params_problem(run: EvolveResult, params: dict) -> str:
             )
         if where and whole_number(again) and held.episodes != again:
             return f"{where}episodes = {brief(held.episodes)} is not allowed: its unit's params.champion_reevaluation is {again}: allowed {again}"
-    return _budget_problem(run, params)
+    return _history_fall_problem(run, params) or _budget_problem(run, params)
+
+
+def _history_fall_problem(run: EvolveResult, params: dict) -> str:
+    """'' unless the champion's fitness falls in the history of a run whose champion is the best single fitness ever
+    told (T24-09: [[50, -327086], [66, -1.0], [92, -311685]] was reported): a unit on one MDP (params.target.kind 'mdp':
+    steady state, or a population optimiser on an MDP; evolution.run's best-ever generation), NEAT's aside. A run on a
+    family (generational NE, races, CMA-ES, OpenAI-ES, uh-cma: each generation's best estimate) and NEAT's (each
+    generation's best) may fall; every such unit of the committed store rises or stays."""
+    target = params.get("target")
+    if not (isinstance(target, dict) and target.get("kind") == "mdp") or NEAT_TOPOLOGY in (params.get("topology"), run.champion.topology):
+        return ""
+    best = -math.inf
+    for i, (episodes, value) in enumerate(run.history):
+        v = float(value)
+        if v < best and not _close(v, best):
+            return (
+                f"history[{i}] = {brief([episodes, value])} is not allowed: its unit evolves on one MDP (params.target.kind 'mdp'), "
+                f"where the champion is the best fitness ever told, and an earlier record reached {best!r}: allowed at least that"
+            )
+        best = max(best, v)
+    return ""
 
 
 def robustness_inconsistency(result: RobustnessResult) -> str:

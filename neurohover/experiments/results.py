@@ -216,7 +216,9 @@ class StoredPolicy(_Record):
 
 
 class _Timing(_Record):
-    """Wall-clock seconds, each a finite number >= 0 (a test run's seconds -5 was exported; T22-09)."""
+    """Wall-clock seconds, each a finite number >= 0 (a test run's seconds -5 was exported; T22-09) and at most 100 years
+    (1e300 was taken; T24-07), each part of another at most it (result_checks: a test run's offline seconds, T23-14; an
+    evolution run's kernel seconds, T24-09)."""
 
     def __post_init__(self) -> None:
         super().__post_init__()
