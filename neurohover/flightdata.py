@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real
-from .flightmeta import check_meaning
+from .flightmeta import check_meaning, check_policy_actions, flown_policy
 from .paths import json_text, strict_json
 from .sim.constants import ACTION_NAMES, EPISODE_STEPS, MAX_EPISODE_STEPS, OBS_NAMES
 
@@ -115,6 +115,9 @@ class FlightData:
         if not isinstance(other, FlightData):
             return NotImplemented  # Python's TypeError ("unsupported operand"), as for any sum it cannot make
         meta = {**self.metadata, **other.metadata}
+        for name in set(meta) - {*_PER_EPISODE, "episode_steps", "policy_flown"}:  # one entry for the whole recording
+            if name not in self.metadata or name not in other.metadata or not same_values(self.metadata[name], other.metadata[name]):
+                del meta[name]  # the second's seed and policy were kept for every episode (T24-04), as its task was (ninth trial)
         for name in _PER_EPISODE:  # one entry per episode: both halves, or none (load() refuses a list of the wrong length)
             a, b = self.metadata.get(name), other.metadata.get(name)
             if isinstance(a, list) and isinstance(b, list) and len(a) == self.n_episodes and len(b) == other.n_episodes:
@@ -127,11 +130,11 @@ class FlightData:
             flags, lengths = meta.get("crashed"), [n.shape[0] for n in self.actions + other.actions]
             if isinstance(flags, list) and any(not c and n < meta["episode_steps"] for c, n in zip(flags, lengths)):
                 del meta["episode_steps"]  # a shorter budget's full episodes: no one budget holds for all (T22-01)
-        if self.metadata.get("task") != other.metadata.get("task"):  # two tasks' episodes: neither names them all
-            meta.pop("task", None)
         flown = self.metadata.get("policy_flown"), other.metadata.get("policy_flown")
         if any(f is not None for f in flown) and flown[0] != flown[1]:  # two policies flew them: EC-MER must not take one for both
             meta["policy_flown"] = None
+        elif flown == (None, None) and "policy" not in meta and ("policy" in self.metadata or "policy" in other.metadata):
+            meta["policy_flown"] = None  # older files of two policy names: EC-MER took the baseline for both once one was dropped (T24-04)
         return FlightData(self.observations + other.observations, self.actions + other.actions, meta)
 
     def recorded_policy(self, name: str = "flight data"):
@@ -143,12 +146,9 @@ class FlightData:
         NeurohoverError
             If joined recordings of two policies record none (``policy_flown`` None), or the record is damaged.
         """
-        from .policies import policy_from_dict
-
-        flown = self.metadata.get("policy_flown", False)
-        if flown is None:
+        if "policy_flown" in self.metadata and self.metadata["policy_flown"] is None:
             raise NeurohoverError(f"{name} were flown by more than one policy (joined recordings): EC-MER learns one closed loop; give --policy FILE")
-        return None if flown is False else policy_from_dict(flown, f"{name}, metadata policy_flown")
+        return flown_policy(self.metadata, name)  # one that is no policy: named as load() names it (T24-06)
 
     def save(self, path: str | Path, dtype: str = "float64") -> Path:
         """Write the flight data to ``path`` (a name ending ``.npz``, as ``fly --record`` takes), as float64 (exact) or
@@ -171,6 +171,8 @@ class FlightData:
         )  # metadata changed after making (episode_steps -5) was written, then refused by load()
         for i, crashed in enumerate(crash_flags(self)):  # NaN readings were written, then refused by load() (T22-02's check)
             check_flown(self.observations[i], self.actions[i], crashed, f"flight data to save, episode {i}")
+        if dtype == "float64":  # what load() checks of a float64 file: a policy_flown that does not give the actions (T24-06)
+            check_policy_actions(self.metadata, self.observations, self.actions, "flight data")
         largest = float(np.finfo(dtype).max)
         for name in ("observations", "actions"):  # 1e300 was written as float32's inf, without a word (fifteenth trial, T15-29)
             big = max((float(np.abs(a[np.isfinite(a)]).max(initial=0.0)) for a in getattr(self, name)), default=0.0)
@@ -189,7 +191,10 @@ class FlightData:
 
     @classmethod
     def load(cls, path: str | Path) -> FlightData:
-        """Read flight data written by :meth:`save`; other files are refused with a clear message."""
+        """Read flight data written by :meth:`save`; other files are refused with a clear message, as are metadata that
+        contradict themselves or the episodes (:func:`check_metadata`). A float64 file's ``policy_flown`` must give the
+        first episode's first 200 recorded actions (T24-06: some milliseconds, whatever the file's size; a float32 file's
+        rounded readings are left to EC-MER's check: :func:`neurohover.flightmeta.check_policy_actions`)."""
         from .paths import input_file
 
         if not isinstance(path, (str, Path)):  # None was a TypeError (second trial)
@@ -232,6 +237,7 @@ class FlightData:
                 f"flight-data file {str(path)!r} is truncated or inconsistent: {lengths.size} episodes of {lengths.sum()} steps "
                 f"but arrays {obs.shape} and {act.shape}"
             )
+        exact = obs.dtype == np.float64 and act.dtype == np.float64  # the readings the policy saw, not rounded (T24-06)
         obs, act = obs.astype(np.float64), act.astype(np.float64)  # a float32 file loads as float64, like every array here
         obs_split = np.split(obs, np.cumsum(lengths + 1)[:-1])
         act_split = np.split(act, np.cumsum(lengths)[:-1])
@@ -239,6 +245,8 @@ class FlightData:
         data = cls(tuple(obs_split), tuple(act_split), metadata)
         for i, crashed in enumerate(crash_flags(data)):  # a NaN was named by plot, not by learn-model, and neither named the file (T22-02)
             check_flown(data.observations[i], data.actions[i], crashed, f"flight-data file {str(path)!r}, episode {i}")
+        if exact:  # after check_flown: the readings the policy is flown on are finite
+            check_policy_actions(metadata, data.observations, data.actions, f"flight-data file {str(path)!r}")
         return data
 
 
@@ -385,6 +393,7 @@ def check_metadata(metadata: object, lengths: np.ndarray, where: str, episodes: 
     for name in ("task", "policy"):  # shown in titles and notes (a task 5 or a policy 123 was taken; eighth trial)
         if metadata.get(name) is not None and not isinstance(metadata[name], str):
             raise NeurohoverError(f"{where}: its metadata {name}={brief(metadata[name])} is not allowed: give text")
+    flown_policy(metadata, where)  # a policy_flown 'x' was taken by load, plot and LR, refused by EC-MER alone (T24-06)
     for name, (fits, each) in _PER_EPISODE.items():  # lists of one entry per episode (returns "x" was taken; eighth trial)
         value = metadata.get(name)  # present as null: refused by name, not taken as absent (mdps null, T21-05)
         if name in metadata and (not isinstance(value, list) or len(value) != n_episodes or not all(fits(v) for v in value)):

@@ -4,24 +4,33 @@
 :mod:`neurohover.experiments.result_checks` checks a stored test run against itself: each MDP is one its task family
 holds (T23-02) and is the MDP its label names (T23-04), the seed is a seed (T23-05), no return is above 0 and each is
 what the episode's observations give (T23-03), and no episode is flagged crashed whose last reading shows none
-(T23-19). What the readings cannot prove (an MDP not recorded, a sensor model between the state and the readings) is
-left unchecked: a file ``fly --record`` wrote is never refused.
+(T23-19). The policy ``policy_flown`` records must be a policy (T24-06, :func:`recorded_policy_problem`) and, where the
+readings are exact, give the recorded actions (:func:`check_policy_actions`). What the readings cannot prove (an MDP not
+recorded, a sensor model between the state and the readings) is left unchecked: a file ``fly --record`` wrote is never
+refused.
 """
 
 from __future__ import annotations
 
+import json
 import re
 from dataclasses import fields, replace
 
 import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real, whole_in
+from .policies import Policy, policy_from_dict
 from .sim.constants import CRASH_STEP_PENALTY, MAX_POSITION, MAX_RATE, MAX_VELOCITY, MIN_QW, WORST_RETURN
 from .sim.rng import MAX_SEED
 from .tasks import MDP, TASK_FAMILIES, get_task_family
 
 #: A label naming one of a family's MDPs by :meth:`TaskFamily.mdp`'s names, as its fixed sets and zero label them.
 _SET_LABEL = re.compile(r"(?:(?P<family>[^/]+)/)?(?P<spec>zero|(?:seeded-)?(?:train|test):[0-9]+)")
+#: A label naming a constant wind as GHH-08's make() writes it by default (``fly --wind``): ``ghh08/wind=[1.0, -2.0]``.
+_WIND_LABEL = re.compile(r"(?:(?P<family>[^/]+)/)?wind=(?P<wind>\[.*\])")
+#: Recorded steps a recorded policy is flown on again to see that it gave their actions, and how near they must be
+#: (float32 files round the observations: actions move by ~1e-6; a policy one gene away moved them by ~0.5; T22-17).
+CHECKED_STEPS, ACTION_TOLERANCE = 200, 1e-4
 #: Readings within the crash bounds by this fraction of each bound: float32 files round them (about 6e-8 relative).
 _CRASH_MARGIN = 1e-5
 #: How far a return may lie from what the observations give, relative to the sums it is made of: a float32 file
@@ -74,7 +83,14 @@ def _check_held(mdp: MDP, i: int, where: str) -> None:
     """Refuse an MDP of a task family that the family does not hold (its parameters out of the family's range, or its
     other fields not the family's: T23-02), or whose label names one of the family's MDPs with other parameters
     (T23-04). No family method tells whether it holds a given MDP: its :meth:`make` checks the ranges of the
-    parameters at its ``row_slice``, so the MDP is held where it is the family's zero or what make gives of them."""
+    parameters at its ``row_slice``, so the MDP is held where it is the family's zero or what make gives of them.
+
+    The labels the code writes for an MDP, and which are checked against its parameters: ``F/zero``, ``F/train:N``,
+    ``F/test:N`` and ``F/seeded-train:N``, ``F/seeded-test:N`` (the MDP the family names so; T23-04; FGHH's seeded sets
+    not, they depend on a sigma the metadata do not record) and ``ghh08/wind=[u, v]`` (``fly --wind``: the wind itself;
+    T24-05). Left unchecked, as they name no parameters: ``F/custom`` (``fly --params``), ``F/sample`` and
+    ``F/sample:N`` (drawn from G by a seed and a sequence the label does not record), a learned model's MDPs (family
+    ``model``) and any label given to ``make(label=...)``."""
     cls = TASK_FAMILIES.get(mdp.family)
     if cls is None:  # a learned model's MDP: any wind, any dynamics
         return
@@ -92,12 +108,16 @@ def _check_held(mdp: MDP, i: int, where: str) -> None:
                 f"{shown} is not allowed: it is no {mdp.family} MDP: its {', '.join(_differences(mdp, made))} differ from every "
                 f"{mdp.family} MDP's ({', '.join(_differences(made, mdp))}), whose parameters are {', '.join(cls.param_names)}"
             )
-    match = _SET_LABEL.fullmatch(mdp.label)
+    match = _SET_LABEL.fullmatch(mdp.label) or _WIND_LABEL.fullmatch(mdp.label)
     if match is None:
         return
-    named, spec = match.group("family") or mdp.family, match.group("spec")
+    named = match.group("family") or mdp.family
     if named != mdp.family:
         raise NeurohoverError(f"{shown} is not allowed: its label names a {brief(named)} MDP, but the MDP's family is {brief(mdp.family)}")
+    if match.re is _WIND_LABEL:  # 'ghh08/wind=[9.0, 9.0]' over a wind of [-0.228, 2.898] was taken (T24-05)
+        _check_wind_label(mdp, match.group("wind"), shown)
+        return
+    spec = match.group("spec")
     if family.has_sigma and spec.startswith("seeded-"):  # FGHH's seeded sets depend on a sigma the metadata does not record
         return
     try:
@@ -107,6 +127,19 @@ def _check_held(mdp: MDP, i: int, where: str) -> None:
     if mdp != replace(named_mdp, sensor=mdp.sensor, drift=mdp.drift):
         theirs = ", ".join(_differences(named_mdp, mdp))
         raise NeurohoverError(f"{shown} is not allowed: its {', '.join(_differences(mdp, named_mdp))} contradict its label: {mdp.family}'s {spec} has {theirs}")
+
+
+def _check_wind_label(mdp: MDP, text: str, shown: str) -> None:
+    """Refuse a ``wind=[...]`` label (what GHH-08's make() writes of the wind it is given, ``fly --wind``) whose numbers
+    are not the MDP's wind: make() writes them as Python lists, whose text reads back as the same floats."""
+    try:
+        named = json.loads(text)
+    except ValueError:
+        named = None
+    if not isinstance(named, list) or not all(type(v) in (int, float) for v in named):
+        raise NeurohoverError(f"{shown} is not allowed: its label names no wind: give wind=[u, v], a list of numbers, as fly --wind writes it")
+    if [float(v) for v in named] != list(mdp.wind):
+        raise NeurohoverError(f"{shown} is not allowed: its wind={brief(list(mdp.wind))} contradicts its label, which names the wind {brief(named)}")
 
 
 def _check_crash(flags: list, obs: np.ndarray, act: np.ndarray, i: int, where: str) -> None:
@@ -155,3 +188,52 @@ def _check_return(returns: list, i: int, obs: np.ndarray, crashed: bool, steps: 
         f"{where}: its metadata returns={brief(returns)} is not allowed: episode {i}'s return {value!r} is not what its "
         f"observations give: {gives}; its returns and observations contradict"
     )
+
+
+def flown_policy(metadata: dict, where: str) -> Policy | None:
+    """The policy metadata ``policy_flown`` records (``fly --record`` keeps the one that flew every episode), or None where
+    none is: no entry, or null (joined recordings of several). One that is no policy is refused, as a policy file is
+    read (:func:`neurohover.policies.policy_from_dict`): 'x' or a genome of 3 genes was taken until EC-MER (T24-06)."""
+    flown = metadata.get("policy_flown")
+    if flown is None:
+        return None
+    try:
+        return policy_from_dict(flown, "it is no policy")
+    except NeurohoverError as err:
+        raise NeurohoverError(
+            f"{where}: its metadata policy_flown={brief(flown)} is not allowed: {err}; give the policy that flew the episodes "
+            "({'topology': 'slp' or 'mlp', 'genome': [...]}, as fly --record writes it), or null"
+        ) from None
+
+
+def action_mismatch(policy: Policy, observations: np.ndarray, actions: np.ndarray) -> tuple[int, int, float, float] | None:
+    """The first of an episode's first :data:`CHECKED_STEPS` steps where ``policy`` does not give the recorded action
+    (clipped to [-1, 1] as the kernel flies it, within :data:`ACTION_TOLERANCE`), as (step, action index, the policy's,
+    the recorded), or None. Steps of a non-finite reading or action are passed over (a crash's NaN action is recorded as
+    given). Recordings hold what the policy saw (a sensor's readings) and ``fly --record`` flies no safeguard, so every
+    recorded action is the policy's own: the one test of it, at load and by EC-MER (models.ec.check_policy_flew)."""
+    for k in range(min(CHECKED_STEPS, actions.shape[0])):
+        if not np.all(np.isfinite(actions[k])) or not np.all(np.isfinite(observations[k])):
+            continue
+        flown = np.clip(policy.act(observations[k]), -1.0, 1.0)
+        i = int(np.argmax(np.abs(flown - actions[k])))
+        if abs(flown[i] - actions[k, i]) > ACTION_TOLERANCE:
+            return k, i, float(flown[i]), float(actions[k, i])
+    return None
+
+
+def check_policy_actions(metadata: dict, observations: tuple, actions: tuple, where: str) -> None:
+    """Refuse a ``policy_flown`` that does not give the first episode's recorded actions (:func:`action_mismatch`): one
+    edited by a gene was plotted and learned from by LR, and named 'baseline' by EC-MER's refusal (T24-06). Its cost is
+    fixed (:data:`CHECKED_STEPS` steps, some milliseconds), whatever the file's size. For exact readings only (a float64
+    file): float32 rounds the readings, and a policy's actions move by its gain times that rounding, which no fixed
+    tolerance tells from another policy's for every genome; EC-MER checks those files against its policy as before."""
+    policy = flown_policy(metadata, where)
+    miss = None if policy is None or not actions else action_mismatch(policy, observations[0], actions[0])
+    if miss is not None:
+        k, i, flown, recorded = miss
+        raise NeurohoverError(
+            f"{where}: its metadata policy_flown={brief(metadata['policy_flown'])} is not allowed: it did not fly the episodes: at "
+            f"step {k} of episode 0 it gives action {i} = {flown:.6g} where they record {recorded:.6g} (fly --record keeps the "
+            "policy that flew them); give that policy, or null"
+        )

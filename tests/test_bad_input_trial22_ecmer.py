@@ -31,11 +31,13 @@ def _edited(path: Path, edit) -> Path:
 
 
 def test_ec_mer_refuses_a_recorded_policy_that_did_not_fly_the_data(cli, tmp_path: Path) -> None:
-    edited = _edited(_recorded(cli, tmp_path), lambda m: m["policy_flown"]["genome"].__setitem__(1, 0.5))
+    # float32: a float64 file's policy_flown is checked at load (T24-06), and its refusal names policy_flown, not 'baseline'
+    edited = _edited(_recorded(cli, tmp_path, "--record-dtype", "float32"), lambda m: m["policy_flown"]["genome"].__setitem__(1, 0.5))
     out = tmp_path / "m.json"
     rc, _, err = cli("learn-model", "--flight-data", str(edited), "--method", "ec-mer", "--budget", "2", "--out", str(out))
     assert rc == 2 and not out.exists(), err
-    assert f"flight data '{edited}': the recorded policy ('baseline') did not fly them" in err and "at step " in err, err
+    named = "the policy their metadata policy_flown records (an slp network, genome [0.0, 0.5, "
+    assert f"flight data '{edited}': {named}" in err and ") did not fly them" in err and "at step " in err, err
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
 
 

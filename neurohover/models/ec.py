@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..flightdata import FlightData
+from ..flightmeta import action_mismatch
 from ..sim.constants import DEFAULT_PARAMS, ROW_NOISE, ROW_PARAMS
 from ..tasks import MDP
 from .model import MODEL_DT, LearnedModel, check_vector
@@ -298,22 +299,27 @@ def learn_ec_mer(
     return LearnedModel(tuple(best), tuple(noise), "ec-mer", time.perf_counter() - start, stats)
 
 
-#: Recorded steps :func:`ec_mer_policy` flies again to see that its policy flew the data, and how near its actions must be
-#: (float32 files round the observations: actions move by ~1e-6; a policy one gene away moved them by ~0.5; T22-17).
-CHECKED_STEPS, ACTION_TOLERANCE = 200, 1e-4
-
-
 def ec_mer_policy(given: str | None, data: FlightData, flight_data: str):
     """EC-MER's policy for ``data`` (read from the file ``flight_data``): the one the flight data record
     (``policy_flown``), else the file their metadata names (older files), else the baseline; ``--policy`` (``given``)
     where they record none, and refused where it is not the recorded one (a policy that never flew the data was fitted
     without a word; eleventh trial, S2). Whichever it is must give the recorded actions on the first episode's first
-    :data:`CHECKED_STEPS` observations (:func:`check_policy_flew`): an edited policy_flown, or an older file's
+    :data:`~neurohover.flightmeta.CHECKED_STEPS` observations (:func:`check_policy_flew`): an edited policy_flown, or an older file's
     metadata naming another run's policy, was fitted without a word (T22-17)."""
     policy = _chosen_policy(given, data, f"flight data {flight_data!r}")
-    named = f"--policy {given!r}" if given is not None else f"the recorded policy ({brief(str(data.metadata.get('policy', 'unnamed')))})"
-    check_policy_flew(policy, data, f"flight data {flight_data!r}", named)
+    check_policy_flew(policy, data, f"flight data {flight_data!r}", _named(given, data))
     return policy
+
+
+def _named(given: str | None, data: FlightData) -> str:
+    """The policy :func:`ec_mer_policy` took, as its refusal names it: an edited policy_flown was named by the metadata's
+    policy name ('baseline'), which EC-MER had not flown (T24-06)."""
+    if given is not None:
+        return f"--policy {given!r}"
+    if data.metadata.get("policy_flown") is not None:
+        flown = data.metadata["policy_flown"]
+        return f"the policy their metadata policy_flown records (an {flown.get('topology')} network, genome {brief(flown.get('genome'))})"
+    return f"the recorded policy ({brief(str(data.metadata.get('policy') or 'baseline'))})"  # older files: the policy named, else the baseline
 
 
 def check_policy_flew(
@@ -324,20 +330,16 @@ def check_policy_flew(
     remedy: str = "give --policy FILE of the policy that flew them, or record them again with fly --record",
 ) -> None:
     """NeurohoverError unless ``policy`` gives the actions recorded in ``data``'s first episode (its first
-    :data:`CHECKED_STEPS` steps, clipped to [-1, 1] as the kernel flies them, within :data:`ACTION_TOLERANCE`), where
-    they are finite (a crash's NaN action is recorded as given). Recordings see what the policy saw (a sensor's readings)
-    and ``fly --record`` flies no safeguard, so every recorded action is the policy's own."""
-    obs, act = data.observations[0], data.actions[0]
-    for k in range(min(CHECKED_STEPS, act.shape[0])):
-        if not np.all(np.isfinite(act[k])) or not np.all(np.isfinite(obs[k])):
-            continue
-        flown = np.clip(policy.act(obs[k]), -1.0, 1.0)
-        i = int(np.argmax(np.abs(flown - act[k])))
-        if abs(flown[i] - act[k, i]) > ACTION_TOLERANCE:
-            raise NeurohoverError(
-                f"{where}: {named} did not fly them (EC-MER fits the closed loop of the policy that did): at step {k} of "
-                f"episode 0 it gives action {i} = {flown[i]:.6g} where they record {act[k, i]:.6g}; {remedy}"
-            )
+    ``flightmeta.CHECKED_STEPS`` steps, clipped to [-1, 1] as the kernel flies them, within ``flightmeta.ACTION_TOLERANCE``), where
+    they are finite (a crash's NaN action is recorded as given): :func:`neurohover.flightmeta.action_mismatch`, the test
+    FlightData.load runs on a float64 file's own policy_flown."""
+    miss = action_mismatch(policy, data.observations[0], data.actions[0])
+    if miss is not None:
+        k, i, flown, recorded = miss
+        raise NeurohoverError(
+            f"{where}: {named} did not fly them (EC-MER fits the closed loop of the policy that did): at step {k} of "
+            f"episode 0 it gives action {i} = {flown:.6g} where they record {recorded:.6g}; {remedy}"
+        )
 
 
 def _chosen_policy(given: str | None, data: FlightData, where: str):
