@@ -6,8 +6,11 @@ Only entries a file holds are checked (older files lack some), so every model ``
 
 from __future__ import annotations
 
+import math
+
 from ..errors import NeurohoverError, brief, finite_real, whole_number
-from ..sim.constants import NOISE_NAMES
+from ..sim.constants import DEFAULT_PARAMS, MAX_EPISODE_STEPS, NOISE_NAMES, WORST_RETURN
+from ..sim.rng import MAX_SEED
 from .model import LearnedModel, check_vector
 
 __all__ = ["FILE_ENTRIES", "model_file_problem"]
@@ -30,6 +33,32 @@ _METHOD_STATS = {
 }  # fmt: skip
 #: Stats entries of numbers >= 0 and how many: per parameter or per axis (EC-MER's noise_std_stationary is one row of 6).
 _STATS_VECTORS = {"param_se": 11, "gene_scale": 11, "residual_rms": 6, "noise_std_stationary": 6, "noise_std_innovations": 6, "noise_std_rms": 6}
+#: Every stats entry a fit of each method writes (learn_lr with a wind's entries, learn_ec_meno, learn_ec_mer): stats
+#: holding one are a fit's and hold no other (stats.zzz was taken where a top-level zzz was refused; T24-08). A caller's
+#: own stats (LearnedModel(stats=...)) hold none of them and stay as they are.
+_FIT_STATS = {
+    "lr": (
+        "estimator", "intercepts", "n_transitions", "n_episodes", "param_se", "discarded_intercepts", "residual_rms", "noise_std_stationary",
+        "noise_std_innovations", "noise_std_rms", "noise", "d_u", "wind_model", "wind_fit_rounds", "uv_residual_rms", "uv_residual_rms_wind_blind",
+    ),
+    "ec-meno": (
+        "budget", "scaling", "evaluations", "seed", "n_transitions", "n_episodes", "one_step_error", "prototype_one_step_error",
+        "least_squares_one_step_error", "excess", "gene_scale", "noise_std_stationary", "history",
+    ),
+    "ec-mer": (
+        "budget", "evaluations", "seed", "episode_seed", "episodes", "n_steps", "true_return", "predicted_return", "return_error",
+        "prototype_predicted_return", "prototype_return_error", "noise_std_stationary", "history",
+    ),
+}  # fmt: skip
+#: LR's stats of a fitted wind alone (learn_lr with wind_model 'constant' or 'sinusoid'; T24-08).
+_WIND_STATS = ("wind_fit_rounds", "uv_residual_rms", "uv_residual_rms_wind_blind")
+#: Stats entries of returns: an episode's, in [-WORST_RETURN, 0] (every reward is minus a sum of squares; T24-08).
+_STATS_RETURNS = ("true_return", "predicted_return", "prototype_predicted_return")
+#: Stats entries of errors and rms: finite numbers >= 0 (T24-08); the least-squares error may be null (no unique minimum).
+_STATS_ERRORS = (
+    "return_error", "prototype_return_error", "one_step_error", "prototype_one_step_error", "least_squares_one_step_error", "uv_residual_rms",
+    "uv_residual_rms_wind_blind",
+)  # fmt: skip
 
 
 def _its(field: str, value: object, allowed: str) -> str:
@@ -41,8 +70,10 @@ def model_file_problem(d: dict, model: LearnedModel) -> str:
     """What in model file ``d`` (read as ``model``) does not fit together, '' when all does: an entry no model file has,
     noise named in another order, stats another method writes or of values no fit makes (estimator 'zz', -1
     transitions, 99999 episodes of 6000 transitions, 3 standard errors of 11 parameters), or an LR fit's intercepts,
-    discarded intercepts, D_u and wind that contradict each other. Each was loaded as it was (T23-10); only entries a
-    file holds are checked (older files lack some), so every model learn_lr, learn_ec_meno and learn_ec_mer write loads."""
+    discarded intercepts, D_u and wind that contradict each other. Each was loaded as it was (T23-10); so were an
+    entry beside a fit's stats that no fit writes, seeds, returns and errors out of range, and EC errors, returns and
+    champion histories that contradict each other (T24-08). Only entries a file holds are checked (older files lack
+    some), so every model learn_lr, learn_ec_meno and learn_ec_mer write loads."""
     unknown = sorted(set(d) - set(FILE_ENTRIES), key=str)
     if unknown:
         return f"its entry {brief(unknown[0])} is not allowed: a model file has only {', '.join(FILE_ENTRIES)}"
@@ -53,11 +84,17 @@ def model_file_problem(d: dict, model: LearnedModel) -> str:
         key = next((k for k in keys if k in stats and k not in _METHOD_STATS[method]), None) if other != method else None
         if key is not None:
             return _its("method", method, f"its stats hold {key}, which {other} alone writes (allowed {other}, or the stats a {method} fit writes)")
-    return _stats_problem(stats) or (_lr_problem(model) if method == "lr" else _ec_problem(model))
+    fit = _FIT_STATS[method]
+    stranger = next((k for k in stats if k not in fit), None) if any(k in fit for k in stats) else None
+    if stranger is not None:  # T24-08: an unknown stats entry beside a fit's was taken
+        return f"its stats entry {brief(stranger)} is not allowed: the stats of a {method} fit hold only {', '.join(fit)}"
+    return _stats_problem(stats, method) or (_lr_problem(model) if method == "lr" else _ec_problem(model))
 
 
-def _stats_problem(stats: dict) -> str:
-    """'' when a model's stats' counts and vectors are ones a fit writes, else what is wrong (T23-10)."""
+def _stats_problem(stats: dict, method: str) -> str:
+    """'' when a model's stats' counts, seeds, returns, errors and vectors are ones a ``method`` fit writes, else what is
+    wrong (T23-10; the seeds, returns and errors, and the counts' upper bounds, T24-08)."""
+    from .ec import MAX_EC_MER_EPISODES
     from .transitions import MIN_TRANSITIONS
 
     n = stats.get("n_transitions")
@@ -68,9 +105,20 @@ def _stats_problem(stats: dict) -> str:
         episodes = stats["n_episodes"]
         if not (whole_number(episodes) and 1 <= episodes <= (top or episodes)):
             return _its("stats.n_episodes", episodes, f"allowed an integer in 1..{top or 'n_transitions'} (each episode has a transition or more)")
-    for key in ("budget", "evaluations", "episodes", "n_steps"):
-        if stats.get(key) is not None and not (whole_number(stats[key]) and stats[key] >= 1):
-            return _its(f"stats.{key}", stats[key], "allowed an integer >= 1" + (" or null (the plateau stop)" if key == "budget" else ""))
+    null = ("budget",) if method == "ec-meno" else ()  # EC-MENO's plateau stop; EC-MER's budget is a number (T24-08)
+    for key, high in (("budget", None), ("evaluations", None), ("episodes", MAX_EC_MER_EPISODES), ("n_steps", MAX_EPISODE_STEPS), ("wind_fit_rounds", None)):
+        if key in stats and not (stats[key] is None and key in null) and not (whole_number(stats[key]) and 1 <= stats[key] <= (high or stats[key])):
+            allowed = f"allowed an integer in 1..{high:,}" if high else "allowed an integer >= 1"
+            return _its(f"stats.{key}", stats[key], allowed + (" or null (the plateau stop)" if key in null else ""))
+    for key in ("seed", "episode_seed"):  # T24-08: seed -1 was taken
+        if key in stats and not (whole_number(stats[key]) and 0 <= stats[key] <= MAX_SEED):
+            return _its(f"stats.{key}", stats[key], "allowed an integer in 0..2**63-1 (the seed the fit ran with)")
+    for key in _STATS_RETURNS:  # T24-08: a return of 5.0 was taken
+        if key in stats and not (finite_real(stats[key]) and -WORST_RETURN <= stats[key] <= 0):
+            return _its(f"stats.{key}", stats[key], f"allowed a finite return in [{-WORST_RETURN:.3g}, 0] (every reward is minus a sum of squares)")
+    for key in _STATS_ERRORS:  # T24-08: an error of -5 was taken
+        if key in stats and not (finite_real(stats[key]) and stats[key] >= 0) and not (stats[key] is None and key == "least_squares_one_step_error"):
+            return _its(f"stats.{key}", stats[key], "allowed a finite number >= 0" + (" or null" if key == "least_squares_one_step_error" else ""))
     for key, length in _STATS_VECTORS.items():
         if key in stats:
             try:
@@ -93,6 +141,9 @@ def _lr_problem(model: LearnedModel) -> str:
     wind = stats.get("wind_model", model.wind.kind)
     if wind != model.wind.kind:
         return _its("wind", model.wind.kind, f"stats.wind_model is {wind!r}: allowed a {wind!r} wind")
+    problem = _lr_noise_wind_problem(model)
+    if problem:
+        return problem
     intercepts = stats.get("intercepts")
     if intercepts is None:  # nothing to hold the rest against
         return ""
@@ -116,10 +167,102 @@ def _lr_problem(model: LearnedModel) -> str:
     return ""
 
 
+def _lr_noise_wind_problem(model: LearnedModel) -> str:
+    """'' when an LR model's noise std is the estimate its stats.noise names and its stats hold a wind fit's entries only
+    with a wind, else what contradicts what (T24-08)."""
+    stats, noise = model.stats, model.stats.get("noise")
+    estimate = stats.get(f"noise_std_{noise}")
+    if estimate is not None and not all(_near(a, b) for a, b in zip(model.noise_std, estimate)):
+        return _its("noise_std", list(model.noise_std), f"its stats.noise {noise!r} gives stats.noise_std_{noise} {brief(estimate)}")
+    key = next((k for k in _WIND_STATS if k in stats), None) if model.wind.kind == "none" else None
+    if key is not None:
+        return _its(f"stats.{key}", stats[key], "allowed only in the stats of a model with a wind (its wind is 'none')")
+    return ""
+
+
+#: How near two numbers a fit computed twice (a batch and one alone: rounding apart) are taken as the same (T24-08).
+_REL, _ABS = 1e-6, 1e-9
+
+
+def _near(a: float, b: float) -> bool:
+    return math.isclose(a, b, rel_tol=_REL, abs_tol=_ABS)
+
+
 def _ec_problem(model: LearnedModel) -> str:
-    """'' when an EC-MENO or EC-MER model has the D_u and wind those methods leave out (they evolve neither; T23-10)."""
+    """'' when an EC-MENO or EC-MER model has the D_u and wind those methods leave out (they evolve neither; T23-10) and
+    stats whose errors, returns and champion history agree (T24-08)."""
     if model.d_u != 0.0:
         return _its("d_u", model.d_u, f"allowed 0.0: {model.method} evolves no D_u")
     if model.wind.kind != "none":
         return _its("wind", model.wind.kind, f"allowed 'none': {model.method} fits no wind")
+    stats = model.stats
+    meno = model.method == "ec-meno"
+    problem = _ec_meno_problem(stats) if meno else _ec_mer_problem(stats)
+    champion = ("n_transitions", "one_step_error") if meno else ("return_error",)  # the champion's return: -n x error, -error
+    last = -math.prod(stats[k] for k in champion) if all(k in stats for k in champion) else None
+    return problem or (_history_problem(stats, " x ".join(champion), last) if "history" in stats else "")
+
+
+def _ec_mer_problem(stats: dict) -> str:
+    """'' when EC-MER's errors are its returns' distances and its champion no worse than the prototype (T24-08)."""
+    for error, predicted in (("return_error", "predicted_return"), ("prototype_return_error", "prototype_predicted_return")):
+        if error in stats and predicted in stats and "true_return" in stats:
+            distance = abs(stats[predicted] - stats["true_return"])
+            if not _near(stats[error], distance):
+                return _its(f"stats.{error}", stats[error], f"allowed |{predicted} - true_return| = {distance!r}")
+    if "return_error" in stats and "prototype_return_error" in stats and not _below(stats["return_error"], stats["prototype_return_error"]):
+        return _its("stats.return_error", stats["return_error"], "allowed at most stats.prototype_return_error (the prototype is evaluated first)")
+    return ""
+
+
+def _ec_meno_problem(stats: dict) -> str:
+    """'' when EC-MENO's scaling, gene scale, errors and excess agree: the champion no worse than the prototype, the
+    least-squares minimum below both, excess the champion's relative distance to it (T24-08)."""
+    from .ec import EC_MENO_SCALINGS
+
+    scaling = stats.get("scaling")
+    if "scaling" in stats and (not isinstance(scaling, str) or scaling not in EC_MENO_SCALINGS):
+        return _its("stats.scaling", scaling, f"allowed {' or '.join(EC_MENO_SCALINGS)} (EC-MENO's gene scalings)")
+    if scaling == "default" and "gene_scale" in stats and not all(_near(a, abs(b)) for a, b in zip(stats["gene_scale"], DEFAULT_PARAMS)):
+        return _its("stats.gene_scale", stats["gene_scale"], "allowed |default parameters| (its scaling 'default')")
+    error, proto = stats.get("one_step_error"), stats.get("prototype_one_step_error")
+    if error is not None and proto is not None and not _below(error, proto):
+        return _its("stats.one_step_error", error, "allowed at most stats.prototype_one_step_error (the prototype is evaluated first)")
+    least = stats.get("least_squares_one_step_error")
+    if least is not None and error is not None and not _below(least, error):
+        return _its("stats.least_squares_one_step_error", least, "allowed at most stats.one_step_error (it is the smallest one-step error)")
+    if "excess" in stats and "least_squares_one_step_error" in stats and error is not None:
+        excess = None if least is None or least <= 0 else (error - least) / least
+        given = stats["excess"]
+        if (excess is None) != (given is None) or (excess is not None and not (finite_real(given) and _near(given, excess))):
+            return _its("stats.excess", given, f"allowed (one_step_error - least_squares_one_step_error) / least_squares_one_step_error = {excess!r}")
+    return ""
+
+
+def _below(a: float, b: float) -> bool:
+    """Whether ``a`` is at most ``b``, or as near as :func:`_near` takes."""
+    return a <= b or _near(a, b)
+
+
+def _history_problem(stats: dict, champion: str, last: float | None) -> str:
+    """'' when an EC model's stats.history is the champion records its evolution keeps: [evaluations, return] of each new
+    champion, both rising, evaluations in 1..stats.evaluations, returns <= 0, the last the champion's (minus ``champion``,
+    ``last``); else what is wrong (an evaluation past those made and a return not the champion's were taken; T24-08)."""
+    history, top = stats["history"], stats.get("evaluations")
+    top = top if whole_number(top) else None
+    records = isinstance(history, list) and bool(history) and all(isinstance(h, list) and len(h) == 2 for h in history)
+    before = (0, -math.inf)
+    for h in history if records else ():
+        if not (whole_number(h[0]) and finite_real(h[1]) and before[0] < h[0] <= (top or h[0]) and before[1] < h[1] <= 0):
+            records = False
+            break
+        before = (h[0], h[1])
+    if not records:
+        return _its(
+            "stats.history",
+            history,
+            f"allowed [evaluations, return] of each new champion, both rising, evaluations in 1..{top or 'evaluations'}, returns <= 0",
+        )
+    if last is not None and not _near(before[1], last):
+        return _its("stats.history", history, f"its last record is the champion's: a return of {last!r} (minus its {champion})")
     return ""
