@@ -177,3 +177,15 @@ def test_the_findings_steps_on_the_command_line(cli, tmp_path: Path) -> None:
         model.write_text(json.dumps({**written, "stats": {**written["stats"], key: value}}))
         with _raises(f"model file '{model}': its stats.{key} {value} is not allowed"):
             LearnedModel.load(model)
+
+
+def test_learn_ec_mer_refuses_a_true_return_above_0() -> None:
+    """T24-08: learn_ec_mer(..., true_return=5.0) learned and returned a model whose file load then refuses (a return is
+    minus a sum of squares); refused before learning, as a True was (T16-18)."""
+    import neurohover as nh
+    from neurohover.models import learn_ec_mer
+
+    base = nh.baseline_policy()
+    fd = nh.evaluate(base, nh.get_task_family("ghh08").zero(), episodes=1, record=True, n_steps=20).flight_data
+    with pytest.raises(NeurohoverError, match=r"^true_return=5\.0 is not allowed: a return is in \[-1\.75e\+10, 0\]"):
+        learn_ec_mer(fd, base, 5.0, budget=2)

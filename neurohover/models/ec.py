@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..flightdata import FlightData
 from ..flightmeta import action_mismatch
-from ..sim.constants import DEFAULT_PARAMS, ROW_NOISE, ROW_PARAMS
+from ..sim.constants import DEFAULT_PARAMS, ROW_NOISE, ROW_PARAMS, WORST_RETURN
 from ..tasks import MDP
 from .model import MODEL_DT, LearnedModel, check_vector
 from .transitions import OneStepProblem, Transitions, noise_from_residuals
@@ -258,6 +258,10 @@ def learn_ec_mer(
     if not finite_real(true_return):  # True was taken as 1.0 (sixteenth trial T16-18)
         raise NeurohoverError(f"true_return={brief(true_return)} must be a finite number (the observed return of the episode)")
     true_return = float(true_return)
+    if not -WORST_RETURN <= true_return <= 0:  # 5.0 was learned from and written, then refused at load (T24-08)
+        raise NeurohoverError(
+            f"true_return={brief(true_return)} is not allowed: a return is in [{-WORST_RETURN:.3g}, 0] (every reward is minus a sum of squares)"
+        )
     n_steps = int(flight_data.actions[0].shape[0])
     if n_steps < 1:
         raise NeurohoverError("the flight data's first episode has no steps; EC-MER needs it to define the episode length")
