@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import re
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -243,7 +244,9 @@ def policy_record_problem(meta: dict) -> str:
     :meth:`Run.result <neurohover.evolution.run.Run.result>` writes, each checked where present, against the evolution's
     own ranges and words and against each other, as :mod:`neurohover.experiments.result_checks` checks a stored test run.
     A budget of -5, n_steps of 0, more evaluations than episodes, a steady-state run over a family, a return of 5.0, a
-    stop reason 'zzz' or a seed of -3 were all accepted after hand edits (T23-11)."""
+    stop reason 'zzz' or a seed of -3 were all accepted after hand edits (T23-11); and the keys ``neurohover evolve``
+    adds (:func:`_validation_problem`, :func:`_place_problem`, :func:`_run_settings_problem`): a validation_return of 5.0,
+    a task other than its target's, mdp_params other than its label's MDP or settings of pop_size 0 (T24-02)."""
     from .evolution.config import MAX_BUDGET, parse_resampling
     from .evolution.fitness import ERROR_FLOOR
     from .evolution.optimisers import NE, OPTIMISERS
@@ -272,7 +275,8 @@ def policy_record_problem(meta: dict) -> str:
         return f"its optimizer {brief(optimizer)} is not allowed: allowed {', '.join(names)}"
     if method is not None and optimizer is not None and method not in names[optimizer]:
         return f"its method {brief(method)} is not allowed: optimizer {optimizer!r} evolves by {' or '.join(names[optimizer])}"
-    return _run_words_problem(meta, own_stop, STOP_REASONS, parse_resampling, (1 + 1e-9) / math.log(ERROR_FLOOR))
+    problem = _run_words_problem(meta, own_stop, STOP_REASONS, parse_resampling, (1 + 1e-9) / math.log(ERROR_FLOOR))
+    return problem or _validation_problem(meta) or _place_problem(meta) or _run_settings_problem(meta)  # T24-02: what evolve adds
 
 
 def _run_words_problem(meta: dict, own_stop: dict, stop_reasons: tuple, parse_resampling, best_fitness: float) -> str:
@@ -313,6 +317,121 @@ def _run_words_problem(meta: dict, own_stop: dict, stop_reasons: tuple, parse_re
         return f"its stop_reason 'budget' is not allowed: {has} (a run stops by its budget once it has flown it)"
     if reason != "budget" and method is not None and reason != own_stop[method]:
         return f"its stop_reason {brief(reason)} is not allowed beside its method {method!r}: allowed budget or {own_stop[method]}"
+    return ""
+
+
+def _validation_problem(meta: dict) -> str:
+    """A record's validation of its champion (evolve flies it on validation_episodes fresh episodes after the run and
+    records their mean return and its standard deviation, :func:`~neurohover.evolution.evolve.validation_return`) against
+    the ranges of such figures and each other ('' when they agree; T24-02)."""
+    from .evaluate import MAX_EPISODES_PER_CALL
+
+    episodes: Any = meta.get("validation_episodes")
+    ret: Any = meta.get("validation_return")
+    sd: Any = meta.get("validation_sd")
+    if "validation_episodes" in meta and not (whole_number(episodes) and 1 <= episodes <= MAX_EPISODES_PER_CALL):
+        allowed = f"an integer in 1..{MAX_EPISODES_PER_CALL:,} (episodes the champion was validated on)"
+        return f"its validation_episodes {brief(episodes)} is not allowed: allowed {allowed}"
+    if "validation_return" in meta and not (finite_real(ret) and -WORST_RETURN <= ret <= 0):
+        return f"its validation_return {brief(ret)} is not allowed: allowed a mean return in [{-WORST_RETURN:.3g}, 0] (every reward is minus a sum of squares)"
+    if "validation_sd" in meta and not (finite_real(sd) and 0 <= sd <= WORST_RETURN / 2):
+        return f"its validation_sd {brief(sd)} is not allowed: allowed a standard deviation of returns in [0, {WORST_RETURN / 2:.3g}]"
+    if episodes == 1 and sd is not None and sd != 0:
+        return f"its validation_sd {brief(sd)} is not allowed beside its validation_episodes 1: one return has no spread (0)"
+    seconds: Any = meta.get("seconds")
+    if "seconds" in meta and not (finite_real(seconds) and seconds >= 0):
+        return f"its seconds {brief(seconds)} is not allowed: allowed a number of seconds >= 0 (how long the run took)"
+    return ""
+
+
+def _place_problem(meta: dict) -> str:
+    """A record's task, mdp (what evolve's --mdp or --wind/--params named), target (the label of the MDP or family the
+    run evolved on) and mdp_params (that MDP) against each other ('' when they agree; T24-02). mdp_params is checked
+    as flight data's MDPs are against their labels (:func:`neurohover.flightmeta._check_held`); a run over a family has
+    none of its own (one seeded from a policy file may keep the seed's, which is not read)."""
+    task, mdp = meta.get("task"), meta.get("mdp")
+    target: Any = meta.get("target")
+    if "mdp" in meta and not isinstance(mdp, str):
+        return f"its mdp {brief(mdp)} is not allowed: give what the run was evolved on as text (G, zero, train:N, ...)"
+    named = target.partition("/")[0] if isinstance(target, str) and "/" in target else None
+    if isinstance(task, str) and named is not None and named != task:
+        return f"its task {brief(task)} is not allowed beside its target {brief(target)}: a run evolves on its task's MDPs, here {named}'s"
+    over_family = mdp == "G" or (isinstance(target, str) and _FAMILY_TARGET.fullmatch(target) is not None)
+    if isinstance(mdp, str) and named is not None:
+        spec = target.partition("/")[2]
+        agrees = (
+            _FAMILY_TARGET.fullmatch(target) is not None if mdp == "G" else spec == mdp or (not _SPEC.fullmatch(mdp) and not _FAMILY_TARGET.fullmatch(target))
+        )
+        if not agrees:
+            return f"its mdp {brief(mdp)} is not allowed beside its target {brief(target)}: the run was evolved on {target.partition('/')[2]!r}"
+    if "mdp_params" not in meta or over_family:
+        return ""
+    return _mdp_params_problem(meta["mdp_params"], task, target)
+
+
+#: What ``neurohover evolve --mdp`` names as one of a family's MDPs (:meth:`TaskFamily.mdp`), labelled ``TASK/<it>``.
+_SPEC = re.compile(r"zero|sample|(?:seeded-)?(?:train|test):[0-9]+")
+
+
+def _mdp_params_problem(params: object, task: object, target: object) -> str:
+    """A record's mdp_params (the MDP a run evolved on, as :meth:`MDP.to_dict` writes it) against its task and target,
+    and against its own label as flight data's MDPs are checked (T24-02)."""
+    from .flightmeta import _check_held
+    from .tasks import MDP
+
+    try:
+        mdp = MDP.from_dict(params) if isinstance(params, dict) else None
+    except NeurohoverError as err:
+        return f"its mdp_params {brief(params)} is not allowed: {err}"
+    if mdp is None:
+        return f"its mdp_params {brief(params)} is not allowed: give the MDP the run was evolved on as a table (MDP.to_dict)"
+    if isinstance(target, str) and mdp.label != target:
+        return f"its mdp_params label {brief(mdp.label)} is not allowed beside its target {brief(target)}: the run was evolved on its target"
+    if isinstance(task, str) and mdp.family != task:
+        return f"its mdp_params family {brief(mdp.family)} is not allowed beside its task {brief(task)}: a run evolves on its task's MDPs"
+    try:
+        _check_held(mdp, 0, "")
+    except NeurohoverError as err:  # flightmeta names a flight-data entry: the reason after its name, said of mdp_params
+        return f"its mdp_params ({brief(mdp.label)}) is not allowed: {str(err).partition(' is not allowed: ')[2] or err}"
+    return ""
+
+
+def _run_settings_problem(meta: dict) -> str:
+    """A record's settings (the optimiser's, as the run used them), champion_fitness_scale and episode_steps against its
+    method, optimizer, champion_return and n_steps ('' when they agree; T24-02): settings are checked as ``evolve`` checks
+    them (:func:`~neurohover.evolution.config.make_settings`)."""
+    from .evolution.config import make_settings
+    from .evolution.fitness import FITNESS_SCALES
+    from .evolution.optimisers import NE
+
+    method, settings = meta.get("method"), meta.get("settings")
+    optimizer = meta.get("optimizer", NE if method in ("steady-state", "generational") else None)
+    steps: Any = meta.get("episode_steps")
+    n_steps: Any = meta.get("n_steps")
+    if "episode_steps" in meta and n_steps is not None and steps != n_steps:
+        why = "evolve flies the run's and the validation's episodes at one length"
+        return f"its n_steps {brief(n_steps)} is not allowed beside its episode_steps {brief(steps)}: {why}"
+    if "settings" in meta and not isinstance(settings, dict):
+        return f"its settings {brief(settings)} is not allowed: give the optimiser's settings as a table"
+    if isinstance(settings, dict) and optimizer is not None and (optimizer != NE or method is not None):
+        given = {k: v for k, v in settings.items() if not (optimizer == NE and k == "budget" and v is None)}  # NE's: the run counts its budget
+        try:
+            make_settings("steady-state" if method == "steady-state" else "generational", optimizer, given)
+        except NeurohoverError as err:
+            return f"its settings {brief(settings)} is not allowed: {err}"
+    scale = meta.get("champion_fitness_scale")
+    ret: Any = meta.get("champion_return")
+    if "champion_fitness_scale" not in meta:
+        return ""
+    if not isinstance(scale, str) or scale not in FITNESS_SCALES:
+        return f"its champion_fitness_scale {brief(scale)} is not allowed: allowed {', '.join(FITNESS_SCALES)} (the scale of its champion_return)"
+    fitness = settings.get("fitness") if isinstance(settings, dict) and method == "generational" else None
+    own = fitness if fitness is not None else ("return" if method not in (None, "generational") else None)
+    if own is not None and scale != own:
+        return f"its champion_fitness_scale {brief(scale)} is not allowed beside its method {brief(method)}: its run's champions are on the {own} scale"
+    if finite_real(ret) and (scale == "return") != (ret <= 0):
+        why = "a return is <= 0" if scale == "return" else "a fitness 1/ln(error) is > 0"
+        return f"its champion_return {brief(ret)} is not allowed beside its champion_fitness_scale {brief(scale)}: {why}"
     return ""
 
 

@@ -271,11 +271,20 @@ def load_policy(source: str | Path) -> Policy:
     from .paths import parse_json
 
     policy = policy_from_dict(parse_json(text, name), name)
-    for check in RECORD_CHECKS.values():  # its record of its run against itself: a budget of -5 or a stop reason 'zzz' was taken (T23-11)
-        problem = check(policy.metadata)
-        if problem:
-            raise NeurohoverError(f"{name}: {problem}")
+    problem = record_problem(policy.metadata)  # its record of its run against itself: a budget of -5 or a stop reason 'zzz' was taken (T23-11)
+    if problem:
+        raise NeurohoverError(f"{name}: {problem}")
     return policy
+
+
+def record_problem(metadata: dict) -> str:
+    """What in a policy's ``metadata`` (its record of the run that evolved it) contradicts itself, by the first of
+    :data:`RECORD_CHECKS` that finds something ('' when none does): :func:`load_policy` refuses a file of such a record."""
+    for check in RECORD_CHECKS.values():
+        problem = check(metadata)
+        if problem:
+            return problem
+    return ""
 
 
 def utf8_text(data: bytes, name: str, what: str) -> str:
@@ -293,18 +302,51 @@ def utf8_text(data: bytes, name: str, what: str) -> str:
         ) from None
 
 
+#: A policy file's suffix (in any case: P.JSON is taken, as model files and flight data take theirs).
+POLICY_SUFFIX = ".json"
+#: The ends of the names of what ``neurohover evolve --out FILE`` writes beside FILE: FILE.checkpoint.json, FILE.history.csv.
+RUN_FILE_ENDS = {".checkpoint.json": "checkpoint (which --resume continues)", ".history.csv": "history (one line per new champion or generation)"}
+
+
 def check_json_policy_name(path: object, option: str) -> None:
-    """Refuse a ``.net`` name for a JSON policy file: :func:`load_policy` reads ``.net`` as the authors' format, so the
-    file could not be read back (third trial; evolve checks its ``--out`` with this before it evolves)."""
-    if isinstance(path, (str, os.PathLike)) and Path(path).suffix == ".net":
+    """Refuse a name a policy file may not be written under, naming it as ``option``: evolve checks its ``--out`` with
+    this before it evolves (refused only at the save, the run was lost), :func:`save_policy` before it writes.
+
+    Taken: a name ending ``.json``, in any case (``p.json``, ``P.JSON``), but for the end below. Refused:
+
+    * ``.net``: :func:`load_policy` reads it as the authors' format, so the JSON written could not be read back (third trial);
+    * any other suffix, or none (``f.npz``, ``q.txt``, ``p``): flight data and other files were overwritten by a policy
+      (T24-01), as learn-model --out and fly --record refuse theirs (T23-16, T21-09);
+    * a name ending ``.checkpoint.json`` or ``.history.csv`` (any case): what evolve writes beside another run's
+      ``--out FILE`` (``FILE.checkpoint.json``, ``FILE.history.csv``), which a policy overwrote, and that run could no longer
+      be resumed (T24-01). A policy named ``x.checkpoint.json`` is refused with them: its name cannot be told from theirs.
+
+    What is no path, ``''``, a name ending in a slash and a directory are left to :func:`neurohover.paths.output_file`
+    to refuse, in its words."""
+    text = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None
+    if not isinstance(text, str) or text == "" or text.endswith(("/", os.sep)) or Path(text).is_dir():
+        return
+    if Path(text).suffix == ".net":
         raise NeurohoverError(
-            f"{option} {str(path)!r}: a policy is written as JSON, which load_policy would misread under the .net suffix "
+            f"{option} {text!r}: a policy is written as JSON, which load_policy would misread under the .net suffix "
             "(the authors' format); give a .json name, or write the authors' format with netfile.policy_to_net"
         )
+    end = next((end for end in RUN_FILE_ENDS if text.lower().endswith(end)), None)
+    if end is not None:  # another run's checkpoint or history was overwritten by a policy (T24-01)
+        raise NeurohoverError(
+            f"{option} {brief(text)} is not allowed: evolve --out FILE writes FILE{end} beside FILE as its run's {RUN_FILE_ENDS[end]}; "
+            f"give a policy file a name ending {POLICY_SUFFIX} but not {' or '.join(RUN_FILE_ENDS)}"
+        )
+    if Path(text).suffix.lower() != POLICY_SUFFIX:  # f.npz, q.txt: flight data and other files were overwritten (T24-01)
+        like = str(Path(text).with_suffix(POLICY_SUFFIX)) if Path(text).name else "policy.json"
+        raise NeurohoverError(f"{option} {brief(text)} is not allowed: a policy file is JSON; give a path ending {POLICY_SUFFIX} (e.g. {brief(like)})")
 
 
 def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
-    """Write ``policy`` (and extra metadata: strict JSON values under keys of their own) as a JSON policy file; returns the path."""
+    """Write ``policy`` (and extra metadata: strict JSON values under keys of their own) as a JSON policy file; returns the path.
+
+    The name is checked by :func:`check_json_policy_name` (a name ending .json, not another run's checkpoint or history;
+    T24-01)."""
     from .paths import output_file, writing
 
     if not isinstance(policy, Policy):

@@ -47,6 +47,7 @@ def test_a_dangling_link_is_refused_as_every_output_and_nothing_is_written_throu
     (tmp_path / "pp").mkdir()
     target = tmp_path / "outside_target"
     (tmp_path / "pp" / "out_link").symlink_to(target)
+    (tmp_path / "pp" / "out_link.json").symlink_to(target)  # evolve --out takes a name ending .json only (T24-01)
     why = f"is a symbolic link to '{target}': a symbolic link to a missing target is not written through"
     for check in (lambda: output_file("pp/out_link", "--out"), lambda: output_dir("pp/out_link", "--out")):
         with pytest.raises(NeurohoverError, match=f"--out 'pp/out_link' {why}"):
@@ -56,13 +57,13 @@ def test_a_dangling_link_is_refused_as_every_output_and_nothing_is_written_throu
     with pytest.raises(NeurohoverError, match=f"--out 'pp/out_link' {why}"):
         with writing("pp/out_link", "--out") as partial:
             partial.write_text("x")
-    for argv in ((*FLY, "--record", "pp/out_link"), (*EVOLVE, "--out", "pp/out_link"), (*EVOLVE, "--out", "pp/out_link/p.json")):
+    for argv in ((*FLY, "--record", "pp/out_link"), (*EVOLVE, "--out", "pp/out_link.json"), (*EVOLVE, "--out", "pp/out_link/p.json")):
         rc, _, err = cli(*argv)
         assert rc == 2 and "a symbolic link to a missing target is not written through" in err and "a file, not a directory" not in err, err
-    assert not target.exists() and not os.path.lexists("pp/out_link.history.csv")
+    assert not target.exists() and not os.path.lexists("pp/out_link.json.history.csv")
     target.write_text("{}")  # a link to a file that exists is written through, the link kept
-    rc, _, err = cli(*EVOLVE, "--out", "pp/out_link")
-    assert rc == 0 and (tmp_path / "pp" / "out_link").is_symlink() and json.loads(target.read_text())["genome"], err
+    rc, _, err = cli(*EVOLVE, "--out", "pp/out_link.json")
+    assert rc == 0 and (tmp_path / "pp" / "out_link.json").is_symlink() and json.loads(target.read_text())["genome"], err
 
 
 def _set_with(tmp_path: Path, task: str, **extra) -> Path:

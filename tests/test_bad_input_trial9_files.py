@@ -121,7 +121,7 @@ def _meta(key: str, value: str):
     [
         ("specialised_3.json", lambda _t: None, "specialised_3.json \\(specialised policy 3\\) records name 'specialised_4', not 'specialised_3'"),
         ("specialised_3.json", _meta("target", "ghh08/train:4"), "records target 'ghh08/train:4', not 'ghh08/train:3'"),
-        ("generic.json", _meta("task", "ghh09"), "generic.json \\(the generic policy\\) records task 'ghh09', not 'ghh08'"),
+        ("generic.json", _meta("task", "ghh09"), "generic.json': its task 'ghh09' is not allowed beside its target 'ghh08/zero'"),  # T24-02: load_policy's
         ("generic.json", _meta("target", "ghh08/train:0"), "records target 'ghh08/train:0', not 'ghh08/zero'"),
     ],
     ids=["copied", "target", "task", "generic-target"],

@@ -197,7 +197,7 @@ def _evolve_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int
     from ..policies import check_json_policy_name, save_policy
 
     _check_evolve_sizes(args)
-    check_json_policy_name(args.out, "--out")  # before evolving: refused only at the save, the run was lost
+    check_json_policy_name(args.out, "--out")  # before evolving (at the save, the run was lost): .json, not a run's checkpoint (T24-01)
     resampling = parse_resampling(args.resampling)
     target, family, mdp_desc = _target(args)
     topology, proto = _seed_policy(args)
