@@ -36,7 +36,7 @@ import numpy as np
 
 from .agents.hybrid import HybridSettings
 from .compete_files import CSV_COLUMNS  # the columns plot --compete reads, each checked (T23-07)
-from .errors import NeurohoverError
+from .errors import NeurohoverError, brief
 from .evolution.seeding import check_seed
 from .paths import write_png
 from .sim.constants import EPISODE_STEPS
@@ -114,9 +114,13 @@ MAX_RUNS = 100_000
 
 def check_sizes(runs: int, episodes: int) -> None:
     """Refuse a competition too large to plan in memory and store (every episode's results are kept)."""
-    for name, value in (("runs", runs), ("episodes", episodes)):
-        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-            raise NeurohoverError(f"{name}={value!r} is out of range: allowed an integer >= 1")
+    # T24-11: 1.5 or True "is not allowed" (a type), 0 "is out of range" (both said out of range); the upper bounds
+    # stay the check below, which names both counts (whole_in would name one)
+    for name, value, high in (("runs", runs, MAX_RUNS), ("episodes", episodes, MAX_RUN_EPISODES)):
+        if type(value) is not int:  # a Python int, as before: the competition's config is stored as JSON
+            raise NeurohoverError(f"{name}={brief(value)} is not allowed: allowed an integer in 1..{high:,}")
+        if value < 1:
+            raise NeurohoverError(f"{name}={value} is out of range: allowed an integer in 1..{high:,}")
     if runs > MAX_RUNS or runs * episodes > MAX_RUN_EPISODES:
         raise NeurohoverError(
             f"runs={runs} x episodes={episodes} is out of range: at most {MAX_RUNS:,} runs and {MAX_RUN_EPISODES:,} episodes in all "

@@ -69,8 +69,7 @@ class KernelFlyer:
         if topology not in TOPOLOGIES:
             raise NeurohoverError(f"unknown policy topology {topology!r}: allowed {', '.join(TOPOLOGIES)}")
         whole_in(seed, "seed", 0, MAX_SEED, "2**63-1")
-        if not whole_number(n_steps) or not 1 <= n_steps <= MAX_EPISODE_STEPS:  # np.timedelta64 is a np.integer (T17-1)
-            raise NeurohoverError(f"n_steps={n_steps!r} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
+        whole_in(n_steps, "n_steps", 1, MAX_EPISODE_STEPS)  # T24-11: 1.5 or True "is not allowed", 0 out of range; np.timedelta64
         self.kind = KIND[topology]
         self.dim = GENOME_LENGTH[topology]
         self.seed = np.uint64(seed)

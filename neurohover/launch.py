@@ -182,8 +182,7 @@ class Batch:
     def _check_values(self) -> None:
         """The values the kernel indexes by, checked in one vectorised pass each before it runs: an index out of range
         read past an array and killed the process (SIGSEGV), a kind 99 flew, n_steps=-5 flew nothing (thirteenth trial, F1)."""
-        if not whole_number(self.n_steps) or not 1 <= self.n_steps <= MAX_EPISODE_STEPS:
-            raise NeurohoverError(f"n_steps={brief(self.n_steps)} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
+        whole_in(self.n_steps, "n_steps", 1, MAX_EPISODE_STEPS)  # T24-11: 1.5 or True "is not allowed", 0 out of range
         whole_in(self.seed, "seed", 0, MAX_SEED, "2**63-1")
         # the kernel compiles once per argument type: np.uint16(5) steps compiled it again, 30-50 s (eighteenth trial, T18-1)
         object.__setattr__(self, "n_steps", int(self.n_steps))  # (the seed goes to the kernel as np.uint64 always: jobs())

@@ -83,7 +83,11 @@ def _settings(name: str) -> type:
         ("uh-cma", {"popsize": 1}, r"CMA-ES popsize=1 must be None or an integer in 2..100,000"),
         ("uh-cma", {"min_evaluations": 0}, r"UH-CMA-ES min_evaluations=0 and max_evaluations=20 must be integers with 1 <= min <= max"),
         ("uh-cma", {"reevaluations": 0}, r"UH-CMA-ES reevaluations=0 must be None or an integer >= 1"),
-        ("incremental", {"max_learning_episodes": 0}, r"max_learning_episodes=0 is out of range: allowed an integer >= 1"),
+        (
+            "incremental",
+            {"max_learning_episodes": 0},
+            r"max_learning_episodes=0 is out of range: allowed an integer in 1..2\*\*63-1",
+        ),  # whole_in's range (T24-11)
         ("steady-state", {"mutate_prob": HUGE_INT}, f"mutate_prob={SHOWN} must be a probability in \\[0, 1\\]"),
         ("generational", {"crossover_prob": HUGE_INT}, f"crossover_prob={SHOWN} must be a probability in \\[0, 1\\]"),
         ("generational", {"init_mutate_frac": HUGE_INT}, f"init_mutate_frac={SHOWN} must be a probability"),

@@ -70,7 +70,8 @@ def test_a_choice_takes_numpy_flags() -> None:
 
 def test_episode_outcome_checks_itself() -> None:
     """F12: EpisodeOutcome('a', 'b', ...) was made, then taken by some agents and a TypeError in others."""
-    with pytest.raises(NeurohoverError, match=r"EpisodeOutcome episode='a' is out of range: allowed an integer >= 0"):
+    # a type, not a range; no bound but int64's (T24-11: whole_in)
+    with pytest.raises(NeurohoverError, match=r"EpisodeOutcome episode='a' is not allowed: allowed an integer in 0..2\*\*63-1"):
         EpisodeOutcome("a", "b", "c", "d", "e", "f")  # type: ignore[arg-type]
     with pytest.raises(NeurohoverError, match=r"EpisodeOutcome ret='x' is not allowed: give the episode's return, a finite number"):
         EpisodeOutcome(0, "x", False, 20, -1, None)  # type: ignore[arg-type]
@@ -89,8 +90,8 @@ def test_every_agent_checks_its_protocol_arguments(name, family) -> None:
     agent.start(family, np.random.default_rng(0))
     with pytest.raises(NeurohoverError, match=r"outcome=None is not allowed: give an EpisodeOutcome"):
         agent.update(None)  # type: ignore[arg-type]
-    for bad in (-1, "x", 1.5):
-        with pytest.raises(NeurohoverError, match=rf"episode={bad!r} is out of range: allowed an integer >= 0"):
+    for bad, problem in ((-1, "is out of range"), ("x", "is not allowed"), (1.5, "is not allowed")):  # a type is no range (T24-11)
+        with pytest.raises(NeurohoverError, match=rf"episode={bad!r} {problem}: allowed an integer in 0..2\*\*63-1"):
             agent.choose(bad)  # type: ignore[arg-type]
     assert isinstance(agent.choose(np.int64(0)), Choice)
 

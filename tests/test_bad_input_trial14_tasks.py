@@ -107,7 +107,8 @@ def test_an_mdp_names_a_known_family_with_its_own_wind() -> None:
         nh.MDP("fghh", wind_kind=1, wind=(1.0, 1.0))
     with pytest.raises(NeurohoverError, match=re.escape("an MDP's dict {} lacks family, params, noise_std, wind_kind, wind, substeps, dt")):
         nh.MDP.from_dict({})
-    with pytest.raises(NeurohoverError, match=re.escape("MDP substeps=10.7 is out of range: allowed an integer in 1..1000")):
+    # a type, not a range (T24-11: whole_in)
+    with pytest.raises(NeurohoverError, match=re.escape("MDP substeps=10.7 is not allowed: allowed an integer in 1..1000")):
         nh.MDP.from_dict({**zero.to_dict(), "substeps": 10.7})  # int() cut it to 10
     assert nh.MDP.from_dict(train.to_dict()) == train and nh.MDP("model", wind_kind=2, wind=(0.5,) * 8).wind_kind == 2
 

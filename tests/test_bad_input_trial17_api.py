@@ -43,7 +43,11 @@ CASES: dict[str, tuple[Callable[[object], object], str, object]] = {
     "evaluate episodes": (lambda v: evaluate(POLICY, MDP, episodes=v, n_steps=5), "episodes={} is not allowed", 1),  # not a range (T24-11)
     "evaluate seed": (lambda v: evaluate(POLICY, MDP, seed=v, n_steps=5), "seed={} is not allowed", 3),
     "evaluate n_steps": (lambda v: evaluate(POLICY, MDP, n_steps=v), "n_steps={} is not allowed", 5),
-    "run_test episodes": (lambda v: run_test(make_agent("baseline", FAMILY), FAMILY, MDP, episodes=v, n_steps=5), "episodes={} is out of range", 1),
+    "run_test episodes": (
+        lambda v: run_test(make_agent("baseline", FAMILY), FAMILY, MDP, episodes=v, n_steps=5),
+        "episodes={} is not allowed",
+        1,
+    ),  # not a range (T24-11)
     "run_test seed": (lambda v: run_test(make_agent("baseline", FAMILY), FAMILY, MDP, episodes=1, seed=v, n_steps=5), "seed={} is not allowed", 3),
     "run_test n_steps": (lambda v: run_test(make_agent("baseline", FAMILY), FAMILY, MDP, episodes=1, n_steps=v), "n_steps={} is not allowed", 5),
     "HoverEnv episode_steps": (lambda v: HoverEnv(episode_steps=v), "episode_steps={} is not allowed", 20),
@@ -59,7 +63,7 @@ CASES: dict[str, tuple[Callable[[object], object], str, object]] = {
     "DangerousState arm_after": (lambda v: DangerousState(arm_after=v), "safeguard arm_after={} is not allowed", 5),
     "Sensor velocity": (lambda v: Sensor(velocity=v), "sensor velocity={} is not a number", 0.5),
     "Sensor dropout": (lambda v: Sensor(dropout=v), "sensor dropout={} is out of range", 0.1),
-    "Sensor delay": (lambda v: Sensor(delay=v), "sensor delay={} is out of range", 2),
+    "Sensor delay": (lambda v: Sensor(delay=v), "sensor delay={} is not allowed", 2),  # not a range (T24-11)
     "Sensor.parse delay": (lambda v: Sensor.parse("position=0.1", delay=v), "sensor delay={} is not allowed", 2),  # 4 was taken as delay 4
     "Drift walk": (lambda v: Drift(walk=v), "drift walk={} is not a number", 0.1),
     "Drift change": (lambda v: Drift(change={"D_w": v}), "drift change D_w={} is not a number", 0.8),

@@ -59,8 +59,8 @@ def test_a_steady_state_run_has_no_parents_to_choose_from() -> None:
 
 
 def test_bad_episode_counts_are_refused(race_run) -> None:
-    for bad in (0, -1, 2.5, True):
-        with pytest.raises(NeurohoverError, match="episodes=.* is out of range"):
+    for bad, problem in ((0, "is out of range"), (-1, "is out of range"), (2.5, "is not allowed"), (True, "is not allowed")):  # a type is no range (T24-11)
+        with pytest.raises(NeurohoverError, match=f"episodes=.* {problem}: allowed an integer in 1..100,000,000"):
             reevaluated_champion(race_run, FAMILY, episodes=bad)
 
 

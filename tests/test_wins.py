@@ -44,7 +44,7 @@ def test_only_the_mdps_every_agent_flew_take_part_and_the_seed_decides() -> None
         ({"a": {"m": [1.0]}}, 5, 10, "at least two agents"),
         ({"a": {"m": [1.0]}, "b": {"n": [1.0]}}, 5, 10, "no MDP in common"),
         ({"a": {"m": [1.0]}, "b": {"m": [1.0]}}, 0, 10, "n_runs=0 is out of range"),
-        ({"a": {"m": [1.0]}, "b": {"m": [1.0]}}, 5, True, "draws=True is out of range"),
+        ({"a": {"m": [1.0]}, "b": {"m": [1.0]}}, 5, True, "draws=True is not allowed"),  # a type, not a range (T24-11)
         ({"a": {"m": [np.nan]}, "b": {"m": [1.0]}}, 5, 10, "'a' has a run whose score is not a finite number"),
         ({"a": {"m": [1.0]}, "b": {"m": [1.0]}}, 10_000, 10_000, "too large"),
     ],

@@ -67,15 +67,18 @@ class ContinualSettings(AgentSettings):
     safeguard_after: int = 0
 
     def __post_init__(self) -> None:
-        for name in ("window", "patience", "max_learning_episodes"):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
-                raise NeurohoverError(f"continual {name}={brief(v)} is out of range: allowed an integer >= 1")
-        for name, unit in (("cooldown", "episodes"), ("safeguard_after", "control steps")):
+        # T24-11: 1.5 or True "is not allowed" (a type), 0 "is out of range" (both said out of range); no bound but int64's
+        for name, low, high, text in (
+            ("window", 1, 2**63 - 1, "2**63-1"),
+            ("patience", 1, 2**63 - 1, "2**63-1"),
+            ("max_learning_episodes", 1, 2**63 - 1, "2**63-1"),
+            ("cooldown", 0, 10**6, "1000000 (episodes)"),
+            ("safeguard_after", 0, 10**6, "1000000 (control steps)"),
+        ):
             v = getattr(self, name)
             if type(v) is not int:  # a Python int only: the settings are stored as JSON (a NumPy integer is no JSON number)
-                raise NeurohoverError(f"continual {name}={brief(v)} is not allowed: allowed an integer in 0..1000000 ({unit})")
-            whole_in(v, f"continual {name}", 0, 10**6, f"1000000 ({unit})")
+                raise NeurohoverError(f"continual {name}={brief(v)} is not allowed: allowed an integer in {low}..{text}")
+            whole_in(v, f"continual {name}", low, high, text)
         t = self.threshold
         if not real_number(t) or not finite_real(t) or t <= 1:
             raise NeurohoverError(f"continual threshold={brief(t)} is out of range: allowed a number > 1 (a ratio of one-step errors)")

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real
+from ..errors import NeurohoverError, brief, finite_real, whole_in
 from ..evaluate import DangerousState
 from ..evolution.steady_state import SteadyStateSettings
 from ..flightdata import FlightData
@@ -107,8 +107,9 @@ class CodeAgentSettings:
         check_model_substeps(self.model_substeps, "model_substeps")  # True == 1 was taken as 1 (eleventh trial)
         for name, low in (("evolutions", 1), ("model_budget", 50), ("n_steps", 1)):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < low:
-                raise NeurohoverError(f"{name}={brief(value)} is out of range: allowed an integer >= {low}")
+            if type(value) is not int:  # T24-11: 1.5 or True "is not allowed" (a type; it said out of range), a Python int as before
+                raise NeurohoverError(f"{name}={brief(value)} is not allowed: allowed an integer in {low}..2**63-1")
+            whole_in(value, name, low, 2**63 - 1, "2**63-1")
         if not (finite_real(self.fired_error) and self.fired_error >= 0):  # finite_real: NumPy's isfinite raised TypeError on 10**400
             raise NeurohoverError(f"fired_error={brief(self.fired_error)} is out of range: allowed a finite number >= 0")
         if not isinstance(self.dangerous, DangerousState):  # anything was taken, then an AttributeError after an episode (eleventh trial)

@@ -12,7 +12,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, whole_in
 from ..evaluate import evaluate
 from ..flightdata import FlightData
 from ..models.lr import DEFAULT_NOISE_ESTIMATE, lr_determined
@@ -97,9 +97,11 @@ class ModelEvolution:
             if value not in allowed:
                 raise NeurohoverError(f"{name}={value!r} is not allowed: choose one of {', '.join(map(str, allowed))}")
         check_model_substeps(self.model_substeps, "model_substeps")  # True was taken as 1 (True in (1, 10))
+        # T24-11: 1.5 or True "is not allowed" (a type), 0 "is out of range" (both said out of range); no bound but int64's
         g = self.authors_generations
-        if isinstance(g, bool) or not isinstance(g, int) or g < 1:
-            raise NeurohoverError(f"authors_generations={g!r} is out of range: allowed an integer >= 1")
+        if type(g) is not int:  # a Python int, as before: the settings are stored as JSON
+            raise NeurohoverError(f"authors_generations={brief(g)} is not allowed: allowed an integer in 1..2**63-1")
+        whole_in(g, "authors_generations", 1, 2**63 - 1, "2**63-1")
         check_device(self.device)
 
     def fit(self, flight_data: FlightData) -> LearnedModel:
@@ -290,9 +292,11 @@ class IncrementalSettings(AgentSettings):
     max_learning_episodes: int = 25
 
     def __post_init__(self) -> None:
+        # T24-11: 1.5 or True "is not allowed" (a type), 0 "is out of range" (both said out of range); no bound but int64's
         m = self.max_learning_episodes
-        if isinstance(m, bool) or not isinstance(m, int) or m < 1:
-            raise NeurohoverError(f"max_learning_episodes={brief(m)} is out of range: allowed an integer >= 1")
+        if type(m) is not int:  # a Python int, as before: the settings are stored as JSON
+            raise NeurohoverError(f"max_learning_episodes={brief(m)} is not allowed: allowed an integer in 1..2**63-1")
+        whole_in(m, "max_learning_episodes", 1, 2**63 - 1, "2**63-1")
 
     @classmethod
     def from_unit(cls, params: dict) -> IncrementalSettings:

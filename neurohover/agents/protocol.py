@@ -29,8 +29,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, whole_number
-from ..evaluate import DangerousState, PolicyTable, check_episode_count, evaluate_jobs
+from ..errors import NeurohoverError, brief, finite_real, whole_in, whole_number
+from ..evaluate import MAX_EPISODES_PER_CALL, DangerousState, PolicyTable, evaluate_jobs
 from ..evolution.seeding import check_seed
 from ..flightdata import FlightData
 from ..policies import Policy
@@ -94,8 +94,8 @@ class Choice:
 
 
 def _check_count(what: str, value: object, least: int) -> None:
-    if not whole_number(value) or value < least:
-        raise NeurohoverError(f"{what}={brief(value)} is out of range: allowed an integer >= {least}")
+    # T24-11: whole_in, so 1.5 or True "is not allowed" (a type) and an integer below least "is out of range"
+    whole_in(value, what, least, 2**63 - 1, "2**63-1")
 
 
 @dataclass(frozen=True)
@@ -278,9 +278,8 @@ def _check_run(agent, family, mdp, episodes, seed) -> int:
         )
     if mdp.family != family.name:  # the agent prepares for its family (its policies, safe pairs): another family's MDP is a mix-up
         raise NeurohoverError(f"mdp {mdp.label!r} is a {mdp.family} MDP, but the run's family is {family.name}: give an MDP of {family.name}")
-    if not whole_number(episodes) or episodes < 1:  # True was one episode; np.timedelta64 int()'s TypeError (T17-1)
-        raise NeurohoverError(f"episodes={brief(episodes)} is out of range: allowed an integer >= 1")
-    check_episode_count(int(episodes), f"episodes={episodes}")
+    # T24-11: whole_in, so 1.5 or True "is not allowed" and 0 "is out of range"; the bound check_episode_count had
+    whole_in(episodes, "episodes", 1, MAX_EPISODES_PER_CALL, f"{MAX_EPISODES_PER_CALL:,} (episodes in one call)")
     mdp.drift.check_run(int(episodes))
     return check_seed(seed)
 

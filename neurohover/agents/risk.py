@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, real_number
+from ..errors import NeurohoverError, brief, finite_real, real_number, whole_in
 from ..policies import Policy, baseline_policy
 from .hybrid import HybridAgent
 from .model_based import ModelEvolution
@@ -67,8 +67,9 @@ class RiskSettings(AgentSettings):
             raise NeurohoverError(f"risk level={brief(self.level)} is not a number: allowed a finite number >= 0 (standard errors below the mean)")
         if not finite_real(self.level) or self.level < 0:
             raise NeurohoverError(f"risk level={brief(self.level)} is out of range: allowed a finite number >= 0 (standard errors below the mean)")
-        if isinstance(self.trials, bool) or not isinstance(self.trials, int) or not 1 <= self.trials <= MAX_TRIALS:
-            raise NeurohoverError(f"risk trials={brief(self.trials)} is out of range: allowed an integer in 1..{MAX_TRIALS:,}")
+        if type(self.trials) is not int:  # T24-11: 1.5 or True "is not allowed" (a type; it said out of range), a Python int as before
+            raise NeurohoverError(f"risk trials={brief(self.trials)} is not allowed: allowed an integer in 1..{MAX_TRIALS:,}")
+        whole_in(self.trials, "risk trials", 1, MAX_TRIALS, f"{MAX_TRIALS:,}")
 
     @classmethod
     def unused(cls, agent: str, given: dict) -> str | None:

@@ -12,7 +12,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from ..errors import NeurohoverError, brief, check_flag, finite_real, float_of, whole_number
+from ..errors import NeurohoverError, brief, check_flag, finite_real, float_of, whole_in, whole_number
 from ..policies import TOPOLOGIES, Policy
 from ..policies import prototype as make_prototype
 from ..sim.constants import MAX_EPISODE_STEPS
@@ -56,7 +56,9 @@ MAX_BUDGET = 10**10
 
 def check_budget(budget, unit: str = "episodes", alternative: str = "") -> int:
     """``budget`` as an int; NeurohoverError unless an integer in 1..MAX_BUDGET (``alternative``: what else the caller allows)."""
-    if not whole_number(budget) or not 1 <= budget <= MAX_BUDGET:  # whole_number: np.timedelta64 is a np.integer (T17-1)
+    if not whole_number(budget):  # T24-11: 1.5 or True "is not allowed" (a type; it said out of range); np.timedelta64 (T17-1)
+        raise NeurohoverError(f"budget={brief(budget)} is not allowed: allowed an integer in 1..{MAX_BUDGET:,} ({unit}){alternative}")
+    if not 1 <= budget <= MAX_BUDGET:
         raise NeurohoverError(f"budget={brief(budget)} is out of range: allowed an integer in 1..{MAX_BUDGET:,} ({unit}){alternative}")
     return int(budget)
 
@@ -337,8 +339,7 @@ class RunConfig:
         if budget is not None:
             budget = check_budget(budget)
         seed = check_seed(seed)
-        if not whole_number(n_steps) or not 1 <= n_steps <= MAX_EPISODE_STEPS:
-            raise NeurohoverError(f"n_steps={brief(n_steps)} is out of range: allowed an integer in 1..{MAX_EPISODE_STEPS}")
+        whole_in(n_steps, "n_steps", 1, MAX_EPISODE_STEPS)  # T24-11: 1.5 or True "is not allowed", 0 out of range
         chosen = ("steady-state" if mdp is not None else "generational") if method is None else method
         if not isinstance(chosen, str) or chosen not in ("steady-state", "generational"):
             raise NeurohoverError(f"unknown method {brief(method)}: allowed steady-state, generational")

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real
+from ..errors import NeurohoverError, brief, finite_real, whole_in
 from ..evaluate import PolicyTable, evaluate_jobs
 from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
@@ -91,8 +91,9 @@ class EonnSettings:
     def __post_init__(self) -> None:
         for name, low in (("pop_size", 2), ("keep", 0), ("generations", 1), ("tournament_size", 1)):
             v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, int) or v < low:
-                raise NeurohoverError(f"{name}={brief(v)} is out of range: allowed an integer >= {low}")
+            if type(v) is not int:  # T24-11: 1.5 or True "is not allowed" (a type; it said out of range), a Python int as before
+                raise NeurohoverError(f"{name}={brief(v)} is not allowed: allowed an integer in {low}..2**63-1")
+            whole_in(v, name, low, 2**63 - 1, "2**63-1")
         if self.keep >= self.pop_size:
             raise NeurohoverError(
                 f"keep={brief(self.keep)} is out of range: allowed 0..pop_size - 1 = {self.pop_size - 1} (at least one offspring a generation)"

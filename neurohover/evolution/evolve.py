@@ -80,8 +80,8 @@ from pathlib import Path
 import numba
 import numpy as np
 
-from ..errors import NeurohoverError, brief, check_flag, real_number, whole_number
-from ..evaluate import check_episode_count, evaluate_jobs, num_threads
+from ..errors import NeurohoverError, brief, check_flag, real_number, whole_in
+from ..evaluate import MAX_EPISODES_PER_CALL, evaluate_jobs, num_threads
 from ..paths import output_file
 from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
@@ -290,9 +290,8 @@ def _fresh_episodes(target, episodes: int, mdp_seed: int) -> tuple[np.ndarray, n
     """The kernel rows and each episode's row index of ``episodes`` fresh episodes of ``target``: all on its MDP, or
     each on a fresh MDP from G drawn with ``mdp_seed``."""
     mdp, family, _ = resolve_target(target)
-    if not whole_number(episodes) or episodes < 1:  # whole_number: np.timedelta64 is a np.integer (T17-1)
-        raise NeurohoverError(f"episodes={brief(episodes)} is out of range: allowed an integer >= 1")
-    check_episode_count(int(episodes), f"episodes={episodes}")
+    # T24-11: whole_in, so 1.5 or True "is not allowed" and 0 "is out of range"; the bound check_episode_count had
+    episodes = whole_in(episodes, "episodes", 1, MAX_EPISODES_PER_CALL, f"{MAX_EPISODES_PER_CALL:,} (episodes in one call)")
     if mdp is not None:
         return mdp.row()[None, :], np.zeros(episodes, dtype=np.int64)
     assert family is not None  # resolve_target gives an MDP or a family

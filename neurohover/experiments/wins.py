@@ -16,7 +16,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from ..errors import NeurohoverError, as_floats, brief, whole_number
+from ..errors import NeurohoverError, as_floats, brief, whole_in
 from ..evolution.seeding import check_seed
 from .keys import UnitKey
 from .results import TestRunResult
@@ -60,9 +60,8 @@ def win_probabilities(runs: Mapping[str, Mapping[str, Sequence[float]]], n_runs:
     WinOdds
         Agent -> probability; the probabilities sum to 1.
     """
-    for name, value in (("n_runs", n_runs), ("draws", draws)):
-        if not whole_number(value) or value < 1:
-            raise NeurohoverError(f"{name}={brief(value)} is out of range: allowed an integer >= 1")
+    # T24-11: 1.5 or True "is not allowed" (a type), 0 "is out of range" (both said out of range); the bound below
+    n_runs, draws = (whole_in(v, name, 1, _MAX_CELLS, f"{_MAX_CELLS:,} (draws x n_runs)") for name, v in (("n_runs", n_runs), ("draws", draws)))
     seed = check_seed(seed)  # every seed's range, 0..2**63-1: 2**64 was taken (sixteenth trial T16-17)
     if draws * n_runs > _MAX_CELLS:
         raise NeurohoverError(f"draws x n_runs = {draws * n_runs:,} is too large: at most {_MAX_CELLS:,} simulated runs per agent at once")

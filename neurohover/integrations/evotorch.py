@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, whole_in
 
 try:
     import torch
@@ -30,7 +30,7 @@ try:
 except ModuleNotFoundError as missing:  # the optional extra
     raise NeurohoverError(f"neurohover.integrations.evotorch needs {missing.name}: pip install 'neurohover[evotorch]'") from None
 
-from ..evaluate import PolicyTable, evaluate_jobs
+from ..evaluate import MAX_EPISODES_PER_CALL, PolicyTable, evaluate_jobs
 from ..evolution.seeding import check_seed
 from ..policies import GENOME_LENGTH, TOPOLOGIES, prototype
 from ..sim.constants import EPISODE_STEPS
@@ -56,8 +56,8 @@ class HoverProblem(Problem):
     ) -> None:
         if topology not in TOPOLOGIES:
             raise NeurohoverError(f"topology={topology!r} is not allowed: use {', '.join(TOPOLOGIES)}")
-        if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
-            raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1")
+        # T24-11: 1.5 or True "is not allowed" (a type), 0 "is out of range" (both said out of range); each call's bound
+        episodes = whole_in(episodes, "episodes", 1, MAX_EPISODES_PER_CALL, f"{MAX_EPISODES_PER_CALL:,} (solutions x episodes in one call)")
         self.family = get_task_family(task, sigma)
         self.sample = mdps == "sample"
         self.rows = None if self.sample else np.array([self.family.mdp(m).row() for m in ([mdps] if isinstance(mdps, str) else mdps)])

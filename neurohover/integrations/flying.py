@@ -28,7 +28,7 @@ import numpy as np
 
 from ..envs.arguments import check_obs_dtype, real_values
 from ..envs.vector import HoverVectorEnv
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, whole_in
 from ..evaluate import Evaluation, check_first_episode
 from ..policies import Policy
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS
@@ -99,9 +99,12 @@ def evaluate_callable(
     mdps, family = _checked_mdps(mdps)
     _check_on_step(on_step)
     first_episode = check_first_episode(first_episode)  # text was a TypeError from first_episode + k, True taken as 1 (twelfth trial T5)
-    if isinstance(episodes, (bool, np.bool_)) or not isinstance(episodes, (int, np.integer)) or not 1 <= episodes * len(mdps) <= MAX_EPISODES:
-        raise NeurohoverError(f"episodes={episodes!r} is out of range: allowed an integer >= 1 with episodes x MDPs <= {MAX_EPISODES}")
-    n = len(mdps) * int(episodes)
+    if len(mdps) > MAX_EPISODES:
+        raise NeurohoverError(f"mdps: {len(mdps):,} MDPs is out of range: at most {MAX_EPISODES} (episodes x MDPs <= {MAX_EPISODES})")
+    # T24-11: 1.5 or True "is not allowed" (a type), 0 "is out of range" (both said out of range)
+    top = MAX_EPISODES // len(mdps)
+    episodes = whole_in(episodes, "episodes", 1, top, f"{top} (episodes x MDPs <= {MAX_EPISODES})")
+    n = len(mdps) * episodes
     sigma = getattr(mdps[0], "sigma", None)
     env = HoverVectorEnv(n, task=family, sigma=sigma, mdp=[m for m in mdps for _ in range(episodes)], episode_steps=n_steps, obs_dtype=obs_dtype)
     streams = [(seed, int(first_episode) + k) for k in range(n)]  # k = m * episodes + e, as evaluate numbers them

@@ -131,9 +131,8 @@ class MDP:
             object.__setattr__(self, name, tuple(vector.tolist()))  # plain Python numbers: reprs read MDP(params=(-0.18, ...))
         if min(self.noise_std) < 0:
             raise NeurohoverError(f"MDP noise_std={self.noise_std!r} is out of range: allowed stds >= 0")
-        if not whole_number(self.substeps) or not 1 <= self.substeps <= MAX_SUBSTEPS:  # np.timedelta64 was int()'s TypeError (T17-1)
-            raise NeurohoverError(f"MDP substeps={brief(self.substeps)} is out of range: allowed an integer in 1..{MAX_SUBSTEPS}")
-        object.__setattr__(self, "substeps", int(self.substeps))
+        # T24-11: whole_in, so 1.5 or True "is not allowed" (a type) and 0 "is out of range"; both said out of range
+        object.__setattr__(self, "substeps", whole_in(self.substeps, "MDP substeps", 1, MAX_SUBSTEPS))
         for name in ("dt", "d_u"):
             value = getattr(self, name)
             if not finite_real(value):  # np.timedelta64 was float()'s TypeError (T17-1), 10**400 an OverflowError

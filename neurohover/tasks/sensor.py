@@ -36,7 +36,7 @@ from __future__ import annotations
 import re
 from dataclasses import asdict, dataclass, fields, replace
 
-from ..errors import FloatRangeError, NeurohoverError, brief, finite_real, float_of, real_number, whole_number
+from ..errors import FloatRangeError, NeurohoverError, brief, finite_real, float_of, real_number, whole_in
 from ..sim.constants import MAX_SENSOR_DELAY, SENSOR_GROUPS
 
 #: The std of each group at noise level 1 (velocity m/s, position m, rates rad/s, attitude).
@@ -79,11 +79,9 @@ class Sensor:
         if not finite_real(p) or not 0 <= p < 1:  # NaN fails the comparison too; np.timedelta64 is no number (T17-1)
             raise NeurohoverError(f"sensor dropout={brief(p)} is out of range: allowed a probability 0 <= dropout < 1")
         object.__setattr__(self, "dropout", float(p))
-        d = self.delay
-        if whole_number(d):
-            object.__setattr__(self, "delay", d := int(d))  # a NumPy integer as the int it is
-        if isinstance(d, bool) or not isinstance(d, int) or not 0 <= d <= MAX_SENSOR_DELAY:
-            raise NeurohoverError(f"sensor delay={brief(d)} is out of range: allowed an integer number of control steps in 0..{MAX_SENSOR_DELAY}")
+        # T24-11: whole_in, so 1.5 or True "is not allowed" (a type) and -1 "is out of range"; both said out of range
+        delay = whole_in(self.delay, "sensor delay", 0, MAX_SENSOR_DELAY, f"{MAX_SENSOR_DELAY} (control steps)")
+        object.__setattr__(self, "delay", delay)  # a NumPy integer as the int it is
 
     @property
     def exact(self) -> bool:
