@@ -50,7 +50,9 @@ def check_meaning(metadata: dict, mdps: list, episodes: tuple[tuple, tuple, list
     for i, mdp in enumerate(mdps):
         if mdp is not None and id(mdp) not in seen:
             seen.add(id(mdp))
-            _check_held(mdp, i, where)
+            problem = held_problem(mdp)
+            if problem:
+                raise NeurohoverError(f"{where}: its metadata mdps entry {i} ({brief(mdp.label)}) is not allowed: {problem}")
     returns = metadata.get("returns")
     returns = returns if isinstance(returns, list) else []
     for i, value in enumerate(returns):  # [5.0, 3.0] was taken (T23-03): every reward is minus a sum of squares
@@ -79,11 +81,12 @@ def _differences(a: MDP, b: MDP) -> list[str]:
     ]
 
 
-def _check_held(mdp: MDP, i: int, where: str) -> None:
-    """Refuse an MDP of a task family that the family does not hold (its parameters out of the family's range, or its
-    other fields not the family's: T23-02), or whose label names one of the family's MDPs with other parameters
-    (T23-04). No family method tells whether it holds a given MDP: its :meth:`make` checks the ranges of the
-    parameters at its ``row_slice``, so the MDP is held where it is the family's zero or what make gives of them.
+def held_problem(mdp: MDP) -> str:
+    """Why ``mdp`` is refused ('' when it is not): an MDP of a task family that the family does not hold (its parameters
+    out of the family's range, or its other fields not the family's: T23-02), or whose label names one of the family's
+    MDPs with other parameters (T23-04); flight data's MDPs and a policy file's mdp_params are checked by it. No family
+    method tells whether it holds a given MDP: its :meth:`make` checks the ranges of the parameters at its ``row_slice``,
+    so the MDP is held where it is the family's zero or what make gives of them.
 
     The labels the code writes for an MDP, and which are checked against its parameters: ``F/zero``, ``F/train:N``,
     ``F/test:N`` and ``F/seeded-train:N``, ``F/seeded-test:N`` (the MDP the family names so; T23-04; FGHH's seeded sets
@@ -93,53 +96,54 @@ def _check_held(mdp: MDP, i: int, where: str) -> None:
     ``model``) and any label given to ``make(label=...)``."""
     cls = TASK_FAMILIES.get(mdp.family)
     if cls is None:  # a learned model's MDP: any wind, any dynamics
-        return
+        return ""
     family = get_task_family(mdp.family)  # a sigma only widens FGHH's draws, not what make() takes
-    shown = f"{where}: its metadata mdps entry {i} ({brief(mdp.label)})"
     zero = replace(family.zero(), sensor=mdp.sensor, drift=mdp.drift)
     if mdp != zero:
         try:
             made = family.make(mdp.row()[cls.row_slice])
         except NeurohoverError as err:
-            raise NeurohoverError(f"{shown} is not allowed: it is no {mdp.family} MDP: {err}") from None
+            return f"it is no {mdp.family} MDP: {err}"
         made = replace(made, sensor=mdp.sensor, drift=mdp.drift)
         if mdp != made:
-            raise NeurohoverError(
-                f"{shown} is not allowed: it is no {mdp.family} MDP: its {', '.join(_differences(mdp, made))} differ from every "
+            return (
+                f"it is no {mdp.family} MDP: its {', '.join(_differences(mdp, made))} differ from every "
                 f"{mdp.family} MDP's ({', '.join(_differences(made, mdp))}), whose parameters are {', '.join(cls.param_names)}"
             )
     match = _SET_LABEL.fullmatch(mdp.label) or _WIND_LABEL.fullmatch(mdp.label)
     if match is None:
-        return
+        return ""
     named = match.group("family") or mdp.family
     if named != mdp.family:
-        raise NeurohoverError(f"{shown} is not allowed: its label names a {brief(named)} MDP, but the MDP's family is {brief(mdp.family)}")
+        return f"its label names a {brief(named)} MDP, but the MDP's family is {brief(mdp.family)}"
     if match.re is _WIND_LABEL:  # 'ghh08/wind=[9.0, 9.0]' over a wind of [-0.228, 2.898] was taken (T24-05)
-        _check_wind_label(mdp, match.group("wind"), shown)
-        return
+        return _wind_label_problem(mdp, match.group("wind"))
     spec = match.group("spec")
     if family.has_sigma and spec.startswith("seeded-"):  # FGHH's seeded sets depend on a sigma the metadata does not record
-        return
+        return ""
     try:
         named_mdp = family.mdp(spec)
     except NeurohoverError as err:
-        raise NeurohoverError(f"{shown} is not allowed: its label names no {mdp.family} MDP: {err}") from None
+        return f"its label names no {mdp.family} MDP: {err}"
     if mdp != replace(named_mdp, sensor=mdp.sensor, drift=mdp.drift):
         theirs = ", ".join(_differences(named_mdp, mdp))
-        raise NeurohoverError(f"{shown} is not allowed: its {', '.join(_differences(mdp, named_mdp))} contradict its label: {mdp.family}'s {spec} has {theirs}")
+        return f"its {', '.join(_differences(mdp, named_mdp))} contradict its label: {mdp.family}'s {spec} has {theirs}"
+    return ""
 
 
-def _check_wind_label(mdp: MDP, text: str, shown: str) -> None:
-    """Refuse a ``wind=[...]`` label (what GHH-08's make() writes of the wind it is given, ``fly --wind``) whose numbers
-    are not the MDP's wind: make() writes them as Python lists, whose text reads back as the same floats."""
+def _wind_label_problem(mdp: MDP, text: str) -> str:
+    """Why a ``wind=[...]`` label (what GHH-08's make() writes of the wind it is given, ``fly --wind``) is refused ('' when
+    it is not): its numbers are not the MDP's wind (make() writes them as Python lists, whose text reads back as the same
+    floats)."""
     try:
         named = json.loads(text)
     except ValueError:
         named = None
     if not isinstance(named, list) or not all(type(v) in (int, float) for v in named):
-        raise NeurohoverError(f"{shown} is not allowed: its label names no wind: give wind=[u, v], a list of numbers, as fly --wind writes it")
+        return "its label names no wind: give wind=[u, v], a list of numbers, as fly --wind writes it"
     if [float(v) for v in named] != list(mdp.wind):
-        raise NeurohoverError(f"{shown} is not allowed: its wind={brief(list(mdp.wind))} contradicts its label, which names the wind {brief(named)}")
+        return f"its wind={brief(list(mdp.wind))} contradicts its label, which names the wind {brief(named)}"
+    return ""
 
 
 def _check_crash(flags: list, obs: np.ndarray, act: np.ndarray, i: int, where: str) -> None:

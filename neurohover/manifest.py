@@ -347,7 +347,7 @@ def _validation_problem(meta: dict) -> str:
 def _place_problem(meta: dict) -> str:
     """A record's task, mdp (what evolve's --mdp or --wind/--params named), target (the label of the MDP or family the
     run evolved on) and mdp_params (that MDP) against each other ('' when they agree; T24-02). mdp_params is checked
-    as flight data's MDPs are against their labels (:func:`neurohover.flightmeta._check_held`); a run over a family has
+    as flight data's MDPs are against their labels (:func:`neurohover.flightmeta.held_problem`); a run over a family has
     none of its own (one seeded from a policy file may keep the seed's, which is not read)."""
     task, mdp = meta.get("task"), meta.get("mdp")
     target: Any = meta.get("target")
@@ -376,7 +376,7 @@ _SPEC = re.compile(r"zero|sample|(?:seeded-)?(?:train|test):[0-9]+")
 def _mdp_params_problem(params: object, task: object, target: object) -> str:
     """A record's mdp_params (the MDP a run evolved on, as :meth:`MDP.to_dict` writes it) against its task and target,
     and against its own label as flight data's MDPs are checked (T24-02)."""
-    from .flightmeta import _check_held
+    from .flightmeta import held_problem
     from .tasks import MDP
 
     try:
@@ -389,11 +389,8 @@ def _mdp_params_problem(params: object, task: object, target: object) -> str:
         return f"its mdp_params label {brief(mdp.label)} is not allowed beside its target {brief(target)}: the run was evolved on its target"
     if isinstance(task, str) and mdp.family != task:
         return f"its mdp_params family {brief(mdp.family)} is not allowed beside its task {brief(task)}: a run evolves on its task's MDPs"
-    try:
-        _check_held(mdp, 0, "")
-    except NeurohoverError as err:  # flightmeta names a flight-data entry: the reason after its name, said of mdp_params
-        return f"its mdp_params ({brief(mdp.label)}) is not allowed: {str(err).partition(' is not allowed: ')[2] or err}"
-    return ""
+    problem = held_problem(mdp)
+    return f"its mdp_params ({brief(mdp.label)}) is not allowed: {problem}" if problem else ""
 
 
 def _run_settings_problem(meta: dict) -> str:

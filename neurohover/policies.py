@@ -279,7 +279,8 @@ def load_policy(source: str | Path) -> Policy:
 
 def record_problem(metadata: dict) -> str:
     """What in a policy's ``metadata`` (its record of the run that evolved it) contradicts itself, by the first of
-    :data:`RECORD_CHECKS` that finds something ('' when none does): :func:`load_policy` refuses a file of such a record."""
+    :data:`RECORD_CHECKS` that finds something ('' when none does): :func:`load_policy` refuses a file of such a record,
+    and :func:`save_policy` refuses to write one (T24-03)."""
     for check in RECORD_CHECKS.values():
         problem = check(metadata)
         if problem:
@@ -346,7 +347,7 @@ def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
     """Write ``policy`` (and extra metadata: strict JSON values under keys of their own) as a JSON policy file; returns the path.
 
     The name is checked by :func:`check_json_policy_name` (a name ending .json, not another run's checkpoint or history;
-    T24-01)."""
+    T24-01), the record by :data:`RECORD_CHECKS` as :func:`load_policy` checks it (T24-03): what is written loads."""
     from .paths import output_file, writing
 
     if not isinstance(policy, Policy):
@@ -361,6 +362,10 @@ def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
         text = json.dumps(data, indent=1, allow_nan=False) + "\n"
     except (TypeError, ValueError) as err:  # an object, or a NaN that other JSON readers refuse
         raise NeurohoverError(f"policy metadata must be strict JSON values (numbers finite): {err}") from None
+    problem = record_problem({k: v for k, v in data.items() if k not in ("topology", "genome")})
+    if problem:  # T24-03: seed=-1 or budget=-5 was written, and load_policy then refused the file
+        shown = repr(str(path)) if isinstance(path, (str, os.PathLike)) else brief(path)  # as load_policy names the file
+        raise NeurohoverError(f"policy file {shown}: {problem} (load_policy would refuse the file; nothing is written)")
     path = output_file(path, "policy file")  # refuses '', a directory and a device; makes missing parents
     with writing(path, "policy file") as partial:
         partial.write_text(text)

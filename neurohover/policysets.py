@@ -515,10 +515,12 @@ def _build(family, root: Path, budget, fghh_budget, seed, safety_episodes, n_ste
     manifest["lineage"] = lineage
     ancestor = None
     if lineage == "chain":  # the ancestor: runs over the training MDPs in turn, each from the last champion
+        flown = 0  # the episodes its stages flew: budget * stages was fewer than the last stage's evaluations at a budget under 5
         for i, mdp in enumerate(train):
             ancestor = run(mdp, f"ancestor (stage {i + 1} of {len(train)}, training MDP {i})", int(seeds[12 + i]), ancestor, save=False, budget=budget)
+            flown += ancestor.metadata["episodes"]
         assert ancestor is not None
-        save_policy(ancestor, root / "ancestor.json", task=family.name, name="ancestor", episodes=budget * len(train))
+        save_policy(ancestor, root / "ancestor.json", task=family.name, name="ancestor", episodes=flown)
     evolved = [
         run(family.zero(), "generic", int(seeds[k]), ancestor, budget=budget)
         if role.target == "zero"

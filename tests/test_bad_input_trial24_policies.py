@@ -1,9 +1,10 @@
-"""Bad input, trial 24: policy files' names and records (T24-01, T24-02).
+"""Bad input, trial 24: policy files' names and records (T24-01, T24-02, T24-03).
 
 ``neurohover evolve --out`` and ``save_policy`` wrote a policy under any name, overwriting flight data or another run's
 checkpoint or history (T24-01); load_policy read a policy file whose record contradicted itself: a validation_return of
-5.0, a task other than its target's, mdp_params other than its label's MDP, settings of pop_size 0 (T24-02). Each is
-refused by name, before anything is written or evolved; every file the code writes still loads."""
+5.0, a task other than its target's, mdp_params other than its label's MDP, settings of pop_size 0 (T24-02); and
+save_policy wrote a record (seed -1) that load_policy then refused (T24-03). Each is refused by name, before anything is
+written or evolved; every file the code writes still loads."""
 
 from __future__ import annotations
 
@@ -130,3 +131,21 @@ def test_fly_refuses_it_with_status_2(written: Path, tmp_path: Path, cli: CliRun
     path.write_text(json.dumps({**json.loads((written / "p.json").read_text()), "validation_return": 5.0}))
     rc, _, err = cli("fly", "--task", "ghh08", "--policy", str(path), "--episodes", "1")
     assert rc == 2 and "its validation_return 5.0 is not allowed" in err and "Traceback" not in err, err
+
+
+@pytest.mark.parametrize(("metadata", "says"), [
+    ({"seed": -1}, "its seed -1 is not allowed: allowed an integer in 0..2**63-1"),
+    ({"budget": -5}, "its budget -5 is not allowed: allowed an integer in 1..10,000,000,000"),
+    ({"validation_return": 5.0}, "its validation_return 5.0 is not allowed"),
+])  # fmt: skip
+def test_save_policy_refuses_a_record_load_policy_would_refuse(tmp_path: Path, metadata: dict, says: str) -> None:
+    """T24-03: save_policy(baseline_policy(), 'sp.json', seed=-1) was written, and load_policy refused it."""
+    path = tmp_path / "sp.json"
+    with pytest.raises(NeurohoverError) as caught:
+        nh.save_policy(nh.baseline_policy(), path, **metadata)
+    assert f"policy file {str(path)!r}: {says}" in str(caught.value) and "nothing is written" in str(caught.value)
+    assert not path.exists()
+    edited = nh.Policy("slp", nh.baseline_policy().genome, metadata)  # the record in the policy's own metadata, too
+    with pytest.raises(NeurohoverError, match="load_policy would refuse the file"):
+        nh.save_policy(edited, path)
+    assert not path.exists()
