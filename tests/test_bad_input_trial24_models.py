@@ -189,3 +189,15 @@ def test_learn_ec_mer_refuses_a_true_return_above_0() -> None:
     fd = nh.evaluate(base, nh.get_task_family("ghh08").zero(), episodes=1, record=True, n_steps=20).flight_data
     with pytest.raises(NeurohoverError, match=r"^true_return=5\.0 is not allowed: a return is in \[-1\.75e\+10, 0\]"):
         learn_ec_mer(fd, base, 5.0, budget=2)
+
+
+@pytest.mark.parametrize(("episodes", "says"), [(1.5, "is not allowed"), (True, "is not allowed"), (0, "is out of range")])
+def test_learn_ec_mer_tells_a_non_integer_episodes_from_one_out_of_range(episodes, says: str) -> None:
+    """T24-11: learn_ec_mer's episodes=1.5 was called 'out of range'; a non-integer is not allowed (errors.whole_in)."""
+    import neurohover as nh
+    from neurohover.models import learn_ec_mer
+
+    base = nh.baseline_policy()
+    fd = nh.evaluate(base, nh.get_task_family("ghh08").zero(), episodes=1, record=True, n_steps=20).flight_data
+    with pytest.raises(NeurohoverError, match=rf"^episodes={episodes!r} {says}: allowed an integer in 1\.\.[0-9,]+ \(per candidate\)$"):
+        learn_ec_mer(fd, base, -1.0, budget=2, episodes=episodes)

@@ -13,7 +13,7 @@ import time
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, whole_number
+from ..errors import NeurohoverError, brief, finite_real, whole_in, whole_number
 from ..flightdata import FlightData
 from ..flightmeta import action_mismatch
 from ..sim.constants import DEFAULT_PARAMS, ROW_NOISE, ROW_PARAMS, WORST_RETURN
@@ -248,8 +248,8 @@ def learn_ec_mer(
     start = time.perf_counter()
     if not isinstance(generic_policy, Policy):
         raise NeurohoverError(f"generic_policy must be a Policy, got {type(generic_policy).__name__}")
-    if not whole_number(episodes) or not 1 <= episodes <= MAX_EC_MER_EPISODES:  # np.timedelta64 was int()'s TypeError (T17-1)
-        raise NeurohoverError(f"episodes={brief(episodes)} is out of range: allowed an integer in 1..{MAX_EC_MER_EPISODES:,} (per candidate)")
+    # np.timedelta64 was int()'s TypeError (T17-1); 1.5 was called out of range (T24-11)
+    whole_in(episodes, "episodes", 1, MAX_EC_MER_EPISODES, f"{MAX_EC_MER_EPISODES:,} (per candidate)")
     tr = Transitions(flight_data)
     # T23-15: the command line checked this (ec_mer_policy), the Python API fitted any policy's closed loop without a word
     check_policy_flew(generic_policy, flight_data, "flight data", "generic_policy", "give the policy that flew them as generic_policy")
