@@ -6,11 +6,11 @@ Every file ``fly --record`` writes still loads (two tasks, crashes and none, flo
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import pytest
+from flight_edits import edited_copy, refused_everywhere
 
 from neurohover.errors import NeurohoverError
 from neurohover.flightdata import FlightData
@@ -42,30 +42,6 @@ def flights(tmp_path_factory) -> dict[str, Path]:
     return paths
 
 
-def _edited(flight: Path, out: Path, edit: Callable[[dict], None]) -> Path:
-    """``flight`` written again to ``out`` with its metadata changed by ``edit``, its arrays as they were: a hand edit."""
-    with np.load(flight) as z:
-        arrays = {k: z[k] for k in z.files}
-    metadata = json.loads(str(arrays["metadata"]))
-    edit(metadata)
-    np.savez_compressed(out, **{**arrays, "metadata": np.array(json.dumps(metadata))})
-    return out
-
-
-def _refused_everywhere(path: Path, message: str, cli, tmp_path: Path) -> None:
-    """``path`` is refused by FlightData.load, plot and learn-model with ``message`` (a plain text), writing nothing."""
-    with pytest.raises(NeurohoverError) as err:
-        FlightData.load(path)
-    assert str(err.value).startswith(f"flight-data file '{path}': its metadata ") and message in str(err.value), str(err.value)
-    for argv in (
-        ["plot", str(path), "--episodes", "0", "--out", str(tmp_path / "p")],
-        ["learn-model", "--flight-data", str(path), "--method", "lr", "--out", str(tmp_path / "m.json")],
-    ):
-        rc, out, stderr = cli(*argv)
-        assert rc == 2 and "Traceback" not in stderr and message in stderr and str(path) in stderr, stderr
-        assert not list(tmp_path.glob("p/*.png")) and not (tmp_path / "m.json").exists()
-
-
 def test_every_recording_fly_writes_loads_back(flights: dict[str, Path], tmp_path: Path) -> None:
     """What is not refused: every file fly --record writes (ghh08, ghh09 and FGHH; crashed episodes, at once or after
     some steps, and full ones; float64 and float32), and two recordings joined and saved."""
@@ -84,14 +60,14 @@ def test_an_mdp_its_task_family_does_not_hold_is_refused(flights: dict[str, Path
     def wind(meta: dict) -> None:
         meta["mdps"][0].update(wind=[9, 9], label="ghh08/custom")
 
-    path = _edited(flights["calm"], tmp_path / "wind.npz", wind)
-    _refused_everywhere(path, "mdps entry 0 ('ghh08/custom') is not allowed: it is no ghh08 MDP: GHH-08 wind [9.0, 9.0] m/s is out of range", cli, tmp_path)
+    path = edited_copy(flights["calm"], tmp_path / "wind.npz", wind)
+    refused_everywhere(path, "mdps entry 0 ('ghh08/custom') is not allowed: it is no ghh08 MDP: GHH-08 wind [9.0, 9.0] m/s is out of range", cli, tmp_path)
 
     def dt(meta: dict) -> None:  # in range, but not the family's dynamics
         meta["mdps"][1].update(dt=0.02, label="x")
 
     with pytest.raises(NeurohoverError, match=r"mdps entry 1 \('x'\) is not allowed: it is no ghh08 MDP: its dt=0.02 differ .*\(dt=0.01\)"):
-        FlightData.load(_edited(flights["calm"], tmp_path / "dt.npz", dt))
+        FlightData.load(edited_copy(flights["calm"], tmp_path / "dt.npz", dt))
 
 
 def test_returns_above_0_or_not_what_the_observations_give_are_refused(flights: dict[str, Path], tmp_path: Path, cli) -> None:
@@ -101,8 +77,8 @@ def test_returns_above_0_or_not_what_the_observations_give_are_refused(flights: 
     def positive(meta: dict) -> None:
         meta["returns"] = [5.0, 3.0]
 
-    path = _edited(flights["calm"], tmp_path / "positive.npz", positive)
-    _refused_everywhere(path, "returns=[5.0, 3.0] is not allowed: episode 0's return 5.0 is not in", cli, tmp_path)
+    path = edited_copy(flights["calm"], tmp_path / "positive.npz", positive)
+    refused_everywhere(path, "returns=[5.0, 3.0] is not allowed: episode 0's return 5.0 is not in", cli, tmp_path)
     obs, act = (np.full((4, 12), 0.01),), (np.zeros((3, 4)),)
     with pytest.raises(NeurohoverError, match=r"^flight data: its metadata returns=\[1.5\] is not allowed"):
         FlightData(obs, act, {"returns": [1.5]})  # no MDP recorded: above 0 is refused all the same
@@ -111,7 +87,7 @@ def test_returns_above_0_or_not_what_the_observations_give_are_refused(flights: 
         def halved(meta: dict) -> None:
             meta["returns"][-1] = meta["returns"][-1] / 2
 
-        edited = _edited(flights[name], tmp_path / f"half-{name}.npz", halved)
+        edited = edited_copy(flights[name], tmp_path / f"half-{name}.npz", halved)
         with pytest.raises(NeurohoverError, match=r"is not what its observations give: .*its returns and observations contradict"):
             FlightData.load(edited)
 
@@ -119,7 +95,7 @@ def test_returns_above_0_or_not_what_the_observations_give_are_refused(flights: 
         meta["returns"][0] += 1748.8
 
     with pytest.raises(NeurohoverError, match=r"episode 0's return .* less 1748.8\d* for each of the 5,99\d steps left of its budget"):
-        FlightData.load(_edited(flights["fall"], tmp_path / "off.npz", off))
+        FlightData.load(edited_copy(flights["fall"], tmp_path / "off.npz", off))
 
 
 @pytest.mark.parametrize("label", ["ghh08/train:4", "train:4", "ghh08/zero", "ghh08/test:100", "fghh/train:3"])
@@ -129,7 +105,7 @@ def test_an_mdp_label_that_names_another_mdp_is_refused(flights: dict[str, Path]
     def relabel(meta: dict) -> None:
         meta["mdps"][1]["label"] = label
 
-    path = _edited(flights["calm"], tmp_path / "label.npz", relabel)
+    path = edited_copy(flights["calm"], tmp_path / "label.npz", relabel)
     with pytest.raises(NeurohoverError) as err:
         FlightData.load(path)
     assert str(err.value).startswith(f"flight-data file '{path}': its metadata mdps entry 1 ({label!r}) is not allowed: "), str(err.value)
@@ -137,7 +113,7 @@ def test_an_mdp_label_that_names_another_mdp_is_refused(flights: dict[str, Path]
         err.value
     )
     if label == "train:4":
-        _refused_everywhere(path, "its wind=(3.81178, 1.41884) contradict its label: ghh08's train:4 has wind=", cli, tmp_path)
+        refused_everywhere(path, "its wind=(3.81178, 1.41884) contradict its label: ghh08's train:4 has wind=", cli, tmp_path)
 
 
 @pytest.mark.parametrize("seed", ["abc", -5, 1.5, 2**63])
@@ -147,8 +123,8 @@ def test_a_seed_that_is_no_seed_is_refused(flights: dict[str, Path], tmp_path: P
     def reseed(meta: dict) -> None:
         meta["seed"] = seed
 
-    path = _edited(flights["calm"], tmp_path / "seed.npz", reseed)
-    _refused_everywhere(path, f"seed={seed!r} is ", cli, tmp_path)
+    path = edited_copy(flights["calm"], tmp_path / "seed.npz", reseed)
+    refused_everywhere(path, f"seed={seed!r} is ", cli, tmp_path)
     with pytest.raises(NeurohoverError, match=r"allowed an integer in 0..2\*\*63-1"):
         FlightData.load(path)
 
@@ -162,8 +138,8 @@ def test_an_episode_flagged_crashed_that_flew_calm_to_its_end_is_refused(flights
         meta["crashed"] = [True, True]
 
     for name in ("calm", "calm32"):
-        path = _edited(flights[name], tmp_path / f"crashed-{name}.npz", crashed)
-        _refused_everywhere(path, "crashed=[True, True] is not allowed: episode 0 is flagged crashed, yet after its last step (6,000)", cli, tmp_path)
+        path = edited_copy(flights[name], tmp_path / f"crashed-{name}.npz", crashed)
+        refused_everywhere(path, "crashed=[True, True] is not allowed: episode 0 is flagged crashed, yet after its last step (6,000)", cli, tmp_path)
     calm = FlightData.load(flights["calm"])
     mdp = calm.metadata["mdps"][0]
     obs, act = [np.zeros((7, 12))], [np.zeros((6, 4))]

@@ -7,11 +7,11 @@ from __future__ import annotations
 
 import json
 import re
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import pytest
+from flight_edits import edited_copy, refused_everywhere
 
 from neurohover.errors import NeurohoverError
 from neurohover.flightdata import FlightData
@@ -47,31 +47,6 @@ def flights(tmp_path_factory) -> dict[str, Path]:
     return paths
 
 
-def _edited(flight: Path, out: Path, edit: Callable[[dict], None]) -> Path:
-    """``flight`` written again to ``out`` with its metadata changed by ``edit``, its arrays as they were: a hand edit."""
-    with np.load(flight) as z:
-        arrays = {k: z[k] for k in z.files}
-    metadata = json.loads(str(arrays["metadata"]))
-    edit(metadata)
-    np.savez_compressed(out, **{**arrays, "metadata": np.array(json.dumps(metadata))})
-    return out
-
-
-def _refused_everywhere(path: Path, message: str, cli, tmp_path: Path) -> None:
-    """``path`` is refused by FlightData.load, plot and learn-model --method lr with ``message``, writing nothing."""
-    with pytest.raises(NeurohoverError) as err:
-        FlightData.load(path)
-    assert str(err.value).startswith(f"flight-data file '{path}': its metadata ") and message in str(err.value), str(err.value)
-    for argv in (
-        ["plot", str(path), "--episodes", "0", "--out", str(tmp_path / "p")],
-        ["learn-model", "--flight-data", str(path), "--method", "lr", "--out", str(tmp_path / "m.json")],
-    ):
-        rc, _, stderr = cli(*argv)
-        assert rc == 2 and "Traceback" not in stderr and message in stderr and str(path) in stderr, stderr
-        assert len(stderr.strip().splitlines()) == 1, stderr
-        assert not list(tmp_path.glob("p/*.png")) and not (tmp_path / "m.json").exists()
-
-
 # --------------------------------------------------------------------------- T24-04: joined recordings
 
 
@@ -98,8 +73,8 @@ def test_joined_older_files_of_two_policies_name_no_policy_for_ec_mer(flights: d
     def older(meta: dict) -> None:
         del meta["policy_flown"]
 
-    a = FlightData.load(_edited(flights["f"], tmp_path / "a.npz", older))
-    b = FlightData.load(_edited(flights["fp"], tmp_path / "b.npz", older))
+    a = FlightData.load(edited_copy(flights["f"], tmp_path / "a.npz", older))
+    b = FlightData.load(edited_copy(flights["fp"], tmp_path / "b.npz", older))
     assert (a + a).metadata["policy"] == "baseline" and "policy_flown" not in (a + a).metadata
     assert "policy" not in (a + b).metadata and (a + b).metadata["policy_flown"] is None
     with pytest.raises(NeurohoverError, match=r"were flown by more than one policy \(joined recordings\)"):
@@ -116,9 +91,9 @@ def test_a_wind_label_that_is_not_the_mdps_wind_is_refused(flights: dict[str, Pa
     def relabel(meta: dict) -> None:
         meta["mdps"][0]["label"] = label
 
-    path = _edited(flights["wind"], tmp_path / "relabelled.npz", relabel)
+    path = edited_copy(flights["wind"], tmp_path / "relabelled.npz", relabel)
     message = f"mdps entry 0 ('{label}') is not allowed: its wind=[-0.228, 2.898] contradicts its label, which names the wind"
-    _refused_everywhere(path, message, cli, tmp_path)
+    refused_everywhere(path, message, cli, tmp_path)
 
 
 @pytest.mark.parametrize("label", ["ghh08/wind=[zz]", "ghh09/wind=[-0.228, 2.898]"])
@@ -128,7 +103,7 @@ def test_a_wind_label_naming_no_wind_or_another_family_is_refused(flights: dict[
 
     expected = "its label names no wind: give wind=[u, v]" if "zz" in label else "its label names a 'ghh09' MDP, but the MDP's family is 'ghh08'"
     with pytest.raises(NeurohoverError, match=rf"mdps entry 0 \('{label[:10]}.*'\) is not allowed: {re.escape(expected)}"):
-        FlightData.load(_edited(flights["wind"], tmp_path / "named.npz", relabel))
+        FlightData.load(edited_copy(flights["wind"], tmp_path / "named.npz", relabel))
 
 
 def test_what_fly_wind_writes_loads_and_labels_it_does_not_write_are_left(flights: dict[str, Path], tmp_path: Path) -> None:
@@ -141,7 +116,7 @@ def test_what_fly_wind_writes_loads_and_labels_it_does_not_write_are_left(flight
         def relabel(meta: dict, label: str = label) -> None:
             meta["mdps"][0]["label"] = label
 
-        assert FlightData.load(_edited(flights["wind"], tmp_path / "other.npz", relabel)).n_episodes == 1
+        assert FlightData.load(edited_copy(flights["wind"], tmp_path / "other.npz", relabel)).n_episodes == 1
 
 
 # --------------------------------------------------------------------------- T24-06: policy_flown
@@ -162,7 +137,7 @@ def test_a_policy_flown_that_is_no_policy_is_refused(flights: dict[str, Path], t
     def edit(meta: dict) -> None:
         meta["policy_flown"] = flown
 
-    _refused_everywhere(_edited(flights["f"], tmp_path / "flown.npz", edit), message, cli, tmp_path)
+    refused_everywhere(edited_copy(flights["f"], tmp_path / "flown.npz", edit), message, cli, tmp_path)
     f = FlightData.load(flights["f"])
     with pytest.raises(NeurohoverError, match=r"^flight data: its metadata policy_flown=.* is not allowed: it is no policy"):
         FlightData(f.observations, f.actions, {**f.metadata, "policy_flown": flown})
@@ -175,8 +150,8 @@ def test_a_policy_flown_that_did_not_fly_the_episodes_is_refused_at_load(flights
     def edit(meta: dict) -> None:
         meta["policy_flown"]["genome"][1] = 0.5
 
-    path = _edited(flights["f"], tmp_path / "gene.npz", edit)
-    _refused_everywhere(path, "it did not fly the episodes: at step 1 of episode 0 it gives action 0 = ", cli, tmp_path)
+    path = edited_copy(flights["f"], tmp_path / "gene.npz", edit)
+    refused_everywhere(path, "it did not fly the episodes: at step 1 of episode 0 it gives action 0 = ", cli, tmp_path)
     f = FlightData.load(flights["f"])
     edited = FlightData(f.observations, f.actions, {**f.metadata, "policy_flown": json.loads(str(np.load(path)["metadata"]))["policy_flown"]})
     with pytest.raises(NeurohoverError, match=r"^flight data: its metadata policy_flown=.* is not allowed: it did not fly the episodes"):
@@ -184,7 +159,7 @@ def test_a_policy_flown_that_did_not_fly_the_episodes_is_refused_at_load(flights
     assert not (tmp_path / "again.npz").exists()
     swapped = FlightData(f.observations, f.actions, {**f.metadata, "policy_flown": OTHER_POLICY})
     with pytest.raises(NeurohoverError, match=r"it did not fly the episodes: at step 1 of episode 0 it gives action 3 = 0.23 where"):
-        FlightData.load(_edited(flights["f"], tmp_path / "swapped.npz", lambda m: m.update(policy_flown=OTHER_POLICY)))
+        FlightData.load(edited_copy(flights["f"], tmp_path / "swapped.npz", lambda m: m.update(policy_flown=OTHER_POLICY)))
     assert swapped.save(tmp_path / "f32.npz", dtype="float32").exists()  # float32: left to EC-MER's check (rounded readings)
 
 
@@ -194,7 +169,7 @@ def test_ec_mer_names_the_policy_flown_that_did_not_fly_them(flights: dict[str, 
     def edit(meta: dict) -> None:
         meta["policy_flown"]["genome"][1] = 0.5
 
-    path = _edited(flights["f32"], tmp_path / "gene32.npz", edit)
+    path = edited_copy(flights["f32"], tmp_path / "gene32.npz", edit)
     assert FlightData.load(path).n_episodes == 1  # float32: loads, rounded readings are not checked at load
     out = tmp_path / "m.json"
     rc, _, err = cli("learn-model", "--flight-data", str(path), "--method", "ec-mer", "--budget", "2", "--out", str(out))
