@@ -28,3 +28,18 @@ def error(err: str, command: str) -> str:
     """The message of ``neurohover COMMAND: error: ...`` on stderr."""
     line = next(ln for ln in err.splitlines() if ln.startswith(f"neurohover {command}: error: "))
     return line.removeprefix(f"neurohover {command}: error: ")
+
+
+def refused_by_every_command(cli, config: Path, store: Path, name: str, line: str, out: Path) -> None:
+    """``results``, ``reproduce --update`` (of ``config``) and ``report`` (into ``out``) each refuse experiment ``name`` of
+    ``store`` with the shared check's ``line``, in exit status 2, writing no report and leaving the store as it was."""
+    before = dump(store)
+    for argv, command in (
+        (("results", name, "--store", str(store), "--format", "json"), "results"),
+        (("reproduce", str(config), "--store", str(store), "--no-progress", "--update"), "reproduce"),
+    ):
+        rc, _, err = cli(*argv)
+        assert rc == 2 and error(err, command) == line, (argv, err)
+    rc, _, err = cli("report", "--store", str(store), "--out", str(out))
+    assert rc == 2 and line in err and not out.exists(), err
+    assert dump(store) == before

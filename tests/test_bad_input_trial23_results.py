@@ -15,7 +15,7 @@ from typing import Any
 
 import pytest
 from conftest import CliRun, tiny_test_runs
-from store_edits import dump, error
+from store_edits import refused_by_every_command
 
 from neurohover.errors import NeurohoverError
 from neurohover.experiments import Store
@@ -221,17 +221,8 @@ def test_results_report_and_reproduce_update_refuse_a_damaged_evolution_run(ev1,
     """T23-08: every command that reads the store refuses the damaged run, in one message, and leaves the store as it was."""
     config, good = ev1
     store = _edited(good, tmp_path / "s.sqlite", EVOLVE, stop_reason="bogus")
-    before = dump(store)
     line = _refused(store, "ev1", EVOLVE, "stop_reason = 'bogus' is not allowed")
-    for argv, command in (
-        (("results", "ev1", "--store", str(store), "--format", "json"), "results"),
-        (("reproduce", str(config), "--store", str(store), "--no-progress", "--update"), "reproduce"),
-    ):
-        rc, out, err = cli(*argv)
-        assert rc == 2 and error(err, command) == line, (argv, err)
-    rc, out, err = cli("report", "--store", str(store), "--out", str(tmp_path / "r"))
-    assert rc == 2 and line in err and not (tmp_path / "r").exists(), err
-    assert dump(store) == before
+    refused_by_every_command(cli, config, store, "ev1", line, tmp_path / "r")
 
 
 def test_a_crashed_champion_of_any_return_is_taken(ev1, tmp_path: Path) -> None:

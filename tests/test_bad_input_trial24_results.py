@@ -15,7 +15,7 @@ from typing import Any
 
 import pytest
 from conftest import CliRun, tiny_test_runs
-from store_edits import dump, error
+from store_edits import refused_by_every_command
 from test_bad_input_trial23_results import EV1, _edited, _refused, _reproduced
 
 from neurohover.compete_files import MAX_SECONDS, NO_OFFLINE, read_compete_dir
@@ -168,17 +168,8 @@ def test_an_evolution_run_that_contradicts_itself_is_refused_by_every_command(ev
     reproduce --update; each command now refuses them in one message and leaves the store as it was."""
     config, good = ev1
     store = _edited(good, tmp_path / "s.sqlite", EVOLVE, **changes)
-    before = dump(store)
     line = _refused(store, "ev1", EVOLVE, says)
-    for argv, command in (
-        (("results", "ev1", "--store", str(store), "--format", "json"), "results"),
-        (("reproduce", str(config), "--store", str(store), "--no-progress", "--update"), "reproduce"),
-    ):
-        rc, out, err = cli(*argv)
-        assert rc == 2 and error(err, command) == line, (argv, err)
-    rc, out, err = cli("report", "--store", str(store), "--out", str(tmp_path / "r"))
-    assert rc == 2 and line in err and not (tmp_path / "r").exists(), err
-    assert dump(store) == before
+    refused_by_every_command(cli, config, store, "ev1", line, tmp_path / "r")
 
 
 def test_the_falling_history_message_names_the_records(ev1, tmp_path: Path) -> None:
