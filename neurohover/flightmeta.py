@@ -105,10 +105,11 @@ def held_problem(mdp: MDP) -> str:
         except NeurohoverError as err:
             return f"it is no {mdp.family} MDP: {err}"
         made = replace(made, sensor=mdp.sensor, drift=mdp.drift)
-        if mdp != made:
+        if mdp != made:  # named against the nearer of the two: a zero MDP's substeps 3 blamed its (zero's) wind too (T25-13)
+            near = min((made, zero), key=lambda other: len(_differences(mdp, other)))
             return (
-                f"it is no {mdp.family} MDP: its {', '.join(_differences(mdp, made))} differ from every "
-                f"{mdp.family} MDP's ({', '.join(_differences(made, mdp))}), whose parameters are {', '.join(cls.param_names)}"
+                f"it is no {mdp.family} MDP: its {', '.join(_differences(mdp, near))} differ from every "
+                f"{mdp.family} MDP's ({', '.join(_differences(near, mdp))}), whose parameters are {', '.join(cls.param_names)}"
             )
     match = _SET_LABEL.fullmatch(mdp.label) or _WIND_LABEL.fullmatch(mdp.label)
     if match is None:

@@ -189,3 +189,20 @@ def test_every_recording_fly_writes_loads_joined_saved_and_reloaded(flights: dic
         for dtype in ("float64", "float32"):
             back = FlightData.load(joined.save(tmp_path / f"{a}-{b}-{dtype}.npz", dtype=dtype))
             assert back.n_episodes == joined.n_episodes and back.metadata == joined.metadata
+
+
+def test_an_mdp_off_its_family_is_named_by_the_fields_at_fault(tmp_path: Path) -> None:
+    """T25-13: a recorded ghh08/zero MDP with substeps 3 was said to differ in its wind_kind and wind too, which are the
+    zero MDP's own (fly --record writes wind_kind 0, wind () for it); only substeps is named now."""
+    from neurohover.cli import main
+
+    flown = tmp_path / "f0.npz"
+    assert main(["fly", "--task", "ghh08", "--episodes", "1", "--record", str(flown)]) == 0
+
+    def edit(meta: dict) -> None:
+        meta["mdps"][0]["substeps"] = 3
+
+    path = edited_copy(flown, tmp_path / "e06.npz", edit)
+    with pytest.raises(NeurohoverError) as err:
+        FlightData.load(path)
+    assert "its substeps=3 differ from every ghh08 MDP's (substeps=10)" in str(err.value), str(err.value)
