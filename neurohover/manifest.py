@@ -70,9 +70,22 @@ def _check_manifest_fields(manifest: dict, path: Path) -> None:
         bad = bad or (name == "lineage" and value not in LINEAGES)
         if bad:
             raise NeurohoverError(f"policy-set manifest {str(path)!r}: {name}={value!r:.40} is not allowed: give {allowed}")
+        if name == "built" and not _is_build_time(value):  # T25-14: 'yesterday' was shown as the build's time
+            raise NeurohoverError(f"policy-set manifest {str(path)!r}: its built {brief(value)} is not allowed: give the build's time as YYYY-MM-DD HH:MM:SS")
         size = sizes.get(name)
         if size is not None and not size[0] <= value <= size[1]:  # T23-11: a budget or n_steps of 0 was taken as a count >= 0
             raise NeurohoverError(f"policy-set manifest {str(path)!r}: its {name} {brief(value)} is not allowed: allowed an integer in {size[2]}")
+
+
+def _is_build_time(text: str) -> bool:
+    """Whether ``text`` is a time as build_policy_set writes a manifest's ``built`` (``time.strftime("%Y-%m-%d %H:%M:%S")``)."""
+    import time
+
+    try:
+        time.strptime(text, "%Y-%m-%d %H:%M:%S")
+    except ValueError:
+        return False
+    return True
 
 
 def _check_tables(manifest: dict, path: Path, rows: int, columns: int) -> None:
@@ -276,7 +289,8 @@ def policy_record_problem(meta: dict) -> str:
     if method is not None and optimizer is not None and method not in names[optimizer]:
         return f"its method {brief(method)} is not allowed: optimizer {optimizer!r} evolves by {' or '.join(names[optimizer])}"
     problem = _run_words_problem(meta, own_stop, STOP_REASONS, parse_resampling, (1 + 1e-9) / math.log(ERROR_FLOOR))
-    return problem or _validation_problem(meta) or _place_problem(meta) or _run_settings_problem(meta)  # T24-02: what evolve adds
+    problem = problem or _validation_problem(meta) or _place_problem(meta) or _run_settings_problem(meta)  # T24-02: what evolve adds
+    return problem or _counts_problem(meta, parse_resampling) or _fields_problem(meta)  # T25-04/05/06/12/14
 
 
 def _run_words_problem(meta: dict, own_stop: dict, stop_reasons: tuple, parse_resampling, best_fitness: float) -> str:
@@ -429,6 +443,81 @@ def _run_settings_problem(meta: dict) -> str:
     if finite_real(ret) and (scale == "return") != (ret <= 0):
         why = "a return is <= 0" if scale == "return" else "a fitness 1/ln(error) is > 0"
         return f"its champion_return {brief(ret)} is not allowed beside its champion_fitness_scale {brief(scale)}: {why}"
+    return ""
+
+
+#: Keys no policy file is written with that read as settings a policy file would hold: never read, they misled (T25-12).
+_NOT_POLICY_KEYS = {
+    "format": "policy files carry no format tag (a model file's or a summary's key?)",
+    "obs_noise": "a policy file records the sensor its run saw as 'sensor' (a table of Sensor.to_dict)",
+    "obs_delay": "a policy file records the sensor its run saw as 'sensor' (a table of Sensor.to_dict)",
+}
+
+
+def _counts_problem(meta: dict, parse_resampling) -> str:
+    """A record's episodes and evaluations against its resampling fixed:K (each evaluation flies K episodes), and a
+    steady-state stop by plateau against its plateau_threshold (T25-06): fixed:3 beside 50 episodes of 50 evaluations, or
+    a plateau after 50 evaluations at a threshold of 1000, were accepted. A chain set's ancestor (name 'ancestor') records
+    the episodes of all its stages and the evaluations of its last: its episodes may be more."""
+    episodes, evaluations, resampling = meta.get("episodes"), meta.get("evaluations"), meta.get("resampling")
+    if isinstance(resampling, str) and resampling.strip().lower().startswith("fixed:") and whole_number(episodes) and whole_number(evaluations):
+        k = parse_resampling(resampling).k
+        if episodes != k * evaluations and not (meta.get("name") == "ancestor" and episodes > k * evaluations):
+            return (
+                f"its episodes {brief(episodes)} is not allowed beside its evaluations {brief(evaluations)} and resampling {brief(resampling)}: "
+                f"each evaluation flies {k} episode{'s' if k != 1 else ''}, {k * evaluations:,} in all"
+            )
+    settings = meta.get("settings")
+    threshold = settings.get("plateau_threshold") if isinstance(settings, dict) else None
+    if meta.get("stop_reason") == "plateau" and meta.get("method") == "steady-state" and whole_number(threshold) and whole_number(evaluations):
+        if evaluations < threshold:
+            return (
+                f"its stop_reason 'plateau' is not allowed beside its evaluations {brief(evaluations)} and settings' plateau_threshold "
+                f"{brief(threshold)}: steady state stops by plateau after plateau_threshold evaluations without a new champion"
+            )
+    return ""
+
+
+def _fields_problem(meta: dict) -> str:
+    """A record's sensor (read as :meth:`Sensor.from_dict <neurohover.tasks.sensor.Sensor.from_dict>` reads it; T25-04),
+    sigma (checked by the FGHH family, against its task and its target's ``G(sigma=...)``; T25-05), prototype against its
+    seed_policy (T25-06), seed_policy and history as what evolve writes (T25-14), and keys no policy file holds (T25-12)."""
+    from .tasks import get_task_family
+    from .tasks.fghh import FGHH
+    from .tasks.sensor import Sensor
+
+    bad = next((key for key in _NOT_POLICY_KEYS if key in meta), None)
+    if bad is not None:
+        return f"its {bad} {brief(meta[bad])} is not allowed: {_NOT_POLICY_KEYS[bad]}"
+    if "sensor" in meta:
+        try:
+            Sensor.from_dict(meta["sensor"])
+        except NeurohoverError as err:
+            return f"its sensor {brief(meta['sensor'])} is not allowed: {err}"
+    task, target = meta.get("task"), meta.get("target")
+    if "sigma" in meta:
+        sigma = meta["sigma"]
+        try:
+            FGHH(sigma=sigma)
+        except NeurohoverError as err:
+            return f"its sigma {brief(sigma)} is not allowed: {err}"
+        try:
+            family = get_task_family(task) if isinstance(task, str) else None
+        except NeurohoverError:  # no task's name: left to the place checks
+            family = None
+        if family is not None and not family.has_sigma:
+            return f"its sigma {brief(sigma)} is not allowed beside its task {brief(task)}: {task}'s MDPs have no breadth (sigma is FGHH's)"
+        said = re.fullmatch(r"[a-z0-9]+/G\(sigma=([^()]*)\)", target) if isinstance(target, str) else None
+        if said is not None and f"{float(sigma):g}" != said.group(1):
+            return f"its sigma {brief(sigma)} is not allowed beside its target {brief(target)}: the run was evolved over G(sigma={said.group(1)})"
+    seed_policy, proto = meta.get("seed_policy"), meta.get("prototype")
+    if "seed_policy" in meta and (not isinstance(seed_policy, str) or seed_policy == ""):
+        return f"its seed_policy {brief(seed_policy)} is not allowed: give what the run was seeded from as text (zero, baseline or a policy file)"
+    if seed_policy in ("zero", "baseline") and "prototype" in meta and proto != seed_policy:
+        return f"its prototype {brief(proto)} is not allowed beside its seed_policy {brief(seed_policy)}: a run seeded from {seed_policy} has its prototype"
+    history = meta.get("history")
+    if "history" in meta and not (isinstance(history, str) and history.endswith(".history.csv") and Path(history).name == history and "\\" not in history):
+        return f"its history {brief(history)} is not allowed: give the name (no folder) of the run's history file beside it, ending .history.csv"
     return ""
 
 

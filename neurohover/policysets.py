@@ -44,7 +44,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError, brief, whole_number
+from .errors import NeurohoverError, brief, finite_real, whole_number
 from .evaluate import MAX_EPISODES_PER_CALL, evaluate
 from .manifest import LINEAGES, _check_manifest_fields, check_ghh_manifest, check_kind_keys, choose_safe, table3_summary
 from .paths import JSONError, strict_json, writing
@@ -134,16 +134,21 @@ def _load(path: Path, what: str, task: str, target: str, built: dict | None = No
     return policy
 
 
-def _built_as(manifest: dict, role: Role) -> dict:
+def _built_as(manifest: dict, role: Role, k: int) -> dict:
     """What the run of ``role`` recorded, as the set's ``manifest`` says its build ran it (where it says): its episode
     length, its budget and its method (a steady-state generic recording a generational run, or n_steps 999 in a set of
-    20, was flown; T23-11)."""
+    20, was flown; T23-11); and its seed, the ``k``-th of the manifest's root seed's (a manifest seed of 7 beside policies
+    of a build from 0 was shown; T25-14)."""
     from .evolution.optimisers import NE, OPTIMISERS
 
     family = role.target == "family"
     optimizer = NE if role.kind == "race" else manifest.get("optimizer", NE)  # a race is NE's (build_policy_set)
     method = ("generational" if family else "steady-state") if optimizer == NE else getattr(OPTIMISERS.get(optimizer), "label", None)
     built = {"n_steps": manifest.get("n_steps"), "budget": manifest.get("fghh_budget" if family else "budget"), "method": method}
+    if whole_number(manifest.get("seed")) and 0 <= manifest["seed"] < 2**63:  # T25-14: as build_policy_set seeds role k
+        built["seed"] = int(np.random.SeedSequence(manifest["seed"]).generate_state(32, dtype=np.uint32)[k])
+    if family:  # T25-07: race:0.1 on the fixed generic was flown; the build runs each generic over G by its role's resampling
+        built["resampling"] = role.resampling
     return {key: value for key, value in built.items() if value is not None}
 
 
@@ -200,18 +205,31 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
     _check_manifest_fields(manifest, manifest_path)
     check_kind_keys(manifest, manifest_path, family.generic_over_distribution)
     targets = {"zero": family.zero().label, "family": f"{family.name}/G"}  # what each role's run evolved on
+    if family.has_sigma and finite_real(manifest.get("sigma")):  # T25-07: G(sigma=0.7) in a set of sigma 0.3 was taken by its prefix
+        targets["family"] = f"{family.name}/G(sigma={float(manifest['sigma']):g})"
     if family.generic_over_distribution:
         roles = {role.kind: role for role in policy_set_roles(family)}
         generics = {
-            name: _load(root / f"generic_{name}.json", f"the {name} generic policy", family.name, targets[roles[name].target], _built_as(manifest, roles[name]))
+            name: _load(
+                root / f"generic_{name}.json",
+                f"the {name} generic policy",
+                family.name,
+                targets[roles[name].target],
+                _built_as(manifest, roles[name], list(roles).index(name)),
+            )
             for name in FGHH_GENERICS
         }
         return PolicySet(family.name, root, generics["race"], generics=generics, manifest=manifest)
+    if manifest.get("lineage") == "independent" and (root / "ancestor.json").exists():  # T25-14: a chain's set was shown as independent
+        raise NeurohoverError(
+            f"policy-set manifest {str(manifest_path)!r}: its lineage 'independent' is not allowed beside ancestor.json, which only a "
+            "chain's build writes (its runs seeded from that ancestor): give lineage 'chain', or rebuild the set"
+        )
     generic_role, *specialised_roles = policy_set_roles(family)
-    generic = _load(root / "generic.json", "the generic policy", family.name, targets["zero"], _built_as(manifest, generic_role))
+    generic = _load(root / "generic.json", "the generic policy", family.name, targets["zero"], _built_as(manifest, generic_role, 0))
     train = family.training_mdps()
     specialised = tuple(
-        _load(root / f"specialised_{i}.json", f"specialised policy {i}", family.name, train[i].label, _built_as(manifest, specialised_roles[i]))
+        _load(root / f"specialised_{i}.json", f"specialised policy {i}", family.name, train[i].label, _built_as(manifest, specialised_roles[i], i + 1))
         for i in range(10)
     )
     safe = check_ghh_manifest(manifest, manifest_path, len(specialised), len(train))
