@@ -23,7 +23,7 @@ from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
 
-from .errors import NeurohoverError, OutputError
+from .errors import NeurohoverError, OutputError, brief
 
 try:
     import fcntl
@@ -42,7 +42,9 @@ __all__ = [
     "input_dir",
     "make_dirs",
     "output_dir",
+    "held_kind",
     "output_file",
+    "output_name",
     "printable",
     "refuse_dangling_link",
     "refuse_link_loop",
@@ -232,6 +234,67 @@ def _no_dash(path: str | os.PathLike, option: str, what: str, stdout: bool) -> N
         raise NeurohoverError(f"{option} '-' is not a {what} name here: {instead}")
 
 
+#: The neurohover files a JSON output can be told apart by (what it is called -> a test of its parsed JSON object):
+#: an output of one kind is not written over a file of another (T25-01 to T25-03: a policy, a checkpoint, a compete
+#: summary replaced by rows or a model without a word).
+JSON_KINDS: dict[str, Callable[[dict], bool]] = {
+    "a policy file": lambda d: {"topology", "genome"} <= d.keys(),
+    "a model file": lambda d: str(d.get("format", "")).startswith("neurohover-model/"),
+    "an evolution checkpoint": lambda d: str(d.get("format", "")).startswith("neurohover-evolution-checkpoint/"),
+    "a competition summary (summary.json)": lambda d: {"experiment", "agent", "task", "runs"} <= d.keys(),
+    "a policy set's manifest": lambda d: {"built", "optimizer"} <= d.keys() and "rows" not in d,
+    "evaluate-agent rows (--json)": lambda d: {"rows", "n_mdps", "episode_steps"} <= d.keys(),
+    "a results export (results --format json)": lambda d: {"experiment", "config_hash", "units"} <= d.keys(),
+}
+_KIND_READ_LIMIT = 64 * 2**20  # a larger file is no neurohover JSON file told apart here
+
+
+def held_kind(path: str | os.PathLike) -> str | None:
+    """What neurohover file the existing regular file ``path`` is, in words (``"a policy file"``), read from its
+    content: a results store (SQLite), flight data (a NumPy archive), one of :data:`JSON_KINDS`; None for anything
+    else (no such file, unreadable, another file). The one test of "which kind of neurohover file is this" that
+    :func:`output_file` refuses to write another kind over."""
+    p = Path(path)
+    try:
+        if not p.is_file() or p.stat().st_size > _KIND_READ_LIMIT:
+            return None
+        with open(p, "rb") as f:
+            body = f.read()
+    except OSError:
+        return None
+    if body.startswith(SQLITE_HEADER):
+        return "a results store (SQLite)"
+    if body.startswith(b"PK\x03\x04"):  # a zip: a NumPy archive (.npz) holds its arrays as NAME.npy
+        return "flight data (a NumPy archive)" if b"format.npy" in body else None
+    if not body.lstrip()[:1] == b"{":
+        return None
+    try:
+        value = json.loads(body)
+    except (ValueError, RecursionError):
+        return None
+    return next((kind for kind, test in JSON_KINDS.items() if isinstance(value, dict) and test(value)), None)
+
+
+def output_name(path: object, option: str, suffixes: tuple[str, ...], what: str, refused_ends: Mapping[str, str] | None = None) -> None:
+    """Refuse a name ``path`` whose suffix (any case) is none of ``suffixes``, naming ``option`` and ``what`` the output
+    is ("evaluate-agent's rows are JSON"), and a name ending one of ``refused_ends`` (end -> whose file that is: evolve's
+    FILE.checkpoint.json, :data:`neurohover.policies.RUN_FILE_ENDS`); what is no path is :func:`output_file`'s to refuse.
+    evaluate-agent --json f.npz wrote JSON over flight data (T25-01), results --out f.npz CSV (T25-02), learn-model --out
+    P.checkpoint.json a model over evolve's checkpoint (T25-03)."""
+    text = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None
+    if not isinstance(text, str) or text in ("", "-") or text.endswith(("/", os.sep)) or Path(text).is_dir():
+        return
+    end = next((end for end in refused_ends or {} if text.lower().endswith(end)), None)
+    if end is not None:
+        raise NeurohoverError(
+            f"{option} {brief(text)} is not allowed: a name ending {end} is that of a run's {(refused_ends or {})[end]}; give "
+            f"a name not ending {' or '.join(refused_ends or {})}"
+        )
+    if suffixes != ("",) and Path(text).suffix.lower() not in suffixes:
+        like = brief(str(Path(text).with_suffix(suffixes[0])) if Path(text).name else f"out{suffixes[0]}")
+        raise NeurohoverError(f"{option} {brief(text)} is not allowed: {what}; give a path ending {' or '.join(suffixes)} (e.g. {like})")
+
+
 def output_file(
     path: str | os.PathLike,
     option: str,
@@ -239,6 +302,10 @@ def output_file(
     *,
     store: bool = False,
     stdout: bool = False,
+    kind: str | None = None,
+    suffixes: tuple[str, ...] = (),
+    what: str = "",
+    refused_ends: Mapping[str, str] | None = None,
 ) -> Path:
     """Check that the file ``path`` can be written (an existing file is kept as it is).
 
@@ -246,7 +313,10 @@ def output_file(
     a file, a symbolic link to a missing target (:func:`refuse_dangling_link`), a '..' after a missing directory
     (:func:`make_dirs`), any place where a file cannot be created, the file of one of ``inputs`` (option -> path: writing it would
     destroy what the command reads) and, unless ``store`` (the path is a results store's own), an existing results
-    store; creates missing parent directories (saying so on standard error).
+    store; given the ``kind`` of file written (one of :data:`JSON_KINDS`' names), an existing neurohover file of
+    another kind (:func:`held_kind`; T25-01 to T25-03), and a name of a suffix not in ``suffixes`` (``what`` says why) or
+    ending one of ``refused_ends`` (:func:`output_name`);
+    creates missing parent directories (saying so on standard error).
     """
     _no_dash(path, option, "file", stdout)
     p = checked_path(path, option)
@@ -266,6 +336,11 @@ def output_file(
     if os.fspath(path).endswith(("/", os.sep)):  # Path() drops the slash: 'x.json/' was written as the file x.json (seventh trial)
         raise NeurohoverError(f"{option} {str(path)!r} ends in '/', which names a directory: give a file path")
     refuse_special_file(p, option, path)
+    if suffixes or refused_ends:  # flight data, a checkpoint replaced by JSON rows, CSV or a model (T25-01 to T25-03)
+        output_name(path, option, suffixes or ("",), what, refused_ends)
+    held = None if kind is None else held_kind(p)
+    if held is not None and held != kind:  # a policy, a checkpoint, a summary replaced by another kind of file (T25-01 to T25-03)
+        raise NeurohoverError(f"{option} {brief(os.fspath(path))} is {held}: give another path (writing {kind} there would destroy it)")
     refuse_dangling_link(p, option, path)  # a link to nothing was written through, wherever it pointed (T19-12)
     make_dirs(p.parent, option, str(path))
     real = Path(os.path.realpath(p))

@@ -105,6 +105,10 @@ def _files_read(args: argparse.Namespace) -> dict[str, str | Path | None]:
     return files
 
 
+#: What evaluate-agent --json writes: refused over a neurohover file of another kind (a policy, a summary; T25-01).
+ROWS_KIND, ROWS_ARE = "evaluate-agent rows (--json)", "evaluate-agent writes its rows as JSON"
+
+
 def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     """Fly a trained policy on full paper episodes of a task's training or test MDPs, beside the competition's baseline
     and the shipped generic policy on the same gusts, and print the paper's measures (return per episode, crashes)."""
@@ -121,14 +125,14 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
         if not low <= value <= high:
             raise NeurohoverError(f"{option} {value} is out of range: allowed an integer in {low}..{high}")
     inputs = {"--policy": args.policy, "--sb3": args.sb3}  # writing one would destroy what is flown (fourth trial)
-    out = None if args.json is None else output_file(args.json, "--json", inputs)
+    out = None if args.json is None else output_file(args.json, "--json", inputs, kind=ROWS_KIND, suffixes=(".json",), what=ROWS_ARE)
     if args.obs_dtype is not None and args.policy is not None:  # the kernel flies a policy file on float64: ignored (fifth trial)
         raise NeurohoverError("--obs-dtype applies to an agent that receives observations (--callable, --sb3, --rl-zoo, --cleanrl), not to a --policy file")
     if args.rl_id and args.policy is not None:
         raise NeurohoverError("--rl-id applies to an agent trained on a neurohover/<NAME>-RL-v0 id, not to a neurohover --policy file")
     act = _agent(args)
     if out is not None:
-        output_file(args.json, "--json", _files_read(args))
+        output_file(args.json, "--json", _files_read(args), kind=ROWS_KIND, suffixes=(".json",), what=ROWS_ARE)
     if isinstance(act, Policy):
         note_policy_task(act, family.name, f"--policy {args.policy}")
     if args.rl_id or (args.rl_zoo is not None and "-RL-v0" in str(args.rl_zoo)):

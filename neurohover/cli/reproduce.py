@@ -131,7 +131,9 @@ def cmd_results(args: argparse.Namespace) -> int:
 
     input_file(args.store, "--store", "results store")
     fmt = _results_format(args.format, args.out)  # before output_file makes --out's directory
-    out = None if args.out is None else output_file(args.out, "--out", {"--store": args.store}, stdout=True)
+    kind = "a results export (results --format json)" if fmt == "json" else None  # (a CSV export: the suffix rule alone)
+    suffixes, what = (".csv", ".json"), "results are written as CSV or JSON"  # CSV over flight data, JSON over a policy (T25-02)
+    out = None if args.out is None else output_file(args.out, "--out", {"--store": args.store}, stdout=True, kind=kind, suffixes=suffixes, what=what)
     with Store(args.store, create=False) as store:
         text = export_results(store, args.name, fmt, args.scale)
     if out is not None:
@@ -307,9 +309,9 @@ def register(sub) -> None:
         "--format",
         choices=("csv", "json"),
         help="csv: one row per unit, one plain value per cell (a long list as its count and mean); json: every unit in full "
-        "(default: what --out's .csv/.json suffix names, else csv; a suffix naming the other is refused)",
+        "(default: what --out's suffix names, else csv; a suffix naming the other is refused)",
     )
-    p.add_argument("--out", help="output file (default: standard output)")
+    p.add_argument("--out", help="output file, its name ending .csv or .json (default: standard output)")
     p.set_defaults(func=cmd_results)
 
     p = sub.add_parser("wins", help="each agent's odds of winning an N-run competition, from stored test runs", description=cmd_wins.__doc__)
