@@ -505,7 +505,8 @@ def _fields_problem(meta: dict) -> str:
             family = get_task_family(task) if isinstance(task, str) else None
         except NeurohoverError:  # no task's name: left to the place checks
             family = None
-        if family is not None and not family.has_sigma:
+        carried = meta.get("seed_policy") not in (None, "zero", "baseline")  # a champion keeps its seed file's keys, an FGHH seed's sigma
+        if family is not None and not family.has_sigma and not carried:
             return f"its sigma {brief(sigma)} is not allowed beside its task {brief(task)}: {task}'s MDPs have no breadth (sigma is FGHH's)"
         said = re.fullmatch(r"[a-z0-9]+/G\(sigma=([^()]*)\)", target) if isinstance(target, str) else None
         if said is not None and f"{float(sigma):g}" != said.group(1):

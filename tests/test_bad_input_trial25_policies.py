@@ -30,7 +30,7 @@ SHORT = ("--budget", "10", "--episode-steps", "20", "--validation-episodes", "1"
 @pytest.fixture(scope="module")
 def written(tmp_path_factory) -> Path:
     """Evolve outputs as the trial wrote them: steady state on ghh08/zero, on ghh08 through a noisy late sensor (which
-    records its sensor) and over FGHH's G (which records its sigma)."""
+    records its sensor), over FGHH's G (which records its sigma) and on ghh08 seeded from that (which keeps its sigma)."""
     from neurohover.cli import main
 
     where = tmp_path_factory.mktemp("written25")
@@ -38,6 +38,7 @@ def written(tmp_path_factory) -> Path:
         "p": [],
         "noisy": ["--obs-noise", "0.3", "--obs-delay", "1"],
         "fghh": ["--task", "fghh", "--mdp", "G", "--setting", "pop_size=5", "--setting", "select_size=2"],
+        "seeded": ["--topology", "slp", "--seed-policy", str(where / "fghh.json")],  # keeps its FGHH seed's sigma
     }
     for name, extra in runs.items():
         task = [] if "--task" in extra else ["--task", "ghh08"]
@@ -64,10 +65,11 @@ def refused(path: Path, *words: str) -> str:
 
 
 def test_the_files_evolve_writes_still_load(written: Path) -> None:
-    for name in ("p", "noisy", "fghh"):
+    for name in ("p", "noisy", "fghh", "seeded"):
         assert policy_record_problem(nh.load_policy(written / f"{name}.json").metadata) == "", name
     assert nh.load_policy(written / "noisy.json").metadata["sensor"]["delay"] == 1
     assert nh.load_policy(written / "fghh.json").metadata["sigma"] == 0.3
+    assert nh.load_policy(written / "seeded.json").metadata["sigma"] == 0.3  # the seed's, carried (not the run's, which has none)
 
 
 @pytest.mark.parametrize(
