@@ -141,9 +141,10 @@ def test_a_crash_on_an_episodes_last_step_is_taken(tiny: Path, tmp_path: Path) -
 @pytest.mark.parametrize(
     ("changes", "says"),
     [
-        (
-            {"agent": "baseline"},
-            "its result contradicts its params: agent = 'baseline' is not allowed: its unit's params.agent is 'model-free', and a result must be its unit's",
+        (  # T25-09: an agent that flies the run's specialised policies ('baseline' is now refused for its policy_changes first)
+            {"agent": "model-free-risk"},
+            "its result contradicts its params: agent = 'model-free-risk' is not allowed: its unit's params.agent is 'model-free', "
+            "and a result must be its unit's",
         ),
         ({"mdp": "ghh09/test:7"}, "mdp = 'ghh09/test:7' is not allowed: its unit's params.mdp.label is 'ghh08/test:0', and a result must be its unit's"),
     ],
@@ -163,7 +164,8 @@ def test_a_model_result_that_contradicts_its_units_params_is_refused() -> None:
     from neurohover.experiments.results import ModelResult, ModelTiming
 
     model = ModelResult(
-        method="lr", mdp="ghh08/test:0", generic_return=-1.0, generic_crashed=False, model_params=(), model_noise_std=(), predicted_return=-1.0,
+        method="lr", mdp="ghh08/test:0", generic_return=-1.0, generic_crashed=False, model_params=(0.0,) * 11, model_noise_std=(0.0,) * 6,
+        predicted_return=-1.0,
         test_returns=(-1.0,), test_mean=-1.0, test_crashes=0, policy_episodes=1, timing=ModelTiming(learn_seconds=0.0, evolve_seconds=0.0),
     )  # fmt: skip
     params = {"method": "lr", "mdp": {"label": "ghh08/test:0"}}

@@ -8,14 +8,14 @@ import dataclasses
 import math
 from typing import TYPE_CHECKING, Any
 
-from ..compete_files import NO_OFFLINE, NO_SAFEGUARD
+from ..compete_files import NO_OFFLINE, NO_SAFEGUARD, policy_label_problem
 from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..evolution.state_codec import MAX_SECONDS
 from ..integrations.neat import NEAT_TOPOLOGY
 from ..sim.constants import WORST_RETURN
 
 if TYPE_CHECKING:
-    from .results import EvolveResult, RobustnessResult, TestRunResult
+    from .results import EvolveResult, ModelResult, RobustnessResult, TestRunResult
 
 
 def _num(v) -> bool:
@@ -65,6 +65,10 @@ def run_inconsistency(run: TestRunResult) -> str:
     problem = _changes_problem(run.policy_changes, n)
     if problem:
         return problem
+    for i, (_, policy) in enumerate(run.policy_changes):  # T25-09: 'specialised:3' of authors-zero, 'model:0' of generic were taken
+        problem = policy_label_problem(run.agent, policy)
+        if problem:
+            return f"policy_changes[{i}]: {problem}"
     if run.crash_steps is not None and len(run.crash_steps) != len(run.crash_episodes):
         return f"{len(run.crash_steps)} crash steps for {len(run.crash_episodes)} crash episodes"
     for i, step in enumerate(run.crash_steps or ()):
@@ -403,6 +407,25 @@ def _history_fall_problem(run: EvolveResult, params: dict) -> str:
             )
         best = max(best, v)
     return ""
+
+
+#: A learned model's parameters and noise standard deviations (learning.LearnedModel's 11 dynamics parameters and 6
+#: noise sds: every model unit of the committed store holds as many).
+MODEL_PARAMS, MODEL_NOISE_STDS = 11, 6
+
+
+def model_inconsistency(result: ModelResult) -> str:
+    """What in model result ``result`` does not fit together ('' when all does; T25-10: model_params of 3 numbers, a
+    generic_return of 5.0 and noise sds of -1.0 were reported): 11 model parameters, 6 noise standard deviations, each a
+    finite number >= 0, and a generic return that is an episode's."""
+    for name, count in (("model_params", MODEL_PARAMS), ("model_noise_std", MODEL_NOISE_STDS)):
+        values = getattr(result, name)
+        if len(values) != count:
+            return f"{name} = {brief(list(values))} is not allowed: a learned model has {count} of them: allowed {count} numbers"
+    for i, sd in enumerate(result.model_noise_std):
+        if not (finite_real(sd) and float(sd) >= 0):
+            return f"model_noise_std[{i}] = {brief(sd)} is not allowed: a standard deviation: allowed a finite number >= 0"
+    return _returns_problem("generic_return", [result.generic_return]).replace("generic_return[0]", "generic_return")
 
 
 def robustness_inconsistency(result: RobustnessResult) -> str:

@@ -30,7 +30,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from .keys import UnitKey  # re-exported: results are read by key
-from .result_checks import KIND_CHECKS, evolve_inconsistency, robustness_inconsistency, run_inconsistency, seconds_problem
+from .result_checks import KIND_CHECKS, evolve_inconsistency, model_inconsistency, robustness_inconsistency, run_inconsistency, seconds_problem
 
 __all__ = [
     "DiagnosticResult",
@@ -468,6 +468,12 @@ class ModelResult(_Record):
     exact_test_crashes: int | None = None
     test_w_sd: Num | None = None
     flown_substeps: int | None = None
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        problem = model_inconsistency(self)
+        if problem:  # model_params of 3 numbers, noise sds of -1.0 were reported (T25-10)
+            raise NeurohoverError(f"model result is inconsistent: {problem}")
 
 
 @dataclass(frozen=True, kw_only=True)
