@@ -13,12 +13,11 @@ from neurohover.experiments.runner import POLICY_SOURCES, unchanged_units
 from neurohover.experiments.store import Store
 
 #: Paper-scale experiments whose config changed on purpose and whose re-run (`reproduce NAME --scale paper
-#: --update`) is under way: the model-substeps default of 2026-12-04 (issue 31; docs/reproduction/README.md), and
-#: topology-ghh08's tanh NEAT variant of 2026-12-06 (issue 35).
+#: --update`) is under way: the model-substeps default of 2026-12-04 (issue 31; docs/reproduction/README.md).
 #: Each must still be taken by --update (its unchanged units kept). Emptied as the store receives the re-runs.
 AWAITING_RERUN = {
     "table4", "fig7", "fig8", "fig11", "ablation-hybrid", "lr-substeps-fig8", "wind-fig7", "wind-fig8", "wind-fig11", "risk-ghh09",
-    "bench-sensors", "bench-sensors-fallback", "bench-sensor-models", "bench-drift", "bench-drift-armed", "topology-ghh08",
+    "bench-sensors", "bench-sensors-fallback", "bench-sensor-models", "bench-drift", "bench-drift-armed",
 }  # fmt: skip
 
 
