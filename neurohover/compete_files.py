@@ -327,6 +327,9 @@ def _check_summary(path: Path, summary: dict, returns: np.ndarray, rows: _Rows) 
     task = summary.get("task")
     if task is not None and task not in TASK_NAMES:
         raise NeurohoverError(f"--compete {str(path)!r} names task {task!r:.40}, not one of {', '.join(TASK_NAMES)}: it is no compete summary")
+    experiment, agent = summary.get("experiment"), summary.get("agent")
+    if isinstance(experiment, str) and task is not None and agent is not None and experiment != f"compete-{task}-{agent}":
+        _check_summary_matches(path, summary, returns, rows)  # an agent its experiment contradicts: the summary's fault, named so
     _check_rows_of_agent(path, summary, rows)  # first: a row's own fault (a policy, say) named, not the figures it moves
     _check_summary_matches(path, summary, returns, rows)  # then a value the rows contradict, named with what they hold
     _check_fields(path, summary)
