@@ -72,3 +72,13 @@ def test_learn_model_out_refuses_a_checkpoint_name_and_a_policy(tmp_path, cli) -
     assert rc == 0, err
     rc, _, err = cli(*base, str(tmp_path / "m.json"))  # a model over a model: its own kind
     assert rc == 0, err
+
+
+def test_results_out_refuses_an_evolve_runs_history_name(tmp_path, cli, tiny_store) -> None:
+    """T25-02 (left by the first fix): results --out p.json.history.csv wrote CSV over evolve's history of p.json, a CSV
+    that no file kind check tells from an export; refused by its name, as evolve --out and learn-model --out refuse it."""
+    history = tmp_path / "p.json.history.csv"
+    history.write_text("episodes,champion_return\n50,-300.0\n")
+    rc, _, err = cli("results", "tr1", "--store", str(tiny_store), "--out", str(history))
+    assert rc == 2 and "is not allowed: a name ending .history.csv is that of a run's history" in err, err
+    assert history.read_text() == "episodes,champion_return\n50,-300.0\n"

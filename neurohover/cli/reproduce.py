@@ -128,12 +128,18 @@ def cmd_results(args: argparse.Namespace) -> int:
     """Export an experiment's finished units from the results store as CSV or JSON."""
     from ..experiments import Store, export_results
     from ..paths import input_file, output_file, writing
+    from ..policies import RUN_FILE_ENDS
 
     input_file(args.store, "--store", "results store")
     fmt = _results_format(args.format, args.out)  # before output_file makes --out's directory
     kind = "a results export (results --format json)" if fmt == "json" else None  # (a CSV export: the suffix rule alone)
     suffixes, what = (".csv", ".json"), "results are written as CSV or JSON"  # CSV over flight data, JSON over a policy (T25-02)
-    out = None if args.out is None else output_file(args.out, "--out", {"--store": args.store}, stdout=True, kind=kind, suffixes=suffixes, what=what)
+    ends = RUN_FILE_ENDS  # an export over evolve's FILE.history.csv (a CSV, no kind held_kind knows) ended the run's record
+    out = (
+        None
+        if args.out is None
+        else output_file(args.out, "--out", {"--store": args.store}, stdout=True, kind=kind, suffixes=suffixes, what=what, refused_ends=ends)
+    )
     with Store(args.store, create=False) as store:
         text = export_results(store, args.name, fmt, args.scale)
     if out is not None:
