@@ -17,7 +17,7 @@ import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real
 from .flightmeta import check_meaning, check_policy_actions, flown_policy
-from .paths import json_text, strict_json
+from .paths import json_text, refuse_suffix, strict_json
 from .sim.constants import ACTION_NAMES, EPISODE_STEPS, MAX_EPISODE_STEPS, OBS_NAMES
 
 FORMAT = "neurohover-flight-data/1"
@@ -288,9 +288,7 @@ def check_flown(observations: np.ndarray, actions: np.ndarray, crashed: bool, wh
 def check_npz_name(path: str | Path, what: str = "flight-data file") -> None:
     """Refuse a flight-data file whose name does not end .npz, naming it as ``what`` (``fly --record`` passes its
     option): 'x.txt' was written as a NumPy archive under that name (T21-09), rx.csv held one (twelfth trial, S2)."""
-    if Path(path).suffix.lower() != ".npz":
-        like = str(Path(path).with_suffix(".npz")) if Path(path).name else "flight.npz"
-        raise NeurohoverError(f"{what} {brief(str(path))} is not allowed: flight data are a NumPy archive; give a path ending .npz (e.g. {brief(like)})")
+    refuse_suffix(str(path), what, (".npz",), "flight data are a NumPy archive", "flight.npz")
 
 
 #: The metadata lists of one entry per episode: name -> (what an entry must be, what it is called).

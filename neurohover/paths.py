@@ -47,6 +47,7 @@ __all__ = [
     "output_name",
     "printable",
     "refuse_dangling_link",
+    "refuse_suffix",
     "refuse_link_loop",
     "refuse_special_file",
     "remove_created_dirs",
@@ -290,9 +291,17 @@ def output_name(path: object, option: str, suffixes: tuple[str, ...], what: str,
             f"{option} {brief(text)} is not allowed: a name ending {end} is that of a run's {(refused_ends or {})[end]}; give "
             f"a name not ending {' or '.join(refused_ends or {})}"
         )
-    if suffixes != ("",) and Path(text).suffix.lower() not in suffixes:
-        like = brief(str(Path(text).with_suffix(suffixes[0])) if Path(text).name else f"out{suffixes[0]}")
-        raise NeurohoverError(f"{option} {brief(text)} is not allowed: {what}; give a path ending {' or '.join(suffixes)} (e.g. {like})")
+    if suffixes != ("",):
+        refuse_suffix(text, option, suffixes, what, f"out{suffixes[0]}")
+
+
+def refuse_suffix(path: str, option: str, suffixes: tuple[str, ...], what: str, example: str) -> None:
+    """Refuse a file name ``path`` whose suffix (any case) is none of ``suffixes``, naming it as ``option``, saying
+    ``what`` the file is ("a model file is JSON") and the name with the first suffix (``example`` where ``path`` has no
+    file name): the one message of output names (:func:`output_name`), flight data, model and policy files."""
+    if Path(path).suffix.lower() not in suffixes:
+        like = str(Path(path).with_suffix(suffixes[0])) if Path(path).name else example
+        raise NeurohoverError(f"{option} {brief(path)} is not allowed: {what}; give a path ending {' or '.join(suffixes)} (e.g. {brief(like)})")
 
 
 def output_file(

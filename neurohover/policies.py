@@ -338,9 +338,10 @@ def check_json_policy_name(path: object, option: str) -> None:
             f"{option} {brief(text)} is not allowed: evolve --out FILE writes FILE{end} beside FILE as its run's {RUN_FILE_ENDS[end]}; "
             f"give a policy file a name ending {POLICY_SUFFIX} but not {' or '.join(RUN_FILE_ENDS)}"
         )
-    if Path(text).suffix.lower() != POLICY_SUFFIX:  # f.npz, q.txt: flight data and other files were overwritten (T24-01)
-        like = str(Path(text).with_suffix(POLICY_SUFFIX)) if Path(text).name else "policy.json"
-        raise NeurohoverError(f"{option} {brief(text)} is not allowed: a policy file is JSON; give a path ending {POLICY_SUFFIX} (e.g. {brief(like)})")
+    from .paths import refuse_suffix
+
+    # f.npz, q.txt: flight data and other files were overwritten (T24-01)
+    refuse_suffix(text, option, (POLICY_SUFFIX,), "a policy file is JSON", f"policy{POLICY_SUFFIX}")
 
 
 def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:

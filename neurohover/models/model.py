@@ -37,7 +37,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import NeurohoverError, as_floats, brief, finite_real, whole_number
-from ..paths import json_text
+from ..paths import json_text, refuse_suffix
 from ..sim.constants import CONTROL_DT, DEFAULT_NOISE_STD, DEFAULT_PARAMS, NOISE_NAMES, PARAM_NAMES, SUBSTEP_DT, SUBSTEPS
 from ..tasks import MDP, finite_vector
 from .wind import NO_WIND, WindModel
@@ -299,10 +299,8 @@ class LearnedModel:
         another suffix is refused (m.npz held JSON; T23-16); a name without one is taken. learn-model asks before it learns."""
         if not isinstance(path, (str, os.PathLike)):
             raise NeurohoverError(f"{what} {brief(path)} is not allowed: give a path (text or a Path) ending {MODEL_SUFFIX}")
-        suffix = Path(path).suffix
-        if suffix and suffix.lower() != MODEL_SUFFIX:
-            like = brief(str(Path(path).with_suffix(MODEL_SUFFIX)))
-            raise NeurohoverError(f"{what} {brief(str(path))} is not allowed: a model file is JSON; give a path ending {MODEL_SUFFIX} (e.g. {like})")
+        if Path(path).suffix:  # a name without one is taken
+            refuse_suffix(str(path), what, (MODEL_SUFFIX,), "a model file is JSON", f"model{MODEL_SUFFIX}")
         return Path(path)
 
     def save(self, path: str | Path) -> Path:
