@@ -32,7 +32,7 @@ import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real, whole_number
 from .paths import input_dir, strict_json
-from .sim.constants import MAX_EPISODE_STEPS, WORST_RETURN
+from .sim.constants import MAX_EPISODE_STEPS, MAX_SECONDS, WORST_RETURN
 from .sim.rng import MAX_SEED
 from .tasks.base import N_TRAINING
 
@@ -93,9 +93,6 @@ def _real_in(low: float, high: float) -> Callable[[object], bool]:
     return lambda value: finite_real(value) and low <= value <= high  # type: ignore[operator]
 
 
-#: The most seconds a run's timing may say, 100 years, as evolution.state_codec.MAX_SECONDS (T19-09), which this layer
-#: may not import: no run lasts longer, and 1e300 was taken (T24-07).
-MAX_SECONDS = 100 * 365.25 * 86400.0
 _SECONDS = (_real_in(0.0, math.inf), "a finite number of seconds >= 0")  # at most MAX_SECONDS: _check_seconds
 #: Every key compete writes to summary.json, in order, with its check and what it allows (None: checked against the
 #: rows, or as a condition, by the checks that say so); a key compete never writes is refused (T23-06).

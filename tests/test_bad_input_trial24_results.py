@@ -115,7 +115,7 @@ def test_what_compete_writes_of_its_seconds_is_read(real: dict[str, Path], tmp_p
 
 def test_the_agents_without_offline_work_never_have_their_update_called() -> None:
     """T24-07: each agent of NO_OFFLINE (offline seconds 0 in every run and summary) makes its first choice final, so
-    run_test never calls its update; MAX_SECONDS is the checkpoints' bound (this layer may not import it)."""
+    run_test never calls its update; MAX_SECONDS is the checkpoints' bound (one constant, sim.constants)."""
     from neurohover.agents.registry import AGENTS
     from neurohover.agents.spec import AgentOptions, AgentPolicies
     from neurohover.evolution.state_codec import MAX_SECONDS as CHECKPOINT_MAX_SECONDS

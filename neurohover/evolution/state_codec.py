@@ -13,6 +13,7 @@ from typing import Any, TypeVar, overload
 import numpy as np
 
 from ..errors import NeurohoverError, as_floats, brief, finite_real, real_number, whole_number
+from ..sim.constants import MAX_SECONDS  # re-exported: a state's bound, as every record's
 
 __all__ = [
     "STATE_DAMAGE",
@@ -201,9 +202,6 @@ def read_entry(state: dict[str, Any], kind: str, key: str, read: Callable[[Any],
 
 #: The largest count a state holds, what an int64 holds: a generation of 2**70 was taken and ended a resumed run at once (T19-08).
 MAX_COUNT = 2**63 - 1
-
-#: The most seconds a state records, 100 years: a run's clock at 1e308 seconds was taken (T19-09).
-MAX_SECONDS = 100 * 365.25 * 86400.0
 
 
 def read_count(value: Any) -> int:
