@@ -13,12 +13,9 @@ from neurohover.experiments.runner import POLICY_SOURCES, unchanged_units
 from neurohover.experiments.store import Store
 
 #: Paper-scale experiments whose config changed on purpose and whose re-run (`reproduce NAME --scale paper
-#: --update`) is under way: the model-substeps default of 2026-12-04 (issue 31; docs/reproduction/README.md).
-#: Each must still be taken by --update (its unchanged units kept). Emptied as the store receives the re-runs.
-AWAITING_RERUN = {
-    "table4", "fig7", "fig8", "fig11", "ablation-hybrid", "lr-substeps-fig8", "wind-fig7", "wind-fig8", "wind-fig11", "risk-ghh09",
-    "bench-sensors", "bench-sensors-fallback", "bench-sensor-models", "bench-drift", "bench-drift-armed",
-}  # fmt: skip
+#: --update`) is under way; each must still be taken by --update (its unchanged units kept). Emptied as the
+#: store receives the re-runs: the model-substeps re-runs of issue 31 all landed by 2026-12-06.
+AWAITING_RERUN: set[str] = set()
 
 
 def test_every_stored_experiment_is_planned_again_with_its_stored_params(committed_store: Path) -> None:
