@@ -70,6 +70,10 @@ class FlightData:
 
     ``==`` compares recordings: the same episodes (each array's shape, dtype and values, NaN equal to NaN) and
     equal metadata. Flight data are unhashable (they hold arrays), as a list is.
+
+    ``metadata`` is free-form JSON: the keys ``fly --record`` writes (task, mdps, seed, returns, crashed,
+    episode_steps, policy, policy_flown, ...) are checked against the episodes and each other wherever present; any
+    other key is the user's own note, kept as given (a documented choice: a misspelt key is kept, not refused).
     """
 
     observations: tuple[np.ndarray, ...]

@@ -362,7 +362,7 @@ def _place_problem(meta: dict) -> str:
     """A record's task, mdp (what evolve's --mdp or --wind/--params named), target (the label of the MDP or family the
     run evolved on) and mdp_params (that MDP) against each other ('' when they agree; T24-02). mdp_params is checked
     as flight data's MDPs are against their labels (:func:`neurohover.flightmeta.held_problem`); a run over a family has
-    none of its own (one seeded from a policy file may keep the seed's, which is not read)."""
+    none (a champion no longer copies its seed policy's record, T25-12)."""
     task, mdp = meta.get("task"), meta.get("mdp")
     target: Any = meta.get("target")
     if "mdp" in meta and not isinstance(mdp, str):
@@ -378,8 +378,10 @@ def _place_problem(meta: dict) -> str:
         )
         if not agrees:
             return f"its mdp {brief(mdp)} is not allowed beside its target {brief(target)}: the run was evolved on {target.partition('/')[2]!r}"
-    if "mdp_params" not in meta or over_family:
+    if "mdp_params" not in meta:
         return ""
+    if over_family:
+        return f"its mdp_params {brief(meta['mdp_params'])} is not allowed beside its target {brief(target)}: a run over a family evolves on no one MDP"
     return _mdp_params_problem(meta["mdp_params"], task, target)
 
 
@@ -505,8 +507,7 @@ def _fields_problem(meta: dict) -> str:
             family = get_task_family(task) if isinstance(task, str) else None
         except NeurohoverError:  # no task's name: left to the place checks
             family = None
-        carried = meta.get("seed_policy") not in (None, "zero", "baseline")  # a champion keeps its seed file's keys, an FGHH seed's sigma
-        if family is not None and not family.has_sigma and not carried:
+        if family is not None and not family.has_sigma:  # a seeded champion no longer carries its seed's sigma (T25-12)
             return f"its sigma {brief(sigma)} is not allowed beside its task {brief(task)}: {task}'s MDPs have no breadth (sigma is FGHH's)"
         said = re.fullmatch(r"[a-z0-9]+/G\(sigma=([^()]*)\)", target) if isinstance(target, str) else None
         if said is not None and f"{float(sigma):g}" != said.group(1):

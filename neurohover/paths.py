@@ -43,6 +43,7 @@ __all__ = [
     "make_dirs",
     "output_dir",
     "held_kind",
+    "CSV_KINDS",
     "output_file",
     "output_name",
     "printable",
@@ -247,12 +248,20 @@ JSON_KINDS: dict[str, Callable[[dict], bool]] = {
     "evaluate-agent rows (--json)": lambda d: {"rows", "n_mdps", "episode_steps"} <= d.keys(),
     "a results export (results --format json)": lambda d: {"experiment", "config_hash", "units"} <= d.keys(),
 }
+#: The neurohover CSV files an output can be told apart by (what it is called -> the cells its header starts with):
+#: a results export over compete's episodes.csv replaced the competition's episodes (T25-12's CSV leftover). Tested
+#: against the columns compete, evolve and results write.
+CSV_KINDS: dict[str, tuple[str, ...]] = {
+    "a competition's episodes (episodes.csv)": ("run", "mdp", "episode", "return"),
+    "an evolution history (.history.csv)": ("generation", "evaluations", "episodes", "generation_episodes", "champion_return"),
+    "a results export (results --format csv)": ("experiment", "scale", "key", "kind"),
+}
 _KIND_READ_LIMIT = 64 * 2**20  # a larger file is no neurohover JSON file told apart here
 
 
 def held_kind(path: str | os.PathLike) -> str | None:
     """What neurohover file the existing regular file ``path`` is, in words (``"a policy file"``), read from its
-    content: a results store (SQLite), flight data (a NumPy archive), one of :data:`JSON_KINDS`; None for anything
+    content: a results store (SQLite), flight data (a NumPy archive), one of :data:`JSON_KINDS` or :data:`CSV_KINDS`; None for anything
     else (no such file, unreadable, another file). The one test of "which kind of neurohover file is this" that
     :func:`output_file` refuses to write another kind over."""
     p = Path(path)
@@ -268,7 +277,8 @@ def held_kind(path: str | os.PathLike) -> str | None:
     if body.startswith(b"PK\x03\x04"):  # a zip: a NumPy archive (.npz) holds its arrays as NAME.npy
         return "flight data (a NumPy archive)" if b"format.npy" in body else None
     if not body.lstrip()[:1] == b"{":
-        return None
+        header = body.split(b"\n", 1)[0].rstrip(b"\r").split(b",")
+        return next((kind for kind, start in CSV_KINDS.items() if [c.decode("latin-1") for c in header[: len(start)]] == list(start)), None)
     try:
         value = json.loads(body)
     except (ValueError, RecursionError):

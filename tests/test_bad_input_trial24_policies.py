@@ -26,8 +26,8 @@ EVOLVE = ("evolve", "--task", "ghh08", "--budget", "10", "--episode-steps", "20"
 @pytest.fixture(scope="module")
 def written(tmp_path_factory) -> Path:
     """Evolve outputs the trial-23 test does not write: on train:0 (as the trial wrote it: 50-step episodes, 2 validation
-    episodes), on an MDP set by --wind, on a sampled MDP, and over G from a seed policy evolved on train:0 (which keeps the
-    seed's mdp_params)."""
+    episodes), on an MDP set by --wind, on a sampled MDP, and over G from a seed policy evolved on train:0 (which no longer
+    copies the seed's mdp_params, T25-12)."""
     from neurohover.cli import main
 
     where = tmp_path_factory.mktemp("written24")
@@ -46,7 +46,16 @@ def written(tmp_path_factory) -> Path:
 def test_the_files_evolve_writes_still_load(written: Path) -> None:
     for name in ("p", "wind", "sample", "seeded"):
         assert policy_record_problem(nh.load_policy(written / f"{name}.json").metadata) == "", name
-    assert nh.load_policy(written / "seeded.json").metadata["mdp_params"]["label"] == "ghh08/train:0"  # the seed's, not read
+    assert "mdp_params" not in nh.load_policy(written / "seeded.json").metadata  # the seed's MDP is not the run's (T25-12)
+
+
+def test_a_run_over_a_family_records_no_mdp_params(written: Path, tmp_path: Path) -> None:
+    """T25-12: a champion over G copied its seed's mdp_params, so the check let them through beside a family target."""
+    data = json.loads((written / "seeded.json").read_text())
+    data["mdp_params"] = json.loads((written / "p.json").read_text())["mdp_params"]
+    (tmp_path / "s.json").write_text(json.dumps(data))
+    with pytest.raises(NeurohoverError, match=r"its mdp_params .* is not allowed beside its target 'ghh08/G': a run over a family evolves on no one MDP"):
+        nh.load_policy(tmp_path / "s.json")
 
 
 @pytest.mark.parametrize(

@@ -30,7 +30,7 @@ SHORT = ("--budget", "10", "--episode-steps", "20", "--validation-episodes", "1"
 @pytest.fixture(scope="module")
 def written(tmp_path_factory) -> Path:
     """Evolve outputs as the trial wrote them: steady state on ghh08/zero, on ghh08 through a noisy late sensor (which
-    records its sensor), over FGHH's G (which records its sigma) and on ghh08 seeded from that (which keeps its sigma)."""
+    records its sensor), over FGHH's G (which records its sigma) and on ghh08 seeded from that (whose record is its own)."""
     from neurohover.cli import main
 
     where = tmp_path_factory.mktemp("written25")
@@ -38,7 +38,7 @@ def written(tmp_path_factory) -> Path:
         "p": [],
         "noisy": ["--obs-noise", "0.3", "--obs-delay", "1"],
         "fghh": ["--task", "fghh", "--mdp", "G", "--setting", "pop_size=5", "--setting", "select_size=2"],
-        "seeded": ["--topology", "slp", "--seed-policy", str(where / "fghh.json")],  # keeps its FGHH seed's sigma
+        "seeded": ["--topology", "slp", "--seed-policy", str(where / "fghh.json")],  # its FGHH seed's record not carried
     }
     for name, extra in runs.items():
         task = [] if "--task" in extra else ["--task", "ghh08"]
@@ -69,7 +69,16 @@ def test_the_files_evolve_writes_still_load(written: Path) -> None:
         assert policy_record_problem(nh.load_policy(written / f"{name}.json").metadata) == "", name
     assert nh.load_policy(written / "noisy.json").metadata["sensor"]["delay"] == 1
     assert nh.load_policy(written / "fghh.json").metadata["sigma"] == 0.3
-    assert nh.load_policy(written / "seeded.json").metadata["sigma"] == 0.3  # the seed's, carried (not the run's, which has none)
+
+
+def test_a_seeded_champion_records_its_own_run_not_its_seeds(written: Path, tmp_path: Path) -> None:
+    """T25-12's writer bug: a champion copied its seed policy's whole record (its sigma, target, validation figures), so
+    a ghh08 run seeded from an FGHH generic said sigma 0.3, and the sigma check had to let seeded files through."""
+    seed, seeded = (nh.load_policy(written / f"{n}.json").metadata for n in ("fghh", "seeded"))
+    assert "sigma" not in seeded and seeded["target"] == "ghh08/zero" and seeded["seed_policy"] == str(written / "fghh.json")
+    assert seeded["prototype"] == seed["prototype"] in ("zero", "baseline")  # where the lineage started is carried on, and only that
+    assert seeded.keys() <= nh.load_policy(written / "p.json").metadata.keys() | {"seed_policy"}
+    refused(edited(written / "seeded.json", tmp_path / "s.json", sigma=0.3), "its sigma 0.3 is not allowed beside its task 'ghh08'")
 
 
 @pytest.mark.parametrize(

@@ -132,9 +132,9 @@ def cmd_results(args: argparse.Namespace) -> int:
 
     input_file(args.store, "--store", "results store")
     fmt = _results_format(args.format, args.out)  # before output_file makes --out's directory
-    kind = "a results export (results --format json)" if fmt == "json" else None  # (a CSV export: the suffix rule alone)
+    kind = f"a results export (results --format {fmt})"  # never over another kind's file: compete's episodes.csv (T25-12)
     suffixes, what = (".csv", ".json"), "results are written as CSV or JSON"  # CSV over flight data, JSON over a policy (T25-02)
-    ends = RUN_FILE_ENDS  # an export over evolve's FILE.history.csv (a CSV, no kind held_kind knows) ended the run's record
+    ends = RUN_FILE_ENDS  # an export over evolve's FILE.history.csv ended the run's record (refused by name before any is written)
     out = (
         None
         if args.out is None

@@ -445,7 +445,10 @@ class Run:
             "n_steps": cfg.n_steps,
             "stop_reason": self.stop_reason,
         }
-        champion = Policy(cfg.topology, np.array(genome, dtype=float), {**cfg.prototype.metadata, **meta})
+        # The champion records this run alone: a seed policy's own record (its sigma, MDP, validation) is another run's
+        # (T25-12); only where the lineage started, its "prototype" (zero or baseline), is carried on.
+        start = {"prototype": cfg.prototype.metadata["prototype"]} if "prototype" in cfg.prototype.metadata else {}
+        champion = Policy(cfg.topology, np.array(genome, dtype=float), {**start, **meta})
         return EvolutionResult(
             champion,
             ret,
