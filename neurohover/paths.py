@@ -49,6 +49,8 @@ __all__ = [
     "printable",
     "refuse_dangling_link",
     "refuse_suffix",
+    "refuse_run_file_name",
+    "RUN_FILE_ENDS",
     "refuse_link_loop",
     "refuse_special_file",
     "remove_created_dirs",
@@ -286,21 +288,33 @@ def held_kind(path: str | os.PathLike) -> str | None:
     return next((kind for kind, test in JSON_KINDS.items() if isinstance(value, dict) and test(value)), None)
 
 
-def output_name(path: object, option: str, suffixes: tuple[str, ...], what: str, refused_ends: Mapping[str, str] | None = None) -> None:
+#: The ends of the names of what ``neurohover evolve --out FILE`` writes beside FILE (end -> what that file is): no other
+#: output is written under them (a policy, a model or an export over another run's checkpoint or history; T24-01, T25-03).
+RUN_FILE_ENDS = {".checkpoint.json": "checkpoint (which --resume continues)", ".history.csv": "history (one line per new champion or generation)"}
+
+
+def refuse_run_file_name(path: str, option: str) -> None:
+    """Refuse a name ``path`` ending (any case) one of :data:`RUN_FILE_ENDS`, naming it as ``option``: the one message
+    of every output that may not replace an evolve run's checkpoint or history."""
+    end = next((end for end in RUN_FILE_ENDS if path.lower().endswith(end)), None)
+    if end is not None:
+        raise NeurohoverError(
+            f"{option} {brief(path)} is not allowed: evolve --out FILE writes FILE{end} beside FILE as its run's {RUN_FILE_ENDS[end]}; "
+            f"give a name not ending {' or '.join(RUN_FILE_ENDS)}"
+        )
+
+
+def output_name(path: object, option: str, suffixes: tuple[str, ...], what: str, run_files: bool = False) -> None:
     """Refuse a name ``path`` whose suffix (any case) is none of ``suffixes``, naming ``option`` and ``what`` the output
-    is ("evaluate-agent's rows are JSON"), and a name ending one of ``refused_ends`` (end -> whose file that is: evolve's
-    FILE.checkpoint.json, :data:`neurohover.policies.RUN_FILE_ENDS`); what is no path is :func:`output_file`'s to refuse.
-    evaluate-agent --json f.npz wrote JSON over flight data (T25-01), results --out f.npz CSV (T25-02), learn-model --out
-    P.checkpoint.json a model over evolve's checkpoint (T25-03)."""
+    is ("evaluate-agent's rows are JSON"), and (``run_files``) a name of an evolve run's own files
+    (:func:`refuse_run_file_name`); what is no path is :func:`output_file`'s to refuse. evaluate-agent --json f.npz wrote
+    JSON over flight data (T25-01), results --out f.npz CSV (T25-02), learn-model --out P.checkpoint.json a model over
+    evolve's checkpoint (T25-03)."""
     text = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None
     if not isinstance(text, str) or text in ("", "-") or text.endswith(("/", os.sep)) or Path(text).is_dir():
         return
-    end = next((end for end in refused_ends or {} if text.lower().endswith(end)), None)
-    if end is not None:
-        raise NeurohoverError(
-            f"{option} {brief(text)} is not allowed: a name ending {end} is that of a run's {(refused_ends or {})[end]}; give "
-            f"a name not ending {' or '.join(refused_ends or {})}"
-        )
+    if run_files:
+        refuse_run_file_name(text, option)
     if suffixes != ("",):
         refuse_suffix(text, option, suffixes, what, f"out{suffixes[0]}")
 
@@ -324,7 +338,7 @@ def output_file(
     kind: str | None = None,
     suffixes: tuple[str, ...] = (),
     what: str = "",
-    refused_ends: Mapping[str, str] | None = None,
+    run_files: bool = False,
 ) -> Path:
     """Check that the file ``path`` can be written (an existing file is kept as it is).
 
@@ -334,7 +348,7 @@ def output_file(
     destroy what the command reads) and, unless ``store`` (the path is a results store's own), an existing results
     store; given the ``kind`` of file written (one of :data:`JSON_KINDS`' names), an existing neurohover file of
     another kind (:func:`held_kind`; T25-01 to T25-03), and a name of a suffix not in ``suffixes`` (``what`` says why) or
-    ending one of ``refused_ends`` (:func:`output_name`);
+    (``run_files``) an evolve run's own file names (:func:`output_name`);
     creates missing parent directories (saying so on standard error).
     """
     _no_dash(path, option, "file", stdout)
@@ -355,8 +369,8 @@ def output_file(
     if os.fspath(path).endswith(("/", os.sep)):  # Path() drops the slash: 'x.json/' was written as the file x.json (seventh trial)
         raise NeurohoverError(f"{option} {str(path)!r} ends in '/', which names a directory: give a file path")
     refuse_special_file(p, option, path)
-    if suffixes or refused_ends:  # flight data, a checkpoint replaced by JSON rows, CSV or a model (T25-01 to T25-03)
-        output_name(path, option, suffixes or ("",), what, refused_ends)
+    if suffixes or run_files:  # flight data, a checkpoint replaced by JSON rows, CSV or a model (T25-01 to T25-03)
+        output_name(path, option, suffixes or ("",), what, run_files)
     held = None if kind is None else held_kind(p)
     if held is not None and held != kind:  # a policy, a checkpoint, a summary replaced by another kind of file (T25-01 to T25-03)
         raise NeurohoverError(f"{option} {brief(os.fspath(path))} is {held}: give another path (writing {kind} there would destroy it)")

@@ -305,8 +305,6 @@ def utf8_text(data: bytes, name: str, what: str) -> str:
 
 #: A policy file's suffix (in any case: P.JSON is taken, as model files and flight data take theirs).
 POLICY_SUFFIX = ".json"
-#: The ends of the names of what ``neurohover evolve --out FILE`` writes beside FILE: FILE.checkpoint.json, FILE.history.csv.
-RUN_FILE_ENDS = {".checkpoint.json": "checkpoint (which --resume continues)", ".history.csv": "history (one line per new champion or generation)"}
 
 
 def check_json_policy_name(path: object, option: str) -> None:
@@ -332,14 +330,9 @@ def check_json_policy_name(path: object, option: str) -> None:
             f"{option} {text!r}: a policy is written as JSON, which load_policy would misread under the .net suffix "
             "(the authors' format); give a .json name, or write the authors' format with netfile.policy_to_net"
         )
-    end = next((end for end in RUN_FILE_ENDS if text.lower().endswith(end)), None)
-    if end is not None:  # another run's checkpoint or history was overwritten by a policy (T24-01)
-        raise NeurohoverError(
-            f"{option} {brief(text)} is not allowed: evolve --out FILE writes FILE{end} beside FILE as its run's {RUN_FILE_ENDS[end]}; "
-            f"give a policy file a name ending {POLICY_SUFFIX} but not {' or '.join(RUN_FILE_ENDS)}"
-        )
-    from .paths import refuse_suffix
+    from .paths import refuse_run_file_name, refuse_suffix
 
+    refuse_run_file_name(text, option)  # another run's checkpoint or history was overwritten by a policy (T24-01)
     # f.npz, q.txt: flight data and other files were overwritten (T24-01)
     refuse_suffix(text, option, (POLICY_SUFFIX,), "a policy file is JSON", f"policy{POLICY_SUFFIX}")
 

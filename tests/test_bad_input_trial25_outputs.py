@@ -57,9 +57,9 @@ def test_learn_model_out_refuses_a_checkpoint_name_and_a_policy(tmp_path, cli) -
     assert rc == 0, err
     base = ["learn-model", "--flight-data", str(data), "--method", "lr", "--out"]
     rc, _, err = cli(*base, str(tmp_path / "p.json.checkpoint.json"))
-    assert rc == 2 and "is not allowed: a name ending .checkpoint.json is that of a run's checkpoint" in err, err
+    assert rc == 2 and "is not allowed: evolve --out FILE writes FILE.checkpoint.json beside FILE as its run's checkpoint" in err, err
     rc, _, err = cli(*base, str(tmp_path / "p.json.history.csv"))
-    assert rc == 2 and "a name ending .history.csv" in err, err
+    assert rc == 2 and "FILE.history.csv beside FILE" in err, err
     pol = tmp_path / "p.json"
     pol.write_text(json.dumps(POLICY))
     rc, _, err = cli(*base, str(pol))
@@ -80,5 +80,5 @@ def test_results_out_refuses_an_evolve_runs_history_name(tmp_path, cli, tiny_sto
     history = tmp_path / "p.json.history.csv"
     history.write_text("episodes,champion_return\n50,-300.0\n")
     rc, _, err = cli("results", "tr1", "--store", str(tiny_store), "--out", str(history))
-    assert rc == 2 and "is not allowed: a name ending .history.csv is that of a run's history" in err, err
+    assert rc == 2 and "is not allowed: evolve --out FILE writes FILE.history.csv beside FILE as its run's history" in err, err
     assert history.read_text() == "episodes,champion_return\n50,-300.0\n"

@@ -319,7 +319,6 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     from ..agents.model_based import ModelEvolution
     from ..flightdata import FlightData
     from ..models import DEFAULT_NOISE_ESTIMATE, LearnedModel, ec_mer_policy, format_parameter_table, learn_ec_meno, learn_ec_mer, learn_lr, parameter_table
-    from ..policies import RUN_FILE_ENDS
     from .options import check_given, given_settings
 
     if args.budget is not None and not 1 <= args.budget <= MAX_BUDGET:
@@ -348,7 +347,7 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
         raise NeurohoverError(f"--policy applies to --method ec-mer only (the policy that flew the data), not to --method {args.method}")
     data = FlightData.load(input_file(args.flight_data, "--flight-data", "flight-data file"))
     inputs = {"--flight-data": args.flight_data, "--policy": args.policy}
-    out = LearnedModel.check_name(output_file(args.out, "--out", inputs, kind="a model file", refused_ends=RUN_FILE_ENDS), "--out")  # T23-16, T25-03
+    out = LearnedModel.check_name(output_file(args.out, "--out", inputs, kind="a model file", run_files=True), "--out")  # T23-16, T25-03
     start = time.perf_counter()
     extra = {} if args.budget is None else {"budget": args.budget}
     with _Ticker(f"learning a {args.method} model from {data.n_episodes} episodes ({data.n_transitions} steps)"):

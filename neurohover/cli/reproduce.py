@@ -128,17 +128,15 @@ def cmd_results(args: argparse.Namespace) -> int:
     """Export an experiment's finished units from the results store as CSV or JSON."""
     from ..experiments import Store, export_results
     from ..paths import input_file, output_file, writing
-    from ..policies import RUN_FILE_ENDS
 
     input_file(args.store, "--store", "results store")
     fmt = _results_format(args.format, args.out)  # before output_file makes --out's directory
     kind = f"a results export (results --format {fmt})"  # never over another kind's file: compete's episodes.csv (T25-12)
     suffixes, what = (".csv", ".json"), "results are written as CSV or JSON"  # CSV over flight data, JSON over a policy (T25-02)
-    ends = RUN_FILE_ENDS  # an export over evolve's FILE.history.csv ended the run's record (refused by name before any is written)
     out = (
         None
         if args.out is None
-        else output_file(args.out, "--out", {"--store": args.store}, stdout=True, kind=kind, suffixes=suffixes, what=what, refused_ends=ends)
+        else output_file(args.out, "--out", {"--store": args.store}, stdout=True, kind=kind, suffixes=suffixes, what=what, run_files=True)
     )
     with Store(args.store, create=False) as store:
         text = export_results(store, args.name, fmt, args.scale)
