@@ -250,13 +250,13 @@ JSON_KINDS: dict[str, Callable[[dict], bool]] = {
     "evaluate-agent rows (--json)": lambda d: {"rows", "n_mdps", "episode_steps"} <= d.keys(),
     "a results export (results --format json)": lambda d: {"experiment", "config_hash", "units"} <= d.keys(),
 }
-#: The neurohover CSV files an output can be told apart by (what it is called -> the cells its header starts with):
-#: a results export over compete's episodes.csv replaced the competition's episodes (T25-12's CSV leftover). Tested
-#: against the columns compete, evolve and results write.
-CSV_KINDS: dict[str, tuple[str, ...]] = {
-    "a competition's episodes (episodes.csv)": ("run", "mdp", "episode", "return"),
-    "an evolution history (.history.csv)": ("generation", "evaluations", "episodes", "generation_episodes", "champion_return"),
-    "a results export (results --format csv)": ("experiment", "scale", "key", "kind"),
+#: The neurohover CSV files an output can be told apart by (what it is called -> the cells its header holds, in any
+#: order): a results export over compete's episodes.csv replaced the competition's episodes (T25-12's CSV leftover).
+#: Tested against the columns compete (older files too: run, episode, return), evolve and results write.
+CSV_KINDS: dict[str, frozenset[str]] = {
+    "a competition's episodes (episodes.csv)": frozenset({"run", "episode", "return"}),
+    "an evolution history (.history.csv)": frozenset({"generation", "evaluations", "episodes", "champion_return"}),
+    "a results export (results --format csv)": frozenset({"experiment", "scale", "key", "kind"}),
 }
 _KIND_READ_LIMIT = 64 * 2**20  # a larger file is no neurohover JSON file told apart here
 
@@ -279,8 +279,8 @@ def held_kind(path: str | os.PathLike) -> str | None:
     if body.startswith(b"PK\x03\x04"):  # a zip: a NumPy archive (.npz) holds its arrays as NAME.npy
         return "flight data (a NumPy archive)" if b"format.npy" in body else None
     if not body.lstrip()[:1] == b"{":
-        header = body.split(b"\n", 1)[0].rstrip(b"\r").split(b",")
-        return next((kind for kind, start in CSV_KINDS.items() if [c.decode("latin-1") for c in header[: len(start)]] == list(start)), None)
+        header = {c.decode("latin-1") for c in body.split(b"\n", 1)[0].rstrip(b"\r").split(b",")}
+        return next((kind for kind, cells in CSV_KINDS.items() if cells <= header), None)
     try:
         value = json.loads(body)
     except (ValueError, RecursionError):

@@ -12,7 +12,7 @@ import pytest
 from conftest import CliRun, tiny_test_runs
 
 from neurohover.compete import compete
-from neurohover.compete_files import CSV_COLUMNS
+from neurohover.compete_files import COMPETE_COLUMNS, CSV_COLUMNS
 from neurohover.evolution.records import HISTORY_COLUMNS, HistoryRecord, write_history_csv
 from neurohover.paths import CSV_KINDS, held_kind
 
@@ -33,14 +33,22 @@ def written(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
 
 
 def test_each_csv_neurohover_writes_is_told_apart_by_its_header(written: dict[str, Path]) -> None:
-    assert CSV_COLUMNS[:4] == CSV_KINDS["a competition's episodes (episodes.csv)"]
-    assert HISTORY_COLUMNS[:5] == CSV_KINDS["an evolution history (.history.csv)"]
+    assert CSV_KINDS["a competition's episodes (episodes.csv)"] == set(COMPETE_COLUMNS) < set(CSV_COLUMNS)  # older files too
+    assert CSV_KINDS["an evolution history (.history.csv)"] < set(HISTORY_COLUMNS)
+    assert all(not a <= b for a in CSV_KINDS.values() for b in CSV_KINDS.values() if a is not b)  # no kind's cells hold another's
     kinds = {name: held_kind(written[name]) for name in ("episodes", "history", "export")}
     assert kinds == {
         "episodes": "a competition's episodes (episodes.csv)",
         "history": "an evolution history (.history.csv)",
         "export": "a results export (results --format csv)",
     }
+
+
+def test_an_older_competitions_episodes_are_told_apart_too(tmp_path: Path) -> None:
+    (tmp_path / "episodes.csv").write_text("run,episode,return\n0,0,-5.0\n")
+    assert held_kind(tmp_path / "episodes.csv") == "a competition's episodes (episodes.csv)"
+    (tmp_path / "other.csv").write_text("run,score\n0,1\n")
+    assert held_kind(tmp_path / "other.csv") is None
 
 
 def test_a_results_export_replaces_an_export_but_not_a_competitions_episodes(written: dict[str, Path], cli: CliRun) -> None:
