@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError, as_floats, brief, finite_real, whole_in, whole_number
+from .errors import NeurohoverError, as_floats, brief, finite_real, real_number, whole_in, whole_number
 from .flightdata import FlightData, same_values
 from .flyer import KernelFlyer
 from .launch import DEVICES, KIND, MAX_SEED, Batch, Flown, check_device, launch, num_threads, use_lanes
@@ -120,9 +120,10 @@ class PolicyTable:
             policies = [policies]
         if not isinstance(policies, Sequence) or isinstance(policies, str) or len(policies) == 0:
             raise NeurohoverError(f"policies={policies!r:.60} is not allowed: give a non-empty sequence of Policy objects")
-        bad = next((p for p in policies if not isinstance(p, Policy)), None)
-        if bad is not None:  # 'baseline' was an AttributeError (second trial)
-            raise NeurohoverError(f"policy {bad!r:.60} is not a Policy: load one with neurohover.load_policy (e.g. load_policy('baseline'))")
+        # 'baseline' was an AttributeError (second trial); None too, read as the 'nothing found' default (T26-B01)
+        bad = [p for p in policies if not isinstance(p, Policy)]
+        if bad:
+            raise NeurohoverError(f"policy {bad[0]!r:.60} is not a Policy: load one with neurohover.load_policy (e.g. load_policy('baseline'))")
         kinds = np.array([KIND[p.topology] for p in policies], dtype=np.int64)
         genomes = np.zeros((len(policies), GENOME_WIDTH))
         for i, p in enumerate(policies):
@@ -186,6 +187,31 @@ class Evaluation:
     seconds: float = field(compare=False)  # wall-clock, not part of the outcome
 
     __hash__ = None  # type: ignore[assignment]  # mutable arrays: the generated hash was a TypeError on ndarray (tenth trial)
+
+    def __post_init__(self) -> None:
+        """Checked as evaluate() builds it: text returns were an AttributeError later, arrays of other shapes NumPy's
+        ValueError in reshape(), flight_data='x' and seconds=nan taken (T26-B02)."""
+        kinds = {"returns": ("fiu", "real numbers"), "crashed": ("b", "True/False flags"), "steps": ("iu", "integers"), "safeguard_step": ("iu", "integers")}
+        for name, (allowed, what) in kinds.items():
+            value = getattr(self, name)
+            if not isinstance(value, np.ndarray) or isinstance(value, np.ma.MaskedArray) or value.dtype.kind not in allowed:
+                raise NeurohoverError(f"Evaluation {name}={brief(value)} is not allowed: give a NumPy array of {what}, one per episode")
+            if value.shape != self.returns.shape:
+                raise NeurohoverError(f"Evaluation {name} has shape {value.shape}, returns {self.returns.shape}: give one entry per episode in each")
+        steps, fired = self.steps, self.safeguard_step
+        if steps.size and (steps.min() < 1 or steps.max() > MAX_EPISODE_STEPS):
+            raise NeurohoverError(f"Evaluation steps holds {brief(int(steps.min() if steps.min() < 1 else steps.max()))}: allowed 1..{MAX_EPISODE_STEPS:,}")
+        bad = np.flatnonzero((fired < -1) | (fired >= steps))
+        if bad.size:
+            i = np.unravel_index(bad[0], fired.shape)
+            raise NeurohoverError(f"Evaluation safeguard_step {int(fired[i])} of a {int(steps[i])}-step episode is not allowed: give -1 (never) or 0..steps-1")
+        if not (self.flight_data is None or isinstance(self.flight_data, FlightData)):
+            raise NeurohoverError(f"Evaluation flight_data={brief(self.flight_data)} is not allowed: give FlightData or None")
+        if self.flight_data is not None and self.flight_data.n_episodes > self.returns.size:
+            raise NeurohoverError(f"Evaluation flight_data holds {self.flight_data.n_episodes} episodes, more than the {self.returns.size} flown")
+        if not (finite_real(self.seconds) and self.seconds >= 0):
+            raise NeurohoverError(f"Evaluation seconds={brief(self.seconds)} is not allowed: give a finite number >= 0 (wall time)")
+        object.__setattr__(self, "seconds", float(self.seconds))
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Evaluation):
@@ -299,10 +325,14 @@ def _fallback_array(fallback_index, n_jobs: int, n_policies: int) -> np.ndarray:
     masked = isinstance(fallback_index, np.ma.MaskedArray)  # np.asarray dropped the mask (T16-9)
     if (fb.dtype.kind not in "iu" and fb.size) or masked:  # ["x"] was NumPy's ValueError (fifth trial); 1.5 was cut to 1
         raise NeurohoverError(f"fallback_index={fallback_index!r:.60} is not allowed: give {n_jobs} integers in -1..{n_policies - 1}")
-    fb = fb.astype(np.int64).reshape(-1)
-    if fb.shape[0] != n_jobs or (fb.size and (fb.min() < -1 or fb.max() >= n_policies)):
-        raise NeurohoverError(f"fallback_index must have {n_jobs} entries in -1..{n_policies - 1}")
-    return fb
+    if fb.size != n_jobs:  # T26-B17: the length and the bad entry were not named
+        raise NeurohoverError(f"fallback_index has {fb.size} entries but there are {n_jobs} jobs: give one per job, each in -1..{n_policies - 1}")
+    bad = np.flatnonzero((fb < -1) | (fb >= n_policies))
+    if bad.size:
+        raise NeurohoverError(
+            f"fallback_index entry {bad[0]} is {brief(fb.reshape(-1)[bad[0]].item())}, out of range: allowed -1 (none) or 0..{n_policies - 1}"
+        )
+    return fb.astype(np.int64).reshape(-1)
 
 
 def check_episode_count(n: int, what: str) -> None:
@@ -515,13 +545,18 @@ class DangerousState:
     def __post_init__(self) -> None:
         if not isinstance(self.rule, str) or self.rule not in SAFEGUARD_RULES:  # an array: NumPy's "truth value is ambiguous" (T16-12)
             raise NeurohoverError(f"unknown safeguard rule {brief(self.rule)}: allowed {', '.join(SAFEGUARD_RULES)}")
-        # finite_real/whole_number: 10**400 was a TypeError, True taken as 1, np.float32(0.5) refused (T15-2, T15-17)
-        if not (finite_real(self.box) and self.box > 0):
-            raise NeurohoverError(f"safeguard box={brief(self.box)} is out of range: allowed a finite number > 0")
-        if not (finite_real(self.tilt) and 0 < self.tilt <= 1):
-            raise NeurohoverError(f"safeguard tilt={brief(self.tilt)} is out of range: allowed 0 < tilt <= 1 (qw threshold)")
-        if not (finite_real(self.threshold) and self.threshold > 0):
-            raise NeurohoverError(f"safeguard threshold={brief(self.threshold)} is out of range: allowed a finite number > 0")
+        # finite_real/whole_number: 10**400 was a TypeError, True taken as 1, np.float32(0.5) refused (T15-2, T15-17);
+        # a non-number (box='1', True) "is not allowed", a number outside the range "is out of range" (T26-B17)
+        for name, ok, allowed, give in (
+            ("box", lambda v: v > 0, "a finite number > 0", "a number > 0"),
+            ("tilt", lambda v: 0 < v <= 1, "0 < tilt <= 1 (qw threshold)", "a number with 0 < tilt <= 1 (qw threshold)"),
+            ("threshold", lambda v: v > 0, "a finite number > 0", "a number > 0"),
+        ):
+            value = getattr(self, name)
+            if not real_number(value):
+                raise NeurohoverError(f"safeguard {name}={brief(value)} is not allowed: give {give}")
+            if not (finite_real(value) and ok(value)):
+                raise NeurohoverError(f"safeguard {name}={brief(value)} is out of range: allowed {allowed}")
         whole_in(self.arm_after, "safeguard arm_after", 0, 10**6, "1000000 (control steps)")
         for name in ("box", "tilt", "threshold"):  # plain Python numbers: the repr and equality of the Python values
             object.__setattr__(self, name, float(getattr(self, name)))

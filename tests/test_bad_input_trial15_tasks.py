@@ -24,9 +24,9 @@ def test_a_safeguard_box_past_a_floats_range_is_refused_by_name() -> None:
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"box": True}, "safeguard box=True is out of range: allowed a finite number > 0"),
-        ({"tilt": True}, "safeguard tilt=True is out of range: allowed 0 < tilt <= 1"),
-        ({"rule": "ratio-sum", "threshold": True}, "safeguard threshold=True is out of range: allowed a finite number > 0"),
+        ({"box": True}, "safeguard box=True is not allowed: give a number > 0"),
+        ({"tilt": True}, "safeguard tilt=True is not allowed: give a number with 0 < tilt <= 1"),
+        ({"rule": "ratio-sum", "threshold": True}, "safeguard threshold=True is not allowed: give a number > 0"),
         ({"arm_after": True}, "safeguard arm_after=True is not allowed: allowed an integer in 0..1000000"),
     ],
 )

@@ -38,7 +38,7 @@ def _flight() -> object:
 #: Per argument: the call with value v, the start of its message for v (given the shown value), and a good value.
 CASES: dict[str, tuple[Callable[[object], object], str, object]] = {
     "get_task_family name": (lambda v: nh.get_task_family(v), "unknown task {}", "ghh08"),
-    "get_task_family sigma": (lambda v: nh.get_task_family("fghh", sigma=v), "sigma={} is not allowed", 0.5),
+    "get_task_family sigma": (lambda v: nh.get_task_family("fghh", sigma=v), "FGHH sigma={} is not allowed", 0.5),
     "make_agent name": (lambda v: make_agent(v, FAMILY), "unknown agent {}", "baseline"),
     "evaluate episodes": (lambda v: evaluate(POLICY, MDP, episodes=v, n_steps=5), "episodes={} is not allowed", 1),  # not a range (T24-11)
     "evaluate seed": (lambda v: evaluate(POLICY, MDP, seed=v, n_steps=5), "seed={} is not allowed", 3),
@@ -59,7 +59,7 @@ CASES: dict[str, tuple[Callable[[object], object], str, object]] = {
     "gym.make episode_steps": (lambda v: gym.make("neurohover/GHH08-v0", episode_steps=v), "episode_steps={} is not allowed", 20),
     "gym.make reset seed": (lambda v: gym.make("neurohover/GHH08-v0", episode_steps=20).reset(seed=v), "seed={} is not allowed", 3),
     "plot_flight_data episodes": (lambda v: plot_flight_data(_flight(), OUT[0], episodes=[v]), "episode {} is not allowed", 0),
-    "DangerousState box": (lambda v: DangerousState(box=v), "safeguard box={} is out of range", 0.5),
+    "DangerousState box": (lambda v: DangerousState(box=v), "safeguard box={} is not allowed", 0.5),
     "DangerousState arm_after": (lambda v: DangerousState(arm_after=v), "safeguard arm_after={} is not allowed", 5),
     "Sensor velocity": (lambda v: Sensor(velocity=v), "sensor velocity={} is not a number", 0.5),
     "Sensor dropout": (lambda v: Sensor(dropout=v), "sensor dropout={} is out of range", 0.1),

@@ -106,7 +106,7 @@ def test_fly_refuses_a_policy_of_a_bad_sensor(written: Path, tmp_path: Path, cli
     [
         ("fghh", 0.7, ("its sigma 0.7 is not allowed beside its target 'fghh/G(sigma=0.3)'", "G(sigma=0.3)")),
         ("fghh", -3, ("its sigma -3 is not allowed: FGHH sigma=-3 is out of range: allowed 0 <= sigma <= 1",)),
-        ("p", "x", ("its sigma 'x' is not allowed: FGHH sigma='x' is out of range",)),
+        ("p", "x", ("its sigma 'x' is not allowed: FGHH sigma='x' is not allowed: give a number 0 <= sigma <= 1",)),  # T26-B17
         ("p", 0.3, ("its sigma 0.3 is not allowed beside its task 'ghh08'", "sigma is FGHH's")),
     ],
 )

@@ -44,7 +44,7 @@ def resolve_mdp(family: TaskFamily, spec: Any, cache: dict[str, MDP] | None = No
                 f"mdp {spec.label or spec.family!r} is an MDP of {spec.family}, not of this environment's family {family.name}: "
                 f"give one of {family.name}'s MDPs (or a learned model)"
             )
-        return spec  # flyable: an MDP checks its numbers and substeps when it is made
+        return sensed_mdp(spec, family.sensor)  # flyable: an MDP checks its numbers and substeps when it is made
     if not isinstance(spec, str):
         raise NeurohoverError(f"mdp={spec!r} is not allowed: use one of {', '.join(MDP_OPTIONS)} or an MDP instance")
     if spec == SAMPLE:
@@ -55,6 +55,26 @@ def resolve_mdp(family: TaskFamily, spec: Any, cache: dict[str, MDP] | None = No
     if cache is not None:
         cache[spec] = mdp
     return mdp
+
+
+def sensed_mdp(mdp: MDP, sensor: Sensor) -> MDP:
+    """An explicit ``mdp`` seen through the environment's ``sensor``, by the rule of an explicit MDP's drift: its own
+    flies where the environment's is exact, the environment's where the MDP's is exact (as the same MDP named by text
+    flies), and two different non-exact ones are refused by name. An MDP object flew with exact sensors under
+    obs_noise, obs_delay and the -NoisySensors ids without a word (T26-B03)."""
+    if sensor.exact or mdp.sensor == sensor:
+        return mdp
+    if mdp.sensor.exact:
+        return mdp.with_sensor(sensor)
+
+    def text(s: Sensor) -> str:
+        return "Sensor(" + ", ".join(f"{k}={v:g}" for k, v in s.to_dict().items() if v) + ")"
+
+    raise NeurohoverError(
+        f"mdp {mdp.label or mdp.family!r} carries its own sensor {text(mdp.sensor)}, not this environment's {text(sensor)} "
+        "(its obs_noise, obs_delay or id): give the MDP without a sensor (mdp.with_sensor(Sensor())) or an environment of "
+        "exact sensors, under which it flies its own"
+    )
 
 
 def refuse_idle_sigma(sigma: Any, mdp: Any, *, flags: bool = False, default: bool = False) -> None:

@@ -219,14 +219,17 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
       0.1 m/s, 0.1 m, 0.1 rad/s, 0.01 scaled by it), a dict of :class:`neurohover.tasks.sensor.Sensor`
       settings (``velocity``, ``position``, ``rates``, ``attitude``, ``correlation``, ``level``) or
       a ``Sensor``. Observations are then the noisy readings; reward and crash stay on the true
-      state. ``obs_delay``: control steps (0..10) the readings arrive late.
+      state. ``obs_delay``: control steps (0..10) the readings arrive late. An explicit MDP (the
+      ``mdp`` argument or option) is seen through these sensors, or the id's, as an MDP named by text
+      is; one with a sensor of its own flies it under exact sensors, and is refused beside another.
     - ``drift``: drifting dynamics (:mod:`neurohover.tasks.drift`): ``None`` (fixed, default), a
       :class:`neurohover.tasks.Drift`, a dict of its settings (``walk``, ``change``, ``change_at``)
       or the command line's text (``"walk=0.01,D_w=0.8@200-800"``); an explicit MDP with a drift of
-      its own drifts so too. The episodes then make up test runs: ``reset(seed=s)`` (or an ``mdp``
-      option, or the first reset) begins a run, drawing its MDP (``"sample"``) and then its drift's
-      seed from ``np_random``; each later ``reset()`` is the run's next episode, on the same MDP
-      with its dynamics drifted to that episode. ``info["run_episode"]`` counts the run's episodes
+      its own drifts so too (beside another ``drift`` it is refused; one without drifts by ``drift``).
+      The episodes then make up test runs: ``reset(seed=s)`` (or an ``mdp`` option, or the first
+      reset) begins a run, drawing its MDP (``"sample"``) and then its drift's seed from ``np_random``;
+      each later ``reset()`` is the run's next episode, on the same MDP with its dynamics drifted to
+      that episode. ``info["run_episode"]`` counts the run's episodes
       from 0; ``info["mdp_info"]`` describes the run's MDP as drawn.
 
     | Id                                        | drift                                          |
@@ -301,7 +304,7 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         self.action_dtype = check_action_dtype(action_dtype)
         self.family: TaskFamily = sensed_family(task, sigma, obs_noise, obs_delay)
         self.episode_steps = check_episode_steps(episode_steps)
-        self._spec: MDP | str = resolve_mdp(self.family, mdp)
+        self._spec: MDP | str = self._resolve(mdp)
         refuse_idle_sigma(sigma, mdp)
         self.observation_space = observation_space(self.obs_dtype)
         self.action_space = action_space(self.action_dtype)
@@ -372,6 +375,18 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
             info["run_episode"] = self._run_episode
         return info
 
+    def _resolve(self, mdp: Any) -> MDP | str:
+        """The ``mdp`` argument or option resolved (:func:`resolve_mdp`, which puts the environment's sensor on an explicit
+        MDP by the rule of drift); an explicit MDP's own drift beside another of the environment's is refused, as a
+        sensor is: the environment's won without a word (T26-B03)."""
+        spec = resolve_mdp(self.family, mdp)
+        if isinstance(spec, MDP) and not (self.drift.none or spec.drift.none or spec.drift == self.drift):
+            raise NeurohoverError(
+                f"mdp {spec.label or spec.family!r} drifts by its own {spec.drift.to_dict()}, not this environment's drift "
+                f"{self.drift.to_dict()}: give the MDP without one (mdp.with_drift(Drift())), or leave drift out and it drifts by its own"
+            )
+        return spec
+
     def _drifted(self, spec: MDP | str, new_run: bool) -> tuple[MDP, np.ndarray]:
         """The MDP of this episode of the test run and the (drifted) row it flies: a seeded reset, a new
         ``mdp`` option or the first reset begins a run (its MDP, then its drift seed, drawn here)."""
@@ -389,7 +404,7 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         super().reset(seed=None if seed is None else check_seed(seed))
         options = check_reset_options(options)
         # Validate every option before touching the episode, so a bad call leaves it as it was.
-        spec = resolve_mdp(self.family, options["mdp"]) if "mdp" in options else self._spec
+        spec = self._resolve(options["mdp"]) if "mdp" in options else self._spec
         stream = check_noise_stream(options["noise"]) if "noise" in options else None
         self._spec = spec
         if self.drift.none and (isinstance(spec, str) or spec.drift.none):

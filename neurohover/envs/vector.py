@@ -89,7 +89,9 @@ class HoverVectorEnv(VectorEnv):
     mdp : str, MDP or sequence of them
         ``"sample"`` (default: each sub-environment draws its own fresh MDP from G at every
         reset), ``"zero"``, ``"train:N"``, ``"test:N"`` or an :class:`~neurohover.MDP`, for all
-        sub-environments, or a sequence of ``num_envs`` of these, one per sub-environment.
+        sub-environments, or a sequence of ``num_envs`` of these, one per sub-environment. An explicit
+        MDP is seen through the sensors of ``obs_noise`` / ``obs_delay`` (or the id's), as one named by
+        text is; one with a sensor of its own flies it under exact sensors, and is refused beside another.
     episode_steps : int
         Control steps per episode (6000); the crash penalty counts the steps left to it.
     max_episode_steps : int, optional

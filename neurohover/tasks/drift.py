@@ -92,13 +92,16 @@ class Drift:
         try:
             # True was read as episode 1 (second trial); a masked array's masked entry was NumPy's MaskError (T16-13)
             # finite_real: np.timedelta64(4) was read as episode 4, inf was int()'s OverflowError (T17-1)
-            if isinstance(self.change_at, np.ma.MaskedArray) or not all(finite_real(x) for x in self.change_at):
+            # 1.5 (no whole episode) was called out of range (T26-B17)
+            if isinstance(self.change_at, np.ma.MaskedArray) or not all(finite_real(x) and float(x).is_integer() for x in self.change_at):
                 raise TypeError
             lo, hi = (int(x) for x in self.change_at)
         except (TypeError, ValueError):
-            raise NeurohoverError(f"drift change_at={brief(self.change_at)} is not allowed: give two episode numbers lo, hi with 0 <= lo <= hi") from None
-        if not 0 <= lo <= hi <= MAX_CHANGE_AT or list(self.change_at) != [lo, hi]:  # 10**30 was NumPy's int64 error at reset (ninth trial)
-            raise NeurohoverError(f"drift change_at={self.change_at!r:.80} is out of range: allowed whole episode numbers 0 <= lo <= hi <= {MAX_CHANGE_AT:,}")
+            raise NeurohoverError(
+                f"drift change_at={brief(self.change_at)} is not allowed: give two episode numbers lo, hi, whole, with 0 <= lo <= hi <= {MAX_CHANGE_AT:,}"
+            ) from None
+        if not 0 <= lo <= hi <= MAX_CHANGE_AT:  # 10**30 was NumPy's int64 error at reset (ninth trial)
+            raise NeurohoverError(f"drift change_at={brief(self.change_at)} is out of range: allowed whole episode numbers 0 <= lo <= hi <= {MAX_CHANGE_AT:,}")
         if not self.change and (lo, hi) != CHANGE_AT:  # said when, but no change to happen then: nothing would
             raise NeurohoverError(f"drift change_at={[lo, hi]} is given without a change: {_PARSE_FORM}")
         object.__setattr__(self, "change_at", (lo, hi))

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real
+from ..errors import NeurohoverError, brief, finite_real, real_number
 from ..sim.constants import DEFAULT_PARAMS, PARAM_NAMES, ROW_PARAMS
 from .base import MDP, TaskFamily, finite_vector, mdp_label
 
@@ -34,8 +34,11 @@ class FGHH(TaskFamily):
 
     def __post_init__(self) -> None:
         s = self.sigma
+        allowed = "0 <= sigma <= 1 (the paper uses 0.2 and 0.3)"
+        if not real_number(s):  # 'x' was called out of range (T26-B17)
+            raise NeurohoverError(f"FGHH sigma={brief(s)} is not allowed: give a number {allowed}")
         if not (finite_real(s) and 0.0 <= s <= 1.0):  # any real number type, np.float32 too
-            raise NeurohoverError(f"FGHH sigma={brief(s)} is out of range: allowed 0 <= sigma <= 1 (the paper uses 0.2 and 0.3)")
+            raise NeurohoverError(f"FGHH sigma={brief(s)} is out of range: allowed {allowed}")
         object.__setattr__(self, "sigma", abs(float(s)))  # -0.0 passes 0 <= sigma but was NumPy's "scale < 0" at the first draw (T14-2)
 
     def make(self, params: Sequence[float] | np.ndarray, label: str = "") -> MDP:

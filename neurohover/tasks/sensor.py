@@ -118,8 +118,10 @@ class Sensor:
     @classmethod
     def at_level(cls, level: float, correlation: float = 0.0, delay: int = 0) -> Sensor:
         """The sensor of noise level ``level``: :data:`LEVEL_PROFILE` scaled by it."""
+        if not real_number(level):  # '1' and None were called out of range (T26-B17)
+            raise NeurohoverError(f"sensor noise level={brief(level)} is not allowed: give a number in 0..{MAX_LEVEL:g}")
         if not finite_real(level) or not 0 <= level <= MAX_LEVEL:  # np.float32(0.5), Fraction(1, 2) in range too (thirteenth trial, F8)
-            raise NeurohoverError(f"sensor noise level={level!r} is out of range: allowed a number in 0..{MAX_LEVEL:g}")
+            raise NeurohoverError(f"sensor noise level={brief(level)} is out of range: allowed a number in 0..{MAX_LEVEL:g}")
         v, p, r, a = (float(level) * s for s in LEVEL_PROFILE)
         return cls(v, p, r, a, correlation=correlation, delay=delay)
 
