@@ -16,8 +16,9 @@ from pathlib import Path
 import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real
+from .filekinds import refuse_suffix
 from .flightmeta import check_meaning, check_policy_actions, flown_policy
-from .paths import json_text, refuse_suffix, strict_json
+from .paths import json_text, strict_json
 from .sim.constants import ACTION_NAMES, EPISODE_STEPS, MAX_EPISODE_STEPS, OBS_NAMES
 
 FORMAT = "neurohover-flight-data/1"

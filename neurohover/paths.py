@@ -24,6 +24,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .errors import NeurohoverError, OutputError, brief
+from .filekinds import SQLITE_HEADER, held_kind, output_name, refuse_run_file_name, refuse_suffix
 
 try:
     import fcntl
@@ -31,6 +32,8 @@ except ImportError:  # not POSIX: no output lock; one run per output is then the
     fcntl = None  # type: ignore[assignment]
 
 __all__ = [
+    "refuse_run_file_name",  # filekinds' (policies and models import them from here)
+    "refuse_suffix",
     "JSONError",
     "WriterLock",
     "checked_path",
@@ -42,15 +45,9 @@ __all__ = [
     "input_dir",
     "make_dirs",
     "output_dir",
-    "held_kind",
-    "CSV_KINDS",
     "output_file",
-    "output_name",
     "printable",
     "refuse_dangling_link",
-    "refuse_suffix",
-    "refuse_run_file_name",
-    "RUN_FILE_ENDS",
     "refuse_link_loop",
     "refuse_special_file",
     "remove_created_dirs",
@@ -227,105 +224,12 @@ def _json_int(text: str) -> int:
     return value
 
 
-SQLITE_HEADER = b"SQLite format 3\x00"  # the first bytes of every SQLite database: a results store
-
-
 def _no_dash(path: str | os.PathLike, option: str, what: str, stdout: bool) -> None:
     """Refuse ``-``, which by custom means standard output, as a name: it was written as a hidden-looking file named '-'
     (eleventh trial); ``stdout``: leaving ``option`` out writes to standard output."""
     if isinstance(path, (str, os.PathLike)) and os.fspath(path) == "-":
         instead = f"leave {option} out for standard output" if stdout else f"give a {what} name (./- for one called '-')"
         raise NeurohoverError(f"{option} '-' is not a {what} name here: {instead}")
-
-
-#: The neurohover files a JSON output can be told apart by (what it is called -> a test of its parsed JSON object):
-#: an output of one kind is not written over a file of another (T25-01 to T25-03: a policy, a checkpoint, a compete
-#: summary replaced by rows or a model without a word).
-JSON_KINDS: dict[str, Callable[[dict], bool]] = {
-    "a policy file": lambda d: {"topology", "genome"} <= d.keys(),
-    "a model file": lambda d: str(d.get("format", "")).startswith("neurohover-model/"),
-    "an evolution checkpoint": lambda d: str(d.get("format", "")).startswith("neurohover-evolution-checkpoint/"),
-    "a competition summary (summary.json)": lambda d: {"experiment", "agent", "task", "runs"} <= d.keys(),
-    "a policy set's manifest": lambda d: {"built", "optimizer"} <= d.keys() and "rows" not in d,
-    "evaluate-agent rows (--json)": lambda d: {"rows", "n_mdps", "episode_steps"} <= d.keys(),
-    "a results export (results --format json)": lambda d: {"experiment", "config_hash", "units"} <= d.keys(),
-}
-#: The neurohover CSV files an output can be told apart by (what it is called -> the cells its header holds, in any
-#: order): a results export over compete's episodes.csv replaced the competition's episodes (T25-12's CSV leftover).
-#: Tested against the columns compete (older files too: run, episode, return), evolve and results write.
-CSV_KINDS: dict[str, frozenset[str]] = {
-    "a competition's episodes (episodes.csv)": frozenset({"run", "episode", "return"}),
-    "an evolution history (.history.csv)": frozenset({"generation", "evaluations", "episodes", "champion_return"}),
-    "a results export (results --format csv)": frozenset({"experiment", "scale", "key", "kind"}),
-}
-_KIND_READ_LIMIT = 64 * 2**20  # a larger file is no neurohover JSON file told apart here
-
-
-def held_kind(path: str | os.PathLike) -> str | None:
-    """What neurohover file the existing regular file ``path`` is, in words (``"a policy file"``), read from its
-    content: a results store (SQLite), flight data (a NumPy archive), one of :data:`JSON_KINDS` or :data:`CSV_KINDS`; None for anything
-    else (no such file, unreadable, another file). The one test of "which kind of neurohover file is this" that
-    :func:`output_file` refuses to write another kind over."""
-    p = Path(path)
-    try:
-        if not p.is_file() or p.stat().st_size > _KIND_READ_LIMIT:
-            return None
-        with open(p, "rb") as f:
-            body = f.read()
-    except OSError:
-        return None
-    if body.startswith(SQLITE_HEADER):
-        return "a results store (SQLite)"
-    if body.startswith(b"PK\x03\x04"):  # a zip: a NumPy archive (.npz) holds its arrays as NAME.npy
-        return "flight data (a NumPy archive)" if b"format.npy" in body else None
-    if not body.lstrip()[:1] == b"{":
-        header = {c.decode("latin-1") for c in body.split(b"\n", 1)[0].rstrip(b"\r").split(b",")}
-        return next((kind for kind, cells in CSV_KINDS.items() if cells <= header), None)
-    try:
-        value = json.loads(body)
-    except (ValueError, RecursionError):
-        return None
-    return next((kind for kind, test in JSON_KINDS.items() if isinstance(value, dict) and test(value)), None)
-
-
-#: The ends of the names of what ``neurohover evolve --out FILE`` writes beside FILE (end -> what that file is): no other
-#: output is written under them (a policy, a model or an export over another run's checkpoint or history; T24-01, T25-03).
-RUN_FILE_ENDS = {".checkpoint.json": "checkpoint (which --resume continues)", ".history.csv": "history (one line per new champion or generation)"}
-
-
-def refuse_run_file_name(path: str, option: str) -> None:
-    """Refuse a name ``path`` ending (any case) one of :data:`RUN_FILE_ENDS`, naming it as ``option``: the one message
-    of every output that may not replace an evolve run's checkpoint or history."""
-    end = next((end for end in RUN_FILE_ENDS if path.lower().endswith(end)), None)
-    if end is not None:
-        raise NeurohoverError(
-            f"{option} {brief(path)} is not allowed: evolve --out FILE writes FILE{end} beside FILE as its run's {RUN_FILE_ENDS[end]}; "
-            f"give a name not ending {' or '.join(RUN_FILE_ENDS)}"
-        )
-
-
-def output_name(path: object, option: str, suffixes: tuple[str, ...], what: str, run_files: bool = False) -> None:
-    """Refuse a name ``path`` whose suffix (any case) is none of ``suffixes``, naming ``option`` and ``what`` the output
-    is ("evaluate-agent's rows are JSON"), and (``run_files``) a name of an evolve run's own files
-    (:func:`refuse_run_file_name`); what is no path is :func:`output_file`'s to refuse. evaluate-agent --json f.npz wrote
-    JSON over flight data (T25-01), results --out f.npz CSV (T25-02), learn-model --out P.checkpoint.json a model over
-    evolve's checkpoint (T25-03)."""
-    text = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None
-    if not isinstance(text, str) or text in ("", "-") or text.endswith(("/", os.sep)) or Path(text).is_dir():
-        return
-    if run_files:
-        refuse_run_file_name(text, option)
-    if suffixes != ("",):
-        refuse_suffix(text, option, suffixes, what, f"out{suffixes[0]}")
-
-
-def refuse_suffix(path: str, option: str, suffixes: tuple[str, ...], what: str, example: str) -> None:
-    """Refuse a file name ``path`` whose suffix (any case) is none of ``suffixes``, naming it as ``option``, saying
-    ``what`` the file is ("a model file is JSON") and the name with the first suffix (``example`` where ``path`` has no
-    file name): the one message of output names (:func:`output_name`), flight data, model and policy files."""
-    if Path(path).suffix.lower() not in suffixes:
-        like = str(Path(path).with_suffix(suffixes[0])) if Path(path).name else example
-        raise NeurohoverError(f"{option} {brief(path)} is not allowed: {what}; give a path ending {' or '.join(suffixes)} (e.g. {brief(like)})")
 
 
 def output_file(
@@ -346,9 +250,9 @@ def output_file(
     a file, a symbolic link to a missing target (:func:`refuse_dangling_link`), a '..' after a missing directory
     (:func:`make_dirs`), any place where a file cannot be created, the file of one of ``inputs`` (option -> path: writing it would
     destroy what the command reads) and, unless ``store`` (the path is a results store's own), an existing results
-    store; given the ``kind`` of file written (one of :data:`JSON_KINDS`' names), an existing neurohover file of
-    another kind (:func:`held_kind`; T25-01 to T25-03), and a name of a suffix not in ``suffixes`` (``what`` says why) or
-    (``run_files``) an evolve run's own file names (:func:`output_name`);
+    store; given the ``kind`` of file written (one of :data:`~neurohover.filekinds.JSON_KINDS`' names), an existing neurohover file of
+    another kind (:func:`~neurohover.filekinds.held_kind`; T25-01 to T25-03), and a name of a suffix not in ``suffixes`` (``what`` says why) or
+    (``run_files``) an evolve run's own file names (:func:`~neurohover.filekinds.output_name`);
     creates missing parent directories (saying so on standard error).
     """
     _no_dash(path, option, "file", stdout)

@@ -2,7 +2,7 @@
 
 ``results NAME --out DIR/episodes.csv`` replaced a competition's episodes with the export's rows: held_kind knew only
 JSON kinds, so a CSV output was checked by its suffix alone. Each CSV neurohover writes is now told apart by its header
-(:data:`neurohover.paths.CSV_KINDS`), and an export replaces only an export."""
+(:data:`neurohover.filekinds.CSV_KINDS`), and an export replaces only an export."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from conftest import CliRun, tiny_test_runs
 from neurohover.compete import compete
 from neurohover.compete_files import COMPETE_COLUMNS, CSV_COLUMNS
 from neurohover.evolution.records import HISTORY_COLUMNS, HistoryRecord, write_history_csv
-from neurohover.paths import CSV_KINDS, held_kind
+from neurohover.filekinds import CSV_KINDS, held_kind
 
 
 @pytest.fixture(scope="module")

@@ -7,7 +7,7 @@ import json
 import pytest
 from conftest import tiny_test_runs
 
-from neurohover.paths import held_kind
+from neurohover.filekinds import held_kind
 
 POLICY = {"topology": "slp", "genome": [0.0] * 12, "prototype": "baseline"}
 

@@ -1,0 +1,111 @@
+"""Which neurohover file a path holds, and the names an output may not take.
+
+:func:`held_kind` tells a results store, flight data and each kind of JSON or CSV file neurohover writes apart by
+their content, so that an output of one kind is never written over a file of another (T25-01 to T25-03, T25-12);
+:func:`output_name` and :func:`refuse_suffix` hold the rules of output names (the suffix of the kind written, never an
+evolve run's own ``FILE.checkpoint.json`` or ``FILE.history.csv``). :mod:`neurohover.paths` applies them in
+:func:`~neurohover.paths.output_file`.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Callable
+from pathlib import Path
+
+from .errors import NeurohoverError, brief
+
+__all__ = ["CSV_KINDS", "JSON_KINDS", "RUN_FILE_ENDS", "SQLITE_HEADER", "held_kind", "output_name", "refuse_run_file_name", "refuse_suffix"]
+
+SQLITE_HEADER = b"SQLite format 3\x00"  # the first bytes of every SQLite database: a results store
+
+
+#: The neurohover files a JSON output can be told apart by (what it is called -> a test of its parsed JSON object):
+#: an output of one kind is not written over a file of another (T25-01 to T25-03: a policy, a checkpoint, a compete
+#: summary replaced by rows or a model without a word).
+JSON_KINDS: dict[str, Callable[[dict], bool]] = {
+    "a policy file": lambda d: {"topology", "genome"} <= d.keys(),
+    "a model file": lambda d: str(d.get("format", "")).startswith("neurohover-model/"),
+    "an evolution checkpoint": lambda d: str(d.get("format", "")).startswith("neurohover-evolution-checkpoint/"),
+    "a competition summary (summary.json)": lambda d: {"experiment", "agent", "task", "runs"} <= d.keys(),
+    "a policy set's manifest": lambda d: {"built", "optimizer"} <= d.keys() and "rows" not in d,
+    "evaluate-agent rows (--json)": lambda d: {"rows", "n_mdps", "episode_steps"} <= d.keys(),
+    "a results export (results --format json)": lambda d: {"experiment", "config_hash", "units"} <= d.keys(),
+}
+#: The neurohover CSV files an output can be told apart by (what it is called -> the cells its header holds, in any
+#: order): a results export over compete's episodes.csv replaced the competition's episodes (T25-12's CSV leftover).
+#: Tested against the columns compete (older files too: run, episode, return), evolve and results write.
+CSV_KINDS: dict[str, frozenset[str]] = {
+    "a competition's episodes (episodes.csv)": frozenset({"run", "episode", "return"}),
+    "an evolution history (.history.csv)": frozenset({"generation", "evaluations", "episodes", "champion_return"}),
+    "a results export (results --format csv)": frozenset({"experiment", "scale", "key", "kind"}),
+}
+_KIND_READ_LIMIT = 64 * 2**20  # a larger file is no neurohover JSON file told apart here
+
+
+def held_kind(path: str | os.PathLike) -> str | None:
+    """What neurohover file the existing regular file ``path`` is, in words (``"a policy file"``), read from its
+    content: a results store (SQLite), flight data (a NumPy archive), one of :data:`JSON_KINDS` or :data:`CSV_KINDS`; None for anything
+    else (no such file, unreadable, another file). The one test of "which kind of neurohover file is this" that
+    :func:`output_file` refuses to write another kind over."""
+    p = Path(path)
+    try:
+        if not p.is_file() or p.stat().st_size > _KIND_READ_LIMIT:
+            return None
+        with open(p, "rb") as f:
+            body = f.read()
+    except OSError:
+        return None
+    if body.startswith(SQLITE_HEADER):
+        return "a results store (SQLite)"
+    if body.startswith(b"PK\x03\x04"):  # a zip: a NumPy archive (.npz) holds its arrays as NAME.npy
+        return "flight data (a NumPy archive)" if b"format.npy" in body else None
+    if not body.lstrip()[:1] == b"{":
+        header = {c.decode("latin-1") for c in body.split(b"\n", 1)[0].rstrip(b"\r").split(b",")}
+        return next((kind for kind, cells in CSV_KINDS.items() if cells <= header), None)
+    try:
+        value = json.loads(body)
+    except (ValueError, RecursionError):
+        return None
+    return next((kind for kind, test in JSON_KINDS.items() if isinstance(value, dict) and test(value)), None)
+
+
+#: The ends of the names of what ``neurohover evolve --out FILE`` writes beside FILE (end -> what that file is): no other
+#: output is written under them (a policy, a model or an export over another run's checkpoint or history; T24-01, T25-03).
+RUN_FILE_ENDS = {".checkpoint.json": "checkpoint (which --resume continues)", ".history.csv": "history (one line per new champion or generation)"}
+
+
+def refuse_run_file_name(path: str, option: str) -> None:
+    """Refuse a name ``path`` ending (any case) one of :data:`RUN_FILE_ENDS`, naming it as ``option``: the one message
+    of every output that may not replace an evolve run's checkpoint or history."""
+    end = next((end for end in RUN_FILE_ENDS if path.lower().endswith(end)), None)
+    if end is not None:
+        raise NeurohoverError(
+            f"{option} {brief(path)} is not allowed: evolve --out FILE writes FILE{end} beside FILE as its run's {RUN_FILE_ENDS[end]}; "
+            f"give a name not ending {' or '.join(RUN_FILE_ENDS)}"
+        )
+
+
+def output_name(path: object, option: str, suffixes: tuple[str, ...], what: str, run_files: bool = False) -> None:
+    """Refuse a name ``path`` whose suffix (any case) is none of ``suffixes``, naming ``option`` and ``what`` the output
+    is ("evaluate-agent's rows are JSON"), and (``run_files``) a name of an evolve run's own files
+    (:func:`refuse_run_file_name`); what is no path is :func:`output_file`'s to refuse. evaluate-agent --json f.npz wrote
+    JSON over flight data (T25-01), results --out f.npz CSV (T25-02), learn-model --out P.checkpoint.json a model over
+    evolve's checkpoint (T25-03)."""
+    text = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None
+    if not isinstance(text, str) or text in ("", "-") or text.endswith(("/", os.sep)) or Path(text).is_dir():
+        return
+    if run_files:
+        refuse_run_file_name(text, option)
+    if suffixes != ("",):
+        refuse_suffix(text, option, suffixes, what, f"out{suffixes[0]}")
+
+
+def refuse_suffix(path: str, option: str, suffixes: tuple[str, ...], what: str, example: str) -> None:
+    """Refuse a file name ``path`` whose suffix (any case) is none of ``suffixes``, naming it as ``option``, saying
+    ``what`` the file is ("a model file is JSON") and the name with the first suffix (``example`` where ``path`` has no
+    file name): the one message of output names (:func:`output_name`), flight data, model and policy files."""
+    if Path(path).suffix.lower() not in suffixes:
+        like = str(Path(path).with_suffix(suffixes[0])) if Path(path).name else example
+        raise NeurohoverError(f"{option} {brief(path)} is not allowed: {what}; give a path ending {' or '.join(suffixes)} (e.g. {brief(like)})")
