@@ -194,4 +194,4 @@ __all__ = [
 ]
 
 from . import envs as _envs  # noqa: E402,F401  (registers the Gymnasium environments)
-from . import manifest as _manifest  # noqa: E402,F401  (installs load_policy's check of a policy file's record, T23-11)
+from . import policy_records as _policy_records  # noqa: E402,F401  (installs load_policy's check of a policy file's record, T23-11)

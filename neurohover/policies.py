@@ -74,7 +74,7 @@ BASELINE_BIASES = (0.02, 0.0, 0.0, 0.23)
 
 #: Checks of a policy file's record of the run that evolved it, by name: each takes the policy's metadata and says what in
 #: it contradicts itself ('' when nothing does). :func:`load_policy` applies them to every JSON policy file it reads.
-#: :mod:`neurohover.manifest` installs its ``policy_record_problem`` as it is imported: it reads the evolution's words (its
+#: :mod:`neurohover.policy_records` installs its ``policy_record_problem`` as it is imported: it reads the evolution's words (its
 #: stop reasons and methods), which this layer may not import (T23-11).
 RECORD_CHECKS: dict[str, Callable[[dict], str]] = {}
 

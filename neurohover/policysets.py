@@ -29,6 +29,11 @@ A policy set is a directory ``<task>/`` holding JSON policy files and a ``manife
 
 The shipped sets live in ``neurohover/data/policies``; ``neurohover build-policies`` rebuilds them
 with the project's own evolution (or writes a set elsewhere with ``--out``).
+
+A set is loaded strictly (:func:`load_policy_set`): every policy must be an MLP (a build evolves nothing else), a
+chain's set must hold its ``ancestor.json`` (an independent one must not), and a JSON file in the folder that no build
+writes (``specialised_10.json`` beside a GHH set's ten) is refused by name rather than ignored. Files of other names
+(a README, notes, a run's ``.history.csv``) are left alone: none can be taken for one of the set's policies.
 """
 
 from __future__ import annotations
@@ -53,6 +58,8 @@ from .sim.constants import MAX_EPISODE_STEPS
 from .tasks import TaskFamily, get_task_family
 
 SHIPPED = Path(__file__).parent / "data" / "policies"
+#: The network of every policy a build evolves (:func:`_evolve_one`), and the one a set's policy may have (T26-B12).
+SET_TOPOLOGY = "mlp"
 FGHH_GENERICS = ("zero", "fixed", "race")
 #: How FGHH's generics over G estimate fitness (the zero-setting one flies one MDP, fixed:1): the
 #: paper's k = 5 and delta = 0.2; build-policies and the experiments' planner both read it.
@@ -125,6 +132,12 @@ def _load(path: Path, what: str, task: str, target: str, built: dict | None = No
             f"build it with: neurohover build-policies --task {path.parent.name} --out {path.parent.parent}"
         )
     policy = load_policy(path)
+    if policy.topology != SET_TOPOLOGY:  # T26-B12: an slp of 40 genes was flown as a specialised policy
+        raise NeurohoverError(
+            f"policy set {str(path.parent)!r}: {path.name} ({what}) has topology {brief(policy.topology)}, which is not allowed: a build "
+            f"evolves every policy of a set as an {SET_TOPOLOGY} (allowed {SET_TOPOLOGY!r}); rebuild the set with: neurohover build-policies "
+            f"--task {path.parent.name}"
+        )
     unknown = sorted(set(policy.metadata) - set(_POLICY_KEYS))
     if unknown:  # "zzz_extra": 1 was flown without a word, where a manifest's unknown key is refused (T20-07)
         shown = ", ".join(brief(key) for key in unknown[:5]) + (f" and {len(unknown) - 5} more" if len(unknown) > 5 else "")
@@ -181,8 +194,22 @@ def _check_place(policy: Policy, path: Path, what: str, place: dict, why: str = 
             )
 
 
+def _refuse_strays(root: Path, family: TaskFamily) -> None:
+    """Refuse a JSON name in a set's folder that no build writes (a specialised_10.json beside ten was ignored without a
+    word; T26-B12). Other names are left alone (see the module doc): none is read as a policy of the set."""
+    n = 0 if family.generic_over_distribution else len(family.training_mdps())
+    own = ["manifest", *(f"generic_{k}" for k in FGHH_GENERICS)] if n == 0 else ["manifest", "generic", *(f"specialised_{i}" for i in range(n)), "ancestor"]
+    strays = sorted(p.name for p in root.iterdir() if p.name.lower().endswith(".json") and (p.name[-5:] != ".json" or p.name[:-5] not in own))
+    if strays:
+        files = ", ".join(f"{name}.json" for name in own) if n == 0 else f"manifest.json, generic.json, specialised_0..{n - 1}.json, ancestor.json (a chain's)"
+        raise NeurohoverError(
+            f"policy set {str(root)!r}: {strays[0]} is no file of a {family.name} set{f' (nor {len(strays) - 1} more)' if len(strays) > 1 else ''}: a "
+            f"build writes {files}; move it elsewhere, or rebuild the set with: neurohover build-policies --task {family.name}"
+        )
+
+
 def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet:
-    """Load the policy set of ``task`` (the shipped one unless ``directory`` is given)."""
+    """Load the policy set of ``task`` (the shipped one unless ``directory`` is given), strictly (see the module doc)."""
     family = get_task_family(task)
     root = policy_dir(family.name, directory)
     manifest_path = root / "manifest.json"
@@ -204,6 +231,7 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
         raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r} is of task {manifest['task']!r}, not {family.name!r}")
     _check_manifest_fields(manifest, manifest_path)
     check_kind_keys(manifest, manifest_path, family.generic_over_distribution)
+    _refuse_strays(root, family)
     targets = {"zero": family.zero().label, "family": f"{family.name}/G"}  # what each role's run evolved on
     if family.has_sigma and finite_real(manifest.get("sigma")):  # T25-07: G(sigma=0.7) in a set of sigma 0.3 was taken by its prefix
         targets["family"] = f"{family.name}/G(sigma={float(manifest['sigma']):g})"
@@ -228,12 +256,28 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
     generic_role, *specialised_roles = policy_set_roles(family)
     generic = _load(root / "generic.json", "the generic policy", family.name, targets["zero"], _built_as(manifest, generic_role, 0))
     train = family.training_mdps()
+    if manifest.get("lineage") == "chain":  # T26-B12: a chain's set without its ancestor was taken
+        _check_ancestor(root, manifest, manifest_path, family.name, train[-1].label, _built_as(manifest, generic_role, 12 + len(train) - 1))
     specialised = tuple(
         _load(root / f"specialised_{i}.json", f"specialised policy {i}", family.name, train[i].label, _built_as(manifest, specialised_roles[i], i + 1))
         for i in range(10)
     )
     safe = check_ghh_manifest(manifest, manifest_path, len(specialised), len(train))
     return PolicySet(family.name, root, generic, specialised, safe, manifest=manifest)
+
+
+def _check_ancestor(root: Path, manifest: dict, manifest_path: Path, task: str, target: str, built: dict) -> None:
+    """Refuse a chain's set without the ancestor its runs were seeded from, or with one its build did not write: run over
+    the training MDPs in turn (its record the last stage's, ``target``, seeded from the build's ``12 + stages - 1``-th
+    child seed, ``built``; :func:`_build`)."""
+    path = root / "ancestor.json"
+    _refuse_not_a_file(path, "the ancestor")
+    if not path.is_file():
+        raise NeurohoverError(
+            f"policy-set manifest {str(manifest_path)!r}: its lineage 'chain' is not allowed without ancestor.json, which a chain's build "
+            f"writes (the ancestor its runs were seeded from): restore it, or rebuild the set with: neurohover build-policies --task {task}"
+        )
+    _load(path, "the ancestor", task, target, built)
 
 
 def crash_matrix(policies: list[Policy], mdps: list, episodes: int, seed: int, n_steps: int = 6000) -> tuple[np.ndarray, np.ndarray]:
@@ -350,8 +394,8 @@ def _evolve_one(
     kwargs["optimizer"] = NE if race else optimizer
     if "resampling" not in kwargs and kwargs["optimizer"] == NE:  # steady state: spend the whole budget (no plateau stop)
         kwargs["settings"] = SteadyStateSettings(plateau_threshold=kwargs["budget"])
-    start_from = seed_policy if seed_policy is not None else prototype("mlp", "baseline")
-    result = evolve(target, topology="mlp", prototype=start_from, seed=child_seed, n_steps=n_steps, **kwargs)
+    start_from = seed_policy if seed_policy is not None else prototype(SET_TOPOLOGY, "baseline")
+    result = evolve(target, topology=SET_TOPOLOGY, prototype=start_from, seed=child_seed, n_steps=n_steps, **kwargs)
     policy = result.champion
     meta = {"episodes": int(result.episodes), "seconds": round(time.perf_counter() - t0, 2)}
     if save:

@@ -18,7 +18,7 @@ LAYERS = [
     {"launch", "flyer", "plots", "compete_files"},
     {"evaluate"},
     {"evolution", "envs"},
-    {"models", "policysets", "manifest", "integrations"},
+    {"models", "policysets", "manifest", "policy_records", "integrations"},
     {"agents"},
     {"experiments"},
     {"compete"},

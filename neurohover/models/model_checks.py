@@ -168,12 +168,19 @@ def _lr_problem(model: LearnedModel) -> str:
 
 
 def _lr_noise_wind_problem(model: LearnedModel) -> str:
-    """'' when an LR model's noise std is the estimate its stats.noise names and its stats hold a wind fit's entries only
-    with a wind, else what contradicts what (T24-08)."""
+    """'' when an LR model's noise std is the estimate its stats.noise names, its stationary noise estimate its residual
+    rms times :data:`~neurohover.models.transitions.STATIONARY_PER_RMS` (both of the same residuals; T26-B14) and its
+    stats hold a wind fit's entries only with a wind, else what contradicts what (T24-08)."""
+    from .transitions import STATIONARY_PER_RMS
+
     stats, noise = model.stats, model.stats.get("noise")
     estimate = stats.get(f"noise_std_{noise}")
     if estimate is not None and not all(_near(a, b) for a, b in zip(model.noise_std, estimate)):
         return _its("noise_std", list(model.noise_std), f"its stats.noise {noise!r} gives stats.noise_std_{noise} {brief(estimate)}")
+    rms, stationary = stats.get("residual_rms"), stats.get("noise_std_stationary")
+    if rms is not None and stationary is not None and not all(_near(s, STATIONARY_PER_RMS * r) for r, s in zip(rms, stationary)):
+        why = f"LR writes its stats.noise_std_stationary {brief(stationary)} as {STATIONARY_PER_RMS:g} x the residual rms of the same fit"
+        return _its("stats.residual_rms", rms, why)  # T26-B14: a residual_rms 10 times the fit's was taken
     key = next((k for k in _WIND_STATS if k in stats), None) if model.wind.kind == "none" else None
     if key is not None:
         return _its(f"stats.{key}", stats[key], "allowed only in the stats of a model with a wind (its wind is 'none')")

@@ -203,6 +203,11 @@ def _checked_residuals(tr: object, residuals: object, batched: bool) -> np.ndarr
     return arr.astype(float, copy=False)
 
 
+#: The stationary-rms noise estimate per unit of residual rms, ``sqrt(1 - 0.8**2) / 0.4`` = 1.5 (:func:`noise_from_residuals`):
+#: an LR model file's ``stats.noise_std_stationary`` is its ``stats.residual_rms`` times it (T26-B14).
+STATIONARY_PER_RMS = math.sqrt(1.0 - NOISE_DECAY**2) / NOISE_GAIN
+
+
 def noise_from_residuals(tr: Transitions, residuals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Gust-noise standard deviations of a model from its one-step residuals.
 
@@ -222,7 +227,7 @@ def noise_from_residuals(tr: Transitions, residuals: np.ndarray) -> tuple[np.nda
     residuals = _checked_residuals(tr, residuals, batched=True)
     innov = tr.innovations(residuals)
     std = np.sqrt(np.mean(innov**2, axis=-2)) / NOISE_GAIN
-    stationary = np.sqrt(np.mean(residuals**2, axis=-2)) * math.sqrt(1.0 - NOISE_DECAY**2) / NOISE_GAIN
+    stationary = np.sqrt(np.mean(residuals**2, axis=-2)) * STATIONARY_PER_RMS
     return std, stationary
 
 
