@@ -32,9 +32,9 @@ import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real, whole_number
 from .paths import input_dir, strict_json
-from .sim.constants import MAX_EPISODE_STEPS, MAX_SECONDS, WORST_RETURN
+from .sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS, MAX_SECONDS, WORST_RETURN
 from .sim.rng import MAX_SEED
-from .tasks.base import N_TRAINING
+from .tasks.base import N_TEST, N_TRAINING
 
 __all__ = [
     "COMPETE_COLUMNS",
@@ -167,6 +167,7 @@ class _Rows:
     fired_line: int | None = None
     split_run: str | None = None  # the refusal of the first row of a run on a second MDP, said once the labels are checked
     after_learning: float | None = None
+    least_charged: tuple[float, int, float, int] | None = None  # the crashed row nearest its charge: return / P - steps, line, return, steps
 
 
 def _check_row(where: str, row: dict, crashed: int, steps: int | None) -> None:
@@ -249,6 +250,8 @@ def _read_rows(csv_path: Path) -> tuple[dict[int, list[tuple[int, float, str]]],
                     facts.crashed_runs.add(run)
                 if steps is not None:
                     facts.steps.setdefault((bool(crashed), steps), line)
+                    if crashed and (facts.least_charged is None or ret / CRASH_STEP_PENALTY - steps > facts.least_charged[0]):
+                        facts.least_charged = (ret / CRASH_STEP_PENALTY - steps, line, ret, steps)
     except (OSError, UnicodeDecodeError, csv.Error) as err:
         raise NeurohoverError(f"--compete {str(csv_path)!r}: cannot read it ({err})") from None
     return runs, seen, facts
@@ -294,7 +297,7 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
         after = [ret for rows in ordered for _, ret, _ in rows[_after_learning_start([p for _, _, p in rows]) :]]
         facts.after_learning = math.fsum(after) / len(after)
     label = path.resolve().name  # no summary (an interrupted competition): the directory's name labels it
-    summary_path, conditions = path / COMPETE_SUMMARY, {}
+    summary_path, conditions, episode_steps = path / COMPETE_SUMMARY, {}, None
     if summary_path.exists():
         try:
             summary = strict_json(summary_path.read_text(encoding="utf-8-sig"))  # a key given twice too (ninth trial)
@@ -305,9 +308,49 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
         _check_summary(summary_path, summary, returns, facts)
         label = f"{summary['agent']} ({summary.get('task', '?')})"
         conditions = {key: summary[key] for key in COMPETE_CONDITIONS if key in summary}
+        episode_steps = summary.get("episode_steps")
     if facts.split_run is not None:  # after the summary's check of each label: a label of no MDP is named as such first
         raise NeurohoverError(facts.split_run)
+    _check_run_mdps(csv_path, facts, len(runs))
+    _check_crash_charge(csv_path, facts, episode_steps)
     return CompeteResult(label, returns, facts.crashes, path, conditions)
+
+
+def _check_crash_charge(csv_path: Path, rows: _Rows, episode_steps: object) -> None:
+    """Refuse a crashed row whose return is above the crash's charge: a crash at step t of an n-step episode is charged
+    CRASH_STEP_PENALTY for each of its n - t steps left (sim.kernel.crash_charge; none for a crash on the last step), so
+    its return is at most -CRASH_STEP_PENALTY * (n - t). n is the summary's episode_steps, else the file's longest
+    episode (at most n: a bound that holds). A crash at step 10 of 20 returning -6.1 was plotted (T26-B09)."""
+    if rows.least_charged is None:
+        return
+    n = episode_steps if whole_number(episode_steps) else max(steps for _, steps in rows.steps)
+    _, line, ret, steps = rows.least_charged
+    charge = CRASH_STEP_PENALTY * (n - steps)
+    if ret > -charge + 1e-9 * charge:
+        raise NeurohoverError(
+            f"--compete {str(csv_path)!r}, line {line}: return {ret!r} is not allowed: the episode crashed at step {steps} of its {n}, and a crash is "
+            f"charged {CRASH_STEP_PENALTY:.6g} for each step left: allowed at most {-charge:.10g}"
+        )
+
+
+def _check_run_mdps(csv_path: Path, rows: _Rows, runs: int) -> None:
+    """Refuse a run on another MDP than compete gives it, naming the line, the value and the one allowed: compete's runs
+    fly its MDP set's MDPs in turn (compete._group, runs ordered by MDP), so where a set holds at least the file's runs
+    (or draws one MDP per run, 'sample') run i flies SET:i; two runs on test:0 of a 2-run competition were plotted
+    (T26-B10). A label of no such shape is not checked here (the summary's task names it), nor runs past a set's size
+    (older competitions flew its MDPs over again in another order)."""
+    for run, (label, line) in sorted(rows.run_mdps.items()):
+        _, slash, rest = label.partition("/")
+        kind, colon, index = rest.partition(":")
+        size = {"test": N_TEST, "train": N_TRAINING}.get(kind, runs)
+        if not (slash and colon and kind in ("test", "train", "sample") and index.isascii() and index.isdigit()) or runs > size:
+            continue
+        if int(index) != run:
+            allowed = f"{label[: len(label) - len(rest)]}{kind}:{run}"
+            raise NeurohoverError(
+                f"--compete {str(csv_path)!r}, line {line}: mdp {brief(label)} is not allowed: compete flies its {kind} MDPs in turn, "
+                f"run i on {kind}:i, so run {run} of its {runs} runs flies {allowed}"
+            )
 
 
 def _check_summary(path: Path, summary: dict, returns: np.ndarray, rows: _Rows) -> None:

@@ -70,6 +70,7 @@ def check_meaning(metadata: dict, mdps: list, episodes: tuple[tuple, tuple, list
             continue  # non-finite readings: flightdata.check_flown names them
         if flags[i] and "crashed" in metadata:  # not a length taken for a crash (files before crashed was recorded)
             _check_crash(metadata["crashed"], observations[i], actions[i], i, where)
+        _check_in_bounds(metadata, observations[i], i, flags[i], where)
         if i < len(returns) and finite_real(returns[i]):
             _check_return(returns, i, observations[i], flags[i], steps if type(steps) is int else None, where)
 
@@ -168,6 +169,55 @@ def _check_crash(flags: list, obs: np.ndarray, act: np.ndarray, i: int, where: s
             f"{np.linalg.norm(last[3:6]):.3g} m, rates under {MAX_RATE:.3g} rad/s, tilt under 15 degrees) after a finite action: "
             "a crash leaves the helicopter out of bounds; its flags and observations contradict"
         )
+
+
+#: The crash bounds as readings show them (sim.constants; sim.kernel.crashed tests the world-frame state): a body-frame
+#: velocity or position of world components each within its bound has a norm within sqrt(3) of it; the rates are the
+#: state's; a unit quaternion's |qw| >= MIN_QW holds its vector part's squares within 1 - MIN_QW**2.
+_READING_BOUNDS = (
+    ("speed", slice(0, 3), 3 * MAX_VELOCITY**2, f"{3**0.5 * MAX_VELOCITY:.4g} m/s (each world component within {MAX_VELOCITY:g})"),
+    ("distance", slice(3, 6), 3 * MAX_POSITION**2, f"{3**0.5 * MAX_POSITION:.4g} m (each world component within {MAX_POSITION:g})"),
+    ("rate", None, MAX_RATE, f"{MAX_RATE:.4g} rad/s"),
+    ("tilt", slice(9, 12), 1.0 - MIN_QW**2, "30 degrees (|qw| at least cos 15 degrees)"),
+)
+
+
+def _check_in_bounds(metadata: dict, obs: np.ndarray, i: int, crashed: bool, where: str) -> None:
+    """Refuse an exact episode's reading past a crash bound where the simulator flew on (T26-B11: a position 50 m off in an
+    episode flagged uncrashed was learned from): it tests the crash after every step and ends the episode at the first
+    past a bound, so every reading but the last is within them, and the last too of an episode flagged uncrashed (where
+    the flag is recorded: a file before crashed was recorded counts a full-length episode uncrashed, a crash on its last
+    step too). The converse of :func:`_check_crash`; one pass over the readings."""
+    flagged = not crashed and "crashed" in metadata
+    rows = obs if flagged else obs[:-1]
+    if rows.shape[0] == 0:
+        return
+    with np.errstate(over="ignore"):  # a reading of 1e300 squares to inf: past every bound
+        ratios = np.stack(
+            [
+                (np.abs(rows[:, 6:9]).max(axis=1) if part is None else np.einsum("ij,ij->i", rows[:, part], rows[:, part])) / bound
+                for _, part, bound, _ in _READING_BOUNDS
+            ]
+        )
+    past_bound = ratios.max(axis=0) > 1.0 + _CRASH_MARGIN
+    if not past_bound.any():
+        return
+    k = int(np.argmax(past_bound))  # the first reading past a bound
+    j = int(np.argmax(ratios[:, k]))
+    name, part, bound, allowed = _READING_BOUNDS[j]
+    shown = float(ratios[j, k] * bound) if part is None else float(np.hypot.reduce(rows[k, part]))  # (hypot: no overflow)
+    if name == "tilt":  # the vector part of a unit quaternion is sin(angle / 2)
+        shown = float(np.degrees(2 * np.arcsin(min(shown, 1.0))))
+    past = f"after step {k:,} its {name} is {shown:.4g}, past the crash bound {allowed}"
+    ends = "the simulator tests the crash after every step and ends the episode at the first past a bound"
+    if flagged:
+        raise NeurohoverError(
+            f"{where}: its metadata crashed={brief(metadata['crashed'])} is not allowed: episode {i} is flagged uncrashed, yet {past}: "
+            f"{ends}; its flags and observations contradict"
+        )
+    raise NeurohoverError(
+        f"{where}: episode {i}'s observations are not allowed: {past}, yet it flies on to step {obs.shape[0] - 1:,}: {ends}; its observations were changed"
+    )
 
 
 def _check_return(returns: list, i: int, obs: np.ndarray, crashed: bool, steps: int | None, where: str) -> None:

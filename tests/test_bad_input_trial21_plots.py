@@ -70,14 +70,14 @@ EPISODES = """run,mdp,episode,return,crashed,steps,policy,safeguard_fired
 0,ghh08/test:0,0,-10.0,0,20,baseline,0
 0,ghh08/test:0,1,-12.5,0,20,baseline,0
 1,ghh08/test:1,0,-30.0,0,20,baseline,0
-1,ghh08/test:1,1,-1000.0,1,7,baseline,0
+1,ghh08/test:1,1,-25000.0,1,7,baseline,0
 """
-TOTALS = np.array([-22.5, -1030.0])
+TOTALS = np.array([-22.5, -25030.0])  # the crash charged its 13 steps left (T26-B09)
 SUMMARY = {
     "task": "ghh08", "agent": "baseline", "mdps": "test", "seed": 0, "store": "results.sqlite", "episode_steps": 20, "sigma": None,
     "sensor": None, "drift": None, "experiment": "compete-ghh08-baseline", "scale": "settings-4a8d2c2c96", "runs": 2, "episodes": 2,
     "mean_cumulative_return": float(TOTALS.mean()), "sd_cumulative_return": float(TOTALS.std(ddof=1)), "crash_rate_runs": 0.5,
-    "crashes_per_episode": 0.25, "mean_return_after_learning": -263.125, "mean_seconds_per_run": 0.1, "mean_offline_seconds_per_run": 0.0,
+    "crashes_per_episode": 0.25, "mean_return_after_learning": -6263.125, "mean_seconds_per_run": 0.1, "mean_offline_seconds_per_run": 0.0,
 }  # fmt: skip
 
 
@@ -110,8 +110,8 @@ def test_plot_refuses_a_compete_summary_whose_task_its_rows_contradict(tmp_path:
         ({"episode_steps": "20"}, "says episode_steps '20', not a number of steps (an integer in 1..10,000,000): it is no compete summary"),
         ({"crashes_per_episode": 0.0}, "says crashes_per_episode 0.0 where its episodes.csv holds 1 crash in 4 episodes"),
         ({"crash_rate_runs": 1.0}, "says crash_rate_runs 1.0 where its episodes.csv holds 1 of 2 runs with a crash"),
-        ({"mean_cumulative_return": -526.0}, "says mean_cumulative_return -526.0 where its episodes.csv's runs return -526.25 in all on average"),
-        ({"sd_cumulative_return": "x"}, "says sd_cumulative_return 'x' where its episodes.csv's runs' cumulative returns have an sd of 712.4"),
+        ({"mean_cumulative_return": -12526.0}, "says mean_cumulative_return -12526.0 where its episodes.csv's runs return -12526.25 in all on average"),
+        ({"sd_cumulative_return": "x"}, "says sd_cumulative_return 'x' where its episodes.csv's runs' cumulative returns have an sd of 17682.97"),
     ],
 )
 def test_read_compete_dir_refuses_a_summary_whose_parts_contradict(tmp_path: Path, edits: dict, message: str) -> None:

@@ -132,10 +132,11 @@ def test_crashes_named_twice_or_at_steps_no_episode_has_are_refused(tiny: Path, 
 
 
 def test_a_crash_on_an_episodes_last_step_is_taken(tiny: Path, tmp_path: Path) -> None:
-    """T22-07: the bound is the kernel's: a crash at control step n_steps (20) is one a run records."""
-    store = _edited(tiny, tmp_path / "s.sqlite", crash_episodes=[0, 1], crash_steps=[20, 1])
+    """T22-07: the bound is the kernel's: a crash at control step n_steps (20) is one a run records (charged no step
+    left, so of any return; a crash at step 1 of these returns is not: T26-B09)."""
+    store = _edited(tiny, tmp_path / "s.sqlite", crash_episodes=[0, 1], crash_steps=[20, 20])
     with Store(store, create=False) as held:
-        assert checked_units(held, "tr1", "quick")[2][RUN].crash_steps == (20, 1)
+        assert checked_units(held, "tr1", "quick")[2][RUN].crash_steps == (20, 20)
 
 
 @pytest.mark.parametrize(

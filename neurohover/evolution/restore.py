@@ -22,7 +22,7 @@ from .fitness import ERROR_FLOOR
 from .generational import GenerationalNE
 from .optimisers import OPTIMISERS
 from .records import check_history, decode_history
-from .steady_state import SteadyStateNE
+from .steady_state import SteadyStateNE, steady_state_evaluations
 
 if TYPE_CHECKING:
     from .run import Run
@@ -139,6 +139,7 @@ def _restored_parts(state: dict, run: Run, opt: Optimiser) -> dict[str, Any]:
     if kernel > wall:  # (each kernel call is timed inside the run's wall time; T21-03)
         raise EntryError(f"counter 'kernel_seconds' is {kernel!r}, more than the run's wall_seconds {wall!r} (its kernel time is part of them)")
     _check_tracker_kept(opt)
+    _check_generation(opt, counts)
     champion = _checked_champion(state["champion"], run.cfg.prototype.genome.size, run.fitness)
     own = run.method in OPTIMISERS and run.family is not None
     _check_run_champion(champion, own, counts["generation"], run.method, opt)
@@ -149,6 +150,29 @@ def _restored_parts(state: dict, run: Run, opt: Optimiser) -> dict[str, Any]:
     # every other run's is its optimiser's (Run._champion_return).
     check_history(history, counts, per_generation=run.method == "generational" or own, champion=champion[1] if own else float(opt.champion_return))
     return {"counters": counts, "seconds": seconds, "champion": champion, "history": history, "race_delta": race_delta}
+
+
+def _check_generation(opt: Optimiser, counts: dict[str, int]) -> None:
+    """EntryError unless the counters' generation is the restored optimiser's (steady state and generational NE count
+    their tells, one a generation of the run) and, of steady state, its evaluations the ones its generations make
+    (:func:`~.steady_state.steady_state_evaluations`): a counters.generation of 5 beside an optimiser at generation 1
+    was resumed and written as the run's generations (T26-B05)."""
+    if not isinstance(opt, (SteadyStateNE, GenerationalNE)):
+        return
+    gen = counts["generation"]
+    if gen != opt.generation:
+        raise EntryError(
+            f"counter 'generation' is {gen:,}, but optimizer_state.generation is {opt.generation:,}: "
+            f"the optimiser is told once a generation of the run (allowed {opt.generation:,})"
+        )
+    if isinstance(opt, SteadyStateNE):
+        s = opt.settings
+        evaluations = steady_state_evaluations(gen, s.pop_size, s.elite_size)
+        if counts["evaluations"] != evaluations:
+            raise EntryError(
+                f"counter 'evaluations' is {counts['evaluations']:,}, but its {gen:,} steady-state generations are {evaluations:,} evaluations "
+                f"(pop_size {s.pop_size}, then {s.pop_size - s.elite_size} a generation): allowed {evaluations:,}"
+            )
 
 
 def _check_tracker_kept(opt: Optimiser) -> None:

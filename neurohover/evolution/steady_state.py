@@ -476,12 +476,20 @@ class SteadyStateNE(ChampionViews):
         return opt
 
 
+def steady_state_evaluations(generation: int, pop_size: int, elite_size: int) -> int:
+    """The evaluations of a steady-state run after ``generation`` generations: its first is the whole population of
+    ``pop_size``, each later one ``pop_size - elite_size`` offspring (pop_size 50, elite 49: generation 1 is 50
+    evaluations, generation 15 is 64). The one rule of it: a checkpoint's optimiser state and counters, and a stored
+    steady-state unit's generations against its evaluations (T26-B04, T26-B05)."""
+    return 0 if generation == 0 else pop_size + (generation - 1) * (pop_size - elite_size)
+
+
 def _check_progress(opt: SteadyStateNE) -> None:
     """NeurohoverError unless a restored optimiser's generation, evaluations, population and champion agree as
     :meth:`SteadyStateNE.tell` makes them: a generation of 2**70, an all-NaN fitness beside a finite champion and a
     champion's return of -1 below the population's best were taken (T19-08, T19-09)."""
     s, gen, t, what = opt.settings, opt._generation, opt._tracker, "SteadyStateNE state dict"
-    evaluations = 0 if gen == 0 else s.pop_size + (gen - 1) * (s.pop_size - s.elite_size)  # the first batch is the whole population
+    evaluations = steady_state_evaluations(gen, s.pop_size, s.elite_size)  # the first batch is the whole population
     if (opt._population is None) != (gen == 0) or t.evaluations != evaluations:
         raise NeurohoverError(
             f"{what} has generation={gen}, tracker evaluations={t.evaluations} and {'no' if opt._population is None else 'a'} population:"

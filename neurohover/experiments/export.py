@@ -125,6 +125,27 @@ def _replannable(config: ExperimentConfig) -> bool:
         return False
 
 
+def _stray_text(key: str, more: str, units: list[dict], planned: dict) -> str:
+    """The refusal of stored unit ``key`` that the config does not plan. Where a unit it is made from is missing, that is
+    the fault named: its params' ``source`` (a robustness unit's: the evolution run whose champion it flies) that the
+    store does not hold, else a planned unit of its group and MDP it does not hold (a robustness unit is planned once
+    every run of its variant on its MDP is stored). A deleted evolution run was told as a robustness unit the config
+    does not plan (T26-B15)."""
+    held = {u["key"] for u in units}
+    params = next((u["params"] for u in units if u["key"] == key), None)
+    source = params.get("source") if isinstance(params, dict) else None
+    parsed = UnitKey.parse(key)
+    if not (isinstance(source, str) and source not in held and UnitKey.parse(source).stage):
+        same = (UnitKey.parse(k) for k in sorted(planned) if k not in held)
+        source = next((k.key for k in same if k.stage != parsed.stage and (k.group, k.mdp) == (parsed.group, parsed.mdp)), None)
+    if source is not None and parsed.stage:
+        return (
+            f"it holds unit {key!r}{more}, made from unit {source!r}, which it does not hold: the config plans the one once the other "
+            "is stored; the unit it is made from was removed or moved (reproduce --fresh starts it over)"
+        )
+    return f"it holds unit {key!r}{more}, which the config does not plan (reproduce --fresh starts it over)"
+
+
 def _check_planned(store: Store, config: ExperimentConfig, units: list[dict]) -> Plan | None:
     """Refuse a stored unit its stored config does not plan, or one whose kind or params (the seed, the episodes) are not
     those the config plans for its key: reproduce refused both (seventh, eighth trial) while results and report exported
@@ -141,7 +162,7 @@ def _check_planned(store: Store, config: ExperimentConfig, units: list[dict]) ->
     stray = sorted(u["key"] for u in checked if u["key"] not in known)
     if stray:
         more = f" (and {len(stray) - 1} more)" if len(stray) > 1 else ""
-        raise NeurohoverError(f"it holds unit {stray[0]!r}{more}, which the config does not plan (reproduce --fresh starts it over)")
+        raise NeurohoverError(_stray_text(stray[0], more, checked, planned))
     for u in checked:
         p = planned.get(u["key"])
         if p is None:

@@ -12,7 +12,7 @@ from ..compete_files import NO_OFFLINE, NO_SAFEGUARD, policy_label_problem
 from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..evolution.state_codec import MAX_SECONDS
 from ..integrations.neat import NEAT_TOPOLOGY
-from ..sim.constants import WORST_RETURN
+from ..sim.constants import CRASH_STEP_PENALTY, WORST_RETURN
 
 if TYPE_CHECKING:
     from .results import EvolveResult, ModelResult, RobustnessResult, TestRunResult
@@ -165,6 +165,12 @@ def params_problem(result: Any, params: Any) -> str:
         for i, step in enumerate(result.crash_steps or ()):
             if not 1 <= step <= n_steps:
                 return f"crash_steps[{i}] = {step!r} is not allowed: its unit's episodes are {n_steps} control steps long: allowed 1..{n_steps}"
+            charge, e = CRASH_STEP_PENALTY * (n_steps - step), result.crash_episodes[i]
+            if float(result.returns[e]) > -charge + 1e-9 * charge:  # sim.kernel.crash_charge: none for a crash on the last step (T26-B09)
+                return (
+                    f"returns[{e}] = {brief(result.returns[e])} is not allowed: episode {e} crashed at step {step} of its {n_steps}, and a crash is "
+                    f"charged {CRASH_STEP_PENALTY:.6g} for each step left: allowed at most {-charge:.10g}"
+                )
     return ""
 
 
@@ -385,7 +391,39 @@ def evolve_params_problem(run: EvolveResult, params: dict) -> str:
             )
         if where and whole_number(again) and held.episodes != again:
             return f"{where}episodes = {brief(held.episodes)} is not allowed: its unit's params.champion_reevaluation is {again}: allowed {again}"
-    return _history_fall_problem(run, params) or _budget_problem(run, params)
+    return _history_fall_problem(run, params) or _budget_problem(run, params) or _generations_problem(run, params)
+
+
+def _generations_problem(run: EvolveResult, params: dict) -> str:
+    """'' unless a steady-state run's generations and evaluations contradict its unit's optimiser settings ('' where its
+    params are of another shape: the plan check's to name): a unit of the neuroevolution (optimiser name ne) on one MDP
+    (params.target.kind 'mdp'), not NEAT, evolves by steady state, whose generations make its evaluations
+    (:func:`~neurohover.evolution.steady_state.steady_state_evaluations`, the checkpoint's rule): generations 40 beside
+    50 evaluations of pop_size 50, elite 49 were reported (T26-B04)."""
+    from ..evolution.config import NE, make_settings, optimiser_of
+    from ..evolution.steady_state import steady_state_evaluations
+
+    target, table = params.get("target"), params.get("optimiser", {})
+    on_mdp = isinstance(target, dict) and target.get("kind") == "mdp" and isinstance(table, dict)
+    if not on_mdp or NEAT_TOPOLOGY in (params.get("topology"), run.champion.topology):
+        return ""
+    try:
+        name, rest = optimiser_of(table)
+        settings = make_settings("steady-state", NE, rest) if name == NE else None
+    except (NeurohoverError, TypeError):
+        return ""
+    if settings is None:
+        return ""
+    pop, elite, g, ev = settings.pop_size, settings.elite_size, run.generations, run.evaluations
+    if ev == steady_state_evaluations(g, pop, elite):
+        return ""
+    each = f"its first generation evaluates {pop} candidates, each later one {pop - elite}"
+    rule = f"its unit evolves by steady state (pop_size {pop}, elite_size {elite}: {each})"
+    if ev >= pop and (ev - pop) % (pop - elite) == 0:
+        fits = 1 + (ev - pop) // (pop - elite)
+        return f"generations = {g!r} is not allowed: {rule}, and its {ev} evaluations are generation {fits}: allowed {fits}"
+    made = steady_state_evaluations(g, pop, elite)
+    return f"evaluations = {ev!r} is not allowed: {rule}, and its {g} generations are {made} evaluations: allowed {made}"
 
 
 def _history_fall_problem(run: EvolveResult, params: dict) -> str:
