@@ -24,7 +24,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .errors import NeurohoverError, OutputError, brief
-from .filekinds import SQLITE_HEADER, held_kind, output_name, refuse_run_file_name, refuse_suffix
+from .filekinds import SQLITE_HEADER, held_kind, output_name
 
 try:
     import fcntl
@@ -32,8 +32,6 @@ except ImportError:  # not POSIX: no output lock; one run per output is then the
     fcntl = None  # type: ignore[assignment]
 
 __all__ = [
-    "refuse_run_file_name",  # filekinds' (policies and models import them from here)
-    "refuse_suffix",
     "JSONError",
     "WriterLock",
     "checked_path",

@@ -330,7 +330,7 @@ def check_json_policy_name(path: object, option: str) -> None:
             f"{option} {text!r}: a policy is written as JSON, which load_policy would misread under the .net suffix "
             "(the authors' format); give a .json name, or write the authors' format with netfile.policy_to_net"
         )
-    from .paths import refuse_run_file_name, refuse_suffix
+    from .filekinds import refuse_run_file_name, refuse_suffix
 
     refuse_run_file_name(text, option)  # another run's checkpoint or history was overwritten by a policy (T24-01)
     # f.npz, q.txt: flight data and other files were overwritten (T24-01)

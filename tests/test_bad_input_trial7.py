@@ -283,9 +283,11 @@ def test_a_policy_of_another_task_is_flown_with_a_note_and_a_bad_task_is_refused
     nh.save_policy(nh.baseline_policy(), other, task="ghh09")
     rc, _, err = cli("fly", "--task", "ghh08", "--episodes", "1", "--policy", str(other))
     assert rc == 0 and "note: --policy " in err and "was evolved for ghh09; flying it on ghh08" in err, err
-    nh.save_policy(nh.baseline_policy(), tmp_path / "t5.json", task=5)
+    with pytest.raises(nh.NeurohoverError, match="its task 5 is not allowed: allowed ghh08, ghh09, fghh"):  # nor written (T26-B07)
+        nh.save_policy(nh.baseline_policy(), tmp_path / "t5.json", task=5)
+    (tmp_path / "t5.json").write_text(json.dumps({**json.loads(other.read_text()), "task": 5}))
     rc, _, err = cli("fly", "--task", "ghh08", "--episodes", "1", "--policy", str(tmp_path / "t5.json"))
-    assert rc == 2 and "the policy's metadata task=5 is not allowed" in err, err
+    assert rc == 2 and "its task 5 is not allowed" in err, err
 
 
 def test_settings_print_a_shared_entry_once() -> None:

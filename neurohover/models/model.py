@@ -37,7 +37,8 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import NeurohoverError, as_floats, brief, finite_real, whole_number
-from ..paths import json_text, refuse_suffix
+from ..filekinds import refuse_suffix
+from ..paths import json_text
 from ..sim.constants import CONTROL_DT, DEFAULT_NOISE_STD, DEFAULT_PARAMS, MAX_SECONDS, NOISE_NAMES, PARAM_NAMES, SUBSTEP_DT, SUBSTEPS
 from ..tasks import MDP, finite_vector
 from .wind import NO_WIND, WindModel
