@@ -44,6 +44,8 @@ from .tasks import N_TEST, N_TRAINING, Drift, Sensor, get_task_family
 from .tasks.drift import MAX_RUN_EPISODES  # a run's episodes, the bound of a drifting MDP's episodes too
 
 STORE_FILE = "results.sqlite"
+#: The attribute an interrupted :func:`compete`'s KeyboardInterrupt carries once its runs began: how many had finished.
+FINISHED_RUNS = "finished_runs"
 
 
 #: The LR-fit settings a competition takes (``lr_fit``): the experiment groups' keys of the same names.
@@ -313,7 +315,8 @@ def compete(
     ------
     KeyboardInterrupt
         When interrupted (SIGTERM too while ``jobs > 1``), after writing ``episodes.csv`` of every
-        finished run; the store keeps them, and the same call resumes.
+        finished run (none: no file is written); the store keeps them, and the same call resumes. Once the runs
+        began, the exception's attribute ``finished_runs`` (:data:`FINISHED_RUNS`) says how many had finished.
     """
     from .agents.registry import agent_spec, check_agent
     from .paths import output_dir
@@ -328,6 +331,7 @@ def compete(
     store_path = _checked_store(store)
     out = output_dir(out, "out")  # made once every setting is checked (None was a TypeError, /dev/full a FileExistsError)
     store_path = store_path or out / STORE_FILE
+    _refuse_other_files(out)
     _refuse_other_settings(config, store_path)
     _note_replaced(out / "summary.json", task, agent)
     ordered = _run_into_store(config, store_path, out / "episodes.csv", jobs=jobs, device=device, progress=progress, on_result=on_result)
@@ -399,11 +403,12 @@ def _run_into_store(config, store_path: Path, episodes_csv: Path, *, jobs: int, 
             if run.units_before:  # say so, as reproduce does: these runs were not flown again
                 reused = f"{run.units_before} of {run.units_total} units (runs and the policies they fly)"
                 print(f"neurohover compete: {reused} were already in {store_path}: reused", file=sys.stderr)
-        except KeyboardInterrupt:  # the finished runs written, for the user to see (the same call resumes them)
+        except KeyboardInterrupt as stop:  # the finished runs written, for the user to see (the same call resumes them)
             executor.close()
             ordered = stored_runs(db)
             if ordered:  # none: the folder stays as it was (an earlier competition's rows were replaced by a header; tenth trial)
                 _write_episodes(episodes_csv, ordered, config.typed.n_steps)
+            setattr(stop, FINISHED_RUNS, len(ordered))  # for the command's line: none finished is said so (T26-A08)
             raise
         finally:
             executor.close()
@@ -442,15 +447,43 @@ def _write_summary(path: Path, summary: dict) -> None:
         partial.write_text(json.dumps(summary, indent=1) + "\n")
 
 
+#: The files compete writes in its output directory that another neurohover file may sit at, and what
+#: :func:`~neurohover.filekinds.held_kind` calls each when compete wrote it.
+_OWN_FILES = {"summary.json": "a competition summary (summary.json)", "episodes.csv": "a competition's episodes (episodes.csv)"}
+
+
+def _refuse_other_files(out: Path) -> None:
+    """Refuse an output directory whose summary.json or episodes.csv is not a competition's, naming what it is, before
+    any run: flight data, a model or a policy file there was replaced without a word (T26-A06). An empty file is
+    replaced (nothing is lost), and so is an older competition's summary (its task and agent, which
+    :func:`_note_replaced` names); a file no neurohover command wrote is refused too (it may be anyone's)."""
+    from .filekinds import held_kind
+
+    for name, own in _OWN_FILES.items():
+        path = out / name
+        if not (path.is_dir() or path.is_file()) or (path.is_file() and path.stat().st_size == 0):
+            continue
+        held = "a directory" if path.is_dir() else held_kind(path)
+        if held == own or (held is None and name == "summary.json" and _held_competition(path) is not None):
+            continue
+        what, written = held or "no file compete wrote", own.replace(f" ({name})", "")
+        raise NeurohoverError(f"{name} in {brief(str(out))} is {what}: compete would replace it with {written}; move it away or give another output directory")
+
+
+def _held_competition(summary_path: Path) -> tuple[str, str] | None:
+    """The (task, agent) of the competition summary at ``summary_path``, None for anything else (no file, not one)."""
+    try:
+        before = json.loads(summary_path.read_text())
+        return (before["task"], before["agent"])
+    except (OSError, ValueError, RecursionError, KeyError, TypeError):
+        return None
+
+
 def _note_replaced(summary_path: Path, task: str, agent: str) -> None:
     """Say when ``out`` holds another competition, whose files this one replaces (without a word before; eighth trial);
     its runs stay in the store."""
-    try:
-        before = json.loads(summary_path.read_text())
-        held = (before["task"], before["agent"])
-    except (OSError, ValueError, RecursionError, KeyError, TypeError):
-        return  # none, or not a summary: nothing to name
-    if held != (task, agent):
+    held = _held_competition(summary_path)
+    if held is not None and held != (task, agent):  # None: no summary, nothing to name
         print(
             f"neurohover compete: note: {str(summary_path.parent)!r} held the competition of {held[1]} on {held[0]}; its episodes.csv, "
             "summary.json and plot are replaced (its runs stay in the store)",

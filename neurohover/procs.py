@@ -9,7 +9,12 @@ busy with a unit nobody will record, then idles as an orphan. The pools made her
   :data:`WATCH_SECONDS` everywhere (a worker reparented to init or a subreaper exits at once);
 - :func:`sigterm_as_interrupt` turns SIGTERM in the parent into :class:`Terminated` (a
   KeyboardInterrupt), so the parent's Ctrl-C path runs: finished work is kept, the workers are
-  ended by :func:`stop_pool`, and the command exits as if interrupted.
+  ended by :func:`stop_pool`, and the command exits as if interrupted;
+- a worker never hears Ctrl-C (SIGINT stays blocked in it from its first instruction on: a
+  terminal sends it to the whole process group) and dies of SIGTERM at once without a word: the
+  parent alone decides, and ends its workers. A worker that raised KeyboardInterrupt as it
+  imported, or while formatting an exception the parent's SIGTERM then interrupted, printed its
+  tracebacks (T26-A01).
 """
 
 from __future__ import annotations
@@ -69,10 +74,38 @@ def watch_parent(parent: int, pdeathsig: bool = True) -> None:
     """
     if pdeathsig:
         _die_with_parent()
+    _deaf_to_ctrl_c()  # already so where the parent spawned it (:class:`_Pool`); this covers any other spawn
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # stop_pool's SIGTERM ends it at once, with no Python code run (T26-A01)
     if os.getppid() != parent:  # the parent died before the watch began
         os._exit(1)
     # The thread covers the other systems (a numba kernel holding the GIL may delay it a little).
     threading.Thread(target=_watch, args=(parent,), name="neurohover-parent-watch", daemon=True).start()
+
+
+def _deaf_to_ctrl_c() -> set[int | signal.Signals]:
+    """Block SIGINT in this thread (and the threads and processes it starts later); the mask it replaces."""
+    if not hasattr(signal, "pthread_sigmask"):  # not POSIX
+        return set()
+    return signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+
+
+class _Pool(ProcessPoolExecutor):
+    """A ProcessPoolExecutor whose workers start with SIGINT blocked (the mask survives fork and exec), so that a Ctrl-C
+    sent to the process group never reaches them, not even while they start (T26-A01). The parent's own Ctrl-C is not
+    lost: it waits, pending, the milliseconds the worker takes to start (or another thread takes it)."""
+
+    def _spawn_process(self) -> None:  # where ProcessPoolExecutor starts every worker (Python 3.9 on; not in typeshed)
+        if not hasattr(signal, "pthread_sigmask"):
+            super()._spawn_process()  # type: ignore[misc]
+            return
+        from multiprocessing import resource_tracker
+
+        resource_tracker.ensure_running()  # started first: starting, it unblocks SIGINT (and SIGTERM) in this thread
+        previous = _deaf_to_ctrl_c()
+        try:
+            super()._spawn_process()  # type: ignore[misc]
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def max_jobs() -> int:
@@ -83,7 +116,8 @@ def max_jobs() -> int:
 def worker_pool(jobs: int) -> ProcessPoolExecutor:
     """A pool of ``jobs`` (1 to :func:`max_jobs`) spawned worker processes that exit when this process dies.
 
-    Spawned, not forked: numba's thread pools are not fork-safe.
+    Spawned, not forked: numba's thread pools are not fork-safe. The workers never hear Ctrl-C, and SIGTERM ends them
+    without a word (:func:`stop_pool` sends it): the parent stops them.
     """
     if not whole_number(jobs) or jobs < 1:  # 0 was concurrent.futures' error, '2' a TypeError (thirteenth trial, F16)
         raise NeurohoverError(f"jobs={brief(jobs)} is not allowed: give a whole number of worker processes >= 1")
@@ -91,7 +125,7 @@ def worker_pool(jobs: int) -> ProcessPoolExecutor:
         raise NeurohoverError(f"jobs={brief(jobs)} is not allowed: give at most {max_jobs()} worker processes (the cores of this machine)")
     jobs = int(jobs)
     main = threading.current_thread() is threading.main_thread()
-    return ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("spawn"), initializer=watch_parent, initargs=(os.getpid(), main))
+    return _Pool(max_workers=jobs, mp_context=multiprocessing.get_context("spawn"), initializer=watch_parent, initargs=(os.getpid(), main))
 
 
 def stop_pool(pool: ProcessPoolExecutor) -> None:

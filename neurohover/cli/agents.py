@@ -108,14 +108,19 @@ def cmd_compete(args: argparse.Namespace) -> int:
             agent_settings=agent_settings,
         )
     except KeyboardInterrupt as stop:
+        from ..compete import FINISHED_RUNS
         from ..procs import stop_words
 
         how, status = stop_words(stop)
-        print(
-            f"neurohover compete: {how}; the finished runs are in {printable(args.out)}/episodes.csv and the results store; "
-            "run the same command again to resume",
-            file=sys.stderr,
-        )
+        finished = getattr(stop, FINISHED_RUNS, None)  # None: stopped before or after the runs, no file to name
+        if finished:
+            runs = "its 1 finished run is" if finished == 1 else f"its {finished} finished runs are"
+            said = f"{runs} in {printable(args.out)}/episodes.csv and the results store; run the same command again to resume"
+        elif finished == 0:  # it named an episodes.csv that was never written (T26-A08)
+            said = "no run had finished; run the same command again to start"
+        else:
+            said = "run the same command again to resume"
+        print(f"neurohover compete: {how}; {said}", file=sys.stderr)
         return status
     print(f"{'agent':<18} {'runs':>5} {'mean cum. return':>17} {'sd':>12} {'crash rate':>11} {'return/ep after learning':>25}")
     print(
