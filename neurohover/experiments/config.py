@@ -41,7 +41,7 @@ from typing import Any
 from ..errors import NeurohoverError, brief, finite_real
 from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..models.model import LEGACY_MODEL_SUBSTEPS
-from .schema import SCHEMAS, check_given, check_kind, validate_table
+from .schema import SCHEMAS, check_given, check_kind, check_used, validate_table
 from .settings import ExperimentSettings, typed_settings
 
 CONFIG_DIR = Path(__file__).parent / "configs"
@@ -307,6 +307,8 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
             resolved = validate_table({**raw["settings"], **scales[other]}, SCHEMAS[kind], f"{where} at scale {other!r}")
             check_kind(resolved, kind, f"{where} at scale {other!r}")
     merged = {**raw["settings"], **scales[scale], **(overrides or {})}
+    # the file's own settings where --set switched the policies source (its policy-evolution settings stay accepted)
+    switched = frozenset({*raw["settings"], *scales[scale]} - set(overrides or {})) if "policies" in (overrides or {}) else frozenset()
     config = make_config(
         raw["name"],
         kind,
@@ -317,6 +319,7 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
         paper_ref=raw.get("paper_ref", ""),
         source=str(path),
         where=f"{where} at scale {scale!r}",
+        switched=switched,
     )
     check_paper(raw.get("paper", {}), raw, where)  # after the settings: a bad agent is named as such, not as a t test naming nothing
     _check_seeds_of(config, where)
@@ -468,6 +471,8 @@ def check_paper(paper, raw: dict, where: str) -> None:
         for side in ("a", "b"):
             if t[side] not in names:
                 raise NeurohoverError(f"{where}: [paper] ttests names {t[side]!r} ({side}), which is no group, variant, method or fit of the config")
+        if t["a"] == t["b"]:  # a group against itself: p = 1, and a verdict of "reversed" for equal means (T26-A05)
+            raise NeurohoverError(f"{where}: [paper] ttests compares {brief(t['a'])} with itself (a = b): give two different groups, variants, methods or fits")
     for key in _PAPER_NUMBERS:  # an entry of no name the report looks up was never shown, without a word
         allowed = names | ({"mlp-baseline"} if key == "table3" else set())  # table3's row for a policy set's specialised MLPs
         for name in paper.get(key, {}):
@@ -486,11 +491,13 @@ def make_config(
     paper_ref: str = "",
     source: str = "",
     where: str | None = None,
+    switched: frozenset[str] = frozenset(),
 ) -> ExperimentConfig:
     """Validate ``settings`` of an experiment of ``kind`` and resolve them into a config.
 
     The one path from settings to a config: shipped TOML files (:func:`load_config`) and inline
-    experiments (``neurohover compete``) both come through here.
+    experiments (``neurohover compete``) both come through here. ``switched``: the settings a config file gives where
+    ``--set policies=...`` switched its policies source (:func:`~.schema.check_used` accepts their policy-evolution ones).
     """
     where = where or f"experiment {name!r}"
     check_name(name, where)
@@ -503,6 +510,7 @@ def make_config(
     resolved = validate_table(dict(settings), SCHEMAS[kind], where)
     check_given(settings, where)
     check_kind(resolved, kind, where)
+    check_used(settings, resolved, kind, where, switched)
     paper = {} if paper is None else paper
     check_paper_table(paper, where)  # after the settings: a bad agent is named as such
     from .plans import external_digest

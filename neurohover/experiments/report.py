@@ -31,6 +31,7 @@ from .report_evolution import EvolutionSection
 from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, test_run_figure, varies
 from .report_models import SensorModels
 from .report_readme import Status, fill_generated, linked_claims, status_table
+from .report_scale import header_note, scale_note
 from .results import ModelResult, TestRunResult
 from .settings import Group, ModelLearningSettings
 from .store import Store
@@ -398,7 +399,6 @@ def curve_style(i: int) -> dict:
     return {"color": f"C{i % 10}", "ls": ("-", "--", ":", "-.")[(i // 10) % 4]}
 
 
-QUICK_NOTE = "a fast smoke-scale run: short episodes and few runs; magnitudes are not comparable with the paper"
 _SECTIONS = {"evolution": EvolutionSection, "model_learning": _ModelLearning, "test_runs": _TestRuns}
 
 _SETTING_KEYS = (
@@ -434,7 +434,7 @@ def _header(cfg: ExperimentConfig, store: Store, units: list[dict], total: int |
     status = "complete" if total is not None and done >= total else f"INCOMPLETE ({done} of {total} units)"
     return (
         f"- Paper: {cfg.paper_ref or 'n/a'}\n"
-        f"- Scale: **{cfg.scale}** ({'the paper protocol' if cfg.scale == 'paper' else QUICK_NOTE}); config hash `{cfg.hash}`\n"
+        f"- Scale: **{cfg.scale}** ({scale_note(cfg)}); config hash `{cfg.hash}`\n"
         f"- Settings: {settings}\n"
         f"- Units: {done} finished, {status}\n"
         f"- Time: {wall:.1f} s wall over {len(sessions)} session(s) on {', '.join(map(str, cores)) or '?'} core(s) "
@@ -580,8 +580,7 @@ def _write_report(store: Store, out: Path, scale: str | None, names: list[str] |
     head = (
         f"# Reproduction report: Koppejan & Whiteson (2011)\n\n"
         f"Generated {time.strftime('%Y-%m-%d %H:%M:%S')} from the results store `{printable(store.path)}`. Error is minus the "
-        f"return (lower is better). Quick-scale runs use short episodes and few runs: they check the pipeline, and "
-        f"their numbers are not comparable in magnitude with the paper's.\n\n" + "\n".join(toc) + "\n"
+        f"return (lower is better).{header_note({sc for _, sc in entries})}\n\n" + "\n".join(toc) + "\n"
     )
     summary = claims_section(claims) if claims else ""
     head += "\n" + summary + conclusions_discussion(out) if summary else ""

@@ -38,6 +38,12 @@ POLICY_SET_GROUP = "policy-set"
 SCHEMAS: dict[str, dict[str, tuple[Any, Any]]] = {kind: schema_of(cls) for kind, cls in KIND_SETTINGS.items()}
 
 
+#: A group's options of the LR models its agents learn, each with the value that leaves a group's units as they are
+#: (given on a group whose agents learn no models: refused; OMIT, any value given). The estimator is written into every
+#: group (absent: "ols"); a baseline group's "gls" was stored without a word while the others were refused (T26-A03).
+MODEL_OPTIONS: dict[str, Any] = {"d_u": OMIT, "noise": OMIT, "model_policy": OMIT, "model_substeps": OMIT, "wind_model": "none", "estimator": "ols"}
+
+
 #: What 0 means for the budget settings that take it: no cap, the run stopped by its own rule (the units pass 0 on as no
 #: budget, ``budget or None``): told where one is refused, for a -1 or "unlimited" meant as no cap (T21-14).
 ZERO_MEANS = dict.fromkeys(
@@ -99,8 +105,8 @@ def check_given(settings: dict, where: str) -> None:
     a NEAT variant's ``prototype`` (NEAT starts from its own genomes: its neat table's ``start``), a group's
     ``exclude_own`` on MDPs other than the training MDPs (only those have a specialised policy of their own).
 
-    The policy-evolution settings (``policy_budget``, ``generic_budget``, ...) are not refused with ``policies`` other
-    than "evolve": one config serves both sources, and the paper-scale runs switch with ``--set policies=shipped``."""
+    The experiment-wide settings no unit uses are refused by :func:`check_used` (the policy-evolution settings a config
+    file gives stay accepted where ``--set policies=shipped`` switched its source: one config serves both sources)."""
     for i, g in enumerate(settings.get("groups") or []):
         if isinstance(g, dict) and g.get("exclude_own") is True and g.get("mdps", "test") != "train":  # accepted without a word (ninth trial)
             raise NeurohoverError(
@@ -113,6 +119,76 @@ def check_given(settings: dict, where: str) -> None:
                 f"{where}, variants[{i}]: prototype = {v['prototype']!r} does nothing for topology = 'neat': NEAT starts from its own "
                 "genomes; give neat = { start = 'baseline' } for the baseline-equivalent start, or leave prototype out"
             )
+
+
+def _given(written: dict, schema: dict, key: str) -> bool:
+    """Whether ``written`` (settings as written) gives ``key`` a value that changes the resolved config and its hash: any
+    value of a setting left out when absent (OMIT), another than the default of one written in when absent."""
+    return key in written and (schema[key][0] is OMIT or written[key] != schema[key][0])
+
+
+def _idle(written: dict, schema: dict, keys: tuple[str, ...], applies: bool, whom: str, where: str) -> None:
+    """Refuse the ``keys`` given (:func:`_given`) when they apply to ``whom`` only and this config runs none (not ``applies``)."""
+    given = [k for k in keys if _given(written, schema, k)]
+    if given and not applies:
+        named = ", ".join(f"{k} = {brief(written[k])}" for k in given)
+        raise NeurohoverError(f"{where}: {named} {'applies' if len(given) == 1 else 'apply'} to {whom}; this config has none: leave it out")
+
+
+#: The test-runs settings of the policies an experiment evolves itself (policies = "evolve"): a --set policies=... on the
+#: command line leaves the config file's own standing (one config serves both sources, :func:`check_used`).
+POLICY_EVOLUTION_SETTINGS = ("policy_budget", "generic_budget", "generic_resampling", "generics_per_agent", "safety_episodes")
+
+
+def check_used(written: dict, settings: dict, kind: str, where: str, switched: frozenset[str] = frozenset()) -> None:
+    """Refuse an experiment-wide setting given (``written``: as written; ``settings``: resolved) that no unit of the
+    config uses, as a group's model options on agents that learn none are (T26-A02, T26-A04): it changed the config's hash
+    for nothing, so a store made without it refused the command, and --update ran every unit again. ``switched``: the
+    policy-evolution settings the config file gives where --set switched its policies source (accepted)."""
+    schema = SCHEMAS[kind]
+    if kind == "evolution":
+        robust = bool(settings["robustness_variants"]) or "robustness_policies" in settings
+        _idle(written, schema, ("robustness_episodes",), robust, "Table 3's robustness units (robustness_variants, or robustness_policies)", where)
+    if kind != "test_runs":
+        return
+    groups, task = settings["groups"], settings["task"]
+    learners = ", ".join(name for name, spec in AGENTS.items() if spec.learns_models)
+    learning = [g for g in groups if AGENTS[g["agent"]].learns_models]
+    _idle(written, schema, ("model_budget", "predict_episodes", "max_learning_episodes"), bool(learning), f"the agents that learn models ({learners})", where)
+    authors = any(g.get("model_policy") == "authors" for g in learning)
+    _idle(written, schema, ("authors_generations",), authors, "the groups of agents that learn models with model_policy = 'authors'", where)
+    fghh = TASK_FAMILIES[task].generic_over_distribution
+    needs = {n for g in groups for n in AGENTS[g["agent"]].needs} | {AGENTS[g["agent"]].generic_kind for g in groups if fghh}
+    evolved = (needs - set(settings.get("generics_from") or {})) if settings["policies"] == "evolve" else set()
+    written = {k: v for k, v in written.items() if k not in switched or k not in POLICY_EVOLUTION_SETTINGS}
+    source = "policies = 'evolve'" + (f", and this config's policies are {brief(settings['policies'])}" if settings["policies"] != "evolve" else "")
+    generics = "the FGHH generics an experiment evolves itself"
+    safe = "the safe pair an experiment chooses among the specialised policies it evolves"
+    rules: tuple[tuple[tuple[str, ...], bool, str], ...]
+    if fghh:
+        rules = (
+            (("policy_budget",), "zero" in evolved, f"the zero-setting generics an experiment evolves itself ({source}; task fghh)"),
+            (
+                ("generic_budget", "generic_resampling"),
+                bool(evolved & {"fixed", "race"}),
+                f"{generics} over G ({source}; agents flying them)",
+            ),
+            (("generics_per_agent",), bool(evolved & {"zero", "fixed", "race"}), f"{generics} ({source})"),
+            (("safety_episodes",), False, f"{safe} (a GHH task, not {task!r})"),
+        )
+    else:
+        safe_agents = ", ".join(name for name, spec in AGENTS.items() if "safe" in spec.needs)
+        rules = (
+            (
+                ("policy_budget",),
+                bool(evolved & {"generic", "specialised", "safe"}),
+                f"the policies an experiment evolves itself ({source}; agents flying them)",
+            ),
+            (("safety_episodes",), "safe" in evolved, f"{safe} ({source}; agents {safe_agents})"),
+            (("generic_budget", "generic_resampling", "generics_per_agent"), False, f"{generics} (task fghh, not {task!r})"),
+        )
+    for keys, applies, whom in rules:
+        _idle(written, schema, keys, applies, whom, where)
 
 
 def _check_neat_variant(settings: dict, v: dict, where: str) -> None:
@@ -253,8 +329,7 @@ def _check_test_runs(settings: dict, task: str, where: str) -> None:
         drift = g.get("drift") or settings.get("drift")
         if drift:  # a table checked by Drift (drift_table()); its change must come within the runs
             Drift.from_dict(drift).check_run(settings["episodes"], f"{where}: group {g['label']!r}")
-        lr_keys = [k for k in ("d_u", "noise", "model_policy", "model_substeps") if k in g]
-        lr_keys += ["wind_model"] if g.get("wind_model", "none") != "none" else []  # the LR model's wind (was ignored for others)
+        lr_keys = [k for k, idle in MODEL_OPTIONS.items() if k in g and g[k] != idle]
         if lr_keys and not AGENTS[g["agent"]].learns_models:
             learners = ", ".join(name for name, spec in AGENTS.items() if spec.learns_models)
             raise NeurohoverError(
