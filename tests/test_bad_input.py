@@ -142,7 +142,8 @@ def test_demo_refuses_zero_episodes_before_its_table(capsys) -> None:
 
 def test_the_script_prints_one_line_per_case() -> None:
     # One case in a fresh process (the script runs all of them by hand; each case runs in-process above).
-    proc = subprocess.run([sys.executable, str(Path(__file__).with_name("bad_input.py")), "--every", str(len(CASES))], capture_output=True, text=True, timeout=900)
+    script = str(Path(__file__).with_name("bad_input.py"))
+    proc = subprocess.run([sys.executable, script, "--every", str(len(CASES))], capture_output=True, text=True, timeout=900)
     lines = proc.stdout.strip().splitlines()
     assert proc.returncode == 0, proc.stdout + proc.stderr
     n = len(CASES[:: len(CASES)])
