@@ -18,6 +18,7 @@ from typing import Any
 
 import pytest
 from conftest import CliRun
+from policy_edits import edited, refused
 
 import neurohover as nh
 from neurohover.errors import NeurohoverError
@@ -44,24 +45,6 @@ def written(tmp_path_factory) -> Path:
         task = [] if "--task" in extra else ["--task", "ghh08"]
         assert main(["evolve", *task, *extra, *SHORT, "--out", str(where / f"{name}.json")]) == 0, name
     return where
-
-
-def edited(src: Path, dst: Path, **changes: Any) -> Path:
-    """``src``'s policy file with ``changes`` (a value None: the key removed) written to ``dst``."""
-    data = json.loads(src.read_text())
-    data.update(changes)
-    dst.write_text(json.dumps({k: v for k, v in data.items() if v is not None}))
-    return dst
-
-
-def refused(path: Path, *words: str) -> str:
-    with pytest.raises(NeurohoverError) as err:
-        nh.load_policy(path)
-    message = str(err.value)
-    assert message.startswith(f"policy file {str(path)!r}: its "), message
-    for word in words:
-        assert word in message, message
-    return message
 
 
 def test_the_files_evolve_writes_still_load(written: Path) -> None:

@@ -14,10 +14,10 @@ from __future__ import annotations
 import json
 import shutil
 from pathlib import Path
-from typing import Any
 
 import pytest
 from conftest import CliRun
+from policy_edits import edited, refused
 
 import neurohover as nh
 from neurohover.errors import NeurohoverError
@@ -52,24 +52,6 @@ def written(tmp_path_factory) -> Path:
     learn_lr(ev.flight_data).save(where / "m.json")
     build_policy_set("ghh08", where / "bp", budget=10, n_steps=20, safety_episodes=1)
     return where
-
-
-def edited(src: Path, dst: Path, **changes: Any) -> Path:
-    """``src``'s JSON file with ``changes`` (a value None: the key removed) written to ``dst``."""
-    data = json.loads(src.read_text())
-    data.update(changes)
-    dst.write_text(json.dumps({k: v for k, v in data.items() if v is not None}))
-    return dst
-
-
-def refused(path: Path, *words: str) -> str:
-    with pytest.raises(NeurohoverError) as err:
-        nh.load_policy(path)
-    message = str(err.value)
-    assert message.startswith(f"policy file {str(path)!r}: its "), message
-    for word in words:
-        assert word in message, message
-    return message
 
 
 def test_everything_written_still_loads(written: Path) -> None:
