@@ -278,8 +278,11 @@ class LearnedModel:
         missing = [k for k in ("method", "params", "noise_std") if k not in d]
         if missing:
             raise NeurohoverError(f"{source}: missing key(s) {', '.join(missing)}; a model needs method, params (11) and noise_std (6)")
-        if "param_names" in d and list(d["param_names"]) != list(PARAM_NAMES):
-            raise NeurohoverError(f"{source}: parameters are named {d['param_names']}, expected {list(PARAM_NAMES)}")
+        from .model_checks import model_entry_problem, model_file_problem  # here: model_checks imports this module
+
+        problem = model_entry_problem(d)  # entries of the wrong kind, before float() or dict() converts them (T27-B01, B02, B11)
+        if problem:
+            raise NeurohoverError(f"{source}: {problem}")
         try:
             wind = WindModel.from_dict(d["wind"], "wind") if "wind" in d else NO_WIND  # files before winds: none
             model = cls(d["params"], d["noise_std"], d["method"], float(d.get("seconds", 0.0)), dict(d.get("stats", {})), float(d.get("d_u", 0.0)), wind)
@@ -287,8 +290,6 @@ class LearnedModel:
             raise NeurohoverError(f"{source}: {err}") from None
         except (TypeError, ValueError) as err:
             raise NeurohoverError(f"{source}: malformed model ({err})") from None
-        from .model_checks import model_file_problem  # here: model_checks imports this module
-
         problem = model_file_problem(d, model)  # the file against itself (T23-10)
         if problem:
             raise NeurohoverError(f"{source}: {problem}")
@@ -428,12 +429,12 @@ def parameter_table(
     if isinstance(true_params, MDP):
         mdp = true_params
         truth = np.array(mdp.params, dtype=float)
-        noise = np.array(mdp.noise_std if true_noise_std is None else check_vector(true_noise_std, 6, "true noise std"))
+        noise = np.array(mdp.noise_std if true_noise_std is None else check_vector(true_noise_std, 6, "true noise std", nonnegative=True))
         substeps = mdp.substeps if substeps is None else substeps
         dt = mdp.dt if dt is None else dt
     else:
         truth = np.array(DEFAULT_PARAMS if true_params is None else check_vector(true_params, 11, "true parameters"))
-        noise = None if true_noise_std is None else np.array(check_vector(true_noise_std, 6, "true noise std"))
+        noise = None if true_noise_std is None else np.array(check_vector(true_noise_std, 6, "true noise std", nonnegative=True))  # T27-B12: -1 taken
     learned, learned_noise = model.equivalent(SUBSTEPS if substeps is None else substeps, SUBSTEP_DT if dt is None else dt)
 
     def rel(a: float, b: float) -> float:

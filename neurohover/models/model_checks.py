@@ -9,11 +9,11 @@ from __future__ import annotations
 import math
 
 from ..errors import NeurohoverError, brief, finite_real, whole_number
-from ..sim.constants import DEFAULT_PARAMS, MAX_EPISODE_STEPS, NOISE_NAMES, WORST_RETURN
+from ..sim.constants import DEFAULT_PARAMS, MAX_EPISODE_STEPS, NOISE_NAMES, PARAM_NAMES, WORST_RETURN
 from ..sim.rng import MAX_SEED
 from .model import LearnedModel, check_vector
 
-__all__ = ["FILE_ENTRIES", "model_file_problem"]
+__all__ = ["FILE_ENTRIES", "model_entry_problem", "model_file_problem"]
 
 
 #: The entries of a model file (:meth:`LearnedModel.to_dict`); files before winds lack "wind" and "d_u".
@@ -64,6 +64,23 @@ _STATS_ERRORS = (
 def _its(field: str, value: object, allowed: str) -> str:
     """The house message of a model file's entry ``field`` whose ``value`` is not allowed."""
     return f"its {field} {brief(value)} is not allowed: {allowed}"
+
+
+def model_entry_problem(d: dict) -> str:
+    """What entry of model file ``d`` is of a kind no model file holds, '' when none is: param_names other than the list
+    of the parameter names (None was a TypeError), a d_u or seconds not a number (text, a bool and null were converted
+    or Python's message) or seconds past policy files' bound, stats not a JSON object (a list of pairs became a dict).
+    Checked before the model is made of them (T27-B01, T27-B02, T27-B11); only entries the file holds."""
+    from ..policy_records import seconds_problem  # the one check of a file's seconds (policy files', T26-B13)
+
+    names = d.get("param_names", list(PARAM_NAMES))
+    if not (isinstance(names, list) and names == list(PARAM_NAMES)):
+        return _its("param_names", names, f"allowed the list {list(PARAM_NAMES)} (the names of params, in order)")
+    if "d_u" in d and not finite_real(d["d_u"]):
+        return _its("d_u", d["d_u"], "allowed a finite number (D_u, the constant u acceleration; 0.0 where none is fitted)")
+    if "stats" in d and not isinstance(d["stats"], dict):
+        return _its("stats", d["stats"], "allowed a JSON object (the fit's statistics by name)")
+    return seconds_problem(d)
 
 
 def model_file_problem(d: dict, model: LearnedModel) -> str:
