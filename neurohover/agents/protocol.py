@@ -34,7 +34,7 @@ from ..evaluate import MAX_EPISODES_PER_CALL, DangerousState, PolicyTable, evalu
 from ..evolution.seeding import check_seed
 from ..flightdata import FlightData
 from ..policies import Policy
-from ..sim.constants import EPISODE_STEPS
+from ..sim.constants import CRASH_STEP_PENALTY, EPISODE_STEPS, WORST_RETURN
 from ..tasks import MDP, TaskFamily
 from .spec import AgentSettings
 
@@ -98,6 +98,20 @@ def _check_count(what: str, value: object, least: int) -> None:
     whole_in(value, what, least, 2**63 - 1, "2**63-1")
 
 
+def _check_return(ret: float, crashed: bool, steps: int) -> None:
+    """NeurohoverError unless ``ret`` can be an episode's return (T27-B10): every reward is minus a sum of squares (so a
+    return is <= 0); a step that does not crash earns at least -CRASH_STEP_PENALTY (the worst state within the crash
+    limits), and a crash is charged that for each step left of a budget of at most MAX_EPISODE_STEPS (so no return is
+    below -WORST_RETURN): a return of ``steps`` uncrashed steps is at least -CRASH_STEP_PENALTY * steps."""
+    least = -WORST_RETURN if crashed else -CRASH_STEP_PENALTY * steps
+    if not least * (1 + 1e-9) <= ret <= 0:  # 1e-9: the rotation into the body frame keeps the squares to rounding
+        how = "an episode that crashed" if crashed else f"{steps} steps that did not crash"
+        raise NeurohoverError(
+            f"EpisodeOutcome ret={brief(ret)} is out of range: allowed {least:.10g}..0 for {how} "
+            f"(every reward is minus a sum of squares, at worst {CRASH_STEP_PENALTY:.6g} a step)"
+        )
+
+
 @dataclass(frozen=True)
 class EpisodeOutcome:
     """What the agent learns after an episode."""
@@ -118,6 +132,12 @@ class EpisodeOutcome:
             raise NeurohoverError(f"EpisodeOutcome crashed={brief(self.crashed)} is not allowed: give True or False")
         _check_count("EpisodeOutcome steps", self.steps, 0)
         _check_count("EpisodeOutcome safeguard_step", self.safeguard_step, -1)
+        # T27-B10: a safeguard step past the episode, a positive return and -1e30 for 20 steps were taken
+        if self.safeguard_step >= max(self.steps, 0):
+            raise NeurohoverError(
+                f"EpisodeOutcome safeguard_step={brief(self.safeguard_step)} of a {self.steps}-step episode is out of range: allowed -1 (never) or 0..steps-1"
+            )
+        _check_return(self.ret, self.crashed, self.steps)
         if self.flight_data is not None and not isinstance(self.flight_data, FlightData):
             raise NeurohoverError(f"EpisodeOutcome flight_data={brief(self.flight_data)} is not allowed: give the episode's FlightData or None")
 

@@ -73,10 +73,11 @@ def mutate(genome: np.ndarray, rng: np.random.Generator, settings: MutationParam
     Raises
     ------
     NeurohoverError
-        A genome or scale that is no real numbers, a scale of another size, an ``rng`` that is no Generator, or
+        A genome or scale that is no real numbers, a non-finite gene, a scale below 0 or of another size, an ``rng`` that is no Generator, or
         settings without the three fields in range (checked before any draw).
     """
     g = genome if type(genome) is np.ndarray and genome.dtype is _F64 else _genes(genome, "genome")
+    _check_finite(g, "genome")
     if not isinstance(rng, np.random.Generator):
         raise _bad_rng(rng)
     try:
@@ -92,6 +93,8 @@ def mutate(genome: np.ndarray, rng: np.random.Generator, settings: MutationParam
         scale = _genes(scale, "scale")
         if scale.size != g.size:  # was NumPy's broadcast error after the draws
             raise NeurohoverError(f"scale has shape {scale.shape}: give one number per gene of the genome, shape {g.shape}")
+        if not (np.isfinite(scale) & (scale >= 0)).all():  # -1 and NaN were taken (T27-B13)
+            raise NeurohoverError(f"scale={brief(scale)} is not allowed: give one finite number >= 0 per gene (a scale of delta)")
     hit_r = rng.random(g.size)
     delta = rng.normal(0.0, std, g.size)
     if scale is not None:
@@ -124,13 +127,15 @@ def crossover(a: np.ndarray, b: np.ndarray, rng: np.random.Generator, settings: 
     Raises
     ------
     NeurohoverError
-        Parents that are no real numbers or differ in shape, an ``rng`` that is no Generator, or settings without
+        Parents that are no real numbers, hold a non-finite gene or differ in shape, an ``rng`` that is no Generator, or settings without
         ``averaging_prob`` in [0, 1] (checked before any draw).
     """
     a = a if type(a) is np.ndarray and a.dtype is _F64 else _genes(a, "a")
     b = b if type(b) is np.ndarray and b.dtype is _F64 else _genes(b, "b")
     if a.shape != b.shape:
         raise NeurohoverError(f"crossover parents must have the same shape, got {a.shape} and {b.shape}")
+    _check_finite(a, "a")
+    _check_finite(b, "b")
     if not isinstance(rng, np.random.Generator):
         raise _bad_rng(rng)
     try:
@@ -153,6 +158,14 @@ _F64 = np.dtype(np.float64)
 def _genes(values, name: str) -> np.ndarray:
     """``values`` as float64 genes, or :func:`~neurohover.evolution.common.as_floats`' error."""
     return as_floats(values, name, "a genome: an array of real numbers")
+
+
+def _check_finite(genes: np.ndarray, name: str) -> None:
+    """NeurohoverError unless every gene is finite, as Policy, SteadyStateNE and CMAES require: NaN parents gave NaN
+    children silently (T27-B13)."""
+    if not np.isfinite(genes).all():
+        bad = np.flatnonzero(~np.isfinite(genes))
+        raise NeurohoverError(f"{name}={brief(genes)} is not allowed: a genome must hold finite numbers; genes {brief(bad.tolist())} are not")
 
 
 def _bad_rng(rng) -> NeurohoverError:
