@@ -32,7 +32,7 @@ import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real, whole_number
 from .paths import input_dir, strict_json
-from .sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS, MAX_SECONDS, WORST_RETURN
+from .sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS, MAX_SECONDS, WORST_RETURN, lowest_return
 from .sim.rng import MAX_SEED
 from .tasks.base import N_TEST, N_TRAINING
 
@@ -168,6 +168,7 @@ class _Rows:
     split_run: str | None = None  # the refusal of the first row of a run on a second MDP, said once the labels are checked
     after_learning: float | None = None
     least_charged: tuple[float, int, float, int] | None = None  # the crashed row nearest its charge: return / P - steps, line, return, steps
+    lowest: tuple[float, int] | None = None  # the lowest return and its line
 
 
 def _check_row(where: str, row: dict, crashed: int, steps: int | None) -> None:
@@ -242,6 +243,8 @@ def _read_rows(csv_path: Path) -> tuple[dict[int, list[tuple[int, float, str]]],
                 facts.run_lines.setdefault(run, line)
                 runs.setdefault(run, []).append((episode, ret, policy))
                 facts.crashes += crashed
+                if facts.lowest is None or ret < facts.lowest[0]:
+                    facts.lowest = (ret, line)
                 facts.mdps.setdefault(mdp, line)
                 facts.policies.setdefault(policy, line)
                 if facts.fired_line is None and row.get("safeguard_fired") == "1":
@@ -312,8 +315,30 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
     if facts.split_run is not None:  # after the summary's check of each label: a label of no MDP is named as such first
         raise NeurohoverError(facts.split_run)
     _check_run_mdps(csv_path, facts, len(runs))
+    _check_lengths(csv_path, facts, episode_steps)
     _check_crash_charge(csv_path, facts, episode_steps)
     return CompeteResult(label, returns, facts.crashes, path, conditions)
+
+
+def _check_lengths(csv_path: Path, rows: _Rows, episode_steps: object) -> None:
+    """Refuse rows of episodes of different lengths and a return below the lowest an episode of the competition's length
+    can have (:func:`~neurohover.sim.constants.lowest_return`). An episode that does not crash flies the whole episode,
+    so without a summary (whose check holds each row to its episode_steps) every uncrashed row's steps are one n and a
+    crashed row's at most n: steps 5 and 20 both uncrashed were plotted (T27-B04), as was a 20-step return of -1e9
+    (T27-B03)."""
+    n = episode_steps if whole_number(episode_steps) else None
+    whole = sorted((line, steps) for (crashed, steps), line in rows.steps.items() if not crashed)
+    if n is None and whole:
+        (first, n), where = whole[0], f"--compete {str(csv_path)!r}, line"
+        for (crashed, steps), line in sorted(rows.steps.items(), key=lambda item: item[1]):
+            if steps != n and (not crashed or steps > n):
+                what = f"a crash at step {steps}" if crashed else f"an uncrashed episode of {steps} steps"
+                why = f"line {first}'s uncrashed episode flies {n} steps, an uncrashed episode flies the whole episode"
+                raise NeurohoverError(f"{where} {line}: steps {steps} is not allowed: {what}, where {why}: allowed {n} (a crash's at most {n})")
+    if n is not None and rows.lowest is not None and rows.lowest[0] < lowest_return(n):
+        ret, line = rows.lowest
+        bound = f"{lowest_return(n):.10g} (the worst step, {CRASH_STEP_PENALTY:.6g}, for each of its {n} steps)"
+        raise NeurohoverError(f"--compete {str(csv_path)!r}, line {line}: return {ret!r} is not allowed: allowed at least {bound}")
 
 
 def _check_crash_charge(csv_path: Path, rows: _Rows, episode_steps: object) -> None:

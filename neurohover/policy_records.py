@@ -14,7 +14,7 @@ from typing import Any
 
 from .errors import NeurohoverError, brief, finite_real, whole_number
 from .policies import RECORD_CHECKS
-from .sim.constants import MAX_EPISODE_STEPS, MAX_SECONDS, WORST_RETURN
+from .sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS, MAX_SECONDS, WORST_RETURN, lowest_return
 
 #: What a policy file's record of its run says the run was over: a task family (``ghh08/G``, ``fghh/G(sigma=0.3)``), not one MDP.
 _FAMILY_TARGET = re.compile(r"[a-z0-9]+/G(\(sigma=[^()]*\))?")
@@ -36,6 +36,7 @@ def policy_record_problem(meta: dict) -> str:
 
     counts = {"seed": (0, MAX_SEED, "in 0..2**63-1 (the run's root seed)"), "budget": (1, MAX_BUDGET, f"in 1..{MAX_BUDGET:,} (episodes), or null"),
               "n_steps": (1, MAX_EPISODE_STEPS, f"in 1..{MAX_EPISODE_STEPS:,} (control steps per episode)"),
+              "episode_steps": (1, MAX_EPISODE_STEPS, f"in 1..{MAX_EPISODE_STEPS:,} (control steps per episode)"),  # T27-B07
               "episodes": (1, None, ">= 1 (episodes flown)"), "evaluations": (1, None, ">= 1 (candidates evaluated)"),
               "generations": (0, None, ">= 0 (generations bred)")}  # fmt: skip
     for name, (low, high, allowed) in counts.items():
@@ -89,6 +90,9 @@ def _run_words_problem(meta: dict, own_stop: dict, stop_reasons: tuple, parse_re
             allowed = f"a return in [{-WORST_RETURN:.3g}, 0] (every reward is minus a sum of squares)"
             allowed += f", or a fitness 1/ln(error) in (0, {best_fitness:.8g}]" if fitness else f" for a {method} run (on the return scale)"
             return f"its champion_return {brief(ret)} is not allowed: allowed {allowed}"
+        problem = _lowest_return_problem(meta, "champion_return", ret)
+        if problem:
+            return problem
     reason = meta.get("stop_reason")
     if reason is None:
         return ""
@@ -119,9 +123,23 @@ def _validation_problem(meta: dict) -> str:
         return f"its validation_return {brief(ret)} is not allowed: allowed a mean return in [{-WORST_RETURN:.3g}, 0] (every reward is minus a sum of squares)"
     if "validation_sd" in meta and not (finite_real(sd) and 0 <= sd <= WORST_RETURN / 2):
         return f"its validation_sd {brief(sd)} is not allowed: allowed a standard deviation of returns in [0, {WORST_RETURN / 2:.3g}]"
+    if "validation_return" in meta and (low := _lowest_return_problem(meta, "validation_return", ret)):
+        return low
     if episodes == 1 and sd is not None and sd != 0:
         return f"its validation_sd {brief(sd)} is not allowed beside its validation_episodes 1: one return has no spread (0)"
     return seconds_problem(meta)
+
+
+def _lowest_return_problem(meta: dict, name: str, ret: float) -> str:
+    """A record's return ``ret`` (its ``name``) against the lowest return of an episode of its length (n_steps, else
+    episode_steps; :func:`~neurohover.sim.constants.lowest_return`), '' when within it or the length is not recorded:
+    -1e9 of a 20-step run was taken (T27-B03)."""
+    steps = [meta[key] for key in ("n_steps", "episode_steps") if whole_number(meta.get(key))]
+    if not steps or ret > 0 or ret >= lowest_return(max(steps)):
+        return ""
+    key = "n_steps" if whole_number(meta.get("n_steps")) else "episode_steps"
+    bound = f"{lowest_return(max(steps)):.10g} (the worst step, {CRASH_STEP_PENALTY:.6g}, for each of its {key} {max(steps):,})"
+    return f"its {name} {brief(ret)} is not allowed: allowed a return >= {bound}"
 
 
 def seconds_problem(record: dict) -> str:

@@ -12,7 +12,7 @@ from ..compete_files import NO_OFFLINE, NO_SAFEGUARD, policy_label_problem
 from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..evolution.state_codec import MAX_SECONDS
 from ..integrations.neat import NEAT_TOPOLOGY
-from ..sim.constants import CRASH_STEP_PENALTY, WORST_RETURN
+from ..sim.constants import CRASH_STEP_PENALTY, WORST_RETURN, lowest_return
 
 if TYPE_CHECKING:
     from .results import EvolveResult, ModelResult, RobustnessResult, TestRunResult
@@ -87,7 +87,8 @@ def run_inconsistency(run: TestRunResult) -> str:
 
 def _changes_problem(changes: Any, n: int) -> str:
     """'' when ``changes`` are a run of ``n`` episodes' policy changes: (episode, policy) pairs of episodes in 0..n-1, in
-    order, each once, and a policy's name; else what is wrong ([[50, 'x'], [-1, '']] of a 3-episode run was taken; T22-09)."""
+    order, each once, and a policy's name, the first at episode 0; else what is wrong ([[50, 'x'], [-1, '']] of a 3-episode
+    run was taken; T22-09)."""
     last = -1
     for i, change in enumerate(changes):
         episode, policy = change if isinstance(change, tuple) and len(change) == 2 else (None, None)
@@ -95,6 +96,9 @@ def _changes_problem(changes: Any, n: int) -> str:
             shown = brief(list(change) if isinstance(change, tuple) else change)
             return f"policy_changes[{i}] = {shown} is not allowed: give [episode, policy name], its episodes among 0..{n - 1}, in order, each once"
         last = episode
+    if not changes or changes[0][0] != 0:  # T27-B09: [] and [[2, 'specialised:2']] of a 3-episode run were taken
+        which = f"policy_changes[0] = {brief(list(changes[0]))}" if changes else "policy_changes = []"
+        return f"{which} is not allowed: every episode flies a policy, so the changes start at episode 0: give [0, policy name] first"
     return ""
 
 
@@ -162,6 +166,11 @@ def params_problem(result: Any, params: Any) -> str:
         )
     n_steps = params.get("n_steps")
     if isinstance(result, TestRunResult) and whole_number(n_steps):
+        lowest = lowest_return(n_steps)  # T27-B03: -1e9 of a 20-step run was reported
+        for i, r in enumerate(result.returns):
+            if float(r) < lowest:
+                bound = f"{lowest:.10g} (the worst step, {CRASH_STEP_PENALTY:.6g}, for each of its {n_steps} steps)"
+                return f"returns[{i}] = {brief(r)} is not allowed: its unit's episodes are {n_steps} control steps long: allowed at least {bound}"
         for i, step in enumerate(result.crash_steps or ()):
             if not 1 <= step <= n_steps:
                 return f"crash_steps[{i}] = {step!r} is not allowed: its unit's episodes are {n_steps} control steps long: allowed 1..{n_steps}"

@@ -51,6 +51,13 @@ CRASH_STEP_PENALTY = 3 * MAX_POSITION**2 + 3 * MAX_RATE**2 + 3 * MAX_VELOCITY**2
 # compete's files are checked against it; every reward is minus a sum of squares, so none is above 0).
 WORST_RETURN = CRASH_STEP_PENALTY * MAX_EPISODE_STEPS
 
+
+def lowest_return(n_steps: int) -> float:
+    """The lowest return an episode of ``n_steps`` control steps can have, -CRASH_STEP_PENALTY * n_steps: each step
+    flown earns at least the worst step's reward, a crash is charged the worst step for each step left (T27-B03)."""
+    return -CRASH_STEP_PENALTY * n_steps
+
+
 # The most seconds a run records, 100 years (checkpoints, stored timings, compete summaries): a run's clock at 1e308
 # seconds (T19-09) and summary seconds of 1e300 (T24-07) were taken; no run lasts longer.
 MAX_SECONDS = 100 * 365.25 * 86400.0
