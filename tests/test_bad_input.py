@@ -382,7 +382,7 @@ def test_a_stored_run_or_config_of_the_wrong_shape_is_named(tmp_path: Path) -> N
     key = "run/model-free/test0/rep0"
     run = {
         "agent": "model-free", "mdp": "ghh08/test:0", "score": -2, "returns": [-1, -1], "crash_episodes": [], "safeguard_episodes": [],
-        "policy_changes": [], "learning_episodes": 0, "mean_return_after_learning": -1, "timing": {"seconds": 1.0, "offline_seconds": 0.0},
+        "policy_changes": [[0, "specialised:0"]], "learning_episodes": 0, "mean_return_after_learning": -1, "timing": {"seconds": 1.0, "offline_seconds": 0.0},
     }  # fmt: skip
     assert stored_runs({key: run}) == {"model-free": {"ghh08/test:0": [-2.0]}}
     for bad in ([1, 2], {"score": -1.0}, {"mdp": "ghh08/test:0", "score": "x"}, {"mdp": "ghh08/test:0", "score": True}):
