@@ -427,6 +427,10 @@ def check_paper_table(paper, where: str) -> None:
     for t in ttests:
         if not isinstance(t, dict) or not {"a", "b", "p"} <= set(t):
             raise NeurohoverError(f"{where}: each [paper] ttests entry needs a, b and p, got {brief(t)}")
+        unknown = sorted(set(t) - {"a", "b", "p"}, key=str)  # a misspelt extra key was dropped without a word (T27-A05)
+        if unknown:
+            named = ", ".join(brief(k) if not isinstance(k, str) or len(k) > 60 else k for k in unknown)
+            raise NeurohoverError(f"{where}: unknown [paper] ttests key(s) {named} in {brief(t)}; allowed: a, b, p")
         if not _paper_p(t["p"]):
             raise NeurohoverError(
                 f"{where}: [paper] ttests p = {brief(t['p'])} is not allowed: give the paper's p-value as text, "
@@ -467,12 +471,19 @@ def check_paper(paper, raw: dict, where: str) -> None:
     tables = [raw.get("settings", {}), *raw.get("scales", {}).values()]
     entries = [e for tab in tables for kind in ("groups", "variants", "fits") for e in tab.get(kind, []) if isinstance(e, dict)]
     names = {e.get(k) for e in entries for k in ("key", "label", "agent")} | {m for tab in tables for m in tab.get("methods", [])}
+    pairs: set[frozenset] = set()
     for t in paper.get("ttests", []):
         for side in ("a", "b"):
             if t[side] not in names:
                 raise NeurohoverError(f"{where}: [paper] ttests names {t[side]!r} ({side}), which is no group, variant, method or fit of the config")
         if t["a"] == t["b"]:  # a group against itself: p = 1, and a verdict of "reversed" for equal means (T26-A05)
             raise NeurohoverError(f"{where}: [paper] ttests compares {brief(t['a'])} with itself (a = b): give two different groups, variants, methods or fits")
+        if frozenset((t["a"], t["b"])) in pairs:  # both orders: the paper found each better than the other (T27-A04)
+            raise NeurohoverError(
+                f"{where}: [paper] ttests compares {brief(t['a'])} with {brief(t['b'])} twice (in either order): "
+                "give each pair once, with a the one the paper found better"
+            )
+        pairs.add(frozenset((t["a"], t["b"])))
     for key in _PAPER_NUMBERS:  # an entry of no name the report looks up was never shown, without a word
         allowed = names | ({"mlp-baseline"} if key == "table3" else set())  # table3's row for a policy set's specialised MLPs
         for name in paper.get(key, {}):

@@ -31,7 +31,7 @@ from .report_evolution import EvolutionSection
 from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, test_run_figure, varies
 from .report_models import SensorModels
 from .report_readme import Status, fill_generated, linked_claims, status_table
-from .report_scale import header_note, scale_note
+from .report_scale import header_note, quick_discussion, scale_note
 from .results import ModelResult, TestRunResult
 from .settings import Group, ModelLearningSettings
 from .store import Store
@@ -482,13 +482,6 @@ def _section(cfg: ExperimentConfig, store: Store, out: Path, current: bool | Non
     return "\n".join(text), sec.claims, status
 
 
-QUICK_DISCUSSION = (
-    "Quick scale only: a check of the whole pipeline with 200-step episodes, few runs and tiny evolution "
-    "budgets. Its numbers are not comparable with the paper's; run `neurohover reproduce NAME --scale "
-    "paper` for that."
-)
-
-
 def _discussion(cfg: ExperimentConfig, out: Path) -> str:
     """The hand-written discussion ``discussion/<name>-<scale>.md`` beside the report, kept across regenerations."""
     path = out / "discussion" / f"{cfg.name}-{cfg.scale}.md"
@@ -496,7 +489,7 @@ def _discussion(cfg: ExperimentConfig, out: Path) -> str:
     if text is not None:
         return text
     if cfg.scale == "quick":
-        return QUICK_DISCUSSION
+        return quick_discussion(cfg)
     return (
         f"_Not written yet: how these results compare with the paper's, and why, goes in "
         f"`discussion/{cfg.name}-{cfg.scale}.md` beside this report; `neurohover report` includes it._"

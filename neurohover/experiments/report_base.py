@@ -109,11 +109,16 @@ def agent_panel(ax, title: str) -> None:
 
 
 def p_significant(p_paper: str) -> bool | None:
+    """Whether a paper's p-value text says significant at 5%: "< X" with X <= 0.05 does ("< 0.05" read as 0.05 was
+    not significant; T27-A03), "<= X" and a plain number where below 0.05; None when it gives no number."""
     text = p_paper.strip().lower()
     if text.startswith("not"):
         return False
     value = p_value(p_paper)
-    return None if value is None else value < 0.05
+    if value is None:
+        return None
+    sign = text[: len(text) - len(text.lstrip("<= "))]
+    return value <= 0.05 if "<" in sign and "=" not in sign else value < 0.05
 
 
 def p_value(p_paper: str) -> float | None:

@@ -16,6 +16,15 @@ QUICK_SENTENCE = (
 )
 
 
+def quick_discussion(cfg: ExperimentConfig) -> str:
+    """A quick-scale section's discussion where none is written: its episode length is the config's own n_steps (a fixed
+    "200-step episodes" was wrong for bench-sensor-models' 300 and any --set n_steps; T27-A02)."""
+    return (
+        f"Quick scale only: a check of the whole pipeline with {cfg.typed.n_steps}-step episodes, few runs and tiny evolution "
+        "budgets. Its numbers are not comparable with the paper's; run `neurohover reproduce NAME --scale paper` for that."
+    )
+
+
 def header_note(scales: set[str] | list[str]) -> str:
     """The page header's sentence on the report's scales: the quick-scale one where a section is at quick scale, else none."""
     return f" {QUICK_SENTENCE}" if "quick" in scales else ""
