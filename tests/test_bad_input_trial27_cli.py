@@ -1,0 +1,26 @@
+"""Bad input, trial 27 (command line): T27-A01, ``evolve --resume`` with another seed policy printed both prototypes cut
+at the same place ("[0.0, 0.0, ..." against "[0.0, 0.0, ..."), never the difference. Two long lists that differ are
+now named by their first differing entry."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from conftest import CliRun
+
+from neurohover.errors import first_difference
+
+
+def test_long_lists_are_named_by_their_first_differing_entry() -> None:
+    assert first_difference("prototype", [0.0] * 30 + [1.0], [0.0] * 31, "the checkpoint's") == "prototype[30]: the checkpoint's 1.0, given 0.0"
+    assert first_difference("x", [1, 2], [1, 3]) == "x: the stored [1, 2], given [1, 3]"  # short: shown whole, as before
+    assert first_difference("x", [0.0] * 30, [0.0] * 31).startswith("x: the stored [0.0")  # of other lengths: as before
+
+
+def test_resuming_from_another_seed_policy_names_the_gene_that_differs(tmp_path: Path, cli: CliRun, monkeypatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    short = ("--task", "ghh08", "--episode-steps", "20", "--validation-episodes", "1", "--out", "p.json")
+    assert cli("evolve", *short, "--budget", "10")[0] == 0
+    rc, out, err = cli("evolve", *short, "--budget", "20", "--seed-policy", "zero", "--resume")
+    assert (rc, out) == (2, "")
+    assert "was written by a different run (prototype[11]: the checkpoint's 0.02, given 0.0)" in err, err
