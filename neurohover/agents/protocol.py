@@ -34,7 +34,7 @@ from ..evaluate import MAX_EPISODES_PER_CALL, DangerousState, PolicyTable, evalu
 from ..evolution.seeding import check_seed
 from ..flightdata import FlightData
 from ..policies import Policy
-from ..sim.constants import CRASH_STEP_PENALTY, EPISODE_STEPS, WORST_RETURN
+from ..sim.constants import CRASH_STEP_PENALTY, EPISODE_STEPS, WORST_RETURN, lowest_return
 from ..tasks import MDP, TaskFamily
 from .spec import AgentSettings
 
@@ -103,7 +103,7 @@ def _check_return(ret: float, crashed: bool, steps: int) -> None:
     return is <= 0); a step that does not crash earns at least -CRASH_STEP_PENALTY (the worst state within the crash
     limits), and a crash is charged that for each step left of a budget of at most MAX_EPISODE_STEPS (so no return is
     below -WORST_RETURN): a return of ``steps`` uncrashed steps is at least -CRASH_STEP_PENALTY * steps."""
-    least = -WORST_RETURN if crashed else -CRASH_STEP_PENALTY * steps
+    least = -WORST_RETURN if crashed else lowest_return(steps)
     if not least * (1 + 1e-9) <= ret <= 0:  # 1e-9: the rotation into the body frame keeps the squares to rounding
         how = "an episode that crashed" if crashed else f"{steps} steps that did not crash"
         raise NeurohoverError(
