@@ -32,7 +32,7 @@ import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real, whole_number
 from .paths import input_dir, strict_json
-from .sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS, MAX_SECONDS, WORST_RETURN, lowest_return
+from .sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS, MAX_SECONDS, WORST_RETURN, crash_charge, crash_return_ceiling, lowest_return, seconds_allowed
 from .sim.rng import MAX_SEED
 from .tasks.base import N_TEST, N_TRAINING
 
@@ -350,11 +350,10 @@ def _check_crash_charge(csv_path: Path, rows: _Rows, episode_steps: object) -> N
         return
     n = episode_steps if whole_number(episode_steps) else max(steps for _, steps in rows.steps)
     _, line, ret, steps = rows.least_charged
-    charge = CRASH_STEP_PENALTY * (n - steps)
-    if ret > -charge + 1e-9 * charge:
+    if ret > crash_return_ceiling(n, steps):
         raise NeurohoverError(
             f"--compete {str(csv_path)!r}, line {line}: return {ret!r} is not allowed: the episode crashed at step {steps} of its {n}, and a crash is "
-            f"charged {CRASH_STEP_PENALTY:.6g} for each step left: allowed at most {-charge:.10g}"
+            f"charged {CRASH_STEP_PENALTY:.6g} for each step left: allowed at most {crash_charge(n, steps):.10g}"
         )
 
 
@@ -419,7 +418,7 @@ def _check_seconds(path: Path, summary: dict) -> None:
     was taken), naming the values (T24-07). Tolerance: result_checks.run_inconsistency's of a stored run's offline
     seconds against its seconds, whose means these are."""
     for key in ("mean_seconds_per_run", "mean_offline_seconds_per_run"):
-        if summary.get(key, 0) > MAX_SECONDS:
+        if not seconds_allowed(summary.get(key, 0)):  # (finite and >= 0 by SUMMARY_FIELDS, checked before)
             raise NeurohoverError(
                 f"--compete {str(path)!r}: its {key} {brief(summary[key])} is not allowed: at most {MAX_SECONDS:.6g} seconds (100 years: no run lasts longer)"
             )

@@ -14,7 +14,7 @@ from typing import Any
 
 from .errors import NeurohoverError, brief, finite_real, whole_number
 from .policies import RECORD_CHECKS
-from .sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS, MAX_SECONDS, WORST_RETURN, lowest_return
+from .sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS, MAX_SECONDS, WORST_RETURN, lowest_return, seconds_allowed
 
 #: What a policy file's record of its run says the run was over: a task family (``ghh08/G``, ``fghh/G(sigma=0.3)``), not one MDP.
 _FAMILY_TARGET = re.compile(r"[a-z0-9]+/G(\(sigma=[^()]*\))?")
@@ -147,7 +147,7 @@ def seconds_problem(record: dict) -> str:
     compete summaries' seconds, :data:`~neurohover.sim.constants.MAX_SECONDS` (100 years), '' when it is within it or
     absent: 1e30 was taken in policy files and policy sets' manifests (T26-B13)."""
     seconds: Any = record.get("seconds")
-    if "seconds" in record and not (finite_real(seconds) and 0 <= seconds <= MAX_SECONDS):
+    if "seconds" in record and not seconds_allowed(seconds):
         return f"its seconds {brief(seconds)} is not allowed: allowed a number of seconds >= 0 and <= {MAX_SECONDS:.6g} (100 years: how long it took)"
     return ""
 

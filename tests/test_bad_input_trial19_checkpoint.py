@@ -210,7 +210,8 @@ def test_a_champion_return_no_run_can_have_is_refused(tiny_checkpoint: Path, cma
     _resume_damaged(tiny_checkpoint, tmp_path, edit(2**70), GHH08.zero(), MDP_RUN, fragment)
     assert json.loads(cma_checkpoint.read_text())["champion"]["genome"] is not None
     for value in (2**70, 1e-300, "inf"):
-        fragment = f"damaged checkpoint: the champion's return is {value!r}: allowed '-inf' or a number <= 0 on the run's fitness scale 'return'"
+        allowed = "'-inf' or a mean return in [-17488.07999, 0] (the worst step, for each of its 10 steps, to none)"  # T27-B03: its n_steps
+        fragment = f"damaged checkpoint: the champion's return is {value!r}: allowed {allowed} on the run's fitness scale 'return'"
         _resume_damaged(cma_checkpoint, tmp_path, edit(value), GHH08, CMA_RUN, fragment)
 
 

@@ -14,11 +14,14 @@ only very short episodes reach; a NaN return (a numerical blow-up) gets fitness 
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..errors import NeurohoverError, as_floats, brief
+from ..sim.constants import lowest_return
 
-__all__ = ["ERROR_FLOOR", "FITNESS_SCALES", "episode_fitness", "error_of_fitness"]
+__all__ = ["ERROR_FLOOR", "FITNESS_SCALES", "episode_fitness", "error_of_fitness", "fitness_range", "in_fitness_range"]
 
 #: What a generational run's ``fitness`` setting may be.
 FITNESS_SCALES = ("inv-log-error", "return")
@@ -51,3 +54,26 @@ def error_of_fitness(fitness: np.ndarray | float, scale: str) -> np.ndarray:
         return -f
     with np.errstate(divide="ignore", over="ignore"):
         return np.where(f > 0, np.exp(1.0 / np.where(f > 0, f, 1.0)), np.inf)
+
+
+def fitness_range(n_steps: int, scale: str) -> tuple[float, float, str]:
+    """``(low, high, words)``: the finite fitness estimates a run of ``n_steps``-step episodes can have on ``scale``, a
+    mean of its episodes' fitness (never a sum: fixed resampling, races and bandits all average), so within one
+    episode's range. On ``return`` it is [lowest_return(n_steps), 0] (every reward is minus a sum of squares, at worst
+    the crash charge of each step); on ``inv-log-error`` 1/ln(error) with the error in [ERROR_FLOOR,
+    -lowest_return(n_steps)], so [1/ln(-lowest_return(n_steps)), 1/ln(ERROR_FLOOR)]. ``-inf`` (a NaN episode's fitness)
+    lies outside; a checker allows it itself. The bounds are exact: a checker allows 1e-9 relative for a mean's
+    rounding (-1e9 in a 20-step run's steady-state fitness was resumed; T27-B03)."""
+    _check_scale(scale)
+    worst = lowest_return(n_steps)
+    if scale == "return":
+        return worst, 0.0, f"a mean return in [{worst:.10g}, 0] (the worst step, for each of its {n_steps:,} steps, to none)"
+    low, high = 1.0 / math.log(max(-worst, ERROR_FLOOR)), 1.0 / math.log(ERROR_FLOOR)
+    return low, high, f"a mean 1/ln(error) in [{low:.7g}, {high:.7g}] (an error of at most {-worst:.10g}, the worst step for each of its {n_steps:,} steps)"
+
+
+def in_fitness_range(values: np.ndarray | float, low: float, high: float) -> np.ndarray:
+    """Whether each of ``values`` lies in [low, high] of :func:`fitness_range`, 1e-9 relative each side for a mean's
+    rounding (False for NaN and infinities)."""
+    v = np.asarray(values, dtype=np.float64)
+    return (v >= low - 1e-9 * abs(low)) & (v <= high + 1e-9 * abs(high))

@@ -18,7 +18,7 @@ from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..flyer import MAX_EPISODE_INDEX
 from .common import EntryError, Optimiser, check_entries, check_genomes, damage_text, dec_array, dec_float, enc_float
 from .config import MAX_BUDGET, Resampling
-from .fitness import ERROR_FLOOR
+from .fitness import fitness_range, in_fitness_range
 from .generational import GenerationalNE
 from .optimisers import OPTIMISERS
 from .records import check_history, decode_history
@@ -140,7 +140,7 @@ def _restored_parts(state: dict, run: Run, opt: Optimiser) -> dict[str, Any]:
         raise EntryError(f"counter 'kernel_seconds' is {kernel!r}, more than the run's wall_seconds {wall!r} (its kernel time is part of them)")
     _check_tracker_kept(opt)
     _check_generation(opt, counts)
-    champion = _checked_champion(state["champion"], run.cfg.prototype.genome.size, run.fitness)
+    champion = _checked_champion(state["champion"], run.cfg.prototype.genome.size, run.fitness, run.cfg.n_steps)
     own = run.method in OPTIMISERS and run.family is not None
     _check_run_champion(champion, own, counts["generation"], run.method, opt)
     race_delta = _checked_race_delta(state.get("race_delta", run.resampling.delta), run.resampling)  # absent before race:auto
@@ -149,6 +149,7 @@ def _restored_parts(state: dict, run: Run, opt: Optimiser) -> dict[str, Any]:
     # A population optimiser on a family keeps its champion (the best of the last generation) in the champion table;
     # every other run's is its optimiser's (Run._champion_return).
     check_history(history, counts, per_generation=run.method == "generational" or own, champion=champion[1] if own else float(opt.champion_return))
+    _check_fitness_values(opt, history, run.cfg.n_steps, run.fitness)  # after: a row off the champion is named as such
     return {"counters": counts, "seconds": seconds, "champion": champion, "history": history, "race_delta": race_delta}
 
 
@@ -272,7 +273,7 @@ MAX_COUNT = (MAX_EPISODE_INDEX + 1) // 2
 _COUNT_LIMIT = "half the kernel's episode indices 0..2**63-1: the rest is room for the resumed run's episodes"
 
 
-def _checked_champion(ch: dict, genome_size: int, scale: str) -> tuple[np.ndarray | None, float]:
+def _checked_champion(ch: dict, genome_size: int, scale: str, n_steps: int) -> tuple[np.ndarray | None, float]:
     """The champion table ``ch`` of a checkpoint: its genome (or None) and its fitness on ``scale`` (a return of 2**70,
     which no episode can score, was taken; T19-08)."""
     genes = ch["genome"]  # a list of numbers, checked one by one as an optimiser's arrays are: True was read as 1.0 (sixteenth trial)
@@ -284,10 +285,32 @@ def _checked_champion(ch: dict, genome_size: int, scale: str) -> tuple[np.ndarra
         raise EntryError("the champion's return is nan")
     if genome is None and value != -math.inf:
         raise EntryError(f"the champion's return is {brief(ch['return'])} without a champion genome: allowed '-inf' (no champion yet)")
-    # A return is minus a sum of squares (<= 0); an inv-log-error fitness 1/ln(error) with error >= ERROR_FLOOR (fitness.py).
-    low, high, allowed = (
-        (0.0, 1.0 / math.log(ERROR_FLOOR), "'-inf' or a number in 0..1/ln(1+1e-6)") if scale == "inv-log-error" else (-math.inf, 0.0, "'-inf' or a number <= 0")
-    )
-    if value != -math.inf and not (low <= value <= high * (1 + 1e-9)):  # (a mean may round an ulp past its largest value)
-        raise EntryError(f"the champion's return is {brief(ch['return'])}: allowed {allowed} on the run's fitness scale {scale!r}")
+    # A mean of its episodes' fitness on the run's scale, within one episode's range of the run's n_steps (fitness.py;
+    # a return of -1e9 in a 20-step run was resumed, T27-B03).
+    low, high, allowed = fitness_range(n_steps, scale)
+    if value != -math.inf and not in_fitness_range(value, low, high):
+        raise EntryError(f"the champion's return is {brief(ch['return'])}: allowed '-inf' or {allowed} on the run's fitness scale {scale!r}")
     return genome, value
+
+
+def _check_fitness_values(opt: Optimiser, history: list, n_steps: int, scale: str) -> None:
+    """EntryError naming the first fitness of the restored optimiser ``opt`` (its champion's, a steady state's
+    population's) or of the checkpoint's ``history`` rows that no run of ``n_steps``-step episodes on ``scale`` tells
+    (:func:`~.fitness.fitness_range`): -1e9 in a 20-step run's optimizer_state.fitness was resumed (T27-B03). -inf (a NaN
+    episode's fitness) is allowed, and NaN in a steady state's fitness: it flies raw returns, and an episode that blows
+    up on a learned model (or any MDP of the API) is told and written as NaN."""
+    low, high, allowed = fitness_range(n_steps, scale)
+    told = [("optimizer_state's champion return", np.array([float(opt.champion_return)]), False)]
+    if isinstance(opt, SteadyStateNE) and opt._fitness is not None:
+        told.append(("optimizer_state.fitness", opt._fitness, True))
+    told.append(("history's champion_return column", np.array([h.champion_return for h in history], dtype=np.float64), False))
+    for name, values, nan_ok in told:
+        bad = np.flatnonzero(~(in_fitness_range(values, low, high) | (values == -math.inf) | (np.isnan(values) & nan_ok)))
+        if bad.size:
+            k = int(bad[0])
+            where = f" data entry {k}" if name == "optimizer_state.fitness" else (f" row {k} (from 0)" if name.startswith("history") else "")
+            nan = ", 'nan' (an episode that blew up)" if nan_ok else ""
+            raise EntryError(
+                f"{name}{where} is {brief(enc_float(float(values[k])))}: not allowed in a run of {n_steps:,}-step episodes on fitness scale {scale!r}:"
+                f" allowed '-inf'{nan} or {allowed}"
+            )

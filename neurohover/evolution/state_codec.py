@@ -13,7 +13,7 @@ from typing import Any, TypeVar, overload
 import numpy as np
 
 from ..errors import NeurohoverError, as_floats, brief, finite_real, real_number, whole_number
-from ..sim.constants import MAX_SECONDS  # re-exported: a state's bound, as every record's
+from ..sim.constants import MAX_SECONDS, seconds_allowed  # MAX_SECONDS re-exported: a state's bound, as every record's
 
 __all__ = [
     "STATE_DAMAGE",
@@ -215,10 +215,10 @@ def read_count(value: Any) -> int:
 
 def read_seconds(value: Any) -> float:
     """A state's seconds: a finite number in [0, :data:`MAX_SECONDS`] (100 years), not a bool, else :class:`EntryError`."""
-    if not finite_real(value) or float(value) < 0.0:
+    if not seconds_allowed(value):
+        if finite_real(value) and float(value) > MAX_SECONDS:
+            raise EntryError(f"more seconds than 100 years: allowed a number in [0, {MAX_SECONDS:.6g}]")
         raise EntryError("not a number of seconds: allowed a finite number >= 0")
-    if float(value) > MAX_SECONDS:
-        raise EntryError(f"more seconds than 100 years: allowed a number in [0, {MAX_SECONDS:.6g}]")
     return float(value)
 
 

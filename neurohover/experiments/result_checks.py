@@ -10,9 +10,8 @@ from typing import TYPE_CHECKING, Any
 
 from ..compete_files import NO_OFFLINE, NO_SAFEGUARD, policy_label_problem
 from ..errors import NeurohoverError, brief, finite_real, whole_number
-from ..evolution.state_codec import MAX_SECONDS
 from ..integrations.neat import NEAT_TOPOLOGY
-from ..sim.constants import CRASH_STEP_PENALTY, WORST_RETURN, lowest_return
+from ..sim.constants import CRASH_STEP_PENALTY, MAX_SECONDS, WORST_RETURN, crash_charge, crash_return_ceiling, lowest_return, seconds_allowed
 
 if TYPE_CHECKING:
     from .results import EvolveResult, ModelResult, RobustnessResult, TestRunResult
@@ -107,10 +106,11 @@ def seconds_problem(timing: Any) -> str:
     (100 years, as a checkpoint's: 1e300 was taken, T24-07), else which is not."""
     for f in dataclasses.fields(timing):
         value = getattr(timing, f.name)
+        if seconds_allowed(value):
+            continue
         if not (finite_real(value) and value >= 0):
             return f"timing.{f.name} = {brief(value)} is not allowed: give a finite number of seconds >= 0"
-        if value > MAX_SECONDS:
-            return f"timing.{f.name} = {brief(value)} is not allowed: at most {MAX_SECONDS:.6g} seconds (100 years: no run lasts longer)"
+        return f"timing.{f.name} = {brief(value)} is not allowed: at most {MAX_SECONDS:.6g} seconds (100 years: no run lasts longer)"
     return ""
 
 
@@ -174,11 +174,11 @@ def params_problem(result: Any, params: Any) -> str:
         for i, step in enumerate(result.crash_steps or ()):
             if not 1 <= step <= n_steps:
                 return f"crash_steps[{i}] = {step!r} is not allowed: its unit's episodes are {n_steps} control steps long: allowed 1..{n_steps}"
-            charge, e = CRASH_STEP_PENALTY * (n_steps - step), result.crash_episodes[i]
-            if float(result.returns[e]) > -charge + 1e-9 * charge:  # sim.kernel.crash_charge: none for a crash on the last step (T26-B09)
+            e = result.crash_episodes[i]
+            if float(result.returns[e]) > crash_return_ceiling(n_steps, step):  # sim.kernel.crash_charge: none for a crash on the last step (T26-B09)
                 return (
                     f"returns[{e}] = {brief(result.returns[e])} is not allowed: episode {e} crashed at step {step} of its {n_steps}, and a crash is "
-                    f"charged {CRASH_STEP_PENALTY:.6g} for each step left: allowed at most {-charge:.10g}"
+                    f"charged {CRASH_STEP_PENALTY:.6g} for each step left: allowed at most {crash_charge(n_steps, step):.10g}"
                 )
     return ""
 

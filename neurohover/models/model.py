@@ -39,7 +39,7 @@ import numpy as np
 from ..errors import NeurohoverError, as_floats, brief, finite_real, whole_number
 from ..filekinds import refuse_suffix
 from ..paths import json_text
-from ..sim.constants import CONTROL_DT, DEFAULT_NOISE_STD, DEFAULT_PARAMS, MAX_SECONDS, NOISE_NAMES, PARAM_NAMES, SUBSTEP_DT, SUBSTEPS
+from ..sim.constants import CONTROL_DT, DEFAULT_NOISE_STD, DEFAULT_PARAMS, MAX_SECONDS, NOISE_NAMES, PARAM_NAMES, SUBSTEP_DT, SUBSTEPS, seconds_allowed
 from ..tasks import MDP, finite_vector
 from .wind import NO_WIND, WindModel
 
@@ -194,7 +194,7 @@ class LearnedModel:
         object.__setattr__(self, "noise_std", check_vector(self.noise_std, 6, "model noise std (u, v, w, p, q, r)", nonnegative=True))
         if self.method not in MODEL_METHODS:
             raise NeurohoverError(f"unknown model-learning method {self.method!r}: allowed {', '.join(MODEL_METHODS)}")
-        if not finite_real(self.seconds) or not 0 <= self.seconds <= MAX_SECONDS:  # T26-B13: 1e30 was taken (checkpoints' bound)
+        if not seconds_allowed(self.seconds):  # T26-B13: 1e30 was taken (checkpoints' bound)
             raise NeurohoverError(f"seconds={brief(self.seconds)} must be a finite number in [0, {MAX_SECONDS:.6g}] (how long the fit took; 100 years at most)")
         if not isinstance(self.stats, dict):
             raise NeurohoverError("stats must be a dict")

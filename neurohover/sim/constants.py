@@ -58,9 +58,35 @@ def lowest_return(n_steps: int) -> float:
     return -CRASH_STEP_PENALTY * n_steps
 
 
+def crash_charge(n_steps: int, t: int) -> float:
+    """The kernel's charge of a crash at control step ``t`` (1-based) of an ``n_steps`` episode, the worst step for every
+    step left, -CRASH_STEP_PENALTY * (n_steps - t): the plain twin of ``sim.kernel.crash_charge`` (none for a crash on
+    the last step; no checks: :func:`crash_penalty` checks its arguments)."""
+    return -CRASH_STEP_PENALTY * (n_steps - t)
+
+
+def crash_return_ceiling(n_steps: int, t: int) -> float:
+    """The largest return an episode that crashes at control step ``t`` of ``n_steps`` can have: it is charged
+    :func:`crash_charge` on top of its rewards (each <= 0), so at most that charge, with 1e-9 of it to spare for the
+    kernel's rounding. What every reader of recorded crashes checks a return against (compete's episodes.csv, stored
+    test runs; T26-B09)."""
+    charge = CRASH_STEP_PENALTY * (n_steps - t)
+    return -charge + 1e-9 * charge
+
+
 # The most seconds a run records, 100 years (checkpoints, stored timings, compete summaries): a run's clock at 1e308
 # seconds (T19-09) and summary seconds of 1e300 (T24-07) were taken; no run lasts longer.
 MAX_SECONDS = 100 * 365.25 * 86400.0
+
+
+def seconds_allowed(value: object) -> bool:
+    """Whether ``value`` is seconds a run may record: a finite real number (not a bool) in [0, :data:`MAX_SECONDS`].
+    The one test of it (checkpoints, policy files, models, stored timings, compete summaries); each reader words its
+    own message of what the seconds are."""
+    from ..errors import finite_real
+
+    return finite_real(value) and 0 <= value <= MAX_SECONDS  # type: ignore[operator]
+
 
 # Wind models.
 WIND_NONE = 0
@@ -124,7 +150,7 @@ def crash_penalty(steps_taken: int, episode_steps: int = EPISODE_STEPS) -> float
         raise NeurohoverError(f"episode_steps={brief(episode_steps)} is not allowed: give a whole number of control steps >= 1")
     if not whole_number(steps_taken) or not 1 <= steps_taken <= episode_steps:
         raise NeurohoverError(f"steps_taken={brief(steps_taken)} is not allowed: give a whole number of steps from 1 to episode_steps={episode_steps}")
-    return -CRASH_STEP_PENALTY * (int(episode_steps) - int(steps_taken))
+    return crash_charge(int(episode_steps), int(steps_taken))
 
 
 #: The MLP's steepened logistic sigma(s) = 1 / (1 + exp(-MLP_STEEPNESS s)) (docs/model.md, Policies).
