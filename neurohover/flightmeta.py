@@ -1,8 +1,8 @@
 """Flight-data metadata checked against itself and against the episodes it describes (docs/model.md, Learned models).
 
 :func:`neurohover.flightdata.check_metadata` checks each field's kind; this module checks what the fields say, the way
-:mod:`neurohover.experiments.result_checks` checks a stored test run against itself: each MDP is one its task family
-holds (T23-02) and is the MDP its label names (T23-04), the seed is a seed (T23-05), no return is above 0 and each is
+:mod:`neurohover.experiments.result_checks` checks a stored test run against itself (each MDP is one its task family
+holds and the MDP its label names as every MDP is built: :mod:`neurohover.tasks.held`), the seed is a seed (T23-05), no return is above 0 and each is
 what the episode's observations give (T23-03), and no episode is flagged crashed whose last reading shows none
 (T23-19). The policy ``policy_flown`` records must be a policy (T24-06, :func:`recorded_policy_problem`) and, where the
 readings are exact, give the recorded actions (:func:`check_policy_actions`). What the readings cannot prove (an MDP not
@@ -12,22 +12,13 @@ refused.
 
 from __future__ import annotations
 
-import json
-import re
-from dataclasses import fields, replace
-
 import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real, whole_in
 from .policies import Policy, policy_from_dict
 from .sim.constants import CRASH_STEP_PENALTY, MAX_POSITION, MAX_RATE, MAX_VELOCITY, MIN_QW, WORST_RETURN
 from .sim.rng import MAX_SEED
-from .tasks import MDP, TASK_FAMILIES, get_task_family
 
-#: A label naming one of a family's MDPs by :meth:`TaskFamily.mdp`'s names, as its fixed sets and zero label them.
-_SET_LABEL = re.compile(r"(?:(?P<family>[^/]+)/)?(?P<spec>zero|(?:seeded-)?(?:train|test):[0-9]+)")
-#: A label naming a constant wind as GHH-08's make() writes it by default (``fly --wind``): ``ghh08/wind=[1.0, -2.0]``.
-_WIND_LABEL = re.compile(r"(?:(?P<family>[^/]+)/)?wind=(?P<wind>\[.*\])")
 #: Recorded steps a recorded policy is flown on again to see that it gave their actions, and how near they must be
 #: (float32 files round the observations: actions move by ~1e-6; a policy one gene away moved them by ~0.5; T22-17).
 CHECKED_STEPS, ACTION_TOLERANCE = 200, 1e-4
@@ -46,13 +37,6 @@ def check_meaning(metadata: dict, mdps: list, episodes: tuple[tuple, tuple, list
     seed = metadata.get("seed")
     if seed is not None:  # 'abc' and -5 were taken (T23-05); every seed's range is sim.rng's
         whole_in(seed, f"{where}: its metadata seed", 0, MAX_SEED, "2**63-1")
-    seen: set[int] = set()  # fly --record writes one table per episode, most of them one MDP
-    for i, mdp in enumerate(mdps):
-        if mdp is not None and id(mdp) not in seen:
-            seen.add(id(mdp))
-            problem = held_problem(mdp)
-            if problem:
-                raise NeurohoverError(f"{where}: its metadata mdps entry {i} ({brief(mdp.label)}) is not allowed: {problem}")
     returns = metadata.get("returns")
     returns = returns if isinstance(returns, list) else []
     for i, value in enumerate(returns):  # [5.0, 3.0] was taken (T23-03): every reward is minus a sum of squares
@@ -73,79 +57,6 @@ def check_meaning(metadata: dict, mdps: list, episodes: tuple[tuple, tuple, list
         _check_in_bounds(metadata, observations[i], i, flags[i], where)
         if i < len(returns) and finite_real(returns[i]):
             _check_return(returns, i, observations[i], flags[i], steps if type(steps) is int else None, where)
-
-
-def _differences(a: MDP, b: MDP) -> list[str]:
-    """The fields (but label, sensor and drift) in which MDP ``a`` differs from ``b``, as ``name=value``."""
-    return [
-        f"{f.name}={brief(getattr(a, f.name))}" for f in fields(MDP) if f.name not in ("label", "sensor", "drift") and getattr(a, f.name) != getattr(b, f.name)
-    ]
-
-
-def held_problem(mdp: MDP) -> str:
-    """Why ``mdp`` is refused ('' when it is not): an MDP of a task family that the family does not hold (its parameters
-    out of the family's range, or its other fields not the family's: T23-02), or whose label names one of the family's
-    MDPs with other parameters (T23-04); flight data's MDPs and a policy file's mdp_params are checked by it. No family
-    method tells whether it holds a given MDP: its :meth:`make` checks the ranges of the parameters at its ``row_slice``,
-    so the MDP is held where it is the family's zero or what make gives of them.
-
-    The labels the code writes for an MDP, and which are checked against its parameters: ``F/zero``, ``F/train:N``,
-    ``F/test:N`` and ``F/seeded-train:N``, ``F/seeded-test:N`` (the MDP the family names so; T23-04; FGHH's seeded sets
-    not, they depend on a sigma the metadata do not record) and ``ghh08/wind=[u, v]`` (``fly --wind``: the wind itself;
-    T24-05). Left unchecked, as they name no parameters: ``F/custom`` (``fly --params``), ``F/sample`` and
-    ``F/sample:N`` (drawn from G by a seed and a sequence the label does not record), a learned model's MDPs (family
-    ``model``) and any label given to ``make(label=...)``."""
-    cls = TASK_FAMILIES.get(mdp.family)
-    if cls is None:  # a learned model's MDP: any wind, any dynamics
-        return ""
-    family = get_task_family(mdp.family)  # a sigma only widens FGHH's draws, not what make() takes
-    zero = replace(family.zero(), sensor=mdp.sensor, drift=mdp.drift)
-    if mdp != zero:
-        try:
-            made = family.make(mdp.row()[cls.row_slice])
-        except NeurohoverError as err:
-            return f"it is no {mdp.family} MDP: {err}"
-        made = replace(made, sensor=mdp.sensor, drift=mdp.drift)
-        if mdp != made:  # named against the nearer of the two: a zero MDP's substeps 3 blamed its (zero's) wind too (T25-13)
-            near = min((made, zero), key=lambda other: len(_differences(mdp, other)))
-            return (
-                f"it is no {mdp.family} MDP: its {', '.join(_differences(mdp, near))} differ from every "
-                f"{mdp.family} MDP's ({', '.join(_differences(near, mdp))}), whose parameters are {', '.join(cls.param_names)}"
-            )
-    match = _SET_LABEL.fullmatch(mdp.label) or _WIND_LABEL.fullmatch(mdp.label)
-    if match is None:
-        return ""
-    named = match.group("family") or mdp.family
-    if named != mdp.family:
-        return f"its label names a {brief(named)} MDP, but the MDP's family is {brief(mdp.family)}"
-    if match.re is _WIND_LABEL:  # 'ghh08/wind=[9.0, 9.0]' over a wind of [-0.228, 2.898] was taken (T24-05)
-        return _wind_label_problem(mdp, match.group("wind"))
-    spec = match.group("spec")
-    if family.has_sigma and spec.startswith("seeded-"):  # FGHH's seeded sets depend on a sigma the metadata does not record
-        return ""
-    try:
-        named_mdp = family.mdp(spec)
-    except NeurohoverError as err:
-        return f"its label names no {mdp.family} MDP: {err}"
-    if mdp != replace(named_mdp, sensor=mdp.sensor, drift=mdp.drift):
-        theirs = ", ".join(_differences(named_mdp, mdp))
-        return f"its {', '.join(_differences(mdp, named_mdp))} contradict its label: {mdp.family}'s {spec} has {theirs}"
-    return ""
-
-
-def _wind_label_problem(mdp: MDP, text: str) -> str:
-    """Why a ``wind=[...]`` label (what GHH-08's make() writes of the wind it is given, ``fly --wind``) is refused ('' when
-    it is not): its numbers are not the MDP's wind (make() writes them as Python lists, whose text reads back as the same
-    floats)."""
-    try:
-        named = json.loads(text)
-    except ValueError:
-        named = None
-    if not isinstance(named, list) or not all(type(v) in (int, float) for v in named):
-        return "its label names no wind: give wind=[u, v], a list of numbers, as fly --wind writes it"
-    if [float(v) for v in named] != list(mdp.wind):
-        return f"its wind={brief(list(mdp.wind))} contradicts its label, which names the wind {brief(named)}"
-    return ""
 
 
 def _check_crash(flags: list, obs: np.ndarray, act: np.ndarray, i: int, where: str) -> None:

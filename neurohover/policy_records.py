@@ -155,7 +155,7 @@ def seconds_problem(record: dict) -> str:
 def _place_problem(meta: dict) -> str:
     """A record's task, mdp (what evolve's --mdp or --wind/--params named), target (the label of the MDP or family the
     run evolved on) and mdp_params (that MDP) against each other ('' when they agree; T24-02). mdp_params is checked
-    as flight data's MDPs are against their labels (:func:`neurohover.flightmeta.held_problem`); a run over a family has
+    as every MDP is against its label (:mod:`neurohover.tasks.held`); a run over a family has
     none (a champion no longer copies its seed policy's record, T25-12)."""
     from .tasks import TASK_NAMES
 
@@ -213,7 +213,6 @@ def _named_mdp_problem(mdp: object, target: object, named: str | None) -> str:
 def _mdp_params_problem(params: object, task: object, target: object) -> str:
     """A record's mdp_params (the MDP a run evolved on, as :meth:`MDP.to_dict` writes it) against its task and target,
     and against its own label as flight data's MDPs are checked (T24-02)."""
-    from .flightmeta import held_problem
     from .tasks import MDP
 
     try:
@@ -226,8 +225,7 @@ def _mdp_params_problem(params: object, task: object, target: object) -> str:
         return f"its mdp_params label {brief(mdp.label)} is not allowed beside its target {brief(target)}: the run was evolved on its target"
     if isinstance(task, str) and mdp.family != task:
         return f"its mdp_params family {brief(mdp.family)} is not allowed beside its task {brief(task)}: a run evolves on its task's MDPs"
-    problem = held_problem(mdp)
-    return f"its mdp_params ({brief(mdp.label)}) is not allowed: {problem}" if problem else ""
+    return ""
 
 
 def _run_settings_problem(meta: dict) -> str:

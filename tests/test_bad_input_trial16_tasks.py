@@ -33,8 +33,8 @@ SLP = nh.baseline_policy()
         (lambda a: nh.get_task_family("ghh08").make(a), [1.0, 2.0], "GHH-08 wind (wind_u, wind_v) must be 2 finite numbers, got masked_array("),
         (lambda a: nh.get_task_family("ghh09").make(a), [0.5] * 8, "GHH-09 parameters x_maxf/"),
         (lambda a: nh.get_task_family("fghh").make(a), list(nh.MDP("fghh").params), "FGHH dynamics parameters "),
-        (lambda a: nh.MDP("ghh08", params=a), list(nh.MDP("ghh08").params), "MDP params=masked_array("),
-        (lambda a: nh.MDP("ghh08", noise_std=a), [0.1] * 6, "MDP noise_std=masked_array("),
+        (lambda a: nh.MDP("model", params=a), list(nh.MDP("ghh08").params), "MDP params=masked_array("),  # any dynamics: a model's
+        (lambda a: nh.MDP("model", noise_std=a), [0.1] * 6, "MDP noise_std=masked_array("),
         (lambda a: nh.get_task_family("ghh09").rows(a), np.full((2, 8), 0.5), "ghh09 parameters masked_array("),
         (lambda a: nh.Policy("slp", a), np.ones(40), "a slp genome must be a list of finite real numbers, got masked_array("),
         (lambda a: SLP.with_genome(a), np.ones(40), "a slp genome must be a list of finite real numbers, got masked_array("),
@@ -82,10 +82,10 @@ def test_mdp_refuses_dates(name: str, length: int, kind: str) -> None:
     """T16-11: MDP params and noise_std of dates were taken as their day numbers (18262.0 x 11)."""
     value = np.full(length, np.datetime64("2020-01-01") if kind == "date" else np.timedelta64(1, "D"))
     with pytest.raises(NeurohoverError, match=re.escape(f"MDP {name}=array([")):
-        nh.MDP("ghh08", **{name: value})
+        nh.MDP("model", **{name: value})
     with pytest.raises(NeurohoverError, match=re.escape(f"MDP {name}=")):
-        nh.MDP("ghh08", **{name: [datetime.date(2020, 1, 1)] * length})
-    assert nh.MDP("ghh08", **{name: np.full(length, 0.25)}).__getattribute__(name) == (0.25,) * length
+        nh.MDP("model", **{name: [datetime.date(2020, 1, 1)] * length})
+    assert nh.MDP("model", **{name: np.full(length, 0.25)}).__getattribute__(name) == (0.25,) * length  # a model: any dynamics
 
 
 NAMES = np.array(["slp", "mlp"])

@@ -61,13 +61,23 @@ def test_an_mdp_its_task_family_does_not_hold_is_refused(flights: dict[str, Path
         meta["mdps"][0].update(wind=[9, 9], label="ghh08/custom")
 
     path = edited_copy(flights["calm"], tmp_path / "wind.npz", wind)
-    refused_everywhere(path, "mdps entry 0 ('ghh08/custom') is not allowed: it is no ghh08 MDP: GHH-08 wind [9.0, 9.0] m/s is out of range", cli, tmp_path)
+    refused_everywhere(
+        path, "mdps entry 0 is not allowed: MDP 'ghh08/custom' is not allowed: it is no ghh08 MDP: GHH-08 wind [9.0, 9.0] m/s is out of range", cli, tmp_path
+    )
 
     def dt(meta: dict) -> None:  # in range, but not the family's dynamics
         meta["mdps"][1].update(dt=0.02, label="x")
 
-    with pytest.raises(NeurohoverError, match=r"mdps entry 1 \('x'\) is not allowed: it is no ghh08 MDP: its dt=0.02 differ .*\(dt=0.01\)"):
+    with pytest.raises(
+        NeurohoverError, match=r"mdps entry 1 is not allowed: MDP substeps=10 x dt=0.02 is not allowed: the substeps must cover one 0.1 s control step"
+    ):
         FlightData.load(edited_copy(flights["calm"], tmp_path / "dt.npz", dt))
+
+    def d_u(meta: dict) -> None:  # in range, but not the family's dynamics: every true MDP has D_u 0
+        meta["mdps"][1].update(d_u=0.5, label="x")
+
+    with pytest.raises(NeurohoverError, match=r"mdps entry 1 is not allowed: MDP 'x' is not allowed: it is no ghh08 MDP: its d_u=0.5 differ .*\(d_u=0.0\)"):
+        FlightData.load(edited_copy(flights["calm"], tmp_path / "d_u.npz", d_u))
 
 
 def test_returns_above_0_or_not_what_the_observations_give_are_refused(flights: dict[str, Path], tmp_path: Path, cli) -> None:
@@ -108,7 +118,7 @@ def test_an_mdp_label_that_names_another_mdp_is_refused(flights: dict[str, Path]
     path = edited_copy(flights["calm"], tmp_path / "label.npz", relabel)
     with pytest.raises(NeurohoverError) as err:
         FlightData.load(path)
-    assert str(err.value).startswith(f"flight-data file '{path}': its metadata mdps entry 1 ({label!r}) is not allowed: "), str(err.value)
+    assert str(err.value).startswith(f"flight-data file '{path}': its metadata mdps entry 1 is not allowed: MDP {label!r} is not allowed: "), str(err.value)
     assert any(text in str(err.value) for text in ("contradict its label: ghh08's ", "its label names no ghh08 MDP", "its label names a 'fghh' MDP")), str(
         err.value
     )

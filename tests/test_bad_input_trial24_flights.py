@@ -92,7 +92,7 @@ def test_a_wind_label_that_is_not_the_mdps_wind_is_refused(flights: dict[str, Pa
         meta["mdps"][0]["label"] = label
 
     path = edited_copy(flights["wind"], tmp_path / "relabelled.npz", relabel)
-    message = f"mdps entry 0 ('{label}') is not allowed: its wind=[-0.228, 2.898] contradicts its label, which names the wind"
+    message = f"mdps entry 0 is not allowed: MDP '{label}' is not allowed: its wind=[-0.228, 2.898] contradicts its label, which names the wind"
     refused_everywhere(path, message, cli, tmp_path)
 
 
@@ -102,7 +102,7 @@ def test_a_wind_label_naming_no_wind_or_another_family_is_refused(flights: dict[
         meta["mdps"][0]["label"] = label
 
     expected = "its label names no wind: give wind=[u, v]" if "zz" in label else "its label names a 'ghh09' MDP, but the MDP's family is 'ghh08'"
-    with pytest.raises(NeurohoverError, match=rf"mdps entry 0 \('{label[:10]}.*'\) is not allowed: {re.escape(expected)}"):
+    with pytest.raises(NeurohoverError, match=rf"mdps entry 0 is not allowed: MDP '{label[:10]}.*' is not allowed: {re.escape(expected)}"):
         FlightData.load(edited_copy(flights["wind"], tmp_path / "named.npz", relabel))
 
 
@@ -193,16 +193,17 @@ def test_every_recording_fly_writes_loads_joined_saved_and_reloaded(flights: dic
 
 def test_an_mdp_off_its_family_is_named_by_the_fields_at_fault(tmp_path: Path) -> None:
     """T25-13: a recorded ghh08/zero MDP with substeps 3 was said to differ in its wind_kind and wind too, which are the
-    zero MDP's own (fly --record writes wind_kind 0, wind () for it); only substeps is named now."""
+    zero MDP's own (fly --record writes wind_kind 0, wind () for it); only the field at fault is named now (a D_u here:
+    substeps 3 is refused before, as no MDP's, T27-B05)."""
     from neurohover.cli import main
 
     flown = tmp_path / "f0.npz"
     assert main(["fly", "--task", "ghh08", "--episodes", "1", "--record", str(flown)]) == 0
 
     def edit(meta: dict) -> None:
-        meta["mdps"][0]["substeps"] = 3
+        meta["mdps"][0]["d_u"] = 0.5
 
     path = edited_copy(flown, tmp_path / "e06.npz", edit)
     with pytest.raises(NeurohoverError) as err:
         FlightData.load(path)
-    assert "its substeps=3 differ from every ghh08 MDP's (substeps=10)" in str(err.value), str(err.value)
+    assert "its d_u=0.5 differ from every ghh08 MDP's (d_u=0.0)," in str(err.value), str(err.value)

@@ -110,8 +110,9 @@ def test_save_policy_refuses_a_name_that_is_no_policy_file_name(tmp_path: Path, 
     ({"mdp": "train:1"}, "its mdp 'train:1' is not allowed beside its target 'ghh08/train:0': the run was evolved on 'train:0'"),
     ({"mdp": "G"}, "its mdp 'G' is not allowed beside its target 'ghh08/train:0'"),
     ({"target": "ghh08/train:1"}, "its mdp 'train:0' is not allowed beside its target 'ghh08/train:1'"),
-    ({"mdp_params": "wind0"}, "its mdp_params ('ghh08/train:0') is not allowed: its wind=(0.0, 0.0) contradict its label: ghh08's train:0 has wind="),
-    ({"mdp_params": "label1"}, "its mdp_params label 'ghh08/train:1' is not allowed beside its target 'ghh08/train:0'"),
+    ({"mdp_params": "wind0"}, "is not allowed: MDP 'ghh08/train:0' is not allowed: its wind=(0.0, 0.0) contradict its label: ghh08's train:0 has wind="),
+    ({"mdp_params": "label1"}, "is not allowed: MDP 'ghh08/train:1' is not allowed: its wind=(-4.91365, 3.1589050000000003) contradict its label"),
+    ({"mdp_params": "custom"}, "its mdp_params label 'ghh08/custom' is not allowed beside its target 'ghh08/train:0'"),
     ({"mdp_params": 5}, "its mdp_params 5 is not allowed: give the MDP the run was evolved on as a table"),
     ({"n_steps": 60}, "its n_steps 60 is not allowed beside its episode_steps 50"),
     ({"champion_fitness_scale": "zzz"}, "its champion_fitness_scale 'zzz' is not allowed: allowed inv-log-error, return"),
@@ -124,7 +125,11 @@ def test_save_policy_refuses_a_name_that_is_no_policy_file_name(tmp_path: Path, 
 def test_a_policy_file_whose_record_contradicts_itself_is_refused_by_name(written: Path, tmp_path: Path, changes: dict, says: str) -> None:
     """T24-02: each was read by load_policy and flown by fly --policy."""
     data = json.loads((written / "p.json").read_text())
-    edits: dict[str, Any] = {"wind0": {**data["mdp_params"], "wind": [0, 0]}, "label1": {**data["mdp_params"], "label": "ghh08/train:1"}}
+    edits: dict[str, Any] = {
+        "wind0": {**data["mdp_params"], "wind": [0, 0]},
+        "label1": {**data["mdp_params"], "label": "ghh08/train:1"},
+        "custom": {**data["mdp_params"], "label": "ghh08/custom"},
+    }
     changes = {k: (edits.get(v, v) if isinstance(v, str) and k == "mdp_params" else v) for k, v in changes.items()}
     if isinstance(changes.get("settings"), dict):
         changes["settings"] = {**data["settings"], **changes["settings"]}

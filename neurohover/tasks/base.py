@@ -13,6 +13,7 @@ import numpy as np
 
 from ..errors import NeurohoverError, as_floats, brief, finite_real, masked_note, whole_in, whole_number
 from ..sim.constants import (
+    CONTROL_DT,
     DEFAULT_NOISE_STD,
     DEFAULT_PARAMS,
     MDP_ROW_LEN,
@@ -33,11 +34,18 @@ from ..sim.constants import (
 from ..sim.reference import ReferenceMDP
 from ..sim.rng import MAX_SEED
 from .drift import NO_DRIFT, Drift
+from .held import check_held, family_code
 from .sensor import EXACT, Sensor
 
 N_TRAINING = 10
 N_TEST = 100
 MAX_SUBSTEPS = 1000  # substeps per 0.1 s control step (the simulator takes 10): more is a typo, and a slow one
+#: The largest magnitude of any number of an MDP (dynamics parameters, noise stds, wind numbers, D_u): 140 times the
+#: defaults' largest (70.54); at it a crash is flown at once, and far past it (1e300) the simulation overflowed to a NaN
+#: return (T27-B06). FGHH's make() holds its parameters to it.
+MAX_MAGNITUDE = 10_000.0
+#: How far substeps x dt may lie from the control step they integrate (a learned model: 1 x 0.1 s; the simulator 10 x 0.01 s).
+COVER_TOLERANCE = 1e-9
 _SET_ENTROPY = 20110401  # fixed root of the seeded training and test sets (the paper's year)
 _FIXED_SETS: dict[tuple[str, int, int, Sensor, Drift], tuple[MDP, ...]] = {}
 _ROW_LAYOUTS: dict[tuple[str, int, Sensor], np.ndarray] = {}
@@ -140,6 +148,16 @@ class MDP:
             object.__setattr__(self, name, float(value))
         if not self.dt > 0:
             raise NeurohoverError(f"MDP dt={self.dt!r} is out of range: allowed a substep length > 0")
+        if abs(self.substeps * self.dt - CONTROL_DT) > COVER_TOLERANCE:  # a dt of 1e9 was flown (T27-B05)
+            raise NeurohoverError(
+                f"MDP substeps={self.substeps} x dt={self.dt!r} is not allowed: the substeps must cover one {CONTROL_DT} s control step "
+                f"(the simulator's {SUBSTEPS} x {SUBSTEP_DT}, a learned model's 1 x {CONTROL_DT})"
+            )
+        for name in ("params", "noise_std", "wind", "d_u"):  # 1e300 flew to a NaN return (T27-B06)
+            value = getattr(self, name)
+            if (max(map(abs, value), default=0.0) if isinstance(value, tuple) else abs(value)) > MAX_MAGNITUDE:
+                raise NeurohoverError(f"MDP {name}={brief(value)} is out of range: allowed numbers in [-{MAX_MAGNITUDE:g}, {MAX_MAGNITUDE:g}]")
+        check_held(self)  # an MDP of a task family is one the family holds, its label the one it names (T27-B05)
 
     def row(self) -> np.ndarray:
         """The float64 row the compiled kernel reads (layout in ``sim.constants``)."""
@@ -238,41 +256,6 @@ def mdp_label(label: object, default: str) -> str:
     return label or default
 
 
-def check_rows(rows: np.ndarray) -> None:
-    """Refuse kernel rows that no MDP has: anything but an (M, MDP_ROW_LEN) array of finite real numbers, substeps not a
-    whole number in 1..MAX_SUBSTEPS, dt <= 0, a negative noise std or an unknown wind kind (the MDP's own checks, in a few
-    NumPy operations: evaluate() calls it on every array). An all-zero row (substeps 0) flew as a perfect 0.0 (T14-18)."""
-    # type and shape first, the cheap tests: a list was a TypeError, a 1-D row an IndexError (T15-4), a mask dropped (T16-9)
-    if (
-        not isinstance(rows, np.ndarray)
-        or isinstance(rows, np.ma.MaskedArray)
-        or rows.ndim != 2
-        or rows.shape[1] != MDP_ROW_LEN
-        or rows.dtype.kind not in "iuf"
-    ):
-        got = brief(rows) if isinstance(rows, np.ma.MaskedArray) or not isinstance(rows, np.ndarray) else f"shape {rows.shape}, dtype {rows.dtype}"
-        raise NeurohoverError(f"MDP rows must be a float array of shape (M, {MDP_ROW_LEN}), rows as MDP.row() gives them; got {got}")
-    if not np.isfinite(rows).all():
-        i = int(np.flatnonzero(~np.isfinite(rows).all(axis=1))[0])
-        raise NeurohoverError(f"MDP rows must be a float array of shape (M, {MDP_ROW_LEN}) of finite numbers; got row {i}: {brief(rows[i].tolist())}")
-    sub, dt, kind = rows[:, ROW_SUBSTEPS], rows[:, ROW_DT], rows[:, ROW_WIND_KIND]
-    ok = (sub >= 1) & (sub <= MAX_SUBSTEPS) & (sub == np.floor(sub)) & (dt > 0) & (rows[:, ROW_NOISE].min(axis=1) >= 0)
-    ok &= (kind == WIND_NONE) | (kind == WIND_CONSTANT) | (kind == WIND_SINUSOID)
-    if ok.all():
-        return
-    i = int(np.flatnonzero(~ok)[0])
-    r = rows[i]
-    fields_ = (
-        ("substeps", r[ROW_SUBSTEPS], 1 <= r[ROW_SUBSTEPS] <= MAX_SUBSTEPS and float(r[ROW_SUBSTEPS]).is_integer(), f"a whole number in 1..{MAX_SUBSTEPS}"),
-        ("dt", r[ROW_DT], r[ROW_DT] > 0, "a substep length > 0"),
-        ("noise_std", r[ROW_NOISE].tolist(), r[ROW_NOISE].min() >= 0, "stds >= 0"),
-        ("wind_kind", r[ROW_WIND_KIND], r[ROW_WIND_KIND] in (WIND_NONE, WIND_CONSTANT, WIND_SINUSOID), "0 (none), 1 (constant) or 2 (sinusoidal)"),
-    )
-    name, value, _, allowed = next(f for f in fields_ if not f[2])
-    shown = value if isinstance(value, list) else float(value)
-    raise NeurohoverError(f"MDP row {i} has {name}={shown!r}, which no MDP has: allowed {allowed} (rows as MDP.row() gives them)")
-
-
 def competition_rows(family: str) -> dict:
     """The competition's training and test rows of ``family`` as listed in the shipped data file."""
     if family not in competition_families():
@@ -292,10 +275,11 @@ def _through_sensor(method):
 
     @functools.wraps(method)
     def made(self, *args, **kwargs):
-        mdp = method(self, *args, **kwargs)
-        if not self.sensor.exact:
-            mdp = mdp.with_sensor(self.sensor)
-        return mdp if self.drift.none else mdp.with_drift(self.drift)
+        with family_code():  # what the family's own code builds, it holds: not checked again (tasks.held)
+            mdp = method(self, *args, **kwargs)
+            if not self.sensor.exact:
+                mdp = mdp.with_sensor(self.sensor)
+            return mdp if self.drift.none else mdp.with_drift(self.drift)
 
     return made
 

@@ -9,14 +9,14 @@ import numpy as np
 
 from ..errors import NeurohoverError, brief, finite_real, real_number
 from ..sim.constants import DEFAULT_PARAMS, PARAM_NAMES, ROW_PARAMS
-from .base import MDP, TaskFamily, finite_vector, mdp_label
+from .base import MAX_MAGNITUDE, MDP, TaskFamily, finite_vector, mdp_label
 
 COMPETITION_FGHH_SIGMA = 0.3  # the only FGHH sigma the authors' code lists MDPs for
 
 
 #: The largest magnitude of an FGHH dynamics parameter make() takes: 140 times the defaults' largest (sigma <= 1 draws
 #: stay far inside); at it a crash is flown at once, and far past it (1e300) the simulation overflowed to NaN.
-MAX_PARAM = 10_000.0
+MAX_PARAM = MAX_MAGNITUDE
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,133 @@
+"""Which MDPs a task family holds: the one check of an MDP against its family, run as every MDP is built (T27-B05).
+
+An MDP of a task family is one its family holds: its zero, or what its :meth:`~neurohover.tasks.base.TaskFamily.make`
+gives of the parameters at the family's ``row_slice`` (their ranges checked there); an MDP that differs from both in
+another field (a GHH-08 wind of 99 m/s, a D_u on a true MDP) is none (T23-02). Its label, where it names one of the
+family's MDPs, must name that MDP (T23-04).
+
+The labels the code writes for an MDP, and which are checked against its parameters: ``F/zero``, ``F/train:N``,
+``F/test:N`` and ``F/seeded-train:N``, ``F/seeded-test:N`` (the MDP the family names so; FGHH's seeded sets not, they
+depend on a sigma an MDP does not record) and ``ghh08/wind=[u, v]`` (``fly --wind``: the wind itself; T24-05). Left
+unchecked, as they name no parameters: ``F/custom`` (``fly --params``), ``F/sample`` and ``F/sample:N`` (drawn from G
+by a seed the label does not record) and any other label given to ``make(label=...)``. A learned model's MDPs (family
+``model``) may fly any wind and dynamics.
+
+The family's own :meth:`make` and :meth:`zero` build MDPs it holds by definition, so MDPs built while they run are not
+checked again (:func:`family_code`): the check never recurses, and a family's fixed sets are built once.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import re
+import threading
+from collections.abc import Iterator
+from dataclasses import fields, replace
+from typing import TYPE_CHECKING
+
+from ..errors import NeurohoverError, brief, finite_real
+
+if TYPE_CHECKING:
+    from .base import MDP
+
+#: A label naming one of a family's MDPs by :meth:`TaskFamily.mdp`'s names, as its fixed sets and zero label them.
+SET_LABEL = re.compile(r"(?:(?P<family>[^/]+)/)?(?P<spec>zero|(?:seeded-)?(?:train|test):[0-9]+)")
+#: A label naming a constant wind as GHH-08's make() writes it by default (``fly --wind``): ``ghh08/wind=[1.0, -2.0]``.
+WIND_LABEL = re.compile(r"(?:(?P<family>[^/]+)/)?wind=(?P<wind>\[.*\])")
+
+_inside = threading.local()  # per thread: whether a family's own make() or zero() is running
+
+
+@contextlib.contextmanager
+def family_code() -> Iterator[None]:
+    """While a family's own make() or zero() runs: the MDPs it builds are held by definition, not checked again."""
+    outer = getattr(_inside, "active", False)
+    _inside.active = True
+    try:
+        yield
+    finally:
+        _inside.active = outer
+
+
+def check_held(mdp: MDP) -> None:
+    """Refuse ``mdp`` where its task family does not hold it (:func:`held_problem`); MDPs a family's own code builds and
+    a learned model's pass."""
+    if getattr(_inside, "active", False):
+        return
+    from . import TASK_FAMILIES
+
+    if mdp.family not in TASK_FAMILIES:  # a learned model's MDP: any wind, any dynamics
+        return
+    with family_code():
+        problem = held_problem(mdp)
+    if problem:
+        raise NeurohoverError(f"MDP {brief(mdp.label) if mdp.label else '(no label)'} is not allowed: {problem}")
+
+
+def held_problem(mdp: MDP) -> str:
+    """Why ``mdp`` is no MDP its task family holds ('' when it is one, or a learned model's); see the module docstring.
+    Call it inside :func:`family_code`: it builds the family's zero, make() and named MDPs to compare."""
+    from . import TASK_FAMILIES, get_task_family
+
+    cls = TASK_FAMILIES[mdp.family]
+    family = get_task_family(mdp.family)  # a sigma only widens FGHH's draws, not what make() takes
+    zero = replace(family.zero(), sensor=mdp.sensor, drift=mdp.drift)
+    if mdp != zero:
+        try:
+            made = family.make(mdp.row()[cls.row_slice])
+        except NeurohoverError as err:
+            return f"it is no {mdp.family} MDP: {err}"
+        made = replace(made, sensor=mdp.sensor, drift=mdp.drift)
+        if mdp != made:  # named against the nearer of the two: a zero MDP's substeps 3 blamed its (zero's) wind too (T25-13)
+            near = min((made, zero), key=lambda other: len(differences(mdp, other)))
+            return (
+                f"it is no {mdp.family} MDP: its {', '.join(differences(mdp, near))} differ from every "
+                f"{mdp.family} MDP's ({', '.join(differences(near, mdp))}), whose parameters are {', '.join(cls.param_names)}"
+            )
+    return _label_problem(mdp, family)
+
+
+def _label_problem(mdp: MDP, family) -> str:
+    """Why ``mdp``'s label contradicts it ('' when it names none of the family's MDPs, or that MDP)."""
+    match = SET_LABEL.fullmatch(mdp.label) or WIND_LABEL.fullmatch(mdp.label)
+    if match is None:
+        return ""
+    named = match.group("family") or mdp.family
+    if named != mdp.family:
+        return f"its label names a {brief(named)} MDP, but the MDP's family is {brief(mdp.family)}"
+    if match.re is WIND_LABEL:  # 'ghh08/wind=[9.0, 9.0]' over a wind of [-0.228, 2.898] was taken (T24-05)
+        return _wind_label_problem(mdp, match.group("wind"))
+    spec = match.group("spec")
+    if family.has_sigma and spec.startswith("seeded-"):  # FGHH's seeded sets depend on a sigma an MDP does not record
+        return ""
+    try:
+        named_mdp = family.mdp(spec)
+    except NeurohoverError as err:
+        return f"its label names no {mdp.family} MDP: {err}"
+    if mdp != replace(named_mdp, sensor=mdp.sensor, drift=mdp.drift):
+        theirs = ", ".join(differences(named_mdp, mdp))
+        return f"its {', '.join(differences(mdp, named_mdp))} contradict its label: {mdp.family}'s {spec} has {theirs}"
+    return ""
+
+
+def _wind_label_problem(mdp: MDP, text: str) -> str:
+    """Why a ``wind=[...]`` label (what GHH-08's make() writes of the wind it is given, ``fly --wind``) is refused ('' when
+    it is not): its numbers are not the MDP's wind (make() writes them as Python lists, whose text reads back as the same
+    floats)."""
+    try:
+        named = json.loads(text)
+    except ValueError:
+        named = None
+    if not isinstance(named, list) or not all(type(v) in (int, float) and finite_real(v) for v in named):  # 10**400: float() overflowed
+        return "its label names no wind: give wind=[u, v], a list of numbers, as fly --wind writes it"
+    if [float(v) for v in named] != list(mdp.wind):
+        return f"its wind={brief(list(mdp.wind))} contradicts its label, which names the wind {brief(named)}"
+    return ""
+
+
+def differences(a: MDP, b: MDP) -> list[str]:
+    """The fields (but label, sensor and drift) in which MDP ``a`` differs from ``b``, as ``name=value``."""
+    return [
+        f"{f.name}={brief(getattr(a, f.name))}" for f in fields(a) if f.name not in ("label", "sensor", "drift") and getattr(a, f.name) != getattr(b, f.name)
+    ]
