@@ -200,7 +200,7 @@ def competition_config(
     are kept apart and the same settings resume.
     """
     from .agents.registry import AGENTS, HYBRID_AGENTS
-    from .experiments.config import make_config, settings_scale
+    from .experiments.config import compete_name, make_config, settings_scale
 
     check_sizes(runs, episodes)
     check_seed(seed)  # the range every command takes
@@ -242,7 +242,7 @@ def competition_config(
         settings["sensor"] = sensor.to_dict()
     if drift is not None and not drift.none:
         settings["drift"] = drift.to_dict()
-    return make_config(f"compete-{task}-{agent}", "test_runs", settings_scale(settings), settings, title=f"compete: {agent} on {task}")
+    return make_config(compete_name(task, agent), "test_runs", settings_scale(settings), settings, title=f"compete: {agent} on {task}")
 
 
 def compete(
@@ -365,7 +365,8 @@ def _checked_store(store) -> Path | None:
     if path.is_file() and path.stat().st_size:  # an empty file becomes the store
         from .experiments import Store
 
-        Store(path, create=False).close()
+        with Store(path, create=False) as db:
+            db.check_sound()  # a file SQLite calls malformed: refused before the output directory is made (T27-A09)
     return path
 
 

@@ -70,7 +70,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
     sensor = sensor_of(args)
     drift = None if args.drift is None else Drift.parse(args.drift)
     if drift is not None:
-        drift.check_run(args.episodes, f"--drift {args.drift!r} with --episodes {args.episodes}")  # named by its options
+        drift.check_run(args.episodes, f"--drift {args.drift!r} with --episodes {args.episodes}", at_given="@" in args.drift)  # named by its options
     agent_settings = None
     if args.agent_setting:
         from ..compete import check_agent_settings

@@ -202,21 +202,54 @@ def resolve_name(name: str | Path) -> Path:
     return shipped[name]
 
 
+COMPETE_PREFIX = "compete-"  # neurohover compete stores its competition as experiment compete-TASK-AGENT
+
+
+def compete_name(task: str, agent: str) -> str:
+    """The experiment name ``neurohover compete`` stores a competition of ``agent`` on ``task`` under."""
+    return f"{COMPETE_PREFIX}{task}-{agent}"
+
+
+def code_written_name(name: str) -> str | None:
+    """Whose name ``name`` is where the code itself writes it into a store (a shipped experiment, its alias, 'all',
+    or compete's ``compete-TASK-AGENT``), or None for a name free for a config of one's own. The one predicate
+    :func:`check_own_name` refuses by."""
+    if name == "all" or name in shipped_configs():
+        return "a shipped experiment's (or 'all')"
+    if name in _aliases():
+        return f"an alias of the shipped experiment {_aliases()[name]!r}"
+    if name.startswith(COMPETE_PREFIX):
+        return "in the name space compete-TASK-AGENT of `neurohover compete`'s own experiments"
+    return None
+
+
 def check_own_name(cfg: ExperimentConfig) -> None:
-    """Refuse a config file of one's own that takes a shipped experiment's name (or ``all``): stored, its results and
-    report would pass for the shipped experiment's (the report gives a shipped name the paper's claims and discussion)."""
+    """Refuse a config file of one's own that takes a name the code itself writes (:func:`code_written_name`): stored,
+    its results and report would pass for the shipped experiment's (the report gives a shipped name the paper's claims
+    and discussion), or would be mixed with a competition's as another scale of one experiment (T27-A06)."""
+    whose = code_written_name(cfg.name)
+    if whose is None:
+        return
     shipped = shipped_configs()
-    if cfg.name == "all" or (cfg.name in shipped and Path(cfg.source).resolve() != shipped[cfg.name].resolve()):
-        raise NeurohoverError(
-            f"config {cfg.source!r}: name = {cfg.name!r} is a shipped experiment's (or 'all'): a config of your own needs a name of its own, "
-            "or its results and report would pass for the shipped experiment's"
-        )
+    if cfg.name in shipped and cfg.source and Path(cfg.source).resolve() == shipped[cfg.name].resolve():
+        return  # the shipped config itself
+    if cfg.name.startswith(COMPETE_PREFIX) and not cfg.source:
+        return  # compete's inline config (make_config with no source file; a config file always has one)
     alias_of = _aliases().get(cfg.name)
     if alias_of is not None:  # `reproduce table3` ran fig2 while `results table3` showed this config's (eleventh trial, S8)
         raise NeurohoverError(
             f"config {cfg.source!r}: name = {cfg.name!r} is an alias of the shipped experiment {alias_of!r}: a config of your own needs a name "
             f"of its own, or `reproduce {cfg.name}` would run {alias_of} while its results pass under the same name"
         )
+    if cfg.name.startswith(COMPETE_PREFIX):
+        raise NeurohoverError(
+            f"config {cfg.source!r}: name = {cfg.name!r} is not allowed: it is {whose}; a config of your own needs a name of its own "
+            f"(not starting with {COMPETE_PREFIX!r}), or its results would be mixed with a competition's as another scale of one experiment"
+        )
+    raise NeurohoverError(
+        f"config {cfg.source!r}: name = {cfg.name!r} is {whose}: a config of your own needs a name of its own, "
+        "or its results and report would pass for the shipped experiment's"
+    )
 
 
 def parse_override(text: str, option: str = "--set") -> tuple[str, Any]:

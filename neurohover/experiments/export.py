@@ -240,6 +240,7 @@ def checked_experiment(store: Store, name: str, scale: str) -> tuple[ExperimentC
         problem = params_problem(results[u["key"]], u["params"])
         if problem:
             raise NeurohoverError(f"{where}: unit {u['key']!r}: its result contradicts its params: {problem}")
+    store.sessions(name, scale)  # its sessions rows, last (a damaged unit named first): for every command, not report alone (T27-A07)
     return config, units, results, made
 
 

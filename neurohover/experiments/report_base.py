@@ -108,9 +108,10 @@ def agent_panel(ax, title: str) -> None:
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, frameon=False)
 
 
-def p_significant(p_paper: str) -> bool | None:
-    """Whether a paper's p-value text says significant at 5%: "< X" with X <= 0.05 does ("< 0.05" read as 0.05 was
-    not significant; T27-A03), "<= X" and a plain number where below 0.05; None when it gives no number."""
+def p_significant(p_paper: str, level: float = 0.05) -> bool | None:
+    """Whether a paper's p-value text says significant at ``level`` (5%, or 1% for :func:`verdict`'s "weaker"): "< X"
+    with X <= level does ("< 0.05" read as 0.05 was not significant at 5%, T27-A03; "< 0.01" was
+    not at 1%, so ours at 0.03 read "holds" beside it), "<= X" and a plain number where below the level; None when it gives no number."""
     text = p_paper.strip().lower()
     if text.startswith("not"):
         return False
@@ -118,7 +119,7 @@ def p_significant(p_paper: str) -> bool | None:
     if value is None:
         return None
     sign = text[: len(text) - len(text.lstrip("<= "))]
-    return value <= 0.05 if "<" in sign and "=" not in sign else value < 0.05
+    return value <= level if "<" in sign and "=" not in sign else value < level
 
 
 def p_value(p_paper: str) -> float | None:
@@ -150,9 +151,8 @@ def verdict(a: str, ma: float, mb: float, p_ours: float, p_paper: str) -> str | 
         return "holds (neither significant)" if not significant else f"differs: significant here ({a} {'better' if ma > mb else 'worse'}), not in the paper"
     if ma <= mb:
         return f"reversed{'' if significant else ', not significant'} (the paper found {a} better; ours is worse)"
-    if expected and significant:
-        paper = p_value(p_paper)
-        return "same direction, weaker (p >= 0.01 here)" if paper is not None and paper < 0.01 and p_ours >= 0.01 else "holds"
+    if expected and significant:  # the paper significant at 1% by its own text, ours not: weaker
+        return "same direction, weaker (p >= 0.01 here)" if p_significant(p_paper, 0.01) and p_ours >= 0.01 else "holds"
     if expected:
         return "same direction, not significant"
     return "holds (same direction, neither significant)" if not significant else "same direction, significant here but not in the paper"

@@ -326,9 +326,11 @@ def _check_test_runs(settings: dict, task: str, where: str) -> None:
         if task not in AGENTS[g["agent"]].tasks:
             raise NeurohoverError(f"{where}: agent {g['agent']!r} does not apply to task {task!r}")
         g["label"] = g["label"] or g["agent"]
-        drift = g.get("drift") or settings.get("drift")
-        if drift:  # a table checked by Drift (drift_table()); its change must come within the runs
-            Drift.from_dict(drift).check_run(settings["episodes"], f"{where}: group {g['label']!r}")
+        own = g.get("drift")
+        drift = own or settings.get("drift")
+        if drift:  # a table checked by Drift (drift_table()); its change must come within the runs, named where it is given (T27-A08)
+            at = f"{where}: group {g['label']!r}" if own else f"{where}: the experiment's drift (every group's)"
+            Drift.from_dict(drift).check_run(settings["episodes"], at, at_given="change_at" in drift, config=True)
         lr_keys = [k for k, idle in MODEL_OPTIONS.items() if k in g and g[k] != idle]
         if lr_keys and not AGENTS[g["agent"]].learns_models:
             learners = ", ".join(name for name, spec in AGENTS.items() if spec.learns_models)

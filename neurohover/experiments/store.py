@@ -41,14 +41,12 @@ from typing import Any
 from ..errors import NeurohoverError, brief, check_flag, finite_real, whole_number
 from ..paths import JSONError, WriterLock, json_text, strict_json
 from .config import check_name, check_scale
+from .store_checks import EXECUTORS as EXECUTORS  # executors.py reads the names from here
+from .store_checks import SESSION_STATUSES, bad_session, sqlite_says
 from .units import Unit
 
 SCHEMA_VERSION = 1
 
-#: How a session can end (:meth:`Store.end_session`; the runner's statuses). A session is "running" until then.
-SESSION_STATUSES = ("finished", "selection finished", "interrupted", "failed")
-#: The executors that run sessions (the ``name`` of executors.LocalExecutor and RayExecutor; importing them here is slow).
-EXECUTORS = ("local", "ray")
 APPLICATION_ID = 0x4E484F56  # "NHOV"
 
 _SCHEMA = """
@@ -233,6 +231,22 @@ class Store:
             )
         except OSError as err:
             raise NeurohoverError(f"cannot open {str(self.lock_path)!r}, the writer lock of results store {str(self.path)!r}: {err.strerror}") from None
+        self.check_sound()
+
+    _sound = False  # SQLite's own check passed, once per open for writing
+
+    def check_sound(self) -> None:
+        """Refuse to write into a file SQLite itself calls malformed (:func:`~.store_checks.sqlite_says`): garbage over
+        one experiment's pages was refused for that experiment, while compete and reproduce of another wrote on into it
+        (T27-A09). Once per open, before its first write."""
+        if not self._sound:
+            said = sqlite_says(self.conn)
+            if said:
+                raise NeurohoverError(
+                    f"results store {str(self.path)!r} is damaged: SQLite's quick_check says {brief(said)}; nothing was written "
+                    "into it: give another --store file (or a sound copy of it)"
+                )
+            self._sound = True
 
     def __enter__(self) -> Store:
         return self
@@ -490,6 +504,7 @@ class Store:
         _check_text(worker, "worker", where, empty=True)
         if session is not None:
             session = _count(session, "session", where, 1)
+        self.check_sound()
         c = self.conn
         with _transaction(c):
             row = c.execute("SELECT config_hash FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
@@ -518,6 +533,7 @@ class Store:
         _check_text(executor, "executor", where)
         cores = _count(cores, "cores", where, 1)
         units_before = _count(units_before, "units_before", where, 0)
+        self.check_sound()
         cur = self.conn.execute(
             "INSERT INTO sessions (name, scale, config_hash, executor, cores, started, wall_seconds, units_run, units_before, status) "
             "VALUES (?, ?, ?, ?, ?, ?, 0, 0, ?, 'running')",
@@ -533,6 +549,7 @@ class Store:
         _check_text(status, "status", where)  # object() was sqlite3's ProgrammingError (T14-5)
         if status not in SESSION_STATUSES:  # free text was stored, and shown by the report as a session's end (fifteenth trial, T15-22)
             raise NeurohoverError(f"{where}: status = {brief(status)} is not allowed: give one of {', '.join(map(repr, SESSION_STATUSES))}")
+        self.check_sound()
         cur = self.conn.execute("UPDATE sessions SET status = ?, wall_seconds = ? - started WHERE id = ?", (status, time.time(), session))
         if cur.rowcount == 0:  # an id start_session never gave matched nothing, without a word (T15-22)
             raise NeurohoverError(f"{where}: session = {session} is not allowed: {str(self.path)!r} has no such session (start_session gives the id)")
@@ -550,36 +567,12 @@ class Store:
             if type(session["cores"]) is not int or session["cores"] < 1:
                 what = f"experiment {name} ({scale}), session {session['id']}'s cores"
                 raise NeurohoverError(f"results store {str(self.path)!r}: {what} are damaged ({session['cores']!r:.40})")
-            bad = _bad_session(session, stored)  # units_run 99 of 4, status 'zzz', started 1e12 were reported (T22-21)
+            bad = bad_session(session, stored)  # units_run 99 of 4, status 'zzz', started 1e12 were reported (T22-21)
             twin = seen.setdefault(tuple(session[c] for c in cols[1:]), session["id"])
             bad = bad or (f"it repeats session {twin} field for field (one run is recorded once)" if twin != session["id"] else "")
             if bad:
                 raise NeurohoverError(f"results store {str(self.path)!r}: experiment {name} ({scale}), session {session['id']} is damaged: {bad}")
         return sessions
-
-
-def _bad_session(session: dict, stored: int) -> str:
-    """What is impossible in a sessions row (checked by :meth:`Store.sessions`), or '': a status no run ends with, an
-    executor that runs none, a start before 2001 or after 2106 (not "now": a clock that lags is no damage), unit counts
-    below 0, or more units before and run than the experiment stores (only ``update`` and ``fresh`` delete units, and
-    both delete the sessions with them). A session killed by SIGKILL stays 'running', and is allowed."""
-    statuses = ("running", *SESSION_STATUSES)
-    value = session["status"]
-    if not isinstance(value, str) or value not in statuses:
-        return f"status {brief(value)} is not allowed: allowed {', '.join(map(repr, statuses))}"
-    value = session["executor"]
-    if not isinstance(value, str) or value not in EXECUTORS:
-        return f"executor {brief(value)} is not allowed: allowed {', '.join(map(repr, EXECUTORS))}"
-    value = session["started"]
-    if not finite_real(value) or not 1e9 <= value < 2**32:  # fixed bounds: a store read on a machine whose clock lags is no damage
-        return f"started {brief(value)} is not allowed: allowed a time (seconds since 1970) from 2001 to 2106"
-    for field in ("units_before", "units_run"):
-        if not whole_number(session[field]) or session[field] < 0:
-            return f"{field} {brief(session[field])} is not allowed: allowed a whole number >= 0"
-    if session["units_before"] + session["units_run"] > stored:
-        counts = f"units_before {session['units_before']} and units_run {session['units_run']}"
-        return f"{counts} are not allowed: together at most the {stored} units the experiment stores"
-    return ""
 
 
 def worker_name() -> str:

@@ -106,17 +106,23 @@ class Drift:
             raise NeurohoverError(f"drift change_at={[lo, hi]} is given without a change: {_PARSE_FORM}")
         object.__setattr__(self, "change_at", (lo, hi))
 
-    def check_run(self, episodes: int, where: str = "") -> None:
-        """Refuse an abrupt change that some test runs of ``episodes`` episodes would never reach (``where``: a prefix naming the run)."""
+    def check_run(self, episodes: int, where: str = "", *, at_given: bool | None = None, config: bool = False) -> None:
+        """Refuse an abrupt change that some test runs of ``episodes`` episodes would never reach (``where``: a prefix naming
+        the run). ``at_given``: whether change_at was given (False: the default; None: not known, the default assumed where
+        it is the default's value); ``config``: given in a config's drift table, so its example is a TOML change_at, not the
+        command line's @LO-HI (T27-A08)."""
         episodes = _whole("episodes", episodes, "a whole number of episodes >= 1", 1)  # 0 suggested the window 0..-1 (thirteenth trial)
         if self.change and self.change_at[1] >= episodes:
             lo, hi = self.change_at
-            default = " (the default where no @LO-HI is given)" if (lo, hi) == CHANGE_AT else ""
+            default = not at_given if at_given is not None else (lo, hi) == CHANGE_AT
+            none_given = "the drift table gives no change_at" if config else "no @LO-HI is given"
+            note = f" (the default where {none_given})" if default else ""
             factors = ",".join(f"{name}={factor:g}" for name, factor in self.change)
+            at = min(lo, episodes - 1)
+            example = f"change_at = [{at}, {episodes - 1}]" if config else f"{factors}@{at}-{episodes - 1}"
             raise NeurohoverError(
-                f"{where + ': ' if where else ''}drift change_at={[lo, hi]}{default} can come after the last of a test run's {episodes} episodes, "
-                f"so some runs would never change: give change_at within 0..{episodes - 1} "
-                f"(e.g. {factors}@{min(lo, episodes - 1)}-{episodes - 1}) or more episodes"
+                f"{where + ': ' if where else ''}drift change_at={[lo, hi]}{note} can come after the last of a test run's {episodes} episodes, "
+                f"so some runs would never change: give change_at within 0..{episodes - 1} (e.g. {example}) or more episodes"
             )
 
     @property
