@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import ROOT, finish_run, start_gated_run
+from conftest import finish_run, start_gated_run
 
 from neurohover.cli import main
 from neurohover.errors import NeurohoverError
@@ -589,8 +589,11 @@ def test_the_commands_are_registered_in_the_cli(capsys) -> None:
 
 @pytest.mark.paper
 def test_paper_scale_reproduction() -> None:
-    """Every experiment at the paper's scale (days of CPU; resumable: set NEUROHOVER_PAPER_STORE)."""
-    store = os.environ.get("NEUROHOVER_PAPER_STORE", str(ROOT / "paper-results.sqlite"))
+    """Every experiment at the paper's scale (days of CPU; resumable): runs only where NEUROHOVER_PAPER_STORE names its
+    store, so a `-m paper` run (or one that drops the marker) never starts days of work by accident."""
+    store = os.environ.get("NEUROHOVER_PAPER_STORE")
+    if not store:
+        pytest.skip("days of CPU: set NEUROHOVER_PAPER_STORE=FILE to run every experiment at the paper's scale into FILE")
     jobs = str(os.cpu_count() or 1)
     assert main(["reproduce", "all", "--scale", "paper", "--store", store, "--jobs", jobs]) == 0
     assert main(["report", "--store", store, "--scale", "paper", "--out", str(Path(store).with_suffix("")) + "-report"]) == 0
