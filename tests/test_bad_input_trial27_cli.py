@@ -24,3 +24,14 @@ def test_resuming_from_another_seed_policy_names_the_gene_that_differs(tmp_path:
     rc, out, err = cli("evolve", *short, "--budget", "20", "--seed-policy", "zero", "--resume")
     assert (rc, out) == (2, "")
     assert "was written by a different run (prototype[11]: the checkpoint's 0.02, given 0.0)" in err, err
+
+
+def test_as_authors_takes_its_own_values_beside_it_and_names_a_contradiction(tmp_path: Path, cli: CliRun) -> None:
+    """Trial 27 (borderline): ``learn-model --as-authors --d-u discard`` was refused though it agrees with the preset;
+    a value that contradicts it is named."""
+    base = ("learn-model", "--flight-data", str(tmp_path / "none.npz"), "--method", "lr", "--out", str(tmp_path / "m.json"), "--as-authors")
+    rc, _, err = cli(*base, "--d-u", "keep", "--noise-estimate", "rms")
+    assert rc == 2 and "--as-authors sets --d-u discard and --noise-estimate rms: --d-u keep contradicts it" in err, err
+    rc, _, err = cli(*base, "--d-u", "discard", "--noise-estimate", "rms")  # agrees: it goes on to read the data
+    assert rc == 2 and "--as-authors" not in err and "none.npz" in err, err
+    assert not (tmp_path / "m.json").exists()

@@ -339,8 +339,9 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
         if value is not None and args.method != "lr":
             raise NeurohoverError(f"{option} applies to --method lr only (least squares), not to --method {args.method}")
     check_given(ModelEvolution, given_settings(args, args.lr_options), args.lr_options)  # named by their options, before anything is read
-    if args.as_authors and (args.d_u, args.noise_estimate) != (None, None):
-        raise NeurohoverError("--as-authors sets --d-u discard and --noise-estimate rms: give either it or those options, not both")
+    against = [f"{o} {v}" for o, v, own in (("--d-u", args.d_u, "discard"), ("--noise-estimate", args.noise_estimate, "rms")) if v not in (None, own)]
+    if args.as_authors and against:  # the preset's own values beside it agree with it (T27, borderline: they were refused)
+        raise NeurohoverError(f"--as-authors sets --d-u discard and --noise-estimate rms: {', '.join(against)} contradicts it; give either it or other values")
     if args.policy == "":  # '' fell through to the flight data's policy (second trial)
         raise NeurohoverError("--policy is empty: give the policy file that flew the data, or 'baseline'")
     if args.policy is not None and args.method != "ec-mer":
