@@ -220,3 +220,14 @@ def test_a09_a_sound_store_is_checked_once_per_open(tiny, tmp_path: Path, monkey
 )
 def test_the_weaker_verdict_follows_the_papers_own_level(paper: str, ours: float, said: str) -> None:
     assert verdict("a", 2.0, 1.0, ours, paper) == said
+
+
+def test_a_group_label_is_as_long_as_a_name_at_most(tmp_path: Path) -> None:
+    """Trial 27 (borderline): a group label of 5,000 characters was taken, where an experiment's name has at most 100."""
+    config = tmp_path / "c.toml"
+    long = "a" * 5000
+    config.write_text(tiny_test_runs("baseline").replace('agent = "baseline"\n', f'agent = "baseline"\nlabel = "{long}"\n'))
+    with pytest.raises(NeurohoverError, match=r"group label 'aaaa.*\(5,000 characters\) is not allowed: give at most 100 characters"):
+        load_config(config, "quick")
+    config.write_text(tiny_test_runs("baseline").replace('agent = "baseline"\n', f'agent = "baseline"\nlabel = "{long[:100]}"\n'))
+    assert load_config(config, "quick").settings["groups"][0]["label"] == long[:100]

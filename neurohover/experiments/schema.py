@@ -222,6 +222,7 @@ def _check_neat_variant(settings: dict, v: dict, where: str) -> None:
 
 #: One word of a unit key that a config names (a variant's key, a part of a group's label): nothing that reads as a path.
 _KEY_WORD = r"[A-Za-z0-9][A-Za-z0-9._+=-]*"
+MAX_LABEL = 100  # characters of a group label, as of an experiment's name (config.check_name)
 _KEY_WORD_ALLOWED = "letters, digits, '.', '_', '+', '=' or '-', starting with a letter or digit"
 
 
@@ -315,6 +316,8 @@ def _check_test_runs(settings: dict, task: str, where: str) -> None:
     """Groups (agents for the task, their LR and own settings, written in where defaulted) and the generics' sources."""
     labels = [g["label"] or g["agent"] for g in settings["groups"]]
     for label in labels:  # a group's label is part of its units' keys, whose parts '/' separates (seventh trial: "../x")
+        if len(label) > MAX_LABEL:  # 5,000 characters were taken, where names have 100 (trial 27, borderline)
+            raise NeurohoverError(f"{where}: group label {brief(label)} is not allowed: give at most {MAX_LABEL} characters")
         if not re.fullmatch(f"{_KEY_WORD}(/{_KEY_WORD})*", label):
             raise NeurohoverError(
                 f"{where}: group label {label!r:.60} is not allowed: give words of {_KEY_WORD_ALLOWED}, joined by '/' (it names the group's "
