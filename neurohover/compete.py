@@ -333,7 +333,7 @@ def compete(
     store_path = store_path or out / STORE_FILE
     _refuse_other_files(out)
     _refuse_other_settings(config, store_path)
-    _note_replaced(out / "summary.json", task, agent)
+    _note_replaced(out / "summary.json", task, agent, config.scale)
     ordered = _run_into_store(config, store_path, out / "episodes.csv", jobs=jobs, device=device, progress=progress, on_result=on_result)
     summary = {"task": task, "agent": agent, "mdps": mdps, "seed": seed, "store": str(store_path), **_flown_under(n_steps, sigma, sensor, drift)}
     summary |= {"experiment": config.name, "scale": config.scale, **summarise(ordered)}
@@ -471,25 +471,33 @@ def _refuse_other_files(out: Path) -> None:
         raise NeurohoverError(f"{name} in {brief(str(out))} is {what}: compete would replace it with {written}; move it away or give another output directory")
 
 
-def _held_competition(summary_path: Path) -> tuple[str, str] | None:
-    """The (task, agent) of the competition summary at ``summary_path``, None for anything else (no file, not one)."""
+def _held_competition(summary_path: Path) -> tuple[str, str, object] | None:
+    """The (task, agent, scale) of the competition summary at ``summary_path``, None for anything else (no file, not one)."""
     try:
         before = json.loads(summary_path.read_text())
-        return (before["task"], before["agent"])
-    except (OSError, ValueError, RecursionError, KeyError, TypeError):
+        return (before["task"], before["agent"], before.get("scale"))
+    except (OSError, ValueError, RecursionError, KeyError, TypeError, AttributeError):
         return None
 
 
-def _note_replaced(summary_path: Path, task: str, agent: str) -> None:
-    """Say when ``out`` holds another competition, whose files this one replaces (without a word before; eighth trial);
-    its runs stay in the store."""
+def _note_replaced(summary_path: Path, task: str, agent: str, scale: str) -> None:
+    """Say when ``out`` holds another competition, whose files this one replaces (without a word before; eighth trial):
+    of another agent or task, or of the same with other settings (its ``scale``, settings-HASH: a re-run with only --seed
+    changed replaced them without a word, trial 27); its runs stay in the store."""
     held = _held_competition(summary_path)
-    if held is not None and held != (task, agent):  # None: no summary, nothing to name
-        print(
-            f"neurohover compete: note: {str(summary_path.parent)!r} held the competition of {held[1]} on {held[0]}; its episodes.csv, "
-            "summary.json and plot are replaced (its runs stay in the store)",
-            file=sys.stderr,
-        )
+    if held is None:  # no summary, nothing to name
+        return
+    if held[:2] != (task, agent):
+        what = f"the competition of {held[1]} on {held[0]}"
+    elif held[2] != scale:
+        what = f"a competition of {agent} on {task} with other settings ({brief(held[2])}; these are {scale})"
+    else:
+        return
+    print(
+        f"neurohover compete: note: {str(summary_path.parent)!r} held {what}; its episodes.csv, summary.json and plot are replaced "
+        "(its runs stay in the store)",
+        file=sys.stderr,
+    )
 
 
 def _run_order(key: str) -> tuple[int, int]:

@@ -35,3 +35,14 @@ def test_as_authors_takes_its_own_values_beside_it_and_names_a_contradiction(tmp
     rc, _, err = cli(*base, "--d-u", "discard", "--noise-estimate", "rms")  # agrees: it goes on to read the data
     assert rc == 2 and "--as-authors" not in err and "none.npz" in err, err
     assert not (tmp_path / "m.json").exists()
+
+
+def test_a_competition_with_other_settings_into_the_same_folder_says_it_replaces_its_files(tmp_path: Path, cli: CliRun) -> None:
+    """Trial 27 (borderline): ``compete --out D`` again with only --seed changed replaced D's files without the note a
+    competition of another agent gets."""
+    base = ("compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--episode-steps", "20", "--out", str(tmp_path / "d"))
+    assert cli(*base)[0] == 0
+    rc, _, err = cli(*base, "--seed", "5")
+    assert rc == 0 and "held a competition of baseline on ghh08 with other settings ('settings-" in err and "; these are settings-" in err, err
+    rc, _, err = cli(*base, "--seed", "5")  # the same again: nothing replaced but its own files
+    assert rc == 0 and "note:" not in err, err
