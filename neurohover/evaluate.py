@@ -38,6 +38,7 @@ from .sim.constants import (
     SAFEGUARD_RATIO_LIMITS,
     SAFEGUARD_RATIO_THRESHOLD,
     SAFEGUARD_TILT,
+    return_floor,
 )
 from .sim.kernel import GENOME_WIDTH
 from .tasks import MDP, Sensor, check_rows, refuse_drift
@@ -198,13 +199,19 @@ class Evaluation:
                 raise NeurohoverError(f"Evaluation {name}={brief(value)} is not allowed: give a NumPy array of {what}, one per episode")
             if value.shape != self.returns.shape:
                 raise NeurohoverError(f"Evaluation {name} has shape {value.shape}, returns {self.returns.shape}: give one entry per episode in each")
-        steps, fired = self.steps, self.safeguard_step
-        if steps.size and (steps.min() < 1 or steps.max() > MAX_EPISODE_STEPS):
-            raise NeurohoverError(f"Evaluation steps holds {brief(int(steps.min() if steps.min() < 1 else steps.max()))}: allowed 1..{MAX_EPISODE_STEPS:,}")
+        steps, fired, r = self.steps, self.safeguard_step, self.returns
+        lo, hi = (int(steps.min()), int(steps.max())) if steps.size else (1, 1)
+        if lo < 1 or hi > MAX_EPISODE_STEPS:
+            raise NeurohoverError(f"Evaluation steps holds {brief(lo if lo < 1 else hi)}: allowed 1..{MAX_EPISODE_STEPS:,}")
         bad = np.flatnonzero((fired < -1) | (fired >= steps))
         if bad.size:
             i = np.unravel_index(bad[0], fired.shape)
             raise NeurohoverError(f"Evaluation safeguard_step {int(fired[i])} of a {int(steps[i])}-step episode is not allowed: give -1 (never) or 0..steps-1")
+        if r.size and not (r.max() <= 0 and r.min() >= return_floor(lo, False)):  # T27-B10: the least floor of all first
+            if (bad := np.flatnonzero((r > 0) | (r < (floor := return_floor(steps, self.crashed))) | np.isinf(r))).size:  # NaN: T27-B06's
+                i = np.unravel_index(bad[0], r.shape)
+                how = "an episode that crashed" if self.crashed[i] else f"a {int(steps[i])}-step episode that did not crash"
+                raise NeurohoverError(f"Evaluation returns holds {brief(float(r[i]))} for {how}: allowed {float(floor[i]) / (1 + 1e-9):.10g}..0")
         if not (self.flight_data is None or isinstance(self.flight_data, FlightData)):
             raise NeurohoverError(f"Evaluation flight_data={brief(self.flight_data)} is not allowed: give FlightData or None")
         if self.flight_data is not None and self.flight_data.n_episodes > self.returns.size:

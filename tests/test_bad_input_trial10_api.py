@@ -24,7 +24,8 @@ def _flight(metadata: dict | None = None, dtype=np.float64) -> FlightData:
 
 def _evaluation(returns=(1.0, 2.0), seconds: float = 0.5, flight: FlightData | None = None) -> Evaluation:
     n = len(returns)
-    return Evaluation(np.array(returns), np.zeros(n, dtype=bool), np.full(n, 20), np.full(n, -1), flight, seconds)
+    # minus the returns given: every return is <= 0 (T27-B10)
+    return Evaluation(-np.array(returns), np.zeros(n, dtype=bool), np.full(n, 20), np.full(n, -1), flight, seconds)
 
 
 def test_flown_evaluations_compare_by_value() -> None:

@@ -66,7 +66,7 @@ CASES: dict[str, tuple[Callable[[object], object], str, int, str]] = {
         "100,000,000 (episodes in one call)",
     ),
     "EpisodeOutcome episode": (lambda v: EpisodeOutcome(v, -1.0, False, 20, -1, None), "EpisodeOutcome episode", 0, INT64),  # type: ignore[arg-type]
-    "EpisodeOutcome steps": (lambda v: EpisodeOutcome(0, -1.0, False, v, -1, None), "EpisodeOutcome steps", 0, INT64),  # type: ignore[arg-type]
+    "EpisodeOutcome steps": (lambda v: EpisodeOutcome(0, -1.0, False, v, -1, None), "EpisodeOutcome steps", 1, "10000000"),  # type: ignore[arg-type]  # T27-B10: 1..MAX_EPISODE_STEPS
     "EpisodeOutcome safeguard_step": (lambda v: EpisodeOutcome(0, -1.0, False, 20, v, None), "EpisodeOutcome safeguard_step", -1, INT64),  # type: ignore[arg-type]
     "Agent.choose episode": (lambda v: make_agent("baseline", FAMILY).choose(v), "episode", 0, INT64),  # type: ignore[arg-type]
     "continual window": (lambda v: ContinualSettings(window=v), "continual window", 1, INT64),  # type: ignore[arg-type]

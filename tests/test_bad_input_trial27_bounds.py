@@ -121,3 +121,101 @@ def test_one_seconds_predicate_serves_every_reader(value) -> None:
         assert not allowed
     timing = dataclasses.make_dataclass("Timing", [("seconds", object)])(value)  # a record of one field, as a stored timing
     assert (seconds_problem(timing) == "") is allowed
+
+
+# --------------------------------------------------------------------------- T27-B03: a stored evolve unit
+
+
+def _stored_evolve_unit(store: Path, fitness: str | None, n_steps: int) -> tuple[str, dict, dict]:
+    """The key, result and params of the committed store's first evolve unit on ``fitness`` with ``n_steps``-step episodes
+    and validation episodes."""
+    import sqlite3
+
+    with sqlite3.connect(store) as conn:
+        rows = conn.execute("SELECT key, params, result FROM units WHERE kind = 'evolve'").fetchall()
+    conn.close()
+    for key, params, result in rows:
+        p, r = json.loads(params), json.loads(result)
+        if p.get("n_steps") == n_steps and r.get("fitness") == fitness and r.get("validation"):
+            return key, r, p
+    raise AssertionError(f"no evolve unit on {fitness} with {n_steps} steps")
+
+
+@pytest.mark.parametrize(
+    ("fitness", "edit", "says"),
+    [
+        (
+            "return",
+            {"champion": -1e9},
+            "champion_return = -1000000000.0 is not allowed: its unit's episodes are 200 control steps long: allowed a mean return in [-349761.5997, 0]",
+        ),
+        (None, {"champion": -349762.0}, "champion_return = -349762.0 is not allowed: its unit's episodes are 200 control steps long"),
+        (
+            "inv-log-error",
+            {"champion": 0.05},
+            "champion_return = 0.05 is not allowed: its unit's episodes are 200 control steps long: allowed a mean 1/ln(error) in [0.07833917, 1000001]",
+        ),
+        (
+            "return",
+            {"validation": -1e9},
+            "validation[0] = -1000000000.0 is not allowed: its unit's episodes are 200 control steps long: allowed at least -349761.5997",
+        ),
+    ],
+    ids=["return", "raw", "inv-log-error", "validation"],
+)
+def test_a_stored_evolve_unit_beyond_its_own_episode_length_is_refused(committed_store: Path, fitness, edit: dict, says: str) -> None:
+    from neurohover.experiments.result_checks import params_problem
+    from neurohover.experiments.results import result_from_dict
+
+    key, result, params = _stored_evolve_unit(committed_store, fitness, 200)
+    assert params_problem(result_from_dict("evolve", result, key), params) == ""
+    if "champion" in edit:  # the champion's fitness is its history's last (the run's other checks), so both move
+        result["champion_return"] = result["history"][-1][1] = edit["champion"]
+    else:
+        result["validation"][0] = edit["validation"]
+    assert params_problem(result_from_dict("evolve", result, key), params).startswith(says)
+
+
+# --------------------------------------------------------------------------- T27-B10: EpisodeOutcome's steps, Evaluation's returns
+
+
+@pytest.mark.parametrize(("steps", "says"), [(0, "steps=0 is out of range"), (10**7 + 1, "steps=10000001 is out of range")])
+def test_an_episode_outcome_of_no_steps_or_past_the_longest_episode_is_refused(steps: int, says: str) -> None:
+    from neurohover.agents.protocol import EpisodeOutcome
+
+    with _raises(f"EpisodeOutcome {says}: allowed an integer in 1..10000000"):
+        EpisodeOutcome(episode=0, ret=0.0, crashed=True, steps=steps, safeguard_step=-1, flight_data=None)
+    assert EpisodeOutcome(episode=0, ret=-1.0, crashed=False, steps=10**7, safeguard_step=-1, flight_data=None).steps == 10**7
+
+
+@pytest.mark.parametrize(
+    ("ret", "crashed", "says"),
+    [
+        (5.0, False, "Evaluation returns holds 5.0 for a 20-step episode that did not crash: allowed -34976.15997..0"),
+        (-1e9, False, "Evaluation returns holds -1000000000.0 for a 20-step episode that did not crash: allowed -34976.15997..0"),
+        (-1e30, True, "Evaluation returns holds -1e+30 for an episode that crashed: allowed -1.748807999e+10..0"),
+        (-math.inf, True, "Evaluation returns holds -inf for an episode that crashed"),
+        (math.inf, False, "Evaluation returns holds inf for a 20-step episode"),
+    ],
+)
+def test_an_evaluation_of_returns_no_episode_can_have_is_refused(ret: float, crashed: bool, says: str) -> None:
+    import numpy as np
+
+    from neurohover.evaluate import Evaluation
+
+    def made(value: float, flag: bool) -> Evaluation:
+        returns = np.array([[-3.0, value]])
+        return Evaluation(returns, np.array([[False, flag]]), np.array([[20, 20]]), np.full((1, 2), -1), None, 0.0)
+
+    assert made(-34976.0, False).returns[0, 1] == -34976.0 and made(-1e9, True).crashed[0, 1]  # a crash: up to -WORST_RETURN
+    assert np.isnan(made(math.nan, True).returns[0, 1])  # a blow-up is not judged here (T27-B06)
+    with _raises(says):
+        made(ret, crashed)
+
+
+def test_every_evaluate_return_passes() -> None:
+    import neurohover as nh
+
+    family = get_task_family("ghh08")
+    ev = nh.evaluate("baseline", [family.zero(), family.make([4.9, -3.0])], episodes=3, n_steps=30)
+    assert ev.returns.size == 6 and (ev.returns <= 0).all()

@@ -34,7 +34,7 @@ from ..evaluate import MAX_EPISODES_PER_CALL, DangerousState, PolicyTable, evalu
 from ..evolution.seeding import check_seed
 from ..flightdata import FlightData
 from ..policies import Policy
-from ..sim.constants import CRASH_STEP_PENALTY, EPISODE_STEPS, WORST_RETURN, lowest_return
+from ..sim.constants import CRASH_STEP_PENALTY, EPISODE_STEPS, MAX_EPISODE_STEPS, WORST_RETURN, lowest_return
 from ..tasks import MDP, TaskFamily
 from .spec import AgentSettings
 
@@ -130,7 +130,7 @@ class EpisodeOutcome:
             raise NeurohoverError(f"EpisodeOutcome ret={brief(self.ret)} is not allowed: give the episode's return, a finite number")
         if not isinstance(self.crashed, (bool, np.bool_)):
             raise NeurohoverError(f"EpisodeOutcome crashed={brief(self.crashed)} is not allowed: give True or False")
-        _check_count("EpisodeOutcome steps", self.steps, 0)
+        whole_in(self.steps, "EpisodeOutcome steps", 1, MAX_EPISODE_STEPS)  # T27-B10: 0 and 10**8 were taken (Evaluation's 1..MAX_EPISODE_STEPS)
         _check_count("EpisodeOutcome safeguard_step", self.safeguard_step, -1)
         # T27-B10: a safeguard step past the episode, a positive return and -1e30 for 20 steps were taken
         if self.safeguard_step >= max(self.steps, 0):

@@ -400,7 +400,34 @@ def evolve_params_problem(run: EvolveResult, params: dict) -> str:
             )
         if where and whole_number(again) and held.episodes != again:
             return f"{where}episodes = {brief(held.episodes)} is not allowed: its unit's params.champion_reevaluation is {again}: allowed {again}"
-    return _history_fall_problem(run, params) or _budget_problem(run, params) or _generations_problem(run, params)
+    return _own_length_problem(run, params) or _history_fall_problem(run, params) or _budget_problem(run, params) or _generations_problem(run, params)
+
+
+def _own_length_problem(run: EvolveResult, params: dict) -> str:
+    """'' unless a figure of evolution run ``run`` is one no episode of its unit's ``params.n_steps`` can give ('' where
+    it gives none: the plan check's to name): its champion's fitness and its history's, each a mean of its episodes'
+    fitness on its scale (:func:`~neurohover.evolution.fitness.fitness_range`; never a sum), or a validation return below
+    :func:`~neurohover.sim.constants.lowest_return`. -inf and NaN are :func:`_fitness_problem`'s to judge. -1e9 of a
+    20-step run was reported, bounded only by WORST_RETURN's 10**7 steps (T27-B03)."""
+    from ..evolution.fitness import fitness_range, in_fitness_range
+
+    n_steps = params.get("n_steps")
+    if not (whole_number(n_steps) and n_steps >= 1):
+        return ""
+    scale = run.fitness if run.fitness in ("return", "inv-log-error") else "return"
+    low, high, allowed = fitness_range(n_steps, scale)
+    named = [("champion_return", run.champion_return), *((f"history[{i}]'s champion fitness", entry[1]) for i, entry in enumerate(run.history))]
+    for name, value in named:
+        v = float(value)
+        if math.isfinite(v) and not in_fitness_range(v, low, high):
+            return f"{name} = {brief(value)} is not allowed: its unit's episodes are {n_steps:,} control steps long: allowed {allowed} or -inf"
+    lowest = lowest_return(n_steps)
+    for where, held in [("", run), *((f"{n}.", getattr(run, n)) for n in ("reevaluated", "reevaluated_best_ever"))]:
+        for i, r in enumerate(() if held is None or held.validation is None else held.validation):
+            if float(r) < lowest:  # (NaN is no number below it: a blown-up episode, kept as 'nan')
+                bound = f"{lowest:.10g} (the worst step, {CRASH_STEP_PENALTY:.6g}, for each of its {n_steps:,} steps)"
+                return f"{where}validation[{i}] = {brief(r)} is not allowed: its unit's episodes are {n_steps:,} control steps long: allowed at least {bound}"
+    return ""
 
 
 def _generations_problem(run: EvolveResult, params: dict) -> str:

@@ -7,6 +7,7 @@ MDPs (task-family MDPs or learned models) is a plain 2-D array.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -56,6 +57,16 @@ def lowest_return(n_steps: int) -> float:
     """The lowest return an episode of ``n_steps`` control steps can have, -CRASH_STEP_PENALTY * n_steps: each step
     flown earns at least the worst step's reward, a crash is charged the worst step for each step left (T27-B03)."""
     return -CRASH_STEP_PENALTY * n_steps
+
+
+def return_floor(steps: Any, crashed: Any) -> Any:
+    """The least return of each episode of ``steps`` control steps flown (the crashing one counted) and ``crashed``
+    flags, 1e-9 below for the squares' rounding: ``lowest_return(steps)`` uncrashed, -WORST_RETURN crashed (charged
+    the worst step for each step left of a budget of at most MAX_EPISODE_STEPS): what an Evaluation checks its returns
+    against, an EpisodeOutcome's rule (agents.protocol._check_return) vectorised (T27-B10)."""
+    if isinstance(crashed, bool):  # one episode's (a scalar: no array built)
+        return (-WORST_RETURN if crashed else lowest_return(steps)) * (1 + 1e-9)
+    return np.where(crashed, -WORST_RETURN, lowest_return(steps)) * (1 + 1e-9)
 
 
 def crash_charge(n_steps: int, t: int) -> float:
