@@ -80,3 +80,16 @@ def test_kernel_rows_past_the_bounds_are_refused(column: int, value: float, says
     with pytest.raises(NeurohoverError, match=re.escape(f"MDP row 1 has {'' if 'dt' in says else 'a parameter, noise std, wind number or D_u of '}{says}")):
         check_rows(rows)
     check_rows(rows[:1])
+
+
+@pytest.mark.parametrize("label", ["ghh08/train:0", "ghh09/test:5", "fghh/zero", "ghh08/wind=[1.0, 2.0]"])
+def test_a_learned_models_mdp_takes_no_task_familys_label(label: str) -> None:
+    """T28-B09: a model's MDP labelled 'ghh08/train:0' was evolved on, and the policy file claimed that target; a GHH-09
+    env reported 'ghh08/test:5'."""
+    model = LearnedModel(tuple(one_substep_params()[0]), (0.1,) * 6, "lr")
+    with pytest.raises(
+        NeurohoverError, match=re.escape(f"MDP {label!r} is not allowed: its label names a '{label.split('/')[0]}' MDP, but the MDP is a learned model's")
+    ):
+        model.mdp(label=label)
+    assert model.mdp(label="model/lr").label == "model/lr" and model.mdp(label="learned").label == "learned"
+    assert nh.MDP("model", substeps=1, dt=0.1, label="train:3").label == "train:3"  # names no family: a model's own
