@@ -103,7 +103,10 @@ def learn_ec_meno(flight_data: FlightData, *, budget: int | None = None, seed: i
 
     The objective's exact minimum is known in closed form (:meth:`OneStepProblem.least_squares`:
     OLS per axis, LR's ``"ols"`` fit with intercepts ``"v"``); ``stats`` reports it next to the
-    champion's (``one_step_error``, ``least_squares_one_step_error``, ``excess``).
+    champion's (``one_step_error``, ``least_squares_one_step_error``, ``excess``). Flight data that
+    leave an axis undetermined (collinear regressors, which LR refuses) are fitted on purpose: the
+    evolution starts from the prototype, which holds the directions the data do not see, and
+    ``least_squares_one_step_error`` and ``excess`` are None (no unique minimum; T28-B17).
 
     Genes (``scaling``)
         ``"data"`` (default): gene i is parameter i divided by :func:`ec_meno_gene_scale`, the
