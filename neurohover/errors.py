@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
+import operator
 from typing import TYPE_CHECKING, Any, TypeGuard
 
 if TYPE_CHECKING:  # numpy is imported where used: the package installs its signal handlers after this module, before numpy
@@ -25,8 +26,38 @@ class Terminated(KeyboardInterrupt):
 
 def whole_number(value: object) -> TypeGuard[int]:
     """Whether ``value`` is an integer, NumPy's included, and not a bool (True is an int, and was taken as 1). The one
-    test of every integer argument; the type checker takes it as an int (NumPy's integers compare and index alike)."""
-    return isinstance(value, numbers.Integral) and not isinstance(value, bool) and type(value).__name__ not in _TIMES
+    test of every integer argument; the type checker takes it as an int (NumPy's integers compare and index alike).
+    An int subclass whose ``int()`` is not its value is not: the value checked must be the value used (T28-B01)."""
+    if not (isinstance(value, numbers.Integral) and not isinstance(value, bool) and type(value).__name__ not in _TIMES):
+        return False
+    return type(value) is int or _honest_int(value)
+
+
+def _honest_int(value: Any) -> bool:
+    """Whether ``int(value)``, ``float(value)`` and the integer that comparisons see (``operator.index``) agree: an int
+    subclass with ``__int__`` returning 10**9 passed n_steps=I(20) and flew 10**9 steps (T28-B01)."""
+    try:
+        exact = operator.index(value)
+        if int(value) != exact:
+            return False
+    except (TypeError, ValueError, OverflowError):
+        return False
+    return _same_float(value, exact)
+
+
+def _same_float(value: Any, exact: float | int) -> bool:
+    """Whether ``float(value)`` is ``float(exact)`` (NaN is NaN; both past a float's range count as alike)."""
+    try:
+        given = float(value)
+    except OverflowError:
+        given = None
+    except (TypeError, ValueError):
+        return False
+    try:
+        true = float(exact)
+    except OverflowError:
+        true = None
+    return given == true or (given is not None and true is not None and math.isnan(given) and math.isnan(true))
 
 
 #: NumPy's time types: np.timedelta64 is a np.signedinteger (so Integral) whose int() raises (seventeenth trial, T17-1).
@@ -40,15 +71,22 @@ def whole_in(value: object, name: str, low: int, high: int, high_text: str | Non
     allowed = f"allowed an integer in {low}..{high_text or high}"
     if not whole_number(value):
         raise NeurohoverError(f"{name}={brief(value)} is not allowed: {allowed}")
-    if not low <= value <= high:
+    exact = operator.index(value)  # the integer checked is the integer returned (T28-B01)
+    if not low <= exact <= high:
         raise NeurohoverError(f"{name}={brief(value)} is out of range: {allowed}")
-    return int(value)
+    return exact
 
 
 def real_number(value: object) -> TypeGuard[float]:
     """Whether ``value`` is a real number, NumPy's included: not a bool (True is an int) nor a NumPy time (an Integral
-    whose float() and int() raise, T17-1). The one test of a number argument; :func:`finite_real` adds finiteness."""
-    return isinstance(value, numbers.Real) and not isinstance(value, bool) and type(value).__name__ not in _TIMES
+    whose float() and int() raise, T17-1). The one test of a number argument; :func:`finite_real` adds finiteness.
+    A float or int subclass whose ``float()`` (or ``int()``) is not its value is not: MDP(d_u=F(0.0)) with a NaN
+    ``__float__`` stored NaN (T28-B01)."""
+    if not (isinstance(value, numbers.Real) and not isinstance(value, bool) and type(value).__name__ not in _TIMES):
+        return False
+    if type(value) in (float, int) or not isinstance(value, (float, int)):
+        return True
+    return _same_float(value, float.__float__(value)) if isinstance(value, float) else _honest_int(value)
 
 
 def finite_real(value: object) -> bool:
@@ -57,8 +95,8 @@ def finite_real(value: object) -> bool:
     if not real_number(value):
         return False
     try:
-        return math.isfinite(value)
-    except OverflowError:
+        return math.isfinite(float(value))  # the value converted, as callers store it (T28-B01)
+    except (OverflowError, TypeError, ValueError):
         return False
 
 
@@ -80,6 +118,8 @@ def brief(value: object) -> str:
         text = " ".join(text.split()) if "\n" in text else text  # an array's repr spans lines: one line in a message
     except Exception:  # a container of such an int; any repr that raises: a message must not (T17-1)
         text = f"a {type(value).__name__}"
+    if isinstance(value, (int, float)) and type(value).__module__ not in ("builtins", "numpy") and not real_number(value):
+        text = f"{type(value).__name__}({text})"  # a number whose int()/float() lie: F(0.0), not 0.0 (T28-B01)
     return text if len(text) <= 60 else text[:57] + "..."
 
 

@@ -68,18 +68,18 @@ def as_policies(policies) -> list[Policy]:
     """``policies`` as a list of :class:`Policy`: a Policy, a policy file's path or ``"baseline"``
     (as wherever a policy file is accepted), or a sequence of these; anything else is refused."""
 
+    allowed = "give a Policy, a policy file's path or 'baseline' (or a sequence of these, or a PolicyTable)"
+
     def one(p) -> Policy:
-        if isinstance(p, Policy):
-            return p
-        if isinstance(p, (str, Path)):
-            return load_policy(p)
-        raise NeurohoverError(f"policy {p!r} is not allowed: give a Policy, a policy file's path or 'baseline' (or a sequence of these, or a PolicyTable)")
+        if isinstance(p, (Policy, str, Path)):
+            return p if isinstance(p, Policy) else load_policy(p)
+        raise NeurohoverError(f"policy {brief(p)} is not allowed: {allowed}")  # brief: a set of 100 policies was 44,495 characters (T28-B02)
 
     if isinstance(policies, (Policy, str, Path)):
         return [one(policies)]
     if isinstance(policies, Sequence):
         return [one(p) for p in policies]
-    raise NeurohoverError(f"policies={policies!r} is not allowed: give a Policy, a policy file's path or 'baseline' (or a sequence of these, or a PolicyTable)")
+    raise NeurohoverError(f"policies={brief(policies)} is not allowed: {allowed}")
 
 
 @dataclass(frozen=True, eq=False)

@@ -93,9 +93,11 @@ class FlightData:
             arrays = getattr(self, name)
             if isinstance(arrays, (str, bytes, np.ndarray)) or not isinstance(arrays, (tuple, list)):
                 raise NeurohoverError(f"flight data {name}={brief(arrays)} is not allowed: give a sequence of arrays, one per episode")
-            # a masked array was stored as it was, its hidden values learned from (T16-9)
-            if not all(isinstance(a, np.ndarray) and not isinstance(a, np.ma.MaskedArray) and a.dtype.kind in "fi" for a in arrays):
-                raise NeurohoverError(f"flight data {name} must be arrays of real numbers (plain, not masked), one per episode")
+            # a masked array was stored as it was, its hidden values learned from (T16-9); an np.matrix, and save() was a TypeError (T28-B06)
+            if not all(type(a) is np.ndarray and a.dtype.kind in "fi" for a in arrays):
+                other = next((type(a).__name__ for a in arrays if isinstance(a, np.ndarray) and type(a) is not np.ndarray), None)
+                note = f" (not {other}: give np.asarray of it)" if other and other != "MaskedArray" else ""
+                raise NeurohoverError(f"flight data {name} must be arrays of real numbers (plain, not masked), one per episode{note}")
             object.__setattr__(self, name, tuple(arrays))
         _metadata_text(self.metadata, "flight data")  # None, [1], {1: 2}, a NaN were taken, and refused or changed by save() (T15-29, T21-08)
         if len(self.observations) != len(self.actions):

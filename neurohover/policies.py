@@ -10,7 +10,6 @@ keys. The name ``baseline`` stands for the competition's baseline policy whereve
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from collections.abc import Callable, Sequence
@@ -119,8 +118,11 @@ class Policy:
             return NotImplemented
         return self.topology == other.topology and np.array_equal(self.genome, other.genome)
 
-    def __hash__(self) -> int:
-        return hash((self.topology, self.genome.tobytes()))
+    def __hash__(self) -> int:  # + 0.0: a gene -0.0 hashed apart from 0.0, which == takes as equal (T28-B15)
+        return hash((self.topology, (self.genome + 0.0).tobytes()))
+
+    def __reduce__(self):  # copies and unpickled policies are built anew: their genome was writable, NaN flown (T28-B03)
+        return (Policy, (self.topology, self.genome, self.metadata))
 
     def act(self, observation: Sequence[float]) -> tuple[float, float, float, float]:
         """Actions for a 12-number observation, computed in plain Python (the readable definition).
@@ -342,19 +344,22 @@ def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
 
     The name is checked by :func:`check_json_policy_name` (a name ending .json, not another run's checkpoint or history;
     T24-01), the record by :data:`RECORD_CHECKS` as :func:`load_policy` checks it (T24-03): what is written loads."""
-    from .paths import output_file, writing
+    from .paths import json_text, output_file, writing
 
     if not isinstance(policy, Policy):
         raise NeurohoverError(f"policy={policy!r:.60} is not allowed: give a Policy (load_policy('baseline') for the baseline's)")
     check_json_policy_name(path, "policy file")
+    check_genome(policy.genome, policy.topology)  # a genome made writable and given an inf blamed the metadata (T28-B03)
     data = policy_to_dict(policy)
-    taken = sorted({"topology", "genome"} & set(metadata))  # the policy's metadata may be updated, its network not
-    if taken:  # they would overwrite the policy itself and write a file load_policy refuses (second trial)
-        raise NeurohoverError(f"metadata key(s) {', '.join(taken)} are the policy's own: give the metadata other names")
+    for given, what in ((policy.metadata, "policy metadata"), (metadata, "metadata")):
+        taken = sorted({"topology", "genome"} & set(given))  # the policy's metadata may be updated, its network not
+        if taken:  # they would overwrite the policy itself (second trial), from its own metadata edited in place too (T28-B05)
+            raise NeurohoverError(f"{what} key(s) {', '.join(taken)} are the policy's own: give the metadata other names")
     data.update(metadata)
-    try:
-        text = json.dumps(data, indent=1, allow_nan=False) + "\n"
-    except (TypeError, ValueError) as err:  # an object, or a NaN that other JSON readers refuse
+    _check_text_keys(data)
+    try:  # json_text: what load_policy reads back (x=10**400 was written, then refused; T28-B14)
+        text = json_text(data, indent=1) + "\n"
+    except (TypeError, ValueError, RecursionError) as err:  # an object, or a NaN that other JSON readers refuse
         raise NeurohoverError(f"policy metadata must be strict JSON values (numbers finite): {err}") from None
     problem = record_problem({k: v for k, v in data.items() if k not in ("topology", "genome")})
     if problem:  # T24-03: seed=-1 or budget=-5 was written, and load_policy then refused the file
@@ -364,3 +369,25 @@ def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
     with writing(path, "policy file") as partial:
         partial.write_text(text)
     return path
+
+
+def _check_text_keys(data: dict) -> None:
+    """Refuse policy metadata holding a key that is not text, at any depth: JSON writes every key as text, and {1: 2} came
+    back from the file as {'1': 2} (T28-B14), as flight data refuse it (T15-29)."""
+    stack: list[object] = [data]
+    seen: set[int] = set()  # a dict that holds itself: json_text names it
+    while stack:
+        value = stack.pop()
+        if isinstance(value, (dict, list, tuple)) and id(value) in seen:
+            continue
+        seen.add(id(value))
+        if isinstance(value, dict):
+            key = next((k for k in value if not isinstance(k, str)), None)
+            if key is not None:
+                raise NeurohoverError(
+                    f"policy metadata key {brief(key)} is not allowed: give text keys "
+                    "(JSON writes every key as text, so the file would load back with other metadata)"
+                )
+            stack.extend(value.values())
+        elif isinstance(value, (list, tuple)):
+            stack.extend(value)

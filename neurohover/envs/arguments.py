@@ -46,7 +46,7 @@ def resolve_mdp(family: TaskFamily, spec: Any, cache: dict[str, MDP] | None = No
             )
         return sensed_mdp(spec, family.sensor)  # flyable: an MDP checks its numbers and substeps when it is made
     if not isinstance(spec, str):
-        raise NeurohoverError(f"mdp={spec!r} is not allowed: use one of {', '.join(MDP_OPTIONS)} or an MDP instance")
+        raise NeurohoverError(f"mdp={brief(spec)} is not allowed: use one of {', '.join(MDP_OPTIONS)} or an MDP instance")
     if spec == SAMPLE:
         return SAMPLE
     if cache is not None and spec in cache:
