@@ -31,7 +31,7 @@ from typing import NoReturn
 import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real, whole_number
-from .paths import input_dir, strict_json
+from .paths import input_dir, number_text, refuse_special_file, strict_json
 from .sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS, MAX_SECONDS, WORST_RETURN, crash_charge, crash_return_ceiling, lowest_return, seconds_allowed
 from .sim.rng import MAX_SEED
 from .tasks.base import N_TEST, N_TRAINING
@@ -194,6 +194,23 @@ def _after_learning_start(labels: list[str]) -> int:
     return start
 
 
+def _row_numbers(where: str, row: dict[str, str]) -> tuple:
+    """A row's run, episode, return, crashed (0 where absent, as in older files) and steps (None where absent), each
+    written as compete writes it (:func:`~neurohover.paths.number_text`): int() and float() took '0_0', '\u0660' and
+    full-width digits (T28-B12); steps '20.0' was "must be numbers"."""
+    cells: list[int | float | None] = []
+    for column in ("run", "episode", "return", "crashed", "steps"):
+        text = row.get(column)
+        if not text and column in ("crashed", "steps"):  # absent from older files
+            cells.append(0 if column == "crashed" else None)
+            continue
+        try:
+            cells.append(number_text(text or "", whole=column != "return"))
+        except ValueError as err:
+            raise NeurohoverError(f"{where}: {column} {err}") from None
+    return tuple(cells)
+
+
 def _read_rows(csv_path: Path) -> tuple[dict[int, list[tuple[int, float, str]]], dict[int, set[int]], _Rows]:
     """Each run's (episode, return, policy) rows of the episodes file ``csv_path``, each run's episode numbers, and the
     facts the summary check compares; a row compete never writes refused, naming the line."""
@@ -219,11 +236,7 @@ def _read_rows(csv_path: Path) -> tuple[dict[int, list[tuple[int, float, str]]],
                 if None in row or None in row.values():  # T23-07: values past the header's columns were ignored
                     count = len(columns) + len(row.get(None) or ()) - sum(v is None for k, v in row.items() if k is not None)
                     raise NeurohoverError(f"{where}: it holds {count} values where the header names {len(columns)} columns: give one value per column")
-                try:
-                    run, episode, ret = int(row["run"]), int(row["episode"]), float(row["return"])
-                    crashed, steps = int(row.get("crashed") or 0), int(row["steps"]) if row.get("steps") else None
-                except (TypeError, ValueError):
-                    raise NeurohoverError(f"{where}: run, episode, return, crashed and steps must be numbers") from None
+                run, episode, ret, crashed, steps = _row_numbers(where, row)
                 _check_row(where, row, crashed, steps)
                 if not (math.isfinite(ret) and -WORST_RETURN <= ret <= 0):  # -1e308 overflowed the plot (eighth trial); every reward is <= 0 (ninth)
                     raise NeurohoverError(
@@ -270,7 +283,9 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
         compete never writes or that contradicts it (:func:`_check_summary`).
     """
     path = input_dir(path, "--compete")  # None or 5 was pathlib's TypeError (eleventh trial)
-    csv_path = path / COMPETE_FILE
+    csv_path, summary_path = path / COMPETE_FILE, path / COMPETE_SUMMARY
+    for held in (csv_path, summary_path):  # a FIFO summary.json hung plot --compete for ever (T28-A08)
+        refuse_special_file(held, "--compete", instead="give directories written by neurohover compete --out")
     if not csv_path.is_file():
         raise NeurohoverError(f"--compete {str(path)!r} holds no {COMPETE_FILE}: give directories written by neurohover compete --out")
     runs, seen, facts = _read_rows(csv_path)
@@ -300,7 +315,7 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
         after = [ret for rows in ordered for _, ret, _ in rows[_after_learning_start([p for _, _, p in rows]) :]]
         facts.after_learning = math.fsum(after) / len(after)
     label = path.resolve().name  # no summary (an interrupted competition): the directory's name labels it
-    summary_path, conditions, episode_steps = path / COMPETE_SUMMARY, {}, None
+    conditions, episode_steps = {}, None
     if summary_path.exists():
         try:
             summary = strict_json(summary_path.read_text(encoding="utf-8-sig"))  # a key given twice too (ninth trial)

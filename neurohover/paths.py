@@ -16,6 +16,7 @@ from __future__ import annotations
 import errno
 import json
 import os
+import re
 import socket
 import sys
 import tempfile
@@ -23,8 +24,8 @@ from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
 
-from .errors import NeurohoverError, OutputError, brief
-from .filekinds import SQLITE_HEADER, held_kind, output_name
+from .errors import NeurohoverError, OutputError, brief, float_of
+from .filekinds import PNG_KIND, SQLITE_HEADER, held_kind, output_name
 
 try:
     import fcntl
@@ -42,10 +43,13 @@ __all__ = [
     "input_file",
     "input_dir",
     "make_dirs",
+    "number_text",
     "output_dir",
     "output_file",
     "printable",
     "refuse_dangling_link",
+    "refuse_foreign_output",
+    "refuse_gone_cwd",
     "refuse_link_loop",
     "refuse_special_file",
     "remove_created_dirs",
@@ -141,6 +145,7 @@ def checked_path(path, option: str, what: str = "file path") -> Path:
         raise NeurohoverError(f"{option} is empty; give a {what}")
     if "\x00" in text:
         raise NeurohoverError(f"{option} {text!r:.80} holds a NUL character: give a {what}")
+    refuse_gone_cwd(text, option)
     longest = max(Path(text).parts, key=lambda part: len(os.fsencode(part)), default="")  # "." has no parts (fifth trial)
     if len(os.fsencode(longest)) > NAME_MAX or len(os.fsencode(text)) > PATH_MAX:
         shown = repr(text) if len(text) <= 80 else repr(text[:40]) + " ... " + repr(text[-20:])
@@ -150,6 +155,17 @@ def checked_path(path, option: str, what: str = "file path") -> Path:
         )
     refuse_link_loop(text, option)
     return Path(text)
+
+
+def refuse_gone_cwd(path: str | os.PathLike, option: str) -> None:
+    """Refuse a relative ``path`` when the current directory has been removed: os.getcwd() fails, and the command said
+    only "No such file or directory", naming no path (T28-A12)."""
+    if os.path.isabs(path):
+        return
+    try:
+        os.getcwd()
+    except FileNotFoundError:
+        raise NeurohoverError(f"{option} {os.fspath(path)!r}: the current directory no longer exists: give an absolute path") from None
 
 
 def refuse_link_loop(path: str | os.PathLike, option: str) -> None:
@@ -222,6 +238,21 @@ def _json_int(text: str) -> int:
     return value
 
 
+_WHOLE_TEXT = re.compile(r"0|-?[1-9][0-9]{0,18}")  # as str(int) writes one, up to 19 digits (2**63 - 1 has 19)
+_REAL_TEXT = re.compile(r"-?(?:[0-9]+(?:\.[0-9]+)?(?:e[-+]?[0-9]+)?|inf)|nan")  # as repr(float) writes one
+
+
+def number_text(text: str, whole: bool = False) -> int | float:
+    """The number a CSV cell ``text`` holds as Python writes one (``str(int)``, ``repr(float)``: ``20``, ``-7.38``,
+    ``1e-05``, ``-inf``, ``nan``; ``whole``: an integer, no sign before 0), else a ValueError saying what is allowed:
+    ``int()`` and ``float()`` also read '1_0', other scripts' digits ('\u0661'), spaces and '+5' (T28-B12, T28-B13).
+    The range of the number is the caller's to check."""
+    if isinstance(text, str) and (_WHOLE_TEXT if whole else _REAL_TEXT).fullmatch(text):
+        return int(text) if whole else float_of(text)
+    allowed = "a whole number (at most 19 digits)" if whole else "a number"
+    raise ValueError(f"{brief(text)} is not allowed: allowed {allowed} in ASCII digits, as Python writes it")
+
+
 def _no_dash(path: str | os.PathLike, option: str, what: str, stdout: bool) -> None:
     """Refuse ``-``, which by custom means standard output, as a name: it was written as a hidden-looking file named '-'
     (eleventh trial); ``stdout``: leaving ``option`` out writes to standard output."""
@@ -291,12 +322,38 @@ def output_file(
     return p
 
 
-def refuse_special_file(path: str | os.PathLike, option: str, given: str | os.PathLike | None = None) -> None:
+def refuse_special_file(path: str | os.PathLike, option: str, given: str | os.PathLike | None = None, instead: str = "give a file path") -> None:
     """Refuse an existing ``path`` that is neither a regular file nor a directory: written by replacing it, a device node
-    (/dev/full, as root) or a FIFO became a PNG (fourteenth trial). ``given``: the path as the user gave it (default ``path``)."""
+    (/dev/full, as root) or a FIFO became a PNG (fourteenth trial); read, a FIFO hung the command for ever (T28-A08).
+    ``given``: the path as the user gave it (default ``path``); ``instead``: what to do."""
     p = Path(path)
     if p.exists() and not p.is_file() and not p.is_dir():
-        raise NeurohoverError(f"{option} {str(path if given is None else given)!r} is not a regular file (a device, pipe or socket); give a file path")
+        raise NeurohoverError(f"{option} {str(path if given is None else given)!r} is not a regular file (a device, pipe or socket); {instead}")
+
+
+def refuse_foreign_output(path: str | os.PathLike, option: str, kind: str) -> None:
+    """Refuse to write ``kind`` (one of :func:`~neurohover.filekinds.held_kind`'s words, e.g. ``"a PNG image"``) at the
+    output name ``path`` a command chose itself (a figure, report.md) unless it is absent, empty or already ``kind``:
+    a user's notes at report.md and a text file at a figure's name were replaced without a word (T28-A04, T28-A05). A
+    symbolic link is refused too (report.md was written through one to a file outside --out), and so are a directory
+    and a device, pipe or socket, by name."""
+    shown = repr(os.fspath(path))
+    if os.path.islink(path):
+        raise NeurohoverError(
+            f"{option} {shown} is a symbolic link (to {os.readlink(os.fspath(path))!r}): {kind} is not written through one; "
+            "remove the link or give another directory"
+        )
+    p = Path(path)
+    if p.is_dir():
+        raise NeurohoverError(f"{option} {shown} is a directory: {kind} would be written there; move it away or give another directory")
+    refuse_special_file(p, option, instead="move it away or give another directory")
+    if not p.is_file() or p.stat().st_size == 0:
+        return
+    held = held_kind(p)
+    if held != kind:
+        raise NeurohoverError(
+            f"{option} {shown} is {held or 'a file neurohover did not write'}: it would be replaced with {kind}; move it away or give another directory"
+        )
 
 
 @contextmanager
@@ -323,7 +380,8 @@ def writing(path: str | os.PathLike, option: str) -> Iterator[Path]:
 
 def write_png(fig, path: str | os.PathLike, what: str, dpi: float | None = None) -> Path:
     """Write the matplotlib figure ``fig`` as a PNG to ``path`` through :func:`writing` (whole or not at all: a full
-    disk left an empty PNG and a traceback)."""
+    disk left an empty PNG and a traceback), only where no file of another kind sits (:func:`refuse_foreign_output`)."""
+    refuse_foreign_output(path, what, PNG_KIND)
     with writing(path, what) as partial:
         fig.savefig(partial, format="png", dpi=dpi)
     return Path(path)

@@ -193,7 +193,8 @@ def cmd_evolve(args: argparse.Namespace) -> int:
 
 def _evolve_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int:
     from ..evolution.evolve import EvolutionInterrupted, evolve, parse_resampling, validation_return, write_history_csv
-    from ..paths import output_file, sole_writer, writing
+    from ..evolution.records import CHECKPOINT_KIND, HISTORY_KIND
+    from ..paths import output_file, sole_writer
     from ..policies import check_json_policy_name, save_policy
 
     _check_evolve_sizes(args)
@@ -201,10 +202,10 @@ def _evolve_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int
     resampling = parse_resampling(args.resampling)
     target, family, mdp_desc = _target(args)
     topology, proto = _seed_policy(args)
-    out = output_file(args.out, "--out", {"--seed-policy": args.seed_policy})
+    out = output_file(args.out, "--out", {"--seed-policy": args.seed_policy}, kind="a policy file")
     held.enter_context(sole_writer(out, "--out"))
-    history_path = output_file(f"{out}.history.csv", "--out (its history file)")
-    checkpoint = output_file(f"{out}.checkpoint.json", "--out (its checkpoint file)")
+    history_path = output_file(f"{out}.history.csv", "--out (its history file)", kind=HISTORY_KIND)
+    checkpoint = output_file(f"{out}.checkpoint.json", "--out (its checkpoint file)", kind=CHECKPOINT_KIND)
     if args.resume and not checkpoint.is_file():
         raise NeurohoverError(f"--resume: no checkpoint {str(checkpoint)!r} (it is written next to --out by an earlier run)")
     note = None
@@ -252,8 +253,7 @@ def _evolve_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int
     )
     save_policy(result.champion, out, **_evolve_meta(args, family, target, mdp_desc, resampling, result, scale, validation, history_path.name))
     try:
-        with writing(history_path, "--out's history") as path:
-            write_history_csv(result.history, path)
+        write_history_csv(result.history, history_path)  # atomically, as writing() writes
     except NeurohoverError as err:  # said what was written and what was not (fourth trial: "no partial file" beside two files)
         raise NeurohoverError(f"{err}; the champion is written to {str(out)!r} and the run's checkpoint kept in {str(checkpoint)!r}") from None
     summary = {

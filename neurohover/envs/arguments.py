@@ -157,7 +157,9 @@ def _make_time_limit(registered: int | None) -> int | None:
     """The ``TimeLimit`` that the ``gymnasium.make`` call now building the environment applies: its ``max_episode_steps``
     argument (None for -1, no limit) or else its spec's, read from that call's frame, since make() adds the wrapper after it
     sets the spec and passes the environment neither (T23-17); the id's ``registered`` limit where no make() call is found
-    (the spec set by other code)."""
+    (the spec set by other code). A limit Gymnasium's ``TimeLimit`` would misread or refuse with its TypeError is refused
+    by name: True truncated every episode at one step without a word (T28-B10), and ``np.int64(5)``, 5.5 or '5' were
+    that TypeError (T28-B11; make() hands the wrapper its own argument, so this cannot convert it)."""
     make_code = getattr(getattr(gym.envs.registration, "make", None), "__code__", None)
     frame: FrameType | None = sys._getframe(1)
     while frame is not None and frame.f_code is not make_code:
@@ -165,10 +167,14 @@ def _make_time_limit(registered: int | None) -> int | None:
     if frame is None:
         return registered
     given = frame.f_locals.get("max_episode_steps")
-    if given is not None:
-        return None if given == -1 else given if whole_number(given) else registered
-    made = getattr(frame.f_locals.get("env_spec"), "max_episode_steps", registered)
-    return made if made is None or whole_number(made) else registered
+    if given is None:
+        given = getattr(frame.f_locals.get("env_spec"), "max_episode_steps", registered)
+    if given is not None and (isinstance(given, bool) or not isinstance(given, int)):
+        raise NeurohoverError(
+            f"max_episode_steps={brief(given)} is not allowed: gymnasium.make's TimeLimit takes a Python int "
+            f"(a NumPy integer as int(...)) >= 1, or -1 for no limit"
+        )
+    return None if given == -1 else given
 
 
 def check_no_unknown_kwargs(unknown: dict[str, Any], allowed: Sequence[str]) -> None:

@@ -240,7 +240,12 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
 
     ``reset(seed=..., options=...)`` takes the options ``{"mdp": spec}`` (same values as the
     ``mdp`` argument; it also applies to later episodes) and ``{"noise": (seed, episode)}``
-    (fly that gust-noise stream in this episode).
+    (fly that gust-noise stream in this episode). A refused reset (a bad seed or option) leaves the
+    episode as it was. Gymnasium's passive checker (off for these ids) cannot take one: with
+    ``gymnasium.make(..., disable_env_checker=False)`` a refused *first* reset leaves the checker
+    without that reset's data, as Gymnasium 1.4 marks its check done before it calls ``reset``, and
+    the next ``step()`` is the checker's own TypeError whatever this environment checks first; make
+    the environment again after one (T28-B04).
 
     ## Seeding
 

@@ -90,6 +90,7 @@ from .config import CMA_DEFAULTS, Resampling, RunConfig, parse_resampling, resol
 from .fitness import episode_fitness
 from .records import (
     CHECKPOINT_FORMAT,
+    CHECKPOINT_KIND,
     HISTORY_COLUMNS,
     EvolutionInterrupted,
     EvolutionResult,
@@ -152,7 +153,10 @@ def _prepare(run: Run, checkpoint, progress, resume: bool, threads: int | None, 
     if progress is not None and not callable(progress):  # progress=3 was "'int' object is not callable" mid-run (second trial)
         raise NeurohoverError(f"progress={progress!r:.60} is not allowed: give a callable taking a ProgressInfo, or None")
     check_flag(resume, "resume", "continue from the checkpoint")  # resume="no" resumed (its truth), fifteenth trial
-    path = None if checkpoint is None else (Path(checkpoint) if resume else output_file(checkpoint, "checkpoint"))  # checked before the run
+    if checkpoint is None or resume:
+        path = None if checkpoint is None else Path(checkpoint)
+    else:  # checked before the run; a JSON name, no file of another kind (a model file was replaced; T28-B07)
+        path = output_file(checkpoint, "checkpoint", kind=CHECKPOINT_KIND, suffixes=(".json",), what="a checkpoint is JSON")
     if resume:
         if path is None:
             raise NeurohoverError("resume=True needs the checkpoint path")
@@ -253,7 +257,7 @@ def evolve(
     NeurohoverError
         Bad input, or a checkpoint that does not match the run.
     EvolutionInterrupted
-        On Ctrl-C or a ``KeyboardInterrupt`` from ``progress``.
+        On Ctrl-C or a ``KeyboardInterrupt`` from ``progress`` (from its last call, ``done``: with the run's ``result``).
     """
     cfg = RunConfig.build(
         target, topology=topology, prototype=prototype, optimizer=optimizer, resampling=resampling, budget=budget, settings=settings, seed=seed,

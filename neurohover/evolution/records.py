@@ -14,12 +14,15 @@ from typing import Any
 import numpy as np
 
 from ..errors import NeurohoverError, brief, first_difference, whole_number
-from ..paths import JSONError, strict_json
+from ..filekinds import CSV_KINDS, JSON_KINDS
+from ..paths import JSONError, number_text, output_file, strict_json, writing
 from ..policies import Policy
 from .common import EntryError, enc_float, read_count, read_return, read_seconds
 
 __all__ = [
     "CHECKPOINT_FORMAT",
+    "CHECKPOINT_KIND",
+    "HISTORY_KIND",
     "HISTORY_COLUMNS",
     "EvolutionInterrupted",
     "EvolutionResult",
@@ -38,6 +41,10 @@ __all__ = [
 
 #: The ``format`` entry of a checkpoint file.
 CHECKPOINT_FORMAT = "neurohover-evolution-checkpoint/1"
+#: What a checkpoint and a history CSV are called among the kinds of file :func:`~neurohover.filekinds.held_kind` tells
+#: apart: each writer replaces only a file of its own kind (a checkpoint or a history over a model or policy; T28-B07).
+CHECKPOINT_KIND, HISTORY_KIND = "an evolution checkpoint", "an evolution history (.history.csv)"
+assert CHECKPOINT_KIND in JSON_KINDS and HISTORY_KIND in CSV_KINDS
 
 
 @dataclass(frozen=True)
@@ -144,12 +151,16 @@ class EvolutionResult:
 
 
 class EvolutionInterrupted(KeyboardInterrupt):
-    """The run was interrupted; ``checkpoint`` is where its state was saved (None: not saved)."""
+    """The run was interrupted; ``checkpoint`` is where its state was saved (None: not saved). ``result`` is the
+    finished run's :class:`EvolutionResult` where the interrupt came from the last ``progress`` call (``done``: the
+    run had ended; it escaped as a bare KeyboardInterrupt and the result was lost, T28-B08), else None."""
 
-    def __init__(self, checkpoint: Path | None, episodes: int) -> None:
-        super().__init__(f"evolution interrupted after {episodes} episodes" + (f"; checkpoint saved to {checkpoint}" if checkpoint else ""))
+    def __init__(self, checkpoint: Path | None, episodes: int, result: EvolutionResult | None = None) -> None:
+        ended = "evolution ended, interrupted in its last progress call," if result is not None else "evolution interrupted"
+        super().__init__(f"{ended} after {episodes} episodes" + (f"; checkpoint saved to {checkpoint}" if checkpoint else ""))
         self.checkpoint = checkpoint
         self.episodes = episodes
+        self.result = result
 
 
 # --------------------------------------------------------------------------------- history CSV
@@ -158,15 +169,22 @@ class EvolutionInterrupted(KeyboardInterrupt):
 def write_history_csv(history, path: str | Path) -> Path:
     """Write history records as CSV with the header :data:`HISTORY_COLUMNS`.
 
-    ``champion_return`` is written exactly (``repr``), ``wall_seconds`` to 0.1 ms.
+    ``champion_return`` is written exactly (``repr``), ``wall_seconds`` to 0.1 ms. A record a run never keeps (a NaN
+    return, a negative count; :data:`_HISTORY_READERS`) is refused by name, and ``path`` must end .csv and hold no
+    neurohover file of another kind (a policy or flight data was replaced; T28-B07, T28-B13): nothing is written then.
     """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "w", newline="") as f:
+    rows = [[h.generation, h.evaluations, h.episodes, h.generation_episodes, h.champion_return, h.wall_seconds] for h in history]
+    for n, row in enumerate(rows):
+        for column, read, value in zip(HISTORY_COLUMNS, _HISTORY_READERS, row):
+            try:
+                read(value)
+            except ValueError as err:
+                raise NeurohoverError(f"history record {n} (from 0): {column}={brief(value)} is not allowed ({err}); nothing is written") from None
+    path = output_file(path, "history file", kind=HISTORY_KIND, suffixes=(".csv",), what="a history is CSV")
+    with writing(path, "history file") as partial, open(partial, "w", newline="") as f:
         writer = csv.writer(f, lineterminator="\n")
         writer.writerow(HISTORY_COLUMNS)
-        for h in history:
-            writer.writerow([h.generation, h.evaluations, h.episodes, h.generation_episodes, repr(h.champion_return), f"{h.wall_seconds:.4f}"])
+        writer.writerows([*row[:4], repr(float(row[4])), f"{row[5]:.4f}"] for row in rows)
     return path
 
 
@@ -176,20 +194,37 @@ def read_history_csv(path: str | Path) -> list[HistoryRecord]:
     Raises
     ------
     NeurohoverError
-        If the file does not start with the header :data:`HISTORY_COLUMNS`, or a row is not one
-        record.
+        If the file does not start with the header :data:`HISTORY_COLUMNS`, or a row is not one record as
+        :func:`write_history_csv` writes it: each number in ASCII digits (:func:`~neurohover.paths.number_text`), counts
+        >= 0, a champion's fitness finite or '-inf' (on the run's scale: 1/ln(error) is > 0), seconds finite and >= 0, and the rows as a run records them
+        (:func:`check_history`; wall seconds never falling). int() and float() took 'nan', '1_0', other scripts' digits
+        and falling counts (T28-B13).
     """
     with open(path, newline="") as f:
         rows = [row for row in csv.reader(f) if row]
     if not rows or tuple(rows[0]) != HISTORY_COLUMNS:
         raise NeurohoverError(f"{str(path)!r} is not an evolution history (expected the header {','.join(HISTORY_COLUMNS)})")
-    out = []
+    out: list[HistoryRecord] = []
     for n, row in enumerate(rows[1:], start=2):
-        try:
-            g, ev, ep, gep, r, w = row
-            out.append(HistoryRecord(int(g), int(ev), int(ep), int(gep), float(r), float(w)))
-        except ValueError:
-            raise NeurohoverError(f"{str(path)!r}, row {n}: {','.join(row)!r} is not a history record ({','.join(HISTORY_COLUMNS)})") from None
+        if len(row) != len(HISTORY_COLUMNS):
+            raise NeurohoverError(f"{str(path)!r}, row {n}: {brief(','.join(row))} is not a history record ({','.join(HISTORY_COLUMNS)})")
+        cells: list = []
+        for column, read, text in zip(HISTORY_COLUMNS, _HISTORY_READERS, row):
+            try:
+                number = number_text(text, whole=read is read_count)
+            except ValueError as err:
+                raise NeurohoverError(f"{str(path)!r}, row {n}: {column} {err}") from None
+            try:
+                cells.append(read(number))
+                if column == "wall_seconds" and out and cells[-1] < out[-1].wall_seconds:
+                    raise ValueError(f"below row {n - 1}'s {out[-1].wall_seconds:g}: a run's seconds never fall")
+            except ValueError as err:
+                raise NeurohoverError(f"{str(path)!r}, row {n}: {column} {brief(text)} is not allowed ({err})") from None
+        out.append(HistoryRecord(*cells))
+    try:
+        check_history(out, {c: getattr(out[-1], c) for c in ("generation", "evaluations", "episodes")} if out else {}, per_generation=False)
+    except EntryError as err:
+        raise NeurohoverError(f"{str(path)!r}: {err} (row 0 is the file's row 2)") from None
     return out
 
 

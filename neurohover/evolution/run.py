@@ -315,7 +315,10 @@ class Run:
         if checkpoint is not None:
             write_checkpoint(checkpoint, self.state(wall))
         if progress is not None:
-            progress(self._info(wall, True, budget))
+            try:
+                progress(self._info(wall, True, budget))
+            except KeyboardInterrupt:  # the run has ended (and its checkpoint is written): its result goes with the interrupt (T28-B08)
+                raise EvolutionInterrupted(checkpoint, self.flyer.episodes, self.result()) from None
 
     def _info(self, wall: float, done: bool, budget) -> ProgressInfo:
         eps = self.flyer.episodes

@@ -312,7 +312,7 @@ class LearnedModel:
         if isinstance(path, (str, os.PathLike)):  # (other paths are output_file's to refuse)
             self.check_name(path)
         text = json.dumps(self.to_dict(), indent=1, allow_nan=False) + "\n"
-        out = output_file(path, "model file")  # /dev/full, a directory: one clear error
+        out = output_file(path, "model file", kind="a model file")  # /dev/full, a directory: one clear error
         with writing(out, "model file") as partial:
             partial.write_text(text)
         return out
