@@ -378,10 +378,8 @@ def evaluate_jobs(
     fallback_index : array_like of int, optional
         Per job, the policy the safeguard hands control to (-1: no safeguard for that job).
     safeguard_limits : sequence or array of 24 floats, optional
-        The dangerous-state test in the kernel's layout (:meth:`DangerousState.limits`): limits on
-        |u|, |v|, |w|, |x|, |y|, |z|, |p|, |q|, |r|, the tilt threshold on qw (inf: no tilt
-        condition), the test's kind, the ratio-sum threshold and limits. Default:
-        ``DangerousState()``, the authors' GHH-09 test.
+        Only with ``fallback_index``: the dangerous-state test in the kernel's layout (:meth:`DangerousState.limits`): limits on |u|, |v|, |w|,
+        |x|, |y|, |z|, |p|, |q|, |r|, the tilt threshold on qw (inf: none), the kind, the ratio-sum threshold and limits. Default: ``DangerousState()``.
     record : array_like of bool, optional
         Per job, whether to record its flight data.
     n_steps : int
@@ -403,6 +401,8 @@ def evaluate_jobs(
     m_idx = _index_array(mdp_index, n_jobs, "mdp_index")
     e_idx = _index_array(episode_index, n_jobs, "episode_index")
     fb = _fallback_array(fallback_index, n_jobs, len(table))
+    if safeguard_limits is not None and fallback_index is None:  # the limits acted on no job, without a word (T28-B16)
+        raise NeurohoverError("safeguard_limits needs fallback_index= (each job's fallback policy, -1: none): alone it acts on no job; give both, or neither")
     try:
         limits = SAFEGUARD_LIMITS if safeguard_limits is None else as_floats(safeguard_limits, "safeguard_limits", "")
     except NeurohoverError:  # 'x' was NumPy's ValueError (fourth trial), a masked array's hidden values were used (T16-9)
