@@ -459,9 +459,11 @@ def _refuse_other_files(out: Path) -> None:
     replaced (nothing is lost), and so is an older competition's summary (its task and agent, which
     :func:`_note_replaced` names); a file no neurohover command wrote is refused too (it may be anyone's)."""
     from .filekinds import held_kind
+    from .paths import refuse_special_file
 
     for name, own in _OWN_FILES.items():
         path = out / name
+        refuse_special_file(path, "--out", instead="move it away or give another output directory")  # a FIFO hung it (T28-A08)
         if not (path.is_dir() or path.is_file()) or (path.is_file() and path.stat().st_size == 0):
             continue
         held = "a directory" if path.is_dir() else held_kind(path)

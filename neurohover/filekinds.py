@@ -16,9 +16,27 @@ from pathlib import Path
 
 from .errors import NeurohoverError, brief
 
-__all__ = ["CSV_KINDS", "JSON_KINDS", "RUN_FILE_ENDS", "SQLITE_HEADER", "held_kind", "output_name", "refuse_run_file_name", "refuse_suffix"]
+__all__ = [
+    "CSV_KINDS",
+    "JSON_KINDS",
+    "PNG_KIND",
+    "PNG_SIGNATURE",
+    "REPORT_HEADER",
+    "REPORT_KIND",
+    "RUN_FILE_ENDS",
+    "SQLITE_HEADER",
+    "held_kind",
+    "output_name",
+    "refuse_run_file_name",
+    "refuse_suffix",
+]
 
 SQLITE_HEADER = b"SQLite format 3\x00"  # the first bytes of every SQLite database: a results store
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"  # the first bytes of every PNG file: the only file a figure or plot replaces (T28-A05)
+PNG_KIND = "a PNG image"
+#: The first line of every ``report.md`` that ``neurohover report`` writes: the only report.md it replaces (T28-A04).
+REPORT_HEADER = "# Reproduction report: Koppejan & Whiteson (2011)\n"
+REPORT_KIND = "a reproduction report (report.md)"
 
 
 #: The neurohover files a JSON output can be told apart by (what it is called -> a test of its parsed JSON object):
@@ -46,7 +64,8 @@ _KIND_READ_LIMIT = 64 * 2**20  # a larger file is no neurohover JSON file told a
 
 def held_kind(path: str | os.PathLike) -> str | None:
     """What neurohover file the existing regular file ``path`` is, in words (``"a policy file"``), read from its
-    content: a results store (SQLite), flight data (a NumPy archive), one of :data:`JSON_KINDS` or :data:`CSV_KINDS`; None for anything
+    content: a results store (SQLite), a PNG image, a report.md of ``neurohover report``, flight data (a NumPy archive),
+    one of :data:`JSON_KINDS` or :data:`CSV_KINDS`; None for anything
     else (no such file, unreadable, another file). The one test of "which kind of neurohover file is this" that
     :func:`output_file` refuses to write another kind over."""
     p = Path(path)
@@ -59,6 +78,10 @@ def held_kind(path: str | os.PathLike) -> str | None:
         return None
     if body.startswith(SQLITE_HEADER):
         return "a results store (SQLite)"
+    if body.startswith(PNG_SIGNATURE):
+        return PNG_KIND
+    if body.startswith(REPORT_HEADER.encode()):
+        return REPORT_KIND
     if body.startswith(b"PK\x03\x04"):  # a zip: a NumPy archive (.npz) holds its arrays as NAME.npy
         return "flight data (a NumPy archive)" if b"format.npy" in body else None
     if not body.lstrip()[:1] == b"{":

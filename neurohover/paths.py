@@ -346,7 +346,7 @@ def refuse_foreign_output(path: str | os.PathLike, option: str, kind: str) -> No
     p = Path(path)
     if p.is_dir():
         raise NeurohoverError(f"{option} {shown} is a directory: {kind} would be written there; move it away or give another directory")
-    refuse_special_file(p, option, instead="move it away or give another directory")
+    refuse_special_file(p, option)
     if not p.is_file() or p.stat().st_size == 0:
         return
     held = held_kind(p)

@@ -12,7 +12,8 @@ import signal
 import sqlite3
 import sys
 import unicodedata
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from typing import NoReturn
 
 from .. import __version__
@@ -142,6 +143,7 @@ def _run(argv: Sequence[str] | None) -> int:
 
     forget_created_dirs()
     try:
+        _refuse_closed_stdout(args)
         if getattr(args, "seed", None) is not None:  # every command's --seed, one range, before any work
             from ..evolution.seeding import check_seed
 
@@ -162,8 +164,11 @@ def _run(argv: Sequence[str] | None) -> int:
         # SIGTERM (a timeout, kill) ends every command as Ctrl-C does: one line, its cleanup run, no partial file (a
         # bare SIGTERM killed fly, evolve, compete and reproduce without a word; fourth trial); a Ctrl-C landing in
         # numba's compilation is not lost.
-        with sigterm_as_interrupt(), interrupts_survive_callbacks():
-            return args.func(args)
+        with sigterm_as_interrupt(), interrupts_survive_callbacks(), _stdout_or_nothing():
+            status = args.func(args)
+            if sys.stdout is not None:
+                sys.stdout.flush()  # inside the try: a reader gone away is the BrokenPipeError below, not one at exit
+            return status
     except NeurohoverError as err:
         print(f"neurohover {args.command}: error: {shorter_numbers(str(err))}", file=sys.stderr)
         remove_created_dirs()  # a failed command leaves no empty output directory behind
@@ -187,7 +192,8 @@ def _run(argv: Sequence[str] | None) -> int:
         print(f"neurohover {args.command}: {how}", file=sys.stderr)
         remove_created_dirs()  # an output directory it made and left empty (an interrupted build-policies; fourth trial)
         return status
-    except BrokenPipeError:  # the reader went away (`neurohover demo | head -1`): stop quietly, as Python's docs advise
+    except BrokenPipeError:  # the reader went away (`neurohover demo | head -1`): stop quietly with status 1, as Python's
+        # docs advise ("Note on SIGPIPE"), and no line: the reader asked for no more (T28-A01)
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())  # so that the interpreter's own flush at exit does not fail again
         return 1
@@ -196,6 +202,39 @@ def _run(argv: Sequence[str] | None) -> int:
         print(f"neurohover {args.command}: error: {shorter_numbers(f'{err.strerror or err}{where}')}", file=sys.stderr)
         remove_created_dirs()
         return 2
+
+
+def _prints_only(args: argparse.Namespace) -> bool:
+    """Whether the command ``args`` gives its result on standard output only (no output file of its own)."""
+    if args.command in ("demo", "bench", "settings", "wins"):
+        return True
+    only_stdout = {"results": "out", "fly": "record", "evaluate-agent": "json"}
+    if args.command in only_stdout:
+        return getattr(args, only_stdout[args.command], None) is None
+    return args.command == "reproduce" and bool(getattr(args, "list", False))
+
+
+def _refuse_closed_stdout(args: argparse.Namespace) -> None:
+    """Refuse, before any work, a command that prints its result when standard output is closed (``1>&-``: Python's
+    sys.stdout is then None; results raised AttributeError, fly and wins lost their output without a word; T28-A01)."""
+    if sys.stdout is None and _prints_only(args):
+        instead = " (or write them to a file with --out FILE)" if args.command == "results" else ""
+        raise NeurohoverError(f"standard output is closed: this command prints its results there; run it with standard output open{instead}")
+
+
+@contextmanager
+def _stdout_or_nothing() -> Iterator[None]:
+    """Inside this block, a closed standard output (None) is the null device, so that a command writing its files
+    prints its notes nowhere instead of failing on them (T28-A01); sys.stdout is None again after it."""
+    if sys.stdout is not None:
+        yield
+        return
+    with open(os.devnull, "w") as nothing:
+        sys.stdout = nothing
+        try:
+            yield
+        finally:
+            sys.stdout = None
 
 
 def shorter_numbers(message: str) -> str:

@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import NeurohoverError, OutputError, brief, check_flag, whole_number
+from ..filekinds import REPORT_HEADER, REPORT_KIND
 from .config import ORDER, ExperimentConfig, check_paper_table, shipped_counterpart, with_shipped_paper
 from .export import checked_units
 from .keys import UnitKey
@@ -530,7 +531,10 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
 
 
 def _write_report(store: Store, out: Path, scale: str | None, names: list[str] | None, refuse_all_damaged: bool) -> Path:
-    from ..paths import printable, writing
+    from ..paths import printable, refuse_foreign_output, writing
+
+    path = out / "report.md"
+    refuse_foreign_output(path, "report", REPORT_KIND)  # before any figure: only a report.md it wrote is replaced (T28-A04)
 
     entries = [(n, s) for n, s, _, _ in store.experiments() if (scale is None or s == scale) and (not names or n in names)]
     if names:
@@ -571,13 +575,13 @@ def _write_report(store: Store, out: Path, scale: str | None, names: list[str] |
     if refuse_all_damaged and not statuses:  # the command said "report written" and exited 0, the damage only inside (T19-07)
         raise NeurohoverError(f"nothing could be reported from {str(store.path)!r}: every experiment asked for is damaged (said above); no report written")
     head = (
-        f"# Reproduction report: Koppejan & Whiteson (2011)\n\n"
+        f"{REPORT_HEADER}\n"
         f"Generated {time.strftime('%Y-%m-%d %H:%M:%S')} from the results store `{printable(store.path)}`. Error is minus the "
         f"return (lower is better).{header_note({sc for _, sc in entries})}\n\n" + "\n".join(toc) + "\n"
     )
     summary = claims_section(claims) if claims else ""
     head += "\n" + summary + conclusions_discussion(out) if summary else ""
-    path = out / "report.md"
+    refuse_foreign_output(path, "report", REPORT_KIND)  # made while the figures were drawn
     with writing(path, "report") as partial:  # a full disk left an empty report.md and an unnamed error (seventh trial)
         partial.write_text(head + "\n" + "\n".join(sections), errors="backslashreplace")  # no text can fail it half-way
     readme = out / "README.md"

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import NeurohoverError
+from ..paths import refuse_special_file
 from .report_base import table
 
 #: The paper's tables and figures, whose claims the claims table lists (at paper scale), in the paper's order.
@@ -79,6 +80,10 @@ def read_discussion(path: Path) -> str | None:
     """
     if not (path.exists() or path.is_symlink()):
         return None
+    try:  # a FIFO hung the report for ever (T28-A08)
+        refuse_special_file(path, "discussion", instead="give a Markdown file in UTF-8, or remove it")
+    except NeurohoverError as err:
+        raise DiscussionError(str(err)) from None
     try:
         return path.read_text(encoding="utf-8-sig").strip()
     except (OSError, UnicodeDecodeError) as err:
