@@ -103,7 +103,7 @@ def test_reproduce_refuses_bad_arguments_before_any_unit_runs(tmp_path: Path, kw
 def test_reproduce_takes_a_single_only_pattern_as_one(tmp_path: Path) -> None:
     """Twelfth trial U3: only="run/*" was taken as the patterns r, u, n, ... ("--only 'r' matches no unit")."""
     with Store(tmp_path / "s.sqlite") as store:
-        summary = reproduce(make_config("mc5", "test_runs", "quick", SETTINGS), store, LocalExecutor(1), progress=False, only="run/*")
+        summary = reproduce(make_config("mc5", "test_runs", "quick", SETTINGS), store, LocalExecutor(1), progress=False, only="run/**")
     assert summary.succeeded and summary.units_run == 1
 
 

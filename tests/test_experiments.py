@@ -603,7 +603,7 @@ def test_only_runs_the_selected_units_and_a_later_call_finishes_the_rest(tmp_pat
     config = _write(tmp_path, SLOW_CONFIG.replace("runs = 12", "runs = 4").replace("budget = 3000", "budget = 200"))
     store = tmp_path / "s.sqlite"
     base = ["reproduce", str(config), "--store", str(store), "--no-progress"]
-    assert main([*base, "--only", "evolve/k1/run1", "--only", "*/run3"]) == 0
+    assert main([*base, "--only", "evolve/k1/run1", "--only", "**/run3"]) == 0
     assert "selection finished; ran 2 units, 0 already in the store, 2/4 done" in capsys.readouterr().out
     with Store(store) as s:
         first = s.results("slowtest", "quick")

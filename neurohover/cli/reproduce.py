@@ -291,7 +291,8 @@ def register(sub) -> None:
         "--only",
         action="append",
         metavar="PATTERN",
-        help="run only the units whose keys match this glob (repeatable), e.g. 'run/hybrid/*/rep0'; the policies they fly are always made",
+        help="run only the units whose keys match this glob (repeatable), e.g. 'run/hybrid/*/rep0': '*' and '?' match within one part of a key "
+        "(not across '/', as a group label may hold one), '**' across parts; the policies they fly are always made",
     )
     p.add_argument("--fresh", action="store_true", help="discard the experiment's stored results at this scale first")
     p.add_argument(

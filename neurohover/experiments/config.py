@@ -38,9 +38,10 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from ..errors import NeurohoverError, brief, finite_real
+from ..errors import NeurohoverError, brief
 from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..models.model import LEGACY_MODEL_SUBSTEPS
+from .paper_checks import check_paper, check_paper_table, check_texts, control_character
 from .schema import SCHEMAS, check_given, check_kind, check_used, validate_table
 from .settings import ExperimentSettings, typed_settings
 
@@ -213,13 +214,17 @@ def compete_name(task: str, agent: str) -> str:
 def code_written_name(name: str) -> str | None:
     """Whose name ``name`` is where the code itself writes it into a store (a shipped experiment, its alias, 'all',
     or compete's ``compete-TASK-AGENT``), or None for a name free for a config of one's own. The one predicate
-    :func:`check_own_name` refuses by."""
+    :func:`check_own_name` refuses by. Case is ignored: 'FIG7' beside fig7 wrote figures that are one file on a
+    case-insensitive file system (T28-A10)."""
     if name == "all" or name in shipped_configs():
         return "a shipped experiment's (or 'all')"
     if name in _aliases():
         return f"an alias of the shipped experiment {_aliases()[name]!r}"
-    if name.startswith(COMPETE_PREFIX):
+    if name.lower().startswith(COMPETE_PREFIX):
         return "in the name space compete-TASK-AGENT of `neurohover compete`'s own experiments"
+    taken = next((n for n in ["all", *shipped_configs(), *_aliases()] if n.lower() == name.lower()), None)
+    if taken is not None:
+        return f"the shipped name {taken!r} but for case (their figures would be one file where case is ignored)"
     return None
 
 
@@ -241,7 +246,7 @@ def check_own_name(cfg: ExperimentConfig) -> None:
             f"config {cfg.source!r}: name = {cfg.name!r} is an alias of the shipped experiment {alias_of!r}: a config of your own needs a name "
             f"of its own, or `reproduce {cfg.name}` would run {alias_of} while its results pass under the same name"
         )
-    if cfg.name.startswith(COMPETE_PREFIX):
+    if cfg.name.lower().startswith(COMPETE_PREFIX):
         raise NeurohoverError(
             f"config {cfg.source!r}: name = {cfg.name!r} is not allowed: it is {whose}; a config of your own needs a name of its own "
             f"(not starting with {COMPETE_PREFIX!r}), or its results would be mixed with a competition's as another scale of one experiment"
@@ -256,6 +261,9 @@ def parse_override(text: str, option: str = "--set") -> tuple[str, Any]:
     """``KEY=VALUE`` of command-line ``option`` with VALUE in TOML syntax (a bare word is taken as a string)."""
     if not isinstance(text, str):  # None was an AttributeError (eighth trial)
         raise NeurohoverError(f"{option} {text!r:.40} is not allowed: give KEY=VALUE as text (VALUE in TOML syntax)")
+    bad = control_character(text)
+    if bad is not None:  # TOML read the lines after a newline, and they were dropped without a word (T28-A06)
+        raise NeurohoverError(f"{option} {brief(text)} is not allowed: it holds the control character {bad}; give one KEY=VALUE on one line")
     key, sep, value = text.partition("=")
     key = key.strip()
     if not sep or not key:
@@ -294,6 +302,19 @@ def _bad_byte(err: UnicodeDecodeError) -> str:
     return f"byte {data[start]:#04x} at line {line}, column {column}"
 
 
+def _check_shape(raw: dict, where: str) -> None:
+    """Refuse [settings] and [scales] tables of the wrong TOML shape, by name: ``[[scales.quick]]`` (a list) or
+    ``settings = 5`` were TypeErrors where they are merged, and ``scales = "quick"`` named the scales c, i, k, q, u (T28-A02)."""
+    if not isinstance(raw["settings"], dict):
+        raise NeurohoverError(f"{where}: settings = {brief(raw['settings'])} is not allowed: give a table of settings ([settings], not [[settings]])")
+    scales = raw.get("scales", {})
+    if not isinstance(scales, dict):
+        raise NeurohoverError(f"{where}: scales = {brief(scales)} is not allowed: give a table of scale tables ([scales.quick] and [scales.paper])")
+    for name, table in scales.items():
+        if name in SCALES and not isinstance(table, dict):  # an unknown name is refused as such (load_config)
+            raise NeurohoverError(f"{where}: scales.{name} = {brief(table)} is not allowed: give a table of settings ([scales.{name}], not [[scales.{name}]])")
+
+
 def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None = None) -> ExperimentConfig:
     """Load, resolve and validate an experiment config at ``scale`` (``quick`` or ``paper``)."""
     if not isinstance(scale, str) or scale not in SCALES:  # an array was numpy's 'truth value is ambiguous' (T18-3)
@@ -329,6 +350,7 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
     kind = raw["kind"]
     if kind not in KINDS:
         raise NeurohoverError(f"{where}: kind = {kind!r} is not allowed: expected one of {', '.join(KINDS)}")
+    _check_shape(raw, where)
     scales = raw.get("scales", {})
     bad_scales = sorted(set(scales) - set(SCALES))
     if bad_scales:
@@ -385,10 +407,6 @@ def settings_scale(settings: dict) -> str:
     return f"settings-{hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()[:10]}"
 
 
-#: What a config's [paper] table may hold (what the report reads from it).
-PAPER_KEYS = ("notes", "claims", "ttests", "groups", "table", "table3")
-
-
 def check_name(name, where: str) -> None:
     """Refuse an experiment name that is not a safe file name (``../x``, ``""``, a slash)."""
     if not isinstance(name, str) or not _SAFE_NAME.fullmatch(name):
@@ -400,128 +418,6 @@ def check_scale(scale, where: str) -> None:
     was stored (twelfth trial, S7). Shared by :func:`make_config` and the store's writes."""
     if not isinstance(scale, str) or (scale not in SCALES and not _COMPETE_SCALE.fullmatch(scale)):
         raise NeurohoverError(f"{where}: scale = {brief(scale)} is not allowed: give one of {', '.join(SCALES)} (or a compete run's settings-HASH)")
-
-
-def _paper_p(p) -> bool:
-    """Whether ``p`` reads as a paper's p-value: a number in 0..1 (after '<' or '<='; words may follow it), 'not
-    significant', or 'none' (a test the paper did not make, with why)."""
-    if not isinstance(p, str):
-        return False
-    if p.strip().lower().startswith(("not significant", "none")):
-        return True
-    try:
-        return 0 <= float(p.strip().lower().lstrip("<= ").split()[0]) <= 1
-    except (ValueError, IndexError):
-        return False
-
-
-#: The numbers each entry of a [paper] table may give (what the report reads), the required ones first.
-_PAPER_NUMBERS = {
-    "table": (("r_m", "r_a"), ("t", "sd")),  # Table 4's: method -> t, r_m, r_a, sd
-    "groups": ((), ("crash_rate", "return_per_episode_no_crash")),  # test runs': group -> ...
-    "table3": ((), ("r", "sd", "r_G", "sd_G", "crashes_G")),  # Table 3's: variant -> ...
-}
-
-
-def _json_value(value, path: str, where: str) -> None:
-    """Refuse a value under [paper] that the store's JSON cannot hold (inf, nan, 10**400, an object), by its key path:
-    it was a json error once the store file was made (twelfth trial, T3)."""
-    if isinstance(value, dict):
-        for k, v in value.items():
-            if not isinstance(k, str):
-                raise NeurohoverError(f"{where}: [paper] {path} has key {brief(k)}: give text keys")
-            _json_value(v, f"{path}.{k}", where)
-    elif isinstance(value, list | tuple):
-        for i, v in enumerate(value):
-            _json_value(v, f"{path}[{i}]", where)
-    elif isinstance(value, float | int) and not isinstance(value, bool) and not finite_real(value):
-        raise NeurohoverError(f"{where}: [paper] {path} = {brief(value)} is not allowed: give a finite number")
-    elif not isinstance(value, str | bool | int | float):
-        raise NeurohoverError(f"{where}: [paper] {path} = {brief(value)} is not allowed: give text, a Python int or float, a list or a table (what JSON holds)")
-
-
-def check_paper_table(paper, where: str) -> None:
-    """Refuse a [paper] table the report cannot read: unknown keys, values the store's JSON cannot hold, and entries of the
-    wrong shape (a text where the report formats a number was a traceback in `report`, after reproduce had run; twelfth
-    trial, T1-T3). Shared by config files and :func:`make_config`."""
-    if not isinstance(paper, dict):
-        raise NeurohoverError(f"{where}: [paper] = {brief(paper)} is not allowed: give a table (a dict) of {', '.join(PAPER_KEYS)}")
-    unknown = sorted(set(paper) - set(PAPER_KEYS), key=str)
-    if unknown:
-        named = ", ".join(brief(k) if not isinstance(k, str) or len(k) > 60 else k for k in unknown)
-        raise NeurohoverError(f"{where}: unknown [paper] key(s) {named}; allowed: {', '.join(PAPER_KEYS)}")
-    for key in ("notes", "claims"):  # lists of sentences (a string here was reported letter by letter)
-        value = paper.get(key, [])
-        if not isinstance(value, list) or not all(isinstance(x, str) for x in value):
-            raise NeurohoverError(f"{where}: [paper] {key} = {brief(value)} is not allowed: give a list of strings")
-    ttests = paper.get("ttests", [])
-    if not isinstance(ttests, list):  # 5 was a TypeError, 'x' read letter by letter (twelfth trial, T2)
-        raise NeurohoverError(f"{where}: [paper] ttests = {brief(ttests)} is not allowed: give a list of tables with a, b and p")
-    for t in ttests:
-        if not isinstance(t, dict) or not {"a", "b", "p"} <= set(t):
-            raise NeurohoverError(f"{where}: each [paper] ttests entry needs a, b and p, got {brief(t)}")
-        unknown = sorted(set(t) - {"a", "b", "p"}, key=str)  # a misspelt extra key was dropped without a word (T27-A05)
-        if unknown:
-            named = ", ".join(brief(k) if not isinstance(k, str) or len(k) > 60 else k for k in unknown)
-            raise NeurohoverError(f"{where}: unknown [paper] ttests key(s) {named} in {brief(t)}; allowed: a, b, p")
-        if not _paper_p(t["p"]):
-            raise NeurohoverError(
-                f"{where}: [paper] ttests p = {brief(t['p'])} is not allowed: give the paper's p-value as text, "
-                "e.g. '5.8e-12', '< 0.0026', 'not significant' or 'none (why)'"
-            )
-        for side in ("a", "b"):  # a list was a TypeError where the names are looked up
-            if not isinstance(t[side], str):
-                raise NeurohoverError(f"{where}: [paper] ttests {side} = {brief(t[side])} is not allowed: give a group, variant, method or fit by name")
-    for key, (required, optional) in _PAPER_NUMBERS.items():
-        _check_paper_numbers(paper.get(key, {}), key, required, optional, where)
-    for key, value in paper.items():  # what the shapes leave open (a t test's other keys)
-        _json_value(value, key, where)
-
-
-def _check_paper_numbers(table, key: str, required: tuple[str, ...], optional: tuple[str, ...], where: str) -> None:
-    """A [paper] ``table`` / ``groups`` / ``table3``: names, each a table of the numbers ``required`` and ``optional``."""
-    allowed = ", ".join((*required, *optional)) + (f" ({' and '.join(required)} required)" if required else "")
-    shape = f"give a table of names, each a table of numbers {allowed}"
-    if not isinstance(table, dict):
-        raise NeurohoverError(f"{where}: [paper] {key} = {brief(table)} is not allowed: {shape}")
-    for name, entry in table.items():
-        if not isinstance(entry, dict):
-            raise NeurohoverError(f"{where}: [paper] {key}.{name} = {brief(entry)} is not allowed: {shape}")
-        unknown = sorted(map(str, set(entry) - {*required, *optional}))
-        missing = [k for k in required if k not in entry]
-        if unknown or missing:
-            what = f"unknown number(s) {', '.join(unknown)}" if unknown else f"no {' or '.join(missing)}"
-            raise NeurohoverError(f"{where}: [paper] {key}.{name} has {what}: allowed {allowed}")
-        for k, v in entry.items():
-            if not finite_real(v) or (k == "crash_rate" and not 0 <= v <= 1) or (k == "crashes_G" and not (isinstance(v, int) and v >= 0)):
-                want = "a rate in 0..1" if k == "crash_rate" else "an integer >= 0" if k == "crashes_G" else "a finite number"
-                raise NeurohoverError(f"{where}: [paper] {key}.{name}.{k} = {brief(v)} is not allowed: give {want}")
-
-
-def check_paper(paper, raw: dict, where: str) -> None:
-    """Refuse a paper t test or number table entry that names no group, variant, method or fit at any scale (its shape was checked by
-    :func:`make_config`, :func:`check_paper_table`)."""
-    tables = [raw.get("settings", {}), *raw.get("scales", {}).values()]
-    entries = [e for tab in tables for kind in ("groups", "variants", "fits") for e in tab.get(kind, []) if isinstance(e, dict)]
-    names = {e.get(k) for e in entries for k in ("key", "label", "agent")} | {m for tab in tables for m in tab.get("methods", [])}
-    pairs: set[frozenset] = set()
-    for t in paper.get("ttests", []):
-        for side in ("a", "b"):
-            if t[side] not in names:
-                raise NeurohoverError(f"{where}: [paper] ttests names {t[side]!r} ({side}), which is no group, variant, method or fit of the config")
-        if t["a"] == t["b"]:  # a group against itself: p = 1, and a verdict of "reversed" for equal means (T26-A05)
-            raise NeurohoverError(f"{where}: [paper] ttests compares {brief(t['a'])} with itself (a = b): give two different groups, variants, methods or fits")
-        if frozenset((t["a"], t["b"])) in pairs:  # both orders: the paper found each better than the other (T27-A04)
-            raise NeurohoverError(
-                f"{where}: [paper] ttests compares {brief(t['a'])} with {brief(t['b'])} twice (in either order): "
-                "give each pair once, with a the one the paper found better"
-            )
-        pairs.add(frozenset((t["a"], t["b"])))
-    for key in _PAPER_NUMBERS:  # an entry of no name the report looks up was never shown, without a word
-        allowed = names | ({"mlp-baseline"} if key == "table3" else set())  # table3's row for a policy set's specialised MLPs
-        for name in paper.get(key, {}):
-            if name not in allowed:
-                raise NeurohoverError(f"{where}: [paper] {key} names {brief(name)}, which is no group, variant, method or fit of the config")
 
 
 def make_config(
@@ -548,15 +444,15 @@ def make_config(
     if not isinstance(kind, str) or kind not in KINDS:  # an array was numpy's 'truth value is ambiguous' (T18-3)
         raise NeurohoverError(f"{where}: kind = {brief(kind)} is not allowed: expected one of {', '.join(KINDS)}")
     check_scale(scale, where)
-    for key, text in (("title", title), ("paper_ref", paper_ref), ("source", source)):  # title=5 was later called a damaged store (twelfth trial, U2)
-        if not isinstance(text, str):
-            raise NeurohoverError(f"{where}: {key} = {brief(text)} is not allowed: give text")
+    if not isinstance(source, str):  # title=5 was later called a damaged store (twelfth trial, U2)
+        raise NeurohoverError(f"{where}: source = {brief(source)} is not allowed: give text")
+    check_texts(title, paper_ref, settings if isinstance(settings, dict) else {}, where)  # one line each: a newline put headings into the report (T28-A07)
     resolved = validate_table(dict(settings), SCHEMAS[kind], where)
     check_given(settings, where)
     check_kind(resolved, kind, where)
     check_used(settings, resolved, kind, where, switched)
     paper = {} if paper is None else paper
-    check_paper_table(paper, where)  # after the settings: a bad agent is named as such
+    check_paper_table(paper, where, kind)  # after the settings: a bad agent is named as such
     from .plans import external_digest
 
     digest = external_digest(kind, resolved)

@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+import functools
 import re
 from dataclasses import dataclass
 
-__all__ = ["UnitKey"]
+__all__ = ["UnitKey", "key_matches"]
 
 _KEY_PATTERNS = (
     ("evolve", re.compile(r"evolve/(?P<group>.+?)(?:/(?P<mdp>train\d+))?/run(?P<rep>\d+)")),
@@ -95,3 +96,45 @@ class UnitKey:
                 rep = parts.get("rep")
                 return cls(key, stage, parts["group"], parts.get("mdp"), None if rep is None else int(rep))
         return cls(key, "", "")
+
+
+@functools.lru_cache(maxsize=256)
+def _pattern_regex(pattern: str) -> re.Pattern[str]:
+    """The regular expression of an ``--only`` glob: ``*`` any text within one part of a key (no '/'), ``**`` any text
+    across parts, ``?`` one character but '/', ``[...]`` / ``[!...]`` one character of (not of) a set, but '/'."""
+    out, i, n = [], 0, len(pattern)
+    while i < n:
+        ch = pattern[i]
+        if pattern.startswith("**", i):
+            out.append(".*")
+            i += 2
+            continue
+        i += 1
+        if ch == "*":
+            out.append("[^/]*")
+        elif ch == "?":
+            out.append("[^/]")
+        elif ch == "[":
+            j = i + (i < n and pattern[i] == "!")
+            j += j < n and pattern[j] == "]"  # a ']' first is one of the set
+            j = pattern.find("]", j)
+            if j < 0:  # no closing ']': a literal '['
+                out.append(re.escape(ch))
+                continue
+            body, i = pattern[i:j], j + 1
+            negated = body.startswith("!")
+            body = re.sub(r"([\\^\[&~|])", r"\\\1", body[negated:])  # literal in the set (a '-' keeps its ranges)
+            out.append(f"[^{body}/]" if negated else f"(?!/)[{body}]")
+        else:
+            out.append(re.escape(ch))
+    try:
+        return re.compile("".join(out), re.DOTALL)
+    except re.error:  # a set no regex takes ("[z-a]"): the pattern as it is written
+        return re.compile(re.escape(pattern))
+
+
+def key_matches(key: str, pattern: str) -> bool:
+    """Whether unit ``key`` matches the ``--only`` glob ``pattern`` (case counts): ``*`` and ``?`` stay within one part of
+    the key, between two '/', and ``**`` crosses them. A group label may hold '/' (``base/mf``): with fnmatch's ``*``,
+    ``run/base/*/rep0`` selected that group's units too (T28-A11)."""
+    return _pattern_regex(pattern).fullmatch(key) is not None

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import fnmatch
 import json
 import sys
 import time
@@ -11,6 +10,7 @@ from dataclasses import dataclass, field
 
 from ..errors import NeurohoverError, brief, check_flag
 from .config import POLICY_SOURCES, ExperimentConfig, check_own_name, check_paper_table
+from .keys import key_matches
 from .plans import Plan, plan, run_keys, source_experiments
 from .store import Store
 
@@ -56,11 +56,11 @@ def _short(err: BaseException) -> str:
 
 
 def selected(key: str, only: Sequence[str]) -> bool:
-    """Whether unit ``key`` is in the selection ``only`` (glob patterns; empty: every unit).
+    """Whether unit ``key`` is in the selection ``only`` (glob patterns, :func:`~.keys.key_matches`; empty: every unit).
 
     Shared prerequisites (``policy/...`` units: the policies that test runs fly) are always selected.
     """
-    return not only or key.startswith("policy/") or any(fnmatch.fnmatchcase(key, pat) for pat in only)
+    return not only or key.startswith("policy/") or any(key_matches(key, pat) for pat in only)
 
 
 def check_restart(fresh: bool, update: bool, only: Sequence[str] = ()) -> None:
@@ -139,7 +139,9 @@ def _matches_no_unit(config, pattern: str, units) -> NeurohoverError:
     for key in keys:
         stages.setdefault(key.split("/")[0], []).append(key)
     examples = [k for ks in stages.values() for k in ks[:2]]
-    return NeurohoverError(f"{config.name}: --only {pattern!r} matches no unit; unit keys look like {', '.join(examples[:6])}")
+    across = "*" in pattern and any(key_matches(k, pattern.replace("*", "**")) for k in keys)  # fnmatch's '*' until T28-A11
+    hint = " ('*' matches within one part of a key, not across '/': give '**' to cross parts)" if across else ""
+    return NeurohoverError(f"{config.name}: --only {pattern!r} matches no unit{hint}; unit keys look like {', '.join(examples[:6])}")
 
 
 def _checked_results(config: ExperimentConfig, store: Store, held: str | None) -> tuple[dict[str, dict], Plan | None]:
@@ -189,7 +191,7 @@ def _refuse_unmatched(config: ExperimentConfig, store: Store, held: str | None, 
     results = store.results(config.name, config.scale) if held == config.hash else {}
     later = run_keys(config)  # a test-runs plan lists its runs once their policies are stored: their keys, now
     first = plan(config, results, sources) if later else _with_policy_stand_ins(config, results, sources)
-    unmatched = [pat for pat in only if not any(fnmatch.fnmatchcase(k, pat) for k in [*(u.key for u in first.units), *later])]
+    unmatched = [pat for pat in only if not any(key_matches(k, pat) for k in [*(u.key for u in first.units), *later])]
     if unmatched and (len(first.units) == first.total or later):
         raise _matches_no_unit(config, unmatched[0], first.units)
 
@@ -272,7 +274,7 @@ def reproduce(
         while True:
             p = first_round if first_round is not None else plan(config, results, sources)
             first_round = None
-            matched.update(pat for pat in only for u in p.units if fnmatch.fnmatchcase(u.key, pat))
+            matched.update(pat for pat in only for u in p.units if key_matches(u.key, pat))
             summary.units_total = p.total
             bar.total = p.total
             bar.refresh()

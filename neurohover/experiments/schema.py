@@ -325,6 +325,14 @@ def _check_test_runs(settings: dict, task: str, where: str) -> None:
             )
     if len(set(labels)) != len(labels):
         raise NeurohoverError(f"{where}: group labels must be unique (set label = ... on repeated agents), got {labels}")
+    agents = {name.lower(): name for name in AGENTS}
+    for g, label in zip(settings["groups"], labels, strict=True):  # wins, the report and the paper's claims read a group by its label (T28-A03)
+        other = agents.get(label.lower())
+        if other is not None and other != g["agent"]:
+            raise NeurohoverError(
+                f"{where}: group label {label!r} is not allowed for agent {g['agent']!r}: it is the name of the agent {other!r}, and its results "
+                "would pass for that agent's; give a label of its own"
+            )
     for g in settings["groups"]:
         if task not in AGENTS[g["agent"]].tasks:
             raise NeurohoverError(f"{where}: agent {g['agent']!r} does not apply to task {task!r}")

@@ -308,6 +308,12 @@ class Store:
                 for table in ("experiments", "units", "sessions"):
                     c.execute(f"DELETE FROM {table} WHERE name = ? AND scale = ?", (name, scale))
             row = c.execute("SELECT config_hash FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
+            other = c.execute("SELECT name FROM experiments WHERE lower(name) = lower(?) AND name != ? LIMIT 1", (name, name)).fetchone()
+            if row is None and other is not None:  # one file of figures where case is ignored, one report anchor (T28-A10)
+                raise NeurohoverError(
+                    f"results store {str(self.path)!r} already holds experiment {other[0]!r}, and {name!r} differs from it only in case: their "
+                    "figures would be one file where case is ignored; give the experiment another name (or another --store)"
+                )
             if row is None:
                 c.execute("INSERT INTO experiments VALUES (?, ?, ?, ?, ?)", (name, scale, config_hash, text, time.time()))
             elif row[0] != config_hash:
