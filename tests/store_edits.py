@@ -6,6 +6,17 @@ import shutil
 import sqlite3
 from pathlib import Path
 
+#: One tiny competition (baseline on ghh08, one run of two 20-step episodes): the store tests damage copies of.
+COMPETE = ("compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--episode-steps", "20")
+
+
+def competed_store(where: Path) -> Path:
+    """The store one tiny compete run (:data:`COMPETE`) writes under ``where``."""
+    from neurohover.cli import main
+
+    assert main([*COMPETE, "--out", str(where / "c"), "--store", str(where / "s.sqlite")]) == 0
+    return where / "s.sqlite"
+
 
 def damaged(store: Path, at: Path, sql: str) -> Path:
     """A copy of ``store`` at ``at`` with ``sql`` run on it."""

@@ -12,14 +12,13 @@ from pathlib import Path
 
 import pytest
 from conftest import CliRun, tiny_test_runs
-from store_edits import damaged, dump, error
+from store_edits import COMPETE, competed_store, damaged, dump, error
 
 from neurohover.errors import NeurohoverError
 from neurohover.experiments import LocalExecutor, Store, reproduce
 from neurohover.experiments.config import make_config
 
 RUN = "run/baseline/test0/rep0"
-COMPETE = ("compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--episode-steps", "20")
 
 
 @pytest.fixture(scope="module")
@@ -38,11 +37,7 @@ def tiny(tmp_path_factory) -> tuple[Path, Path]:
 @pytest.fixture(scope="module")
 def competed(tmp_path_factory) -> Path:
     """A store that one tiny compete run (baseline on ghh08, one run) wrote; tests damage copies of it."""
-    from neurohover.cli import main
-
-    where = tmp_path_factory.mktemp("compete19")
-    assert main([*COMPETE, "--out", str(where / "c"), "--store", str(where / "s.sqlite")]) == 0
-    return where / "s.sqlite"
+    return competed_store(tmp_path_factory.mktemp("compete19"))
 
 
 @pytest.mark.parametrize("sql", ["ALTER TABLE units DROP COLUMN result", "DROP TABLE units", "ALTER TABLE sessions DROP COLUMN status"])
