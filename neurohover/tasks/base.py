@@ -34,7 +34,7 @@ from ..sim.constants import (
 from ..sim.reference import ReferenceMDP
 from ..sim.rng import MAX_SEED
 from .drift import NO_DRIFT, Drift
-from .held import check_held, family_code
+from .held import check_held, check_label, family_code
 from .sensor import EXACT, Sensor
 
 N_TRAINING = 10
@@ -279,7 +279,9 @@ def _through_sensor(method):
             mdp = method(self, *args, **kwargs)
             if not self.sensor.exact:
                 mdp = mdp.with_sensor(self.sensor)
-            return mdp if self.drift.none else mdp.with_drift(self.drift)
+            mdp = mdp if self.drift.none else mdp.with_drift(self.drift)
+        check_label(mdp)  # but a caller's label= is the caller's: it must name this MDP (T29-B01)
+        return mdp
 
     return made
 
@@ -355,6 +357,8 @@ class TaskFamily:
         The MDP parameters :meth:`make` takes.
     row_slice : slice
         Where those parameters sit in an MDP's kernel row (the rest of a sampled row is fixed).
+    param_bounds : (float, float)
+        The range each parameter lies in (:meth:`make` and :meth:`rows` refuse one outside it).
     set_code : int
         Distinguishes its seeded fixed sets from other families'.
     has_sigma : bool
@@ -375,6 +379,7 @@ class TaskFamily:
     n_params: int = 0
     param_names: tuple[str, ...] = ()
     row_slice: slice = slice(0, 0)
+    param_bounds: tuple[float, float] = (-MAX_MAGNITUDE, MAX_MAGNITUDE)
     set_code: int = 0
     has_sigma: bool = False
     wind_kind: int = WIND_NONE
@@ -480,8 +485,8 @@ class TaskFamily:
         return _ROW_LAYOUTS[key].copy()
 
     def rows(self, params: np.ndarray) -> np.ndarray:
-        """Kernel rows of the MDPs of ``params`` (n, n_params), as ``make(p).row()`` gives: their shape and finiteness are
-        checked, their ranges not (:meth:`make` checks those)."""
+        """Kernel rows of the MDPs of ``params`` (n, n_params), as ``make(p).row()`` gives: their shape, finiteness and
+        :attr:`param_bounds` are checked."""
         try:  # numbers only (NumPy reads '1' as 1.0), not a masked array, whose hidden values were used (T16-9)
             arr: np.ndarray | None = as_floats(params, "params", "")
         except NeurohoverError:
@@ -491,6 +496,13 @@ class TaskFamily:
             shown = f"of shape {arr.shape}" if arr is not None and (arr.ndim != 2 or arr.shape[1] != self.n_params) else " ".join(brief(params).split())
             raise NeurohoverError(
                 f"{self.name} parameters {shown} are not allowed: give an array of shape (n, {self.n_params}) of finite numbers ({', '.join(self.param_names)})"
+            )
+        low, high = self.param_bounds  # as make() refuses them: a GHH-08 wind of 99 m/s was flown from rows (T29-B02)
+        outside = np.flatnonzero(((arr < low) | (arr > high)).any(axis=1))
+        if outside.size:
+            i = int(outside[0])
+            raise NeurohoverError(
+                f"{self.name} parameters row {i} {brief(arr[i].tolist())} is out of range: each must lie in [{low:g}, {high:g}] ({', '.join(self.param_names)})"
             )
         params = arr
         out = np.repeat(self.row_template()[None, :], params.shape[0], axis=0)
@@ -505,14 +517,16 @@ class TaskFamily:
         key = (self.name, self.set_variant(), which, self.sensor, self.drift)
         if key not in _FIXED_SETS:  # MDPs are immutable, so each set is built once per process
             rng = np.random.default_rng(np.random.SeedSequence([_SET_ENTROPY, self.set_code, which, self.set_variant()]))
-            _FIXED_SETS[key] = tuple(self.make(self.sample_params(rng, 1)[0], label=f"{self.name}/{kind}:{i}") for i in range(n))
+            with family_code():  # the set's own labels name it: checking them would build the set again
+                _FIXED_SETS[key] = tuple(self.make(self.sample_params(rng, 1)[0], label=f"{self.name}/{kind}:{i}") for i in range(n))
         return list(_FIXED_SETS[key])
 
     def _competition_set(self, kind: str) -> list[MDP]:
         key = (self.name, -1, 0 if kind == "train" else 1, self.sensor, self.drift)
         if key not in _FIXED_SETS:
             rows = competition_rows(self.name)[kind]
-            _FIXED_SETS[key] = tuple(self.make(self.competition_params(r), label=f"{self.name}/{kind}:{i}") for i, r in enumerate(rows))
+            with family_code():  # as _seeded_set's
+                _FIXED_SETS[key] = tuple(self.make(self.competition_params(r), label=f"{self.name}/{kind}:{i}") for i, r in enumerate(rows))
         return list(_FIXED_SETS[key])
 
     def training_mdps(self) -> list[MDP]:

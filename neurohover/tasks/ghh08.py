@@ -24,6 +24,7 @@ class GHH08(TaskFamily):
     row_slice = slice(ROW_WIND.start, ROW_WIND.start + 2)
     set_code = 8
     wind_kind = WIND_CONSTANT
+    param_bounds = (-MAX_WIND, MAX_WIND)
 
     def make(self, params: Sequence[float] | np.ndarray, label: str = "") -> MDP:
         wind = finite_vector(params, 2, "GHH-08 wind (wind_u, wind_v)")

@@ -33,10 +33,11 @@ class GHH09(TaskFamily):
     row_slice = slice(ROW_WIND.start, ROW_WIND.start + 8)
     set_code = 9
     wind_kind = WIND_SINUSOID
+    param_bounds = (0.0, 1.0)
 
     def make(self, params: Sequence[float] | np.ndarray, label: str = "") -> MDP:
         p = finite_vector(params, 8, "GHH-09 parameters " + "/".join(GHH09_PARAM_NAMES))
-        bad = [f"{n}={v}" for n, v in zip(GHH09_PARAM_NAMES, p) if not 0.0 <= v <= 1.0]
+        bad = [f"{n}={v}" for n, v in zip(GHH09_PARAM_NAMES, p) if not self.param_bounds[0] <= v <= self.param_bounds[1]]
         if bad:
             raise NeurohoverError(f"GHH-09 parameters out of range ({', '.join(bad)}): each must lie in [0, 1]")
         return MDP("ghh09", wind_kind=WIND_SINUSOID, wind=tuple(p.tolist()), label=mdp_label(label, "ghh09/custom"))

@@ -13,7 +13,8 @@ by a seed the label does not record) and any other label given to ``make(label=.
 ``model``) may fly any wind and dynamics, under any label but one that names a task family's MDP (T28-B09).
 
 The family's own :meth:`make` and :meth:`zero` build MDPs it holds by definition, so MDPs built while they run are not
-checked again (:func:`family_code`): the check never recurses, and a family's fixed sets are built once.
+checked again (:func:`family_code`): the check never recurses, and a family's fixed sets are built once. A label the
+caller gives make() or sample() is still checked against the MDP built (:func:`check_label`).
 """
 
 from __future__ import annotations
@@ -70,6 +71,19 @@ def check_held(mdp: MDP) -> None:
         problem = held_problem(mdp)
     if problem:
         raise NeurohoverError(f"MDP {brief(mdp.label) if mdp.label else '(no label)'} is not allowed: {problem}")
+
+
+def check_label(mdp: MDP) -> None:
+    """Refuse the label a caller gave a family's make() or sample() where it names another MDP than the one built
+    ('ghh08/train:0' on a wind of (0, 0), 'zero' on a draw; T29-B01): the family's code holds the MDP, not the label."""
+    if getattr(_inside, "active", False) or (SET_LABEL.fullmatch(mdp.label) or WIND_LABEL.fullmatch(mdp.label)) is None:
+        return
+    from . import get_task_family
+
+    with family_code():
+        problem = _label_problem(mdp, get_task_family(mdp.family))
+    if problem:
+        raise NeurohoverError(f"MDP {brief(mdp.label)} is not allowed: {problem}")
 
 
 def held_problem(mdp: MDP) -> str:
