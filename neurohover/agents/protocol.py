@@ -36,6 +36,8 @@ from ..flightdata import FlightData
 from ..policies import Policy
 from ..sim.constants import CRASH_STEP_PENALTY, EPISODE_STEPS, MAX_EPISODE_STEPS, WORST_RETURN, lowest_return
 from ..tasks import MDP, TaskFamily
+from ..tasks.drift import Drift
+from ..tasks.sensor import Sensor
 from .spec import AgentSettings
 
 REPEAT_CHUNK = 64  # most episodes per kernel call for a repeated choice
@@ -282,8 +284,35 @@ def _family_label(name: str, sigma: float | None) -> str:
     return name if sigma is None else f"{name} (sigma {sigma:g})"
 
 
-def _check_run(agent, family, mdp, episodes, seed) -> int:
-    """:func:`run_test`'s arguments checked (NeurohoverError naming the bad one); returns the seed."""
+def _refuse_own(mdp: MDP, what: str, own: Sensor | Drift, family: Sensor | Drift) -> None:
+    def text(x: Sensor | Drift) -> str:  # the settings given, as the environments name a sensor
+        return type(x).__name__ + "(" + ", ".join(f"{k}={v}" for k, v in x.to_dict().items() if v) + ")"
+
+    raise NeurohoverError(
+        f"mdp {mdp.label or mdp.family!r} carries its own {what} {text(own)}, not the run's family's {text(family)}: give "
+        f"the MDP without one (mdp.with_{what}({type(own).__name__}())), or a family without a {what}, under which it flies its own"
+    )
+
+
+def _flown_mdp(mdp: MDP, family: TaskFamily) -> MDP:
+    """``mdp`` as the run flies it: the family's sensor and drift by the environments' rule for an explicit MDP
+    (``neurohover.envs.arguments.sensed_mdp``): an MDP of exact sensors takes the family's sensor, one without drift its
+    drift, and an MDP carrying a sensor or drift other than the family's (not exact, not none) is refused. A plain MDP
+    flew exact sensors and fixed dynamics in a sensor or drift family's run without a word (T29-B03)."""
+    if not (family.sensor.exact or mdp.sensor == family.sensor):
+        if not mdp.sensor.exact:
+            _refuse_own(mdp, "sensor", mdp.sensor, family.sensor)
+        mdp = mdp.with_sensor(family.sensor)
+    if not (family.drift.none or mdp.drift == family.drift):
+        if not mdp.drift.none:
+            _refuse_own(mdp, "drift", mdp.drift, family.drift)
+        mdp = mdp.with_drift(family.drift)
+    return mdp
+
+
+def _check_run(agent, family, mdp, episodes, seed, n_steps) -> tuple[MDP, int]:
+    """:func:`run_test`'s arguments checked (NeurohoverError naming the bad one); returns the MDP flown
+    (:func:`_flown_mdp`) and the seed."""
     if not isinstance(agent, Agent):
         raise NeurohoverError(f"agent={agent!r:.80} is not allowed: give an Agent (neurohover.agents.registry.make_agent(name, family))")
     if not isinstance(family, TaskFamily):
@@ -298,10 +327,14 @@ def _check_run(agent, family, mdp, episodes, seed) -> int:
         )
     if mdp.family != family.name:  # the agent prepares for its family (its policies, safe pairs): another family's MDP is a mix-up
         raise NeurohoverError(f"mdp {mdp.label!r} is a {mdp.family} MDP, but the run's family is {family.name}: give an MDP of {family.name}")
+    mdp = _flown_mdp(mdp, family)
     # T24-11: whole_in, so 1.5 or True "is not allowed" and 0 "is out of range"; the bound check_episode_count had
     whole_in(episodes, "episodes", 1, MAX_EPISODES_PER_CALL, f"{MAX_EPISODES_PER_CALL:,} (episodes in one call)")
     mdp.drift.check_run(int(episodes))
-    return check_seed(seed)
+    settings = getattr(agent, "settings", None)
+    if isinstance(settings, AgentSettings) and whole_number(n_steps):  # others are refused where the episodes fly
+        settings.check_episode_steps(int(n_steps))  # settings that cannot act in episodes this long (twelfth trial, S3)
+    return mdp, check_seed(seed)
 
 
 def run_test(
@@ -317,15 +350,14 @@ def run_test(
 ) -> RunResult:
     """Fly one test run of ``episodes`` episodes of ``agent`` on ``mdp``.
 
-    Episode e's gusts come from stream (seed, e), so two agents run with the same seed meet the
-    same noise. The agent's own randomness derives from ``seed`` as well, and so does the drift of
-    an MDP with drifting dynamics (``mdp.drift``: episode e flies its row e, the agent unaware). ``device``: where the
-    episodes in the MDP fly (the agent's own evolutions on models follow its ``ModelEvolution``).
+    Episode e's gusts come from stream (seed, e), so two agents run with the same seed meet the same noise. The agent's
+    own randomness derives from ``seed`` as well, and so does the drift of an MDP with drifting dynamics (``mdp.drift``:
+    episode e flies its row e, the agent unaware). ``device``: where the episodes in the MDP fly (the agent's own
+    evolutions on models follow its ``ModelEvolution``). The family's sensor and drift apply as to the environments'
+    explicit ``mdp``: an MDP of exact sensors flies through ``family.sensor``, one without drift drifts by
+    ``family.drift``, an MDP's own flies beside a family's exact or none, one differing is refused (result.mdp: as flown).
     """
-    seed = _check_run(agent, family, mdp, episodes, seed)
-    settings = getattr(agent, "settings", None)
-    if isinstance(settings, AgentSettings) and whole_number(n_steps):  # others are refused where the episodes fly
-        settings.check_episode_steps(int(n_steps))  # settings that cannot act in episodes this long (twelfth trial, S3)
+    mdp, seed = _check_run(agent, family, mdp, episodes, seed, n_steps)
     start_time = time.perf_counter()
     agent.start(family, np.random.default_rng(np.random.SeedSequence([seed, 0xA6E27])))
     returns = np.zeros(episodes)

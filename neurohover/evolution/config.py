@@ -209,10 +209,11 @@ def resolve_prototype(prototype, topology: str) -> Policy:
     raise NeurohoverError(f"prototype must be a Policy, 'zero' or 'baseline', got {prototype!r}")
 
 
-def resolve_target(target) -> tuple[MDP | None, TaskFamily | None, dict]:
-    """``(mdp or None, family or None, description dict)`` of an MDP, a learned model or a task family."""
+def resolve_target(target, caller: str = "evolve") -> tuple[MDP | None, TaskFamily | None, dict]:
+    """``(mdp or None, family or None, description dict)`` of an MDP, a learned model or a task family; ``caller``: the
+    function a refusal names (validation_return's named evolve, T29-B10)."""
     if isinstance(target, (MDP, TaskFamily)):
-        refuse_drift(target, "evolution")
+        refuse_drift(target, "evolution" if caller == "evolve" else caller)
     if isinstance(target, MDP):
         return target, None, {"kind": "mdp", "mdp": target.to_dict()}
     if isinstance(target, TaskFamily):  # all it is (sensor included): part of the run's checkpoint and results
@@ -220,7 +221,7 @@ def resolve_target(target) -> tuple[MDP | None, TaskFamily | None, dict]:
     if callable(getattr(target, "mdp", None)) and hasattr(target, "method"):  # a LearnedModel
         mdp = target.mdp()
         return mdp, None, {"kind": "mdp", "mdp": mdp.to_dict()}
-    raise NeurohoverError(f"evolve needs an MDP, a learned model or a task family as target, got {type(target).__name__}")
+    raise NeurohoverError(f"{caller} needs an MDP, a learned model or a task family as target, got {type(target).__name__}")
 
 
 def optimiser_of(table: Mapping[str, Any]) -> tuple[str, dict[str, Any]]:

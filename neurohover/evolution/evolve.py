@@ -283,17 +283,17 @@ def validation_return(
     uses, so these episodes are independent of the ones the run flew. ``device`` as in :func:`evolve`.
     """
     noise_seed, mdp_seed = validation_seeds(check_seed(seed))
-    rows, m_idx = _fresh_episodes(target, episodes, mdp_seed)
+    rows, m_idx = _fresh_episodes(target, episodes, mdp_seed, "validation_return")
     ev = evaluate_jobs(
         [policy], rows, np.zeros(episodes, dtype=np.int64), m_idx, np.arange(episodes), seed=noise_seed, n_steps=n_steps, threads=threads, device=device
     )
     return ev.returns
 
 
-def _fresh_episodes(target, episodes: int, mdp_seed: int) -> tuple[np.ndarray, np.ndarray]:
+def _fresh_episodes(target, episodes: int, mdp_seed: int, caller: str) -> tuple[np.ndarray, np.ndarray]:
     """The kernel rows and each episode's row index of ``episodes`` fresh episodes of ``target``: all on its MDP, or
     each on a fresh MDP from G drawn with ``mdp_seed``."""
-    mdp, family, _ = resolve_target(target)
+    mdp, family, _ = resolve_target(target, caller)
     # T24-11: whole_in, so 1.5 or True "is not allowed" and 0 "is out of range"; the bound check_episode_count had
     episodes = whole_in(episodes, "episodes", 1, MAX_EPISODES_PER_CALL, f"{MAX_EPISODES_PER_CALL:,} (episodes in one call)")
     if mdp is not None:
@@ -333,7 +333,7 @@ def reevaluated_champion(
     if pool is None or len(pool) == 0:
         raise NeurohoverError("the run has no selected parents to choose from again: generational evolution keeps them, other methods do not")
     noise_seed, mdp_seed = reevaluation_seeds(check_seed(int(result.settings["seed"])))
-    rows, m = _fresh_episodes(target, episodes, mdp_seed)
+    rows, m = _fresh_episodes(target, episodes, mdp_seed, "reevaluated_champion")
     k = len(pool)
     champion = result.champion
     policies = [Policy(champion.topology, np.array(g, dtype=float), champion.metadata) for g in pool]

@@ -472,9 +472,23 @@ def run_unit(unit: Unit | dict, threads: int | None = 1, device: str = "cpu") ->
 
 
 def strip_timing(result: Any) -> Any:
-    """A result without its wall-clock measurements (for comparing runs)."""
-    if isinstance(result, dict):
-        return {k: strip_timing(v) for k, v in result.items() if k != "timing"}
-    if isinstance(result, list):
-        return [strip_timing(v) for v in result]
-    return result
+    """A result without its wall-clock measurements (for comparing runs). A result that holds itself (no stored one,
+    JSON, can) or is nested past Python's recursion limit is refused by name (was a RecursionError, T29-B09)."""
+    inside: set[int] = set()  # the dicts and lists on the path from the top to the value at hand
+
+    def strip(value: Any) -> Any:
+        if not isinstance(value, (dict, list)):
+            return value
+        if id(value) in inside:
+            raise NeurohoverError(
+                f"result={brief(result)} is not allowed: it holds itself (a {type(value).__name__} inside its own), as no stored result (JSON) can"
+            )
+        inside.add(id(value))
+        out = {k: strip(v) for k, v in value.items() if k != "timing"} if isinstance(value, dict) else [strip(v) for v in value]
+        inside.discard(id(value))
+        return out
+
+    try:
+        return strip(result)
+    except RecursionError:
+        raise NeurohoverError(f"result={brief(result)} is not allowed: it is nested too deep to read (past Python's recursion limit)") from None

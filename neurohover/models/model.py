@@ -29,14 +29,14 @@ from __future__ import annotations
 import json
 import math
 import os
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import NeurohoverError, as_floats, brief, finite_real, whole_number
+from ..errors import NeurohoverError, as_floats, brief, finite_real, real_number, whole_number
 from ..filekinds import refuse_suffix
 from ..paths import json_text
 from ..sim.constants import CONTROL_DT, DEFAULT_NOISE_STD, DEFAULT_PARAMS, MAX_SECONDS, NOISE_NAMES, PARAM_NAMES, SUBSTEP_DT, SUBSTEPS, seconds_allowed
@@ -127,11 +127,17 @@ def check_vector(values, length: int, what: str, nonnegative: bool = False) -> t
     # the one array check: a masked array's mask was dropped and its hidden values used (T16-9); objects are checked below
     if isinstance(values, np.ma.MaskedArray) or (isinstance(values, np.ndarray) and values.dtype.kind != "O"):
         as_floats(values, what, f"{length} real numbers")
+    if isinstance(values, Iterator):  # refused as MDP(params=...) and a family's make() refuse one; it said "got 1" (T29-B10)
+        raise NeurohoverError(f"{what} must be {length} numbers, got an iterator {brief(values)}: give them as a list, tuple or array")
     try:  # as objects: a float conversion read '1' as 1.0 and True as 1.0, and 10**400 was an OverflowError (T14-13)
         flat = np.asarray(values, dtype=object).reshape(-1)
     except (TypeError, ValueError):
         raise NeurohoverError(f"{what} must be {length} numbers, got {brief(values)}") from None
     if flat.size != length:  # here, so the message shows the values shortened
+        if np.ndim(np.asarray(values, dtype=object)) == 0 and not real_number(values):  # an object, not a count of numbers (T29-B10)
+            hint = " (give its .params)" if hasattr(values, "params") else ""
+            got = "None" if values is None else f"one {type(values).__name__} object{hint}: {brief(values)}"
+            raise NeurohoverError(f"{what} must be {length} numbers, got {got}")
         raise NeurohoverError(f"{what} must be {length} numbers, got {flat.size}: {brief(values)}")
     arr = finite_vector(flat.tolist(), length, what)  # the one finite-vector check (neurohover.tasks): text, bools, 10**400
     if nonnegative and np.any(arr < 0):
@@ -421,7 +427,8 @@ def parameter_table(
     (default: the simulator's defaults). The learned one-substep values are first converted to the
     true MDP's integration with :func:`equivalent_params` (10 x 0.01 s for the simulator; nothing
     to convert when the truth is itself a one-substep model). Noise rows (``std_u`` ...) appear when
-    true noise is known.
+    true noise is known. ``substeps`` and ``dt`` choose the integration for 11 numbers; beside an MDP
+    only its own is allowed (another was a silent override of the truth's integration).
     """
     if not isinstance(model, LearnedModel):
         raise NeurohoverError(f"parameter_table needs a LearnedModel, got {type(model).__name__}")
@@ -430,8 +437,14 @@ def parameter_table(
         mdp = true_params
         truth = np.array(mdp.params, dtype=float)
         noise = np.array(mdp.noise_std if true_noise_std is None else check_vector(true_noise_std, 6, "true noise std", nonnegative=True))
-        substeps = mdp.substeps if substeps is None else substeps
-        dt = mdp.dt if dt is None else dt
+        given = {k: v for k, v in (("substeps", substeps), ("dt", dt)) if v is not None and not (real_number(v) and v == getattr(mdp, k))}
+        if given:  # they overrode the MDP's own integration without a word (trial 29b)
+            raise NeurohoverError(
+                f"{', '.join(f'{k}={brief(v)}' for k, v in given.items())} is not allowed beside the MDP {mdp.label or mdp.family!r}, which integrates "
+                f"{mdp.substeps} x {mdp.dt:g} s: the learned values are compared in the true MDP's own integration, so leave "
+                "substeps and dt out (or give the true parameters as 11 numbers to choose another)"
+            )
+        substeps, dt = mdp.substeps, mdp.dt
     else:
         truth = np.array(DEFAULT_PARAMS if true_params is None else check_vector(true_params, 11, "true parameters"))
         noise = None if true_noise_std is None else np.array(check_vector(true_noise_std, 6, "true noise std", nonnegative=True))  # T27-B12: -1 taken
@@ -455,6 +468,13 @@ def format_parameter_table(rows: Sequence[ParamRow]) -> str:
     bad = next((r for r in rows if not isinstance(r, ParamRow)), None)
     if bad is not None:
         raise NeurohoverError(f"row {brief(bad)} is not allowed: give the ParamRow rows that parameter_table returns")
+    for r in rows:  # a ParamRow's fields are not checked where it is made: None or text was a TypeError here (T29-B08)
+        bad_field = "name" if not isinstance(r.name, str) else next((f for f in ParamRow._fields[1:] if not real_number(getattr(r, f))), None)
+        if bad_field is not None:
+            raise NeurohoverError(
+                f"row {brief(r.name)}: its {bad_field} {brief(getattr(r, bad_field))} is not allowed: a ParamRow holds a name "
+                "(text) and the learned, true and rel_error numbers that parameter_table gives"
+            )
     lines = [f"{'name':>6} {'learned':>11} {'true':>11} {'rel.err':>8}"]
     lines += [f"{r.name:>6} {r.learned:>11.4f} {r.true:>11.4f} {100 * r.rel_error:>7.1f}%" for r in rows]
     return "\n".join(lines)
