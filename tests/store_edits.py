@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import shutil
 import sqlite3
+import tempfile
 from pathlib import Path
 
 #: One tiny competition (baseline on ghh08, one run of two 20-step episodes): the store tests damage copies of.
@@ -16,6 +19,31 @@ def competed_store(where: Path) -> Path:
 
     assert main([*COMPETE, "--out", str(where / "c"), "--store", str(where / "s.sqlite")]) == 0
     return where / "s.sqlite"
+
+
+@functools.cache
+def _tiny():
+    from conftest import tiny_test_runs
+
+    from neurohover.experiments.config import load_config
+
+    with tempfile.TemporaryDirectory() as where:
+        path = Path(where) / "tr1.toml"
+        path.write_text(tiny_test_runs("baseline"))
+        return load_config(str(path), "quick")
+
+
+def tiny_config(name: str = "tr1", scale: str = "quick"):
+    """A tiny test-runs config (conftest's, flying the baseline) named ``name`` at ``scale`` (a compete run's
+    settings-HASH too): one :meth:`Store.begin` takes, as it takes only configs the store's readers read (T29-B07)."""
+    return dataclasses.replace(_tiny(), name=name, scale=scale)
+
+
+def begin(store, name: str = "tr1", scale: str = "quick", **kw) -> str:
+    """Register experiment ``name`` at ``scale`` in ``store`` with :func:`tiny_config`; its config hash."""
+    config = tiny_config(name, scale)
+    store.begin(name, scale, config.hash, config.to_dict(), **kw)
+    return config.hash
 
 
 def damaged(store: Path, at: Path, sql: str) -> Path:

@@ -74,10 +74,12 @@ def test_a_config_named_after_a_shipped_alias_is_refused(tmp_path: Path, cli) ->
 
 def test_results_out_dash_points_to_standard_output(tmp_path: Path, cli) -> None:
     """S7: `results --out -` wrote a file named '-'; its default is standard output, which the message now names."""
+    from store_edits import begin
+
     from neurohover.experiments import Store
 
     with Store(tmp_path / "s.sqlite") as db:
-        db.begin("fig2", "quick", "h", {})
+        begin(db, "fig2")
     rc, _, err = cli("results", "fig2", "--store", str(tmp_path / "s.sqlite"), "--out", "-")
     assert rc == 2 and "--out '-' is not a file name here: leave --out out for standard output" in err, err
     assert not (tmp_path / "-").exists() and not Path("-").exists()

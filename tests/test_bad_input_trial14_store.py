@@ -8,6 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from store_edits import begin, tiny_config
 
 from neurohover.errors import NeurohoverError
 from neurohover.experiments import RayExecutor, Store, Unit, plan, reproduce, run_unit
@@ -16,14 +17,15 @@ from neurohover.experiments.params import unit_params
 
 NAN = float("nan")
 UNIT = Unit("e", "k", "diagnostic", {"value": 1})
+H = tiny_config().hash  # what each store.begin below registers (T29-B07: a real config)
 SETTINGS = dict(task="ghh08", seed=1, policies="shipped", episodes=2, n_steps=20, groups=[dict(agent="baseline", mdps="test", n_mdps=1)])
 
 
 def _stored(path: Path) -> Store:
     """A store holding experiment e (quick) with one finished unit."""
     store = Store(path)
-    store.begin("e", "quick", "h", {})
-    assert store.put("e", "quick", "h", UNIT, {"value": 1}, 0.5)
+    begin(store, "e")
+    assert store.put("e", "quick", H, UNIT, {"value": 1}, 0.5)
     return store
 
 
@@ -32,7 +34,7 @@ def test_begin_refuses_a_fresh_flag_that_is_no_bool(tmp_path: Path, fresh) -> No
     """T14-4: fresh='no' counted as True and deleted every stored unit of the experiment."""
     with _stored(tmp_path / "s.sqlite") as store:
         with pytest.raises(NeurohoverError, match=r"fresh=.* is not allowed: give True \(delete the experiment's stored units first\) or False"):
-            store.begin("e", "quick", "h", {}, fresh=fresh)
+            begin(store, "e", fresh=fresh)
         assert store.results("e", "quick") == {"k": {"value": 1}}
 
 
@@ -73,18 +75,18 @@ def test_store_refuses_a_create_flag_that_is_no_bool(tmp_path: Path) -> None:
         (lambda s: s.begin("x", "quick", "h", {1: 1, "1": 2}), "is not allowed: give a JSON object"),  # two keys "1" once written
         (lambda s: s.update("e", "quick", "h2", {}, keep=None), "update: keep = None is not allowed: give a list or set of unit keys"),
         (lambda s: s.update("e", "quick", "h2", {}, keep="k"), "update: keep = 'k' is not allowed"),
-        (lambda s: s.put("e", "quick", "h", None, {}, 1.0), "put: unit = None is not allowed: give the Unit that finished"),
+        (lambda s: s.put("e", "quick", H, None, {}, 1.0), "put: unit = None is not allowed: give the Unit that finished"),
         (
-            lambda s: s.put("e", "quick", "h", Unit("e", "k2", "diagnostic", {}), {}, NAN),
+            lambda s: s.put("e", "quick", H, Unit("e", "k2", "diagnostic", {}), {}, NAN),
             "put: seconds = nan is not allowed: give a finite number of seconds >= 0",
         ),
-        (lambda s: s.put("e", "quick", "h", Unit("e", "k2", "diagnostic", {}), {}, -1.0), "seconds = -1.0 is not allowed"),
-        (lambda s: s.put("e", "quick", "h", Unit("e", "k2", "diagnostic", {}), {"a": NAN}, 1.0), "put: unit k2's result = {'a': nan} is not allowed"),
-        (lambda s: s.put("e", "quick", "h", Unit("e", "k2", "diagnostic", {}), [1], 1.0), "put: unit k2's result = [1] is not allowed: give a dict"),
-        (lambda s: s.put("e", "quick", "h", Unit("e", "k2", "diagnostic", {}), {}, 1.0, worker=None), "put: worker = None is not allowed: give text"),
-        (lambda s: s.start_session("e", "quick", "h", "local", 0, 0), "start_session: cores = 0 is not allowed: give a whole number >= 1"),
-        (lambda s: s.start_session("e", "quick", "h", "local", "x", 0), "start_session: cores = 'x' is not allowed"),
-        (lambda s: s.start_session("e", "quick", "h", "local", 1, -1), "start_session: units_before = -1 is not allowed: give a whole number >= 0"),
+        (lambda s: s.put("e", "quick", H, Unit("e", "k2", "diagnostic", {}), {}, -1.0), "seconds = -1.0 is not allowed"),
+        (lambda s: s.put("e", "quick", H, Unit("e", "k2", "diagnostic", {}), {"a": NAN}, 1.0), "put: unit k2's result = {'a': nan} is not allowed"),
+        (lambda s: s.put("e", "quick", H, Unit("e", "k2", "diagnostic", {}), [1], 1.0), "put: unit k2's result = [1] is not allowed: give a dict"),
+        (lambda s: s.put("e", "quick", H, Unit("e", "k2", "diagnostic", {}), {}, 1.0, worker=None), "put: worker = None is not allowed: give text"),
+        (lambda s: s.start_session("e", "quick", H, "local", 0, 0), "start_session: cores = 0 is not allowed: give a whole number >= 1"),
+        (lambda s: s.start_session("e", "quick", H, "local", "x", 0), "start_session: cores = 'x' is not allowed"),
+        (lambda s: s.start_session("e", "quick", H, "local", 1, -1), "start_session: units_before = -1 is not allowed: give a whole number >= 0"),
         (lambda s: s.end_session(1, object()), "end_session: status = <object object"),
         (lambda s: s.end_session(None, "finished"), "end_session: session = None is not allowed: give a whole number >= 1"),
     ],
@@ -94,7 +96,7 @@ def test_store_writes_refuse_bad_arguments_before_writing(tmp_path: Path, call, 
     read called the store damaged), 5 stored as '5', '' and NUL taken, cores=0 stored (sessions() then damaged), and
     seconds=nan a unit silently dropped (a lost result). Each is one message now, and the store is as it was."""
     with _stored(tmp_path / "s.sqlite") as store:
-        store.end_session(store.start_session("e", "quick", "h", "local", 1, 0), "finished")
+        store.end_session(store.start_session("e", "quick", H, "local", 1, 0), "finished")
         before = (store.experiments(), store.units("e", "quick"), store.sessions("e", "quick"))
         with pytest.raises(NeurohoverError) as info:
             call(store)
@@ -105,9 +107,9 @@ def test_store_writes_refuse_bad_arguments_before_writing(tmp_path: Path, call, 
 def test_store_takes_a_compete_scale_and_the_units_it_always_took(tmp_path: Path) -> None:
     """T14-5: the checks leave a compete run's settings-HASH scale and a unit of no worker, in a session, as they were."""
     with Store(tmp_path / "s.sqlite") as store:
-        store.begin("mc", "settings-0123456789", "h", {"a": [1, 2.5, None, True, "x"]})
-        session = store.start_session("mc", "settings-0123456789", "h", "local", 2, 0)
-        assert store.put("mc", "settings-0123456789", "h", UNIT, {"value": 1}, 0, session=session)
+        begin(store, "mc", "settings-0123456789")
+        session = store.start_session("mc", "settings-0123456789", H, "local", 2, 0)
+        assert store.put("mc", "settings-0123456789", H, Unit("mc", "k", "diagnostic", {}), {"value": 1}, 0, session=session)
         store.end_session(session, "finished")
         assert store.sessions("mc", "settings-0123456789")[0]["units_run"] == 1
 

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from store_edits import begin
 
 from neurohover.bench import benchmark_evolution, run_benchmarks
 from neurohover.errors import NeurohoverError
@@ -73,13 +74,14 @@ def test_end_session_names_an_unknown_session_and_status(tmp_path: Path) -> None
     with Store(tmp_path / "s.sqlite") as store:
         with pytest.raises(NeurohoverError, match=re.escape("end_session: session = 99999 is not allowed:") + ".*has no such session"):
             store.end_session(99999, "finished")
-        session = store.start_session("e", "quick", "h", "local", 1, 0)
+        h = begin(store, "e")  # a session of an experiment the store holds (T29-B04)
+        session = store.start_session("e", "quick", h, "local", 1, 0)
         allowed = "give one of 'finished', 'selection finished', 'interrupted', 'failed'"
         with pytest.raises(NeurohoverError, match=re.escape(f"end_session: status = 'weird' is not allowed: {allowed}")):
             store.end_session(session, "weird")
-        for status in SESSION_STATUSES:
-            store.end_session(session, status)
-        assert store.sessions("e", "quick")[0]["status"] == SESSION_STATUSES[-1]
+        for status in SESSION_STATUSES:  # each ends a session of its own: an ended one is not ended again (T29-B05)
+            store.end_session(store.start_session("e", "quick", h, "local", 1, 0), status)
+        assert [s["status"] for s in store.sessions("e", "quick")] == ["running", *SESSION_STATUSES]
 
 
 @pytest.mark.parametrize("run", [run_benchmarks, benchmark_evolution])

@@ -22,10 +22,12 @@ def _flight(metadata: dict | None = None) -> FlightData:
 
 
 def _store(tmp_path: Path):
+    from store_edits import begin
+
     from neurohover.experiments import Store
 
     store = Store(tmp_path / "s.sqlite")
-    store.begin("fig2", "quick", "h", {})
+    begin(store, "fig2")
     return store
 
 

@@ -7,6 +7,7 @@ import re
 
 import numpy as np
 import pytest
+from store_edits import begin
 
 from neurohover.errors import NeurohoverError
 from neurohover.experiments.store import Store
@@ -67,7 +68,7 @@ def test_impossible_session_row_is_store_damage(change, message, tmp_path):
     """T22-21: sessions rows of units_run 99 (of no unit), units_before -5, status 'zzz', executor 'zzz' or a start in
     1e12 were read, and printed by results and report; Store.sessions() now names the session, field and value."""
     with Store(tmp_path / "s.sqlite") as store:
-        session = store.start_session("e", "quick", "h", "local", 1, 0)
+        session = store.start_session("e", "quick", begin(store, "e"), "local", 1, 0)  # of a begun experiment (T29-B04)
         assert store.sessions("e", "quick")[0]["status"] == "running"  # a run killed by SIGKILL stays 'running': allowed
         store.conn.execute(f"UPDATE sessions SET {change} WHERE id = ?", (session,))
         with pytest.raises(NeurohoverError, match=re.escape(f"experiment e (quick), session {session} is damaged: {message}")):
@@ -77,7 +78,7 @@ def test_impossible_session_row_is_store_damage(change, message, tmp_path):
 def test_repeated_session_row_is_store_damage(tmp_path):
     """T22-21: a sessions row copied (a new id, every other field the same) counted one run twice."""
     with Store(tmp_path / "s.sqlite") as store:
-        first = store.start_session("e", "quick", "h", "local", 1, 0)
+        first = store.start_session("e", "quick", begin(store, "e"), "local", 1, 0)
         store.end_session(first, "finished")
         store.conn.execute(
             "INSERT INTO sessions SELECT NULL, name, scale, config_hash, executor, cores, started, wall_seconds, units_run, units_before, status FROM sessions"

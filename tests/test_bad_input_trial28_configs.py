@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 from conftest import CliRun, tiny_test_runs
-from store_edits import error
+from store_edits import begin, error
 
 from neurohover.errors import NeurohoverError
 from neurohover.experiments import Store
@@ -187,10 +187,10 @@ def test_a10_a_shipped_name_but_for_case_is_refused(tmp_path: Path, cli: CliRun)
 
 def test_a10_a_store_refuses_a_name_differing_from_a_stored_one_only_in_case(tmp_path: Path) -> None:
     with Store(tmp_path / "s.sqlite") as store:
-        store.begin("mini", "quick", "a" * 16, {"name": "mini"})
-        store.begin("mini", "paper", "b" * 16, {"name": "mini"})  # the same experiment at another scale
+        begin(store, "mini")
+        begin(store, "mini", "paper")  # the same experiment at another scale
         with pytest.raises(NeurohoverError, match=r"already holds experiment 'mini', and 'MINI' differs from it only in case"):
-            store.begin("MINI", "quick", "a" * 16, {"name": "MINI"})
+            begin(store, "MINI")
         assert [e[0] for e in store.experiments()] == ["mini", "mini"]
 
 

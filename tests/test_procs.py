@@ -404,17 +404,19 @@ def test_a_store_that_a_live_run_writes_is_refused_and_a_killed_run_blocks_nothi
 
 
 def test_two_stores_on_one_file_in_one_process_take_turns(tmp_path: Path) -> None:
+    from store_edits import begin
+
     from neurohover.errors import NeurohoverError
 
     path = tmp_path / "s.sqlite"
     with Store(path) as first, Store(path) as second:
-        first.begin("x", "quick", "h", {})
+        h = begin(first, "x")
         with pytest.raises(NeurohoverError, match=rf"is in use: another run \(pid {os.getpid()} on host "):
-            second.begin("x", "quick", "h", {})
-        assert first.experiments() == second.experiments() == [("x", "quick", "h", 0)]  # reading needs no lock
+            begin(second, "x")
+        assert first.experiments() == second.experiments() == [("x", "quick", h, 0)]  # reading needs no lock
         first.close()
         assert not first.lock_path.exists()  # a closed Store removes its lock file ...
-        second.begin("x", "quick", "h", {})  # ... and releases its lock
+        begin(second, "x")  # ... and releases its lock
         assert second.lock_path.read_text().split()[0] == str(os.getpid())
     assert not path.with_name("s.sqlite.lock").exists()
 
@@ -482,14 +484,16 @@ class _CommitThenInterrupt:
 
 
 def test_a_ctrl_c_just_after_a_unit_commits_stays_a_ctrl_c_and_keeps_the_unit(tmp_path: Path) -> None:
+    from store_edits import begin
+
     from neurohover.experiments.units import Unit
 
     with Store(tmp_path / "s.sqlite") as store:
-        store.begin("exp", "quick", "h" * 16, {})
+        h = begin(store, "exp")
         conn = store.conn
         store.conn = _CommitThenInterrupt(conn)  # type: ignore[assignment]
         with pytest.raises(KeyboardInterrupt):  # not sqlite's "cannot rollback - no transaction is active"
-            store.put("exp", "quick", "h" * 16, Unit("exp", "u0", "diagnostic", {"value": 1}), {"value": 1}, 0.1)
+            store.put("exp", "quick", h, Unit("exp", "u0", "diagnostic", {"value": 1}), {"value": 1}, 0.1)
         store.conn = conn
         assert list(store.results("exp", "quick")) == ["u0"]  # committed: kept
 

@@ -24,6 +24,7 @@ from .plans import Plan, external_digest, plan, run_keys, source_experiments
 from .result_checks import params_problem
 from .results import UnitResult, check_run_lengths, flat_cells, result_from_dict
 from .store import Store
+from .store_checks import hash_problem, read_config
 
 FORMATS = ("csv", "json")
 
@@ -84,12 +85,9 @@ def _check_hashes(store: Store, name: str, scale: str, stored: dict, config: Exp
     config_hash set to 'deadbeef' was exported and reported, a unit's set to 'x' reused by reproduce (T20-04).
     ``store.update`` gives every kept unit the new hash, so a unit of another hash is never one a run left."""
     held = store.config_hash(name, scale)
-    if held != config.hash or stored.get("hash") != held:
-        raise NeurohoverError(
-            f"its config hashes to {config.hash}, but the store records config hash {brief(held)} (its config: {brief(stored.get('hash'))}): "
-            "the config or its hash was changed after its units were run, or another version of neurohover wrote it, so its units "
-            "cannot be told to be this config's (reproduce --fresh runs it again)"
-        )
+    problem = hash_problem(held, stored, config)  # Store.begin's check too (T29-B07)
+    if problem:
+        raise NeurohoverError(problem)
     for key, unit_hash in sorted(store.unit_config_hashes(name, scale).items()):
         if unit_hash != held:
             raise NeurohoverError(
@@ -211,12 +209,10 @@ def checked_experiment(store: Store, name: str, scale: str) -> tuple[ExperimentC
     where = f"results store {str(store.path)!r}, experiment {name} ({scale}), is damaged"
     refuse_orphans(store, name)  # its units at a scale of no config row, ignored (T21-15): refuse_orphans says why
     stored = store.config(name, scale)  # the store names a row that is no JSON object itself, as for the units below
-    try:
-        config = ExperimentConfig.from_dict(stored)
+    try:  # Store.begin's check too (T29-B07)
+        config = read_config(stored, scale)
     except NeurohoverError as err:
         raise NeurohoverError(f"{where}: {err}") from None
-    if config.scale != scale:  # a quick config under a 'paper' row was reported as the paper's claims (T21-01)
-        raise NeurohoverError(f"{where}: its row is at scale {scale!r} but its config is the {brief(config.scale)} one")
     units = store.units(name, scale)
     runs = {u["key"]: u["result"] for u in units if u["kind"] == "test_run"}
     try:  # before the results are read: a run of another length is named as such (T22-05)

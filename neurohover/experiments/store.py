@@ -38,11 +38,21 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
-from ..errors import NeurohoverError, brief, check_flag, finite_real, whole_number
-from ..paths import JSONError, WriterLock, json_text, strict_json
+from ..errors import NeurohoverError, brief, check_flag, finite_real
+from ..paths import JSONError, WriterLock, strict_json
 from .config import check_name, check_scale
 from .store_checks import EXECUTORS as EXECUTORS  # executors.py reads the names from here
-from .store_checks import SESSION_STATUSES, bad_session, sqlite_says
+from .store_checks import (
+    SESSION_STATUSES,
+    _check_text,
+    _count,
+    _object_text,
+    bad_session,
+    config_problem,
+    experiment_problem,
+    session_problem,
+    sqlite_says,
+)
 from .units import Unit
 
 SCHEMA_VERSION = 1
@@ -83,35 +93,6 @@ def check_experiment(name: Any, scale: Any, where: str) -> None:
     trial, T14-5): names as :func:`~neurohover.experiments.config.check_name` allows, scales quick, paper or settings-HASH."""
     check_name(name, where)
     check_scale(scale, where)
-
-
-def _check_text(value: Any, what: str, where: str, empty: bool = False) -> None:
-    """Refuse a stored text field that is no text, empty (unless ``empty``) or holding NUL (None was an IntegrityError)."""
-    if not isinstance(value, str) or (not value and not empty) or "\x00" in value:
-        allowed = "text" if empty else "non-empty text"
-        raise NeurohoverError(f"{where}: {what} = {brief(value)} is not allowed: give {allowed} without NUL characters")
-
-
-def _count(value: Any, what: str, where: str, least: int) -> int:
-    """``value`` as an int of at least ``least``, or one error naming it (cores=0 was stored, and read back as damaged)."""
-    if not whole_number(value) or value < least:
-        raise NeurohoverError(f"{where}: {what} = {brief(value)} is not allowed: give a whole number >= {least}")
-    return int(value)
-
-
-def _object_text(value: Any, what: str, where: str) -> str:
-    """``value``'s JSON text, if it is a JSON object that reads back (:func:`~neurohover.paths.strict_json`), or one error
-    naming it: a list was stored and every later read called the store damaged, NaN was json's ValueError (T14-5)."""
-    if not isinstance(value, dict):
-        raise NeurohoverError(f"{where}: {what} = {brief(value)} is not allowed: give a dict (a JSON object)")
-    try:
-        text = json_text(value, separators=(",", ":"))  # what is written reads back: no key twice ({1: .., '1': ..}), no NaN
-    except (TypeError, ValueError, RecursionError) as err:  # JSONError is a ValueError
-        raise NeurohoverError(
-            f"{where}: {what} = {brief(value)} is not allowed: give a JSON object of text, finite numbers, bools, None, lists and such objects "
-            f"({str(err)[:80]})"
-        ) from None
-    return text
 
 
 @contextlib.contextmanager
@@ -209,7 +190,8 @@ class Store:
         return real.with_name(real.name + ".lock")
 
     def lock(self) -> None:
-        """Make this Store the file's only writer until :meth:`close` (does nothing if it already is).
+        """Make this Store the file's only writer until :meth:`close` (does nothing if it already is). Every write calls it
+        first: a second Store put and started sessions while the first held the lock (T29-B06).
 
         Two runs writing one store would each compute every unit the other has not finished yet.
         The lock is an OS advisory lock on :attr:`lock_path`, which the kernel releases when the
@@ -292,12 +274,14 @@ class Store:
         """Register experiment (name, scale) with its config hash, or check that it matches.
 
         ``fresh`` deletes the experiment's stored units and sessions first (a deliberate restart).
-        Takes the writer lock first (see :meth:`lock`).
+        Takes the writer lock first (see :meth:`lock`). ``config`` must be what the readers read: an ExperimentConfig's
+        ``to_dict()`` at ``scale``, hashing to ``config_hash`` (:func:`~.store_checks.config_problem`; T29-B07).
         """
         where = self._where("begin")
         check_experiment(name, scale, where)
         _check_text(config_hash, "config_hash", where)
         text = _object_text(config, "config", where)
+        self._check_config(config, scale, config_hash, where)
         check_flag(fresh, "fresh", "delete the experiment's stored units first")
         if not fresh:  # its row kept: a damaged one named (T22-09)
             self._check_created(name)
@@ -342,6 +326,7 @@ class Store:
         given = list(keep) if isinstance(keep, Iterable) and not isinstance(keep, (str, bytes, dict)) else None
         if given is None or not all(isinstance(k, str) for k in given):  # None was a TypeError; a text would be kept letter by letter
             raise NeurohoverError(f"{where}: keep = {brief(keep)} is not allowed: give a list or set of unit keys (text) to keep")
+        self._check_config(config, scale, config_hash, where)
         kept = set(given)
         self.lock()
         c = self.conn
@@ -486,6 +471,12 @@ class Store:
             raise NeurohoverError(f"results store {str(self.path)!r}: {what} is damaged (a JSON {type(value).__name__}, not an object)")
         return value
 
+    def _check_config(self, config: dict, scale: str, config_hash: str, where: str) -> None:
+        """Refuse a config the readers would call damaged (:func:`~.store_checks.config_problem`; T29-B07)."""
+        problem = config_problem(config, scale, config_hash)
+        if problem:
+            raise NeurohoverError(f"{where}: config = {brief(config)} is not allowed: {problem}; give the config's to_dict()")
+
     def _where(self, method: str) -> str:
         """Where a write's arguments are refused, for its messages."""
         return f"results store {str(self.path)!r}, {method}"
@@ -508,9 +499,11 @@ class Store:
         if not (finite_real(seconds) and seconds >= 0):
             raise NeurohoverError(f"{where}: seconds = {brief(seconds)} is not allowed: give a finite number of seconds >= 0")
         _check_text(worker, "worker", where, empty=True)
+        if unit.experiment != name:  # stored under another experiment's name without a word (T29-B05)
+            raise NeurohoverError(f"{where}: unit {brief(unit.key)}'s experiment = {brief(unit.experiment)} is not allowed: give a unit of {name} (its plan's)")
         if session is not None:
             session = _count(session, "session", where, 1)
-        self.check_sound()
+        self.lock()
         c = self.conn
         with _transaction(c):
             row = c.execute("SELECT config_hash FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
@@ -519,6 +512,9 @@ class Store:
                     f"refusing to record unit {unit.key!r}: experiment {name!r} ({scale}) in "
                     f"{str(self.path)!r} has config hash {row[0] if row else None}, not {config_hash}"
                 )
+            problem = "" if session is None else session_problem(c, session, (name, scale, config_hash))
+            if problem:  # another experiment's session, or an ended one, counted the unit (T29-B05)
+                raise NeurohoverError(f"{where}: {problem}")
             cur = c.execute(
                 "INSERT OR IGNORE INTO units VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                 (name, scale, unit.key, unit.kind, config_hash, params, text, float(seconds), worker, time.time()),
@@ -539,12 +535,20 @@ class Store:
         _check_text(executor, "executor", where)
         cores = _count(cores, "cores", where, 1)
         units_before = _count(units_before, "units_before", where, 0)
-        self.check_sound()
-        cur = self.conn.execute(
-            "INSERT INTO sessions (name, scale, config_hash, executor, cores, started, wall_seconds, units_run, units_before, status) "
-            "VALUES (?, ?, ?, ?, ?, ?, 0, 0, ?, 'running')",
-            (name, scale, config_hash, executor, cores, time.time(), units_before),
-        )
+        self.lock()
+        c = self.conn
+        with _transaction(c):  # a session sessions() would call damaged is refused (T29-B04)
+            problem = experiment_problem(c, name, scale, config_hash)
+            stored = c.execute("SELECT COUNT(*) FROM units WHERE name = ? AND scale = ?", (name, scale)).fetchone()[0]
+            if not problem and units_before > stored:
+                problem = f"units_before = {units_before} is not allowed: experiment {name} ({scale}) stores {stored} units"
+            if problem:
+                raise NeurohoverError(f"{where}: {problem}")
+            cur = c.execute(
+                "INSERT INTO sessions (name, scale, config_hash, executor, cores, started, wall_seconds, units_run, units_before, status) "
+                "VALUES (?, ?, ?, ?, ?, ?, 0, 0, ?, 'running')",
+                (name, scale, config_hash, executor, cores, time.time(), units_before),
+            )
         assert cur.lastrowid is not None  # an INSERT always sets it
         return cur.lastrowid
 
@@ -555,10 +559,13 @@ class Store:
         _check_text(status, "status", where)  # object() was sqlite3's ProgrammingError (T14-5)
         if status not in SESSION_STATUSES:  # free text was stored, and shown by the report as a session's end (fifteenth trial, T15-22)
             raise NeurohoverError(f"{where}: status = {brief(status)} is not allowed: give one of {', '.join(map(repr, SESSION_STATUSES))}")
-        self.check_sound()
-        cur = self.conn.execute("UPDATE sessions SET status = ?, wall_seconds = ? - started WHERE id = ?", (status, time.time(), session))
-        if cur.rowcount == 0:  # an id start_session never gave matched nothing, without a word (T15-22)
-            raise NeurohoverError(f"{where}: session = {session} is not allowed: {str(self.path)!r} has no such session (start_session gives the id)")
+        self.lock()
+        c = self.conn
+        with _transaction(c):  # an id start_session never gave (T15-22), or a session already ended (T29-B05)
+            problem = session_problem(c, session)
+            if problem:
+                raise NeurohoverError(f"{where}: {problem}")
+            c.execute("UPDATE sessions SET status = ?, wall_seconds = ? - started WHERE id = ?", (status, time.time(), session))
 
     def sessions(self, name: str, scale: str) -> list[dict]:
         cols = ("id", "executor", "cores", "started", "wall_seconds", "units_run", "units_before", "status")

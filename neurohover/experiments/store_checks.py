@@ -4,8 +4,11 @@ writes (kept apart from the store's own module, which holds its reads and writes
 from __future__ import annotations
 
 import sqlite3
+from typing import Any
 
-from ..errors import brief, finite_real, whole_number
+from ..errors import NeurohoverError, brief, finite_real, whole_number
+from ..paths import json_text
+from .config import ExperimentConfig
 
 #: How a session can end (:meth:`Store.end_session`; the runner's statuses). A session is "running" until then.
 SESSION_STATUSES = ("finished", "selection finished", "interrupted", "failed")
@@ -46,3 +49,91 @@ def bad_session(session: dict, stored: int) -> str:
         counts = f"units_before {session['units_before']} and units_run {session['units_run']}"
         return f"{counts} are not allowed: together at most the {stored} units the experiment stores"
     return ""
+
+
+def read_config(stored: Any, scale: str) -> ExperimentConfig:
+    """The experiment config a store row at ``scale`` holds (:meth:`ExperimentConfig.from_dict`), or one NeurohoverError
+    naming what is wrong with it: what every reader (``results``, ``report``, reproduce's check) and :meth:`Store.begin`
+    require, so the store never takes a config its readers call damaged (T29-B07)."""
+    config = ExperimentConfig.from_dict(stored)
+    if config.scale != scale:  # a quick config under a 'paper' row was reported as the paper's claims (T21-01)
+        raise NeurohoverError(f"its row is at scale {scale!r} but its config is the {brief(config.scale)} one")
+    return config
+
+
+def hash_problem(held: Any, stored: dict, config: ExperimentConfig) -> str:
+    """Why the config hash ``held`` of an experiment row cannot be its config's (``stored``, read as ``config``), or '':
+    a config_hash set to 'deadbeef' was exported and reported (T20-04); the readers and :meth:`Store.begin` refuse it."""
+    if held != config.hash or stored.get("hash") != held:
+        return (
+            f"its config hashes to {config.hash}, but the store records config hash {brief(held)} (its config: {brief(stored.get('hash'))}): "
+            "the config or its hash was changed after its units were run, or another version of neurohover wrote it, so its units "
+            "cannot be told to be this config's (reproduce --fresh runs it again)"
+        )
+    return ""
+
+
+def config_problem(config: dict, scale: str, config_hash: str) -> str:
+    """Why :meth:`Store.begin` or :meth:`Store.update` cannot store ``config`` under ``config_hash`` at ``scale``, or '':
+    what :func:`read_config` and :func:`hash_problem` would later call damaged (any JSON object was taken; T29-B07)."""
+    try:
+        return hash_problem(config_hash, config, read_config(config, scale))
+    except NeurohoverError as err:
+        return str(err).removeprefix("a stored experiment config is damaged: ")
+
+
+def experiment_problem(conn: sqlite3.Connection, name: str, scale: str, config_hash: str) -> str:
+    """Why a session of experiment (name, scale) under ``config_hash`` cannot be recorded, or '': the store holds no
+    such experiment, or holds it under another config hash (the store's own sessions() called such rows damaged; T29-B04)."""
+    row = conn.execute("SELECT config_hash FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
+    if row is None:
+        return f"the store holds no experiment {brief(name)} ({scale}): begin registers it first"
+    if row[0] != config_hash:
+        return f"config_hash = {brief(config_hash)} is not allowed: experiment {name} ({scale}) has config hash {brief(row[0])}"
+    return ""
+
+
+def session_problem(conn: sqlite3.Connection, session: int, of: tuple[str, str, str] | None = None) -> str:
+    """Why session ``session`` cannot count a unit of experiment ``of`` (name, scale, config hash; None: end_session's
+    any), or end, or '': the store has no such session, it is another experiment's (or another config's),
+    or it has already ended (the store's own sessions() called the counts damaged; T29-B05)."""
+    row = conn.execute("SELECT name, scale, config_hash, status FROM sessions WHERE id = ?", (session,)).fetchone()
+    if row is None:
+        return f"session = {session} is not allowed: the store has no such session (start_session gives the id)"
+    if of is not None and tuple(row[:3]) != of:
+        return (
+            f"session = {session} is not allowed: it is a session of experiment {brief(row[0])} ({brief(row[1])}) under config hash "
+            f"{brief(row[2])}, not of {of[0]} ({of[1]}) under {of[2]}"
+        )
+    if row[3] != "running":
+        return f"session = {session} is not allowed: it has already ended ({brief(row[3])}); start_session gives a running one"
+    return ""
+
+
+def _check_text(value: Any, what: str, where: str, empty: bool = False) -> None:
+    """Refuse a stored text field that is no text, empty (unless ``empty``) or holding NUL (None was an IntegrityError)."""
+    if not isinstance(value, str) or (not value and not empty) or "\x00" in value:
+        allowed = "text" if empty else "non-empty text"
+        raise NeurohoverError(f"{where}: {what} = {brief(value)} is not allowed: give {allowed} without NUL characters")
+
+
+def _count(value: Any, what: str, where: str, least: int) -> int:
+    """``value`` as an int of at least ``least``, or one error naming it (cores=0 was stored, and read back as damaged)."""
+    if not whole_number(value) or value < least:
+        raise NeurohoverError(f"{where}: {what} = {brief(value)} is not allowed: give a whole number >= {least}")
+    return int(value)
+
+
+def _object_text(value: Any, what: str, where: str) -> str:
+    """``value``'s JSON text, if it is a JSON object that reads back (:func:`~neurohover.paths.strict_json`), or one error
+    naming it: a list was stored and every later read called the store damaged, NaN was json's ValueError (T14-5)."""
+    if not isinstance(value, dict):
+        raise NeurohoverError(f"{where}: {what} = {brief(value)} is not allowed: give a dict (a JSON object)")
+    try:
+        text = json_text(value, separators=(",", ":"))  # what is written reads back: no key twice ({1: .., '1': ..}), no NaN
+    except (TypeError, ValueError, RecursionError) as err:  # JSONError is a ValueError
+        raise NeurohoverError(
+            f"{where}: {what} = {brief(value)} is not allowed: give a JSON object of text, finite numbers, bools, None, lists and such objects "
+            f"({str(err)[:80]})"
+        ) from None
+    return text
