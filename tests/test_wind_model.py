@@ -14,7 +14,7 @@ from neurohover import baseline_policy, evaluate, get_task_family
 from neurohover.agents.model_based import ModelEvolution
 from neurohover.cli import main
 from neurohover.errors import NeurohoverError
-from neurohover.experiments.config import load_config
+from neurohover.experiments.config import load_config, make_config
 from neurohover.experiments.plans import plan
 from neurohover.experiments.units import unit_agent
 from neurohover.models import LearnedModel, learn_lr, one_step_error, one_substep_params
@@ -144,7 +144,8 @@ def test_agents_and_experiment_groups_take_the_wind_model() -> None:
     assert all("wind_model" not in u.params for u in units)  # unchanged plans: no key for the default
     groups = [dict(g) for g in base.settings["groups"]]
     group = groups[1] = dict(groups[1], wind_model="sinusoid")  # the incremental agent
-    cfg = load_config("fig8", "quick", {"policies": "shipped", "groups": groups})
+    own = {k: v for k, v in base.settings.items() if k != "policy_budget"}  # a config of its own: --set may not change a shipped group (T29-A02)
+    cfg = make_config("windy-fig8", "test_runs", "quick", {**own, "groups": groups})
     windy_units = [u for u in plan(cfg, {}).units if u.params.get("group") == group["label"]]
     assert windy_units and all(u.params["wind_model"] == "sinusoid" for u in windy_units)
     agent = unit_agent(windy_units[0].params)

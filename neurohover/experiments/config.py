@@ -378,6 +378,10 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
     )
     check_paper(raw.get("paper", {}), raw, where)  # after the settings: a bad agent is named as such, not as a t test naming nothing
     _check_seeds_of(config, where)
+    if overrides and not own:  # the report would judge other conditions against the paper's claims (T29-A02)
+        from .overrides import check_shipped_overrides
+
+        check_shipped_overrides(raw["name"], str(path), load_config(str(path), scale).settings, config.settings, f"{where} at scale {scale!r}")
     return config
 
 

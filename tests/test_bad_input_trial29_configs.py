@@ -1,0 +1,38 @@
+"""Trial 29a's findings on experiment configs, settings hashes and the FGHH policy sets (T29-A02, T29-A05, T29-A07, T29-A08)."""
+
+from __future__ import annotations
+
+import pytest
+
+from neurohover.errors import NeurohoverError
+from neurohover.experiments.config import load_config
+
+
+@pytest.mark.parametrize(
+    ("name", "overrides", "named"),
+    [
+        ("fig7", {"task": "ghh09"}, "changes task from 'ghh08' to 'ghh09'"),
+        ("table4", {"task": "ghh09"}, "changes task from 'ghh08' to 'ghh09'"),
+        ("fig8", {"task": "ghh08"}, "changes task from 'ghh09' to 'ghh08'"),
+        ("fig12", {"sigma": 0.3}, "changes sigma from 0.2 to 0.3"),
+        ("fig7", {"groups": [{"agent": "model-free", "mdps": "train", "n_mdps": 2}, {"agent": "incremental", "n_mdps": 2}]}, "the mdps of group 'model-free'"),
+    ],
+)
+def test_a_set_that_changes_what_the_papers_claims_are_about_is_refused(name, overrides, named, cli, tmp_path) -> None:
+    """T29-A02: `reproduce fig7 --set task="ghh09"` ran GHH-09 under fig7's GHH-08 title and judged it against the
+    paper's GHH-08 t tests ("reversed"); an override of a shipped experiment's conditions is refused by name."""
+    with pytest.raises(NeurohoverError, match=f"{named}.*not allowed for the shipped experiment '{name}'.*config of your own: copy "):
+        load_config(name, "quick", overrides)
+    rc, _, err = cli("reproduce", "fig7", "--store", str(tmp_path / "s.sqlite"), "--set", 'task="ghh09"')
+    assert rc == 2 and "changes task from 'ghh08' to 'ghh09'" in err and not (tmp_path / "s.sqlite").exists()
+
+
+def test_a_set_of_scale_seed_or_policy_source_stays_allowed() -> None:
+    """T29-A02: what stays allowed: how much is run (the trial's episodes, n_steps, groups of fewer MDPs), the seed,
+    the policy source, and a condition set to the shipped value."""
+    groups = [{"agent": a, "mdps": "test", "n_mdps": 2} for a in ("model-free", "model-based", "incremental")]
+    small = {"episodes": 3, "n_steps": 20, "max_learning_episodes": 2, "model_budget": 10, "policies": "shipped", "seed": 7, "task": "ghh08"}
+    cfg = load_config("fig7", "quick", {**small, "groups": groups})
+    assert cfg.settings["task"] == "ghh08" and [g["n_mdps"] for g in cfg.settings["groups"]] == [2, 2, 2]
+    assert load_config("fig12", "quick", {"runs": 2, "budget": 40, "sigma": 0.2}).settings["runs"] == 2
+    assert load_config("fig16", "quick", {"generics_from": {}}).settings["generics_from"] == {}
