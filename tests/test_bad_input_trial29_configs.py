@@ -36,3 +36,26 @@ def test_a_set_of_scale_seed_or_policy_source_stays_allowed() -> None:
     assert cfg.settings["task"] == "ghh08" and [g["n_mdps"] for g in cfg.settings["groups"]] == [2, 2, 2]
     assert load_config("fig12", "quick", {"runs": 2, "budget": 40, "sigma": 0.2}).settings["runs"] == 2
     assert load_config("fig16", "quick", {"generics_from": {}}).settings["generics_from"] == {}
+
+
+def test_a_set_of_another_sigma_names_advice_that_can_be_followed(cli, tmp_path) -> None:
+    """T29-A05: compete at an FGHH sigma other than the shipped set's said "build one for this sigma", but nothing builds
+    a set for another sigma; it names what does fly there: the set's sigma, an agent of no set, or a config evolving its own."""
+    from neurohover.agents.registry import check_agent
+    from neurohover.tasks import get_task_family
+
+    with pytest.raises(NeurohoverError, match=r"build-policies builds fghh sets for sigma = 0.3 only: .*\(baseline\).*sigma = 0.2 and policies = \"evolve\""):
+        check_agent("authors-fixed", get_task_family("fghh", 0.2))
+    rc, _, err = cli("compete", "--task", "fghh", "--agent", "generic", "--runs", "1", "--episodes", "2", "--sigma", "0.2", "--out", str(tmp_path / "g"))
+    assert rc == 2 and "build one for this sigma" not in err and 'policies = "evolve"' in err
+
+
+def test_evaluate_agent_notes_a_generic_of_another_sigma(cli) -> None:
+    """T29-A08: evaluate-agent --task fghh --sigma 0.2 flew the shipped sigma-0.3 generic as "generic" without a word,
+    where compete refuses that set; the row stays (a reference), with a note naming both sigmas."""
+    args = ("evaluate-agent", "--task", "fghh", "--policy", "baseline", "--n-mdps", "1", "--episode-steps", "5")
+    rc, out, err = cli(*args, "--sigma", "0.2")
+    assert rc == 0 and "generic" in out
+    assert "note: the generic row flies the shipped fghh generic, evolved for sigma = 0.3, not 0.2" in err
+    rc, _, err = cli(*args)
+    assert rc == 0 and "note" not in err

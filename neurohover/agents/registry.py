@@ -77,9 +77,14 @@ def _policy_set(family: TaskFamily, policy_dir: str | None) -> PolicySet:
     ps = load_policy_set(family.name, policy_dir)
     built = ps.manifest.get("sigma")
     if family.sigma is not None and family.generic_over_distribution and built is not None and float(built) != family.sigma:
+        idle = ", ".join(name for name, s in AGENTS.items() if not s.needs and s.applies_to(family))
+        builds = get_task_family(family.name).sigma  # the sigma build-policies evolves the set's generics at
+        # "build one for this sigma" could not be followed: build-policies evolves FGHH's generics at its family's sigma only (T29-A05)
         raise NeurohoverError(
-            f"the {family.name} policy set in {str(ps.directory)!r} was evolved for sigma = {built}, "
-            f"not {family.sigma}: build one for this sigma and give its directory (--policy-dir)"
+            f"the {family.name} policy set in {str(ps.directory)!r} was evolved for sigma = {built}, not {family.sigma}, and "
+            f"build-policies builds {family.name} sets for sigma = {builds} only: fly sigma = {built}, or an agent that flies no policy set "
+            f"({idle}), or run a test-runs experiment config of your own with task = {family.name!r}, sigma = {family.sigma} and "
+            f'policies = "evolve" (it evolves its own generics at that sigma; `neurohover reproduce MY.toml`)'
         )
     return ps
 

@@ -109,6 +109,22 @@ def _files_read(args: argparse.Namespace) -> dict[str, str | Path | None]:
 ROWS_KIND, ROWS_ARE = "evaluate-agent rows (--json)", "evaluate-agent writes its rows as JSON"
 
 
+def _generic_sigma_note(family) -> str | None:
+    """Why the ``generic`` row is no generic of ``family``'s sigma, or None: the shipped FGHH generic was evolved over G at
+    the set's sigma. Flown with this note (an evaluation, not a competition), where compete refuses the set (T29-A08)."""
+    if not family.generic_over_distribution or family.sigma is None:
+        return None
+    from ..policysets import load_policy_set
+
+    built = load_policy_set(family.name).manifest.get("sigma")
+    if built is None or float(built) == family.sigma:
+        return None
+    return (
+        f"the generic row flies the shipped {family.name} generic, evolved for sigma = {built}, not {family.sigma} (the sigma of these MDPs): "
+        "a reference only (compete refuses that set at this sigma)"
+    )
+
+
 def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     """Fly a trained policy on full paper episodes of a task's training or test MDPs, beside the competition's baseline
     and the shipped generic policy on the same gusts, and print the paper's measures (return per episode, crashes)."""
@@ -150,6 +166,9 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     print(f"{'policy':<10} {'return/episode':>15} {'median over MDPs':>17} {'crashed':>12}")
     for r in rows:
         print(f"{r.name:<10} {r.return_per_episode:>15.6g} {r.median_over_mdps:>17.6g} {f'{r.crashes} of {r.episodes}':>12}")
+    note = _generic_sigma_note(family)
+    if note is not None:
+        print(f"neurohover evaluate-agent: note: {note}", file=sys.stderr)
     if out is not None:
         with writing(out, "--json") as path:
             path.write_text(json.dumps({"task": args.task, "mdps": args.mdps, "n_mdps": n, "episodes": args.episodes, "seed": args.seed,
