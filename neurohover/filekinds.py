@@ -19,14 +19,19 @@ from .errors import NeurohoverError, brief
 __all__ = [
     "CSV_KINDS",
     "JSON_KINDS",
+    "NAME_MAX",
     "PNG_KIND",
     "PNG_SIGNATURE",
     "REPORT_HEADER",
     "REPORT_KIND",
+    "POLICY_SET_KIND",
     "RUN_FILE_ENDS",
     "SQLITE_HEADER",
+    "fitting_name",
     "held_kind",
+    "name_limit",
     "output_name",
+    "refuse_policy_set",
     "refuse_run_file_name",
     "refuse_suffix",
 ]
@@ -47,7 +52,8 @@ JSON_KINDS: dict[str, Callable[[dict], bool]] = {
     "a model file": lambda d: str(d.get("format", "")).startswith("neurohover-model/"),
     "an evolution checkpoint": lambda d: str(d.get("format", "")).startswith("neurohover-evolution-checkpoint/"),
     "a competition summary (summary.json)": lambda d: {"experiment", "agent", "task", "runs"} <= d.keys(),
-    "a policy set's manifest": lambda d: {"built", "optimizer"} <= d.keys() and "rows" not in d,
+    # every manifest build-policies writes (a default build's has no "optimizer"; T29-A04), and the shipped sets'
+    "a policy set's manifest": lambda d: {"task", "budget", "seed", "n_steps", "built"} <= d.keys() and "rows" not in d,
     "evaluate-agent rows (--json)": lambda d: {"rows", "n_mdps", "episode_steps"} <= d.keys(),
     "a results export (results --format json)": lambda d: {"experiment", "config_hash", "units"} <= d.keys(),
 }
@@ -59,6 +65,7 @@ CSV_KINDS: dict[str, frozenset[str]] = {
     "an evolution history (.history.csv)": frozenset({"generation", "evaluations", "episodes", "champion_return"}),
     "a results export (results --format csv)": frozenset({"experiment", "scale", "key", "kind"}),
 }
+POLICY_SET_KIND = "a policy set's manifest"  # what held_kind calls a set's manifest.json: no other writer adds files beside it
 _KIND_READ_LIMIT = 64 * 2**20  # a larger file is no neurohover JSON file told apart here
 
 
@@ -99,6 +106,37 @@ def held_kind(path: str | os.PathLike) -> str | None:
 RUN_FILE_ENDS = {".checkpoint.json": "checkpoint (which --resume continues)", ".history.csv": "history (one line per new champion or generation)"}
 
 
+#: The longest name of one file or directory in bytes where the file system cannot say (Linux's NAME_MAX).
+NAME_MAX = 255
+
+
+def name_limit(path: str | os.PathLike) -> int:
+    """The longest name in bytes that the file system holding ``path`` takes (``PC_NAME_MAX`` of its nearest existing
+    directory), :data:`NAME_MAX` where it cannot say."""
+    try:
+        here = Path(os.path.abspath(path))
+    except (OSError, ValueError):  # the working directory is gone
+        return NAME_MAX
+    for directory in (here, *here.parents):
+        try:
+            if directory.is_dir():
+                limit = os.pathconf(directory, "PC_NAME_MAX")
+                return limit if limit > 0 else NAME_MAX
+        except (OSError, ValueError):  # a part too long itself, no such setting here
+            continue
+    return NAME_MAX
+
+
+def fitting_name(name: str, limit: int, room: int = 0) -> str:
+    """``name`` with the end of its stem cut (its suffix kept) until it and ``room`` more bytes (the longest end a
+    command adds to it) fit ``limit`` bytes: a name suggested in a message is one the command then takes (T29-A01)."""
+    suffix = Path(name).suffix
+    stem = name[: len(name) - len(suffix)]
+    while stem and len(os.fsencode(stem + suffix)) + room > limit:
+        stem = stem[:-1]
+    return stem + suffix
+
+
 def refuse_run_file_name(path: str, option: str) -> None:
     """Refuse a name ``path`` ending (any case) one of :data:`RUN_FILE_ENDS`, naming it as ``option``: the one message
     of every output that may not replace an evolve run's checkpoint or history."""
@@ -110,25 +148,43 @@ def refuse_run_file_name(path: str, option: str) -> None:
         )
 
 
-def output_name(path: object, option: str, suffixes: tuple[str, ...], what: str, run_files: bool = False) -> None:
+def output_name(path: object, option: str, suffixes: tuple[str, ...], what: str, run_files: bool = False, ends: tuple[str, ...] = ()) -> None:
     """Refuse a name ``path`` whose suffix (any case) is none of ``suffixes``, naming ``option`` and ``what`` the output
     is ("evaluate-agent's rows are JSON"), and (``run_files``) a name of an evolve run's own files
     (:func:`refuse_run_file_name`); what is no path is :func:`output_file`'s to refuse. evaluate-agent --json f.npz wrote
     JSON over flight data (T25-01), results --out f.npz CSV (T25-02), learn-model --out P.checkpoint.json a model over
-    evolve's checkpoint (T25-03)."""
+    evolve's checkpoint (T25-03). ``ends``: what the command adds to the name for files beside it (:func:`refuse_suffix`)."""
     text = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None
     if not isinstance(text, str) or text in ("", "-") or text.endswith(("/", os.sep)) or Path(text).is_dir():
         return
     if run_files:
         refuse_run_file_name(text, option)
     if suffixes != ("",):
-        refuse_suffix(text, option, suffixes, what, f"out{suffixes[0]}")
+        refuse_suffix(text, option, suffixes, what, f"out{suffixes[0]}", ends)
 
 
-def refuse_suffix(path: str, option: str, suffixes: tuple[str, ...], what: str, example: str) -> None:
+def refuse_suffix(path: str, option: str, suffixes: tuple[str, ...], what: str, example: str, ends: tuple[str, ...] = ()) -> None:
     """Refuse a file name ``path`` whose suffix (any case) is none of ``suffixes``, naming it as ``option``, saying
     ``what`` the file is ("a model file is JSON") and the name with the first suffix (``example`` where ``path`` has no
-    file name): the one message of output names (:func:`output_name`), flight data, model and policy files."""
+    file name), shortened where it, or it with the longest of ``ends`` (what the command adds to it for the files it
+    writes beside it: evolve's :data:`RUN_FILE_ENDS`), would be too long (:func:`fitting_name`): the one message of
+    output names (:func:`output_name`), flight data, model and policy files."""
     if Path(path).suffix.lower() not in suffixes:
         like = str(Path(path).with_suffix(suffixes[0])) if Path(path).name else example
+        if Path(path).name:
+            room = max((len(os.fsencode(end)) for end in ends), default=0)
+            like = str(Path(like).with_name(fitting_name(Path(like).name, name_limit(Path(like).parent), room)))
         raise NeurohoverError(f"{option} {brief(path)} is not allowed: {what}; give a path ending {' or '.join(suffixes)} (e.g. {brief(like)})")
+
+
+def refuse_policy_set(directory: Path, option: str, given: str | os.PathLike) -> None:
+    """Refuse to write ``given`` (``option``) into ``directory`` where it holds a policy set's manifest.json: a set holds
+    only the files its build wrote, and compete --policy-dir refused a set that compete --out, evaluate-agent --json or
+    evolve --out had written into (T29-A06). build-policies writes its sets through a directory of its own."""
+    manifest = directory / "manifest.json"
+    if held_kind(manifest) == POLICY_SET_KIND:
+        where = "is" if Path(given) == directory else f"is in {brief(str(directory))}, which is"
+        raise NeurohoverError(
+            f"{option} {brief(os.fspath(given))} {where} a policy set's directory (its manifest.json): a set holds only "
+            "what build-policies writes, and compete --policy-dir refuses one with other files; give another directory"
+        )

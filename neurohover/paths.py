@@ -25,7 +25,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .errors import NeurohoverError, OutputError, brief, float_of
-from .filekinds import PNG_KIND, SQLITE_HEADER, held_kind, output_name
+from .filekinds import NAME_MAX, PNG_KIND, SQLITE_HEADER, fitting_name, held_kind, name_limit, output_name, refuse_policy_set
 
 try:
     import fcntl
@@ -129,13 +129,17 @@ def refuse_dangling_link(path: str | os.PathLike, option: str, given: str | os.P
         )
 
 
-#: The longest name of one file or directory, and of a whole path, in bytes (Linux's NAME_MAX and PATH_MAX).
-NAME_MAX, PATH_MAX = 255, 4096
+#: The longest whole path in bytes (Linux's PATH_MAX); the longest name, :data:`~neurohover.filekinds.NAME_MAX`, is
+#: where the file system cannot say (:func:`~neurohover.filekinds.name_limit`).
+PATH_MAX = 4096
 
 
-def checked_path(path, option: str, what: str = "file path") -> Path:
+def checked_path(path, option: str, what: str = "file path", ends: tuple[str, ...] = ()) -> Path:
     """``path`` (a str or path object) as a Path: empty, another type, a NUL byte or a name longer than the file system
-    takes refused by name (the OS's TypeError, ValueError and OSError before); ``what`` says what to give instead."""
+    takes refused by name (the OS's TypeError, ValueError and OSError before); ``what`` says what to give instead.
+    ``ends``: what the command adds to the file's name for the files it writes beside it (evolve's ``NAME.history.csv``
+    and ``NAME.checkpoint.json``), whose longest must fit too: a name of 250 bytes was taken, and the run's history file
+    then refused (T29-A01)."""
     if not isinstance(path, (str, os.PathLike)):
         raise NeurohoverError(f"{option}={path!r:.60} is not allowed: give a {what}")
     text = os.fspath(path)
@@ -146,12 +150,18 @@ def checked_path(path, option: str, what: str = "file path") -> Path:
     if "\x00" in text:
         raise NeurohoverError(f"{option} {text!r:.80} holds a NUL character: give a {what}")
     refuse_gone_cwd(text, option)
-    longest = max(Path(text).parts, key=lambda part: len(os.fsencode(part)), default="")  # "." has no parts (fifth trial)
-    if len(os.fsencode(longest)) > NAME_MAX or len(os.fsencode(text)) > PATH_MAX:
-        shown = repr(text) if len(text) <= 80 else repr(text[:40]) + " ... " + repr(text[-20:])
+    parts = Path(text).parts  # "." has no parts (fifth trial)
+    end = max(ends, key=lambda e: len(os.fsencode(e)), default="")
+    sizes = [len(os.fsencode(part)) for part in parts]
+    if sizes and end and parts[-1] != os.sep:
+        sizes[-1] += len(os.fsencode(end))
+    longest, whole = max(sizes, default=0), len(os.fsencode(text + end))
+    limit = name_limit(Path(text).parent) if longest > 14 else NAME_MAX  # (no file system takes fewer than 14)
+    if longest > limit or whole > PATH_MAX:
+        beside = f" with the {end} it writes beside it" if end and sizes[-1] == longest and longest > limit else ""
         raise NeurohoverError(
-            f"{option} {shown} is too long: at most {NAME_MAX} bytes in one file or directory name "
-            f"(here {len(os.fsencode(longest)):,}) and {PATH_MAX} in the whole path (here {len(os.fsencode(text)):,})"
+            f"{option} {brief(text)} is too long: at most {limit} bytes in one file or directory name "
+            f"(here {longest:,}{beside}) and {PATH_MAX} in the whole path (here {whole:,})"
         )
     refuse_link_loop(text, option)
     return Path(text)
@@ -272,6 +282,7 @@ def output_file(
     suffixes: tuple[str, ...] = (),
     what: str = "",
     run_files: bool = False,
+    ends: tuple[str, ...] = (),
 ) -> Path:
     """Check that the file ``path`` can be written (an existing file is kept as it is).
 
@@ -281,11 +292,13 @@ def output_file(
     destroy what the command reads) and, unless ``store`` (the path is a results store's own), an existing results
     store; given the ``kind`` of file written (one of :data:`~neurohover.filekinds.JSON_KINDS`' names), an existing neurohover file of
     another kind (:func:`~neurohover.filekinds.held_kind`; T25-01 to T25-03), and a name of a suffix not in ``suffixes`` (``what`` says why) or
-    (``run_files``) an evolve run's own file names (:func:`~neurohover.filekinds.output_name`);
+    (``run_files``) an evolve run's own file names (:func:`~neurohover.filekinds.output_name`), a name too long for the
+    file system, it or it with the longest of ``ends`` (what the command adds to it for files beside it:
+    :func:`checked_path`), and a file in a policy set's directory (:func:`~neurohover.filekinds.refuse_policy_set`);
     creates missing parent directories (saying so on standard error).
     """
     _no_dash(path, option, "file", stdout)
-    p = checked_path(path, option)
+    p = checked_path(path, option, ends=ends)
     for name, given in (inputs or {}).items():
         if given is not None and str(given) != "" and p.exists() and Path(given).exists() and p.samefile(given):
             raise NeurohoverError(f"{option} {str(path)!r} is the file of {name}: give another path (writing it would destroy what is read)")
@@ -303,7 +316,8 @@ def output_file(
         raise NeurohoverError(f"{option} {str(path)!r} ends in '/', which names a directory: give a file path")
     refuse_special_file(p, option, path)
     if suffixes or run_files:  # flight data, a checkpoint replaced by JSON rows, CSV or a model (T25-01 to T25-03)
-        output_name(path, option, suffixes or ("",), what, run_files)
+        output_name(path, option, suffixes or ("",), what, run_files, ends)
+    refuse_policy_set(p.parent, option, path)
     held = None if kind is None else held_kind(p)
     if held is not None and held != kind:  # a policy, a checkpoint, a summary replaced by another kind of file (T25-01 to T25-03)
         raise NeurohoverError(f"{option} {brief(os.fspath(path))} is {held}: give another path (writing {kind} there would destroy it)")
@@ -367,7 +381,8 @@ def writing(path: str | os.PathLike, option: str) -> Iterator[Path]:
     refuse_dangling_link(path, option)  # every writer: one to nothing wrote wherever it pointed (T19-12)
     p = Path(os.path.realpath(path))  # through a symbolic link: its file is written, the link kept (not replaced by a file)
     refuse_special_file(p, option, path)  # every writer, not only those checked by output_file first (fourteenth trial)
-    partial = p.with_name(f".{p.name}.{os.getpid()}.partial")
+    tail = f".{os.getpid()}.partial"  # the name cut where the file's own fits and this one would not (T29-A01)
+    partial = p.with_name("." + fitting_name(p.name, name_limit(p.parent), len(os.fsencode(tail)) + 1) + tail)
     try:
         yield partial
         refuse_special_file(p, option, path)  # made while the block ran
@@ -389,11 +404,13 @@ def write_png(fig, path: str | os.PathLike, what: str, dpi: float | None = None)
 
 def output_dir(path: str | os.PathLike, option: str) -> Path:
     """Check that files can be written in the directory ``path`` (not ``-``), creating it (saying so) if missing; a
-    symbolic link to a missing target and a '..' after a missing directory are refused (:func:`make_dirs`)."""
+    symbolic link to a missing target and a '..' after a missing directory are refused (:func:`make_dirs`), and so is a
+    policy set's directory (:func:`~neurohover.filekinds.refuse_policy_set`)."""
     _no_dash(path, option, "directory", False)
     p = checked_path(path, option, "directory")
     if p.exists() and not p.is_dir():
         raise NeurohoverError(f"{option} {str(path)!r} is a file; give a directory")
+    refuse_policy_set(p, option, path)
     make_dirs(p, option, str(path))
     try:
         with tempfile.TemporaryFile(dir=p):

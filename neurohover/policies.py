@@ -309,7 +309,7 @@ def utf8_text(data: bytes, name: str, what: str) -> str:
 POLICY_SUFFIX = ".json"
 
 
-def check_json_policy_name(path: object, option: str) -> None:
+def check_json_policy_name(path: object, option: str, ends: tuple[str, ...] = ()) -> None:
     """Refuse a name a policy file may not be written under, naming it as ``option``: evolve checks its ``--out`` with
     this before it evolves (refused only at the save, the run was lost), :func:`save_policy` before it writes.
 
@@ -322,10 +322,18 @@ def check_json_policy_name(path: object, option: str) -> None:
       ``--out FILE`` (``FILE.checkpoint.json``, ``FILE.history.csv``), which a policy overwrote, and that run could no longer
       be resumed (T24-01). A policy named ``x.checkpoint.json`` is refused with them: its name cannot be told from theirs.
 
+    A name too long for the file system, it or it with the longest of ``ends`` (evolve's ``FILE.checkpoint.json``
+    beside it), is refused first (:func:`neurohover.paths.checked_path`): it was a bare "File name too long", and a
+    name suggested for one without a suffix was then too long for the run's history file (T29-A01).
+
     What is no path, ``''``, a name ending in a slash and a directory are left to :func:`neurohover.paths.output_file`
     to refuse, in its words."""
+    from .paths import checked_path
+
     text = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None
-    if not isinstance(text, str) or text == "" or text.endswith(("/", os.sep)) or Path(text).is_dir():
+    if not isinstance(text, str) or text == "" or text.endswith(("/", os.sep)):
+        return
+    if Path(checked_path(text, option, ends=ends)).is_dir():
         return
     if Path(text).suffix == ".net":
         raise NeurohoverError(
@@ -336,7 +344,7 @@ def check_json_policy_name(path: object, option: str) -> None:
 
     refuse_run_file_name(text, option)  # another run's checkpoint or history was overwritten by a policy (T24-01)
     # f.npz, q.txt: flight data and other files were overwritten (T24-01)
-    refuse_suffix(text, option, (POLICY_SUFFIX,), "a policy file is JSON", f"policy{POLICY_SUFFIX}")
+    refuse_suffix(text, option, (POLICY_SUFFIX,), "a policy file is JSON", f"policy{POLICY_SUFFIX}", ends)
 
 
 def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:

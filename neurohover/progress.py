@@ -1,12 +1,15 @@
 """The one progress bar of every command: tqdm on standard error, drawn only on a terminal, and drawn on a terminal that
-reports no width too (T19-11)."""
+reports no width too (T19-11). A bar that is not drawn is a stand-in that never imports tqdm, and a TQDM_* environment
+variable tqdm cannot read is refused by name (T29-A03)."""
 
 from __future__ import annotations
 
 import os
 import sys
 
-__all__ = ["UNSIZED_COLUMNS", "progress_bar"]
+from .errors import NeurohoverError
+
+__all__ = ["UNSIZED_COLUMNS", "check_progress_variables", "progress_bar"]
 
 #: How wide a progress bar is drawn on a terminal that reports no width.
 UNSIZED_COLUMNS = 80
@@ -16,14 +19,90 @@ def progress_bar(**settings):
     """A tqdm progress bar (``settings``: tqdm's) on standard error unless ``file`` says otherwise, shown only when
     that stream is a terminal (``disable=None``, tqdm's own test, unless given). On a terminal that reports no width, a
     pseudo-terminal nobody sized (``script``, ``docker exec -t``), it is drawn :data:`UNSIZED_COLUMNS` wide: tqdm drew
-    nothing there, and learn-model and evolve sat silent for minutes (T19-11)."""
-    from tqdm import tqdm
-
+    nothing there, and learn-model and evolve sat silent for minutes (T19-11). A bar not drawn (``disable=True``, or
+    ``None`` off a terminal) is a :class:`_Quiet` stand-in: tqdm is not imported, nor are its TQDM_* variables read."""
     stream = settings.pop("file", sys.stderr)
     settings.setdefault("disable", None)
+    if settings["disable"] or (settings["disable"] is None and not _terminal(stream)):
+        return _Quiet(stream, settings.get("iterable"), settings.get("total"), settings.get("initial", 0))
+    tqdm = _tqdm()
     if _unsized_terminal(stream):
         settings.update(ncols=UNSIZED_COLUMNS, nrows=24, dynamic_ncols=False)
     return tqdm(file=stream, **settings)
+
+
+def check_progress_variables() -> None:
+    """Refuse a TQDM_* environment variable that tqdm cannot read (:func:`_tqdm`), before a command does any work; nothing
+    is imported where none is set."""
+    if any(name.startswith("TQDM_") for name in os.environ):
+        _tqdm()
+
+
+def _tqdm():
+    """tqdm's bar class, a TQDM_* variable it cannot read refused by name: tqdm converts each TQDM_<PARAMETER> to its
+    parameter's type as it imports, and TQDM_MININTERVAL=abc was its ValueError's traceback from fly, evolve, compete,
+    learn-model, reproduce (--no-progress too) and report (T29-A03)."""
+    try:
+        from tqdm import tqdm
+    except ValueError as err:
+        given = {name: value for name, value in os.environ.items() if name.startswith("TQDM_")}
+        bad = [name for name, value in given.items() if repr(value) in str(err)] or list(given)
+        names = " or ".join(f"{name}={given[name]!r:.40}" for name in bad)
+        raise NeurohoverError(
+            f"environment variable {names} is not allowed: tqdm (the progress bar) cannot read it ({str(err):.80}); "
+            "give what tqdm's docs allow (a number for TQDM_MININTERVAL, TQDM_POSITION and the like), or unset it"
+        ) from None
+    return tqdm
+
+
+class _Quiet:
+    """A progress bar that draws nothing: what the commands use of tqdm's (``update``, ``n``, ``total``, ``refresh``,
+    ``set_description_str``, ``set_postfix_str``, ``write``, ``close``, iteration and ``with``), without tqdm."""
+
+    def __init__(self, stream, iterable=None, total=None, initial=0) -> None:
+        self.stream, self.iterable, self.total, self.n = stream, iterable, total, initial
+
+    def __iter__(self):
+        for item in self.iterable if self.iterable is not None else ():
+            yield item
+            self.n += 1
+
+    def __enter__(self) -> _Quiet:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def update(self, n: float = 1) -> None:
+        self.n += n
+
+    def refresh(self, *args, **kwargs) -> None:
+        pass
+
+    def set_description_str(self, *args, **kwargs) -> None:
+        pass
+
+    def set_postfix_str(self, *args, **kwargs) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+    def write(self, text: str, file=None, end: str = "\n") -> None:
+        """``text`` on ``file`` (standard output unless given), as tqdm.write."""
+        out = sys.stdout if file is None else file
+        if out is None:
+            return
+        out.write(text + end)
+        out.flush()
+
+
+def _terminal(stream) -> bool:
+    """Whether ``stream`` is a terminal (tqdm's own test of ``disable=None``)."""
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, OSError, ValueError):  # no isatty, a closed stream
+        return False
 
 
 def _unsized_terminal(stream) -> bool:

@@ -144,6 +144,10 @@ def _run(argv: Sequence[str] | None) -> int:
     forget_created_dirs()
     try:
         _refuse_closed_stdout(args)
+        if getattr(args, "progress", None) is not False:  # a TQDM_* variable tqdm cannot read, before any work (T29-A03)
+            from ..progress import check_progress_variables
+
+            check_progress_variables()
         if getattr(args, "seed", None) is not None:  # every command's --seed, one range, before any work
             from ..evolution.seeding import check_seed
 

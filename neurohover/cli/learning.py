@@ -194,15 +194,16 @@ def cmd_evolve(args: argparse.Namespace) -> int:
 def _evolve_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int:
     from ..evolution.evolve import EvolutionInterrupted, evolve, parse_resampling, validation_return, write_history_csv
     from ..evolution.records import CHECKPOINT_KIND, HISTORY_KIND
+    from ..filekinds import RUN_FILE_ENDS
     from ..paths import output_file, sole_writer
     from ..policies import check_json_policy_name, save_policy
 
     _check_evolve_sizes(args)
-    check_json_policy_name(args.out, "--out")  # before evolving (at the save, the run was lost): .json, not a run's checkpoint (T24-01)
+    check_json_policy_name(args.out, "--out", tuple(RUN_FILE_ENDS))  # before evolving (at the save, the run was lost): .json, not a run's checkpoint (T24-01)
     resampling = parse_resampling(args.resampling)
     target, family, mdp_desc = _target(args)
     topology, proto = _seed_policy(args)
-    out = output_file(args.out, "--out", {"--seed-policy": args.seed_policy}, kind="a policy file")
+    out = output_file(args.out, "--out", {"--seed-policy": args.seed_policy}, kind="a policy file", ends=tuple(RUN_FILE_ENDS))
     held.enter_context(sole_writer(out, "--out"))
     history_path = output_file(f"{out}.history.csv", "--out (its history file)", kind=HISTORY_KIND)
     checkpoint = output_file(f"{out}.checkpoint.json", "--out (its checkpoint file)", kind=CHECKPOINT_KIND)

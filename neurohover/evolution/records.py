@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import NeurohoverError, brief, first_difference, whole_number
-from ..filekinds import CSV_KINDS, JSON_KINDS
+from ..filekinds import CSV_KINDS, JSON_KINDS, fitting_name, name_limit
 from ..paths import JSONError, number_text, output_file, strict_json, writing
 from ..policies import Policy
 from .common import EntryError, enc_float, read_count, read_return, read_seconds
@@ -263,7 +263,8 @@ def decode_history(rows) -> list[HistoryRecord]:
 def write_checkpoint(path: Path, state: dict) -> None:
     """Write a checkpoint atomically: strict JSON to ``PATH.PID.tmp``, synced, then renamed over ``path``."""
     path = Path(os.path.realpath(path))  # through a symbolic link: its file is written, the link kept (ninth trial)
-    tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")  # one per process: two runs on one --out truncated each other's (tenth trial)
+    tail = f".{os.getpid()}.tmp"  # one per process: two runs on one --out truncated each other's (tenth trial)
+    tmp = path.with_name(fitting_name(path.name, name_limit(path.parent), len(tail)) + tail)  # cut where it would be too long (T29-A01)
     path.parent.mkdir(parents=True, exist_ok=True)
     try:
         with open(tmp, "w") as f:
