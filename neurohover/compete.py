@@ -200,6 +200,7 @@ def competition_config(
     are kept apart and the same settings resume.
     """
     from .agents.registry import AGENTS, HYBRID_AGENTS
+    from .experiments.canonical import typed_numbers
     from .experiments.config import compete_name, make_config, settings_scale
 
     check_sizes(runs, episodes)
@@ -211,7 +212,7 @@ def competition_config(
         allowed = ", ".join(HybridSettings().to_dict())
         raise NeurohoverError(f"hybrid={hybrid!r:.60} is not allowed: give a HybridSettings or a dict of its settings ({allowed})")
     if agent in HYBRID_AGENTS:
-        group["hybrid"] = hybrid.to_dict()
+        group["hybrid"] = typed_numbers(HybridSettings().to_dict(), hybrid.to_dict())  # box = 1 as 1.0 (T29-A07)
     elif hybrid != HybridSettings():  # would be ignored without a word
         raise NeurohoverError(f"hybrid settings apply to the hybrid agents only ({', '.join(HYBRID_AGENTS)}), not to agent {agent!r}")
     if wind_model != "none":  # the wind of the LR models the agent learns (absent: the digest of older competitions)
@@ -221,8 +222,13 @@ def competition_config(
             raise NeurohoverError(f"lr_fit key {key!r} is not allowed: choose from {', '.join(LR_FIT_KEYS)}")
         group[key] = choice
     wide: dict[str, object] = {}  # the incremental agents' max_learning_episodes: a setting of the whole experiment
+    own: dict = {}
     if agent_settings:  # the agent's own typed settings, checked by its spec's class (absent: as before)
         own = check_agent_settings(agent, agent_settings, n_steps)
+        defaults = AGENTS[agent].settings().to_dict()  # type: ignore[misc]  # an agent that takes settings has a class
+        own = typed_numbers(defaults, own)  # level=1 as 1.0 ...
+        own = {} if own == defaults else own  # ... and the defaults given as left out: one competition, not three (T29-A07)
+    if own:
         if getattr(AGENTS[agent].settings, "UNIT_KEY", None) in _EXPERIMENT_WIDE:  # by the class, not by its keys: continual has one of the same name
             wide = own
         else:

@@ -59,3 +59,52 @@ def test_evaluate_agent_notes_a_generic_of_another_sigma(cli) -> None:
     assert "note: the generic row flies the shipped fghh generic, evolved for sigma = 0.3, not 0.2" in err
     rc, _, err = cli(*args)
     assert rc == 0 and "note" not in err
+
+
+def _competition(**agent_settings):
+    from neurohover.compete import competition_config
+
+    return competition_config("ghh08", "hybrid-risk", runs=1, episodes=2, n_steps=20, agent_settings=agent_settings or None)
+
+
+def test_equal_agent_settings_spelt_otherwise_are_one_competition() -> None:
+    """T29-A07: compete's defaults left out, level=1 (kept as an int) and criterion="lcb" (level written in as 1.0) were
+    three settings hashes, each flown again; they are one, and level=2 is level=2.0."""
+    plain = _competition()
+    for spelt in (_competition(level=1), _competition(criterion="lcb"), _competition(level=1.0, trials=2)):
+        assert (spelt.scale, spelt.hash) == (plain.scale, plain.hash)
+    two = _competition(level=2)
+    assert (two.scale, two.hash) == (_competition(level=2.0).scale, _competition(level=2.0).hash) != (plain.scale, plain.hash)
+
+
+def _tiny(**extra):
+    from neurohover.experiments.config import make_config
+
+    settings = {"task": "ghh08", "seed": 1, "policies": "shipped", "episodes": 2, "n_steps": 20, "groups": [{"agent": "baseline", "n_mdps": 1}], **extra}
+    return make_config("tiny", "test_runs", "quick", settings)
+
+
+def test_equal_sensor_and_drift_spelt_otherwise_hash_alike() -> None:
+    """T29-A07: sensor={}, drift={} and a sensor's dropout=0 gave another config hash than the same config without them."""
+    plain = _tiny().hash
+    assert _tiny(sensor={}).hash == _tiny(drift={}).hash == plain
+    assert _tiny(groups=[{"agent": "baseline", "n_mdps": 1, "sensor": {}, "drift": {}}]).hash == plain
+    half = _tiny(sensor={"level": 0.5}).hash
+    assert _tiny(sensor={"level": 0.5, "dropout": 0}).hash == _tiny(sensor={"level": 0.5, "delay": 0}).hash == half != plain
+    assert _tiny(sensor={"level": 1}).hash == _tiny(sensor={"level": 1.0}).hash
+    walk = _tiny(drift={"walk": 0.01})
+    assert walk.hash != plain and _tiny(sensor={"level": 0.5}, groups=[{"agent": "baseline", "n_mdps": 1, "sensor": {"level": 0.5}}]).hash == half
+
+
+@pytest.mark.parametrize("name", __import__("neurohover.experiments.config", fromlist=["x"]).experiment_names())
+def test_the_canonical_spelling_keeps_every_shipped_hash(name, monkeypatch) -> None:
+    """T29-A07: the committed store holds every shipped experiment under its config hash: the canonical spelling changes
+    none of them, at either scale, with the experiment's policies or the shipped ones."""
+    from neurohover.experiments import config
+
+    for scale in ("quick", "paper"):
+        now = config.load_config(name, scale)
+        with monkeypatch.context() as m:
+            m.setattr(config, "canonical_settings", lambda resolved: resolved)
+            before = config.load_config(name, scale)
+        assert now.hash == before.hash

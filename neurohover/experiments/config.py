@@ -41,6 +41,7 @@ from typing import Any
 from ..errors import NeurohoverError, brief
 from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..models.model import LEGACY_MODEL_SUBSTEPS
+from .canonical import canonical_settings
 from .paper_checks import check_paper, check_paper_table, check_texts, control_character
 from .schema import SCHEMAS, check_given, check_kind, check_used, validate_table
 from .settings import ExperimentSettings, typed_settings
@@ -455,6 +456,7 @@ def make_config(
     check_given(settings, where)
     check_kind(resolved, kind, where)
     check_used(settings, resolved, kind, where, switched)
+    canonical_settings(resolved)  # equal settings spelt otherwise hash alike (T29-A07)
     paper = {} if paper is None else paper
     check_paper_table(paper, where, kind)  # after the settings: a bad agent is named as such
     from .plans import external_digest
