@@ -23,6 +23,12 @@ from .sim.constants import MLP_STEEPNESS
 
 TOPOLOGIES = ("slp", "mlp")
 GENOME_LENGTH = {"slp": 40, "mlp": 42}
+#: The largest gene magnitude a policy takes (T30-B01: genes of 1e308 were taken and acted NaN/inf). Far above anything
+#: evolution produces (the shipped policies and the committed store's champions stay under 20; a run at the largest
+#: spread, MAX_SPREAD 1e100, draws genes near 1e101, and eonn and the champion become Policies mid-run), yet an MLP's
+#: deepest product, gene x gene x (sum of five inputs), stays finite for observations up to 3e67, far past any flown
+#: state (crash limits of 20 m, 5 m/s, 4 pi rad/s, and sensor noise of std <= 1e4).
+MAX_GENE = 1e120
 INPUT_NAMES = ("u", "v", "w", "x", "y", "z", "qx", "qy", "qz")
 MLP_BIAS_NAMES = ("hy", "hx", "hz", "L1", "L2", "L3", "L4", "S1", "S2", "S3", "S4", "a1", "a2", "a3", "a4")
 MLP_WEIGHT_NAMES = (
@@ -175,6 +181,11 @@ def check_genome(genome, topology: str) -> np.ndarray:
         raise NeurohoverError(f"a {topology} genome has {n} genes, got shape {arr.shape}")
     if not np.all(np.isfinite(arr)):
         raise NeurohoverError(f"a {topology} genome must hold finite numbers; genes {np.flatnonzero(~np.isfinite(arr)).tolist()} are not")
+    big = np.flatnonzero(np.abs(arr) > MAX_GENE)
+    if big.size:  # finite genes of 1e308 acted NaN and inf (T30-B01)
+        raise NeurohoverError(
+            f"a {topology} genome's gene {int(big[0])} {brief(float(arr[big[0]]))} is out of range: allowed numbers in [-{MAX_GENE:g}, {MAX_GENE:g}]"
+        )
     return arr
 
 
