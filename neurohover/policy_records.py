@@ -174,9 +174,10 @@ def _place_problem(meta: dict) -> str:
     over_family = mdp == "G" or (isinstance(target, str) and _FAMILY_TARGET.fullmatch(target) is not None)
     if isinstance(mdp, str) and named is not None:
         spec = target.partition("/")[2]
-        agrees = (
-            _FAMILY_TARGET.fullmatch(target) is not None if mdp == "G" else spec == mdp or (not _SPEC.fullmatch(mdp) and not _FAMILY_TARGET.fullmatch(target))
-        )
+        over = _FAMILY_TARGET.fullmatch(target) is not None
+        # beside a target naming one of the family's MDPs, evolve writes that very spec: 'banana', '' or 'TRAIN:0' were
+        # taken beside ghh08/train:0 (T30-B02); beside an MDP of its own label (--wind, --params), its own words
+        agrees = over if mdp == "G" else (spec == mdp if _SPEC.fullmatch(spec) else not _SPEC.fullmatch(mdp) and not over)
         if not agrees:
             return f"its mdp {brief(mdp)} is not allowed beside its target {brief(target)}: the run was evolved on {target.partition('/')[2]!r}"
     if "mdp_params" not in meta:
