@@ -570,10 +570,16 @@ def result_from_dict(kind: str, d: dict, key: str | None = None) -> UnitResult:
     NeurohoverError
         An unknown kind, or a dict that is not a result of that kind.
     """
-    cls = RESULT_TYPES.get(kind)
+    return result_type(kind).from_dict(d, f"result of {kind} unit {key!r}" if key else None)
+
+
+def result_type(kind: Any) -> type[_Record]:
+    """The result class of a unit kind (:data:`RESULT_TYPES`), or NeurohoverError naming the kinds: the readers' check,
+    which Store.put makes too (a unit of kind 'banana' was stored, then called damaged; T30-B03)."""
+    cls = RESULT_TYPES.get(kind) if isinstance(kind, str) else None
     if cls is None:
         raise NeurohoverError(f"unknown unit kind {kind!r}: allowed {', '.join(RESULT_TYPES)}")
-    return cls.from_dict(d, f"result of {kind} unit {key!r}" if key else None)
+    return cls
 
 
 def check_run_lengths(episodes: Any, results: dict[str, Any]) -> None:

@@ -48,6 +48,7 @@ from .store_checks import (
     _count,
     _object_text,
     bad_session,
+    check_unit_kind,
     config_problem,
     experiment_problem,
     session_problem,
@@ -494,6 +495,7 @@ class Store:
             raise NeurohoverError(f"{where}: unit = {brief(unit)} is not allowed: give the Unit that finished (a plan's)")
         _check_text(unit.key, "the unit's key", where)
         _check_text(unit.kind, "the unit's kind", where)
+        check_unit_kind(unit.key, unit.kind, where)
         params = _object_text(unit.params, f"unit {unit.key}'s params", where)
         text = _object_text(result, f"unit {unit.key}'s result", where)
         if not (finite_real(seconds) and seconds >= 0):

@@ -9,6 +9,7 @@ from typing import Any
 from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..paths import json_text
 from .config import ExperimentConfig
+from .results import result_type
 
 #: How a session can end (:meth:`Store.end_session`; the runner's statuses). A session is "running" until then.
 SESSION_STATUSES = ("finished", "selection finished", "interrupted", "failed")
@@ -137,3 +138,12 @@ def _object_text(value: Any, what: str, where: str) -> str:
             f"({str(err)[:80]})"
         ) from None
     return text
+
+
+def check_unit_kind(key: str, kind: Any, where: str) -> None:
+    """Refuse a unit of a kind its readers do not know, by their own check (:func:`~neurohover.experiments.results.result_type`):
+    a unit of kind 'banana' was stored, and export and results then called the store damaged (T30-B03)."""
+    try:
+        result_type(kind)
+    except NeurohoverError as err:
+        raise NeurohoverError(f"{where}: unit {brief(key)}: {err}") from None
