@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 import zipfile
 import zlib
+from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -27,12 +28,20 @@ SAVE_DTYPES = ("float64", "float32")
 
 def _check_declared_size(path: Path) -> None:
     """Refuse an archive whose arrays declare more than half the free memory, before reading them (a header declaring
-    (1e11, 12) was a MemoryError of 8.73 TiB; sixth trial). Members it cannot read are left to np.load to name."""
+    (1e11, 12) was a MemoryError of 8.73 TiB; sixth trial), or one holding a member twice (the last copy was read without a
+    word, where other zip readers take the first; T30-B04). Members it cannot read are left to np.load to name."""
     from .procs import half_free_memory
 
     total = 0
     with zipfile.ZipFile(path) as archive:
-        for name in archive.namelist():
+        names = archive.namelist()
+        repeated = sorted(name for name, count in Counter(names).items() if count > 1)
+        if repeated:
+            raise NeurohoverError(
+                f"{str(path)!r} is not a readable flight-data file: it holds member(s) {', '.join(repeated)} more than once "
+                "(which copy counts is each zip reader's guess); save it again with FlightData.save"
+            )
+        for name in names:
             with archive.open(name) as f:
                 try:
                     version = np.lib.format.read_magic(f)
