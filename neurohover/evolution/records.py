@@ -200,8 +200,11 @@ def read_history_csv(path: str | Path) -> list[HistoryRecord]:
         (:func:`check_history`; wall seconds never falling). int() and float() took 'nan', '1_0', other scripts' digits
         and falling counts (T28-B13).
     """
-    with open(path, newline="") as f:
-        rows = [row for row in csv.reader(f) if row]
+    try:  # utf-8-sig: a byte-order mark (a spreadsheet's "UTF-8 with BOM") hid the header (T30-B05)
+        with open(path, newline="", encoding="utf-8-sig") as f:
+            rows = [row for row in csv.reader(f) if row]
+    except UnicodeDecodeError as err:
+        raise NeurohoverError(f"{str(path)!r} is not an evolution history: it is not UTF-8 text (byte {err.start})") from None
     if not rows or tuple(rows[0]) != HISTORY_COLUMNS:
         raise NeurohoverError(f"{str(path)!r} is not an evolution history (expected the header {','.join(HISTORY_COLUMNS)})")
     out: list[HistoryRecord] = []
