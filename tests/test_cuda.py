@@ -23,20 +23,22 @@ SCRIPT = r"""
 import json, warnings
 import numpy as np
 from numba.core.registry import CPUDispatcher
-from neurohover import Policy, Safeguard, baseline_policy, evaluate, get_task_family, prototype
+from neurohover import Policy, PolicyTable, Safeguard, baseline_policy, evaluate, get_task_family, prototype
 from neurohover.sim import cuda as sim_cuda
 
 warnings.filterwarnings("ignore", "overflow encountered", RuntimeWarning)  # uint64 streams wrap in plain Python
 mlp = prototype("mlp", "baseline").genome + np.random.default_rng(0).normal(0, 0.01, 42)
-nonfinite = prototype("mlp", "baseline").genome.copy()
-nonfinite[[18, 34]] = 1e200  # l1 = 1e200 v, a1 = 1e200 l1: an infinite action once v != 0
 rolling = baseline_policy().genome.copy()
 rolling[36] += 0.5  # a1 bias: rolls over within 15 steps, unless the safeguard's fallback takes over
-policies = [baseline_policy(), Policy("mlp", mlp), Policy("slp", rolling), Policy("mlp", nonfinite)]
+policies = [baseline_policy(), Policy("mlp", mlp), Policy("slp", rolling), prototype("mlp", "baseline")]
+table = PolicyTable.from_policies(policies)
+genomes = table.genomes.copy()
+genomes[3, [18, 34]] = 1e200  # l1 = 1e200 v, a1 = 1e200 l1: an infinite action once v != 0 (a table: a Policy's genes are bounded)
+table = PolicyTable(table.kinds, genomes)
 mdps = [get_task_family("ghh09").mdp("train:0"), get_task_family("fghh", 0.3).mdp("sample", 3)]
 out = {"simulating": sim_cuda.simulating()}
 for device in ("cpu", "cuda"):
-    ev = evaluate(policies, mdps, episodes=2, seed=11, n_steps=40, device=device)
+    ev = evaluate(table, mdps, episodes=2, seed=11, n_steps=40, device=device)
     sg = evaluate(policies[2], mdps, episodes=2, seed=11, n_steps=40, record=True, device=device,
                   safeguard=Safeguard(baseline_policy()))
     out[device] = {

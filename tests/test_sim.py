@@ -8,7 +8,19 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from neurohover import MDP, DangerousState, NeurohoverError, Policy, Safeguard, baseline_policy, evaluate, evaluate_jobs, get_task_family, prototype
+from neurohover import (
+    MDP,
+    DangerousState,
+    NeurohoverError,
+    Policy,
+    PolicyTable,
+    Safeguard,
+    baseline_policy,
+    evaluate,
+    evaluate_jobs,
+    get_task_family,
+    prototype,
+)
 from neurohover.sim.constants import CRASH_STEP_PENALTY, EPISODE_STEPS, MAX_RATE, MAX_VELOCITY, MDP_ROW_LEN, MIN_QW
 from neurohover.sim.reference import fly_episode
 from neurohover.sim.rng import episode_normals
@@ -99,10 +111,11 @@ def test_crash_penalty_and_episode_length() -> None:
 
 
 def test_non_finite_action_is_a_crash_with_full_penalty() -> None:
-    g = prototype("mlp", "baseline").genome.copy()
-    g[3] = 1.7e308  # bias of L1
-    g[15 + 6] = 1.7e308  # hy -> L1: the sum overflows to inf, and so does a1
-    ev = evaluate(Policy("mlp", g), get_task_family("ghh08").zero(), episodes=2, seed=SEED, record=True)
+    table = PolicyTable.from_policies([prototype("mlp", "baseline")])  # a table: a Policy's genes are bounded (T30-B01)
+    g = table.genomes.copy()
+    g[0, 3] = 1.7e308  # bias of L1
+    g[0, 15 + 6] = 1.7e308  # hy -> L1: the sum overflows to inf, and so does a1
+    ev = evaluate(PolicyTable(table.kinds, g), get_task_family("ghh08").zero(), episodes=2, seed=SEED, record=True)
     assert ev.crashed.all() and (ev.steps == 1).all()
     np.testing.assert_array_equal(ev.returns.ravel(), -CRASH_STEP_PENALTY * (EPISODE_STEPS - 1))
     assert not np.isfinite(ev.flight_data.actions[0][0, 0])
