@@ -54,6 +54,8 @@ LR_FIT_KEYS = ("d_u", "noise", "model_policy", "model_substeps")
 
 def summarise(results: Sequence) -> dict:
     """Summary figures over test runs (:class:`~neurohover.experiments.results.TestRunResult`; see the module docstring)."""
+    if not len(results):  # a mean of nothing was numpy's "Mean of empty slice" and NaN figures (T30-A02)
+        raise NeurohoverError("summarise needs at least one test run: results holds none")
     scores = np.array([float(r.score) for r in results])
     returns = [np.array(r.returns, dtype=float) for r in results]
     after = [ret[r.learning_episodes :] for r, ret in zip(results, returns, strict=True)]
@@ -420,6 +422,10 @@ def _run_into_store(config, store_path: Path, episodes_csv: Path, *, jobs: int, 
         finally:
             executor.close()
         ordered = stored_runs(db)  # a failure (a full disk) left above: the folder as it was
+        if run.failed:  # said as reproduce says it, never summarised (all runs failed: "Mean of empty slice"; T30-A02)
+            if ordered:
+                _write_episodes(episodes_csv, ordered, config.typed.n_steps)
+            raise NeurohoverError(f"{run.line()}; the finished runs are kept in {str(store_path)!r}, and the same call resumes")
         _write_episodes(episodes_csv, ordered, config.typed.n_steps)
     return ordered
 

@@ -1,0 +1,68 @@
+"""Bad-input trial 30 (command line): T30-A02 (compete whose runs all failed), T30-A04 (an output name that is a symlink),
+T30-A05 (--policy-dir naming a set's own directory), T30-A06 (~ in a config's path settings)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from neurohover.errors import NeurohoverError
+
+
+def _failing_units(monkeypatch, fail) -> None:
+    from neurohover.experiments import executors
+
+    real = executors.run_unit
+
+    def run_unit(unit, threads=None, device="cpu"):
+        if fail(unit["key"]):
+            raise RuntimeWarning("overflow encountered in scalar multiply")
+        return real(unit, threads, device)
+
+    monkeypatch.setattr(executors, "run_unit", run_unit)
+
+
+def test_compete_whose_runs_all_failed_says_so_as_reproduce_does_and_summarises_nothing(tmp_path: Path, monkeypatch, cli) -> None:
+    _failing_units(monkeypatch, lambda key: key.startswith("run/"))
+    out = tmp_path / "g06"
+    code, _, err = cli("compete", "--task", "ghh08", "--agent", "baseline", "--runs", "2", "--episodes", "2", "--episode-steps", "20", "--out", str(out))
+    assert code == 2 and "Traceback" not in err and "Mean of empty slice" not in err
+    assert "failed; ran 0 units" in err and "2 failed, first: run/baseline/test" in err and "RuntimeWarning: overflow" in err
+    assert not (out / "episodes.csv").exists() and not (out / "summary.json").exists()  # no header-only episodes.csv
+
+
+def test_compete_with_a_failed_run_writes_the_finished_ones_and_no_summary(tmp_path: Path, monkeypatch) -> None:
+    from neurohover.compete import compete
+
+    _failing_units(monkeypatch, lambda key: key.startswith("run/") and key.endswith("test1/rep0"))
+    with pytest.raises(NeurohoverError, match=r"1 failed, first: run/baseline/test1/rep0: RuntimeWarning"):
+        compete("ghh08", "baseline", runs=2, episodes=2, n_steps=20, out=tmp_path / "p")
+    assert not (tmp_path / "p" / "summary.json").exists()
+    assert len((tmp_path / "p" / "episodes.csv").read_text().splitlines()) == 3  # header and the finished run's 2 episodes
+
+
+def test_summarise_refuses_no_runs_by_name() -> None:
+    from neurohover.compete import summarise
+
+    with pytest.raises(NeurohoverError, match="summarise needs at least one test run"):
+        summarise([])
+
+
+def test_results_out_refuses_a_link_to_a_file_of_another_suffix_and_writes_through_one_to_a_csv(tmp_path: Path, cli) -> None:
+    """T30-A04: results --out lnk.csv, a link to a TOML config, replaced the config with CSV (the suffix was checked on the
+    link's name only). A link to a CSV file is still written through (trial 29)."""
+    from conftest import tiny_test_runs
+
+    config, store = tmp_path / "tr1.toml", tmp_path / "tr1.sqlite"
+    config.write_text(tiny_test_runs("baseline"))
+    assert cli("reproduce", str(config), "--store", str(store), "--no-progress")[0] == 0
+    (tmp_path / "cfg2.toml").write_text(config.read_text())
+    (tmp_path / "lnk.csv").symlink_to(tmp_path / "cfg2.toml")
+    rc, _, err = cli("results", "tr1", "--store", str(store), "--out", str(tmp_path / "lnk.csv"))
+    assert rc == 2 and "is a symbolic link to" in err and "cfg2.toml" in err and "give a path ending .csv or .json" in err
+    assert (tmp_path / "cfg2.toml").read_text() == config.read_text()
+    (tmp_path / "old.csv").write_text("")
+    (tmp_path / "ok.csv").symlink_to(tmp_path / "old.csv")
+    assert cli("results", "tr1", "--store", str(store), "--out", str(tmp_path / "ok.csv"))[0] == 0
+    assert (tmp_path / "old.csv").read_text().startswith("experiment,")
