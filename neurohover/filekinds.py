@@ -153,7 +153,8 @@ def output_name(path: object, option: str, suffixes: tuple[str, ...], what: str,
     is ("evaluate-agent's rows are JSON"), and (``run_files``) a name of an evolve run's own files
     (:func:`refuse_run_file_name`); what is no path is :func:`output_file`'s to refuse. evaluate-agent --json f.npz wrote
     JSON over flight data (T25-01), results --out f.npz CSV (T25-02), learn-model --out P.checkpoint.json a model over
-    evolve's checkpoint (T25-03). ``ends``: what the command adds to the name for files beside it (:func:`refuse_suffix`)."""
+    evolve's checkpoint (T25-03); a link of such a name to a file of another suffix, a config, was written through (T30-A04).
+    ``ends``: what the command adds to the name for files beside it (:func:`refuse_suffix`)."""
     text = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None
     if not isinstance(text, str) or text in ("", "-") or text.endswith(("/", os.sep)) or Path(text).is_dir():
         return
@@ -161,6 +162,12 @@ def output_name(path: object, option: str, suffixes: tuple[str, ...], what: str,
         refuse_run_file_name(text, option)
     if suffixes != ("",):
         refuse_suffix(text, option, suffixes, what, f"out{suffixes[0]}", ends)
+        target = os.path.realpath(text)  # a link's own name passed, the file written is its target's (T30-A04)
+        if os.path.islink(text) and os.path.exists(target) and Path(target).suffix.lower() not in suffixes:
+            raise NeurohoverError(
+                f"{option} {brief(text)} is a symbolic link to {brief(target)}, a name that is not allowed: {what}; "
+                f"give a path ending {' or '.join(suffixes)} that is no link to another kind of file"
+            )
 
 
 def refuse_suffix(path: str, option: str, suffixes: tuple[str, ...], what: str, example: str, ends: tuple[str, ...] = ()) -> None:
