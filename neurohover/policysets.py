@@ -217,6 +217,8 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
         raise NeurohoverError(f"policy directory {str(directory)!r} is not a directory: give the directory that holds {family.name}/")
     _refuse_not_a_file(manifest_path, "its manifest")
     if not manifest_path.is_file():
+        if directory is not None and root.parent.name == family.name and (root.parent / "manifest.json").is_file():  # T30-A05
+            raise NeurohoverError(f"policy directory {str(directory)!r} is itself a {family.name} set: give its parent {str(root.parent.parent)!r}")
         raise NeurohoverError(
             f"no policy set for {family.name} in {str(root)!r} (manifest.json missing); build it with: neurohover build-policies "
             f"--task {family.name} --out {str(root.parent)!r}"

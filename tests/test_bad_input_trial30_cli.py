@@ -66,3 +66,17 @@ def test_results_out_refuses_a_link_to_a_file_of_another_suffix_and_writes_throu
     (tmp_path / "ok.csv").symlink_to(tmp_path / "old.csv")
     assert cli("results", "tr1", "--store", str(store), "--out", str(tmp_path / "ok.csv"))[0] == 0
     assert (tmp_path / "old.csv").read_text().startswith("experiment,")
+
+
+def test_policy_dir_naming_a_sets_own_directory_is_told_to_give_its_parent(tmp_path: Path, cli) -> None:
+    """T30-A05: --policy-dir bq0/ghh08 was told to build a set with --out 'bq0/ghh08', which build-policies refuses."""
+    from neurohover.policysets import build_policy_set, load_policy_set
+
+    build_policy_set("ghh08", tmp_path / "bq0", budget=2, n_steps=5, safety_episodes=1)
+    own = tmp_path / "bq0" / "ghh08"
+    with pytest.raises(NeurohoverError, match=rf"policy directory '{own}' is itself a ghh08 set: give its parent '{tmp_path / 'bq0'}'"):
+        load_policy_set("ghh08", own)
+    rc, _, err = cli("compete", "--task", "ghh08", "--agent", "model-free", "--runs", "1", "--episodes", "1", "--episode-steps", "5",
+                     "--policy-dir", str(own), "--out", str(tmp_path / "p06"))  # fmt: skip
+    assert rc == 2 and "is itself a ghh08 set: give its parent" in err and "build-policies" not in err
+    assert load_policy_set("ghh08", tmp_path / "bq0").task == "ghh08"
