@@ -122,6 +122,13 @@ def _negative_values_attached(parser: argparse.ArgumentParser, given: list[str])
 
 
 def _run(argv: Sequence[str] | None) -> int:
+    if sys.flags.optimize >= 2:  # -OO strips the docstrings the commands' help (and pycma) are built from (T30-A01)
+        print(
+            f"neurohover: error: PYTHONOPTIMIZE={sys.flags.optimize} (python -OO) is not allowed: it strips the docstrings neurohover's "
+            "help and pycma read; unset it, or set it to 1",
+            file=sys.stderr,
+        )
+        return 2
     parser = build_parser()  # a Ctrl-C while it imports the command modules: the package's hook (neurohover/__init__.py)
     given = list(sys.argv[1:] if argv is None else argv)
     action = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))

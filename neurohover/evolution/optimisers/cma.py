@@ -14,7 +14,6 @@ import sys
 from dataclasses import dataclass
 from typing import Any
 
-import cma
 import numpy as np
 
 from ...errors import NeurohoverError, brief, whole_number
@@ -44,6 +43,22 @@ __all__ = ["CMAES", "SIGMA0", "CMASettings", "losses_of"]
 #: episodes, 1000 episodes, SLP and MLP from the baseline) found 0.01-0.03 best and 0.1 crashing
 #: nearly every SLP candidate (pycma's usual 0.5 belongs to problems scaled to unit boxes).
 SIGMA0 = 0.02
+
+
+def pycma() -> Any:
+    """pycma, imported where a CMA optimiser is made or restored, not with neurohover: under ``python -OO``
+    (PYTHONOPTIMIZE=2) it fails at import, reading docstrings that are stripped, and took every command down (T30-A01)."""
+    try:
+        import cma
+    except AttributeError as err:
+        if sys.flags.optimize < 2:
+            raise
+        raise NeurohoverError(
+            f"the CMA optimisers need pycma, which cannot be imported with PYTHONOPTIMIZE={sys.flags.optimize} (python -OO strips "
+            f"the docstrings it reads: {err}): unset PYTHONOPTIMIZE, or set it to 1, to use them"
+        ) from None
+    return cma
+
 
 #: Where classes pickled in earlier checkpoints now live (module, name) -> (module, name).
 _MOVED = {
@@ -194,7 +209,7 @@ class CMAES(PopulationOptimiser):
         if popsize is not None:
             opts["popsize"] = int(popsize)
         super().__init__()
-        self._es = cma.CMAEvolutionStrategy(x0, float(sigma0), opts)
+        self._es = pycma().CMAEvolutionStrategy(x0, float(sigma0), opts)
         self.budget = None if budget is None else int(budget)
 
     def _ask(self) -> np.ndarray:
@@ -260,6 +275,7 @@ class CMAES(PopulationOptimiser):
         check_state({"version": common.STATE_VERSION, **state, **({"type": kind} if legacy else {})}, kind)
         check_entries(state, kind, ("type", "version", "pickle"))
         holder: list = [None]
+        pycma()  # the pickle names pycma's classes: imported here, with its one message under -OO
 
         def unpickle(text: str) -> CMAES:
             try:

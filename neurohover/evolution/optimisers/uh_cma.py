@@ -27,13 +27,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-import cma
 import numpy as np
 
 from ...errors import NeurohoverError, brief, whole_number
 from ..common import TellInfo, check_settings, require_std
 from . import OptimiserSpec
-from .cma import CMAES, CMASettings, losses_of
+from .cma import CMAES, CMASettings, losses_of, pycma
 
 __all__ = ["UHCMAES", "UHCMASettings"]
 
@@ -88,7 +87,7 @@ class UHCMAES(CMAES):
                 " generation; give a smaller reevaluations or a larger popsize"
             )
         evals = [s.min_evaluations, s.min_evaluations, s.max_evaluations]  # minimum, start, maximum
-        self._noise = cma.NoiseHandler(self._es.N, maxevals=evals, reevals=s.reevaluations, epsilon=s.epsilon)
+        self._noise = pycma().NoiseHandler(self._es.N, maxevals=evals, reevals=s.reevaluations, epsilon=s.epsilon)
         self._round: dict[str, Any] | None = None  # the generation waiting for its re-evaluations
 
     @property
