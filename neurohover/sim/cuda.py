@@ -24,7 +24,9 @@ The module imports without CUDA; :func:`cuda_problem` says why the GPU cannot be
 
 from __future__ import annotations
 
+import contextlib
 import types
+import warnings
 
 import numpy as np
 from numba.core.registry import CPUDispatcher
@@ -55,6 +57,18 @@ def simulating() -> bool:
     from numba.core import config
 
     return bool(config.ENABLE_CUDASIM)  # type: ignore[attr-defined]  # numba.config sets it at import, from the environment
+
+
+@contextlib.contextmanager
+def _wraparound_quiet():
+    """Under the simulator the device code runs as Python on NumPy scalars, whose uint64 products in ``sim.rng`` wrap on
+    purpose (as they do on a GPU) and warned "overflow encountered" 8 lines a run (T30-A03); on a GPU: nothing to do."""
+    if not simulating():
+        yield
+        return
+    with warnings.catch_warnings():  # process-wide filters: the simulator's threads see them
+        warnings.filterwarnings("ignore", "overflow encountered", RuntimeWarning, r"neurohover\.sim\.rng")
+        yield
 
 
 def cuda_problem() -> str | None:
@@ -232,7 +246,8 @@ def rollout_batch_cuda(jobs: Jobs, extras: Extras, out: Flown, threads_per_block
     d_extras = Extras(to(extras.fallback), bool(extras.safeguard), to(extras.limits), to(extras.slots), d_obs, d_act)
     d_out = [cuda.device_array(n_jobs, dtype=host.dtype) for host in out]  # returns, crash flags, steps, safeguard steps
     tpb = threads_per_block or THREADS_PER_BLOCK
-    k[(n_jobs + tpb - 1) // tpb, tpb](d_jobs, d_extras, Flown(*d_out))
+    with _wraparound_quiet():
+        k[(n_jobs + tpb - 1) // tpb, tpb](d_jobs, d_extras, Flown(*d_out))
     for device_array, host in zip(d_out, out, strict=True):
         device_array.copy_to_host(host)
     if recording:
@@ -291,36 +306,38 @@ class StepBatch:
             return cuda.to_device(np.ascontiguousarray(a))
 
         blocks = (n + self._tpb - 1) // self._tpb
-        _reset_kernel()[blocks, self._tpb](
-            to(np.asarray(idx, dtype=np.int64)),
-            to(mdp_rows),
-            to(states),
-            to(noise),
-            to(rngs),
-            to(steps),
-            self.rows,
-            self.states,
-            self.noise,
-            self.rngs,
-            self.steps,
-        )
+        with _wraparound_quiet():
+            _reset_kernel()[blocks, self._tpb](
+                to(np.asarray(idx, dtype=np.int64)),
+                to(mdp_rows),
+                to(states),
+                to(noise),
+                to(rngs),
+                to(steps),
+                self.rows,
+                self.states,
+                self.noise,
+                self.rngs,
+                self.steps,
+            )
 
     def step(self, actions, n_steps, obs_out, rew_out, crash_out) -> None:
         """One control step of every helicopter: ``actions`` (n, 4) in, the host outputs filled in place."""
         self._actions.copy_to_device(np.ascontiguousarray(actions))
-        self._kernel[(self._n + self._tpb - 1) // self._tpb, self._tpb](
-            self.rows,
-            self.env_mdp,
-            self.states,
-            self.noise,
-            self.rngs,
-            self.steps,
-            self._actions,
-            np.int64(n_steps),
-            self._obs,
-            self._rew,
-            self._crash,
-        )
+        with _wraparound_quiet():
+            self._kernel[(self._n + self._tpb - 1) // self._tpb, self._tpb](
+                self.rows,
+                self.env_mdp,
+                self.states,
+                self.noise,
+                self.rngs,
+                self.steps,
+                self._actions,
+                np.int64(n_steps),
+                self._obs,
+                self._rew,
+                self._crash,
+            )
         self._obs.copy_to_host(obs_out)
         self._rew.copy_to_host(rew_out)
         self._crash.copy_to_host(crash_out)
