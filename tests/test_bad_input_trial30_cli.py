@@ -10,6 +10,16 @@ import pytest
 from neurohover.errors import NeurohoverError
 
 
+def _shipped_set_in(parent: Path) -> Path:
+    """A copy of the shipped GHH-08 policy set in ``parent``/ghh08 (building one takes many seconds); ``parent``."""
+    import shutil
+
+    from neurohover.policysets import policy_dir
+
+    shutil.copytree(policy_dir("ghh08", None), parent / "ghh08")
+    return parent
+
+
 def _failing_units(monkeypatch, fail) -> None:
     from neurohover.experiments import executors
 
@@ -70,9 +80,9 @@ def test_results_out_refuses_a_link_to_a_file_of_another_suffix_and_writes_throu
 
 def test_policy_dir_naming_a_sets_own_directory_is_told_to_give_its_parent(tmp_path: Path, cli) -> None:
     """T30-A05: --policy-dir bq0/ghh08 was told to build a set with --out 'bq0/ghh08', which build-policies refuses."""
-    from neurohover.policysets import build_policy_set, load_policy_set
+    from neurohover.policysets import load_policy_set
 
-    build_policy_set("ghh08", tmp_path / "bq0", budget=2, n_steps=5, safety_episodes=1)
+    _shipped_set_in(tmp_path / "bq0")
     own = tmp_path / "bq0" / "ghh08"
     with pytest.raises(NeurohoverError, match=rf"policy directory '{own}' is itself a ghh08 set: give its parent '{tmp_path / 'bq0'}'"):
         load_policy_set("ghh08", own)
@@ -80,3 +90,22 @@ def test_policy_dir_naming_a_sets_own_directory_is_told_to_give_its_parent(tmp_p
                      "--policy-dir", str(own), "--out", str(tmp_path / "p06"))  # fmt: skip
     assert rc == 2 and "is itself a ghh08 set: give its parent" in err and "build-policies" not in err
     assert load_policy_set("ghh08", tmp_path / "bq0").task == "ghh08"
+
+
+def test_a_config_policies_path_expands_tilde_as_generics_from_does(tmp_path: Path, monkeypatch) -> None:
+    """T30-A06: policies = "~/bq0" was refused as "no such directory" with ~/bq0 holding the set, while generics_from =
+    "dir:~/..." expanded ~ (one config, two readings of ~)."""
+    from conftest import tiny_test_runs
+
+    from neurohover.experiments.config import load_config
+
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    _shipped_set_in(tmp_path / "home" / "bq0")
+    text = tiny_test_runs("model-free")
+    (tmp_path / "tilde.toml").write_text(text.replace('policies = "shipped"', 'policies = "~/bq0"'))
+    (tmp_path / "full.toml").write_text(text.replace('policies = "shipped"', f"policies = {str(tmp_path / 'home' / 'bq0')!r}"))
+    tilde, full = load_config(str(tmp_path / "tilde.toml"), "quick"), load_config(str(tmp_path / "full.toml"), "quick")
+    assert tilde.external_digest and tilde.external_digest == full.external_digest  # the same set, read through ~
+    monkeypatch.setenv("HOME", str(tmp_path))  # ~/bq0 is now missing: refused, as before
+    with pytest.raises(NeurohoverError, match=r"policies = '~/bq0' is not allowed: .*no such directory"):
+        load_config(str(tmp_path / "tilde.toml"), "quick")

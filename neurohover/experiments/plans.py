@@ -80,12 +80,13 @@ _SOURCE_KEYS = {"test_runs": "policies", "model_learning": "generic", "evolution
 def _load_external(task: str, source: str, key: str = "policies"):
     from pathlib import Path
 
-    if source != "shipped" and not Path(source).is_dir():  # a generic "nope" was named as policies (eighth trial)
+    folder = Path(source).expanduser()  # "~/bq0" as generics_from's "dir:~/..." is: the user's home (T30-A06)
+    if source != "shipped" and not folder.is_dir():  # a generic "nope" was named as policies (eighth trial)
         raise NeurohoverError(
             f"{key} = {source!r} is not allowed: give {_SOURCE_WORDS[key]}'shipped' or a directory holding <task>/ policy sets "
             f"(no such directory; build it with: neurohover build-policies --task {task} --out {source})"
         )
-    return load_policy_set(task, None if source == "shipped" else source)
+    return load_policy_set(task, None if source == "shipped" else folder)
 
 
 def external_digest(kind: str, s: dict) -> str:
