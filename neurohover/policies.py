@@ -273,6 +273,11 @@ def load_policy(source: str | Path) -> Policy:
     path = input_file(source, "policy file", "policy file (JSON, an authors' .net file, or 'baseline')")  # the one check of a file read
     net = path.suffix == ".net"
     name = f"{'network' if net else 'policy'} file {str(path)!r}"
+    from .filekinds import held_kind
+
+    kind = None if net else held_kind(path)
+    if kind not in (None, "a policy file"):  # a store was "must be UTF-8 text", a model file "missing key(s)" (trial 30)
+        raise NeurohoverError(f"{name} is {kind}, not a policy file: give a policy file (as evolve --out writes it), an authors' .net file or 'baseline'")
     try:
         text = utf8_text(path.read_bytes(), name, "a network file" if net else "a policy file")
     except OSError as err:

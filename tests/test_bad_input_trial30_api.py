@@ -6,6 +6,7 @@ read without a word; a history CSV after a UTF-8 byte-order mark was "not an evo
 from __future__ import annotations
 
 import json
+import re
 import warnings
 import zipfile
 from pathlib import Path
@@ -151,3 +152,18 @@ def test_a_history_that_is_not_utf8_is_refused_by_name(tmp_path: Path) -> None:
     bad.write_bytes(b"\xff\xfegeneration")
     with pytest.raises(NeurohoverError, match=r"is not an evolution history: it is not UTF-8 text \(byte 0\)$"):
         read_history_csv(bad)
+
+
+def test_load_policy_names_another_kind_of_neurohover_file(tmp_path) -> None:
+    """Trial 30 (borderline): a results store given as a policy was "must be UTF-8 text", a model file "missing key(s)
+    topology, genome"; a file neurohover can tell apart is named by its kind."""
+    import sqlite3
+
+    store = tmp_path / "s.sqlite"
+    sqlite3.connect(store).execute("CREATE TABLE t (x)").connection.commit()
+    summary = tmp_path / "summary.json"
+    summary.write_text('{"experiment": "e", "agent": "baseline", "task": "ghh08", "runs": 1}')
+    for path, kind in ((store, "a results store (SQLite)"), (summary, "a competition summary (summary.json)")):
+        with pytest.raises(NeurohoverError, match=f"^policy file '{re.escape(str(path))}' is {re.escape(kind)}, not a policy file: give a policy file"):
+            nh.load_policy(path)
+    assert nh.load_policy(nh.save_policy(nh.baseline_policy(), tmp_path / "b.json")) == nh.baseline_policy()
