@@ -109,3 +109,12 @@ def test_a_config_policies_path_expands_tilde_as_generics_from_does(tmp_path: Pa
     monkeypatch.setenv("HOME", str(tmp_path))  # ~/bq0 is now missing: refused, as before
     with pytest.raises(NeurohoverError, match=r"policies = '~/bq0' is not allowed: .*no such directory"):
         load_config(str(tmp_path / "tilde.toml"), "quick")
+
+
+def test_reproduce_all_says_set_applies_to_every_experiment(tmp_path, cli) -> None:
+    """Trial 30 (borderline): ``reproduce all --set episodes=2`` was refused as fig2's unknown setting, without saying that
+    --set applies to every experiment of 'all'."""
+    rc, out, err = cli("reproduce", "all", "--set", "episodes=2", "--store", str(tmp_path / "s.sqlite"))
+    assert (rc, out) == (2, "") and "unknown setting(s) episodes" in err, err
+    assert err.rstrip().endswith("(--set applies to every experiment of 'all': give one NAME to set what only some have)"), err
+    assert not (tmp_path / "s.sqlite").exists()

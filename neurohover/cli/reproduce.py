@@ -51,7 +51,12 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     check_device(args.device)
     output_file(args.store, "--store", store=True)
     overrides = parse_overrides(args.set)
-    configs = load_configs(args.name, args.scale, overrides)
+    try:
+        configs = load_configs(args.name, args.scale, overrides)
+    except NeurohoverError as err:
+        if args.name == "all" and overrides:  # fig2 refused episodes=2 without saying why it was asked (trial 30, borderline)
+            raise NeurohoverError(f"{err} (--set applies to every experiment of 'all': give one NAME to set what only some have)") from None
+        raise
     for config in configs:
         check_own_name(config)  # before a store is made
     named = [c.name for c in configs]
