@@ -118,3 +118,11 @@ def test_reproduce_all_says_set_applies_to_every_experiment(tmp_path, cli) -> No
     assert (rc, out) == (2, "") and "unknown setting(s) episodes" in err, err
     assert err.rstrip().endswith("(--set applies to every experiment of 'all': give one NAME to set what only some have)"), err
     assert not (tmp_path / "s.sqlite").exists()
+
+
+def test_a_cleanrl_path_is_checked_before_torch(tmp_path, cli) -> None:
+    """Trial 30 (borderline): ``--cleanrl FILE`` said "needs torch" (where it is not installed): the path at fault was named
+    only once torch was there."""
+    (tmp_path / "m.zip").write_bytes(b"PK")
+    rc, _, err = cli("evaluate-agent", "--task", "ghh08", "--cleanrl", str(tmp_path / "m.zip"))
+    assert rc == 2 and "m.zip" in err and "torch" not in err, err

@@ -75,12 +75,12 @@ def _actor_weights(state: Any, model: Path, torch) -> dict[str, Any]:
 
 def cleanrl_policy(run: str | Path) -> Callable[[np.ndarray], np.ndarray]:
     """The actor of a CleanRL PPO run folder (``*.cleanrl_model`` and ``obs_rms.pkl``) as a batch function."""
+    model, stats = cleanrl_files(run)  # the path before the library: a file was "needs torch" (trial 30, borderline)
     try:
         import torch
         from torch import nn
     except ModuleNotFoundError:
         raise NeurohoverError("a CleanRL run needs torch: pip install torch==2.13.0 (a CPU build)") from None
-    model, stats = cleanrl_files(run)
     try:
         state = torch.load(model, map_location="cpu")
         with stats.open("rb") as f:
