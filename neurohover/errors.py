@@ -218,3 +218,27 @@ def as_floats(values: Any, name: str, allowed: str) -> np.ndarray:
     if a.dtype.kind not in "fiu":  # one dtype test: this runs at every tell()
         raise _not_floats(values, name, allowed, _NOT_REAL.get(a.dtype.kind, a.dtype.name))
     return np.array(a, dtype=np.float64)
+
+
+def refuse_non_text_keys(data: object, where: str) -> None:
+    """Refuse ``data`` (metadata about to be written as JSON) holding a key that is not text at any depth, naming it and
+    the top-level key it is under: JSON writes every key as text, and {1: 2} came back as {'1': 2} (flight data T21-08,
+    policy files T28-B14). A NumPy object array's dicts are looked into (flight data may hold them). It names the
+    key; :func:`neurohover.paths.json_text` then tests the values."""
+    stack: list[tuple[object, object]] = [(None, data)]  # (the top-level key it is under, a value)
+    seen: set[int] = set()  # a dict that holds itself: json_text names it
+    while stack:
+        top, value = stack.pop()
+        if getattr(getattr(value, "dtype", None), "kind", "") == "O":  # an object array: its dicts' keys too
+            value = value.tolist()  # type: ignore[attr-defined]
+        if isinstance(value, (dict, list, tuple)) and id(value) not in seen:
+            seen.add(id(value))
+            items = value.items() if isinstance(value, dict) else ((None, item) for item in value)
+            for key, item in items:
+                if isinstance(value, dict) and not isinstance(key, str):
+                    under = "" if top is None else f" (under {brief(top)})"
+                    raise NeurohoverError(
+                        f"{where} metadata key {brief(key)}{under} is not allowed: give text keys (JSON writes every key as text, "
+                        "so the file would load back with other metadata)"
+                    )
+                stack.append((key if top is None else top, item))

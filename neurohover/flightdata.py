@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError, brief, finite_real
+from .errors import NeurohoverError, brief, finite_real, refuse_non_text_keys
 from .filekinds import refuse_suffix
 from .flightmeta import check_meaning, check_policy_actions, flown_policy
 from .paths import json_text, strict_json
@@ -328,22 +328,7 @@ def _metadata_text(metadata: object, where: str) -> str:
     TypeError mid-write, a NaN written and read back; T16-24) and a key that is not text (JSON writes {1: 2} as {'1': 2},
     other metadata; T21-08). The one check of metadata, when flight data are made and when they are saved."""
     metadata = _check_dict(metadata, where)
-    stack: list[tuple[object, object]] = [(None, metadata)]  # (the top-level key it is under, a value)
-    seen: set[int] = set()  # a dict that holds itself: json_text names it below
-    while stack:
-        top, value = stack.pop()
-        value = value.tolist() if isinstance(value, np.ndarray) and value.dtype.kind == "O" else value  # its dicts' keys too
-        if isinstance(value, (dict, list, tuple)) and id(value) not in seen:
-            seen.add(id(value))
-            items = value.items() if isinstance(value, dict) else ((None, item) for item in value)
-            for key, item in items:
-                if isinstance(value, dict) and not isinstance(key, str):
-                    under = "" if top is None else f" (under {brief(top)})"
-                    raise NeurohoverError(
-                        f"{where} metadata key {brief(key)}{under} is not allowed: give text keys (JSON writes every key as text, "
-                        "so the file would load back with other metadata)"
-                    )
-                stack.append((key if top is None else top, item))
+    refuse_non_text_keys(metadata, where)
     try:
         text = json_text(metadata, default=_plain)
     except (TypeError, ValueError, RecursionError) as err:

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError, as_floats, brief, masked_note
+from .errors import NeurohoverError, as_floats, brief, masked_note, refuse_non_text_keys
 from .sim.constants import MLP_STEEPNESS
 
 TOPOLOGIES = ("slp", "mlp")
@@ -273,26 +273,39 @@ def load_policy(source: str | Path) -> Policy:
     path = input_file(source, "policy file", "policy file (JSON, an authors' .net file, or 'baseline')")  # the one check of a file read
     net = path.suffix == ".net"
     name = f"{'network' if net else 'policy'} file {str(path)!r}"
-    from .filekinds import held_kind
-
-    kind = None if net else held_kind(path)
-    if kind not in (None, "a policy file"):  # a store was "must be UTF-8 text", a model file "missing key(s)" (trial 30)
-        raise NeurohoverError(f"{name} is {kind}, not a policy file: give a policy file (as evolve --out writes it), an authors' .net file or 'baseline'")
     try:
         text = utf8_text(path.read_bytes(), name, "a network file" if net else "a policy file")
     except OSError as err:
         raise NeurohoverError(f"{name} cannot be read ({err.strerror or type(err).__name__})") from None
+    except NeurohoverError:
+        _refuse_other_kind(path, name, net)
+        raise
     if net:
         from .netfile import policy_from_net
 
         return policy_from_net(text, name)
     from .paths import parse_json
 
-    policy = policy_from_dict(parse_json(text, name), name)
+    try:
+        policy = policy_from_dict(parse_json(text, name), name)
+    except NeurohoverError:
+        _refuse_other_kind(path, name, net)
+        raise
     problem = record_problem(policy.metadata)  # its record of its run against itself: a budget of -5 or a stop reason 'zzz' was taken (T23-11)
     if problem:
         raise NeurohoverError(f"{name}: {problem}")
     return policy
+
+
+def _refuse_other_kind(path: Path, name: str, net: bool) -> None:
+    """Where a file load_policy cannot read is a neurohover file of another kind, say so: a results store was "must be
+    UTF-8 text", a compete summary "missing key(s) topology, genome" (trial 30). Looked at only once the read failed."""
+    from .filekinds import held_kind
+
+    kind = None if net else held_kind(path)
+    if kind not in (None, "a policy file"):
+        allowed = "give a policy file (as evolve --out writes it), an authors' .net file or 'baseline'"
+        raise NeurohoverError(f"{name} is {kind}, not a policy file: {allowed}") from None
 
 
 def record_problem(metadata: dict) -> str:
@@ -380,7 +393,7 @@ def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
         if taken:  # they would overwrite the policy itself (second trial), from its own metadata edited in place too (T28-B05)
             raise NeurohoverError(f"{what} key(s) {', '.join(taken)} are the policy's own: give the metadata other names")
     data.update(metadata)
-    _check_text_keys(data)
+    refuse_non_text_keys(data, "policy")  # {1: 2} came back as {'1': 2} (T28-B14)
     try:  # json_text: what load_policy reads back (x=10**400 was written, then refused; T28-B14)
         text = json_text(data, indent=1) + "\n"
     except (TypeError, ValueError, RecursionError) as err:  # an object, or a NaN that other JSON readers refuse
@@ -393,25 +406,3 @@ def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
     with writing(path, "policy file") as partial:
         partial.write_text(text)
     return path
-
-
-def _check_text_keys(data: dict) -> None:
-    """Refuse policy metadata holding a key that is not text, at any depth: JSON writes every key as text, and {1: 2} came
-    back from the file as {'1': 2} (T28-B14), as flight data refuse it (T15-29)."""
-    stack: list[object] = [data]
-    seen: set[int] = set()  # a dict that holds itself: json_text names it
-    while stack:
-        value = stack.pop()
-        if isinstance(value, (dict, list, tuple)) and id(value) in seen:
-            continue
-        seen.add(id(value))
-        if isinstance(value, dict):
-            key = next((k for k in value if not isinstance(k, str)), None)
-            if key is not None:
-                raise NeurohoverError(
-                    f"policy metadata key {brief(key)} is not allowed: give text keys "
-                    "(JSON writes every key as text, so the file would load back with other metadata)"
-                )
-            stack.extend(value.values())
-        elif isinstance(value, (list, tuple)):
-            stack.extend(value)

@@ -81,7 +81,7 @@ def crash_return_ceiling(n_steps: int, t: int) -> float:
     :func:`crash_charge` on top of its rewards (each <= 0), so at most that charge, with 1e-9 of it to spare for the
     kernel's rounding. What every reader of recorded crashes checks a return against (compete's episodes.csv, stored
     test runs; T26-B09)."""
-    charge = CRASH_STEP_PENALTY * (n_steps - t)
+    charge = -crash_charge(n_steps, t)
     return -charge + 1e-9 * charge
 
 
