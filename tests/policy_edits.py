@@ -12,6 +12,16 @@ import neurohover as nh
 from neurohover.errors import NeurohoverError
 
 
+def evolved_policy_file(where: Path) -> Path:
+    """A policy file as evolve writes it under ``where``: a 10-episode run of 20-step episodes on ghh08/train:0."""
+    from neurohover.cli import main
+
+    out = where / "p.json"
+    argv = ["evolve", "--task", "ghh08", "--mdp", "train:0", "--topology", "slp", "--seed-policy", "baseline", "--budget", "10"]
+    assert main([*argv, "--episode-steps", "20", "--seed", "1", "--out", str(out)]) == 0
+    return out
+
+
 def edited(src: Path, dst: Path, **changes: Any) -> Path:
     """``src``'s JSON file with ``changes`` (a value None: the key removed) written to ``dst``."""
     data = json.loads(src.read_text())

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 from conftest import CliRun, tiny_test_runs
-from policy_edits import edited, refused
+from policy_edits import edited, evolved_policy_file, refused
 from store_edits import refused_by_every_command
 from test_bad_input_trial23_results import _edited, _refused, _reproduced
 
@@ -29,12 +29,7 @@ HEADER = "run,mdp,episode,return,crashed,steps,policy,safeguard_fired\n"
 @pytest.fixture(scope="module")
 def policy_file(tmp_path_factory) -> Path:
     """A policy file as evolve writes it: a 10-episode run of 20-step episodes on ghh08/train:0."""
-    from neurohover.cli import main
-
-    out = tmp_path_factory.mktemp("p27") / "p.json"
-    argv = ["evolve", "--task", "ghh08", "--mdp", "train:0", "--topology", "slp", "--seed-policy", "baseline", "--budget", "10"]
-    assert main([*argv, "--episode-steps", "20", "--seed", "1", "--out", str(out)]) == 0
-    return out
+    return evolved_policy_file(tmp_path_factory.mktemp("p27"))
 
 
 @pytest.fixture(scope="module")

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from policy_edits import edited, refused
+from policy_edits import edited, evolved_policy_file, refused
 from store_edits import begin
 
 import neurohover as nh
@@ -30,12 +30,7 @@ MAX_GENE = 1e120  # neurohover.policies.MAX_GENE
 @pytest.fixture(scope="module")
 def policy_file(tmp_path_factory) -> Path:
     """A policy file as evolve writes it: a 10-episode run of 20-step episodes on ghh08/train:0."""
-    from neurohover.cli import main
-
-    out = tmp_path_factory.mktemp("p30") / "p.json"
-    argv = ["evolve", "--task", "ghh08", "--mdp", "train:0", "--topology", "slp", "--seed-policy", "baseline", "--budget", "10"]
-    assert main([*argv, "--episode-steps", "20", "--seed", "1", "--out", str(out)]) == 0
-    return out
+    return evolved_policy_file(tmp_path_factory.mktemp("p30"))
 
 
 # ----------------------------------------------------------------------------------------------- T30-B01
