@@ -26,7 +26,8 @@ from typing import Any
 from ..errors import NeurohoverError, brief, whole_number
 from ..evaluate import DEVICES, check_device
 from ..procs import max_jobs, sigterm_as_interrupt, stop_pool, worker_pool
-from .store import EXECUTORS, worker_name
+from .store import worker_name
+from .store_checks import EXECUTORS
 from .units import Unit, run_unit
 
 OnResult = Callable[[Unit, dict, float, str], None]

@@ -41,18 +41,17 @@ from typing import Any
 from ..errors import NeurohoverError, brief, check_flag, finite_real
 from ..paths import JSONError, WriterLock, strict_json
 from .config import check_name, check_scale
-from .store_checks import EXECUTORS as EXECUTORS  # executors.py reads the names from here
 from .store_checks import (
     SESSION_STATUSES,
-    _check_text,
-    _count,
-    _object_text,
     bad_session,
+    check_text,
     check_unit_kind,
     config_problem,
     experiment_problem,
+    object_text,
     session_problem,
     sqlite_says,
+    stored_count,
 )
 from .units import Unit
 
@@ -280,8 +279,8 @@ class Store:
         """
         where = self._where("begin")
         check_experiment(name, scale, where)
-        _check_text(config_hash, "config_hash", where)
-        text = _object_text(config, "config", where)
+        check_text(config_hash, "config_hash", where)
+        text = object_text(config, "config", where)
         self._check_config(config, scale, config_hash, where)
         check_flag(fresh, "fresh", "delete the experiment's stored units first")
         if not fresh:  # its row kept: a damaged one named (T22-09)
@@ -322,8 +321,8 @@ class Store:
         """
         where = self._where("update")
         check_experiment(name, scale, where)
-        _check_text(config_hash, "config_hash", where)
-        text = _object_text(config, "config", where)
+        check_text(config_hash, "config_hash", where)
+        text = object_text(config, "config", where)
         given = list(keep) if isinstance(keep, Iterable) and not isinstance(keep, (str, bytes, dict)) else None
         if given is None or not all(isinstance(k, str) for k in given):  # None was a TypeError; a text would be kept letter by letter
             raise NeurohoverError(f"{where}: keep = {brief(keep)} is not allowed: give a list or set of unit keys (text) to keep")
@@ -490,21 +489,21 @@ class Store:
         """
         where = self._where("put")
         check_experiment(name, scale, where)
-        _check_text(config_hash, "config_hash", where)
+        check_text(config_hash, "config_hash", where)
         if not isinstance(unit, Unit):
             raise NeurohoverError(f"{where}: unit = {brief(unit)} is not allowed: give the Unit that finished (a plan's)")
-        _check_text(unit.key, "the unit's key", where)
-        _check_text(unit.kind, "the unit's kind", where)
+        check_text(unit.key, "the unit's key", where)
+        check_text(unit.kind, "the unit's kind", where)
         check_unit_kind(unit.key, unit.kind, where)
-        params = _object_text(unit.params, f"unit {unit.key}'s params", where)
-        text = _object_text(result, f"unit {unit.key}'s result", where)
+        params = object_text(unit.params, f"unit {unit.key}'s params", where)
+        text = object_text(result, f"unit {unit.key}'s result", where)
         if not (finite_real(seconds) and seconds >= 0):
             raise NeurohoverError(f"{where}: seconds = {brief(seconds)} is not allowed: give a finite number of seconds >= 0")
-        _check_text(worker, "worker", where, empty=True)
+        check_text(worker, "worker", where, empty=True)
         if unit.experiment != name:  # stored under another experiment's name without a word (T29-B05)
             raise NeurohoverError(f"{where}: unit {brief(unit.key)}'s experiment = {brief(unit.experiment)} is not allowed: give a unit of {name} (its plan's)")
         if session is not None:
-            session = _count(session, "session", where, 1)
+            session = stored_count(session, "session", where, 1)
         self.lock()
         c = self.conn
         with _transaction(c):
@@ -533,10 +532,10 @@ class Store:
         Arguments are checked first (cores=0 was stored, and :meth:`sessions` then called the store damaged; T14-5)."""
         where = self._where("start_session")
         check_experiment(name, scale, where)
-        _check_text(config_hash, "config_hash", where)
-        _check_text(executor, "executor", where)
-        cores = _count(cores, "cores", where, 1)
-        units_before = _count(units_before, "units_before", where, 0)
+        check_text(config_hash, "config_hash", where)
+        check_text(executor, "executor", where)
+        cores = stored_count(cores, "cores", where, 1)
+        units_before = stored_count(units_before, "units_before", where, 0)
         self.lock()
         c = self.conn
         with _transaction(c):  # a session sessions() would call damaged is refused (T29-B04)
@@ -557,8 +556,8 @@ class Store:
     def end_session(self, session: int, status: str) -> None:
         """Record how session ``session`` (:meth:`start_session`'s id) ended: ``status`` (one of :data:`SESSION_STATUSES`) and its wall time."""
         where = self._where("end_session")
-        session = _count(session, "session", where, 1)
-        _check_text(status, "status", where)  # object() was sqlite3's ProgrammingError (T14-5)
+        session = stored_count(session, "session", where, 1)
+        check_text(status, "status", where)  # object() was sqlite3's ProgrammingError (T14-5)
         if status not in SESSION_STATUSES:  # free text was stored, and shown by the report as a session's end (fifteenth trial, T15-22)
             raise NeurohoverError(f"{where}: status = {brief(status)} is not allowed: give one of {', '.join(map(repr, SESSION_STATUSES))}")
         self.lock()

@@ -111,21 +111,21 @@ def session_problem(conn: sqlite3.Connection, session: int, of: tuple[str, str, 
     return ""
 
 
-def _check_text(value: Any, what: str, where: str, empty: bool = False) -> None:
+def check_text(value: Any, what: str, where: str, empty: bool = False) -> None:
     """Refuse a stored text field that is no text, empty (unless ``empty``) or holding NUL (None was an IntegrityError)."""
     if not isinstance(value, str) or (not value and not empty) or "\x00" in value:
         allowed = "text" if empty else "non-empty text"
         raise NeurohoverError(f"{where}: {what} = {brief(value)} is not allowed: give {allowed} without NUL characters")
 
 
-def _count(value: Any, what: str, where: str, least: int) -> int:
+def stored_count(value: Any, what: str, where: str, least: int) -> int:
     """``value`` as an int of at least ``least``, or one error naming it (cores=0 was stored, and read back as damaged)."""
     if not whole_number(value) or value < least:
         raise NeurohoverError(f"{where}: {what} = {brief(value)} is not allowed: give a whole number >= {least}")
     return int(value)
 
 
-def _object_text(value: Any, what: str, where: str) -> str:
+def object_text(value: Any, what: str, where: str) -> str:
     """``value``'s JSON text, if it is a JSON object that reads back (:func:`~neurohover.paths.strict_json`), or one error
     naming it: a list was stored and every later read called the store damaged, NaN was json's ValueError (T14-5)."""
     if not isinstance(value, dict):
