@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 from collections.abc import Callable
 from pathlib import Path
 
@@ -34,6 +35,7 @@ __all__ = [
     "refuse_policy_set",
     "refuse_run_file_name",
     "refuse_suffix",
+    "refuse_unencodable",
 ]
 
 SQLITE_HEADER = b"SQLite format 3\x00"  # the first bytes of every SQLite database: a results store
@@ -108,6 +110,20 @@ RUN_FILE_ENDS = {".checkpoint.json": "checkpoint (which --resume continues)", ".
 
 #: The longest name of one file or directory in bytes where the file system cannot say (Linux's NAME_MAX).
 NAME_MAX = 255
+
+
+def refuse_unencodable(text: str, option: str) -> None:
+    """Refuse a path ``text`` the file system's encoding cannot encode: a non-ASCII name under an ASCII locale
+    (``LC_ALL=C PYTHONUTF8=0``), a lone surrogate under any; each was os.fsencode's UnicodeEncodeError (T31-B03)."""
+    try:
+        os.fsencode(text)
+    except UnicodeEncodeError as err:
+        coding = sys.getfilesystemencoding()
+        hint = " or run under a UTF-8 locale (LC_ALL=C.UTF-8, or PYTHONUTF8=1)" if coding.lower().replace("-", "") != "utf8" else ""
+        raise NeurohoverError(
+            f"{option} {brief(text)} is not allowed: the file system's encoding ({coding}) cannot encode the characters "
+            f"{ascii(err.object[err.start : err.end])} in it: give a name of characters it can encode{hint}"
+        ) from None
 
 
 def name_limit(path: str | os.PathLike) -> int:

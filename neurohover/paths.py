@@ -25,7 +25,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .errors import NeurohoverError, OutputError, brief, float_of
-from .filekinds import NAME_MAX, PNG_KIND, SQLITE_HEADER, fitting_name, held_kind, name_limit, output_name, refuse_policy_set
+from .filekinds import NAME_MAX, PNG_KIND, SQLITE_HEADER, fitting_name, held_kind, name_limit, output_name, refuse_policy_set, refuse_unencodable
 
 try:
     import fcntl
@@ -149,6 +149,7 @@ def checked_path(path, option: str, what: str = "file path", ends: tuple[str, ..
         raise NeurohoverError(f"{option} is empty; give a {what}")
     if "\x00" in text:
         raise NeurohoverError(f"{option} {text!r:.80} holds a NUL character: give a {what}")
+    refuse_unencodable(text, option)
     refuse_gone_cwd(text, option)
     parts = Path(text).parts  # "." has no parts (fifth trial)
     end = max(ends, key=lambda e: len(os.fsencode(e)), default="")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import io
 import json
 import math
 import os
@@ -15,7 +16,7 @@ import numpy as np
 
 from ..errors import NeurohoverError, brief, first_difference, whole_number
 from ..filekinds import CSV_KINDS, JSON_KINDS, fitting_name, name_limit
-from ..paths import JSONError, number_text, output_file, strict_json, writing
+from ..paths import JSONError, input_file, number_text, output_file, strict_json, writing
 from ..policies import Policy
 from .common import EntryError, enc_float, read_count, read_return, read_seconds
 
@@ -198,15 +199,24 @@ def read_history_csv(path: str | Path) -> list[HistoryRecord]:
         :func:`write_history_csv` writes it: each number in ASCII digits (:func:`~neurohover.paths.number_text`), counts
         >= 0, a champion's fitness finite or '-inf' (on the run's scale: 1/ln(error) is > 0), seconds finite and >= 0, and the rows as a run records them
         (:func:`check_history`; wall seconds never falling). int() and float() took 'nan', '1_0', other scripts' digits
-        and falling counts (T28-B13).
+        and falling counts (T28-B13). The file ends with a newline, as written: a file cut inside its last number read as
+        another number (T31-B07).
     """
+    input_file(path, "history file")  # a path the file system cannot encode was a UnicodeEncodeError (T31-B03)
     try:  # utf-8-sig: a byte-order mark (a spreadsheet's "UTF-8 with BOM") hid the header (T30-B05)
         with open(path, newline="", encoding="utf-8-sig") as f:
-            rows = [row for row in csv.reader(f) if row]
+            text = f.read()
     except UnicodeDecodeError as err:
         raise NeurohoverError(f"{str(path)!r} is not an evolution history: it is not UTF-8 text (byte {err.start})") from None
+    rows = [row for row in csv.reader(io.StringIO(text, newline="")) if row]
     if not rows or tuple(rows[0]) != HISTORY_COLUMNS:
         raise NeurohoverError(f"{str(path)!r} is not an evolution history (expected the header {','.join(HISTORY_COLUMNS)})")
+    if not text.endswith("\n"):  # ',0.0193' cut to ',0.01' was read as 0.01
+        last = text.rsplit("\n", 1)[-1]
+        raise NeurohoverError(
+            f"{str(path)!r} does not end with a newline, as every history neurohover writes does: it looks cut off "
+            f"(its last line {brief(last)}); give the whole file"
+        )
     out: list[HistoryRecord] = []
     for n, row in enumerate(rows[1:], start=2):
         if len(row) != len(HISTORY_COLUMNS):

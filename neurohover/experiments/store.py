@@ -39,6 +39,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import NeurohoverError, brief, check_flag, finite_real
+from ..filekinds import SQLITE_HEADER
 from ..paths import JSONError, WriterLock, strict_json
 from .config import check_name, check_scale
 from .store_checks import (
@@ -130,6 +131,9 @@ class Store:
             raise NeurohoverError(f"results store {str(self.path)!r} is not a regular file (a device, pipe or socket); give a file name")
         if not create and self.path.stat().st_size == 0:  # read, it was given the schema: a refused command changed it (seventh trial)
             raise NeurohoverError(f"results store {str(self.path)!r} is empty (0 bytes): it holds no experiment yet")
+        with contextlib.suppress(OSError), open(self.path, "rb") as f:  # missing or unreadable: SQLite says so below
+            if f.read(len(SQLITE_HEADER)) not in (b"", SQLITE_HEADER):  # 1 byte: SQLite took it as empty (T31-B01)
+                raise NeurohoverError(f"{str(self.path)!r} is not a neurohover results store (it does not start with SQLite's header {SQLITE_HEADER!r})")
         make_dirs(self.path.parent, "results store", str(path))  # a file as its parent was pathlib's FileExistsError (fifteenth trial, T15-10)
         self._lock = WriterLock(self.lock_path)
         new = not self.path.exists() or self.path.stat().st_size == 0

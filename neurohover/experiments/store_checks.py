@@ -112,10 +112,18 @@ def session_problem(conn: sqlite3.Connection, session: int, of: tuple[str, str, 
 
 
 def check_text(value: Any, what: str, where: str, empty: bool = False) -> None:
-    """Refuse a stored text field that is no text, empty (unless ``empty``) or holding NUL (None was an IntegrityError)."""
+    """Refuse a stored text field that is no text, empty (unless ``empty``), holding NUL (None was an IntegrityError) or
+    a character UTF-8 cannot encode (a lone surrogate, '\\ud800', was SQLite's UnicodeEncodeError; T31-B06)."""
+    allowed = "text" if empty else "non-empty text"
     if not isinstance(value, str) or (not value and not empty) or "\x00" in value:
-        allowed = "text" if empty else "non-empty text"
         raise NeurohoverError(f"{where}: {what} = {brief(value)} is not allowed: give {allowed} without NUL characters")
+    try:
+        value.encode("utf-8")
+    except UnicodeEncodeError as err:
+        raise NeurohoverError(
+            f"{where}: {what} = {brief(value)} is not allowed: it holds {ascii(err.object[err.start : err.end])}, a lone surrogate, "
+            f"which UTF-8 cannot store: give {allowed} without lone surrogates"
+        ) from None
 
 
 def stored_count(value: Any, what: str, where: str, least: int) -> int:
