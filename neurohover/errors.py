@@ -27,7 +27,9 @@ class Terminated(KeyboardInterrupt):
 def whole_number(value: object) -> TypeGuard[int]:
     """Whether ``value`` is an integer, NumPy's included, and not a bool (True is an int, and was taken as 1). The one
     test of every integer argument; the type checker takes it as an int (NumPy's integers compare and index alike).
-    An int subclass whose ``int()`` is not its value is not: the value checked must be the value used (T28-B01)."""
+    An int subclass whose ``int()`` is not its value is not: the value checked must be the value used (T28-B01). A test
+    only: where the value is used, use the Python int :func:`whole_in` returns (or ``operator.index``), not the value
+    given, whose NumPy arithmetic wraps (np.int8(127) + 1 is -128: evaluate's n_steps + 1, T31-B02)."""
     if not (isinstance(value, numbers.Integral) and not isinstance(value, bool) and type(value).__name__ not in _TIMES):
         return False
     return type(value) is int or _honest_int(value)

@@ -305,8 +305,8 @@ MAX_STEPS_PER_CALL, MAX_RECORD_BYTES, RECORD_BYTES_PER_STEP = 10**12, 8 * 2**30,
 MAX_EPISODES_PER_CALL = 100_000_000
 
 
-def _check_n_steps(n_steps) -> None:
-    whole_in(n_steps, "n_steps", 1, MAX_EPISODE_STEPS)  # np.timedelta64 was int()'s TypeError (T17-1)
+def _check_n_steps(n_steps) -> int:
+    return whole_in(n_steps, "n_steps", 1, MAX_EPISODE_STEPS)  # an int: np.int8(127) + 1 overflowed (T31-B02); np.timedelta64 (T17-1)
 
 
 def _check_call_size(n_jobs: int, n_steps: int, n_rec: int) -> None:
@@ -394,8 +394,8 @@ def evaluate_jobs(
     check_device(device)
     table = policies if isinstance(policies, PolicyTable) else PolicyTable.from_policies(policies)
     rows = mdp_rows(mdps)
-    whole_in(seed, "seed", 0, MAX_SEED, "2**63-1")  # True was seed 1; np.timedelta64 int()'s TypeError (T17-1)
-    _check_n_steps(n_steps)
+    seed = whole_in(seed, "seed", 0, MAX_SEED, "2**63-1")  # True was seed 1; np.timedelta64 int()'s TypeError (T17-1)
+    n_steps = _check_n_steps(n_steps)  # the int checked is the int flown: np.int8(127) + 1 was -128 (T31-B02)
     p_idx = _index_array(policy_index, None, "policy_index")
     n_jobs = p_idx.shape[0]
     m_idx = _index_array(mdp_index, n_jobs, "mdp_index")
@@ -425,7 +425,7 @@ def evaluate_jobs(
     if rec.shape[0] != n_jobs:
         raise NeurohoverError(f"record must have one flag per job ({n_jobs}), got {rec.shape[0]}")
     n_rec = int(rec.sum())
-    _check_call_size(n_jobs, int(n_steps), n_rec)
+    _check_call_size(n_jobs, n_steps, n_rec)
     slots = np.full(n_jobs, -1, dtype=np.int64)
     slots[rec] = np.arange(n_rec)
     obs_out = np.zeros((n_rec, n_steps + 1, 12))
@@ -479,16 +479,16 @@ def evaluate(
         raise NeurohoverError("policies=PolicyTable of 0 policies is not allowed: give a non-empty sequence of Policy objects or a non-empty PolicyTable")
     rows = mdp_rows(mdps)
     # T24-11: whole_in, so 1.5 or True "is not allowed" (a type) and 0 "is out of range"; both once said out of range
-    whole_in(episodes, "episodes", 1, MAX_EPISODES_PER_CALL, f"{MAX_EPISODES_PER_CALL:,} (policies x MDPs x episodes in one call)")
+    episodes = whole_in(episodes, "episodes", 1, MAX_EPISODES_PER_CALL, f"{MAX_EPISODES_PER_CALL:,} (policies x MDPs x episodes in one call)")
     if not isinstance(record, (bool, np.bool_)):
         raise NeurohoverError(f"record={record!r} is not allowed: give True or False")
-    check_first_episode(first_episode)
+    first_episode = check_first_episode(first_episode)  # ints from here on: NumPy's small ints overflowed (T31-B02)
     if safeguard is not None and not isinstance(safeguard, Safeguard):
         raise NeurohoverError(f"safeguard={safeguard!r:.60} is not allowed: give a neurohover.evaluate.Safeguard(fallback_policy) or None")
     n_pol, n_mdp = len(table), rows.shape[0]
-    check_episode_count(n_pol * n_mdp * int(episodes), f"{n_pol} policies x {n_mdp} MDPs x episodes={episodes}")
-    _check_n_steps(n_steps)  # both before the job arrays are made (10**8 episodes of 10**7 steps took 50 s to refuse)
-    _check_call_size(n_pol * n_mdp * int(episodes), int(n_steps), n_pol * n_mdp * int(episodes) if record else 0)
+    check_episode_count(n_pol * n_mdp * episodes, f"{n_pol} policies x {n_mdp} MDPs x episodes={episodes}")
+    n_steps = _check_n_steps(n_steps)  # both before the job arrays are made (10**8 episodes of 10**7 steps took 50 s to refuse)
+    _check_call_size(n_pol * n_mdp * episodes, n_steps, n_pol * n_mdp * episodes if record else 0)
     p_idx, m_idx, e = np.meshgrid(np.arange(n_pol), np.arange(n_mdp), np.arange(episodes), indexing="ij")
     episode_index = first_episode + m_idx * episodes + e
     fallback = None

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real, whole_in
-from .policies import Policy, policy_from_dict
+from .policies import MAX_OBSERVATION, Policy, policy_from_dict
 from .sim.constants import CRASH_STEP_PENALTY, MAX_POSITION, MAX_RATE, MAX_VELOCITY, MIN_QW, WORST_RETURN
 from .sim.rng import MAX_SEED
 
@@ -175,11 +175,12 @@ def flown_policy(metadata: dict, where: str) -> Policy | None:
 def action_mismatch(policy: Policy, observations: np.ndarray, actions: np.ndarray) -> tuple[int, int, float, float] | None:
     """The first of an episode's first :data:`CHECKED_STEPS` steps where ``policy`` does not give the recorded action
     (clipped to [-1, 1] as the kernel flies it, within :data:`ACTION_TOLERANCE`), as (step, action index, the policy's,
-    the recorded), or None. Steps of a non-finite reading or action are passed over (a crash's NaN action is recorded as
-    given). Recordings hold what the policy saw (a sensor's readings) and ``fly --record`` flies no safeguard, so every
-    recorded action is the policy's own: the one test of it, at load and by EC-MER (models.ec.check_policy_flew)."""
+    the recorded), or None. Steps of a non-finite action, or of a reading Policy.act refuses (non-finite or past
+    MAX_OBSERVATION, T31-B05), are passed over (a crash's NaN action is recorded as given). Recordings hold what the
+    policy saw (a sensor's readings) and ``fly --record`` flies no safeguard, so every recorded action is the policy's
+    own: the one test of it, at load and by EC-MER (models.ec.check_policy_flew)."""
     for k in range(min(CHECKED_STEPS, actions.shape[0])):
-        if not np.all(np.isfinite(actions[k])) or not np.all(np.isfinite(observations[k])):
+        if not np.all(np.isfinite(actions[k])) or not np.all(np.abs(observations[k]) <= MAX_OBSERVATION):  # Policy.act's bound (T31-B05)
             continue
         flown = np.clip(policy.act(observations[k]), -1.0, 1.0)
         i = int(np.argmax(np.abs(flown - actions[k])))

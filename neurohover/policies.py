@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import NeurohoverError, as_floats, brief, masked_note, refuse_non_text_keys
-from .sim.constants import MLP_STEEPNESS
+from .sim.constants import MLP_STEEPNESS, OBS_NAMES
 
 TOPOLOGIES = ("slp", "mlp")
 GENOME_LENGTH = {"slp": 40, "mlp": 42}
@@ -29,6 +29,10 @@ GENOME_LENGTH = {"slp": 40, "mlp": 42}
 #: deepest product, gene x gene x (sum of five inputs), stays finite for observations up to 3e67, far past any flown
 #: state (crash limits of 20 m, 5 m/s, 4 pi rad/s, and sensor noise of std <= 1e4).
 MAX_GENE = 1e120
+#: The largest observation entry :meth:`Policy.act` takes (T31-B05: 1e190 and 1.7e308 acted inf and NaN): with genes
+#: <= MAX_GENE an MLP's actions stay below about 3e300 (an SLP's 9e180), finite, for entries up to it; flown states
+#: stay far below (the crash limits above, sensor noise of std <= 1e4).
+MAX_OBSERVATION = 1e60
 INPUT_NAMES = ("u", "v", "w", "x", "y", "z", "qx", "qy", "qz")
 MLP_BIAS_NAMES = ("hy", "hx", "hz", "L1", "L2", "L3", "L4", "S1", "S2", "S3", "S4", "a1", "a2", "a3", "a4")
 MLP_WEIGHT_NAMES = (
@@ -133,7 +137,9 @@ class Policy:
     def act(self, observation: Sequence[float]) -> tuple[float, float, float, float]:
         """Actions for a 12-number observation, computed in plain Python (the readable definition).
 
-        Raises NeurohoverError for an observation that is not 12 finite numbers (a NaN would give NaN actions silently)."""
+        Raises NeurohoverError for an observation that is not 12 finite numbers (a NaN would give NaN actions silently),
+        or one with an entry past :data:`MAX_OBSERVATION` (1e60) in magnitude: the rule that keeps every action finite for
+        genes up to :data:`MAX_GENE` (1e190 gave inf and NaN actions; T31-B05). Flown states stay far below it."""
         try:  # not text, booleans or complex numbers; not a masked array, whose hidden values were flown (T16-9)
             raw = np.asarray(observation)
             obs = raw.astype(np.float64) if raw.dtype.kind in "iuf" and not isinstance(observation, np.ma.MaskedArray) else np.zeros(0)
@@ -142,6 +148,12 @@ class Policy:
         if obs.shape != (12,) or not np.all(np.isfinite(obs)):  # the shape: (3, 4) was flown flattened as one observation (T15-28)
             raise NeurohoverError(
                 f"observation {brief(observation)} is not allowed: give 12 finite numbers of shape (12,) (u, v, w, x, y, z, p, q, r, qx, qy, qz)"
+            )
+        big = np.flatnonzero(np.abs(obs) > MAX_OBSERVATION)
+        if big.size:  # one test per call, outside the arithmetic: the kernel's hot path is not this one
+            raise NeurohoverError(
+                f"observation {brief(observation)} is out of range: its {OBS_NAMES[big[0]]} {brief(float(obs[big[0]]))} is past "
+                f"{MAX_OBSERVATION:g}; allowed 12 finite numbers in [-{MAX_OBSERVATION:g}, {MAX_OBSERVATION:g}] (actions stay finite)"
             )
         u, v, w, x, y, z, _p, _q, _r, qx, qy, qz = obs.tolist()
         g = self.genome.tolist()

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, whole_in, whole_number
+from ..errors import NeurohoverError, brief, finite_real, whole_in
 from ..evaluate import MAX_EPISODES_PER_CALL, DangerousState, PolicyTable, evaluate_jobs
 from ..evolution.seeding import check_seed
 from ..flightdata import FlightData
@@ -95,9 +95,9 @@ class Choice:
             )
 
 
-def _check_count(what: str, value: object, least: int) -> None:
+def _check_count(what: str, value: object, least: int) -> int:
     # T24-11: whole_in, so 1.5 or True "is not allowed" (a type) and an integer below least "is out of range"
-    whole_in(value, what, least, 2**63 - 1, "2**63-1")
+    return whole_in(value, what, least, 2**63 - 1, "2**63-1")
 
 
 def _check_return(ret: float, crashed: bool, steps: int) -> None:
@@ -127,13 +127,13 @@ class EpisodeOutcome:
 
     def __post_init__(self) -> None:
         # EpisodeOutcome('a', 'b', ...) was made, then refused by some agents with a TypeError and taken by others (thirteenth trial, F12).
-        _check_count("EpisodeOutcome episode", self.episode, 0)
+        object.__setattr__(self, "episode", _check_count("EpisodeOutcome episode", self.episode, 0))  # ints, not NumPy's (T31-B02)
         if not finite_real(self.ret):
             raise NeurohoverError(f"EpisodeOutcome ret={brief(self.ret)} is not allowed: give the episode's return, a finite number")
         if not isinstance(self.crashed, (bool, np.bool_)):
             raise NeurohoverError(f"EpisodeOutcome crashed={brief(self.crashed)} is not allowed: give True or False")
-        whole_in(self.steps, "EpisodeOutcome steps", 1, MAX_EPISODE_STEPS)  # T27-B10: 0 and 10**8 were taken (Evaluation's 1..MAX_EPISODE_STEPS)
-        _check_count("EpisodeOutcome safeguard_step", self.safeguard_step, -1)
+        object.__setattr__(self, "steps", whole_in(self.steps, "EpisodeOutcome steps", 1, MAX_EPISODE_STEPS))  # T27-B10: 0 and 10**8 were taken
+        object.__setattr__(self, "safeguard_step", _check_count("EpisodeOutcome safeguard_step", self.safeguard_step, -1))
         # T27-B10: a safeguard step past the episode, a positive return and -1e30 for 20 steps were taken
         if self.safeguard_step >= max(self.steps, 0):
             raise NeurohoverError(
@@ -180,8 +180,7 @@ def _checked_start(start):
 def _checked_choose(choose):
     @functools.wraps(choose)
     def checked(self, episode):
-        _check_count("episode", episode, 0)
-        choice = choose(self, int(episode))
+        choice = choose(self, _check_count("episode", episode, 0))
         if not isinstance(choice, Choice):
             raise NeurohoverError(f"agent {self.name!r} chose {brief(choice)} for episode {episode}: its choose must return a Choice")
         self._asked_record = choice.record
@@ -310,9 +309,9 @@ def _flown_mdp(mdp: MDP, family: TaskFamily) -> MDP:
     return mdp
 
 
-def _check_run(agent, family, mdp, episodes, seed, n_steps) -> tuple[MDP, int]:
+def _check_run(agent, family, mdp, episodes, seed, n_steps) -> tuple[MDP, int, int, int]:
     """:func:`run_test`'s arguments checked (NeurohoverError naming the bad one); returns the MDP flown
-    (:func:`_flown_mdp`) and the seed."""
+    (:func:`_flown_mdp`), the seed, episodes and n_steps (Python ints: np.int8(127) + 1 overflowed, T31-B02)."""
     if not isinstance(agent, Agent):
         raise NeurohoverError(f"agent={agent!r:.80} is not allowed: give an Agent (neurohover.agents.registry.make_agent(name, family))")
     if not isinstance(family, TaskFamily):
@@ -329,12 +328,13 @@ def _check_run(agent, family, mdp, episodes, seed, n_steps) -> tuple[MDP, int]:
         raise NeurohoverError(f"mdp {mdp.label!r} is a {mdp.family} MDP, but the run's family is {family.name}: give an MDP of {family.name}")
     mdp = _flown_mdp(mdp, family)
     # T24-11: whole_in, so 1.5 or True "is not allowed" and 0 "is out of range"; the bound check_episode_count had
-    whole_in(episodes, "episodes", 1, MAX_EPISODES_PER_CALL, f"{MAX_EPISODES_PER_CALL:,} (episodes in one call)")
-    mdp.drift.check_run(int(episodes))
+    episodes = whole_in(episodes, "episodes", 1, MAX_EPISODES_PER_CALL, f"{MAX_EPISODES_PER_CALL:,} (episodes in one call)")
+    mdp.drift.check_run(episodes)
+    n_steps = whole_in(n_steps, "n_steps", 1, MAX_EPISODE_STEPS)  # as evaluate_jobs checks it, before the agent starts
     settings = getattr(agent, "settings", None)
-    if isinstance(settings, AgentSettings) and whole_number(n_steps):  # others are refused where the episodes fly
-        settings.check_episode_steps(int(n_steps))  # settings that cannot act in episodes this long (twelfth trial, S3)
-    return mdp, check_seed(seed)
+    if isinstance(settings, AgentSettings):
+        settings.check_episode_steps(n_steps)  # settings that cannot act in episodes this long (twelfth trial, S3)
+    return mdp, check_seed(seed), episodes, n_steps
 
 
 def run_test(
@@ -357,7 +357,7 @@ def run_test(
     explicit ``mdp``: an MDP of exact sensors flies through ``family.sensor``, one without drift drifts by
     ``family.drift``, an MDP's own flies beside a family's exact or none, one differing is refused (result.mdp: as flown).
     """
-    mdp, seed = _check_run(agent, family, mdp, episodes, seed, n_steps)
+    mdp, seed, episodes, n_steps = _check_run(agent, family, mdp, episodes, seed, n_steps)
     start_time = time.perf_counter()
     agent.start(family, np.random.default_rng(np.random.SeedSequence([seed, 0xA6E27])))
     returns = np.zeros(episodes)

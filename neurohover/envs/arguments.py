@@ -183,15 +183,14 @@ def check_no_unknown_kwargs(unknown: dict[str, Any], allowed: Sequence[str]) -> 
         raise NeurohoverError(f"unknown argument(s) {', '.join(sorted(unknown))}: allowed {', '.join(allowed)}")
 
 
-def check_count(value: Any, name: str, largest: int) -> None:
-    """Refuse ``value`` (the argument ``name``) unless it is an integer in 1..``largest`` (:func:`~neurohover.errors.whole_in`)."""
-    whole_in(value, name, 1, largest)
+def check_count(value: Any, name: str, largest: int) -> int:
+    """``value`` (the argument ``name``) as an int, refused unless it is an integer in 1..``largest`` (:func:`~neurohover.errors.whole_in`)."""
+    return whole_in(value, name, 1, largest)
 
 
 def check_episode_steps(episode_steps: Any, name: str = "episode_steps") -> int:
     """``episode_steps`` (the argument ``name``) as an int, or a clear error."""
-    check_count(episode_steps, name, MAX_EPISODE_STEPS)
-    return int(episode_steps)
+    return check_count(episode_steps, name, MAX_EPISODE_STEPS)
 
 
 def check_reset_options(options: dict[str, Any] | None, extra: Sequence[str] = ()) -> dict[str, Any]:

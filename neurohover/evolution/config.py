@@ -340,7 +340,7 @@ class RunConfig:
         if budget is not None:
             budget = check_budget(budget)
         seed = check_seed(seed)
-        whole_in(n_steps, "n_steps", 1, MAX_EPISODE_STEPS)  # T24-11: 1.5 or True "is not allowed", 0 out of range
+        n_steps = whole_in(n_steps, "n_steps", 1, MAX_EPISODE_STEPS)  # T24-11: 1.5 or True "is not allowed", 0 out of range
         chosen = ("steady-state" if mdp is not None else "generational") if method is None else method
         if not isinstance(chosen, str) or chosen not in ("steady-state", "generational"):
             raise NeurohoverError(f"unknown method {brief(method)}: allowed steady-state, generational")

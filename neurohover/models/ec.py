@@ -252,7 +252,7 @@ def learn_ec_mer(
     if not isinstance(generic_policy, Policy):
         raise NeurohoverError(f"generic_policy must be a Policy, got {type(generic_policy).__name__}")
     # np.timedelta64 was int()'s TypeError (T17-1); 1.5 was called out of range (T24-11)
-    whole_in(episodes, "episodes", 1, MAX_EC_MER_EPISODES, f"{MAX_EC_MER_EPISODES:,} (per candidate)")
+    episodes = whole_in(episodes, "episodes", 1, MAX_EC_MER_EPISODES, f"{MAX_EC_MER_EPISODES:,} (per candidate)")  # an int (T31-B02)
     tr = Transitions(flight_data)
     # T23-15: the command line checked this (ec_mer_policy), the Python API fitted any policy's closed loop without a word
     check_policy_flew(generic_policy, flight_data, "flight data", "generic_policy", "give the policy that flew them as generic_policy")

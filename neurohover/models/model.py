@@ -41,6 +41,7 @@ from ..filekinds import refuse_suffix
 from ..paths import json_text
 from ..sim.constants import CONTROL_DT, DEFAULT_NOISE_STD, DEFAULT_PARAMS, MAX_SECONDS, NOISE_NAMES, PARAM_NAMES, SUBSTEP_DT, SUBSTEPS, seconds_allowed
 from ..tasks import MDP, finite_vector
+from ..tasks.base import MAX_MAGNITUDE
 from .wind import NO_WIND, WindModel
 
 __all__ = [
@@ -207,6 +208,7 @@ class LearnedModel:
         check_stats(self.stats)
         if not finite_real(self.d_u):
             raise NeurohoverError(f"d_u={brief(self.d_u)} must be a finite number")
+        _refuse_past_mdp_bound(self)
         if not isinstance(self.wind, WindModel):
             raise NeurohoverError(f"wind must be a WindModel, got {self.wind!r:.80}")
 
@@ -337,6 +339,18 @@ class LearnedModel:
         except OSError as err:
             raise NeurohoverError(f"{name} cannot be read ({err.strerror or type(err).__name__})") from None
         return cls.from_dict(parse_json(text, name), name)
+
+
+def _refuse_past_mdp_bound(model: LearnedModel) -> None:
+    """Refuse a model's parameter, noise std or D_u past every MDP's bound (:data:`~neurohover.tasks.base.MAX_MAGNITUDE`),
+    naming it: a file's d_u of 1e308 loaded, compared and saved again, and only flying it (:meth:`LearnedModel.mdp`)
+    refused it, without naming the file (T31-B04). A loaded file's refusal names the file (:meth:`LearnedModel.from_dict`)."""
+    named = [*zip(PARAM_NAMES, model.params), *((f"noise std {n}", v) for n, v in zip(NOISE_NAMES, model.noise_std)), ("d_u", model.d_u)]
+    for name, value in named:
+        if abs(value) > MAX_MAGNITUDE:
+            raise NeurohoverError(
+                f"model {name}={brief(value)} is out of range: allowed numbers in [-{MAX_MAGNITUDE:g}, {MAX_MAGNITUDE:g}] (every MDP's bound: no MDP flies it)"
+            )
 
 
 def _axes_without_equivalent(params: np.ndarray) -> list[str]:
