@@ -31,6 +31,7 @@ from typing import NoReturn
 import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real, whole_number
+from .filekinds import refuse_cut_off
 from .paths import input_dir, number_text, refuse_special_file, strict_json
 from .sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS, MAX_SECONDS, WORST_RETURN, crash_charge, crash_return_ceiling, lowest_return, seconds_allowed
 from .sim.rng import MAX_SEED
@@ -230,6 +231,7 @@ def _read_rows(csv_path: Path) -> tuple[dict[int, list[tuple[int, float, str]]],
                 raise NeurohoverError(
                     f"--compete {str(csv_path)!r}, line 1: column {brief(odd)} is not allowed: compete writes the columns {', '.join(CSV_COLUMNS)}, each once"
                 )
+            refuse_cut_off(csv_path, f"--compete {str(csv_path)!r}", "episodes file compete writes")  # a cut '-123.45' read as -123.4
             facts.has_crashed = "crashed" in columns
             for line, row in enumerate(reader, start=2):
                 where = f"--compete {str(csv_path)!r}, line {line}"

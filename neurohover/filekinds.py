@@ -211,3 +211,15 @@ def refuse_policy_set(directory: Path, option: str, given: str | os.PathLike) ->
             f"{option} {brief(os.fspath(given))} {where} a policy set's directory (its manifest.json): a set holds only "
             "what build-policies writes, and compete --policy-dir refuses one with other files; give another directory"
         )
+
+
+def refuse_cut_off(path: str | os.PathLike, where: str, kind: str) -> None:
+    """Refuse a text file whose last byte is not a newline, as every ``kind`` neurohover writes ends, ``where`` naming
+    the file: a file cut inside its last line read ',0.0193' cut to ',0.01' as another number (T31-B07)."""
+    with open(path, "rb") as f:
+        size = f.seek(0, os.SEEK_END)
+        f.seek(max(size - 200, 0))
+        tail = f.read()
+    if size and not tail.endswith(b"\n"):
+        last = tail.rsplit(b"\n", 1)[-1].decode("utf-8", "replace")
+        raise NeurohoverError(f"{where} does not end with a newline, as every {kind} does: it looks cut off (its last line {brief(last)}); give the whole file")

@@ -145,3 +145,18 @@ def test_a_history_csv_cut_inside_its_last_number_is_refused(tmp_path: Path) -> 
         read_history_csv(header_only)
     with pytest.raises(NeurohoverError, match=r"history file '.*gone\.history\.csv': no such file"):
         read_history_csv(tmp_path / "gone.history.csv")
+
+
+def test_a_compete_episodes_file_cut_inside_its_last_row_is_refused(tmp_path: Path) -> None:
+    """T31-B07's twin in compete's episodes.csv: a row cut inside its return read as another return, a cut-off
+    safeguard_fired '1' as 0; every episodes file compete writes ends with a newline."""
+    from neurohover.compete import compete
+    from neurohover.compete_files import read_compete_dir
+
+    out = tmp_path / "c"
+    compete("ghh08", "baseline", out=out, runs=1, episodes=2, n_steps=20)
+    read_compete_dir(out)
+    csv_path = out / "episodes.csv"
+    csv_path.write_bytes(csv_path.read_bytes().rstrip(b"\r\n")[:-2])
+    with pytest.raises(NeurohoverError, match=r"^--compete '.*episodes\.csv' does not end with a newline.*looks cut off \(its last line '0,.*,baseline'\)"):
+        read_compete_dir(out)

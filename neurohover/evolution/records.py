@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import NeurohoverError, brief, first_difference, whole_number
-from ..filekinds import CSV_KINDS, JSON_KINDS, fitting_name, name_limit
+from ..filekinds import CSV_KINDS, JSON_KINDS, fitting_name, name_limit, refuse_cut_off
 from ..paths import JSONError, input_file, number_text, output_file, strict_json, writing
 from ..policies import Policy
 from .common import EntryError, enc_float, read_count, read_return, read_seconds
@@ -211,12 +211,7 @@ def read_history_csv(path: str | Path) -> list[HistoryRecord]:
     rows = [row for row in csv.reader(io.StringIO(text, newline="")) if row]
     if not rows or tuple(rows[0]) != HISTORY_COLUMNS:
         raise NeurohoverError(f"{str(path)!r} is not an evolution history (expected the header {','.join(HISTORY_COLUMNS)})")
-    if not text.endswith("\n"):  # ',0.0193' cut to ',0.01' was read as 0.01
-        last = text.rsplit("\n", 1)[-1]
-        raise NeurohoverError(
-            f"{str(path)!r} does not end with a newline, as every history neurohover writes does: it looks cut off "
-            f"(its last line {brief(last)}); give the whole file"
-        )
+    refuse_cut_off(path, repr(str(path)), "history neurohover writes")  # ',0.0193' cut to ',0.01' was read as 0.01
     out: list[HistoryRecord] = []
     for n, row in enumerate(rows[1:], start=2):
         if len(row) != len(HISTORY_COLUMNS):
