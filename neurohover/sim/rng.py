@@ -9,6 +9,7 @@ than Box-Muller; the gust noise needs 6 draws per control step, 36,000 per episo
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numba as nb
@@ -27,12 +28,32 @@ _TWO_POW_M53 = 1.0 / 9007199254740992.0
 MAX_SEED = 2**63 - 1
 
 
+def _wrapping(**options):
+    """``nb.njit(**options)``; where numba leaves the function as Python (``NUMBA_DISABLE_JIT=1``), the function under
+    ``np.errstate(over="ignore")``: its uint64 sums and products wrap on purpose, as they do silently in compiled code, and
+    NumPy's scalars warned "overflow encountered" (a traceback under PYTHONWARNINGS=error; T31-A06)."""
+
+    def decorate(fn):
+        compiled = nb.njit(**options)(fn)
+        if compiled is not fn:  # compiled: the machine code is unchanged
+            return compiled
+
+        @functools.wraps(fn)
+        def wrapping(*args):
+            with np.errstate(over="ignore"):
+                return fn(*args)
+
+        return wrapping
+
+    return decorate
+
+
 def check_seed(seed) -> int:
     """``seed`` as an int; NeurohoverError unless it is an integer in ``0..2**63-1`` (not a bool)."""
     return whole_in(seed, "seed", 0, MAX_SEED, "2**63-1")  # np.timedelta64(4) was taken as 4 (T17-1); 1.5 "out of range" (T22-14)
 
 
-@nb.njit(cache=True, inline="always")
+@_wrapping(cache=True, inline="always")
 def splitmix64(x: np.uint64) -> np.uint64:
     """SplitMix64 finaliser of ``x + golden``: a 64-bit hash used to expand seeds."""
     z = x + _GOLDEN
@@ -46,7 +67,7 @@ def _rotl(x: np.uint64, k: int) -> np.uint64:
     return (x << _U64(k)) | (x >> _U64(64 - k))
 
 
-@nb.njit(cache=True)
+@_wrapping(cache=True)
 def seed_stream(state: np.ndarray, seed: np.uint64, episode: np.uint64) -> None:
     """Fill ``state`` (4 uint64) with the xoshiro256** state of episode ``episode`` of ``seed``."""
     x = splitmix64(splitmix64(seed) ^ (episode * _EPISODE_KEY))
@@ -55,7 +76,7 @@ def seed_stream(state: np.ndarray, seed: np.uint64, episode: np.uint64) -> None:
         state[i] = x
 
 
-@nb.njit(cache=True, inline="always")
+@_wrapping(cache=True, inline="always")
 def next_u64(state: np.ndarray) -> np.uint64:
     """Next 64 random bits of a xoshiro256** stream (Blackman & Vigna 2018)."""
     s0 = state[0]
