@@ -30,3 +30,31 @@ def test_a06_the_compiled_streams_are_still_numbas() -> None:
     from neurohover.sim import rng
 
     assert all(isinstance(f, CPUDispatcher) for f in (rng.splitmix64, rng.seed_stream, rng.next_u64))
+
+
+def test_a07_a_wind_of_minus_zero_is_the_mdp_of_zero(tmp_path) -> None:
+    """T31-A07: ``evolve --wind=1,-0 --resume`` over a checkpoint of ``--wind=1,0`` (the same MDP) was refused as "a different run":
+    the MDP label kept the sign ('ghh08/wind=[1.0, -0.0]'). An MDP's numbers read -0.0 as 0.0, as a policy's genes do (T28-B15)."""
+    from neurohover.evolution.evolve import evolve
+    from neurohover.tasks import MDP, get_task_family
+
+    ghh08 = get_task_family("ghh08")
+    assert ghh08.make([1.0, -0.0]).label == "ghh08/wind=[1.0, 0.0]" == ghh08.make([1.0, 0.0]).label
+    assert str(ghh08.make([-0.0, -0.0]).to_dict()["wind"]) == "[0.0, 0.0]"
+    model = MDP("model", params=(-0.0,) * 11, d_u=-0.0, label="model/lr")
+    assert str(model.params[0]) == "0.0" and str(model.d_u) == "0.0"
+    ckpt = tmp_path / "run.ckpt.json"
+    given = dict(budget=5, checkpoint=ckpt, topology="slp", prototype="baseline", seed=3, n_steps=20)
+    evolve(ghh08.make([1.0, 0.0]), **given)
+    resumed = evolve(ghh08.make([1.0, -0.0]), **{**given, "budget": 100}, resume=True)
+    assert resumed.history
+
+
+def test_a07_the_cli_resumes_a_wind_of_minus_zero(tmp_path, cli) -> None:
+    from neurohover.evolution.evolve import evolve
+    from neurohover.tasks import get_task_family
+
+    out = tmp_path / "p.json"
+    evolve(get_task_family("ghh08").make([1.0, 0.0]), budget=5, checkpoint=f"{out}.checkpoint.json", seed=0, n_steps=20)
+    rc, _, err = cli("evolve", "--task", "ghh08", "--wind=1,-0", "--budget", "100", "--episode-steps", "20", "--out", str(out), "--resume")
+    assert rc == 0 and "different run" not in err, err

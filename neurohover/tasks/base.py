@@ -136,7 +136,8 @@ class MDP:
                 vector = finite_vector(values, length, f"MDP {name}")
             except NeurohoverError:
                 raise NeurohoverError(f"MDP {name}={brief(values)} is not allowed: {allowed}") from None
-            object.__setattr__(self, name, tuple(vector.tolist()))  # plain Python numbers: reprs read MDP(params=(-0.18, ...))
+            # plain Python numbers: reprs read MDP(params=(-0.18, ...)); + 0.0: a -0.0 is 0.0, the same MDP (T31-A07, as genes in T28-B15)
+            object.__setattr__(self, name, tuple((vector + 0.0).tolist()))
         if min(self.noise_std) < 0:
             raise NeurohoverError(f"MDP noise_std={self.noise_std!r} is out of range: allowed stds >= 0")
         # T24-11: whole_in, so 1.5 or True "is not allowed" (a type) and 0 "is out of range"; both said out of range
@@ -145,7 +146,7 @@ class MDP:
             value = getattr(self, name)
             if not finite_real(value):  # np.timedelta64 was float()'s TypeError (T17-1), 10**400 an OverflowError
                 raise NeurohoverError(f"MDP {name}={brief(value)} is not allowed: give a finite number")
-            object.__setattr__(self, name, float(value))
+            object.__setattr__(self, name, float(value) + 0.0)
         if not self.dt > 0:
             raise NeurohoverError(f"MDP dt={self.dt!r} is out of range: allowed a substep length > 0")
         if abs(self.substeps * self.dt - CONTROL_DT) > COVER_TOLERANCE:  # a dt of 1e9 was flown (T27-B05)

@@ -27,7 +27,7 @@ class GHH08(TaskFamily):
     param_bounds = (-MAX_WIND, MAX_WIND)
 
     def make(self, params: Sequence[float] | np.ndarray, label: str = "") -> MDP:
-        wind = finite_vector(params, 2, "GHH-08 wind (wind_u, wind_v)")
+        wind = finite_vector(params, 2, "GHH-08 wind (wind_u, wind_v)") + 0.0  # a -0.0 labelled another run (T31-A07)
         if np.any(np.abs(wind) > MAX_WIND):
             raise NeurohoverError(f"GHH-08 wind {wind.tolist()} m/s is out of range: each component must lie in [-5, 5]")
         return MDP("ghh08", wind_kind=WIND_CONSTANT, wind=tuple(wind.tolist()), label=mdp_label(label, f"ghh08/wind={wind.tolist()}"))
