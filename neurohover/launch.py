@@ -47,10 +47,13 @@ def num_threads(threads: int | None) -> Iterator[None]:
         yield
         return
     limit = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # numba.config sets it at import, from the environment
+    cores = numba.config.NUMBA_DEFAULT_NUM_THREADS  # type: ignore[attr-defined]
+    # the variable named where it, not the machine, limits the range ("allowed 1..1 on this machine" of 2 cores; trial 31a, borderline)
+    where = "on this machine" if limit == cores else f"under NUMBA_NUM_THREADS={limit} (this machine has {cores} cores)"
     if not whole_number(threads):  # True was one thread; np.int64(1) is one (thirteenth trial, F8)
-        raise NeurohoverError(f"threads={brief(threads)} is not allowed: give an integer in 1..{limit} on this machine")
+        raise NeurohoverError(f"threads={brief(threads)} is not allowed: give an integer in 1..{limit} {where}")
     if not 1 <= threads <= limit:
-        raise NeurohoverError(f"threads={brief(threads)} is out of range: allowed 1..{limit} on this machine")
+        raise NeurohoverError(f"threads={brief(threads)} is out of range: allowed 1..{limit} {where}")
     previous = numba.get_num_threads()
     numba.set_num_threads(int(threads))
     try:

@@ -58,3 +58,22 @@ def test_a07_the_cli_resumes_a_wind_of_minus_zero(tmp_path, cli) -> None:
     evolve(get_task_family("ghh08").make([1.0, 0.0]), budget=5, checkpoint=f"{out}.checkpoint.json", seed=0, n_steps=20)
     rc, _, err = cli("evolve", "--task", "ghh08", "--wind=1,-0", "--budget", "100", "--episode-steps", "20", "--out", str(out), "--resume")
     assert rc == 0 and "different run" not in err, err
+
+
+def test_the_thread_range_names_numba_num_threads_where_it_limits(monkeypatch) -> None:
+    """Trial 31a, borderline: under NUMBA_NUM_THREADS=1 on 2 cores, --threads 2 was "allowed 1..1 on this machine"."""
+    import numba
+    import pytest
+
+    from neurohover.errors import NeurohoverError
+    from neurohover.launch import num_threads
+
+    monkeypatch.setattr(numba.config, "NUMBA_DEFAULT_NUM_THREADS", 2, raising=False)
+    monkeypatch.setattr(numba.config, "NUMBA_NUM_THREADS", 1, raising=False)
+    with pytest.raises(NeurohoverError, match=r"^threads=2 is out of range: allowed 1\.\.1 under NUMBA_NUM_THREADS=1 \(this machine has 2 cores\)$"):
+        with num_threads(2):
+            pass
+    monkeypatch.setattr(numba.config, "NUMBA_NUM_THREADS", 2, raising=False)
+    with pytest.raises(NeurohoverError, match=r"^threads=3 is out of range: allowed 1\.\.2 on this machine$"):
+        with num_threads(3):
+            pass
