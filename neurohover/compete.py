@@ -29,7 +29,8 @@ from __future__ import annotations
 import csv
 import json
 import sys
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -338,18 +339,43 @@ def compete(
     )  # fmt: skip
     store_path = _checked_store(store)
     out = output_dir(out, "out")  # made once every setting is checked (None was a TypeError, /dev/full a FileExistsError)
-    store_path = store_path or out / STORE_FILE
-    _refuse_other_files(out)
-    _refuse_other_settings(config, store_path)
-    _note_replaced(out / "summary.json", task, agent, config.scale)
-    ordered = _run_into_store(config, store_path, out / "episodes.csv", jobs=jobs, device=device, progress=progress, on_result=on_result)
-    summary = {"task": task, "agent": agent, "mdps": mdps, "seed": seed, "store": str(store_path), **_flown_under(n_steps, sigma, sensor, drift)}
-    summary |= {"experiment": config.name, "scale": config.scale, **summarise(ordered)}
-    _write_summary(out / "summary.json", summary)
-    plot_cumulative(
-        {agent: np.array([np.cumsum(np.array(r.returns, dtype=float)) for r in ordered])}, out / "cumulative.png", f"{task}: {agent}, {len(ordered)} runs"
-    )
+    with _sole_competition(out):
+        store_path = store_path or out / STORE_FILE
+        _refuse_other_files(out)
+        _refuse_other_settings(config, store_path)
+        _note_replaced(out / "summary.json", task, agent, config.scale)
+        ordered = _run_into_store(config, store_path, out / "episodes.csv", jobs=jobs, device=device, progress=progress, on_result=on_result)
+        summary = {"task": task, "agent": agent, "mdps": mdps, "seed": seed, "store": str(store_path), **_flown_under(n_steps, sigma, sensor, drift)}
+        summary |= {"experiment": config.name, "scale": config.scale, **summarise(ordered)}
+        _write_summary(out / "summary.json", summary)
+        curves = np.array([np.cumsum(np.array(r.returns, dtype=float)) for r in ordered])
+        plot_cumulative({agent: curves}, out / "cumulative.png", f"{task}: {agent}, {len(ordered)} runs")
     return summary, ordered
+
+
+#: The lock file a running competition holds in its output directory (:func:`_sole_competition`).
+LOCK_FILE = ".compete.lock"
+
+
+@contextmanager
+def _sole_competition(out: Path) -> Iterator[None]:
+    """Be the only competition writing into ``out`` inside this block: a second run there is refused, naming the first's
+    pid. Two runs into one folder with other --store files both finished, each printing the folder's files as its own
+    results, which were the second's (trial 31, borderline). A :class:`~neurohover.paths.WriterLock` on
+    :data:`LOCK_FILE` in ``out`` (beside the default store's own lock); a folder where it cannot be made is left
+    unguarded, as :func:`~neurohover.paths.sole_writer` leaves one."""
+    from .paths import WriterLock
+
+    lock = WriterLock(out / LOCK_FILE)
+    try:
+        busy = "is in use: another compete run ({}) is writing its files; wait for it to end, or give another output directory"
+        lock.acquire(lambda who: f"out {brief(str(out))} {busy.format(who)}")
+    except OSError:
+        pass
+    try:
+        yield
+    finally:
+        lock.release()
 
 
 def _flown_under(n_steps: int, sigma: float | None, sensor: Sensor | None, drift: Drift | None) -> dict:
@@ -365,10 +391,12 @@ def _flown_under(n_steps: int, sigma: float | None, sensor: Sensor | None, drift
 
 def _checked_store(store) -> Path | None:
     """The store's path, refused before the output directory is made: a bad path, or a file that is no store (third trial)."""
+    from .filekinds import refuse_long_store_name
     from .paths import output_file
 
     if store is None:
         return None
+    refuse_long_store_name(store, "store")  # its -journal too (T31-A03)
     path = output_file(store, "store", store=True)
     if path.is_file() and path.stat().st_size:  # an empty file becomes the store
         from .experiments import Store

@@ -28,11 +28,13 @@ __all__ = [
     "POLICY_SET_KIND",
     "RUN_FILE_ENDS",
     "SQLITE_HEADER",
+    "STORE_ENDS",
     "fitting_name",
     "held_kind",
     "name_limit",
     "output_name",
     "refuse_policy_set",
+    "refuse_long_store_name",
     "refuse_run_file_name",
     "refuse_suffix",
     "refuse_unencodable",
@@ -151,6 +153,34 @@ def fitting_name(name: str, limit: int, room: int = 0) -> str:
     while stem and len(os.fsencode(stem + suffix)) + room > limit:
         stem = stem[:-1]
     return stem + suffix
+
+
+#: What SQLite and the store's writer lock add to a results store's name for the files they write beside it
+#: (``STORE-journal`` the longest, then ``STORE.lock``).
+STORE_ENDS = ("-journal", ".lock")
+
+
+def refuse_long_store_name(path: object, option: str) -> None:
+    """Refuse a results store ``path`` (``option``) to be written whose name, with the longest of :data:`STORE_ENDS`,
+    is longer than the file system takes, naming the limit and a name that fits: a name of 249 to 255 bytes was taken,
+    and the run then failed on its ``-journal`` with the OS's bare "File name too long", the name cut (T31-A03). What is
+    no path to check is :func:`~neurohover.paths.checked_path`'s to refuse."""
+    if not isinstance(path, (str, os.PathLike)) or not isinstance(text := os.fspath(path), str) or "\x00" in text:
+        return
+    name = Path(text).name
+    try:
+        size = len(os.fsencode(name))
+    except UnicodeError:  # unencodable: refused by name elsewhere
+        return
+    end = max(STORE_ENDS, key=lambda e: len(os.fsencode(e)))
+    room = len(os.fsencode(end))
+    limit = name_limit(Path(text).parent) if size + room > 14 else NAME_MAX
+    if name and size + room > limit:
+        like = str(Path(text).with_name(fitting_name(name, limit, room)))
+        raise NeurohoverError(
+            f"{option} {brief(text)} is too long: at most {limit} bytes in one file name, with the {end} SQLite writes beside "
+            f"the store (here {size:,} + {room} = {size + room:,}); give a shorter name, e.g. {brief(like)}"
+        )
 
 
 def refuse_run_file_name(path: str, option: str) -> None:

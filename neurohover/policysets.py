@@ -52,7 +52,7 @@ import numpy as np
 from .errors import NeurohoverError, brief, finite_real, whole_number
 from .evaluate import MAX_EPISODES_PER_CALL, evaluate
 from .manifest import LINEAGES, _check_manifest_fields, check_ghh_manifest, check_kind_keys, choose_safe, table3_summary
-from .paths import JSONError, strict_json, writing
+from .paths import JSONError, sole_writer, strict_json, writing
 from .policies import Policy, load_policy, save_policy, utf8_text
 from .sim.constants import MAX_EPISODE_STEPS
 from .tasks import TaskFamily, get_task_family
@@ -515,41 +515,43 @@ def build_policy_set(
     # Built beside the set it replaces, which it replaces only once complete: an interrupted build (or a failed one)
     # leaves the old set, shipped or not, as it was. Each finished run is kept in root's stages/, and the same build
     # run again resumes from them (fourth trial: an interrupted build lost every finished stage).
-    root = final.with_name(final.name + ".building")
-    build = {"task": family.name, "sigma": family.sigma, "budget": budget, "fghh_budget": fghh_budget, "seed": seed, "n_steps": n_steps,
-             "safety_episodes": safety_episodes, "lineage": lineage, "optimizer": optimizer, "version": _version()}  # fmt: skip
-    if _stage_file(root, "build").is_file() and _build_state(root) == build:
-        say(f"{family.name}: resuming the interrupted build in {root} ({len(list((root / STAGES).glob('*.json'))) - 1} runs finished)")
-    else:
-        if root.exists():
-            say(f"{family.name}: {root} holds an interrupted build of other settings; it is started over")
-        shutil.rmtree(root, ignore_errors=True)
-        try:
-            (root / STAGES).mkdir(parents=True)
-            with writing(_stage_file(root, "build"), "the build's state") as partial:  # a full disk left it empty (seventh trial)
-                partial.write_text(json.dumps(build) + "\n")
-        except BaseException:
+    final.parent.mkdir(parents=True, exist_ok=True)  # where the lock is
+    with sole_writer(final, "out"):  # a second build deleted the first's live .building as "interrupted" (T31-A02)
+        root = final.with_name(final.name + ".building")
+        build = {"task": family.name, "sigma": family.sigma, "budget": budget, "fghh_budget": fghh_budget, "seed": seed, "n_steps": n_steps,
+                 "safety_episodes": safety_episodes, "lineage": lineage, "optimizer": optimizer, "version": _version()}  # fmt: skip
+        if _stage_file(root, "build").is_file() and _build_state(root) == build:
+            say(f"{family.name}: resuming the interrupted build in {root} ({len(list((root / STAGES).glob('*.json'))) - 1} runs finished)")
+        else:
+            if root.exists():
+                say(f"{family.name}: {root} holds an interrupted build of other settings; it is started over")
             shutil.rmtree(root, ignore_errors=True)
+            try:
+                (root / STAGES).mkdir(parents=True)
+                with writing(_stage_file(root, "build"), "the build's state") as partial:  # a full disk left it empty (seventh trial)
+                    partial.write_text(json.dumps(build) + "\n")
+            except BaseException:
+                shutil.rmtree(root, ignore_errors=True)
+                raise
+        try:
+            built = _build(family, root, budget, fghh_budget, seed, safety_episodes, n_steps, lineage, optimizer, say)
+        except KeyboardInterrupt:  # stopped: the finished runs stay for the same build to resume
+            say(f"{family.name}: stopped; the finished runs are kept in {root}: run the same build again to resume")
             raise
-    try:
-        built = _build(family, root, budget, fghh_budget, seed, safety_episodes, n_steps, lineage, optimizer, say)
-    except KeyboardInterrupt:  # stopped: the finished runs stay for the same build to resume
-        say(f"{family.name}: stopped; the finished runs are kept in {root}: run the same build again to resume")
-        raise
-    except BaseException as err:  # failed: nothing half-built is left
-        shutil.rmtree(root, ignore_errors=True)
-        if isinstance(err, OSError):  # a full disk said only "No space left on device" (seventh trial)
-            why = err.strerror or err
-            raise NeurohoverError(f"out {str(final.parent)!r}: cannot write the {family.name} set ({why}); nothing half-built is left") from None
-        raise
-    shutil.rmtree(root / STAGES)
-    old = final.with_name(final.name + ".replaced")
-    shutil.rmtree(old, ignore_errors=True)
-    if final.exists():
-        final.rename(old)
-    root.rename(final)
-    shutil.rmtree(old, ignore_errors=True)
-    return replace(built, directory=final)
+        except BaseException as err:  # failed: nothing half-built is left
+            shutil.rmtree(root, ignore_errors=True)
+            if isinstance(err, OSError):  # a full disk said only "No space left on device" (seventh trial)
+                why = err.strerror or err
+                raise NeurohoverError(f"out {str(final.parent)!r}: cannot write the {family.name} set ({why}); nothing half-built is left") from None
+            raise
+        shutil.rmtree(root / STAGES)
+        old = final.with_name(final.name + ".replaced")
+        shutil.rmtree(old, ignore_errors=True)
+        if final.exists():
+            final.rename(old)
+        root.rename(final)
+        shutil.rmtree(old, ignore_errors=True)
+        return replace(built, directory=final)
 
 
 def _build(family, root: Path, budget, fghh_budget, seed, safety_episodes, n_steps, lineage, optimizer, say) -> PolicySet:

@@ -20,10 +20,10 @@ def progress_bar(**settings):
     that stream is a terminal (``disable=None``, tqdm's own test, unless given). On a terminal that reports no width, a
     pseudo-terminal nobody sized (``script``, ``docker exec -t``), it is drawn :data:`UNSIZED_COLUMNS` wide: tqdm drew
     nothing there, and learn-model and evolve sat silent for minutes (T19-11). A bar not drawn (``disable=True``, or
-    ``None`` off a terminal) is a :class:`_Quiet` stand-in: tqdm is not imported, nor are its TQDM_* variables read."""
+    ``None`` off a terminal, or on a closed stream) is a :class:`_Quiet` stand-in: tqdm is not imported, nor are its TQDM_* variables read."""
     stream = settings.pop("file", sys.stderr)
     settings.setdefault("disable", None)
-    if settings["disable"] or (settings["disable"] is None and not _terminal(stream)):
+    if settings["disable"] or (settings["disable"] is None and not _terminal(stream)) or _closed(stream):
         return _Quiet(stream, settings.get("iterable"), settings.get("total"), settings.get("initial", 0))
     tqdm = _tqdm()
     if _unsized_terminal(stream):
@@ -95,6 +95,23 @@ class _Quiet:
             return
         out.write(text + end)
         out.flush()
+
+
+def _closed(stream) -> bool:
+    """Whether ``stream`` is no stream to draw on: None (standard error closed, ``2>&-``: --progress died in tqdm with
+    AttributeError and status 1, before any work; T31-A04), a closed file or one whose descriptor is closed. Such a bar is off, as a closed standard
+    output is the null device for a command that writes files (T28-A01)."""
+    if stream is None or getattr(stream, "closed", False):
+        return True
+    try:
+        fd = stream.fileno()
+    except (AttributeError, OSError, ValueError):  # no file descriptor (a StringIO): open
+        return False
+    try:
+        os.write(fd, b"")  # a descriptor closed, or reopened for reading only, under the stream (tqdm's Errno 9)
+    except OSError:
+        return True
+    return False
 
 
 def _terminal(stream) -> bool:

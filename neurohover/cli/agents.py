@@ -46,6 +46,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
     from ..agents.model_based import ModelEvolution
     from ..agents.registry import AGENTS, HYBRID_AGENTS, agent_spec
     from ..compete import agents_with_settings, check_sizes, compete
+    from ..filekinds import refuse_long_store_name
     from ..paths import checked_path, input_dir, output_file, printable
     from ..tasks import Drift
     from .options import check_given, given_settings, sensor_of
@@ -82,6 +83,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
             raise NeurohoverError(f"--policy-dir applies to agents that fly a policy set's policies, not to --agent {args.agent}")
         input_dir(args.policy_dir, "--policy-dir")
     if args.store is not None:
+        refuse_long_store_name(args.store, "--store")  # its -journal too (T31-A03)
         output_file(args.store, "--store", store=True)  # --out is made by compete once it has checked every setting
     checked_path(args.out, "--out", "directory path")  # named as typed: compete() calls it out (eleventh trial, U8)
     try:

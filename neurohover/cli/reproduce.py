@@ -27,6 +27,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     from ..experiments.config import check_own_name, experiment_names, parse_overrides
     from ..experiments.plans import source_experiments
     from ..experiments.runner import check_restart
+    from ..filekinds import refuse_long_store_name
     from ..paths import output_file
     from ..procs import stop_words
 
@@ -49,6 +50,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     if args.address is not None and args.executor != "ray":
         raise NeurohoverError(f"--address {args.address} names a Ray cluster; add --executor ray (or leave out --address)")
     check_device(args.device)
+    refuse_long_store_name(args.store, "--store")  # its -journal too (T31-A03)
     output_file(args.store, "--store", store=True)
     overrides = parse_overrides(args.set)
     try:

@@ -39,7 +39,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import NeurohoverError, brief, check_flag, finite_real
-from ..filekinds import SQLITE_HEADER
+from ..filekinds import SQLITE_HEADER, refuse_long_store_name
 from ..paths import JSONError, WriterLock, strict_json
 from .config import check_name, check_scale
 from .store_checks import (
@@ -123,6 +123,8 @@ class Store:
         check_flag(create, "create", "make the store if missing")  # create='no' was true (sixth trial)
 
         self.path = checked_path(path, "results store", "results store's file path")  # None, 3, NUL, a name too long
+        if create:  # its -journal too (a reader writes none; T31-A03)
+            refuse_long_store_name(self.path, "results store")
         if not self.path.exists() and not create:
             raise NeurohoverError(f"results store {str(self.path)!r} does not exist")
         if self.path.exists() and self.path.is_dir():
