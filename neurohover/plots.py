@@ -21,10 +21,14 @@ Example
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
+import re
+import sys
 import textwrap
-from collections.abc import Sequence
+import warnings
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -44,6 +48,7 @@ __all__ = [
     "crashed_episode",
     "episode_crashed",
     "flight_figure",
+    "noting_missing_glyphs",
     "plot_compete",
     "plot_flight_data",
     "save_figure",
@@ -59,6 +64,36 @@ def new_figure(width: float, height: float, dpi: int = 100) -> Figure:
     return fig
 
 
+#: matplotlib's warning for a character its font lacks, which it draws as a box: "Glyph 20013 (...) missing from font(s) DejaVu Sans."
+_MISSING_GLYPH = re.compile(r"Glyph (\d+) \(.*\) missing from font\(s\) (.+?)\.?$")
+_NOTED_GLYPHS: set[str] = set()  # the characters noted in this process: a report's figures share a title
+
+
+@contextlib.contextmanager
+def noting_missing_glyphs() -> Iterator[None]:
+    """Draw in the block with matplotlib's "Glyph ... missing from font(s)" UserWarnings (each with its source line: a name or
+    title with 𝄞 or CJK; T31-A01) replaced by one neurohover note naming the characters the font lacks, each once a process;
+    every other warning is shown as it was."""
+    caught: list[warnings.WarningMessage] = []
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.filterwarnings("always", _MISSING_GLYPH.pattern, UserWarning)  # also under PYTHONWARNINGS=error
+            yield
+    finally:  # outside the catching: a warning shown here is the caller's
+        missing: dict[str, str] = {}
+        for w in caught:
+            match = _MISSING_GLYPH.match(str(w.message)) if issubclass(w.category, UserWarning) else None
+            if match is None:
+                warnings.showwarning(w.message, w.category, w.filename, w.lineno, w.file, w.line)
+            elif chr(int(match[1])) not in _NOTED_GLYPHS:
+                missing.setdefault(chr(int(match[1])), match[2])
+        if missing:
+            _NOTED_GLYPHS.update(missing)
+            chars = ", ".join(f"{c!r} (U+{ord(c):04X})" for c in missing)
+            fonts = ", ".join(dict.fromkeys(missing.values()))
+            print(f"neurohover: note: the plot font ({fonts}) has no glyph for {chars}: drawn as boxes", file=sys.stderr)
+
+
 def save_figure(fig: Figure, path: str | Path) -> Path:
     """Write ``fig`` as a PNG to ``path``, checked as every output file is (:func:`~neurohover.paths.output_file`:
     not a directory, device, pipe or socket; missing parent directories are created, saying so)."""
@@ -67,7 +102,8 @@ def save_figure(fig: Figure, path: str | Path) -> Path:
     if not isinstance(fig, Figure):  # None was an AttributeError mid-write
         raise NeurohoverError(f"fig={brief(fig)} is not allowed: give a matplotlib Figure (e.g. from flight_figure or compete_figure)")
     path = output_file(path, "plot file")  # a FIFO or /dev/full was replaced by the PNG (fourteenth trial, T14-1)
-    return write_png(fig, path, "plot file")
+    with noting_missing_glyphs():
+        return write_png(fig, path, "plot file")
 
 
 def _title(title: object) -> str:
@@ -198,7 +234,8 @@ def flight_figure(
     axes[-1].set_xlabel("time (s)")
     end = f"crashed at {t_obs[-1]:.1f} s (step {act.shape[0]})" if crashed else f"{act.shape[0]} steps, no crash"
     fig.suptitle(f"{title}\n{end}" if title else end, color=CRASH_COLOR if crashed else "black")
-    fig.tight_layout()
+    with noting_missing_glyphs():
+        fig.tight_layout()
     return fig
 
 
@@ -327,7 +364,8 @@ def compete_figure(results: Sequence[CompeteResult], title: str = "") -> Figure:
     if differ:
         heading += f" (flown under different {', '.join(differ)}: see the legend)"
     fig.suptitle(heading)
-    fig.tight_layout()
+    with noting_missing_glyphs():
+        fig.tight_layout()
     return fig
 
 

@@ -77,3 +77,48 @@ def test_the_thread_range_names_numba_num_threads_where_it_limits(monkeypatch) -
     with pytest.raises(NeurohoverError, match=r"^threads=3 is out of range: allowed 1\.\.2 on this machine$"):
         with num_threads(3):
             pass
+
+
+def test_a01_a_character_the_plot_font_lacks_is_one_note(tmp_path, cli, monkeypatch) -> None:
+    """T31-A01: a flight-data name with 𝄞 or CJK (legal) made ``plot`` print matplotlib's "Glyph ... missing from font(s)"
+    UserWarnings with their source lines (from plots.py's tight_layout and paths.py's savefig); now one neurohover note."""
+    import warnings
+
+    import neurohover as nh
+    from neurohover import plots
+
+    monkeypatch.setattr(plots, "_NOTED_GLYPHS", set())
+    monkeypatch.chdir(tmp_path)
+    data = nh.evaluate(nh.load_policy("baseline"), nh.get_task_family("ghh08").zero(), n_steps=20, record=True).flight_data
+    data.save(tmp_path / "u 𝄞中.npz")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("error")  # PYTHONWARNINGS=error: a glyph warning was a traceback
+        rc, out, err = cli("plot", "u 𝄞中.npz", "--out", "u13")
+    assert rc == 0 and not caught, err
+    assert "UserWarning" not in err and "Glyph" not in err, err
+    notes = [line for line in err.splitlines() if "note" in line]
+    assert notes == ["neurohover: note: the plot font (DejaVu Sans) has no glyph for '𝄞' (U+1D11E), '中' (U+4E2D): drawn as boxes"], err
+    assert (tmp_path / "u13" / "u 𝄞中-episode0.png").stat().st_size > 0 and out.strip() == "u13/u 𝄞中-episode0.png"
+
+
+def test_a01_the_figure_helpers_note_once_and_keep_other_warnings(tmp_path, capsys, monkeypatch) -> None:
+    import warnings
+
+    import pytest
+
+    from neurohover import plots
+
+    monkeypatch.setattr(plots, "_NOTED_GLYPHS", set())
+    fig = plots.new_figure(3, 2)
+    fig.add_subplot().set_title("t\u6587\u5b57")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with plots.noting_missing_glyphs():
+            fig.tight_layout()
+        plots.save_figure(fig, tmp_path / "a.png")
+        plots.save_figure(fig, tmp_path / "b.png")
+    assert not [w for w in caught if "Glyph" in str(w.message)], [str(w.message) for w in caught]
+    assert capsys.readouterr().err == "neurohover: note: the plot font (DejaVu Sans) has no glyph for '文' (U+6587), '字' (U+5B57): drawn as boxes\n"
+    with pytest.warns(RuntimeWarning, match="kept"):
+        with plots.noting_missing_glyphs():
+            warnings.warn("kept", RuntimeWarning, stacklevel=1)

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from ..paths import write_png
+from ..plots import noting_missing_glyphs
 from .config import ExperimentConfig
 from .keys import UnitKey
 from .results import UnitResult
@@ -181,8 +182,9 @@ class Section:
 
     def save(self, fig) -> str:
         """Write the section's figure next to the report; returns its file name."""
-        fig.tight_layout()
-        return write_png(fig, self.out / f"{self.stem}.png", "report figure", dpi=110).name
+        with noting_missing_glyphs():  # a title the plot font cannot draw: one note, not matplotlib's warnings (T31-A01)
+            fig.tight_layout()
+            return write_png(fig, self.out / f"{self.stem}.png", "report figure", dpi=110).name
 
     def save_panels(self, fig, axes, xlabel: str, ylabels: tuple[str, str]) -> str:
         """Label two panels (the second on a log scale), title the figure, put one legend below both (so it
@@ -200,8 +202,9 @@ class Section:
         fig.set_size_inches(width, height + extra)
         fig.suptitle(f"{self.cfg.title} ({self.cfg.scale} scale)", fontsize=10)
         fig.legend(handles, labels, loc="lower center", ncol=2, fontsize=8, frameon=False)
-        fig.tight_layout(rect=(0, extra / (height + extra), 1, 1))
-        return write_png(fig, self.out / f"{self.stem}.png", "report figure", dpi=110).name
+        with noting_missing_glyphs():
+            fig.tight_layout(rect=(0, extra / (height + extra), 1, 1))
+            return write_png(fig, self.out / f"{self.stem}.png", "report figure", dpi=110).name
 
     def add_tests(self, samples: dict[str, list[float]], labels: dict[str, str], what: str) -> None:
         for t in self.paper.get("ttests", []):
