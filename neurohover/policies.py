@@ -416,5 +416,5 @@ def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
         raise NeurohoverError(f"policy file {shown}: {problem} (load_policy would refuse the file; nothing is written)")
     path = output_file(path, "policy file", kind="a policy file")  # refuses '', a directory and a device; makes missing parents
     with writing(path, "policy file") as partial:
-        partial.write_text(text)
+        partial.write_text(text, encoding="utf-8")
     return path

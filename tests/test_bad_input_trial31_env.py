@@ -122,3 +122,57 @@ def test_a01_the_figure_helpers_note_once_and_keep_other_warnings(tmp_path, caps
     with pytest.warns(RuntimeWarning, match="kept"):
         with plots.noting_missing_glyphs():
             warnings.warn("kept", RuntimeWarning, stacklevel=1)
+
+
+ASCII_LOCALE = {"LC_ALL": "C", "PYTHONUTF8": "0", "PYTHONIOENCODING": ""}
+
+_A05_SCRIPT = """
+import sys
+from pathlib import Path
+from neurohover.errors import NeurohoverError
+from neurohover.experiments import Store
+from neurohover.experiments.config import make_config
+from neurohover.experiments.plans import _load_external
+from neurohover.experiments.report import write_report
+
+print(sys.getfilesystemencoding())
+try:
+    _load_external("ghh08", "pd \\xe9")
+except NeurohoverError as err:
+    print(ascii(str(err)))
+settings = dict(task="ghh08", seed=1, policies="shipped", episodes=2, n_steps=20, groups=[dict(agent="baseline", mdps="test", n_mdps=1)])
+cfg = make_config("ml1", "test_runs", "quick", settings, title="t\\u4e2d\\u6587")
+with Store(Path(sys.argv[1]) / "s.sqlite") as store:
+    store.begin(cfg.name, cfg.scale, cfg.hash, cfg.to_dict())
+    print(write_report(store, Path(sys.argv[1]) / "rep"))
+"""
+
+
+def test_a05_an_unencodable_config_path_is_refused_by_its_encoding_and_the_report_is_utf8(tmp_path) -> None:
+    """T31-A05: under LC_ALL=C PYTHONUTF8=0 a config's policies = "pd é" (an existing set, read as --policy-dir reads it) was
+    "no such directory": the ASCII file system encoding cannot encode it. It is refused naming the encoding, as every path
+    entry point does (T31-B03), with the UTF-8 locale to run under; and report.md is UTF-8 under any locale (it wrote
+    the title as escapes)."""
+    (tmp_path / "pd é").mkdir()
+    run = subprocess.run([sys.executable, "-c", _A05_SCRIPT, str(tmp_path)], env={**os.environ, **ASCII_LOCALE}, capture_output=True, text=True,
+                         encoding="utf-8", timeout=120)  # fmt: skip
+    assert run.returncode == 0 and "Traceback" not in run.stderr, run.stderr
+    lines = run.stdout.splitlines()
+    assert lines[0] == "ascii", lines
+    assert lines[1] == ascii(
+        "policies = 'pd \xe9' is not allowed: the file system's encoding (ascii) cannot encode the characters '\\xe9' in it: give a name "
+        "of characters it can encode or run under a UTF-8 locale (LC_ALL=C.UTF-8, or PYTHONUTF8=1)"
+    ), lines
+    assert "## t\u4e2d\u6587 [quick]" in (tmp_path / "rep" / "report.md").read_text(encoding="utf-8")
+
+
+def test_a05_the_suggested_build_command_is_quoted(tmp_path) -> None:
+    import pytest
+
+    from neurohover.errors import NeurohoverError
+    from neurohover.experiments.plans import _load_external
+
+    missing = str(tmp_path / "pd 1")
+    with pytest.raises(NeurohoverError) as err:
+        _load_external("ghh08", missing)
+    assert str(err.value).endswith(f"(no such directory; build it with: neurohover build-policies --task ghh08 --out '{missing}')")

@@ -172,7 +172,7 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     if out is not None:
         with writing(out, "--json") as path:
             path.write_text(json.dumps({"task": args.task, "mdps": args.mdps, "n_mdps": n, "episodes": args.episodes, "seed": args.seed,
-                                        "episode_steps": args.episode_steps, "rows": [r.__dict__ for r in rows]}, indent=1))  # fmt: skip
+                                        "episode_steps": args.episode_steps, "rows": [r.__dict__ for r in rows]}, indent=1), encoding="utf-8")  # fmt: skip
         print(f"wrote {printable(args.json)}", file=sys.stderr)
     return 0
 

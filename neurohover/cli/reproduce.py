@@ -149,7 +149,7 @@ def cmd_results(args: argparse.Namespace) -> int:
         text = export_results(store, args.name, fmt, args.scale)
     if out is not None:
         with writing(out, "--out") as path:
-            path.write_text(text)
+            path.write_text(text, encoding="utf-8")  # the locale's encoding wrote escapes or failed (T31-A05)
         print(f"wrote {printable(args.out)}", file=sys.stderr)
     else:
         sys.stdout.write(text)

@@ -182,7 +182,7 @@ def write_history_csv(history, path: str | Path) -> Path:
             except ValueError as err:
                 raise NeurohoverError(f"history record {n} (from 0): {column}={brief(value)} is not allowed ({err}); nothing is written") from None
     path = output_file(path, "history file", kind=HISTORY_KIND, suffixes=(".csv",), what="a history is CSV")
-    with writing(path, "history file") as partial, open(partial, "w", newline="") as f:
+    with writing(path, "history file") as partial, open(partial, "w", newline="", encoding="utf-8") as f:
         writer = csv.writer(f, lineterminator="\n")
         writer.writerow(HISTORY_COLUMNS)
         writer.writerows([*row[:4], repr(float(row[4])), f"{row[5]:.4f}"] for row in rows)
@@ -275,7 +275,7 @@ def write_checkpoint(path: Path, state: dict) -> None:
     tmp = path.with_name(fitting_name(path.name, name_limit(path.parent), len(tail)) + tail)  # cut where it would be too long (T29-A01)
     path.parent.mkdir(parents=True, exist_ok=True)
     try:
-        with open(tmp, "w") as f:
+        with open(tmp, "w", encoding="utf-8") as f:
             json.dump(state, f, allow_nan=False)
             f.flush()
             os.fsync(f.fileno())

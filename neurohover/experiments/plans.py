@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import shlex
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,6 +28,7 @@ import numpy as np
 from ..agents.hybrid import HybridSettings
 from ..agents.registry import HYBRID_AGENTS, agent_spec
 from ..errors import NeurohoverError, brief
+from ..filekinds import refuse_unencodable
 from ..integrations.neat import NEAT_TOPOLOGY
 from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..models.model import LEGACY_MODEL_SUBSTEPS
@@ -80,11 +82,13 @@ _SOURCE_KEYS = {"test_runs": "policies", "model_learning": "generic", "evolution
 def _load_external(task: str, source: str, key: str = "policies"):
     from pathlib import Path
 
+    if source != "shipped":  # 'pd é' under LC_ALL=C PYTHONUTF8=0 was "no such directory", is_dir() False (T31-A05)
+        refuse_unencodable(source, f"{key} =")
     folder = Path(source).expanduser()  # "~/bq0" as generics_from's "dir:~/..." is: the user's home (T30-A06)
     if source != "shipped" and not folder.is_dir():  # a generic "nope" was named as policies (eighth trial)
-        raise NeurohoverError(
+        raise NeurohoverError(  # the command quoted: 'pd 1' unquoted built 'pd' (T31-A05)
             f"{key} = {source!r} is not allowed: give {_SOURCE_WORDS[key]}'shipped' or a directory holding <task>/ policy sets "
-            f"(no such directory; build it with: neurohover build-policies --task {task} --out {source})"
+            f"(no such directory; build it with: neurohover build-policies --task {task} --out {shlex.quote(source)})"
         )
     return load_policy_set(task, None if source == "shipped" else folder)
 

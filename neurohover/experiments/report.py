@@ -583,7 +583,7 @@ def _write_report(store: Store, out: Path, scale: str | None, names: list[str] |
     head += "\n" + summary + conclusions_discussion(out) if summary else ""
     refuse_foreign_output(path, "report", REPORT_KIND)  # made while the figures were drawn
     with writing(path, "report") as partial:  # a full disk left an empty report.md and an unnamed error (seventh trial)
-        partial.write_text(head + "\n" + "\n".join(sections), errors="backslashreplace")  # no text can fail it half-way
+        partial.write_text(head + "\n" + "\n".join(sections), encoding="utf-8", errors="backslashreplace")  # no text can fail it half-way
     readme = out / "README.md"
     fill_generated(readme, "status", status_table([s for s in statuses if s.scale == "paper"]))
     if summary:

@@ -51,7 +51,7 @@ def fill_generated(path: Path, key: str, text: str) -> bool:
     if not path.is_file():
         return False
     begin, end = _marker(key)
-    old = path.read_text()
+    old = path.read_text(encoding="utf-8")
     pattern = re.compile(re.escape(begin) + r"\n.*?" + re.escape(end), re.S)
     if not pattern.search(old):
         return False
@@ -60,7 +60,7 @@ def fill_generated(path: Path, key: str, text: str) -> bool:
         from ..paths import writing
 
         with writing(path, "README") as partial:  # whole or not at all: a full disk must not cut the README short
-            partial.write_text(new)
+            partial.write_text(new, encoding="utf-8")
     return True
 
 

@@ -431,7 +431,7 @@ def run_diagnostic(p: dict, threads: int | None, device: str = "cpu") -> dict:
             time.sleep(0.01)
     marker = p.get("exit_unless")
     if marker and not os.path.exists(marker):
-        with open(marker, "w") as f:
+        with open(marker, "w", encoding="utf-8") as f:
             f.write(str(os.getpid()))
         os._exit(3)
     time.sleep(float(p.get("sleep", 0.0)))

@@ -249,7 +249,7 @@ def neat_config(settings: NeatSettings):
     text = _CONFIG.format(**fields, n_inputs=N_INPUTS, n_outputs=ACTION_DIM)  # the template names the settings' fields
     fd, path = tempfile.mkstemp(suffix=".ini", prefix="neurohover-neat-")
     try:
-        with os.fdopen(fd, "w") as f:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
             f.write(text)
         return neat.Config(neat.DefaultGenome, neat.DefaultReproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation, path)
     finally:

@@ -322,7 +322,7 @@ class LearnedModel:
         text = json.dumps(self.to_dict(), indent=1, allow_nan=False) + "\n"
         out = output_file(path, "model file", kind="a model file")  # /dev/full, a directory: one clear error
         with writing(out, "model file") as partial:
-            partial.write_text(text)
+            partial.write_text(text, encoding="utf-8")
         return out
 
     @classmethod
@@ -333,7 +333,7 @@ class LearnedModel:
         path = input_file(path, "model file", "model file (JSON, from learn-model --out)")
         name = f"model file {str(path)!r}"
         try:
-            text = path.read_text()
+            text = path.read_text(encoding="utf-8")
         except UnicodeDecodeError as err:
             raise NeurohoverError(f"{name} is not valid JSON (truncated or not a model file?): {err}") from None
         except OSError as err:
