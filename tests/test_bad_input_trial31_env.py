@@ -132,12 +132,16 @@ from pathlib import Path
 from neurohover.errors import NeurohoverError
 from neurohover.experiments import Store
 from neurohover.experiments.config import make_config
-from neurohover.experiments.plans import _load_external
+from neurohover.experiments.plans import _dir_champions, _load_external
 from neurohover.experiments.report import write_report
 
 print(sys.getfilesystemencoding())
 try:
     _load_external("ghh08", "pd \\xe9")
+except NeurohoverError as err:
+    print(ascii(str(err)))
+try:
+    _dir_champions("dir:pd \\xe9")
 except NeurohoverError as err:
     print(ascii(str(err)))
 settings = dict(task="ghh08", seed=1, policies="shipped", episodes=2, n_steps=20, groups=[dict(agent="baseline", mdps="test", n_mdps=1)])
@@ -163,6 +167,7 @@ def test_a05_an_unencodable_config_path_is_refused_by_its_encoding_and_the_repor
         "policies = 'pd \xe9' is not allowed: the file system's encoding (ascii) cannot encode the characters '\\xe9' in it: give a name "
         "of characters it can encode or run under a UTF-8 locale (LC_ALL=C.UTF-8, or PYTHONUTF8=1)"
     ), lines
+    assert lines[2].startswith(ascii("generics_from dir: 'pd \xe9' is not allowed: the file system's encoding (ascii) cannot encode")[:-1]), lines
     assert "## t\u4e2d\u6587 [quick]" in (tmp_path / "rep" / "report.md").read_text(encoding="utf-8")
 
 

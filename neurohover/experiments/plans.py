@@ -120,6 +120,7 @@ def _dir_champions(source: str) -> list[tuple[str, dict]]:
 
     from ..policies import load_policy
 
+    refuse_unencodable(source[len(DIR_SOURCE) :], "generics_from dir:")  # as policies = (T31-A05)
     folder = Path(source[len(DIR_SOURCE) :]).expanduser()
     files = sorted(f for f in folder.iterdir() if f.suffix in (".net", ".json")) if folder.is_dir() else []
     if not files:
