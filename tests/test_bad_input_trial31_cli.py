@@ -178,3 +178,19 @@ def test_a_bar_on_a_closed_or_unwritable_stream_is_not_drawn(tmp_path: Path) -> 
     closed = open(tmp_path / "g", "w")
     closed.close()
     assert isinstance(progress_bar(total=3, file=closed, disable=False), _Quiet)
+
+
+def test_an_error_with_standard_error_open_for_reading_only_is_said_on_standard_output() -> None:
+    """``2</dev/null``: standard error is a descriptor open for reading, so the error line failed again inside the
+    command's own handler: status 1 and no word anywhere (trial 31). Taken as closed, the line goes to standard output."""
+
+    def read_only_stderr() -> None:
+        fd = os.open(os.devnull, os.O_RDONLY)
+        os.dup2(fd, 2)
+
+    code = "import sys; from neurohover.cli.app import main; sys.exit(main())"
+    done = subprocess.run(
+        [sys.executable, "-c", code, "fly", "--task", "nope"], cwd=ROOT, stdout=subprocess.PIPE, text=True, preexec_fn=read_only_stderr, timeout=60
+    )
+    assert done.returncode == 2
+    assert "neurohover fly: error: unknown task 'nope'" in done.stdout

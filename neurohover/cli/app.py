@@ -6,6 +6,7 @@ Bad input prints one clear message and exits with status 2 (never a traceback fr
 from __future__ import annotations
 
 import argparse
+import io
 import os
 import re
 import signal
@@ -89,6 +90,7 @@ def _other_scripts_digits(argv: Sequence[str]) -> str | None:
 def main(argv: Sequence[str] | None = None) -> int:
     """The command line: ``neurohover ARGS`` (``argv``: the arguments, default ``sys.argv[1:]``); the exit status."""
     if argv is None:  # a path of undecodable bytes printed under a strict UTF-8 stdout was a traceback after the results (ninth trial)
+        _unwritable_stderr_closed()
         for stream in (sys.stdout, sys.stderr):
             if hasattr(stream, "reconfigure"):
                 stream.reconfigure(errors="backslashreplace")
@@ -99,6 +101,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         signal.signal(signal.SIGTERM, signal.SIG_IGN)
     return status
+
+
+def _unwritable_stderr_closed() -> None:
+    """Take a standard error open for reading only (``2</dev/null``) as closed, None, as Python takes ``2>&-``: every
+    error line then failed again inside its own handler, status 1 and no word anywhere (trial 31); closed, the line goes
+    to standard output, as print() sends it."""
+    try:
+        fd = sys.stderr.fileno() if sys.stderr is not None else None
+    except (OSError, ValueError, io.UnsupportedOperation):  # a stream with no descriptor of its own writes as it writes
+        return
+    if fd is not None:
+        try:
+            os.write(fd, b"")
+        except OSError:
+            sys.stderr = None
 
 
 def _negative_values_attached(parser: argparse.ArgumentParser, given: list[str]) -> list[str]:
