@@ -22,6 +22,7 @@ def test_a06_the_pure_python_kernel_wraps_its_uint64_arithmetic_silently() -> No
     assert run.returncode == 0 and "Traceback" not in run.stderr, run.stderr[-2000:]
     assert "overflow" not in run.stderr and "RuntimeWarning" not in run.stderr, run.stderr[-2000:]
     assert "mean_return: -962.946" in run.stdout, run.stdout  # the compiled kernel's return: the same streams
+    assert "compiling" not in run.stderr, run.stderr  # nothing compiles under it: the note said so on every run
 
 
 def test_a06_the_compiled_streams_are_still_numbas() -> None:
