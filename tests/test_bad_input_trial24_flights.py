@@ -110,7 +110,12 @@ def test_what_fly_wind_writes_loads_and_labels_it_does_not_write_are_left(flight
     """A wind of 0,0, -0 and 1e-5 (float32) loads as fly --wind wrote it; a --params label ('ghh08/custom') or any label
     of the user's names no parameters and is not checked."""
     labels = {FlightData.load(flights[n]).metadata["mdps"][0]["label"] for n in ("wind", "wind0", "wind-0")}
-    assert labels == {"ghh08/wind=[-0.228, 2.898]", "ghh08/wind=[0.0, 0.0]", "ghh08/wind=[-0.0, 1e-05]"}
+    assert labels == {"ghh08/wind=[-0.228, 2.898]", "ghh08/wind=[0.0, 0.0]", "ghh08/wind=[0.0, 1e-05]"}  # -0 is 0 (T31-A07)
+
+    def older(meta: dict) -> None:  # as fly wrote a wind of -0 before T31-A07
+        meta["mdps"][0]["label"] = "ghh08/wind=[-0.0, 1e-05]"
+
+    assert FlightData.load(edited_copy(flights["wind-0"], tmp_path / "older.npz", older)).n_episodes == 1
     for label in ("ghh08/custom", "my wind", "ghh08/sample:3"):
 
         def relabel(meta: dict, label: str = label) -> None:
