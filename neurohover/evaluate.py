@@ -41,7 +41,7 @@ from .sim.constants import (
     return_floor,
 )
 from .sim.kernel import GENOME_WIDTH
-from .tasks import MDP, Sensor, check_rows, refuse_drift
+from .tasks import MDP, Sensor, check_rows, refuse_drift, refuse_unordered_mdps
 
 # Re-exported where they were first defined: KernelFlyer, DEVICES, check_device, num_threads, use_lanes.
 __all__ = [
@@ -272,7 +272,7 @@ def mdp_rows(mdps: MDP | Sequence[MDP] | np.ndarray) -> np.ndarray:
         return np.ascontiguousarray(mdps, dtype=float)
     if isinstance(mdps, (str, bytes)) or not hasattr(mdps, "__len__") or len(mdps) == 0 or not all(isinstance(m, MDP) for m in mdps):
         raise NeurohoverError(f"mdps={mdps!r:.60} is not allowed: give an MDP, a non-empty sequence of MDPs or an array of MDP rows")
-    for m in mdps:
+    for m in refuse_unordered_mdps(mdps):  # a set flew in hash order (T32-B02)
         refuse_drift(m, "this batch")
     return np.stack([m.row() for m in mdps])
 

@@ -32,7 +32,7 @@ from ..errors import NeurohoverError, brief, whole_in
 from ..evaluate import Evaluation, check_first_episode
 from ..policies import Policy
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS
-from ..tasks import MDP
+from ..tasks import MDP, refuse_unordered_mdps
 
 __all__ = ["AgentRow", "checked_obs_statistics", "compare_agent", "evaluate_callable"]
 
@@ -42,6 +42,7 @@ MAX_EPISODES = 1 << 16  # helicopters in one lockstep batch: the vector environm
 def _checked_mdps(mdps: Any) -> tuple[list[MDP], str]:
     """``mdps`` (one MDP or a sequence of them, of one task family) as a list, with their family: the one check of
     :func:`evaluate_callable` and :func:`compare_agent` (a Policy flew MDPs of mixed families; twelfth trial S5)."""
+    refuse_unordered_mdps(mdps)  # a set flew in hash order (T32-B02)
     if isinstance(mdps, MDP):
         mdps = [mdps]
     elif isinstance(mdps, Iterable) and not isinstance(mdps, (str, bytes)):

@@ -27,7 +27,7 @@ import pkgutil
 
 from ..errors import NeurohoverError, brief
 from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, competition_rows, finite_vector
-from .drift import NO_DRIFT, Drift, refuse_drift
+from .drift import NO_DRIFT, Drift, refuse_drift, refuse_unordered_mdps
 from .fghh import COMPETITION_FGHH_SIGMA, FGHH
 from .ghh08 import GHH08, MAX_WIND
 from .ghh09 import GHH09, GHH09_PARAM_NAMES
@@ -139,4 +139,5 @@ __all__ = [
     "finite_vector",
     "get_task_family",
     "refuse_drift",
+    "refuse_unordered_mdps",
 ]
