@@ -183,6 +183,20 @@ def check_no_unknown_kwargs(unknown: dict[str, Any], allowed: Sequence[str]) -> 
         raise NeurohoverError(f"unknown argument(s) {', '.join(sorted(unknown))}: allowed {', '.join(allowed)}")
 
 
+class FixedSettings:
+    """An environment whose settings (its constructor's arguments, ``_FIXED``) cannot change once it is made (``_made``):
+    its steps trust the values checked then. ``env.episode_steps = -1`` (or ``set_wrapper_attr``) made a crash pay
+    +3497.6, ``"20"`` a numba TypingError, and ``set_wrapper_attr("task", ...)`` was taken and ignored (T32-B04)."""
+
+    _FIXED: tuple[str, ...] = ()
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name in self._FIXED and self.__dict__.get("_made"):
+            how = "reset(options={'mdp': ...}) flies another MDP" if name == "mdp" else f"make a new environment with {name}=..."
+            raise NeurohoverError(f"{name}={brief(value)} is not allowed: an environment's {name} is fixed when it is made (its steps trust it); {how}")
+        super().__setattr__(name, value)
+
+
 def check_count(value: Any, name: str, largest: int) -> int:
     """``value`` (the argument ``name``) as an int, refused unless it is an integer in 1..``largest`` (:func:`~neurohover.errors.whole_in`)."""
     return whole_in(value, name, 1, largest)

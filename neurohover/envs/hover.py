@@ -37,6 +37,7 @@ from ..tasks import MDP, TASK_FAMILIES, TaskFamily
 from ..tasks.drift import Drift, DriftRun
 from .arguments import (
     SAMPLE,
+    FixedSettings,
     MdpSpec,
     check_action_dtype,
     check_against_id,
@@ -110,7 +111,7 @@ def action_space(dtype: Any = np.float64) -> spaces.Box:
     return spaces.Box(-1.0, 1.0, (ACTION_DIM,), dtype)
 
 
-class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
+class HoverEnv(FixedSettings, gym.Env[np.ndarray, np.ndarray]):
     """Hover an XCell Tempest helicopter at the origin, in an MDP drawn from a task family.
 
     ## Description
@@ -120,6 +121,8 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
     for 10 minutes of flight at 10 Hz, in an MDP that the agent does not know. The task family
     fixes the distribution G of MDPs: ``ghh08`` (constant wind up to 5 m/s), ``ghh09``
     (sinusoidal winds) or ``fghh`` (every dynamics parameter perturbed, relative std ``sigma``).
+    Its arguments are fixed once it is made: setting one (``env.episode_steps = 50``, Gymnasium's
+    ``set_wrapper_attr``) is refused, as the steps trust them; make another environment.
 
     ## Action Space
 
@@ -287,6 +290,7 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
     """
 
     metadata = {"render_modes": list(RENDER_MODES), "render_fps": RENDER_FPS}
+    _FIXED = (*ENV_KWARGS, "family")  # fixed once made (FixedSettings; T32-B04)
 
     def __init__(
         self,
@@ -336,6 +340,7 @@ class HoverEnv(gym.Env[np.ndarray, np.ndarray]):
         self._trail: list[np.ndarray] = []
         self._renderer: Any = None
         self._window: Any = None
+        self._made = True  # its settings are fixed from here (FixedSettings)
 
     _env_spec: Any = None
 

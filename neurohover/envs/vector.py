@@ -36,6 +36,7 @@ from ..sim.step import ENV_NOISE_WIDTH, ENV_RNG_WIDTH, start_readings
 from ..tasks import MDP, TaskFamily, refuse_drift
 from .arguments import (
     SAMPLE,
+    FixedSettings,
     MdpSpec,
     check_action_dtype,
     check_against_id,
@@ -67,7 +68,7 @@ def _seed_streams(rngs: np.ndarray, idx: np.ndarray, streams: np.ndarray) -> Non
         seed_stream(rngs[i], np.uint64(streams[i, 0]), np.uint64(streams[i, 1]))
 
 
-class HoverVectorEnv(VectorEnv):
+class HoverVectorEnv(FixedSettings, VectorEnv):
     """``num_envs`` independent hovering helicopters (see :class:`neurohover.envs.hover.HoverEnv`).
 
     Observations are float64 arrays of shape (num_envs, 12) (float32 with
@@ -75,7 +76,8 @@ class HoverVectorEnv(VectorEnv):
     terminations and truncations are (num_envs,) arrays. Sub-environments reset automatically
     in Gymnasium's ``NEXT_STEP`` mode: the step after sub-environment i terminated or was
     truncated ignores its action and returns its new episode's first observation (all zeros; with noisy sensors their reading),
-    reward 0 and ``terminated = truncated = False``.
+    reward 0 and ``terminated = truncated = False``. The arguments are fixed once it is made: setting one
+    (``envs.episode_steps = 50``, ``set_wrapper_attr``) is refused; make another environment.
 
     Parameters
     ----------
@@ -135,6 +137,7 @@ class HoverVectorEnv(VectorEnv):
     """
 
     metadata = {"render_modes": [], "render_fps": RENDER_FPS, "autoreset_mode": AutoresetMode.NEXT_STEP}
+    _FIXED = (*VECTOR_ENV_KWARGS, "family")  # fixed once made (FixedSettings; T32-B04)
 
     def __init__(
         self,
@@ -199,6 +202,7 @@ class HoverVectorEnv(VectorEnv):
         # On the GPU the host's _state, _noise and _rng rows are written only by resets (and then
         # copied in); the device holds the flying values. _steps is mirrored on the host.
         self._stepper = stepper(device, self._rows, self._index, self._state, self._noise, self._rng, self._steps)
+        self._made = True  # its settings are fixed from here (FixedSettings)
 
     # -- read-only views -------------------------------------------------------------------
 
@@ -340,7 +344,7 @@ class HoverVectorEnv(VectorEnv):
         for i in idx.tolist():
             gen = self._gens[i]
             spec = self._specs[i]
-            if spec is SAMPLE:
+            if isinstance(spec, str):  # SAMPLE: "is SAMPLE" failed on an unpickled copy, whose string is equal but another (T32-B19)
                 # The same draws as family.sample(gen), but building the MDP object is ~8x dearer
                 # than the draw itself, so it is built only when someone asks (``mdps``).
                 d = sample_params(gen, 1)[0]
