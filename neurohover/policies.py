@@ -177,8 +177,20 @@ class Policy:
         )
 
     def with_genome(self, genome: np.ndarray, **metadata) -> Policy:
-        """A policy of the same topology with another genome."""
-        return Policy(self.topology, genome, {**self.metadata, **metadata})  # uncast: float() read '0.5', dates and bools (T16-10)
+        """A policy of the same topology with another genome, and this one's metadata (updated by ``metadata``) less the
+        keys that record results of flying this genome (:data:`GENOME_RESULT_KEYS`: its champion and validation returns,
+        history file, episode and evaluation counts, stop reason, seconds): they are not the new genome's (T32-B14). The
+        keys that describe its run's setting (task, target, method, settings, seed, budget, n_steps ...) are kept."""
+        kept = {k: v for k, v in self.metadata.items() if k not in GENOME_RESULT_KEYS}
+        return Policy(self.topology, genome, {**kept, **metadata})  # uncast: float() read '0.5', dates and bools (T16-10)
+
+
+#: Metadata keys that record results of flying a policy's genome (as ``neurohover evolve`` writes them):
+#: :meth:`Policy.with_genome` leaves them out, as another genome's results (a saved policy claimed them; T32-B14).
+GENOME_RESULT_KEYS = frozenset(
+    {"champion_return", "champion_fitness_scale", "validation_return", "validation_sd", "validation_episodes", "history",
+     "episodes", "evaluations", "generations", "seconds", "stop_reason", "reevaluated_from"}
+)  # fmt: skip
 
 
 def check_genome(genome, topology: str) -> np.ndarray:
