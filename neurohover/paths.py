@@ -17,20 +17,16 @@ import errno
 import json
 import os
 import re
-import socket
 import sys
 import tempfile
-from collections.abc import Callable, Iterator, Mapping
+import threading
+from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
 
 from .errors import NeurohoverError, OutputError, brief, float_of
 from .filekinds import NAME_MAX, PNG_KIND, SQLITE_HEADER, fitting_name, held_kind, name_limit, output_name, refuse_policy_set, refuse_unencodable
-
-try:
-    import fcntl
-except ImportError:  # not POSIX: no output lock; one run per output is then the user's care
-    fcntl = None  # type: ignore[assignment]
+from .locks import WriterLock, sole_writer
 
 __all__ = [
     "JSONError",
@@ -55,6 +51,7 @@ __all__ = [
     "remove_created_dirs",
     "sole_writer",
     "write_png",
+    "writer_file",
     "writing",
 ]
 
@@ -129,17 +126,32 @@ def refuse_dangling_link(path: str | os.PathLike, option: str, given: str | os.P
         )
 
 
-#: The longest whole path in bytes (Linux's PATH_MAX); the longest name, :data:`~neurohover.filekinds.NAME_MAX`, is
-#: where the file system cannot say (:func:`~neurohover.filekinds.name_limit`).
-PATH_MAX = 4096
+def _path_max() -> int:
+    try:
+        limit = int(os.pathconf("/", "PC_PATH_MAX"))
+    except (AttributeError, OSError, ValueError):  # not POSIX, or the system cannot say
+        limit = 0
+    return limit if limit > 0 else 4096
 
 
-def checked_path(path, option: str, what: str = "file path", ends: tuple[str, ...] = ()) -> Path:
+#: The whole path's limit in bytes, its terminating NUL included (PATH_MAX: ``os.pathconf``'s PC_PATH_MAX, else 4096),
+#: so the longest path is one byte less; the longest name, :data:`~neurohover.filekinds.NAME_MAX`, is where the file
+#: system cannot say (:func:`~neurohover.filekinds.name_limit`).
+PATH_MAX = _path_max()
+
+_DIRECTORY_ENDS = tuple(sorted({f"{sep}{end}" for sep in {"/", os.sep} for end in ("", ".", "..")}, key=len, reverse=True))
+
+
+def checked_path(path, option: str, what: str = "file path", ends: tuple[str, ...] = (), file: bool = False) -> Path:
     """``path`` (a str or path object) as a Path: empty, another type, a NUL byte or a name longer than the file system
     takes refused by name (the OS's TypeError, ValueError and OSError before); ``what`` says what to give instead.
     ``ends``: what the command adds to the file's name for the files it writes beside it (evolve's ``NAME.history.csv``
     and ``NAME.checkpoint.json``), whose longest must fit too: a name of 250 bytes was taken, and the run's history file
-    then refused (T29-A01)."""
+    then refused (T29-A01). The whole path is counted as given and made absolute, as every check and write then uses
+    it: a relative path of 4,081 bytes in a directory of 26 was an OSError "File name too long" (T32-B06).
+    ``file``: the path names a file, so one ending in '/', '/.' or '/..' that is no directory is refused (Path()
+    drops the first two: 'p.json/' and 'p.json/.' were read and written as p.json; T32-B07, T32-B08); an existing
+    directory is the caller's to name."""
     if not isinstance(path, (str, os.PathLike)):
         raise NeurohoverError(f"{option}={path!r:.60} is not allowed: give a {what}")
     text = os.fspath(path)
@@ -157,14 +169,20 @@ def checked_path(path, option: str, what: str = "file path", ends: tuple[str, ..
     if sizes and end and parts[-1] != os.sep:
         sizes[-1] += len(os.fsencode(end))
     longest, whole = max(sizes, default=0), len(os.fsencode(text + end))
+    absolute = len(os.fsencode(os.path.abspath(text) + end))  # the current directory's length too (T32-B06)
     limit = name_limit(Path(text).parent) if longest > 14 else NAME_MAX  # (no file system takes fewer than 14)
-    if longest > limit or whole > PATH_MAX:
+    if longest > limit or max(whole, absolute) >= PATH_MAX:
         beside = f" with the {end} it writes beside it" if end and sizes[-1] == longest and longest > limit else ""
+        made = f", {absolute:,} made absolute" if absolute != whole else ""
         raise NeurohoverError(
             f"{option} {brief(text)} is too long: at most {limit} bytes in one file or directory name "
-            f"(here {longest:,}{beside}) and {PATH_MAX} in the whole path (here {whole:,})"
+            f"(here {longest:,}{beside}) and {PATH_MAX - 1:,} in the whole path (here {whole:,}{made})"
         )
     refuse_link_loop(text, option)
+    if file:
+        tail = next((e for e in _DIRECTORY_ENDS if text.endswith(e)), "")
+        if tail and not Path(text).is_dir():
+            raise NeurohoverError(f"{option} {text!r} ends in {tail!r}, which names a directory: give a {what}")
     return Path(text)
 
 
@@ -299,7 +317,7 @@ def output_file(
     creates missing parent directories (saying so on standard error).
     """
     _no_dash(path, option, "file", stdout)
-    p = checked_path(path, option, ends=ends)
+    p = checked_path(path, option, ends=ends, file=True)  # 'x.json/' and 'x.json/.' too (seventh trial, T32-B08)
     for name, given in (inputs or {}).items():
         if given is not None and str(given) != "" and p.exists() and Path(given).exists() and p.samefile(given):
             raise NeurohoverError(f"{option} {str(path)!r} is the file of {name}: give another path (writing it would destroy what is read)")
@@ -313,8 +331,6 @@ def output_file(
             raise NeurohoverError(f"{option} {str(path)!r} is a results store (SQLite): give another path (writing it would destroy its results)")
     if p.is_dir():
         raise NeurohoverError(f"{option} {str(path)!r} is a directory; give a file path")
-    if os.fspath(path).endswith(("/", os.sep)):  # Path() drops the slash: 'x.json/' was written as the file x.json (seventh trial)
-        raise NeurohoverError(f"{option} {str(path)!r} ends in '/', which names a directory: give a file path")
     refuse_special_file(p, option, path)
     if suffixes or run_files:  # flight data, a checkpoint replaced by JSON rows, CSV or a model (T25-01 to T25-03)
         output_name(path, option, suffixes or ("",), what, run_files, ends)
@@ -327,14 +343,33 @@ def output_file(
     real = Path(os.path.realpath(p))
     existed = real.exists()
     try:
-        with open(real, "ab"):  # appending nothing leaves an existing file's content and time as they are
-            pass
+        existed = not _probe(real)
     except OSError as err:
         what = "write this file" if existed else f"create a file in {str(real.parent)!r}"
         raise NeurohoverError(f"{option} {str(path)!r}: cannot {what} ({_why(err)})") from None
-    if not existed:
-        real.unlink(missing_ok=True)  # the file the check made, not a link to it (which unlink would remove instead)
     return p
+
+
+def _probe(real: Path) -> bool:
+    """Open the file ``real`` for writing, appending nothing (an existing file's content and time stay as they are);
+    True where the probe created it, and then removed it again, unless another writer has put its own file there
+    meanwhile: a thread's check removed the file another had just saved (T32-B01)."""
+    try:
+        fd = os.open(real, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+    except FileExistsError:
+        os.close(os.open(real, os.O_WRONLY | os.O_APPEND))
+        return False
+    try:
+        made = os.fstat(fd)
+    finally:
+        os.close(fd)
+    try:
+        now = os.stat(real)
+        if (now.st_dev, now.st_ino) == (made.st_dev, made.st_ino):
+            real.unlink()  # the file the check made, not a link to it (which unlink would remove instead)
+    except FileNotFoundError:
+        pass
+    return True
 
 
 def refuse_special_file(path: str | os.PathLike, option: str, given: str | os.PathLike | None = None, instead: str = "give a file path") -> None:
@@ -371,6 +406,16 @@ def refuse_foreign_output(path: str | os.PathLike, option: str, kind: str) -> No
         )
 
 
+def writer_file(path: Path, ending: str, hidden: bool = False) -> Path:
+    """The temporary file beside ``path`` one writer writes before it moves it onto ``path``: ``NAME.PID.TID{ending}``
+    (``hidden``: with a leading dot), one per process and thread. Named by the process only, threads saving one path at
+    once truncated and moved each other's: a corrupt file, one save said done and the others "No such file or
+    directory" (T32-B01). The name is cut where the file's own fits and this one would not (T29-A01)."""
+    tail = f".{os.getpid()}.{threading.get_native_id()}{ending}"
+    dot = "." if hidden else ""
+    return path.with_name(dot + fitting_name(path.name, name_limit(path.parent), len(os.fsencode(dot + tail))) + tail)
+
+
 @contextmanager
 def writing(path: str | os.PathLike, option: str) -> Iterator[Path]:
     """Write the output file ``path`` inside this block, through the path it yields (a temporary file beside it, moved
@@ -382,8 +427,7 @@ def writing(path: str | os.PathLike, option: str) -> Iterator[Path]:
     refuse_dangling_link(path, option)  # every writer: one to nothing wrote wherever it pointed (T19-12)
     p = Path(os.path.realpath(path))  # through a symbolic link: its file is written, the link kept (not replaced by a file)
     refuse_special_file(p, option, path)  # every writer, not only those checked by output_file first (fourteenth trial)
-    tail = f".{os.getpid()}.partial"  # the name cut where the file's own fits and this one would not (T29-A01)
-    partial = p.with_name("." + fitting_name(p.name, name_limit(p.parent), len(os.fsencode(tail)) + 1) + tail)
+    partial = writer_file(p, ".partial", hidden=True)
     try:
         yield partial
         refuse_special_file(p, option, path)  # made while the block ran
@@ -423,7 +467,7 @@ def output_dir(path: str | os.PathLike, option: str) -> Path:
 
 def input_file(path: str | os.PathLike, option: str, what: str = "file") -> Path:
     """Check that ``path`` is an existing, readable regular file."""
-    p = checked_path(path, option, what)
+    p = checked_path(path, option, what, file=True)  # 'p.json/' was read as p.json (T32-B08)
     if not p.exists():
         raise NeurohoverError(f"{option} {str(path)!r}: no such {what}")
     if p.is_dir():
@@ -498,95 +542,3 @@ def printable(text: str | os.PathLike) -> str:
 def forget_created_dirs() -> None:
     """Start a command afresh: what earlier commands in this process created is theirs."""
     _created.clear()
-
-
-class WriterLock:
-    """One process writing an output at a time: an OS advisory lock (``flock``) on a lock file beside it.
-
-    The holder writes its pid and host into the file. The kernel drops the lock when its process ends in any way, so a
-    killed run never blocks the next one; :meth:`release` removes the file while still holding the lock, and a run that
-    opened the old file meanwhile sees, once it gets the lock, that the path names another file and starts over. Used by
-    :func:`sole_writer` (evolve's ``--out``) and by the results store (``STORE.lock``).
-    """
-
-    def __init__(self, path: Path, attempts: int = 100) -> None:
-        self.path = path  # the lock file
-        self.attempts = attempts
-        self.fd = -1
-
-    @property
-    def held(self) -> bool:
-        return self.fd >= 0
-
-    def open_file(self) -> int:
-        """The lock file, created if missing, opened for reading and writing (an OSError where it cannot be)."""
-        return os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
-
-    def acquire(self, busy: Callable[[str], str]) -> bool:
-        """Take the lock (nothing if this object holds it). Another process holding it raises NeurohoverError with
-        ``busy(who)``, ``who`` naming the holder ("pid 12 on host h"). False where the lock cannot be taken at all (not
-        POSIX, or a filesystem without locks): the output is then written unguarded. Opening the file may raise OSError."""
-        if self.held:
-            return True
-        if fcntl is None:
-            return False
-        for _ in range(self.attempts):
-            fd = self.open_file()
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except OSError as err:
-                holder = os.read(fd, 256).decode(errors="replace").split()
-                os.close(fd)
-                if err.errno not in (errno.EAGAIN, errno.EWOULDBLOCK, errno.EACCES):
-                    return False  # ENOLCK and the like: the filesystem cannot lock
-                who = f"pid {holder[0]} on host {holder[1]}" if len(holder) >= 2 else f"pid {holder[0]}" if holder else "another process"
-                raise NeurohoverError(busy(who)) from None
-            if self._names(fd):
-                break
-            os.close(fd)  # the previous holder removed it as it released: lock the path's new file
-        else:
-            raise NeurohoverError(f"could not lock {str(self.path)!r}: it kept being replaced by other runs")
-        self.fd = fd
-        try:
-            os.ftruncate(fd, 0)
-            os.write(fd, f"{os.getpid()} {socket.gethostname()}\n".encode())
-        except OSError:  # no room for the pid: the lock holds all the same
-            pass
-        return True
-
-    def _names(self, fd: int) -> bool:
-        """Whether the lock path still is the file ``fd`` holds (not removed or replaced since it was opened)."""
-        try:
-            now = os.stat(self.path)
-        except FileNotFoundError:
-            return False
-        held = os.fstat(fd)
-        return (now.st_dev, now.st_ino) == (held.st_dev, held.st_ino)
-
-    def release(self) -> None:
-        """Remove the lock file, then drop the lock (nothing if not held)."""
-        if not self.held:
-            return
-        try:
-            self.path.unlink()
-        except OSError:
-            pass
-        os.close(self.fd)
-        self.fd = -1
-
-
-@contextmanager
-def sole_writer(path: Path, option: str) -> Iterator[None]:
-    """Be the only run writing the output ``path`` (and the files named after it) inside this block: a second run on
-    the same output is refused, naming the first's pid. Two evolve runs on one --out both said they finished and left
-    one's policy beside the other's checkpoint (tenth trial). A :class:`WriterLock` on ``.NAME.lock`` beside it; a
-    folder where it cannot be made (full, read-only) is left to the output's own write to name."""
-    lock = WriterLock(path.with_name(f".{path.name}.lock"))
-    try:
-        lock.acquire(lambda who: f"{option} {str(path)!r} is being written by another run ({who}): wait for it to end, or give another {option}")
-    except OSError:
-        pass
-    try:
-        yield
-    finally:
-        lock.release()

@@ -12,7 +12,7 @@ PACKAGE = Path(neurohover.__file__).resolve().parent
 # task family -> MDP rows -> batched rollouts -> returns and flight data -> evolution / models -> agents
 # -> experiments -> store, report, plots; the command line and the package's front door on top.
 LAYERS = [
-    {"command", "errors", "filekinds", "paths", "procs", "progress", "settingsdoc"},
+    {"command", "errors", "filekinds", "locks", "paths", "procs", "progress", "settingsdoc"},
     {"sim"},
     {"tasks", "flightdata", "flightmeta", "policies", "netfile", "wrappers"},
     {"launch", "flyer", "plots", "compete_files"},

@@ -48,7 +48,7 @@ Checkpoints
 With ``checkpoint=PATH`` the run writes, at most every ``checkpoint_every_s`` seconds, at its end,
 and when interrupted, a JSON file (``neurohover-evolution-checkpoint/1``) with the optimiser's
 ``state_dict`` (CMA-ES: its pickled pycma state, base64), the episode counter, the MDP stream's
-state and the history, atomically (written to ``PATH.PID.tmp``, then ``os.replace``). ``resume=True``
+state and the history, atomically (written to ``PATH.PID.TID.tmp``, then ``os.replace``). ``resume=True``
 continues from it bit-for-bit (same champion, history and counters as an uninterrupted run); the
 run's configuration must match the checkpoint's, except the budget, which may be raised.
 Interrupts (Ctrl-C, or ``KeyboardInterrupt`` raised by the ``progress`` callback) take effect at

@@ -15,8 +15,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import NeurohoverError, brief, first_difference, whole_number
-from ..filekinds import CSV_KINDS, JSON_KINDS, fitting_name, name_limit, refuse_cut_off
-from ..paths import JSONError, input_file, number_text, output_file, strict_json, writing
+from ..filekinds import CSV_KINDS, JSON_KINDS, refuse_cut_off
+from ..paths import JSONError, input_file, number_text, output_file, strict_json, writer_file, writing
 from ..policies import Policy
 from .common import EntryError, enc_float, read_count, read_return, read_seconds
 
@@ -269,10 +269,9 @@ def decode_history(rows) -> list[HistoryRecord]:
 
 
 def write_checkpoint(path: Path, state: dict) -> None:
-    """Write a checkpoint atomically: strict JSON to ``PATH.PID.tmp``, synced, then renamed over ``path``."""
+    """Write a checkpoint atomically: strict JSON to ``PATH.PID.TID.tmp``, synced, then renamed over ``path``."""
     path = Path(os.path.realpath(path))  # through a symbolic link: its file is written, the link kept (ninth trial)
-    tail = f".{os.getpid()}.tmp"  # one per process: two runs on one --out truncated each other's (tenth trial)
-    tmp = path.with_name(fitting_name(path.name, name_limit(path.parent), len(tail)) + tail)  # cut where it would be too long (T29-A01)
+    tmp = writer_file(path, ".tmp")  # one per process (tenth trial) and thread (T32-B01); cut where too long (T29-A01)
     path.parent.mkdir(parents=True, exist_ok=True)
     try:
         with open(tmp, "w", encoding="utf-8") as f:

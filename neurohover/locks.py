@@ -1,0 +1,112 @@
+"""One process writing an output at a time: :class:`WriterLock`, an OS advisory lock on a lock file beside the output,
+and :func:`sole_writer`, evolve's guard of its ``--out`` (re-exported by :mod:`neurohover.paths`, where they were)."""
+
+from __future__ import annotations
+
+import errno
+import os
+import socket
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+from .errors import NeurohoverError
+
+try:
+    import fcntl
+except ImportError:  # not POSIX: no output lock; one run per output is then the user's care
+    fcntl = None  # type: ignore[assignment]
+
+__all__ = ["WriterLock", "sole_writer"]
+
+
+class WriterLock:
+    """One process writing an output at a time: an OS advisory lock (``flock``) on a lock file beside it.
+
+    The holder writes its pid and host into the file. The kernel drops the lock when its process ends in any way, so a
+    killed run never blocks the next one; :meth:`release` removes the file while still holding the lock, and a run that
+    opened the old file meanwhile sees, once it gets the lock, that the path names another file and starts over. Used by
+    :func:`sole_writer` (evolve's ``--out``) and by the results store (``STORE.lock``).
+    """
+
+    def __init__(self, path: Path, attempts: int = 100) -> None:
+        self.path = path  # the lock file
+        self.attempts = attempts
+        self.fd = -1
+
+    @property
+    def held(self) -> bool:
+        return self.fd >= 0
+
+    def open_file(self) -> int:
+        """The lock file, created if missing, opened for reading and writing (an OSError where it cannot be)."""
+        return os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+
+    def acquire(self, busy: Callable[[str], str]) -> bool:
+        """Take the lock (nothing if this object holds it). Another process holding it raises NeurohoverError with
+        ``busy(who)``, ``who`` naming the holder ("pid 12 on host h"). False where the lock cannot be taken at all (not
+        POSIX, or a filesystem without locks): the output is then written unguarded. Opening the file may raise OSError."""
+        if self.held:
+            return True
+        if fcntl is None:
+            return False
+        for _ in range(self.attempts):
+            fd = self.open_file()
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError as err:
+                holder = os.read(fd, 256).decode(errors="replace").split()
+                os.close(fd)
+                if err.errno not in (errno.EAGAIN, errno.EWOULDBLOCK, errno.EACCES):
+                    return False  # ENOLCK and the like: the filesystem cannot lock
+                who = f"pid {holder[0]} on host {holder[1]}" if len(holder) >= 2 else f"pid {holder[0]}" if holder else "another process"
+                raise NeurohoverError(busy(who)) from None
+            if self._names(fd):
+                break
+            os.close(fd)  # the previous holder removed it as it released: lock the path's new file
+        else:
+            raise NeurohoverError(f"could not lock {str(self.path)!r}: it kept being replaced by other runs")
+        self.fd = fd
+        try:
+            os.ftruncate(fd, 0)
+            os.write(fd, f"{os.getpid()} {socket.gethostname()}\n".encode())
+        except OSError:  # no room for the pid: the lock holds all the same
+            pass
+        return True
+
+    def _names(self, fd: int) -> bool:
+        """Whether the lock path still is the file ``fd`` holds (not removed or replaced since it was opened)."""
+        try:
+            now = os.stat(self.path)
+        except FileNotFoundError:
+            return False
+        held = os.fstat(fd)
+        return (now.st_dev, now.st_ino) == (held.st_dev, held.st_ino)
+
+    def release(self) -> None:
+        """Remove the lock file, then drop the lock (nothing if not held)."""
+        if not self.held:
+            return
+        try:
+            self.path.unlink()
+        except OSError:
+            pass
+        os.close(self.fd)
+        self.fd = -1
+
+
+@contextmanager
+def sole_writer(path: Path, option: str) -> Iterator[None]:
+    """Be the only run writing the output ``path`` (and the files named after it) inside this block: a second run on
+    the same output is refused, naming the first's pid. Two evolve runs on one --out both said they finished and left
+    one's policy beside the other's checkpoint (tenth trial). A :class:`WriterLock` on ``.NAME.lock`` beside it; a
+    folder where it cannot be made (full, read-only) is left to the output's own write to name."""
+    lock = WriterLock(path.with_name(f".{path.name}.lock"))
+    try:
+        lock.acquire(lambda who: f"{option} {str(path)!r} is being written by another run ({who}): wait for it to end, or give another {option}")
+    except OSError:
+        pass
+    try:
+        yield
+    finally:
+        lock.release()
