@@ -422,6 +422,37 @@ def genome_record(genome) -> tuple[float, ...]:
     return tuple(out)
 
 
+#: The most a NEAT record's bias, response or weight may be: neat-python's clamp of all three (_CONFIG), so a record
+#: it evolved always holds them; 1e308 flew NaN, and a node key of 0.5 was cut to 0 (T32-B16).
+MAX_NEAT_VALUE, MAX_NODE_KEY = 30.0, 2**53
+
+
+def _check_record_network(record: Sequence[float], n_nodes: int) -> None:
+    """A record's nodes and connections as neat-python builds them, checked: whole, unrepeated node keys 0..2**53 with
+    the 4 outputs 0..3 among them, values within +-30, and each connection once, from an input (-9..-1) or a node, to
+    a node. A record without nodes was neat-python's KeyError 0, a connection from node 55 its KeyError 55 (T32-B15);
+    a repeated node or connection kept the last (T32-B16)."""
+    name = "a NEAT record's {} {} is not allowed: {}"
+    keys = [record[1 + 4 * j] for j in range(n_nodes)]
+    for key in keys:
+        if not (float(key).is_integer() and 0 <= key <= MAX_NODE_KEY):
+            raise NeurohoverError(name.format("node key", brief(key), f"allowed a whole number in 0..2**53 (outputs 0..{ACTION_DIM - 1})"))
+    if len(set(keys)) < len(keys) or not set(range(ACTION_DIM)) <= set(keys):
+        raise NeurohoverError(name.format("node keys", brief(keys), f"give each node once, the outputs 0..{ACTION_DIM - 1} among them"))
+    values = [(what, record[1 + 4 * j + k]) for j in range(n_nodes) for k, what in ((1, "bias"), (2, "response"))]
+    values += [("weight", record[j + 2]) for j in range(1 + 4 * n_nodes, len(record), 3)]
+    for what, v in values:
+        if abs(v) > MAX_NEAT_VALUE:
+            raise NeurohoverError(name.format(what, brief(v), f"allowed numbers in [-{MAX_NEAT_VALUE:g}, {MAX_NEAT_VALUE:g}] (neat-python's clamp)"))
+    seen: set[tuple[float, float]] = set()
+    for j in range(1 + 4 * n_nodes, len(record), 3):
+        i, o = record[j], record[j + 1]
+        if (i, o) in seen or not (i in keys or (float(i).is_integer() and -N_INPUTS <= i <= -1)) or o not in keys:
+            why = "it is listed twice" if (i, o) in seen else f"give it once, from an input -{N_INPUTS}..-1 or a node of the record to a node"
+            raise NeurohoverError(name.format("connection", f"{brief(i)} -> {brief(o)}", why))
+        seen.add((i, o))
+
+
 def network_of_record(record: Sequence[float]) -> PackedNetworks:
     """The network of a :func:`genome_record`, packed for :func:`forward` (neat-python's evaluation order)."""
     import neat
@@ -439,6 +470,7 @@ def network_of_record(record: Sequence[float]) -> PackedNetworks:
         raise NeurohoverError(f"a NEAT record's node count {brief(record[0])} is not allowed: give a whole number >= 0")
     if len(record) < 1 + 4 * n_nodes or (len(record) - 1 - 4 * n_nodes) % 3:
         raise NeurohoverError(f"a NEAT record of {len(record)} numbers does not hold {n_nodes} nodes and whole connections")
+    _check_record_network(record, n_nodes)
     genome = neat.DefaultGenome(0)
     gc = config.genome_config
     for j in range(n_nodes):
