@@ -295,7 +295,7 @@ def load_policy(source: str | Path) -> Policy:
     from .paths import input_file
 
     path = input_file(source, "policy file", "policy file (JSON, an authors' .net file, or 'baseline')")  # the one check of a file read
-    net = path.suffix == ".net"
+    net = path.suffix.lower() == ".net"  # in any case, as the .json suffix is taken: p.NET was read as JSON (T32-B21)
     name = f"{'network' if net else 'policy'} file {str(path)!r}"
     try:
         text = utf8_text(path.read_bytes(), name, "a network file" if net else "a policy file")
@@ -368,7 +368,7 @@ def check_json_policy_name(path: object, option: str, ends: tuple[str, ...] = ()
 
     Taken: a name ending ``.json``, in any case (``p.json``, ``P.JSON``), but for the end below. Refused:
 
-    * ``.net``: :func:`load_policy` reads it as the authors' format, so the JSON written could not be read back (third trial);
+    * ``.net`` (any case): :func:`load_policy` reads it as the authors' format, so the JSON written could not be read back (third trial);
     * any other suffix, or none (``f.npz``, ``q.txt``, ``p``): flight data and other files were overwritten by a policy
       (T24-01), as learn-model --out and fly --record refuse theirs (T23-16, T21-09);
     * a name ending ``.checkpoint.json`` or ``.history.csv`` (any case): what evolve writes beside another run's
@@ -388,7 +388,7 @@ def check_json_policy_name(path: object, option: str, ends: tuple[str, ...] = ()
         return
     if Path(checked_path(text, option, ends=ends)).is_dir():
         return
-    if Path(text).suffix == ".net":
+    if Path(text).suffix.lower() == ".net":
         raise NeurohoverError(
             f"{option} {text!r}: a policy is written as JSON, which load_policy would misread under the .net suffix "
             "(the authors' format); give a .json name, or write the authors' format with netfile.policy_to_net"

@@ -21,6 +21,7 @@ from neurohover.evolution.records import read_checkpoint, read_history_csv, writ
 from neurohover.experiments.store import Store
 from neurohover.flightdata import FlightData
 from neurohover.models import LearnedModel, learn_lr
+from neurohover.netfile import policy_to_net
 from neurohover.paths import PATH_MAX
 
 
@@ -165,3 +166,17 @@ def test_a_file_path_ending_in_slash_dot_is_refused_by_writers_as_slash_is(fligh
             with _raises(f"'{tmp_path / name}{end}' ends in '{end}', which names a directory: give a file path"):
                 write(f"{tmp_path / name}{end}")
     assert list(tmp_path.iterdir()) == []
+
+
+# T32-B21 ------------------------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("suffix", [".NET", ".Net"])
+def test_an_authors_net_file_is_read_as_one_in_any_case_of_its_suffix(tmp_path: Path, suffix: str) -> None:
+    """T32-B21: p.NET was read as JSON ("not valid JSON"), though .JSON is taken as .json."""
+    policy = baseline_policy()
+    (tmp_path / f"p{suffix}").write_text(policy_to_net(policy))
+    assert nh.load_policy(tmp_path / f"p{suffix}") == nh.load_policy(tmp_path / f"p{suffix}")
+    assert nh.load_policy(tmp_path / f"p{suffix}").genome.tolist() == pytest.approx(policy.genome.tolist())
+    with _raises("a policy is written as JSON, which load_policy would misread under the .net suffix"):
+        nh.save_policy(policy, tmp_path / f"q{suffix}")
