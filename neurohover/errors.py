@@ -222,11 +222,11 @@ def as_floats(values: Any, name: str, allowed: str) -> np.ndarray:
     return np.array(a, dtype=np.float64)
 
 
-def refuse_non_text_keys(data: object, where: str) -> None:
-    """Refuse ``data`` (metadata about to be written as JSON) holding a key that is not text at any depth, naming it and
-    the top-level key it is under: JSON writes every key as text, and {1: 2} came back as {'1': 2} (flight data T21-08,
-    policy files T28-B14). A NumPy object array's dicts are looked into (flight data may hold them). It names the
-    key; :func:`neurohover.paths.json_text` then tests the values."""
+def refuse_non_text_keys(data: object, where: str, what: str = "metadata") -> None:
+    """Refuse ``data`` (``what`` about to be written as JSON: metadata, a unit's result) holding a key that is not text at
+    any depth, naming it and the top-level key it is under: JSON writes every key as text, and {1: 2} came back as {'1': 2}
+    (flight data T21-08, policy files T28-B14, store results T32-B11). A NumPy object array's dicts are looked into (flight
+    data may hold them). It names the key; :func:`neurohover.paths.json_text` then tests the values."""
     stack: list[tuple[object, object]] = [(None, data)]  # (the top-level key it is under, a value)
     seen: set[int] = set()  # a dict that holds itself: json_text names it
     while stack:
@@ -240,7 +240,7 @@ def refuse_non_text_keys(data: object, where: str) -> None:
                 if isinstance(value, dict) and not isinstance(key, str):
                     under = "" if top is None else f" (under {brief(top)})"
                     raise NeurohoverError(
-                        f"{where} metadata key {brief(key)}{under} is not allowed: give text keys (JSON writes every key as text, "
-                        "so the file would load back with other metadata)"
+                        f"{where} {what} key {brief(key)}{under} is not allowed: give text keys (JSON writes every key as text, "
+                        "so the file would load back with other keys)"
                     )
                 stack.append((key if top is None else top, item))

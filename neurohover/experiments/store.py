@@ -34,25 +34,30 @@ import os
 import socket
 import sqlite3
 import time
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
 from ..errors import NeurohoverError, brief, check_flag, finite_real
 from ..filekinds import SQLITE_HEADER, refuse_long_store_name
 from ..paths import JSONError, WriterLock, strict_json
-from .config import check_name, check_scale
 from .store_checks import (
     SESSION_STATUSES,
+    GuardedConnection,
     bad_session,
+    check_experiment,
     check_text,
     check_unit_kind,
     config_problem,
     experiment_problem,
     object_text,
+    refuse_moved,
     session_problem,
     sqlite_says,
     stored_count,
+)
+from .store_checks import (
+    transaction as _transaction,
 )
 from .units import Unit
 
@@ -89,27 +94,6 @@ def _dumps(obj: Any) -> str:
     return json.dumps(obj, separators=(",", ":"), allow_nan=False)
 
 
-def check_experiment(name: Any, scale: Any, where: str) -> None:
-    """Refuse an experiment name or scale that no config has (5 was stored as '5', '' and NUL were taken; fourteenth
-    trial, T14-5): names as :func:`~neurohover.experiments.config.check_name` allows, scales quick, paper or settings-HASH."""
-    check_name(name, where)
-    check_scale(scale, where)
-
-
-@contextlib.contextmanager
-def _transaction(c: sqlite3.Connection) -> Iterator[None]:
-    """One write transaction (taking the write lock at once): committed when the block ends, rolled back
-    when it raises. A Ctrl-C landing just after the COMMIT stays a Ctrl-C: there is nothing left to roll back."""
-    c.execute("BEGIN IMMEDIATE")
-    try:
-        yield
-        c.execute("COMMIT")
-    except BaseException:
-        if c.in_transaction:
-            c.execute("ROLLBACK")
-        raise
-
-
 class Store:
     """A results store file (created if missing).
 
@@ -140,9 +124,11 @@ class Store:
         self._lock = WriterLock(self.lock_path)
         new = not self.path.exists() or self.path.stat().st_size == 0
         try:
-            self.conn = sqlite3.connect(str(self.path), timeout=30.0, isolation_level=None)
+            self.conn = sqlite3.connect(str(self.path), timeout=30.0, isolation_level=None, check_same_thread=False, factory=GuardedConnection)
             self.conn.execute("PRAGMA synchronous = FULL")
             self._check_schema()
+            opened = os.stat(self.path)  # its file, as later reads and writes check (T32-B10)
+            self._file, self._ident = Path(os.path.abspath(self.path)), (opened.st_dev, opened.st_ino)
         except (sqlite3.OperationalError, OSError) as err:
             if new:  # it could not be made (disk full, read-only): no empty file left that a later run takes for a store
                 self._close_quietly()
@@ -159,7 +145,7 @@ class Store:
     _closed = False
 
     @property
-    def conn(self) -> sqlite3.Connection:
+    def conn(self) -> GuardedConnection:
         """The store's open connection; once :meth:`close` ran, one NeurohoverError saying so (a closed Store was
         reported as a damaged file, which may lead a user to delete a good store; eleventh trial)."""
         if self._closed:
@@ -167,7 +153,7 @@ class Store:
         return self._conn
 
     @conn.setter
-    def conn(self, value: sqlite3.Connection) -> None:
+    def conn(self, value: GuardedConnection) -> None:
         self._conn = value
 
     def _close_quietly(self) -> None:
@@ -209,17 +195,18 @@ class Store:
             If another live process (or another Store in this one) holds the lock; the message names
             the store and the holder's pid.
         """
-        self.conn  # noqa: B018  (a closed Store refused by name before it locks the file)
-        try:
-            self._lock.acquire(
-                lambda who: (
-                    f"results store {str(self.path)!r} is in use: another run ({who}) is writing it; wait for that run "
-                    f"to end (or stop it), or give another --store file. Reading it (results, report) works meanwhile"
+        with self.conn.guard:  # a closed Store refused by name before it locks the file; one thread at a time (T32-B09)
+            refuse_moved(self.path, self._file, self._ident)
+            try:
+                self._lock.acquire(
+                    lambda who: (
+                        f"results store {str(self.path)!r} is in use: another run ({who}) is writing it; wait for that run "
+                        f"to end (or stop it), or give another --store file. Reading it (results, report) works meanwhile"
+                    )
                 )
-            )
-        except OSError as err:
-            raise NeurohoverError(f"cannot open {str(self.lock_path)!r}, the writer lock of results store {str(self.path)!r}: {err.strerror}") from None
-        self.check_sound()
+            except OSError as err:
+                raise NeurohoverError(f"cannot open {str(self.lock_path)!r}, the writer lock of results store {str(self.path)!r}: {err.strerror}") from None
+            self.check_sound()
 
     _sound = False  # SQLite's own check passed, once per open for writing
 
@@ -367,7 +354,9 @@ class Store:
             if not isinstance(value, str):
                 raise NeurohoverError(f"{value!r:.60} is not allowed as an experiment name or scale: give text (e.g. 'fig7', 'paper')")
         try:
-            return self.conn.execute(sql, params).fetchall()
+            with self.conn.guard:
+                refuse_moved(self.path, self._file, self._ident)
+                return self.conn.execute(sql, params).fetchall()
         except sqlite3.DatabaseError as err:
             raise NeurohoverError(f"results store {str(self.path)!r} is damaged: {what} cannot be read ({str(err)[:60]})") from None
 

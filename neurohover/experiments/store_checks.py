@@ -3,18 +3,71 @@ writes (kept apart from the store's own module, which holds its reads and writes
 
 from __future__ import annotations
 
+import contextlib
+import os
 import sqlite3
+import threading
+from collections.abc import Iterator
+from pathlib import Path
 from typing import Any
 
-from ..errors import NeurohoverError, brief, finite_real, whole_number
+from ..errors import NeurohoverError, brief, finite_real, refuse_non_text_keys, whole_number
 from ..paths import json_text
-from .config import ExperimentConfig
+from .config import ExperimentConfig, check_name, check_scale
 from .results import result_type
 
 #: How a session can end (:meth:`Store.end_session`; the runner's statuses). A session is "running" until then.
 SESSION_STATUSES = ("finished", "selection finished", "interrupted", "failed")
 #: The executors that run sessions (the ``name`` of executors.LocalExecutor and RayExecutor; importing them here is slow).
 EXECUTORS = ("local", "ray")
+
+
+class GuardedConnection(sqlite3.Connection):
+    """A store's connection, which any thread may use, one statement or transaction at a time (each holds :attr:`guard`):
+    a Store opened in one thread and written from another was sqlite3's ProgrammingError, and its reads called the store
+    damaged (T32-B09)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.guard = threading.RLock()
+
+
+def refuse_moved(path: Path, file: Path, opened: tuple[int, int]) -> None:
+    """Refuse to read or write store ``path`` once its ``file`` (absolute) names no file, or another file than the one
+    opened (device and inode): SQLite wrote into the moved or removed file ('attempt to write a readonly database') and read
+    its old rows without a word (T32-B10)."""
+    try:
+        now = os.stat(file)
+        same = (now.st_dev, now.st_ino) == opened
+    except OSError:
+        same = False
+    if not same:
+        raise NeurohoverError(
+            f"results store {str(path)!r} is gone: its file was moved, removed or replaced since this Store opened it; "
+            "nothing was read or written: open it again with Store(path)"
+        )
+
+
+@contextlib.contextmanager
+def transaction(c: GuardedConnection) -> Iterator[None]:
+    """One write transaction (taking the write lock at once): committed when the block ends, rolled back
+    when it raises. A Ctrl-C landing just after the COMMIT stays a Ctrl-C: there is nothing left to roll back. One thread's at a time."""
+    with c.guard:
+        c.execute("BEGIN IMMEDIATE")
+        try:
+            yield
+            c.execute("COMMIT")
+        except BaseException:
+            if c.in_transaction:
+                c.execute("ROLLBACK")
+            raise
+
+
+def check_experiment(name: Any, scale: Any, where: str) -> None:
+    """Refuse an experiment name or scale that no config has (5 was stored as '5', '' and NUL were taken; fourteenth
+    trial, T14-5): names as :func:`~neurohover.experiments.config.check_name` allows, scales quick, paper or settings-HASH."""
+    check_name(name, where)
+    check_scale(scale, where)
 
 
 def sqlite_says(conn: sqlite3.Connection) -> str:
@@ -145,6 +198,7 @@ def object_text(value: Any, what: str, where: str) -> str:
             f"{where}: {what} = {brief(value)} is not allowed: give a JSON object of text, finite numbers, bools, None, lists and such objects "
             f"({str(err)[:80]})"
         ) from None
+    refuse_non_text_keys(value, f"{where}:", what)  # {1: 2} was stored, and read back as {'1': 2} (T32-B11)
     return text
 
 
