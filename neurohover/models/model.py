@@ -36,7 +36,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import NeurohoverError, as_floats, brief, finite_real, real_number, whole_number
+from ..errors import NeurohoverError, as_floats, brief, finite_real, real_number, refuse_non_text_keys, whole_number
 from ..filekinds import refuse_suffix
 from ..paths import json_text
 from ..sim.constants import CONTROL_DT, DEFAULT_NOISE_STD, DEFAULT_PARAMS, MAX_SECONDS, NOISE_NAMES, PARAM_NAMES, SUBSTEP_DT, SUBSTEPS, seconds_allowed
@@ -150,6 +150,7 @@ def check_stats(stats: dict) -> None:
     """Refuse a model's ``stats`` unless :meth:`LearnedModel.save` can write them and :meth:`LearnedModel.load` read them
     back: strict JSON values, numbers finite (an object() or a NaN was json's TypeError or ValueError at the save;
     fourteenth trial T14-12), as ``save_policy`` and ``FlightData.save`` refuse their metadata."""
+    refuse_non_text_keys(stats, "model", "stats")  # {1: 2} was written, and read back as {'1': 2} (T32-B05)
     try:
         json_text(stats)  # the round trip: load() reads what its parser takes
     except (TypeError, ValueError, RecursionError) as err:  # RecursionError: nesting too deep to write
@@ -319,7 +320,13 @@ class LearnedModel:
 
         if isinstance(path, (str, os.PathLike)):  # (other paths are output_file's to refuse)
             self.check_name(path)
+        check_stats(self.stats)  # stats may be changed after making: a NaN was json's ValueError (T32-B05)
         text = json.dumps(self.to_dict(), indent=1, allow_nan=False) + "\n"
+        shown = repr(str(path)) if isinstance(path, (str, os.PathLike)) else brief(path)  # as load names the file
+        try:  # what load reads back: stats.n_episodes = -5 was written, then refused by load (T32-B05)
+            type(self).from_dict(json.loads(text), f"model file {shown}")
+        except NeurohoverError as err:
+            raise NeurohoverError(f"{err} (LearnedModel.load would refuse the file; nothing is written)") from None
         out = output_file(path, "model file", kind="a model file")  # /dev/full, a directory: one clear error
         with writing(out, "model file") as partial:
             partial.write_text(text, encoding="utf-8")
