@@ -258,6 +258,12 @@ class FlightData:
         obs_split = np.split(obs, np.cumsum(lengths + 1)[:-1])
         act_split = np.split(act, np.cumsum(lengths)[:-1])
         check_metadata(metadata, lengths, f"flight-data file {str(path)!r}", (tuple(obs_split), tuple(act_split)))  # and the readings (T23-03, T23-19)
+        bad = next((k for k, v in metadata.items() if not _json_ok({k: v})), None)  # a NaN no check above names (T32-B18)
+        if bad is not None:  # it was refused as metadata that "cannot be saved", the file not named
+            raise NeurohoverError(
+                f"flight-data file {str(path)!r}: its metadata {bad if len(bad) <= 60 else brief(bad)}={brief(metadata[bad])} is not allowed: "
+                "give strict JSON values, numbers finite (NaN and Infinity are no JSON: FlightData.save refuses them)"
+            )
         data = cls(tuple(obs_split), tuple(act_split), metadata)
         for i, crashed in enumerate(crash_flags(data)):  # a NaN was named by plot, not by learn-model, and neither named the file (T22-02)
             check_flown(data.observations[i], data.actions[i], crashed, f"flight-data file {str(path)!r}, episode {i}")

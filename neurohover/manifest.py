@@ -112,7 +112,12 @@ def table3_summary(crashes: np.ndarray, returns: np.ndarray) -> dict:
     return {"r": round(float(np.diag(returns).mean()), 2), "r_G": round(float(returns.mean()), 2), "crashed_episodes": int(crashes.sum())}
 
 
-def choose_safe(crashes: np.ndarray, returns: np.ndarray, n: int = 2) -> tuple[int, ...]:
+#: How many safe specialised policies a GHH set has: build-policies chooses (:func:`choose_safe`) and its manifest lists
+#: that many, and the hybrid agents fly them.
+SAFE_POLICIES = 2
+
+
+def choose_safe(crashes: np.ndarray, returns: np.ndarray, n: int = SAFE_POLICIES) -> tuple[int, ...]:
     """The paper's rule: specialised policies that never crashed on the *other* training MDPs;
     the ``n`` with the best mean return there. Fewer qualify: the fewest crashes, then return. ``crashes`` and
     ``returns``: (P, P) arrays of real numbers (policy i trained on MDP i), P >= 2; ``n`` in 1..P."""
@@ -170,9 +175,11 @@ def check_ghh_manifest(manifest: dict, path: Path, n_policies: int, n_mdps: int)
         not isinstance(safe, list)
         or not all(type(i) is int and 0 <= i < n_policies for i in safe)  # "x" was a TypeError (fifth trial)
         or len(set(safe)) != len(safe)  # [6, 6]: one policy flown as both safe ones (sixth trial)
+        or ("safe" in manifest and len(safe) != SAFE_POLICIES)  # [] and [6] were taken, where the tables choose 2 (T32-B12)
     ):
         raise NeurohoverError(
-            f"{where}: safe={safe!r:.60} is not allowed: give a list of the safe specialised policies' distinct indices, each in 0..{n_policies - 1}"
+            f"{where}: safe={safe!r:.60} is not allowed: give a list of the {SAFE_POLICIES} safe specialised policies' distinct indices, "
+            f"each in 0..{n_policies - 1} (build-policies lists the {SAFE_POLICIES} the paper's rule chooses; the hybrid agents fly them)"
         )
     _check_tables(manifest, path, n_policies, n_mdps)
     crashes, returns = manifest.get("crashes_on_training_mdps"), manifest.get("mean_return_on_training_mdps")

@@ -60,7 +60,20 @@ def policy_record_problem(meta: dict) -> str:
     problem = _run_words_problem(meta, own_stop, STOP_REASONS, parse_resampling, (1 + 1e-9) / math.log(ERROR_FLOOR))
     problem = problem or _validation_problem(meta) or _place_problem(meta) or _run_settings_problem(meta)  # T24-02: what evolve adds
     problem = problem or _counts_problem(meta, parse_resampling) or _generations_problem(meta, parse_resampling)  # T26-B04/B06
-    return problem or _fields_problem(meta)  # T25-04/05/06/12/14
+    return problem or _fields_problem(meta) or _not_json_problem(meta)  # T25-04/05/06/12/14, T32-B17
+
+
+def _not_json_problem(meta: dict) -> str:
+    """A metadata value that is no strict JSON (a NaN or an Infinity at any depth), named by its key: Python's JSON
+    reader takes those literals, so a policy file's note of NaN loaded, and save_policy then refused the policy (T32-B17)."""
+    from .paths import json_text
+
+    for key, value in meta.items():
+        try:
+            json_text({key: value})
+        except (TypeError, ValueError, RecursionError):
+            return f"its {key} {brief(value)} is not allowed: give strict JSON values, numbers finite (NaN and Infinity are no JSON: save_policy refuses them)"
+    return ""
 
 
 def _run_words_problem(meta: dict, own_stop: dict, stop_reasons: tuple, parse_resampling, best_fitness: float) -> str:

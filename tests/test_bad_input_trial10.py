@@ -63,7 +63,7 @@ def test_a_hybrid_agent_without_two_safe_policies_names_the_manifest(tmp_path: P
     manifest.write_text(json.dumps({**json.loads(manifest.read_text()), "safe": [6]}))
     argv = ["compete", "--task", "ghh08", "--agent", "hybrid", "--runs", "1", "--episodes", "2", "--episode-steps", "20"]
     rc, _, err = cli(*argv, "--out", str(tmp_path / "c"), "--policy-dir", str(tmp_path / "pd"))
-    assert rc == 2 and f"policy-set manifest '{manifest}': safe=[6] is not allowed for agent 'hybrid': it flies exactly 2 safe" in err, err
+    assert rc == 2 and f"policy-set manifest '{manifest}': safe=[6] is not allowed: give a list of the 2 safe" in err, err  # at load (T32-B12)
 
 
 def test_sigma_beside_the_zero_setting_says_which_mdps_take_it(cli) -> None:
