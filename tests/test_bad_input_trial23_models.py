@@ -179,12 +179,12 @@ def test_learn_model_refuses_an_npz_name_before_learning(cli, tmp_path: Path, mo
 
 
 def test_save_refuses_another_suffix_and_takes_none(flight, tmp_path: Path) -> None:
-    """T23-16 in the Python API: LearnedModel.save('m.npz') is refused; .json and a name without a suffix are written."""
+    """T23-16 in the Python API: LearnedModel.save('m.npz') is refused; .json is written (a name without a suffix was
+    too, and is refused since T32-B20: tests/test_bad_input_trial32_paths.py)."""
     model = learn_lr(flight)
     with _raises("model file '/tmp/x/m.npz' is not allowed: a model file is JSON; give a path ending .json (e.g. '/tmp/x/m.json')"):
         model.save("/tmp/x/m.npz")
     with _raises(f"model file {brief(str(tmp_path / 'm.npz'))} is not allowed: a model file is JSON; give a path ending .json"):
         model.save(tmp_path / "m.npz")
     assert not (tmp_path / "m.npz").exists()
-    assert LearnedModel.load(model.save(tmp_path / "model")) == model
     assert LearnedModel.load(model.save(tmp_path / "M.JSON")) == model

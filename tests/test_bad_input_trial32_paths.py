@@ -16,7 +16,7 @@ import pytest
 
 import neurohover as nh
 from neurohover import baseline_policy, evaluate, get_task_family
-from neurohover.errors import NeurohoverError
+from neurohover.errors import NeurohoverError, brief
 from neurohover.evolution.records import read_checkpoint, read_history_csv, write_checkpoint
 from neurohover.experiments.store import Store
 from neurohover.flightdata import FlightData
@@ -154,6 +154,11 @@ def test_a_file_path_ending_in_a_slash_or_dot_is_refused_by_readers(flight: Flig
     model = learn_lr(flight).save(tmp_path / "m.json")
     with _raises(f"model file '{model}/.' ends in '/.', which names a directory"):
         LearnedModel.load(f"{model}/.")
+    store = tmp_path / "st.sqlite"
+    Store(store).close()
+    for end in ("/", "/."):
+        with _raises(f"results store '{store}{end}' ends in '{end}', which names a directory"):
+            Store(f"{store}{end}")
     with _raises(f"policy file '{tmp_path}/' is a directory"):  # a directory is still named as one
         nh.load_policy(f"{tmp_path}/")
 
@@ -166,6 +171,20 @@ def test_a_file_path_ending_in_slash_dot_is_refused_by_writers_as_slash_is(fligh
             with _raises(f"'{tmp_path / name}{end}' ends in '{end}', which names a directory: give a file path"):
                 write(f"{tmp_path / name}{end}")
     assert list(tmp_path.iterdir()) == []
+
+
+# T32-B20 ------------------------------------------------------------------------------------------------------------
+
+
+def test_a_model_name_without_a_suffix_is_refused_as_a_policys_is(flight: FlightData, tmp_path: Path) -> None:
+    """T32-B20: LearnedModel.save('m') was written though 'm.model' was refused; save_policy('p') is refused."""
+    model = learn_lr(flight)
+    with _raises(
+        f"model file {brief(str(tmp_path / 'm'))} is not allowed: a model file is JSON; give a path ending .json (e.g. {brief(str(tmp_path / 'm.json'))})"
+    ):
+        model.save(tmp_path / "m")
+    assert list(tmp_path.iterdir()) == []
+    assert LearnedModel.load(model.save(tmp_path / "M.JSON")) == model
 
 
 # T32-B21 ------------------------------------------------------------------------------------------------------------

@@ -106,7 +106,7 @@ class Store:
 
         check_flag(create, "create", "make the store if missing")  # create='no' was true (sixth trial)
 
-        self.path = checked_path(path, "results store", "results store's file path")  # None, 3, NUL, a name too long
+        self.path = checked_path(path, "results store", "results store's file path", file=True)  # None, 3, NUL, too long, 'x/' (T32-B08)
         if create:  # its -journal too (a reader writes none; T31-A03)
             refuse_long_store_name(self.path, "results store")
         if not self.path.exists() and not create:

@@ -307,15 +307,15 @@ class LearnedModel:
     @staticmethod
     def check_name(path: str | Path, what: str = "model file") -> Path:
         """``path`` as a Path if a model file may be written there, named as ``what``: a model is JSON, so a name of
-        another suffix is refused (m.npz held JSON; T23-16); a name without one is taken. learn-model asks before it learns."""
+        another suffix (m.npz held JSON; T23-16) or of none is refused, as a policy file's and flight data's are (a name
+        without one was written, and 'm.model' refused; T32-B20). learn-model asks before it learns."""
         if not isinstance(path, (str, os.PathLike)):
             raise NeurohoverError(f"{what} {brief(path)} is not allowed: give a path (text or a Path) ending {MODEL_SUFFIX}")
-        if Path(path).suffix:  # a name without one is taken
-            refuse_suffix(str(path), what, (MODEL_SUFFIX,), "a model file is JSON", f"model{MODEL_SUFFIX}")
+        refuse_suffix(str(path), what, (MODEL_SUFFIX,), "a model file is JSON", f"model{MODEL_SUFFIX}")
         return Path(path)
 
     def save(self, path: str | Path) -> Path:
-        """Write the model as JSON (format tag ``neurohover-model/1``; a name ending .json or of no suffix); returns the path."""
+        """Write the model as JSON (format tag ``neurohover-model/1``; a name ending .json, in any case); returns the path."""
         from ..paths import output_file, writing
 
         if isinstance(path, (str, os.PathLike)):  # (other paths are output_file's to refuse)
