@@ -35,6 +35,7 @@ __all__ = [
     "output_name",
     "refuse_policy_set",
     "refuse_long_store_name",
+    "refuse_sqlite_name",
     "refuse_run_file_name",
     "refuse_suffix",
     "refuse_unencodable",
@@ -160,11 +161,30 @@ def fitting_name(name: str, limit: int, room: int = 0) -> str:
 STORE_ENDS = ("-journal", ".lock")
 
 
+def refuse_sqlite_name(path: object, option: str) -> None:
+    """Refuse a results store ``path`` (``option``) that SQLite reads as no file: ``:memory:`` (a database thrown away
+    when the run ends: a whole experiment ran into one and said "finished", T32-A01) and a name beginning ``file:`` (any
+    case), a SQLite URI (``file:s03.sqlite`` wrote s03.sqlite, ``file:`` alone a temporary database; T32-A02). The store
+    is opened by its absolute path, so such a name would be a file of that name, which is most likely not what was
+    meant: given as ``./file:x``, it is that file, and so is a Path object (pathlib has no URIs, and drops the './':
+    compete's OUT/results.sqlite under an --out 'file:d' is d's file). What is no path is
+    :func:`~neurohover.paths.checked_path`'s."""
+    if not isinstance(path, str):
+        return
+    text = path
+    if text == ":memory:":
+        raise NeurohoverError(f"{option} {text!r} is not allowed: it is SQLite's in-memory database, lost when the run ends; give a file path")
+    if text[:5].lower() == "file:":
+        raise NeurohoverError(f"{option} {brief(text)} looks like a SQLite URI: give a file path ({brief('./' + text)} for a file of that name)")
+
+
 def refuse_long_store_name(path: object, option: str) -> None:
     """Refuse a results store ``path`` (``option``) to be written whose name, with the longest of :data:`STORE_ENDS`,
     is longer than the file system takes, naming the limit and a name that fits: a name of 249 to 255 bytes was taken,
     and the run then failed on its ``-journal`` with the OS's bare "File name too long", the name cut (T31-A03). What is
-    no path to check is :func:`~neurohover.paths.checked_path`'s to refuse."""
+    no path to check is :func:`~neurohover.paths.checked_path`'s to refuse. A name SQLite reads as no file is refused
+    first (:func:`refuse_sqlite_name`)."""
+    refuse_sqlite_name(path, option)
     if not isinstance(path, (str, os.PathLike)) or not isinstance(text := os.fspath(path), str) or "\x00" in text:
         return
     name = Path(text).name

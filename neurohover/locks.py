@@ -17,7 +17,7 @@ try:
 except ImportError:  # not POSIX: no output lock; one run per output is then the user's care
     fcntl = None  # type: ignore[assignment]
 
-__all__ = ["WriterLock", "sole_writer"]
+__all__ = ["WriterLock", "hold_file", "sole_writer"]
 
 
 class WriterLock:
@@ -110,3 +110,22 @@ def sole_writer(path: Path, option: str) -> Iterator[None]:
         yield
     finally:
         lock.release()
+
+
+def hold_file(path: str | os.PathLike, busy: str) -> int:
+    """Take an exclusive ``flock`` on the file ``path`` itself and return its descriptor (close it to let go; -1 where
+    locks are not to be had), or raise NeurohoverError with ``busy`` where another holds it. A lock file named after a
+    path is got around by a hard link, another name of the same file (two runs wrote one store at once; T32-A08); this
+    one follows the file. ``flock`` locks are apart from SQLite's own (POSIX ``fcntl`` locks, dropped when any of the
+    process's descriptors of the file closes), so SQLite never drops it. Opening the file may raise OSError."""
+    if fcntl is None:
+        return -1
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError as err:
+        os.close(fd)
+        if err.errno in (errno.EAGAIN, errno.EWOULDBLOCK, errno.EACCES):
+            raise NeurohoverError(busy) from None
+        return -1  # ENOLCK and the like: the filesystem cannot lock
+    return fd

@@ -6,6 +6,7 @@ Bad input prints one clear message and exits with status 2 (never a traceback fr
 from __future__ import annotations
 
 import argparse
+import contextlib
 import io
 import os
 import re
@@ -192,7 +193,7 @@ def _run(argv: Sequence[str] | None) -> int:
         # SIGTERM (a timeout, kill) ends every command as Ctrl-C does: one line, its cleanup run, no partial file (a
         # bare SIGTERM killed fly, evolve, compete and reproduce without a word; fourth trial); a Ctrl-C landing in
         # numba's compilation is not lost.
-        with sigterm_as_interrupt(), interrupts_survive_callbacks(), _stdout_or_nothing():
+        with sigterm_as_interrupt(), interrupts_survive_callbacks(), _stdout_or_nothing(), _whole_stdout_writes():
             status = args.func(args)
             if sys.stdout is not None:
                 sys.stdout.flush()  # inside the try: a reader gone away is the BrokenPipeError below, not one at exit
@@ -202,8 +203,10 @@ def _run(argv: Sequence[str] | None) -> int:
         remove_created_dirs()  # a failed command leaves no empty output directory behind
         return 2
     except sqlite3.DatabaseError as err:  # a store file damaged mid-file, or not a store at all
+        from ..experiments.store_checks import write_failed
+
         which = f" {str(args.store)!r}" if getattr(args, "store", None) else ""
-        if "full" in str(err):  # SQLITE_FULL: the disk, not the store (it was called damaged; eighth trial)
+        if write_failed(err):  # the disk or a file-size limit, not the store (it was called damaged; eighth trial, T32-A04)
             print(f"neurohover {args.command}: error: cannot write the results store{which} ({err}); its finished units are kept", file=sys.stderr)
             remove_created_dirs()
             return 2
@@ -263,6 +266,60 @@ def _stdout_or_nothing() -> Iterator[None]:
             yield
         finally:
             sys.stdout = None
+
+
+class _WholeWrites(io.RawIOBase):
+    """Standard output's file descriptor, written whole or not at all: Python's own writer drops the rest of a write
+    that a file-size limit (``ulimit -f``) or a full disk cut short, without a word, so that ``results > FILE`` left
+    a cut export and status 0 (T32-A05). The first failure is one NeurohoverError (a reader gone away stays the
+    BrokenPipeError that ends the command quietly); what is written after it goes nowhere, the error being told."""
+
+    def __init__(self, fd: int) -> None:
+        super().__init__()
+        self.fd, self.failed = fd, False
+
+    def writable(self) -> bool:
+        return True
+
+    def fileno(self) -> int:
+        return self.fd
+
+    def isatty(self) -> bool:
+        return os.isatty(self.fd)
+
+    def write(self, data) -> int:
+        view = memoryview(data).cast("B")
+        done = 0
+        while done < len(view) and not self.failed:
+            try:
+                done += os.write(self.fd, view[done:])
+            except BrokenPipeError:
+                raise
+            except OSError as err:
+                self.failed = True
+                raise NeurohoverError(f"cannot write standard output ({err.strerror}): what the command printed there is cut short") from None
+        return len(view)
+
+
+@contextmanager
+def _whole_stdout_writes() -> Iterator[None]:
+    """Inside this block, standard output (where it is the process's own file) is written through :class:`_WholeWrites`."""
+    old = sys.stdout
+    if not isinstance(old, io.TextIOWrapper) or not isinstance(getattr(old.buffer, "raw", old.buffer), io.FileIO):
+        yield
+        return
+    old.flush()
+    raw = _WholeWrites(old.fileno())
+    layer = raw if isinstance(old.buffer, io.FileIO) else io.BufferedWriter(raw)  # python -u (PYTHONUNBUFFERED): none
+    sys.stdout = io.TextIOWrapper(layer, encoding=old.encoding, errors=old.errors, line_buffering=old.line_buffering, write_through=old.write_through)
+    try:
+        yield
+    finally:
+        new, sys.stdout = sys.stdout, old
+        with contextlib.suppress(Exception):  # a failure was told; a reader gone away is the BrokenPipeError above
+            new.flush()
+        raw.failed = True  # so that nothing is written again when the wrapper is collected
+        new.detach()
 
 
 def shorter_numbers(message: str) -> str:

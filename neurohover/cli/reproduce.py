@@ -17,6 +17,7 @@ from pathlib import Path
 
 from ..errors import NeurohoverError, brief
 from ..evaluate import DEVICES, check_device
+from ..filekinds import refuse_sqlite_name
 from ..paths import printable
 from .options import integer
 
@@ -136,6 +137,7 @@ def cmd_results(args: argparse.Namespace) -> int:
     from ..experiments import Store, export_results
     from ..paths import input_file, output_file, writing
 
+    refuse_sqlite_name(args.store, "--store")  # before "no such results store" (T32-A02)
     input_file(args.store, "--store", "results store")
     fmt = _results_format(args.format, args.out)  # before output_file makes --out's directory
     kind = f"a results export (results --format {fmt})"  # never over another kind's file: compete's episodes.csv (T25-12)
@@ -196,6 +198,7 @@ def cmd_wins(args: argparse.Namespace) -> int:
     from ..experiments.wins import stored_runs, win_probabilities
     from ..paths import input_file
 
+    refuse_sqlite_name(args.store, "--store")  # before "no such results store" (T32-A02)
     input_file(args.store, "--store", "results store")
     lengths = _positive_ints(args.runs, "--runs")
     with Store(args.store, create=False) as store:
@@ -254,6 +257,7 @@ def cmd_report(args: argparse.Namespace) -> int:
     from ..experiments.report import check_names
     from ..paths import input_file, output_dir
 
+    refuse_sqlite_name(args.store, "--store")  # before "no such results store" (T32-A02)
     input_file(args.store, "--store", "results store")
     check_names(args.names or None)  # before anything is opened or made (T23-18)
     with Store(args.store, create=False) as store:

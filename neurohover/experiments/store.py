@@ -18,10 +18,10 @@ Durability: each finished unit is written in its own transaction (with its sessi
 the moment it finishes, so an interrupted run (Ctrl-C or SIGKILL) loses no finished unit, and
 running again with the same store skips every finished unit.
 
-One writer: a run holds an OS lock (``flock``) on ``STORE.lock`` beside the store from its first
-write until it closes the store, and writes its pid there; a second run is refused, naming that
-pid. Closing the store removes the file; the kernel drops the lock when its process dies, so a
-killed run (which leaves the file) never blocks the next one.
+One writer: a run holds an OS lock (``flock``) on ``STORE.lock`` beside the store, and on the store's file itself (a
+hard link has another lock file), from its first write until it closes the store, and writes its pid there; a second
+run is refused, naming that pid. Closing the store removes the file; the kernel drops the lock when its process dies,
+so a killed run (which leaves the file) never blocks the next one.
 Readers (``results``, ``report``) take no lock.
 """
 
@@ -39,7 +39,8 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import NeurohoverError, brief, check_flag, finite_real
-from ..filekinds import SQLITE_HEADER, refuse_long_store_name
+from ..filekinds import SQLITE_HEADER, refuse_long_store_name, refuse_sqlite_name
+from ..locks import hold_file
 from ..paths import JSONError, WriterLock, strict_json
 from .store_checks import (
     SESSION_STATUSES,
@@ -106,9 +107,10 @@ class Store:
 
         check_flag(create, "create", "make the store if missing")  # create='no' was true (sixth trial)
 
+        refuse_sqlite_name(path, "results store")  # ':memory:' and 'file:' URIs: never a file (as given: './file:x' is one; T32-A01, T32-A02)
         self.path = checked_path(path, "results store", "results store's file path", file=True)  # None, 3, NUL, too long, 'x/' (T32-B08)
         if create:  # its -journal too (a reader writes none; T31-A03)
-            refuse_long_store_name(self.path, "results store")
+            refuse_long_store_name(path, "results store")
         if not self.path.exists() and not create:
             raise NeurohoverError(f"results store {str(self.path)!r} does not exist")
         if self.path.exists() and self.path.is_dir():
@@ -124,7 +126,9 @@ class Store:
         self._lock = WriterLock(self.lock_path)
         new = not self.path.exists() or self.path.stat().st_size == 0
         try:
-            self.conn = sqlite3.connect(str(self.path), timeout=30.0, isolation_level=None, check_same_thread=False, factory=GuardedConnection)
+            # By its absolute path: SQLite reads a name beginning 'file:' as a URI, whatever uri= says (T32-A02).
+            self.conn = sqlite3.connect(os.path.abspath(self.path), timeout=30.0, isolation_level=None, check_same_thread=False, factory=GuardedConnection)
+            self.conn.store = str(self.path)  # as given, in a failed write's message (T32-A04)
             self.conn.execute("PRAGMA synchronous = FULL")
             self._check_schema()
             opened = os.stat(self.path)  # its file, as later reads and writes check (T32-B10)
@@ -143,6 +147,7 @@ class Store:
             raise
 
     _closed = False
+    _held: int | None = None  # the descriptor of the store's file flocked while writing (-1: no locks here)
 
     @property
     def conn(self) -> GuardedConnection:
@@ -167,6 +172,8 @@ class Store:
         if self._closed:
             return
         self.conn.close()
+        if self._held is not None and self._held >= 0:
+            os.close(self._held)
         self._lock.release()
         self._closed = True
 
@@ -197,15 +204,19 @@ class Store:
         """
         with self.conn.guard:  # a closed Store refused by name before it locks the file; one thread at a time (T32-B09)
             refuse_moved(self.path, self._file, self._ident)
+            busy = "wait for that run to end (or stop it), or give another --store file. Reading it (results, report) works meanwhile"
             try:
-                self._lock.acquire(
-                    lambda who: (
-                        f"results store {str(self.path)!r} is in use: another run ({who}) is writing it; wait for that run "
-                        f"to end (or stop it), or give another --store file. Reading it (results, report) works meanwhile"
-                    )
-                )
+                self._lock.acquire(lambda who: f"results store {str(self.path)!r} is in use: another run ({who}) is writing it; {busy}")
             except OSError as err:
                 raise NeurohoverError(f"cannot open {str(self.lock_path)!r}, the writer lock of results store {str(self.path)!r}: {err.strerror}") from None
+            if self._held is None:  # the file itself too: a hard link has another lock file (T32-A08)
+                try:
+                    self._held = hold_file(
+                        self._file, f"results store {str(self.path)!r} is in use: another run is writing it under another name (a hard link); {busy}"
+                    )
+                except (NeurohoverError, OSError):
+                    self._lock.release()
+                    raise
             self.check_sound()
 
     _sound = False  # SQLite's own check passed, once per open for writing

@@ -30,6 +30,25 @@ class GuardedConnection(sqlite3.Connection):
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.guard = threading.RLock()
+        self.store = str(args[0]) if args else "?"  # the store's name in a failed write's message (the Store sets it as given)
+
+
+#: SQLite's errors of a write that the disk or a file-size limit refused (EFBIG under ``ulimit -f`` is SQLITE_IOERR_WRITE).
+WRITE_ERRORS = ("SQLITE_FULL", "SQLITE_IOERR_WRITE", "SQLITE_IOERR_FSYNC", "SQLITE_IOERR_DIR_FSYNC", "SQLITE_IOERR_TRUNCATE", "SQLITE_IOERR_DELETE")
+
+
+def write_failed(err: sqlite3.Error) -> bool:
+    """Whether SQLite's ``err`` says a write failed (a full disk, a file-size limit), the store itself sound: it was
+    called "damaged or no results store" (T32-A04)."""
+    return getattr(err, "sqlite_errorname", "") in WRITE_ERRORS or "full" in str(err)
+
+
+def write_failure(store: str, err: sqlite3.Error) -> NeurohoverError:
+    """The one message of a write to results store ``store`` that ``err`` (:func:`write_failed`) refused."""
+    return NeurohoverError(
+        f"cannot write the results store {store!r} ({err}: the disk is full or a file-size limit, ulimit -f, is reached); "
+        "its finished units are kept, and the same command resumes once there is room"
+    )
 
 
 def refuse_moved(path: Path, file: Path, opened: tuple[int, int]) -> None:
@@ -57,9 +76,12 @@ def transaction(c: GuardedConnection) -> Iterator[None]:
         try:
             yield
             c.execute("COMMIT")
-        except BaseException:
+        except BaseException as err:
             if c.in_transaction:
-                c.execute("ROLLBACK")
+                with contextlib.suppress(sqlite3.Error):  # its own failure is no news: the write failed
+                    c.execute("ROLLBACK")
+            if isinstance(err, sqlite3.Error) and write_failed(err):
+                raise write_failure(c.store, err) from None
             raise
 
 
