@@ -17,19 +17,21 @@ def _interrupted(kind, value, tb) -> None:
     if issubclass(kind, KeyboardInterrupt):  # Ctrl-C or SIGTERM while NumPy and numba import, before main() can catch it
         terminated = issubclass(kind, Terminated)
         print(f"neurohover: {'terminated' if terminated else 'interrupted'}", file=sys.stderr, flush=True)
-        os._exit(143 if terminated else 130)  # as main() ends them (Python would end by the signal itself)
+        os._exit(128 + getattr(value, "signum", 15) if terminated else 130)  # as main() ends them (Python would end by the signal itself)
     else:
         sys.__excepthook__(kind, value, tb)
 
 
 from .command import running_as_command  # noqa: E402  (stdlib only: before NumPy and numba import)
-from .errors import Terminated, raise_terminated  # noqa: E402
+from .errors import Terminated, raise_terminated, stop_signals  # noqa: E402
 
 if running_as_command():
     import signal
 
     sys.excepthook = _interrupted
-    signal.signal(signal.SIGTERM, raise_terminated)  # from the first import on, SIGTERM ends the command as Ctrl-C does (fourth trial)
+    for signum in stop_signals():  # from the first import on, SIGTERM ends the command as Ctrl-C does (fourth trial); SIGHUP too (T32-A03)
+        if signum == signal.SIGTERM or signal.getsignal(signum) != signal.SIG_IGN:  # nohup's ignored SIGHUP stays ignored
+            signal.signal(signum, raise_terminated)
 
 from .errors import NeurohoverError  # noqa: E402
 

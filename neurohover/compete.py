@@ -202,7 +202,7 @@ def competition_config(
     Its scale is a digest of the settings, so competitions with other settings in the same store
     are kept apart and the same settings resume.
     """
-    from .agents.registry import AGENTS, HYBRID_AGENTS
+    from .agents.registry import AGENTS, HYBRID_AGENTS, agent_spec
     from .experiments.canonical import typed_numbers
     from .experiments.config import compete_name, make_config, settings_scale
 
@@ -231,6 +231,9 @@ def competition_config(
         defaults = AGENTS[agent].settings().to_dict()  # type: ignore[misc]  # an agent that takes settings has a class
         own = typed_numbers(defaults, own)  # level=1 as 1.0 ...
         own = {} if own == defaults else own  # ... and the defaults given as left out: one competition, not three (T29-A07)
+    spec_settings = agent_spec(agent).settings
+    if spec_settings is not None and spec_settings.UNIT_KEY == "agent_settings":  # the defaults too: trials 2 in 3 episodes
+        spec_settings.from_dict(dict(own)).check_episodes(agent, episodes)  # before any run (T32-A07), as --drift's change_at
     if own:
         if getattr(AGENTS[agent].settings, "UNIT_KEY", None) in _EXPERIMENT_WIDE:  # by the class, not by its keys: continual has one of the same name
             wide = own
@@ -485,7 +488,7 @@ def _write_summary(path: Path, summary: dict) -> None:
     from .paths import writing
 
     with writing(path, "summary file") as partial:  # whole or not at all
-        partial.write_text(json.dumps(summary, indent=1) + "\n")
+        partial.write_text(json.dumps(summary, indent=1) + "\n", encoding="utf-8")
 
 
 #: The files compete writes in its output directory that another neurohover file may sit at, and what
@@ -516,7 +519,7 @@ def _refuse_other_files(out: Path) -> None:
 def _held_competition(summary_path: Path) -> tuple[str, str, object] | None:
     """The (task, agent, scale) of the competition summary at ``summary_path``, None for anything else (no file, not one)."""
     try:
-        before = json.loads(summary_path.read_text())
+        before = json.loads(summary_path.read_text(encoding="utf-8"))
         return (before["task"], before["agent"], before.get("scale"))
     except (OSError, ValueError, RecursionError, KeyError, TypeError, AttributeError):
         return None

@@ -6,6 +6,7 @@ import dataclasses
 import math
 import numbers
 import operator
+import signal
 from typing import TYPE_CHECKING, Any, TypeGuard
 
 if TYPE_CHECKING:  # numpy is imported where used: the package installs its signal handlers after this module, before numpy
@@ -21,7 +22,22 @@ class OutputError(NeurohoverError):
 
 
 class Terminated(KeyboardInterrupt):
-    """SIGTERM arrived where the command handles it (like Ctrl-C: finished work kept, one line, status 143)."""
+    """A stop signal (:func:`stop_signals`: SIGTERM, SIGHUP, SIGUSR1) arrived where the command handles it (like Ctrl-C:
+    finished work kept, one line, status 128 + ``signum``: 143 for SIGTERM, 129 for SIGHUP)."""
+
+    def __init__(self, *args: object, signum: int = 15) -> None:
+        super().__init__(*args)
+        self.signum = signum
+
+
+def stop_signals(command: bool = True) -> list[signal.Signals]:
+    """The signals the command takes as SIGTERM (:class:`Terminated`): SIGTERM, SIGHUP (a closed terminal or a dropped SSH
+    session) and SIGUSR1, where the system has them. Python's defaults ended a run at once without a word, and evolve
+    without its checkpoint (T32-A03). SIGQUIT keeps its default: the stop at once, with a core dump, that it asks for.
+    ``command`` False: those a program calling neurohover hands over while it runs (not SIGUSR1, often a program's own:
+    faulthandler's stack dump, a log rotation)."""
+    names = ("SIGTERM", "SIGHUP", "SIGUSR1") if command else ("SIGTERM", "SIGHUP")
+    return [getattr(signal, name) for name in names if hasattr(signal, name)]
 
 
 def whole_number(value: object) -> TypeGuard[int]:
@@ -152,8 +168,8 @@ def check_flag(value: Any, name: str, meaning: str) -> None:
 
 
 def raise_terminated(signum, frame) -> None:
-    """A SIGTERM handler: the signal as :class:`Terminated` in the main thread."""
-    raise Terminated(f"signal {signum}")
+    """A handler of the :func:`stop_signals`: the signal as :class:`Terminated` in the main thread."""
+    raise Terminated(f"signal {signum}", signum=int(signum))
 
 
 def settings_from_dict(cls: type, values: Any, *, unknown_what: str, bad_what: str) -> Any:

@@ -313,7 +313,7 @@ def _write_ghh_set(
             "seconds": seconds,
         }
     )
-    (root / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n")
+    (root / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n", encoding="utf-8")
     t3 = manifest["table3"]
     say(f"{task}: safe specialised policies {safe}; Table 3 on the training MDPs: r = {t3['r']:.1f}, r_G = {t3['r_G']:.1f}")
     say(f"{task}: {t3['crashed_episodes']} crashed episodes of {crashes.size * safety_episodes}")
@@ -529,7 +529,7 @@ def build_policy_set(
             try:
                 (root / STAGES).mkdir(parents=True)
                 with writing(_stage_file(root, "build"), "the build's state") as partial:  # a full disk left it empty (seventh trial)
-                    partial.write_text(json.dumps(build) + "\n")
+                    partial.write_text(json.dumps(build) + "\n", encoding="utf-8")
             except BaseException:
                 shutil.rmtree(root, ignore_errors=True)
                 raise
@@ -574,7 +574,7 @@ def _build(family, root: Path, budget, fghh_budget, seed, safety_episodes, n_ste
             how = {"budget": fghh_budget, "resampling": role.resampling} if role.target == "family" else {"budget": budget}
             generics[role.kind] = run(family if role.target == "family" else family.zero(), f"generic_{role.kind}", int(seeds[k]), **how)
         manifest["seconds"] = round(time.perf_counter() - start, 1)
-        (root / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n")
+        (root / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n", encoding="utf-8")
         return PolicySet(family.name, root, generics["race"], generics=generics, manifest=manifest)
 
     train = family.training_mdps()

@@ -9,10 +9,11 @@ busy with a unit nobody will record, then idles as an orphan. The pools made her
   :data:`WATCH_SECONDS` everywhere (a worker reparented to init or a subreaper exits at once);
 - :func:`sigterm_as_interrupt` turns SIGTERM in the parent into :class:`Terminated` (a
   KeyboardInterrupt), so the parent's Ctrl-C path runs: finished work is kept, the workers are
-  ended by :func:`stop_pool`, and the command exits as if interrupted;
-- a worker never hears Ctrl-C (SIGINT stays blocked in it from its first instruction on: a
-  terminal sends it to the whole process group) and dies of SIGTERM at once without a word: the
-  parent alone decides, and ends its workers. A worker that raised KeyboardInterrupt as it
+  ended by :func:`stop_pool`, and the command exits as if interrupted; SIGHUP and SIGUSR1 alike
+  (:func:`~neurohover.errors.stop_signals`; they ended the run without a word, T32-A03);
+- a worker never hears Ctrl-C nor a hang-up (SIGINT and SIGHUP stay blocked in it from its first
+  instruction on: a terminal sends them to the whole process group) and dies of SIGTERM at once
+  without a word: the parent alone decides, and ends its workers. A worker that raised KeyboardInterrupt as it
   imported, or while formatting an exception the parent's SIGTERM then interrupted, printed its
   tracebacks (T26-A01).
 """
@@ -30,14 +31,24 @@ import time
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
 
-from .errors import NeurohoverError, Terminated, brief, raise_terminated, whole_number
+from .errors import NeurohoverError, Terminated, brief, raise_terminated, stop_signals, whole_number
 
 WATCH_SECONDS = 0.5  # how often a worker checks that its parent is alive
 
 _PR_SET_PDEATHSIG = 1  # from <linux/prctl.h>
 
 
-__all__ = ["Terminated", "interrupts_survive_callbacks", "max_jobs", "sigterm_as_interrupt", "stop_pool", "stop_words", "watch_parent", "worker_pool"]
+__all__ = [
+    "Terminated",
+    "interrupts_survive_callbacks",
+    "max_jobs",
+    "refuse_gone_cwd_for_workers",
+    "sigterm_as_interrupt",
+    "stop_pool",
+    "stop_words",
+    "watch_parent",
+    "worker_pool",
+]
 
 
 def _die_with_parent() -> bool:
@@ -83,10 +94,27 @@ def watch_parent(parent: int, pdeathsig: bool = True) -> None:
 
 
 def _deaf_to_ctrl_c() -> set[int | signal.Signals]:
-    """Block SIGINT in this thread (and the threads and processes it starts later); the mask it replaces."""
+    """Block SIGINT and SIGHUP, the signals a terminal sends its whole process group, in this thread (and the threads and
+    processes it starts later); the mask it replaces."""
     if not hasattr(signal, "pthread_sigmask"):  # not POSIX
         return set()
-    return signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    return signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGHUP})
+
+
+def _start_resource_tracker() -> None:
+    """Start multiprocessing's resource tracker, if not running, with SIGHUP blocked: it ignores SIGINT and SIGTERM of
+    its own, but a hang-up sent to the process group killed it, and the pool's shutdown then printed its warning and
+    tracebacks (T32-A03)."""
+    from multiprocessing import resource_tracker
+
+    if not hasattr(signal, "pthread_sigmask"):  # not POSIX
+        resource_tracker.ensure_running()
+        return
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGHUP})
+    try:
+        resource_tracker.ensure_running()
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 class _Pool(ProcessPoolExecutor):
@@ -98,9 +126,7 @@ class _Pool(ProcessPoolExecutor):
         if not hasattr(signal, "pthread_sigmask"):
             super()._spawn_process()  # type: ignore[misc]
             return
-        from multiprocessing import resource_tracker
-
-        resource_tracker.ensure_running()  # started first: starting, it unblocks SIGINT (and SIGTERM) in this thread
+        _start_resource_tracker()  # started first: starting, it unblocks SIGINT (and SIGTERM) in this thread
         previous = _deaf_to_ctrl_c()
         try:
             super()._spawn_process()  # type: ignore[misc]
@@ -111,6 +137,25 @@ class _Pool(ProcessPoolExecutor):
 def max_jobs() -> int:
     """The most worker processes a pool may have: this machine's cores (``reproduce --jobs`` is bounded alike)."""
     return os.cpu_count() or 1
+
+
+def refuse_gone_cwd_for_workers(jobs: int) -> None:
+    """Refuse ``jobs`` worker processes (more than 1) when the working directory has been removed: multiprocessing's spawn
+    asks for it, and the command failed with a bare "No such file or directory", leaving an empty store or output
+    directory behind (T32-A06). Called before anything is written."""
+    if jobs <= 1:
+        return
+    try:
+        os.getcwd()
+    except FileNotFoundError:
+        try:  # Linux names the removed directory
+            gone = repr(os.readlink("/proc/self/cwd").removesuffix(" (deleted)")) + " "
+        except OSError:
+            gone = ""
+        raise NeurohoverError(
+            f"--jobs {jobs} is not allowed here: the working directory {gone}no longer exists: worker processes cannot start "
+            "there; cd to an existing directory (or give --jobs 1)"
+        ) from None
 
 
 def worker_pool(jobs: int) -> ProcessPoolExecutor:
@@ -124,7 +169,9 @@ def worker_pool(jobs: int) -> ProcessPoolExecutor:
     if jobs > max_jobs():  # 10**6 was taken, each worker started as work arrived (fourteenth trial T14-21)
         raise NeurohoverError(f"jobs={brief(jobs)} is not allowed: give at most {max_jobs()} worker processes (the cores of this machine)")
     jobs = int(jobs)
+    refuse_gone_cwd_for_workers(jobs)
     main = threading.current_thread() is threading.main_thread()
+    _start_resource_tracker()  # before the pool's queues register their semaphores with it
     return _Pool(max_workers=jobs, mp_context=multiprocessing.get_context("spawn"), initializer=watch_parent, initargs=(os.getpid(), main))
 
 
@@ -151,11 +198,11 @@ def stop_pool(pool: ProcessPoolExecutor) -> None:
 
 def stop_words(stop: BaseException) -> tuple[str, int]:
     """How a command says it was stopped by ``stop`` (a KeyboardInterrupt, or one raised while handling it) and its
-    exit status: ("terminated", 143) for SIGTERM, ("interrupted", 130) for Ctrl-C (128 + the signal, as shells report)."""
+    exit status: ("terminated", 143) for SIGTERM (129 for SIGHUP, 138 for SIGUSR1), ("interrupted", 130) for Ctrl-C (128 + the signal, as shells report)."""
     cause: BaseException | None = stop
     while cause is not None:
         if isinstance(cause, Terminated):
-            return "terminated", 143
+            return "terminated", 128 + cause.signum  # 129 for SIGHUP (T32-A03)
         cause = cause.__cause__ or cause.__context__
     return "interrupted", 130
 
@@ -179,7 +226,7 @@ def interrupts_survive_callbacks() -> Iterator[None]:
         if not isinstance(unraisable.exc_value, KeyboardInterrupt):
             previous(unraisable)
             return
-        signum = signal.SIGTERM if isinstance(unraisable.exc_value, Terminated) else signal.SIGINT
+        signum = signal.Signals(unraisable.exc_value.signum) if isinstance(unraisable.exc_value, Terminated) else signal.SIGINT
         threading.Thread(target=_deliver_again, args=(signum,), daemon=True).start()
 
     sys.unraisablehook = hook
@@ -196,19 +243,27 @@ def _deliver_again(signum: signal.Signals) -> None:
 
 @contextlib.contextmanager
 def sigterm_as_interrupt() -> Iterator[None]:
-    """While inside, SIGTERM raises :class:`Terminated` in the main thread.
+    """While inside, SIGTERM (SIGHUP alike: :func:`~neurohover.errors.stop_signals`) raises :class:`Terminated` in the
+    main thread.
 
-    Does nothing outside the main thread or when SIGTERM already has a handler of its own.
+    Does nothing outside the main thread; leaves a signal that already has a handler of its own as it is.
     """
-    if threading.current_thread() is not threading.main_thread() or signal.getsignal(signal.SIGTERM) != signal.SIG_DFL:
+    if threading.current_thread() is not threading.main_thread():
         yield
         return
-    signal.signal(signal.SIGTERM, raise_terminated)
+    # Not SIGUSR1: the command takes it at import; a program's own (faulthandler's dump registers no Python handler) stays.
+    taken = [signum for signum in stop_signals(command=False) if signal.getsignal(signum) == signal.SIG_DFL]
+    if not taken:
+        yield
+        return
+    for signum in taken:
+        signal.signal(signum, raise_terminated)
     try:
         with interrupts_survive_callbacks():
             yield
     finally:
-        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        for signum in taken:
+            signal.signal(signum, signal.SIG_DFL)
 
 
 def half_free_memory() -> int:

@@ -71,6 +71,24 @@ class RiskSettings(AgentSettings):
             raise NeurohoverError(f"risk trials={brief(self.trials)} is not allowed: allowed an integer in 1..{MAX_TRIALS:,}")
         whole_in(self.trials, "risk trials", 1, MAX_TRIALS, f"{MAX_TRIALS:,}")
 
+    def check_episodes(self, agent: str, episodes: int) -> None:
+        """model-free-risk's trials of its specialised policies that fill the whole run: it would never settle, and its
+        criterion and level would have no effect (trials=1000000 in 25 episodes ran as trials=3, T32-A07)."""
+        if agent != "model-free-risk":
+            return
+        from ..tasks.base import N_TRAINING  # the specialised policies of a GHH policy set, one per training MDP
+
+        trying = N_TRAINING * self.trials
+        if trying < episodes:
+            return
+        fits = (episodes - 1) // N_TRAINING
+        allowed = f"give trials at most {fits}, or more than {trying:,} episodes" if fits >= 1 else f"give more than {trying:,} episodes"
+        raise NeurohoverError(
+            f"risk trials={self.trials:,} cannot fit in a run of {episodes:,} episodes: model-free-risk flies each of its {N_TRAINING} "
+            f"specialised policies trials times ({trying:,} episodes) before it settles on the best by its risk score, so it would "
+            f"never settle and its criterion would have no effect; {allowed}"
+        )
+
     @classmethod
     def unused(cls, agent: str, given: dict) -> str | None:
         """``trials`` beside a hybrid, ``level`` beside another criterion than lcb: each would be ignored (fifth trial)."""

@@ -73,6 +73,10 @@ class AgentSettings:
         """Refuse settings that cannot act in episodes of ``n_steps`` control steps (a NeurohoverError naming both): the
         settings class cannot see the episode length, so the run checks it here before any episode flies."""
 
+    def check_episodes(self, agent: str, episodes: int) -> None:
+        """Refuse settings with which ``agent`` cannot act within a run of ``episodes`` episodes (a NeurohoverError naming
+        both): the settings class cannot see the run's length, so the competition checks it before any run."""
+
     @classmethod
     def unused(cls, agent: str, given: dict) -> str | None:
         """Why one of the ``given`` settings would do nothing for ``agent`` (refused rather than ignored), or None; a setting

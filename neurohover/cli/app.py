@@ -99,8 +99,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     if argv is None and running_as_command():  # the command's own process (a program calling main() keeps its signals)
         # The command is over and has said so: a Ctrl-C or SIGTERM now would kill the interpreter while it exits, with
         # no line and a status saying that the finished command was stopped (fourth trial).
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        from ..errors import stop_signals
+
+        for signum in (signal.SIGINT, *stop_signals()):  # SIGHUP, SIGUSR1 as SIGTERM (T32-A03)
+            signal.signal(signum, signal.SIG_IGN)
     return status
 
 

@@ -242,7 +242,8 @@ def cmd_wins(args: argparse.Namespace) -> int:
         print(json.dumps({"experiment": args.name, "scale": scale, "against": args.against, "draws": args.draws, "seed": args.seed, "rows": rows}, indent=1))
         return 0
     what = f"against {args.against} alone" if args.against else "against the others"
-    print(f"{args.name} ({scale}): probability of winning a competition of N runs {what} ({args.draws:,} simulated competitions)")
+    draws = f"{args.draws:,} simulated competition{'' if args.draws == 1 else 's'}"  # not "1 simulated competitions" (trial 32)
+    print(f"{args.name} ({scale}): probability of winning a competition of N runs {what} ({draws})")
     width = max(len(r["agent"]) for r in rows)
     print(f"{'agent':<{width}}  MDPs  " + "  ".join(f"{'N = ' + str(n):>8}" for n in lengths))
     for r in rows:

@@ -25,7 +25,7 @@ from typing import Any
 
 from ..errors import NeurohoverError, brief, whole_number
 from ..evaluate import DEVICES, check_device
-from ..procs import max_jobs, sigterm_as_interrupt, stop_pool, worker_pool
+from ..procs import max_jobs, refuse_gone_cwd_for_workers, sigterm_as_interrupt, stop_pool, worker_pool
 from .store import worker_name
 from .store_checks import EXECUTORS
 from .units import Unit, run_unit
@@ -50,6 +50,7 @@ def check_jobs(jobs) -> int:
         raise NeurohoverError(f"--jobs {brief(jobs)} is not allowed: give an integer in 1..{cores} (the cores of this machine)")
     if not 1 <= int(jobs) <= cores:
         raise NeurohoverError(f"--jobs {brief(jobs)} is out of range: allowed an integer in 1..{cores} (the cores of this machine)")
+    refuse_gone_cwd_for_workers(int(jobs))  # before anything is written (T32-A06)
     return int(jobs)  # np.int64(2) as 2
 
 

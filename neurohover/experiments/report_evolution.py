@@ -511,4 +511,4 @@ def _authors_generics(out: Path, cfg: ExperimentConfig) -> dict:
     path = out / "authors-fghh-generics.json"
     if not path.is_file():
         return {}
-    return json.loads(path.read_text()).get(f"{cfg.name}-{cfg.scale}", {})
+    return json.loads(path.read_text(encoding="utf-8")).get(f"{cfg.name}-{cfg.scale}", {})

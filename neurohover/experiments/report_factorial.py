@@ -229,7 +229,7 @@ def authors_policy_runs(out, scale: str) -> dict[str, dict[str, dict]]:
     path = Path(out) / "authors-ghh09-policies.json"
     if not path.is_file():
         return {}
-    groups = json.loads(path.read_text()).get(f"fig8-{scale}", {})
+    groups = json.loads(path.read_text(encoding="utf-8")).get(f"fig8-{scale}", {})
     return {g: {"/".join(r["key"].split("/")[-2:]): r for r in runs} for g, runs in groups.items()}
 
 

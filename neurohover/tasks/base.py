@@ -267,7 +267,7 @@ def competition_rows(family: str) -> dict:
 def competition_families() -> tuple[str, ...]:
     """The families the competition's data file lists MDPs of."""
     if not _COMPETITION:
-        _COMPETITION.update(json.loads(COMPETITION_MDPS_FILE.read_text()))
+        _COMPETITION.update(json.loads(COMPETITION_MDPS_FILE.read_text(encoding="utf-8")))
     return tuple(k for k, v in _COMPETITION.items() if isinstance(v, dict) and "train" in v)  # not its "about" note
 
 
