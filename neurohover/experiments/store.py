@@ -45,6 +45,7 @@ from ..paths import JSONError, WriterLock, strict_json
 from .store_checks import (
     SESSION_STATUSES,
     GuardedConnection,
+    StoreWriteError,
     bad_session,
     check_experiment,
     check_text,
@@ -57,9 +58,7 @@ from .store_checks import (
     sqlite_says,
     stored_count,
 )
-from .store_checks import (
-    transaction as _transaction,
-)
+from .store_checks import transaction as _transaction
 from .units import Unit
 
 SCHEMA_VERSION = 1
@@ -133,12 +132,14 @@ class Store:
             self._check_schema()
             opened = os.stat(self.path)  # its file, as later reads and writes check (T32-B10)
             self._file, self._ident = Path(os.path.abspath(self.path)), (opened.st_dev, opened.st_ino)
-        except (sqlite3.OperationalError, OSError) as err:
+        except (sqlite3.OperationalError, OSError, StoreWriteError) as err:
             if new:  # it could not be made (disk full, read-only): no empty file left that a later run takes for a store
                 self._close_quietly()
                 for made in (self.path, self.path.with_name(self.path.name + "-journal")):
                     made.unlink(missing_ok=True)
-                raise NeurohoverError(f"cannot create the results store {str(self.path)!r} ({err}); no file is left") from None
+                raise NeurohoverError(f"cannot create the results store {str(self.path)!r} ({getattr(err, 'reason', err)}); no file is left") from None
+            if isinstance(err, StoreWriteError):
+                raise
             raise NeurohoverError(f"results store {str(self.path)!r} cannot be read ({err})") from None
         except sqlite3.DatabaseError as err:
             raise NeurohoverError(f"{str(self.path)!r} is not a neurohover results store (SQLite says: {err})") from None

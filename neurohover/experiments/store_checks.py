@@ -43,11 +43,21 @@ def write_failed(err: sqlite3.Error) -> bool:
     return getattr(err, "sqlite_errorname", "") in WRITE_ERRORS or "full" in str(err)
 
 
-def write_failure(store: str, err: sqlite3.Error) -> NeurohoverError:
+class StoreWriteError(NeurohoverError):
+    """A write to a results store that the disk or a file-size limit refused (:func:`write_failure`); ``reason`` is
+    SQLite's word for it, which a store being made names in its own message."""
+
+    def __init__(self, message: str, reason: str) -> None:
+        super().__init__(message)
+        self.reason = reason
+
+
+def write_failure(store: str, err: sqlite3.Error) -> StoreWriteError:
     """The one message of a write to results store ``store`` that ``err`` (:func:`write_failed`) refused."""
-    return NeurohoverError(
+    return StoreWriteError(
         f"cannot write the results store {store!r} ({err}: the disk is full or a file-size limit, ulimit -f, is reached); "
-        "its finished units are kept, and the same command resumes once there is room"
+        "its finished units are kept, and the same command resumes once there is room",
+        str(err),
     )
 
 
