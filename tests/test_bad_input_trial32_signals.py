@@ -45,7 +45,8 @@ def test_hangup_and_usr1_are_stop_signals_as_sigterm_is() -> None:
 
 def test_a_hangup_stops_reproduce_as_sigterm_does_keeping_its_finished_units(tmp_path: Path) -> None:
     """T32-A03: the run died at once (the shell said "Hangup"); now it says "terminated", names its finished units, and
-    exits 128 + the signal."""
+    exits 128 + the signal. (SIGUSR1 stops the command alike: test_hangup_and_usr1_are_stop_signals_as_sigterm_is;
+    this gated run is a program calling main(), which keeps its own SIGUSR1.)"""
     config = tmp_path / "exp.toml"
     config.write_text(SLOW_CONFIG)
     store, gates = tmp_path / "s.sqlite", tmp_path / "gates"
@@ -63,17 +64,17 @@ def test_a_hangup_stops_reproduce_as_sigterm_does_keeping_its_finished_units(tmp
     assert len(_finished(store)) == 1
 
 
-@pytest.mark.parametrize(("sig", "group", "status"), [(signal.SIGHUP, True, 129), (signal.SIGUSR1, False, 138)], ids=["SIGHUP", "SIGUSR1"])
-def test_a_hangup_to_the_group_of_a_reproduce_with_workers_stops_it_with_one_line(tmp_path: Path, sig: int, group: bool, status: int) -> None:
-    """T32-A03: a terminal's hang-up to the whole process group of ``reproduce --jobs 2`` (SIGUSR1 to the command): the
-    command's stop line and 128 + the signal, not multiprocessing's "leaked semaphore objects" warning (nor the resource
-    tracker's tracebacks, once a hang-up had killed it too)."""
+def test_a_hangup_to_the_group_of_a_reproduce_with_workers_stops_it_with_one_line(tmp_path: Path) -> None:
+    """T32-A03: a terminal's hang-up to the whole process group of ``reproduce --jobs 2``: the command's stop line and
+    129, not multiprocessing's "leaked semaphore objects" warning (nor the resource tracker's tracebacks, once a hang-up
+    had killed it too)."""
+    sig, status = signal.SIGHUP, 129
     config = tmp_path / "long.toml"
     config.write_text(LONG_CONFIG)
     proc = _start(tmp_path, "reproduce", str(config), "--store", str(tmp_path / "s.sqlite"), "--jobs", "2", "--no-progress")
     try:
         _busy_workers(proc, 2, cpu=0.2)
-        os.killpg(proc.pid, sig) if group else os.kill(proc.pid, sig)
+        os.killpg(proc.pid, sig)
         rc = proc.wait(timeout=60)
         time.sleep(0.5)  # the resource tracker, when it warns, does so as the command exits
         err = (tmp_path / "stderr.txt").read_text()
@@ -92,7 +93,7 @@ def test_a_hangup_stops_evolve_with_its_line(tmp_path: Path) -> None:
     proc = _start(tmp_path, *argv)
     try:
         deadline = time.monotonic() + 120  # a safety net: imported, its kernel loaded and flying
-        while time.monotonic() < deadline and proc.poll() is None and _cpu_seconds(proc.pid) < 4.0:
+        while time.monotonic() < deadline and proc.poll() is None and _cpu_seconds(proc.pid) < 2.5:
             time.sleep(0.05)
         os.kill(proc.pid, signal.SIGHUP)
         rc = proc.wait(timeout=60)
@@ -116,7 +117,7 @@ def test_a_hangup_leaves_a_command_started_under_nohup_running(tmp_path: Path) -
         )  # fmt: skip
     try:
         deadline = time.monotonic() + 120  # a safety net: imported, its kernel loaded and flying
-        while time.monotonic() < deadline and proc.poll() is None and _cpu_seconds(proc.pid) < 4.0:
+        while time.monotonic() < deadline and proc.poll() is None and _cpu_seconds(proc.pid) < 2.5:
             time.sleep(0.05)
         os.kill(proc.pid, signal.SIGHUP)
         time.sleep(1.0)
