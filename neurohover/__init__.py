@@ -23,12 +23,13 @@ def _interrupted(kind, value, tb) -> None:
 
 
 from .command import running_as_command  # noqa: E402  (stdlib only: before NumPy and numba import)
-from .errors import Terminated, raise_terminated, stop_signals  # noqa: E402
+from .errors import Terminated, raise_terminated, redeliver_ignored_stop, stop_signals  # noqa: E402
 
 if running_as_command():
     import signal
 
     sys.excepthook = _interrupted
+    sys.unraisablehook = redeliver_ignored_stop  # a stop inside an import's callback was ignored, the run went on
     for signum in stop_signals():  # from the first import on, SIGTERM ends the command as Ctrl-C does (fourth trial); SIGHUP too (T32-A03)
         if signum == signal.SIGTERM or signal.getsignal(signum) != signal.SIG_IGN:  # nohup's ignored SIGHUP stays ignored
             signal.signal(signum, raise_terminated)

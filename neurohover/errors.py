@@ -7,6 +7,7 @@ import math
 import numbers
 import operator
 import signal
+import sys
 from typing import TYPE_CHECKING, Any, TypeGuard
 
 if TYPE_CHECKING:  # numpy is imported where used: the package installs its signal handlers after this module, before numpy
@@ -170,6 +171,25 @@ def check_flag(value: Any, name: str, meaning: str) -> None:
 def raise_terminated(signum, frame) -> None:
     """A handler of the :func:`stop_signals`: the signal as :class:`Terminated` in the main thread."""
     raise Terminated(f"signal {signum}", signum=int(signum))
+
+
+def redeliver_ignored_stop(unraisable: Any) -> None:
+    """A ``sys.unraisablehook``: a stop (:class:`Terminated`, or Ctrl-C's KeyboardInterrupt) raised inside a callback
+    whose exceptions Python ignores (importlib's module-lock weakref callback while the package imported, a ``__del__``)
+    was printed as "Exception ignored" and lost, the command running on to status 0; its signal is sent again, to be
+    handled where the command can stop. Anything else goes to Python's own hook."""
+    stop = unraisable.exc_value
+    if isinstance(stop, KeyboardInterrupt):
+        import os
+        import threading
+
+        # A moment later, from another thread: sent now (raise_signal handles it at once), it would be ignored again here.
+        signum = stop.signum if isinstance(stop, Terminated) else signal.SIGINT
+        later = threading.Timer(0.05, os.kill, (os.getpid(), signum))
+        later.daemon = True
+        later.start()
+        return
+    sys.__unraisablehook__(unraisable)
 
 
 def settings_from_dict(cls: type, values: Any, *, unknown_what: str, bad_what: str) -> Any:

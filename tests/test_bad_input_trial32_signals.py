@@ -226,3 +226,32 @@ def test_wins_with_one_draw_says_competition(tmp_path: Path, cli) -> None:
     assert rc == 0 and "(1 simulated competition)" in out, err
     rc, out, err = cli("wins", "tr1", "--store", str(store), "--draws", "2", "--runs", "1")
     assert rc == 0 and "(2 simulated competitions)" in out, err
+
+
+STOP_IN_A_CALLBACK = """
+import signal, sys, time, weakref
+from neurohover.errors import Terminated, raise_terminated, redeliver_ignored_stop
+signal.signal(signal.SIGTERM, raise_terminated)
+if sys.argv[1] == "hook":
+    sys.unraisablehook = redeliver_ignored_stop
+class Held: pass
+held = Held()
+ref = weakref.ref(held, lambda _: raise_terminated(signal.SIGTERM, None))  # as importlib's module-lock callback took it
+try:
+    del held  # the callback runs: its Terminated is "ignored"
+    for _ in range(200):  # the command's work goes on: the stop, sent again, lands in it
+        time.sleep(0.01)
+    print("ran on")
+except Terminated as stop:
+    print("stopped", stop.signum)
+"""
+
+
+@pytest.mark.parametrize("hook", ["hook", "python's"])
+def test_a_stop_raised_inside_a_callback_python_ignores_is_delivered_again(hook: str) -> None:
+    """A SIGTERM landing in importlib's weakref callback while the package imported was printed as "Exception ignored"
+    and lost: ``fly`` ran on to status 0 (test_procs' SIGTERM at 1.0 s, seen once). The package's unraisable hook sends
+    the signal again, and the stop lands where the command handles it."""
+    done = subprocess.run([sys.executable, "-c", STOP_IN_A_CALLBACK, hook], cwd=ROOT, capture_output=True, text=True, timeout=60)
+    assert done.stdout == ("stopped 15\n" if hook == "hook" else "ran on\n"), done.stdout + done.stderr
+    assert ("Exception ignored" in done.stderr) == (hook != "hook"), done.stderr
