@@ -189,3 +189,17 @@ def test_b19_an_unpickled_vector_env_flies_the_same_episodes() -> None:
             got, want = u.step(a), v.step(a)
             assert all(np.array_equal(x, y) for x, y in zip(got[:4], want[:4]))
         assert u.mdps == v.mdps
+
+
+def test_b04_fixed_settings_cost_a_step_nothing() -> None:
+    """T32-B04's fix first took every attribute set through a Python ``__setattr__`` (10% of a HoverEnv step): the
+    settings are descriptors now, a step's own attributes plain sets, and a setting read is a plain read."""
+    from neurohover.envs import HoverEnv, HoverVectorEnv
+
+    for cls in (HoverEnv, HoverVectorEnv):
+        assert cls.__setattr__ is object.__setattr__, cls
+    env = HoverEnv("ghh08")
+    assert "episode_steps" in env.__dict__ and env.episode_steps == 6000
+    assert not hasattr(env, "task")  # an argument it keeps no attribute of reads as none
+    with pytest.raises(NeurohoverError, match="episode_steps=20 is not allowed"):
+        env.episode_steps = 20

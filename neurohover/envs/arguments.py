@@ -3,10 +3,11 @@ noise stream, the sensors, the id they were made under, sizes, dtypes and reset 
 
 from __future__ import annotations
 
+import inspect
 import sys
 from collections.abc import Callable, Sequence
 from types import FrameType
-from typing import Any
+from typing import Any, NoReturn
 
 import gymnasium as gym
 import numpy as np
@@ -183,18 +184,69 @@ def check_no_unknown_kwargs(unknown: dict[str, Any], allowed: Sequence[str]) -> 
         raise NeurohoverError(f"unknown argument(s) {', '.join(sorted(unknown))}: allowed {', '.join(allowed)}")
 
 
+def _refuse_setting(name: str, value: Any) -> NoReturn:
+    how = "reset(options={'mdp': ...}) flies another MDP" if name == "mdp" else f"make a new environment with {name}=..."
+    raise NeurohoverError(f"{name}={brief(value)} is not allowed: an environment's {name} is fixed when it is made (its steps trust it); {how}")
+
+
+class _Setting:
+    """A made environment's setting: read from the instance's own attributes (no call: steps read them), refused when
+    set once the environment is made (:meth:`FixedSettings.fix_settings`)."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+
+    def __set__(self, env: Any, value: Any) -> None:
+        if env.__dict__.get("_made"):
+            _refuse_setting(self.name, value)
+        env.__dict__[self.name] = value
+
+
+class _Absent(_Setting):
+    """A constructor argument the environment keeps no attribute of (``task``, ``sigma``, ...): none to read, and refused
+    when set (``set_wrapper_attr("task", ...)`` was taken and ignored)."""
+
+    def __get__(self, env: Any, owner: Any = None) -> Any:
+        if env is None:
+            return self
+        raise AttributeError(f"{type(env).__name__!r} object has no attribute {self.name!r}")
+
+
+class _Property(_Setting):
+    """A setting the class gives as a property (HoverEnv's ``mdp``): read through it, refused when set once made."""
+
+    def __init__(self, name: str, prop: property) -> None:
+        super().__init__(name)
+        self.prop = prop
+
+    def __get__(self, env: Any, owner: Any = None) -> Any:
+        return self if env is None else self.prop.__get__(env, owner)
+
+    def __set__(self, env: Any, value: Any) -> None:
+        if env.__dict__.get("_made") or self.prop.fset is None:
+            _refuse_setting(self.name, value)
+        self.prop.__set__(env, value)
+
+
 class FixedSettings:
-    """An environment whose settings (its constructor's arguments, ``_FIXED``) cannot change once it is made (``_made``):
-    its steps trust the values checked then. ``env.episode_steps = -1`` (or ``set_wrapper_attr``) made a crash pay
-    +3497.6, ``"20"`` a numba TypingError, and ``set_wrapper_attr("task", ...)`` was taken and ignored (T32-B04)."""
+    """An environment whose settings (its constructor's arguments, ``_FIXED``) cannot change once it is made
+    (:meth:`fix_settings`): its steps trust the values checked then. ``env.episode_steps = -1`` (or
+    ``set_wrapper_attr``) made a crash pay +3497.6, ``"20"`` a numba TypingError, and ``set_wrapper_attr("task", ...)``
+    was taken and ignored (T32-B04). Descriptors, not ``__setattr__``: that ran on every attribute a step sets, 10% of a
+    HoverEnv step."""
 
     _FIXED: tuple[str, ...] = ()
 
-    def __setattr__(self, name: str, value: Any) -> None:
-        if name in self._FIXED and self.__dict__.get("_made"):
-            how = "reset(options={'mdp': ...}) flies another MDP" if name == "mdp" else f"make a new environment with {name}=..."
-            raise NeurohoverError(f"{name}={brief(value)} is not allowed: an environment's {name} is fixed when it is made (its steps trust it); {how}")
-        super().__setattr__(name, value)
+    def fix_settings(self) -> None:
+        """Fix the settings from here on: called once, at the end of the constructor."""
+        cls = type(self)
+        for name in self._FIXED:
+            given = inspect.getattr_static(cls, name, None)
+            if isinstance(given, property):
+                setattr(cls, name, _Property(name, given))
+            elif not isinstance(given, _Setting):
+                setattr(cls, name, _Setting(name) if name in self.__dict__ else _Absent(name))
+        self.__dict__["_made"] = True
 
 
 def check_count(value: Any, name: str, largest: int) -> int:

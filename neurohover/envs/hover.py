@@ -340,7 +340,7 @@ class HoverEnv(FixedSettings, gym.Env[np.ndarray, np.ndarray]):
         self._trail: list[np.ndarray] = []
         self._renderer: Any = None
         self._window: Any = None
-        self._made = True  # its settings are fixed from here (FixedSettings)
+        self.fix_settings()  # its settings are fixed from here (FixedSettings)
 
     _env_spec: Any = None
 

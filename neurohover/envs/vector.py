@@ -202,7 +202,7 @@ class HoverVectorEnv(FixedSettings, VectorEnv):
         # On the GPU the host's _state, _noise and _rng rows are written only by resets (and then
         # copied in); the device holds the flying values. _steps is mirrored on the host.
         self._stepper = stepper(device, self._rows, self._index, self._state, self._noise, self._rng, self._steps)
-        self._made = True  # its settings are fixed from here (FixedSettings)
+        self.fix_settings()  # its settings are fixed from here (FixedSettings)
 
     # -- read-only views -------------------------------------------------------------------
 
