@@ -364,21 +364,13 @@ LOCK_FILE = ".compete.lock"
 def _sole_competition(out: Path) -> Iterator[None]:
     """Be the only competition writing into ``out`` inside this block: a second run there is refused, naming the first's
     pid. Two runs into one folder with other --store files both finished, each printing the folder's files as its own
-    results, which were the second's (trial 31, borderline). A :class:`~neurohover.paths.WriterLock` on
-    :data:`LOCK_FILE` in ``out`` (beside the default store's own lock); a folder where it cannot be made is left
-    unguarded, as :func:`~neurohover.paths.sole_writer` leaves one."""
-    from .paths import WriterLock
+    results, which were the second's (trial 31, borderline). A lock on :data:`LOCK_FILE` in ``out``
+    (:func:`~neurohover.locks.holding`, beside the default store's own lock)."""
+    from .locks import holding
 
-    lock = WriterLock(out / LOCK_FILE)
-    try:
-        busy = "is in use: another compete run ({}) is writing its files; wait for it to end, or give another output directory"
-        lock.acquire(lambda who: f"out {brief(str(out))} {busy.format(who)}")
-    except OSError:
-        pass
-    try:
+    busy = "is in use: another compete run ({}) is writing its files; wait for it to end, or give another output directory"
+    with holding(out / LOCK_FILE, lambda who: f"out {brief(str(out))} {busy.format(who)}"):
         yield
-    finally:
-        lock.release()
 
 
 def _flown_under(n_steps: int, sigma: float | None, sensor: Sensor | None, drift: Drift | None) -> dict:

@@ -96,20 +96,31 @@ class WriterLock:
 
 
 @contextmanager
-def sole_writer(path: Path, option: str) -> Iterator[None]:
-    """Be the only run writing the output ``path`` (and the files named after it) inside this block: a second run on
-    the same output is refused, naming the first's pid. Two evolve runs on one --out both said they finished and left
-    one's policy beside the other's checkpoint (tenth trial). A :class:`WriterLock` on ``.NAME.lock`` beside it; a
-    folder where it cannot be made (full, read-only) is left to the output's own write to name."""
-    lock = WriterLock(path.with_name(f".{path.name}.lock"))
+def holding(lock_path: Path, busy: Callable[[str], str]) -> Iterator[None]:
+    """Hold a :class:`WriterLock` on ``lock_path`` inside this block, refused with ``busy(who)`` while another run holds
+    it; a folder where it cannot be made (full, read-only) is left to the output's own write to name."""
+    lock = WriterLock(lock_path)
     try:
-        lock.acquire(lambda who: f"{option} {str(path)!r} is being written by another run ({who}): wait for it to end, or give another {option}")
+        lock.acquire(busy)
     except OSError:
         pass
     try:
         yield
     finally:
         lock.release()
+
+
+@contextmanager
+def sole_writer(path: Path, option: str) -> Iterator[None]:
+    """Be the only run writing the output ``path`` (and the files named after it) inside this block: a second run on
+    the same output is refused, naming the first's pid. Two evolve runs on one --out both said they finished and left
+    one's policy beside the other's checkpoint (tenth trial). A :class:`WriterLock` on ``.NAME.lock`` beside it
+    (:func:`holding`)."""
+    with holding(
+        path.with_name(f".{path.name}.lock"),
+        lambda who: f"{option} {str(path)!r} is being written by another run ({who}): wait for it to end, or give another {option}",
+    ):
+        yield
 
 
 def hold_file(path: str | os.PathLike, busy: str) -> int:
