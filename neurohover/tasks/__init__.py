@@ -27,11 +27,11 @@ import pkgutil
 
 from ..errors import NeurohoverError, brief
 from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, competition_rows, finite_vector
-from .drift import NO_DRIFT, Drift, refuse_drift, refuse_unordered_mdps
+from .drift import NO_DRIFT, Drift, refuse_drift
 from .fghh import COMPETITION_FGHH_SIGMA, FGHH
 from .ghh08 import GHH08, MAX_WIND
 from .ghh09 import GHH09, GHH09_PARAM_NAMES
-from .rows import check_rows
+from .rows import check_rows, refuse_unordered_mdps
 from .sensor import EXACT, Sensor
 
 _FIRST = ("ghh08", "ghh09", "fghh")  # the paper's order in help texts; other families follow by name

@@ -26,9 +26,7 @@ change_at      (200, 800)  the change happens at an episode drawn uniformly from
 
 from __future__ import annotations
 
-from collections.abc import Set
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
@@ -288,15 +286,3 @@ def refuse_drift(mdp, where: str) -> None:
             "drift is flown by test runs (compete, run_test, test-runs configs) and HoverEnv(drift=...); "
             "for the fixed dynamics use .with_drift(Drift())"
         )
-
-
-def refuse_unordered_mdps(mdps: Any) -> Any:
-    """``mdps``, unless it is a set of MDPs (a frozenset, a dict's keys): a set has no order, so which MDP was in which
-    column, and its episodes' gusts (tied to its position), changed with PYTHONHASHSEED from run to run (T32-B02). The
-    one check of evaluate's, evaluate_jobs', crash_matrix's and evaluate_callable's MDPs; a set of policies is refused too."""
-    if isinstance(mdps, Set):
-        raise NeurohoverError(
-            f"mdps={brief(mdps)} is not allowed: a {type(mdps).__name__} has no order, and each MDP's results depend on its position;"
-            " give an MDP or a list or tuple of MDPs"
-        )
-    return mdps

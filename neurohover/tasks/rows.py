@@ -1,7 +1,10 @@
-"""The check of kernel rows given as an array (``evaluate_jobs``, ``evaluate`` of rows): the MDP's own checks, but the
-family's, in a few NumPy operations."""
+"""The checks of a batch of MDPs for the kernel: rows given as an array (``evaluate_jobs``, ``evaluate`` of rows), the
+MDP's own checks, but the family's, in a few NumPy operations; and MDPs given in a collection with no order."""
 
 from __future__ import annotations
+
+from collections.abc import Set
+from typing import Any
 
 import numpy as np
 
@@ -64,3 +67,15 @@ def check_rows(rows: np.ndarray) -> None:
     name, value, _, allowed = next(f for f in fields_ if not f[2])
     shown = value if isinstance(value, list) else float(value)
     raise NeurohoverError(f"MDP row {i} has {name}={shown!r}, which no MDP has: allowed {allowed} (rows as MDP.row() gives them)")
+
+
+def refuse_unordered_mdps(mdps: Any) -> Any:
+    """``mdps``, unless it is a set of MDPs (a frozenset, a dict's keys): a set has no order, so which MDP was in which
+    column, and its episodes' gusts (tied to its position), changed with PYTHONHASHSEED from run to run (T32-B02). The
+    one check of evaluate's, evaluate_jobs', crash_matrix's and evaluate_callable's MDPs; a set of policies is refused too."""
+    if isinstance(mdps, Set):
+        raise NeurohoverError(
+            f"mdps={brief(mdps)} is not allowed: a {type(mdps).__name__} has no order, and each MDP's results depend on its position;"
+            " give an MDP or a list or tuple of MDPs"
+        )
+    return mdps
