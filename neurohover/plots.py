@@ -30,17 +30,18 @@ import textwrap
 import warnings
 from collections.abc import Iterator, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
-from matplotlib.ticker import MaxNLocator
 
 from .compete_files import COMPETE_CONDITIONS, CompeteResult, read_compete_dirs
 from .errors import NeurohoverError, brief, whole_number
 from .flightdata import FlightData, check_flown, check_metadata, crash_flags
 from .paths import output_dir, output_file, printable
 from .sim.constants import ACTION_NAMES, CONTROL_DT, EPISODE_STEPS, MAX_EPISODE_STEPS
+
+if TYPE_CHECKING:  # matplotlib is imported by what draws: every command line imports this module
+    from matplotlib.figure import Figure
 
 __all__ = [
     "attitude_angles",
@@ -59,6 +60,9 @@ CRASH_COLOR = "tab:red"
 
 def new_figure(width: float, height: float, dpi: int = 100) -> Figure:
     """A figure with its own Agg canvas (no pyplot)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg  # loaded by what draws, not by every command
+    from matplotlib.figure import Figure
+
     fig = Figure(figsize=(width, height), dpi=dpi)
     FigureCanvasAgg(fig)
     return fig
@@ -97,6 +101,8 @@ def noting_missing_glyphs() -> Iterator[None]:
 def save_figure(fig: Figure, path: str | Path) -> Path:
     """Write ``fig`` as a PNG to ``path``, checked as every output file is (:func:`~neurohover.paths.output_file`:
     not a directory, device, pipe or socket; missing parent directories are created, saying so)."""
+    from matplotlib.figure import Figure
+
     from .paths import write_png
 
     if not isinstance(fig, Figure):  # None was an AttributeError mid-write
@@ -338,6 +344,8 @@ def compete_figure(results: Sequence[CompeteResult], title: str = "") -> Figure:
         raise NeurohoverError(  # [None] was an AttributeError, [] an empty figure (fourteenth trial, T14-11)
             f"results={brief(results)} is not allowed: give a list of one or more CompeteResult (read_compete_dir or read_compete_dirs)"
         )
+    from matplotlib.ticker import MaxNLocator
+
     heading = _title(title) or "mean cumulative error over runs"
     fig = new_figure(11.0, 4.5)
     axes = fig.subplots(1, 2)

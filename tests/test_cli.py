@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -214,3 +215,17 @@ def test_compete_refuses_bad_options_before_it_makes_its_output_directory(cli, t
     for bad in (["--agent", "Baseline"], ["--agent", "baseline", "--drift", "walk=-1"], ["--agent", "continual", "--agent-setting", "cooldown=nan"]):
         rc, _, err = cli("compete", "--task", "ghh08", *bad, "--runs", "1", "--episodes", "2", "--out", str(out))
         assert rc == 2 and "created directory" not in err and not out.exists(), bad
+
+
+def test_the_command_line_loads_matplotlib_and_scipy_stats_only_where_it_draws_or_tests() -> None:
+    """Every command imports the parser of every command: with matplotlib (plots) and scipy.stats (races, the report's
+    tests) loaded at import, each started `neurohover` paid about a second before doing anything."""
+    script = (
+        "import sys\n"
+        "from neurohover.cli.app import build_parser\n"
+        "import neurohover.experiments, neurohover.evolution, neurohover.plots\n"
+        "build_parser()\n"
+        "print(sorted(m for m in sys.modules if m.split('.')[0] == 'matplotlib' or m.startswith('scipy.stats')))\n"
+    )
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env={**os.environ, "MPLBACKEND": ""})
+    assert run.returncode == 0 and run.stdout.strip() == "[]", run.stdout + run.stderr

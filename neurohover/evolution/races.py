@@ -51,7 +51,6 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
-from scipy import stats
 
 from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..procs import half_free_memory
@@ -201,6 +200,8 @@ def _mean(samples: np.ndarray) -> float:
 @functools.lru_cache(maxsize=4096)
 def _standard_quantiles(n: int, delta: float) -> tuple[float, float]:
     """Quantiles at (1 -/+ delta)/2 of the standardised posterior of the mean (as in SciPy)."""
+    from scipy import stats  # half a second to import: only a race needs it, not every command line
+
     q_lo, q_hi = (1.0 - delta) / 2.0, (1.0 + delta) / 2.0
     if n > 1000:  # scipy.stats.mvsdist switches to a normal approximation here
         return float(stats.norm.ppf(q_lo)), float(stats.norm.ppf(q_hi))

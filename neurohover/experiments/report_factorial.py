@@ -14,10 +14,9 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 
 import numpy as np
-from scipy import stats
 
 from ..models.lr import LEGACY_NOISE_ESTIMATE
-from .report_base import Section, agent_panel, fmt, fmt_p, log_errors, new_figure, table
+from .report_base import Section, agent_panel, fmt, fmt_p, log_errors, new_figure, paired_p, table
 from .results import ModelResult, TestRunResult
 
 #: (setting, our level, the other level, what it is, whose the other level is). The first three are the authors'
@@ -80,7 +79,7 @@ def main_effects(cells: Mapping[str, dict[str, str | int]], values: Mapping[str,
         d = np.array(diffs, dtype=float)
         if not d.size:  # no two cells differ in this factor alone: it is not varied here
             continue
-        p = float(stats.wilcoxon(d).pvalue) if np.any(d != 0) else None
+        p = paired_p(d) if np.any(d != 0) else None
         out.append(
             {
                 "factor": f"{what} ({name}: {ours} -> {theirs})",
@@ -251,7 +250,7 @@ def authors_policy_section(theirs: Mapping[str, Mapping[str, dict]], ours: Calla
                 rows.append([label, name, str(len(scores)), fmt(np.mean(scores)), f"{sum(crashed)} ({np.mean(crashed):.1%})", fmt(per_episode)])
         d = np.array([runs[k]["score"] - float(mine[k].score) for k in runs if k in mine])
         if d.size and np.any(d != 0):
-            p = float(stats.wilcoxon(d).pvalue)
+            p = paired_p(d)
             direction = "better" if np.median(d) > 0 else "worse"
             lines.append(
                 f"{label} with the authors' published policies instead of ours: {direction} (median paired difference of the cumulative reward "

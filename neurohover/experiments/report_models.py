@@ -13,7 +13,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
 
 from .report_base import Section, fmt, fmt_p, log_errors, new_figure, table
 from .results import ModelResult
@@ -102,6 +101,8 @@ class SensorModels(Section):
             p = "-"
             paired = [(u.exact, reference[u.mdp].exact) for u in units if u.mdp in reference]
             if label != exact_label and len(paired) >= 5:
+                from scipy import stats  # imported where a report is written, not by every command line
+
                 a, b = np.array(paired).T
                 p = fmt_p(stats.wilcoxon(a, b).pvalue) + f" ({int((a > b).sum())} of {len(a)} worse)"
             rows.append(
