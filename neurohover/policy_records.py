@@ -73,7 +73,27 @@ def _not_json_problem(meta: dict) -> str:
             json_text({key: value})
         except (TypeError, ValueError, RecursionError):
             return f"its {key} {brief(value)} is not allowed: give strict JSON values, numbers finite (NaN and Infinity are no JSON: save_policy refuses them)"
+        if nesting_depth(value) > MAX_NOTE_DEPTH:  # a note 600 deep loaded, then the Policy could not be copied or pickled (T33-B03)
+            return f"its {key} {brief(value)} is not allowed: it is nested more than {MAX_NOTE_DEPTH} lists or tables deep"
     return ""
+
+
+#: How deep a policy's metadata value (a free-form note) may nest lists and tables: one 600 deep loaded (Python's JSON
+#: reader follows about 990), and the Policy then could not be deep-copied or pickled, a RecursionError (T33-B03).
+MAX_NOTE_DEPTH = 100
+
+
+def nesting_depth(value: Any) -> int:
+    """How many lists (or tuples) and dicts ``value`` nests, at its deepest (0 for a number or text), counted without
+    recursion, and no further than one past :data:`MAX_NOTE_DEPTH`."""
+    depth, level = 0, [value]
+    while depth <= MAX_NOTE_DEPTH:
+        inner = [v for v in level if isinstance(v, (list, tuple, dict))]
+        if not inner:
+            break
+        depth += 1
+        level = [item for v in inner for item in (v.values() if isinstance(v, dict) else v)]
+    return depth
 
 
 def _run_words_problem(meta: dict, own_stop: dict, stop_reasons: tuple, parse_resampling, best_fitness: float) -> str:

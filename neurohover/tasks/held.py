@@ -20,7 +20,6 @@ caller gives make() or sample() is still checked against the MDP built (:func:`c
 from __future__ import annotations
 
 import contextlib
-import json
 import re
 import threading
 from collections.abc import Iterator
@@ -136,9 +135,11 @@ def _wind_label_problem(mdp: MDP, text: str) -> str:
     """Why a ``wind=[...]`` label (what GHH-08's make() writes of the wind it is given, ``fly --wind``) is refused ('' when
     it is not): its numbers are not the MDP's wind (make() writes them as Python lists, whose text reads back as the same
     floats)."""
+    from ..paths import strict_json
+
     try:
-        named = json.loads(text)
-    except ValueError:
+        named = strict_json(text)
+    except ValueError:  # JSONError: no JSON, or nested past what Python can follow (a RecursionError, T33-B01)
         named = None
     if not isinstance(named, list) or not all(type(v) in (int, float) and finite_real(v) for v in named):  # 10**400: float() overflowed
         return "its label names no wind: give wind=[u, v], a list of numbers, as fly --wind writes it"

@@ -1,0 +1,70 @@
+"""Bad-input trial 33 (33b), the Python API: T33-B01 (an MDP label ``wind=[[[...]]]`` nested 1,000 deep was a
+RecursionError), T33-B03 (a policy file's note nested 600 deep loaded, and the Policy could not be copied or pickled),
+T33-B04 (plots.new_figure passed matplotlib's errors through), T33-B09 (a learned model's MDP labelled ``train:3`` without
+its family), T33-B10 (PolicyTable kinds that contradict its padded genomes), T33-B11 (a Policy subclass's own act) and
+T33-B13 (FlightData.load and LearnedModel.save refused an os.PathLike)."""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import json
+import pickle
+from pathlib import Path
+
+import pytest
+from flight_edits import edited_copy, refused_everywhere
+
+import neurohover as nh
+from neurohover.errors import NeurohoverError
+
+DEEP = 1000
+
+
+@pytest.fixture(scope="module")
+def flight(tmp_path_factory) -> Path:
+    """A recording as ``neurohover fly --record`` writes it (ghh08 train:1, two episodes)."""
+    from neurohover.cli import main
+
+    path = tmp_path_factory.mktemp("flight") / "f.npz"
+    argv = ["fly", "--task", "ghh08", "--mdp", "train:1", "--episodes", "2", "--threads", "1", "--json", "--record", str(path)]
+    assert main(argv) == 0
+    return path
+
+
+def test_b01_a_wind_label_nested_deep_is_refused_by_name(flight: Path, cli, tmp_path: Path) -> None:
+    """T33-B01: ``ghh08/wind=[[[...]]]`` 1,000 deep was a RecursionError from json.loads in the label's check, through
+    dataclasses.replace, MDP.from_dict, FlightData.load, learn-model and plot; 10 deep was refused by name already."""
+    m = nh.get_task_family("ghh08").mdp("train:0")
+    label = "ghh08/wind=" + "[" * DEEP + "]" * DEEP
+    with pytest.raises(NeurohoverError, match="its label names no wind: give wind=.u, v., a list of numbers"):
+        dataclasses.replace(m, label=label)
+    with pytest.raises(NeurohoverError, match="its label names no wind"):
+        type(m).from_dict({**m.to_dict(), "label": label})
+
+    def deep(meta: dict) -> None:
+        meta["mdps"][0]["label"] = label
+
+    path = edited_copy(flight, tmp_path / "deep.npz", deep)
+    refused_everywhere(path, "its label names no wind", cli, tmp_path)
+    assert dataclasses.replace(m, label="ghh08/wind=" + json.dumps(list(m.wind))).wind == m.wind  # its own wind still names it
+
+
+def test_b03_a_policy_note_nested_deep_is_refused_at_load_and_save(tmp_path: Path) -> None:
+    """T33-B03: a note 600 deep loaded (Python's JSON reader follows about 990 levels), and the Policy could then not be
+    deep-copied or pickled. Notes nest at most 100 lists or tables deep, at load and at save alike."""
+    b = nh.baseline_policy()
+    path = tmp_path / "deep.json"
+    for depth, taken in ((100, True), (101, False), (600, False)):
+        note = "[" * depth + "]" * depth
+        path.write_text(f'{{"topology": "slp", "genome": {json.dumps(b.genome.tolist())}, "note": {note}}}')
+        if taken:
+            p = nh.load_policy(path)
+            assert copy.deepcopy(p) == p and pickle.loads(pickle.dumps(p)) == p
+            nh.save_policy(p, tmp_path / "again.json")
+            continue
+        deep = r"its note \[\[\[.* is not allowed: it is nested more than 100 lists or tables deep$"
+        with pytest.raises(NeurohoverError, match=r"^policy file '.*deep.json': " + deep):
+            nh.load_policy(path)
+        with pytest.raises(NeurohoverError, match="its note .* is not allowed: it is nested more than 100 lists or tables deep"):
+            nh.save_policy(b, tmp_path / "out.json", note=json.loads(note))
