@@ -192,13 +192,20 @@ def redeliver_ignored_stop(unraisable: Any) -> None:
     sys.__unraisablehook__(unraisable)
 
 
+def unknown_keys(keys: Any, known: Any) -> str:
+    """The ``keys`` not among ``known``, named for a message ('' if none): text keys as written (a 100,000-character one
+    shortened), any other (b'pop_size', 1) as its repr; sorted as text, so keys of mixed types sort, and ``", ".join``
+    of non-text keys raised TypeError (evolve settings={1: 10}, T33-B02)."""
+    unknown = [k for k in set(keys) if k not in set(known)]
+    return ", ".join(sorted((k if isinstance(k, str) and len(k) <= 60 else brief(k) for k in unknown), key=str))
+
+
 def settings_from_dict(cls: type, values: Any, *, unknown_what: str, bad_what: str) -> Any:
     """An instance of the settings dataclass ``cls`` from a dict of some of its fields: unknown keys and
     values ``cls`` refuses (TypeError, ValueError) become one NeurohoverError each, naming them."""
     fields = [f.name for f in dataclasses.fields(cls)]
-    unknown = sorted(set(values) - set(fields))
-    if unknown:
-        named = ", ".join(k if isinstance(k, str) and len(k) <= 60 else brief(k) for k in unknown)  # a 100,000-character key shortened
+    named = unknown_keys(values, fields)
+    if named:
         raise NeurohoverError(f"unknown {unknown_what} setting(s) {named}: allowed {', '.join(fields)}")
     try:
         return cls(**values)

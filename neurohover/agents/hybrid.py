@@ -18,7 +18,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, unknown_keys
 from ..evaluate import DangerousState
 from ..flightdata import FlightData
 from ..policies import Policy, baseline_policy
@@ -80,9 +80,9 @@ class HybridSettings(AgentSettings):
     def from_dict(cls, values: dict) -> HybridSettings:
         """Settings from a (partial) dict of :meth:`to_dict`'s keys; unknown keys are refused."""
         known = set(cls().to_dict())
-        unknown = sorted(set(values) - known)
+        unknown = unknown_keys(values, known)
         if unknown:
-            raise NeurohoverError(f"unknown hybrid setting(s) {', '.join(unknown)}: allowed {', '.join(sorted(known))}")
+            raise NeurohoverError(f"unknown hybrid setting(s) {unknown}: allowed {', '.join(sorted(known))}")
         v = {**cls().to_dict(), **values}
         return cls(v["replacement"], v["model_from"], DangerousState(v["rule"], v["box"], v["tilt"]))
 

@@ -12,7 +12,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from ..errors import NeurohoverError, brief, check_flag, finite_real, float_of, whole_in, whole_number
+from ..errors import NeurohoverError, brief, check_flag, finite_real, float_of, unknown_keys, whole_in, whole_number
 from ..policies import TOPOLOGIES, Policy
 from ..policies import prototype as make_prototype
 from ..sim.constants import MAX_EPISODE_STEPS
@@ -260,11 +260,11 @@ def make_settings(method: str, optimizer: str, settings) -> Any:
         raise NeurohoverError(f"settings must be a {cls.__name__} or a dict of its fields, got {type(settings).__name__}")
     fields = {f.name for f in dataclasses.fields(cls)} - {"budget"}
     presets = GENERATIONAL_PRESETS if cls is GenerationalSettings else {}
-    unknown = sorted(set(settings) - fields - ({"preset"} if presets else set()))
+    unknown = unknown_keys(settings, fields | ({"preset"} if presets else set()))
     if unknown:
-        budget = "; the run's budget is its own option (--budget, evolve(budget=...)), counted in episodes" if "budget" in unknown else ""
+        budget = "; the run's budget is its own option (--budget, evolve(budget=...)), counted in episodes" if "budget" in settings else ""
         raise NeurohoverError(
-            f"unknown {method} setting(s) {', '.join(unknown)}: allowed {', '.join(sorted(fields | ({'preset'} if presets else set())))}{budget}"
+            f"unknown {method} setting(s) {unknown}: allowed {', '.join(sorted(fields | ({'preset'} if presets else set())))}{budget}"
         )
     values = dict(settings)
     if "preset" in values:
