@@ -335,10 +335,16 @@ class RunConfig:
         if not isinstance(optimizer, str) or optimizer not in optimiser_names():
             raise NeurohoverError(f"unknown optimizer {brief(optimizer)}: allowed {', '.join(optimiser_names())}")
         resampling = parse_resampling(resampling)
-        if budget is None and isinstance(settings, (SteadyStateSettings, GenerationalSettings)):
-            budget = settings.budget
         if budget is not None:
             budget = check_budget(budget)
+        if isinstance(settings, (SteadyStateSettings, GenerationalSettings)) and settings.budget is not None:
+            if budget is None:
+                budget = check_budget(settings.budget)
+            elif budget != settings.budget:  # one of the two was dropped without a word (T33-B08)
+                raise NeurohoverError(
+                    f"budget={brief(budget)} is not allowed beside settings.budget={brief(settings.budget)}: "
+                    "give the budget once (evolve(budget=...), in episodes), or both alike"
+                )
         seed = check_seed(seed)
         n_steps = whole_in(n_steps, "n_steps", 1, MAX_EPISODE_STEPS)  # T24-11: 1.5 or True "is not allowed", 0 out of range
         chosen = ("steady-state" if mdp is not None else "generational") if method is None else method

@@ -213,7 +213,8 @@ def evolve(
     budget : int, optional
         Episodes to fly (checked between generations). Default: the paper's termination
         (steady state: plateau; generational: ``generations``; CMA-ES: pycma's criteria; OpenAI-ES
-        has none, so it needs a budget).
+        has none, so it needs a budget). A settings object's own ``budget`` serves when this is None;
+        both given and different is refused.
     settings : SteadyStateSettings, GenerationalSettings, dict or str, optional
         Overrides of the optimiser settings (paper Tables 6/7): a settings object, a dict of
         fields, or for the generational method a preset's name (``"table7"``, the default;
