@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .compete_files import COMPETE_CONDITIONS, CompeteResult, read_compete_dirs
-from .errors import NeurohoverError, brief, whole_number
+from .errors import NeurohoverError, brief, finite_real, real_number, whole_in, whole_number
 from .flightdata import FlightData, check_flown, check_metadata, crash_flags
 from .paths import output_dir, output_file, printable
 from .sim.constants import ACTION_NAMES, CONTROL_DT, EPISODE_STEPS, MAX_EPISODE_STEPS
@@ -58,12 +58,28 @@ __all__ = [
 CRASH_COLOR = "tab:red"
 
 
+#: The largest figure side new_figure draws, in inches, and in pixels (Agg's own limit: 2**16).
+MAX_FIGURE_INCHES, MAX_FIGURE_PIXELS = 100.0, 2**16
+
+
 def new_figure(width: float, height: float, dpi: int = 100) -> Figure:
-    """A figure with its own Agg canvas (no pyplot)."""
+    """A figure of ``width`` x ``height`` inches (each in (0, 100]) at ``dpi`` dots per inch (1..1000, neither side past
+    2**16 pixels) with its own Agg canvas (no pyplot). -1, NaN or '1' inches and dpi=10**9 were matplotlib's ValueError or
+    TypeError, the last only as the figure was saved (T33-B04)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg  # loaded by what draws, not by every command
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(width, height), dpi=dpi)
+    for name, value in (("width", width), ("height", height)):
+        allowed = f"allowed a number of inches, 0 < {name} <= {MAX_FIGURE_INCHES:g}"
+        if not real_number(value):
+            raise NeurohoverError(f"figure {name}={brief(value)} is not allowed: {allowed}")
+        if not (finite_real(value) and 0 < value <= MAX_FIGURE_INCHES):
+            raise NeurohoverError(f"figure {name}={brief(value)} is out of range: {allowed}")
+    dpi = whole_in(dpi, "figure dpi", 1, 1000)
+    if max(width, height) * dpi > MAX_FIGURE_PIXELS:
+        side = f"{max(width, height):g} inches at dpi {dpi} is {max(width, height) * dpi:,.0f} pixels"
+        raise NeurohoverError(f"figure dpi={dpi} is out of range: {side}, and a side is at most {MAX_FIGURE_PIXELS:,} pixels")
+    fig = Figure(figsize=(float(width), float(height)), dpi=dpi)
     FigureCanvasAgg(fig)
     return fig
 

@@ -68,3 +68,24 @@ def test_b03_a_policy_note_nested_deep_is_refused_at_load_and_save(tmp_path: Pat
             nh.load_policy(path)
         with pytest.raises(NeurohoverError, match="its note .* is not allowed: it is nested more than 100 lists or tables deep"):
             nh.save_policy(b, tmp_path / "out.json", note=json.loads(note))
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        ((-1, 1), "figure width=-1 is out of range: allowed a number of inches, 0 < width <= 100"),
+        ((float("nan"), 1), "figure width=nan is out of range: allowed a number of inches"),
+        (("1", 1), "figure width='1' is not allowed: allowed a number of inches"),
+        ((1, 0), "figure height=0 is out of range: allowed a number of inches, 0 < height <= 100"),
+        ((1, 1, 10**9), "figure dpi=1000000000 is out of range: allowed an integer in 1..1000"),
+        ((80, 2, 1000), "figure dpi=1000 is out of range: 80 inches at dpi 1000 is 80,000 pixels, and a side is at most 65,536 pixels"),
+    ],
+)
+def test_b04_new_figure_refuses_sizes_matplotlib_cannot_draw(args: tuple, message: str) -> None:
+    """T33-B04: plots.new_figure passed matplotlib's ValueError or TypeError through (dpi=10**9 only as it was saved)."""
+    from neurohover.plots import new_figure
+
+    with pytest.raises(NeurohoverError) as err:
+        new_figure(*args)
+    assert str(err.value) == message or str(err.value).startswith(message), str(err.value)
+    assert new_figure(2.5, 1, dpi=50).get_size_inches().tolist() == [2.5, 1.0]
