@@ -92,4 +92,4 @@ def test_a_learned_models_mdp_takes_no_task_familys_label(label: str) -> None:
     ):
         model.mdp(label=label)
     assert model.mdp(label="model/lr").label == "model/lr" and model.mdp(label="learned").label == "learned"
-    assert nh.MDP("model", substeps=1, dt=0.1, label="train:3").label == "train:3"  # names no family: a model's own
+    assert nh.MDP("model", substeps=1, dt=0.1, label="model/train:3").label == "model/train:3"  # 'train:3' alone is refused (T33-B09)

@@ -10,6 +10,7 @@ import copy
 import dataclasses
 import json
 import pickle
+import re
 from pathlib import Path
 
 import pytest
@@ -89,3 +90,18 @@ def test_b04_new_figure_refuses_sizes_matplotlib_cannot_draw(args: tuple, messag
         new_figure(*args)
     assert str(err.value) == message or str(err.value).startswith(message), str(err.value)
     assert new_figure(2.5, 1, dpi=50).get_size_inches().tolist() == [2.5, 1.0]
+
+
+@pytest.mark.parametrize("label", ["train:3", "zero", "test:5", "seeded-train:2", "wind=[1.0, 2.0]"])
+def test_b09_a_learned_models_mdp_takes_no_set_label_without_its_family(label: str) -> None:
+    """T33-B09: T28-B09 refused 'ghh08/train:3' on a model's MDP, but 'train:3' or 'zero' was taken, and a policy evolved
+    on it recorded the target 'train:3', a competition MDP's name."""
+    from neurohover.models import LearnedModel, one_substep_params
+
+    model = LearnedModel(tuple(one_substep_params()[0]), (0.1,) * 6, "lr")
+    says = f"MDP {label!r} is not allowed: its label names a task family's MDP ({label!r}, as a family names its own), but the MDP is a learned model's"
+    with pytest.raises(NeurohoverError, match=re.escape(says)):
+        model.mdp(label=label)
+    with pytest.raises(NeurohoverError, match=re.escape(says)):
+        nh.MDP("model", substeps=1, dt=0.1, label=label)
+    assert model.mdp(label="model/train:3").label == "model/train:3" and model.mdp(label="mine").label == "mine"

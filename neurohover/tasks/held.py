@@ -10,7 +10,8 @@ The labels the code writes for an MDP, and which are checked against its paramet
 depend on a sigma an MDP does not record) and ``ghh08/wind=[u, v]`` (``fly --wind``: the wind itself; T24-05). Left
 unchecked, as they name no parameters: ``F/custom`` (``fly --params``), ``F/sample`` and ``F/sample:N`` (drawn from G
 by a seed the label does not record) and any other label given to ``make(label=...)``. A learned model's MDPs (family
-``model``) may fly any wind and dynamics, under any label but one that names a task family's MDP (T28-B09).
+``model``) may fly any wind and dynamics, under any label but one that names a task family's MDP, with the family or
+without it (``ghh08/train:3``, T28-B09; ``train:3``, ``zero``, T33-B09).
 
 The family's own :meth:`make` and :meth:`zero` build MDPs it holds by definition, so MDPs built while they run are not
 checked again (:func:`family_code`): the check never recurses, and a family's fixed sets are built once. A label the
@@ -60,9 +61,12 @@ def check_held(mdp: MDP) -> None:
     if mdp.family not in TASK_FAMILIES:  # a learned model's MDP: any wind, any dynamics, but no task family's label
         match = SET_LABEL.fullmatch(mdp.label) or WIND_LABEL.fullmatch(mdp.label)
         named = match.group("family") if match else None
-        if named in TASK_FAMILIES:  # 'ghh08/train:0' on a model was evolved on, and claimed as the policy's target (T28-B09)
+        # 'ghh08/train:0' on a model was evolved on, and claimed as the policy's target (T28-B09); 'train:3' or 'zero',
+        # a task family's names without the family, the same (T33-B09)
+        if match is not None and (named is None or named in TASK_FAMILIES):
+            names = f"a {brief(named)} MDP" if named else f"a task family's MDP ({brief(match.group(0))}, as a family names its own)"
             raise NeurohoverError(
-                f"MDP {brief(mdp.label)} is not allowed: its label names a {brief(named)} MDP, but the MDP is a learned model's "
+                f"MDP {brief(mdp.label)} is not allowed: its label names {names}, but the MDP is a learned model's "
                 f"(family {brief(mdp.family)}): give it a label of its own, e.g. 'model/lr'"
             )
         return
