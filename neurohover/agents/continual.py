@@ -75,10 +75,9 @@ class ContinualSettings(AgentSettings):
             ("cooldown", 0, 10**6, "1000000 (episodes)"),
             ("safeguard_after", 0, 10**6, "1000000 (control steps)"),
         ):
-            v = getattr(self, name)
-            if type(v) is not int:  # a Python int only: the settings are stored as JSON (a NumPy integer is no JSON number)
-                raise NeurohoverError(f"continual {name}={brief(v)} is not allowed: allowed an integer in {low}..{text}")
-            whole_in(v, f"continual {name}", low, high, text)
+            # stored as the Python int whole_in returns: the settings are stored as JSON (a NumPy integer is no JSON
+            # number), and np.int64(10), which every other integer argument takes, was refused (T33-B12)
+            object.__setattr__(self, name, whole_in(getattr(self, name), f"continual {name}", low, high, text))
         t = self.threshold
         if not real_number(t) or not finite_real(t) or t <= 1:
             raise NeurohoverError(f"continual threshold={brief(t)} is out of range: allowed a number > 1 (a ratio of one-step errors)")

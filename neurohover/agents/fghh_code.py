@@ -106,10 +106,8 @@ class CodeAgentSettings:
     def __post_init__(self) -> None:
         check_model_substeps(self.model_substeps, "model_substeps")  # True == 1 was taken as 1 (eleventh trial)
         for name, low in (("evolutions", 1), ("model_budget", 50), ("n_steps", 1)):
-            value = getattr(self, name)
-            if type(value) is not int:  # T24-11: 1.5 or True "is not allowed" (a type; it said out of range), a Python int as before
-                raise NeurohoverError(f"{name}={brief(value)} is not allowed: allowed an integer in {low}..2**63-1")
-            whole_in(value, name, low, 2**63 - 1, "2**63-1")
+            # T24-11: 1.5 or True "is not allowed"; stored as the Python int whole_in returns, np.int64 taken (T33-B12)
+            object.__setattr__(self, name, whole_in(getattr(self, name), name, low, 2**63 - 1, "2**63-1"))
         if not (finite_real(self.fired_error) and self.fired_error >= 0):  # finite_real: NumPy's isfinite raised TypeError on 10**400
             raise NeurohoverError(f"fired_error={brief(self.fired_error)} is out of range: allowed a finite number >= 0")
         if not isinstance(self.dangerous, DangerousState):  # anything was taken, then an AttributeError after an episode (eleventh trial)

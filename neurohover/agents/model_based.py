@@ -18,7 +18,7 @@ from ..flightdata import FlightData
 from ..models.lr import DEFAULT_NOISE_ESTIMATE, lr_determined
 from ..models.model import DEFAULT_MODEL_SUBSTEPS, LearnedModel
 from ..policies import Policy, baseline_policy
-from ..sim.constants import EPISODE_STEPS
+from ..sim.constants import EPISODE_STEPS, MAX_EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
 from .protocol import Agent, Choice, EpisodeOutcome, check_agent_policy
 from .spec import FGHH_GENERIC_KINDS, AgentOptions, AgentPolicies, AgentSettings, AgentSpec
@@ -82,6 +82,8 @@ class ModelEvolution:
 
     def __post_init__(self) -> None:
         from ..evaluate import check_device
+        from ..evolution.common import MAX_EPISODES
+        from ..evolution.config import MAX_BUDGET
         from ..models import D_U_CHOICES, ESTIMATORS, NOISE_ESTIMATES
         from ..models.model import check_model_substeps
         from ..models.wind import WIND_MODELS
@@ -97,11 +99,18 @@ class ModelEvolution:
             if value not in allowed:
                 raise NeurohoverError(f"{name}={value!r} is not allowed: choose one of {', '.join(map(str, allowed))}")
         check_model_substeps(self.model_substeps, "model_substeps")  # True was taken as 1 (True in (1, 10))
+        object.__setattr__(self, "model_substeps", int(self.model_substeps))  # np.int64(1) stored as a JSON number
+        # budget, predict_episodes and n_steps went unchecked ('x' was taken, then refused mid-run by evolve; T33-B12):
+        # the experiments' caps (model_budget, predict_episodes), the kernel's episode length
+        for name, high, text in (
+            ("budget", MAX_BUDGET, f"{MAX_BUDGET:,} (model evaluations)"),
+            ("predict_episodes", MAX_EPISODES, f"{MAX_EPISODES:,}"),
+            ("n_steps", MAX_EPISODE_STEPS, f"{MAX_EPISODE_STEPS:,} (control steps)"),
+        ):
+            object.__setattr__(self, name, whole_in(getattr(self, name), name, 1, high, text))
         # T24-11: 1.5 or True "is not allowed" (a type), 0 "is out of range" (both said out of range); no bound but int64's
-        g = self.authors_generations
-        if type(g) is not int:  # a Python int, as before: the settings are stored as JSON
-            raise NeurohoverError(f"authors_generations={brief(g)} is not allowed: allowed an integer in 1..2**63-1")
-        whole_in(g, "authors_generations", 1, 2**63 - 1, "2**63-1")
+        # stored as the Python int whole_in returns (the settings are stored as JSON); np.int64 was refused (T33-B12)
+        object.__setattr__(self, "authors_generations", whole_in(self.authors_generations, "authors_generations", 1, 2**63 - 1, "2**63-1"))
         check_device(self.device)
 
     def fit(self, flight_data: FlightData) -> LearnedModel:
@@ -293,10 +302,8 @@ class IncrementalSettings(AgentSettings):
 
     def __post_init__(self) -> None:
         # T24-11: 1.5 or True "is not allowed" (a type), 0 "is out of range" (both said out of range); no bound but int64's
-        m = self.max_learning_episodes
-        if type(m) is not int:  # a Python int, as before: the settings are stored as JSON
-            raise NeurohoverError(f"max_learning_episodes={brief(m)} is not allowed: allowed an integer in 1..2**63-1")
-        whole_in(m, "max_learning_episodes", 1, 2**63 - 1, "2**63-1")
+        # stored as the Python int whole_in returns (the settings are stored as JSON); np.int64 was refused (T33-B12)
+        object.__setattr__(self, "max_learning_episodes", whole_in(self.max_learning_episodes, "max_learning_episodes", 1, 2**63 - 1, "2**63-1"))
 
     @classmethod
     def from_unit(cls, params: dict) -> IncrementalSettings:

@@ -67,9 +67,8 @@ class RiskSettings(AgentSettings):
             raise NeurohoverError(f"risk level={brief(self.level)} is not a number: allowed a finite number >= 0 (standard errors below the mean)")
         if not finite_real(self.level) or self.level < 0:
             raise NeurohoverError(f"risk level={brief(self.level)} is out of range: allowed a finite number >= 0 (standard errors below the mean)")
-        if type(self.trials) is not int:  # T24-11: 1.5 or True "is not allowed" (a type; it said out of range), a Python int as before
-            raise NeurohoverError(f"risk trials={brief(self.trials)} is not allowed: allowed an integer in 1..{MAX_TRIALS:,}")
-        whole_in(self.trials, "risk trials", 1, MAX_TRIALS, f"{MAX_TRIALS:,}")
+        # T24-11: 1.5 or True "is not allowed"; stored as the Python int whole_in returns, np.int64 taken (T33-B12)
+        object.__setattr__(self, "trials", whole_in(self.trials, "risk trials", 1, MAX_TRIALS, f"{MAX_TRIALS:,}"))
 
     def check_episodes(self, agent: str, episodes: int) -> None:
         """model-free-risk's trials of its specialised policies that fill the whole run: it would never settle, and its

@@ -1,0 +1,91 @@
+"""The thirty-third bad-input trial's findings in evolve, its checkpoints and the agents' settings (T33-B02, T33-B05,
+T33-B06, T33-B07, T33-B08, T33-B12, T33-B15, T33-B16): settings with keys that are not text were Python's TypeError;
+a checkpoint edited (resampling, a population gene past Policy's cap, n_steps, champion null) was resumed or refused
+with Python's text; a budget given twice dropped one silently; agent settings refused NumPy integers; 0-d arrays were
+"out of range"."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import re
+
+import numpy as np
+import pytest
+
+from neurohover.agents.continual import ContinualSettings
+from neurohover.agents.fghh_code import CodeAgentSettings
+from neurohover.agents.model_based import IncrementalSettings, ModelEvolution
+from neurohover.agents.registry import AgentOptions, make_agent
+from neurohover.agents.risk import RiskSettings
+from neurohover.errors import NeurohoverError
+from neurohover.evolution.evolve import evolve
+from neurohover.evolution.steady_state import SteadyStateSettings
+from neurohover.tasks import get_task_family
+
+ZERO = get_task_family("ghh08").zero()
+#: The run behind the tiny_checkpoint fixture (conftest.py).
+MDP_RUN = dict(topology="slp", prototype="baseline", seed=3, n_steps=20)
+
+
+@pytest.mark.parametrize("key", [b"pop_size", 1, (1, 2)])
+def test_evolve_settings_with_a_key_that_is_not_text_are_refused_naming_it(key) -> None:
+    """T33-B02: settings={1: 10} was "TypeError: sequence item 0: expected str instance, int found"."""
+    with pytest.raises(NeurohoverError, match=re.escape(f"unknown steady-state setting(s) {key!r}: allowed ")):
+        evolve(ZERO, budget=5, settings={key: 10}, **MDP_RUN)
+    with pytest.raises(NeurohoverError, match=re.escape(f"unknown cma setting(s) {key!r}")):  # keys of mixed types sort
+        evolve(ZERO, budget=5, optimizer="cma", settings={key: 10, "zz": 1}, **MDP_RUN)
+
+
+def test_hybrid_agent_settings_with_a_key_that_is_not_text_are_refused_naming_it() -> None:
+    """T33-B02: make_agent('hybrid', ..) with settings {1: 10} was a TypeError (continual's was clean)."""
+    with pytest.raises(NeurohoverError, match=re.escape("unknown hybrid setting(s) 1, b'x': allowed box, model_from")):
+        make_agent("hybrid", "ghh08", options=AgentOptions(settings={1: 10, b"x": 2}))
+
+
+def test_a_budget_given_twice_and_different_is_refused() -> None:
+    """T33-B08: evolve(budget=100, settings=SteadyStateSettings(budget=30)) flew 100 episodes without a word."""
+    settings = SteadyStateSettings(pop_size=4, elite_size=3, budget=6)
+    with pytest.raises(NeurohoverError, match=re.escape("budget=8 is not allowed beside settings.budget=6: give the budget once")):
+        evolve(ZERO, budget=8, settings=settings, **MDP_RUN)
+    assert evolve(ZERO, budget=6, settings=settings, **MDP_RUN).episodes == 6  # both alike: taken
+    assert evolve(ZERO, settings=settings, **MDP_RUN).episodes == 6  # the settings' own: as before
+
+
+@pytest.mark.parametrize(
+    "cls, name",
+    [
+        (ContinualSettings, "window"),
+        (ContinualSettings, "patience"),
+        (ContinualSettings, "max_learning_episodes"),
+        (ContinualSettings, "cooldown"),
+        (ContinualSettings, "safeguard_after"),
+        (RiskSettings, "trials"),
+        (CodeAgentSettings, "model_budget"),
+        (CodeAgentSettings, "evolutions"),
+        (IncrementalSettings, "max_learning_episodes"),
+        (ModelEvolution, "authors_generations"),
+        (ModelEvolution, "budget"),
+        (ModelEvolution, "predict_episodes"),
+        (ModelEvolution, "model_substeps"),
+    ],
+)
+def test_agent_settings_take_numpy_integers_and_store_python_ints(cls, name: str) -> None:
+    """T33-B12: np.int64(10) was "not allowed: allowed an integer"; it is taken and stored as a Python int (JSON)."""
+    given = getattr(cls(), name)
+    settings = cls(**{name: np.int64(given or 1)})
+    assert type(getattr(settings, name)) is int and getattr(settings, name) == (given or 1)
+    json.dumps(dataclasses.asdict(settings), default=str)
+
+
+def test_agent_settings_from_make_agent_take_numpy_integers() -> None:
+    """T33-B12 as the trial met it: through make_agent's settings dicts."""
+    make_agent("continual", "ghh08", options=AgentOptions(settings={"cooldown": np.int64(10)}))
+    make_agent("incremental", "ghh08", options=AgentOptions(settings={"max_learning_episodes": np.int64(5)}))
+
+
+@pytest.mark.parametrize("name, value", [("budget", "x"), ("budget", 0), ("predict_episodes", 1.5), ("n_steps", 0), ("n_steps", 10**8)])
+def test_model_evolution_checks_its_counts(name: str, value) -> None:
+    """Noticed with T33-B12: ModelEvolution's budget, predict_episodes and n_steps were not checked at all ('x' taken)."""
+    with pytest.raises(NeurohoverError, match=re.escape(f"{name}={value!r} is ")):
+        ModelEvolution(**{name: value})
