@@ -24,7 +24,7 @@ from .errors import NeurohoverError, as_floats, brief, finite_real, real_number,
 from .flightdata import FlightData, same_values
 from .flyer import KernelFlyer
 from .launch import DEVICES, KIND, MAX_SEED, Batch, Flown, check_device, launch, num_threads, use_lanes
-from .policies import GENOME_LENGTH, TOPOLOGIES, Policy, load_policy
+from .policies import GENOME_LENGTH, TOPOLOGIES, Policy, check_padding, load_policy
 from .sim.constants import (
     EPISODE_STEPS,
     MAX_EPISODE_STEPS,
@@ -112,6 +112,7 @@ class PolicyTable:
             raise NeurohoverError(f"PolicyTable genomes must be an array of shape ({kinds.shape[0]}, {GENOME_WIDTH}), got shape {genomes.shape}")
         if genomes.dtype.kind not in "iuf":  # not issubdtype(np.integer): time spans are NumPy integers (T17-1); booleans are kind 'b'
             raise NeurohoverError(f"PolicyTable genomes must be real numbers, got dtype {genomes.dtype} (complex and objects were a ValueError in the kernel)")
+        check_padding(kinds, genomes, KIND)  # an MLP row declared an SLP flew as one, its genes 40 and 41 unread (T33-B10)
         object.__setattr__(self, "kinds", kinds.astype(np.int64, copy=False))  # uint8 kinds were refused by the kernel's batch
         object.__setattr__(self, "genomes", genomes.astype(np.float64, copy=False))
 
@@ -146,8 +147,7 @@ class PolicyTable:
         if raw.dtype.kind not in "iuf" or isinstance(genomes, np.ma.MaskedArray):
             what = "a masked array" if isinstance(genomes, np.ma.MaskedArray) else raw.dtype
             raise NeurohoverError(f"{topology} genomes of {what} are not allowed: give an array of real numbers (P, {GENOME_LENGTH[topology]})")
-        g = raw.astype(float)
-        n = GENOME_LENGTH[topology]
+        g, n = raw.astype(float), GENOME_LENGTH[topology]
         if g.ndim != 2 or g.shape[1] != n or g.shape[0] == 0:
             raise NeurohoverError(f"{topology} genomes must be an array of shape (P >= 1, {n}), got {g.shape}")
         table = np.zeros((g.shape[0], GENOME_WIDTH))

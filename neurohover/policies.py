@@ -285,6 +285,24 @@ def policy_from_dict(d: dict, source: str = "policy") -> Policy:
         raise NeurohoverError(f"{source}: {err}") from None
 
 
+def check_padding(kinds: np.ndarray, genomes: np.ndarray, kind_numbers: dict[str, int]) -> None:
+    """Refuse a kernel table's row whose genes past its kind's genome (``kind_numbers``: topology to kind) are not zero,
+    as :meth:`~neurohover.evaluate.PolicyTable.from_policies` pads them: an MLP row declared an SLP (kinds [0, 0]) flew
+    as one, its genes 40 and 41 unread (T33-B10)."""
+    lengths = np.zeros(max(kind_numbers.values()) + 1, dtype=np.int64)
+    for topology, number in kind_numbers.items():
+        lengths[number] = GENOME_LENGTH[topology]
+    padded = np.arange(genomes.shape[1]) >= lengths[kinds][:, None]
+    rows, genes = np.nonzero(padded & (genomes != 0))  # NaN too
+    if rows.size:
+        row, gene = int(rows[0]), int(genes[0])
+        topology = next(t for t, number in kind_numbers.items() if number == kinds[row])
+        raise NeurohoverError(
+            f"PolicyTable row {row} is not allowed: its kind {int(kinds[row])} ({topology}) reads genes 0..{GENOME_LENGTH[topology] - 1}, but its gene "
+            f"{gene} is {brief(float(genomes[row, gene]))}, not the zero that pads an {topology} genome: give the row its genome's kind (from_policies does)"
+        )
+
+
 def load_policy(source: str | Path) -> Policy:
     """Load a policy file (JSON, or the authors' ``.net`` format: :mod:`neurohover.netfile`), or
     the baseline policy for the name ``baseline``."""

@@ -13,6 +13,7 @@ import pickle
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 from flight_edits import edited_copy, refused_everywhere
 
@@ -105,3 +106,21 @@ def test_b09_a_learned_models_mdp_takes_no_set_label_without_its_family(label: s
     with pytest.raises(NeurohoverError, match=re.escape(says)):
         nh.MDP("model", substeps=1, dt=0.1, label=label)
     assert model.mdp(label="model/train:3").label == "model/train:3" and model.mdp(label="mine").label == "mine"
+
+
+def test_b10_a_policy_table_row_whose_padding_is_not_zero_is_refused() -> None:
+    """T33-B10: PolicyTable(kinds=[0, 0], genomes) flew an MLP row as an SLP (-31,508 against its own -39), though its
+    genes 40 and 41, which pad an SLP row with zeros, showed the mistake. An SLP flown as an MLP cannot be told."""
+    from neurohover.evaluate import PolicyTable
+
+    t = PolicyTable.from_policies([nh.baseline_policy(), nh.prototype("mlp", "baseline")])
+    says = "PolicyTable row 1 is not allowed: its kind 0 (slp) reads genes 0..39, but its gene 40 is 1.0, not the zero that pads an slp genome"
+    with pytest.raises(NeurohoverError, match=re.escape(says)):
+        PolicyTable(np.array([0, 0]), t.genomes)
+    genomes = t.genomes.copy()
+    genomes[0, 41] = np.nan
+    with pytest.raises(NeurohoverError, match=re.escape("row 0 is not allowed: its kind 0 (slp) reads genes 0..39, but its gene 41 is nan")):
+        PolicyTable(t.kinds, genomes)
+    genomes[0, 41], genomes[0, 5] = 0.0, np.nan  # a non-finite gene it reads is flown, and crashes (documented)
+    assert PolicyTable(t.kinds, genomes) == PolicyTable(t.kinds.astype(np.uint8), genomes)
+    assert PolicyTable(np.array([1, 1]), t.genomes).kinds.tolist() == [1, 1]
