@@ -62,7 +62,7 @@ CASES: dict[str, tuple[Callable[[object], object], str, object]] = {
     "DangerousState box": (lambda v: DangerousState(box=v), "safeguard box={} is not allowed", 0.5),
     "DangerousState arm_after": (lambda v: DangerousState(arm_after=v), "safeguard arm_after={} is not allowed", 5),
     "Sensor velocity": (lambda v: Sensor(velocity=v), "sensor velocity={} is not a number", 0.5),
-    "Sensor dropout": (lambda v: Sensor(dropout=v), "sensor dropout={} is out of range", 0.1),
+    "Sensor dropout": (lambda v: Sensor(dropout=v), "sensor dropout={} is not a number", 0.1),  # not a range (T33-B16)
     "Sensor delay": (lambda v: Sensor(delay=v), "sensor delay={} is not allowed", 2),  # not a range (T24-11)
     "Sensor.parse delay": (lambda v: Sensor.parse("position=0.1", delay=v), "sensor delay={} is not allowed", 2),  # 4 was taken as delay 4
     "Drift walk": (lambda v: Drift(walk=v), "drift walk={} is not a number", 0.1),

@@ -165,7 +165,7 @@ def test_fitness_scale_must_be_text(scale) -> None:
         ({"checkpoint_every_s": 5}, "checkpoint_every_s=5 needs checkpoint= (the file it writes)"),
         ({"progress_every_s": 5}, "progress_every_s=5 needs progress= (the callable it paces)"),
         ({"checkpoint_every_s": True, "checkpoint": "x.json"}, "checkpoint_every_s=True must be a number > 0 (seconds)"),
-        ({"progress_every_s": True, "progress": print}, "progress_every_s=True is out of range"),
+        ({"progress_every_s": True, "progress": print}, "progress_every_s=True is not a number"),  # a type, not a range (T33-B16)
     ],
 )
 def test_intervals_need_their_partner(kwargs: dict, fragment: str, tmp_path: Path, monkeypatch) -> None:

@@ -89,3 +89,22 @@ def test_model_evolution_checks_its_counts(name: str, value) -> None:
     """Noticed with T33-B12: ModelEvolution's budget, predict_episodes and n_steps were not checked at all ('x' taken)."""
     with pytest.raises(NeurohoverError, match=re.escape(f"{name}={value!r} is ")):
         ModelEvolution(**{name: value})
+
+
+@pytest.mark.parametrize("value", [np.array(0.1), "0.1", None, np.timedelta64(1)])
+def test_a_sensor_dropout_of_another_type_is_not_a_number(value) -> None:
+    """T33-B16: Sensor(dropout=np.array(0.1)) was "out of range" (0.1 is in range): refused for its type, it is "not a number"."""
+    from neurohover.tasks.sensor import Sensor
+
+    with pytest.raises(NeurohoverError, match=re.escape("is not a number: allowed a probability 0 <= dropout < 1")):
+        Sensor(dropout=value)
+    with pytest.raises(NeurohoverError, match=re.escape("sensor dropout=1.5 is out of range")):
+        Sensor(dropout=1.5)
+
+
+def test_progress_every_s_of_another_type_is_not_a_number() -> None:
+    """T33-B16: evolve(progress_every_s=np.array(0.1)) was "out of range"."""
+    with pytest.raises(NeurohoverError, match=re.escape("progress_every_s=array(0.1) is not a number: allowed a finite number of seconds")):
+        evolve(ZERO, budget=5, progress=print, progress_every_s=np.array(0.1), **MDP_RUN)
+    with pytest.raises(NeurohoverError, match=re.escape("progress_every_s=-1 is out of range")):
+        evolve(ZERO, budget=5, progress=print, progress_every_s=-1, **MDP_RUN)

@@ -138,8 +138,10 @@ def _intervals(checkpoint, checkpoint_every_s, progress, progress_every_s) -> tu
     if progress_every_s is None:
         progress_every_s = PROGRESS_EVERY_S
     elif not real_number(progress_every_s) or not 0 <= progress_every_s < math.inf:
+        # np.array(0.1), refused for its type, was called out of range (T33-B16)
+        refused = "is out of range" if real_number(progress_every_s) else "is not a number"
         raise NeurohoverError(
-            f"progress_every_s={brief(progress_every_s)} is out of range: allowed a finite number of seconds >= 0 (0: every generation), "
+            f"progress_every_s={brief(progress_every_s)} {refused}: allowed a finite number of seconds >= 0 (0: every generation), "
             f"or None ({PROGRESS_EVERY_S:g})"
         )
     elif progress is None:

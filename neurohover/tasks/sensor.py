@@ -76,6 +76,8 @@ class Sensor:
         if self.correlation > 0 and not any(getattr(self, name) for name in SENSOR_GROUPS):  # it did nothing (fifth trial)
             raise NeurohoverError(f"sensor correlation={self.correlation!r} applies to noise: give a level or the stds beside it")
         p = self.dropout
+        if not real_number(p):  # np.array(0.1) was called out of range, a value refused for its type (T33-B16)
+            raise NeurohoverError(f"sensor dropout={brief(p)} is not a number: allowed a probability 0 <= dropout < 1")
         if not finite_real(p) or not 0 <= p < 1:  # NaN fails the comparison too; np.timedelta64 is no number (T17-1)
             raise NeurohoverError(f"sensor dropout={brief(p)} is out of range: allowed a probability 0 <= dropout < 1")
         object.__setattr__(self, "dropout", float(p))
