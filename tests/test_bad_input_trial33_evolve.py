@@ -108,3 +108,17 @@ def test_progress_every_s_of_another_type_is_not_a_number() -> None:
         evolve(ZERO, budget=5, progress=print, progress_every_s=np.array(0.1), **MDP_RUN)
     with pytest.raises(NeurohoverError, match=re.escape("progress_every_s=-1 is out of range")):
         evolve(ZERO, budget=5, progress=print, progress_every_s=-1, **MDP_RUN)
+
+
+@pytest.mark.parametrize("entry", ["champion", "counters", "config"])
+@pytest.mark.parametrize("value", [None, 5, []])
+def test_a_checkpoint_table_that_is_no_table_is_refused_naming_it(tiny_checkpoint, tmp_path, entry: str, value) -> None:
+    """T33-B15: "champion": null was "a damaged checkpoint: TypeError: 'NoneType' object is not subscriptable" (counters and
+    config alike); now the entry is named with what is allowed."""
+    state = json.loads(tiny_checkpoint.read_text())
+    state[entry] = value
+    ckpt = tmp_path / "run.ckpt.json"
+    ckpt.write_text(json.dumps(state))
+    with pytest.raises(NeurohoverError, match=re.escape(f"is a damaged checkpoint: {entry}={value!r} is not allowed: allowed a table of ")) as err:
+        evolve(ZERO, budget=60, checkpoint=ckpt, resume=True, **MDP_RUN)
+    assert "Error:" not in str(err.value)

@@ -36,6 +36,12 @@ def _damaged(source: str, err: Exception) -> NeurohoverError:
 #: Every entry a checkpoint (:meth:`Run.state`) has held, and every entry of its counters and champion tables.
 CHECKPOINT_ENTRIES = ("format", "config", "budget", "optimizer_state", "counters", "mdp_stream", "race_delta", "champion", "history", "stop_reason")
 COUNTERS = ("episodes", "next_index", "flown", "steps", "generation", "evaluations", "wall_seconds", "kernel_seconds")
+#: The checkpoint entries that are tables, and what each holds (for the message refusing one that is not).
+_TABLES = {
+    "config": "the run's settings (target, method, optimizer, resampling, topology, prototype, seed, n_steps, settings)",
+    "counters": ", ".join(COUNTERS),
+    "champion": "genome (a list of numbers, or null before the first champion) and return",
+}
 #: Why a run stopped, as :func:`stop_reason` says it.
 STOP_REASONS = ("budget", "plateau", "generations", *sorted({spec.stop_reason for spec in OPTIMISERS.values()}))
 
@@ -60,6 +66,9 @@ def _check_tables(state: dict, source: str) -> None:
     without a word, as the optimiser state's were before (sixteenth trial)."""
     remedy = "resume from an undamaged copy or start again without resuming"
     check_entries(state, "checkpoint", CHECKPOINT_ENTRIES, what=source, remedy=remedy)
+    for name, allowed in _TABLES.items():  # "champion": null was Python's "TypeError: 'NoneType' object is not subscriptable" (T33-B15)
+        if name in state and not isinstance(state[name], dict):
+            raise _damaged(source, EntryError(f"{name}={brief(state[name])} is not allowed: allowed a table of {allowed}, as the run wrote it"))
     for name, entries in (("counters", COUNTERS), ("champion", ("genome", "return"))):
         if isinstance(state.get(name), dict):
             check_entries(state[name], "checkpoint", entries, what=f"the {name} table of {source}", remedy=remedy)
