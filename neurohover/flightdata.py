@@ -176,9 +176,9 @@ class FlightData:
         meta_text = _metadata_text(self.metadata, "flight data")  # checked again: metadata may be changed after making
         if not self.actions or self.n_transitions == 0:
             raise NeurohoverError("flight data to save needs at least one step flown (load() refuses any other file)")
-        new = isinstance(path, (str, Path)) and str(path) not in ("", "-") and not str(path).endswith("/") and not os.path.exists(path)
-        if new:
-            check_npz_name(path)  # before output_file makes its directory; '', '-', 'dir/' and what exists it names as such
+        text = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None  # an os.PathLike's text, not its repr (T33-B13)
+        if isinstance(text, str) and text not in ("", "-") and not text.endswith("/") and not os.path.exists(text):
+            check_npz_name(text)  # before output_file makes its directory; '', '-', 'dir/' and what exists it names as such
         path = output_file(path, "flight-data file")  # refuses '', a directory and a device (/dev/null was a struct.error)
         check_npz_name(path)
         lengths = np.array([a.shape[0] for a in self.actions], dtype=np.int64)
@@ -213,7 +213,7 @@ class FlightData:
         rounded readings are left to EC-MER's check: :func:`neurohover.flightmeta.check_policy_actions`)."""
         from .paths import input_file
 
-        if not isinstance(path, (str, Path)):  # None was a TypeError (second trial)
+        if not isinstance(path, (str, os.PathLike)):  # None was a TypeError (second trial); an os.PathLike is a path (T33-B13)
             raise NeurohoverError(f"flight-data file {path!r} is not allowed: give a path")
         path = input_file(path, "flight-data file")  # an empty path, a directory: named as such, not as missing
         if not zipfile.is_zipfile(path):  # np.load would try (and refuse) to unpickle anything else

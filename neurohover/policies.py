@@ -442,7 +442,7 @@ def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
         raise NeurohoverError(f"policy metadata must be strict JSON values (numbers finite): {err}") from None
     problem = record_problem({k: v for k, v in data.items() if k not in ("topology", "genome")})
     if problem:  # T24-03: seed=-1 or budget=-5 was written, and load_policy then refused the file
-        shown = repr(str(path)) if isinstance(path, (str, os.PathLike)) else brief(path)  # as load_policy names the file
+        shown = repr(os.fspath(path)) if isinstance(path, (str, os.PathLike)) else brief(path)  # as load_policy names the file
         raise NeurohoverError(f"policy file {shown}: {problem} (load_policy would refuse the file; nothing is written)")
     path = output_file(path, "policy file", kind="a policy file")  # refuses '', a directory and a device; makes missing parents
     with writing(path, "policy file") as partial:

@@ -124,3 +124,32 @@ def test_b10_a_policy_table_row_whose_padding_is_not_zero_is_refused() -> None:
     genomes[0, 41], genomes[0, 5] = 0.0, np.nan  # a non-finite gene it reads is flown, and crashes (documented)
     assert PolicyTable(t.kinds, genomes) == PolicyTable(t.kinds.astype(np.uint8), genomes)
     assert PolicyTable(np.array([1, 1]), t.genomes).kinds.tolist() == [1, 1]
+
+
+class _PathLike:
+    """An os.PathLike that is no pathlib object (a py.path.local, a fsspec local path)."""
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+
+    def __fspath__(self) -> str:
+        return self.text
+
+
+def test_b13_flight_data_and_model_files_take_an_os_pathlike(flight: Path, tmp_path: Path, monkeypatch) -> None:
+    """T33-B13: FlightData.load refused an os.PathLike ("is not allowed: give a path"), and LearnedModel.save took its
+    repr for the name ("give a path ending .json (e.g. '<__main__.json')"); load_policy, save_policy, FlightData.save
+    and LearnedModel.load took it."""
+    from neurohover.models import LearnedModel, one_substep_params
+
+    monkeypatch.chdir(tmp_path)
+    data = nh.FlightData.load(_PathLike(str(flight)))
+    assert data == nh.FlightData.load(flight)
+    assert data.save(_PathLike("again.npz")) == Path("again.npz")
+    model = LearnedModel(tuple(one_substep_params()[0]), (0.1,) * 6, "lr")
+    assert model.save(_PathLike("m.json")) == Path("m.json") and LearnedModel.load(_PathLike("m.json")) == model
+    with pytest.raises(NeurohoverError, match=re.escape("model file 'm.txt' is not allowed: a model file is JSON; give a path ending .json (e.g. 'm.json')")):
+        model.save(_PathLike("m.txt"))
+    with pytest.raises(NeurohoverError, match=re.escape("flight-data file 'f.txt' is not allowed: flight data are a NumPy archive")):
+        data.save(_PathLike("f.txt"))
+    assert not Path("m.txt").exists() and not Path("f.txt").exists()

@@ -309,10 +309,13 @@ class LearnedModel:
         """``path`` as a Path if a model file may be written there, named as ``what``: a model is JSON, so a name of
         another suffix (m.npz held JSON; T23-16) or of none is refused, as a policy file's and flight data's are (a name
         without one was written, and 'm.model' refused; T32-B20). learn-model asks before it learns."""
+        from ..paths import checked_path
+
         if not isinstance(path, (str, os.PathLike)):
             raise NeurohoverError(f"{what} {brief(path)} is not allowed: give a path (text or a Path) ending {MODEL_SUFFIX}")
-        refuse_suffix(str(path), what, (MODEL_SUFFIX,), "a model file is JSON", f"model{MODEL_SUFFIX}")
-        return Path(path)
+        text = os.fspath(checked_path(path, what, f"path ending {MODEL_SUFFIX}"))  # an os.PathLike's own text, not its repr (T33-B13)
+        refuse_suffix(text, what, (MODEL_SUFFIX,), "a model file is JSON", f"model{MODEL_SUFFIX}")
+        return Path(text)
 
     def save(self, path: str | Path) -> Path:
         """Write the model as JSON (format tag ``neurohover-model/1``; a name ending .json, in any case); returns the path."""
@@ -322,7 +325,7 @@ class LearnedModel:
             self.check_name(path)
         check_stats(self.stats)  # stats may be changed after making: a NaN was json's ValueError (T32-B05)
         text = json.dumps(self.to_dict(), indent=1, allow_nan=False) + "\n"
-        shown = repr(str(path)) if isinstance(path, (str, os.PathLike)) else brief(path)  # as load names the file
+        shown = repr(os.fspath(path)) if isinstance(path, (str, os.PathLike)) else brief(path)  # as load names the file
         try:  # what load reads back: stats.n_episodes = -5 was written, then refused by load (T32-B05)
             type(self).from_dict(json.loads(text), f"model file {shown}")
         except NeurohoverError as err:
