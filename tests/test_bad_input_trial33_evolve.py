@@ -122,3 +122,18 @@ def test_a_checkpoint_table_that_is_no_table_is_refused_naming_it(tiny_checkpoin
     with pytest.raises(NeurohoverError, match=re.escape(f"is a damaged checkpoint: {entry}={value!r} is not allowed: allowed a table of ")) as err:
         evolve(ZERO, budget=60, checkpoint=ckpt, resume=True, **MDP_RUN)
     assert "Error:" not in str(err.value)
+
+
+@pytest.mark.parametrize("gene", [1e300, -1.5e120])
+def test_a_checkpoint_population_gene_past_a_policys_cap_is_refused(tiny_checkpoint, tmp_path, gene: float) -> None:
+    """T33-B06: a population gene of 1e300 was resumed and kept, though a Policy caps genes at 1e120 (T30-B01)."""
+    state = json.loads(tiny_checkpoint.read_text())
+    state["optimizer_state"]["population"]["data"][1] = gene
+    ckpt = tmp_path / "run.ckpt.json"
+    ckpt.write_text(json.dumps(state))
+    fragment = f"population holds a gene that is out of range: data entry 1 (genome 0, gene 1) is {gene!r}; allowed numbers in [-1e+120, 1e+120]"
+    with pytest.raises(NeurohoverError, match=re.escape(fragment)):
+        evolve(ZERO, budget=60, checkpoint=ckpt, resume=True, **MDP_RUN)
+    state["optimizer_state"]["population"]["data"][1] = 1e120  # at the cap: taken
+    ckpt.write_text(json.dumps(state))
+    assert evolve(ZERO, budget=55, checkpoint=ckpt, resume=True, **MDP_RUN).episodes == 55

@@ -13,6 +13,7 @@ from typing import Any, TypeVar, overload
 import numpy as np
 
 from ..errors import NeurohoverError, as_floats, brief, finite_real, real_number, whole_number
+from ..policies import MAX_GENE
 from ..sim.constants import MAX_SECONDS, seconds_allowed  # MAX_SECONDS re-exported: a state's bound, as every record's
 
 __all__ = [
@@ -103,14 +104,16 @@ def dec_array(d: dict[str, Any] | None, name: str = "array") -> np.ndarray | Non
 
 
 @overload
-def check_genomes(a: np.ndarray, size: int, name: str, rows: int | None = None) -> np.ndarray: ...
+def check_genomes(a: np.ndarray, size: int, name: str, rows: int | None = None, genes: bool = True) -> np.ndarray: ...
 @overload
-def check_genomes(a: None, size: int, name: str, rows: int | None = None) -> None: ...
+def check_genomes(a: None, size: int, name: str, rows: int | None = None, genes: bool = True) -> None: ...
 @overload
-def check_genomes(a: np.ndarray | None, size: int, name: str, rows: int | None = None) -> np.ndarray | None: ...
-def check_genomes(a: np.ndarray | None, size: int, name: str, rows: int | None = None) -> np.ndarray | None:
+def check_genomes(a: np.ndarray | None, size: int, name: str, rows: int | None = None, genes: bool = True) -> np.ndarray | None: ...
+def check_genomes(a: np.ndarray | None, size: int, name: str, rows: int | None = None, genes: bool = True) -> np.ndarray | None:
     """``a`` (a state's decoded array) unless it is not genomes of ``size`` genes (``rows`` of them, or one genome when
-    ``rows`` is 0): ValueError naming ``name``, so that a damaged checkpoint is refused on reading, not mid-run."""
+    ``rows`` is 0): ValueError naming ``name``, so that a damaged checkpoint is refused on reading, not mid-run. Genes
+    (``genes``; not an array of genome shape that holds other numbers, Adam's moments) are capped as a Policy's are
+    (:data:`~neurohover.policies.MAX_GENE`): a population gene of 1e300 was resumed and kept (T33-B06)."""
     if a is None:
         return None
     if rows == 0:
@@ -127,6 +130,11 @@ def check_genomes(a: np.ndarray | None, size: int, name: str, rows: int | None =
         where = f"gene {k}" if a.ndim == 1 else f"data entry {k} (genome {k // size}, gene {k % size})"
         more = f", and {bad.size - 1} more" if bad.size > 1 else ""
         raise NeurohoverError(f"{name} holds a gene that is not a finite number: {where} is {brief(float(a.flat[k]))}{more}; allowed finite numbers")
+    big = np.flatnonzero(np.abs(a) > MAX_GENE) if genes else ()
+    if len(big):
+        k = int(big[0])
+        where = f"gene {k}" if a.ndim == 1 else f"data entry {k} (genome {k // size}, gene {k % size})"
+        raise NeurohoverError(f"{name} holds a gene that is out of range: {where} is {brief(float(a.flat[k]))}; allowed numbers in [-{MAX_GENE:g}, {MAX_GENE:g}] (a policy's genes)")
     if rows and a.shape[0] != rows:  # a pop_size of 60 over 50 genomes was run on (sixteenth trial)
         raise NeurohoverError(f"{name} has {a.shape[0]} genomes where the state's settings make {rows}")
     return a

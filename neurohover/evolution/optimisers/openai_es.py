@@ -234,7 +234,7 @@ def _moments(value: Any, size: int) -> tuple[np.ndarray, np.ndarray]:
     TypeError at the first tell(); T19-03)."""
     if isinstance(value, (list, dict)) and len(value) != 2:  # other values fail at indexing
         raise EntryError("not Adam's two moments: allowed a list of the two arrays state_dict() wrote")
-    m, v = (check_genomes(required(dec_array(value[i], "Adam moment"), "Adam moment"), size, "Adam moment", rows=0) for i in (0, 1))
+    m, v = (check_genomes(required(dec_array(value[i], "Adam moment"), "Adam moment"), size, "Adam moment", rows=0, genes=False) for i in (0, 1))
     if np.any(v < 0.0):  # a running mean of squares: its square root is taken
         raise EntryError("Adam's second moment holds a negative number: allowed numbers >= 0")
     return m, v
