@@ -24,7 +24,7 @@ from .errors import NeurohoverError, as_floats, brief, finite_real, real_number,
 from .flightdata import FlightData, same_values
 from .flyer import KernelFlyer
 from .launch import DEVICES, KIND, MAX_SEED, Batch, Flown, check_device, launch, num_threads, use_lanes
-from .policies import GENOME_LENGTH, TOPOLOGIES, Policy, check_padding, load_policy
+from .policies import GENOME_LENGTH, TOPOLOGIES, Policy, check_padding, load_policy, refuse_own_act
 from .sim.constants import (
     EPISODE_STEPS,
     MAX_EPISODE_STEPS,
@@ -126,6 +126,7 @@ class PolicyTable:
         bad = [p for p in policies if not isinstance(p, Policy)]
         if bad:
             raise NeurohoverError(f"policy {bad[0]!r:.60} is not a Policy: load one with neurohover.load_policy (e.g. load_policy('baseline'))")
+        refuse_own_act(policies)  # a subclass's own act was ignored: the kernel flies the genome (T33-B11)
         kinds = np.array([KIND[p.topology] for p in policies], dtype=np.int64)
         genomes = np.zeros((len(policies), GENOME_WIDTH))
         for i, p in enumerate(policies):
@@ -491,8 +492,7 @@ def evaluate(
     _check_call_size(n_pol * n_mdp * episodes, n_steps, n_pol * n_mdp * episodes if record else 0)
     p_idx, m_idx, e = np.meshgrid(np.arange(n_pol), np.arange(n_mdp), np.arange(episodes), indexing="ij")
     episode_index = first_episode + m_idx * episodes + e
-    fallback = None
-    limits = None
+    fallback = limits = None
     if safeguard is not None:
         table = PolicyTable(
             np.append(table.kinds, KIND[safeguard.fallback.topology]), np.vstack([table.genomes, PolicyTable.from_policies([safeguard.fallback]).genomes])

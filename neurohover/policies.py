@@ -285,6 +285,18 @@ def policy_from_dict(d: dict, source: str = "policy") -> Policy:
         raise NeurohoverError(f"{source}: {err}") from None
 
 
+def refuse_own_act(policies: Sequence[Policy], what: str = "flown") -> None:
+    """Refuse a :class:`Policy` subclass with an ``act`` of its own where the policy is ``what`` (flown by the kernel, or
+    saved): the kernel flies the genome, and a file holds it, never a Python ``act``, so a subclass's own act was ignored
+    by evaluate, run_test and save_policy, without a word, while ``p.act`` gave other actions (T33-B11)."""
+    for p in policies:
+        if type(p).act is not Policy.act:
+            raise NeurohoverError(
+                f"policy of type {type(p).__name__!r} is not allowed: it has an act of its own, which is never {what} (the kernel flies "
+                "the genome); fly your own act with neurohover.integrations.flying.evaluate_callable, or give a plain Policy"
+            )
+
+
 def check_padding(kinds: np.ndarray, genomes: np.ndarray, kind_numbers: dict[str, int]) -> None:
     """Refuse a kernel table's row whose genes past its kind's genome (``kind_numbers``: topology to kind) are not zero,
     as :meth:`~neurohover.evaluate.PolicyTable.from_policies` pads them: an MLP row declared an SLP (kinds [0, 0]) flew
@@ -428,6 +440,7 @@ def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
     if not isinstance(policy, Policy):
         raise NeurohoverError(f"policy={policy!r:.60} is not allowed: give a Policy (load_policy('baseline') for the baseline's)")
     check_json_policy_name(path, "policy file")
+    refuse_own_act([policy], "saved")  # a file holds the genome: a subclass's own act was lost (T33-B11)
     check_genome(policy.genome, policy.topology)  # a genome made writable and given an inf blamed the metadata (T28-B03)
     data = policy_to_dict(policy)
     for given, what in ((policy.metadata, "policy metadata"), (metadata, "metadata")):

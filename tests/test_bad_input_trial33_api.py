@@ -153,3 +153,41 @@ def test_b13_flight_data_and_model_files_take_an_os_pathlike(flight: Path, tmp_p
     with pytest.raises(NeurohoverError, match=re.escape("flight-data file 'f.txt' is not allowed: flight data are a NumPy archive")):
         data.save(_PathLike("f.txt"))
     assert not Path("m.txt").exists() and not Path("f.txt").exists()
+
+
+class _Still(nh.Policy):
+    """A subclass whose own act gives no thrust: what a researcher writes to fly a controller of their own."""
+
+    def act(self, observation):
+        return (0.0, 0.0, 0.0, 0.0)
+
+
+class _Named(nh.Policy):
+    """A subclass that adds a method but keeps Policy's act: flown as its genome, as before."""
+
+    def name(self) -> str:
+        return "named"
+
+
+def test_b11_a_policy_subclass_with_its_own_act_is_refused_where_flown_or_saved(tmp_path: Path) -> None:
+    """T33-B11: a subclass's own act was ignored by evaluate, run_test and save_policy (the kernel flies the genome, a
+    file holds it): it flew as the baseline, without a word. Refused where the kernel would fly it or a file hold it;
+    evaluate_callable flies a Python act. A subclass that keeps Policy's act flies, and p.act itself is the user's."""
+    from neurohover.agents.model_free import ModelFreeAgent
+    from neurohover.agents.protocol import run_test
+
+    b = nh.baseline_policy()
+    family = nh.get_task_family("ghh08")
+    m = family.mdp("train:0")
+    still = _Still(b.topology, b.genome)
+    says = "policy of type '_Still' is not allowed: it has an act of its own, which is never flown (the kernel flies the genome); fly your own act with"
+    flown = (lambda: nh.evaluate(still, m, n_steps=5), lambda: nh.evaluate([b, still], m, n_steps=5))
+    for call in (*flown, lambda: run_test(ModelFreeAgent([still]), family, m, episodes=1, n_steps=5)):
+        with pytest.raises(NeurohoverError, match=re.escape(says)):
+            call()
+    with pytest.raises(NeurohoverError, match=re.escape("policy of type '_Still' is not allowed: it has an act of its own, which is never saved")):
+        nh.save_policy(still, tmp_path / "still.json")
+    assert not (tmp_path / "still.json").exists() and still.act([0.0] * 12) == (0.0, 0.0, 0.0, 0.0)
+    named = _Named(b.topology, b.genome)
+    assert nh.evaluate(named, m, n_steps=5).returns.tolist() == nh.evaluate(b, m, n_steps=5).returns.tolist()
+    assert nh.load_policy(nh.save_policy(named, tmp_path / "named.json")) == b
