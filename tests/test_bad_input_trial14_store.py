@@ -17,6 +17,7 @@ from neurohover.experiments.params import unit_params
 
 NAN = float("nan")
 UNIT = Unit("e", "k", "diagnostic", {"value": 1})
+OK = {"value": 1, "seed": None}  # a diagnostic unit's result as run_unit gives it
 H = tiny_config().hash  # what each store.begin below registers (T29-B07: a real config)
 SETTINGS = dict(task="ghh08", seed=1, policies="shipped", episodes=2, n_steps=20, groups=[dict(agent="baseline", mdps="test", n_mdps=1)])
 
@@ -25,7 +26,7 @@ def _stored(path: Path) -> Store:
     """A store holding experiment e (quick) with one finished unit."""
     store = Store(path)
     begin(store, "e")
-    assert store.put("e", "quick", H, UNIT, {"value": 1}, 0.5)
+    assert store.put("e", "quick", H, UNIT, {"value": 1, "seed": None}, 0.5)
     return store
 
 
@@ -35,7 +36,7 @@ def test_begin_refuses_a_fresh_flag_that_is_no_bool(tmp_path: Path, fresh) -> No
     with _stored(tmp_path / "s.sqlite") as store:
         with pytest.raises(NeurohoverError, match=r"fresh=.* is not allowed: give True \(delete the experiment's stored units first\) or False"):
             begin(store, "e", fresh=fresh)
-        assert store.results("e", "quick") == {"k": {"value": 1}}
+        assert store.results("e", "quick") == {"k": {"value": 1, "seed": None}}
 
 
 @pytest.mark.parametrize(("flag", "message"), [("fresh", "fresh='no' is not allowed: give True"), ("update", "update='no' is not allowed: give True")])
@@ -51,7 +52,7 @@ def test_reproduce_refuses_fresh_or_update_flags_that_are_no_bools(tmp_path: Pat
     with _stored(tmp_path / "s.sqlite") as store:
         with pytest.raises(NeurohoverError, match=message):
             reproduce(make_config("mc14", "test_runs", "quick", SETTINGS), store, Idle(), progress=False, **{flag: "no"})
-        assert [e[0] for e in store.experiments()] == ["e"] and store.results("e", "quick") == {"k": {"value": 1}}
+        assert [e[0] for e in store.experiments()] == ["e"] and store.results("e", "quick") == {"k": {"value": 1, "seed": None}}
 
 
 def test_store_refuses_a_create_flag_that_is_no_bool(tmp_path: Path) -> None:
@@ -77,13 +78,13 @@ def test_store_refuses_a_create_flag_that_is_no_bool(tmp_path: Path) -> None:
         (lambda s: s.update("e", "quick", "h2", {}, keep="k"), "update: keep = 'k' is not allowed"),
         (lambda s: s.put("e", "quick", H, None, {}, 1.0), "put: unit = None is not allowed: give the Unit that finished"),
         (
-            lambda s: s.put("e", "quick", H, Unit("e", "k2", "diagnostic", {}), {}, NAN),
+            lambda s: s.put("e", "quick", H, Unit("e", "k2", "diagnostic", {}), OK, NAN),
             "put: seconds = nan is not allowed: give a finite number of seconds >= 0",
         ),
-        (lambda s: s.put("e", "quick", H, Unit("e", "k2", "diagnostic", {}), {}, -1.0), "seconds = -1.0 is not allowed"),
+        (lambda s: s.put("e", "quick", H, Unit("e", "k2", "diagnostic", {}), OK, -1.0), "seconds = -1.0 is not allowed"),
         (lambda s: s.put("e", "quick", H, Unit("e", "k2", "diagnostic", {}), {"a": NAN}, 1.0), "put: unit k2's result = {'a': nan} is not allowed"),
         (lambda s: s.put("e", "quick", H, Unit("e", "k2", "diagnostic", {}), [1], 1.0), "put: unit k2's result = [1] is not allowed: give a dict"),
-        (lambda s: s.put("e", "quick", H, Unit("e", "k2", "diagnostic", {}), {}, 1.0, worker=None), "put: worker = None is not allowed: give text"),
+        (lambda s: s.put("e", "quick", H, Unit("e", "k2", "diagnostic", {}), OK, 1.0, worker=None), "put: worker = None is not allowed: give text"),
         (lambda s: s.start_session("e", "quick", H, "local", 0, 0), "start_session: cores = 0 is not allowed: give a whole number >= 1"),
         (lambda s: s.start_session("e", "quick", H, "local", "x", 0), "start_session: cores = 'x' is not allowed"),
         (lambda s: s.start_session("e", "quick", H, "local", 1, -1), "start_session: units_before = -1 is not allowed: give a whole number >= 0"),
@@ -109,7 +110,7 @@ def test_store_takes_a_compete_scale_and_the_units_it_always_took(tmp_path: Path
     with Store(tmp_path / "s.sqlite") as store:
         begin(store, "mc", "settings-0123456789")
         session = store.start_session("mc", "settings-0123456789", H, "local", 2, 0)
-        assert store.put("mc", "settings-0123456789", H, Unit("mc", "k", "diagnostic", {}), {"value": 1}, 0, session=session)
+        assert store.put("mc", "settings-0123456789", H, Unit("mc", "k", "diagnostic", {}), {"value": 1, "seed": None}, 0, session=session)
         store.end_session(session, "finished")
         assert store.sessions("mc", "settings-0123456789")[0]["units_run"] == 1
 

@@ -66,7 +66,7 @@ def test_b04_start_session_refuses_a_session_the_readers_call_damaged(store: Sto
 
 
 def test_b04_start_session_takes_the_units_the_experiment_stores(store: Store) -> None:
-    assert store.put("e1", "quick", H, _unit(), {"value": 1}, 0.1)
+    assert store.put("e1", "quick", H, _unit(), {"value": 1, "seed": None}, 0.1)
     session = store.start_session("e1", "quick", H, "local", 1, 1)
     assert [s["units_before"] for s in store.sessions("e1", "quick")] == [1] and session >= 1
 
@@ -78,28 +78,28 @@ def test_b05_put_refuses_another_experiments_session_and_an_ended_one(store: Sto
     other = store.start_session("e2", "quick", H, "local", 1, 0)
     _refused(
         store,
-        lambda s: s.put("e1", "quick", H, _unit(), {"value": 1}, 0.1, session=other),
+        lambda s: s.put("e1", "quick", H, _unit(), {"value": 1, "seed": None}, 0.1, session=other),
         f"put: session = {other} is not allowed: it is a session of experiment 'e2' ('quick') under config hash '{H}', not of e1 (quick)",
     )
     ended = store.start_session("e1", "quick", H, "local", 1, 0)
     store.end_session(ended, "finished")
     _refused(
         store,
-        lambda s: s.put("e1", "quick", H, _unit(), {"value": 1}, 0.1, session=ended),
+        lambda s: s.put("e1", "quick", H, _unit(), {"value": 1, "seed": None}, 0.1, session=ended),
         f"put: session = {ended} is not allowed: it has already ended ('finished'); start_session gives a running one",
     )
     _refused(
-        store, lambda s: s.put("e1", "quick", H, _unit(), {"value": 1}, 0.1, session=999), "put: session = 999 is not allowed: the store has no such session"
+        store, lambda s: s.put("e1", "quick", H, _unit(), {"value": 1, "seed": None}, 0.1, session=999), "put: session = 999 is not allowed: the store has no such session"
     )
     running = store.start_session("e1", "quick", H, "local", 1, 0)
-    assert store.put("e1", "quick", H, _unit(), {"value": 1}, 0.1, session=running)
+    assert store.put("e1", "quick", H, _unit(), {"value": 1, "seed": None}, 0.1, session=running)
     assert [s["units_run"] for s in store.sessions("e1", "quick")] == [0, 1] and store.sessions("e2", "quick")[0]["units_run"] == 0
 
 
 def test_b05_put_refuses_a_unit_of_another_experiment(store: Store) -> None:
     _refused(
         store,
-        lambda s: s.put("e1", "quick", H, _unit("zz", "k2"), {"value": 2}, 0.1),
+        lambda s: s.put("e1", "quick", H, _unit("zz", "k2"), {"value": 2, "seed": None}, 0.1),
         "put: unit 'k2''s experiment = 'zz' is not allowed: give a unit of e1 (its plan's)",
     )
     assert store.results("e1", "quick") == {}
@@ -119,7 +119,7 @@ def test_b06_every_write_of_a_second_store_is_refused_while_the_first_holds_the_
     session = store.start_session("e1", "quick", H, "local", 1, 0)  # store holds the lock (begin took it)
     with Store(store.path) as second:
         for call in (
-            lambda s: s.put("e1", "quick", H, _unit("e1", "k9"), {"value": 9}, 1.0),
+            lambda s: s.put("e1", "quick", H, _unit("e1", "k9"), {"value": 9, "seed": None}, 1.0),
             lambda s: s.start_session("e1", "quick", H, "local", 1, 0),
             lambda s: s.end_session(session, "finished"),
             lambda s: begin(s, "e1"),
@@ -128,7 +128,7 @@ def test_b06_every_write_of_a_second_store_is_refused_while_the_first_holds_the_
         ):
             _refused(second, call, f"results store {str(store.path)!r} is in use: another run (pid ")
         store.close()
-        assert second.put("e1", "quick", H, _unit("e1", "k9"), {"value": 9}, 1.0)  # the lock free: the write takes it
+        assert second.put("e1", "quick", H, _unit("e1", "k9"), {"value": 9, "seed": None}, 1.0)  # the lock free: the write takes it
         assert second.lock_path.exists()
 
 

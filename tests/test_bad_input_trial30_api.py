@@ -105,7 +105,7 @@ def test_put_refuses_a_unit_of_an_unknown_kind(tmp_path: Path) -> None:
         ):
             store.put("tr2", "quick", h, Unit("tr2", "k1", "banana", {}), {"r": 1}, 1.0)
         assert store.units("tr2", "quick") == []
-        assert store.put("tr2", "quick", h, Unit("tr2", "k1", "diagnostic", {}), {"value": 1}, 1.0)
+        assert store.put("tr2", "quick", h, Unit("tr2", "k1", "diagnostic", {}), {"value": 1, "seed": None}, 1.0)
 
 
 # ----------------------------------------------------------------------------------------------- T30-B04

@@ -112,14 +112,14 @@ def test_a_lone_surrogate_in_a_stored_text_field_is_refused_by_name(tmp_path: Pa
     store = Store(tmp_path / "sur.sqlite")
     h = store_edits.begin(store, "tr2")
     calls = {
-        "the unit's key": lambda: store.put("tr2", "quick", h, Unit("tr2", "x\ud800", "test_run", {}), {"r": 1}, 1.0),
-        "worker": lambda: store.put("tr2", "quick", h, Unit("tr2", "w1", "test_run", {}), {"r": 1}, 1.0, worker="w\ud800"),
+        "the unit's key": lambda: store.put("tr2", "quick", h, Unit("tr2", "x\ud800", "diagnostic", {}), {"value": 1, "seed": None}, 1.0),
+        "worker": lambda: store.put("tr2", "quick", h, Unit("tr2", "w1", "diagnostic", {}), {"value": 1, "seed": None}, 1.0, worker="w\ud800"),
         "executor": lambda: store.start_session("tr2", "quick", h, "loc\ud800", 1, 0),
     }
     for what, call in calls.items():
         with pytest.raises(NeurohoverError, match=rf"{what} = '\w+\\ud800' is not allowed: it holds '\\ud800', a lone surrogate"):
             call()
-    assert store.put("tr2", "quick", h, Unit("tr2", "w1", "test_run", {}), {"r": 1}, 1.0, worker="w")
+    assert store.put("tr2", "quick", h, Unit("tr2", "w1", "diagnostic", {}), {"value": 1, "seed": None}, 1.0, worker="w")
 
 
 def test_a_lone_surrogate_in_policy_and_flight_metadata_reads_back(tmp_path: Path) -> None:

@@ -124,10 +124,10 @@ from neurohover.errors import NeurohoverError
 from neurohover.experiments import Store, Unit
 with Store(sys.argv[1]) as store:
     h = SE.begin(store)
-    store.put("tr1", "quick", h, Unit("tr1", "k1", "test_run", {}), {"r": 1}, 1.0)
+    store.put("tr1", "quick", h, Unit("tr1", "k1", "diagnostic", {}), {"value": 1, "seed": None}, 1.0)
     resource.setrlimit(resource.RLIMIT_FSIZE, (os.path.getsize(sys.argv[1]), resource.RLIM_INFINITY))
     try:
-        store.put("tr1", "quick", h, Unit("tr1", "k2", "test_run", {}), {"r": "x" * 100000}, 1.0)
+        store.put("tr1", "quick", h, Unit("tr1", "k2", "diagnostic", {}), {"value": "x" * 100000, "seed": None}, 1.0)
     except NeurohoverError as err:
         print(err)
 """

@@ -50,17 +50,17 @@ def test_a_store_is_read_and_written_from_another_thread(tmp_path: Path) -> None
     with Store(tmp_path / "thr.sqlite") as store:
         h = SE.begin(store, "tr2")
         assert _in_thread(store.experiments) == [("tr2", "quick", h, 0)]
-        assert _in_thread(lambda: store.put("tr2", "quick", h, Unit("tr2", "k1", "test_run", {}), {"r": 1}, 1.0)) is True
-        assert store.results("tr2", "quick") == {"k1": {"r": 1}}
-        assert _in_thread(lambda: store.results("tr2", "quick")) == {"k1": {"r": 1}}
+        assert _in_thread(lambda: store.put("tr2", "quick", h, Unit("tr2", "k1", "diagnostic", {}), {"value": 1, "seed": None}, 1.0)) is True
+        assert store.results("tr2", "quick") == {"k1": {"value": 1, "seed": None}}
+        assert _in_thread(lambda: store.results("tr2", "quick")) == {"k1": {"value": 1, "seed": None}}
 
 
 def test_puts_from_several_threads_at_once_all_land(tmp_path: Path) -> None:
     """Threads writing one Store at once take turns (one transaction at a time on its connection)."""
     with Store(tmp_path / "thr.sqlite") as store:
         h = SE.begin(store, "tr2")
-        units = [Unit("tr2", f"k{i}", "test_run", {}) for i in range(8)]
-        threads = [threading.Thread(target=store.put, args=("tr2", "quick", h, u, {"r": 1}, 1.0)) for u in units]
+        units = [Unit("tr2", f"k{i}", "diagnostic", {}) for i in range(8)]
+        threads = [threading.Thread(target=store.put, args=("tr2", "quick", h, u, {"value": 1, "seed": None}, 1.0)) for u in units]
         for thread in threads:
             thread.start()
         for thread in threads:
@@ -87,7 +87,7 @@ def test_a_store_whose_file_is_gone_is_refused_naming_it(tmp_path: Path, how: st
         os.replace(tmp_path / "other", path)
     gone = f"results store {str(path)!r} is gone: its file was moved, removed or replaced since this Store opened it"
     with pytest.raises(NeurohoverError, match="^" + gone.replace("(", r"\(").replace(")", r"\)")):
-        store.put("tr2", "quick", h, Unit("tr2", "k", "test_run", {}), {"r": 1}, 1.0)
+        store.put("tr2", "quick", h, Unit("tr2", "k", "diagnostic", {}), {"value": 1, "seed": None}, 1.0)
     with pytest.raises(NeurohoverError, match="is gone: its file was moved"):
         store.experiments()
     store.close()

@@ -493,7 +493,7 @@ def test_a_ctrl_c_just_after_a_unit_commits_stays_a_ctrl_c_and_keeps_the_unit(tm
         conn = store.conn
         store.conn = _CommitThenInterrupt(conn)  # type: ignore[assignment]
         with pytest.raises(KeyboardInterrupt):  # not sqlite's "cannot rollback - no transaction is active"
-            store.put("exp", "quick", h, Unit("exp", "u0", "diagnostic", {"value": 1}), {"value": 1}, 0.1)
+            store.put("exp", "quick", h, Unit("exp", "u0", "diagnostic", {"value": 1}), {"value": 1, "seed": None}, 0.1)
         store.conn = conn
         assert list(store.results("exp", "quick")) == ["u0"]  # committed: kept
 

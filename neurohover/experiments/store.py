@@ -47,9 +47,9 @@ from .store_checks import (
     GuardedConnection,
     StoreWriteError,
     bad_session,
+    check_executor,
     check_experiment,
     check_text,
-    check_unit_kind,
     config_problem,
     experiment_problem,
     object_text,
@@ -57,9 +57,9 @@ from .store_checks import (
     session_problem,
     sqlite_says,
     stored_count,
+    unit_texts,
 )
 from .store_checks import transaction as _transaction
-from .units import Unit
 
 SCHEMA_VERSION = 1
 
@@ -266,6 +266,9 @@ class Store:
                 f"this version reads schema version {SCHEMA_VERSION}. Use a new --store file "
                 f"(or the neurohover version that wrote it); results of different schemas are never mixed"
             )
+        made = c.execute("SELECT type, name FROM sqlite_master WHERE type IN ('trigger', 'view') OR (type = 'index' AND sql IS NOT NULL)").fetchone()
+        if made is not None:  # a trigger that dropped each unit written made compete fail with "results holds none" (T33-B14)
+            raise NeurohoverError(f"results store {str(self.path)!r} holds a {made[0]} {made[1]!r} neurohover did not make; give another --store file")
         for table, columns in _columns().items():  # a dropped column was found only after reproduce had written (T19-04)
             have = {r[1] for r in c.execute(f"PRAGMA table_info({table})")}
             lacking = [col for col in columns if col not in have]
@@ -497,18 +500,10 @@ class Store:
         where = self._where("put")
         check_experiment(name, scale, where)
         check_text(config_hash, "config_hash", where)
-        if not isinstance(unit, Unit):
-            raise NeurohoverError(f"{where}: unit = {brief(unit)} is not allowed: give the Unit that finished (a plan's)")
-        check_text(unit.key, "the unit's key", where)
-        check_text(unit.kind, "the unit's kind", where)
-        check_unit_kind(unit.key, unit.kind, where)
-        params = object_text(unit.params, f"unit {unit.key}'s params", where)
-        text = object_text(result, f"unit {unit.key}'s result", where)
+        params, text = unit_texts(unit, result, name, where)
         if not (finite_real(seconds) and seconds >= 0):
             raise NeurohoverError(f"{where}: seconds = {brief(seconds)} is not allowed: give a finite number of seconds >= 0")
         check_text(worker, "worker", where, empty=True)
-        if unit.experiment != name:  # stored under another experiment's name without a word (T29-B05)
-            raise NeurohoverError(f"{where}: unit {brief(unit.key)}'s experiment = {brief(unit.experiment)} is not allowed: give a unit of {name} (its plan's)")
         if session is not None:
             session = stored_count(session, "session", where, 1)
         self.lock()
@@ -527,6 +522,11 @@ class Store:
                 "INSERT OR IGNORE INTO units VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                 (name, scale, unit.key, unit.kind, config_hash, params, text, float(seconds), worker, time.time()),
             )
+            if c.execute("SELECT 1 FROM units WHERE name = ? AND scale = ? AND key = ?", (name, scale, unit.key)).fetchone() is None:
+                raise NeurohoverError(  # a trigger or an index of someone else's dropped it, and the unit was lost (T33-B14)
+                    f"results store {str(self.path)!r} did not keep unit {unit.key!r} of {name} ({scale}): its write was dropped "
+                    "(a trigger or index neurohover did not make?); give another --store file"
+                )
             if session is not None and cur.rowcount:
                 c.execute("UPDATE sessions SET units_run = units_run + 1, wall_seconds = ? - started WHERE id = ?", (time.time(), session))
         return bool(cur.rowcount)
@@ -540,7 +540,7 @@ class Store:
         where = self._where("start_session")
         check_experiment(name, scale, where)
         check_text(config_hash, "config_hash", where)
-        check_text(executor, "executor", where)
+        check_executor(executor, where)
         cores = stored_count(cores, "cores", where, 1)
         units_before = stored_count(units_before, "units_before", where, 0)
         self.lock()

@@ -14,7 +14,9 @@ from typing import Any
 from ..errors import NeurohoverError, brief, finite_real, refuse_non_text_keys, whole_number
 from ..paths import json_text
 from .config import ExperimentConfig, check_name, check_scale
-from .results import result_type
+from .result_checks import params_problem
+from .results import result_from_dict, result_type
+from .units import Unit
 
 #: How a session can end (:meth:`Store.end_session`; the runner's statuses). A session is "running" until then.
 SESSION_STATUSES = ("finished", "selection finished", "interrupted", "failed")
@@ -211,11 +213,48 @@ def check_text(value: Any, what: str, where: str, empty: bool = False) -> None:
         ) from None
 
 
+#: The largest whole number an SQLite INTEGER holds (10**30 cores was Python's OverflowError; T33-B18).
+SQLITE_INT_MAX = 2**63 - 1
+
+
 def stored_count(value: Any, what: str, where: str, least: int) -> int:
-    """``value`` as an int of at least ``least``, or one error naming it (cores=0 was stored, and read back as damaged)."""
-    if not whole_number(value) or value < least:
-        raise NeurohoverError(f"{where}: {what} = {brief(value)} is not allowed: give a whole number >= {least}")
+    """``value`` as an int from ``least`` to :data:`SQLITE_INT_MAX`, or one error naming it (cores=0 was stored, and read
+    back as damaged)."""
+    if not whole_number(value) or not least <= value <= SQLITE_INT_MAX:
+        raise NeurohoverError(f"{where}: {what} = {brief(value)} is not allowed: give a whole number >= {least} (at most 2**63 - 1, SQLite's largest)")
     return int(value)
+
+
+def check_executor(executor: Any, where: str) -> None:
+    """Refuse an executor no session may hold (:data:`EXECUTORS`): 'LOCAL' was stored, and :meth:`Store.sessions` then
+    called the session damaged (T33-B17)."""
+    check_text(executor, "executor", where)
+    if executor not in EXECUTORS:
+        raise NeurohoverError(f"{where}: executor = {brief(executor)} is not allowed: give one of {', '.join(map(repr, EXECUTORS))}")
+
+
+def unit_texts(unit: Any, result: Any, name: str, where: str) -> tuple[str, str]:
+    """A finished unit's params and result as the store writes them (JSON text), or one error naming what its readers
+    would call damaged: no Unit, a key, kind or params that cannot be stored, a unit of another experiment (T29-B05), a
+    result that is no result of its kind, or that contradicts its unit's params (:func:`~.export.checked_units`' checks of
+    one unit: a test run's result {'x': 1} was stored, and every later results and report refused the experiment;
+    T33-B17). Whether the stored config plans the unit is the readers' check of the whole experiment."""
+    if not isinstance(unit, Unit):
+        raise NeurohoverError(f"{where}: unit = {brief(unit)} is not allowed: give the Unit that finished (a plan's)")
+    check_text(unit.key, "the unit's key", where)
+    check_text(unit.kind, "the unit's kind", where)
+    check_unit_kind(unit.key, unit.kind, where)
+    params = object_text(unit.params, f"unit {unit.key}'s params", where)
+    text = object_text(result, f"unit {unit.key}'s result", where)
+    if unit.experiment != name:  # stored under another experiment's name without a word (T29-B05)
+        raise NeurohoverError(f"{where}: unit {brief(unit.key)}'s experiment = {brief(unit.experiment)} is not allowed: give a unit of {name} (its plan's)")
+    try:
+        problem = params_problem(result_from_dict(unit.kind, result, unit.key), unit.params)
+    except NeurohoverError as err:
+        problem = str(err)
+    if problem:
+        raise NeurohoverError(f"{where}: {problem}: give the result run_unit returned for the unit")
+    return params, text
 
 
 def object_text(value: Any, what: str, where: str) -> str:
