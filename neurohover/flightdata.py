@@ -264,6 +264,8 @@ class FlightData:
                 f"flight-data file {str(path)!r}: its metadata {bad if len(bad) <= 60 else brief(bad)}={brief(metadata[bad])} is not allowed: "
                 "give strict JSON values, numbers finite (NaN and Infinity are no JSON: FlightData.save refuses them)"
             )
+        if _too_deep(metadata):
+            raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata {_too_deep(metadata)}")
         data = cls(tuple(obs_split), tuple(act_split), metadata)
         for i, crashed in enumerate(crash_flags(data)):  # a NaN was named by plot, not by learn-model, and neither named the file (T22-02)
             check_flown(data.observations[i], data.actions[i], crashed, f"flight-data file {str(path)!r}, episode {i}")
@@ -341,7 +343,21 @@ def _metadata_text(metadata: object, where: str) -> str:
         bad = next((k for k, v in metadata.items() if not _json_ok({k: v})), None)  # the entry to name, where one alone fails
         shown = f", not {bad if len(bad) <= 60 else brief(bad)}={brief(metadata[bad])}" if isinstance(bad, str) else ""
         raise NeurohoverError(f"{where} metadata cannot be saved as JSON: give strict JSON values (numbers finite){shown} ({err})") from None
+    deep = _too_deep(metadata)
+    if deep:
+        raise NeurohoverError(f"{where} metadata {deep}")
     return text
+
+
+def _too_deep(metadata: dict) -> str:
+    """Which metadata value nests more lists or tables than :data:`~neurohover.paths.MAX_NOTE_DEPTH`, in words ('' when
+    none does): a note 600 deep loaded, and the flight data could then not be deep-copied or pickled (T33-B03)."""
+    from .paths import MAX_NOTE_DEPTH, nesting_depth
+
+    bad = next((k for k, v in metadata.items() if nesting_depth(v) > MAX_NOTE_DEPTH), None)
+    if bad is None:
+        return ""
+    return f"{bad if len(bad) <= 60 else brief(bad)}={brief(metadata[bad])} is not allowed: it is nested more than {MAX_NOTE_DEPTH} lists or tables deep"
 
 
 def _plain(value: object) -> object:

@@ -247,6 +247,25 @@ def json_text(value, **dumps) -> str:
     return text
 
 
+#: How deep a free-form value read from a file (a policy's or flight data's metadata note) may nest lists and tables:
+#: Python's JSON reader follows about 990 levels, and what it read 600 deep could not be deep-copied or pickled, a
+#: RecursionError (T33-B03).
+MAX_NOTE_DEPTH = 100
+
+
+def nesting_depth(value) -> int:
+    """How many lists (or tuples) and dicts ``value`` nests, at its deepest (0 for a number or text), counted without
+    recursion, and no further than one past :data:`MAX_NOTE_DEPTH`."""
+    depth, level = 0, [value]
+    while depth <= MAX_NOTE_DEPTH:
+        inner = [v for v in level if isinstance(v, (list, tuple, dict))]
+        if not inner:
+            break
+        depth += 1
+        level = [item for v in inner for item in (v.values() if isinstance(v, dict) else v)]
+    return depth
+
+
 def parse_json(text: str, name: str):
     """The JSON ``text`` of the file ``name``, strictly (:func:`strict_json`): a key given twice, nesting deeper than
     Python can follow and numbers past a float's range are refused by name (third trial)."""

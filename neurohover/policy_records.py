@@ -66,7 +66,7 @@ def policy_record_problem(meta: dict) -> str:
 def _not_json_problem(meta: dict) -> str:
     """A metadata value that is no strict JSON (a NaN or an Infinity at any depth), named by its key: Python's JSON
     reader takes those literals, so a policy file's note of NaN loaded, and save_policy then refused the policy (T32-B17)."""
-    from .paths import json_text
+    from .paths import MAX_NOTE_DEPTH, json_text, nesting_depth
 
     for key, value in meta.items():
         try:
@@ -77,23 +77,6 @@ def _not_json_problem(meta: dict) -> str:
             return f"its {key} {brief(value)} is not allowed: it is nested more than {MAX_NOTE_DEPTH} lists or tables deep"
     return ""
 
-
-#: How deep a policy's metadata value (a free-form note) may nest lists and tables: one 600 deep loaded (Python's JSON
-#: reader follows about 990), and the Policy then could not be deep-copied or pickled, a RecursionError (T33-B03).
-MAX_NOTE_DEPTH = 100
-
-
-def nesting_depth(value: Any) -> int:
-    """How many lists (or tuples) and dicts ``value`` nests, at its deepest (0 for a number or text), counted without
-    recursion, and no further than one past :data:`MAX_NOTE_DEPTH`."""
-    depth, level = 0, [value]
-    while depth <= MAX_NOTE_DEPTH:
-        inner = [v for v in level if isinstance(v, (list, tuple, dict))]
-        if not inner:
-            break
-        depth += 1
-        level = [item for v in inner for item in (v.values() if isinstance(v, dict) else v)]
-    return depth
 
 
 def _run_words_problem(meta: dict, own_stop: dict, stop_reasons: tuple, parse_resampling, best_fitness: float) -> str:
