@@ -5,6 +5,7 @@ fewer episodes than evaluations) are refused on resume by name, as a damaged che
 from __future__ import annotations
 
 import json
+import math
 import re
 from pathlib import Path
 
@@ -15,6 +16,7 @@ from neurohover.errors import NeurohoverError
 from neurohover.evolution.evolve import evolve
 from neurohover.flyer import KernelFlyer
 from neurohover.policies import prototype
+from neurohover.sim.constants import CRASH_STEP_PENALTY
 from neurohover.tasks import get_task_family
 
 ZERO = get_task_family("ghh08").zero()
@@ -95,7 +97,10 @@ def test_a_history_row_no_run_can_have_is_refused(tiny_checkpoint: Path, tmp_pat
 
 
 def test_counters_at_their_bounds_resume(tiny_checkpoint: Path, tmp_path: Path) -> None:
-    """Counters every run can have are taken: one step an episode (each crashed on its first), as many episodes as
-    evaluations, the kernel's time all of the wall time."""
-    for counters in ({"steps": 50}, {"steps": 50 * 20}, {"wall_seconds": 2.0, "kernel_seconds": 2.0}):
+    """Counters every run can have are taken: the fewest steps its population's returns allow (each episode that flew s
+    steps charged the worst step for its 20 - s left, T33-B07; one step an episode if each crashed on its first), as many
+    episodes as evaluations, the kernel's time all of the wall time."""
+    fitness = json.loads(tiny_checkpoint.read_text())["optimizer_state"]["fitness"]["data"]
+    fewest = math.ceil(sum(20 + f / CRASH_STEP_PENALTY for f in fitness))
+    for counters in ({"steps": fewest}, {"steps": 50 * 20}, {"wall_seconds": 2.0, "kernel_seconds": 2.0}):
         _resume(tiny_checkpoint, tmp_path, lambda s, c=counters: s["counters"].update(c))

@@ -137,3 +137,41 @@ def test_a_checkpoint_population_gene_past_a_policys_cap_is_refused(tiny_checkpo
     state["optimizer_state"]["population"]["data"][1] = 1e120  # at the cap: taken
     ckpt.write_text(json.dumps(state))
     assert evolve(ZERO, budget=55, checkpoint=ckpt, resume=True, **MDP_RUN).episodes == 55
+
+
+def _edited(tiny_checkpoint, tmp_path, edit):
+    state = json.loads(tiny_checkpoint.read_text())
+    edit(state)
+    ckpt = tmp_path / "run.ckpt.json"
+    ckpt.write_text(json.dumps(state))
+    return ckpt
+
+
+def test_a_checkpoints_resampling_edited_against_its_counters_is_refused(tiny_checkpoint, tmp_path) -> None:
+    """T33-B05: resampling fixed:1 edited to fixed:2 (and resumed with it) beside 50 episodes of 50 evaluations was
+    resumed, a run half fixed:1; the command line refused it only after the whole run, naming the policy file."""
+    ckpt = _edited(tiny_checkpoint, tmp_path, lambda s: s["config"].update(resampling="fixed:2"))
+    fragment = "counter 'episodes' is 50, not allowed beside its 50 evaluations under the config's resampling fixed:2: each evaluation flies 2 episodes, 100 in all"
+    with pytest.raises(NeurohoverError, match=re.escape(fragment)):
+        evolve(ZERO, budget=200, resampling="fixed:2", checkpoint=ckpt, resume=True, **MDP_RUN)
+
+
+def test_a_checkpoints_resampling_edited_is_refused_before_the_command_line_flies(tiny_checkpoint, tmp_path, cli) -> None:
+    """T33-B05 on the command line: refused at once, naming the checkpoint, nothing flown or written."""
+    state = json.loads(tiny_checkpoint.read_text())
+    state["config"]["resampling"] = "fixed:2"
+    (tmp_path / "run.json.checkpoint.json").write_text(json.dumps(state))
+    out = tmp_path / "run.json"
+    run = ("evolve", "--task", "ghh08", "--mdp", "zero", "--topology", "slp", "--seed-policy", "baseline", "--seed", "3", "--episode-steps", "20")
+    rc, _, err = cli(*run, "--resampling", "fixed:2", "--budget", "200", "--out", str(out), "--resume")
+    assert rc == 2 and not out.exists() and "Traceback" not in err, err
+    text = " ".join(err.split())
+    assert "run.json.checkpoint.json' is a damaged checkpoint: counter 'episodes' is 50" in text and "policy file" not in text
+
+
+def test_a_checkpoints_n_steps_edited_against_its_steps_is_refused(tiny_checkpoint, tmp_path) -> None:
+    """T33-B07: n_steps 20 edited to 6000 (and resumed with it) was taken, though its episodes flew a few hundred steps in
+    all and their returns say few of them crashed (a crash is charged the worst step for each step left)."""
+    ckpt = _edited(tiny_checkpoint, tmp_path, lambda s: s["config"].update(n_steps=6000))
+    with pytest.raises(NeurohoverError, match=r"counter 'steps' is [\d,]+, fewer than the [\d,]+ that the population's returns in optimizer_state.fitness need"):
+        evolve(ZERO, budget=60, checkpoint=ckpt, resume=True, **{**MDP_RUN, "n_steps": 6000})

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..flyer import MAX_EPISODE_INDEX
+from ..sim.constants import CRASH_STEP_PENALTY
 from .common import EntryError, Optimiser, check_entries, check_genomes, damage_text, dec_array, dec_float, enc_float
 from .config import MAX_BUDGET, Resampling
 from .fitness import fitness_range, in_fitness_range
@@ -149,6 +150,7 @@ def _restored_parts(state: dict, run: Run, opt: Optimiser) -> dict[str, Any]:
         raise EntryError(f"counter 'kernel_seconds' is {kernel!r}, more than the run's wall_seconds {wall!r} (its kernel time is part of them)")
     _check_tracker_kept(opt)
     _check_generation(opt, counts)
+    _check_counts_of_run(counts, run.resampling, opt, run.cfg.n_steps)
     champion = _checked_champion(state["champion"], run.cfg.prototype.genome.size, run.fitness, run.cfg.n_steps)
     own = run.method in OPTIMISERS and run.family is not None
     _check_run_champion(champion, own, counts["generation"], run.method, opt)
@@ -246,6 +248,33 @@ def _checked_race_delta(delta: Any, resampling: Resampling) -> float | None:
         allowed = "null (fixed resampling races no candidates)" if resampling.delta is None else f"{resampling.delta!r}, the delta of {resampling}"
         raise EntryError(f"race_delta is {brief(delta)}: allowed {allowed}")
     return float(delta)
+
+
+def _check_counts_of_run(counts: dict[str, int], resampling: Resampling, opt: Optimiser, n_steps: int) -> None:
+    """EntryError unless the counters fit the run's resampling and episode length (its config, which the resumed call
+    matches, edited with it): under fixed:K each evaluation flies K episodes (T33-B05: fixed:2 beside 50 episodes of 50
+    evaluations was resumed, a run half fixed:1; the command line refused it only after the whole run, naming the policy
+    file), and a steady state's population fitness (raw returns, each a mean of K episodes of its own) needs steps: an
+    episode that flew s of n_steps steps crashed and was charged the worst step for each step left, so its return is at
+    most -CRASH_STEP_PENALTY * (n_steps - s) (T33-B07: n_steps 20 edited to 6000 was resumed, 50 episodes of 434 steps
+    in all whose returns said they crashed none but one). Not detectable without flying again: an edited seed."""
+    episodes, evaluations = counts["episodes"], counts["evaluations"]
+    if resampling.kind == "fixed" and episodes != resampling.k * evaluations:
+        k = resampling.k
+        raise EntryError(
+            f"counter 'episodes' is {episodes:,}, not allowed beside its {evaluations:,} evaluations under the config's resampling {resampling}: "
+            f"each evaluation flies {k} episode{'s' if k != 1 else ''}, {k * evaluations:,} in all"
+        )
+    if isinstance(opt, SteadyStateNE) and opt._fitness is not None and resampling.kind == "fixed":
+        f = opt._fitness[np.isfinite(opt._fitness)]  # (NaN: an episode that blew up; -inf: one whose fitness is NaN)
+        f = np.minimum(f, 0.0) * (1 + 1e-9)  # the rounding of a mean, toward fewer steps
+        least = float(np.sum(resampling.k * (n_steps + f / CRASH_STEP_PENALTY)))
+        if counts["steps"] < math.floor(least + 1e-6):
+            raise EntryError(
+                f"counter 'steps' is {counts['steps']:,}, fewer than the {math.floor(least + 1e-6):,} that the population's returns in "
+                f"optimizer_state.fitness need in episodes of the config's n_steps {n_steps:,} (an episode that flew s steps crashed, "
+                f"charged {CRASH_STEP_PENALTY:.6g} for each of its n_steps - s steps left); allowed the counters and config the run wrote"
+            )
 
 
 def _checked_counts(c: dict, n_steps: int) -> dict[str, int]:
