@@ -151,7 +151,9 @@ def test_a_checkpoints_resampling_edited_against_its_counters_is_refused(tiny_ch
     """T33-B05: resampling fixed:1 edited to fixed:2 (and resumed with it) beside 50 episodes of 50 evaluations was
     resumed, a run half fixed:1; the command line refused it only after the whole run, naming the policy file."""
     ckpt = _edited(tiny_checkpoint, tmp_path, lambda s: s["config"].update(resampling="fixed:2"))
-    fragment = "counter 'episodes' is 50, not allowed beside its 50 evaluations under the config's resampling fixed:2: each evaluation flies 2 episodes, 100 in all"
+    fragment = (
+        "counter 'episodes' is 50, not allowed beside its 50 evaluations under the config's resampling fixed:2: each evaluation flies 2 episodes, 100 in all"
+    )
     with pytest.raises(NeurohoverError, match=re.escape(fragment)):
         evolve(ZERO, budget=200, resampling="fixed:2", checkpoint=ckpt, resume=True, **MDP_RUN)
 
@@ -173,5 +175,6 @@ def test_a_checkpoints_n_steps_edited_against_its_steps_is_refused(tiny_checkpoi
     """T33-B07: n_steps 20 edited to 6000 (and resumed with it) was taken, though its episodes flew a few hundred steps in
     all and their returns say few of them crashed (a crash is charged the worst step for each step left)."""
     ckpt = _edited(tiny_checkpoint, tmp_path, lambda s: s["config"].update(n_steps=6000))
-    with pytest.raises(NeurohoverError, match=r"counter 'steps' is [\d,]+, fewer than the [\d,]+ that the population's returns in optimizer_state.fitness need"):
+    fragment = r"counter 'steps' is [\d,]+, fewer than the [\d,]+ that the population's returns in optimizer_state.fitness need"
+    with pytest.raises(NeurohoverError, match=fragment):
         evolve(ZERO, budget=60, checkpoint=ckpt, resume=True, **{**MDP_RUN, "n_steps": 6000})

@@ -12,7 +12,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, whole_in
+from ..errors import NeurohoverError, whole_in
 from ..evaluate import evaluate
 from ..flightdata import FlightData
 from ..models.lr import DEFAULT_NOISE_ESTIMATE, lr_determined

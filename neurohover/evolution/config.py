@@ -263,9 +263,7 @@ def make_settings(method: str, optimizer: str, settings) -> Any:
     unknown = unknown_keys(settings, fields | ({"preset"} if presets else set()))
     if unknown:
         budget = "; the run's budget is its own option (--budget, evolve(budget=...)), counted in episodes" if "budget" in settings else ""
-        raise NeurohoverError(
-            f"unknown {method} setting(s) {unknown}: allowed {', '.join(sorted(fields | ({'preset'} if presets else set())))}{budget}"
-        )
+        raise NeurohoverError(f"unknown {method} setting(s) {unknown}: allowed {', '.join(sorted(fields | ({'preset'} if presets else set())))}{budget}")
     values = dict(settings)
     if "preset" in values:
         name = values.pop("preset")

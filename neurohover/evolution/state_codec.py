@@ -130,11 +130,14 @@ def check_genomes(a: np.ndarray | None, size: int, name: str, rows: int | None =
         where = f"gene {k}" if a.ndim == 1 else f"data entry {k} (genome {k // size}, gene {k % size})"
         more = f", and {bad.size - 1} more" if bad.size > 1 else ""
         raise NeurohoverError(f"{name} holds a gene that is not a finite number: {where} is {brief(float(a.flat[k]))}{more}; allowed finite numbers")
-    big = np.flatnonzero(np.abs(a) > MAX_GENE) if genes else ()
-    if len(big):
+    big = np.flatnonzero(np.abs(a) > MAX_GENE) if genes else np.flatnonzero(np.zeros(0))
+    if big.size:
         k = int(big[0])
         where = f"gene {k}" if a.ndim == 1 else f"data entry {k} (genome {k // size}, gene {k % size})"
-        raise NeurohoverError(f"{name} holds a gene that is out of range: {where} is {brief(float(a.flat[k]))}; allowed numbers in [-{MAX_GENE:g}, {MAX_GENE:g}] (a policy's genes)")
+        raise NeurohoverError(
+            f"{name} holds a gene that is out of range: {where} is {brief(float(a.flat[k]))}; "
+            f"allowed numbers in [-{MAX_GENE:g}, {MAX_GENE:g}] (a policy's genes)"
+        )
     if rows and a.shape[0] != rows:  # a pop_size of 60 over 50 genomes was run on (sixteenth trial)
         raise NeurohoverError(f"{name} has {a.shape[0]} genomes where the state's settings make {rows}")
     return a
