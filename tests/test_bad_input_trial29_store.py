@@ -89,7 +89,9 @@ def test_b05_put_refuses_another_experiments_session_and_an_ended_one(store: Sto
         f"put: session = {ended} is not allowed: it has already ended ('finished'); start_session gives a running one",
     )
     _refused(
-        store, lambda s: s.put("e1", "quick", H, _unit(), {"value": 1, "seed": None}, 0.1, session=999), "put: session = 999 is not allowed: the store has no such session"
+        store,
+        lambda s: s.put("e1", "quick", H, _unit(), {"value": 1, "seed": None}, 0.1, session=999),
+        "put: session = 999 is not allowed: the store has no such session",
     )
     running = store.start_session("e1", "quick", H, "local", 1, 0)
     assert store.put("e1", "quick", H, _unit(), {"value": 1, "seed": None}, 0.1, session=running)
