@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+import io
 from pathlib import Path
 
 import numpy as np
@@ -43,17 +45,19 @@ def test_the_authors_agent_settings_are_checked() -> None:
 
 
 @pytest.fixture(scope="module")
-def sources(tmp_path_factory) -> tuple[Path, dict]:
-    """A store holding quick Figures 13 and 15 (their champions are Figure 16's generics)."""
+def sources(tmp_path_factory) -> tuple[Path, dict, str]:
+    """A store holding quick Figures 13 and 15 (their champions are Figure 16's generics), run as the command line runs
+    them: ``reproduce fig16`` on an empty store, its sources first; and what it said on standard error."""
     path = tmp_path_factory.mktemp("fig16") / "store.sqlite"
-    for name in ("fig13", "fig15"):
-        assert main(["reproduce", name, "--store", str(path), "--no-progress"]) == 0
+    said = io.StringIO()
+    with contextlib.redirect_stderr(said):
+        assert main(["reproduce", "fig16", "--store", str(path), "--no-progress"]) == 0
     with Store(path) as store:
-        return path, {name: store.results(name, "quick") for name in ("fig13", "fig15")}
+        return path, {name: store.results(name, "quick") for name in ("fig13", "fig15")}, said.getvalue()
 
 
 def test_each_run_draws_its_generic_from_the_sources_champions(sources) -> None:
-    _, results = sources
+    _, results, _ = sources
     cfg = load_config("fig16", "quick")
     units = [u for u in plan(cfg, {}, results).units if u.kind == "test_run"]
     fig15 = load_config("fig15", "quick").settings
@@ -76,16 +80,18 @@ def test_each_run_draws_its_generic_from_the_sources_champions(sources) -> None:
     assert [u.params for u in plan(cfg, {}, results).units] == [u.params for u in plan(cfg, {}, results).units]
 
 
-def test_without_its_sources_figure_16_waits_and_says_for_what(sources, tmp_path: Path, capsys) -> None:
+def test_without_its_sources_figure_16_waits_and_says_for_what(sources) -> None:
     cfg = load_config("fig16", "quick")
     p = plan(cfg, {}, {})
     assert not any(u.params.get("agent", "").endswith(("-race", "-fixed")) for u in p.units)
     assert any("fig15" in w and "not in the store yet" for w in p.waiting)
-    # On the command line the sources run first, into the same store.
-    store = tmp_path / "s.sqlite"
-    assert main(["reproduce", "fig16", "--store", str(store), "--no-progress"]) == 0
-    err = capsys.readouterr().err
+    # On the command line the sources run first, into the same store (the fixture's run, on an empty store).
+    path, results, err = sources
     assert "running fig13 first" in err and "running fig15 first" in err
+    with Store(path) as store:  # and then Figure 16, its runs on the sources' generics too
+        stored = store.results("fig16", "quick")
+    assert {u.key for u in plan(cfg, {}, results).units} <= set(stored)
+    assert {k.split("/")[1].rsplit("-", 1)[-1] for k in stored if k.startswith("run/")} >= {"race", "fixed"}
 
 
 def test_a_bad_generics_source_is_refused() -> None:
@@ -100,7 +106,7 @@ def test_the_report_shows_fghh_runs_on_their_fitness_scale_beside_the_authors_ge
 
     from neurohover.experiments import write_report
 
-    path, results = sources
+    path, results, _ = sources
     out = tmp_path / "report"
     out.mkdir()
     flights = {"returns": [[-150.0, -1e7], [-1000.0, -200.0]], "crashed": [[False, True], [False, False]]}
