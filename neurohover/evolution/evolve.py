@@ -213,10 +213,9 @@ def evolve(
     resampling : str, optional
         ``"fixed:K"`` (default ``fixed:1``) or ``"race:DELTA"`` (generational NE on a family only).
     budget : int, optional
-        Episodes to fly (checked between generations). Default: the paper's termination
-        (steady state: plateau; generational: ``generations``; CMA-ES: pycma's criteria; OpenAI-ES
-        has none, so it needs a budget). A settings object's own ``budget`` serves when this is None;
-        both given and different is refused.
+        Episodes to fly (checked between generations). Default: a settings object's ``budget`` (both
+        given and different is refused), else the paper's termination (steady state: plateau;
+        generational: ``generations``; CMA-ES: pycma's criteria; OpenAI-ES has none: give a budget).
     settings : SteadyStateSettings, GenerationalSettings, dict or str, optional
         Overrides of the optimiser settings (paper Tables 6/7): a settings object, a dict of
         fields, or for the generational method a preset's name (``"table7"``, the default;
