@@ -78,7 +78,6 @@ def _not_json_problem(meta: dict) -> str:
     return ""
 
 
-
 def _run_words_problem(meta: dict, own_stop: dict, stop_reasons: tuple, parse_resampling, best_fitness: float) -> str:
     """:func:`policy_record_problem`'s checks of a record's target, resampling, champion_return and stop_reason against its
     method, budget and episodes ('' when they agree)."""

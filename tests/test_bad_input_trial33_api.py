@@ -72,7 +72,6 @@ def test_b03_a_policy_note_nested_deep_is_refused_at_load_and_save(tmp_path: Pat
             nh.save_policy(b, tmp_path / "out.json", note=json.loads(note))
 
 
-
 def test_b03_a_flight_data_note_nested_deep_is_refused_at_load_and_save(flight: Path, tmp_path: Path) -> None:
     """T33-B03, the same in flight data: a metadata note 600 deep loaded, and the FlightData could not be deep-copied."""
     deep = "note=[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[... is not allowed: it is nested more than 100 lists or tables deep"
@@ -87,6 +86,7 @@ def test_b03_a_flight_data_note_nested_deep_is_refused_at_load_and_save(flight: 
         nh.FlightData(data.observations, data.actions, {**data.metadata, "note": json.loads("[" * 101 + "]" * 101)})
     kept = nh.FlightData(data.observations, data.actions, {**data.metadata, "note": json.loads("[" * 100 + "]" * 100)})
     assert copy.deepcopy(kept) == kept and nh.FlightData.load(kept.save(tmp_path / "kept.npz")) == kept
+
 
 @pytest.mark.parametrize(
     ("args", "message"),
