@@ -17,6 +17,7 @@ import errno
 import json
 import os
 import re
+import stat
 import sys
 import tempfile
 import threading
@@ -395,8 +396,11 @@ def refuse_special_file(path: str | os.PathLike, option: str, given: str | os.Pa
     """Refuse an existing ``path`` that is neither a regular file nor a directory: written by replacing it, a device node
     (/dev/full, as root) or a FIFO became a PNG (fourteenth trial); read, a FIFO hung the command for ever (T28-A08).
     ``given``: the path as the user gave it (default ``path``); ``instead``: what to do."""
-    p = Path(path)
-    if p.exists() and not p.is_file() and not p.is_dir():
+    try:  # one stat, not exists() then is_file(): a file another thread's check made and removed between them was "a device"
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):
+        return
+    if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
         raise NeurohoverError(f"{option} {str(path if given is None else given)!r} is not a regular file (a device, pipe or socket); {instead}")
 
 

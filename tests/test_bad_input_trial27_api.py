@@ -17,9 +17,10 @@ from neurohover.sim.constants import CRASH_STEP_PENALTY, WORST_RETURN
 
 def test_a_nan_genome_in_a_policy_table_flies_as_a_crash() -> None:
     """T27-B08 is no bug: PolicyTable and from_genomes document that a non-finite genome is flown and crashes at once
-    (an optimiser's diverged sample is scored, not a stopped run), where a Policy (a file's) refuses it."""
+    (an optimiser's diverged sample is scored, not a stopped run), where a Policy (a file's) refuses it. A table's
+    padding past an SLP's 40 genes stays zero (T33-B10: anything else is an MLP row declared an SLP)."""
     mdp = nh.get_task_family("ghh08").mdp("train:0")
-    for table in (nh.PolicyTable.from_genomes(np.full((1, 40), np.nan), "slp"), nh.PolicyTable(np.array([0]), np.full((1, 42), np.nan))):
+    for table in (nh.PolicyTable.from_genomes(np.full((1, 40), np.nan), "slp"), nh.PolicyTable(np.array([0]), np.pad(np.full((1, 40), np.nan), ((0, 0), (0, 2))))):
         ev = nh.evaluate(table, mdp, n_steps=20)
         assert ev.returns.ravel().tolist() == pytest.approx([-CRASH_STEP_PENALTY * 19])  # a crash at step 1 of 20
         assert ev.crashed.ravel().tolist() == [True] and ev.steps.ravel().tolist() == [1]
