@@ -184,11 +184,18 @@ def experiment_names() -> list[str]:
     return list(shipped_configs())
 
 
+def _is_file(path: Path) -> bool:
+    try:
+        return path.is_file()
+    except (OSError, ValueError):  # a name too long to be a file's is no file
+        return False
+
+
 def resolve_name(name: str | Path) -> Path:
     """The config file of a shipped experiment name (or alias), or of a path to a .toml file."""
     name = str(name)  # a pathlib.Path of a .toml file too
     path = Path(name)
-    if name.endswith(".toml"):
+    if name.lower().endswith(".toml"):  # base.TOML too, as .JSON and .NPZ are read (T33-A01)
         from ..paths import checked_path
 
         checked_path(name, "config file")  # a name too long was an OSError (fourth trial)
@@ -199,6 +206,8 @@ def resolve_name(name: str | Path) -> Path:
         return path
     shipped = shipped_configs()
     name = _aliases().get(name, name)
+    if name not in shipped and (len(path.parts) > 1 or _is_file(path)):  # a path, taken for a name (T33-A02)
+        raise NeurohoverError(f"config file {name!r} is not allowed: a config file's name ends .toml; give a path ending .toml, or an experiment name")
     if name not in shipped:
         raise NeurohoverError(f"unknown experiment {name!r}: known experiments are {', '.join(shipped)} (or 'all', or a path to a .toml config file)")
     return shipped[name]
