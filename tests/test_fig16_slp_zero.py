@@ -80,3 +80,14 @@ def test_generics_drawn_from_a_directory_of_policy_files(tmp_path: Path) -> None
     assert cfg.hash != other.hash  # the files' genomes are part of the config
     with pytest.raises(NeurohoverError, match="no directory of policy files"):
         make_config("x", "test_runs", "quick", {**settings, "generics_from": {"race": f"dir:{tmp_path / 'none'}"}, "groups": cfg.settings["groups"]})
+
+
+def test_a_directorys_policy_files_are_drawn_whatever_the_case_of_their_suffix(tmp_path: Path) -> None:
+    """A file of the folder named .JSON or .Net was left out of the draw without a word, as load_policy reads it."""
+    folder = _generics(tmp_path / "race")
+    (folder / "policy_01.json").rename(folder / "policy_01.JSON")
+    (folder / "policy_02.json").rename(folder / "policy_02.Json")
+    settings = {"task": "fghh", "sigma": 0.3, "seed": 3, "episodes": 2, "generics_from": {"race": f"dir:{folder}"}}
+    cfg = make_config("x", "test_runs", "quick", {**settings, "groups": [{"agent": "authors-race", "n_mdps": 8}]})
+    drawn = {u.params["policies"]["generic_source"].rsplit("/", 1)[-1] for u in plan(cfg, {}).units if u.kind == "test_run"}
+    assert drawn == {"policy_00.json", "policy_01.JSON", "policy_02.Json"}

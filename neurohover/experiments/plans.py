@@ -122,7 +122,7 @@ def _dir_champions(source: str) -> list[tuple[str, dict]]:
 
     refuse_unencodable(source[len(DIR_SOURCE) :], "generics_from dir:")  # as policies = (T31-A05)
     folder = Path(source[len(DIR_SOURCE) :]).expanduser()
-    files = sorted(f for f in folder.iterdir() if f.suffix in (".net", ".json")) if folder.is_dir() else []
+    files = sorted(f for f in folder.iterdir() if f.suffix.lower() in (".net", ".json")) if folder.is_dir() else []
     if not files:
         raise NeurohoverError(f"generics_from {source!r}: no directory of policy files (.net or .json) there; give dir:PATH of one")
     return [(f"{source}/{f.name}", policy_dict(load_policy(f))) for f in files]
