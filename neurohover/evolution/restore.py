@@ -265,8 +265,9 @@ def _check_counts_of_run(counts: dict[str, int], resampling: Resampling, opt: Op
             f"counter 'episodes' is {episodes:,}, not allowed beside its {evaluations:,} evaluations under the config's resampling {resampling}: "
             f"each evaluation flies {k} episode{'s' if k != 1 else ''}, {k * evaluations:,} in all"
         )
-    if isinstance(opt, SteadyStateNE) and opt._fitness is not None and resampling.kind == "fixed":
-        f = opt._fitness[np.isfinite(opt._fitness)]  # (NaN: an episode that blew up; -inf: one whose fitness is NaN)
+    fitness = opt.fitness if isinstance(opt, SteadyStateNE) else None
+    if fitness is not None and resampling.kind == "fixed":
+        f = fitness[np.isfinite(fitness)]  # (NaN: an episode that blew up; -inf: one whose fitness is NaN)
         f = np.minimum(f, 0.0) * (1 + 1e-9)  # the rounding of a mean, toward fewer steps
         least = float(np.sum(resampling.k * (n_steps + f / CRASH_STEP_PENALTY)))
         if counts["steps"] < math.floor(least + 1e-6):
