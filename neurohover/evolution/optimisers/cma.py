@@ -96,7 +96,8 @@ _PICKLED = frozenset(
 
 
 class _Randn:
-    """pycma's ``randn`` option drawing from the CMAES wrapper's private generator (rebuilt on load)."""
+    """pycma's ``randn`` option drawing from the CMAES wrapper's private generator (rebuilt on load). It holds the
+    generator itself, so a pickle or deepcopy of the optimiser draws from the copy's own generator."""
 
     def __init__(self, holder: list) -> None:
         self.holder = holder
@@ -198,10 +199,10 @@ class CMAES(PopulationOptimiser):
         if budget is not None:  # True was taken as a budget of 1 (fifteenth trial)
             require_int("budget", budget, 1)
         self._rng = np.random.default_rng(check_seed(seed))
-        rng = self._rng
         opts: dict = {
             "seed": float("nan"),
-            "randn": lambda *shape: rng.standard_normal(shape),
+            # an object, not a closure: a lambda made pickle.dumps fail and copy.deepcopy share the generator (T34-B01, B04)
+            "randn": _Randn([self._rng]),
             "verbose": -9,
             "verb_disp": 0,
             "verb_log": 0,
