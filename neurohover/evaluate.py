@@ -24,7 +24,7 @@ from .errors import NeurohoverError, as_floats, brief, finite_real, real_number,
 from .flightdata import FlightData, same_values
 from .flyer import KernelFlyer
 from .launch import DEVICES, KIND, MAX_SEED, Batch, Flown, check_device, launch, num_threads, use_lanes
-from .policies import GENOME_LENGTH, TOPOLOGIES, Policy, check_padding, load_policy, refuse_own_act
+from .policies import GENOME_LENGTH, Policy, check_padding, genome_rows, load_policy, refuse_own_act
 from .sim.constants import (
     EPISODE_STEPS,
     MAX_EPISODE_STEPS,
@@ -141,16 +141,7 @@ class PolicyTable:
         crashes at once, as the simulator defines, instead of stopping the run (a policy file, meant to be flown as
         it is, is refused instead).
         """
-        if not isinstance(topology, str) or topology not in TOPOLOGIES:  # an array was NumPy's "truth value is ambiguous" (T16-12)
-            raise NeurohoverError(f"unknown policy topology {brief(topology)}: allowed {', '.join(TOPOLOGIES)}")
-        raw = np.asarray(genomes)
-        # text was NumPy's ValueError, complex numbers lost their imaginary part (fifth trial), a mask was dropped (T16-9)
-        if raw.dtype.kind not in "iuf" or isinstance(genomes, np.ma.MaskedArray):
-            what = "a masked array" if isinstance(genomes, np.ma.MaskedArray) else raw.dtype
-            raise NeurohoverError(f"{topology} genomes of {what} are not allowed: give an array of real numbers (P, {GENOME_LENGTH[topology]})")
-        g, n = raw.astype(float), GENOME_LENGTH[topology]
-        if g.ndim != 2 or g.shape[1] != n or g.shape[0] == 0:
-            raise NeurohoverError(f"{topology} genomes must be an array of shape (P >= 1, {n}), got {g.shape}")
+        g, n = genome_rows(genomes, topology), GENOME_LENGTH[topology]  # the checks: a ragged list was NumPy's ValueError (T34-B02)
         table = np.zeros((g.shape[0], GENOME_WIDTH))
         table[:, :n] = g
         return cls(np.full(g.shape[0], KIND[topology], dtype=np.int64), table)
@@ -333,6 +324,8 @@ def _fallback_array(fallback_index, n_jobs: int, n_policies: int) -> np.ndarray:
     masked = isinstance(fallback_index, np.ma.MaskedArray)  # np.asarray dropped the mask (T16-9)
     if (fb.dtype.kind not in "iu" and fb.size) or masked:  # ["x"] was NumPy's ValueError (fifth trial); 1.5 was cut to 1
         raise NeurohoverError(f"fallback_index={fallback_index!r:.60} is not allowed: give {n_jobs} integers in -1..{n_policies - 1}")
+    if fb.ndim > 1:  # flattened, as the job indexes are not (T34-B11)
+        raise NeurohoverError(f"fallback_index must be a 1-D array of job indices, got shape {fb.shape}: give one per job, each in -1..{n_policies - 1}")
     if fb.size != n_jobs:  # T26-B17: the length and the bad entry were not named
         raise NeurohoverError(f"fallback_index has {fb.size} entries but there are {n_jobs} jobs: give one per job, each in -1..{n_policies - 1}")
     bad = np.flatnonzero((fb < -1) | (fb >= n_policies))

@@ -315,6 +315,26 @@ def check_padding(kinds: np.ndarray, genomes: np.ndarray, kind_numbers: dict[str
         )
 
 
+def genome_rows(genomes: object, topology: str) -> np.ndarray:
+    """``genomes`` as a float64 array (P >= 1, the topology's genome length), for
+    :meth:`~neurohover.evaluate.PolicyTable.from_genomes`, or a clear error. Non-finite genes are taken (that table flies
+    an optimiser's diverged sample, which crashes at once)."""
+    _check_topology(topology)  # an array was NumPy's "truth value is ambiguous" (T16-12)
+    n = GENOME_LENGTH[topology]
+    try:
+        raw = np.asarray(genomes)
+    except (TypeError, ValueError, OverflowError):  # rows of unequal length were NumPy's "inhomogeneous shape" (T34-B02)
+        raise NeurohoverError(f"{topology} genomes={brief(genomes)} are not allowed: give an array of real numbers (P, {n}), rows of equal length") from None
+    # text was NumPy's ValueError, complex numbers lost their imaginary part (fifth trial), a mask was dropped (T16-9)
+    if raw.dtype.kind not in "iuf" or isinstance(genomes, np.ma.MaskedArray):
+        what = "a masked array" if isinstance(genomes, np.ma.MaskedArray) else raw.dtype
+        raise NeurohoverError(f"{topology} genomes of {what} are not allowed: give an array of real numbers (P, {n})")
+    g = raw.astype(float)
+    if g.ndim != 2 or g.shape[1] != n or g.shape[0] == 0:
+        raise NeurohoverError(f"{topology} genomes must be an array of shape (P >= 1, {n}), got {g.shape}")
+    return g
+
+
 def load_policy(source: str | Path) -> Policy:
     """Load a policy file (JSON, or the authors' ``.net`` format: :mod:`neurohover.netfile`), or
     the baseline policy for the name ``baseline``."""
