@@ -138,7 +138,8 @@ class ContinualAgent(Agent):
 
     def choose(self, episode: int) -> Choice:
         fallback = self.generic if self.settings.safeguard and self.policy is not self.generic else None
-        return Choice(self.policy, self.label, fallback=fallback, dangerous=self._dangerous, record=True)
+        dangerous = self._dangerous if fallback is not None else DangerousState()  # a rule without a fallback is refused (T34-B07)
+        return Choice(self.policy, self.label, fallback=fallback, dangerous=dangerous, record=True)
 
     def _candidate(self, ret: float) -> tuple:
         """The flying policy with its return, label, model and the model's own error (a phase's best so far)."""

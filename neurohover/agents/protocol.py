@@ -55,11 +55,12 @@ class Choice:
     fallback : Policy or None
         Safeguard fallback: on a dangerous state it flies the rest of the episode.
     dangerous : DangerousState
-        What counts as a dangerous state (default: the authors' test, docs/model.md, Safeguard).
+        What counts as a dangerous state (default: the authors' test, docs/model.md, Safeguard);
+        another than the default needs a ``fallback``.
     record : bool
-        Whether the agent wants this episode's flight data.
+        Whether the agent wants this episode's flight data (not with ``final``).
     final : bool
-        The agent keeps this choice for the rest of the run.
+        The agent keeps this choice for the rest of the run (flown in one batch, without ``update``).
     repeat : bool
         The agent keeps this choice until an episode in which the safeguard fires or the
         helicopter crashes. The harness then flies several episodes per kernel call and reports
@@ -92,6 +93,16 @@ class Choice:
         if self.final and self.repeat:
             raise NeurohoverError(
                 "Choice final=True with repeat=True is not allowed: final keeps the choice for the rest of the run, repeat until an event; give one"
+            )
+        if self.final and self.record:  # T34-B06: a final choice is flown in one batch, without update: the recording was never delivered
+            raise NeurohoverError(
+                "Choice final=True with record=True is not allowed: a final choice flies the rest of the run in one batch "
+                "and update never sees its flight data; record an episode before choosing final"
+            )
+        if self.fallback is None and self.dangerous != DangerousState():  # T34-B07, the agent-level twin of T28-B16
+            raise NeurohoverError(
+                f"Choice dangerous={brief(self.dangerous)} is not allowed without a fallback: the safeguard hands control to the "
+                "fallback, so alone the rule acts on nothing; give fallback= too, or leave dangerous out"
             )
 
 
