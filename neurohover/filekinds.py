@@ -19,6 +19,7 @@ from .errors import NeurohoverError, brief
 
 __all__ = [
     "CSV_KINDS",
+    "FLIGHT_DATA_KIND",
     "JSON_KINDS",
     "NAME_MAX",
     "PNG_KIND",
@@ -70,6 +71,7 @@ CSV_KINDS: dict[str, frozenset[str]] = {
     "an evolution history (.history.csv)": frozenset({"generation", "evaluations", "episodes", "champion_return"}),
     "a results export (results --format csv)": frozenset({"experiment", "scale", "key", "kind"}),
 }
+FLIGHT_DATA_KIND = "flight data (a NumPy archive)"  # what held_kind calls an .npz: FlightData.save writes over no other kind (T34-B03)
 POLICY_SET_KIND = "a policy set's manifest"  # what held_kind calls a set's manifest.json: no other writer adds files beside it
 _KIND_READ_LIMIT = 64 * 2**20  # a larger file is no neurohover JSON file told apart here
 
@@ -95,7 +97,7 @@ def held_kind(path: str | os.PathLike) -> str | None:
     if body.startswith(REPORT_HEADER.encode()):
         return REPORT_KIND
     if body.startswith(b"PK\x03\x04"):  # a zip: a NumPy archive (.npz) holds its arrays as NAME.npy
-        return "flight data (a NumPy archive)" if b"format.npy" in body else None
+        return FLIGHT_DATA_KIND if b"format.npy" in body else None
     if not body.lstrip()[:1] == b"{":
         header = {c.decode("latin-1") for c in body.split(b"\n", 1)[0].rstrip(b"\r").split(b",")}
         return next((kind for kind, cells in CSV_KINDS.items() if cells <= header), None)

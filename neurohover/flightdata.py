@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real, refuse_non_text_keys
-from .filekinds import refuse_suffix
+from .filekinds import FLIGHT_DATA_KIND, refuse_suffix
 from .flightmeta import check_meaning, check_policy_actions, flown_policy
 from .paths import json_text, strict_json
 from .sim.constants import ACTION_NAMES, EPISODE_STEPS, MAX_EPISODE_STEPS, OBS_NAMES
@@ -179,7 +179,8 @@ class FlightData:
         text = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None  # an os.PathLike's text, not its repr (T33-B13)
         if isinstance(text, str) and text not in ("", "-") and not text.endswith("/") and not os.path.exists(text):
             check_npz_name(text)  # before output_file makes its directory; '', '-', 'dir/' and what exists it names as such
-        path = output_file(path, "flight-data file")  # refuses '', a directory and a device (/dev/null was a struct.error)
+        # refuses '', a directory and a device (/dev/null was a struct.error), and another kind of neurohover file, through a link too (T34-B03)
+        path = output_file(path, "flight-data file", kind=FLIGHT_DATA_KIND)
         check_npz_name(path)
         lengths = np.array([a.shape[0] for a in self.actions], dtype=np.int64)
         check_metadata(

@@ -6,6 +6,9 @@ got N") and T34-B16 (saving float32 flight data printed NumPy's overflow Runtime
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -31,3 +34,56 @@ def test_b11_evaluate_jobs_refuses_a_2d_fallback_index() -> None:
         nh.evaluate_jobs(policies, mdps, [0, 1], [0, 1], [0, 1], fallback_index=np.array([[1, -1]]), n_steps=20)
     ev = nh.evaluate_jobs(policies, mdps, [0, 1], [0, 1], [0, 1], fallback_index=np.array([1, -1]), n_steps=20)
     assert ev.returns.shape == (2,)
+
+
+@pytest.fixture(scope="module")
+def flight(tmp_path_factory) -> Path:
+    """A recording as ``neurohover fly --record`` writes it (ghh08 train:1, one episode)."""
+    from neurohover.cli import main
+
+    path = tmp_path_factory.mktemp("flight") / "f.npz"
+    argv = ["fly", "--task", "ghh08", "--mdp", "train:1", "--episodes", "1", "--threads", "1", "--json", "--record", str(path)]
+    assert main(argv) == 0
+    return path
+
+
+def _other_kinds(folder: Path) -> dict[str, str]:
+    """A policy file, a model-like file, a checkpoint and a history of neurohover's, each as its first bytes (name -> kind)."""
+    folder.mkdir(exist_ok=True)
+    nh.save_policy(nh.baseline_policy(), folder / "pol.json")
+    (folder / "mod.json").write_text(json.dumps({"format": "neurohover-model/1"}) + "\n")
+    (folder / "ck.json").write_text(json.dumps({"format": "neurohover-evolution-checkpoint/1"}) + "\n")
+    (folder / "h.csv").write_text("generation,evaluations,episodes,champion_return\n0,1,1,-5.0\n")
+    return {"pol.json": "a policy file", "mod.json": "a model file", "ck.json": "an evolution checkpoint", "h.csv": "an evolution history"}
+
+
+def test_b03_flight_data_save_writes_over_no_other_kind_of_file(flight: Path, tmp_path: Path) -> None:
+    """T34-B03: FlightData.save replaced a policy file, a model file, a checkpoint or a history reached by a symbolic link
+    named .npz, or simply named .npz, as save_policy, LearnedModel.save and evolve(checkpoint=) refuse to."""
+    fd = nh.FlightData.load(flight)
+    for name, kind in _other_kinds(tmp_path / "k").items():
+        target = tmp_path / "k" / name
+        before = target.read_bytes()
+        link = tmp_path / f"link_{name}.npz"
+        link.symlink_to(target)
+        renamed = tmp_path / f"{name}.npz"
+        renamed.write_bytes(before)
+        for path in (link, renamed):
+            with pytest.raises(NeurohoverError, match=rf"^flight-data file .* is {kind}.*: give another path \(writing flight data"):
+                fd.save(path)
+        assert target.read_bytes() == before and renamed.read_bytes() == before
+    again = tmp_path / "again.npz"  # flight data over flight data, through a link too: written as before
+    again.write_bytes(flight.read_bytes())
+    (tmp_path / "again_link.npz").symlink_to(again)
+    assert fd.save(tmp_path / "again_link.npz") == tmp_path / "again_link.npz"
+    assert nh.FlightData.load(again).n_transitions == fd.n_transitions
+
+
+def test_b03_fly_record_through_a_link_to_a_checkpoint_is_refused_before_flying(cli, tmp_path: Path) -> None:
+    """T34-B03: ``fly --record link.npz`` (a link to an evolution checkpoint) turned the checkpoint into a zip archive."""
+    _other_kinds(tmp_path)
+    before = (tmp_path / "ck.json").read_bytes()
+    (tmp_path / "link.npz").symlink_to(tmp_path / "ck.json")
+    code, out, err = cli("fly", "--task", "ghh08", "--mdp", "train:1", "--episodes", "1", "--record", str(tmp_path / "link.npz"))
+    assert code != 0 and "is an evolution checkpoint: give another path (writing flight data" in err, err
+    assert (tmp_path / "ck.json").read_bytes() == before

@@ -62,6 +62,7 @@ def _fly(policy, mdps: list, args: argparse.Namespace, show_progress: bool):
 
 def cmd_fly(args: argparse.Namespace) -> int:
     """Fly a policy and print return statistics."""
+    from ..filekinds import FLIGHT_DATA_KIND
     from ..flightdata import check_npz_name
     from ..paths import output_file, printable
     from ..policies import load_policy
@@ -83,7 +84,7 @@ def cmd_fly(args: argparse.Namespace) -> int:
     if args.record is not None:
         if Path(args.record).suffix:  # another suffix is refused before output_file makes its directory
             check_npz_name(args.record, "--record")
-        output_file(args.record, "--record", {"--policy": args.policy})
+        output_file(args.record, "--record", {"--policy": args.policy}, kind=FLIGHT_DATA_KIND)  # a checkpoint through a link (T34-B03)
         check_npz_name(args.record, "--record")  # no suffix: after output_file's own refusals ('-', a directory, a device)
     returns, crashed, seconds, fd, n_unique = _fly(policy, mdps, args, show_progress=not args.json)
     if fd is not None:
