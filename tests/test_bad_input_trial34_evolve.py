@@ -5,6 +5,7 @@ T34-B09 (NEAT records with a cycle or self-loop), T34-B12 (NeatSettings with Num
 from __future__ import annotations
 
 import copy
+import os
 import pickle
 
 import numpy as np
@@ -62,3 +63,38 @@ def test_cma_state_dict_still_round_trips():
     assert b._es.opts["randn"].holder[0] is b._rng
     for x, y in zip(_rounds(a), _rounds(b), strict=True):
         assert np.array_equal(x, y)
+
+
+def _tiny_evolve(**kw):
+    from neurohover.evolution import evolve
+
+    mdp = nh.get_task_family("ghh08").mdp("train:0")
+    return evolve(mdp, **{"topology": "slp", "budget": 20, "n_steps": 20, "seed": 1, **kw})
+
+
+def test_a_checkpoint_another_run_writes_is_refused(tmp_path):
+    """T34-B08: two runs on one checkpoint both ran and overwrote each other's; the second is now refused by the writer
+    lock the CLI's --out takes (here held by this process, as another run would hold it), a resume too."""
+    from neurohover.locks import sole_writer
+
+    ck = tmp_path / "ck.json"
+    with sole_writer(ck, "checkpoint"):
+        for resume in (False, True):
+            with pytest.raises(nh.NeurohoverError, match=r"checkpoint '.*ck\.json' is being written by another run \(pid \d+"):
+                _tiny_evolve(checkpoint=ck, resume=resume)
+    assert not ck.exists()
+    _tiny_evolve(checkpoint=ck)  # released: taken, and the lock file removed after
+    _tiny_evolve(checkpoint=ck, resume=True, budget=200)
+    assert ck.is_file() and sorted(p.name for p in tmp_path.iterdir()) == ["ck.json"]
+
+
+def test_a_relative_checkpoint_is_resolved_when_the_run_starts(tmp_path, monkeypatch):
+    """T34-B10: after an os.chdir in the run, a relative checkpoint was written under the new folder."""
+    (tmp_path / "elsewhere").mkdir()
+    monkeypatch.chdir(tmp_path)
+
+    def progress(info) -> None:
+        os.chdir(tmp_path / "elsewhere")
+
+    _tiny_evolve(checkpoint="run/ck.json", progress=progress, progress_every_s=0, checkpoint_every_s=1e-6)
+    assert (tmp_path / "run" / "ck.json").is_file() and not (tmp_path / "elsewhere" / "run").exists()

@@ -73,6 +73,7 @@ Example
 
 from __future__ import annotations
 
+import contextlib
 import math
 from collections.abc import Callable
 from pathlib import Path
@@ -82,7 +83,7 @@ import numpy as np
 
 from ..errors import NeurohoverError, brief, check_flag, real_number, whole_in
 from ..evaluate import MAX_EPISODES_PER_CALL, evaluate_jobs, num_threads
-from ..paths import output_file
+from ..paths import output_file, sole_writer
 from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP
@@ -149,9 +150,9 @@ def _intervals(checkpoint, checkpoint_every_s, progress, progress_every_s) -> tu
     return float(checkpoint_every_s), float(progress_every_s)
 
 
-def _prepare(run: Run, checkpoint, progress, resume: bool, threads: int | None, device: str, trace: list | None) -> Path | None:
-    """Check the checkpoint and progress options, restore the run from its checkpoint on ``resume``, and load (or compile) the
-    kernel before the run's clock starts (which also validates the thread count); the checkpoint's path."""
+def _checkpoint_path(checkpoint, progress, resume: bool) -> Path | None:
+    """Check the checkpoint and progress options; the checkpoint's path, made absolute once, as the run starts: a
+    relative one was resolved at every write, and after an os.chdir the checkpoint went to another folder (T34-B10)."""
     if progress is not None and not callable(progress):  # progress=3 was "'int' object is not callable" mid-run (second trial)
         raise NeurohoverError(f"progress={progress!r:.60} is not allowed: give a callable taking a ProgressInfo, or None")
     check_flag(resume, "resume", "continue from the checkpoint")  # resume="no" resumed (its truth), fifteenth trial
@@ -159,9 +160,16 @@ def _prepare(run: Run, checkpoint, progress, resume: bool, threads: int | None, 
         path = None if checkpoint is None else Path(checkpoint)
     else:  # checked before the run; a JSON name, no file of another kind (a model file was replaced; T28-B07)
         path = output_file(checkpoint, "checkpoint", kind=CHECKPOINT_KIND, suffixes=(".json",), what="a checkpoint is JSON")
+    if resume and path is None:
+        raise NeurohoverError("resume=True needs the checkpoint path")
+    return None if path is None else path.absolute()
+
+
+def _prepare(run: Run, path: Path | None, resume: bool, threads: int | None, device: str, trace: list | None) -> None:
+    """Restore the run from its checkpoint ``path`` on ``resume``, and load (or compile) the kernel before the run's clock
+    starts (which also validates the thread count)."""
     if resume:
-        if path is None:
-            raise NeurohoverError("resume=True needs the checkpoint path")
+        assert path is not None  # _checkpoint_path refused resume without one
         run.restore(read_checkpoint(path), f"checkpoint {str(path)!r}")
         run.stop_reason = None
     run.flyer.trace = trace
@@ -171,7 +179,6 @@ def _prepare(run: Run, checkpoint, progress, resume: bool, threads: int | None, 
         assert run.family is not None  # a run has one MDP (its rows) or a family
         warm_up = run.family.zero()
     evaluate_jobs([run.cfg.prototype], warm_up, [0], [0], [0], n_steps=1, threads=threads, device=device)
-    return path
 
 
 def evolve(
@@ -238,7 +245,9 @@ def evolve(
         seconds and at the end; may raise ``KeyboardInterrupt`` to stop the run (the checkpoint is
         written first).
     checkpoint : path, optional
-        Checkpoint file, written every ``checkpoint_every_s`` seconds, at the end and on interrupt.
+        Checkpoint file, written every ``checkpoint_every_s`` seconds, at the end and on interrupt. A relative path
+        is taken from the folder current when the run starts; while it runs, another run on the same checkpoint is
+        refused (a writer lock, ``.NAME.lock`` beside it, as the CLI's ``--out``).
     checkpoint_every_s : float, optional
         Seconds between checkpoints (> 0); None: 60. Only with ``checkpoint``.
     resume : bool
@@ -267,10 +276,14 @@ def evolve(
     )  # fmt: skip
     every_checkpoint, every_progress = _intervals(checkpoint, checkpoint_every_s, progress, progress_every_s)
     run = Run(cfg, device=device)
-    path = _prepare(run, checkpoint, progress, resume, threads, device, _trace)
-    with num_threads(threads if threads is not None else numba.get_num_threads()):  # restores the count after
-        run.flyer.start()
-        run.run(progress, path, every_checkpoint, every_progress)
+    path = _checkpoint_path(checkpoint, progress, resume)
+    with contextlib.ExitStack() as held:
+        if path is not None:  # one run on a checkpoint at a time, as the CLI's --out: two both ran and overwrote it (T34-B08)
+            held.enter_context(sole_writer(path, "checkpoint"))
+        _prepare(run, path, resume, threads, device, _trace)
+        with num_threads(threads if threads is not None else numba.get_num_threads()):  # restores the count after
+            run.flyer.start()
+            run.run(progress, path, every_checkpoint, every_progress)
     if _flown is not None:
         _flown["steps"] = run.flyer.flown_steps
     return run.result()
