@@ -87,3 +87,14 @@ def test_b03_fly_record_through_a_link_to_a_checkpoint_is_refused_before_flying(
     code, out, err = cli("fly", "--task", "ghh08", "--mdp", "train:1", "--episodes", "1", "--record", str(tmp_path / "link.npz"))
     assert code != 0 and "is an evolution checkpoint: give another path (writing flight data" in err, err
     assert (tmp_path / "ck.json").read_bytes() == before
+
+
+@pytest.mark.parametrize(("family", "kwargs"), [("ghh08", {}), ("fghh", {"sigma": 0.5}), ("ghh09", {})])
+def test_b15_make_of_a_2d_array_names_its_shape(family: str, kwargs: dict) -> None:
+    """T34-B15: ``make(np.array([[0.5, 1.0]]))`` said "must be 2 numbers, got 2"; the flat parameters still make an MDP."""
+    fam = nh.get_task_family(family, **kwargs)
+    params = fam.sample_params(np.random.default_rng(0), 1)[0]
+    n = params.size
+    with pytest.raises(NeurohoverError, match=rf"must be a flat sequence of {n} numbers, got shape \(1, {n}\): "):
+        fam.make(params[None, :])
+    assert fam.make(params).family == fam.make(list(params)).family

@@ -242,6 +242,8 @@ def finite_vector(values: Sequence[float] | np.ndarray, length: int, what: str) 
         arr = as_floats(values, what, "")  # its message is replaced by this function's own
     except NeurohoverError:  # objects such as 10**400, dates, ragged lists; a masked array
         raise NeurohoverError(f"{what} must be {length} finite numbers, got {brief(values)}{masked_note(values)}") from None
+    if arr.ndim > 1:  # a (1, 2) array was "must be 2 numbers, got 2" (T34-B15)
+        raise NeurohoverError(f"{what} must be a flat sequence of {length} numbers, got shape {arr.shape}: {brief(values)}")
     if arr.shape != (length,):
         raise NeurohoverError(f"{what} must be {length} numbers, got {arr.size}: {brief(values)}")
     if not np.all(np.isfinite(arr)):
