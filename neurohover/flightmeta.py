@@ -180,7 +180,8 @@ def action_mismatch(policy: Policy, observations: np.ndarray, actions: np.ndarra
     policy saw (a sensor's readings) and ``fly --record`` flies no safeguard, so every recorded action is the policy's
     own: the one test of it, at load and by EC-MER (models.ec.check_policy_flew)."""
     for k in range(min(CHECKED_STEPS, actions.shape[0])):
-        if not np.all(np.isfinite(actions[k])) or not np.all(np.abs(observations[k]) <= MAX_OBSERVATION):  # Policy.act's bound (T31-B05)
+        # Policy.act's bound (T31-B05), in float64: float32 readings cast 1e60 to inf, with NumPy's overflow warning (T34-B16)
+        if not np.all(np.isfinite(actions[k])) or not np.all(np.abs(observations[k].astype(np.float64)) <= MAX_OBSERVATION):
             continue
         flown = np.clip(policy.act(observations[k]), -1.0, 1.0)
         i = int(np.argmax(np.abs(flown - actions[k])))

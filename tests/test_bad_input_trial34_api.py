@@ -7,6 +7,7 @@ got N") and T34-B16 (saving float32 flight data printed NumPy's overflow Runtime
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -98,3 +99,14 @@ def test_b15_make_of_a_2d_array_names_its_shape(family: str, kwargs: dict) -> No
     with pytest.raises(NeurohoverError, match=rf"must be a flat sequence of {n} numbers, got shape \(1, {n}\): "):
         fam.make(params[None, :])
     assert fam.make(params).family == fam.make(list(params)).family
+
+
+def test_b16_saving_float32_flight_data_warns_nothing(flight: Path, tmp_path: Path) -> None:
+    """T34-B16: FlightData of float32 readings printed NumPy's "overflow encountered in cast" (flightmeta.py) at save,
+    as the policy check compared them with MAX_OBSERVATION (1e60, past float32's range); the file was written."""
+    fd = nh.FlightData.load(flight)
+    f32 = nh.FlightData(tuple(o.astype(np.float32) for o in fd.observations), fd.actions, metadata=dict(fd.metadata))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for dtype in ("float64", "float32"):
+            assert nh.FlightData.load(f32.save(tmp_path / f"{dtype}.npz", dtype=dtype)).n_transitions == fd.n_transitions
