@@ -15,6 +15,11 @@ so a crash stays worse than any way of flying on::
 
 On a vector environment use ``gymnasium.wrappers.vector.TransformReward(envs, crash_aware)``.
 Report the unwrapped environment's returns (``RecordEpisodeStatistics`` inside this wrapper).
+A crash is found by the size of the environment's own reward, so reward transforms (``ClipReward``,
+``TransformReward``, ``NormalizeReward``, a second ``CrashAwareReward``) go outside this wrapper, never
+inside, where they squashed a crash into an ordinary step: :class:`CrashAwareReward` refuses them, and an
+``-RL-v0`` id, whose rewards are crash-aware already (T34-B05). A wrapper of your own that changes the
+rewards in ``step`` is not seen: keep it outside too.
 """
 
 from __future__ import annotations
@@ -73,12 +78,34 @@ def crash_aware(reward, gamma: float = 0.99, scale: float = 1.0):
     return float(out) if np.ndim(reward) == 0 else out
 
 
+def refuse_changed_rewards(env: gym.Env) -> None:
+    """Refuse an ``env`` whose rewards a wrapper inside it has changed (a reward wrapper, ``NormalizeReward``) or made
+    crash-aware already (a :class:`CrashAwareReward`, as every ``-RL-v0`` id has): :func:`crash_aware` finds a crash by
+    ``|r| >= CRASH_STEP_PENALTY``, and a clipped, scaled or normalised crash was squashed as an ordinary step (T34-B05)."""
+    layer = env
+    while isinstance(layer, gym.Wrapper):
+        if isinstance(layer, CrashAwareReward):
+            raise NeurohoverError(
+                f"env={brief(env)} is not allowed: its rewards are crash-aware already (a CrashAwareReward inside it, as every "
+                "neurohover/<NAME>-RL-v0 id has); wrap it once, or wrap a plain id (e.g. neurohover/GHH08-Short-v0)"
+            )
+        if isinstance(layer, (gym.RewardWrapper, gym.wrappers.NormalizeReward)):
+            raise NeurohoverError(
+                f"env={brief(env)} is not allowed: its {type(layer).__name__} changes the rewards before CrashAwareReward sees them, "
+                f"and a crash (|r| >= {CRASH_STEP_PENALTY:g}) would be squashed as an ordinary step; put reward wrappers outside CrashAwareReward"
+            )
+        layer = layer.env
+
+
 class CrashAwareReward(gym.RewardWrapper):
-    """Rewards of :func:`crash_aware` (``gamma``: the learner's discount, in (0, 1]; ``scale`` > 0)."""
+    """Rewards of :func:`crash_aware` (``gamma``: the learner's discount, in (0, 1]; ``scale`` > 0), over an ``env`` whose
+    rewards are the environment's own: a reward wrapper, ``NormalizeReward`` or a CrashAwareReward inside (an ``-RL-v0``
+    id) is refused (:func:`refuse_changed_rewards`)."""
 
     def __init__(self, env: gym.Env, gamma: float = 0.99, scale: float = 1.0) -> None:
         check_env(env)
         check_discount_and_scale(gamma, scale)
+        refuse_changed_rewards(env)
         super().__init__(env)
         self.gamma, self.scale = float(gamma), float(scale)
 

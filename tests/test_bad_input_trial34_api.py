@@ -110,3 +110,34 @@ def test_b16_saving_float32_flight_data_warns_nothing(flight: Path, tmp_path: Pa
         warnings.simplefilter("error")
         for dtype in ("float64", "float32"):
             assert nh.FlightData.load(f32.save(tmp_path / f"{dtype}.npz", dtype=dtype)).n_transitions == fd.n_transitions
+
+
+def _crash_step(env) -> float:
+    """The reward of the step that ends an episode flown at zero controls (a crash within 20 steps on train:0)."""
+    env.reset(seed=0)
+    while True:
+        _, r, terminated, truncated, _ = env.step(np.zeros(4, dtype=env.action_space.dtype))
+        if terminated or truncated:
+            return float(r)
+
+
+def test_b05_crash_aware_reward_refuses_changed_or_crash_aware_rewards_inside() -> None:
+    """T34-B05: CrashAwareReward over ClipReward, TransformReward, NormalizeReward or itself squashed the crash as an
+    ordinary step (-0.69 instead of -98), and an -RL-v0 id (crash-aware already) was wrapped again without a word."""
+    import gymnasium as gym
+    from gymnasium.wrappers import ClipReward, NormalizeReward, RecordEpisodeStatistics, TransformReward
+
+    from neurohover.wrappers import CrashAwareReward
+
+    def base():
+        return gym.make("neurohover/GHH08-v0", mdp="train:0", episode_steps=20)
+
+    for inner in (ClipReward(base(), -1, 1), TransformReward(base(), lambda r: r / 1000), NormalizeReward(base())):
+        name = type(inner).__name__
+        with pytest.raises(NeurohoverError, match=rf"its {name} changes the rewards before CrashAwareReward sees them.*put reward wrappers outside"):
+            CrashAwareReward(RecordEpisodeStatistics(inner))
+    for inner in (CrashAwareReward(base()), gym.make("neurohover/GHH08-RL-v0", mdp="train:0")):
+        with pytest.raises(NeurohoverError, match=r"its rewards are crash-aware already"):
+            CrashAwareReward(inner)
+    plain = _crash_step(CrashAwareReward(RecordEpisodeStatistics(base())))  # what the docs advise: statistics inside
+    assert plain < -50 and _crash_step(ClipReward(CrashAwareReward(base()), -1, 1)) == -1.0  # transforms go outside
