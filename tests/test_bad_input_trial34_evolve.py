@@ -98,3 +98,56 @@ def test_a_relative_checkpoint_is_resolved_when_the_run_starts(tmp_path, monkeyp
 
     _tiny_evolve(checkpoint="run/ck.json", progress=progress, progress_every_s=0, checkpoint_every_s=1e-6)
     assert (tmp_path / "run" / "ck.json").is_file() and not (tmp_path / "elsewhere" / "run").exists()
+
+
+def _neat_record(conns: list[float]) -> list[float]:
+    from neurohover.integrations.neat import ACTIVATIONS
+
+    ident = float(ACTIVATIONS.index("identity"))
+    nodes = [v for k in range(6) for v in (k, 0.0, 1.0, ident)]  # outputs 0..3, hidden 4 and 5
+    return [6.0] + nodes + conns
+
+
+@pytest.mark.parametrize(
+    "conns, cycle",
+    [
+        ([-1, 0, 1.0, 0, 0, 5.0], "0 -> 0"),
+        ([-1, 0, 1.0, 0, 1, 3.0, 1, 0, 3.0], "0 -> 1 -> 0"),
+        ([-1, 4, 1.0, 4, 4, 2.0, 4, 0, 1.0], "4 -> 4"),
+        ([-1, 4, 1.0, 4, 5, 1.0, 5, 4, 1.0, 5, 0, 1.0], "4 -> 5 -> 4"),
+    ],
+)
+def test_a_neat_record_with_a_cycle_is_refused(conns, cycle):
+    """T34-B09: a cycle's or self-loop's nodes were dropped by neat-python's feed-forward network without a word."""
+    from neurohover.integrations.neat import network_of_record
+
+    with pytest.raises(nh.NeurohoverError, match=f"^a NEAT record's connection cycle {cycle} is not allowed: give a feed-forward network"):
+        network_of_record(_neat_record(conns))
+
+
+def test_a_neat_record_without_a_cycle_still_flies():
+    """Chains through hidden nodes and links between outputs are feed-forward, and fly."""
+    from neurohover.integrations.neat import forward, network_of_record
+
+    record = _neat_record([-1, 4, 1.0, 4, 5, 1.0, 5, 0, 1.0, 0, 1, 2.0, 1, 2, 1.0, -2, 2, 1.0])
+    out = forward(network_of_record(record), np.zeros(1, np.int64), np.ones((1, 12)))
+    assert out.tolist() == [[1.0, 2.0, 3.0, 0.0]]
+
+
+def test_neat_settings_take_numpy_numbers():
+    """T34-B12: np.int64 sizes were "must be an integer", np.float32 probabilities "must be a probability in [0, 1]"; they
+    are taken and stored as Python numbers."""
+    from neurohover.integrations.neat import NeatSettings
+
+    s = NeatSettings(
+        pop_size=np.int64(4), episodes=np.int32(2), node_add_prob=np.float32(0.25), weight_mutate_power=np.float64(0.5), bias_init_stdev=np.float32(0)
+    )
+    assert (s.pop_size, s.episodes, s.node_add_prob) == (4, 2, 0.25)
+    assert all(type(v) in (int, float) for v in (s.pop_size, s.episodes, s.node_add_prob, s.weight_mutate_power, s.bias_init_stdev))
+    for bad, words in (
+        ({"pop_size": np.int64(3)}, r"pop_size=np.int64\(3\) must be an integer in 4..100000"),
+        ({"pop_size": np.bool_(True)}, "pop_size="),
+        ({"node_add_prob": np.float32(1.5)}, r"node_add_prob=np.float32\(1.5\) must be a probability"),
+    ):
+        with pytest.raises(nh.NeurohoverError, match=words):
+            NeatSettings(**bad)

@@ -28,6 +28,7 @@ from __future__ import annotations
 import copy
 import functools
 import math
+import operator
 import os
 import random
 import tempfile
@@ -39,7 +40,7 @@ from typing import Any
 import numba as nb
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real
+from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..evolution.config import check_budget
 from ..evolution.fitness import FITNESS_SCALES, episode_fitness
 from ..evolution.seeding import check_seed
@@ -142,8 +143,9 @@ class NeatSettings:
     def __post_init__(self) -> None:  # a NeurohoverError (a ValueError) naming the value and what is allowed
         for name, low, high in (("pop_size", 4, MAX_POP), ("episodes", 1, MAX_EPISODES_PER_GENOME)):
             v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, int) or not low <= v <= high:
+            if not whole_number(v) or not low <= v <= high:  # NumPy's integers too: np.int64(4) "must be an integer" (T34-B12)
                 raise NeurohoverError(f"{name}={brief(v)} must be an integer in {low}..{high}")
+            object.__setattr__(self, name, operator.index(v))
         # text first: an array's `in` was NumPy's "truth value ... is ambiguous" (sixteenth trial)
         if not isinstance(self.initial, str) or self.initial not in ("full_direct", "unconnected"):
             raise NeurohoverError(f"initial={brief(self.initial)}: allowed full_direct or unconnected")
@@ -158,23 +160,17 @@ class NeatSettings:
         object.__setattr__(self, "activations", tuple(acts))
         if self.start == "baseline" and (self.initial != "full_direct" or "identity" not in self.activations):
             raise NeurohoverError("start='baseline' needs initial='full_direct' and 'identity' among the activations (the baseline is linear)")
-
-        def number(v) -> bool:
-            return isinstance(v, (int, float)) and not isinstance(v, bool) and finite_real(v)
-
-        for name in ("node_add_prob", "conn_add_prob", "node_delete_prob", "conn_delete_prob", "activation_mutate_rate", "replace_rate", "weight_mutate_rate"):
-            v = getattr(self, name)
-            if not (number(v) and 0.0 <= v <= 1.0):
-                raise NeurohoverError(f"{name}={brief(v)} must be a probability in [0, 1]")
-        # neat-python clamps weights and biases to +-30: a larger spread only saturates them
-        for name in ("weight_mutate_power", "bias_mutate_power", "compatibility_threshold"):
-            v = getattr(self, name)
-            if not (number(v) and 0.0 < v <= MAX_SPREAD):
-                raise NeurohoverError(f"{name}={brief(v)} must be a number in (0, {MAX_SPREAD:g}]")
-        for name in ("weight_init_stdev", "bias_init_stdev"):
-            v = getattr(self, name)
-            if not (number(v) and 0.0 <= v <= MAX_SPREAD):
-                raise NeurohoverError(f"{name}={brief(v)} must be a number in [0, {MAX_SPREAD:g}]")
+        probs = ("node_add_prob", "conn_add_prob", "node_delete_prob", "conn_delete_prob", "activation_mutate_rate", "replace_rate", "weight_mutate_rate")
+        for group, least, most, allowed in (  # (neat-python clamps weights and biases to +-30: a larger spread only saturates them)
+            (probs, 0.0, 1.0, "a probability in [0, 1]"),
+            (("weight_mutate_power", "bias_mutate_power", "compatibility_threshold"), None, MAX_SPREAD, f"a number in (0, {MAX_SPREAD:g}]"),
+            (("weight_init_stdev", "bias_init_stdev"), 0.0, MAX_SPREAD, f"a number in [0, {MAX_SPREAD:g}]"),
+        ):
+            for name in group:  # NumPy's numbers too (np.float32(0.25) was "must be a probability"; T34-B12), stored as floats
+                v = getattr(self, name)
+                if not (finite_real(v) and (0.0 < v if least is None else least <= v) and v <= most):
+                    raise NeurohoverError(f"{name}={brief(v)} must be {allowed}")
+                object.__setattr__(self, name, float(v) + 0.0)  # -0.0 as 0.0
 
 
 _CONFIG = """
@@ -430,8 +426,8 @@ MAX_NEAT_VALUE, MAX_NODE_KEY = 30.0, 2**53
 def _check_record_network(record: Sequence[float], n_nodes: int) -> None:
     """A record's nodes and connections as neat-python builds them, checked: whole, unrepeated node keys 0..2**53 with
     the 4 outputs 0..3 among them, values within +-30, and each connection once, from an input (-9..-1) or a node, to
-    a node. A record without nodes was neat-python's KeyError 0, a connection from node 55 its KeyError 55 (T32-B15);
-    a repeated node or connection kept the last (T32-B16)."""
+    a node, and no cycle among them. A record without nodes was neat-python's KeyError 0, a connection from node 55 its
+    KeyError 55 (T32-B15); a repeated node or connection kept the last (T32-B16); a cycle's nodes were dropped (T34-B09)."""
     name = "a NEAT record's {} {} is not allowed: {}"
     keys = [record[1 + 4 * j] for j in range(n_nodes)]
     for key in keys:
@@ -451,6 +447,32 @@ def _check_record_network(record: Sequence[float], n_nodes: int) -> None:
             why = "it is listed twice" if (i, o) in seen else f"give it once, from an input -{N_INPUTS}..-1 or a node of the record to a node"
             raise NeurohoverError(name.format("connection", f"{brief(i)} -> {brief(o)}", why))
         seen.add((i, o))
+    cycle = _cycle_of(seen)
+    if cycle:  # neat-python's FeedForwardNetwork dropped every node on it, and the record flew without them (T34-B09)
+        path = " -> ".join(brief(int(k)) for k in cycle)
+        raise NeurohoverError(name.format("connection cycle", path, "give a feed-forward network, as NEAT evolves here (a cycle's nodes flew as absent)"))
+
+
+def _cycle_of(links: set[tuple[float, float]]) -> list[float]:
+    """A cycle of the directed graph ``links`` (its nodes, the first repeated last: ``[0, 0]`` for a self-loop), or []."""
+    succ: dict[float, list[float]] = {}
+    for i, o in sorted(links):
+        succ.setdefault(i, []).append(o)
+    done: set[float] = set()
+    for root in (r for r in sorted(succ) if r not in done):
+        path, stack = {root: None}, [iter(succ[root])]  # the nodes on the current path, in order
+        while stack:
+            nxt = next(stack[-1], None)
+            if nxt in path:
+                nodes = list(path)
+                return nodes[nodes.index(nxt) :] + [nxt]
+            if nxt is None:
+                done.add(path.popitem()[0])
+                stack.pop()
+            elif nxt not in done:
+                path[nxt] = None
+                stack.append(iter(succ.get(nxt, ())))
+    return []
 
 
 def network_of_record(record: Sequence[float]) -> PackedNetworks:
