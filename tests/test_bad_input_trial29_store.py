@@ -128,7 +128,7 @@ def test_b06_every_write_of_a_second_store_is_refused_while_the_first_holds_the_
             lambda s: s.update("e1", "quick", H, tiny_config("e1").to_dict(), keep=[]),
             lambda s: s.forget_if_empty("e2", "quick"),
         ):
-            _refused(second, call, f"results store {str(store.path)!r} is in use: another run (pid ")
+            _refused(second, call, f"results store {str(store.path)!r} is in use: another open Store of this process (pid ")  # T34-B14
         store.close()
         assert second.put("e1", "quick", H, _unit("e1", "k9"), {"value": 9, "seed": None}, 1.0)  # the lock free: the write takes it
         assert second.lock_path.exists()

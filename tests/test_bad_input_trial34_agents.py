@@ -34,3 +34,57 @@ def test_continual_agent_without_safeguard_flies():
 
     agent = ContinualAgent(nh.baseline_policy(), settings=ContinualSettings(safeguard_after=5))  # flying the generic: no fallback
     assert agent.choose(0).fallback is None
+
+
+def test_store_dropped_unclosed_lets_go_of_its_lock(tmp_path):
+    """T34-B14: a Store dropped without close() kept its writer lock, and the next Store of the same process was told
+    that "another run (pid <its own pid>)" wrote it, for as long as the process lived (a notebook cell run twice)."""
+    import gc
+
+    from neurohover.experiments.store import Store
+
+    path = tmp_path / "s.sqlite"
+    for _ in range(3):  # a loop of Store(path) + lock() without close: the second pass failed
+        s = Store(path)
+        s.lock()
+        del s
+    s = Store(path)
+    s.lock()
+    s = None  # rebinding drops it at once
+    t = Store(path)
+    t.lock()
+    del t
+    gc.collect()
+    assert not (tmp_path / "s.sqlite.lock").exists()  # released as close() does
+    with Store(path) as u:
+        u.lock()
+
+
+def test_store_held_by_this_process_is_named_so(tmp_path):
+    """T34-B14: a lock another open Store of this very process holds is not "another run": waiting never ends it."""
+    import os
+
+    from neurohover.experiments.store import Store
+
+    path = tmp_path / "s.sqlite"
+    with Store(path) as first:
+        first.lock()
+        with pytest.raises(nh.NeurohoverError, match=rf"another open Store of this process \(pid {os.getpid()} .*close\(\) that Store first"):
+            Store(path).lock()
+    with Store(path) as again:  # closed: free again
+        again.lock()
+
+
+def test_forked_copy_of_a_store_leaves_the_lock_alone(tmp_path):
+    """T34-B14: the collector's release acts only in the process that took the lock, not in a child forked from it."""
+    import os
+
+    from neurohover.experiments.store_checks import let_go
+    from neurohover.locks import WriterLock
+
+    lock = WriterLock(tmp_path / "x.lock")
+    assert lock.acquire(lambda who: who)
+    let_go(lock, -1, os.getpid() + 1)  # as in a forked child
+    assert lock.held and lock.path.exists()
+    let_go(lock, -1, os.getpid())
+    assert not lock.held and not lock.path.exists()

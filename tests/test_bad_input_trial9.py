@@ -133,7 +133,9 @@ def test_a_store_given_through_a_symbolic_link_has_the_same_writer_lock(tmp_path
         first.lock()
         with Store(tmp_path / "link.sqlite") as second:
             assert second.lock_path == first.lock_path == tmp_path / "s.sqlite.lock"
-            with pytest.raises(NeurohoverError, match=f"results store '{tmp_path}/link.sqlite' is in use: another run \\(pid {os.getpid()} "):
+            with pytest.raises(
+                NeurohoverError, match=f"results store '{tmp_path}/link.sqlite' is in use: another open Store of this process \\(pid {os.getpid()} "
+            ):
                 second.lock()
 
 

@@ -411,7 +411,7 @@ def test_two_stores_on_one_file_in_one_process_take_turns(tmp_path: Path) -> Non
     path = tmp_path / "s.sqlite"
     with Store(path) as first, Store(path) as second:
         h = begin(first, "x")
-        with pytest.raises(NeurohoverError, match=rf"is in use: another run \(pid {os.getpid()} on host "):
+        with pytest.raises(NeurohoverError, match=rf"is in use: another open Store of this process \(pid {os.getpid()} on host "):
             begin(second, "x")
         assert first.experiments() == second.experiments() == [("x", "quick", h, 0)]  # reading needs no lock
         first.close()

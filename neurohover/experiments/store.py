@@ -20,8 +20,8 @@ running again with the same store skips every finished unit.
 
 One writer: a run holds an OS lock (``flock``) on ``STORE.lock`` beside the store, and on the store's file itself (a
 hard link has another lock file), from its first write until it closes the store, and writes its pid there; a second
-run is refused, naming that pid. Closing the store removes the file; the kernel drops the lock when its process dies,
-so a killed run (which leaves the file) never blocks the next one.
+run is refused, naming that pid. Closing the store (or dropping it unclosed) removes the file; the kernel drops the lock
+when its process dies, so a killed run (which leaves the file) never blocks the next one.
 Readers (``results``, ``report``) take no lock.
 """
 
@@ -34,13 +34,13 @@ import os
 import socket
 import sqlite3
 import time
+import weakref
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
 from ..errors import NeurohoverError, brief, check_flag, finite_real
 from ..filekinds import SQLITE_HEADER, refuse_long_store_name, refuse_sqlite_name
-from ..locks import hold_file
 from ..paths import JSONError, WriterLock, strict_json
 from .store_checks import (
     SESSION_STATUSES,
@@ -52,11 +52,13 @@ from .store_checks import (
     check_text,
     config_problem,
     experiment_problem,
+    let_go,
     object_text,
     refuse_moved,
     session_problem,
     sqlite_says,
     stored_count,
+    take_writer_lock,
     unit_texts,
 )
 from .store_checks import transaction as _transaction
@@ -149,6 +151,7 @@ class Store:
 
     _closed = False
     _held: int | None = None  # the descriptor of the store's file flocked while writing (-1: no locks here)
+    _let_go: weakref.finalize | None = None  # drops the writer lock: close(), or the garbage collector (T34-B14)
 
     @property
     def conn(self) -> GuardedConnection:
@@ -173,9 +176,8 @@ class Store:
         if self._closed:
             return
         self.conn.close()
-        if self._held is not None and self._held >= 0:
-            os.close(self._held)
-        self._lock.release()
+        if self._let_go is not None:
+            self._let_go()
         self._closed = True
 
     # ------------------------------------------------------------------ one writer
@@ -205,19 +207,9 @@ class Store:
         """
         with self.conn.guard:  # a closed Store refused by name before it locks the file; one thread at a time (T32-B09)
             refuse_moved(self.path, self._file, self._ident)
-            busy = "wait for that run to end (or stop it), or give another --store file. Reading it (results, report) works meanwhile"
-            try:
-                self._lock.acquire(lambda who: f"results store {str(self.path)!r} is in use: another run ({who}) is writing it; {busy}")
-            except OSError as err:
-                raise NeurohoverError(f"cannot open {str(self.lock_path)!r}, the writer lock of results store {str(self.path)!r}: {err.strerror}") from None
-            if self._held is None:  # the file itself too: a hard link has another lock file (T32-A08)
-                try:
-                    self._held = hold_file(
-                        self._file, f"results store {str(self.path)!r} is in use: another run is writing it under another name (a hard link); {busy}"
-                    )
-                except (NeurohoverError, OSError):
-                    self._lock.release()
-                    raise
+            self._held = take_writer_lock(self._lock, self.path, self._file, self._held)
+            if self._let_go is None:  # dropped unclosed, the Store lets go when collected (T34-B14)
+                self._let_go = weakref.finalize(self, let_go, self._lock, self._held, os.getpid())
             self.check_sound()
 
     _sound = False  # SQLite's own check passed, once per open for writing

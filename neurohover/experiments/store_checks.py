@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import socket
 import sqlite3
 import threading
 from collections.abc import Iterator
@@ -12,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import NeurohoverError, brief, finite_real, refuse_non_text_keys, whole_number
+from ..locks import WriterLock, hold_file
 from ..paths import json_text
 from .config import ExperimentConfig, check_name, check_scale
 from .result_checks import params_problem
@@ -280,3 +282,40 @@ def check_unit_kind(key: str, kind: Any, where: str) -> None:
         result_type(kind)
     except NeurohoverError as err:
         raise NeurohoverError(f"{where}: unit {brief(key)}: {err}") from None
+
+
+def take_writer_lock(lock: WriterLock, path: Path, file: Path, held: int | None) -> int:
+    """Take the writer lock of the results store ``path`` (as given): its lock file, then (unless ``held``, the descriptor
+    already held) its file ``file`` itself, as a hard link has another lock file (T32-A08). Returns that file's
+    descriptor (-1: no locks here). A lock this very process holds, through another open Store, is named as such: it was
+    "another run (pid <its own pid>)", and waiting for it never helped (T34-B14)."""
+    busy = "wait for that run to end (or stop it), or give another --store file. Reading it (results, report) works meanwhile"
+    own = f"pid {os.getpid()} on host {socket.gethostname()}"
+
+    def holder(who: str) -> str:
+        if who == own:
+            return f"results store {str(path)!r} is in use: another open Store of this process ({own}) is writing it; close() that Store first"
+        return f"results store {str(path)!r} is in use: another run ({who}) is writing it; {busy}"
+
+    try:
+        lock.acquire(holder)
+    except OSError as err:
+        raise NeurohoverError(f"cannot open {str(lock.path)!r}, the writer lock of results store {str(path)!r}: {err.strerror}") from None
+    if held is not None:
+        return held
+    try:
+        return hold_file(file, f"results store {str(path)!r} is in use: another run is writing it under another name (a hard link); {busy}")
+    except (NeurohoverError, OSError):
+        lock.release()
+        raise
+
+
+def let_go(lock: WriterLock, held: int, pid: int) -> None:
+    """Drop a store's writer lock: close its file's descriptor ``held`` and release ``lock``; in a process forked from the
+    holder ``pid``, nothing (its parent still writes). :meth:`Store.close` calls it, and so does the garbage collector for
+    a Store dropped unclosed: its lock was kept until the process ended (T34-B14)."""
+    if os.getpid() != pid:
+        return
+    if held >= 0:
+        os.close(held)
+    lock.release()
