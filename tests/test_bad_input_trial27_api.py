@@ -20,7 +20,8 @@ def test_a_nan_genome_in_a_policy_table_flies_as_a_crash() -> None:
     (an optimiser's diverged sample is scored, not a stopped run), where a Policy (a file's) refuses it. A table's
     padding past an SLP's 40 genes stays zero (T33-B10: anything else is an MLP row declared an SLP)."""
     mdp = nh.get_task_family("ghh08").mdp("train:0")
-    for table in (nh.PolicyTable.from_genomes(np.full((1, 40), np.nan), "slp"), nh.PolicyTable(np.array([0]), np.pad(np.full((1, 40), np.nan), ((0, 0), (0, 2))))):
+    padded = np.pad(np.full((1, 40), np.nan), ((0, 0), (0, 2)))  # an SLP row of a table MLPs share
+    for table in (nh.PolicyTable.from_genomes(np.full((1, 40), np.nan), "slp"), nh.PolicyTable(np.array([0]), padded)):
         ev = nh.evaluate(table, mdp, n_steps=20)
         assert ev.returns.ravel().tolist() == pytest.approx([-CRASH_STEP_PENALTY * 19])  # a crash at step 1 of 20
         assert ev.crashed.ravel().tolist() == [True] and ev.steps.ravel().tolist() == [1]
