@@ -277,16 +277,22 @@ def evolve(
     every_checkpoint, every_progress = _intervals(checkpoint, checkpoint_every_s, progress, progress_every_s)
     run = Run(cfg, device=device)
     path = _checkpoint_path(checkpoint, progress, resume)
-    with contextlib.ExitStack() as held:
-        if path is not None:  # one run on a checkpoint at a time, as the CLI's --out: two both ran and overwrote it (T34-B08)
-            held.enter_context(sole_writer(path, "checkpoint"))
-        _prepare(run, path, resume, threads, device, _trace)
-        with num_threads(threads if threads is not None else numba.get_num_threads()):  # restores the count after
-            run.flyer.start()
-            run.run(progress, path, every_checkpoint, every_progress)
+    _fly_run(run, path, resume, threads, device, _trace, lambda: run.run(progress, path, every_checkpoint, every_progress))
     if _flown is not None:
         _flown["steps"] = run.flyer.flown_steps
     return run.result()
+
+
+def _fly_run(run: Run, path: Path | None, resume: bool, threads: int | None, device: str, trace: list | None, fly: Callable[[], None]) -> None:
+    """Prepare ``run`` (resumed from ``path`` if asked) and ``fly()`` it on ``threads``, holding its checkpoint's writer lock
+    throughout: one run on a checkpoint at a time, as the CLI's --out (two both ran and overwrote it; T34-B08)."""
+    with contextlib.ExitStack() as held:
+        if path is not None:
+            held.enter_context(sole_writer(path, "checkpoint"))
+        _prepare(run, path, resume, threads, device, trace)
+        with num_threads(threads if threads is not None else numba.get_num_threads()):  # restores the count after
+            run.flyer.start()
+            fly()
 
 
 def validation_return(
