@@ -16,6 +16,8 @@ every path without a new argument.
 from __future__ import annotations
 
 import contextlib
+import importlib
+import os
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -38,6 +40,37 @@ __all__ = [
 
 #: The kernel's code of each policy topology.
 KIND = {"slp": POLICY_SLP, "mlp": POLICY_MLP}
+
+
+#: Set in a process forked after its parent flew on numba's GNU OpenMP threads: the pid of that parent (T34-B13).
+_forked_from_omp: int | None = None
+
+
+def _note_fork() -> None:
+    """In a forked child: note a parent whose numba OpenMP (GNU libgomp) pool ran, as libgomp does not survive fork."""
+    global _forked_from_omp
+    try:
+        layer = numba.threading_layer()
+    except ValueError:  # no parallel kernel ran yet: the child starts its own pool, as a spawned one does
+        return
+    if layer == "omp" and getattr(importlib.import_module("numba.np.ufunc.omppool"), "openmp_vendor", "GNU") == "GNU":
+        _forked_from_omp = _forked_from_omp or os.getppid()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_note_fork)
+
+
+def refuse_forked_openmp() -> None:
+    """Refuse to fly on the CPU in a process forked after its parent flew on numba's OpenMP threads: numba printed
+    "Terminating: fork() called from a process already using GNU OpenMP" and killed the child, and a multiprocessing
+    Pool (fork, Linux's default start method) started another, forever (T34-B13)."""
+    if _forked_from_omp is not None:
+        raise NeurohoverError(
+            f"cannot fly in a process forked from one that flew (pid {_forked_from_omp}): numba's OpenMP threads do not survive fork; "
+            "start the workers with multiprocessing.get_context('spawn') or 'forkserver', or set NUMBA_THREADING_LAYER=workqueue "
+            "before importing neurohover (docs/performance.md, Many processes)"
+        )
 
 
 @contextlib.contextmanager
@@ -242,11 +275,14 @@ class Batch:
 
 
 def _fly_lanes(b: Batch, out: Flown) -> None:
+    refuse_forked_openmp()
     rollout_lanes(b.jobs(), numba.get_num_threads(), out)
 
 
 def _fly_kernel(rollout: Callable[..., None], b: Batch, out: Flown) -> None:
     """The one call of the scalar kernel (``rollout``: the CPU kernel or the CUDA launcher, same arguments)."""
+    if rollout is rollout_batch:
+        refuse_forked_openmp()
     rollout(b.jobs(), b.extras(), out)
 
 
@@ -350,6 +386,7 @@ def launch_parked(batch: Batch, out: Flown, slots: np.ndarray, n_required: int, 
 
 
 def _fly_parked(b: Batch, out: Flown, slots: np.ndarray, n_required: int, parking: Parking) -> None:
+    refuse_forked_openmp()
     rollout_lanes_parked(b.jobs(), slots, n_required, numba.get_num_threads(), parking, out)
 
 

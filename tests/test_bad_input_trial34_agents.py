@@ -88,3 +88,49 @@ def test_forked_copy_of_a_store_leaves_the_lock_alone(tmp_path):
     assert lock.held and lock.path.exists()
     let_go(lock, -1, os.getpid())
     assert not lock.held and not lock.path.exists()
+
+
+_FORK_SCRIPT = """
+import os, sys
+import neurohover as nh
+from neurohover.errors import NeurohoverError
+
+def fly():
+    fam = nh.get_task_family("ghh08")
+    nh.evaluate(nh.baseline_policy(), fam.mdp("train:0"), episodes=1, n_steps=20, seed=1)
+
+def in_child():
+    pid = os.fork()
+    if pid == 0:
+        try:
+            fly()
+        except NeurohoverError as err:
+            print("refused:", err, flush=True)
+            os._exit(7)
+        os._exit(0)
+    return os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1])
+
+print("before", in_child(), flush=True)  # forked before any flight: the child starts its own threads
+fly()
+print("after", in_child(), flush=True)
+"""
+
+
+def test_a_child_forked_after_a_flight_is_refused_not_killed():
+    """T34-B13: a process forked after its parent flew on numba's GNU OpenMP threads was killed at its first flight
+    ("Terminating: fork() called from a process already using GNU OpenMP"), and a fork Pool respawned it forever; it is
+    now refused with the remedies named. The child of a parent that never flew flies."""
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "NUMBA_THREADING_LAYER": "omp"}
+    done = subprocess.run([sys.executable, "-c", _FORK_SCRIPT], env=env, capture_output=True, text=True, timeout=60)
+    if "threading layer numba cannot load here" in done.stderr:
+        pytest.skip("no OpenMP threading layer here")
+    assert done.returncode == 0, done.stderr[-2000:]
+    lines = done.stdout.splitlines()
+    assert "before 0" in lines and "after 7" in lines, done.stdout + done.stderr[-2000:]
+    refusal = next(line for line in lines if line.startswith("refused:"))
+    assert "numba's OpenMP threads do not survive fork" in refusal and "get_context('spawn')" in refusal and "NUMBA_THREADING_LAYER=workqueue" in refusal
+    assert "Terminating" not in done.stderr
