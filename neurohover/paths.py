@@ -374,11 +374,18 @@ def _probe(real: Path) -> bool:
     """Open the file ``real`` for writing, appending nothing (an existing file's content and time stay as they are);
     True where the probe created it, and then removed it again, unless another writer has put its own file there
     meanwhile: a thread's check removed the file another had just saved (T32-B01)."""
-    try:
-        fd = os.open(real, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
-    except FileExistsError:
-        os.close(os.open(real, os.O_WRONLY | os.O_APPEND))
-        return False
+    for _ in range(100):  # a file another thread's probe made and removed between our two opens: try again
+        try:
+            fd = os.open(real, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+            break
+        except FileExistsError:
+            try:
+                os.close(os.open(real, os.O_WRONLY | os.O_APPEND))
+                return False
+            except FileNotFoundError:
+                continue
+    else:
+        raise FileNotFoundError(errno.ENOENT, "the file came and went a hundred times while it was checked", str(real))
     try:
         made = os.fstat(fd)
     finally:

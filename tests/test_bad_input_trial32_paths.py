@@ -199,3 +199,24 @@ def test_an_authors_net_file_is_read_as_one_in_any_case_of_its_suffix(tmp_path: 
     assert nh.load_policy(tmp_path / f"p{suffix}").genome.tolist() == pytest.approx(policy.genome.tolist())
     with _raises("a policy is written as JSON, which load_policy would misread under the .net suffix"):
         nh.save_policy(policy, tmp_path / f"q{suffix}")
+
+
+def test_a_file_another_threads_check_made_and_removed_between_two_opens_is_checked_again(tmp_path: Path, monkeypatch) -> None:
+    """T32-B01 again (seen under load): one thread's check found the file another thread's check had just made
+    (O_EXCL failed), which removed it before the first opened it to append: "cannot write this file (No such file or
+    directory)". The interleaving, forced: the check tries again, and the save succeeds."""
+    import neurohover.paths as paths
+
+    real_open, calls = os.open, []
+
+    def interleaved(path, flags, *args):
+        calls.append(flags)
+        if len(calls) == 1 and flags & os.O_EXCL:
+            raise FileExistsError(17, "made by another thread's check", str(path))
+        if len(calls) == 2 and flags & os.O_APPEND:
+            raise FileNotFoundError(2, "removed by that check", str(path))
+        return real_open(path, flags, *args)
+
+    monkeypatch.setattr(paths.os, "open", interleaved)
+    out = paths.output_file(tmp_path / "p.json", "policy file")
+    assert out == tmp_path / "p.json" and len(calls) >= 3 and not out.exists()  # probed, and the probe's file removed
