@@ -50,6 +50,7 @@ from .store_checks import (
     check_executor,
     check_experiment,
     check_text,
+    config_differs,
     config_problem,
     experiment_problem,
     let_go,
@@ -291,7 +292,7 @@ class Store:
             if fresh:
                 for table in ("experiments", "units", "sessions"):
                     c.execute(f"DELETE FROM {table} WHERE name = ? AND scale = ?", (name, scale))
-            row = c.execute("SELECT config_hash FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
+            row = c.execute("SELECT config_hash, config FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
             other = c.execute("SELECT name FROM experiments WHERE lower(name) = lower(?) AND name != ? LIMIT 1", (name, name)).fetchone()
             if row is None and other is not None:  # one file of figures where case is ignored, one report anchor (T28-A10)
                 raise NeurohoverError(
@@ -301,13 +302,7 @@ class Store:
             if row is None:
                 c.execute("INSERT INTO experiments VALUES (?, ?, ?, ?, ?)", (name, scale, config_hash, text, time.time()))
             elif row[0] != config_hash:
-                raise NeurohoverError(
-                    f"results store {str(self.path)!r} already holds experiment {name!r} at scale {scale!r} with config "
-                    f"hash {row[0]}, but this config hashes to {config_hash}: the settings differ, so the results would "
-                    f"not be comparable. Use another --store file, restore the old config, rerun with --update to keep "
-                    f"the stored units the new config plans unchanged (and run the others), or with --fresh to discard "
-                    f"every stored result of {name!r} ({scale})"
-                )
+                raise NeurohoverError(config_differs(str(self.path), name, scale, row[0], row[1], config_hash, config))
             else:  # same settings: keep the latest title and paper numbers (they do not change results)
                 c.execute("UPDATE experiments SET config = ? WHERE name = ? AND scale = ?", (text, name, scale))
 
