@@ -327,7 +327,8 @@ def compete(
     ------
     KeyboardInterrupt
         When interrupted (SIGTERM too while ``jobs > 1``), after writing ``episodes.csv`` of every
-        finished run (none: no file is written); the store keeps them, and the same call resumes. Once the runs
+        finished run, an earlier competition's summary.json and cumulative.png in ``out`` removed (none finished: no file is
+        written or removed); the store keeps them, and the same call resumes. Once the runs
         began, the exception's attribute ``finished_runs`` (:data:`FINISHED_RUNS`) says how many had finished.
     """
     from .agents.registry import agent_spec, check_agent
@@ -439,7 +440,7 @@ def _run_into_store(config, store_path: Path, episodes_csv: Path, *, jobs: int, 
             executor.close()
             ordered = stored_runs(db)
             if ordered:  # none: the folder stays as it was (an earlier competition's rows were replaced by a header; tenth trial)
-                _write_episodes(episodes_csv, ordered, config.typed.n_steps)
+                _write_partial(episodes_csv, ordered, config.typed.n_steps)
             setattr(stop, FINISHED_RUNS, len(ordered))  # for the command's line: none finished is said so (T26-A08)
             raise
         finally:
@@ -447,10 +448,22 @@ def _run_into_store(config, store_path: Path, episodes_csv: Path, *, jobs: int, 
         ordered = stored_runs(db)  # a failure (a full disk) left above: the folder as it was
         if run.failed:  # said as reproduce says it, never summarised (all runs failed: "Mean of empty slice"; T30-A02)
             if ordered:
-                _write_episodes(episodes_csv, ordered, config.typed.n_steps)
+                _write_partial(episodes_csv, ordered, config.typed.n_steps)
             raise NeurohoverError(f"{run.line()}; the finished runs are kept in {str(store_path)!r}, and the same call resumes")
         _write_episodes(episodes_csv, ordered, config.typed.n_steps)
     return ordered
+
+
+def _write_partial(episodes_csv: Path, ordered: list, n_steps: int) -> None:
+    """The finished runs of a competition that stopped before its end, as its ``episodes_csv`` alone: an earlier
+    competition's summary.json and cumulative.png in that folder are removed first, as :func:`_note_replaced` says. They
+    stayed beside the new rows, and plot --compete refused the folder, blaming the new rows (T34-A04); a folder without
+    a summary is what an interrupted competition leaves, and plot --compete labels it by its name."""
+    for name in ("summary.json", "cumulative.png"):
+        stale = episodes_csv.parent / name
+        if stale.is_file() or stale.is_symlink():  # _refuse_other_files let only a competition's summary (or an empty file) stay
+            stale.unlink()
+    _write_episodes(episodes_csv, ordered, n_steps)
 
 
 def _refuse_other_settings(config, store_path: Path) -> None:
@@ -532,7 +545,8 @@ def _note_replaced(summary_path: Path, task: str, agent: str, scale: str) -> Non
         return
     print(
         f"neurohover compete: note: {str(summary_path.parent)!r} held {what}; its episodes.csv, summary.json and plot are replaced "
-        "(its runs stay in the store)",
+        "(its runs stay in the store; stopped before its end, this one leaves only the episodes.csv of its finished runs, and the "
+        "folder as it was if none had finished)",
         file=sys.stderr,
     )
 
