@@ -587,6 +587,6 @@ def register(sub) -> None:
     p.add_argument(
         "--policy",
         help="ec-mer: the policy that flew the data (default: the one fly --record stored in the flight data, else the file named there, else "
-        "baseline); where the data record one, --policy must be that one",
+        "baseline); where the data record or name one, --policy must be that one",
     )
     p.set_defaults(func=cmd_learn_model, lr_options=lr_options)

@@ -310,9 +310,10 @@ def ec_mer_policy(given: str | None, data: FlightData, flight_data: str):
     """EC-MER's policy for ``data`` (read from the file ``flight_data``): the one the flight data record
     (``policy_flown``), else the file their metadata names (older files), else the baseline; ``--policy`` (``given``)
     where they record none, and refused where it is not the recorded one (a policy that never flew the data was fitted
-    without a word; eleventh trial, S2). Whichever it is must give the recorded actions on the first episode's first
-    :data:`~neurohover.flightmeta.CHECKED_STEPS` observations (:func:`check_policy_flew`): an edited policy_flown, or an older file's
-    metadata naming another run's policy, was fitted without a word (T22-17)."""
+    without a word; eleventh trial, S2), or in an older file without ``policy_flown`` not the one its metadata name
+    (T34-A05). Whichever it is must give the recorded actions on the first episode's first
+    :data:`~neurohover.flightmeta.CHECKED_STEPS` observations (:func:`check_policy_flew`): an edited policy_flown, or an
+    older file's metadata naming another run's policy, was fitted without a word (T22-17)."""
     policy = _chosen_policy(given, data, f"flight data {flight_data!r}")
     check_policy_flew(policy, data, f"flight data {flight_data!r}", _named(given, data))
     return policy
@@ -362,7 +363,10 @@ def _chosen_policy(given: str | None, data: FlightData, where: str):
         except NeurohoverError as err:
             raise NeurohoverError(f"{err} (the policy the flight data's metadata name; give --policy FILE)") from None
     policy = load_policy(given)
-    if data.metadata.get("policy_flown") is None:  # none recorded (older files) or joined recordings of several: --policy says
+    if "policy_flown" not in data.metadata:  # older files: their policy's name alone (T34-A05)
+        _check_named_policy(given, policy, data, where)
+        return policy
+    if data.metadata["policy_flown"] is None:  # joined recordings of several: --policy says
         return policy
     try:
         recorded = data.recorded_policy(where)
@@ -375,3 +379,30 @@ def _chosen_policy(given: str | None, data: FlightData, where: str):
             "the closed loop of the policy that flew the data; leave --policy out to use the recorded one"
         )
     return policy
+
+
+def _check_named_policy(given: str, policy, data: FlightData, where: str) -> None:
+    """Refuse a --policy other than the one an older file's metadata name (no ``policy_flown``: fly --record of older
+    neurohover wrote the policy's name alone), or one that cannot be checked, the named one being unreadable here:
+    EC-MER fitted another policy's closed loop without a word wherever the two gave like actions on the steps
+    :func:`check_policy_flew` compares (T34-A05). Data naming no policy (made in Python) are left to that check."""
+    from ..policies import load_policy
+
+    named = data.metadata.get("policy")
+    if named is None:
+        return
+    lacks = "no policy_flown (the policy that flew them: fly --record of an older neurohover kept its name alone)"
+    try:
+        recorded = load_policy(str(named))
+    except NeurohoverError as err:
+        raise NeurohoverError(
+            f"--policy {given!r} cannot be checked against {where}: they record {lacks}, and the policy their metadata name, "
+            f"{brief(str(named))}, cannot be read here ({err}); run learn-model where that name reads the policy, leaving --policy "
+            "out, or record the flight again with fly --record"
+        ) from None
+    if recorded != policy:
+        raise NeurohoverError(
+            f"--policy {given!r} is not the policy that flew {where}: their metadata name {brief(str(named))}, a different network, and "
+            f"record {lacks}; EC-MER fits the closed loop of the policy that flew the data; leave --policy out to use the named one, or "
+            "record the flight again with fly --record"
+        )
