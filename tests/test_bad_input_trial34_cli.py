@@ -50,3 +50,41 @@ def test_a_store_an_older_neurohover_wrote_is_refused_saying_the_new_settings_ar
         "wrote this store. To go on with it, rerun with --update" in message
     )
     assert "restore the old config" not in message and "or give another --store file" in message
+
+
+# T34-A01 ------------------------------------------------------------------------------------------------------------
+
+
+def _shrunk_fig7(n_mdps: int = 2):
+    """Figure 7 at paper scale with --set running much less of it: two of its agents on ``n_mdps`` MDPs, 2 episodes of 20 steps."""
+    from neurohover.experiments.config import load_config
+
+    groups = [{"agent": agent, "mdps": "test", "n_mdps": n_mdps} for agent in ("model-free", "incremental")]
+    overrides = {"policies": "shipped", "episodes": 2, "n_steps": 20, "model_budget": 10, "max_learning_episodes": 1, "groups": groups}
+    return load_config("fig7", "paper", overrides)
+
+
+def test_a_paper_scale_run_shrunk_by_set_is_not_called_the_paper_protocol() -> None:
+    from neurohover.experiments.config import load_config
+    from neurohover.experiments.report_scale import paper_protocol, scale_note
+
+    note = scale_note(_shrunk_fig7())
+    assert note.startswith("not the paper's protocol: --set ran less than fig7 at paper scale as shipped: episodes (2 < 1000), max_learning_episodes")
+    assert "n_steps (20 < 6000), group 'model-free' n_mdps (2 < 100)" in note and "left out of the paper-scale claims table" in note
+    table4 = load_config("table4", "paper", {"generic_budget": 50, "n_mdps": 1})
+    assert "generic_budget (50 < no cap), n_mdps (1 < 100)" in scale_note(table4) and not paper_protocol(table4)
+    # more than the paper's, or only where the policies come from: the paper's protocol still
+    for overrides in ({}, {"policies": "shipped"}, {"episodes": 2000, "generic_budget": 0, "model_budget": 3000}):
+        cfg = load_config("fig7", "paper", overrides)
+        assert scale_note(cfg) == "the paper protocol" and paper_protocol(cfg)
+
+
+def test_a_paper_scale_run_shrunk_by_set_stays_out_of_the_paper_scale_claims(tmp_path: Path) -> None:
+    """Its t tests were judged in "Claims and conclusions (paper scale)" and counted in the conclusions' tally."""
+    from neurohover.experiments import LocalExecutor, reproduce, write_report
+
+    with Store(tmp_path / "s.sqlite") as store:
+        reproduce(_shrunk_fig7(), store, LocalExecutor(1), progress=False)
+        report = write_report(store, tmp_path / "r").read_text(encoding="utf-8")
+    assert "- Scale: **paper** (not the paper's protocol: --set ran less than fig7" in report
+    assert "Claims and conclusions" not in report and "### Against the paper" in report

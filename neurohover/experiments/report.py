@@ -32,7 +32,7 @@ from .report_evolution import EvolutionSection
 from .report_factorial import FitFactorial, authors_policy_runs, authors_policy_section, test_run_effects, test_run_figure, varies
 from .report_models import SensorModels
 from .report_readme import Status, fill_generated, linked_claims, status_table
-from .report_scale import header_note, quick_discussion, scale_note
+from .report_scale import header_note, paper_protocol, quick_discussion, scale_note
 from .results import ModelResult, TestRunResult
 from .settings import Group, ModelLearningSettings
 from .store import Store
@@ -570,7 +570,7 @@ def _write_report(store: Store, out: Path, scale: str | None, names: list[str] |
         sections.append(text)
         anchor = _anchor(cfg.title + " [" + sc + "]")
         toc.append(f"- [{cfg.title} [{sc}]](#{anchor})")
-        if sc == "paper" and name in PAPER_FIGURES:
+        if sc == "paper" and name in PAPER_FIGURES and paper_protocol(cfg):  # not one whose --set ran less (T34-A01)
             claims[name] = (anchor, checked)
     if refuse_all_damaged and not statuses:  # the command said "report written" and exited 0, the damage only inside (T19-07)
         raise NeurohoverError(f"nothing could be reported from {str(store.path)!r}: every experiment asked for is damaged (said above); no report written")

@@ -5,9 +5,12 @@ of 6000 steps was called a smoke run)."""
 from __future__ import annotations
 
 import functools
+import math
 
-from .config import ExperimentConfig, load_config
+from .config import ExperimentConfig, load_config, shipped_counterpart
+from .overrides import ENTRIES, ENTRY_SCALE_LIKE, SCALE_LIKE
 from .report_claims import PAPER_FIGURES
+from .schema import ZERO_MEANS
 
 QUICK_NOTE = "a fast smoke-scale run: short episodes and few runs; magnitudes are not comparable with the paper"
 #: The page header's word on quick-scale sections (said only where the report has one).
@@ -54,33 +57,97 @@ def paper_reference(task: str, agent: str, mdps: str) -> tuple[str, int, int, in
     return best[0], best[2], best[3], best[6]
 
 
-def scale_note(cfg: ExperimentConfig) -> str:
-    """What the report's Scale line says of ``cfg``'s scale: quick, paper, or a settings-HASH run described by its own
-    episodes, episode length and runs: paper-comparable where each is at least the paper's for the runs it corresponds
-    to (:func:`paper_reference`), else which are shorter or fewer."""
-    if cfg.scale == "paper":
-        return "the paper protocol"
-    if cfg.scale == "quick":
-        return QUICK_NOTE
+def _shown(key: str, value: object) -> str:
+    return "no cap" if key in ZERO_MEANS and value == 0 else str(value)
+
+
+def _less(key: str, ours: object, paper: object) -> bool:
+    """Whether setting ``key``'s value ``ours`` runs less than ``paper`` (a budget of 0 is no cap: more than any)."""
+    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (ours, paper)):
+        return False
+    if key in ZERO_MEANS:
+        ours, paper = ours or math.inf, paper or math.inf
+    return ours < paper  # type: ignore[operator]
+
+
+def _shrunk(ours: dict, paper: dict) -> list[str]:
+    """The settings of how much is run (:data:`~.overrides.SCALE_LIKE`, and a named entry's sizes) that ``ours`` sets
+    lower than a shipped experiment's paper-scale ``paper``."""
+    out = [f"{k} ({_shown(k, ours[k])} < {_shown(k, paper[k])})" for k in sorted(SCALE_LIKE) if k in ours and k in paper and _less(k, ours[k], paper[k])]
+    for key, label in ENTRIES.items():
+        before = {e.get(label): e for e in paper.get(key) or [] if isinstance(e, dict)}
+        for entry in ours.get(key) or []:
+            was = before.get(entry.get(label), {})
+            out += [
+                f"{key[:-1]} {entry[label]!r} {k} ({entry[k]} < {was[k]})"
+                for k in sorted(ENTRY_SCALE_LIKE)
+                if k in entry and k in was and _less(k, entry[k], was[k])
+            ]
+    return out
+
+
+def paper_shortfall(cfg: ExperimentConfig) -> tuple[str, list[str]] | None:
+    """The paper protocol ``cfg``'s runs compare with, and what they run less of than it ([]: nothing; None: nothing to
+    compare with, at quick scale or in a config of one's own). The one decision of whether a run is the paper's protocol,
+    which the report's Scale line and its paper-scale claims table both read: a paper-scale run of a shipped experiment
+    against the shipped paper scale (its --set may change how much is run; one that shrank it was called the paper
+    protocol and counted in the claims, T34-A01), a compete run's settings-HASH against the paper figure's runs of its
+    agent (:func:`paper_reference`; T26-A07)."""
     s = cfg.settings
-    if cfg.kind != "test_runs" or not s.get("groups"):
-        return "a run of settings of its own (see Settings)"
+    if cfg.scale == "paper":
+        shipped = shipped_counterpart(cfg)
+        return None if shipped is None else (f"{cfg.name} at paper scale as shipped", _shrunk(s, shipped.settings))
+    if cfg.scale == "quick" or cfg.kind != "test_runs" or not s.get("groups"):
+        return None
     group = min(s["groups"], key=lambda g: g["n_mdps"] * g["runs_per_mdp"])
     runs = group["n_mdps"] * group["runs_per_mdp"]
-    ours = f"{s['episodes']} episodes of {s['n_steps']} steps, {runs} runs"
     ref = paper_reference(s["task"], group["agent"], group["mdps"])
     if ref is None:
-        return f"a run of settings of its own ({ours}); no paper figure runs task {s['task']} to compare it with"
+        return None
     figure, episodes, n_steps, paper_runs = ref
-    theirs = f"{figure} at paper scale: {episodes} episodes of {n_steps} steps, {paper_runs} runs"
     short = [
         *([f"fewer episodes ({s['episodes']} < {episodes})"] if s["episodes"] < episodes else []),
         *([f"shorter episodes ({s['n_steps']} < {n_steps} steps)"] if s["n_steps"] < n_steps else []),
         *([f"fewer runs ({runs} < {paper_runs})"] if runs < paper_runs else []),
     ]
+    return f"{figure} at paper scale: {episodes} episodes of {n_steps} steps, {paper_runs} runs", short
+
+
+def paper_protocol(cfg: ExperimentConfig) -> bool:
+    """Whether ``cfg`` is a paper-scale run of the paper's protocol, whose claims the paper-scale claims table judges:
+    not one whose --set ran less of it (:func:`paper_shortfall`; T34-A01)."""
+    if cfg.scale != "paper":
+        return False
+    shortfall = paper_shortfall(cfg)
+    return shortfall is None or not shortfall[1]
+
+
+def scale_note(cfg: ExperimentConfig) -> str:
+    """What the report's Scale line says of ``cfg``'s scale: quick, paper (or, where --set ran less than the paper
+    scale, not the paper's protocol), or a settings-HASH run described by its own episodes, episode length and runs:
+    paper-comparable where each is at least the paper's for the runs it corresponds to (:func:`paper_reference`), else
+    which are shorter or fewer (:func:`paper_shortfall`)."""
+    if cfg.scale == "quick":
+        return QUICK_NOTE
+    shortfall = paper_shortfall(cfg)
+    if cfg.scale == "paper":
+        if shortfall is None or not shortfall[1]:
+            return "the paper protocol"
+        return (
+            f"not the paper's protocol: --set ran less than {shortfall[0]}: {', '.join(shortfall[1])}; magnitudes are not "
+            "comparable with the paper, and its claims are left out of the paper-scale claims table"
+        )
+    s = cfg.settings
+    if cfg.kind != "test_runs" or not s.get("groups"):
+        return "a run of settings of its own (see Settings)"
+    group = min(s["groups"], key=lambda g: g["n_mdps"] * g["runs_per_mdp"])
+    ours = f"{s['episodes']} episodes of {s['n_steps']} steps, {group['n_mdps'] * group['runs_per_mdp']} runs"
+    if shortfall is None:
+        return f"a run of settings of its own ({ours}); no paper figure runs task {s['task']} to compare it with"
+    theirs, short = shortfall
     if not short:
         return f"paper-comparable: {ours}, at least the paper's ({theirs})"
-    if s["episodes"] >= episodes and s["n_steps"] >= n_steps:  # the runs alone are fewer
+    if not any(x.startswith(("fewer episodes", "shorter episodes")) for x in short):  # the runs alone are fewer
         why = "magnitudes per episode compare with the paper's; its spread and tests rest on fewer runs"
     else:
         why = "magnitudes are not comparable with the paper"
