@@ -88,3 +88,38 @@ def test_a_paper_scale_run_shrunk_by_set_stays_out_of_the_paper_scale_claims(tmp
         report = write_report(store, tmp_path / "r").read_text(encoding="utf-8")
     assert "- Scale: **paper** (not the paper's protocol: --set ran less than fig7" in report
     assert "Claims and conclusions" not in report and "### Against the paper" in report
+
+
+# T34-A03 ------------------------------------------------------------------------------------------------------------
+
+
+def test_wins_on_a_compete_experiment_says_it_holds_one_agent_and_what_wins_compares(tmp_path: Path, cli, capsys) -> None:
+    """Every compete experiment holds one agent: wins said only "a competition needs at least two agents, got
+    ['baseline']", and its help offered compete runs' scales."""
+    store = SE.competed_store(tmp_path)
+    rc, _, err = cli("wins", "compete-ghh08-baseline", "--store", str(store))
+    assert rc == 2 and SE.error(err, "wins").startswith("experiment 'compete-ghh08-baseline' (settings-"), err
+    assert (
+        "holds the test runs of one agent (baseline), as every `neurohover compete` experiment does, and a competition needs two or more: "
+        "wins compares the groups of one experiment; give a test-runs experiment of two or more groups (none in this store)" in err
+    )
+    with pytest.raises(SystemExit):
+        cli("wins", "--help")
+    out = " ".join(capsys.readouterr().out.split())
+    assert "settings-HASH" not in out and "a compete experiment holds one agent" in out and "--scale SCALE which scale: quick or paper" in out
+
+
+def test_wins_names_the_experiments_of_the_store_it_can_compare_and_refuses_one_agent_of_several(tmp_path: Path, cli) -> None:
+    from conftest import tiny_test_runs
+
+    config = tmp_path / "tr2.toml"
+    config.write_text(tiny_test_runs("baseline", "generic", name="tr2"))
+    store = SE.competed_store(tmp_path)
+    assert cli("reproduce", str(config), "--store", str(store), "--no-progress")[0] == 0
+    rc, _, err = cli("wins", "compete-ghh08-baseline", "--store", str(store))
+    assert rc == 2 and "give a test-runs experiment of two or more groups (this store's tr2 (quick))" in err, err
+    rc, _, err = cli("wins", "tr2", "--store", str(store), "--agents", "generic")
+    assert (
+        rc == 2 and SE.error(err, "wins") == "--agents 'generic' names one agent: a competition needs two or more; give more of baseline, generic, or --against"
+    )
+    assert cli("wins", "tr2", "--store", str(store), "--runs", "1")[0] == 0

@@ -195,7 +195,7 @@ def cmd_wins(args: argparse.Namespace) -> int:
     can be chosen for N. With --against LABEL, each agent against that one alone."""
     from ..experiments import Store
     from ..experiments.export import checked_units, resolve_scale
-    from ..experiments.wins import stored_runs, win_probabilities
+    from ..experiments.wins import one_agent, several_groups, stored_runs, win_probabilities
     from ..paths import input_file
 
     refuse_sqlite_name(args.store, "--store")  # before "no such results store" (T32-A02)
@@ -206,6 +206,7 @@ def cmd_wins(args: argparse.Namespace) -> int:
         config, units, _ = checked_units(store, args.name, scale)  # results' check: a unit of kind 'bogus' was a test run here (T19-05)
         runs = stored_runs({u["key"]: u["result"] for u in units})
         groups = config.settings.get("groups", [])
+        comparable = several_groups(store) if len(runs) == 1 else []
     planned = {g.get("label") for g in groups if isinstance(g, dict)} if isinstance(groups, list) else set()
     foreign = sorted(set(runs) - planned)
     if foreign:  # a unit of no planned group was entered as an agent (sixth trial)
@@ -213,6 +214,8 @@ def cmd_wins(args: argparse.Namespace) -> int:
         raise NeurohoverError(f"{where} is damaged: it holds test runs of group {foreign[0]!r}, which {args.name} ({scale}) does not plan")
     if not runs:
         raise NeurohoverError(f"experiment {args.name!r} ({scale}) has no stored test runs: wins compares the agents of a test-runs experiment")
+    if len(runs) == 1:  # every compete experiment: "a competition needs at least two agents, got ['baseline']" (T34-A03)
+        raise NeurohoverError(one_agent(args.name, scale, next(iter(runs)), comparable))
     for option, value in (("--agents", args.agents), ("--against", args.against)):  # '' entered every agent (second trial)
         if value is not None and not all(value.split(",")):  # named alone: the other may not have been given (fifth trial)
             raise NeurohoverError(f"{option} {value!r}: an agent's label is empty; allowed {', '.join(runs)}")
@@ -222,6 +225,8 @@ def cmd_wins(args: argparse.Namespace) -> int:
             raise NeurohoverError(f"agent {label!r} has no test runs in {args.name!r} ({scale}): allowed {', '.join(runs)}")
     if len(set(chosen)) != len(chosen):
         raise NeurohoverError(f"--agents {args.agents!r} names an agent twice: give each once")
+    if len(chosen) == 1 and not args.against:  # "a competition needs at least two agents, got ['x']" (T34-A03)
+        raise NeurohoverError(f"--agents {args.agents!r} names one agent: a competition needs two or more; give more of {', '.join(runs)}, or --against")
     others = ",".join(a for a in chosen if a != args.against)
     if args.against and args.agents and args.against in chosen and others:  # it was dropped from the table without a word (twelfth trial, S4)
         raise NeurohoverError(f"--against {args.against} is also in --agents {args.agents!r}: an agent is not compared with itself; give --agents {others}")
@@ -332,11 +337,9 @@ def register(sub) -> None:
     p.set_defaults(func=cmd_results)
 
     p = sub.add_parser("wins", help="each agent's odds of winning an N-run competition, from stored test runs", description=cmd_wins.__doc__)
-    p.add_argument("name", help="experiment name (a test-runs experiment)")
+    p.add_argument("name", help="experiment name (a test-runs experiment of two or more groups; a compete experiment holds one agent)")
     p.add_argument("--store", required=True, help="results store file")
-    p.add_argument(
-        "--scale", metavar="SCALE", type=stored_scale, help="which scale: quick, paper or a compete run's settings-HASH (needed when the store holds several)"
-    )
+    p.add_argument("--scale", metavar="SCALE", type=stored_scale, help="which scale: quick or paper (needed when the store holds several)")
     p.add_argument("--runs", default="1,5,20", help="competition lengths N, comma-separated (default 1,5,20)")
     p.add_argument("--agents", help="group labels to enter, comma-separated (default: every group of the experiment)")
     p.add_argument("--against", metavar="LABEL", help="each agent against this group alone (head to head); not also one of --agents")

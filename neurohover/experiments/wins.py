@@ -18,10 +18,11 @@ import numpy as np
 
 from ..errors import NeurohoverError, as_floats, brief, whole_in
 from ..evolution.seeding import check_seed
+from .config import COMPETE_PREFIX
 from .keys import UnitKey
 from .results import TestRunResult
 
-__all__ = ["DEFAULT_DRAWS", "WinOdds", "stored_runs", "win_probabilities"]
+__all__ = ["DEFAULT_DRAWS", "WinOdds", "one_agent", "several_groups", "stored_runs", "win_probabilities"]
 
 DEFAULT_DRAWS = 10_000
 _MAX_CELLS = 50_000_000  # draws x runs per agent held at once: about 400 MB of float64
@@ -116,3 +117,31 @@ def stored_runs(results: Mapping[str, dict]) -> dict[str, dict[str, list[float]]
                 raise NeurohoverError(f"the stored result of unit {key!r} is damaged: {err}") from None
             runs.setdefault(unit.group, {}).setdefault(str(run.mdp), []).append(float(run.score))
     return runs
+
+
+def several_groups(store) -> list[str]:
+    """'NAME (SCALE)' of each test-runs experiment in ``store`` (a :class:`~.store.Store`) that plans two or more groups:
+    those ``wins`` can compare (a damaged config is left out; the command that reads it says why)."""
+    out = []
+    for name, scale, _, _ in store.experiments():
+        try:
+            groups = store.config(name, scale).get("settings", {}).get("groups")
+        except NeurohoverError:
+            continue
+        if isinstance(groups, list) and len(groups) >= 2:
+            out.append(f"{name} ({scale})")
+    return out
+
+
+def one_agent(name: str, scale: str, label: str, others: list[str]) -> str:
+    """The refusal of ``wins`` on experiment ``name`` whose stored test runs are of one group (``label``) only, saying
+    what works: a compete experiment holds one agent each, and wins compares the groups of one experiment (it said only
+    "a competition needs at least two agents, got ['baseline']", though its help offered compete scales; T34-A03).
+    ``others``: the store's experiments that :func:`several_groups` finds."""
+    compete = ", as every `neurohover compete` experiment does," if name.lower().startswith(COMPETE_PREFIX) else ""
+    where = f"this store's {', '.join(others)}" if others else "none in this store"
+    return (
+        f"experiment {name!r} ({scale}) holds the test runs of one agent ({label}){compete} and a competition needs two or more: "
+        f"wins compares the groups of one experiment; give a test-runs experiment of two or more groups ({where}), such as a "
+        "reproduce of fig7 or a config of your own with a group per agent"
+    )
