@@ -301,6 +301,12 @@ def check_padding(kinds: np.ndarray, genomes: np.ndarray, kind_numbers: dict[str
     """Refuse a kernel table's row whose genes past its kind's genome (``kind_numbers``: topology to kind) are not zero,
     as :meth:`~neurohover.evaluate.PolicyTable.from_policies` pads them: an MLP row declared an SLP (kinds [0, 0]) flew
     as one, its genes 40 and 41 unread (T33-B10)."""
+    for topology, number in kind_numbers.items():  # a quick look first: evolution builds a table every generation
+        rows = kinds == number
+        if GENOME_LENGTH[topology] < genomes.shape[1] and genomes[rows, GENOME_LENGTH[topology] :].any():  # NaN too
+            break
+    else:
+        return  # every padding gene zero
     lengths = np.zeros(max(kind_numbers.values()) + 1, dtype=np.int64)
     for topology, number in kind_numbers.items():
         lengths[number] = GENOME_LENGTH[topology]
