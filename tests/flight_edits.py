@@ -13,6 +13,16 @@ from neurohover.errors import NeurohoverError
 from neurohover.flightdata import FlightData
 
 
+def recorded(where: Path, episodes: int) -> Path:
+    """A recording as ``neurohover fly --record`` writes it under ``where`` (ghh08 train:1, ``episodes`` episodes)."""
+    from neurohover.cli import main
+
+    path = where / "f.npz"
+    argv = ["fly", "--task", "ghh08", "--mdp", "train:1", "--episodes", str(episodes), "--threads", "1", "--json", "--record", str(path)]
+    assert main(argv) == 0
+    return path
+
+
 def edited_copy(flight: Path, out: Path, edit: Callable[[dict], None]) -> Path:
     """``flight`` written again to ``out`` with its metadata changed by ``edit``, its arrays as they were: a hand edit."""
     with np.load(flight) as z:

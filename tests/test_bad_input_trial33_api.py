@@ -13,6 +13,7 @@ import pickle
 import re
 from pathlib import Path
 
+import flight_edits as FE
 import numpy as np
 import pytest
 from flight_edits import edited_copy, refused_everywhere
@@ -26,12 +27,7 @@ DEEP = 1000
 @pytest.fixture(scope="module")
 def flight(tmp_path_factory) -> Path:
     """A recording as ``neurohover fly --record`` writes it (ghh08 train:1, two episodes)."""
-    from neurohover.cli import main
-
-    path = tmp_path_factory.mktemp("flight") / "f.npz"
-    argv = ["fly", "--task", "ghh08", "--mdp", "train:1", "--episodes", "2", "--threads", "1", "--json", "--record", str(path)]
-    assert main(argv) == 0
-    return path
+    return FE.recorded(tmp_path_factory.mktemp("flight"), 2)
 
 
 def test_b01_a_wind_label_nested_deep_is_refused_by_name(flight: Path, cli, tmp_path: Path) -> None:

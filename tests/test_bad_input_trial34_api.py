@@ -10,6 +10,7 @@ import json
 import warnings
 from pathlib import Path
 
+import flight_edits as FE
 import numpy as np
 import pytest
 
@@ -40,12 +41,7 @@ def test_b11_evaluate_jobs_refuses_a_2d_fallback_index() -> None:
 @pytest.fixture(scope="module")
 def flight(tmp_path_factory) -> Path:
     """A recording as ``neurohover fly --record`` writes it (ghh08 train:1, one episode)."""
-    from neurohover.cli import main
-
-    path = tmp_path_factory.mktemp("flight") / "f.npz"
-    argv = ["fly", "--task", "ghh08", "--mdp", "train:1", "--episodes", "1", "--threads", "1", "--json", "--record", str(path)]
-    assert main(argv) == 0
-    return path
+    return FE.recorded(tmp_path_factory.mktemp("flight"), 1)
 
 
 def _other_kinds(folder: Path) -> dict[str, str]:
