@@ -74,7 +74,7 @@ def test_a_sample_fn_that_cannot_be_called_is_refused_up_front(which: str) -> No
     [
         ([1.0, 2.0], 1.5, r"delta=1\.5 must be a confidence level strictly between 0 and 1"),
         ([1.0, 2.0], -0.5, r"delta=-0\.5 must be a confidence level strictly between 0 and 1"),
-        ([1.0, 2.0], "x", r"delta='x' must be a confidence level strictly between 0 and 1"),
+        ([1.0, 2.0], "x", r"delta='x' is not a number: allowed a confidence level strictly between 0 and 1"),
         ([1.0, np.nan], 0.9, r"samples=\[1\.0, nan\] is not allowed: give finite returns or -inf, no NaN and no \+inf"),
         ([1.0, np.inf], 0.9, r"samples=\[1\.0, inf\] is not allowed: give finite returns or -inf"),
         (["a", "b"], 0.9, r"samples=\['a', 'b'\] is not allowed: give an array of returns"),

@@ -45,14 +45,13 @@ from __future__ import annotations
 
 import functools
 import math
-import numbers
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numba
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, whole_number
+from ..errors import NeurohoverError, brief, finite_real, real_number, whole_number
 from ..procs import half_free_memory
 from .common import as_floats
 
@@ -172,8 +171,11 @@ def _check_room(n: int, episodes: int) -> None:
 
 
 def _check_delta(delta: object) -> float:
-    if not (isinstance(delta, numbers.Real) and finite_real(delta) and 0.0 < float(delta) < 1.0):  # finite_real: float(10**400) overflowed
-        raise NeurohoverError(f"delta={brief(delta)} must be a confidence level strictly between 0 and 1 (e.g. 0.9 for 90% confidence bounds)")
+    level = "a confidence level strictly between 0 and 1 (e.g. 0.9 for 90% confidence bounds)"
+    if not real_number(delta):  # '0.5', Decimal, a 0-d array, True were called out of range (T35-B10)
+        raise NeurohoverError(f"delta={brief(delta)} is not a number: allowed {level}")
+    if not (finite_real(delta) and 0.0 < float(delta) < 1.0):  # finite_real: float(10**400) overflowed
+        raise NeurohoverError(f"delta={brief(delta)} must be {level}")
     return float(delta)
 
 
