@@ -22,3 +22,32 @@ def test_t35_b10_delta_of_the_wrong_type_is_not_a_number(delta):
         bayes_mean_bounds(np.array([1.0, 2.0]), delta)
     with pytest.raises(NeurohoverError, match=r"delta=1\.5 must be a confidence level"):
         bayes_mean_bounds(np.array([1.0, 2.0]), 1.5)
+
+
+@pytest.mark.parametrize("unit", [1e200, 1e-320, 1e300])
+def test_t35_b04_bounds_of_huge_and_denormal_returns_are_those_of_scaled_ones(unit):
+    x = np.array([-1.0, -2.0, -3.0])
+    lo, hi = bayes_mean_bounds(x, 0.05)
+    with np.errstate(all="raise"):  # the overflow was a RuntimeWarning, then (-inf, inf)
+        got = bayes_mean_bounds(x * unit, 0.05)
+    assert np.all(np.isfinite(got)) and got[0] < got[1]
+    assert got == pytest.approx((lo * unit, hi * unit), rel=1e-3 if unit < 1e-300 else 1e-12)
+
+
+def test_t35_b04_the_race_kernel_gives_the_same_bounds_for_huge_returns():
+    rng = np.random.default_rng(0)
+    table = -1e200 * (1 + np.arange(4)[:, None] + rng.random((4, 3)))
+    drawn = np.zeros(4, dtype=int)
+
+    def sample(idx):  # each candidate's next column (a candidate listed twice flies two episodes)
+        out = np.empty(len(idx))
+        for n, i in enumerate(idx):
+            out[n] = table[i, drawn[i]]
+            drawn[i] += 1
+        return out
+
+    r = selection_race(sample, 4, 2, 0.9, t_limit=3)
+    for i in range(4):
+        k = int(r.n_samples[i])
+        assert (r.lower[i], r.upper[i]) == bayes_mean_bounds(table[i, :k], 0.9)
+    assert np.all(np.isfinite(r.lower)) and np.all(np.isfinite(r.upper))

@@ -228,7 +228,10 @@ def bayes_mean_bounds(samples: np.ndarray, delta: float) -> tuple[float, float]:
     - one sample: ``(-inf, +inf)`` (``bayes_mvs`` raises; nothing is known
       about the spread);
     - zero variance (all samples equal): ``(mean, mean)`` (``bayes_mvs`` gives NaN);
-    - any ``-inf`` sample (the races map NaN to ``-inf``): ``(-inf, -inf)``.
+    - any ``-inf`` sample (the races map NaN to ``-inf``): ``(-inf, -inf)``;
+    - returns past 2**500 or below 2**-400 in size, whose squares overflow or
+      underflow (``bayes_mvs`` gives ``(-inf, inf)``, or zero width): computed
+      in units of a power of two, so the bounds stay finite and correct.
 
     Parameters
     ----------
@@ -258,11 +261,15 @@ def bayes_mean_bounds(samples: np.ndarray, delta: float) -> tuple[float, float]:
     if np.all(x == x[0]):
         m = float(x[0])
         return m, m
+    p = int(_scale_exponent(x, n))  # returns whose squares overflow or underflow: in units of 2**p (T35-B04)
+    if p:
+        x = x * math.ldexp(1.0, -p)
+    up = math.ldexp(1.0, p)
     xbar = float(x.mean())
     var = float(x.var())
     scale = math.sqrt(var / n) if n > 1000 else math.sqrt(var / (n - 1))
     q_lo, q_hi = _standard_quantiles(n, delta)
-    return q_lo * scale + xbar, q_hi * scale + xbar
+    return (q_lo * scale + xbar) * up, (q_hi * scale + xbar) * up
 
 
 def fixed_resampling(sample_fn: SampleFn, n_candidates: int, k: int) -> ResamplingResult:
@@ -492,6 +499,26 @@ def _pairwise_sum(x, n):
 
 
 @numba.njit(cache=True, error_model="numpy")
+def _scale_exponent(x, n):
+    """0 where the returns ``x[:n]`` have a mean and variance a float holds to full precision, else the even ``p``
+    that brings the largest near 1: the bounds are then those of ``x / 2**p`` times ``2**p``, exact powers of two.
+    Returns past 2**500 (~3e150) overflowed the squared deviations to (-inf, inf); below 2**-400 (~4e-121) they
+    underflowed, and denormal returns gave zero-width bounds (T35-B04)."""
+    largest = 0.0
+    for t in range(n):
+        a = abs(x[t])
+        if a > largest:
+            largest = a
+    if largest == 0.0 or _SMALL <= largest <= _LARGE:
+        return 0
+    p = min(max(math.frexp(largest)[1], -1000), 1000)  # 2**-p and 2**p both floats; denormals come to ~2**-62 at most
+    return p - p % 2
+
+
+_LARGE, _SMALL = 2.0**500, 2.0**-400
+
+
+@numba.njit(cache=True, error_model="numpy")
 def _race_round(samples, active, first_new, k, q_lo, q_hi, need_select, need_discard, crashed, means, lower, upper, sel, dis):
     """One round of :func:`selection_race` for its undecided candidates ``active`` (each with ``k`` samples in
     its row of ``samples``, ``first_new ..`` new this round): update ``crashed``, write ``means`` and the
@@ -503,13 +530,21 @@ def _race_round(samples, active, first_new, k, q_lo, q_hi, need_select, need_dis
             if samples[i, t] == -np.inf:
                 crashed[i] = True
     squares = np.empty(k)
+    scaled = np.empty(k)
     for i in active:
         row = samples[i]
         if crashed[i]:
             means[i] = lower[i] = upper[i] = -np.inf
             continue
+        p = _scale_exponent(row, k)
+        if p != 0:  # returns whose squares overflow or underflow: those of row / 2**p, times 2**p (T35-B04)
+            down = math.ldexp(1.0, -p)
+            for t in range(k):
+                scaled[t] = row[t] * down
+            row = scaled
+        up = math.ldexp(1.0, p)  # 1.0 (p = 0): the same bits as unscaled
         mean = _pairwise_sum(row, k) / k
-        means[i] = mean
+        means[i] = mean * up
         if k == 1:
             lower[i], upper[i] = -np.inf, np.inf
             continue
@@ -519,15 +554,15 @@ def _race_round(samples, active, first_new, k, q_lo, q_hi, need_select, need_dis
                 constant = False
                 break
         if constant:
-            lower[i] = upper[i] = row[0]
+            lower[i] = upper[i] = samples[i, 0]
             continue
         for t in range(k):
             d = row[t] - mean
             squares[t] = d * d
         var = _pairwise_sum(squares, k) / k
         scale = np.sqrt(var / k) if k > 1000 else np.sqrt(var / (k - 1))
-        lower[i] = q_lo * scale + mean
-        upper[i] = q_hi * scale + mean
+        lower[i] = (q_lo * scale + mean) * up
+        upper[i] = (q_hi * scale + mean) * up
     for q in range(active.shape[0]):
         i = active[q]
         beaten = 0
