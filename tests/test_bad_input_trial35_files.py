@@ -51,3 +51,15 @@ def test_t35_b04_the_race_kernel_gives_the_same_bounds_for_huge_returns():
         k = int(r.n_samples[i])
         assert (r.lower[i], r.upper[i]) == bayes_mean_bounds(table[i, :k], 0.9)
     assert np.all(np.isfinite(r.lower)) and np.all(np.isfinite(r.upper))
+
+
+@pytest.mark.parametrize("text", ["D_w=0.8@1_000-2_000", "D_w=0.8@1_0", "D_w=0.8@200-8_00"])
+def test_t35_b09_drift_windows_refuse_underscores_as_sensor_parse_does(text):
+    from neurohover.tasks.drift import Drift
+    from neurohover.tasks.sensor import Sensor
+
+    with pytest.raises(NeurohoverError, match="is not understood"):
+        Drift.parse(text)
+    with pytest.raises(NeurohoverError, match="needs a number after '='"):
+        Sensor.parse("delay=1_0")
+    assert Drift.parse("D_w=0.8@200-800").change_at == (200, 800)

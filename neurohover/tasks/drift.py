@@ -212,7 +212,7 @@ class Drift:
                 number = float_of(value)
                 if when:
                     lo, dash, hi = when.partition("-")
-                    at = (int(lo), int(hi if dash else lo))  # '@200-' is no window: int('') refuses it
+                    at = (_episode(lo), _episode(hi if dash else lo))  # '@200-' is no window: int('') refuses it
             except ValueError as err:
                 why = f" ({err})" if isinstance(err, FloatRangeError) else ""
                 raise NeurohoverError(f"drift {part[:40]!r} is not understood{why}: {_PARSE_FORM}") from None
@@ -234,6 +234,14 @@ class Drift:
 
 
 NO_DRIFT = Drift()
+
+
+def _episode(text: str) -> int:
+    """An episode of a window, read as :func:`float_of` reads a number (Sensor.parse's): no '_' between digits, which
+    int() reads ('@1_000-2_000' was episodes 1000..2000; T35-B09); a whole number, as int() reads it."""
+    if "_" in text:
+        raise ValueError(f"invalid literal for int(): {text!r} (no '_' between digits)")
+    return int(text)
 
 
 def _whole(name: str, value, what: str, low: int, high: int | None = None) -> int:
