@@ -115,15 +115,17 @@ def noting_missing_glyphs() -> Iterator[None]:
 
 
 def save_figure(fig: Figure, path: str | Path) -> Path:
-    """Write ``fig`` as a PNG to ``path``, checked as every output file is (:func:`~neurohover.paths.output_file`:
-    not a directory, device, pipe or socket; missing parent directories are created, saying so)."""
+    """Write ``fig`` as a PNG to ``path``, a name ending .png (any case), checked as every output file is
+    (:func:`~neurohover.paths.output_file`: not a directory, device, pipe or socket; missing parent directories are
+    created, saying so)."""
     from matplotlib.figure import Figure
 
     from .paths import write_png
 
     if not isinstance(fig, Figure):  # None was an AttributeError mid-write
         raise NeurohoverError(f"fig={brief(fig)} is not allowed: give a matplotlib Figure (e.g. from flight_figure or compete_figure)")
-    path = output_file(path, "plot file")  # a FIFO or /dev/full was replaced by the PNG (fourteenth trial, T14-1)
+    # A FIFO or /dev/full was replaced by the PNG (fourteenth trial, T14-1); 'figure.pdf' got PNG bytes (T35-B05).
+    path = output_file(path, "plot file", suffixes=(".png",), what="a plot is PNG")
     with noting_missing_glyphs():
         return write_png(fig, path, "plot file")
 

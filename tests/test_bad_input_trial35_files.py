@@ -63,3 +63,14 @@ def test_t35_b09_drift_windows_refuse_underscores_as_sensor_parse_does(text):
     with pytest.raises(NeurohoverError, match="needs a number after '='"):
         Sensor.parse("delay=1_0")
     assert Drift.parse("D_w=0.8@200-800").change_at == (200, 800)
+
+
+@pytest.mark.parametrize("name", ["figure.pdf", "pc.jpg", "notes.txt", "noext"])
+def test_t35_b05_a_plot_named_other_than_png_is_refused(tmp_path, name):
+    from neurohover import plots
+
+    fig = plots.new_figure(3, 3)
+    with pytest.raises(NeurohoverError, match=r"is not allowed: a plot is PNG; give a path ending \.png"):
+        plots.save_figure(fig, tmp_path / name)
+    assert not (tmp_path / name).exists()
+    assert plots.save_figure(fig, tmp_path / "upper.PNG").read_bytes()[:4] == b"\x89PNG"
