@@ -24,7 +24,7 @@ from .errors import NeurohoverError, as_floats, brief, finite_real, real_number,
 from .flightdata import FlightData, same_values
 from .flyer import KernelFlyer
 from .launch import DEVICES, KIND, MAX_SEED, Batch, Flown, check_device, launch, num_threads, use_lanes
-from .policies import GENOME_LENGTH, Policy, check_padding, genome_rows, load_policy, refuse_own_act
+from .policies import GENOME_LENGTH, Policy, check_padding, frozen, genome_rows, load_policy, refuse_own_act
 from .sim.constants import (
     EPISODE_STEPS,
     MAX_EPISODE_STEPS,
@@ -113,8 +113,10 @@ class PolicyTable:
         if genomes.dtype.kind not in "iuf":  # not issubdtype(np.integer): time spans are NumPy integers (T17-1); booleans are kind 'b'
             raise NeurohoverError(f"PolicyTable genomes must be real numbers, got dtype {genomes.dtype} (complex and objects were a ValueError in the kernel)")
         check_padding(kinds, genomes, KIND)  # an MLP row declared an SLP flew as one, its genes 40 and 41 unread (T33-B10)
-        object.__setattr__(self, "kinds", kinds.astype(np.int64, copy=False))  # uint8 kinds were refused by the kernel's batch
-        object.__setattr__(self, "genomes", genomes.astype(np.float64, copy=False))
+        # uint8 kinds were refused by the kernel's batch; read-only, as a Policy's genome: a row made an SLP after the
+        # padding check flew as one (T35-B01), the caller's own array copied rather than frozen
+        object.__setattr__(self, "kinds", frozen(kinds.astype(np.int64, copy=False), self.kinds))
+        object.__setattr__(self, "genomes", frozen(genomes.astype(np.float64, copy=False), self.genomes))
 
     @classmethod
     def from_policies(cls, policies: Sequence[Policy]) -> PolicyTable:
@@ -131,7 +133,7 @@ class PolicyTable:
         genomes = np.zeros((len(policies), GENOME_WIDTH))
         for i, p in enumerate(policies):
             genomes[i, : p.genome.size] = p.genome
-        return cls(kinds, genomes)
+        return cls(frozen(kinds, None), frozen(genomes, None))  # made here: frozen, not copied again
 
     @classmethod
     def from_genomes(cls, genomes: np.ndarray, topology: str) -> PolicyTable:
@@ -144,7 +146,7 @@ class PolicyTable:
         g, n = genome_rows(genomes, topology), GENOME_LENGTH[topology]  # the checks: a ragged list was NumPy's ValueError (T34-B02)
         table = np.zeros((g.shape[0], GENOME_WIDTH))
         table[:, :n] = g
-        return cls(np.full(g.shape[0], KIND[topology], dtype=np.int64), table)
+        return cls(frozen(np.full(g.shape[0], KIND[topology], dtype=np.int64), None), frozen(table, None))  # not copied again
 
     def __len__(self) -> int:
         return self.kinds.shape[0]
@@ -412,6 +414,11 @@ def evaluate_jobs(
             f"safeguard_limits must be {SAFEGUARD_LAYOUT_LEN} numbers in the layout of DangerousState.limits() (9 box limits, the tilt "
             f"threshold, the kind 0 or 1, the ratio threshold, 12 ratio limits, all > 0 but the kind; then the arming step, a whole "
             f"number >= 0), got {limits.tolist()}"
+        )
+    if limits[SAFEGUARD_ARM] >= n_steps and (fb >= 0).any():  # the safeguard never armed, without a word (T35-B03)
+        raise NeurohoverError(
+            f"safeguard arm_after={int(limits[SAFEGUARD_ARM])} is not below the episode's {n_steps} control steps (n_steps): "
+            f"the safeguard would never test; give arm_after below {n_steps}"
         )
     rec = np.zeros(n_jobs, dtype=bool) if record is None else np.asarray(record).reshape(-1)
     if rec.dtype != bool or isinstance(record, np.ma.MaskedArray):  # record='x' was read as True (second trial); a mask dropped (T16-9)

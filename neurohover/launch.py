@@ -255,7 +255,9 @@ class Batch:
 
     def jobs(self) -> Jobs:
         """The jobs in the kernel's layout (every path reads them)."""
-        return Jobs(self.rows, self.kinds, self.genomes, self.policy_index, self.mdp_index, self.episode_index, np.uint64(self.seed), self.n_steps)
+        # a PolicyTable's read-only arrays (T35-B01) copied: numba compiled the kernel again for read-only arrays
+        kinds, genomes = (a if a.flags.writeable else a.copy() for a in (self.kinds, self.genomes))
+        return Jobs(self.rows, kinds, genomes, self.policy_index, self.mdp_index, self.episode_index, np.uint64(self.seed), self.n_steps)
 
     def extras(self) -> Extras:
         """The safeguard and the recording in the kernel's layout (the scalar and CUDA kernels read them)."""

@@ -321,6 +321,16 @@ def check_padding(kinds: np.ndarray, genomes: np.ndarray, kind_numbers: dict[str
         )
 
 
+def frozen(array: np.ndarray, given: object) -> np.ndarray:
+    """``array`` made read-only, copied first where it shares memory with ``given`` (the caller's array, from which it
+    was made) and that memory can still be written: freezing it would freeze the caller's array, or leave a way round
+    the checks made (a PolicyTable row made an SLP after its padding check flew as one; T35-B01)."""
+    if isinstance(given, np.ndarray) and np.may_share_memory(array, given) and (given.flags.writeable or not given.flags.owndata):
+        array = array.copy()
+    array.setflags(write=False)
+    return array
+
+
 def genome_rows(genomes: object, topology: str) -> np.ndarray:
     """``genomes`` as a float64 array (P >= 1, the topology's genome length), for
     :meth:`~neurohover.evaluate.PolicyTable.from_genomes`, or a clear error. Non-finite genes are taken (that table flies

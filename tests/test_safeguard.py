@@ -72,7 +72,8 @@ def test_an_armed_test_fires_at_the_first_dangerous_step_from_its_arming_step() 
     steps = late.safeguard_step.ravel()
     # armed later: it fires no earlier than its arming step, or the roller crashed before the fallback could take over
     assert ((steps >= k0.max() + 1) | ((steps == -1) & late.crashed.ravel())).all()
-    assert (fly(DangerousState(arm_after=10**6)).safeguard_step.ravel() == -1).all()  # never armed
+    with pytest.raises(NeurohoverError, match="safeguard arm_after=1000000 is not below the episode's 300 control steps"):
+        fly(DangerousState(arm_after=10**6))  # it would never arm: refused since T35-B03
 
 
 _RATIOS = [5.0] * 3 + [20.0] * 3 + [4 * math.pi] * 3 + [1.0] * 3
