@@ -232,11 +232,26 @@ class Agent:
     def start(self, family: TaskFamily, rng: np.random.Generator) -> None:
         """Prepare for a new run on an unknown MDP of ``family`` (reset any per-run state)."""
 
-    def choose(self, episode: int) -> Choice:  # pragma: no cover - abstract
-        raise NotImplementedError
+    def choose(self, episode: int) -> Choice:  # abstract: a bare NotImplementedError named nothing (T35-B02)
+        raise NeurohoverError(_unimplemented(self, "choose"))
 
-    def update(self, outcome: EpisodeOutcome) -> None:  # pragma: no cover - abstract
-        raise NotImplementedError
+    def update(self, outcome: EpisodeOutcome) -> None:  # abstract
+        raise NeurohoverError(_unimplemented(self, "update"))
+
+
+def _unimplemented(agent: Agent, method: str) -> str:
+    """The message for an agent whose class leaves ``method`` to the base class (T35-B02)."""
+    return (
+        f"agent class {type(agent).__name__} does not define {method}, which is not allowed: an Agent subclass implements both "
+        "choose(self, episode) -> Choice and update(self, outcome: EpisodeOutcome) -> None (neurohover.agents.protocol)"
+    )
+
+
+def check_agent_methods(agent: Agent) -> None:
+    """Refuse an agent whose class leaves choose or update to the base class, before any episode flies (T35-B02)."""
+    for method in ("choose", "update"):
+        if getattr(getattr(agent, method, None), "__func__", None) is Agent.__dict__[method]:
+            raise NeurohoverError(_unimplemented(agent, method))
 
 
 Agent.start = _checked_start(Agent.start)  # type: ignore[method-assign]  # agents that keep the base start are checked too
@@ -325,6 +340,7 @@ def _check_run(agent, family, mdp, episodes, seed, n_steps) -> tuple[MDP, int, i
     (:func:`_flown_mdp`), the seed, episodes and n_steps (Python ints: np.int8(127) + 1 overflowed, T31-B02)."""
     if not isinstance(agent, Agent):
         raise NeurohoverError(f"agent={agent!r:.80} is not allowed: give an Agent (neurohover.agents.registry.make_agent(name, family))")
+    check_agent_methods(agent)
     if not isinstance(family, TaskFamily):
         raise NeurohoverError(f"family={family!r:.80} is not allowed: give a TaskFamily (neurohover.get_task_family(name))")
     if not isinstance(mdp, MDP):
