@@ -12,6 +12,7 @@ import importlib
 import pkgutil
 
 from ..errors import NeurohoverError, brief
+from ..integrations.flying import generic_sigma_problem
 from ..policysets import PolicySet, load_policy_set
 from ..tasks import TaskFamily, get_task_family
 from .protocol import Agent
@@ -75,8 +76,8 @@ def policies_from_set(spec: AgentSpec, ps: PolicySet) -> AgentPolicies:
 def _policy_set(family: TaskFamily, policy_dir: str | None) -> PolicySet:
     """The family's policy set, refused when it was evolved for another breadth sigma."""
     ps = load_policy_set(family.name, policy_dir)
-    built = ps.manifest.get("sigma")
-    if family.sigma is not None and family.generic_over_distribution and built is not None and float(built) != family.sigma:
+    built = generic_sigma_problem(family, ps.manifest.get("sigma"))  # one decision, compare_agent's too (T35-B07)
+    if built is not None:
         idle = ", ".join(name for name, s in AGENTS.items() if not s.needs and s.applies_to(family))
         builds = get_task_family(family.name).sigma  # the sigma build-policies evolves the set's generics at
         # "build one for this sigma" could not be followed: build-policies evolves FGHH's generics at its family's sigma only (T29-A05)

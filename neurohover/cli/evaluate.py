@@ -114,10 +114,11 @@ def _generic_sigma_note(family) -> str | None:
     the set's sigma. Flown with this note (an evaluation, not a competition), where compete refuses the set (T29-A08)."""
     if not family.generic_over_distribution or family.sigma is None:
         return None
+    from ..integrations.flying import generic_sigma_problem
     from ..policysets import load_policy_set
 
-    built = load_policy_set(family.name).manifest.get("sigma")
-    if built is None or float(built) == family.sigma:
+    built = generic_sigma_problem(family, load_policy_set(family.name).manifest.get("sigma"))  # make_agent's decision (T35-B07)
+    if built is None:
         return None
     return (
         f"the generic row flies the shipped {family.name} generic, evolved for sigma = {built}, not {family.sigma} (the sigma of these MDPs): "
@@ -130,6 +131,7 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     and the shipped generic policy on the same gusts, and print the paper's measures (return per episode, crashes)."""
     from ..integrations.flying import compare_agent
     from ..paths import output_file, writing
+    from ..policysets import load_policy_set
     from ..progress import progress_bar
 
     family = task_family_of(args)  # with --obs-noise / --obs-delay every policy flies through those sensors
@@ -158,15 +160,16 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     mdps = [family.mdp(f"{args.mdps}:{i}") for i in range(n)]
     # the agent's flight (a kernel policy flies in one call: no steps to count), on a terminal only
     quiet = True if isinstance(act, Policy) else None
+    note = _generic_sigma_note(family)
     with progress_bar(total=args.episode_steps, desc="agent's episodes", unit="step", disable=quiet, dynamic_ncols=True) as bar:
-        rows = compare_agent(
-            act, mdps, episodes=args.episodes, seed=args.seed, n_steps=args.episode_steps, obs_dtype=args.obs_dtype, on_step=lambda: bar.update(1)
-        )
+        rows = compare_agent(  # at another sigma the shipped generic flies as a reference, with the note below
+            act, mdps, episodes=args.episodes, seed=args.seed, n_steps=args.episode_steps, obs_dtype=args.obs_dtype, on_step=lambda: bar.update(1),
+            generic=load_policy_set(family.name).generic if note is not None else None,
+        )  # fmt: skip
     print(f"{args.task} {args.mdps} MDPs 0-{n - 1}, {args.episodes} episode(s) each of {args.episode_steps} steps, gusts of seed {args.seed}:")
     print(f"{'policy':<10} {'return/episode':>15} {'median over MDPs':>17} {'crashed':>12}")
     for r in rows:
         print(f"{r.name:<10} {r.return_per_episode:>15.6g} {r.median_over_mdps:>17.6g} {f'{r.crashes} of {r.episodes}':>12}")
-    note = _generic_sigma_note(family)
     if note is not None:
         print(f"neurohover evaluate-agent: note: {note}", file=sys.stderr)
     if out is not None:

@@ -21,7 +21,7 @@ from __future__ import annotations
 import functools
 import time
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -32,7 +32,7 @@ from ..errors import NeurohoverError, brief, whole_in
 from ..evaluate import Evaluation, check_first_episode
 from ..policies import Policy
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS
-from ..tasks import MDP, refuse_unordered_mdps
+from ..tasks import MDP, TaskFamily, get_task_family, refuse_unordered_mdps
 
 __all__ = ["AgentRow", "checked_obs_statistics", "compare_agent", "evaluate_callable"]
 
@@ -190,6 +190,7 @@ def compare_agent(
     n_steps: int = EPISODE_STEPS,
     obs_dtype: str | None = None,
     on_step: Callable[[], None] | None = None,
+    generic: Policy | None = None,
 ) -> list[AgentRow]:
     """``act`` flown on ``mdps`` beside the competition's baseline and the shipped generic policy of the MDPs' task,
     all on the same gusts (:func:`evaluate_callable` and :func:`neurohover.evaluate` number them alike): a learned
@@ -198,13 +199,17 @@ def compare_agent(
     ``obs_dtype`` (default ``"float32"``) and ``on_step`` as there for a callable; a
     :class:`~neurohover.policies.Policy` flies in the compiled kernel, as the other two do, in one call (``on_step``
     is not called) on float64 observations, so ``obs_dtype`` beside it is refused, as the CLI refuses ``--obs-dtype``
-    beside ``--policy``. Returns rows for ``agent``, ``baseline`` and ``generic``, in that order."""
+    beside ``--policy``. ``generic``: the generic row's policy (default: the shipped generic of the MDPs' task, refused,
+    as make_agent refuses the set, for FGHH MDPs not drawn at the sigma it was evolved for; T35-B07). Returns rows for
+    ``agent``, ``baseline`` and ``generic``, in that order."""
     from ..evaluate import evaluate
     from ..policies import baseline_policy
     from ..policysets import load_policy_set
 
     mdps, family = _checked_mdps(mdps)  # one MDP was "'MDP' object is not iterable" (twelfth trial T5)
     _check_on_step(on_step)
+    if generic is not None and not isinstance(generic, Policy):
+        raise NeurohoverError(f"generic={brief(generic)} is not allowed: give a Policy for the generic row, or None (the shipped generic)")
     if obs_dtype is not None:  # checked for a Policy too, which ignored obs_dtype='x' (twelfth trial S5)
         check_obs_dtype(obs_dtype)
     if isinstance(act, Policy):
@@ -218,11 +223,41 @@ def compare_agent(
         agent = evaluate_callable(
             act, mdps, episodes=episodes, seed=seed, n_steps=n_steps, obs_dtype="float32" if obs_dtype is None else obs_dtype, indexed=indexed, on_step=on_step
         )
-    generic = load_policy_set(family).generic
+    if generic is None:
+        ps = load_policy_set(family)
+        _refuse_other_sigma(mdps, get_task_family(family), ps.manifest.get("sigma"))
+        generic = ps.generic
     rows = [AgentRow.of("agent", agent)]
     for name, policy in (("baseline", baseline_policy()), ("generic", generic)):
         rows.append(AgentRow.of(name, evaluate(policy, mdps, episodes=episodes, seed=seed, n_steps=n_steps)))
     return rows
+
+
+def generic_sigma_problem(family: TaskFamily, built: object) -> float | None:
+    """``built``, the sigma a policy set's generics were evolved for (its manifest's), where ``family`` flies another
+    breadth sigma over which a generic is evolved; None where they fit or either is unknown. The one decision of
+    make_agent and compare_agent (they refuse the set) and evaluate-agent (a note; T35-B07)."""
+    if family.sigma is None or not family.generic_over_distribution or built is None or float(built) == family.sigma:  # type: ignore[arg-type]
+        return None
+    return float(built)  # type: ignore[arg-type]
+
+
+def _refuse_other_sigma(mdps: list[MDP], family: TaskFamily, built: object) -> None:
+    """Refuse the shipped generic for ``mdps`` not drawn at the sigma it was evolved for. MDPs carry no sigma: they are
+    taken to be of ``family`` (at its build sigma) where it names each by its label with the same dynamics (T35-B07)."""
+    if not family.generic_over_distribution or built is None:
+        return
+    for m in mdps:
+        try:
+            named = family.mdp(m.label.split("/", 1)[-1])
+        except NeurohoverError:
+            named = None
+        if generic_sigma_problem(family, built) is not None or named is None or replace(m, sensor=named.sensor, drift=named.drift) != named:
+            raise NeurohoverError(
+                f"mdps {m.label or brief(m)!r} is not allowed with the shipped {family.name} generic: it is no {family.name} MDP of sigma = {built}, "
+                f"the sigma that generic was evolved for (make_agent refuses the set at another sigma too): give MDPs of "
+                f"get_task_family({family.name!r}), or generic= a policy of your own for the generic row"
+            )
 
 
 def _bad_actions(raw: Any, n: int) -> str:
