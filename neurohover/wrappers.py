@@ -25,26 +25,32 @@ rewards in ``step`` is not seen: keep it outside too.
 from __future__ import annotations
 
 import math
+import sys
 
 import gymnasium as gym
 import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real, real_number
-from .sim.constants import CRASH_STEP_PENALTY
+from .sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS
 
 __all__ = ["CrashAwareReward", "crash_aware"]
 
 WORST_STEP = math.log1p(CRASH_STEP_PENALTY)  # the squashed worst step, about 7.47
+#: The largest ``scale``: a crash charged for every step of the longest episode (MAX_EPISODE_STEPS), squashed and
+#: scaled, stays finite (1e308 made crash rewards -inf with an overflow warning; T35-B08).
+MAX_SCALE = 1e300
+assert MAX_SCALE * WORST_STEP * MAX_EPISODE_STEPS < sys.float_info.max
 
 
 def check_discount_and_scale(gamma, scale) -> None:
     """Refuse a discount outside (0, 1] or a scale that is not a finite number > 0, by name: any real type (NumPy
     scalars, Fraction) is taken; np.float32(0.9) was "out of range" (twelfth trial U1), so a wrong type says so."""
-    for name, value, allowed in (("gamma", gamma, "a discount in (0, 1]"), ("scale", scale, "a finite number > 0")):
+    scales = f"a finite number > 0 and <= {MAX_SCALE:g} (a larger one makes a crash's reward infinite)"
+    for name, value, allowed in (("gamma", gamma, "a discount in (0, 1]"), ("scale", scale, scales)):
         if not real_number(value):
             raise NeurohoverError(f"{name}={brief(value)} is not allowed: give a real number, {allowed}")
         number = float(value) if finite_real(value) else math.nan  # nan: out of range either way
-        if not (0.0 < number <= 1.0 if name == "gamma" else number > 0):
+        if not (0.0 < number <= 1.0 if name == "gamma" else 0 < number <= MAX_SCALE):
             raise NeurohoverError(f"{name}={brief(value)} is out of range: allowed {allowed}")
 
 
@@ -74,7 +80,13 @@ def crash_aware(reward, gamma: float = 0.99, scale: float = 1.0):
         raise NeurohoverError(f"reward={reward!r:.60} is not allowed: give finite numbers (a crash is a finite charge)")
     left = r / CRASH_STEP_PENALTY
     crash = -WORST_STEP * (left if gamma == 1.0 else (1.0 - gamma**left) / (1.0 - gamma))
-    out = scale * np.where(r >= CRASH_STEP_PENALTY, crash, -np.log1p(r))
+    with np.errstate(over="ignore"):  # refused below, by name
+        out = scale * np.where(r >= CRASH_STEP_PENALTY, crash, -np.log1p(r))
+    if not np.all(np.isfinite(out)):  # a charge far past MAX_EPISODE_STEPS steps, scaled (T35-B08)
+        raise NeurohoverError(
+            f"reward={reward!r:.60} with scale={brief(scale)} is not allowed: its squashed reward is past the largest float; "
+            f"give a crash charge of at most {MAX_EPISODE_STEPS:,} steps (MAX_EPISODE_STEPS), or a smaller scale"
+        )
     return float(out) if np.ndim(reward) == 0 else out
 
 

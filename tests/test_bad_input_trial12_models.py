@@ -123,14 +123,17 @@ def test_crash_aware_takes_any_real_number_type_in_range(gamma: object, scale: o
     assert (wrapped.gamma, wrapped.scale) == (float(gamma), float(scale))  # type: ignore[arg-type]
 
 
+SCALES = " and <= 1e+300 (a larger one makes a crash's reward infinite)"  # the bound since T35-B08
+
+
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
         ({"gamma": "0.9"}, "gamma='0.9' is not allowed: give a real number, a discount in (0, 1]"),
         ({"gamma": True}, "gamma=True is not allowed: give a real number, a discount in (0, 1]"),
-        ({"scale": None}, "scale=None is not allowed: give a real number, a finite number > 0"),
+        ({"scale": None}, "scale=None is not allowed: give a real number, a finite number > 0" + SCALES),
         ({"gamma": np.float32(1.5)}, "gamma=np.float32(1.5) is out of range: allowed a discount in (0, 1]"),
-        ({"scale": float("inf")}, "scale=inf is out of range: allowed a finite number > 0"),
+        ({"scale": float("inf")}, "scale=inf is out of range: allowed a finite number > 0" + SCALES),
     ],
 )
 def test_crash_aware_says_whether_the_type_or_the_value_is_wrong(kwargs: dict, message: str) -> None:
