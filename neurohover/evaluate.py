@@ -373,7 +373,7 @@ def evaluate_jobs(
         Root seed of every episode's noise stream.
     fallback_index : array_like of int, optional
         Per job, the policy the safeguard hands control to (-1: no safeguard for that job).
-    safeguard_limits : sequence or array of 24 floats, optional
+    safeguard_limits : sequence or array of 25 floats, optional
         Only with ``fallback_index``: the dangerous-state test in the kernel's layout (:meth:`DangerousState.limits`): limits on |u|, |v|, |w|,
         |x|, |y|, |z|, |p|, |q|, |r|, the tilt threshold on qw (inf: none), the kind, the ratio-sum threshold and limits. Default: ``DangerousState()``.
     record : array_like of bool, optional
