@@ -5,6 +5,7 @@ column added by hand), T35-B09 (drift windows read as Python's int() reads)."""
 from __future__ import annotations
 
 import decimal
+import re
 
 import numpy as np
 import pytest
@@ -74,3 +75,20 @@ def test_t35_b05_a_plot_named_other_than_png_is_refused(tmp_path, name):
         plots.save_figure(fig, tmp_path / name)
     assert not (tmp_path / name).exists()
     assert plots.save_figure(fig, tmp_path / "upper.PNG").read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.parametrize("table", ["units", "sessions"])
+def test_t35_b06_a_store_with_a_column_added_by_hand_is_refused_at_open(tmp_path, table):
+    import sqlite3
+
+    from neurohover.experiments.store import Store
+
+    path = tmp_path / "s.sqlite"
+    with Store(path):
+        pass
+    with sqlite3.connect(path) as c:
+        c.execute(f"ALTER TABLE {table} ADD COLUMN note TEXT")
+    c.close()
+    message = f"results store {str(path)!r} holds column(s) 'note' in its table {table} that neurohover did not make; give another --store file"
+    with pytest.raises(NeurohoverError, match=re.escape(message)):
+        Store(path, create=False)

@@ -263,11 +263,15 @@ class Store:
         if made is not None:  # a trigger that dropped each unit written made compete fail with "results holds none" (T33-B14)
             raise NeurohoverError(f"results store {str(self.path)!r} holds a {made[0]} {made[1]!r} neurohover did not make; give another --store file")
         for table, columns in _columns().items():  # a dropped column was found only after reproduce had written (T19-04)
-            have = {r[1] for r in c.execute(f"PRAGMA table_info({table})")}
+            have = [r[1] for r in c.execute(f"PRAGMA table_info({table})")]
             lacking = [col for col in columns if col not in have]
             if lacking:
                 what = "is missing" if not have else f"lacks column(s) {', '.join(lacking)}"
                 raise NeurohoverError(f"results store {str(self.path)!r} is damaged: its table {table} {what}; give another --store file")
+            extra = ", ".join(repr(col) for col in have if col not in columns)  # reproduce flew, then failed to write (T35-B06)
+            if extra:
+                made = f"column(s) {extra} in its table {table} that neurohover did not make"
+                raise NeurohoverError(f"results store {str(self.path)!r} holds {made}; give another --store file")
 
     # ------------------------------------------------------------------ experiments
 
