@@ -24,7 +24,7 @@ def test_a_step_size_past_its_bound_is_refused_up_front(optimizer: str, tmp_path
     """T1: sigma0=1e308 was pycma's AssertionError mid-run; settings cma documented sigma0 only as "> 0"."""
     rc, _, err = cli(*_evolve(tmp_path, "--optimizer", optimizer, "--budget", "20", "--setting", "sigma0=1e308"))
     assert rc == 2 and "Traceback" not in err, err
-    assert "CMA-ES sigma0=1e+308 must be a finite number > 0 and <= 1e+100 (a larger one overflows the genes)" in err, err
+    assert "CMA-ES sigma0=1e+308 must be a finite number >= 1e-100 and <= 1e+100 (a larger one overflows the genes)" in err, err
     assert not (tmp_path / "p.json").exists()
     rc, out, _ = cli("settings", optimizer)
     assert rc == 0 and "The initial step size (> 0 and <= 1e100" in out, out
@@ -77,7 +77,7 @@ def _settings(name: str) -> type:
 @pytest.mark.parametrize(
     ("name", "values", "message"),
     [
-        ("cma", {"sigma0": -1}, r"CMA-ES sigma0=-1 must be a finite number > 0 and <= 1e\+100"),
+        ("cma", {"sigma0": -1}, r"CMA-ES sigma0=-1 must be a finite number >= 1e-100 and <= 1e\+100"),
         ("cma", {"popsize": HUGE_INT}, f"CMA-ES popsize={SHOWN} must be None or an integer in 2..100,000"),
         ("uh-cma", {"epsilon": -1}, r"UH-CMA-ES epsilon=-1 must be a finite number >= 0"),
         ("uh-cma", {"popsize": 1}, r"CMA-ES popsize=1 must be None or an integer in 2..100,000"),
@@ -175,8 +175,8 @@ def test_ask_and_tell_out_of_order_or_with_text_say_what_to_do() -> None:
 @pytest.mark.parametrize(
     ("optimizer", "setting", "message"),
     [
-        ("openai-es", "sigma=1e308", r"sigma=1e\+308 must be a finite number > 0 and <= 1e\+100 \(a larger one overflows the genes\)"),
-        ("openai-es", "learning_rate=1e308", r"learning_rate=1e\+308 must be a finite number > 0 and <= 1e\+100"),
+        ("openai-es", "sigma=1e308", r"sigma=1e\+308 must be a finite number >= 1e-100 and <= 1e\+100 \(a larger one overflows the genes\)"),
+        ("openai-es", "learning_rate=1e308", r"learning_rate=1e\+308 must be a finite number >= 1e-100 and <= 1e\+100"),
         ("ne", "mutate_std=1e308", r"mutate_std=1e\+308 must be a finite number >= 0 and <= 1e\+100 \(a larger one overflows the genes\)"),
     ],
 )

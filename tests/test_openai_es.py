@@ -64,7 +64,7 @@ def test_state_dict_between_ask_and_tell_continues_bit_for_bit() -> None:
 
 @pytest.mark.parametrize(
     ("settings", "message"),
-    [({"popsize": 5}, "must be even"), ({"sigma": 0}, "sigma=0.0 must be a finite number > 0"), ({"beta1": 1.0}, r"beta1=1.0 must be in \[0, 1\)")],
+    [({"popsize": 5}, "must be even"), ({"sigma": 0}, "sigma=0.0 must be a finite number >= 1e-100"), ({"beta1": 1.0}, r"beta1=1.0 must be in \[0, 1\)")],
 )
 def test_bad_settings_are_refused_naming_the_value(settings: dict, message: str) -> None:
     with pytest.raises(nh.NeurohoverError, match=message):

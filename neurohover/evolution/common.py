@@ -262,13 +262,16 @@ def require_std(name: str, value: Any) -> float:
 #: far below a float's 1.8e308, so that genes drawn at that spread, and pycma's adaptation of it, stay finite
 #: (sigma0=1e308 was pycma's AssertionError, sigma and mutate_std=1e308 a late "genome must hold finite numbers"; eleventh trial).
 MAX_SPREAD = 1e100
+#: The smallest positive spread a positive one may be: pycma's adaptation of sigma0=1e-320 (a subnormal) lost every
+#: digit and failed its own "assert np.isfinite" (T35-A01); 1e-100 is as far below any useful step as MAX_SPREAD above.
+MIN_POSITIVE_SPREAD = 1e-100
 
 
 def require_spread(name: str, value: Any, *, positive: bool = False, what: str = "") -> float:
-    """``value`` as a float, or NeurohoverError unless it is a spread in [0, :data:`MAX_SPREAD`] (``(0, ...]`` if
-    ``positive``); ``what`` leads the message (the optimiser's name)."""
-    if not finite_real(value) or not (0.0 < float(value) if positive else 0.0 <= float(value)) or float(value) > MAX_SPREAD:
-        low = "> 0" if positive else ">= 0"
+    """``value`` as a float, or NeurohoverError unless it is a spread in [0, :data:`MAX_SPREAD`] (from
+    :data:`MIN_POSITIVE_SPREAD` if ``positive``); ``what`` leads the message (the optimiser's name)."""
+    if not finite_real(value) or not (MIN_POSITIVE_SPREAD <= float(value) if positive else 0.0 <= float(value)) or float(value) > MAX_SPREAD:
+        low = f">= {MIN_POSITIVE_SPREAD:g}" if positive else ">= 0"
         raise NeurohoverError(f"{what}{name}={brief(value)} must be a finite number {low} and <= {MAX_SPREAD:g} (a larger one overflows the genes)")
     return float(value) + 0.0  # -0.0 made 0.0: mutate_std=-0.0 was taken, then NumPy's "scale < 0" mid-run (fourteenth trial)
 

@@ -173,7 +173,7 @@ class CMAES(PopulationOptimiser):
     prototype : np.ndarray
         1-D initial mean (D >= 2, a pycma requirement).
     sigma0 : float, default :data:`SIGMA0` (0.02)
-        Initial step size (> 0 and <= 1e100).
+        Initial step size (>= 1e-100 and <= 1e100).
     seed : int, default 0
         Seed of the private generator.
     popsize : int, optional
@@ -315,7 +315,7 @@ class CMASettings:
     Attributes
     ----------
     sigma0 : float
-        The initial step size (> 0 and <= 1e100, :data:`~neurohover.evolution.common.MAX_SPREAD`; 0.02: :data:`SIGMA0` says why).
+        The initial step size (>= 1e-100 and <= 1e100, :data:`~neurohover.evolution.common.MAX_SPREAD`; 0.02: :data:`SIGMA0` says why).
     popsize : int or None
         Genomes per generation (>= 2; None: pycma's 4 + 3 ln D).
     """

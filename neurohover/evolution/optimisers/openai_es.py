@@ -71,9 +71,9 @@ class OpenAIESSettings:
     popsize : int
         Genomes per generation (even: antithetic pairs).
     sigma : float
-        The spread of the perturbations (> 0 and <= 1e100, :data:`~neurohover.evolution.common.MAX_SPREAD`).
+        The spread of the perturbations (>= 1e-100 and <= 1e100, :data:`~neurohover.evolution.common.MAX_SPREAD`).
     learning_rate : float
-        Adam's step size (> 0 and <= 1e100).
+        Adam's step size (>= 1e-100 and <= 1e100).
     beta1, beta2 : float
         Adam's decay rates, in [0, 1).
     epsilon : float
