@@ -27,7 +27,7 @@ def test_a_step_size_past_its_bound_is_refused_up_front(optimizer: str, tmp_path
     assert "CMA-ES sigma0=1e+308 must be a finite number >= 1e-100 and <= 1e+100 (a larger one overflows the genes)" in err, err
     assert not (tmp_path / "p.json").exists()
     rc, out, _ = cli("settings", optimizer)
-    assert rc == 0 and "The initial step size (> 0 and <= 1e100" in out, out
+    assert rc == 0 and "The initial step size (>= 1e-100 and <= 1e100" in out, out
 
 
 def test_more_reevaluations_than_a_generation_holds_are_refused(tmp_path: Path, cli) -> None:
