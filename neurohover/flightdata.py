@@ -265,8 +265,9 @@ class FlightData:
                 f"flight-data file {str(path)!r}: its metadata {bad if len(bad) <= 60 else brief(bad)}={brief(metadata[bad])} is not allowed: "
                 "give strict JSON values, numbers finite (NaN and Infinity are no JSON: FlightData.save refuses them)"
             )
-        if _too_deep(metadata):
-            raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata {_too_deep(metadata)}")
+        deep = _too_deep(metadata)
+        if deep:
+            raise NeurohoverError(f"flight-data file {str(path)!r}: its metadata {deep}")
         data = cls(tuple(obs_split), tuple(act_split), metadata)
         for i, crashed in enumerate(crash_flags(data)):  # a NaN was named by plot, not by learn-model, and neither named the file (T22-02)
             check_flown(data.observations[i], data.actions[i], crashed, f"flight-data file {str(path)!r}, episode {i}")

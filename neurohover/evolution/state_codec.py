@@ -124,19 +124,18 @@ def check_genomes(a: np.ndarray | None, size: int, name: str, rows: int | None =
         raise NeurohoverError(f"{name} has shape {a.shape}, expected {expected} (genomes of {size} genes)")
     if a.dtype.kind != "f":
         raise NeurohoverError(f"{name} holds a gene that is not a finite number: its genes are {a.dtype} values, allowed finite floats")
+
+    def where(k: int) -> str:
+        return f"gene {k} is {brief(float(a.flat[k]))}" if a.ndim == 1 else f"data entry {k} (genome {k // size}, gene {k % size}) is {brief(float(a.flat[k]))}"
+
     bad = np.flatnonzero(~np.isfinite(a))  # a NaN gene was resumed without a word (eighth trial); which one, T21-13
     if bad.size:
-        k = int(bad[0])
-        where = f"gene {k}" if a.ndim == 1 else f"data entry {k} (genome {k // size}, gene {k % size})"
         more = f", and {bad.size - 1} more" if bad.size > 1 else ""
-        raise NeurohoverError(f"{name} holds a gene that is not a finite number: {where} is {brief(float(a.flat[k]))}{more}; allowed finite numbers")
-    big = np.flatnonzero(np.abs(a) > MAX_GENE) if genes else np.flatnonzero(np.zeros(0))
-    if big.size:
-        k = int(big[0])
-        where = f"gene {k}" if a.ndim == 1 else f"data entry {k} (genome {k // size}, gene {k % size})"
+        raise NeurohoverError(f"{name} holds a gene that is not a finite number: {where(int(bad[0]))}{more}; allowed finite numbers")
+    big = np.flatnonzero(np.abs(a) > MAX_GENE)
+    if genes and big.size:  # (not Adam's moments, which are no genes)
         raise NeurohoverError(
-            f"{name} holds a gene that is out of range: {where} is {brief(float(a.flat[k]))}; "
-            f"allowed numbers in [-{MAX_GENE:g}, {MAX_GENE:g}] (a policy's genes)"
+            f"{name} holds a gene that is out of range: {where(int(big[0]))}; allowed numbers in [-{MAX_GENE:g}, {MAX_GENE:g}] (a policy's genes)"
         )
     if rows and a.shape[0] != rows:  # a pop_size of 60 over 50 genomes was run on (sixteenth trial)
         raise NeurohoverError(f"{name} has {a.shape[0]} genomes where the state's settings make {rows}")

@@ -206,9 +206,9 @@ def resolve_name(name: str | Path) -> Path:
         return path
     shipped = shipped_configs()
     name = _aliases().get(name, name)
-    if name not in shipped and (len(path.parts) > 1 or _is_file(path)):  # a path, taken for a name (T33-A02)
-        raise NeurohoverError(f"config file {name!r} is not allowed: a config file's name ends .toml; give a path ending .toml, or an experiment name")
     if name not in shipped:
+        if len(path.parts) > 1 or _is_file(path):  # a path, taken for a name (T33-A02)
+            raise NeurohoverError(f"config file {name!r} is not allowed: a config file's name ends .toml; give a path ending .toml, or an experiment name")
         raise NeurohoverError(f"unknown experiment {name!r}: known experiments are {', '.join(shipped)} (or 'all', or a path to a .toml config file)")
     return shipped[name]
 

@@ -247,12 +247,13 @@ def _refuse_other_sigma(mdps: list[MDP], family: TaskFamily, built: object) -> N
     taken to be of ``family`` (at its build sigma) where it names each by its label with the same dynamics (T35-B07)."""
     if not family.generic_over_distribution or built is None:
         return
+    other_sigma = generic_sigma_problem(family, built) is not None  # the family's own sigma is another: every MDP refused
     for m in mdps:
         try:
             named = family.mdp(m.label.split("/", 1)[-1])
         except NeurohoverError:
             named = None
-        if generic_sigma_problem(family, built) is not None or named is None or replace(m, sensor=named.sensor, drift=named.drift) != named:
+        if other_sigma or named is None or replace(m, sensor=named.sensor, drift=named.drift) != named:
             raise NeurohoverError(
                 f"mdps {m.label or brief(m)!r} is not allowed with the shipped {family.name} generic: it is no {family.name} MDP of sigma = {built}, "
                 f"the sigma that generic was evolved for (make_agent refuses the set at another sigma too): give MDPs of "

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import copy
 import functools
+import graphlib
 import math
 import operator
 import os
@@ -454,24 +455,17 @@ def _check_record_network(record: Sequence[float], n_nodes: int) -> None:
 
 
 def _cycle_of(links: set[tuple[float, float]]) -> list[float]:
-    """A cycle of the directed graph ``links`` (its nodes, the first repeated last: ``[0, 0]`` for a self-loop), or []."""
-    succ: dict[float, list[float]] = {}
+    """A cycle of the directed graph ``links`` (its nodes from the smallest, the first repeated last: ``[0, 0]`` for a
+    self-loop), or []: the standard library's topological sort finds it."""
+    order: graphlib.TopologicalSorter = graphlib.TopologicalSorter()
     for i, o in sorted(links):
-        succ.setdefault(i, []).append(o)
-    done: set[float] = set()
-    for root in (r for r in sorted(succ) if r not in done):
-        path, stack = {root: None}, [iter(succ[root])]  # the nodes on the current path, in order
-        while stack:
-            nxt = next(stack[-1], None)
-            if nxt in path:
-                nodes = list(path)
-                return nodes[nodes.index(nxt) :] + [nxt]
-            if nxt is None:
-                done.add(path.popitem()[0])
-                stack.pop()
-            elif nxt not in done:
-                path[nxt] = None
-                stack.append(iter(succ.get(nxt, ())))
+        order.add(o, i)  # o is computed after i
+    try:
+        order.prepare()
+    except graphlib.CycleError as err:
+        cycle = err.args[1][:-1]  # in the links' direction
+        first = cycle.index(min(cycle))
+        return cycle[first:] + cycle[: first + 1]
     return []
 
 
