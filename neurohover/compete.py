@@ -480,6 +480,8 @@ def _refuse_other_settings(config, store_path: Path) -> None:
         if held is None or held == config.hash:
             return
         stored = db.config(config.name, config.scale)
+    if config.same_but_unflown_digest(stored):  # reproduce re-labels its runs (T35-A02)
+        return
     diff = first_difference("config", stored, config.to_dict())
     if diff.startswith("config.external_digest:"):  # the policy files' digest: said in words
         diff = "the policy set's files differ from those its runs flew, " + diff.removeprefix("config.external_digest: ").replace("the stored", "digest")

@@ -120,6 +120,17 @@ class ExperimentConfig:
         payload = {"kind": self.kind, "settings": settings, "units_version": UNITS_VERSION, "external": self.external_digest}
         return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
 
+    def same_but_unflown_digest(self, stored: dict) -> bool:
+        """Whether ``stored`` (a store's config) is this one but for the digest of a policy set none of its units fly:
+        written before T35-A02, when every named set was hashed, and its results do not depend on the set's files."""
+        if self.external_digest:
+            return False
+        try:
+            old = ExperimentConfig.from_dict(stored)
+        except NeurohoverError:  # a damaged one is named by the store's own checks
+            return False
+        return bool(old.external_digest) and replace(old, external_digest="").hash == self.hash
+
     def to_dict(self) -> dict:
         return {
             "name": self.name,

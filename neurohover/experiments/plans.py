@@ -99,7 +99,8 @@ def external_digest(kind: str, s: dict) -> str:
     source = s.get(key)
     payload: dict = {}
     if source not in (None, "evolve", "baseline"):
-        ps = _load_external(s["task"], source, key)
+        ps = _load_external(s["task"], source, key)  # read even where unflown: a directory that is none is named
+    if source not in (None, "evolve", "baseline") and _flies_set(kind, s):
         payload = {
             "generic": policy_dict(ps.generic),
             "specialised": [policy_dict(p) for p in ps.specialised],
@@ -112,6 +113,15 @@ def external_digest(kind: str, s: dict) -> str:
     if not payload:
         return ""
     return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
+
+
+def _flies_set(kind: str, s: dict) -> bool:
+    """Whether a config's units fly policies of the set its policy source names: test runs whose every group is
+    baseline fly none, and their results do not depend on the set's files (T35-A02: they were refused once it changed)."""
+    if kind != "test_runs":
+        return True
+    family = family_of(s["task"], s.get("sigma"))  # what a set holds depends on the task alone, not its sensors
+    return bool(_needs(family, [g["agent"] for g in s["groups"]]))
 
 
 def _dir_champions(source: str) -> list[tuple[str, dict]]:
@@ -244,6 +254,17 @@ def _spec(agent: str):
     return agent_spec(agent)
 
 
+def _needs(family, agents: list[str]) -> set[str]:
+    """The kinds of policy (generic, specialised, safe, ...) that ``agents`` fly of ``family``'s policy set."""
+    needs: set[str] = set()
+    for agent in agents:
+        spec = _spec(agent)
+        needs |= spec.needs
+        if family.generic_over_distribution and spec.generic_kind is not None:
+            needs.add(spec.generic_kind)
+    return needs
+
+
 def source_experiments(cfg: ExperimentConfig) -> list[str]:
     """The experiments whose results a config's units need (``generics_from``), in the order named."""
     s = cfg.typed
@@ -287,13 +308,7 @@ class _Policies:
         self.settings = s
         self.task = s.task
         self.family = family_of(s.task, s.sigma, s.sensor)
-        needs: set[str] = set()
-        for g in s.groups:
-            spec = _spec(g.agent)
-            needs |= spec.needs
-            if self.family.generic_over_distribution and spec.generic_kind is not None:
-                needs.add(spec.generic_kind)
-        self.needs = needs
+        self.needs = needs = _needs(self.family, [g.agent for g in s.groups])
         self.units: list[Unit] = []
         self.total = 0
         self.external = None if s.policies == "evolve" else _load_external(self.task, s.policies)
@@ -315,15 +330,15 @@ class _Policies:
                     self._add(UnitKey.make("policy", f"specialised{role.index}"), {"kind": "mdp", "mdp": train[role.index].to_dict()}, budget)
             if "safe" in needs:
                 self.total += 1
-                spec = [self.results.get(UnitKey.make("policy", f"specialised{i}")) for i in range(10)]
-                if all(spec):
+                found = [self.results.get(UnitKey.make("policy", f"specialised{i}")) for i in range(10)]
+                if all(found):
                     self.units.append(
                         _unit(
                             cfg,
                             UnitKey.make("policy", "safety"),
                             "safety",
                             {
-                                "policies": [r["champion"] for r in spec],
+                                "policies": [r["champion"] for r in found if r is not None],
                                 "mdps": [m.to_dict() for m in self.family.training_mdps()],
                                 "episodes": s.safety_episodes,
                                 "n_steps": s.n_steps,

@@ -242,7 +242,13 @@ def reproduce(
         _refuse_unmatched(config, store, held, only)
     _refuse_other_version_first(config, store, held, update)
     checked = None if fresh else _checked_results(config, store, held)  # before anything is written (T19-04, T19-06)
-    if update and held is not None and held != config.hash:
+    if held is not None and held != config.hash and not update and config.same_but_unflown_digest(store.config(config.name, config.scale)):
+        kept = store.update(config.name, config.scale, config.hash, config.to_dict(), unchanged_units(config, store))  # T35-A02
+        print(
+            f"{config.name} ({config.scale}): {kept} stored units stand under hash {config.hash} (its {held} hashed a policy set none of them flies)",
+            file=sys.stderr,
+        )
+    elif update and held is not None and held != config.hash:
         _check_policy_source(config, store)
         kept = store.update(config.name, config.scale, config.hash, config.to_dict(), unchanged_units(config, store))
         print(f"{config.name} ({config.scale}): the config changed (hash {held} -> {config.hash}); {kept} stored units stand unchanged", file=sys.stderr)
