@@ -31,13 +31,20 @@ class Terminated(KeyboardInterrupt):
         self.signum = signum
 
 
+#: The signals whose default ends a process and that the command takes as SIGTERM: a batch scheduler's warnings before
+#: its kill (SIGUSR1/SIGUSR2: SGE's -notify, Slurm's --signal; SIGXCPU: a CPU-time limit) and the timers (T35-A03).
+_ALSO_STOPPING = ("SIGUSR1", "SIGUSR2", "SIGXCPU", "SIGALRM", "SIGVTALRM", "SIGPROF")
+
+
 def stop_signals(command: bool = True) -> list[signal.Signals]:
     """The signals the command takes as SIGTERM (:class:`Terminated`): SIGTERM, SIGHUP (a closed terminal or a dropped SSH
-    session) and SIGUSR1, where the system has them. Python's defaults ended a run at once without a word, and evolve
-    without its checkpoint (T32-A03). SIGQUIT keeps its default: the stop at once, with a core dump, that it asks for.
-    ``command`` False: those a program calling neurohover hands over while it runs (not SIGUSR1, often a program's own:
-    faulthandler's stack dump, a log rotation)."""
-    names = ("SIGTERM", "SIGHUP", "SIGUSR1") if command else ("SIGTERM", "SIGHUP")
+    session), SIGUSR1, SIGUSR2, SIGXCPU, SIGALRM, SIGVTALRM and SIGPROF, where the system has them. Python's defaults
+    ended a run at once without a word, and evolve without its checkpoint (T32-A03, T35-A03). SIGQUIT and SIGTRAP keep
+    their defaults: the stop at once, with a core dump, that they ask for (as SIGKILL, the temporary files such a stop
+    leaves are removed by the next run of the output: :func:`~neurohover.locks.remove_dead_writers_files`).
+    ``command`` False: those a program calling neurohover hands over while it runs (SIGTERM and SIGHUP; the others
+    are often a program's own: faulthandler's stack dump, a log rotation, its own timers)."""
+    names = ("SIGTERM", "SIGHUP", *_ALSO_STOPPING) if command else ("SIGTERM", "SIGHUP")
     return [getattr(signal, name) for name in names if hasattr(signal, name)]
 
 

@@ -1,16 +1,20 @@
 """One process writing an output at a time: :class:`WriterLock`, an OS advisory lock on a lock file beside the output,
-and :func:`sole_writer`, evolve's guard of its ``--out`` (re-exported by :mod:`neurohover.paths`, where they were)."""
+:func:`sole_writer`, evolve's guard of its ``--out``, and :func:`writer_file`, the temporary file one writer writes
+(re-exported by :mod:`neurohover.paths`, where they were)."""
 
 from __future__ import annotations
 
 import errno
 import os
+import re
 import socket
+import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
 from .errors import NeurohoverError
+from .filekinds import fitting_name, name_limit
 
 try:
     import fcntl
@@ -120,7 +124,61 @@ def sole_writer(path: Path, option: str) -> Iterator[None]:
         path.with_name(f".{path.name}.lock"),
         lambda who: f"{option} {str(path)!r} is being written by another run ({who}): wait for it to end, or give another {option}",
     ):
+        remove_dead_writers_files(path)
         yield
+
+
+def writer_file(path: Path, ending: str, hidden: bool = False, pid: int | None = None, tid: int | None = None) -> Path:
+    """The temporary file beside ``path`` one writer writes before it moves it onto ``path``: ``NAME.PID.TID{ending}``
+    (``hidden``: with a leading dot), one per process and thread (this one's, unless ``pid`` and ``tid`` are given).
+    Named by the process only, threads saving one path at once truncated and moved each other's: a corrupt file, one
+    save said done and the others "No such file or directory" (T32-B01). The name is cut where the file's own fits and
+    this one would not (T29-A01)."""
+    tail = f".{os.getpid() if pid is None else pid}.{threading.get_native_id() if tid is None else tid}{ending}"
+    dot = "." if hidden else ""
+    return path.with_name(dot + fitting_name(path.name, name_limit(path.parent), len(os.fsencode(dot + tail))) + tail)
+
+
+#: The writer files :func:`writer_file` names for the outputs a :func:`sole_writer` guards: (ending, hidden).
+WRITER_FILES = ((".tmp", False), (".partial", True))
+_WRITER_NAME = re.compile(r"\.(\d{1,10})\.(\d{1,20})(\.tmp|\.partial)\Z")
+
+
+def remove_dead_writers_files(path: Path) -> list[Path]:
+    """Remove the temporary files of writers of ``path`` (:func:`writer_file`) whose process no longer runs, and return
+    them: a writer killed mid-write (SIGKILL, or a signal whose default stops the process: SIGQUIT's core dump) left its
+    half-written file beside the output for ever (T35-A03). Called while :func:`sole_writer` holds ``path``, so no live
+    neurohover writes them; a file of a live process (this one's threads, or a pid reused since) is left alone."""
+    removed: list[Path] = []
+    try:
+        names = os.listdir(path.parent)
+    except OSError:  # an unreadable folder: its writes say so
+        return removed
+    for name in names:
+        found = _WRITER_NAME.search(name)
+        if found is None:
+            continue
+        pid, tid = int(found[1]), int(found[2])
+        if (found[3], name.startswith(".")) not in WRITER_FILES or writer_file(path, found[3], name.startswith("."), pid, tid).name != name:
+            continue
+        if pid != os.getpid() and not _running(pid):
+            try:
+                (path.parent / name).unlink()
+                removed.append(path.parent / name)
+            except OSError:
+                pass
+    return removed
+
+
+def _running(pid: int) -> bool:
+    """Whether process ``pid`` runs on this host (one of another user's counts as running)."""
+    try:
+        os.kill(pid, 0)
+    except (ProcessLookupError, OverflowError):  # no such process (a pid past the system's is none)
+        return False
+    except PermissionError:
+        return True
+    return True
 
 
 def hold_file(path: str | os.PathLike, busy: str) -> int:

@@ -20,14 +20,13 @@ import re
 import stat
 import sys
 import tempfile
-import threading
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
 
 from .errors import NeurohoverError, OutputError, brief, float_of
-from .filekinds import NAME_MAX, PNG_KIND, SQLITE_HEADER, fitting_name, held_kind, name_limit, output_name, refuse_policy_set, refuse_unencodable
-from .locks import WriterLock, sole_writer
+from .filekinds import NAME_MAX, PNG_KIND, SQLITE_HEADER, held_kind, name_limit, output_name, refuse_policy_set, refuse_unencodable
+from .locks import WriterLock, sole_writer, writer_file
 
 __all__ = [
     "JSONError",
@@ -434,16 +433,6 @@ def refuse_foreign_output(path: str | os.PathLike, option: str, kind: str) -> No
         raise NeurohoverError(
             f"{option} {shown} is {held or 'a file neurohover did not write'}: it would be replaced with {kind}; move it away or give another directory"
         )
-
-
-def writer_file(path: Path, ending: str, hidden: bool = False) -> Path:
-    """The temporary file beside ``path`` one writer writes before it moves it onto ``path``: ``NAME.PID.TID{ending}``
-    (``hidden``: with a leading dot), one per process and thread. Named by the process only, threads saving one path at
-    once truncated and moved each other's: a corrupt file, one save said done and the others "No such file or
-    directory" (T32-B01). The name is cut where the file's own fits and this one would not (T29-A01)."""
-    tail = f".{os.getpid()}.{threading.get_native_id()}{ending}"
-    dot = "." if hidden else ""
-    return path.with_name(dot + fitting_name(path.name, name_limit(path.parent), len(os.fsencode(dot + tail))) + tail)
 
 
 @contextmanager

@@ -9,10 +9,10 @@ busy with a unit nobody will record, then idles as an orphan. The pools made her
   :data:`WATCH_SECONDS` everywhere (a worker reparented to init or a subreaper exits at once);
 - :func:`sigterm_as_interrupt` turns SIGTERM in the parent into :class:`Terminated` (a
   KeyboardInterrupt), so the parent's Ctrl-C path runs: finished work is kept, the workers are
-  ended by :func:`stop_pool`, and the command exits as if interrupted; SIGHUP and SIGUSR1 alike
-  (:func:`~neurohover.errors.stop_signals`; they ended the run without a word, T32-A03);
-- a worker never hears Ctrl-C nor a hang-up (SIGINT and SIGHUP stay blocked in it from its first
-  instruction on: a terminal sends them to the whole process group) and dies of SIGTERM at once
+  ended by :func:`stop_pool`, and the command exits as if interrupted; SIGHUP, SIGUSR1, SIGUSR2 and the others of
+  :func:`~neurohover.errors.stop_signals` alike (they ended the run without a word, T32-A03, T35-A03);
+- a worker never hears Ctrl-C, a hang-up nor a scheduler's warning (they stay blocked in it from its first
+  instruction on: a terminal or a scheduler sends them to the whole process group) and dies of SIGTERM at once
   without a word: the parent alone decides, and ends its workers. A worker that raised KeyboardInterrupt as it
   imported, or while formatting an exception the parent's SIGTERM then interrupted, printed its
   tracebacks (T26-A01).
@@ -93,12 +93,19 @@ def watch_parent(parent: int, pdeathsig: bool = True) -> None:
     threading.Thread(target=_watch, args=(parent,), name="neurohover-parent-watch", daemon=True).start()
 
 
+def _group_signals() -> set[signal.Signals]:
+    """The signals a terminal or a batch scheduler sends a whole process group, which the parent alone hears: SIGINT
+    and the command's :func:`~neurohover.errors.stop_signals` but SIGTERM (stop_pool's, which ends a worker)."""
+    return {signal.SIGINT, *stop_signals()} - {signal.SIGTERM}
+
+
 def _deaf_to_ctrl_c() -> set[int | signal.Signals]:
-    """Block SIGINT and SIGHUP, the signals a terminal sends its whole process group, in this thread (and the threads and
-    processes it starts later); the mask it replaces."""
+    """Block the :func:`_group_signals` (SIGINT, SIGHUP, a scheduler's SIGUSR2 warning, ...) in this thread (and the
+    threads and processes it starts later); the mask it replaces. A worker they killed broke the pool before the parent
+    could stop in order (T35-A03)."""
     if not hasattr(signal, "pthread_sigmask"):  # not POSIX
         return set()
-    return signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGHUP})
+    return signal.pthread_sigmask(signal.SIG_BLOCK, _group_signals())
 
 
 def _start_resource_tracker() -> None:
@@ -110,7 +117,7 @@ def _start_resource_tracker() -> None:
     if not hasattr(signal, "pthread_sigmask"):  # not POSIX
         resource_tracker.ensure_running()
         return
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGHUP})
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, _group_signals() - {signal.SIGINT})
     try:
         resource_tracker.ensure_running()
     finally:
@@ -198,7 +205,8 @@ def stop_pool(pool: ProcessPoolExecutor) -> None:
 
 def stop_words(stop: BaseException) -> tuple[str, int]:
     """How a command says it was stopped by ``stop`` (a KeyboardInterrupt, or one raised while handling it) and its
-    exit status: ("terminated", 143) for SIGTERM (129 for SIGHUP, 138 for SIGUSR1), ("interrupted", 130) for Ctrl-C (128 + the signal, as shells report)."""
+    exit status: ("terminated", 143) for SIGTERM (129 for SIGHUP, 138 for SIGUSR1, 140 for SIGUSR2), ("interrupted", 130)
+    for Ctrl-C (128 + the signal, as shells report)."""
     cause: BaseException | None = stop
     while cause is not None:
         if isinstance(cause, Terminated):

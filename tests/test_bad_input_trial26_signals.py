@@ -93,8 +93,8 @@ def test_a_stop_at_any_moment_of_a_jobs_2_compete_prints_one_line(tmp_path: Path
 
 
 def _ctrl_c_state() -> tuple[bool, object]:
-    """This process's SIGINT blocked?, and its SIGTERM handler (run in a pool worker)."""
-    return signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, []), signal.getsignal(signal.SIGTERM)
+    """This process's SIGINT and a scheduler's SIGUSR2 warning (T35-A03) blocked?, and its SIGTERM handler (run in a pool worker)."""
+    return {signal.SIGINT, signal.SIGUSR2} <= signal.pthread_sigmask(signal.SIG_BLOCK, []), signal.getsignal(signal.SIGTERM)
 
 
 @pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="POSIX signal masks")

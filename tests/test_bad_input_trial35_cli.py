@@ -1,10 +1,16 @@
 """Bad-input trial 35 (the command line): a subnormal CMA-ES sigma0 taken, then pycma's AssertionError (T35-A01); a
-baseline-only run refused because a policy set it never flies changed (T35-A02)."""
+baseline-only run refused because a policy set it never flies changed (T35-A02); evolve ended without a word by a batch
+scheduler's warning signals and the timers, its half-written checkpoint left beside the output for ever (T35-A03)."""
 
 from __future__ import annotations
 
 import json
+import os
 import shutil
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -75,3 +81,61 @@ def test_a_baseline_competition_stored_with_the_sets_digest_is_taken_and_relabel
     with Store(tmp_path / "c" / "results.sqlite") as db:
         assert db.results(name, scale) == before and db.config_hash(name, scale) != old_hash
         assert db.config(name, scale)["external_digest"] == ""
+
+
+def test_the_scheduler_warnings_and_timers_stop_a_command_as_sigterm_does() -> None:
+    """SIGUSR2 and SIGXCPU (what SGE's -notify, Slurm's --signal and a CPU-time limit send before their kill) and the
+    timer signals stop the command with its line and 128 + the signal; SIGQUIT and SIGTRAP keep their core dumps."""
+    from neurohover.errors import Terminated, raise_terminated, stop_signals
+    from neurohover.procs import stop_words
+
+    also = {signal.SIGUSR2, signal.SIGXCPU, signal.SIGALRM, signal.SIGVTALRM, signal.SIGPROF}
+    assert also <= set(stop_signals()) and not {signal.SIGQUIT, signal.SIGTRAP} & set(stop_signals())
+    assert not also & set(stop_signals(command=False))  # a program calling main() keeps its own timers
+    for signum in also:
+        with pytest.raises(Terminated) as caught:
+            raise_terminated(signum, None)
+        assert stop_words(caught.value) == ("terminated", 128 + signum)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="real processes signalled, found in /proc")
+def test_evolve_stopped_by_a_schedulers_sigusr2_saves_its_checkpoint_and_says_so(tmp_path: Path) -> None:
+    from test_procs import _cpu_seconds, _end_group, _start
+
+    out = tmp_path / "e.json"
+    argv = ["evolve", "--task", "ghh08", "--mdp", "G", "--budget", "1000000", "--episode-steps", "200", "--checkpoint-every", "1"]
+    proc = _start(tmp_path, *argv, "--out", str(out))
+    try:
+        deadline = time.monotonic() + 120  # a safety net: imported, its kernel loaded and flying
+        while time.monotonic() < deadline and proc.poll() is None and _cpu_seconds(proc.pid) < 2.5:
+            time.sleep(0.05)
+        os.kill(proc.pid, signal.SIGUSR2)
+        rc = proc.wait(timeout=60)
+        err = (tmp_path / "stderr.txt").read_text()
+        assert rc == 128 + signal.SIGUSR2 and "Traceback" not in err, err[-2000:]
+        assert err.strip().splitlines()[-1].startswith("neurohover evolve: terminated"), err[-2000:]
+        left = sorted(p.name for p in tmp_path.iterdir() if p.name not in ("stdout.txt", "stderr.txt"))
+        assert left == ["e.json.checkpoint.json"], left  # no lock, no temporary file
+    finally:
+        _end_group(proc)
+
+
+def _dead_pid() -> int:
+    """The pid of a process that has ended (and been reaped)."""
+    proc = subprocess.Popen(["true"])
+    proc.wait()
+    return proc.pid
+
+
+def test_a_killed_writers_temporary_files_are_removed_by_the_next_run_of_its_output(cli, tmp_path: Path) -> None:
+    """A writer stopped at once (SIGKILL, SIGQUIT's core dump) leaves NAME.PID.TID.tmp / .NAME.PID.TID.partial: the
+    next run on that output removes those of processes no longer running, not a live one's nor other files."""
+    out = tmp_path / "e.json"
+    dead = _dead_pid()
+    stale = [tmp_path / f"e.json.checkpoint.json.{dead}.{dead}.tmp", tmp_path / f".e.json.{dead}.{dead + 1}.partial"]
+    kept = [tmp_path / f"e.json.checkpoint.json.{os.getpid()}.999999.tmp", tmp_path / f"e.json.{dead}.{dead}.tmp.notes", tmp_path / f"f.json.{dead}.1.tmp"]
+    for path in stale + kept:
+        path.write_text("{")
+    rc, _, err = cli("evolve", "--task", "ghh08", "--mdp", "G", "--budget", "10", "--episode-steps", "20", "--out", str(out))
+    assert rc == 0, err
+    assert not any(path.exists() for path in stale) and all(path.exists() for path in kept)
