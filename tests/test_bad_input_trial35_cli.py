@@ -77,7 +77,7 @@ def test_a_baseline_competition_stored_with_the_sets_digest_is_taken_and_relabel
         old_hash, before = db.config_hash(name, scale), db.results(name, scale)
         assert db.config(name, scale)["external_digest"]
     rc, _, err = cli(*argv)
-    assert rc == 0 and "hashed a policy set none of them flies" in err, err
+    assert rc == 0 and "hashed an unflown policy set" in err, err
     with Store(tmp_path / "c" / "results.sqlite") as db:
         assert db.results(name, scale) == before and db.config_hash(name, scale) != old_hash
         assert db.config(name, scale)["external_digest"] == ""
@@ -100,14 +100,14 @@ def test_the_scheduler_warnings_and_timers_stop_a_command_as_sigterm_does() -> N
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="real processes signalled, found in /proc")
 def test_evolve_stopped_by_a_schedulers_sigusr2_saves_its_checkpoint_and_says_so(tmp_path: Path) -> None:
-    from test_procs import _cpu_seconds, _end_group, _start
+    from test_procs import _end_group, _start
 
     out = tmp_path / "e.json"
     argv = ["evolve", "--task", "ghh08", "--mdp", "G", "--budget", "1000000", "--episode-steps", "200", "--checkpoint-every", "1"]
     proc = _start(tmp_path, *argv, "--out", str(out))
     try:
-        deadline = time.monotonic() + 120  # a safety net: imported, its kernel loaded and flying
-        while time.monotonic() < deadline and proc.poll() is None and _cpu_seconds(proc.pid) < 2.5:
+        deadline = time.monotonic() + 120  # a safety net: its first generation checkpointed
+        while time.monotonic() < deadline and proc.poll() is None and not (tmp_path / "e.json.checkpoint.json").exists():
             time.sleep(0.05)
         os.kill(proc.pid, signal.SIGUSR2)
         rc = proc.wait(timeout=60)

@@ -121,6 +121,26 @@ def _refuse_other_version_first(config: ExperimentConfig, store: Store, held: st
     _refuse_other_version(config, store, stored_config)
 
 
+def _take_changed_config(config: ExperimentConfig, store: Store, held: str | None, update: bool) -> bool:
+    """Register ``config`` where the store holds its experiment under another hash (``held``), keeping the stored units
+    it plans alike, and say so: with ``update``, or where the stored config hashed a policy set none of its units flies
+    (an older neurohover's: refused once the set changed, though its results do not depend on it; T35-A02). Whether
+    units were dropped (their results must be read again)."""
+    if held is None or held == config.hash:
+        return False
+    if not update:
+        if config.same_but_unflown_digest(store.config(config.name, config.scale)):
+            kept = store.update(config.name, config.scale, config.hash, config.to_dict(), unchanged_units(config, store))
+            print(
+                f"{config.name} ({config.scale}): {kept} stored units stand under hash {config.hash} (its {held} hashed an unflown policy set)", file=sys.stderr
+            )
+        return False
+    _check_policy_source(config, store)
+    kept = store.update(config.name, config.scale, config.hash, config.to_dict(), unchanged_units(config, store))
+    print(f"{config.name} ({config.scale}): the config changed (hash {held} -> {config.hash}); {kept} stored units stand unchanged", file=sys.stderr)
+    return True
+
+
 def _check_policy_source(config: ExperimentConfig, store: Store) -> None:
     """Refuse an ``--update`` whose policies come from elsewhere than the stored runs' (every unit would run again)."""
     stored = store.config(config.name, config.scale)["settings"]
@@ -242,16 +262,7 @@ def reproduce(
         _refuse_unmatched(config, store, held, only)
     _refuse_other_version_first(config, store, held, update)
     checked = None if fresh else _checked_results(config, store, held)  # before anything is written (T19-04, T19-06)
-    if held is not None and held != config.hash and not update and config.same_but_unflown_digest(store.config(config.name, config.scale)):
-        kept = store.update(config.name, config.scale, config.hash, config.to_dict(), unchanged_units(config, store))  # T35-A02
-        print(
-            f"{config.name} ({config.scale}): {kept} stored units stand under hash {config.hash} (its {held} hashed a policy set none of them flies)",
-            file=sys.stderr,
-        )
-    elif update and held is not None and held != config.hash:
-        _check_policy_source(config, store)
-        kept = store.update(config.name, config.scale, config.hash, config.to_dict(), unchanged_units(config, store))
-        print(f"{config.name} ({config.scale}): the config changed (hash {held} -> {config.hash}); {kept} stored units stand unchanged", file=sys.stderr)
+    if _take_changed_config(config, store, held, update):
         checked = None  # fewer units now: read again
     store.begin(config.name, config.scale, config.hash, config.to_dict(), fresh=fresh)
     results, made = checked if checked is not None else _checked_results(config, store, config.hash)  # read and planned once
