@@ -181,14 +181,27 @@ def shipped_configs() -> dict[str, Path]:
 
 
 def _aliases() -> dict[str, str]:
-    out = {}
+    """Alias -> name of the shipped configs, read again only where a file changed (every name was resolved by
+    parsing all 35 files: a quarter of planning every stored experiment)."""
+    files = []
     for name, path in shipped_configs().items():
         try:
-            for alias in tomllib.loads(path.read_text(encoding="utf-8")).get("aliases", []):
-                out[alias] = name
-        except tomllib.TOMLDecodeError:
+            st = path.stat()
+        except OSError:
+            continue
+        files.append((name, str(path), st.st_mtime_ns, st.st_size))
+    return dict(_aliases_of(tuple(files)))
+
+
+@functools.lru_cache(maxsize=4)
+def _aliases_of(files: tuple[tuple[str, str, int, int], ...]) -> tuple[tuple[str, str], ...]:
+    out = []
+    for name, path, _, _ in files:
+        try:
+            out += [(alias, name) for alias in tomllib.loads(Path(path).read_text(encoding="utf-8")).get("aliases", [])]
+        except (tomllib.TOMLDecodeError, OSError, UnicodeDecodeError):
             pass
-    return out
+    return tuple(out)
 
 
 def experiment_names() -> list[str]:

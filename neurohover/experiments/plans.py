@@ -18,6 +18,7 @@ Unit keys (unique within an experiment)::
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import shlex
@@ -369,6 +370,17 @@ class _Policies:
         self.units.append(_policy_evolution_unit(self.cfg, key, target, budget, resampling, topology))
         self.total += 1
 
+    @functools.cached_property
+    def _ext_dicts(self) -> dict:
+        """The external set's policies as params hold them, made once (per run, they were a fifth of planning)."""
+        ext = self.external
+        assert ext is not None
+        return {
+            "generic": policy_dict(ext.generic),
+            "specialised": [policy_dict(p) for p in ext.specialised],
+            "generics": {k: policy_dict(v) for k, v in ext.generics.items()},
+        }
+
     def _evolved(self, key: str) -> dict | None:
         r = self.results.get(key)
         return None if r is None else r["champion"]
@@ -391,18 +403,18 @@ class _Policies:
                     source, out["generic"] = champions[int(rng.integers(len(champions)))]
                     out["generic_source"] = source
                 elif ext is not None:
-                    out["generic"] = policy_dict(ext.generics[kind])
+                    out["generic"] = dict(self._ext_dicts["generics"][kind])
                 else:
                     j = run_counter % self.settings.generics_per_agent
                     out["generic"] = self._evolved(UnitKey.make("policy", f"generic-{kind}{j}"))
                     out["generic_source"] = UnitKey.make("policy", f"generic-{kind}{j}")
             return None if any(v is None for v in out.values()) else out
         if "generic" in need:
-            out["generic"] = policy_dict(ext.generic) if ext is not None else self._evolved(UnitKey.make("policy", "generic"))
+            out["generic"] = dict(self._ext_dicts["generic"]) if ext is not None else self._evolved(UnitKey.make("policy", "generic"))
         if need & {"specialised", "safe"}:
             specialised: list[dict | None]
             if ext is not None:
-                specialised = [policy_dict(p) for p in ext.specialised]
+                specialised = [dict(d) for d in self._ext_dicts["specialised"]]
             else:
                 specialised = [self._evolved(UnitKey.make("policy", f"specialised{i}")) for i in range(10)]
             if any(p is None for p in specialised):
