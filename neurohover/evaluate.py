@@ -22,7 +22,7 @@ import numpy as np
 
 from .errors import NeurohoverError, as_floats, brief, finite_real, real_number, whole_in, whole_number
 from .flightdata import FlightData, same_values
-from .flyer import KernelFlyer
+from .flyer import KernelFlyer, refuse_other_import
 from .launch import DEVICES, KIND, MAX_SEED, Batch, Flown, check_device, launch, num_threads, use_lanes
 from .policies import GENOME_LENGTH, Policy, check_padding, frozen, genome_rows, load_policy, refuse_own_act
 from .sim.constants import (
@@ -65,8 +65,8 @@ __all__ = [
 
 
 def as_policies(policies) -> list[Policy]:
-    """``policies`` as a list of :class:`Policy`: a Policy, a policy file's path or ``"baseline"``
-    (as wherever a policy file is accepted), or a sequence of these; anything else is refused."""
+    """``policies`` as a list of :class:`Policy`: a Policy, a policy file's path or ``"baseline"``, or a sequence of these."""
+    refuse_other_import(policies if isinstance(policies, (list, tuple)) else [policies])  # a reloaded module's (T36-B10)
 
     allowed = "give a Policy, a policy file's path or 'baseline' (or a sequence of these, or a PolicyTable)"
 
@@ -125,7 +125,7 @@ class PolicyTable:
         if not isinstance(policies, Sequence) or isinstance(policies, str) or len(policies) == 0:
             raise NeurohoverError(f"policies={policies!r:.60} is not allowed: give a non-empty sequence of Policy objects")
         # 'baseline' was an AttributeError (second trial); None too, read as the 'nothing found' default (T26-B01)
-        bad = [p for p in policies if not isinstance(p, Policy)]
+        bad = [p for p in refuse_other_import(policies) if not isinstance(p, Policy)]
         if bad:
             raise NeurohoverError(f"policy {bad[0]!r:.60} is not a Policy: load one with neurohover.load_policy (e.g. load_policy('baseline'))")
         refuse_own_act(policies)  # a subclass's own act was ignored: the kernel flies the genome (T33-B11)

@@ -2,16 +2,20 @@
 
 from __future__ import annotations
 
+import sys
+from collections.abc import Sequence
+from typing import Any
+
 import numba
 import numpy as np
 
 from .errors import NeurohoverError, brief, whole_in, whole_number
 from .launch import KIND, MAX_SEED, Batch, Flown, Parking, check_device, launch, launch_parked, rows_alike
-from .policies import GENOME_LENGTH, TOPOLOGIES
+from .policies import GENOME_LENGTH, TOPOLOGIES, Policy
 from .sim.constants import MAX_EPISODE_STEPS, SAFEGUARD_LIMITS
 from .sim.kernel import GENOME_WIDTH
 
-__all__ = ["MAX_EPISODE_INDEX", "KernelFlyer"]
+__all__ = ["MAX_EPISODE_INDEX", "KernelFlyer", "refuse_other_import"]
 
 #: The last episode index the kernel holds (its episode indices are int64): past it np.add overflowed (T19-01).
 MAX_EPISODE_INDEX = 2**63 - 1
@@ -250,3 +254,18 @@ class KernelFlyer:
         self.crashed = crashed
         self.job_steps = steps
         return returns
+
+
+def refuse_other_import(policies: Sequence[Any]) -> Sequence[Any]:
+    """``policies``, unless one is a Policy of another import of neurohover.policies than the one the package flies: after
+    ``importlib.reload(neurohover.policies)`` an earlier Policy was refused as one with "an act of its own" and a fresh one
+    as no Policy (T36-B10). Two Policy classes cannot both be flown, so it is refused, by its true cause. (Here, beside
+    the kernel's other checks of what it flies: evaluate.py is at the module size limit.)"""
+    current = getattr(sys.modules.get(Policy.__module__), "Policy", Policy)
+    for p in policies:
+        if any(c.__module__ == Policy.__module__ and c.__qualname__ == "Policy" and not (c is Policy is current) for c in type(p).__mro__):
+            raise NeurohoverError(
+                f"policy {brief(p)} is not allowed: it is a Policy of another import of neurohover.policies (the module was reloaded?), while "
+                "neurohover's other modules hold the first import's Policy; restart the interpreter instead of reloading a neurohover module"
+            )
+    return policies

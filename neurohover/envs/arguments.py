@@ -129,14 +129,17 @@ def check_against_id(spec: Any, family: TaskFamily, episode_steps: int, limit: i
     if registered is None:  # made directly, or from an unregistered spec
         return
     task = registered.kwargs.get("task")
-    if task is not None and task != family.name:
+    # a user's own id (not in neurohover's namespace) is the user's: make()'s task= overrides its kwargs, as Gymnasium's
+    # make does; it was refused with an empty list of ids to use instead, "()" (T36-B11)
+    if task is not None and task != family.name and registered.namespace == "neurohover":
         ids = [
             i
             for i, r in gym.registry.items()
             if i.startswith("neurohover/") and r.kwargs.get("task") == family.name and r.entry_point == registered.entry_point
         ]
         raise NeurohoverError(
-            f"{spec.id} is the {task} task family: task={family.name!r} conflicts with it; make a {family.name} id instead ({', '.join(ids[:3])})"
+            f"{spec.id} is the {task} task family: task={family.name!r} conflicts with it; make a {family.name} id instead"
+            + (f" ({', '.join(ids[:3])})" if ids else "")
         )
     applied = _make_time_limit(registered.max_episode_steps) if limit is None else limit
     if applied is None or episode_steps <= applied:
@@ -184,9 +187,10 @@ def check_no_unknown_kwargs(unknown: dict[str, Any], allowed: Sequence[str]) -> 
         raise NeurohoverError(f"unknown argument(s) {', '.join(sorted(unknown))}: allowed {', '.join(allowed)}")
 
 
-def _refuse_setting(name: str, value: Any) -> NoReturn:
+def _refuse_setting(name: str, value: Any, deleted: bool = False) -> NoReturn:
     how = "reset(options={'mdp': ...}) flies another MDP" if name == "mdp" else f"make a new environment with {name}=..."
-    raise NeurohoverError(f"{name}={brief(value)} is not allowed: an environment's {name} is fixed when it is made (its steps trust it); {how}")
+    what = f"del {name}" if deleted else f"{name}={brief(value)}"
+    raise NeurohoverError(f"{what} is not allowed: an environment's {name} is fixed when it is made (its steps trust it); {how}")
 
 
 class _Setting:
@@ -200,6 +204,13 @@ class _Setting:
         if env.__dict__.get("_made"):
             _refuse_setting(self.name, value)
         env.__dict__[self.name] = value
+
+    def __delete__(self, env: Any) -> None:  # ``del env.episode_steps`` was a bare AttributeError '__delete__' (T36-B03)
+        if env.__dict__.get("_made"):
+            _refuse_setting(self.name, None, deleted=True)
+        if self.name not in env.__dict__:
+            raise AttributeError(f"{type(env).__name__!r} object has no attribute {self.name!r}")
+        del env.__dict__[self.name]
 
 
 class _Absent(_Setting):
@@ -226,6 +237,11 @@ class _Property(_Setting):
         if env.__dict__.get("_made") or self.prop.fset is None:
             _refuse_setting(self.name, value)
         self.prop.__set__(env, value)
+
+    def __delete__(self, env: Any) -> None:
+        if env.__dict__.get("_made") or self.prop.fdel is None:
+            _refuse_setting(self.name, None, deleted=True)
+        self.prop.__delete__(env)
 
 
 class FixedSettings:

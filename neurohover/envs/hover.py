@@ -212,7 +212,7 @@ class HoverEnv(FixedSettings, gym.Env[np.ndarray, np.ndarray]):
     - ``episode_steps``: control steps per episode (6000). ``gymnasium.make`` also adds a
       ``TimeLimit`` of the id's episode length; pass ``max_episode_steps`` to ``make`` for longer
       episodes (a longer ``episode_steps`` alone is warned of). ``task`` is the id's: another task
-      under an id is refused.
+      under one of neurohover's ids is refused (a user's own id takes it, as Gymnasium's make does).
     - ``obs_dtype``: ``"float64"`` (default) or ``"float32"`` (for deep-RL libraries): the
       observation space's dtype and the returned observations'. The simulation itself always
       runs in float64, so the episodes are the same, observations rounded to float32.
@@ -502,6 +502,13 @@ class HoverEnv(FixedSettings, gym.Env[np.ndarray, np.ndarray]):
             text = f"{self._mdp.label}   step {steps}/{self.episode_steps}   return {self._return:.6g}{end}"
         trail = np.array(self._trail) if self._trail else None
         return self._renderer.draw(self._state[0], wind, text, trail)
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The environment's state for pickle and ``copy.deepcopy``, without its renderer and window: matplotlib's are not
+        picklable (its BufferRegion, T36-B02), and they only draw, so the copy makes its own at its next render."""
+        state = self.__dict__.copy()
+        state["_renderer"] = state["_window"] = None
+        return state
 
     def close(self) -> None:
         """Close the window of ``"human"`` mode and release the renderer (safe to call twice)."""

@@ -232,6 +232,10 @@ class AskTellOrderError(NeurohoverError, RuntimeError):
 #: What an out-of-order call is told to do (eleventh trial: a bare RuntimeError, which ``except NeurohoverError`` missed).
 TELL_FIRST = "tell() called without a pending ask(): call ask() first, then tell() one return per genome it gave"
 ASK_AGAIN = "ask() called again before tell() of the previous {what}: tell() its returns first, one per genome it gave"
+BUSY = (
+    "ask() or tell() called while another ask() or tell() of this optimiser is running (another thread's?): "
+    "one sequence of calls only; give each thread its own optimiser"
+)
 
 
 # --------------------------------------------------------------------------- settings checks
@@ -555,18 +559,35 @@ class PopulationOptimiser(ChampionViews):
     def _tell(self, genomes: np.ndarray, returns: np.ndarray, info: TellInfo | None) -> None:
         raise NotImplementedError
 
+    _busy = False  # True while ask() draws or tell() updates: a call meanwhile (another thread's) is refused (T36-B04)
+
+    def _claim(self) -> None:
+        if self._busy:
+            raise AskTellOrderError(BUSY)
+        self.__dict__["_busy"] = True  # in the instance only while busy: a state_dict() is as before
+
     def ask(self) -> np.ndarray:
         """The next batch of genomes, shape ``(n, D)``."""
         if self._pending is None:
-            self._pending = np.asarray(self._ask(), dtype=np.float64)
+            self._claim()
+            try:
+                self._pending = np.asarray(self._ask(), dtype=np.float64)
+            finally:
+                self.__dict__.pop("_busy", None)
+        elif self._busy:  # the batch being told: its update is under way
+            raise AskTellOrderError(BUSY)
         return self._pending.copy()
 
     def tell(self, fitness: np.ndarray, info: TellInfo | None = None) -> None:
         """One return per asked genome (maximised; non-finite ones never become champion)."""
-        if self._pending is None:
-            raise AskTellOrderError(TELL_FIRST)
         genomes = self._pending
+        if genomes is None:
+            raise AskTellOrderError(BUSY if self._busy else TELL_FIRST)
         f = check_returns(fitness, genomes.shape[0], info=info)
-        self._tell(genomes, f, info)
-        self._tracker.update(genomes, f, self._clock())
-        self._pending = None
+        self._claim()  # a second tell() of this batch (another thread's) was pycma's RuntimeError (T36-B04)
+        try:
+            self._tell(genomes, f, info)
+            self._tracker.update(genomes, f, self._clock())
+            self._pending = None
+        finally:
+            self.__dict__.pop("_busy", None)

@@ -33,15 +33,19 @@ from ..evaluate import Evaluation, check_first_episode
 from ..policies import Policy
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS
 from ..tasks import MDP, TaskFamily, get_task_family, refuse_unordered_mdps
+from ..tasks.base import LEARNED_MODEL
 
 __all__ = ["AgentRow", "checked_obs_statistics", "compare_agent", "evaluate_callable"]
 
 MAX_EPISODES = 1 << 16  # helicopters in one lockstep batch: the vector environment's arrays stay small
 
 
-def _checked_mdps(mdps: Any) -> tuple[list[MDP], str]:
+def _checked_mdps(mdps: Any) -> tuple[list[MDP], str | None]:
     """``mdps`` (one MDP or a sequence of them, of one task family) as a list, with their family: the one check of
-    :func:`evaluate_callable` and :func:`compare_agent` (a Policy flew MDPs of mixed families; twelfth trial S5)."""
+    :func:`evaluate_callable` and :func:`compare_agent` (a Policy flew MDPs of mixed families; twelfth trial S5). A
+    learned model's MDP is of no family and flies beside any, as an environment's explicit ``mdp`` does
+    (:func:`~neurohover.envs.arguments.resolve_mdp`; it was refused as not "of one task family", T36-B06); the family
+    is None where all are models'."""
     refuse_unordered_mdps(mdps)  # a set flew in hash order (T32-B02)
     if isinstance(mdps, MDP):
         mdps = [mdps]
@@ -49,10 +53,10 @@ def _checked_mdps(mdps: Any) -> tuple[list[MDP], str]:
         mdps = list(mdps)
     if not isinstance(mdps, list) or not mdps or not all(isinstance(m, MDP) for m in mdps):
         raise NeurohoverError("mdps must be one MDP or a non-empty sequence of MDPs (e.g. get_task_family('ghh08').mdp('train:3'))")
-    families = sorted({m.family for m in mdps})
-    if len(families) != 1 or families[0] == "model":
-        raise NeurohoverError(f"mdps must all be MDPs of one task family (got {', '.join(families)})")
-    return mdps, families[0]
+    families = sorted({m.family for m in mdps} - {LEARNED_MODEL})
+    if len(families) > 1:
+        raise NeurohoverError(f"mdps must all be MDPs of one task family (got {', '.join(families)}): a learned model's MDP flies beside any")
+    return mdps, families[0] if families else None
 
 
 def _check_on_step(on_step: Any) -> None:
@@ -81,7 +85,7 @@ def evaluate_callable(
         Maps observations, shape (B, 12) of ``obs_dtype``, to actions, shape (B, 4) (clipped to
         [-1, 1] by the environment, as for every policy). B is the number of episodes still flying.
     mdps : MDP or sequence of MDP
-        MDPs of one task family.
+        MDPs of one task family; a learned model's MDP (``LearnedModel.mdp()``) flies beside any, or alone.
     episodes, seed, first_episode, n_steps
         As :func:`neurohover.evaluate`: episode e on MDP m meets gust stream
         ``(seed, first_episode + m * episodes + e)``.
@@ -107,7 +111,7 @@ def evaluate_callable(
     episodes = whole_in(episodes, "episodes", 1, top, f"{top} (episodes x MDPs <= {MAX_EPISODES})")
     n = len(mdps) * episodes
     sigma = getattr(mdps[0], "sigma", None)
-    env = HoverVectorEnv(n, task=family, sigma=sigma, mdp=[m for m in mdps for _ in range(episodes)], episode_steps=n_steps, obs_dtype=obs_dtype)
+    env = HoverVectorEnv(n, task=family or "ghh08", sigma=sigma, mdp=[m for m in mdps for _ in range(episodes)], episode_steps=n_steps, obs_dtype=obs_dtype)
     streams = [(seed, int(first_episode) + k) for k in range(n)]  # k = m * episodes + e, as evaluate numbers them
     start = time.perf_counter()
     obs, _ = env.reset(seed=seed, options={"noise": streams})
@@ -200,7 +204,8 @@ def compare_agent(
     :class:`~neurohover.policies.Policy` flies in the compiled kernel, as the other two do, in one call (``on_step``
     is not called) on float64 observations, so ``obs_dtype`` beside it is refused, as the CLI refuses ``--obs-dtype``
     beside ``--policy``. ``generic``: the generic row's policy (default: the shipped generic of the MDPs' task, refused,
-    as make_agent refuses the set, for FGHH MDPs not drawn at the sigma it was evolved for; T35-B07). Returns rows for
+    as make_agent refuses the set, for FGHH MDPs not drawn at the sigma it was evolved for; T35-B07; learned models' MDPs
+    alone are of no task, so give it). Returns rows for
     ``agent``, ``baseline`` and ``generic``, in that order."""
     from ..evaluate import evaluate
     from ..policies import baseline_policy
@@ -210,6 +215,11 @@ def compare_agent(
     _check_on_step(on_step)
     if generic is not None and not isinstance(generic, Policy):
         raise NeurohoverError(f"generic={brief(generic)} is not allowed: give a Policy for the generic row, or None (the shipped generic)")
+    if generic is None and family is None:  # a shipped generic is a task family's (T36-B06)
+        raise NeurohoverError(
+            f"generic=None is not allowed beside mdps of learned models only ({brief([m.label for m in mdps])}): they are of no task family, so "
+            "no shipped generic is theirs; give generic= a policy for the generic row (e.g. load_policy_set('ghh08').generic for a model of GHH-08 flights)"
+        )
     if obs_dtype is not None:  # checked for a Policy too, which ignored obs_dtype='x' (twelfth trial S5)
         check_obs_dtype(obs_dtype)
     if isinstance(act, Policy):
@@ -224,6 +234,7 @@ def compare_agent(
             act, mdps, episodes=episodes, seed=seed, n_steps=n_steps, obs_dtype="float32" if obs_dtype is None else obs_dtype, indexed=indexed, on_step=on_step
         )
     if generic is None:
+        assert family is not None  # refused above for models' MDPs alone
         ps = load_policy_set(family)
         _refuse_other_sigma(mdps, get_task_family(family), ps.manifest.get("sigma"))
         generic = ps.generic

@@ -234,14 +234,17 @@ class MDP:
 def finite_vector(values: Sequence[float] | np.ndarray, length: int, what: str) -> np.ndarray:
     """``values`` as a float array of ``length`` finite numbers, or a clear error naming ``what``."""
     # complex numbers too: NumPy dropped their imaginary part with a warning only (fourth trial)
-    if isinstance(values, str) or any(
-        isinstance(v, (str, bytes, bool, np.bool_, complex, np.complexfloating)) for v in np.ravel(np.asarray(values, dtype=object))
-    ):
+    objects = np.asarray(values, dtype=object)
+    if isinstance(values, str) or any(isinstance(v, (str, bytes, bool, np.bool_, complex, np.complexfloating)) for v in np.ravel(objects)):
         raise NeurohoverError(f"{what} must be {length} numbers, got {brief(values)}")
     try:  # as_floats: a masked array's hidden values and a date's day number were taken as numbers (T16-9, T16-11)
         arr = as_floats(values, what, "")  # its message is replaced by this function's own
     except NeurohoverError:  # objects such as 10**400, dates, ragged lists; a masked array
-        raise NeurohoverError(f"{what} must be {length} finite numbers, got {brief(values)}{masked_note(values)}") from None
+        if isinstance(values, np.ma.MaskedArray) or not objects.size or not all(finite_real(v) for v in objects.flat):
+            raise NeurohoverError(f"{what} must be {length} finite numbers, got {brief(values)}{masked_note(values)}") from None
+        # real numbers NumPy holds as objects (a Fraction, an int past int64), each taken as every float setting takes
+        # one (finite_real; Decimal is none); a Fraction was "must be 2 finite numbers" (T36-B09)
+        arr = np.array([float(v) for v in objects.flat]).reshape(objects.shape)
     if arr.ndim > 1:  # a (1, 2) array was "must be 2 numbers, got 2" (T34-B15)
         raise NeurohoverError(f"{what} must be a flat sequence of {length} numbers, got shape {arr.shape}: {brief(values)}")
     if arr.shape != (length,):
