@@ -27,7 +27,7 @@ import re
 
 import numpy as np
 
-from .errors import NeurohoverError
+from .errors import NeurohoverError, brief
 from .policies import INPUT_NAMES, MLP_BIAS_NAMES, MLP_WEIGHT_NAMES, Policy
 
 _INPUTS = {1: "u", 2: "v", 3: "w", 4: "x", 5: "y", 6: "z", 7: "p", 8: "q", 9: "r", 10: "qx", 11: "qy", 12: "qz"}
@@ -61,6 +61,8 @@ def _integer(text: str, what: str) -> int:
     """A node id, position or function: an integer in plain ASCII digits."""
     if not _INTEGER.fullmatch(text):
         raise ValueError(f"{what} {text!r} is not allowed: give an integer in ASCII digits (no '_')")
+    if len(text.lstrip("+-")) > 18:  # past 4,300 digits int() said "use sys.set_int_max_str_digits()" (T36-A05)
+        raise ValueError(f"{what} {brief(text)} is not allowed: give an integer of at most 18 digits (node ids, positions and functions are small)")
     return int(text)
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import io
+import itertools
 import os
 import re
 import signal
@@ -51,6 +52,14 @@ class _FlagOnce(argparse._StoreTrueAction):
         super().__call__(parser, namespace, values, option_string)
 
 
+class _SwitchOnce(argparse.BooleanOptionalAction):
+    """A --x/--no-x switch: given twice, in either spelling or an abbreviation, it is refused as a repeated option is."""
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        _once(self, parser, namespace, option_string)
+        super().__call__(parser, namespace, values, option_string)
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse's parser with single-valued options and flags refused when repeated (its subcommands' parsers are of
     this class too; other scripts' digits are refused by main, in every argument)."""
@@ -60,6 +69,7 @@ class _Parser(argparse.ArgumentParser):
         self.register("action", None, _StoreOnce)
         self.register("action", "store", _StoreOnce)
         self.register("action", "store_true", _FlagOnce)
+        self.register("action", argparse.BooleanOptionalAction, _SwitchOnce)  # --prog --no-progress: the last won (T36-A03)
 
     def error(self, message: str) -> NoReturn:
         """argparse's error in one line, as every other refusal (its usage block made 3-7 lines; T22-18), pointing to
@@ -77,6 +87,20 @@ def build_parser() -> argparse.ArgumentParser:
     for module in (flying, learning, agents, evaluate, reproduce, plots):
         module.register(sub)
     return parser
+
+
+def _refuse_version_with_more(parser: argparse.ArgumentParser, given: list[str], commands: dict) -> None:
+    """Refuse --version (or what argparse takes for it: any unique prefix before the command, --vers; T36-A02) given
+    with other arguments: argparse prints the version and drops the rest without a word."""
+    head = list(itertools.takewhile(lambda a: a not in commands, given))
+    asked = [a for a in head if len(a) > 2 and "--version".startswith(a)]
+    if not asked or len(given) == 1:
+        return
+    if len(asked) > 1:  # "got ''" named nothing (T36-A04)
+        parser.error(f"--version is given more than once ({' '.join(asked)}): give it once")
+    rest = list(given)
+    rest.remove(asked[0])
+    parser.error(f"--version takes no other arguments, got {' '.join(rest)!r}")
 
 
 def _other_scripts_digits(argv: Sequence[str]) -> str | None:
@@ -157,8 +181,7 @@ def _run(argv: Sequence[str] | None) -> int:
     odd = _other_scripts_digits(given)
     if odd is not None:
         named.error(f"argument {odd!r} holds digits of another script: give numbers in ASCII digits")
-    if "--version" in given and len(given) > 1:  # argparse prints the version and drops the rest without a word
-        parser.error(f"--version takes no other arguments, got {' '.join(a for a in given if a != '--version')!r}")
+    _refuse_version_with_more(parser, given, commands)
     for option in named._actions:  # argparse keeps the last of --x --no-x without a word (fourth trial)
         if isinstance(option, argparse.BooleanOptionalAction) and all(any(g.split("=")[0] == o for g in given) for o in option.option_strings):
             named.error(f"{' and '.join(option.option_strings)} are both given: give one")

@@ -488,8 +488,13 @@ def cmd_settings(args: argparse.Namespace) -> int:
         if own is None:
             raise NeurohoverError(f"agent {name!r} takes no settings of its own (agents that do: {', '.join(a for a, s in AGENTS.items() if s.settings)})")
         name = _settings_name(own)
+    if name == "ne":  # evolve --optimizer ne, the default: its settings are the method's (T36-A06)
+        print("ne (evolve's default optimiser) takes the settings of steady-state on one MDP (--mdp) and of generational over a family:\n")
+        print(format_settings(found["steady-state"], "steady-state") + "\n")
+        print(format_settings(found["generational"], "generational"))
+        return 0
     if name not in found:
-        raise NeurohoverError(f"no settings named {brief(args.name)}: allowed {', '.join(found)}, or an agent's name")
+        raise NeurohoverError(f"no settings named {brief(args.name)}: allowed {', '.join(found)}, ne, or an agent's name")
     print(format_settings(found[name], name))
     return 0
 

@@ -109,7 +109,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
 
 def _options_beside_list(args: argparse.Namespace) -> list[str]:
     """The options given beside ``reproduce --list``, as typed (single-valued ones and flags are recorded as they are parsed)."""
-    given = sorted(getattr(args, "_given_options", set()) - {"list", "name"})  # NAME: refused above
+    given = sorted(getattr(args, "_given_options", set()) - {"list", "name", "progress"})  # NAME: refused above; progress: as typed, below
     given += [d for d in ("set", "only") if getattr(args, d, None)]  # repeatable: not recorded
     names = [f"--{d.replace('_', '-')}" for d in given]
     if args.progress is not None:

@@ -33,6 +33,7 @@ import functools
 import hashlib
 import json
 import re
+import sys
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -311,7 +312,13 @@ def parse_override(text: str, option: str = "--set") -> tuple[str, Any]:
             why = re.sub(r" \(at (line \d+, column \d+|end of document)\)$", "", str(err))  # positions in our wrapper, not in VALUE
             raise NeurohoverError(f"bad {option} {text!r}: VALUE is not valid TOML ({why})") from None
         parsed = value.strip()
+    except ValueError:  # tomllib's int() past 4,300 digits, not a TOMLDecodeError (T36-A01)
+        raise NeurohoverError(f"bad {option} {brief(text)}: VALUE holds {_TOO_LONG}") from None
     return key, parsed
+
+
+#: What tomllib cannot read (Python's int_max_str_digits): past every setting's range (T36-A01).
+_TOO_LONG = f"an integer of more than {sys.get_int_max_str_digits() or 4300} digits, past every setting's range: give a number in the setting's range"
 
 
 def parse_overrides(texts: list[str] | None, option: str = "--set") -> dict[str, Any]:
@@ -364,6 +371,8 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
         raise NeurohoverError(f"config {str(path)!r} is not allowed: its TOML is nested too deeply") from None
     except UnicodeDecodeError as err:  # was "cannot be read (UnicodeDecodeError)", naming neither the rule nor the place (T19-15)
         raise NeurohoverError(f"config {str(path)!r} cannot be read: a config must be UTF-8 text, and {_bad_byte(err)} is not (save it as UTF-8)") from None
+    except ValueError:  # tomllib's int() past 4,300 digits (T36-A01; after UnicodeDecodeError, a ValueError too)
+        raise NeurohoverError(f"config {str(path)!r} is not allowed: it holds {_TOO_LONG}") from None
     except OSError as err:
         raise NeurohoverError(f"config {str(path)!r} cannot be read ({err.strerror or type(err).__name__})") from None
     where = f"config {str(path)!r}"
