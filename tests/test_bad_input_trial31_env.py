@@ -133,7 +133,7 @@ from pathlib import Path
 from neurohover.errors import NeurohoverError
 from neurohover.experiments import Store
 from neurohover.experiments.config import make_config
-from neurohover.experiments.plans import _dir_champions, _load_external
+from neurohover.experiments.external import dir_champions as _dir_champions, load_external as _load_external
 from neurohover.experiments.report import write_report
 
 print(sys.getfilesystemencoding())
@@ -176,7 +176,7 @@ def test_a05_the_suggested_build_command_is_quoted(tmp_path) -> None:
     import pytest
 
     from neurohover.errors import NeurohoverError
-    from neurohover.experiments.plans import _load_external
+    from neurohover.experiments.external import load_external as _load_external
 
     missing = str(tmp_path / "pd 1")
     with pytest.raises(NeurohoverError) as err:

@@ -42,10 +42,16 @@ n_steps = 20
 
 
 def _nudge_unflown_policy(policies: Path) -> None:
+    """A set whose specialised_3 changed, as a rebuild changes it: its manifest records the new genome (T36-B05)."""
+    from neurohover.manifest import DIGESTS, genome_digest
+
     path = policies / "ghh08" / "specialised_3.json"
     policy = json.loads(path.read_text())
     policy["genome"][0] += 0.01
     path.write_text(json.dumps(policy))
+    manifest = json.loads((policies / "ghh08" / "manifest.json").read_text())
+    manifest[DIGESTS]["specialised_3.json"] = genome_digest(neurohover.load_policy(path))
+    (policies / "ghh08" / "manifest.json").write_text(json.dumps(manifest))
 
 
 def test_a_baseline_only_experiment_runs_on_after_a_policy_it_never_flies_changed(cli, tmp_path: Path) -> None:
@@ -66,11 +72,11 @@ def test_a_baseline_only_experiment_runs_on_after_a_policy_it_never_flies_change
 
 def test_a_baseline_competition_stored_with_the_sets_digest_is_taken_and_relabelled(cli, tmp_path: Path, monkeypatch) -> None:
     """A folder an older neurohover wrote (its config hashed the shipped set) takes a baseline compete again, runs kept."""
-    from neurohover.experiments import plans
+    from neurohover.experiments import external
 
     argv = ["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--episode-steps", "20", "--out", str(tmp_path / "c")]
     with monkeypatch.context() as m:  # as neurohover hashed it before T35-A02: every named set
-        m.setattr(plans, "_flies_set", lambda kind, settings: True)
+        m.setattr(external, "_flies_set", lambda kind, settings: True)
         assert cli(*argv)[0] == 0
     with Store(tmp_path / "c" / "results.sqlite") as db:
         ((name, scale, *_),) = db.experiments()

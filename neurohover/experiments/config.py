@@ -501,7 +501,7 @@ def make_config(
     canonical_settings(resolved)  # equal settings spelt otherwise hash alike (T29-A07)
     paper = {} if paper is None else paper
     check_paper_table(paper, where, kind)  # after the settings: a bad agent is named as such
-    from .plans import external_digest
+    from .external import external_digest
 
     digest = external_digest(kind, resolved)
     return ExperimentConfig(name, title or name, kind, scale, resolved, paper, paper_ref, source, digest)

@@ -19,8 +19,9 @@ import json
 
 from ..errors import NeurohoverError, brief, first_difference
 from .config import ExperimentConfig
+from .external import external_digest
 from .keys import UnitKey
-from .plans import Plan, external_digest, plan, run_keys, source_experiments
+from .plans import Plan, plan, run_keys, source_experiments
 from .result_checks import params_problem
 from .results import UnitResult, check_run_lengths, flat_cells, result_from_dict
 from .store import Store

@@ -19,9 +19,6 @@ Unit keys (unique within an experiment)::
 from __future__ import annotations
 
 import functools
-import hashlib
-import json
-import shlex
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,15 +26,15 @@ import numpy as np
 from ..agents.hybrid import HybridSettings
 from ..agents.registry import HYBRID_AGENTS, agent_spec
 from ..errors import NeurohoverError, brief
-from ..filekinds import refuse_unencodable
 from ..integrations.neat import NEAT_TOPOLOGY
 from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..models.model import LEGACY_MODEL_SUBSTEPS
 from ..policies import baseline_policy
-from ..policysets import load_policy_set, policy_set_roles
+from ..policysets import policy_set_roles
 from ..tasks import EXACT, N_TEST, N_TRAINING, Sensor
 from ..tasks.drift import Drift
 from .config import ExperimentConfig, load_config
+from .external import dir_champions, load_external, policy_needs
 from .keys import UnitKey
 from .schema import DIR_SOURCE, POLICY_SET_GROUP, variant_optimizer
 from .settings import EvolutionSettings, ExperimentSettings, Group, ModelLearningSettings, TestRunsSettings
@@ -73,70 +70,6 @@ def _unit(cfg: ExperimentConfig, key: str, kind: str, params: dict, seed_key: st
 
 
 # --------------------------------------------------------------------------------- external policies
-
-
-#: What each setting naming a policy source takes besides 'shipped' and a directory (the message names the setting given).
-_SOURCE_WORDS = {"policies": "'evolve', ", "generic": "'evolve', 'baseline', ", "robustness_policies": ""}
-_SOURCE_KEYS = {"test_runs": "policies", "model_learning": "generic", "evolution": "robustness_policies"}
-
-
-def _load_external(task: str, source: str, key: str = "policies"):
-    from pathlib import Path
-
-    if source != "shipped":  # 'pd é' under LC_ALL=C PYTHONUTF8=0 was "no such directory", is_dir() False (T31-A05)
-        refuse_unencodable(source, f"{key} =")
-    folder = Path(source).expanduser()  # "~/bq0" as generics_from's "dir:~/..." is: the user's home (T30-A06)
-    if source != "shipped" and not folder.is_dir():  # a generic "nope" was named as policies (eighth trial)
-        raise NeurohoverError(  # the command quoted: 'pd 1' unquoted built 'pd' (T31-A05)
-            f"{key} = {source!r} is not allowed: give {_SOURCE_WORDS[key]}'shipped' or a directory holding <task>/ policy sets "
-            f"(no such directory; build it with: neurohover build-policies --task {task} --out {shlex.quote(source)})"
-        )
-    return load_policy_set(task, None if source == "shipped" else folder)
-
-
-def external_digest(kind: str, s: dict) -> str:
-    """Digest of policies a config reads from a directory (so results never mix policy sets)."""
-    key = _SOURCE_KEYS.get(kind, "policies")
-    source = s.get(key)
-    payload: dict = {}
-    if source not in (None, "evolve", "baseline"):
-        ps = _load_external(s["task"], source, key)  # read even where unflown: a directory that is none is named
-    if source not in (None, "evolve", "baseline") and _flies_set(kind, s):
-        payload = {
-            "generic": policy_dict(ps.generic),
-            "specialised": [policy_dict(p) for p in ps.specialised],
-            "safe": list(ps.safe),
-            "generics": {k: policy_dict(v) for k, v in sorted(ps.generics.items())},
-        }
-    drawn = {k: v for k, v in sorted((s.get("generics_from") or {}).items()) if str(v).startswith(DIR_SOURCE)} if kind == "test_runs" else {}
-    if drawn:  # generics read from policy files: their genomes are part of the config
-        payload["generics_from"] = {k: [p for _, p in _dir_champions(v)] for k, v in drawn.items()}
-    if not payload:
-        return ""
-    return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
-
-
-def _flies_set(kind: str, s: dict) -> bool:
-    """Whether a config's units fly policies of the set its policy source names: test runs whose every group is
-    baseline fly none, and their results do not depend on the set's files (T35-A02: they were refused once it changed)."""
-    if kind != "test_runs":
-        return True
-    family = family_of(s["task"], s.get("sigma"))  # what a set holds depends on the task alone, not its sensors
-    return bool(_needs(family, [g["agent"] for g in s["groups"]]))
-
-
-def _dir_champions(source: str) -> list[tuple[str, dict]]:
-    """``[(label, policy)]`` of the policy files in the directory ``dir:PATH`` names, in file-name order."""
-    from pathlib import Path
-
-    from ..policies import load_policy
-
-    refuse_unencodable(source[len(DIR_SOURCE) :], "generics_from dir:")  # as policies = (T31-A05)
-    folder = Path(source[len(DIR_SOURCE) :]).expanduser()
-    files = sorted(f for f in folder.iterdir() if f.suffix.lower() in (".net", ".json")) if folder.is_dir() else []
-    if not files:
-        raise NeurohoverError(f"generics_from {source!r}: no directory of policy files (.net or .json) there; give dir:PATH of one")
-    return [(f"{source}/{f.name}", policy_dict(load_policy(f))) for f in files]
 
 
 # --------------------------------------------------------------------------------- evolution
@@ -216,7 +149,7 @@ def _policy_set_robustness(cfg: ExperimentConfig, train: list) -> list[Unit]:
     """Table 3 for a policy set: specialised policy i flown on every training MDP, as MDP i's best champion is."""
     s = cfg.typed
     assert isinstance(s, EvolutionSettings) and s.robustness_policies is not None
-    ps = _load_external(s.task, s.robustness_policies, "robustness_policies")
+    ps = load_external(s.task, s.robustness_policies, "robustness_policies")
     params = {"mdps": [m.to_dict() for m in train], "episodes": s.robustness_episodes, "n_steps": s.n_steps}
     return [
         _unit(
@@ -251,21 +184,6 @@ def _policy_evolution_unit(cfg: ExperimentConfig, key: str, target: dict, budget
     )
 
 
-def _spec(agent: str):
-    return agent_spec(agent)
-
-
-def _needs(family, agents: list[str]) -> set[str]:
-    """The kinds of policy (generic, specialised, safe, ...) that ``agents`` fly of ``family``'s policy set."""
-    needs: set[str] = set()
-    for agent in agents:
-        spec = _spec(agent)
-        needs |= spec.needs
-        if family.generic_over_distribution and spec.generic_kind is not None:
-            needs.add(spec.generic_kind)
-    return needs
-
-
 def source_experiments(cfg: ExperimentConfig) -> list[str]:
     """The experiments whose results a config's units need (``generics_from``), in the order named."""
     s = cfg.typed
@@ -280,7 +198,7 @@ def _source_champions(source: str, scale: str, results: dict) -> tuple[list[tupl
     highest mean, so that no test MDP chooses it), or None and why while its runs are unfinished."""
 
     if source.startswith(DIR_SOURCE):
-        return _dir_champions(source), ""
+        return dir_champions(source), ""
     name, _, want = source.partition("/")
     src = load_config(name, scale).typed
     if not isinstance(src, EvolutionSettings):
@@ -309,10 +227,10 @@ class _Policies:
         self.settings = s
         self.task = s.task
         self.family = family_of(s.task, s.sigma, s.sensor)
-        self.needs = needs = _needs(self.family, [g.agent for g in s.groups])
+        self.needs = needs = policy_needs(self.family, [g.agent for g in s.groups])
         self.units: list[Unit] = []
         self.total = 0
-        self.external = None if s.policies == "evolve" else _load_external(self.task, s.policies)
+        self.external = None if s.policies == "evolve" else load_external(self.task, s.policies)
         if self.external is not None:
             if self.family.generic_over_distribution and s.generics_per_agent != 1:
                 raise NeurohoverError(
@@ -387,7 +305,7 @@ class _Policies:
 
     def for_agent(self, agent: str, mdp_index: int | None, run_counter: int, exclude_own: bool, key: str = "") -> dict | None:
         """The policies of one run of ``agent``, unit ``key`` (None: not ready yet)."""
-        spec = _spec(agent)
+        spec = agent_spec(agent)
         need = spec.needs
         out: dict = {}
         ext = self.external
@@ -546,7 +464,7 @@ def _plan_model_learning(cfg: ExperimentConfig, results: dict) -> Plan:
     elif s.generic == "baseline":
         generic = policy_dict(baseline_policy())
     else:
-        generic = policy_dict(_load_external(s.task, s.generic, "generic").generic)
+        generic = policy_dict(load_external(s.task, s.generic, "generic").generic)
     if generic is None:
         return Plan(units, total)
     for i, mdp in enumerate(_mdps(family, s.mdps, s.n_mdps, s.seed)):
