@@ -168,11 +168,17 @@ def float_of(text: str) -> float:
     return value
 
 
-def check_flag(value: Any, name: str, meaning: str) -> None:
-    """Refuse a flag that is not a bool: any truthy value counted as True (``fresh='no'`` deleted every stored unit,
-    T14-4; ``quick='no'``, ``fit_drags='no'``, fifteenth trial). The one check of a True/False argument."""
-    if not isinstance(value, bool):
-        raise NeurohoverError(f"{name}={brief(value)} is not allowed: give True ({meaning}) or False")
+def check_flag(value: Any, name: str, meaning: str) -> bool:
+    """The Python bool of a flag, or one error refusing one that is not a bool: any truthy value counted as True
+    (``fresh='no'`` deleted every stored unit, T14-4; ``quick='no'``, ``fit_drags='no'``, fifteenth trial). The one
+    check of a True/False argument. A NumPy bool (``(a > 0).any()``, a flag read from an .npz) is one, as evaluate's
+    ``record`` and a Choice take it (it was refused, T36-B07)."""
+    if isinstance(value, bool):
+        return value
+    numpy = sys.modules.get("numpy")  # not imported: the value is no NumPy bool
+    if numpy is not None and isinstance(value, numpy.bool_):
+        return bool(value)
+    raise NeurohoverError(f"{name}={brief(value)} is not allowed: give True ({meaning}) or False")
 
 
 def raise_terminated(signum, frame) -> None:

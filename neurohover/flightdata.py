@@ -13,6 +13,7 @@ import zlib
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 
@@ -259,7 +260,7 @@ class FlightData:
         obs_split = np.split(obs, np.cumsum(lengths + 1)[:-1])
         act_split = np.split(act, np.cumsum(lengths)[:-1])
         check_metadata(metadata, lengths, f"flight-data file {str(path)!r}", (tuple(obs_split), tuple(act_split)))  # and the readings (T23-03, T23-19)
-        bad = next((k for k, v in metadata.items() if not _json_ok({k: v})), None)  # a NaN no check above names (T32-B18)
+        bad = unwritable_key(metadata)  # a NaN no check above names (T32-B18)
         if bad is not None:  # it was refused as metadata that "cannot be saved", the file not named
             raise NeurohoverError(
                 f"flight-data file {str(path)!r}: its metadata {bad if len(bad) <= 60 else brief(bad)}={brief(metadata[bad])} is not allowed: "
@@ -340,9 +341,9 @@ def _metadata_text(metadata: object, where: str) -> str:
     metadata = _check_dict(metadata, where)
     refuse_non_text_keys(metadata, where)
     try:
-        text = json_text(metadata, default=_plain)
+        text = json_text(metadata, default=plain_json)
     except (TypeError, ValueError, RecursionError) as err:
-        bad = next((k for k, v in metadata.items() if not _json_ok({k: v})), None)  # the entry to name, where one alone fails
+        bad = unwritable_key(metadata)  # the entry to name, where one alone fails
         shown = f", not {bad if len(bad) <= 60 else brief(bad)}={brief(metadata[bad])}" if isinstance(bad, str) else ""
         raise NeurohoverError(f"{where} metadata cannot be saved as JSON: give strict JSON values (numbers finite){shown} ({err})") from None
     deep = _too_deep(metadata)
@@ -362,9 +363,15 @@ def _too_deep(metadata: dict) -> str:
     return f"{bad if len(bad) <= 60 else brief(bad)}={brief(metadata[bad])} is not allowed: it is nested more than {MAX_NOTE_DEPTH} lists or tables deep"
 
 
-def _plain(value: object) -> object:
-    """A NumPy number or (unmasked) array in metadata as the plain number or list JSON writes (``json.dumps``' default):
-    flight data made in Python may hold them (``==`` compares them whole); anything else is json's TypeError."""
+_K = TypeVar("_K")
+
+
+def plain_json(value: object) -> object:
+    """A NumPy number or (unmasked) array as the plain number or list JSON writes (``json.dumps``' ``default``): values
+    made in Python may hold them (``np.argmax``'s np.int64, a float32 score, ``(a > 0).any()``); anything else is json's
+    TypeError. The one conversion of the metadata and statistics neurohover writes as JSON: flight data's metadata, a
+    policy file's metadata (:func:`~neurohover.policies.save_policy`) and a model's stats (their NumPy numbers were
+    refused, T36-B08)."""
     if isinstance(value, (np.generic, np.ndarray)) and not isinstance(value, np.ma.MaskedArray):
         plain = value.tolist()  # a date or a complex number stays one, and is refused as such
         if not isinstance(plain, (np.generic, np.ndarray)):
@@ -372,10 +379,16 @@ def _plain(value: object) -> object:
     raise TypeError(f"Object of type {type(value).__name__} is not JSON serializable")
 
 
+def unwritable_key(table: dict[_K, object]) -> _K | None:
+    """The first key of ``table`` whose entry alone JSON cannot write (strictly, NumPy numbers as :func:`plain_json`
+    writes them), None when each can: the entry a refusal names (json's own message names no key, and no NaN)."""
+    return next((k for k, v in table.items() if not _json_ok({k: v})), None)
+
+
 def _json_ok(value: object) -> bool:
     """Whether :func:`_metadata_text`'s JSON writes ``value``."""
     try:
-        json_text(value, default=_plain)
+        json_text(value, default=plain_json)
     except (TypeError, ValueError, RecursionError):
         return False
     return True
@@ -446,7 +459,7 @@ def _checked_mdps(tables: list, where: str) -> list:
     known: dict[str, object] = {}  # the same table once: fly --record writes one per episode, most of them alike
     for i, table in enumerate(tables):
         try:
-            text = json_text(table, default=_plain, sort_keys=True)
+            text = json_text(table, default=plain_json, sort_keys=True)
         except (TypeError, ValueError, RecursionError):  # no JSON (changed after making): checked here, named by save()
             text = ""
         if not text or text not in known:

@@ -471,7 +471,8 @@ def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
 
     The name is checked by :func:`check_json_policy_name` (a name ending .json, not another run's checkpoint or history;
     T24-01), the record by :data:`RECORD_CHECKS` as :func:`load_policy` checks it (T24-03): what is written loads."""
-    from .paths import json_text, output_file, writing
+    from .flightdata import plain_json, unwritable_key  # here: flightdata imports this module
+    from .paths import json_text, output_file, strict_json, writing
 
     if not isinstance(policy, Policy):
         raise NeurohoverError(f"policy={policy!r:.60} is not allowed: give a Policy (load_policy('baseline') for the baseline's)")
@@ -485,11 +486,13 @@ def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
             raise NeurohoverError(f"{what} key(s) {', '.join(taken)} are the policy's own: give the metadata other names")
     data.update(metadata)
     refuse_non_text_keys(data, "policy")  # {1: 2} came back as {'1': 2} (T28-B14)
-    try:  # json_text: what load_policy reads back (x=10**400 was written, then refused; T28-B14)
-        text = json_text(data, indent=1) + "\n"
+    try:  # json_text: what load_policy reads back (x=10**400 was written, then refused; T28-B14); NumPy numbers as
+        text = json_text(data, indent=1, default=plain_json) + "\n"  # flight data's metadata takes them (T36-B08)
     except (TypeError, ValueError, RecursionError) as err:  # an object, or a NaN that other JSON readers refuse
-        raise NeurohoverError(f"policy metadata must be strict JSON values (numbers finite): {err}") from None
-    problem = record_problem({k: v for k, v in data.items() if k not in ("topology", "genome")})
+        bad = unwritable_key(data)  # the entry named, as the model's stats and flight data's metadata name it (T36-B08)
+        shown = f", not {bad if len(bad) <= 60 else brief(bad)}={brief(data[bad])}" if isinstance(bad, str) else ""
+        raise NeurohoverError(f"policy metadata must be strict JSON values (numbers finite){shown}: {err}") from None
+    problem = record_problem({k: v for k, v in strict_json(text).items() if k not in ("topology", "genome")})  # as written
     if problem:  # T24-03: seed=-1 or budget=-5 was written, and load_policy then refused the file
         shown = repr(os.fspath(path)) if isinstance(path, (str, os.PathLike)) else brief(path)  # as load_policy names the file
         raise NeurohoverError(f"policy file {shown}: {problem} (load_policy would refuse the file; nothing is written)")

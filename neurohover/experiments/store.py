@@ -107,7 +107,7 @@ class Store:
     def __init__(self, path: str | Path, *, create: bool = True) -> None:
         from ..paths import checked_path, make_dirs
 
-        check_flag(create, "create", "make the store if missing")  # create='no' was true (sixth trial)
+        create = check_flag(create, "create", "make the store if missing")  # create='no' was true (sixth trial)
 
         refuse_sqlite_name(path, "results store")  # ':memory:' and 'file:' URIs: never a file (as given: './file:x' is one; T32-A01, T32-A02)
         self.path = checked_path(path, "results store", "results store's file path", file=True)  # None, 3, NUL, too long, 'x/' (T32-B08)
@@ -287,7 +287,7 @@ class Store:
         check_text(config_hash, "config_hash", where)
         text = object_text(config, "config", where)
         self._check_config(config, scale, config_hash, where)
-        check_flag(fresh, "fresh", "delete the experiment's stored units first")
+        fresh = check_flag(fresh, "fresh", "delete the experiment's stored units first")
         if not fresh:  # its row kept: a damaged one named (T22-09)
             self._check_created(name)
         self.lock()
@@ -355,10 +355,12 @@ class Store:
 
     def _rows(self, sql: str, params: tuple, what: str) -> list[tuple]:
         """The rows of a read, a damaged file named with what could not be read (SQLite's message named a column and
-        printed raw bytes; fourth trial). Names and scales must be text."""
+        printed raw bytes; fourth trial). Names and scales must be text, without NUL or a lone surrogate, as the writes
+        refuse them (a lone surrogate, '\\udcff', was SQLite's UnicodeEncodeError; T36-B01)."""
         for value in params:
             if not isinstance(value, str):
                 raise NeurohoverError(f"{value!r:.60} is not allowed as an experiment name or scale: give text (e.g. 'fig7', 'paper')")
+            check_text(value, "experiment name or scale", f"results store {str(self.path)!r}", empty=True)
         try:
             with self.conn.guard:
                 refuse_moved(self.path, self._file, self._ident)

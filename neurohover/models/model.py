@@ -38,6 +38,7 @@ import numpy as np
 
 from ..errors import NeurohoverError, as_floats, brief, finite_real, real_number, refuse_non_text_keys, whole_number
 from ..filekinds import refuse_suffix
+from ..flightdata import plain_json, unwritable_key
 from ..paths import json_text
 from ..sim.constants import CONTROL_DT, DEFAULT_NOISE_STD, DEFAULT_PARAMS, MAX_SECONDS, NOISE_NAMES, PARAM_NAMES, SUBSTEP_DT, SUBSTEPS, seconds_allowed
 from ..tasks import MDP, finite_vector
@@ -151,16 +152,11 @@ def check_stats(stats: dict) -> None:
     back: strict JSON values, numbers finite (an object() or a NaN was json's TypeError or ValueError at the save;
     fourteenth trial T14-12), as ``save_policy`` and ``FlightData.save`` refuse their metadata."""
     refuse_non_text_keys(stats, "model", "stats")  # {1: 2} was written, and read back as {'1': 2} (T32-B05)
-    try:
-        json_text(stats)  # the round trip: load() reads what its parser takes
+    try:  # the round trip: load() reads what its parser takes; NumPy numbers as flight data's metadata writes them (T36-B08)
+        json_text(stats, default=plain_json)
     except (TypeError, ValueError, RecursionError) as err:  # RecursionError: nesting too deep to write
-        subject = "model stats"
-        for key, value in stats.items():  # name the first entry at fault (json's message names no key, and no NaN)
-            try:
-                json_text({key: value})
-            except (TypeError, ValueError, RecursionError):
-                subject = f"model stats entry {brief(key)} = {brief(value)}"
-                break
+        key = unwritable_key(stats)  # name the first entry at fault (json's message names no key, and no NaN)
+        subject = "model stats" if key is None else f"model stats entry {brief(key)} = {brief(stats[key])}"
         raise NeurohoverError(f"{subject} is not allowed: give strict JSON values, numbers finite ({err})") from None
 
 
@@ -324,7 +320,7 @@ class LearnedModel:
         if isinstance(path, (str, os.PathLike)):  # (other paths are output_file's to refuse)
             self.check_name(path)
         check_stats(self.stats)  # stats may be changed after making: a NaN was json's ValueError (T32-B05)
-        text = json.dumps(self.to_dict(), indent=1, allow_nan=False) + "\n"
+        text = json.dumps(self.to_dict(), indent=1, allow_nan=False, default=plain_json) + "\n"
         shown = repr(os.fspath(path)) if isinstance(path, (str, os.PathLike)) else brief(path)  # as load names the file
         try:  # what load reads back: stats.n_episodes = -5 was written, then refused by load (T32-B05)
             type(self).from_dict(json.loads(text), f"model file {shown}")
