@@ -6,7 +6,10 @@ file, lives in :mod:`neurohover.policy_records` (re-exported here)."""
 
 from __future__ import annotations
 
+import hashlib
+import re
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -14,8 +17,15 @@ from .errors import NeurohoverError, brief, finite_real, whole_number
 from .policy_records import policy_record_problem, seconds_problem  # noqa: F401  (policy_record_problem re-exported: once here)
 from .sim.constants import MAX_EPISODE_STEPS
 
+if TYPE_CHECKING:
+    from .policies import Policy
+    from .policysets import Role
+
 #: How GHH-08/09 policy sets seed their runs (see the doc of :mod:`neurohover.policysets`).
 LINEAGES = ("chain", "independent")
+#: The manifest's record of each policy file's network: file name -> :func:`genome_digest` of the policy its build wrote
+#: there. A build writes it; an older build's manifest holds none, and its files are loaded unchecked (T36-B05).
+DIGESTS = "genome_sha256"
 
 
 # What a manifest's descriptive fields may hold (they are shown and compared, never flown): name -> (kinds, what is allowed).
@@ -46,7 +56,7 @@ def _manifest_sizes() -> dict[str, tuple[int, int, str]]:
 
 
 # Every key a build writes into a manifest, of a GHH or an FGHH set, and the descriptive fields above.
-_MANIFEST_KEYS = ("task", *_MANIFEST_FIELDS, "safe", "crashes_on_training_mdps", "mean_return_on_training_mdps", "table3")
+_MANIFEST_KEYS = ("task", *_MANIFEST_FIELDS, DIGESTS, "safe", "crashes_on_training_mdps", "mean_return_on_training_mdps", "table3")
 
 
 def _check_manifest_fields(manifest: dict, path: Path) -> None:
@@ -75,6 +85,69 @@ def _check_manifest_fields(manifest: dict, path: Path) -> None:
     problem = seconds_problem(manifest)  # T26-B13: 1e30 was taken, where a checkpoint's seconds are at most 100 years
     if problem:
         raise NeurohoverError(f"policy-set manifest {str(path)!r}: {problem}")
+    digests = manifest.get(DIGESTS, {})
+    if not isinstance(digests, dict) or not all(isinstance(d, str) and re.fullmatch("[0-9a-f]{16}", d) for d in digests.values()):
+        raise NeurohoverError(
+            f"policy-set manifest {str(path)!r}: its {DIGESTS} {brief(digests)} is not allowed: give a table of file name -> 16 hex digits "
+            "(each policy file's genome_digest, as build-policies writes it)"
+        )
+
+
+def built_as(manifest: dict, role: Role, k: int) -> dict:
+    """What the run of ``role`` recorded, as the set's ``manifest`` says its build ran it (where it says): its episode
+    length, its budget and its method (a steady-state generic recording a generational run, or n_steps 999 in a set of
+    20, was flown; T23-11); and its seed, the ``k``-th of the manifest's root seed's (a manifest seed of 7 beside policies
+    of a build from 0 was shown; T25-14)."""
+    from .evolution.optimisers import NE, OPTIMISERS
+
+    family = role.target == "family"
+    optimizer = NE if role.kind == "race" else manifest.get("optimizer", NE)  # a race is NE's (build_policy_set)
+    method = ("generational" if family else "steady-state") if optimizer == NE else getattr(OPTIMISERS.get(optimizer), "label", None)
+    built = {"n_steps": manifest.get("n_steps"), "budget": manifest.get("fghh_budget" if family else "budget"), "method": method}
+    if whole_number(manifest.get("seed")) and 0 <= manifest["seed"] < 2**63:  # T25-14: as build_policy_set seeds role k
+        built["seed"] = int(np.random.SeedSequence(manifest["seed"]).generate_state(32, dtype=np.uint32)[k])
+    if family:  # T25-07: race:0.1 on the fixed generic was flown; the build runs each generic over G by its role's resampling
+        built["resampling"] = role.resampling
+    return {key: value for key, value in built.items() if value is not None}
+
+
+def genome_digest(policy: Policy) -> str:
+    """16 hex digits of SHA-256 over a policy's topology and genes (float64, little-endian): what a set's manifest records
+    of each policy file (:data:`DIGESTS`). A gene -0.0 differs from 0.0, as the file's text does."""
+    genome = np.ascontiguousarray(policy.genome, dtype="<f8")
+    return hashlib.sha256(policy.topology.encode() + b":" + genome.tobytes()).hexdigest()[:16]
+
+
+def set_files(generic: Policy | None = None, specialised=(), ancestor: Policy | None = None, generics: dict | None = None) -> dict[str, Policy]:
+    """A set's policies by the file name a build writes each to (those given)."""
+    files = {} if generic is None else {"generic.json": generic}
+    files.update({f"specialised_{i}.json": p for i, p in enumerate(specialised)})
+    files.update({f"generic_{kind}.json": p for kind, p in (generics or {}).items()})
+    return files if ancestor is None else {**files, "ancestor.json": ancestor}
+
+
+def genome_digests(files: dict[str, Policy]) -> dict[str, str]:
+    """The manifest's :data:`DIGESTS` of a set's policy ``files`` (:func:`set_files`)."""
+    return {name: genome_digest(policy) for name, policy in files.items()}
+
+
+def check_digests(manifest: dict, path: Path, files: dict[str, Policy]) -> None:
+    """Refuse a policy file whose genome is not the one its set's ``manifest`` (at ``path``) recorded: two specialised
+    policies scaled by hand loaded with the manifest's safe list, crash table and champion returns of the ones its build
+    flew, and the hybrid agent fell back on policies that now always crash (T36-B05). A manifest without
+    :data:`DIGESTS` (a build before it was written) is not checked: its set loads as before."""
+    digests = manifest.get(DIGESTS)
+    if digests is None:
+        return
+    for name, policy in files.items():
+        want, have = digests.get(name), genome_digest(policy)
+        if want != have:
+            said = f"records no {DIGESTS} of {name}" if want is None else f"records {name}'s genome as {want}, and the file holds {have}"
+            raise NeurohoverError(
+                f"policy set {str(path.parent)!r}: its manifest.json {said} (a hand edit, or a policy of another build copied in?): its safe "
+                f"list, tables and the file's record are of the genome its build wrote; restore the file, or rebuild the set with: neurohover "
+                f"build-policies --task {path.parent.name} --out {str(path.parent.parent)!r}"
+            )
 
 
 def _is_build_time(text: str) -> bool:

@@ -33,7 +33,9 @@ with the project's own evolution (or writes a set elsewhere with ``--out``).
 A set is loaded strictly (:func:`load_policy_set`): every policy must be an MLP (a build evolves nothing else), a
 chain's set must hold its ``ancestor.json`` (an independent one must not), and a JSON file in the folder that no build
 writes (``specialised_10.json`` beside a GHH set's ten) is refused by name rather than ignored. Files of other names
-(a README, notes, a run's ``.history.csv``) are left alone: none can be taken for one of the set's policies.
+(a README, notes, a run's ``.history.csv``) are left alone: none can be taken for one of the set's policies. A file
+whose genome is not the one its manifest's ``genome_sha256`` records (an edit by hand) is refused by name (T36-B05); a
+manifest without digests (an older build) loads as before, unchecked.
 """
 
 from __future__ import annotations
@@ -51,7 +53,19 @@ import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real, whole_number
 from .evaluate import MAX_EPISODES_PER_CALL, evaluate
-from .manifest import LINEAGES, _check_manifest_fields, check_ghh_manifest, check_kind_keys, choose_safe, table3_summary
+from .manifest import (
+    DIGESTS,
+    LINEAGES,
+    _check_manifest_fields,
+    built_as,
+    check_digests,
+    check_ghh_manifest,
+    check_kind_keys,
+    choose_safe,
+    genome_digests,
+    set_files,
+    table3_summary,
+)
 from .paths import JSONError, sole_writer, strict_json, writing
 from .policies import Policy, load_policy, save_policy, utf8_text
 from .sim.constants import MAX_EPISODE_STEPS
@@ -124,7 +138,7 @@ _POLICY_KEYS = ("topology", "genome", "prototype", "method", "optimizer", "resam
 
 def _load(path: Path, what: str, task: str, target: str, built: dict | None = None) -> Policy:
     """The policy ``what`` of ``task``'s set, from ``path``, evolved on ``target`` (an MDP's label, or ``TASK/G`` over G)
-    by the run that ``built`` (:func:`_built_as`) says its manifest's build made."""
+    by the run that ``built`` (:func:`~neurohover.manifest.built_as`) says its manifest's build made."""
     _refuse_not_a_file(path, what)
     if not path.is_file():
         raise NeurohoverError(
@@ -145,24 +159,6 @@ def _load(path: Path, what: str, task: str, target: str, built: dict | None = No
     _check_place(policy, path, what, {"task": task, "name": path.stem, "target": target})
     _check_place(policy, path, what, built or {}, "what its manifest.json says the build ran: a policy of another build copied in, or a hand edit?")
     return policy
-
-
-def _built_as(manifest: dict, role: Role, k: int) -> dict:
-    """What the run of ``role`` recorded, as the set's ``manifest`` says its build ran it (where it says): its episode
-    length, its budget and its method (a steady-state generic recording a generational run, or n_steps 999 in a set of
-    20, was flown; T23-11); and its seed, the ``k``-th of the manifest's root seed's (a manifest seed of 7 beside policies
-    of a build from 0 was shown; T25-14)."""
-    from .evolution.optimisers import NE, OPTIMISERS
-
-    family = role.target == "family"
-    optimizer = NE if role.kind == "race" else manifest.get("optimizer", NE)  # a race is NE's (build_policy_set)
-    method = ("generational" if family else "steady-state") if optimizer == NE else getattr(OPTIMISERS.get(optimizer), "label", None)
-    built = {"n_steps": manifest.get("n_steps"), "budget": manifest.get("fghh_budget" if family else "budget"), "method": method}
-    if whole_number(manifest.get("seed")) and 0 <= manifest["seed"] < 2**63:  # T25-14: as build_policy_set seeds role k
-        built["seed"] = int(np.random.SeedSequence(manifest["seed"]).generate_state(32, dtype=np.uint32)[k])
-    if family:  # T25-07: race:0.1 on the fixed generic was flown; the build runs each generic over G by its role's resampling
-        built["resampling"] = role.resampling
-    return {key: value for key, value in built.items() if value is not None}
 
 
 def _refuse_not_a_file(path: Path, what: str) -> None:
@@ -209,7 +205,8 @@ def _refuse_strays(root: Path, family: TaskFamily) -> None:
 
 
 def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet:
-    """Load the policy set of ``task`` (the shipped one unless ``directory`` is given), strictly (see the module doc)."""
+    """Load the policy set of ``task`` (the shipped one unless ``directory`` is given), strictly (see the module doc); an
+    older build's manifest, which records no genome digests, loads as before."""
     family = get_task_family(task)
     root = policy_dir(family.name, directory)
     manifest_path = root / "manifest.json"
@@ -245,10 +242,11 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
                 f"the {name} generic policy",
                 family.name,
                 targets[roles[name].target],
-                _built_as(manifest, roles[name], list(roles).index(name)),
+                built_as(manifest, roles[name], list(roles).index(name)),
             )
             for name in FGHH_GENERICS
         }
+        check_digests(manifest, manifest_path, set_files(generics=generics))  # a hand-edited genome (T36-B05)
         return PolicySet(family.name, root, generics["race"], generics=generics, manifest=manifest)
     if manifest.get("lineage") == "independent" and (root / "ancestor.json").exists():  # T25-14: a chain's set was shown as independent
         raise NeurohoverError(
@@ -256,14 +254,15 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
             "chain's build writes (its runs seeded from that ancestor): give lineage 'chain', or rebuild the set"
         )
     generic_role, *specialised_roles = policy_set_roles(family)
-    generic = _load(root / "generic.json", "the generic policy", family.name, targets["zero"], _built_as(manifest, generic_role, 0))
+    generic = _load(root / "generic.json", "the generic policy", family.name, targets["zero"], built_as(manifest, generic_role, 0))
     train = family.training_mdps()
     if manifest.get("lineage") == "chain":  # T26-B12: a chain's set without its ancestor was taken
-        _check_ancestor(root, manifest, manifest_path, family.name, train[-1].label, _built_as(manifest, generic_role, 12 + len(train) - 1))
+        _check_ancestor(root, manifest, manifest_path, family.name, train[-1].label, built_as(manifest, generic_role, 12 + len(train) - 1))
     specialised = tuple(
-        _load(root / f"specialised_{i}.json", f"specialised policy {i}", family.name, train[i].label, _built_as(manifest, specialised_roles[i], i + 1))
+        _load(root / f"specialised_{i}.json", f"specialised policy {i}", family.name, train[i].label, built_as(manifest, specialised_roles[i], i + 1))
         for i in range(10)
     )
+    check_digests(manifest, manifest_path, set_files(generic, specialised))  # two safe genomes x1000 were flown (T36-B05)
     safe = check_ghh_manifest(manifest, manifest_path, len(specialised), len(train))
     return PolicySet(family.name, root, generic, specialised, safe, manifest=manifest)
 
@@ -279,7 +278,7 @@ def _check_ancestor(root: Path, manifest: dict, manifest_path: Path, task: str, 
             f"policy-set manifest {str(manifest_path)!r}: its lineage 'chain' is not allowed without ancestor.json, which a chain's build "
             f"writes (the ancestor its runs were seeded from): restore it, or rebuild the set with: neurohover build-policies --task {task}"
         )
-    _load(path, "the ancestor", task, target, built)
+    check_digests(manifest, manifest_path, {"ancestor.json": _load(path, "the ancestor", task, target, built)})
 
 
 def crash_matrix(policies: list[Policy], mdps: list, episodes: int, seed: int, n_steps: int = 6000) -> tuple[np.ndarray, np.ndarray]:
@@ -573,7 +572,7 @@ def _build(family, root: Path, budget, fghh_budget, seed, safety_episodes, n_ste
         for k, role in enumerate(roles):
             how = {"budget": fghh_budget, "resampling": role.resampling} if role.target == "family" else {"budget": budget}
             generics[role.kind] = run(family if role.target == "family" else family.zero(), f"generic_{role.kind}", int(seeds[k]), **how)
-        manifest["seconds"] = round(time.perf_counter() - start, 1)
+        manifest.update({"seconds": round(time.perf_counter() - start, 1), DIGESTS: genome_digests(set_files(generics=generics))})
         (root / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n", encoding="utf-8")
         return PolicySet(family.name, root, generics["race"], generics=generics, manifest=manifest)
 
@@ -594,6 +593,7 @@ def _build(family, root: Path, budget, fghh_budget, seed, safety_episodes, n_ste
         for k, role in enumerate(roles)
     ]
     generic, specialised = evolved[0], evolved[1:]
+    manifest[DIGESTS] = genome_digests(set_files(generic, specialised, ancestor))  # what load_policy_set checks (T36-B05)
     crashes, returns = crash_matrix(specialised, train, safety_episodes, seed=int(seeds[11]), n_steps=n_steps)
     seconds = round(time.perf_counter() - start, 1)
     return _write_ghh_set(family.name, root, manifest, generic, specialised, crashes, returns, safety_episodes, seconds, say)

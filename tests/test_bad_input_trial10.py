@@ -90,6 +90,8 @@ def test_a_store_of_the_competition_run_with_another_policy_set_is_refused_and_t
     import json
     import shutil
 
+    from neurohover.manifest import DIGESTS, genome_digest
+    from neurohover.policies import load_policy
     from neurohover.policysets import policy_dir
 
     shutil.copytree(policy_dir("ghh08"), tmp_path / "pd" / "ghh08")
@@ -101,6 +103,9 @@ def test_a_store_of_the_competition_run_with_another_policy_set_is_refused_and_t
     generic = tmp_path / "pd" / "ghh08" / "generic.json"
     policy = json.loads(generic.read_text())
     generic.write_text(json.dumps({**policy, "genome": [g * 0.5 for g in policy["genome"]]}))
+    manifest = json.loads((generic.parent / "manifest.json").read_text())  # another build's set: its manifest records it (T36-B05)
+    manifest[DIGESTS]["generic.json"] = genome_digest(load_policy(generic))
+    (generic.parent / "manifest.json").write_text(json.dumps(manifest))
     rc, _, err = cli(*argv, "--out", str(tmp_path / "c2"), "--store", str(tmp_path / "c1" / "results.sqlite"))
     assert rc == 2 and "holds this competition (compete-ghh08-generic) run with other settings (the policy set's files differ" in err, err
     assert "--update" not in err and "--fresh" not in err
