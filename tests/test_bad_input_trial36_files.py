@@ -71,6 +71,7 @@ def test_the_flag_arguments_take_a_numpy_bool(tmp_path: Path) -> None:
     store_edits.begin(store, "tr2", fresh=np.bool_(True))
     assert Resampling("race", delta=0.2, auto=np.bool_(False)) == Resampling("race", delta=0.2)
     assert str(Resampling("race", k=5, delta=0.2, auto=np.bool_(True))) == "race:auto"
+    assert type(Resampling("race", k=5, delta=0.2, auto=np.bool_(True)).auto) is bool  # kept as Python's: its repr and JSON
     m = nh.get_task_family("ghh08").training_mdps()[0]
     assert evolve(m, topology="slp", budget=20, n_steps=10, resume=np.bool_(False)).episodes >= 20
 

@@ -82,6 +82,7 @@ class Resampling:
         k, delta = _checked_resampling(self.kind, self.k, self.delta, self.rule, self.auto)
         object.__setattr__(self, "k", k)  # NumPy's integers and floats as Python's: str() and the checkpoint's JSON
         object.__setattr__(self, "delta", delta)
+        object.__setattr__(self, "auto", bool(self.auto))  # a NumPy bool (checked above) as Python's: its repr and JSON
 
     def __str__(self) -> str:
         if self.kind == "fixed":
