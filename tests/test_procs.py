@@ -513,7 +513,9 @@ def test_a_large_demo_hears_sigterm_between_its_calls() -> None:
     """Fifth trial: demo --episodes 4000000 flew each family in one kernel call and heard neither SIGTERM nor Ctrl-C for
     minutes (SIGKILL ended it). Now it flies in calls of a few thousand episodes and stops at the next one."""
     proc = subprocess.Popen([sys.executable, "-m", "neurohover", "demo", "--episodes", "4000000"], stderr=subprocess.PIPE, text=True, env=ENV)
-    time.sleep(6.0)  # compiled and flying (the kernel cache is warm in the suite)
+    deadline = time.monotonic() + 120  # a safety net: imported, its kernel loaded and flying its first call
+    while time.monotonic() < deadline and proc.poll() is None and _cpu_seconds(proc.pid) < 4.0:
+        time.sleep(0.05)
     proc.send_signal(signal.SIGTERM)
     _, err = proc.communicate(timeout=60)  # one call of 4,000,000 episodes takes hours here
     assert proc.returncode == 143 and "Traceback" not in err and err.strip().splitlines()[-1].endswith("terminated"), err[-1500:]
