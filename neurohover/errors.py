@@ -275,7 +275,20 @@ def as_floats(values: Any, name: str, allowed: str) -> np.ndarray:
         raise _not_floats(values, name, allowed, "") from None
     if a.dtype.kind not in "fiu":  # one dtype test: this runs at every tell()
         raise _not_floats(values, name, allowed, _NOT_REAL.get(a.dtype.kind, a.dtype.name))
-    return np.array(a, dtype=np.float64)
+    return float64_of(a)
+
+
+def float64_of(a: np.ndarray, copy: bool = True) -> np.ndarray:
+    """``a`` (real numbers) as float64 (a copy unless ``copy`` is False and it is float64 already): a value past
+    float64's range (an np.longdouble 1e400) is +-inf, as float() makes it, without NumPy's "overflow encountered in
+    cast" warning (a traceback under PYTHONWARNINGS=error; T37-B10), for the caller's own test of non-finite values.
+    The one conversion of given real arrays to float64."""
+    import numpy as np
+
+    if a.dtype.kind == "f" and a.dtype.itemsize > 8:  # only a longdouble can overflow the cast
+        with np.errstate(over="ignore"):
+            return a.astype(np.float64)
+    return a.astype(np.float64, copy=copy)
 
 
 def refuse_non_text_keys(data: object, where: str, what: str = "metadata") -> None:

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError, as_floats, brief, masked_note, refuse_non_text_keys
+from .errors import NeurohoverError, as_floats, brief, float64_of, masked_note, refuse_non_text_keys
 from .sim.constants import MLP_STEEPNESS, OBS_NAMES
 
 TOPOLOGIES = ("slp", "mlp")
@@ -142,7 +142,7 @@ class Policy:
         genes up to :data:`MAX_GENE` (1e190 gave inf and NaN actions; T31-B05). Flown states stay far below it."""
         try:  # not text, booleans or complex numbers; not a masked array, whose hidden values were flown (T16-9)
             raw = np.asarray(observation)
-            obs = raw.astype(np.float64) if raw.dtype.kind in "iuf" and not isinstance(observation, np.ma.MaskedArray) else np.zeros(0)
+            obs = float64_of(raw) if raw.dtype.kind in "iuf" and not isinstance(observation, np.ma.MaskedArray) else np.zeros(0)
         except (TypeError, ValueError):
             obs = np.zeros(0)
         if obs.shape != (12,) or not np.all(np.isfinite(obs)):  # the shape: (3, 4) was flown flattened as one observation (T15-28)

@@ -12,7 +12,7 @@ from typing import Any, NoReturn
 import gymnasium as gym
 import numpy as np
 
-from ..errors import NeurohoverError, brief, whole_in, whole_number
+from ..errors import NeurohoverError, brief, float64_of, whole_in, whole_number
 from ..sim.constants import MAX_EPISODE_STEPS
 from ..tasks import MDP, TaskFamily, get_task_family
 from ..tasks.sensor import Sensor
@@ -310,7 +310,7 @@ def real_values(values: Any, message: str | Callable[[], str]) -> np.ndarray:
         raw = np.asarray(values)
         if raw.dtype.kind not in "iuf":  # booleans too: [True] * 4 is no action
             raise TypeError(raw.dtype)
-        return raw.astype(np.float64, copy=False)
+        return float64_of(raw, copy=False)  # a longdouble past float64's range: inf, flown as inf is (T37-B10)
     except (TypeError, ValueError):
         raise refused() from None
 
@@ -322,6 +322,10 @@ def _check_dtype(value: Any, name: str) -> np.dtype:
         dtype = None
     if value is None or dtype is None or dtype.name not in OBS_DTYPES:
         raise NeurohoverError(f"{name}={brief(value)} is not allowed: use {' or '.join(map(repr, OBS_DTYPES))}")
+    if not dtype.isnative:  # '>f8' is named float64 too: its observations were byte-swapped, which PyTorch refuses (T37-B01)
+        raise NeurohoverError(
+            f"{name}={brief(value)} is not allowed: its byte order is not this machine's; use {' or '.join(map(repr, OBS_DTYPES))} (native byte order)"
+        )
     return dtype
 
 

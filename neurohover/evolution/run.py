@@ -20,7 +20,7 @@ from typing import Any, cast
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..flyer import KernelFlyer
 from ..launch import Parking
 from ..policies import Policy
@@ -194,9 +194,12 @@ class Run:
         except (KeyError, TypeError, ValueError, AttributeError, IndexError, OverflowError) as err:
             raise _damaged(source, err) from None
         counts, seconds = parts["counters"], parts["seconds"]
-        if self.budget is not None and counts["episodes"] > self.budget:  # it stopped at once "by budget", a plateau's run (seventh trial)
+        # a lowered budget stopped it at once "by budget", a plateau's run (seventh trial); its own budget, which the first
+        # population may overrun (budget 10, flew 50), resumes finished, as any finished run does (T37-B09)
+        if self.budget is not None and counts["episodes"] > self.budget and state.get("budget") != self.budget:
             raise NeurohoverError(
-                f"budget {self.budget:,} is below the {counts['episodes']:,} episodes {source}'s run has flown: a resumed run's budget may only be raised"
+                f"budget {self.budget:,} is below the {counts['episodes']:,} episodes {source}'s run has flown: a resumed run's budget may only be raised "
+                f"(give at least {counts['episodes']:,}, or its own budget, {brief(state.get('budget'))})"
             )
         self.opt = opt
         if self.mdp_rng is not None:

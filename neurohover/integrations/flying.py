@@ -19,6 +19,7 @@ the paper's policies are compared on the same episodes::
 from __future__ import annotations
 
 import functools
+import inspect
 import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, replace
@@ -28,7 +29,7 @@ import numpy as np
 
 from ..envs.arguments import check_obs_dtype, real_values
 from ..envs.vector import HoverVectorEnv
-from ..errors import NeurohoverError, brief, whole_in
+from ..errors import NeurohoverError, brief, float64_of, whole_in
 from ..evaluate import Evaluation, check_first_episode
 from ..policies import Policy
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS
@@ -103,6 +104,7 @@ def evaluate_callable(
         raise NeurohoverError(f"indexed={indexed!r:.40} is not allowed: give True (act takes the episodes' indices too) or False")
     mdps, family = _checked_mdps(mdps)
     _check_on_step(on_step)
+    unchecked = not _check_arity(act, bool(indexed))  # no signature to read: a TypeError of its first call says so
     first_episode = check_first_episode(first_episode)  # text was a TypeError from first_episode + k, True taken as 1 (twelfth trial T5)
     if len(mdps) > MAX_EPISODES:
         raise NeurohoverError(f"mdps: {len(mdps):,} MDPs is out of range: at most {MAX_EPISODES} (episodes x MDPs <= {MAX_EPISODES})")
@@ -120,7 +122,13 @@ def evaluate_callable(
     actions = np.zeros((n, ACTION_DIM))
     while alive.any():
         live = np.flatnonzero(alive)
-        raw = act(obs[live], live) if indexed else act(obs[live])
+        try:
+            raw = act(obs[live], live) if indexed else act(obs[live])
+        except TypeError as err:  # act(obs, k) without indexed=True was a bare TypeError (T37-B11)
+            if unchecked:
+                raise NeurohoverError(f"{_arity_problem(act, bool(indexed))} (its first call raised TypeError: {str(err)[:80]})") from err
+            raise
+        unchecked = False
         # complex, text, None and bool were read as numbers, as the environments do not (ninth trial)
         out = real_values(  # the message is built only when refused: str(raw) at every step was half a step's time
             raw,
@@ -156,7 +164,7 @@ def checked_obs_statistics(mean: Any, var: Any, n_obs: int, what: str) -> tuple[
         if a.dtype.kind not in "iuf" or a.shape != (n_obs,):
             shown = f"shape {a.shape} of {a.dtype}" if a.dtype.kind != "O" else f"{str(value)[:40]!r}"
             raise NeurohoverError(f"{what} holds a {name} of {shown}, not an array of {n_obs} real numbers")
-        a = a.astype(np.float64)
+        a = float64_of(a)  # a longdouble past float64's range: inf, refused below (T37-B10)
         bad = np.flatnonzero(~np.isfinite(a) | ((a < 0) if name == "var" else False))
         if bad.size:
             raise NeurohoverError(
@@ -277,3 +285,27 @@ def _bad_actions(raw: Any, n: int) -> str:
     return (
         f"act returned {type(raw).__name__} {str(raw)[:60]!r}: expected numbers (real ones: not text, booleans, complex or None), an array ({n}, {ACTION_DIM})"
     )
+
+
+def _arity_problem(act: Any, indexed: bool, signature: str = "") -> str:
+    """The refusal of an ``act`` that cannot be called as ``indexed`` calls it (its arity is another)."""
+    name = getattr(act, "__qualname__", None) or type(act).__name__
+    calls = "act(observations, indices)" if indexed else "act(observations)"
+    return (
+        f"act {brief(name)}{f' of signature {brief(signature)}' if signature else ''} is not allowed: indexed={indexed} calls it as {calls}; "
+        "give a function of (observations) with indexed=False, or of (observations, indices) with indexed=True"
+    )
+
+
+def _check_arity(act: Any, indexed: bool) -> bool:
+    """Refuse ``act`` where its signature cannot take the arguments ``indexed`` passes (T37-B11); whether it was checked
+    (False: no signature to read, e.g. a builtin's)."""
+    try:
+        signature = inspect.signature(act)
+    except (TypeError, ValueError):
+        return False
+    try:
+        signature.bind(*((None, None) if indexed else (None,)))
+    except TypeError:
+        raise NeurohoverError(_arity_problem(act, indexed, str(signature))) from None
+    return True

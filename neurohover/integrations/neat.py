@@ -41,7 +41,7 @@ from typing import Any
 import numba as nb
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, whole_number
+from ..errors import NeurohoverError, brief, finite_real, float64_of, whole_number
 from ..evolution.config import check_budget
 from ..evolution.fitness import FITNESS_SCALES, episode_fitness
 from ..evolution.seeding import check_seed
@@ -347,7 +347,7 @@ def observation_batch(obs: object) -> np.ndarray:
     flew silently, where Policy.act refuses both (thirteenth trial, F19)."""
     try:
         raw = np.asarray(obs)
-        batch = raw.astype(np.float64) if raw.dtype.kind in "iuf" else None  # not text, booleans or complex
+        batch = float64_of(raw) if raw.dtype.kind in "iuf" else None  # not text, booleans or complex; longdouble 1e400: inf (T37-B10)
     except (TypeError, ValueError):
         batch = None
     if batch is None or batch.ndim != 2 or batch.shape[1] != 12 or not np.all(np.isfinite(batch)):

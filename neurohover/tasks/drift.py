@@ -26,6 +26,7 @@ change_at      (200, 800)  the change happens at an episode drawn uniformly from
 
 from __future__ import annotations
 
+import operator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -94,9 +95,10 @@ class Drift:
             # True was read as episode 1 (second trial); a masked array's masked entry was NumPy's MaskError (T16-13)
             # finite_real: np.timedelta64(4) was read as episode 4, inf was int()'s OverflowError (T17-1)
             # 1.5 (no whole episode) was called out of range (T26-B17)
-            if isinstance(self.change_at, np.ma.MaskedArray) or not all(finite_real(x) and float(x).is_integer() for x in self.change_at):
+            # 5.0 (a float) is no episode number, as whole_in refuses it everywhere else (it was taken as 5, T37-B12)
+            if isinstance(self.change_at, np.ma.MaskedArray) or not all(whole_number(x) for x in self.change_at):
                 raise TypeError
-            lo, hi = (int(x) for x in self.change_at)
+            lo, hi = (operator.index(x) for x in self.change_at)
         except (TypeError, ValueError):
             raise NeurohoverError(
                 f"drift change_at={brief(self.change_at)} is not allowed: give two episode numbers lo, hi, whole, with 0 <= lo <= hi <= {MAX_CHANGE_AT:,}"

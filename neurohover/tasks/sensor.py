@@ -33,10 +33,11 @@ entry's noise is about the size of the baseline policy's typical hovering error 
 
 from __future__ import annotations
 
+import operator
 import re
 from dataclasses import asdict, dataclass, fields, replace
 
-from ..errors import FloatRangeError, NeurohoverError, brief, finite_real, float_of, real_number, whole_in
+from ..errors import FloatRangeError, NeurohoverError, brief, finite_real, float_of, real_number, whole_in, whole_number
 from ..sim.constants import MAX_SENSOR_DELAY, SENSOR_GROUPS
 
 #: The std of each group at noise level 1 (velocity m/s, position m, rates rad/s, attitude).
@@ -163,6 +164,8 @@ class Sensor:
                 raise NeurohoverError(f"sensor setting {part[:40]!r} needs a number after '='{why}") from None
         if not settings:
             raise NeurohoverError(f"sensor {text!r} is empty: {expected}")
+        if not whole_number(delay):  # 2.0 as Sensor(delay=) refuses it (whole_in; it was taken beside key=value text, T37-B12)
+            raise NeurohoverError(f"sensor delay={brief(delay)} is not allowed: give a whole number of control steps in 0..{MAX_SENSOR_DELAY}")
         values: dict[str, float | int] = {"delay": delay} | settings
         if not real_number(values["delay"]):  # "x" was a ValueError (fifth trial), np.timedelta64(2) delay 2
             raise NeurohoverError(f"sensor delay={values['delay']!r:.40} is not allowed: give a whole number of control steps")
@@ -181,10 +184,10 @@ class Sensor:
         """
         if obs_delay is None:
             delay = None
-        elif not finite_real(obs_delay) or not float(obs_delay).is_integer():  # np.int64(2) as Sensor(delay=) takes it (thirteenth trial, F8)
-            raise NeurohoverError(f"obs_delay={obs_delay!r} is not allowed: give a whole number of control steps in 0..{MAX_SENSOR_DELAY}")
+        elif not whole_number(obs_delay):  # np.int64(2) as Sensor(delay=) takes it (F8); 2.0 as it refuses it (whole_in, T37-B12)
+            raise NeurohoverError(f"obs_delay={brief(obs_delay)} is not allowed: give a whole number of control steps in 0..{MAX_SENSOR_DELAY}")
         else:
-            delay = int(obs_delay)
+            delay = operator.index(obs_delay)
         if obs_noise is None:
             return cls(delay=delay or 0)
         if isinstance(obs_noise, Sensor):
