@@ -34,8 +34,13 @@ def _check_declared_size(path: Path) -> None:
     from .procs import half_free_memory
 
     total = 0
-    with zipfile.ZipFile(path) as archive:
+    try:
+        archive = zipfile.ZipFile(path)
+    except NotImplementedError as err:  # a zip version past zipfile's: its message, not a traceback (T37-B02)
+        raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file ({err}): allowed {NPZ_WRITERS}") from None
+    with archive:
         names = archive.namelist()
+        _check_members(path, archive)
         repeated = sorted(name for name, count in Counter(names).items() if count > 1)
         if repeated:
             raise NeurohoverError(
@@ -53,6 +58,53 @@ def _check_declared_size(path: Path) -> None:
             total += int(np.prod(shape, dtype=object)) * dtype.itemsize
     if total > half_free_memory():
         raise NeurohoverError(f"{str(path)!r} declares arrays of {total:,} bytes: more than half the memory free now; give a smaller file")
+
+
+#: What a flight-data file may be, as its refusals say.
+NPZ_WRITERS = "an .npz that neurohover or numpy.savez wrote"
+#: The zip compression methods zipfile reads (stored, deflated, bzip2, lzma), and the flag bits it cannot read past:
+#: encrypted (0), compressed patched data (5), strong encryption (6).
+_ZIP_METHODS = {zipfile.ZIP_STORED: "stored", zipfile.ZIP_DEFLATED: "deflated", zipfile.ZIP_BZIP2: "bzip2", zipfile.ZIP_LZMA: "lzma"}
+_ZIP_FLAGS = {0x1: "encrypted (flag bit 0)", 0x20: "compressed patched data (flag bit 5)", 0x40: "strongly encrypted (flag bit 6)"}
+#: The arrays a flight-data file holds, each an .npy member.
+_ARRAYS = ("format", "lengths", "observations", "actions", "metadata")
+
+
+def _check_members(path: Path, archive: zipfile.ZipFile) -> None:
+    """Refuse a member zipfile cannot read (encrypted, patched, or compressed by a method it lacks: Deflate64, zstd,
+    AES), which was zipfile's RuntimeError or NotImplementedError (T37-B02), and one of the arrays stored without its
+    .npy name, which NumPy hands back as bytes, preferred to the .npy member of that name (an AttributeError; T37-B03)."""
+    for info in archive.infolist():
+        flags = [said for bit, said in _ZIP_FLAGS.items() if info.flag_bits & bit]
+        if flags or info.compress_type not in _ZIP_METHODS:
+            said = flags[0] if flags else f"compressed by method {info.compress_type}, which zipfile does not read"
+            methods = ", ".join(list(_ZIP_METHODS.values())[:-1]) + " or " + list(_ZIP_METHODS.values())[-1]
+            raise NeurohoverError(
+                f"{str(path)!r} is not a readable flight-data file: its member {brief(info.filename)} is {said}: "
+                f"allowed {NPZ_WRITERS} (members {methods}; not encrypted)"
+            )
+        if info.filename in _ARRAYS:
+            raise NeurohoverError(
+                f"{str(path)!r} is not a readable flight-data file: its member {brief(info.filename)} is not allowed: "
+                f"arrays are .npy members ({info.filename}.npy), as in {NPZ_WRITERS}"
+            )
+
+
+def _float64(values: np.ndarray, name: str, path: Path) -> np.ndarray:
+    """A flight-data file's observations or actions as native float64, whatever their stored float dtype and byte order
+    (a '>f8' file skipped the policy_flown check, T37-B04); a value past float64's range (np.longdouble's 1e400) is
+    refused as no finite float64 number, without NumPy's overflow warning (T37-B10)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        native = values.astype(np.float64)
+    if values.dtype.itemsize > 8:  # wider than float64: its finite values may not be finite float64 numbers
+        past = np.isinf(native) & np.isfinite(values)
+        if past.any():
+            k, i = (int(x) for x in np.argwhere(past)[0])
+            raise NeurohoverError(
+                f"flight-data file {str(path)!r}: its {name} row {k} column {i} = {brief(values[k, i])} is not allowed: "
+                "it is no finite float64 number (past float64's range); give flight data as flown"
+            )
+    return native
 
 
 def same_values(a: object, b: object) -> bool:
@@ -210,9 +262,10 @@ class FlightData:
     @classmethod
     def load(cls, path: str | Path) -> FlightData:
         """Read flight data written by :meth:`save`; other files are refused with a clear message, as are metadata that
-        contradict themselves or the episodes (:func:`check_metadata`). A float64 file's ``policy_flown`` must give the
-        first episode's first 200 recorded actions (T24-06: some milliseconds, whatever the file's size; a float32 file's
-        rounded readings are left to EC-MER's check: :func:`neurohover.flightmeta.check_policy_actions`)."""
+        contradict themselves or the episodes (:func:`check_metadata`). A float64 file's ``policy_flown`` (in either byte
+        order, or wider: read as native float64 first, T37-B04) must give the first episode's first 200 recorded actions
+        (T24-06: some milliseconds, whatever the file's size; a float32 file's rounded readings are left to EC-MER's check:
+        :func:`neurohover.flightmeta.check_policy_actions`; float16 is refused)."""
         from .paths import input_file
 
         if not isinstance(path, (str, os.PathLike)):  # None was a TypeError (second trial); an os.PathLike is a path (T33-B13)
@@ -242,6 +295,12 @@ class FlightData:
         if obs.dtype.kind != "f" or act.dtype.kind != "f":
             kinds = f"{obs.dtype} and {act.dtype}"
             raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file: its observations and actions are {kinds}, not real numbers")
+        if obs.dtype.itemsize < 4 or act.dtype.itemsize < 4:  # float16: rounded past what the policy_flown check reads (T37-B04)
+            kinds = f"{obs.dtype.name} and {act.dtype.name}"
+            raise NeurohoverError(
+                f"{str(path)!r} is not a readable flight-data file: its observations and actions are {kinds}: allowed float32 or wider "
+                "(FlightData.save writes float64 or float32)"
+            )
         if lengths.size and int(lengths.max()) > MAX_EPISODE_STEPS:  # 2**62 twice summed to a negative count (seventh trial)
             longest = int(lengths.max())
             raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file: an episode of {longest:,} steps (at most {MAX_EPISODE_STEPS:,})")
@@ -255,8 +314,9 @@ class FlightData:
                 f"flight-data file {str(path)!r} is truncated or inconsistent: {lengths.size} episodes of {lengths.sum()} steps "
                 f"but arrays {obs.shape} and {act.shape}"
             )
-        exact = obs.dtype == np.float64 and act.dtype == np.float64  # the readings the policy saw, not rounded (T24-06)
-        obs, act = obs.astype(np.float64), act.astype(np.float64)  # a float32 file loads as float64, like every array here
+        # the readings the policy saw, not rounded (T24-06), in either byte order ('>f8' skipped the check: T37-B04)
+        exact = obs.dtype.itemsize >= 8 and act.dtype.itemsize >= 8
+        obs, act = _float64(obs, "observations", path), _float64(act, "actions", path)  # float32 loads as float64, as all here
         obs_split = np.split(obs, np.cumsum(lengths + 1)[:-1])
         act_split = np.split(act, np.cumsum(lengths)[:-1])
         check_metadata(metadata, lengths, f"flight-data file {str(path)!r}", (tuple(obs_split), tuple(act_split)))  # and the readings (T23-03, T23-19)

@@ -131,14 +131,17 @@ def genome_digests(files: dict[str, Policy]) -> dict[str, str]:
     return {name: genome_digest(policy) for name, policy in files.items()}
 
 
-def check_digests(manifest: dict, path: Path, files: dict[str, Policy]) -> None:
+def check_digests(manifest: dict, path: Path, files: dict[str, Policy], others: tuple[str, ...] | None = None) -> None:
     """Refuse a policy file whose genome is not the one its set's ``manifest`` (at ``path``) recorded: two specialised
     policies scaled by hand loaded with the manifest's safe list, crash table and champion returns of the ones its build
     flew, and the hybrid agent fell back on policies that now always crash (T36-B05). A manifest without
-    :data:`DIGESTS` (a build before it was written) is not checked: its set loads as before."""
+    :data:`DIGESTS` (a build before it was written) is not checked: its set loads as before. Given ``others``, the set's
+    files are ``files`` and ``others`` (checked elsewhere), and an entry of another file is refused (T37-B08)."""
     digests = manifest.get(DIGESTS)
     if digests is None:
         return
+    if others is not None:
+        check_digest_names(manifest, path, [*files, *others])
     for name, policy in files.items():
         want, have = digests.get(name), genome_digest(policy)
         if want != have:
@@ -148,6 +151,18 @@ def check_digests(manifest: dict, path: Path, files: dict[str, Policy]) -> None:
                 f"list, tables and the file's record are of the genome its build wrote; restore the file, or rebuild the set with: neurohover "
                 f"build-policies --task {path.parent.name} --out {str(path.parent.parent)!r}"
             )
+
+
+def check_digest_names(manifest: dict, path: Path, names) -> None:
+    """Refuse a :data:`DIGESTS` entry of a file the set (at ``path``'s directory) does not have, by name: the set's
+    policy files are ``names``; an entry for specialised_10.json was taken without a word (T37-B08)."""
+    digests = manifest.get(DIGESTS) or {}
+    stray = next((name for name in digests if name not in names), None)
+    if stray is not None:
+        raise NeurohoverError(
+            f"policy-set manifest {str(path)!r}: its {DIGESTS} entry {brief(stray)} is not allowed: the set has no such policy file "
+            f"(allowed one entry per file of the set: {', '.join(sorted(names))})"
+        )
 
 
 def _is_build_time(text: str) -> bool:
@@ -282,6 +297,7 @@ def _check_safe(safe: list[int], crashes: np.ndarray, returns: np.ndarray | None
         "when more qualify and the fewest crashes there when fewer do: give safe policies the tables agree with, or rebuild "
         f"the set (neurohover build-policies --task {task})"
     )
+    mean = None if returns is None else np.array([returns[i][others[i]].mean() for i in range(len(returns))])
     for s in safe:
         better = [u for u in unlisted if crash_others[u] < crash_others[s]]
         if better:
@@ -291,9 +307,8 @@ def _check_safe(safe: list[int], crashes: np.ndarray, returns: np.ndarray | None
                 f"in {int(crashes[s, j])} episodes on training MDP {j} ({int(crash_others[s])} on the other training MDPs in all), while "
                 f"policy {better[0]}, not listed, crashed in {int(crash_others[better[0]])} there; {rule}"
             )
-        if returns is None:
+        if mean is None:
             continue
-        mean = np.array([returns[i][others[i]].mean() for i in range(len(returns))])
         better = [u for u in unlisted if crash_others[u] == crash_others[s] and mean[u] > mean[s] + _ROUNDING]
         if better:
             best = max(better, key=lambda u: mean[u])
@@ -301,6 +316,34 @@ def _check_safe(safe: list[int], crashes: np.ndarray, returns: np.ndarray | None
                 f"{where}: safe lists specialised policy {s}, whose mean return on the other training MDPs is {mean[s]:.2f}, but not "
                 f"policy {best}, which crashed there as rarely ({int(crash_others[s])} episodes) and returned {mean[best]:.2f}; {rule}"
             )
+    _check_safe_order(safe, crash_others, mean, where, task)
+
+
+def _check_safe_order(safe: list[int], crash_others: np.ndarray, mean: np.ndarray | None, where: str, task: str) -> None:
+    """Refuse safe policies listed in another order than the paper's rule (:func:`choose_safe`) gives on the manifest's
+    tables: fewest crashes on the other training MDPs first, then the best mean return there. The hybrid agents fly
+    safe:0 first, so [2, 6] for the build's [6, 2] changed every run's returns without a word (T37-B07). What the tables
+    cannot order is taken in either order: mean returns within their rounding (0.01; :data:`_ROUNDING`), and any two
+    of as many crashes in a manifest without mean_return_on_training_mdps (an older manifest loads as before)."""
+
+    def after(a: int, b: int) -> bool:  # the rule puts b before a, whatever the rounding
+        if crash_others[b] != crash_others[a]:
+            return bool(crash_others[b] < crash_others[a])
+        return mean is not None and bool(mean[b] > mean[a] + _ROUNDING)
+
+    wrong = next(((a, b) for k, a in enumerate(safe) for b in safe[k + 1 :] if after(a, b)), None)
+    if wrong is None:
+        return
+    a, b = wrong
+    ordered = sorted(safe, key=lambda i: (crash_others[i], 0.0 if mean is None else -mean[i]))
+    how = f"{int(crash_others[b])} crashes there to {int(crash_others[a])}"
+    if crash_others[a] == crash_others[b] and mean is not None:
+        how = f"as few crashes there ({int(crash_others[a])}) and a mean return of {mean[b]:.2f} to {mean[a]:.2f}"
+    raise NeurohoverError(
+        f"{where}: safe={safe!r} is not allowed: the paper's rule on its tables gives {ordered} (policy {b}, with {how} on the "
+        f"other training MDPs, comes before policy {a}; the hybrid agents fly safe:0 first): give safe {ordered}, or rebuild the "
+        f"set (neurohover build-policies --task {task})"
+    )
 
 
 def _check_table3(table3: object, crashes: list | None, returns: list | None, where: str) -> None:

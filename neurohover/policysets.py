@@ -9,7 +9,7 @@ A policy set is a directory ``<task>/`` holding JSON policy files and a ``manife
   table of crashed episodes (``crashes_on_training_mdps``, of ``safety_episodes`` per cell) and of
   mean returns (``mean_return_on_training_mdps``) of every specialised policy on every training MDP
   that the rule was applied to, and Table 3's figures of them (``table3``): a manifest whose safe
-  list, counts or figures contradict its tables is refused (:mod:`neurohover.manifest`).
+  list (its order too: the hybrid agents fly the first first), counts or figures contradict its tables is refused (:mod:`neurohover.manifest`).
 
   **Lineage.** By default (``lineage="chain"``) every run is seeded from one *ancestor*, and the
   ancestor is itself a chain of runs from the baseline policy over the training MDPs in turn (run
@@ -246,7 +246,7 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
             )
             for name in FGHH_GENERICS
         }
-        check_digests(manifest, manifest_path, set_files(generics=generics))  # a hand-edited genome (T36-B05)
+        check_digests(manifest, manifest_path, set_files(generics=generics), others=())  # a hand-edited genome (T36-B05)
         return PolicySet(family.name, root, generics["race"], generics=generics, manifest=manifest)
     if manifest.get("lineage") == "independent" and (root / "ancestor.json").exists():  # T25-14: a chain's set was shown as independent
         raise NeurohoverError(
@@ -262,7 +262,8 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
         _load(root / f"specialised_{i}.json", f"specialised policy {i}", family.name, train[i].label, built_as(manifest, specialised_roles[i], i + 1))
         for i in range(10)
     )
-    check_digests(manifest, manifest_path, set_files(generic, specialised))  # two safe genomes x1000 were flown (T36-B05)
+    ancestor = ("ancestor.json",) if manifest.get("lineage") == "chain" else ()  # the set's files, a digest of none refused (T37-B08)
+    check_digests(manifest, manifest_path, set_files(generic, specialised), others=ancestor)  # two safe genomes x1000 were flown (T36-B05)
     safe = check_ghh_manifest(manifest, manifest_path, len(specialised), len(train))
     return PolicySet(family.name, root, generic, specialised, safe, manifest=manifest)
 

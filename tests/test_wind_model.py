@@ -61,7 +61,7 @@ def test_a_model_file_records_its_wind_and_older_files_read_as_wind_blind(tmp_pa
     del data["wind"]
     path.write_text(json.dumps(data))
     assert LearnedModel.load(path).wind == NO_WIND
-    data["wind"] = {"kind": "sinusoid", "x": {"omega": -2.0}}
+    data["wind"] = {"kind": "sinusoid", "x": {**WIND.x.to_dict(), "omega": -2.0}, "y": WIND.y.to_dict()}  # a file's wind is whole (T37-B05)
     path.write_text(json.dumps(data))
     with pytest.raises(NeurohoverError, match=r"model file .*m\.json.*: wind omega=-2.0 must be >= 0"):
         LearnedModel.load(path)

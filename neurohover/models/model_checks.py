@@ -80,7 +80,33 @@ def model_entry_problem(d: dict) -> str:
         return _its("d_u", d["d_u"], "allowed a finite number (D_u, the constant u acceleration; 0.0 where none is fitted)")
     if "stats" in d and not isinstance(d["stats"], dict):
         return _its("stats", d["stats"], "allowed a JSON object (the fit's statistics by name)")
-    return seconds_problem(d)
+    return (_wind_problem(d["wind"]) if "wind" in d else "") or seconds_problem(d)
+
+
+#: A model file's wind table and each of its axes, as :meth:`LearnedModel.to_dict` writes them (every file since winds).
+_WIND_ENTRIES = ("kind", "x", "y")
+_AXIS_ENTRIES = ("amplitude", "omega", "phase", "offset")
+
+
+def _wind_problem(wind: object) -> str:
+    """What in a model file's wind table is not what a model file holds, '' when nothing is: an entry beside kind, x
+    and y, a missing x or y (read as no wind), or an axis without all of amplitude, omega, phase and offset (an entry
+    'X' was dropped without a word and a missing axis read as zeros, where every other table is strict; T37-B05).
+    WindModel.from_dict, given a table in Python, still takes an axis's missing entries as 0."""
+    allowed = f"a model file's wind holds {', '.join(_WIND_ENTRIES)} (x and y each {', '.join(_AXIS_ENTRIES)})"
+    if not isinstance(wind, dict):
+        return _its("wind", wind, f"allowed a JSON object: {allowed}")
+    stranger = next((k for k in wind if k not in _WIND_ENTRIES), None)
+    if stranger is not None:
+        return f"its wind entry {brief(stranger)} is not allowed: {allowed}"
+    missing = [k for k in _WIND_ENTRIES if k not in wind]
+    if missing:
+        return f"its wind {brief(wind)} is not allowed: it lacks {', '.join(missing)}; {allowed}"
+    for name in ("x", "y"):
+        axis = wind[name]
+        if not isinstance(axis, dict) or sorted(axis, key=str) != sorted(_AXIS_ENTRIES):
+            return _its(f"wind.{name}", axis, f"allowed a JSON object of exactly {', '.join(_AXIS_ENTRIES)} (numbers)")
+    return ""
 
 
 def model_file_problem(d: dict, model: LearnedModel) -> str:
