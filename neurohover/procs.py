@@ -142,8 +142,13 @@ class _Pool(ProcessPoolExecutor):
 
 
 def max_jobs() -> int:
-    """The most worker processes a pool may have: this machine's cores (``reproduce --jobs`` is bounded alike)."""
-    return os.cpu_count() or 1
+    """The most worker processes a pool may have: the cores this process may run on (its affinity mask, as numba's
+    --threads are bounded; ``reproduce --jobs`` is bounded alike). Bounded by the machine's, ``taskset -c 0`` took
+    --jobs 2 and recorded the run as on 2 cores (T37-A06)."""
+    try:
+        return len(os.sched_getaffinity(0)) or 1
+    except (AttributeError, OSError):  # not Linux: the machine's cores
+        return os.cpu_count() or 1
 
 
 def refuse_gone_cwd_for_workers(jobs: int) -> None:
@@ -174,7 +179,7 @@ def worker_pool(jobs: int) -> ProcessPoolExecutor:
     if not whole_number(jobs) or jobs < 1:  # 0 was concurrent.futures' error, '2' a TypeError (thirteenth trial, F16)
         raise NeurohoverError(f"jobs={brief(jobs)} is not allowed: give a whole number of worker processes >= 1")
     if jobs > max_jobs():  # 10**6 was taken, each worker started as work arrived (fourteenth trial T14-21)
-        raise NeurohoverError(f"jobs={brief(jobs)} is not allowed: give at most {max_jobs()} worker processes (the cores of this machine)")
+        raise NeurohoverError(f"jobs={brief(jobs)} is not allowed: give at most {max_jobs()} worker processes (the cores this process may use)")
     jobs = int(jobs)
     refuse_gone_cwd_for_workers(jobs)
     main = threading.current_thread() is threading.main_thread()

@@ -66,7 +66,7 @@ def test_store_refuses_a_create_flag_that_is_no_bool(tmp_path: Path) -> None:
     [
         (lambda s: s.begin("x", None, "h", {}), "begin: scale = None is not allowed: give one of quick, paper (or a compete run's settings-HASH)"),
         (lambda s: s.begin("x", "weird", "h", {}), "scale = 'weird' is not allowed: give one of quick, paper"),
-        (lambda s: s.begin(5, "quick", "h", {}), "begin: name = 5 is not allowed: give 1-100 letters, digits"),
+        (lambda s: s.begin(5, "quick", "h", {}), "begin: name = 5 is not allowed: give 1-100 ASCII letters (A-Z, a-z), digits"),
         (lambda s: s.begin("", "quick", "h", {}), "name = '' is not allowed"),
         (lambda s: s.begin("a\x00b", "quick", "h", {}), "name = 'a\\x00b' is not allowed"),
         (lambda s: s.begin("x", "quick", None, {}), "begin: config_hash = None is not allowed: give non-empty text without NUL characters"),

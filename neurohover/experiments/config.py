@@ -457,7 +457,9 @@ def settings_scale(settings: dict) -> str:
 def check_name(name, where: str) -> None:
     """Refuse an experiment name that is not a safe file name (``../x``, ``""``, a slash)."""
     if not isinstance(name, str) or not _SAFE_NAME.fullmatch(name):
-        raise NeurohoverError(f"{where}: name = {brief(name)} is not allowed: give 1-100 letters, digits, '.', '_' or '-', starting with a letter or digit")
+        raise NeurohoverError(
+            f"{where}: name = {brief(name)} is not allowed: give 1-100 ASCII letters (A-Z, a-z), digits, '.', '_' or '-', starting with a letter or digit"
+        )
 
 
 def check_scale(scale, where: str) -> None:

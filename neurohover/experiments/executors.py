@@ -44,12 +44,12 @@ def timed_run(unit: dict, threads: int | None = 1, device: str = "cpu") -> tuple
 
 
 def check_jobs(jobs) -> int:
-    """``jobs`` local worker processes: an integer from 1 to this machine's cores (NeurohoverError otherwise)."""
+    """``jobs`` local worker processes: an integer from 1 to the cores this process may use (NeurohoverError otherwise)."""
     cores = max_jobs()
     if not whole_number(jobs):  # '2' was called out of range (twelfth trial, U1)
-        raise NeurohoverError(f"--jobs {brief(jobs)} is not allowed: give an integer in 1..{cores} (the cores of this machine)")
+        raise NeurohoverError(f"--jobs {brief(jobs)} is not allowed: give an integer in 1..{cores} (the cores this process may use)")
     if not 1 <= int(jobs) <= cores:
-        raise NeurohoverError(f"--jobs {brief(jobs)} is out of range: allowed an integer in 1..{cores} (the cores of this machine)")
+        raise NeurohoverError(f"--jobs {brief(jobs)} is out of range: allowed an integer in 1..{cores} (the cores this process may use)")
     refuse_gone_cwd_for_workers(int(jobs))  # before anything is written (T32-A06)
     return int(jobs)  # np.int64(2) as 2
 
