@@ -137,5 +137,6 @@ def test_reference_simulator_refuses_non_finite_numbers(call, message: str) -> N
 
 def test_worker_pool_is_bounded_by_the_cores() -> None:
     """T14-21: worker_pool(10**6) made a pool of a million workers (started as work arrived)."""
-    with pytest.raises(NeurohoverError, match=rf"jobs=1000000 is not allowed: give at most {procs.max_jobs()} worker processes \(the cores this process may use\)"):
+    expected = rf"jobs=1000000 is not allowed: give at most {procs.max_jobs()} worker processes \(the cores this process may use\)"
+    with pytest.raises(NeurohoverError, match=expected):
         procs.worker_pool(10**6)

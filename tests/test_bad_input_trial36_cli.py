@@ -3,7 +3,8 @@ a config, tomllib's ValueError a traceback (T36-A01); --vers (argparse's prefix 
 (T36-A02); --progress/--no-progress repeated or abbreviated, the last winning (T36-A03); --version --version naming ''
 (T36-A04); a .net file's integer of 5,000 digits refused with Python's advice to call sys.set_int_max_str_digits()
 (T36-A05); `settings ne` refused though evolve's help says `settings OPTIMIZER` lists them (T36-A06). Trial 37's weak
-ones: --jobs bounded by the machine's cores, not the process's (T37-A06); "letters" meaning ASCII letters (T37-A07)."""
+ones: --jobs bounded by the machine's cores, not the process's (T37-A06); a shipped alias unknown to results, report and
+wins (T37-A05); "letters" meaning ASCII letters (T37-A07)."""
 
 from __future__ import annotations
 
@@ -122,3 +123,13 @@ def test_a_config_name_of_a_non_ascii_letter_is_refused_saying_ascii(cli, tmp_pa
     (tmp_path / "c.toml").write_text(CONFIG.replace("EPISODES", "2").replace('name = "mine"', 'name = "café"'))
     rc, _, err = cli("reproduce", str(tmp_path / "c.toml"), "--store", str(tmp_path / "s.sqlite"), "--no-progress")
     assert rc == 2 and "name = 'café' is not allowed: give 1-100 ASCII letters (A-Z, a-z), digits" in err, err
+
+
+def test_results_wins_and_report_take_a_shipped_alias_as_reproduce_does(cli, committed_store: Path, tmp_path: Path) -> None:
+    """T37-A05: reproduce table3 ran fig2, but results, report and wins said the store holds no experiment 'table3'."""
+    by_alias = cli("results", "table3", "--store", str(committed_store), "--scale", "quick")
+    assert by_alias[0] == 0 and by_alias[1] == cli("results", "fig2", "--store", str(committed_store), "--scale", "quick")[1]
+    rc, _, err = cli("wins", "table3", "--store", str(committed_store), "--scale", "quick")
+    assert rc == 2 and "experiment 'fig2' (quick) has no stored test runs" in err, err  # found, and named by its name
+    rc, _, err = cli("report", "table3", "--store", str(committed_store), "--scale", "quick", "--out", str(tmp_path / "r"))
+    assert rc == 0 and (tmp_path / "r" / "report.md").is_file(), err

@@ -17,6 +17,7 @@ from pathlib import Path
 
 from ..errors import NeurohoverError, brief
 from ..evaluate import DEVICES, check_device
+from ..experiments.config import shipped_name
 from ..filekinds import refuse_sqlite_name
 from ..paths import printable
 from .options import integer
@@ -139,6 +140,7 @@ def cmd_results(args: argparse.Namespace) -> int:
 
     refuse_sqlite_name(args.store, "--store")  # before "no such results store" (T32-A02)
     input_file(args.store, "--store", "results store")
+    args.name = shipped_name(args.name)  # table3 as reproduce takes it: fig2 (T37-A05)
     fmt = _results_format(args.format, args.out)  # before output_file makes --out's directory
     kind = f"a results export (results --format {fmt})"  # never over another kind's file: compete's episodes.csv (T25-12)
     suffixes, what = (".csv", ".json"), "results are written as CSV or JSON"  # CSV over flight data, JSON over a policy (T25-02)
@@ -201,6 +203,7 @@ def cmd_wins(args: argparse.Namespace) -> int:
     refuse_sqlite_name(args.store, "--store")  # before "no such results store" (T32-A02)
     input_file(args.store, "--store", "results store")
     lengths = _positive_ints(args.runs, "--runs")
+    args.name = shipped_name(args.name)  # table3: fig2 (T37-A05)
     with Store(args.store, create=False) as store:
         scale = resolve_scale(store, args.name, args.scale)
         config, units, _ = checked_units(store, args.name, scale)  # results' check: a unit of kind 'bogus' was a test run here (T19-05)
@@ -266,6 +269,7 @@ def cmd_report(args: argparse.Namespace) -> int:
     refuse_sqlite_name(args.store, "--store")  # before "no such results store" (T32-A02)
     input_file(args.store, "--store", "results store")
     check_names(args.names or None)  # before anything is opened or made (T23-18)
+    args.names = [shipped_name(n) for n in args.names] if args.names else args.names  # table3: fig2 (T37-A05)
     with Store(args.store, create=False) as store:
         held = {n for n, s, _, _ in store.experiments() if args.scale is None or s == args.scale}
         missing = [n for n in args.names or () if n not in held]

@@ -205,6 +205,12 @@ def _aliases_of(files: tuple[tuple[str, str, int, int], ...]) -> tuple[tuple[str
     return tuple(out)
 
 
+def shipped_name(name):
+    """The shipped experiment an alias names (``table3`` -> ``fig2``), or ``name`` itself: no config of one's own takes
+    a shipped name or alias (:func:`check_own_name`), so a store holds a shipped experiment under its name only."""
+    return _aliases().get(name, name) if isinstance(name, str) else name
+
+
 def experiment_names() -> list[str]:
     return list(shipped_configs())
 
