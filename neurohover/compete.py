@@ -349,7 +349,8 @@ def compete(
         _refuse_other_settings(config, store_path)
         _note_replaced(out / "summary.json", task, agent, config.scale)
         ordered = _run_into_store(config, store_path, out / "episodes.csv", jobs=jobs, device=device, progress=progress, on_result=on_result)
-        summary = {"task": task, "agent": agent, "mdps": mdps, "seed": seed, "store": str(store_path), **_flown_under(n_steps, sigma, sensor, drift)}
+        flown = get_task_family(task, sigma).set_name(mdps)  # the set its rows' MDPs name: seeded-test at FGHH sigma 0.2 (T37-A02)
+        summary = {"task": task, "agent": agent, "mdps": flown, "seed": seed, "store": str(store_path), **_flown_under(n_steps, sigma, sensor, drift)}
         summary |= {"experiment": config.name, "scale": config.scale, **summarise(ordered)}
         _write_summary(out / "summary.json", summary)
         curves = np.array([np.cumsum(np.array(r.returns, dtype=float)) for r in ordered])

@@ -7,7 +7,8 @@ run on two MDPs); a summary in one place, :func:`_check_summary`, against itself
 for its kind and range (:data:`SUMMARY_FIELDS`), each figure against the one its rows give, the conditions its task
 can fly under, the MDPs its runs fly and the rows its agent writes. A key compete never writes is refused, not
 ignored (a misspelt one would leave a curve unlabelled without a word); one compete writes may be absent (older
-summaries hold fewer), as may the columns after run, episode and return in older episodes files.
+summaries hold fewer), as may the columns after run, episode and return in older episodes files; the offline_seconds
+column of files written before a8bc471 is read as that older layout (:data:`OLDER_COLUMNS`).
 
 Example
 -------
@@ -35,7 +36,7 @@ from .filekinds import refuse_cut_off
 from .paths import input_dir, number_text, refuse_special_file, strict_json
 from .sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS, MAX_SECONDS, WORST_RETURN, crash_charge, crash_return_ceiling, lowest_return, seconds_allowed
 from .sim.rng import MAX_SEED
-from .tasks.base import N_TEST, N_TRAINING
+from .tasks import N_TEST, N_TRAINING, set_name
 
 __all__ = [
     "COMPETE_COLUMNS",
@@ -60,6 +61,9 @@ COMPETE_CONDITIONS = ("episode_steps", "sigma", "sensor", "drift")  # summary.js
 COMPETE_COLUMNS = ("run", "episode", "return")  # the columns of compete's episodes.csv read here
 #: Every column compete writes to episodes.csv (compete.CSV_COLUMNS is this); older files hold fewer, none holds others (T23-07).
 CSV_COLUMNS = ("run", "mdp", "episode", "return", "crashed", "steps", "policy", "safeguard_fired")
+#: The columns of an older layout, read and ignored: offline_seconds, each episode's, last in the files compete wrote
+#: before a8bc471 (2026-11-27; summary.json's mean_offline_seconds_per_run holds it now; T37-A03).
+OLDER_COLUMNS = ("offline_seconds",)
 #: The agents that fly under no safeguard (no Choice of theirs has a fallback), whose safeguard_fired is 0 in every row
 #: (T23-07). The agents' specs do not declare it, and this layer may not read them: tests/test_bad_input_trial23_compete.py
 #: checks that every other registered agent is one with a safeguard.
@@ -87,6 +91,8 @@ POLICY_LABELS: dict[str, dict[str, tuple[int, int | None] | None]] = {
 #: seconds are 0.0 exactly (T24-07; every stored baseline and generic run of the committed store holds 0.0, every
 #: other agent's more). tests/test_bad_input_trial24_results.py checks that each one's first choice is final.
 NO_OFFLINE = frozenset({"baseline", "generic"})
+#: The MDP sets a summary's mdps names, as its rows' labels name them (TaskFamily.set_name: seeded-test at FGHH sigma 0.2).
+MDP_SETS = ("test", "train", "seeded-test", "seeded-train", "sample")
 _SCALE = re.compile(r"settings-[0-9a-f]{10}")  # experiments.config.settings_scale: a competition's scale, a digest of its settings
 
 
@@ -100,7 +106,7 @@ _SECONDS = (_real_in(0.0, math.inf), "a finite number of seconds >= 0")  # at mo
 SUMMARY_FIELDS: dict[str, tuple[Callable[[object], bool] | None, str]] = {
     "task": (None, "a task's name"),
     "agent": (lambda v: isinstance(v, str) and v != "", "an agent's name"),
-    "mdps": (lambda v: v in ("test", "train", "sample"), "test, train or sample (the MDP set)"),
+    "mdps": (lambda v: v in MDP_SETS, "test, train, seeded-test, seeded-train or sample (the MDP set)"),
     "seed": (lambda v: whole_number(v) and 0 <= v <= MAX_SEED, "an integer in 0..2**63-1"),
     "store": (lambda v: isinstance(v, str) and v != "", "the results store's path"),
     "episode_steps": (None, "a number of control steps"),
@@ -226,10 +232,11 @@ def _read_rows(csv_path: Path) -> tuple[dict[int, list[tuple[int, float, str]]],
             missing = [c for c in COMPETE_COLUMNS if c not in columns]
             if missing:
                 raise NeurohoverError(f"--compete {str(csv_path)!r} is not a compete episodes file: no column {', '.join(missing)}")
-            odd = next((c for c in columns if c not in CSV_COLUMNS or columns.count(c) > 1), None)
+            odd = next((c for c in columns if c not in CSV_COLUMNS + OLDER_COLUMNS or columns.count(c) > 1), None)
             if odd is not None:  # T23-07: an extra column was ignored without a word
                 raise NeurohoverError(
-                    f"--compete {str(csv_path)!r}, line 1: column {brief(odd)} is not allowed: compete writes the columns {', '.join(CSV_COLUMNS)}, each once"
+                    f"--compete {str(csv_path)!r}, line 1: column {brief(odd)} is not allowed: compete writes the columns {', '.join(CSV_COLUMNS)}, "
+                    f"each once (older versions also {', '.join(OLDER_COLUMNS)})"
                 )
             refuse_cut_off(csv_path, f"--compete {str(csv_path)!r}", "episodes file compete writes")  # a cut '-123.45' read as -123.4
             facts.has_crashed = "crashed" in columns
@@ -466,7 +473,7 @@ def _check_summary_matches(path: Path, summary: dict, returns: np.ndarray, rows:
         family, slash, rest = label.partition("/")
         if slash and task is not None and family != task:
             refuse("task", f"its episodes.csv holds {family} MDPs (line {line}: mdp {brief(label)})")
-        if slash and ":" in rest and "mdps" in summary and rest.partition(":")[0] != summary["mdps"]:
+        if slash and ":" in rest and "mdps" in summary and rest.partition(":")[0] != set_name(task, summary.get("sigma"), summary["mdps"]):
             refuse("mdps", f"its episodes.csv holds {rest.partition(':')[0]} MDPs (line {line}: mdp {brief(label)})")
     if isinstance(experiment, str) and task is not None and experiment != f"compete-{task}-{summary['agent']}":  # task names hold no '-'
         refuse("task" if experiment.split("-")[1:2] != [task] else "agent", f"its experiment is {brief(experiment)} (compete-TASK-AGENT)")
@@ -529,16 +536,14 @@ def _check_conditions(path: Path, summary: dict) -> None:
 def _check_mdp_labels(path: Path, summary: dict, runs: int, rows: _Rows) -> None:
     """Refuse an MDP that is no label of the summary's task (mdp 'zzz', T22-04) or none of the MDPs its runs fly
     (test:999 of a 2-run competition, T23-07), naming the line, the value and what is allowed."""
-    from .tasks import N_TEST, N_TRAINING
-
     task = summary.get("task")
     for label, line in rows.mdps.items() if task is not None else ():
         _, slash, rest = label.partition("/")
         kind, _, index = rest.partition(":")
         where = f"--compete {str(path.with_name(COMPETE_FILE))!r}, line {line}"
-        if label and not (slash and kind in ("test", "train", "sample") and index.isascii() and index.isdigit()):
-            raise NeurohoverError(f"{where}: mdp {brief(label)} is not allowed: a {task} MDP's label, {task}/SET:I (SET test, train or sample)")
-        flown = min(runs, {"test": N_TEST, "train": N_TRAINING}.get(kind, runs))  # compete._group: a run per MDP, or the whole set
+        if label and not (slash and kind in MDP_SETS and index.isascii() and index.isdigit()):
+            raise NeurohoverError(f"{where}: mdp {brief(label)} is not allowed: a {task} MDP's label, {task}/SET:I (SET {', '.join(MDP_SETS)})")
+        flown = min(runs, {"test": N_TEST, "train": N_TRAINING}.get(kind.removeprefix("seeded-"), runs))  # compete._group: a run per MDP, or the whole set
         if label and (len(index) > 9 or int(index) >= flown):
             raise NeurohoverError(
                 f"{where}: mdp {brief(label)} is not allowed: a competition of {runs} runs on {task}'s {kind} MDPs "

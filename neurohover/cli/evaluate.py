@@ -174,7 +174,7 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
         print(f"neurohover evaluate-agent: note: {note}", file=sys.stderr)
     if out is not None:
         with writing(out, "--json") as path:
-            path.write_text(json.dumps({"task": args.task, "mdps": args.mdps, "n_mdps": n, "episodes": args.episodes, "seed": args.seed,
+            path.write_text(json.dumps({"task": args.task, "mdps": family.set_name(args.mdps), "n_mdps": n, "episodes": args.episodes, "seed": args.seed,
                                         "episode_steps": args.episode_steps, "rows": [r.__dict__ for r in rows]}, indent=1), encoding="utf-8")  # fmt: skip
         print(f"wrote {printable(args.json)}", file=sys.stderr)
     return 0

@@ -40,21 +40,24 @@ MDP_FAMILY = "G"
 
 
 def _target(args: argparse.Namespace):
-    """(target, family, mdp description for the metadata)."""
+    """(target, family, mdp for the metadata: what is flown, FGHH's seeded-test:0 for test:0 at sigma 0.2; T37-A01)."""
+    from ..policies import record_problem
     from .options import explicit_mdp, refuse_sigma_on_zero, task_family_of
 
     family = task_family_of(args)
     explicit = explicit_mdp(args, family)
-    if explicit is not None:
-        return explicit[0], family, explicit[1]
     spec = args.mdp if args.mdp is not None else (MDP_FAMILY if family.generic_over_distribution else "zero")
-    refuse_sigma_on_zero(args, spec)
-    if spec == MDP_FAMILY:
+    if explicit is None:
+        refuse_sigma_on_zero(args, spec)
+    if explicit is None and spec == MDP_FAMILY:
         return family, family, MDP_FAMILY
-    if spec == "sample":  # one MDP drawn from G with the run's seed
-        rng = np.random.default_rng(np.random.SeedSequence(args.seed, spawn_key=(4,)))
-        return family.sample(rng, label=f"{family.name}/sample"), family, "sample"
-    return family.mdp(spec), family, spec
+    if spec == "sample" and explicit is None:  # one MDP drawn from G with the run's seed
+        explicit = family.sample(np.random.default_rng(np.random.SeedSequence(args.seed, spawn_key=(4,))), label=f"{family.name}/sample"), "sample"
+    target, desc = explicit or (family.mdp(spec), family.set_name(spec))
+    problem = record_problem({"task": family.name, "mdp": desc, "target": target.label, "mdp_params": target.to_dict()})
+    if problem:  # refused before flying: after the whole budget, the run's work was lost (T37-A01)
+        raise NeurohoverError(f"policy file {str(args.out)!r}: {problem} (load_policy would refuse the file; nothing is flown)")
+    return target, family, desc
 
 
 def _seed_policy(args: argparse.Namespace):

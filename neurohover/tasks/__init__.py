@@ -25,7 +25,7 @@ from __future__ import annotations
 import importlib
 import pkgutil
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, finite_real
 from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, competition_rows, finite_vector
 from .drift import NO_DRIFT, Drift, refuse_drift
 from .fghh import COMPETITION_FGHH_SIGMA, FGHH
@@ -113,6 +113,18 @@ def family_for(name: str, sigma: float | None, sensor: Sensor | None = None, dri
     return get_task_family(name, sigma if has else None, sensor, drift)
 
 
+def set_name(task: object, sigma: object, spec: object) -> object:
+    """What ``spec`` names among ``task``'s MDPs at breadth ``sigma``, as their labels write it (:meth:`TaskFamily.set_name`:
+    FGHH's ``test`` at sigma 0.2 is ``seeded-test``); ``spec`` itself where task, sigma or spec is none a family takes (refused
+    where they are checked). Read back in files that wrote the spec asked for (compete's summary before T37-A02)."""
+    if not (isinstance(spec, str) and task in TASK_FAMILIES and (sigma is None or finite_real(sigma))):
+        return spec
+    try:
+        return family_for(str(task), sigma).set_name(spec)  # type: ignore[arg-type]
+    except NeurohoverError:
+        return spec
+
+
 __all__ = [
     "COMPETITION_FGHH_SIGMA",
     "COMPETITION_MDPS_FILE",
@@ -140,4 +152,5 @@ __all__ = [
     "get_task_family",
     "refuse_drift",
     "refuse_unordered_mdps",
+    "set_name",
 ]

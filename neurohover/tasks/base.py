@@ -535,15 +535,25 @@ class TaskFamily:
                 _FIXED_SETS[key] = tuple(self.make(self.competition_params(r), label=f"{self.name}/{kind}:{i}") for i, r in enumerate(rows))
         return list(_FIXED_SETS[key])
 
+    def set_name(self, spec: str) -> str:
+        """What ``spec`` (``train``, ``test``, ``train:N``, ``test:N`` or any other MDP name) flies, as its MDPs' labels
+        name it: the one place that decides it. Where the family has no competition sets (FGHH at a sigma other than
+        0.3) ``train`` and ``test`` are its seeded sets, labelled ``seeded-train:N`` / ``seeded-test:N``; a policy's mdp,
+        compete's and evaluate-agent's ``mdps`` write this name, as the MDPs flown are labelled (T37-A01, T37-A02)."""
+        kind, colon, index = spec.partition(":")
+        if kind in ("train", "test") and not self.has_competition_sets:
+            return f"seeded-{kind}{colon}{index}"
+        return spec
+
     def training_mdps(self) -> list[MDP]:
-        """The 10 training MDPs: the competition's (seeded draws where it has none)."""
-        if self.has_competition_sets:
+        """The 10 training MDPs: the competition's (seeded draws where it has none: :meth:`set_name`)."""
+        if self.set_name("train") == "train":
             return self._competition_set("train")
         return self.seeded_training_mdps()
 
     def test_mdps(self) -> list[MDP]:
-        """The 100 test MDPs: the competition's (seeded draws where it has none)."""
-        if self.has_competition_sets:
+        """The 100 test MDPs: the competition's (seeded draws where it has none: :meth:`set_name`)."""
+        if self.set_name("test") == "test":
             return self._competition_set("test")
         return self.seeded_test_mdps()
 

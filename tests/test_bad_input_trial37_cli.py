@@ -1,0 +1,140 @@
+"""Bad-input trial 37 (the command line): FGHH's train:N / test:N at a sigma other than 0.3 are its seeded sets, and
+what neurohover writes of them says so, as the MDPs flown are labelled (TaskFamily.set_name, the one place that decides
+it): evolve --mdp test:0 --sigma 0.2 flew its whole budget, then refused its own policy file (metadata 'test:0' beside
+target 'fghh/seeded-test:0'), and --resume the same; a record load_policy would refuse is now refused before flying
+(T37-A01). compete --sigma 0.2 (the paper's FGHH sigma) wrote summary mdps 'test' beside seeded-test rows, which plot
+--compete refused as two competitions; evaluate-agent --json wrote mdps 'test' for them too (T37-A02). A compete folder
+of a version before a8bc471, whose episodes.csv holds an offline_seconds column, is read as that older layout; a column
+no version writes is still refused (T37-A03)."""
+
+from __future__ import annotations
+
+import csv
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+
+def refused(capsys, *argv: str) -> str:
+    """What ``neurohover ARGV`` says as it refuses it (exit status 2), in this process."""
+    from neurohover.cli import main
+
+    try:
+        rc = main(list(argv))
+    except SystemExit as done:  # argparse's refusals exit; the commands' own return 2
+        rc = done.code
+    assert rc == 2
+    return capsys.readouterr().err
+
+
+TINY = ("--runs", "1", "--episodes", "2", "--episode-steps", "20")
+
+
+@pytest.fixture(scope="module")
+def fghh_compete(tmp_path_factory) -> Path:
+    """compete's own folder for FGHH at sigma 0.2 (the paper's FGHH sigma; its test MDPs are the seeded ones)."""
+    from neurohover.cli import main
+
+    out = tmp_path_factory.mktemp("t37a02") / "c"
+    assert main(["compete", "--task", "fghh", "--sigma", "0.2", "--agent", "baseline", *TINY, "--out", str(out)]) == 0
+    return out
+
+
+@pytest.fixture(scope="module")
+def ghh08_compete(tmp_path_factory) -> Path:
+    from neurohover.cli import main
+
+    out = tmp_path_factory.mktemp("t37a03") / "c"
+    assert main(["compete", "--task", "ghh08", "--agent", "baseline", *TINY, "--out", str(out)]) == 0
+    return out
+
+
+@pytest.mark.parametrize("spec", ["test:0", "train:1"])
+def test_evolve_fghh_set_at_another_sigma_writes_its_policy(cli, tmp_path, spec):
+    """T37-A01: the policy file is written, naming what was flown (seeded-*), and load_policy reads it."""
+    from neurohover.policies import load_policy
+
+    out = tmp_path / "a.json"
+    rc, _, err = cli("evolve", "--task", "fghh", "--mdp", spec, "--sigma", "0.2", "--budget", "10", "--episode-steps", "20", "--out", str(out))
+    assert rc == 0, err
+    meta = load_policy(out).metadata
+    assert meta["mdp"] == f"seeded-{spec}" and meta["target"] == f"fghh/seeded-{spec}"
+
+
+def test_evolve_competition_sets_keep_their_names(cli, tmp_path):
+    """T37-A01: at sigma 0.3 (and for GHH-08) test:N is the competition's MDP, named so."""
+    from neurohover.policies import load_policy
+
+    out = tmp_path / "g.json"
+    assert cli("evolve", "--task", "ghh08", "--mdp", "test:2", "--budget", "10", "--episode-steps", "20", "--out", str(out))[0] == 0
+    assert load_policy(out).metadata["mdp"] == "test:2"
+
+
+def test_evolve_refuses_a_contradictory_record_before_flying(capsys, tmp_path, monkeypatch):
+    """T37-A01: a record load_policy would refuse is refused before a single episode is flown (no checkpoint written)."""
+    import neurohover.policies
+
+    monkeypatch.setattr(neurohover.policies, "record_problem", lambda meta: f"its mdp {meta['mdp']!r} is not allowed: (a contradiction)")
+    out = tmp_path / "a.json"
+    err = refused(capsys, "evolve", "--task", "fghh", "--mdp", "test:0", "--sigma", "0.2", "--budget", "10", "--episode-steps", "20", "--out", str(out))
+    assert "nothing is flown" in err and "(a contradiction)" in err
+    assert not list(tmp_path.iterdir())
+
+
+def test_compete_fghh_at_sigma_02_plots(cli, fghh_compete, tmp_path):
+    """T37-A02: compete names the set its rows fly (seeded-test), and plot --compete reads its own folder."""
+    summary = json.loads((fghh_compete / "summary.json").read_text())
+    assert summary["mdps"] == "seeded-test"
+    with open(fghh_compete / "episodes.csv", newline="") as f:
+        assert {row["mdp"] for row in csv.DictReader(f)} == {"fghh/seeded-test:0"}
+    rc, _, err = cli("plot", "--compete", str(fghh_compete), "--out", str(tmp_path / "p"))
+    assert rc == 0, err
+
+
+def test_compete_summary_of_the_older_layout_plots(cli, capsys, fghh_compete, tmp_path):
+    """T37-A02: a summary written before the fix ('test' for the seeded test MDPs at sigma 0.2) is read; one naming
+    another set, or 'test' at sigma 0.3 beside seeded rows, is still refused as a contradiction."""
+    older = tmp_path / "older"
+    shutil.copytree(fghh_compete, older)
+    summary = json.loads((older / "summary.json").read_text())
+    (older / "summary.json").write_text(json.dumps({**summary, "mdps": "test"}))
+    rc, _, err = cli("plot", "--compete", str(older), "--out", str(tmp_path / "p"))
+    assert rc == 0, err
+    for edit in ({"mdps": "train"}, {"mdps": "seeded-train"}, {"mdps": "test", "sigma": 0.3}):
+        (older / "summary.json").write_text(json.dumps({**summary, **edit}))
+        err = refused(capsys, "plot", "--compete", str(older), "--out", str(tmp_path / "q"))
+        assert "the two are of different competitions" in err and "seeded-test" in err
+
+
+def test_evaluate_agent_json_names_the_seeded_set(cli, tmp_path):
+    """T37-A02 (minor note): evaluate-agent --json names what its rows flew, as compete does."""
+    out = tmp_path / "e.json"
+    argv = ("evaluate-agent", "--task", "fghh", "--policy", "baseline", "--n-mdps", "1", "--episode-steps", "20", "--json", str(out))
+    rc, _, err = cli(*argv, "--sigma", "0.2")
+    assert rc == 0, err
+    assert json.loads(out.read_text())["mdps"] == "seeded-test"
+    assert cli(*argv)[0] == 0  # sigma 0.3: the competition's test MDPs
+    assert json.loads(out.read_text())["mdps"] == "test"
+
+
+def _add_column(folder: Path, name: str, value: str) -> None:
+    path = folder / "episodes.csv"
+    lines = path.read_text().splitlines()
+    path.write_text("\n".join([f"{lines[0]},{name}"] + [f"{line},{value}" for line in lines[1:]]) + "\n")
+
+
+def test_plot_reads_an_older_offline_seconds_column(cli, capsys, ghh08_compete, tmp_path):
+    """T37-A03: offline_seconds, each row's, as compete wrote it before a8bc471, is read; a column no version writes
+    is refused, naming both."""
+    older = tmp_path / "older"
+    shutil.copytree(ghh08_compete, older)
+    _add_column(older, "offline_seconds", "0.000000")
+    rc, _, err = cli("plot", "--compete", str(older), "--out", str(tmp_path / "p"))
+    assert rc == 0, err
+    odd = tmp_path / "odd"
+    shutil.copytree(ghh08_compete, odd)
+    _add_column(odd, "online_seconds", "0.0")
+    err = refused(capsys, "plot", "--compete", str(odd), "--out", str(tmp_path / "q"))
+    assert "column 'online_seconds' is not allowed" in err and "older versions also offline_seconds" in err
