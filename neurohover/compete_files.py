@@ -92,7 +92,7 @@ POLICY_LABELS: dict[str, dict[str, tuple[int, int | None] | None]] = {
 #: other agent's more). tests/test_bad_input_trial24_results.py checks that each one's first choice is final.
 NO_OFFLINE = frozenset({"baseline", "generic"})
 #: The MDP sets a summary's mdps names, as its rows' labels name them (TaskFamily.set_name: seeded-test at FGHH sigma 0.2).
-MDP_SETS = ("test", "train", "seeded-test", "seeded-train", "sample")
+MDP_SETS, SETS_TEXT = ("test", "train", "seeded-test", "seeded-train", "sample"), "test, train, seeded-test, seeded-train or sample"
 _SCALE = re.compile(r"settings-[0-9a-f]{10}")  # experiments.config.settings_scale: a competition's scale, a digest of its settings
 
 
@@ -106,7 +106,7 @@ _SECONDS = (_real_in(0.0, math.inf), "a finite number of seconds >= 0")  # at mo
 SUMMARY_FIELDS: dict[str, tuple[Callable[[object], bool] | None, str]] = {
     "task": (None, "a task's name"),
     "agent": (lambda v: isinstance(v, str) and v != "", "an agent's name"),
-    "mdps": (lambda v: v in MDP_SETS, "test, train, seeded-test, seeded-train or sample (the MDP set)"),
+    "mdps": (lambda v: v in MDP_SETS, f"{SETS_TEXT} (the MDP set)"),
     "seed": (lambda v: whole_number(v) and 0 <= v <= MAX_SEED, "an integer in 0..2**63-1"),
     "store": (lambda v: isinstance(v, str) and v != "", "the results store's path"),
     "episode_steps": (None, "a number of control steps"),
@@ -542,7 +542,7 @@ def _check_mdp_labels(path: Path, summary: dict, runs: int, rows: _Rows) -> None
         kind, _, index = rest.partition(":")
         where = f"--compete {str(path.with_name(COMPETE_FILE))!r}, line {line}"
         if label and not (slash and kind in MDP_SETS and index.isascii() and index.isdigit()):
-            raise NeurohoverError(f"{where}: mdp {brief(label)} is not allowed: a {task} MDP's label, {task}/SET:I (SET {', '.join(MDP_SETS)})")
+            raise NeurohoverError(f"{where}: mdp {brief(label)} is not allowed: a {task} MDP's label, {task}/SET:I (SET {SETS_TEXT})")
         flown = min(runs, {"test": N_TEST, "train": N_TRAINING}.get(kind.removeprefix("seeded-"), runs))  # compete._group: a run per MDP, or the whole set
         if label and (len(index) > 9 or int(index) >= flown):
             raise NeurohoverError(

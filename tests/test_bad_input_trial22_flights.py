@@ -157,7 +157,7 @@ COMPETE_ROWS = "episodes.csv', line 2: "
         (5, "-5", {"episode_steps": None}, f"{COMPETE_ROWS}steps '-5' is not allowed: an episode's steps, an integer in 1..10,000,000"),
         (0, str(10**18), {}, f"{COMPETE_ROWS}run 1000000000000000000 is not allowed: compete numbers its runs 0, 1, 2, ..."),
         (0, str(10**30), {}, f"{COMPETE_ROWS}run '1000000000000000000000000000000' is not allowed: allowed a whole number (at most 19 digits)"),
-        (1, "zzz", {}, f"{COMPETE_ROWS}mdp 'zzz' is not allowed: a ghh08 MDP's label, ghh08/SET:I (SET test, train or sample)"),
+        (1, "zzz", {}, f"{COMPETE_ROWS}mdp 'zzz' is not allowed: a ghh08 MDP's label, ghh08/SET:I (SET test, train, seeded-test, seeded-train or sample)"),
         (7, "7", {}, f"{COMPETE_ROWS}safeguard_fired '7' is not allowed: 0 or 1 (whether the safeguard took over)"),
         (0, "0", {"sigma": float("nan")}, "summary.json' says sigma nan, which compete never flies under: a family's breadth is a finite number >= 0"),
         (0, "0", {"sensor": {"level": -5}}, "summary.json' says sensor {'level': -5}, which compete never flies under: sensor noise level=-5 is out of range"),
