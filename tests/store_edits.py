@@ -1,9 +1,11 @@
-"""Helpers of the tests that damage a results store and read what a command said of it (trials 19 and 21)."""
+"""Helpers of the tests that damage a results store and read what a command said of it (trials 19 and 21), and of
+those that edit a copy of a shipped policy set's manifest (trials 22 and 37)."""
 
 from __future__ import annotations
 
 import dataclasses
 import functools
+import json
 import shutil
 import sqlite3
 import tempfile
@@ -82,3 +84,16 @@ def refused_by_every_command(cli, config: Path, store: Path, name: str, line: st
     rc, _, err = cli("report", "--store", str(store), "--out", str(out))
     assert rc == 2 and line in err and not out.exists(), err
     assert dump(store) == before
+
+
+def edited_policy_set(tmp_path: Path, task: str, change) -> Path:
+    """A copy of the shipped ``task`` set under ``tmp_path/pd`` whose manifest ``change`` (a function of the dict) edited;
+    the copy's parent folder (a policy directory)."""
+    from neurohover.policysets import SHIPPED
+
+    shutil.copytree(SHIPPED / task, tmp_path / "pd" / task)
+    path = tmp_path / "pd" / task / "manifest.json"
+    manifest = json.loads(path.read_text())
+    change(manifest)
+    path.write_text(json.dumps(manifest))
+    return tmp_path / "pd"

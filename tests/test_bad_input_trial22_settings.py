@@ -5,11 +5,10 @@ and an FGHH manifest's GHH tables (accepted and never read) too (T22-16)."""
 
 from __future__ import annotations
 
-import json
-import shutil
 from pathlib import Path
 
 import pytest
+from store_edits import edited_policy_set
 
 from neurohover.errors import NeurohoverError
 
@@ -51,18 +50,6 @@ def test_a_good_generic_resampling_is_kept() -> None:
     assert cfg.settings["generic_resampling"] == {"race": "race:0.3"}
 
 
-def _set(tmp_path: Path, task: str, change) -> Path:
-    """A copy of the shipped ``task`` set under ``tmp_path/pd`` whose manifest ``change`` (a function of the dict) edited."""
-    from neurohover.policysets import SHIPPED
-
-    shutil.copytree(SHIPPED / task, tmp_path / "pd" / task)
-    path = tmp_path / "pd" / task / "manifest.json"
-    manifest = json.loads(path.read_text())
-    change(manifest)
-    path.write_text(json.dumps(manifest))
-    return tmp_path / "pd"
-
-
 def _cell(name: str, i: int, j: int, value):
     return lambda m: m[name][i].__setitem__(j, value)
 
@@ -100,14 +87,14 @@ def test_a_manifest_that_contradicts_itself_is_refused(tmp_path: Path, task: str
     accepted and ignored."""
     from neurohover.policysets import load_policy_set
 
-    pd = _set(tmp_path, task, change)
+    pd = edited_policy_set(tmp_path, task, change)
     with pytest.raises(NeurohoverError, match=message):
         load_policy_set(task, pd)
 
 
 def test_a_safe_policy_that_crashed_on_the_command_line_is_one_line_and_status_2(cli, tmp_path: Path) -> None:
     """T22-16 as found: compete --agent hybrid --policy-dir with such a set ran (status 0)."""
-    pd = _set(tmp_path, "ghh08", _cell("crashes_on_training_mdps", 6, 0, 3))
+    pd = edited_policy_set(tmp_path, "ghh08", _cell("crashes_on_training_mdps", 6, 0, 3))
     argv = ["compete", "--task", "ghh08", "--agent", "hybrid", "--runs", "1", "--episodes", "2", "--episode-steps", "20"]
     rc, _, err = cli(*argv, "--policy-dir", str(pd), "--out", str(tmp_path / "X"))
     assert rc == 2 and "Traceback" not in err
@@ -123,4 +110,4 @@ def test_the_shipped_manifests_are_taken_and_safe_lists_in_another_order_are_not
     for task in ("ghh08", "ghh09", "fghh"):
         load_policy_set(task)
     with pytest.raises(NeurohoverError, match=r"safe=\[2, 6\] is not allowed: the paper's rule on its tables gives \[6, 2\]"):
-        load_policy_set("ghh08", _set(tmp_path, "ghh08", lambda m: m.__setitem__("safe", [2, 6])))
+        load_policy_set("ghh08", edited_policy_set(tmp_path, "ghh08", lambda m: m.__setitem__("safe", [2, 6])))

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import io
 import json
-import shutil
 import struct
 import warnings
 import zipfile
@@ -18,12 +17,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 from flight_edits import recorded
+from store_edits import edited_policy_set
 
 from neurohover.errors import NeurohoverError
 from neurohover.flightdata import FlightData
 from neurohover.manifest import DIGESTS
 from neurohover.models import LearnedModel, learn_lr
-from neurohover.policysets import SHIPPED, load_policy_set
+from neurohover.policysets import load_policy_set
 
 
 @pytest.fixture(scope="module")
@@ -236,20 +236,10 @@ def test_a_model_file_as_written_and_one_before_winds_still_load(model_file: dic
 # ---------------------------------------------------------------------------------------------- T37-B07, T37-B08
 
 
-def _set(tmp_path: Path, task: str, change) -> Path:
-    """A copy of the shipped ``task`` set under tmp_path/pd, its manifest changed by ``change``."""
-    shutil.copytree(SHIPPED / task, tmp_path / "pd" / task)
-    path = tmp_path / "pd" / task / "manifest.json"
-    manifest = json.loads(path.read_text())
-    change(manifest)
-    path.write_text(json.dumps(manifest))
-    return tmp_path / "pd"
-
-
 @pytest.mark.parametrize(("task", "safe", "rule"), [("ghh08", [2, 6], [6, 2]), ("ghh09", [3, 6], [6, 3])])
 def test_a_safe_list_reordered_against_its_tables_is_refused(tmp_path: Path, task: str, safe: list[int], rule: list[int]) -> None:
     """T37-B07: [6, 2] -> [2, 6] was taken, and the hybrid agent flew policy 2 as safe:0 (every run's returns changed)."""
-    pd = _set(tmp_path, task, lambda m: m.__setitem__("safe", safe))
+    pd = edited_policy_set(tmp_path, task, lambda m: m.__setitem__("safe", safe))
     with pytest.raises(NeurohoverError) as err:
         load_policy_set(task, pd)
     message = str(err.value)
@@ -269,8 +259,8 @@ def test_a_safe_order_the_tables_cannot_tell_is_taken_either_way(tmp_path: Path)
         m["table3"]["r_G"] = round(float(np.mean(returns)), 2)
         m["safe"] = [2, 6]
 
-    assert load_policy_set("ghh08", _set(tmp_path / "a", "ghh08", close)).safe == (2, 6)
-    older = _set(tmp_path / "b", "ghh08", lambda m: (m.pop("mean_return_on_training_mdps"), m.pop("table3"), m.__setitem__("safe", [2, 6])))
+    assert load_policy_set("ghh08", edited_policy_set(tmp_path / "a", "ghh08", close)).safe == (2, 6)
+    older = edited_policy_set(tmp_path / "b", "ghh08", lambda m: (m.pop("mean_return_on_training_mdps"), m.pop("table3"), m.__setitem__("safe", [2, 6])))
     assert load_policy_set("ghh08", older).safe == (2, 6)
     for task, safe in (("ghh08", (6, 2)), ("ghh09", (6, 3))):  # the shipped sets, as built
         assert load_policy_set(task).safe == safe
@@ -279,7 +269,7 @@ def test_a_safe_order_the_tables_cannot_tell_is_taken_either_way(tmp_path: Path)
 @pytest.mark.parametrize(("task", "name"), [("ghh08", "specialised_10.json"), ("ghh08", "notes.txt"), ("fghh", "generic.json")])
 def test_a_digest_of_a_file_the_set_does_not_have_is_refused(tmp_path: Path, task: str, name: str) -> None:
     """T37-B08: genome_sha256['specialised_10.json'] was taken without a word (the file itself is refused)."""
-    pd = _set(tmp_path, task, lambda m: m[DIGESTS].__setitem__(name, "0123456789abcdef"))
+    pd = edited_policy_set(tmp_path, task, lambda m: m[DIGESTS].__setitem__(name, "0123456789abcdef"))
     with pytest.raises(NeurohoverError) as err:
         load_policy_set(task, pd)
     message = str(err.value)
@@ -295,7 +285,7 @@ def test_an_independent_sets_digest_of_an_ancestor_is_refused(tmp_path: Path) ->
     def independent(m: dict) -> None:
         m["lineage"] = "independent"
 
-    pd = _set(tmp_path, "ghh08", independent)
+    pd = edited_policy_set(tmp_path, "ghh08", independent)
     (pd / "ghh08" / "ancestor.json").unlink()
     with pytest.raises(NeurohoverError, match=f"its {DIGESTS} entry 'ancestor.json' is not allowed: the set has no such policy file"):
         load_policy_set("ghh08", pd)
