@@ -138,3 +138,33 @@ def test_plot_reads_an_older_offline_seconds_column(cli, capsys, ghh08_compete, 
     _add_column(odd, "online_seconds", "0.0")
     err = refused(capsys, "plot", "--compete", str(odd), "--out", str(tmp_path / "q"))
     assert "column 'online_seconds' is not allowed" in err and "older versions also offline_seconds" in err
+
+
+# ------------------------------------------------------------------------------------------- T37-A04
+
+
+def test_a_setting_that_takes_none_takes_the_word_none_from_the_command_line() -> None:
+    """T37-A04: `--setting init_mutate_frac=none` was "must be a probability in [0, 1]", though documented as float or None."""
+    from neurohover.errors import NeurohoverError
+    from neurohover.evolution.config import make_settings
+
+    generational = make_settings("generational", "ne", {"init_mutate_frac": "none", "init_mutate_std": "None"})
+    assert generational.init_mutate_frac is None and generational.init_mutate_std is None
+    assert make_settings("steady-state", "ne", {"mutation_floor": "NONE"}).mutation_floor is None
+    with pytest.raises(NeurohoverError, match="bad generational settings"):  # a setting that takes no None still refuses it
+        make_settings("generational", "ne", {"mutate_frac": "none"})
+
+
+def test_a_resume_names_every_differing_setting_at_once() -> None:
+    """T37-A04: a resume named one differing setting per try (three runs to learn three differences)."""
+    from neurohover.evolution.records import config_difference
+
+    saved = {"method": "generational", "settings": {"elitist": True, "fitness": "return", "pop_size": 50, "init_mutate_frac": None}}
+    given = {"method": "generational", "settings": {"elitist": False, "fitness": "inv-log-error", "pop_size": 50, "init_mutate_frac": 0.5}}
+    found = config_difference("config", saved, given)
+    assert found is not None and [part.split(":")[0] for part in found.split("; ")] == [
+        "config.settings.elitist",
+        "config.settings.fitness",
+        "config.settings.init_mutate_frac",
+    ], found
+    assert config_difference("config", saved, saved) is None

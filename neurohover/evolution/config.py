@@ -240,7 +240,8 @@ def make_settings(method: str, optimizer: str, settings) -> Any:
     overrides, or for the generational method a preset's name; a dict may name its base with
     ``"preset"``, :data:`~.generational.GENERATIONAL_PRESETS`) checked for ``method`` /
     ``optimizer``: a population optimiser's settings dataclass (:mod:`.optimisers`), or the
-    neuroevolution's with the budget left None (the run counts the budget in episodes itself)."""
+    neuroevolution's with the budget left None (the run counts the budget in episodes itself). In a dict, the text
+    ``"none"`` (any case: the command line's ``--setting KEY=none``) is None for a setting that takes None."""
     if optimizer != NE:
         return population_settings(optimizer, settings)
     cls = SteadyStateSettings if method == "steady-state" else GenerationalSettings
@@ -272,6 +273,8 @@ def make_settings(method: str, optimizer: str, settings) -> Any:
             raise NeurohoverError(f"unknown {method} preset {name!r}: allowed {', '.join(presets)}")
         values = {**dataclasses.asdict(presets[name]), **values}
         values.pop("budget")
+    optional = {f.name for f in dataclasses.fields(cls) if "None" in str(f.type)}
+    values = {k: None if k in optional and isinstance(v, str) and v.lower() == "none" else v for k, v in values.items()}  # --setting KEY=none (T37-A04)
     try:
         return cls(**values)
     except ValueError as err:

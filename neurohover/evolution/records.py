@@ -372,12 +372,11 @@ def _same(saved: Any, given: Any) -> bool:
 
 
 def config_difference(path: str, saved: Any, given: Any) -> str | None:
-    """Where a checkpoint's config value ``saved`` (at ``path``) first differs from the ``given`` one of the run
-    resuming it (:func:`_same`): the message part that names both, or None where they agree."""
+    """Where a checkpoint's config value ``saved`` (at ``path``) differs from the ``given`` one of the run resuming it
+    (:func:`_same`): the message part that names both, or None where they agree. A table's first differing key (an MDP's
+    label says what its other fields would), but every differing key of a settings table (one a try took three runs
+    to learn three; T37-A04)."""
     if isinstance(saved, dict) and isinstance(given, dict):
-        for key in sorted(set(saved) | set(given), key=str):
-            found = config_difference(f"{path}.{key}", saved.get(key), given.get(key))
-            if found is not None:
-                return found
-        return None
+        found = [d for key in sorted(set(saved) | set(given), key=str) if (d := config_difference(f"{path}.{key}", saved.get(key), given.get(key)))]
+        return ("; ".join(found) if path.endswith("settings") else found[0]) if found else None
     return None if _same(saved, given) else first_difference(path, saved, given, "the checkpoint's")
