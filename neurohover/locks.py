@@ -159,8 +159,8 @@ def remove_dead_writers_files(path: Path) -> list[Path]:
         if found is None:
             continue
         pid, tid = int(found[1]), int(found[2])
-        if (found[3], name.startswith(".")) not in WRITER_FILES or writer_file(path, found[3], name.startswith("."), pid, tid).name != name:
-            continue
+        if not any(writer_file(path, ending, hidden, pid, tid).name == name for ending, hidden in WRITER_FILES if ending == found[3]):
+            continue  # another file's, or another output's (an output named '.x' has a leading dot of its own)
         if pid != os.getpid() and not _running(pid):
             try:
                 (path.parent / name).unlink()
@@ -176,8 +176,8 @@ def _running(pid: int) -> bool:
         os.kill(pid, 0)
     except (ProcessLookupError, OverflowError):  # no such process (a pid past the system's is none)
         return False
-    except PermissionError:
-        return True
+    except PermissionError:  # another user's
+        pass
     return True
 
 

@@ -145,3 +145,17 @@ def test_a_killed_writers_temporary_files_are_removed_by_the_next_run_of_its_out
     rc, _, err = cli("evolve", "--task", "ghh08", "--mdp", "G", "--budget", "10", "--episode-steps", "20", "--out", str(out))
     assert rc == 0, err
     assert not any(path.exists() for path in stale) and all(path.exists() for path in kept)
+
+
+def test_a_killed_writers_files_beside_an_output_whose_name_starts_with_a_dot_are_removed(tmp_path: Path) -> None:
+    """The writer files of an output named '.p.json' start with a dot of the output's own: '.p.json.PID.TID.tmp' was
+    taken for a hidden .tmp (none is written) and left for ever."""
+    from neurohover.locks import sole_writer
+
+    dead = _dead_pid()
+    stale = [tmp_path / f".p.json.{dead}.{dead}.tmp", tmp_path / f"..p.json.{dead}.{dead}.partial"]
+    kept = tmp_path / f".p.json.{os.getpid()}.1.tmp"
+    for path in [*stale, kept]:
+        path.write_text("{")
+    with sole_writer(tmp_path / ".p.json", "--out"):
+        assert not any(path.exists() for path in stale) and kept.exists()
