@@ -205,12 +205,18 @@ def redeliver_ignored_stop(unraisable: Any) -> None:
     sys.__unraisablehook__(unraisable)
 
 
+def key_text(key: Any) -> str:
+    """A table's key as a message names it: text as written (one of more than 60 characters shortened by :func:`brief`),
+    any other key (b'pop_size', 1) as its repr."""
+    return key if isinstance(key, str) and len(key) <= 60 else brief(key)
+
+
 def unknown_keys(keys: Any, known: Any) -> str:
     """The ``keys`` not among ``known``, named for a message ('' if none): text keys as written (a 100,000-character one
     shortened), any other (b'pop_size', 1) as its repr; sorted as text, so keys of mixed types sort, and ``", ".join``
     of non-text keys raised TypeError (evolve settings={1: 10}, T33-B02)."""
     unknown = [k for k in set(keys) if k not in set(known)]
-    return ", ".join(sorted((k if isinstance(k, str) and len(k) <= 60 else brief(k) for k in unknown), key=str))
+    return ", ".join(sorted(map(key_text, unknown), key=str))
 
 
 def settings_from_dict(cls: type, values: Any, *, unknown_what: str, bad_what: str) -> Any:

@@ -17,7 +17,7 @@ from typing import TypeVar
 
 import numpy as np
 
-from .errors import NeurohoverError, brief, finite_real, refuse_non_text_keys
+from .errors import NeurohoverError, brief, finite_real, float64_of, key_text, refuse_non_text_keys
 from .filekinds import FLIGHT_DATA_KIND, refuse_suffix
 from .flightmeta import check_meaning, check_policy_actions, flown_policy
 from .paths import json_text, strict_json
@@ -94,8 +94,7 @@ def _float64(values: np.ndarray, name: str, path: Path) -> np.ndarray:
     """A flight-data file's observations or actions as native float64, whatever their stored float dtype and byte order
     (a '>f8' file skipped the policy_flown check, T37-B04); a value past float64's range (np.longdouble's 1e400) is
     refused as no finite float64 number, without NumPy's overflow warning (T37-B10)."""
-    with np.errstate(over="ignore", invalid="ignore"):
-        native = values.astype(np.float64)
+    native = float64_of(values)
     if values.dtype.itemsize > 8:  # wider than float64: its finite values may not be finite float64 numbers
         past = np.isinf(native) & np.isfinite(values)
         if past.any():
@@ -323,7 +322,7 @@ class FlightData:
         bad = unwritable_key(metadata)  # a NaN no check above names (T32-B18)
         if bad is not None:  # it was refused as metadata that "cannot be saved", the file not named
             raise NeurohoverError(
-                f"flight-data file {str(path)!r}: its metadata {bad if len(bad) <= 60 else brief(bad)}={brief(metadata[bad])} is not allowed: "
+                f"flight-data file {str(path)!r}: its metadata {key_text(bad)}={brief(metadata[bad])} is not allowed: "
                 "give strict JSON values, numbers finite (NaN and Infinity are no JSON: FlightData.save refuses them)"
             )
         deep = _too_deep(metadata)
@@ -404,7 +403,7 @@ def _metadata_text(metadata: object, where: str) -> str:
         text = json_text(metadata, default=plain_json)
     except (TypeError, ValueError, RecursionError) as err:
         bad = unwritable_key(metadata)  # the entry to name, where one alone fails
-        shown = f", not {bad if len(bad) <= 60 else brief(bad)}={brief(metadata[bad])}" if isinstance(bad, str) else ""
+        shown = f", not {key_text(bad)}={brief(metadata[bad])}" if isinstance(bad, str) else ""
         raise NeurohoverError(f"{where} metadata cannot be saved as JSON: give strict JSON values (numbers finite){shown} ({err})") from None
     deep = _too_deep(metadata)
     if deep:
@@ -420,7 +419,7 @@ def _too_deep(metadata: dict) -> str:
     bad = next((k for k, v in metadata.items() if nesting_depth(v) > MAX_NOTE_DEPTH), None)
     if bad is None:
         return ""
-    return f"{bad if len(bad) <= 60 else brief(bad)}={brief(metadata[bad])} is not allowed: it is nested more than {MAX_NOTE_DEPTH} lists or tables deep"
+    return f"{key_text(bad)}={brief(metadata[bad])} is not allowed: it is nested more than {MAX_NOTE_DEPTH} lists or tables deep"
 
 
 _K = TypeVar("_K")

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import NeurohoverError, as_floats, brief, float64_of, masked_note, refuse_non_text_keys
+from .errors import NeurohoverError, as_floats, brief, float64_of, key_text, masked_note, refuse_non_text_keys
 from .sim.constants import MLP_STEEPNESS, OBS_NAMES
 
 TOPOLOGIES = ("slp", "mlp")
@@ -490,7 +490,7 @@ def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
         text = json_text(data, indent=1, default=plain_json) + "\n"  # flight data's metadata takes them (T36-B08)
     except (TypeError, ValueError, RecursionError) as err:  # an object, or a NaN that other JSON readers refuse
         bad = unwritable_key(data)  # the entry named, as the model's stats and flight data's metadata name it (T36-B08)
-        shown = f", not {bad if len(bad) <= 60 else brief(bad)}={brief(data[bad])}" if isinstance(bad, str) else ""
+        shown = f", not {key_text(bad)}={brief(data[bad])}" if isinstance(bad, str) else ""
         raise NeurohoverError(f"policy metadata must be strict JSON values (numbers finite){shown}: {err}") from None
     problem = record_problem({k: v for k, v in strict_json(text).items() if k not in ("topology", "genome")})  # as written
     if problem:  # T24-03: seed=-1 or budget=-5 was written, and load_policy then refused the file

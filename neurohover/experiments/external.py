@@ -41,13 +41,13 @@ def external_digest(kind: str, s: dict) -> str:
     payload: dict = {}
     if source not in (None, "evolve", "baseline"):
         ps = load_external(s["task"], source, key)  # read even where unflown: a directory that is none is named
-    if source not in (None, "evolve", "baseline") and _flies_set(kind, s):
-        payload = {
-            "generic": policy_dict(ps.generic),
-            "specialised": [policy_dict(p) for p in ps.specialised],
-            "safe": list(ps.safe),
-            "generics": {k: policy_dict(v) for k, v in sorted(ps.generics.items())},
-        }
+        if _flies_set(kind, s):
+            payload = {
+                "generic": policy_dict(ps.generic),
+                "specialised": [policy_dict(p) for p in ps.specialised],
+                "safe": list(ps.safe),
+                "generics": {k: policy_dict(v) for k, v in sorted(ps.generics.items())},
+            }
     drawn = {k: v for k, v in sorted((s.get("generics_from") or {}).items()) if str(v).startswith(DIR_SOURCE)} if kind == "test_runs" else {}
     if drawn:  # generics read from policy files: their genomes are part of the config
         payload["generics_from"] = {k: [p for _, p in dir_champions(v)] for k, v in drawn.items()}

@@ -12,7 +12,7 @@ from collections.abc import Callable
 from dataclasses import MISSING, dataclass, fields
 from typing import Any
 
-from ..errors import NeurohoverError, brief, finite_real, whole_number
+from ..errors import NeurohoverError, brief, finite_real, unknown_keys, whole_number
 from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..models.model import LEGACY_MODEL_SUBSTEPS
 
@@ -138,10 +138,10 @@ def unit_params(kind: str, params: dict) -> Any:
     if not isinstance(params, dict):
         raise NeurohoverError(f"a {kind!r} unit's params = {brief(params)} are not allowed: give a dict of {cls.__name__}'s fields")
     declared = fields(cls)
-    unknown = sorted((k if isinstance(k, str) and len(k) <= 60 else brief(k) for k in set(params) - {f.name for f in declared}), key=str)
+    unknown = unknown_keys(params, {f.name for f in declared})
     missing = [f.name for f in declared if f.name not in params and f.default is MISSING and f.default_factory is MISSING]
     if unknown or missing:
-        wrong = [f"hold {', '.join(unknown)}, which {cls.__name__} does not declare"] if unknown else []
+        wrong = [f"hold {unknown}, which {cls.__name__} does not declare"] if unknown else []
         wrong += [f"lack {', '.join(missing)}, which {cls.__name__} needs"] if missing else []
         raise NeurohoverError(f"a {kind!r} unit's params {' and '.join(wrong)}")
     for f in declared:  # a number's type, before a runner uses it (np.timedelta64 passed as an int into NumPy's TypeError; T17-1)

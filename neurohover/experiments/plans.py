@@ -69,9 +69,6 @@ def _unit(cfg: ExperimentConfig, key: str, kind: str, params: dict, seed_key: st
     return Unit(cfg.name, key, kind, params)
 
 
-# --------------------------------------------------------------------------------- external policies
-
-
 # --------------------------------------------------------------------------------- evolution
 
 

@@ -547,13 +547,13 @@ class TaskFamily:
 
     def training_mdps(self) -> list[MDP]:
         """The 10 training MDPs: the competition's (seeded draws where it has none: :meth:`set_name`)."""
-        if self.set_name("train") == "train":
+        if self.has_competition_sets:
             return self._competition_set("train")
         return self.seeded_training_mdps()
 
     def test_mdps(self) -> list[MDP]:
         """The 100 test MDPs: the competition's (seeded draws where it has none: :meth:`set_name`)."""
-        if self.set_name("test") == "test":
+        if self.has_competition_sets:
             return self._competition_set("test")
         return self.seeded_test_mdps()
 
