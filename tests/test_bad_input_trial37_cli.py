@@ -112,10 +112,12 @@ def test_evaluate_agent_json_names_the_seeded_set(cli, tmp_path):
     """T37-A02 (minor note): evaluate-agent --json names what its rows flew, as compete does."""
     out = tmp_path / "e.json"
     argv = ("evaluate-agent", "--task", "fghh", "--policy", "baseline", "--n-mdps", "1", "--episode-steps", "20", "--json", str(out))
-    rc, _, err = cli(*argv, "--sigma", "0.2")
+    rc, printed, err = cli(*argv, "--sigma", "0.2")
     assert rc == 0, err
     assert json.loads(out.read_text())["mdps"] == "seeded-test"
-    assert cli(*argv)[0] == 0  # sigma 0.3: the competition's test MDPs
+    assert printed.startswith("fghh seeded-test MDPs 0-0,")  # its screen says so too
+    rc, printed, _ = cli(*argv)  # sigma 0.3: the competition's test MDPs
+    assert rc == 0 and printed.startswith("fghh test MDPs 0-0,")
     assert json.loads(out.read_text())["mdps"] == "test"
 
 
