@@ -68,6 +68,7 @@ from .manifest import (
 )
 from .paths import JSONError, sole_writer, strict_json, writing
 from .policies import Policy, load_policy, save_policy, utf8_text
+from .policystages import STAGES, build_state, finished_stage, run_seeds, stage_file
 from .sim.constants import MAX_EPISODE_STEPS
 from .tasks import TaskFamily, get_task_family
 
@@ -384,8 +385,8 @@ def _evolve_one(
     from .evolution.optimisers import NE
     from .policies import prototype
 
-    stage = _stage_file(root, str(child_seed))  # the run's seed names it: each run of a build has its own
-    policy = _finished_stage(stage, f"{family.name}/{name}", say)
+    stage = stage_file(root, str(child_seed))  # the run's seed names it: each run of a build has its own
+    policy = finished_stage(stage, f"{family.name}/{name}", say)
     if policy is not None:  # finished before the build was stopped: the same run again would give the same champion
         if save:
             save_policy(policy, root / f"{name}.json", task=family.name, name=name, **{k: policy.metadata[k] for k in ("episodes", "seconds")})
@@ -405,44 +406,6 @@ def _evolve_one(
     save_policy(policy, stage, task=family.name, name=name, **meta)
     say(f"{family.name}/{name}: champion {result.champion_return:.1f} after {result.episodes} episodes ({time.perf_counter() - t0:.0f} s)")
     return policy
-
-
-def _finished_stage(stage: Path, what: str, say) -> Policy | None:
-    """The champion a finished run of an interrupted build left in ``stage``, None when there is none; a damaged one is
-    said and removed, and the run flown again (it failed the whole build, which then deleted every finished run;
-    eighth trial)."""
-    if not stage.is_file():
-        return None
-    try:
-        policy: Policy | None = load_policy(stage)
-    except NeurohoverError:
-        policy = None
-    if policy is not None and {"episodes", "seconds"} <= policy.metadata.keys():  # what the set's file takes from it
-        return policy
-    say(f"{what}: the interrupted build's stage {stage.name} is damaged; this run is flown again")
-    stage.unlink()
-    return None
-
-
-STAGES = "stages"  # a build's finished runs, kept while it is under way (build_policy_set resumes from them)
-
-
-def _stage_file(root: Path, key: str) -> Path:
-    return root / STAGES / f"{key}.json"
-
-
-def _build_state(root: Path) -> dict:
-    """The settings of the interrupted build in ``root``; a damaged state refused by name (an empty one, which a full disk
-    left, was a JSONDecodeError; seventh trial), since its finished runs cannot be told to be of this build."""
-    state = _stage_file(root, "build")
-    try:  # strictly: an integer of 5,000 digits or nesting 100,000 deep was a traceback (ninth trial)
-        value = strict_json(state.read_bytes())
-    except (OSError, JSONError) as err:
-        value = err
-    if not isinstance(value, dict):
-        why = str(value)[:100] if isinstance(value, Exception) else f"a JSON {type(value).__name__}, not an object"
-        raise NeurohoverError(f"the interrupted build's state {str(state)!r} is damaged ({why}): delete {str(root)!r} to start the build over")
-    return value
 
 
 def _version() -> str:
@@ -520,15 +483,16 @@ def build_policy_set(
         root = final.with_name(final.name + ".building")
         build = {"task": family.name, "sigma": family.sigma, "budget": budget, "fghh_budget": fghh_budget, "seed": seed, "n_steps": n_steps,
                  "safety_episodes": safety_episodes, "lineage": lineage, "optimizer": optimizer, "version": _version()}  # fmt: skip
-        if _stage_file(root, "build").is_file() and _build_state(root) == build:
-            say(f"{family.name}: resuming the interrupted build in {root} ({len(list((root / STAGES).glob('*.json'))) - 1} runs finished)")
+        if stage_file(root, "build").is_file() and build_state(root) == build:
+            finished = sum(stage_file(root, str(s)).is_file() for s in set(run_seeds(seed)))  # its own runs' (a hand-edited seed's are not)
+            say(f"{family.name}: resuming the interrupted build in {root} ({finished} runs finished)")
         else:
             if root.exists():
                 say(f"{family.name}: {root} holds an interrupted build of other settings; it is started over")
             shutil.rmtree(root, ignore_errors=True)
             try:
                 (root / STAGES).mkdir(parents=True)
-                with writing(_stage_file(root, "build"), "the build's state") as partial:  # a full disk left it empty (seventh trial)
+                with writing(stage_file(root, "build"), "the build's state") as partial:  # a full disk left it empty (seventh trial)
                     partial.write_text(json.dumps(build) + "\n", encoding="utf-8")
             except BaseException:
                 shutil.rmtree(root, ignore_errors=True)
@@ -561,7 +525,7 @@ def _build(family, root: Path, budget, fghh_budget, seed, safety_episodes, n_ste
     manifest: dict = {"task": family.name, "budget": budget, "seed": seed, "n_steps": n_steps, "built": time.strftime("%Y-%m-%d %H:%M:%S")}
     if optimizer != NE:
         manifest["optimizer"] = optimizer
-    seeds = np.random.SeedSequence(seed).generate_state(32, dtype=np.uint32)
+    seeds = run_seeds(seed)
     roles = policy_set_roles(family)
     start = time.perf_counter()
 

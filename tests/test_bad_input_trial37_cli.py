@@ -170,3 +170,30 @@ def test_a_resume_names_every_differing_setting_at_once() -> None:
         "config.settings.init_mutate_frac",
     ], found
     assert config_difference("config", saved, saved) is None
+
+
+def test_a_resumed_build_counts_only_the_runs_of_its_own_seed(tmp_path):
+    """T37 (minor note): after stages/build.json was edited by hand to another seed, build-policies said "resuming the
+    interrupted build ... (1 runs finished)" and then flew that run again (its stage is named by the other seed's run)."""
+    from neurohover.policysets import build_policy_set
+
+    lines: list[str] = []
+
+    def stop_after_the_first_run(line: str) -> None:
+        lines.append(line)
+        if "champion" in line:
+            raise KeyboardInterrupt
+
+    tiny = {"budget": 2, "safety_episodes": 1, "n_steps": 10}
+    with pytest.raises(KeyboardInterrupt):
+        build_policy_set("ghh08", tmp_path, seed=0, progress=stop_after_the_first_run, **tiny)
+    with pytest.raises(KeyboardInterrupt):  # the same build: its first run is kept, its second flown
+        build_policy_set("ghh08", tmp_path, seed=0, progress=stop_after_the_first_run, **tiny)
+    assert any(line.endswith("(1 runs finished)") for line in lines), lines
+    state = tmp_path / "ghh08.building" / "stages" / "build.json"
+    state.write_text(json.dumps({**json.loads(state.read_text()), "seed": 1}))  # edited to match the next command
+    lines.clear()
+    with pytest.raises(KeyboardInterrupt):
+        build_policy_set("ghh08", tmp_path, seed=1, progress=stop_after_the_first_run, **tiny)
+    assert any(line.endswith("(0 runs finished)") for line in lines), lines  # seed 0's two runs are not seed 1's
+    assert not any("kept from the interrupted build" in line for line in lines), lines

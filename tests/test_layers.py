@@ -18,7 +18,7 @@ LAYERS = [
     {"launch", "flyer", "plots", "compete_files"},
     {"evaluate"},
     {"evolution", "envs"},
-    {"models", "policysets", "manifest", "policy_records", "integrations"},
+    {"models", "policysets", "policystages", "manifest", "policy_records", "integrations"},
     {"agents"},
     {"experiments"},
     {"compete"},
