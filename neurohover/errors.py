@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import datetime
 import math
 import numbers
 import operator
@@ -139,6 +140,9 @@ def brief(value: object) -> str:
             return f"an integer of about {int(int(value).bit_length() * math.log10(2)) + 1} digits"
         if len(digits) > 30:
             return f"{'-' if value < 0 else ''}{digits[:10]}...({len(digits)} digits)"
+    if isinstance(value, (datetime.date, datetime.time)):  # a TOML date or time: as TOML writes it, not datetime.date(...)
+        kind = "date and time" if isinstance(value, datetime.datetime) else "date" if isinstance(value, datetime.date) else "time"
+        return f"{value.isoformat()} (a {kind})"
     try:
         text = repr(value)
         text = " ".join(text.split()) if "\n" in text else text  # an array's repr spans lines: one line in a message

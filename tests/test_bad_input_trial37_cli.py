@@ -10,6 +10,7 @@ no version writes is still refused (T37-A03)."""
 from __future__ import annotations
 
 import csv
+import datetime
 import json
 import shutil
 from pathlib import Path
@@ -197,3 +198,20 @@ def test_a_resumed_build_counts_only_the_runs_of_its_own_seed(tmp_path):
         build_policy_set("ghh08", tmp_path, seed=1, progress=stop_after_the_first_run, **tiny)
     assert any(line.endswith("(0 runs finished)") for line in lines), lines  # seed 0's two runs are not seed 1's
     assert not any("kept from the interrupted build" in line for line in lines), lines
+
+
+def test_a_toml_date_is_echoed_as_toml_writes_it(capsys, tmp_path):
+    """T37 (minor note): a TOML date in a config was echoed as Python's repr, `seed = datetime.date(1979, 5, 27)`."""
+    from neurohover.errors import brief
+    from neurohover.experiments.config import CONFIG_DIR
+
+    text = (CONFIG_DIR / "fig2.toml").read_text()
+    kept = [line for line in text.splitlines() if not line.startswith(("aliases", "name =", "title ="))]
+    config = tmp_path / "d.toml"
+    config.write_text("\n".join(['name = "d"', *kept]).replace("seed = 2011", "seed = 1979-05-27", 1) + "\n")
+    err = refused(capsys, "reproduce", str(config), "--store", str(tmp_path / "s.sqlite"))
+    assert "seed = 1979-05-27 (a date) is not allowed: expected an integer" in err and "datetime" not in err, err
+    config.write_text(config.read_text().replace("seed = 1979-05-27", "seed = 2011").replace('name = "d"', 'name = "d"\ntitle = 07:32:00'))
+    assert "title = 07:32:00 (a time) is not allowed: give text" in refused(capsys, "reproduce", str(config), "--store", str(tmp_path / "s.sqlite"))
+    assert brief(datetime.datetime(1979, 5, 27, 7, 32)) == "1979-05-27T07:32:00 (a date and time)"
+    assert not (tmp_path / "s.sqlite").exists()

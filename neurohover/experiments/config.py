@@ -395,10 +395,10 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
         raise NeurohoverError(f"{where}: aliases apply to the shipped experiments only (a config of your own is named by its path): remove the key")
     for key in ("title", "paper_ref"):  # title = 5 was stored, then refused as a damaged store's (sixth trial)
         if key in raw and not isinstance(raw[key], str):
-            raise NeurohoverError(f"{where}: {key} = {raw[key]!r:.40} is not allowed: give text")
+            raise NeurohoverError(f"{where}: {key} = {brief(raw[key])} is not allowed: give text")
     kind = raw["kind"]
     if kind not in KINDS:
-        raise NeurohoverError(f"{where}: kind = {kind!r} is not allowed: expected one of {', '.join(KINDS)}")
+        raise NeurohoverError(f"{where}: kind = {brief(kind)} is not allowed: expected one of {', '.join(KINDS)}")
     _check_shape(raw, where)
     scales = raw.get("scales", {})
     bad_scales = sorted(set(scales) - set(SCALES))

@@ -78,7 +78,7 @@ def validate_table(values: dict, schema: dict, where: str) -> dict:
         ok, allowed = check(value)
         if not ok:
             no_cap = ZERO_MEANS.get(key, "") if check(0)[0] else ""  # -1 for "unlimited" was refused without the way to say it (T21-14)
-            raise NeurohoverError(f"{where}: {key} = {value!r} is not allowed: expected {allowed}{no_cap}")
+            raise NeurohoverError(f"{where}: {key} = {brief(value)} is not allowed: expected {allowed}{no_cap}")
         out[key] = value
     return out
 
