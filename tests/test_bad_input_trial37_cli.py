@@ -215,3 +215,22 @@ def test_a_toml_date_is_echoed_as_toml_writes_it(capsys, tmp_path):
     assert "title = 07:32:00 (a time) is not allowed: give text" in refused(capsys, "reproduce", str(config), "--store", str(tmp_path / "s.sqlite"))
     assert brief(datetime.datetime(1979, 5, 27, 7, 32)) == "1979-05-27T07:32:00 (a date and time)"
     assert not (tmp_path / "s.sqlite").exists()
+
+
+def test_a_generational_checkpoint_of_a_preset_names_it(capsys, cli, tmp_path):
+    """T37-A04 (left then): resuming a generational checkpoint of other settings named each differing setting, but not
+    that they were a preset's (an older version's checkpoint runs raw-elitist's rules): the message gives the preset
+    and the settings beside it, as the command line and as Python take them, and the command it gives resumes."""
+    out = str(tmp_path / "p.json")
+    run = ("evolve", "--task", "fghh", "--mdp", "G", "--episode-steps", "10", "--out", out)
+    rc, _, err = cli(*run, "--budget", "100", "--preset", "raw-elitist", "--setting", "pop_size=40")
+    assert rc == 0, err
+    err = refused(capsys, *run, "--budget", "140", "--resume")
+    hint = "its settings are the 'raw-elitist' preset's but pop_size: evolve --preset raw-elitist --setting pop_size=40"
+    assert hint in err and "(settings={'preset': 'raw-elitist', 'pop_size': 40} in Python)" in err, err
+    err = refused(capsys, *run, "--budget", "140", "--resume", "--preset", "authors-script")
+    assert hint in err, err
+    rc, _, err = cli(*run, "--budget", "140", "--resume", "--preset", "raw-elitist", "--setting", "pop_size=40")
+    assert rc == 0, err
+    err = refused(capsys, *run, "--budget", "180", "--resume", "--preset", "raw-elitist")  # nearer than any preset: no hint
+    assert "settings.pop_size: the checkpoint's 40, given 50" in err and "preset's" not in err, err

@@ -293,6 +293,25 @@ def upgrade_saved_config(saved: dict) -> dict:
     return saved
 
 
+def preset_hint(saved: dict, given: dict) -> str:
+    """How to resume a generational checkpoint ``saved`` whose settings are a preset's, or nearer one than those
+    ``given`` (an older checkpoint's are ``raw-elitist``'s, which no message named; T37-A04): '' where none is nearer."""
+    theirs, mine = saved.get("settings"), given.get("settings")
+    if saved.get("method") != "generational" or not isinstance(theirs, dict) or not isinstance(mine, dict):
+        return ""
+
+    def differing(values: dict) -> list[str]:
+        return [key for key in sorted(theirs, key=str) if key not in values or values[key] != theirs[key]]
+
+    name, rest = min(((n, differing(dataclasses.asdict(p))) for n, p in GENERATIONAL_PRESETS.items()), key=lambda found: len(found[1]))
+    if len(rest) >= len(differing(mine)):
+        return ""
+    cli = "".join(f" --setting {key}={'none' if theirs[key] is None else json.dumps(theirs[key]).strip(chr(34))}" for key in rest)
+    python = {"preset": name, **{key: theirs[key] for key in rest}}
+    but = " but " + ", ".join(rest) if rest else ""
+    return f"; its settings are the {name!r} preset's{but}: evolve --preset {name}{cli} (settings={python!r:.200} in Python)"
+
+
 @dataclass(frozen=True)
 class RunConfig:
     """A checked run definition (build it with :meth:`build`).

@@ -27,7 +27,7 @@ from ..policies import Policy
 from ..sim.lanes import LANES
 from .bandits import BANDITS, top_mu_bandit
 from .common import STATE_DAMAGE, Optimiser, TellInfo, damage_text, enc_float
-from .config import RACE_T_LIMIT, RunConfig, next_auto_delta, upgrade_saved_config
+from .config import RACE_T_LIMIT, RunConfig, next_auto_delta, preset_hint, upgrade_saved_config
 from .fitness import episode_fitness
 from .generational import GenerationalNE
 from .optimisers import OPTIMISERS
@@ -169,6 +169,7 @@ class Run:
             raise NeurohoverError(  # the values named, not only their keys (tenth trial)
                 f"{source} was written by a different run ({values}); resume with the same "
                 "target, method, optimizer, resampling, topology, prototype, seed, episode steps and settings (only the budget may change)"
+                + preset_hint(saved, self.config)
             )
         try:
             opt = type(self.opt).from_state_dict(state["optimizer_state"])
