@@ -234,3 +234,16 @@ def test_a_generational_checkpoint_of_a_preset_names_it(capsys, cli, tmp_path):
     assert rc == 0, err
     err = refused(capsys, *run, "--budget", "180", "--resume", "--preset", "raw-elitist")  # nearer than any preset: no hint
     assert "settings.pop_size: the checkpoint's 40, given 50" in err and "preset's" not in err, err
+
+
+def test_checkpoint_every_inf_checkpoints_at_the_end_only(cli, tmp_path):
+    """Noticed in trial 37, a documented choice: `--checkpoint-every inf` is no periodic checkpoint, the one at the
+    end (and on a stop) still written, from which --resume continues."""
+    out = tmp_path / "p.json"
+    run = ("evolve", "--task", "ghh08", "--episode-steps", "10", "--out", str(out), "--checkpoint-every", "inf")
+    rc, _, err = cli(*run, "--budget", "20")
+    assert rc == 0, err
+    state = json.loads((tmp_path / "p.json.checkpoint.json").read_text())
+    assert state["counters"]["episodes"] >= 20 and state["budget"] == 20
+    rc, _, err = cli(*run, "--budget", "100", "--resume")  # the first generation of 50 overran 20
+    assert rc == 0 and json.loads((tmp_path / "p.json.checkpoint.json").read_text())["counters"]["episodes"] >= 100, err

@@ -571,7 +571,7 @@ def register(sub) -> None:
     )
     p.add_argument("--out", required=True, metavar="FILE", help="champion policy file; FILE.history.csv and FILE.checkpoint.json go next to it")
     p.add_argument("--resume", action="store_true", help="continue the run from FILE.checkpoint.json (same options; the budget may be raised)")
-    p.add_argument("--checkpoint-every", type=real, default=60.0, metavar="SECONDS", help="checkpoint interval (default 60 s)")
+    p.add_argument("--checkpoint-every", type=real, default=60.0, metavar="SECONDS", help="checkpoint interval (default 60; inf: at the end and on a stop)")
     p.add_argument("--validation-episodes", type=integer, default=10, help="fresh episodes to validate the champion (default 10)")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.set_defaults(func=cmd_evolve)

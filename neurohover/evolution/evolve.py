@@ -249,7 +249,7 @@ def evolve(
         is taken from the folder current when the run starts; while it runs, another run on the same checkpoint is
         refused (a writer lock, ``.NAME.lock`` beside it, as the CLI's ``--out``).
     checkpoint_every_s : float, optional
-        Seconds between checkpoints (> 0); None: 60. Only with ``checkpoint``.
+        Seconds between checkpoints (> 0; ``math.inf``: only at the end and when stopped); None: 60. Only with ``checkpoint``.
     resume : bool
         Continue from ``checkpoint`` (which must exist).
     method : {"steady-state", "generational"}, optional
