@@ -247,3 +247,18 @@ def test_checkpoint_every_inf_checkpoints_at_the_end_only(cli, tmp_path):
     assert state["counters"]["episodes"] >= 20 and state["budget"] == 20
     rc, _, err = cli(*run, "--budget", "100", "--resume")  # the first generation of 50 overran 20
     assert rc == 0 and json.loads((tmp_path / "p.json.checkpoint.json").read_text())["counters"]["episodes"] >= 100, err
+
+
+def test_a_relative_policy_directory_is_read_from_the_working_directory(monkeypatch, tmp_path):
+    """Noticed in trial 37, a documented choice (README, Reproducing the paper): a config's relative `policies = "DIR"`
+    is read from the working directory, as command-line paths are; when it is missing, the message says where it looked."""
+    from neurohover.errors import NeurohoverError
+    from neurohover.experiments.external import load_external
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(NeurohoverError, match=f"no such directory in the working directory '{tmp_path}'; build it with"):
+        load_external("ghh08", "pd")
+    (tmp_path / "pd").mkdir()
+    with pytest.raises(NeurohoverError, match="pd") as err:  # found there: what it holds is checked next
+        load_external("ghh08", "pd")
+    assert "no such directory" not in str(err.value)

@@ -189,6 +189,6 @@ def substeps():
 
 def policy_source():
     def check(v):
-        return isinstance(v, str) and v != "", "'evolve', 'shipped' or a directory holding <task>/ policy sets"
+        return isinstance(v, str) and v != "", "'evolve', 'shipped' or a directory holding <task>/ policy sets (a relative one from the working directory)"
 
     return check

@@ -27,9 +27,13 @@ def load_external(task: str, source: str, key: str = "policies"):
         refuse_unencodable(source, f"{key} =")
     folder = Path(source).expanduser()  # "~/bq0" as generics_from's "dir:~/..." is: the user's home (T30-A06)
     if source != "shipped" and not folder.is_dir():  # a generic "nope" was named as policies (eighth trial)
+        try:  # a relative one is read from the working directory, not the config's folder: say which
+            where = "" if folder.is_absolute() else f" in the working directory {str(Path.cwd())!r}"
+        except OSError:  # the working directory was removed
+            where = ""
         raise NeurohoverError(  # the command quoted: 'pd 1' unquoted built 'pd' (T31-A05)
             f"{key} = {source!r} is not allowed: give {_SOURCE_WORDS[key]}'shipped' or a directory holding <task>/ policy sets "
-            f"(no such directory; build it with: neurohover build-policies --task {task} --out {shlex.quote(source)})"
+            f"(no such directory{where}; build it with: neurohover build-policies --task {task} --out {shlex.quote(source)})"
         )
     return load_policy_set(task, None if source == "shipped" else folder)
 
