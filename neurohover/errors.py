@@ -23,6 +23,10 @@ class OutputError(NeurohoverError):
     """An output file could not be written (a full disk, a read-only place): the output's fault, not the input's."""
 
 
+class CheckpointReplaced(UserWarning):
+    """An evolution started afresh where its checkpoint file holds a run's checkpoint (``resume=True`` continues it)."""
+
+
 class Terminated(KeyboardInterrupt):
     """A stop signal (:func:`stop_signals`: SIGTERM, SIGHUP, SIGUSR1) arrived where the command handles it (like Ctrl-C:
     finished work kept, one line, status 128 + ``signum``: 143 for SIGTERM, 129 for SIGHUP)."""

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from neurohover.cli import main
-from neurohover.errors import NeurohoverError
+from neurohover.errors import CheckpointReplaced, NeurohoverError
 from neurohover.evolution.evolve import (
     HISTORY_COLUMNS,
     EvolutionInterrupted,
@@ -230,7 +230,8 @@ def test_interrupted_and_resumed_equals_uninterrupted(tmp_path: Path, target, kw
     resumed = evolve(target, budget=600, checkpoint=ckpt, resume=True, **common)
     assert _key(resumed) == _key(full)
     # A finished run with a smaller budget continues to the larger one, also bit for bit.
-    evolve(target, budget=300, checkpoint=ckpt, **common)
+    with pytest.warns(CheckpointReplaced):  # the interrupted run's checkpoint is replaced, and said so (T38-B08)
+        evolve(target, budget=300, checkpoint=ckpt, **common)
     extended = evolve(target, budget=600, checkpoint=ckpt, resume=True, **common)
     assert _key(extended) == _key(full)
 

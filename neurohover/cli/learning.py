@@ -25,11 +25,12 @@ import math
 import sys
 import threading
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief
+from ..errors import CheckpointReplaced, NeurohoverError, brief
 from ..evaluate import DEVICES, check_device, check_episode_count
 from ..evolution.config import MAX_BUDGET
 from ..evolution.generational import GENERATIONAL_PRESETS
@@ -212,9 +213,8 @@ def _evolve_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int
     checkpoint = output_file(f"{out}.checkpoint.json", "--out (its checkpoint file)", kind=CHECKPOINT_KIND)
     if args.resume and not checkpoint.is_file():
         raise NeurohoverError(f"--resume: no checkpoint {str(checkpoint)!r} (it is written next to --out by an earlier run)")
-    note = None
-    if not args.resume and checkpoint.is_file():
-        note = f"neurohover evolve: starting afresh; {checkpoint} will be overwritten (use --resume to continue it)"
+    note = f"neurohover evolve: starting afresh; {checkpoint} will be overwritten (--resume continues it)" if not args.resume and checkpoint.is_file() else None
+    held.enter_context(warnings.catch_warnings(action="ignore", category=CheckpointReplaced))  # said by the note, not as evolve() warns
     settings = _optimiser_settings(args, mdp_desc == MDP_FAMILY)
     bar = _Bar(args.budget, f"evolve {family.name}/{mdp_desc}", note)
     try:

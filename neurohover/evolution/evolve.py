@@ -75,13 +75,14 @@ from __future__ import annotations
 
 import contextlib
 import math
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 
 import numba
 import numpy as np
 
-from ..errors import NeurohoverError, brief, check_flag, real_number, whole_in
+from ..errors import CheckpointReplaced, NeurohoverError, brief, check_flag, real_number, whole_in
 from ..evaluate import MAX_EPISODES_PER_CALL, evaluate_jobs, num_threads
 from ..paths import output_file, sole_writer
 from ..policies import Policy
@@ -160,6 +161,9 @@ def _checkpoint_path(checkpoint, progress, resume: bool) -> Path | None:
         path = None if checkpoint is None else Path(checkpoint)
     else:  # checked before the run; a JSON name, no file of another kind (a model file was replaced; T28-B07)
         path = output_file(checkpoint, "checkpoint", kind=CHECKPOINT_KIND, suffixes=(".json",), what="a checkpoint is JSON")
+        if path.is_file():  # a notebook's cell run again replaced an unfinished run's without a word (T38-B08), as the CLI says
+            warnings.warn(f"checkpoint {str(path)!r} holds a run's checkpoint: this run starts afresh and replaces it (resume=True continues it)",
+                          CheckpointReplaced, stacklevel=3)  # fmt: skip
     if resume and path is None:
         raise NeurohoverError("resume=True needs the checkpoint path")
     return None if path is None else path.absolute()
