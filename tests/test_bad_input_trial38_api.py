@@ -9,7 +9,7 @@ import warnings
 
 import pytest
 
-from neurohover.errors import CheckpointReplaced
+from neurohover.evolution import CheckpointReplaced  # where evolve() is
 
 
 def test_evolve_warns_as_it_replaces_a_checkpoint(tmp_path, cli):

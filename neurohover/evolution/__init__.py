@@ -9,6 +9,7 @@ Modules: ``steady_state`` and ``generational`` (the paper's neuroevolution), ``o
 ``records``, ``seeding``.
 """
 
+from ..errors import CheckpointReplaced
 from .common import ChampionRecord, Optimiser
 from .evolve import (
     EvolutionInterrupted,
@@ -34,6 +35,7 @@ from .steady_state import ROULETTE_ERROR_FLOOR, SteadyStateNE, SteadyStateSettin
 
 __all__ = [
     "CMAES",
+    "CheckpointReplaced",
     "EvolutionInterrupted",
     "EvolutionResult",
     "HistoryRecord",
