@@ -32,3 +32,23 @@ def test_evolve_warns_as_it_replaces_a_checkpoint(tmp_path, cli):
         warnings.simplefilter("error", CheckpointReplaced)  # the command line's own note, not the warning
         rc, _, err = cli(*argv)
     assert rc == 0 and "starting afresh; " in err and "(--resume continues it)" in err and "CheckpointReplaced" not in err, err
+
+
+def test_the_vector_env_takes_the_autoreset_mode_it_resets_in():
+    """T38-B01: make_vec(..., autoreset_mode=AutoresetMode.NEXT_STEP), the mode its metadata names, was refused as an
+    unknown argument (Gymnasium passes a vector entry point's arguments only as keywords), and SAME_STEP likewise
+    without naming the mode it takes."""
+    import gymnasium as gym
+    from gymnasium.vector import AutoresetMode
+
+    from neurohover.errors import NeurohoverError
+
+    make = {"id": "neurohover/GHH08-v0", "num_envs": 2, "vectorization_mode": "vector_entry_point"}
+    for given in (AutoresetMode.NEXT_STEP, "NextStep"):
+        env = gym.make_vec(**make, autoreset_mode=given)
+        assert env.unwrapped.autoreset_mode is AutoresetMode.NEXT_STEP is env.metadata["autoreset_mode"]
+        env.reset(seed=0)
+        env.close()
+    for given in (AutoresetMode.SAME_STEP, AutoresetMode.DISABLED, "x", 3):
+        with pytest.raises(NeurohoverError, match="is not supported: this vector env resets in AutoresetMode.NEXT_STEP \\('NextStep'\\) only"):
+            gym.make_vec(**make, autoreset_mode=given)

@@ -58,6 +58,7 @@ MAX_NUM_ENVS = 10**7
 #: What ``gymnasium.make_vec`` may pass to :class:`HoverVectorEnv`.
 VECTOR_ENV_KWARGS = (
     "num_envs", "task", "sigma", "mdp", "episode_steps", "max_episode_steps", "render_mode", "obs_dtype", "device", "action_dtype", "obs_noise", "obs_delay",
+    "autoreset_mode",
 )  # fmt: skip
 
 
@@ -66,6 +67,18 @@ def _seed_streams(rngs: np.ndarray, idx: np.ndarray, streams: np.ndarray) -> Non
     """Seed the noise streams of sub-environments ``idx`` from their (seed, episode) rows."""
     for i in idx:
         seed_stream(rngs[i], np.uint64(streams[i, 0]), np.uint64(streams[i, 1]))
+
+
+def _next_step_only(mode: Any) -> AutoresetMode:
+    """The vector env's autoreset mode: NEXT_STEP, the one it resets in; given as such it was refused as an unknown
+    argument, and another mode was refused without naming the one it takes (T38-B01)."""
+    try:
+        taken = AutoresetMode.NEXT_STEP if mode is None else AutoresetMode(mode)
+    except (ValueError, TypeError):
+        taken = None
+    if taken is not AutoresetMode.NEXT_STEP:
+        raise NeurohoverError(f"autoreset_mode={brief(mode)} is not supported: this vector env resets in AutoresetMode.NEXT_STEP ('NextStep') only")
+    return taken
 
 
 class HoverVectorEnv(FixedSettings, VectorEnv):
@@ -111,6 +124,9 @@ class HoverVectorEnv(FixedSettings, VectorEnv):
         raises :class:`~neurohover.NeurohoverError`.
     action_dtype : {"float64", "float32"}
         dtype of the action space (the simulation runs in float64 either way).
+    autoreset_mode : AutoresetMode, optional
+        ``AutoresetMode.NEXT_STEP`` (or its value ``"NextStep"``), the one mode it resets in, as its metadata says;
+        None: that one. Another mode is refused by name.
 
     Notes
     -----
@@ -153,9 +169,11 @@ class HoverVectorEnv(FixedSettings, VectorEnv):
         action_dtype: Any = "float64",
         obs_noise: Any = None,
         obs_delay: Any = None,
+        autoreset_mode: Any = None,
         **unknown: Any,
     ) -> None:
         check_no_unknown_kwargs(unknown, VECTOR_ENV_KWARGS)
+        self.autoreset_mode = _next_step_only(autoreset_mode)
         check_device(device)
         check_count(num_envs, "num_envs", MAX_NUM_ENVS)  # 8.0 was called out of range (T22-14)
         if render_mode is not None:
