@@ -427,7 +427,7 @@ def _run_into_store(config, store_path: Path, episodes_csv: Path, *, jobs: int, 
             on_result(key, TestRunResult.from_dict(result, key))
 
     def stored_runs(db) -> list:
-        stored = db.results(config.name, config.scale)
+        stored = db.results(config.name, config.scale, missing_ok=True)  # interrupted before its first unit
         return [TestRunResult.from_dict(stored[k], k) for k in sorted((k for k in stored if k.startswith("run/")), key=_run_order)]
 
     executor = make_executor("local", jobs=jobs, device=device)

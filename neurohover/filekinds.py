@@ -30,6 +30,7 @@ __all__ = [
     "RUN_FILE_ENDS",
     "SQLITE_HEADER",
     "STORE_ENDS",
+    "UTF8_BOM",
     "fitting_name",
     "held_kind",
     "name_limit",
@@ -73,6 +74,7 @@ CSV_KINDS: dict[str, frozenset[str]] = {
 }
 FLIGHT_DATA_KIND = "flight data (a NumPy archive)"  # what held_kind calls an .npz: FlightData.save writes over no other kind (T34-B03)
 POLICY_SET_KIND = "a policy set's manifest"  # what held_kind calls a set's manifest.json: no other writer adds files beside it
+UTF8_BOM = b"\xef\xbb\xbf"  # a byte-order mark ("UTF-8 with BOM"): held_kind reads a JSON or CSV file after it, as its readers do
 _KIND_READ_LIMIT = 64 * 2**20  # a larger file is no neurohover JSON file told apart here
 
 
@@ -98,6 +100,7 @@ def held_kind(path: str | os.PathLike) -> str | None:
         return REPORT_KIND
     if body.startswith(b"PK\x03\x04"):  # a zip: a NumPy archive (.npz) holds its arrays as NAME.npy
         return FLIGHT_DATA_KIND if b"format.npy" in body else None
+    body = body.removeprefix(UTF8_BOM)  # neurohover's readers read a JSON or CSV file after a byte-order mark (T38-B03)
     if not body.lstrip()[:1] == b"{":
         header = {c.decode("latin-1") for c in body.split(b"\n", 1)[0].rstrip(b"\r").split(b",")}
         return next((kind for kind, cells in CSV_KINDS.items() if cells <= header), None)

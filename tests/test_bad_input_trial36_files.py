@@ -37,13 +37,14 @@ def test_a_store_read_of_a_name_with_a_lone_surrogate_is_refused_by_name(tmp_pat
 
 
 def test_the_other_store_readers_refuse_a_lone_surrogate_and_an_unknown_name_is_still_none(tmp_path: Path) -> None:
-    """T36-B01: scales and orphan_units too; a plain name the store does not hold is answered as before."""
+    """T36-B01: scales and orphan_units too; a plain name the store does not hold is answered as before (results refuses
+    it, listing what the store holds, unless missing_ok: T38-B05)."""
     store = Store(tmp_path / "sur.sqlite")
     store_edits.begin(store, "tr2")
     for call in (lambda: store.scales("\udcff"), lambda: store.orphan_units("\udcff")):
         with pytest.raises(NeurohoverError, match="a lone surrogate, which UTF-8 cannot store"):
             call()
-    assert store.results("nope", "quick") == {} and store.config_hash("nope", "quick") is None and store.orphan_units("nope") == []
+    assert store.results("nope", "quick", missing_ok=True) == {} and store.config_hash("nope", "quick") is None and store.orphan_units("nope") == []
 
 
 # ---------------------------------------------------------------------------------------------- T36-B07

@@ -212,7 +212,7 @@ def test_bad_model_files_are_refused(tmp_path, zero_flight) -> None:
         with pytest.raises(NeurohoverError, match=message):
             LearnedModel.load(tmp_path / name)
     zero_flight.flight_data.save(tmp_path / "flight.npz")  # binary, another neurohover format
-    with pytest.raises(NeurohoverError, match="not valid JSON"):
+    with pytest.raises(NeurohoverError, match="cannot be read: a model file must be UTF-8 text, and byte 0x"):  # as a policy file's (T38-B02)
         LearnedModel.load(tmp_path / "flight.npz")
     with pytest.raises(NeurohoverError, match="no such model file"):
         LearnedModel.load(tmp_path / "nowhere.json")

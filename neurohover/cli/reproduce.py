@@ -90,7 +90,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
                     update = args.update and config.name not in sources_added
                     summary = reproduce(config, store, executor, fresh=fresh, update=update, progress=args.progress, only=tuple(args.only or ()))
                 except KeyboardInterrupt as stop:
-                    done = len(store.results(config.name, config.scale))
+                    done = len(store.results(config.name, config.scale, missing_ok=True))
                     how, status = stop_words(stop)
                     print(
                         f"neurohover reproduce: {how}; {done} finished units of {config.name} are in {args.store}; run the same command again to resume",

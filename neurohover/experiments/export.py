@@ -154,7 +154,7 @@ def _check_planned(store: Store, config: ExperimentConfig, units: list[dict]) ->
     checked = [u for u in units if u["kind"] != "diagnostic"]
     if not checked or not _replannable(config):
         return None
-    sources = {n: store.results(n, config.scale) for n in source_experiments(config)}
+    sources = {n: store.results(n, config.scale, missing_ok=True) for n in source_experiments(config)}
     made = plan(config, {u["key"]: u["result"] for u in units}, sources)
     planned = {u.key: u for u in made.units}
     known = set(planned) | set(run_keys(config))

@@ -344,7 +344,7 @@ class _TestRuns(Section):
             if of is None or of["experiment"] == self.cfg.name or not self.runs(g.label):
                 continue
             theirs = {}
-            for u in self.store.units(of["experiment"], self.cfg.scale):
+            for u in self.store.units(of["experiment"], self.cfg.scale, missing_ok=True):
                 key = UnitKey.parse(u["key"])
                 if (key.stage, key.group) == ("run", of["group"]):
                     theirs[f"{key.mdp}/rep{key.rep}"] = float(u["result"]["score"])

@@ -236,7 +236,7 @@ class EvolutionSection(Section):
             other = load_config(source, self.cfg.scale)
         except NeurohoverError:
             return f"\nPaired with {source}: not a shipped experiment, so not compared.\n"
-        theirs = {u["key"]: result_from_dict(u["kind"], u["result"], u["key"]) for u in self.store.units(source, self.cfg.scale)}
+        theirs = {u["key"]: result_from_dict(u["kind"], u["result"], u["key"]) for u in self.store.units(source, self.cfg.scale, missing_ok=True)}
 
         def scores(results: dict, vkey: str) -> dict[int | None, float]:
             """Run number -> mean validation 1/ln(error) of the variant's runs (validated ones)."""

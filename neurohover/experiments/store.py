@@ -28,7 +28,6 @@ Readers (``results``, ``report``) take no lock.
 from __future__ import annotations
 
 import contextlib
-import functools
 import json
 import os
 import socket
@@ -41,8 +40,9 @@ from typing import Any
 
 from ..errors import NeurohoverError, brief, check_flag, finite_real
 from ..filekinds import SQLITE_HEADER, refuse_long_store_name, refuse_sqlite_name
-from ..paths import JSONError, WriterLock, strict_json
+from ..paths import JSONError, WriterLock, refuse_dangling_link, strict_json
 from .store_checks import (
+    HELD_SQL,
     SESSION_STATUSES,
     GuardedConnection,
     StoreWriteError,
@@ -54,11 +54,13 @@ from .store_checks import (
     config_problem,
     experiment_problem,
     let_go,
+    missing_text,
     object_text,
     refuse_moved,
     session_problem,
     sqlite_says,
     stored_count,
+    table_columns,
     take_writer_lock,
     unit_texts,
 )
@@ -82,15 +84,6 @@ CREATE TABLE sessions (
     wall_seconds REAL NOT NULL, units_run INTEGER NOT NULL, units_before INTEGER NOT NULL,
     status TEXT NOT NULL);
 """
-
-
-@functools.cache
-def _columns() -> dict[str, list[str]]:
-    """Each table's columns, as :data:`_SCHEMA` makes them (read from an empty store in memory: written down once)."""
-    with contextlib.closing(sqlite3.connect(":memory:")) as c:
-        c.executescript(_SCHEMA)
-        tables = [t for (t,) in c.execute("SELECT name FROM sqlite_master WHERE type = 'table' AND name NOT LIKE 'sqlite_%'")]
-        return {t: [r[1] for r in c.execute(f"PRAGMA table_info({t})")] for t in tables}
 
 
 def _dumps(obj: Any) -> str:
@@ -124,6 +117,7 @@ class Store:
         with contextlib.suppress(OSError), open(self.path, "rb") as f:  # missing or unreadable: SQLite says so below
             if f.read(len(SQLITE_HEADER)) not in (b"", SQLITE_HEADER):  # 1 byte: SQLite took it as empty (T31-B01)
                 raise NeurohoverError(f"{str(self.path)!r} is not a neurohover results store (it does not start with SQLite's header {SQLITE_HEADER!r})")
+        refuse_dangling_link(self.path, "results store", path)  # SQLite's "unable to open database file" (T38-B07), as --store says
         make_dirs(self.path.parent, "results store", str(path))  # a file as its parent was pathlib's FileExistsError (fifteenth trial, T15-10)
         self._lock = WriterLock(self.lock_path)
         new = not self.path.exists() or self.path.stat().st_size == 0
@@ -228,6 +222,11 @@ class Store:
                 )
             self._sound = True
 
+    def __reduce__(self):  # copy.deepcopy, pickle: "cannot pickle 'GuardedConnection' object" (T38-B04)
+        raise NeurohoverError(
+            f"a Store ({str(self.path)!r}) holds an open SQLite connection and cannot be pickled or copied: pass its path and open Store(path) where it is used"
+        )
+
     def __enter__(self) -> Store:
         return self
 
@@ -262,7 +261,7 @@ class Store:
         made = c.execute("SELECT type, name FROM sqlite_master WHERE type IN ('trigger', 'view') OR (type = 'index' AND sql IS NOT NULL)").fetchone()
         if made is not None:  # a trigger that dropped each unit written made compete fail with "results holds none" (T33-B14)
             raise NeurohoverError(f"results store {str(self.path)!r} holds a {made[0]} {made[1]!r} neurohover did not make; give another --store file")
-        for table, columns in _columns().items():  # a dropped column was found only after reproduce had written (T19-04)
+        for table, columns in table_columns(_SCHEMA).items():  # a dropped column was found only after reproduce had written (T19-04)
             have = [r[1] for r in c.execute(f"PRAGMA table_info({table})")]
             lacking = [col for col in columns if col not in have]
             if lacking:
@@ -414,12 +413,15 @@ class Store:
     def missing_message(self, name: str | None, scale: str | None) -> str:
         """The message for an experiment (None: any experiment; at ``scale``, if given) this store does not hold,
         listing what it holds (any was "holds no experiment '(any)'"; eleventh trial)."""
-        present = [f"{n} ({s})" for n, s, _, _ in self.experiments()]
-        at = f" at scale {scale!r}" if scale is not None else ""  # '' too: its clause dropped, the message contradicted itself (T17-10)
-        if name is None and not present:
-            return f"results store {str(self.path)!r} holds no experiment yet"
-        what = f"no experiment {brief(name)}{at}" if name is not None else f"nothing{at}"
-        return f"results store {str(self.path)!r} holds {what}; it holds: " + (", ".join(present) if present else "nothing yet")
+        return missing_text(str(self.path), [f"{n} ({s})" for n, s, _, _ in self.experiments()], name, scale)
+
+    def _refuse_unheld(self, name: str, scale: str, missing_ok: object) -> None:
+        """Refuse experiment (name, scale) the store holds no config or unit of, listing what it holds as :meth:`config`
+        does: 'FIG7', 'fig7 ' or 'QUICK' read as no units, without a word (T38-B05). ``missing_ok``: read as nothing
+        stored yet (reproduce's sources, an experiment interrupted before its first unit)."""
+        if not check_flag(missing_ok, "missing_ok", "read an experiment not stored as one without units"):
+            if not self._rows(HELD_SQL, (name, scale), f"experiment {name} ({scale})")[0][0]:
+                raise NeurohoverError(self.missing_message(name, scale))
 
     def scales(self, name: str) -> list[str]:
         self._check_created(name)
@@ -427,18 +429,21 @@ class Store:
 
     # ------------------------------------------------------------------ units
 
-    def results(self, name: str, scale: str) -> dict[str, dict]:
-        """key -> result of every finished unit."""
+    def results(self, name: str, scale: str, *, missing_ok: bool = False) -> dict[str, dict]:
+        """key -> result of every finished unit (an experiment the store does not hold refused unless ``missing_ok``)."""
+        self._refuse_unheld(name, scale, missing_ok)
         rows = self._rows("SELECT key, result FROM units WHERE name = ? AND scale = ?", (name, scale), f"experiment {name} ({scale})'s results")
         return {k: self._json(r, f"experiment {name} ({scale}), unit {k}'s result") for k, r in rows}
 
-    def unit_config_hashes(self, name: str, scale: str) -> dict[str, Any]:
-        """key -> the config hash each finished unit was run under (as stored: a damaged one may be no text)."""
+    def unit_config_hashes(self, name: str, scale: str, *, missing_ok: bool = False) -> dict[str, Any]:
+        """key -> the config hash each finished unit was run under (as stored: a damaged one may be no text); as :meth:`results`."""
+        self._refuse_unheld(name, scale, missing_ok)
         rows = self._rows("SELECT key, config_hash FROM units WHERE name = ? AND scale = ?", (name, scale), f"experiment {name} ({scale})'s units")
         return dict(rows)
 
-    def units(self, name: str, scale: str) -> list[dict]:
-        """Every finished unit: key, kind, params, result, seconds, worker, finished (time)."""
+    def units(self, name: str, scale: str, *, missing_ok: bool = False) -> list[dict]:
+        """Every finished unit: key, kind, params, result, seconds, worker, finished (time); as :meth:`results`."""
+        self._refuse_unheld(name, scale, missing_ok)
         rows = self._rows(
             "SELECT key, kind, params, result, seconds, worker, finished FROM units WHERE name = ? AND scale = ? ORDER BY key",
             (name, scale),
@@ -568,7 +573,9 @@ class Store:
                 raise NeurohoverError(f"{where}: {problem}")
             c.execute("UPDATE sessions SET status = ?, wall_seconds = ? - started WHERE id = ?", (status, time.time(), session))
 
-    def sessions(self, name: str, scale: str) -> list[dict]:
+    def sessions(self, name: str, scale: str, *, missing_ok: bool = False) -> list[dict]:
+        """Every recorded run of experiment (name, scale) (:meth:`start_session`), checked; as :meth:`results`."""
+        self._refuse_unheld(name, scale, missing_ok)
         cols = ("id", "executor", "cores", "started", "wall_seconds", "units_run", "units_before", "status")
         rows = self._rows(
             f"SELECT {', '.join(cols)} FROM sessions WHERE name = ? AND scale = ? ORDER BY id", (name, scale), f"experiment {name} ({scale})'s sessions"

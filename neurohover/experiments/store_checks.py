@@ -4,6 +4,7 @@ writes (kept apart from the store's own module, which holds its reads and writes
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import os
 import socket
@@ -20,6 +21,28 @@ from .config import ExperimentConfig, check_name, check_scale
 from .result_checks import params_problem
 from .results import result_from_dict, result_type
 from .units import Unit
+
+#: Whether a store holds experiment (name, scale): its config row, or units of it (orphans, which their readers name).
+HELD_SQL = "SELECT EXISTS (SELECT 1 FROM experiments WHERE name = ?1 AND scale = ?2) OR EXISTS (SELECT 1 FROM units WHERE name = ?1 AND scale = ?2)"
+
+
+def missing_text(store: str, present: list[str], name: str | None, scale: str | None) -> str:
+    """:meth:`Store.missing_message`'s words: ``store`` (its path) holds ``present`` (``"NAME (SCALE)"`` each)."""
+    at = f" at scale {scale!r}" if scale is not None else ""  # '' too: its clause dropped, the message contradicted itself (T17-10)
+    if name is None and not present:
+        return f"results store {store!r} holds no experiment yet"
+    what = f"no experiment {brief(name)}{at}" if name is not None else f"nothing{at}"
+    return f"results store {store!r} holds {what}; it holds: " + (", ".join(present) if present else "nothing yet")
+
+
+@functools.cache
+def table_columns(schema: str) -> dict[str, list[str]]:
+    """Each table's columns, as ``schema`` (the store's) makes them (read from an empty store in memory: written down once)."""
+    with contextlib.closing(sqlite3.connect(":memory:")) as c:
+        c.executescript(schema)
+        tables = [t for (t,) in c.execute("SELECT name FROM sqlite_master WHERE type = 'table' AND name NOT LIKE 'sqlite_%'")]
+        return {t: [r[1] for r in c.execute(f"PRAGMA table_info({t})")] for t in tables}
+
 
 #: How a session can end (:meth:`Store.end_session`; the runner's statuses). A session is "running" until then.
 SESSION_STATUSES = ("finished", "selection finished", "interrupted", "failed")

@@ -335,13 +335,12 @@ class LearnedModel:
     def load(cls, path: str | Path) -> LearnedModel:
         """Read a model written by :meth:`save`; other files are refused with a clear message."""
         from ..paths import input_file, parse_json
+        from ..policies import utf8_text
 
         path = input_file(path, "model file", "model file (JSON, from learn-model --out)")
         name = f"model file {str(path)!r}"
-        try:
-            text = path.read_text(encoding="utf-8")
-        except UnicodeDecodeError as err:
-            raise NeurohoverError(f"{name} is not valid JSON (truncated or not a model file?): {err}") from None
+        try:  # after a byte-order mark, as every other JSON file neurohover reads ("Unexpected UTF-8 BOM"; T38-B02)
+            text = utf8_text(path.read_bytes(), name, "a model file")
         except OSError as err:
             raise NeurohoverError(f"{name} cannot be read ({err.strerror or type(err).__name__})") from None
         return cls.from_dict(parse_json(text, name), name)
