@@ -255,8 +255,7 @@ def evolve(
     checkpoint_every_s : float, optional
         Seconds between checkpoints (> 0; ``math.inf``: only at the end and when stopped); None: 60. Only with ``checkpoint``.
     resume : bool
-        Continue from ``checkpoint`` (which must exist). Without it an existing checkpoint is replaced, with a
-        :class:`~neurohover.errors.CheckpointReplaced` warning.
+        Continue from ``checkpoint`` (which must exist); False replaces one, with a ``CheckpointReplaced`` warning.
     method : {"steady-state", "generational"}, optional
         Default: steady state for an MDP, generational for a family.
     progress_every_s : float, optional
