@@ -37,9 +37,9 @@ import numpy as np
 
 from .agents.hybrid import HybridSettings
 from .compete_files import CSV_COLUMNS  # the columns plot --compete reads, each checked (T23-07)
-from .errors import NeurohoverError, brief
+from .errors import NeurohoverError, brief, first_difference
 from .evolution.seeding import check_seed
-from .paths import write_png
+from .plots import plot_cumulative
 from .sim.constants import EPISODE_STEPS
 from .tasks import N_TEST, N_TRAINING, Drift, Sensor, get_task_family
 from .tasks.drift import MAX_RUN_EPISODES  # a run's episodes, the bound of a drifting MDP's episodes too
@@ -84,33 +84,6 @@ def episode_rows(run: int, result, n_steps: int) -> list[list]:
         steps[e] = s
     crashed, fired = set(result.crash_episodes), set(result.safeguard_episodes)
     return [[run, result.mdp, e, repr(float(ret)), int(e in crashed), steps[e], policy[e], int(e in fired)] for e, ret in enumerate(result.returns)]
-
-
-def plot_cumulative(curves: dict[str, np.ndarray], path: Path, title: str) -> Path:
-    """Mean cumulative error per episode of each agent, linear and log scale (paper Figs 4 and 7)."""
-    # Object-oriented matplotlib (no pyplot): the caller's backend and pyplot figures stay as they are.
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(11, 4))
-    FigureCanvasAgg(fig)
-    axes = fig.subplots(1, 2)
-    for name, cumulative in curves.items():
-        error = -cumulative.mean(axis=0)
-        episodes = np.arange(1, error.size + 1)
-        for ax in axes:
-            ax.plot(episodes, error, label=name)
-    axes[0].set_ylabel("cumulative error (-cumulative reward)")
-    axes[1].set_yscale("log")
-    axes[1].set_ylabel("cumulative error (log scale)")
-    for ax in axes:
-        ax.set_xlabel("episode")
-        ax.grid(alpha=0.3)
-        ax.legend()
-    fig.suptitle(title)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    return write_png(fig, path, "plot file", dpi=110)
 
 
 #: The largest competition (planned in memory, each episode's results stored): its runs (MAX_RUN_EPISODES: its episodes over all runs).
@@ -350,7 +323,8 @@ def compete(
         _note_replaced(out / "summary.json", task, agent, config.scale)
         ordered = _run_into_store(config, store_path, out / "episodes.csv", jobs=jobs, device=device, progress=progress, on_result=on_result)
         flown = get_task_family(task, sigma).set_name(mdps)  # the set its rows' MDPs name: seeded-test at FGHH sigma 0.2 (T37-A02)
-        summary = {"task": task, "agent": agent, "mdps": flown, "seed": seed, "store": str(store_path), **_flown_under(n_steps, sigma, sensor, drift)}
+        summary = {"task": task, "agent": agent, "mdps": flown, "seed": seed, "store": str(store_path.absolute()),  # where plot --compete checks it
+                   **_flown_under(n_steps, sigma, sensor, drift)}  # fmt: skip
         summary |= {"experiment": config.name, "scale": config.scale, **summarise(ordered)}
         _write_summary(out / "summary.json", summary)
         curves = np.array([np.cumsum(np.array(r.returns, dtype=float)) for r in ordered])
@@ -571,3 +545,39 @@ def _write_episodes(path: Path, results: Sequence, n_steps: int) -> None:
         writer.writerow(CSV_COLUMNS)
         for run, result in enumerate(results):
             writer.writerows(episode_rows(run, result, n_steps))
+
+
+def check_against_store(folder: str | Path) -> None:
+    """Refuse a compete folder whose ``summary.json`` names a flight condition (sigma, sensor, drift, episode steps, seed)
+    that the config its store holds contradicts (a sensor edited into the summary labelled curves with a condition never
+    flown, and nothing in the folder contradicts it; T38-B06). ``neurohover plot --compete`` calls it after
+    :func:`~neurohover.compete_files.read_compete_dir` (whose layer reads no store). The summary names its store by its
+    absolute path (a relative one, which older versions wrote, from the working directory); a store no longer there, or
+    holding no such experiment, is not read."""
+    from .experiments import Store
+    from .paths import strict_json
+
+    summary_path = Path(folder) / "summary.json"
+    if not summary_path.is_file():
+        return
+    summary = strict_json(summary_path.read_bytes())  # read_compete_dir has checked it
+    store, name, scale = (summary.get(key) for key in ("store", "experiment", "scale"))
+    if not (isinstance(store, str) and isinstance(name, str) and isinstance(scale, str) and Path(store).is_file()):
+        return
+    held = Store(store, create=False)
+    try:
+        if (name, scale) not in {(n, s) for n, s, _, _ in held.experiments()}:
+            return
+        settings = held.config(name, scale).get("settings", {})
+    finally:
+        held.close()
+    stored = {"sigma": settings.get("sigma"), "episode_steps": settings.get("n_steps"), "seed": settings.get("seed"),
+              "sensor": Sensor.from_dict(settings.get("sensor") or {}).to_dict(), "drift": Drift.from_dict(settings.get("drift") or {}).to_dict()}  # fmt: skip
+    given = {**{key: summary.get(key, stored[key]) for key in ("sigma", "episode_steps", "seed")},
+             "sensor": Sensor.from_dict(summary.get("sensor") or {}).to_dict(), "drift": Drift.from_dict(summary.get("drift") or {}).to_dict()}  # fmt: skip
+    differs = first_difference("", stored, given, "its store's").lstrip(".")
+    if given != stored:  # the first differing key, a sensor's level (its dict cut at 60 characters read alike; T38-B06)
+        raise NeurohoverError(
+            f"--compete {str(summary_path)!r} is not what its store {store!r} holds for {name} ({scale}): {differs} "
+            "(an edit by hand, or the store run again with other settings?)"
+        )

@@ -411,3 +411,32 @@ def plot_compete(dirs: Sequence[str | Path], out: str | Path) -> tuple[Path, Fig
     results = read_compete_dirs(dirs)
     fig = compete_figure(results)
     return save_figure(fig, out), fig
+
+
+def plot_cumulative(curves: dict[str, np.ndarray], path: Path, title: str) -> Path:
+    """Mean cumulative error per episode of each agent, linear and log scale (paper Figs 4 and 7)."""
+    # Object-oriented matplotlib (no pyplot): the caller's backend and pyplot figures stay as they are.
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(11, 4))
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(1, 2)
+    for name, cumulative in curves.items():
+        error = -cumulative.mean(axis=0)
+        episodes = np.arange(1, error.size + 1)
+        for ax in axes:
+            ax.plot(episodes, error, label=name)
+    axes[0].set_ylabel("cumulative error (-cumulative reward)")
+    axes[1].set_yscale("log")
+    axes[1].set_ylabel("cumulative error (log scale)")
+    for ax in axes:
+        ax.set_xlabel("episode")
+        ax.grid(alpha=0.3)
+        ax.legend()
+    fig.suptitle(title)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    from .paths import write_png
+
+    return write_png(fig, path, "plot file", dpi=110)

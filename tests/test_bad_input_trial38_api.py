@@ -52,3 +52,30 @@ def test_the_vector_env_takes_the_autoreset_mode_it_resets_in():
     for given in (AutoresetMode.SAME_STEP, AutoresetMode.DISABLED, "x", 3):
         with pytest.raises(NeurohoverError, match="is not supported: this vector env resets in AutoresetMode.NEXT_STEP \\('NextStep'\\) only"):
             gym.make_vec(**make, autoreset_mode=given)
+
+
+def test_plot_compete_checks_a_summary_against_its_store(cli, tmp_path, monkeypatch):
+    """T38-B06: a compete summary.json edited to a sensor or drift its runs never flew was plotted under that label
+    (nothing in the folder contradicts it); plot --compete checks the flight conditions against the store the summary
+    names, which compete now names by its absolute path (an older relative one from the working directory)."""
+    import shutil
+
+    monkeypatch.chdir(tmp_path)
+    argv = ("compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--episode-steps", "10")
+    rc, _, err = cli(*argv, "--out", "c", "--store", "c.sqlite")
+    assert rc == 0, err
+    summary = json.loads((tmp_path / "c" / "summary.json").read_text())
+    assert summary["store"] == str(tmp_path / "c.sqlite")
+    plot = ("plot", "--out", str(tmp_path / "png"), "--compete")
+    assert cli(*plot, "c")[0] == 0
+    for edit, named in (({"sensor": {"velocity": 0.5}}, "sensor.velocity: its store's 0.0, given 0.5"),
+                        ({"drift": {"walk": 0.1}}, "drift.walk: its store's 0.0, given 0.1"),
+                        ({"seed": 7}, "seed: its store's 0, given 7"),
+                        ({"store": "c.sqlite", "seed": 3}, "seed: its store's 0, given 3")):  # an older relative store path  # fmt: skip
+        shutil.rmtree("e", ignore_errors=True)
+        shutil.copytree("c", "e")
+        (tmp_path / "e" / "summary.json").write_text(json.dumps({**summary, **edit}))
+        rc, _, err = cli(*plot, "e")
+        assert rc == 2 and "is not what its store" in err and named in err and "compete-ghh08-baseline" in err, err
+    (tmp_path / "c.sqlite").rename(tmp_path / "moved.sqlite")  # a store no longer where the summary says is not read
+    assert cli(*plot, "e")[0] == 0

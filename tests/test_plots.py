@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from neurohover.compete import plot_cumulative
 from neurohover.experiments import Store, write_report
+from neurohover.plots import plot_cumulative
 
 DPI = 110  # what both plotters save with
 

@@ -70,10 +70,13 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
         written = plot_flight_data(data, out, stem=path.stem, episodes=_episodes(args.episodes, data.n_episodes))
     else:
+        from ..compete import check_against_store
         from ..compete_files import read_compete_dirs
         from ..plots import compete_figure, save_figure
 
         results = read_compete_dirs(args.compete)  # every directory checked and read before anything is written
+        for folder in args.compete:  # and against the stores they name (T38-B06)
+            check_against_store(folder)
         out = output_dir(args.out if args.out is not None else results[0].path.resolve().parent, "--out")
         written = [save_figure(compete_figure(results), out / COMPETE_PNG)]
     for p in written:
