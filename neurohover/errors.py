@@ -37,20 +37,25 @@ class Terminated(KeyboardInterrupt):
 
 
 #: The signals whose default ends a process and that the command takes as SIGTERM: a batch scheduler's warnings before
-#: its kill (SIGUSR1/SIGUSR2: SGE's -notify, Slurm's --signal; SIGXCPU: a CPU-time limit) and the timers (T35-A03).
-_ALSO_STOPPING = ("SIGUSR1", "SIGUSR2", "SIGXCPU", "SIGALRM", "SIGVTALRM", "SIGPROF")
+#: its kill (SIGUSR1/SIGUSR2: SGE's -notify, Slurm's --signal; SIGXCPU: a CPU-time limit), the timers (T35-A03), a UPS's
+#: SIGPWR, SIGIO and SIGSTKFLT (T38-A04); and the real-time signals (:func:`stop_signals`).
+_ALSO_STOPPING = ("SIGUSR1", "SIGUSR2", "SIGXCPU", "SIGALRM", "SIGVTALRM", "SIGPROF", "SIGPWR", "SIGIO", "SIGSTKFLT")
 
 
-def stop_signals(command: bool = True) -> list[signal.Signals]:
+def stop_signals(command: bool = True) -> list[int]:
     """The signals the command takes as SIGTERM (:class:`Terminated`): SIGTERM, SIGHUP (a closed terminal or a dropped SSH
-    session), SIGUSR1, SIGUSR2, SIGXCPU, SIGALRM, SIGVTALRM and SIGPROF, where the system has them. Python's defaults
-    ended a run at once without a word, and evolve without its checkpoint (T32-A03, T35-A03). SIGQUIT and SIGTRAP keep
+    session), SIGUSR1, SIGUSR2, SIGXCPU, SIGALRM, SIGVTALRM, SIGPROF, SIGPWR, SIGIO, SIGSTKFLT and SIGRTMIN..SIGRTMAX,
+    where the system has them: every signal whose default ends a process without a core dump, and SIGXCPU. Python's
+    defaults ended a run at once without a word, and evolve without its checkpoint (T32-A03, T35-A03, T38-A04). SIGQUIT and SIGTRAP keep
     their defaults: the stop at once, with a core dump, that they ask for (as SIGKILL, the temporary files such a stop
     leaves are removed by the next run of the output: :func:`~neurohover.locks.remove_dead_writers_files`).
     ``command`` False: those a program calling neurohover hands over while it runs (SIGTERM and SIGHUP; the others
     are often a program's own: faulthandler's stack dump, a log rotation, its own timers)."""
     names = ("SIGTERM", "SIGHUP", *_ALSO_STOPPING) if command else ("SIGTERM", "SIGHUP")
-    return [getattr(signal, name) for name in names if hasattr(signal, name)]
+    found = [int(getattr(signal, name)) for name in names if hasattr(signal, name)]
+    if command and hasattr(signal, "SIGRTMIN"):  # most have no name of their own: numbers
+        found += range(signal.SIGRTMIN, signal.SIGRTMAX + 1)
+    return found
 
 
 def whole_number(value: object) -> TypeGuard[int]:

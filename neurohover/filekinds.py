@@ -264,7 +264,7 @@ def refuse_policy_set(directory: Path, option: str, given: str | os.PathLike) ->
         where = "is" if Path(given) == directory else f"is in {brief(str(directory))}, which is"
         raise NeurohoverError(
             f"{option} {brief(os.fspath(given))} {where} a policy set's directory (its manifest.json): a set holds only "
-            "what build-policies writes, and compete --policy-dir refuses one with other files; give another directory"
+            "what build-policies writes (its loader refuses a JSON file no build writes, and leaves other files alone as notes); give another directory"
         )
 
 

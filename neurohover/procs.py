@@ -93,7 +93,7 @@ def watch_parent(parent: int, pdeathsig: bool = True) -> None:
     threading.Thread(target=_watch, args=(parent,), name="neurohover-parent-watch", daemon=True).start()
 
 
-def _group_signals() -> set[signal.Signals]:
+def _group_signals() -> set[int]:
     """The signals a terminal or a batch scheduler sends a whole process group, which the parent alone hears: SIGINT
     and the command's :func:`~neurohover.errors.stop_signals` but SIGTERM (stop_pool's, which ends a worker)."""
     return {signal.SIGINT, *stop_signals()} - {signal.SIGTERM}
@@ -239,7 +239,7 @@ def interrupts_survive_callbacks() -> Iterator[None]:
         if not isinstance(unraisable.exc_value, KeyboardInterrupt):
             previous(unraisable)
             return
-        signum = signal.Signals(unraisable.exc_value.signum) if isinstance(unraisable.exc_value, Terminated) else signal.SIGINT
+        signum = unraisable.exc_value.signum if isinstance(unraisable.exc_value, Terminated) else signal.SIGINT  # SIGRTMIN+1 has no name
         threading.Thread(target=_deliver_again, args=(signum,), daemon=True).start()
 
     sys.unraisablehook = hook
@@ -249,9 +249,9 @@ def interrupts_survive_callbacks() -> Iterator[None]:
         sys.unraisablehook = previous
 
 
-def _deliver_again(signum: signal.Signals) -> None:
+def _deliver_again(signum: int) -> None:
     time.sleep(REDELIVER_SECONDS)
-    _thread.interrupt_main(signum)
+    _thread.interrupt_main(signum)  # type: ignore[arg-type]  # an int: typeshed says Signals, SIGRTMIN+1 has no member
 
 
 @contextlib.contextmanager

@@ -1,0 +1,71 @@
+"""Bad-input trial 38 (the command line): SIGPWR, SIGIO, SIGSTKFLT and the real-time signals ended evolve and reproduce
+without a word, leaving their lock files (T38-A04): they stop a command as SIGTERM does. The writers that refuse a
+policy set's directory gave compete --policy-dir's refusal of other files as their reason, where a set's loader leaves
+files other than JSON alone (T38-A06): the reason now says what the loader does, and that choice is pinned."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+LINUX = sys.platform.startswith("linux")
+
+
+@pytest.mark.skipif(not LINUX, reason="Linux's SIGPWR, SIGSTKFLT and real-time signals")
+def test_every_signal_that_ends_a_process_quietly_stops_a_command_as_sigterm_does() -> None:
+    from neurohover.errors import Terminated, raise_terminated, stop_signals
+    from neurohover.procs import stop_words
+
+    also = {signal.SIGPWR, signal.SIGIO, signal.SIGSTKFLT, signal.SIGRTMIN, signal.SIGRTMIN + 1, signal.SIGRTMAX}
+    assert also <= set(stop_signals()) and not also & set(stop_signals(command=False))
+    assert not {signal.SIGQUIT, signal.SIGTRAP, signal.SIGSEGV, signal.SIGCHLD, signal.SIGWINCH} & set(stop_signals())
+    for signum in also:
+        with pytest.raises(Terminated) as caught:
+            raise_terminated(signum, None)
+        assert stop_words(caught.value) == ("terminated", 128 + signum)
+
+
+@pytest.mark.skipif(not LINUX, reason="real processes signalled, found in /proc")
+def test_evolve_stopped_by_a_real_time_signal_saves_its_checkpoint_and_says_so(tmp_path: Path) -> None:
+    from test_procs import _end_group, _start  # type: ignore[import-not-found]
+
+    out, signum = tmp_path / "e.json", signal.SIGRTMIN + 1  # one with no name of its own
+    argv = ["evolve", "--task", "ghh08", "--mdp", "G", "--budget", "1000000", "--episode-steps", "200", "--checkpoint-every", "1"]
+    proc = _start(tmp_path, *argv, "--out", str(out))
+    try:
+        deadline = time.monotonic() + 120  # a safety net: its first generation checkpointed
+        while time.monotonic() < deadline and proc.poll() is None and not (tmp_path / "e.json.checkpoint.json").exists():
+            time.sleep(0.05)
+        os.kill(proc.pid, signum)
+        rc = proc.wait(timeout=60)
+        err = (tmp_path / "stderr.txt").read_text()
+        assert rc == 128 + signum and "Traceback" not in err, err[-2000:]
+        assert err.strip().splitlines()[-1].startswith("neurohover evolve: terminated"), err[-2000:]
+        left = sorted(p.name for p in tmp_path.iterdir() if p.name not in ("stdout.txt", "stderr.txt"))
+        assert left == ["e.json.checkpoint.json"], left  # no lock, no temporary file
+    finally:
+        _end_group(proc)
+
+
+def test_a_policy_sets_other_files_are_left_alone_and_writers_say_so(cli, tmp_path: Path) -> None:
+    """T38-A06: compete --policy-dir flies a set beside a store, flight data or a folder of the user's (notes, as a
+    README is), and refuses a JSON file no build writes; the writers' refusal gives that as its reason."""
+    from neurohover.policysets import SHIPPED
+
+    shutil.copytree(SHIPPED / "ghh08", tmp_path / "sets" / "ghh08")
+    (tmp_path / "sets" / "ghh08" / "notes").mkdir()
+    (tmp_path / "sets" / "ghh08" / "f.npz").write_bytes(b"PK\x03\x04")
+    argv = ("compete", "--task", "ghh08", "--agent", "model-free", "--runs", "1", "--episodes", "2", "--episode-steps", "10")
+    rc, _, err = cli(*argv, "--policy-dir", str(tmp_path / "sets"), "--out", str(tmp_path / "c"))
+    assert rc == 0, err
+    rc, _, err = cli("fly", "--task", "ghh08", "--episodes", "1", "--record", str(tmp_path / "sets" / "ghh08" / "r.npz"))
+    assert rc == 2 and "a set holds only what build-policies writes (its loader refuses a JSON file no build writes" in err, err
+    (tmp_path / "sets" / "ghh08" / "extra.json").write_text("{}")
+    rc, _, err = cli(*argv, "--policy-dir", str(tmp_path / "sets"), "--out", str(tmp_path / "d"))
+    assert rc == 2 and "extra.json" in err, err
