@@ -69,3 +69,21 @@ def test_a_policy_sets_other_files_are_left_alone_and_writers_say_so(cli, tmp_pa
     (tmp_path / "sets" / "ghh08" / "extra.json").write_text("{}")
     rc, _, err = cli(*argv, "--policy-dir", str(tmp_path / "sets"), "--out", str(tmp_path / "d"))
     assert rc == 2 and "extra.json" in err, err
+
+
+def test_evaluate_agent_imports_a_callable_from_the_working_directory(tmp_path: Path) -> None:
+    """T38-A03: the documented `neurohover evaluate-agent --callable my_agents:act` beside my_agents.py was "No module
+    named 'my_agents'" through the installed script, whose import path starts with the script's folder, not the
+    working directory (python -m neurohover has it). Run as such a script: one in another folder."""
+    import subprocess
+
+    script, work = tmp_path / "bin" / "neurohover_script.py", tmp_path / "work"
+    script.parent.mkdir()
+    work.mkdir()
+    script.write_text("import sys\nfrom neurohover.cli import main\nsys.exit(main())\n")
+    (work / "my_agents_t38.py").write_text("import numpy as np\n\n\ndef act(obs):\n    return np.zeros((len(obs), 4))\n")
+    argv = ["evaluate-agent", "--task", "ghh08", "--callable", "my_agents_t38:act", "--n-mdps", "1", "--episode-steps", "10"]
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"} | {"PYTHONPATH": str(Path(__file__).resolve().parents[1])}
+    done = subprocess.run([sys.executable, str(script), *argv], cwd=work, capture_output=True, text=True, timeout=300, env=env)
+    assert done.returncode == 0 and done.stdout.splitlines()[2].startswith("agent "), done.stderr[-2000:]
+    assert "my_agents_t38" not in " ".join(sys.path)

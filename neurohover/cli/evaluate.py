@@ -8,9 +8,12 @@ the shipped generic on the same gusts (:func:`neurohover.integrations.flying.com
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import json
+import os
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 from ..errors import NeurohoverError
@@ -58,9 +61,10 @@ def _agent(args: argparse.Namespace):
     if args.callable is not None:
         module, _, name = args.callable.partition(":")
         if not module or not name:
-            raise NeurohoverError(f"--callable {args.callable!r} is not allowed: give MODULE:FUNCTION (e.g. mypkg.agents:act), importable from here")
+            raise NeurohoverError(f"--callable {args.callable!r} is not allowed: give MODULE:FUNCTION (e.g. my_agents:act), importable from here or sys.path")
         try:
-            fn = getattr(importlib.import_module(module), name)
+            with _working_directory_on_path():
+                fn = getattr(importlib.import_module(module), name)
         except (ImportError, AttributeError) as err:
             raise NeurohoverError(f"--callable {args.callable!r}: {err}") from None
         except SyntaxError as err:  # a module that does not compile is named, as a missing one is
@@ -86,6 +90,25 @@ def _agent(args: argparse.Namespace):
     from ..integrations.sb3 import sb3_policy
 
     return sb3_policy(args.sb3, algo=algo)
+
+
+@contextlib.contextmanager
+def _working_directory_on_path() -> Iterator[None]:
+    """The working directory first on the import path while --callable's module imports, as ``python -m`` has it: the
+    ``neurohover`` script's path starts with its own folder, and the documented ``--callable my_agents:act`` beside
+    the user's my_agents.py was "No module named 'my_agents'" (T38-A03)."""
+    try:
+        here = os.getcwd()
+    except OSError:  # a removed working directory: nothing to import from it
+        here = ""
+    added = bool(here) and here not in sys.path
+    if added:
+        sys.path.insert(0, here)
+    try:
+        yield
+    finally:
+        if added and here in sys.path:
+            sys.path.remove(here)
 
 
 def _files_read(args: argparse.Namespace) -> dict[str, str | Path | None]:
@@ -191,7 +214,9 @@ def register(sub) -> None:
     add_sensor_options(p)
     g = p.add_argument_group("the agent (exactly one)")
     g.add_argument("--policy", help="a neurohover policy file (.json or the competition's .net), or baseline")
-    g.add_argument("--callable", help="MODULE:FUNCTION mapping a batch of observations (B, 12) to actions (B, 4)")
+    g.add_argument(
+        "--callable", help="MODULE:FUNCTION mapping a batch of observations (B, 12) to actions (B, 4); MODULE from the working directory or sys.path"
+    )
     g.add_argument("--rl-zoo", help="an RL Zoo run folder (logs/ALGO/ENV_N): its final model and frozen observation statistics")
     g.add_argument("--sb3", help="a Stable-Baselines3 model file (MODEL.zip)")
     g.add_argument("--cleanrl", help="a CleanRL ppo_continuous_action run folder (runs/RUN: its model and saved obs_rms.pkl)")
