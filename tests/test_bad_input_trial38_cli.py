@@ -87,3 +87,22 @@ def test_evaluate_agent_imports_a_callable_from_the_working_directory(tmp_path: 
     done = subprocess.run([sys.executable, str(script), *argv], cwd=work, capture_output=True, text=True, timeout=300, env=env)
     assert done.returncode == 0 and done.stdout.splitlines()[2].startswith("agent "), done.stderr[-2000:]
     assert "my_agents_t38" not in " ".join(sys.path)
+
+
+def test_a_model_option_given_another_kind_of_input_names_it(cli, tmp_path: Path) -> None:
+    """T38-A05: --sb3 given a neurohover policy file or flight data, and --rl-zoo a folder of no run, answered "needs
+    stable_baselines3: pip install ..." where it is not installed; the input is checked first, whether it is or not."""
+    policy, data = tmp_path / "e1.json", tmp_path / "r1.npz"
+    base = ("evaluate-agent", "--task", "ghh08", "--n-mdps", "1", "--episode-steps", "10")
+    from neurohover import baseline_policy, save_policy
+
+    save_policy(baseline_policy(), policy)
+    assert cli("fly", "--task", "ghh08", "--episodes", "1", "--record", str(data))[0] == 0
+    rc, _, err = cli(*base, "--sb3", str(policy))
+    assert rc == 2 and "is a policy file of neurohover's, not a Stable-Baselines3 model file: fly it with --policy" in err, err
+    rc, _, err = cli(*base, "--sb3", str(data))
+    assert rc == 2 and "is flight data (a NumPy archive) of neurohover's, not a Stable-Baselines3 model file" in err, err
+    rc, _, err = cli(*base, "--rl-zoo", str(tmp_path))
+    assert rc == 2 and "is not an RL Zoo run folder: expected one ENV.zip (or best_model.zip) in it" in err, err
+    for _, _, err in (cli(*base, "--sb3", str(policy)), cli(*base, "--rl-zoo", str(tmp_path))):
+        assert "pip install" not in err

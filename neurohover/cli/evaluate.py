@@ -78,15 +78,17 @@ def _agent(args: argparse.Namespace):
         from ..integrations.cleanrl import cleanrl_policy
 
         return cleanrl_policy(args.cleanrl)
+    from ..integrations.sb3_files import rl_zoo_files, sb3_model_file
     from ..paths import input_dir, input_file
 
     if args.rl_zoo is not None:
         input_dir(args.rl_zoo, "--rl-zoo")  # the path before the library: a typo read as "SB3 is not installed" (third trial)
+        sb3_model_file(rl_zoo_files(args.rl_zoo, algo)[0])  # and what it holds: a folder of no run likewise (T38-A05)
         from ..integrations.sb3 import rl_zoo_policy
 
         return rl_zoo_policy(args.rl_zoo, algo=algo)
     if not Path(f"{args.sb3}.zip").is_file():  # SB3's load adds .zip to a name without it
-        input_file(args.sb3, "--sb3", "SB3 model file (.zip)")
+        sb3_model_file(input_file(args.sb3, "--sb3", "SB3 model file (.zip)"))  # a policy file was "needs stable_baselines3" (T38-A05)
     from ..integrations.sb3 import sb3_policy
 
     return sb3_policy(args.sb3, algo=algo)
@@ -118,7 +120,7 @@ def _files_read(args: argparse.Namespace) -> dict[str, str | Path | None]:
     if args.callable is not None:
         files["--callable"] = getattr(sys.modules.get(args.callable.partition(":")[0]), "__file__", None)
     if args.rl_zoo is not None:
-        from ..integrations.sb3 import rl_zoo_files
+        from ..integrations.sb3_files import rl_zoo_files
 
         files["--rl-zoo (its model)"], files["--rl-zoo (its statistics)"] = rl_zoo_files(args.rl_zoo, args.algo or "ppo")
     if args.cleanrl is not None:

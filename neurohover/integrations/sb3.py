@@ -36,6 +36,7 @@ from ..sim.constants import ACTION_DIM
 from ..sim.rng import MAX_SEED
 from . import SB3_ALGORITHMS
 from .flying import checked_obs_statistics
+from .sb3_files import check_algo, rl_zoo_files, sb3_model_file
 
 try:
     from stable_baselines3.common.vec_env.base_vec_env import VecEnv
@@ -194,9 +195,7 @@ class SB3VecEnv(VecEnv):
 
 
 def _algorithm(algo: str):
-    if not isinstance(algo, str) or algo not in SB3_ALGORITHMS:  # ['ppo'] was a TypeError "unhashable" (thirteenth trial, F13)
-        raise NeurohoverError(f"algo={brief(algo)} is not supported: allowed {', '.join(SB3_ALGORITHMS)}")
-    package, name = SB3_ALGORITHMS[algo]
+    package, name = SB3_ALGORITHMS[check_algo(algo)]
     try:
         return getattr(importlib.import_module(package), name)
     except ModuleNotFoundError:
@@ -205,8 +204,7 @@ def _algorithm(algo: str):
 
 def _load(algorithm, path: Path):
     """A saved model, or one clear error naming the file (not a zip, another algorithm's, damaged)."""
-    if not zipfile.is_zipfile(path):
-        raise NeurohoverError(f"{str(path)!r} is not a Stable-Baselines3 model file (a MODEL.zip that model.save wrote)")
+    sb3_model_file(path)
     try:
         return algorithm.load(path, device="cpu")
     except (zipfile.BadZipFile, KeyError, ValueError, RuntimeError, EOFError, AttributeError, TypeError, pickle.UnpicklingError) as err:
@@ -262,30 +260,8 @@ def sb3_policy(model_zip: str | Path, *, algo: str = "ppo", deterministic: bool 
     wrap it yourself if it learned behind a normaliser), ready for :func:`neurohover.integrations.flying.evaluate_callable`."""
     check_flag(deterministic, "deterministic", "the Gaussian's mean")  # 'no' was true
     path = checked_path(model_zip, "model_zip", "MODEL.zip file path")  # None, 5, b'x.zip' were pathlib's TypeError (thirteenth trial, F13)
-    if not path.is_file():
-        raise NeurohoverError(f"{str(path)!r} is not a Stable-Baselines3 model file (MODEL.zip)")
+    sb3_model_file(path)  # before the algorithm's import
     return _policy_of(_load(_algorithm(algo), path), deterministic)
-
-
-def rl_zoo_files(run: str | Path, algo: str = "ppo") -> tuple[Path, Path | None]:
-    """The files :func:`rl_zoo_policy` reads in the RL Zoo run folder ``run``: its model (``ENV.zip``, or
-    ``best_model.zip`` when there is no final one) and its observation statistics (``ENV/vecnormalize.pkl``; None
-    when there are none)."""
-    _algorithm(algo)
-    run = checked_path(run, "run", "path of an RL Zoo run folder")  # None was pathlib's TypeError (thirteenth trial, F13)
-    if not run.is_dir():  # "found []" for a folder that is not there (seventh trial)
-        raise NeurohoverError(f"RL Zoo run folder {str(run)!r}: {'no such directory' if not run.exists() else 'not a directory'}")
-    zips = sorted(z for z in run.glob("*.zip") if not z.name.startswith("rl_model_"))
-    finals = [z for z in zips if z.name != "best_model.zip"]
-    model_zip = finals[0] if len(finals) == 1 else run / "best_model.zip"
-    if len(finals) > 1 or not model_zip.is_file():
-        raise NeurohoverError(f"{str(run)!r} is not an RL Zoo run folder: expected one ENV.zip (or best_model.zip) in it, found {[z.name for z in zips]}")
-    stats_file = run / model_zip.stem / "vecnormalize.pkl"
-    if model_zip.name == "best_model.zip":
-        stats_file = next(run.glob("*/vecnormalize.pkl"), stats_file)
-    if stats_file.exists() and not stats_file.is_file():  # a directory was skipped: the policy flew unnormalised (ninth trial)
-        raise NeurohoverError(f"{str(stats_file)!r} is not a file: expected the run's VecNormalize statistics (or nothing, for a run without them)")
-    return model_zip, stats_file if stats_file.exists() else None
 
 
 def _vecnormalize(path: Path, n_obs: int):
