@@ -89,6 +89,68 @@ def _check_numba_variables() -> None:
         _refuse_setting(f"environment variable {name}={value!r:.40} is not allowed: {what}")
 
 
+def _check_source_date_epoch() -> None:
+    """Refuse a SOURCE_DATE_EPOCH that NumPy's f2py cannot read, as f2py does (``int()``, then ``time.gmtime``): f2py
+    reads it as it imports, and NumPy and SciPy import f2py lazily, so 'abc', '1.5' or 99999999999999999999 was its
+    ValueError or OverflowError traceback from fly, evolve and report, and compete's failed units (T38-A01). Set but
+    empty is taken as unset, as the reproducible-builds specification has it (a shell's ``SOURCE_DATE_EPOCH=``), and
+    removed from the environment for f2py, which would read it as an integer."""
+    import time
+
+    value = os.environ.get("SOURCE_DATE_EPOCH")
+    if value is None:
+        return
+    if value == "":
+        del os.environ["SOURCE_DATE_EPOCH"]
+        return
+    try:
+        time.gmtime(int(value))
+    except (ValueError, OverflowError, OSError):
+        _refuse_setting(
+            f"environment variable SOURCE_DATE_EPOCH={value!r:.40} is not allowed: give a whole number of seconds since "
+            "1970-01-01 UTC (a build date NumPy's f2py reads as it imports), or unset it"
+        )
+
+
+#: The address space (RLIMIT_AS, ``ulimit -v``) a command needs, in MiB: this much, this much more for each OpenBLAS
+#: thread (NumPy's and SciPy's copy each reserve a 32 MiB buffer and a stack per thread as they load) and this much for
+#: each of numba's (a stack). Fly of ghh08 with 2 threads each ran in 488 MiB (peak 484) and failed in 460; 1 thread
+#: each peaked at 395 MiB, 8 each at 957 (T38-A02).
+ADDRESS_SPACE_MIB = (315, 75, 10)
+
+
+def _pool_threads() -> tuple[int, int]:
+    """The threads OpenBLAS (OPENBLAS_NUM_THREADS, GOTO_NUM_THREADS or OMP_NUM_THREADS, else one per core, at most 64)
+    and numba (NUMBA_NUM_THREADS, else one per core) will start in this process."""
+    cores = os.cpu_count() or 1
+    numba = os.environ.get("NUMBA_NUM_THREADS", "").strip()
+    blas = next((os.environ[k].strip() for k in ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS") if os.environ.get(k, "").strip()), "")
+    counts = [int(v) if v.isascii() and v.isdigit() and int(v) > 0 else cores for v in (blas, numba)]
+    return min(counts[0], 64), counts[1]
+
+
+def _check_address_space() -> None:
+    """Refuse, as the command, an address-space limit (RLIMIT_AS, ``ulimit -v``) below what its thread pools reserve as
+    they start: SciPy's OpenBLAS, loaded by numba's first compilation, retried its buffer's mmap for ever (OpenBLAS issue
+    5289) with the interpreter's lock held, so the command hung without a word and SIGTERM's handler never ran; a
+    little more room and OpenBLAS's failed thread start raised SIGINT ("interrupted"), less and llvmlite would not load
+    (T38-A02). A program importing us keeps its own limits."""
+    import resource
+
+    soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+    if not running_as_command() or soft == resource.RLIM_INFINITY:
+        return
+    blas, numba = _pool_threads()
+    base, per_blas, per_numba = ADDRESS_SPACE_MIB
+    need = (base + per_blas * blas + per_numba * numba) * 1024  # KiB, as ulimit -v counts
+    if soft // 1024 < need:
+        _refuse_setting(
+            f"the address-space limit (ulimit -v) {soft // 1024} KiB is not allowed: neurohover needs {need} KiB with {blas} OpenBLAS "
+            f"and {numba} numba threads (NumPy's and SciPy's OpenBLAS hang when they cannot reserve their buffers); "
+            "raise it, or set OPENBLAS_NUM_THREADS and NUMBA_NUM_THREADS lower, or unset it (ulimit -v unlimited)"
+        )
+
+
 def _import_numba() -> None:
     """Import numba, a variable it cannot parse refused by name: it warned with a traceback and took its default (any
     NUMBA_ variable besides those of :data:`_NUMBA_VARIABLES`, NUMBA_DEBUG=x...; T16-3). Numba's other warnings are
@@ -159,6 +221,8 @@ def _check_matplotlib_backend() -> None:
 
 
 _check_numba_variables()
+_check_source_date_epoch()
+_check_address_space()
 _check_matplotlib_backend()
 _import_numba()
 _check_threading_layer()
