@@ -135,8 +135,10 @@ def _check_address_space() -> None:
     5289) with the interpreter's lock held, so the command hung without a word and SIGTERM's handler never ran; a
     little more room and OpenBLAS's failed thread start raised SIGINT ("interrupted"), less and llvmlite would not load
     (T38-A02). A program importing us keeps its own limits."""
-    import resource
-
+    try:
+        import resource
+    except ImportError:  # not POSIX: no such limit
+        return
     soft = resource.getrlimit(resource.RLIMIT_AS)[0]
     if not running_as_command() or soft == resource.RLIM_INFINITY:
         return
