@@ -378,8 +378,8 @@ def _counts_problem(meta: dict, parse_resampling) -> str:
 
 def _fields_problem(meta: dict) -> str:
     """A record's sensor (read as :meth:`Sensor.from_dict <neurohover.tasks.sensor.Sensor.from_dict>` reads it; T25-04),
-    sigma (checked by the FGHH family, against its task and its target's ``G(sigma=...)``; T25-05), prototype against its
-    seed_policy (T25-06), seed_policy and history as what evolve writes (T25-14), and keys no policy file holds (T25-12)."""
+    sigma (checked by the FGHH family, against its task and its target's ``G(sigma=...)``; T25-05), prototype as evolve
+    writes it (T39-B05) and against its seed_policy (T25-06), seed_policy and history as what evolve writes (T25-14), and keys no policy file holds (T25-12)."""
     from dataclasses import fields
 
     from .tasks import MDP, get_task_family
@@ -419,6 +419,11 @@ def _fields_problem(meta: dict) -> str:
     seed_policy, proto = meta.get("seed_policy"), meta.get("prototype")
     if "seed_policy" in meta and (not isinstance(seed_policy, str) or seed_policy == ""):
         return f"its seed_policy {brief(seed_policy)} is not allowed: give what the run was seeded from as text (zero, baseline or a policy file)"
+    if "prototype" in meta and not (isinstance(proto, str) and proto in ("zero", "baseline")):  # 3 and 'zzz' were saved and loaded (T39-B05)
+        return (
+            f"its prototype {brief(proto)} is not allowed: give where the run's lineage started, zero or baseline "
+            "(neurohover.policies.prototype's seeds, which evolve writes and carries on), or leave it out"
+        )
     if seed_policy in ("zero", "baseline") and "prototype" in meta and proto != seed_policy:
         return f"its prototype {brief(proto)} is not allowed beside its seed_policy {brief(seed_policy)}: a run seeded from {seed_policy} has its prototype"
     history = meta.get("history")

@@ -29,7 +29,7 @@ from ..models.transitions import one_step_error
 from ..policies import Policy
 from ..tasks import TaskFamily
 from .model_based import ModelEvolution, enough_to_learn, evolve_on_model
-from .protocol import Agent, Choice, EpisodeOutcome, check_agent_policy
+from .protocol import Agent, Choice, EpisodeOutcome, check_agent_policy, check_agent_settings
 from .spec import AgentOptions, AgentPolicies, AgentSettings, AgentSpec
 
 
@@ -112,13 +112,18 @@ class ContinualAgent(Agent):
     name = "continual"
 
     def __init__(self, generic: Policy, evolution: ModelEvolution = ModelEvolution(), settings: ContinualSettings = ContinualSettings()) -> None:
-        check_agent_policy("generic", generic)
         self.generic, self.evolution, self.settings = generic, evolution, settings
-        self._dangerous = DangerousState(arm_after=settings.safeguard_after)
+        self.check_arguments()
         self._reset(np.random.default_rng(0))
+
+    def check_arguments(self) -> None:
+        check_agent_policy("generic", self.generic)
+        check_agent_settings("evolution", self.evolution, ModelEvolution)
+        check_agent_settings("settings", self.settings, ContinualSettings)
 
     def _reset(self, rng: np.random.Generator) -> None:
         self._rng = rng
+        self._dangerous = DangerousState(arm_after=self.settings.safeguard_after)  # of the settings at the run's start
         self.window: list[tuple[np.ndarray, np.ndarray]] = []  # (observations, actions) of the recent episodes
         self.policy, self.label = self.generic, "generic"
         self.learning = True  # in a learning phase (else flying a kept policy and watching its model)

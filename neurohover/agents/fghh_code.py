@@ -44,7 +44,7 @@ from ..policies import Policy, baseline_policy, prototype
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
 from .model_based import enough_to_learn, learn_model
-from .protocol import Agent, Choice, EpisodeOutcome, check_agent_policy
+from .protocol import Agent, Choice, EpisodeOutcome, check_agent_policy, check_agent_settings
 from .spec import FGHH_GENERIC_KINDS, AgentOptions, AgentPolicies, AgentSpec
 
 #: The authors' ``eonn`` settings on the model (their FGHH agent): 49 of 50 kept, one offspring a
@@ -124,11 +124,16 @@ class CodeFGHHAgent(Agent):
     name = "authors"
 
     def __init__(self, generic: Policy, settings: CodeAgentSettings = CodeAgentSettings()) -> None:
-        check_agent_policy("generic", generic)
         self.generic = generic
         self.settings = settings
         self.fallback = baseline_policy()
+        self.check_arguments()
         self._reset(np.random.default_rng(0))
+
+    def check_arguments(self) -> None:
+        check_agent_policy("generic", self.generic)
+        check_agent_settings("settings", self.settings, CodeAgentSettings)
+        check_agent_policy("fallback", self.fallback)
 
     def _reset(self, rng: np.random.Generator) -> None:
         self._rng = rng

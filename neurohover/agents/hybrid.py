@@ -24,7 +24,7 @@ from ..flightdata import FlightData
 from ..policies import Policy, baseline_policy
 from ..tasks import MDP, TaskFamily
 from .model_based import ModelEvolution, enough_to_learn, evolve_on_model
-from .protocol import Agent, Choice, EpisodeOutcome, check_agent_policies, check_agent_policy
+from .protocol import Agent, Choice, EpisodeOutcome, check_agent_policies, check_agent_policy, check_agent_settings, check_name_text
 from .spec import AgentOptions, AgentPolicies, AgentSettings, AgentSpec
 
 N_EVOLVED = 3
@@ -108,15 +108,22 @@ class HybridAgent(Agent):
         hybrid: HybridSettings = HybridSettings(),
     ) -> None:
         check_agent_policies("safe", safe, exactly=2)
-        check_agent_policy("generic", generic)
-        check_agent_policy("fallback", fallback)
         self.safe = list(safe)
         self.generic = generic
         self.fallback = fallback
         self.settings = settings
         self.hybrid = hybrid
         self.name = name
+        self.check_arguments()
         self._reset(np.random.default_rng(0))
+
+    def check_arguments(self) -> None:
+        check_agent_policies("safe", self.safe, exactly=2)
+        check_agent_policy("generic", self.generic)
+        check_agent_policy("fallback", self.fallback)  # None after construction flew without a safeguard (T39-B03)
+        check_agent_settings("settings", self.settings, ModelEvolution)
+        check_agent_settings("hybrid", self.hybrid, HybridSettings)
+        check_name_text("name", self.name, "the agent in the run's records")  # None, 5 and '' were taken (T39-B04)
 
     def _reset(self, rng: np.random.Generator) -> None:
         self._rng = rng

@@ -20,7 +20,7 @@ from ..models.model import DEFAULT_MODEL_SUBSTEPS, LearnedModel
 from ..policies import Policy, baseline_policy
 from ..sim.constants import EPISODE_STEPS, MAX_EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
-from .protocol import Agent, Choice, EpisodeOutcome, check_agent_policy
+from .protocol import Agent, Choice, EpisodeOutcome, check_agent_policy, check_agent_settings
 from .spec import FGHH_GENERIC_KINDS, AgentOptions, AgentPolicies, AgentSettings, AgentSpec
 
 #: How a policy is evolved on a learned model: ``"ours"``, steady state from the generic policy with
@@ -192,18 +192,27 @@ def evolve_on_model(model: MDP, prototype: Policy, settings: ModelEvolution, see
     return policy, float(predicted)
 
 
+def check_max_learning_episodes(value: object) -> int:
+    """The incremental agents' ``max_learning_episodes`` as an int, refused unless a whole number in 1..2**63-1."""
+    return whole_in(value, "max_learning_episodes", 1, 2**63 - 1, "2**63-1")
+
+
 class ModelBasedAgent(Agent):
     """Fly the generic policy once, learn an LR model, evolve a policy on it, keep it for the run."""
 
     name = "model-based"
 
     def __init__(self, generic: Policy, settings: ModelEvolution = ModelEvolution()) -> None:
-        check_agent_policy("generic", generic)
         self.generic = generic
         self.settings = settings
+        self.check_arguments()
         self.policy: Policy | None = None
         self.flight_data: FlightData | None = None
         self._rng = np.random.default_rng(0)
+
+    def check_arguments(self) -> None:
+        check_agent_policy("generic", self.generic)
+        check_agent_settings("settings", self.settings, ModelEvolution)
 
     def start(self, family: TaskFamily, rng: np.random.Generator) -> None:
         self.policy = None
@@ -229,17 +238,25 @@ class IncrementalModelBasedAgent(Agent):
 
     If no policy meets its prediction within ``max_learning_episodes`` episodes, the agent keeps the
     policy with the best return flown so far (a choice the paper leaves open; the paper's runs stopped
-    within a few episodes).
+    within a few episodes). ``max_learning_episodes``: a whole number from 1 (keep the generic policy after
+    its first episode) to 2**63-1 (in effect, learn until a policy meets its prediction), as
+    :class:`IncrementalSettings` takes it.
     """
 
     name = "incremental"
 
     def __init__(self, generic: Policy, settings: ModelEvolution = ModelEvolution(), max_learning_episodes: int = 25) -> None:
-        check_agent_policy("generic", generic)
         self.generic = generic
         self.settings = settings
         self.max_learning_episodes = max_learning_episodes
+        self.check_arguments()
         self._reset(np.random.default_rng(0))
+
+    def check_arguments(self) -> None:
+        check_agent_policy("generic", self.generic)
+        check_agent_settings("settings", self.settings, ModelEvolution)
+        # -1, 0, 2.5 and True were taken: the agent stopped learning after its first episode without a word (T39-B03)
+        self.max_learning_episodes = check_max_learning_episodes(self.max_learning_episodes)
 
     def _reset(self, rng: np.random.Generator) -> None:
         self._rng = rng
@@ -303,7 +320,7 @@ class IncrementalSettings(AgentSettings):
     def __post_init__(self) -> None:
         # T24-11: 1.5 or True "is not allowed" (a type), 0 "is out of range" (both said out of range); no bound but int64's
         # stored as the Python int whole_in returns (the settings are stored as JSON); np.int64 was refused (T33-B12)
-        object.__setattr__(self, "max_learning_episodes", whole_in(self.max_learning_episodes, "max_learning_episodes", 1, 2**63 - 1, "2**63-1"))
+        object.__setattr__(self, "max_learning_episodes", check_max_learning_episodes(self.max_learning_episodes))
 
     @classmethod
     def from_unit(cls, params: dict) -> IncrementalSettings:

@@ -18,14 +18,19 @@ Subclass :class:`Agent` and implement ``choose`` and ``update``::
 
 ``final=True`` promises the agent will choose the same policy for every remaining episode, which
 lets the harness fly the rest of the run in one parallel batch (same results, far faster).
+``choose`` and ``update`` are called as plain Python calls ``agent.choose(episode)`` (a staticmethod or classmethod is
+fine); an agent with construction arguments (policies, settings, counts) checks them in ``check_arguments``, which its
+constructor calls and :func:`run_test` calls again before the run, so one changed after construction is refused too.
 """
 
 from __future__ import annotations
 
 import functools
+import inspect
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from types import FunctionType
 
 import numpy as np
 
@@ -79,8 +84,7 @@ class Choice:
         # A hand-written agent's bad Choice was an AttributeError in the harness, or an int label in the records (thirteenth trial, F11).
         if not isinstance(self.policy, Policy):
             raise NeurohoverError(f"Choice policy={brief(self.policy)} is not allowed: give a Policy (neurohover.policies.baseline_policy(), for example)")
-        if not isinstance(self.label, str) or not self.label.strip():
-            raise NeurohoverError(f"Choice label={brief(self.label)} is not allowed: give a non-empty text naming the policy (e.g. 'specialised:3')")
+        check_name_text("Choice label", self.label, "the policy (e.g. 'specialised:3')")
         if self.fallback is not None and not isinstance(self.fallback, Policy):
             raise NeurohoverError(f"Choice fallback={brief(self.fallback)} is not allowed: give a Policy or None")
         if not isinstance(self.dangerous, DangerousState):
@@ -104,6 +108,21 @@ class Choice:
                 f"Choice dangerous={brief(self.dangerous)} is not allowed without a fallback: the safeguard hands control to the "
                 "fallback, so alone the rule acts on nothing; give fallback= too, or leave dangerous out"
             )
+
+
+def check_name_text(what: str, value: object, naming: str) -> str:
+    """``value`` (the argument ``what``) checked to be a name in the run's records: non-empty text of printable characters
+    (a Choice's label; an agent's name, RunResult.agent: None, 5 and 'x\\ny' were taken, T39-B04)."""
+    if not isinstance(value, str) or not value.strip() or not value.isprintable():
+        raise NeurohoverError(f"{what}={brief(value)} is not allowed: give a non-empty text (one line, printable) naming {naming}")
+    return value
+
+
+def check_agent_settings(what: str, value: object, kind: type) -> None:
+    """An agent's constructor argument ``what`` checked to be settings of class ``kind``: None, 'x' or another class's
+    settings were stored, then an AttributeError at the first episode that read them (T39-B02)."""
+    if not isinstance(value, kind):
+        raise NeurohoverError(f"{what}={brief(value)} is not allowed: give a {kind.__name__} ({kind.__name__}() for its defaults)")
 
 
 def _check_count(what: str, value: object, least: int) -> int:
@@ -175,6 +194,14 @@ def check_agent_policies(what: str, value: object, exactly: int | None = None) -
 _CHECKED: set = set()  # the wrapped methods (a subclass's own method is wrapped once)
 
 
+def _bound(method, agent):
+    """``method`` (a class's own start, choose or update as defined: a function, a staticmethod, a classmethod, a property,
+    another callable) as plain Python's ``agent.method`` gives it: through its descriptor. Called raw, a staticmethod got
+    the agent too and a classmethod was no callable (T39-B01)."""
+    get = getattr(type(method), "__get__", None)
+    return method if get is None else get(method, agent, type(agent))
+
+
 def _checked_start(start):
     @functools.wraps(start)
     def checked(self, family, rng):
@@ -183,7 +210,7 @@ def _checked_start(start):
         if not isinstance(rng, np.random.Generator):
             raise NeurohoverError(f"rng={brief(rng)} is not allowed: give a numpy Generator (np.random.default_rng(seed))")
         self._asked_record = False
-        return start(self, family, rng)
+        return _bound(start, self)(family, rng)
 
     return checked
 
@@ -191,7 +218,7 @@ def _checked_start(start):
 def _checked_choose(choose):
     @functools.wraps(choose)
     def checked(self, episode):
-        choice = choose(self, _check_count("episode", episode, 0))
+        choice = _bound(choose, self)(_check_count("episode", episode, 0))
         if not isinstance(choice, Choice):
             raise NeurohoverError(f"agent {self.name!r} chose {brief(choice)} for episode {episode}: its choose must return a Choice")
         self._asked_record = choice.record
@@ -207,7 +234,7 @@ def _checked_update(update):
             raise NeurohoverError(f"outcome={brief(outcome)} is not allowed: give an EpisodeOutcome")
         if getattr(self, "_asked_record", False) and outcome.flight_data is None:  # the incremental agent's bare AssertionError
             raise NeurohoverError(f"outcome of episode {outcome.episode} has no flight data, but agent {self.name!r} chose to record it: give its FlightData")
-        return update(self, outcome)
+        return _bound(update, self)(outcome)
 
     return checked
 
@@ -238,6 +265,12 @@ class Agent:
     def update(self, outcome: EpisodeOutcome) -> None:  # abstract
         raise NeurohoverError(_unimplemented(self, "update"))
 
+    def check_arguments(self) -> None:
+        """Refuse the agent's construction arguments (its policies, settings and counts, as its attributes hold them) with
+        a NeurohoverError naming the bad one: its constructor calls it, and :func:`run_test` again before the run starts,
+        so one changed after construction (``agent.settings = None``, ``hybrid.safe = []``) is refused as the constructor
+        refuses it (T39-B02). An agent with arguments of its own overrides it."""
+
 
 def _unimplemented(agent: Agent, method: str) -> str:
     """The message for an agent whose class leaves ``method`` to the base class (T35-B02)."""
@@ -247,11 +280,44 @@ def _unimplemented(agent: Agent, method: str) -> str:
     )
 
 
+#: How run_test calls each method of an agent (T39-B01: a keyword-only episode was Python's bare TypeError).
+_CALLS = {"start": ("start(family, rng)", 2), "choose": ("choose(episode)", 1), "update": ("update(outcome)", 1)}
+
+
+def _signature_problem(agent: Agent, method: str) -> str:
+    """Why run_test cannot call the agent's ``method`` as plain Python would (an instance's attribute that is no callable,
+    or a function whose signature cannot take run_test's arguments), or ''."""
+    calls, n = _CALLS[method]
+    what = f"agent class {type(agent).__name__}'s {method}"
+    allowed = f"run_test calls agent.{calls}; give a method {method}(self, {calls[len(method) + 1 :]} (a staticmethod or classmethod called so is fine)"
+    if method in vars(agent):  # set on the agent itself: Python calls it as it is
+        given = vars(agent)[method]
+        return "" if callable(given) else f"agent {agent.name!r}'s {method}={brief(given)} is not allowed: {allowed}"
+    own = inspect.getattr_static(type(agent), method)
+    raw = getattr(own, "__wrapped__", own) if own in _CHECKED else own
+    if not isinstance(raw, (FunctionType, staticmethod, classmethod)):  # a property or a callable object: read when called
+        return ""
+    try:
+        signature = inspect.signature(_bound(raw, agent))
+    except (TypeError, ValueError):  # no signature to read: its call will say
+        return ""
+    try:
+        signature.bind(*(None,) * n)
+    except TypeError:
+        return f"{what} of signature {brief(str(signature))} is not allowed: {allowed}"
+    return ""
+
+
 def check_agent_methods(agent: Agent) -> None:
-    """Refuse an agent whose class leaves choose or update to the base class, before any episode flies (T35-B02)."""
+    """Refuse an agent whose class leaves choose or update to the base class (T35-B02), or whose start, choose or update
+    run_test cannot call (T39-B01), before any episode flies."""
     for method in ("choose", "update"):
         if getattr(getattr(agent, method, None), "__func__", None) is Agent.__dict__[method]:
             raise NeurohoverError(_unimplemented(agent, method))
+    for method in _CALLS:
+        problem = _signature_problem(agent, method)
+        if problem:
+            raise NeurohoverError(problem)
 
 
 Agent.start = _checked_start(Agent.start)  # type: ignore[method-assign]  # agents that keep the base start are checked too
@@ -340,12 +406,21 @@ def _check_run(agent, family, mdp, episodes, seed, n_steps) -> tuple[MDP, int, i
     (:func:`_flown_mdp`), the seed, episodes and n_steps (Python ints: np.int8(127) + 1 overflowed, T31-B02)."""
     if not isinstance(agent, Agent):
         raise NeurohoverError(f"agent={agent!r:.80} is not allowed: give an Agent (neurohover.agents.registry.make_agent(name, family))")
+    check_name_text("agent name", agent.name, "the agent in the run's records")  # RunResult.agent (T39-B04)
     check_agent_methods(agent)
+    try:
+        agent.check_arguments()  # its arguments as its constructor checks them: changed after construction (T39-B02)
+    except NeurohoverError as err:
+        raise NeurohoverError(f"agent {agent.name!r}: {err}") from None
     if not isinstance(family, TaskFamily):
         raise NeurohoverError(f"family={family!r:.80} is not allowed: give a TaskFamily (neurohover.get_task_family(name))")
     if not isinstance(mdp, MDP):
         raise NeurohoverError(f"mdp={mdp!r:.80} is not allowed: give an MDP (family.mdp('test:3'), for example)")
     made = agent.made_for
+    if made is not None and not (isinstance(made, tuple) and len(made) == 2 and isinstance(made[0], str)):  # [] was a TypeError (T39-B02)
+        raise NeurohoverError(
+            f"agent {agent.name!r}'s made_for={brief(made)} is not allowed: give None (an agent built by hand) or the (family name, sigma) make_agent sets"
+        )
     if made is not None and made != (family.name, family.sigma):  # GHH-08's policies flew FGHH without a word (tenth trial)
         raise NeurohoverError(
             f"agent {agent.name!r} was made for {_family_label(*made)}, but the run's family is {_family_label(family.name, family.sigma)}: "

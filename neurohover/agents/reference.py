@@ -25,8 +25,11 @@ class GenericAgent(Agent):
     name = "generic"
 
     def __init__(self, generic: Policy) -> None:
-        check_agent_policy("generic", generic)
         self.generic = generic
+        self.check_arguments()
+
+    def check_arguments(self) -> None:
+        check_agent_policy("generic", self.generic)
 
     def choose(self, episode: int) -> Choice:
         return Choice(self.generic, "generic", final=True)

@@ -33,7 +33,7 @@ from ..policies import Policy, baseline_policy
 from .hybrid import HybridAgent
 from .model_based import ModelEvolution
 from .model_free import ModelFreeAgent
-from .protocol import Agent, Choice, EpisodeOutcome
+from .protocol import Agent, Choice, EpisodeOutcome, check_agent_settings
 from .spec import AgentOptions, AgentPolicies, AgentSettings, AgentSpec
 
 #: The most trials of each specialised policy: a run's episodes (1,000,000 at most) cannot hold more (10**13 was accepted).
@@ -118,9 +118,13 @@ class RiskModelFreeAgent(ModelFreeAgent):
     name = "model-free-risk"
 
     def __init__(self, specialised: Sequence[Policy], risk: RiskSettings = RiskSettings()) -> None:
+        self.risk = risk  # before the constructor's check_arguments
         super().__init__(specialised)
-        self.risk = risk
         self.trials: list[list[float]] = [[] for _ in self.specialised]
+
+    def check_arguments(self) -> None:
+        super().check_arguments()
+        check_agent_settings("risk", self.risk, RiskSettings)
 
     def start(self, family, rng: np.random.Generator) -> None:
         super().start(family, rng)
@@ -145,8 +149,12 @@ class RiskHybridAgent(HybridAgent):
     """The hybrid agent (authors' re-ranking) ranking its candidates by a risk score instead of the mean."""
 
     def __init__(self, safe, generic, fallback, settings: ModelEvolution = ModelEvolution(), name: str = "hybrid-risk", risk: RiskSettings = RiskSettings()):
+        self.risk = risk  # before the constructor's check_arguments
         super().__init__(safe, generic, fallback, settings, name=name)
-        self.risk = risk
+
+    def check_arguments(self) -> None:
+        super().check_arguments()
+        check_agent_settings("risk", self.risk, RiskSettings)
 
     @property
     def scores(self) -> list[float]:
