@@ -33,6 +33,10 @@ if running_as_command():
     for signum in stop_signals():  # from the first import on, SIGTERM ends the command as Ctrl-C does (fourth trial); SIGHUP too (T32-A03)
         if signum == signal.SIGTERM or signal.getsignal(signum) != signal.SIG_IGN:  # nohup's ignored SIGHUP stays ignored
             signal.signal(signum, raise_terminated)
+    if sys.flags.warn_default_encoding:  # -W error::EncodingWarning made numba's import (open() of /proc/cpuinfo) a
+        import warnings  # traceback in every command (T39-A02): the libraries' own opens are theirs; ours name UTF-8
+
+        warnings.filterwarnings("ignore", category=EncodingWarning, module=r"(?!neurohover(\.|$))")
 
 from .errors import NeurohoverError  # noqa: E402
 

@@ -185,7 +185,7 @@ def main(argv: list[str] | None = None) -> int:
     report = gpu_benchmarks(quick=args.quick)
     print("\n".join(format_gpu(report)))
     if args.json:
-        with open(args.json, "w") as f:
+        with open(args.json, "w", encoding="utf-8") as f:
             json.dump(report, f, indent=2)
     return 0
 

@@ -540,7 +540,7 @@ def _run_order(key: str) -> tuple[int, int]:
 def _write_episodes(path: Path, results: Sequence, n_steps: int) -> None:
     from .paths import writing
 
-    with writing(path, "episodes file") as partial, open(partial, "w", newline="") as f:  # whole or not at all (a full disk: eighth trial)
+    with writing(path, "episodes file") as partial, open(partial, "w", newline="", encoding="utf-8") as f:  # whole or not at all (a full disk: eighth trial)
         writer = csv.writer(f)
         writer.writerow(CSV_COLUMNS)
         for run, result in enumerate(results):

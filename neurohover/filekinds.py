@@ -29,6 +29,8 @@ __all__ = [
     "POLICY_SET_KIND",
     "RUN_FILE_ENDS",
     "SQLITE_HEADER",
+    "SQLITE_SIDE_ENDS",
+    "SQLITE_SIDE_FILES",
     "STORE_ENDS",
     "UTF8_BOM",
     "fitting_name",
@@ -37,6 +39,7 @@ __all__ = [
     "output_name",
     "refuse_policy_set",
     "refuse_long_store_name",
+    "refuse_sqlite_side_files",
     "refuse_sqlite_name",
     "refuse_run_file_name",
     "refuse_suffix",
@@ -164,6 +167,10 @@ def fitting_name(name: str, limit: int, room: int = 0) -> str:
 #: What SQLite and the store's writer lock add to a results store's name for the files they write beside it
 #: (``STORE-journal`` the longest, then ``STORE.lock``).
 STORE_ENDS = ("-journal", ".lock")
+#: The files SQLite keeps beside a store X under X's name and these ends, and the bytes each of its own starts with (a
+#: rollback journal's header may be zeroed; -shm is WAL mode's, which neurohover's stores never enter).
+SQLITE_SIDE_FILES = {"-journal": (b"\xd9\xd5\x05\xf9\x20\xa1\x63\xd7", bytes(8)), "-wal": (b"\x37\x7f\x06\x82", b"\x37\x7f\x06\x83")}
+SQLITE_SIDE_ENDS = (*SQLITE_SIDE_FILES, "-shm")
 
 
 def refuse_sqlite_name(path: object, option: str) -> None:
@@ -174,6 +181,13 @@ def refuse_sqlite_name(path: object, option: str) -> None:
     meant: given as ``./file:x``, it is that file, and so is a Path object (pathlib has no URIs, and drops the './':
     compete's OUT/results.sqlite under an --out 'file:d' is d's file). What is no path is
     :func:`~neurohover.paths.checked_path`'s."""
+    named = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None
+    if isinstance(named, str) and named.endswith(SQLITE_SIDE_ENDS):  # SQLite deleted it as X opened (T39-A01)
+        end = next(end for end in SQLITE_SIDE_ENDS if named.endswith(end))
+        raise NeurohoverError(
+            f"{option} {brief(named)} is not allowed: SQLite keeps the {end} file of a store {brief(named[: -len(end)])} under that name, "
+            f"and deletes it as that store opens; give a name not ending {', '.join(SQLITE_SIDE_ENDS)}"
+        )
     if not isinstance(path, str):
         return
     text = path
@@ -181,6 +195,33 @@ def refuse_sqlite_name(path: object, option: str) -> None:
         raise NeurohoverError(f"{option} {text!r} is not allowed: it is SQLite's in-memory database, lost when the run ends; give a file path")
     if text[:5].lower() == "file:":
         raise NeurohoverError(f"{option} {brief(text)} looks like a SQLite URI: give a file path ({brief('./' + text)} for a file of that name)")
+
+
+def refuse_sqlite_side_files(store: Path, given: object) -> None:
+    """Refuse to open the results store ``store`` (``given``) where a file beside it under a name SQLite keeps for it
+    (:data:`SQLITE_SIDE_FILES`) is not SQLite's: as it opened X, SQLite deleted X-journal, another store or a policy
+    file so named, without a word (T39-A01); a directory there was the OS's bare "Is a directory" (T39-A03). An empty
+    one, or one that starts as SQLite's own do, is SQLite's to roll back or remove."""
+    for end, heads in SQLITE_SIDE_FILES.items():
+        side = store.with_name(store.name + end)
+        where = f"results store {brief(os.fspath(given)) if isinstance(given, (str, os.PathLike)) else brief(given)}: {brief(str(side))}"
+        try:
+            is_dir = side.is_dir()
+        except OSError:  # a name too long for one beside a store that exists: read only (T31-A03)
+            continue
+        if is_dir:
+            raise NeurohoverError(f"{where} is a directory where SQLite keeps the store's {end} file: remove it, or give the store another name")
+        try:
+            with open(side, "rb") as f:
+                head = f.read(len(heads[0]))
+        except OSError:  # none there (or unreadable: SQLite says so)
+            continue
+        if head and head not in heads:
+            held = held_kind(side) or "a file of its own"
+            raise NeurohoverError(
+                f"{where} is {held}, not SQLite's {end} file of the store, and SQLite would delete it as the store opens: "
+                "move it away, or give the store another name"
+            )
 
 
 def refuse_long_store_name(path: object, option: str) -> None:

@@ -285,7 +285,7 @@ def _stdout_or_nothing() -> Iterator[None]:
     if sys.stdout is not None:
         yield
         return
-    with open(os.devnull, "w") as nothing:
+    with open(os.devnull, "w", encoding="utf-8") as nothing:
         sys.stdout = nothing
         try:
             yield

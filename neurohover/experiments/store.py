@@ -27,7 +27,6 @@ Readers (``results``, ``report``) take no lock.
 
 from __future__ import annotations
 
-import contextlib
 import json
 import os
 import socket
@@ -39,8 +38,8 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import NeurohoverError, brief, check_flag, finite_real
-from ..filekinds import SQLITE_HEADER, refuse_long_store_name, refuse_sqlite_name
-from ..paths import JSONError, WriterLock, refuse_dangling_link, strict_json
+from ..filekinds import refuse_long_store_name, refuse_sqlite_name
+from ..paths import JSONError, WriterLock, strict_json
 from .store_checks import (
     HELD_SQL,
     SESSION_STATUSES,
@@ -49,6 +48,7 @@ from .store_checks import (
     bad_session,
     check_executor,
     check_experiment,
+    check_store_file,
     check_text,
     config_differs,
     config_problem,
@@ -106,18 +106,7 @@ class Store:
         self.path = checked_path(path, "results store", "results store's file path", file=True)  # None, 3, NUL, too long, 'x/' (T32-B08)
         if create:  # its -journal too (a reader writes none; T31-A03)
             refuse_long_store_name(path, "results store")
-        if not self.path.exists() and not create:
-            raise NeurohoverError(f"results store {str(self.path)!r} does not exist")
-        if self.path.exists() and self.path.is_dir():
-            raise NeurohoverError(f"results store {str(self.path)!r} is a directory; give a file name")
-        if self.path.exists() and not self.path.is_file():  # a device was taken for a new store, and deleted (fifth trial)
-            raise NeurohoverError(f"results store {str(self.path)!r} is not a regular file (a device, pipe or socket); give a file name")
-        if not create and self.path.stat().st_size == 0:  # read, it was given the schema: a refused command changed it (seventh trial)
-            raise NeurohoverError(f"results store {str(self.path)!r} is empty (0 bytes): it holds no experiment yet")
-        with contextlib.suppress(OSError), open(self.path, "rb") as f:  # missing or unreadable: SQLite says so below
-            if f.read(len(SQLITE_HEADER)) not in (b"", SQLITE_HEADER):  # 1 byte: SQLite took it as empty (T31-B01)
-                raise NeurohoverError(f"{str(self.path)!r} is not a neurohover results store (it does not start with SQLite's header {SQLITE_HEADER!r})")
-        refuse_dangling_link(self.path, "results store", path)  # SQLite's "unable to open database file" (T38-B07), as --store says
+        check_store_file(self.path, path, create)  # what SQLite would open, or delete beside it, before it does
         make_dirs(self.path.parent, "results store", str(path))  # a file as its parent was pathlib's FileExistsError (fifteenth trial, T15-10)
         self._lock = WriterLock(self.lock_path)
         new = not self.path.exists() or self.path.stat().st_size == 0

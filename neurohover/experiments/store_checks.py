@@ -15,8 +15,9 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import NeurohoverError, brief, finite_real, refuse_non_text_keys, whole_number
+from ..filekinds import SQLITE_HEADER, refuse_sqlite_side_files
 from ..locks import WriterLock, hold_file
-from ..paths import json_text, strict_json
+from ..paths import json_text, refuse_dangling_link, strict_json
 from .config import ExperimentConfig, check_name, check_scale
 from .result_checks import params_problem
 from .results import result_from_dict, result_type
@@ -393,3 +394,22 @@ def config_differs(store: str, name: str, scale: str, held: str, stored: Any, co
         f"{head}, so the results would not be comparable. Use another --store file, restore the old config, {update}, or with --fresh "
         f"to discard every stored result of {name!r} ({scale})"
     )
+
+
+def check_store_file(path: Path, given: str | Path, create: bool) -> None:
+    """Refuse a results store ``path`` (``given``) that :class:`~neurohover.experiments.Store` cannot open as one, each
+    by what it is: missing where it is read, a directory, a device, empty where read, a file of another kind, a link to
+    nowhere, or beside a file SQLite would take for its journal and delete (:func:`~neurohover.filekinds.refuse_sqlite_side_files`)."""
+    if not path.exists() and not create:
+        raise NeurohoverError(f"results store {str(path)!r} does not exist")
+    if path.exists() and path.is_dir():
+        raise NeurohoverError(f"results store {str(path)!r} is a directory; give a file name")
+    if path.exists() and not path.is_file():  # a device was taken for a new store, and deleted (fifth trial)
+        raise NeurohoverError(f"results store {str(path)!r} is not a regular file (a device, pipe or socket); give a file name")
+    if not create and path.stat().st_size == 0:  # read, it was given the schema: a refused command changed it (seventh trial)
+        raise NeurohoverError(f"results store {str(path)!r} is empty (0 bytes): it holds no experiment yet")
+    with contextlib.suppress(OSError), open(path, "rb") as f:  # missing or unreadable: SQLite says so
+        if f.read(len(SQLITE_HEADER)) not in (b"", SQLITE_HEADER):  # 1 byte: SQLite took it as empty (T31-B01)
+            raise NeurohoverError(f"{str(path)!r} is not a neurohover results store (it does not start with SQLite's header {SQLITE_HEADER!r})")
+    refuse_dangling_link(path, "results store", given)  # SQLite's "unable to open database file" (T38-B07), as --store says
+    refuse_sqlite_side_files(path, given)  # X-journal, another store so named, deleted as X opened (T39-A01, T39-A03)
