@@ -211,6 +211,6 @@ def test_a11_only_runs_the_group_it_names(tmp_path: Path, cli: CliRun) -> None:
     )
     config = _config(tmp_path, text)
     rc, out, err = cli("reproduce", str(config), "--store", str(tmp_path / "s.sqlite"), "--only", "run/base/*/rep0", "--no-progress")
-    assert rc == 0 and "ran 1 units, 0 already in the store, 1/2 done" in out, (out, err)
+    assert rc == 0 and "ran 1 unit, 0 already in the store, 1/2 done" in out, (out, err)
     rc, _, err = cli("reproduce", str(config), "--store", str(tmp_path / "s.sqlite"), "--only", "run/*", "--no-progress")
     assert rc == 2 and "matches no unit ('*' matches within one part of a key, not across '/': give '**' to cross parts)" in err, err

@@ -158,7 +158,7 @@ def test_reproduce_with_progress_runs_with_standard_error_closed(cli, tmp_path: 
     """It died in tqdm (AttributeError), status 1 and no word, before any unit ran."""
     monkeypatch.setattr(sys, "stderr", None)  # what Python makes of `2>&-`
     rc, stdout, _ = cli("reproduce", str(tiny_config), "--store", str(tmp_path / "s.sqlite"), "--progress")
-    assert rc == 0 and "tr1 (quick): finished; ran 1 units" in stdout, stdout
+    assert rc == 0 and "tr1 (quick): finished; ran 1 unit," in stdout, stdout
 
 
 def test_a_bar_asked_for_in_a_process_whose_standard_error_is_closed_is_not_drawn() -> None:

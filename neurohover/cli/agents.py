@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 from ..errors import NeurohoverError
 from ..evaluate import DEVICES
@@ -117,7 +118,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
         finished = getattr(stop, FINISHED_RUNS, None)  # None: stopped before or after the runs, no file to name
         if finished:
             runs = "its 1 finished run is" if finished == 1 else f"its {finished} finished runs are"
-            said = f"{runs} in {printable(args.out)}/episodes.csv and the results store; run the same command again to resume"
+            said = f"{runs} in {printable(Path(args.out) / 'episodes.csv')} and the results store; run the same command again to resume"
         elif finished == 0:  # it named an episodes.csv that was never written (T26-A08)
             said = "no run had finished; run the same command again to start"
         else:
@@ -129,7 +130,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
         f"{summary['agent']:<18} {summary['runs']:>5} {summary['mean_cumulative_return']:>17.5g} {summary['sd_cumulative_return']:>12.4g} "
         f"{summary['crash_rate_runs']:>11.1%} {summary['mean_return_after_learning']:>25.5g}"
     )
-    out = printable(args.out)  # a newline or U+202E in --out split or reversed the line (fourteenth trial, T14-24)
+    out = printable(Path(args.out))  # a newline or U+202E in --out split or reversed the line (fourteenth trial, T14-24); 'k/' as 'k'
     print(f"results: {out}/episodes.csv, {out}/summary.json, {out}/cumulative.png; store: {printable(summary['store'])}")
     return 0
 

@@ -41,7 +41,7 @@ class RunSummary:
 
     def line(self) -> str:
         text = (
-            f"{self.name} ({self.scale}): {self.status}; ran {self.units_run} units, {self.units_before} already in "
+            f"{self.name} ({self.scale}): {self.status}; ran {self.units_run} unit{'' if self.units_run == 1 else 's'}, {self.units_before} already in "
             f"the store, {self.units_done}/{self.units_total} done, {self.wall_seconds:.1f} s on {self.cores} cores ({self.executor})"
         )
         if self.failed:
