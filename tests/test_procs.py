@@ -398,7 +398,7 @@ def test_a_store_that_a_live_run_writes_is_refused_and_a_killed_run_blocks_nothi
         assert lock.read_text().split()[0] == str(holder.pid)
         rc, out, err = cli(*tiny, "--fresh")
         assert rc == 0, err[-2000:]
-        assert "ran 1 units, 0 already in the store" in out
+        assert "ran 1 unit, 0 already in the store" in out
     finally:
         _end_group(holder)
 
