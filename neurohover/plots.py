@@ -369,23 +369,17 @@ def compete_figure(results: Sequence[CompeteResult], title: str = "") -> Figure:
     axes = fig.subplots(1, 2)
     labels = [r.label for r in results]
     differ = _differing_conditions(results)
+    curves: list[tuple[str, np.ndarray]] = []
     for r in results:
         name = r.label if labels.count(r.label) == 1 else f"{r.label} [{r.path.name}]"  # same agent twice
         label = f"{printable(name)}: {r.returns.shape[0]} runs, {r.crashes} crashes"  # names that are no UTF-8
         if differ:  # 50-step drifting episodes beside 6000-step ones were overlaid without a word (eleventh trial, S4)
             flown = ", ".join(f"{key} {_condition_text(r.conditions.get(key, '?'))}" for key in differ)
             label += "\n" + textwrap.fill(printable(flown), 70)  # lines of their own: one long line ran off the figure's edge
-        error = r.cumulative_error
-        episodes = np.arange(1, error.size + 1)
-        for ax in axes:
-            ax.plot(episodes, error, label=label)
-    axes[0].set_ylabel("cumulative error (-cumulative reward)")
-    axes[1].set_yscale("log")
-    axes[1].set_ylabel("cumulative error (log scale)")
+        curves.append((label, r.cumulative_error))
+    draw_cumulative(axes, curves)
     for ax in axes:
-        ax.set_xlabel("episode")
         ax.xaxis.set_major_locator(MaxNLocator(integer=True))
-        ax.grid(alpha=0.3)
     axes[0].legend(fontsize=8)
     if differ:
         heading += f" (flown under different {', '.join(differ)}: see the legend)"
@@ -413,6 +407,20 @@ def plot_compete(dirs: Sequence[str | Path], out: str | Path) -> tuple[Path, Fig
     return save_figure(fig, out), fig
 
 
+def draw_cumulative(axes, curves: list[tuple[str, np.ndarray]]) -> None:
+    """Each (label, cumulative error after each episode) on a linear and a log panel (the paper's Figs 4 and 7)."""
+    for label, error in curves:
+        episodes = np.arange(1, error.size + 1)
+        for ax in axes:
+            ax.plot(episodes, error, label=label)
+    axes[0].set_ylabel("cumulative error (-cumulative reward)")
+    axes[1].set_yscale("log")
+    axes[1].set_ylabel("cumulative error (log scale)")
+    for ax in axes:
+        ax.set_xlabel("episode")
+        ax.grid(alpha=0.3)
+
+
 def plot_cumulative(curves: dict[str, np.ndarray], path: Path, title: str) -> Path:
     """Mean cumulative error per episode of each agent, linear and log scale (paper Figs 4 and 7)."""
     # Object-oriented matplotlib (no pyplot): the caller's backend and pyplot figures stay as they are.
@@ -422,17 +430,8 @@ def plot_cumulative(curves: dict[str, np.ndarray], path: Path, title: str) -> Pa
     fig = Figure(figsize=(11, 4))
     FigureCanvasAgg(fig)
     axes = fig.subplots(1, 2)
-    for name, cumulative in curves.items():
-        error = -cumulative.mean(axis=0)
-        episodes = np.arange(1, error.size + 1)
-        for ax in axes:
-            ax.plot(episodes, error, label=name)
-    axes[0].set_ylabel("cumulative error (-cumulative reward)")
-    axes[1].set_yscale("log")
-    axes[1].set_ylabel("cumulative error (log scale)")
+    draw_cumulative(axes, [(name, -cumulative.mean(axis=0)) for name, cumulative in curves.items()])
     for ax in axes:
-        ax.set_xlabel("episode")
-        ax.grid(alpha=0.3)
         ax.legend()
     fig.suptitle(title)
     fig.tight_layout()

@@ -104,8 +104,9 @@ def test_the_scheduler_warnings_and_timers_stop_a_command_as_sigterm_does() -> N
         assert stop_words(caught.value) == ("terminated", 128 + signum)
 
 
-@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="real processes signalled, found in /proc")
-def test_evolve_stopped_by_a_schedulers_sigusr2_saves_its_checkpoint_and_says_so(tmp_path: Path) -> None:
+def assert_evolve_stops_on(tmp_path: Path, signum: int) -> None:
+    """A running evolve signalled ``signum`` (once its first checkpoint is written) ends as SIGTERM ends it: its line,
+    128 + the signal, its checkpoint, no lock or temporary file (trial 38's real-time signal too)."""
     from test_procs import _end_group, _start
 
     out = tmp_path / "e.json"
@@ -115,15 +116,20 @@ def test_evolve_stopped_by_a_schedulers_sigusr2_saves_its_checkpoint_and_says_so
         deadline = time.monotonic() + 120  # a safety net: its first generation checkpointed
         while time.monotonic() < deadline and proc.poll() is None and not (tmp_path / "e.json.checkpoint.json").exists():
             time.sleep(0.05)
-        os.kill(proc.pid, signal.SIGUSR2)
+        os.kill(proc.pid, signum)
         rc = proc.wait(timeout=60)
         err = (tmp_path / "stderr.txt").read_text()
-        assert rc == 128 + signal.SIGUSR2 and "Traceback" not in err, err[-2000:]
+        assert rc == 128 + signum and "Traceback" not in err, err[-2000:]
         assert err.strip().splitlines()[-1].startswith("neurohover evolve: terminated"), err[-2000:]
         left = sorted(p.name for p in tmp_path.iterdir() if p.name not in ("stdout.txt", "stderr.txt"))
         assert left == ["e.json.checkpoint.json"], left  # no lock, no temporary file
     finally:
         _end_group(proc)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="real processes signalled, found in /proc")
+def test_evolve_stopped_by_a_schedulers_sigusr2_saves_its_checkpoint_and_says_so(tmp_path: Path) -> None:
+    assert_evolve_stops_on(tmp_path, signal.SIGUSR2)
 
 
 def _dead_pid() -> int:

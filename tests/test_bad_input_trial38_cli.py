@@ -9,7 +9,6 @@ import os
 import shutil
 import signal
 import sys
-import time
 from pathlib import Path
 
 import pytest
@@ -33,24 +32,9 @@ def test_every_signal_that_ends_a_process_quietly_stops_a_command_as_sigterm_doe
 
 @pytest.mark.skipif(not LINUX, reason="real processes signalled, found in /proc")
 def test_evolve_stopped_by_a_real_time_signal_saves_its_checkpoint_and_says_so(tmp_path: Path) -> None:
-    from test_procs import _end_group, _start  # type: ignore[import-not-found]
+    from test_bad_input_trial35_cli import assert_evolve_stops_on  # type: ignore[import-not-found]
 
-    out, signum = tmp_path / "e.json", signal.SIGRTMIN + 1  # one with no name of its own
-    argv = ["evolve", "--task", "ghh08", "--mdp", "G", "--budget", "1000000", "--episode-steps", "200", "--checkpoint-every", "1"]
-    proc = _start(tmp_path, *argv, "--out", str(out))
-    try:
-        deadline = time.monotonic() + 120  # a safety net: its first generation checkpointed
-        while time.monotonic() < deadline and proc.poll() is None and not (tmp_path / "e.json.checkpoint.json").exists():
-            time.sleep(0.05)
-        os.kill(proc.pid, signum)
-        rc = proc.wait(timeout=60)
-        err = (tmp_path / "stderr.txt").read_text()
-        assert rc == 128 + signum and "Traceback" not in err, err[-2000:]
-        assert err.strip().splitlines()[-1].startswith("neurohover evolve: terminated"), err[-2000:]
-        left = sorted(p.name for p in tmp_path.iterdir() if p.name not in ("stdout.txt", "stderr.txt"))
-        assert left == ["e.json.checkpoint.json"], left  # no lock, no temporary file
-    finally:
-        _end_group(proc)
+    assert_evolve_stops_on(tmp_path, signal.SIGRTMIN + 1)  # one with no name of its own
 
 
 def test_a_policy_sets_other_files_are_left_alone_and_writers_say_so(cli, tmp_path: Path) -> None:
