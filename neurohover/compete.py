@@ -575,8 +575,8 @@ def check_against_store(folder: str | Path) -> None:
               "sensor": Sensor.from_dict(settings.get("sensor") or {}).to_dict(), "drift": Drift.from_dict(settings.get("drift") or {}).to_dict()}  # fmt: skip
     given = {**{key: summary.get(key, stored[key]) for key in ("sigma", "episode_steps", "seed")},
              "sensor": Sensor.from_dict(summary.get("sensor") or {}).to_dict(), "drift": Drift.from_dict(summary.get("drift") or {}).to_dict()}  # fmt: skip
-    differs = first_difference("", stored, given, "its store's").lstrip(".")
     if given != stored:  # the first differing key, a sensor's level (its dict cut at 60 characters read alike; T38-B06)
+        differs = first_difference("", stored, given, "its store's").lstrip(".")
         raise NeurohoverError(
             f"--compete {str(summary_path)!r} is not what its store {store!r} holds for {name} ({scale}): {differs} "
             "(an edit by hand, or the store run again with other settings?)"

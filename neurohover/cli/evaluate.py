@@ -134,21 +134,23 @@ def _files_read(args: argparse.Namespace) -> dict[str, str | Path | None]:
 ROWS_KIND, ROWS_ARE = "evaluate-agent rows (--json)", "evaluate-agent writes its rows as JSON"
 
 
-def _generic_sigma_note(family) -> str | None:
-    """Why the ``generic`` row is no generic of ``family``'s sigma, or None: the shipped FGHH generic was evolved over G at
-    the set's sigma. Flown with this note (an evaluation, not a competition), where compete refuses the set (T29-A08)."""
+def _generic_at_other_sigma(family) -> tuple[str, Policy] | None:
+    """Why the ``generic`` row is no generic of ``family``'s sigma, and the shipped generic it flies, or None: the
+    shipped FGHH generic was evolved over G at the set's sigma. Flown with this note (an evaluation, not a competition),
+    where compete refuses the set (T29-A08)."""
     if not family.generic_over_distribution or family.sigma is None:
         return None
     from ..integrations.flying import generic_sigma_problem
     from ..policysets import load_policy_set
 
-    built = generic_sigma_problem(family, load_policy_set(family.name).manifest.get("sigma"))  # make_agent's decision (T35-B07)
+    shipped = load_policy_set(family.name)
+    built = generic_sigma_problem(family, shipped.manifest.get("sigma"))  # make_agent's decision (T35-B07)
     if built is None:
         return None
     return (
         f"the generic row flies the shipped {family.name} generic, evolved for sigma = {built}, not {family.sigma} (the sigma of these MDPs): "
         "a reference only (compete refuses that set at this sigma)"
-    )
+    ), shipped.generic
 
 
 def cmd_evaluate_agent(args: argparse.Namespace) -> int:
@@ -156,7 +158,6 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     and the shipped generic policy on the same gusts, and print the paper's measures (return per episode, crashes)."""
     from ..integrations.flying import compare_agent
     from ..paths import output_file, writing
-    from ..policysets import load_policy_set
     from ..progress import progress_bar
 
     family = task_family_of(args)  # with --obs-noise / --obs-delay every policy flies through those sensors
@@ -185,11 +186,11 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     mdps = [family.mdp(f"{args.mdps}:{i}") for i in range(n)]
     # the agent's flight (a kernel policy flies in one call: no steps to count), on a terminal only
     quiet = True if isinstance(act, Policy) else None
-    note = _generic_sigma_note(family)
+    note, generic = _generic_at_other_sigma(family) or (None, None)
     with progress_bar(total=args.episode_steps, desc="agent's episodes", unit="step", disable=quiet, dynamic_ncols=True) as bar:
         rows = compare_agent(  # at another sigma the shipped generic flies as a reference, with the note below
             act, mdps, episodes=args.episodes, seed=args.seed, n_steps=args.episode_steps, obs_dtype=args.obs_dtype, on_step=lambda: bar.update(1),
-            generic=load_policy_set(family.name).generic if note is not None else None,
+            generic=generic,
         )  # fmt: skip
     print(f"{args.task} {family.set_name(args.mdps)} MDPs 0-{n - 1}, {args.episodes} episode(s) each of {args.episode_steps} steps, gusts of seed {args.seed}:")
     print(f"{'policy':<10} {'return/episode':>15} {'median over MDPs':>17} {'crashed':>12}")

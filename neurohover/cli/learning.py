@@ -50,11 +50,11 @@ def _target(args: argparse.Namespace):
     spec = args.mdp if args.mdp is not None else (MDP_FAMILY if family.generic_over_distribution else "zero")
     if explicit is None:
         refuse_sigma_on_zero(args, spec)
-    if explicit is None and spec == MDP_FAMILY:
-        return family, family, MDP_FAMILY
-    if spec == "sample" and explicit is None:  # one MDP drawn from G with the run's seed
-        explicit = family.sample(np.random.default_rng(np.random.SeedSequence(args.seed, spawn_key=(4,))), label=f"{family.name}/sample"), "sample"
-    target, desc = explicit or (family.mdp(spec), family.set_name(spec))
+        if spec == MDP_FAMILY:
+            return family, family, MDP_FAMILY
+        rng = np.random.default_rng(np.random.SeedSequence(args.seed, spawn_key=(4,)))  # "sample": one MDP from G, the run's seed
+        explicit = (family.sample(rng, label=f"{family.name}/sample"), "sample") if spec == "sample" else (family.mdp(spec), family.set_name(spec))
+    target, desc = explicit
     problem = record_problem({"task": family.name, "mdp": desc, "target": target.label, "mdp_params": target.to_dict()})
     if problem:  # refused before flying: after the whole budget, the run's work was lost (T37-A01)
         raise NeurohoverError(f"policy file {str(args.out)!r}: {problem} (load_policy would refuse the file; nothing is flown)")

@@ -132,8 +132,8 @@ def check_genomes(a: np.ndarray | None, size: int, name: str, rows: int | None =
     if bad.size:
         more = f", and {bad.size - 1} more" if bad.size > 1 else ""
         raise NeurohoverError(f"{name} holds a gene that is not a finite number: {where(int(bad[0]))}{more}; allowed finite numbers")
-    big = np.flatnonzero(np.abs(a) > MAX_GENE)
-    if genes and big.size:  # (not Adam's moments, which are no genes)
+    big = np.flatnonzero(np.abs(a) > MAX_GENE) if genes else np.empty(0, dtype=np.intp)  # not Adam's moments, which are no genes
+    if big.size:
         raise NeurohoverError(
             f"{name} holds a gene that is out of range: {where(int(big[0]))}; allowed numbers in [-{MAX_GENE:g}, {MAX_GENE:g}] (a policy's genes)"
         )

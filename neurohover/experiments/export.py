@@ -21,7 +21,7 @@ from ..errors import NeurohoverError, brief, first_difference
 from .config import ExperimentConfig
 from .external import external_digest
 from .keys import UnitKey
-from .plans import Plan, plan, run_keys, source_experiments
+from .plans import Plan, plan, run_keys, source_results
 from .result_checks import params_problem
 from .results import UnitResult, check_run_lengths, flat_cells, result_from_dict
 from .store import Store
@@ -154,7 +154,7 @@ def _check_planned(store: Store, config: ExperimentConfig, units: list[dict]) ->
     checked = [u for u in units if u["kind"] != "diagnostic"]
     if not checked or not _replannable(config):
         return None
-    sources = {n: store.results(n, config.scale, missing_ok=True) for n in source_experiments(config)}
+    sources = source_results(config, store)
     made = plan(config, {u["key"]: u["result"] for u in units}, sources)
     planned = {u.key: u for u in made.units}
     known = set(planned) | set(run_keys(config))

@@ -189,6 +189,12 @@ def source_experiments(cfg: ExperimentConfig) -> list[str]:
     return list(dict.fromkeys(names))
 
 
+def source_results(cfg: ExperimentConfig, store) -> dict[str, dict]:
+    """name -> the stored results of each of :func:`source_experiments` at the config's scale (none yet: empty), what
+    :func:`plan` takes as its sources."""
+    return {name: store.results(name, cfg.scale, missing_ok=True) for name in source_experiments(cfg)}
+
+
 def _source_champions(source: str, scale: str, results: dict) -> tuple[list[tuple[str, dict]] | None, str]:
     """The final champions ``[(key, policy)]`` of ``source`` (``EXPERIMENT/VARIANT`` or
     ``EXPERIMENT/best-race``: the race variant whose final champions' fitness estimates have the

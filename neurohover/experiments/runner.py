@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from ..errors import NeurohoverError, brief, check_flag
 from .config import POLICY_SOURCES, ExperimentConfig, check_own_name, check_paper_table
 from .keys import key_matches
-from .plans import Plan, plan, run_keys, source_experiments
+from .plans import Plan, plan, run_keys, source_results
 from .store import Store
 
 
@@ -85,7 +85,7 @@ def unchanged_units(config: ExperimentConfig, store: Store) -> set[str]:
     """
     _refuse_other_version(config, store, ExperimentConfig.from_dict(store.config(config.name, config.scale)))
     stored = {u["key"]: u for u in store.units(config.name, config.scale)}
-    sources = {name: store.results(name, config.scale, missing_ok=True) for name in source_experiments(config)}
+    sources = source_results(config, store)
     kept: dict[str, dict] = {}
     while True:
         same = [
@@ -207,7 +207,7 @@ def _refuse_unmatched(config: ExperimentConfig, store: Store, held: str | None, 
     """Refuse an ``only`` pattern that matches no unit of a plan complete now (or of the test runs to come). A plan that
     waits for its own policy units is completed with stand-ins for them (:func:`_with_policy_stand_ins`): table4's
     'zzz*' was refused only after its generic policy was evolved and stored (sixteenth trial, T16-8)."""
-    sources = {n: store.results(n, config.scale, missing_ok=True) for n in source_experiments(config)}
+    sources = source_results(config, store)
     results = store.results(config.name, config.scale) if held == config.hash else {}
     later = run_keys(config)  # a test-runs plan lists its runs once their policies are stored: their keys, now
     first = plan(config, results, sources) if later else _with_policy_stand_ins(config, results, sources)
@@ -266,7 +266,7 @@ def reproduce(
         checked = None  # fewer units now: read again
     store.begin(config.name, config.scale, config.hash, config.to_dict(), fresh=fresh)
     results, made = checked if checked is not None else _checked_results(config, store, config.hash)  # read and planned once
-    sources = {name: store.results(name, config.scale, missing_ok=True) for name in source_experiments(config)}
+    sources = source_results(config, store)
     first_round: Plan | None = made if made is not None else plan(config, results, sources)
     summary = RunSummary(config.name, config.scale, executor.name, executor.cores, units_before=len(results))
     session: int | None = store.start_session(config.name, config.scale, config.hash, executor.name, summary.cores, len(results))
