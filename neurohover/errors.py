@@ -218,6 +218,23 @@ def redeliver_ignored_stop(unraisable: Any) -> None:
     sys.__unraisablehook__(unraisable)
 
 
+def refused_signature(fn: Any, n: int) -> str | None:
+    """The signature of ``fn``, as text, where it cannot be called with ``n`` positional arguments; '' where it can; None
+    where it has none to read (a builtin's: its call says). The one arity check of a user's callable (an act given to
+    evaluate_callable, an agent's choose; T37-B11, T39-B01)."""
+    import inspect
+
+    try:
+        signature = inspect.signature(fn)
+    except (TypeError, ValueError):
+        return None
+    try:
+        signature.bind(*(None,) * n)
+    except TypeError:
+        return str(signature)
+    return ""
+
+
 def key_text(key: Any) -> str:
     """A table's key as a message names it: text as written (one of more than 60 characters shortened by :func:`brief`),
     any other key (b'pop_size', 1) as its repr."""

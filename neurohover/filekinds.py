@@ -202,9 +202,10 @@ def refuse_sqlite_side_files(store: Path, given: object) -> None:
     (:data:`SQLITE_SIDE_FILES`) is not SQLite's: as it opened X, SQLite deleted X-journal, another store or a policy
     file so named, without a word (T39-A01); a directory there was the OS's bare "Is a directory" (T39-A03). An empty
     one, or one that starts as SQLite's own do, is SQLite's to roll back or remove."""
+    named = f"results store {brief(os.fspath(given)) if isinstance(given, (str, os.PathLike)) else brief(given)}"
     for end, heads in SQLITE_SIDE_FILES.items():
         side = store.with_name(store.name + end)
-        where = f"results store {brief(os.fspath(given)) if isinstance(given, (str, os.PathLike)) else brief(given)}: {brief(str(side))}"
+        where = f"{named}: {brief(str(side))}"
         try:
             is_dir = side.is_dir()
         except OSError:  # a name too long for one beside a store that exists: read only (T31-A03)

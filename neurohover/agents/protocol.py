@@ -34,7 +34,7 @@ from types import FunctionType
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, whole_in
+from ..errors import NeurohoverError, brief, finite_real, refused_signature, whole_in
 from ..evaluate import MAX_EPISODES_PER_CALL, DangerousState, PolicyTable, evaluate_jobs
 from ..evolution.seeding import check_seed
 from ..flightdata import FlightData
@@ -297,15 +297,8 @@ def _signature_problem(agent: Agent, method: str) -> str:
     raw = getattr(own, "__wrapped__", own) if own in _CHECKED else own
     if not isinstance(raw, (FunctionType, staticmethod, classmethod)):  # a property or a callable object: read when called
         return ""
-    try:
-        signature = inspect.signature(_bound(raw, agent))
-    except (TypeError, ValueError):  # no signature to read: its call will say
-        return ""
-    try:
-        signature.bind(*(None,) * n)
-    except TypeError:
-        return f"{what} of signature {brief(str(signature))} is not allowed: {allowed}"
-    return ""
+    refused = refused_signature(_bound(raw, agent), n)  # None: no signature to read, its call will say
+    return f"{what} of signature {brief(refused)} is not allowed: {allowed}" if refused else ""
 
 
 def check_agent_methods(agent: Agent) -> None:

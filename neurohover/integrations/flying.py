@@ -19,7 +19,6 @@ the paper's policies are compared on the same episodes::
 from __future__ import annotations
 
 import functools
-import inspect
 import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, replace
@@ -29,7 +28,7 @@ import numpy as np
 
 from ..envs.arguments import check_obs_dtype, real_values
 from ..envs.vector import HoverVectorEnv
-from ..errors import NeurohoverError, brief, float64_of, whole_in
+from ..errors import NeurohoverError, brief, float64_of, refused_signature, whole_in
 from ..evaluate import Evaluation, check_first_episode
 from ..policies import Policy
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS
@@ -300,12 +299,7 @@ def _arity_problem(act: Any, indexed: bool, signature: str = "") -> str:
 def _check_arity(act: Any, indexed: bool) -> bool:
     """Refuse ``act`` where its signature cannot take the arguments ``indexed`` passes (T37-B11); whether it was checked
     (False: no signature to read, e.g. a builtin's)."""
-    try:
-        signature = inspect.signature(act)
-    except (TypeError, ValueError):
-        return False
-    try:
-        signature.bind(*((None, None) if indexed else (None,)))
-    except TypeError:
-        raise NeurohoverError(_arity_problem(act, indexed, str(signature))) from None
-    return True
+    refused = refused_signature(act, 2 if indexed else 1)
+    if refused:
+        raise NeurohoverError(_arity_problem(act, indexed, refused))
+    return refused is not None
