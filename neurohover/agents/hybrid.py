@@ -107,8 +107,7 @@ class HybridAgent(Agent):
         name: str = "hybrid",
         hybrid: HybridSettings = HybridSettings(),
     ) -> None:
-        check_agent_policies("safe", safe, exactly=2)
-        self.safe = list(safe)
+        self.safe = safe
         self.generic = generic
         self.fallback = fallback
         self.settings = settings
@@ -119,6 +118,7 @@ class HybridAgent(Agent):
 
     def check_arguments(self) -> None:
         check_agent_policies("safe", self.safe, exactly=2)
+        self.safe = list(self.safe)
         check_agent_policy("generic", self.generic)
         check_agent_policy("fallback", self.fallback)  # None after construction flew without a safeguard (T39-B03)
         check_agent_settings("settings", self.settings, ModelEvolution)

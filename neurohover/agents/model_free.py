@@ -24,13 +24,13 @@ class ModelFreeAgent(Agent):
     name = "model-free"
 
     def __init__(self, specialised: Sequence[Policy]) -> None:
-        check_agent_policies("specialised", specialised)
-        self.specialised = list(specialised)
+        self.specialised = specialised
         self.check_arguments()
         self.trial_returns = np.full(len(self.specialised), -np.inf)
 
     def check_arguments(self) -> None:
         check_agent_policies("specialised", self.specialised)
+        self.specialised = list(self.specialised)
 
     def start(self, family: TaskFamily, rng: np.random.Generator) -> None:
         self.trial_returns = np.full(len(self.specialised), -np.inf)
