@@ -4,6 +4,7 @@ each give one clear message (exit 2 / NeurohoverError), and the options SB3 docu
 
 from __future__ import annotations
 
+import os
 import pickle
 from pathlib import Path
 
@@ -160,7 +161,10 @@ def test_json_onto_any_file_the_agent_is_read_from_is_refused(tmp_path, model_zi
         (("--cleanrl", str(cleanrl)), cleanrl / "obs_rms.pkl", "--cleanrl (its obs_rms.pkl)"),
     ):
         before = read.read_bytes()
-        rc, _, err = cli(*BASE, *source, "--json", str(read))
+        link = tmp_path / f"rows-{read.name}.json"  # --json takes a JSON name only: one that is the file read
+        link.unlink(missing_ok=True)
+        os.link(read, link)  # a hard link: a JSON name, the very file (a symbolic link is refused by its target's name)
+        rc, _, err = cli(*BASE, *source, "--json", str(link))
         assert rc == 2 and f"is the file of {named}: give another path (writing it would destroy what is read)" in err, err
         assert read.read_bytes() == before
 

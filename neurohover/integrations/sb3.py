@@ -203,8 +203,8 @@ def _algorithm(algo: str):
 
 
 def _load(algorithm, path: Path):
-    """A saved model, or one clear error naming the file (not a zip, another algorithm's, damaged)."""
-    sb3_model_file(path)
+    """A saved model (its file checked by :func:`~.sb3_files.sb3_model_file`), or one clear error naming the file
+    (another algorithm's, damaged)."""
     try:
         return algorithm.load(path, device="cpu")
     except (zipfile.BadZipFile, KeyError, ValueError, RuntimeError, EOFError, AttributeError, TypeError, pickle.UnpicklingError) as err:
@@ -260,6 +260,7 @@ def sb3_policy(model_zip: str | Path, *, algo: str = "ppo", deterministic: bool 
     wrap it yourself if it learned behind a normaliser), ready for :func:`neurohover.integrations.flying.evaluate_callable`."""
     check_flag(deterministic, "deterministic", "the Gaussian's mean")  # 'no' was true
     path = checked_path(model_zip, "model_zip", "MODEL.zip file path")  # None, 5, b'x.zip' were pathlib's TypeError (thirteenth trial, F13)
+    check_algo(algo)  # the arguments in order: algo=['ppo'] beside an empty file was named by the file (T38-A05's order)
     sb3_model_file(path)  # before the algorithm's import
     return _policy_of(_load(_algorithm(algo), path), deterministic)
 
@@ -298,8 +299,8 @@ def rl_zoo_policy(run: str | Path, *, algo: str = "ppo", deterministic: bool = T
     :func:`neurohover.integrations.flying.evaluate_callable`.
     """
     check_flag(deterministic, "deterministic", "the Gaussian's mean")  # 'no' was true
-    algorithm = _algorithm(algo)
     model_zip, stats_file = rl_zoo_files(run, algo)
-    model = _load(algorithm, model_zip)
+    sb3_model_file(model_zip)  # before the algorithm's import
+    model = _load(_algorithm(algo), model_zip)
     stats = None if stats_file is None else _vecnormalize(stats_file, int(np.prod(model.observation_space.shape)))
     return _policy_of(model, deterministic, None if stats is None else stats.normalize_obs)
