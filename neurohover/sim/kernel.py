@@ -488,4 +488,5 @@ def rollout_batch(jobs, extras, out):
         rng = np.empty(4, dtype=np.uint64)
         srng = np.empty(4, dtype=np.uint64)
         scratch = np.empty(SENSOR_SCRATCH)
-        fly_job(j, rng, srng, scratch, jobs, extras, out)
+        # int64: the parfor body's index is uint64, its typing pass's int64, and each type compiled fly_job once more
+        fly_job(np.int64(j), rng, srng, scratch, jobs, extras, out)

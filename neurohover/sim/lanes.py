@@ -427,11 +427,13 @@ def fly_queue(jobs, out, stats, n_required, job_slot, parking, left, queue):
         stats[0] += 1
         packed = live > SCALAR_TAIL
         if packed:
-            B0[:] = B[: 13 * LANES]
+            for i in range(13 * LANES):  # a loop, not B0[:] = B[...]: numba's slice copy compiles a formatted error message (seconds)
+                B0[i] = B[i]
         if not (packed and substeps(B, W, n_sub, has_wind)):
             if packed:
                 stats[1] += 1
-                B[: 13 * LANES] = B0
+                for i in range(13 * LANES):
+                    B[i] = B0[i]
             _integrate_each(B, N, A, job, step, mdp_rows, job_mdp)
         observe_lanes(B)
         # Bookkeeping, scalar per lane: return, end of episode, refill.
