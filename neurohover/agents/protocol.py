@@ -19,8 +19,9 @@ Subclass :class:`Agent` and implement ``choose`` and ``update``::
 ``final=True`` promises the agent will choose the same policy for every remaining episode, which
 lets the harness fly the rest of the run in one parallel batch (same results, far faster).
 ``choose`` and ``update`` are called as plain Python calls ``agent.choose(episode)`` (a staticmethod or classmethod is
-fine); an agent with construction arguments (policies, settings, counts) checks them in ``check_arguments``, which its
-constructor calls and :func:`run_test` calls again before the run, so one changed after construction is refused too.
+fine; an ``async def`` or generator method is refused: its call would not run its body); an agent with construction
+arguments (policies, settings, counts) checks them in ``check_arguments``, which its constructor calls and
+:func:`run_test` calls again before the run, so one changed after construction is refused too.
 """
 
 from __future__ import annotations
@@ -292,13 +293,29 @@ def _signature_problem(agent: Agent, method: str) -> str:
     allowed = f"run_test calls agent.{calls}; give a method {method}(self, {calls[len(method) + 1 :]} (a staticmethod or classmethod called so is fine)"
     if method in vars(agent):  # set on the agent itself: Python calls it as it is
         given = vars(agent)[method]
-        return "" if callable(given) else f"agent {agent.name!r}'s {method}={brief(given)} is not allowed: {allowed}"
+        if not callable(given):
+            return f"agent {agent.name!r}'s {method}={brief(given)} is not allowed: {allowed}"
+        return _deferred_problem(f"agent {agent.name!r}'s {method}", given, allowed)
     own = inspect.getattr_static(type(agent), method)
     raw = getattr(own, "__wrapped__", own) if own in _CHECKED else own
     if not isinstance(raw, (FunctionType, staticmethod, classmethod)):  # a property or a callable object: read when called
         return ""
     refused = refused_signature(_bound(raw, agent), n)  # None: no signature to read, its call will say
-    return f"{what} of signature {brief(refused)} is not allowed: {allowed}" if refused else ""
+    return f"{what} of signature {brief(refused)} is not allowed: {allowed}" if refused else _deferred_problem(what, _bound(raw, agent), allowed)
+
+
+def _deferred_problem(what: str, fn: object, allowed: str) -> str:
+    """Why ``fn`` would not run when called: an ``async def`` or a generator function (``yield`` in its body) only makes
+    a coroutine or generator object, so an update's body never ran (T40-B04); or ''."""
+    kinds = (
+        (inspect.iscoroutinefunction, "an async def function", "a coroutine"),
+        (inspect.isasyncgenfunction, "an async generator function", "an async generator"),
+        (inspect.isgeneratorfunction, "a generator function (yield in its body)", "a generator"),
+    )
+    for test, kind, makes in kinds:
+        if test(fn):
+            return f"{what}, {kind}, is not allowed: its call only makes {makes} object, so its body never runs; {allowed}, a plain def"
+    return ""
 
 
 def check_agent_methods(agent: Agent) -> None:
