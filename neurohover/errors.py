@@ -181,6 +181,16 @@ def float_of(text: str) -> float:
     return value
 
 
+def check_name_text(what: str, value: object, naming: str, *, empty: bool = False) -> str:
+    """``value`` (the argument ``what``) checked to be a name in the run's records: text of printable characters, one line,
+    non-empty unless ``empty`` (a Choice's label, an agent's name: None, 5 and 'x\\ny' were taken, T39-B04; an MDP's
+    label, which may be '': 'wind\\nrun 2' was taken, T40-B13)."""
+    if not isinstance(value, str) or not value.isprintable() or not (value.strip() or (empty and not value)):
+        kind = "a text" if empty else "a non-empty text"
+        raise NeurohoverError(f"{what}={brief(value)} is not allowed: give {kind} (one line, printable) naming {naming}")
+    return value
+
+
 def check_flag(value: Any, name: str, meaning: str) -> bool:
     """The Python bool of a flag, or one error refusing one that is not a bool: any truthy value counted as True
     (``fresh='no'`` deleted every stored unit, T14-4; ``quick='no'``, ``fit_drags='no'``, fifteenth trial). The one

@@ -6,11 +6,15 @@ CrashAwareReward scale that makes every reward a denormal (T40-B16) were accepte
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import pytest
 
 import neurohover as nh
 from neurohover.agents import Agent, Choice, run_test
 from neurohover.errors import NeurohoverError
+from neurohover.sim.constants import ROW_PARAMS
+from neurohover.tasks import MDP, TaskFamily
 
 P = nh.baseline_policy()
 FAM = nh.get_task_family("ghh08")
@@ -71,3 +75,57 @@ def test_an_agents_async_or_generator_method_is_refused_before_the_run(cls, meth
     with pytest.raises(NeurohoverError, match=r"^agent 'learner''s update, an async def function, is not allowed"):
         run_test(plain, FAM, FAM.zero(), episodes=2, n_steps=20)
     assert run_test(_Learner(), FAM, FAM.zero(), episodes=2, n_steps=20).policy == ["baseline", "baseline"]
+
+
+def test_a_user_family_may_not_take_a_shipped_familys_name():
+    """T40-B01: a class named 'ghh08' replaced GHH-08's wind kinds as it was defined, and GHH-08's own windy MDPs were
+    refused for the rest of the process; now the class is refused by name and GHH-08 is untouched."""
+    ghh08 = nh.get_task_family("ghh08")
+    for taken in ("ghh08", "model"):
+        with pytest.raises(NeurohoverError, match=rf"^task family class Mine's name '{taken}' is not allowed: .* has it, .*give the family a name of its own"):
+
+            @dataclass(frozen=True)
+            class Mine(TaskFamily):
+                name = taken
+                n_params = 2
+
+    assert ghh08.make([1, 2]).wind == (1.0, 2.0)
+    assert MDP.from_dict(ghh08.mdp("train:1").to_dict()) == ghh08.mdp("train:1")
+
+
+_NAMES = ("C_u", "C_v", "D_v", "C_w", "D_w", "C_p", "D_p", "C_q", "D_q", "C_r", "D_r")
+
+
+@pytest.mark.parametrize(
+    ("attributes", "message"),
+    [
+        ({"n_params": 20}, r"its n_params 20 is not allowed: it must be the number of its param_names, 11 \(C_u, "),
+        ({"param_bounds": (1.0, -1.0)}, r"its param_bounds \(1.0, -1.0\) is not allowed: give \(low, high\), two finite numbers with low < high"),
+        ({"row_slice": slice(0, 5)}, r"its row_slice slice\(0, 5, None\) is not allowed: give the slice of the"),
+        ({"param_names": ("a",) * 11}, r"its param_names \('a', .* is not allowed: give a tuple of distinct non-empty texts"),
+        ({"n_params": 0, "param_names": (), "row_slice": slice(0, 0)}, r"its n_params 0 is not allowed: give how many parameters make\(\) takes"),
+        ({"wind_kind": 7}, r"its wind_kind 7 is not allowed: give 0 \(none\), 1 \(constant\) or 2 \(sinusoidal\)"),
+    ],
+)
+def test_a_user_familys_contradictory_class_attributes_are_refused_as_it_is_defined(attributes, message):
+    """T40-B15: n_params 20 beside 11 param_names, or param_bounds (1, -1), were taken; sample() and the fixed sets worked
+    and only rows() refused. The class's own attributes are checked once, as it is defined; a consistent one passes."""
+    base = {"name": "heavy40", "n_params": 11, "param_names": _NAMES, "row_slice": ROW_PARAMS}
+    with pytest.raises(NeurohoverError, match=r"^task family class Heavy \('heavy40'\): " + message):
+        type("Heavy", (TaskFamily,), {**base, **attributes})
+    assert type("Heavy", (TaskFamily,), base).n_params == 11  # defined again: the same class, its name its own
+
+
+def test_an_mdp_label_is_one_printable_line():
+    """T40-B13: make(label='wind\\nrun 2') was taken and shown in an env's info['mdp'], though a Choice's label and an
+    agent's name are refused so; MDP.from_dict refuses it too, and the labels neurohover writes load."""
+    fam = nh.get_task_family("ghh08")
+    for bad in ("wind\nrun 2", "a\tb", "  "):
+        with pytest.raises(NeurohoverError, match=r"^MDP label=.* is not allowed: give a text \(one line, printable\) naming the MDP"):
+            fam.make([1, 2], label=bad)
+    d = fam.mdp("train:1").to_dict()
+    with pytest.raises(NeurohoverError, match=r"^MDP label='x\\ny' is not allowed"):
+        MDP.from_dict({**d, "label": "x\ny"})
+    for mdp in (fam.make([1, 2]), fam.make([1, 2], label="wind run 2"), fam.zero(), fam.sample(0), nh.get_task_family("fghh").mdp("test:4")):
+        assert MDP.from_dict(mdp.to_dict()).label == mdp.label
+    assert MDP.from_dict({k: v for k, v in d.items() if k != "label"}).label == ""

@@ -35,7 +35,7 @@ from types import FunctionType
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, refused_signature, whole_in
+from ..errors import NeurohoverError, brief, check_name_text, finite_real, refused_signature, whole_in
 from ..evaluate import MAX_EPISODES_PER_CALL, DangerousState, PolicyTable, evaluate_jobs
 from ..evolution.seeding import check_seed
 from ..flightdata import FlightData
@@ -109,14 +109,6 @@ class Choice:
                 f"Choice dangerous={brief(self.dangerous)} is not allowed without a fallback: the safeguard hands control to the "
                 "fallback, so alone the rule acts on nothing; give fallback= too, or leave dangerous out"
             )
-
-
-def check_name_text(what: str, value: object, naming: str) -> str:
-    """``value`` (the argument ``what``) checked to be a name in the run's records: non-empty text of printable characters
-    (a Choice's label; an agent's name, RunResult.agent: None, 5 and 'x\\ny' were taken, T39-B04)."""
-    if not isinstance(value, str) or not value.strip() or not value.isprintable():
-        raise NeurohoverError(f"{what}={brief(value)} is not allowed: give a non-empty text (one line, printable) naming {naming}")
-    return value
 
 
 def check_agent_settings(what: str, value: object, kind: type) -> None:

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError, as_floats, brief, finite_real, masked_note, whole_in, whole_number
+from ..errors import NeurohoverError, as_floats, brief, check_name_text, finite_real, masked_note, whole_in, whole_number
 from ..sim.constants import (
     CONTROL_DT,
     DEFAULT_NOISE_STD,
@@ -34,7 +34,8 @@ from ..sim.constants import (
 from ..sim.reference import ReferenceMDP
 from ..sim.rng import MAX_SEED
 from .drift import NO_DRIFT, Drift
-from .held import check_held, check_label, family_code
+from .held import LEARNED_MODEL, check_held, check_label, family_code, register_family
+from .held import WIND_KINDS as _WIND_KINDS
 from .sensor import EXACT, Sensor
 
 N_TRAINING = 10
@@ -51,10 +52,6 @@ _FIXED_SETS: dict[tuple[str, int, int, Sensor, Drift], tuple[MDP, ...]] = {}
 _ROW_LAYOUTS: dict[tuple[str, int, Sensor], np.ndarray] = {}
 COMPETITION_MDPS_FILE = Path(__file__).parent.parent / "data" / "competition-mdps.json"
 _COMPETITION: dict[str, dict] = {}
-LEARNED_MODEL = "model"  # the family name of a learned model's MDP, which may fly any wind
-#: The wind kinds the MDPs of each family may have, by family name: each TaskFamily subclass registers its own as it is
-#: defined (none, or none and its ``wind_kind``); an unknown family, or ghh09's wind under ghh08's name, was flown (T14-17).
-_WIND_KINDS: dict[str, tuple[int, ...]] = {LEARNED_MODEL: (WIND_NONE, WIND_CONSTANT, WIND_SINUSOID)}
 #: The keys of :meth:`MDP.to_dict`'s table that :meth:`MDP.from_dict` needs (``label``, ``d_u``, ``sensor``, ``drift`` may be left out).
 MDP_KEYS = ("family", "params", "noise_std", "wind_kind", "wind", "substeps", "dt")
 #: The keys :meth:`MDP.from_dict` also reads; any other is refused.
@@ -115,6 +112,7 @@ class MDP:
             raise NeurohoverError(f"drift must be a neurohover Drift, got {self.drift!r}")
         if not isinstance(self.label, str):  # make(label=5) was kept as the number (second trial)
             raise NeurohoverError(f"MDP label={self.label!r:.60} is not allowed: give a string")
+        check_name_text("MDP label", self.label, "the MDP (e.g. 'ghh08/gusty')", empty=True)  # 'wind\nrun 2' was taken (T40-B13)
         if not isinstance(self.family, str) or self.family not in _WIND_KINDS:
             names = [n for n in _WIND_KINDS if n != LEARNED_MODEL]
             raise NeurohoverError(f"MDP family={brief(self.family)} is not allowed: give a task family's name ({', '.join(names)}) or {LEARNED_MODEL!r}")
@@ -354,6 +352,8 @@ class TaskFamily:
 
     A family module subclasses this (as a frozen dataclass) and sets the class attributes and
     the three methods marked below; sampling, kernel rows, fixed sets and names come from here.
+    The class is checked as it is defined (:func:`~neurohover.tasks.held.register_family`): its name
+    its own (another class's, ``model`` included, is refused) and its attributes in agreement.
 
     Attributes
     ----------
@@ -396,8 +396,8 @@ class TaskFamily:
 
     def __init_subclass__(cls, **kwargs) -> None:
         super().__init_subclass__(**kwargs)
-        if cls.__dict__.get("name"):  # the wind kinds an MDP of its name may have (MDP's own check)
-            _WIND_KINDS[cls.name] = (WIND_NONE,) if cls.wind_kind == WIND_NONE else (WIND_NONE, cls.wind_kind)
+        if cls.__dict__.get("name"):  # its attributes checked, the wind kinds an MDP of its name may have (MDP's own check)
+            register_family(cls)
         for name in ("make", "zero"):  # the one place a family's MDPs get its sensor
             if name in cls.__dict__:
                 setattr(cls, name, _through_sensor(cls.__dict__[name]))

@@ -27,10 +27,17 @@ from collections.abc import Iterator
 from dataclasses import fields, replace
 from typing import TYPE_CHECKING
 
-from ..errors import NeurohoverError, brief, finite_real
+from ..errors import NeurohoverError, brief, check_name_text, finite_real, real_number, whole_number
+from ..sim.constants import MDP_ROW_LEN, WIND_CONSTANT, WIND_NONE, WIND_SINUSOID
 
 if TYPE_CHECKING:
     from .base import MDP
+
+LEARNED_MODEL = "model"  # the family name of a learned model's MDP, which may fly any wind
+#: The wind kinds the MDPs of each family may have, by family name: each TaskFamily subclass registers its own as it is
+#: defined (none, or none and its ``wind_kind``); an unknown family, or ghh09's wind under ghh08's name, was flown (T14-17).
+WIND_KINDS: dict[str, tuple[int, ...]] = {LEARNED_MODEL: (WIND_NONE, WIND_CONSTANT, WIND_SINUSOID)}
+_OWNERS: dict[str, str] = {LEARNED_MODEL: "the learned models' family"}  # the class of each family name (class module.qualname)
 
 #: A label naming one of a family's MDPs by :meth:`TaskFamily.mdp`'s names, as its fixed sets and zero label them.
 SET_LABEL = re.compile(r"(?:(?P<family>[^/]+)/)?(?P<spec>zero|(?:seeded-)?(?:train|test):[0-9]+)")
@@ -163,3 +170,43 @@ def differences(a: MDP, b: MDP) -> list[str]:
     return [
         f"{f.name}={brief(getattr(a, f.name))}" for f in fields(a) if f.name not in ("label", "sensor", "drift") and getattr(a, f.name) != getattr(b, f.name)
     ]
+
+
+def register_family(cls: type) -> None:
+    """Check a TaskFamily subclass that names a family (sets its own ``name``) and register the wind kinds its MDPs may
+    have. Its class attributes must agree (n_params 20 with 11 param_names, param_bounds (1, -1) were taken and failed
+    only in rows(), T40-B15), and its name must be no other class's: a user's class named 'ghh08' replaced GHH-08's wind
+    kinds, and GHH-08's own windy MDPs were refused for the rest of the process (T40-B01). The same class defined again
+    (its module reloaded, a notebook cell run again) replaces its own registration."""
+    name = cls.__dict__["name"]
+    what = f"task family class {cls.__name__}"
+    check_name_text(f"{what}'s name", name, "the family (e.g. 'heavy')")
+    owner = f"class {cls.__module__}.{cls.__qualname__}"
+    if _OWNERS.get(name, owner) != owner:
+        raise NeurohoverError(
+            f"{what}'s name {name!r} is not allowed: {_OWNERS[name]} has it, and a second family of that name would change which MDPs "
+            f"the first holds; give the family a name of its own (taken: {', '.join(sorted(_OWNERS))})"
+        )
+    problem = _class_problem(cls)
+    if problem:
+        raise NeurohoverError(f"{what} ({name!r}): {problem}")
+    WIND_KINDS[name] = (WIND_NONE,) if cls.wind_kind == WIND_NONE else (WIND_NONE, cls.wind_kind)  # type: ignore[attr-defined]
+    _OWNERS[name] = owner
+
+
+def _class_problem(cls) -> str:
+    """Why a task family class's own attributes contradict each other ('' when they agree)."""
+    n, names, where, bounds = cls.n_params, cls.param_names, cls.row_slice, cls.param_bounds
+    if not whole_number(n) or not 1 <= n <= MDP_ROW_LEN:
+        return f"its n_params {brief(n)} is not allowed: give how many parameters make() takes, an integer in 1..{MDP_ROW_LEN}"
+    if not isinstance(names, (tuple, list)) or not all(isinstance(x, str) and x for x in names) or len(set(names)) != len(names):
+        return f"its param_names {brief(names)} is not allowed: give a tuple of distinct non-empty texts, one per parameter"
+    if len(names) != n:
+        return f"its n_params {n} is not allowed: it must be the number of its param_names, {len(names)} ({', '.join(names)})"
+    if not isinstance(where, slice) or len(range(MDP_ROW_LEN)[where]) != n or where.step not in (None, 1):
+        return f"its row_slice {brief(where)} is not allowed: give the slice of the {MDP_ROW_LEN}-number kernel row that holds its {n} parameters"
+    if not (isinstance(bounds, tuple) and len(bounds) == 2 and all(real_number(b) and finite_real(b) for b in bounds) and bounds[0] < bounds[1]):
+        return f"its param_bounds {brief(bounds)} is not allowed: give (low, high), two finite numbers with low < high, the range of each parameter"
+    if cls.wind_kind not in (WIND_NONE, WIND_CONSTANT, WIND_SINUSOID) or isinstance(cls.wind_kind, bool):
+        return f"its wind_kind {brief(cls.wind_kind)} is not allowed: give {WIND_NONE} (none), {WIND_CONSTANT} (constant) or {WIND_SINUSOID} (sinusoidal)"
+    return ""
