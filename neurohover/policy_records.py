@@ -30,7 +30,7 @@ def policy_record_problem(meta: dict) -> str:
     a task other than its target's, mdp_params other than its label's MDP or settings of pop_size 0 (T24-02)."""
     from .evolution.config import MAX_BUDGET, parse_resampling
     from .evolution.fitness import ERROR_FLOOR
-    from .evolution.optimisers import NE, OPTIMISERS
+    from .evolution.optimisers import NE, OPTIMISERS, USER_NAME
     from .evolution.restore import STOP_REASONS
     from .sim.rng import MAX_SEED
 
@@ -50,12 +50,16 @@ def policy_record_problem(meta: dict) -> str:
             return f"its {small} {brief(meta[small])} is not allowed: more than its {large} {brief(meta[large])}, and {why}"
     own_stop = {"steady-state": "plateau", "generational": "generations", **{spec.label: spec.stop_reason for spec in OPTIMISERS.values()}}
     method, optimizer = meta.get("method"), meta.get("optimizer")
-    if method is not None and (not isinstance(method, str) or method not in own_stop):
-        return f"its method {brief(method)} is not allowed: allowed {', '.join(own_stop)}"
+    users = [isinstance(v, str) and USER_NAME.fullmatch(v) is not None for v in (method, optimizer)]  # T40-B14
+    user = " or user:NAME (an optimiser registered at run time)"
+    if method is not None and not users[0] and (not isinstance(method, str) or method not in own_stop):
+        return f"its method {brief(method)} is not allowed: allowed {', '.join(own_stop)}{user}"
     names = {NE: ("steady-state", "generational"), **{name: (spec.label,) for name, spec in OPTIMISERS.items()}}
-    if optimizer is not None and (not isinstance(optimizer, str) or optimizer not in names):
-        return f"its optimizer {brief(optimizer)} is not allowed: allowed {', '.join(names)}"
-    if method is not None and optimizer is not None and method not in names[optimizer]:
+    if optimizer is not None and not users[1] and (not isinstance(optimizer, str) or optimizer not in names):
+        return f"its optimizer {brief(optimizer)} is not allowed: allowed {', '.join(names)}{user}"
+    if method is not None and optimizer is not None and users[0] != users[1]:
+        return f"its method {brief(method)} is not allowed beside its optimizer {brief(optimizer)}: a run of a user:NAME optimizer records both so"
+    if method is not None and optimizer is not None and not users[1] and method not in names[optimizer]:
         return f"its method {brief(method)} is not allowed: optimizer {optimizer!r} evolves by {' or '.join(names[optimizer])}"
     problem = _run_words_problem(meta, own_stop, STOP_REASONS, parse_resampling, (1 + 1e-9) / math.log(ERROR_FLOOR))
     problem = problem or _validation_problem(meta) or _place_problem(meta) or _run_settings_problem(meta)  # T24-02: what evolve adds
@@ -117,7 +121,7 @@ def _run_words_problem(meta: dict, own_stop: dict, stop_reasons: tuple, parse_re
     if reason == "budget" and "budget" in meta and (budget is None or (episodes is not None and episodes < budget)):
         has = "it has no budget" if budget is None else f"its {episodes:,} episodes are fewer than its budget {budget:,}"
         return f"its stop_reason 'budget' is not allowed: {has} (a run stops by its budget once it has flown it)"
-    if reason != "budget" and method is not None and reason != own_stop[method]:
+    if reason != "budget" and method in own_stop and reason != own_stop[method]:  # (a user:NAME method's own stop is its own)
         return f"its stop_reason {brief(reason)} is not allowed beside its method {method!r}: allowed budget or {own_stop[method]}"
     return ""
 
@@ -283,11 +287,13 @@ def _recorded_settings(meta: dict) -> Any:
     (:func:`~neurohover.evolution.config.make_settings`: its table over the defaults); None where it records none (or no
     optimiser to read them by), NeurohoverError where they are not allowed."""
     from .evolution.config import make_settings
-    from .evolution.optimisers import NE
+    from .evolution.optimisers import NE, USER_NAME
 
     method, settings = meta.get("method"), meta.get("settings")
     optimizer = meta.get("optimizer", NE if method in ("steady-state", "generational") else None)
     if not (isinstance(settings, dict) and optimizer is not None and (optimizer != NE or method is not None)):
+        return None
+    if isinstance(optimizer, str) and USER_NAME.fullmatch(optimizer):  # a user's optimiser: its settings class may not be here
         return None
     given = {k: v for k, v in settings.items() if not (optimizer == NE and k == "budget" and v is None)}  # NE's: the run counts its budget
     return make_settings("steady-state" if method == "steady-state" else "generational", optimizer, given)

@@ -51,7 +51,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, real_number, whole_number
+from ..errors import NeurohoverError, brief, finite_real, real_number, refused_signature, whole_number
 from ..procs import half_free_memory
 from .common import as_floats
 
@@ -183,6 +183,12 @@ def _check_sample_fn(sample_fn: object) -> None:
     """Refuse a ``sample_fn`` that cannot be called before anything is flown (None was a TypeError mid-run; thirteenth trial, F14)."""
     if not callable(sample_fn):
         raise NeurohoverError(f"sample_fn={brief(sample_fn)} is not allowed: give a function of an array of candidate indices returning one return per index")
+    refused = refused_signature(sample_fn, 1)  # a wrong arity was a raw TypeError at its first call (T40-B02)
+    if refused:
+        raise NeurohoverError(
+            f"sample_fn of signature {brief(refused)} is not allowed: it is called as sample_fn(indices); "
+            "give a function of an array of candidate indices returning one return per index"
+        )
 
 
 def _draw(sample_fn: SampleFn, indices: np.ndarray) -> np.ndarray:
@@ -196,7 +202,17 @@ def _draw(sample_fn: SampleFn, indices: np.ndarray) -> np.ndarray:
 
 
 def _mean(samples: np.ndarray) -> float:
-    return -math.inf if np.any(np.isneginf(samples)) else float(np.mean(samples))
+    """One candidate's mean return, as a race's (:func:`_race_round`): returns past 2**500 in size in units of a power of
+    two, so that finite returns of 1e308 average to 1e308, not +inf after an overflow warning (T40-B03, as T35-B04's bounds)."""
+    if np.any(np.isneginf(samples)):
+        return -math.inf
+    largest = float(np.max(np.abs(samples)))
+    if largest == 0.0 or _SMALL <= largest <= _LARGE:  # most returns: no call of the compiled scale (its first loads numba)
+        return float(np.mean(samples))
+    p = int(_scale_exponent(samples, samples.size))
+    if p == 0:
+        return float(np.mean(samples))
+    return float(np.mean(samples * math.ldexp(1.0, -p))) * math.ldexp(1.0, p)
 
 
 @functools.lru_cache(maxsize=4096)

@@ -20,17 +20,18 @@ from typing import Any, cast
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, finite_real, real_number
 from ..flyer import KernelFlyer
 from ..launch import Parking
 from ..policies import Policy
+from ..sim.constants import lowest_return
 from ..sim.lanes import LANES
 from .bandits import BANDITS, top_mu_bandit
 from .common import STATE_DAMAGE, Optimiser, TellInfo, damage_text, enc_float
 from .config import RACE_T_LIMIT, RunConfig, next_auto_delta, preset_hint, upgrade_saved_config
 from .fitness import episode_fitness
 from .generational import GenerationalNE
-from .optimisers import OPTIMISERS
+from .optimisers import OPTIMISERS, recorded_names
 from .race_sampler import RaceSampler
 from .races import fixed_resampling, selection_race
 from .records import (
@@ -281,6 +282,8 @@ class Run:
         next_ckpt = time.perf_counter() + flag_every
         next_progress = time.perf_counter() + progress_every_s
         budget = self.budget
+        if checkpoint is not None:  # a state JSON cannot write, refused before anything flies (T40-B06)
+            self._check_state_json(self.opt.state_dict())
         if self.method == "generational":
             step = self._generational_generation
         elif self.method == "steady-state" or self.family is None:
@@ -305,19 +308,19 @@ class Run:
                         next_progress = now + progress_every_s
                         progress(self._info(now - start, False, budget))
                     if checkpoint is not None and now >= next_ckpt:  # (next_ckpt is inf without a checkpoint)
-                        write_checkpoint(checkpoint, self.state(now - start))
+                        self._write_checkpoint(checkpoint, now - start)
                         next_ckpt = time.perf_counter() + flag_every
             except KeyboardInterrupt:
                 # At a generation boundary (first Ctrl-C, or the progress callback) the state is whole
                 # and is saved; a second Ctrl-C mid-generation leaves the last periodic checkpoint.
                 if not boundary or checkpoint is None:
                     raise EvolutionInterrupted(None, self.flyer.episodes) from None
-                write_checkpoint(checkpoint, self.state(time.perf_counter() - start))
+                self._write_checkpoint(checkpoint, time.perf_counter() - start)
                 raise EvolutionInterrupted(checkpoint, self.flyer.episodes) from None
         wall = time.perf_counter() - start
         self.elapsed = wall
         if checkpoint is not None:
-            write_checkpoint(checkpoint, self.state(wall))
+            self._write_checkpoint(checkpoint, wall)
         if progress is not None:
             try:
                 progress(self._info(wall, True, budget))
@@ -340,21 +343,22 @@ class Run:
         """Steady state, or a population optimiser on an MDP: the champion is the best single fitness ever told;
         a record per new champion."""
         opt = self.opt
-        before = opt.champion_return
+        before = self._told_champion()
         before_eps = self.flyer.episodes
-        genomes = opt.ask()
+        genomes = self._asked()
         returns = self._fly_fixed(genomes)
         opt.tell(returns, TellInfo(crashed=self._crashed()))
         self.generation += 1
         self.evaluations += genomes.shape[0]
-        if opt.champion_return != before:
-            self._record(before_eps, opt.champion_return, start)
+        champion = self._told_champion()
+        if champion != before:
+            self._record(before_eps, champion, start)
 
     def _generational_generation(self, start: float) -> None:
         """Generational NE: fixed resampling or a selection race; a record per generation."""
         opt = cast(GenerationalNE, self.opt)
         before_eps = self.flyer.episodes
-        genomes = opt.ask()
+        genomes = self._asked()
         if self.resampling.selects:
             delta = self.race_delta
             assert delta is not None  # every race has its delta (Run() formats it in config.to_dict() first)
@@ -388,7 +392,7 @@ class Run:
         best-ever maximum over noisy estimates would be biased); a record per generation."""
         opt = self.opt
         before_eps = self.flyer.episodes
-        genomes = opt.ask()
+        genomes = self._asked()
         means, _ = self._fly_family_fixed(genomes)
         opt.tell(means)
         key = np.where(np.isnan(means), -np.inf, means)
@@ -397,6 +401,62 @@ class Run:
         self.generation += 1
         self.evaluations += genomes.shape[0]
         self._record(before_eps, self.champion_return, start)
+
+    # ----------------------------------------------------------------- a user optimiser's answers, checked
+
+    def _asked(self) -> np.ndarray:
+        """The optimiser's next generation, checked: a user's optimiser (README, A new optimiser) asking genomes of another
+        length, none, or a list failed in the flyer or in numba ("number of threads must be between 1 and 2"; T40-B05)."""
+        genomes = self.opt.ask()
+        d = self.cfg.prototype.genome.size
+        if isinstance(genomes, np.ndarray) and genomes.dtype.kind in "fiu" and genomes.ndim == 2 and genomes.shape[0] >= 1 and genomes.shape[1] == d:
+            if np.isfinite(genomes).all():
+                return genomes
+            gave = f"an array of shape {genomes.shape} with genes NaN or infinite"
+        elif isinstance(genomes, np.ndarray):
+            gave = f"an array of shape {genomes.shape} and dtype {genomes.dtype}"
+        else:
+            gave = f"a {type(genomes).__name__} {brief(genomes)}"
+        raise NeurohoverError(
+            f"optimizer {brief(self.cfg.optimizer)}: its ask() gave {gave}, which is not allowed: give a NumPy array of real numbers of shape (n, {d}), "
+            f"n >= 1 genomes of the {self.cfg.topology} topology's {d} finite genes"
+        )
+
+    def _told_champion(self) -> float:
+        """The optimiser's champion_return, checked where it is the run's (on one MDP, on the return scale): -inf before a
+        finite return, else a return an episode can have; a user's optimiser reporting 1e9 was taken as the result (T40-B06b)."""
+        ret = self.opt.champion_return
+        if self.method == "generational" or (finite_real(ret) and lowest_return(self.cfg.n_steps) * (1 + 1e-9) <= ret <= 0):
+            return float(ret)
+        if real_number(ret) and float(ret) == -math.inf:
+            return float(ret)
+        raise NeurohoverError(
+            f"optimizer {brief(self.cfg.optimizer)}: its champion_return {brief(ret)} is not allowed: allowed -inf (no finite return told yet) or a return "
+            f"told, in [{lowest_return(self.cfg.n_steps):.6g}, 0] for episodes of {self.cfg.n_steps} steps (every reward is minus a sum of squares)"
+        )
+
+    def _write_checkpoint(self, path: Path, wall: float) -> None:
+        """Write the checkpoint after ``wall`` seconds; an optimiser state JSON cannot write refused by its key (T40-B06)."""
+        state = self.state(wall)
+        try:
+            write_checkpoint(path, state)
+        except (TypeError, ValueError) as err:
+            if not isinstance(err, NeurohoverError):
+                self._check_state_json(state["optimizer_state"])
+            raise
+
+    def _check_state_json(self, state: Any) -> None:
+        """NeurohoverError naming the first entry of optimiser state ``state`` that strict JSON cannot write (an np.float32,
+        an array, NaN): ``state_dict()`` returns a plain JSON-serialisable snapshot (:class:`~.common.Optimiser`)."""
+        where = _unwritable(state, "")
+        if where is not None:
+            at, value = where
+            raise NeurohoverError(
+                f"optimizer {brief(self.cfg.optimizer)}: its state_dict() entry {at or '(the whole state)'} is {type(value).__name__} {brief(value)}, "
+                "which is not allowed: "
+                "a checkpoint is strict JSON, so state_dict() gives plain numbers (finite; non-finite as text), text, lists and tables of text keys "
+                "(an np.float32 as float(...), an array as .tolist())"
+            )
 
     # ----------------------------------------------------------------- result
 
@@ -420,7 +480,7 @@ class Run:
     def _champion_return(self) -> float:
         if self.method in OPTIMISERS and self.family is not None:
             return self.champion_return
-        return float(self.opt.champion_return)
+        return self._told_champion()
 
     def _champion_genome(self) -> np.ndarray | None:
         if self.method in OPTIMISERS and self.family is not None:
@@ -438,9 +498,10 @@ class Run:
         target = self.config["target"]
         label = target["mdp"]["label"] if target["kind"] == "mdp" else f"{target['family']}/G" + (f"(sigma={target['sigma']:g})" if "sigma" in target else "")
         cfg = self.cfg
+        method, optimizer = recorded_names(cfg.optimizer) if cfg.optimizer in OPTIMISERS else (self.method, cfg.optimizer)
         meta = {
-            "method": OPTIMISERS[cfg.optimizer].label if cfg.optimizer in OPTIMISERS else self.method,
-            "optimizer": cfg.optimizer,
+            "method": method,
+            "optimizer": optimizer,
             "resampling": str(self.resampling),
             "target": label,
             "seed": cfg.seed,
@@ -472,3 +533,27 @@ class Run:
             parents=getattr(self.opt, "parents", None),
             hall_of_fame=getattr(self.opt, "hall_of_fame", None),
         )
+
+
+def _unwritable(value: Any, at: str) -> tuple[str, Any] | None:
+    """Where in ``value`` (its path from ``at``, and what is there) strict JSON cannot write, or None where it can."""
+    import json
+
+    try:
+        json.dumps(value, allow_nan=False)
+        return None
+    except (TypeError, ValueError, RecursionError):
+        pass
+    if isinstance(value, dict):
+        for key, item in value.items():
+            if not isinstance(key, str):
+                return f"{at}[{brief(key)}] (a key that is no text)", key
+            found = _unwritable(item, f"{at}[{key!r}]")
+            if found is not None:
+                return found
+    elif isinstance(value, (list, tuple)):
+        for i, item in enumerate(value):
+            found = _unwritable(item, f"{at}[{i}]")
+            if found is not None:
+                return found
+    return at, value

@@ -7,6 +7,10 @@ this package that declares ``OPTIMISER_SPECS`` (a sequence of :class:`OptimiserS
 here, so adding one is one new module plus its tests (``openai_es.py`` shows how). The run flies
 each generation with fixed resampling, keeps on one MDP the best single return ever told as
 champion, and over a task family the best estimate of the last generation.
+
+An optimiser registered at run time instead (``OPTIMISERS["my-es"] = OptimiserSpec("my-es", ...)`` in a script) runs
+the same; its champions record it as method and optimizer ``user:my-es`` (:func:`recorded_names`), which every process
+reads (one without it registered too), while a record of a shipped optimiser's name is checked against the registry.
 """
 
 from __future__ import annotations
@@ -14,6 +18,7 @@ from __future__ import annotations
 import dataclasses
 import importlib
 import pkgutil
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -22,7 +27,7 @@ import numpy as np
 
 from ...errors import NeurohoverError, brief, settings_from_dict
 
-__all__ = ["NE", "OPTIMISERS", "OptimiserSpec", "optimiser_names", "population_settings"]
+__all__ = ["NE", "OPTIMISERS", "SHIPPED", "USER_NAME", "OptimiserSpec", "optimiser_names", "population_settings", "recorded_names"]
 
 NE = "ne"  # the paper's neuroevolution: not a population optimiser of this registry
 
@@ -80,6 +85,22 @@ def _discover() -> dict[str, OptimiserSpec]:
 
 #: Every population optimiser by name (modules in name order: cma, openai_es, ...).
 OPTIMISERS: dict[str, OptimiserSpec] = _discover()
+
+#: The optimisers every process knows: this package's modules'. A policy's record names one as it is.
+SHIPPED: frozenset[str] = frozenset(OPTIMISERS)
+
+#: How a policy's record names an optimiser registered at run time (``OPTIMISERS[name] = OptimiserSpec(...)`` in a
+#: script, not a module here), which another process has not registered: ``user:`` and a one-line name of at most 64
+#: letters, digits and ``._+-``, read by every process (T40-B14: "its method 'my-es' is not allowed" everywhere else).
+USER_NAME = re.compile(r"user:[A-Za-z0-9][A-Za-z0-9._+-]{0,63}")
+
+
+def recorded_names(name: str) -> tuple[str, str]:
+    """The ``(method, optimizer)`` a champion's record of a run of population optimiser ``name`` says: its label and its
+    name where it is :data:`SHIPPED`, else both prefixed ``user:`` (a record every process reads; a name
+    :data:`USER_NAME` does not take is refused as the policy is saved)."""
+    spec = OPTIMISERS[name]
+    return (spec.label, name) if name in SHIPPED else (f"user:{spec.label}", f"user:{name}")
 
 
 def optimiser_names() -> tuple[str, ...]:
