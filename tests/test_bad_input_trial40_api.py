@@ -129,3 +129,26 @@ def test_an_mdp_label_is_one_printable_line():
     for mdp in (fam.make([1, 2]), fam.make([1, 2], label="wind run 2"), fam.zero(), fam.sample(0), nh.get_task_family("fghh").mdp("test:4")):
         assert MDP.from_dict(mdp.to_dict()).label == mdp.label
     assert MDP.from_dict({k: v for k, v in d.items() if k != "label"}).label == ""
+
+
+@pytest.mark.parametrize(
+    ("env_id", "kwargs", "key", "keeps"),
+    [
+        ("FGHH-DriftingDynamics", {"drift": None}, "drift=None", "a walk > 0"),
+        ("FGHH-AbruptChange", {"drift": {"walk": 0.01}}, r"drift=\{'walk': 0.01\}", "a change"),
+        ("GHH09-DelayedSensors", {"obs_delay": 0}, "obs_delay=0", "a delay > 0"),
+        ("GHH09-NoisySensors", {"obs_noise": 0}, "obs_noise=0", "a noise level > 0"),
+        ("GHH08-CorrelatedSensors", {"obs_noise": 1.0}, "obs_noise=1.0", "a noise level > 0 and a correlation > 0"),
+    ],
+)
+def test_a_variant_ids_defining_setting_is_not_removed_by_make_kwargs(env_id, kwargs, key, keeps):
+    """T40-B12: -DriftingDynamics with drift=None flew fixed dynamics, -DelayedSensors with obs_delay=0 exact sensors,
+    without a word (another task= is refused for the same reason); a kwarg that keeps the setting is taken."""
+    import gymnasium as gym
+
+    name = env_id.split("-")[0]
+    with pytest.raises(NeurohoverError, match=rf"^neurohover/{env_id}-v0 is {name} with .*: its {key} removes what defines the id, .*give .* with {keeps}"):
+        gym.make(f"neurohover/{env_id}-v0", **kwargs)
+    assert gym.make("neurohover/GHH09-DelayedSensors-v0", obs_delay=3).unwrapped.family.sensor.delay == 3
+    assert gym.make("neurohover/FGHH-DriftingDynamics-v0", drift={"walk": 0.02}).unwrapped.drift.walk == 0.02
+    assert gym.make("neurohover/GHH08-NoisySensors-v0", obs_delay=1).unwrapped.family.sensor.delay == 1

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import NeurohoverError, brief, float64_of, whole_in, whole_number
 from ..sim.constants import MAX_EPISODE_STEPS
-from ..tasks import MDP, TaskFamily, get_task_family
+from ..tasks import MDP, NO_DRIFT, Drift, TaskFamily, get_task_family
 from ..tasks.sensor import Sensor
 
 OBS_DTYPES = ("float64", "float32")
@@ -117,7 +117,35 @@ def sensed_family(task: str, sigma: float | None, obs_noise: Any, obs_delay: Any
     return get_task_family(task, sigma, sensor=Sensor.of(obs_noise, obs_delay))
 
 
-def check_against_id(spec: Any, family: TaskFamily, episode_steps: int, limit: int | None = None) -> None:
+#: What defines each variant id (``neurohover/<NAME>-<suffix>-v0``), by suffix: the make() kwarg that sets it, what it
+#: is, what keeps it, and whether the environment's sensor and drift keep it. A kwarg may change the setting (another
+#: level, delay or walk) but not remove it, as it may not change the id's task: ``-DriftingDynamics`` with drift=None
+#: flew fixed dynamics (T40-B12).
+VARIANT_SETTINGS: dict[str, tuple[str, str, str, Callable[[Sensor, Drift], bool]]] = {
+    "NoisySensors": ("obs_noise", "noisy sensors", "a noise level > 0", lambda s, d: any(s.stds)),
+    "CorrelatedSensors": ("obs_noise", "correlated sensor noise", "a noise level > 0 and a correlation > 0", lambda s, d: any(s.stds) and s.correlation > 0),
+    "DelayedSensors": ("obs_delay", "late sensors", "a delay > 0", lambda s, d: s.delay > 0),
+    "DriftingDynamics": ("drift", "drifting dynamics", "a walk > 0", lambda s, d: d.walk > 0),
+    "AbruptChange": ("drift", "an abrupt change of the dynamics", "a change (e.g. {'change': {'D_w': 0.8}})", lambda s, d: bool(d.change)),
+}
+
+
+def _refuse_lost_variant(spec: Any, family: TaskFamily, drift: Drift) -> None:
+    """Refuse make()'s kwargs where they remove what defines a variant id (:data:`VARIANT_SETTINGS`)."""
+    name, _, rest = spec.id.partition("/")[2].partition("-")
+    suffix = rest.rpartition("-v")[0]
+    if suffix not in VARIANT_SETTINGS:
+        return
+    key, what, keeps, kept = VARIANT_SETTINGS[suffix]
+    if not kept(family.sensor, drift):
+        given = (getattr(spec, "kwargs", None) or {}).get(key)
+        raise NeurohoverError(
+            f"{spec.id} is {name} with {what}: its {key}={brief(given)} removes what defines the id, which is not allowed: give {key} with {keeps}, "
+            f"or make neurohover/{name}-v0 without it"
+        )
+
+
+def check_against_id(spec: Any, family: TaskFamily, episode_steps: int, limit: int | None = None, drift: Drift = NO_DRIFT) -> None:
     """What ``gymnasium.make(id, **kwargs)`` built, checked against the id (``spec``, set once the env is made): a
     ``task`` that is not the id's is refused; episodes that the time limit cuts before their ``episode_steps`` are warned
     of, whether the limit is the id's or one given to make() or make_vec() (``limit``: the truncation the environment
@@ -141,6 +169,8 @@ def check_against_id(spec: Any, family: TaskFamily, episode_steps: int, limit: i
             f"{spec.id} is the {task} task family: task={family.name!r} conflicts with it; make a {family.name} id instead"
             + (f" ({', '.join(ids[:3])})" if ids else "")
         )
+    if registered.namespace == "neurohover":
+        _refuse_lost_variant(spec, family, drift)
     applied = _make_time_limit(registered.max_episode_steps) if limit is None else limit
     if applied is None or episode_steps <= applied:
         return

@@ -212,7 +212,10 @@ class HoverEnv(FixedSettings, gym.Env[np.ndarray, np.ndarray]):
     - ``episode_steps``: control steps per episode (6000). ``gymnasium.make`` also adds a
       ``TimeLimit`` of the id's episode length; pass ``max_episode_steps`` to ``make`` for longer
       episodes (a longer ``episode_steps`` alone is warned of). ``task`` is the id's: another task
-      under one of neurohover's ids is refused (a user's own id takes it, as Gymnasium's make does).
+      under one of neurohover's ids is refused (a user's own id takes it, as Gymnasium's make does), and
+      so is a kwarg that removes a variant id's defining setting (``obs_noise=0`` under ``-NoisySensors``, white
+      noise under ``-CorrelatedSensors``, ``obs_delay=0`` under ``-DelayedSensors``, ``drift=None`` under
+      ``-DriftingDynamics``, no change under ``-AbruptChange``); one that keeps it (``obs_delay=3``) is taken.
     - ``obs_dtype``: ``"float64"`` (default) or ``"float32"`` (for deep-RL libraries): the
       observation space's dtype and the returned observations'. The simulation itself always
       runs in float64, so the episodes are the same, observations rounded to float32.
@@ -351,7 +354,7 @@ class HoverEnv(FixedSettings, gym.Env[np.ndarray, np.ndarray]):
 
     @spec.setter
     def spec(self, value: Any) -> None:  # gymnasium.make sets it on the env it built: the kwargs it merged are checked here
-        check_against_id(value, self.family, self.episode_steps)
+        check_against_id(value, self.family, self.episode_steps, drift=self.drift)
         self._env_spec = value
 
     @property
