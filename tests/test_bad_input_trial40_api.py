@@ -152,3 +152,19 @@ def test_a_variant_ids_defining_setting_is_not_removed_by_make_kwargs(env_id, kw
     assert gym.make("neurohover/GHH09-DelayedSensors-v0", obs_delay=3).unwrapped.family.sensor.delay == 3
     assert gym.make("neurohover/FGHH-DriftingDynamics-v0", drift={"walk": 0.02}).unwrapped.drift.walk == 0.02
     assert gym.make("neurohover/GHH08-NoisySensors-v0", obs_delay=1).unwrapped.family.sensor.delay == 1
+
+
+def test_a_drift_walk_too_small_to_move_a_parameter_is_refused():
+    """T40-B08: walk=1e-300 (or 1e-320) was taken though every drifted row equalled the fixed one, while walk=0 is refused
+    for that reason; a walk below float64's epsilon (exp(walk) == 1.0) is refused naming the range, the smallest allowed
+    one moves the rows."""
+    from neurohover.tasks.drift import MIN_WALK
+
+    for bad in ("walk=1e-300", "walk=1e-320", "walk=1e-17"):
+        with pytest.raises(NeurohoverError, match=r"^drift walk=1e-\d+ is out of range, too small to change the dynamics: allowed 0 \(none\) or .* 2.22e-16"):
+            nh.Drift.parse(bad)
+    with pytest.raises(NeurohoverError, match=r"^drift walk=5e-324 is out of range, too small"):
+        nh.Drift.from_dict({"walk": 5e-324})
+    row = nh.get_task_family("fghh").mdp("test:0").row()
+    assert not (nh.Drift(MIN_WALK).rows(row, 5, 0) == row).all()
+    assert nh.Drift().none and nh.Drift(0.0).none

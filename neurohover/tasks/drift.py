@@ -16,7 +16,7 @@ are unchanged. Within an episode the MDP stays fixed.
 setting        default     meaning
 =============  ==========  =========================================================================
 walk           0           per-episode std of each parameter's log random walk (0.01: about the
-                           breadth of FGHH's G, sigma 0.3, after 1000 episodes)
+                           breadth of FGHH's G, sigma 0.3, after 1000 episodes); 0 or 2**-52..1
 change         {}          factors (0.01..100) of named parameters at the change, e.g.
                            ``{"D_w": 0.8}``: the collective's gain loses 20 %, as under a
                            heavier load
@@ -46,6 +46,10 @@ MAX_CHANGE_AT = 10**12
 #: The most episodes whose rows one call makes (36 floats each: 29 GB at this bound, compete's bound on a call's episodes);
 #: past NumPy's int64 (10**20) the count was an OverflowError (fourteenth trial, T14-21).
 MAX_RUN_EPISODES = 10**8
+#: The smallest walk but 0 (none), float64's epsilon 2**-52: a parameter's step of one std, exp(walk), is 1.0 below it,
+#: and a drifted row was the fixed one (walk=1e-300 was taken, while walk=0 is refused for drifting nothing; T40-B08).
+MIN_WALK = float(np.finfo(np.float64).eps)
+_WALK_RANGE = f"allowed 0 (none) or a number in {MIN_WALK:.3g}..1 (a per-episode log std; below 2**-52 a step of one std, exp(walk), is 1.0 in float64)"
 _PARSE_FORM = "give walk=STD or PARAM=FACTOR[@LO-HI], e.g. walk=0.01,D_w=0.8@200-800"
 _NOTHING = "give walk > 0 (up to 1) or a change of a factor other than 1, or leave it out (fixed dynamics)"
 
@@ -65,6 +69,8 @@ class Drift:
             raise NeurohoverError(f"drift walk={brief(w)} is not a number: allowed a number in 0..1 (a per-episode log std)")
         if not finite_real(w) or not 0 <= w <= 1:
             raise NeurohoverError(f"drift walk={brief(w)} is out of range: allowed a number in 0..1 (a per-episode log std)")
+        if 0 < w < MIN_WALK:  # a walk that moves no parameter: every drifted row the fixed one
+            raise NeurohoverError(f"drift walk={brief(w)} is out of range, too small to change the dynamics: {_WALK_RANGE}")
         object.__setattr__(self, "walk", float(w))
         try:
             change = dict(self.change) if not isinstance(self.change, (dict, str)) else self.change
