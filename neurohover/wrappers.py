@@ -40,17 +40,24 @@ WORST_STEP = math.log1p(CRASH_STEP_PENALTY)  # the squashed worst step, about 7.
 #: scaled, stays finite (1e308 made crash rewards -inf with an overflow warning; T35-B08).
 MAX_SCALE = 1e300
 assert MAX_SCALE * WORST_STEP * MAX_EPISODE_STEPS < sys.float_info.max
+#: The smallest ``scale``: a step squashed to 1e-7 or more (|r| of 1e-7: hovering all but still), scaled, stays a normal
+#: float, its 53 bits of precision kept (5e-324 made every reward a denormal, one step's the next's; T40-B16).
+MIN_SCALE = 1e-300
+assert MIN_SCALE * 1e-7 >= sys.float_info.min
 
 
 def check_discount_and_scale(gamma, scale) -> None:
-    """Refuse a discount outside (0, 1] or a scale that is not a finite number > 0, by name: any real type (NumPy
+    """Refuse a discount outside (0, 1] or a scale outside MIN_SCALE..MAX_SCALE, by name: any real type (NumPy
     scalars, Fraction) is taken; np.float32(0.9) was "out of range" (twelfth trial U1), so a wrong type says so."""
-    scales = f"a finite number > 0 and <= {MAX_SCALE:g} (a larger one makes a crash's reward infinite)"
+    scales = (
+        f"a finite number > 0 and <= {MAX_SCALE:g} (a larger one makes a crash's reward infinite) and >= {MIN_SCALE:g} (a smaller one makes "
+        "rewards denormal floats, which lose the differences between steps)"
+    )
     for name, value, allowed in (("gamma", gamma, "a discount in (0, 1]"), ("scale", scale, scales)):
         if not real_number(value):
             raise NeurohoverError(f"{name}={brief(value)} is not allowed: give a real number, {allowed}")
         number = float(value) if finite_real(value) else math.nan  # nan: out of range either way
-        if not (0.0 < number <= 1.0 if name == "gamma" else 0 < number <= MAX_SCALE):
+        if not (0.0 < number <= 1.0 if name == "gamma" else MIN_SCALE <= number <= MAX_SCALE):
             raise NeurohoverError(f"{name}={brief(value)} is out of range: allowed {allowed}")
 
 
@@ -110,7 +117,7 @@ def refuse_changed_rewards(env: gym.Env) -> None:
 
 
 class CrashAwareReward(gym.RewardWrapper):
-    """Rewards of :func:`crash_aware` (``gamma``: the learner's discount, in (0, 1]; ``scale`` > 0), over an ``env`` whose
+    """Rewards of :func:`crash_aware` (``gamma``: the learner's discount, in (0, 1]; ``scale`` in 1e-300..1e300), over an ``env`` whose
     rewards are the environment's own: a reward wrapper, ``NormalizeReward`` or a CrashAwareReward inside (an ``-RL-v0``
     id) is refused (:func:`refuse_changed_rewards`)."""
 

@@ -123,7 +123,11 @@ def test_crash_aware_takes_any_real_number_type_in_range(gamma: object, scale: o
     assert (wrapped.gamma, wrapped.scale) == (float(gamma), float(scale))  # type: ignore[arg-type]
 
 
-SCALES = " and <= 1e+300 (a larger one makes a crash's reward infinite)"  # the bound since T35-B08
+# the bounds since T35-B08 (the largest) and T40-B16 (the smallest)
+SCALES = (
+    " and <= 1e+300 (a larger one makes a crash's reward infinite) and >= 1e-300 (a smaller one makes rewards denormal floats, "
+    "which lose the differences between steps)"
+)
 
 
 @pytest.mark.parametrize(

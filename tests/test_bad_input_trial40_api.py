@@ -168,3 +168,20 @@ def test_a_drift_walk_too_small_to_move_a_parameter_is_refused():
     row = nh.get_task_family("fghh").mdp("test:0").row()
     assert not (nh.Drift(MIN_WALK).rows(row, 5, 0) == row).all()
     assert nh.Drift().none and nh.Drift(0.0).none
+
+
+def test_a_crash_aware_scale_that_makes_rewards_denormal_is_refused():
+    """T40-B16: scale=5e-324 made every reward a denormal (-5e-324, -1e-323, -1e-323: steps alike) while scale=0 is
+    refused; the wrapper and crash_aware refuse a scale below MIN_SCALE (1e-300) naming it and the range."""
+    import gymnasium as gym
+
+    from neurohover.wrappers import MIN_SCALE, CrashAwareReward, crash_aware
+
+    allowed = r"is out of range: allowed a finite number > 0 and <= 1e\+300 \(.*\) and >= 1e-300 \(a smaller one makes rewards denormal floats"
+    for scale in (5e-324, 1e-310, 1e-301):
+        with pytest.raises(NeurohoverError, match=rf"^scale={scale!r} {allowed}"):
+            crash_aware(-0.2, scale=scale)
+        with pytest.raises(NeurohoverError, match=rf"^scale={scale!r} {allowed}"):
+            CrashAwareReward(gym.make("neurohover/GHH08-Short-v0"), scale=scale)
+    rewards = crash_aware([-0.2, -0.21, -1748.8 * 900, -1e-7], scale=MIN_SCALE)
+    assert len(set(rewards.tolist())) == 4 and all(abs(r) >= 2.2250738585072014e-308 for r in rewards)
