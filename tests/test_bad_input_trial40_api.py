@@ -2,7 +2,8 @@
 (T40-B04); a user TaskFamily named as a shipped family overwrote that family's wind kinds (T40-B01), and one with
 contradictory class attributes failed only in rows() (T40-B15); a registered variant id lost its defining setting to
 gym.make's kwargs (T40-B12); an MDP label took newlines (T40-B13); a drift walk too small to move a row (T40-B08) and a
-CrashAwareReward scale that makes every reward a denormal (T40-B16) were accepted."""
+CrashAwareReward scale that makes every reward a denormal (T40-B16) were accepted. Left from trial 39: a subclass of a
+built-in agent whose own __init__ skipped its base class's failed with a bare AttributeError."""
 
 from __future__ import annotations
 
@@ -185,3 +186,17 @@ def test_a_crash_aware_scale_that_makes_rewards_denormal_is_refused():
             CrashAwareReward(gym.make("neurohover/GHH08-Short-v0"), scale=scale)
     rewards = crash_aware([-0.2, -0.21, -1748.8 * 900, -1e-7], scale=MIN_SCALE)
     assert len(set(rewards.tolist())) == 4 and all(abs(r) >= 2.2250738585072014e-308 for r in rewards)
+
+
+def test_a_subclass_of_a_built_in_agent_skipping_its_base_constructor_is_named():
+    """Left from trial 39: a ModelFreeAgent subclass whose own __init__ never called ModelFreeAgent's was refused by a bare
+    AttributeError ('Mine' object has no attribute 'specialised') from run_test's check of its arguments."""
+    from neurohover.agents import ModelFreeAgent
+
+    class Mine(ModelFreeAgent):
+        def __init__(self, note: str = "x") -> None:
+            self.note = note
+
+    fam = nh.get_task_family("ghh08")
+    with pytest.raises(NeurohoverError, match=r"agent 'model-free' has no attribute 'specialised'.*call super\(\)\.__init__\(\.\.\.\) in Mine\.__init__"):
+        run_test(Mine(), fam, fam.mdp("test:1"), episodes=2, seed=0, n_steps=20)

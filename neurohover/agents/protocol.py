@@ -414,6 +414,13 @@ def _check_run(agent, family, mdp, episodes, seed, n_steps) -> tuple[MDP, int, i
         agent.check_arguments()  # its arguments as its constructor checks them: changed after construction (T39-B02)
     except NeurohoverError as err:
         raise NeurohoverError(f"agent {agent.name!r}: {err}") from None
+    except AttributeError as err:  # a subclass whose own __init__ skipped its base class's: a bare AttributeError
+        if err.obj is not agent:
+            raise
+        raise NeurohoverError(
+            f"agent {agent.name!r} has no attribute {err.name!r}, which is not allowed: its class {type(agent).__name__} defines __init__ "
+            f"without calling its base class's, which sets it (call super().__init__(...) in {type(agent).__name__}.__init__)"
+        ) from None
     if not isinstance(family, TaskFamily):
         raise NeurohoverError(f"family={family!r:.80} is not allowed: give a TaskFamily (neurohover.get_task_family(name))")
     if not isinstance(mdp, MDP):
