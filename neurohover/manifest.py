@@ -98,11 +98,13 @@ def built_as(manifest: dict, role: Role, k: int) -> dict:
     length, its budget and its method (a steady-state generic recording a generational run, or n_steps 999 in a set of
     20, was flown; T23-11); and its seed, the ``k``-th of the manifest's root seed's (a manifest seed of 7 beside policies
     of a build from 0 was shown; T25-14)."""
-    from .evolution.optimisers import NE, OPTIMISERS
+    from .evolution.optimisers import NE, OPTIMISERS, recorded_names
 
     family = role.target == "family"
     optimizer = NE if role.kind == "race" else manifest.get("optimizer", NE)  # a race is NE's (build_policy_set)
-    method = ("generational" if family else "steady-state") if optimizer == NE else getattr(OPTIMISERS.get(optimizer), "label", None)
+    method = ("generational" if family else "steady-state") if optimizer == NE else None
+    if optimizer != NE and isinstance(optimizer, str) and optimizer in OPTIMISERS:  # a user's, registered here, records user:LABEL (T40-B14)
+        method = recorded_names(optimizer)[0]  # (one registered elsewhere, or user:NAME, is not known here: its record is load_policy's to check)
     built = {"n_steps": manifest.get("n_steps"), "budget": manifest.get("fghh_budget" if family else "budget"), "method": method}
     if whole_number(manifest.get("seed")) and 0 <= manifest["seed"] < 2**63:  # T25-14: as build_policy_set seeds role k
         built["seed"] = int(np.random.SeedSequence(manifest["seed"]).generate_state(32, dtype=np.uint32)[k])
@@ -158,6 +160,11 @@ def check_digest_names(manifest: dict, path: Path, names) -> None:
     policy files are ``names``; an entry for specialised_10.json was taken without a word (T37-B08)."""
     digests = manifest.get(DIGESTS) or {}
     stray = next((name for name in digests if name not in names), None)
+    if stray == "ancestor.json" and manifest.get("lineage") is None:  # it named the ancestor, not the lineage missing (T40-B07)
+        raise NeurohoverError(
+            f"policy-set manifest {str(path)!r} has no lineage, and its {DIGESTS} records ancestor.json, which only a chain's build writes: "
+            f"give lineage 'chain' (allowed lineages: {', '.join(LINEAGES)}), as the build wrote it, or rebuild the set"
+        )
     if stray is not None:
         raise NeurohoverError(
             f"policy-set manifest {str(path)!r}: its {DIGESTS} entry {brief(stray)} is not allowed: the set has no such policy file "

@@ -28,7 +28,7 @@ import re
 import sys
 import textwrap
 import warnings
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -63,7 +63,7 @@ MAX_FIGURE_INCHES, MAX_FIGURE_PIXELS = 100.0, 2**16
 
 
 def new_figure(width: float, height: float, dpi: int = 100) -> Figure:
-    """A figure of ``width`` x ``height`` inches (each in (0, 100]) at ``dpi`` dots per inch (1..1000, neither side past
+    """A figure of ``width`` x ``height`` inches (each in (0, 100]) at ``dpi`` dots per inch (1..1000, each side 1 to
     2**16 pixels) with its own Agg canvas (no pyplot). -1, NaN or '1' inches and dpi=10**9 were matplotlib's ValueError or
     TypeError, the last only as the figure was saved (T33-B04)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg  # loaded by what draws, not by every command
@@ -76,6 +76,12 @@ def new_figure(width: float, height: float, dpi: int = 100) -> Figure:
         if not (finite_real(value) and 0 < value <= MAX_FIGURE_INCHES):
             raise NeurohoverError(f"figure {name}={brief(value)} is out of range: {allowed}")
     dpi = whole_in(dpi, "figure dpi", 1, 1000)
+    for name, value in (("width", width), ("height", height)):
+        if value * dpi < 1:  # 0.001 inches was taken, and save_figure failed with PIL's "cannot write empty image" (T40-B10)
+            raise NeurohoverError(
+                f"figure {name}={brief(value)} is out of range: {value:g} inches at dpi {dpi} is {value * dpi:.3g} pixels, and a side is at "
+                f"least 1 pixel (allowed {1 / dpi:g} <= {name} <= {MAX_FIGURE_INCHES:g} inches at dpi {dpi})"
+            )
     if max(width, height) * dpi > MAX_FIGURE_PIXELS:
         side = f"{max(width, height):g} inches at dpi {dpi} is {max(width, height) * dpi:,.0f} pixels"
         raise NeurohoverError(f"figure dpi={dpi} is out of range: {side}, and a side is at most {MAX_FIGURE_PIXELS:,} pixels")
@@ -421,21 +427,46 @@ def draw_cumulative(axes, curves: list[tuple[str, np.ndarray]]) -> None:
         ax.grid(alpha=0.3)
 
 
-def plot_cumulative(curves: dict[str, np.ndarray], path: Path, title: str) -> Path:
-    """Mean cumulative error per episode of each agent, linear and log scale (paper Figs 4 and 7)."""
+def plot_cumulative(curves: Mapping[str, object], path: str | Path, title: str) -> Path:
+    """Mean cumulative error per episode of each agent, linear and log scale (paper Figs 4 and 7), written as the PNG
+    ``path`` as :func:`save_figure` writes one (a name ending .png). ``curves``: label -> cumulative rewards after each
+    episode, a 2-D array of runs x episodes (the mean over runs is drawn) or a 1-D one of one run, of finite numbers <= 0."""
     # Object-oriented matplotlib (no pyplot): the caller's backend and pyplot figures stay as they are.
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(11, 4))
-    FigureCanvasAgg(fig)
+    drawn = [(printable(label), -(cumulative / cumulative.shape[0]).sum(axis=0)) for label, cumulative in _cumulative_curves(curves)]
+    heading = _title(title)
+    path = output_file(path, "plot file", suffixes=(".png",), what="a plot is PNG")  # 'cum.pdf' got PNG bytes (T40-B11)
+    fig = new_figure(11.0, 4.0, dpi=110)
     axes = fig.subplots(1, 2)
-    draw_cumulative(axes, [(name, -cumulative.mean(axis=0)) for name, cumulative in curves.items()])
+    draw_cumulative(axes, drawn)
     for ax in axes:
         ax.legend()
-    fig.suptitle(title)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    from .paths import write_png
+    fig.suptitle(heading)
+    with noting_missing_glyphs():
+        fig.tight_layout()
+    return save_figure(fig, path)
 
-    return write_png(fig, path, "plot file", dpi=110)
+
+def _cumulative_curves(curves: object) -> list[tuple[str, np.ndarray]]:
+    """:func:`plot_cumulative`'s ``curves`` as (label, runs x episodes float64 array), or one message naming the bad
+    curve and what is allowed: a str path and a list, None or text curve were AttributeErrors, NaN, 3-D or no curves
+    drawn without a word (T40-B09, T40-B11)."""
+    allowed = "a 2-D array of runs x episodes (or 1-D, one run) of cumulative rewards, finite numbers <= 0, at least one episode"
+    if not isinstance(curves, Mapping) or not curves:
+        raise NeurohoverError(f"curves={brief(curves)} is not allowed: give a dict of one or more label -> {allowed}")
+    checked = []
+    for label, values in curves.items():
+        if not isinstance(label, str):
+            raise NeurohoverError(f"curves' label {brief(label)} is not allowed: give text naming the curve")
+        try:
+            array = np.asarray(values)
+        except (ValueError, TypeError):  # ragged nested lists
+            array = np.asarray(None)
+        if isinstance(values, np.ma.MaskedArray) or array.dtype.kind not in "fiu" or array.ndim not in (1, 2) or array.size == 0:
+            got = f" of shape {array.shape}" if array.dtype.kind in "fiu" else f"={brief(values)}"
+            raise NeurohoverError(f"curve {brief(label)}{got} is not allowed: give {allowed}")
+        array = np.atleast_2d(array.astype(np.float64))
+        bad = ~(np.isfinite(array) & (array <= 0))
+        if bad.any():  # every reward is minus a sum of squares
+            raise NeurohoverError(f"curve {brief(label)}'s entry {brief(float(array[bad][0]))} is not allowed: give {allowed}")
+        checked.append((label, array))
+    return checked

@@ -12,7 +12,7 @@ import re
 from pathlib import Path
 from typing import Any
 
-from .errors import NeurohoverError, brief, finite_real, whole_number
+from .errors import NeurohoverError, brief, check_name_text, finite_real, whole_number
 from .policies import RECORD_CHECKS
 from .sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS, MAX_SECONDS, WORST_RETURN, lowest_return, seconds_allowed
 
@@ -115,7 +115,12 @@ def _run_words_problem(meta: dict, own_stop: dict, stop_reasons: tuple, parse_re
     reason = meta.get("stop_reason")
     if reason is None:
         return ""
-    if not isinstance(reason, str) or reason not in stop_reasons:
+    if isinstance(method, str) and method.startswith("user:"):  # a user optimiser's own stop is any name it gives (its spec's stop_reason)
+        try:  # 'my-stop' was refused, as save_policy saved the champion of the run that stopped by it
+            check_name_text("stop_reason", reason, "why the run stopped: budget, or its optimiser's own stop")
+        except NeurohoverError as err:
+            return f"its {err}"
+    elif not isinstance(reason, str) or reason not in stop_reasons:
         return f"its stop_reason {brief(reason)} is not allowed: allowed {', '.join(stop_reasons)} (why the run stopped)"
     budget, episodes = meta.get("budget"), meta.get("episodes")
     if reason == "budget" and "budget" in meta and (budget is None or (episodes is not None and episodes < budget)):

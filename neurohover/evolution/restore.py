@@ -81,8 +81,9 @@ def _check_run_entries(state: dict, one_mdp: bool) -> None:
     budget, reason, stream = state["budget"], state["stop_reason"], state["mdp_stream"]
     if budget is not None and not (whole_number(budget) and 1 <= budget <= MAX_BUDGET):
         raise EntryError(f"budget={brief(budget)} is not allowed: allowed null or an integer in 1..{MAX_BUDGET:,}")
-    if reason is not None and (not isinstance(reason, str) or reason not in STOP_REASONS):
-        raise EntryError(f"stop_reason={brief(reason)} is not allowed: allowed null or one of {', '.join(STOP_REASONS)}")
+    reasons = (*STOP_REASONS, *sorted({spec.stop_reason for spec in OPTIMISERS.values()} - set(STOP_REASONS)))  # and those registered since
+    if reason is not None and (not isinstance(reason, str) or reason not in reasons):  # a user optimiser's 'my-stop' was refused (T40-B14)
+        raise EntryError(f"stop_reason={brief(reason)} is not allowed: allowed null or one of {', '.join(reasons)}")
     if one_mdp and stream is not None:  # (a family's stream is the bit generator's to refuse)
         raise EntryError(f"mdp_stream={brief(stream)} is not allowed: allowed null (a run on one MDP draws no MDPs)")
 
