@@ -205,6 +205,11 @@ def _build(name: str):
     def build(policies: AgentPolicies, options: AgentOptions) -> Agent:
         assert policies.generic is not None
         evo = options.evolution
+        if evo is not None and evo.model_policy != "ours":  # ignored without a word: it evolves as the authors' code (T40-A03)
+            raise NeurohoverError(
+                f"model_policy={brief(evo.model_policy)} is not allowed for agent {name!r}: it evolves on the model as the authors' code "
+                "does (MODEL_EVOLUTION), whatever model_policy says; leave model_policy out"
+            )
         # A run's model budget (the configs' model_budget) applies here too: 2,550 is the authors'.
         settings = (
             CodeAgentSettings()
@@ -234,6 +239,7 @@ AGENT_SPECS = tuple(
         _build(f"authors-{kind}"),
         generic_kind=kind,
         learns_models=True,
+        idle_model_options=frozenset({"model_policy"}),  # its evolution on the model is always the authors' (T40-A03)
         summary=f"the authors' FGHH agent (generic, one-episode model, three model policies, the best) from the generic evolved {what}",
     )
     for kind, what in FGHH_GENERIC_KINDS

@@ -109,6 +109,10 @@ class AgentSpec:
     learns_models : bool
         Whether it learns LR models from its flight data (so the model options, such as the
         wind model, apply to it).
+    idle_model_options : frozenset of str
+        The model options (a :class:`~neurohover.agents.model_based.ModelEvolution` field, a config group's key, a
+        CLI option's name) that it learns models without: refused for it rather than ignored (the authors' FGHH agents
+        always evolve on the model as the authors did, whatever ``model_policy`` says; T40-A03).
     summary : str
         One line for help texts.
     """
@@ -120,6 +124,7 @@ class AgentSpec:
     generic_kind: str | None = None
     settings: type[AgentSettings] | None = None
     learns_models: bool = False
+    idle_model_options: frozenset[str] = frozenset()
     summary: str = ""
 
     def __post_init__(self) -> None:

@@ -66,6 +66,12 @@ def cmd_compete(args: argparse.Namespace) -> int:
         if option.field in model and not AGENTS[args.agent].learns_models:
             learners = ", ".join(name for name, spec in AGENTS.items() if spec.learns_models)
             raise NeurohoverError(f"{option.flag} applies to the agents that learn models ({learners}), not to --agent {args.agent}")
+        if option.field in model and option.field in AGENTS[args.agent].idle_model_options:  # taken and ignored (T40-A03)
+            takers = ", ".join(n for n, s in AGENTS.items() if s.learns_models and option.field not in s.idle_model_options)
+            raise NeurohoverError(
+                f"{option.flag} applies to the agents that evolve policies on their models as it says ({takers}), not to --agent "
+                f"{args.agent}, which would ignore it (its evolution on the model is always its own); leave it out"
+            )
     check_given(ModelEvolution, model, args.model_options)
     wind_model = str(model.pop("wind_model", "none"))
     check_sizes(args.runs, args.episodes)

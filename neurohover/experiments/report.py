@@ -518,6 +518,7 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
     every experiment asked for is damaged, NeurohoverError and nothing written, not a report of the damage alone.
     """
     from ..paths import created_dirs_removed_on_failure, output_dir
+    from .report_replaced import held_report, note_replaced
 
     if not isinstance(store, Store):  # None was an AttributeError (sixth trial)
         raise NeurohoverError(f"store={store!r:.60} is not allowed: give a Store(PATH)")
@@ -527,7 +528,10 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
     check_flag(refuse_all_damaged, "refuse_all_damaged", "write nothing when every experiment is damaged")
     with created_dirs_removed_on_failure():  # a failure leaves no directory it made, as on the command line (eleventh trial)
         out = output_dir(out, "report directory")  # '' wrote into the current directory; a file, a device or 5: OSError, TypeError
-        return _write_report(store, out, scale, names, refuse_all_damaged)
+        held = held_report(out / "report.md")  # what it replaces, said once written (T40-A04)
+        path = _write_report(store, out, scale, names, refuse_all_damaged)
+    note_replaced(held, path, store.path)
+    return path
 
 
 def _write_report(store: Store, out: Path, scale: str | None, names: list[str] | None, refuse_all_damaged: bool) -> Path:

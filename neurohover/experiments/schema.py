@@ -349,6 +349,12 @@ def _check_test_runs(settings: dict, task: str, where: str) -> None:
                 f"{where}: group {g['label']!r}: {', '.join(lr_keys)} {'applies' if len(lr_keys) == 1 else 'apply'} to the agents that learn models "
                 f"({learners}), not to {g['agent']!r}"
             )
+        idle = [k for k in MODEL_OPTIONS if k in g and k in AGENTS[g["agent"]].idle_model_options]
+        if idle:  # model_policy for the authors' FGHH agents: taken, ignored, and a hash of its own (T40-A03)
+            raise NeurohoverError(
+                f"{where}: group {g['label']!r}: {', '.join(idle)} {'is' if len(idle) == 1 else 'are'} not allowed for agent {g['agent']!r}, "
+                "which would ignore it (its evolution on the model is always its own): leave it out"
+            )
         if AGENTS[g["agent"]].learns_models:  # the estimate and the substeps are part of the config (and its hash)
             g["noise"] = g.get("noise", DEFAULT_NOISE_ESTIMATE)
             g["model_substeps"] = g.get("model_substeps", default_model_substeps(task))

@@ -49,6 +49,15 @@ MAX_STD = 100.0
 MAX_LEVEL = MAX_STD / max(LEVEL_PROFILE)
 
 
+def _is_number(text: str) -> bool:
+    """Whether ``text`` reads as a number (a bare noise level), for naming what is wrong with a setting."""
+    try:
+        float_of(text)  # '1_0' is no number here either
+    except ValueError:
+        return False
+    return True
+
+
 @dataclass(frozen=True)
 class Sensor:
     """Noisy, correlated, late sensors; ``Sensor()`` is exact (see the module docstring's table)."""
@@ -148,11 +157,17 @@ class Sensor:
                 raise NeurohoverError(f"sensor level {exc}: allowed a noise level in 0..{MAX_LEVEL:g}") from None
         settings: dict[str, float] = {}
         expected = f"allowed a noise level (e.g. 0.5) or key=value pairs with keys {', '.join(allowed)}"
-        for part in (p.strip() for p in text.split(",")):
+        parts = [p.strip() for p in text.split(",")]
+        if "" in parts:  # '0.5,' was called 'not understood' for its level (T40-A01)
+            raise NeurohoverError(f"sensor {text!r} has an empty setting between commas: {expected}")
+        for part in parts:
             key, eq, value = part.partition("=")
             key = key.strip()
-            if not part:
-                raise NeurohoverError(f"sensor {text!r} has an empty setting between commas: {expected}")
+            if not eq and len(parts) > 1 and _is_number(part):  # '0.5,velocity=0.1' refused 0.5 while naming it allowed (T40-A01)
+                raise NeurohoverError(
+                    f"sensor {text!r:.80} gives the bare level {part!r:.40} beside another setting: a bare level is allowed "
+                    f"only alone; among key=value pairs write level={part:.40} (one level), with keys {', '.join(allowed)}"
+                )
             if not eq or key not in allowed:
                 raise NeurohoverError(f"sensor setting {part!r} is not understood: {expected}")
             if key in settings:
