@@ -30,7 +30,7 @@ def policy_record_problem(meta: dict) -> str:
     a task other than its target's, mdp_params other than its label's MDP or settings of pop_size 0 (T24-02)."""
     from .evolution.config import MAX_BUDGET, parse_resampling
     from .evolution.fitness import ERROR_FLOOR
-    from .evolution.optimisers import NE, OPTIMISERS, USER_NAME
+    from .evolution.optimisers import NE, SHIPPED_SPECS, USER_NAME  # shipped names as shipped: not this process's registry (T41-B02/B03)
     from .evolution.restore import STOP_REASONS
     from .sim.rng import MAX_SEED
 
@@ -48,17 +48,19 @@ def policy_record_problem(meta: dict) -> str:
                               ("generations", "evaluations", "each generation evaluates at least one candidate")):  # fmt: skip
         if meta.get(small) is not None and meta.get(large) is not None and meta[small] > meta[large]:
             return f"its {small} {brief(meta[small])} is not allowed: more than its {large} {brief(meta[large])}, and {why}"
-    own_stop = {"steady-state": "plateau", "generational": "generations", **{spec.label: spec.stop_reason for spec in OPTIMISERS.values()}}
+    own_stop = {"steady-state": "plateau", "generational": "generations", **{spec.label: spec.stop_reason for spec in SHIPPED_SPECS.values()}}
     method, optimizer = meta.get("method"), meta.get("optimizer")
     users = [isinstance(v, str) and USER_NAME.fullmatch(v) is not None for v in (method, optimizer)]  # T40-B14
     user = " or user:NAME (an optimiser registered at run time)"
     if method is not None and not users[0] and (not isinstance(method, str) or method not in own_stop):
         return f"its method {brief(method)} is not allowed: allowed {', '.join(own_stop)}{user}"
-    names = {NE: ("steady-state", "generational"), **{name: (spec.label,) for name, spec in OPTIMISERS.items()}}
+    names = {NE: ("steady-state", "generational"), **{name: (spec.label,) for name, spec in SHIPPED_SPECS.items()}}
     if optimizer is not None and not users[1] and (not isinstance(optimizer, str) or optimizer not in names):
         return f"its optimizer {brief(optimizer)} is not allowed: allowed {', '.join(names)}{user}"
     if method is not None and optimizer is not None and users[0] != users[1]:
         return f"its method {brief(method)} is not allowed beside its optimizer {brief(optimizer)}: a run of a user:NAME optimizer records both so"
+    if users[0] and optimizer is not None and method != optimizer:  # user:openai-es beside user:other-name was written (T41-B04)
+        return f"its method {brief(method)} is not allowed beside its optimizer {brief(optimizer)}: a run of optimizer user:NAME records method user:NAME"
     if method is not None and optimizer is not None and not users[1] and method not in names[optimizer]:
         return f"its method {brief(method)} is not allowed: optimizer {optimizer!r} evolves by {' or '.join(names[optimizer])}"
     problem = _run_words_problem(meta, own_stop, STOP_REASONS, parse_resampling, (1 + 1e-9) / math.log(ERROR_FLOOR))
@@ -250,6 +252,9 @@ def _mdp_params_problem(params: object, task: object, target: object) -> str:
         return f"its mdp_params label {brief(mdp.label)} is not allowed beside its target {brief(target)}: the run was evolved on its target"
     if isinstance(task, str) and mdp.family != task:
         return f"its mdp_params family {brief(mdp.family)} is not allowed beside its task {brief(task)}: a run evolves on its task's MDPs"
+    if not mdp.drift.none:  # evolve refuses a drifting target, yet {"walk": 0.01} was taken (T41-B05)
+        why = "evolution flies fixed dynamics (drift is flown by test runs), so no run evolved on it"
+        return f"its mdp_params drift {brief(params.get('drift') if isinstance(params, dict) else None)} is not allowed: {why}; allowed none (leave drift out)"
     return ""
 
 

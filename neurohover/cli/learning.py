@@ -138,8 +138,7 @@ def _check_evolve_sizes(args: argparse.Namespace) -> None:
 def _evolve_meta(args, family, target, mdp_desc: str, resampling, result, scale: str, validation, history_name: str) -> dict:
     """What the champion's policy file records about its run."""
     meta = {
-        "task": family.name,
-        **({} if family.sensor.exact else {"sensor": family.sensor.to_dict()}),
+        "task": family.name,  # (the sensor its run saw through is the champion's own record: Run.result)
         "mdp": mdp_desc,
         "optimizer": args.optimizer,
         "resampling": str(resampling),

@@ -19,7 +19,7 @@ from ..sim.constants import MAX_EPISODE_STEPS
 from ..tasks import MDP, TaskFamily, refuse_drift
 from .bandits import BANDITS
 from .generational import GENERATIONAL_PRESETS, OLD_GENERATIONAL, GenerationalSettings
-from .optimisers import NE, OPTIMISERS, optimiser_names, population_settings
+from .optimisers import NE, OPTIMISERS, optimiser_names, optimiser_spec, population_settings
 from .optimisers.cma import CMASettings
 from .races import MAX_RESAMPLING, RACE_RULES  # MAX_RESAMPLING: a generation of 50 candidates is then 5,000,000 episodes
 from .seeding import check_seed
@@ -355,6 +355,7 @@ class RunConfig:
         proto = resolve_prototype(prototype, topology)
         if not isinstance(optimizer, str) or optimizer not in optimiser_names():
             raise NeurohoverError(f"unknown optimizer {brief(optimizer)}: allowed {', '.join(optimiser_names())}")
+        spec = None if optimizer == NE else optimiser_spec(optimizer)  # its registry entry checked first (T41-B02..B04)
         resampling = parse_resampling(resampling)
         if budget is not None:
             budget = check_budget(budget)
@@ -386,10 +387,10 @@ class RunConfig:
                 f"resampling {resampling} (a bandit) needs rewards in [0, 1]: the fitness scale inv-log-error (1/ln(error)), "
                 f"not {getattr(checked, 'fitness', None)!r}"
             )
-        if optimizer != NE and budget is None and not OPTIMISERS[optimizer].stops_itself:
+        if spec is not None and budget is None and not spec.stops_itself:
             raise NeurohoverError(f"optimizer {optimizer!r} has no stopping rule of its own: give a budget (episodes)")
-        if optimizer != NE and proto.genome.size < OPTIMISERS[optimizer].min_genes:
-            raise NeurohoverError(f"{optimizer} needs a genome of at least {OPTIMISERS[optimizer].min_genes} genes")
+        if spec is not None and proto.genome.size < spec.min_genes:
+            raise NeurohoverError(f"{optimizer} needs a genome of at least {spec.min_genes} genes")
         return cls(
             mdp, family, target_desc, proto, topology, optimizer, chosen, resampling, None if budget is None else int(budget), seed, int(n_steps), checked
         )

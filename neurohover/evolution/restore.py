@@ -21,7 +21,7 @@ from .common import EntryError, Optimiser, check_entries, check_genomes, damage_
 from .config import MAX_BUDGET, Resampling
 from .fitness import fitness_range, in_fitness_range
 from .generational import GenerationalNE
-from .optimisers import OPTIMISERS
+from .optimisers import OPTIMISERS, SHIPPED_SPECS, usable_specs
 from .records import check_history, decode_history
 from .steady_state import SteadyStateNE, steady_state_evaluations
 
@@ -44,7 +44,7 @@ _TABLES = {
     "champion": "genome (a list of numbers, or null before the first champion) and return",
 }
 #: Why a run stopped, as :func:`stop_reason` says it.
-STOP_REASONS = ("budget", "plateau", "generations", *sorted({spec.stop_reason for spec in OPTIMISERS.values()}))
+STOP_REASONS = ("budget", "plateau", "generations", *sorted({spec.stop_reason for spec in SHIPPED_SPECS.values()}))
 
 
 def stop_reason(method: str, opt: Optimiser, budget: int | None, episodes: int, generation: int) -> str | None:
@@ -81,7 +81,7 @@ def _check_run_entries(state: dict, one_mdp: bool) -> None:
     budget, reason, stream = state["budget"], state["stop_reason"], state["mdp_stream"]
     if budget is not None and not (whole_number(budget) and 1 <= budget <= MAX_BUDGET):
         raise EntryError(f"budget={brief(budget)} is not allowed: allowed null or an integer in 1..{MAX_BUDGET:,}")
-    reasons = (*STOP_REASONS, *sorted({spec.stop_reason for spec in OPTIMISERS.values()} - set(STOP_REASONS)))  # and those registered since
+    reasons = (*STOP_REASONS, *sorted({spec.stop_reason for spec in usable_specs().values()} - set(STOP_REASONS)))  # and those registered since
     if reason is not None and (not isinstance(reason, str) or reason not in reasons):  # a user optimiser's 'my-stop' was refused (T40-B14)
         raise EntryError(f"stop_reason={brief(reason)} is not allowed: allowed null or one of {', '.join(reasons)}")
     if one_mdp and stream is not None:  # (a family's stream is the bit generator's to refuse)

@@ -499,7 +499,9 @@ class Run:
         label = target["mdp"]["label"] if target["kind"] == "mdp" else f"{target['family']}/G" + (f"(sigma={target['sigma']:g})" if "sigma" in target else "")
         cfg = self.cfg
         method, optimizer = recorded_names(cfg.optimizer) if cfg.optimizer in OPTIMISERS else (self.method, cfg.optimizer)
+        sensor = cfg.mdp.sensor if cfg.mdp is not None else cfg.family.sensor if cfg.family is not None else None
         meta = {
+            **({} if sensor is None or sensor.exact else {"sensor": sensor.to_dict()}),  # what the run saw through: the API's and the CLI's (T41-B08)
             "method": method,
             "optimizer": optimizer,
             "resampling": str(self.resampling),

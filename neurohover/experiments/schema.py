@@ -19,7 +19,7 @@ from ..agents.registry import AGENTS, HYBRID_AGENTS
 from ..errors import NeurohoverError, brief
 from ..evolution.config import make_settings, optimiser_of
 from ..evolution.evolve import parse_resampling
-from ..evolution.optimisers import OPTIMISERS
+from ..evolution.optimisers import optimiser_spec
 from ..integrations.neat import NEAT_TOPOLOGY
 from ..models.lr import DEFAULT_NOISE_ESTIMATE
 from ..models.model import default_model_substeps
@@ -247,7 +247,7 @@ def _check_evolution(settings: dict, task: str, where: str) -> None:
         table = settings["optimizer"] if v is None else variant_optimizer(settings["optimizer"], v.get("optimizer"))
         try:  # the optimizer settings are checked here, not when a unit first runs
             name, rest = optimiser_of(table)
-            if name != "ne" and settings["budget"] == 0 and not OPTIMISERS[name].stops_itself:
+            if name != "ne" and not optimiser_spec(name).stops_itself and settings["budget"] == 0:  # its entry checked (T41-B02)
                 raise NeurohoverError(f"optimizer {name!r} has no stopping rule of its own: give the experiment a budget")
             make_settings(method, name, rest)
         except NeurohoverError as err:

@@ -10,7 +10,13 @@ champion, and over a task family the best estimate of the last generation.
 
 An optimiser registered at run time instead (``OPTIMISERS["my-es"] = OptimiserSpec("my-es", ...)`` in a script) runs
 the same; its champions record it as method and optimizer ``user:my-es`` (:func:`recorded_names`), which every process
-reads (one without it registered too), while a record of a shipped optimiser's name is checked against the registry.
+reads (one without it registered too), while a record of a shipped optimiser's name is checked against the shipped spec.
+Where the registry is used (:func:`optimiser_spec`: ``evolve``, an experiment config, a run's record) its entry must be
+an :class:`OptimiserSpec` under its own name, a shipped name must hold its shipped spec (:data:`SHIPPED_SPECS`), and a
+run-time name is one line of at most 64 letters, digits and ``._+-`` (what :data:`USER_NAME` reads back) whose label is
+its name: ``label`` is how a shipped optimiser names its method (``cma`` evolves by ``cma-es``), and a run-time
+optimiser's method is its name (T41-B02..B04). A bad entry is refused by name where it is used, and no other run or
+policy file is the worse for it.
 """
 
 from __future__ import annotations
@@ -21,13 +27,27 @@ import pkgutil
 import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
 
 from ...errors import NeurohoverError, brief, settings_from_dict
 
-__all__ = ["NE", "OPTIMISERS", "SHIPPED", "USER_NAME", "OptimiserSpec", "optimiser_names", "population_settings", "recorded_names"]
+__all__ = [
+    "NE",
+    "OPTIMISERS",
+    "SHIPPED",
+    "SHIPPED_SPECS",
+    "USER_NAME",
+    "OptimiserSpec",
+    "entry_problem",
+    "optimiser_names",
+    "optimiser_spec",
+    "population_settings",
+    "recorded_names",
+    "usable_specs",
+]
 
 NE = "ne"  # the paper's neuroevolution: not a population optimiser of this registry
 
@@ -86,8 +106,12 @@ def _discover() -> dict[str, OptimiserSpec]:
 #: Every population optimiser by name (modules in name order: cma, openai_es, ...).
 OPTIMISERS: dict[str, OptimiserSpec] = _discover()
 
+#: The optimisers every process knows, as this package's modules declare them: what a shipped name holds wherever the
+#: registry is used, and what a policy's record of one is checked against (a slot replaced in one process is not; T41-B03).
+SHIPPED_SPECS: Mapping[str, OptimiserSpec] = MappingProxyType(dict(OPTIMISERS))
+
 #: The optimisers every process knows: this package's modules'. A policy's record names one as it is.
-SHIPPED: frozenset[str] = frozenset(OPTIMISERS)
+SHIPPED: frozenset[str] = frozenset(SHIPPED_SPECS)
 
 #: How a policy's record names an optimiser registered at run time (``OPTIMISERS[name] = OptimiserSpec(...)`` in a
 #: script, not a module here), which another process has not registered: ``user:`` and a one-line name of at most 64
@@ -95,25 +119,67 @@ SHIPPED: frozenset[str] = frozenset(OPTIMISERS)
 USER_NAME = re.compile(r"user:[A-Za-z0-9][A-Za-z0-9._+-]{0,63}")
 
 
+def entry_problem(name: object, spec: object) -> str:
+    """What is wrong with the registry entry ``OPTIMISERS[name] = spec`` ('' when nothing): no :class:`OptimiserSpec`
+    (5 or None was an AttributeError in evolve and in every later load_policy, T41-B02), a shipped name holding another
+    spec (``OPTIMISERS["cma"] = OPTIMISERS["openai-es"]`` ran OpenAI-ES as cma, T41-B03), or a run-time entry under a key
+    other than its spec's name, a key :data:`USER_NAME` does not read back, or a label other than its name (they recorded
+    ``user:openai-es`` beside ``user:other-name``, T41-B04)."""
+    entry = f"OPTIMISERS[{brief(name)}] = {brief(spec)} is not allowed"
+    if not isinstance(spec, OptimiserSpec):
+        return f"{entry}: register an OptimiserSpec under its name (OPTIMISERS[spec.name] = spec)"
+    if isinstance(name, str) and name in SHIPPED:
+        if spec == SHIPPED_SPECS[name]:
+            return ""
+        return f"{entry}: {name!r} is a shipped optimiser's name and holds its shipped spec; register yours under a name of its own"
+    if spec.name != name:
+        return f"{entry}: its spec's name {brief(spec.name)} is not its key; register a spec under its own name (OPTIMISERS[spec.name] = spec)"
+    if not isinstance(name, str) or name == NE or not USER_NAME.fullmatch(f"user:{name}"):
+        return f"{entry}: a run-time optimiser's name is one line of at most 64 letters, digits and ._+- (not {NE!r}), which its records name as user:NAME"
+    if spec.label != name:
+        return f"{entry}: its label {brief(spec.label)} is not its name; a run-time optimiser records its name as its method (user:{name}): leave label out"
+    return ""
+
+
+def optimiser_spec(name: str) -> OptimiserSpec:
+    """The registry's spec of population optimiser ``name``, its entry checked (:func:`entry_problem`; NeurohoverError
+    naming a bad one, or an unknown name)."""
+    if not isinstance(name, str) or name not in OPTIMISERS:
+        raise NeurohoverError(f"unknown optimizer {brief(name)}: allowed {', '.join(optimiser_names())}")
+    spec = OPTIMISERS[name]
+    problem = entry_problem(name, spec)
+    if problem:
+        raise NeurohoverError(problem)
+    return spec
+
+
+def usable_specs() -> dict[str, OptimiserSpec]:
+    """The registry's entries that :func:`optimiser_spec` takes: what a listing of every optimiser reads, so that one bad
+    entry breaks only its own use."""
+    return {name: spec for name, spec in list(OPTIMISERS.items()) if not entry_problem(name, spec)}
+
+
 def recorded_names(name: str) -> tuple[str, str]:
     """The ``(method, optimizer)`` a champion's record of a run of population optimiser ``name`` says: its label and its
-    name where it is :data:`SHIPPED`, else both prefixed ``user:`` (a record every process reads; a name
-    :data:`USER_NAME` does not take is refused as the policy is saved)."""
-    spec = OPTIMISERS[name]
-    return (spec.label, name) if name in SHIPPED else (f"user:{spec.label}", f"user:{name}")
+    name where it is :data:`SHIPPED` (from :data:`SHIPPED_SPECS`), else ``user:NAME`` for both (a record every process
+    reads; the entry is checked by :func:`optimiser_spec`)."""
+    if isinstance(name, str) and name in SHIPPED:
+        return SHIPPED_SPECS[name].label, name
+    optimiser_spec(name)
+    return f"user:{name}", f"user:{name}"
 
 
 def optimiser_names() -> tuple[str, ...]:
-    """Every optimiser an evolution run takes: the paper's ``ne`` first, then the registry's."""
-    return (NE, *OPTIMISERS)
+    """Every optimiser an evolution run takes: the paper's ``ne`` first, then the registry's (its text keys)."""
+    return (NE, *(name for name in list(OPTIMISERS) if isinstance(name, str)))
 
 
 def population_settings(name: str, settings: Any) -> Any:
     """The checked settings object of population optimiser ``name`` from None (the defaults), an
     object of its settings class, or a dict of overrides (NeurohoverError on a bad key or value)."""
-    if not isinstance(name, str) or name not in OPTIMISERS:  # a list or an array was "unhashable type" (sixteenth trial)
-        raise NeurohoverError(f"unknown optimizer {brief(name)}: allowed {', '.join(optimiser_names())}")
-    cls = OPTIMISERS[name].settings
+    # a list or an array was "unhashable type" (sixteenth trial); a bad entry is named (T41-B02), a shipped name's settings
+    # are its shipped spec's (a record of one reads alike in every process: evolve refuses a replaced slot, T41-B03)
+    cls = SHIPPED_SPECS[name].settings if isinstance(name, str) and name in SHIPPED else optimiser_spec(name).settings
     if settings is None:
         return cls()
     if type(settings) is cls:  # exactly its class: a subclass's settings (UH-CMA-ES's of CMA-ES's) belong to another optimiser
