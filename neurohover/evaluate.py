@@ -24,7 +24,7 @@ from .errors import NeurohoverError, as_floats, brief, finite_real, real_number,
 from .flightdata import FlightData, same_values
 from .flyer import KernelFlyer, refuse_other_import
 from .launch import DEVICES, KIND, MAX_SEED, Batch, Flown, check_device, launch, num_threads, use_lanes
-from .policies import GENOME_LENGTH, Policy, check_padding, frozen, genome_rows, load_policy, refuse_own_act
+from .policies import GENOME_LENGTH, Policy, check_genome, check_padding, frozen, genome_rows, load_policy, refuse_own_act
 from .sim.constants import (
     EPISODE_STEPS,
     MAX_EPISODE_STEPS,
@@ -129,10 +129,12 @@ class PolicyTable:
         if bad:
             raise NeurohoverError(f"policy {bad[0]!r:.60} is not a Policy: load one with neurohover.load_policy (e.g. load_policy('baseline'))")
         refuse_own_act(policies)  # a subclass's own act was ignored: the kernel flies the genome (T33-B11)
+        # checked again as save_policy does: a frozen field overwritten (object.__setattr__) was a KeyError or flown (T41-B11)
+        checked = [check_genome(p.genome, p.topology) for p in policies]
         kinds = np.array([KIND[p.topology] for p in policies], dtype=np.int64)
         genomes = np.zeros((len(policies), GENOME_WIDTH))
-        for i, p in enumerate(policies):
-            genomes[i, : p.genome.size] = p.genome
+        for i, genome in enumerate(checked):
+            genomes[i, : genome.size] = genome
         return cls(frozen(kinds, None), frozen(genomes, None))  # made here: frozen, not copied again
 
     @classmethod
@@ -281,7 +283,8 @@ def _index_array(values, n_jobs: int | None, what: str) -> np.ndarray:
         raise NeurohoverError(f"{what} must be a 1-D array of job indices, got shape {arr.shape}")
     check_episode_count(arr.size, f"{what} of {arr.size:,} jobs")  # before its int64 copy (10**10 int8 indices: 75 GiB; third trial)
     if arr.size and arr.dtype.kind not in "iu":  # not issubdtype(np.integer): a time span's array is one (T17-1)
-        raise NeurohoverError(f"{what} must hold integers, got dtype {arr.dtype}")
+        wide = next((v for v in arr.flat if whole_number(v) and not -(2**63) <= v < 2**63), None) if arr.dtype == object else None  # T41-B09
+        raise NeurohoverError(f"{what} holds {brief(wide)}, out of range: allowed 0..2**63-1" if wide else f"{what} must hold integers, got dtype {arr.dtype}")
     if arr.size and np.issubdtype(arr.dtype, np.unsignedinteger) and arr.max() > np.iinfo(np.int64).max:  # would wrap negative
         raise NeurohoverError(f"{what} holds {arr.max()}, out of range: allowed 0..2**63-1")
     arr = arr.astype(np.int64).reshape(-1)
@@ -332,9 +335,7 @@ def _fallback_array(fallback_index, n_jobs: int, n_policies: int) -> np.ndarray:
         raise NeurohoverError(f"fallback_index has {fb.size} entries but there are {n_jobs} jobs: give one per job, each in -1..{n_policies - 1}")
     bad = np.flatnonzero((fb < -1) | (fb >= n_policies))
     if bad.size:
-        raise NeurohoverError(
-            f"fallback_index entry {bad[0]} is {brief(fb.reshape(-1)[bad[0]].item())}, out of range: allowed -1 (none) or 0..{n_policies - 1}"
-        )
+        raise NeurohoverError(f"fallback_index entry {bad[0]} is {brief(fb.flat[bad[0]].item())}, out of range: allowed -1 (none) or 0..{n_policies - 1}")
     return fb.astype(np.int64).reshape(-1)
 
 
@@ -494,9 +495,8 @@ def evaluate(
     episode_index = first_episode + m_idx * episodes + e
     fallback = limits = None
     if safeguard is not None:
-        table = PolicyTable(
-            np.append(table.kinds, KIND[safeguard.fallback.topology]), np.vstack([table.genomes, PolicyTable.from_policies([safeguard.fallback]).genomes])
-        )
+        extra = PolicyTable.from_policies([safeguard.fallback])  # its kind from the checked policy (KIND['rnn'] was a KeyError; T41-B11)
+        table = PolicyTable(np.append(table.kinds, extra.kinds), np.vstack([table.genomes, extra.genomes]))
         fallback = np.full(p_idx.size, n_pol, dtype=np.int64)
         limits = safeguard.dangerous.limits()
     ev = evaluate_jobs(

@@ -26,6 +26,9 @@ LINEAGES = ("chain", "independent")
 #: The manifest's record of each policy file's network: file name -> :func:`genome_digest` of the policy its build wrote
 #: there. A build writes it; an older build's manifest holds none, and its files are loaded unchecked (T36-B05).
 DIGESTS = "genome_sha256"
+#: Where every policy of a set records its lineage started: a build starts each run from the baseline network (a chain's
+#: from its ancestor, which did). A build that writes :data:`DIGESTS` records it in every file.
+BUILT_PROTOTYPE = "baseline"
 
 
 # What a manifest's descriptive fields may hold (they are shown and compared, never flown): name -> (kinds, what is allowed).
@@ -106,6 +109,7 @@ def built_as(manifest: dict, role: Role, k: int) -> dict:
     if optimizer != NE and isinstance(optimizer, str) and optimizer in OPTIMISERS:  # a user's, registered here, records user:LABEL (T40-B14)
         method = recorded_names(optimizer)[0]  # (one registered elsewhere, or user:NAME, is not known here: its record is load_policy's to check)
     built = {"n_steps": manifest.get("n_steps"), "budget": manifest.get("fghh_budget" if family else "budget"), "method": method}
+    built["prototype"] = BUILT_PROTOTYPE  # every run of a build (a chain's from its ancestor) starts from the baseline: 'zero' was taken (T41-B06)
     if whole_number(manifest.get("seed")) and 0 <= manifest["seed"] < 2**63:  # T25-14: as build_policy_set seeds role k
         built["seed"] = int(np.random.SeedSequence(manifest["seed"]).generate_state(32, dtype=np.uint32)[k])
     if family:  # T25-07: race:0.1 on the fixed generic was flown; the build runs each generic over G by its role's resampling
@@ -138,12 +142,19 @@ def check_digests(manifest: dict, path: Path, files: dict[str, Policy], others: 
     policies scaled by hand loaded with the manifest's safe list, crash table and champion returns of the ones its build
     flew, and the hybrid agent fell back on policies that now always crash (T36-B05). A manifest without
     :data:`DIGESTS` (a build before it was written) is not checked: its set loads as before. Given ``others``, the set's
-    files are ``files`` and ``others`` (checked elsewhere), and an entry of another file is refused (T37-B08)."""
+    files are ``files`` and ``others`` (checked elsewhere), and an entry of another file is refused (T37-B08). A file of
+    such a set that records no prototype is refused too (its build wrote :data:`BUILT_PROTOTYPE`; T41-B06)."""
     digests = manifest.get(DIGESTS)
     if digests is None:
         return
     if others is not None:
         check_digest_names(manifest, path, [*files, *others])
+    bare = next((name for name, policy in files.items() if "prototype" not in policy.metadata), None)
+    if bare is not None:  # a prototype deleted by hand was taken (T41-B06); a build before DIGESTS may not have written it
+        raise NeurohoverError(
+            f"policy set {str(path.parent)!r}: {bare} records no prototype, which its build wrote (allowed {BUILT_PROTOTYPE!r}: every run of a "
+            f"build starts from the baseline): restore it, or rebuild the set with: neurohover build-policies --task {path.parent.name}"
+        )
     for name, policy in files.items():
         want, have = digests.get(name), genome_digest(policy)
         if want != have:

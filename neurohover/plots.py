@@ -161,10 +161,16 @@ def _real_array(values: object, name: str, columns: int, shape: str) -> np.ndarr
     return array.astype(np.float64, copy=False)
 
 
-def _check_episode_steps(episode_steps: object) -> int:
-    """``episode_steps`` (a full episode's control steps) as an int, or one message saying what is allowed."""
+def _check_episode_steps(episode_steps: object, flown: int = 0) -> int:
+    """``episode_steps`` (a full episode's control steps) as an int, or one message saying what is allowed; not below
+    ``flown``, the steps of the episode drawn (10 for 6,000 was drawn as "no crash", as FlightData refuses; T41-B07)."""
     if not whole_number(episode_steps) or not 1 <= episode_steps <= MAX_EPISODE_STEPS:  # nan or -1 said "no crash" (T14-11)
         raise NeurohoverError(f"episode_steps={brief(episode_steps)} is not allowed: give an integer in 1..{MAX_EPISODE_STEPS:,}")
+    if flown > episode_steps:
+        raise NeurohoverError(
+            f"the episode has {flown:,} steps, more than episode_steps={int(episode_steps):,} (every episode ends at that budget): "
+            f"give its episode's budget, an integer in {flown:,}..{MAX_EPISODE_STEPS:,}"
+        )
     return int(episode_steps)
 
 
@@ -197,8 +203,8 @@ def attitude_angles(observations: np.ndarray) -> np.ndarray:
 def crashed_episode(actions: np.ndarray, episode_steps: int = EPISODE_STEPS) -> bool:
     """Whether an episode of ``actions`` (a (T, 4) array) crashed: it ended before ``episode_steps`` control steps
     (an integer in 1..MAX_EPISODE_STEPS)."""
-    steps = _check_episode_steps(episode_steps)
-    return _real_array(actions, "actions", 4, "(T, 4)").shape[0] < steps
+    flown = _real_array(actions, "actions", 4, "(T, 4)").shape[0]
+    return flown < _check_episode_steps(episode_steps, flown)
 
 
 def flight_figure(
@@ -235,7 +241,7 @@ def flight_figure(
     if act.shape[0] < 1 or obs.shape[0] != act.shape[0] + 1:  # (0, 12) was an IndexError (T14-11)
         raise NeurohoverError(f"observations of shape {obs.shape} and actions of shape {act.shape} are not one episode: give (T + 1, 12) and (T, 4), T >= 1")
     title = _title(title)  # a file or policy name that is no UTF-8 was matplotlib's TypeError (eleventh trial)
-    steps = _check_episode_steps(episode_steps)
+    steps = _check_episode_steps(episode_steps, act.shape[0])
     if crashed is None:
         crashed = crashed_episode(act, steps)
     elif not isinstance(crashed, (bool, np.bool_)):

@@ -195,6 +195,7 @@ GENOME_RESULT_KEYS = frozenset(
 
 def check_genome(genome, topology: str) -> np.ndarray:
     """Return ``genome`` as a float64 vector of the topology's length, or raise a clear error."""
+    _check_topology(topology)  # a Policy's topology overwritten with 'rnn' was a KeyError here (T41-B11)
     try:  # text, booleans, complex numbers (third trial), objects, dates and masked arrays (T16-9, T16-10): as_floats
         arr = as_floats(genome, "genome", "")
     except NeurohoverError:

@@ -35,7 +35,9 @@ chain's set must hold its ``ancestor.json`` (an independent one must not), and a
 writes (``specialised_10.json`` beside a GHH set's ten) is refused by name rather than ignored. Files of other names
 (a README, notes, a run's ``.history.csv``) are left alone: none can be taken for one of the set's policies. A file
 whose genome is not the one its manifest's ``genome_sha256`` records (an edit by hand) is refused by name (T36-B05); a
-manifest without digests (an older build) loads as before, unchecked.
+manifest without digests (an older build) loads as before, unchecked. Every file's record of the run must be the one its
+manifest says the build ran (name, target, seed, budget, n_steps, method and prototype 'baseline', where recorded; a
+build that writes digests records the prototype in every file: T41-B06).
 """
 
 from __future__ import annotations
@@ -54,6 +56,7 @@ import numpy as np
 from .errors import NeurohoverError, brief, finite_real, whole_number
 from .evaluate import MAX_EPISODES_PER_CALL, evaluate
 from .manifest import (
+    BUILT_PROTOTYPE,
     DIGESTS,
     LINEAGES,
     _check_manifest_fields,
@@ -397,7 +400,7 @@ def _evolve_one(
     kwargs["optimizer"] = NE if race else optimizer
     if "resampling" not in kwargs and kwargs["optimizer"] == NE:  # steady state: spend the whole budget (no plateau stop)
         kwargs["settings"] = SteadyStateSettings(plateau_threshold=kwargs["budget"])
-    start_from = seed_policy if seed_policy is not None else prototype(SET_TOPOLOGY, "baseline")
+    start_from = seed_policy if seed_policy is not None else prototype(SET_TOPOLOGY, BUILT_PROTOTYPE)  # what the set's loader checks
     result = evolve(target, topology=SET_TOPOLOGY, prototype=start_from, seed=child_seed, n_steps=n_steps, **kwargs)
     policy = result.champion
     meta = {"episodes": int(result.episodes), "seconds": round(time.perf_counter() - t0, 2)}

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from ..envs.arguments import check_obs_dtype, real_values
+from ..envs.arguments import check_episode_steps, check_obs_dtype, real_values
 from ..envs.vector import HoverVectorEnv
 from ..errors import NeurohoverError, brief, float64_of, refused_signature, whole_in
 from ..evaluate import Evaluation, check_first_episode
@@ -63,6 +63,11 @@ def _check_on_step(on_step: Any) -> None:
     """Refuse an ``on_step`` that cannot be called before anything flies (5 was a TypeError after the first step; twelfth trial T5)."""
     if on_step is not None and not callable(on_step):
         raise NeurohoverError(f"on_step={brief(on_step)} is not allowed: give a function of no arguments (called after each step) or None")
+    refused = None if on_step is None else refused_signature(on_step, 0)  # lambda x: None was a bare TypeError after the first step (T41-B01)
+    if refused:
+        raise NeurohoverError(
+            f"on_step of signature {brief(refused)} is not allowed: the flight calls on_step() after each step; give a function of no arguments, or None"
+        )
 
 
 def evaluate_callable(
@@ -104,6 +109,7 @@ def evaluate_callable(
     mdps, family = _checked_mdps(mdps)
     _check_on_step(on_step)
     unchecked = not _check_arity(act, bool(indexed))  # no signature to read: a TypeError of its first call says so
+    n_steps = check_episode_steps(n_steps, "n_steps")  # refused as "episode_steps=0", a parameter it has not (T41-B10)
     first_episode = check_first_episode(first_episode)  # text was a TypeError from first_episode + k, True taken as 1 (twelfth trial T5)
     if len(mdps) > MAX_EPISODES:
         raise NeurohoverError(f"mdps: {len(mdps):,} MDPs is out of range: at most {MAX_EPISODES} (episodes x MDPs <= {MAX_EPISODES})")
