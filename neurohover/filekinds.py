@@ -78,7 +78,25 @@ CSV_KINDS: dict[str, frozenset[str]] = {
 FLIGHT_DATA_KIND = "flight data (a NumPy archive)"  # what held_kind calls an .npz: FlightData.save writes over no other kind (T34-B03)
 POLICY_SET_KIND = "a policy set's manifest"  # what held_kind calls a set's manifest.json: no other writer adds files beside it
 UTF8_BOM = b"\xef\xbb\xbf"  # a byte-order mark ("UTF-8 with BOM"): held_kind reads a JSON or CSV file after it, as its readers do
-_KIND_READ_LIMIT = 64 * 2**20  # a larger file is no neurohover JSON file told apart here
+_KIND_READ_LIMIT = 64 * 2**20  # a larger JSON file is no neurohover JSON file told apart here (it is parsed whole)
+_END_READ = 2**20  # the bytes read from each end of a file: the kinds other than JSON are told apart by them, whatever its size
+
+
+def _ends(path: Path) -> tuple[bytes, bytes, int] | None:
+    """The first and the last :data:`_END_READ` bytes of the regular file ``path`` (one read where it is no longer) and
+    its size; None where it is no such file or cannot be read."""
+    try:
+        if not path.is_file():
+            return None
+        with open(path, "rb") as f:
+            head = f.read(_END_READ)
+            size = max(os.fstat(f.fileno()).st_size, len(head))
+            if size <= len(head):
+                return head, head, size
+            f.seek(max(size - _END_READ, len(head)))
+            return head, f.read(_END_READ), size
+    except OSError:
+        return None
 
 
 def held_kind(path: str | os.PathLike) -> str | None:
@@ -86,30 +104,37 @@ def held_kind(path: str | os.PathLike) -> str | None:
     content: a results store (SQLite), a PNG image, a report.md of ``neurohover report``, flight data (a NumPy archive),
     one of :data:`JSON_KINDS` or :data:`CSV_KINDS`; None for anything
     else (no such file, unreadable, another file). The one test of "which kind of neurohover file is this" that
-    :func:`output_file` refuses to write another kind over."""
+    :func:`output_file` refuses to write another kind over. All but a JSON file are told apart by the ends of the file
+    (:func:`_ends`), so size does not matter: flight data over 64 MiB was no flight data, and any output replaced it
+    without a word (T41-A01); a JSON file is parsed whole, up to :data:`_KIND_READ_LIMIT`."""
     p = Path(path)
-    try:
-        if not p.is_file() or p.stat().st_size > _KIND_READ_LIMIT:
-            return None
-        with open(p, "rb") as f:
-            body = f.read()
-    except OSError:
+    ends = _ends(p)
+    if ends is None:
         return None
-    if body.startswith(SQLITE_HEADER):
+    head, tail, size = ends
+    if head.startswith(SQLITE_HEADER):
         return "a results store (SQLite)"
-    if body.startswith(PNG_SIGNATURE):
+    if head.startswith(PNG_SIGNATURE):
         return PNG_KIND
-    if body.startswith(REPORT_HEADER.encode()):
+    if head.startswith(REPORT_HEADER.encode()):
         return REPORT_KIND
-    if body.startswith(b"PK\x03\x04"):  # a zip: a NumPy archive (.npz) holds its arrays as NAME.npy
-        return FLIGHT_DATA_KIND if b"format.npy" in body else None
-    body = body.removeprefix(UTF8_BOM)  # neurohover's readers read a JSON or CSV file after a byte-order mark (T38-B03)
-    if not body.lstrip()[:1] == b"{":
-        header = {c.decode("latin-1") for c in body.split(b"\n", 1)[0].rstrip(b"\r").split(b",")}
+    if head.startswith(b"PK\x03\x04"):  # a zip: a NumPy archive (.npz) holds its arrays as NAME.npy, named in its
+        # first member's header (flight data's format comes first) and in the central directory at its end
+        return FLIGHT_DATA_KIND if b"format.npy" in head or b"format.npy" in tail else None
+    head = head.removeprefix(UTF8_BOM)  # neurohover's readers read a JSON or CSV file after a byte-order mark (T38-B03)
+    start = head.lstrip()[:1]
+    if start not in (b"{", b""):
+        line, newline, _ = head.partition(b"\n")
+        if not newline and size > _END_READ:  # a first line longer than every neurohover header
+            return None
+        header = {c.decode("latin-1") for c in line.rstrip(b"\r").split(b",")}
         return next((kind for kind, cells in CSV_KINDS.items() if cells <= header), None)
+    if size > _KIND_READ_LIMIT:
+        return None
     try:
+        body = p.read_bytes().removeprefix(UTF8_BOM)
         value = json.loads(body)
-    except (ValueError, RecursionError):
+    except (OSError, ValueError, RecursionError):
         return None
     return next((kind for kind, test in JSON_KINDS.items() if isinstance(value, dict) and test(value)), None)
 
