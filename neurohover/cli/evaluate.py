@@ -156,8 +156,13 @@ def _generic_at_other_sigma(family) -> tuple[str, Policy] | None:
 def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     """Fly a trained policy on full paper episodes of a task's training or test MDPs, beside the competition's baseline
     and the shipped generic policy on the same gusts, and print the paper's measures (return per episode, crashes)."""
+    with contextlib.ExitStack() as held:  # --json's writer lock, held until the command ends
+        return _evaluate_agent(args, held)
+
+
+def _evaluate_agent(args: argparse.Namespace, held: contextlib.ExitStack) -> int:
     from ..integrations.flying import compare_agent
-    from ..paths import output_file, writing
+    from ..paths import output_file, sole_writer, writing
     from ..progress import progress_bar
 
     family = task_family_of(args)  # with --obs-noise / --obs-delay every policy flies through those sensors
@@ -177,6 +182,7 @@ def cmd_evaluate_agent(args: argparse.Namespace) -> int:
     act = _agent(args)
     if out is not None:
         output_file(args.json, "--json", _files_read(args), kind=ROWS_KIND, suffixes=(".json",), what=ROWS_ARE)
+        held.enter_context(sole_writer(out, "--json"))  # one of two runs at once was lost, both saying they wrote it (T41-A02)
     if isinstance(act, Policy):
         note_policy_task(act, family.name, f"--policy {args.policy}")
     if args.rl_id or (args.rl_zoo is not None and "-RL-v0" in str(args.rl_zoo)):

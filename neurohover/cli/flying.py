@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import sys
 from pathlib import Path
@@ -62,9 +63,14 @@ def _fly(policy, mdps: list, args: argparse.Namespace, show_progress: bool):
 
 def cmd_fly(args: argparse.Namespace) -> int:
     """Fly a policy and print return statistics."""
+    with contextlib.ExitStack() as held:  # --record's writer lock, held until the command ends
+        return _fly_command(args, held)
+
+
+def _fly_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int:
     from ..filekinds import FLIGHT_DATA_KIND
     from ..flightdata import check_npz_name
-    from ..paths import output_file, printable
+    from ..paths import output_file, printable, sole_writer
     from ..policies import load_policy
 
     if args.episodes < 1:
@@ -84,8 +90,9 @@ def cmd_fly(args: argparse.Namespace) -> int:
     if args.record is not None:
         if Path(args.record).suffix:  # another suffix is refused before output_file makes its directory
             check_npz_name(args.record, "--record")
-        output_file(args.record, "--record", {"--policy": args.policy}, kind=FLIGHT_DATA_KIND)  # a checkpoint through a link (T34-B03)
+        record = output_file(args.record, "--record", {"--policy": args.policy}, kind=FLIGHT_DATA_KIND)  # a checkpoint through a link (T34-B03)
         check_npz_name(args.record, "--record")  # no suffix: after output_file's own refusals ('-', a directory, a device)
+        held.enter_context(sole_writer(record, "--record"))  # two runs at once both said they wrote it; one's episodes were lost (T41-A02)
     returns, crashed, seconds, fd, n_unique = _fly(policy, mdps, args, show_progress=not args.json)
     if fd is not None:
         fd.metadata.update(

@@ -35,7 +35,7 @@ from ..evaluate import DEVICES, check_device, check_episode_count
 from ..evolution.config import MAX_BUDGET
 from ..evolution.generational import GENERATIONAL_PRESETS
 from ..evolution.optimisers import OPTIMISERS, optimiser_names
-from ..paths import input_file, output_file, printable
+from ..paths import input_file, output_file, printable, sole_writer
 
 MDP_FAMILY = "G"
 
@@ -352,22 +352,23 @@ def cmd_learn_model(args: argparse.Namespace) -> int:
     data = FlightData.load(input_file(args.flight_data, "--flight-data", "flight-data file"))
     inputs = {"--flight-data": args.flight_data, "--policy": args.policy}
     out = LearnedModel.check_name(output_file(args.out, "--out", inputs, kind="a model file", run_files=True), "--out")  # T23-16, T25-03
-    start = time.perf_counter()
-    extra = {} if args.budget is None else {"budget": args.budget}
-    with _Ticker(f"learning a {args.method} model from {data.n_episodes} episodes ({data.n_transitions} steps)"):
-        if args.method == "lr":
-            d_u, noise = ("discard", "rms") if args.as_authors else (args.d_u or "keep", args.noise_estimate or DEFAULT_NOISE_ESTIMATE)
-            model = learn_lr(data, estimator=args.estimator or "ols", wind_model=args.wind_model or "none", d_u=d_u, noise=noise)
-        elif args.method == "ec-meno":
-            model = learn_ec_meno(data, seed=seed, **extra)
-        else:
-            model = learn_ec_mer(data, ec_mer_policy(args.policy, data, args.flight_data), seed=seed, **extra)
-    truth, why = _true_mdp(data.metadata)
-    try:  # before the model is written: a refused MDP left m.json behind its refusal (T23-01)
-        rows = parameter_table(model, truth)
-    except NeurohoverError as err:
-        raise NeurohoverError(f"flight-data file {args.flight_data!r}: its metadata's MDP {brief(truth.label if truth else '')}: {err}") from None
-    model.save(out)  # written whole or not at all (a failed write: one message, the old file as it was)
+    with sole_writer(out, "--out"):  # two runs at once both said they wrote it; one's model was lost (T41-A02)
+        start = time.perf_counter()
+        extra = {} if args.budget is None else {"budget": args.budget}
+        with _Ticker(f"learning a {args.method} model from {data.n_episodes} episodes ({data.n_transitions} steps)"):
+            if args.method == "lr":
+                d_u, noise = ("discard", "rms") if args.as_authors else (args.d_u or "keep", args.noise_estimate or DEFAULT_NOISE_ESTIMATE)
+                model = learn_lr(data, estimator=args.estimator or "ols", wind_model=args.wind_model or "none", d_u=d_u, noise=noise)
+            elif args.method == "ec-meno":
+                model = learn_ec_meno(data, seed=seed, **extra)
+            else:
+                model = learn_ec_mer(data, ec_mer_policy(args.policy, data, args.flight_data), seed=seed, **extra)
+        truth, why = _true_mdp(data.metadata)
+        try:  # before the model is written: a refused MDP left m.json behind its refusal (T23-01)
+            rows = parameter_table(model, truth)
+        except NeurohoverError as err:
+            raise NeurohoverError(f"flight-data file {args.flight_data!r}: its metadata's MDP {brief(truth.label if truth else '')}: {err}") from None
+        model.save(out)  # written whole or not at all (a failed write: one message, the old file as it was)
     print(f"{args.method} model written to {printable(out)} ({time.perf_counter() - start:.2f} s)")
     if truth is not None:
         print(f"learned parameters (converted to the simulator's 10 substeps) next to the true ones of {truth.label or 'the MDP'}:")

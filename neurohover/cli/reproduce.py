@@ -10,6 +10,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import sys
@@ -136,7 +137,7 @@ def _remove_if_empty(path: Path, keep_file: bool = False) -> None:
 def cmd_results(args: argparse.Namespace) -> int:
     """Export an experiment's finished units from the results store as CSV or JSON."""
     from ..experiments import Store, export_results
-    from ..paths import input_file, output_file, writing
+    from ..paths import input_file, output_file, sole_writer, writing
 
     refuse_sqlite_name(args.store, "--store")  # before "no such results store" (T32-A02)
     input_file(args.store, "--store", "results store")
@@ -149,11 +150,15 @@ def cmd_results(args: argparse.Namespace) -> int:
         if args.out is None
         else output_file(args.out, "--out", {"--store": args.store}, stdout=True, kind=kind, suffixes=suffixes, what=what, run_files=True)
     )
-    with Store(args.store, create=False) as store:
-        text = export_results(store, args.name, fmt, args.scale)
+    with contextlib.ExitStack() as held:
+        if out is not None:  # one of two runs at once was lost, both saying they wrote it (T41-A02)
+            held.enter_context(sole_writer(out, "--out"))
+        with Store(args.store, create=False) as store:
+            text = export_results(store, args.name, fmt, args.scale)
+        if out is not None:
+            with writing(out, "--out") as path:
+                path.write_text(text, encoding="utf-8")  # the locale's encoding wrote escapes or failed (T31-A05)
     if out is not None:
-        with writing(out, "--out") as path:
-            path.write_text(text, encoding="utf-8")  # the locale's encoding wrote escapes or failed (T31-A05)
         print(f"wrote {printable(args.out)}", file=sys.stderr)
     else:
         sys.stdout.write(text)
