@@ -32,6 +32,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
+import math
 import re
 import sys
 import tomllib
@@ -318,9 +319,26 @@ def parse_override(text: str, option: str = "--set") -> tuple[str, Any]:
             why = re.sub(r" \(at (line \d+, column \d+|end of document)\)$", "", str(err))  # positions in our wrapper, not in VALUE
             raise NeurohoverError(f"bad {option} {text!r}: VALUE is not valid TOML ({why})") from None
         parsed = value.strip()
+        number = _toml_number(parsed)
+        if number is not None:  # '.5' was refused as "must be a finite number", as if no number were given (T41-A03)
+            raise NeurohoverError(f"bad {option} {brief(text)}: {brief(parsed)} is text, not a TOML number: write {key}={number}") from None
     except ValueError:  # tomllib's int() past 4,300 digits, not a TOMLDecodeError (T36-A01)
         raise NeurohoverError(f"bad {option} {brief(text)}: VALUE holds {_TOO_LONG}") from None
     return key, parsed
+
+
+def _toml_number(text: str) -> str | None:
+    """How TOML writes the number ``text`` reads as where TOML reads no number there ('.5', '5.', '+.5', '01', '1.e5'),
+    else None (a word, inf, nan)."""
+    if not re.fullmatch(r"[+-]?[0-9_.]*[0-9][0-9_.]*(?:[eE][+-]?[0-9_]+)?", text):
+        return None
+    try:
+        number = float(text)
+    except ValueError:
+        return None
+    if re.fullmatch(r"[+-]?[0-9_]+", text):
+        return str(int(text))
+    return repr(number) if math.isfinite(number) else None
 
 
 #: What tomllib cannot read (Python's int_max_str_digits): past every setting's range (T36-A01).
