@@ -39,7 +39,12 @@ def _episodes(text: str | None, n: int) -> list[int] | None:
             first, last = integer(lo), integer(hi) if sep else integer(lo)
         except ValueError:
             raise NeurohoverError(f"--episodes {text!r} is not allowed: give episode numbers and ranges, e.g. 0,3,10-12") from None
-        if first > last:  # both ends may be in range: "out of range" misled (seventh trial)
+        if last < 0:  # '0--1' was a reversed range, and its example -1-0 refused (T41-A04)
+            raise NeurohoverError(
+                f"--episodes {part.strip()!r} is not allowed: {last} is no episode number (they are 0 or more: the flight data hold "
+                f"episodes 0..{n - 1}); give FIRST-LAST with 0 <= FIRST <= LAST, e.g. 0-{n - 1}"
+            )
+        if first > last and first < n:  # both ends may be in range: "out of range" misled (seventh trial)
             raise NeurohoverError(f"--episodes {part.strip()!r} is a reversed range: give FIRST-LAST with FIRST <= LAST, e.g. {last}-{first}")
         if not (0 <= first <= last < n):
             raise NeurohoverError(f"--episodes {part.strip()!r} is out of range: the flight data hold episodes 0..{n - 1}")
