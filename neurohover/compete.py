@@ -37,7 +37,7 @@ import numpy as np
 
 from .agents.hybrid import HybridSettings
 from .compete_files import CSV_COLUMNS  # the columns plot --compete reads, each checked (T23-07)
-from .errors import NeurohoverError, brief, first_difference, refused_signature
+from .errors import NeurohoverError, brief, check_arity, first_difference
 from .evolution.seeding import check_seed
 from .plots import plot_cumulative
 from .sim.constants import EPISODE_STEPS
@@ -386,12 +386,8 @@ def _check_run(jobs, device, on_result, progress) -> None:
     check_device(device)
     if on_result is not None and not callable(on_result):
         raise NeurohoverError(f"on_result={on_result!r:.60} is not allowed: give a callable (unit key, TestRunResult), or None")
-    refused = None if on_result is None else refused_signature(on_result, 2)
-    if refused:  # one of the wrong arity was a TypeError after the first unit was stored (T40-B02)
-        raise NeurohoverError(
-            f"on_result of signature {brief(refused)} is not allowed: it is called as on_result(unit key, TestRunResult); "
-            "give a callable of those two arguments, or None"
-        )
+    # one of the wrong arity was a TypeError after the first unit was stored (T40-B02)
+    check_arity("on_result", on_result, 2, "it is called as on_result(unit key, TestRunResult)", "a callable of those two arguments, or None")
     if progress not in (None, True, False):
         raise NeurohoverError(f"progress={progress!r:.60} is not allowed: give True, False or None (a bar only on a terminal)")
 

@@ -245,6 +245,15 @@ def refused_signature(fn: Any, n: int) -> str | None:
     return ""
 
 
+def check_arity(name: str, fn: Any, n: int, called: str, give: str) -> None:
+    """Refuse a user's callback ``name`` that cannot be called with the ``n`` positional arguments it is called with
+    (``called``: how it is called; ``give``: what to give instead); None, and one with no signature to read (a builtin's),
+    pass. One of the wrong arity was a bare TypeError at its first call, often after work was done (T40-B02, T41-B01)."""
+    refused = None if fn is None else refused_signature(fn, n)
+    if refused:
+        raise NeurohoverError(f"{name} of signature {brief(refused)} is not allowed: {called}; give {give}")
+
+
 def key_text(key: Any) -> str:
     """A table's key as a message names it: text as written (one of more than 60 characters shortened by :func:`brief`),
     any other key (b'pop_size', 1) as its repr."""

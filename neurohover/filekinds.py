@@ -132,7 +132,7 @@ def held_kind(path: str | os.PathLike) -> str | None:
     if size > _KIND_READ_LIMIT:
         return None
     try:
-        body = p.read_bytes().removeprefix(UTF8_BOM)
+        body = head if size <= _END_READ else p.read_bytes().removeprefix(UTF8_BOM)  # the head is the whole of a small file
         value = json.loads(body)
     except (OSError, ValueError, RecursionError):
         return None

@@ -82,7 +82,7 @@ from pathlib import Path
 import numba
 import numpy as np
 
-from ..errors import CheckpointReplaced, NeurohoverError, brief, check_flag, real_number, refused_signature, whole_in
+from ..errors import CheckpointReplaced, NeurohoverError, brief, check_arity, check_flag, real_number, whole_in
 from ..evaluate import MAX_EPISODES_PER_CALL, evaluate_jobs, num_threads
 from ..paths import output_file, sole_writer
 from ..policies import Policy
@@ -156,11 +156,8 @@ def _checkpoint_path(checkpoint, progress, resume: bool) -> Path | None:
     relative one was resolved at every write, and after an os.chdir the checkpoint went to another folder (T34-B10)."""
     if progress is not None and not callable(progress):  # progress=3 was "'int' object is not callable" mid-run (second trial)
         raise NeurohoverError(f"progress={progress!r:.60} is not allowed: give a callable taking a ProgressInfo, or None")
-    refused = None if progress is None else refused_signature(progress, 1)  # a wrong arity failed after the first generation (T40-B02)
-    if refused:
-        raise NeurohoverError(
-            f"progress of signature {brief(refused)} is not allowed: the run calls progress(info); give a callable of one ProgressInfo, or None"
-        )
+    # a wrong arity failed after the first generation (T40-B02)
+    check_arity("progress", progress, 1, "the run calls progress(info)", "a callable of one ProgressInfo, or None")
     check_flag(resume, "resume", "continue from the checkpoint")  # resume="no" resumed (its truth), fifteenth trial
     if checkpoint is None or resume:
         path = None if checkpoint is None else Path(checkpoint)

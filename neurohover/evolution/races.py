@@ -51,7 +51,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, real_number, refused_signature, whole_number
+from ..errors import NeurohoverError, brief, check_arity, finite_real, real_number, whole_number
 from ..procs import half_free_memory
 from .common import as_floats
 
@@ -183,12 +183,8 @@ def _check_sample_fn(sample_fn: object) -> None:
     """Refuse a ``sample_fn`` that cannot be called before anything is flown (None was a TypeError mid-run; thirteenth trial, F14)."""
     if not callable(sample_fn):
         raise NeurohoverError(f"sample_fn={brief(sample_fn)} is not allowed: give a function of an array of candidate indices returning one return per index")
-    refused = refused_signature(sample_fn, 1)  # a wrong arity was a raw TypeError at its first call (T40-B02)
-    if refused:
-        raise NeurohoverError(
-            f"sample_fn of signature {brief(refused)} is not allowed: it is called as sample_fn(indices); "
-            "give a function of an array of candidate indices returning one return per index"
-        )
+    # a wrong arity was a raw TypeError at its first call (T40-B02)
+    check_arity("sample_fn", sample_fn, 1, "it is called as sample_fn(indices)", "a function of an array of candidate indices returning one return per index")
 
 
 def _draw(sample_fn: SampleFn, indices: np.ndarray) -> np.ndarray:
