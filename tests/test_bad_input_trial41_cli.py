@@ -62,24 +62,32 @@ def test_a01_flight_data_over_64_mib_is_flight_data_and_not_replaced(tmp_path: P
     assert held_kind(_sparse(tmp_path / "line.csv", b"run,episode,return" + b"x" * 2**21)) is None  # no header line in its head
 
 
-def test_a02_a_second_fly_record_on_a_file_being_written_is_refused(tmp_path: Path, cli, monkeypatch) -> None:
-    """The first run holds --record's lock while it writes: a second run on the file then is refused (the test, not
-    the machine's speed, decides when the second starts: inside the first's save); one after the other still replaces it."""
+def _second_run_inside_save(monkeypatch, owner: type, argv: list[str]) -> list[int]:
+    """``owner.save`` patched to run ``neurohover ARGV`` once more, in-process, while the first run holds its output's
+    lock (before it writes): no timing decides whether the two overlap. Returns the second run's exit statuses."""
     from neurohover.cli import main
-    from neurohover.flightdata import FlightData
 
-    monkeypatch.chdir(tmp_path)  # the names in messages short
-    out = Path("r.npz")
-    argv = ["fly", "--task", "ghh08", "--mdp", "train:1", "--episodes", "1", "--threads", "1", "--json", "--record", str(out)]
     second: list[int] = []
-    save = FlightData.save
+    save = owner.save
 
     def save_during_another(self, path, *a, **k):
         if not second:
             second.append(main(argv))
         return save(self, path, *a, **k)
 
-    monkeypatch.setattr(FlightData, "save", save_during_another)
+    monkeypatch.setattr(owner, "save", save_during_another)
+    return second
+
+
+def test_a02_a_second_fly_record_on_a_file_being_written_is_refused(tmp_path: Path, cli, monkeypatch) -> None:
+    """The first run holds --record's lock while it writes: a second run on the file then is refused (the test, not
+    the machine's speed, decides when the second starts: inside the first's save); one after the other still replaces it."""
+    from neurohover.flightdata import FlightData
+
+    monkeypatch.chdir(tmp_path)  # the names in messages short
+    out = Path("r.npz")
+    argv = ["fly", "--task", "ghh08", "--mdp", "train:1", "--episodes", "1", "--threads", "1", "--json", "--record", str(out)]
+    second = _second_run_inside_save(monkeypatch, FlightData, argv)
     rc, _, err = cli(*argv)
     assert rc == 0 and second == [2] and out.is_file(), err
     assert f"--record '{out}' is being written by another run (pid " in err and "give another --record" in err, err
@@ -88,22 +96,13 @@ def test_a02_a_second_fly_record_on_a_file_being_written_is_refused(tmp_path: Pa
 
 
 def test_a02_a_second_learn_model_on_a_model_being_written_is_refused(tmp_path: Path, cli, monkeypatch) -> None:
-    from neurohover.cli import main
     from neurohover.models import LearnedModel
 
     monkeypatch.chdir(tmp_path)  # the names in messages short
     data = recorded(tmp_path, 1)
     out = Path("m.json")
     argv = ["learn-model", "--flight-data", str(data), "--method", "lr", "--out", str(out)]
-    second: list[int] = []
-    save = LearnedModel.save
-
-    def save_during_another(self, path, *a, **k):
-        if not second:
-            second.append(main(argv))
-        return save(self, path, *a, **k)
-
-    monkeypatch.setattr(LearnedModel, "save", save_during_another)
+    second = _second_run_inside_save(monkeypatch, LearnedModel, argv)
     rc, _, err = cli(*argv)
     assert rc == 0 and second == [2] and out.is_file(), err
     assert f"--out '{out}' is being written by another run (pid " in err, err
