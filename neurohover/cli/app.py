@@ -127,6 +127,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         for signum in (signal.SIGINT, *stop_signals()):  # SIGHUP, SIGUSR1 as SIGTERM (T32-A03)
             signal.signal(signum, signal.SIG_IGN)
+        # `python -m` ends by SIGINT itself (status -2, not 130) once a Ctrl-C escaped an eval() of source text, caught or
+        # not (namedtuple's, as a module of the command imported); evaluating text again clears CPython's mark of it.
+        eval("0")
     return status
 
 
