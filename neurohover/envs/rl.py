@@ -31,6 +31,7 @@ prints is the raw one of full 6000-step episodes, comparable with the paper's.
 
 from __future__ import annotations
 
+from functools import partial
 from typing import Any
 
 import gymnasium as gym
@@ -41,7 +42,7 @@ from gymnasium.wrappers.vector import TransformReward as VectorTransformReward
 
 from ..errors import NeurohoverError, brief
 from ..sim.constants import ACTION_DIM, MAX_POSITION, MAX_RATE, MAX_VELOCITY
-from ..tasks import get_task_family
+from ..tasks import TaskFamily, get_task_family
 from ..wrappers import CrashAwareReward, check_env, crash_aware
 from .arguments import real_values
 from .hover import HoverEnv
@@ -120,11 +121,28 @@ def rl_policy(act, task: str):
     return policy
 
 
+def refuse_carried(env: gym.Env, wrapper: type, transform: str) -> None:
+    """Refuse an ``env`` that carries ``wrapper`` already (every ``-RL-v0`` id carries both :class:`ScaledObservation`
+    and :class:`ScaledAction`): stacked, the transform was applied twice (forty-second trial T42-B04), as the crash-aware
+    reward was before :func:`neurohover.wrappers.refuse_changed_rewards` (T34-B05)."""
+    layer = env
+    while isinstance(layer, gym.Wrapper):
+        if isinstance(layer, wrapper):
+            raise NeurohoverError(
+                f"env={brief(env)} is not allowed in {wrapper.__name__}: it carries that transform already, {transform} (a "
+                f"{wrapper.__name__} inside it, as every neurohover/<NAME>-RL-v0 id has); wrap it once, or wrap a plain id "
+                "(e.g. neurohover/GHH08-Short-v0)"
+            )
+        layer = layer.env
+
+
 class ScaledObservation(gym.ObservationWrapper):
-    """Observations of :func:`scale_observation` (the space keeps its shape and dtype; its bounds are infinite)."""
+    """Observations of :func:`scale_observation` (the space keeps its shape and dtype; its bounds are infinite), over an
+    ``env`` whose observations are not scaled already (an ``-RL-v0`` id's are: refused, T42-B04)."""
 
     def __init__(self, env: gym.Env) -> None:
         check_env(env)
+        refuse_carried(env, ScaledObservation, "its observations are divided by the crash limits")
         super().__init__(env)
 
     def observation(self, observation: np.ndarray) -> np.ndarray:
@@ -132,11 +150,20 @@ class ScaledObservation(gym.ObservationWrapper):
 
 
 class ScaledAction(gym.ActionWrapper):
-    """Actions in [-1, 1] made the task's controls by :func:`controls`."""
+    """Actions in [-1, 1] made the task's controls by :func:`controls`, over an ``env`` whose actions are controls (an
+    ``-RL-v0`` id's are scaled already: refused, T42-B04); ``task`` must be the env's own family where it has one
+    (another family's authority was flown silently, T42-B05)."""
 
     def __init__(self, env: gym.Env, task: str) -> None:
         check_env(env)
         self.task = get_task_family(task).name  # refused by name, not flown with full authority (T15-18)
+        refuse_carried(env, ScaledAction, "its actions in [-1, 1] are made controls")
+        family = getattr(env.unwrapped, "family", None)
+        if isinstance(family, TaskFamily) and family.name != self.task:
+            raise NeurohoverError(
+                f"task={brief(task)} is not allowed: the env flies family {family.name!r}, and the action authority of family "
+                f"{self.task!r} would be flown on it; give task={family.name!r}, the env's own"
+            )
         super().__init__(env)
 
     def action(self, action: np.ndarray) -> np.ndarray:
@@ -155,6 +182,16 @@ def make_rl_vector_env(**kwargs: Any) -> gym.vector.VectorEnv:
     :class:`neurohover.integrations.sb3.SB3VecEnv`): the same transforms on every helicopter."""
     env = HoverVectorEnv(**{**RL_SETTINGS, **kwargs})
     scaled = VectorTransformObservation(env, scale_observation, env.observation_space)
-    task = env.family.name
-    acting = VectorTransformAction(scaled, lambda a: controls(a, task).astype(env.action_space.dtype), env.action_space)
-    return VectorTransformReward(acting, lambda r: crash_aware(r, RL_GAMMA, RL_REWARD_SCALE).astype(np.float64))
+    # module-level functions, not local lambdas: the vector env pickles as the plain one does (T42-B01)
+    acting = VectorTransformAction(scaled, partial(typed_controls, task=env.family.name, dtype=env.action_space.dtype), env.action_space)
+    return VectorTransformReward(acting, rl_reward)
+
+
+def typed_controls(action: np.ndarray, task: str, dtype: Any) -> np.ndarray:
+    """:func:`controls` in the env's action ``dtype``: the native vector env's action transform."""
+    return controls(action, task).astype(dtype)
+
+
+def rl_reward(reward: np.ndarray) -> np.ndarray:
+    """The RL ids' reward: :func:`crash_aware` with :data:`RL_GAMMA` and :data:`RL_REWARD_SCALE`, float64."""
+    return np.asarray(crash_aware(reward, RL_GAMMA, RL_REWARD_SCALE), dtype=np.float64)
