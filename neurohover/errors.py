@@ -254,6 +254,34 @@ def check_arity(name: str, fn: Any, n: int, called: str, give: str) -> None:
         raise NeurohoverError(f"{name} of signature {brief(refused)} is not allowed: {called}; give {give}")
 
 
+def reloaded_text(cls: type) -> str:
+    """Why a ``cls`` of another import of its module is refused, as a message's reason: after ``importlib.reload`` of a
+    neurohover module its classes are new class objects, while neurohover's other modules hold the first ones, so an
+    object of either is no instance of the other's (a Policy, T36-B10; a Sensor, Drift, FlightData or MDP, T42-B07..B09)."""
+    name, module = cls.__qualname__, cls.__module__
+    article = "an" if name[:1] in "AEIOU" or (name.isupper() and name[:1] in "FHLMNRSX") else "a"
+    return (
+        f"it is {article} {name} of another import of {module} (the module was reloaded?), while neurohover's other modules "
+        f"hold the first import's {name}; restart the interpreter instead of reloading a neurohover module"
+    )
+
+
+def other_import(value: object, cls: type) -> str:
+    """:func:`reloaded_text` where ``value``'s class, or one it derives from, has ``cls``'s module and qualified name yet is
+    another class object (of another import of that module); '' where none is. An isinstance check that failed names
+    this cause first: "sensor must be a neurohover Sensor, got Sensor(...)" named none (T42-B07..B09)."""
+    same = (c for c in type(value).__mro__ if c.__module__ == cls.__module__ and c.__qualname__ == cls.__qualname__)
+    return reloaded_text(cls) if any(c is not cls for c in same) else ""
+
+
+def refuse_reloaded(value: object, cls: type, what: str) -> None:
+    """Refuse ``value`` (called ``what``) where :func:`other_import` names a reload as why it is no ``cls``: call it where an
+    isinstance check of ``cls`` failed, before that check's own message."""
+    reason = other_import(value, cls)
+    if reason:
+        raise NeurohoverError(f"{what} {brief(value)} is not allowed: {reason}")
+
+
 def key_text(key: Any) -> str:
     """A table's key as a message names it: text as written (one of more than 60 characters shortened by :func:`brief`),
     any other key (b'pop_size', 1) as its repr."""

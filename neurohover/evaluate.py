@@ -439,10 +439,10 @@ def evaluate_jobs(
     flight = None
     if n_rec:
         rec_steps = out.steps[rec]
+        meta = {"episode_steps": int(n_steps), "crashed": [bool(c) for c in out.crashed[rec]]}  # a short episode is not a crash
+        meta |= {"safeguard_step": out.safeguard_step[rec].tolist()} if (fb[rec] >= 0).any() else {}  # where a fallback took over (T42-B03)
         flight = FlightData(
-            tuple(obs_out[i, : rec_steps[i] + 1].copy() for i in range(n_rec)),
-            tuple(act_out[i, : rec_steps[i]].copy() for i in range(n_rec)),
-            {"episode_steps": int(n_steps), "crashed": [bool(c) for c in out.crashed[rec]]},  # a short episode is not a crash
+            tuple(obs_out[i, : rec_steps[i] + 1].copy() for i in range(n_rec)), tuple(act_out[i, : rec_steps[i]].copy() for i in range(n_rec)), meta
         )
     return Evaluation(out.returns, out.crashed, out.steps, out.safeguard_step, flight, seconds)
 

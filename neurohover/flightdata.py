@@ -134,7 +134,7 @@ class FlightData:
     equal metadata. Flight data are unhashable (they hold arrays), as a list is.
 
     ``metadata`` is free-form JSON: the keys ``fly --record`` writes (task, mdps, seed, returns, crashed,
-    episode_steps, policy, policy_flown, ...) are checked against the episodes and each other wherever present; any
+    episode_steps, policy, policy_flown, safeguard_step, ...) are checked against the episodes and each other wherever present; any
     other key is the user's own note, kept as given (a documented choice: a misspelt key is kept, not refused).
     """
 
@@ -188,6 +188,8 @@ class FlightData:
                 del meta[name]  # the second's seed and policy were kept for every episode (T24-04), as its task was (ninth trial)
         for name in _PER_EPISODE:  # one entry per episode: both halves, or none (load() refuses a list of the wrong length)
             a, b = self.metadata.get(name), other.metadata.get(name)
+            if name == "safeguard_step" and (a is None) != (b is None):  # a recording without: no fallback flew it (fly --record's)
+                a, b = [-1] * self.n_episodes if a is None else a, [-1] * other.n_episodes if b is None else b
             if isinstance(a, list) and isinstance(b, list) and len(a) == self.n_episodes and len(b) == other.n_episodes:
                 meta[name] = a + b
             else:
@@ -382,6 +384,8 @@ _PER_EPISODE = {
     "returns": (finite_real, "one number"),
     "mdps": (lambda m: isinstance(m, dict), "one MDP (a table)"),
     "crashed": (lambda c: type(c) is bool, "one true or false"),
+    # evaluate(record=True, safeguard=...) writes it: the step its fallback took over at, and flew on from; -1: never (T42-B03)
+    "safeguard_step": (lambda s: type(s) is int and s >= -1, "one control step (-1: no fallback flew it; k: one flew from step k on)"),
 }
 
 
@@ -493,6 +497,13 @@ def check_metadata(metadata: object, lengths: np.ndarray, where: str, episodes: 
         value = metadata.get(name)  # present as null: refused by name, not taken as absent (mdps null, T21-05)
         if name in metadata and (not isinstance(value, list) or len(value) != n_episodes or not all(fits(v) for v in value)):
             raise NeurohoverError(f"{where}: its metadata {name}={brief(value)} is not allowed: {each} per episode ({n_episodes}), or no {name} entry")
+    handed = metadata.get("safeguard_step") or []
+    late = next((i for i, k in enumerate(handed) if k >= lengths[i]), None)
+    if late is not None:  # the fallback takes over at a step it flies: one of 0..steps-1
+        raise NeurohoverError(
+            f"{where}: its metadata safeguard_step={brief(handed)} is not allowed: episode {late} has {int(lengths[late]):,} steps, yet "
+            f"its fallback took over at step {handed[late]:,}: allowed -1 (never) or 0..{int(lengths[late]) - 1:,}"
+        )
     flags = metadata.get("crashed")
     uncrashed = [i for i, c in enumerate(flags) if not c and lengths[i] < steps] if steps is not None and flags is not None else []
     if uncrashed:  # 3000 steps of a 6000-step budget, crashed false, were drawn as "3000 steps, no crash" and learned from (T22-01)

@@ -9,7 +9,7 @@ from typing import Any
 import numba
 import numpy as np
 
-from .errors import NeurohoverError, brief, whole_in, whole_number
+from .errors import NeurohoverError, brief, reloaded_text, whole_in, whole_number
 from .launch import KIND, MAX_SEED, Batch, Flown, Parking, check_device, launch, launch_parked, rows_alike
 from .policies import GENOME_LENGTH, TOPOLOGIES, Policy
 from .sim.constants import MAX_EPISODE_STEPS, SAFEGUARD_LIMITS
@@ -264,8 +264,5 @@ def refuse_other_import(policies: Sequence[Any]) -> Sequence[Any]:
     current = getattr(sys.modules.get(Policy.__module__), "Policy", Policy)
     for p in policies:
         if any(c.__module__ == Policy.__module__ and c.__qualname__ == "Policy" and not (c is Policy is current) for c in type(p).__mro__):
-            raise NeurohoverError(
-                f"policy {brief(p)} is not allowed: it is a Policy of another import of neurohover.policies (the module was reloaded?), while "
-                "neurohover's other modules hold the first import's Policy; restart the interpreter instead of reloading a neurohover module"
-            )
+            raise NeurohoverError(f"policy {brief(p)} is not allowed: {reloaded_text(Policy)}")
     return policies

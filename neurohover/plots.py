@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .compete_files import COMPETE_CONDITIONS, CompeteResult, read_compete_dirs
-from .errors import NeurohoverError, brief, finite_real, real_number, whole_in, whole_number
+from .errors import NeurohoverError, brief, finite_real, real_number, refuse_reloaded, whole_in, whole_number
 from .flightdata import FlightData, check_flown, check_metadata, crash_flags
 from .paths import output_dir, output_file, printable
 from .sim.constants import ACTION_NAMES, CONTROL_DT, EPISODE_STEPS, MAX_EPISODE_STEPS
@@ -338,6 +338,7 @@ def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight"
 def _check_flight_data(data: object) -> None:
     """Refuse anything but :class:`FlightData`, naming it."""
     if not isinstance(data, FlightData):
+        refuse_reloaded(data, FlightData, "data")  # T42-B08
         raise NeurohoverError(f"data={brief(data)} is not allowed: give FlightData (e.g. FlightData.load('flight.npz'))")
 
 

@@ -423,12 +423,15 @@ def _fields_problem(meta: dict) -> str:
             FGHH(sigma=sigma)
         except NeurohoverError as err:
             return f"its sigma {brief(sigma)} is not allowed: {err}"
+        # no task: its target's family, as the API's evolve writes a target alone ('ghh08/train:0' took a sigma; T42-B06)
+        named = task if "task" in meta else target.partition("/")[0] if isinstance(target, str) and "/" in target else None
         try:
-            family = get_task_family(task) if isinstance(task, str) else None
+            family = get_task_family(named) if isinstance(named, str) else None
         except NeurohoverError:  # no task's name: left to the place checks
             family = None
         if family is not None and not family.has_sigma:  # a seeded champion no longer carries its seed's sigma (T25-12)
-            return f"its sigma {brief(sigma)} is not allowed beside its task {brief(task)}: {task}'s MDPs have no breadth (sigma is FGHH's)"
+            beside = f"task {brief(task)}" if "task" in meta else f"target {brief(target)}"
+            return f"its sigma {brief(sigma)} is not allowed beside its {beside}: {named}'s MDPs have no breadth (sigma is FGHH's)"
         said = re.fullmatch(r"[a-z0-9]+/G\(sigma=([^()]*)\)", target) if isinstance(target, str) else None
         if said is not None and f"{float(sigma):g}" != said.group(1):
             return f"its sigma {brief(sigma)} is not allowed beside its target {brief(target)}: the run was evolved over G(sigma={said.group(1)})"

@@ -47,12 +47,18 @@ def _checked_mdps(mdps: Any) -> tuple[list[MDP], str | None]:
     (:func:`~neurohover.envs.arguments.resolve_mdp`; it was refused as not "of one task family", T36-B06); the family
     is None where all are models'."""
     refuse_unordered_mdps(mdps)  # a set flew in hash order (T32-B02)
+    given = mdps
     if isinstance(mdps, MDP):
         mdps = [mdps]
-    elif isinstance(mdps, Iterable) and not isinstance(mdps, (str, bytes)):
+    elif isinstance(mdps, Iterable) and not isinstance(mdps, (str, bytes, np.ndarray)):
+        # an array is refused as evaluate and evolve_neat refuse it: a 0-d one was a TypeError "iteration over a 0-d
+        # array", a 1-D object array of MDPs flew here though evaluate refuses it (T42-B02)
         mdps = list(mdps)
     if not isinstance(mdps, list) or not mdps or not all(isinstance(m, MDP) for m in mdps):
-        raise NeurohoverError("mdps must be one MDP or a non-empty sequence of MDPs (e.g. get_task_family('ghh08').mdp('train:3'))")
+        raise NeurohoverError(
+            f"mdps={brief(given)} is not allowed: mdps must be one MDP or a non-empty sequence of MDPs"
+            " (a list or tuple, not an array; e.g. get_task_family('ghh08').mdp('train:3'))"
+        )
     families = sorted({m.family for m in mdps} - {LEARNED_MODEL})
     if len(families) > 1:
         raise NeurohoverError(f"mdps must all be MDPs of one task family (got {', '.join(families)}): a learned model's MDP flies beside any")

@@ -13,7 +13,7 @@ import time
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, whole_in, whole_number
+from ..errors import NeurohoverError, brief, finite_real, refuse_reloaded, whole_in, whole_number
 from ..flightdata import FlightData
 from ..flightmeta import action_mismatch
 from ..sim.constants import DEFAULT_PARAMS, ROW_NOISE, ROW_PARAMS, WORST_RETURN
@@ -199,6 +199,7 @@ def observed_return(flight_data: FlightData, episode: int = 0) -> float:
     """Return of one recorded episode recomputed from its observations: ``-sum_k |obs_k|^2``
     over the observations after each action (valid for an episode that did not crash)."""
     if not isinstance(flight_data, FlightData):
+        refuse_reloaded(flight_data, FlightData, "flight data")  # T42-B08
         raise NeurohoverError(f"flight data must be a FlightData, got {type(flight_data).__name__}")
     # a float was a TypeError from indexing, True taken as episode 1 (twelfth trial T4)
     if not whole_number(episode):
@@ -340,7 +341,17 @@ def check_policy_flew(
     """NeurohoverError unless ``policy`` gives the actions recorded in ``data``'s first episode (its first
     ``flightmeta.CHECKED_STEPS`` steps, clipped to [-1, 1] as the kernel flies them, within ``flightmeta.ACTION_TOLERANCE``), where
     they are finite (a crash's NaN action is recorded as given): :func:`neurohover.flightmeta.action_mismatch`, the test
-    FlightData.load runs on a float64 file's own policy_flown."""
+    FlightData.load runs on a float64 file's own policy_flown. Flight data whose metadata ``safeguard_step`` records that a
+    safeguard's fallback took over an episode are refused first: its later steps are the fallback's, and the action test
+    reads episode 0's first steps alone (T42-B03; data without the entry, as fly --record writes, flew no fallback)."""
+    handed = data.metadata.get("safeguard_step") or []
+    i = next((i for i, k in enumerate(handed) if k >= 0), None)
+    if i is not None:
+        raise NeurohoverError(
+            f"{where}: episode {i} is not allowed: a safeguard's fallback flew it from step {handed[i]:,} on (metadata safeguard_step="
+            f"{brief(handed)}), and EC-MER fits the closed loop of one policy; give flight data no fallback flew (every safeguard_step "
+            "-1: record without a safeguard, as fly --record does)"
+        )
     miss = action_mismatch(policy, data.observations[0], data.actions[0])
     if miss is not None:
         k, i, flown, recorded = miss

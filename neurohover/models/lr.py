@@ -62,7 +62,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, refuse_reloaded
 from ..flightdata import FlightData
 from ..sim.constants import NOISE_DECAY, NOISE_NAMES, PARAM_NAMES
 from .model import LearnedModel, one_substep_params
@@ -114,6 +114,7 @@ def lr_determined(flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS,
     # learn_lr's own checks: an unknown intercepts or wind_model answered True (twelfth trial S6)
     _check_options(intercepts=(intercepts, INTERCEPTS), wind_model=(wind_model, WIND_MODELS))
     if not isinstance(flight_data, FlightData):
+        refuse_reloaded(flight_data, FlightData, "flight data")  # importlib.reload(flightdata): "got FlightData" (T42-B08)
         raise NeurohoverError(f"flight data must be a FlightData, got {type(flight_data).__name__}")
     if flight_data.n_transitions < MIN_TRANSITIONS:
         return False

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, refuse_reloaded
 from ..flightdata import FlightData, check_flown, crash_flags
 from ..sim.constants import GRAVITY, NOISE_DECAY, NOISE_GAIN, NOISE_NAMES, OBS_NAMES, PARAM_NAMES
 from ..tasks import MDP
@@ -102,6 +102,7 @@ class Transitions:
 
     def __init__(self, flight_data: FlightData, what: str = "flight data") -> None:
         if not isinstance(flight_data, FlightData):
+            refuse_reloaded(flight_data, FlightData, what)  # importlib.reload(flightdata): "got FlightData" (T42-B08)
             raise NeurohoverError(f"{what} must be a FlightData, got {type(flight_data).__name__}")
         episodes = []
         for e, (o, a, crashed) in enumerate(zip(flight_data.observations, flight_data.actions, crash_flags(flight_data))):

@@ -25,7 +25,7 @@ from __future__ import annotations
 import importlib
 import pkgutil
 
-from ..errors import NeurohoverError, brief, finite_real
+from ..errors import NeurohoverError, brief, finite_real, refuse_reloaded
 from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, competition_rows, finite_vector
 from .drift import NO_DRIFT, Drift, refuse_drift
 from .fghh import COMPETITION_FGHH_SIGMA, FGHH
@@ -62,10 +62,12 @@ def get_task_family(name: str, sigma: float | None = None, sensor: Sensor | None
     seen through ``sensor`` (:mod:`neurohover.tasks.sensor`; None: exact sensors), its dynamics drifting
     over a test run by ``drift`` (:mod:`neurohover.tasks.drift`; None: fixed)."""
     if sensor is not None and not isinstance(sensor, Sensor):
+        refuse_reloaded(sensor, Sensor, "sensor")  # importlib.reload(tasks.sensor): its Sensor was "no neurohover.Sensor" (T42-B07)
         raise NeurohoverError(
             f"sensor={sensor!r} is not allowed: give a neurohover.Sensor (e.g. Sensor.of(obs_noise=1.0) or Sensor.parse('level=1.0')) or None for exact sensors"
         )
     if drift is not None and not isinstance(drift, Drift):
+        refuse_reloaded(drift, Drift, "drift")
         raise NeurohoverError(f"drift={drift!r} is not allowed: give a neurohover.Drift or None for fixed dynamics")
     family = _family(name, sigma)
     if sensor is not None and not sensor.exact:

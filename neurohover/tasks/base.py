@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError, as_floats, brief, check_name_text, finite_real, masked_note, whole_in, whole_number
+from ..errors import NeurohoverError, as_floats, brief, check_name_text, finite_real, masked_note, refuse_reloaded, whole_in, whole_number
 from ..sim.constants import (
     CONTROL_DT,
     DEFAULT_NOISE_STD,
@@ -107,8 +107,10 @@ class MDP:
 
     def __post_init__(self) -> None:
         if not isinstance(self.sensor, Sensor):
+            refuse_reloaded(self.sensor, Sensor, "sensor")  # importlib.reload(tasks.sensor): "got Sensor(...)" named no cause (T42-B07)
             raise NeurohoverError(f"sensor must be a neurohover Sensor, got {self.sensor!r}")
         if not isinstance(self.drift, Drift):
+            refuse_reloaded(self.drift, Drift, "drift")
             raise NeurohoverError(f"drift must be a neurohover Drift, got {self.drift!r}")
         if not isinstance(self.label, str):  # make(label=5) was kept as the number (second trial)
             raise NeurohoverError(f"MDP label={self.label!r:.60} is not allowed: give a string")
@@ -413,6 +415,7 @@ class TaskFamily:
     def with_sensor(self, sensor: Sensor) -> TaskFamily:
         """This family seen through ``sensor``: every MDP it makes, samples or lists carries it."""
         if not isinstance(sensor, Sensor):
+            refuse_reloaded(sensor, Sensor, "sensor")  # T42-B07
             raise NeurohoverError(f"sensor must be a neurohover Sensor, got {sensor!r}")
         out = copy.copy(self)
         object.__setattr__(out, "sensor", sensor)
@@ -421,6 +424,7 @@ class TaskFamily:
     def with_drift(self, drift: Drift) -> TaskFamily:
         """This family with drifting dynamics: every MDP it makes, samples or lists carries ``drift``."""
         if not isinstance(drift, Drift):
+            refuse_reloaded(drift, Drift, "drift")  # T42-B07
             raise NeurohoverError(f"drift must be a neurohover Drift, got {drift!r}")
         out = copy.copy(self)
         object.__setattr__(out, "drift", drift)

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import FloatRangeError, NeurohoverError, as_floats, brief, finite_real, float_of, real_number, whole_number
+from ..errors import FloatRangeError, NeurohoverError, as_floats, brief, finite_real, float_of, real_number, refuse_reloaded, whole_number
 from ..sim.constants import MDP_ROW_LEN, PARAM_NAMES, ROW_PARAMS
 from ..sim.rng import MAX_SEED
 
@@ -281,6 +281,7 @@ class DriftRun:
 
     def __init__(self, drift: Drift, row: np.ndarray, seed: int) -> None:
         if not isinstance(drift, Drift):
+            refuse_reloaded(drift, Drift, "drift")  # T42-B07
             raise NeurohoverError(f"drift={brief(drift)} is not allowed: give a Drift (Drift.of reads its other forms)")
         self.drift, self._row, self.seed = drift, _row(row), _seed(seed)
         self._rows = np.zeros((0, self._row.shape[0]))

@@ -27,7 +27,7 @@ from collections.abc import Iterator
 from dataclasses import fields, replace
 from typing import TYPE_CHECKING
 
-from ..errors import NeurohoverError, brief, check_name_text, finite_real, real_number, whole_number
+from ..errors import NeurohoverError, brief, check_name_text, finite_real, other_import, real_number, reloaded_text, whole_number
 from ..sim.constants import MDP_ROW_LEN, WIND_CONSTANT, WIND_NONE, WIND_SINUSOID
 
 if TYPE_CHECKING:
@@ -103,13 +103,16 @@ def held_problem(mdp: MDP) -> str:
     from .base import MDP
 
     if type(mdp) is not MDP:  # its == meets no family MDP (a dataclass's == compares classes): refused as "its  differ" (T37-B06)
-        return (
+        return other_import(mdp, MDP) or (  # an MDP of the first import, after importlib.reload(tasks.base) (T42-B09)
             f"it is a {brief(type(mdp).__name__)} (a subclass of neurohover.MDP), but a {mdp.family} MDP is a neurohover.MDP itself: "
             "give neurohover.MDP(**{f.name: getattr(m, f.name) for f in dataclasses.fields(m)})"
         )
     cls = TASK_FAMILIES[mdp.family]
     family = get_task_family(mdp.family)  # a sigma only widens FGHH's draws, not what make() takes
-    zero = replace(family.zero(), sensor=mdp.sensor, drift=mdp.drift)
+    zero = family.zero()
+    if type(zero) is not MDP:  # the families hold the first import's MDP: "its  differ from every fghh MDP's ()" (T42-B09)
+        return reloaded_text(MDP)
+    zero = replace(zero, sensor=mdp.sensor, drift=mdp.drift)
     if mdp != zero:
         try:
             made = family.make(mdp.row()[cls.row_slice])
