@@ -555,7 +555,8 @@ def check_against_store(folder: str | Path) -> None:
     flown, and nothing in the folder contradicts it; T38-B06). ``neurohover plot --compete`` calls it after
     :func:`~neurohover.compete_files.read_compete_dir` (whose layer reads no store). The summary names its store by its
     absolute path (a relative one, which older versions wrote, from the working directory); a store no longer there, or
-    holding no such experiment, is not read."""
+    holding no such experiment, is not read; one holding the experiment at other scales only refuses the summary's
+    (T42-A02)."""
     from .experiments import Store
     from .paths import strict_json
 
@@ -568,7 +569,13 @@ def check_against_store(folder: str | Path) -> None:
         return
     held = Store(store, create=False)
     try:
-        if (name, scale) not in {(n, s) for n, s, _, _ in held.experiments()}:
+        scales = sorted({s for n, s, _, _ in held.experiments() if n == name})
+        if scale not in scales:  # the experiment held at other scales only: a scale edited too (T42-A02)
+            if scales:
+                raise NeurohoverError(
+                    f"--compete {str(summary_path)!r}: its scale {brief(scale)} is not one its store {store!r} holds for "
+                    f"{name}: it holds {', '.join(scales)} (an edit by hand, or another store now at that path?)"
+                )
             return
         settings = held.config(name, scale).get("settings", {})
     finally:

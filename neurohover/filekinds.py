@@ -322,13 +322,17 @@ def refuse_suffix(path: str, option: str, suffixes: tuple[str, ...], what: str, 
         raise NeurohoverError(f"{option} {brief(path)} is not allowed: {what}; give a path ending {' or '.join(suffixes)} (e.g. {brief(like)})")
 
 
-def refuse_policy_set(directory: Path, option: str, given: str | os.PathLike) -> None:
+def refuse_policy_set(directory: Path, option: str, given: str | os.PathLike, link: bool = False) -> None:
     """Refuse to write ``given`` (``option``) into ``directory`` where it holds a policy set's manifest.json: a set holds
     only the files its build wrote, and compete --policy-dir refused a set that compete --out, evaluate-agent --json or
-    evolve --out had written into (T29-A06). build-policies writes its sets through a directory of its own."""
+    evolve --out had written into (T29-A06). build-policies writes its sets through a directory of its own. ``link``:
+    ``given`` is a symbolic link to a file in ``directory``, which a writer writes through (T42-A04)."""
     manifest = directory / "manifest.json"
     if held_kind(manifest) == POLICY_SET_KIND:
-        where = "is" if Path(given) == directory else f"is in {brief(str(directory))}, which is"
+        if link:
+            where = f"is a symbolic link to a file in {brief(str(directory))}, which is"
+        else:
+            where = "is" if Path(given) == directory else f"is in {brief(str(directory))}, which is"
         raise NeurohoverError(
             f"{option} {brief(os.fspath(given))} {where} a policy set's directory (its manifest.json): a set holds only "
             "what build-policies writes (its loader refuses a JSON file no build writes, and leaves other files alone as notes); give another directory"

@@ -332,8 +332,8 @@ def output_file(
     another kind (:func:`~neurohover.filekinds.held_kind`; T25-01 to T25-03), and a name of a suffix not in ``suffixes`` (``what`` says why) or
     (``run_files``) an evolve run's own file names (:func:`~neurohover.filekinds.output_name`), a name too long for the
     file system, it or it with the longest of ``ends`` (what the command adds to it for files beside it:
-    :func:`checked_path`), and a file in a policy set's directory (:func:`~neurohover.filekinds.refuse_policy_set`);
-    creates missing parent directories (saying so on standard error).
+    :func:`checked_path`), and a file in a policy set's directory (:func:`~neurohover.filekinds.refuse_policy_set`), a
+    symbolic link to one too; creates missing parent directories (saying so on standard error).
     """
     _no_dash(path, option, "file", stdout)
     p = checked_path(path, option, ends=ends, file=True)  # 'x.json/' and 'x.json/.' too (seventh trial, T32-B08)
@@ -354,6 +354,8 @@ def output_file(
     if suffixes or run_files:  # flight data, a checkpoint replaced by JSON rows, CSV or a model (T25-01 to T25-03)
         output_name(path, option, suffixes or ("",), what, run_files, ends)
     refuse_policy_set(p.parent, option, path)
+    if p.is_symlink():  # written through: a file link into a set replaced the set's policy (T42-A04)
+        refuse_policy_set(Path(os.path.realpath(p)).parent, option, path, link=True)
     held = None if kind is None else held_kind(p)
     if held is not None and held != kind:  # a policy, a checkpoint, a summary replaced by another kind of file (T25-01 to T25-03)
         raise NeurohoverError(f"{option} {brief(os.fspath(path))} is {held}: give another path (writing {kind} there would destroy it)")

@@ -3,7 +3,8 @@
 ``neurohover plot FLIGHT.npz [--out DIR]`` draws each episode of a flight-data file (written by
 ``neurohover fly --record``) to ``DIR/<name>-episode<i>.png``: position error, velocity, attitude
 (roll, pitch, yaw), angular rates and actions over time, a crash (an episode shorter than 6000
-steps) marked in red. ``DIR`` defaults to the file's directory.
+steps) marked in red. ``DIR`` defaults to the file's directory. Figures of another flight
+of the same name that ``DIR`` holds are left there and named on stderr.
 
 ``neurohover plot --compete DIR [DIR ...] [--out OUTDIR]`` overlays the mean cumulative error of
 several ``neurohover compete --out DIR`` results (their ``episodes.csv``; agent and task from
@@ -21,11 +22,16 @@ The files written are printed, one per line.
 from __future__ import annotations
 
 import argparse
+import re
+import sys
+from pathlib import Path
 
 from ..errors import NeurohoverError
 from .options import integer
 
 COMPETE_PNG = "compete.png"
+#: Figures of another flight named in plot's note, at most (the rest counted).
+_NAMED = 8
 
 
 def _episodes(text: str | None, n: int) -> list[int] | None:
@@ -55,6 +61,29 @@ def _episodes(text: str | None, n: int) -> list[int] | None:
     return out
 
 
+def _note_left(out: Path, stem: str, n: int) -> None:
+    """Say (stderr) which ``<stem>-episode<i>.png`` in ``out`` no plot of this flight writes: another flight of
+    the same name's figures, left in the folder beside this one's, as ``report`` says of its own (T42-A03). Never removed:
+    they are a person's files as much as neurohover's."""
+    width = len(str(max(n - 1, 0)))
+    own = {f"{stem}-episode{i:0{width}d}.png" for i in range(n)}
+    pattern = re.compile(re.escape(stem) + r"-episode[0-9]+\.png")
+    try:
+        stale = [p.name for p in out.iterdir() if pattern.fullmatch(p.name) and p.name not in own and p.is_file()]
+    except OSError:  # the folder unreadable after writing: nothing to say
+        return
+    if stale:
+        from ..paths import printable
+
+        stale.sort(key=lambda name: (len(name), name))  # episode2 before episode10
+        named = ", ".join(stale[:_NAMED]) + (f" and {len(stale) - _NAMED} more" if len(stale) > _NAMED else "")
+        print(
+            f"neurohover plot: note: {printable(out)!r} holds figures of another flight named {stem!r} (this one has {n} "
+            f"episode(s)), left in the folder (remove them if unwanted): {named}",
+            file=sys.stderr,
+        )
+
+
 def cmd_plot(args: argparse.Namespace) -> int:
     """Plot a recorded flight (one PNG per episode) or overlay competition results (one PNG)."""
     from ..paths import input_file, output_dir, printable
@@ -74,6 +103,7 @@ def cmd_plot(args: argparse.Namespace) -> int:
         from ..plots import plot_flight_data
 
         written = plot_flight_data(data, out, stem=path.stem, episodes=_episodes(args.episodes, data.n_episodes))
+        _note_left(out, path.stem, data.n_episodes)
     else:
         from ..compete import check_against_store
         from ..compete_files import read_compete_dirs
