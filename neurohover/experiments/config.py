@@ -424,10 +424,7 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
         raise NeurohoverError(f"{where}: unknown scale table(s) {', '.join(bad_scales)}; allowed: {', '.join(SCALES)}")
     if scale not in scales:
         raise NeurohoverError(f"{where}: has no [scales.{scale}] table")
-    for other in scales:  # a typo in the scale not run now must not wait for the day it runs
-        if other != scale:
-            resolved = validate_table({**raw["settings"], **scales[other]}, SCHEMAS[kind], f"{where} at scale {other!r}")
-            check_kind(resolved, kind, f"{where} at scale {other!r}")
+    _check_shared(raw["settings"], scales, scale, overrides or {}, kind, where)
     merged = {**raw["settings"], **scales[scale], **(overrides or {})}
     # the file's own settings where --set switched the policies source (its policy-evolution settings stay accepted)
     switched = frozenset({*raw["settings"], *scales[scale]} - set(overrides or {})) if "policies" in (overrides or {}) else frozenset()
@@ -442,7 +439,11 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
         source=str(path),
         where=f"{where} at scale {scale!r}",
         switched=switched,
-    )
+    )  # the run's own scale first: a mistake found in both was named by the other scale (T42-A01)
+    for other in scales:  # a typo in the scale not run now must not wait for the day it runs
+        if other != scale:
+            resolved = validate_table({**raw["settings"], **scales[other]}, SCHEMAS[kind], f"{where} at scale {other!r}")
+            check_kind(resolved, kind, f"{where} at scale {other!r}")
     check_paper(raw.get("paper", {}), raw, where)  # after the settings: a bad agent is named as such, not as a t test naming nothing
     _check_seeds_of(config, where)
     if overrides and not own:  # the report would judge other conditions against the paper's claims (T29-A02)
@@ -450,6 +451,14 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
 
         check_shipped_overrides(raw["name"], str(path), load_config(str(path), scale).settings, config.settings, f"{where} at scale {scale!r}")
     return config
+
+
+def _check_shared(settings: dict, scales: dict, scale: str, overrides: dict, kind: str, where: str) -> None:
+    """Check each setting [settings] gives that some scale uses (one its scale table, or --set on the run's scale, does
+    not replace) on its own, naming [settings]: ``seed = "7"`` there was named by the first scale checked, 'paper' under
+    --scale quick too (T42-A01). The checks across settings need the merged table: they name the scale, the run's first."""
+    used = {k: v for k, v in settings.items() if any(k not in table and (other != scale or k not in overrides) for other, table in scales.items())}
+    validate_table(used, SCHEMAS[kind], f"{where}, [settings]", given_only=True)
 
 
 def _check_seeds_of(config: ExperimentConfig, where: str) -> None:

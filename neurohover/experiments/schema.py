@@ -52,7 +52,9 @@ ZERO_MEANS = dict.fromkeys(
 ) | {"ec_meno_budget": " (0: no cap, EC-MENO stops at its plateau)"}
 
 
-def validate_table(values: dict, schema: dict, where: str) -> dict:
+def validate_table(values: dict, schema: dict, where: str, *, given_only: bool = False) -> dict:
+    """``values`` checked against ``schema``, with the defaults written in. ``given_only``: check the settings given and
+    nothing else (no required setting missed, no defaults): a config's [settings] table, whose scale tables add the rest."""
     unknown = sorted(set(values) - set(schema))
     if unknown:
         hint = " (the optimizer table is spelled `optimizer`, as on the command line)" if "optimiser" in unknown else ""
@@ -60,6 +62,8 @@ def validate_table(values: dict, schema: dict, where: str) -> dict:
     out: dict[str, Any] = {}
     for key, (default, check) in schema.items():
         if key not in values:
+            if given_only:
+                continue
             if default is REQUIRED:
                 raise NeurohoverError(f"{where}: missing required setting {key!r}")
             if default is OMIT:

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, refuse_reloaded
+from ..errors import NeurohoverError, brief, finite_real, refuse_reloaded
 from ..flightdata import FlightData, check_flown, crash_flags
 from ..sim.constants import GRAVITY, NOISE_DECAY, NOISE_GAIN, NOISE_NAMES, OBS_NAMES, PARAM_NAMES
 from ..tasks import MDP
@@ -69,6 +69,30 @@ def _check_readings(flight_data: FlightData, what: str) -> None:
             )
 
 
+def _check_quaternions(observations: list[np.ndarray], flown: list[int], metadata: dict, what: str) -> None:
+    """Refuse quaternion vector parts longer than 1: LR and the EC methods take ``qw = sqrt(1 - |q vector|^2)`` and the
+    body-to-world rotation of each reading, which only a unit quaternion has. Readings through a noisy attitude sensor
+    (``--obs-noise attitude=S``) can pass 1 (at S = 0.2 in some hover episodes): kept refused, naming the sensor noise the
+    episode's metadata records and what to record instead, where "not helicopter observations" blamed the file (T42-A05)."""
+    worst = [float(np.einsum("ij,ij->i", q, q).max(initial=0.0)) for q in (o[:, 9:12].astype(float) for o in observations)]
+    if max(worst, default=0.0) <= _MAX_QUAT_NORM2:
+        return
+    longest = math.sqrt(max(worst))
+    tables = metadata.get("mdps")
+    tables = tables if isinstance(tables, list) else []
+    for i, e in enumerate(flown):
+        table = tables[e] if e < len(tables) and isinstance(tables[e], dict) else {}
+        sensor = table.get("sensor")
+        noise = sensor.get("attitude", 0.0) if isinstance(sensor, dict) else 0.0
+        if worst[i] > _MAX_QUAT_NORM2 and finite_real(noise) and noise > 0:
+            raise NeurohoverError(
+                f"{what}: quaternion vector parts (qx, qy, qz) longer than 1 (max {math.sqrt(worst[i]):.6g} in episode {e}), read through the "
+                f"attitude sensor noise {brief(noise)} its metadata records for that episode: a model is fitted from unit quaternions "
+                "(qw = sqrt(1 - |q vector|^2)), so record the flight with less attitude noise (e.g. --obs-noise attitude=0.05) or exact sensors"
+            )
+    raise NeurohoverError(f"{what}: quaternion vector parts (qx, qy, qz) longer than 1 (max {longest:.6g}); not helicopter observations")
+
+
 class Transitions:
     """All transitions k -> k+1 of the flight data, concatenated over episodes, with rotations.
 
@@ -104,13 +128,14 @@ class Transitions:
         if not isinstance(flight_data, FlightData):
             refuse_reloaded(flight_data, FlightData, what)  # importlib.reload(flightdata): "got FlightData" (T42-B08)
             raise NeurohoverError(f"{what} must be a FlightData, got {type(flight_data).__name__}")
-        episodes = []
+        episodes, flown = [], []  # flown: each kept episode's index in the flight data
         for e, (o, a, crashed) in enumerate(zip(flight_data.observations, flight_data.actions, crash_flags(flight_data))):
             check_flown(o, a, crashed, f"{what}, episode {e}")  # "holds non-finite observations or actions" named none (T22-02)
             if crashed and a.shape[0] and not np.isfinite(a[-1]).all():
                 o, a = o[:-1], a[:-1]  # the simulator never flew it: its next observation repeats the last
             if a.shape[0] > 0:
                 episodes.append((o, a))
+                flown.append(e)
         n = sum(a.shape[0] for _, a in episodes)
         if n < MIN_TRANSITIONS:
             raise NeurohoverError(f"{what} holds {n} transitions in {flight_data.n_episodes} episodes; learning a model needs at least {MIN_TRANSITIONS}")
@@ -118,12 +143,7 @@ class Transitions:
         nxt = np.concatenate([o[1:] for o, _ in episodes]).astype(float, copy=False)
         act = np.concatenate([a for _, a in episodes]).astype(float, copy=False)
         _check_readings(flight_data, what)
-        for arr in (obs, nxt):
-            norm2 = np.einsum("ij,ij->i", arr[:, 9:12], arr[:, 9:12])
-            if np.any(norm2 > _MAX_QUAT_NORM2):
-                raise NeurohoverError(
-                    f"{what}: quaternion vector parts (qx, qy, qz) longer than 1 (max {math.sqrt(norm2.max()):.6g}); not helicopter observations"
-                )
+        _check_quaternions([o for o, _ in episodes], flown, flight_data.metadata, what)
         if np.any(np.abs(act) > 1.0 + 1e-12):
             raise NeurohoverError(
                 f"{what}: actions outside [-1, 1] (max |a| {np.abs(act).max():.6g}); flight data hold the clipped actions the simulator applied"
