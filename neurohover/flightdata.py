@@ -171,6 +171,13 @@ class FlightData:
         # metadata load() refuses (episode_steps -5, crashed 'x') was taken here and written by save() (T18-4)
         check_metadata(self.metadata, np.array([a.shape[0] for a in self.actions], dtype=np.int64), "flight data", (self.observations, self.actions))
 
+    def check_again(self, where: str = "flight data") -> None:
+        """The metadata checks ``FlightData(...)`` runs, run again by each reader that relies on the metadata (the
+        learners, Transitions, ``+``): metadata may be edited after making, and an edited safeguard_step ['a', None] was
+        a TypeError in EC-MER, an episode_steps 'x' or crashed 'yes' learned from without a word (T43-B06)."""
+        _metadata_text(self.metadata, where)
+        check_metadata(self.metadata, np.array([a.shape[0] for a in self.actions], dtype=np.int64), where, (self.observations, self.actions))
+
     @property
     def n_episodes(self) -> int:
         return len(self.actions)
@@ -182,6 +189,8 @@ class FlightData:
     def __add__(self, other: FlightData) -> FlightData:
         if not isinstance(other, FlightData):
             return NotImplemented  # Python's TypeError ("unsupported operand"), as for any sum it cannot make
+        self.check_again("flight data (the first of +)")  # an edited crashed of the wrong length was dropped without a word (T43-B06)
+        other.check_again("flight data (the second of +)")
         meta = {**self.metadata, **other.metadata}
         for name in set(meta) - {*_PER_EPISODE, "episode_steps", "policy_flown"}:  # one entry for the whole recording
             if name not in self.metadata or name not in other.metadata or not same_values(self.metadata[name], other.metadata[name]):

@@ -33,7 +33,7 @@ from ..sim.constants import (
 from ..sim.reference import competition_time
 from ..sim.rng import check_seed, seed_stream
 from ..sim.step import ENV_NOISE_WIDTH, ENV_RNG_WIDTH, start_readings, step_batch
-from ..tasks import MDP, TASK_FAMILIES, TaskFamily
+from ..tasks import MDP, TASK_FAMILIES, TaskFamily, family_class
 from ..tasks.drift import Drift, DriftRun
 from .arguments import (
     SAMPLE,
@@ -90,7 +90,8 @@ def mdp_info(mdp: MDP) -> dict[str, Any]:
     parameters; FGHH: the 11 dynamics parameters), named by ``param_names``. An MDP of no task
     family (a learned model) gives its 11 dynamics parameters and D_u.
     """
-    cls = TASK_FAMILIES.get(_an_mdp(mdp, "mdp_info").family)
+    family = _an_mdp(mdp, "mdp_info").family
+    cls = family_class(family) if family in TASK_FAMILIES else None  # its entry checked (T43-B10)
     if cls is not None:
         params, names = mdp.row()[cls.row_slice], tuple(cls.param_names)
     else:

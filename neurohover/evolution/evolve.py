@@ -163,9 +163,6 @@ def _checkpoint_path(checkpoint, progress, resume: bool) -> Path | None:
         path = None if checkpoint is None else Path(checkpoint)
     else:  # checked before the run; a JSON name, no file of another kind (a model file was replaced; T28-B07)
         path = output_file(checkpoint, "checkpoint", kind=CHECKPOINT_KIND, suffixes=(".json",), what="a checkpoint is JSON")
-        if path.is_file():  # a notebook's cell run again replaced an unfinished run's without a word (T38-B08), as the CLI says
-            warnings.warn(f"checkpoint {str(path)!r} holds a run's checkpoint: this run starts afresh and replaces it (resume=True continues it)",
-                          CheckpointReplaced, stacklevel=3)  # fmt: skip
     if resume and path is None:
         raise NeurohoverError("resume=True needs the checkpoint path")
     return None if path is None else path.absolute()
@@ -295,6 +292,11 @@ def _fly_run(run: Run, path: Path | None, resume: bool, threads: int | None, dev
     with contextlib.ExitStack() as held:
         if path is not None:
             held.enter_context(sole_writer(path, "checkpoint"))
+            # once the lock is held: a run refused as a second writer warned first that it replaced the checkpoint (T43-B16);
+            # a notebook's cell run again replaced an unfinished run's without a word (T38-B08), as the CLI says
+            if not resume and path.is_file():
+                warnings.warn(f"checkpoint {str(path)!r} holds a run's checkpoint: this run starts afresh and replaces it (resume=True continues it)",
+                              CheckpointReplaced, stacklevel=3)  # fmt: skip
         _prepare(run, path, resume, threads, device, trace)
         with num_threads(threads if threads is not None else numba.get_num_threads()):  # restores the count after
             run.flyer.start()

@@ -315,6 +315,10 @@ def ec_mer_policy(given: str | None, data: FlightData, flight_data: str):
     (T34-A05). Whichever it is must give the recorded actions on the first episode's first
     :data:`~neurohover.flightmeta.CHECKED_STEPS` observations (:func:`check_policy_flew`): an edited policy_flown, or an
     older file's metadata naming another run's policy, was fitted without a word (T22-17)."""
+    if not isinstance(data, FlightData):
+        refuse_reloaded(data, FlightData, "flight data")
+        raise NeurohoverError(f"flight data must be a FlightData, got {type(data).__name__}")
+    data.check_again(f"flight data {flight_data!r}")  # metadata edited after making (T43-B06)
     policy = _chosen_policy(given, data, f"flight data {flight_data!r}")
     check_policy_flew(policy, data, f"flight data {flight_data!r}", _named(given, data))
     return policy

@@ -128,6 +128,7 @@ class Transitions:
         if not isinstance(flight_data, FlightData):
             refuse_reloaded(flight_data, FlightData, what)  # importlib.reload(flightdata): "got FlightData" (T42-B08)
             raise NeurohoverError(f"{what} must be a FlightData, got {type(flight_data).__name__}")
+        flight_data.check_again(what)  # metadata edited after making: the learners read crashed and episode_steps (T43-B06)
         episodes, flown = [], []  # flown: each kept episode's index in the flight data
         for e, (o, a, crashed) in enumerate(zip(flight_data.observations, flight_data.actions, crash_flags(flight_data))):
             check_flown(o, a, crashed, f"{what}, episode {e}")  # "holds non-finite observations or actions" named none (T22-02)

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import importlib
 import pkgutil
+from types import MappingProxyType
 
 from ..errors import NeurohoverError, brief, finite_real, refuse_reloaded
 from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, competition_rows, finite_vector
@@ -52,9 +53,40 @@ def discover(package: str) -> dict[str, type[TaskFamily]]:
     return found
 
 
-#: Every task family class by name.
+#: Every task family class by name. A run-time entry is a TaskFamily subclass under its own name; a shipped name holds
+#: its shipped class (:func:`family_class` checks the entry it reads).
 TASK_FAMILIES: dict[str, type[TaskFamily]] = discover(__name__)
 TASK_NAMES: tuple[str, ...] = tuple(TASK_FAMILIES)
+_SHIPPED = MappingProxyType(dict(TASK_FAMILIES))
+
+
+def entry_problem(name: object, cls: object) -> str:
+    """What is wrong with the registry entry ``TASK_FAMILIES[name] = cls`` ('' when nothing): no TaskFamily subclass (5
+    was an AttributeError 'has_sigma'), a shipped name holding another class (``TASK_FAMILIES["ghh08"] = GHH09`` gave
+    GHH-09 for ghh08), or a class whose name is not its key (an alias 'zz' gave a family named ghh08; T43-B10)."""
+    entry = f"TASK_FAMILIES[{brief(name)}] = {brief(cls)} is not allowed"
+    if not (isinstance(cls, type) and issubclass(cls, TaskFamily)):
+        return f"{entry}: register a TaskFamily subclass under its name (TASK_FAMILIES[cls.name] = cls)"
+    if isinstance(name, str) and name in _SHIPPED:
+        if cls is _SHIPPED[name]:
+            return ""
+        return f"{entry}: {name!r} is a shipped task family's name and holds its shipped class; register yours under a name of its own"
+    if cls.name != name:
+        return f"{entry}: its class's name {brief(cls.name)} is not its key; register a class under its own name (TASK_FAMILIES[cls.name] = cls)"
+    return ""
+
+
+def family_class(name: str) -> type[TaskFamily]:
+    """The registry's class of task family ``name`` (a key of :data:`TASK_FAMILIES`), its entry checked
+    (:func:`entry_problem`; NeurohoverError naming a bad one, or an unknown name with the registry's names as it is)."""
+    if not isinstance(name, str) or name not in TASK_FAMILIES:
+        allowed = [n for n, c in list(TASK_FAMILIES.items()) if isinstance(n, str) and not entry_problem(n, c)]
+        raise NeurohoverError(f"unknown task {brief(name)}: allowed {', '.join(allowed)}")  # TASK_NAMES listed a deleted entry
+    cls = TASK_FAMILIES[name]
+    problem = entry_problem(name, cls)
+    if problem:
+        raise NeurohoverError(problem)
+    return cls
 
 
 def get_task_family(name: str, sigma: float | None = None, sensor: Sensor | None = None, drift: Drift | None = None) -> TaskFamily:
@@ -78,10 +110,10 @@ def get_task_family(name: str, sigma: float | None = None, sensor: Sensor | None
 def _family(name: str, sigma: float | None) -> TaskFamily:
     key = str(name).lower().replace("-", "")
     if key not in TASK_FAMILIES:
-        raise NeurohoverError(f"unknown task {brief(name)}: allowed {', '.join(TASK_NAMES)}")
-    cls = TASK_FAMILIES[key]
+        family_class(name)  # refused, naming the registry's names
+    cls = family_class(key)
     if sigma is not None and not cls.has_sigma:
-        with_sigma = [n for n, c in TASK_FAMILIES.items() if c.has_sigma]
+        with_sigma = [n for n, c in list(TASK_FAMILIES.items()) if not entry_problem(n, c) and c.has_sigma]
         raise NeurohoverError(f"sigma applies to the {', '.join(with_sigma)} task only, not to {brief(name)}")
     if cls.has_sigma and sigma is not None:  # the family's own check and message: 10**400 was cut to 40 digits, its range unnamed (T26-B16)
         return cls(sigma=sigma)  # type: ignore[call-arg]
@@ -111,7 +143,7 @@ def family_from_dict(d: dict) -> TaskFamily:
 def family_for(name: str, sigma: float | None, sensor: Sensor | None = None, drift: Drift | None = None) -> TaskFamily:
     """Like :func:`get_task_family`, but a ``sigma`` is ignored for families without one (configs carry one for all)."""
     key = str(name).lower().replace("-", "")
-    has = key in TASK_FAMILIES and TASK_FAMILIES[key].has_sigma
+    has = key in TASK_FAMILIES and family_class(key).has_sigma
     return get_task_family(name, sigma if has else None, sensor, drift)
 
 

@@ -263,10 +263,12 @@ def mdp_label(label: object, default: str) -> str:
 
 
 def competition_rows(family: str) -> dict:
-    """The competition's training and test rows of ``family`` as listed in the shipped data file."""
+    """The competition's training and test rows of ``family`` as listed in the shipped data file: a copy of its own, so
+    an edit of it changes no MDP (the cache itself was returned: an edited row flew as the competition's train:0, and
+    ``.clear()`` had the family refused for the rest of the process; T43-B07)."""
     if family not in competition_families():
         raise NeurohoverError(f"the competition data file lists no MDPs of {family!r}: it has {', '.join(competition_families())}")
-    return _COMPETITION[family]
+    return copy.deepcopy(_COMPETITION[family])
 
 
 def competition_families() -> tuple[str, ...]:

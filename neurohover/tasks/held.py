@@ -99,7 +99,7 @@ def check_label(mdp: MDP) -> None:
 def held_problem(mdp: MDP) -> str:
     """Why ``mdp`` is no MDP its task family holds ('' when it is one, or a learned model's); see the module docstring.
     Call it inside :func:`family_code`: it builds the family's zero, make() and named MDPs to compare."""
-    from . import TASK_FAMILIES, get_task_family
+    from . import get_task_family
     from .base import MDP
 
     if type(mdp) is not MDP:  # its == meets no family MDP (a dataclass's == compares classes): refused as "its  differ" (T37-B06)
@@ -107,8 +107,8 @@ def held_problem(mdp: MDP) -> str:
             f"it is a {brief(type(mdp).__name__)} (a subclass of neurohover.MDP), but a {mdp.family} MDP is a neurohover.MDP itself: "
             "give neurohover.MDP(**{f.name: getattr(m, f.name) for f in dataclasses.fields(m)})"
         )
-    cls = TASK_FAMILIES[mdp.family]
-    family = get_task_family(mdp.family)  # a sigma only widens FGHH's draws, not what make() takes
+    family = get_task_family(mdp.family)  # a sigma only widens FGHH's draws, not what make() takes; its entry checked (T43-B10)
+    cls = type(family)
     zero = family.zero()
     if type(zero) is not MDP:  # the families hold the first import's MDP: "its  differ from every fghh MDP's ()" (T42-B09)
         return reloaded_text(MDP)
