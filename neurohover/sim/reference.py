@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, whole_number
+from ..errors import NeurohoverError, as_floats, brief, finite_real, real_number, whole_number
 from .constants import (
     CRASH_STEP_PENALTY,
     EPISODE_STEPS,
@@ -66,8 +66,15 @@ def _rotate_inverse(q: Quat, v: Vec) -> Vec:
 
 
 def rotation_vector_quaternion(rv: Vec) -> Quat:
-    """Unit quaternion of a rotation vector; first-order form below an angle of 1e-4 (docs/model.md, Simulator)."""
-    return _rotation_vector_quaternion(_reals(rv, 3, "rv"))  # type: ignore[arg-type]
+    """Unit quaternion of a rotation vector; first-order form below an angle of 1e-4 (docs/model.md, Simulator). Any
+    finite rotation vector is one: past 1e150 rad (whose squares would overflow, an OverflowError; T43-B03) its half
+    angle is taken from the halved vector, the same rotation."""
+    x, y, z = _reals(rv, 3, "rv")
+    if max(abs(x), abs(y), abs(z)) < 1e150:
+        return _rotation_vector_quaternion((x, y, z))
+    half = math.hypot(x / 2, y / 2, z / 2)  # finite: at most sqrt(3) * 0.9e308
+    s = math.sin(half)
+    return (x / 2 / half * s, y / 2 / half * s, z / 2 / half * s, math.cos(half))
 
 
 def _rotation_vector_quaternion(rv: Vec) -> Quat:
@@ -110,20 +117,8 @@ class ReferenceMDP:
 
     def __post_init__(self) -> None:
         """Refuse what the simulator cannot fly: 3 params were an unpack ValueError mid-episode, substeps=0 flew no
-        physics and returned 0.0 (thirteenth trial, F6, F7)."""
-        _reals(self.params, 11, "params")
-        _reals(self.noise_std, 6, "noise_std", nonnegative=True)  # standard deviations, as the MDP's (fourteenth trial T14-21)
-        _reals(self.wind, 8, "wind")
-        sensor = _reals(self.sensor, 7, "sensor")
-        _check_sensor(sensor)
-        if self.wind_kind not in (0, WIND_CONSTANT, WIND_SINUSOID) or isinstance(self.wind_kind, bool):
-            raise NeurohoverError(f"wind_kind={brief(self.wind_kind)} is not allowed: give 0 (none), {WIND_CONSTANT} (constant) or {WIND_SINUSOID} (sinusoid)")
-        if not whole_number(self.substeps) or self.substeps < 1:
-            raise NeurohoverError(f"substeps={brief(self.substeps)} is not allowed: give an integer >= 1 (physics substeps of a control step)")
-        if not finite_real(self.dt) or self.dt <= 0:
-            raise NeurohoverError(f"dt={brief(self.dt)} is not allowed: give a finite number > 0 (seconds of a substep)")
-        if not finite_real(self.d_u):
-            raise NeurohoverError(f"d_u={brief(self.d_u)} is not allowed: give a finite number")
+        physics and returned 0.0 (thirteenth trial, F6, F7). Checked again where it is flown (:func:`_check_mdp`)."""
+        _check_mdp(self)
 
     def wind_at(self, t: float) -> Vec:
         """World-frame wind (m/s) at time t (for GHH-09, t as :func:`competition_time` floors it)."""
@@ -141,7 +136,9 @@ class ReferenceMDP:
 
 @dataclass
 class ReferenceHelicopter:
-    """State of one helicopter in the world frame (north-east-down)."""
+    """State of one helicopter in the world frame (north-east-down). Its fields are checked where it is made and at each
+    :meth:`step` (wrong action or normals were unpack and index errors, episode_steps=-5 paid a crash a positive
+    reward; T43-B02); :func:`fly_episode`, which checks them once, steps it unchecked."""
 
     mdp: ReferenceMDP
     velocity: Vec = (0.0, 0.0, 0.0)
@@ -151,6 +148,22 @@ class ReferenceHelicopter:
     noise: list[float] = field(default_factory=lambda: [0.0] * 6)
     steps: int = 0
     episode_steps: int = EPISODE_STEPS
+
+    def __post_init__(self) -> None:
+        self._check()
+
+    def _check(self) -> None:
+        """Refuse a state the simulator cannot step (the fields are the caller's to change between steps)."""
+        _check_mdp(self.mdp, "mdp.")
+        for name, n in (("velocity", 3), ("position", 3), ("rates", 3), ("orientation", 4)):
+            setattr(self, name, _reals(getattr(self, name), n, name))
+        self.noise = list(_reals(self.noise, 6, "noise"))
+        for name, low in (("episode_steps", 1), ("steps", 0)):
+            value, high = getattr(self, name), (MAX_EPISODE_STEPS if name == "episode_steps" else self.episode_steps)
+            if not whole_number(value) or not low <= value <= high:
+                meaning = "control steps of an episode" if name == "episode_steps" else "control steps flown, at most episode_steps"
+                raise NeurohoverError(f"{name}={brief(value)} is not allowed: give an integer in {low}..{high} ({meaning})")
+            setattr(self, name, int(value))
 
     def observation(self) -> list[float]:
         """Body-frame velocity, body-frame position, angular rates, quaternion vector part."""
@@ -166,7 +179,21 @@ class ReferenceHelicopter:
         )
 
     def step(self, action: Sequence[float], normals: Sequence[float]) -> tuple[float, bool]:
-        """One 0.1 s control step; returns (reward, crashed)."""
+        """One 0.1 s control step; returns (reward, crashed). ``action``: 4 real numbers (NaN or inf crashes), ``normals``:
+        6 finite standard normals (the gusts' of this step, :func:`neurohover.sim.rng.episode_normals`)."""
+        self._check()
+        if self.steps >= self.episode_steps:
+            raise NeurohoverError(
+                f"step {self.steps + 1} is not allowed: the episode of episode_steps={self.episode_steps} is flown (make a new ReferenceHelicopter)"
+            )
+        if not _is_action(action):
+            raise NeurohoverError(f"action={brief(action)} is not allowed: give 4 real numbers (a sequence or an array)")
+        if isinstance(normals, (str, bytes)) or not isinstance(normals, (Sequence, np.ndarray)):
+            raise NeurohoverError(f"normals={brief(normals)} is not allowed: give 6 real numbers, all finite (a sequence or an array)")
+        return self._step(action, _reals(normals, 6, "normals"))
+
+    def _step(self, action: Sequence[float], normals: Sequence[float]) -> tuple[float, bool]:
+        """:meth:`step` unchecked, for :func:`fly_episode`."""
         self.steps += 1
         if not all(math.isfinite(a) for a in action):
             return -CRASH_STEP_PENALTY * (self.episode_steps - self.steps), True
@@ -207,7 +234,8 @@ class ReferenceHelicopter:
 @dataclass
 class ReferenceSensors:
     """The sensor model of docs/benchmarks.md, literally: noise e_k on each reading, delivered ``delay`` readings late,
-    each reading but the reset's lost with probability ``dropout`` (the one delivered last held instead)."""
+    each reading but the reset's lost with probability ``dropout`` (the one delivered last held instead). Its sensor and
+    normals are checked where it is made, the reading's row at each :meth:`read` (short normals were an IndexError; T43-B02)."""
 
     sensor: Sequence[float]
     normals: Sequence[Sequence[float]]  # 12 standard normals per reading, 13 with a dropout (rng.sensor_normals)
@@ -215,8 +243,30 @@ class ReferenceSensors:
     readings: list[list[float]] = field(default_factory=list)
     delivered: list[float] = field(default_factory=list)
 
+    def __post_init__(self) -> None:
+        sensor = _reals(self.sensor, 7, "sensor")
+        _check_sensor(sensor)
+        self.sensor = sensor
+        self.normals = _normal_rows("normals", self.normals, 1, _sensor_widths(sensor), every=True)
+        self.noise = list(_reals(self.noise, 12, "noise"))
+        if not isinstance(self.readings, list) or not all(isinstance(r, list) and len(r) == 12 for r in self.readings):
+            raise NeurohoverError(f"readings={brief(self.readings)} is not allowed: give a list of the readings made (lists of 12 numbers), [] at the reset")
+
     def read(self, observation: Sequence[float]) -> list[float]:
-        """The reading the policy gets now, of the true ``observation`` just made."""
+        """The reading the policy gets now, of the true ``observation`` just made (12 real numbers)."""
+        k = len(self.readings)
+        if k >= len(self.normals):
+            raise NeurohoverError(f"reading {k} is not allowed: normals has {len(self.normals)} rows, one per reading (give more rows)")
+        try:
+            ok = len(observation) == 12 and all(real_number(o) for o in observation)
+        except TypeError:
+            ok = False
+        if not ok or isinstance(observation, (str, bytes)):
+            raise NeurohoverError(f"observation={brief(observation)} is not allowed: give 12 real numbers (ReferenceHelicopter.observation())")
+        return self._read(observation)
+
+    def _read(self, observation: Sequence[float]) -> list[float]:
+        """:meth:`read` unchecked, for :func:`fly_episode`."""
         k = len(self.readings)
         rho, delay, dropout = self.sensor[4], int(self.sensor[5]), self.sensor[6]
         for i in range(12):
@@ -244,21 +294,45 @@ def fly_episode(
     kernel records them); the reward stays on the true observation.
     """
     normals, sensor_normals = _check_episode(mdp, policy, normals, n_steps, sensor_normals)
+    # a copy of its fields, checked as it is made: one the policy changes mid-episode is not flown (T43-B01)
+    mdp = ReferenceMDP(tuple(mdp.params), tuple(mdp.noise_std), mdp.wind_kind, tuple(mdp.wind), mdp.substeps, mdp.dt, mdp.d_u, tuple(mdp.sensor))
     heli = ReferenceHelicopter(mdp, episode_steps=n_steps)
     sensors = None if sensor_normals is None else ReferenceSensors(mdp.sensor, sensor_normals)
 
     def seen(observation: list[float]) -> list[float]:
-        return observation if sensors is None else sensors.read(observation)
+        return observation if sensors is None else sensors._read(observation)
 
     observations = [seen(heli.observation())]
     total = 0.0
     for k in range(n_steps):
-        reward, crash = heli.step(_action(policy, observations[-1], k), normals[k])
+        reward, crash = heli._step(_action(policy, observations[-1], k), normals[k])
         total += reward
         observations.append(seen(heli.observation()))
         if crash:
             return total, True, observations
     return total, False, observations
+
+
+def _check_mdp(mdp: object, prefix: str = "") -> None:
+    """Refuse ``mdp`` unless it is a :class:`ReferenceMDP` the simulator can fly (``prefix``: how messages name its fields,
+    "mdp." where it is flown). A plain dataclass, it may be changed after it is made: substeps=0 flew a perfect 0.0
+    return, a NaN dt a NaN one, 3 params were an unpack ValueError (T43-B01); so it is checked again where flown."""
+    if not isinstance(mdp, ReferenceMDP):
+        raise NeurohoverError(f"mdp={brief(mdp)} is not allowed: give a ReferenceMDP (an MDP's to_reference())")
+    _reals(mdp.params, 11, f"{prefix}params")
+    _reals(mdp.noise_std, 6, f"{prefix}noise_std", nonnegative=True)  # standard deviations, as the MDP's (fourteenth trial T14-21)
+    _reals(mdp.wind, 8, f"{prefix}wind")
+    _check_sensor(_reals(mdp.sensor, 7, f"{prefix}sensor"), prefix)
+    if mdp.wind_kind not in (0, WIND_CONSTANT, WIND_SINUSOID) or isinstance(mdp.wind_kind, bool):
+        raise NeurohoverError(
+            f"{prefix}wind_kind={brief(mdp.wind_kind)} is not allowed: give 0 (none), {WIND_CONSTANT} (constant) or {WIND_SINUSOID} (sinusoid)"
+        )
+    if not whole_number(mdp.substeps) or mdp.substeps < 1:
+        raise NeurohoverError(f"{prefix}substeps={brief(mdp.substeps)} is not allowed: give an integer >= 1 (physics substeps of a control step)")
+    if not finite_real(mdp.dt) or mdp.dt <= 0:
+        raise NeurohoverError(f"{prefix}dt={brief(mdp.dt)} is not allowed: give a finite number > 0 (seconds of a substep)")
+    if not finite_real(mdp.d_u):
+        raise NeurohoverError(f"{prefix}d_u={brief(mdp.d_u)} is not allowed: give a finite number")
 
 
 def _reals(values: object, n: int, what: str, nonnegative: bool = False) -> tuple[float, ...]:
@@ -274,59 +348,72 @@ def _reals(values: object, n: int, what: str, nonnegative: bool = False) -> tupl
     return tuple(float(v) for v in items)
 
 
-def _check_sensor(sensor: tuple[float, ...]) -> None:
+def _check_sensor(sensor: tuple[float, ...], prefix: str = "") -> None:
     """Refuse a sensor the simulator cannot read: a delay of 1.5 steps flew as 1 without a word (fifteenth trial T15-27),
     a correlation of 1 or more took the root of a negative number."""
     if min(sensor[:4]) < 0 or not 0 <= sensor[4] < 1 or not 0 <= sensor[6] < 1:
         raise NeurohoverError(
-            f"sensor={brief(sensor)} is not allowed: give 4 stds >= 0, a correlation in [0, 1), a delay in 0..{MAX_SENSOR_DELAY} and a dropout in [0, 1)"
+            f"{prefix}sensor={brief(sensor)} is not allowed: give 4 stds >= 0, a correlation in [0, 1), "
+            f"a delay in 0..{MAX_SENSOR_DELAY} and a dropout in [0, 1)"
         )
     if not sensor[5].is_integer() or not 0 <= sensor[5] <= MAX_SENSOR_DELAY:
-        raise NeurohoverError(f"sensor delay={brief(sensor[5])} is not allowed: give a whole number of control steps in 0..{MAX_SENSOR_DELAY}")
+        raise NeurohoverError(f"{prefix}sensor delay={brief(sensor[5])} is not allowed: give a whole number of control steps in 0..{MAX_SENSOR_DELAY}")
 
 
 def _check_episode(mdp: object, policy: object, normals: object, n_steps: object, sensor_normals: object) -> tuple[list[list[float]], list[list[float]] | None]:
     """Refuse what :func:`fly_episode` cannot fly, before it flies (short normals were an IndexError mid-episode, n_steps=-1
     returned (0.0, False); thirteenth trial, F6, F7): one vectorised look at each array of normals. Returns the normals
     as Python floats (float32 normals flew in float32; fifteenth trial T15-27)."""
-    if not isinstance(mdp, ReferenceMDP):
-        raise NeurohoverError(f"mdp={brief(mdp)} is not allowed: give a ReferenceMDP (an MDP's to_reference())")
+    _check_mdp(mdp, "mdp.")  # a ReferenceMDP changed after it was made (T43-B01)
+    assert isinstance(mdp, ReferenceMDP)
     if not callable(policy):
         raise NeurohoverError(f"policy={brief(policy)} is not allowed: give a function of an observation (12 numbers) to 4 actions")
     if not whole_number(n_steps) or not 1 <= int(n_steps) <= MAX_EPISODE_STEPS:
         raise NeurohoverError(f"n_steps={brief(n_steps)} is not allowed: give an integer in 1..{MAX_EPISODE_STEPS}")
-    width = 13 if mdp.sensor[6] > 0 else 12
-    checked: list[list[list[float]] | None] = [None, None]
-    for j, (name, given, rows, widths) in enumerate(
-        (("normals", normals, int(n_steps), (6,)), ("sensor_normals", sensor_normals, int(n_steps) + 1, (width, 13)))
-    ):
-        if name == "sensor_normals" and given is None:
-            continue
-        want = f"give at least {rows} rows of {widths[0]} numbers (neurohover.sim.rng)"
-        try:
-            arr = np.asarray(given, dtype=float)
-        except (TypeError, ValueError, OverflowError):  # ragged rows, text, 10**400 (an OverflowError)
-            raise NeurohoverError(f"{name}={brief(given)} is not allowed: {want}") from None
-        if arr.ndim != 2 or arr.shape[0] < rows or arr.shape[1] not in widths:
-            raise NeurohoverError(f"{name} of shape {arr.shape} is not allowed: {want}")
-        if not np.isfinite(arr[:rows]).all():  # a NaN gust flew a NaN return called "not crashed" (fourteenth trial T14-21)
-            row, col = (int(i) for i in np.argwhere(~np.isfinite(arr[:rows]))[0])
-            raise NeurohoverError(f"{name}[{row}][{col}] = {arr[row, col]} is not allowed: give finite standard normals (neurohover.sim.rng)")
-        checked[j] = arr[:rows].tolist()
-    if sensor_normals is not None and not any(mdp.sensor):  # they were ignored without a word (fifteenth trial T15-27)
+    checked = _normal_rows("normals", normals, int(n_steps), (6,))
+    if sensor_normals is None:
+        return checked, None
+    sensor_checked = _normal_rows("sensor_normals", sensor_normals, int(n_steps) + 1, _sensor_widths(mdp.sensor))
+    if not any(mdp.sensor):  # they were ignored without a word (fifteenth trial T15-27)
         raise NeurohoverError(f"sensor_normals are not allowed with the exact sensor {brief(tuple(mdp.sensor))}: they apply to a noisy or late sensor only")
-    assert checked[0] is not None
-    return checked[0], checked[1]
+    return checked, sensor_checked
+
+
+def _sensor_widths(sensor: Sequence[float]) -> tuple[int, ...]:
+    """The widths a sensor's rows of normals may have: 13 with a dropout (its draw), else 12 (or 13, the 13th unread)."""
+    return (13,) if sensor[6] > 0 else (12, 13)
+
+
+def _normal_rows(name: str, given: object, rows: int, widths: tuple[int, ...], every: bool = False) -> list[list[float]]:
+    """The first ``rows`` rows of ``given`` (the argument ``name``; all of them where ``every``) as Python floats, or one
+    NeurohoverError: fewer rows,
+    another width, a NaN (a NaN gust flew a NaN return called "not crashed", fourteenth trial T14-21), or no real numbers
+    (complex ones were flown by their real part with NumPy's ComplexWarning, T43-B14)."""
+    want = f"at least {rows} rows of {widths[0]} numbers (neurohover.sim.rng)"
+    arr = as_floats(given, name, want)
+    if arr.ndim != 2 or arr.shape[0] < rows or arr.shape[1] not in widths:
+        raise NeurohoverError(f"{name} of shape {arr.shape} is not allowed: give {want}")
+    rows = arr.shape[0] if every else rows
+    if not np.isfinite(arr[:rows]).all():
+        row, col = (int(i) for i in np.argwhere(~np.isfinite(arr[:rows]))[0])
+        raise NeurohoverError(f"{name}[{row}][{col}] = {arr[row, col]} is not allowed: give finite standard normals (neurohover.sim.rng)")
+    return arr[:rows].tolist()
+
+
+def _is_action(action: object) -> bool:
+    """Whether ``action`` is 4 real numbers (NaN and inf too: they crash) in a sequence or an array: a dict {0: .., 3: ..}
+    flew its keys 0, 1, 2, 3 (T43-B14); np.timedelta64, a numbers.Real, was float()'s TypeError (T17-1)."""
+    if isinstance(action, (str, bytes)) or not isinstance(action, (Sequence, np.ndarray)):
+        return False
+    try:
+        return len(action) == 4 and all(finite_real(a) or isinstance(a, (float, np.floating)) for a in action)
+    except TypeError:
+        return False
 
 
 def _action(policy: Callable[[list[float]], Sequence[float]], observation: list[float], k: int) -> Sequence[float]:
     """The policy's action, refused unless it is 4 numbers (3 were an unpack ValueError; thirteenth trial, F6)."""
     action = policy(observation)
-    try:
-        # real numbers, NaN too (it crashes): np.timedelta64, a numbers.Real, was float()'s TypeError (T17-1)
-        ok = len(action) == 4 and all(finite_real(a) or isinstance(a, (float, np.floating)) for a in action)
-    except TypeError:
-        ok = False
-    if not ok:
-        raise NeurohoverError(f"the policy's action at step {k} is {brief(action)}, not allowed: a policy gives 4 numbers")
+    if not _is_action(action):
+        raise NeurohoverError(f"the policy's action at step {k} is {brief(action)}, not allowed: a policy gives 4 numbers (a sequence or an array)")
     return action
