@@ -10,6 +10,7 @@ import warnings
 import numpy as np
 import pytest
 
+import neurohover.models.wind as W
 from neurohover.errors import NeurohoverError
 from neurohover.sim.constants import CRASH_STEP_PENALTY
 from neurohover.sim.reference import ReferenceHelicopter, ReferenceSensors, fly_episode, rotation_vector_quaternion
@@ -140,3 +141,78 @@ def test_fly_episode_refuses_a_dict_action_and_complex_normals() -> None:
     # sequences and arrays of 4 real numbers fly alike
     ref = _reference()
     assert fly_episode(ref, lambda o: np.zeros(4), NORMALS, n_steps=5)[:2] == fly_episode(ref, lambda o: [0, 0, 0, 0], NORMALS, n_steps=5)[:2]
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda: W.sinusoid_axes((1.0, 0.1, 0.2)), r"wind=\(1.0, 0.1, 0.2\) is not allowed: give 8 finite numbers, a GHH-09 wind's"),
+        (lambda: W.sinusoid_axes(None), r"wind=None is not allowed: give 8 finite numbers"),
+        (lambda: W.sinusoid_axes([math.nan] * 8), r"wind=\[nan, .* is not allowed: give 8 finite numbers"),
+        (lambda: W.model_times("a"), r"steps='a' is not allowed: give control step numbers, whole and >= 0"),
+        (lambda: W.model_times(None), r"steps=None is not allowed: give control step numbers"),
+        (lambda: W.model_times([-1]), r"steps=\[-1\] is not allowed: give control step numbers, whole and >= 0"),
+        (lambda: W.model_times([1.5]), r"steps=\[1.5\] is not allowed: give control step numbers, whole"),
+        (lambda: W.WindModel().world("x"), r"t='x' is not allowed: give times in seconds, finite real numbers"),
+        (lambda: W.WindAxis(1, 1, 0, 0).at("abc"), r"t='abc' is not allowed: give times in seconds, finite real numbers"),
+        (lambda: W.WindAxis(1, 1, 0, 0).at([math.nan]), r"t=\[nan\] is not allowed: give times in seconds, finite real numbers"),
+        (lambda: W.body_wind(None, W.WindModel()), r"tr=None is not allowed: give the flight data as Transitions"),
+    ],
+)
+def test_the_wind_helpers_check_their_input(call, message: str) -> None:
+    """T43-B04: the public helpers of neurohover.models.wind leaked ValueError, TypeError and AttributeError; model_times(None)
+    was NaN and model_times([-1]) a time of -0.1 s without a word. fit_wind, in the same module, refused such input."""
+    with pytest.raises(NeurohoverError, match=message):
+        call()
+
+
+def test_the_wind_helpers_take_what_they_took() -> None:
+    """T43-B04: numbers, arrays and an MDP's wind as before."""
+    assert W.model_times(5) == 0.5 and W.model_times(np.arange(3)).tolist() == [0.0, 0.1, 0.2] and W.model_times([np.int32(2)]).tolist() == [0.2]
+    axis = W.WindAxis(2.0, 3.0, 0.5, 1.0)
+    assert axis.at(0.25) == 2.0 * math.sin(0.75 + 0.5) + 1.0 and axis.at(np.zeros((2, 3))).shape == (2, 3)
+    assert W.WindModel("sinusoid", axis, axis).world([0.0, 0.1]).shape == (2, 2)
+    mdp = get_task_family("ghh09").mdp("train:0")
+    assert W.sinusoid_axes(mdp.wind) == W.sinusoid_axes(list(mdp.wind))
+
+
+def test_format_parameter_table_names_a_none_row() -> None:
+    """T43-B05: None, the bad-row search's own "no bad row" answer, passed the check and was an AttributeError."""
+    from neurohover.models import ParamRow, format_parameter_table
+
+    row = ParamRow("C_u", -0.18, -0.18, 0.0)
+    with pytest.raises(NeurohoverError, match="row None is not allowed: give the ParamRow rows that parameter_table returns"):
+        format_parameter_table([row, None])
+    assert "C_u" in format_parameter_table([row])
+
+
+@pytest.mark.parametrize(
+    "make", [lambda: iter([("C_u", 2.0)]), lambda: (p for p in [("C_u", 2.0)]), lambda: map(tuple, [("C_u", 2.0)]), lambda: zip(["C_u"], [2.0])]
+)
+def test_a_drift_change_given_as_an_iterator_is_refused(make) -> None:
+    """T43-B08: an iterator was "has no len()", a TypeError; it is refused as change_at and walk refuse a generator."""
+    from neurohover.tasks.drift import Drift
+
+    with pytest.raises(
+        NeurohoverError,
+        match=r"drift change=<.*> is not allowed: give parameter factors as a table or a list of \(name, factor\) pairs, not a one-shot iterator",
+    ):
+        Drift(change=make())
+    assert Drift(change=[("C_u", 2.0)]) == Drift(change={"C_u": 2.0})
+
+
+def test_a_closed_renderer_draws_on_a_new_figure() -> None:
+    """T43-B09: draw after close() was an AttributeError ('NoneType' object has no attribute 'dpi'); it draws again, as an
+    environment's render() after close() does."""
+    from neurohover.envs.render import HoverRenderer
+
+    renderer = HoverRenderer(64, 48)
+    state = [0.0] * 12 + [1.0]
+    before = renderer.draw(state, [1.0, 0.0, 0.0], "x")
+    renderer.close()
+    renderer.close()
+    with pytest.raises(NeurohoverError, match="draw state"):  # checked as before
+        renderer.draw([0.0] * 3, [1.0, 0.0, 0.0], "x")
+    after = renderer.draw(state, [1.0, 0.0, 0.0], "x")
+    assert after.shape == (48, 64, 3) and (after == before).all()
+    renderer.close()

@@ -154,6 +154,7 @@ class HoverRenderer:
         self._wind_text = w.text(0.0, -1.12, "", ha="center", va="top", fontsize=8, animated=True)
         self._range: float | None = None
         self._background = None
+        self._closed = False
 
     def pixel_box(self, part: str) -> tuple[int, int, int, int]:
         """Pixel box (row0, row1, col0, col1) of a part of every frame: ``"top"``, ``"side"``,
@@ -210,6 +211,8 @@ class HoverRenderer:
         if track.size and (track.ndim != 2 or track.shape[1] != 3):  # (2, 2) was NumPy's reshape error (T14-14)
             raise NeurohoverError(f"draw trail of shape {track.shape} is not allowed: give an (n, 3) array of world positions, oldest first")
         track = track.astype(np.float64, copy=False).reshape(-1, 3)
+        if self._closed:  # drawn on a new figure of the same size
+            self.__init__(self.width, self.height)  # type: ignore[misc]
         pos = s[3:6]
         rot = rotation_matrix(s[9], s[10], s[11], s[12])
         self._set_range(view_range(pos))
@@ -266,8 +269,10 @@ class HoverRenderer:
         return np.asarray(self.canvas.buffer_rgba())[:, :, :3].copy()
 
     def close(self) -> None:
-        """Release the figure (the renderer cannot draw afterwards)."""
+        """Release the figure; a later :meth:`draw` makes a new one, as an environment's render() after close() does
+        (it was an AttributeError; T43-B09). Safe to call twice."""
         self.figure.clear()
+        self._closed = True
 
 
 def _interactive_backend(name: str) -> bool:

@@ -484,9 +484,9 @@ def format_parameter_table(rows: Sequence[ParamRow]) -> str:
     if isinstance(rows, (str, bytes)) or not isinstance(rows, Iterable):
         raise NeurohoverError(f"rows={brief(rows)} is not allowed: give the list of ParamRow that parameter_table returns")
     rows = list(rows)
-    bad = next((r for r in rows if not isinstance(r, ParamRow)), None)
+    bad = next((i for i, r in enumerate(rows) if not isinstance(r, ParamRow)), None)  # its place: a None row is one (T43-B05)
     if bad is not None:
-        raise NeurohoverError(f"row {brief(bad)} is not allowed: give the ParamRow rows that parameter_table returns")
+        raise NeurohoverError(f"row {brief(rows[bad])} is not allowed: give the ParamRow rows that parameter_table returns")
     for r in rows:  # a ParamRow's fields are not checked where it is made: None or text was a TypeError here (T29-B08)
         bad_field = "name" if not isinstance(r.name, str) else next((f for f in ParamRow._fields[1:] if not real_number(getattr(r, f))), None)
         if bad_field is not None:

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, check_flag, finite_real, whole_number
+from ..errors import NeurohoverError, as_floats, brief, check_flag, finite_real, whole_number
 from ..sim.constants import CONTROL_DT, SUBSTEP_DT, SUBSTEPS, WIND_CONSTANT, WIND_NONE, WIND_SINUSOID
 
 __all__ = ["DEFAULT_WIND_MODEL", "NO_WIND", "WIND_MODELS", "WindAxis", "WindModel", "body_wind", "effective_wind", "fit_wind", "model_times", "sinusoid_axes"]
@@ -71,7 +71,7 @@ class WindAxis:
 
     def at(self, t: np.ndarray) -> np.ndarray:
         """The wind (m/s) at times ``t`` (s)."""
-        return self.amplitude * np.sin(self.omega * np.asarray(t, dtype=float) + self.phase) + self.offset
+        return self.amplitude * np.sin(self.omega * _times(t) + self.phase) + self.offset
 
     def to_dict(self) -> dict:
         return {"amplitude": self.amplitude, "omega": self.omega, "phase": self.phase, "offset": self.offset}
@@ -110,6 +110,7 @@ class WindModel:
 
     def world(self, t: np.ndarray) -> np.ndarray:
         """The world wind (len(t), 2) at times ``t``."""
+        t = _times(t)
         return np.column_stack([self.x.at(t), self.y.at(t)])
 
     def to_dict(self) -> dict:
@@ -132,11 +133,24 @@ class WindModel:
 NO_WIND = WindModel()
 
 
+def _times(t: object) -> np.ndarray:
+    """Times ``t`` (s) as float64, or one NeurohoverError: text was NumPy's ValueError (T43-B04), NaN a NaN wind."""
+    allowed = "times in seconds, finite real numbers (a number or an array)"
+    out = as_floats(t, "t", allowed)
+    if not np.isfinite(out).all():
+        raise NeurohoverError(f"t={brief(t)} is not allowed: give {allowed}")
+    return out
+
+
 def sinusoid_axes(wind: tuple[float, ...]) -> tuple[WindAxis, WindAxis]:
     """The x and y axes of a GHH-09 wind given as its 8 competition parameters (SPEC section 2)."""
+    allowed = "8 finite numbers, a GHH-09 wind's maxf, freq, phase and center of x, then of y (an MDP's wind)"
+    values = as_floats(wind, "wind", allowed)  # 3 numbers were an unpack ValueError, None a TypeError (T43-B04)
+    if values.shape != (8,) or not np.isfinite(values).all():
+        raise NeurohoverError(f"wind={brief(wind)} is not allowed: give {allowed}")
     axes = []
     for j in (0, 4):
-        maxf, freq, phase, center = wind[j : j + 4]
+        maxf, freq, phase, center = values[j : j + 4].tolist()
         axes.append(WindAxis(5.0 * (maxf - center), 20.0 * math.pi * freq, 2.0 * math.pi * phase if freq != 0.0 else 0.0, 5.0 * center))
     return axes[0], axes[1]
 
@@ -144,7 +158,13 @@ def sinusoid_axes(wind: tuple[float, ...]) -> tuple[WindAxis, WindAxis]:
 def model_times(steps: np.ndarray) -> np.ndarray:
     """Wind times (s) of control steps ``steps`` in a one-substep model, as the kernel computes them
     (the competition's ``int(t*100)/100`` floor of ``t = 0.1 * step``)."""
-    t = 0.1 * np.asarray(steps, dtype=float)
+    try:  # 'a' was NumPy's ValueError, None a NaN time and -1 a time of -0.1 s, without a word (T43-B04)
+        given = np.asarray(steps)
+    except (TypeError, ValueError):
+        given = np.asarray(None)
+    if given.dtype.kind not in "iu" or (given < 0).any():
+        raise NeurohoverError(f"steps={brief(steps)} is not allowed: give control step numbers, whole and >= 0 (an integer or an array of them)")
+    t = 0.1 * given.astype(float)
     return np.trunc(t * 100.0) / 100.0
 
 
@@ -174,6 +194,12 @@ def effective_wind(axis: WindAxis) -> WindAxis:
 
 def body_wind(tr, wind: WindModel) -> np.ndarray:
     """The wind (N, 2) along the body u and v axes at each transition of ``tr`` (a Transitions)."""
+    from .transitions import Transitions  # here: transitions imports this module
+
+    if not isinstance(tr, Transitions):  # None was an AttributeError (T43-B04), as fit_wind refuses it
+        raise NeurohoverError(f"tr={brief(tr)} is not allowed: give the flight data as Transitions (neurohover.models.Transitions)")
+    if not isinstance(wind, WindModel):
+        raise NeurohoverError(f"wind={brief(wind)} is not allowed: give a WindModel (a learned model's wind)")
     w = wind.world(model_times(tr.step))
     return np.column_stack([tr.R[:, 0, 0] * w[:, 0] + tr.R[:, 1, 0] * w[:, 1], tr.R[:, 0, 1] * w[:, 0] + tr.R[:, 1, 1] * w[:, 1]])
 

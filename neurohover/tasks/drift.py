@@ -27,6 +27,7 @@ change_at      (200, 800)  the change happens at an episode drawn uniformly from
 from __future__ import annotations
 
 import operator
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -72,13 +73,16 @@ class Drift:
         if 0 < w < MIN_WALK:  # a walk that moves no parameter: every drifted row the fixed one
             raise NeurohoverError(f"drift walk={brief(w)} is out of range, too small to change the dynamics: {_WALK_RANGE}")
         object.__setattr__(self, "walk", float(w))
-        try:
+        try:  # a one-shot iterator (a generator, map, zip) is refused, as change_at and walk refuse one (T43-B08)
+            if isinstance(self.change, Iterator):
+                raise TypeError
             change = dict(self.change) if not isinstance(self.change, (dict, str)) else self.change
             if not isinstance(change, dict) or not all(isinstance(n, str) for n in change):  # no assert: python -O strips it (T32-B03)
                 raise TypeError
         except (TypeError, ValueError):
+            pairs = " or a list of (name, factor) pairs, not a one-shot iterator" if isinstance(self.change, Iterator) else ""
             raise NeurohoverError(
-                f"drift change={self.change!r} is not allowed: give parameter factors as a table, e.g. {{'D_w': 0.8}} (Drift.parse reads 'D_w=0.8')"
+                f"drift change={self.change!r} is not allowed: give parameter factors as a table{pairs}, e.g. {{'D_w': 0.8}} (Drift.parse reads 'D_w=0.8')"
             ) from None
         if not isinstance(self.change, dict) and len(change) != len(self.change):  # (D_w, 0.8), (D_w, 0.9): the last kept (sixth trial)
             raise NeurohoverError(f"drift change={self.change!r:.80} sets a parameter twice: give each once")
