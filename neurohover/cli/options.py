@@ -180,7 +180,17 @@ def add_task_option(p: argparse.ArgumentParser) -> None:
     """--task: one of the registered task families (every command that flies takes it)."""
     from ..tasks import TASK_NAMES
 
-    p.add_argument("--task", required=True, help=f"task family: {', '.join(TASK_NAMES)}")
+    p.add_argument("--task", required=True, type=task_name, help=f"task family: {', '.join(TASK_NAMES)}")
+
+
+def task_name(text: str) -> str:
+    """--task as its family's name where it spells one as the task lookup reads it ('GHH-08' is ghh08), else as given
+    (each command's own check names it): compete built its experiment from 'GHH-08' and refused what every other
+    command flew (T43-A01)."""
+    from ..tasks import TASK_FAMILIES
+
+    key = text.lower().replace("-", "")
+    return key if key in TASK_FAMILIES else text
 
 
 def real(text: str) -> float:
