@@ -44,6 +44,12 @@ from .sim.constants import EPISODE_STEPS
 from .tasks import N_TEST, N_TRAINING, Drift, Sensor, get_task_family
 from .tasks.drift import MAX_RUN_EPISODES  # a run's episodes, the bound of a drifting MDP's episodes too
 
+#: The entry points, which check what they are given (summarise, episode_rows: compete's helpers over its own store's results, unchecked; T43-B15).
+__all__ = [
+    "FINISHED_RUNS", "LR_FIT_KEYS", "MAX_RUNS", "STORE_FILE", "agents_with_settings", "check_against_store", "check_agent_settings", "check_sizes",
+    "compete", "competition_config",
+]  # fmt: skip
+
 STORE_FILE = "results.sqlite"
 #: The attribute an interrupted :func:`compete`'s KeyboardInterrupt carries once its runs began: how many had finished.
 FINISHED_RUNS = "finished_runs"
@@ -132,6 +138,8 @@ def check_agent_settings(agent: str, values: Mapping[str, object], n_steps: int 
     from .agents.registry import agent_spec
 
     spec = agent_spec(agent)
+    if not isinstance(values, Mapping):  # None was dict()'s TypeError (T43-B15)
+        raise NeurohoverError(f"agent_settings={brief(values)} is not allowed: give a dict of the agent's own settings (`neurohover settings {agent}`)")
     if spec.settings is None or spec.settings.UNIT_KEY not in ("agent_settings", *_EXPERIMENT_WIDE):
         # incremental's max_learning_episodes was refused here while `neurohover settings incremental` listed it (eleventh trial, U2)
         hybrid = " (its settings, `neurohover settings hybrid`, are the --safeguard-*/--hybrid-* options, hybrid= in Python)" if spec.settings else ""
@@ -199,7 +207,7 @@ def competition_config(
         group[key] = choice
     wide: dict[str, object] = {}  # the incremental agents' max_learning_episodes: a setting of the whole experiment
     own: dict = {}
-    if agent_settings:  # the agent's own typed settings, checked by its spec's class (absent: as before)
+    if agent_settings is not None and (agent_settings or not isinstance(agent_settings, Mapping)):  # the agent's own settings, checked by its class
         own = check_agent_settings(agent, agent_settings, n_steps)
         defaults = AGENTS[agent].settings().to_dict()  # type: ignore[misc]  # an agent that takes settings has a class
         own = typed_numbers(defaults, own)  # level=1 as 1.0 ...

@@ -120,6 +120,10 @@ def built_as(manifest: dict, role: Role, k: int) -> dict:
 def genome_digest(policy: Policy) -> str:
     """16 hex digits of SHA-256 over a policy's topology and genes (float64, little-endian): what a set's manifest records
     of each policy file (:data:`DIGESTS`). A gene -0.0 differs from 0.0, as the file's text does."""
+    from .policies import Policy
+
+    if not isinstance(policy, Policy):  # None was an AttributeError (T43-B15)
+        raise NeurohoverError(f"policy={brief(policy)} is not allowed: give a Policy (neurohover.load_policy of a policy file)")
     genome = np.ascontiguousarray(policy.genome, dtype="<f8")
     return hashlib.sha256(policy.topology.encode() + b":" + genome.tobytes()).hexdigest()[:16]
 
@@ -214,7 +218,11 @@ def _check_tables(manifest: dict, path: Path, rows: int, columns: int) -> None:
 def table3_summary(crashes: np.ndarray, returns: np.ndarray) -> dict:
     """Table 3's robustness figures of specialised policy i trained on MDP i, from (P, M) arrays of
     crash counts and mean returns: r on its own MDP and r_G over all the MDPs, each averaged over
-    the policies, and the crashed episodes in all."""
+    the policies, and the crashed episodes in all. ``crashes`` and ``returns``: (P, P) arrays of real numbers, P >= 1 (a
+    (5, 3) beside a (5, 2) was summarised without a word, an empty one NaN; T43-B15)."""
+    crashes, returns = _square(crashes, "crashes", least=1), _square(returns, "returns", least=1)
+    if returns.shape != crashes.shape:
+        raise NeurohoverError(f"returns of shape {returns.shape} is not allowed beside crashes of shape {crashes.shape}: give both (P, P)")
     return {"r": round(float(np.diag(returns).mean()), 2), "r_G": round(float(returns.mean()), 2), "crashed_episodes": int(crashes.sum())}
 
 
@@ -240,16 +248,16 @@ def choose_safe(crashes: np.ndarray, returns: np.ndarray, n: int = SAFE_POLICIES
     return tuple(int(i) for i in order[:n])
 
 
-def _square(values: object, name: str) -> np.ndarray:
-    """``values`` as a (P, P) float array, P >= 2, or a NeurohoverError naming its shape (a list was an AttributeError, a
+def _square(values: object, name: str, least: int = 2) -> np.ndarray:
+    """``values`` as a (P, P) float array, P >= ``least``, or a NeurohoverError naming its shape (a list was an AttributeError, a
     (3, 2) array an IndexError; twelfth trial, T7)."""
     try:
         array = np.asarray(values, dtype=float)
     except (TypeError, ValueError):
         array = None
-    if array is None or array.ndim != 2 or array.shape[0] != array.shape[1] or array.shape[0] < 2:
+    if array is None or array.ndim != 2 or array.shape[0] != array.shape[1] or array.shape[0] < least:
         shape = f"of shape {array.shape}" if array is not None else brief(values)
-        raise NeurohoverError(f"{name} {shape} is not allowed: give a (P, P) array of numbers, P >= 2 (policy i on training MDP j)")
+        raise NeurohoverError(f"{name} {shape} is not allowed: give a (P, P) array of numbers, P >= {least} (policy i on training MDP j)")
     return array
 
 
@@ -377,7 +385,8 @@ def _check_table3(table3: object, crashes: list | None, returns: list | None, wh
             f"{where}: table3={brief(table3)} is not allowed: give a table of r and r_G (finite numbers: mean returns on the own "
             "and on all training MDPs) and crashed_episodes (a whole number >= 0)"
         )
-    given = table3_summary(np.array(crashes if crashes is not None else [[0]]), np.array(returns if returns is not None else [[0.0]]))
+    shape = np.shape(next((t for t in (crashes, returns) if t is not None), [[0]]))  # a table left out: zeros of the other's shape
+    given = table3_summary(np.zeros(shape) if crashes is None else np.array(crashes), np.zeros(shape) if returns is None else np.array(returns))
     for name, table in (("crashed_episodes", crashes), ("r", returns), ("r_G", returns)):
         if table is not None and abs(table3[name] - given[name]) > (0 if name == "crashed_episodes" else _ROUNDING):
             source = "crashes_on_training_mdps" if name == "crashed_episodes" else "mean_return_on_training_mdps"

@@ -29,6 +29,7 @@ naming the allowed ones). Its hash covers every setting that changes results, pl
 
 from __future__ import annotations
 
+import copy
 import functools
 import hashlib
 import json
@@ -45,6 +46,7 @@ from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..models.model import LEGACY_MODEL_SUBSTEPS
 from .canonical import canonical_settings
 from .paper_checks import check_paper, check_paper_table, check_texts, control_character
+from .readonly import read_only
 from .schema import SCHEMAS, check_given, check_kind, check_used, validate_table
 from .settings import ExperimentSettings, typed_settings
 
@@ -98,7 +100,12 @@ def _legacy_dropped(settings: dict) -> dict:
 
 @dataclass(frozen=True)
 class ExperimentConfig:
-    """A resolved, validated experiment config at one scale."""
+    """A resolved, validated experiment config at one scale.
+
+    Read-only, its ``settings`` too: they are a :class:`~.readonly.ReadOnlyDict` of the settings given (nested tables and
+    lists read-only as well), which refuses an edit with a NeurohoverError. An edit went through unchecked, and was honoured
+    or ignored as ``typed`` (cached) had been read or not (T43-B13); a change is an override
+    (``load_config(..., overrides=...)``) or settings of one's own to :func:`make_config`, both checked."""
 
     name: str
     title: str
@@ -109,6 +116,12 @@ class ExperimentConfig:
     paper_ref: str = ""
     source: str = ""
     external_digest: str = ""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "settings", read_only(self.settings))  # a read-only copy: the caller's dict is no alias
+
+    def __deepcopy__(self, memo: dict) -> ExperimentConfig:
+        return replace(self, paper=copy.deepcopy(self.paper, memo))  # settings kept read-only (a deep copy of them is plain)
 
     @functools.cached_property
     def typed(self) -> ExperimentSettings:

@@ -25,6 +25,7 @@ from ..models.lr import DEFAULT_NOISE_ESTIMATE
 from ..models.model import default_model_substeps
 from ..tasks import TASK_FAMILIES, Drift
 from .checks import OMIT, REQUIRED, schema_of
+from .readonly import plain
 from .settings import KIND_SETTINGS
 
 #: A ``generics_from`` source that names a directory of policy files (``.net`` or ``.json``) instead of an experiment.
@@ -70,7 +71,7 @@ def validate_table(values: dict, schema: dict, where: str, *, given_only: bool =
                 continue
             out[key] = json.loads(json.dumps(default))
             continue
-        value = values[key]
+        value = plain(values[key])  # np.int64(3) as 3: the config is stored as JSON (a seed of np.arange was refused; T43-B11)
         if isinstance(check, tuple):  # a list of sub-tables
             if not isinstance(value, list) or not value or not all(isinstance(x, dict) for x in value):
                 raise NeurohoverError(f"{where}: {key!r} must be a non-empty list of tables ([[{key}]] in TOML)")

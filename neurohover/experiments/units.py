@@ -79,6 +79,9 @@ def unit_seed(root: int, experiment: str, key: str) -> int:
     for name, value in (("experiment", experiment), ("key", key)):
         if not isinstance(value, str):
             raise NeurohoverError(f"{name}={brief(value)} is not allowed: give text")
+        from .store_checks import check_text  # the store's check of its text fields (here: a cycle at import time)
+
+        check_text(value, name, "unit_seed", empty=True)  # a lone surrogate was encode()'s UnicodeEncodeError (T43-B12)
     digest = hashlib.sha256(f"{experiment}/{key}".encode()).digest()
     words = [int(w) for w in np.frombuffer(digest, dtype="<u4")]
     state = np.random.SeedSequence([int(root), *words]).generate_state(1, np.uint64)[0]
