@@ -125,7 +125,17 @@ def test_an_edited_task_family_entry_is_refused_by_name(monkeypatch, key, entry,
     assert nh.get_task_family("fghh", 0.3).name == "fghh"  # the other entries still serve
 
 
-def test_an_unknown_task_lists_the_registry_as_it_is(monkeypatch):
+@pytest.fixture
+def registry_in_order():
+    """The registry put back in its order afterwards (monkeypatch puts a deleted entry back at the end, and the
+    refusals of other tests in this worker list the names in the registry's order)."""
+    saved = dict(T.TASK_FAMILIES)
+    yield
+    T.TASK_FAMILIES.clear()
+    T.TASK_FAMILIES.update(saved)
+
+
+def test_an_unknown_task_lists_the_registry_as_it_is(registry_in_order, monkeypatch):  # put back after monkeypatch
     monkeypatch.delitem(T.TASK_FAMILIES, "ghh08")
     monkeypatch.setitem(T.TASK_FAMILIES, "zz", 5)  # a bad entry is no name to offer
     with pytest.raises(NeurohoverError, match=r"^unknown task 'ghh08': allowed ghh09, fghh$"):
