@@ -98,8 +98,14 @@ def settings_rows(cls: type) -> list[SettingRow]:
         else:
             default = "(required)"
         kind, text = docs.get(f.name, ("", ""))
-        rows.append(SettingRow(f.name, kind or str(f.type), default, text))
+        rows.append(SettingRow(f.name, kind or _annotation_text(f.type), default, text))
     return rows
+
+
+def _annotation_text(annotation: object) -> str:
+    """A field's annotation as its source writes it: 'float', not "<class 'float'>" where a user's class annotates with
+    real types (no ``from __future__ import annotations``; T44-B18); text annotations as they are."""
+    return annotation if isinstance(annotation, str) else inspect.formatannotation(annotation)
 
 
 def plain(text: str) -> str:

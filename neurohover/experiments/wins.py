@@ -12,7 +12,7 @@ win. Drawing MDPs first keeps the agents paired on the same MDPs, as in a compet
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence, Sized
 
 import numpy as np
 
@@ -71,7 +71,7 @@ def win_probabilities(runs: Mapping[str, Mapping[str, Sequence[float]]], n_runs:
     agents = list(runs)
     if len(agents) < 2:
         raise NeurohoverError(f"a competition needs at least two agents, got {agents}")
-    common = sorted(set.intersection(*(set(m for m, s in runs[a].items() if len(s)) for a in agents)))
+    common = sorted(set.intersection(*(set(m for m, s in runs[a].items() if _run_count(a, m, s)) for a in agents)))
     if not common:
         raise NeurohoverError(f"the agents {', '.join(agents)} flew no MDP in common: their runs cannot be paired into competitions")
     rng = np.random.default_rng(seed)
@@ -90,6 +90,17 @@ def win_probabilities(runs: Mapping[str, Mapping[str, Sequence[float]]], n_runs:
     odds = WinOdds({a: float(share[i].mean()) for i, a in enumerate(agents)})
     odds.n_runs, odds.draws, odds.mdps = n_runs, draws, len(common)
     return odds
+
+
+def _run_count(agent: str, mdp: str, scores: object) -> int:
+    """How many runs ``agent`` has on ``mdp``: its scores must be a list or array of them (a number or a one-shot iterator
+    was a TypeError "has no len()"; an iterator is refused as Drift and the models' vectors refuse one; T44-B01)."""
+    if isinstance(scores, Iterator) or not isinstance(scores, Sized) or getattr(scores, "ndim", 1) == 0:
+        one_shot = ", not a one-shot iterator" if isinstance(scores, Iterator) else ""
+        raise NeurohoverError(
+            f"agent {agent!r} has runs on MDP {mdp!r} given as {brief(scores)}: give a list of the cumulative rewards of its runs there{one_shot}"
+        )
+    return len(scores)
 
 
 def _scores(agent: str, mdp: str, scores: Sequence[float]) -> np.ndarray:

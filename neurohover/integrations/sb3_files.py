@@ -25,8 +25,10 @@ def check_algo(algo: object) -> str:
     return algo
 
 
-def sb3_model_file(path: Path) -> Path:
-    """``path`` where it may be a saved model (a zip that is no neurohover file), else one clear error naming it."""
+def sb3_model_file(path: str | Path) -> Path:
+    """``path`` (a str or path object) as a Path where it may be a saved model (a zip that is no neurohover file), else
+    one clear error naming it."""
+    path = checked_path(path, "path", "MODEL.zip file path")  # a str was an AttributeError 'is_file' (T44-B05)
     if not path.is_file():
         raise NeurohoverError(f"{str(path)!r} is not a Stable-Baselines3 model file (MODEL.zip)")
     kind = held_kind(path)

@@ -41,7 +41,7 @@ from ..filekinds import refuse_suffix
 from ..flightdata import plain_json, unwritable_key
 from ..paths import json_text
 from ..sim.constants import CONTROL_DT, DEFAULT_NOISE_STD, DEFAULT_PARAMS, MAX_SECONDS, NOISE_NAMES, PARAM_NAMES, SUBSTEP_DT, SUBSTEPS, seconds_allowed
-from ..tasks import MDP, finite_vector
+from ..tasks import MDP, TASK_FAMILIES, TaskFamily, family_class, finite_vector
 from ..tasks.base import MAX_MAGNITUDE
 from .wind import NO_WIND, WindModel
 
@@ -93,13 +93,22 @@ def check_model_substeps(substeps: object, name: str = "substeps") -> None:
         raise NeurohoverError(f"{name}={brief(substeps)}: allowed {' or '.join(map(str, MODEL_SUBSTEPS))} (integrations of a learned model's control step)")
 
 
-def default_model_substeps(task: str) -> int:
+def default_model_substeps(task: str | TaskFamily) -> int:
     """The substeps in which a task's agents evolve policies on their learned models unless told otherwise.
 
+    ``task``: a task family's name (as the task lookup reads it: 'GHH-08' too) or a TaskFamily; another value or an
+    unknown name is refused (it was 10 for any of them, and an array NumPy's ambiguous truth; T44-B20).
     GHH-08 and GHH-09: :data:`DEFAULT_MODEL_SUBSTEPS` (ten; the paper's equations and figures). FGHH: one,
     as the authors' published FGHH code flies its model (``Helicopter(params, noise_std, 0.1)``).
     """
-    return 1 if task == "fghh" else DEFAULT_MODEL_SUBSTEPS
+    if isinstance(task, TaskFamily):
+        name = task.name
+    elif isinstance(task, str):
+        name = task.lower().replace("-", "")
+        family_class(name if name in TASK_FAMILIES else task)  # an unknown name refused, naming the registry's names
+    else:
+        raise NeurohoverError(f"task={brief(task)} is not allowed: give a task family's name ({', '.join(map(str, TASK_FAMILIES))}) or a TaskFamily")
+    return 1 if name == "fghh" else DEFAULT_MODEL_SUBSTEPS
 
 
 #: Per axis: indices of its gain parameters (D_v, D_w, D_p, D_q, D_r; u has none).
@@ -196,8 +205,9 @@ class LearnedModel:
     def __post_init__(self) -> None:
         object.__setattr__(self, "params", check_vector(self.params, 11, "model parameters " + "/".join(PARAM_NAMES)))
         object.__setattr__(self, "noise_std", check_vector(self.noise_std, 6, "model noise std (u, v, w, p, q, r)", nonnegative=True))
-        if self.method not in MODEL_METHODS:
-            raise NeurohoverError(f"unknown model-learning method {self.method!r}: allowed {', '.join(MODEL_METHODS)}")
+        if not isinstance(self.method, str) or self.method not in MODEL_METHODS:  # an array of texts was NumPy's ambiguous truth (T44-B13)
+            raise NeurohoverError(f"unknown model-learning method {brief(self.method)}: allowed {', '.join(MODEL_METHODS)}")
+        object.__setattr__(self, "method", str(self.method))  # a NumPy text (np.str_) as a plain str
         if not seconds_allowed(self.seconds):  # T26-B13: 1e30 was taken (checkpoints' bound)
             raise NeurohoverError(f"seconds={brief(self.seconds)} must be a finite number in [0, {MAX_SECONDS:.6g}] (how long the fit took; 100 years at most)")
         if not isinstance(self.stats, dict):
