@@ -6,7 +6,9 @@ and sole_writer given a str path (T44-B17, T44-B19)."""
 
 from __future__ import annotations
 
+import copy
 import dataclasses
+import re
 
 import numpy as np
 import pytest
@@ -76,3 +78,67 @@ def test_default_model_substeps_refuses_what_is_no_task_family() -> None:
     for task in (None, 5, np.array(["fghh", "ghh08"])):
         with pytest.raises(NeurohoverError, match=r"task=.* is not allowed: give a task family's name \(ghh08, ghh09, fghh\) or a TaskFamily"):
             default_model_substeps(task)  # type: ignore[arg-type]
+
+
+@pytest.fixture(scope="module")
+def evolve_unit():
+    import neurohover.experiments as E
+
+    u = E.plan(E.load_config("fig7", "quick"), {}).units[0]
+    assert u.kind == "evolve"
+    return u
+
+
+@pytest.mark.parametrize(
+    ("edit", "allowed"),
+    [
+        ({"target": None}, 'a table {"kind": "mdp"'),
+        ({"target": {"kind": "mdp"}}, 'a table {"kind": "mdp"'),
+        ({"target": {"kind": "bogus", "task": "ghh09"}}, 'a table {"kind": "mdp"'),
+        ({"optimiser": None}, "a table (dict)"),
+        ({"history_points": -1}, "an integer >= 2"),
+        ({"budget": -1}, "an integer in 0..10000000000"),
+        ({"seed": None}, "an integer in 0..2**63-1"),
+        ({"topology": 5}, "text"),
+        ({"resampling": "x"}, "fixed:K"),
+        ({"validation_mdps": "train"}, "one of None, 'test'"),
+    ],
+)
+def test_run_unit_refuses_evolve_params_edited_by_hand(evolve_unit, edit: dict, allowed: str) -> None:
+    """T44-B11, T44-B12: target None was a TypeError, {'kind': 'mdp'} a KeyError, kind 'bogus' flew as a family run,
+    optimiser None a TypeError, history_points -1 NumPy's error: each is refused naming the unit and the param."""
+    import neurohover.experiments as E
+
+    name = next(iter(edit))
+    params = {**copy.deepcopy(evolve_unit.params), "budget": 10, "n_steps": 20, **edit}
+    message = f"unit {evolve_unit.key!r}: its param {name} = "
+    with pytest.raises(NeurohoverError, match=re.escape(message) + ".* is not allowed: give " + re.escape(allowed)):
+        E.run_unit(E.Unit(evolve_unit.experiment, evolve_unit.key, evolve_unit.kind, params))
+
+
+def test_an_evolve_units_budget_0_is_the_plateau_stop(evolve_unit) -> None:
+    """T44-B12, not a bug: a unit's budget 0 is the plateau stop, as the configs' policy_budget and generic_budget 0
+    plan it (evolve's own budget=None); a planned unit holds it, and run_unit takes it."""
+    import neurohover.experiments as E
+    from neurohover.experiments.params import EvolveParams, checked_unit_params
+
+    unit = E.plan(E.load_config("fig7", "quick", {"policy_budget": 0}), {}).units[0]
+    assert (unit.key, unit.params["budget"]) == (evolve_unit.key, 0)
+    assert checked_unit_params("evolve", unit.params, unit.key).budget == 0
+    assert "budget`` 0: no budget, the plateau stop" in (EvolveParams.__doc__ or "")
+
+
+def test_every_planned_unit_passes_the_checks_of_run_unit() -> None:
+    """The checks run_unit adds refuse no unit the planner writes (a structure check with None everywhere is
+    unit_params' own, tests/test_experiment_settings.py)."""
+    from neurohover.experiments import load_config, plan
+    from neurohover.experiments.params import PARAMS, checked_unit_params
+
+    kinds = set()
+    for name in ("fig7", "fig11", "table4", "fig13", "ablation-fghh"):
+        cfg = load_config(name, "quick")
+        for unit in plan(load_config(name, "quick", {"policies": "shipped"}) if cfg.kind == "test_runs" else cfg, {}, {}).units:
+            if unit.kind in PARAMS:
+                checked_unit_params(unit.kind, unit.params, unit.key)
+                kinds.add(unit.kind)
+    assert kinds >= {"evolve", "test_run"}

@@ -9,31 +9,59 @@ planner and these declarations cannot drift apart). Optional keys the planner le
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import MISSING, dataclass, fields
+from dataclasses import MISSING, dataclass, field, fields
 from typing import Any
 
 from ..errors import NeurohoverError, brief, finite_real, unknown_keys, whole_number
+from ..evolution.config import MAX_BUDGET
+from ..evolution.seeding import MAX_SEED
 from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..models.model import LEGACY_MODEL_SUBSTEPS
+from .checks import MAX_EPISODES, MAX_STEPS, choice, resampling
+
+
+def _whole(low: int, high: int | None = None, high_text: str | None = None) -> Callable[[object], tuple[bool, str]]:
+    """A check (as :mod:`.checks` writes them) of a whole number in ``low..high`` (``high_text`` writes ``high``);
+    NumPy integers too, as :func:`unit_params` takes them."""
+    allowed = f"an integer >= {low}" if high is None else f"an integer in {low}..{high_text or high}"
+    return lambda v: (whole_number(v) and low <= v and (high is None or v <= high), allowed)
+
+
+def _target(t: object) -> tuple[bool, str]:
+    """An evolution unit's target: ``{"kind": "mdp", "mdp": {...}}`` or ``{"kind": "family", "task": ...[, ...]}``
+    (what the MDP and the family are made of is checked where they are read)."""
+    allowed = 'a table {"kind": "mdp", "mdp": {an MDP\'s table}} or {"kind": "family", "task": NAME[, "sigma", "sensor", "drift"]}'
+    if not isinstance(t, dict):
+        return False, allowed
+    if t.get("kind") == "mdp":
+        return set(t) == {"kind", "mdp"} and isinstance(t["mdp"], dict), allowed
+    return t.get("kind") == "family" and "task" in t, allowed
+
+
+def checked(check: Callable[[object], tuple[bool, str]], default: Any = MISSING) -> Any:
+    """A params field whose value :func:`checked_unit_params` also checks with ``check`` (a :mod:`.checks`-style
+    ``value -> (ok, allowed)``), beside its annotation's types."""
+    return field(default=default, metadata={"check": check})
 
 
 @dataclass(frozen=True, kw_only=True)
 class EvolveParams:
-    """One evolution run: ``target`` is ``{"kind": "mdp", "mdp": ...}`` or ``{"kind": "family", "task", "sigma"[, "sensor"]}``."""
+    """One evolution run: ``target`` is ``{"kind": "mdp", "mdp": ...}`` or ``{"kind": "family", "task", "sigma"[, "sensor"]}``;
+    ``budget`` 0: no budget, the plateau stop (the configs' ``policy_budget`` and ``generic_budget`` 0)."""
 
-    target: dict
+    target: dict = checked(_target)
     topology: str
     prototype: str | dict
-    resampling: str
-    budget: int
+    resampling: str = checked(resampling())
+    budget: int = checked(_whole(0, MAX_BUDGET))
     optimiser: dict
-    n_steps: int
-    validation_episodes: int
-    history_points: int = 300
-    validation_mdps: str | None = None
-    validation_seed: int | None = None
-    champion_reevaluation: int = 0  # fresh episodes that choose the champion again among the last parents (0: not)
-    seed: int
+    n_steps: int = checked(_whole(1, MAX_STEPS))
+    validation_episodes: int = checked(_whole(0, MAX_EPISODES))
+    history_points: int = checked(_whole(2), 300)
+    validation_mdps: str | None = checked(choice(None, "test"), None)
+    validation_seed: int | None = checked(lambda v: (v is None or _whole(0, MAX_SEED)(v)[0], "None or an integer in 0..2**63-1"), None)
+    champion_reevaluation: int = checked(_whole(0, MAX_EPISODES), 0)  # fresh episodes that choose the champion again among the last parents (0: not)
+    seed: int = checked(_whole(0, MAX_SEED, "2**63-1"))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -159,3 +187,34 @@ _NUMBERS: dict[str, tuple[Callable[[object], bool], str]] = {
     "float": (finite_real, "a finite real number"),
     "float | None": (finite_real, "a finite real number or None"),
 }
+
+
+#: An annotation's type name -> its test (a params field's value is one of the types its annotation names).
+_TYPES: dict[str, tuple[Callable[[object], bool], str]] = {
+    "int": (whole_number, "an integer"),
+    "float": (finite_real, "a finite number"),
+    "str": (lambda v: isinstance(v, str), "text"),
+    "dict": (lambda v: isinstance(v, dict), "a table (dict)"),
+    "list": (lambda v: isinstance(v, list), "a list"),
+    "bool": (lambda v: isinstance(v, bool), "true or false"),
+    "None": (lambda v: v is None, "None"),
+}
+
+
+def checked_unit_params(kind: str, params: dict, key: str) -> Any:
+    """The params of unit ``key`` of ``kind`` as its typed params (:func:`unit_params`), each value checked against its
+    field's annotation (None only where it allows None) and the field's own check: what :func:`~.units.run_unit` reads,
+    so that a unit edited by hand is refused by unit and param as the config checks refuse a planned one's settings
+    (target None was a TypeError, kind 'bogus' flew as a family run, history_points -1 NumPy's error; T44-B11, T44-B12)."""
+    try:
+        typed = unit_params(kind, params)
+    except NeurohoverError as err:
+        raise NeurohoverError(f"unit {brief(key)}: {err}") from None
+    for f in fields(typed):
+        value = getattr(typed, f.name)
+        names = str(f.type).split(" | ")
+        ok, allowed = f.metadata["check"](value) if "check" in f.metadata else (True, "")
+        if not any(_TYPES[n][0](value) for n in names) or not ok:
+            allowed = allowed or " or ".join(_TYPES[n][1] for n in names)
+            raise NeurohoverError(f"unit {brief(key)}: its param {f.name} = {brief(value)} is not allowed: give {allowed}")
+    return typed

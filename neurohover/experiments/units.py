@@ -40,7 +40,7 @@ from ..policies import Policy
 from ..policies import prototype as make_prototype
 from ..policysets import choose_safe
 from ..tasks import EXACT, MDP, Sensor, family_for, family_from_dict
-from .params import unit_params
+from .params import PARAMS, checked_unit_params, unit_params
 from .results import (
     DiagnosticResult,
     EvolveResult,
@@ -470,6 +470,8 @@ def run_unit(unit: Unit | dict, threads: int | None = 1, device: str = "cpu") ->
     runner = _RUNNERS.get(unit.kind)
     if runner is None:
         raise NeurohoverError(f"unknown unit kind {unit.kind!r}: allowed {', '.join(_RUNNERS)}")
+    if unit.kind in PARAMS:  # a unit edited by hand is refused by unit and param (T44-B11, T44-B12)
+        checked_unit_params(unit.kind, unit.params, unit.key)
     with num_threads(threads):  # also for library calls that take no thread count (e.g. EC-MER)
         return runner(unit.params, threads, device)
 
