@@ -155,9 +155,9 @@ def check_agent_settings(agent: str, values: Mapping[str, object], n_steps: int 
 
 def agents_with_settings() -> list[str]:
     """The registered agents that take --agent-setting (agent_settings=): those with settings of their own but the hybrid agents."""
-    from .agents.registry import AGENTS
+    from .agents.registry import usable_agents
 
-    return sorted(name for name, spec in AGENTS.items() if spec.settings is not None and spec.settings.UNIT_KEY in ("agent_settings", *_EXPERIMENT_WIDE))
+    return sorted(n for n, s in usable_agents().items() if s.settings is not None and s.settings.UNIT_KEY in ("agent_settings", *_EXPERIMENT_WIDE))
 
 
 def competition_config(
@@ -183,10 +183,11 @@ def competition_config(
     Its scale is a digest of the settings, so competitions with other settings in the same store
     are kept apart and the same settings resume.
     """
-    from .agents.registry import AGENTS, HYBRID_AGENTS, agent_spec
+    from .agents.registry import HYBRID_AGENTS, agent_spec
     from .experiments.canonical import typed_numbers
     from .experiments.config import compete_name, make_config, settings_scale
 
+    spec_settings = agent_spec(agent).settings  # an unknown agent, or a bad registry entry, named first (T44-B14)
     check_sizes(runs, episodes)
     check_seed(seed)  # the range every command takes
     group: dict[str, object] = {"agent": agent, **_group(task, runs, mdps)}
@@ -209,14 +210,13 @@ def competition_config(
     own: dict = {}
     if agent_settings is not None and (agent_settings or not isinstance(agent_settings, Mapping)):  # the agent's own settings, checked by its class
         own = check_agent_settings(agent, agent_settings, n_steps)
-        defaults = AGENTS[agent].settings().to_dict()  # type: ignore[misc]  # an agent that takes settings has a class
+        defaults = spec_settings().to_dict()  # type: ignore[misc]  # an agent that takes settings has a class
         own = typed_numbers(defaults, own)  # level=1 as 1.0 ...
         own = {} if own == defaults else own  # ... and the defaults given as left out: one competition, not three (T29-A07)
-    spec_settings = agent_spec(agent).settings
     if spec_settings is not None and spec_settings.UNIT_KEY == "agent_settings":  # the defaults too: trials 2 in 3 episodes
         spec_settings.from_dict(dict(own)).check_episodes(agent, episodes)  # before any run (T32-A07), as --drift's change_at
     if own:
-        if getattr(AGENTS[agent].settings, "UNIT_KEY", None) in _EXPERIMENT_WIDE:  # by the class, not by its keys: continual has one of the same name
+        if getattr(spec_settings, "UNIT_KEY", None) in _EXPERIMENT_WIDE:  # by the class, not by its keys: continual has one of the same name
             wide = own
         else:
             group["settings"] = own

@@ -436,6 +436,12 @@ def _check_run(agent, family, mdp, episodes, seed, n_steps) -> tuple[MDP, int, i
             f"make the agent for it (make_agent(name, family))"
         )
     if mdp.family != family.name:  # the agent prepares for its family (its policies, safe pairs): another family's MDP is a mix-up
+        if mdp.family == "model":  # a learned model records no family it was learned for: a test run on one is not its family's (T44-B16)
+            raise NeurohoverError(
+                f"mdp {mdp.label!r} is a model MDP, but the run's family is {family.name}: an agent's test run flies an MDP of its "
+                f"family (its policies were chosen for {family.name}); fly a learned model's MDP with evaluate, evolve or a Gymnasium "
+                f"environment, or give an MDP of {family.name}"
+            )
         raise NeurohoverError(f"mdp {mdp.label!r} is a {mdp.family} MDP, but the run's family is {family.name}: give an MDP of {family.name}")
     mdp = _flown_mdp(mdp, family)
     # T24-11: whole_in, so 1.5 or True "is not allowed" and 0 "is out of range"; the bound check_episode_count had

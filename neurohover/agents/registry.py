@@ -10,6 +10,9 @@ from __future__ import annotations
 import dataclasses
 import importlib
 import pkgutil
+from collections.abc import Mapping, Sequence
+from types import MappingProxyType
+from typing import cast
 
 from ..errors import NeurohoverError, brief
 from ..integrations.flying import generic_sigma_problem
@@ -23,40 +26,115 @@ _FIRST = ("reference", "model_free", "model_based", "hybrid")
 
 
 def discover(package: str) -> dict[str, AgentSpec]:
-    """The ``AGENT_SPECS`` of every module of ``package``, by agent name, in a stable order."""
-    path = importlib.import_module(package).__path__
-    names = sorted((m.name for m in pkgutil.iter_modules(path)), key=lambda n: (_FIRST.index(n) if n in _FIRST else len(_FIRST), n))
+    """The ``AGENT_SPECS`` of every module of ``package`` (an importable package's dotted name, e.g.
+    ``"neurohover.agents"``), by agent name, in a stable order. Modules whose names start with ``_`` are not imported:
+    ``__main__`` ran a package's command line (``discover("neurohover")`` exited with the CLI's usage error, and a user's
+    package's ``__main__.py`` ended the interpreter; T44-B06)."""
+    path = _package_path(package)
+    names = sorted(
+        (m.name for m in pkgutil.iter_modules(path) if not m.name.startswith("_")), key=lambda n: (_FIRST.index(n) if n in _FIRST else len(_FIRST), n)
+    )
     specs: dict[str, AgentSpec] = {}
     for name in names:
-        if name == "registry":
+        if package == __package__ and name == "registry":
             continue
-        for spec in getattr(importlib.import_module(f"{package}.{name}"), "AGENT_SPECS", ()):
+        declared = getattr(importlib.import_module(f"{package}.{name}"), "AGENT_SPECS", ())
+        if isinstance(declared, (str, bytes)) or not isinstance(declared, Sequence) or not all(isinstance(s, AgentSpec) for s in declared):
+            raise NeurohoverError(f"module {package}.{name}'s AGENT_SPECS={brief(declared)} is not allowed: declare a tuple of AgentSpecs")
+        for spec in declared:
             if spec.name in specs:
-                raise RuntimeError(f"agent {spec.name!r} is declared twice (module {name!r} and another)")
+                raise NeurohoverError(f"agent {spec.name!r} is declared twice (module {package}.{name} and another): give each agent a name of its own")
             specs[spec.name] = spec
     return specs
 
 
-#: Every agent by name, in a stable order.
+def _package_path(package: object) -> list[str]:
+    """The ``__path__`` of the package called ``package``; NeurohoverError naming a value that is no dotted name, a
+    package that is not importable or a module that is not a package (they leaked ValueError, ModuleNotFoundError,
+    TypeError or AttributeError; T44-B06)."""
+    allowed = f"give an importable package's dotted name, e.g. {__package__!r}"
+    if not isinstance(package, str) or not all(part.isidentifier() for part in package.split(".")):
+        raise NeurohoverError(f"package={brief(package)} is not allowed: {allowed}")
+    try:
+        module = importlib.import_module(package)
+    except ModuleNotFoundError as err:  # the package itself (or a package above it), not a module its code imports
+        if err.name is None or not (package == err.name or package.startswith(f"{err.name}.")):
+            raise
+        raise NeurohoverError(f"package={package!r} is not allowed: no module named {err.name!r} is importable; {allowed}") from None
+    path = getattr(module, "__path__", None)
+    if path is None:
+        raise NeurohoverError(f"package={package!r} is not allowed: it is a module, not a package of agent modules; {allowed}")
+    return list(path)
+
+
+#: Every agent by name, in a stable order. A run-time entry is an AgentSpec under its own name; a shipped name holds its
+#: shipped spec (:func:`agent_spec` checks the entry it reads).
 AGENTS: dict[str, AgentSpec] = discover(__package__)
+#: The agents this package's modules declare: what a shipped name holds wherever the registry is read (T44-B15).
+SHIPPED_SPECS: Mapping[str, AgentSpec] = MappingProxyType(dict(AGENTS))
 #: The agents that take hybrid settings (safeguard and replacement rule): those whose own settings are HybridSettings.
 HYBRID_AGENTS: tuple[str, ...] = tuple(name for name, spec in AGENTS.items() if spec.settings is not None and spec.settings.UNIT_KEY == "hybrid")
 
 
+def entry_problem(name: object, spec: object) -> str:
+    """What is wrong with the registry entry ``AGENTS[name] = spec`` ('' when nothing): no :class:`AgentSpec` (a text was
+    an AttributeError 'applies_to' in make_agent and compete, T44-B14), a shipped name holding another spec, or a key
+    other than its spec's name (``AGENTS["alias"]`` made the best-of-two agent without a word, T44-B15)."""
+    entry = f"AGENTS[{brief(name)}] = {brief(spec)} is not allowed"
+    if not isinstance(spec, AgentSpec):
+        return f"{entry}: register an AgentSpec under its name (AGENTS[spec.name] = spec)"
+    if isinstance(name, str) and name in SHIPPED_SPECS:
+        if spec == SHIPPED_SPECS[name]:
+            return ""
+        return f"{entry}: {name!r} is a shipped agent's name and holds its shipped spec; register yours under a name of its own"
+    if spec.name != name:
+        return f"{entry}: its spec's name {brief(spec.name)} is not its key; register a spec under its own name (AGENTS[spec.name] = spec)"
+    return ""
+
+
+def usable_agents() -> dict[str, AgentSpec]:
+    """The registry's entries that :func:`agent_spec` takes: what a listing of every agent reads, so that one bad entry
+    breaks only its own use."""
+    return {name: spec for name, spec in list(AGENTS.items()) if not entry_problem(name, spec)}
+
+
+def _task_family(task: object, what: str) -> TaskFamily:
+    """``task`` as a task family: a family as it is, a task's name through :func:`get_task_family` (as make_agent takes
+    it); anything else refused, naming ``what`` (check_agent's None or 'ghh08' was an AttributeError, T44-B07/B08)."""
+    if isinstance(task, str):
+        return get_task_family(task)
+    if not isinstance(task, TaskFamily):
+        raise NeurohoverError(f"{what}={brief(task)} is not allowed: give a task family (neurohover.get_task_family('ghh08')) or its name")
+    return task
+
+
 def agent_spec(name: str, task: str | TaskFamily | None = None) -> AgentSpec:
-    """The spec of agent ``name``; refuses unknown names and, given ``task`` (a name or a family), agents for other tasks."""
+    """The spec of agent ``name``, its registry entry checked (:func:`entry_problem`); refuses unknown names and, given
+    ``task`` (a name or a family, or an object with a family's ``name`` and ``generic_over_distribution``), agents for
+    other tasks."""
     if not isinstance(name, str) or name not in AGENTS:  # a list was unhashable's TypeError
-        raise NeurohoverError(f"unknown agent {brief(name)}: allowed {', '.join(AGENTS)}")
+        raise NeurohoverError(f"unknown agent {brief(name)}: allowed {', '.join(usable_agents())}")
     spec = AGENTS[name]
+    problem = entry_problem(name, spec)
+    if problem:
+        raise NeurohoverError(problem)
     if task is not None:
-        family = get_task_family(task) if isinstance(task, str) else task
+        # a family's stand-in (its name and generic_over_distribution: what applies_to reads) is taken as a family is
+        like = isinstance(getattr(task, "name", None), str) and isinstance(getattr(task, "generic_over_distribution", None), bool)
+        family = cast("TaskFamily", task) if like else _task_family(task, "task")
         if not spec.applies_to(family):
             raise NeurohoverError(f"agent {name!r} does not apply to task {family.name!r}: it runs on {', '.join(spec.tasks)}")
     return spec
 
 
-def policies_from_set(spec: AgentSpec, ps: PolicySet) -> AgentPolicies:
-    """The policies of a policy set that agent ``spec`` flies."""
+def policies_from_set(spec: AgentSpec | str, ps: PolicySet) -> AgentPolicies:
+    """The policies of policy set ``ps`` that agent ``spec`` (an AgentSpec or an agent's name) flies."""
+    if isinstance(spec, str):
+        spec = agent_spec(spec)
+    if not isinstance(spec, AgentSpec):  # None or 5 were AttributeErrors (T44-B08)
+        raise NeurohoverError(f"spec={brief(spec)} is not allowed: give an AgentSpec or an agent's name ({', '.join(usable_agents())})")
+    if not isinstance(ps, PolicySet):
+        raise NeurohoverError(f"ps={brief(ps)} is not allowed: give a PolicySet (neurohover.policysets.load_policy_set(task))")
     generic = None
     if "generic" in spec.needs:
         kind = spec.generic_kind if ps.generics else None
@@ -78,7 +156,7 @@ def _policy_set(family: TaskFamily, policy_dir: str | None) -> PolicySet:
     ps = load_policy_set(family.name, policy_dir)
     built = generic_sigma_problem(family, ps.manifest.get("sigma"))  # one decision, compare_agent's too (T35-B07)
     if built is not None:
-        idle = ", ".join(name for name, s in AGENTS.items() if not s.needs and s.applies_to(family))
+        idle = ", ".join(name for name, s in usable_agents().items() if not s.needs and s.applies_to(family))
         builds = get_task_family(family.name).sigma  # the sigma build-policies evolves the set's generics at
         # "build one for this sigma" could not be followed: build-policies evolves FGHH's generics at its family's sigma only (T29-A05)
         raise NeurohoverError(
@@ -93,16 +171,17 @@ def _policy_set(family: TaskFamily, policy_dir: str | None) -> PolicySet:
 def _refuse_idle_policy_dir(spec: AgentSpec, policy_dir: object) -> None:
     """Refuse a policy directory for an agent that flies no policy set: it was ignored without a word (T17-8)."""
     if policy_dir is not None and not spec.needs:
-        idle = ", ".join(name for name, s in AGENTS.items() if not s.needs)  # a few: the rest (16 now) is a long list
+        idle = ", ".join(name for name, s in usable_agents().items() if not s.needs)  # a few: the rest (16 now) is a long list
         raise NeurohoverError(
             f"policy_dir={brief(policy_dir)} is not allowed for agent {spec.name!r}: it flies no policy set, so leave it out "
             f"(a policy set's directory applies to every agent but {idle})"
         )
 
 
-def check_agent(name: str, family: TaskFamily, policy_dir: str | None = None) -> None:
-    """Refuse unknown agents, agents for another task, a policy directory for an agent that flies no policy set, and
-    missing or mismatched policy sets, with clear messages."""
+def check_agent(name: str, family: TaskFamily | str, policy_dir: str | None = None) -> None:
+    """Refuse unknown agents, agents for another task (``family``: a task family or its name, as make_agent takes it), a
+    policy directory for an agent that flies no policy set, and missing or mismatched policy sets, with clear messages."""
+    family = _task_family(family, "family")
     spec = agent_spec(name, family)
     _refuse_idle_policy_dir(spec, policy_dir)
     if spec.needs:
@@ -112,10 +191,7 @@ def check_agent(name: str, family: TaskFamily, policy_dir: str | None = None) ->
 def make_agent(name: str, family: TaskFamily | str, *, policy_dir: str | None = None, options: AgentOptions = AgentOptions()) -> Agent:
     """A fresh agent called ``name`` for ``family`` (a task family or its name), flying the policies of its policy set
     (``policy_dir``: the directory of policy sets, default the shipped ones; only for an agent that flies a policy set)."""
-    if isinstance(family, str):  # a task's name, as agent_spec takes it (was an AttributeError; bad-input trial)
-        family = get_task_family(family)
-    if not isinstance(family, TaskFamily):
-        raise NeurohoverError(f"family={family!r:.80} is not allowed: give a task family (neurohover.get_task_family('ghh08')) or its name")
+    family = _task_family(family, "family")  # a task's name, as agent_spec takes it (was an AttributeError; bad-input trial)
     if not isinstance(options, AgentOptions):
         raise NeurohoverError(f"options={options!r:.80} is not allowed: give an AgentOptions")
     spec = agent_spec(name, family)
@@ -151,4 +227,18 @@ def _checked_options(spec: AgentSpec, options: AgentOptions) -> AgentOptions:
     return options
 
 
-__all__ = ["AGENTS", "HYBRID_AGENTS", "AgentOptions", "AgentPolicies", "AgentSpec", "agent_spec", "check_agent", "discover", "make_agent", "policies_from_set"]
+__all__ = [
+    "AGENTS",
+    "HYBRID_AGENTS",
+    "SHIPPED_SPECS",
+    "AgentOptions",
+    "AgentPolicies",
+    "AgentSpec",
+    "agent_spec",
+    "check_agent",
+    "discover",
+    "entry_problem",
+    "make_agent",
+    "policies_from_set",
+    "usable_agents",
+]

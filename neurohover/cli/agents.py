@@ -45,14 +45,14 @@ def cmd_compete(args: argparse.Namespace) -> int:
     """Run R independent test runs of an agent; print a summary and write results and a plot."""
     from ..agents.hybrid import HybridSettings
     from ..agents.model_based import ModelEvolution
-    from ..agents.registry import AGENTS, HYBRID_AGENTS, agent_spec
+    from ..agents.registry import HYBRID_AGENTS, agent_spec, usable_agents
     from ..compete import agents_with_settings, check_sizes, compete
     from ..filekinds import refuse_long_store_name
     from ..paths import checked_path, input_dir, output_file, printable
     from ..tasks import Drift
     from .options import check_given, given_settings, sensor_of
 
-    agent_spec(args.agent, args.task)  # an unknown agent, or one for another task, before anything else is read or made
+    spec = agent_spec(args.agent, args.task)  # an unknown agent, or one for another task, before anything else is read or made
     given = [o.flag for o in args.hybrid_options if getattr(args, o.dest) is not None]
     if given and args.agent not in HYBRID_AGENTS:
         own = args.agent in agents_with_settings()
@@ -63,11 +63,11 @@ def cmd_compete(args: argparse.Namespace) -> int:
     hybrid = HybridSettings.from_dict(given_settings(args, args.hybrid_options))  # the option's field names are its keys
     model = given_settings(args, args.model_options)
     for option in args.model_options:
-        if option.field in model and not AGENTS[args.agent].learns_models:
-            learners = ", ".join(name for name, spec in AGENTS.items() if spec.learns_models)
+        if option.field in model and not spec.learns_models:
+            learners = ", ".join(name for name, s in usable_agents().items() if s.learns_models)
             raise NeurohoverError(f"{option.flag} applies to the agents that learn models ({learners}), not to --agent {args.agent}")
-        if option.field in model and option.field in AGENTS[args.agent].idle_model_options:  # taken and ignored (T40-A03)
-            takers = ", ".join(n for n, s in AGENTS.items() if s.learns_models and option.field not in s.idle_model_options)
+        if option.field in model and option.field in spec.idle_model_options:  # taken and ignored (T40-A03)
+            takers = ", ".join(n for n, s in usable_agents().items() if s.learns_models and option.field not in s.idle_model_options)
             raise NeurohoverError(
                 f"{option.flag} applies to the agents that evolve policies on their models as it says ({takers}), not to --agent "
                 f"{args.agent}, which would ignore it (its evolution on the model is always its own); leave it out"
@@ -86,7 +86,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
 
         agent_settings = check_agent_settings(args.agent, parse_overrides(args.agent_setting, "--agent-setting"), args.episode_steps)
     if args.policy_dir is not None:
-        if not AGENTS[args.agent].needs:  # it flies no policy of a set: the option would be ignored (second trial)
+        if not spec.needs:  # it flies no policy of a set: the option would be ignored (second trial)
             raise NeurohoverError(f"--policy-dir applies to agents that fly a policy set's policies, not to --agent {args.agent}")
         input_dir(args.policy_dir, "--policy-dir")
     if args.store is not None:
@@ -144,7 +144,7 @@ def cmd_compete(args: argparse.Namespace) -> int:
 def register(sub) -> None:
     from ..agents.hybrid import HybridSettings
     from ..agents.model_based import ModelEvolution
-    from ..agents.registry import AGENTS
+    from ..agents.registry import usable_agents
     from ..compete import LR_FIT_KEYS
     from ..evaluate import DangerousState
     from ..evolution.optimisers import optimiser_names
@@ -178,7 +178,7 @@ def register(sub) -> None:
 
     p = sub.add_parser("compete", help="run test runs of an on-line agent", description=cmd_compete.__doc__)
     add_task_option(p)
-    p.add_argument("--agent", required=True, help="; ".join(f"{name} ({', '.join(spec.tasks)}): {spec.summary}" for name, spec in AGENTS.items()))
+    p.add_argument("--agent", required=True, help="; ".join(f"{name} ({', '.join(spec.tasks)}): {spec.summary}" for name, spec in usable_agents().items()))
     p.add_argument("--runs", type=integer, default=10, help="independent test runs (default 10)")
     p.add_argument("--episodes", type=integer, default=1000, help="episodes per run (default 1000)")
     p.add_argument("--mdps", default="test", help="test (the fixed test MDPs in turn), sample (fresh from G) or train")

@@ -452,7 +452,7 @@ def settings_classes() -> dict[str, type]:
     """Every settings class a run or an agent takes, by the name ``neurohover settings NAME`` knows it: the
     neuroevolution's two methods, each population optimiser, the authors' eonn, NEAT, and each agent's own."""
     from ..agents.fghh_code import CodeAgentSettings
-    from ..agents.registry import AGENTS
+    from ..agents.registry import usable_agents
     from ..evolution.eonn import EonnSettings
     from ..evolution.generational import GenerationalSettings
     from ..evolution.optimisers import OPTIMISERS
@@ -462,7 +462,7 @@ def settings_classes() -> dict[str, type]:
     found: dict[str, type] = {"steady-state": SteadyStateSettings, "generational": GenerationalSettings}
     found.update({name: spec.settings for name, spec in OPTIMISERS.items()})
     found.update({"eonn": EonnSettings, "neat": NeatSettings, "authors-fghh": CodeAgentSettings})
-    for agent in AGENTS.values():  # one entry per class, by its name
+    for agent in usable_agents().values():  # one entry per class, by its name (a bad registry entry breaks only its own use)
         if agent.settings is not None:
             found[_settings_name(agent.settings)] = agent.settings
     return found
@@ -483,13 +483,13 @@ def cmd_settings(args: argparse.Namespace) -> int:
         for name, cls in found.items():
             print(f"{name:<{width}}  {summary(cls)}")
         return 0
-    from ..agents.registry import AGENTS
+    from ..agents.registry import usable_agents
 
     name = args.name
-    if name not in found and name in AGENTS:  # an agent's name: its settings class's entry
-        own = AGENTS[name].settings
+    if name not in found and name in (agents := usable_agents()):  # an agent's name: its settings class's entry
+        own = agents[name].settings
         if own is None:
-            raise NeurohoverError(f"agent {name!r} takes no settings of its own (agents that do: {', '.join(a for a, s in AGENTS.items() if s.settings)})")
+            raise NeurohoverError(f"agent {name!r} takes no settings of its own (agents that do: {', '.join(a for a, s in agents.items() if s.settings)})")
         name = _settings_name(own)
     if name == "ne":  # evolve --optimizer ne, the default: its settings are the method's (T36-A06)
         print("ne (evolve's default optimiser) takes the settings of steady-state on one MDP (--mdp) and of generational over a family:\n")
