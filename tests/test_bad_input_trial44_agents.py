@@ -8,6 +8,7 @@ stays refused, and the README and glossary no longer say the model's MDP flies a
 
 from __future__ import annotations
 
+import copy
 import re
 import sys
 import textwrap
@@ -19,8 +20,9 @@ import neurohover as nh
 from neurohover.agents import registry as R
 from neurohover.agents import run_test
 from neurohover.agents.spec import AgentSpec
-from neurohover.compete import agents_with_settings, compete
+from neurohover.compete import agents_with_settings, compete, competition_config
 from neurohover.errors import NeurohoverError
+from neurohover.experiments.config import make_config
 from neurohover.models import LearnedModel
 from neurohover.policysets import load_policy_set
 
@@ -143,6 +145,16 @@ def test_registry_entry_that_is_no_spec(monkeypatch, tmp_path):
     assert "junk" not in str(err.value)
     assert "junk" not in R.usable_agents()
     _still_usable()
+
+
+def test_registry_bad_entry_in_experiment_configs(monkeypatch):
+    monkeypatch.setitem(R.AGENTS, "junk", "not a spec")
+    monkeypatch.setitem(R.AGENTS, 5, R.SHIPPED_SPECS["baseline"])  # a key that is no text: 'int' has no attribute 'lower'
+    config = competition_config("ghh08", "baseline", runs=1, episodes=2)  # the other agents' configs are made
+    settings = copy.deepcopy(dict(config.settings))
+    settings["groups"] = [{**settings["groups"][0], "agent": "junk"}]
+    with pytest.raises(NeurohoverError, match=r"agent.*'junk'.*not allowed.*'baseline'"):
+        make_config("t44-junk", "test_runs", "quick", settings)
 
 
 def test_registry_alias_and_replaced_shipped_slot(monkeypatch):

@@ -14,7 +14,7 @@ import copy
 from dataclasses import MISSING, Field, field, fields
 from typing import Any
 
-from ..agents.registry import AGENTS
+from ..agents.registry import usable_agents
 from ..errors import NeurohoverError
 from ..evolution.evolve import parse_resampling
 from ..evolution.races import RACE_RULES
@@ -91,7 +91,8 @@ def seed():
 
 def agent():
     def check(v):
-        return v in AGENTS, "one of " + ", ".join(repr(a) for a in AGENTS)
+        agents = usable_agents()  # a bad registry entry is refused as a config's agent (T44-B14)
+        return isinstance(v, str) and v in agents, "one of " + ", ".join(repr(a) for a in agents)
 
     return check
 

@@ -15,7 +15,7 @@ import re
 from typing import Any
 
 from ..agents.hybrid import HybridSettings
-from ..agents.registry import AGENTS, HYBRID_AGENTS
+from ..agents.registry import AGENTS, HYBRID_AGENTS, usable_agents
 from ..errors import NeurohoverError, brief
 from ..evolution.config import make_settings, optimiser_of
 from ..evolution.evolve import parse_resampling
@@ -157,7 +157,7 @@ def check_used(written: dict, settings: dict, kind: str, where: str, switched: f
     if kind != "test_runs":
         return
     groups, task = settings["groups"], settings["task"]
-    learners = ", ".join(name for name, spec in AGENTS.items() if spec.learns_models)
+    learners = ", ".join(name for name, spec in usable_agents().items() if spec.learns_models)
     learning = [g for g in groups if AGENTS[g["agent"]].learns_models]
     _idle(written, schema, ("model_budget", "predict_episodes", "max_learning_episodes"), bool(learning), f"the agents that learn models ({learners})", where)
     authors = any(g.get("model_policy") == "authors" for g in learning)
@@ -182,7 +182,7 @@ def check_used(written: dict, settings: dict, kind: str, where: str, switched: f
             (("safety_episodes",), False, f"{safe} (a GHH task, not {task!r})"),
         )
     else:
-        safe_agents = ", ".join(name for name, spec in AGENTS.items() if "safe" in spec.needs)
+        safe_agents = ", ".join(name for name, spec in usable_agents().items() if "safe" in spec.needs)
         rules = (
             (
                 ("policy_budget",),
@@ -330,7 +330,7 @@ def _check_test_runs(settings: dict, task: str, where: str) -> None:
             )
     if len(set(labels)) != len(labels):
         raise NeurohoverError(f"{where}: group labels must be unique (set label = ... on repeated agents), got {labels}")
-    agents = {name.lower(): name for name in AGENTS}
+    agents = {name.lower(): name for name in usable_agents()}  # a bad registry entry breaks only its own use (T44-B14)
     for g, label in zip(settings["groups"], labels, strict=True):  # wins, the report and the paper's claims read a group by its label (T28-A03)
         other = agents.get(label.lower())
         if other is not None and other != g["agent"]:
@@ -349,7 +349,7 @@ def _check_test_runs(settings: dict, task: str, where: str) -> None:
             Drift.from_dict(drift).check_run(settings["episodes"], at, at_given="change_at" in drift, config=True)
         lr_keys = [k for k, idle in MODEL_OPTIONS.items() if k in g and g[k] != idle]
         if lr_keys and not AGENTS[g["agent"]].learns_models:
-            learners = ", ".join(name for name, spec in AGENTS.items() if spec.learns_models)
+            learners = ", ".join(name for name, spec in usable_agents().items() if spec.learns_models)
             raise NeurohoverError(
                 f"{where}: group {g['label']!r}: {', '.join(lr_keys)} {'applies' if len(lr_keys) == 1 else 'apply'} to the agents that learn models "
                 f"({learners}), not to {g['agent']!r}"
