@@ -23,7 +23,7 @@ import numpy as np
 from .errors import NeurohoverError, as_floats, brief, finite_real, real_number, whole_in, whole_number
 from .flightdata import FlightData, same_values
 from .flyer import KernelFlyer, refuse_other_import
-from .launch import DEVICES, KIND, MAX_SEED, Batch, Flown, check_device, launch, num_threads, use_lanes
+from .launch import DEVICES, KIND, MAX_EPISODES_PER_CALL, MAX_SEED, Batch, Flown, check_device, launch, num_threads, use_lanes
 from .policies import GENOME_LENGTH, Policy, check_genome, check_padding, frozen, genome_rows, load_policy, refuse_own_act
 from .sim.constants import (
     EPISODE_STEPS,
@@ -273,7 +273,7 @@ def mdp_rows(mdps: MDP | Sequence[MDP] | np.ndarray) -> np.ndarray:
     return np.stack([m.row() for m in mdps])
 
 
-def _index_array(values, n_jobs: int | None, what: str) -> np.ndarray:
+def _index_array(values, n_jobs: int | None, what: str, jobs=None) -> np.ndarray:
     """``values`` as a 1-D int64 array of job indices; their range is checked where every launch's is (launch.check_job_indices,
     from :class:`Batch`), so a KernelFlyer's or a hand-made Batch's indices cannot segfault either (thirteenth trial, F1)."""
     if isinstance(values, np.ma.MaskedArray):  # np.asarray dropped the mask: the hidden indices were flown (T16-9)
@@ -288,18 +288,16 @@ def _index_array(values, n_jobs: int | None, what: str) -> np.ndarray:
     if arr.size and np.issubdtype(arr.dtype, np.unsignedinteger) and arr.max() > np.iinfo(np.int64).max:  # would wrap negative
         raise NeurohoverError(f"{what} holds {arr.max()}, out of range: allowed 0..2**63-1")
     arr = arr.astype(np.int64).reshape(-1)
-    if n_jobs is not None and arr.shape[0] != n_jobs:
-        raise NeurohoverError(f"{what} has {arr.shape[0]} entries but there are {n_jobs} jobs")
+    if n_jobs is not None and arr.shape[0] != n_jobs:  # policy_index (``jobs``) sets the jobs: an empty one blamed mdp_index (T44-B10)
+        raise NeurohoverError(
+            f"{what} has {arr.shape[0]} entries but policy_index={brief(jobs)} (shape {np.shape(jobs)}) sets the job count, {n_jobs}: give one per job in each"
+        )
     return arr
 
 
 #: The most control steps one call flies (about a day of the kernel on two cores), and the most memory its recorded
 #: flight data may take (12 readings and 4 actions a step, float64).
 MAX_STEPS_PER_CALL, MAX_RECORD_BYTES, RECORD_BYTES_PER_STEP = 10**12, 8 * 2**30, 16 * 8
-
-#: The most episodes one call flies: each holds about 60 bytes of job and result arrays in memory (6 GB at
-#: this bound), so a larger run is refused up front with this number rather than failing to allocate.
-MAX_EPISODES_PER_CALL = 100_000_000
 
 
 def _check_n_steps(n_steps) -> int:
@@ -395,8 +393,8 @@ def evaluate_jobs(
     n_steps = _check_n_steps(n_steps)  # the int checked is the int flown: np.int8(127) + 1 was -128 (T31-B02)
     p_idx = _index_array(policy_index, None, "policy_index")
     n_jobs = p_idx.shape[0]
-    m_idx = _index_array(mdp_index, n_jobs, "mdp_index")
-    e_idx = _index_array(episode_index, n_jobs, "episode_index")
+    m_idx = _index_array(mdp_index, n_jobs, "mdp_index", policy_index)
+    e_idx = _index_array(episode_index, n_jobs, "episode_index", policy_index)
     fb = _fallback_array(fallback_index, n_jobs, len(table))
     if safeguard_limits is not None and fallback_index is None:  # the limits acted on no job, without a word (T28-B16)
         raise NeurohoverError("safeguard_limits needs fallback_index= (each job's fallback policy, -1: none): alone it acts on no job; give both, or neither")

@@ -10,7 +10,7 @@ import numba
 import numpy as np
 
 from .errors import NeurohoverError, brief, reloaded_text, whole_in, whole_number
-from .launch import KIND, MAX_SEED, Batch, Flown, Parking, check_device, launch, launch_parked, rows_alike
+from .launch import KIND, MAX_EPISODES_PER_CALL, MAX_SEED, Batch, Flown, Parking, check_device, launch, launch_parked, rows_alike
 from .policies import GENOME_LENGTH, TOPOLOGIES, Policy
 from .sim.constants import MAX_EPISODE_STEPS, SAFEGUARD_LIMITS
 from .sim.kernel import GENOME_WIDTH
@@ -180,6 +180,7 @@ class KernelFlyer:
             Per job, the genome and the MDP row it flies; None: 0 for every job; ``"range"``:
             job j flies number j.
         n_jobs : int
+            The number of jobs, 1..:data:`~neurohover.launch.MAX_EPISODES_PER_CALL`.
         episode_index : numpy.ndarray of int64, optional
             Per job, its episode index, from indices :meth:`reserve` gave: the jobs are then not
             counted in :attr:`episodes` and :attr:`steps` (the caller counts what it uses).
@@ -189,8 +190,12 @@ class KernelFlyer:
         numpy.ndarray
             The jobs' returns: a view of the flyer's buffer, valid until the next call.
         """
-        if not whole_number(n_jobs) or n_jobs < 0:  # -1 flew all but one buffer slot
-            raise NeurohoverError(f"n_jobs={brief(n_jobs)} is not allowed: give the number of jobs, an integer >= 0")
+        # whole_in: a Python int (np.int8(5) overflowed in _check_room), at least one job (0 was numba's thread-count error),
+        # at most evaluate_jobs' episodes in one call (2**70 was NumPy's "maximum allowed dimension exceeded"); T44-B09
+        n_jobs = whole_in(n_jobs, "n_jobs", 1, MAX_EPISODES_PER_CALL, f"{MAX_EPISODES_PER_CALL:,} (episodes in one call)")
+        for name, index in (("policy_index", policy_index), ("mdp_index", mdp_index)):  # any other text flew as "range" (T44-B09)
+            if isinstance(index, str) and index != "range":
+                raise NeurohoverError(f"{name}={brief(index)} is not allowed: give None (0 for every job), 'range' (job j: number j) or an array of indices")
         self._load_genomes(genomes)
         zeros, arange, e, minus, returns, crashed, steps, sg = self._views_for(n_jobs)
         p = zeros if policy_index is None else (arange if isinstance(policy_index, str) else policy_index)

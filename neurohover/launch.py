@@ -34,12 +34,17 @@ from .sim.rng import MAX_SEED
 from .sim.step import step_batch
 
 __all__ = [
-    "DEVICES", "KIND", "MAX_SEED", "Batch", "Flown", "Parking", "check_device", "check_job_indices", "launch", "launch_parked", "load_kernel", "num_threads",
-    "rows_alike", "Stepper", "stepper", "use_lanes",
+    "DEVICES", "KIND", "MAX_EPISODES_PER_CALL", "MAX_SEED", "Batch", "Flown", "Parking", "check_device", "check_job_indices", "launch", "launch_parked",
+    "load_kernel", "num_threads", "rows_alike", "Stepper", "stepper", "use_lanes",
 ]  # fmt: skip
 
 #: The kernel's code of each policy topology.
 KIND = {"slp": POLICY_SLP, "mlp": POLICY_MLP}
+
+#: The most episodes one call flies: each holds about 60 bytes of job and result arrays in memory (6 GB at
+#: this bound), so a larger run is refused up front with this number rather than failing to allocate
+#: (evaluate_jobs and KernelFlyer.fly; here, below both: evaluate.py is at the module size limit).
+MAX_EPISODES_PER_CALL = 100_000_000
 
 
 #: Set in a process forked after its parent flew on numba's GNU OpenMP threads: the pid of that parent (T34-B13).

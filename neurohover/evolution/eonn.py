@@ -29,16 +29,18 @@ the repository's root) flies every kept genome again each generation; their heli
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, whole_in
+from ..errors import NeurohoverError, brief, finite_real, settings_from_dict, whole_in
 from ..evaluate import PolicyTable, evaluate_jobs
 from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
-from ..tasks import MDP
-from .common import MAX_SPREAD, require_spread, set_field
+from ..tasks import MDP, refuse_drift
+from .common import MAX_SPREAD, require_prob, require_spread, set_field
 from .fitness import episode_fitness
 from .operators import crossover, mutate
 from .seeding import check_seed
@@ -90,10 +92,9 @@ class EonnSettings:
 
     def __post_init__(self) -> None:
         for name, low in (("pop_size", 2), ("keep", 0), ("generations", 1), ("tournament_size", 1)):
-            v = getattr(self, name)
-            if type(v) is not int:  # T24-11: 1.5 or True "is not allowed" (a type; it said out of range), a Python int as before
-                raise NeurohoverError(f"{name}={brief(v)} is not allowed: allowed an integer in {low}..2**63-1")
-            whole_in(v, name, low, 2**63 - 1, "2**63-1")
+            # whole_in: NumPy's integers too, stored as Python ints, as GenerationalSettings' (T44-B22); 1.5 or True
+            # "is not allowed" (a type; it said out of range, T24-11)
+            set_field(self, name, whole_in(getattr(self, name), name, low, 2**63 - 1, "2**63-1"))
         if self.keep >= self.pop_size:
             raise NeurohoverError(
                 f"keep={brief(self.keep)} is out of range: allowed 0..pop_size - 1 = {self.pop_size - 1} (at least one offspring a generation)"
@@ -102,11 +103,13 @@ class EonnSettings:
             raise NeurohoverError(f"tournament_size={brief(self.tournament_size)} is out of range: allowed 1..pop_size = {self.pop_size}")
         for name in ("mutate_prob", "mutate_frac", "mutate_repl", "averaging_prob", "spawn_frac"):
             v = getattr(self, name)
-            if not finite_real(v) or not 0.0 <= v <= 1.0:
+            if not finite_real(v) or not 0.0 <= float(v) <= 1.0:
                 raise NeurohoverError(f"{name}={brief(v)} is out of range: allowed a probability in [0, 1]")
+            set_field(self, name, require_prob(name, v))  # a Python float, as GenerationalSettings stores (np.float32 was kept; T44-B22)
         for name in ("mutate_std", "spawn_std"):  # 10**400 was NumPy's TypeError, 1e308 overflowed the genes (eleventh trial)
             v = getattr(self, name)
-            if not finite_real(v) or not 0.0 <= v <= MAX_SPREAD:
+            # float(v) compared: np.float32's comparison with MAX_SPREAD cast 1e100 to float32 and warned (T44-B23)
+            if not finite_real(v) or not 0.0 <= float(v) <= MAX_SPREAD:
                 raise NeurohoverError(f"{name}={brief(v)} is out of range: allowed a number in [0, {MAX_SPREAD:g}] (a larger one overflows the genes)")
             set_field(self, name, require_spread(name, v))  # -0.0 as 0.0: NumPy's normal() refused it mid-run (fourteenth trial)
 
@@ -132,18 +135,38 @@ def _child(pool: np.ndarray, fitness: np.ndarray, rng: np.random.Generator, s: E
     return mutate(child, rng, s) if rng.random() < s.mutate_prob else child
 
 
+def _check_arguments(mdp: object, prototype: object, settings: object) -> EonnSettings:
+    """:func:`eonn_evolve`'s settings as an :class:`EonnSettings`, once ``mdp`` and ``prototype`` are checked."""
+    if not isinstance(mdp, MDP):
+        raise NeurohoverError(f"mdp={brief(mdp)} is not allowed: eonn_evolve flies one MDP (an MDP of a task, or a learned model's .mdp())")
+    refuse_drift(mdp, "eonn_evolve")
+    if not isinstance(prototype, Policy):
+        raise NeurohoverError(f"prototype={brief(prototype)} is not allowed: give a Policy (e.g. neurohover.baseline_policy())")
+    if settings is None:
+        return EonnSettings()
+    if isinstance(settings, Mapping):
+        return settings_from_dict(EonnSettings, settings, unknown_what="eonn", bad_what="eonn settings")
+    if not isinstance(settings, EonnSettings):
+        raise NeurohoverError(f"settings={brief(settings)} is not allowed: give an EonnSettings, a dict of its fields or None (its defaults)")
+    return settings
+
+
 def eonn_evolve(
     mdp: MDP,
     prototype: Policy,
     *,
-    settings: EonnSettings = EonnSettings(),
+    settings: EonnSettings | Mapping[str, Any] | None = None,
     seed: int = 0,
     n_steps: int = EPISODE_STEPS,
     threads: int | None = 1,
     device: str = "cpu",
 ) -> EonnResult:
-    """Evolve a policy of ``prototype``'s topology on ``mdp`` as the authors' ``eonn`` did (module docstring)."""
-    s = settings
+    """Evolve a policy of ``prototype``'s topology on ``mdp`` as the authors' ``eonn`` did (module docstring).
+
+    ``mdp`` is one MDP (a learned model's ``.mdp()`` included), ``prototype`` a :class:`~neurohover.policies.Policy`,
+    ``settings`` an :class:`EonnSettings`, a dict of its fields or None (its defaults), as ``evolve_topology`` takes
+    its settings; anything else is one NeurohoverError (each was an AttributeError; T44-B21)."""
+    s = _check_arguments(mdp, prototype, settings)
     rng = np.random.default_rng(check_seed(seed))
     spawn = dataclasses.replace(s, mutate_frac=s.spawn_frac, mutate_std=s.spawn_std)  # spawn's mutation of the first pool
     start = np.asarray(prototype.genome, dtype=np.float64)

@@ -18,8 +18,8 @@ import math
 
 import numpy as np
 
-from ..errors import NeurohoverError, as_floats, brief
-from ..sim.constants import lowest_return
+from ..errors import NeurohoverError, as_floats, brief, finite_real, whole_in
+from ..sim.constants import MAX_EPISODE_STEPS, lowest_return
 
 __all__ = ["ERROR_FLOOR", "FITNESS_SCALES", "episode_fitness", "error_of_fitness", "fitness_range", "in_fitness_range"]
 
@@ -49,7 +49,7 @@ def episode_fitness(returns: np.ndarray, scale: str) -> np.ndarray:
 def error_of_fitness(fitness: np.ndarray | float, scale: str) -> np.ndarray:
     """The error (``-return``) whose fitness on ``scale`` is ``fitness``: ``exp(1/f)`` or ``-f``."""
     _check_scale(scale)  # any other scale was read as inv-log-error
-    f = np.asarray(fitness, dtype=np.float64)
+    f = as_floats(fitness, "fitness", "fitness values")  # 'x' was NumPy's ValueError (T44-B04)
     if scale == "return":
         return -f
     with np.errstate(divide="ignore", over="ignore"):
@@ -65,6 +65,7 @@ def fitness_range(n_steps: int, scale: str) -> tuple[float, float, str]:
     lies outside; a checker allows it itself. The bounds are exact: a checker allows 1e-9 relative for a mean's
     rounding (-1e9 in a 20-step run's steady-state fitness was resumed; T27-B03)."""
     _check_scale(scale)
+    n_steps = whole_in(n_steps, "n_steps", 1, MAX_EPISODE_STEPS)  # -1 or NaN: bounds of nonsense (T44-B04)
     worst = lowest_return(n_steps)
     if scale == "return":
         return worst, 0.0, f"a mean return in [{worst:.10g}, 0] (the worst step, for each of its {n_steps:,} steps, to none)"
@@ -75,5 +76,11 @@ def fitness_range(n_steps: int, scale: str) -> tuple[float, float, str]:
 def in_fitness_range(values: np.ndarray | float, low: float, high: float) -> np.ndarray:
     """Whether each of ``values`` lies in [low, high] of :func:`fitness_range`, 1e-9 relative each side for a mean's
     rounding (False for NaN and infinities)."""
-    v = np.asarray(values, dtype=np.float64)
+    for name, bound in (("low", low), ("high", high)):  # None was a TypeError, NaN held nothing (T44-B04)
+        if not finite_real(bound):
+            raise NeurohoverError(f"{name}={brief(bound)} is not allowed: allowed a finite number (a bound of fitness_range)")
+    if float(low) > float(high):
+        raise NeurohoverError(f"low={brief(low)} is out of range: allowed a number at most high={brief(high)} (a range of fitness_range)")
+    low, high = float(low), float(high)
+    v = as_floats(values, "values", "fitness values")
     return (v >= low - 1e-9 * abs(low)) & (v <= high + 1e-9 * abs(high))
