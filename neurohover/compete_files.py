@@ -569,7 +569,7 @@ def _check_rows_of_agent(path: Path, summary: dict, rows: _Rows) -> None:
 
 def policy_label_problem(agent: object, label: str) -> str:
     """'' when ``agent`` names a policy it flies ``label`` (:data:`ONE_POLICY`, :data:`POLICY_LABELS`; an agent in
-    neither, a hand-written one, is not checked), else what it flies (T25-08, T25-09). result_checks asks this too."""
+    neither, a hand-written one, is not checked), else what it flies (T25-08, T25-09); result_checks asks too. Internal: called with a stored label."""
     fixed = ONE_POLICY.get(agent) if isinstance(agent, str) else None
     if fixed is not None:
         return "" if label == fixed else f"policy {brief(label)} is not allowed: agent {agent} flies {fixed!r} only"

@@ -1,5 +1,8 @@
 """Which neurohover file a path holds, and the names an output may not take.
 
+Internal: neurohover's plumbing, called with values neurohover has checked: its helpers trust their callers and do not
+check their own arguments (README, Python API, What is public).
+
 :func:`held_kind` tells a results store, flight data and each kind of JSON or CSV file neurohover writes apart by
 their content, so that an output of one kind is never written over a file of another (T25-01 to T25-03, T25-12);
 :func:`output_name` and :func:`refuse_suffix` hold the rules of output names (the suffix of the kind written, never an

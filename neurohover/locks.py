@@ -1,6 +1,10 @@
 """One process writing an output at a time: :class:`WriterLock`, an OS advisory lock on a lock file beside the output,
 :func:`sole_writer`, evolve's guard of its ``--out``, and :func:`writer_file`, the temporary file one writer writes
-(re-exported by :mod:`neurohover.paths`, where they were)."""
+(re-exported by :mod:`neurohover.paths`, where they were).
+
+Internal: neurohover's plumbing, called with values neurohover has checked: its helpers trust their callers and do not
+check their own arguments (README, Python API, What is public).
+"""
 
 from __future__ import annotations
 
@@ -115,11 +119,12 @@ def holding(lock_path: Path, busy: Callable[[str], str]) -> Iterator[None]:
 
 
 @contextmanager
-def sole_writer(path: Path, option: str) -> Iterator[None]:
+def sole_writer(path: str | os.PathLike, option: str) -> Iterator[None]:
     """Be the only run writing the output ``path`` (and the files named after it) inside this block: a second run on
     the same output is refused, naming the first's pid. Two evolve runs on one --out both said they finished and left
     one's policy beside the other's checkpoint (tenth trial). A :class:`WriterLock` on ``.NAME.lock`` beside it
-    (:func:`holding`)."""
+    (:func:`holding`). ``path``: a str or path object (a str was an AttributeError 'with_name'; T44-B19)."""
+    path = Path(path)
     with holding(
         path.with_name(f".{path.name}.lock"),
         lambda who: f"{option} {str(path)!r} is being written by another run ({who}): wait for it to end, or give another {option}",

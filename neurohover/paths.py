@@ -1,5 +1,8 @@
 """Checks of the command line's file and directory arguments, made before any long computation.
 
+Internal: neurohover's plumbing (README, Python API, What is public): its checks refuse a bad path by name, and its
+other helpers (``json_text``, ``printable``, ...) trust their callers, which give them checked values.
+
 Each check refuses a bad path with one :class:`~neurohover.errors.NeurohoverError` that names the
 option, the path and what is expected. Output checks really create (and remove again) a file, so
 an unwritable place is found even where permission bits do not tell (``/proc``, read-only mounts,

@@ -142,3 +142,42 @@ def test_every_planned_unit_passes_the_checks_of_run_unit() -> None:
                 checked_unit_params(unit.kind, unit.params, unit.key)
                 kinds.add(unit.kind)
     assert kinds >= {"evolve", "test_run"}
+
+
+PLUMBING = ("paths", "filekinds", "locks", "evolution.state_codec", "experiments.keys", "models.model_checks")
+INTERNAL_HELPERS = (
+    ("compete_files", "policy_label_problem"),
+    ("experiments.results", "num"),
+    ("models.model", "check_stats"),
+    ("integrations.neat", "pack_networks"),
+)
+
+
+def test_the_plumbing_says_it_is_internal_as_the_readme_says() -> None:
+    """T44-B17, T44-B19, not bugs: these helpers are neurohover's plumbing, called with checked values (None, NaN and
+    the like reach them from no public call). README's Python API section says where the public boundary is, and each
+    plumbing module and helper says "Internal:"."""
+    import importlib
+    from pathlib import Path
+
+    readme = " ".join((Path(__file__).parents[1] / "README.md").read_text(encoding="utf-8").split())
+    section = readme[readme.index("**What is public.**") :].split("## ")[0]
+    for name in PLUMBING:
+        assert "Internal:" in (importlib.import_module(f"neurohover.{name}").__doc__ or ""), name
+        assert f"`.{name}`" in section or f"`neurohover.{name}`" in section, name
+    for module, helper in INTERNAL_HELPERS:
+        assert "Internal:" in (getattr(importlib.import_module(f"neurohover.{module}"), helper).__doc__ or ""), helper
+        assert f"`{module}.{helper}`" in section, helper
+
+
+def test_sole_writer_takes_a_str_path(tmp_path, monkeypatch) -> None:
+    """T44-B19: locks.sole_writer given a str path was an AttributeError 'with_name' (every path-taking function takes
+    a str or a path object)."""
+    from neurohover.locks import sole_writer
+
+    monkeypatch.chdir(tmp_path)
+    with sole_writer("out.json", "--out"):
+        assert (tmp_path / ".out.json.lock").exists()
+        with pytest.raises(NeurohoverError, match="--out '.*out.json' is being written by another run"):
+            with sole_writer(str(tmp_path / "out.json"), "--out"):
+                pass

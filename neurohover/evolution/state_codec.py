@@ -1,6 +1,9 @@
 """How an optimiser's ``state_dict`` is written and read back: numbers and arrays in strict JSON, and the checks that
 refuse a damaged state on reading, naming its entry (split out of :mod:`neurohover.evolution.common`, which re-exports
 every name here).
+
+Internal: neurohover's plumbing, called with values neurohover has checked: its helpers trust their callers and do not
+check their own arguments (README, Python API, What is public).
 """
 
 from __future__ import annotations

@@ -1,4 +1,8 @@
-"""Unit keys: the names the planner gives units (``run/<group>/<mdps><i>/rep<r>``, ...) and their parts."""
+"""Unit keys: the names the planner gives units (``run/<group>/<mdps><i>/rep<r>``, ...) and their parts.
+
+Internal: neurohover's plumbing, called with values neurohover has checked: its helpers trust their callers and do not
+check their own arguments (README, Python API, What is public).
+"""
 
 from __future__ import annotations
 

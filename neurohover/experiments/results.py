@@ -56,7 +56,8 @@ Num = float | str
 
 
 def num(x: float) -> Num:
-    """``x`` as a JSON-safe :data:`Num` (non-finite values as strings)."""
+    """``x`` as a JSON-safe :data:`Num` (non-finite values as strings). Internal: called with a number that a run gave
+    (README, Python API, What is public)."""
     x = float(x)
     return x if math.isfinite(x) else ("nan" if math.isnan(x) else ("inf" if x > 0 else "-inf"))
 

@@ -273,7 +273,8 @@ class PackedNetworks:
 
 
 def pack_networks(genomes: Sequence, config) -> PackedNetworks:
-    """Pack neat-python genomes into :class:`PackedNetworks` (via ``neat.nn.FeedForwardNetwork.create``)."""
+    """Pack neat-python genomes into :class:`PackedNetworks` (via ``neat.nn.FeedForwardNetwork.create``). Internal:
+    called with the genomes and config of a NEAT run (README, Python API, What is public)."""
     import neat
 
     node_start, node_slot, node_act, node_bias, node_resp = [0], [], [], [], []

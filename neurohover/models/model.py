@@ -159,7 +159,8 @@ def check_vector(values, length: int, what: str, nonnegative: bool = False) -> t
 def check_stats(stats: dict) -> None:
     """Refuse a model's ``stats`` unless :meth:`LearnedModel.save` can write them and :meth:`LearnedModel.load` read them
     back: strict JSON values, numbers finite (an object() or a NaN was json's TypeError or ValueError at the save;
-    fourteenth trial T14-12), as ``save_policy`` and ``FlightData.save`` refuse their metadata."""
+    fourteenth trial T14-12), as ``save_policy`` and ``FlightData.save`` refuse their metadata. Internal: called with a
+    dict (:class:`LearnedModel` checks that first; README, Python API, What is public)."""
     refuse_non_text_keys(stats, "model", "stats")  # {1: 2} was written, and read back as {'1': 2} (T32-B05)
     try:  # the round trip: load() reads what its parser takes; NumPy numbers as flight data's metadata writes them (T36-B08)
         json_text(stats, default=plain_json)

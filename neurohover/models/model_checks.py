@@ -2,7 +2,11 @@
 :func:`model_file_problem`, the one place of those checks (T23-10), and the entries they know (:data:`FILE_ENTRIES`).
 
 Only entries a file holds are checked (older files lack some), so every model ``learn_lr``, ``learn_ec_meno`` and
-``learn_ec_mer`` write loads."""
+``learn_ec_mer`` write loads.
+
+Internal: neurohover's plumbing, called with values neurohover has checked: its helpers trust their callers and do not
+check their own arguments (README, Python API, What is public).
+"""
 
 from __future__ import annotations
 
