@@ -45,7 +45,9 @@ _ALSO_STOPPING = ("SIGUSR1", "SIGUSR2", "SIGXCPU", "SIGALRM", "SIGVTALRM", "SIGP
 def stop_signals(command: bool = True) -> list[int]:
     """The signals the command takes as SIGTERM (:class:`Terminated`): SIGTERM, SIGHUP (a closed terminal or a dropped SSH
     session), SIGUSR1, SIGUSR2, SIGXCPU, SIGALRM, SIGVTALRM, SIGPROF, SIGPWR, SIGIO, SIGSTKFLT and SIGRTMIN..SIGRTMAX,
-    where the system has them: every signal whose default ends a process without a core dump, and SIGXCPU. Python's
+    where the system has them: every signal whose default ends a process without a core dump but SIGPIPE, and SIGXCPU.
+    SIGPIPE stays ignored, as Python sets it: a reader gone away is a BrokenPipeError, the command's quiet status 1
+    (``neurohover demo | head -1``), which a handler would make a "terminated" stop (T44-A02). Python's
     defaults ended a run at once without a word, and evolve without its checkpoint (T32-A03, T35-A03, T38-A04). SIGQUIT and SIGTRAP keep
     their defaults: the stop at once, with a core dump, that they ask for (as SIGKILL, the temporary files such a stop
     leaves are removed by the next run of the output: :func:`~neurohover.locks.remove_dead_writers_files`).

@@ -352,7 +352,7 @@ def register(sub) -> None:
     p.add_argument("--runs", default="1,5,20", help="competition lengths N, comma-separated (default 1,5,20)")
     p.add_argument("--agents", help="group labels to enter, comma-separated (default: every group of the experiment)")
     p.add_argument("--against", metavar="LABEL", help="each agent against this group alone (head to head); not also one of --agents")
-    p.add_argument("--draws", type=integer, default=10_000, help="simulated competitions (default 10,000)")
+    p.add_argument("--draws", type=integer, default=10_000, help="simulated competitions (default 10000)")
     p.add_argument("--seed", type=integer, default=0, help="seed of the bootstrap (default 0)")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=cmd_wins)

@@ -396,6 +396,27 @@ def config_differs(store: str, name: str, scale: str, held: str, stored: Any, co
     )
 
 
+#: The longest full path (bytes, symbolic links resolved, as SQLite's unix VFS resolves them) that SQLite opens a store
+#: by: its limit is 512 bytes (SQLITE_MAX_PATHNAME, NUL included), and it makes the ``-journal`` name (8 more) from
+#: it, read or written. Found by experiment (SQLite 3.40): 504 bytes open, 505 are its bare "unable to open database
+#: file", however short --store or each of its names is (a deep working directory; T44-A05).
+SQLITE_MAX_PATH = 504
+
+
+def refuse_long_store_path(path: Path) -> None:
+    """Refuse a results store whose full path is longer than SQLite opens (:data:`SQLITE_MAX_PATH`), naming its length."""
+    try:
+        size = len(os.fsencode(os.path.realpath(path)))
+    except (OSError, UnicodeError, ValueError):  # unresolvable or unencodable: refused by name elsewhere, or SQLite says
+        return
+    if size > SQLITE_MAX_PATH:
+        raise NeurohoverError(
+            f"results store {brief(str(path))} is too long for SQLite: its full path (the working directory and links "
+            f"resolved) is {size:,} bytes, and SQLite opens at most {SQLITE_MAX_PATH} (its limit of 512 less the 8 of "
+            f"'-journal'); give a path in a folder nearer the root"
+        )
+
+
 def check_store_file(path: Path, given: str | Path, create: bool) -> None:
     """Refuse a results store ``path`` (``given``) that :class:`~neurohover.experiments.Store` cannot open as one, each
     by what it is: missing where it is read, a directory, a device, empty where read, a file of another kind, a link to
@@ -413,3 +434,4 @@ def check_store_file(path: Path, given: str | Path, create: bool) -> None:
             raise NeurohoverError(f"{str(path)!r} is not a neurohover results store (it does not start with SQLite's header {SQLITE_HEADER!r})")
     refuse_dangling_link(path, "results store", given)  # SQLite's "unable to open database file" (T38-B07), as --store says
     refuse_sqlite_side_files(path, given)  # X-journal, another store so named, deleted as X opened (T39-A01, T39-A03)
+    refuse_long_store_path(path)  # SQLite's bare "unable to open database file" (T44-A05)
