@@ -170,6 +170,7 @@ def register(sub) -> None:
     )
     p.add_argument(
         "--optimizer",
+        "--optimiser",
         choices=optimiser_names(),
         default="ne",
         help="ne (default: the paper's neuroevolution) or a population optimiser for the runs on one MDP and FGHH's fixed generic",

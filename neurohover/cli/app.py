@@ -71,6 +71,12 @@ class _Parser(argparse.ArgumentParser):
         self.register("action", "store_true", _FlagOnce)
         self.register("action", argparse.BooleanOptionalAction, _SwitchOnce)  # --prog --no-progress: the last won (T36-A03)
 
+    def _get_option_tuples(self, option_string: str) -> list:
+        """argparse's options an abbreviation may mean, one per option: --optim was ambiguous between the two spellings
+        of one option, --optimizer and --optimiser (Python < 3.12.7; T44-A01)."""
+        found = super()._get_option_tuples(option_string)
+        return [t for n, t in enumerate(found) if all(t[0] is not u[0] for u in found[:n])]
+
     def error(self, message: str) -> NoReturn:
         """argparse's error in one line, as every other refusal (its usage block made 3-7 lines; T22-18), pointing to
         --help for the usage; a 100,000-character value shortened (its "invalid choice: 'ggg...'" echoed it whole)."""

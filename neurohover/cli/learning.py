@@ -9,11 +9,10 @@
   validation_sd, episodes, seconds, stop_reason, ...;
 * ``FILE.history.csv``: the run's history, columns
   ``generation,evaluations,episodes,generation_episodes,champion_return,wall_seconds``
-  (see :class:`neurohover.evolution.evolve.HistoryRecord`: steady state, one line per new champion
-  and one for the last generation; generational, one line per generation, ``generation_episodes``
-  being the episodes a race or fixed resampling spent on it);
-* ``FILE.checkpoint.json``: the run's checkpoint (every ``--checkpoint-every`` seconds, at the end
-  and on Ctrl-C), which ``--resume`` continues from; the budget may be raised when resuming.
+  (see :class:`neurohover.evolution.evolve.HistoryRecord`: steady state, one line per new champion and one for the last
+  generation; generational, one line per generation, ``generation_episodes`` being the episodes a race or fixed resampling spent on it);
+* ``FILE.checkpoint.json``: the run's checkpoint (every ``--checkpoint-every`` seconds, at the end and on Ctrl-C), which
+  ``--resume`` continues from, with its own budget unless ``--budget`` raises it.
 """
 
 from __future__ import annotations
@@ -198,8 +197,8 @@ def _evolve_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int
     from ..evolution.evolve import EvolutionInterrupted, evolve, parse_resampling, validation_return, write_history_csv
     from ..evolution.records import CHECKPOINT_KIND, HISTORY_KIND
     from ..filekinds import RUN_FILE_ENDS
-    from ..paths import output_file, sole_writer
     from ..policies import check_json_policy_name, save_policy
+    from .options import resumed_budget
 
     _check_evolve_sizes(args)
     check_json_policy_name(args.out, "--out", tuple(RUN_FILE_ENDS))  # before evolving (at the save, the run was lost): .json, not a run's checkpoint (T24-01)
@@ -210,8 +209,8 @@ def _evolve_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int
     held.enter_context(sole_writer(out, "--out"))
     history_path = output_file(f"{out}.history.csv", "--out (its history file)", kind=HISTORY_KIND)
     checkpoint = output_file(f"{out}.checkpoint.json", "--out (its checkpoint file)", kind=CHECKPOINT_KIND)
-    if args.resume and not checkpoint.is_file():
-        raise NeurohoverError(f"--resume: no checkpoint {str(checkpoint)!r} (it is written next to --out by an earlier run)")
+    if args.resume:  # a missing checkpoint refused; --budget left out is the checkpoint's own budget (T44-A03)
+        args.budget = resumed_budget(checkpoint, args.budget)
     note = f"neurohover evolve: starting afresh; {checkpoint} will be overwritten (--resume continues it)" if not args.resume and checkpoint.is_file() else None
     held.enter_context(warnings.catch_warnings(action="ignore", category=CheckpointReplaced))  # said by the note, not as evolve() warns
     settings = _optimiser_settings(args, mdp_desc == MDP_FAMILY)
@@ -536,6 +535,7 @@ def register(sub) -> None:
     p.add_argument("--seed-policy", default="baseline", help="prototype: zero, baseline (baseline-equivalent network; default) or a policy FILE")
     p.add_argument(
         "--optimizer",
+        "--optimiser",
         choices=optimiser_names(),
         default="ne",
         help="ne: the paper's neuroevolution (default); " + "; ".join(f"{n}: {s.summary}" for n, s in OPTIMISERS.items()) + " (same budget and resampling)",
@@ -545,7 +545,7 @@ def register(sub) -> None:
         default="fixed:1",
         help="fixed:K (mean of K episodes per candidate; default fixed:1) or race:DELTA (selection races at confidence 0<DELTA<1; generational only)",
     )
-    p.add_argument("--budget", type=integer, help="episodes to fly (default: the paper's stop: plateau for steady state, 4000 generations for generational)")
+    p.add_argument("--budget", type=integer, help="episodes to fly (default: the paper's plateau (steady state) or 4000 generations; --resume: the run's own)")
     add_setting_options(p, SteadyStateSettings, ("plateau_rule",), who="steady state")  # the rest through --setting
     p.add_argument(
         "--preset",

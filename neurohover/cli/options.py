@@ -11,7 +11,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from ..envs.arguments import refuse_idle_sigma
-from ..errors import FloatRangeError, NeurohoverError, float_of
+from ..errors import FloatRangeError, NeurohoverError, float_of, whole_number
 from ..tasks.sensor import Sensor
 
 
@@ -255,3 +255,19 @@ def note_policy_task(policy, task: str, option: str) -> None:
         raise NeurohoverError(f"{option}: the policy's metadata task={own!r:.40} is not allowed: give a task family's name")
     if own != task:
         print(f"neurohover: note: {option} was evolved for {own}; flying it on {task}", file=sys.stderr)
+
+
+def resumed_budget(checkpoint, budget: int | None) -> int | None:
+    """``evolve --resume``'s budget: ``--budget`` where given, else the checkpoint's own (left out, it was none, and a finished
+    100-episode run went on to the plateau without a word; T44-A03). A checkpoint that is missing is refused here, one whose
+    budget is damaged by the resume's own checks."""
+    from ..evolution.config import MAX_BUDGET
+    from ..evolution.records import read_checkpoint
+
+    if not checkpoint.is_file():
+        raise NeurohoverError(f"--resume: no checkpoint {str(checkpoint)!r} (it is written next to --out by an earlier run)")
+    if budget is not None:
+        return budget
+    state = read_checkpoint(checkpoint)
+    own = state.get("budget") if isinstance(state, dict) else None
+    return own if whole_number(own) and 1 <= own <= MAX_BUDGET else None

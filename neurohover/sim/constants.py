@@ -125,6 +125,9 @@ MDP_ROW_LEN = 36
 MAX_SENSOR_DELAY = 10  # control steps (1 s): the kernel's per-episode ring buffer holds MAX_SENSOR_DELAY + 1 readings
 SENSOR_SCRATCH = 12 * (MAX_SENSOR_DELAY + 3)  # floats a sensing episode keeps: the noise, the reading held, the ring buffer
 SENSOR_GROUPS: tuple[str, ...] = ("velocity", "position", "rates", "attitude")  # 3 observation entries each
+#: The smallest noise but 0 (none), float64's epsilon 2**-52: a drift walk's step of one std, exp(walk), is 1.0 below it,
+#: and a sensor std below it changes no reading of a size the state has (1e-320 flew exact sensors recorded as noisy; T40-B08, T44-A04).
+MIN_NOISE = float(np.finfo(np.float64).eps)
 
 OBS_NAMES: tuple[str, ...] = ("u", "v", "w", "x", "y", "z", "p", "q", "r", "qx", "qy", "qz")
 ACTION_NAMES: tuple[str, ...] = ("aileron", "elevator", "rudder", "collective")

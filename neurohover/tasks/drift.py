@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import FloatRangeError, NeurohoverError, as_floats, brief, finite_real, float_of, real_number, refuse_reloaded, whole_number
-from ..sim.constants import MDP_ROW_LEN, PARAM_NAMES, ROW_PARAMS
+from ..sim.constants import MDP_ROW_LEN, MIN_NOISE, PARAM_NAMES, ROW_PARAMS
 from ..sim.rng import MAX_SEED
 
 _DRIFT_TAG = 0xD81F7  # separates a run's drift stream from its agent's and its gusts'
@@ -47,9 +47,9 @@ MAX_CHANGE_AT = 10**12
 #: The most episodes whose rows one call makes (36 floats each: 29 GB at this bound, compete's bound on a call's episodes);
 #: past NumPy's int64 (10**20) the count was an OverflowError (fourteenth trial, T14-21).
 MAX_RUN_EPISODES = 10**8
-#: The smallest walk but 0 (none), float64's epsilon 2**-52: a parameter's step of one std, exp(walk), is 1.0 below it,
-#: and a drifted row was the fixed one (walk=1e-300 was taken, while walk=0 is refused for drifting nothing; T40-B08).
-MIN_WALK = float(np.finfo(np.float64).eps)
+#: The smallest walk but 0 (none), float64's epsilon 2**-52 (sim.constants.MIN_NOISE): a parameter's step of one std,
+#: exp(walk), is 1.0 below it, and a drifted row was the fixed one (walk=1e-300 was taken, while walk=0 is refused for drifting nothing; T40-B08).
+MIN_WALK = MIN_NOISE
 _WALK_RANGE = f"allowed 0 (none) or a number in {MIN_WALK:.3g}..1 (a per-episode log std; below 2**-52 a step of one std, exp(walk), is 1.0 in float64)"
 _PARSE_FORM = "give walk=STD or PARAM=FACTOR[@LO-HI], e.g. walk=0.01,D_w=0.8@200-800"
 _NOTHING = "give walk > 0 (up to 1) or a change of a factor other than 1, or leave it out (fixed dynamics)"

@@ -28,7 +28,9 @@ dropout        1        probability that a reading is lost (the last one held), 
 =============  =======  ==========================================================
 
 A noise *level* L is the profile ``L * (0.1 m/s, 0.1 m, 0.1 rad/s, 0.01)``: at level 1 each
-entry's noise is about the size of the baseline policy's typical hovering error on it.
+entry's noise is about the size of the baseline policy's typical hovering error on it. A std above 0 but
+below 2**-52 (``MIN_STD``, drift's smallest walk) changes no reading and is refused, as is a level whose
+attitude std falls below it (``MIN_LEVEL``).
 """
 
 from __future__ import annotations
@@ -38,7 +40,7 @@ import re
 from dataclasses import asdict, dataclass, fields, replace
 
 from ..errors import FloatRangeError, NeurohoverError, brief, finite_real, float_of, real_number, whole_in, whole_number
-from ..sim.constants import MAX_SENSOR_DELAY, SENSOR_GROUPS
+from ..sim.constants import MAX_SENSOR_DELAY, MIN_NOISE, SENSOR_GROUPS
 
 #: The std of each group at noise level 1 (velocity m/s, position m, rates rad/s, attitude).
 LEVEL_PROFILE = (0.1, 0.1, 0.1, 0.01)
@@ -47,6 +49,11 @@ LEVEL_PROFILE = (0.1, 0.1, 0.1, 0.01)
 MAX_STD = 100.0
 #: The largest noise level: the one whose profile reaches MAX_STD.
 MAX_LEVEL = MAX_STD / max(LEVEL_PROFILE)
+#: The smallest std of a group but 0 (exact), float64's epsilon 2**-52 as drift's smallest walk: below it a reading
+#: is the true value (1e-320 flew exact sensors, recorded as noisy; T44-A04). The smallest level is the one whose profile reaches it.
+MIN_STD = MIN_NOISE
+MIN_LEVEL = MIN_STD / min(LEVEL_PROFILE)
+_TOO_SMALL = "too small to change a reading (below 2**-52)"
 
 
 def _is_number(text: str) -> bool:
@@ -80,6 +87,8 @@ class Sensor:
             number = float(value)
             if name != "correlation" and number > MAX_STD:
                 raise NeurohoverError(f"sensor {name}={value!r} is out of range: allowed a std in 0..{MAX_STD:g}")
+            if name != "correlation" and 0 < number < MIN_STD:
+                raise NeurohoverError(f"sensor {name}={brief(value)} is out of range, {_TOO_SMALL}: allowed 0 (exact) or a std in {MIN_STD:.3g}..{MAX_STD:g}")
             object.__setattr__(self, name, number)
         if self.correlation >= 1.0:
             raise NeurohoverError(f"sensor correlation={self.correlation!r} is out of range: allowed 0 <= correlation < 1")
@@ -134,6 +143,9 @@ class Sensor:
             raise NeurohoverError(f"sensor noise level={brief(level)} is not allowed: give a number in 0..{MAX_LEVEL:g}")
         if not finite_real(level) or not 0 <= level <= MAX_LEVEL:  # np.float32(0.5), Fraction(1, 2) in range too (thirteenth trial, F8)
             raise NeurohoverError(f"sensor noise level={brief(level)} is out of range: allowed a number in 0..{MAX_LEVEL:g}")
+        if 0 < level < MIN_LEVEL:
+            allowed = f"allowed 0 (exact) or a number in {MIN_LEVEL:.3g}..{MAX_LEVEL:g}"
+            raise NeurohoverError(f"sensor noise level={brief(level)} is out of range, too small to change a reading (an attitude std below 2**-52): {allowed}")
         v, p, r, a = (float(level) * s for s in LEVEL_PROFILE)
         return cls(v, p, r, a, correlation=correlation, delay=delay)
 
