@@ -256,6 +256,28 @@ def check_arity(name: str, fn: Any, n: int, called: str, give: str) -> None:
         raise NeurohoverError(f"{name} of signature {brief(refused)} is not allowed: {called}; give {give}")
 
 
+def registry_entry_problem(registry: str, name: object, value: object, kind: type, shipped: Any, what: str, noun: str) -> str:
+    """What is wrong with the entry ``registry[name] = value`` of an extension point's registry ('' when nothing), the
+    checks the agents', optimisers' and task families' registries share (T41-B02..B04, T43-B10, T44-B14/B15): ``value``
+    is no ``kind`` (a subclass of it where ``kind``'s instances are classes, as task families are), a shipped name
+    holds another value, or a key other than the value's own name. ``shipped``: the shipped entries by name; ``what``:
+    the kind of entry in words ("agent"); ``noun``: what the value is called ("spec", "class")."""
+    var = "cls" if noun == "class" else noun
+    entry = f"{registry}[{brief(name)}] = {brief(value)} is not allowed"
+    is_kind = isinstance(value, type) and issubclass(value, kind) if noun == "class" else isinstance(value, kind)
+    if not is_kind:
+        article = "an" if kind.__name__[:1] in "AEIOU" else "a"
+        return f"{entry}: register {article} {kind.__name__}{' subclass' if noun == 'class' else ''} under its name ({registry}[{var}.name] = {var})"
+    if isinstance(name, str) and name in shipped:
+        if value == shipped[name]:
+            return ""
+        return f"{entry}: {name!r} is a shipped {what}'s name and holds its shipped {noun}; register yours under a name of its own"
+    own = getattr(value, "name", None)
+    if own != name:
+        return f"{entry}: its {noun}'s name {brief(own)} is not its key; register a {noun} under its own name ({registry}[{var}.name] = {var})"
+    return ""
+
+
 def reloaded_text(cls: type) -> str:
     """Why a ``cls`` of another import of its module is refused, as a message's reason: after ``importlib.reload`` of a
     neurohover module its classes are new class objects, while neurohover's other modules hold the first ones, so an

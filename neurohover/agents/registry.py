@@ -14,7 +14,7 @@ from collections.abc import Mapping, Sequence
 from types import MappingProxyType
 from typing import cast
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, registry_entry_problem
 from ..integrations.flying import generic_sigma_problem
 from ..policysets import PolicySet, load_policy_set
 from ..tasks import TaskFamily, get_task_family
@@ -80,16 +80,7 @@ def entry_problem(name: object, spec: object) -> str:
     """What is wrong with the registry entry ``AGENTS[name] = spec`` ('' when nothing): no :class:`AgentSpec` (a text was
     an AttributeError 'applies_to' in make_agent and compete, T44-B14), a shipped name holding another spec, or a key
     other than its spec's name (``AGENTS["alias"]`` made the best-of-two agent without a word, T44-B15)."""
-    entry = f"AGENTS[{brief(name)}] = {brief(spec)} is not allowed"
-    if not isinstance(spec, AgentSpec):
-        return f"{entry}: register an AgentSpec under its name (AGENTS[spec.name] = spec)"
-    if isinstance(name, str) and name in SHIPPED_SPECS:
-        if spec == SHIPPED_SPECS[name]:
-            return ""
-        return f"{entry}: {name!r} is a shipped agent's name and holds its shipped spec; register yours under a name of its own"
-    if spec.name != name:
-        return f"{entry}: its spec's name {brief(spec.name)} is not its key; register a spec under its own name (AGENTS[spec.name] = spec)"
-    return ""
+    return registry_entry_problem("AGENTS", name, spec, AgentSpec, SHIPPED_SPECS, "agent", "spec")
 
 
 def usable_agents() -> dict[str, AgentSpec]:

@@ -26,7 +26,7 @@ import importlib
 import pkgutil
 from types import MappingProxyType
 
-from ..errors import NeurohoverError, brief, finite_real, refuse_reloaded
+from ..errors import NeurohoverError, brief, finite_real, refuse_reloaded, registry_entry_problem
 from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, competition_rows, finite_vector
 from .drift import NO_DRIFT, Drift, refuse_drift
 from .fghh import COMPETITION_FGHH_SIGMA, FGHH
@@ -64,16 +64,7 @@ def entry_problem(name: object, cls: object) -> str:
     """What is wrong with the registry entry ``TASK_FAMILIES[name] = cls`` ('' when nothing): no TaskFamily subclass (5
     was an AttributeError 'has_sigma'), a shipped name holding another class (``TASK_FAMILIES["ghh08"] = GHH09`` gave
     GHH-09 for ghh08), or a class whose name is not its key (an alias 'zz' gave a family named ghh08; T43-B10)."""
-    entry = f"TASK_FAMILIES[{brief(name)}] = {brief(cls)} is not allowed"
-    if not (isinstance(cls, type) and issubclass(cls, TaskFamily)):
-        return f"{entry}: register a TaskFamily subclass under its name (TASK_FAMILIES[cls.name] = cls)"
-    if isinstance(name, str) and name in _SHIPPED:
-        if cls is _SHIPPED[name]:
-            return ""
-        return f"{entry}: {name!r} is a shipped task family's name and holds its shipped class; register yours under a name of its own"
-    if cls.name != name:
-        return f"{entry}: its class's name {brief(cls.name)} is not its key; register a class under its own name (TASK_FAMILIES[cls.name] = cls)"
-    return ""
+    return registry_entry_problem("TASK_FAMILIES", name, cls, TaskFamily, _SHIPPED, "task family", "class")
 
 
 def family_class(name: str) -> type[TaskFamily]:

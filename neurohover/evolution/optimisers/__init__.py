@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import NeurohoverError, brief, settings_from_dict
+from ...errors import NeurohoverError, brief, registry_entry_problem, settings_from_dict
 
 __all__ = [
     "NE",
@@ -125,15 +125,11 @@ def entry_problem(name: object, spec: object) -> str:
     spec (``OPTIMISERS["cma"] = OPTIMISERS["openai-es"]`` ran OpenAI-ES as cma, T41-B03), or a run-time entry under a key
     other than its spec's name, a key :data:`USER_NAME` does not read back, or a label other than its name (they recorded
     ``user:openai-es`` beside ``user:other-name``, T41-B04)."""
+    shared = registry_entry_problem("OPTIMISERS", name, spec, OptimiserSpec, SHIPPED_SPECS, "optimiser", "spec")
+    if shared or (isinstance(name, str) and name in SHIPPED):
+        return shared
+    assert isinstance(spec, OptimiserSpec)  # the shared checks refused anything else
     entry = f"OPTIMISERS[{brief(name)}] = {brief(spec)} is not allowed"
-    if not isinstance(spec, OptimiserSpec):
-        return f"{entry}: register an OptimiserSpec under its name (OPTIMISERS[spec.name] = spec)"
-    if isinstance(name, str) and name in SHIPPED:
-        if spec == SHIPPED_SPECS[name]:
-            return ""
-        return f"{entry}: {name!r} is a shipped optimiser's name and holds its shipped spec; register yours under a name of its own"
-    if spec.name != name:
-        return f"{entry}: its spec's name {brief(spec.name)} is not its key; register a spec under its own name (OPTIMISERS[spec.name] = spec)"
     if not isinstance(name, str) or name == NE or not USER_NAME.fullmatch(f"user:{name}"):
         return f"{entry}: a run-time optimiser's name is one line of at most 64 letters, digits and ._+- (not {NE!r}), which its records name as user:NAME"
     if spec.label != name:
