@@ -69,7 +69,7 @@ def test_a_bool_is_not_a_number_of_model_substeps() -> None:
 
 
 def _settings(name: str) -> type:
-    from neurohover.cli.learning import settings_classes
+    from neurohover.cli.settings import settings_classes
 
     return settings_classes()[name]
 

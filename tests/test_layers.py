@@ -75,7 +75,7 @@ def test_the_command_line_package_has_no_import_cycle() -> None:
         within[path.stem] = names
     assert within["options"] == set()  # the shared options import no command
     commands = set(within) - {"__init__", "app", "options"}
-    assert commands == {"flying", "learning", "agents", "evaluate", "reproduce", "plots"}
+    assert commands == {"flying", "settings", "learning", "agents", "evaluate", "reproduce", "plots"}
     for name in commands:
         assert within[name] <= {"options"}, f"cli/{name}.py imports {within[name] - {'options'}}"
     assert within["app"] == commands

@@ -10,7 +10,7 @@ import dataclasses
 
 import pytest
 
-from neurohover.cli.learning import settings_classes
+from neurohover.cli.settings import settings_classes
 from neurohover.settingsdoc import documented, format_settings, plain, settings_rows
 
 

@@ -22,7 +22,7 @@ from typing import NoReturn
 from .. import __version__
 from ..command import running_as_command
 from ..errors import NeurohoverError
-from . import agents, evaluate, flying, learning, plots, reproduce
+from . import agents, evaluate, flying, learning, plots, reproduce, settings
 
 #: Commands that fly the CPU kernel at once; on a fresh install they say so before it compiles.
 COMPILING = ("fly", "demo", "bench", "evolve", "build-policies", "compete", "evaluate-agent", "reproduce")
@@ -90,7 +90,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    for module in (flying, learning, agents, evaluate, reproduce, plots):
+    for module in (flying, settings, learning, agents, evaluate, reproduce, plots):
         module.register(sub)
     return parser
 
