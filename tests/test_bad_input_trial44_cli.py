@@ -137,3 +137,29 @@ def test_fly_and_compete_refuse_a_negligible_obs_noise(cli, tmp_path, noise: str
     )
     assert rc == 2 and "too small to change a reading" in err, err
     assert not out.exists()
+
+
+def test_a_stop_during_the_final_validation_names_the_checkpoint_and_resume(tmp_path, monkeypatch, capsys) -> None:
+    """A Ctrl-C (or SIGTERM) while evolve validated its champion said only "interrupted"; the run is over and its
+    checkpoint kept, and --resume validates the champion without evolving again."""
+    import importlib
+
+    from neurohover.cli import main
+
+    evolve_module = importlib.import_module("neurohover.evolution.evolve")  # the package's `evolve` is the function
+
+    out = tmp_path / "v.json"
+    argv = ["evolve", "--task", "ghh08", "--mdp", "train:0", "--budget", "20", "--episode-steps", "20", "--validation-episodes", "1", "--out", str(out)]
+    real = evolve_module.validation_return
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(evolve_module, "validation_return", interrupted)
+    assert main(argv) == 130
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "interrupted during the champion's validation" in err and "v.json.checkpoint.json" in err and "--resume" in err, err
+    assert not out.exists()
+    monkeypatch.setattr(evolve_module, "validation_return", real)
+    assert main([*argv, "--resume"]) == 0
+    assert out.exists()

@@ -250,10 +250,21 @@ def _evolve_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int
     bar.close()
     # The champion's estimate is on the run's fitness scale (1/ln(error) over a family by default).
     scale = result.settings["settings"].get("fitness", "return") if result.settings.get("method") == "generational" else "return"
-    validation = validation_return(
-        result.champion, target, episodes=args.validation_episodes, seed=args.seed, n_steps=args.episode_steps, threads=args.threads, device=args.device
-    )
-    save_policy(result.champion, out, **_evolve_meta(args, family, target, mdp_desc, resampling, result, scale, validation, history_path.name))
+    try:
+        validation = validation_return(
+            result.champion, target, episodes=args.validation_episodes, seed=args.seed, n_steps=args.episode_steps, threads=args.threads, device=args.device
+        )
+        save_policy(result.champion, out, **_evolve_meta(args, family, target, mdp_desc, resampling, result, scale, validation, history_path.name))
+    except KeyboardInterrupt as err:  # the run is over and checkpointed: a stop here said only "interrupted" (trial 44)
+        from ..procs import stop_words
+
+        how, status = stop_words(err)
+        print(
+            f"neurohover evolve: {how} during the champion's validation; the evolution is finished and kept in {printable(checkpoint)} "
+            "(run the same command with --resume to validate its champion without evolving again)",
+            file=sys.stderr,
+        )
+        return status
     try:
         write_history_csv(result.history, history_path)  # atomically, as writing() writes
     except NeurohoverError as err:  # said what was written and what was not (fourth trial: "no partial file" beside two files)
