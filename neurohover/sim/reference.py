@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import NeurohoverError, as_floats, brief, finite_real, real_number, whole_number
+from ..errors import NeurohoverError, as_floats, brief, finite_real, whole_number
 from .constants import (
     CRASH_STEP_PENALTY,
     EPISODE_STEPS,
@@ -186,7 +186,7 @@ class ReferenceHelicopter:
             raise NeurohoverError(
                 f"step {self.steps + 1} is not allowed: the episode of episode_steps={self.episode_steps} is flown (make a new ReferenceHelicopter)"
             )
-        if not _is_action(action):
+        if not _n_reals(action, 4):
             raise NeurohoverError(f"action={brief(action)} is not allowed: give 4 real numbers (a sequence or an array)")
         if isinstance(normals, (str, bytes)) or not isinstance(normals, (Sequence, np.ndarray)):
             raise NeurohoverError(f"normals={brief(normals)} is not allowed: give 6 real numbers, all finite (a sequence or an array)")
@@ -257,11 +257,7 @@ class ReferenceSensors:
         k = len(self.readings)
         if k >= len(self.normals):
             raise NeurohoverError(f"reading {k} is not allowed: normals has {len(self.normals)} rows, one per reading (give more rows)")
-        try:
-            ok = len(observation) == 12 and all(real_number(o) for o in observation)
-        except TypeError:
-            ok = False
-        if not ok or isinstance(observation, (str, bytes)):
+        if not _n_reals(observation, 12):
             raise NeurohoverError(f"observation={brief(observation)} is not allowed: give 12 real numbers (ReferenceHelicopter.observation())")
         return self._read(observation)
 
@@ -400,13 +396,14 @@ def _normal_rows(name: str, given: object, rows: int, widths: tuple[int, ...], e
     return arr[:rows].tolist()
 
 
-def _is_action(action: object) -> bool:
-    """Whether ``action`` is 4 real numbers (NaN and inf too: they crash) in a sequence or an array: a dict {0: .., 3: ..}
-    flew its keys 0, 1, 2, 3 (T43-B14); np.timedelta64, a numbers.Real, was float()'s TypeError (T17-1)."""
-    if isinstance(action, (str, bytes)) or not isinstance(action, (Sequence, np.ndarray)):
+def _n_reals(values: object, n: int) -> bool:
+    """Whether ``values`` are ``n`` real numbers (NaN and inf floats too: an action of them crashes) in a sequence or an
+    array, the one test of an action (n=4) and of an observation read (n=12): a dict {0: .., 3: ..} flew its keys 0, 1,
+    2, 3 (T43-B14); np.timedelta64, a numbers.Real, was float()'s TypeError (T17-1); an int past a float's range is none."""
+    if isinstance(values, (str, bytes)) or not isinstance(values, (Sequence, np.ndarray)):
         return False
     try:
-        return len(action) == 4 and all(finite_real(a) or isinstance(a, (float, np.floating)) for a in action)
+        return len(values) == n and all(finite_real(v) or isinstance(v, (float, np.floating)) for v in values)
     except TypeError:
         return False
 
@@ -414,6 +411,6 @@ def _is_action(action: object) -> bool:
 def _action(policy: Callable[[list[float]], Sequence[float]], observation: list[float], k: int) -> Sequence[float]:
     """The policy's action, refused unless it is 4 numbers (3 were an unpack ValueError; thirteenth trial, F6)."""
     action = policy(observation)
-    if not _is_action(action):
+    if not _n_reals(action, 4):
         raise NeurohoverError(f"the policy's action at step {k} is {brief(action)}, not allowed: a policy gives 4 numbers (a sequence or an array)")
     return action
