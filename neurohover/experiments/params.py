@@ -174,25 +174,17 @@ def unit_params(kind: str, params: dict) -> Any:
         raise NeurohoverError(f"a {kind!r} unit's params {' and '.join(wrong)}")
     for f in declared:  # a number's type, before a runner uses it (np.timedelta64 passed as an int into NumPy's TypeError; T17-1)
         value = params.get(f.name)  # None: left to the runner, as before (a structure-only check passes None everywhere)
-        number = _NUMBERS.get(str(f.type))
-        if value is not None and number is not None and not number[0](value):
-            raise NeurohoverError(f"a {kind!r} unit's params: {f.name} = {brief(value)} is not allowed: give {number[1]}")
+        names = str(f.type).split(" | ")
+        if value is not None and {"int", "float"} & set(names) and not _of_types(value, names):
+            raise NeurohoverError(f"a {kind!r} unit's params: {f.name} = {brief(value)} is not allowed: give {_types_text(names)}")
     return cls(**params)
 
 
-# A number field's annotation -> its test and what it allows.
-_NUMBERS: dict[str, tuple[Callable[[object], bool], str]] = {
-    "int": (whole_number, "a whole number"),
-    "int | None": (whole_number, "a whole number or None"),
-    "float": (finite_real, "a finite real number"),
-    "float | None": (finite_real, "a finite real number or None"),
-}
-
-
-#: An annotation's type name -> its test (a params field's value is one of the types its annotation names).
+#: An annotation's type name -> its test and what it allows (a params field's value is one of the types its annotation
+#: names): read by :func:`unit_params` for the number fields and by :func:`checked_unit_params` for every field.
 _TYPES: dict[str, tuple[Callable[[object], bool], str]] = {
-    "int": (whole_number, "an integer"),
-    "float": (finite_real, "a finite number"),
+    "int": (whole_number, "a whole number"),
+    "float": (finite_real, "a finite real number"),
     "str": (lambda v: isinstance(v, str), "text"),
     "dict": (lambda v: isinstance(v, dict), "a table (dict)"),
     "list": (lambda v: isinstance(v, list), "a list"),
@@ -214,7 +206,17 @@ def checked_unit_params(kind: str, params: dict, key: str) -> Any:
         value = getattr(typed, f.name)
         names = str(f.type).split(" | ")
         ok, allowed = f.metadata["check"](value) if "check" in f.metadata else (True, "")
-        if not any(_TYPES[n][0](value) for n in names) or not ok:
-            allowed = allowed or " or ".join(_TYPES[n][1] for n in names)
+        if not _of_types(value, names) or not ok:
+            allowed = allowed or _types_text(names)
             raise NeurohoverError(f"unit {brief(key)}: its param {f.name} = {brief(value)} is not allowed: give {allowed}")
     return typed
+
+
+def _of_types(value: object, names: list[str]) -> bool:
+    """Whether ``value`` is of one of the types an annotation ``names`` (:data:`_TYPES`)."""
+    return any(_TYPES[n][0](value) for n in names)
+
+
+def _types_text(names: list[str]) -> str:
+    """What an annotation of the types ``names`` allows, in words ("a whole number or None")."""
+    return " or ".join(_TYPES[n][1] for n in names)
