@@ -40,7 +40,7 @@ from ..evaluate import PolicyTable, evaluate_jobs
 from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, refuse_drift
-from .common import MAX_SPREAD, require_prob, require_spread, set_field
+from .common import MAX_SPREAD, require_spread, set_field
 from .fitness import episode_fitness
 from .operators import crossover, mutate
 from .seeding import check_seed
@@ -105,7 +105,7 @@ class EonnSettings:
             v = getattr(self, name)
             if not finite_real(v) or not 0.0 <= float(v) <= 1.0:
                 raise NeurohoverError(f"{name}={brief(v)} is out of range: allowed a probability in [0, 1]")
-            set_field(self, name, require_prob(name, v))  # a Python float, as GenerationalSettings stores (np.float32 was kept; T44-B22)
+            set_field(self, name, float(v))  # a Python float, as GenerationalSettings stores (np.float32 was kept; T44-B22)
         for name in ("mutate_std", "spawn_std"):  # 10**400 was NumPy's TypeError, 1e308 overflowed the genes (eleventh trial)
             v = getattr(self, name)
             # float(v) compared: np.float32's comparison with MAX_SPREAD cast 1e100 to float32 and warned (T44-B23)
