@@ -187,10 +187,9 @@ def task_name(text: str) -> str:
     """--task as its family's name where it spells one as the task lookup reads it ('GHH-08' is ghh08), else as given
     (each command's own check names it): compete built its experiment from 'GHH-08' and refused what every other
     command flew (T43-A01)."""
-    from ..tasks import TASK_FAMILIES
+    from ..tasks import task_key
 
-    key = text.lower().replace("-", "")
-    return key if key in TASK_FAMILIES else text
+    return str(task_key(text))
 
 
 def real(text: str) -> float:

@@ -41,7 +41,7 @@ from ..filekinds import refuse_suffix
 from ..flightdata import plain_json, unwritable_key
 from ..paths import json_text
 from ..sim.constants import CONTROL_DT, DEFAULT_NOISE_STD, DEFAULT_PARAMS, MAX_SECONDS, NOISE_NAMES, PARAM_NAMES, SUBSTEP_DT, SUBSTEPS, seconds_allowed
-from ..tasks import MDP, TASK_FAMILIES, TaskFamily, family_class, finite_vector
+from ..tasks import MDP, TASK_FAMILIES, TaskFamily, family_class, finite_vector, task_key
 from ..tasks.base import MAX_MAGNITUDE
 from .wind import NO_WIND, WindModel
 
@@ -104,8 +104,7 @@ def default_model_substeps(task: str | TaskFamily) -> int:
     if isinstance(task, TaskFamily):
         name = task.name
     elif isinstance(task, str):
-        name = task.lower().replace("-", "")
-        family_class(name if name in TASK_FAMILIES else task)  # an unknown name refused, naming the registry's names
+        name = family_class(task_key(task)).name  # an unknown name refused, naming the registry's names
     else:
         raise NeurohoverError(f"task={brief(task)} is not allowed: give a task family's name ({', '.join(map(str, TASK_FAMILIES))}) or a TaskFamily")
     return 1 if name == "fghh" else DEFAULT_MODEL_SUBSTEPS

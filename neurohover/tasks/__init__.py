@@ -67,7 +67,7 @@ def entry_problem(name: object, cls: object) -> str:
     return registry_entry_problem("TASK_FAMILIES", name, cls, TaskFamily, _SHIPPED, "task family", "class")
 
 
-def family_class(name: str) -> type[TaskFamily]:
+def family_class(name: object) -> type[TaskFamily]:
     """The registry's class of task family ``name`` (a key of :data:`TASK_FAMILIES`), its entry checked
     (:func:`entry_problem`; NeurohoverError naming a bad one, or an unknown name with the registry's names as it is)."""
     if not isinstance(name, str) or name not in TASK_FAMILIES:
@@ -98,11 +98,16 @@ def get_task_family(name: str, sigma: float | None = None, sensor: Sensor | None
     return family if drift is None or drift.none else family.with_drift(drift)
 
 
-def _family(name: str, sigma: float | None) -> TaskFamily:
+def task_key(name: object) -> object:
+    """The registry's key that ``name`` spells as the task lookup reads it (any case, hyphens dropped: 'GHH-08' is
+    ghh08), else ``name`` as given, for :func:`family_class` to refuse by what was written. The one spelling rule of a
+    task's name: the command line's --task, the families' lookups and the models' default substeps read it."""
     key = str(name).lower().replace("-", "")
-    if key not in TASK_FAMILIES:
-        family_class(name)  # refused, naming the registry's names
-    cls = family_class(key)
+    return key if key in TASK_FAMILIES else name
+
+
+def _family(name: str, sigma: float | None) -> TaskFamily:
+    cls = family_class(task_key(name))  # an unknown name refused as written, naming the registry's names
     if sigma is not None and not cls.has_sigma:
         with_sigma = [n for n, c in list(TASK_FAMILIES.items()) if not entry_problem(n, c) and c.has_sigma]
         raise NeurohoverError(f"sigma applies to the {', '.join(with_sigma)} task only, not to {brief(name)}")
@@ -133,7 +138,7 @@ def family_from_dict(d: dict) -> TaskFamily:
 
 def family_for(name: str, sigma: float | None, sensor: Sensor | None = None, drift: Drift | None = None) -> TaskFamily:
     """Like :func:`get_task_family`, but a ``sigma`` is ignored for families without one (configs carry one for all)."""
-    key = str(name).lower().replace("-", "")
+    key = task_key(name)
     has = key in TASK_FAMILIES and family_class(key).has_sigma
     return get_task_family(name, sigma if has else None, sensor, drift)
 
@@ -178,4 +183,5 @@ __all__ = [
     "refuse_drift",
     "refuse_unordered_mdps",
     "set_name",
+    "task_key",
 ]
