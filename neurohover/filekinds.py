@@ -318,8 +318,11 @@ def refuse_suffix(path: str, option: str, suffixes: tuple[str, ...], what: str, 
     writes beside it: evolve's :data:`RUN_FILE_ENDS`), would be too long (:func:`fitting_name`): the one message of
     output names (:func:`output_name`), flight data, model and policy files."""
     if Path(path).suffix.lower() not in suffixes:
-        like = str(Path(path).with_suffix(suffixes[0])) if Path(path).name else example
-        if Path(path).name:
+        name = Path(path).name
+        like = str(Path(path).with_suffix(suffixes[0])) if name else example
+        if name.lower() in suffixes:  # '.json' is a hidden file without a suffix: out.json, not '.json.csv', was meant
+            like = str(Path(path).with_name("out" + name))
+        if name:
             room = max((len(os.fsencode(end)) for end in ends), default=0)
             like = str(Path(like).with_name(fitting_name(Path(like).name, name_limit(Path(like).parent), room)))
         raise NeurohoverError(f"{option} {brief(path)} is not allowed: {what}; give a path ending {' or '.join(suffixes)} (e.g. {brief(like)})")

@@ -1,10 +1,10 @@
 """``neurohover plot``: PNG plots of recorded flights and of competition results.
 
 ``neurohover plot FLIGHT.npz [--out DIR]`` draws each episode of a flight-data file (written by
-``neurohover fly --record``) to ``DIR/<name>-episode<i>.png``: position error, velocity, attitude
-(roll, pitch, yaw), angular rates and actions over time, a crash (an episode shorter than 6000
-steps) marked in red. ``DIR`` defaults to the file's directory. Figures of another flight
-of the same name that ``DIR`` holds are left there and named on stderr.
+``neurohover fly --record``) to ``DIR/<name>-episode<i>.png`` (a name too long for that cut at its
+end): position error, velocity, attitude (roll, pitch, yaw), angular rates and actions over time, a
+crash (an episode shorter than 6000 steps) marked in red. ``DIR`` defaults to the file's directory.
+Figures of another flight of the same name that ``DIR`` holds are left there and named on stderr.
 
 ``neurohover plot --compete DIR [DIR ...] [--out OUTDIR]`` overlays the mean cumulative error of
 several ``neurohover compete --out DIR`` results (their ``episodes.csv``; agent and task from
@@ -22,11 +22,12 @@ The files written are printed, one per line.
 from __future__ import annotations
 
 import argparse
+import os
 import re
 import sys
 from pathlib import Path
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from .options import integer
 
 COMPETE_PNG = "compete.png"
@@ -59,6 +60,18 @@ def _episodes(text: str | None, n: int) -> list[int] | None:
             raise NeurohoverError(f"--episodes {text!r} names episode {twice[0]} more than once: give each episode once")
         out.extend(range(first, last + 1))
     return out
+
+
+def _fitting_stem(stem: str, out: Path, n: int) -> str:
+    """``stem`` cut at its end until ``<stem>-episode<i>.png`` fits a file name in ``out``, saying so on stderr: fly
+    --record takes a name up to the limit, and plot then refused the figures' longer names."""
+    from ..filekinds import fitting_name, name_limit
+
+    end = "-episode" + "0" * len(str(max(n - 1, 0))) + ".png"
+    fitted = fitting_name(stem, name_limit(out), room=len(os.fsencode(end)))
+    if fitted != stem:
+        print(f"neurohover plot: note: the figures are named {brief(fitted)}-episode<i>.png: the flight's whole name is too long for them", file=sys.stderr)
+    return fitted
 
 
 def _note_left(out: Path, stem: str, n: int) -> None:
@@ -102,8 +115,9 @@ def cmd_plot(args: argparse.Namespace) -> int:
         out = output_dir(args.out if args.out is not None else path.parent, "--out")
         from ..plots import plot_flight_data
 
-        written = plot_flight_data(data, out, stem=path.stem, episodes=_episodes(args.episodes, data.n_episodes))
-        _note_left(out, path.stem, data.n_episodes)
+        stem = _fitting_stem(path.stem, out, data.n_episodes)
+        written = plot_flight_data(data, out, stem=stem, episodes=_episodes(args.episodes, data.n_episodes))
+        _note_left(out, stem, data.n_episodes)
     else:
         from ..compete import check_against_store
         from ..compete_files import read_compete_dirs

@@ -29,7 +29,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     from ..experiments import Store, load_configs, make_executor, reproduce
     from ..experiments.config import check_own_name, experiment_names, parse_overrides
     from ..experiments.plans import source_experiments
-    from ..experiments.runner import check_restart
+    from ..experiments.runner import check_patterns_once, check_restart
     from ..filekinds import refuse_long_store_name
     from ..paths import output_file
     from ..procs import stop_words
@@ -48,6 +48,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     if args.store is None:
         raise NeurohoverError("give the results store file with --store FILE (it is created if missing)")
     check_restart(args.fresh, args.update, args.only or ())  # before the store file is made
+    check_patterns_once(args.only or (), "--only")
     if args.executor == "ray" and args.jobs != 1:
         raise NeurohoverError("--jobs applies to --executor local; Ray runs one unit per CPU of the cluster")
     if args.address is not None and args.executor != "ray":

@@ -63,6 +63,14 @@ def selected(key: str, only: Sequence[str]) -> bool:
     return not only or key.startswith("policy/") or any(key_matches(key, pat) for pat in only)
 
 
+def check_patterns_once(patterns: Sequence[str], option: str) -> None:
+    """Refuse a selection naming one pattern twice (``--only P --only P`` was taken without a word, where a repeated
+    --obs-noise key is refused)."""
+    twice = next((p for i, p in enumerate(patterns) if p in patterns[:i]), None)
+    if twice is not None:
+        raise NeurohoverError(f"{option} names the pattern {brief(twice)} twice: give each pattern once")
+
+
 def check_restart(fresh: bool, update: bool, only: Sequence[str] = ()) -> None:
     """Refuse ``fresh`` (discard every stored result) together with ``update`` (keep the unchanged ones) or ``only`` (run a
     selection: the stored units outside it were lost; sixth trial)."""
@@ -200,6 +208,7 @@ def _check_arguments(config, store, executor, progress, on_unit, only, fresh, up
     patterns = (only,) if isinstance(only, str) else only
     if not isinstance(patterns, Sequence) or not all(isinstance(p, str) for p in patterns):
         raise NeurohoverError(f"only={brief(only)} is not allowed: give a glob pattern of unit keys or a list of them, e.g. ['run/hybrid/*']")
+    check_patterns_once(patterns, "only")
     return tuple(patterns)
 
 
