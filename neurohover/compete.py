@@ -26,17 +26,14 @@ exactly as in the experiments.
 
 from __future__ import annotations
 
-import csv
-import json
 import sys
-from collections.abc import Callable, Iterator, Mapping, Sequence
-from contextlib import contextmanager
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 
 from .agents.hybrid import HybridSettings
-from .compete_files import CSV_COLUMNS  # the columns plot --compete reads, each checked (T23-07)
+from .compete_folder import note_replaced, refuse_other_files, sole_competition, write_episodes, write_partial, write_summary
 from .errors import NeurohoverError, brief, check_arity, first_difference
 from .evolution.seeding import check_seed
 from .plots import plot_cumulative
@@ -44,7 +41,7 @@ from .sim.constants import EPISODE_STEPS
 from .tasks import N_TEST, N_TRAINING, Drift, Sensor, get_task_family
 from .tasks.drift import MAX_RUN_EPISODES  # a run's episodes, the bound of a drifting MDP's episodes too
 
-#: The entry points, which check what they are given (summarise, episode_rows: compete's helpers over its own store's results, unchecked; T43-B15).
+#: The entry points, which check what they are given (summarise: compete's helper over its own store's results, unchecked; T43-B15).
 __all__ = [
     "FINISHED_RUNS", "LR_FIT_KEYS", "MAX_RUNS", "STORE_FILE", "agents_with_settings", "check_against_store", "check_agent_settings", "check_sizes",
     "compete", "competition_config",
@@ -78,18 +75,6 @@ def summarise(results: Sequence) -> dict:
         "mean_seconds_per_run": float(np.mean([r.timing.seconds for r in results])),
         "mean_offline_seconds_per_run": float(np.mean([r.timing.offline_seconds for r in results])),
     }
-
-
-def episode_rows(run: int, result, n_steps: int) -> list[list]:
-    """The ``episodes.csv`` rows of one test run (a ``TestRunResult``)."""
-    policy = [""] * len(result.returns)
-    for e, label in result.policy_changes:
-        policy[e:] = [label] * (len(policy) - e)
-    steps = [n_steps] * len(policy)
-    for e, s in zip(result.crash_episodes, result.crash_steps or (), strict=False):
-        steps[e] = s
-    crashed, fired = set(result.crash_episodes), set(result.safeguard_episodes)
-    return [[run, result.mdp, e, repr(float(ret)), int(e in crashed), steps[e], policy[e], int(e in fired)] for e, ret in enumerate(result.returns)]
 
 
 #: The largest competition (planned in memory, each episode's results stored): its runs (MAX_RUN_EPISODES: its episodes over all runs).
@@ -324,37 +309,20 @@ def compete(
     )  # fmt: skip
     store_path = _checked_store(store)
     out = output_dir(out, "out")  # made once every setting is checked (None was a TypeError, /dev/full a FileExistsError)
-    with _sole_competition(out):
+    with sole_competition(out):
         store_path = store_path or out / STORE_FILE
-        _refuse_other_files(out)
+        refuse_other_files(out)
         _refuse_other_settings(config, store_path)
-        _note_replaced(out / "summary.json", task, agent, config.scale)
+        note_replaced(out / "summary.json", task, agent, config.scale)
         ordered = _run_into_store(config, store_path, out / "episodes.csv", jobs=jobs, device=device, progress=progress, on_result=on_result)
         flown = get_task_family(task, sigma).set_name(mdps)  # the set its rows' MDPs name: seeded-test at FGHH sigma 0.2 (T37-A02)
         summary = {"task": task, "agent": agent, "mdps": flown, "seed": seed, "store": str(store_path.absolute()),  # where plot --compete checks it
                    **_flown_under(n_steps, sigma, sensor, drift)}  # fmt: skip
         summary |= {"experiment": config.name, "scale": config.scale, **summarise(ordered)}
-        _write_summary(out / "summary.json", summary)
+        write_summary(out / "summary.json", summary)
         curves = np.array([np.cumsum(np.array(r.returns, dtype=float)) for r in ordered])
         plot_cumulative({agent: curves}, out / "cumulative.png", f"{task}: {agent}, {len(ordered)} runs")
     return summary, ordered
-
-
-#: The lock file a running competition holds in its output directory (:func:`_sole_competition`).
-LOCK_FILE = ".compete.lock"
-
-
-@contextmanager
-def _sole_competition(out: Path) -> Iterator[None]:
-    """Be the only competition writing into ``out`` inside this block: a second run there is refused, naming the first's
-    pid. Two runs into one folder with other --store files both finished, each printing the folder's files as its own
-    results, which were the second's (trial 31, borderline). A lock on :data:`LOCK_FILE` in ``out``
-    (:func:`~neurohover.locks.holding`, beside the default store's own lock)."""
-    from .locks import holding
-
-    busy = "is in use: another compete run ({}) is writing its files; wait for it to end, or give another output directory"
-    with holding(out / LOCK_FILE, lambda who: f"out {brief(str(out))} {busy.format(who)}"):
-        yield
 
 
 def _flown_under(n_steps: int, sigma: float | None, sensor: Sensor | None, drift: Drift | None) -> dict:
@@ -425,7 +393,7 @@ def _run_into_store(config, store_path: Path, episodes_csv: Path, *, jobs: int, 
             executor.close()
             ordered = stored_runs(db)
             if ordered:  # none: the folder stays as it was (an earlier competition's rows were replaced by a header; tenth trial)
-                _write_partial(episodes_csv, ordered, config.typed.n_steps)
+                write_partial(episodes_csv, ordered, config.typed.n_steps)
             setattr(stop, FINISHED_RUNS, len(ordered))  # for the command's line: none finished is said so (T26-A08)
             raise
         finally:
@@ -433,22 +401,10 @@ def _run_into_store(config, store_path: Path, episodes_csv: Path, *, jobs: int, 
         ordered = stored_runs(db)  # a failure (a full disk) left above: the folder as it was
         if run.failed:  # said as reproduce says it, never summarised (all runs failed: "Mean of empty slice"; T30-A02)
             if ordered:
-                _write_partial(episodes_csv, ordered, config.typed.n_steps)
+                write_partial(episodes_csv, ordered, config.typed.n_steps)
             raise NeurohoverError(f"{run.line()}; the finished runs are kept in {str(store_path)!r}, and the same call resumes")
-        _write_episodes(episodes_csv, ordered, config.typed.n_steps)
+        write_episodes(episodes_csv, ordered, config.typed.n_steps)
     return ordered
-
-
-def _write_partial(episodes_csv: Path, ordered: list, n_steps: int) -> None:
-    """The finished runs of a competition that stopped before its end, as its ``episodes_csv`` alone: an earlier
-    competition's summary.json and cumulative.png in that folder are removed first, as :func:`_note_replaced` says. They
-    stayed beside the new rows, and plot --compete refused the folder, blaming the new rows (T34-A04); a folder without
-    a summary is what an interrupted competition leaves, and plot --compete labels it by its name."""
-    for name in ("summary.json", "cumulative.png"):
-        stale = episodes_csv.parent / name
-        if stale.is_file() or stale.is_symlink():  # _refuse_other_files let only a competition's summary (or an empty file) stay
-            stale.unlink()
-    _write_episodes(episodes_csv, ordered, n_steps)
 
 
 def _refuse_other_settings(config, store_path: Path) -> None:
@@ -476,68 +432,6 @@ def _refuse_other_settings(config, store_path: Path) -> None:
     )
 
 
-def _write_summary(path: Path, summary: dict) -> None:
-    from .paths import writing
-
-    with writing(path, "summary file") as partial:  # whole or not at all
-        partial.write_text(json.dumps(summary, indent=1) + "\n", encoding="utf-8")
-
-
-#: The files compete writes in its output directory that another neurohover file may sit at, and what
-#: :func:`~neurohover.filekinds.held_kind` calls each when compete wrote it.
-_OWN_FILES = {"summary.json": "a competition summary (summary.json)", "episodes.csv": "a competition's episodes (episodes.csv)"}
-
-
-def _refuse_other_files(out: Path) -> None:
-    """Refuse an output directory whose summary.json or episodes.csv is not a competition's, naming what it is, before
-    any run: flight data, a model or a policy file there was replaced without a word (T26-A06). An empty file is
-    replaced (nothing is lost), and so is an older competition's summary (its task and agent, which
-    :func:`_note_replaced` names); a file no neurohover command wrote is refused too (it may be anyone's)."""
-    from .filekinds import held_kind
-    from .paths import refuse_special_file
-
-    for name, own in _OWN_FILES.items():
-        path = out / name
-        refuse_special_file(path, "--out", instead="move it away or give another output directory")  # a FIFO hung it (T28-A08)
-        if not (path.is_dir() or path.is_file()) or (path.is_file() and path.stat().st_size == 0):
-            continue
-        held = "a directory" if path.is_dir() else held_kind(path)
-        if held == own or (held is None and name == "summary.json" and _held_competition(path) is not None):
-            continue
-        what, written = held or "no file compete wrote", own.replace(f" ({name})", "")
-        raise NeurohoverError(f"{name} in {brief(str(out))} is {what}: compete would replace it with {written}; move it away or give another output directory")
-
-
-def _held_competition(summary_path: Path) -> tuple[str, str, object] | None:
-    """The (task, agent, scale) of the competition summary at ``summary_path``, None for anything else (no file, not one)."""
-    try:
-        before = json.loads(summary_path.read_text(encoding="utf-8"))
-        return (before["task"], before["agent"], before.get("scale"))
-    except (OSError, ValueError, RecursionError, KeyError, TypeError, AttributeError):
-        return None
-
-
-def _note_replaced(summary_path: Path, task: str, agent: str, scale: str) -> None:
-    """Say when ``out`` holds another competition, whose files this one replaces (without a word before; eighth trial):
-    of another agent or task, or of the same with other settings (its ``scale``, settings-HASH: a re-run with only --seed
-    changed replaced them without a word, trial 27); its runs stay in the store."""
-    held = _held_competition(summary_path)
-    if held is None:  # no summary, nothing to name
-        return
-    if held[:2] != (task, agent):
-        what = f"the competition of {held[1]} on {held[0]}"
-    elif held[2] != scale:
-        what = f"a competition of {agent} on {task} with other settings ({brief(held[2])}; these are {scale})"
-    else:
-        return
-    print(
-        f"neurohover compete: note: {str(summary_path.parent)!r} held {what}; its episodes.csv, summary.json and plot are replaced "
-        "(its runs stay in the store; stopped before its end, this one leaves only the episodes.csv of its finished runs, and the "
-        "folder as it was if none had finished)",
-        file=sys.stderr,
-    )
-
-
 def _run_order(key: str) -> tuple[int, int]:
     """Runs in the order of their MDP, then repetition (keys ``run/<agent>/<set><i>/rep<r>``)."""
     from .experiments.keys import UnitKey
@@ -545,16 +439,6 @@ def _run_order(key: str) -> tuple[int, int]:
     parsed = UnitKey.parse(key)
     index = parsed.mdp_index
     return (index if index is not None else -1, parsed.rep if parsed.rep is not None else 0)
-
-
-def _write_episodes(path: Path, results: Sequence, n_steps: int) -> None:
-    from .paths import writing
-
-    with writing(path, "episodes file") as partial, open(partial, "w", newline="", encoding="utf-8") as f:  # whole or not at all (a full disk: eighth trial)
-        writer = csv.writer(f)
-        writer.writerow(CSV_COLUMNS)
-        for run, result in enumerate(results):
-            writer.writerows(episode_rows(run, result, n_steps))
 
 
 def check_against_store(folder: str | Path) -> None:

@@ -67,9 +67,9 @@ def test_what_compete_writes_is_read(real: dict[str, Path], cli, tmp_path: Path)
     """T23-06/T23-07: every check takes what compete writes: baseline, a learning agent (its policy changes, the mean
     after learning from its last policy), an agent under a safeguard and fghh's sigma on sampled MDPs; its summary's keys
     are those checked, and compete writes the columns checked."""
-    from neurohover import compete
+    from neurohover import compete_folder  # the writer of compete's episodes.csv
 
-    assert compete.CSV_COLUMNS == CSV_COLUMNS
+    assert compete_folder.CSV_COLUMNS == CSV_COLUMNS
     for name, (task, agent, _) in REAL.items():
         result = read_compete_dir(real[name])
         assert result.label == f"{agent} ({task})" and result.returns.shape == ((2, 2) if name == "fghh" else (2, 3))

@@ -57,7 +57,7 @@ def test_runs_beyond_the_set_must_fill_it_evenly() -> None:
 
 
 def test_a_crashing_run_records_its_crash_step() -> None:
-    from neurohover.compete import episode_rows
+    from neurohover.compete_folder import episode_rows
     from neurohover.experiments.results import TestRunResult, TestRunTiming
 
     result = TestRunResult(
