@@ -144,7 +144,7 @@ def test_kl_bounds_refuses_mismatched_arrays_a_negative_level_and_no_halving(mea
 )
 def test_crash_rate_refuses_counts_that_are_no_fraction(crashes, episodes, fragment: str) -> None:
     """F20: crash_rate(1, 0) was a ZeroDivisionError, (5, 2) gave '250%' and (-1, 2) '-50%' silently."""
-    from neurohover.experiments.report import crash_rate
+    from neurohover.experiments.report_testruns import crash_rate
 
     with pytest.raises(NeurohoverError, match=fragment):
         crash_rate(crashes, episodes)

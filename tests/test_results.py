@@ -240,7 +240,7 @@ def replay(committed_store: Path, units: list[tuple[str, str, str]]) -> None:
 
 
 def test_a_crash_rate_is_never_shown_as_zero_when_an_episode_crashed() -> None:
-    from neurohover.experiments.report import crash_rate
+    from neurohover.experiments.report_testruns import crash_rate
 
     assert [crash_rate(c, 20_000) for c in (0, 1, 30, 200, 10_687, 20_000)] == ["0%", "0.005%", "0.15%", "1%", "53%", "100%"]
 

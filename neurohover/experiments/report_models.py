@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .report_base import Section, fmt, fmt_p, log_errors, new_figure, table
+from .report_base import Section, fmt, fmt_p, log_errors, new_figure, ratio_verdict, sd, table
 from .results import ModelResult
 
 
@@ -156,3 +156,85 @@ def _sensor_text(sensor: dict | None) -> str:
     if sensor is None:
         return "exact"
     return ", ".join(f"{k} {v}" for k, v in sensor.items())
+
+
+class ModelLearningSection(Section):
+    """A model-learning experiment's section (Table 4): the policies evolved on each method's learned models, flown in the true MDP."""
+
+    def figure(self) -> str | None:
+        data: dict[str, list[ModelResult]] = {m: self.group("model", m) for m in self.s.methods}
+        data = {m: v for m, v in data.items() if v}
+        if not data:
+            return None
+        fig, axes = new_figure(figsize=(6.5, 4))
+        ax = axes[0, 0]
+        errors = [log_errors([float(r.test_mean) for r in v]) for v in data.values()]
+        ax.boxplot(errors)
+        ax.set_xticks(range(1, len(data) + 1), [m.upper() for m in data])
+        ax.set_yscale("log")
+        ax.set_ylabel("error of the evolved policy in the true MDP (log scale)")
+        ax.set_title(f"Table 4: policies evolved on learned models ({self.cfg.scale} scale)", fontsize=10)
+        ax.grid(alpha=0.3, which="both")
+        return self.save(fig)
+
+    def body(self) -> str:
+        ref = self.paper.get("table", {})
+        rows = []
+        means = {}
+        for m in self.s.methods:
+            units: list[ModelResult] = self.group("model", m)
+            if not units:
+                continue
+            r = np.array([float(u.test_mean) for u in units])
+            t = np.array([u.timing.learn_seconds for u in units])
+            crashes = sum(u.test_crashes for u in units)
+            episodes = sum(len(u.test_returns) for u in units)
+            p = ref.get(m, {})
+            means[m] = r.mean()
+            rows.append(
+                [
+                    m.upper(),
+                    str(len(units)),
+                    fmt(t.mean()),
+                    fmt(p.get("t")),
+                    fmt(np.median(r)),
+                    fmt(p.get("r_m")),
+                    fmt(r.mean()),
+                    fmt(p.get("r_a")),
+                    fmt(sd(r)),
+                    fmt(p.get("sd")),
+                    f"{crashes} of {episodes}",
+                ]
+            )
+            if p:
+                self.add_claim(f"Table 4, {m.upper()}: median r_m", fmt(p.get("r_m")), fmt(np.median(r)), ratio_verdict(float(np.median(r)), float(p["r_m"])))
+                self.comparisons.append(
+                    f"{m.upper()}: our median {fmt(np.median(r))} vs paper {fmt(p.get('r_m'))}; our mean "
+                    f"{fmt(r.mean())} vs paper {fmt(p.get('r_a'))}; our time to learn {fmt(t.mean())} s vs paper "
+                    f"{fmt(p.get('t'))} s."
+                )
+        if ref and means:
+            ours = sorted(means, key=lambda k: -means[k])
+            paper = sorted((k for k in ref if k in means), key=lambda k: -ref[k]["r_a"])
+            if paper:  # conclusion (2): of the paper's methods, LR's policies are the best (by mean return)
+                mine = [k for k in ours if k in paper]
+                self.add_claim(
+                    "Table 4: the best method by mean return",
+                    paper[0].upper(),
+                    mine[0].upper(),
+                    "holds" if mine[0] == paper[0] else "differs (ours: " + " > ".join(x.upper() for x in mine) + ")",
+                    "ranking",
+                )
+            self.comparisons.append(
+                "Ranking by mean return (best first): ours "
+                + " > ".join(x.upper() for x in ours)
+                + "; paper "
+                + " > ".join(x.upper() for x in paper)
+                + (" (same order)." if ours == paper else " (different order).")
+            )
+        return (
+            "### Table 4\n\n"
+            + table(["method", "MDPs", "t (s)", "paper t", "r_m", "paper r_m", "r_a", "paper r_a", "sd", "paper sd", "crashed episodes"], rows)
+            + f"\n\nt: seconds to learn the model from one episode of flight data of the generic policy; r_m, r_a, sd: median, "
+            f"mean and sd over MDPs of the evolved policy's mean return over {self.s.test_episodes} episodes in the true MDP.\n"
+        )
