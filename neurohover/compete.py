@@ -448,7 +448,8 @@ def check_against_store(folder: str | Path) -> None:
     :func:`~neurohover.compete_files.read_compete_dir` (whose layer reads no store). The summary names its store by its
     absolute path (a relative one, which older versions wrote, from the working directory); a store no longer there, or
     holding no such experiment, is not read; one holding the experiment at other scales only refuses the summary's
-    (T42-A02)."""
+    (T42-A02), and one holding the summary's scale under another experiment refuses its name: a settings-HASH digests
+    the agent and task with the settings, so it names one competition (agent and experiment edited together; T45-B09)."""
     from .experiments import Store
     from .paths import strict_json
 
@@ -461,12 +462,19 @@ def check_against_store(folder: str | Path) -> None:
         return
     held = Store(store, create=False)
     try:
-        scales = sorted({s for n, s, _, _ in held.experiments() if n == name})
+        experiments = held.experiments()
+        scales = sorted({s for n, s, _, _ in experiments if n == name})
+        others = sorted({n for n, s, _, _ in experiments if s == scale and n != name and s.startswith("settings-")})
         if scale not in scales:  # the experiment held at other scales only: a scale edited too (T42-A02)
             if scales:
                 raise NeurohoverError(
                     f"--compete {str(summary_path)!r}: its scale {brief(scale)} is not one its store {store!r} holds for "
                     f"{name}: it holds {', '.join(scales)} (an edit by hand, or another store now at that path?)"
+                )
+            if others:  # T45-B09
+                raise NeurohoverError(
+                    f"--compete {str(summary_path)!r}: its experiment {brief(name)} is not the one its store {store!r} holds its scale "
+                    f"{scale} under: {', '.join(others)} (a settings digest names one competition: an edit by hand of its agent and experiment?)"
                 )
             return
         settings = held.config(name, scale).get("settings", {})

@@ -25,7 +25,7 @@ from .plans import Plan, plan, run_keys, source_results
 from .result_checks import params_problem
 from .results import UnitResult, check_run_lengths, flat_cells, result_from_dict
 from .store import Store
-from .store_checks import hash_problem, read_config
+from .store_checks import hash_problem, read_config, unit_seconds_problem
 
 FORMATS = ("csv", "json")
 
@@ -237,6 +237,9 @@ def checked_experiment(store: Store, name: str, scale: str) -> tuple[ExperimentC
         problem = params_problem(results[u["key"]], u["params"])
         if problem:
             raise NeurohoverError(f"{where}: unit {u['key']!r}: its result contradicts its params: {problem}")
+        problem = unit_seconds_problem(u["seconds"], results[u["key"]])  # last: an edited result's own timing named first (T45-B02)
+        if problem:
+            raise NeurohoverError(f"{where}: unit {u['key']!r}: {problem}")
     store.sessions(name, scale)  # its sessions rows, last (a damaged unit named first): for every command, not report alone (T27-A07)
     return config, units, results, made
 

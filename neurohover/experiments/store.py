@@ -37,12 +37,14 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from ..errors import NeurohoverError, brief, check_flag, finite_real
+from ..errors import NeurohoverError, brief, check_flag
 from ..filekinds import refuse_long_store_name, refuse_sqlite_name
 from ..paths import JSONError, WriterLock, strict_json
+from ..sim.constants import MAX_SECONDS, seconds_allowed
 from .store_checks import (
     HELD_SQL,
     SESSION_STATUSES,
+    TIME_ALLOWED,
     GuardedConnection,
     StoreWriteError,
     bad_session,
@@ -57,11 +59,13 @@ from .store_checks import (
     missing_text,
     object_text,
     refuse_moved,
+    seconds_said,
     session_problem,
     sqlite_says,
     stored_count,
     table_columns,
     take_writer_lock,
+    time_allowed,
     unit_texts,
 )
 from .store_checks import transaction as _transaction
@@ -378,14 +382,15 @@ class Store:
 
     def _check_created(self, name: str | None = None) -> None:
         """Refuse an experiment row (of ``name`` only, if given) whose created time, which orders the experiments, is no
-        number: 'yesterday' was taken, and sorted after every number (T22-09)."""
-        sql = "SELECT name, scale, created FROM experiments WHERE typeof(created) NOT IN ('integer', 'real')"
+        number: 'yesterday' was taken, and sorted after every number (T22-09); nor a time (-5 was taken; T45-B02)."""
+        sql = "SELECT name, scale, created FROM experiments WHERE (typeof(created) NOT IN ('integer', 'real') OR NOT (created >= 1e9 AND created < 4294967296))"
         rows = self._rows(sql + (" AND name = ?" if name is not None else "") + " LIMIT 1", () if name is None else (name,), "its list of experiments")
         if rows:
             bad, scale, created = rows[0]
+            said = "no number: allowed seconds since 1970" if not isinstance(created, (int, float)) else f"not allowed: {TIME_ALLOWED}"
             raise NeurohoverError(
                 f"results store {str(self.path)!r} is damaged: experiment {brief(bad)} ({brief(scale)})'s created time {brief(created)} is "
-                "no number: allowed seconds since 1970 (give another --store file, or reproduce --fresh to start it over)"
+                f"{said} (give another --store file, or reproduce --fresh to start it over)"
             )
 
     def config_hash(self, name: str, scale: str) -> str | None:
@@ -446,16 +451,22 @@ class Store:
                 "result": self._json(r, f"experiment {name} ({scale}), unit {k}'s result"),
                 "seconds": self._seconds(s, f"experiment {name} ({scale}), unit {k}'s seconds"),
                 "worker": w,
-                "finished": f,
+                "finished": self._time(f, f"experiment {name} ({scale}), unit {k}'s finished time"),
             }
             for k, kind, p, r, s, w, f in rows
         ]
 
     def _seconds(self, value: Any, what: str) -> float:
-        """A stored duration, or one clear error naming the damaged row (text was a TypeError in report; seventh trial)."""
-        if finite_real(value) and value >= 0:
+        """A stored duration, or one error naming the damaged row (text was a TypeError in report, seventh trial; 1e300 exported, T45-B02)."""
+        if seconds_allowed(value):
             return value
-        raise NeurohoverError(f"results store {str(self.path)!r}: {what} is damaged ({value!r:.40} is no number of seconds >= 0)")
+        raise NeurohoverError(f"results store {str(self.path)!r}: {what} is damaged ({seconds_said(value)})")
+
+    def _time(self, value: Any, what: str) -> float:
+        """A stored time (:data:`~.store_checks.TIME_ALLOWED`), or one error naming the damaged row (1e12 exported; T45-B02)."""
+        if not time_allowed(value):
+            raise NeurohoverError(f"results store {str(self.path)!r}: {what} {brief(value)} is damaged: {TIME_ALLOWED}")
+        return value
 
     def _json(self, text: str, what: str) -> dict:
         """A stored JSON object, or one clear error naming the damaged row (the rest of the store stays readable): every
@@ -488,8 +499,8 @@ class Store:
         check_experiment(name, scale, where)
         check_text(config_hash, "config_hash", where)
         params, text = unit_texts(unit, result, name, where)
-        if not (finite_real(seconds) and seconds >= 0):
-            raise NeurohoverError(f"{where}: seconds = {brief(seconds)} is not allowed: give a finite number of seconds >= 0")
+        if not seconds_allowed(seconds):  # what Store.units reads back (1e300 was exported; T45-B02)
+            raise NeurohoverError(f"{where}: seconds = {brief(seconds)} is not allowed: give a finite number of seconds >= 0, at most {MAX_SECONDS:.6g}")
         check_text(worker, "worker", where, empty=True)
         if session is not None:
             session = stored_count(session, "session", where, 1)

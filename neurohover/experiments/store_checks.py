@@ -18,6 +18,7 @@ from ..errors import NeurohoverError, brief, finite_real, refuse_non_text_keys, 
 from ..filekinds import SQLITE_HEADER, refuse_sqlite_side_files
 from ..locks import WriterLock, hold_file
 from ..paths import json_text, refuse_dangling_link, strict_json
+from ..sim.constants import MAX_SECONDS
 from .config import ExperimentConfig, check_name, check_scale
 from .result_checks import params_problem
 from .results import result_from_dict, result_type
@@ -47,6 +48,40 @@ def table_columns(schema: str) -> dict[str, list[str]]:
 
 #: How a session can end (:meth:`Store.end_session`; the runner's statuses). A session is "running" until then.
 SESSION_STATUSES = ("finished", "selection finished", "interrupted", "failed")
+#: The times a store records (a session's start, a unit's finish, an experiment's creation), in seconds since 1970: fixed
+#: bounds, not "now" (a store read on a machine whose clock lags is no damage). 0 and 1e12 were taken (T45-B02).
+TIME_ALLOWED = "allowed a time (seconds since 1970) from 2001 to 2106"
+
+
+def time_allowed(value: Any) -> bool:
+    """Whether ``value`` is a time a store may record (:data:`TIME_ALLOWED`)."""
+    return finite_real(value) and 1e9 <= value < 2**32
+
+
+def seconds_said(value: Any) -> str:
+    """What is wrong with a stored duration that is no :func:`~neurohover.sim.constants.seconds_allowed` (a unit's
+    seconds, a session's wall seconds): 1e300 was exported (T45-B02)."""
+    if finite_real(value) and value > 0:
+        return f"{brief(value)} is more than {MAX_SECONDS:.6g} seconds: 100 years at most"
+    return f"{value!r:.40} is no number of seconds >= 0"
+
+
+def unit_seconds_problem(seconds: float, result: Any) -> str:
+    """Why a unit's stored ``seconds`` contradict its typed ``result``'s own timing, or '': the store records the
+    executor's time of the whole unit (executors.timed_run), which holds the run its result times (units.py), so never
+    less (1e300, and 0 for a run of 0.64 s, read alike; T45-B02). A result without timing (a diagnostic's) is not checked."""
+    timing = getattr(result, "timing", None)
+    if timing is None:
+        return ""
+    inner = float(timing.learn_seconds) + float(timing.evolve_seconds) if hasattr(timing, "learn_seconds") else float(timing.seconds)
+    if inner > seconds * (1 + 1e-9) + 1e-6:
+        return (
+            f"its seconds {brief(seconds)} are not allowed: the store times the whole unit, which holds its result's own "
+            f"timing of {brief(inner)} seconds: allowed at least that"
+        )
+    return ""
+
+
 #: The executors that run sessions (the ``name`` of executors.LocalExecutor and RayExecutor; importing them here is slow).
 EXECUTORS = ("local", "ray")
 
@@ -155,8 +190,8 @@ def bad_session(session: dict, stored: int) -> str:
     if not isinstance(value, str) or value not in EXECUTORS:
         return f"executor {brief(value)} is not allowed: allowed {', '.join(map(repr, EXECUTORS))}"
     value = session["started"]
-    if not finite_real(value) or not 1e9 <= value < 2**32:  # fixed bounds: a store read on a machine whose clock lags is no damage
-        return f"started {brief(value)} is not allowed: allowed a time (seconds since 1970) from 2001 to 2106"
+    if not time_allowed(value):
+        return f"started {brief(value)} is not allowed: {TIME_ALLOWED}"
     for field in ("units_before", "units_run"):
         if not whole_number(session[field]) or session[field] < 0:
             return f"{field} {brief(session[field])} is not allowed: allowed a whole number >= 0"
