@@ -115,6 +115,15 @@ def whole_in(value: object, name: str, low: int, high: int, high_text: str | Non
     return exact
 
 
+def check_length(length: object, what: str, least: int = 1) -> None:
+    """Refuse a ``length`` (how many numbers ``what`` holds) that is no whole number >= ``least``: the one check of
+    :func:`neurohover.tasks.finite_vector`'s (0: an MDP without wind holds none) and :func:`neurohover.models.check_vector`'s
+    (an array was NumPy's "truth value is ambiguous" in finite_vector, T45-B05; '2' was "x must be 2 numbers, got 2" in
+    check_vector, T14-13)."""
+    if not whole_number(length) or length < least:
+        raise NeurohoverError(f"length={brief(length)} is not allowed: give a whole number >= {least} (how many numbers {what} holds)")
+
+
 def real_number(value: object) -> TypeGuard[float]:
     """Whether ``value`` is a real number, NumPy's included: not a bool (True is an int) nor a NumPy time (an Integral
     whose float() and int() raise, T17-1). The one test of a number argument; :func:`finite_real` adds finiteness.

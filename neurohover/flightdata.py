@@ -128,7 +128,8 @@ class FlightData:
     """Flown episodes: ``observations[i]`` is (steps_i + 1, 12), ``actions[i]`` is (steps_i, 4).
 
     ``observations[i][k]`` is what the policy saw before choosing ``actions[i][k]`` (the clipped
-    action the simulator applied); the last observation follows the last action.
+    action the simulator applied); the last observation follows the last action. The arrays are read-only: copies of
+    writeable ones given, so an edit cannot get past the checks made (T45-B07).
 
     ``==`` compares recordings: the same episodes (each array's shape, dtype and values, NaN equal to NaN) and
     equal metadata. Flight data are unhashable (they hold arrays), as a list is.
@@ -154,27 +155,26 @@ class FlightData:
             arrays = getattr(self, name)
             if isinstance(arrays, (str, bytes, np.ndarray)) or not isinstance(arrays, (tuple, list)):
                 raise NeurohoverError(f"flight data {name}={brief(arrays)} is not allowed: give a sequence of arrays, one per episode")
-            # a masked array was stored as it was, its hidden values learned from (T16-9); an np.matrix, and save() was a TypeError (T28-B06)
-            if not all(type(a) is np.ndarray and a.dtype.kind in "fi" for a in arrays):
-                other = next((type(a).__name__ for a in arrays if isinstance(a, np.ndarray) and type(a) is not np.ndarray), None)
-                note = f" (not {other}: give np.asarray of it)" if other and other != "MaskedArray" else ""
-                raise NeurohoverError(f"flight data {name} must be arrays of real numbers (plain, not masked), one per episode{note}")
-            object.__setattr__(self, name, tuple(arrays))
+            _check_arrays(arrays, name, "flight data")
+            # read-only: an edit after the checks below (an inf reading) was taken by observed_return and save (T45-B07)
+            object.__setattr__(self, name, tuple(_frozen(a) for a in arrays))
         _metadata_text(self.metadata, "flight data")  # None, [1], {1: 2}, a NaN were taken, and refused or changed by save() (T15-29, T21-08)
-        if len(self.observations) != len(self.actions):
-            raise NeurohoverError(f"flight data needs one action array per observation array, got {len(self.observations)} and {len(self.actions)}")
-        for i, (obs, act) in enumerate(zip(self.observations, self.actions)):
-            if obs.ndim != 2 or obs.shape[1] != 12 or act.ndim != 2 or act.shape[1] != 4 or obs.shape[0] != act.shape[0] + 1:
-                raise NeurohoverError(f"flight-data episode {i}: observations must be (T+1, 12) and actions (T, 4), got {obs.shape} and {act.shape}")
-            if act.shape[0] == 0:  # written by save(), then refused by load() (T22-19)
-                raise NeurohoverError(f"flight data: episode {i} has 0 steps (a flown one has at least 1)")
+        _check_episodes(self.observations, self.actions, "flight data")
         # metadata load() refuses (episode_steps -5, crashed 'x') was taken here and written by save() (T18-4)
         check_metadata(self.metadata, np.array([a.shape[0] for a in self.actions], dtype=np.int64), "flight data", (self.observations, self.actions))
 
     def check_again(self, where: str = "flight data") -> None:
-        """The metadata checks ``FlightData(...)`` runs, run again by each reader that relies on the metadata (the
-        learners, Transitions, ``+``): metadata may be edited after making, and an edited safeguard_step ['a', None] was
-        a TypeError in EC-MER, an episode_steps 'x' or crashed 'yes' learned from without a word (T43-B06)."""
+        """The checks ``FlightData(...)`` runs, run again by each reader (the learners, Transitions, observed_return,
+        ``+``, save): metadata may be edited after making (an edited safeguard_step ['a', None] was a TypeError in EC-MER,
+        T43-B06), and the arrays replaced (``object.__setattr__``: 10 readings for 100 actions were NumPy's broadcast
+        error in learn_lr, a wrong return in observed_return, taken by Transitions; T45-B06). The arrays themselves are
+        read-only (T45-B07)."""
+        for name in ("observations", "actions"):
+            arrays = getattr(self, name)
+            if not isinstance(arrays, tuple):
+                raise NeurohoverError(f"{where}: its {name} {brief(arrays)} are not allowed: give a tuple of arrays, one per episode")
+            _check_arrays(arrays, name, where)
+        _check_episodes(self.observations, self.actions, where)
         _metadata_text(self.metadata, where)
         check_metadata(self.metadata, np.array([a.shape[0] for a in self.actions], dtype=np.int64), where, (self.observations, self.actions))
 
@@ -246,9 +246,7 @@ class FlightData:
         path = output_file(path, "flight-data file", kind=FLIGHT_DATA_KIND)
         check_npz_name(path)
         lengths = np.array([a.shape[0] for a in self.actions], dtype=np.int64)
-        check_metadata(
-            self.metadata, lengths, "flight data", (self.observations, self.actions)
-        )  # metadata changed after making (episode_steps -5) was written, then refused by load()
+        self.check_again()  # metadata changed after making (episode_steps -5) was written, then refused by load(); arrays replaced (T45-B06)
         for i, crashed in enumerate(crash_flags(self)):  # NaN readings were written, then refused by load() (T22-02's check)
             check_flown(self.observations[i], self.actions[i], crashed, f"flight data to save, episode {i}")
         if dtype == "float64":  # what load() checks of a float64 file: a policy_flown that does not give the actions (T24-06)
@@ -327,6 +325,8 @@ class FlightData:
         # the readings the policy saw, not rounded (T24-06), in either byte order ('>f8' skipped the check: T37-B04)
         exact = obs.dtype.itemsize >= 8 and act.dtype.itemsize >= 8
         obs, act = _float64(obs, "observations", path), _float64(act, "actions", path)  # float32 loads as float64, as all here
+        obs.setflags(write=False)  # their episodes' views are then not copied (_frozen)
+        act.setflags(write=False)
         obs_split = np.split(obs, np.cumsum(lengths + 1)[:-1])
         act_split = np.split(act, np.cumsum(lengths)[:-1])
         check_metadata(metadata, lengths, f"flight-data file {str(path)!r}", (tuple(obs_split), tuple(act_split)))  # and the readings (T23-03, T23-19)
@@ -345,6 +345,36 @@ class FlightData:
         if exact:  # after check_flown: the readings the policy is flown on are finite
             check_policy_actions(metadata, data.observations, data.actions, f"flight-data file {str(path)!r}")
         return data
+
+
+def _check_arrays(arrays: tuple | list, name: str, where: str) -> None:
+    """Refuse ``arrays`` (a FlightData's ``name``) unless each is a plain array of real numbers: a masked array was stored
+    as it was, its hidden values learned from (T16-9); an np.matrix, and save() was a TypeError (T28-B06)."""
+    if not all(type(a) is np.ndarray and a.dtype.kind in "fi" for a in arrays):
+        other = next((type(a).__name__ for a in arrays if isinstance(a, np.ndarray) and type(a) is not np.ndarray), None)
+        note = f" (not {other}: give np.asarray of it)" if other and other != "MaskedArray" else ""
+        raise NeurohoverError(f"{where} {name} must be arrays of real numbers (plain, not masked), one per episode{note}")
+
+
+def _check_episodes(observations: tuple, actions: tuple, where: str) -> None:
+    """Refuse episodes whose observations and actions do not pair up as flown: (T+1, 12) readings for (T, 4) actions, T >= 1."""
+    if len(observations) != len(actions):
+        raise NeurohoverError(f"{where} needs one action array per observation array, got {len(observations)} and {len(actions)}")
+    for i, (obs, act) in enumerate(zip(observations, actions)):
+        if obs.ndim != 2 or obs.shape[1] != 12 or act.ndim != 2 or act.shape[1] != 4 or obs.shape[0] != act.shape[0] + 1:
+            raise NeurohoverError(f"{where}, episode {i}: observations must be (T+1, 12) and actions (T, 4), got {obs.shape} and {act.shape}")
+        if act.shape[0] == 0:  # written by save(), then refused by load() (T22-19)
+            raise NeurohoverError(f"{where}: episode {i} has 0 steps (a flown one has at least 1)")
+
+
+def _frozen(array: np.ndarray) -> np.ndarray:
+    """``array`` read-only, copied first unless no one can write its memory (a read-only array, or a read-only view of one,
+    as :meth:`FlightData.load` and ``+`` give): the caller's array stays theirs, writeable (T45-B07)."""
+    owner = array if array.flags.owndata else array.base
+    if array.flags.writeable or not isinstance(owner, np.ndarray) or owner.flags.writeable:
+        array = array.copy()
+    array.setflags(write=False)
+    return array
 
 
 def crash_flags(data: FlightData) -> list[bool]:

@@ -63,10 +63,19 @@ def check_discount_and_scale(gamma, scale) -> None:
             raise NeurohoverError(f"{name}={brief(value)} is out of range: allowed {allowed}")
 
 
-def check_env(env) -> None:
-    """Refuse a wrapper's ``env`` that is no gymnasium Env by name (None was Gymnasium's TypeError; fifteenth trial T15-11)."""
-    if not isinstance(env, gym.Env):
+def check_env(env, hover: bool = False) -> None:
+    """Refuse a wrapper's ``env`` that is no gymnasium Env by name (None was Gymnasium's TypeError; fifteenth trial T15-11),
+    and, where ``hover``, one whose unwrapped env is no neurohover HoverEnv: CrashAwareReward's crash charge and squash are
+    a hovering env's (CartPole's +1 for staying upright became a penalty of -0.69; T45-B10)."""
+    if not isinstance(env, gym.Env) or (hover and not _hovers(env)):
         raise NeurohoverError(f"env={brief(env)} is not allowed: give a gymnasium Env (gymnasium.make('neurohover/GHH08-Short-v0'), a HoverEnv)")
+
+
+def _hovers(env: gym.Env) -> bool:
+    """Whether ``env`` unwrapped is a neurohover HoverEnv (looked up, not imported: neurohover.envs is a layer above; an
+    env made while it was not imported is none)."""
+    hover = sys.modules.get("neurohover.envs.hover")
+    return hover is not None and isinstance(env.unwrapped, hover.HoverEnv)
 
 
 def crash_aware(reward, gamma: float = 0.99, scale: float = 1.0):
@@ -120,11 +129,11 @@ def refuse_changed_rewards(env: gym.Env) -> None:
 
 class CrashAwareReward(gym.RewardWrapper):
     """Rewards of :func:`crash_aware` (``gamma``: the learner's discount, in (0, 1]; ``scale`` in 1e-300..1e300), over an ``env`` whose
-    rewards are the environment's own: a reward wrapper, ``NormalizeReward`` or a CrashAwareReward inside (an ``-RL-v0``
+    rewards are a neurohover HoverEnv's own (another env is refused, T45-B10): a reward wrapper, ``NormalizeReward`` or a CrashAwareReward inside (an ``-RL-v0``
     id) is refused (:func:`refuse_changed_rewards`)."""
 
     def __init__(self, env: gym.Env, gamma: float = 0.99, scale: float = 1.0) -> None:
-        check_env(env)
+        check_env(env, hover=True)
         check_discount_and_scale(gamma, scale)
         refuse_changed_rewards(env)
         super().__init__(env)

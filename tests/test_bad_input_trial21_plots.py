@@ -42,8 +42,10 @@ def test_plot_refuses_a_flight_data_file_of_nan_observations_as_learn_model_does
 
 def test_plot_flight_data_refuses_an_infinite_observation_of_any_episode_before_writing(tmp_path: Path) -> None:
     """T21-04: one infinite reading in the second episode; nothing is drawn, the first episode's file neither."""
-    data = _flight(episodes=2)
-    data.observations[1][2, 5] = -np.inf
+    clean = _flight(episodes=2)
+    observations = [o.copy() for o in clean.observations]  # flight data's arrays are read-only (T45-B07): new ones made
+    observations[1][2, 5] = -np.inf
+    data = FlightData(tuple(observations), clean.actions, clean.metadata)
     with pytest.raises(NeurohoverError, match=re.escape(f"flight data, episode 1: step 2 reads z = -inf: {NOT_FLOWN}")):
         plot_flight_data(data, tmp_path / "plots")
     assert not (tmp_path / "plots").exists()

@@ -14,7 +14,7 @@ import time
 import numpy as np
 
 from ..errors import NeurohoverError, brief, finite_real, refuse_reloaded, whole_in, whole_number
-from ..flightdata import FlightData
+from ..flightdata import FlightData, check_flown, crash_flags
 from ..flightmeta import action_mismatch
 from ..sim.constants import DEFAULT_PARAMS, ROW_NOISE, ROW_PARAMS, WORST_RETURN
 from ..tasks import MDP
@@ -197,7 +197,8 @@ def _thin(history: list, keep: int = 200) -> list:
 
 def observed_return(flight_data: FlightData, episode: int = 0) -> float:
     """Return of one recorded episode recomputed from its observations: ``-sum_k |obs_k|^2``
-    over the observations after each action (valid for an episode that did not crash)."""
+    over the observations after each action (valid for an episode that did not crash). The flight data are checked again
+    (:meth:`FlightData.check_again`) and the episode's readings as flown (:func:`~neurohover.flightdata.check_flown`)."""
     if not isinstance(flight_data, FlightData):
         refuse_reloaded(flight_data, FlightData, "flight data")  # T42-B08
         raise NeurohoverError(f"flight data must be a FlightData, got {type(flight_data).__name__}")
@@ -206,6 +207,8 @@ def observed_return(flight_data: FlightData, episode: int = 0) -> float:
         raise NeurohoverError(f"episode={brief(episode)} is not allowed: give an integer in 0..{flight_data.n_episodes - 1}")
     if not 0 <= episode < flight_data.n_episodes:
         raise NeurohoverError(f"episode {brief(episode)} is not in the flight data: give an integer in 0..{flight_data.n_episodes - 1}")
+    flight_data.check_again()  # arrays replaced after making: 10 readings for 100 actions gave a wrong return (T45-B06)
+    check_flown(flight_data.observations[episode], flight_data.actions[episode], crash_flags(flight_data)[episode], f"flight data, episode {episode}")
     obs = flight_data.observations[episode][1:]
     return -float(np.einsum("ij,ij->", obs, obs))
 

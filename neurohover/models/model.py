@@ -36,7 +36,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import NeurohoverError, as_floats, brief, finite_real, real_number, refuse_non_text_keys, whole_number
+from ..errors import NeurohoverError, as_floats, brief, check_flag, check_length, finite_real, real_number, refuse_non_text_keys, whole_number
 from ..filekinds import refuse_suffix
 from ..flightdata import plain_json, unwritable_key
 from ..paths import json_text
@@ -132,8 +132,8 @@ def check_vector(values, length: int, what: str, nonnegative: bool = False) -> t
     -------
     tuple of float
     """
-    if not whole_number(length) or length < 1:  # '2' was "x must be 2 numbers, got 2" (fourteenth trial T14-13)
-        raise NeurohoverError(f"length={brief(length)} is not allowed: give a whole number >= 1 (how many numbers {what} holds)")
+    check_length(length, what)  # '2' was "x must be 2 numbers, got 2" (fourteenth trial T14-13)
+    nonnegative = check_flag(nonnegative, "nonnegative", "refuse negative numbers")  # 'x' and nan were taken, an array ambiguous (T45-B05)
     # the one array check: a masked array's mask was dropped and its hidden values used (T16-9); objects are checked below
     if isinstance(values, np.ma.MaskedArray) or (isinstance(values, np.ndarray) and values.dtype.kind != "O"):
         as_floats(values, what, f"{length} real numbers")

@@ -138,8 +138,8 @@ def family_from_dict(d: dict) -> TaskFamily:
 
 def family_for(name: str, sigma: float | None, sensor: Sensor | None = None, drift: Drift | None = None) -> TaskFamily:
     """Like :func:`get_task_family`, but a ``sigma`` is ignored for families without one (configs carry one for all)."""
-    key = task_key(name)
-    has = key in TASK_FAMILIES and family_class(key).has_sigma
+    key = task_key(name)  # a list or an array, unhashable, was a TypeError here; get_task_family refuses it by name (T45-B04)
+    has = isinstance(key, str) and key in TASK_FAMILIES and family_class(key).has_sigma
     return get_task_family(name, sigma if has else None, sensor, drift)
 
 
@@ -147,7 +147,7 @@ def set_name(task: object, sigma: object, spec: object) -> object:
     """What ``spec`` names among ``task``'s MDPs at breadth ``sigma``, as their labels write it (:meth:`TaskFamily.set_name`:
     FGHH's ``test`` at sigma 0.2 is ``seeded-test``); ``spec`` itself where task, sigma or spec is none a family takes (refused
     where they are checked). Read back in files that wrote the spec asked for (compete's summary before T37-A02)."""
-    if not (isinstance(spec, str) and task in TASK_FAMILIES and (sigma is None or finite_real(sigma))):
+    if not (isinstance(spec, str) and isinstance(task, str) and task in TASK_FAMILIES and (sigma is None or finite_real(sigma))):
         return spec
     try:
         return family_for(str(task), sigma).set_name(spec)  # type: ignore[arg-type]

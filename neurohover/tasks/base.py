@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError, as_floats, brief, check_name_text, finite_real, masked_note, refuse_reloaded, whole_in, whole_number
+from ..errors import NeurohoverError, as_floats, brief, check_length, check_name_text, finite_real, masked_note, refuse_reloaded, whole_in, whole_number
 from ..sim.constants import (
     CONTROL_DT,
     DEFAULT_NOISE_STD,
@@ -233,6 +233,7 @@ class MDP:
 
 def finite_vector(values: Sequence[float] | np.ndarray, length: int, what: str) -> np.ndarray:
     """``values`` as a float array of ``length`` finite numbers, or a clear error naming ``what``."""
+    check_length(length, what, 0)
     # complex numbers too: NumPy dropped their imaginary part with a warning only (fourth trial)
     objects = np.asarray(values, dtype=object)
     if isinstance(values, str) or any(isinstance(v, (str, bytes, bool, np.bool_, complex, np.complexfloating)) for v in np.ravel(objects)):
