@@ -36,7 +36,7 @@ def test_a_state_pickle_naming_a_pycma_function_is_refused() -> None:
     import cma.utilities.utils as utils
 
     state = {"type": "CMAES", "version": 1, "pickle": base64.b64encode(pickle.dumps(utils.print_warning)).decode()}
-    with pytest.raises(NeurohoverError, match=r"its pickle names 'cma\.utilities\.utils\.print_warning', no class of pycma"):
+    with pytest.raises(NeurohoverError, match=r"its pickle names 'cma\.utilities\.utils\.print_warning', which no CMA state holds"):
         CMAES.from_state_dict(state)
 
 

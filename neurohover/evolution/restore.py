@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..flyer import MAX_EPISODE_INDEX
-from ..sim.constants import CRASH_STEP_PENALTY
+from ..sim.constants import CRASH_STEP_PENALTY, MAX_SECONDS, seconds_allowed
 from .common import EntryError, Optimiser, check_entries, check_genomes, damage_text, dec_array, dec_float, enc_float
 from .config import MAX_BUDGET, Resampling
 from .fitness import fitness_range, in_fitness_range
@@ -146,6 +146,8 @@ def _restored_parts(state: dict, run: Run, opt: Optimiser) -> dict[str, Any]:
     for k, v in seconds.items():
         if not (finite_real(v) and v >= 0):  # finite_real: '1.5' was read as 1.5 (sixteenth trial)
             raise EntryError(f"counter {k!r} is {brief(v)}, not a number of seconds >= 0")
+        if not seconds_allowed(v):  # 1e300 was resumed into the result, its history and the next checkpoint (T45-B01)
+            raise EntryError(f"counter {k!r} is {brief(v)}, more seconds than 100 years: allowed a number in [0, {MAX_SECONDS:.6g}]")
     kernel, wall = seconds["kernel_seconds"], seconds["wall_seconds"]
     if kernel > wall:  # (each kernel call is timed inside the run's wall time; T21-03)
         raise EntryError(f"counter 'kernel_seconds' is {kernel!r}, more than the run's wall_seconds {wall!r} (its kernel time is part of them)")

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import NeurohoverError
+from ..errors import NeurohoverError, brief
 from ..paths import checked_path
 from ..sim.constants import ACTION_DIM, OBS_DIM
 from .flying import checked_obs_statistics
@@ -32,6 +32,33 @@ __all__ = ["cleanrl_files", "cleanrl_policy"]
 OBS_CLIP = 10.0  # the script's TransformObservation clip after NormalizeObservation
 EPSILON = 1e-8  # NormalizeObservation's
 LAYERS = ("0.weight", "0.bias", "2.weight", "2.bias", "4.weight", "4.bias")  # the actor's Linear layers, between Tanh
+
+
+#: The globals a pickle of NumPy arrays (or lists) of the statistics names (numpy.core: NumPy 1's numpy._core; _frombuffer:
+#: pickle protocol 5): nothing else is looked up. pickle.load took any, and ran what the file said (trial 45's note).
+_STATS_GLOBALS = frozenset(
+    {
+        ("numpy", "dtype"),
+        ("numpy", "ndarray"),
+        *((f"numpy.{core}.multiarray", name) for core in ("_core", "core") for name in ("_reconstruct", "scalar")),
+        *((f"numpy.{core}.numeric", "_frombuffer") for core in ("_core", "core")),
+        ("_codecs", "encode"),  # bytes in pickle protocols 0 to 2
+    }
+)
+
+
+class _StatsUnpickler(pickle.Unpickler):
+    def find_class(self, module: str, name: str):
+        """Only NumPy's array, scalar and dtype rebuilders (:data:`_STATS_GLOBALS`)."""
+        if (module, name) not in _STATS_GLOBALS:
+            raise NeurohoverError(f"its pickle names {brief(f'{module}.{name}')}, which no (mean, var) of arrays holds: allowed NumPy arrays or lists")
+        return super().find_class(module, name)
+
+
+def load_obs_statistics(path: Path) -> Any:
+    """What the pickle ``path`` (a run's obs_rms.pkl) holds, unpickled with only NumPy's arrays allowed in it."""
+    with path.open("rb") as f:
+        return _StatsUnpickler(f).load()
 
 
 def cleanrl_files(run: str | Path) -> tuple[Path, Path]:
@@ -83,8 +110,9 @@ def cleanrl_policy(run: str | Path) -> Callable[[np.ndarray], np.ndarray]:
         raise NeurohoverError("a CleanRL run needs torch: pip install torch==2.13.0 (a CPU build)") from None
     try:
         state = torch.load(model, map_location="cpu")
-        with stats.open("rb") as f:
-            loaded = pickle.load(f)
+        loaded = load_obs_statistics(stats)
+    except NeurohoverError as err:
+        raise NeurohoverError(f"{str(run)!r}: its obs_rms.pkl cannot be read: {err}") from None
     except Exception as err:  # damaged bytes unpickle into any of a dozen exception types
         first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
         raise NeurohoverError(f"{str(run)!r}: its model or obs_rms.pkl cannot be read: {first}") from None

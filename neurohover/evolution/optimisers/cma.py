@@ -10,6 +10,7 @@ import base64
 import binascii
 import io
 import pickle
+import struct
 import sys
 from dataclasses import dataclass
 from typing import Any
@@ -69,28 +70,52 @@ _MOVED = {
 }
 
 
-#: The globals a CMA or UH-CMA state's pickle names besides pycma's classes (found by loading real states; numpy.core is
-#: NumPy 1's name of numpy._core): nothing else is looked up when a state is read back (T23-12).
+#: The globals a CMA or UH-CMA state's pickle names (found by pickling the states of both optimisers, with pycma 4.5,
+#: in 2 to 301 dimensions, after many generations, a popsize, budget and noise handler's settings of each kind, and a run to pycma's own stop;
+#: numpy.core is NumPy 1's name of numpy._core): nothing else is looked up when a state is read back. Any class of a
+#: ``cma.*`` module was let through, and cma.logger.Logger deleted a file or made directories before the checkpoint was
+#: refused (T45-B03; os.mkdir: T23-12).
+_PYCMA = {
+    "cma.boundary_handler": ("BoundNone", "BoundTransform"),
+    "cma.evolution_strategy": ("CMAEvolutionStrategy", "_CMASolutionDict_functional", "_CMAStopDict", "_StopTolXStagnation", "_pass"),
+    "cma.logger": ("CMADataLogger",),
+    "cma.optimization_tools": ("BestSolution", "NoiseHandler"),
+    "cma.options_parameters": ("CMAOptions", "CMAParameters", "is_feasible"),
+    "cma.recombination_weights": ("RecombinationWeights",),
+    "cma.sampler": ("GaussFullSampler",),
+    "cma.sigma_adaptation": ("CMAAdaptSigmaCSA", "CMAAdaptSigmaTPA", "_TPAParameters"),  # TPA: 300 genes or more
+    "cma.transformations": ("DiagonalDecoding", "GenoPheno", "RoundIntegerVariables"),
+    "cma.utilities.utils": ("BlancClass", "DictFromTagsInString", "ElapsedWCTime", "MoreToWrite", "SolutionDict"),
+}
+
+#: The globals a state's pickle calls (pickle's REDUCE): NumPy's array, scalar, dtype and generator rebuilders and plain
+#: data. pycma's and neurohover's classes are only made empty and filled (NEWOBJ, BUILD), never called: a call of
+#: CMADataLogger or CMAEvolutionStrategy runs their constructors with the pickle's arguments (T45-B03).
+_CALLED = frozenset(
+    {
+        ("numpy", "dtype"),
+        ("numpy.random._pickle", "__bit_generator_ctor"),
+        ("numpy.random._pickle", "__generator_ctor"),
+        ("numpy.random.bit_generator", "__pyx_unpickle_SeedSequence"),
+        *((core, name) for core in ("numpy._core.multiarray", "numpy.core.multiarray") for name in ("_reconstruct", "scalar")),
+        *(("builtins", name) for name in ("range", "slice", "complex", "set", "frozenset", "bytearray", "object")),  # plain data
+    }
+)
+
 _PICKLED = frozenset(
     {
-        ("cma.evolution_strategy", "_pass"),
-        ("cma.options_parameters", "is_feasible"),
+        *_CALLED,
+        *((module, name) for module, names in _PYCMA.items() for name in names),
         ("neurohover.evolution.common", "ChampionRecord"),
         ("neurohover.evolution.common", "ChampionTracker"),
         ("neurohover.evolution.common", "Clock"),
         ("neurohover.evolution.optimisers.cma", "CMAES"),
         ("neurohover.evolution.optimisers.uh_cma", "UHCMAES"),
-        ("numpy", "dtype"),
         ("numpy", "median"),
         ("numpy", "ndarray"),
         ("numpy.linalg", "eigh"),
         ("numpy.random._pcg64", "PCG64"),
-        ("numpy.random._pickle", "__bit_generator_ctor"),
-        ("numpy.random._pickle", "__generator_ctor"),
         ("numpy.random.bit_generator", "SeedSequence"),
-        ("numpy.random.bit_generator", "__pyx_unpickle_SeedSequence"),
-        *((core, name) for core in ("numpy._core.multiarray", "numpy.core.multiarray") for name in ("_reconstruct", "scalar")),
-        *(("builtins", name) for name in ("range", "slice", "complex", "set", "frozenset", "bytearray", "object")),  # plain data
     }
 )
 
@@ -117,10 +142,56 @@ class _Pickler(pickle.Pickler):
         return "randn" if obj is self._randn or isinstance(obj, _Randn) else None
 
 
-class _Unpickler(pickle.Unpickler):
+def _name(obj: Any) -> str:
+    """A global's module.name (its kind's name for anything else)."""
+    name = getattr(obj, "__qualname__", None)
+    return f"{getattr(obj, '__module__', '?')}.{name}" if isinstance(name, str) else f"a {type(obj).__name__}"
+
+
+def _load_reduce(self: Any) -> None:
+    """pickle's REDUCE (a call), only of :data:`_CALLED`'s globals."""
+    if id(self.stack[-2]) not in self.callable_ids:
+        raise EntryError(f"its pickle calls {brief(_name(self.stack[-2]))}, which no CMA state calls: allowed the pickle state_dict() wrote")
+    pickle._Unpickler.load_reduce(self)  # type: ignore[attr-defined]
+
+
+def _load_build(self: Any) -> None:
+    """pickle's BUILD (an object's state set), not of a global: its attributes would be replaced for every user."""
+    if id(self.stack[-2]) in self.global_ids:
+        raise EntryError(f"its pickle sets the attributes of {brief(_name(self.stack[-2]))}, which no CMA state does: allowed the pickle state_dict() wrote")
+    pickle._Unpickler.load_build(self)  # type: ignore[attr-defined]
+
+
+def _load_call(self: Any) -> None:
+    """pickle's INST and OBJ (protocols 0 and 1), which call a class: never in a state written with protocol 4."""
+    raise EntryError("its pickle makes an object with INST or OBJ (pickle protocols 0 and 1), which no CMA state does: allowed the pickle state_dict() wrote")
+
+
+class _Opcodes(dict):
+    """pickle's opcodes: an unknown one is pickle's UnpicklingError, as in its C unpickler (a bare KeyError said nothing)."""
+
+    def __missing__(self, key: int):
+        raise pickle.UnpicklingError(f"invalid load key, {bytes([key])!r}.")
+
+
+class _Unpickler(pickle._Unpickler):
+    """pickle's own (Python) unpickler, so that its calls and attribute settings can be checked too (T45-B03)."""
+
+    dispatch = _Opcodes(
+        {
+            **pickle._Unpickler.dispatch,
+            pickle.REDUCE[0]: _load_reduce,
+            pickle.BUILD[0]: _load_build,
+            pickle.INST[0]: _load_call,
+            pickle.OBJ[0]: _load_call,
+        }
+    )
+
     def __init__(self, file, holder: list) -> None:
         super().__init__(file)
         self._randn = _Randn(holder)
+        self.callable_ids: set[int] = set()  # ids of the globals looked up: they live on beyond the load
+        self.global_ids: set[int] = set()
 
     def persistent_load(self, pid):
         if pid != "randn":
@@ -128,17 +199,15 @@ class _Unpickler(pickle.Unpickler):
         return self._randn
 
     def find_class(self, module: str, name: str):
-        """Only what a CMA state holds: pycma's classes, the few functions and NumPy and neurohover names it pickles
-        (:data:`_PICKLED`). Any other global was looked up and called as the pickle said: a checkpoint's pickle of
-        os.mkdir made its directory before the resume was refused (T23-12)."""
+        """Only what a CMA state holds (:data:`_PICKLED`): any other global was looked up and called as the pickle said,
+        and made a directory (os.mkdir, T23-12) or deleted a file (cma.logger.Logger, T45-B03) before the resume was refused."""
         moved = _MOVED.get((module, name))
-        if moved is not None:
-            return getattr(*moved)
-        if (module, name) not in _PICKLED and not module.startswith("cma."):
+        if moved is None and (module, name) not in _PICKLED:
             raise EntryError(f"its pickle names {brief(f'{module}.{name}')}, which no CMA state holds: allowed the pickle state_dict() wrote")
-        found = super().find_class(module, name)
-        if module.startswith("cma.") and (module, name) not in _PICKLED and not (isinstance(found, type) and found.__module__ == module):
-            raise EntryError(f"its pickle names {brief(f'{module}.{name}')}, no class of pycma: allowed the pickle state_dict() wrote")
+        found = getattr(*moved) if moved is not None else super().find_class(module, name)
+        self.global_ids.add(id(found))
+        if (module, name) in _CALLED:
+            self.callable_ids.add(id(found))
         return found
 
 
@@ -283,7 +352,10 @@ class CMAES(PopulationOptimiser):
                 data = base64.b64decode(text, validate=True)
             except binascii.Error:  # its type's name, "Error", would say nothing
                 raise EntryError("not base64 text: allowed the text state_dict() wrote") from None
-            opt = _Unpickler(io.BytesIO(data), holder).load()
+            try:
+                opt = _Unpickler(io.BytesIO(data), holder).load()
+            except (struct.error, pickle.PickleError) as err:  # cut short, or NumPy's generator state of another kind
+                raise pickle.UnpicklingError(str(err) if isinstance(err, pickle.PickleError) else "pickle data was truncated") from None
             if not isinstance(opt, cls):  # a pickle of something else was returned as it was
                 raise TypeError(f"it holds a {type(opt).__name__}, not a {kind}")
             # its champion tracking read back as SteadyStateNE's is: evaluations -1 was taken (sixteenth trial)
