@@ -72,6 +72,42 @@ def test_a_pickle_calling_a_class_a_cma_state_holds_is_refused(tmp_path: Path) -
     assert not (tmp_path / "out").exists()
 
 
+def test_a_damaged_bytearray_length_is_refused_before_it_is_allocated() -> None:
+    """The closing check's fuzz of T45-B03's unpickler (one byte of a real state changed, 3,000 times): a BYTEARRAY8
+    opcode's length of terabytes was allocated before it was read, a MemoryError; no state holds one (protocol 4)."""
+    data = pickle.PROTO + bytes([4]) + pickle.BYTEARRAY8 + (2**50).to_bytes(8, "little") + pickle.STOP
+    for kind in (CMAES, UHCMAES):
+        state = {"type": kind.__name__, "version": 1, "pickle": base64.b64encode(data).decode()}
+        with pytest.raises(NeurohoverError, match=r"holds a bytearray \(pickle protocol 5\), which no CMA state does"):
+            kind.from_state_dict(state)
+
+
+def _told(kind):
+    opt = CMAES(np.zeros(5), 0.3, seed=1) if kind is CMAES else UHCMAES(np.zeros(5), UHCMASettings(), seed=1)
+    for _ in range(2):
+        asked = opt.ask()
+        opt.tell(-np.arange(len(asked), dtype=float))
+    return opt
+
+
+@pytest.mark.parametrize("kind", [CMAES, UHCMAES])
+def test_a_state_whose_pickle_was_damaged_is_refused_by_its_digest(kind) -> None:
+    """The closing check's fuzz of T45-B03's unpickler: one byte changed in a dtype's pickled state was NumPy's
+    SystemError, or a RuntimeError raised later from its internals; a state now carries its pickle's sha256."""
+    state = _told(kind).state_dict()
+    data = bytearray(base64.b64decode(state["pickle"]))
+    for at in range(0, len(data), max(1, len(data) // 50)):  # fifty places through the pickle
+        damaged = bytearray(data)
+        damaged[at] ^= 0x10
+        with pytest.raises(NeurohoverError, match="sha256 differs from the state's"):
+            kind.from_state_dict({**state, "pickle": base64.b64encode(bytes(damaged)).decode()})
+    for digest in ("x", None, 5, "A" * 64):
+        with pytest.raises(NeurohoverError, match="'sha256' entry .* is damaged .*64 hex digits"):
+            kind.from_state_dict({**state, "sha256": digest})
+    legacy = {k: v for k, v in state.items() if k != "sha256"}  # written before the digest: still read
+    assert kind.from_state_dict(legacy).ask().shape == _told(kind).ask().shape
+
+
 def test_states_the_cma_optimisers_write_still_resume() -> None:
     """T45-B03: the allowed globals are those the states of CMA-ES and UH-CMA-ES (with re-evaluations, after several
     generations) pickle; each state read back continues as the optimiser it was written from."""

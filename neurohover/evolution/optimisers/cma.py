@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import base64
 import binascii
+import hashlib
 import io
 import pickle
 import struct
@@ -167,6 +168,12 @@ def _load_call(self: Any) -> None:
     raise EntryError("its pickle makes an object with INST or OBJ (pickle protocols 0 and 1), which no CMA state does: allowed the pickle state_dict() wrote")
 
 
+def _load_bytearray8(self: Any) -> None:
+    """pickle's BYTEARRAY8 (protocol 5), never in a state written with protocol 4: its length is allocated before it is
+    read, so a damaged one asked for terabytes (a MemoryError, the rest of the machine's memory taken first)."""
+    raise EntryError("its pickle holds a bytearray (pickle protocol 5), which no CMA state does: allowed the pickle state_dict() wrote")
+
+
 class _Opcodes(dict):
     """pickle's opcodes: an unknown one is pickle's UnpicklingError, as in its C unpickler (a bare KeyError said nothing)."""
 
@@ -184,6 +191,7 @@ class _Unpickler(pickle._Unpickler):
             pickle.BUILD[0]: _load_build,
             pickle.INST[0]: _load_call,
             pickle.OBJ[0]: _load_call,
+            pickle.BYTEARRAY8[0]: _load_bytearray8,
         }
     )
 
@@ -324,7 +332,9 @@ class CMAES(PopulationOptimiser):
         form), base64-encoded, with the private generator's draws reconnected on load."""
         buf = io.BytesIO()
         _Pickler(buf, self._es.opts["randn"]).dump(self)
-        return {"type": type(self).__name__, "version": common.STATE_VERSION, "pickle": base64.b64encode(buf.getvalue()).decode("ascii")}
+        data = buf.getvalue()
+        return {"type": type(self).__name__, "version": common.STATE_VERSION, "pickle": base64.b64encode(data).decode("ascii"),
+                "sha256": hashlib.sha256(data).hexdigest()}  # fmt: skip
 
     @classmethod
     def from_state_dict(cls, state: dict[str, Any]) -> CMAES:
@@ -343,7 +353,8 @@ class CMAES(PopulationOptimiser):
         # before 2026-12-06 have no version, and a UHCMAES one then said 'CMAES'
         legacy = kind != "CMAES" and isinstance(state.get("type"), str) and state["type"] == "CMAES"
         check_state({"version": common.STATE_VERSION, **state, **({"type": kind} if legacy else {})}, kind)
-        check_entries(state, kind, ("type", "version", "pickle"))
+        check_entries(state, kind, ("type", "version", "pickle", "sha256"))  # states written before 2026-12-07 have no sha256
+        digest = read_entry(state, kind, "sha256", _digest) if "sha256" in state else None
         holder: list = [None]
         pycma()  # the pickle names pycma's classes: imported here, with its one message under -OO
 
@@ -352,10 +363,13 @@ class CMAES(PopulationOptimiser):
                 data = base64.b64decode(text, validate=True)
             except binascii.Error:  # its type's name, "Error", would say nothing
                 raise EntryError("not base64 text: allowed the text state_dict() wrote") from None
+            if digest is not None and hashlib.sha256(data).hexdigest() != digest:  # a byte changed in a dtype's state was a
+                # SystemError, or a RuntimeError raised later from NumPy's internals (the closing check's fuzz of T45-B03)
+                raise EntryError("its bytes are not those state_dict() wrote (their sha256 differs from the state's): it was damaged or edited")
             try:
                 opt = _Unpickler(io.BytesIO(data), holder).load()
-            except (struct.error, pickle.PickleError) as err:  # cut short, or NumPy's generator state of another kind
-                raise pickle.UnpicklingError(str(err) if isinstance(err, pickle.PickleError) else "pickle data was truncated") from None
+            except (struct.error, pickle.PickleError, SystemError, MemoryError) as err:  # cut short, NumPy's generator state of another kind
+                raise pickle.UnpicklingError(str(err) if isinstance(err, pickle.PickleError) else f"pickle data was damaged ({type(err).__name__})") from None
             if not isinstance(opt, cls):  # a pickle of something else was returned as it was
                 raise TypeError(f"it holds a {type(opt).__name__}, not a {kind}")
             # its champion tracking read back as SteadyStateNE's is: evaluations -1 was taken (sixteenth trial)
@@ -366,6 +380,13 @@ class CMAES(PopulationOptimiser):
         opt = read_entry(state, kind, "pickle", unpickle)  # {}, 'x': a bare KeyError, binascii.Error (fourteenth trial)
         holder[0] = opt._rng
         return opt
+
+
+def _digest(value: object) -> str:
+    """A state's ``sha256`` entry: 64 lower-case hex digits."""
+    if not (isinstance(value, str) and len(value) == 64 and all(c in "0123456789abcdef" for c in value)):
+        raise EntryError(f"{brief(value)} is not allowed: the 64 hex digits of the pickle's sha256 that state_dict() wrote")
+    return value
 
 
 def _check_parts(opt: CMAES) -> None:
