@@ -67,8 +67,13 @@ def check_env(env, hover: bool = False) -> None:
     """Refuse a wrapper's ``env`` that is no gymnasium Env by name (None was Gymnasium's TypeError; fifteenth trial T15-11),
     and, where ``hover``, one whose unwrapped env is no neurohover HoverEnv: CrashAwareReward's crash charge and squash are
     a hovering env's (CartPole's +1 for staying upright became a penalty of -0.69; T45-B10)."""
-    if not isinstance(env, gym.Env) or (hover and not _hovers(env)):
+    if not isinstance(env, gym.Env):
         raise NeurohoverError(f"env={brief(env)} is not allowed: give a gymnasium Env (gymnasium.make('neurohover/GHH08-Short-v0'), a HoverEnv)")
+    if hover and not _hovers(env):
+        raise NeurohoverError(
+            f"env={brief(env)} is not allowed: it flies a {type(env.unwrapped).__name__}, not a neurohover HoverEnv, whose observations, "
+            "actions and rewards this wrapper transforms; give a neurohover env (gymnasium.make('neurohover/GHH08-Short-v0'))"
+        )
 
 
 def _hovers(env: gym.Env) -> bool:

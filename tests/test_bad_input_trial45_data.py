@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import neurohover  # noqa: F401  (registers the neurohover/ ids)
+from neurohover.envs.rl import ScaledAction, ScaledObservation
 from neurohover.errors import NeurohoverError
 from neurohover.flightdata import FlightData
 from neurohover.models import Transitions, check_vector, learn_lr, observed_return
@@ -115,9 +116,20 @@ def test_b07_observed_return_refuses_a_reading_no_flight_gives() -> None:
 
 def test_b10_crash_aware_reward_refuses_an_env_that_is_no_hover_env() -> None:
     """T45-B10: CrashAwareReward(gym.make("CartPole-v1")) was taken, CartPole's +1 for staying upright made -0.69."""
-    said = r"^env=.*CartPole.* is not allowed: give a gymnasium Env \(gymnasium.make\('neurohover/GHH08-Short-v0'\), a HoverEnv\)$"
+    said = r"^env=.*CartPole.* is not allowed: it flies a CartPoleEnv, not a neurohover HoverEnv, .*; give a neurohover env \(gymnasium.make"
     with pytest.raises(NeurohoverError, match=said):
         CrashAwareReward(gym.make("CartPole-v1"))
+
+
+@pytest.mark.parametrize(("wrap", "env_id"), [(lambda e: ScaledObservation(e), "CartPole-v1"), (lambda e: ScaledAction(e, "ghh08"), "Pendulum-v1")])
+def test_the_rl_transforms_refuse_an_env_that_is_no_hover_env(wrap, env_id: str) -> None:
+    """After T45-B10: ScaledObservation took CartPole and ScaledAction Pendulum (their first reset or step was refused);
+    both now refuse an env of other shapes at construction (an env of a helicopter's shapes stays the user's: T42-B05)."""
+    with pytest.raises(NeurohoverError, match=r"space is a Box of shape \((4|1),\), and this transform takes .* \((12|4),\)\)"):
+        wrap(gym.make(env_id))
+    assert wrap(gym.make("neurohover/GHH08-Short-v0")).reset(seed=0)[0].shape == (12,)
+    stacked = ScaledObservation(gym.wrappers.FrameStackObservation(gym.make("neurohover/GHH08-Short-v0"), 3))  # rows of 12
+    assert stacked.reset(seed=0)[0].shape == (3, 12)
     env = CrashAwareReward(gym.wrappers.RecordEpisodeStatistics(gym.make("neurohover/GHH08-Short-v0")))
     env.reset(seed=0)
     assert env.step(np.zeros(4, dtype=np.float32))[1] < 0.0

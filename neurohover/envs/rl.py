@@ -136,12 +136,26 @@ def refuse_carried(env: gym.Env, wrapper: type, transform: str) -> None:
         layer = layer.env
 
 
+def refuse_shape(env: gym.Env, kind: str, size: int, what: str) -> None:
+    """Refuse an ``env`` whose ``kind`` ("observation" or "action") space is not a Box of rows of ``size`` numbers
+    (frames stacked are rows): the RL transforms take any env of a helicopter's shapes (a user's own too), not another
+    task's (after T45-B10)."""
+    space = getattr(env, f"{kind}_space", None)
+    if not isinstance(space, gym.spaces.Box) or space.shape[-1:] != (size,):
+        shown = f"a Box of shape {space.shape}" if isinstance(space, gym.spaces.Box) else brief(space)
+        raise NeurohoverError(
+            f"env={brief(env)} is not allowed: its {kind} space is {shown}, and this transform takes {what} (a Box of shape "
+            f"({size},)); give a neurohover env (gymnasium.make('neurohover/GHH08-Short-v0')) or one of a helicopter's shapes"
+        )
+
+
 class ScaledObservation(gym.ObservationWrapper):
     """Observations of :func:`scale_observation` (the space keeps its shape and dtype; its bounds are infinite), over an
     ``env`` whose observations are not scaled already (an ``-RL-v0`` id's are: refused, T42-B04)."""
 
     def __init__(self, env: gym.Env) -> None:
         check_env(env)
+        refuse_shape(env, "observation", 12, "the 12 readings of a helicopter")  # CartPole was taken, its first reset refused
         refuse_carried(env, ScaledObservation, "its observations are divided by the crash limits")
         super().__init__(env)
 
@@ -156,6 +170,7 @@ class ScaledAction(gym.ActionWrapper):
 
     def __init__(self, env: gym.Env, task: str) -> None:
         check_env(env)
+        refuse_shape(env, "action", 4, "a helicopter's 4 controls")  # Pendulum's one torque was taken, its first step refused
         self.task = get_task_family(task).name  # refused by name, not flown with full authority (T15-18)
         refuse_carried(env, ScaledAction, "its actions in [-1, 1] are made controls")
         family = getattr(env.unwrapped, "family", None)
