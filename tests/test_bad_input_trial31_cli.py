@@ -77,7 +77,7 @@ def test_a_second_competition_into_a_folder_in_use_is_refused(cli, tmp_path: Pat
     assert lock.acquire(lambda who: who)
     try:
         rc, stdout, err = cli(*COMPETE, "--out", str(out), "--store", str(tmp_path / "other.sqlite"))
-        assert rc == 2 and f"error: out {brief(str(out))} is in use: another compete run (pid {os.getpid()} on host " in err, err
+        assert rc == 2 and f"error: --out {brief(str(out))} is in use: another compete run (pid {os.getpid()} on host " in err, err
         assert "give another output directory" in err and "results:" not in stdout
         assert sorted(p.name for p in out.iterdir()) == [".compete.lock"]
     finally:

@@ -41,6 +41,15 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
     return 0
 
 
+def _named_out(err: NeurohoverError) -> NeurohoverError:
+    """``err`` of compete(), naming its directory as the command's --out where it names the API's parameter ``out`` (its
+    path follows, as repr() or brief() shows it: a dangling link as --out said "out 'd6' is a symbolic link"; trial 45)."""
+    said = str(err)
+    if said.startswith(("out '", 'out "')):
+        err.args = ("--" + said, *err.args[1:])
+    return err
+
+
 def cmd_compete(args: argparse.Namespace) -> int:
     """Run R independent test runs of an agent; print a summary and write results and a plot."""
     from ..agents.hybrid import HybridSettings
@@ -116,6 +125,8 @@ def cmd_compete(args: argparse.Namespace) -> int:
             lr_fit=model,  # d_u, noise, model_policy, model_substeps where given (ModelEvolution checks them)
             agent_settings=agent_settings,
         )
+    except NeurohoverError as err:
+        raise _named_out(err) from None
     except KeyboardInterrupt as stop:
         from ..compete import FINISHED_RUNS
         from ..procs import stop_words

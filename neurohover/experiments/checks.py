@@ -129,7 +129,10 @@ def text_list(*allowed: str):
 
 
 def keys_list():
-    return lambda v: (isinstance(v, list) and all(isinstance(x, str) for x in v), "a list of variant keys")
+    def check(v):  # a key given twice: its row twice in the report's Table 3 (T45-A03)
+        return isinstance(v, list) and all(isinstance(x, str) for x in v) and len(set(v)) == len(v), "a list of distinct variant keys"
+
+    return check
 
 
 def resampling():

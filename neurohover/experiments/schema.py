@@ -239,6 +239,7 @@ def _check_evolution(settings: dict, task: str, where: str) -> None:
     for key in keys:  # a key is one part of its units' keys (evolve/KEY/...): "../x" was taken (eighth trial)
         if not re.fullmatch(_KEY_WORD, key):
             raise NeurohoverError(f"{where}: variant key {key!r:.60} is not allowed: give {_KEY_WORD_ALLOWED}")
+    _unique_labels(settings["variants"], "variant", where)
     for v in settings["variants"]:
         if v["sigma"] is not None and not TASK_FAMILIES[task].has_sigma:
             raise NeurohoverError(f"{where}: variant {v['key']!r} sets sigma but the task is {task!r}")
@@ -432,6 +433,22 @@ def _keyed(items: list[dict], what: str, where: str) -> None:
         raise NeurohoverError(f"{where}: {what} keys must be unique and of lower-case letters, digits, '.' and '-', got {keys}")
     for item in items:
         item["label"] = item["label"] or item["key"]
+    _unique_labels(items, what, where)
+
+
+def _unique_labels(items: list[dict], what: str, where: str) -> None:
+    """Refuse two of ``items`` (variants, conditions, fits: keyed sub-tables, their labels written in) under one label,
+    spaces aside: it names each one's row in the report's tables, its figures' legends and its ranking, which could not
+    tell them apart (two variants' "SLP, baseline seed" rows; T45-A03), as repeated group labels are refused."""
+    seen: dict[str, str] = {}
+    for item in items:
+        label, key = item["label"], item["key"]
+        other = seen.setdefault(" ".join(label.split()), key)
+        if other != key:
+            raise NeurohoverError(
+                f"{where}: {what} label {brief(label)} is not allowed on {what} {key!r}: {what} {other!r} has it; give each {what} a label "
+                "of its own (it names its rows in the report's tables and figures)"
+            )
 
 
 def variant_optimizer(experiment: dict, own: dict | None) -> dict:
