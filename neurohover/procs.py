@@ -42,6 +42,8 @@ __all__ = [
     "Terminated",
     "interrupts_survive_callbacks",
     "max_jobs",
+    "open_files_line",
+    "refuse_few_descriptors",
     "refuse_gone_cwd_for_workers",
     "sigterm_as_interrupt",
     "stop_pool",
@@ -170,6 +172,71 @@ def refuse_gone_cwd_for_workers(jobs: int) -> None:
         ) from None
 
 
+def pool_descriptors(jobs: int) -> int:
+    """The file descriptors this process needs free to start a pool of ``jobs`` workers: 2 per worker (its sentinel and
+    the pipe its task data went down), 6 for the pool's queues and wake-up pipe, 1 for multiprocessing's resource
+    tracker, and 4 while a worker is spawned (measured on Linux: one fewer free and the pool failed with EMFILE; T45-A01)."""
+    return 2 * jobs + 11
+
+
+#: What a command opens before its pool starts: the store, its lock, SQLite's second handle, compete's folder lock.
+COMMAND_DESCRIPTORS = 4
+
+
+def _descriptors() -> tuple[int, int, int] | None:
+    """(soft limit, hard limit, descriptors free below the soft limit), or None where it is unlimited or cannot be read."""
+    import resource
+
+    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    if soft == resource.RLIM_INFINITY:
+        return None
+    try:
+        held = [int(fd) for fd in os.listdir("/proc/self/fd")]  # Linux; the listing's own descriptor among them
+    except (OSError, ValueError):
+        return None
+    return soft, hard, soft - (sum(fd < soft for fd in held) - 1)
+
+
+def _limit_words(soft: int, hard: int) -> str:
+    import resource
+
+    return f"`ulimit -n`, the open-files limit, is {soft}; its hard limit {'unlimited' if hard == resource.RLIM_INFINITY else hard}"
+
+
+def refuse_few_descriptors(jobs: int, name: str = "--jobs", opened: int = COMMAND_DESCRIPTORS) -> None:
+    """Refuse ``jobs`` worker processes (more than 1) when the open-files limit leaves too few descriptors free to start
+    them and to open the ``opened`` files a command opens first: the pool failed with a bare "Too many open files", a
+    new output folder and an empty store left behind (T45-A01). Called before anything is written."""
+    found = _descriptors()
+    if found is None:
+        return
+    soft, hard, free = found
+    need = pool_descriptors(jobs) + opened
+    if free >= need:
+        return
+    fewer = f" or give fewer {name} ({name} 1 starts no worker process)" if name == "--jobs" else ", or start fewer workers"
+    workers = f"{jobs} worker process{'es' if jobs > 1 else ''}"
+    target = soft - free + need  # the limit that leaves them free (1024, the usual one, where the hard limit allows it)
+    suggest = target if 1024 <= target or hard < 1024 else 1024
+    raise NeurohoverError(
+        f"{name} {jobs} is not allowed here: starting {workers} needs {need} free file descriptors, and {free} are free "
+        f"({_limit_words(soft, hard)}); raise the limit (`ulimit -n {suggest}`){fewer}"
+    )
+
+
+def open_files_line(err: OSError, takes_jobs: bool) -> str:
+    """The one line for a command ended by EMFILE or ENFILE (too many open files), naming the limit and what to do."""
+    import errno
+
+    found = _descriptors()
+    limit = f" ({_limit_words(found[0], found[1])})" if found else ""
+    fewer = " or give fewer --jobs" if takes_jobs else ""
+    where = f" opening {str(err.filename)!r:.120}" if err.filename else ""
+    if err.errno == errno.ENFILE:
+        return f"too many open files on this system{where} (its table of open files is full, /proc/sys/fs/file-max): close other programs{fewer}"
+    return f"too many open files{where}{limit}: raise the limit (`ulimit -n 1024` or more){fewer}"
+
+
 def worker_pool(jobs: int) -> ProcessPoolExecutor:
     """A pool of ``jobs`` (1 to :func:`max_jobs`) spawned worker processes that exit when this process dies.
 
@@ -182,6 +249,7 @@ def worker_pool(jobs: int) -> ProcessPoolExecutor:
         raise NeurohoverError(f"jobs={brief(jobs)} is not allowed: give at most {max_jobs()} worker processes (the cores this process may use)")
     jobs = int(jobs)
     refuse_gone_cwd_for_workers(jobs)
+    refuse_few_descriptors(jobs, "jobs", opened=0)
     main = threading.current_thread() is threading.main_thread()
     _start_resource_tracker()  # before the pool's queues register their semaphores with it
     return _Pool(max_workers=jobs, mp_context=multiprocessing.get_context("spawn"), initializer=watch_parent, initargs=(os.getpid(), main))

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import errno
 import io
 import itertools
 import os
@@ -263,6 +264,12 @@ def _run(argv: Sequence[str] | None) -> int:
         os.dup2(devnull, sys.stdout.fileno())  # so that the interpreter's own flush at exit does not fail again
         return 1
     except OSError as err:  # what no check foresaw (a name too long, a full disk inside a library): one line, not a traceback
+        if err.errno in (errno.EMFILE, errno.ENFILE):  # the limit and what to do, not a bare "Too many open files" (T45-A01)
+            from ..procs import open_files_line
+
+            print(f"neurohover {args.command}: error: {open_files_line(err, hasattr(args, 'jobs'))}", file=sys.stderr)
+            remove_created_dirs()
+            return 2
         where = f": {str(err.filename)!r:.120}" if err.filename else ""
         print(f"neurohover {args.command}: error: {shorter_numbers(f'{err.strerror or err}{where}')}", file=sys.stderr)
         remove_created_dirs()

@@ -25,7 +25,7 @@ from typing import Any
 
 from ..errors import NeurohoverError, brief, whole_number
 from ..evaluate import DEVICES, check_device
-from ..procs import max_jobs, refuse_gone_cwd_for_workers, sigterm_as_interrupt, stop_pool, worker_pool
+from ..procs import max_jobs, refuse_few_descriptors, refuse_gone_cwd_for_workers, sigterm_as_interrupt, stop_pool, worker_pool
 from .store import worker_name
 from .store_checks import EXECUTORS
 from .units import Unit, run_unit
@@ -51,6 +51,8 @@ def check_jobs(jobs) -> int:
     if not 1 <= int(jobs) <= cores:
         raise NeurohoverError(f"--jobs {brief(jobs)} is out of range: allowed an integer in 1..{cores} (the cores this process may use)")
     refuse_gone_cwd_for_workers(int(jobs))  # before anything is written (T32-A06)
+    if jobs > 1:  # too low an open-files limit for the workers, too (T45-A01)
+        refuse_few_descriptors(int(jobs))
     return int(jobs)  # np.int64(2) as 2
 
 
@@ -185,10 +187,20 @@ def check_ray_address(address: str, source: str = "--address") -> None:
             reason = f"unknown host {host!r}"
         else:
             reason = (err.strerror or str(err)).lower()
+        instead = "unset RAY_ADDRESS and leave out --address" if source == "RAY_ADDRESS" else "leave out --address"
         raise NeurohoverError(
             f"{source} {address!r}: no Ray cluster is listening at {host}:{port} ({reason}); start one first "
-            f"(`ray start --head` prints its address) or leave out --address to start a local Ray instance"
+            f"(`ray start --head` prints its address) or {instead} to start a local Ray instance"
         ) from None
+
+
+def ray_address_used(address: str | None) -> tuple[str, str | None]:
+    """Where the cluster that ``ray.init(address)`` joins is named, and its address: ``RAY_ADDRESS`` (when set and
+    not empty) for ``address`` None or ``auto``, as Ray reads it; ``--address`` itself otherwise."""
+    env = os.environ.get("RAY_ADDRESS") or None
+    if address in (None, "auto") and env is not None:
+        return "RAY_ADDRESS", env
+    return "--address", address
 
 
 def _one_line(err: BaseException) -> str:
@@ -216,8 +228,9 @@ class RayExecutor:
         self.ray = ray
         self.started = False
         if not ray.is_initialized():
-            # ray.init(address=None) joins the cluster named by RAY_ADDRESS, so check that one too.
-            source, given = ("--address", address) if address is not None else ("RAY_ADDRESS", os.environ.get("RAY_ADDRESS") or None)
+            # ray.init(address=None or "auto") joins the cluster that RAY_ADDRESS names, so check that one too (with
+            # --address auto it was not checked, and Ray retried a dead one without end; T45-A02).
+            source, given = ray_address_used(address)
             if given is not None:
                 check_ray_address(given, source)
             kwargs: dict[str, Any] = {"include_dashboard": False, "log_to_driver": True}
