@@ -43,6 +43,7 @@ __all__ = [
     "interrupts_survive_callbacks",
     "max_jobs",
     "open_files_line",
+    "cannot_open_line",
     "refuse_few_descriptors",
     "refuse_gone_cwd_for_workers",
     "sigterm_as_interrupt",
@@ -235,6 +236,14 @@ def open_files_line(err: OSError, takes_jobs: bool) -> str:
     if err.errno == errno.ENFILE:
         return f"too many open files on this system{where} (its table of open files is full, /proc/sys/fs/file-max): close other programs{fewer}"
     return f"too many open files{where}{limit}: raise the limit (`ulimit -n 1024` or more){fewer}"
+
+
+def cannot_open_line(said: str) -> str:
+    """What follows "the results store X" where SQLite could not open a file it needs (SQLITE_CANTOPEN, ``said`` its
+    words): the open-files limit or the folder, not damage (a healthy store was called damaged; T45-A01)."""
+    found = _descriptors()
+    limit = f"too few open files allowed ({_limit_words(found[0], found[1])}: raise it, e.g. `ulimit -n 1024`) or " if found and found[0] < 1024 else ""
+    return f"could not open a file it needs (SQLite says: {said}): {limit}its folder's permissions; the store itself is not damaged"
 
 
 def worker_pool(jobs: int) -> ProcessPoolExecutor:

@@ -107,3 +107,23 @@ def test_make_executor_ray_auto_checks_the_ray_address_it_reads(monkeypatch) -> 
     monkeypatch.setattr(ray, "init", lambda *a, **k: pytest.fail("ray.init was called"))
     with pytest.raises(NeurohoverError, match=r"^RAY_ADDRESS '127.0.0.1:1': no Ray cluster is listening at 127.0.0.1:1"):
         make_executor("ray", address="auto")
+
+
+def test_a_store_sqlite_cannot_open_a_file_for_is_not_called_damaged(cli, monkeypatch, tmp_path: Path) -> None:
+    """T45-A01's close: under `ulimit -n 7` SQLite could not open the store's journal (SQLITE_CANTOPEN), and a healthy
+    store was called "damaged or no results store"; it now names the open-files limit or the folder instead."""
+    import sqlite3
+
+    import neurohover.compete
+
+    def fail(*args, **kwargs):
+        err = sqlite3.OperationalError("unable to open database file")
+        err.sqlite_errorcode = sqlite3.SQLITE_CANTOPEN  # as SQLite's own error carries it
+        raise err
+
+    monkeypatch.setattr(neurohover.compete, "compete", fail)
+    monkeypatch.setattr(resource, "getrlimit", lambda which: (64, 64))  # a low limit, as the trial's
+    rc, _, err = cli("compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "1", "--out", str(tmp_path / "c"))
+    assert rc == 2 and "damaged or is no results store" not in err, err
+    assert "could not open a file it needs (SQLite says: unable to open database file): too few open files allowed" in err, err
+    assert "the open-files limit, is 64" in err and "the store itself is not damaged" in err

@@ -245,6 +245,12 @@ def _run(argv: Sequence[str] | None) -> int:
             print(f"neurohover {args.command}: error: cannot write the results store{which} ({err}); its finished units are kept", file=sys.stderr)
             remove_created_dirs()
             return 2
+        if getattr(err, "sqlite_errorcode", None) == sqlite3.SQLITE_CANTOPEN:  # a file it could not open, not damage
+            from ..procs import cannot_open_line  # a healthy store was called damaged under `ulimit -n 7` (T45-A01)
+
+            print(f"neurohover {args.command}: error: the results store{which} {cannot_open_line(str(err)[:60])}", file=sys.stderr)
+            remove_created_dirs()
+            return 2
         print(
             f"neurohover {args.command}: error: the results store{which} cannot be read ({str(err)[:60]}): it is damaged or is no results store",
             file=sys.stderr,
