@@ -71,6 +71,13 @@ def test_an_evolution_config_refuses_two_variants_under_one_label(tmp_path: Path
     assert [v["label"] for v in _config(tmp_path, EVOLUTION.replace("LABEL", "SLP, zero seed")).settings["variants"]][1] == "SLP, zero seed"
 
 
+@pytest.mark.parametrize("label", ["   ", " \u3000 "])
+def test_a_label_of_spaces_only_is_refused(tmp_path: Path, label: str) -> None:
+    """Trial 45's fixer's note: a variant's (or condition's, fit's, group's) label of spaces only was taken, an empty row."""
+    with pytest.raises(NeurohoverError, match=r"variants\[1\]: label = .* is not allowed: expected a non-empty string \(not only spaces\)"):
+        _config(tmp_path, EVOLUTION.replace("LABEL", label))
+
+
 @pytest.mark.parametrize(("lst", "what"), [("conditions", "condition"), ("fits", "fit")])
 def test_a_model_learning_config_refuses_two_conditions_or_fits_under_one_label(tmp_path: Path, lst: str, what: str) -> None:
     """Condition 'a' labelled 'b', and condition 'b' whose label is its key: the report's rows were keyed by label."""
