@@ -238,23 +238,7 @@ def _run(argv: Sequence[str] | None) -> int:
         remove_created_dirs()  # a failed command leaves no empty output directory behind
         return 2
     except sqlite3.DatabaseError as err:  # a store file damaged mid-file, or not a store at all
-        from ..experiments.store_checks import write_failed
-
-        which = f" {str(args.store)!r}" if getattr(args, "store", None) else ""
-        if write_failed(err):  # the disk or a file-size limit, not the store (it was called damaged; eighth trial, T32-A04)
-            print(f"neurohover {args.command}: error: cannot write the results store{which} ({err}); its finished units are kept", file=sys.stderr)
-            remove_created_dirs()
-            return 2
-        if getattr(err, "sqlite_errorcode", None) == sqlite3.SQLITE_CANTOPEN:  # a file it could not open, not damage
-            from ..procs import cannot_open_line  # a healthy store was called damaged under `ulimit -n 7` (T45-A01)
-
-            print(f"neurohover {args.command}: error: the results store{which} {cannot_open_line(str(err)[:60])}", file=sys.stderr)
-            remove_created_dirs()
-            return 2
-        print(
-            f"neurohover {args.command}: error: the results store{which} cannot be read ({str(err)[:60]}): it is damaged or is no results store",
-            file=sys.stderr,
-        )
+        print(f"neurohover {args.command}: error: {_store_failure(args, err)}", file=sys.stderr)
         remove_created_dirs()
         return 2
     except KeyboardInterrupt as stop:
@@ -280,6 +264,20 @@ def _run(argv: Sequence[str] | None) -> int:
         print(f"neurohover {args.command}: error: {shorter_numbers(f'{err.strerror or err}{where}')}", file=sys.stderr)
         remove_created_dirs()
         return 2
+
+
+def _store_failure(args: argparse.Namespace, err: sqlite3.DatabaseError) -> str:
+    """The line for an SQLite error no check foresaw: a write that failed, a file SQLite could not open, or damage."""
+    from ..experiments.store_checks import write_failed
+
+    which = f" {str(args.store)!r}" if getattr(args, "store", None) else ""
+    if write_failed(err):  # the disk or a file-size limit, not the store (it was called damaged; eighth trial, T32-A04)
+        return f"cannot write the results store{which} ({err}); its finished units are kept"
+    if getattr(err, "sqlite_errorcode", None) == sqlite3.SQLITE_CANTOPEN:  # a file it could not open, not damage
+        from ..procs import cannot_open_line  # a healthy store was called damaged under `ulimit -n 7` (T45-A01)
+
+        return f"the results store{which} {cannot_open_line(str(err)[:60])}"
+    return f"the results store{which} cannot be read ({str(err)[:60]}): it is damaged or is no results store"
 
 
 def _prints_only(args: argparse.Namespace) -> bool:
