@@ -6,6 +6,7 @@ refused; CleanRL's obs_rms.pkl, the trial's note, was read with an unrestricted 
 from __future__ import annotations
 
 import base64
+import io
 import json
 import pickle
 from pathlib import Path
@@ -178,3 +179,29 @@ def test_a_manifests_seconds_below_its_policies_seconds_are_taken(tmp_path: Path
     loaded = load_policy_set("ghh08", pd)
     assert loaded.manifest["seconds"] == 0.5
     assert sum(p.metadata["seconds"] for p in (loaded.generic, *loaded.specialised)) > 300
+
+
+def test_a_state_naming_pycma_classes_where_older_pycma_keeps_them_is_read(monkeypatch) -> None:
+    """After T45-B03: pycma 3.4 pickles CMAOptions as cma.evolution_strategy's (4.4 on: cma.options_parameters'), 4.0
+    BoundTransform as cma.constraints_handler's; the allow-list named the modules of 4.5 only, so every pycma the
+    package takes before 4.4 (cma>=3.4) had its own checkpoints refused. Here 4.5's class pickled under 3.4's module."""
+    import cma.evolution_strategy
+    import cma.options_parameters
+
+    assert cma.evolution_strategy.CMAOptions is cma.options_parameters.CMAOptions
+    monkeypatch.setattr(cma.options_parameters.CMAOptions, "__module__", "cma.evolution_strategy")
+    opt = CMAES(np.zeros(5), 0.3, seed=1)
+    state = opt.state_dict()
+    named = []
+
+    class Recorder(pickle.Unpickler):
+        def find_class(self, module, name):
+            named.append((module, name))
+            return super().find_class(module, name)
+
+        def persistent_load(self, pid):
+            return None
+
+    Recorder(io.BytesIO(base64.b64decode(state["pickle"]))).load()
+    assert ("cma.evolution_strategy", "CMAOptions") in named and ("cma.options_parameters", "CMAOptions") not in named
+    np.testing.assert_array_equal(CMAES.from_state_dict(state).ask(), opt.ask())

@@ -71,23 +71,28 @@ _MOVED = {
 }
 
 
-#: The globals a CMA or UH-CMA state's pickle names (found by pickling the states of both optimisers, with pycma 4.5,
-#: in 2 to 301 dimensions, after many generations, a popsize, budget and noise handler's settings of each kind, and a run to pycma's own stop;
-#: numpy.core is NumPy 1's name of numpy._core): nothing else is looked up when a state is read back. Any class of a
-#: ``cma.*`` module was let through, and cma.logger.Logger deleted a file or made directories before the checkpoint was
-#: refused (T45-B03; os.mkdir: T23-12).
-_PYCMA = {
-    "cma.boundary_handler": ("BoundNone", "BoundTransform"),
-    "cma.evolution_strategy": ("CMAEvolutionStrategy", "_CMASolutionDict_functional", "_CMAStopDict", "_StopTolXStagnation", "_pass"),
-    "cma.logger": ("CMADataLogger",),
-    "cma.optimization_tools": ("BestSolution", "NoiseHandler"),
-    "cma.options_parameters": ("CMAOptions", "CMAParameters", "is_feasible"),
-    "cma.recombination_weights": ("RecombinationWeights",),
-    "cma.sampler": ("GaussFullSampler",),
-    "cma.sigma_adaptation": ("CMAAdaptSigmaCSA", "CMAAdaptSigmaTPA", "_TPAParameters"),  # TPA: 300 genes or more
-    "cma.transformations": ("DiagonalDecoding", "GenoPheno", "RoundIntegerVariables"),
-    "cma.utilities.utils": ("BlancClass", "DictFromTagsInString", "ElapsedWCTime", "MoreToWrite", "SolutionDict"),
-}
+#: The names of pycma's globals a CMA or UH-CMA state's pickle holds, in whichever ``cma.*`` module the installed pycma
+#: keeps them (found by pickling the states of both optimisers with pycma 3.4, 4.0, 4.2, 4.3, 4.4 and 4.5, in 5 to 301
+#: dimensions, after several generations, with a budget, and in earlier trials a noise handler's settings of each kind and
+#: a run to pycma's own stop: CMAOptions moved from cma.evolution_strategy to cma.options_parameters, BoundTransform from
+#: cma.constraints_handler to cma.boundary_handler): nothing else of pycma is looked up when a state is read back. Any
+#: class of a ``cma.*`` module was let through, and cma.logger.Logger deleted a file or made directories before the
+#: checkpoint was refused (T45-B03; os.mkdir: T23-12).
+_PYCMA = frozenset(
+    {
+        "BestSolution", "BlancClass", "BoundNone", "BoundTransform", "CMAAdaptSigmaCSA", "CMAAdaptSigmaTPA", "CMADataLogger",
+        "CMAEvolutionStrategy", "CMAOptions", "CMAParameters", "DiagonalDecoding", "DictFromTagsInString", "ElapsedWCTime",
+        "GaussFullSampler", "GenoPheno", "MoreToWrite", "NoiseHandler", "RecombinationWeights", "RoundIntegerVariables",
+        "SolutionDict", "_CMAParameters", "_CMASolutionDict_functional", "_CMAStopDict", "_StopTolXStagnation", "_TPAParameters",
+        "_pass", "is_feasible",
+    }
+)  # fmt: skip
+
+
+def _of_pycma(module: str, name: str) -> bool:
+    """Whether ``module.name`` is one of :data:`_PYCMA`'s globals of pycma."""
+    return (module == "cma" or module.startswith("cma.")) and name in _PYCMA
+
 
 #: The globals a state's pickle calls (pickle's REDUCE): NumPy's array, scalar, dtype and generator rebuilders and plain
 #: data. pycma's and neurohover's classes are only made empty and filled (NEWOBJ, BUILD), never called: a call of
@@ -100,13 +105,13 @@ _CALLED = frozenset(
         ("numpy.random.bit_generator", "__pyx_unpickle_SeedSequence"),
         *((core, name) for core in ("numpy._core.multiarray", "numpy.core.multiarray") for name in ("_reconstruct", "scalar")),
         *(("builtins", name) for name in ("range", "slice", "complex", "set", "frozenset", "bytearray", "object")),  # plain data
+        ("collections", "OrderedDict"),  # pycma 4.2 to 4.4's options
     }
 )
 
 _PICKLED = frozenset(
     {
         *_CALLED,
-        *((module, name) for module, names in _PYCMA.items() for name in names),
         ("neurohover.evolution.common", "ChampionRecord"),
         ("neurohover.evolution.common", "ChampionTracker"),
         ("neurohover.evolution.common", "Clock"),
@@ -210,7 +215,7 @@ class _Unpickler(pickle._Unpickler):
         """Only what a CMA state holds (:data:`_PICKLED`): any other global was looked up and called as the pickle said,
         and made a directory (os.mkdir, T23-12) or deleted a file (cma.logger.Logger, T45-B03) before the resume was refused."""
         moved = _MOVED.get((module, name))
-        if moved is None and (module, name) not in _PICKLED:
+        if moved is None and (module, name) not in _PICKLED and not _of_pycma(module, name):
             raise EntryError(f"its pickle names {brief(f'{module}.{name}')}, which no CMA state holds: allowed the pickle state_dict() wrote")
         found = getattr(*moved) if moved is not None else super().find_class(module, name)
         self.global_ids.add(id(found))
