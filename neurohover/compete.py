@@ -441,13 +441,37 @@ def _run_order(key: str) -> tuple[int, int]:
     return (index if index is not None else -1, parsed.rep if parsed.rep is not None else 0)
 
 
+def _store_of(folder: Path, recorded: object, name: str, scale: str) -> str | None:
+    """The store :func:`check_against_store` reads for compete folder ``folder``, whose summary records ``recorded`` and
+    experiment (name, scale), or None: the folder's own :data:`STORE_FILE` (compete's default store, which travels with
+    the folder) where it holds the experiment at that scale, else the recorded path where a file is there, else the
+    folder's own. A folder moved elsewhere was not checked at all, and once a new study ran at its old path it was checked
+    against that study's store (T46-B05, T46-B06); an own file left by an earlier compete into the same folder, whose
+    summary names its --store, is not this competition's store, and is not read."""
+    from .experiments import Store
+
+    own = folder / STORE_FILE
+    there = recorded if isinstance(recorded, str) and Path(recorded).is_file() else None
+    if not own.is_file():
+        return there
+    if there is not None:
+        held = Store(own, create=False)
+        try:
+            if (name, scale) not in {(n, s) for n, s, _, _ in held.experiments()}:
+                return there
+        finally:
+            held.close()
+    return str(own)
+
+
 def check_against_store(folder: str | Path) -> None:
     """Refuse a compete folder whose ``summary.json`` names a flight condition (sigma, sensor, drift, episode steps, seed)
     that the config its store holds contradicts (a sensor edited into the summary labelled curves with a condition never
     flown, and nothing in the folder contradicts it; T38-B06). ``neurohover plot --compete`` calls it after
-    :func:`~neurohover.compete_files.read_compete_dir` (whose layer reads no store). The summary names its store by its
-    absolute path (a relative one, which older versions wrote, from the working directory); a store no longer there, or
-    holding no such experiment, is not read; one holding the experiment at other scales only refuses the summary's
+    :func:`~neurohover.compete_files.read_compete_dir` (whose layer reads no store). The store read is the folder's own
+    results.sqlite, compete's default store, which moves with the folder (:func:`_store_of`); else the one the summary
+    names by its absolute path (a relative one, which older versions wrote, from the working directory); a store no
+    longer there, or holding no such experiment, is not read; one holding the experiment at other scales only refuses the summary's
     (T42-A02), and one holding the summary's scale under another experiment refuses its name: a settings-HASH digests
     the agent and task with the settings, so it names one competition (agent and experiment edited together; T45-B09)."""
     from .experiments import Store
@@ -457,8 +481,9 @@ def check_against_store(folder: str | Path) -> None:
     if not summary_path.is_file():
         return
     summary = strict_json(summary_path.read_bytes())  # read_compete_dir has checked it
-    store, name, scale = (summary.get(key) for key in ("store", "experiment", "scale"))
-    if not (isinstance(store, str) and isinstance(name, str) and isinstance(scale, str) and Path(store).is_file()):
+    name, scale = summary.get("experiment"), summary.get("scale")
+    store = _store_of(Path(folder), summary.get("store"), name, scale) if isinstance(name, str) and isinstance(scale, str) else None
+    if store is None:
         return
     held = Store(store, create=False)
     try:

@@ -51,6 +51,7 @@ from .store_checks import (
     check_executor,
     check_experiment,
     check_store_file,
+    check_tables,
     check_text,
     config_differs,
     config_problem,
@@ -63,7 +64,6 @@ from .store_checks import (
     session_problem,
     sqlite_says,
     stored_count,
-    table_columns,
     take_writer_lock,
     time_allowed,
     unit_texts,
@@ -254,16 +254,7 @@ class Store:
         made = c.execute("SELECT type, name FROM sqlite_master WHERE type IN ('trigger', 'view') OR (type = 'index' AND sql IS NOT NULL)").fetchone()
         if made is not None:  # a trigger that dropped each unit written made compete fail with "results holds none" (T33-B14)
             raise NeurohoverError(f"results store {str(self.path)!r} holds a {made[0]} {made[1]!r} neurohover did not make; give another --store file")
-        for table, columns in table_columns(_SCHEMA).items():  # a dropped column was found only after reproduce had written (T19-04)
-            have = [r[1] for r in c.execute(f"PRAGMA table_info({table})")]
-            lacking = [col for col in columns if col not in have]
-            if lacking:
-                what = "is missing" if not have else f"lacks column(s) {', '.join(lacking)}"
-                raise NeurohoverError(f"results store {str(self.path)!r} is damaged: its table {table} {what}; give another --store file")
-            extra = ", ".join(repr(col) for col in have if col not in columns)  # reproduce flew, then failed to write (T35-B06)
-            if extra:
-                made = f"column(s) {extra} in its table {table} that neurohover did not make"
-                raise NeurohoverError(f"results store {str(self.path)!r} holds {made}; give another --store file")
+        check_tables(c, str(self.path), _SCHEMA)  # each table's columns (T19-04, T35-B06) and keys (T46-B03)
 
     # ------------------------------------------------------------------ experiments
 

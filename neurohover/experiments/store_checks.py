@@ -46,6 +46,59 @@ def table_columns(schema: str) -> dict[str, list[str]]:
         return {t: [r[1] for r in c.execute(f"PRAGMA table_info({t})")] for t in tables}
 
 
+def table_keys(conn: sqlite3.Connection, table: str) -> tuple[tuple[str, ...], frozenset[tuple[str, ...]], tuple[str, ...]]:
+    """Table ``table``'s primary key (its columns in key order), the columns of each of its unique indexes, and its NOT
+    NULL columns, as ``conn`` holds them."""
+    info = list(conn.execute(f"PRAGMA table_info({table})"))
+    key = tuple(r[1] for r in sorted((r for r in info if r[5]), key=lambda r: r[5]))
+    unique = frozenset(tuple(i[2] for i in conn.execute(f"PRAGMA index_info({r[1]!r})")) for r in conn.execute(f"PRAGMA index_list({table})") if r[2])
+    return key, unique, tuple(r[1] for r in info if r[3])
+
+
+@functools.cache
+def schema_keys(schema: str) -> dict[str, tuple[tuple[str, ...], frozenset[tuple[str, ...]], tuple[str, ...]]]:
+    """Each table's :func:`table_keys` as ``schema`` (the store's) makes them (read from an empty store in memory)."""
+    with contextlib.closing(sqlite3.connect(":memory:")) as c:
+        c.executescript(schema)
+        return {t: table_keys(c, t) for t in table_columns(schema)}
+
+
+def check_tables(conn: sqlite3.Connection, store: str, schema: str) -> None:
+    """Refuse a store whose tables are not the ones ``schema`` (the store's) makes: a column missing (T19-04) or one
+    neurohover did not make (T35-B06), or a table rebuilt without its primary key, unique or NOT NULL constraints (a hand
+    merge of two stores, or a restore by CREATE TABLE ... AS SELECT): a unit, session or experiment held twice was listed,
+    counted and its seconds summed twice, and a second experiment row under another config hash was not seen (T46-B03, T46-B04)."""
+    for table, columns in table_columns(schema).items():
+        have = [r[1] for r in conn.execute(f"PRAGMA table_info({table})")]
+        lacking = [col for col in columns if col not in have]
+        if lacking:
+            what = "is missing" if not have else f"lacks column(s) {', '.join(lacking)}"
+            raise NeurohoverError(f"results store {store!r} is damaged: its table {table} {what}; give another --store file")
+        extra = ", ".join(repr(col) for col in have if col not in columns)
+        if extra:
+            raise NeurohoverError(
+                f"results store {store!r} holds column(s) {extra} in its table {table} that neurohover did not make; give another --store file"
+            )
+        key, unique, not_null = schema_keys(schema)[table]
+        held = table_keys(conn, table)
+        if held == (key, unique, not_null):
+            continue
+        rebuilt = "rebuilt without neurohover's constraints, by a hand merge or a restore with CREATE TABLE ... AS SELECT?"
+        fix = "give another --store file, or copy the rows (each key once) into the tables of a store neurohover made"
+        if held[:2] == (key, unique):
+            lax = ", ".join(c for c in not_null if c not in held[2])
+            raise NeurohoverError(
+                f"results store {store!r} is damaged: its table {table} lets column(s) {lax} hold NULL (its NOT NULL is gone: {rebuilt}); {fix}"
+            )
+        what = "lacks its primary key" if not held[0] else "lacks the primary key and unique constraints neurohover makes,"
+        twice = conn.execute(f"SELECT {', '.join(key)} FROM {table} GROUP BY {', '.join(key)} HAVING count(*) > 1 LIMIT 1").fetchone()
+        said = f", and holds the row of {', '.join(f'{k} {brief(v)}' for k, v in zip(key, twice))} more than once" if twice else ""
+        raise NeurohoverError(
+            f"results store {store!r} is damaged: its table {table} {what} ({', '.join(key)}){said} ({rebuilt}): a row held twice is "
+            f"read and counted twice; {fix}"
+        )
+
+
 #: How a session can end (:meth:`Store.end_session`; the runner's statuses). A session is "running" until then.
 SESSION_STATUSES = ("finished", "selection finished", "interrupted", "failed")
 #: The times a store records (a session's start, a unit's finish, an experiment's creation), in seconds since 1970: fixed
