@@ -1,14 +1,12 @@
-"""Reading ``neurohover compete --out DIR`` directories: ``episodes.csv`` and ``summary.json``, each checked against
-what compete writes and against each other (:func:`read_compete_dir`, :func:`read_compete_dirs`), as ``neurohover plot
---compete`` (:func:`neurohover.plots.plot_compete`) reads them.
+"""Reading ``neurohover compete --out DIR`` directories: ``episodes.csv`` and ``summary.json``, each checked against what compete writes and against
+each other (:func:`read_compete_dir`, :func:`read_compete_dirs`), as ``neurohover plot --compete`` (:func:`neurohover.plots.plot_compete`) reads them.
 
-A row is checked as it is read (a value compete never writes: a flag other than 0 or 1, a column it never writes, a
-run on two MDPs); a summary in one place, :func:`_check_summary`, against itself and its rows: each key compete writes
-for its kind and range (:data:`SUMMARY_FIELDS`), each figure against the one its rows give, the conditions its task
-can fly under, the MDPs its runs fly and the rows its agent writes. A key compete never writes is refused, not
-ignored (a misspelt one would leave a curve unlabelled without a word); one compete writes may be absent (older
-summaries hold fewer), as may the columns after run, episode and return in older episodes files; the offline_seconds
-column of files written before a8bc471 is read as that older layout (:data:`OLDER_COLUMNS`).
+A row is checked as it is read (a value compete never writes: a flag other than 0 or 1, a column it never writes, a run on two MDPs); a summary in one
+place, :func:`_check_summary`, against itself and its rows: each key compete writes for its kind and range (:data:`SUMMARY_FIELDS`), each figure
+against the one its rows give, the conditions its task can fly under, the MDPs its runs fly and the rows its agent writes. A key compete never writes
+is refused, not ignored (a misspelt one would leave a curve unlabelled without a word); one compete writes may be absent (older summaries hold fewer),
+as may the columns after run, episode and return in older episodes files; the offline_seconds column of files written before a8bc471 is read as that
+older layout (:data:`OLDER_COLUMNS`).
 
 Example
 -------
@@ -33,6 +31,7 @@ import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real, whole_number
 from .filekinds import refuse_cut_off
+from .flightmeta import compared_by_value
 from .paths import input_dir, number_text, refuse_special_file, strict_json
 from .sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS, MAX_SECONDS, WORST_RETURN, crash_charge, crash_return_ceiling, lowest_return, seconds_allowed
 from .sim.rng import MAX_SEED
@@ -127,7 +126,8 @@ SUMMARY_FIELDS: dict[str, tuple[Callable[[object], bool] | None, str]] = {
 }
 
 
-@dataclass(frozen=True)
+@compared_by_value  # == by value: arrays whole (T46-B08)
+@dataclass(frozen=True, eq=False)
 class CompeteResult:
     """The returns of one ``neurohover compete --out DIR``.
 
@@ -407,14 +407,14 @@ def _check_summary(path: Path, summary: dict, returns: np.ndarray, rows: _Rows) 
     (:func:`_check_summary_matches`: named with what they hold), each value's kind and range (:func:`_check_fields`),
     its offline seconds against its seconds and agent (:func:`_check_seconds`), the conditions its task can fly under
     (:func:`_check_conditions`) and the MDPs (:func:`_check_mdp_labels`)."""
-    from .tasks import TASK_NAMES
+    from .tasks import task_names
 
     unknown = next((key for key in summary if key not in SUMMARY_FIELDS), None)
     if unknown is not None:
         raise NeurohoverError(f"--compete {str(path)!r}: its key {brief(unknown)} is not allowed: compete writes the keys {', '.join(SUMMARY_FIELDS)}")
-    task = summary.get("task")
-    if task is not None and task not in TASK_NAMES:
-        raise NeurohoverError(f"--compete {str(path)!r} names task {task!r:.40}, not one of {', '.join(TASK_NAMES)}: it is no compete summary")
+    task, names = summary.get("task"), task_names()  # the registry as it is (T46-B07)
+    if task is not None and task not in names:
+        raise NeurohoverError(f"--compete {str(path)!r} names task {task!r:.40}, not one of {', '.join(names)}: it is no compete summary")
     experiment, agent = summary.get("experiment"), summary.get("agent")
     if isinstance(experiment, str) and task is not None and agent is not None and experiment != f"compete-{task}-{agent}":
         _check_summary_matches(path, summary, returns, rows)  # an agent its experiment contradicts: the summary's fault, named so
@@ -513,7 +513,7 @@ def _check_conditions(path: Path, summary: dict) -> None:
     {"level": -5} and a drift "junk" labelled the curves without a word; T22-04): sigma finite and >= 0, a sensor and a
     drift as their parsers read them (Sensor.from_dict, Drift.from_dict; no drift as compete writes Drift() too), and
     each one that its task takes (a sigma on ghh08 was taken, T23-06: compete asks the task family, as here)."""
-    from .tasks import TASK_NAMES, Drift, Sensor, get_task_family
+    from .tasks import Drift, Sensor, get_task_family, task_names
 
     task = summary.get("task")
     flown: dict[str, object] = {}  # the conditions read so far, as compete hands them to get_task_family
@@ -527,7 +527,7 @@ def _check_conditions(path: Path, summary: dict) -> None:
                 flown[key] = Sensor.from_dict(value)
             if key == "drift" and value is not None:  # {walk 0, change {}}: compete's Drift(), which from_dict calls no drift
                 flown[key] = Drift.from_dict({k: v for k, v in value.items() if k != "walk" or v != 0} if isinstance(value, dict) else value)
-            if task in TASK_NAMES:
+            if task in task_names():
                 get_task_family(task, **flown)  # type: ignore[arg-type]
         except NeurohoverError as err:
             raise NeurohoverError(f"--compete {str(path)!r} says {key} {brief(value)}, which compete never flies under: {err}") from None

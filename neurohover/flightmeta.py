@@ -12,6 +12,9 @@ refused.
 
 from __future__ import annotations
 
+from dataclasses import fields
+from typing import Any, TypeVar
+
 import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real, whole_in
@@ -205,3 +208,25 @@ def check_policy_actions(metadata: dict, observations: tuple, actions: tuple, wh
             f"step {k} of episode 0 it gives action {i} = {flown:.6g} where they record {recorded:.6g} (fly --record keeps the "
             "policy that flew them); give that policy, or null"
         )
+
+
+_D = TypeVar("_D", bound=type)
+
+
+def compared_by_value(cls: _D) -> _D:
+    """Dataclass ``cls`` (made with eq=False) given the ``==`` of :func:`neurohover.flightdata.same_values` over its
+    compared fields (not those of compare=False: arrays whole, NaN equal to NaN), and no hash, as a list has none: the
+    generated ``==`` of one holding arrays was NumPy's "truth value is ambiguous" (RunResult, RaceResult,
+    ResamplingResult, CompeteResult; T46-B08)."""
+    from .flightdata import same_values  # flightdata imports this module
+
+    names = tuple(f.name for f in fields(cls) if f.compare)
+
+    def __eq__(self: Any, other: object) -> bool:
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return same_values(tuple(getattr(self, n) for n in names), tuple(getattr(other, n) for n in names))
+
+    setattr(cls, "__eq__", __eq__)  # noqa: B010
+    setattr(cls, "__hash__", None)  # noqa: B010
+    return cls

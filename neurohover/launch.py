@@ -26,6 +26,7 @@ import numba
 import numpy as np
 
 from .errors import NeurohoverError, brief, whole_in, whole_number
+from .flightmeta import compared_by_value
 from .sim.constants import MAX_EPISODE_STEPS, MDP_ROW_LEN, ROW_SUBSTEPS, ROW_WIND_KIND, SAFEGUARD_LIMITS
 from .sim.jobs import PARK_F, PARK_U, Extras, Flown, Jobs, Parking
 from .sim.kernel import GENOME_WIDTH, POLICY_MLP, POLICY_SLP, rollout_batch
@@ -175,7 +176,8 @@ def _check_array(what: str, a: object, ndim: int, dtype: type, width: int | None
         raise NeurohoverError(f"{what}={shown} is not allowed: give a {ndim}-d {np.dtype(dtype)} numpy array{columns}")
 
 
-@dataclass(frozen=True)
+@compared_by_value  # == by value: arrays whole (T46-B08)
+@dataclass(frozen=True, eq=False)
 class Batch:
     """The jobs of one kernel launch, as the kernel reads them; checked once, here, by shape and dtype.
 

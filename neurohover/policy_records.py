@@ -183,12 +183,13 @@ def _place_problem(meta: dict) -> str:
     run evolved on) and mdp_params (that MDP) against each other ('' when they agree; T24-02). mdp_params is checked
     as every MDP is against its label (:mod:`neurohover.tasks.held`); a run over a family has
     none (a champion no longer copies its seed policy's record, T25-12)."""
-    from .tasks import TASK_NAMES
+    from .tasks import task_names
 
     task, mdp = meta.get("task"), meta.get("mdp")
     target: Any = meta.get("target")
-    if "task" in meta and not (isinstance(task, str) and task in TASK_NAMES):  # T26-B07: 'ghh10' was taken
-        return f"its task {brief(task)} is not allowed: allowed {', '.join(TASK_NAMES)} (the registered task families)"
+    names = task_names()  # the registry as it is: a family registered at run time too (T46-B07)
+    if "task" in meta and not (isinstance(task, str) and task in names):  # T26-B07: 'ghh10' was taken
+        return f"its task {brief(task)} is not allowed: allowed {', '.join(names)} (the registered task families)"
     if "mdp" in meta and not isinstance(mdp, str):
         return f"its mdp {brief(mdp)} is not allowed: give what the run was evolved on as text (G, zero, train:N, ...)"
     named = target.partition("/")[0] if isinstance(target, str) and "/" in target else None
@@ -221,15 +222,15 @@ def _named_mdp_problem(mdp: object, target: object, named: str | None) -> str:
     """A record's target naming a task family that is registered, and its mdp and target's MDP (``train:12``) one its
     family has, by the family's own parser (:meth:`TaskFamily.mdp`): with mdp_params removed, ghh10/train:0 or
     ghh08/train:12 were taken (T26-B07)."""
-    from .tasks import TASK_NAMES, get_task_family
+    from .tasks import get_task_family, task_names
 
     if named is None:
         return ""
-    spec = str(target).partition("/")[2]
-    if named not in TASK_NAMES and (_SPEC.fullmatch(spec) or _FAMILY_TARGET.fullmatch(str(target))):
-        return f"its target {brief(target)} is not allowed: {named!r} is no task family (allowed {', '.join(TASK_NAMES)}, the registered ones)"
+    spec, names = str(target).partition("/")[2], task_names()  # a family registered at run time too (T46-B07)
+    if named not in names and (_SPEC.fullmatch(spec) or _FAMILY_TARGET.fullmatch(str(target))):
+        return f"its target {brief(target)} is not allowed: {named!r} is no task family (allowed {', '.join(names)}, the registered ones)"
     for key, given in (("mdp", mdp), ("target", spec)):
-        if named in TASK_NAMES and isinstance(given, str) and _SPEC.fullmatch(given) and given != "sample":  # sample: drawn, any
+        if named in names and isinstance(given, str) and _SPEC.fullmatch(given) and given != "sample":  # sample: drawn, any
             try:
                 get_task_family(named).mdp(given)
             except NeurohoverError as err:

@@ -236,6 +236,12 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
     check_kind_keys(manifest, manifest_path, family.generic_over_distribution)
     _refuse_strays(root, family)
     targets = {"zero": family.zero().label, "family": f"{family.name}/G"}  # what each role's run evolved on
+    if family.has_sigma and manifest.get("sigma") is None:  # T46-B12: without one, sigma-0.3 generics flew at any sigma
+        what = "its sigma null" if "sigma" in manifest else "no sigma"
+        raise NeurohoverError(
+            f"policy-set manifest {str(manifest_path)!r} has {what}: not allowed for a {family.name} set, whose generics were evolved for one"
+            f" breadth (each file's target says {family.name}/G(sigma=...)): give the sigma build-policies wrote, a finite number"
+        )
     if family.has_sigma and finite_real(manifest.get("sigma")):  # T25-07: G(sigma=0.7) in a set of sigma 0.3 was taken by its prefix
         targets["family"] = f"{family.name}/G(sigma={float(manifest['sigma']):g})"
     if family.generic_over_distribution:

@@ -39,6 +39,7 @@ from ..errors import NeurohoverError, brief, check_name_text, finite_real, refus
 from ..evaluate import MAX_EPISODES_PER_CALL, DangerousState, PolicyTable, evaluate_jobs
 from ..evolution.seeding import check_seed
 from ..flightdata import FlightData
+from ..flightmeta import compared_by_value
 from ..policies import Policy
 from ..sim.constants import CRASH_STEP_PENALTY, EPISODE_STEPS, MAX_EPISODE_STEPS, WORST_RETURN, lowest_return
 from ..tasks import MDP, TaskFamily
@@ -326,7 +327,8 @@ Agent.start = _checked_start(Agent.start)  # type: ignore[method-assign]  # agen
 _CHECKED.add(Agent.start)
 
 
-@dataclass
+@compared_by_value  # == by value: arrays whole (T46-B08)
+@dataclass(eq=False)
 class RunResult:
     """Per-episode records of one test run; ``score`` is the cumulative return."""
 

@@ -144,6 +144,6 @@ class AgentSpec:
     @property
     def tasks(self) -> tuple[str, ...]:
         """The registered task families it runs on, by name (for help texts)."""
-        from ..tasks import TASK_NAMES, get_task_family
+        from ..tasks import get_task_family, task_names
 
-        return tuple(name for name in TASK_NAMES if self.applies_to(get_task_family(name)))
+        return tuple(name for name in task_names() if self.applies_to(get_task_family(name)))  # run-time entries too (T46-B07)

@@ -25,6 +25,7 @@ from typing import Any, Protocol, TypeVar
 import numpy as np
 
 from ..errors import NeurohoverError, as_floats, brief, finite_real, whole_number
+from ..flightmeta import compared_by_value
 from .state_codec import (
     STATE_DAMAGE,
     STATE_VERSION,
@@ -95,7 +96,8 @@ __all__ = [
 ]
 
 
-@dataclass(frozen=True)
+@compared_by_value  # == by value: arrays whole (T46-B08)
+@dataclass(frozen=True, eq=False)
 class TellInfo:
     """What an evolution run knows of a generation besides its fitness values; each optimiser
     reads what it uses and ignores the rest.

@@ -52,6 +52,7 @@ import numba
 import numpy as np
 
 from ..errors import NeurohoverError, brief, check_arity, finite_real, real_number, whole_number
+from ..flightmeta import compared_by_value
 from ..procs import half_free_memory
 from .common import as_floats
 
@@ -74,7 +75,8 @@ SampleFn = Callable[[np.ndarray], np.ndarray]
 RACE_RULES = ("prose", "algorithm1", "authors")
 
 
-@dataclass(frozen=True)
+@compared_by_value  # == by value: arrays whole (T46-B08)
+@dataclass(frozen=True, eq=False)
 class ResamplingResult:
     """Outcome of :func:`fixed_resampling`.
 
@@ -93,7 +95,8 @@ class ResamplingResult:
     episodes_spent: int
 
 
-@dataclass(frozen=True)
+@compared_by_value
+@dataclass(frozen=True, eq=False)
 class RaceResult:
     """Outcome of :func:`selection_race`.
 

@@ -20,7 +20,7 @@ from ..evolution.evolve import parse_resampling
 from ..evolution.races import RACE_RULES
 from ..models.model import MODEL_SUBSTEPS
 from ..sim.constants import MAX_EPISODE_STEPS
-from ..tasks import Drift, Sensor
+from ..tasks import Drift, Sensor, task_names
 
 REQUIRED = object()
 OMIT = object()  # default of a setting added later: absent from the resolved config unless given (older configs keep their hash)
@@ -93,6 +93,14 @@ def agent():
     def check(v):
         agents = usable_agents()  # a bad registry entry is refused as a config's agent (T44-B14)
         return isinstance(v, str) and v in agents, "one of " + ", ".join(repr(a) for a in agents)
+
+    return check
+
+
+def task_family():
+    def check(v):
+        names = task_names()  # the registry as it is, as agent() reads its own: run-time entries too (T46-B07)
+        return isinstance(v, str) and v in names, "one of " + ", ".join(repr(a) for a in names)
 
     return check
 

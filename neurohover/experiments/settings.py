@@ -21,7 +21,6 @@ from ..integrations.neat import NEAT_TOPOLOGY
 from ..models.lr import D_U_CHOICES, DEFAULT_NOISE_ESTIMATE, NOISE_ESTIMATES
 from ..models.model import LEGACY_MODEL_SUBSTEPS
 from ..policysets import FGHH_GENERIC_RESAMPLING
-from ..tasks import TASK_NAMES
 from .checks import (
     MAX_EPISODES,
     MAX_RUNS,
@@ -42,6 +41,7 @@ from .checks import (
     setting,
     substeps,
     table,
+    task_family,
     text,
     text_list,
 )
@@ -126,7 +126,7 @@ class Fit:
 class ExperimentSettings:
     """What every experiment kind has."""
 
-    task: str = setting(choice(*TASK_NAMES))
+    task: str = setting(task_family())
     sigma: float | None = setting(number(0.0, 1.0), None)
     seed: int = setting(seed())
     n_steps: int = setting(integer(1, MAX_STEPS), 6000)

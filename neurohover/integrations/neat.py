@@ -45,6 +45,7 @@ from ..errors import NeurohoverError, brief, finite_real, float64_of, whole_numb
 from ..evolution.config import check_budget
 from ..evolution.fitness import FITNESS_SCALES, episode_fitness
 from ..evolution.seeding import check_seed
+from ..flightmeta import compared_by_value
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS, OBS_NAMES
 from ..tasks import MDP, TaskFamily
 
@@ -253,7 +254,8 @@ def neat_config(settings: NeatSettings):
         os.unlink(path)
 
 
-@dataclass(frozen=True)
+@compared_by_value  # == by value: arrays whole (T46-B08)
+@dataclass(frozen=True, eq=False)
 class PackedNetworks:
     """Feed-forward networks as flat arrays for :func:`forward`: per network its node evaluations in
     neat-python's order (``node_start``), per node its value slot, activation id, bias, response and

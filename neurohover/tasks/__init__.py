@@ -67,12 +67,18 @@ def entry_problem(name: object, cls: object) -> str:
     return registry_entry_problem("TASK_FAMILIES", name, cls, TaskFamily, _SHIPPED, "task family", "class")
 
 
+def task_names() -> tuple[str, ...]:
+    """The task families' names as :data:`TASK_FAMILIES` holds them now, run-time entries too and bad entries left out
+    (:func:`entry_problem`): what a policy's task and target, a compete summary's task and a config's task may name.
+    :data:`TASK_NAMES`, frozen at import, refused a champion evolved on a family registered at run time (T46-B07)."""
+    return tuple(n for n, c in list(TASK_FAMILIES.items()) if isinstance(n, str) and not entry_problem(n, c))
+
+
 def family_class(name: object) -> type[TaskFamily]:
     """The registry's class of task family ``name`` (a key of :data:`TASK_FAMILIES`), its entry checked
     (:func:`entry_problem`; NeurohoverError naming a bad one, or an unknown name with the registry's names as it is)."""
     if not isinstance(name, str) or name not in TASK_FAMILIES:
-        allowed = [n for n, c in list(TASK_FAMILIES.items()) if isinstance(n, str) and not entry_problem(n, c)]
-        raise NeurohoverError(f"unknown task {brief(name)}: allowed {', '.join(allowed)}")  # TASK_NAMES listed a deleted entry
+        raise NeurohoverError(f"unknown task {brief(name)}: allowed {', '.join(task_names())}")  # TASK_NAMES listed a deleted entry
     cls = TASK_FAMILIES[name]
     problem = entry_problem(name, cls)
     if problem:
