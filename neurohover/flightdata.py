@@ -33,6 +33,9 @@ def _check_declared_size(path: Path) -> None:
     word, where other zip readers take the first; T30-B04). Members it cannot read are left to np.load to name."""
     from .procs import half_free_memory
 
+    with open(path, "rb") as f:  # zipfile reads an archive with bytes in front; np.load took them for a pickle (T46-B02)
+        if f.read(4) not in (b"PK\x03\x04", b"PK\x05\x06"):
+            raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file: its zip archive has bytes in front of it: allowed {NPZ_WRITERS}")
     total = 0
     try:
         archive = zipfile.ZipFile(path)
@@ -62,6 +65,15 @@ def _check_declared_size(path: Path) -> None:
 
 #: What a flight-data file may be, as its refusals say.
 NPZ_WRITERS = "an .npz that neurohover or numpy.savez wrote"
+
+
+def _member_array(z, name: str, path: Path) -> np.ndarray:
+    """Array ``name`` of the open archive ``z``: np.load gives a NAME.npy that is no .npy as bytes (AttributeErrors; T46-B01)."""
+    if not isinstance(value := z[name], np.ndarray):
+        raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file: its member {name}.npy is no NumPy array: allowed {NPZ_WRITERS}")
+    return value
+
+
 #: The zip compression methods zipfile reads (stored, deflated, bzip2, lzma), and the flag bits it cannot read past:
 #: encrypted (0), compressed patched data (5), strong encryption (6).
 _ZIP_METHODS = {zipfile.ZIP_STORED: "stored", zipfile.ZIP_DEFLATED: "deflated", zipfile.ZIP_BZIP2: "bzip2", zipfile.ZIP_LZMA: "lzma"}
@@ -288,7 +300,7 @@ class FlightData:
             with np.load(path, allow_pickle=False) as z:
                 if "format" not in z.files or str(z["format"]) != FORMAT:
                     raise NeurohoverError(f"{str(path)!r} is not a neurohover flight-data file (expected format {FORMAT})")
-                lengths, obs, act = z["lengths"], z["observations"], z["actions"]
+                lengths, obs, act = (_member_array(z, name, path) for name in ("lengths", "observations", "actions"))
                 metadata = strict_json(str(z["metadata"]))  # nesting 100,000 deep was a RecursionError (ninth trial)
         except (OSError, ValueError, zipfile.BadZipFile, EOFError, KeyError, zlib.error) as err:  # zlib: damaged bytes (sixth trial)
             if isinstance(err, NeurohoverError):

@@ -75,6 +75,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import os
 import warnings
 from collections.abc import Callable
 from pathlib import Path
@@ -84,6 +85,7 @@ import numpy as np
 
 from ..errors import CheckpointReplaced, NeurohoverError, brief, check_arity, check_flag, real_number, whole_in
 from ..evaluate import MAX_EPISODES_PER_CALL, evaluate_jobs, num_threads
+from ..filekinds import held_kind
 from ..paths import output_file, sole_writer
 from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
@@ -98,6 +100,7 @@ from .records import (
     EvolutionResult,
     HistoryRecord,
     ProgressInfo,
+    check_resumed_checkpoint,
     read_checkpoint,
     read_history_csv,
     write_history_csv,
@@ -163,8 +166,14 @@ def _checkpoint_path(checkpoint, progress, resume: bool) -> Path | None:
         path = None if checkpoint is None else Path(checkpoint)
     else:  # checked before the run; a JSON name, no file of another kind (a model file was replaced; T28-B07)
         path = output_file(checkpoint, "checkpoint", kind=CHECKPOINT_KIND, suffixes=(".json",), what="a checkpoint is JSON")
+        if path.is_file() and path.stat().st_size and held_kind(path) != CHECKPOINT_KIND:  # notes.json was replaced (T46-B14)
+            raise NeurohoverError(
+                f"checkpoint {os.fspath(checkpoint)!r} is a file neurohover did not write: give another path (writing {CHECKPOINT_KIND} there would destroy it)"
+            )
     if resume and path is None:
         raise NeurohoverError("resume=True needs the checkpoint path")
+    if resume and path is not None:
+        check_resumed_checkpoint(path)  # a directory or a pipe was "does not exist" (T46-B13)
     return None if path is None else path.absolute()
 
 
@@ -250,7 +259,8 @@ def evolve(
     checkpoint : path, optional
         Checkpoint file, written every ``checkpoint_every_s`` seconds, at the end and on interrupt. A relative path
         is taken from the folder current when the run starts; while it runs, another run on the same checkpoint is
-        refused (a writer lock, ``.NAME.lock`` beside it, as the CLI's ``--out``).
+        refused (a writer lock, ``.NAME.lock`` beside it, as the CLI's ``--out``). A file there that is no checkpoint
+        (another neurohover kind, or one neurohover did not write) is refused, not replaced; an empty file is taken.
     checkpoint_every_s : float, optional
         Seconds between checkpoints (> 0; ``math.inf``: only at the end and when stopped); None: 60. Only with ``checkpoint``.
     resume : bool
@@ -294,7 +304,7 @@ def _fly_run(run: Run, path: Path | None, resume: bool, threads: int | None, dev
             held.enter_context(sole_writer(path, "checkpoint"))
             # once the lock is held: a run refused as a second writer warned first that it replaced the checkpoint (T43-B16);
             # a notebook's cell run again replaced an unfinished run's without a word (T38-B08), as the CLI says
-            if not resume and path.is_file():
+            if not resume and path.is_file() and path.stat().st_size:  # an empty file holds no run's checkpoint (T46-B14)
                 warnings.warn(f"checkpoint {str(path)!r} holds a run's checkpoint: this run starts afresh and replaces it (resume=True continues it)",
                               CheckpointReplaced, stacklevel=3)  # fmt: skip
         _prepare(run, path, resume, threads, device, trace)

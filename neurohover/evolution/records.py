@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import NeurohoverError, brief, first_difference, whole_number
 from ..filekinds import CSV_KINDS, JSON_KINDS, refuse_cut_off
-from ..paths import JSONError, input_file, number_text, output_file, strict_json, writer_file, writing
+from ..paths import JSONError, input_file, number_text, output_file, refuse_special_file, strict_json, writer_file, writing
 from ..policies import Policy
 from .common import EntryError, enc_float, read_count, read_return, read_seconds
 
@@ -287,8 +287,17 @@ def write_checkpoint(path: Path, state: dict) -> None:
         raise
 
 
+def check_resumed_checkpoint(path: Path) -> None:
+    """Refuse a checkpoint to resume from that is there but no regular file as a run without resume does: a directory
+    or a pipe was said not to exist (T46-B13)."""
+    if path.is_dir():
+        raise NeurohoverError(f"checkpoint {str(path)!r} is a directory; give a file path")
+    refuse_special_file(path, "checkpoint")
+
+
 def read_checkpoint(path: Path) -> dict:
-    """The JSON a checkpoint file holds (NeurohoverError if it is missing or not JSON)."""
+    """The JSON a checkpoint file holds (NeurohoverError if it is missing, no regular file or not JSON)."""
+    check_resumed_checkpoint(path)
     if not path.is_file():
         raise NeurohoverError(f"no checkpoint to resume from: {str(path)!r} does not exist")
     try:  # strictly: nested thousands deep (eighth trial), an integer of 5,000 digits (ninth trial), a key twice

@@ -34,6 +34,7 @@ import functools
 import hashlib
 import json
 import math
+import os
 import re
 import sys
 import tomllib
@@ -236,9 +237,17 @@ def _is_file(path: Path) -> bool:
         return False
 
 
+def check_experiment_name(name: object) -> None:
+    """Refuse an experiment name that is neither text nor a path: a NumPy string array was its text ("['fig2']"), and
+    load_configs took np.array(["all"]) for 'all' and two names for NumPy's "truth value is ambiguous" (T46-B09)."""
+    if not isinstance(name, str) and not (isinstance(name, os.PathLike) and isinstance(os.fspath(name), str)):
+        raise NeurohoverError(f"experiment {brief(name)} is not allowed: give one experiment's name, 'all', or a path to a .toml config file (as text)")
+
+
 def resolve_name(name: str | Path) -> Path:
     """The config file of a shipped experiment name (or alias), or of a path to a .toml file."""
-    name = str(name)  # a pathlib.Path of a .toml file too
+    check_experiment_name(name)
+    name = os.fspath(name)  # a pathlib.Path of a .toml file too
     path = Path(name)
     if name.lower().endswith(".toml"):  # base.TOML too, as .JSON and .NPZ are read (T33-A01)
         from ..paths import checked_path
@@ -557,6 +566,7 @@ def make_config(
 
 def load_configs(name: str, scale: str, overrides: dict[str, Any] | None = None) -> list[ExperimentConfig]:
     """``all`` (every shipped experiment) or one name / path."""
+    check_experiment_name(name)
     if name == "all":
         return [load_config(n, scale, overrides) for n in shipped_configs()]
     return [load_config(name, scale, overrides)]

@@ -26,7 +26,7 @@ from .report_claims import PAPER_FIGURES, DiscussionError, claims_section, concl
 from .report_evolution import EvolutionSection
 from .report_factorial import FitFactorial
 from .report_models import ModelLearningSection, SensorModels
-from .report_readme import Status, fill_generated, linked_claims, status_table
+from .report_readme import Status, check_readme, fill_generated, linked_claims, status_table
 from .report_scale import header_note, paper_protocol, quick_discussion, scale_note
 from .report_testruns import TestRunsSection
 from .settings import ModelLearningSettings
@@ -171,6 +171,7 @@ def _write_report(store: Store, out: Path, scale: str | None, names: list[str] |
 
     path = out / "report.md"
     refuse_foreign_output(path, "report", REPORT_KIND)  # before any figure: only a report.md it wrote is replaced (T28-A04)
+    check_readme(out / "README.md")  # before any figure: one not UTF-8, or a block twice (T46-B10, T46-B11)
 
     entries = [(n, s) for n, s, _, _ in store.experiments() if (scale is None or s == scale) and (not names or n in names)]
     if names:

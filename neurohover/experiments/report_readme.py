@@ -16,6 +16,7 @@ import re
 from pathlib import Path
 from typing import NamedTuple
 
+from ..errors import NeurohoverError
 from .report_base import table
 
 
@@ -46,13 +47,46 @@ def _marker(key: str) -> tuple[str, str]:
     return f"<!-- generated: {key} -->", f"<!-- /generated: {key} -->"
 
 
+#: The generated blocks ``neurohover report`` fills.
+GENERATED_KEYS = ("status", "claims")
+
+
+def _pattern(key: str) -> re.Pattern[str]:
+    begin, end = _marker(key)
+    return re.compile(re.escape(begin) + r"\n.*?" + re.escape(end), re.S)
+
+
+def check_readme(path: Path) -> None:
+    """Refuse the README at ``path`` (if there is one) before the report writes anything: one that is not UTF-8 text
+    was a UnicodeDecodeError after report.md and the figures were written (T46-B10), and one holding a generated block
+    twice had the second left stale without a word (T46-B11)."""
+    if not path.is_file():
+        return
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as err:
+        from .config import _bad_byte
+
+        raise NeurohoverError(
+            f"README {str(path)!r} cannot be read: the report fills its generated blocks in UTF-8 text, and {_bad_byte(err)} is not "
+            "(save it as UTF-8); nothing written"
+        ) from None
+    except OSError as err:
+        raise NeurohoverError(f"README {str(path)!r} cannot be read ({err.strerror or type(err).__name__}); nothing written") from None
+    for key in GENERATED_KEYS:
+        if len(_pattern(key).findall(text)) > 1:
+            raise NeurohoverError(
+                f"README {str(path)!r} holds the generated block {_marker(key)[0]!r} more than once: it is filled in one place only; keep one (nothing written)"
+            )
+
+
 def fill_generated(path: Path, key: str, text: str) -> bool:
     """Replace block ``key`` of the file at ``path`` with ``text``; returns whether the file has that block."""
     if not path.is_file():
         return False
     begin, end = _marker(key)
     old = path.read_text(encoding="utf-8")
-    pattern = re.compile(re.escape(begin) + r"\n.*?" + re.escape(end), re.S)
+    pattern = _pattern(key)
     if not pattern.search(old):
         return False
     new = pattern.sub(lambda _: f"{begin}\n{text.rstrip()}\n{end}", old, count=1)
