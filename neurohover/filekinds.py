@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -57,13 +58,15 @@ REPORT_HEADER = "# Reproduction report: Koppejan & Whiteson (2011)\n"
 REPORT_KIND = "a reproduction report (report.md)"
 
 
+#: What held_kind calls an evolve run's checkpoint (its format first: told apart at any size).
+CHECKPOINT_KIND = "an evolution checkpoint"
 #: The neurohover files a JSON output can be told apart by (what it is called -> a test of its parsed JSON object):
 #: an output of one kind is not written over a file of another (T25-01 to T25-03: a policy, a checkpoint, a compete
 #: summary replaced by rows or a model without a word).
 JSON_KINDS: dict[str, Callable[[dict], bool]] = {
     "a policy file": lambda d: {"topology", "genome"} <= d.keys(),
     "a model file": lambda d: str(d.get("format", "")).startswith("neurohover-model/"),
-    "an evolution checkpoint": lambda d: str(d.get("format", "")).startswith("neurohover-evolution-checkpoint/"),
+    CHECKPOINT_KIND: lambda d: str(d.get("format", "")).startswith("neurohover-evolution-checkpoint/"),
     "a competition summary (summary.json)": lambda d: {"experiment", "agent", "task", "runs"} <= d.keys(),
     # every manifest build-policies writes (a default build's has no "optimizer"; T29-A04), and the shipped sets'
     "a policy set's manifest": lambda d: {"task", "budget", "seed", "n_steps", "built"} <= d.keys() and "rows" not in d,
@@ -132,8 +135,9 @@ def held_kind(path: str | os.PathLike) -> str | None:
             return None
         header = {c.decode("latin-1") for c in line.rstrip(b"\r").split(b",")}
         return next((kind for kind, cells in CSV_KINDS.items() if cells <= header), None)
-    if size > _KIND_READ_LIMIT:
-        return None
+    if size > _KIND_READ_LIMIT:  # a checkpoint's format comes first: one of a large genome's CMA state is told apart
+        # (evolve refuses to write its checkpoint over a file of no kind, and would have refused its own; after T46-B14)
+        return CHECKPOINT_KIND if re.match(rb'\{\s*"format"\s*:\s*"neurohover-evolution-checkpoint/', head.lstrip()) else None
     try:
         body = head if size <= _END_READ else p.read_bytes().removeprefix(UTF8_BOM)  # the head is the whole of a small file
         value = json.loads(body)

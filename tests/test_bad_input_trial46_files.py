@@ -137,3 +137,25 @@ def test_evolve_replaces_no_file_at_its_checkpoint_path_but_a_checkpoint(tmp_pat
     assert empty.read_text().startswith('{"format": "neurohover-evolution-checkpoint/')
     with pytest.warns(CheckpointReplaced, match="holds a run's checkpoint"):
         evolve(mdp, checkpoint=empty, seed=1, **RUN)
+
+
+def test_a_checkpoint_over_the_json_read_limit_is_still_a_checkpoint(tmp_path):
+    """After T46-B14: a checkpoint of a large genome's CMA state (about 1,400 genes and more) is over the 64 MiB that
+    held_kind parses, was called a file of no kind, and evolve then refused to write its own checkpoint over it."""
+    from neurohover import get_task_family
+    from neurohover.evolution import evolve
+    from neurohover.filekinds import CHECKPOINT_KIND, held_kind
+
+    big = tmp_path / "big.json"
+    with open(big, "w") as f:  # a checkpoint's format first, as run.py writes it, then 65 MiB of state
+        f.write('{"format": "neurohover-evolution-checkpoint/1", "pad": "')
+        f.write("x" * (65 * 2**20))
+        f.write('"}')
+    assert held_kind(big) == CHECKPOINT_KIND
+    mdp = get_task_family("ghh08").training_mdps()[0]
+    with pytest.warns(CheckpointReplaced, match="holds a run's checkpoint"):
+        evolve(mdp, checkpoint=big, **RUN)
+    assert big.stat().st_size < 2**20
+    other = tmp_path / "other.json"
+    other.write_text('{"notes": "' + "x" * (65 * 2**20) + '"}')
+    assert held_kind(other) is None
