@@ -249,9 +249,8 @@ def evolve(
     threads : int, optional
         Kernel threads (default: all cores); results do not depend on it. Unused on ``"cuda"``.
     device : {"cpu", "cuda"}
-        Where the candidates fly: the CPU kernel (default) or its CUDA build on a GPU
-        (:class:`~neurohover.flyer.KernelFlyer`); results agree to within docs/gpu.md's
-        tolerance. Not part of the run's config: a checkpoint resumes on either device.
+        Where the candidates fly: the CPU kernel (default) or its CUDA build on a GPU (:class:`~neurohover.flyer.KernelFlyer`);
+        results agree to within docs/gpu.md's tolerance. Not part of the run's config: a checkpoint resumes on either device.
     progress : callable, optional
         Called with a :class:`ProgressInfo` after a generation at most every ``progress_every_s``
         seconds and at the end; may raise ``KeyboardInterrupt`` to stop the run (the checkpoint is
@@ -269,12 +268,9 @@ def evolve(
         Default: steady state for an MDP, generational for a family.
     progress_every_s : float, optional
         Seconds between ``progress`` calls (>= 0; 0: every generation); None: 0.2. Only with ``progress``.
-    _trace : list, optional
-        For benchmarks: receives every kernel call's jobs (:attr:`KernelFlyer.trace
-        <neurohover.flyer.KernelFlyer>`).
-    _flown : dict, optional
-        For benchmarks: receives ``steps``, the control steps the kernel flew (a race flies some it
-        does not use: parked or look-ahead samples).
+    _trace, _flown : list, dict, optional
+        For benchmarks: receive every kernel call's jobs (:attr:`KernelFlyer.trace <neurohover.flyer.KernelFlyer>`),
+        and ``steps``, the control steps the kernel flew (a race flies some it does not use).
 
     Raises
     ------
