@@ -51,7 +51,7 @@ from .kernel import (
     update_noise,
     wind_at,
 )
-from .packed import LANES, N_PAR, ROW_CRASH, ROW_DYN, ROW_OBS, ROW_REWARD, ROWS, observe_lanes, substeps
+from .packed import LANES, N_PAR, ROW_CRASH, ROW_DYN, ROW_OBS, ROW_REWARD, ROWS, observe_lanes, or_python, substeps
 from .rng import next_normal, seed_sensor_stream, seed_stream
 
 #: At most this many lanes in flight (the queue empty), a control step's substeps run per lane with ``kernel.integrate``
@@ -156,6 +156,19 @@ def _read(B, seen, srngs, scratch, lane, t, row):
         seen[lane, m] = r[m]
 
 
+def _python_fetch_add(counter, delta):
+    """``_fetch_add`` where numba leaves the kernels as Python (``NUMBA_DISABLE_JIT=1``): its prange loops run serially
+    there, so a plain read, add and write is the atomic add (an intrinsic has no pure-Python form; T46-A03)."""
+    before = counter[0]
+    counter[0] = before + delta
+    return before
+
+
+def _python_fence() -> None:
+    """``_fence`` where numba leaves the kernels as Python: one thread, nothing to order."""
+
+
+@or_python(_python_fetch_add)
 @intrinsic
 def _fetch_add(typingctx, counter, delta):
     """Atomically add ``delta`` to ``counter[0]`` (an int64 array) and return its value before: a queue
@@ -170,6 +183,7 @@ def _fetch_add(typingctx, counter, delta):
     return sig, codegen
 
 
+@or_python(_python_fence)
 @intrinsic
 def _fence(typingctx):
     """A sequentially consistent fence: the loads after it are not hoisted above it (another thread's counts)."""
@@ -184,13 +198,13 @@ def _fence(typingctx):
 @nb.njit(cache=True)
 def _take(counter) -> int:
     """The next job index of a shared queue (one per call, every thread taking from it)."""
-    return _fetch_add(counter, 1)  # type: ignore[call-arg]  # an intrinsic: numba supplies typingctx
+    return _fetch_add(counter, 1)  # an intrinsic: numba supplies typingctx
 
 
 @nb.njit(cache=True)
 def _required_over(left) -> bool:
     """Whether a call's required jobs are all over (``left[0]``: those not over, counted down by every thread)."""
-    _fence()  # type: ignore[call-arg]  # an intrinsic: numba supplies typingctx
+    _fence()  # an intrinsic: numba supplies typingctx
     return left[0] == 0
 
 

@@ -21,6 +21,9 @@ constant, non-overlapping offsets and its SLP vectorizer packs the fully unrolle
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from fractions import Fraction
+from typing import Any
 
 import numba as nb
 from llvmlite import ir
@@ -41,6 +44,31 @@ ROWS = 43
 N_PAR = 21  # per-lane scalar parameters (P[lane]): 0-5 noise std, 6-11 d_u d_v d_w d_p d_q d_r, 12-20 wind
 
 
+def or_python(python) -> Callable[[Any], Any]:
+    """The decorated intrinsic, or ``python`` where numba leaves the kernels as Python (``NUMBA_DISABLE_JIT=1``) and calls
+    it from plain Python: "<intrinsic ...> is not usable in pure-python" ended every evolution (T46-A03)."""
+
+    def choose(compiled):
+        return python if getattr(nb.config, "DISABLE_JIT", 0) else compiled  # set from the environment at import
+
+    return choose
+
+
+def _python_fma(a: float, b: float, c: float) -> float:
+    """:func:`fma` in plain Python, rounded once as llvm.fma is (Fraction's exact sum; int / int rounds correctly)."""
+    a, b, c = float(a), float(b), float(c)
+    if not (math.isfinite(a) and math.isfinite(b) and math.isfinite(c)) or a == 0.0 or b == 0.0:
+        return a * b + c  # IEEE's own result: an exact product (a signed zero) or a non-finite operand
+    exact = Fraction(a) * Fraction(b) + Fraction(c)
+    if exact == 0:
+        return 0.0  # an exact zero sum of nonzero terms is +0 when rounding to nearest
+    try:
+        return float(exact)
+    except OverflowError:
+        return math.inf if exact > 0 else -math.inf
+
+
+@or_python(_python_fma)
 @intrinsic
 def fma(typingctx, a, b, c):
     """``a * b + c`` rounded once: llvm.fma.f64, which SLP packs into vfmadd...pd."""
