@@ -441,18 +441,36 @@ def _run_order(key: str) -> tuple[int, int]:
     return (index if index is not None else -1, parsed.rep if parsed.rep is not None else 0)
 
 
+def _holds_store(path: str | Path) -> bool:
+    """Whether ``path`` (as given: 'x.sqlite/' names no file) is a file that starts as a neurohover results store does:
+    SQLite's header, with neurohover's application id. A path that now holds an empty file, one of another kind, or
+    another program's SQLite file (an archive restored elsewhere, the path reused) holds no store, as a path with
+    nothing there; :func:`_store_of` reads neither (T46-A01)."""
+    from .experiments.store import APPLICATION_ID
+    from .filekinds import SQLITE_HEADER
+
+    try:
+        if not Path(path).is_file():  # a pipe, opened, would wait for a writer
+            return False
+        with open(path, "rb") as f:
+            head = f.read(72)  # the application id is the big-endian integer at bytes 68 to 71 of SQLite's header
+    except (OSError, ValueError):  # a directory, a path NUL in it, nothing there
+        return False
+    return head.startswith(SQLITE_HEADER) and len(head) == 72 and int.from_bytes(head[68:72], "big") == APPLICATION_ID
+
+
 def _store_of(folder: Path, recorded: object, name: str, scale: str) -> str | None:
     """The store :func:`check_against_store` reads for compete folder ``folder``, whose summary records ``recorded`` and
     experiment (name, scale), or None: the folder's own :data:`STORE_FILE` (compete's default store, which travels with
-    the folder) where it holds the experiment at that scale, else the recorded path where a file is there, else the
-    folder's own. A folder moved elsewhere was not checked at all, and once a new study ran at its old path it was checked
-    against that study's store (T46-B05, T46-B06); an own file left by an earlier compete into the same folder, whose
-    summary names its --store, is not this competition's store, and is not read."""
+    the folder) where it holds the experiment at that scale, else the recorded path where a store is there
+    (:func:`_holds_store`), else the folder's own. A folder moved elsewhere was not checked at all, and once a new study
+    ran at its old path it was checked against that study's store (T46-B05, T46-B06); an own file left by an earlier
+    compete into the same folder, whose summary names its --store, is not this competition's store, and is not read."""
     from .experiments import Store
 
     own = folder / STORE_FILE
-    there = recorded if isinstance(recorded, str) and Path(recorded).is_file() else None
-    if not own.is_file():
+    there = recorded if isinstance(recorded, str) and _holds_store(recorded) else None
+    if not _holds_store(own):
         return there
     if there is not None:
         held = Store(own, create=False)

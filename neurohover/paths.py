@@ -312,6 +312,28 @@ def _no_dash(path: str | os.PathLike, option: str, what: str, stdout: bool) -> N
         raise NeurohoverError(f"{option} '-' is not a {what} name here: {instead}")
 
 
+def refuse_pseudo_fs(path: Path, option: str, given: str | os.PathLike, into: bool = False, instead: str = "") -> None:
+    """Refuse to create a file or directory ``path`` (``into``: files in the directory ``path``) directly in /dev or
+    anywhere under /proc or /sys: ``plot /dev/stdin`` wrote its PNGs into /dev, ``--out /dev/stdout.csv`` made a
+    regular file there (T46-A05). An existing path (/dev/null, /dev/stdout, /dev/shm/x) is taken as before."""
+    try:
+        if not into and os.path.lexists(path):
+            return
+        above = path if into else path.parent
+        while not above.exists() and above != above.parent:  # the nearest existing directory: the new one is made in it
+            above = above.parent
+        real = Path(os.path.realpath(above))
+    except (OSError, ValueError):  # named by the checks that follow
+        return
+    if real == Path("/dev") or real.is_relative_to("/proc") or real.is_relative_to("/sys"):
+        made = "write files" if above == path else "create a file" if above == path.parent else "create a folder"
+        instead = instead or f"give {option} {'DIR' if into else 'FILE'} elsewhere"
+        raise NeurohoverError(
+            f"{option} {str(given)!r}: cannot {made} in {str(real)!r} (in /dev, /proc or /sys: a pseudo file system, where "
+            f"nothing neurohover writes belongs); {instead}"
+        )
+
+
 def output_file(
     path: str | os.PathLike,
     option: str,
@@ -363,6 +385,7 @@ def output_file(
     if held is not None and held != kind:  # a policy, a checkpoint, a summary replaced by another kind of file (T25-01 to T25-03)
         raise NeurohoverError(f"{option} {brief(os.fspath(path))} is {held}: give another path (writing {kind} there would destroy it)")
     refuse_dangling_link(p, option, path)  # a link to nothing was written through, wherever it pointed (T19-12)
+    refuse_pseudo_fs(p, option, path)
     make_dirs(p.parent, option, str(path))
     real = Path(os.path.realpath(p))
     existed = real.exists()
@@ -480,6 +503,7 @@ def output_dir(path: str | os.PathLike, option: str) -> Path:
     if p.exists() and not p.is_dir():
         raise NeurohoverError(f"{option} {str(path)!r} is a file; give a directory")
     refuse_policy_set(p, option, path)
+    refuse_pseudo_fs(p, option, path, into=True)
     make_dirs(p, option, str(path))
     try:
         with tempfile.TemporaryFile(dir=p):

@@ -99,7 +99,7 @@ def _note_left(out: Path, stem: str, n: int) -> None:
 
 def cmd_plot(args: argparse.Namespace) -> int:
     """Plot a recorded flight (one PNG per episode) or overlay competition results (one PNG)."""
-    from ..paths import input_file, output_dir, printable
+    from ..paths import input_file, output_dir, printable, refuse_pseudo_fs
 
     if args.flight is not None and args.compete:
         raise NeurohoverError("give either a flight-data file or --compete DIR ..., not both")
@@ -112,6 +112,8 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
         path = input_file(args.flight, "FLIGHT", "flight-data file")
         data = FlightData.load(path)  # refuses anything but flight data, with the reason
+        if args.out is None:  # plot /dev/stdin wrote its figures into /dev (T46-A05)
+            refuse_pseudo_fs(path.parent, "plot's default --out (FLIGHT's folder)", path.parent, into=True, instead="give --out DIR")
         out = output_dir(args.out if args.out is not None else path.parent, "--out")
         from ..plots import plot_flight_data
 

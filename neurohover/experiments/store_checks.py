@@ -455,7 +455,8 @@ def config_changes(stored: Any, given: dict) -> tuple[str, bool]:
     new one (``given``), for :meth:`Store.begin`'s refusal: each differing setting, stored vs given (reproduce named
     only the two hashes; T34-A02), and whether the stored config only lacks settings a newer neurohover writes in."""
     try:
-        old, new = ExperimentConfig.from_dict(strict_json(stored)).settings, ExperimentConfig.from_dict(given).settings  # today's spelling
+        held = ExperimentConfig.from_dict(strict_json(stored))
+        old, new = held.settings, ExperimentConfig.from_dict(given).settings  # today's spelling
     except (NeurohoverError, TypeError, ValueError):
         return "the stored config cannot be read to compare it", False
     changes = _setting_changes(old, new, "")
@@ -463,10 +464,32 @@ def config_changes(stored: Any, given: dict) -> tuple[str, bool]:
         return "their settings are equal: another version of neurohover (which computes its units otherwise) or another policy set ran them", False
     shown = "; ".join(f"{k}: stored {'absent' if a is _ABSENT else brief(a)}, given {'absent' if b is _ABSENT else brief(b)}" for k, a, b in changes[:6])
     shown += f" (and {len(changes) - 6} more)" if len(changes) > 6 else ""
-    if all(a is _ABSENT for _, a, _ in changes):
+    defaulted = _defaulted(held.kind, old, new, changes)
+    if len(defaulted) == len(changes):
         return f"the settings differ only in ones the stored config lacks, which a newer neurohover added at their defaults ({shown})", True
-    absent = "; absent: a setting the older neurohover that wrote the store did not have" if any(a is _ABSENT for _, a, _ in changes) else ""
+    absent = f"; {', '.join(defaulted)}: a setting the older neurohover that wrote the store did not have, at its default" if defaulted else ""
     return f"the settings differ ({shown}{absent})", False
+
+
+def _defaulted(kind: str, old: dict, new: dict, changes: list[tuple[str, Any, Any]]) -> list[str]:
+    """The changes (:func:`_setting_changes`) that a newer neurohover made: a setting the stored settings ``old`` lack that
+    this version writes in (its schema's default) when it resolves them again, given at that value. A setting this version
+    leaves out at its default too (a sensor, an optimizer's name), given now, is the user's change: it was called an older
+    neurohover's, at a default it is not at, and the remedies of a changed config were left out (T46-A02)."""
+    from .canonical import canonical_settings
+    from .schema import SCHEMAS, check_kind, validate_table
+
+    absent = [k for k, a, _ in changes if a is _ABSENT]
+    if not absent:
+        return []
+    try:
+        again = validate_table(json.loads(json.dumps(old)), SCHEMAS[kind], "the stored config")
+        check_kind(again, kind, "the stored config")
+        canonical_settings(again)
+    except (NeurohoverError, KeyError, TypeError, ValueError):  # not today's to resolve: no default is told
+        return []
+    still = {k for k, _, _ in _setting_changes(again, new, "")}
+    return [k for k in absent if k not in still]
 
 
 def config_differs(store: str, name: str, scale: str, held: str, stored: Any, config_hash: str, config: dict) -> str:
