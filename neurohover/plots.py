@@ -12,6 +12,14 @@ process's matplotlib backend, so plotting is safe in any program (and thread) th
 otherwise. ``neurohover plot`` (:mod:`neurohover.cli.plots`) calls :func:`plot_flight_data`
 and :func:`plot_compete`.
 
+House style: the figures are the paper's, from stored results, so they do not depend on the user's matplotlibrc
+(``./matplotlibrc``, ``$MATPLOTLIBRC``, ``~/.config/matplotlib``). Every public function here that makes, draws or
+saves a figure, and :func:`neurohover.experiments.report.write_report`, runs in matplotlib's default style
+(:func:`house_style`: ``matplotlib.rcdefaults()`` inside ``matplotlib.rc_context()``, the backend left as it is, and
+the caller's rcParams back as they were afterwards). An rc with ``text.usetex: True`` and no LaTeX, ``savefig.dpi: 1``
+or an empty ``axes.prop_cycle`` made every drawing command a traceback (T46-A04). The rcParams are process-wide: a
+thread of the caller's that draws while one of these runs sees the defaults.
+
 Example
 -------
 >>> from neurohover.flightdata import FlightData
@@ -22,15 +30,16 @@ Example
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import os
 import re
 import sys
 import textwrap
 import warnings
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, ParamSpec, TypeVar
 
 import numpy as np
 
@@ -49,6 +58,7 @@ __all__ = [
     "crashed_episode",
     "episode_crashed",
     "flight_figure",
+    "house_style",
     "noting_missing_glyphs",
     "plot_compete",
     "plot_flight_data",
@@ -56,12 +66,31 @@ __all__ = [
 ]
 
 CRASH_COLOR = "tab:red"
+_P = ParamSpec("_P")
+_R = TypeVar("_R")
+
+
+def house_style(fn: Callable[_P, _R]) -> Callable[_P, _R]:
+    """``fn`` run in matplotlib's default style, whatever the user's matplotlibrc says: ``matplotlib.rcdefaults()``
+    (which leaves the backend alone) inside ``matplotlib.rc_context()``, so the caller's rcParams are back afterwards.
+    A figure made and saved inside one call looks the same everywhere (T46-A04, the module's House style)."""
+
+    @functools.wraps(fn)
+    def styled(*args: _P.args, **kwargs: _P.kwargs) -> _R:
+        import matplotlib  # loaded by what draws, not by every command
+
+        with matplotlib.rc_context():
+            matplotlib.rcdefaults()
+            return fn(*args, **kwargs)
+
+    return styled
 
 
 #: The largest figure side new_figure draws, in inches, and in pixels (Agg's own limit: 2**16).
 MAX_FIGURE_INCHES, MAX_FIGURE_PIXELS = 100.0, 2**16
 
 
+@house_style
 def new_figure(width: float, height: float, dpi: int = 100) -> Figure:
     """A figure of ``width`` x ``height`` inches (each in (0, 100]) at ``dpi`` dots per inch (1..1000, each side 1 to
     2**16 pixels) with its own Agg canvas (no pyplot). -1, NaN or '1' inches and dpi=10**9 were matplotlib's ValueError or
@@ -120,6 +149,7 @@ def noting_missing_glyphs() -> Iterator[None]:
             print(f"neurohover: note: the plot font ({fonts}) has no glyph for {chars}: drawn as boxes", file=sys.stderr)
 
 
+@house_style
 def save_figure(fig: Figure, path: str | Path) -> Path:
     """Write ``fig`` as a PNG to ``path``, a name ending .png (any case), checked as every output file is
     (:func:`~neurohover.paths.output_file`: not a directory, device, pipe or socket; missing parent directories are
@@ -207,6 +237,7 @@ def crashed_episode(actions: np.ndarray, episode_steps: int = EPISODE_STEPS) -> 
     return flown < _check_episode_steps(episode_steps, flown)
 
 
+@house_style
 def flight_figure(
     observations: np.ndarray,
     actions: np.ndarray,
@@ -301,6 +332,7 @@ def episode_crashed(data: FlightData, i: int) -> bool:
     return crash_flags(data)[i]
 
 
+@house_style
 def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight", episodes: Sequence[int] | None = None) -> list[Path]:
     """One PNG per episode of ``data`` (:func:`flight_figure`), ``<stem>-episode<i>.png`` in ``out_dir``;
     ``episodes``: only these (a list of distinct 0-based indices; default all). ``out_dir`` is created, saying so, if
@@ -365,6 +397,7 @@ def _episode_list(episodes: object, n: int) -> list[int]:
 # -- competitions -----------------------------------------------------------------------------
 
 
+@house_style
 def compete_figure(results: Sequence[CompeteResult], title: str = "") -> Figure:
     """Mean cumulative error per episode of each result, linear (left) and log scale (right).
 
@@ -412,6 +445,7 @@ def _condition_text(value) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
+@house_style
 def plot_compete(dirs: Sequence[str | Path], out: str | Path) -> tuple[Path, Figure]:
     """Overlay the compete results in ``dirs`` (:func:`compete_figure`) and write the PNG ``out``; ``dirs`` is checked
     as :func:`read_compete_dirs` says."""
@@ -420,6 +454,7 @@ def plot_compete(dirs: Sequence[str | Path], out: str | Path) -> tuple[Path, Fig
     return save_figure(fig, out), fig
 
 
+@house_style
 def draw_cumulative(axes, curves: list[tuple[str, np.ndarray]]) -> None:
     """Each (label, cumulative error after each episode) on a linear and a log panel (the paper's Figs 4 and 7)."""
     for label, error in curves:
@@ -434,6 +469,7 @@ def draw_cumulative(axes, curves: list[tuple[str, np.ndarray]]) -> None:
         ax.grid(alpha=0.3)
 
 
+@house_style
 def plot_cumulative(curves: Mapping[str, object], path: str | Path, title: str) -> Path:
     """Mean cumulative error per episode of each agent, linear and log scale (paper Figs 4 and 7), written as the PNG
     ``path`` as :func:`save_figure` writes one (a name ending .png). ``curves``: label -> cumulative rewards after each

@@ -1,5 +1,7 @@
 """Bad-input trial 46 (46a), the environment: T46-A03 (under NUMBA_DISABLE_JIT=1 every evolution ended in "<intrinsic
-_fetch_add> is not usable in pure-python": the lanes' atomic queue, fence and packed fma had no pure-Python form)."""
+_fetch_add> is not usable in pure-python": the lanes' atomic queue, fence and packed fma had no pure-Python form), T46-A04 (a
+matplotlibrc that matplotlib accepts, text.usetex without LaTeX, savefig.dpi 1 or an empty axes.prop_cycle, made plot, compete,
+plot --compete and report a traceback: the figures are drawn in matplotlib's default style)."""
 
 from __future__ import annotations
 
@@ -42,3 +44,71 @@ def test_a03_the_pure_python_fma_rounds_once_and_the_queue_counts() -> None:
     assert str(_python_fma(-0.0, 1.0, -0.0)) == "-0.0" and str(_python_fma(2.0, 3.0, -6.0)) == "0.0"
     counter = np.array([5], dtype=np.int64)
     assert _python_fetch_add(counter, 1) == 5 and counter[0] == 6 and _python_fetch_add(counter, -1) == 6 and counter[0] == 5
+
+
+#: A matplotlibrc that matplotlib accepts and that made every drawing command a traceback (T46-A04): LaTeX that is not
+#: there (or is: usetex is then not matplotlib's default), a 1-dpi save (FreeType's "invalid ppem value"), no colours.
+_USERS_RC = "text.usetex: True\nsavefig.dpi: 1\naxes.prop_cycle: cycler('color', [])\n"
+
+#: The drawing commands in one process (matplotlib reads the rc once, at import): each one's exit status, then the rc.
+_DRAWING = """
+import sys
+from pathlib import Path
+from neurohover.cli import main
+import matplotlib
+
+config = Path("tr.toml")
+config.write_text(sys.argv[1])
+runs = [
+    ["fly", "--task", "ghh08", "--episodes", "1", "--record", "f.npz"],
+    ["plot", "f.npz", "--out", "flight"],
+    ["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--episode-steps", "20", "--out", "c"],
+    ["plot", "--compete", "c", "--out", "overlay"],
+    ["reproduce", "tr.toml", "--store", "s.sqlite"],
+    ["report", "--store", "s.sqlite", "--out", "report"],
+]
+print([main(argv) for argv in runs])
+print(matplotlib.rcParams["text.usetex"], matplotlib.rcParams["savefig.dpi"], len(matplotlib.rcParams["axes.prop_cycle"]))
+"""
+
+
+def test_a04_the_figures_are_drawn_in_matplotlibs_default_style_whatever_the_users_rc(tmp_path) -> None:
+    """T46-A04: with that rc in ./matplotlibrc or $MATPLOTLIBRC, plot, compete (exit 1 after its runs were stored, no
+    cumulative.png), plot --compete and report ended in a traceback. The figures are drawn in matplotlib's default style
+    (plots.house_style), and the process's rcParams are the user's again afterwards."""
+    from conftest import tiny_test_runs
+
+    (tmp_path / "users.rc").write_text(_USERS_RC)
+    run = subprocess.run(
+        [sys.executable, "-c", _DRAWING, tiny_test_runs("baseline")],
+        env={**os.environ, "MATPLOTLIBRC": str(tmp_path / "users.rc"), "MPLBACKEND": "Agg"},
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert run.returncode == 0 and "Traceback" not in run.stderr, run.stderr[-3000:]
+    statuses, rc = run.stdout.strip().splitlines()[-2:]
+    assert statuses == "[0, 0, 0, 0, 0, 0]", run.stderr[-3000:]
+    assert rc == "True 1.0 0"  # the user's rc, read by matplotlib, still in force around neurohover's figures
+    pngs = sorted(p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*.png"))
+    assert pngs == ["c/cumulative.png", "flight/f-episode0.png", "overlay/compete.png", "report/tr1-quick.png"], pngs
+    from PIL import Image
+
+    with Image.open(tmp_path / "overlay" / "compete.png") as image:
+        assert image.size == (1100, 450)  # 11 x 4.5 inches at matplotlib's default savefig.dpi ("figure": 100), not 1
+
+
+def test_a04_house_style_draws_in_the_defaults_and_gives_the_callers_rc_back(tmp_path) -> None:
+    import matplotlib
+
+    from neurohover.plots import house_style
+
+    @house_style
+    def seen() -> tuple:
+        return matplotlib.rcParams["text.usetex"], matplotlib.rcParams["savefig.dpi"], matplotlib.get_backend()
+
+    backend = matplotlib.get_backend()
+    with matplotlib.rc_context({"text.usetex": True, "savefig.dpi": 1}):
+        assert seen() == (False, "figure", backend)
+        assert matplotlib.rcParams["text.usetex"] is True and matplotlib.rcParams["savefig.dpi"] == 1

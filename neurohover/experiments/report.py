@@ -20,6 +20,7 @@ from pathlib import Path
 
 from ..errors import NeurohoverError, OutputError, brief, check_flag
 from ..filekinds import REPORT_HEADER, REPORT_KIND
+from ..plots import house_style
 from .config import ORDER, ExperimentConfig, check_paper_table, shipped_counterpart, with_shipped_paper
 from .export import checked_units
 from .report_claims import PAPER_FIGURES, DiscussionError, claims_section, conclusions_discussion, read_discussion
@@ -142,6 +143,7 @@ def check_names(names: object) -> None:
         raise NeurohoverError(f"experiment {twice[0]!r} is named more than once: give each once")
 
 
+@house_style  # the figures in matplotlib's default style, whatever the user's matplotlibrc says (T46-A04)
 def write_report(store: Store, out: str | Path, *, scale: str | None = None, names: list[str] | None = None, refuse_all_damaged: bool = False) -> Path:
     """Write figures and ``report.md`` for the experiments in ``store`` into ``out``; returns report.md's path.
 
