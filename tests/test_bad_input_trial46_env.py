@@ -112,3 +112,22 @@ def test_a04_house_style_draws_in_the_defaults_and_gives_the_callers_rc_back(tmp
     with matplotlib.rc_context({"text.usetex": True, "savefig.dpi": 1}):
         assert seen() == (False, "figure", backend)
         assert matplotlib.rcParams["text.usetex"] is True and matplotlib.rcParams["savefig.dpi"] == 1
+
+
+def test_a04_the_envs_frames_are_drawn_whatever_the_users_rc() -> None:
+    """After T46-A04: render_mode='rgb_array' drew its frames in the user's rc (an empty axes.prop_cycle was matplotlib's
+    ZeroDivisionError at the first render, text.usetex without LaTeX a RuntimeError); they are drawn as every figure is."""
+    import gymnasium as gym
+    import matplotlib
+    from cycler import cycler
+
+    import neurohover  # noqa: F401  (registers the ids)
+
+    with matplotlib.rc_context({"axes.prop_cycle": cycler(color=[]), "text.usetex": True}):
+        env = gym.make("neurohover/GHH08-Short-v0", render_mode="rgb_array")
+        env.reset(seed=0)
+        first = env.render()
+        env.step(np.zeros(4, dtype=np.float32))
+        assert first.shape == env.render().shape and first.dtype == np.uint8
+        env.close()
+        assert matplotlib.rcParams["text.usetex"] is True  # the caller's rc given back

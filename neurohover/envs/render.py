@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import NeurohoverError, brief, finite_real, whole_number
+from ..plots import house_style  # frames drawn in matplotlib's default style, as every figure (after T46-A04)
 from ..sim.constants import MAX_POSITION
 from .arguments import real_values
 
@@ -101,6 +102,7 @@ class HoverRenderer:
         Frame size in pixels.
     """
 
+    @house_style
     def __init__(self, width: int = FRAME_WIDTH, height: int = FRAME_HEIGHT) -> None:
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
@@ -188,6 +190,7 @@ class HoverRenderer:
             else:
                 box.set_data([], [])
 
+    @house_style
     def draw(self, state: Sequence[float], wind: Sequence[float], text: str, trail: np.ndarray | None = None) -> np.ndarray:
         """One frame, an (height, width, 3) uint8 array.
 
@@ -268,6 +271,7 @@ class HoverRenderer:
         self.figure.draw_artist(self._text)
         return np.asarray(self.canvas.buffer_rgba())[:, :, :3].copy()
 
+    @house_style
     def close(self) -> None:
         """Release the figure; a later :meth:`draw` makes a new one, as an environment's render() after close() does
         (it was an AttributeError; T43-B09). Safe to call twice."""
@@ -302,6 +306,7 @@ class HumanWindow:
         self._image: Any = None
         self._warned = False
 
+    @house_style
     def show(self, frame: np.ndarray) -> None:
         """Show ``frame``, an (height, width, 3) uint8 RGB image (or RGBA) as :meth:`HoverRenderer.draw` gives."""
         if not isinstance(frame, np.ndarray) or frame.dtype != np.uint8 or frame.ndim != 3 or frame.shape[2] not in (3, 4) or not frame.size:
@@ -327,6 +332,7 @@ class HumanWindow:
                 stacklevel=3,
             )
 
+    @house_style
     def close(self) -> None:
         if self._figure is not None:
             import matplotlib.pyplot as plt
