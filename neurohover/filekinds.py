@@ -329,6 +329,10 @@ def refuse_suffix(path: str, option: str, suffixes: tuple[str, ...], what: str, 
         if name:
             room = max((len(os.fsencode(end)) for end in ends), default=0)
             like = str(Path(like).with_name(fitting_name(Path(like).name, name_limit(Path(like).parent), room)))
+        if name.lower() in suffixes:  # the name ends in the suffix: say why it is refused (T47-B15)
+            raise NeurohoverError(
+                f"{option} {brief(path)} is not allowed: {brief(name)} is a hidden file's name with no stem: give a name before the suffix (e.g. {brief(like)})"
+            )
         raise NeurohoverError(f"{option} {brief(path)} is not allowed: {what}; give a path ending {' or '.join(suffixes)} (e.g. {brief(like)})")
 
 

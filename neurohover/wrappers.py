@@ -92,6 +92,11 @@ def crash_aware(reward, gamma: float = 0.99, scale: float = 1.0):
     """
     check_discount_and_scale(gamma, scale)  # gamma=2 or scale=-1 were taken here and refused by the wrapper (fifth trial)
     gamma, scale = float(gamma), float(scale)  # a Fraction would make object arrays
+    if isinstance(reward, np.ma.MaskedArray):  # np.asarray dropped the mask: the hidden values were squashed (T47-B11)
+        raise NeurohoverError(
+            f"reward={brief(reward)} is not allowed: give a real number or an array of them "
+            "(not a masked array: its masked entries would be squashed at their hidden values)"
+        )
     try:
         raw = np.asarray(reward)
     except ValueError:  # a ragged list was NumPy's "inhomogeneous shape" (twelfth trial T6)

@@ -481,14 +481,19 @@ def network_of_record(record: Sequence[float]) -> PackedNetworks:
     listed = (isinstance(record, Sequence) and not isinstance(record, (str, bytes))) or (isinstance(record, np.ndarray) and record.ndim == 1)
     if not listed or len(record) == 0 or not all(finite_real(v) for v in record):
         raise NeurohoverError(f"record={brief(record)} is not allowed: give a genome_record (a non-empty list of finite numbers)")
-    if not all(float(record[j]).is_integer() and 0 <= record[j] < len(ACTIVATIONS) for j in range(4, min(len(record), 1 + 4 * max(int(record[0]), 0)), 4)):
-        raise NeurohoverError(f"record={brief(record)} is not allowed: its activation ids must be whole numbers 0..{len(ACTIVATIONS) - 1}")
-    config = neat_config(NeatSettings(activations=ACTIVATIONS))
     n_nodes = int(record[0])
     if n_nodes < 0 or not float(record[0]).is_integer():
         raise NeurohoverError(f"a NEAT record's node count {brief(record[0])} is not allowed: give a whole number >= 0")
-    if len(record) < 1 + 4 * n_nodes or (len(record) - 1 - 4 * n_nodes) % 3:
-        raise NeurohoverError(f"a NEAT record of {len(record)} numbers does not hold {n_nodes} nodes and whole connections")
+    if len(record) < 1 + 4 * n_nodes or (len(record) - 1 - 4 * n_nodes) % 3:  # before the ids: 99 blamed them (T47-B16)
+        fits = [n for n in range(ACTION_DIM, (len(record) - 1) // 4 + 1) if (len(record) - 1 - 4 * n) % 3 == 0]  # of the outputs at least
+        holds = f"holds {', '.join(map(str, fits[:5]))}{', ...' if len(fits) > 5 else ''} nodes" if fits else f"holds no {ACTION_DIM} nodes or more"
+        raise NeurohoverError(
+            f"a NEAT record's node count {brief(record[0])} is not allowed: a record of {len(record)} numbers (the count, then 4 per node and 3 per "
+            f"connection) does not hold {brief(record[0])} nodes and whole connections; it {holds}"
+        )
+    if not all(float(record[j]).is_integer() and 0 <= record[j] < len(ACTIVATIONS) for j in range(4, 1 + 4 * n_nodes, 4)):
+        raise NeurohoverError(f"record={brief(record)} is not allowed: its activation ids must be whole numbers 0..{len(ACTIVATIONS) - 1}")
+    config = neat_config(NeatSettings(activations=ACTIVATIONS))
     _check_record_network(record, n_nodes)
     genome = neat.DefaultGenome(0)
     gc = config.genome_config

@@ -366,6 +366,9 @@ def _refuse_past_mdp_bound(model: LearnedModel) -> None:
             raise NeurohoverError(
                 f"model {name}={brief(value)} is out of range: allowed numbers in [-{MAX_MAGNITUDE:g}, {MAX_MAGNITUDE:g}] (every MDP's bound: no MDP flies it)"
             )
+    problem = model.wind.bound_problem(MAX_MAGNITUDE) if isinstance(model.wind, WindModel) else ""  # (a wind's field, by name: T47-B08)
+    if problem:
+        raise NeurohoverError(f"model wind {problem} (every MDP's bound, {MAX_MAGNITUDE:g}, on its wind numbers: no MDP flies it)")
 
 
 def _axes_without_equivalent(params: np.ndarray) -> list[str]:

@@ -77,6 +77,9 @@ def model_entry_problem(d: dict) -> str:
     Checked before the model is made of them (T27-B01, T27-B02, T27-B11); only entries the file holds."""
     from ..policy_records import seconds_problem  # the one check of a file's seconds (policy files', T26-B13)
 
+    for key, length in (("params", len(PARAM_NAMES)), ("noise_std", len(NOISE_NAMES))):  # nested lists were read flat (T47-B09)
+        if isinstance(d[key], list) and any(isinstance(x, (list, dict)) for x in d[key]):
+            return _its(key, d[key], f"allowed a flat list of {length} numbers (a list inside it is not read as numbers)")
     names = d.get("param_names", list(PARAM_NAMES))
     if not (isinstance(names, list) and names == list(PARAM_NAMES)):
         return _its("param_names", names, f"allowed the list {list(PARAM_NAMES)} (the names of params, in order)")

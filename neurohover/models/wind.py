@@ -108,6 +108,21 @@ class WindModel:
             slots += [a.amplitude / 5.0 + center, a.omega / (20.0 * math.pi), a.phase / (2.0 * math.pi), center]
         return WIND_SINUSOID, tuple(slots)
 
+    def bound_problem(self, bound: float) -> str:
+        """The first field whose MDP wind number (:meth:`mdp_wind`) is past ``bound`` (an MDP's), as '<axis>.<field>=<value>
+        is out of range: allowed ...', '' when none is: 1e308 made a model that only :meth:`mdp_wind`'s MDP refused (T47-B08)."""
+        k = 1.0 if self.kind == "constant" else 5.0  # a sinusoid's offset and maxf are flown divided by 5
+        for name, a in (("x", self.x), ("y", self.y)):
+            for field, value, number, allowed in (
+                ("offset", a.offset, a.offset / k, f"offset in [-{k * bound:g}, {k * bound:g}]"),
+                ("amplitude", a.amplitude, a.amplitude / 5.0 + a.offset / 5.0, f"amplitude + offset in [-{5 * bound:g}, {5 * bound:g}]"),
+                ("omega", a.omega, a.omega / (20.0 * math.pi), f"omega in [0, {20 * math.pi * bound:.7g}] rad/s"),
+                ("phase", a.phase, a.phase / (2.0 * math.pi), f"phase in [-{2 * math.pi * bound:.7g}, {2 * math.pi * bound:.7g}] rad"),
+            ):
+                if abs(number) > bound:
+                    return f"{name}.{field}={brief(value)} is out of range: allowed {allowed}"
+        return ""
+
     def world(self, t: np.ndarray) -> np.ndarray:
         """The world wind (len(t), 2) at times ``t``."""
         t = _times(t)
