@@ -34,10 +34,10 @@ import numpy as np
 
 from .agents.hybrid import HybridSettings
 from .compete_folder import note_replaced, refuse_other_files, sole_competition, write_episodes, write_partial, write_summary
-from .errors import NeurohoverError, brief, check_arity, first_difference
+from .errors import NeurohoverError, brief, check_arity, first_difference, whole_in
 from .evolution.seeding import check_seed
 from .plots import plot_cumulative
-from .sim.constants import EPISODE_STEPS
+from .sim.constants import EPISODE_STEPS, MAX_EPISODE_STEPS
 from .tasks import N_TEST, N_TRAINING, Drift, Sensor, get_task_family
 from .tasks.drift import MAX_RUN_EPISODES  # a run's episodes, the bound of a drifting MDP's episodes too
 
@@ -134,7 +134,8 @@ def check_agent_settings(agent: str, values: Mapping[str, object], n_steps: int 
     if why is not None:
         raise NeurohoverError(f"agent {agent!r}: {why}")
     if n_steps is not None:  # before any run: continual's safeguard_after past the episode would never test (twelfth trial, S3)
-        checked.check_episode_steps(n_steps)
+        # as every n_steps is checked: 'zz' was a TypeError, NaN and True were taken, -1 blamed the setting (T47-B02)
+        checked.check_episode_steps(whole_in(n_steps, "n_steps", 1, MAX_EPISODE_STEPS))
     return checked.to_dict()
 
 

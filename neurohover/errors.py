@@ -282,7 +282,7 @@ def registry_entry_problem(registry: str, name: object, value: object, kind: typ
             return ""
         return f"{entry}: {name!r} is a shipped {what}'s name and holds its shipped {noun}; register yours under a name of its own"
     own = getattr(value, "name", None)
-    if own != name:
+    if not isinstance(name, str) or own != name:  # an array key: NumPy's ambiguous truth (T47-B06)
         return f"{entry}: its {noun}'s name {brief(own)} is not its key; register a {noun} under its own name ({registry}[{var}.name] = {var})"
     return ""
 

@@ -208,8 +208,8 @@ class ContinualAgent(Agent):
 
 
 def _continual(policies: AgentPolicies, options: AgentOptions) -> Agent:
-    assert policies.generic is not None
-    return ContinualAgent(policies.generic, options.evolution or ModelEvolution(), options.settings or ContinualSettings())
+    generic = check_agent_policy("generic", policies.generic)  # not an assert: a bare AssertionError (T47-B01)
+    return ContinualAgent(generic, options.evolution or ModelEvolution(), options.settings or ContinualSettings())
 
 
 AGENT_SPECS = (

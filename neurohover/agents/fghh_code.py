@@ -203,7 +203,7 @@ class CodeFGHHAgent(Agent):
 
 def _build(name: str):
     def build(policies: AgentPolicies, options: AgentOptions) -> Agent:
-        assert policies.generic is not None
+        generic = check_agent_policy("generic", policies.generic)  # not an assert: a bare AssertionError (T47-B01)
         evo = options.evolution
         if evo is not None and evo.model_policy != "ours":  # ignored without a word: it evolves as the authors' code (T40-A03)
             raise NeurohoverError(
@@ -224,7 +224,7 @@ def _build(name: str):
                 model_substeps=evo.model_substeps,
             )
         )
-        agent = CodeFGHHAgent(policies.generic, settings)
+        agent = CodeFGHHAgent(generic, settings)
         agent.name = name
         return agent
 

@@ -220,11 +220,9 @@ class HybridAgent(Agent):
 
 def _hybrid(name: str, fallback: str):
     def build(policies: AgentPolicies, options: AgentOptions) -> Agent:
-        assert policies.generic is not None
-        backup = policies.generic if fallback == "generic" else baseline_policy()
-        return HybridAgent(
-            policies.safe, policies.generic, backup, options.evolution or ModelEvolution(), name=name, hybrid=options.settings or HybridSettings()
-        )
+        generic = check_agent_policy("generic", policies.generic)  # not an assert: a bare AssertionError (T47-B01)
+        backup = generic if fallback == "generic" else baseline_policy()
+        return HybridAgent(policies.safe, generic, backup, options.evolution or ModelEvolution(), name=name, hybrid=options.settings or HybridSettings())
 
     return build
 

@@ -328,15 +328,15 @@ class IncrementalSettings(AgentSettings):
 
 
 def _model_based(policies: AgentPolicies, options: AgentOptions) -> Agent:
-    assert policies.generic is not None
-    return ModelBasedAgent(policies.generic, options.evolution or ModelEvolution())
+    generic = check_agent_policy("generic", policies.generic)  # not an assert: a bare AssertionError (T47-B01)
+    return ModelBasedAgent(generic, options.evolution or ModelEvolution())
 
 
 def _incremental(name: str):
     def build(policies: AgentPolicies, options: AgentOptions) -> Agent:
-        assert policies.generic is not None
+        generic = check_agent_policy("generic", policies.generic)  # not an assert: a bare AssertionError (T47-B01)
         settings = options.settings or IncrementalSettings()
-        agent = IncrementalModelBasedAgent(policies.generic, options.evolution or ModelEvolution(), max_learning_episodes=settings.max_learning_episodes)
+        agent = IncrementalModelBasedAgent(generic, options.evolution or ModelEvolution(), max_learning_episodes=settings.max_learning_episodes)
         agent.name = name
         return agent
 

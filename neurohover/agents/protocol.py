@@ -168,11 +168,13 @@ class EpisodeOutcome:
             raise NeurohoverError(f"EpisodeOutcome flight_data={brief(self.flight_data)} is not allowed: give the episode's FlightData or None")
 
 
-def check_agent_policy(what: str, value: object) -> None:
-    """An agent's constructor argument ``what`` checked to be a Policy: None was an AttributeError deep in the first
-    flight (thirteenth trial, F11)."""
+def check_agent_policy(what: str, value: object) -> Policy:
+    """An agent's constructor argument ``what`` checked to be a Policy, and returned: None was an AttributeError deep in
+    the first flight (thirteenth trial, F11). The spec builds check their generic here too: an assert was a bare
+    AssertionError (a clean refusal only under python -O, T47-B01)."""
     if not isinstance(value, Policy):
         raise NeurohoverError(f"{what}={brief(value)} is not allowed: give a Policy (neurohover.policies.load_policy(path), for example)")
+    return value
 
 
 def check_agent_policies(what: str, value: object, exactly: int | None = None) -> None:

@@ -39,8 +39,8 @@ class GenericAgent(Agent):
 
 
 def _generic(policies: AgentPolicies, options: AgentOptions) -> Agent:
-    assert policies.generic is not None
-    return GenericAgent(policies.generic)
+    generic = check_agent_policy("generic", policies.generic)  # not an assert: a bare AssertionError (T47-B01)
+    return GenericAgent(generic)
 
 
 AGENT_SPECS = (

@@ -130,6 +130,11 @@ def policies_from_set(spec: AgentSpec | str, ps: PolicySet) -> AgentPolicies:
     if "generic" in spec.needs:
         kind = spec.generic_kind if ps.generics else None
         generic = ps.generics[kind] if kind is not None and ps.generics else ps.generic
+    if "safe" in spec.needs and not ps.safe and isinstance(ps.manifest, dict) and "safe" not in ps.manifest:
+        raise NeurohoverError(  # not "safe=[]", a value the file does not hold (T47-B17)
+            f"policy-set manifest {str(ps.directory / 'manifest.json')!r} has no 'safe' list, which agent {spec.name!r} needs: it flies "
+            "exactly 2 safe specialised policies (build-policies writes the 2 the paper's rule chooses; give two indices of its specialised policies)"
+        )
     if "safe" in spec.needs and len(ps.safe) != 2:  # the agent's own refusal named no file (tenth trial)
         raise NeurohoverError(
             f"policy-set manifest {str(ps.directory / 'manifest.json')!r}: safe={list(ps.safe)} is not allowed for agent {spec.name!r}: "

@@ -33,7 +33,7 @@ from ..policies import Policy, baseline_policy
 from .hybrid import HybridAgent
 from .model_based import ModelEvolution
 from .model_free import ModelFreeAgent
-from .protocol import Agent, Choice, EpisodeOutcome, check_agent_settings
+from .protocol import Agent, Choice, EpisodeOutcome, check_agent_policy, check_agent_settings
 from .spec import AgentOptions, AgentPolicies, AgentSettings, AgentSpec
 
 #: The most trials of each specialised policy: a run's episodes (1,000,000 at most) cannot hold more (10**13 was accepted).
@@ -163,10 +163,10 @@ class RiskHybridAgent(HybridAgent):
 
 def _hybrid_risk(name: str, fallback: str):
     def build(policies: AgentPolicies, options: AgentOptions) -> Agent:
-        assert policies.generic is not None
-        backup = policies.generic if fallback == "generic" else baseline_policy()
+        generic = check_agent_policy("generic", policies.generic)  # not an assert: a bare AssertionError (T47-B01)
+        backup = generic if fallback == "generic" else baseline_policy()
         risk = options.settings or RiskSettings()
-        return RiskHybridAgent(policies.safe, policies.generic, backup, options.evolution or ModelEvolution(), name=name, risk=risk)
+        return RiskHybridAgent(policies.safe, generic, backup, options.evolution or ModelEvolution(), name=name, risk=risk)
 
     return build
 

@@ -35,6 +35,7 @@ from ..sim.rng import MAX_SEED, seed_stream
 from ..sim.step import ENV_NOISE_WIDTH, ENV_RNG_WIDTH, start_readings
 from ..tasks import MDP, TaskFamily, refuse_drift
 from .arguments import (
+    MDP_OPTIONS,
     SAMPLE,
     FixedSettings,
     MdpSpec,
@@ -81,6 +82,14 @@ def _next_step_only(mode: Any) -> AutoresetMode:
     return taken
 
 
+def _listed(mdp: Any) -> Any:
+    """An ``mdp`` setting given as a plain 1-D NumPy array (of names, say) as the list it holds, as a list is taken: it
+    was refused as no name (T47-B14); anything else as it is."""
+    if isinstance(mdp, np.ndarray) and not isinstance(mdp, np.ma.MaskedArray) and mdp.ndim == 1:
+        return mdp.tolist()
+    return mdp
+
+
 class HoverVectorEnv(FixedSettings, VectorEnv):
     """``num_envs`` independent hovering helicopters (see :class:`neurohover.envs.hover.HoverEnv`).
 
@@ -104,9 +113,10 @@ class HoverVectorEnv(FixedSettings, VectorEnv):
     mdp : str, MDP or sequence of them
         ``"sample"`` (default: each sub-environment draws its own fresh MDP from G at every
         reset), ``"zero"``, ``"train:N"``, ``"test:N"`` or an :class:`~neurohover.MDP`, for all
-        sub-environments, or a sequence of ``num_envs`` of these, one per sub-environment. An explicit
-        MDP is seen through the sensors of ``obs_noise`` / ``obs_delay`` (or the id's), as one named by
-        text is; one with a sensor of its own flies it under exact sensors, and is refused beside another.
+        sub-environments, or a sequence of ``num_envs`` of these (a list, a tuple or a 1-D array), one per
+        sub-environment. An explicit MDP is seen through the sensors of ``obs_noise`` / ``obs_delay`` (or the
+        id's), as one named by text is; one with a sensor of its own flies it under exact sensors, and is refused
+        beside another.
     episode_steps : int
         Control steps per episode (6000); the crash penalty counts the steps left to it.
     max_episode_steps : int, optional
@@ -186,7 +196,7 @@ class HoverVectorEnv(FixedSettings, VectorEnv):
         self.max_episode_steps = self.episode_steps if max_episode_steps is None else check_episode_steps(max_episode_steps, "max_episode_steps")
         self._limit = min(self.episode_steps, self.max_episode_steps)
         self._specs: list[MDP | str] = self.resolve_mdps(mdp)
-        refuse_idle_sigma(sigma, mdp)
+        refuse_idle_sigma(sigma, _listed(mdp))
         self.render_mode = None
         self.single_observation_space = observation_space(self.obs_dtype)
         self.single_action_space = action_space(check_action_dtype(action_dtype))
@@ -285,14 +295,18 @@ class HoverVectorEnv(FixedSettings, VectorEnv):
         """The ``mdp`` option of :meth:`reset` (one MDP, a name, or one per helicopter) as one setting per helicopter,
         checked: a name the family does not know, a wrong count or a drifting MDP raise NeurohoverError."""
         cache: dict[str, MDP] = {}
+        value = _listed(value)
         if isinstance(value, (str, MDP)):
             specs = [resolve_mdp(self.family, value, cache)] * self.num_envs
         elif isinstance(value, (list, tuple)):
             if len(value) != self.num_envs:
                 raise NeurohoverError(f"mdp has {len(value)} entries but there are num_envs={self.num_envs} sub-environments")
             specs = [resolve_mdp(self.family, v, cache) for v in value]
-        else:
-            return [resolve_mdp(self.family, value, cache)]  # raises with the allowed values
+        else:  # the per-helicopter form named too (T47-B14)
+            raise NeurohoverError(
+                f"mdp={brief(value)} is not allowed: use one of {', '.join(MDP_OPTIONS)} or an MDP instance, "
+                f"or a sequence of num_envs={self.num_envs} of these (a list or a 1-D array), one per sub-environment"
+            )
         for spec in specs:
             if isinstance(spec, MDP):
                 refuse_drift(spec, "the vector environment (one episode per sub-environment, no runs)")

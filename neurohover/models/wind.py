@@ -86,8 +86,8 @@ class WindModel:
     y: WindAxis = WindAxis()
 
     def __post_init__(self) -> None:
-        if self.kind not in WIND_MODELS:
-            raise NeurohoverError(f"wind model {self.kind!r} is not allowed: choose one of {', '.join(WIND_MODELS)}")
+        if not isinstance(self.kind, str) or self.kind not in WIND_MODELS:  # an array: NumPy's ambiguous truth (T47-B06)
+            raise NeurohoverError(f"wind model {brief(self.kind)} is not allowed: choose one of {', '.join(WIND_MODELS)}")
         if not isinstance(self.x, WindAxis) or not isinstance(self.y, WindAxis):
             raise NeurohoverError("a wind model's x and y must be WindAxis values")
         if self.kind != "sinusoid" and any(a.amplitude != 0.0 or a.omega != 0.0 or a.phase != 0.0 for a in (self.x, self.y)):

@@ -267,8 +267,8 @@ def competition_rows(family: str) -> dict:
     """The competition's training and test rows of ``family`` as listed in the shipped data file: a copy of its own, so
     an edit of it changes no MDP (the cache itself was returned: an edited row flew as the competition's train:0, and
     ``.clear()`` had the family refused for the rest of the process; T43-B07)."""
-    if family not in competition_families():
-        raise NeurohoverError(f"the competition data file lists no MDPs of {family!r}: it has {', '.join(competition_families())}")
+    if not isinstance(family, str) or family not in competition_families():  # an array: NumPy's ambiguous truth (T47-B06)
+        raise NeurohoverError(f"the competition data file lists no MDPs of {brief(family)}: it has {', '.join(competition_families())}")
     return copy.deepcopy(_COMPETITION[family])
 
 

@@ -301,6 +301,8 @@ class DriftRun:
 def refuse_drift(mdp, where: str) -> None:
     """A clear error where an MDP (or task family) that drifts would be flown as if its dynamics were fixed:
     only test runs and :class:`neurohover.envs.HoverEnv` fly the drift."""
+    if not isinstance(getattr(mdp, "drift", None), Drift):  # a name or None was an AttributeError (T47-B05)
+        raise NeurohoverError(f"mdp={brief(mdp)} is not allowed: give an MDP or a task family (neurohover.get_task_family('ghh08'))")
     if not mdp.drift.none:
         raise NeurohoverError(
             f"{getattr(mdp, 'label', None) or mdp.name} has drifting dynamics ({mdp.drift.to_dict()}), which {where} would fly as if fixed: "
