@@ -20,7 +20,7 @@ import numpy as np
 from .errors import NeurohoverError, brief, finite_real, float64_of, key_text, refuse_non_text_keys
 from .filekinds import FLIGHT_DATA_KIND, refuse_suffix
 from .flightmeta import check_meaning, check_policy_actions, flown_policy
-from .paths import json_text, strict_json
+from .paths import json_text, path_text, strict_json
 from .sim.constants import ACTION_NAMES, EPISODE_STEPS, MAX_EPISODE_STEPS, OBS_NAMES
 
 FORMAT = "neurohover-flight-data/1"
@@ -251,7 +251,7 @@ class FlightData:
         meta_text = _metadata_text(self.metadata, "flight data")  # checked again: metadata may be changed after making
         if not self.actions or self.n_transitions == 0:
             raise NeurohoverError("flight data to save needs at least one step flown (load() refuses any other file)")
-        text = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None  # an os.PathLike's text, not its repr (T33-B13)
+        text = path_text(path)  # an os.PathLike's text, not its repr (T33-B13)
         if isinstance(text, str) and text not in ("", "-") and not text.endswith("/") and not os.path.exists(text):
             check_npz_name(text)  # before output_file makes its directory; '', '-', 'dir/' and what exists it names as such
         # refuses '', a directory and a device (/dev/null was a struct.error), and another kind of neurohover file, through a link too (T34-B03)

@@ -145,6 +145,13 @@ PATH_MAX = _path_max()
 _DIRECTORY_ENDS = tuple(sorted({f"{sep}{end}" for sep in {"/", os.sep} for end in ("", ".", "..")}, key=len, reverse=True))
 
 
+def path_text(path) -> str | None:
+    """The text of ``path`` (a str or os.PathLike), or None for anything else: a path object whose ``__fspath__`` gives no
+    str too, which :func:`checked_path` then names (os.fspath's TypeError on an int named no value; T47-B07)."""
+    text = path if isinstance(path, str) else type(path).__fspath__(path) if isinstance(path, os.PathLike) else None
+    return text if isinstance(text, str) else None
+
+
 def checked_path(path, option: str, what: str = "file path", ends: tuple[str, ...] = (), file: bool = False) -> Path:
     """``path`` (a str or path object) as a Path: empty, another type, a NUL byte or a name longer than the file system
     takes refused by name (the OS's TypeError, ValueError and OSError before); ``what`` says what to give instead.
@@ -157,9 +164,9 @@ def checked_path(path, option: str, what: str = "file path", ends: tuple[str, ..
     directory is the caller's to name."""
     if not isinstance(path, (str, os.PathLike)):
         raise NeurohoverError(f"{option}={path!r:.60} is not allowed: give a {what}")
-    text = os.fspath(path)
+    text = path if isinstance(path, str) else path.__fspath__()  # os.fspath's TypeError on an int named no value (T47-B07)
     if not isinstance(text, str):
-        raise NeurohoverError(f"{option}={path!r:.60} is not allowed: give a {what} as text")
+        raise NeurohoverError(f"{option}={path!r:.60} is not allowed: its __fspath__() gives {brief(text)}: give a {what} as text")
     if text == "":
         raise NeurohoverError(f"{option} is empty; give a {what}")
     if "\x00" in text:
@@ -307,7 +314,7 @@ def number_text(text: str, whole: bool = False) -> int | float:
 def _no_dash(path: str | os.PathLike, option: str, what: str, stdout: bool) -> None:
     """Refuse ``-``, which by custom means standard output, as a name: it was written as a hidden-looking file named '-'
     (eleventh trial); ``stdout``: leaving ``option`` out writes to standard output."""
-    if isinstance(path, (str, os.PathLike)) and os.fspath(path) == "-":
+    if path_text(path) == "-":
         instead = f"leave {option} out for standard output" if stdout else f"give a {what} name (./- for one called '-')"
         raise NeurohoverError(f"{option} '-' is not a {what} name here: {instead}")
 

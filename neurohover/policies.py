@@ -448,9 +448,9 @@ def check_json_policy_name(path: object, option: str, ends: tuple[str, ...] = ()
 
     What is no path, ``''``, a name ending in a slash and a directory are left to :func:`neurohover.paths.output_file`
     to refuse, in its words."""
-    from .paths import checked_path
+    from .paths import checked_path, path_text
 
-    text = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None
+    text = path_text(path)
     if not isinstance(text, str) or text == "" or text.endswith(("/", os.sep)):
         return
     if Path(checked_path(text, option, ends=ends)).is_dir():

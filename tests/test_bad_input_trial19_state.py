@@ -86,7 +86,7 @@ def _check_refused(cls, make, edit, fragment: str) -> None:
         (lambda s: s["hall_of_fame"][0].__setitem__(1, NAN_GENES), "hall of fame genome holds a gene that is not a finite number"),
         (lambda s: s.update(parents=NAN_GENES), "parents has shape (4,), expected (n, 4)"),
         (lambda s: s.update(asked="true"), "'asked' entry 'true' is damaged (not a flag"),
-        (lambda s: s.update(rng=None), "random state None is not one of a numpy bit generator"),
+        (lambda s: s.update(rng=None), "rng=None is not allowed: allowed a PCG64 state table"),
     ],
 )
 def test_a_generational_states_entries_are_checked_on_loading(edit, fragment: str) -> None:

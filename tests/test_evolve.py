@@ -484,7 +484,7 @@ def test_evolve_says_when_the_plateau_ends_a_run_before_its_budget(tmp_path: Pat
         (lambda s: s.update(optimizer_state="x"), "cannot restore the optimiser \\(state dict is a str"),
         (lambda s: s["optimizer_state"].update(population={"shape": [50, 3], "data": [0.0] * 150}), "population has shape \\(50, 3\\), expected \\(n, 42\\)"),
         (lambda s: s["optimizer_state"].update(champion_genome={"shape": [3], "data": [0.0] * 3}), "optimiser \\(champion genome has shape"),
-        (lambda s: s["optimizer_state"].update(rng={"bit_generator": "XX"}), "not one of a numpy bit generator"),
+        (lambda s: s["optimizer_state"].update(rng={"bit_generator": "XX"}), "rng={'bit_generator': 'XX'} is not allowed: allowed a PCG64 state table"),
         (lambda s: s.pop("counters"), "it has no 'counters' entry"),
         (lambda s: s["counters"].update(episodes=-5), "counter 'episodes' is -5, not a count"),
         (lambda s: s["counters"].update(wall_seconds=-1.0), "counter 'wall_seconds' is -1.0"),

@@ -14,11 +14,12 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, first_difference, whole_number
-from ..filekinds import CSV_KINDS, JSON_KINDS, refuse_cut_off
+from ..errors import NeurohoverError, brief, first_difference
+from ..filekinds import CSV_KINDS, JSON_KINDS, held_kind, refuse_cut_off
 from ..paths import JSONError, input_file, number_text, output_file, refuse_special_file, strict_json, writer_file, writing
 from ..policies import Policy
 from .common import EntryError, enc_float, read_count, read_return, read_seconds
+from .state_codec import check_stream
 
 __all__ = [
     "CHECKPOINT_FORMAT",
@@ -36,6 +37,7 @@ __all__ = [
     "encode_history",
     "read_checkpoint",
     "read_history_csv",
+    "refuse_replaced",
     "write_checkpoint",
     "write_history_csv",
 ]
@@ -287,6 +289,22 @@ def write_checkpoint(path: Path, state: dict) -> None:
         raise
 
 
+def refuse_replaced(path: Path, state: dict) -> None:
+    """Refuse to write a run's checkpoint over ``path`` once it holds a file neurohover did not write there as a
+    checkpoint (as :func:`~neurohover.evolution.evolve` refuses one given up front): a policy file a progress callback
+    saved there mid-run was replaced by the next checkpoint without a word (T47-B13). The run is kept: ``state`` is
+    written beside it, as NAME.checkpoint.json, which the message names (resume from it)."""
+    real = Path(os.path.realpath(path))
+    if not real.is_file() or not real.stat().st_size or (held := held_kind(real)) == CHECKPOINT_KIND:
+        return
+    said = f"checkpoint {str(path)!r} now holds {held or 'a file neurohover did not write'}, written there during the run, and was left as it is"
+    beside = real.with_name(f"{real.stem}.checkpoint.json")
+    if beside.is_file() and beside.stat().st_size and held_kind(beside) != CHECKPOINT_KIND:
+        raise NeurohoverError(f"{said}; {str(beside)!r} is not a checkpoint either, so the run's checkpoint was not written: the run stops")
+    write_checkpoint(beside, state)
+    raise NeurohoverError(f"{said}; the run's checkpoint was written to {str(beside)!r} instead (resume=True with that path goes on): the run stops")
+
+
 def check_resumed_checkpoint(path: Path) -> None:
     """Refuse a checkpoint to resume from that is there but no regular file as a run without resume does: a directory
     or a pipe was said not to exist (T46-B13)."""
@@ -344,28 +362,6 @@ def check_history(records: list[HistoryRecord], counts: dict[str, int], per_gene
             f"history is not the champion's: {held} where the run's champion (at generation {counts['generation']:,}) has return"
             f" {enc_float(champion)!r}; a run records a row whenever its champion changes, so its last row holds the champion's return"
         )
-
-
-#: The entries of a PCG64 bit generator's state (numpy's ``bit_generator.state``): the largest value of each, and as text.
-_STREAM_TOPS = {"state": (2**128 - 1, "2**128-1"), "inc": (2**128 - 1, "2**128-1"), "has_uint32": (1, "1"), "uinteger": (2**32 - 1, "2**32-1")}
-
-
-def check_stream(stream: Any, kind: str) -> None:
-    """EntryError (a ValueError, said plainly in a damaged checkpoint's message) unless ``stream`` is a state of the
-    ``kind`` (PCG64) bit generator as numpy writes it: its setter took a state or inc of True, 1.5 or 2**70 and a
-    has_uint32 of -1 (T19-08)."""
-    entries = ("bit_generator", "state", "has_uint32", "uinteger")
-    if kind != "PCG64" or not isinstance(stream, dict) or sorted(stream) != sorted(entries) or stream["bit_generator"] != kind:
-        raise EntryError(f"mdp_stream={brief(stream)} is not allowed: allowed a {kind} state table ({', '.join(entries)}) as the run wrote it")
-    inner = stream["state"]
-    if not isinstance(inner, dict) or sorted(inner) != ["inc", "state"]:
-        raise EntryError(f"mdp_stream's state={brief(inner)} is not allowed: allowed a table of state and inc")
-    for name, value in (("state.state", inner["state"]), ("state.inc", inner["inc"]), ("has_uint32", stream["has_uint32"]), ("uinteger", stream["uinteger"])):
-        top, text = _STREAM_TOPS[name.rpartition(".")[2]]
-        if not whole_number(value) or not 0 <= value <= top:
-            raise EntryError(f"mdp_stream's {name}={brief(value)} is not allowed: allowed an integer in 0..{text}")
-    if inner["inc"] % 2 == 0:  # numpy sets (seed sequence << 1) | 1
-        raise EntryError(f"mdp_stream's state.inc={brief(inner['inc'])} is not allowed: a PCG64 increment is odd")
 
 
 def _same(saved: Any, given: Any) -> bool:

@@ -43,6 +43,7 @@ from .records import (
     check_stream,
     config_difference,
     encode_history,
+    refuse_replaced,
     write_checkpoint,
 )
 from .restore import _check_between_generations, _check_prototype, _check_run_entries, _check_stop_reason, _check_tables, _damaged, _restored_parts, stop_reason
@@ -438,6 +439,7 @@ class Run:
     def _write_checkpoint(self, path: Path, wall: float) -> None:
         """Write the checkpoint after ``wall`` seconds; an optimiser state JSON cannot write refused by its key (T40-B06)."""
         state = self.state(wall)
+        refuse_replaced(path, state)  # a policy file a progress callback saved there (T47-B13)
         try:
             write_checkpoint(path, state)
         except (TypeError, ValueError) as err:

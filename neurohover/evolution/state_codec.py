@@ -26,6 +26,7 @@ __all__ = [
     "check_entries",
     "check_genomes",
     "check_state",
+    "check_stream",
     "damage_text",
     "dec_array",
     "dec_float",
@@ -146,12 +147,34 @@ def check_genomes(a: np.ndarray | None, size: int, name: str, rows: int | None =
 
 
 def rng_from_state(state: dict[str, Any]) -> np.random.Generator:
-    """A ``numpy.random.Generator`` in the saved ``bit_generator.state``."""
-    if not isinstance(state, dict) or state.get("bit_generator") not in ("PCG64", "PCG64DXSM", "MT19937", "Philox", "SFC64"):
-        raise NeurohoverError(f"random state {state!r:.80} is not one of a numpy bit generator")
-    bit_generator = getattr(np.random, state["bit_generator"])()
+    """A ``numpy.random.Generator`` in the saved ``bit_generator.state`` (:func:`check_stream`)."""
+    check_stream(state, "PCG64", "rng")  # default_rng's, each optimiser's: 2.5 and True were taken (T47-B10)
+    bit_generator: Any = np.random.PCG64()
     bit_generator.state = state
     return np.random.Generator(bit_generator)
+
+
+#: The entries of a PCG64 bit generator's state (numpy's ``bit_generator.state``): the largest value of each, and as text.
+_STREAM_TOPS = {"state": (2**128 - 1, "2**128-1"), "inc": (2**128 - 1, "2**128-1"), "has_uint32": (1, "1"), "uinteger": (2**32 - 1, "2**32-1")}
+
+
+def check_stream(stream: Any, kind: str, what: str = "mdp_stream") -> None:
+    """EntryError (a ValueError, said plainly in a damaged checkpoint's message) unless ``stream`` is a state of the
+    ``kind`` (PCG64) bit generator as numpy writes it: its setter took a state or inc of True, 1.5 or 2**70 and a
+    has_uint32 of -1 (T19-08). ``what``: the entry named (an optimiser's ``rng``, whose 2.5 and True numpy took as well,
+    and a resumed run differed from the uninterrupted one without a word; T47-B10)."""
+    entries = ("bit_generator", "state", "has_uint32", "uinteger")
+    if kind != "PCG64" or not isinstance(stream, dict) or sorted(stream) != sorted(entries) or stream["bit_generator"] != kind:
+        raise EntryError(f"{what}={brief(stream)} is not allowed: allowed a {kind} state table ({', '.join(entries)}) as the run wrote it")
+    inner = stream["state"]
+    if not isinstance(inner, dict) or sorted(inner) != ["inc", "state"]:
+        raise EntryError(f"{what}'s state={brief(inner)} is not allowed: allowed a table of state and inc")
+    for name, value in (("state.state", inner["state"]), ("state.inc", inner["inc"]), ("has_uint32", stream["has_uint32"]), ("uinteger", stream["uinteger"])):
+        top, text = _STREAM_TOPS[name.rpartition(".")[2]]
+        if not whole_number(value) or not 0 <= value <= top:
+            raise EntryError(f"{what}'s {name}={brief(value)} is not allowed: allowed an integer in 0..{text}")
+    if inner["inc"] % 2 == 0:  # numpy sets (seed sequence << 1) | 1
+        raise EntryError(f"{what}'s state.inc={brief(inner['inc'])} is not allowed: a PCG64 increment is odd")
 
 
 def check_state(state: dict[str, Any], kind: str) -> None:

@@ -43,6 +43,7 @@ from ..paths import JSONError, WriterLock, strict_json
 from ..sim.constants import MAX_SECONDS, seconds_allowed
 from .store_checks import (
     HELD_SQL,
+    MAX_CORES,
     SESSION_STATUSES,
     TIME_ALLOWED,
     GuardedConnection,
@@ -60,6 +61,7 @@ from .store_checks import (
     missing_text,
     object_text,
     refuse_moved,
+    refuse_wrong_cells,
     seconds_said,
     session_problem,
     sqlite_says,
@@ -106,8 +108,8 @@ class Store:
 
         create = check_flag(create, "create", "make the store if missing")  # create='no' was true (sixth trial)
 
+        self.path = checked_path(path, "results store", "results store's file path", file=True)  # None, 3, NUL, too long, 'x/', __fspath__ 5 (T32-B08, T47-B07)
         refuse_sqlite_name(path, "results store")  # ':memory:' and 'file:' URIs: never a file (as given: './file:x' is one; T32-A01, T32-A02)
-        self.path = checked_path(path, "results store", "results store's file path", file=True)  # None, 3, NUL, too long, 'x/' (T32-B08)
         if create:  # its -journal too (a reader writes none; T31-A03)
             refuse_long_store_name(path, "results store")
         check_store_file(self.path, path, create)  # what SQLite would open, or delete beside it, before it does
@@ -375,6 +377,7 @@ class Store:
         """Refuse an experiment row (of ``name`` only, if given) whose created time, which orders the experiments, is no
         number: 'yesterday' was taken, and sorted after every number (T22-09); nor a time (-5 was taken; T45-B02)."""
         sql = "SELECT name, scale, created FROM experiments WHERE (typeof(created) NOT IN ('integer', 'real') OR NOT (created >= 1e9 AND created < 4294967296))"
+        refuse_wrong_cells(self._rows, str(self.path), _SCHEMA, name, None)  # a BLOB name listed as bytes (T47-B03)
         rows = self._rows(sql + (" AND name = ?" if name is not None else "") + " LIMIT 1", () if name is None else (name,), "its list of experiments")
         if rows:
             bad, scale, created = rows[0]
@@ -407,6 +410,7 @@ class Store:
         if not check_flag(missing_ok, "missing_ok", "read an experiment not stored as one without units"):
             if not self._rows(HELD_SQL, (name, scale), f"experiment {name} ({scale})")[0][0]:
                 raise NeurohoverError(self.missing_message(name, scale))
+        refuse_wrong_cells(self._rows, str(self.path), _SCHEMA, name, scale)  # a BLOB key returned as bytes (T47-B03)
 
     def scales(self, name: str) -> list[str]:
         self._check_created(name)
@@ -530,7 +534,7 @@ class Store:
         check_experiment(name, scale, where)
         check_text(config_hash, "config_hash", where)
         check_executor(executor, where)
-        cores = stored_count(cores, "cores", where, 1)
+        cores = stored_count(cores, "cores", where, 1, MAX_CORES)
         units_before = stored_count(units_before, "units_before", where, 0)
         self.lock()
         c = self.conn
@@ -576,9 +580,6 @@ class Store:
         seen: dict[tuple, int] = {}
         for session in sessions:  # what the report sums and prints: numbers, or the damaged row named
             session["wall_seconds"] = self._seconds(session["wall_seconds"], f"experiment {name} ({scale}), session {session['id']}'s wall seconds")
-            if type(session["cores"]) is not int or session["cores"] < 1:
-                what = f"experiment {name} ({scale}), session {session['id']}'s cores"
-                raise NeurohoverError(f"results store {str(self.path)!r}: {what} are damaged ({session['cores']!r:.40})")
             bad = bad_session(session, stored)  # units_run 99 of 4, status 'zzz', started 1e12 were reported (T22-21)
             twin = seen.setdefault(tuple(session[c] for c in cols[1:]), session["id"])
             bad = bad or (f"it repeats session {twin} field for field (one run is recorded once)" if twin != session["id"] else "")

@@ -10,7 +10,7 @@ import os
 import socket
 import sqlite3
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -97,6 +97,36 @@ def check_tables(conn: sqlite3.Connection, store: str, schema: str) -> None:
             f"results store {store!r} is damaged: its table {table} {what} ({', '.join(key)}){said} ({rebuilt}): a row held twice is "
             f"read and counted twice; {fix}"
         )
+
+
+@functools.cache
+def text_columns(schema: str) -> dict[str, tuple[str, ...]]:
+    """Each table's TEXT columns, as ``schema`` (the store's) makes them."""
+    with contextlib.closing(sqlite3.connect(":memory:")) as c:
+        c.executescript(schema)
+        return {t: tuple(r[1] for r in c.execute(f"PRAGMA table_info({t})") if r[2] == "TEXT") for t in table_columns(schema)}
+
+
+def refuse_wrong_cells(read: Callable[[str, tuple, str], list], store: str, schema: str, name: str | None, scale: str | None) -> None:
+    """Refuse a store whose TEXT column holds a cell of another storage class (SQLite keeps a hand-written BLOB as it is
+    there), naming its table, row and column: a BLOB key was returned by results() as bytes and was export's TypeError, a
+    BLOB worker json's (T47-B03). ``read`` is the store's reader (sql, params, what). ``scale`` given: every text cell of
+    experiment (name, scale)'s rows in each table; else the experiments table's listed cells (of experiment ``name``, if given)."""
+    tables = text_columns(schema) if scale is not None else {"experiments": ("name", "scale", "config_hash")}
+    params = (name, scale) if scale is not None else (name,) if name is not None else ()
+    where = " AND name = ?1" + (" AND scale = ?2" if scale is not None else "") if params else ""
+    for table, columns in tables.items():
+        odd = " OR ".join(f"typeof({col}) != 'text'" for col in columns)
+        sql = f"SELECT rowid, {', '.join(columns)} FROM {table} WHERE ({odd}){where} LIMIT 1"
+        for rowid, *cells in read(sql, params, f"its table {table}"):
+            col, value = next((c, v) for c, v in zip(columns, cells) if not isinstance(v, str))
+            what = "a BLOB" if isinstance(value, bytes) else "NULL" if value is None else "a number"
+            key = dict(zip(columns, cells)).get("key")
+            unit = f" (unit {key!r})" if isinstance(key, str) else ""
+            raise NeurohoverError(
+                f"results store {store!r} is damaged: its table {table}, row {rowid}{unit}, column {col} holds {what} ({brief(value)}), "
+                "not the text neurohover writes there (a hand edit?); give another --store file, or reproduce --fresh to run the experiment over"
+            )
 
 
 #: How a session can end (:meth:`Store.end_session`; the runner's statuses). A session is "running" until then.
@@ -232,7 +262,7 @@ def sqlite_says(conn: sqlite3.Connection) -> str:
 
 def bad_session(session: dict, stored: int) -> str:
     """What is impossible in a sessions row (checked by :meth:`Store.sessions`), or '': a status no run ends with, an
-    executor that runs none, a start before 2001 or after 2106 (not "now": a clock that lags is no damage), unit counts
+    executor that runs none, cores not in 1..:data:`MAX_CORES`, a start before 2001 or after 2106 (not "now": a clock that lags is no damage), unit counts
     below 0, or more units before and run than the experiment stores (only ``update`` and ``fresh`` delete units, and
     both delete the sessions with them). A session killed by SIGKILL stays 'running', and is allowed."""
     statuses = ("running", *SESSION_STATUSES)
@@ -242,6 +272,9 @@ def bad_session(session: dict, stored: int) -> str:
     value = session["executor"]
     if not isinstance(value, str) or value not in EXECUTORS:
         return f"executor {brief(value)} is not allowed: allowed {', '.join(map(repr, EXECUTORS))}"
+    value = session["cores"]  # 2**62 was read and exported (T47-B12)
+    if not whole_number(value) or not 1 <= value <= MAX_CORES:
+        return f"cores {brief(value)} is not allowed: allowed a whole number from 1 to {MAX_CORES:,}"
     value = session["started"]
     if not time_allowed(value):
         return f"started {brief(value)} is not allowed: {TIME_ALLOWED}"
@@ -330,13 +363,16 @@ def check_text(value: Any, what: str, where: str, empty: bool = False) -> None:
 
 #: The largest whole number an SQLite INTEGER holds (10**30 cores was Python's OverflowError; T33-B18).
 SQLITE_INT_MAX = 2**63 - 1
+#: The most cores a session may record (2**20, more than any cluster runs one experiment on): 2**62 was read and exported (T47-B12).
+MAX_CORES = 2**20
 
 
-def stored_count(value: Any, what: str, where: str, least: int) -> int:
-    """``value`` as an int from ``least`` to :data:`SQLITE_INT_MAX`, or one error naming it (cores=0 was stored, and read
-    back as damaged)."""
-    if not whole_number(value) or not least <= value <= SQLITE_INT_MAX:
-        raise NeurohoverError(f"{where}: {what} = {brief(value)} is not allowed: give a whole number >= {least} (at most 2**63 - 1, SQLite's largest)")
+def stored_count(value: Any, what: str, where: str, least: int, most: int = SQLITE_INT_MAX) -> int:
+    """``value`` as an int from ``least`` to ``most`` (:data:`SQLITE_INT_MAX`, or :data:`MAX_CORES`), or one error naming it
+    (cores=0 was stored, and read back as damaged)."""
+    if not whole_number(value) or not least <= value <= most:
+        top = "2**63 - 1, SQLite's largest" if most == SQLITE_INT_MAX else f"{most:,}"
+        raise NeurohoverError(f"{where}: {what} = {brief(value)} is not allowed: give a whole number >= {least} (at most {top})")
     return int(value)
 
 
