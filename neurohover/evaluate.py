@@ -338,9 +338,8 @@ def _fallback_array(fallback_index, n_jobs: int, n_policies: int) -> np.ndarray:
 
 
 def check_episode_count(n: int, what: str) -> None:
-    """Refuse ``n`` episodes in one call above :data:`MAX_EPISODES_PER_CALL` (``what`` names where they come from), and
-    an ``n`` that is no count of episodes ('5' and None were TypeErrors, 2.5 and -3 were taken; T47-B04)."""
-    if not whole_number(n) or n < 0:
+    """Refuse ``n`` episodes in one call above :data:`MAX_EPISODES_PER_CALL` (``what`` names where they come from)."""
+    if not whole_number(n) or n < 0:  # '5' and None were TypeErrors, 2.5 and -3 were taken (T47-B04)
         raise NeurohoverError(f"{what}: its episode count {brief(n)} is not allowed: give a whole number of episodes, 0..{MAX_EPISODES_PER_CALL:,}")
     if n > MAX_EPISODES_PER_CALL:
         raise NeurohoverError(
