@@ -464,7 +464,7 @@ def _store_of(folder: Path, recorded: object, name: str, scale: str) -> str | No
     """The store :func:`check_against_store` reads for compete folder ``folder``, whose summary records ``recorded`` and
     experiment (name, scale), or None: the folder's own :data:`STORE_FILE` (compete's default store, which travels with
     the folder) where it holds the experiment at that scale, else the recorded path where a store is there
-    (:func:`_holds_store`), else the folder's own. A folder moved elsewhere was not checked at all, and once a new study
+    (:func:`_holds_store`), else the folder's own where the summary names a default store. A folder moved elsewhere was not checked at all, and once a new study
     ran at its old path it was checked against that study's store (T46-B05, T46-B06); an own file left by an earlier
     compete into the same folder, whose summary names its --store, is not this competition's store, and is not read."""
     from .experiments import Store
@@ -473,6 +473,8 @@ def _store_of(folder: Path, recorded: object, name: str, scale: str) -> str | No
     there = recorded if isinstance(recorded, str) and _holds_store(recorded) else None
     if not _holds_store(own):
         return there
+    if there is None and isinstance(recorded, str) and Path(recorded).name != STORE_FILE:  # its --store gone: an own file
+        return None  # left by an earlier compete is not this one's store, and its summary was called edited (T47-A01)
     if there is not None:
         held = Store(own, create=False)
         try:
