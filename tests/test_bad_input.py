@@ -471,7 +471,9 @@ def test_a_stored_row_that_is_no_json_object_is_named(tmp_path: Path, capsys) ->
     with Store(path) as store:
         reproduce(load_config("fig2", "quick", {"runs": 1, "budget": 40, "n_steps": 20}), store, LocalExecutor(1), progress=False)
     for sql, what in (
-        ("UPDATE units SET result = X'80FF00' WHERE key = (SELECT min(key) FROM units)", "'s result is damaged (not JSON"),
+        # a BLOB is no text cell at all (T47-B03: named by table, row and column), text that is no JSON a damaged result
+        ("UPDATE units SET result = X'80FF00' WHERE key = (SELECT min(key) FROM units)", "column result holds a BLOB (b'\\x80\\xff\\x00'), not the text"),
+        ("UPDATE units SET result = 'x{' WHERE key = (SELECT min(key) FROM units)", "'s result is damaged (not JSON"),
         ("UPDATE experiments SET config = '[]'", "'s config is damaged (a JSON list, not an object)"),
     ):
         damaged = tmp_path / "d.sqlite"
