@@ -36,6 +36,7 @@ import os
 import re
 import sys
 import textwrap
+import threading
 import warnings
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
@@ -360,11 +361,43 @@ def plot_flight_data(data: FlightData, out_dir: str | Path, stem: str = "flight"
     chosen = range(data.n_episodes) if episodes is None else _episode_list(episodes, data.n_episodes)
     out_dir = output_dir(out_dir, "out_dir")  # a file, FIFO or /dev/null was NotADirectoryError (T14-10); made, saying so, if missing
     paths = []
-    for i in chosen:
-        obs, act = data.observations[i], data.actions[i]
-        fig = flight_figure(obs, act, title=_episode_title(data, i, stem), episode_steps=int(steps), crashed=episode_crashed(data, i))
-        paths.append(save_figure(fig, out_dir / f"{stem}-episode{i:0{width}d}.png"))
+    with sole_plot(out_dir, "out_dir"):  # two flights of one name at once mixed their episodes (T47-A03)
+        for i in chosen:
+            obs, act = data.observations[i], data.actions[i]
+            fig = flight_figure(obs, act, title=_episode_title(data, i, stem), episode_steps=int(steps), crashed=episode_crashed(data, i))
+            paths.append(save_figure(fig, out_dir / f"{stem}-episode{i:0{width}d}.png"))
     return paths
+
+
+#: The lock file a plot being drawn holds in its output directory (:func:`sole_plot`).
+LOCK_FILE = ".plot.lock"
+_HELD = threading.local()  # the folders this thread holds (.dirs): neurohover plot holds its --out around plot_flight_data
+
+
+@contextlib.contextmanager
+def sole_plot(out: Path, option: str) -> Iterator[None]:
+    """Be the only plot writing into the directory ``out`` (named ``option`` in a refusal) inside this block: a second
+    one there is refused, naming the first's pid. Two flights of one name plotted into one --out at once both exited 0,
+    the folder left with a mix of their episodes' figures and no note (T47-A03). A lock on :data:`LOCK_FILE` in ``out``,
+    as compete's (:func:`~neurohover.compete_folder.sole_competition`); a thread already holding ``out`` goes on."""
+    from .locks import holding
+
+    try:
+        st = os.stat(out)
+        key: object = (st.st_dev, st.st_ino)
+    except OSError:  # its writes say what is wrong with it
+        key = str(out)
+    held: set = _HELD.__dict__.setdefault("dirs", set())
+    if key in held:
+        yield
+        return
+    busy = "is in use: another plot run ({}) is writing its files; wait for it to end, or give another output directory"
+    with holding(out / LOCK_FILE, lambda who: f"{option} {brief(str(out))} {busy.format(who)}"):
+        held.add(key)
+        try:
+            yield
+        finally:
+            held.discard(key)
 
 
 def _check_flight_data(data: object) -> None:

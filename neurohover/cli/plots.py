@@ -4,7 +4,8 @@
 ``neurohover fly --record``) to ``DIR/<name>-episode<i>.png`` (a name too long for that cut at its
 end): position error, velocity, attitude (roll, pitch, yaw), angular rates and actions over time, a
 crash (an episode shorter than 6000 steps) marked in red. ``DIR`` defaults to the file's directory.
-Figures of another flight of the same name that ``DIR`` holds are left there and named on stderr.
+Figures of another flight of the same name that ``DIR`` holds are left there and named on stderr. A plot into a
+``DIR`` another plot is writing is refused, naming its pid.
 
 ``neurohover plot --compete DIR [DIR ...] [--out OUTDIR]`` overlays the mean cumulative error of
 several ``neurohover compete --out DIR`` results (their ``episodes.csv``; agent and task from
@@ -115,21 +116,23 @@ def cmd_plot(args: argparse.Namespace) -> int:
         if args.out is None:  # plot /dev/stdin wrote its figures into /dev (T46-A05)
             refuse_pseudo_fs(path.parent, "plot's default --out (FLIGHT's folder)", path.parent, into=True, instead="give --out DIR")
         out = output_dir(args.out if args.out is not None else path.parent, "--out")
-        from ..plots import plot_flight_data
+        from ..plots import plot_flight_data, sole_plot
 
         stem = _fitting_stem(path.stem, out, data.n_episodes)
-        written = plot_flight_data(data, out, stem=stem, episodes=_episodes(args.episodes, data.n_episodes))
-        _note_left(out, stem, data.n_episodes)
+        with sole_plot(out, "--out"):  # two at once mixed two flights' episodes without a note (T47-A03)
+            written = plot_flight_data(data, out, stem=stem, episodes=_episodes(args.episodes, data.n_episodes))
+            _note_left(out, stem, data.n_episodes)
     else:
         from ..compete import check_against_store
         from ..compete_files import read_compete_dirs
-        from ..plots import compete_figure, save_figure
+        from ..plots import compete_figure, save_figure, sole_plot
 
         results = read_compete_dirs(args.compete)  # every directory checked and read before anything is written
         for folder in args.compete:  # and against the stores they name (T38-B06)
             check_against_store(folder)
         out = output_dir(args.out if args.out is not None else results[0].path.resolve().parent, "--out")
-        written = [save_figure(compete_figure(results), out / COMPETE_PNG)]
+        with sole_plot(out, "--out"):
+            written = [save_figure(compete_figure(results), out / COMPETE_PNG)]
     for p in written:
         print(printable(p))  # a newline or U+202E in --out split or reversed the line (fourteenth trial, T14-24)
     return 0

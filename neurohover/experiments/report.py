@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import sys
 import time
+from contextlib import AbstractContextManager
 from pathlib import Path
 
 from ..errors import NeurohoverError, OutputError, brief, check_flag
@@ -149,7 +150,8 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
 
     A ``README.md`` in ``out`` with generated blocks gets them filled from the store (:mod:`.report_readme`). A damaged
     experiment is said in its place and in a warning line on stderr; ``refuse_all_damaged`` (the command line's): when
-    every experiment asked for is damaged, NeurohoverError and nothing written, not a report of the damage alone.
+    every experiment asked for is damaged, NeurohoverError and nothing written, not a report of the damage alone. A
+    report into an ``out`` that another report is writing is refused, naming its pid (:func:`sole_report`).
     """
     from ..paths import created_dirs_removed_on_failure, output_dir
     from .report_replaced import held_report, note_replaced
@@ -162,10 +164,26 @@ def write_report(store: Store, out: str | Path, *, scale: str | None = None, nam
     check_flag(refuse_all_damaged, "refuse_all_damaged", "write nothing when every experiment is damaged")
     with created_dirs_removed_on_failure():  # a failure leaves no directory it made, as on the command line (eleventh trial)
         out = output_dir(out, "report directory")  # '' wrote into the current directory; a file, a device or 5: OSError, TypeError
-        held = held_report(out / "report.md")  # what it replaces, said once written (T40-A04)
-        path = _write_report(store, out, scale, names, refuse_all_damaged)
-    note_replaced(held, path, store.path)
+        with sole_report(out):
+            held = held_report(out / "report.md")  # what it replaces, said once written (T40-A04)
+            path = _write_report(store, out, scale, names, refuse_all_damaged)
+            note_replaced(held, path, store.path)
     return path
+
+
+#: The lock file a report being written holds in its output directory (:func:`sole_report`).
+LOCK_FILE = ".report.lock"
+
+
+def sole_report(out: Path) -> AbstractContextManager[None]:
+    """Be the only report writing into ``out`` inside this block: a second one there is refused, naming the first's pid.
+    Two reports of different stores into one --out at once both said "report written", the folder left with one's
+    report.md and the other's figures, and no note (T47-A02). A lock on :data:`LOCK_FILE` in ``out``, as compete's
+    (:func:`~neurohover.compete_folder.sole_competition`)."""
+    from ..locks import holding
+
+    busy = "is in use: another report run ({}) is writing its files; wait for it to end, or give another output directory"
+    return holding(out / LOCK_FILE, lambda who: f"report directory {brief(str(out))} {busy.format(who)}")
 
 
 def _write_report(store: Store, out: Path, scale: str | None, names: list[str] | None, refuse_all_damaged: bool) -> Path:
