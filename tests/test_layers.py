@@ -15,7 +15,7 @@ LAYERS = [
     {"command", "errors", "filekinds", "locks", "paths", "procs", "progress", "settingsdoc"},
     {"sim"},
     {"tasks", "flightdata", "flightmeta", "policies", "netfile", "wrappers"},
-    {"launch", "flyer", "plots", "compete_files", "compete_folder"},
+    {"launch", "flyer", "plots", "compete_files", "compete_folder", "safeguard"},
     {"evaluate"},
     {"evolution", "envs"},
     {"models", "policysets", "policystages", "manifest", "policy_records", "integrations"},
