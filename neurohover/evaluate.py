@@ -278,7 +278,8 @@ def _index_array(values, n_jobs: int | None, what: str, jobs=None) -> np.ndarray
         raise NeurohoverError(f"{what} must be a 1-D array of job indices, got shape {arr.shape}")
     check_episode_count(arr.size, f"{what} of {arr.size:,} jobs")  # before its int64 copy (10**10 int8 indices: 75 GiB; third trial)
     if arr.size and arr.dtype.kind not in "iu":  # not issubdtype(np.integer): a time span's array is one (T17-1)
-        wide = next((v for v in arr.flat if whole_number(v) and not -(2**63) <= v < 2**63), None) if arr.dtype == object else None  # T41-B09
+        given = arr.flat if arr.dtype == object else values if isinstance(values, (list, tuple)) else ()  # [0, 2**63] is float64 (T48-B07)
+        wide = next((v for v in given if whole_number(v) and not -(2**63) <= v < 2**63), None)  # T41-B09
         raise NeurohoverError(f"{what} holds {brief(wide)}, out of range: allowed 0..2**63-1" if wide else f"{what} must hold integers, got dtype {arr.dtype}")
     if arr.size and np.issubdtype(arr.dtype, np.unsignedinteger) and arr.max() > np.iinfo(np.int64).max:  # would wrap negative
         raise NeurohoverError(f"{what} holds {arr.max()}, out of range: allowed 0..2**63-1")

@@ -339,13 +339,12 @@ def check_settings(settings: Any, cls: type[_Settings]) -> _Settings:
 
 
 def check_prototype(prototype: np.ndarray) -> np.ndarray:
-    """A float64 copy of a non-empty, finite 1-D genome (ValueError otherwise)."""
+    """A float64 copy of a non-empty 1-D genome of finite genes a Policy takes (ValueError otherwise; T48-B04: genes of
+    1e300, past :data:`~neurohover.policies.MAX_GENE`, were evolved, refused only when the champion became a Policy)."""
     p = as_floats(prototype, "prototype", "a non-empty 1-D genome of finite numbers")
     if p.ndim != 1 or p.size == 0:
         raise NeurohoverError(f"prototype must be a non-empty 1-D genome, got shape {p.shape}")
-    if not np.all(np.isfinite(p)):
-        raise NeurohoverError("prototype must be finite")
-    return p
+    return check_genomes(p, p.size, "prototype", rows=0)
 
 
 def check_info(info: Any, asked: int | None = None) -> None:

@@ -155,6 +155,13 @@ def _stats_problem(stats: dict, method: str) -> str:
         episodes = stats["n_episodes"]
         if not (whole_number(episodes) and 1 <= episodes <= (top or episodes)):
             return _its("stats.n_episodes", episodes, f"allowed an integer in 1..{top or 'n_transitions'} (each episode has a transition or more)")
+        if top is not None and top > episodes * MAX_EPISODE_STEPS:  # T48-B03: 10**30 transitions in 3 episodes were taken
+            top = episodes * MAX_EPISODE_STEPS
+            return _its(
+                "stats.n_transitions",
+                n,
+                f"allowed an integer in {MIN_TRANSITIONS}..{top:,} (its {episodes} episodes of at most {MAX_EPISODE_STEPS:,} steps each)",
+            )
     null = ("budget",) if method == "ec-meno" else ()  # EC-MENO's plateau stop; EC-MER's budget is a number (T24-08)
     for key, high in (("budget", None), ("evaluations", None), ("episodes", MAX_EC_MER_EPISODES), ("n_steps", MAX_EPISODE_STEPS), ("wind_fit_rounds", None)):
         if key in stats and not (stats[key] is None and key in null) and not (whole_number(stats[key]) and 1 <= stats[key] <= (high or stats[key])):
