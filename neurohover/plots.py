@@ -48,7 +48,7 @@ from .compete_files import COMPETE_CONDITIONS, CompeteResult, read_compete_dirs
 from .errors import NeurohoverError, brief, finite_real, real_number, refuse_reloaded, whole_in, whole_number
 from .flightdata import FlightData, check_flown, check_metadata, crash_flags
 from .paths import output_dir, output_file, printable
-from .sim.constants import ACTION_NAMES, CONTROL_DT, EPISODE_STEPS, MAX_EPISODE_STEPS
+from .sim.constants import ACTION_NAMES, CONTROL_DT, EPISODE_STEPS, MAX_EPISODE_STEPS, OBS_NAMES
 
 if TYPE_CHECKING:  # matplotlib is imported by what draws: every command line imports this module
     from matplotlib.figure import Figure
@@ -214,8 +214,10 @@ def attitude_angles(observations: np.ndarray) -> np.ndarray:
     Parameters
     ----------
     observations : (T, 12) array
-        Observations; entries 9-11 are the quaternion's vector part, its scalar part qw is
-        ``sqrt(1 - |q|^2)`` (positive: a helicopter more than 30 degrees from level has crashed).
+        Observations, finite; entries 9-11 are the quaternion's vector part, its scalar part qw is
+        ``sqrt(1 - |q|^2)`` (positive: a helicopter more than 30 degrees from level has crashed). A noisy
+        sensor's reading may lie past the unit ball (|q| > 1, as recorded flights of ``Sensor(attitude=1)`` do):
+        it is taken as the nearest rotation, its vector part scaled to norm 1 (qw = 0).
 
     Returns
     -------
@@ -223,6 +225,14 @@ def attitude_angles(observations: np.ndarray) -> np.ndarray:
         Roll, pitch, yaw in degrees.
     """
     q = _real_array(observations, "observations", 12, "(T, 12)")[:, 9:12]
+    bad = np.argwhere(~np.isfinite(q))
+    if bad.size:  # NaN readings gave NaN angles; flight_figure refuses them (check_flown) (T48-B06)
+        k, j = (int(x) for x in bad[0])
+        raise NeurohoverError(
+            f"observations row {k}: its {OBS_NAMES[9 + j]} {q[k, j]} is not allowed: no flight records a NaN or infinite reading; give finite observations"
+        )
+    norm = np.hypot(np.hypot(q[:, 0], q[:, 1]), q[:, 2])  # no overflow: 1e300 readings squared were NumPy's RuntimeWarnings (T48-B01)
+    q = np.where((norm > 1.0)[:, None], q / np.maximum(norm, 1.0)[:, None], q)  # a noisy reading past the unit ball: its nearest rotation
     qx, qy, qz = q[:, 0], q[:, 1], q[:, 2]
     qw = np.sqrt(np.clip(1.0 - (qx * qx + qy * qy + qz * qz), 0.0, 1.0))
     roll = np.arctan2(2.0 * (qw * qx + qy * qz), 1.0 - 2.0 * (qx * qx + qy * qy))
@@ -232,9 +242,11 @@ def attitude_angles(observations: np.ndarray) -> np.ndarray:
 
 
 def crashed_episode(actions: np.ndarray, episode_steps: int = EPISODE_STEPS) -> bool:
-    """Whether an episode of ``actions`` (a (T, 4) array) crashed: it ended before ``episode_steps`` control steps
+    """Whether an episode of ``actions`` (a (T, 4) array, T >= 1) crashed: it ended before ``episode_steps`` control steps
     (an integer in 1..MAX_EPISODE_STEPS)."""
     flown = _real_array(actions, "actions", 4, "(T, 4)").shape[0]
+    if flown < 1:  # (0, 4) was called a crash (T48-B05), as FlightData.load refuses such an episode
+        raise NeurohoverError(f"actions of shape ({flown}, 4) are not an episode: it has 0 steps (a flown one has at least 1); give a (T, 4) array, T >= 1")
     return flown < _check_episode_steps(episode_steps, flown)
 
 

@@ -406,8 +406,11 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
     """Load, resolve and validate an experiment config at ``scale`` (``quick`` or ``paper``)."""
     if not isinstance(scale, str) or scale not in SCALES:  # an array was numpy's 'truth value is ambiguous' (T18-3)
         raise NeurohoverError(f"unknown scale {brief(scale)}: allowed {', '.join(SCALES)}")
-    if overrides is not None and not (isinstance(overrides, dict) and all(isinstance(k, str) for k in overrides)):  # a TypeError (fourth trial)
-        raise NeurohoverError(f"overrides={overrides!r:.60} is not allowed: give a dict of settings, e.g. {{'episodes': 3}} (the CLI's --set episodes=3)")
+    # a TypeError (fourth trial); the example is a setting of every shipped config ('episodes' was not fig2's, T48-B09)
+    if overrides is not None and not (isinstance(overrides, dict) and all(isinstance(k, str) for k in overrides)):
+        raise NeurohoverError(
+            f"overrides={overrides!r:.60} is not allowed: give a dict whose keys are setting names (text), e.g. {{'seed': 3}} (the CLI's --set seed=3)"
+        )
     path = resolve_name(name_or_path)
     try:
         raw = tomllib.loads(path.read_text(encoding="utf-8-sig"))  # TOML is UTF-8; a byte-order mark (Windows editors) was "Invalid statement" (ninth trial)

@@ -80,10 +80,12 @@ class Sensor:
     def __post_init__(self) -> None:
         for name in (*SENSOR_GROUPS, "correlation"):
             value = getattr(self, name)
+            # correlation's range, not "a finite number >= 0", for -0.5 or '2' as for 1.5 (T48-B08)
+            allowed = "0 <= correlation < 1" if name == "correlation" else "a finite number >= 0"
             if not real_number(value):  # NumPy's numbers are numbers too; not a bool, nor a NumPy time (T17-1)
-                raise NeurohoverError(f"sensor {name}={brief(value)} is not a number: allowed a finite number >= 0")
+                raise NeurohoverError(f"sensor {name}={brief(value)} is not a number: allowed {allowed}")
             if not finite_real(value) or value < 0:  # np.timedelta64 was float()'s TypeError (T17-1), 10**400 an OverflowError
-                raise NeurohoverError(f"sensor {name}={brief(value)} is out of range: allowed a finite number >= 0")
+                raise NeurohoverError(f"sensor {name}={brief(value)} is out of range: allowed {allowed}")
             number = float(value)
             if name != "correlation" and number > MAX_STD:
                 raise NeurohoverError(f"sensor {name}={value!r} is out of range: allowed a std in 0..{MAX_STD:g}")
