@@ -142,6 +142,21 @@ def _plan_evolution(cfg: ExperimentConfig, results: dict) -> Plan:
     return Plan(units, total)
 
 
+def robust_sources(cfg: ExperimentConfig) -> dict[str, list[str]]:
+    """Every robustness unit's key of an evolution experiment that flies a champion of its own evolve units, each with
+    the keys of those units (planned once they are all stored): ``reproduce --only`` makes them first and is checked
+    against these keys (T48-A01, T48-A02); empty for the other kinds."""
+    s = cfg.typed
+    if not isinstance(s, EvolutionSettings):
+        return {}
+    n_train = len(family_of(s.task, s.sigma, s.sensor).training_mdps()[: s.n_mdps]) if s.robustness_variants else 0
+    return {
+        UnitKey.make("robust", vkey, f"train{i}"): [UnitKey.make("evolve", vkey, f"train{i}", r) for r in range(s.runs)]
+        for vkey in s.robustness_variants
+        for i in range(n_train)
+    }
+
+
 def _policy_set_robustness(cfg: ExperimentConfig, train: list) -> list[Unit]:
     """Table 3 for a policy set: specialised policy i flown on every training MDP, as MDP i's best champion is."""
     s = cfg.typed

@@ -5,13 +5,13 @@ from __future__ import annotations
 import json
 import sys
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass, field
 
 from ..errors import NeurohoverError, brief, check_flag
 from .config import POLICY_SOURCES, ExperimentConfig, check_own_name, check_paper_table
 from .keys import key_matches
-from .plans import Plan, plan, run_keys, source_results
+from .plans import Plan, plan, robust_sources, run_keys, source_results
 from .store import Store
 
 
@@ -55,12 +55,20 @@ def _short(err: BaseException) -> str:
     return f"{type(err).__name__}: {lines[-1] if lines else text}"[:500]
 
 
-def selected(key: str, only: Sequence[str]) -> bool:
+def selected(key: str, only: Sequence[str], needed: Collection[str] = ()) -> bool:
     """Whether unit ``key`` is in the selection ``only`` (glob patterns, :func:`~.keys.key_matches`; empty: every unit).
 
-    Shared prerequisites (``policy/...`` units: the policies that test runs fly) are always selected.
+    Shared prerequisites (``policy/...`` units: the policies that test runs fly) are always selected, and so are the
+    units in ``needed`` (:func:`prerequisites`: the evolve units whose champions selected robustness units fly).
     """
-    return not only or key.startswith("policy/") or any(key_matches(key, pat) for pat in only)
+    return not only or key.startswith("policy/") or key in needed or any(key_matches(key, pat) for pat in only)
+
+
+def prerequisites(config: ExperimentConfig, only: Sequence[str]) -> set[str]:
+    """The keys of the units a selection ``only`` needs made first besides ``policy/`` units: the evolve units whose
+    best champion a selected robustness unit flies (:func:`~.plans.robust_sources`). They were neither run nor named,
+    and the run said "selection finished" (T48-A01)."""
+    return {src for key, srcs in robust_sources(config).items() if any(key_matches(key, pat) for pat in only) for src in srcs}
 
 
 def check_patterns_once(patterns: Sequence[str], option: str) -> None:
@@ -162,7 +170,7 @@ def _check_policy_source(config: ExperimentConfig, store: Store) -> None:
 
 def _matches_no_unit(config, pattern: str, units) -> NeurohoverError:
     """The error of an ``--only`` pattern that selects nothing, with what unit keys look like (of every stage)."""
-    keys = [u.key for u in units] + run_keys(config)
+    keys = list(dict.fromkeys([u.key for u in units] + run_keys(config) + list(robust_sources(config))))
     stages: dict[str, list[str]] = {}
     for key in keys:
         stages.setdefault(key.split("/")[0], []).append(key)
@@ -220,8 +228,9 @@ def _refuse_unmatched(config: ExperimentConfig, store: Store, held: str | None, 
     results = store.results(config.name, config.scale) if held == config.hash else {}
     later = run_keys(config)  # a test-runs plan lists its runs once their policies are stored: their keys, now
     first = plan(config, results, sources) if later else _with_policy_stand_ins(config, results, sources)
-    unmatched = [pat for pat in only if not any(key_matches(k, pat) for k in [*(u.key for u in first.units), *later])]
-    if unmatched and (len(first.units) == first.total or later):
+    keys = [*(u.key for u in first.units), *later, *robust_sources(config)]  # robust units wait for their evolve units (T48-A02)
+    unmatched = [pat for pat in only if not any(key_matches(k, pat) for k in keys)]
+    if unmatched and (len(set(keys)) >= first.total or later):
         raise _matches_no_unit(config, unmatched[0], first.units)
 
 
@@ -296,6 +305,7 @@ def reproduce(
         bar.write(f"{config.name}: unit {unit.key} failed: {_short(err)}", file=sys.stderr)
 
     matched: set[str] = set()
+    needed = prerequisites(config, only)
     try:
         while True:
             p = first_round if first_round is not None else plan(config, results, sources)
@@ -304,7 +314,7 @@ def reproduce(
             summary.units_total = p.total
             bar.total = p.total
             bar.refresh()
-            todo = [u for u in p.units if u.key not in results and selected(u.key, only)]
+            todo = [u for u in p.units if u.key not in results and selected(u.key, only, needed)]
             if not todo:
                 break
             executor.run(todo, on_result, on_error)
