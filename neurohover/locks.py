@@ -119,15 +119,17 @@ def holding(lock_path: Path, busy: Callable[[str], str]) -> Iterator[None]:
 
 
 @contextmanager
-def sole_writer(path: str | os.PathLike, option: str) -> Iterator[None]:
+def sole_writer(path: str | os.PathLike, option: str, given: str | os.PathLike | None = None) -> Iterator[None]:
     """Be the only run writing the output ``path`` (and the files named after it) inside this block: a second run on
     the same output is refused, naming the first's pid. Two evolve runs on one --out both said they finished and left
     one's policy beside the other's checkpoint (tenth trial). A :class:`WriterLock` on ``.NAME.lock`` beside it
-    (:func:`holding`). ``path``: a str or path object (a str was an AttributeError 'with_name'; T44-B19)."""
+    (:func:`holding`). ``path``: a str or path object (a str was an AttributeError 'with_name'; T44-B19); ``given``:
+    the path as the user gave it, for the message, where ``path`` was made absolute (T48-A03)."""
     path = Path(path)
+    named = str(path if given is None else given)
     with holding(
         path.with_name(f".{path.name}.lock"),
-        lambda who: f"{option} {str(path)!r} is being written by another run ({who}): wait for it to end, or give another {option}",
+        lambda who: f"{option} {named!r} is being written by another run ({who}): wait for it to end, or give another {option}",
     ):
         remove_dead_writers_files(path)
         yield

@@ -175,14 +175,16 @@ def _evaluate_agent(args: argparse.Namespace, held: contextlib.ExitStack) -> int
             raise NeurohoverError(f"{option} {value} is out of range: allowed an integer in {low}..{high}")
     inputs = {"--policy": args.policy, "--sb3": args.sb3}  # writing one would destroy what is flown (fourth trial)
     out = None if args.json is None else output_file(args.json, "--json", inputs, kind=ROWS_KIND, suffixes=(".json",), what=ROWS_ARE)
+    if out is not None:  # absolute before the agent's code runs: its os.chdir sent the file elsewhere and left the lock (T48-A03)
+        out = Path(os.path.abspath(out))
     if args.obs_dtype is not None and args.policy is not None:  # the kernel flies a policy file on float64: ignored (fifth trial)
         raise NeurohoverError("--obs-dtype applies to an agent that receives observations (--callable, --sb3, --rl-zoo, --cleanrl), not to a --policy file")
     if args.rl_id and args.policy is not None:
         raise NeurohoverError("--rl-id applies to an agent trained on a neurohover/<NAME>-RL-v0 id, not to a neurohover --policy file")
     act = _agent(args)
     if out is not None:
-        output_file(args.json, "--json", _files_read(args), kind=ROWS_KIND, suffixes=(".json",), what=ROWS_ARE)
-        held.enter_context(sole_writer(out, "--json"))  # one of two runs at once was lost, both saying they wrote it (T41-A02)
+        output_file(out, "--json", _files_read(args), kind=ROWS_KIND, suffixes=(".json",), what=ROWS_ARE)
+        held.enter_context(sole_writer(out, "--json", args.json))  # one of two runs at once was lost, both saying they wrote it (T41-A02)
     if isinstance(act, Policy):
         note_policy_task(act, family.name, f"--policy {args.policy}")
     if args.rl_id or (args.rl_zoo is not None and "-RL-v0" in str(args.rl_zoo)):
