@@ -62,6 +62,17 @@ def test_t47_b03_a_blob_experiment_name_is_not_listed_as_bytes(store_file: Path,
             store.experiments()
 
 
+def test_t47_b03_orphan_units_of_a_blob_name_are_not_listed_as_bytes(store_file: Path, tmp_path: Path) -> None:
+    """The T47-B03 fixer's note: units whose name is a BLOB have no config row, and orphan_units() listed them as bytes."""
+    from neurohover.experiments import Store
+
+    with Store(edited(store_file, tmp_path / "d.sqlite", "UPDATE units SET name = ?", b"fig7"), create=False) as store:
+        with pytest.raises(NeurohoverError, match=r"its table units holds units of experiment b'fig7', scale 'settings-[0-9a-f]+', not the text"):
+            store.orphan_units()
+    with Store(store_file, create=False) as store:
+        assert store.orphan_units() == []
+
+
 def test_t47_b12_session_cores_past_2_20_are_refused_written_and_read(store_file: Path, tmp_path: Path) -> None:
     from neurohover.experiments import Store
 

@@ -362,7 +362,12 @@ class Store:
             + (" AND u.name = ?" if name is not None else "")
             + " GROUP BY u.name, u.scale ORDER BY u.name, u.scale"
         )
-        return [tuple(r) for r in self._rows(sql, () if name is None else (name,), "its list of units")]
+        rows = [tuple(r) for r in self._rows(sql, () if name is None else (name,), "its list of units")]
+        odd = next((r[:2] for r in rows if not (isinstance(r[0], str) and isinstance(r[1], str))), None)
+        if odd is not None:  # a BLOB name was returned as bytes (as results() keys were, T47-B03)
+            raise NeurohoverError(f"results store {str(self.path)!r} is damaged: its table units holds units of experiment {brief(odd[0])}, "
+                                  f"scale {brief(odd[1])}, not the text neurohover writes there (a hand edit?); give another --store file")  # fmt: skip
+        return rows
 
     def experiments(self) -> list[tuple[str, str, str, int]]:
         """(name, scale, config_hash, finished units) of every experiment in the store."""
