@@ -238,7 +238,11 @@ def test_a_terminated_build_leaves_no_half_built_set(tmp_path: Path) -> None:
             time.sleep(0.1)
         assert building.is_dir(), (tmp_path / "stderr.txt").read_text()[-2000:]
         os.kill(proc.pid, signal.SIGTERM)
-        assert proc.wait(timeout=60) == 143  # terminated, also when the stop lands mid-evolution (it said interrupted, 130)
+        try:  # twice in the twenty-sixth session's full runs it did not end within 60 s: its stderr says where it was
+            status = proc.wait(timeout=60)
+        except subprocess.TimeoutExpired:
+            pytest.fail("build-policies did not end within 60 s of SIGTERM; its stderr: " + (tmp_path / "stderr.txt").read_text()[-3000:])
+        assert status == 143  # terminated, also when the stop lands mid-evolution (it said interrupted, 130)
         err = (tmp_path / "stderr.txt").read_text()
         assert "the finished runs are kept in" in err and err.strip().splitlines()[-1].endswith("terminated"), err[-1500:]
         assert not (out / "ghh08").exists() and sorted(p.name for p in building.iterdir()) == ["stages"]  # no half-built set
