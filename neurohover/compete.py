@@ -464,25 +464,21 @@ def _store_of(folder: Path, recorded: object, name: str, scale: str) -> str | No
     """The store :func:`check_against_store` reads for compete folder ``folder``, whose summary records ``recorded`` and
     experiment (name, scale), or None: the folder's own :data:`STORE_FILE` (compete's default store, which travels with
     the folder) where it holds the experiment at that scale, else the recorded path where a store is there
-    (:func:`_holds_store`), else the folder's own where the summary names a default store. A folder moved elsewhere was not checked at all, and once a new study
-    ran at its old path it was checked against that study's store (T46-B05, T46-B06); an own file left by an earlier
-    compete into the same folder, whose summary names its --store, is not this competition's store, and is not read."""
+    (:func:`_holds_store`), else the folder's own where the summary names a default store. A folder moved elsewhere was
+    not checked at all, and once a new study ran at its old path it was checked against that study's store (T46-B05,
+    T46-B06); an own file left by an earlier compete into the same folder, whose summary names its --store, is not this
+    competition's store, and is not read (T47-A01)."""
     from .experiments import Store
 
     own = folder / STORE_FILE
     there = recorded if isinstance(recorded, str) and _holds_store(recorded) else None
     if not _holds_store(own):
         return there
-    if there is None and isinstance(recorded, str) and Path(recorded).name != STORE_FILE:  # its --store gone: an own file
-        return None  # left by an earlier compete is not this one's store, and its summary was called edited (T47-A01)
-    if there is not None:
-        held = Store(own, create=False)
-        try:
-            if (name, scale) not in {(n, s) for n, s, _, _ in held.experiments()}:
-                return there
-        finally:
-            held.close()
-    return str(own)
+    if there is None:  # the recorded store gone: the own file is this competition's only if the summary names a default store
+        return str(own) if not isinstance(recorded, str) or Path(recorded).name == STORE_FILE else None
+    with Store(own, create=False) as held:
+        holds = (name, scale) in {(n, s) for n, s, _, _ in held.experiments()}
+    return str(own) if holds else there
 
 
 def check_against_store(folder: str | Path) -> None:

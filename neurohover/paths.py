@@ -164,9 +164,10 @@ def checked_path(path, option: str, what: str = "file path", ends: tuple[str, ..
     directory is the caller's to name."""
     if not isinstance(path, (str, os.PathLike)):
         raise NeurohoverError(f"{option}={path!r:.60} is not allowed: give a {what}")
-    text = path if isinstance(path, str) else path.__fspath__()  # os.fspath's TypeError on an int named no value (T47-B07)
-    if not isinstance(text, str):
-        raise NeurohoverError(f"{option}={path!r:.60} is not allowed: its __fspath__() gives {brief(text)}: give a {what} as text")
+    text = path_text(path)
+    if text is None:  # os.fspath's TypeError on an int named no value (T47-B07)
+        given = path.__fspath__() if isinstance(path, os.PathLike) else path
+        raise NeurohoverError(f"{option}={path!r:.60} is not allowed: its __fspath__() gives {brief(given)}: give a {what} as text")
     if text == "":
         raise NeurohoverError(f"{option} is empty; give a {what}")
     if "\x00" in text:
