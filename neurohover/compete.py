@@ -492,7 +492,7 @@ def check_against_store(folder: str | Path) -> None:
     (T42-A02), and one holding the summary's scale under another experiment refuses its name: a settings-HASH digests
     the agent and task with the settings, so it names one competition (agent and experiment edited together; T45-B09)."""
     from .experiments import Store
-    from .paths import strict_json
+    from .jsontext import strict_json
 
     summary_path = Path(folder) / "summary.json"
     if not summary_path.is_file():

@@ -29,10 +29,12 @@ from typing import NoReturn
 
 import numpy as np
 
+from .compete_labels import NO_OFFLINE, NO_SAFEGUARD, policy_label_problem
 from .errors import NeurohoverError, brief, finite_real, whole_number
 from .filekinds import refuse_cut_off
 from .flightmeta import compared_by_value
-from .paths import input_dir, number_text, refuse_special_file, strict_json
+from .jsontext import number_text, strict_json
+from .paths import input_dir, refuse_special_file
 from .sim.constants import CRASH_STEP_PENALTY, MAX_EPISODE_STEPS, MAX_SECONDS, WORST_RETURN, crash_charge, crash_return_ceiling, lowest_return, seconds_allowed
 from .sim.rng import MAX_SEED
 from .tasks import N_TEST, N_TRAINING, set_name
@@ -43,13 +45,8 @@ __all__ = [
     "COMPETE_FILE",
     "COMPETE_SUMMARY",
     "CSV_COLUMNS",
-    "NO_OFFLINE",
-    "NO_SAFEGUARD",
-    "ONE_POLICY",
-    "POLICY_LABELS",
     "SUMMARY_FIELDS",
     "CompeteResult",
-    "policy_label_problem",
     "read_compete_dir",
     "read_compete_dirs",
 ]
@@ -63,33 +60,6 @@ CSV_COLUMNS = ("run", "mdp", "episode", "return", "crashed", "steps", "policy", 
 #: The columns of an older layout, read and ignored: offline_seconds, each episode's, last in the files compete wrote
 #: before a8bc471 (2026-11-27; summary.json's mean_offline_seconds_per_run holds it now; T37-A03).
 OLDER_COLUMNS = ("offline_seconds",)
-#: The agents that fly under no safeguard (no Choice of theirs has a fallback), whose safeguard_fired is 0 in every row
-#: (T23-07). The agents' specs do not declare it, and this layer may not read them: tests/test_bad_input_trial23_compete.py
-#: checks that every other registered agent is one with a safeguard.
-NO_SAFEGUARD = frozenset(
-    {"baseline", "generic", "model-free", "model-based", "incremental", "incremental-zero", "incremental-fixed", "incremental-race", "model-free-risk"}
-)
-#: The agents that fly one policy throughout, and its label in every row's policy column (T23-07).
-ONE_POLICY = {"baseline": "baseline", "generic": "generic"}
-_GROWS = None  # a count with no bound: a policy of each model learned, or each replacement evolved, so far
-#: The policies every other agent names in its rows' policy column and its stored runs' policy_changes (T25-08, T25-09:
-#: 'specialised:1' of authors-zero, 'model:1' of model-free were taken): per kind, None for a bare name, else the
-#: numbers KIND:N takes (low, high; high None: no bound), as agents/* label their Choices: model_free and risk
-#: specialised:{episode} (the task's N_TRAINING specialised policies), model_based (model-based: generic, then model:1;
-#: incremental*: model:{models learned} from 1), hybrid (safe:0..1, model:0..N_EVOLVED-1, replacement:{n} from 1),
-#: continual (model:{models} from 1), fghh_code (authors-*: model:1..3, its three evolutions). This layer may not import
-#: the agents: tests/test_bad_input_trial25_results.py checks the table against them.
-POLICY_LABELS: dict[str, dict[str, tuple[int, int | None] | None]] = {
-    **dict.fromkeys(("model-free", "model-free-risk"), {"specialised": (0, N_TRAINING - 1)}),
-    "model-based": {"generic": None, "model": (1, 1)},
-    **dict.fromkeys(("incremental", "incremental-zero", "incremental-fixed", "incremental-race", "continual"), {"generic": None, "model": (1, _GROWS)}),
-    **dict.fromkeys(("hybrid", "hybrid-baseline", "hybrid-risk", "hybrid-baseline-risk"), {"safe": (0, 1), "model": (0, 2), "replacement": (1, _GROWS)}),
-    **dict.fromkeys(("authors-zero", "authors-fixed", "authors-race"), {"generic": None, "model": (1, 3)}),
-}
-#: The agents whose first Choice is final: agents.protocol.run_test never calls their update, so every run's offline
-#: seconds are 0.0 exactly (T24-07; every stored baseline and generic run of the committed store holds 0.0, every
-#: other agent's more). tests/test_bad_input_trial24_results.py checks that each one's first choice is final.
-NO_OFFLINE = frozenset({"baseline", "generic"})
 #: The MDP sets a summary's mdps names, as its rows' labels name them (TaskFamily.set_name: seeded-test at FGHH sigma 0.2).
 MDP_SETS, SETS_TEXT = ("test", "train", "seeded-test", "seeded-train", "sample"), "test, train, seeded-test, seeded-train or sample"
 _SCALE = re.compile(r"settings-[0-9a-f]{10}")  # experiments.config.settings_scale: a competition's scale, a digest of its settings
@@ -203,7 +173,7 @@ def _after_learning_start(labels: list[str]) -> int:
 
 def _row_numbers(where: str, row: dict[str, str]) -> tuple:
     """A row's run, episode, return, crashed (0 where absent, as in older files) and steps (None where absent), each
-    written as compete writes it (:func:`~neurohover.paths.number_text`): int() and float() took '0_0', '\u0660' and
+    written as compete writes it (:func:`~neurohover.jsontext.number_text`): int() and float() took '0_0', '\u0660' and
     full-width digits (T28-B12); steps '20.0' was "must be numbers"."""
     cells: list[int | float | None] = []
     for column in ("run", "episode", "return", "crashed", "steps"):
@@ -565,27 +535,6 @@ def _check_rows_of_agent(path: Path, summary: dict, rows: _Rows) -> None:
         problem = policy_label_problem(agent, label) if label else ""
         if problem:
             raise NeurohoverError(f"--compete {str(csv_path)!r}, line {line}: {problem}")
-
-
-def policy_label_problem(agent: object, label: str) -> str:
-    """'' when ``agent`` names a policy it flies ``label`` (:data:`ONE_POLICY`, :data:`POLICY_LABELS`; an agent in
-    neither, a hand-written one, is not checked), else what it flies (T25-08, T25-09); result_checks asks too. Internal: called with a stored label."""
-    fixed = ONE_POLICY.get(agent) if isinstance(agent, str) else None
-    if fixed is not None:
-        return "" if label == fixed else f"policy {brief(label)} is not allowed: agent {agent} flies {fixed!r} only"
-    kinds = POLICY_LABELS.get(agent) if isinstance(agent, str) else None
-    if kinds is None:
-        return ""
-    kind, colon, number = label.partition(":")
-    bounds = kinds.get(kind, False)
-    if bounds is None and not colon:
-        return ""
-    if isinstance(bounds, tuple) and number.isascii() and number.isdigit() and len(number) <= 9 and number == str(int(number)):
-        low, high = bounds
-        if low <= int(number) and (high is None or int(number) <= high):
-            return ""
-    flies = [k if b is None else f"{k}:{b[0]}" if b[0] == b[1] else f"{k}:N (N >= {b[0]})" if b[1] is None else f"{k}:{b[0]}..{b[1]}" for k, b in kinds.items()]
-    return f"policy {brief(label)} is not allowed: agent {agent} flies {', '.join(flies)}"
 
 
 def read_compete_dirs(dirs: Sequence[str | Path]) -> list[CompeteResult]:

@@ -411,7 +411,7 @@ def refuse_non_text_keys(data: object, where: str, what: str = "metadata") -> No
     """Refuse ``data`` (``what`` about to be written as JSON: metadata, a unit's result) holding a key that is not text at
     any depth, naming it and the top-level key it is under: JSON writes every key as text, and {1: 2} came back as {'1': 2}
     (flight data T21-08, policy files T28-B14, store results T32-B11). A NumPy object array's dicts are looked into (flight
-    data may hold them). It names the key; :func:`neurohover.paths.json_text` then tests the values."""
+    data may hold them). It names the key; :func:`neurohover.jsontext.json_text` then tests the values."""
     stack: list[tuple[object, object]] = [(None, data)]  # (the top-level key it is under, a value)
     seen: set[int] = set()  # a dict that holds itself: json_text names it
     while stack:

@@ -20,7 +20,8 @@ import numpy as np
 from .errors import NeurohoverError, brief, finite_real, float64_of, key_text, refuse_non_text_keys
 from .filekinds import FLIGHT_DATA_KIND, refuse_suffix
 from .flightmeta import check_meaning, check_policy_actions, flown_policy
-from .paths import json_text, path_text, strict_json
+from .jsontext import json_text, strict_json
+from .paths import path_text
 from .sim.constants import ACTION_NAMES, EPISODE_STEPS, MAX_EPISODE_STEPS, OBS_NAMES
 
 FORMAT = "neurohover-flight-data/1"
@@ -467,9 +468,9 @@ def _metadata_text(metadata: object, where: str) -> str:
 
 
 def _too_deep(metadata: dict) -> str:
-    """Which metadata value nests more lists or tables than :data:`~neurohover.paths.MAX_NOTE_DEPTH`, in words ('' when
+    """Which metadata value nests more lists or tables than :data:`~neurohover.jsontext.MAX_NOTE_DEPTH`, in words ('' when
     none does): a note 600 deep loaded, and the flight data could then not be deep-copied or pickled (T33-B03)."""
-    from .paths import MAX_NOTE_DEPTH, nesting_depth
+    from .jsontext import MAX_NOTE_DEPTH, nesting_depth
 
     bad = next((k for k, v in metadata.items() if nesting_depth(v) > MAX_NOTE_DEPTH), None)
     if bad is None:

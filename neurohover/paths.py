@@ -1,7 +1,7 @@
 """Checks of the command line's file and directory arguments, made before any long computation.
 
 Internal: neurohover's plumbing (README, Python API, What is public): its checks refuse a bad path by name, and its
-other helpers (``json_text``, ``printable``, ...) trust their callers, which give them checked values.
+other helpers (``printable``, ...) trust their callers, which give them checked values.
 
 Each check refuses a bad path with one :class:`~neurohover.errors.NeurohoverError` that names the
 option, the path and what is expected. Output checks really create (and remove again) a file, so
@@ -17,9 +17,7 @@ directory only, never out of one the check would create (left empty beside the o
 from __future__ import annotations
 
 import errno
-import json
 import os
-import re
 import stat
 import sys
 import tempfile
@@ -27,22 +25,17 @@ from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
 
-from .errors import NeurohoverError, OutputError, brief, float_of
+from .errors import NeurohoverError, OutputError, brief
 from .filekinds import NAME_MAX, PNG_KIND, SQLITE_HEADER, held_kind, name_limit, output_name, refuse_policy_set, refuse_unencodable
 from .locks import WriterLock, sole_writer, writer_file
 
 __all__ = [
-    "JSONError",
     "WriterLock",
     "checked_path",
     "created_dirs_removed_on_failure",
-    "parse_json",
-    "json_text",
-    "strict_json",
     "input_file",
     "input_dir",
     "make_dirs",
-    "number_text",
     "output_dir",
     "output_file",
     "printable",
@@ -217,99 +210,6 @@ def refuse_link_loop(path: str | os.PathLike, option: str) -> None:
     except OSError as err:
         if err.errno == errno.ELOOP:
             raise NeurohoverError(f"{option} {os.fspath(path)!r} cannot be read (too many levels of symbolic links)") from None
-
-
-def _unique_keys(pairs: list) -> dict:
-    value = dict(pairs)
-    if len(value) < len(pairs):  # counted once per object, not once per key: a store's large rows stay quick (ninth trial)
-        keys = [k for k, _ in pairs]
-        twice = sorted({k for k in keys if keys.count(k) > 1})
-        raise ValueError(f"key {twice[0]!r} is given more than once")
-    return value
-
-
-class JSONError(ValueError):
-    """JSON text :func:`strict_json` refuses; the message says why in words (``deep``: it is nested too deeply)."""
-
-    def __init__(self, why: str, deep: bool = False) -> None:
-        super().__init__(why)
-        self.deep = deep
-
-
-def strict_json(text: str | bytes):
-    """The value of the JSON ``text``, strictly, or one :class:`JSONError` saying why not: text that is no JSON, a key
-    given twice (Python keeps the last without a word), nesting deeper than Python can follow and integers past a
-    float's range (4,301 digits and more were int()'s own ValueError). The one decision every reader of a JSON file or
-    stored row shares, each wrapping the reason in its own message (ninth trial)."""
-    try:
-        return json.loads(text, object_pairs_hook=_unique_keys, parse_int=_json_int)
-    except RecursionError:
-        raise JSONError("its JSON is nested too deeply", deep=True) from None
-    except (ValueError, TypeError) as err:  # json.JSONDecodeError, UnicodeDecodeError (bytes), TypeError (no text at all)
-        raise JSONError(str(err)) from None
-
-
-def json_text(value, **dumps) -> str:
-    """``value`` written as strict JSON (``json.dumps(value, allow_nan=False, **dumps)``) that :func:`strict_json` reads
-    back, or the TypeError / ValueError / RecursionError saying why not (an object, a NaN, a key twice as 1 and '1', an
-    integer past a float's range, nesting too deep): the one test of a value about to be stored, each caller naming it."""
-    text = json.dumps(value, allow_nan=False, **dumps)
-    strict_json(text)
-    return text
-
-
-#: How deep a free-form value read from a file (a policy's or flight data's metadata note) may nest lists and tables:
-#: Python's JSON reader follows about 990 levels, and what it read 600 deep could not be deep-copied or pickled, a
-#: RecursionError (T33-B03).
-MAX_NOTE_DEPTH = 100
-
-
-def nesting_depth(value) -> int:
-    """How many lists (or tuples) and dicts ``value`` nests, at its deepest (0 for a number or text), counted without
-    recursion, and no further than one past :data:`MAX_NOTE_DEPTH`."""
-    depth, level = 0, [value]
-    while depth <= MAX_NOTE_DEPTH:
-        inner = [v for v in level if isinstance(v, (list, tuple, dict))]
-        if not inner:
-            break
-        depth += 1
-        level = [item for v in inner for item in (v.values() if isinstance(v, dict) else v)]
-    return depth
-
-
-def parse_json(text: str, name: str):
-    """The JSON ``text`` of the file ``name``, strictly (:func:`strict_json`): a key given twice, nesting deeper than
-    Python can follow and numbers past a float's range are refused by name (third trial)."""
-    try:
-        return strict_json(text)
-    except JSONError as err:
-        raise NeurohoverError(f"{name} is not allowed: {err}" if err.deep else f"{name} is not valid JSON: {err}") from None
-
-
-def _json_int(text: str) -> int:
-    if len(text) > 400:  # past a float's range, and past int()'s 4,300 digits a ValueError of its own (ninth trial)
-        raise ValueError(f"the number {text[:20]}... ({len(text)} digits) is out of range")
-    value = int(text)
-    try:
-        float(value)  # past a float's range no genome or parameter can hold it (an OverflowError later)
-    except OverflowError:
-        raise ValueError(f"the number {text[:20]}... ({len(text)} digits) is out of range") from None
-    return value
-
-
-_WHOLE_TEXT = re.compile(r"0|-?[1-9][0-9]{0,18}")  # as str(int) writes one, up to 19 digits (2**63 - 1 has 19)
-_REAL_TEXT = re.compile(r"-?(?:[0-9]+(?:\.[0-9]+)?(?:e[-+]?[0-9]+)?|inf)|nan")  # as repr(float) writes one
-
-
-def number_text(text: str, whole: bool = False) -> int | float:
-    """The number a CSV cell ``text`` holds as Python writes one (``str(int)``, ``repr(float)``: ``20``, ``-7.38``,
-    ``1e-05``, ``-inf``, ``nan``; ``whole``: an integer, no sign before 0), else a ValueError saying what is allowed:
-    ``int()`` and ``float()`` also read '1_0', other scripts' digits ('\u0661'), spaces and '+5' (T28-B12, T28-B13).
-    The range of the number is the caller's to check."""
-    if isinstance(text, str) and (_WHOLE_TEXT if whole else _REAL_TEXT).fullmatch(text):
-        return int(text) if whole else float_of(text)
-    allowed = "a whole number (at most 19 digits)" if whole else "a number"
-    raise ValueError(f"{brief(text)} is not allowed: allowed {allowed} in ASCII digits, as Python writes it")
 
 
 def _no_dash(path: str | os.PathLike, option: str, what: str, stdout: bool) -> None:

@@ -375,7 +375,7 @@ def load_policy(source: str | Path) -> Policy:
         from .netfile import policy_from_net
 
         return policy_from_net(text, name)
-    from .paths import parse_json
+    from .jsontext import parse_json
 
     try:
         policy = policy_from_dict(parse_json(text, name), name)
@@ -473,7 +473,8 @@ def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
     The name is checked by :func:`check_json_policy_name` (a name ending .json, not another run's checkpoint or history;
     T24-01), the record by :data:`RECORD_CHECKS` as :func:`load_policy` checks it (T24-03): what is written loads."""
     from .flightdata import plain_json, unwritable_key  # here: flightdata imports this module
-    from .paths import json_text, output_file, strict_json, writing
+    from .jsontext import json_text, strict_json
+    from .paths import output_file, writing
 
     if not isinstance(policy, Policy):
         raise NeurohoverError(f"policy={policy!r:.60} is not allowed: give a Policy (load_policy('baseline') for the baseline's)")

@@ -72,7 +72,7 @@ def policy_record_problem(meta: dict) -> str:
 def _not_json_problem(meta: dict) -> str:
     """A metadata value that is no strict JSON (a NaN or an Infinity at any depth), named by its key: Python's JSON
     reader takes those literals, so a policy file's note of NaN loaded, and save_policy then refused the policy (T32-B17)."""
-    from .paths import MAX_NOTE_DEPTH, json_text, nesting_depth
+    from .jsontext import MAX_NOTE_DEPTH, json_text, nesting_depth
 
     for key, value in meta.items():
         try:

@@ -55,6 +55,7 @@ import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real, whole_number
 from .evaluate import MAX_EPISODES_PER_CALL, evaluate
+from .jsontext import JSONError, strict_json
 from .manifest import (
     BUILT_PROTOTYPE,
     DIGESTS,
@@ -69,7 +70,7 @@ from .manifest import (
     set_files,
     table3_summary,
 )
-from .paths import JSONError, sole_writer, strict_json, writing
+from .paths import sole_writer, writing
 from .policies import Policy, load_policy, save_policy, utf8_text
 from .policystages import STAGES, build_state, finished_stage, run_seeds, stage_file
 from .sim.constants import MAX_EPISODE_STEPS

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import NeurohoverError
-from .paths import JSONError, strict_json
+from .jsontext import JSONError, strict_json
 from .policies import Policy, load_policy
 
 

@@ -11,7 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from neurohover.compete_files import CSV_COLUMNS, NO_SAFEGUARD, ONE_POLICY, SUMMARY_FIELDS, read_compete_dir
+from neurohover.compete_files import CSV_COLUMNS, SUMMARY_FIELDS, read_compete_dir
+from neurohover.compete_labels import NO_SAFEGUARD, ONE_POLICY
 from neurohover.errors import NeurohoverError
 
 #: Small real competitions (2 runs of 3 episodes of 40 steps; fghh's of 2 of 20): (task, agent, extra arguments).

@@ -271,7 +271,7 @@ def test_every_stored_evolution_and_robustness_result_of_the_committed_store_is_
 
 
 def test_any_agent_without_a_safeguard_is_refused_safeguard_episodes(tmp_path: Path) -> None:
-    """T23-14: not only the baseline: a generic run (no safeguard either; compete_files.NO_SAFEGUARD, as plot --compete
+    """T23-14: not only the baseline: a generic run (no safeguard either; compete_labels.NO_SAFEGUARD, as plot --compete
     reads rows) stored with safeguard episodes is refused; a hybrid run's are its own (checked elsewhere)."""
     config, store = _reproduced(tmp_path, tiny_test_runs("generic"))
     edited = _edited(store, tmp_path / "e.sqlite", "run/generic/test0/rep0", safeguard_episodes=[1])

@@ -18,7 +18,8 @@ from conftest import CliRun, tiny_test_runs
 from store_edits import refused_by_every_command
 from test_bad_input_trial23_results import EV1, _edited, _refused, _reproduced
 
-from neurohover.compete_files import MAX_SECONDS, NO_OFFLINE, read_compete_dir
+from neurohover.compete_files import MAX_SECONDS, read_compete_dir
+from neurohover.compete_labels import NO_OFFLINE
 from neurohover.errors import NeurohoverError
 from neurohover.experiments.result_checks import _history_fall_problem, params_problem
 from neurohover.experiments.results import result_from_dict

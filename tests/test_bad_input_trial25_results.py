@@ -18,7 +18,8 @@ from conftest import CliRun, tiny_model_learning, tiny_test_runs
 from store_edits import refused_by_every_command
 from test_bad_input_trial23_results import _edited, _refused, _reproduced
 
-from neurohover.compete_files import ONE_POLICY, POLICY_LABELS, policy_label_problem, read_compete_dir
+from neurohover.compete_files import read_compete_dir
+from neurohover.compete_labels import ONE_POLICY, POLICY_LABELS, policy_label_problem
 from neurohover.errors import NeurohoverError
 
 RUN = "run/model-free/test0/rep0"

@@ -144,9 +144,8 @@ def test_every_planned_unit_passes_the_checks_of_run_unit() -> None:
     assert kinds >= {"evolve", "test_run"}
 
 
-PLUMBING = ("paths", "filekinds", "locks", "evolution.state_codec", "experiments.keys", "models.model_checks")
+PLUMBING = ("paths", "filekinds", "jsontext", "locks", "compete_labels", "evolution.state_codec", "experiments.keys", "models.model_checks")
 INTERNAL_HELPERS = (
-    ("compete_files", "policy_label_problem"),
     ("experiments.results", "num"),
     ("models.model", "check_stats"),
     ("integrations.neat", "pack_networks"),

@@ -16,7 +16,7 @@ from test_bad_input_trial7 import _config, _damaged, tiny_store  # noqa: F401  (
 
 import neurohover as nh
 from neurohover.errors import NeurohoverError
-from neurohover.paths import JSONError, parse_json, strict_json
+from neurohover.jsontext import JSONError, parse_json, strict_json
 
 DEEP = '{"a": ' + "[" * 100_000 + "]" * 100_000 + "}"
 HUGE = '{"a": 1' + "0" * 5000 + "}"

@@ -16,7 +16,8 @@ import numpy as np
 
 from ..errors import NeurohoverError, brief, first_difference
 from ..filekinds import CSV_KINDS, JSON_KINDS, held_kind, refuse_cut_off
-from ..paths import JSONError, input_file, number_text, output_file, refuse_special_file, strict_json, writer_file, writing
+from ..jsontext import JSONError, number_text, strict_json
+from ..paths import input_file, output_file, refuse_special_file, writer_file, writing
 from ..policies import Policy
 from .common import EntryError, enc_float, read_count, read_return, read_seconds
 from .state_codec import check_stream
@@ -198,7 +199,7 @@ def read_history_csv(path: str | Path) -> list[HistoryRecord]:
     ------
     NeurohoverError
         If the file does not start with the header :data:`HISTORY_COLUMNS`, or a row is not one record as
-        :func:`write_history_csv` writes it: each number in ASCII digits (:func:`~neurohover.paths.number_text`), counts
+        :func:`write_history_csv` writes it: each number in ASCII digits (:func:`~neurohover.jsontext.number_text`), counts
         >= 0, a champion's fitness finite or '-inf' (on the run's scale: 1/ln(error) is > 0), seconds finite and >= 0, and the rows as a run records them
         (:func:`check_history`; wall seconds never falling). int() and float() took 'nan', '1_0', other scripts' digits
         and falling counts (T28-B13). The file ends with a newline, as written: a file cut inside its last number read as

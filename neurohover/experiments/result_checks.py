@@ -8,7 +8,7 @@ import dataclasses
 import math
 from typing import TYPE_CHECKING, Any
 
-from ..compete_files import NO_OFFLINE, NO_SAFEGUARD, policy_label_problem
+from ..compete_labels import NO_OFFLINE, NO_SAFEGUARD, policy_label_problem
 from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..integrations.neat import NEAT_TOPOLOGY
 from ..sim.constants import CRASH_STEP_PENALTY, MAX_SECONDS, WORST_RETURN, crash_charge, crash_return_ceiling, lowest_return, seconds_allowed
@@ -142,7 +142,7 @@ def params_problem(result: Any, params: Any) -> str:
     """What in a stored unit's ``result`` contradicts the unit's own ``params`` ('' when nothing does; params of another
     shape are the plan check's to name): a test run's agent or MDP, or a model's method or MDP, other than its params
     say (a run of model-free on ghh08/test:0 holding agent 'baseline' and mdp 'ghh09/test:7' was exported; T22-08), offline
-    seconds of an agent that does none (:data:`~neurohover.compete_files.NO_OFFLINE`; T24-07), or a crash at a step past
+    seconds of an agent that does none (:data:`~neurohover.compete_labels.NO_OFFLINE`; T24-07), or a crash at a step past
     its episodes' ``n_steps`` (999999 of 20 was reported; T22-07); an evolution run's or a
     robustness unit's figures that contradict its params (T23-08: :func:`evolve_params_problem`,
     :func:`robustness_params_problem`)."""

@@ -39,7 +39,8 @@ from typing import Any
 
 from ..errors import NeurohoverError, brief, check_flag
 from ..filekinds import refuse_long_store_name, refuse_sqlite_name
-from ..paths import JSONError, WriterLock, strict_json
+from ..jsontext import JSONError, strict_json
+from ..paths import WriterLock
 from ..sim.constants import MAX_SECONDS, seconds_allowed
 from .store_checks import (
     HELD_SQL,

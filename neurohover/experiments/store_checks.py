@@ -16,8 +16,9 @@ from typing import Any
 
 from ..errors import NeurohoverError, brief, finite_real, refuse_non_text_keys, whole_number
 from ..filekinds import SQLITE_HEADER, refuse_sqlite_side_files
+from ..jsontext import json_text, strict_json
 from ..locks import WriterLock, hold_file
-from ..paths import json_text, refuse_dangling_link, strict_json
+from ..paths import refuse_dangling_link
 from ..sim.constants import MAX_SECONDS
 from .config import ExperimentConfig, check_name, check_scale
 from .result_checks import params_problem
@@ -409,7 +410,7 @@ def unit_texts(unit: Any, result: Any, name: str, where: str) -> tuple[str, str]
 
 
 def object_text(value: Any, what: str, where: str) -> str:
-    """``value``'s JSON text, if it is a JSON object that reads back (:func:`~neurohover.paths.strict_json`), or one error
+    """``value``'s JSON text, if it is a JSON object that reads back (:func:`~neurohover.jsontext.strict_json`), or one error
     naming it: a list was stored and every later read called the store damaged, NaN was json's ValueError (T14-5)."""
     if not isinstance(value, dict):
         raise NeurohoverError(f"{where}: {what} = {brief(value)} is not allowed: give a dict (a JSON object)")

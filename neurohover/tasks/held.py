@@ -155,7 +155,7 @@ def _wind_label_problem(mdp: MDP, text: str) -> str:
     """Why a ``wind=[...]`` label (what GHH-08's make() writes of the wind it is given, ``fly --wind``) is refused ('' when
     it is not): its numbers are not the MDP's wind (make() writes them as Python lists, whose text reads back as the same
     floats)."""
-    from ..paths import strict_json
+    from ..jsontext import strict_json
 
     try:
         named = strict_json(text)
