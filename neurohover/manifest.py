@@ -62,7 +62,7 @@ def _manifest_sizes() -> dict[str, tuple[int, int, str]]:
 _MANIFEST_KEYS = ("task", *_MANIFEST_FIELDS, DIGESTS, "safe", "crashes_on_training_mdps", "mean_return_on_training_mdps", "table3")
 
 
-def _check_manifest_fields(manifest: dict, path: Path) -> None:
+def check_manifest_fields(manifest: dict, path: Path) -> None:
     """Refuse a key no build writes and a descriptive field of the wrong kind by name (sixth trial: n_steps "x", a
     lineage 5 were shown as given)."""
     unknown = [key for key in manifest if key not in _MANIFEST_KEYS]

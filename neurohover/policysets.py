@@ -60,11 +60,11 @@ from .manifest import (
     BUILT_PROTOTYPE,
     DIGESTS,
     LINEAGES,
-    _check_manifest_fields,
     built_as,
     check_digests,
     check_ghh_manifest,
     check_kind_keys,
+    check_manifest_fields,
     choose_safe,
     genome_digests,
     set_files,
@@ -233,7 +233,7 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
         raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r} must be a JSON object, got {type(manifest).__name__}")
     if manifest.get("task", family.name) != family.name:  # another task's set copied under this name: its policies fly the wrong task
         raise NeurohoverError(f"policy-set manifest {str(manifest_path)!r} is of task {manifest['task']!r}, not {family.name!r}")
-    _check_manifest_fields(manifest, manifest_path)
+    check_manifest_fields(manifest, manifest_path)
     check_kind_keys(manifest, manifest_path, family.generic_over_distribution)
     _refuse_strays(root, family)
     targets = {"zero": family.zero().label, "family": f"{family.name}/G"}  # what each role's run evolved on

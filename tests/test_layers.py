@@ -102,3 +102,36 @@ def test_modules_and_functions_stay_small_enough_to_read() -> None:
                 long_functions.append((rel, node.name))
     assert long_modules == []
     assert set(long_functions) == LONG_FUNCTIONS
+
+
+#: Modules whose private names others may import: the package's own pieces imported as modules for a side effect.
+PRIVATE_MODULES = {"_cache"}
+
+
+def _private_reaches(path: Path) -> list[str]:
+    """Each ``from .module import _name`` and ``module._name`` of ``path`` that reaches into another neurohover module."""
+    tree = ast.parse(path.read_text())
+    modules = set()  # local names bound to a neurohover module (import ... as, from . import module)
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and (node.level or (node.module or "").startswith("neurohover")):
+            for alias in node.names:
+                private = alias.name.startswith("_") and not alias.name.startswith("__") and alias.name not in PRIVATE_MODULES
+                if private:
+                    out.append(f"{path.relative_to(PACKAGE.parent)}:{node.lineno} imports {alias.name} from {node.module or '.'}")
+                if node.module is None or alias.name[:1].islower():
+                    modules.add(alias.asname or alias.name)
+        elif isinstance(node, ast.Import):
+            modules |= {(a.asname or a.name).split(".")[0] for a in node.names if a.name.startswith("neurohover")}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id in modules:
+            if node.attr.startswith("_") and not node.attr.startswith("__"):
+                out.append(f"{path.relative_to(PACKAGE.parent)}:{node.lineno} reads {node.value.id}.{node.attr}")
+    return out
+
+
+def test_no_module_reaches_into_another_modules_private_names() -> None:
+    """The developers' guide: no reaching into another module's private names (a name another module needs is public in
+    its home, if not in its ``__all__``)."""
+    reaches = [line for path in sorted(PACKAGE.rglob("*.py")) for line in _private_reaches(path)]
+    assert not reaches, "\n".join(reaches)

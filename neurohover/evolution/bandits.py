@@ -27,7 +27,7 @@ import numpy as np
 
 from ..errors import NeurohoverError, brief, finite_real
 from .common import as_floats
-from .races import MAX_RESAMPLING, RaceResult, SampleFn, _check_int, _check_room, _check_sample_fn, _draw
+from .races import MAX_RESAMPLING, RaceResult, SampleFn, check_int, check_room, check_sample_fn, draw_samples
 
 __all__ = ["BANDITS", "MAX_BISECTIONS", "kl_bounds", "lucb_radius", "top_mu_bandit"]
 
@@ -41,7 +41,7 @@ MAX_BISECTIONS = 10_000
 def lucb_radius(samples: np.ndarray, t: int, n: int, delta: float) -> np.ndarray:
     """LUCB1's confidence radius ``sqrt(ln(5 n t^4 / (4 delta)) / (2 u))`` for candidates with ``samples`` = u episodes each."""
     u = _sample_counts(samples)
-    t, n = _check_int("t", t, 1), _check_int("n", n, 1)  # t=0 was a math domain error (thirteenth trial, F15)
+    t, n = check_int("t", t, 1), check_int("n", n, 1)  # t=0 was a math domain error (thirteenth trial, F15)
     delta = _check_probability(delta)
     return np.sqrt(math.log(5.0 * n * float(t) ** 4 / (4.0 * delta)) / (2.0 * u))
 
@@ -79,7 +79,7 @@ def kl_bounds(means: np.ndarray, samples: np.ndarray, level: float, iterations: 
         )
     if not finite_real(level) or level < 0:  # a negative level was taken silently
         raise NeurohoverError(f"level={brief(level)} is not allowed: give a finite number >= 0")
-    iterations = _check_int("iterations", iterations, 1, MAX_BISECTIONS, "halvings")  # -1 was taken silently: no halving at all
+    iterations = check_int("iterations", iterations, 1, MAX_BISECTIONS, "halvings")  # -1 was taken silently: no halving at all
     n = p.size
     room = np.tile(float(level) / u, 2)
     up = np.arange(2 * n) < n  # the first half bisects upper bounds, the second lower ones
@@ -113,17 +113,17 @@ def top_mu_bandit(sample_fn: SampleFn, n_candidates: int, mu: int, delta: float,
     stopped (``n_raced`` = mu when its bounds separated them, 0 when the episode limit ended it), ``means``,
     ``n_samples``, the last ``lower`` / ``upper`` bounds, ``rounds`` the rule's rounds.
     """
-    n = _check_int("n_candidates", n_candidates, 2)
-    mu = _check_int("mu", mu, 1)
+    n = check_int("n_candidates", n_candidates, 2)
+    mu = check_int("mu", mu, 1)
     if mu >= n:
         raise NeurohoverError(f"mu={mu} must be smaller than n_candidates={n}")
     delta = _check_probability(delta)
     if not isinstance(rule, str) or rule not in BANDITS:
         raise NeurohoverError(f"rule={brief(rule)} is not a bandit rule: choose one of {', '.join(BANDITS)}")
-    t_limit = _check_int("t_limit", t_limit, 1, MAX_RESAMPLING)
-    _check_room(n, 0)  # per candidate arrays only: a round flies two candidates (10**13 was a MemoryError; T17-3)
-    _check_sample_fn(sample_fn)  # None was a TypeError (thirteenth trial, F14)
-    sums = _rewards(_draw(sample_fn, np.arange(n))).copy()  # _draw: a race's check of the answer (its shape, +inf)  # every candidate once
+    t_limit = check_int("t_limit", t_limit, 1, MAX_RESAMPLING)
+    check_room(n, 0)  # per candidate arrays only: a round flies two candidates (10**13 was a MemoryError; T17-3)
+    check_sample_fn(sample_fn)  # None was a TypeError (thirteenth trial, F14)
+    sums = _rewards(draw_samples(sample_fn, np.arange(n))).copy()  # draw_samples: a race's check of the answer (its shape, +inf)  # every candidate once
     counts = np.ones(n, dtype=np.int64)
     rounds, separated = 0, False
     while True:
@@ -145,7 +145,7 @@ def top_mu_bandit(sample_fn: SampleFn, n_candidates: int, mu: int, delta: float,
         if not fly:
             break
         rounds += 1
-        drawn = _rewards(_draw(sample_fn, np.asarray(fly, dtype=np.int64)))
+        drawn = _rewards(draw_samples(sample_fn, np.asarray(fly, dtype=np.int64)))
         for i, r in zip(fly, drawn):
             sums[i] += r
             counts[i] += 1

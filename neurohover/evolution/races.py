@@ -147,7 +147,7 @@ class RaceResult:
 MAX_RESAMPLING = 100_000
 
 
-def _check_int(name: str, value: object, minimum: int, maximum: int | None = None, unit: str = "episodes per candidate") -> int:
+def check_int(name: str, value: object, minimum: int, maximum: int | None = None, unit: str = "episodes per candidate") -> int:
     if not whole_number(value) or value < minimum:
         raise NeurohoverError(f"{name}={brief(value)} must be an integer >= {minimum}")
     if maximum is not None and value > maximum:
@@ -156,11 +156,11 @@ def _check_int(name: str, value: object, minimum: int, maximum: int | None = Non
 
 
 #: Bytes a race, a bandit or fixed resampling holds per candidate (bounds, means, flags, indices) and per episode
-#: sample (the samples, a grown copy, a call's indices and returns), for :func:`_check_room`.
+#: sample (the samples, a grown copy, a call's indices and returns), for :func:`check_room`.
 _CANDIDATE_BYTES, _SAMPLE_BYTES = 256, 32
 
 
-def _check_room(n: int, episodes: int) -> None:
+def check_room(n: int, episodes: int) -> None:
     """Refuse ``n`` candidates of at most ``episodes`` kept samples each (0: none kept) whose arrays would not fit in half
     the memory free now (10**13 candidates were a MemoryError of 72.8 TiB, 2**63 an empty result of 2**64 episodes; T17-3)."""
     room = half_free_memory()
@@ -182,7 +182,7 @@ def _check_delta(delta: object) -> float:
     return float(delta)
 
 
-def _check_sample_fn(sample_fn: object) -> None:
+def check_sample_fn(sample_fn: object) -> None:
     """Refuse a ``sample_fn`` that cannot be called before anything is flown (None was a TypeError mid-run; thirteenth trial, F14)."""
     if not callable(sample_fn):
         raise NeurohoverError(f"sample_fn={brief(sample_fn)} is not allowed: give a function of an array of candidate indices returning one return per index")
@@ -190,7 +190,7 @@ def _check_sample_fn(sample_fn: object) -> None:
     check_arity("sample_fn", sample_fn, 1, "it is called as sample_fn(indices)", "a function of an array of candidate indices returning one return per index")
 
 
-def _draw(sample_fn: SampleFn, indices: np.ndarray) -> np.ndarray:
+def draw_samples(sample_fn: SampleFn, indices: np.ndarray) -> np.ndarray:
     """Call ``sample_fn`` and check its answer (races and bandits alike); NaN returns become ``-inf`` (worst)."""
     out = as_floats(sample_fn(indices.copy()), "sample_fn's returns", f"{indices.size} numbers, one per candidate")
     if out.shape != indices.shape:
@@ -305,12 +305,12 @@ def fixed_resampling(sample_fn: SampleFn, n_candidates: int, k: int) -> Resampli
     -------
     ResamplingResult
     """
-    _check_sample_fn(sample_fn)
-    n = _check_int("n_candidates", n_candidates, 1)
-    k = _check_int("k", k, 1, MAX_RESAMPLING)
-    _check_room(n, k)
+    check_sample_fn(sample_fn)
+    n = check_int("n_candidates", n_candidates, 1)
+    k = check_int("k", k, 1, MAX_RESAMPLING)
+    check_room(n, k)
     idx = np.arange(n)
-    samples = np.stack([_draw(sample_fn, idx) for _ in range(k)], axis=1)
+    samples = np.stack([draw_samples(sample_fn, idx) for _ in range(k)], axis=1)
     means = np.array([_mean(row) for row in samples])
     return ResamplingResult(samples=samples, means=means, episodes_spent=n * k)
 
@@ -416,16 +416,16 @@ def selection_race(
 
 def _race_arguments(sample_fn, n_candidates, mu, delta, t_limit, batch, rule) -> tuple[int, int, float, int, int]:
     """:func:`selection_race`'s arguments checked (NeurohoverError naming the bad one)."""
-    _check_sample_fn(sample_fn)
-    n = _check_int("n_candidates", n_candidates, 2)
-    mu = _check_int("mu", mu, 1)
+    check_sample_fn(sample_fn)
+    n = check_int("n_candidates", n_candidates, 2)
+    mu = check_int("mu", mu, 1)
     if mu >= n:
         raise NeurohoverError(f"mu={mu} must be smaller than n_candidates={n}")
     if not isinstance(rule, str) or rule not in RACE_RULES:
         raise NeurohoverError(f"rule={brief(rule)} is not a race rule: choose one of {', '.join(RACE_RULES)}")
-    t_limit = _check_int("t_limit", t_limit, 1, MAX_RESAMPLING)
-    _check_room(n, t_limit)
-    return n, mu, _check_delta(delta), t_limit, _check_int("batch", batch, 0)
+    t_limit = check_int("t_limit", t_limit, 1, MAX_RESAMPLING)
+    check_room(n, t_limit)
+    return n, mu, _check_delta(delta), t_limit, check_int("batch", batch, 0)
 
 
 def _fly_ahead(sample_fn: SampleFn, samples: np.ndarray, active: np.ndarray, rounds: int, batch: int, t_limit: int) -> tuple[np.ndarray, int]:
@@ -437,7 +437,7 @@ def _fly_ahead(sample_fn: SampleFn, samples: np.ndarray, active: np.ndarray, rou
     """
     ahead = max(2 if rounds == 0 else 1, -(-batch // active.size))
     ahead = min(ahead, t_limit - rounds)
-    draws = _draw(sample_fn, np.tile(active, ahead))  # listed in round order
+    draws = draw_samples(sample_fn, np.tile(active, ahead))  # listed in round order
     if rounds + ahead > samples.shape[1]:
         grown = np.empty((samples.shape[0], min(t_limit, max(2 * samples.shape[1], rounds + ahead))))
         grown[:, : samples.shape[1]] = samples

@@ -4,7 +4,7 @@
 its entries, counters, champion, history, race delta, budget, stop reason and MDP stream, each against the others and
 against the restored optimiser (its prototype, its champion). A resume continues a stopped run: a run stopped by its
 budget goes on under a larger one; one stopped by its optimiser (plateau, generations, cma-stop, optimiser-stop) stops
-again at once, so a checkpoint's stop reason must be the one its state stops by (:func:`_check_stop_reason`).
+again at once, so a checkpoint's stop reason must be the one its state stops by (:func:`check_stop_reason`).
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ if TYPE_CHECKING:
     from .run import Run
 
 
-def _damaged(source: str, err: Exception) -> NeurohoverError:
+def damaged(source: str, err: Exception) -> NeurohoverError:
     """The error of a checkpoint ``source`` that cannot be read back (``err`` says what is wrong)."""
     return NeurohoverError(f"{source} is a damaged checkpoint: {damage_text(err)}; resume from an undamaged copy or start again without resuming")
 
@@ -62,20 +62,20 @@ def stop_reason(method: str, opt: Optimiser, budget: int | None, episodes: int, 
     return None
 
 
-def _check_tables(state: dict, source: str) -> None:
+def check_tables(state: dict, source: str) -> None:
     """NeurohoverError naming an unknown entry of checkpoint ``state`` or of its counters or champion: one was ignored
     without a word, as the optimiser state's were before (sixteenth trial)."""
     remedy = "resume from an undamaged copy or start again without resuming"
     check_entries(state, "checkpoint", CHECKPOINT_ENTRIES, what=source, remedy=remedy)
     for name, allowed in _TABLES.items():  # "champion": null was Python's "TypeError: 'NoneType' object is not subscriptable" (T33-B15)
         if name in state and not isinstance(state[name], dict):
-            raise _damaged(source, EntryError(f"{name}={brief(state[name])} is not allowed: allowed a table of {allowed}, as the run wrote it"))
+            raise damaged(source, EntryError(f"{name}={brief(state[name])} is not allowed: allowed a table of {allowed}, as the run wrote it"))
     for name, entries in (("counters", COUNTERS), ("champion", ("genome", "return"))):
         if isinstance(state.get(name), dict):
             check_entries(state[name], "checkpoint", entries, what=f"the {name} table of {source}", remedy=remedy)
 
 
-def _check_run_entries(state: dict, one_mdp: bool) -> None:
+def check_run_entries(state: dict, one_mdp: bool) -> None:
     """EntryError unless checkpoint ``state``'s budget, stop reason and MDP stream are what :meth:`Run.state` writes
     (a budget of '100', a stop_reason of 5 and an mdp_stream of 'x' on one MDP were taken; sixteenth trial)."""
     budget, reason, stream = state["budget"], state["stop_reason"], state["mdp_stream"]
@@ -88,7 +88,7 @@ def _check_run_entries(state: dict, one_mdp: bool) -> None:
         raise EntryError(f"mdp_stream={brief(stream)} is not allowed: allowed null (a run on one MDP draws no MDPs)")
 
 
-def _check_between_generations(opt: Optimiser) -> None:
+def check_between_generations(opt: Optimiser) -> None:
     """EntryError if restored optimiser ``opt`` holds a batch asked and not told: a run checkpoints between
     generations only (asked=true was the API's "ask() called again before tell()", naming no checkpoint; T20-03)."""
     if isinstance(opt, GenerationalNE) and opt._asked:
@@ -97,7 +97,7 @@ def _check_between_generations(opt: Optimiser) -> None:
         raise EntryError("optimizer_state's pending batch is not allowed: a run's checkpoint is written between generations (allowed null)")
 
 
-def _check_prototype(opt: Optimiser, genome: np.ndarray) -> None:
+def check_prototype(opt: Optimiser, genome: np.ndarray) -> None:
     """EntryError unless restored optimiser ``opt``'s prototype (steady state's and generational NE's keep one) is the
     config's ``genome``, which bred its first population: a prototype gene of 9.0 beside the config's 0.0 was taken (T22-12)."""
     mine = opt.prototype if isinstance(opt, (GenerationalNE, SteadyStateNE)) else None
@@ -115,7 +115,7 @@ def _check_prototype(opt: Optimiser, genome: np.ndarray) -> None:
         )
 
 
-def _check_stop_reason(state: dict, method: str, opt: Optimiser, counts: dict[str, int]) -> None:
+def check_stop_reason(state: dict, method: str, opt: Optimiser, counts: dict[str, int]) -> None:
     """EntryError unless checkpoint ``state``'s stop reason is null (written while the run went on) or the one its
     restored run stops by under its own budget (:func:`stop_reason`): 'plateau' on a run that stopped by its budget was
     taken, and the run went on (T22-12). A resume after a stop continues the run: past a budget stop with a larger
@@ -137,7 +137,7 @@ def _check_stop_reason(state: dict, method: str, opt: Optimiser, counts: dict[st
         raise EntryError(f"stop_reason={brief(reason)} is not allowed: the run it holds {held}")
 
 
-def _restored_parts(state: dict, run: Run, opt: Optimiser) -> dict[str, Any]:
+def restored_parts(state: dict, run: Run, opt: Optimiser) -> dict[str, Any]:
     """The counters, champion, history and race delta of checkpoint ``state`` for ``run`` (whose restored optimiser is
     ``opt``), each checked (ValueError, TypeError or KeyError naming what is wrong), before any of them is restored."""
     c = state["counters"]

@@ -46,7 +46,7 @@ from .records import (
     refuse_replaced,
     write_checkpoint,
 )
-from .restore import _check_between_generations, _check_prototype, _check_run_entries, _check_stop_reason, _check_tables, _damaged, _restored_parts, stop_reason
+from .restore import check_between_generations, check_prototype, check_run_entries, check_stop_reason, check_tables, damaged, restored_parts, stop_reason
 from .seeding import mdp_rng, noise_seed, optimiser_seed
 from .steady_state import SteadyStateNE
 
@@ -158,13 +158,13 @@ class Run:
         be this one, except the budget. A damaged checkpoint is refused by name, nothing restored."""
         if not isinstance(state, dict) or state.get("format") != CHECKPOINT_FORMAT:
             raise NeurohoverError(f"{source} is not an evolution checkpoint (expected format {CHECKPOINT_FORMAT!r})")
-        _check_tables(state, source)
+        check_tables(state, source)
         try:
             saved = upgrade_saved_config(state["config"])
             if not isinstance(saved, dict):
                 raise TypeError(f"its config is a {type(saved).__name__}, not a table")
         except (KeyError, TypeError, ValueError, AttributeError) as err:
-            raise _damaged(source, err) from None
+            raise damaged(source, err) from None
         found = [d for k in sorted(set(saved) | set(self.config), key=str) if (d := config_difference(k, saved.get(k), self.config.get(k))) is not None]
         if found:
             values = "; ".join(found)
@@ -185,17 +185,17 @@ class Run:
                     f"{source} was written by a different run ({differs}): its optimiser's settings are not its config's; resume from an undamaged copy"
                 )
         try:
-            _check_between_generations(opt)
-            _check_prototype(opt, self.cfg.prototype.genome)
-            parts = _restored_parts(state, self, opt)
-            _check_run_entries(state, self.mdp_rng is None)
-            _check_stop_reason(state, self.method, opt, parts["counters"])
+            check_between_generations(opt)
+            check_prototype(opt, self.cfg.prototype.genome)
+            parts = restored_parts(state, self, opt)
+            check_run_entries(state, self.mdp_rng is None)
+            check_stop_reason(state, self.method, opt, parts["counters"])
             if self.mdp_rng is not None:
                 check_stream(state["mdp_stream"], type(self.mdp_rng.bit_generator).__name__)
                 stream = np.random.Generator(type(self.mdp_rng.bit_generator)())
                 stream.bit_generator.state = state["mdp_stream"]
         except (KeyError, TypeError, ValueError, AttributeError, IndexError, OverflowError) as err:
-            raise _damaged(source, err) from None
+            raise damaged(source, err) from None
         counts, seconds = parts["counters"], parts["seconds"]
         # a lowered budget stopped it at once "by budget", a plateau's run (seventh trial); its own budget, which the first
         # population may overrun (budget 10, flew 50), resumes finished, as any finished run does (T37-B09)

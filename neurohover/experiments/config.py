@@ -380,7 +380,7 @@ def parse_overrides(texts: list[str] | None, option: str = "--set") -> dict[str,
     return out
 
 
-def _bad_byte(err: UnicodeDecodeError) -> str:
+def bad_byte(err: UnicodeDecodeError) -> str:
     """Where ``err`` found the first byte that is no UTF-8 in the text it decoded: "byte 0xe9 at line 1, column 9"."""
     data = bytes(err.object)  # utf-8-sig: the text after a byte-order mark, which the line and column count from
     start = max(0, min(err.start, len(data) - 1))
@@ -419,7 +419,7 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
     except RecursionError:  # a value nested thousands deep (seventh trial)
         raise NeurohoverError(f"config {str(path)!r} is not allowed: its TOML is nested too deeply") from None
     except UnicodeDecodeError as err:  # was "cannot be read (UnicodeDecodeError)", naming neither the rule nor the place (T19-15)
-        raise NeurohoverError(f"config {str(path)!r} cannot be read: a config must be UTF-8 text, and {_bad_byte(err)} is not (save it as UTF-8)") from None
+        raise NeurohoverError(f"config {str(path)!r} cannot be read: a config must be UTF-8 text, and {bad_byte(err)} is not (save it as UTF-8)") from None
     except ValueError:  # tomllib's int() past 4,300 digits (T36-A01; after UnicodeDecodeError, a ValueError too)
         raise NeurohoverError(f"config {str(path)!r} is not allowed: it holds {_TOO_LONG}") from None
     except OSError as err:

@@ -65,10 +65,10 @@ def check_readme(path: Path) -> None:
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError as err:
-        from .config import _bad_byte
+        from .config import bad_byte
 
         raise NeurohoverError(
-            f"README {str(path)!r} cannot be read: the report fills its generated blocks in UTF-8 text, and {_bad_byte(err)} is not "
+            f"README {str(path)!r} cannot be read: the report fills its generated blocks in UTF-8 text, and {bad_byte(err)} is not "
             "(save it as UTF-8); nothing written"
         ) from None
     except OSError as err:

@@ -100,7 +100,7 @@ DEFAULT_NOISE_ESTIMATE = "rms"
 LEGACY_NOISE_ESTIMATE = "innovations"
 
 
-def _intercept(axis: int, intercepts: str) -> bool:
+def has_intercept(axis: int, intercepts: str) -> bool:
     """Whether LR fits a constant on ``axis`` (0-5: u, v, w, p, q, r) under ``intercepts``."""
     return intercepts == "all" or (axis == 1 and intercepts in ("v", "uv")) or (axis == 0 and intercepts == "uv")
 
@@ -121,7 +121,7 @@ def lr_determined(flight_data: FlightData, intercepts: str = DEFAULT_INTERCEPTS,
     if wind_model == "sinusoid" and max(a.shape[0] for a in flight_data.actions) < MIN_WIND_STEPS:
         return False
     tr = Transitions(flight_data)
-    return all(np.linalg.matrix_rank(x) == x.shape[1] for x in (tr.regressors(axis, _intercept(axis, intercepts))[0] for axis in range(6)))
+    return all(np.linalg.matrix_rank(x) == x.shape[1] for x in (tr.regressors(axis, has_intercept(axis, intercepts))[0] for axis in range(6)))
 
 
 def _check_options(**options: tuple[str, Sequence[str]]) -> None:
@@ -139,7 +139,7 @@ def _fit_axes(tr: Transitions, intercepts: str, estimator: str) -> tuple[np.ndar
     se = np.zeros(11)
     discarded: dict[str, float] = {}
     for axis in range(6):
-        x, idx = tr.regressors(axis, _intercept(axis, intercepts))
+        x, idx = tr.regressors(axis, has_intercept(axis, intercepts))
         target = y[:, axis]
         if estimator == "gls":
             x = (x[1:] - NOISE_DECAY * x[:-1])[tr.pair]

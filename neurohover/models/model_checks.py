@@ -188,7 +188,7 @@ def _stats_problem(stats: dict, method: str) -> str:
 def _lr_problem(model: LearnedModel) -> str:
     """'' when an LR model's stats name its options and its intercepts, discarded intercepts, D_u and wind are what
     :func:`~neurohover.models.lr.learn_lr` makes of them; else what contradicts what (T23-10)."""
-    from .lr import D_U_CHOICES, ESTIMATORS, INTERCEPTS, NOISE_ESTIMATES, _intercept
+    from .lr import D_U_CHOICES, ESTIMATORS, INTERCEPTS, NOISE_ESTIMATES, has_intercept
     from .wind import WIND_MODELS
 
     stats = model.stats
@@ -213,7 +213,7 @@ def _lr_problem(model: LearnedModel) -> str:
     discarded = stats.get("discarded_intercepts", {})
     if not (isinstance(discarded, dict) and all(k in NOISE_NAMES and finite_real(v) for k, v in discarded.items())):
         return _its("stats.discarded_intercepts", discarded, f"allowed a table of axes ({', '.join(NOISE_NAMES)}) to finite numbers")
-    fitted = {name for axis, name in enumerate(NOISE_NAMES) if _intercept(axis, intercepts)} - {"v"}  # the v constant is D_v
+    fitted = {name for axis, name in enumerate(NOISE_NAMES) if has_intercept(axis, intercepts)} - {"v"}  # the v constant is D_v
     optional = {"u"} if intercepts == "uv" and "d_u" not in stats and wind == "none" else set()  # before d_u: "uv" discarded u
     expected = fitted - ({"u"} if kept or wind != "none" else set())
     if not expected - optional <= set(discarded) <= expected | optional:
