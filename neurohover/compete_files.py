@@ -21,7 +21,6 @@ from __future__ import annotations
 import csv
 import math
 import os
-import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,7 +28,7 @@ from typing import NoReturn
 
 import numpy as np
 
-from .compete_labels import NO_OFFLINE, NO_SAFEGUARD, policy_label_problem
+from .compete_labels import COMPETE_SCALE, NO_OFFLINE, NO_SAFEGUARD, policy_label_problem
 from .errors import NeurohoverError, brief, finite_real, whole_number
 from .filekinds import refuse_cut_off
 from .flightmeta import compared_by_value
@@ -62,7 +61,6 @@ CSV_COLUMNS = ("run", "mdp", "episode", "return", "crashed", "steps", "policy", 
 OLDER_COLUMNS = ("offline_seconds",)
 #: The MDP sets a summary's mdps names, as its rows' labels name them (TaskFamily.set_name: seeded-test at FGHH sigma 0.2).
 MDP_SETS, SETS_TEXT = ("test", "train", "seeded-test", "seeded-train", "sample"), "test, train, seeded-test, seeded-train or sample"
-_SCALE = re.compile(r"settings-[0-9a-f]{10}")  # experiments.config.settings_scale: a competition's scale, a digest of its settings
 
 
 def _real_in(low: float, high: float) -> Callable[[object], bool]:
@@ -83,7 +81,7 @@ SUMMARY_FIELDS: dict[str, tuple[Callable[[object], bool] | None, str]] = {
     "sensor": (None, "a sensor's settings"),
     "drift": (None, "a drift's settings"),
     "experiment": (lambda v: isinstance(v, str) and v.startswith("compete-"), "compete-TASK-AGENT"),
-    "scale": (lambda v: isinstance(v, str) and _SCALE.fullmatch(v) is not None, "settings- and 10 hex digits (a digest of the settings)"),
+    "scale": (lambda v: isinstance(v, str) and COMPETE_SCALE.fullmatch(v) is not None, "settings- and 10 hex digits (a digest of the settings)"),
     "runs": (lambda v: whole_number(v) and v >= 1, "an integer >= 1"),
     "episodes": (lambda v: whole_number(v) and v >= 1, "an integer >= 1"),
     "mean_cumulative_return": (_real_in(-math.inf, 0.0), "a finite number <= 0 (every reward is minus a sum of squares)"),

@@ -1,16 +1,20 @@
-"""What each agent writes in a competition's rows: the policies it names and whether a safeguard or off-line time is
-possible, checked by compete's readers (:mod:`neurohover.compete_files`) and by the store's (``result_checks``).
+"""What a competition's files may say: its scale (a digest of its settings), and per agent the policies its rows name
+and whether a safeguard or off-line time is possible, checked by compete's readers (:mod:`neurohover.compete_files`) and by the store's (``result_checks``).
 
 Internal: neurohover's plumbing (README, Python API, What is public).
 """
 
 from __future__ import annotations
 
+import re
+
 from .errors import brief
 from .tasks import N_TRAINING
 
-__all__ = ["NO_OFFLINE", "NO_SAFEGUARD", "ONE_POLICY", "POLICY_LABELS", "policy_label_problem"]
+__all__ = ["COMPETE_SCALE", "NO_OFFLINE", "NO_SAFEGUARD", "ONE_POLICY", "POLICY_LABELS", "policy_label_problem"]
 
+#: The scale of a competition's experiment: its settings' digest, 10 hex digits (experiments.config.settings_scale).
+COMPETE_SCALE = re.compile(r"settings-[0-9a-f]{10}")
 #: The agents that fly under no safeguard (no Choice of theirs has a fallback), whose safeguard_fired is 0 in every row
 #: (T23-07). The agents' specs do not declare it, and this layer may not read them: tests/test_bad_input_trial23_compete.py
 #: checks that every other registered agent is one with a safeguard.

@@ -42,6 +42,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from ..compete_labels import COMPETE_SCALE
 from ..errors import NeurohoverError, brief
 from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..models.model import LEGACY_MODEL_SUBSTEPS
@@ -502,8 +503,6 @@ def _check_seeds_of(config: ExperimentConfig, where: str) -> None:
 #: An experiment's name becomes file names (figures, discussions, exports): letters, digits, '.', '_' and '-',
 #: starting with a letter or digit, so that no name can reach outside the report's folder.
 _SAFE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}")
-#: The scale of a compete run's experiment (neurohover.compete): its settings' digest, 10 hex digits (settings_scale).
-_COMPETE_SCALE = re.compile(r"settings-[0-9a-f]{10}")
 
 
 def settings_scale(settings: dict) -> str:
@@ -523,7 +522,7 @@ def check_name(name, where: str) -> None:
 def check_scale(scale, where: str) -> None:
     """Refuse a scale no experiment has: quick, paper, or a compete run's settings-HASH (:func:`settings_scale`); 'weird'
     was stored (twelfth trial, S7). Shared by :func:`make_config` and the store's writes."""
-    if not isinstance(scale, str) or (scale not in SCALES and not _COMPETE_SCALE.fullmatch(scale)):
+    if not isinstance(scale, str) or (scale not in SCALES and not COMPETE_SCALE.fullmatch(scale)):
         raise NeurohoverError(f"{where}: scale = {brief(scale)} is not allowed: give one of {', '.join(SCALES)} (or a compete run's settings-HASH)")
 
 
