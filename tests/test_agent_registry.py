@@ -130,6 +130,10 @@ def test_the_readmes_example_agent_works_as_one_new_module(tmp_path: Path, monke
     agent = spec.build(policies_from_set(spec, load_policy_set("ghh08")), AgentOptions())
     run = run_test(agent, family, family.test_mdps()[0], episodes=4, n_steps=100)
     assert run.policy[:2] == ["candidate:0", "candidate:1"] and run.policy[2] == run.policy[3]
+    # T49-B02: flown again, the same agent scores as a fresh one (its start resets what the first run learned)
+    again = run_test(agent, family, family.test_mdps()[1], episodes=4, n_steps=100)
+    fresh = run_test(spec.build(policies_from_set(spec, load_policy_set("ghh08")), AgentOptions()), family, family.test_mdps()[1], episodes=4, n_steps=100)
+    assert again.policy == fresh.policy and np.array_equal(again.returns, fresh.returns)
     sys.modules.pop("readme_agents", None)
     sys.modules.pop("readme_agents.best_of_two", None)
 

@@ -16,6 +16,10 @@ Subclass :class:`Agent` and implement ``choose`` and ``update``::
         def update(self, outcome):
             pass
 
+Per-run state (what the agent learns in a run) is set in ``start(self, family, rng)``, which :func:`run_test` calls
+before each run: an agent whose class defines no start and whose attributes changed in a run is refused a second run
+(it would begin with what the last one left; make a new agent, or define start).
+
 ``final=True`` promises the agent will choose the same policy for every remaining episode, which
 lets the harness fly the rest of the run in one parallel batch (same results, far faster).
 ``choose`` and ``update`` are called as plain Python calls ``agent.choose(episode)`` (a staticmethod or classmethod is
@@ -45,6 +49,7 @@ from ..sim.constants import CRASH_STEP_PENALTY, EPISODE_STEPS, MAX_EPISODE_STEPS
 from ..tasks import MDP, TaskFamily
 from ..tasks.drift import Drift
 from ..tasks.sensor import Sensor
+from .kept_state import note_run_start, refuse_kept_state
 from .spec import AgentSettings
 
 REPEAT_CHUNK = 64  # most episodes per kernel call for a repeated choice
@@ -407,6 +412,11 @@ def _flown_mdp(mdp: MDP, family: TaskFamily) -> MDP:
     return mdp
 
 
+def _keeps_base_start(agent: Agent) -> bool:
+    """Whether ``agent`` has no start of its own (nor one set on it): nothing resets its state between runs."""
+    return "start" not in getattr(agent, "__dict__", {}) and inspect.getattr_static(type(agent), "start") is Agent.__dict__["start"]
+
+
 def _check_run(agent, family, mdp, episodes, seed, n_steps) -> tuple[MDP, int, int, int]:
     """:func:`run_test`'s arguments checked (NeurohoverError naming the bad one); returns the MDP flown
     (:func:`_flown_mdp`), the seed, episodes and n_steps (Python ints: np.int8(127) + 1 overflowed, T31-B02)."""
@@ -425,6 +435,8 @@ def _check_run(agent, family, mdp, episodes, seed, n_steps) -> tuple[MDP, int, i
             f"agent {agent.name!r} has no attribute {err.name!r}, which is not allowed: its class {type(agent).__name__} defines __init__ "
             f"without calling its base class's, which sets it (call super().__init__(...) in {type(agent).__name__}.__init__)"
         ) from None
+    if _keeps_base_start(agent):  # nothing resets what its last run left (T49-B02)
+        refuse_kept_state(agent)
     if not isinstance(family, TaskFamily):
         raise NeurohoverError(f"family={family!r:.80} is not allowed: give a TaskFamily (neurohover.get_task_family(name))")
     if not isinstance(mdp, MDP):
@@ -479,6 +491,8 @@ def run_test(
     ``family.drift``, an MDP's own flies beside a family's exact or none, one differing is refused (result.mdp: as flown).
     """
     mdp, seed, episodes, n_steps = _check_run(agent, family, mdp, episodes, seed, n_steps)
+    if _keeps_base_start(agent):
+        note_run_start(agent)
     start_time = time.perf_counter()
     agent.start(family, np.random.default_rng(np.random.SeedSequence([seed, 0xA6E27])))
     returns = np.zeros(episodes)
