@@ -188,6 +188,8 @@ def competition_config(
         raise NeurohoverError(f"hybrid settings apply to the hybrid agents only ({', '.join(HYBRID_AGENTS)}), not to agent {agent!r}")
     if wind_model != "none":  # the wind of the LR models the agent learns (absent: the digest of older competitions)
         group["wind_model"] = wind_model
+    if lr_fit is not None and not isinstance(lr_fit, Mapping):  # 'noise=rms' was an AttributeError (T49-B04)
+        raise NeurohoverError(f"lr_fit={brief(lr_fit)} is not allowed: give a dict of LR fit choices (keys {', '.join(LR_FIT_KEYS)}), or None")
     for key, choice in (lr_fit or {}).items():  # LR as the authors fitted it (absent: ours, the digest of older competitions)
         if key not in LR_FIT_KEYS:
             raise NeurohoverError(f"lr_fit key {key!r} is not allowed: choose from {', '.join(LR_FIT_KEYS)}")
@@ -491,15 +493,20 @@ def check_against_store(folder: str | Path) -> None:
     longer there, or holding no such experiment, is not read; one holding the experiment at other scales only refuses the summary's
     (T42-A02), and one holding the summary's scale under another experiment refuses its name: a settings-HASH digests
     the agent and task with the settings, so it names one competition (agent and experiment edited together; T45-B09)."""
+    from .compete_files import COMPETE_SUMMARY, read_summary
     from .experiments import Store
-    from .jsontext import strict_json
+    from .paths import input_dir, refuse_special_file
 
-    summary_path = Path(folder) / "summary.json"
-    if not summary_path.is_file():
+    folder = input_dir(folder, "--compete")  # None or 5 was os.fspath's TypeError (T49-B03)
+    summary_path = folder / COMPETE_SUMMARY
+    refuse_special_file(summary_path, "--compete", instead="give directories written by neurohover compete --out")
+    if not summary_path.exists():  # an interrupted competition's: nothing to check
         return
-    summary = strict_json(summary_path.read_bytes())  # read_compete_dir has checked it
+    summary = read_summary(summary_path)  # as read_compete_dir reads it: a key given twice, [1, 2] leaked (T49-B03)
     name, scale = summary.get("experiment"), summary.get("scale")
-    store = _store_of(Path(folder), summary.get("store"), name, scale) if isinstance(name, str) and isinstance(scale, str) else None
+    if not (isinstance(name, str) and isinstance(scale, str)):
+        return
+    store = _store_of(folder, summary.get("store"), name, scale)
     if store is None:
         return
     held = Store(store, create=False)

@@ -294,12 +294,7 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
     label = path.resolve().name  # no summary (an interrupted competition): the directory's name labels it
     conditions, episode_steps = {}, None
     if summary_path.exists():
-        try:
-            summary = strict_json(summary_path.read_text(encoding="utf-8-sig"))  # a key given twice too (ninth trial)
-        except (OSError, ValueError) as err:  # damaged: refused, not silently relabelled (second trial)
-            raise NeurohoverError(f"--compete {str(summary_path)!r} cannot be read ({err}); remove it to label the curve by its directory's name") from None
-        if not (isinstance(summary, dict) and isinstance(summary.get("agent"), str) and isinstance(summary.get("task", ""), str)):
-            raise NeurohoverError(f"--compete {str(summary_path)!r} is not a compete summary: no agent and task names")
+        summary = read_summary(summary_path)
         _check_summary(summary_path, summary, returns, facts)
         label = f"{summary['agent']} ({summary.get('task', '?')})"
         conditions = {key: summary[key] for key in COMPETE_CONDITIONS if key in summary}
@@ -310,6 +305,20 @@ def read_compete_dir(path: str | Path) -> CompeteResult:
     _check_lengths(csv_path, facts, episode_steps)
     _check_crash_charge(csv_path, facts, episode_steps)
     return CompeteResult(label, returns, facts.crashes, path, conditions)
+
+
+def read_summary(summary_path: Path) -> dict:
+    """A compete folder's ``summary.json``, read strictly: damaged (a key given twice, not UTF-8, empty, nested or a number
+    past what strict_json reads) or no table naming its agent and task refused by name. The one reading of it, by
+    :func:`read_compete_dir` and :func:`neurohover.compete.check_against_store` (whose own copy leaked a JSONError and an
+    AttributeError: T49-B03); the checks against its rows are :func:`_check_summary`'s."""
+    try:
+        summary = strict_json(summary_path.read_text(encoding="utf-8-sig"))  # a key given twice too (ninth trial)
+    except (OSError, ValueError) as err:  # damaged: refused, not silently relabelled (second trial)
+        raise NeurohoverError(f"--compete {str(summary_path)!r} cannot be read ({err}); remove it to label the curve by its directory's name") from None
+    if not (isinstance(summary, dict) and isinstance(summary.get("agent"), str) and isinstance(summary.get("task", ""), str)):
+        raise NeurohoverError(f"--compete {str(summary_path)!r} is not a compete summary: no agent and task names")
+    return summary
 
 
 def _check_lengths(csv_path: Path, rows: _Rows, episode_steps: object) -> None:

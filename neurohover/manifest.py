@@ -188,9 +188,13 @@ def check_digest_names(manifest: dict, path: Path, names) -> None:
 
 
 def _is_build_time(text: str) -> bool:
-    """Whether ``text`` is a time as build_policy_set writes a manifest's ``built`` (``time.strftime("%Y-%m-%d %H:%M:%S")``)."""
+    """Whether ``text`` is a time as build_policy_set writes a manifest's ``built`` (``time.strftime("%Y-%m-%d %H:%M:%S")``):
+    that form exactly, in ASCII digits with one space, and a real date and time (strptime took a newline, a tab or an NBSP
+    for the space, Unicode digits and one-digit fields: T49-B01)."""
     import time
 
+    if not re.fullmatch(r"[0-9]{4}-[0-9]{2}-[0-9]{2} [0-9]{2}:[0-9]{2}:[0-9]{2}", text):
+        return False
     try:
         time.strptime(text, "%Y-%m-%d %H:%M:%S")
     except ValueError:
