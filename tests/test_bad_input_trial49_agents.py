@@ -58,7 +58,8 @@ def test_b02_an_agent_without_start_that_kept_state_is_refused_a_second_run() ->
     policies = load_policy_set("ghh08")
     agent = KeepsReturns(policies.generic, policies.specialised[0])
     _run(agent)
-    with pytest.raises(NeurohoverError, match=r"agent 'keeps-returns' has flown a test run, and its attribute 'returns' changed in it, .* defines no start\(self, family, rng\)"):
+    refused = r"agent 'keeps-returns' has flown a test run, and its attribute 'returns' changed in it, .* defines no start\(self, family, rng\)"
+    with pytest.raises(NeurohoverError, match=refused):
         _run(agent, 1)
     assert len(agent.returns) == 2  # refused before the agent was called again
 

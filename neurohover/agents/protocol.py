@@ -467,7 +467,10 @@ def _check_run(agent, family, mdp, episodes, seed, n_steps) -> tuple[MDP, int, i
     settings = getattr(agent, "settings", None)
     if isinstance(settings, AgentSettings):
         settings.check_episode_steps(n_steps)  # settings that cannot act in episodes this long (twelfth trial, S3)
-    return mdp, check_seed(seed), episodes, n_steps
+    seed = check_seed(seed)
+    if _keeps_base_start(agent):  # the run starts: what its attributes hold now, compared when the next starts
+        note_run_start(agent)
+    return mdp, seed, episodes, n_steps
 
 
 def run_test(
@@ -491,8 +494,6 @@ def run_test(
     ``family.drift``, an MDP's own flies beside a family's exact or none, one differing is refused (result.mdp: as flown).
     """
     mdp, seed, episodes, n_steps = _check_run(agent, family, mdp, episodes, seed, n_steps)
-    if _keeps_base_start(agent):
-        note_run_start(agent)
     start_time = time.perf_counter()
     agent.start(family, np.random.default_rng(np.random.SeedSequence([seed, 0xA6E27])))
     returns = np.zeros(episodes)
