@@ -302,6 +302,7 @@ def refuse_drift(mdp, where: str) -> None:
     """A clear error where an MDP (or task family) that drifts would be flown as if its dynamics were fixed:
     only test runs and :class:`neurohover.envs.HoverEnv` fly the drift."""
     if not isinstance(getattr(mdp, "drift", None), Drift):  # a name or None was an AttributeError (T47-B05)
+        refuse_reloaded(getattr(mdp, "drift", None), Drift, "mdp's drift")  # a reloaded module's MDP is an MDP, of another import
         raise NeurohoverError(f"mdp={brief(mdp)} is not allowed: give an MDP or a task family (neurohover.get_task_family('ghh08'))")
     if not mdp.drift.none:
         raise NeurohoverError(
