@@ -19,7 +19,8 @@ def test_an_mdp_made_before_a_reload_of_drift_is_named_by_its_cause() -> None:
     saved = dict(module.__dict__)
     try:
         importlib.reload(module)
-        with pytest.raises(NeurohoverError, match=r"^mdp's drift Drift\(.*is a Drift of another import of neurohover\.tasks\.drift \(the module was reloaded\?\)"):
+        cause = r"^mdp's drift Drift\(.*is a Drift of another import of neurohover\.tasks\.drift \(the module was reloaded\?\)"
+        with pytest.raises(NeurohoverError, match=cause):
             nh.evaluate(nh.baseline_policy(), mdp, n_steps=10)
     finally:
         module.__dict__.clear()
