@@ -15,8 +15,8 @@ Error is minus the return (lower is better), as in the paper's plots.
 from __future__ import annotations
 
 import sys
-import time
 from contextlib import AbstractContextManager
+from datetime import datetime
 from pathlib import Path
 
 from ..errors import NeurohoverError, OutputError, brief, check_flag
@@ -233,7 +233,7 @@ def _write_report(store: Store, out: Path, scale: str | None, names: list[str] |
         raise NeurohoverError(f"nothing could be reported from {str(store.path)!r}: every experiment asked for is damaged (said above); no report written")
     head = (
         f"{REPORT_HEADER}\n"
-        f"Generated {time.strftime('%Y-%m-%d %H:%M:%S')} from the results store `{printable(store.path)}`. Error is minus the "
+        f"Generated {_now()} from the results store `{printable(store.path)}`. Error is minus the "
         f"return (lower is better).{header_note({sc for _, sc in entries})}\n\n" + "\n".join(toc) + "\n"
     )
     summary = claims_section(claims) if claims else ""
@@ -246,6 +246,12 @@ def _write_report(store: Store, out: Path, scale: str | None, names: list[str] |
     if summary:
         fill_generated(readme, "claims", linked_claims(summary))
     return path
+
+
+def _now() -> str:
+    """The report's Generated time: local time with its UTC offset, ``2026-12-08 00:50:13+14:00`` (a bare local time
+    read as another zone's, hours off; trial 49)."""
+    return datetime.now().astimezone().isoformat(sep=" ", timespec="seconds")
 
 
 def _anchor(title: str) -> str:

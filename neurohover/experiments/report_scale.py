@@ -1,13 +1,23 @@
 """What the report says of an experiment's scale: ``quick`` (a smoke run), ``paper`` (the paper's protocol), or a compete
 run's ``settings-HASH``, described by its own settings against the paper's (T26-A07: a run at the paper's 1000 episodes
-of 6000 steps was called a smoke run)."""
+of 6000 steps was called a smoke run).
+
+A config of one's own at its paper scale is the paper's protocol only where its stored settings are a shipped
+experiment's at paper scale (the same config hash); else it is "its config's paper scale" (T49-A01: a copy of fig2 with
+--set n_steps=20 was called the paper protocol and compared with the paper's numbers without a word). The store holds
+the config's settings after --set and the path it was read from, not its ``[scales.paper]`` before --set: that table is
+read from the config file at the stored path, as it reads now, and a run whose stored settings are below it is noted
+as the shipped case is (``--set ran less than NAME at paper scale as its config says``); where that file no longer
+reads as the same experiment (moved, a path relative to another folder, renamed), the note says that whether --set ran
+less is not known."""
 
 from __future__ import annotations
 
 import functools
 import math
 
-from .config import ExperimentConfig, load_config, shipped_counterpart
+from ..errors import NeurohoverError
+from .config import POLICY_SOURCES, ExperimentConfig, load_config, shipped_configs, shipped_counterpart
 from .overrides import ENTRIES, ENTRY_SCALE_LIKE, SCALE_LIKE
 from .report_claims import PAPER_FIGURES
 from .schema import ZERO_MEANS
@@ -113,25 +123,97 @@ def paper_shortfall(cfg: ExperimentConfig) -> tuple[str, list[str]] | None:
     return f"{figure} at paper scale: {episodes} episodes of {n_steps} steps, {paper_runs} runs", short
 
 
+def _sources(cfg: ExperimentConfig) -> tuple[tuple[str, object], ...]:
+    return tuple((k, cfg.settings[k]) for k in POLICY_SOURCES if k in cfg.settings)
+
+
+@functools.cache
+def _shipped_paper_hashes(sources: tuple[tuple[str, object], ...]) -> dict[str, str]:
+    """Config hash -> name of each shipped experiment at paper scale with the policy sources ``sources`` (a kind that
+    takes none of them is left out: its hash cannot be a stored one's that has them)."""
+    out: dict[str, str] = {}
+    for name in shipped_configs():
+        try:
+            out.setdefault(load_config(name, "paper", dict(sources)).hash, name)
+        except NeurohoverError:
+            continue
+    return out
+
+
+def shipped_match(cfg: ExperimentConfig) -> str | None:
+    """The shipped experiment whose paper-scale settings a config of one's own at paper scale runs (the same config hash;
+    None: none, or not a config of one's own at paper scale; T49-A01)."""
+    if cfg.scale != "paper" or cfg.name in shipped_configs():
+        return None
+    try:
+        return _shipped_paper_hashes(_sources(cfg)).get(cfg.hash)
+    except TypeError:  # a policy source that cannot be a cache key (a table): no shipped config has one
+        return None
+
+
+def own_counterpart(cfg: ExperimentConfig) -> ExperimentConfig | None:
+    """A stored config of one's own as its config file reads now, at the stored scale before --set (with the stored
+    policy sources, as :func:`~.config.shipped_counterpart`); None where it is a shipped experiment, or its file at the
+    stored path no longer reads as the same experiment of the same kind (moved, renamed, a relative path from another
+    folder: the store holds no copy of the file's ``[scales]``; T49-A01)."""
+    if not cfg.source or cfg.name in shipped_configs():
+        return None
+    try:
+        own = load_config(cfg.source, cfg.scale, dict(_sources(cfg)))
+    except NeurohoverError:
+        return None
+    return own if (own.name, own.kind) == (cfg.name, cfg.kind) else None
+
+
 def paper_protocol(cfg: ExperimentConfig) -> bool:
     """Whether ``cfg`` is a paper-scale run of the paper's protocol, whose claims the paper-scale claims table judges:
-    not one whose --set ran less of it (:func:`paper_shortfall`; T34-A01)."""
+    not one whose --set ran less of it (:func:`paper_shortfall`; T34-A01), nor a config of one's own unless its settings
+    are a shipped experiment's at paper scale (:func:`shipped_match`; T49-A01)."""
     if cfg.scale != "paper":
         return False
     shortfall = paper_shortfall(cfg)
-    return shortfall is None or not shortfall[1]
+    if shortfall is None:
+        return shipped_match(cfg) is not None
+    return not shortfall[1]
+
+
+_NOT_PAPER = "magnitudes are not comparable with the paper"
+
+
+def own_paper_note(cfg: ExperimentConfig) -> str:
+    """The Scale line's note on a config of one's own at paper scale (T49-A01): the paper protocol where its settings
+    are a shipped experiment's at paper scale; not the paper's protocol where --set ran less than its config's own paper
+    scale (as the file at its stored path reads now); else its config's paper scale, which is not the paper's protocol."""
+    match = shipped_match(cfg)
+    if match is not None:
+        return f"the paper protocol: its settings are the shipped {match}'s at paper scale"
+    own = own_counterpart(cfg)
+    short = [] if own is None else _shrunk(cfg.settings, own.settings)
+    if short:
+        return (
+            f"not the paper's protocol: --set ran less than {cfg.name} at paper scale as its config says "
+            f"({cfg.source!r}, as it reads now): {', '.join(short)}; {_NOT_PAPER}"
+        )
+    gone = f"; its config {cfg.source!r} does not read now as this experiment, so whether --set ran less than its paper scale is not known"
+    known = "" if own is not None else gone
+    return (
+        f"its config's paper scale, not the paper's protocol: a config of its own, whose settings are no shipped "
+        f"experiment's at paper scale{known}; its numbers compare with the paper's only as far as its settings do (see Settings)"
+    )
 
 
 def scale_note(cfg: ExperimentConfig) -> str:
     """What the report's Scale line says of ``cfg``'s scale: quick, paper (or, where --set ran less than the paper
-    scale, not the paper's protocol), or a settings-HASH run described by its own episodes, episode length and runs:
-    paper-comparable where each is at least the paper's for the runs it corresponds to (:func:`paper_reference`), else
-    which are shorter or fewer (:func:`paper_shortfall`)."""
+    scale, not the paper's protocol; a config of one's own: :func:`own_paper_note`), or a settings-HASH run described
+    by its own episodes, episode length and runs: paper-comparable where each is at least the paper's for the runs it
+    corresponds to (:func:`paper_reference`), else which are shorter or fewer (:func:`paper_shortfall`)."""
     if cfg.scale == "quick":
         return QUICK_NOTE
     shortfall = paper_shortfall(cfg)
     if cfg.scale == "paper":
-        if shortfall is None or not shortfall[1]:
+        if shortfall is None:  # a config of one's own (T49-A01)
+            return own_paper_note(cfg)
+        if not shortfall[1]:
             return "the paper protocol"
         return (
             f"not the paper's protocol: --set ran less than {shortfall[0]}: {', '.join(shortfall[1])}; magnitudes are not "
