@@ -167,7 +167,10 @@ def _import_numba() -> None:
     if "numba" in sys.modules:  # imported before us: it has read (and warned about) its variables already
         return
     with warnings.catch_warnings(record=True) as caught:
-        import numba  # noqa: F401
+        try:
+            import numba  # noqa: F401
+        except ModuleNotFoundError as err:  # numba, or NumPy it imports first: a traceback from every command (T49)
+            _missing_dependency(err)
     for w in caught:
         bad = re.match(r"Environment variable '(\w+)' is defined but its associated value '(.*)' could not be parsed", str(w.message), re.S)
         if bad is None:
@@ -177,6 +180,20 @@ def _import_numba() -> None:
         given = f"{bad[1]}={bad[2]!r:.40}"
         given = f"environment variable {given}" if bad[1] in os.environ else f"{given} of .numba_config.yaml"
         _refuse_setting(f"{given} is not allowed: numba cannot read it ({why.strip():.80}); give what numba's docs allow, or unset it")
+
+
+def _missing_dependency(err: ModuleNotFoundError) -> None:
+    """A required package that is not installed (``python -S``, another interpreter than the one neurohover was
+    installed into), named on one line: the command's exit 2, an ImportError on import. Its traceback was all."""
+    name = (err.name or "numba").partition(".")[0]
+    message = (
+        f"neurohover needs the package {name}, which this Python ({sys.executable}) cannot import ({err}): install it "
+        f"(pip install {name}, or pip install neurohover with its dependencies), or run the Python it was installed into"
+    )
+    if running_as_command():
+        print(f"neurohover: error: {message}", file=sys.stderr, flush=True)
+        sys.exit(2)
+    raise ModuleNotFoundError(message, name=err.name) from None
 
 
 def _check_threading_layer() -> None:

@@ -341,6 +341,7 @@ def _flown_under(n_steps: int, sigma: float | None, sensor: Sensor | None, drift
 
 def _checked_store(store) -> Path | None:
     """The store's path, refused before the output directory is made: a bad path, or a file that is no store (third trial)."""
+    from .experiments.store_checks import new_store
     from .filekinds import refuse_long_store_name
     from .paths import output_file
 
@@ -348,7 +349,7 @@ def _checked_store(store) -> Path | None:
         return None
     refuse_long_store_name(store, "store")  # its -journal too (T31-A03)
     path = output_file(store, "store", store=True)
-    if path.is_file() and path.stat().st_size:  # an empty file becomes the store
+    if not new_store(path):  # an empty file becomes the store, as reproduce's does (T49-A02)
         from .experiments import Store
 
         with Store(path, create=False) as db:
@@ -416,8 +417,9 @@ def _refuse_other_settings(config, store_path: Path) -> None:
     take (tenth trial)."""
     from .errors import first_difference
     from .experiments import Store
+    from .experiments.store_checks import new_store
 
-    if not store_path.is_file():
+    if new_store(store_path):  # nothing there, or an empty file (reproduce's new store, just made: "in use" as it runs)
         return
     with Store(store_path, create=False) as db:
         held = db.config_hash(config.name, config.scale)

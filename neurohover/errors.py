@@ -7,6 +7,7 @@ import datetime
 import math
 import numbers
 import operator
+import re
 import signal
 import sys
 from typing import TYPE_CHECKING, Any, TypeGuard
@@ -190,6 +191,14 @@ def float_of(text: str) -> float:
         shown = shown if len(shown) <= 30 else f"{shown[:10]}...({len(shown)} characters)"
         raise FloatRangeError(f"{shown} is past a float's range (about 1.8e308)")
     return value
+
+
+def comma_separated(part: str) -> str | None:
+    """``part``, one KEY=VALUE setting of a comma-separated list, written with commas where it holds more settings
+    separated by spaces or ';' ('level=0.5;delay=1' -> 'level=0.5,delay=1'), else None: a sensor's and a drift's text
+    said only that its first value needs a number (T49-A03)."""
+    pieces = [p for p in re.split(r"[\s;]+", re.sub(r"\s*=\s*", "=", str(part).strip())) if p]
+    return ",".join(pieces) if len(pieces) > 1 and all("=" in p for p in pieces) else None
 
 
 def check_name_text(what: str, value: object, naming: str, *, empty: bool = False) -> str:

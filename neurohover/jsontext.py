@@ -9,10 +9,11 @@ from __future__ import annotations
 
 import json
 import re
+import unicodedata
 
 from .errors import NeurohoverError, brief, float_of
 
-__all__ = ["MAX_NOTE_DEPTH", "JSONError", "json_text", "nesting_depth", "number_text", "parse_json", "strict_json"]
+__all__ = ["MAX_NOTE_DEPTH", "JSONError", "json_text", "nesting_depth", "number_text", "odd_character", "parse_json", "strict_json", "toml_odd_character"]
 
 
 def _unique_keys(pairs: list) -> dict:
@@ -42,7 +43,67 @@ def strict_json(text: str | bytes):
     except RecursionError:
         raise JSONError("its JSON is nested too deeply", deep=True) from None
     except (ValueError, TypeError) as err:  # json.JSONDecodeError, UnicodeDecodeError (bytes), TypeError (no text at all)
-        raise JSONError(str(err)) from None
+        named = "" if "BOM" in str(err) else odd_character(getattr(err, "doc", None), getattr(err, "pos", None), "JSON")
+        raise JSONError(f"{err}{named}") from None
+
+
+_QUOTES = {"'": "\u2018\u2019\u201a\u201b\u2032\u00b4", '"': "\u201c\u201d\u201e\u201f\u2033\u00ab\u00bb"}
+
+
+def _ascii_form(char: str) -> str | None:
+    """The ASCII that ``char`` looks like or stands for where text was pasted from a slide or a word processor: a curly
+    quote's straight one, a space (a no-break space, U+3000...), '' (a zero-width character), a full-width character's or
+    a dash's ASCII; None for ASCII and other characters."""
+    quote = next((q for q, alike in _QUOTES.items() if char in alike), None)
+    category = unicodedata.category(char)
+    if char.isascii() or quote:
+        return quote
+    if category == "Zs":
+        return " "
+    if category == "Cf":
+        return ""
+    if category == "Pd" or char == "\u2212":
+        return "-"
+    form = unicodedata.normalize("NFKC", char)
+    return form if form.isascii() and len(form) == 1 else None
+
+
+def odd_character(text: object, pos: object, language: str) -> str:
+    """``": 'X' (U+.... NAME) is not allowed there: ..."`` naming the character other than ASCII at ``pos`` of ``text``,
+    where the reader of ``language`` ('JSON', 'TOML') stopped, or else a look-alike of ASCII before it on its line (a
+    curly quote closing a key), with what is allowed; '' where there is none. The readers gave only a position, and
+    a curly quote or a no-break space pasted from a slide is not seen there (T49-A04, T49-A05)."""
+    if not isinstance(text, str) or not isinstance(pos, int) or not 0 <= pos <= len(text):
+        return ""
+    line = text.rfind("\n", 0, pos) + 1
+    at = pos if pos < len(text) and not text[pos].isascii() else None
+    at = at if at is not None else next((i for i in range(pos - 1, line - 1, -1) if _ascii_form(text[i]) is not None), None)
+    if at is None:
+        return ""
+    char, form = text[at], _ascii_form(text[at])
+    shown = f"{char!r} (U+{ord(char):04X} {unicodedata.name(char, 'a character with no name')})"
+    if form in _QUOTES:
+        quotes = '(")' if language == "JSON" else f"({form})"
+        noun, rule = "an ASCII quote", f"{language} strings take ASCII {'double ' if language == 'JSON' else ''}quotes {quotes}"
+    elif form == " ":
+        noun, rule = "an ASCII space", f"outside strings {language} takes ASCII spaces (' ')"
+    else:
+        noun = "ASCII"
+        rule = f"outside strings {language} takes ASCII characters only" + (f": write {form!r}" if form else ": delete it" if form == "" else "")
+    if at == pos:
+        return f": {shown} is not allowed there: {rule}"
+    return f": near it, at column {at - line + 1}, {shown} is not {noun}: {rule}"
+
+
+def toml_odd_character(text: str, err: ValueError) -> str:
+    """:func:`odd_character` at the position tomllib's error ``err`` names ("(at line L, column C)") in ``text``."""
+    where = re.search(r"\(at (?:line (\d+), column (\d+)|end of document)\)$", str(err))
+    if where is None:
+        return ""
+    lines = text.split("\n")
+    row = int(where[1] or len(lines)) - 1
+    pos = sum(len(line) + 1 for line in lines[:row]) + (int(where[2]) - 1 if where[2] else len(lines[row]) if row < len(lines) else 0)
+    return odd_character(text, pos, "TOML")
 
 
 def json_text(value, **dumps) -> str:

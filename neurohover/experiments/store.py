@@ -60,6 +60,7 @@ from .store_checks import (
     experiment_problem,
     let_go,
     missing_text,
+    new_store,
     object_text,
     refuse_moved,
     refuse_wrong_cells,
@@ -116,7 +117,7 @@ class Store:
         check_store_file(self.path, path, create)  # what SQLite would open, or delete beside it, before it does
         make_dirs(self.path.parent, "results store", str(path))  # a file as its parent was pathlib's FileExistsError (fifteenth trial, T15-10)
         self._lock = WriterLock(self.lock_path)
-        new = not self.path.exists() or self.path.stat().st_size == 0
+        new = new_store(self.path)
         try:
             # By its absolute path: SQLite reads a name beginning 'file:' as a URI, whatever uri= says (T32-A02).
             self.conn = sqlite3.connect(os.path.abspath(self.path), timeout=30.0, isolation_level=None, check_same_thread=False, factory=GuardedConnection)

@@ -565,6 +565,13 @@ def refuse_long_store_path(path: Path) -> None:
         )
 
 
+def new_store(path: Path) -> bool:
+    """Whether a writer makes a new results store at ``path``: nothing is there, or an empty (0-byte) file. The one
+    decision :class:`~neurohover.experiments.Store` and compete share (compete refused the empty file reproduce takes,
+    T49-A02); a reader refuses an empty file (:func:`check_store_file`)."""
+    return not path.is_file() or path.stat().st_size == 0
+
+
 def check_store_file(path: Path, given: str | Path, create: bool) -> None:
     """Refuse a results store ``path`` (``given``) that :class:`~neurohover.experiments.Store` cannot open as one, each
     by what it is: missing where it is read, a directory, a device, empty where read, a file of another kind, a link to

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import FloatRangeError, NeurohoverError, as_floats, brief, finite_real, float_of, real_number, refuse_reloaded, whole_number
+from ..errors import FloatRangeError, NeurohoverError, as_floats, brief, comma_separated, finite_real, float_of, real_number, refuse_reloaded, whole_number
 from ..sim.constants import MDP_ROW_LEN, MIN_NOISE, PARAM_NAMES, ROW_PARAMS
 from ..sim.rng import MAX_SEED
 
@@ -227,7 +227,9 @@ class Drift:
                     at = (_episode(lo), _episode(hi if dash else lo))  # '@200-' is no window: int('') refuses it
             except ValueError as err:
                 why = f" ({err})" if isinstance(err, FloatRangeError) else ""
-                raise NeurohoverError(f"drift {part[:40]!r} is not understood{why}: {_PARSE_FORM}") from None
+                commas = comma_separated(part)  # 'walk=0.01 D_w=0.8': separated by a space (T49-A03)
+                form = f"separate settings with commas ({commas:.80}); {_PARSE_FORM}" if commas and not why else _PARSE_FORM
+                raise NeurohoverError(f"drift {part[:40]!r} is not understood{why}: {form}") from None
             if not eq:
                 raise NeurohoverError(f"drift {part!r} is not understood: {_PARSE_FORM}")
             if when and key.strip() == "walk":  # walk=0.01@0-1 beside a change gave the change its window

@@ -39,7 +39,7 @@ import operator
 import re
 from dataclasses import asdict, dataclass, fields, replace
 
-from ..errors import FloatRangeError, NeurohoverError, brief, finite_real, float_of, real_number, whole_in, whole_number
+from ..errors import FloatRangeError, NeurohoverError, brief, comma_separated, finite_real, float_of, real_number, whole_in, whole_number
 from ..sim.constants import MAX_SENSOR_DELAY, MIN_NOISE, SENSOR_GROUPS
 
 #: The std of each group at noise level 1 (velocity m/s, position m, rates rad/s, attitude).
@@ -189,8 +189,14 @@ class Sensor:
             try:
                 settings[key] = float_of(value)
             except ValueError as err:
-                why = f": {err}" if isinstance(err, FloatRangeError) else ""
-                raise NeurohoverError(f"sensor setting {part[:40]!r} needs a number after '='{why}") from None
+                if isinstance(err, FloatRangeError) or not value.strip():
+                    why = f": {err}" if isinstance(err, FloatRangeError) else ""
+                    raise NeurohoverError(f"sensor setting {part[:40]!r} needs a number after '='{why}") from None
+                commas = comma_separated(part)  # 'velocity=0.05 position=0.05': one value, said to need a number (T49-A03)
+                said = f"{key}: its value {brief(value.strip())} is not a number: separate settings with commas ({commas:.80})" if commas else (
+                    f"{part[:40]!r} needs a number after '=': its value {brief(value.strip())} is not one; give KEY=NUMBER pairs separated by commas"
+                )  # fmt: skip
+                raise NeurohoverError(f"sensor setting {said}, with keys {', '.join(allowed)}") from None
         if not settings:
             raise NeurohoverError(f"sensor {text!r} is empty: {expected}")
         if not whole_number(delay):  # 2.0 as Sensor(delay=) refuses it (whole_in; it was taken beside key=value text, T37-B12)
