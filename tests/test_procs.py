@@ -47,12 +47,12 @@ n_steps = 200
 """
 
 
-def _start(tmp_path: Path, *argv: str) -> subprocess.Popen:
-    """``neurohover ARGV`` in its own session (so a failed test can end the whole group)."""
+def _start(tmp_path: Path, *argv: str, env: dict[str, str] | None = None) -> subprocess.Popen:
+    """``neurohover ARGV`` in its own session (so a failed test can end the whole group), in ``env`` (None: ENV)."""
     out = open(tmp_path / "stdout.txt", "w")
     err = open(tmp_path / "stderr.txt", "w")
     try:
-        return subprocess.Popen([sys.executable, "-m", "neurohover", *argv], cwd=ROOT, env=ENV, stdout=out, stderr=err, start_new_session=True)
+        return subprocess.Popen([sys.executable, "-m", "neurohover", *argv], cwd=ROOT, env=env or ENV, stdout=out, stderr=err, start_new_session=True)
     finally:
         out.close()
         err.close()
@@ -229,7 +229,8 @@ def test_a_terminated_build_leaves_no_half_built_set(tmp_path: Path) -> None:
     # numba's compilation is test_an_interrupt_dropped_in_a_c_callback_is_delivered_again's case.
     warm = ["build-policies", "--task", "ghh08", "--budget", "2", "--episode-steps", "20", "--out", str(tmp_path / "warm")]
     subprocess.run([sys.executable, "-m", "neurohover", *warm], cwd=ROOT, env=ENV, capture_output=True, check=True)
-    proc = _start(tmp_path, "build-policies", "--task", "ghh08", "--budget", "1000000", "--out", str(out))
+    # faulthandler on: SIGABRT after the wait below prints every thread's Python stack (two full runs hung here)
+    proc = _start(tmp_path, "build-policies", "--task", "ghh08", "--budget", "1000000", "--out", str(out), env={**ENV, "PYTHONFAULTHANDLER": "1"})
     try:
         building = out / "ghh08.building"
         for _ in range(600):  # the build under way (its kernel loaded from the cache)
@@ -241,7 +242,9 @@ def test_a_terminated_build_leaves_no_half_built_set(tmp_path: Path) -> None:
         try:  # twice in the twenty-sixth session's full runs it did not end within 60 s: its stderr says where it was
             status = proc.wait(timeout=60)
         except subprocess.TimeoutExpired:
-            pytest.fail("build-policies did not end within 60 s of SIGTERM; its stderr: " + (tmp_path / "stderr.txt").read_text()[-3000:])
+            os.kill(proc.pid, signal.SIGABRT)  # faulthandler's dump of where it is, then the end
+            proc.wait(timeout=30)
+            pytest.fail("build-policies did not end within 60 s of SIGTERM; its stderr: " + (tmp_path / "stderr.txt").read_text()[-6000:])
         assert status == 143  # terminated, also when the stop lands mid-evolution (it said interrupted, 130)
         err = (tmp_path / "stderr.txt").read_text()
         assert "the finished runs are kept in" in err and err.strip().splitlines()[-1].endswith("terminated"), err[-1500:]
