@@ -351,22 +351,26 @@ def refuse_foreign_output(path: str | os.PathLike, option: str, kind: str) -> No
     output name ``path`` a command chose itself (a figure, report.md) unless it is absent, empty or already ``kind``:
     a user's notes at report.md and a text file at a figure's name were replaced without a word (T28-A04, T28-A05). A
     symbolic link is refused too (report.md was written through one to a file outside --out), and so are a directory
-    and a device, pipe or socket, by name."""
+    and a device, pipe or socket, by name: an :class:`~neurohover.errors.OutputError`, the output's fault (report called
+    the experiment whose figure was blocked damaged; T50-A04)."""
     shown = repr(os.fspath(path))
     if os.path.islink(path):
-        raise NeurohoverError(
+        raise OutputError(
             f"{option} {shown} is a symbolic link (to {os.readlink(os.fspath(path))!r}): {kind} is not written through one; "
             "remove the link or give another directory"
         )
     p = Path(path)
     if p.is_dir():
-        raise NeurohoverError(f"{option} {shown} is a directory: {kind} would be written there; move it away or give another directory")
-    refuse_special_file(p, option)
+        raise OutputError(f"{option} {shown} is a directory: {kind} would be written there; move it away or give another directory")
+    try:
+        refuse_special_file(p, option)
+    except NeurohoverError as err:
+        raise OutputError(str(err)) from None
     if not p.is_file() or p.stat().st_size == 0:
         return
     held = held_kind(p)
     if held != kind:
-        raise NeurohoverError(
+        raise OutputError(
             f"{option} {shown} is {held or 'a file neurohover did not write'}: it would be replaced with {kind}; move it away or give another directory"
         )
 

@@ -15,8 +15,8 @@ Error is minus the return (lower is better), as in the paper's plots.
 from __future__ import annotations
 
 import sys
+import time
 from contextlib import AbstractContextManager
-from datetime import datetime
 from pathlib import Path
 
 from ..errors import NeurohoverError, OutputError, brief, check_flag
@@ -250,8 +250,14 @@ def _write_report(store: Store, out: Path, scale: str | None, names: list[str] |
 
 def _now() -> str:
     """The report's Generated time: local time with its UTC offset, ``2026-12-08 00:50:13+14:00`` (a bare local time
-    read as another zone's, hours off; trial 49)."""
-    return datetime.now().astimezone().isoformat(sep=" ", timespec="seconds")
+    read as another zone's, hours off; trial 49). Written from the C library's local time, which takes any TZ it
+    accepts: datetime refuses offsets of 24 hours and more (TZ='UTC-25' was a traceback after every figure; T50-A01)."""
+    local = time.localtime()
+    offset = local.tm_gmtoff or 0
+    hours, rest = divmod(abs(offset), 3600)
+    minutes, seconds = divmod(rest, 60)
+    zone = f"{'-' if offset < 0 else '+'}{hours:02d}:{minutes:02d}" + (f":{seconds:02d}" if seconds else "")
+    return time.strftime("%Y-%m-%d %H:%M:%S", local) + zone
 
 
 def _anchor(title: str) -> str:
