@@ -48,6 +48,13 @@ def _thread_count(value: str) -> bool:
     return value.strip().isascii() and value.strip().isdigit() and 1 <= int(value) <= MAX_NUMBA_THREADS
 
 
+def _omp_thread_counts(value: str) -> bool:
+    """OMP_NUM_THREADS as libgomp reads it: whole numbers > 0 separated by commas, each with spaces or a '+' around."""
+    import re
+
+    return all(re.fullmatch(r"\s*\+?[0-9]+\s*", n, re.ASCII) and 0 < int(n) < 2**63 for n in value.split(","))
+
+
 def _zero_or_one(value: str) -> bool:
     return value.strip() in ("0", "1")
 
@@ -71,6 +78,8 @@ _NUMBA_VARIABLES = {
         lambda value: sorted(value.split()) == ["omp", "tbb", "workqueue"],
         "give tbb, omp and workqueue in the order numba tries them, separated by spaces, or unset it",
     ),
+    # read by libgomp as numba's omp layer loads it at the first flight: '1.0' was its "Invalid value" line, then its default (T50)
+    "OMP_NUM_THREADS": (_omp_thread_counts, "give a whole number > 0 (OpenMP's threads), or a comma list of them (one per nesting level), or unset it"),
 }
 
 

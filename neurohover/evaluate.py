@@ -373,8 +373,8 @@ def evaluate_jobs(
     safeguard_limits : sequence or array of 25 floats, optional
         Only with ``fallback_index``: the dangerous-state test in the kernel's layout (:meth:`DangerousState.limits`): limits on |u|, |v|, |w|,
         |x|, |y|, |z|, |p|, |q|, |r|, the tilt threshold on qw (inf: none), the kind, the ratio-sum threshold and limits. Default: ``DangerousState()``.
-    record : array_like of bool, optional
-        Per job, whether to record its flight data.
+    record : bool or array_like of bool, optional
+        Per job, whether to record its flight data; one bool (Python's or NumPy's) for every job. Default: none.
     n_steps : int
         Control steps per episode (6000 in the benchmark).
     threads : int, optional
@@ -417,9 +417,10 @@ def evaluate_jobs(
             f"safeguard arm_after={int(limits[SAFEGUARD_ARM])} is not below the episode's {n_steps} control steps (n_steps): "
             f"the safeguard would never test; give arm_after below {n_steps}"
         )
-    rec = np.zeros(n_jobs, dtype=bool) if record is None else np.asarray(record).reshape(-1)
+    rec = np.zeros(n_jobs, dtype=bool) if record is None else np.asarray(record)
     if rec.dtype != bool or isinstance(record, np.ma.MaskedArray):  # record='x' was read as True (second trial); a mask dropped (T16-9)
-        raise NeurohoverError(f"record={record!r:.60} is not allowed: give one True/False flag per job ({n_jobs})")
+        raise NeurohoverError(f"record={record!r:.60} is not allowed: give one True/False flag per job ({n_jobs}), or one for every job")
+    rec = np.full(n_jobs, bool(rec)) if rec.ndim == 0 else rec.reshape(-1)  # one bool flags every job, as evaluate's does (T50-B05)
     if rec.shape[0] != n_jobs:
         raise NeurohoverError(f"record must have one flag per job ({n_jobs}), got {rec.shape[0]}")
     n_rec = int(rec.sum())

@@ -20,7 +20,7 @@ import numpy as np
 from .errors import NeurohoverError, brief, finite_real, float64_of, key_text, refuse_non_text_keys
 from .filekinds import FLIGHT_DATA_KIND, refuse_suffix
 from .flightmeta import check_meaning, check_policy_actions, flown_policy
-from .jsontext import json_text, strict_json
+from .jsontext import JSONError, json_text, strict_json
 from .paths import path_text
 from .sim.constants import ACTION_NAMES, EPISODE_STEPS, MAX_EPISODE_STEPS, OBS_NAMES
 
@@ -68,10 +68,15 @@ def _check_declared_size(path: Path) -> None:
 NPZ_WRITERS = "an .npz that neurohover or numpy.savez wrote"
 
 
-def _member_array(z, name: str, path: Path) -> np.ndarray:
-    """Array ``name`` of the open archive ``z``: np.load gives a NAME.npy that is no .npy as bytes (AttributeErrors; T46-B01)."""
+def _member_array(z, name: str, path: Path, text: str = "") -> np.ndarray:
+    """Array ``name`` of the open archive ``z``: np.load gives a NAME.npy that is no .npy as bytes (AttributeErrors; T46-B01).
+    With ``text`` (what it holds), a 0-d str array as save writes it: bytes or a 1-element array were str()'s "b'...'" or
+    "['...']", refused as no JSON or no flight data without naming the member (T50-B06)."""
     if not isinstance(value := z[name], np.ndarray):
         raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file: its member {name}.npy is no NumPy array: allowed {NPZ_WRITERS}")
+    if text and (value.dtype.kind != "U" or value.ndim != 0):
+        said, allowed = f"a {value.dtype} array of shape {value.shape}", f"a 0-d text array (NumPy dtype 'U', numpy.array(str)) holding {text}"
+        raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file: its member {name}.npy holds {said}: allowed {allowed}, as save writes it")
     return value
 
 
@@ -299,14 +304,15 @@ class FlightData:
         try:
             _check_declared_size(path)
             with np.load(path, allow_pickle=False) as z:
-                if "format" not in z.files or str(z["format"]) != FORMAT:
+                if "format" not in z.files or str(_member_array(z, "format", path, repr(FORMAT))) != FORMAT:
                     raise NeurohoverError(f"{str(path)!r} is not a neurohover flight-data file (expected format {FORMAT})")
                 lengths, obs, act = (_member_array(z, name, path) for name in ("lengths", "observations", "actions"))
-                metadata = strict_json(str(z["metadata"]))  # nesting 100,000 deep was a RecursionError (ninth trial)
+                metadata = strict_json(str(_member_array(z, "metadata", path, "a JSON object")))  # 100,000 deep was a RecursionError (ninth trial)
         except (OSError, ValueError, zipfile.BadZipFile, EOFError, KeyError, zlib.error) as err:  # zlib: damaged bytes (sixth trial)
             if isinstance(err, NeurohoverError):
                 raise
-            raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file ({type(err).__name__}: {err})") from None
+            where = " in its member metadata.npy: allowed a JSON object, as save writes it" if isinstance(err, JSONError) else ""  # T50-B06
+            raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file ({type(err).__name__}: {err}){where}") from None
         if lengths.ndim != 1 or lengths.dtype.kind not in "iu" or (lengths < 0).any():  # float or text lengths were NumPy errors
             raise NeurohoverError(f"{str(path)!r} is not a readable flight-data file: its episode lengths are not one count (an integer >= 0) per episode")
         if lengths.size == 0:  # first: its metadata's lists, one entry per episode, were refused for not being empty (T21-12)

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import NeurohoverError, brief, finite_real, real_number
-from ..sim.constants import DEFAULT_PARAMS, PARAM_NAMES, ROW_PARAMS
+from ..sim.constants import DEFAULT_PARAMS, MIN_NOISE, PARAM_NAMES, ROW_PARAMS
 from .base import MAX_MAGNITUDE, MDP, TaskFamily, finite_vector, mdp_label
 
 COMPETITION_FGHH_SIGMA = 0.3  # the only FGHH sigma the authors' code lists MDPs for
@@ -17,6 +17,10 @@ COMPETITION_FGHH_SIGMA = 0.3  # the only FGHH sigma the authors' code lists MDPs
 #: The largest magnitude of an FGHH dynamics parameter make() takes: 140 times the defaults' largest (sigma <= 1 draws
 #: stay far inside); at it a crash is flown at once, and far past it (1e300) the simulation overflowed to NaN.
 MAX_PARAM = MAX_MAGNITUDE
+#: The smallest sigma but 0, float64's epsilon 2**-52 as drift's smallest walk and a sensor's smallest std: a draw is
+#: d + |d| sigma z, and below it a parameter's std |d| sigma is under one float64 step of d, so a draw is d or a step
+#: from it (1e-17 drew the zero setting 200 times in 200, labelled and recorded as its own sigma; T50-B02).
+MIN_SIGMA = MIN_NOISE
 
 
 @dataclass(frozen=True)
@@ -39,6 +43,11 @@ class FGHH(TaskFamily):
             raise NeurohoverError(f"FGHH sigma={brief(s)} is not allowed: give a number {allowed}")
         if not (finite_real(s) and 0.0 <= s <= 1.0):  # any real number type, np.float32 too
             raise NeurohoverError(f"FGHH sigma={brief(s)} is out of range: allowed {allowed}")
+        if 0 < s < MIN_SIGMA:  # flew as sigma 0 (T50-B02)
+            raise NeurohoverError(
+                f"FGHH sigma={brief(s)} is out of range, too small to change the dynamics (a parameter's std below 2**-52 of it): "
+                f"allowed 0 (the zero setting's dynamics) or a number in {MIN_SIGMA!r}..1 (the paper uses 0.2 and 0.3)"
+            )
         object.__setattr__(self, "sigma", abs(float(s)))  # -0.0 passes 0 <= sigma but was NumPy's "scale < 0" at the first draw (T14-2)
 
     def make(self, params: Sequence[float] | np.ndarray, label: str = "") -> MDP:
