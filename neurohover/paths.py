@@ -46,6 +46,7 @@ __all__ = [
     "refuse_special_file",
     "remove_created_dirs",
     "sole_writer",
+    "temp_text_file",
     "write_png",
     "writer_file",
     "writing",
@@ -395,6 +396,26 @@ def writing(path: str | os.PathLike, option: str) -> Iterator[Path]:
         raise OutputError(f"{option} {str(path)!r}: cannot write it ({_why(err)}); no partial file is left") from None
     finally:
         partial.unlink(missing_ok=True)
+
+
+@contextmanager
+def temp_text_file(text: str, what: str) -> Iterator[str]:
+    """The path of a file in the temporary folder holding ``text`` (``what`` names it in the message), removed after the
+    block. A temporary folder that cannot take it (removed mid-session, as a job's TMPDIR is; read-only; full) is one
+    :class:`~neurohover.errors.OutputError` naming it, not a traceback (T50-B01)."""
+    folder = tempfile.gettempdir()  # Python keeps the first one it found for the whole process
+    try:
+        fd, path = tempfile.mkstemp(suffix=".tmp", prefix="neurohover-")
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+    except OSError as err:
+        raise OutputError(
+            f"the temporary folder {folder!r}: cannot write {what} in it ({_why(err)}); allowed: TMPDIR naming a writable directory when neurohover starts"
+        ) from None
+    try:
+        yield path
+    finally:
+        Path(path).unlink(missing_ok=True)
 
 
 def write_png(fig, path: str | os.PathLike, what: str, dpi: float | None = None) -> Path:

@@ -88,8 +88,8 @@ CASES: dict[str, tuple[Callable[[object], object], str, int, str]] = {
     "win_probabilities draws": (lambda v: win_probabilities(RUNS, n_runs=1, draws=v), "draws", 1, "50,000,000 (draws x n_runs)"),  # type: ignore[arg-type]
     "CodeAgentSettings evolutions": (lambda v: CodeAgentSettings(evolutions=v), "evolutions", 1, INT64),  # type: ignore[arg-type]
     "CodeAgentSettings model_budget": (lambda v: CodeAgentSettings(model_budget=v), "model_budget", 50, INT64),  # type: ignore[arg-type]
-    "EonnSettings pop_size": (lambda v: EonnSettings(pop_size=v), "pop_size", 2, INT64),  # type: ignore[arg-type]
-    "EonnSettings generations": (lambda v: EonnSettings(generations=v), "generations", 1, INT64),  # type: ignore[arg-type]
+    "EonnSettings pop_size": (lambda v: EonnSettings(pop_size=v), "pop_size", 2, "100,000"),  # type: ignore[arg-type]  # evolve's (T50-B04)
+    "EonnSettings generations": (lambda v: EonnSettings(generations=v), "generations", 1, "10,000,000,000"),  # type: ignore[arg-type]  # MAX_BUDGET
     "RiskSettings trials": (lambda v: RiskSettings(trials=v), "risk trials", 1, "1,000,000"),  # type: ignore[arg-type]
     "MDP substeps": (lambda v: nh.MDP.from_dict({**MDP.to_dict(), "substeps": v}), "MDP substeps", 1, "1000"),
     "Sensor delay": (lambda v: Sensor(delay=v), "sensor delay", 0, "10 (control steps)"),  # type: ignore[arg-type]

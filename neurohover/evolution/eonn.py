@@ -40,7 +40,8 @@ from ..evaluate import PolicyTable, evaluate_jobs
 from ..policies import Policy
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, refuse_drift
-from .common import MAX_SPREAD, require_spread, set_field
+from .common import MAX_POPULATION, MAX_SPREAD, require_spread, set_field
+from .config import MAX_BUDGET
 from .fitness import episode_fitness
 from .operators import crossover, mutate
 from .seeding import check_seed
@@ -55,11 +56,12 @@ class EonnSettings:
     Attributes
     ----------
     pop_size : int
-        Population size.
+        Population size (2 to 100,000, :data:`~neurohover.evolution.common.MAX_POPULATION`).
     keep : int
         Genomes kept each generation (the rest replaced by offspring; ``keep < pop_size``).
     generations : int
-        Generations to run.
+        Generations to run (1 to 10**10; the episodes they fly, :attr:`episodes`, at most
+        :data:`~neurohover.evolution.config.MAX_BUDGET`, 10**10, as ``evolve``'s budget).
     tournament_size : int
         Genomes per tournament that picks a parent.
     mutate_prob : float
@@ -91,16 +93,24 @@ class EonnSettings:
     spawn_std: float = 0.5
 
     def __post_init__(self) -> None:
-        for name, low in (("pop_size", 2), ("keep", 0), ("generations", 1), ("tournament_size", 1)):
+        # pop_size 10**18 grew the first population without end, as generations would have flown (T50-B04): evolve's bounds
+        bounds = {"pop_size": (2, MAX_POPULATION), "keep": (0, 2**63 - 1), "generations": (1, MAX_BUDGET), "tournament_size": (1, 2**63 - 1)}
+        for name, (low, high) in bounds.items():
             # whole_in: NumPy's integers too, stored as Python ints, as GenerationalSettings' (T44-B22); 1.5 or True
             # "is not allowed" (a type; it said out of range, T24-11)
-            set_field(self, name, whole_in(getattr(self, name), name, low, 2**63 - 1, "2**63-1"))
+            set_field(self, name, whole_in(getattr(self, name), name, low, high, "2**63-1" if high == 2**63 - 1 else f"{high:,}"))
         if self.keep >= self.pop_size:
             raise NeurohoverError(
                 f"keep={brief(self.keep)} is out of range: allowed 0..pop_size - 1 = {self.pop_size - 1} (at least one offspring a generation)"
             )
         if self.tournament_size > self.pop_size:
             raise NeurohoverError(f"tournament_size={brief(self.tournament_size)} is out of range: allowed 1..pop_size = {self.pop_size}")
+        if self.episodes > MAX_BUDGET:  # evolve's largest budget
+            most = (MAX_BUDGET - self.pop_size) // (self.pop_size - self.keep)
+            raise NeurohoverError(
+                f"generations={brief(self.generations)} is out of range: with pop_size={self.pop_size} and keep={self.keep} it flies "
+                f"{self.episodes:,} episodes; allowed at most {MAX_BUDGET:,} episodes (as evolve's budget), so generations in 1..{most:,}"
+            )
         for name in ("mutate_prob", "mutate_frac", "mutate_repl", "averaging_prob", "spawn_frac"):
             v = getattr(self, name)
             if not finite_real(v) or not 0.0 <= float(v) <= 1.0:

@@ -30,9 +30,7 @@ import functools
 import graphlib
 import math
 import operator
-import os
 import random
-import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from dataclasses import fields as dataclass_fields
@@ -46,6 +44,7 @@ from ..evolution.config import check_budget
 from ..evolution.fitness import FITNESS_SCALES, episode_fitness
 from ..evolution.seeding import check_seed
 from ..flightmeta import compared_by_value
+from ..paths import temp_text_file
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS, OBS_NAMES
 from ..tasks import MDP, TaskFamily
 
@@ -245,13 +244,8 @@ def neat_config(settings: NeatSettings):
 
     fields = {**asdict(settings), "activations": " ".join(settings.activations), "activation_default": settings.activations[0]}
     text = _CONFIG.format(**fields, n_inputs=N_INPUTS, n_outputs=ACTION_DIM)  # the template names the settings' fields
-    fd, path = tempfile.mkstemp(suffix=".ini", prefix="neurohover-neat-")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
+    with temp_text_file(text, "neat-python's config file") as path:  # neat-python's Config reads a file, by name only
         return neat.Config(neat.DefaultGenome, neat.DefaultReproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation, path)
-    finally:
-        os.unlink(path)
 
 
 @compared_by_value  # == by value: arrays whole (T46-B08)

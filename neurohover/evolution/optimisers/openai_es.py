@@ -23,7 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import NeurohoverError
+from ...errors import NeurohoverError, brief, finite_real
+from ...policies import MAX_GENE
 from ..common import (
     STATE_VERSION,
     ChampionTracker,
@@ -54,7 +55,17 @@ from ..common import (
 from ..seeding import check_seed
 from . import OptimiserSpec
 
-__all__ = ["OpenAIES", "OpenAIESSettings"]
+__all__ = ["MAX_EPSILON", "MAX_L2", "OpenAIES", "OpenAIESSettings"]
+
+#: The largest L2 coefficient. A gradient entry is the ranks' term, at most max|noise| / (2 sigma) <= about 5e100 (noise
+#: under 10, sigma >= 1e-100; the returns enter only as ranks in [-0.5, 0.5], so no return, not even -WORST_RETURN, scales
+#: it), minus l2 * mean, the mean a genome's (<= policies.MAX_GENE, 1e120): at l2 <= 1e20 an entry stays below 1e140 and
+#: its square, Adam's second moment, below 1e280, far below a float's 1.8e308 (l2=1e300 made it inf; T50-B03).
+MAX_L2 = 1e20
+#: The largest Adam epsilon: 1, the largest in use (TensorFlow's note for Inception; Adam's own 1e-8). It only keeps the
+#: step finite where sqrt(v) is 0; far above the gradient's size it, not the gradient, sets the step, which shrinks to
+#: nothing (epsilon=1e300 moved the mean by 7.7e-302, without a word; T50-B03).
+MAX_EPSILON = 1.0
 
 
 @dataclass(frozen=True)
@@ -77,9 +88,9 @@ class OpenAIESSettings:
     beta1, beta2 : float
         Adam's decay rates, in [0, 1).
     epsilon : float
-        Adam's denominator offset (> 0).
+        Adam's denominator offset (> 0 and <= 1, :data:`MAX_EPSILON`).
     l2 : float
-        The weight decay of the mean (>= 0).
+        The weight decay of the mean (>= 0 and <= 1e20, :data:`MAX_L2`: Adam's moments stay finite).
     """
 
     popsize: int = 20
@@ -97,17 +108,21 @@ class OpenAIESSettings:
         set_field(self, "popsize", popsize)
         for name in ("sigma", "learning_rate"):  # steps in genome units: 1e308 overflowed the genes late in the run (eleventh trial)
             set_field(self, name, require_spread(name, require_std(name, getattr(self, name)), positive=True))  # as a float: sigma=0.0
-        value = require_std("epsilon", self.epsilon)
-        if value <= 0.0:
-            raise NeurohoverError(f"epsilon={value!r} must be a finite number > 0")
-        set_field(self, "epsilon", value)
+        for name, low, top in (("epsilon", "> 0", MAX_EPSILON), ("l2", ">= 0", MAX_L2)):  # l2=1e300 made Adam's moment inf (T50-B03)
+            value = getattr(self, name)
+            if not finite_real(value) or not (0.0 < float(value) if low == "> 0" else 0.0 <= float(value)) or float(value) > top:
+                why = f" ({MAX_LIMITS[name]})" if finite_real(value) and float(value) > top else ""
+                raise NeurohoverError(f"{name}={brief(value)} must be a finite number {low} and <= {top:g}{why}")
+            set_field(self, name, float(value) + 0.0)  # -0.0 as 0.0, as require_std
         for name in ("beta1", "beta2"):
             value = require_std(name, getattr(self, name))
             if not value < 1.0:
                 raise NeurohoverError(f"{name}={value!r} must be in [0, 1)")
             set_field(self, name, value)
-        set_field(self, "l2", require_std("l2", self.l2))
 
+
+#: Why each of :class:`OpenAIESSettings`' capped settings is capped (its refusal says so).
+MAX_LIMITS = {"epsilon": "a larger one, not the gradient, sets Adam's step, and the mean stops", "l2": "a larger one overflows Adam's moments"}
 
 #: Every entry an :meth:`OpenAIES.state_dict` has held.
 STATE_ENTRIES = ("type", "version", "settings", "mean", "adam", "generation", "pending", "rng", "tracker", "wall_seconds")
@@ -170,13 +185,14 @@ class OpenAIES(PopulationOptimiser):
         half = self.popsize // 2
         weights = shaped[:half] - shaped[half:]  # a pair's two genomes share its noise, with opposite signs
         grad = weights @ self._eps / (self.popsize * s.sigma) - s.l2 * self.mean
-        self.generation += 1
-        t = self.generation
-        self._m = s.beta1 * self._m + (1.0 - s.beta1) * grad
-        self._v = s.beta2 * self._v + (1.0 - s.beta2) * grad * grad
-        step = s.learning_rate * math.sqrt(1.0 - s.beta2**t) / (1.0 - s.beta1**t)
-        self.mean = self.mean + step * self._m / (np.sqrt(self._v) + s.epsilon)  # ascent: returns are maximised
-        self._eps = None
+        t = self.generation + 1
+        with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused below, by name
+            m = s.beta1 * self._m + (1.0 - s.beta1) * grad
+            v = s.beta2 * self._v + (1.0 - s.beta2) * grad * grad
+            step = s.learning_rate * math.sqrt(1.0 - s.beta2**t) / (1.0 - s.beta1**t)
+            mean = self.mean + step * m / (np.sqrt(v) + s.epsilon)  # ascent: returns are maximised
+        _refuse_unresumable(mean, m, v, t)
+        self.generation, self._m, self._v, self.mean, self._eps = t, m, v, mean, None
 
     def stop(self) -> bool:
         """OpenAI-ES has no termination criterion of its own: the run's budget stops it."""
@@ -238,6 +254,19 @@ def _moments(value: Any, size: int) -> tuple[np.ndarray, np.ndarray]:
     if np.any(v < 0.0):  # a running mean of squares: its square root is taken
         raise EntryError("Adam's second moment holds a negative number: allowed numbers >= 0")
     return m, v
+
+
+def _refuse_unresumable(mean: np.ndarray, m: np.ndarray, v: np.ndarray, generation: int) -> None:
+    """NeurohoverError, the state unchanged, where generation ``generation``'s update gave a state :meth:`OpenAIES.from_state_dict`
+    refuses (a moment not finite, a mean gene past :data:`~neurohover.policies.MAX_GENE`): it was written as a checkpoint
+    its own resume refused (T50-B03); the run stops there, its last checkpoint kept."""
+    for name, a, top in (("Adam's first moment", m, math.inf), ("Adam's second moment", v, math.inf), ("the mean", mean, MAX_GENE)):
+        bad = np.flatnonzero(~np.isfinite(a) | (np.abs(a) > top))
+        if bad.size:
+            raise NeurohoverError(
+                f"OpenAI-ES stopped at generation {generation}: {name}'s gene {int(bad[0])} became {brief(float(a[bad[0]]))}, which is not allowed: "
+                f"allowed finite numbers{'' if top == math.inf else f' in [-{top:g}, {top:g}] (a policy genome)'}; give smaller settings"
+            )
 
 
 def _make(genome: np.ndarray, settings: OpenAIESSettings, seed: int) -> OpenAIES:
