@@ -1,6 +1,7 @@
-"""Issue 37, items left by the twenty-sixth session and closed in the twenty-seventh: an MDP made before
+"""Issue 37, items left by the twenty-sixth session and closed in the twenty-seventh, and one seen on the way: an MDP made before
 ``importlib.reload(neurohover.tasks.drift)`` was refused by evaluate as "give an MDP or a task family", although it is
-one (its Drift is of the first import): now named by its cause, as T42-B07 names a reloaded Sensor's or Drift's."""
+one (its Drift is of the first import): now named by its cause, as T42-B07 names a reloaded Sensor's or Drift's; FGHH
+sigmas of one set variant shared the seeded set first built."""
 
 from __future__ import annotations
 
@@ -26,3 +27,17 @@ def test_an_mdp_made_before_a_reload_of_drift_is_named_by_its_cause() -> None:
         module.__dict__.clear()
         module.__dict__.update(saved)
     assert nh.evaluate(nh.baseline_policy(), mdp, n_steps=10).returns.size == 1  # the first import's again
+
+
+def test_fghh_sigmas_of_one_set_variant_fly_their_own_seeded_sets() -> None:
+    """Seen while fixing T50-B02: FGHH's seeded sets were cached by set_variant (round(sigma * 1e6)), so after sigma
+    0.2000001's test set, sigma 0.2000004's was the same MDPs, drawn at the other sigma, without a word. Both draw from
+    one seed (one variant), so each parameter's distance from the default scales with its own sigma."""
+    import numpy as np
+
+    from neurohover.tasks.fghh import DEFAULT_PARAMS
+
+    first = nh.get_task_family("fghh", 0.2000001).test_mdps()[0]
+    second = nh.get_task_family("fghh", 0.2000004).test_mdps()[0]
+    ratio = (np.asarray(second.params) - DEFAULT_PARAMS) / (np.asarray(first.params) - DEFAULT_PARAMS)
+    assert np.allclose(ratio, 0.2000004 / 0.2000001, rtol=1e-9, atol=0)

@@ -527,7 +527,8 @@ class TaskFamily:
         return self.rows(self.sample_params(rng, n))
 
     def _seeded_set(self, which: int, n: int, kind: str) -> list[MDP]:
-        key = (self.name, self.set_variant(), which, self.sensor, self.drift)
+        # the family's own sigma too: sigmas of one variant (0.2000001, 0.2000004) draw from one seed, but not one set
+        key = (self.name, self.set_variant(), getattr(self, "sigma", None), which, self.sensor, self.drift)
         if key not in _FIXED_SETS:  # MDPs are immutable, so each set is built once per process
             rng = np.random.default_rng(np.random.SeedSequence([_SET_ENTROPY, self.set_code, which, self.set_variant()]))
             with family_code():  # the set's own labels name it: checking them would build the set again
