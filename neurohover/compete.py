@@ -340,11 +340,14 @@ def _flown_under(n_steps: int, sigma: float | None, sensor: Sensor | None, drift
 
 
 def _checked_store(store) -> Path | None:
-    """The store's path, refused before the output directory is made: a bad path, or a file that is no store (third trial)."""
+    """The store's path, refused before the output directory is made: a bad path, a file that is no store (third trial),
+    or a clock whose times its readers refuse (T50-A03)."""
     from .experiments.store_checks import new_store
+    from .experiments.store_clock import clock_time
     from .filekinds import refuse_long_store_name
     from .paths import output_file
 
+    clock_time(f"results store {str(store)!r}" if store is not None else "compete's results store")
     if store is None:
         return None
     refuse_long_store_name(store, "store")  # its -journal too (T31-A03)

@@ -77,9 +77,10 @@ def refuse_other_files(out: Path) -> None:
     """Refuse an output directory whose summary.json or episodes.csv is not a competition's, naming what it is, before
     any run: flight data, a model or a policy file there was replaced without a word (T26-A06). An empty file is
     replaced (nothing is lost), and so is an older competition's summary (its task and agent, which
-    :func:`note_replaced` names); a file no neurohover command wrote is refused too (it may be anyone's)."""
-    from .filekinds import held_kind
-    from .paths import refuse_special_file
+    :func:`note_replaced` names); a file no neurohover command wrote is refused too (it may be anyone's). So is a
+    cumulative.png the plot would not replace, as the plot checks it (it was checked once every run flew; T50-A05)."""
+    from .filekinds import PNG_KIND, held_kind
+    from .paths import output_file, refuse_foreign_output, refuse_special_file
 
     for name, own in OWN_FILES.items():
         path = out / name
@@ -91,6 +92,9 @@ def refuse_other_files(out: Path) -> None:
             continue
         what, written = held or "no file compete wrote", own.replace(f" ({name})", "")
         raise NeurohoverError(f"{name} in {brief(str(out))} is {what}: compete would replace it with {written}; move it away or give another output directory")
+    plot = out / "cumulative.png"  # checked as plot_cumulative and write_png check it once every run flew (T50-A05)
+    output_file(plot, "plot file", suffixes=(".png",), what="a plot is PNG")
+    refuse_foreign_output(plot, "plot file", PNG_KIND)
 
 
 def held_competition(summary_path: Path) -> tuple[str, str, object] | None:

@@ -31,7 +31,6 @@ import json
 import os
 import socket
 import sqlite3
-import time
 import weakref
 from collections.abc import Iterable
 from pathlib import Path
@@ -64,15 +63,14 @@ from .store_checks import (
     object_text,
     refuse_moved,
     refuse_wrong_cells,
-    seconds_said,
     session_problem,
     sqlite_says,
     stored_count,
     take_writer_lock,
-    time_allowed,
     unit_texts,
 )
 from .store_checks import transaction as _transaction
+from .store_clock import WALL_SQL, SessionClocks, clock_time, stored_seconds, stored_time
 
 SCHEMA_VERSION = 1
 
@@ -115,6 +113,9 @@ class Store:
         if create:  # its -journal too (a reader writes none; T31-A03)
             refuse_long_store_name(path, "results store")
         check_store_file(self.path, path, create)  # what SQLite would open, or delete beside it, before it does
+        if create and new_store(self.path):  # a clock its readers refuse: no store made (T50-A03)
+            clock_time(f"cannot create the results store {str(self.path)!r}")
+        self._clocks = SessionClocks()  # its sessions' wall seconds, on the monotonic clock (T50-A02)
         make_dirs(self.path.parent, "results store", str(path))  # a file as its parent was pathlib's FileExistsError (fifteenth trial, T15-10)
         self._lock = WriterLock(self.lock_path)
         new = new_store(self.path)
@@ -277,6 +278,7 @@ class Store:
         fresh = check_flag(fresh, "fresh", "delete the experiment's stored units first")
         if not fresh:  # its row kept: a damaged one named (T22-09)
             self._check_created(name)
+        now = clock_time(where)  # a time its readers take, or nothing written (T50-A03)
         self.lock()
         c = self.conn
         with _transaction(c):
@@ -291,7 +293,7 @@ class Store:
                     "figures would be one file where case is ignored; give the experiment another name (or another --store)"
                 )
             if row is None:
-                c.execute("INSERT INTO experiments VALUES (?, ?, ?, ?, ?)", (name, scale, config_hash, text, time.time()))
+                c.execute("INSERT INTO experiments VALUES (?, ?, ?, ?, ?)", (name, scale, config_hash, text, now))
             elif row[0] != config_hash:
                 raise NeurohoverError(config_differs(str(self.path), name, scale, row[0], row[1], config_hash, config))
             else:  # same settings: keep the latest title and paper numbers (they do not change results)
@@ -314,6 +316,7 @@ class Store:
             raise NeurohoverError(f"{where}: keep = {brief(keep)} is not allowed: give a list or set of unit keys (text) to keep")
         self._check_config(config, scale, config_hash, where)
         kept = set(given)
+        clock_time(where)  # a run follows, its times refused: nothing deleted first (T50-A03)
         self.lock()
         c = self.conn
         with _transaction(c):
@@ -451,24 +454,12 @@ class Store:
                 "kind": kind,
                 "params": self._json(p, f"experiment {name} ({scale}), unit {k}'s params"),
                 "result": self._json(r, f"experiment {name} ({scale}), unit {k}'s result"),
-                "seconds": self._seconds(s, f"experiment {name} ({scale}), unit {k}'s seconds"),
+                "seconds": stored_seconds(self.path, s, f"experiment {name} ({scale}), unit {k}'s seconds"),
                 "worker": w,
-                "finished": self._time(f, f"experiment {name} ({scale}), unit {k}'s finished time"),
+                "finished": stored_time(self.path, f, f"experiment {name} ({scale}), unit {k}'s finished time"),
             }
             for k, kind, p, r, s, w, f in rows
         ]
-
-    def _seconds(self, value: Any, what: str) -> float:
-        """A stored duration, or one error naming the damaged row (text was a TypeError in report, seventh trial; 1e300 exported, T45-B02)."""
-        if seconds_allowed(value):
-            return value
-        raise NeurohoverError(f"results store {str(self.path)!r}: {what} is damaged ({seconds_said(value)})")
-
-    def _time(self, value: Any, what: str) -> float:
-        """A stored time (:data:`~.store_checks.TIME_ALLOWED`), or one error naming the damaged row (1e12 exported; T45-B02)."""
-        if not time_allowed(value):
-            raise NeurohoverError(f"results store {str(self.path)!r}: {what} {brief(value)} is damaged: {TIME_ALLOWED}")
-        return value
 
     def _json(self, text: str, what: str) -> dict:
         """A stored JSON object, or one clear error naming the damaged row (the rest of the store stays readable): every
@@ -506,6 +497,7 @@ class Store:
         check_text(worker, "worker", where, empty=True)
         if session is not None:
             session = stored_count(session, "session", where, 1)
+        now = clock_time(where)
         self.lock()
         c = self.conn
         with _transaction(c):
@@ -520,7 +512,7 @@ class Store:
                 raise NeurohoverError(f"{where}: {problem}")
             cur = c.execute(
                 "INSERT OR IGNORE INTO units VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                (name, scale, unit.key, unit.kind, config_hash, params, text, float(seconds), worker, time.time()),
+                (name, scale, unit.key, unit.kind, config_hash, params, text, float(seconds), worker, now),
             )
             if c.execute("SELECT 1 FROM units WHERE name = ? AND scale = ? AND key = ?", (name, scale, unit.key)).fetchone() is None:
                 raise NeurohoverError(  # a trigger or an index of someone else's dropped it, and the unit was lost (T33-B14)
@@ -528,7 +520,7 @@ class Store:
                     "(a trigger or index neurohover did not make?); give another --store file"
                 )
             if session is not None and cur.rowcount:
-                c.execute("UPDATE sessions SET units_run = units_run + 1, wall_seconds = ? - started WHERE id = ?", (time.time(), session))
+                c.execute(f"UPDATE sessions SET units_run = units_run + 1, {WALL_SQL} WHERE id = ?", (*self._clocks.wall(session), session))
         return bool(cur.rowcount)
 
     # ------------------------------------------------------------------ sessions
@@ -543,6 +535,7 @@ class Store:
         check_executor(executor, where)
         cores = stored_count(cores, "cores", where, 1, MAX_CORES)
         units_before = stored_count(units_before, "units_before", where, 0)
+        now = clock_time(where)
         self.lock()
         c = self.conn
         with _transaction(c):  # a session sessions() would call damaged is refused (T29-B04)
@@ -555,9 +548,10 @@ class Store:
             cur = c.execute(
                 "INSERT INTO sessions (name, scale, config_hash, executor, cores, started, wall_seconds, units_run, units_before, status) "
                 "VALUES (?, ?, ?, ?, ?, ?, 0, 0, ?, 'running')",
-                (name, scale, config_hash, executor, cores, time.time(), units_before),
+                (name, scale, config_hash, executor, cores, now, units_before),
             )
         assert cur.lastrowid is not None  # an INSERT always sets it
+        self._clocks.start(cur.lastrowid)
         return cur.lastrowid
 
     def end_session(self, session: int, status: str) -> None:
@@ -573,7 +567,7 @@ class Store:
             problem = session_problem(c, session)
             if problem:
                 raise NeurohoverError(f"{where}: {problem}")
-            c.execute("UPDATE sessions SET status = ?, wall_seconds = ? - started WHERE id = ?", (status, time.time(), session))
+            c.execute(f"UPDATE sessions SET status = ?, {WALL_SQL} WHERE id = ?", (status, *self._clocks.wall(session), session))
 
     def sessions(self, name: str, scale: str, *, missing_ok: bool = False) -> list[dict]:
         """Every recorded run of experiment (name, scale) (:meth:`start_session`), checked; as :meth:`results`."""
@@ -586,7 +580,7 @@ class Store:
         stored = self._rows("SELECT COUNT(*) FROM units WHERE name = ? AND scale = ?", (name, scale), f"experiment {name} ({scale})'s units")[0][0]
         seen: dict[tuple, int] = {}
         for session in sessions:  # what the report sums and prints: numbers, or the damaged row named
-            session["wall_seconds"] = self._seconds(session["wall_seconds"], f"experiment {name} ({scale}), session {session['id']}'s wall seconds")
+            session["wall_seconds"] = stored_seconds(self.path, session["wall_seconds"], f"experiment {name} ({scale}), session {session['id']}'s wall seconds")
             bad = bad_session(session, stored)  # units_run 99 of 4, status 'zzz', started 1e12 were reported (T22-21)
             twin = seen.setdefault(tuple(session[c] for c in cols[1:]), session["id"])
             bad = bad or (f"it repeats session {twin} field for field (one run is recorded once)" if twin != session["id"] else "")

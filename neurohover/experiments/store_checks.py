@@ -133,7 +133,8 @@ def refuse_wrong_cells(read: Callable[[str, tuple, str], list], store: str, sche
 #: How a session can end (:meth:`Store.end_session`; the runner's statuses). A session is "running" until then.
 SESSION_STATUSES = ("finished", "selection finished", "interrupted", "failed")
 #: The times a store records (a session's start, a unit's finish, an experiment's creation), in seconds since 1970: fixed
-#: bounds, not "now" (a store read on a machine whose clock lags is no damage). 0 and 1e12 were taken (T45-B02).
+#: bounds, not "now" (a store read on a machine whose clock lags is no damage; one whose clock reads outside them writes
+#: none: store_clock.clock_time, T50-A03). 0 and 1e12 were taken (T45-B02).
 TIME_ALLOWED = "allowed a time (seconds since 1970) from 2001 to 2106"
 
 
