@@ -48,7 +48,7 @@ MAX_MAGNITUDE = 10_000.0
 #: How far substeps x dt may lie from the control step they integrate (a learned model: 1 x 0.1 s; the simulator 10 x 0.01 s).
 COVER_TOLERANCE = 1e-9
 _SET_ENTROPY = 20110401  # fixed root of the seeded training and test sets (the paper's year)
-_FIXED_SETS: dict[tuple[str, int, int, Sensor, Drift], tuple[MDP, ...]] = {}
+_FIXED_SETS: dict[tuple[str, int, float | None, int, Sensor, Drift], tuple[MDP, ...]] = {}
 _ROW_LAYOUTS: dict[tuple[str, int, Sensor], np.ndarray] = {}
 COMPETITION_MDPS_FILE = Path(__file__).parent.parent / "data" / "competition-mdps.json"
 _COMPETITION: dict[str, dict] = {}
@@ -536,7 +536,7 @@ class TaskFamily:
         return list(_FIXED_SETS[key])
 
     def _competition_set(self, kind: str) -> list[MDP]:
-        key = (self.name, -1, 0 if kind == "train" else 1, self.sensor, self.drift)
+        key = (self.name, -1, None, 0 if kind == "train" else 1, self.sensor, self.drift)
         if key not in _FIXED_SETS:
             rows = competition_rows(self.name)[kind]
             with family_code():  # as _seeded_set's
