@@ -32,9 +32,9 @@ from ..sim.constants import (
     WIND_SINUSOID,
 )
 from ..sim.reference import ReferenceMDP
-from ..sim.rng import MAX_SEED
 from .drift import NO_DRIFT, Drift
-from .held import LEARNED_MODEL, check_held, check_label, family_code, register_family
+from .family_checks import checked_draws, generator, through_sensor
+from .held import LEARNED_MODEL, check_held, family_code, register_family
 from .held import WIND_KINDS as _WIND_KINDS
 from .sensor import EXACT, Sensor
 
@@ -279,47 +279,6 @@ def competition_families() -> tuple[str, ...]:
     return tuple(k for k, v in _COMPETITION.items() if isinstance(v, dict) and "train" in v)  # not its "about" note
 
 
-def _through_sensor(method):
-    """``method`` (a family's make or zero) with the family's sensor and drift put on the MDP it returns."""
-
-    @functools.wraps(method)
-    def made(self, *args, **kwargs):
-        with family_code():  # what the family's own code builds, it holds: not checked again (tasks.held)
-            mdp = method(self, *args, **kwargs)
-            if not self.sensor.exact:
-                mdp = mdp.with_sensor(self.sensor)
-            mdp = mdp if self.drift.none else mdp.with_drift(self.drift)
-        check_label(mdp)  # but a caller's label= is the caller's: it must name this MDP (T29-B01)
-        return mdp
-
-    return made
-
-
-MAX_SAMPLES = 10**7  # MDPs drawn in one call (their rows: 2.9 GB)
-
-
-def generator(rng, what: str = "rng") -> np.random.Generator:
-    """``rng`` as a NumPy Generator: a Generator, a seed (an integer >= 0) or None (fresh entropy); else a clear error."""
-    if rng is None or isinstance(rng, np.random.Generator):
-        return np.random.default_rng(rng)
-    if not whole_number(rng) or not 0 <= rng <= MAX_SEED:  # every seed's range; np.timedelta64 was int()'s TypeError (T17-1)
-        raise NeurohoverError(f"{what}={brief(rng)} is not allowed: give a numpy Generator, a seed (an integer in 0..2**63-1) or None")
-    return np.random.default_rng(int(rng))
-
-
-def _checked_draws(method):
-    """A family's ``sample_params`` with its arguments checked (it is the family's own code)."""
-
-    @functools.wraps(method)
-    def draws(self, rng, n):
-        if not isinstance(rng, np.random.Generator):
-            raise NeurohoverError(f"rng={rng!r} is not allowed: give a numpy Generator (np.random.default_rng(seed))")
-        whole_in(n, "n", 0, MAX_SAMPLES, f"{MAX_SAMPLES:,} (MDPs drawn in one call)")  # np.timedelta64 was int()'s TypeError (T17-1)
-        return method(self, rng, int(n))
-
-    return draws
-
-
 def _checked_competition_row(method):
     """A family's ``competition_params`` with its row checked: the family's ``n_params`` finite numbers ('ab' was a
     TypeError, [1] scaled to [5.0] for a two-number GHH-08 row; T15-5)."""
@@ -405,11 +364,11 @@ class TaskFamily:
             register_family(cls)
         for name in ("make", "zero"):  # the one place a family's MDPs get its sensor
             if name in cls.__dict__:
-                setattr(cls, name, _through_sensor(cls.__dict__[name]))
+                setattr(cls, name, through_sensor(cls.__dict__[name]))
         if "competition_params" in cls.__dict__:
             cls.competition_params = _checked_competition_row(cls.__dict__["competition_params"])  # type: ignore[method-assign]
         if "sample_params" in cls.__dict__:
-            cls.sample_params = _checked_draws(cls.__dict__["sample_params"])  # type: ignore[method-assign]
+            cls.sample_params = checked_draws(cls.__dict__["sample_params"])  # type: ignore[method-assign]
         # Defined before the dataclass decorator runs, so it keeps them: equality includes the sensor.
         cls.__eq__ = _family_eq  # type: ignore[method-assign]
         cls.__hash__ = _family_hash  # type: ignore[method-assign]

@@ -1,0 +1,54 @@
+"""The checks :class:`~neurohover.tasks.base.TaskFamily` puts around a family's own methods as the family class is defined:
+its ``make`` and ``zero`` give MDPs through its sensor and drift, and its ``sample_params`` is called with a checked
+generator and count; and :func:`generator`, the one reading of an ``rng`` argument."""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from ..errors import NeurohoverError, brief, whole_in, whole_number
+from ..sim.rng import MAX_SEED
+from .held import check_label, family_code
+
+
+def through_sensor(method):
+    """``method`` (a family's make or zero) with the family's sensor and drift put on the MDP it returns."""
+
+    @functools.wraps(method)
+    def made(self, *args, **kwargs):
+        with family_code():  # what the family's own code builds, it holds: not checked again (tasks.held)
+            mdp = method(self, *args, **kwargs)
+            if not self.sensor.exact:
+                mdp = mdp.with_sensor(self.sensor)
+            mdp = mdp if self.drift.none else mdp.with_drift(self.drift)
+        check_label(mdp)  # but a caller's label= is the caller's: it must name this MDP (T29-B01)
+        return mdp
+
+    return made
+
+
+MAX_SAMPLES = 10**7  # MDPs drawn in one call (their rows: 2.9 GB)
+
+
+def generator(rng, what: str = "rng") -> np.random.Generator:
+    """``rng`` as a NumPy Generator: a Generator, a seed (an integer >= 0) or None (fresh entropy); else a clear error."""
+    if rng is None or isinstance(rng, np.random.Generator):
+        return np.random.default_rng(rng)
+    if not whole_number(rng) or not 0 <= rng <= MAX_SEED:  # every seed's range; np.timedelta64 was int()'s TypeError (T17-1)
+        raise NeurohoverError(f"{what}={brief(rng)} is not allowed: give a numpy Generator, a seed (an integer in 0..2**63-1) or None")
+    return np.random.default_rng(int(rng))
+
+
+def checked_draws(method):
+    """A family's ``sample_params`` with its arguments checked (it is the family's own code)."""
+
+    @functools.wraps(method)
+    def draws(self, rng, n):
+        if not isinstance(rng, np.random.Generator):
+            raise NeurohoverError(f"rng={rng!r} is not allowed: give a numpy Generator (np.random.default_rng(seed))")
+        whole_in(n, "n", 0, MAX_SAMPLES, f"{MAX_SAMPLES:,} (MDPs drawn in one call)")  # np.timedelta64 was int()'s TypeError (T17-1)
+        return method(self, rng, int(n))
+
+    return draws
