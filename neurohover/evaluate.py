@@ -14,7 +14,7 @@ Example
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -261,8 +261,10 @@ def mdp_rows(mdps: MDP | Sequence[MDP] | np.ndarray) -> np.ndarray:
                     i = int(np.flatnonzero((sensors == values).all(axis=1))[0])
                     raise NeurohoverError(f"MDP row {i} has an invalid sensor model {values.tolist()}: {err}") from None
         return np.ascontiguousarray(mdps, dtype=float)
-    if isinstance(mdps, (str, bytes)) or not hasattr(mdps, "__len__") or len(mdps) == 0 or not all(isinstance(m, MDP) for m in mdps):
-        raise NeurohoverError(f"mdps={mdps!r:.60} is not allowed: give an MDP, a non-empty sequence of MDPs or an array of MDP rows")
+    # Iterable too: a sized object that cannot be iterated (a PolicyTable) was a TypeError "not iterable" (T51-B01)
+    sized = isinstance(mdps, Iterable) and not isinstance(mdps, (str, bytes)) and hasattr(mdps, "__len__")
+    if not sized or len(mdps) == 0 or not all(isinstance(m, MDP) for m in mdps):
+        raise NeurohoverError(f"mdps={brief(mdps)} is not allowed: give an MDP, a non-empty sequence of MDPs or an array of MDP rows")
     for m in refuse_unordered_mdps(mdps):  # a set flew in hash order (T32-B02)
         refuse_drift(m, "this batch")
     return np.stack([m.row() for m in mdps])

@@ -8,7 +8,7 @@ import functools
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, whole_in, whole_number
+from ..errors import NeurohoverError, as_floats, brief, whole_in, whole_number
 from ..sim.rng import MAX_SEED
 from .held import check_label, family_code
 
@@ -42,13 +42,39 @@ def generator(rng, what: str = "rng") -> np.random.Generator:
 
 
 def checked_draws(method):
-    """A family's ``sample_params`` with its arguments checked (it is the family's own code)."""
+    """A family's ``sample_params`` with its arguments and its answer checked (it is the family's own code): the one
+    check of every caller's draws (sample, the seeded sets, sample_rows, the environments)."""
 
     @functools.wraps(method)
     def draws(self, rng, n):
         if not isinstance(rng, np.random.Generator):
             raise NeurohoverError(f"rng={rng!r} is not allowed: give a numpy Generator (np.random.default_rng(seed))")
         whole_in(n, "n", 0, MAX_SAMPLES, f"{MAX_SAMPLES:,} (MDPs drawn in one call)")  # np.timedelta64 was int()'s TypeError (T17-1)
-        return method(self, rng, int(n))
+        return checked_answer(self, method(self, rng, int(n)), int(n))
 
     return draws
+
+
+def checked_answer(family, answer, n: int) -> np.ndarray:
+    """``answer`` of ``family.sample_params(rng, n)`` as a float array of shape (n, n_params) of finite numbers within the
+    family's ``param_bounds``, else one error naming sample_params, what it gave and what is asked: 4 rows for 3 were
+    flown without a word (T51-B04), and a 1-D answer's first number handed to make() by sample() (T51-B05)."""
+    what = f"{family.name} sample_params(rng, {n})'s answer"
+    allowed = f"it must be an array of shape (n, n_params) = ({n}, {family.n_params}) of finite numbers ({', '.join(family.param_names)})"
+    if type(answer) is np.ndarray and answer.dtype == np.float64:  # the shipped families' own: not copied (up to MAX_SAMPLES rows)
+        arr = answer
+    else:
+        try:
+            arr = as_floats(answer, what, "")
+        except NeurohoverError:
+            raise NeurohoverError(f"{what} {brief(answer)} is not allowed: {allowed}") from None
+    if arr.shape != (n, family.n_params):
+        raise NeurohoverError(f"{what} of shape {arr.shape} is not allowed: {allowed}")
+    if not np.isfinite(arr).all():
+        raise NeurohoverError(f"{what} {brief(arr.tolist())} is not allowed: {allowed}")
+    low, high = family.param_bounds  # as rows() and make() refuse them: the vector environment writes the draws into its rows
+    outside = np.flatnonzero(((arr < low) | (arr > high)).any(axis=1))
+    if outside.size:
+        i = int(outside[0])
+        raise NeurohoverError(f"{what} row {i} {brief(arr[i].tolist())} is out of range: each parameter must lie in [{low:g}, {high:g}]")
+    return arr
