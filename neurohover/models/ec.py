@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import NeurohoverError, brief, finite_real, refuse_reloaded, whole_in, whole_number
 from ..flightdata import FlightData, check_flown, crash_flags
 from ..flightmeta import action_mismatch
-from ..sim.constants import DEFAULT_PARAMS, ROW_NOISE, ROW_PARAMS, WORST_RETURN
+from ..sim.constants import CRASH_STEP_PENALTY, DEFAULT_PARAMS, ROW_NOISE, ROW_PARAMS, WORST_RETURN, crash_charge
 from ..tasks import MDP
 from .model import MODEL_DT, LearnedModel, check_vector
 from .transitions import OneStepProblem, Transitions, noise_from_residuals
@@ -196,21 +196,51 @@ def _thin(history: list, keep: int = 200) -> list:
 
 
 def observed_return(flight_data: FlightData, episode: int = 0) -> float:
-    """Return of one recorded episode recomputed from its observations: ``-sum_k |obs_k|^2``
-    over the observations after each action (valid for an episode that did not crash). The flight data are checked again
+    """The return of one recorded episode, recomputed from its observations as the simulator earns it: each step's
+    reward is ``-|obs_k|^2`` of the observation after its action, and an episode whose metadata record it crashed
+    (``crashed``) earns at its crashing step the crash charge instead, ``-CRASH_STEP_PENALTY`` for each step left of its
+    metadata's ``episode_steps`` (:func:`~neurohover.sim.constants.crash_charge`; none for a crash on the last step), as
+    the return :func:`~neurohover.evaluate` reports, and the one EC-MER's model episodes of that budget are compared
+    with. A crashed episode whose metadata record no ``episode_steps`` (joined recordings of two budgets) is refused:
+    its charge is unknown (the partial sum of its readings was answered without a word, a return 2,000 times too high;
+    T51-B03). Where the metadata record no crash flags (files before 2026-12-04, flight data made without metadata),
+    no crash is charged: the sum over every observation. The flight data are checked again
     (:meth:`FlightData.check_again`) and the episode's readings as flown (:func:`~neurohover.flightdata.check_flown`)."""
     if not isinstance(flight_data, FlightData):
         refuse_reloaded(flight_data, FlightData, "flight data")  # T42-B08
         raise NeurohoverError(f"flight data must be a FlightData, got {type(flight_data).__name__}")
+    n = flight_data.n_episodes
+    allowed = f"give an integer in 0..{n - 1}" if n else "the flight data hold no episode (FlightData((), ()), an empty window)"
     # a float was a TypeError from indexing, True taken as episode 1 (twelfth trial T4)
     if not whole_number(episode):
-        raise NeurohoverError(f"episode={brief(episode)} is not allowed: give an integer in 0..{flight_data.n_episodes - 1}")
-    if not 0 <= episode < flight_data.n_episodes:
-        raise NeurohoverError(f"episode {brief(episode)} is not in the flight data: give an integer in 0..{flight_data.n_episodes - 1}")
+        raise NeurohoverError(f"episode={brief(episode)} is not allowed: {allowed}")
+    if not 0 <= episode < n:  # T51-B06: "give an integer in 0..-1" of flight data holding none
+        raise NeurohoverError(f"episode {brief(episode)} is not in the flight data: {allowed}")
     flight_data.check_again()  # arrays replaced after making: 10 readings for 100 actions gave a wrong return (T45-B06)
     check_flown(flight_data.observations[episode], flight_data.actions[episode], crash_flags(flight_data)[episode], f"flight data, episode {episode}")
-    obs = flight_data.observations[episode][1:]
-    return -float(np.einsum("ij,ij->", obs, obs))
+    squares = np.einsum("ij,ij->i", flight_data.observations[episode][1:], flight_data.observations[episode][1:])
+    budget = _crash_budget(flight_data, episode)
+    if budget is None:
+        return -float(squares.sum())
+    flown = squares.shape[0]
+    return -float(squares[: flown - 1].sum()) + crash_charge(budget, flown)
+
+
+def _crash_budget(flight_data: FlightData, episode: int) -> int | None:
+    """The control steps of the budget episode ``episode`` (a valid index) was flown to, where its metadata record it
+    crashed: its crash is charged each step left of it (:func:`observed_return`), and EC-MER's model episodes fly it. None
+    where no crash is recorded; refused where one is but no ``episode_steps`` (T51-B03)."""
+    flags = flight_data.metadata.get("crashed")
+    if not (isinstance(flags, list) and flags[episode] is True):  # checked against the episodes by FlightData
+        return None
+    steps = flight_data.metadata.get("episode_steps")
+    if type(steps) is not int:
+        raise NeurohoverError(
+            f"flight data, episode {episode}: its metadata episode_steps={brief(steps)} is not allowed: the episode crashed (crashed="
+            f"{brief(flags)}) and its crash is charged {CRASH_STEP_PENALTY:.6g} for each step left of that budget, so give an integer "
+            "(joined recordings of two budgets keep none), or the episode's return yourself (learn_ec_mer's true_return)"
+        )
+    return steps
 
 
 def _model_rows(params: np.ndarray, noise: np.ndarray) -> np.ndarray:
@@ -240,9 +270,10 @@ def learn_ec_mer(
 
     Fitness of a candidate is ``-|R_model - true_return|``, where R_model is the mean return of
     ``generic_policy`` flown on the candidate model for ``episodes`` episodes (the paper: one) of
-    the flight data's first-episode length, every candidate meeting the same gusts (common random
-    numbers from ``episode_seed``), and ``true_return`` the return observed in the flight data's
-    first episode (default: recomputed from its observations with :func:`observed_return`). Each
+    the flight data's first-episode length (its metadata's episode_steps where it crashed), every candidate meeting the
+    same gusts (common random numbers from ``episode_seed``), and ``true_return`` the return observed in the flight
+    data's first episode (default: recomputed from its observations with :func:`observed_return`, a crash's charge
+    included). Each
     candidate's noise std come from its own one-step residuals (as in LR), so the model's gusts
     match what the candidate cannot explain. Prototype and settings as in EC-MENO; genes are the
     parameters divided by |default| (EC-MENO's ``"default"`` scaling; its ``"data"`` scale is
@@ -269,7 +300,8 @@ def learn_ec_mer(
         raise NeurohoverError(
             f"true_return={brief(true_return)} is not allowed: a return is in [{-WORST_RETURN:.3g}, 0] (every reward is minus a sum of squares)"
         )
-    n_steps = int(flight_data.actions[0].shape[0])
+    # a first episode that crashed is flown to its budget: its true return holds the charge of the steps left (T51-B03)
+    n_steps = _crash_budget(flight_data, 0) or int(flight_data.actions[0].shape[0])
     if n_steps < 1:
         raise NeurohoverError("the flight data's first episode has no steps; EC-MER needs it to define the episode length")
     table = PolicyTable.from_policies([generic_policy])

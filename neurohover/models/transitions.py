@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, refuse_reloaded
+from ..errors import NeurohoverError, brief, finite_real, float64_of, refuse_reloaded
 from ..flightdata import FlightData, check_flown, crash_flags
 from ..sim.constants import GRAVITY, NOISE_DECAY, NOISE_GAIN, NOISE_NAMES, OBS_NAMES, PARAM_NAMES
 from ..tasks import MDP
@@ -222,7 +222,26 @@ def _checked_residuals(tr: object, residuals: object, batched: bool) -> np.ndarr
     if arr.dtype.kind not in "iuf" or arr.ndim < 2 or (arr.ndim > 2 and not batched) or arr.shape[-2:] != (tr.n, 6):
         given = f" of shape {arr.shape} and dtype {arr.dtype}" if isinstance(residuals, np.ndarray) else f"={brief(residuals)}"
         raise NeurohoverError(f"residuals{given} is not allowed: give a real array {shape} with N = {tr.n}, the transitions of tr")
-    return arr.astype(float, copy=False)
+    arr = float64_of(arr, copy=False)
+    bound = residual_bound(tr.n)
+    bad = np.argwhere(~(np.abs(arr) <= bound))  # NaN, +-inf and squares past float64 gave NaN or inf noise (T51-B02)
+    if bad.size:
+        at = tuple(int(i) for i in bad[0])
+        index = ", ".join(str(i) for i in at[:-1])
+        raise NeurohoverError(
+            f"residuals[{index}, {NOISE_NAMES[at[-1]]}] {brief(float(arr[at]))} is not allowed: give finite numbers in [-{bound:.6g}, {bound:.6g}] "
+            f"(the noise estimates are roots of means of their squares over the {tr.n} transitions of tr, which must stay finite)"
+        )
+    return arr
+
+
+def residual_bound(n: int) -> float:
+    """The largest size of a residual :func:`noise_from_residuals` and :func:`authors_noise` take for ``n`` transitions:
+    their squares' mean must stay finite, and the terms squared are at most 1.8 times a residual (an innovation
+    ``r_k - 0.8 r_{k-1}``) or 0.1 sqrt(3) times (a world-frame velocity step), so twice the bound, squared and summed
+    ``n`` times, stays below a quarter of float64's largest number, rounding and all (T51-B02: 1e200 gave inf with
+    NumPy's overflow warning)."""
+    return math.sqrt(float(np.finfo(np.float64).max) / n) / 4.0
 
 
 #: The stationary-rms noise estimate per unit of residual rms, ``sqrt(1 - 0.8**2) / 0.4`` = 1.5 (:func:`noise_from_residuals`):
