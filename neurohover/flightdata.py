@@ -225,8 +225,9 @@ class FlightData:
         if type(a) is int and type(b) is int:  # every episode within the budget load() checks (ninth trial)
             meta["episode_steps"] = max(a, b)
             flags, lengths = meta.get("crashed"), [n.shape[0] for n in self.actions + other.actions]
-            if isinstance(flags, list) and any(not c and n < meta["episode_steps"] for c, n in zip(flags, lengths)):
-                del meta["episode_steps"]  # a shorter budget's full episodes: no one budget holds for all (T22-01)
+            budgets = [a] * self.n_episodes + [b] * other.n_episodes  # a crash is charged for its own budget's steps left
+            if isinstance(flags, list) and any((budget if c else n) < max(a, b) for c, n, budget in zip(flags, lengths, budgets)):
+                del meta["episode_steps"]  # a shorter budget's full episodes or crashes: no one budget holds for all (T22-01)
         flown = self.metadata.get("policy_flown"), other.metadata.get("policy_flown")
         if any(f is not None for f in flown) and flown[0] != flown[1]:  # two policies flew them: EC-MER must not take one for both
             meta["policy_flown"] = None

@@ -1,7 +1,7 @@
-"""Issue 37, items left by the twenty-sixth session and closed in the twenty-seventh, and one seen on the way: an MDP made before
+"""Issue 37, items left by the twenty-sixth session and closed in the twenty-seventh, and two seen on the way: an MDP made before
 ``importlib.reload(neurohover.tasks.drift)`` was refused by evaluate as "give an MDP or a task family", although it is
 one (its Drift is of the first import): now named by its cause, as T42-B07 names a reloaded Sensor's or Drift's; FGHH
-sigmas of one set variant shared the seeded set first built."""
+sigmas of one set variant shared the seeded set first built; a crash joined with a longer budget was charged for it."""
 
 from __future__ import annotations
 
@@ -41,3 +41,21 @@ def test_fghh_sigmas_of_one_set_variant_fly_their_own_seeded_sets() -> None:
     second = nh.get_task_family("fghh", 0.2000004).test_mdps()[0]
     ratio = (np.asarray(second.params) - DEFAULT_PARAMS) / (np.asarray(first.params) - DEFAULT_PARAMS)
     assert np.allclose(ratio, 0.2000004 / 0.2000001, rtol=1e-9, atol=0)
+
+
+def test_a_crash_joined_with_a_longer_budget_keeps_no_budget() -> None:
+    """Seen while fixing T51-B03: a + b kept the longer episode_steps where only the shorter recording crashed, so
+    observed_return charged its crash for the longer budget's steps left, a wrong return without a word. Now the joined
+    recording keeps no budget, and the crashed episode's return is refused by name; the other's is its own."""
+    from neurohover.models import observed_return
+
+    mdp = nh.get_task_family("ghh08").mdp("train:0")
+    crashed = nh.evaluate(nh.prototype("slp", "zero"), mdp, record=True, n_steps=100)
+    full = nh.evaluate(nh.baseline_policy(), mdp, record=True, n_steps=200)
+    assert crashed.crashed.all() and not full.crashed.any()
+    both = crashed.flight_data + full.flight_data
+    assert "episode_steps" not in both.metadata
+    with pytest.raises(NeurohoverError, match=r"episode 0: its metadata episode_steps=None is not allowed: the episode crashed"):
+        observed_return(both, 0)
+    assert observed_return(both, 1) == pytest.approx(float(full.returns.ravel()[0]), rel=1e-12)
+    assert (full.flight_data + full.flight_data).metadata["episode_steps"] == 200  # one budget: kept

@@ -59,7 +59,7 @@ def test_an_uncrashed_episode_shorter_than_its_budget_is_refused_by_plot_and_lea
 def test_what_fly_and_older_files_record_of_short_episodes_is_taken(tmp_path: Path) -> None:
     """T22-01: what is not refused: a crash on the budget's last step (the kernel tests it after every step), a crashed
     shorter episode, a file with no crashed flags (recorded before they were) or no budget, and recordings of two budgets
-    joined (their shorter full episodes: the joined data keep no budget, as none holds for all)."""
+    joined (their shorter full episodes or crashes: the joined data keep no budget, as none holds for all)."""
     obs, act = _episodes(30, 60)
     FlightData.load(_write(tmp_path / "a.npz", [30, 60], {"episode_steps": 60, "crashed": [True, True]}))
     FlightData.load(_write(tmp_path / "b.npz", [30, 60], {"episode_steps": 60}))
@@ -68,7 +68,9 @@ def test_what_fly_and_older_files_record_of_short_episodes_is_taken(tmp_path: Pa
     long = FlightData(obs[1:], act[1:], {"episode_steps": 60, "crashed": [False]})
     assert "episode_steps" not in (short + long).metadata and (short + long).metadata["crashed"] == [False, False]
     crashed = FlightData(obs[:1], act[:1], {"episode_steps": 30, "crashed": [True]})
-    assert (crashed + long).metadata["episode_steps"] == 60  # every episode fits the longer budget
+    # every episode fits the longer budget, but the crash was charged for its own 30 (session 27: no budget kept)
+    assert "episode_steps" not in (crashed + long).metadata
+    assert (long + long).metadata["episode_steps"] == 60
     assert FlightData.load((short + long).save(tmp_path / "joined.npz")).n_episodes == 2
 
 
