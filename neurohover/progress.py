@@ -52,7 +52,25 @@ def _tqdm():
             f"environment variable {names} is not allowed: tqdm (the progress bar) cannot read it ({str(err):.80}); "
             "give what tqdm's docs allow (a number for TQDM_MININTERVAL, TQDM_POSITION and the like), or unset it"
         ) from None
+    _check_bar_format(tqdm, os.environ.get("TQDM_BAR_FORMAT"))
     return tqdm
+
+
+def _check_bar_format(tqdm, bar_format: str | None) -> None:
+    """Refuse a TQDM_BAR_FORMAT tqdm cannot draw: it is read as tqdm imports but used only when a bar is first drawn,
+    so '{bogus}' was a KeyError traceback mid-command, a store's session left 'running' (T51-A01). Drawn here as a bar's
+    first frame (no rate, no postfix yet) and a later one, of a total and of none."""
+    if bar_format is None:
+        return
+    try:
+        for n, total, elapsed, postfix in ((0, None, 0.0, None), (0, 10, 0.0, None), (3, 10, 1.2, "x"), (3, None, 1.2, "x")):
+            tqdm.format_meter(n, total, elapsed, ncols=80, prefix="unit", unit="it", bar_format=bar_format, postfix=postfix)
+    except Exception as err:  # tqdm formats the user's text with str.format: any error of it (KeyError, ValueError, IndexError, ...)
+        raise NeurohoverError(
+            f"environment variable TQDM_BAR_FORMAT={bar_format!r:.60} is not allowed: tqdm (the progress bar) cannot draw a "
+            f"bar with it ({type(err).__name__}: {str(err):.60}); give a format of tqdm's fields, e.g. '{{l_bar}}{{bar}}{{r_bar}}', "
+            "or unset it"
+        ) from None
 
 
 class _Quiet:

@@ -247,8 +247,11 @@ class Store:
                     c.execute(f"PRAGMA user_version = {SCHEMA_VERSION}")
                     c.execute(f"PRAGMA application_id = {APPLICATION_ID}")
             return self._check_schema()
-        if app != APPLICATION_ID:
-            raise NeurohoverError(f"{str(self.path)!r} is an SQLite file but not a neurohover results store; give another --store file")
+        if app != APPLICATION_ID:  # which mark is missing, and how a hand merge keeps it (T51-A02)
+            raise NeurohoverError(
+                f"{str(self.path)!r} is an SQLite file but not a neurohover results store (its PRAGMA application_id is {app}, a store's "
+                f"{APPLICATION_ID}); give another --store file, or merge stores into a copy of one neurohover wrote (docs/glossary.md, Store)"
+            )
         if version != SCHEMA_VERSION:
             newer = "a newer" if version > SCHEMA_VERSION else "an older"
             raise NeurohoverError(
