@@ -48,44 +48,25 @@ def test_a_sized_object_that_cannot_be_iterated_as_mdps_is_refused(mdps: str) ->
 # --------------------------------------------------------------------------- T51-B04, B05: sample_params' answer
 
 
-@dataclass(frozen=True)
-class Extra51(TaskFamily):
-    """A family whose sample_params draws one row too many."""
-
-    name = "extra51"
-    n_params = 11
-    param_names = _NAMES
-    row_slice = ROW_PARAMS
-    set_code = 151
+def _user_family(name: str, code: int, sample_params, doc: str) -> type[TaskFamily]:
+    """A user's family of the 11 GHH parameters (as README's Extending neurohover writes one) whose sample_params is
+    ``sample_params``."""
 
     def make(self, params, label=""):
-        return MDP("extra51", params=tuple(finite_vector(params, 11, "p").tolist()), label=label)
+        return MDP(name, params=tuple(finite_vector(params, 11, "p").tolist()), label=label)
 
-    def zero(self):
-        return MDP("extra51", label="extra51/zero")
-
-    def sample_params(self, rng, n):
-        return np.repeat(DEFAULT_PARAMS[None, :], n + 1, axis=0)
+    body = {"name": name, "n_params": 11, "param_names": _NAMES, "row_slice": ROW_PARAMS, "set_code": code, "__doc__": doc}
+    body |= {"make": make, "zero": lambda self: MDP(name, label=f"{name}/zero"), "sample_params": sample_params}
+    return dataclass(frozen=True)(type(name.title(), (TaskFamily,), body))
 
 
-@dataclass(frozen=True)
-class Flat51(TaskFamily):
-    """A family whose sample_params answers one MDP's parameters flat, shape (11,), for n=1."""
-
-    name = "flat51"
-    n_params = 11
-    param_names = _NAMES
-    row_slice = ROW_PARAMS
-    set_code = 152
-
-    def make(self, params, label=""):
-        return MDP("flat51", params=tuple(finite_vector(params, 11, "p").tolist()), label=label)
-
-    def zero(self):
-        return MDP("flat51", label="flat51/zero")
-
-    def sample_params(self, rng, n):
-        return DEFAULT_PARAMS.copy() if n == 1 else np.repeat(DEFAULT_PARAMS[None, :], n, axis=0)
+Extra51 = _user_family("extra51", 151, lambda self, rng, n: np.repeat(DEFAULT_PARAMS[None, :], n + 1, axis=0), "One row too many.")
+Flat51 = _user_family(
+    "flat51",
+    152,
+    lambda self, rng, n: DEFAULT_PARAMS.copy() if n == 1 else np.repeat(DEFAULT_PARAMS[None, :], n, axis=0),
+    "One MDP's parameters flat, shape (11,), for n=1.",
+)
 
 
 def _asked(name: str, n: int, shape: str) -> str:
@@ -133,24 +114,7 @@ def test_the_shipped_families_answers_pass_unchanged() -> None:
 _ANSWER: dict[str, object] = {}
 
 
-@dataclass(frozen=True)
-class Odd51(TaskFamily):
-    """A family whose sample_params answers whatever ``_ANSWER["value"]`` holds."""
-
-    name = "odd51"
-    n_params = 11
-    param_names = _NAMES
-    row_slice = ROW_PARAMS
-    set_code = 153
-
-    def make(self, params, label=""):
-        return MDP("odd51", params=tuple(finite_vector(params, 11, "p").tolist()), label=label)
-
-    def zero(self):
-        return MDP("odd51", label="odd51/zero")
-
-    def sample_params(self, rng, n):
-        return _ANSWER["value"]
+Odd51 = _user_family("odd51", 153, lambda self, rng, n: _ANSWER["value"], 'Whatever _ANSWER["value"] holds.')
 
 
 @pytest.mark.parametrize(
