@@ -181,7 +181,7 @@ def check_agent(name: str, family: TaskFamily | str, policy_dir: str | None = No
     spec = agent_spec(name, family)
     _refuse_idle_policy_dir(spec, policy_dir)
     if spec.needs:
-        spec.build(policies_from_set(spec, _policy_set(family, policy_dir)), AgentOptions())
+        spec.built(policies_from_set(spec, _policy_set(family, policy_dir)), AgentOptions())
 
 
 def make_agent(name: str, family: TaskFamily | str, *, policy_dir: str | None = None, options: AgentOptions = AgentOptions()) -> Agent:
@@ -198,7 +198,7 @@ def make_agent(name: str, family: TaskFamily | str, *, policy_dir: str | None = 
 
         policy_dir = str(checked_path(policy_dir, "policy_dir", "policy set's directory"))  # 3 was a TypeError (fourth trial)
     policies = policies_from_set(spec, _policy_set(family, policy_dir)) if spec.needs else AgentPolicies()
-    agent = spec.build(policies, options)
+    agent = spec.built(policies, options)  # an Agent, checked before it is marked (T52-B14)
     agent.made_for = (family.name, family.sigma)  # run_test refuses another family (tenth trial)
     return agent
 

@@ -11,7 +11,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from ..errors import settings_from_dict
+from ..errors import NeurohoverError, brief, check_name_text, refused_signature, settings_from_dict
 from ..policies import Policy
 
 if TYPE_CHECKING:
@@ -99,12 +99,12 @@ class AgentSpec:
         Which of :data:`POLICY_NEEDS` it flies.
     build : callable
         ``build(policies, options) -> Agent``: a fresh agent from an :class:`AgentPolicies` and
-        :class:`AgentOptions`.
+        :class:`AgentOptions` (its signature checked when the spec is made, its answer by :meth:`built`).
     generic_kind : str or None
         On a family with generic policies by kind (FGHH: ``"zero"``, ``"fixed"``, ``"race"``),
         which one is this agent's generic policy.
     settings : type, optional
-        Its own typed settings (an :class:`AgentSettings` dataclass), handed to ``build`` as
+        Its own typed settings (a frozen dataclass subclass of :class:`AgentSettings`), handed to ``build`` as
         ``AgentOptions.settings``; None: it has none.
     learns_models : bool
         Whether it learns LR models from its flight data (so the model options, such as the
@@ -128,13 +128,57 @@ class AgentSpec:
     summary: str = ""
 
     def __post_init__(self) -> None:
-        unknown = set(self.needs) - set(POLICY_NEEDS)
+        # NeurohoverErrors naming the value and what is allowed (they were bare ValueErrors, T52-B13)
+        check_name_text("AgentSpec name", self.name, "the agent (what --agent and experiment configs call it)")
+        needs = self.needs
+        if not isinstance(needs, (frozenset, set, tuple, list)) or not all(isinstance(n, str) for n in needs):
+            raise NeurohoverError(f"agent {self.name!r}: needs={brief(needs)} is not allowed: give a frozenset of {POLICY_NEEDS} (frozenset() for none)")
+        unknown = set(needs) - set(POLICY_NEEDS)
         if unknown:
-            raise ValueError(f"agent {self.name!r}: unknown policy needs {sorted(unknown)}; allowed {POLICY_NEEDS}")
-        if self.runs_on not in FAMILY_CONDITIONS:
-            raise ValueError(f"agent {self.name!r}: runs_on={self.runs_on!r}; allowed {FAMILY_CONDITIONS}")
+            raise NeurohoverError(f"agent {self.name!r}: unknown policy needs {sorted(unknown)}; allowed {POLICY_NEEDS}")
+        object.__setattr__(self, "needs", frozenset(needs))  # a set or a list, as a frozen spec holds it (hashable)
+        if not isinstance(self.runs_on, str) or self.runs_on not in FAMILY_CONDITIONS:
+            raise NeurohoverError(f"agent {self.name!r}: runs_on={brief(self.runs_on)}; allowed {FAMILY_CONDITIONS}")
+        kinds = tuple(kind for kind, _ in FGHH_GENERIC_KINDS)
+        if self.generic_kind is not None and (not isinstance(self.generic_kind, str) or self.generic_kind not in kinds):
+            raise NeurohoverError(f"agent {self.name!r}: generic_kind={brief(self.generic_kind)} is not allowed: give one of {kinds}, or None")
         if self.runs_on != "specialised" and "generic" in self.needs and self.generic_kind is None:
-            raise ValueError(f"agent {self.name!r} flies a generic policy on families with generics by kind: name its generic_kind")
+            raise NeurohoverError(
+                f"agent {self.name!r} (runs_on={self.runs_on!r}) flies a generic policy on families with generics by kind: "
+                f"name its generic_kind (one of {kinds})"
+            )
+        self._check_build_and_settings()
+
+    def _check_build_and_settings(self) -> None:
+        """Refuse a ``build`` that cannot be called as ``build(policies, options)`` (a TypeError at make_agent, T52-B14)
+        and ``settings`` that are no frozen AgentSettings dataclass (an AttributeError or TypeError once settings were
+        given, T52-B15)."""
+        build = self.build
+        if not callable(build):
+            raise NeurohoverError(f"agent {self.name!r}: build={brief(build)} is not allowed: give a callable; {_BUILD}")
+        refused = refused_signature(build, 2)
+        if refused:
+            raise NeurohoverError(
+                f"agent {self.name!r}: build of signature {brief(refused)} is not allowed: it is called as build(policies, options); "
+                "give a callable of those two arguments answering an Agent"
+            )
+        cls = self.settings
+        if cls is None or (isinstance(cls, type) and issubclass(cls, AgentSettings) and _frozen_dataclass(cls)):
+            return
+        raise NeurohoverError(
+            f"agent {self.name!r}: settings={brief(cls)} is not allowed: give a frozen dataclass subclass of "
+            "neurohover.agents.spec.AgentSettings (@dataclass(frozen=True) class MySettings(AgentSettings): ...), or None (no settings)"
+        )
+
+    def built(self, policies: AgentPolicies, options: AgentOptions) -> Agent:
+        """``build(policies, options)``, its answer checked to be an :class:`~neurohover.agents.protocol.Agent` (None or a
+        Policy was an AttributeError or FrozenInstanceError where make_agent marked it, T52-B14)."""
+        from .protocol import Agent
+
+        agent = self.build(policies, options)
+        if not isinstance(agent, Agent):
+            raise NeurohoverError(f"agent {self.name!r}: its build answered {brief(agent)}, which is not allowed: {_BUILD}")
+        return agent
 
     def applies_to(self, family: TaskFamily) -> bool:
         """Whether the agent runs on ``family`` (its :attr:`runs_on` condition)."""
@@ -147,3 +191,13 @@ class AgentSpec:
         from ..tasks import get_task_family, task_names
 
         return tuple(name for name in task_names() if self.applies_to(get_task_family(name)))  # run-time entries too (T46-B07)
+
+
+#: What a spec's ``build`` must be, for messages.
+_BUILD = "build(policies, options) (an AgentPolicies and an AgentOptions) must answer an Agent (neurohover.agents.protocol.Agent)"
+
+
+def _frozen_dataclass(cls: type) -> bool:
+    """Whether ``cls`` is a frozen dataclass (itself or by inheritance)."""
+    params = getattr(cls, "__dataclass_params__", None)
+    return dataclasses.is_dataclass(cls) and params is not None and bool(params.frozen)

@@ -389,7 +389,7 @@ def unit_agent(p: dict, device: str = "cpu"):
         ),
         settings=None if spec.settings is None else spec.settings.from_unit(p),  # the agent's own, typed (from its UNIT_KEY)
     )
-    return spec.build(policies, options)
+    return spec.built(policies, options)
 
 
 def run_test_run(p: dict, threads: int | None, device: str = "cpu") -> dict:
