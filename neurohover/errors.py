@@ -296,6 +296,28 @@ def registry_entry_problem(registry: str, name: object, value: object, kind: typ
     return ""
 
 
+def package_path(package: object, example: str, contents: str) -> list[str]:
+    """The ``__path__`` of the package called ``package`` (an extension point's ``discover``); NeurohoverError naming a
+    value that is no dotted name, a package that is not importable or a module that is not a package (they leaked
+    ValueError, ModuleNotFoundError, TypeError or AttributeError; T44-B06, T52-B16). ``example``: a package's name to
+    give; ``contents``: what its modules are ("agent modules")."""
+    import importlib
+
+    allowed = f"give an importable package's dotted name, e.g. {example!r}"
+    if not isinstance(package, str) or not all(part.isidentifier() for part in package.split(".")):
+        raise NeurohoverError(f"package={brief(package)} is not allowed: {allowed}")
+    try:
+        module = importlib.import_module(package)
+    except ModuleNotFoundError as err:  # the package itself (or a package above it), not a module its code imports
+        if err.name is None or not (package == err.name or package.startswith(f"{err.name}.")):
+            raise
+        raise NeurohoverError(f"package={package!r} is not allowed: no module named {err.name!r} is importable; {allowed}") from None
+    path = getattr(module, "__path__", None)
+    if path is None:
+        raise NeurohoverError(f"package={package!r} is not allowed: it is a module, not a package of {contents}; {allowed}")
+    return list(path)
+
+
 def reloaded_text(cls: type) -> str:
     """Why a ``cls`` of another import of its module is refused, as a message's reason: after ``importlib.reload`` of a
     neurohover module its classes are new class objects, while neurohover's other modules hold the first ones, so an

@@ -16,6 +16,7 @@ import neurohover as nh
 import neurohover.tasks as T
 from neurohover.errors import NeurohoverError
 from neurohover.evolution import races
+from neurohover.sim.constants import WIND_CONSTANT
 from tests.store_edits import edited_policy_set
 
 
@@ -52,8 +53,14 @@ def test_results_holding_arrays_compare_by_value(result) -> None:
 
 @pytest.fixture
 def mine(monkeypatch):
-    """A task family registered at run time, as ``TASK_FAMILIES["mine"] = Mine``."""
-    cls = dataclasses.dataclass(frozen=True)(type("Mine", (T.GHH08,), {"name": "mine", "set_code": 98}))
+    """A task family registered at run time, as ``TASK_FAMILIES["mine"] = Mine``: GHH-08's under a name of its own, its
+    make and zero its own (the inherited ones answer ghh08 MDPs, refused as mine's; T52-B05)."""
+
+    def make(self, params, label=""):
+        return T.MDP("mine", wind_kind=WIND_CONSTANT, wind=tuple(T.finite_vector(params, 2, "wind").tolist()), label=label)
+
+    body = {"name": "mine", "set_code": 98, "make": make, "zero": lambda self: T.MDP("mine", label="mine/zero")}
+    cls = dataclasses.dataclass(frozen=True)(type("Mine", (T.GHH08,), body))
     monkeypatch.setitem(T.TASK_FAMILIES, "mine", cls)
     return cls
 

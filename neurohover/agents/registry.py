@@ -14,7 +14,7 @@ from collections.abc import Mapping, Sequence
 from types import MappingProxyType
 from typing import cast
 
-from ..errors import NeurohoverError, brief, registry_entry_problem
+from ..errors import NeurohoverError, brief, package_path, registry_entry_problem
 from ..integrations.flying import generic_sigma_problem
 from ..policysets import PolicySet, load_policy_set
 from ..tasks import TaskFamily, get_task_family
@@ -50,21 +50,9 @@ def discover(package: str) -> dict[str, AgentSpec]:
 
 def _package_path(package: object) -> list[str]:
     """The ``__path__`` of the package called ``package``; NeurohoverError naming a value that is no dotted name, a
-    package that is not importable or a module that is not a package (they leaked ValueError, ModuleNotFoundError,
-    TypeError or AttributeError; T44-B06)."""
-    allowed = f"give an importable package's dotted name, e.g. {__package__!r}"
-    if not isinstance(package, str) or not all(part.isidentifier() for part in package.split(".")):
-        raise NeurohoverError(f"package={brief(package)} is not allowed: {allowed}")
-    try:
-        module = importlib.import_module(package)
-    except ModuleNotFoundError as err:  # the package itself (or a package above it), not a module its code imports
-        if err.name is None or not (package == err.name or package.startswith(f"{err.name}.")):
-            raise
-        raise NeurohoverError(f"package={package!r} is not allowed: no module named {err.name!r} is importable; {allowed}") from None
-    path = getattr(module, "__path__", None)
-    if path is None:
-        raise NeurohoverError(f"package={package!r} is not allowed: it is a module, not a package of agent modules; {allowed}")
-    return list(path)
+    package that is not importable or a module that is not a package (T44-B06; :func:`~neurohover.errors.package_path`,
+    which the task families' discover shares)."""
+    return package_path(package, __package__, "agent modules")
 
 
 #: Every agent by name, in a stable order. A run-time entry is an AgentSpec under its own name; a shipped name holds its

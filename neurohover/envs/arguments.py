@@ -165,10 +165,17 @@ def check_against_id(spec: Any, family: TaskFamily, episode_steps: int, limit: i
             for i, r in gym.registry.items()
             if i.startswith("neurohover/") and r.kwargs.get("task") == family.name and r.entry_point == registered.entry_point
         ]
-        raise NeurohoverError(
-            f"{spec.id} is the {task} task family: task={family.name!r} conflicts with it; make a {family.name} id instead"
-            + (f" ({', '.join(ids[:3])})" if ids else "")
+        # a family registered at run time has no neurohover id (register_envs makes them for the shipped ones): "make a
+        # wide id instead" named none (T52-B06)
+        known = any(i.startswith("neurohover/") and r.kwargs.get("task") == family.name for i, r in gym.registry.items())
+        instead = (
+            f"make a {family.name} id instead" + (f" ({', '.join(ids[:3])})" if ids else "")
+            if known
+            else f"neurohover has no id for it (its ids are the shipped families'): build neurohover.envs.HoverEnv(task={family.name!r}) "
+            f"(or HoverVectorEnv) directly, or register an id of your own with gymnasium.register(id=..., entry_point={registered.entry_point!r}, "
+            f"kwargs={{'task': {family.name!r}}})"
         )
+        raise NeurohoverError(f"{spec.id} is the {task} task family: task={family.name!r} conflicts with it; {instead}")
     if registered.namespace == "neurohover":
         _refuse_lost_variant(spec, family, drift)
     applied = _make_time_limit(registered.max_episode_steps) if limit is None else limit

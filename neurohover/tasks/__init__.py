@@ -26,7 +26,7 @@ import importlib
 import pkgutil
 from types import MappingProxyType
 
-from ..errors import NeurohoverError, brief, finite_real, refuse_reloaded, registry_entry_problem
+from ..errors import NeurohoverError, brief, finite_real, package_path, refuse_reloaded, registry_entry_problem
 from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, competition_rows, finite_vector
 from .drift import NO_DRIFT, Drift, refuse_drift
 from .fghh import COMPETITION_FGHH_SIGMA, FGHH
@@ -39,17 +39,27 @@ _FIRST = ("ghh08", "ghh09", "fghh")  # the paper's order in help texts; other fa
 
 
 def discover(package: str) -> dict[str, type[TaskFamily]]:
-    """The ``TASK_FAMILY`` class of every module of ``package``, by family name."""
+    """The ``TASK_FAMILY`` class of every module of ``package`` (an importable package's dotted name, e.g.
+    ``"neurohover.tasks"``), by family name, in a stable order; modules whose names start with ``_`` are not imported (as
+    the agents' discover). A ``TASK_FAMILY`` that is no TaskFamily subclass with a name of its own, a name declared twice
+    and a bad package are refused by name (an AttributeError 'name', a ModuleNotFoundError; T52-B16)."""
+    path = package_path(package, __name__, "task family modules")
     names = sorted(
-        (m.name for m in pkgutil.iter_modules(importlib.import_module(package).__path__)), key=lambda n: (_FIRST.index(n) if n in _FIRST else len(_FIRST), n)
+        (m.name for m in pkgutil.iter_modules(path) if not m.name.startswith("_")), key=lambda n: (_FIRST.index(n) if n in _FIRST else len(_FIRST), n)
     )
     found: dict[str, type[TaskFamily]] = {}
     for module in names:
         cls = getattr(importlib.import_module(f"{package}.{module}"), "TASK_FAMILY", None)
-        if cls is not None:
-            if cls.name in found:
-                raise RuntimeError(f"task family {cls.name!r} is declared twice")
-            found[cls.name] = cls
+        if cls is None:
+            continue
+        if not (isinstance(cls, type) and issubclass(cls, TaskFamily) and cls.__dict__.get("name")):
+            raise NeurohoverError(
+                f"module {package}.{module}'s TASK_FAMILY={brief(cls)} is not allowed: declare a TaskFamily subclass (the class, not an instance) "
+                "that sets a name of its own"
+            )
+        if cls.name in found:
+            raise NeurohoverError(f"task family {cls.name!r} is declared twice (module {package}.{module} and another): give each family a name of its own")
+        found[cls.name] = cls
     return found
 
 

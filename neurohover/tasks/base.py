@@ -48,8 +48,10 @@ MAX_MAGNITUDE = 10_000.0
 #: How far substeps x dt may lie from the control step they integrate (a learned model: 1 x 0.1 s; the simulator 10 x 0.01 s).
 COVER_TOLERANCE = 1e-9
 _SET_ENTROPY = 20110401  # fixed root of the seeded training and test sets (the paper's year)
-_FIXED_SETS: dict[tuple[str, int, float | None, int, Sensor, Drift], tuple[MDP, ...]] = {}
-_ROW_LAYOUTS: dict[tuple[str, int, Sensor], np.ndarray] = {}
+#: The fixed sets and row templates built, by the family's class (not its name: a subclass of GHH08 that kept the name
+#: "ghh08" replaced GHH-08's sets, and a user's family defined again kept the first definition's; T52-B01, T52-B02).
+_FIXED_SETS: dict[tuple[type, int, float | None, int, Sensor, Drift], tuple[MDP, ...]] = {}
+_ROW_LAYOUTS: dict[tuple[type, int, Sensor], np.ndarray] = {}
 COMPETITION_MDPS_FILE = Path(__file__).parent.parent / "data" / "competition-mdps.json"
 _COMPETITION: dict[str, dict] = {}
 #: The keys of :meth:`MDP.to_dict`'s table that :meth:`MDP.from_dict` needs (``label``, ``d_u``, ``sensor``, ``drift`` may be left out).
@@ -364,7 +366,7 @@ class TaskFamily:
             register_family(cls)
         for name in ("make", "zero"):  # the one place a family's MDPs get its sensor
             if name in cls.__dict__:
-                setattr(cls, name, through_sensor(cls.__dict__[name]))
+                setattr(cls, name, through_sensor(cls.__dict__[name], name, MDP))
         if "competition_params" in cls.__dict__:
             cls.competition_params = _checked_competition_row(cls.__dict__["competition_params"])  # type: ignore[method-assign]
         if "sample_params" in cls.__dict__:
@@ -445,7 +447,7 @@ class TaskFamily:
 
     def row_template(self) -> np.ndarray:
         """The kernel row every sampled MDP shares outside :attr:`row_slice` (checked once against :meth:`make`)."""
-        key = (self.name, self.set_variant(), self.sensor)
+        key = (type(self), self.set_variant(), self.sensor)
         if key not in _ROW_LAYOUTS:
             probe = self.sample_params(np.random.default_rng(0), 1)[0]
             template = self.make(probe).row()
@@ -487,7 +489,7 @@ class TaskFamily:
 
     def _seeded_set(self, which: int, n: int, kind: str) -> list[MDP]:
         # the family's own sigma too: sigmas of one variant (0.2000001, 0.2000004) draw from one seed, but not one set
-        key = (self.name, self.set_variant(), getattr(self, "sigma", None), which, self.sensor, self.drift)
+        key = (type(self), self.set_variant(), getattr(self, "sigma", None), which, self.sensor, self.drift)
         if key not in _FIXED_SETS:  # MDPs are immutable, so each set is built once per process
             rng = np.random.default_rng(np.random.SeedSequence([_SET_ENTROPY, self.set_code, which, self.set_variant()]))
             with family_code():  # the set's own labels name it: checking them would build the set again
@@ -495,7 +497,7 @@ class TaskFamily:
         return list(_FIXED_SETS[key])
 
     def _competition_set(self, kind: str) -> list[MDP]:
-        key = (self.name, -1, None, 0 if kind == "train" else 1, self.sensor, self.drift)
+        key = (type(self), -1, None, 0 if kind == "train" else 1, self.sensor, self.drift)
         if key not in _FIXED_SETS:
             rows = competition_rows(self.name)[kind]
             with family_code():  # as _seeded_set's

@@ -1,5 +1,5 @@
 """The checks :class:`~neurohover.tasks.base.TaskFamily` puts around a family's own methods as the family class is defined:
-its ``make`` and ``zero`` give MDPs through its sensor and drift, and its ``sample_params`` is called with a checked
+its ``make`` and ``zero`` answer MDPs of the family (checked) through its sensor and drift, and its ``sample_params`` is called with a checked
 generator and count; and :func:`generator`, the one reading of an ``rng`` argument."""
 
 from __future__ import annotations
@@ -13,13 +13,16 @@ from ..sim.rng import MAX_SEED
 from .held import check_label, family_code
 
 
-def through_sensor(method):
-    """``method`` (a family's make or zero) with the family's sensor and drift put on the MDP it returns."""
+def through_sensor(method, which: str, mdp_class: type):
+    """``method`` (a family's make or zero) with its answer checked (:func:`check_made`) and the family's sensor and drift
+    put on the MDP it returns; ``which``: the method's name, ``mdp_class``: the MDP class of the module that defined the
+    family (after ``importlib.reload`` of tasks.base the shipped families still build the first import's)."""
 
     @functools.wraps(method)
     def made(self, *args, **kwargs):
         with family_code():  # what the family's own code builds, it holds: not checked again (tasks.held)
             mdp = method(self, *args, **kwargs)
+            check_made(self, which, mdp, mdp_class)
             if not self.sensor.exact:
                 mdp = mdp.with_sensor(self.sensor)
             mdp = mdp if self.drift.none else mdp.with_drift(self.drift)
@@ -27,6 +30,26 @@ def through_sensor(method):
         return mdp
 
     return made
+
+
+def check_made(family, method: str, mdp: object, mdp_class: type) -> None:
+    """Refuse what a family's ``make`` or ``zero`` answered where it is no MDP of the family (an MDP whose family is the
+    family's name): None was an AttributeError 'label' (T52-B04), and a renamed subclass of a shipped family, whose
+    inherited make and zero answer the shipped family's MDPs, was refused only at run_test (T52-B05)."""
+    name = family.name
+    if not isinstance(mdp, mdp_class):
+        raise NeurohoverError(f"{name} {method}()'s answer {brief(mdp)} is not allowed: it must be an MDP of the family, neurohover.MDP({name!r}, ...)")
+    if mdp.family != name:  # type: ignore[attr-defined]
+        owner = next(c for c in type(family).__mro__ if method in c.__dict__)
+        inherited = (
+            ""
+            if owner is type(family)
+            else f" ({type(family).__name__} inherits {method} from {owner.__name__}: a renamed subclass must override make and zero)"
+        )
+        raise NeurohoverError(
+            f"{name} {method}()'s answer {brief(mdp.label or mdp)} is not allowed: it is a {mdp.family!r} MDP, but make and zero must answer "  # type: ignore[attr-defined]
+            f"MDPs of {name!r}, neurohover.MDP({name!r}, ...){inherited}"
+        )
 
 
 MAX_SAMPLES = 10**7  # MDPs drawn in one call (their rows: 2.9 GB)

@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING
 
 from ..errors import NeurohoverError, brief, check_name_text, finite_real, other_import, real_number, reloaded_text, whole_number
 from ..sim.constants import MDP_ROW_LEN, WIND_CONSTANT, WIND_NONE, WIND_SINUSOID
+from ..sim.rng import MAX_SEED
 
 if TYPE_CHECKING:
     from .base import MDP
@@ -212,4 +213,6 @@ def _class_problem(cls) -> str:
         return f"its param_bounds {brief(bounds)} is not allowed: give (low, high), two finite numbers with low < high, the range of each parameter"
     if cls.wind_kind not in (WIND_NONE, WIND_CONSTANT, WIND_SINUSOID) or isinstance(cls.wind_kind, bool):
         return f"its wind_kind {brief(cls.wind_kind)} is not allowed: give {WIND_NONE} (none), {WIND_CONSTANT} (constant) or {WIND_SINUSOID} (sinusoidal)"
+    if not whole_number(cls.set_code) or not 0 <= cls.set_code <= MAX_SEED:  # 1.5 was NumPy's TypeError at training_mdps() (T52-B03)
+        return f"its set_code {brief(cls.set_code)} is not allowed: give an integer in 0..2**63-1, a seed that distinguishes its seeded fixed sets"
     return ""
