@@ -281,8 +281,9 @@ def _store_failure(args: argparse.Namespace, err: sqlite3.DatabaseError) -> str:
 
 
 def _prints_only(args: argparse.Namespace) -> bool:
-    """Whether the command ``args`` gives its result on standard output only (no output file of its own)."""
-    if args.command in ("demo", "bench", "settings", "wins"):
+    """Whether the command ``args`` gives a result on standard output only: no output file of its own, or a --json
+    summary asked for beside its files (evolve --json, fly --record F --json exited 0 with the JSON lost; T52-A01)."""
+    if args.command in ("demo", "bench", "settings", "wins") or getattr(args, "json", None) is True:
         return True
     only_stdout = {"results": "out", "fly": "record", "evaluate-agent": "json"}
     if args.command in only_stdout:
@@ -295,6 +296,8 @@ def _refuse_closed_stdout(args: argparse.Namespace) -> None:
     sys.stdout is then None; results raised AttributeError, fly and wins lost their output without a word; T28-A01)."""
     if sys.stdout is None and _prints_only(args):
         instead = " (or write them to a file with --out FILE)" if args.command == "results" else ""
+        if getattr(args, "json", None) is True and (args.command == "evolve" or getattr(args, "record", None) is not None):
+            instead = " (or leave out --json: its files are written without it)"
         raise NeurohoverError(f"standard output is closed: this command prints its results there; run it with standard output open{instead}")
 
 

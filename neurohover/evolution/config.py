@@ -88,15 +88,23 @@ class Resampling:
         if self.kind == "fixed":
             return f"fixed:{self.k}"
         if self.kind in BANDITS:
-            return f"{self.kind}:{self.delta:g}"
+            return f"{self.kind}:{_delta_text(self.delta)}"
         if self.auto:
             return "race:auto" + ("" if self.k == AUTO_K else f":{self.k}")
-        return f"race:{self.delta:g}" + ("" if self.rule == "prose" else f":{self.rule}")
+        return f"race:{_delta_text(self.delta)}" + ("" if self.rule == "prose" else f":{self.rule}")
 
     @property
     def selects(self) -> bool:
         """Whether it selects the parents itself (a race or a bandit), so it needs generational evolution."""
         return self.kind != "fixed"
+
+
+def _delta_text(delta: float | None) -> str:
+    """``delta`` as a label writes it: '%g' where that reads back as the same number (race:0.05, as every label so far),
+    else Python's shortest exact text: race:0.1234567891 was recorded as race:0.123457, and a resume given the recorded
+    label was refused as a damaged checkpoint (T52-A02)."""
+    short = f"{delta:g}" if delta is not None else "None"  # None: a race:auto's, which its label does not write
+    return short if delta is None or float(short) == delta else repr(delta)
 
 
 #: race:auto (the paper leaves delta open: Section 7 asks for an automatic choice). The cost a race should have is
@@ -242,8 +250,8 @@ def make_settings(method: str, optimizer: str, settings) -> Any:
     ``optimizer``: a population optimiser's settings dataclass (:mod:`.optimisers`), or the
     neuroevolution's with the budget left None (the run counts the budget in episodes itself). In a dict, the text
     ``"none"`` (any case: the command line's ``--setting KEY=none``) is None for a setting that takes None."""
-    if optimizer != NE:
-        return population_settings(optimizer, settings)
+    if optimizer != NE:  # CMA-ES's popsize=none was refused as "must be None or an integer" (T52-A03)
+        return population_settings(optimizer, _none_texts(settings, _settings_class(optimizer)))
     cls = SteadyStateSettings if method == "steady-state" else GenerationalSettings
     if settings is None:
         return cls()
@@ -273,12 +281,28 @@ def make_settings(method: str, optimizer: str, settings) -> Any:
             raise NeurohoverError(f"unknown {method} preset {name!r}: allowed {', '.join(presets)}")
         values = {**dataclasses.asdict(presets[name]), **values}
         values.pop("budget")
-    optional = {f.name for f in dataclasses.fields(cls) if "None" in str(f.type)}
-    values = {k: None if k in optional and isinstance(v, str) and v.lower() == "none" else v for k, v in values.items()}  # --setting KEY=none (T37-A04)
+    values = _none_texts(values, cls)  # --setting KEY=none (T37-A04)
     try:
         return cls(**values)
     except ValueError as err:
         raise NeurohoverError(f"bad {method} settings: {err}") from None
+
+
+def _settings_class(optimizer: str) -> type | None:
+    """The settings dataclass of population optimiser ``optimizer`` (None for a name the registry refuses: its own check
+    says why)."""
+    try:
+        return optimiser_spec(optimizer).settings
+    except NeurohoverError:
+        return None
+
+
+def _none_texts(settings: Any, cls: type | None) -> Any:
+    """``settings`` with the text "none" (any case) as None for each field of the dataclass ``cls`` that takes None."""
+    if not isinstance(settings, Mapping) or cls is None or not dataclasses.is_dataclass(cls):
+        return settings
+    optional = {f.name for f in dataclasses.fields(cls) if "None" in str(f.type)}
+    return {k: None if k in optional and isinstance(v, str) and v.lower() == "none" else v for k, v in settings.items()}
 
 
 def upgrade_saved_config(saved: dict) -> dict:
