@@ -10,14 +10,46 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, real_number
+from ..errors import NeurohoverError, brief, finite_real, real_number, refused_signature
 from ..sim.constants import lowest_return
-from .common import Optimiser
+from .common import STATE_DAMAGE, Optimiser, enc_float
+from .records import decode_history
 
 if TYPE_CHECKING:
     from .config import RunConfig
 
-__all__ = ["asked_genomes", "check_state_json", "told_champion"]
+__all__ = ["AnswerError", "asked_genomes", "check_made", "check_restored", "check_state_json", "checked_champion_genome", "stopped", "told_champion"]
+
+#: What a run calls of its optimiser, and with how many positional arguments (README, A new optimiser).
+CALLS = {"ask": (0,), "tell": (1, 2), "stop": (0,), "state_dict": (0,), "from_state_dict": (1,)}
+
+
+class AnswerError(NeurohoverError):
+    """An optimiser's answer refused by name: raised as it is where a checkpoint is read, not as a damaged checkpoint."""
+
+
+def check_made(opt: Any, optimizer: str, called: str = "make") -> None:
+    """AnswerError unless ``opt`` (what ``called`` answered) is an optimiser a run can use: its ask, tell, stop, state_dict
+    and from_state_dict callable with what a run gives them, and its champion_genome and champion_return readable. A make
+    answering None was an AttributeError at the first ask; a tell(self, fitness) a TypeError after the first generation
+    was flown (T52-B08, B10)."""
+    calls = ", ".join(f"{name}()" for name in CALLS)
+    for name, counts in CALLS.items():
+        method = getattr(opt, name, None)
+        if not callable(method):
+            raise AnswerError(
+                f"optimizer {brief(optimizer)}: its {called} answered {type(opt).__name__} {brief(opt)}, which has no {name}() and is not allowed: "
+                f"answer an optimiser with {calls}, champion_genome and champion_return"
+            )
+        refused = next(filter(None, (refused_signature(method, n) for n in counts)), None)
+        if refused:
+            takes = "tell(fitness, info=None) (info a TellInfo, left out on a task family)" if name == "tell" else f"{name}({'state' if counts[0] else ''})"
+            raise AnswerError(
+                f"optimizer {brief(optimizer)}: its {name} of signature {brief(refused)} is not allowed: a run calls {takes}; give one taking that"
+            )
+    for name in ("champion_genome", "champion_return"):
+        if not hasattr(opt, name):
+            raise AnswerError(f"optimizer {brief(optimizer)}: its {called} answered {type(opt).__name__} {brief(opt)}, which has no {name} and is not allowed")
 
 
 def asked_genomes(opt: Optimiser, cfg: RunConfig) -> np.ndarray:
@@ -53,6 +85,61 @@ def told_champion(opt: Optimiser, cfg: RunConfig) -> float:
     )
 
 
+def check_restored(opt: Any, state: dict, cfg: RunConfig) -> None:
+    """AnswerError naming a user optimiser's from_state_dict where its answer is no optimiser, or (on one MDP, where the
+    run's champion is its optimiser's) one whose champion_return is not the one the checkpoint's history records last:
+    one that ignored its state, or answered None, was called "a damaged checkpoint" of an intact file (T52-B12)."""
+    check_made(opt, cfg.optimizer, "from_state_dict")
+    if cfg.family is not None:
+        return
+    try:
+        history = decode_history(state["history"])
+        ret = float(opt.champion_return)
+    except STATE_DAMAGE:  # (a damaged history, or a return no number: the checks of the checkpoint name it)
+        return
+    saved = history[-1].champion_return if history else -math.inf
+    if ret != saved:
+        row = f"its last history row's, at generation {history[-1].generation:,}" if history else "its history has no row"
+        raise AnswerError(
+            f"optimizer {brief(cfg.optimizer)}: its from_state_dict answered an optimiser of champion_return {enc_float(ret)}, where the checkpoint's "
+            f"champion has return {enc_float(saved)} ({row}), which is not allowed: from_state_dict(state) gives back the optimiser whose "
+            "state_dict() wrote state, its champion too"
+        )
+
+
+def checked_champion_genome(opt: Optimiser, cfg: RunConfig) -> np.ndarray | None:
+    """The optimiser's champion_genome, checked where it is the run's champion: None (no champion yet) or real numbers of
+    the genome's shape, finite. 'x' was "could not convert string to float", a ragged list NumPy's inhomogeneous shape, a
+    table a TypeError, and a complex genome taken with only NumPy's ComplexWarning (T52-B07)."""
+    genome = opt.champion_genome
+    if genome is None:
+        return None
+    d = cfg.prototype.genome.size
+    try:
+        a = np.asarray(genome) if isinstance(genome, (np.ndarray, list, tuple)) else None
+    except (ValueError, TypeError):  # a ragged list
+        a = None
+    if a is not None and a.dtype.kind in "fiu" and a.shape == (d,):
+        if np.isfinite(a).all():
+            return a.astype(float)
+        gave = f"genes NaN or infinite ({', '.join(map(str, np.flatnonzero(~np.isfinite(a))[:5]))}...)"
+    else:
+        gave = f"{type(genome).__name__} {brief(genome)}" + ("" if a is None else f" (shape {a.shape}, dtype {a.dtype})")
+    raise NeurohoverError(
+        f"optimizer {brief(cfg.optimizer)}: its champion_genome {gave} is not allowed: give None (no champion yet) or a NumPy array of real numbers of "
+        f"shape ({d},), the {cfg.topology} topology's {d} finite genes"
+    )
+
+
+def stopped(opt: Optimiser, optimizer: str) -> bool:
+    """The answer of the optimiser's stop(), checked to be a bool (Python's or NumPy's): "yes", None and [] were taken by
+    their truth (T52-B11)."""
+    answer = opt.stop()
+    if isinstance(answer, (bool, np.bool_)):
+        return bool(answer)
+    raise AnswerError(f"optimizer {brief(optimizer)}: its stop() answered {type(answer).__name__} {brief(answer)}, which is not allowed: answer True or False")
+
+
 def check_state_json(state: Any, optimizer: str) -> None:
     """NeurohoverError naming the first entry of optimiser state ``state`` that strict JSON cannot write (an np.float32,
     an array, NaN): ``state_dict()`` returns a plain JSON-serialisable snapshot (:class:`~.common.Optimiser`)."""
@@ -67,23 +154,30 @@ def check_state_json(state: Any, optimizer: str) -> None:
         )
 
 
-def _unwritable(value: Any, at: str) -> tuple[str, Any] | None:
-    """Where in ``value`` (its path from ``at``, and what is there) strict JSON cannot write, or None where it can."""
-    try:
-        json.dumps(value, allow_nan=False)
-        return None
-    except (TypeError, ValueError, RecursionError):
-        pass
+def _unwritable(value: Any, at: str, writable: bool | None = None) -> tuple[str, Any] | None:
+    """Where in ``value`` (its path from ``at``, and what is there) strict JSON cannot write, or writes as another value
+    (a key that is no text comes back as text, a tuple as a list: T52-B17), or None where it writes ``value`` as it is.
+    ``writable``: whether ``json.dumps`` writes it (None: not yet asked)."""
+    if writable is None:
+        try:
+            json.dumps(value, allow_nan=False)
+            writable = True
+        except (TypeError, ValueError, RecursionError):
+            writable = False
+    if isinstance(value, tuple):
+        return f"{at} (a tuple, which JSON writes as a list)", value
     if isinstance(value, dict):
         for key, item in value.items():
             if not isinstance(key, str):
-                return f"{at}[{brief(key)}] (a key that is no text)", key
-            found = _unwritable(item, f"{at}[{key!r}]")
+                return f"{at}[{brief(key)}] (a key that is no text, which JSON writes as text)", key
+            found = _unwritable(item, f"{at}[{key!r}]", True if writable else None)
             if found is not None:
                 return found
-    elif isinstance(value, (list, tuple)):
+    elif isinstance(value, list):
         for i, item in enumerate(value):
-            found = _unwritable(item, f"{at}[{i}]")
+            found = _unwritable(item, f"{at}[{i}]", True if writable else None)
             if found is not None:
                 return found
-    return at, value
+    elif not writable:
+        return at, value
+    return None

@@ -17,6 +17,7 @@ import numpy as np
 from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..flyer import MAX_EPISODE_INDEX
 from ..sim.constants import CRASH_STEP_PENALTY, MAX_SECONDS, seconds_allowed
+from .answers import stopped
 from .common import EntryError, Optimiser, check_entries, check_genomes, damage_text, dec_array, dec_float, enc_float
 from .config import MAX_BUDGET, Resampling
 from .fitness import fitness_range, in_fitness_range
@@ -56,8 +57,8 @@ def stop_reason(method: str, opt: Optimiser, budget: int | None, episodes: int, 
     if generation == 0:
         return None
     if method in OPTIMISERS:
-        return OPTIMISERS[method].stop_reason if opt.stop() else None
-    if opt.stop():
+        return OPTIMISERS[method].stop_reason if stopped(opt, method) else None
+    if stopped(opt, method):
         return "plateau" if method == "steady-state" else "generations"
     return None
 

@@ -25,13 +25,13 @@ from ..flyer import KernelFlyer
 from ..launch import Parking
 from ..policies import Policy
 from ..sim.lanes import LANES
-from .answers import asked_genomes, check_state_json, told_champion
+from .answers import AnswerError, asked_genomes, check_made, check_restored, check_state_json, checked_champion_genome, told_champion
 from .bandits import BANDITS, top_mu_bandit
 from .common import STATE_DAMAGE, Optimiser, TellInfo, damage_text, enc_float
 from .config import RACE_T_LIMIT, RunConfig, next_auto_delta, preset_hint, upgrade_saved_config
 from .fitness import episode_fitness
 from .generational import GenerationalNE
-from .optimisers import OPTIMISERS, recorded_names
+from .optimisers import OPTIMISERS, SHIPPED, recorded_names
 from .race_sampler import RaceSampler
 from .races import fixed_resampling, selection_race
 from .records import (
@@ -113,6 +113,7 @@ class Run:
         self.opt: Optimiser
         if self.method in OPTIMISERS:
             self.opt = OPTIMISERS[self.method].make(genome, settings, seed)
+            check_made(self.opt, config.optimizer)  # None was an AttributeError at the first ask (T52-B08)
         elif self.method == "steady-state":
             self.opt = SteadyStateNE(genome, settings, seed=seed)
         else:
@@ -177,6 +178,8 @@ class Run:
             opt = type(self.opt).from_state_dict(state["optimizer_state"])
         except STATE_DAMAGE as err:  # from_state_dict names the damaged entry; a state's own class may raise more
             raise NeurohoverError(f"{source}: cannot restore the optimiser ({damage_text(err)})") from None
+        if self.method in OPTIMISERS and self.method not in SHIPPED:  # named, not "a damaged checkpoint" (T52-B12)
+            check_restored(opt, state, self.cfg)
         mine, theirs = (getattr(o, "settings", None) for o in (self.opt, opt))  # the state's own copy was flown, unchecked
         if dataclasses.is_dataclass(mine) and dataclasses.is_dataclass(theirs) and not isinstance(mine, type) and not isinstance(theirs, type):
             differs = config_difference("optimizer_state.settings", dataclasses.asdict(theirs), dataclasses.asdict(mine))
@@ -194,6 +197,8 @@ class Run:
                 check_stream(state["mdp_stream"], type(self.mdp_rng.bit_generator).__name__)
                 stream = np.random.Generator(type(self.mdp_rng.bit_generator)())
                 stream.bit_generator.state = state["mdp_stream"]
+        except AnswerError:  # the optimiser's answer (its stop()), not the file
+            raise
         except (KeyError, TypeError, ValueError, AttributeError, IndexError, OverflowError) as err:
             raise damaged(source, err) from None
         counts, seconds = parts["counters"], parts["seconds"]
@@ -452,7 +457,7 @@ class Run:
     def _champion_genome(self) -> np.ndarray | None:
         if self.method in OPTIMISERS and self.family is not None:
             return self.champion_genome
-        return self.opt.champion_genome
+        return checked_champion_genome(self.opt, self.cfg)
 
     def result(self) -> EvolutionResult:
         """The run's :class:`EvolutionResult` (NeurohoverError if no candidate had a finite fitness)."""

@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import NeurohoverError, brief, registry_entry_problem, settings_from_dict
+from ...errors import NeurohoverError, brief, refused_signature, registry_entry_problem, settings_from_dict
 
 __all__ = [
     "NE",
@@ -63,7 +63,7 @@ class OptimiserSpec:
     summary : str
         One line for help texts.
     settings : type
-        A frozen dataclass of its settings, with defaults; its ``__post_init__`` raises
+        A frozen dataclass of its settings, with defaults of plain JSON values; its ``__post_init__`` raises
         ValueError on a bad value.
     make : callable
         ``make(prototype genome, settings, seed)`` -> an optimiser with ``ask``, ``tell(fitness, info)``,
@@ -72,7 +72,7 @@ class OptimiserSpec:
     min_genes : int
         The shortest genome it can search.
     stop_reason : str
-        What a run records when the optimiser's own ``stop()`` ends it.
+        What a run records when the optimiser's own ``stop()`` (a bool) ends it: one printable line, not ``'budget'``.
     label : str
         The ``method`` written in a champion's metadata (default: the name).
     stops_itself : bool
@@ -134,7 +134,51 @@ def entry_problem(name: object, spec: object) -> str:
         return f"{entry}: a run-time optimiser's name is one line of at most 64 letters, digits and ._+- (not {NE!r}), which its records name as user:NAME"
     if spec.label != name:
         return f"{entry}: its label {brief(spec.label)} is not its name; a run-time optimiser records its name as its method (user:{name}): leave label out"
+    return _parts_problem(entry, spec)
+
+
+def _parts_problem(entry: str, spec: OptimiserSpec) -> str:
+    """What is wrong with a run-time spec's make, settings, stops_itself and stop_reason ('' when nothing): a make of
+    the wrong arity or none was a TypeError at the run's start, a settings class that is no frozen dataclass or has a
+    default JSON cannot write one in its config, a truthy stops_itself='no' ran without a budget for ever, and a
+    stop_reason 'budget' recorded a run its optimiser stopped as one its budget stopped (T52-B08, B09, B11)."""
+    make, cls = spec.make, spec.settings
+    if not callable(make):
+        return f"{entry}: its make {brief(make)} is no callable: give make(prototype, settings, seed) answering the optimiser (its class, or a function)"
+    refused = refused_signature(make, 3)
+    if refused:
+        return (
+            f"{entry}: its make of signature {brief(refused)} cannot be called as a run calls it, make(prototype genome, settings, seed): give one taking those"
+        )
+    if not (isinstance(cls, type) and dataclasses.is_dataclass(cls) and cls.__dataclass_params__.frozen):  # type: ignore[attr-defined]
+        return (
+            f"{entry}: its settings {brief(cls)} is no frozen dataclass class: give the frozen dataclass of its settings, with defaults (not an object of it)"
+        )
+    for field in dataclasses.fields(cls):
+        if field.default is dataclasses.MISSING and field.default_factory is dataclasses.MISSING:
+            return f"{entry}: its settings field {field.name!r} has no default: give every field a default (settings left out are the defaults)"
+        if field.default is not dataclasses.MISSING and not _plain_json(field.default):
+            return (
+                f"{entry}: its settings field {field.name!r}'s default is {type(field.default).__name__} {brief(field.default)}, no plain JSON value: "
+                "give plain JSON values (bool, int, float, text, None, lists of them), which a run records in its config (a NumPy scalar as its .item())"
+            )
+    if not isinstance(spec.stops_itself, (bool, np.bool_)):
+        return f"{entry}: its stops_itself {brief(spec.stops_itself)} is no bool: give True (its stop() can end a run) or False (it needs a budget)"
+    reason = spec.stop_reason
+    if not isinstance(reason, str) or not reason.isprintable() or not reason.strip() or reason == "budget":
+        return (
+            f"{entry}: its stop_reason {brief(reason)} names no stop of its own: give a non-empty text (one line, printable) naming its own stop, "
+            "other than 'budget' (a run's stop by its budget)"
+        )
     return ""
+
+
+def _plain_json(value: object) -> bool:
+    """Whether ``value`` is a plain JSON value: None, a bool, int, float or text, or a list of them (a subclass, as
+    NumPy's scalars are, is not: JSON cannot write np.float32)."""
+    if isinstance(value, list):
+        return all(_plain_json(item) for item in value)
+    return value is None or type(value) in (bool, int, float, str)
 
 
 def optimiser_spec(name: str) -> OptimiserSpec:
