@@ -15,6 +15,7 @@ import json
 
 import numpy as np
 import pytest
+from test_bad_input_trial40_evolution import _Mine as _Trial40Mine
 
 import neurohover as nh
 from neurohover.errors import NeurohoverError
@@ -29,37 +30,9 @@ class _S:
     popsize: int = 4
 
 
-class _Mine:
-    """A user's optimiser (the trial's): a generation of 4 copies of the prototype, its champion the best told."""
-
-    def __init__(self, proto, settings, seed):
-        self.p, self.best, self.r = np.asarray(proto, float), None, -np.inf
-
-    def ask(self):
-        self.last = self.p + np.zeros((4, self.p.size))
-        return self.last
-
-    def tell(self, f, info=None):
-        i = int(np.argmax(f))
-        self.best, self.r = self.last[i], float(f[i])
-
-    def stop(self):
-        return False
-
-    @property
-    def champion_genome(self):
-        return self.best
-
-    @property
-    def champion_return(self):
-        return self.r
-
-    def state_dict(self):
-        return {}
-
-    @classmethod
-    def from_state_dict(cls, state):
-        return cls(np.zeros(40), _S(), 0)
+class _Mine(_Trial40Mine):
+    """A user's optimiser (the trial's): a generation of 4 copies of the prototype, its champion the best told (trial
+    40's, answering as it should: each test here changes one of its methods on this subclass)."""
 
 
 def _register(monkeypatch, **kwargs):
