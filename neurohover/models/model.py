@@ -218,6 +218,11 @@ class LearnedModel:
         _refuse_past_mdp_bound(self)
         if not isinstance(self.wind, WindModel):
             raise NeurohoverError(f"wind must be a WindModel, got {self.wind!r:.80}")
+        if self.d_u != 0.0 and self.wind.kind != "none":  # a wind holds what D_u would: LR's wind fit keeps no u constant (T53-B04)
+            raise NeurohoverError(
+                f"its d_u {brief(self.d_u)} is not allowed with a {self.wind.kind!r} wind: allowed 0.0 (a model's wind takes the place of "
+                "D_u, the constant u acceleration, as LR's wind fit keeps none), or no wind"
+            )
 
     def mdp(self, label: str | None = None, substeps: int = 1) -> MDP:
         """The model as an MDP for the kernel: family ``"model"``, its wind (if any).

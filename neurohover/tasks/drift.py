@@ -172,7 +172,11 @@ class Drift:
 
     @classmethod
     def from_dict(cls, d: dict) -> Drift:
-        """A drift from a table of its settings (unknown keys refused by name)."""
+        """A drift from a table of its settings (unknown keys refused by name).
+
+        A table that gives walk 0 and drifts nothing is refused as a likely slip ({walk = 0}: leave the drift out), except
+        the whole table :meth:`to_dict` writes for ``Drift()`` (walk, change and change_at all given, no change, the default
+        change_at): it reads back as ``Drift()``, no drift (it was refused, T53-B06)."""
         if not isinstance(d, dict):
             raise NeurohoverError(f"a drift must be a table of settings (walk, change, change_at), got {d!r}")
         unknown = sorted(set(d) - {"walk", "change", "change_at"})
@@ -182,7 +186,8 @@ class Drift:
         if not isinstance(change, dict):
             raise NeurohoverError(f"drift change={change!r} is not allowed: give a table of parameter factors, e.g. {{D_w = 0.8}}")
         drift = cls(d.get("walk", 0.0), tuple(change.items()), d.get("change_at", CHANGE_AT))  # checked in __post_init__
-        if "walk" in d and drift.none:  # {walk = 0}: a drift table that drifts nothing (eleventh trial, S3)
+        written = set(d) == {"walk", "change", "change_at"}  # Drift().to_dict(): change_at is the default where there is no change
+        if "walk" in d and drift.none and not written:  # {walk = 0}: a drift table that drifts nothing (eleventh trial, S3)
             raise NeurohoverError(f"drift walk={d['walk']!r} changes nothing: {_NOTHING}")
         return drift
 
