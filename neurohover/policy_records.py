@@ -195,7 +195,7 @@ def _place_problem(meta: dict) -> str:
     named = target.partition("/")[0] if isinstance(target, str) and "/" in target else None
     if isinstance(task, str) and named is not None and named != task:
         return f"its task {brief(task)} is not allowed beside its target {brief(target)}: a run evolves on its task's MDPs, here {named}'s"
-    problem = _named_mdp_problem(mdp, target, named)
+    problem = _named_mdp_problem(mdp, target, named) or (_task_mdp_problem(task, mdp) if named is None else "")
     if problem:
         return problem
     over_family = mdp == "G" or (isinstance(target, str) and _FAMILY_TARGET.fullmatch(target) is not None)
@@ -235,6 +235,53 @@ def _named_mdp_problem(mdp: object, target: object, named: str | None) -> str:
                 get_task_family(named).mdp(given)
             except NeurohoverError as err:
                 return f"its {key} {brief(mdp if key == 'mdp' else target)} is not allowed: {named} has no such MDP ({err})"
+    said = _TARGET_SIGMA.fullmatch(str(target))
+    return _target_sigma_problem(str(target), named, said.group(1)) if said is not None and named in names else ""
+
+
+#: A family target's breadth, as :meth:`Run.result <neurohover.evolution.run.Run.result>` writes it: ``fghh/G(sigma=0.3)``.
+_TARGET_SIGMA = re.compile(r"[a-z0-9]+/G\(sigma=([^()]*)\)")
+
+
+def _target_sigma_problem(target: str, named: str, text: str) -> str:
+    """The sigma a family target names, ``G(sigma=...)``, checked as the record's sigma key is (by the family's own
+    check, :class:`~neurohover.tasks.fghh.FGHH`) and written as a run writes it ('%g'): ghh08/G(sigma=0.3) and
+    fghh/G(sigma=5), -1, nan or abc were taken (T53-B02/B03). Its agreement with the sigma key: :func:`_fields_problem`."""
+    from .tasks import get_task_family
+
+    if not get_task_family(named).has_sigma:
+        return f"its target {brief(target)} is not allowed: {named}'s MDPs have no breadth (sigma is FGHH's); allowed {named}/G"
+    value: Any = text  # refused by the family's check as written where it is no number
+    for number in (int, float):  # 5 named as 5, not 5.0
+        try:
+            value = number(text)
+            break
+        except ValueError:
+            pass
+    try:
+        get_task_family(named, value)
+    except NeurohoverError as err:
+        return f"its target {brief(target)} is not allowed: {err}"
+    if f"{value:g}" != text:  # ' 0.3', '0.30' or '3e-1': a run writes '%g', which the sigma key is compared with
+        return f"its target {brief(target)} is not allowed: its sigma {text!r} is not written as a run writes it; allowed {named}/G(sigma={value:g})"
+    return ""
+
+
+def _task_mdp_problem(task: object, mdp: object) -> str:
+    """A record's mdp, with no target naming a family, against its task as a target's is against the target's family
+    (:func:`_named_mdp_problem`): one of the task's MDPs by its parser (:meth:`TaskFamily.mdp`), G, sample, or what
+    evolve's --wind and --params write; train:99, banana or '' beside ghh08 were taken (T53-B01)."""
+    from .tasks import get_task_family, task_names
+
+    if not (isinstance(task, str) and task in task_names() and isinstance(mdp, str)):
+        return ""  # a task refused by _place_problem; an mdp that is no text too
+    if mdp in ("G", "sample") or mdp.startswith(("wind=", "params=")):
+        return ""
+    try:
+        get_task_family(task).mdp(mdp)
+    except NeurohoverError as err:
+        also = "or G (its family), wind=U,V or params=... (what evolve's --wind and --params write)"
+        return f"its mdp {brief(mdp)} is not allowed beside its task {brief(task)}: {task} has no such MDP ({err}); {also}"
     return ""
 
 
