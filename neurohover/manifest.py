@@ -42,10 +42,6 @@ _MANIFEST_FIELDS: dict[str, tuple[tuple[type, ...], str]] = {
 }  # fmt: skip
 
 
-#: How far a policy file's seconds (rounded to 0.01 s) may exceed its manifest's (to 0.1 s), the build's: rounding only.
-SECONDS_ROUNDING = 0.05 + 0.005
-
-
 def _manifest_sizes() -> dict[str, tuple[int, int, str]]:
     """The sizes a build takes (:func:`~neurohover.policysets.check_build`), as a manifest records them: name -> (lowest,
     highest, the range in words). A budget or n_steps of 0 was accepted as a count >= 0 (T23-11)."""
@@ -143,19 +139,6 @@ def set_files(generic: Policy | None = None, specialised=(), ancestor: Policy | 
 def genome_digests(files: dict[str, Policy]) -> dict[str, str]:
     """The manifest's :data:`DIGESTS` of a set's policy ``files`` (:func:`set_files`)."""
     return {name: genome_digest(policy) for name, policy in files.items()}
-
-
-def check_seconds(manifest: dict, manifest_path: Path, files: dict) -> None:
-    """Refuse a policy file whose seconds exceed its manifest's, the whole build's, beyond rounding (a file's 1e6 beside a
-    manifest's 604.4 loaded; T53-B05): a build writes a file's to 0.01 s and the manifest's to 0.1 s. Not their sum (rounded)."""
-    total = manifest.get("seconds")
-    for name, policy in files.items():
-        have = policy.metadata.get("seconds")
-        if finite_real(total) and finite_real(have) and float(have) > float(total) + SECONDS_ROUNDING:  # type: ignore[arg-type]
-            raise NeurohoverError(
-                f"policy-set manifest {str(manifest_path)!r}: {name}'s seconds {brief(have)} is not allowed beside the manifest's seconds "
-                f"{brief(total)}: its run is part of the build, so allowed at most the build's (to rounding); rebuild the set, or restore the files"
-            )
 
 
 def check_digests(manifest: dict, path: Path, files: dict[str, Policy], others: tuple[str, ...] | None = None) -> None:

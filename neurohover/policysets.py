@@ -65,7 +65,6 @@ from .manifest import (
     check_ghh_manifest,
     check_kind_keys,
     check_manifest_fields,
-    check_seconds,
     choose_safe,
     genome_digests,
     set_files,
@@ -259,7 +258,6 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
             for name in FGHH_GENERICS
         }
         check_digests(manifest, manifest_path, set_files(generics=generics), others=())  # a hand-edited genome (T36-B05)
-        check_seconds(manifest, manifest_path, set_files(generics=generics))
         return PolicySet(family.name, root, generics["race"], generics=generics, manifest=manifest)
     if manifest.get("lineage") == "independent" and (root / "ancestor.json").exists():  # T25-14: a chain's set was shown as independent
         raise NeurohoverError(
@@ -277,7 +275,6 @@ def load_policy_set(task: str, directory: str | Path | None = None) -> PolicySet
     )
     ancestor = ("ancestor.json",) if manifest.get("lineage") == "chain" else ()  # the set's files, a digest of none refused (T37-B08)
     check_digests(manifest, manifest_path, set_files(generic, specialised), others=ancestor)  # two safe genomes x1000 were flown (T36-B05)
-    check_seconds(manifest, manifest_path, set_files(generic, specialised))
     safe = check_ghh_manifest(manifest, manifest_path, len(specialised), len(train))
     return PolicySet(family.name, root, generic, specialised, safe, manifest=manifest)
 
@@ -390,22 +387,9 @@ def replaceable_set(task: str, out: str | Path | None) -> Path:
 
 
 def _evolve_one(
-    target,
-    name: str,
-    child_seed: int,
-    seed_policy: Policy | None = None,
-    save: bool = True,
-    *,
-    family,
-    root: Path,
-    n_steps: int,
-    optimizer: str,
-    say,
-    kept: list[float],
-    **kwargs,
+    target, name: str, child_seed: int, seed_policy: Policy | None = None, save: bool = True, *, family, root: Path, n_steps: int, optimizer: str, say, **kwargs
 ) -> Policy:
-    """One run of a set's build from ``seed_policy`` (default: the baseline MLP), its champion saved as ``name``; a run kept
-    from an interrupted build adds its seconds to ``kept`` (the build's seconds count them: no file's may exceed them)."""
+    """One run of a set's build from ``seed_policy`` (default: the baseline MLP), its champion saved as ``name``."""
     from .evolution import SteadyStateSettings
     from .evolution.evolve import evolve
     from .evolution.optimisers import NE
@@ -414,7 +398,6 @@ def _evolve_one(
     stage = stage_file(root, str(child_seed))  # the run's seed names it: each run of a build has its own
     policy = finished_stage(stage, f"{family.name}/{name}", say)
     if policy is not None:  # finished before the build was stopped: the same run again would give the same champion
-        kept.append(float(policy.metadata.get("seconds", 0.0)))
         if save:
             save_policy(policy, root / f"{name}.json", task=family.name, name=name, **{k: policy.metadata[k] for k in ("episodes", "seconds")})
         say(f"{family.name}/{name}: kept from the interrupted build")
@@ -554,8 +537,9 @@ def _build(family, root: Path, budget, fghh_budget, seed, safety_episodes, n_ste
         manifest["optimizer"] = optimizer
     seeds = run_seeds(seed)
     roles = policy_set_roles(family)
-    start, kept = time.perf_counter(), list[float]()  # kept: the seconds of runs kept from an interrupted build (T53-B05)
-    run = functools.partial(_evolve_one, family=family, root=root, n_steps=n_steps, optimizer=optimizer, say=say, kept=kept)
+    start = time.perf_counter()
+
+    run = functools.partial(_evolve_one, family=family, root=root, n_steps=n_steps, optimizer=optimizer, say=say)
 
     if family.generic_over_distribution:
         manifest.update({"sigma": family.sigma, "fghh_budget": fghh_budget})
@@ -563,7 +547,7 @@ def _build(family, root: Path, budget, fghh_budget, seed, safety_episodes, n_ste
         for k, role in enumerate(roles):
             how = {"budget": fghh_budget, "resampling": role.resampling} if role.target == "family" else {"budget": budget}
             generics[role.kind] = run(family if role.target == "family" else family.zero(), f"generic_{role.kind}", int(seeds[k]), **how)
-        manifest.update({"seconds": round(time.perf_counter() - start + sum(kept), 1), DIGESTS: genome_digests(set_files(generics=generics))})
+        manifest.update({"seconds": round(time.perf_counter() - start, 1), DIGESTS: genome_digests(set_files(generics=generics))})
         (root / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n", encoding="utf-8")
         return PolicySet(family.name, root, generics["race"], generics=generics, manifest=manifest)
 
@@ -586,5 +570,5 @@ def _build(family, root: Path, budget, fghh_budget, seed, safety_episodes, n_ste
     generic, specialised = evolved[0], evolved[1:]
     manifest[DIGESTS] = genome_digests(set_files(generic, specialised, ancestor))  # what load_policy_set checks (T36-B05)
     crashes, returns = crash_matrix(specialised, train, safety_episodes, seed=int(seeds[11]), n_steps=n_steps)
-    seconds = round(time.perf_counter() - start + sum(kept), 1)
+    seconds = round(time.perf_counter() - start, 1)
     return _write_ghh_set(family.name, root, manifest, generic, specialised, crashes, returns, safety_episodes, seconds, say)
