@@ -14,7 +14,11 @@ import sys
 
 
 def _interrupted(kind, value, tb) -> None:
-    if issubclass(kind, KeyboardInterrupt):  # Ctrl-C or SIGTERM while NumPy and numba import, before main() can catch it
+    stop, depth = value, 0
+    while stop is not None and not isinstance(stop, KeyboardInterrupt) and depth < 20:  # one Python wrapped: a Ctrl-C in a
+        stop, depth = stop.__cause__ or stop.__context__, depth + 1  # class body's __set_name__ is a RuntimeError (session 27)
+    if isinstance(stop, KeyboardInterrupt):  # Ctrl-C or SIGTERM while NumPy and numba import, before main() can catch it
+        kind, value = type(stop), stop
         terminated = issubclass(kind, Terminated)
         print(f"neurohover: {'terminated' if terminated else 'interrupted'}", file=sys.stderr, flush=True)
         os._exit(128 + getattr(value, "signum", 15) if terminated else 130)  # as main() ends them (Python would end by the signal itself)

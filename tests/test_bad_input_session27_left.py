@@ -1,7 +1,8 @@
-"""Issue 37, items left by the twenty-sixth session and closed in the twenty-seventh, and two seen on the way: an MDP made before
+"""Issue 37, items left by the twenty-sixth session and closed in the twenty-seventh, and three seen on the way: an MDP made before
 ``importlib.reload(neurohover.tasks.drift)`` was refused by evaluate as "give an MDP or a task family", although it is
 one (its Drift is of the first import): now named by its cause, as T42-B07 names a reloaded Sensor's or Drift's; FGHH
-sigmas of one set variant shared the seeded set first built; a crash joined with a longer budget was charged for it."""
+sigmas of one set variant shared the seeded set first built; a crash joined with a longer budget was charged for it;
+a Ctrl-C that Python wrapped in a RuntimeError while the command imported was a traceback."""
 
 from __future__ import annotations
 
@@ -59,3 +60,24 @@ def test_a_crash_joined_with_a_longer_budget_keeps_no_budget() -> None:
         observed_return(both, 0)
     assert observed_return(both, 1) == pytest.approx(float(full.returns.ravel()[0]), rel=1e-12)
     assert (full.flight_data + full.flight_data).metadata["episode_steps"] == 200  # one budget: kept
+
+
+def test_a_ctrl_c_python_wraps_while_the_package_imports_ends_with_one_line() -> None:
+    """Seen in this session's full run: a Ctrl-C landing in a class body's __set_name__ (functools.cached_property) while
+    the command imported its modules is raised by Python as RuntimeError("Error calling __set_name__") from the
+    KeyboardInterrupt, and the import-time hook printed its traceback: now it ends with one line and 130, as a bare one."""
+    import subprocess
+    import sys
+
+    script = (
+        "import neurohover\n"
+        "try:\n"
+        "    try:\n"
+        "        raise KeyboardInterrupt\n"
+        "    except KeyboardInterrupt as stop:\n"
+        "        raise RuntimeError(\"Error calling __set_name__ on 'cached_property' instance\") from stop\n"
+        "except RuntimeError as err:\n"
+        "    neurohover._interrupted(type(err), err, err.__traceback__)\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 130 and proc.stderr.strip() == "neurohover: interrupted", proc.stderr[-1500:]
