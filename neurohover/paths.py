@@ -26,7 +26,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .errors import NeurohoverError, OutputError, brief
-from .filekinds import NAME_MAX, PNG_KIND, SQLITE_HEADER, held_kind, name_limit, output_name, refuse_policy_set, refuse_unencodable
+from .filekinds import FLIGHT_DATA_KIND, NAME_MAX, PNG_KIND, SQLITE_HEADER, held_kind, name_limit, output_name, refuse_policy_set, refuse_unencodable
 from .locks import WriterLock, sole_writer, writer_file
 
 __all__ = [
@@ -293,6 +293,8 @@ def output_file(
     held = None if kind is None else held_kind(p)
     if held is not None and held != kind:  # a policy, a checkpoint, a summary replaced by another kind of file (T25-01 to T25-03)
         raise NeurohoverError(f"{option} {brief(os.fspath(path))} is {held}: give another path (writing {kind} there would destroy it)")
+    if kind == FLIGHT_DATA_KIND and held is None and p.is_file() and p.stat().st_size:  # a user's own archive was replaced (T53-A04)
+        raise NeurohoverError(f"{option} {brief(os.fspath(path))} is a file neurohover did not write: give another path (writing {kind} would destroy it)")
     refuse_dangling_link(p, option, path)  # a link to nothing was written through, wherever it pointed (T19-12)
     refuse_pseudo_fs(p, option, path)
     make_dirs(p.parent, option, str(path))
