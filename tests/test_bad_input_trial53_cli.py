@@ -1,6 +1,8 @@
 """Bad-input trial 53, side A (the command line): fly --record (and FlightData.save) replaced a .npz that neurohover did
 not write, a user's own NumPy archive or a text file, without a word (T53-A04): refused now, naming it, as the other
-writers refuse files they did not write; flight data neurohover wrote is still replaced."""
+writers refuse files they did not write; flight data neurohover wrote is still replaced. A sensor delay's text of a
+value no whole number, 9.0000000000000001 (9.0 as a float), flew as delay 9 (T53-A05), and 99999999999999999999 was
+named as 1e20 in its refusal (T53-A06): the delay is read from its text's own decimal value."""
 
 from __future__ import annotations
 
@@ -35,3 +37,18 @@ def test_a04_flight_data_neurohover_wrote_is_replaced(tmp_path: Path, cli) -> No
         rc, _, err = cli("fly", "--task", "ghh08", "--episodes", episodes, "--record", str(path))
         assert rc == 0, err
     assert nh.FlightData.load(path).n_episodes == 2
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("delay=9.0000000000000001", "sensor delay='9.0000000000000001' is not a whole number of control steps"),
+    ("level=0.5,delay=3.0000000000000001", "sensor delay='3.0000000000000001' is not a whole number of control steps"),
+    ("delay=99999999999999999999", "sensor delay=99999999999999999999 is out of range: allowed an integer in 0..10"),
+])  # fmt: skip
+def test_a05_a06_a_sensor_delay_is_read_from_its_text(cli, text: str, message: str) -> None:
+    rc, _, err = cli("fly", "--task", "ghh08", "--episodes", "1", "--obs-noise", text)
+    assert rc == 2 and message in err, err
+
+
+@pytest.mark.parametrize(("text", "delay"), [("delay=2.0", 2), ("delay=1e0", 1), ("delay=2", 2), ("level=0.5,delay=3", 3)])
+def test_a05_whole_delays_in_any_form_are_taken(text: str, delay: int) -> None:
+    assert nh.Sensor.parse(text).delay == delay

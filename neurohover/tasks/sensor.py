@@ -35,6 +35,8 @@ attitude std falls below it (``MIN_LEVEL``).
 
 from __future__ import annotations
 
+import decimal
+import math
 import operator
 import re
 from dataclasses import asdict, dataclass, fields, replace
@@ -197,6 +199,11 @@ class Sensor:
                     f"{part[:40]!r} needs a number after '=': its value {brief(value.strip())} is not one; give KEY=NUMBER pairs separated by commas"
                 )  # fmt: skip
                 raise NeurohoverError(f"sensor setting {said}, with keys {', '.join(allowed)}") from None
+            if key == "delay" and math.isfinite(settings[key]):  # the text's own value: 9.0000000000000001 is 9.0 as a float (T53-A05)
+                exact = decimal.Decimal(value.strip())
+                if exact != exact.to_integral_value():
+                    raise NeurohoverError(f"sensor delay={value.strip()[:40]!r} is not a whole number of control steps")
+                settings[key] = int(exact)  # 99999999999999999999 named as itself, not as the float 1e20 (T53-A06)
         if not settings:
             raise NeurohoverError(f"sensor {text!r} is empty: {expected}")
         if not whole_number(delay):  # 2.0 as Sensor(delay=) refuses it (whole_in; it was taken beside key=value text, T37-B12)
