@@ -19,6 +19,7 @@ from pathlib import Path
 import pytest
 import store_edits as SE
 from flight_edits import recorded
+from test_bad_input_trial34_cli import _again  # a second begin of tr1, its message
 
 from neurohover.errors import NeurohoverError
 from neurohover.experiments import Store
@@ -72,13 +73,6 @@ def test_the_recorded_store_is_still_read_where_the_own_file_is_no_store(compete
 
 
 # T46-A02 ------------------------------------------------------------------------------------------------------------
-
-
-def _again(store: Store, settings: dict) -> str:
-    config = dataclasses.replace(SE.tiny_config(), settings=settings)
-    with pytest.raises(NeurohoverError) as err:
-        store.begin("tr1", "quick", config.hash, config.to_dict())
-    return str(err.value)
 
 
 def test_a_setting_added_to_ones_own_config_is_a_change_of_settings(tmp_path: Path) -> None:
