@@ -201,6 +201,12 @@ def comma_separated(part: str) -> str | None:
     return ",".join(pieces) if len(pieces) > 1 and all("=" in p for p in pieces) else None
 
 
+def frozen_dataclass_class(cls: object) -> bool:
+    """Whether ``cls`` is a class that is a frozen dataclass (itself or by inheritance): what a registry's settings are
+    (an agent spec's, an optimiser spec's), not an object of one."""
+    return isinstance(cls, type) and dataclasses.is_dataclass(cls) and bool(cls.__dataclass_params__.frozen)  # type: ignore[attr-defined]
+
+
 def check_name_text(what: str, value: object, naming: str, *, empty: bool = False) -> str:
     """``value`` (the argument ``what``) checked to be a name in the run's records: text of printable characters, one line,
     non-empty unless ``empty`` (a Choice's label, an agent's name: None, 5 and 'x\\ny' were taken, T39-B04; an MDP's

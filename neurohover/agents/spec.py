@@ -11,7 +11,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from ..errors import NeurohoverError, brief, check_name_text, refused_signature, settings_from_dict
+from ..errors import NeurohoverError, brief, check_name_text, frozen_dataclass_class, refused_signature, settings_from_dict
 from ..policies import Policy
 
 if TYPE_CHECKING:
@@ -163,7 +163,7 @@ class AgentSpec:
                 "give a callable of those two arguments answering an Agent"
             )
         cls = self.settings
-        if cls is None or (isinstance(cls, type) and issubclass(cls, AgentSettings) and _frozen_dataclass(cls)):
+        if cls is None or (isinstance(cls, type) and issubclass(cls, AgentSettings) and frozen_dataclass_class(cls)):
             return
         raise NeurohoverError(
             f"agent {self.name!r}: settings={brief(cls)} is not allowed: give a frozen dataclass subclass of "
@@ -195,9 +195,3 @@ class AgentSpec:
 
 #: What a spec's ``build`` must be, for messages.
 _BUILD = "build(policies, options) (an AgentPolicies and an AgentOptions) must answer an Agent (neurohover.agents.protocol.Agent)"
-
-
-def _frozen_dataclass(cls: type) -> bool:
-    """Whether ``cls`` is a frozen dataclass (itself or by inheritance)."""
-    params = getattr(cls, "__dataclass_params__", None)
-    return dataclasses.is_dataclass(cls) and params is not None and bool(params.frozen)

@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import NeurohoverError, brief, refused_signature, registry_entry_problem, settings_from_dict
+from ...errors import NeurohoverError, brief, frozen_dataclass_class, refused_signature, registry_entry_problem, settings_from_dict
 
 __all__ = [
     "NE",
@@ -150,7 +150,7 @@ def _parts_problem(entry: str, spec: OptimiserSpec) -> str:
         return (
             f"{entry}: its make of signature {brief(refused)} cannot be called as a run calls it, make(prototype genome, settings, seed): give one taking those"
         )
-    if not (isinstance(cls, type) and dataclasses.is_dataclass(cls) and cls.__dataclass_params__.frozen):  # type: ignore[attr-defined]
+    if not frozen_dataclass_class(cls):
         return (
             f"{entry}: its settings {brief(cls)} is no frozen dataclass class: give the frozen dataclass of its settings, with defaults (not an object of it)"
         )
