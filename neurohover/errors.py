@@ -175,7 +175,22 @@ def brief(value: object) -> str:
 
 
 class FloatRangeError(ValueError):
-    """A number written past a float's range (:func:`float_of`)."""
+    """A number written past a float's range (:func:`float_of`), or a whole number of more digits than Python reads
+    (:func:`int_of`)."""
+
+
+def int_of(text: str) -> int:
+    """``int(text)``, but a whole number of more digits than Python reads (``sys.get_int_max_str_digits()``, 4,300) is
+    a :class:`FloatRangeError` saying it is out of range, not int()'s "Exceeds the limit" ValueError, which callers
+    reported as text that is no number (``plot --episodes``, ``wins --runs``, a drift's ``@LO-HI``; T53-A01..A03)."""
+    try:
+        return int(text)
+    except ValueError:
+        digits = str(text).strip().lstrip("+-")
+        limit = sys.get_int_max_str_digits()
+        if digits.isascii() and digits.isdigit() and limit and len(digits) > limit:
+            raise FloatRangeError(f"{digits[:10]}...({len(digits):,} digits) is out of range: past every range neurohover allows") from None
+        raise
 
 
 def float_of(text: str) -> float:

@@ -11,7 +11,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from ..envs.arguments import refuse_idle_sigma
-from ..errors import FloatRangeError, NeurohoverError, float_of, whole_number
+from ..errors import FloatRangeError, NeurohoverError, float_of, int_of, whole_number
 from ..tasks.sensor import Sensor
 
 
@@ -204,13 +204,21 @@ def real(text: str) -> float:
 _INTEGER = re.compile(r"\s*[+-]?[0-9]+\s*")
 
 
+class IntegerRangeError(FloatRangeError, argparse.ArgumentTypeError):
+    """:func:`integer`'s refusal of a whole number past every range: argparse prints its text ("invalid integer value"
+    before), and the callers that read lists of integers catch it as the ValueError it is."""
+
+
 def integer(text: str) -> int:
     """A command-line whole number, in the digits 0-9: int() also reads '1_0' as 10 (``--episodes 1_0`` flew 10
     episodes, every integer option alike; sixteenth trial, T16-4), which :func:`~neurohover.errors.float_of` refuses
     for a real number. The type of every integer option (argparse: "invalid integer value: '1_0'")."""
     if not isinstance(text, str) or not _INTEGER.fullmatch(text):
         raise ValueError(f"invalid literal for an integer: {text!r:.60} (digits 0-9 only, no '_')")
-    return int(text)
+    try:
+        return int_of(text)
+    except FloatRangeError as err:  # past 4,300 digits: argparse shows an ArgumentTypeError's own text (T53-A01)
+        raise IntegerRangeError(str(err)) from None
 
 
 def add_sigma_option(p: argparse.ArgumentParser) -> None:

@@ -28,7 +28,7 @@ import re
 import sys
 from pathlib import Path
 
-from ..errors import NeurohoverError, brief
+from ..errors import FloatRangeError, NeurohoverError, brief
 from .options import integer
 
 COMPETE_PNG = "compete.png"
@@ -45,6 +45,8 @@ def _episodes(text: str | None, n: int) -> list[int] | None:
         lo, sep, hi = part.strip().partition("-")
         try:
             first, last = integer(lo), integer(hi) if sep else integer(lo)
+        except FloatRangeError as err:  # more digits than Python reads (T53-A01)
+            raise NeurohoverError(f"--episodes {err}; the flight data hold episodes 0..{n - 1}") from None
         except ValueError:
             raise NeurohoverError(f"--episodes {text!r} is not allowed: give episode numbers and ranges, e.g. 0,3,10-12") from None
         if last < 0:  # '0--1' was a reversed range, and its example -1-0 refused (T41-A04)

@@ -16,7 +16,7 @@ import os
 import sys
 from pathlib import Path
 
-from ..errors import NeurohoverError, brief
+from ..errors import FloatRangeError, NeurohoverError, brief
 from ..evaluate import DEVICES, check_device
 from ..experiments.config import shipped_name
 from ..filekinds import refuse_sqlite_name
@@ -179,6 +179,8 @@ def _results_format(given: str | None, out) -> str:
 def _positive_ints(text: str, option: str) -> list[int]:
     try:
         values = [integer(v) for v in text.split(",")]
+    except FloatRangeError as err:  # more digits than Python reads (T53-A02)
+        raise NeurohoverError(f"{option} {err}; give whole numbers >= 1, comma-separated (e.g. 1,5,20)") from None
     except ValueError:
         values = []
     if not values or min(values) < 1:

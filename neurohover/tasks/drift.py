@@ -32,7 +32,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import FloatRangeError, NeurohoverError, as_floats, brief, comma_separated, finite_real, float_of, real_number, refuse_reloaded, whole_number
+from ..errors import (
+    FloatRangeError,
+    NeurohoverError,
+    as_floats,
+    brief,
+    comma_separated,
+    finite_real,
+    float_of,
+    int_of,
+    real_number,
+    refuse_reloaded,
+    whole_number,
+)
 from ..sim.constants import MDP_ROW_LEN, MIN_NOISE, PARAM_NAMES, ROW_PARAMS
 from ..sim.rng import MAX_SEED
 
@@ -260,7 +272,7 @@ def _episode(text: str) -> int:
     int() reads ('@1_000-2_000' was episodes 1000..2000; T35-B09); a whole number, as int() reads it."""
     if "_" in text:
         raise ValueError(f"invalid literal for int(): {text!r} (no '_' between digits)")
-    return int(text)
+    return int_of(text)  # past 4,300 digits a FloatRangeError naming it, as a number past a float's range is (T53-A03)
 
 
 def _whole(name: str, value, what: str, low: int, high: int | None = None) -> int:
