@@ -154,10 +154,14 @@ def check_state_json(state: Any, optimizer: str) -> None:
         )
 
 
-def _unwritable(value: Any, at: str, writable: bool | None = None) -> tuple[str, Any] | None:
+def _unwritable(value: Any, at: str, writable: bool | None = None, within: tuple[int, ...] = ()) -> tuple[str, Any] | None:
     """Where in ``value`` (its path from ``at``, and what is there) strict JSON cannot write, or writes as another value
     (a key that is no text comes back as text, a tuple as a list: T52-B17), or None where it writes ``value`` as it is.
-    ``writable``: whether ``json.dumps`` writes it (None: not yet asked)."""
+    ``writable``: whether ``json.dumps`` writes it (None: not yet asked); ``within``: the ids of the lists and tables
+    that hold it (a state that holds itself was followed without end)."""
+    if id(value) in within:
+        return f"{at} (a list or table that holds itself, which JSON cannot write)", value
+    within = (*within, id(value)) if isinstance(value, (dict, list)) else within
     if writable is None:
         try:
             json.dumps(value, allow_nan=False)
@@ -170,12 +174,12 @@ def _unwritable(value: Any, at: str, writable: bool | None = None) -> tuple[str,
         for key, item in value.items():
             if not isinstance(key, str):
                 return f"{at}[{brief(key)}] (a key that is no text, which JSON writes as text)", key
-            found = _unwritable(item, f"{at}[{key!r}]", True if writable else None)
+            found = _unwritable(item, f"{at}[{key!r}]", True if writable else None, within)
             if found is not None:
                 return found
     elif isinstance(value, list):
         for i, item in enumerate(value):
-            found = _unwritable(item, f"{at}[{i}]", True if writable else None)
+            found = _unwritable(item, f"{at}[{i}]", True if writable else None, within)
             if found is not None:
                 return found
     elif not writable:
