@@ -148,6 +148,17 @@ def finite_real(value: object) -> bool:
         return False
 
 
+def lowest_allowed(bound: float) -> str:
+    """A range's lower ``bound`` in three significant digits, rounded up so that the number shown is allowed: the
+    smallest sensor std, level and drift walk (2**-52 and multiples) were shown rounded down, as 2.22e-16, a number
+    the same range refuses."""
+    text = f"{bound:.3g}"
+    if float(text) >= bound:
+        return text
+    mantissa, _, exponent = f"{bound:.2e}".partition("e")
+    return f"{float(mantissa) + 0.01:.3g}e{int(exponent):+03d}"
+
+
 def brief(value: object) -> str:
     """``repr(value)`` for a message: an int of more than 30 digits as its first ten and its length, a text of more than
     60 characters as paths are shown (its first 40 and last 20 and its length), any other repr cut at 60 characters (a

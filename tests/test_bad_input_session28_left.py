@@ -1,12 +1,17 @@
 """Items left open by earlier sessions' trials of issue 37, fixed in the twenty-eighth session: an optimiser's
 state_dict() that holds itself was followed without end (a RecursionError) by the check that names what strict JSON
-cannot write."""
+cannot write. The smallest sensor std, noise level and drift walk (2**-52 and a multiple of it) were shown rounded down
+(2.22e-16 for 2.2204e-16), a number the same range refused: the bound shown is rounded up now, and is allowed."""
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
+import neurohover as nh
 from neurohover import NeurohoverError
+from neurohover.errors import lowest_allowed
 from neurohover.evolution.answers import check_state_json
 
 
@@ -30,3 +35,29 @@ def test_a_state_that_holds_itself_is_named_not_followed(where: str, entry: str)
 def test_a_state_that_holds_one_list_twice_is_written() -> None:
     shared = [1.0, 2.0]
     check_state_json({"a": shared, "b": shared, "c": [shared, shared]}, "mine")  # the same list twice is no cycle
+
+
+def _refusal(make) -> str:
+    with pytest.raises(NeurohoverError) as err:
+        make()
+    return str(err.value)
+
+
+@pytest.mark.parametrize(
+    ("too_small", "at"),
+    [
+        (lambda: nh.Sensor(velocity=1e-17), lambda x: nh.Sensor(velocity=x)),
+        (lambda: nh.Sensor.at_level(1e-17), nh.Sensor.at_level),
+        (lambda: nh.Drift(walk=1e-17), lambda x: nh.Drift(walk=x)),
+    ],
+)
+def test_the_smallest_value_a_refusal_shows_is_allowed(too_small, at) -> None:
+    shown = re.search(r"or a (?:number|std) in ([0-9.e+-]+)\.\.", _refusal(too_small))
+    assert shown is not None
+    at(float(shown.group(1)))  # the number the message allows flies
+
+
+@pytest.mark.parametrize("bound", [2.0**-52, 100 * 2.0**-52, 1.0, 1e-3, 9.99951e-5, 1.234e-7, 123456.0])
+def test_a_lower_bound_is_shown_at_or_above_itself_in_three_digits(bound: float) -> None:
+    shown = lowest_allowed(bound)
+    assert float(shown) >= bound and float(shown) <= bound * 1.01 and len(shown.partition("e")[0].replace(".", "").lstrip("0")) <= 3, shown

@@ -162,7 +162,7 @@ def test_a_drift_walk_too_small_to_move_a_parameter_is_refused():
     from neurohover.tasks.drift import MIN_WALK
 
     for bad in ("walk=1e-300", "walk=1e-320", "walk=1e-17"):
-        with pytest.raises(NeurohoverError, match=r"^drift walk=1e-\d+ is out of range, too small to change the dynamics: allowed 0 \(none\) or .* 2.22e-16"):
+        with pytest.raises(NeurohoverError, match=r"^drift walk=1e-\d+ is out of range, too small to change the dynamics: allowed 0 \(none\) or .* 2.23e-16"):
             nh.Drift.parse(bad)
     with pytest.raises(NeurohoverError, match=r"^drift walk=5e-324 is out of range, too small"):
         nh.Drift.from_dict({"walk": 5e-324})

@@ -102,7 +102,7 @@ def test_the_sensor_floor_is_the_drifts() -> None:
 @pytest.mark.parametrize("level", [1e-320, 5e-324, 1e-17, 1e-300, MIN_LEVEL / 2])
 def test_a_negligible_noise_level_is_refused(level: float) -> None:
     with pytest.raises(
-        NeurohoverError, match=r"sensor noise level=.* is out of range, too small to change a reading .*allowed 0 \(exact\) or a number in 2.22e-14..1000"
+        NeurohoverError, match=r"sensor noise level=.* is out of range, too small to change a reading .*allowed 0 \(exact\) or a number in 2.23e-14..1000"
     ):
         Sensor.at_level(level)
     with pytest.raises(NeurohoverError, match="too small to change a reading"):
@@ -114,7 +114,7 @@ def test_a_negligible_noise_level_is_refused(level: float) -> None:
 @pytest.mark.parametrize("group", ["velocity", "position", "rates", "attitude"])
 @pytest.mark.parametrize("std", [1e-320, 5e-324, 1e-17])
 def test_a_negligible_group_std_is_refused(group: str, std: float) -> None:
-    said = rf"sensor {group}={std!r} is out of range, too small to change a reading .*allowed 0 \(exact\) or a std in 2.22e-16..100"
+    said = rf"sensor {group}={std!r} is out of range, too small to change a reading .*allowed 0 \(exact\) or a std in 2.23e-16..100"
     with pytest.raises(NeurohoverError, match=said):
         Sensor(**{group: std})
     with pytest.raises(NeurohoverError, match=said):

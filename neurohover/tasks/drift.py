@@ -41,6 +41,7 @@ from ..errors import (
     finite_real,
     float_of,
     int_of,
+    lowest_allowed,
     real_number,
     refuse_reloaded,
     whole_number,
@@ -62,7 +63,9 @@ MAX_RUN_EPISODES = 10**8
 #: The smallest walk but 0 (none), float64's epsilon 2**-52 (sim.constants.MIN_NOISE): a parameter's step of one std,
 #: exp(walk), is 1.0 below it, and a drifted row was the fixed one (walk=1e-300 was taken, while walk=0 is refused for drifting nothing; T40-B08).
 MIN_WALK = MIN_NOISE
-_WALK_RANGE = f"allowed 0 (none) or a number in {MIN_WALK:.3g}..1 (a per-episode log std; below 2**-52 a step of one std, exp(walk), is 1.0 in float64)"
+_WALK_RANGE = (
+    f"allowed 0 (none) or a number in {lowest_allowed(MIN_WALK)}..1 (a per-episode log std; below 2**-52 a step of one std, exp(walk), is 1.0 in float64)"
+)
 _PARSE_FORM = "give walk=STD or PARAM=FACTOR[@LO-HI], e.g. walk=0.01,D_w=0.8@200-800"
 _NOTHING = "give walk > 0 (up to 1) or a change of a factor other than 1, or leave it out (fixed dynamics)"
 

@@ -41,7 +41,7 @@ import operator
 import re
 from dataclasses import asdict, dataclass, fields, replace
 
-from ..errors import FloatRangeError, NeurohoverError, brief, comma_separated, finite_real, float_of, real_number, whole_in, whole_number
+from ..errors import FloatRangeError, NeurohoverError, brief, comma_separated, finite_real, float_of, lowest_allowed, real_number, whole_in, whole_number
 from ..sim.constants import MAX_SENSOR_DELAY, MIN_NOISE, SENSOR_GROUPS
 
 #: The std of each group at noise level 1 (velocity m/s, position m, rates rad/s, attitude).
@@ -92,7 +92,8 @@ class Sensor:
             if name != "correlation" and number > MAX_STD:
                 raise NeurohoverError(f"sensor {name}={value!r} is out of range: allowed a std in 0..{MAX_STD:g}")
             if name != "correlation" and 0 < number < MIN_STD:
-                raise NeurohoverError(f"sensor {name}={brief(value)} is out of range, {_TOO_SMALL}: allowed 0 (exact) or a std in {MIN_STD:.3g}..{MAX_STD:g}")
+                allowed = f"allowed 0 (exact) or a std in {lowest_allowed(MIN_STD)}..{MAX_STD:g}"
+                raise NeurohoverError(f"sensor {name}={brief(value)} is out of range, {_TOO_SMALL}: {allowed}")
             object.__setattr__(self, name, number)
         if self.correlation >= 1.0:
             raise NeurohoverError(f"sensor correlation={self.correlation!r} is out of range: allowed 0 <= correlation < 1")
@@ -148,7 +149,7 @@ class Sensor:
         if not finite_real(level) or not 0 <= level <= MAX_LEVEL:  # np.float32(0.5), Fraction(1, 2) in range too (thirteenth trial, F8)
             raise NeurohoverError(f"sensor noise level={brief(level)} is out of range: allowed a number in 0..{MAX_LEVEL:g}")
         if 0 < level < MIN_LEVEL:
-            allowed = f"allowed 0 (exact) or a number in {MIN_LEVEL:.3g}..{MAX_LEVEL:g}"
+            allowed = f"allowed 0 (exact) or a number in {lowest_allowed(MIN_LEVEL)}..{MAX_LEVEL:g}"
             raise NeurohoverError(f"sensor noise level={brief(level)} is out of range, too small to change a reading (an attitude std below 2**-52): {allowed}")
         v, p, r, a = (float(level) * s for s in LEVEL_PROFILE)
         return cls(v, p, r, a, correlation=correlation, delay=delay)
