@@ -13,14 +13,13 @@ import zlib
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TypeVar
 
 import numpy as np
 
 from .errors import NeurohoverError, brief, finite_real, float64_of, key_text, refuse_non_text_keys
 from .filekinds import FLIGHT_DATA_KIND, refuse_suffix
 from .flightmeta import check_meaning, check_policy_actions, flown_policy
-from .jsontext import JSONError, json_text, strict_json
+from .jsontext import JSONError, json_text, plain_json, strict_json, unwritable_key
 from .paths import path_text
 from .sim.constants import ACTION_NAMES, EPISODE_STEPS, MAX_EPISODE_STEPS, OBS_NAMES
 
@@ -483,37 +482,6 @@ def _too_deep(metadata: dict) -> str:
     if bad is None:
         return ""
     return f"{key_text(bad)}={brief(metadata[bad])} is not allowed: it is nested more than {MAX_NOTE_DEPTH} lists or tables deep"
-
-
-_K = TypeVar("_K")
-
-
-def plain_json(value: object) -> object:
-    """A NumPy number or (unmasked) array as the plain number or list JSON writes (``json.dumps``' ``default``): values
-    made in Python may hold them (``np.argmax``'s np.int64, a float32 score, ``(a > 0).any()``); anything else is json's
-    TypeError. The one conversion of the metadata and statistics neurohover writes as JSON: flight data's metadata, a
-    policy file's metadata (:func:`~neurohover.policies.save_policy`) and a model's stats (their NumPy numbers were
-    refused, T36-B08)."""
-    if isinstance(value, (np.generic, np.ndarray)) and not isinstance(value, np.ma.MaskedArray):
-        plain = value.tolist()  # a date or a complex number stays one, and is refused as such
-        if not isinstance(plain, (np.generic, np.ndarray)):
-            return plain
-    raise TypeError(f"Object of type {type(value).__name__} is not JSON serializable")
-
-
-def unwritable_key(table: dict[_K, object]) -> _K | None:
-    """The first key of ``table`` whose entry alone JSON cannot write (strictly, NumPy numbers as :func:`plain_json`
-    writes them), None when each can: the entry a refusal names (json's own message names no key, and no NaN)."""
-    return next((k for k, v in table.items() if not _json_ok({k: v})), None)
-
-
-def _json_ok(value: object) -> bool:
-    """Whether :func:`_metadata_text`'s JSON writes ``value``."""
-    try:
-        json_text(value, default=plain_json)
-    except (TypeError, ValueError, RecursionError):
-        return False
-    return True
 
 
 def check_metadata(metadata: object, lengths: np.ndarray, where: str, episodes: tuple[tuple, tuple] | None = None) -> None:

@@ -2,7 +2,7 @@
 
 Internal: neurohover's plumbing (README, Python API, What is public). :func:`strict_json` refuses what Python's own
 reader keeps without a word (a key twice, nesting too deep to follow, integers past a float's range);
-:func:`number_text` reads a number only as Python writes one.
+:func:`number_text` reads a number only as Python writes one; :func:`plain_json` writes the NumPy numbers of metadata.
 """
 
 from __future__ import annotations
@@ -10,10 +10,23 @@ from __future__ import annotations
 import json
 import re
 import unicodedata
+from typing import TypeVar
 
 from .errors import NeurohoverError, brief, float_of
 
-__all__ = ["MAX_NOTE_DEPTH", "JSONError", "json_text", "nesting_depth", "number_text", "odd_character", "parse_json", "strict_json", "toml_odd_character"]
+__all__ = [
+    "MAX_NOTE_DEPTH",
+    "JSONError",
+    "json_text",
+    "nesting_depth",
+    "number_text",
+    "odd_character",
+    "parse_json",
+    "plain_json",
+    "strict_json",
+    "toml_odd_character",
+    "unwritable_key",
+]
 
 
 def _unique_keys(pairs: list) -> dict:
@@ -167,3 +180,36 @@ def number_text(text: str, whole: bool = False) -> int | float:
         return int(text) if whole else float_of(text)
     allowed = "a whole number (at most 19 digits)" if whole else "a number"
     raise ValueError(f"{brief(text)} is not allowed: allowed {allowed} in ASCII digits, as Python writes it")
+
+
+_K = TypeVar("_K")
+
+
+def plain_json(value: object) -> object:
+    """A NumPy number or (unmasked) array as the plain number or list JSON writes (``json.dumps``' ``default``): values
+    made in Python may hold them (``np.argmax``'s np.int64, a float32 score, ``(a > 0).any()``); anything else is json's
+    TypeError. The one conversion of the metadata and statistics neurohover writes as JSON: flight data's metadata, a
+    policy file's metadata (:func:`~neurohover.policies.save_policy`) and a model's stats (their NumPy numbers were
+    refused, T36-B08)."""
+    import numpy as np  # here: the package installs its signal handlers before numpy (errors)
+
+    if isinstance(value, (np.generic, np.ndarray)) and not isinstance(value, np.ma.MaskedArray):
+        plain = value.tolist()  # a date or a complex number stays one, and is refused as such
+        if not isinstance(plain, (np.generic, np.ndarray)):
+            return plain
+    raise TypeError(f"Object of type {type(value).__name__} is not JSON serializable")
+
+
+def unwritable_key(table: dict[_K, object]) -> _K | None:
+    """The first key of ``table`` whose entry alone JSON cannot write (strictly, NumPy numbers as :func:`plain_json`
+    writes them), None when each can: the entry a refusal names (json's own message names no key, and no NaN)."""
+    return next((k for k, v in table.items() if not _json_ok({k: v})), None)
+
+
+def _json_ok(value: object) -> bool:
+    """Whether the JSON of metadata (flight data's, a policy file's, a model's stats) writes ``value``."""
+    try:
+        json_text(value, default=plain_json)
+    except (TypeError, ValueError, RecursionError):
+        return False
+    return True

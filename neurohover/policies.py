@@ -472,8 +472,7 @@ def save_policy(policy: Policy, path: str | Path, **metadata) -> Path:
 
     The name is checked by :func:`check_json_policy_name` (a name ending .json, not another run's checkpoint or history;
     T24-01), the record by :data:`RECORD_CHECKS` as :func:`load_policy` checks it (T24-03): what is written loads."""
-    from .flightdata import plain_json, unwritable_key  # here: flightdata imports this module
-    from .jsontext import json_text, strict_json
+    from .jsontext import json_text, plain_json, strict_json, unwritable_key
     from .paths import output_file, writing
 
     if not isinstance(policy, Policy):

@@ -38,8 +38,7 @@ import numpy as np
 
 from ..errors import NeurohoverError, as_floats, brief, check_flag, check_length, finite_real, real_number, refuse_non_text_keys, whole_number
 from ..filekinds import refuse_suffix
-from ..flightdata import plain_json, unwritable_key
-from ..jsontext import json_text
+from ..jsontext import json_text, plain_json, unwritable_key
 from ..sim.constants import CONTROL_DT, DEFAULT_NOISE_STD, DEFAULT_PARAMS, MAX_SECONDS, NOISE_NAMES, PARAM_NAMES, SUBSTEP_DT, SUBSTEPS, seconds_allowed
 from ..tasks import MDP, TASK_FAMILIES, TaskFamily, family_class, finite_vector, task_key
 from ..tasks.base import MAX_MAGNITUDE
