@@ -16,6 +16,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+from typing import Any
 
 from ..errors import NeurohoverError, brief, first_difference
 from .config import ExperimentConfig
@@ -23,7 +24,7 @@ from .external import external_digest
 from .keys import UnitKey
 from .plans import Plan, plan, run_keys, source_results
 from .result_checks import params_problem
-from .results import UnitResult, check_run_lengths, flat_cells, result_from_dict
+from .results import UnitResult, flat_cells, result_from_dict
 from .store import Store
 from .store_checks import hash_problem, read_config, unit_seconds_problem
 
@@ -174,6 +175,19 @@ def _check_planned(store: Store, config: ExperimentConfig, units: list[dict]) ->
                 "it was changed in the store (reproduce --fresh starts it over)"
             )
     return made
+
+
+def check_run_lengths(episodes: Any, results: dict[str, Any]) -> None:
+    """Refuse a stored test run whose episodes are not the experiment's ``episodes`` (None: not a test-runs experiment), by
+    its key: the report stacks every run's returns (a shorter one was a NumPy ValueError there; seventh trial). ``results``
+    are the test runs' results as stored (key -> dict), checked before :func:`result_from_dict` reads them, so a run of
+    another length is named as such rather than for a return it holds (T22-05); one of no returns is left to that check."""
+    if episodes is None:
+        return
+    for key, result in results.items():
+        returns = result.get("returns") if isinstance(result, dict) else None
+        if isinstance(returns, list) and returns and len(returns) != episodes:
+            raise NeurohoverError(f"test run {key!r} holds {len(returns)} episodes' returns where its experiment flies {episodes}")
 
 
 def checked_units(store: Store, name: str, scale: str) -> tuple[ExperimentConfig, list[dict], dict[str, UnitResult]]:

@@ -581,19 +581,3 @@ def result_type(kind: Any) -> type[_Record]:
     if cls is None:
         raise NeurohoverError(f"unknown unit kind {kind!r}: allowed {', '.join(RESULT_TYPES)}")
     return cls
-
-
-def check_run_lengths(episodes: Any, results: dict[str, Any]) -> None:
-    """Refuse a stored test run whose episodes are not the experiment's ``episodes`` (None: not a test-runs experiment), by
-    its key: the report stacks every run's returns (a shorter one was a NumPy ValueError there; seventh trial). ``results``
-    are the test runs' results as stored (key -> dict), checked before :func:`result_from_dict` reads them, so a run of
-    another length is named as such rather than for a return it holds (T22-05); one of no returns is left to that check."""
-    if episodes is None:
-        return
-    for key, result in results.items():
-        returns = result.get("returns") if isinstance(result, dict) else None
-        if isinstance(returns, list) and returns and len(returns) != episodes:
-            raise NeurohoverError(f"test run {key!r} holds {len(returns)} episodes' returns where its experiment flies {episodes}")
-
-
-# --------------------------------------------------------------------------------- unit keys
