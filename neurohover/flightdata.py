@@ -7,6 +7,7 @@ lengths kept, so a file of any number of episodes loads back exactly; or, with
 
 from __future__ import annotations
 
+import copy
 import os
 import zipfile
 import zlib
@@ -208,6 +209,9 @@ class FlightData:
             return NotImplemented  # Python's TypeError ("unsupported operand"), as for any sum it cannot make
         self.check_again("flight data (the first of +)")  # an edited crashed of the wrong length was dropped without a word (T43-B06)
         other.check_again("flight data (the second of +)")
+        if not self.actions or not other.actions:  # no episodes: they add none and contradict no entry (sum(..., empty) lost 'crashed')
+            kept = other if not self.actions else self
+            return FlightData(kept.observations, kept.actions, copy.deepcopy(kept.metadata))
         meta = {**self.metadata, **other.metadata}
         for name in set(meta) - {*_PER_EPISODE, "episode_steps", "policy_flown"}:  # one entry for the whole recording
             if name not in self.metadata or name not in other.metadata or not same_values(self.metadata[name], other.metadata[name]):

@@ -1,7 +1,9 @@
 """Items left open by earlier sessions' trials of issue 37, fixed in the twenty-eighth session: an optimiser's
 state_dict() that holds itself was followed without end (a RecursionError) by the check that names what strict JSON
 cannot write. The smallest sensor std, noise level and drift walk (2**-52 and a multiple of it) were shown rounded down
-(2.22e-16 for 2.2204e-16), a number the same range refused: the bound shown is rounded up now, and is allowed."""
+(2.22e-16 for 2.2204e-16), a number the same range refused: the bound shown is rounded up now, and is allowed. Flight
+data + flight data of no episodes (``sum(recordings, FlightData((), ()))``) dropped the per-episode entries (crashed,
+returns) of the other: a recording of no episodes adds none and contradicts no entry."""
 
 from __future__ import annotations
 
@@ -61,3 +63,14 @@ def test_the_smallest_value_a_refusal_shows_is_allowed(too_small, at) -> None:
 def test_a_lower_bound_is_shown_at_or_above_itself_in_three_digits(bound: float) -> None:
     shown = lowest_allowed(bound)
     assert float(shown) >= bound and float(shown) <= bound * 1.01 and len(shown.partition("e")[0].replace(".", "").lstrip("0")) <= 3, shown
+
+
+def test_adding_flight_data_of_no_episodes_keeps_the_others_entries() -> None:
+    fam = nh.get_task_family("ghh08")
+    one = nh.evaluate(nh.baseline_policy(), fam.zero(), n_steps=10, record=True, episodes=2).flight_data
+    two = nh.evaluate(nh.baseline_policy(), fam.zero(), n_steps=10, record=True, episodes=1, seed=5).flight_data
+    assert "crashed" in one.metadata
+    empty = nh.FlightData((), ())
+    assert empty + one == one and one + empty == one and empty + empty == empty
+    total = sum([one, two], nh.FlightData((), ()))
+    assert total == one + two and total.metadata["crashed"] == one.metadata["crashed"] + two.metadata["crashed"]
