@@ -3,18 +3,21 @@ state_dict() that holds itself was followed without end (a RecursionError) by th
 cannot write. The smallest sensor std, noise level and drift walk (2**-52 and a multiple of it) were shown rounded down
 (2.22e-16 for 2.2204e-16), a number the same range refused: the bound shown is rounded up now, and is allowed. Flight
 data + flight data of no episodes (``sum(recordings, FlightData((), ()))``) dropped the per-episode entries (crashed,
-returns) of the other: a recording of no episodes adds none and contradicts no entry."""
+returns) of the other: a recording of no episodes adds none and contradicts no entry. Masked residuals given to
+noise_from_residuals or authors_noise lost their mask: the hidden residuals counted in the noise; refused now."""
 
 from __future__ import annotations
 
 import re
 
+import numpy as np
 import pytest
 
 import neurohover as nh
 from neurohover import NeurohoverError
 from neurohover.errors import lowest_allowed
 from neurohover.evolution.answers import check_state_json
+from neurohover.models import Transitions, authors_noise, noise_from_residuals
 
 
 def _holding_itself(where: str) -> dict:
@@ -74,3 +77,14 @@ def test_adding_flight_data_of_no_episodes_keeps_the_others_entries() -> None:
     assert empty + one == one and one + empty == one and empty + empty == empty
     total = sum([one, two], nh.FlightData((), ()))
     assert total == one + two and total.metadata["crashed"] == one.metadata["crashed"] + two.metadata["crashed"]
+
+
+@pytest.mark.parametrize("noise", [noise_from_residuals, authors_noise])
+def test_masked_residuals_are_refused_not_counted(noise) -> None:
+    flown = nh.evaluate(nh.baseline_policy(), nh.get_task_family("ghh08").mdp("train:0"), record=True, n_steps=50).flight_data
+    tr = Transitions(flown)
+    values = np.zeros((tr.n, 6))
+    values[3, 2] = 1e3  # hidden by the mask: it must not count
+    with pytest.raises(NeurohoverError, match=r"a masked array: give its values, e.g. .filled\(\)"):
+        noise(tr, np.ma.masked_array(values, mask=values != 0))
+    noise(tr, values)  # the same values unmasked are taken

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, float64_of, refuse_reloaded
+from ..errors import NeurohoverError, brief, finite_real, float64_of, masked_note, refuse_reloaded
 from ..flightdata import FlightData, check_flown, crash_flags
 from ..sim.constants import GRAVITY, NOISE_DECAY, NOISE_GAIN, NOISE_NAMES, OBS_NAMES, PARAM_NAMES
 from ..tasks import MDP
@@ -219,6 +219,8 @@ def _checked_residuals(tr: object, residuals: object, batched: bool) -> np.ndarr
     except ValueError:  # ragged rows
         arr = np.asarray(None)
     shape = "(..., N, 6)" if batched else "(N, 6)"
+    if isinstance(residuals, np.ma.MaskedArray):  # np.asarray drops the mask: the hidden residuals counted in the noise
+        raise NeurohoverError(f"residuals of shape {arr.shape} are not allowed{masked_note(residuals)}: give a real array {shape} with N = {tr.n}")
     if arr.dtype.kind not in "iuf" or arr.ndim < 2 or (arr.ndim > 2 and not batched) or arr.shape[-2:] != (tr.n, 6):
         given = f" of shape {arr.shape} and dtype {arr.dtype}" if isinstance(residuals, np.ndarray) else f"={brief(residuals)}"
         raise NeurohoverError(f"residuals{given} is not allowed: give a real array {shape} with N = {tr.n}, the transitions of tr")
