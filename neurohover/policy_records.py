@@ -203,8 +203,9 @@ def _place_problem(meta: dict) -> str:
         spec = target.partition("/")[2]
         over = _FAMILY_TARGET.fullmatch(target) is not None
         # beside a target naming one of the family's MDPs, evolve writes that very spec: 'banana', '' or 'TRAIN:0' were
-        # taken beside ghh08/train:0 (T30-B02); beside an MDP of its own label (--wind, --params), its own words
-        agrees = over if mdp == "G" else (spec == mdp if _SPEC.fullmatch(spec) else not _SPEC.fullmatch(mdp) and not over)
+        # taken beside ghh08/train:0 (T30-B02); beside an MDP of its own label, what --wind or --params wrote, as beside a
+        # task alone (_task_mdp_problem): 'banana' was taken beside ghh08/wind=[1.0, 2.0]
+        agrees = over if mdp == "G" else (spec == mdp if _SPEC.fullmatch(spec) else mdp.startswith(_OWN_MDP) and not over)
         if not agrees:
             return f"its mdp {brief(mdp)} is not allowed beside its target {brief(target)}: the run was evolved on {target.partition('/')[2]!r}"
     if "mdp_params" not in meta:
@@ -213,6 +214,9 @@ def _place_problem(meta: dict) -> str:
         return f"its mdp_params {brief(meta['mdp_params'])} is not allowed beside its target {brief(target)}: a run over a family evolves on no one MDP"
     return _mdp_params_problem(meta["mdp_params"], task, target)
 
+
+#: How the mdp of a run on an MDP of its own label begins: what evolve's --wind and --params write (``wind=1,2``).
+_OWN_MDP = ("wind=", "params=")
 
 #: What ``neurohover evolve --mdp`` names as one of a family's MDPs (:meth:`TaskFamily.mdp`), labelled ``TASK/<it>``.
 _SPEC = re.compile(r"zero|sample|(?:seeded-)?(?:train|test):[0-9]+")
@@ -275,7 +279,7 @@ def _task_mdp_problem(task: object, mdp: object) -> str:
 
     if not (isinstance(task, str) and task in task_names() and isinstance(mdp, str)):
         return ""  # a task refused by _place_problem; an mdp that is no text too
-    if mdp in ("G", "sample") or mdp.startswith(("wind=", "params=")):
+    if mdp in ("G", "sample") or mdp.startswith(_OWN_MDP):
         return ""
     try:
         get_task_family(task).mdp(mdp)

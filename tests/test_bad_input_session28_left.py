@@ -4,7 +4,9 @@ cannot write. The smallest sensor std, noise level and drift walk (2**-52 and a 
 (2.22e-16 for 2.2204e-16), a number the same range refused: the bound shown is rounded up now, and is allowed. Flight
 data + flight data of no episodes (``sum(recordings, FlightData((), ()))``) dropped the per-episode entries (crashed,
 returns) of the other: a recording of no episodes adds none and contradicts no entry. Masked residuals given to
-noise_from_residuals or authors_noise lost their mask: the hidden residuals counted in the noise; refused now."""
+noise_from_residuals or authors_noise lost their mask: the hidden residuals counted in the noise; refused now. A policy
+record's mdp beside a target of its own label (what evolve --wind writes, ``ghh08/wind=[1.0, 2.0]``) could be any word
+('banana'), where beside a task alone it must be what --wind or --params wrote: one rule for both now."""
 
 from __future__ import annotations
 
@@ -88,3 +90,12 @@ def test_masked_residuals_are_refused_not_counted(noise) -> None:
     with pytest.raises(NeurohoverError, match=r"a masked array: give its values, e.g. .filled\(\)"):
         noise(tr, np.ma.masked_array(values, mask=values != 0))
     noise(tr, values)  # the same values unmasked are taken
+
+
+@pytest.mark.parametrize("mdp", ["banana", "", "train:0", "G"])
+def test_a_records_mdp_beside_a_target_of_its_own_label_is_what_evolve_wrote(tmp_path, mdp: str) -> None:
+    target = "ghh08/wind=[1.0, 2.0]"  # what `evolve --task ghh08 --wind 1,2` writes, beside mdp 'wind=1,2'
+    with pytest.raises(NeurohoverError, match=f"its mdp {re.escape(repr(mdp))} is not allowed beside its target"):
+        nh.save_policy(nh.baseline_policy(), tmp_path / "p.json", task="ghh08", mdp=mdp, target=target)
+    nh.save_policy(nh.baseline_policy(), tmp_path / "p.json", task="ghh08", mdp="wind=1,2", target=target)
+    assert nh.load_policy(tmp_path / "p.json").metadata["mdp"] == "wind=1,2"
