@@ -86,7 +86,7 @@ def _hovers(env: gym.Env) -> bool:
 def crash_aware(reward, gamma: float = 0.99, scale: float = 1.0):
     """The crash-aware squash of a reward (a float, or an array of them).
 
-    ``-log(1 + |r|)`` for an ordinary step; for a crash step (``|r| >= CRASH_STEP_PENALTY``,
+    ``reward`` is a neurohover reward, at most 0. ``-log(1 + |r|)`` for an ordinary step; for a crash step (``|r| >= CRASH_STEP_PENALTY``,
     ``left = |r| / CRASH_STEP_PENALTY`` steps charged) ``-log(1 + CRASH_STEP_PENALTY) * (1 -
     gamma**left) / (1 - gamma)``; times ``scale``.
     """
@@ -106,6 +106,11 @@ def crash_aware(reward, gamma: float = 0.99, scale: float = 1.0):
     r = np.abs(raw.astype(np.float64))
     if not np.all(np.isfinite(r)):  # nan came out as nan, inf as a crash of endless steps
         raise NeurohoverError(f"reward={reward!r:.60} is not allowed: give finite numbers (a crash is a finite charge)")
+    if np.any(raw > 0):  # +5 was squashed as -5 and +2000 charged as a crash (T54-B07)
+        raise NeurohoverError(
+            f"reward={brief(reward)} is not allowed: give rewards <= 0, as neurohover's are (minus a sum of squares; a crash minus "
+            "its charge): a positive reward comes from another environment or an earlier transform"
+        )
     left = r / CRASH_STEP_PENALTY
     crash = -WORST_STEP * (left if gamma == 1.0 else (1.0 - gamma**left) / (1.0 - gamma))
     with np.errstate(over="ignore"):  # refused below, by name

@@ -591,7 +591,7 @@ def test_the_python_leftovers_of_the_fifth_trial_are_refused_by_name() -> None:
     ):
         with pytest.raises(NeurohoverError, match=message):
             call()
-    assert crash_aware(3) == pytest.approx(-np.log(4.0)) and nh.evaluate_jobs(
+    assert crash_aware(-3) == pytest.approx(-np.log(4.0)) and nh.evaluate_jobs(
         [bp], [fam.zero()], [0], [0], [0], n_steps=10, fallback_index=[0]
     ).returns.shape == (1,)
 
