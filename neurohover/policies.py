@@ -354,10 +354,10 @@ def genome_rows(genomes: object, topology: str) -> np.ndarray:
 
 def load_policy(source: str | Path) -> Policy:
     """Load a policy file (JSON, or the authors' ``.net`` format: :mod:`neurohover.netfile`), or
-    the baseline policy for the name ``baseline``."""
+    the baseline policy for the text ``"baseline"``; a path (``Path("baseline")``) is always read as a file."""
     if not isinstance(source, (str, os.PathLike)):
         raise NeurohoverError(f"policy source {source!r} is not allowed: give a policy file's path or 'baseline'")
-    if str(source) == "baseline":
+    if isinstance(source, str) and source == "baseline":  # Path('baseline') was the built-in too, not the file (T54-B09)
         return baseline_policy()
     from .paths import input_file
 

@@ -21,7 +21,7 @@ from ..integrations import SB3_ALGORITHMS
 from ..paths import printable
 from ..policies import Policy
 from ..sim.constants import MAX_EPISODE_STEPS
-from .options import add_sensor_options, add_sigma_option, add_task_option, integer, note_policy_task, task_family_of
+from .options import add_sensor_options, add_sigma_option, add_task_option, integer, note_policy_name, note_policy_task, task_family_of
 
 SOURCES = ("policy", "callable", "rl_zoo", "sb3", "cleanrl")
 
@@ -56,6 +56,7 @@ def _agent(args: argparse.Namespace):
         from ..policies import load_policy
 
         if args.policy == "baseline":  # the name load_policy takes wherever a policy file is taken (README)
+            note_policy_name(args.policy, "--policy")
             return load_policy("baseline")
         return load_policy(input_file(args.policy, "--policy", "policy file"))
     if args.callable is not None:

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import NeurohoverError
 from ..sim.constants import EPISODE_STEPS
-from .options import add_task_options, family_and_mdps, integer, max_in_memory, note_policy_task
+from .options import add_task_options, family_and_mdps, integer, max_in_memory, note_policy_name, note_policy_task
 
 # Episodes per kernel call of a progress-reporting fly: large enough to keep every core busy.
 FLY_CHUNK = 256
@@ -83,6 +83,7 @@ def _fly_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int:
         raise NeurohoverError(
             f"--episodes {args.episodes} is out of range: about {per_episode} bytes each, at most {most} fit in half this machine's free memory"
         )
+    note_policy_name(args.policy, "--policy")
     policy = load_policy(args.policy)
     rng = np.random.default_rng(args.seed)
     family, mdps = family_and_mdps(args, args.episodes, rng)

@@ -62,8 +62,10 @@ def _target(args: argparse.Namespace):
 
 def _seed_policy(args: argparse.Namespace):
     from ..policies import load_policy
+    from .options import note_policy_name
 
     if args.seed_policy in ("zero", "baseline"):
+        note_policy_name(args.seed_policy, "--seed-policy", ("zero", "baseline"))
         return args.topology, args.seed_policy  # None: evolve's default (SLP over a family, MLP on one MDP)
     from ..paths import checked_path, input_file
 

@@ -252,6 +252,17 @@ def max_in_memory(bytes_each: int) -> int:
     return max(1, half_free_memory() // bytes_each)
 
 
+def note_policy_name(text: str, option: str, names: tuple[str, ...] = ("baseline",)) -> None:
+    """Say on standard error when ``text`` is one of the policy ``names`` the option takes (``baseline``; --seed-policy's
+    ``zero`` too) and also a file here: the name is flown, and the file only as ``./NAME`` (``--policy baseline`` flew the
+    built-in beside a file 'baseline' without a word; T54-B09)."""
+    from pathlib import Path
+
+    if text in names and Path(text).exists():
+        said = f"{option} {text} is the built-in {text} policy, not the file {text!r} here (give {option} ./{text} for the file)"
+        print(f"neurohover: note: {said}", file=sys.stderr)
+
+
 def note_policy_task(policy, task: str, option: str) -> None:
     """Say on standard error when a policy file was evolved for another task than the one it flies (a transfer can be
     meant, so it is flown; a `task` of the wrong kind in its metadata is refused; seventh trial)."""
