@@ -85,6 +85,12 @@ def check_manifest_fields(manifest: dict, path: Path) -> None:
         size = sizes.get(name)
         if size is not None and not size[0] <= value <= size[1]:  # T23-11: a budget or n_steps of 0 was taken as a count >= 0
             raise NeurohoverError(f"policy-set manifest {str(path)!r}: its {name} {brief(value)} is not allowed: allowed an integer in {size[2]}")
+    optimizer = manifest.get("optimizer")
+    if isinstance(optimizer, str) and not _optimiser_name(optimizer):  # '' or 'user:foo' was read beside NE's files (T54-B02)
+        raise NeurohoverError(
+            f"policy-set manifest {str(path)!r}: its optimizer {brief(optimizer)} is not allowed: give the name build-policies --optimizer "
+            "took (ne, a shipped optimiser's, or a run-time one's: at most 64 letters, digits and ._+-)"
+        )
     problem = seconds_problem(manifest)  # T26-B13: 1e30 was taken, where a checkpoint's seconds are at most 100 years
     if problem:
         raise NeurohoverError(f"policy-set manifest {str(path)!r}: {problem}")
@@ -96,19 +102,28 @@ def check_manifest_fields(manifest: dict, path: Path) -> None:
         )
 
 
+def _optimiser_name(name: str) -> bool:
+    """Whether ``name`` is one build-policies --optimizer takes: NE, a shipped optimiser's, or a run-time one's."""
+    from .evolution.optimisers import NE, SHIPPED, USER_NAME
+
+    return name == NE or name in SHIPPED or USER_NAME.fullmatch(f"user:{name}") is not None
+
+
 def built_as(manifest: dict, role: Role, k: int) -> dict:
     """What the run of ``role`` recorded, as the set's ``manifest`` says its build ran it (where it says): its episode
     length, its budget and its method (a steady-state generic recording a generational run, or n_steps 999 in a set of
     20, was flown; T23-11); and its seed, the ``k``-th of the manifest's root seed's (a manifest seed of 7 beside policies
     of a build from 0 was shown; T25-14)."""
-    from .evolution.optimisers import NE, OPTIMISERS, recorded_names
+    from .evolution.optimisers import NE, OPTIMISERS, SHIPPED, recorded_names
 
     family = role.target == "family"
     optimizer = NE if role.kind == "race" else manifest.get("optimizer", NE)  # a race is NE's (build_policy_set)
     method = ("generational" if family else "steady-state") if optimizer == NE else None
     if optimizer != NE and isinstance(optimizer, str) and optimizer in OPTIMISERS:  # a user's, registered here, records user:LABEL (T40-B14)
         method = recorded_names(optimizer)[0]  # (one registered elsewhere, or user:NAME, is not known here: its record is load_policy's to check)
-    built = {"n_steps": manifest.get("n_steps"), "budget": manifest.get("fghh_budget" if family else "budget"), "method": method}
+    # the optimiser's own record, as a run records it: a name no build ran ('pso', '') beside files of NE's runs was read (T54-B02)
+    recorded = optimizer if optimizer == NE or optimizer in SHIPPED else f"user:{optimizer}"
+    built = {"n_steps": manifest.get("n_steps"), "budget": manifest.get("fghh_budget" if family else "budget"), "method": method, "optimizer": recorded}
     built["prototype"] = BUILT_PROTOTYPE  # every run of a build (a chain's from its ancestor) starts from the baseline: 'zero' was taken (T41-B06)
     if whole_number(manifest.get("seed")) and 0 <= manifest["seed"] < 2**63:  # T25-14: as build_policy_set seeds role k
         built["seed"] = int(np.random.SeedSequence(manifest["seed"]).generate_state(32, dtype=np.uint32)[k])

@@ -164,6 +164,12 @@ def _edited_set(written: Path, at: Path, task: str, file: str, **changes: Any) -
         ),
         ("ghh08", "manifest.json", {"budget": 77}, "records budget 10, not 77"),
         ("fghh", "manifest.json", {"fghh_budget": 77}, "generic_fixed.json (the fixed generic policy) records budget 50, not 77"),
+        # T54-B02: a manifest's optimizer no build of its files ran was read as sound (only 'cma' was caught, by its method)
+        ("ghh08", "manifest.json", {"optimizer": "pso"}, "generic.json (the generic policy) records optimizer 'ne', not 'user:pso'"),
+        ("ghh09", "manifest.json", {"optimizer": "ne"}, "generic.json (the generic policy) records method 'openai-es', not 'steady-state'"),
+        ("ghh09", "manifest.json", {"optimizer": "uh-cma"}, "generic.json (the generic policy) records method 'openai-es', not 'uh-cma-es'"),
+        ("ghh08", "manifest.json", {"optimizer": ""}, "manifest.json': its optimizer '' is not allowed: give the name build-policies --optimizer took"),
+        ("ghh08", "manifest.json", {"optimizer": "user:foo"}, "its optimizer 'user:foo' is not allowed: give the name build-policies --optimizer took"),
     ],
 )
 def test_a_hand_edited_policy_set_is_refused_by_name(written: Path, tmp_path: Path, task: str, file: str, changes: dict, says: str) -> None:
