@@ -18,7 +18,19 @@ from .records import decode_history
 if TYPE_CHECKING:
     from .config import RunConfig
 
-__all__ = ["AnswerError", "asked_genomes", "check_made", "check_restored", "check_state_json", "checked_champion_genome", "stopped", "told_champion"]
+__all__ = [
+    "AnswerError",
+    "asked_genomes",
+    "check_made",
+    "check_restored",
+    "check_state_json",
+    "checked_champion",
+    "checked_champion_genome",
+    "held_champion",
+    "read_only",
+    "stopped",
+    "told_champion",
+]
 
 #: What a run calls of its optimiser, and with how many positional arguments (README, A new optimiser).
 CALLS = {"ask": (0,), "tell": (1, 2), "stop": (0,), "state_dict": (0,), "from_state_dict": (1,)}
@@ -69,6 +81,14 @@ def asked_genomes(opt: Optimiser, cfg: RunConfig) -> np.ndarray:
         f"optimizer {brief(cfg.optimizer)}: its ask() gave {gave}, which is not allowed: give a NumPy array of real numbers of shape (n, {d}), "
         f"n >= 1 genomes of the {cfg.topology} topology's {d} finite genes"
     )
+
+
+def read_only(values: np.ndarray) -> np.ndarray:
+    """A read-only copy of ``values`` (what a run tells its optimiser): a tell() writing into its fitness argument changed
+    the returns the run then recorded, so that the run's result was 0.0 for a champion flying -73.5 (T54-B04)."""
+    told = np.array(values)
+    told.flags.writeable = False
+    return told
 
 
 def told_champion(opt: Optimiser, cfg: RunConfig) -> float:
@@ -129,6 +149,45 @@ def checked_champion_genome(opt: Optimiser, cfg: RunConfig) -> np.ndarray | None
         f"optimizer {brief(cfg.optimizer)}: its champion_genome {gave} is not allowed: give None (no champion yet) or a NumPy array of real numbers of "
         f"shape ({d},), the {cfg.topology} topology's {d} finite genes"
     )
+
+
+#: A champion the run holds for its optimiser: its genome (None before one) and return (-inf before a finite one).
+Held = tuple[np.ndarray | None, float]
+
+
+def held_champion(opt: Optimiser, cfg: RunConfig) -> Held:
+    """The optimiser's champion genome and return, checked one by one and together: a genome held with return -inf was taken,
+    and lost only where save_policy refused its metadata (T54-B05); a finite return without a genome names no champion."""
+    genome, ret = checked_champion_genome(opt, cfg), told_champion(opt, cfg)
+    if (genome is None) != (ret == -math.inf):
+        raise NeurohoverError(
+            f"optimizer {brief(cfg.optimizer)}: its champion_return {brief(ret)} with {'champion_genome None' if genome is None else 'a champion_genome held'} "
+            "is not allowed: give -inf with champion_genome None (no finite return told yet), or a genome with the return told for it"
+        )
+    return genome, ret
+
+
+def checked_champion(opt: Optimiser, cfg: RunConfig, held: Held, genomes: np.ndarray, returns: np.ndarray) -> Held:
+    """The optimiser's champion after the run told it ``returns`` of ``genomes`` (its last ask(), as flown), where ``held``
+    was its champion before: that one, or a genome of ``genomes`` with the return told for it. A champion_return above
+    every return told (T54-B03), or a genome never asked recorded with another's return (T54-B06), was the run's result.
+    Only the champion before and the last generation are kept, so a long run holds one genome more, not every one told."""
+    genome, ret = held_champion(opt, cfg)
+    if genome is None:
+        return genome, ret
+    rows = np.flatnonzero((genomes == genome).all(axis=1))  # (by value: a copy of an asked genome, a list too, is that genome)
+    allowed = {float(r) for r in returns[rows]} | ({held[1]} if held[0] is not None and np.array_equal(held[0], genome) else set())
+    if not allowed:
+        raise NeurohoverError(
+            f"optimizer {brief(cfg.optimizer)}: its champion_genome {brief(genome)} is not allowed: it is no genome its ask() gave, and the run flies and "
+            "tells only those; give None (no champion yet), the champion before, or a genome of the last ask()"
+        )
+    if ret not in allowed:
+        told = ", ".join(map(str, sorted(allowed, reverse=True)[:5]))
+        raise NeurohoverError(
+            f"optimizer {brief(cfg.optimizer)}: its champion_return {brief(ret)} is not allowed: give a return told for its champion_genome ({told})"
+        )
+    return genome, ret
 
 
 def stopped(opt: Optimiser, optimizer: str) -> bool:

@@ -25,7 +25,19 @@ from ..flyer import KernelFlyer
 from ..launch import Parking
 from ..policies import Policy
 from ..sim.lanes import LANES
-from .answers import AnswerError, asked_genomes, check_made, check_restored, check_state_json, checked_champion_genome, told_champion
+from .answers import (
+    AnswerError,
+    Held,
+    asked_genomes,
+    check_made,
+    check_restored,
+    check_state_json,
+    checked_champion,
+    checked_champion_genome,
+    held_champion,
+    read_only,
+    told_champion,
+)
 from .bandits import BANDITS, top_mu_bandit
 from .common import STATE_DAMAGE, Optimiser, TellInfo, damage_text, enc_float
 from .config import RACE_T_LIMIT, RunConfig, next_auto_delta, preset_hint, upgrade_saved_config
@@ -124,6 +136,9 @@ class Run:
         self.elapsed = 0.0  # wall seconds of earlier sessions (resume)
         self.champion_genome: np.ndarray | None = None  # a population optimiser on a family: best of the last generation
         self.champion_return = -math.inf
+        # On one MDP, the optimiser's champion as last checked (.answers.checked_champion); None: read it from the optimiser
+        # (a restored one, whose return check_restored compared with the history's).
+        self._held: Held | None = (None, -math.inf)
         self.stop_reason: str | None = None
         self._parking: Parking | None = None  # slots of a race's parked episodes, reused from race to race
         self.race_delta = self.resampling.delta  # race:auto changes it race by race (in the checkpoint)
@@ -216,6 +231,7 @@ class Run:
         self.generation, self.evaluations = counts["generation"], counts["evaluations"]
         self.flyer.kernel_seconds, self.elapsed = seconds["kernel_seconds"], seconds["wall_seconds"]
         self.champion_genome, self.champion_return = parts["champion"]
+        self._held = None
         self.history = parts["history"]
         self.race_delta = parts["race_delta"]
 
@@ -349,14 +365,18 @@ class Run:
         """Steady state, or a population optimiser on an MDP: the champion is the best single fitness ever told;
         a record per new champion."""
         opt = self.opt
-        before = self._told_champion()
+        if self._held is None:
+            self._held = held_champion(opt, self.cfg)
+        before = self._held[1]
         before_eps = self.flyer.episodes
         genomes = self._asked()
         returns = self._fly_fixed(genomes)
-        opt.tell(returns, TellInfo(crashed=self._crashed()))
+        asked = genomes.copy()  # (an optimiser may reuse its ask()'s array in its tell)
+        opt.tell(read_only(returns), TellInfo(crashed=self._crashed()))  # tell writing into it changed the run's records (T54-B04)
         self.generation += 1
         self.evaluations += genomes.shape[0]
-        champion = self._told_champion()
+        self._held = checked_champion(opt, self.cfg, self._held, asked, returns)
+        champion = self._held[1]
         if champion != before:
             self._record(before_eps, champion, start)
 
@@ -400,10 +420,11 @@ class Run:
         before_eps = self.flyer.episodes
         genomes = self._asked()
         means, _ = self._fly_family_fixed(genomes)
-        opt.tell(means)
         key = np.where(np.isnan(means), -np.inf, means)
         best = int(np.argmax(key))
-        self.champion_genome, self.champion_return = genomes[best].copy(), float(key[best])
+        champion = genomes[best].copy(), float(key[best])  # before tell, which may reuse its ask()'s array
+        opt.tell(read_only(means))  # tell writing into it changed the run's records (T54-B04)
+        self.champion_genome, self.champion_return = champion
         self.generation += 1
         self.evaluations += genomes.shape[0]
         self._record(before_eps, self.champion_return, start)
