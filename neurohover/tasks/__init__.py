@@ -29,6 +29,7 @@ from types import MappingProxyType
 from ..errors import NeurohoverError, brief, finite_real, package_path, refuse_reloaded, registry_entry_problem
 from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, competition_rows, finite_vector
 from .drift import NO_DRIFT, Drift, refuse_drift
+from .family_checks import class_problem
 from .fghh import COMPETITION_FGHH_SIGMA, FGHH
 from .ghh08 import GHH08, MAX_WIND
 from .ghh09 import GHH09, GHH09_PARAM_NAMES
@@ -73,8 +74,13 @@ _SHIPPED = MappingProxyType(dict(TASK_FAMILIES))
 def entry_problem(name: object, cls: object) -> str:
     """What is wrong with the registry entry ``TASK_FAMILIES[name] = cls`` ('' when nothing): no TaskFamily subclass (5
     was an AttributeError 'has_sigma'), a shipped name holding another class (``TASK_FAMILIES["ghh08"] = GHH09`` gave
-    GHH-09 for ghh08), or a class whose name is not its key (an alias 'zz' gave a family named ghh08; T43-B10)."""
-    return registry_entry_problem("TASK_FAMILIES", name, cls, TaskFamily, _SHIPPED, "task family", "class")
+    GHH-09 for ghh08), or a class whose name is not its key (an alias 'zz' gave a family named ghh08; T43-B10); of a
+    run-time class, a name the records cannot hold, a flag that is no bool or has_sigma without a sigma field
+    (:func:`~neurohover.tasks.family_checks.class_problem`; T54-B08, B10, B11)."""
+    shared = registry_entry_problem("TASK_FAMILIES", name, cls, TaskFamily, _SHIPPED, "task family", "class")
+    if shared or name in _SHIPPED:
+        return shared
+    return class_problem(f"TASK_FAMILIES[{brief(name)}] = {brief(cls)} is not allowed", name, cls)  # type: ignore[arg-type]
 
 
 def task_names() -> tuple[str, ...]:

@@ -33,7 +33,7 @@ from ..sim.constants import (
 )
 from ..sim.reference import ReferenceMDP
 from .drift import NO_DRIFT, Drift
-from .family_checks import checked_draws, generator, through_sensor
+from .family_checks import checked_draws, generator, row_layout_problem, through_sensor
 from .held import LEARNED_MODEL, check_held, family_code, register_family
 from .held import WIND_KINDS as _WIND_KINDS
 from .sensor import EXACT, Sensor
@@ -324,7 +324,7 @@ class TaskFamily:
     Attributes
     ----------
     name : str
-        Its id (``--task``), e.g. ``"ghh08"``.
+        Its id (``--task``), e.g. ``"ghh08"``: lowercase letters, digits, ``.`` and ``_`` (``family_checks.FAMILY_NAME``).
     n_params, param_names
         The MDP parameters :meth:`make` takes.
     row_slice : slice
@@ -334,7 +334,7 @@ class TaskFamily:
     set_code : int
         Distinguishes its seeded fixed sets from other families'.
     has_sigma : bool
-        Whether it has a breadth ``sigma`` (FGHH).
+        Whether it has a breadth ``sigma`` (FGHH), a field of its dataclass.
     wind_kind : int
         The wind its MDPs fly besides none (``sim.constants``: WIND_CONSTANT for GHH-08, WIND_SINUSOID for GHH-09;
         WIND_NONE: no wind); an MDP of its name with another is refused.
@@ -451,10 +451,9 @@ class TaskFamily:
         if key not in _ROW_LAYOUTS:
             probe = self.sample_params(np.random.default_rng(0), 1)[0]
             template = self.make(probe).row()
-            check = template.copy()
-            check[self.row_slice] = probe
-            if not np.array_equal(check, template):
-                raise RuntimeError(f"{self.name}: make() does not put the parameters in row_slice {self.row_slice}")
+            problem = row_layout_problem(self, probe, template)
+            if problem:  # was a RuntimeError, where every other bad family is a NeurohoverError (T54-B12)
+                raise NeurohoverError(problem)
             _ROW_LAYOUTS[key] = template
         return _ROW_LAYOUTS[key].copy()
 

@@ -1,10 +1,14 @@
 """The checks :class:`~neurohover.tasks.base.TaskFamily` puts around a family's own methods as the family class is defined:
 its ``make`` and ``zero`` answer MDPs of the family (checked) through its sensor and drift, and its ``sample_params`` is called with a checked
-generator and count; and :func:`generator`, the one reading of an ``rng`` argument."""
+generator and count; the checks of a registered family class (:func:`class_problem`) and of its kernel row layout
+(:func:`row_layout_problem`); and :func:`generator`, the one reading of an ``rng`` argument."""
 
 from __future__ import annotations
 
+import copy
+import dataclasses
 import functools
+import re
 
 import numpy as np
 
@@ -23,6 +27,8 @@ def through_sensor(method, which: str, mdp_class: type):
         with family_code():  # what the family's own code builds, it holds: not checked again (tasks.held)
             mdp = method(self, *args, **kwargs)
             check_made(self, which, mdp, mdp_class)
+            if which == "make":
+                check_made_label(self, mdp, kwargs.get("label", args[1] if len(args) > 1 else ""))
             if not self.sensor.exact:
                 mdp = mdp.with_sensor(self.sensor)
             mdp = mdp if self.drift.none else mdp.with_drift(self.drift)
@@ -52,6 +58,16 @@ def check_made(family, method: str, mdp: object, mdp_class: type) -> None:
         )
 
 
+def check_made_label(family, mdp, label: object) -> None:
+    """Refuse an MDP that ``family.make(params, label=label)`` answered under another label than the text ``label`` given:
+    a make that ignored it labelled all 110 fixed MDPs alike, so records and stores could not tell them apart (T54-B13)."""
+    if isinstance(label, str) and label and mdp.label != label:
+        raise NeurohoverError(
+            f"{family.name} make()'s answer labelled {brief(mdp.label)} is not allowed: make(params, label={label!r}) must answer "
+            f"an MDP of that label, neurohover.MDP({family.name!r}, ..., label=label)"
+        )
+
+
 MAX_SAMPLES = 10**7  # MDPs drawn in one call (their rows: 2.9 GB)
 
 
@@ -73,9 +89,42 @@ def checked_draws(method):
         if not isinstance(rng, np.random.Generator):
             raise NeurohoverError(f"rng={rng!r} is not allowed: give a numpy Generator (np.random.default_rng(seed))")
         whole_in(n, "n", 0, MAX_SAMPLES, f"{MAX_SAMPLES:,} (MDPs drawn in one call)")  # np.timedelta64 was int()'s TypeError (T17-1)
-        return checked_answer(self, method(self, rng, int(n)), int(n))
+        probe = None if type(self) in _DRAWS_AS_SINGLES else copy.deepcopy(rng)  # the generator as it was, for the check below
+        answer = checked_answer(self, method(self, rng, int(n)), int(n))
+        if probe is not None:  # once per class: its batches drew MDPs its single draws never gave, unnoticed (T54-B01)
+            _DRAWS_AS_SINGLES.add(type(self))  # before: a sample_params that calls itself does not check again
+            try:
+                check_batches(self, method, probe)
+            except BaseException:
+                _DRAWS_AS_SINGLES.discard(type(self))
+                raise
+        return answer
 
     return draws
+
+
+#: The family classes whose sample_params was found to draw n MDPs as n single draws would (:func:`check_batches`).
+_DRAWS_AS_SINGLES: set[type] = set()
+
+
+def check_batches(family, method, rng: np.random.Generator) -> None:
+    """Refuse a family whose ``sample_params`` (``method``, unchecked) does not draw 2 MDPs as 2 single draws would, both
+    values and the generator consumed, from copies of ``rng``: the protocol's promise that a stream of MDPs does not
+    depend on batch sizes (sample_rows, evolution over G and the vector environment would fly MDPs sample() never gives)."""
+    batched, single = copy.deepcopy(rng), rng
+    pair = checked_answer(family, method(family, batched, 2), 2)
+    one_by_one = np.concatenate([checked_answer(family, method(family, single, 1), 1) for _ in range(2)])
+    what = f"{family.name} sample_params(rng, 2)'s answer"
+    allowed = "give n draws that consume the generator as n single draws would (a stream of MDPs must not depend on batch sizes)"
+    close = np.isclose(pair, one_by_one, rtol=1e-9, atol=1e-12)
+    if not close.all():
+        i, j = (int(k) for k in np.argwhere(~close)[0])
+        raise NeurohoverError(
+            f"{what} is not allowed: its row {i} has {family.param_names[j]}={float(pair[i, j])!r}, where single draws sample_params(rng, 1) from the "
+            f"same generator give {float(one_by_one[i, j])!r} (draw {i}); {allowed}"
+        )
+    if not np.array_equal(batched.bit_generator.random_raw(2), single.bit_generator.random_raw(2)):
+        raise NeurohoverError(f"{what} is not allowed: it leaves the generator elsewhere than 2 single draws sample_params(rng, 1) do; {allowed}")
 
 
 def checked_answer(family, answer, n: int) -> np.ndarray:
@@ -101,3 +150,54 @@ def checked_answer(family, answer, n: int) -> np.ndarray:
         i = int(outside[0])
         raise NeurohoverError(f"{what} row {i} {brief(arr[i].tolist())} is out of range: each parameter must lie in [{low:g}, {high:g}]")
     return arr
+
+
+#: What a task family's name may be: the records write it before '/' in MDP labels and targets, before ':' in specs and
+#: inside Gymnasium ids, and the task lookup reads any case with hyphens dropped (tasks.task_key), so one line of at most
+#: 64 lowercase letters, digits, '.' and '_' ('he/avy/seeded-train:1' read as family 'he'; T54-B08).
+FAMILY_NAME = re.compile(r"[a-z0-9][a-z0-9._]{0,63}")
+#: The flags of a family class, with what True means (T54-B11).
+FLAGS = {"has_sigma": "it has a breadth sigma, a field of its dataclass", "generic_over_distribution": "its generic policies are evolved over G"}
+
+
+def class_problem(entry: str, name: str, cls: type) -> str:
+    """What is wrong with a run-time task family class registered as ``name`` ('' when nothing), beside the registry's
+    shared checks (``entry``: the refusal's start, ``TASK_FAMILIES['x'] = ... is not allowed``): a name the records cannot
+    hold (T54-B08), a flag that is no bool ('no' read as True; T54-B11), has_sigma without a ``sigma`` field
+    (get_task_family(name, 0.3) was a TypeError; T54-B10)."""
+    if not FAMILY_NAME.fullmatch(name):
+        return (
+            f"{entry}: a task family's name is one line of at most 64 lowercase letters, digits, '.' and '_' (no '/', ':', spaces, capitals "
+            "or '-': the records write it in MDP labels F/train:N, and the task lookup reads any case with hyphens dropped)"
+        )
+    flags = {flag: getattr(cls, flag, None) for flag in FLAGS}
+    for flag, value in flags.items():
+        if not isinstance(value, (bool, np.bool_)):
+            return f"{entry}: its {flag} {brief(value)} is no bool: give True ({FLAGS[flag]}) or False"
+    if flags["has_sigma"] and not (dataclasses.is_dataclass(cls) and any(f.name == "sigma" and f.init for f in dataclasses.fields(cls))):
+        return (
+            f"{entry}: its has_sigma is True, but it has no sigma field: declare one in its dataclass (sigma: float = 0.3, as FGHH does) "
+            "or set has_sigma = False"
+        )
+    return ""
+
+
+def row_layout_problem(family, probe: np.ndarray, template: np.ndarray) -> str:
+    """Why ``template``, the kernel row of ``family.make(probe)``, does not hold ``probe`` at the family's ``row_slice``
+    ('' when it does), naming where the parameters sit if they sit together elsewhere (it was a RuntimeError; T54-B12)."""
+    where = family.row_slice
+    check = template.copy()
+    check[where] = probe
+    if np.array_equal(check, template):
+        return ""
+    n = len(probe)
+    found = next((i for i in range(len(template) - n + 1) if np.array_equal(template[i : i + n], probe)), None)
+    hint = (
+        f"they sit at slice({found}, {found + n}): give row_slice = slice({found}, {found + n})"
+        if found is not None
+        else "they sit nowhere in its row: make(params) must build the MDP of those parameters"
+    )
+    return (
+        f"{family.name} make()'s kernel row is not allowed: it does not put the parameters {brief(probe.tolist())} in row_slice {where} "
+        f"(it holds {brief(template[where].tolist())} there); {hint}"
+    )
