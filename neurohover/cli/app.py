@@ -155,9 +155,16 @@ def _unwritable_stderr_closed() -> None:
             sys.stderr = None
 
 
+def _negative_number(arg: str) -> bool:
+    """Whether ``arg`` reads as a negative number or list of them: '-1,5', '-.5', and '-inf', '-nan', '-Infinity' in any
+    case (argparse took those for options: "expected one argument"; T54-A02)."""
+    rest = arg[1:2].isdigit() or arg[1:2] == "." or arg[1:].lower().startswith(("inf", "nan"))
+    return arg[:1] == "-" and rest
+
+
 def _negative_values_attached(parser: argparse.ArgumentParser, given: list[str]) -> list[str]:
     """``--runs -1,5`` as ``--runs=-1,5``: argparse takes a value that starts with '-' and is not a plain number for an
-    option and says only "expected one argument" (fourth trial); attached, the option's own check names it. A unique
+    option and says only "expected one argument" (fourth trial; -inf and -nan too, T54-A02); attached, the option's own check names it. A unique
     abbreviation (``--win -3,1``) is joined too: argparse accepts abbreviations everywhere else."""
     takes_value = {o for a in parser._actions if a.nargs is None for o in a.option_strings}
     every = {o for a in parser._actions for o in a.option_strings}
@@ -168,7 +175,7 @@ def _negative_values_attached(parser: argparse.ArgumentParser, given: list[str])
 
     out: list[str] = []
     for arg in given:
-        if out and spelled_out(out[-1]) in takes_value and len(arg) > 1 and arg[0] == "-" and (arg[1].isdigit() or arg[1] == "."):
+        if out and spelled_out(out[-1]) in takes_value and _negative_number(arg):
             out[-1] = f"{out[-1]}={arg}"
         else:
             out.append(arg)
