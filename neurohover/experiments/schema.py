@@ -23,7 +23,7 @@ from ..evolution.optimisers import optimiser_spec
 from ..integrations.neat import NEAT_TOPOLOGY
 from ..models.lr import DEFAULT_NOISE_ESTIMATE
 from ..models.model import default_model_substeps
-from ..tasks import TASK_FAMILIES, Drift
+from ..tasks import Drift, family_class, task_names
 from .checks import OMIT, REQUIRED, schema_of
 from .readonly import plain
 from .settings import KIND_SETTINGS
@@ -92,8 +92,8 @@ def check_kind(settings: dict, kind: str, where: str) -> None:
     """Cross-field checks (and the defaults they write in), by the experiment's kind."""
     task, sigma = settings["task"], settings.get("sigma")
 
-    if sigma is not None and not TASK_FAMILIES[task].has_sigma:
-        with_sigma = ", ".join(repr(n) for n, c in TASK_FAMILIES.items() if c.has_sigma)
+    if sigma is not None and not family_class(task).has_sigma:  # the registry's checked entries: a has_sigma 'no' was listed (T54-B11)
+        with_sigma = ", ".join(repr(n) for n in task_names() if family_class(n).has_sigma)
         raise NeurohoverError(f"{where}: sigma applies to task {with_sigma} only, not {task!r}")
     if kind == "evolution":
         _check_evolution(settings, task, where)
@@ -154,6 +154,9 @@ def check_used(written: dict, settings: dict, kind: str, where: str, switched: f
     if kind == "evolution":
         robust = bool(settings["robustness_variants"]) or "robustness_policies" in settings
         _idle(written, schema, ("robustness_episodes",), robust, "Table 3's robustness units (robustness_variants, or robustness_policies)", where)
+    if kind == "model_learning":  # read only by the fits with model_policy = 'authors', yet part of the hash (T54-A01)
+        authors = any(f["model_policy"] == "authors" for f in settings.get("fits", ()))
+        _idle(written, schema, ("authors_generations",), authors, "the fits with model_policy = 'authors'", where)
     if kind != "test_runs":
         return
     groups, task = settings["groups"], settings["task"]
@@ -162,7 +165,7 @@ def check_used(written: dict, settings: dict, kind: str, where: str, switched: f
     _idle(written, schema, ("model_budget", "predict_episodes", "max_learning_episodes"), bool(learning), f"the agents that learn models ({learners})", where)
     authors = any(g.get("model_policy") == "authors" for g in learning)
     _idle(written, schema, ("authors_generations",), authors, "the groups of agents that learn models with model_policy = 'authors'", where)
-    fghh = TASK_FAMILIES[task].generic_over_distribution
+    fghh = family_class(task).generic_over_distribution
     needs = {n for g in groups for n in AGENTS[g["agent"]].needs} | {AGENTS[g["agent"]].generic_kind for g in groups if fghh}
     evolved = (needs - set(settings.get("generics_from") or {})) if settings["policies"] == "evolve" else set()
     written = {k: v for k, v in written.items() if k not in switched or k not in POLICY_EVOLUTION_SETTINGS}
@@ -241,7 +244,7 @@ def _check_evolution(settings: dict, task: str, where: str) -> None:
             raise NeurohoverError(f"{where}: variant key {key!r:.60} is not allowed: give {_KEY_WORD_ALLOWED}")
     _unique_labels(settings["variants"], "variant", where)
     for v in settings["variants"]:
-        if v["sigma"] is not None and not TASK_FAMILIES[task].has_sigma:
+        if v["sigma"] is not None and not family_class(task).has_sigma:
             raise NeurohoverError(f"{where}: variant {v['key']!r} sets sigma but the task is {task!r}")
         if settings["target"] != "family" and parse_resampling(v["resampling"]).selects:
             raise NeurohoverError(f"{where}: variant {v['key']!r}: selection races and bandits need target = 'family'")
@@ -268,7 +271,7 @@ def _check_evolution(settings: dict, task: str, where: str) -> None:
     if settings["robustness_variants"] and settings["target"] != "train":
         raise NeurohoverError(f"{where}: robustness_variants need target = 'train'")
     if "robustness_policies" in settings:
-        if settings["target"] != "train" or TASK_FAMILIES[task].generic_over_distribution:
+        if settings["target"] != "train" or family_class(task).generic_over_distribution:
             raise NeurohoverError(
                 f"{where}: robustness_policies flies a set's specialised policies on the training MDPs: it needs target = 'train' and a GHH task"
             )
@@ -400,7 +403,7 @@ def _check_test_runs(settings: dict, task: str, where: str) -> None:
                 f"{where}: generics_from = {{ {kind} = {source!r} }} is not allowed: expected keys fixed and/or race holding "
                 "'EXPERIMENT/VARIANT', 'EXPERIMENT/best-race' (e.g. fixed = 'fig13/k5') or 'dir:PATH' (a directory of policy files)"
             )
-    if "generic_topology" in settings and (settings["policies"] != "evolve" or not TASK_FAMILIES[task].generic_over_distribution):
+    if "generic_topology" in settings and (settings["policies"] != "evolve" or not family_class(task).generic_over_distribution):
         raise NeurohoverError(f"{where}: generic_topology applies to the FGHH generics an experiment evolves itself (policies = 'evolve', task fghh)")
     _check_generic_resampling(settings["generic_resampling"], where)
 
