@@ -473,6 +473,23 @@ def _check_run(agent, family, mdp, episodes, seed, n_steps) -> tuple[MDP, int, i
     return mdp, seed, episodes, n_steps
 
 
+def _chosen(agent: Agent, e: int, flown: dict[str, tuple[Policy, int]]) -> Choice:
+    """The agent's choice for episode ``e``, checked: a Choice (a Policy was an AttributeError on .final; thirteenth
+    trial, F11) whose label names one policy over the run (``flown``: each label's policy and first episode, updated);
+    one label flying two policies recorded the learning episodes as the final policy's (T55-B06)."""
+    choice = agent.choose(e)
+    if not isinstance(choice, Choice):
+        raise NeurohoverError(f"agent {agent.name!r} chose {brief(choice)} for episode {e}: its choose must return a Choice")
+    policy, first = flown.setdefault(choice.label, (choice.policy, e))
+    if choice.policy != policy:  # (equal: the same topology and genome)
+        other = "another topology" if choice.policy.topology != policy.topology else "another genome"
+        raise NeurohoverError(
+            f"agent {agent.name!r} chose label {brief(choice.label)} for episode {e} with a policy of {other} than it flew under that label from episode "
+            f"{first}, which is not allowed: give each policy a label of its own (the label names the policy in the run's records)"
+        )
+    return choice
+
+
 def run_test(
     agent: Agent,
     family: TaskFamily,
@@ -513,10 +530,9 @@ def run_test(
 
     e = 0
     chunk = 1
+    flown: dict[str, tuple[Policy, int]] = {}
     while e < episodes:
-        choice = agent.choose(e)
-        if not isinstance(choice, Choice):  # a Policy was an AttributeError on .final (thirteenth trial, F11)
-            raise NeurohoverError(f"agent {agent.name!r} chose {brief(choice)} for episode {e}: its choose must return a Choice")
+        choice = _chosen(agent, e, flown)
         if choice.final:
             # The choice holds for the rest of the run: fly it in one parallel batch.
             rest = np.arange(e, episodes)

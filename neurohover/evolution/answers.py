@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -23,6 +24,7 @@ __all__ = [
     "asked_genomes",
     "check_made",
     "check_restored",
+    "check_round_trip",
     "check_state_json",
     "checked_champion",
     "checked_champion_genome",
@@ -105,26 +107,69 @@ def told_champion(opt: Optimiser, cfg: RunConfig) -> float:
     )
 
 
-def check_restored(opt: Any, state: dict, cfg: RunConfig) -> None:
+def check_restored(opt: Any, state: dict, cfg: RunConfig, written: Any, since: float) -> None:
     """AnswerError naming a user optimiser's from_state_dict where its answer is no optimiser, or (on one MDP, where the
     run's champion is its optimiser's) one whose champion_return is not the one the checkpoint's history records last:
-    one that ignored its state, or answered None, was called "a damaged checkpoint" of an intact file (T52-B12)."""
+    one that ignored its state, or answered None, was called "a damaged checkpoint" of an intact file (T52-B12). Then,
+    on one MDP and over a family, one whose state_dict() is not ``written`` (the checkpoint's optimiser state, as read,
+    restored from at ``time.perf_counter()`` ``since``), by :func:`check_round_trip`: one that forgot its generator or
+    champion resumed as another run (T55-B04)."""
     check_made(opt, cfg.optimizer, "from_state_dict")
-    if cfg.family is not None:
-        return
-    try:
-        history = decode_history(state["history"])
-        ret = float(opt.champion_return)
-    except STATE_DAMAGE:  # (a damaged history, or a return no number: the checks of the checkpoint name it)
-        return
-    saved = history[-1].champion_return if history else -math.inf
-    if ret != saved:
-        row = f"its last history row's, at generation {history[-1].generation:,}" if history else "its history has no row"
+    if cfg.family is None:
+        try:
+            history = decode_history(state["history"])
+            ret = float(opt.champion_return)
+        except STATE_DAMAGE:  # (a damaged history, or a return no number: the checks of the checkpoint name it)
+            history, ret = None, math.nan
+        saved = history[-1].champion_return if history else -math.inf
+        if history is not None and ret != saved:
+            row = f"its last history row's, at generation {history[-1].generation:,}" if history else "its history has no row"
+            raise AnswerError(
+                f"optimizer {brief(cfg.optimizer)}: its from_state_dict answered an optimiser of champion_return {enc_float(ret)}, where the checkpoint's "
+                f"champion has return {enc_float(saved)} ({row}), which is not allowed: from_state_dict(state) gives back the optimiser whose "
+                "state_dict() wrote state, its champion too"
+            )
+    check_round_trip(opt, written, cfg.optimizer, since)
+
+
+def check_round_trip(opt: Any, written: Any, optimizer: str, since: float) -> None:
+    """AnswerError naming the first entry (its path) where ``opt.state_dict()``, as strict JSON writes it, is not
+    ``written``, the state ``opt`` was restored from at ``time.perf_counter()`` ``since``: the README's "strict JSON
+    that reads back as it was" (T55-B04). Only a ``wall_seconds`` entry (the wall clock :class:`~.common.Clock`
+    continues) may have grown, by at most the seconds since then."""
+    mine = opt.state_dict()
+    seconds = time.perf_counter() - since
+    check_state_json(mine, optimizer)
+    found = _difference(json.loads(json.dumps(mine, allow_nan=False)), written, "", seconds)
+    if found is not None:
+        at, now, was = found
         raise AnswerError(
-            f"optimizer {brief(cfg.optimizer)}: its from_state_dict answered an optimiser of champion_return {enc_float(ret)}, where the checkpoint's "
-            f"champion has return {enc_float(saved)} ({row}), which is not allowed: from_state_dict(state) gives back the optimiser whose "
-            "state_dict() wrote state, its champion too"
+            f"optimizer {brief(optimizer)}: its from_state_dict answered an optimiser whose state_dict() entry {at or '(the whole state)'} is {now}, "
+            f"where the checkpoint's state has {was}, which is not allowed: from_state_dict(state) gives back the optimiser whose state_dict() "
+            "wrote state, all of it (its generator's state and champion too)"
         )
+
+
+def _difference(mine: Any, was: Any, at: str, seconds: float) -> tuple[str, str, str] | None:
+    """The first path under ``at`` where ``mine`` is not ``was`` as strict JSON writes them (a key missing, another type,
+    1 for 1.0), with the two shown; None where they agree (``wall_seconds`` may have grown by ``seconds``)."""
+    if isinstance(mine, dict) and isinstance(was, dict):
+        for key in [*was, *(k for k in mine if k not in was)]:
+            if key not in mine or key not in was:
+                return f"{at}[{key!r}]", "missing" if key not in mine else brief(mine[key]), "no such entry" if key not in was else brief(was[key])
+            found = _difference(mine[key], was[key], f"{at}[{key!r}]", seconds)
+            if found is not None:
+                return found
+        return None
+    if isinstance(mine, list) and isinstance(was, list) and len(mine) == len(was):
+        return next(filter(None, (_difference(a, b, f"{at}[{i}]", seconds) for i, (a, b) in enumerate(zip(mine, was)))), None)
+    if isinstance(mine, list) and isinstance(was, list):
+        return at, f"a list of {len(mine):,}", f"a list of {len(was):,}"
+    if json.dumps(mine) == json.dumps(was):
+        return None
+    if at.endswith("['wall_seconds']") and all(type(v) is float for v in (mine, was)) and 0 <= mine - was <= seconds:
+        return None  # the wall clock ran on between from_state_dict and state_dict (a PopulationOptimiser's)
+    return at, brief(mine), brief(was)
 
 
 def checked_champion_genome(opt: Optimiser, cfg: RunConfig) -> np.ndarray | None:

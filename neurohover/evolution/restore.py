@@ -9,6 +9,7 @@ again at once, so a checkpoint's stop reason must be the one its state stops by 
 
 from __future__ import annotations
 
+import hashlib
 import math
 from typing import TYPE_CHECKING, Any
 
@@ -17,6 +18,7 @@ import numpy as np
 from ..errors import NeurohoverError, brief, finite_real, whole_number
 from ..flyer import MAX_EPISODE_INDEX
 from ..sim.constants import CRASH_STEP_PENALTY, MAX_SECONDS, seconds_allowed
+from ..tasks import TaskFamily
 from .answers import stopped
 from .common import EntryError, Optimiser, check_entries, check_genomes, damage_text, dec_array, dec_float, enc_float
 from .config import MAX_BUDGET, Resampling
@@ -36,7 +38,10 @@ def damaged(source: str, err: Exception) -> NeurohoverError:
 
 
 #: Every entry a checkpoint (:meth:`Run.state`) has held, and every entry of its counters and champion tables.
-CHECKPOINT_ENTRIES = ("format", "config", "budget", "optimizer_state", "counters", "mdp_stream", "race_delta", "champion", "history", "stop_reason")
+CHECKPOINT_ENTRIES = (
+    *("format", "config", "budget", "optimizer_state", "counters", "mdp_stream", "race_delta", "champion", "history", "stop_reason"),
+    "family_draws",  # over a task family registered at run time only (T55-B10)
+)
 COUNTERS = ("episodes", "next_index", "flown", "steps", "generation", "evaluations", "wall_seconds", "kernel_seconds")
 #: The checkpoint entries that are tables, and what each holds (for the message refusing one that is not).
 _TABLES = {
@@ -46,6 +51,39 @@ _TABLES = {
 }
 #: Why a run stopped, as :func:`stop_reason` says it.
 STOP_REASONS = ("budget", "plateau", "generations", *sorted({spec.stop_reason for spec in SHIPPED_SPECS.values()}))
+
+
+#: The seed and number of the draws whose digest (:func:`family_draws`) a checkpoint over a run-time family records.
+FAMILY_DRAWS_SEED, FAMILY_DRAWS = 20261207, 4
+
+
+def family_draws(family: TaskFamily | None, shipped_too: bool = False) -> str | None:
+    """A digest of ``family``'s distribution G (sha256 of :data:`FAMILY_DRAWS` seeded draws of its ``sample_params``,
+    16 hex digits) where it is registered at run time (its class not neurohover's own), else None (and for one MDP): a
+    family redefined under its name between a run and its resume flew two distributions as one (T55-B10). A shipped
+    family's checkpoint records none, its format as before (its class cannot change under its name); ``shipped_too``
+    digests one anyway (a checkpoint that records one is compared)."""
+    if family is None or (not shipped_too and type(family).__module__.split(".")[0] == "neurohover"):
+        return None
+    draws = np.ascontiguousarray(family.sample_params(np.random.default_rng(FAMILY_DRAWS_SEED), FAMILY_DRAWS), dtype=np.float64)
+    return hashlib.sha256(draws.tobytes()).hexdigest()[:16]
+
+
+def check_family_draws(state: dict, family: TaskFamily | None, source: str) -> None:
+    """NeurohoverError where checkpoint ``state`` records a digest of its family's draws (:func:`family_draws`) that the
+    family resuming it no longer gives; a checkpoint without one (older, or a shipped family's) resumes as before."""
+    saved = state.get("family_draws")
+    if saved is None:
+        return
+    if family is None or not isinstance(saved, str):
+        raise damaged(source, EntryError(f"family_draws={brief(saved)} is not allowed: allowed a digest of text, over a task family only, as the run wrote it"))
+    now = family_draws(family, shipped_too=True)
+    if now != saved:
+        raise NeurohoverError(
+            f"{source} was written by a run over another task family {brief(family.name)} (its sample_params' seeded draws have digest {saved}, "
+            f"the family's now {now}: it was redefined under its name since), which is not allowed: resume with the family defined as when the run "
+            "began, or start again without resuming"
+        )
 
 
 def stop_reason(method: str, opt: Optimiser, budget: int | None, episodes: int, generation: int) -> str | None:

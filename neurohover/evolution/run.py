@@ -8,6 +8,7 @@ and :meth:`Run.restore` continues from one bit-for-bit, after :mod:`~neurohover.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 import signal
@@ -58,7 +59,18 @@ from .records import (
     refuse_replaced,
     write_checkpoint,
 )
-from .restore import check_between_generations, check_prototype, check_run_entries, check_stop_reason, check_tables, damaged, restored_parts, stop_reason
+from .restore import (
+    check_between_generations,
+    check_family_draws,
+    check_prototype,
+    check_run_entries,
+    check_stop_reason,
+    check_tables,
+    damaged,
+    family_draws,
+    restored_parts,
+    stop_reason,
+)
 from .seeding import mdp_rng, noise_seed, optimiser_seed
 from .steady_state import SteadyStateNE
 
@@ -142,6 +154,7 @@ class Run:
         self.stop_reason: str | None = None
         self._parking: Parking | None = None  # slots of a race's parked episodes, reused from race to race
         self.race_delta = self.resampling.delta  # race:auto changes it race by race (in the checkpoint)
+        self._family_draws = family_draws(self.family)  # None on one MDP and over a shipped family
 
     # ----------------------------------------------------------------- checkpoints
 
@@ -167,7 +180,7 @@ class Run:
             "champion": {"genome": None if self.champion_genome is None else self.champion_genome.tolist(), "return": enc_float(self.champion_return)},
             "history": encode_history(self.history),
             "stop_reason": self.stop_reason,
-        }
+        } | ({} if self._family_draws is None else {"family_draws": self._family_draws})  # a run-time family's G (T55-B10)
 
     def restore(self, state: dict, source: str) -> None:
         """Continue from checkpoint ``state`` (read from ``source``, named in errors); its run must
@@ -189,12 +202,15 @@ class Run:
                 "target, method, optimizer, resampling, topology, prototype, seed, episode steps and settings (only the budget may change)"
                 + preset_hint(saved, self.config)
             )
+        check_family_draws(state, self.family, source)  # the family's name alike, its G too (T55-B10)
+        user = self.method in OPTIMISERS and self.method not in SHIPPED
+        written, since = copy.deepcopy(state.get("optimizer_state")) if user else None, time.perf_counter()  # as read: from_state_dict may edit it
         try:
             opt = type(self.opt).from_state_dict(state["optimizer_state"])
         except STATE_DAMAGE as err:  # from_state_dict names the damaged entry; a state's own class may raise more
             raise NeurohoverError(f"{source}: cannot restore the optimiser ({damage_text(err)})") from None
-        if self.method in OPTIMISERS and self.method not in SHIPPED:  # named, not "a damaged checkpoint" (T52-B12)
-            check_restored(opt, state, self.cfg)
+        if user:  # named, not "a damaged checkpoint" (T52-B12); its whole state read back, over a family too (T55-B04)
+            check_restored(opt, state, self.cfg, written, since)
         mine, theirs = (getattr(o, "settings", None) for o in (self.opt, opt))  # the state's own copy was flown, unchecked
         if dataclasses.is_dataclass(mine) and dataclasses.is_dataclass(theirs) and not isinstance(mine, type) and not isinstance(theirs, type):
             differs = config_difference("optimizer_state.settings", dataclasses.asdict(theirs), dataclasses.asdict(mine))
