@@ -326,7 +326,9 @@ class HoverVectorEnv(FixedSettings, VectorEnv):
             and all(s is None or (whole_number(s) and 0 <= s <= MAX_SEED) for s in seed)
         ):
             return [None if s is None else int(s) for s in seed]
-        raise NeurohoverError(f"seed={brief(seed)} is not allowed: give None, an integer in 0..2**63-1, or a list of {n} such integers (or None)")
+        raise NeurohoverError(  # one seed's range as the refusal above states it: seed + i seeds sub-environment i (T55-B11)
+            f"seed={brief(seed)} is not allowed: give None, an integer in 0..2**63-{n}, or a list of {n} integers in 0..2**63-1 (or None)"
+        )
 
     def _check_streams(self, value: Any) -> list[tuple[int, int]]:
         n = self.num_envs

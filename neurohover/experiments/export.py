@@ -23,6 +23,7 @@ from .config import ExperimentConfig
 from .external import external_digest
 from .keys import UnitKey
 from .plans import Plan, plan, run_keys, source_results
+from .put_checks import key_shape_problem
 from .result_checks import params_problem
 from .results import UnitResult, flat_cells, result_from_dict
 from .store import Store
@@ -71,17 +72,6 @@ def resolve_scale(store: Store, name: str, scale: str | None) -> str:
     return scale
 
 
-#: The unit key stages (:class:`~neurohover.experiments.keys.UnitKey`) each experiment kind's plan names its units with.
-PLANNED_STAGES = {"evolution": ("evolve", "robust"), "model_learning": ("policy", "model"), "test_runs": ("policy", "run")}
-_KEY_FORMS = {
-    "evolve": "evolve/<variant>[/train<i>]/run<r>",
-    "robust": "robust/<variant>/train<i>",
-    "policy": "policy/<name>",
-    "model": "model/<method>/<mdps><i>",
-    "run": "run/<group>/<mdps><i>/rep<r>",
-}
-
-
 def _check_hashes(store: Store, name: str, scale: str, stored: dict, config: ExperimentConfig) -> None:
     """Refuse an experiment whose recorded config hash is not its config's, or a unit run under another hash: a
     config_hash set to 'deadbeef' was exported and reported, a unit's set to 'x' reused by reproduce (T20-04).
@@ -99,20 +89,10 @@ def _check_hashes(store: Store, name: str, scale: str, stored: dict, config: Exp
 
 
 def _check_key(config: ExperimentConfig, unit: dict) -> None:
-    """Refuse a unit key of no shape the experiment's plan gives (e.g. 'run/../../x' was exported and drawn, and left out
-    by wins; T20-05): a stage its kind plans, its parts written back as the key. A 'diagnostic' unit (the tests' own
-    plans) may have any key."""
-    if unit["kind"] == "diagnostic":
-        return
-    key = UnitKey.parse(unit["key"])
-    stages = PLANNED_STAGES[config.kind]
-    try:
-        fits = key.stage in stages and UnitKey.make(key.stage, key.group, key.mdp, key.rep) == unit["key"]
-    except ValueError:
-        fits = False
-    if not fits:
-        forms = " or ".join(_KEY_FORMS[s] for s in stages)
-        raise NeurohoverError(f"its key is of no shape a {config.kind} experiment plans: its unit keys are {forms}")  # the caller names the unit
+    """Refuse a unit key of no shape the experiment's plan gives (:func:`~.put_checks.key_shape_problem`; T20-05)."""
+    problem = key_shape_problem(config.kind, unit["key"], unit["kind"])
+    if problem:
+        raise NeurohoverError(problem)  # the caller names the unit
 
 
 def _replannable(config: ExperimentConfig) -> bool:

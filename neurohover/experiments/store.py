@@ -40,7 +40,7 @@ from ..errors import NeurohoverError, brief, check_flag
 from ..filekinds import refuse_long_store_name, refuse_sqlite_name
 from ..jsontext import JSONError, strict_json
 from ..paths import WriterLock
-from ..sim.constants import MAX_SECONDS, seconds_allowed
+from .put_checks import planned_problem, put_arguments
 from .store_checks import (
     HELD_SQL,
     MAX_CORES,
@@ -67,7 +67,6 @@ from .store_checks import (
     sqlite_says,
     stored_count,
     take_writer_lock,
-    unit_texts,
 )
 from .store_checks import transaction as _transaction
 from .store_clock import WALL_SQL, SessionClocks, clock_time, stored_seconds, stored_time
@@ -492,24 +491,20 @@ class Store:
         dropped without a word: a lost result; fourteenth trial, T14-5).
         """
         where = self._where("put")
-        check_experiment(name, scale, where)
-        check_text(config_hash, "config_hash", where)
-        params, text = unit_texts(unit, result, name, where)
-        if not seconds_allowed(seconds):  # what Store.units reads back (1e300 was exported; T45-B02)
-            raise NeurohoverError(f"{where}: seconds = {brief(seconds)} is not allowed: give a finite number of seconds >= 0, at most {MAX_SECONDS:.6g}")
-        check_text(worker, "worker", where, empty=True)
-        if session is not None:
-            session = stored_count(session, "session", where, 1)
+        params, text, session = put_arguments(where, name, scale, config_hash, unit, result, seconds, worker, session)
         now = clock_time(where)
         self.lock()
         c = self.conn
         with _transaction(c):
-            row = c.execute("SELECT config_hash FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
+            row = c.execute("SELECT config_hash, config FROM experiments WHERE name = ? AND scale = ?", (name, scale)).fetchone()
             if row is None or row[0] != config_hash:
                 raise NeurohoverError(
                     f"refusing to record unit {unit.key!r}: experiment {name!r} ({scale}) in "
                     f"{str(self.path)!r} has config hash {row[0] if row else None}, not {config_hash}"
                 )
+            problem = planned_problem(self._json(row[1], f"experiment {name} ({scale})'s config"), scale, unit)
+            if problem:  # every reader then refused the whole experiment as damaged (T55-B09)
+                raise NeurohoverError(f"{where}: unit {brief(unit.key)} is not allowed: {problem}; give a unit of the plan of {name} ({scale})")
             problem = "" if session is None else session_problem(c, session, (name, scale, config_hash))
             if problem:  # another experiment's session, or an ended one, counted the unit (T29-B05)
                 raise NeurohoverError(f"{where}: {problem}")

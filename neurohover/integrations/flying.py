@@ -28,7 +28,7 @@ import numpy as np
 
 from ..envs.arguments import check_episode_steps, check_obs_dtype, real_values
 from ..envs.vector import HoverVectorEnv
-from ..errors import NeurohoverError, brief, check_arity, float64_of, refused_signature, whole_in
+from ..errors import NeurohoverError, brief, check_arity, float64_of, masked_note, refused_signature, whole_in
 from ..evaluate import Evaluation, check_first_episode
 from ..policies import Policy
 from ..sim.constants import ACTION_DIM, EPISODE_STEPS
@@ -165,6 +165,8 @@ def checked_obs_statistics(mean: Any, var: Any, n_obs: int, what: str) -> tuple[
     reported as the agent crashing, other shapes were tracebacks (ninth trial)."""
     checked = []
     for name, value in (("mean", mean), ("var", var)):
+        if isinstance(value, np.ma.MaskedArray):  # np.asarray drops the mask: the hidden values were taken (T55-B12)
+            raise NeurohoverError(f"{what} holds a {name} that is not an array of {n_obs} real numbers{masked_note(value)}")
         try:
             a = np.asarray(value)
         except (TypeError, ValueError):  # a ragged nesting

@@ -29,6 +29,7 @@ def through_sensor(method, which: str, mdp_class: type):
             check_made(self, which, mdp, mdp_class)
             if which == "make":
                 check_made_label(self, mdp, kwargs.get("label", args[1] if len(args) > 1 else ""))
+                check_made_bounds(self, mdp)
             if not self.sensor.exact:
                 mdp = mdp.with_sensor(self.sensor)
             mdp = mdp if self.drift.none else mdp.with_drift(self.drift)
@@ -65,6 +66,21 @@ def check_made_label(family, mdp, label: object) -> None:
         raise NeurohoverError(
             f"{family.name} make()'s answer labelled {brief(mdp.label)} is not allowed: make(params, label={label!r}) must answer "
             f"an MDP of that label, neurohover.MDP({family.name!r}, ..., label=label)"
+        )
+
+
+def check_made_bounds(family, mdp) -> None:
+    """Refuse an MDP that ``family.make`` answered whose parameters (its kernel row at the family's ``row_slice``, where
+    :meth:`~neurohover.tasks.base.TaskFamily.rows` writes them) lie outside the family's ``param_bounds``, naming the
+    first such parameter: it was flown, where rows() of the same parameters refused them (T55-B05)."""
+    low, high = family.param_bounds
+    values = mdp.row()[family.row_slice]
+    outside = np.flatnonzero((values < low) | (values > high))
+    if outside.size:
+        j = int(outside[0])
+        raise NeurohoverError(
+            f"{family.name} make()'s answer {brief(mdp.label or mdp)} is out of range: its {family.param_names[j]}={float(values[j])!r} lies "
+            f"outside the family's param_bounds; each parameter must lie in [{low:g}, {high:g}] ({', '.join(family.param_names)})"
         )
 
 
