@@ -52,7 +52,8 @@ class AgentOptions:
 
 class AgentSettings:
     """What an agent's own settings class provides (a frozen dataclass that also subclasses this):
-    ``from_dict`` (unknown keys refused, a NeurohoverError for a bad value), ``to_dict``, and
+    ``from_dict`` (unknown keys refused, a NeurohoverError for a bad value: one its ``__post_init__`` refuses, one
+    that is not its field's type where that is int, float, bool or text, or a non-finite number), ``to_dict``, and
     ``from_unit``, the settings of an experiment's test-run unit: by default its params'
     ``agent_settings`` table, which the planner copies from the config group's ``settings``."""
 
@@ -172,12 +173,21 @@ class AgentSpec:
 
     def built(self, policies: AgentPolicies, options: AgentOptions) -> Agent:
         """``build(policies, options)``, its answer checked to be an :class:`~neurohover.agents.protocol.Agent` (None or a
-        Policy was an AttributeError or FrozenInstanceError where make_agent marked it, T52-B14)."""
+        Policy was an AttributeError or FrozenInstanceError where make_agent marked it, T52-B14) that, where settings were
+        given and it holds settings of this kind (or None) as ``settings``, holds those given (T55-B07)."""
         from .protocol import Agent
 
         agent = self.build(policies, options)
         if not isinstance(agent, Agent):
             raise NeurohoverError(f"agent {self.name!r}: its build answered {brief(agent)}, which is not allowed: {_BUILD}")
+        given, held = options.settings, getattr(agent, "settings", _NONE_HELD)
+        # a build that dropped them flew with settings None while the run recorded those given (T55-B07); an agent that
+        # holds them elsewhere (the shipped agents' settings are a ModelEvolution, say) is not compared
+        if given is not None and (held is None or isinstance(held, AgentSettings)) and held != given:
+            raise NeurohoverError(
+                f"agent {self.name!r}: its build made an agent whose settings are {brief(held)}, not the {type(given).__name__} it was given "
+                f"({brief(given)}), which the run records: hand options.settings on to the agent"
+            )
         return agent
 
     def applies_to(self, family: TaskFamily) -> bool:
@@ -192,6 +202,9 @@ class AgentSpec:
 
         return tuple(name for name in task_names() if self.applies_to(get_task_family(name)))  # run-time entries too (T46-B07)
 
+
+#: An agent without a ``settings`` attribute: it holds its settings, if any, where :meth:`AgentSpec.built` cannot see them.
+_NONE_HELD = object()
 
 #: What a spec's ``build`` must be, for messages.
 _BUILD = "build(policies, options) (an AgentPolicies and an AgentOptions) must answer an Agent (neurohover.agents.protocol.Agent)"

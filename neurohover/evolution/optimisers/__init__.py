@@ -13,10 +13,10 @@ the same; its champions record it as method and optimizer ``user:my-es`` (:func:
 reads (one without it registered too), while a record of a shipped optimiser's name is checked against the shipped spec.
 Where the registry is used (:func:`optimiser_spec`: ``evolve``, an experiment config, a run's record) its entry must be
 an :class:`OptimiserSpec` under its own name, a shipped name must hold its shipped spec (:data:`SHIPPED_SPECS`), and a
-run-time name is one line of at most 64 letters, digits and ``._+-`` (what :data:`USER_NAME` reads back) whose label is
-its name: ``label`` is how a shipped optimiser names its method (``cma`` evolves by ``cma-es``), and a run-time
-optimiser's method is its name (T41-B02..B04). A bad entry is refused by name where it is used, and no other run or
-policy file is the worse for it.
+run-time name is one line of at most 64 letters, digits and ``._+-`` (what :data:`USER_NAME` reads back; not ``ne``
+nor one of :data:`NE_METHODS`) whose label is its name: ``label`` is how a shipped optimiser names its method (``cma``
+evolves by ``cma-es``), and a run-time optimiser's method is its name (T41-B02..B04). A bad entry is refused by name
+where it is used, and no other run or policy file is the worse for it.
 """
 
 from __future__ import annotations
@@ -36,6 +36,7 @@ from ...errors import NeurohoverError, brief, frozen_dataclass_class, refused_si
 
 __all__ = [
     "NE",
+    "NE_METHODS",
     "OPTIMISERS",
     "SHIPPED",
     "SHIPPED_SPECS",
@@ -50,6 +51,9 @@ __all__ = [
 ]
 
 NE = "ne"  # the paper's neuroevolution: not a population optimiser of this registry
+#: The methods of the paper's neuroevolution, which an evolution run tells from a population optimiser's by name: no
+#: run-time optimiser's name (one named 'generational' was an AttributeError, 'steady-state' an AssertionError, T55-B08).
+NE_METHODS = ("steady-state", "generational")
 
 
 @dataclass(frozen=True)
@@ -64,7 +68,8 @@ class OptimiserSpec:
         One line for help texts.
     settings : type
         A frozen dataclass of its settings, with defaults of plain JSON values; its ``__post_init__`` raises
-        ValueError on a bad value.
+        ValueError on a bad value (a value given that is not its field's type, where that is int, float, bool or
+        text, or that is no finite number, is refused before the optimiser is made).
     make : callable
         ``make(prototype genome, settings, seed)`` -> an optimiser with ``ask``, ``tell(fitness, info)``,
         ``stop``, ``champion_genome``, ``champion_return``, ``state_dict`` and a
@@ -130,8 +135,9 @@ def entry_problem(name: object, spec: object) -> str:
         return shared
     assert isinstance(spec, OptimiserSpec)  # the shared checks refused anything else
     entry = f"OPTIMISERS[{brief(name)}] = {brief(spec)} is not allowed"
-    if not isinstance(name, str) or name == NE or not USER_NAME.fullmatch(f"user:{name}"):
-        return f"{entry}: a run-time optimiser's name is one line of at most 64 letters, digits and ._+- (not {NE!r}), which its records name as user:NAME"
+    if not isinstance(name, str) or name in (NE, *NE_METHODS) or not USER_NAME.fullmatch(f"user:{name}"):
+        taken = ", ".join(map(repr, (NE, *NE_METHODS)))
+        return f"{entry}: a run-time optimiser's name is one line of at most 64 letters, digits and ._+- (not {taken}), which its records name as user:NAME"
     if spec.label != name:
         return f"{entry}: its label {brief(spec.label)} is not its name; a run-time optimiser records its name as its method (user:{name}): leave label out"
     return _parts_problem(entry, spec)
