@@ -305,7 +305,7 @@ def compete(
 
     _check_run(jobs, device, on_result, progress)  # every check before the output directory is made (third trial)
     agent_spec(agent)  # an unknown agent named before the task is looked at
-    check_agent(agent, get_task_family(task, sigma), policy_dir)
+    check_agent(agent, get_task_family(task, sigma), policy_dir, agent_settings or None)  # its build, with its settings (T55-B07)
     config = competition_config(
         task, agent, runs=runs, episodes=episodes, mdps=mdps, seed=seed, sigma=sigma, n_steps=n_steps, policy_dir=policy_dir, hybrid=hybrid,
         sensor=sensor, drift=drift, wind_model=wind_model, lr_fit=lr_fit, agent_settings=agent_settings,

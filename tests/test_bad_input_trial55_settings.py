@@ -259,3 +259,15 @@ def test_a_run_time_optimiser_named_as_a_method_of_ne_is_refused(name):
             evolve(nh.get_task_family("ghh08"), optimizer=name, topology="slp", n_steps=10, budget=8)
     finally:
         OPTIMISERS.pop(name, None)
+
+
+def test_compete_refuses_a_build_that_drops_its_settings_before_writing(agents, tmp_path, capsys):  # T55-B07
+    from neurohover.cli import main
+
+    out = tmp_path / "c"
+    args = ["compete", "--task", "ghh08", "--runs", "1", "--episodes", "2", "--episode-steps", "20", "--out", str(out), "--agent-setting", "k=7"]
+    assert main([*args, "--agent", "dropping"]) == 2
+    err = capsys.readouterr().err
+    assert "agent 'dropping': its build made an agent whose settings are None, not the BSettings it was given" in err, err
+    assert not out.exists()
+    assert main([*args, "--agent", "holding"]) == 0, capsys.readouterr().err  # one that hands them on flies

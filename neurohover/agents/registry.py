@@ -12,7 +12,7 @@ import importlib
 import pkgutil
 from collections.abc import Mapping, Sequence
 from types import MappingProxyType
-from typing import cast
+from typing import Any, cast
 
 from ..errors import NeurohoverError, brief, package_path, registry_entry_problem
 from ..integrations.flying import generic_sigma_problem
@@ -162,14 +162,18 @@ def _refuse_idle_policy_dir(spec: AgentSpec, policy_dir: object) -> None:
         )
 
 
-def check_agent(name: str, family: TaskFamily | str, policy_dir: str | None = None) -> None:
+def check_agent(name: str, family: TaskFamily | str, policy_dir: str | None = None, settings: Any = None) -> None:
     """Refuse unknown agents, agents for another task (``family``: a task family or its name, as make_agent takes it), a
-    policy directory for an agent that flies no policy set, and missing or mismatched policy sets, with clear messages."""
+    policy directory for an agent that flies no policy set, missing or mismatched policy sets, and an agent its spec
+    builds otherwise than its ``settings`` say (its settings, as AgentOptions takes them), with clear messages: the
+    trial build that compete makes before it writes anything (a build dropping them was refused only once a run began;
+    T55-B07)."""
     family = _task_family(family, "family")
     spec = agent_spec(name, family)
     _refuse_idle_policy_dir(spec, policy_dir)
-    if spec.needs:
-        spec.built(policies_from_set(spec, _policy_set(family, policy_dir)), AgentOptions())
+    options = _checked_options(spec, AgentOptions(settings=settings))
+    if spec.needs or settings is not None:
+        spec.built(policies_from_set(spec, _policy_set(family, policy_dir)) if spec.needs else AgentPolicies(), options)
 
 
 def make_agent(name: str, family: TaskFamily | str, *, policy_dir: str | None = None, options: AgentOptions = AgentOptions()) -> Agent:
