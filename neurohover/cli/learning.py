@@ -34,6 +34,7 @@ from ..evaluate import DEVICES, check_device, check_episode_count
 from ..evolution.config import MAX_BUDGET
 from ..evolution.generational import GENERATIONAL_PRESETS
 from ..evolution.optimisers import OPTIMISERS, optimiser_names
+from ..evolution.records import EvolutionInterrupted
 from ..paths import input_file, output_file, printable, sole_writer
 
 MDP_FAMILY = "G"
@@ -196,7 +197,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
 
 
 def _evolve_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int:
-    from ..evolution.evolve import EvolutionInterrupted, evolve, parse_resampling, validation_return, write_history_csv
+    from ..evolution.evolve import evolve, parse_resampling, validation_return, write_history_csv
     from ..evolution.records import CHECKPOINT_KIND, HISTORY_KIND
     from ..filekinds import RUN_FILE_ENDS
     from ..policies import check_json_policy_name, save_policy
@@ -217,6 +218,7 @@ def _evolve_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int
     held.enter_context(warnings.catch_warnings(action="ignore", category=CheckpointReplaced))  # said by the note, not as evolve() warns
     settings = _optimiser_settings(args, mdp_desc == MDP_FAMILY)
     bar = _Bar(args.budget, f"evolve {family.name}/{mdp_desc}", note)
+    before = _modified(checkpoint)
     try:
         result = evolve(
             target,
@@ -236,19 +238,8 @@ def _evolve_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int
             settings=settings,
         )
     except EvolutionInterrupted as err:
-        from ..procs import stop_words
-
         bar.close()
-        how, status = stop_words(err)
-        if err.checkpoint is not None:
-            print(
-                f"neurohover evolve: {how} after {err.episodes} episodes; checkpoint saved to {err.checkpoint} "
-                "(run the same command with --resume to continue)",
-                file=sys.stderr,
-            )
-        else:
-            print(f"neurohover evolve: {how} mid-generation; the last periodic checkpoint (if any) is {printable(checkpoint)}", file=sys.stderr)
-        return status
+        return _evolve_stopped(err, checkpoint, before, args.resume)
     bar.close()
     # The champion's estimate is on the run's fitness scale (1/ln(error) over a family by default).
     scale = result.settings["settings"].get("fitness", "return") if result.settings.get("method") == "generational" else "return"
@@ -287,6 +278,36 @@ def _evolve_command(args: argparse.Namespace, held: contextlib.ExitStack) -> int
     }
     _print_evolve_summary(args, summary, result)
     return 0
+
+
+def _modified(path: Path) -> int | None:
+    """When ``path`` was last modified (ns), None where there is no such file."""
+    try:
+        return path.stat().st_mtime_ns
+    except OSError:
+        return None
+
+
+def _evolve_stopped(err: EvolutionInterrupted, checkpoint: Path, before: int | None, resumed: bool) -> int:
+    """Say how the stopped evolve run ``err`` ended and what it left; its exit status (128 + the
+    signal). ``before``: the checkpoint's :func:`_modified` when the run began."""
+    from ..procs import stop_words
+
+    how, status = stop_words(err)
+    if err.checkpoint is not None:
+        print(
+            f"neurohover evolve: {how} after {err.episodes} episodes; checkpoint saved to {err.checkpoint} (run the same command with --resume to continue)",
+            file=sys.stderr,
+        )
+        return status
+    # Stopped again mid-generation: the line named a checkpoint that was not there (T55-A01).
+    now = _modified(checkpoint)
+    if now is not None and (resumed or now != before):
+        left = f"its last checkpoint is {printable(checkpoint)} (run the same command with --resume to continue from it)"
+    else:
+        left = "no checkpoint of this run was saved"
+    print(f"neurohover evolve: {how} mid-generation; {left}", file=sys.stderr)
+    return status
 
 
 class _Ticker:

@@ -51,9 +51,10 @@ and when interrupted, a JSON file (``neurohover-evolution-checkpoint/1``) with t
 state and the history, atomically (written to ``PATH.PID.TID.tmp``, then ``os.replace``). ``resume=True``
 continues from it bit-for-bit (same champion, history and counters as an uninterrupted run); the
 run's configuration must match the checkpoint's, except the budget, which may be raised.
-Interrupts (Ctrl-C, or ``KeyboardInterrupt`` raised by the ``progress`` callback) take effect at
-the next generation boundary: the checkpoint is written and :class:`EvolutionInterrupted` (a
-``KeyboardInterrupt``) is raised; a second Ctrl-C stops at once without writing.
+Interrupts (Ctrl-C, a stop signal the command takes as SIGTERM: SIGTERM, SIGHUP, SIGUSR1, or a
+``KeyboardInterrupt`` raised by the ``progress`` callback) take effect at the next generation boundary:
+the checkpoint is written and :class:`EvolutionInterrupted` (a ``KeyboardInterrupt``; raised from
+:class:`~neurohover.errors.Terminated` for a stop signal) is raised; a second one stops at once without writing.
 
 Modules
 -------
@@ -277,7 +278,8 @@ def evolve(
     NeurohoverError
         Bad input, or a checkpoint that does not match the run.
     EvolutionInterrupted
-        On Ctrl-C or a ``KeyboardInterrupt`` from ``progress`` (from its last call, ``done``: with the run's ``result``).
+        On Ctrl-C, a stop signal (SIGTERM, SIGHUP, SIGUSR1) or a ``KeyboardInterrupt`` from ``progress`` (from its last
+        call, ``done``: with the run's ``result``).
     """
     cfg = RunConfig.build(
         target, topology=topology, prototype=prototype, optimizer=optimizer, resampling=resampling, budget=budget, settings=settings, seed=seed,

@@ -21,7 +21,7 @@ from typing import Any, cast
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, Terminated, brief, raise_terminated, stop_signals
 from ..flyer import KernelFlyer
 from ..launch import Parking
 from ..policies import Policy
@@ -82,34 +82,49 @@ RACE_BATCH_PER_THREAD = 4 * LANES
 
 
 class InterruptFlag:
-    """Context manager: a first Ctrl-C (SIGINT) sets :attr:`set`, so that the run stops at the next
-    generation boundary; a second one raises ``KeyboardInterrupt`` at once. Outside the main
-    thread it installs no handler."""
+    """Context manager: a first Ctrl-C (SIGINT), or a first stop signal the command takes as SIGTERM (the
+    :func:`~neurohover.errors.stop_signals` whose handler is :func:`~neurohover.errors.raise_terminated`), sets
+    :attr:`set`, so that the run stops at the next generation boundary and saves its checkpoint; a second one raises
+    at once (``KeyboardInterrupt``, or :class:`~neurohover.errors.Terminated`). :attr:`signum` is the first signal.
+    Outside the main thread it installs no handler."""
 
     def __init__(self) -> None:
         self.set = False
-        self._previous: Callable[[int, FrameType | None], Any] | int | None = None  # the handler signal.signal replaced
+        self.signum: int | None = None
+        self._previous: dict[int, Callable[[int, FrameType | None], Any] | int | None] = {}  # the handlers signal.signal replaced
 
     def __enter__(self) -> InterruptFlag:
         if threading.current_thread() is threading.main_thread():
-            try:
-                self._previous = signal.signal(signal.SIGINT, self._handler)
-            except ValueError:  # not allowed here (e.g. embedded interpreter)
-                self._previous = None
+            # A SIGTERM raised mid-generation and lost the run, where Ctrl-C saved it (T55-A01); a program's own handler stays.
+            taken = [signal.SIGINT, *(s for s in stop_signals() if signal.getsignal(s) is raise_terminated)]
+            for signum in taken:
+                try:
+                    self._previous[signum] = signal.signal(signum, self._handler)
+                except ValueError:  # not allowed here (e.g. embedded interpreter)
+                    pass
         return self
+
+    def stop(self, signum: int | None = None) -> KeyboardInterrupt:
+        """The stop ``signum`` (default: the first signal) asks for: Ctrl-C's ``KeyboardInterrupt``, a stop signal's
+        :class:`~neurohover.errors.Terminated` (the command says "terminated", status 128 + the signal)."""
+        signum = self.signum if signum is None else signum
+        if signum is None or signum == signal.SIGINT:
+            return KeyboardInterrupt()
+        return Terminated(f"signal {signum}", signum=int(signum))
 
     def _handler(self, signum, frame) -> None:
         if self.set:
-            raise KeyboardInterrupt
-        self.set = True
+            raise self.stop(signum)
+        self.set, self.signum = True, int(signum)
 
     def __exit__(self, exc_type, exc, tb) -> None:
-        if self._previous is not None:
-            signal.signal(signal.SIGINT, self._previous)
+        for signum, previous in self._previous.items():
+            if previous is not None:  # None: a handler not set from Python, which cannot be put back
+                signal.signal(signum, previous)
         if self.set and exc_type is None:
-            # Ctrl-C came after the last generation's check: the run is complete, but the
-            # interrupt must still reach the caller (e.g. a reproduce loop), never be swallowed.
-            raise KeyboardInterrupt
+            # The signal came after the last generation's check: the run is complete, but the
+            # stop must still reach the caller (e.g. a reproduce loop), never be swallowed.
+            raise self.stop()
 
 
 class Run:
@@ -341,7 +356,7 @@ class Run:
                     boundary = True
                     now = time.perf_counter()
                     if flag.set:
-                        raise KeyboardInterrupt
+                        raise flag.stop()  # Terminated for SIGTERM: the command says so, status 143 (T55-A01)
                     if now >= next_progress and progress is not None:
                         next_progress = now + progress_every_s
                         progress(self._info(now - start, False, budget))
@@ -349,8 +364,8 @@ class Run:
                         self._write_checkpoint(checkpoint, now - start)
                         next_ckpt = time.perf_counter() + flag_every
             except KeyboardInterrupt:
-                # At a generation boundary (first Ctrl-C, or the progress callback) the state is whole
-                # and is saved; a second Ctrl-C mid-generation leaves the last periodic checkpoint.
+                # At a generation boundary (a first Ctrl-C or SIGTERM, or the progress callback) the state is
+                # whole and is saved; a second one mid-generation leaves the last periodic checkpoint.
                 if not boundary or checkpoint is None:
                     raise EvolutionInterrupted(None, self.flyer.episodes) from None
                 self._write_checkpoint(checkpoint, time.perf_counter() - start)
