@@ -81,6 +81,12 @@ CSV_KINDS: dict[str, frozenset[str]] = {
     "an evolution history (.history.csv)": frozenset({"generation", "evaluations", "episodes", "champion_return"}),
     "a results export (results --format csv)": frozenset({"experiment", "scale", "key", "kind"}),
 }
+_STRING = rb'"(?:[^"\\]|\\.)*"'  # a JSON string
+#: How the JSON kinds of a size past :data:`_KIND_READ_LIMIT` begin (the keys their writers put first, in order).
+_LARGE_JSON_STARTS = {
+    CHECKPOINT_KIND: rb'\{\s*"format"\s*:\s*"neurohover-evolution-checkpoint/',
+    "a results export (results --format json)": rb'\{\s*"experiment"\s*:\s*' + _STRING + rb'\s*,\s*"scale"\s*:\s*' + _STRING + rb'\s*,\s*"config_hash"\s*:',
+}
 FLIGHT_DATA_KIND = "flight data (a NumPy archive)"  # what held_kind calls an .npz: FlightData.save writes over no other kind (T34-B03)
 POLICY_SET_KIND = "a policy set's manifest"  # what held_kind calls a set's manifest.json: no other writer adds files beside it
 UTF8_BOM = b"\xef\xbb\xbf"  # a byte-order mark ("UTF-8 with BOM"): held_kind reads a JSON or CSV file after it, as its readers do
@@ -135,9 +141,9 @@ def held_kind(path: str | os.PathLike) -> str | None:
             return None
         header = {c.decode("latin-1") for c in line.rstrip(b"\r").split(b",")}
         return next((kind for kind, cells in CSV_KINDS.items() if cells <= header), None)
-    if size > _KIND_READ_LIMIT:  # a checkpoint's format comes first: one of a large genome's CMA state is told apart
-        # (evolve refuses to write its checkpoint over a file of no kind, and would have refused its own; after T46-B14)
-        return CHECKPOINT_KIND if re.match(rb'\{\s*"format"\s*:\s*"neurohover-evolution-checkpoint/', head.lstrip()) else None
+    if size > _KIND_READ_LIMIT:  # told apart by how it begins: a checkpoint of a large genome's CMA state, a large
+        # experiment's export (a file of no kind is not written over: after T46-B14, T55-A02)
+        return next((kind for kind, start in _LARGE_JSON_STARTS.items() if re.match(start, head.lstrip())), None)
     try:
         body = head if size <= _END_READ else p.read_bytes().removeprefix(UTF8_BOM)  # the head is the whole of a small file
         value = json.loads(body)

@@ -26,7 +26,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .errors import NeurohoverError, OutputError, brief
-from .filekinds import FLIGHT_DATA_KIND, NAME_MAX, PNG_KIND, SQLITE_HEADER, held_kind, name_limit, output_name, refuse_policy_set, refuse_unencodable
+from .filekinds import CHECKPOINT_KIND, NAME_MAX, PNG_KIND, SQLITE_HEADER, held_kind, name_limit, output_name, refuse_policy_set, refuse_unencodable
 from .locks import WriterLock, sole_writer, writer_file
 
 __all__ = [
@@ -263,7 +263,9 @@ def output_file(
     (:func:`make_dirs`), any place where a file cannot be created, the file of one of ``inputs`` (option -> path: writing it would
     destroy what the command reads) and, unless ``store`` (the path is a results store's own), an existing results
     store; given the ``kind`` of file written (one of :data:`~neurohover.filekinds.JSON_KINDS`' names), an existing neurohover file of
-    another kind (:func:`~neurohover.filekinds.held_kind`; T25-01 to T25-03), and a name of a suffix not in ``suffixes`` (``what`` says why) or
+    another kind (:func:`~neurohover.filekinds.held_kind`; T25-01 to T25-03) or a non-empty file that is no neurohover
+    file at all (T53-A04, T55-A02; a checkpoint's is :func:`~neurohover.evolution.evolve.evolve`'s), and a name of a
+    suffix not in ``suffixes`` (``what`` says why) or
     (``run_files``) an evolve run's own file names (:func:`~neurohover.filekinds.output_name`), a name too long for the
     file system, it or it with the longest of ``ends`` (what the command adds to it for files beside it:
     :func:`checked_path`), and a file in a policy set's directory (:func:`~neurohover.filekinds.refuse_policy_set`), a
@@ -293,7 +295,9 @@ def output_file(
     held = None if kind is None else held_kind(p)
     if held is not None and held != kind:  # a policy, a checkpoint, a summary replaced by another kind of file (T25-01 to T25-03)
         raise NeurohoverError(f"{option} {brief(os.fspath(path))} is {held}: give another path (writing {kind} there would destroy it)")
-    if kind == FLIGHT_DATA_KIND and held is None and p.is_file() and p.stat().st_size:  # a user's own archive was replaced (T53-A04)
+    # a user's own archive (T53-A04), notes at a policy's, model's or export's name (T55-A02) were replaced; a checkpoint
+    # is evolve()'s to judge, which knows whether it resumes from it (a damaged one is named there; T46-B14)
+    if kind not in (None, CHECKPOINT_KIND) and held is None and p.is_file() and p.stat().st_size:
         raise NeurohoverError(f"{option} {brief(os.fspath(path))} is a file neurohover did not write: give another path (writing {kind} would destroy it)")
     refuse_dangling_link(p, option, path)  # a link to nothing was written through, wherever it pointed (T19-12)
     refuse_pseudo_fs(p, option, path)

@@ -81,7 +81,20 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message: str) -> NoReturn:
         """argparse's error in one line, as every other refusal (its usage block made 3-7 lines; T22-18), pointing to
         --help for the usage; a 100,000-character value shortened (its "invalid choice: 'ggg...'" echoed it whole)."""
+        message = _no_value(message)
         self.exit(2, f"{self.prog}: error: {shorter_numbers(message)} (usage: {self.prog} --help)\n")
+
+
+def _no_value(message: str) -> str:
+    """argparse's ``message``, with its "ignored explicit argument" for a flag or switch given a value (--json=yes,
+    --progress=false) said as what is allowed: it named no rule, and "ignored" read as if the run went on (T55-A03)."""
+    found = re.fullmatch(r"argument (\S+): ignored explicit argument (.*)", message, re.DOTALL)
+    if found is None:
+        return message
+    names, value = found[1].split("/"), found[2]
+    switch = len(names) == 2 and names[1] == "--no-" + names[0].removeprefix("--")  # a BooleanOptionalAction's pair
+    allowed = f"{names[0]} or {names[1]}" if switch else f"{' or '.join(names)} alone, or leave it out"
+    return f"{found[1]} takes no value, got {value}: give {allowed}"
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -24,7 +24,7 @@ from .external import external_digest
 from .keys import UnitKey
 from .plans import Plan, plan, run_keys, source_results
 from .put_checks import key_shape_problem
-from .result_checks import params_problem
+from .result_checks import identity_problem, params_problem
 from .results import UnitResult, flat_cells, result_from_dict
 from .store import Store
 from .store_checks import hash_problem, read_config, unit_seconds_problem
@@ -215,11 +215,16 @@ def checked_experiment(store: Store, name: str, scale: str) -> tuple[ExperimentC
     except NeurohoverError as err:
         raise NeurohoverError(f"{where}: {err}") from None
     results: dict[str, UnitResult] = {}
+    contradicted = ""  # a result naming another agent or MDP than its params, which its own check blamed on a sound field (T55-A04)
     for u in units:
         try:
             results[u["key"]] = result_from_dict(u["kind"], u["result"], u["key"])
             _check_key(config, u)
         except NeurohoverError as err:
+            contradicted = identity_problem(u["kind"], u["result"], u["params"])
+            if contradicted:  # named after the plan check, which names params changed instead
+                contradicted = f"{where}: unit {u['key']!r}: its result contradicts its params: {contradicted}"
+                break
             unit = "" if repr(u["key"]) in str(err) else f"unit {u['key']!r}: "
             raise NeurohoverError(f"{where}: {unit}{err}") from None
     try:
@@ -227,6 +232,8 @@ def checked_experiment(store: Store, name: str, scale: str) -> tuple[ExperimentC
         made = _check_planned(store, config, units)
     except NeurohoverError as err:
         raise NeurohoverError(f"{where}: {err}") from None
+    if contradicted:
+        raise NeurohoverError(contradicted)
     for u in units:  # a result must be its unit's (T22-07, T22-08); after the plan check, which names params changed
         problem = params_problem(results[u["key"]], u["params"])
         if problem:

@@ -138,6 +138,20 @@ def _params_says(params: dict, name: str) -> Any:
     return params.get(name)
 
 
+def identity_problem(kind: Any, result: Any, params: Any) -> str:
+    """What names another run than the unit's ``params`` in its ``result`` of ``kind`` (as stored, a dict, or read): a
+    test run's agent or MDP, a model's method or MDP ('' when none does, or for another kind). Compared before the
+    result's own consistency: a test run whose agent was edited was blamed on its sound policy_changes (T55-A04)."""
+    names = {"test_run": ("agent", "mdp"), "model": ("method", "mdp")}.get(kind, ()) if isinstance(params, dict) else ()
+    for name in names:
+        says = _params_says(params, name)
+        held = result.get(name) if isinstance(result, dict) else getattr(result, name, None)
+        if isinstance(says, str) and isinstance(held, str) and held != says:
+            where = "params.mdp.label" if name == "mdp" else f"params.{name}"
+            return f"{name} = {brief(held)} is not allowed: its unit's {where} is {brief(says)}, and a result must be its unit's"
+    return ""
+
+
 def params_problem(result: Any, params: Any) -> str:
     """What in a stored unit's ``result`` contradicts the unit's own ``params`` ('' when nothing does; params of another
     shape are the plan check's to name): a test run's agent or MDP, or a model's method or MDP, other than its params
@@ -154,11 +168,9 @@ def params_problem(result: Any, params: Any) -> str:
         return robustness_params_problem(result, params)
     if not (isinstance(result, (TestRunResult, ModelResult)) and isinstance(params, dict)):
         return ""
-    for name in ("agent", "mdp") if isinstance(result, TestRunResult) else ("method", "mdp"):
-        says = _params_says(params, name)
-        if isinstance(says, str) and getattr(result, name) != says:
-            where = "params.mdp.label" if name == "mdp" else f"params.{name}"
-            return f"{name} = {brief(getattr(result, name))} is not allowed: its unit's {where} is {brief(says)}, and a result must be its unit's"
+    problem = identity_problem("test_run" if isinstance(result, TestRunResult) else "model", result, params)
+    if problem:
+        return problem
     if isinstance(result, TestRunResult) and result.agent in NO_OFFLINE and float(result.timing.offline_seconds) != 0:
         return (  # its update is never called (T24-07: as plot --compete reads a summary); after its agent against its params
             f"timing.offline_seconds = {brief(result.timing.offline_seconds)} is not allowed: agent {result.agent} does no work between "

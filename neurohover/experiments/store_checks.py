@@ -21,7 +21,7 @@ from ..locks import WriterLock, hold_file
 from ..paths import refuse_dangling_link
 from ..sim.constants import MAX_SECONDS
 from .config import ExperimentConfig, check_name, check_scale
-from .result_checks import params_problem
+from .result_checks import identity_problem, params_problem
 from .results import result_from_dict, result_type
 from .units import Unit
 
@@ -402,7 +402,7 @@ def unit_texts(unit: Any, result: Any, name: str, where: str) -> tuple[str, str]
     if unit.experiment != name:  # stored under another experiment's name without a word (T29-B05)
         raise NeurohoverError(f"{where}: unit {brief(unit.key)}'s experiment = {brief(unit.experiment)} is not allowed: give a unit of {name} (its plan's)")
     try:
-        problem = params_problem(result_from_dict(unit.kind, result, unit.key), unit.params)
+        problem = identity_problem(unit.kind, result, unit.params) or params_problem(result_from_dict(unit.kind, result, unit.key), unit.params)
     except NeurohoverError as err:
         problem = str(err)
     if problem:
