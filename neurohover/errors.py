@@ -219,6 +219,16 @@ def float_of(text: str) -> float:
     return value
 
 
+def setting_float(value: Any) -> float:
+    """A real setting ``value`` (checked by :func:`finite_real`) as the float it is read as: a NumPy float narrower than
+    float64 (np.float32, np.float16) as the decimal it prints as, and -0.0 as 0.0. np.float32(0.3) was kept as
+    0.30000001192092896, so FGHH flew its seeded sets (T56-B03); a -0.0 sensor or drift was hashed as another competition (T56-B04)."""
+    numpy = sys.modules.get("numpy")  # not imported: the value is no NumPy float
+    if numpy is not None and isinstance(value, numpy.floating) and value.itemsize < 8:
+        return float(str(value)) + 0.0  # str: NumPy's shortest repr, '0.3'; exact values (0.25) read the same
+    return float(value) + 0.0
+
+
 def comma_separated(part: str) -> str | None:
     """``part``, one KEY=VALUE setting of a comma-separated list, written with commas where it holds more settings
     separated by spaces or ';' ('level=0.5;delay=1' -> 'level=0.5,delay=1'), else None: a sensor's and a drift's text
@@ -477,6 +487,19 @@ def setting_type_problem(cls: type, values: Any) -> str:
         if _non_finite(value):
             return f"{shown} is out of range: allowed " + (f"a finite number ({field})" if where else "finite numbers (settings are recorded as JSON)")
     return ""
+
+
+def settings_defaults_problem(cls: type) -> str:
+    """What is wrong with the defaults of the settings dataclass ``cls`` ('' when nothing): a field without one (settings
+    left out are the defaults) or one :func:`setting_type_problem` refuses, which flew unchecked (an agent's NaN or
+    ``n: int = 'x'``, T56-B01); a field of another type (a nested dataclass) is left to the class. Run-time optimisers'
+    specs and agents' specs check it (T52-B09)."""
+    fields = dataclasses.fields(cls)
+    bare = next((f.name for f in fields if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING), None)
+    if bare is not None:
+        return f"field {bare!r} has no default: give every field a default (settings left out are the defaults)"
+    problem = setting_type_problem(cls, {f.name: f.default for f in fields if f.default is not dataclasses.MISSING})
+    return f"default {problem}" if problem else ""
 
 
 def first_difference(path: str, saved: Any, given: Any, saved_as: str = "the stored") -> str:

@@ -14,7 +14,7 @@ from collections.abc import Mapping, Sequence
 from types import MappingProxyType
 from typing import Any, cast
 
-from ..errors import NeurohoverError, brief, package_path, registry_entry_problem
+from ..errors import NeurohoverError, brief, package_path, registry_entry_problem, setting_type_problem
 from ..integrations.flying import generic_sigma_problem
 from ..policysets import PolicySet, load_policy_set
 from ..tasks import TaskFamily, get_task_family
@@ -197,8 +197,8 @@ def make_agent(name: str, family: TaskFamily | str, *, policy_dir: str | None = 
 
 def _checked_options(spec: AgentSpec, options: AgentOptions) -> AgentOptions:
     """``options`` as ``spec``'s build reads them: an evolution that is a ModelEvolution, settings of the agent's own class
-    (a dict is read by that class); settings for an agent without any, or of another class, refused (fourth trial: they
-    were accepted and ignored, or an AttributeError once the agent learned)."""
+    (a dict is read by that class, an instance checked as a dict is, T56-B01); settings for an agent without any, or of
+    another class, refused (fourth trial: they were accepted and ignored, or an AttributeError once the agent learned)."""
     from .model_based import ModelEvolution
 
     if options.evolution is not None and not isinstance(options.evolution, ModelEvolution):
@@ -212,6 +212,10 @@ def _checked_options(spec: AgentSpec, options: AgentOptions) -> AgentOptions:
         return dataclasses.replace(options, settings=spec.settings.from_dict(given))
     if not isinstance(given, spec.settings):
         raise NeurohoverError(f"agent {spec.name!r} takes settings of {spec.settings.__name__} (or a dict of its fields), got {given!r:.60}")
+    # an instance is checked as a dict of its fields is: S(k='x', rate=inf) flew unchecked (T56-B01)
+    problem = setting_type_problem(type(given), {f.name: getattr(given, f.name) for f in dataclasses.fields(cast("Any", given))})
+    if problem:
+        raise NeurohoverError(f"bad {type(given).__name__}: {problem}")
     return options
 
 

@@ -11,7 +11,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from ..errors import NeurohoverError, brief, check_name_text, frozen_dataclass_class, refused_signature, settings_from_dict
+from ..errors import NeurohoverError, brief, check_name_text, frozen_dataclass_class, refused_signature, settings_defaults_problem, settings_from_dict
 from ..policies import Policy
 
 if TYPE_CHECKING:
@@ -105,7 +105,8 @@ class AgentSpec:
         On a family with generic policies by kind (FGHH: ``"zero"``, ``"fixed"``, ``"race"``),
         which one is this agent's generic policy.
     settings : type, optional
-        Its own typed settings (a frozen dataclass subclass of :class:`AgentSettings`), handed to ``build`` as
+        Its own typed settings (a frozen dataclass subclass of :class:`AgentSettings`, every field with a default,
+        finite and of its field's type where that is int, float, bool or text), handed to ``build`` as
         ``AgentOptions.settings``; None: it has none.
     learns_models : bool
         Whether it learns LR models from its flight data (so the model options, such as the
@@ -153,7 +154,7 @@ class AgentSpec:
     def _check_build_and_settings(self) -> None:
         """Refuse a ``build`` that cannot be called as ``build(policies, options)`` (a TypeError at make_agent, T52-B14)
         and ``settings`` that are no frozen AgentSettings dataclass (an AttributeError or TypeError once settings were
-        given, T52-B15)."""
+        given, T52-B15) or whose defaults are missing, not their fields' plain types or not finite (T56-B01)."""
         build = self.build
         if not callable(build):
             raise NeurohoverError(f"agent {self.name!r}: build={brief(build)} is not allowed: give a callable; {_BUILD}")
@@ -164,7 +165,12 @@ class AgentSpec:
                 "give a callable of those two arguments answering an Agent"
             )
         cls = self.settings
-        if cls is None or (isinstance(cls, type) and issubclass(cls, AgentSettings) and frozen_dataclass_class(cls)):
+        if cls is None:
+            return
+        if isinstance(cls, type) and issubclass(cls, AgentSettings) and frozen_dataclass_class(cls):
+            defaults = settings_defaults_problem(cls)  # NaN or 'x' for an int flew unchecked (T56-B01)
+            if defaults:
+                raise NeurohoverError(f"agent {self.name!r}: its settings class {cls.__name__}'s {defaults}")
             return
         raise NeurohoverError(
             f"agent {self.name!r}: settings={brief(cls)} is not allowed: give a frozen dataclass subclass of "

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, real_number, refused_signature
+from ..errors import NeurohoverError, brief, finite_real, masked_note, real_number, refused_signature
 from ..sim.constants import lowest_return
 from .common import STATE_DAMAGE, Optimiser, enc_float
 from .records import decode_history
@@ -68,10 +68,13 @@ def check_made(opt: Any, optimizer: str, called: str = "make") -> None:
 
 def asked_genomes(opt: Optimiser, cfg: RunConfig) -> np.ndarray:
     """The optimiser's next generation, checked: a user's optimiser (README, A new optimiser) asking genomes of another
-    length, none, or a list failed in the flyer or in numba ("number of threads must be between 1 and 2"; T40-B05)."""
+    length, none, or a list failed in the flyer or in numba ("number of threads must be between 1 and 2"; T40-B05); a
+    masked array is refused, as every array given is (:func:`~neurohover.errors.as_floats`)."""
     genomes = opt.ask()
     d = cfg.prototype.genome.size
-    if isinstance(genomes, np.ndarray) and genomes.dtype.kind in "fiu" and genomes.ndim == 2 and genomes.shape[0] >= 1 and genomes.shape[1] == d:
+    if isinstance(genomes, np.ma.MaskedArray):  # isfinite skips masked genes, which flew at their hidden values, NaN too (T56-B02)
+        gave = f"a masked array of shape {genomes.shape}"
+    elif isinstance(genomes, np.ndarray) and genomes.dtype.kind in "fiu" and genomes.ndim == 2 and genomes.shape[0] >= 1 and genomes.shape[1] == d:
         if np.isfinite(genomes).all():
             return genomes
         gave = f"an array of shape {genomes.shape} with genes NaN or infinite"
@@ -81,7 +84,7 @@ def asked_genomes(opt: Optimiser, cfg: RunConfig) -> np.ndarray:
         gave = f"a {type(genomes).__name__} {brief(genomes)}"
     raise NeurohoverError(
         f"optimizer {brief(cfg.optimizer)}: its ask() gave {gave}, which is not allowed: give a NumPy array of real numbers of shape (n, {d}), "
-        f"n >= 1 genomes of the {cfg.topology} topology's {d} finite genes"
+        f"n >= 1 genomes of the {cfg.topology} topology's {d} finite genes{masked_note(genomes)}"
     )
 
 
@@ -181,7 +184,8 @@ def checked_champion_genome(opt: Optimiser, cfg: RunConfig) -> np.ndarray | None
         return None
     d = cfg.prototype.genome.size
     try:
-        a = np.asarray(genome) if isinstance(genome, (np.ndarray, list, tuple)) else None
+        # a masked array's masked genes would be recorded at their hidden values, as its ask() is refused (T56-B02)
+        a = np.asarray(genome) if isinstance(genome, (np.ndarray, list, tuple)) and not isinstance(genome, np.ma.MaskedArray) else None
     except (ValueError, TypeError):  # a ragged list
         a = None
     if a is not None and a.dtype.kind in "fiu" and a.shape == (d,):
@@ -192,7 +196,7 @@ def checked_champion_genome(opt: Optimiser, cfg: RunConfig) -> np.ndarray | None
         gave = f"{type(genome).__name__} {brief(genome)}" + ("" if a is None else f" (shape {a.shape}, dtype {a.dtype})")
     raise NeurohoverError(
         f"optimizer {brief(cfg.optimizer)}: its champion_genome {gave} is not allowed: give None (no champion yet) or a NumPy array of real numbers of "
-        f"shape ({d},), the {cfg.topology} topology's {d} finite genes"
+        f"shape ({d},), the {cfg.topology} topology's {d} finite genes{masked_note(genome)}"
     )
 
 

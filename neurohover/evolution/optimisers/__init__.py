@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import NeurohoverError, brief, frozen_dataclass_class, refused_signature, registry_entry_problem, settings_from_dict
+from ...errors import NeurohoverError, brief, frozen_dataclass_class, refused_signature, registry_entry_problem, settings_defaults_problem, settings_from_dict
 
 __all__ = [
     "NE",
@@ -146,7 +146,7 @@ def entry_problem(name: object, spec: object) -> str:
 def _parts_problem(entry: str, spec: OptimiserSpec) -> str:
     """What is wrong with a run-time spec's make, settings, stops_itself and stop_reason ('' when nothing): a make of
     the wrong arity or none was a TypeError at the run's start, a settings class that is no frozen dataclass or has a
-    default JSON cannot write one in its config, a truthy stops_itself='no' ran without a budget for ever, and a
+    default JSON cannot write one in its config (or a NaN or wrong-type one, T56-B01), a truthy stops_itself='no' ran without a budget for ever, and a
     stop_reason 'budget' recorded a run its optimiser stopped as one its budget stopped (T52-B08, B09, B11)."""
     make, cls = spec.make, spec.settings
     if not callable(make):
@@ -160,9 +160,10 @@ def _parts_problem(entry: str, spec: OptimiserSpec) -> str:
         return (
             f"{entry}: its settings {brief(cls)} is no frozen dataclass class: give the frozen dataclass of its settings, with defaults (not an object of it)"
         )
+    defaults = settings_defaults_problem(cls)  # a field without one, or NaN or 'x' for an int: the agents' check too (T56-B01)
+    if defaults:
+        return f"{entry}: its settings {defaults}"
     for field in dataclasses.fields(cls):
-        if field.default is dataclasses.MISSING and field.default_factory is dataclasses.MISSING:
-            return f"{entry}: its settings field {field.name!r} has no default: give every field a default (settings left out are the defaults)"
         if field.default is not dataclasses.MISSING and not _plain_json(field.default):
             return (
                 f"{entry}: its settings field {field.name!r}'s default is {type(field.default).__name__} {brief(field.default)}, no plain JSON value: "
