@@ -87,6 +87,12 @@ def model_entry_problem(d: dict) -> str:
         return _its("d_u", d["d_u"], "allowed a finite number (D_u, the constant u acceleration; 0.0 where none is fitted)")
     if "stats" in d and not isinstance(d["stats"], dict):
         return _its("stats", d["stats"], "allowed a JSON object (the fit's statistics by name)")
+    newer = [why for why, has in (("its stats say d_u 'keep'", d.get("stats", {}).get("d_u") == "keep"), ("it has a wind entry", "wind" in d)) if has]
+    if "d_u" not in d and newer:  # read as a file from before D_u: loaded with D_u 0.0, flown without its u acceleration (T56-B05)
+        return (
+            f"it has no d_u entry, but {' and '.join(newer)}, which files hold only since D_u is recorded: give d_u, a finite number "
+            "(D_u, the constant u acceleration; 0.0 where none is fitted)"
+        )
     return (_wind_problem(d["wind"]) if "wind" in d else "") or seconds_problem(d)
 
 

@@ -93,6 +93,8 @@ def task_names() -> tuple[str, ...]:
 def family_class(name: object) -> type[TaskFamily]:
     """The registry's class of task family ``name`` (a key of :data:`TASK_FAMILIES`), its entry checked
     (:func:`entry_problem`; NeurohoverError naming a bad one, or an unknown name with the registry's names as it is)."""
+    if isinstance(name, TaskFamily):  # a family where its name goes was "unknown task FGHH(sigma=0.2)" (T56-B06)
+        raise NeurohoverError(f"task={brief(name)} is not allowed: give the task's name, {_name_of(name)}")
     if not isinstance(name, str) or name not in TASK_FAMILIES:
         raise NeurohoverError(f"unknown task {brief(name)}: allowed {', '.join(task_names())}")  # TASK_NAMES listed a deleted entry
     cls = TASK_FAMILIES[name]
@@ -100,6 +102,15 @@ def family_class(name: object) -> type[TaskFamily]:
     if problem:
         raise NeurohoverError(problem)
     return cls
+
+
+def _name_of(family: TaskFamily) -> str:
+    """How :func:`family_class`'s refusal of the task family object ``family`` names what to give instead: its name and its settings."""
+    settings = [f"sigma={family.sigma!r}"] if getattr(family, "has_sigma", False) else []
+    sensor, drift = getattr(family, "sensor", None), getattr(family, "drift", None)
+    settings += ["its sensor"] if isinstance(sensor, Sensor) and not sensor.exact else []
+    settings += ["its drift"] if isinstance(drift, Drift) and not drift.none else []
+    return f"{brief(family.name)}" + (f" (and {', '.join(settings)})" if settings else "")
 
 
 def get_task_family(name: str, sigma: float | None = None, sensor: Sensor | None = None, drift: Drift | None = None) -> TaskFamily:

@@ -11,7 +11,19 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import NeurohoverError, as_floats, brief, check_length, check_name_text, finite_real, masked_note, refuse_reloaded, whole_in, whole_number
+from ..errors import (
+    NeurohoverError,
+    as_floats,
+    brief,
+    check_length,
+    check_name_text,
+    finite_real,
+    masked_note,
+    refuse_reloaded,
+    setting_float,
+    whole_in,
+    whole_number,
+)
 from ..sim.constants import (
     CONTROL_DT,
     DEFAULT_NOISE_STD,
@@ -148,7 +160,7 @@ class MDP:
             value = getattr(self, name)
             if not finite_real(value):  # np.timedelta64 was float()'s TypeError (T17-1), 10**400 an OverflowError
                 raise NeurohoverError(f"MDP {name}={brief(value)} is not allowed: give a finite number")
-            object.__setattr__(self, name, float(value) + 0.0)
+            object.__setattr__(self, name, setting_float(value))  # -0.0 as 0.0, np.float32(0.3) as 0.3 (T56-B03)
         if not self.dt > 0:
             raise NeurohoverError(f"MDP dt={self.dt!r} is out of range: allowed a substep length > 0")
         if abs(self.substeps * self.dt - CONTROL_DT) > COVER_TOLERANCE:  # a dt of 1e9 was flown (T27-B05)
@@ -248,6 +260,15 @@ def finite_vector(values: Sequence[float] | np.ndarray, length: int, what: str) 
         # real numbers NumPy holds as objects (a Fraction, an int past int64), each taken as every float setting takes
         # one (finite_real; Decimal is none); a Fraction was "must be 2 finite numbers" (T36-B09)
         arr = np.array([float(v) for v in objects.flat]).reshape(objects.shape)
+    items = (
+        list(values.flat)
+        if isinstance(values, np.ndarray) and values.dtype.kind == "f" and values.dtype.itemsize < 8
+        else values
+        if isinstance(values, (list, tuple))
+        else ()
+    )
+    if arr.ndim == 1 and any(isinstance(v, np.floating) and v.itemsize < 8 for v in items):  # np.float32(0.3) as 0.3 (T56-B03)
+        arr = np.array([setting_float(v) for v in items])
     if arr.ndim > 1:  # a (1, 2) array was "must be 2 numbers, got 2" (T34-B15)
         raise NeurohoverError(f"{what} must be a flat sequence of {length} numbers, got shape {arr.shape}: {brief(values)}")
     if arr.shape != (length,):

@@ -44,6 +44,7 @@ from ..errors import (
     lowest_allowed,
     real_number,
     refuse_reloaded,
+    setting_float,
     whole_number,
 )
 from ..sim.constants import MDP_ROW_LEN, MIN_NOISE, PARAM_NAMES, ROW_PARAMS
@@ -87,7 +88,7 @@ class Drift:
             raise NeurohoverError(f"drift walk={brief(w)} is out of range: allowed a number in 0..1 (a per-episode log std)")
         if 0 < w < MIN_WALK:  # a walk that moves no parameter: every drifted row the fixed one
             raise NeurohoverError(f"drift walk={brief(w)} is out of range, too small to change the dynamics: {_WALK_RANGE}")
-        object.__setattr__(self, "walk", float(w))
+        object.__setattr__(self, "walk", setting_float(w))  # -0.0 as 0.0, np.float32 as printed (T56-B03, B04)
         try:  # a one-shot iterator (a generator, map, zip) is refused, as change_at and walk refuse one (T43-B08)
             if isinstance(self.change, Iterator):
                 raise TypeError
@@ -113,8 +114,8 @@ class Drift:
                 raise NeurohoverError(
                     f"drift change {name}={factor!r} changes nothing: give a factor other than 1 (in {MIN_FACTOR:g}..{MAX_FACTOR:g}) or leave {name} out"
                 )
-            factors[PARAM_NAMES.index(name)] = float(factor)
-        object.__setattr__(self, "change", tuple(sorted((n, float(f)) for n, f in change.items())))
+            factors[PARAM_NAMES.index(name)] = setting_float(factor)
+        object.__setattr__(self, "change", tuple(sorted((n, setting_float(f)) for n, f in change.items())))
         object.__setattr__(self, "_factors", factors)
         try:
             # True was read as episode 1 (second trial); a masked array's masked entry was NumPy's MaskError (T16-13)

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, real_number
+from ..errors import NeurohoverError, brief, finite_real, real_number, setting_float
 from ..sim.constants import DEFAULT_PARAMS, MIN_NOISE, PARAM_NAMES, ROW_PARAMS
 from .base import MAX_MAGNITUDE, MDP, TaskFamily, finite_vector, mdp_label
 
@@ -48,7 +48,7 @@ class FGHH(TaskFamily):
                 f"FGHH sigma={brief(s)} is out of range, too small to change the dynamics (a parameter's std below 2**-52 of it): "
                 f"allowed 0 (the zero setting's dynamics) or a number in {MIN_SIGMA!r}..1 (the paper uses 0.2 and 0.3)"
             )
-        object.__setattr__(self, "sigma", abs(float(s)))  # -0.0 passes 0 <= sigma but was NumPy's "scale < 0" at the first draw (T14-2)
+        object.__setattr__(self, "sigma", setting_float(s))  # -0.0 passes 0 <= sigma but was NumPy's "scale < 0" at the first draw (T14-2)
 
     def make(self, params: Sequence[float] | np.ndarray, label: str = "") -> MDP:
         p = finite_vector(params, 11, "FGHH dynamics parameters " + "/".join(PARAM_NAMES))

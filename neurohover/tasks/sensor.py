@@ -41,7 +41,19 @@ import operator
 import re
 from dataclasses import asdict, dataclass, fields, replace
 
-from ..errors import FloatRangeError, NeurohoverError, brief, comma_separated, finite_real, float_of, lowest_allowed, real_number, whole_in, whole_number
+from ..errors import (
+    FloatRangeError,
+    NeurohoverError,
+    brief,
+    comma_separated,
+    finite_real,
+    float_of,
+    lowest_allowed,
+    real_number,
+    setting_float,
+    whole_in,
+    whole_number,
+)
 from ..sim.constants import MAX_SENSOR_DELAY, MIN_NOISE, SENSOR_GROUPS
 
 #: The std of each group at noise level 1 (velocity m/s, position m, rates rad/s, attitude).
@@ -88,7 +100,7 @@ class Sensor:
                 raise NeurohoverError(f"sensor {name}={brief(value)} is not a number: allowed {allowed}")
             if not finite_real(value) or value < 0:  # np.timedelta64 was float()'s TypeError (T17-1), 10**400 an OverflowError
                 raise NeurohoverError(f"sensor {name}={brief(value)} is out of range: allowed {allowed}")
-            number = float(value)
+            number = setting_float(value)  # np.float32(0.1) as 0.1 (T56-B03), -0.0 as 0.0: one competition (T56-B04)
             if name != "correlation" and number > MAX_STD:
                 raise NeurohoverError(f"sensor {name}={value!r} is out of range: allowed a std in 0..{MAX_STD:g}")
             if name != "correlation" and 0 < number < MIN_STD:
@@ -104,7 +116,7 @@ class Sensor:
             raise NeurohoverError(f"sensor dropout={brief(p)} is not a number: allowed a probability 0 <= dropout < 1")
         if not finite_real(p) or not 0 <= p < 1:  # NaN fails the comparison too; np.timedelta64 is no number (T17-1)
             raise NeurohoverError(f"sensor dropout={brief(p)} is out of range: allowed a probability 0 <= dropout < 1")
-        object.__setattr__(self, "dropout", float(p))
+        object.__setattr__(self, "dropout", setting_float(p))
         # T24-11: whole_in, so 1.5 or True "is not allowed" (a type) and -1 "is out of range"; both said out of range
         delay = whole_in(self.delay, "sensor delay", 0, MAX_SENSOR_DELAY, f"{MAX_SENSOR_DELAY} (control steps)")
         object.__setattr__(self, "delay", delay)  # a NumPy integer as the int it is
@@ -151,7 +163,7 @@ class Sensor:
         if 0 < level < MIN_LEVEL:
             allowed = f"allowed 0 (exact) or a number in {lowest_allowed(MIN_LEVEL)}..{MAX_LEVEL:g}"
             raise NeurohoverError(f"sensor noise level={brief(level)} is out of range, too small to change a reading (an attitude std below 2**-52): {allowed}")
-        v, p, r, a = (float(level) * s for s in LEVEL_PROFILE)
+        v, p, r, a = (setting_float(level) * s for s in LEVEL_PROFILE)  # np.float32(0.1) as 0.1 (T56-B03)
         return cls(v, p, r, a, correlation=correlation, delay=delay)
 
     @classmethod
