@@ -177,8 +177,8 @@ def test_long_names_are_shortened_in_python_too(tmp_path: Path) -> None:
     import neurohover as nh
     from neurohover.agents.model_based import IncrementalSettings
     from neurohover.agents.registry import agent_spec
-    from neurohover.errors import settings_from_dict
     from neurohover.experiments import Store
+    from neurohover.settings_checks import settings_from_dict
 
     long = "g" * 100_000
     calls = [

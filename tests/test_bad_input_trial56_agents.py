@@ -16,9 +16,10 @@ import pytest
 from neurohover.agents import registry as R
 from neurohover.agents.protocol import Agent, Choice
 from neurohover.agents.spec import AgentOptions, AgentSettings, AgentSpec
-from neurohover.errors import NeurohoverError, settings_defaults_problem
+from neurohover.errors import NeurohoverError
 from neurohover.evolution.answers import asked_genomes, checked_champion_genome
 from neurohover.evolution.optimisers import SHIPPED_SPECS, OptimiserSpec, entry_problem
+from neurohover.settings_checks import settings_defaults_problem
 
 NEEDS = frozenset({"generic"})
 

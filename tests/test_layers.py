@@ -12,7 +12,7 @@ PACKAGE = Path(neurohover.__file__).resolve().parent
 # task family -> MDP rows -> batched rollouts -> returns and flight data -> evolution / models -> agents
 # -> experiments -> store, report, plots; the command line and the package's front door on top.
 LAYERS = [
-    {"command", "errors", "filekinds", "jsontext", "locks", "paths", "procs", "progress", "settingsdoc"},
+    {"command", "errors", "filekinds", "jsontext", "locks", "paths", "procs", "progress", "settings_checks", "settingsdoc"},
     {"sim"},
     {"tasks", "flightdata", "flightmeta", "policies", "netfile", "wrappers"},
     {"launch", "flyer", "plots", "compete_files", "compete_labels", "compete_folder", "safeguard"},

@@ -14,9 +14,10 @@ from collections.abc import Mapping, Sequence
 from types import MappingProxyType
 from typing import Any, cast
 
-from ..errors import NeurohoverError, brief, package_path, registry_entry_problem, setting_type_problem
+from ..errors import NeurohoverError, brief, package_path, registry_entry_problem
 from ..integrations.flying import generic_sigma_problem
 from ..policysets import PolicySet, load_policy_set
+from ..settings_checks import setting_type_problem
 from ..tasks import TaskFamily, get_task_family
 from .protocol import Agent
 from .spec import AgentOptions, AgentPolicies, AgentSpec

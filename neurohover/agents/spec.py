@@ -11,8 +11,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from ..errors import NeurohoverError, brief, check_name_text, frozen_dataclass_class, refused_signature, settings_defaults_problem, settings_from_dict
+from ..errors import NeurohoverError, brief, check_name_text, frozen_dataclass_class, refused_signature
 from ..policies import Policy
+from ..settings_checks import settings_defaults_problem, settings_from_dict
 
 if TYPE_CHECKING:
     from ..tasks import TaskFamily

@@ -35,9 +35,10 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, settings_from_dict, whole_in
+from ..errors import NeurohoverError, brief, finite_real, whole_in
 from ..evaluate import PolicyTable, evaluate_jobs
 from ..policies import Policy
+from ..settings_checks import settings_from_dict
 from ..sim.constants import EPISODE_STEPS
 from ..tasks import MDP, refuse_drift
 from .common import MAX_POPULATION, MAX_SPREAD, require_spread, set_field

@@ -32,7 +32,8 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import NeurohoverError, brief, frozen_dataclass_class, refused_signature, registry_entry_problem, settings_defaults_problem, settings_from_dict
+from ...errors import NeurohoverError, brief, frozen_dataclass_class, refused_signature, registry_entry_problem
+from ...settings_checks import settings_defaults_problem, settings_from_dict
 
 __all__ = [
     "NE",
