@@ -146,3 +146,22 @@ def test_a_masked_champion_genome_is_refused():
     opt = SimpleNamespace(champion_genome=_masked(0.5, (3,)))
     with pytest.raises(NeurohoverError, match=r"its champion_genome MaskedArray .* is not allowed: .*\(a masked array: give its values"):
         checked_champion_genome(opt, CFG)
+
+
+def test_a_run_time_optimisers_settings_object_is_checked_as_a_dict_is() -> None:  # T56-B01's rest: population_settings
+    import dataclasses as dc
+
+    from neurohover.evolution.optimisers import OPTIMISERS, OptimiserSpec, population_settings
+
+    @dc.dataclass(frozen=True)
+    class Plain:
+        popsize: int = 4
+        sigma: float = 0.1
+
+    OPTIMISERS["plain56"] = OptimiserSpec("plain56", "user", settings=Plain, make=lambda p, s, seed: None, stops_itself=False)
+    try:
+        with pytest.raises(NeurohoverError, match=r"bad plain56 settings: sigma='x' is not allowed: give a finite number"):
+            population_settings("plain56", Plain(sigma="x"))  # type: ignore[arg-type]
+        assert population_settings("plain56", Plain(sigma=0.5)) == Plain(sigma=0.5)
+    finally:
+        OPTIMISERS.pop("plain56", None)

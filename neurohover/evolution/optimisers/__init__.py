@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import NeurohoverError, brief, frozen_dataclass_class, refused_signature, registry_entry_problem
-from ...settings_checks import settings_defaults_problem, settings_from_dict
+from ...settings_checks import setting_type_problem, settings_defaults_problem, settings_from_dict
 
 __all__ = [
     "NE",
@@ -231,6 +231,9 @@ def population_settings(name: str, settings: Any) -> Any:
     if settings is None:
         return cls()
     if type(settings) is cls:  # exactly its class: a subclass's settings (UH-CMA-ES's of CMA-ES's) belong to another optimiser
+        problem = setting_type_problem(cls, {f.name: getattr(settings, f.name) for f in dataclasses.fields(cls)})
+        if problem:  # an object of its class was flown unchecked, where a dict of the same values is refused (T56-B01's rest)
+            raise NeurohoverError(f"bad {name} settings: {problem}")
         return settings
     if not isinstance(settings, Mapping):
         fields = [f.name for f in dataclasses.fields(cls)]
