@@ -42,6 +42,8 @@ def _argv(command: str, made: Path, out: Path) -> tuple[str, ...]:
         return (*EVOLVE, "--out", str(out))
     if command == "learn-model":
         return ("learn-model", "--flight-data", str(made / "r.npz"), "--method", "lr", "--out", str(out))
+    if command == "evaluate-agent":
+        return ("evaluate-agent", "--task", "ghh08", "--policy", "baseline", "--n-mdps", "1", "--episode-steps", "20", "--json", str(out))
     return ("results", "tr1", "--store", str(made / "s.sqlite"), "--out", str(out))
 
 
@@ -54,13 +56,15 @@ def _argv(command: str, made: Path, out: Path) -> tuple[str, ...]:
     ("learn-model", "u.json", '{"mine": true}\n', "a model file"),
     ("results", "u.csv", "my,own,data\n", "a results export (results --format csv)"),
     ("results", "u.json", '{"name": "my-notes"}\n', "a results export (results --format json)"),
+    ("evaluate-agent", "mine.json", "my notes\n", "evaluate-agent rows (--json)"),  # T56-A01, fixed by T55-A02's rule
 ])  # fmt: skip
 def test_a02_a_users_own_file_is_not_replaced(tmp_path: Path, cli, made: Path, monkeypatch, command: str, name: str, text: str, kind: str) -> None:
     monkeypatch.chdir(tmp_path)  # the path as given, short: shown whole
     out = Path(name)
     out.write_text(text)
     rc, _, err = cli(*_argv(command, made, out))
-    assert rc == 2 and f"--out {name!r} is a file neurohover did not write: give another path (writing {kind} would destroy it)" in err, err
+    option = "--json" if command == "evaluate-agent" else "--out"
+    assert rc == 2 and f"{option} {name!r} is a file neurohover did not write: give another path (writing {kind} would destroy it)" in err, err
     assert out.read_text() == text
     assert sorted(p.name for p in tmp_path.iterdir()) == [name]  # nor an evolve run's files beside it
 
