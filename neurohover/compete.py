@@ -389,6 +389,7 @@ def _run_into_store(config, store_path: Path, episodes_csv: Path, *, jobs: int, 
         stored = db.results(config.name, config.scale, missing_ok=True)  # interrupted before its first unit
         return [TestRunResult.from_dict(stored[k], k) for k in sorted((k for k in stored if k.startswith("run/")), key=_run_order)]
 
+    _note_other_runs(config, store_path)  # before flying (T56-A02)
     executor = make_executor("local", jobs=jobs, device=device)
     with Store(store_path) as db:
         try:
@@ -438,6 +439,42 @@ def _refuse_other_settings(config, store_path: Path) -> None:
         f"results store {str(store_path)!r} holds this competition ({config.name}) run with other settings ({diff}): its runs would "
         "not be comparable; give another --store (or --out), or the settings it was run with (its runs stay in the store)"
     )
+
+
+def _note_other_runs(config, store_path: Path) -> None:
+    """Say on stderr, before flying, that the store holds this competition with another run count only: the count is
+    part of the settings digest (its scale), so those runs are not reused, and --runs N flew them all again without a
+    word (T56-A02; stores keep their scales, so the digest is not changed)."""
+    from .experiments import Store
+    from .experiments.store_checks import new_store
+
+    def runs_apart(stored: dict) -> tuple[dict, int]:  # the config less its scale, hash and run count; the run count
+        settings = dict(stored.get("settings") or {})
+        groups = [dict(g) for g in settings.get("groups") or [] if isinstance(g, dict)]
+        count = sum(int(g.pop("n_mdps", 0)) * int(g.pop("runs_per_mdp", 1)) for g in groups)
+        rest = {k: v for k, v in stored.items() if k not in ("scale", "hash")}
+        return rest | {"settings": settings | {"groups": groups}}, count
+
+    if new_store(store_path):
+        return
+    mine, runs = runs_apart(config.to_dict())
+    with Store(store_path, create=False) as db:
+        if db.config_hash(config.name, config.scale) is not None:  # this competition's own runs are resumed
+            return
+        for _, scale, _, units in (e for e in db.experiments() if e[0] == config.name and e[1] != config.scale):
+            try:
+                other, count = runs_apart(db.config(config.name, scale))
+            except (TypeError, ValueError):  # a config edited by hand (NeurohoverError too): not this competition's to note
+                continue
+            if other == mine and units:
+                print(
+                    f"neurohover compete: note: results store {str(store_path)!r} holds this competition with {count} runs ({scale}, "
+                    f"{units} finished units): they are not reused, as the run count is part of a competition's settings digest; "
+                    f"its {runs} runs are flown anew under {config.scale}. To reuse them, give --runs {count} (results and wins "
+                    "then name a competition by --scale)",
+                    file=sys.stderr,
+                )
+                return
 
 
 def _run_order(key: str) -> tuple[int, int]:

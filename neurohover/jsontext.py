@@ -25,6 +25,7 @@ __all__ = [
     "plain_json",
     "strict_json",
     "toml_odd_character",
+    "toml_twice",
     "unwritable_key",
 ]
 
@@ -117,6 +118,29 @@ def toml_odd_character(text: str, err: ValueError) -> str:
     row = int(where[1] or len(lines)) - 1
     pos = sum(len(line) + 1 for line in lines[:row]) + (int(where[2]) - 1 if where[2] else len(lines[row]) if row < len(lines) else 0)
     return odd_character(text, pos, "TOML")
+
+
+def _toml_key(line: str) -> str:
+    """The key of TOML line ``line`` (``key = value``, quotes and spaces around dots dropped), or '' where it is none."""
+    if line.lstrip().startswith("[") or "=" not in line:
+        return ""
+    return ".".join(part.strip().strip("\"'") for part in line.split("=", 1)[0].split("."))
+
+
+def toml_twice(text: str, err: ValueError) -> str:
+    """tomllib's "Cannot overwrite a value (at line L, ...)" in ``text`` said as the key given twice and where, or ''
+    for any other error: it named neither the key nor the rule (T56-A04)."""
+    where = re.fullmatch(r"Cannot overwrite a value \(at (?:line (\d+), column \d+|end of document)\)", str(err))
+    lines = text.split("\n")
+    row = int(where[1] or len(lines)) - 1 if where else -1
+    key = _toml_key(lines[row]) if 0 <= row < len(lines) else ""
+    if not key:
+        return ""
+    top = max((i for i in range(row) if lines[i].lstrip().startswith("[")), default=-1)  # the table the line is in
+    table = f" in {lines[top].strip()}" if top >= 0 else ""
+    before = [i + 1 for i in range(top + 1, row) if _toml_key(lines[i]) == key]
+    said = f"lines {before[-1]} and {row + 1}" if before else f"line {row + 1}; a line above gives it, or a table it names, a value"
+    return f"key {key!r} is given twice{table} ({said}): give each key once"
 
 
 def json_text(value, **dumps) -> str:

@@ -44,7 +44,7 @@ from typing import Any
 
 from ..compete_labels import COMPETE_SCALE
 from ..errors import NeurohoverError, brief
-from ..jsontext import toml_odd_character
+from ..jsontext import toml_odd_character, toml_twice
 from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..models.model import LEGACY_MODEL_SUBSTEPS
 from .canonical import canonical_settings
@@ -417,7 +417,7 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
     try:
         raw = tomllib.loads(text := path.read_text(encoding="utf-8-sig"))  # TOML is UTF-8; a byte-order mark was "Invalid statement" (ninth trial)
     except tomllib.TOMLDecodeError as err:  # a curly quote pasted from a slide named (T49-A04)
-        raise NeurohoverError(f"config {str(path)!r} is not valid TOML: {err}{toml_odd_character(text, err)}") from None
+        raise NeurohoverError(f"config {str(path)!r} is not valid TOML: {toml_twice(text, err) or err}{toml_odd_character(text, err)}") from None
     except RecursionError:  # a value nested thousands deep (seventh trial)
         raise NeurohoverError(f"config {str(path)!r} is not allowed: its TOML is nested too deeply") from None
     except UnicodeDecodeError as err:  # was "cannot be read (UnicodeDecodeError)", naming neither the rule nor the place (T19-15)
