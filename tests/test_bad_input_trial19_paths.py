@@ -61,7 +61,7 @@ def test_a_dangling_link_is_refused_as_every_output_and_nothing_is_written_throu
         rc, _, err = cli(*argv)
         assert rc == 2 and "a symbolic link to a missing target is not written through" in err and "a file, not a directory" not in err, err
     assert not target.exists() and not os.path.lexists("pp/out_link.json.history.csv")
-    target.write_text("{}")  # a link to a file that exists is written through, the link kept
+    target.write_text("")  # a link to a file that exists is written through, the link kept (empty: not a user's own, T55-A02)
     rc, _, err = cli(*EVOLVE, "--out", "pp/out_link.json")
     assert rc == 0 and (tmp_path / "pp" / "out_link.json").is_symlink() and json.loads(target.read_text())["genome"], err
 

@@ -229,6 +229,7 @@ def test_a_model_file_as_written_and_one_before_winds_still_load(model_file: dic
     (tmp_path / "m.json").write_text(json.dumps(model_file))
     assert LearnedModel.load(tmp_path / "m.json").wind.kind == "none"
     older = {k: v for k, v in model_file.items() if k not in ("wind", "d_u")}
+    older["stats"] = {k: v for k, v in model_file["stats"].items() if k != "d_u"}  # stats' d_u came after d_u and wind (T56-B05)
     (tmp_path / "old.json").write_text(json.dumps(older))
     assert LearnedModel.load(tmp_path / "old.json").wind.kind == "none"
 

@@ -146,7 +146,7 @@ def test_an_output_through_a_symbolic_link_writes_its_file_and_a_dangling_one_is
     rc, _, err = cli("reproduce", "fig2", "--store", str(tmp_path / "dangling.sqlite"))
     assert rc == 2 and f"is a symbolic link to 'nowhere/x.sqlite', whose directory '{tmp_path}/nowhere' does not exist" in err, err
     (tmp_path / "real").mkdir()
-    (tmp_path / "real" / "p.json").write_text("{}")  # a link to a file is written through; one to nothing is refused (T19-12)
+    (tmp_path / "real" / "p.json").write_text("")  # a link to a file is written through; one to nothing is refused (T19-12); empty, not a user's own (T55-A02)
     (tmp_path / "p.json").symlink_to(tmp_path / "real" / "p.json")
     rc, _, err = cli("evolve", "--task", "ghh08", "--mdp", "train:0", "--budget", "3", "--episode-steps", "20", "--out", str(tmp_path / "p.json"))
     assert rc == 0, err
