@@ -218,7 +218,7 @@ class Run:
                 + preset_hint(saved, self.config)
             )
         check_family_draws(state, self.family, source)  # the family's name alike, its G too (T55-B10)
-        user = self.method in OPTIMISERS and self.method not in SHIPPED
+        user = self._runtime_optimiser
         written, since = copy.deepcopy(state.get("optimizer_state")) if user else None, time.perf_counter()  # as read: from_state_dict may edit it
         try:
             opt = type(self.opt).from_state_dict(state["optimizer_state"])
@@ -398,7 +398,7 @@ class Run:
         opt = self.opt
         # A run-time optimiser's champion is checked against what the run flew (T54-B03, B06); the shipped ones' answers
         # are the package's own (tested), and the check cost a steady-state run of 200-step episodes 14 % of its time.
-        user = self.method in OPTIMISERS and self.method not in SHIPPED
+        user = self._runtime_optimiser
         if self._held is None:
             self._held = held_champion(opt, self.cfg) if user else (None, self._told_champion())
         before = self._held[1]
@@ -467,6 +467,12 @@ class Run:
 
     def _asked(self) -> np.ndarray:
         return asked_genomes(self.opt, self.cfg)
+
+    @property
+    def _runtime_optimiser(self) -> bool:
+        """Whether the run's optimiser is one registered at run time (its answers are checked against what the run flew,
+        its restored state against the checkpoint's), not a shipped one."""
+        return self.method in OPTIMISERS and self.method not in SHIPPED
 
     def _told_champion(self) -> float:
         return told_champion(self.opt, self.cfg)
