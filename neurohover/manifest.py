@@ -104,9 +104,9 @@ def check_manifest_fields(manifest: dict, path: Path) -> None:
 
 def _optimiser_name(name: str) -> bool:
     """Whether ``name`` is one build-policies --optimizer takes: NE, a shipped optimiser's, or a run-time one's."""
-    from .evolution.optimisers import NE, SHIPPED, USER_NAME
+    from .evolution.optimisers import NE, SHIPPED, runtime_name
 
-    return name == NE or name in SHIPPED or USER_NAME.fullmatch(f"user:{name}") is not None
+    return name == NE or name in SHIPPED or runtime_name(name)
 
 
 def built_as(manifest: dict, role: Role, k: int) -> dict:

@@ -48,6 +48,7 @@ __all__ = [
     "optimiser_spec",
     "population_settings",
     "recorded_names",
+    "runtime_name",
     "usable_specs",
 ]
 
@@ -125,6 +126,12 @@ SHIPPED: frozenset[str] = frozenset(SHIPPED_SPECS)
 USER_NAME = re.compile(r"user:[A-Za-z0-9][A-Za-z0-9._+-]{0,63}")
 
 
+def runtime_name(name: object) -> bool:
+    """Whether ``name`` may name an optimiser registered at run time: one line of at most 64 letters, digits and ``._+-``
+    that :data:`USER_NAME` reads back, not NE's name nor one of its methods (run.py compares a run's method with those)."""
+    return isinstance(name, str) and name not in (NE, *NE_METHODS) and USER_NAME.fullmatch(f"user:{name}") is not None
+
+
 def entry_problem(name: object, spec: object) -> str:
     """What is wrong with the registry entry ``OPTIMISERS[name] = spec`` ('' when nothing): no :class:`OptimiserSpec`
     (5 or None was an AttributeError in evolve and in every later load_policy, T41-B02), a shipped name holding another
@@ -136,7 +143,7 @@ def entry_problem(name: object, spec: object) -> str:
         return shared
     assert isinstance(spec, OptimiserSpec)  # the shared checks refused anything else
     entry = f"OPTIMISERS[{brief(name)}] = {brief(spec)} is not allowed"
-    if not isinstance(name, str) or name in (NE, *NE_METHODS) or not USER_NAME.fullmatch(f"user:{name}"):
+    if not runtime_name(name):
         taken = ", ".join(map(repr, (NE, *NE_METHODS)))
         return f"{entry}: a run-time optimiser's name is one line of at most 64 letters, digits and ._+- (not {taken}), which its records name as user:NAME"
     if spec.label != name:
