@@ -292,12 +292,13 @@ def output_file(
     refuse_policy_set(p.parent, option, path)
     if p.is_symlink():  # written through: a file link into a set replaced the set's policy (T42-A04)
         refuse_policy_set(Path(os.path.realpath(p)).parent, option, path, link=True)
+    size = _size(p)  # before its kind is read: a file another thread saved in between was called not neurohover's (T32-B01)
     held = None if kind is None else held_kind(p)
     if held is not None and held != kind:  # a policy, a checkpoint, a summary replaced by another kind of file (T25-01 to T25-03)
         raise NeurohoverError(f"{option} {brief(os.fspath(path))} is {held}: give another path (writing {kind} there would destroy it)")
     # a user's own archive (T53-A04), notes at a policy's, model's or export's name (T55-A02) were replaced; a checkpoint
     # is evolve()'s to judge, which knows whether it resumes from it (a damaged one is named there; T46-B14)
-    if kind not in (None, CHECKPOINT_KIND) and held is None and p.is_file() and p.stat().st_size:
+    if kind not in (None, CHECKPOINT_KIND) and held is None and size:
         raise NeurohoverError(f"{option} {brief(os.fspath(path))} is a file neurohover did not write: give another path (writing {kind} would destroy it)")
     refuse_dangling_link(p, option, path)  # a link to nothing was written through, wherever it pointed (T19-12)
     refuse_pseudo_fs(p, option, path)
@@ -310,6 +311,14 @@ def output_file(
         what = "write this file" if existed else f"create a file in {str(real.parent)!r}"
         raise NeurohoverError(f"{option} {str(path)!r}: cannot {what} ({_why(err)})") from None
     return p
+
+
+def _size(p: Path) -> int:
+    """The size of the regular file ``p``; 0 for anything else, or where it is gone (a probe's file, removed)."""
+    try:
+        return p.stat().st_size if p.is_file() else 0
+    except OSError:
+        return 0
 
 
 def _probe(real: Path) -> bool:

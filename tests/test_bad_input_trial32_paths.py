@@ -81,6 +81,28 @@ def test_threads_saving_one_flight_data_path_leave_one_whole_archive(flight: Fli
     assert sorted(p.name for p in tmp_path.iterdir()) == ["race.npz"]
 
 
+def test_flight_data_saved_by_another_thread_while_its_kind_is_read_is_not_called_a_foreign_file(
+    flight: FlightData, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """T32-B01 again (CI, 2026-12-07): the path's kind was read while it did not exist yet, its size once another
+    thread's save had put flight data there: "a file neurohover did not write". The interleaving, made certain."""
+    import neurohover.paths as paths
+
+    out = tmp_path / "race.npz"
+    other = flight.save(tmp_path / "other.npz")
+    real_held_kind = paths.held_kind
+
+    def held_kind_then_another_save(path):  # the other thread's save lands just after this one read the kind
+        held = real_held_kind(path)
+        if not out.exists():
+            os.replace(other, out)
+        return held
+
+    monkeypatch.setattr(paths, "held_kind", held_kind_then_another_save)
+    assert flight.save(out) == out
+    assert FlightData.load(out).n_transitions == flight.n_transitions
+
+
 def test_threads_writing_one_checkpoint_path_leave_one_whole_checkpoint(tmp_path: Path) -> None:
     """T32-B01: evolve threads sharing a checkpoint path: "cannot write it (No such file or directory)"."""
     out = tmp_path / "ck.json"
