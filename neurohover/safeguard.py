@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import NeurohoverError, brief, finite_real, real_number, whole_in
+from .errors import NeurohoverError, brief, finite_real, real_number, setting_float, whole_in
 from .policies import Policy
 from .sim.constants import (
     SAFEGUARD_BOX,
@@ -72,7 +72,7 @@ class DangerousState:
                 raise NeurohoverError(f"safeguard {name}={brief(value)} is out of range: allowed {allowed}")
         whole_in(self.arm_after, "safeguard arm_after", 0, 10**6, "1000000 (control steps)")
         for name in ("box", "tilt", "threshold"):  # plain Python numbers: the repr and equality of the Python values
-            object.__setattr__(self, name, float(getattr(self, name)))
+            object.__setattr__(self, name, setting_float(getattr(self, name)))  # np.float32(0.3) as 0.3 (T57-B01)
         object.__setattr__(self, "arm_after", int(self.arm_after))
         unused = {  # a setting the rule does not read, set anyway, would be ignored without a word (third trial)
             "box": self.rule == "ratio-sum" and self.box != SAFEGUARD_BOX,

@@ -24,7 +24,7 @@ from typing import Any, Protocol, TypeVar
 
 import numpy as np
 
-from ..errors import NeurohoverError, as_floats, brief, finite_real, whole_number
+from ..errors import NeurohoverError, as_floats, brief, finite_real, lowest_allowed, setting_float, whole_number
 from ..flightmeta import compared_by_value
 from .state_codec import (
     STATE_DAMAGE,
@@ -251,17 +251,17 @@ def require_int(name: str, value: Any, minimum: int) -> int:
 
 
 def require_prob(name: str, value: Any) -> float:
-    """``value`` as a float, or NeurohoverError unless it is a probability in [0, 1]."""
+    """``value`` as a float (:func:`~neurohover.errors.setting_float`), or NeurohoverError unless it is a probability in [0, 1]."""
     if not finite_real(value) or not 0.0 <= float(value) <= 1.0:  # finite_real first: float(10**400) overflowed (eleventh trial)
         raise NeurohoverError(f"{name}={brief(value)} must be a probability in [0, 1]")
-    return float(value)
+    return setting_float(value)  # np.float32(0.3) as 0.3, -0.0 as 0.0, as every other settings class stores them (T57-B01)
 
 
 def require_std(name: str, value: Any) -> float:
-    """``value`` as a float (-0.0 as 0.0), or NeurohoverError unless it is a finite number >= 0."""
+    """``value`` as a float (:func:`~neurohover.errors.setting_float`: -0.0 as 0.0), or NeurohoverError unless it is a finite number >= 0."""
     if not finite_real(value) or float(value) < 0.0:
         raise NeurohoverError(f"{name}={brief(value)} must be a finite number >= 0")
-    return float(value) + 0.0  # -0.0 + 0.0 is 0.0, any other float unchanged: NumPy's normal() refused a scale of -0.0 (fourteenth trial)
+    return setting_float(value)  # -0.0 as 0.0: NumPy's normal() refused a scale of -0.0 (fourteenth trial); np.float32(0.3) as 0.3 (T57-B01)
 
 
 #: The largest spread (a mutation's or a search distribution's standard deviation, a step size) any optimiser takes:
@@ -271,15 +271,21 @@ MAX_SPREAD = 1e100
 #: The smallest positive spread a positive one may be: pycma's adaptation of sigma0=1e-320 (a subnormal) lost every
 #: digit and failed its own "assert np.isfinite" (T35-A01); 1e-100 is as far below any useful step as MAX_SPREAD above.
 MIN_POSITIVE_SPREAD = 1e-100
+#: The smallest mutation spread but 0, 2**-52: N(0, std) (relative with a mutation_floor) moves no gene of size 1 below it (T57-A01).
+MIN_SPREAD = float(np.finfo(np.float64).eps)
 
 
 def require_spread(name: str, value: Any, *, positive: bool = False, what: str = "") -> float:
-    """``value`` as a float, or NeurohoverError unless it is a spread in [0, :data:`MAX_SPREAD`] (from
-    :data:`MIN_POSITIVE_SPREAD` if ``positive``); ``what`` leads the message (the optimiser's name)."""
+    """``value`` as a float (:func:`~neurohover.errors.setting_float`), or NeurohoverError unless a spread <= :data:`MAX_SPREAD`: 0 or
+    from :data:`MIN_SPREAD`, or from :data:`MIN_POSITIVE_SPREAD` if ``positive``; ``what`` leads the message (the optimiser's name)."""
     if not finite_real(value) or not (MIN_POSITIVE_SPREAD <= float(value) if positive else 0.0 <= float(value)) or float(value) > MAX_SPREAD:
         low = f">= {MIN_POSITIVE_SPREAD:g}" if positive else ">= 0"
         raise NeurohoverError(f"{what}{name}={brief(value)} must be a finite number {low} and <= {MAX_SPREAD:g} (a larger one overflows the genes)")
-    return float(value) + 0.0  # -0.0 made 0.0: mutate_std=-0.0 was taken, then NumPy's "scale < 0" mid-run (fourteenth trial)
+    spread = setting_float(value)  # np.float32(0.3) as 0.3 (T57-B01); -0.0 as 0.0: NumPy's "scale < 0" mid-run (fourteenth trial)
+    if not positive and 0.0 < spread < MIN_SPREAD:
+        low = f"0 (no mutation) or a number in {lowest_allowed(MIN_SPREAD)}..{MAX_SPREAD:g}"
+        raise NeurohoverError(f"{what}{name}={brief(value)} is out of range, too small to move a gene (below 2**-52): allowed {low}")
+    return spread
 
 
 def set_field(obj: Any, name: str, value: Any) -> None:

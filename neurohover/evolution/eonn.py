@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, whole_in
+from ..errors import NeurohoverError, brief, finite_real, setting_float, whole_in
 from ..evaluate import PolicyTable, evaluate_jobs
 from ..policies import Policy
 from ..settings_checks import settings_from_dict
@@ -70,7 +70,7 @@ class EonnSettings:
     mutate_frac : float
         Each gene's chance of mutating in a mutated offspring.
     mutate_std : float
-        The spread of a mutation's Gaussian (0 to 1e100, :data:`~neurohover.evolution.common.MAX_SPREAD`).
+        The spread of a mutation's Gaussian, 0 to 1e100 (:data:`~neurohover.evolution.common.MAX_SPREAD`): 0 (none) or from 2**-52.
     mutate_repl : float
         A mutated gene's chance of being replaced by the Gaussian draw (else the draw is added).
     averaging_prob : float
@@ -78,7 +78,7 @@ class EonnSettings:
     spawn_frac : float
         Each gene's chance of mutating in the prototype's copies that make the initial population.
     spawn_std : float
-        The spread of that initial mutation's Gaussian (0 to 1e100).
+        The spread of that initial mutation's Gaussian (0 to 1e100, as ``mutate_std``'s).
     """
 
     pop_size: int = 50
@@ -116,7 +116,7 @@ class EonnSettings:
             v = getattr(self, name)
             if not finite_real(v) or not 0.0 <= float(v) <= 1.0:
                 raise NeurohoverError(f"{name}={brief(v)} is out of range: allowed a probability in [0, 1]")
-            set_field(self, name, float(v))  # a Python float, as GenerationalSettings stores (np.float32 was kept; T44-B22)
+            set_field(self, name, setting_float(v))  # a Python float, as GenerationalSettings stores (T44-B22): np.float32(0.3) as 0.3 (T57-B01)
         for name in ("mutate_std", "spawn_std"):  # 10**400 was NumPy's TypeError, 1e308 overflowed the genes (eleventh trial)
             v = getattr(self, name)
             # float(v) compared: np.float32's comparison with MAX_SPREAD cast 1e100 to float32 and warned (T44-B23)

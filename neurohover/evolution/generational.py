@@ -79,7 +79,7 @@ class GenerationalSettings:
     mutate_frac : float
         Per-gene mutation probability.
     mutate_std : float
-        Standard deviation of the Gaussian mutation (0 to 1e100, :data:`~neurohover.evolution.common.MAX_SPREAD`).
+        Standard deviation of the Gaussian mutation, 0 to 1e100 (:data:`~neurohover.evolution.common.MAX_SPREAD`): 0 (none) or from 2**-52.
     mutate_repl : float
         Probability that a mutated gene is replaced rather than shifted.
     budget : int or None

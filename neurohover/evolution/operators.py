@@ -18,7 +18,7 @@ import numba
 import numpy as np
 
 from ..errors import NeurohoverError, brief
-from .common import MAX_SPREAD, as_floats, require_prob, require_spread
+from .common import MAX_SPREAD, MIN_SPREAD, as_floats, require_prob, require_spread
 
 __all__ = ["MutationParams", "CrossoverParams", "mutate", "crossover"]
 
@@ -84,7 +84,8 @@ def mutate(genome: np.ndarray, rng: np.random.Generator, settings: MutationParam
         frac, std, repl = settings.mutate_frac, settings.mutate_std, settings.mutate_repl
     except AttributeError:
         raise _bad_settings(settings, "mutate_frac, mutate_std and mutate_repl") from None
-    if not (type(frac) is float and type(std) is float and type(repl) is float and 0.0 <= frac <= 1.0 and 0.0 <= repl <= 1.0 and 0.0 <= std <= MAX_SPREAD):
+    fast = type(frac) is float and type(std) is float and type(repl) is float and 0.0 <= frac <= 1.0 and 0.0 <= repl <= 1.0
+    if not (fast and (std == 0.0 or MIN_SPREAD <= std <= MAX_SPREAD)):  # 1e-320 flew as 0 (T57-A01)
         require_prob("mutate_frac", frac)  # the settings classes' checks, for what the fast test above does not pass
         require_prob("mutate_repl", repl)
         std = require_spread("mutate_std", std)

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import NeurohoverError, brief, finite_real, real_number
+from ..errors import NeurohoverError, brief, finite_real, real_number, setting_float
 from .common import (
     ASK_AGAIN,
     MAX_SPREAD,
@@ -98,7 +98,7 @@ class SteadyStateSettings:
     mutate_frac : float
         Per-gene mutation probability.
     mutate_std : float
-        Standard deviation of the Gaussian mutation (0 to 1e100, :data:`~neurohover.evolution.common.MAX_SPREAD`).
+        Standard deviation of the Gaussian mutation, 0 to 1e100 (:data:`~neurohover.evolution.common.MAX_SPREAD`): 0 (none) or from 2**-52.
     mutate_repl : float
         Probability that a mutated gene is replaced rather than shifted.
     plateau_threshold : int
@@ -155,7 +155,7 @@ class SteadyStateSettings:
             floor = self.mutation_floor
             if not real_number(floor) or not (finite_real(floor) and 0 < float(floor) <= MAX_SPREAD):
                 raise NeurohoverError(f"mutation_floor={brief(floor)} is out of range: allowed None or a number in (0, {MAX_SPREAD:g}]")
-            set_field(self, "mutation_floor", float(floor))
+            set_field(self, "mutation_floor", setting_float(floor))  # np.float32(0.3) as 0.3, as every real field (T57-B01)
         if not isinstance(self.plateau_rule, str) or self.plateau_rule not in PLATEAU_RULES:
             raise NeurohoverError(f"unknown plateau_rule {brief(self.plateau_rule)}: allowed {', '.join(PLATEAU_RULES)}")
         if not isinstance(self.selection, str) or self.selection not in SELECTIONS:
