@@ -107,7 +107,10 @@ def test_an_agent_s_settings_instance_is_checked_as_a_dict_is(holding, given, wh
 
 def test_an_agent_s_settings_instance_of_its_types_is_taken(holding):
     given = KSettings(k=np.int64(3), rate=1)
-    assert R.make_agent(holding, "ghh08", options=AgentOptions(settings=given)).settings is given
+    taken = R.make_agent(holding, "ghh08", options=AgentOptions(settings=given)).settings
+    assert taken == given and (type(taken.k), type(taken.rate)) == (int, float)  # as plain Python values (T57-B02)
+    plain = KSettings(k=3, rate=0.25)
+    assert R.make_agent(holding, "ghh08", options=AgentOptions(settings=plain)).settings is plain
 
 
 class _Opt:

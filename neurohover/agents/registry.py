@@ -17,7 +17,7 @@ from typing import Any, cast
 from ..errors import NeurohoverError, brief, package_path, registry_entry_problem
 from ..integrations.flying import generic_sigma_problem
 from ..policysets import PolicySet, load_policy_set
-from ..settings_checks import setting_type_problem
+from ..settings_checks import checked_settings
 from ..tasks import TaskFamily, get_task_family
 from .protocol import Agent
 from .spec import AgentOptions, AgentPolicies, AgentSpec
@@ -213,11 +213,9 @@ def _checked_options(spec: AgentSpec, options: AgentOptions) -> AgentOptions:
         return dataclasses.replace(options, settings=spec.settings.from_dict(given))
     if not isinstance(given, spec.settings):
         raise NeurohoverError(f"agent {spec.name!r} takes settings of {spec.settings.__name__} (or a dict of its fields), got {given!r:.60}")
-    # an instance is checked as a dict of its fields is: S(k='x', rate=inf) flew unchecked (T56-B01)
-    problem = setting_type_problem(type(given), {f.name: getattr(given, f.name) for f in dataclasses.fields(cast("Any", given))})
-    if problem:
-        raise NeurohoverError(f"bad {type(given).__name__}: {problem}")
-    return options
+    # an instance is checked as a dict of its fields is (S(k='x', rate=inf) flew unchecked, T56-B01), and the agent gets
+    # its plain values (np.float32(0.1) as 0.1, T57-B02)
+    return dataclasses.replace(options, settings=checked_settings(given, bad_what=type(given).__name__))
 
 
 __all__ = [

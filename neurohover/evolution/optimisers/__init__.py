@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import NeurohoverError, brief, frozen_dataclass_class, refused_signature, registry_entry_problem
-from ...settings_checks import setting_type_problem, settings_defaults_problem, settings_from_dict
+from ...settings_checks import checked_settings, settings_defaults_problem, settings_from_dict
 
 __all__ = [
     "NE",
@@ -238,10 +238,8 @@ def population_settings(name: str, settings: Any) -> Any:
     if settings is None:
         return cls()
     if type(settings) is cls:  # exactly its class: a subclass's settings (UH-CMA-ES's of CMA-ES's) belong to another optimiser
-        problem = setting_type_problem(cls, {f.name: getattr(settings, f.name) for f in dataclasses.fields(cls)})
-        if problem:  # an object of its class was flown unchecked, where a dict of the same values is refused (T56-B01's rest)
-            raise NeurohoverError(f"bad {name} settings: {problem}")
-        return settings
+        # an object of its class was flown unchecked, where a dict of the same values is refused (T56-B01's rest); plain values (T57-B02)
+        return checked_settings(settings, bad_what=f"{name} settings")
     if not isinstance(settings, Mapping):
         fields = [f.name for f in dataclasses.fields(cls)]
         raise NeurohoverError(f"settings for optimizer {name!r} must be a {cls.__name__} or a dict with keys {', '.join(fields)}")
