@@ -101,6 +101,7 @@ def test_build_policies_writes_a_loadable_set_with_computed_safe_policies(tiny_p
     assert manifest["table3"] == table3_summary(crashes, returns)
 
 
+@pytest.mark.slow
 def test_a_stopped_rebuild_leaves_the_old_set_as_it_was(tiny_policy_dir: Path, tmp_path: Path) -> None:
     """A rebuild of the shipped sets stopped after a minute had deleted their ancestor.json (bad-input trial):
     a set is built beside the old one and replaces it only when complete."""
@@ -120,6 +121,7 @@ def test_a_stopped_rebuild_leaves_the_old_set_as_it_was(tiny_policy_dir: Path, t
     assert not (tmp_path / "ghh08" / "stages").exists()
 
 
+@pytest.mark.slow
 def test_a_stopped_build_resumes_from_its_finished_runs_to_the_same_set(tmp_path: Path) -> None:
     """issue 37, fourth trial: a build stopped after some stages started over at stage 1 when run again."""
     whole = build_policy_set("ghh08", tmp_path / "whole", budget=20, n_steps=30, safety_episodes=1)
@@ -148,6 +150,7 @@ def test_table3_summary_averages_own_mdp_and_all_mdps() -> None:
     assert table3_summary(crashes, returns) == {"r": -150.0, "r_G": -275.0, "crashed_episodes": 1}
 
 
+@pytest.mark.slow
 def test_chain_lineage_seeds_every_run_from_the_ancestor_and_independent_from_the_baseline(tiny_policy_dir: Path, tmp_path: Path) -> None:
     base = prototype("mlp", "baseline").genome
     manifest = json.loads((tiny_policy_dir / "ghh08" / "manifest.json").read_text())
@@ -204,6 +207,7 @@ def test_build_policies_and_the_planner_evolve_the_policies_of_one_recipe() -> N
     assert over_g and all(r == FGHH_GENERIC_RESAMPLING[k.split("-")[1].rstrip("0123456789")] for k, r in over_g.items())
 
 
+@pytest.mark.slow
 def test_shipped_ghh08_specialised_policies_match_table_3s_mlp_row() -> None:
     """Table 3 (MLP, evolved from the baseline): r = -132.60 on the policy's own training MDP,
     r_G = -2001.89 across all ten, no crash on any. The shipped set must stay near that."""
@@ -216,6 +220,7 @@ def test_shipped_ghh08_specialised_policies_match_table_3s_mlp_row() -> None:
     assert -175 < r and -2700 < r_g, (r, r_g)
 
 
+@pytest.mark.slow
 def test_shipped_ghh09_set_is_crash_free_on_the_training_mdps_and_its_safe_pair_is_the_papers() -> None:
     """The paper's hybrid flies the specialised policies of training MDPs #4 and #7 (0-based 3, 6)."""
     family = get_task_family("ghh09")
@@ -235,6 +240,7 @@ def test_choose_safe_follows_the_papers_rule() -> None:
     assert choose_safe(crashes, returns) == (3, 1)
 
 
+@pytest.mark.slow
 def test_model_based_agents_beat_the_baseline_on_ghh08_test_mdps() -> None:
     family = get_task_family("ghh08")
     generic = prototype("mlp", "baseline")
@@ -276,6 +282,7 @@ def _roller() -> Policy:
     return Policy("slp", g)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("replacement", ["rerank", "evolve"])
 def test_hybrid_discards_a_policy_that_needs_the_safeguard(replacement: str) -> None:
     family = get_task_family("ghh09")
@@ -291,6 +298,7 @@ def test_hybrid_discards_a_policy_that_needs_the_safeguard(replacement: str) -> 
         assert result.policy[5] == agent.candidates[int(np.argmax([np.mean(v[:1]) for v in agent.values]))][1]
 
 
+@pytest.mark.slow
 def test_hybrid_rerank_scores_each_candidate_by_the_mean_of_its_episodes_as_the_authors_code() -> None:
     family = get_task_family("ghh09")
     agent = HybridAgent([baseline_policy(), baseline_policy()], prototype("mlp", "baseline"), baseline_policy(), SHORT)
@@ -318,6 +326,7 @@ def _flight(e: int):
     return evaluate(baseline_policy(), family.training_mdps()[0], seed=e, record=True, n_steps=300).flight_data
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("model_from", ["first-safe", "both"])
 def test_hybrid_learns_its_model_from_the_chosen_trial_episodes(model_from: str) -> None:
     family = get_task_family("ghh09")
@@ -341,6 +350,7 @@ def test_hybrid_settings_refuse_unknown_variants(kwargs: dict, message: str) -> 
         HybridSettings(**kwargs)
 
 
+@pytest.mark.slow
 def test_compete_writes_results_plot_and_keeps_finished_runs_on_interrupt(tiny_policy_dir: Path, tmp_path: Path) -> None:
     out = tmp_path / "run"
     summary, results = compete("ghh08", "model-free", runs=3, episodes=12, seed=1, jobs=2, out=out, n_steps=300, policy_dir=str(tiny_policy_dir))
@@ -417,6 +427,7 @@ class _Repeater(Agent):
         self.seen.append(outcome.episode)
 
 
+@pytest.mark.slow
 def test_repeated_choices_flown_ahead_equal_episode_by_episode_flights() -> None:
     # Some episodes fire the safeguard, some do not: the speculative chunks must not change a result.
     family = get_task_family("ghh09")

@@ -24,6 +24,7 @@ def workdir(tmp_path_factory) -> Path:
     return setup(tmp_path_factory.mktemp("bad-input"))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("args, expected", CASES, ids=[" ".join(a[:1] + a[-2:]) for a, _ in CASES])
 def test_each_case_is_refused_with_one_clear_line(args, expected, workdir: Path, capsys, monkeypatch) -> None:
     monkeypatch.chdir(workdir)
@@ -35,6 +36,7 @@ def test_each_case_is_refused_with_one_clear_line(args, expected, workdir: Path,
     assert sorted(p.name for p in workdir.iterdir()) == before  # nothing written, no stray directories
 
 
+@pytest.mark.slow
 def test_the_script_runs_a_case_in_a_fresh_process(workdir: Path) -> None:
     # evolve with an unwritable --out and a budget of 1e9 episodes: refused before evolving (which would
     # take days: the timeout is only a net against that), with no progress line or compile note.
@@ -140,6 +142,7 @@ def test_demo_refuses_zero_episodes_before_its_table(capsys) -> None:
     assert capsys.readouterr().out == ""  # the header was printed before the refusal (second trial)
 
 
+@pytest.mark.slow
 def test_the_script_prints_one_line_per_case() -> None:
     # One case in a fresh process (the script runs all of them by hand; each case runs in-process above).
     script = str(Path(__file__).with_name("bad_input.py"))
@@ -181,6 +184,7 @@ def test_an_evolution_checkpoint_is_never_written_over_a_device_or_an_empty_path
     assert fifo.is_fifo()
 
 
+@pytest.mark.slow
 def test_a_write_cut_short_leaves_no_partial_file(tmp_path: Path) -> None:
     """A file-size limit (RLIMIT_FSIZE) makes the flight data's write fail halfway, as a full disk would."""
     script = (
@@ -277,6 +281,7 @@ def test_a_repeated_sensor_key_and_a_damaged_store_are_one_clear_line(tmp_path: 
         assert rc == 2 and "Traceback" not in err and "cannot be read" in err and str(damaged) in err and len(err) < 400, err
 
 
+@pytest.mark.slow
 def test_a_damaged_row_is_named_and_the_rest_of_the_store_reported(tmp_path: Path, capsys) -> None:
     """issue 37: a unit or config whose stored JSON is damaged was a JSONDecodeError traceback; now the command
     names the row, and the report reports every other experiment, the damaged one in its place."""
@@ -485,6 +490,7 @@ def test_a_stored_row_that_is_no_json_object_is_named(tmp_path: Path, capsys) ->
         assert what in err and "Traceback" not in err, err
 
 
+@pytest.mark.slow
 def test_a_stored_value_of_the_wrong_kind_is_named_by_report_results_and_wins(tmp_path: Path, capsys) -> None:
     """Sixth trial: a stored test run's score "x" was a ValueError in report (leaving a lone figure), exported by results
     --format json with exit 0."""

@@ -62,6 +62,7 @@ def test_a_crash_joined_with_a_longer_budget_keeps_no_budget() -> None:
     assert (full.flight_data + full.flight_data).metadata["episode_steps"] == 200  # one budget: kept
 
 
+@pytest.mark.slow
 def test_a_ctrl_c_python_wraps_while_the_package_imports_ends_with_one_line() -> None:
     """Seen in this session's full run: a Ctrl-C landing in a class body's __set_name__ (functools.cached_property) while
     the command imported its modules is raised by Python as RuntimeError("Error calling __set_name__") from the

@@ -84,6 +84,7 @@ def test_policy_tables_compare_by_value() -> None:
         hash(a)
 
 
+@pytest.mark.slow
 def test_a_store_of_the_competition_run_with_another_policy_set_is_refused_and_the_folder_kept(tmp_path: Path, cli) -> None:
     """U1, S3: the refusal named two hashes and --update / --fresh, which compete does not take; a failed competition
     rewrote its --out folder's episodes.csv (a header only, or another competition's rows under its summary)."""

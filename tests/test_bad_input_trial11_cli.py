@@ -85,6 +85,7 @@ def test_results_out_dash_points_to_standard_output(tmp_path: Path, cli) -> None
     assert not (tmp_path / "-").exists() and not Path("-").exists()
 
 
+@pytest.mark.slow
 def test_results_and_wins_take_the_scales_a_compete_store_holds(tmp_path: Path, cli) -> None:
     """U1: "choose one with --scale" named scales like settings-e4eae2eb06, which --scale (quick, paper) refused."""
     out = tmp_path / "c"

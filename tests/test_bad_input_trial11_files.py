@@ -39,6 +39,7 @@ def tiny_store(tmp_path: Path, cli) -> Path:
     return store
 
 
+@pytest.mark.slow
 def test_a_report_on_a_store_whose_name_is_no_utf8_is_written(tiny_store: Path, tmp_path: Path, cli) -> None:
     """T3: report.md copies the store's name, and a byte that is no UTF-8 in it was a UnicodeEncodeError after the
     figures were written (report.md missing); the name is now escaped as messages show it."""
@@ -84,6 +85,7 @@ def _flight_data(path: Path, policy: str) -> Path:
     return path
 
 
+@pytest.mark.slow
 def test_flight_data_whose_file_or_policy_name_is_no_utf8_is_plotted(tmp_path: Path) -> None:
     """T4: a flight-data file, or the policy its metadata names, whose name holds a byte that is no UTF-8 was
     matplotlib's TypeError from the figure's title (``neurohover plot`` takes the file's name as the stem); the title
@@ -105,6 +107,7 @@ def _compete_dir(path: Path) -> Path:
     return path
 
 
+@pytest.mark.slow
 def test_compete_curves_named_with_bytes_that_are_no_utf8_are_plotted(tmp_path: Path, cli) -> None:
     """T4: a competition directory named with a byte that is no UTF-8 labels its curve; it was matplotlib's TypeError."""
     rc, _, err = cli("plot", "--compete", str(_compete_dir(tmp_path / "c\udcff")), "--out", str(tmp_path / "pl"))
@@ -179,6 +182,7 @@ def test_fghh_budget_beside_another_task_says_to_leave_it_out(cli, tmp_path: Pat
     ), err
 
 
+@pytest.mark.slow
 def test_overlaid_competitions_name_the_conditions_they_differ_in(tmp_path: Path) -> None:
     """S4: 50-step drifting episodes were overlaid on 6000-step ones as if comparable; summary.json kept neither."""
     import json

@@ -192,6 +192,7 @@ def test_a_spread_that_overflows_the_genes_is_refused_up_front(optimizer: str, s
     assert "<= 1e100" in out or "0 to 1e100" in out, out
 
 
+@pytest.mark.slow
 def test_ec_mer_refuses_a_policy_other_than_the_one_that_flew_the_data(tmp_path: Path, cli) -> None:
     """S2: learn-model --method ec-mer --policy FILE fitted the closed loop of FILE, a policy that never flew the data
     (their metadata record the baseline), without a word."""

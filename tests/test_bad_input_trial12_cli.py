@@ -83,6 +83,7 @@ def test_resampling_with_an_empty_field_is_refused(spec: str, tmp_path: Path, mo
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_a_continual_safeguard_delayed_past_the_episode_is_refused_before_flying() -> None:
     """S3: safeguard_after at or past the episode length was accepted, so the safeguard never tested."""
     import neurohover as nh

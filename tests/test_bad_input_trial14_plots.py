@@ -84,6 +84,7 @@ def test_writing_never_replaces_a_fifo(tmp_path: Path) -> None:
     assert _is_fifo(fifo) and _is_fifo(later) and sorted(p.name for p in tmp_path.iterdir()) == ["fifo", "later"]
 
 
+@pytest.mark.slow
 def test_plot_flight_data_refuses_a_bad_out_dir_episodes_data_or_metadata(tmp_path: Path) -> None:
     """T14-10: a FIFO as out_dir was NotADirectoryError, episodes=0 "'int' object is not iterable", data None an
     AttributeError and metadata episode_steps "x" int()'s ValueError."""
@@ -168,6 +169,7 @@ def test_printable_escapes_control_and_format_characters() -> None:
     assert printable("é 日本/x.npz") == "é 日本/x.npz"  # printable text stays as it is
 
 
+@pytest.mark.slow
 def test_result_lines_of_fly_and_plot_escape_the_names(tmp_path: Path, cli) -> None:
     """T14-24: fly --record 'a\\nb.npz' and plot --out 'p\\nq' printed the names raw (one result over two lines; U+202E
     reversed the rest of the line)."""
@@ -180,6 +182,7 @@ def test_result_lines_of_fly_and_plot_escape_the_names(tmp_path: Path, cli) -> N
     assert out == f"{tmp_path}/p\\nq/a\\nb\\u202e-episode0.png\n"
 
 
+@pytest.mark.slow
 def test_result_line_of_compete_escapes_the_names(tmp_path: Path, cli) -> None:
     """T14-24: compete --out 'c\\x01d' printed the control character raw in its "results:" line."""
     out_dir = tmp_path / "c\x01d"

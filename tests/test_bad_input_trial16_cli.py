@@ -25,6 +25,7 @@ def _command(env: dict[str, str], *args: str, code: str | None = None) -> subpro
     return subprocess.run(argv, env={**os.environ, **env}, capture_output=True, text=True, timeout=120)
 
 
+@pytest.mark.slow
 def test_an_unknown_matplotlib_backend_is_named() -> None:
     """T16-1: MPLBACKEND=bogus was matplotlib's ValueError traceback from every command, --help too (pycma imports it)."""
     proc = _command({"MPLBACKEND": "bogus"}, "--help")
@@ -81,6 +82,7 @@ def test_numba_variables_numba_cannot_read_are_named(monkeypatch, name: str, val
         neurohover._check_numba_variables()
 
 
+@pytest.mark.slow
 def test_any_numba_variable_numba_cannot_parse_is_named() -> None:
     """T16-3: any other numba variable read with int() (NUMBA_DEBUG_CACHE=x) printed numba's warning with a traceback."""
     proc = _command({"NUMBA_DEBUG_CACHE": "x"}, "--help")

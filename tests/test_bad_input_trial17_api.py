@@ -72,6 +72,7 @@ CASES: dict[str, tuple[Callable[[object], object], str, object]] = {
 OUT: list[Path] = []  # plot_flight_data's output directory, set by the test
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("time", TIMES, ids=["5s", "4-no-unit"])
 @pytest.mark.parametrize("case", list(CASES))
 def test_a_time_span_is_no_number(case: str, time: np.timedelta64, tmp_path: Path) -> None:

@@ -108,6 +108,7 @@ def test_compete_refuses_a_damaged_config_and_leaves_the_store_as_it_was(compete
     assert dump(store) == before
 
 
+@pytest.mark.slow
 def test_report_warns_of_each_damaged_experiment_and_exits_2_when_none_is_reported(tiny, tmp_path: Path, cli: CliRun) -> None:
     """T19-07: a report of a store whose every experiment was damaged exited 0 with "report written", the damage said
     only inside report.md; now each damaged experiment is one warning line on stderr, and nothing reported is exit 2."""

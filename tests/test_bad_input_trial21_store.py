@@ -30,6 +30,7 @@ def tiny(tmp_path_factory) -> tuple[Path, Path]:
     return config, where / "s.sqlite"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("edit", "says"),
     [
@@ -90,6 +91,7 @@ def test_every_command_names_units_at_a_scale_of_no_config_as_damage(tiny, tmp_p
     assert dump(store) == before
 
 
+@pytest.mark.slow
 def test_report_warns_of_units_of_an_experiment_it_holds_no_config_of(tiny, tmp_path: Path, cli: CliRun) -> None:
     """T21-15: units of an experiment 'ghost' with no config row at all were left out of the report without a word;
     now one warning line names them (the report of the sound experiments written), and asked for alone they are refused."""

@@ -64,6 +64,7 @@ def _refused(folder: Path, message: str, cli, tmp_path: Path) -> None:
     assert not (tmp_path / "plots" / "compete.png").exists()
 
 
+@pytest.mark.slow
 def test_what_compete_writes_is_read(real: dict[str, Path], cli, tmp_path: Path) -> None:
     """T23-06/T23-07: every check takes what compete writes: baseline, a learning agent (its policy changes, the mean
     after learning from its last policy), an agent under a safeguard and fghh's sigma on sampled MDPs; its summary's keys
@@ -92,6 +93,7 @@ SUMMARY_CASES = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("edits", "message"), SUMMARY_CASES, ids=[next(iter(e)) for e, _ in SUMMARY_CASES])
 def test_a_summary_of_values_compete_never_writes_is_refused(real: dict[str, Path], cli, tmp_path: Path, edits: dict, message: str) -> None:
     """T23-06: a summary.json with mean_return_after_learning 5.0 (its rows give a mean <= 0), a sigma on a ghh08
@@ -100,6 +102,7 @@ def test_a_summary_of_values_compete_never_writes_is_refused(real: dict[str, Pat
     _refused(_copy(real, tmp_path / "c", **edits), message, cli, tmp_path)
 
 
+@pytest.mark.slow
 def test_a_mean_after_learning_out_of_range_is_refused_where_the_rows_do_not_give_it(real: dict[str, Path], cli, tmp_path: Path) -> None:
     """T23-06: rows that name no policy (an older file) give no mean after learning to compare with; a positive one is
     still refused by its range."""
@@ -122,6 +125,7 @@ ROW_CASES = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("lines", "column", "value", "message"), ROW_CASES, ids=["two_mdps", "test999", "fired", "policy"])
 def test_rows_no_competition_writes_are_refused_with_their_line(
     real: dict[str, Path], cli, tmp_path: Path, lines: list[int], column: str, value: str, message: str
@@ -134,6 +138,7 @@ def test_rows_no_competition_writes_are_refused_with_their_line(
     _refused(folder, message, cli, tmp_path)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("header", "row", "message"),
     [

@@ -52,6 +52,7 @@ def written(tmp_path_factory) -> Path:
     return where
 
 
+@pytest.mark.slow
 def test_every_file_the_code_writes_still_loads(written: Path) -> None:
     """The published sets (ancestors included), each evolve output and each built set load, file by file and as sets."""
     for name in EVOLVE_RUNS:
@@ -76,6 +77,7 @@ def _edited_policy(written: Path, at: Path, name: str, **changes: Any) -> Path:
     return at
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("name", "changes", "says"),
     [
@@ -123,6 +125,7 @@ def test_a_hand_edited_policy_file_is_refused_by_name(written: Path, tmp_path: P
     assert f"policy file {str(path)!r}: " in str(caught.value) and says in str(caught.value)
 
 
+@pytest.mark.slow
 def test_the_command_line_refuses_it_with_status_2(written: Path, tmp_path: Path, cli: CliRun) -> None:
     path = _edited_policy(written, tmp_path / "p.json", "steady", stop_reason="zzz")
     rc, _, err = cli("fly", "--task", "ghh08", "--policy", str(path), "--episodes", "1")
@@ -139,6 +142,7 @@ def _edited_set(written: Path, at: Path, task: str, file: str, **changes: Any) -
     return at
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("task", "file", "changes", "says"),
     [
@@ -179,6 +183,7 @@ def test_a_hand_edited_policy_set_is_refused_by_name(written: Path, tmp_path: Pa
     assert says in str(caught.value) and str(directory) in str(caught.value)
 
 
+@pytest.mark.slow
 def test_compete_refuses_a_hand_edited_set_with_status_2(written: Path, tmp_path: Path, cli: CliRun) -> None:
     directory = _edited_set(written, tmp_path, "ghh08", "specialised_3.json", seed=-3)
     argv = ["compete", "--task", "ghh08", "--agent", "model-free", "--policy-dir", str(directory), "--runs", "1", "--episodes", "1"]

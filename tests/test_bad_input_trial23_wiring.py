@@ -16,6 +16,7 @@ from neurohover.flightdata import FlightData
 from neurohover.plots import plot_flight_data
 
 
+@pytest.mark.slow
 def test_a_plain_import_checks_a_policy_files_record(tmp_path: Path) -> None:
     path = tmp_path / "p.json"
     shipped = Path(__file__).parents[1] / "neurohover" / "data" / "policies" / "ghh08" / "generic.json"

@@ -50,6 +50,7 @@ def flights(tmp_path_factory) -> dict[str, Path]:
 # --------------------------------------------------------------------------- T24-04: joined recordings
 
 
+@pytest.mark.slow
 def test_joined_recordings_keep_no_seed_or_policy_the_halves_do_not_share(flights: dict[str, Path], tmp_path: Path) -> None:
     """T24-04: f (baseline, seed 3) + fp (p.json, seed 7) recorded seed 7 and policy p.json for all three episodes."""
     f, fp, f7 = (FlightData.load(flights[n]) for n in ("f", "fp", "f7"))
@@ -183,6 +184,7 @@ def test_ec_mer_names_the_policy_flown_that_did_not_fly_them(flights: dict[str, 
     assert "'baseline'" not in err, err
 
 
+@pytest.mark.slow
 def test_every_recording_fly_writes_loads_joined_saved_and_reloaded(flights: dict[str, Path], tmp_path: Path) -> None:
     """What is not refused: every file above (two policies, seeds, --wind, a noisy delayed sensor, crashes, float32),
     and their joins saved as float64 and float32 and loaded back."""

@@ -48,6 +48,7 @@ def _load(d: dict, tmp_path: Path) -> LearnedModel:
 # --------------------------------------------------------------------------- every model the code writes loads
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("budget", "seed"), [(5, 0), (30, 7), (150, 11)])
 def test_ec_models_of_budgets_and_seeds_load(flight, budget: int, seed: int, tmp_path: Path) -> None:
     """T24-08: the new checks take EC-MER's and EC-MENO's models of several budgets, seeds, episodes and scalings."""
@@ -59,6 +60,7 @@ def test_ec_models_of_budgets_and_seeds_load(flight, budget: int, seed: int, tmp
         assert LearnedModel.load(model.save(tmp_path / "m.json")) == model
 
 
+@pytest.mark.slow
 def test_ec_models_of_crashed_flights_and_the_plateau_stop_load(flight, tmp_path: Path) -> None:
     """T24-08: EC-MER given the recorded return of a crashed episode (as the experiments give it) and EC-MENO run to
     its plateau stop (budget null) load too."""
@@ -164,6 +166,7 @@ def test_a_callers_own_stats_still_load(flight, tmp_path: Path) -> None:
     assert LearnedModel.load(model.save(tmp_path / "m.json")).stats == model.stats
 
 
+@pytest.mark.slow
 def test_the_findings_steps_on_the_command_line(cli, tmp_path: Path) -> None:
     """T24-08 as found: fly --record, learn-model --method ec-mer --budget 10 --out me.json, then stats.true_return set to
     5.0 (or stats.return_error 1.0) in the file: LearnedModel.load refuses it, naming the stat."""

@@ -96,6 +96,7 @@ SUMMARY_CASES = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("name", "edits", "message"), SUMMARY_CASES, ids=[f"{n}-{i}" for i, (n, _, _) in enumerate(SUMMARY_CASES)])
 def test_a_summary_whose_seconds_contradict_it_is_refused(real: dict[str, Path], cli: CliRun, tmp_path: Path, name: str, edits: dict, message: str) -> None:
     """T24-07: offline seconds 5.0 of a 0.14-second baseline run, any offline seconds of the baseline (it learns
@@ -103,6 +104,7 @@ def test_a_summary_whose_seconds_contradict_it_is_refused(real: dict[str, Path],
     _summary_refused(_copy(real, tmp_path / "c", name, **edits), message, cli, tmp_path)
 
 
+@pytest.mark.slow
 def test_what_compete_writes_of_its_seconds_is_read(real: dict[str, Path], tmp_path: Path) -> None:
     """T24-07: a baseline competition writes offline seconds 0.0 exactly, a learning agent's more (within its
     seconds), and both are read; a learning agent's offline seconds within its seconds are its own."""
@@ -128,6 +130,7 @@ def test_the_agents_without_offline_work_never_have_their_update_called() -> Non
         assert agent.choose(0).final, name
 
 
+@pytest.mark.slow
 def test_a_stored_baseline_run_with_offline_seconds_is_refused(tr1, tmp_path: Path, cli: CliRun) -> None:
     """T24-07: a stored baseline run with offline seconds within its seconds was taken (compete would write them in a
     summary that plot --compete refuses); the store now refuses it as plot refuses the summary."""
@@ -145,6 +148,7 @@ def _raised_first(r: dict[str, Any]) -> list[list[Any]]:
     return history
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("changes", "says"),
     [
@@ -173,6 +177,7 @@ def test_an_evolution_run_that_contradicts_itself_is_refused_by_every_command(ev
     refused_by_every_command(cli, config, store, "ev1", line, tmp_path / "r")
 
 
+@pytest.mark.slow
 def test_the_falling_history_message_names_the_records(ev1, tmp_path: Path) -> None:
     """T24-09: the message names the record that falls, the earlier record's fitness and what is allowed."""
     store = _edited(ev1[1], tmp_path / "s.sqlite", EVOLVE, history=_raised_first)
@@ -183,6 +188,7 @@ def test_the_falling_history_message_names_the_records(ev1, tmp_path: Path) -> N
     ), message
 
 
+@pytest.mark.slow
 def test_a_falling_history_is_taken_where_the_champion_is_each_generations_best(ev1) -> None:
     """T24-09: only what is proven is refused: on a family (generational NE, races, CMA-ES, OpenAI-ES, uh-cma: the best
     estimate of the last generation) and for NEAT (each generation's best) a champion's fitness may fall."""

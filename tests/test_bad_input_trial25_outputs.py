@@ -50,6 +50,7 @@ def test_results_out_refuses_another_suffix_and_a_policy_file(tmp_path, cli, tin
     assert json.loads(pol.read_text()) == POLICY
 
 
+@pytest.mark.slow
 def test_learn_model_out_refuses_a_checkpoint_name_and_a_policy(tmp_path, cli) -> None:
     """T25-03: learn-model --out P.checkpoint.json replaced evolve's checkpoint; --out p.json an evolved policy."""
     data = tmp_path / "f0.npz"

@@ -68,6 +68,7 @@ def test_a02_a_file_s_policy_budget_stands_where_set_switches_the_source(tmp_pat
         load_config(str(path), "quick", {"policies": "shipped", "policy_budget": 7})
 
 
+@pytest.mark.slow
 def test_a02_every_shipped_config_loads_at_both_scales() -> None:
     for name in shipped_configs():
         for scale in ("quick", "paper"):

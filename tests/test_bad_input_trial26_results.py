@@ -49,6 +49,7 @@ def test_the_steady_state_rule_is_one() -> None:
     assert steady_state_evaluations(3, 6, 2) == 6 + 2 * 4
 
 
+@pytest.mark.slow
 def test_a_stored_steady_state_run_of_generations_its_evaluations_contradict_is_refused(ev1: tuple[Path, Path], tmp_path: Path, cli: CliRun) -> None:
     """T26-B04: generations 40 beside 60 evaluations of pop_size 50, elite 49 (generation 11) was exported and reported."""
     config, store = ev1
@@ -63,6 +64,7 @@ def test_a_stored_steady_state_run_of_generations_its_evaluations_contradict_is_
     refused_by_every_command(cli, config, at, "ev1", line, tmp_path / "report")
 
 
+@pytest.mark.slow
 def test_a_steady_state_run_under_other_optimiser_settings_is_checked_by_them(ev1: tuple[Path, Path]) -> None:
     """T26-B04: the rule takes the unit's own pop_size and elite_size; a run of another optimiser is not checked by it."""
     from neurohover.experiments.results import EvolveResult
@@ -128,6 +130,7 @@ def test_a_crash_on_the_last_step_is_charged_nothing() -> None:
     assert crash_charge(20, 20) == 0.0 and crash_charge(20, 10) == -10 * CRASH_STEP_PENALTY
 
 
+@pytest.mark.slow
 def test_the_trials_crashed_results_are_sound_without_their_crash_steps(ev1: tuple[Path, Path], tmp_path: Path) -> None:
     """T26-B09 (1), (2): champion_crashed true beside a champion return of -58.4 (the mean of K episodes, any of which
     may crash on its last step) and a robustness crash beside a return of -64.7 are read as stored."""
@@ -175,6 +178,7 @@ def _rows_edited(competition: Path, at: Path, old: str, new: str, summary: bool 
     return at
 
 
+@pytest.mark.slow
 def test_a_compete_crash_charged_less_than_its_step_gives_is_refused(competition: Path, tmp_path: Path, cli: CliRun) -> None:
     """T26-B09 (3): the trial's row (crashed 1, return -6.1, step 20 of 20) is sound; at step 10 it is refused, without
     a summary too (the file's longest episode bounds the episodes' length)."""
@@ -192,6 +196,7 @@ def test_a_compete_crash_charged_less_than_its_step_gives_is_refused(competition
 # --------------------------------------------------------------------------- T26-B10: a run's MDP
 
 
+@pytest.mark.slow
 def test_a_compete_run_on_another_runs_mdp_is_refused(competition: Path, tmp_path: Path, cli: CliRun) -> None:
     """T26-B10: run 1 of 2 on test:0 (compete flies it on test:1) was plotted; refused with the summary and without."""
     assert read_compete_dir(competition).returns.shape == (2, 3)
@@ -238,6 +243,7 @@ def _observation_edited(flight: Path, at: Path, row: int, column: int, value: fl
     return at
 
 
+@pytest.mark.slow
 def test_an_uncrashed_episode_past_a_crash_bound_is_refused(flights: dict[str, Path], tmp_path: Path, cli: CliRun) -> None:
     """T26-B11: x 50 m (no world component is past 20 m, so no body-frame reading past 34.6 m) at step 100 of an episode
     flagged uncrashed was loaded and learned from."""
@@ -250,6 +256,7 @@ def test_an_uncrashed_episode_past_a_crash_bound_is_refused(flights: dict[str, P
     assert rc == 2 and says in stderr and not (tmp_path / "m.json").exists(), stderr
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("column", "value", "says"), [(6, 13.0, "its rate is 13, past the crash bound 12.57 rad/s"), (9, 0.5, "its tilt is 60")])
 def test_each_crash_bound_is_read(flights: dict[str, Path], tmp_path: Path, column: int, value: float, says: str) -> None:
     """T26-B11: the rates' bound and the tilt's (a quaternion's vector part of 0.5 is 60 degrees off level)."""
@@ -257,6 +264,7 @@ def test_each_crash_bound_is_read(flights: dict[str, Path], tmp_path: Path, colu
         FlightData.load(_observation_edited(flights["f"], tmp_path / "x.npz", 7, column, value))
 
 
+@pytest.mark.slow
 def test_a_crashed_episodes_readings_before_its_last_are_within_the_bounds(flights: dict[str, Path], tmp_path: Path) -> None:
     """T26-B11: a crash's last reading is past a bound (sound), a reading before it is refused."""
     crashed = FlightData.load(flights["fall"])
@@ -265,6 +273,7 @@ def test_a_crashed_episodes_readings_before_its_last_are_within_the_bounds(fligh
         FlightData.load(_observation_edited(flights["fall"], tmp_path / "c.npz", 2, 0, 9.0))
 
 
+@pytest.mark.slow
 def test_a_noisy_sensors_readings_are_not_held_to_the_bounds(flights: dict[str, Path], tmp_path: Path) -> None:
     """T26-B11: only exact readings are the state; a noisy sensor's may lie past a bound."""
     assert FlightData.load(_observation_edited(flights["noisy"], tmp_path / "n.npz", 100, 3, 50.0)).observations[0][100, 3] == 50.0
@@ -273,6 +282,7 @@ def test_a_noisy_sensors_readings_are_not_held_to_the_bounds(flights: dict[str, 
 # --------------------------------------------------------------------------- T26-B15: a missing source unit
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sql", ["DELETE FROM units WHERE key = '{key}'", "UPDATE units SET name = 'fig7' WHERE key = '{key}'"])
 def test_a_unit_whose_source_is_missing_is_named_so(ev1: tuple[Path, Path], tmp_path: Path, cli: CliRun, sql: str) -> None:
     """T26-B15: the robustness unit's evolution run deleted (or moved to another experiment) was told as a unit the

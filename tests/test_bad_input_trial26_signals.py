@@ -72,6 +72,7 @@ def _only_the_commands_line(out: str, how: str) -> None:
     assert out.strip().splitlines()[-1].startswith(f"neurohover compete: {how}; "), out[-3000:]
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="finds the workers in /proc")
 @pytest.mark.parametrize("delay", [0.05, 0.3, 0.8])  # as the workers start (their imports take about a second), and later
 def test_ctrl_c_to_the_group_during_a_jobs_2_compete_prints_one_line(tmp_path: Path, delay: float) -> None:
@@ -97,6 +98,7 @@ def _ctrl_c_state() -> tuple[bool, object]:
     return {signal.SIGINT, signal.SIGUSR2} <= signal.pthread_sigmask(signal.SIG_BLOCK, []), signal.getsignal(signal.SIGTERM)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="POSIX signal masks")
 def test_a_pool_worker_never_hears_ctrl_c_and_dies_of_sigterm_at_once() -> None:
     from neurohover.procs import stop_pool, worker_pool
@@ -155,6 +157,7 @@ def test_a_compete_stopped_before_any_run_finished_says_so(tmp_path: Path, cli, 
     assert not (tmp_path / "c" / "episodes.csv").exists()
 
 
+@pytest.mark.slow
 def test_a_compete_stopped_after_a_run_names_its_episodes(tmp_path: Path, cli, monkeypatch) -> None:
     _interrupt_after(monkeypatch, 1)
     rc, _, err = cli(*TINY, "--out", str(tmp_path / "c"))
@@ -220,6 +223,7 @@ def test_compete_refuses_another_file_by_exit_2(tmp_path: Path, cli) -> None:
     assert not (folder / "results.sqlite").exists()
 
 
+@pytest.mark.slow
 def test_compete_still_replaces_a_competition_an_older_summary_and_empty_files(tmp_path: Path, cli) -> None:
     out = tmp_path / "c"
     assert cli(*TINY, "--out", str(out))[0] == 0

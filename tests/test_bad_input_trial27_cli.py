@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 from conftest import CliRun
 
 from neurohover.errors import first_difference
@@ -37,6 +38,7 @@ def test_as_authors_takes_its_own_values_beside_it_and_names_a_contradiction(tmp
     assert not (tmp_path / "m.json").exists()
 
 
+@pytest.mark.slow
 def test_a_competition_with_other_settings_into_the_same_folder_says_it_replaces_its_files(tmp_path: Path, cli: CliRun) -> None:
     """Trial 27 (borderline): ``compete --out D`` again with only --seed changed replaced D's files without the note a
     competition of another agent gets."""

@@ -44,6 +44,7 @@ def test_a_command_writing_a_file_runs_with_a_closed_standard_output(cli, tiny_s
     assert sys.stdout is None
 
 
+@pytest.mark.slow
 def test_a_reader_gone_away_ends_the_command_quietly_with_status_1() -> None:
     """Python's recommended handling of a broken pipe (its docs' "Note on SIGPIPE"): status 1 and no line on stderr."""
     proc = subprocess.Popen([sys.executable, "-m", "neurohover", "settings", "hybrid"], cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
@@ -56,6 +57,7 @@ def test_a_reader_gone_away_ends_the_command_quietly_with_status_1() -> None:
 # T28-A04: report --out replaces only its own report.md and figures, and writes through no symbolic link
 
 
+@pytest.mark.slow
 def test_report_replaces_its_own_report_and_figure(cli, tiny_store, tmp_path) -> None:
     out = tmp_path / "rep"
     assert cli("report", "--store", str(tiny_store), "--out", str(out))[0] == 0
@@ -107,6 +109,7 @@ def test_write_png_replaces_a_png_or_an_empty_file_and_refuses_another_file(tmp_
     assert (tmp_path / "notes.png").read_text() == "my pic\n"
 
 
+@pytest.mark.slow
 def test_plot_of_flight_data_refuses_a_text_file_at_an_episode_png(cli, tmp_path) -> None:
     assert cli("fly", "--task", "ghh08", "--episodes", "1", "--record", str(tmp_path / "f.npz"))[0] == 0
     (tmp_path / "f-episode0.png").write_text("notes\n")
@@ -146,6 +149,7 @@ def _unblocked(fifo: Path) -> threading.Event:
     return opened
 
 
+@pytest.mark.slow
 def test_report_refuses_a_fifo_discussion(cli, tiny_store, tmp_path) -> None:
     (tmp_path / "discussion").mkdir()
     os.mkfifo(tmp_path / "discussion" / "tr1-quick.md")

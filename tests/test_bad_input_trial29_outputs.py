@@ -65,6 +65,7 @@ def _run(*argv: str, **env: str) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, *argv], capture_output=True, text=True, env={**os.environ, **env}, timeout=120)
 
 
+@pytest.mark.slow
 def test_a_tqdm_variable_tqdm_cannot_read_is_refused_by_name(tmp_path: Path) -> None:
     """T29-A03: TQDM_MININTERVAL=abc was tqdm's ValueError traceback from fly, evolve, compete, learn-model, reproduce
     and report."""
@@ -73,6 +74,7 @@ def test_a_tqdm_variable_tqdm_cannot_read_is_refused_by_name(tmp_path: Path) -> 
     assert run.returncode == 2 and why in run.stderr and "Traceback" not in run.stderr, run.stderr
 
 
+@pytest.mark.slow
 def test_a_bar_not_drawn_does_not_import_tqdm_and_one_drawn_names_the_variable() -> None:
     """T29-A03: reproduce --no-progress imported tqdm, and its bad TQDM_POSITION, all the same."""
     script = (
@@ -121,6 +123,7 @@ def test_every_manifest_build_policies_writes_is_told_apart(sets, optimizer: str
         assert held_kind(policy_dir(task) / "manifest.json") == POLICY_SET_KIND
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("optimizer", ["ne", "cma"])
 def test_no_writer_but_build_policies_adds_a_file_to_a_policy_set(cli, sets, tmp_path: Path, optimizer: str) -> None:
     """T29-A04, T29-A06: compete --out, evaluate-agent --json and evolve --out into a set's directory were taken (evolve

@@ -8,9 +8,12 @@ import os
 import subprocess
 import sys
 
+import pytest
+
 OO = {**os.environ, "PYTHONOPTIMIZE": "2"}
 
 
+@pytest.mark.slow
 def test_the_command_line_refuses_python_oo_by_name() -> None:
     run = subprocess.run([sys.executable, "-m", "neurohover", "--version"], env=OO, capture_output=True, text=True, timeout=120)
     assert run.returncode == 2 and "Traceback" not in run.stderr, run.stderr
@@ -19,6 +22,7 @@ def test_the_command_line_refuses_python_oo_by_name() -> None:
     )
 
 
+@pytest.mark.slow
 def test_the_library_imports_under_python_oo_and_names_pycma_where_it_is_needed() -> None:
     script = (
         "import numpy as np\n"
@@ -36,6 +40,7 @@ def test_the_library_imports_under_python_oo_and_names_pycma_where_it_is_needed(
     assert lines[0] == "ghh08/zero" and lines[1].startswith("the CMA optimisers need pycma, which cannot be imported with PYTHONOPTIMIZE=2"), run.stdout
 
 
+@pytest.mark.slow
 def test_the_cuda_simulator_does_not_warn_of_the_rngs_wraparound() -> None:
     """T30-A03: under NUMBA_ENABLE_CUDASIM=1 (which neurohover's --device cuda refusal suggests) every run printed 8 lines
     of "overflow encountered" from sim/rng.py: its uint64 arithmetic wraps on purpose, as on a GPU."""

@@ -70,6 +70,7 @@ def test_a_killed_builds_lock_and_building_folder_are_cleared(cli, tmp_path: Pat
 # Borderline: one competition at a time in one --out, whatever its store
 
 
+@pytest.mark.slow
 def test_a_second_competition_into_a_folder_in_use_is_refused(cli, tmp_path: Path) -> None:
     out = tmp_path / "d"
     out.mkdir()
@@ -87,6 +88,7 @@ def test_a_second_competition_into_a_folder_in_use_is_refused(cli, tmp_path: Pat
     assert not (out / ".compete.lock").exists()  # released: no file left beside the results
 
 
+@pytest.mark.slow
 def test_a_killed_competitions_lock_file_does_not_block_the_next(cli, tmp_path: Path) -> None:
     out = tmp_path / "d"
     out.mkdir()
@@ -161,6 +163,7 @@ def test_reproduce_with_progress_runs_with_standard_error_closed(cli, tmp_path: 
     assert rc == 0 and "tr1 (quick): finished; ran 1 unit," in stdout, stdout
 
 
+@pytest.mark.slow
 def test_a_bar_asked_for_in_a_process_whose_standard_error_is_closed_is_not_drawn() -> None:
     """Standard error closed as a shell's ``2>&-`` closes it, in a process of its own."""
     code = "from neurohover.progress import progress_bar\nwith progress_bar(total=2, disable=False) as bar:\n    bar.update(2)\nprint('ok')"
@@ -180,6 +183,7 @@ def test_a_bar_on_a_closed_or_unwritable_stream_is_not_drawn(tmp_path: Path) -> 
     assert isinstance(progress_bar(total=3, file=closed, disable=False), _Quiet)
 
 
+@pytest.mark.slow
 def test_an_error_with_standard_error_open_for_reading_only_is_said_on_standard_output() -> None:
     """``2</dev/null``: standard error is a descriptor open for reading, so the error line failed again inside the
     command's own handler: status 1 and no word anywhere (trial 31). Taken as closed, the line goes to standard output."""

@@ -10,11 +10,14 @@ import os
 import subprocess
 import sys
 
+import pytest
+
 
 def _neurohover(*args: str, env: dict[str, str] | None = None, cwd=None) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "neurohover", *args], env={**os.environ, **(env or {})}, cwd=cwd, capture_output=True, text=True, timeout=120)
 
 
+@pytest.mark.slow
 def test_a06_the_pure_python_kernel_wraps_its_uint64_arithmetic_silently() -> None:
     """T31-A06: NUMBA_DISABLE_JIT=1 (numba's documented pure-Python switch) printed "overflow encountered" from sim/rng.py's
     SplitMix64 and xoshiro256**, whose uint64 products wrap on purpose; under PYTHONWARNINGS=error ``fly`` was a traceback."""
@@ -80,6 +83,7 @@ def test_the_thread_range_names_numba_num_threads_where_it_limits(monkeypatch) -
             pass
 
 
+@pytest.mark.slow
 def test_a01_a_character_the_plot_font_lacks_is_one_note(tmp_path, cli, monkeypatch) -> None:
     """T31-A01: a flight-data name with 𝄞 or CJK (legal) made ``plot`` print matplotlib's "Glyph ... missing from font(s)"
     UserWarnings with their source lines (from plots.py's tight_layout and paths.py's savefig); now one neurohover note."""
@@ -153,6 +157,7 @@ with Store(Path(sys.argv[1]) / "s.sqlite") as store:
 """
 
 
+@pytest.mark.slow
 def test_a05_an_unencodable_config_path_is_refused_by_its_encoding_and_the_report_is_utf8(tmp_path) -> None:
     """T31-A05: under LC_ALL=C PYTHONUTF8=0 a config's policies = "pd é" (an existing set, read as --policy-dir reads it) was
     "no such directory": the ASCII file system encoding cannot encode it. It is refused naming the encoding, as every path

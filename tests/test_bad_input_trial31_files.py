@@ -83,6 +83,7 @@ print(json.dumps(said))
 """
 
 
+@pytest.mark.slow
 def test_a_path_the_file_systems_encoding_cannot_encode_is_refused_by_name(tmp_path: Path) -> None:
     """T31-B03: under LC_ALL=C PYTHONUTF8=0 (file-system encoding 'ascii') a non-ASCII path was os.fsencode's
     UnicodeEncodeError from every API file entry point; each is one NeurohoverError naming the path and the encoding."""
@@ -147,6 +148,7 @@ def test_a_history_csv_cut_inside_its_last_number_is_refused(tmp_path: Path) -> 
         read_history_csv(tmp_path / "gone.history.csv")
 
 
+@pytest.mark.slow
 def test_a_compete_episodes_file_cut_inside_its_last_row_is_refused(tmp_path: Path) -> None:
     """T31-B07's twin in compete's episodes.csv: a row cut inside its return read as another return, a cut-off
     safeguard_fired '1' as 0; every episodes file compete writes ends with a newline."""

@@ -43,6 +43,7 @@ def test_b02_a_set_of_mdps_is_refused_by_name(unordered) -> None:
     assert nh.evaluate(b, tuple(MDPS), n_steps=5).returns.shape == (1, 3, 1)  # a sequence still flies
 
 
+@pytest.mark.slow
 def test_b03_drift_refuses_text_under_python_O() -> None:
     """T32-B03: Drift's check of ``change`` was an assert inside try/except AssertionError: under ``python -O`` the assert
     was gone and 'D_w=0.8' was an AttributeError. No check in the package is an assert caught as an error now."""

@@ -68,6 +68,7 @@ def test_a_store_named_like_a_uri_given_as_a_path_is_that_file(tmp_path: Path, m
         assert [e[0] for e in store.experiments()] == ["tr1"]
 
 
+@pytest.mark.slow
 def test_compete_names_the_file_its_store_is_in(cli, tmp_path: Path, monkeypatch) -> None:
     monkeypatch.chdir(tmp_path)
     rc, out, err = cli(*SE.COMPETE, "--out", "c", "--store", "./file:c.sqlite")
@@ -96,6 +97,7 @@ def test_a_hard_link_to_a_store_being_written_is_refused(tmp_path: Path) -> None
     second.close()
 
 
+@pytest.mark.slow
 def test_a_hard_link_is_refused_to_another_process(tmp_path: Path) -> None:
     (tmp_path / "hold.py").write_text(
         "import sys\nsys.path.insert(0, sys.argv[2])\nimport store_edits as SE\nfrom neurohover.experiments import Store\n"
@@ -133,6 +135,7 @@ with Store(sys.argv[1]) as store:
 """
 
 
+@pytest.mark.slow
 def test_a_write_a_file_size_limit_refuses_says_so_and_keeps_the_store(tmp_path: Path) -> None:
     path = tmp_path / "u.sqlite"
     done = subprocess.run([sys.executable, "-c", _LIMITED_PUT, str(path), str(TESTS)], capture_output=True, text=True, timeout=60)
@@ -166,6 +169,7 @@ def _limited(size: int):
     return lambda: resource.setrlimit(resource.RLIMIT_FSIZE, (size, resource.RLIM_INFINITY))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("unbuffered", ["1", ""])
 def test_results_cut_short_on_standard_output_fail(competed: Path, tmp_path: Path, unbuffered: str) -> None:
     out = tmp_path / "o.csv"

@@ -43,6 +43,7 @@ def test_hangup_and_usr1_are_stop_signals_as_sigterm_is() -> None:
     assert stop_words(Terminated("signal 15")) == ("terminated", 143)  # the default: SIGTERM's
 
 
+@pytest.mark.slow
 def test_a_hangup_stops_reproduce_as_sigterm_does_keeping_its_finished_units(tmp_path: Path) -> None:
     """T32-A03: the run died at once (the shell said "Hangup"); now it says "terminated", names its finished units, and
     exits 128 + the signal. (SIGUSR1 stops the command alike: test_hangup_and_usr1_are_stop_signals_as_sigterm_is;
@@ -64,6 +65,7 @@ def test_a_hangup_stops_reproduce_as_sigterm_does_keeping_its_finished_units(tmp
     assert len(_finished(store)) == 1
 
 
+@pytest.mark.slow
 def test_a_hangup_to_the_group_of_a_reproduce_with_workers_stops_it_with_one_line(tmp_path: Path) -> None:
     """T32-A03: a terminal's hang-up to the whole process group of ``reproduce --jobs 2``: the command's stop line and
     129, not multiprocessing's "leaked semaphore objects" warning (nor the resource tracker's tracebacks, once a hang-up
@@ -85,6 +87,7 @@ def test_a_hangup_to_the_group_of_a_reproduce_with_workers_stops_it_with_one_lin
         _end_group(proc)
 
 
+@pytest.mark.slow
 def test_a_hangup_stops_evolve_with_its_line(tmp_path: Path) -> None:
     """T32-A03: evolve printed nothing on SIGHUP; now it stops as on SIGTERM: its line and 129."""
     from test_procs import _cpu_seconds
@@ -104,6 +107,7 @@ def test_a_hangup_stops_evolve_with_its_line(tmp_path: Path) -> None:
         _end_group(proc)
 
 
+@pytest.mark.slow
 def test_a_hangup_leaves_a_command_started_under_nohup_running(tmp_path: Path) -> None:
     """T32-A03's fix keeps ``nohup``: a SIGHUP the command was started ignoring stays ignored; SIGTERM still stops it."""
     from test_procs import _cpu_seconds
@@ -141,6 +145,7 @@ sys.exit(main(sys.argv[2:]))
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", ["reproduce", "compete"])
 def test_jobs_from_a_removed_working_directory_is_refused_before_anything_is_written(tmp_path: Path, command: str) -> None:
     """T32-A06: "error: No such file or directory" naming nothing, an empty store (compete: its folder) left behind."""
@@ -203,6 +208,7 @@ def test_risk_trials_that_fill_the_run_are_refused(tmp_path: Path, cli) -> None:
 # ------------------------------------------------------------------------------------------- borderline
 
 
+@pytest.mark.slow
 def test_every_text_read_or_write_of_the_package_names_its_encoding() -> None:
     """Borderline: tasks/base.py's competition MDPs and compete.py's summary were read in the locale's encoding
     (``-X warn_default_encoding`` named them)."""
@@ -247,6 +253,7 @@ except Terminated as stop:
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("hook", ["hook", "python's"])
 def test_a_stop_raised_inside_a_callback_python_ignores_is_delivered_again(hook: str) -> None:
     """A SIGTERM landing in importlib's weakref callback while the package imported was printed as "Exception ignored"

@@ -26,6 +26,7 @@ def test_a_session_of_an_executor_that_runs_none_is_refused_and_the_sessions_sti
         assert store.sessions("tr1", "quick") == []
 
 
+@pytest.mark.slow
 def test_a_unit_result_its_readers_would_call_damaged_is_refused_before_it_is_written(tmp_path: Path) -> None:
     """A test run's result {'x': 1}, and one whose MDP is not its unit's, were stored; results and report then
     refused the whole experiment as damaged."""
@@ -60,6 +61,7 @@ def test_counts_past_sqlites_integers_are_refused_by_name(tmp_path: Path) -> Non
 # T33-B14 ------------------------------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_a_store_holding_a_trigger_is_refused_naming_it_and_compete_makes_no_output(tmp_path: Path, cli) -> None:
     path = SE.damaged(SE.competed_store(tmp_path), tmp_path / "t.sqlite", "CREATE TRIGGER t BEFORE INSERT ON units BEGIN SELECT RAISE(IGNORE); END")
     rc, _, err = cli(*SE.COMPETE, "--out", str(tmp_path / "o"), "--store", str(path))

@@ -36,6 +36,7 @@ def test_continual_agent_without_safeguard_flies():
     assert agent.choose(0).fallback is None
 
 
+@pytest.mark.slow
 def test_store_dropped_unclosed_lets_go_of_its_lock(tmp_path):
     """T34-B14: a Store dropped without close() kept its writer lock, and the next Store of the same process was told
     that "another run (pid <its own pid>)" wrote it, for as long as the process lived (a notebook cell run twice)."""
@@ -116,6 +117,7 @@ print("after", in_child(), flush=True)
 """
 
 
+@pytest.mark.slow
 def test_a_child_forked_after_a_flight_is_refused_not_killed():
     """T34-B13: a process forked after its parent flew on numba's GNU OpenMP threads was killed at its first flight
     ("Terminating: fork() called from a process already using GNU OpenMP"), and a fork Pool respawned it forever; it is

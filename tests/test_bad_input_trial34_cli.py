@@ -79,6 +79,7 @@ def test_a_paper_scale_run_shrunk_by_set_is_not_called_the_paper_protocol() -> N
         assert scale_note(cfg) == "the paper protocol" and paper_protocol(cfg)
 
 
+@pytest.mark.slow
 def test_a_paper_scale_run_shrunk_by_set_stays_out_of_the_paper_scale_claims(tmp_path: Path) -> None:
     """Its t tests were judged in "Claims and conclusions (paper scale)" and counted in the conclusions' tally."""
     from neurohover.experiments import LocalExecutor, reproduce, write_report
@@ -93,6 +94,7 @@ def test_a_paper_scale_run_shrunk_by_set_stays_out_of_the_paper_scale_claims(tmp
 # T34-A03 ------------------------------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_wins_on_a_compete_experiment_says_it_holds_one_agent_and_what_wins_compares(tmp_path: Path, cli, capsys) -> None:
     """Every compete experiment holds one agent: wins said only "a competition needs at least two agents, got
     ['baseline']", and its help offered compete runs' scales."""
@@ -109,6 +111,7 @@ def test_wins_on_a_compete_experiment_says_it_holds_one_agent_and_what_wins_comp
     assert "settings-HASH" not in out and "a compete experiment holds one agent" in out and "--scale SCALE which scale: quick or paper" in out
 
 
+@pytest.mark.slow
 def test_wins_names_the_experiments_of_the_store_it_can_compare_and_refuses_one_agent_of_several(tmp_path: Path, cli) -> None:
     from conftest import tiny_test_runs
 

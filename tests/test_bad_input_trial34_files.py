@@ -27,6 +27,7 @@ def _finished(cli, out: Path) -> None:
     assert rc == 0 and (out / "summary.json").is_file() and (out / "cumulative.png").is_file(), err
 
 
+@pytest.mark.slow
 def test_an_interrupted_compete_removes_the_earlier_competitions_summary_and_plot(tmp_path: Path, cli, monkeypatch) -> None:
     out = tmp_path / "c"
     _finished(cli, out)
@@ -44,6 +45,7 @@ def test_an_interrupted_compete_removes_the_earlier_competitions_summary_and_plo
     assert json.loads((out / "summary.json").read_text())["runs"] == 2
 
 
+@pytest.mark.slow
 def test_a_compete_stopped_before_a_run_finished_leaves_the_earlier_competition_whole(tmp_path: Path, cli, monkeypatch) -> None:
     out = tmp_path / "c"
     _finished(cli, out)
@@ -80,6 +82,7 @@ def _near_baseline(tmp_path: Path) -> Path:
     return path
 
 
+@pytest.mark.slow
 def test_ec_mer_refuses_another_policy_than_an_older_files_named_one(tmp_path: Path, cli) -> None:
     near = _near_baseline(tmp_path)
     old = _older(cli, tmp_path)

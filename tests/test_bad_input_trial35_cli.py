@@ -70,6 +70,7 @@ def test_a_baseline_only_experiment_runs_on_after_a_policy_it_never_flies_change
         assert db.results("mine", "quick") == before
 
 
+@pytest.mark.slow
 def test_a_baseline_competition_stored_with_the_sets_digest_is_taken_and_relabelled(cli, tmp_path: Path, monkeypatch) -> None:
     """A folder an older neurohover wrote (its config hashed the shipped set) takes a baseline compete again, runs kept."""
     from neurohover.experiments import external
@@ -127,6 +128,7 @@ def assert_evolve_stops_on(tmp_path: Path, signum: int) -> None:
         _end_group(proc)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="real processes signalled, found in /proc")
 def test_evolve_stopped_by_a_schedulers_sigusr2_saves_its_checkpoint_and_says_so(tmp_path: Path) -> None:
     assert_evolve_stops_on(tmp_path, signal.SIGUSR2)

@@ -40,6 +40,7 @@ def _rendered_env():
     return env
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("how", ["pickle", "deepcopy"])
 def test_a_rendered_env_copies_and_the_copy_continues_exactly(how) -> None:
     """T36-B02: after one render() pickle and deepcopy failed inside matplotlib (its BufferRegion is not picklable)."""

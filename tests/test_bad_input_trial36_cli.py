@@ -110,6 +110,7 @@ def test_settings_of_the_ne_optimiser_are_its_methods(cli) -> None:
 # ------------------------------------------------------------------------------------------- trial 37, weak findings
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not hasattr(os, "sched_setaffinity"), reason="CPU affinity is Linux's")
 def test_jobs_are_bounded_by_the_cores_the_process_may_use() -> None:
     """T37-A06: under `taskset -c 0` --jobs 2 was taken (two workers on one core) and the run recorded as on 2 cores."""
@@ -125,6 +126,7 @@ def test_a_config_name_of_a_non_ascii_letter_is_refused_saying_ascii(cli, tmp_pa
     assert rc == 2 and "name = 'café' is not allowed: give 1-100 ASCII letters (A-Z, a-z), digits" in err, err
 
 
+@pytest.mark.slow
 def test_results_wins_and_report_take_a_shipped_alias_as_reproduce_does(cli, committed_store: Path, tmp_path: Path) -> None:
     """T37-A05: reproduce table3 ran fig2, but results, report and wins said the store holds no experiment 'table3'."""
     by_alias = cli("results", "table3", "--store", str(committed_store), "--scale", "quick")

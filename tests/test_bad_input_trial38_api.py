@@ -54,6 +54,7 @@ def test_the_vector_env_takes_the_autoreset_mode_it_resets_in():
             gym.make_vec(**make, autoreset_mode=given)
 
 
+@pytest.mark.slow
 def test_plot_compete_checks_a_summary_against_its_store(cli, tmp_path, monkeypatch):
     """T38-B06: a compete summary.json edited to a sensor or drift its runs never flew was plotted under that label
     (nothing in the folder contradicts it); plot --compete checks the flight conditions against the store the summary

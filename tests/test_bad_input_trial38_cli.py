@@ -30,6 +30,7 @@ def test_every_signal_that_ends_a_process_quietly_stops_a_command_as_sigterm_doe
         assert stop_words(caught.value) == ("terminated", 128 + signum)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not LINUX, reason="real processes signalled, found in /proc")
 def test_evolve_stopped_by_a_real_time_signal_saves_its_checkpoint_and_says_so(tmp_path: Path) -> None:
     from test_bad_input_trial35_cli import assert_evolve_stops_on  # type: ignore[import-not-found]
@@ -37,6 +38,7 @@ def test_evolve_stopped_by_a_real_time_signal_saves_its_checkpoint_and_says_so(t
     assert_evolve_stops_on(tmp_path, signal.SIGRTMIN + 1)  # one with no name of its own
 
 
+@pytest.mark.slow
 def test_a_policy_sets_other_files_are_left_alone_and_writers_say_so(cli, tmp_path: Path) -> None:
     """T38-A06: compete --policy-dir flies a set beside a store, flight data or a folder of the user's (notes, as a
     README is), and refuses a JSON file no build writes; the writers' refusal gives that as its reason."""
@@ -55,6 +57,7 @@ def test_a_policy_sets_other_files_are_left_alone_and_writers_say_so(cli, tmp_pa
     assert rc == 2 and "extra.json" in err, err
 
 
+@pytest.mark.slow
 def test_evaluate_agent_imports_a_callable_from_the_working_directory(tmp_path: Path) -> None:
     """T38-A03: the documented `neurohover evaluate-agent --callable my_agents:act` beside my_agents.py was "No module
     named 'my_agents'" through the installed script, whose import path starts with the script's folder, not the

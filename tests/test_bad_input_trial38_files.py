@@ -71,6 +71,7 @@ def test_a_file_with_a_byte_order_mark_is_told_apart_and_not_replaced(tmp_path: 
         assert marked[what].read_bytes() == before, what
 
 
+@pytest.mark.slow
 def test_results_out_does_not_replace_a_history_with_a_byte_order_mark(tmp_path: Path, cli) -> None:
     """T38-B03 (the command line): results --out replaced an evolve history CSV with a byte-order mark: "wrote bom_h.csv"."""
     from store_edits import competed_store

@@ -54,12 +54,14 @@ def test_a_file_sqlite_would_take_for_a_stores_journal_is_refused_and_kept(cli, 
         assert opened.experiments() == []
 
 
+@pytest.mark.slow
 def test_warnings_of_the_libraries_default_encodings_as_errors_end_no_command() -> None:
     argv = [sys.executable, "-X", "warn_default_encoding", "-W", "error::EncodingWarning", "-m", "neurohover", "fly", "--task", "ghh08", "--episodes", "1"]
     done = subprocess.run(argv, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0 and "EncodingWarning" not in done.stderr, done.stderr[-2000:]
 
 
+@pytest.mark.slow
 def test_compete_names_its_files_once_under_an_out_ending_in_a_slash(cli, tmp_path: Path) -> None:
     """Noticed in trial 39: `--out k18/` printed k18//episodes.csv; and a reproduce of one unit said "ran 1 units"."""
     argv = ("compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--episode-steps", "10")

@@ -70,6 +70,7 @@ def test_model_policy_is_refused_for_them_by_the_python_api(tmp_path: Path) -> N
     assert not (tmp_path / "c").exists()
 
 
+@pytest.mark.slow
 def test_report_over_another_stores_report_says_what_it_replaces(cli, tmp_path: Path) -> None:
     first = competed_store(tmp_path / "a")
     second = tmp_path / "b.sqlite"

@@ -131,6 +131,7 @@ def test_a_user_optimisers_positive_champion_return_is_refused(mine):
     assert -1e4 < _evolve("mine").champion_return <= 0  # a well-behaved one runs
 
 
+@pytest.mark.slow
 def test_a_user_optimisers_policy_reads_in_another_process(monkeypatch, tmp_path):
     spec = OPTIMISERS["openai-es"]
     monkeypatch.setitem(OPTIMISERS, "my-es", OptimiserSpec("my-es", "mine", spec.settings, spec.make, stops_itself=False))

@@ -25,6 +25,7 @@ PNG = b"\x89PNG\r\n\x1a\n"
 CURVE = {"agent": np.cumsum(-np.ones((2, 10)), axis=1)}
 
 
+@pytest.mark.slow
 def test_plot_cumulative_takes_a_str_path_and_a_one_run_curve(tmp_path: Path) -> None:
     path = plots.plot_cumulative(CURVE, str(tmp_path / "sub" / "cum.png"), "title")
     assert path == tmp_path / "sub" / "cum.png" and path.read_bytes()[:8] == PNG
@@ -71,6 +72,7 @@ def test_a_figure_of_one_pixel_is_written(tmp_path: Path) -> None:
     assert plots.save_figure(plots.new_figure(0.01, 1), tmp_path / "tiny.png").read_bytes()[:8] == PNG
 
 
+@pytest.mark.slow
 def test_plot_flight_data_takes_a_stem_as_a_file_name_takes_it(tmp_path: Path) -> None:
     """T40-B13 (plot part), not a bug: a stem is a file-name prefix, and file names take control characters (``neurohover
     plot 'a\\nb.npz'`` writes 'a\\nb-episode0.png', its stem the file's: T14-24's test), escaped where they are shown;
@@ -140,6 +142,7 @@ def test_a_user_optimisers_own_stop_is_saved_and_resumed(my_stop, tmp_path: Path
         nh.load_policy(tmp_path / "bad.json")
 
 
+@pytest.mark.slow
 def test_a_set_built_by_a_user_optimiser_loads_where_it_was_built(monkeypatch, tmp_path: Path) -> None:
     from neurohover.manifest import built_as
     from neurohover.policysets import build_policy_set, load_policy_set, policy_set_roles

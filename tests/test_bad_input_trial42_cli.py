@@ -20,6 +20,7 @@ COMPETE = ("compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "
 EVOLVE = ("evolve", "--task", "ghh08", "--budget", "10", "--episode-steps", "20", "--out")
 
 
+@pytest.mark.slow
 def test_a02_a_summary_naming_a_scale_its_store_does_not_hold_is_refused(tmp_path: Path, monkeypatch, cli) -> None:
     """The store there and holding the experiment, at its real scale only: the summary's scale is named, and the
     scales the store holds; a store no longer there is still not read (documented)."""
@@ -42,6 +43,7 @@ def test_a02_a_summary_naming_a_scale_its_store_does_not_hold_is_refused(tmp_pat
     assert cli(*plot, "b")[0] == 0
 
 
+@pytest.mark.slow
 def test_a03_plot_names_the_figures_of_another_flight_it_leaves(tmp_path: Path, cli) -> None:
     """Never removed; a flight's own episodes (of another --episodes choice) and files of other names are not named."""
     flight = recorded(tmp_path, 2)

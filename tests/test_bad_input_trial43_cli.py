@@ -11,6 +11,7 @@ import pytest
 from neurohover.cli import main
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("spelling", ["GHH-08", "GHH08", "ghh-08"])
 def test_compete_takes_every_spelling_of_a_task_family_the_other_commands_take(spelling: str, tmp_path: Path, capsys) -> None:
     out = tmp_path / "c"

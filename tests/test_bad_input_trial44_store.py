@@ -56,6 +56,7 @@ def test_the_store_refuses_a_full_path_over_sqlites_limit(tmp_path: Path) -> Non
         Store(over, create=False)
 
 
+@pytest.mark.slow
 def test_reproduce_and_results_refuse_a_store_in_a_deep_folder(cli, tmp_path: Path, monkeypatch) -> None:
     """T44-A05: --store in a deep folder, or a short --store from a deep working directory."""
     config = tmp_path / "mini.toml"
@@ -70,6 +71,7 @@ def test_reproduce_and_results_refuse_a_store_in_a_deep_folder(cli, tmp_path: Pa
     assert rc == 2 and error(err, "results").startswith("results store 's.sqlite' is too long for SQLite: its full path"), err
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not LINUX, reason="signal handlers read from /proc")
 def test_a_sent_sigpipe_leaves_a_command_running_to_its_end(tmp_path: Path) -> None:
     """T44-A02: SIGPIPE stays ignored, as Python sets it (a reader gone away is a BrokenPipeError, the quiet status 1

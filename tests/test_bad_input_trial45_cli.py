@@ -33,6 +33,7 @@ def _soft_limit(soft: int):
 needs_two_cores = pytest.mark.skipif(_cores() < 2 or not os.path.isdir("/proc/self/fd"), reason="--jobs 2 needs 2 cores; Linux's /proc")
 
 
+@pytest.mark.slow
 @needs_two_cores
 def test_compete_with_workers_under_a_low_open_files_limit_is_refused_up_front(tmp_path: Path) -> None:
     """T45-A01: refused before anything is written, naming the limit, --jobs and what to do (no folder left)."""
@@ -48,6 +49,7 @@ def test_compete_with_workers_under_a_low_open_files_limit_is_refused_up_front(t
     assert not (tmp_path / "c").exists()
 
 
+@pytest.mark.slow
 @needs_two_cores
 def test_a_worker_pool_under_a_low_open_files_limit_is_refused_by_name(tmp_path: Path) -> None:
     """T45-A01, the API: worker_pool(2) measures what starting the workers takes, not EMFILE from inside multiprocessing."""
@@ -78,6 +80,7 @@ def test_too_many_open_files_anywhere_is_one_line_naming_the_limit(cli, monkeypa
         assert f"the open-files limit, is {resource.getrlimit(resource.RLIMIT_NOFILE)[0]}" in err
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("env_address", ["127.0.0.1:1", "ray://127.0.0.1:1"])
 def test_ray_address_auto_checks_the_ray_address_it_reads(tmp_path: Path, env_address: str) -> None:
     """T45-A02: --address auto joins RAY_ADDRESS; a dead one is refused before ray.init (it retried without end). The

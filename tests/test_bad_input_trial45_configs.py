@@ -92,6 +92,7 @@ def test_robustness_variants_refuse_a_key_twice() -> None:
         load_config("fig2", "quick", {"robustness_variants": ["slp-baseline", "slp-baseline"]})
 
 
+@pytest.mark.slow
 def test_every_shipped_config_still_loads_at_both_scales(cli) -> None:
     loaded = {(c.name, c.scale) for name in shipped_configs() for scale in ("quick", "paper") for c in load_configs(name, scale)}
     assert {scale for _, scale in loaded} == {"quick", "paper"} and len(loaded) > 50
@@ -99,6 +100,7 @@ def test_every_shipped_config_still_loads_at_both_scales(cli) -> None:
     assert rc == 0 and "fig2" in out, err
 
 
+@pytest.mark.slow
 def test_the_committed_store_still_reads_and_a_stored_config_with_repeated_labels_too(committed_store: Path, tmp_path: Path, cli) -> None:
     """Stored configs are read as stored (none of the committed store's repeats a label); one that does is still read by
     results and report, its config hash rewritten with its labels."""

@@ -36,6 +36,7 @@ def test_the_api_refuses_one_only_pattern_given_twice(tmp_path) -> None:
         assert store.experiments() == []
 
 
+@pytest.mark.slow
 def test_plot_cuts_a_recorded_name_too_long_for_its_figures(cli, tmp_path) -> None:
     flight = tmp_path / ("a" * 244 + ".npz")
     rc, _, err = cli("fly", "--task", "ghh08", "--episodes", "2", "--record", str(flight))
@@ -49,6 +50,7 @@ def test_plot_cuts_a_recorded_name_too_long_for_its_figures(cli, tmp_path) -> No
     assert out.split() == [str(tmp_path / "pl" / n) for n in names]
 
 
+@pytest.mark.slow
 def test_plot_keeps_a_name_that_fits(cli, tmp_path) -> None:
     flight = tmp_path / "short.npz"
     assert cli("fly", "--task", "ghh08", "--episodes", "1", "--record", str(flight))[0] == 0

@@ -19,6 +19,7 @@ def _neurohover(*args: str, env: dict[str, str] | None = None, cwd=None) -> subp
     return subprocess.run([sys.executable, "-m", "neurohover", *args], env={**os.environ, **(env or {})}, cwd=cwd, capture_output=True, text=True, timeout=120)
 
 
+@pytest.mark.slow
 def test_a03_an_evolution_runs_as_plain_python_with_the_compiled_runs_champion(tmp_path, cli) -> None:
     """T46-A03: ``NUMBA_DISABLE_JIT=1 neurohover evolve`` (ne, cma; build-policies, reproduce's evolve units) was a traceback
     from sim/lanes.py's queue. Its champion is the compiled run's, its returns the same to rounding (the compiled kernel
@@ -72,6 +73,7 @@ print(matplotlib.rcParams["text.usetex"], matplotlib.rcParams["savefig.dpi"], le
 """
 
 
+@pytest.mark.slow
 def test_a04_the_figures_are_drawn_in_matplotlibs_default_style_whatever_the_users_rc(tmp_path) -> None:
     """T46-A04: with that rc in ./matplotlibrc or $MATPLOTLIBRC, plot, compete (exit 1 after its runs were stored, no
     cumulative.png), plot --compete and report ended in a traceback. The figures are drawn in matplotlib's default style

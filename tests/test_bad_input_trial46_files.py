@@ -139,6 +139,7 @@ def test_evolve_replaces_no_file_at_its_checkpoint_path_but_a_checkpoint(tmp_pat
         evolve(mdp, checkpoint=empty, seed=1, **RUN)
 
 
+@pytest.mark.slow
 def test_a_checkpoint_over_the_json_read_limit_is_still_a_checkpoint(tmp_path):
     """After T46-B14: a checkpoint of a large genome's CMA state (about 1,400 genes and more) is over the 64 MiB that
     held_kind parses, was called a file of no kind, and evolve then refused to write its own checkpoint over it."""

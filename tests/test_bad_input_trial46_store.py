@@ -93,6 +93,7 @@ def competed(out: Path, n_steps: int = 10, store: Path | None = None) -> Path:
     return out
 
 
+@pytest.mark.slow
 def test_a_moved_compete_folder_is_checked_against_its_own_store(tmp_path: Path) -> None:
     """T46-B05: moved away (its store inside it), a summary edited to another sensor or seed is still refused."""
     from neurohover.compete import check_against_store
@@ -108,6 +109,7 @@ def test_a_moved_compete_folder_is_checked_against_its_own_store(tmp_path: Path)
         assert named in str(err.value)
 
 
+@pytest.mark.slow
 def test_an_archived_compete_folder_is_not_checked_against_a_new_study_at_its_old_path(tmp_path: Path) -> None:
     """T46-B06: run1 archived as run1_2026, a new study (other settings) at run1: both are checked against their own stores."""
     from neurohover.compete import check_against_store
@@ -118,6 +120,7 @@ def test_an_archived_compete_folder_is_not_checked_against_a_new_study_at_its_ol
     check_against_store(tmp_path / "run1")
 
 
+@pytest.mark.slow
 def test_an_own_store_left_by_an_earlier_compete_is_not_read(tmp_path: Path) -> None:
     """A compete with --store into a folder an earlier compete left its default store in is checked against its --store."""
     from neurohover.compete import check_against_store

@@ -29,6 +29,7 @@ def _held(path: Path) -> WriterLock:
 # T47-A02: one report at a time in one --out
 
 
+@pytest.mark.slow
 def test_a02_a_report_into_a_folder_another_report_is_writing_is_refused(cli, tmp_path: Path) -> None:
     from neurohover.experiments import Store, write_report
 
@@ -49,6 +50,7 @@ def test_a02_a_report_into_a_folder_another_report_is_writing_is_refused(cli, tm
     assert rc == 0 and (out / "report.md").is_file() and not (out / ".report.lock").exists(), err
 
 
+@pytest.mark.slow
 def test_a02_a_killed_reports_lock_file_does_not_block_the_next(cli, tmp_path: Path) -> None:
     store = competed_store(tmp_path)
     out = tmp_path / "r"
@@ -61,6 +63,7 @@ def test_a02_a_killed_reports_lock_file_does_not_block_the_next(cli, tmp_path: P
 # T47-A03: one plot at a time in one --out
 
 
+@pytest.mark.slow
 def test_a03_a_plot_into_a_folder_another_plot_is_writing_is_refused(cli, tmp_path: Path) -> None:
     from neurohover.flightdata import FlightData
     from neurohover.plots import plot_flight_data
@@ -83,6 +86,7 @@ def test_a03_a_plot_into_a_folder_another_plot_is_writing_is_refused(cli, tmp_pa
     assert sorted(p.name for p in out.iterdir()) == ["f-episode0.png"]  # no lock file left
 
 
+@pytest.mark.slow
 def test_a03_plot_compete_into_a_folder_another_plot_is_writing_is_refused(cli, tmp_path: Path) -> None:
     assert cli(*COMPETE, "--out", str(tmp_path / "c"))[0] == 0
     out = tmp_path / "p"
@@ -98,6 +102,7 @@ def test_a03_plot_compete_into_a_folder_another_plot_is_writing_is_refused(cli, 
     assert rc == 0 and sorted(p.name for p in out.iterdir()) == ["compete.png"], err
 
 
+@pytest.mark.slow
 def test_a03_a_killed_plots_lock_file_does_not_block_the_next(cli, tmp_path: Path) -> None:
     flight = recorded(tmp_path, 1)
     out = tmp_path / "p"

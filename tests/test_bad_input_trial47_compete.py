@@ -13,6 +13,7 @@ from neurohover.errors import NeurohoverError
 COMPETE = ("compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episode-steps", "20")
 
 
+@pytest.mark.slow
 def test_a_leftover_own_store_is_not_read_once_the_named_store_is_gone(cli, tmp_path: Path, monkeypatch) -> None:
     from neurohover.compete import check_against_store
 
@@ -26,6 +27,7 @@ def test_a_leftover_own_store_is_not_read_once_the_named_store_is_gone(cli, tmp_
     assert rc == 0 and out.strip().endswith("compete.png"), err
 
 
+@pytest.mark.slow
 def test_a_moved_folder_is_still_checked_against_its_own_default_store(cli, tmp_path: Path, monkeypatch) -> None:
     """T46-B05 kept: a folder whose summary names its own default store is checked against it after a move."""
     import json

@@ -32,6 +32,7 @@ def _flight(tmp_path: Path, sensor: nh.Sensor | None = None, huge: bool = False)
     return FlightData.load(path)
 
 
+@pytest.mark.slow
 def test_huge_readings_plot_without_numpy_warnings(tmp_path: Path) -> None:
     """T48-B01: 1e300 readings squared in attitude_angles were NumPy's overflow RuntimeWarnings (a traceback under -W error)."""
     data = _flight(tmp_path, huge=True)
@@ -55,6 +56,7 @@ def test_attitude_angles_refuses_non_finite_readings() -> None:
                 attitude_angles(obs)
 
 
+@pytest.mark.slow
 def test_attitude_angles_of_readings_past_the_unit_ball(tmp_path: Path) -> None:
     """T48-B06: a vector part of norm sqrt(3) gave angles of no rotation (roll 146, pitch -90). A noisy sensor's
     recording gives such readings (its norm past 1, loaded by FlightData.load), so they are not refused: they are taken
@@ -99,6 +101,7 @@ def test_sensor_correlation_refusals_name_its_range(value) -> None:
         nh.Sensor(attitude=0.01, correlation=value)
 
 
+@pytest.mark.slow
 def test_overrides_with_a_key_not_text_name_a_setting_every_config_takes() -> None:
     """T48-B09: {1: 2} was told "give a dict of settings, e.g. {'episodes': 3}", a setting fig2 refuses."""
     with pytest.raises(NeurohoverError) as err:

@@ -22,6 +22,7 @@ ROOT = Path(__file__).resolve().parents[1]
 COMPETE = ["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--episode-steps", "20"]
 
 
+@pytest.mark.slow
 def test_compete_takes_an_empty_store_file_as_a_new_store(cli, tmp_path: Path, monkeypatch) -> None:
     """T49-A02: an empty --store file (and an empty results.sqlite in --out, the default store) becomes the store, as
     reproduce takes it: Store and compete share one decision (new_store)."""

@@ -31,6 +31,7 @@ def _mine(where: Path, **changes: int) -> Path:
     return path
 
 
+@pytest.mark.slow
 def test_a_config_of_ones_own_shrunk_by_set_is_not_called_the_paper_protocol(tmp_path: Path) -> None:
     from neurohover.experiments.config import load_config
     from neurohover.experiments.report_scale import paper_protocol, scale_note
@@ -76,6 +77,7 @@ def kiritimati(monkeypatch):
     time.tzset()
 
 
+@pytest.mark.slow
 def test_the_report_notes_a_shrunk_config_of_ones_own_and_its_time_with_the_utc_offset(tmp_path: Path, kiritimati) -> None:
     from neurohover.experiments import LocalExecutor, Store, reproduce, write_report
     from neurohover.experiments.config import load_config

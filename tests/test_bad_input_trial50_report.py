@@ -24,6 +24,7 @@ def far_zone(request, monkeypatch):
     time.tzset()
 
 
+@pytest.mark.slow
 def test_a01_the_report_is_written_under_an_offset_of_a_day_or_more(tiny_store: Path, tmp_path: Path, cli, far_zone: str) -> None:  # noqa: F811
     rc, _, err = cli("report", "--store", str(tiny_store), "--out", str(tmp_path / "rep"))
     assert rc == 0, err
@@ -34,6 +35,7 @@ def test_a01_the_report_is_written_under_an_offset_of_a_day_or_more(tiny_store: 
     assert stamp[1].endswith(f"{'-' if offset < 0 else '+'}{hours:02d}:{rest // 60:02d}" + (f":{rest % 60:02d}" if rest % 60 else ""))
 
 
+@pytest.mark.slow
 def test_a04_a_blocked_figure_is_named_and_nothing_is_called_damaged(tiny_store: Path, tmp_path: Path, cli) -> None:  # noqa: F811
     rc, _, err = cli("report", "--store", str(tiny_store), "--out", str(tmp_path / "first"))
     figures = sorted(p.name for p in (tmp_path / "first").glob("*.png"))

@@ -35,6 +35,7 @@ def _lagging(monkeypatch, by: float) -> None:
     monkeypatch.setattr(time, "time", lambda: real() - by)
 
 
+@pytest.mark.slow
 def test_a_clock_stepped_back_during_a_run_leaves_a_store_every_reader_reads(tmp_path: Path, monkeypatch) -> None:
     """T50-A02: the session started, then the clock went back an hour: its wall seconds were -3599.6, and every
     reader refused the store as damaged."""
@@ -88,6 +89,7 @@ def test_a_writer_whose_clock_reads_1973_writes_no_store(tmp_path: Path, monkeyp
     assert rc == 2 and "compete's results store: the system clock's time" in err and not (tmp_path / "d").exists(), err
 
 
+@pytest.mark.slow
 def test_a_store_is_neither_written_nor_changed_where_the_clock_reads_1973_but_is_read(tmp_path: Path, monkeypatch) -> None:
     """T50-A03: a sound store, read where the clock lags, is no damage; a write into it (begin, update, a session, a
     unit) is refused before anything changes."""

@@ -261,6 +261,7 @@ def test_a_run_time_optimiser_named_as_a_method_of_ne_is_refused(name):
         OPTIMISERS.pop(name, None)
 
 
+@pytest.mark.slow
 def test_compete_refuses_a_build_that_drops_its_settings_before_writing(agents, tmp_path, capsys):  # T55-B07
     from neurohover.cli import main
 

@@ -141,6 +141,7 @@ def test_a_second_stop_mid_generation_names_no_checkpoint_that_is_not_there(tmp_
     assert f"terminated mid-generation; its last checkpoint is {ckpt} (run the same command with --resume" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="a real process signalled")
 def test_sigterm_to_a_running_evolve_command_saves_its_checkpoint_and_the_same_command_resumes(cli, tmp_path: Path) -> None:
     """T55-A01 as reported: `neurohover evolve` sent SIGTERM once flying (its first periodic checkpoint written) ends at

@@ -17,6 +17,7 @@ from neurohover.experiments.config import load_config, make_config
 from neurohover.experiments.config_changes import config_changes
 
 
+@pytest.mark.slow
 def test_compete_notes_runs_stored_under_another_run_count(tmp_path, capsys) -> None:
     """T56-A02: the same competition with another --runs is said to fly its runs anew, naming the stored count."""
     compete("ghh08", "baseline", runs=1, episodes=1, n_steps=20, out=tmp_path / "c")

@@ -163,6 +163,7 @@ def test_a_damaged_build_state_is_named_and_a_full_disk_leaves_none(tmp_path, cl
         assert state.read_text() == text  # refused, left as it was
 
 
+@pytest.mark.slow
 def test_a_full_disk_names_the_file_for_evolve_report_and_build_policies(tiny_store, tmp_path, cli) -> None:
     """U1: evolve, report and build-policies said only "No space left on device"; report left a 0-byte report.md and
     build-policies a 0-byte build.json."""

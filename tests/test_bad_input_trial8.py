@@ -108,6 +108,7 @@ def test_deeply_nested_checkpoints_and_compete_summaries_and_huge_returns_are_re
             parse_override(bad)  # type: ignore[arg-type]
 
 
+@pytest.mark.slow
 def test_a_damaged_stage_of_an_interrupted_build_is_flown_again_and_the_others_kept(tmp_path) -> None:
     """S1: one empty stage file failed the resumed build, which then deleted every finished run."""
     from neurohover.policysets import build_policy_set
@@ -132,6 +133,7 @@ def test_a_damaged_stage_of_an_interrupted_build_is_flown_again_and_the_others_k
     assert again.generic == first.generic and again.specialised == first.specialised  # the same build, resumed
 
 
+@pytest.mark.slow
 def test_a_full_disk_while_report_draws_a_figure_is_no_damaged_store(tmp_path, cli) -> None:
     """S2: the figure's write failed, and report.md said "the store's copy is damaged", exit 0."""
     import subprocess
@@ -201,6 +203,7 @@ def test_a_stored_unit_of_other_params_is_refused_not_reused(tmp_path, cli, tiny
     assert rc == 0 and "0 units" in out + err, err  # the undamaged store: every unit finished, none run again
 
 
+@pytest.mark.slow
 def test_a_competition_into_a_folder_of_another_says_it_replaces_its_files(tmp_path, cli) -> None:
     """S8: compete --out D with another agent replaced D's episodes.csv, summary.json and plot without a word."""
     base = ["compete", "--task", "ghh08", "--runs", "1", "--episodes", "2", "--episode-steps", "20", "--out", str(tmp_path / "d")]
@@ -212,6 +215,7 @@ def test_a_competition_into_a_folder_of_another_says_it_replaces_its_files(tmp_p
     assert rc == 0 and "held the competition of baseline on ghh08; its episodes.csv, summary.json and plot are replaced" in err, err
 
 
+@pytest.mark.slow
 def test_a_compete_file_cut_short_is_refused_not_plotted_short(tmp_path, cli) -> None:
     """S9: an episodes.csv whose last run was cut mid-way was plotted with every run cut to the shortest."""
     folder = tmp_path / "c"

@@ -14,6 +14,7 @@ from test_bad_input_trial7 import _config, tiny_store  # noqa: F401  (tiny_store
 from neurohover.errors import NeurohoverError
 
 
+@pytest.mark.slow
 def test_a_path_of_undecodable_bytes_is_printed_under_a_strict_utf8_stdout(tmp_path: Path) -> None:
     """T3: fly --record g<0xff>.npz wrote its file, then raised UnicodeEncodeError printing the path (a strict stdout is
     Python's default under en_US.UTF-8)."""
@@ -25,6 +26,7 @@ def test_a_path_of_undecodable_bytes_is_printed_under_a_strict_utf8_stdout(tmp_p
     assert "flight data: g\\udcff.npz" in proc.stdout and (tmp_path / name).is_file()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("make", "reason"), [(lambda p: p.write_bytes(b"abc\xff\xfe def"), "it is not UTF-8 text"), (Path.mkdir, "Is a directory")])
 def test_an_unreadable_discussion_is_named_not_a_traceback_or_skipped(make, reason, tmp_path, cli, tiny_store) -> None:  # noqa: F811
     """T4: a discussion file that is not UTF-8 was a UnicodeDecodeError in report; a directory in its place was skipped."""
@@ -35,6 +37,7 @@ def test_an_unreadable_discussion_is_named_not_a_traceback_or_skipped(make, reas
     assert "damaged" not in err
 
 
+@pytest.mark.slow
 def test_a_discussion_saved_with_a_byte_order_mark_is_read_without_it(tmp_path, cli, tiny_store) -> None:  # noqa: F811
     (tmp_path / "rep" / "discussion").mkdir(parents=True)
     (tmp_path / "rep" / "discussion" / "mytest-quick.md").write_bytes("\ufeffOur words.".encode())

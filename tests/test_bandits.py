@@ -64,6 +64,7 @@ def test_separated_candidates_are_told_apart_before_the_limit(rule: str) -> None
     assert result.episodes_spent < 4 * 500 and result.episodes_spent == result.n_samples.sum()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("rule", ["lucb", "kl-lucb"])
 def test_at_a_races_limit_fifty_candidates_are_never_told_apart(rule: str) -> None:
     """Distribution-free bounds need more than 10 episodes a candidate: the rule runs to the limit (n_raced 0),
@@ -86,6 +87,7 @@ def test_bad_bandit_settings_are_refused() -> None:
         parse_resampling("lucb:1.5")
 
 
+@pytest.mark.slow
 def test_generational_evolution_selects_by_lucb_and_refuses_raw_returns() -> None:
     family = family_of("fghh", 0.3, None)
     run = evolve(family, topology="slp", prototype="baseline", resampling="lucb:0.1", budget=700, seed=2, n_steps=40)

@@ -90,6 +90,7 @@ def test_malformed_policy_files_are_refused(cli, tmp_path: Path) -> None:
         assert rc == 2 and expected[name] in err, (name, err)
 
 
+@pytest.mark.slow
 def test_every_command_has_help(capsys) -> None:
     from neurohover.cli import build_parser
 
@@ -217,6 +218,7 @@ def test_compete_refuses_bad_options_before_it_makes_its_output_directory(cli, t
         assert rc == 2 and "created directory" not in err and not out.exists(), bad
 
 
+@pytest.mark.slow
 def test_the_command_line_loads_matplotlib_and_scipy_stats_only_where_it_draws_or_tests() -> None:
     """Every command imports the parser of every command: with matplotlib (plots) and scipy.stats (races, the report's
     tests) loaded at import, each started `neurohover` paid about a second before doing anything."""

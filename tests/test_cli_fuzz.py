@@ -11,6 +11,8 @@ import argparse
 import subprocess
 import sys
 
+import pytest
+
 from neurohover.cli import build_parser, main
 from neurohover.cli.options import real
 
@@ -47,6 +49,7 @@ def _options():
                 yield name, act.option_strings[-1], act.type
 
 
+@pytest.mark.slow
 def test_no_option_of_any_command_ends_in_a_traceback(tmp_path, monkeypatch, capsys) -> None:
     monkeypatch.chdir(tmp_path)  # options that name files write them here
     assert main(["fly", "--task", "ghh08", "--episodes", "1", "--record", str(tmp_path / "flight.npz")]) == 0
@@ -73,6 +76,7 @@ def test_no_option_of_any_command_ends_in_a_traceback(tmp_path, monkeypatch, cap
     assert not silent, f"accepted without a word: {silent}"
 
 
+@pytest.mark.slow
 def test_a_reader_that_goes_away_ends_the_command_quietly() -> None:
     """`neurohover demo | head -1`: the pipe closes under the table, and no traceback follows."""
     demo = subprocess.Popen([sys.executable, "-m", "neurohover", "demo", "--mdps", "2", "--episodes", "1"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)

@@ -26,6 +26,7 @@ def test_sampled_mdps_are_those_of_the_same_group_in_any_experiment_with_that_se
     assert [u.params["seed"] for u in ours] != [u.params["seed"] for u in theirs]
 
 
+@pytest.mark.slow
 def test_a_competition_resumes_from_its_store_and_flies_nothing_twice(tmp_path: Path) -> None:
     flown: list[str] = []
     first, runs = compete("ghh08", "baseline", runs=3, episodes=4, n_steps=80, out=tmp_path / "a", on_result=lambda key, result: flown.append(key))
@@ -40,6 +41,7 @@ def test_a_competition_resumes_from_its_store_and_flies_nothing_twice(tmp_path: 
         assert sorted(n for n, *_ in store.experiments()) == ["compete-ghh08-baseline"] * 2
 
 
+@pytest.mark.slow
 def test_episode_rows_carry_steps_and_policies(tmp_path: Path) -> None:
     summary, runs = compete("ghh08", "baseline", runs=2, episodes=3, n_steps=60, out=tmp_path / "b")
     rows = list(csv.DictReader(open(tmp_path / "b" / "episodes.csv")))
@@ -76,6 +78,7 @@ def test_a_crashing_run_records_its_crash_step() -> None:
     assert episode_rows(4, result, 100) == [[4, "m", 0, "-1.0", 0, 100, "a", 1], [4, "m", 1, "-2.0", 1, 17, "b", 0]]
 
 
+@pytest.mark.slow
 def test_compete_says_when_it_reuses_stored_runs(tmp_path: Path, capsys) -> None:
     from neurohover.cli import main
 
@@ -86,6 +89,7 @@ def test_compete_says_when_it_reuses_stored_runs(tmp_path: Path, capsys) -> None
     assert "2 of 2 units (runs and the policies they fly) were already in" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_an_agents_own_settings_reach_its_runs_and_are_checked(cli, tmp_path) -> None:
     from neurohover.compete import competition_config
 

@@ -27,6 +27,7 @@ def _run(name: str, drift: Drift, episodes: int = 60):
     return agent, run_test(agent, family, family.mdp("test:3").with_drift(drift), episodes=episodes, seed=4, n_steps=1000)
 
 
+@pytest.mark.slow
 def test_on_a_fixed_mdp_it_learns_once_and_keeps_its_policy() -> None:
     agent, run = _run("continual", Drift(), episodes=40)
     _, incremental = _run("incremental", Drift(), episodes=40)
@@ -34,6 +35,7 @@ def test_on_a_fixed_mdp_it_learns_once_and_keeps_its_policy() -> None:
     assert run.returns.sum() == pytest.approx(incremental.returns.sum(), rel=0.05)
 
 
+@pytest.mark.slow
 def test_after_an_abrupt_change_it_re_learns_where_the_incremental_agent_keeps_crashing() -> None:
     agent, run = _run("continual", STRONGER_ROTORS)
     _, incremental = _run("incremental", STRONGER_ROTORS)

@@ -13,6 +13,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 from conftest import ROOT
 
 # Startup code that makes --seed's check raise KeyboardInterrupt from inside an eval() of text, as a Ctrl-C landing in
@@ -27,6 +28,7 @@ seeding.check_seed = check_seed
 """
 
 
+@pytest.mark.slow
 def test_a_ctrl_c_caught_inside_an_eval_still_ends_python_m_with_130(tmp_path: Path) -> None:
     (tmp_path / "sitecustomize.py").write_text(INTERRUPT_IN_EVAL, encoding="utf-8")
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), str(ROOT)])}

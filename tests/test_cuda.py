@@ -66,6 +66,7 @@ def simulated() -> dict:
     return run_simulated(SCRIPT)
 
 
+@pytest.mark.slow
 def test_cuda_kernel_matches_cpu_kernel_under_the_simulator(simulated: dict) -> None:
     cpu, gpu = simulated["cpu"], simulated["cuda"]
     assert simulated["simulating"]
@@ -77,6 +78,7 @@ def test_cuda_kernel_matches_cpu_kernel_under_the_simulator(simulated: dict) -> 
     np.testing.assert_allclose(gpu["returns"], cpu["returns"], rtol=SIM_RTOL, atol=0)
 
 
+@pytest.mark.slow
 def test_cuda_safeguard_and_flight_data_match_the_cpu_kernel(simulated: dict) -> None:
     cpu, gpu = simulated["cpu"], simulated["cuda"]
     assert min(cpu["sg_step"]) > 0 and cpu["sg_steps"] == [40] * 4  # the fallback took over and saved every episode
@@ -88,6 +90,7 @@ def test_cuda_safeguard_and_flight_data_match_the_cpu_kernel(simulated: dict) ->
             np.testing.assert_allclose(g, c, rtol=SIM_RTOL, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_cuda_build_compiles_the_cpu_sources_with_every_callee_retargeted(simulated: dict) -> None:
     # The physics and the streams come from the CPU kernel's own functions, none hand-copied ...
     for name in (
@@ -112,6 +115,7 @@ def test_cuda_build_compiles_the_cpu_sources_with_every_callee_retargeted(simula
     assert simulated["cpu_callees_left"] == []
 
 
+@pytest.mark.slow
 def test_gpu_benchmark_pieces_run_under_the_simulator(simulated: dict) -> None:
     bench = simulated["bench"]
     agreement = bench["report"]["agreement"]
@@ -151,6 +155,7 @@ print(ptx.count(".entry"), ptx.count("ld.const.f64") > 0, ptx.count("mul.rn.f64"
 """
 
 
+@pytest.mark.slow
 def test_cuda_kernel_compiles_for_a_real_gpu() -> None:
     # Where numba-cuda and NVVM are installed (a GPU machine, or pip install 'neurohover[cuda]' plus the
     # CUDA compiler wheels), the kernel compiles to PTX without a GPU; elsewhere this test is skipped.
@@ -191,6 +196,7 @@ def test_unknown_device_is_refused() -> None:
         evaluate(baseline_policy(), get_task_family("ghh08").zero(), n_steps=10, device="gpu")
 
 
+@pytest.mark.slow
 def test_cuda_module_restores_the_numpy_alias_numba_cuda_needs() -> None:
     # numba-cuda 0.30.4 overloads np.row_stack when it builds its first kernel; NumPy 2.5 removed that alias, and
     # on an H200 with NumPy 2.5.2 no kernel compiled. Importing the CUDA module puts the alias back.

@@ -35,6 +35,7 @@ print(json.dumps(out))
 """
 
 
+@pytest.mark.slow
 def test_agents_fly_the_same_test_runs_on_the_simulated_gpu() -> None:
     out = run_simulated(SCRIPT)
     cpu, gpu = out["cpu"], out["cuda"]

@@ -119,6 +119,7 @@ def _close(a, b, path: str = "") -> None:
         assert a == b, path
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", ["steady", "fixed2", "race", "cma"])
 def test_evolve_on_cuda_finds_the_cpu_champion(simulated: dict, case: str) -> None:
     assert simulated["simulating"]
@@ -129,6 +130,7 @@ def test_evolve_on_cuda_finds_the_cpu_champion(simulated: dict, case: str) -> No
     np.testing.assert_allclose(gpu["return"], cpu["return"], rtol=SIM_RTOL, atol=0)
 
 
+@pytest.mark.slow
 def test_evolve_runs_generations_and_races(simulated: dict) -> None:
     # Not one generation only: replacement (steady state), resampling, races and CMA-ES updates ran.
     ev = simulated["evolve"]
@@ -136,6 +138,7 @@ def test_evolve_runs_generations_and_races(simulated: dict) -> None:
     assert len(ev["fixed2/cpu"]["history"]) >= 2 and len(ev["race/cpu"]["history"]) >= 2 and len(ev["cma/cpu"]["history"]) >= 3
 
 
+@pytest.mark.slow
 def test_reproduce_on_cuda_matches_the_cpu_store(simulated: dict) -> None:
     runs = simulated["reproduce"]
     assert runs["cpu"]["rc"] == runs["cuda"]["rc"] == 0
@@ -145,6 +148,7 @@ def test_reproduce_on_cuda_matches_the_cpu_store(simulated: dict) -> None:
     assert runs["cpu_then_cuda"]["rc"] == 0 and runs["cpu_then_cuda"]["results"] == runs["cpu"]["results"]
 
 
+@pytest.mark.slow
 def test_cli_evolve_on_cuda_matches_the_cpu(simulated: dict) -> None:
     cli = simulated["cli"]
     assert cli["cpu"]["rc"] == cli["cuda"]["rc"] == 0

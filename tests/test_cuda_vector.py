@@ -63,6 +63,7 @@ def simulated() -> dict:
     return run_simulated(SCRIPT)
 
 
+@pytest.mark.slow
 def test_vector_env_on_cuda_matches_the_cpu(simulated: dict) -> None:
     assert simulated["simulating"]
     cpu, gpu = simulated["cpu"], simulated["cuda"]
@@ -73,6 +74,7 @@ def test_vector_env_on_cuda_matches_the_cpu(simulated: dict) -> None:
         assert gpu[key] == cpu[key], key
 
 
+@pytest.mark.slow
 def test_the_case_crashes_truncates_and_autoresets(simulated: dict) -> None:
     cpu = simulated["cpu"]
     term = np.array(cpu["term"])

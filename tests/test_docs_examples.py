@@ -64,6 +64,7 @@ def test_the_readmes_new_agent_is_found_and_flies_as_it_says(tmp_path: Path, mon
     sys.modules.pop("myagents.best_of_two", None)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("index", range(len(_readme_python_blocks())), ids=[f"{i}-{h}" for i, (h, _) in enumerate(_readme_python_blocks())])
 def test_readme_python_block_runs_as_written(index: int, tmp_path: Path) -> None:
     heading, code = _readme_python_blocks()[index]
@@ -71,6 +72,7 @@ def test_readme_python_block_runs_as_written(index: int, tmp_path: Path) -> None
     assert proc.returncode == 0, f"README block {index} (## {heading}) failed:\n{code}\n{proc.stderr}"
 
 
+@pytest.mark.slow
 def test_experiments_docstring_example_runs_as_a_script(tmp_path: Path) -> None:
     doc = neurohover.experiments.__doc__
     example = doc[doc.index("Example\n-------") :]
@@ -92,6 +94,7 @@ def test_experiments_docstring_example_runs_as_a_script(tmp_path: Path) -> None:
     assert (tmp_path / "report" / "report.md").read_text().strip()
 
 
+@pytest.mark.slow
 def test_version_is_the_installed_distributions(tmp_path: Path) -> None:
     assert neurohover.__version__ == importlib.metadata.version("neurohover")
     # A distribution found first on sys.path supplies the version: nothing is hard-coded.

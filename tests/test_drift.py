@@ -141,6 +141,7 @@ def test_test_runs_config_and_groups_carry_the_drift_into_their_units(tmp_path) 
         load_config(str(config), "quick")
 
 
+@pytest.mark.slow
 def test_compete_flies_a_drifting_task_from_the_command_line(cli, tmp_path) -> None:
     out = tmp_path / "c"
     rc, _, err = cli("compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "3", "--episode-steps", "100",
@@ -161,6 +162,7 @@ def test_baseline_flies_the_same_with_or_without_a_zero_drift() -> None:
     assert np.array_equal(a.returns, b.returns)
 
 
+@pytest.mark.slow
 def test_the_benchmark_report_tabulates_agents_by_condition(cli, tmp_path) -> None:
     store = tmp_path / "r.sqlite"
     assert cli("reproduce", "bench-drift", "--store", str(store), "--no-progress")[0] == 0

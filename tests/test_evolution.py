@@ -103,6 +103,7 @@ def test_steady_state_ask_tell_shapes_and_budget() -> None:
     assert opt.population.shape == (50, D)
 
 
+@pytest.mark.slow
 def test_steady_state_improves() -> None:
     opt = SteadyStateNE(np.zeros(D), SteadyStateSettings(budget=3000), seed=3)
     run_to_stop(opt)
@@ -281,6 +282,7 @@ def test_generational_determinism() -> None:
 # --------------------------------------------------------------------------- CMA-ES
 
 
+@pytest.mark.slow
 def test_cmaes_improves_is_deterministic_and_leaves_global_rng_alone() -> None:
     before = np.random.get_state()[1].copy()
     opts = [CMAES(np.zeros(D), sigma0=0.5, seed=s, budget=1500) for s in (3, 3, 4)]

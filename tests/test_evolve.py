@@ -202,6 +202,7 @@ def test_seed_changes_the_run() -> None:
     assert _key(a) != _key(b)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "target,kwargs",
     [
@@ -264,6 +265,7 @@ def test_validation_episodes_are_fresh_and_reproducible() -> None:
 # --------------------------------------------------------------------------------- commands
 
 
+@pytest.mark.slow
 def test_evolve_command_writes_policy_history_and_resumes(cli, tmp_path: Path) -> None:
     out = tmp_path / "champ.json"
     args = ["evolve", "--task", "ghh08", "--mdp", "train:1", "--topology", "slp", "--episode-steps", "300", "--seed", "5", "--out", str(out), "--json"]
@@ -464,6 +466,7 @@ def test_race_auto_matches_the_cost_of_fixed_resampling() -> None:
     assert run.settings["resampling"] == "race:auto" and 0.5 * fixed_cost <= run.episodes <= 1.5 * fixed_cost
 
 
+@pytest.mark.slow
 def test_evolve_says_when_the_plateau_ends_a_run_before_its_budget(tmp_path: Path, capsys) -> None:
     """issue 37: a --budget on one MDP is a cap; a run the plateau stopped first said nothing of it."""
     args = ["evolve", "--task", "ghh08", "--mdp", "train:0", "--episode-steps", "20", "--validation-episodes", "1", "--out", str(tmp_path / "p.json")]

@@ -43,6 +43,7 @@ def test_a_default_written_in_both_the_schema_and_the_settings_class_is_the_same
             assert (tuple(default) if isinstance(default, list) else default) == ours, (cls.__name__, f.name, default, ours)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scale", ["quick", "paper"])
 def test_every_shipped_config_reads_as_its_typed_settings(scale: str) -> None:
     for name in experiment_names():
@@ -58,6 +59,7 @@ def test_every_shipped_config_reads_as_its_typed_settings(scale: str) -> None:
             typed.seed = 1  # type: ignore[misc]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scale", ["quick", "paper"])
 def test_every_planned_unit_reads_as_its_typed_params(scale: str) -> None:
     kinds = set()

@@ -90,6 +90,7 @@ def _write(tmp_path: Path, text: str, name: str = "exp.toml") -> Path:
 # --------------------------------------------------------------------------------- configs
 
 
+@pytest.mark.slow
 def test_every_experiment_of_the_paper_is_shipped_at_both_scales() -> None:
     assert experiment_names() == PAPER_EXPERIMENTS + ABLATIONS + BENCHMARKS + BEYOND
     for name in PAPER_EXPERIMENTS + ABLATIONS + BENCHMARKS + BEYOND:
@@ -327,6 +328,7 @@ def _interrupt_after(proc: subprocess.Popen, store: Path, n: int, sig: int) -> d
     return _finished(store)
 
 
+@pytest.mark.slow
 def test_an_interrupted_run_loses_no_finished_unit_and_resumes(tmp_path: Path) -> None:
     """Ctrl-C, then SIGKILL, then a full run on the same store: nothing finished is lost or redone."""
     config = _write(tmp_path, SLOW_CONFIG)
@@ -356,6 +358,7 @@ def test_an_interrupted_run_loses_no_finished_unit_and_resumes(tmp_path: Path) -
         assert [s.results("slowtest", "quick")[f"u{i:02d}"]["value"] for i in range(12)] == list(range(12))
 
 
+@pytest.mark.slow
 def test_a_resumed_unit_equals_an_uninterrupted_one(tmp_path: Path) -> None:
     # Each unit is seeded by its key, so a unit run after an interruption gives what it would have.
     cfg = load_config(str(_write(tmp_path, SLOW_CONFIG)), "quick")
@@ -383,6 +386,7 @@ def quick_store(tmp_path_factory) -> Path:
     return path
 
 
+@pytest.mark.slow
 def test_quick_experiments_end_to_end(quick_store: Path, cli) -> None:
     with Store(quick_store) as store:
         assert {n for n, _, _, _ in store.experiments()} == {"fig2", "table4", "fig8", "fig15"}
@@ -403,6 +407,7 @@ def test_quick_experiments_end_to_end(quick_store: Path, cli) -> None:
     assert rc == 0 and "ran 0 units, 18 already in the store" in out
 
 
+@pytest.mark.slow
 def test_results_export_csv_and_json(quick_store: Path, cli, tmp_path: Path) -> None:
     rc, out, _ = cli("results", "fig8", "--store", str(quick_store), "--format", "json")
     data = json.loads(out)
@@ -430,6 +435,7 @@ def test_results_export_csv_and_json(quick_store: Path, cli, tmp_path: Path) -> 
     assert rc == 2 and "no such results store" in err
 
 
+@pytest.mark.slow
 def test_report_draws_the_figures_and_compares_with_the_paper(quick_store: Path, tmp_path: Path, cli) -> None:
     out = tmp_path / "report"
     rc, printed, _ = cli("report", "--store", str(quick_store), "--out", str(out))
@@ -481,6 +487,7 @@ def test_report_draws_the_figures_and_compares_with_the_paper(quick_store: Path,
     assert "removed" not in err and str(tmp_path / "x") not in err and not (tmp_path / "x").exists()  # none made and removed (sixth trial)
 
 
+@pytest.mark.slow
 def test_the_report_takes_the_papers_table_from_the_shipped_config(quick_store: Path, tmp_path: Path, cli) -> None:
     """Issue 33: a protocol note corrected in the shipped config reaches the report of runs stored before (the [paper]
     table is documentation, outside the config hash), so no note contradicts the stored settings."""
@@ -496,6 +503,7 @@ def test_the_report_takes_the_papers_table_from_the_shipped_config(quick_store: 
     assert "AN OUTDATED NOTE" not in text and load_config("fig8", "quick").paper["notes"][0] in text
 
 
+@pytest.mark.slow
 def test_a_report_of_fghh_runs_without_validation_ranks_nothing_and_warns_nothing(tmp_path: Path, cli) -> None:
     # Bug: the ranking took the mean of an empty list of validation scores (numpy's "Mean of empty slice").
     config = tmp_path / "tiny.toml"
@@ -515,6 +523,7 @@ def test_a_report_of_fghh_runs_without_validation_ranks_nothing_and_warns_nothin
     assert "| k = 1 |" in text and "Ranking by mean validation" not in text
 
 
+@pytest.mark.slow
 def test_failed_units_are_reported_and_not_recorded(tmp_path: Path, monkeypatch) -> None:
     from neurohover.experiments import runner
     from neurohover.experiments.plans import Plan
@@ -541,6 +550,7 @@ def test_failed_units_are_reported_and_not_recorded(tmp_path: Path, monkeypatch)
         executor.close()
 
 
+@pytest.mark.slow
 def test_policies_from_a_policy_set_directory(tmp_path: Path, capsys) -> None:
     from neurohover.policysets import build_policy_set
 
@@ -599,6 +609,7 @@ def test_paper_scale_reproduction() -> None:
     assert main(["report", "--store", store, "--scale", "paper", "--out", str(Path(store).with_suffix("")) + "-report"]) == 0
 
 
+@pytest.mark.slow
 def test_only_runs_the_selected_units_and_a_later_call_finishes_the_rest(tmp_path: Path, capsys) -> None:
     config = _write(tmp_path, SLOW_CONFIG.replace("runs = 12", "runs = 4").replace("budget = 3000", "budget = 200"))
     store = tmp_path / "s.sqlite"
@@ -666,6 +677,7 @@ def test_paired_runs_mostly_equal_are_described_by_the_pairs_that_differ() -> No
     assert paired_verdict(np.array([-1.0, -2.0, 1.0])).startswith("worse in the median pair (1 of 3 runs better")
 
 
+@pytest.mark.slow
 def test_an_interrupt_ends_the_running_worker_processes_at_once() -> None:
     import multiprocessing
 
@@ -691,6 +703,7 @@ def test_an_interrupt_ends_the_running_worker_processes_at_once() -> None:
     assert not [p for p in multiprocessing.active_children() if p.is_alive()]
 
 
+@pytest.mark.slow
 def test_the_report_opens_with_the_papers_claims_and_conclusions(committed_store: Path, tmp_path: Path) -> None:
     """Issue 33: every claim checked at paper scale, with its verdict; a reversed effect is never counted as holding.
     The hand-written account of the conclusions (issue 32) follows their table."""
@@ -749,6 +762,7 @@ def test_a_refused_only_leaves_the_store_as_it_was(tmp_path: Path, capsys) -> No
         assert [e[0] for e in s.experiments()] == ["slowtest"]
 
 
+@pytest.mark.slow
 def test_an_update_that_forgets_the_policy_source_is_refused(tmp_path) -> None:
     """--update without the run's `--set policies=shipped` would have run every unit again (and dropped the stored
     ones): it is refused with the setting to give, and the store is left as it was."""

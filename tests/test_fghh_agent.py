@@ -56,6 +56,7 @@ def sources(tmp_path_factory) -> tuple[Path, dict, str]:
         return path, {name: store.results(name, "quick") for name in ("fig13", "fig15")}, said.getvalue()
 
 
+@pytest.mark.slow
 def test_each_run_draws_its_generic_from_the_sources_champions(sources) -> None:
     _, results, _ = sources
     cfg = load_config("fig16", "quick")
@@ -80,6 +81,7 @@ def test_each_run_draws_its_generic_from_the_sources_champions(sources) -> None:
     assert [u.params for u in plan(cfg, {}, results).units] == [u.params for u in plan(cfg, {}, results).units]
 
 
+@pytest.mark.slow
 def test_without_its_sources_figure_16_waits_and_says_for_what(sources) -> None:
     cfg = load_config("fig16", "quick")
     p = plan(cfg, {}, {})
@@ -101,6 +103,7 @@ def test_a_bad_generics_source_is_refused() -> None:
         plan(load_config("fig16", "quick", {"generics_from": {"fixed": "fig13/k7"}}), {}, {})
 
 
+@pytest.mark.slow
 def test_the_report_shows_fghh_runs_on_their_fitness_scale_beside_the_authors_generics(sources, tmp_path: Path) -> None:
     import json
 
@@ -122,6 +125,7 @@ def test_the_report_shows_fghh_runs_on_their_fitness_scale_beside_the_authors_ge
     assert (out / "fig13-quick.png").is_file()
 
 
+@pytest.mark.slow
 def test_fresh_never_discards_the_sources_run_first(sources, tmp_path: Path, capsys) -> None:
     store = tmp_path / "s.sqlite"
     store.write_bytes(sources[0].read_bytes())  # Figures 13 and 15 finished, as a first fig16 run leaves them
@@ -133,6 +137,7 @@ def test_fresh_never_discards_the_sources_run_first(sources, tmp_path: Path, cap
     assert "fig13 (quick): finished; ran 0 units" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_the_report_compares_variants_of_either_scale_on_the_test_mdps(tmp_path: Path) -> None:
     from neurohover.experiments import write_report
 

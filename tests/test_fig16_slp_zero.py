@@ -42,6 +42,7 @@ def test_the_generics_topology_is_refused_where_no_generic_is_evolved() -> None:
         make_config("x", "test_runs", "quick", {**base, "generic_topology": "rnn"})
 
 
+@pytest.mark.slow
 def test_the_report_pairs_each_run_with_figure_16s(committed_store: Path, tmp_path: Path) -> None:
     path = tmp_path / "s.sqlite"
     shutil.copyfile(committed_store, path)

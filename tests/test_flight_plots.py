@@ -62,6 +62,7 @@ def files(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
 # -- flights ----------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_plot_writes_one_png_per_episode_beside_the_file(files, capsys) -> None:
     capsys.readouterr()
     assert main(["plot", str(files["flight"])]) == 0
@@ -73,6 +74,7 @@ def test_plot_writes_one_png_per_episode_beside_the_file(files, capsys) -> None:
         assert (width, height) == (1000, 1100) and path.stat().st_size > 50_000  # five panels of 6000 steps
 
 
+@pytest.mark.slow
 def test_plot_out_dir_is_created(files, capsys) -> None:
     out = files["root"] / "new" / "plots"
     assert main(["plot", str(files["crash"]), "--out", str(out)]) == 0
@@ -81,6 +83,7 @@ def test_plot_out_dir_is_created(files, capsys) -> None:
     assert "created directory" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_flight_figure_panels_hold_the_episode(files) -> None:
     data = FlightData.load(files["flight"])
     obs, act = data.observations[0], data.actions[0]
@@ -107,6 +110,7 @@ def test_crash_is_marked(files) -> None:
     assert not crashed_episode(FlightData.load(files["flight"]).actions[0])
 
 
+@pytest.mark.slow
 def test_plot_flight_data_titles_from_the_metadata(files, tmp_path: Path) -> None:
     data = FlightData.load(files["flight"])
     paths = plot_flight_data(data, tmp_path, stem="x")
@@ -146,6 +150,7 @@ def test_compete_overlay_has_one_line_per_directory(files) -> None:
     assert labels[0].startswith("baseline (ghh08): 2 runs") and labels[1].startswith("model-free (ghh08)")
 
 
+@pytest.mark.slow
 def test_compete_overlay_of_three_directories(files, tmp_path: Path) -> None:
     again = tmp_path / "baseline-again"  # the same agent twice (a directory given twice is refused)
     shutil.copytree(files["baseline"], again)
@@ -155,6 +160,7 @@ def test_compete_overlay_of_three_directories(files, tmp_path: Path) -> None:
     assert png_size(path) == (1100, 450)
 
 
+@pytest.mark.slow
 def test_plot_compete_command(files, capsys) -> None:
     capsys.readouterr()
     assert main(["plot", "--compete", str(files["baseline"]), str(files["model-free"])]) == 0
@@ -246,12 +252,14 @@ def test_bad_input_is_one_message_and_exit_2(bad, capsys, args: list[str], messa
     assert captured.out == ""
 
 
+@pytest.mark.slow
 def test_bad_input_in_a_real_process(tmp_path: Path) -> None:
     run = subprocess.run([sys.executable, "-m", "neurohover", "plot", str(tmp_path / "none.npz")], capture_output=True, text=True)
     assert run.returncode == 2 and "Traceback" not in run.stderr
     assert run.stderr.strip() == f"neurohover plot: error: FLIGHT '{tmp_path / 'none.npz'}': no such flight-data file"
 
 
+@pytest.mark.slow
 def test_plot_draws_only_the_episodes_asked_for(tmp_path: Path, capsys) -> None:
     from neurohover.cli import main
 

@@ -127,6 +127,7 @@ def test_a_checkpoint_written_before_the_fitness_scale_resumes_as_it_ran() -> No
     assert (old.settings.fitness, old.settings.elitist, old.settings.init_mutate_std) == ("return", True, None)
 
 
+@pytest.mark.slow
 def test_evolve_on_the_command_line_takes_a_preset_and_settings(tmp_path, capsys) -> None:
     import json
 

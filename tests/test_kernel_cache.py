@@ -59,6 +59,7 @@ def _edit(path: Path, old: str, new: str) -> None:
     path.write_text(text.replace(old, new))
 
 
+@pytest.mark.slow
 def test_edits_outside_kernel_py_recompile_and_unchanged_sources_load_from_cache(tmp_path: Path) -> None:
     copy = tmp_path / "src"
     shutil.copytree(PACKAGE, copy / "neurohover", ignore=shutil.ignore_patterns("__pycache__", "*.nb[ic]"))
@@ -110,6 +111,7 @@ def test_every_cached_function_of_the_package_is_keyed_on_the_simulator_sources(
         assert isinstance(f._cache._impl.locator, SimSourceLocator), f.__qualname__
 
 
+@pytest.mark.slow
 def test_simulator_modules_import_nothing_of_the_package_outside_sim() -> None:
     # The hash covers sim/*.py only, so compiled code there must not depend on other modules of ours. The one exception,
     # neurohover.errors, holds no compiled code: the Python entry points' argument checks raise its NeurohoverError.

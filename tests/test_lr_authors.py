@@ -222,6 +222,7 @@ def test_main_effects_pair_cells_that_differ_in_one_factor() -> None:
     assert only["factor"].startswith("the noise estimate") and only["pairs"] == 9
 
 
+@pytest.mark.slow
 def test_the_factorial_reports_every_fit_and_each_factors_effect(tmp_path) -> None:
     from neurohover.experiments import LocalExecutor, Store, reproduce, write_report
 

@@ -70,6 +70,7 @@ def test_bad_substeps_are_refused(model) -> None:
         make_config("y", "model_learning", "quick", {**ml, "fits": [{"key": "a", "model_substeps": 3}]})
 
 
+@pytest.mark.slow
 def test_the_substeps_fit_evolves_on_ten_substeps_and_reports_the_factor(tmp_path) -> None:
     cfg = load_config("lr-substeps-table4", "quick", {"n_steps": 60})
     units = {u.key: u for u in plan(cfg, {}).units}
@@ -112,6 +113,7 @@ def test_the_fig8_groups_take_ten_substeps_on_figure_8s_seeds() -> None:
         make_config("x", "test_runs", "quick", {**base, "groups": [{"agent": "incremental", "n_mdps": 1, "model_substeps": 2}]})
 
 
+@pytest.mark.slow
 def test_compete_takes_the_model_substeps_for_the_agents_that_learn_models(tmp_path, capsys) -> None:
     import json
     import sqlite3

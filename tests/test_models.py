@@ -263,6 +263,7 @@ def test_ec_meno_lowers_one_step_error(zero_flight) -> None:
     assert np.all(np.asarray(model.noise_std) > 0)
 
 
+@pytest.mark.slow
 def test_ec_mer_lowers_return_error(zero_flight) -> None:
     fd = zero_flight.flight_data
     true_return = float(zero_flight.returns[0, 0, 0])

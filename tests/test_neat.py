@@ -83,6 +83,7 @@ def test_bad_settings_are_refused() -> None:
         evolve_topology([], budget=1000)
 
 
+@pytest.mark.slow
 def test_a_genome_seeded_with_the_baseline_flies_the_baseline() -> None:
     """The whole path (the network, its inputs, the vector environment's gusts) is the kernel's: a NEAT
     genome made the baseline earns the baseline policy's returns on the same episodes."""
@@ -183,6 +184,7 @@ def test_a_neat_run_over_the_family_must_be_validated_on_its_test_mdps(tmp_path:
         load_config(str(path), "quick")
 
 
+@pytest.mark.slow
 def test_the_report_pairs_each_neat_run_with_the_mlp_run_of_its_seed(tmp_path: Path) -> None:
     """A NEAT variant paired with an NE variant of the same experiment: the section's paired block tests the run pairs
     (same MDP, seed and validation episodes) by Wilcoxon, with the p-value scipy gives on the stored returns."""

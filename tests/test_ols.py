@@ -156,6 +156,7 @@ def test_one_step_error_is_a_sum_of_axes_and_least_squares_is_its_minimum(windy)
     np.testing.assert_allclose(theta[:5], ols_v[:5], rtol=0.02, atol=2e-3)
 
 
+@pytest.mark.slow
 def test_ec_meno_reaches_the_closed_form_minimum(windy) -> None:
     problem = OneStepProblem(windy)
     theta = problem.least_squares()
@@ -173,6 +174,7 @@ def test_ec_meno_reaches_the_closed_form_minimum(windy) -> None:
     assert old.stats["evaluations"] == 2000 and old.stats["excess"] > 1e-2
 
 
+@pytest.mark.slow
 def test_ec_meno_moves_d_w_to_where_the_data_put_it() -> None:
     """Data flown in a one-substep model whose D_w is 10 % smaller than the default: EC-MENO
     leaves the prototype's D_w (-42.15) for the least-squares value (about -37)."""

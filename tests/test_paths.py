@@ -35,6 +35,7 @@ def test_a_name_longer_than_the_file_system_takes_is_refused_by_name(tmp_path: P
     assert checked_path("x" * NAME_MAX, "--out").name == "x" * NAME_MAX
 
 
+@pytest.mark.slow
 def test_every_command_names_a_name_too_long_without_a_traceback(tmp_path: Path) -> None:
     long = str(tmp_path / ("x" * 300 + ".json"))
     for argv in (["fly", "--task", "ghh08", "--episodes", "1", "--policy", long], ["results", "fig7", "--store", long]):

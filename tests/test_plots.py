@@ -46,6 +46,7 @@ def _backend_raw() -> str:
     return dict.__getitem__(matplotlib.rcParams, "backend")  # without resolving it
 
 
+@pytest.mark.slow
 def test_compete_plot_keeps_the_backend(svg_backend, tmp_path: Path) -> None:
     rng = np.random.default_rng(0)
     curves = {"a": np.cumsum(-rng.uniform(1, 2, (3, 50)), axis=1), "b": np.cumsum(-rng.uniform(2, 3, (3, 50)), axis=1)}
@@ -54,6 +55,7 @@ def test_compete_plot_keeps_the_backend(svg_backend, tmp_path: Path) -> None:
     _assert_png(path, {(11, 4)})
 
 
+@pytest.mark.slow
 def test_report_figures_keep_the_backend(svg_backend, committed_store: Path, tmp_path: Path) -> None:
     store_path = tmp_path / "results.sqlite"
     shutil.copyfile(committed_store, store_path)

@@ -125,6 +125,7 @@ def _end_group(proc: subprocess.Popen) -> None:
 # --------------------------------------------------------------------------------- no orphans
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM], ids=["SIGKILL", "SIGTERM"])
 def test_the_workers_of_a_killed_reproduce_exit(tmp_path: Path, sig: int) -> None:
     config = tmp_path / "long.toml"
@@ -147,6 +148,7 @@ def test_the_workers_of_a_killed_reproduce_exit(tmp_path: Path, sig: int) -> Non
         _end_group(proc)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM], ids=["SIGKILL", "SIGTERM"])
 def test_the_workers_of_a_killed_compete_exit(tmp_path: Path, sig: int) -> None:
     proc = _start(
@@ -181,6 +183,7 @@ def _ctrl_c_as_in_a_terminal() -> None:
     signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("delay", [0.6, 1.2, 2.5])  # from the package's import on (before it, Python itself is starting)
 def test_ctrl_c_at_any_moment_ends_with_one_line_and_130(delay: float) -> None:
     """issue 37, third trial: a Ctrl-C while the package imported NumPy and numba was a KeyboardInterrupt traceback (the
@@ -196,6 +199,7 @@ def test_ctrl_c_at_any_moment_ends_with_one_line_and_130(delay: float) -> None:
     assert proc.returncode == 130 and "Traceback" not in err and err.strip().splitlines()[-1].endswith("interrupted"), err[-1500:]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("delay", [1.0, 2.5, 6.0])  # from the package import on (before it, Python itself starts), then while it flies
 def test_sigterm_at_any_moment_ends_any_command_with_one_line_and_143(delay: float) -> None:
     """issue 37, fourth trial: SIGTERM (a timeout, kill) ended fly, evolve, compete and reproduce without a line."""
@@ -221,6 +225,7 @@ def test_a_stop_is_named_by_its_signal_also_when_raised_while_handling_it() -> N
         assert stop_words(err) == ("terminated", 143)  # build-policies said "interrupted", 130 for a SIGTERM (fourth trial)
 
 
+@pytest.mark.slow
 def test_a_terminated_build_leaves_no_half_built_set(tmp_path: Path) -> None:
     """issue 37, third trial: SIGTERM (timeout, kill) left <out>/ghh08.building without a word; now it ends as Ctrl-C
     does, keeping only the finished runs beside the set, which the same build resumes from (fourth trial)."""
@@ -280,6 +285,7 @@ def _deliver_again_and_wait(callback, stop: BaseException) -> None:
 # --------------------------------------------------------------------------------- Ray addresses
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "address, message",
     [
@@ -343,6 +349,7 @@ def test_malformed_ray_addresses_are_refused(address: str) -> None:
         ray_endpoint(address)
 
 
+@pytest.mark.slow
 def test_a_bad_ray_address_environment_variable_is_named(tmp_path: Path) -> None:
     proc = subprocess.run(
         [sys.executable, "-m", "neurohover", "reproduce", "fig2", "--executor", "ray", "--store", str(tmp_path / "s.sqlite"), "--no-progress"],
@@ -373,6 +380,7 @@ def _running_session(store: Path, name: str) -> bool:
         return False
 
 
+@pytest.mark.slow
 def test_a_store_that_a_live_run_writes_is_refused_and_a_killed_run_blocks_nothing(tmp_path: Path, cli) -> None:
     # The holder is a process of its own; this process plays the second writer and the readers.
     store = tmp_path / "s.sqlite"
@@ -516,6 +524,7 @@ def test_main_called_in_a_program_leaves_its_signals_as_they_were(monkeypatch, c
     assert (signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)) == before
 
 
+@pytest.mark.slow
 def test_a_large_demo_hears_sigterm_between_its_calls() -> None:
     """Fifth trial: demo --episodes 4000000 flew each family in one kernel call and heard neither SIGTERM nor Ctrl-C for
     minutes (SIGKILL ended it). Now it flies in calls of a few thousand episodes and stops at the next one."""
@@ -528,6 +537,7 @@ def test_a_large_demo_hears_sigterm_between_its_calls() -> None:
     assert proc.returncode == 143 and "Traceback" not in err and err.strip().splitlines()[-1].endswith("terminated"), err[-1500:]
 
 
+@pytest.mark.slow
 def test_demo_in_calls_prints_what_one_call_prints(monkeypatch, capsys) -> None:
     from neurohover.cli import flying, main
 

@@ -74,6 +74,7 @@ def _table(seed: int) -> np.ndarray:
     return rng.normal(0.0, 1.0, LAMBDA)[:, None] + rng.normal(0.0, 1.5, (LAMBDA, T_LIMIT))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("rule", ["algorithm1", "authors"])
 @pytest.mark.parametrize("seed", range(6))
 def test_a_rule_matches_its_reference(rule: str, seed: int) -> None:
@@ -87,6 +88,7 @@ def test_a_rule_matches_its_reference(rule: str, seed: int) -> None:
     assert len(set(race.selected.tolist())) == MU
 
 
+@pytest.mark.slow
 def test_the_rules_decide_differently_and_the_look_ahead_changes_nothing() -> None:
     """On 100 random races (candidates' spread 1, episodes' 0.3) Algorithm 1 spends other episodes than the prose
     rule in some, and the authors' loop picks other parents than Algorithm 1 in many."""
@@ -131,6 +133,7 @@ def test_fig15_rules_runs_take_the_seeds_and_validation_of_figure_15s_races() ->
         make_config("x", "evolution", "quick", {**base, "seeds_of": {"experiment": "fig15"}})
 
 
+@pytest.mark.slow
 def test_the_report_pairs_each_rules_run_with_figure_15s(tmp_path) -> None:
     small = {"runs": 2, "budget": 400, "n_steps": 50, "validation_episodes": 4}
     with Store(tmp_path / "s.sqlite") as store:

@@ -357,6 +357,7 @@ def test_selection_race_matches_reference_with_stream_sampler(seed: int) -> None
     _assert_race_equal(selection_race(make(), n, mu, delta, t_limit), ref)
 
 
+@pytest.mark.slow
 def test_selection_race_matches_reference_beyond_1000_samples() -> None:
     """Indistinguishable candidates raced past n = 1000 (normal-approximation bounds)."""
     rng = np.random.default_rng(5)

@@ -50,6 +50,7 @@ def _subset_config():
     return load_config("fig16", "quick", {"generics_per_agent": 1, "generics_from": {}, "generic_budget": 2000})
 
 
+@pytest.mark.slow
 def test_ray_and_local_runs_give_identical_results(ray_cluster, tmp_path: Path) -> None:
     cfg = _subset_config()
     with Store(tmp_path / "local.sqlite") as local, Store(tmp_path / "ray.sqlite") as remote:
@@ -70,6 +71,7 @@ def test_ray_and_local_runs_give_identical_results(ray_cluster, tmp_path: Path) 
         assert any(w != "" for w in (u["worker"] for u in remote.units(cfg.name, cfg.scale)))
 
 
+@pytest.mark.slow
 def test_reproduce_command_with_the_ray_executor(ray_cluster, tmp_path: Path, capsys) -> None:
     store = tmp_path / "s.sqlite"
     argv = ["reproduce", "fig15", "--scale", "quick", "--set", "runs=1", "--set", "budget=600", "--store", str(store), "--executor", "ray", "--no-progress"]
@@ -82,6 +84,7 @@ def test_reproduce_command_with_the_ray_executor(ray_cluster, tmp_path: Path, ca
     assert "--jobs applies to --executor local" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_a_driver_in_another_process_joins_the_cluster_with_address(ray_cluster, tmp_path: Path) -> None:
     address = ray_cluster.get_runtime_context().gcs_address
     store = tmp_path / "s.sqlite"
@@ -117,6 +120,7 @@ def test_a_driver_in_another_process_joins_the_cluster_with_address(ray_cluster,
         assert {k: strip_timing(v) for k, v in s.results("fig15", "quick").items()} == {k: strip_timing(v) for k, v in local.items()}
 
 
+@pytest.mark.slow
 def test_a_dying_worker_is_retried_by_ray(ray_cluster, tmp_path: Path) -> None:
     marker = tmp_path / "died-once"
     unit = Unit("diag", "retry", "diagnostic", {"exit_unless": str(marker), "value": 42})
@@ -126,6 +130,7 @@ def test_a_dying_worker_is_retried_by_ray(ray_cluster, tmp_path: Path) -> None:
     assert errors == [] and results == [{"value": 42, "seed": None}]
 
 
+@pytest.mark.slow
 def test_a_unit_whose_worker_keeps_dying_is_reported_not_recorded(ray_cluster, tmp_path: Path, monkeypatch) -> None:
     from neurohover.experiments import runner
 

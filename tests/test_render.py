@@ -87,6 +87,7 @@ def test_frames_change_under_random_actions() -> None:
             break
 
 
+@pytest.mark.slow
 def test_windy_frame_differs_from_calm_only_in_wind_and_text() -> None:
     family = get_task_family("ghh08")
     calm = HoverEnv("ghh08", mdp=family.zero(), render_mode="rgb_array")
@@ -164,6 +165,7 @@ def _fly(env: gym.Env, n: int, render: bool):
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("env_id", ["neurohover/GHH08-v0", "neurohover/GHH09-v0", "neurohover/FGHH-v0"])
 def test_rendering_does_not_change_results(env_id: str) -> None:
     plain = _fly(gym.make(env_id), 60, render=False)
@@ -174,6 +176,7 @@ def test_rendering_does_not_change_results(env_id: str) -> None:
         assert r1 == r2 and te1 == te2 and tr1 == tr2 and i1 == i2
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("mode", ["rgb_array", "human"])
 def test_gymnasium_env_checker_passes_with_rendering(mode: str) -> None:
     gc.collect()  # an earlier test's unclosed files warn when collected: not this env's warnings

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import pytest
 
+
+@pytest.mark.slow
 def test_the_readme_beside_the_report_gets_its_numbers_from_the_store(tmp_path) -> None:
     """Issue 33: a README's generated blocks are filled from the store; the text around them is kept."""
     from neurohover.experiments import LocalExecutor, Store, load_config, reproduce, write_report

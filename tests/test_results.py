@@ -44,6 +44,7 @@ def _round_trip(rows) -> set[str]:
     return kinds
 
 
+@pytest.mark.slow
 def test_stored_results_of_every_experiment_and_kind_round_trip_exactly(committed_store: Path) -> None:
     """The first 10 units (by key) of every experiment, scale and kind; the whole store, which grows with every paper-scale
     run, is the paper-marked test below (python3 -m pytest -m paper)."""
@@ -153,6 +154,7 @@ def test_the_mdp_index_is_the_number_in_the_mdp_part() -> None:
     assert UnitKey.parse("policy/generic-race1").mdp_index is None
 
 
+@pytest.mark.slow
 def test_export_and_report_read_typed_results(committed_store: Path, tmp_path: Path) -> None:
     """The CSV gains the key's parts from UnitKey; a result the types refuse is named in the report, in its experiment's place."""
     import csv
@@ -175,6 +177,7 @@ def test_export_and_report_read_typed_results(committed_store: Path, tmp_path: P
     assert re.search(r"Not reported: the store's copy is damaged\.\*\* .*evolve/k5/run0.*missing key", report)
 
 
+@pytest.mark.slow
 def test_unit_keys_are_made_and_parsed_by_one_scheme() -> None:
     from neurohover.experiments.config import load_config, shipped_configs
     from neurohover.experiments.plans import plan
@@ -217,6 +220,7 @@ REPLAYED_SLOW = [
 ]
 
 
+@pytest.mark.slow
 def test_stored_units_run_again_to_their_stored_results(committed_store: Path) -> None:
     replay(committed_store, REPLAYED)
 
@@ -245,6 +249,7 @@ def test_a_crash_rate_is_never_shown_as_zero_when_an_episode_crashed() -> None:
     assert [crash_rate(c, 20_000) for c in (0, 1, 30, 200, 10_687, 20_000)] == ["0%", "0.005%", "0.15%", "1%", "53%", "100%"]
 
 
+@pytest.mark.slow
 def test_runs_paired_with_their_own_copies_are_called_the_same_runs(committed_store: Path, tmp_path: Path) -> None:
     """wind-fig8's wind-blind groups are Figure 8's runs again: the report said "as good in the median pair (0 of 80
     runs better, ..., Wilcoxon p = 1, not significant)", a test where there is nothing to test."""

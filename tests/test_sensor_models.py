@@ -70,6 +70,7 @@ def test_noisy_readings_bias_the_model_and_exact_sensors_fly_the_same_gusts() ->
     assert noisy.own_one_step_error > noisy.exact_one_step_error
 
 
+@pytest.mark.slow
 def test_the_report_tabulates_every_condition(tmp_path: Path) -> None:
     cfg = load_config(NAME, "quick", {"n_mdps": 1, "conditions": [{"key": "exact"}, {"key": "white2", "sensor": {"level": 2.0}}]})
     with Store(tmp_path / "s.sqlite") as store:

@@ -334,6 +334,7 @@ print(json.dumps(out))
 """
 
 
+@pytest.mark.slow
 def test_cuda_build_senses_as_the_cpu_kernel_under_the_simulator() -> None:
     out = run_simulated(CUDA_SCRIPT)
     np.testing.assert_allclose(out["cuda"]["returns"], out["cpu"]["returns"], rtol=1e-9)

@@ -256,6 +256,7 @@ def test_generational_breeding_is_unchanged(monkeypatch) -> None:
 # --------------------------------------------------------------------------------- steady state ask/tell
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "pop_size,elite_size,crossover_prob,dim",
     [

@@ -113,6 +113,7 @@ def _always_crashing() -> Policy:
     return Policy("mlp", np.full_like(proto.genome, 3.0))  # saturated actions: crashes in a few steps
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("rule,reason", [("literal", "plateau"), ("no-crash", "budget")])
 def test_evolve_passes_crash_flags(rule, reason) -> None:
     settings = dict(plateau_threshold=30, pop_size=10, elite_size=9, mutate_frac=0.0, plateau_rule=rule)

@@ -7,6 +7,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
 from neurohover.experiments.config import ExperimentConfig, load_config, shipped_configs
 from neurohover.experiments.plans import plan, source_experiments
 from neurohover.experiments.runner import POLICY_SOURCES, unchanged_units
@@ -18,6 +20,7 @@ from neurohover.experiments.store import Store
 AWAITING_RERUN: set[str] = set()
 
 
+@pytest.mark.slow
 def test_every_stored_experiment_is_planned_again_with_its_stored_params(committed_store: Path) -> None:
     shipped = set(shipped_configs())
     checked = rerun = 0

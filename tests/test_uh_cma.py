@@ -84,6 +84,7 @@ def test_its_settings_extend_cma_es_but_are_not_taken_for_them() -> None:
         evolve(GHH08.mdp("train:0"), optimizer="cma", settings=UHCMASettings(), budget=10)
 
 
+@pytest.mark.slow
 def test_evolve_runs_it_and_resumes_bit_for_bit(tmp_path: Path) -> None:
     assert OPTIMISERS["uh-cma"].stops_itself
     common = dict(topology="slp", optimizer="uh-cma", seed=4, n_steps=200, settings={"max_evaluations": 4})

@@ -54,6 +54,7 @@ def test_bad_input_is_refused_with_one_clear_message(runs, n, draws, message) ->
         win_probabilities(runs, n, draws=draws)
 
 
+@pytest.mark.slow
 def test_the_wins_command_gives_each_agents_odds_from_a_stores_test_runs(cli, tmp_path) -> None:
     import json
 
