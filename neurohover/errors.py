@@ -395,11 +395,13 @@ def key_text(key: Any) -> str:
 
 
 def unknown_keys(keys: Any, known: Any) -> str:
-    """The ``keys`` not among ``known``, named for a message ('' if none): text keys as written (a 100,000-character one
-    shortened), any other (b'pop_size', 1) as its repr; sorted as text, so keys of mixed types sort, and ``", ".join``
-    of non-text keys raised TypeError (evolve settings={1: 10}, T33-B02)."""
-    unknown = [k for k in set(keys) if k not in set(known)]
-    return ", ".join(sorted(map(key_text, unknown), key=str))
+    """The ``keys`` not among ``known``, named for a message, '' only if there are none: each key as its repr (a
+    100,000-character one shortened, :func:`brief`), so the key '' is named ``''`` and a trailing space shows; sorted by
+    ``str``, so keys of mixed types sort, and ``", ".join`` of non-text keys raised TypeError (evolve settings={1: 10},
+    T33-B02). Named as written, the key '' read '', which every caller took as "none unknown" (T58-B01..B03)."""
+    known = set(known)
+    unknown = sorted((key for key in set(keys) if key not in known), key=str)
+    return ", ".join(brief(key) or f"a {type(key).__name__} whose repr is ''" for key in unknown)  # never '' for a key
 
 
 def first_difference(path: str, saved: Any, given: Any, saved_as: str = "the stored") -> str:

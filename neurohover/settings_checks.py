@@ -1,7 +1,8 @@
 """The one check of a registry's settings (an agent spec's, a run-time optimiser's, EONN's): a frozen settings dataclass
 read from a table of some of its fields (:func:`settings_from_dict`), each value against its field's plain JSON type
 (:func:`setting_type_problem`) and a class's own defaults likewise (:func:`settings_defaults_problem`); an object of it
-likewise (:func:`checked_settings`). Settings taken hold plain Python values (:func:`plain_settings`, T57-B02).
+likewise (:func:`checked_settings`). Settings taken hold plain Python values (:func:`plain_settings`, T57-B02), in a
+list or tuple field too (T58-B04).
 
 Internal: neurohover's plumbing (README, Python API, What is public).
 """
@@ -52,18 +53,30 @@ def checked_settings(settings: Any, *, bad_what: str) -> Any:
 
 def plain_settings(settings: Any) -> Any:
     """``settings`` (an object of a settings dataclass whose values :func:`setting_type_problem` took) with each value of
-    a plain-typed field as the plain Python value it is read as (:func:`_plain`); the same object where each already is.
+    a plain-typed field as the plain Python value it is read as (:func:`_plain`), and each list or tuple field's as a
+    list or tuple (the field's own) of such values (:func:`_plain_sequence`); the same object where each already is.
     np.float32(0.1), a Fraction, np.int64(3) reached the agent and its recorded settings, which JSON cannot write, and
-    -0.0 hashed as another run than 0.0 (T57-B02)."""
-    kinds = _field_types(type(settings))
+    -0.0 hashed as another run than 0.0 (T57-B02); in a list field they were JSON's TypeError once the run began (T58-B04)."""
+    cls = type(settings)
+    kinds, sequences = _field_types(cls), _sequence_fields(cls)
     changes = {}
     for field in dataclasses.fields(settings):
         value = getattr(settings, field.name)
-        if field.init and field.name in kinds and _takes(kinds[field.name], value):
-            plain = _plain(kinds[field.name], value)
+        if field.init:
+            plain = _plain_value(kinds, sequences, field.name, value)
             if not _same(plain, value):
                 changes[field.name] = plain
     return dataclasses.replace(settings, **changes) if changes else settings
+
+
+def _plain_value(kinds: dict[str, tuple[type, ...]], sequences: dict[str, _Sequence], key: str, value: object) -> object:
+    """Field ``key``'s ``value`` as :func:`plain_settings` holds it; ``value`` itself where the field is of no type checked
+    here (``kinds``, ``sequences``: :func:`_field_types`, :func:`_sequence_fields`) or the value is none of it."""
+    if key in kinds and _takes(kinds[key], value):
+        return _plain(kinds[key], value)
+    if key in sequences and value is not None and not _sequence_problem(sequences[key], value):
+        return _plain_sequence(sequences[key], value)
+    return value
 
 
 def _plain(kinds: tuple[type, ...], value: object) -> object:
@@ -80,35 +93,162 @@ def _plain(kinds: tuple[type, ...], value: object) -> object:
     return setting_float(value)
 
 
-def _same(plain: object, value: object) -> bool:
-    """Whether ``value`` is already ``plain``: of its very type, equal, and of its sign (-0.0 is no 0.0)."""
-    if type(plain) is not type(value) or plain != value:
+def _same(plain: object, value: object, *, signs: bool = True, int_floats: bool = False) -> bool:
+    """Whether ``value`` is already ``plain``: of its very type, equal, and of its sign (-0.0 is no 0.0; ``signs`` False:
+    either sign), item by item in a list, tuple or table; ``int_floats``: an int where ``plain`` is its float counts."""
+    if int_floats and type(value) is int and type(plain) is float:
+        return plain == value
+    if type(plain) is not type(value):
         return False
-    return not isinstance(plain, float) or math.copysign(1.0, plain) == math.copysign(1.0, value)  # type: ignore[arg-type]
+    if isinstance(plain, (list, tuple)):
+        items: Any = value
+        return len(plain) == len(items) and all(_same(a, b, signs=signs, int_floats=int_floats) for a, b in zip(plain, items, strict=True))
+    if isinstance(plain, dict):
+        table: Any = value
+        return plain.keys() == table.keys() and all(_same(plain[k], table[k], signs=signs, int_floats=int_floats) for k in plain)
+    if plain != value:
+        return False
+    return not (signs and isinstance(plain, float)) or math.copysign(1.0, plain) == math.copysign(1.0, value)  # type: ignore[arg-type]
 
 
 #: The plain JSON types a settings field's value is checked against, and what each allows (for messages).
 _PLAIN_TYPES: dict[type, str] = {bool: "true or false", int: "an integer", float: "a finite number", str: "a text"}
 
 
-def _field_types(cls: type) -> dict[str, tuple[type, ...]]:
-    """The plain JSON types (:data:`_PLAIN_TYPES`, and ``type(None)`` for an Optional) each field of the settings
-    dataclass ``cls`` takes, by name: from its annotation, else (an annotation that does not resolve) its default's
-    type. A field of any other type is left out: the class's own ``__post_init__`` checks it."""
-    import types
+def _hints(cls: type) -> dict[str, Any]:
+    """Each field's annotation of the settings dataclass ``cls``, by name, else (an annotation that does not resolve)
+    its default's type: a default_factory's made once, as the class itself makes it (T58-B05)."""
     import typing
 
     try:
         hints = typing.get_type_hints(cls)
     except Exception:  # a name the class's module cannot resolve (a class defined in a function): its defaults say
         hints = {}
-    found = {}
+    found: dict[str, Any] = {}
     for field in dataclasses.fields(cls):
-        hint = hints.get(field.name, type(field.default) if field.default is not dataclasses.MISSING else None)
-        kinds = typing.get_args(hint) if typing.get_origin(hint) in (typing.Union, types.UnionType) else (hint,)
-        if kinds and all(kind in _PLAIN_TYPES or kind is type(None) for kind in kinds) and kinds != (type(None),):
-            found[field.name] = kinds
+        if field.name in hints:
+            found[field.name] = hints[field.name]
+        elif field.default is not dataclasses.MISSING:
+            found[field.name] = type(field.default)
+        elif field.default_factory is not dataclasses.MISSING:
+            try:
+                found[field.name] = type(field.default_factory())
+            except Exception:  # settings_defaults_problem names it
+                pass
     return found
+
+
+def _union(hint: Any) -> tuple[Any, ...]:
+    """The types of ``hint``: a Union's (``int | None``, Optional) members, or ``hint`` alone."""
+    import types
+    import typing
+
+    return typing.get_args(hint) if typing.get_origin(hint) in (typing.Union, types.UnionType) else (hint,)
+
+
+def _field_types(cls: type) -> dict[str, tuple[type, ...]]:
+    """The plain JSON types (:data:`_PLAIN_TYPES`, and ``type(None)`` for an Optional) each field of the settings
+    dataclass ``cls`` takes, by name: from its annotation, else (an annotation that does not resolve) its default's
+    type. A list or tuple field is :func:`_sequence_fields`'; a field of any other type is left out: the class's own
+    ``__post_init__`` checks it."""
+    found = {}
+    for name, hint in _hints(cls).items():
+        kinds = _union(hint)
+        if kinds and all(kind in _PLAIN_TYPES or kind is type(None) for kind in kinds) and kinds != (type(None),):
+            found[name] = kinds
+    return found
+
+
+#: A list or tuple field's type: its container (list or tuple), its items' plain types (None: any plain JSON value,
+#: lists and text-keyed tables of them included), whether None is allowed, and its annotation as a message writes it.
+_Sequence = tuple[type, "tuple[type, ...] | None", bool, str]
+
+
+def _sequence_fields(cls: type) -> dict[str, _Sequence]:
+    """The list and tuple fields of the settings dataclass ``cls`` (``list``, ``list[float]``, ``tuple[int, ...]``, an
+    Optional of one), by name, with what their items may be (:data:`_Sequence`): items of another type (a dataclass)
+    leave the field to the class. Their items went unchecked: NumPy ints were JSON's TypeError at the run's start (T58-B04)."""
+    import typing
+
+    found: dict[str, _Sequence] = {}
+    for name, hint in _hints(cls).items():
+        kinds = _union(hint)
+        rest = [kind for kind in kinds if kind is not type(None)]
+        container = (typing.get_origin(rest[0]) or rest[0]) if len(rest) == 1 else None
+        if container not in (list, tuple):
+            continue
+        items = tuple(item for arg in typing.get_args(rest[0]) if arg is not Ellipsis for item in _union(arg))
+        shown = " | ".join("None" if kind is type(None) else str(kind) if typing.get_args(kind) else kind.__name__ for kind in kinds)
+        if all(item is Any or (typing.get_origin(item) or item) in (list, tuple, dict) for item in items):
+            found[name] = (container, None, len(rest) < len(kinds), shown)  # any JSON value (bare ``list``, ``list[list[float]]``)
+        elif all(item in _PLAIN_TYPES or item is type(None) for item in items) and set(items) != {type(None)}:
+            found[name] = (container, tuple(dict.fromkeys(items)), len(rest) < len(kinds), shown)
+    return found
+
+
+def _as_sequence(value: object) -> list | tuple | None:
+    """``value`` as the list or tuple it is meant as: itself, or a NumPy array's items (an array of numbers given for a
+    list is meant as its numbers, T58-B04); None for anything else (a set has no order, text and tables are no lists)."""
+    numpy = sys.modules.get("numpy")  # not imported: the value is no NumPy array
+    if isinstance(value, (list, tuple)):
+        return value
+    array: Any = value
+    if numpy is not None and type(array) is numpy.ndarray and array.ndim >= 1:  # a masked array's hidden values: refused
+        return list(array)
+    return None
+
+
+class _Refused(Exception):
+    """An item of a list or tuple setting that is no value its field takes (``item``, for the message)."""
+
+    def __init__(self, item: object) -> None:
+        super().__init__()
+        self.item = item
+
+
+def _plain_item(items: tuple[type, ...] | None, item: object) -> object:
+    """``item`` of a list or tuple setting as its plain Python value: one of ``items`` read as :func:`_plain` reads it, or
+    (``items`` None) any JSON value, NumPy's made plain, lists and text-keyed tables of them item by item; else :class:`_Refused`."""
+    if items is not None:
+        if not _takes(items, item):
+            raise _Refused(item)
+        return _plain(items, item)
+    if item is None or isinstance(item, str) or _is_bool(item) or real_number(item):
+        return _plain((bool, int, float, str, type(None)), item)
+    inner = _as_sequence(item)
+    if inner is not None:
+        plain = [_plain_item(None, x) for x in inner]
+        return tuple(plain) if isinstance(inner, tuple) else plain
+    if isinstance(item, dict) and all(isinstance(key, str) for key in item):
+        return {key: _plain_item(None, x) for key, x in item.items()}
+    raise _Refused(item)
+
+
+def _plain_sequence(kind: _Sequence, value: object) -> list | tuple:
+    """``value`` (which :func:`_sequence_problem` took) as its field's container of plain Python values: a tuple given
+    for a list field is a list, as JSON reads it back (and a list for a tuple field a tuple)."""
+    container, items, _, _ = kind
+    plain = [_plain_item(items, item) for item in _as_sequence(value) or ()]
+    return tuple(plain) if container is tuple else plain
+
+
+def _sequence_problem(kind: _Sequence, value: object) -> str:
+    """What is wrong with ``value`` for a list or tuple field of ``kind`` ('' when nothing): no list, tuple or NumPy array
+    (a set, text, a number), or an item that is not one the field takes."""
+    container, items, none, _ = kind
+    other = "tuple" if container is list else "list"
+    if items is None:
+        allowed = "of plain JSON values (numbers, texts, true or false, None, and lists and text-keyed tables of them)"
+    else:
+        allowed = "whose items are each " + " or ".join(_PLAIN_TYPES[k] for k in items if k is not type(None)) + (" or None" if type(None) in items else "")
+    give = f"give a {container.__name__} (or a {other}) {allowed}{', or None' if none else ''}"
+    if _as_sequence(value) is None:
+        return give
+    try:
+        _plain_sequence(kind, value)
+    except _Refused as refused:
+        return f"it holds {brief(refused.item)}: {give}"
+    return ""
 
 
 def _is_bool(value: object) -> bool:
@@ -140,10 +280,11 @@ def _non_finite(value: object) -> bool:
 def setting_type_problem(cls: type, values: Any) -> str:
     """What is wrong with the given ``values`` of the settings dataclass ``cls``'s fields ('' when nothing): a value
     that is not its field's plain JSON type (int, float, bool, text, or an Optional of one; ints are taken for floats,
-    bools are no numbers) or that is, or holds, a number past the finite ones. The one check of an agent's and a
+    bools are no numbers), for a list or tuple field no list, tuple or array of its items' types or of JSON values
+    (:func:`_sequence_problem`, T58-B04), or that is, or holds, a number past the finite ones. The one check of an agent's and a
     run-time optimiser's settings, which a class without checks of its own took and handed on: ``k='x'`` for
     ``k: int = 2`` (T55-B01, B02), ``rate=nan``, refused only by the results store after the run's folder was made (T55-B03)."""
-    kinds = _field_types(cls)
+    kinds, sequences = _field_types(cls), _sequence_fields(cls)
     for key, value in values.items():
         where = kinds.get(key)
         shown = f"{key_text(key)}={brief(value)}"
@@ -152,6 +293,12 @@ def setting_type_problem(cls: type, values: Any) -> str:
         if where is not None and not _takes(where, value):
             allowed = " or ".join(_PLAIN_TYPES[kind] for kind in where if kind is not type(None))
             return f"{shown} is not allowed: give {allowed}{', or None' if type(None) in where else ''} ({field})"
+        sequence = sequences.get(key)
+        if sequence is not None and not (value is None and sequence[2]):  # a list field's items (T58-B04)
+            problem = _sequence_problem(sequence, value)
+            if problem:
+                return f"{shown} is not allowed: {problem} (its field {cls.__name__}.{key} is of type {sequence[3]})"
+            value = _plain_sequence(sequence, value)  # an array's items, for the check of finite numbers
         if _non_finite(value):
             return f"{shown} is out of range: allowed " + (f"a finite number ({field})" if where else "finite numbers (settings are recorded as JSON)")
     return ""
@@ -162,19 +309,32 @@ def settings_defaults_problem(cls: type) -> str:
     left out are the defaults) or one :func:`setting_type_problem` refuses, which flew unchecked (an agent's NaN or
     ``n: int = 'x'``, T56-B01), or one that is not a plain Python value (np.float32(0.1), a Fraction, -0.0: an agent
     makes its defaults itself, unconverted, T57-B02; an int for a float field is one); a field of another type (a nested
-    dataclass) is left to the class. Run-time optimisers' specs and agents' specs check it (T52-B09)."""
+    dataclass) is left to the class. A default_factory's default is made once and checked alike: ``[nan]`` flew a whole
+    run, then its checkpoint was JSON's ValueError and the run lost (T58-B05). Run-time optimisers' specs and agents'
+    specs check it (T52-B09)."""
     fields = dataclasses.fields(cls)
     bare = next((f.name for f in fields if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING), None)
     if bare is not None:
         return f"field {bare!r} has no default: give every field a default (settings left out are the defaults)"
-    defaults = {f.name: f.default for f in fields if f.default is not dataclasses.MISSING}
-    problem = setting_type_problem(cls, defaults)
-    if problem:
-        return f"default {problem}"
-    kinds = _field_types(cls)
+    defaults: dict[str, Any] = {}
+    made = set()
+    for f in fields:
+        if f.default is not dataclasses.MISSING:
+            defaults[f.name] = f.default
+        elif f.default_factory is not dataclasses.MISSING:
+            try:
+                defaults[f.name] = f.default_factory()
+            except Exception as err:  # the class cannot make its defaults: named at registration, not at the run
+                return f"field {f.name!r}'s default_factory raised {type(err).__name__} {brief(str(err))}: give one that makes the default"
+            made.add(f.name)
     for key, value in defaults.items():
-        plain = _plain(kinds[key], value) if key in kinds else value
-        if not (_same(plain, value) or (type(value) is int and type(plain) is float)):  # 1 for 1.0: Python's own spelling
-            why = "no plain JSON value" if type(plain) is not type(value) else "which settings given are read as 0.0"
+        problem = setting_type_problem(cls, {key: value})
+        if problem:
+            return f"default{' (made by its default_factory)' if key in made else ''} {problem}"
+    kinds, sequences = _field_types(cls), _sequence_fields(cls)
+    for key, value in defaults.items():
+        plain = _plain_value(kinds, sequences, key, value)
+        if not _same(plain, value, int_floats=True):  # 1 for 1.0: Python's own spelling
+            why = "which settings given are read as 0.0" if _same(plain, value, signs=False, int_floats=True) else "no plain JSON value"
             return f"field {key!r}'s default is {type(value).__name__} {brief(value)}, {why}: give {plain!r} (the defaults are used as written)"
     return ""

@@ -139,7 +139,7 @@ def test_unit_params_name_the_missing_and_unknown_params() -> None:
     """T14-23: run_unit(Unit('fig7', 'k', 'evolve', {})) was "EvolveParams.__init__() missing 9 keyword-only arguments"."""
     with pytest.raises(NeurohoverError, match=r"'evolve' unit's params lack target, topology, prototype, .*seed, which EvolveParams needs"):
         run_unit(Unit("fig7", "k", "evolve", {}))
-    with pytest.raises(NeurohoverError, match=r"params hold x, which SafetyParams does not declare and lack policies, mdps, episodes, n_steps, seed"):
+    with pytest.raises(NeurohoverError, match=r"params hold 'x', which SafetyParams does not declare and lack policies, mdps, episodes, n_steps, seed"):
         unit_params("safety", {"x": 1})
     with pytest.raises(NeurohoverError, match=r"'safety' unit's params = \[1\] are not allowed: give a dict of SafetyParams's fields"):
         unit_params("safety", [1])  # type: ignore[arg-type]

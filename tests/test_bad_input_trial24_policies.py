@@ -118,7 +118,7 @@ def test_save_policy_refuses_a_name_that_is_no_policy_file_name(tmp_path: Path, 
     ({"champion_fitness_scale": "zzz"}, "its champion_fitness_scale 'zzz' is not allowed: allowed inv-log-error, return"),
     ({"champion_fitness_scale": "inv-log-error"}, "its champion_fitness_scale 'inv-log-error' is not allowed beside its method 'steady-state'"),
     ({"settings": {"pop_size": 0}}, "is not allowed: bad steady-state settings: pop_size=0 must be an integer >= 2"),
-    ({"settings": {"zzz": 1}}, "is not allowed: unknown steady-state setting(s) zzz: allowed averaging_prob"),
+    ({"settings": {"zzz": 1}}, "is not allowed: unknown steady-state setting(s) 'zzz': allowed averaging_prob"),
     ({"settings": 3}, "its settings 3 is not allowed: give the optimiser's settings as a table"),
     ({"seconds": -1}, "its seconds -1 is not allowed: allowed a number of seconds >= 0"),
 ])  # fmt: skip

@@ -115,7 +115,7 @@ def test_reproduce_all_says_set_applies_to_every_experiment(tmp_path, cli) -> No
     """Trial 30 (borderline): ``reproduce all --set episodes=2`` was refused as fig2's unknown setting, without saying that
     --set applies to every experiment of 'all'."""
     rc, out, err = cli("reproduce", "all", "--set", "episodes=2", "--store", str(tmp_path / "s.sqlite"))
-    assert (rc, out) == (2, "") and "unknown setting(s) episodes" in err, err
+    assert (rc, out) == (2, "") and "unknown setting(s) 'episodes'" in err, err
     assert err.rstrip().endswith("(--set applies to every experiment of 'all': give one NAME to set what only some have)"), err
     assert not (tmp_path / "s.sqlite").exists()
 

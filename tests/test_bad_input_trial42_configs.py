@@ -30,7 +30,7 @@ def test_a_mistake_in_settings_is_named_by_settings_not_a_scale(tmp_path, paper)
     with pytest.raises(NeurohoverError, match=r"mine\.toml', \[settings\], groups\[0\]: n_mdps = 0 is not allowed: expected an integer >= 1$"):
         load_config(groups, "quick")
     unknown = _config(tmp_path, base.replace("seed = 1", "seed = 1\nsed = 2"), paper)
-    with pytest.raises(NeurohoverError, match=r"mine\.toml', \[settings\]: unknown setting\(s\) sed; allowed: "):
+    with pytest.raises(NeurohoverError, match=r"mine\.toml', \[settings\]: unknown setting\(s\) 'sed'; allowed: "):
         load_config(unknown, "quick")
 
 

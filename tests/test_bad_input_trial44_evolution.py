@@ -123,7 +123,7 @@ SMALL = EonnSettings(pop_size=4, keep=3, generations=1, tournament_size=2)
         (("M", "baseline", SMALL), r"^prototype='baseline' is not allowed: give a Policy"),
         (("M", "P", 5), r"^settings=5 is not allowed: give an EonnSettings, a dict of its fields or None"),
         (("M", "P", {"pop_size": 4}), r"^bad eonn settings: keep=49 is out of range"),
-        (("M", "P", {"popsize": 4}), r"^unknown eonn setting\(s\) popsize: allowed pop_size, keep"),
+        (("M", "P", {"popsize": 4}), r"^unknown eonn setting\(s\) 'popsize': allowed pop_size, keep"),
     ],
 )
 def test_eonn_evolve_checks_its_mdp_prototype_and_settings(args: tuple, message: str) -> None:

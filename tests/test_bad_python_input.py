@@ -64,7 +64,7 @@ def test_a_typo_in_the_scale_not_run_is_refused_at_once(tmp_path) -> None:
     assert "[[scales.paper.groups]]" not in text  # the paper scale's groups come from [settings]
     bad = tmp_path / "fig7-typo.toml"
     bad.write_text(text.replace("[scales.paper]", '[scales.paper]\nagnet = "x"'))
-    with pytest.raises(NeurohoverError, match="at scale 'paper': unknown setting.s. agnet"):
+    with pytest.raises(NeurohoverError, match="at scale 'paper': unknown setting.s. 'agnet'"):
         load_config(str(bad), "quick")
     load_config("fig7", "quick")  # the shipped one loads
     titled = tmp_path / "mine.toml"  # sixth trial: title = 5 was stored, then called a damaged store's config

@@ -109,7 +109,7 @@ def test_an_agents_own_settings_reach_its_runs_and_are_checked(cli, tmp_path) ->
     rc, _, err = cli("compete", "--task", "ghh08", "--agent", "baseline", "--agent-setting", "level=3", "--runs", "1", "--out", str(tmp_path / "b"))
     assert rc == 2 and "agent 'baseline' takes no settings table of its own; agents that do:" in err and "continual" in err
     rc, _, err = cli("compete", "--task", "ghh08", "--agent", "continual", "--agent-setting", "cooldwn=3", "--runs", "1", "--out", str(tmp_path / "c"))
-    assert rc == 2 and "unknown ContinualSettings setting(s) cooldwn" in err
+    assert rc == 2 and "unknown ContinualSettings setting(s) 'cooldwn'" in err
     # Fifth trial: a setting the agent would ignore was accepted without a word.
     for agent, given, why in (
         ("hybrid-risk", ["trials=3"], "trials applies to model-free-risk only, not to hybrid-risk"),

@@ -161,7 +161,7 @@ def test_unknown_experiment_lists_the_known_ones(cli, tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     "edit, message",
     [
-        (lambda t: t.replace('target = "family"', 'target = "family"\nbudgett = 3'), "unknown setting(s) budgett"),
+        (lambda t: t.replace('target = "family"', 'target = "family"\nbudgett = 3'), "unknown setting(s) 'budgett'"),
         (lambda t: t.replace("runs = 12", 'runs = "twelve"'), "runs = 'twelve' is not allowed: expected an integer in 1..10000"),
         (lambda t: t.replace("runs = 12\n", ""), "missing required setting 'runs'"),
         (lambda t: t.replace('task = "fghh"', 'task = "ghh08"'), "sigma applies to task 'fghh' only"),

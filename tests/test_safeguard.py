@@ -181,7 +181,7 @@ def test_a_hybrid_group_takes_its_settings_under_the_name_every_agent_uses(tmp_p
         ("hybrid = { tilt = 1.5 }\n", "hybrid", "tilt=1.5 is out of range"),
         ("hybrid = { box = -1 }\n", "hybrid", "box=-1 is out of range"),
         ('hybrid = { replacement = "magic" }\n', "hybrid", "unknown hybrid replacement 'magic'"),
-        ('hybrid = { colour = "red" }\n', "hybrid", "unknown hybrid setting(s) colour"),
+        ('hybrid = { colour = "red" }\n', "hybrid", "unknown hybrid setting(s) 'colour'"),
         ('hybrid = { rule = "paper" }\n', "incremental", "hybrid settings apply to the agents hybrid, hybrid-baseline only"),
     ],
 )

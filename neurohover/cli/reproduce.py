@@ -228,9 +228,11 @@ def cmd_wins(args: argparse.Namespace) -> int:
     if len(runs) == 1:  # every compete experiment: "a competition needs at least two agents, got ['baseline']" (T34-A03)
         raise NeurohoverError(one_agent(args.name, scale, next(iter(runs)), comparable))
     for option, value in (("--agents", args.agents), ("--against", args.against)):  # '' entered every agent (second trial)
-        if value is not None and not all(value.split(",")):  # named alone: the other may not have been given (fifth trial)
+        if value is not None and not all(p.strip() for p in value.split(",")):  # named alone: the other may not have been given (fifth trial)
             raise NeurohoverError(f"{option} {value!r}: an agent's label is empty; allowed {', '.join(runs)}")
-    chosen = args.agents.split(",") if args.agents else list(runs)
+    # spaces around a label are no part of it (a group's label holds none), as --runs reads "1, 5": "a, b" was refused (T58-A02)
+    chosen = [a.strip() for a in args.agents.split(",")] if args.agents else list(runs)
+    args.against = args.against and args.against.strip()
     for label in [*chosen, *([args.against] if args.against else [])]:
         if label not in runs:
             raise NeurohoverError(f"agent {label!r} has no test runs in {args.name!r} ({scale}): allowed {', '.join(runs)}")

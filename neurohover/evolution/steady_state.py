@@ -200,6 +200,7 @@ def roulette_weights(returns: np.ndarray) -> np.ndarray:
     :data:`ROULETTE_ERROR_FLOOR` (slightly above 1) so that every finite
     return gets a finite positive weight; NaN / ``-inf`` returns get weight 0
     (never picked unless every weight is 0, in which case all get weight 1).
+    A ``+inf`` return is refused, as :meth:`SteadyStateNE.tell` refuses it.
 
     Parameters
     ----------
@@ -210,8 +211,14 @@ def roulette_weights(returns: np.ndarray) -> np.ndarray:
     -------
     np.ndarray
         Non-negative weights, same shape.
+
+    Raises
+    ------
+    NeurohoverError
+        ``returns`` that are no non-empty 1-D array of numbers, or hold ``+inf``.
     """
     r = as_returns(returns, "returns", "an array of returns (numbers)")
+    r = check_returns(r, r.size, "returns")  # +inf, the best return there is, got weight 0: never picked (T58-B06)
     w = np.where(np.isfinite(r), episode_fitness(r, "inv-log-error"), 0.0)
     if not np.count_nonzero(w):
         w = np.ones_like(r)

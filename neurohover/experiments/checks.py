@@ -2,7 +2,8 @@
 config that leaves it out resolves to, so the typed settings (:mod:`.settings`) are the one source of the config
 schema (:func:`schema_of`, read by :mod:`.schema`), of the defaults the planner reads and of the checks.
 
-A check is ``value -> (ok, what is allowed)``. What an absent setting resolves to: :data:`REQUIRED` (the config
+A check is ``value -> (ok, what is allowed)``, or ``(ok, what is allowed, the value as read)`` where a setting has one
+spelling of several (a task's name: :func:`task_family`). What an absent setting resolves to: :data:`REQUIRED` (the config
 must give it), :data:`OMIT` (a setting added later: absent from the resolved config unless given, so that older
 configs keep their hash; the field's default is what its absence means) or a value (written into the resolved
 config, and so into its hash).
@@ -20,7 +21,7 @@ from ..evolution.evolve import parse_resampling
 from ..evolution.races import RACE_RULES
 from ..models.model import MODEL_SUBSTEPS
 from ..sim.constants import MAX_EPISODE_STEPS
-from ..tasks import Drift, Sensor, task_names
+from ..tasks import Drift, Sensor, task_key, task_names
 
 REQUIRED = object()
 OMIT = object()  # default of a setting added later: absent from the resolved config unless given (older configs keep their hash)
@@ -100,7 +101,8 @@ def agent():
 def task_family():
     def check(v):
         names = task_names()  # the registry as it is, as agent() reads its own: run-time entries too (T46-B07)
-        return isinstance(v, str) and v in names, "one of " + ", ".join(repr(a) for a in names)
+        key = task_key(v) if isinstance(v, str) else v  # 'GHH08' is ghh08, as --task reads it, and is stored and hashed so (T58-A01)
+        return isinstance(key, str) and key in names, "one of " + ", ".join(repr(a) for a in names), key
 
     return check
 

@@ -3,7 +3,8 @@
 ``SCHEMAS[kind]`` maps each setting to ``(absent, check)``, read from the kind's typed settings class
 (:mod:`.settings`; :func:`~.checks.setting` declares each field): ``absent`` is ``REQUIRED`` (the config
 must give it), ``OMIT`` (a setting added later, absent from the resolved config unless given, so that
-older configs keep their hash) or a value; the check returns ``(ok, what is allowed)``; a
+older configs keep their hash) or a value; the check returns ``(ok, what is allowed)`` (and the value as read, where a
+setting has one spelling of several, as a task's name); a
 ``("list", SUB_SCHEMA)`` pair is a list of sub-tables (``[[variants]]``, ``[[groups]]``).
 :func:`validate_table` applies a schema, :func:`check_kind` the checks across settings.
 """
@@ -16,7 +17,7 @@ from typing import Any
 
 from ..agents.hybrid import HybridSettings
 from ..agents.registry import AGENTS, HYBRID_AGENTS, usable_agents
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, unknown_keys
 from ..evolution.config import make_settings, optimiser_of
 from ..evolution.evolve import parse_resampling
 from ..evolution.optimisers import optimiser_spec
@@ -56,10 +57,10 @@ ZERO_MEANS = dict.fromkeys(
 def validate_table(values: dict, schema: dict, where: str, *, given_only: bool = False) -> dict:
     """``values`` checked against ``schema``, with the defaults written in. ``given_only``: check the settings given and
     nothing else (no required setting missed, no defaults): a config's [settings] table, whose scale tables add the rest."""
-    unknown = sorted(set(values) - set(schema))
+    unknown = unknown_keys(values, schema)  # each key quoted: the key '' read "unknown setting(s) ; allowed" (T58-B03)
     if unknown:
-        hint = " (the optimizer table is spelled `optimizer`, as on the command line)" if "optimiser" in unknown else ""
-        raise NeurohoverError(f"{where}: unknown setting(s) {', '.join(unknown)}; allowed: {', '.join(sorted(schema))}{hint}")
+        hint = " (the optimizer table is spelled `optimizer`, as on the command line)" if "optimiser" in values and "optimiser" not in schema else ""
+        raise NeurohoverError(f"{where}: unknown setting(s) {unknown}; allowed: {', '.join(sorted(schema))}{hint}")
     out: dict[str, Any] = {}
     for key, (default, check) in schema.items():
         if key not in values:
@@ -80,11 +81,11 @@ def validate_table(values: dict, schema: dict, where: str, *, given_only: bool =
         if value is None and default is None:
             out[key] = None
             continue
-        ok, allowed = check(value)
+        ok, allowed, *read = check(value)
         if not ok:
             no_cap = ZERO_MEANS.get(key, "") if check(0)[0] else ""  # -1 for "unlimited" was refused without the way to say it (T21-14)
             raise NeurohoverError(f"{where}: {key} = {brief(value)} is not allowed: expected {allowed}{no_cap}")
-        out[key] = value
+        out[key] = read[0] if read else value  # the setting's one spelling, where its check reads one ('GHH08': ghh08; T58-A01)
     return out
 
 
