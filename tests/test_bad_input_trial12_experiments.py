@@ -28,12 +28,12 @@ ML_CONFIG = tiny_model_learning("ml1", "baseline") + "\n[paper]\n"
         ('table = { lr = { t = "abc" } }', "[paper] table.lr has no r_m or r_a: allowed r_m, r_a, t, sd (r_m and r_a required)"),
         ("table = { lr = { r_m = 1, r_a = 2, t = [1, 2] } }", "[paper] table.lr.t = [1, 2] is not allowed: give a finite number"),
         ('groups = { baseline = { crash_rate = "x" } }', "[paper] groups.baseline.crash_rate = 'x' is not allowed: give a rate in 0..1"),
-        ("table3 = { slp = { r = 1, x = 2 } }", "[paper] table3.slp has unknown number(s) x: allowed r, sd, r_G, sd_G, crashes_G"),
+        ("table3 = { slp = { r = 1, x = 2 } }", "[paper] table3.slp has unknown number(s) 'x': allowed r, sd, r_G, sd_G, crashes_G"),
         ("ttests = 5", "[paper] ttests = 5 is not allowed: give a list of tables with a, b and p"),
         ('ttests = "x"', "[paper] ttests = 'x' is not allowed: give a list of tables with a, b and p"),
         ("table = { lr = { r_m = 1, r_a = 2, t = inf } }", "[paper] table.lr.t = inf is not allowed: give a finite number"),
         ("table = { lr = { r_m = 1, r_a = 2, sd = 1e400 } }", "[paper] table.lr.sd = inf is not allowed: give a finite number"),
-        ('ttests = [{ a = "lr", b = "lr", p = "0.1", x = nan }]', "unknown [paper] ttests key(s) x in"),  # (T27-A05: before its value)
+        ('ttests = [{ a = "lr", b = "lr", p = "0.1", x = nan }]', "unknown [paper] ttests key(s) 'x' in"),  # (T27-A05: before its value)
     ],
 )
 def test_a_paper_table_of_the_wrong_shape_is_refused_before_reproduce_runs(tmp_path: Path, cli, paper: str, message: str) -> None:
@@ -67,10 +67,10 @@ def test_report_says_a_stored_paper_table_of_the_wrong_shape_and_writes_the_repo
         ({"paper": "x"}, "experiment 'mc1': [paper] = 'x' is not allowed: give a table (a dict) of notes, claims, ttests"),
         ({"title": 5}, "experiment 'mc1': title = 5 is not allowed: give text"),
         ({"paper": {"groups": {"baseline": {"crash_rate": float("inf")}}}}, "[paper] groups.baseline.crash_rate = inf is not allowed: give a rate"),
-        ({"paper": {"x": object()}}, "unknown [paper] key(s) x; allowed: notes, claims, ttests, groups, table, table3"),
+        ({"paper": {"x": object()}}, "unknown [paper] key(s) 'x'; allowed: notes, claims, ttests, groups, table, table3"),
         (
             {"paper": {"ttests": [{"a": "baseline", "b": "baseline", "p": "0.1", "w": {1}}]}},
-            "unknown [paper] ttests key(s) w in {'a': 'baseline', 'b': 'baseline', 'p': '0.1', 'w': {1}}; allowed: a, b, p",
+            "unknown [paper] ttests key(s) 'w' in {'a': 'baseline', 'b': 'baseline', 'p': '0.1', 'w': {1}}; allowed: a, b, p",
         ),
     ],
 )

@@ -173,7 +173,7 @@ def test_unknown_experiment_lists_the_known_ones(cli, tmp_path: Path) -> None:
         # issue 37: a name that escapes the report's folder, an unknown [paper] key, a paper test naming nothing
         (lambda t: t.replace('name = "slowtest"', 'name = "../../escaped"'), "name = '../../escaped' is not allowed"),
         (lambda t: t.replace('name = "slowtest"', 'name = ""'), "name = '' is not allowed"),
-        (lambda t: t + '\n[paper]\nnotez = ["x"]\n', "unknown [paper] key(s) notez; allowed: notes"),
+        (lambda t: t + '\n[paper]\nnotez = ["x"]\n', "unknown [paper] key(s) 'notez'; allowed: notes"),
         (lambda t: t + '\n[paper]\nttests = [{ a = "k1", b = "k9", p = "0.01" }]\n', "[paper] ttests names 'k9' (b)"),
         (lambda t: t + "\n[paper]\ntable3 = { k9 = { r = 1.0 } }\n", "[paper] table3 names 'k9', which is no group"),  # was never shown
         # second trial: a string of claims was reported letter by letter, a p-value of "banana" printed as the paper's

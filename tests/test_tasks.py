@@ -41,7 +41,7 @@ def test_an_evolution_target_records_what_the_family_is() -> None:
 @pytest.mark.parametrize(
     "bad, message",
     [
-        ({"family": "ghh08", "sigmaa": 0.3}, "unknown key(s) sigmaa"),
+        ({"family": "ghh08", "sigmaa": 0.3}, "unknown key(s) 'sigmaa'"),
         ({"sigma": 0.3}, "no family name"),
         ({"family": "ghh99"}, "unknown task 'ghh99'"),
         ({"family": "ghh08", "sigma": 0.3}, "sigma applies to the fghh task only"),

@@ -43,7 +43,7 @@ from pathlib import Path
 from typing import Any
 
 from ..compete_labels import COMPETE_SCALE
-from ..errors import NeurohoverError, brief
+from ..errors import NeurohoverError, brief, unknown_keys
 from ..jsontext import toml_odd_character, toml_twice
 from ..models.lr import LEGACY_NOISE_ESTIMATE
 from ..models.model import LEGACY_MODEL_SUBSTEPS
@@ -428,9 +428,9 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
         raise NeurohoverError(f"config {str(path)!r} cannot be read ({err.strerror or type(err).__name__})") from None
     where = f"config {str(path)!r}"
     allowed_top = {"name", "title", "kind", "paper_ref", "aliases", "settings", "scales", "paper"}
-    unknown = sorted(set(raw) - allowed_top)
+    unknown = unknown_keys(raw, allowed_top)  # each as its repr: the key '' was named as nothing
     if unknown:
-        raise NeurohoverError(f"{where}: unknown top-level key(s) {', '.join(unknown)}; allowed: {', '.join(sorted(allowed_top))}")
+        raise NeurohoverError(f"{where}: unknown top-level key(s) {unknown}; allowed: {', '.join(sorted(allowed_top))}")
     for key in ("name", "kind", "settings"):
         if key not in raw:
             raise NeurohoverError(f"{where}: missing top-level key {key!r}")

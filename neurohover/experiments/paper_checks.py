@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import unicodedata
 
-from ..errors import NeurohoverError, brief, finite_real
+from ..errors import NeurohoverError, brief, finite_real, unknown_keys
 
 #: The most characters of each one-line text of a config (the report writes each into one line or heading of Markdown;
 #: a 20,000-character title was taken, T28-A07): the shipped configs' longest are a third of these.
@@ -103,9 +103,8 @@ def check_paper_table(paper, where: str, kind: str | None = None) -> None:
     report section never shows (:data:`KIND_PAPER_KEYS`) is refused too (T28-A09)."""
     if not isinstance(paper, dict):
         raise NeurohoverError(f"{where}: [paper] = {brief(paper)} is not allowed: give a table (a dict) of {', '.join(PAPER_KEYS)}")
-    unknown = sorted(set(paper) - set(PAPER_KEYS), key=str)
-    if unknown:
-        named = ", ".join(brief(k) if not isinstance(k, str) or len(k) > 60 else k for k in unknown)
+    named = unknown_keys(paper, PAPER_KEYS)  # each as its repr: the key '' was named as nothing
+    if named:
         raise NeurohoverError(f"{where}: unknown [paper] key(s) {named}; allowed: {', '.join(PAPER_KEYS)}")
     for key in ("notes", "claims"):  # lists of sentences (a string here was reported letter by letter)
         value = paper.get(key, [])
@@ -119,9 +118,8 @@ def check_paper_table(paper, where: str, kind: str | None = None) -> None:
     for t in ttests:
         if not isinstance(t, dict) or not {"a", "b", "p"} <= set(t):
             raise NeurohoverError(f"{where}: each [paper] ttests entry needs a, b and p, got {brief(t)}")
-        unknown = sorted(set(t) - {"a", "b", "p"}, key=str)  # a misspelt extra key was dropped without a word (T27-A05)
-        if unknown:
-            named = ", ".join(brief(k) if not isinstance(k, str) or len(k) > 60 else k for k in unknown)
+        named = unknown_keys(t, {"a", "b", "p"})  # a misspelt extra key was dropped without a word (T27-A05)
+        if named:
             raise NeurohoverError(f"{where}: unknown [paper] ttests key(s) {named} in {brief(t)}; allowed: a, b, p")
         if not _paper_p(t["p"]):
             raise NeurohoverError(
@@ -154,10 +152,10 @@ def _check_paper_numbers(table, key: str, required: tuple[str, ...], optional: t
     for name, entry in table.items():
         if not isinstance(entry, dict):
             raise NeurohoverError(f"{where}: [paper] {key}.{name} = {brief(entry)} is not allowed: {shape}")
-        unknown = sorted(map(str, set(entry) - {*required, *optional}))
+        unknown = unknown_keys(entry, {*required, *optional})
         missing = [k for k in required if k not in entry]
         if unknown or missing:
-            what = f"unknown number(s) {', '.join(unknown)}" if unknown else f"no {' or '.join(missing)}"
+            what = f"unknown number(s) {unknown}" if unknown else f"no {' or '.join(missing)}"
             raise NeurohoverError(f"{where}: [paper] {key}.{name} has {what}: allowed {allowed}")
         for k, v in entry.items():
             if not finite_real(v) or (k == "crash_rate" and not 0 <= v <= 1) or (k == "crashes_G" and not (isinstance(v, int) and v >= 0)):

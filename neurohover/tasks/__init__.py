@@ -26,7 +26,7 @@ import importlib
 import pkgutil
 from types import MappingProxyType
 
-from ..errors import NeurohoverError, brief, finite_real, package_path, refuse_reloaded, registry_entry_problem
+from ..errors import NeurohoverError, brief, finite_real, package_path, refuse_reloaded, registry_entry_problem, unknown_keys
 from .base import COMPETITION_MDPS_FILE, MDP, N_TEST, N_TRAINING, TaskFamily, competition_rows, finite_vector
 from .drift import NO_DRIFT, Drift, refuse_drift
 from .family_checks import class_problem
@@ -160,9 +160,9 @@ def family_from_dict(d: dict) -> TaskFamily:
     d = dict(d)
     if "task" in d and "family" not in d:
         d["family"] = d.pop("task")
-    unknown = sorted(set(d) - set(FAMILY_KEYS))
+    unknown = unknown_keys(d, FAMILY_KEYS)  # each as its repr: the key '' was named as nothing
     if unknown or "family" not in d:
-        what = f"unknown key(s) {', '.join(unknown)}" if unknown else "no family name"
+        what = f"unknown key(s) {unknown}" if unknown else "no family name"
         raise NeurohoverError(f"task family table {d!r:.120}: {what}; allowed {', '.join(FAMILY_KEYS)} (family required)")
     sensor = None if d.get("sensor") is None else Sensor.from_dict(d["sensor"])
     drift = None if d.get("drift") is None else Drift.from_dict(d["drift"])

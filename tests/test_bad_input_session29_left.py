@@ -1,0 +1,47 @@
+"""What trial 58's fix of ``unknown_keys`` (T58-B01..B03) left in five checks that joined unknown keys by hand: a task
+family table, a [paper] table, its ttests entries and its numbers, and a config's top-level keys named the key ''
+as nothing ("unknown key(s) ; allowed ..."). Each now names it as its repr, ``''``."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from neurohover.errors import NeurohoverError
+from neurohover.experiments.config import load_config
+from neurohover.experiments.paper_checks import check_paper_table
+from neurohover.tasks import family_from_dict
+
+
+def _names_the_empty_key(fragment: str):
+    return pytest.raises(NeurohoverError, match=re.escape(fragment))
+
+
+def test_a_task_family_tables_empty_key_is_named() -> None:
+    with _names_the_empty_key("unknown key(s) ''; allowed family"):
+        family_from_dict({"family": "ghh08", "": 1})
+
+
+def test_a_paper_tables_empty_key_is_named() -> None:
+    with _names_the_empty_key("unknown [paper] key(s) ''; allowed"):
+        check_paper_table({"notes": [], "": 1}, "config 'x'")
+
+
+def test_a_paper_t_tests_empty_key_is_named() -> None:
+    with _names_the_empty_key("unknown [paper] ttests key(s) '' in"):
+        check_paper_table({"ttests": [{"a": "x", "b": "y", "p": "0.01", "": 1}]}, "config 'x'")
+
+
+def test_a_paper_numbers_empty_key_is_named() -> None:
+    with _names_the_empty_key("unknown number(s) ''"):
+        check_paper_table({"groups": {"baseline": {"mean": -1.0, "": 2.0}}}, "config 'x'")
+
+
+def test_a_configs_empty_top_level_key_is_named(tmp_path: Path) -> None:
+    shipped = (Path(__file__).parents[1] / "neurohover" / "experiments" / "configs" / "fig2.toml").read_text()
+    config = tmp_path / "mine.toml"
+    config.write_text('"" = 1\n' + shipped)
+    with _names_the_empty_key("unknown top-level key(s) ''; allowed"):
+        load_config(str(config), "quick")
