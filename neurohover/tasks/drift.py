@@ -263,6 +263,9 @@ class Drift:
                 if number == 0:  # 'walk=0' was flown as a drift that drifts nothing (eleventh trial, S3)
                     raise NeurohoverError(f"drift {part!r} changes nothing: {_NOTHING}")
                 walk = number
+            elif key.strip() not in PARAM_NAMES:  # 'WALK=0.01' was named only "not a dynamics parameter" (trial 59, side A)
+                named = f"{key.strip()!r:.40} is not walk and not a dynamics parameter"
+                raise NeurohoverError(f"drift {part!r:.60}: {named}; allowed walk=STD and {', '.join(PARAM_NAMES)}")
             else:
                 change[key.strip()] = number
         return cls(walk, tuple(change.items()), at)
