@@ -39,11 +39,19 @@ def levels(obj) -> dict[str, str | int]:
     return out
 
 
+def learns_models(group) -> bool:
+    """Whether a group's agent learns models: as its registered spec says, else as the store records it (check_kind
+    writes a noise estimate into every such group), so a store of a run-time agent this process has not registered is
+    reported too, as its results are exported (it was a KeyError traceback; T59-B03)."""
+    from ..agents.registry import usable_agents
+
+    spec = usable_agents().get(group.agent)
+    return spec.learns_models if spec is not None else group.noise is not None
+
+
 def varies(objs) -> bool:
     """Whether these fits, or the groups among these that learn models, differ in a factor (a factorial)."""
-    from ..agents.registry import AGENTS
-
-    learners = [o for o in objs if not hasattr(o, "agent") or AGENTS[o.agent].learns_models]
+    learners = [o for o in objs if not hasattr(o, "agent") or learns_models(o)]
     return len({tuple(sorted(levels(o).items())) for o in learners}) > 1
 
 
@@ -198,11 +206,9 @@ def test_run_effects(groups, runs: Callable[[str], Mapping[str, TestRunResult]])
     """Per agent of a test-runs experiment whose groups vary the LR fit: each factor's main effect on the
     runs' cumulative reward, paired by run (``runs(label)``: the group's runs by MDP and repetition; the
     groups of an agent fly the same seeds); Markdown and comparison lines."""
-    from ..agents.registry import AGENTS
-
     by_agent: dict[str, list] = {}
     for g in groups:
-        if AGENTS[g.agent].learns_models:
+        if learns_models(g):
             by_agent.setdefault(g.agent, []).append(g)
     text, lines = [], []
     for agent, gs in by_agent.items():
@@ -276,11 +282,9 @@ def test_run_figure(groups, runs: Callable[[str], list[TestRunResult]], title: s
     """One log-scale panel per agent whose groups vary the LR fit: each fit's mean cumulative error over
     episodes (colour: D_u and noise; dashed: the authors' model policy), the other groups as grey
     references, the legend below the panels. Returns the matplotlib figure, or None without data."""
-    from ..agents.registry import AGENTS
-
-    learners = [g for g in groups if AGENTS[g.agent].learns_models]
+    learners = [g for g in groups if learns_models(g)]
     agents = list(dict.fromkeys(g.agent for g in learners))
-    others = [g for g in groups if not AGENTS[g.agent].learns_models]
+    others = [g for g in groups if not learns_models(g)]
     if not agents or not any(runs(g.label) for g in groups):
         return None
     fig, axes = new_figure(len(agents), figsize=(5.5 * len(agents), 5.2))

@@ -29,6 +29,7 @@ def through_sensor(method, which: str, mdp_class: type):
             check_made(self, which, mdp, mdp_class)
             if which == "make":
                 check_made_label(self, mdp, kwargs.get("label", args[1] if len(args) > 1 else ""))
+                check_made_row(self, mdp, kwargs.get("params", args[0] if args else None))
                 check_made_bounds(self, mdp)
             if not self.sensor.exact:
                 mdp = mdp.with_sensor(self.sensor)
@@ -67,6 +68,25 @@ def check_made_label(family, mdp, label: object) -> None:
             f"{family.name} make()'s answer labelled {brief(mdp.label)} is not allowed: make(params, label={label!r}) must answer "
             f"an MDP of that label, neurohover.MDP({family.name!r}, ..., label=label)"
         )
+
+
+def check_made_row(family, mdp, params: object) -> None:
+    """Refuse an MDP that ``family.make(params)`` answered whose kernel row does not hold ``params`` at the family's
+    ``row_slice`` (:func:`row_layout_problem`): only rows() checked it, so a make that ignored its params flew
+    training_mdps, sample(), evaluate and HoverEnv at the default dynamics without a word (T59-B02). Checked at every
+    call where the params read one way only: a float64 array (every sampled and seeded MDP's) or plain Python numbers
+    (the competition's); a narrower float (np.float32(0.3): 0.3 or 0.30000001?) or a Fraction is make's own to read."""
+    plain = isinstance(params, (list, tuple)) and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in params)
+    if not (plain or (isinstance(params, np.ndarray) and params.dtype == np.float64)):
+        return
+    try:
+        probe = np.asarray(params, dtype=float).reshape(-1)
+    except (TypeError, ValueError, OverflowError):  # a ragged list, an int past float64: make took it its own way
+        return
+    if probe.shape == (family.n_params,):
+        problem = row_layout_problem(family, probe, mdp.row())
+        if problem:
+            raise NeurohoverError(problem)
 
 
 def check_made_bounds(family, mdp) -> None:
