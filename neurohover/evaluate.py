@@ -36,7 +36,8 @@ from .sim.constants import (
     return_floor,
 )
 from .sim.kernel import GENOME_WIDTH
-from .tasks import MDP, Sensor, check_rows, refuse_drift, refuse_unordered_mdps
+from .tasks import MDP, TASK_NAMES, Sensor, check_rows, refuse_drift, refuse_unordered_mdps
+from .tasks.held import LEARNED_MODEL
 
 # Re-exported where they were first defined: KernelFlyer, DEVICES, check_device, num_threads, use_lanes.
 __all__ = [
@@ -376,7 +377,8 @@ def evaluate_jobs(
         Only with ``fallback_index``: the dangerous-state test in the kernel's layout (:meth:`DangerousState.limits`): limits on |u|, |v|, |w|,
         |x|, |y|, |z|, |p|, |q|, |r|, the tilt threshold on qw (inf: none), the kind, the ratio-sum threshold and limits. Default: ``DangerousState()``.
     record : bool or array_like of bool, optional
-        Per job, whether to record its flight data; one bool (Python's or NumPy's) for every job. Default: none.
+        Per job, whether to record its flight data; one bool (Python's or NumPy's) for every job. Default: none. Their
+        metadata hold no ``mdps`` (:func:`evaluate` adds them): run_test hands them to agents, which must not see their MDP.
     n_steps : int
         Control steps per episode (6000 in the benchmark).
     threads : int, optional
@@ -474,6 +476,9 @@ def evaluate(
 
     Episode e on MDP m has episode index ``first_episode + m * episodes + e`` for every policy,
     so all policies meet the same gusts. ``device="cuda"`` flies them on a GPU (:func:`evaluate_jobs`).
+    With ``record=True`` the flight data's metadata hold each episode's MDP (``mdps``, as ``fly --record`` writes
+    them; none for MDP rows given as an array, or for MDPs of a family registered at run time, which a process without
+    it could not read back), so their crash flags are checked against their readings as fly's are.
     """
     table = policies if isinstance(policies, PolicyTable) else PolicyTable.from_policies(as_policies(policies))
     if len(table) == 0:  # an empty table returned an empty Evaluation, where [] is refused (T15-20)
@@ -512,4 +517,8 @@ def evaluate(
         threads=threads,
         device=device,
     )
+    if ev.flight_data is not None and not isinstance(mdps, np.ndarray):  # an edited crashed flag was taken without them (T59-B04)
+        flown = [mdps] if isinstance(mdps, MDP) else list(mdps)
+        if all(m.family in (*TASK_NAMES, LEARNED_MODEL) for m in flown):  # a run-time family's: unreadable where it is not registered
+            ev.flight_data.metadata["mdps"] = [flown[m].to_dict() for m in m_idx.ravel()]  # one table per episode, in job order
     return ev.reshape((n_pol, n_mdp, episodes))

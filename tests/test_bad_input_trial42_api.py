@@ -86,7 +86,7 @@ def test_a_safeguarded_recording_records_the_handover_and_ec_mer_refuses_it(tmp_
     handed = ev.safeguard_step.ravel().tolist()
     assert handed == [210, 210]
     fd = ev.flight_data
-    assert fd.metadata == {"episode_steps": 230, "crashed": [False, False], "safeguard_step": handed}
+    assert fd.metadata == {"episode_steps": 230, "crashed": [False, False], "safeguard_step": handed, "mdps": [MDP.to_dict()] * 2}  # mdps: T59-B04
     path = fd.save(tmp_path / "sg.npz")
     assert FlightData.load(path) == fd
     bad = nh.Policy("slp", nh.baseline_policy().genome * 3)
@@ -117,7 +117,7 @@ def test_a_recording_no_fallback_took_over_is_learnt_and_unflagged_ones_are_unch
     assert calm.metadata["safeguard_step"] == [-1, -1]
     b = nh.baseline_policy()
     plain = nh.evaluate(b, MDP, episodes=1, n_steps=20, record=True).flight_data
-    assert plain.metadata == {"episode_steps": 20, "crashed": [False]}
+    assert plain.metadata == {"episode_steps": 20, "crashed": [False], "mdps": [MDP.to_dict()]}  # mdps: T59-B04
     bad = nh.Policy("slp", b.genome * 3)
     assert learn_ec_mer(calm, bad, budget=10, seed=0).method == "ec-mer"
     handed = _safeguarded(arm_after=10, n_steps=20).flight_data

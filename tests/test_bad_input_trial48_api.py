@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import importlib
+import json
 import warnings
 from pathlib import Path
 
@@ -20,7 +21,7 @@ from neurohover.plots import attitude_angles, crashed_episode, flight_figure, pl
 
 def _flight(tmp_path: Path, sensor: nh.Sensor | None = None, huge: bool = False) -> FlightData:
     """A 5-step recording of the baseline (saved and loaded), its observations 1e300 if ``huge`` (a hand edit that
-    FlightData.load accepts: the file records no MDPs to bound its readings by)."""
+    FlightData.load accepts where the file records no MDPs to bound its readings by, as evaluate's did before T59-B04)."""
     family = nh.get_task_family("ghh08", sensor=sensor) if sensor else nh.get_task_family("ghh08")
     data = nh.evaluate(nh.baseline_policy(), family.training_mdps()[0], record=True, seed=2, n_steps=5).flight_data
     path = data.save(tmp_path / "f.npz")
@@ -28,6 +29,8 @@ def _flight(tmp_path: Path, sensor: nh.Sensor | None = None, huge: bool = False)
         with np.load(path) as z:
             arrays = {k: z[k] for k in z.files}
         arrays["observations"] = arrays["observations"] * 0 + 1e300
+        meta = json.loads(str(arrays["metadata"]))
+        arrays["metadata"] = np.array(json.dumps({k: v for k, v in meta.items() if k != "mdps"}))  # its MDP would refuse them
         np.savez(path, **arrays)
     return FlightData.load(path)
 

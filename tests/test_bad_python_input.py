@@ -616,7 +616,7 @@ def test_the_sixth_trials_severe_cases(tmp_path) -> None:
             member = io.BytesIO()
             np.save(member, value)
             archive.writestr(f"{key}.npy", header.getvalue() if key == "observations" else member.getvalue())
-    with pytest.raises(NeurohoverError, match="declares arrays of 9,600,000,000,944 bytes: more than half the memory free now"):
+    with pytest.raises(NeurohoverError, match=r"declares arrays of 9,600,000,00\d,\d{3} bytes: more than half the memory free now"):  # + metadata
         FlightData.load(tmp_path / "bomb.npz")
     with zipfile.ZipFile(tmp_path / "deflated.npz", "w", zipfile.ZIP_DEFLATED) as archive:
         for key, value in arrays.items():

@@ -24,13 +24,13 @@ rates          rad/s    std of the noise on p, q, r, 0..100
 attitude       1        std of the noise on the quaternion's qx, qy, qz, 0..100
 correlation    1        AR(1) coefficient rho of the noise, 0 <= rho < 1
 delay          steps    control steps (0.1 s each) the readings arrive late, 0..10
-dropout        1        probability that a reading is lost (the last one held), 0 <= p < 1
+dropout        1        probability that a reading is lost (the last one held), 0 or 2**-52 <= p < 1
 =============  =======  ==========================================================
 
 A noise *level* L is the profile ``L * (0.1 m/s, 0.1 m, 0.1 rad/s, 0.01)``: at level 1 each
 entry's noise is about the size of the baseline policy's typical hovering error on it. A std above 0 but
 below 2**-52 (``MIN_STD``, drift's smallest walk) changes no reading and is refused, as is a level whose
-attitude std falls below it (``MIN_LEVEL``).
+attitude std falls below it (``MIN_LEVEL``) and a dropout above 0 but below 2**-52 (``MIN_DROPOUT``).
 """
 
 from __future__ import annotations
@@ -68,6 +68,9 @@ MAX_LEVEL = MAX_STD / max(LEVEL_PROFILE)
 MIN_STD = MIN_NOISE
 MIN_LEVEL = MIN_STD / min(LEVEL_PROFILE)
 _TOO_SMALL = "too small to change a reading (below 2**-52)"
+#: The smallest dropout but 0 (none), 2**-52 as the stds': a reading is lost where Phi(z') < p, z' a 13th normal drawn each step
+#: for any p > 0, so below it under 2e-4 of a reading is lost in the 10**12 steps a call may fly, yet z' shifts all later noise (T59-B01).
+MIN_DROPOUT = MIN_NOISE
 
 
 def _is_number(text: str) -> bool:
@@ -116,7 +119,11 @@ class Sensor:
             raise NeurohoverError(f"sensor dropout={brief(p)} is not a number: allowed a probability 0 <= dropout < 1")
         if not finite_real(p) or not 0 <= p < 1:  # NaN fails the comparison too; np.timedelta64 is no number (T17-1)
             raise NeurohoverError(f"sensor dropout={brief(p)} is out of range: allowed a probability 0 <= dropout < 1")
-        object.__setattr__(self, "dropout", setting_float(p))
+        p = setting_float(p)  # np.float32 as the decimal it prints as, compared and kept (T56-B03)
+        if 0 < p < MIN_DROPOUT:  # every path (from_dict, parse, from_row_values, MDP rows) builds a Sensor here (T59-B01)
+            allowed = f"allowed 0 (none) or a probability {lowest_allowed(MIN_DROPOUT)} <= dropout < 1"
+            raise NeurohoverError(f"sensor dropout={brief(self.dropout)} is out of range, too small to lose a reading in practice (below 2**-52): {allowed}")
+        object.__setattr__(self, "dropout", p)
         # T24-11: whole_in, so 1.5 or True "is not allowed" (a type) and -1 "is out of range"; both said out of range
         delay = whole_in(self.delay, "sensor delay", 0, MAX_SENSOR_DELAY, f"{MAX_SENSOR_DELAY} (control steps)")
         object.__setattr__(self, "delay", delay)  # a NumPy integer as the int it is
