@@ -55,7 +55,7 @@ def test_a03_the_verdict_of_a_paper_p_under_005_holds() -> None:
 def test_a05_an_unknown_key_in_a_t_test_is_refused(tmp_path: Path, extra: str) -> None:
     text = _ttests(f'{{ a = "model-free", b = "baseline", p = "0.01", {extra} }}')
     key = extra.split()[0]
-    with pytest.raises(NeurohoverError, match=rf"unknown \[paper\] ttests key\(s\) {key} in .*; allowed: a, b, p$"):
+    with pytest.raises(NeurohoverError, match=rf"unknown \[paper\] ttests key\(s\) '{key}' in .*; allowed: a, b, p$"):
         load_config(str(_config(tmp_path, text)), "quick")
 
 
