@@ -121,6 +121,7 @@ def check_agent_settings(agent: str, values: Mapping[str, object], n_steps: int 
     agent that ``neurohover settings`` lists settings for takes them here, but the hybrid agents, whose settings are
     the ``hybrid`` argument (the --safeguard-*/--hybrid-* options). ``n_steps``: the episode length they must act in."""
     from .agents.registry import agent_spec
+    from .agents.spec import unused_reason
 
     spec = agent_spec(agent)
     if not isinstance(values, Mapping):  # None was dict()'s TypeError (T43-B15)
@@ -130,7 +131,7 @@ def check_agent_settings(agent: str, values: Mapping[str, object], n_steps: int 
         hybrid = " (its settings, `neurohover settings hybrid`, are the --safeguard-*/--hybrid-* options, hybrid= in Python)" if spec.settings else ""
         raise NeurohoverError(f"agent {agent!r} takes no settings table of its own{hybrid}; agents that do: {', '.join(agents_with_settings())}")
     checked = spec.settings.from_dict(dict(values))
-    why = spec.settings.unused(agent, dict(values))
+    why = unused_reason(spec.settings, agent, dict(values))  # its answer checked (T60-B06)
     if why is not None:
         raise NeurohoverError(f"agent {agent!r}: {why}")
     if n_steps is not None:  # before any run: continual's safeguard_after past the episode would never test (twelfth trial, S3)
@@ -263,7 +264,7 @@ def compete(
     jobs : int
         Local worker processes.
     store : path, optional
-        Results store (default ``out/results.sqlite``); finished runs in it are not flown again.
+        Results store (default ``out/results.sqlite``; not a file compete writes in ``out``); finished runs in it are not flown again.
     hybrid : HybridSettings or mapping
         The hybrid agents' safeguard and replacement rule (or a dict of its ``to_dict`` keys); refused for other agents.
     on_result : callable, optional
@@ -314,7 +315,7 @@ def compete(
     out = output_dir(out, "out")  # made once every setting is checked (None was a TypeError, /dev/full a FileExistsError)
     with sole_competition(out):
         store_path = store_path or out / STORE_FILE
-        refuse_other_files(out)
+        refuse_other_files(out, store_path)
         _refuse_other_settings(config, store_path)
         note_replaced(out / "summary.json", task, agent, config.scale)
         ordered = _run_into_store(config, store_path, out / "episodes.csv", jobs=jobs, device=device, progress=progress, on_result=on_result)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 import sys
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
@@ -15,8 +16,8 @@ from .compete_files import CSV_COLUMNS  # the columns plot --compete reads, each
 from .errors import NeurohoverError, brief
 
 __all__ = [
-    "LOCK_FILE", "OWN_FILES", "episode_rows", "held_competition", "note_replaced", "refuse_other_files", "sole_competition",
-    "write_episodes", "write_partial", "write_summary",
+    "LOCK_FILE", "OUT_FILES", "OWN_FILES", "episode_rows", "held_competition", "note_replaced", "refuse_other_files", "refuse_store_in_out",
+    "sole_competition", "write_episodes", "write_partial", "write_summary",
 ]  # fmt: skip
 
 
@@ -73,15 +74,46 @@ def write_summary(path: Path, summary: dict) -> None:
 OWN_FILES = {"summary.json": "a competition summary (summary.json)", "episodes.csv": "a competition's episodes (episodes.csv)"}
 
 
-def refuse_other_files(out: Path) -> None:
-    """Refuse an output directory whose summary.json or episodes.csv is not a competition's, naming what it is, before
-    any run: flight data, a model or a policy file there was replaced without a word (T26-A06). An empty file is
-    replaced (nothing is lost), and so is an older competition's summary (its task and agent, which
-    :func:`note_replaced` names); a file no neurohover command wrote is refused too (it may be anyone's). So is a
-    cumulative.png the plot would not replace, as the plot checks it (it was checked once every run flew; T50-A05)."""
+#: Every file compete writes in its output directory (its runs' files and its lock), none of which a store may be.
+OUT_FILES = (*OWN_FILES, "cumulative.png", LOCK_FILE)
+
+
+def refuse_store_in_out(out: Path, store: Path) -> None:
+    """Refuse a results ``store`` that is one of :data:`OUT_FILES` in ``out``, or whose lock file is (its paths resolved:
+    './', symbolic and hard links): compete wrote its summary.json or episodes.csv over the store it had just filled,
+    and its runs were lost (T60-A01); an existing store there is refused the same way, before anything is written."""
+    from .filekinds import STORE_ENDS
+
+    real = os.path.realpath(store)
+    for name in OUT_FILES:
+        mine = out / name
+        for end in ("", *STORE_ENDS):  # STORE.lock is written beside it: a store 'OUT/.compete' locked compete's lock
+            if not _same_file(real + end, mine):
+                continue
+            what = "is" if not end else f"has its {end} file at"
+            harm = "writing it would destroy the store and its runs" if not end else f"the store's {end} file and compete's {name} would be one"
+            raise NeurohoverError(
+                f"store {brief(str(store))} {what} {name} in the output directory {brief(str(out))}, one of the files compete "
+                f"writes there itself ({', '.join(OUT_FILES)}): {harm}; give the store another path"
+            )
+
+
+def _same_file(a: str, b: Path) -> bool:
+    """Whether the paths ``a`` and ``b`` name one file, existing or not: the same once resolved, or hard links."""
+    return a == os.path.realpath(b) or (os.path.exists(a) and os.path.exists(b) and os.path.samefile(a, b))
+
+
+def refuse_other_files(out: Path, store: Path) -> None:
+    """Refuse a ``store`` among compete's own files in ``out`` (:func:`refuse_store_in_out`), and an output directory
+    whose summary.json or episodes.csv is not a competition's, naming what it is, before any run: flight data, a model
+    or a policy file there was replaced without a word (T26-A06). An empty file is replaced (nothing is lost), and so is
+    an older competition's summary (its task and agent, which :func:`note_replaced` names); a file no neurohover command
+    wrote is refused too (it may be anyone's). So is a cumulative.png the plot would not replace, as the plot checks it
+    (it was checked once every run flew; T50-A05)."""
     from .filekinds import PNG_KIND, held_kind
     from .paths import output_file, refuse_foreign_output, refuse_special_file
 
+    refuse_store_in_out(out, store)  # first: a store there is named as the store, whatever else it is (T60-A01)
     for name, own in OWN_FILES.items():
         path = out / name
         refuse_special_file(path, "--out", instead="move it away or give another output directory")  # a FIFO hung it (T28-A08)

@@ -37,11 +37,13 @@ def tiny_test_runs(*agents: str, name: str = "tr1", settings: str = "") -> str:
 
 def tiny_model_learning(name: str, generic: str) -> str:
     """A model-learning config (TOML) learning LR on one GHH-08 test MDP, 20 steps and budgets of 10 at the quick scale,
-    its generic policy ``generic`` ("baseline", or "evolve": its own policy/ units first)."""
+    its generic policy ``generic`` ("baseline", or "evolve": its own policy/ units first). It gives only the budgets its
+    units use: an EC method's budget, or generic_budget without generic = "evolve", is refused (T60-A02)."""
+    generic_budget = "generic_budget = 10\n" if generic == "evolve" else ""
     return (
         f'name = "{name}"\nkind = "model_learning"\n\n[settings]\ntask = "ghh08"\nseed = 1\nmdps = "test"\nmethods = ["lr"]\n'
         f'generic = "{generic}"\npolicy_prototype = "generic"\ntest_episodes = 1\n\n[scales.quick]\nn_mdps = 1\nn_steps = 20\n'
-        "generic_budget = 10\nmodel_budget = 10\nec_meno_budget = 10\npolicy_budget = 10\n"
+        f"{generic_budget}policy_budget = 10\n"
     )
 
 

@@ -53,7 +53,6 @@ key = "b"
 [scales.quick]
 n_mdps = 1
 n_steps = 20
-model_budget = 10
 policy_budget = 10
 """
 

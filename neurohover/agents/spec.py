@@ -81,9 +81,24 @@ class AgentSettings:
 
     @classmethod
     def unused(cls, agent: str, given: dict) -> str | None:
-        """Why one of the ``given`` settings would do nothing for ``agent`` (refused rather than ignored), or None; a setting
-        given at its default says nothing (a table written whole, as compete's, names every one)."""
+        """Why one of the ``given`` settings would do nothing for ``agent`` (refused rather than ignored): a non-empty
+        one-line text, or None; a setting given at its default says nothing (a table written whole, as compete's, names
+        every one). Its callers read it through :func:`unused_reason`, which checks the answer."""
         return None
+
+
+def unused_reason(settings: type[AgentSettings], agent: str, given: dict) -> str | None:
+    """``settings.unused(agent, given)``, the settings class's reason why one of the ``given`` settings would do nothing
+    for ``agent``, or None; any other answer than None or a non-empty printable one-line text is refused (a
+    NeurohoverError naming the agent, the method and the answer): '', True or 5 became a refusal of the settings that
+    gave no reason, "agent 'a': " (T60-B06). The one call of it, for compete's table and an experiment group's."""
+    why = settings.unused(agent, given)
+    if why is None or (isinstance(why, str) and why.strip() and why.isprintable()):
+        return why
+    raise NeurohoverError(
+        f"agent {agent!r}: its settings class {settings.__name__}'s unused() answered {type(why).__name__} {brief(why)}, which is not allowed: "
+        "unused(agent, given) answers None (every setting given does something) or a non-empty one-line text saying why one would do nothing"
+    )
 
 
 @dataclass(frozen=True)

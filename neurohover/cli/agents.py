@@ -43,9 +43,10 @@ def cmd_build_policies(args: argparse.Namespace) -> int:
 
 def _named_out(err: NeurohoverError) -> NeurohoverError:
     """``err`` of compete(), naming its directory as the command's --out where it names the API's parameter ``out`` (its
-    path follows, as repr() or brief() shows it: a dangling link as --out said "out 'd6' is a symbolic link"; trial 45)."""
+    path follows, as repr() or brief() shows it: a dangling link as --out said "out 'd6' is a symbolic link"; trial 45),
+    and its store as --store where it names ``store`` (a store among compete's own files in --out; T60-A01)."""
     said = str(err)
-    if said.startswith(("out '", 'out "')):
+    if said.startswith(("out '", 'out "', "store '", 'store "')):
         err.args = ("--" + said, *err.args[1:])
     return err
 

@@ -50,7 +50,7 @@ from ..models.model import LEGACY_MODEL_SUBSTEPS
 from .canonical import canonical_settings
 from .paper_checks import check_paper, check_paper_table, check_texts, control_character
 from .readonly import read_only
-from .schema import SCHEMAS, check_given, check_kind, check_used, validate_table
+from .schema import SCHEMAS, check_given, check_kind, check_used, switched_settings, validate_table
 from .settings import ExperimentSettings, typed_settings
 
 CONFIG_DIR = Path(__file__).parent / "configs"
@@ -453,8 +453,8 @@ def load_config(name_or_path: str, scale: str, overrides: dict[str, Any] | None 
         raise NeurohoverError(f"{where}: has no [scales.{scale}] table")
     _check_shared(raw["settings"], scales, scale, overrides or {}, kind, where)
     merged = {**raw["settings"], **scales[scale], **(overrides or {})}
-    # the file's own settings where --set switched the policies source (its policy-evolution settings stay accepted)
-    switched = frozenset({*raw["settings"], *scales[scale]} - set(overrides or {})) if "policies" in (overrides or {}) else frozenset()
+    # the file's own settings whose source --set switched (policies, generic, methods): they stay accepted (T60-A02)
+    switched = switched_settings({*raw["settings"], *scales[scale]}, overrides or {})
     config = make_config(
         raw["name"],
         kind,
@@ -544,7 +544,7 @@ def make_config(
 
     The one path from settings to a config: shipped TOML files (:func:`load_config`) and inline
     experiments (``neurohover compete``) both come through here. ``switched``: the settings a config file gives where
-    ``--set policies=...`` switched its policies source (:func:`~.schema.check_used` accepts their policy-evolution ones).
+    ``--set`` switched the source they apply to (:func:`~.schema.switched_settings`; :func:`~.schema.check_used` accepts them).
     """
     where = where or f"experiment {name!r}"
     check_name(name, where)

@@ -13,10 +13,12 @@ from __future__ import annotations
 
 import json
 import re
+from collections.abc import Collection
 from typing import Any
 
 from ..agents.hybrid import HybridSettings
 from ..agents.registry import AGENTS, HYBRID_AGENTS, usable_agents
+from ..agents.spec import unused_reason
 from ..errors import NeurohoverError, brief, unknown_keys
 from ..evolution.config import make_settings, optimiser_of
 from ..evolution.evolve import parse_resampling
@@ -145,19 +147,44 @@ def _idle(written: dict, schema: dict, keys: tuple[str, ...], applies: bool, who
 #: command line leaves the config file's own standing (one config serves both sources, :func:`check_used`).
 POLICY_EVOLUTION_SETTINGS = ("policy_budget", "generic_budget", "generic_resampling", "generics_per_agent", "safety_episodes")
 
+#: A model-learning experiment's settings read by one of its methods only (:func:`~.units.run_model`; T60-A02).
+METHOD_SETTINGS = {"ec-mer": ("model_budget", "ec_mer_episodes"), "ec-meno": ("ec_meno_budget",)}
+
+#: The settings a source switched by --set leaves a config file's own standing (one config serves each source, as
+#: ``--set 'generic="shipped"'`` does table4's: :func:`switched_settings`): the test-runs policies' evolution settings, a
+#: model-learning experiment's generic_budget and its methods' own settings.
+SWITCHED_BY: dict[str, tuple[str, ...]] = {
+    "policies": POLICY_EVOLUTION_SETTINGS,
+    "generic": ("generic_budget",),
+    "methods": tuple(k for keys in METHOD_SETTINGS.values() for k in keys),
+}
+
+
+def switched_settings(own: Collection[str], overrides: dict) -> frozenset[str]:
+    """The settings of ``own`` (those a config file gives) whose source (:data:`SWITCHED_BY`) the ``overrides`` (--set)
+    switch and do not give themselves: :func:`check_used` accepts them where no unit uses them."""
+    return frozenset(k for source, keys in SWITCHED_BY.items() if source in overrides for k in keys if k in own and k not in overrides)
+
 
 def check_used(written: dict, settings: dict, kind: str, where: str, switched: frozenset[str] = frozenset()) -> None:
     """Refuse an experiment-wide setting given (``written``: as written; ``settings``: resolved) that no unit of the
     config uses, as a group's model options on agents that learn none are (T26-A02, T26-A04): it changed the config's hash
     for nothing, so a store made without it refused the command, and --update ran every unit again. ``switched``: the
-    policy-evolution settings the config file gives where --set switched its policies source (accepted)."""
+    settings the config file gives where --set switched the source they apply to (:func:`switched_settings`; accepted)."""
     schema = SCHEMAS[kind]
+    switchable = {k for keys in SWITCHED_BY.values() for k in keys}
+    written = {k: v for k, v in written.items() if k not in switched or k not in switchable}
     if kind == "evolution":
         robust = bool(settings["robustness_variants"]) or "robustness_policies" in settings
         _idle(written, schema, ("robustness_episodes",), robust, "Table 3's robustness units (robustness_variants, or robustness_policies)", where)
     if kind == "model_learning":  # read only by the fits with model_policy = 'authors', yet part of the hash (T54-A01)
         authors = any(f["model_policy"] == "authors" for f in settings.get("fits", ()))
         _idle(written, schema, ("authors_generations",), authors, "the fits with model_policy = 'authors'", where)
+        methods = settings["methods"]  # each budget is read by its own method only, yet part of the hash (T60-A02)
+        for method, keys in METHOD_SETTINGS.items():
+            _idle(written, schema, keys, method in methods, f"the method {method!r} (methods = {brief(methods)})", where)
+        generic = f"the generic policy an experiment evolves itself (generic = 'evolve', and this config's generic is {brief(settings['generic'])})"
+        _idle(written, schema, ("generic_budget",), settings["generic"] == "evolve", generic, where)
     if kind != "test_runs":
         return
     groups, task = settings["groups"], settings["task"]
@@ -169,7 +196,6 @@ def check_used(written: dict, settings: dict, kind: str, where: str, switched: f
     fghh = family_class(task).generic_over_distribution
     needs = {n for g in groups for n in AGENTS[g["agent"]].needs} | {AGENTS[g["agent"]].generic_kind for g in groups if fghh}
     evolved = (needs - set(settings.get("generics_from") or {})) if settings["policies"] == "evolve" else set()
-    written = {k: v for k, v in written.items() if k not in switched or k not in POLICY_EVOLUTION_SETTINGS}
     source = "policies = 'evolve'" + (f", and this config's policies are {brief(settings['policies'])}" if settings["policies"] != "evolve" else "")
     generics = "the FGHH generics an experiment evolves itself"
     safe = "the safe pair an experiment chooses among the specialised policies it evolves"
@@ -392,7 +418,7 @@ def _check_test_runs(settings: dict, task: str, where: str) -> None:
                 g["settings"] = checked.to_dict()
             except NeurohoverError as e:
                 raise NeurohoverError(f"{where}: group {g['label']!r}: {e}") from None
-            why = own.unused(g["agent"], given)
+            why = unused_reason(own, g["agent"], given)  # its answer checked (T60-B06)
             if why is not None:  # a setting the agent would ignore (fifth trial)
                 raise NeurohoverError(f"{where}: group {g['label']!r}: {why}")
     for kind, source in settings.get("generics_from", {}).items():

@@ -168,15 +168,11 @@ def _parts_problem(entry: str, spec: OptimiserSpec) -> str:
         return (
             f"{entry}: its settings {brief(cls)} is no frozen dataclass class: give the frozen dataclass of its settings, with defaults (not an object of it)"
         )
-    defaults = settings_defaults_problem(cls)  # a field without one, or NaN or 'x' for an int: the agents' check too (T56-B01)
+    # a field without one, NaN or 'x' for an int (T56-B01), or no plain JSON value whatever the field's type (T60-B02):
+    # the agents' check too, the one check of defaults
+    defaults = settings_defaults_problem(cls)
     if defaults:
         return f"{entry}: its settings {defaults}"
-    for field in dataclasses.fields(cls):
-        if field.default is not dataclasses.MISSING and not _plain_json(field.default):
-            return (
-                f"{entry}: its settings field {field.name!r}'s default is {type(field.default).__name__} {brief(field.default)}, no plain JSON value: "
-                "give plain JSON values (bool, int, float, text, None, lists of them), which a run records in its config (a NumPy scalar as its .item())"
-            )
     if not isinstance(spec.stops_itself, (bool, np.bool_)):
         return f"{entry}: its stops_itself {brief(spec.stops_itself)} is no bool: give True (its stop() can end a run) or False (it needs a budget)"
     reason = spec.stop_reason
@@ -186,14 +182,6 @@ def _parts_problem(entry: str, spec: OptimiserSpec) -> str:
             "other than 'budget' (a run's stop by its budget)"
         )
     return ""
-
-
-def _plain_json(value: object) -> bool:
-    """Whether ``value`` is a plain JSON value: None, a bool, int, float or text, or a list of them (a subclass, as
-    NumPy's scalars are, is not: JSON cannot write np.float32)."""
-    if isinstance(value, list):
-        return all(_plain_json(item) for item in value)
-    return value is None or type(value) in (bool, int, float, str)
 
 
 def optimiser_spec(name: str) -> OptimiserSpec:
