@@ -77,7 +77,7 @@ def test_a_baseline_competition_stored_with_the_sets_digest_is_taken_and_relabel
 
     argv = ["compete", "--task", "ghh08", "--agent", "baseline", "--runs", "1", "--episodes", "2", "--episode-steps", "20", "--out", str(tmp_path / "c")]
     with monkeypatch.context() as m:  # as neurohover hashed it before T35-A02: every named set
-        m.setattr(external, "_flies_set", lambda kind, settings: True)
+        m.setattr(external, "_flies_set", lambda kind, settings, unregistered=None: True)
         assert cli(*argv)[0] == 0
     with Store(tmp_path / "c" / "results.sqlite") as db:
         ((name, scale, *_),) = db.experiments()

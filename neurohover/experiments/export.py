@@ -16,8 +16,11 @@ from __future__ import annotations
 import csv
 import io
 import json
+from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any
 
+from ..agents.spec import FGHH_GENERIC_KINDS
 from ..errors import NeurohoverError, brief, first_difference
 from .config import ExperimentConfig
 from .external import external_digest
@@ -26,8 +29,11 @@ from .plans import Plan, plan, run_keys, source_results
 from .put_checks import key_shape_problem
 from .result_checks import identity_problem, params_problem
 from .results import UnitResult, flat_cells, result_from_dict
+from .settings import TestRunsSettings
 from .store import Store
 from .store_checks import hash_problem, read_config, unit_seconds_problem
+from .stored_agents import StoredAgent, UnregisteredAgentError, agent_runs, stored_agents
+from .units import family_of
 
 FORMATS = ("csv", "json")
 
@@ -95,14 +101,47 @@ def _check_key(config: ExperimentConfig, unit: dict) -> None:
         raise NeurohoverError(problem)  # the caller names the unit
 
 
-def _replannable(config: ExperimentConfig) -> bool:
+def _replannable(config: ExperimentConfig, unregistered: Mapping[str, StoredAgent]) -> bool:
     """Whether ``config``'s plan can be made again as its units were: the policies it reads from outside the store (the
     shipped set, a directory) digest as they did when it was stored. A policy directory since removed or changed (the
-    paper-scale fig16-authors-generics reads 'dir:AUTHORS/...') leaves its units checked by key, kind and result alone."""
+    paper-scale fig16-authors-generics reads 'dir:AUTHORS/...') leaves its units checked by key, kind and result alone.
+    Agents this process has not registered come as their stored runs show them (``unregistered``): their "unknown agent"
+    was taken for a directory gone, and the check skipped (T60-B04). Whether they fly the set is then taken either way,
+    as runs of none show nothing of it (an agent that needs specialised policies flies none on FGHH)."""
+    flies = (None, True) if unregistered else (None,)
     try:
-        return external_digest(config.kind, config.settings) == config.external_digest
+        return config.external_digest in {external_digest(config.kind, config.settings, unregistered, f) for f in flies}
     except NeurohoverError:  # the directory is gone
         return False
+
+
+def _as_stored(params: dict) -> dict:
+    """A planned unit's params as the store writes them (tuples as lists)."""
+    return json.loads(json.dumps(params))
+
+
+def stored_plan(
+    config: ExperimentConfig, units: list[dict], sources: dict[str, dict] | None = None, unregistered: Mapping[str, StoredAgent] | None = None
+) -> Plan:
+    """:func:`~.plans.plan` of a stored ``config`` and its stored ``units`` (:meth:`Store.units`' dicts; ``sources``: as
+    plan takes them), its agents this process has not registered planned as those units show them (``unregistered``;
+    None: :func:`~.stored_agents.stored_agents`): one that flies a generic on a family of generics by kind flies the kind
+    whose plan gives most of its stored runs their policies (T60-B04)."""
+    unregistered = stored_agents(config, units) if unregistered is None else unregistered
+    results = {u["key"]: u["result"] for u in units}
+    s = config.typed
+    open_kind = [a for a in unregistered.values() if "generic" in a.needs and a.generic_kind is None]
+    if open_kind and isinstance(s, TestRunsSettings) and family_of(s.task, s.sigma, s.sensor).generic_over_distribution:
+        best: dict[str, tuple[int, str]] = {}
+        for kind, _ in FGHH_GENERIC_KINDS:
+            made = plan(config, results, sources, {**unregistered, **{a.name: replace(a, generic_kind=kind) for a in open_kind}})
+            planned = {u.key: _as_stored(u.params).get("policies") for u in made.units}
+            for a in open_kind:
+                found = sum(planned.get(u["key"]) == u["params"]["policies"] for u in agent_runs(units, a.name))
+                if a.name not in best or found > best[a.name][0]:
+                    best[a.name] = (found, kind)
+        unregistered = {**unregistered, **{a.name: replace(a, generic_kind=best[a.name][1]) for a in open_kind}}
+    return plan(config, results, sources, unregistered)
 
 
 def _stray_text(key: str, more: str, units: list[dict], planned: dict) -> str:
@@ -131,12 +170,13 @@ def _check_planned(store: Store, config: ExperimentConfig, units: list[dict]) ->
     those the config plans for its key: reproduce refused both (seventh, eighth trial) while results and report exported
     a unit whose seed was edited in the store (T21-02). The plan is made from every stored unit (a later stage is planned
     from earlier results); a test run planned only once its policies are stored is checked by its key alone. A
-    'diagnostic' unit (the tests' own plans) is not planned by any config. Returns the plan (None where none was made)."""
+    'diagnostic' unit (the tests' own plans) is not planned by any config. An agent this process has not registered is
+    planned as its stored runs show it (:func:`stored_plan`; T60-B04). Returns the plan (None where none was made)."""
     checked = [u for u in units if u["kind"] != "diagnostic"]
-    if not checked or not _replannable(config):
+    unregistered = stored_agents(config, units)
+    if not checked or not _replannable(config, unregistered):
         return None
-    sources = source_results(config, store)
-    made = plan(config, {u["key"]: u["result"] for u in units}, sources)
+    made = stored_plan(config, units, source_results(config, store), unregistered)
     planned = {u.key: u for u in made.units}
     known = set(planned) | set(run_keys(config))
     stray = sorted(u["key"] for u in checked if u["key"] not in known)
@@ -147,7 +187,7 @@ def _check_planned(store: Store, config: ExperimentConfig, units: list[dict]) ->
         p = planned.get(u["key"])
         if p is None:
             continue
-        want = {"kind": p.kind, "params": json.loads(json.dumps(p.params))}  # as the store writes them (tuples as lists)
+        want = {"kind": p.kind, "params": _as_stored(p.params)}
         if want != {"kind": u["kind"], "params": u["params"]}:
             differ = first_difference("unit", {"kind": u["kind"], "params": u["params"]}, want)
             raise NeurohoverError(
@@ -230,6 +270,8 @@ def checked_experiment(store: Store, name: str, scale: str) -> tuple[ExperimentC
     try:
         _check_hashes(store, name, scale, stored, config)
         made = _check_planned(store, config, units)
+    except UnregisteredAgentError as err:  # not damage: this process lacks the agent (T60-B04)
+        raise NeurohoverError(f"results store {str(store.path)!r}, experiment {name} ({scale}): {err}") from None
     except NeurohoverError as err:
         raise NeurohoverError(f"{where}: {err}") from None
     if contradicted:

@@ -7,6 +7,8 @@ from __future__ import annotations
 import hashlib
 import json
 import shlex
+from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
 from ..agents.registry import agent_spec
 from ..errors import NeurohoverError
@@ -14,6 +16,9 @@ from ..filekinds import refuse_unencodable
 from ..policysets import load_policy_set
 from .schema import DIR_SOURCE
 from .units import family_of, policy_dict
+
+if TYPE_CHECKING:
+    from .stored_agents import StoredAgent
 
 #: What each setting naming a policy source takes besides 'shipped' and a directory (the message names the setting given).
 _SOURCE_WORDS = {"policies": "'evolve', ", "generic": "'evolve', 'baseline', ", "robustness_policies": ""}
@@ -38,14 +43,16 @@ def load_external(task: str, source: str, key: str = "policies"):
     return load_policy_set(task, None if source == "shipped" else folder)
 
 
-def external_digest(kind: str, s: dict) -> str:
-    """Digest of policies a config reads from a directory (so results never mix policy sets)."""
+def external_digest(kind: str, s: dict, unregistered: Mapping[str, StoredAgent] | None = None, flies: bool | None = None) -> str:
+    """Digest of policies a config reads from a directory (so results never mix policy sets). ``unregistered``: its
+    agents this process has not registered, as a store shows them (:func:`~.stored_agents.stored_agents`); ``flies``:
+    whether its units fly the set, where that is known otherwise (None: as its agents' needs say)."""
     key = _SOURCE_KEYS.get(kind, "policies")
     source = s.get(key)
     payload: dict = {}
     if source not in (None, "evolve", "baseline"):
         ps = load_external(s["task"], source, key)  # read even where unflown: a directory that is none is named
-        if _flies_set(kind, s):
+        if _flies_set(kind, s, unregistered) if flies is None else flies:
             payload = {
                 "generic": policy_dict(ps.generic),
                 "specialised": [policy_dict(p) for p in ps.specialised],
@@ -60,13 +67,13 @@ def external_digest(kind: str, s: dict) -> str:
     return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
 
 
-def _flies_set(kind: str, s: dict) -> bool:
+def _flies_set(kind: str, s: dict, unregistered: Mapping[str, StoredAgent] | None = None) -> bool:
     """Whether a config's units fly policies of the set its policy source names: test runs whose every group is
     baseline fly none, and their results do not depend on the set's files (T35-A02: they were refused once it changed)."""
     if kind != "test_runs":
         return True
     family = family_of(s["task"], s.get("sigma"))  # what a set holds depends on the task alone, not its sensors
-    return bool(policy_needs(family, [g["agent"] for g in s["groups"]]))
+    return bool(policy_needs(family, [g["agent"] for g in s["groups"]], unregistered))
 
 
 def dir_champions(source: str) -> list[tuple[str, dict]]:
@@ -83,11 +90,12 @@ def dir_champions(source: str) -> list[tuple[str, dict]]:
     return [(f"{source}/{f.name}", policy_dict(load_policy(f))) for f in files]
 
 
-def policy_needs(family, agents: list[str]) -> set[str]:
-    """The kinds of policy (generic, specialised, safe, ...) that ``agents`` fly of ``family``'s policy set."""
+def policy_needs(family, agents: list[str], unregistered: Mapping[str, StoredAgent] | None = None) -> set[str]:
+    """The kinds of policy (generic, specialised, safe, ...) that ``agents`` fly of ``family``'s policy set (those of
+    ``unregistered`` as a store shows them: :func:`~.stored_agents.stored_agents`)."""
     needs: set[str] = set()
     for agent in agents:
-        spec = agent_spec(agent)
+        spec = (unregistered or {}).get(agent) or agent_spec(agent)
         needs |= spec.needs
         if family.generic_over_distribution and spec.generic_kind is not None:
             needs.add(spec.generic_kind)

@@ -19,6 +19,7 @@ Unit keys (unique within an experiment)::
 from __future__ import annotations
 
 import functools
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -38,6 +39,7 @@ from .external import dir_champions, load_external, policy_needs
 from .keys import UnitKey
 from .schema import DIR_SOURCE, POLICY_SET_GROUP, variant_optimizer
 from .settings import EvolutionSettings, ExperimentSettings, Group, ModelLearningSettings, TestRunsSettings
+from .stored_agents import StoredAgent, UnregisteredAgentError
 from .units import Unit, family_of, policy_dict, unit_seed
 
 _SAMPLE_TAG = 0x5A3
@@ -238,14 +240,16 @@ class _Policies:
     policy set directory, or drawn from another experiment's champions (``generics_from``).
     ``get`` returns None while the units they come from are unfinished."""
 
-    def __init__(self, cfg: ExperimentConfig, results: dict, sources: dict[str, dict] | None = None) -> None:
-        self.cfg, self.results = cfg, results
+    def __init__(
+        self, cfg: ExperimentConfig, results: dict, sources: dict[str, dict] | None = None, unregistered: Mapping[str, StoredAgent] | None = None
+    ) -> None:
+        self.cfg, self.results, self.unregistered = cfg, results, unregistered or {}
         s = cfg.typed
         assert isinstance(s, TestRunsSettings)
         self.settings = s
         self.task = s.task
         self.family = family_of(s.task, s.sigma, s.sensor)
-        self.needs = needs = policy_needs(self.family, [g.agent for g in s.groups])
+        self.needs = needs = policy_needs(self.family, [g.agent for g in s.groups], self.unregistered)
         self.units: list[Unit] = []
         self.total = 0
         self.external = None if s.policies == "evolve" else load_external(self.task, s.policies)
@@ -256,6 +260,9 @@ class _Policies:
                     f'generics_per_agent = {s.generics_per_agent} needs policies = "evolve"'
                 )
             return
+        hidden = [a for a in self.unregistered.values() if not a.shown]
+        if hidden:  # the policy units planned below depend on what it flies (T60-B04)
+            raise UnregisteredAgentError(hidden[0].unplannable())
         budget = s.policy_budget
         roles = policy_set_roles(self.family)  # the policies of the task's set, as build-policies evolves them
         if not self.family.generic_over_distribution:
@@ -323,7 +330,7 @@ class _Policies:
 
     def for_agent(self, agent: str, mdp_index: int | None, run_counter: int, exclude_own: bool, key: str = "") -> dict | None:
         """The policies of one run of ``agent``, unit ``key`` (None: not ready yet)."""
-        spec = agent_spec(agent)
+        spec = self.unregistered.get(agent) or agent_spec(agent)
         need = spec.needs
         out: dict = {}
         ext = self.external
@@ -393,8 +400,10 @@ def group_hybrid_settings(group: Group) -> dict | None:
     return HybridSettings.from_dict(group.hybrid).to_dict() if group.agent in HYBRID_AGENTS else None
 
 
-def _plan_test_runs(cfg: ExperimentConfig, results: dict, sources: dict[str, dict] | None = None) -> Plan:
-    pol = _Policies(cfg, results, sources)
+def _plan_test_runs(
+    cfg: ExperimentConfig, results: dict, sources: dict[str, dict] | None = None, unregistered: Mapping[str, StoredAgent] | None = None
+) -> Plan:
+    pol = _Policies(cfg, results, sources, unregistered)
     s = pol.settings
     units = list(pol.units)
     total = pol.total
@@ -523,7 +532,7 @@ def _results_table(value) -> bool:
     return isinstance(value, dict) and all(isinstance(k, str) and isinstance(v, dict) for k, v in value.items())
 
 
-def _check_plan_arguments(cfg, results, sources) -> None:
+def _check_plan_arguments(cfg, results, sources, unregistered) -> None:
     """:func:`plan`'s arguments of the right kinds (None, [] or a config of None were AttributeErrors; fourteenth trial, T14-23)."""
     if not isinstance(cfg, ExperimentConfig):
         raise NeurohoverError(f"plan: cfg = {brief(cfg)} is not allowed: give an experiment's config, load_config(NAME, SCALE)")
@@ -533,13 +542,22 @@ def _check_plan_arguments(cfg, results, sources) -> None:
         raise NeurohoverError(
             f"plan: sources = {brief(sources)} is not allowed: give None or a dict of experiment name -> its results (unit key -> result dict)"
         )
+    if unregistered is not None and not (isinstance(unregistered, Mapping) and all(isinstance(a, StoredAgent) for a in unregistered.values())):
+        raise NeurohoverError(f"plan: unregistered = {brief(unregistered)} is not allowed: give None or a dict of agent name -> StoredAgent (stored_agents)")
 
 
-def plan(cfg: ExperimentConfig, results: dict[str, dict], sources: dict[str, dict[str, dict]] | None = None) -> Plan:
+def plan(
+    cfg: ExperimentConfig,
+    results: dict[str, dict],
+    sources: dict[str, dict[str, dict]] | None = None,
+    unregistered: Mapping[str, StoredAgent] | None = None,
+) -> Plan:
     """Every unit that can be defined given ``results`` (key -> result) and the results of the
     experiments it draws from (``sources``: name -> results, :func:`source_experiments`), and the
-    final unit count."""
-    _check_plan_arguments(cfg, results, sources)
+    final unit count. ``unregistered``: the agents of a stored config that this process has not
+    registered, as the store shows them (:func:`~.stored_agents.stored_agents`; T60-B04); an agent
+    neither registered nor among them is refused by name."""
+    _check_plan_arguments(cfg, results, sources, unregistered)
     if cfg.kind == "test_runs":
-        return _plan_test_runs(cfg, results, sources)
+        return _plan_test_runs(cfg, results, sources, unregistered)
     return _PLANNERS[cfg.kind](cfg, results)

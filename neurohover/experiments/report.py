@@ -23,7 +23,8 @@ from ..errors import NeurohoverError, OutputError, brief, check_flag
 from ..filekinds import REPORT_HEADER, REPORT_KIND
 from ..plots import house_style
 from .config import ORDER, ExperimentConfig, check_paper_table, shipped_counterpart, with_shipped_paper
-from .export import checked_units
+from .export import checked_experiment, stored_plan
+from .plans import Plan
 from .report_claims import PAPER_FIGURES, DiscussionError, claims_section, conclusions_discussion, read_discussion
 from .report_evolution import EvolutionSection
 from .report_factorial import FitFactorial
@@ -56,7 +57,7 @@ _SETTING_KEYS = (
 )
 
 
-def _header(cfg: ExperimentConfig, store: Store, units: list[dict], total: int | None) -> str:
+def _header(cfg: ExperimentConfig, store: Store, units: list[dict], total: int | None, unknown: str = "") -> str:
     done = len(units)
     sessions = store.sessions(cfg.name, cfg.scale)
     wall = sum(s["wall_seconds"] for s in sessions)
@@ -66,7 +67,10 @@ def _header(cfg: ExperimentConfig, store: Store, units: list[dict], total: int |
     settings = ", ".join(f"{k} = {cfg.settings[k]}" for k in _SETTING_KEYS if cfg.settings.get(k) not in (None, ""))
     if cfg.kind == "test_runs":
         settings += "; " + ", ".join(f"{g.label}: {g.n_mdps} {g.mdps} MDPs x {g.runs_per_mdp}" for g in getattr(cfg.typed, "groups", ()))
-    status = "complete" if total is not None and done >= total else f"INCOMPLETE ({done} of {total} units)"
+    if total is None:  # it read "INCOMPLETE (1 of None units)", naming neither (T60-B05)
+        status = f"of a total this process cannot count: it cannot plan the experiment again ({unknown})"
+    else:
+        status = "complete" if done >= total else f"INCOMPLETE ({done} of {total} units)"
     return (
         f"- Paper: {cfg.paper_ref or 'n/a'}\n"
         f"- Scale: **{cfg.scale}** ({scale_note(cfg)}); config hash `{cfg.hash}`\n"
@@ -80,18 +84,13 @@ def _header(cfg: ExperimentConfig, store: Store, units: list[dict], total: int |
 def _section(cfg: ExperimentConfig, store: Store, out: Path, current: bool | None, scale: str) -> tuple[str, list[dict[str, str]], Status]:
     """The section of one stored experiment at the store row's ``scale`` (``current``: whether its shipped config still hashes as stored, for the
     status table; None: not a shipped config, or not paper scale)."""
-    from .plans import plan
-
-    _, units, results = checked_units(store, cfg.name, scale)  # results' check (the row's scale: T21-01), and its messages
-    try:
-        total = plan(cfg, {u["key"]: u["result"] for u in units}).total
-    except NeurohoverError:
-        total = None
+    _, units, results, made = checked_experiment(store, cfg.name, scale)  # results' check (the row's scale: T21-01), and its messages
+    total, unknown = _total(cfg, units, made)
     kind = _SECTIONS[cfg.kind]
     if isinstance(cfg.typed, ModelLearningSettings):
         kind = SensorModels if cfg.typed.conditions else FitFactorial if cfg.typed.fits else kind
     sec = kind(cfg, results, store, out)
-    text = [f"## {cfg.title} [{cfg.scale}]\n", _header(cfg, store, units, total)]
+    text = [f"## {cfg.title} [{cfg.scale}]\n", _header(cfg, store, units, total, unknown)]
     figure = sec.figure()
     if figure:
         text.append(f"![{cfg.title}]({figure})\n")
@@ -115,6 +114,17 @@ def _section(cfg: ExperimentConfig, store: Store, out: Path, current: bool | Non
     wall, unit_time, cores = sum(s["wall_seconds"] for s in sessions), sum(u["seconds"] for u in units), tuple(sorted({s["cores"] for s in sessions}))
     status = Status(cfg.name, cfg.title, cfg.scale, len(units), total, wall, unit_time, cores, current=current)
     return "\n".join(text), sec.claims, status
+
+
+def _total(cfg: ExperimentConfig, units: list[dict], made: Plan | None) -> tuple[int | None, str]:
+    """The experiment's unit count: that of the plan its check made, else of one made here (its agents this process
+    has not registered as the store shows them: T60-B05); None and why where none can be made (a policy directory gone)."""
+    if made is not None:
+        return made.total, ""
+    try:
+        return stored_plan(cfg, units).total, ""
+    except NeurohoverError as err:
+        return None, str(err)
 
 
 def _discussion(cfg: ExperimentConfig, out: Path) -> str:
