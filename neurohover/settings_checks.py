@@ -6,7 +6,8 @@ list or tuple field too (T58-B04).
 
 The rule (T60-B01..B03): every settings value, whatever its field's annotation (``dict``, ``Any``, ``frozenset``, none),
 is a plain JSON value once made plain: None, a bool, an int, a finite float, a text, or a list or tuple of them or a
-table with text keys of them, at any depth; NumPy's scalars and arrays (1-d or more) are read as their plain values
+table with text keys of them, nested at most :data:`~neurohover.jsontext.MAX_NOTE_DEPTH` (100) deep and holding no
+list or table that holds it (T61-B01); NumPy's scalars and arrays (1-d or more) are read as their plain values
 and items, as a typed field's are (:func:`_plain_item`). Anything else (a set, a frozenset, an object, a table with
 other keys, NaN anywhere) is refused by name, as a given value and as a default: settings are recorded as JSON, and
 json's TypeError came once the run had begun. A field annotated as a dataclass (HybridSettings' DangerousState) also
@@ -24,6 +25,7 @@ import sys
 from typing import Any, NamedTuple
 
 from .errors import NeurohoverError, brief, finite_real, key_text, real_number, setting_float, unknown_keys, whole_number
+from .jsontext import MAX_NOTE_DEPTH
 
 __all__ = ["checked_settings", "plain_settings", "setting_type_problem", "settings_defaults_problem", "settings_from_dict"]
 
@@ -251,16 +253,19 @@ def _as_sequence(value: object) -> list | tuple | None:
 
 
 class _Refused(Exception):
-    """An item of a list or tuple setting that is no value its field takes (``item``, for the message)."""
+    """An item of a list or tuple setting that is no value its field takes (``item``, for the message), or ``why`` a
+    value is refused whole (nested too deep, or holding itself)."""
 
-    def __init__(self, item: object) -> None:
+    def __init__(self, item: object, why: str = "") -> None:
         super().__init__()
         self.item = item
+        self.why = why
 
 
-def _plain_item(items: tuple[type, ...] | None, item: object) -> object:
+def _plain_item(items: tuple[type, ...] | None, item: object, path: tuple[int, ...] = ()) -> object:
     """``item`` of a list or tuple setting as its plain Python value: one of ``items`` read as :func:`_plain` reads it, or
-    (``items`` None) any JSON value, NumPy's made plain, lists and text-keyed tables of them item by item; else :class:`_Refused`."""
+    (``items`` None) any JSON value, NumPy's made plain, lists and text-keyed tables of them item by item; else :class:`_Refused`.
+    ``path``: the ids of the lists and tables that hold ``item``, outermost first."""
     if items is not None:
         if not _takes(items, item):
             raise _Refused(item)
@@ -268,19 +273,27 @@ def _plain_item(items: tuple[type, ...] | None, item: object) -> object:
     if item is None or isinstance(item, str) or _is_bool(item) or real_number(item):
         return _plain((bool, int, float, str, type(None)), item)
     inner = _as_sequence(item)
+    table = isinstance(item, dict) and all(isinstance(key, str) for key in item)
+    if inner is None and not table:
+        raise _Refused(item)
+    # checked before going in: 500 levels, or a list holding itself, was a raw RecursionError (T61-B01)
+    if id(item) in path:
+        raise _Refused(item, "it holds itself (a list or table inside its own), which JSON cannot write")
+    if len(path) >= MAX_NOTE_DEPTH:
+        raise _Refused(item, f"it is nested more than {MAX_NOTE_DEPTH} lists or tables deep")
+    inside = (*path, id(item))
     if inner is not None:
-        plain = [_plain_item(None, x) for x in inner]
+        plain = [_plain_item(None, x, inside) for x in inner]
         return tuple(plain) if isinstance(inner, tuple) else plain
-    if isinstance(item, dict) and all(isinstance(key, str) for key in item):
-        return {key: _plain_item(None, x) for key, x in item.items()}
-    raise _Refused(item)
+    mapping: Any = item
+    return {key: _plain_item(None, x, inside) for key, x in mapping.items()}
 
 
 def _plain_sequence(kind: _Sequence, value: object) -> list | tuple:
     """``value`` (which :func:`_sequence_problem` took) as its field's container of plain Python values: a tuple given
     for a list field is a list, as JSON reads it back (and a list for a tuple field a tuple)."""
     container, items, _, _ = kind
-    plain = [_plain_item(items, item) for item in _as_sequence(value) or ()]
+    plain = [_plain_item(items, item, (id(value),)) for item in _as_sequence(value) or ()]
     return tuple(plain) if container is tuple else plain
 
 
@@ -299,7 +312,7 @@ def _sequence_problem(kind: _Sequence, value: object) -> str:
     try:
         _plain_sequence(kind, value)
     except _Refused as refused:
-        return f"it holds {brief(refused.item)}: {give}"
+        return refused.why or f"it holds {brief(refused.item)}: {give}"
     return ""
 
 
@@ -313,6 +326,8 @@ def _json_problem(value: object) -> str:
     try:
         _plain_item(None, value)
     except _Refused as refused:
+        if refused.why:
+            return refused.why
         return f"give {_JSON_VALUE}" if refused.item is value else f"it holds {brief(refused.item)}: give {_JSON_VALUE}"
     return ""
 

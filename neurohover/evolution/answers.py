@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import NeurohoverError, brief, finite_real, masked_note, real_number, refused_signature
+from ..jsontext import MAX_NOTE_DEPTH
 from ..sim.constants import lowest_return
 from .common import STATE_DAMAGE, Optimiser, enc_float
 from .records import decode_history
@@ -26,6 +27,7 @@ __all__ = [
     "check_restored",
     "check_round_trip",
     "check_state_json",
+    "check_state_nesting",
     "checked_champion",
     "checked_champion_genome",
     "held_champion",
@@ -250,7 +252,9 @@ def stopped(opt: Optimiser, optimizer: str) -> bool:
 
 def check_state_json(state: Any, optimizer: str) -> None:
     """NeurohoverError naming the first entry of optimiser state ``state`` that strict JSON cannot write (an np.float32,
-    an array, NaN): ``state_dict()`` returns a plain JSON-serialisable snapshot (:class:`~.common.Optimiser`)."""
+    an array, NaN, a list that holds itself), or a state nested too deep (:func:`check_state_nesting`): ``state_dict()``
+    returns a plain JSON-serialisable snapshot (:class:`~.common.Optimiser`)."""
+    check_state_nesting(state, optimizer)  # first: the walk below recurses, and is bounded only once this has passed
     where = _unwritable(state, "")
     if where is not None:
         at, value = where
@@ -262,14 +266,82 @@ def check_state_json(state: Any, optimizer: str) -> None:
         )
 
 
-def _unwritable(value: Any, at: str, writable: bool | None = None, within: tuple[int, ...] = ()) -> tuple[str, Any] | None:
+def check_state_nesting(state: Any, optimizer: str) -> None:
+    """NeurohoverError where optimiser state ``state`` holds a list or table that holds itself, or nests lists and tables
+    (itself counted) more than :data:`~neurohover.jsontext.MAX_NOTE_DEPTH` deep: a state 900 deep was written, and its
+    checkpoint then failed to resume, a RecursionError in copying it; 5,000 deep was one in this check (T61-B02, B03).
+    Measured without recursion, each list or table once."""
+    found = _deepest(state)
+    if found is None:
+        return
+    keys, depth = found
+    if depth is None:
+        raise NeurohoverError(
+            f"optimizer {brief(optimizer)}: its state_dict() entry {_path_text(keys)} (a list or table that holds itself, which JSON cannot write) "
+            "is not allowed: a checkpoint is strict JSON, so state_dict() gives plain numbers, text, lists and tables, none holding itself"
+        )
+    if depth > MAX_NOTE_DEPTH:
+        raise NeurohoverError(
+            f"optimizer {brief(optimizer)}: its state_dict() is nested {depth:,} lists or tables deep (the state counted; deepest under entry "
+            f"{_path_text(keys)}), which is not allowed: at most {MAX_NOTE_DEPTH}, so that a run resumes from its checkpoint "
+            "(a state much deeper cannot be copied or read back)"
+        )
+
+
+def _path_text(keys: list[Any]) -> str:
+    """The entry at path ``keys`` as ``['a'][0]``, its first levels only where it is long."""
+    shown = "".join(f"[{k!r}]" if isinstance(k, (str, int)) else f"[{brief(k)}]" for k in keys[:6])
+    return shown + (f"... ({len(keys):,} levels down)" if len(keys) > 6 else "") if keys else "(the whole state)"
+
+
+def _deepest(value: Any) -> tuple[list[Any], int | None] | None:
+    """The path to the deepest point of ``value`` and how many lists, tuples and tables nest there (itself counted), or the
+    path to a list or table that holds itself and None; None where ``value`` is none of those. Without recursion (a
+    state 5,000 deep was a RecursionError here, T61-B03); a list or table held twice is measured once."""
+    if not isinstance(value, (list, tuple, dict)):
+        return None
+    heights: dict[int, tuple[int, Any]] = {}  # id -> (its depth, the key of its deepest child; None: no list below)
+    frames: list[list[Any]] = [[value, iter(_items(value)), 1, None]]  # container, its items left, its depth so far, its deepest key
+    path: list[Any] = []
+    on_path = {id(value)}
+    while frames:
+        frame = frames[-1]
+        for key, item in frame[1]:
+            if not isinstance(item, (list, tuple, dict)):
+                continue
+            if id(item) in on_path:
+                return [*path, key], None
+            if id(item) not in heights:
+                frames.append([item, iter(_items(item)), 1, None])
+                path.append(key)
+                on_path.add(id(item))
+                break
+            if heights[id(item)][0] + 1 > frame[2]:
+                frame[2], frame[3] = heights[id(item)][0] + 1, key
+        else:
+            frames.pop()
+            on_path.discard(id(frame[0]))
+            heights[id(frame[0])] = (frame[2], frame[3])
+            if frames:
+                key = path.pop()
+                if frame[2] + 1 > frames[-1][2]:
+                    frames[-1][2], frames[-1][3] = frame[2] + 1, key
+    keys, node = [], value
+    while heights[id(node)][1] is not None:  # down the deepest children
+        keys.append(heights[id(node)][1])
+        node = node[keys[-1]]
+    return keys, heights[id(value)][0]
+
+
+def _items(value: list | tuple | dict) -> Any:
+    return value.items() if isinstance(value, dict) else enumerate(value)
+
+
+def _unwritable(value: Any, at: str, writable: bool | None = None) -> tuple[str, Any] | None:
     """Where in ``value`` (its path from ``at``, and what is there) strict JSON cannot write, or writes as another value
     (a key that is no text comes back as text, a tuple as a list: T52-B17), or None where it writes ``value`` as it is.
-    ``writable``: whether ``json.dumps`` writes it (None: not yet asked); ``within``: the ids of the lists and tables
-    that hold it (a state that holds itself was followed without end)."""
-    if id(value) in within:
-        return f"{at} (a list or table that holds itself, which JSON cannot write)", value
-    within = (*within, id(value)) if isinstance(value, (dict, list)) else within
+    ``writable``: whether ``json.dumps`` writes it (None: not yet asked). ``value`` holds no list or table that holds
+    itself, and nests at most :data:`~neurohover.jsontext.MAX_NOTE_DEPTH` deep (:func:`check_state_nesting` ran first)."""
     if writable is None:
         try:
             json.dumps(value, allow_nan=False)
@@ -282,12 +354,12 @@ def _unwritable(value: Any, at: str, writable: bool | None = None, within: tuple
         for key, item in value.items():
             if not isinstance(key, str):
                 return f"{at}[{brief(key)}] (a key that is no text, which JSON writes as text)", key
-            found = _unwritable(item, f"{at}[{key!r}]", True if writable else None, within)
+            found = _unwritable(item, f"{at}[{key!r}]", True if writable else None)
             if found is not None:
                 return found
     elif isinstance(value, list):
         for i, item in enumerate(value):
-            found = _unwritable(item, f"{at}[{i}]", True if writable else None, within)
+            found = _unwritable(item, f"{at}[{i}]", True if writable else None)
             if found is not None:
                 return found
     elif not writable:

@@ -33,6 +33,7 @@ from .answers import (
     check_made,
     check_restored,
     check_state_json,
+    check_state_nesting,
     checked_champion,
     checked_champion_genome,
     held_champion,
@@ -481,6 +482,7 @@ class Run:
         """Write the checkpoint after ``wall`` seconds; an optimiser state JSON cannot write refused by its key (T40-B06)."""
         state = self.state(wall)
         refuse_replaced(path, state)  # a policy file a progress callback saved there (T47-B13)
+        check_state_nesting(state["optimizer_state"], self.cfg.optimizer)  # a state turned 900 deep was written, and never resumed (T61-B02)
         try:
             write_checkpoint(path, state)
         except (TypeError, ValueError) as err:

@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import NeurohoverError, brief, frozen_dataclass_class, refused_signature, registry_entry_problem
+from ...errors import NeurohoverError, brief, frozen_dataclass_class, refused_signature, registry_entry_problem, whole_number
 from ...settings_checks import checked_settings, settings_defaults_problem, settings_from_dict
 
 __all__ = [
@@ -152,7 +152,7 @@ def entry_problem(name: object, spec: object) -> str:
 
 
 def _parts_problem(entry: str, spec: OptimiserSpec) -> str:
-    """What is wrong with a run-time spec's make, settings, stops_itself and stop_reason ('' when nothing): a make of
+    """What is wrong with a run-time spec's make, settings, min_genes, stops_itself and stop_reason ('' when nothing): a make of
     the wrong arity or none was a TypeError at the run's start, a settings class that is no frozen dataclass or has a
     default JSON cannot write one in its config (or a NaN or wrong-type one, T56-B01), a truthy stops_itself='no' ran without a budget for ever, and a
     stop_reason 'budget' recorded a run its optimiser stopped as one its budget stopped (T52-B08, B09, B11)."""
@@ -173,6 +173,8 @@ def _parts_problem(entry: str, spec: OptimiserSpec) -> str:
     defaults = settings_defaults_problem(cls)
     if defaults:
         return f"{entry}: its settings {defaults}"
+    if not whole_number(spec.min_genes) or spec.min_genes < 1:  # '40' and None were a TypeError, NaN no minimum at all (T61-B04)
+        return f"{entry}: its min_genes {brief(spec.min_genes)} is no whole number >= 1: give the fewest genes a genome it searches may have (1: any)"
     if not isinstance(spec.stops_itself, (bool, np.bool_)):
         return f"{entry}: its stops_itself {brief(spec.stops_itself)} is no bool: give True (its stop() can end a run) or False (it needs a budget)"
     reason = spec.stop_reason
