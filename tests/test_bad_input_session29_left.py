@@ -54,3 +54,18 @@ def test_a_drift_text_of_an_unknown_key_names_walk_among_what_is_allowed() -> No
 
     with _refused_with("drift 'WALK=0.01': 'WALK' is not walk and not a dynamics parameter; allowed walk=STD and C_u, C_v"):
         Drift.parse("WALK=0.01")
+
+
+def test_a_drift_walk_in_runs_of_one_episode_is_refused(tmp_path: Path) -> None:
+    """T61-A01: walk=0.5 with one episode a run was stored as drifting and flew fixed dynamics (episode 0 flies the MDP
+    as given); a walk in runs of two episodes is taken."""
+    from neurohover.compete import compete
+    from neurohover.tasks.drift import Drift
+
+    walk = Drift.parse("walk=0.5")
+    with _refused_with("drift walk=0.5 drifts nothing in a test run of 1 episode"):
+        walk.check_run(1)
+    walk.check_run(2)
+    with _refused_with("drifts nothing in a test run of 1 episode"):
+        compete("ghh08", "baseline", runs=1, episodes=1, n_steps=20, out=tmp_path / "c", drift=walk)
+    assert not (tmp_path / "c").exists() or not any((tmp_path / "c").iterdir())

@@ -136,11 +136,17 @@ class Drift:
         object.__setattr__(self, "change_at", (lo, hi))
 
     def check_run(self, episodes: int, where: str = "", *, at_given: bool | None = None, config: bool = False) -> None:
-        """Refuse an abrupt change that some test runs of ``episodes`` episodes would never reach (``where``: a prefix naming
+        """Refuse a walk in runs of one episode, which it never reaches, and an abrupt change that some test runs of
+        ``episodes`` episodes would never reach (``where``: a prefix naming
         the run). ``at_given``: whether change_at was given (False: the default; None: not known, the default assumed where
         it is the default's value); ``config``: given in a config's drift table, so its example is a TOML change_at, not the
         command line's @LO-HI (T27-A08)."""
         episodes = _whole("episodes", episodes, "a whole number of episodes >= 1", 1)  # 0 suggested the window 0..-1 (thirteenth trial)
+        if self.walk > 0 and episodes == 1:  # stored as drifting, flown as fixed: episode 0 flies the MDP as given (T61-A01)
+            raise NeurohoverError(
+                f"{where + ': ' if where else ''}drift walk={self.walk:g} drifts nothing in a test run of 1 episode (its first episode "
+                "flies the MDP as given): give 2 or more episodes, or leave the walk out"
+            )
         if self.change and self.change_at[1] >= episodes:
             lo, hi = self.change_at
             default = not at_given if at_given is not None else (lo, hi) == CHANGE_AT
